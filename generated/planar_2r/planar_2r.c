@@ -609,7 +609,7 @@ planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_T
 
 void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF], int valid[PLANAR_2R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_2R_MAX_IK_SOLUTIONS])
 {
-    /* 67 operations */
+    /* 56 operations */
 
     /* Inputs */
     const planar_2r_real mu0 = mu[0];
@@ -618,38 +618,36 @@ void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2
     /* Intermediate terms */
     const planar_2r_real t0 = (mu0*mu0) + (mu1*mu1);
     const planar_2r_real t1 = 0.5*(2 - t0);
-    const planar_2r_real t2 = mu0 + mu1;
-    const planar_2r_real t3 = (t1*t1);
-    const planar_2r_real t4 = 1 - t3;
-    const int t5 = t4 > 1e-12;
-    const planar_2r_real t6 = (t5 ? t1 : (t1 > 0 ? 1 : -1));
-    const planar_2r_real t7 = (t5 ? sqrt(t4) : 0);
-    const planar_2r_real t8 = atan2(t7, t6);
-    const planar_2r_real t9 = 3.141592653589793 - t8;
-    const planar_2r_real t10 = 3.141592653589793 + t8;
-    const planar_2r_real t11 = -t7;
-    const planar_2r_real t12 = -t6;
-    const planar_2r_real t13 = t12;
-    const planar_2r_real t14 = 1 + t13;
-    const planar_2r_real t15 = mu1*t11 + mu0*t14;
-    const planar_2r_real t16 = mu1*t14 - mu0*t11;
-    const planar_2r_real t17 = (t15*t15) + (t16*t16);
-    const planar_2r_real t18 = (t11*t11) + (t14*t14);
-    const planar_2r_real t19 = 1 + t12;
-    const planar_2r_real t20 = mu1*t7 + mu0*t19;
-    const planar_2r_real t21 = mu1*t19 - mu0*t7;
-    const planar_2r_real t22 = (t20*t20) + (t21*t21);
-    const planar_2r_real t23 = (t7*t7) + (t19*t19);
-    const planar_2r_real t24 = 1e-24*t0;
-    const int t25 = isfinite(t2);
+    const planar_2r_real t2 = 1 - (t1*t1);
+    const planar_2r_real t3 = mu0 + mu1;
+    const int t4 = t2 > 1e-12;
+    const planar_2r_real t5 = (t4 ? t1 : (t1 > 0 ? 1 : -1));
+    const planar_2r_real t6 = (t4 ? sqrt(t2) : 0);
+    const planar_2r_real t7 = atan2(t6, t5);
+    const planar_2r_real t8 = 3.141592653589793 + t7;
+    const planar_2r_real t9 = 3.141592653589793 - t7;
+    const planar_2r_real t10 = 1 - t5;
+    const planar_2r_real t11 = (t6*t6) + (t10*t10);
+    const planar_2r_real t12 = mu0*t10;
+    const planar_2r_real t13 = mu1*t6;
+    const planar_2r_real t14 = t12 - t13;
+    const planar_2r_real t15 = t12 + t13;
+    const planar_2r_real t16 = mu1*t10;
+    const planar_2r_real t17 = mu0*t6;
+    const planar_2r_real t18 = t16 + t17;
+    const planar_2r_real t19 = (t14*t14) + (t18*t18);
+    const planar_2r_real t20 = t16 - t17;
+    const planar_2r_real t21 = (t15*t15) + (t20*t20);
+    const planar_2r_real t22 = 1e-24*t0*t11;
+    const int t23 = isfinite(t3);
 
     /* Outputs */
-    q[0] = (t17 <= t24*t18 ? 0 : atan2(t16, t15));
-    q[1] = t10 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t10));
-    q[2] = (t22 <= t24*t23 ? 0 : atan2(t21, t20));
-    q[3] = -6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t9)) + t9;
-    valid[0] = t25 && t4 >= -1e-12;
-    valid[1] = t25 && t5;
+    q[0] = (t19 <= t22 ? 0 : atan2(t18, t14));
+    q[1] = t8 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t8));
+    q[2] = (t21 <= t22 ? 0 : atan2(t20, t15));
+    q[3] = t9 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t9));
+    valid[0] = t23 && t2 >= -1e-12;
+    valid[1] = t23 && t4;
     in_limits[0] = 1;
     in_limits[1] = 1;
 }
@@ -681,11 +679,11 @@ int planar_2r_ik_nearest(const planar_2r_real mu[PLANAR_2R_TASK_DIM], const plan
     /* Intermediate terms */
     const planar_2r_real t0 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0;
     const planar_2r_real t1 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1;
-    const planar_2r_real t2 = (lb0 && vb0 ? 1 : 0);
+    const planar_2r_real t2 = (vb0 && lb0 ? 1 : 0);
     const planar_2r_real t3 = (t2 > 0 ? 1 : 0);
     const planar_2r_real t4 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0;
     const planar_2r_real t5 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1;
-    const planar_2r_real t6 = (lb1 && vb1 ? 1 : 0);
+    const planar_2r_real t6 = (vb1 && lb1 ? 1 : 0);
     const planar_2r_real t7 = mu0 + mu1 + qn1 + qn2 + qw1 + qw2;
     const planar_2r_real t8 = -qn1;
     const planar_2r_real t9 = -qn2;
@@ -701,14 +699,14 @@ int planar_2r_ik_nearest(const planar_2r_real mu[PLANAR_2R_TASK_DIM], const plan
     const int t19 = t17 > 0;
     const planar_2r_real t20 = (t19 ? t4 : t13);
     const planar_2r_real t21 = (t19 ? t5 : t14);
-    const int t22 = isfinite(t7);
-    const int t23 = t18 > 0;
+    const int t22 = t18 > 0;
+    const int t23 = isfinite(t7);
     const int t24 = t22 && t23;
 
     /* Outputs */
     q[0] = (t24 ? t20 : qn1);
     q[1] = (t24 ? t21 : qn2);
-    return (!t22 ? 2 : (t23 ? 0 : 1));
+    return (!t23 ? 2 : (t22 ? 0 : 1));
 }
 
 int planar_2r_ik(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF])

@@ -626,45 +626,43 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 2 and 2 x 1 and 2 x 1), 67 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 2 and 2 x 1 and 2 x 1), 56 operations."""
     xp, dtype, device, batch, (mu,) = _arguments(("mu", mu, (2,)))
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
     t0 = mu0**2 + mu1**2
     t1 = 0.5*(2 - t0)
-    t2 = mu0 + mu1
-    t3 = t1**2
-    t4 = 1 - t3
-    t5 = xp.greater(t4, 1e-12)
-    t6 = xp.where(t5, t1, xp.where(xp.greater(t1, 0), xp.asarray(1, dtype=dtype), -1))
-    t7 = xp.where(t5, xp.sqrt(t4), 0)
-    t8 = xp.atan2(t7, t6)
-    t9 = 3.141592653589793 - t8
-    t10 = 3.141592653589793 + t8
-    t11 = -t7
-    t12 = -t6
-    t13 = t12
-    t14 = 1 + t13
-    t15 = mu1*t11 + mu0*t14
-    t16 = mu1*t14 - mu0*t11
-    t17 = t15**2 + t16**2
-    t18 = t11**2 + t14**2
-    t19 = 1 + t12
-    t20 = mu1*t7 + mu0*t19
-    t21 = mu1*t19 - mu0*t7
-    t22 = t20**2 + t21**2
-    t23 = t7**2 + t19**2
-    t24 = 1e-24*t0
-    t25 = xp.isfinite(t2)
+    t2 = 1 - t1**2
+    t3 = mu0 + mu1
+    t4 = xp.greater(t2, 1e-12)
+    t5 = xp.where(t4, t1, xp.where(xp.greater(t1, 0), xp.asarray(1, dtype=dtype), -1))
+    t6 = xp.where(t4, xp.sqrt(t2), 0)
+    t7 = xp.atan2(t6, t5)
+    t8 = 3.141592653589793 + t7
+    t9 = 3.141592653589793 - t7
+    t10 = 1 - t5
+    t11 = t6**2 + t10**2
+    t12 = mu0*t10
+    t13 = mu1*t6
+    t14 = t12 - t13
+    t15 = t12 + t13
+    t16 = mu1*t10
+    t17 = mu0*t6
+    t18 = t16 + t17
+    t19 = t14**2 + t18**2
+    t20 = t16 - t17
+    t21 = t15**2 + t20**2
+    t22 = 1e-24*t0*t11
+    t23 = xp.isfinite(t3)
     q = _stack(xp, [
-        xp.where(xp.less_equal(t17, t24*t18), 0, xp.atan2(t16, t15)),  # 0, 0
-        t10 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t10)),  # 0, 1
-        xp.where(xp.less_equal(t22, t24*t23), 0, xp.atan2(t21, t20)),  # 1, 0
-        -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t9)) + t9,  # 1, 1
+        xp.where(xp.less_equal(t19, t22), 0, xp.atan2(t18, t14)),  # 0, 0
+        t8 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t8)),  # 0, 1
+        xp.where(xp.less_equal(t21, t22), 0, xp.atan2(t20, t15)),  # 1, 0
+        t9 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t9)),  # 1, 1
     ], (2, 2))
     valid = _stack(xp, [
-        t25 & xp.greater_equal(t4, -1e-12),  # 0
-        t25 & t5,  # 1
+        t23 & xp.greater_equal(t2, -1e-12),  # 0
+        t23 & t4,  # 1
     ], (2,))
     in_limits = _stack(xp, [
         xp.full(batch, True, dtype=xp.bool, device=device),  # 0
@@ -694,11 +692,11 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     lb1 = branches_in_limits[..., 1]
     t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
     t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
-    t2 = xp.where(lb0 & vb0, xp.asarray(1, dtype=dtype), 0)
+    t2 = xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0)
     t3 = xp.where(xp.greater(t2, 0), xp.asarray(1, dtype=dtype), 0)
     t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
     t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
-    t6 = xp.where(lb1 & vb1, xp.asarray(1, dtype=dtype), 0)
+    t6 = xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0)
     t7 = mu0 + mu1 + qn1 + qn2 + qw1 + qw2
     t8 = -qn1
     t9 = -qn2
@@ -714,14 +712,14 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t19 = xp.greater(t17, 0)
     t20 = xp.where(t19, t4, t13)
     t21 = xp.where(t19, t5, t14)
-    t22 = xp.isfinite(t7)
-    t23 = xp.greater(t18, 0)
+    t22 = xp.greater(t18, 0)
+    t23 = xp.isfinite(t7)
     t24 = t22 & t23
     q = _stack(xp, [
         xp.broadcast_to(xp.where(t24, t20, qn1), batch),  # 0
         xp.broadcast_to(xp.where(t24, t21, qn2), batch),  # 1
     ], (2,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t22), 2, xp.where(t23, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t23), 2, xp.where(t22, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

@@ -465,43 +465,41 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 67 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 56 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     t0 = mu0**2 + mu1**2
     t1 = 0.5*(2 - t0)
-    t2 = mu0 + mu1
-    t3 = t1**2
-    t4 = 1 - t3
-    t5 = (t4 > 1e-12)
-    t6 = casadi.if_else(t5, t1, casadi.if_else((t1 > 0), 1, -1))
-    t7 = casadi.if_else(t5, casadi.sqrt(t4), 0)
-    t8 = casadi.atan2(t7, t6)
-    t9 = 3.141592653589793 - t8
-    t10 = 3.141592653589793 + t8
-    t11 = -t7
-    t12 = -t6
-    t13 = t12
-    t14 = 1 + t13
-    t15 = mu1*t11 + mu0*t14
-    t16 = mu1*t14 - mu0*t11
-    t17 = t15**2 + t16**2
-    t18 = t11**2 + t14**2
-    t19 = 1 + t12
-    t20 = mu1*t7 + mu0*t19
-    t21 = mu1*t19 - mu0*t7
-    t22 = t20**2 + t21**2
-    t23 = t7**2 + t19**2
-    t24 = 1e-24*t0
-    t25 = (casadi.fabs(t2) < casadi.inf)
+    t2 = 1 - t1**2
+    t3 = mu0 + mu1
+    t4 = (t2 > 1e-12)
+    t5 = casadi.if_else(t4, t1, casadi.if_else((t1 > 0), 1, -1))
+    t6 = casadi.if_else(t4, casadi.sqrt(t2), 0)
+    t7 = casadi.atan2(t6, t5)
+    t8 = 3.141592653589793 + t7
+    t9 = 3.141592653589793 - t7
+    t10 = 1 - t5
+    t11 = t6**2 + t10**2
+    t12 = mu0*t10
+    t13 = mu1*t6
+    t14 = t12 - t13
+    t15 = t12 + t13
+    t16 = mu1*t10
+    t17 = mu0*t6
+    t18 = t16 + t17
+    t19 = t14**2 + t18**2
+    t20 = t16 - t17
+    t21 = t15**2 + t20**2
+    t22 = 1e-24*t0*t11
+    t23 = (casadi.fabs(t3) < casadi.inf)
     q = casadi.SX(2, 2)
-    q[0, 0] = casadi.if_else((t17 <= t24*t18), 0, casadi.atan2(t16, t15))
-    q[0, 1] = t10 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t10))
-    q[1, 0] = casadi.if_else((t22 <= t24*t23), 0, casadi.atan2(t21, t20))
-    q[1, 1] = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t9)) + t9
+    q[0, 0] = casadi.if_else((t19 <= t22), 0, casadi.atan2(t18, t14))
+    q[0, 1] = t8 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t8))
+    q[1, 0] = casadi.if_else((t21 <= t22), 0, casadi.atan2(t20, t15))
+    q[1, 1] = t9 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t9))
     valid = casadi.SX(2, 1)
-    valid[0, 0] = casadi.logic_and(t25, (t4 >= -1e-12))
-    valid[1, 0] = casadi.logic_and(t25, t5)
+    valid[0, 0] = casadi.logic_and(t23, (t2 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(t23, t4)
     in_limits = casadi.SX(2, 1)
     in_limits[0, 0] = True
     in_limits[1, 0] = True
@@ -527,11 +525,11 @@ def _ik_nearest(mu, q_seed, weights):
     lb1 = branches_in_limits[1]
     t0 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
     t1 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
-    t2 = casadi.if_else(casadi.logic_and(lb0, vb0), 1, 0)
+    t2 = casadi.if_else(casadi.logic_and(vb0, lb0), 1, 0)
     t3 = casadi.if_else((t2 > 0), 1, 0)
     t4 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
     t5 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
-    t6 = casadi.if_else(casadi.logic_and(lb1, vb1), 1, 0)
+    t6 = casadi.if_else(casadi.logic_and(vb1, lb1), 1, 0)
     t7 = mu0 + mu1 + qn1 + qn2 + qw1 + qw2
     t8 = -qn1
     t9 = -qn2
@@ -547,14 +545,14 @@ def _ik_nearest(mu, q_seed, weights):
     t19 = (t17 > 0)
     t20 = casadi.if_else(t19, t4, t13)
     t21 = casadi.if_else(t19, t5, t14)
-    t22 = (casadi.fabs(t7) < casadi.inf)
-    t23 = (t18 > 0)
+    t22 = (t18 > 0)
+    t23 = (casadi.fabs(t7) < casadi.inf)
     t24 = casadi.logic_and(t22, t23)
     q = casadi.SX(2, 1)
     q[0, 0] = casadi.if_else(t24, t20, qn1)
     q[1, 0] = casadi.if_else(t24, t21, qn2)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t22), 2, casadi.if_else(t23, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t23), 2, casadi.if_else(t22, 0, 1))
     return [q, status]
 
 

@@ -825,7 +825,7 @@ planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_T
     const planar_3r_real t8 = c123 + t0 + t2;
     const planar_3r_real t9 = -t2 + mu0;
     const planar_3r_real t10 = -t3 + mu1;
-    const planar_3r_real t11 = qs1 + qs2 + qs3 + mu0 + mu1 + mu2;
+    const planar_3r_real t11 = qs1 + qs2 + qs3 + mu2 + mu0 + mu1;
     const planar_3r_real t12 = -mu2 + atan2(s123, c123);
     const planar_3r_real t13 = t12 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t12));
     const planar_3r_real t14 = (t9*t9) + (t10*t10) + (t13*t13);
@@ -883,7 +883,7 @@ planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_T
 
 void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF], int valid[PLANAR_3R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_3R_MAX_IK_SOLUTIONS])
 {
-    /* 88 operations */
+    /* 77 operations */
 
     /* Inputs */
     const planar_3r_real mu0 = mu[0];
@@ -897,46 +897,44 @@ void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3
     const planar_3r_real t3 = -t1 + mu1;
     const planar_3r_real t4 = (t2*t2) + (t3*t3);
     const planar_3r_real t5 = 0.5*(2 - t4);
-    const planar_3r_real t6 = mu0 + mu1 + mu2;
-    const planar_3r_real t7 = (t5*t5);
-    const planar_3r_real t8 = 1 - t7;
-    const int t9 = t8 > 1e-12;
-    const planar_3r_real t10 = (t9 ? t5 : (t5 > 0 ? 1 : -1));
-    const planar_3r_real t11 = (t9 ? sqrt(t8) : 0);
-    const planar_3r_real t12 = atan2(t11, t10);
-    const planar_3r_real t13 = 3.141592653589793 - t12;
-    const planar_3r_real t14 = 3.141592653589793 + t12;
-    const planar_3r_real t15 = -t11;
-    const planar_3r_real t16 = -t10;
-    const planar_3r_real t17 = t16;
-    const planar_3r_real t18 = 1 + t17;
-    const planar_3r_real t19 = t2*t18 + t3*t15;
-    const planar_3r_real t20 = t3*t18 - t2*t15;
-    const planar_3r_real t21 = (t19*t19) + (t20*t20);
-    const planar_3r_real t22 = (t18*t18) + (t15*t15);
-    const planar_3r_real t23 = 1 + t16;
-    const planar_3r_real t24 = t2*t23 + t3*t11;
-    const planar_3r_real t25 = t3*t23 - t2*t11;
-    const planar_3r_real t26 = (t24*t24) + (t25*t25);
-    const planar_3r_real t27 = (t11*t11) + (t23*t23);
-    const planar_3r_real t28 = 1e-24*t4;
-    const planar_3r_real t29 = (t21 <= t28*t22 ? 0 : atan2(t20, t19));
-    const planar_3r_real t30 = -mu2;
-    const planar_3r_real t31 = 3.141592653589793 + t30;
-    const planar_3r_real t32 = t29 + t14;
-    const planar_3r_real t33 = (t26 <= t28*t27 ? 0 : atan2(t25, t24));
-    const planar_3r_real t34 = t33 + t13;
-    const int t35 = isfinite(t6);
+    const planar_3r_real t6 = 1 - (t5*t5);
+    const planar_3r_real t7 = mu2 + mu0 + mu1;
+    const int t8 = t6 > 1e-12;
+    const planar_3r_real t9 = (t8 ? t5 : (t5 > 0 ? 1 : -1));
+    const planar_3r_real t10 = (t8 ? sqrt(t6) : 0);
+    const planar_3r_real t11 = atan2(t10, t9);
+    const planar_3r_real t12 = 3.141592653589793 + t11;
+    const planar_3r_real t13 = 3.141592653589793 - t11;
+    const planar_3r_real t14 = 1 - t9;
+    const planar_3r_real t15 = (t10*t10) + (t14*t14);
+    const planar_3r_real t16 = t2*t14;
+    const planar_3r_real t17 = t3*t10;
+    const planar_3r_real t18 = t16 - t17;
+    const planar_3r_real t19 = t16 + t17;
+    const planar_3r_real t20 = t3*t14;
+    const planar_3r_real t21 = t2*t10;
+    const planar_3r_real t22 = t20 + t21;
+    const planar_3r_real t23 = (t18*t18) + (t22*t22);
+    const planar_3r_real t24 = t20 - t21;
+    const planar_3r_real t25 = (t19*t19) + (t24*t24);
+    const planar_3r_real t26 = 1e-24*t4*t15;
+    const planar_3r_real t27 = (t23 <= t26 ? 0 : atan2(t22, t18));
+    const planar_3r_real t28 = -mu2;
+    const planar_3r_real t29 = 3.141592653589793 + t28;
+    const planar_3r_real t30 = t27 + t12;
+    const planar_3r_real t31 = (t25 <= t26 ? 0 : atan2(t24, t19));
+    const planar_3r_real t32 = t31 + t13;
+    const int t33 = isfinite(t7);
 
     /* Outputs */
-    q[0] = t29;
-    q[1] = -6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t14)) + t14;
-    q[2] = -(t30 + t32 + 6.283185307179586*ceil(-0.15915494309189535*(t31 + t32)));
-    q[3] = t33;
+    q[0] = t27;
+    q[1] = -6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t12)) + t12;
+    q[2] = -(t28 + t30 + 6.283185307179586*ceil(-0.15915494309189535*(t29 + t30)));
+    q[3] = t31;
     q[4] = -6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t13)) + t13;
-    q[5] = -(t30 + t34 + 6.283185307179586*ceil(-0.15915494309189535*(t31 + t34)));
-    valid[0] = t35 && t8 >= -1e-12;
-    valid[1] = t35 && t9;
+    q[5] = -(t28 + t32 + 6.283185307179586*ceil(-0.15915494309189535*(t29 + t32)));
+    valid[0] = t33 && t6 >= -1e-12;
+    valid[1] = t33 && t8;
     in_limits[0] = 1;
     in_limits[1] = 1;
 }
@@ -974,13 +972,13 @@ int planar_3r_ik_nearest(const planar_3r_real mu[PLANAR_3R_TASK_DIM], const plan
     const planar_3r_real t0 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0;
     const planar_3r_real t1 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1;
     const planar_3r_real t2 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2;
-    const planar_3r_real t3 = (lb0 && vb0 ? 1 : 0);
+    const planar_3r_real t3 = (vb0 && lb0 ? 1 : 0);
     const planar_3r_real t4 = (t3 > 0 ? 1 : 0);
     const planar_3r_real t5 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0;
     const planar_3r_real t6 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1;
     const planar_3r_real t7 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2;
-    const planar_3r_real t8 = (lb1 && vb1 ? 1 : 0);
-    const planar_3r_real t9 = mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qw1 + qw2 + qw3;
+    const planar_3r_real t8 = (vb1 && lb1 ? 1 : 0);
+    const planar_3r_real t9 = mu2 + mu0 + mu1 + qn1 + qn2 + qn3 + qw1 + qw2 + qw3;
     const planar_3r_real t10 = -qn1;
     const planar_3r_real t11 = -qn2;
     const planar_3r_real t12 = -qn3;
@@ -998,15 +996,15 @@ int planar_3r_ik_nearest(const planar_3r_real mu[PLANAR_3R_TASK_DIM], const plan
     const planar_3r_real t24 = (t23 ? t5 : t16);
     const planar_3r_real t25 = (t23 ? t6 : t17);
     const planar_3r_real t26 = (t23 ? t7 : t18);
-    const int t27 = isfinite(t9);
-    const int t28 = t22 > 0;
+    const int t27 = t22 > 0;
+    const int t28 = isfinite(t9);
     const int t29 = t27 && t28;
 
     /* Outputs */
     q[0] = (t29 ? t24 : qn1);
     q[1] = (t29 ? t25 : qn2);
     q[2] = (t29 ? t26 : qn3);
-    return (!t27 ? 2 : (t28 ? 0 : 1));
+    return (!t28 ? 2 : (t27 ? 0 : 1));
 }
 
 int planar_3r_ik(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF])

@@ -824,7 +824,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t8 = c123 + t0 + t2
     t9 = -t2 + mu0
     t10 = -t3 + mu1
-    t11 = qs1 + qs2 + qs3 + mu0 + mu1 + mu2
+    t11 = qs1 + qs2 + qs3 + mu2 + mu0 + mu1
     t12 = -mu2 + xp.atan2(s123, c123)
     t13 = t12 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t12))
     t14 = t9**2 + t10**2 + t13**2
@@ -885,7 +885,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 3 and 2 x 1 and 2 x 1), 88 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 3 and 2 x 1 and 2 x 1), 77 operations."""
     xp, dtype, device, batch, (mu,) = _arguments(("mu", mu, (3,)))
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
@@ -896,47 +896,45 @@ def ik_branches(mu):
     t3 = -t1 + mu1
     t4 = t2**2 + t3**2
     t5 = 0.5*(2 - t4)
-    t6 = mu0 + mu1 + mu2
-    t7 = t5**2
-    t8 = 1 - t7
-    t9 = xp.greater(t8, 1e-12)
-    t10 = xp.where(t9, t5, xp.where(xp.greater(t5, 0), xp.asarray(1, dtype=dtype), -1))
-    t11 = xp.where(t9, xp.sqrt(t8), 0)
-    t12 = xp.atan2(t11, t10)
-    t13 = 3.141592653589793 - t12
-    t14 = 3.141592653589793 + t12
-    t15 = -t11
-    t16 = -t10
-    t17 = t16
-    t18 = 1 + t17
-    t19 = t2*t18 + t3*t15
-    t20 = t3*t18 - t2*t15
-    t21 = t19**2 + t20**2
-    t22 = t18**2 + t15**2
-    t23 = 1 + t16
-    t24 = t2*t23 + t3*t11
-    t25 = t3*t23 - t2*t11
-    t26 = t24**2 + t25**2
-    t27 = t11**2 + t23**2
-    t28 = 1e-24*t4
-    t29 = xp.where(xp.less_equal(t21, t28*t22), 0, xp.atan2(t20, t19))
-    t30 = -mu2
-    t31 = 3.141592653589793 + t30
-    t32 = t29 + t14
-    t33 = xp.where(xp.less_equal(t26, t28*t27), 0, xp.atan2(t25, t24))
-    t34 = t33 + t13
-    t35 = xp.isfinite(t6)
+    t6 = 1 - t5**2
+    t7 = mu2 + mu0 + mu1
+    t8 = xp.greater(t6, 1e-12)
+    t9 = xp.where(t8, t5, xp.where(xp.greater(t5, 0), xp.asarray(1, dtype=dtype), -1))
+    t10 = xp.where(t8, xp.sqrt(t6), 0)
+    t11 = xp.atan2(t10, t9)
+    t12 = 3.141592653589793 + t11
+    t13 = 3.141592653589793 - t11
+    t14 = 1 - t9
+    t15 = t10**2 + t14**2
+    t16 = t2*t14
+    t17 = t3*t10
+    t18 = t16 - t17
+    t19 = t16 + t17
+    t20 = t3*t14
+    t21 = t2*t10
+    t22 = t20 + t21
+    t23 = t18**2 + t22**2
+    t24 = t20 - t21
+    t25 = t19**2 + t24**2
+    t26 = 1e-24*t4*t15
+    t27 = xp.where(xp.less_equal(t23, t26), 0, xp.atan2(t22, t18))
+    t28 = -mu2
+    t29 = 3.141592653589793 + t28
+    t30 = t27 + t12
+    t31 = xp.where(xp.less_equal(t25, t26), 0, xp.atan2(t24, t19))
+    t32 = t31 + t13
+    t33 = xp.isfinite(t7)
     q = _stack(xp, [
-        t29,  # 0, 0
-        -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t14)) + t14,  # 0, 1
-        -(t30 + t32 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t31 + t32))),  # 0, 2
-        t33,  # 1, 0
+        t27,  # 0, 0
+        -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t12)) + t12,  # 0, 1
+        -(t28 + t30 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t29 + t30))),  # 0, 2
+        t31,  # 1, 0
         -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t13)) + t13,  # 1, 1
-        -(t30 + t34 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t31 + t34))),  # 1, 2
+        -(t28 + t32 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t29 + t32))),  # 1, 2
     ], (2, 3))
     valid = _stack(xp, [
-        t35 & xp.greater_equal(t8, -1e-12),  # 0
-        t35 & t9,  # 1
+        t33 & xp.greater_equal(t6, -1e-12),  # 0
+        t33 & t8,  # 1
     ], (2,))
     in_limits = _stack(xp, [
         xp.full(batch, True, dtype=xp.bool, device=device),  # 0
@@ -972,13 +970,13 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
     t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
     t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
-    t3 = xp.where(lb0 & vb0, xp.asarray(1, dtype=dtype), 0)
+    t3 = xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0)
     t4 = xp.where(xp.greater(t3, 0), xp.asarray(1, dtype=dtype), 0)
     t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
     t6 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
     t7 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
-    t8 = xp.where(lb1 & vb1, xp.asarray(1, dtype=dtype), 0)
-    t9 = mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qw1 + qw2 + qw3
+    t8 = xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0)
+    t9 = mu2 + mu0 + mu1 + qn1 + qn2 + qn3 + qw1 + qw2 + qw3
     t10 = -qn1
     t11 = -qn2
     t12 = -qn3
@@ -996,15 +994,15 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t24 = xp.where(t23, t5, t16)
     t25 = xp.where(t23, t6, t17)
     t26 = xp.where(t23, t7, t18)
-    t27 = xp.isfinite(t9)
-    t28 = xp.greater(t22, 0)
+    t27 = xp.greater(t22, 0)
+    t28 = xp.isfinite(t9)
     t29 = t27 & t28
     q = _stack(xp, [
         xp.broadcast_to(xp.where(t29, t24, qn1), batch),  # 0
         xp.broadcast_to(xp.where(t29, t25, qn2), batch),  # 1
         xp.broadcast_to(xp.where(t29, t26, qn3), batch),  # 2
     ], (3,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t27), 2, xp.where(t28, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t28), 2, xp.where(t27, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

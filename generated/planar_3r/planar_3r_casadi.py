@@ -641,7 +641,7 @@ def _ik_numeric_step(target, q, damping):
     t8 = c123 + t0 + t2
     t9 = -t2 + mu0
     t10 = -t3 + mu1
-    t11 = qs1 + qs2 + qs3 + mu0 + mu1 + mu2
+    t11 = qs1 + qs2 + qs3 + mu2 + mu0 + mu1
     t12 = -mu2 + casadi.atan2(s123, c123)
     t13 = t12 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t12))
     t14 = t9**2 + t10**2 + t13**2
@@ -700,7 +700,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 88 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 77 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -710,46 +710,44 @@ def _ik_branches(mu):
     t3 = -t1 + mu1
     t4 = t2**2 + t3**2
     t5 = 0.5*(2 - t4)
-    t6 = mu0 + mu1 + mu2
-    t7 = t5**2
-    t8 = 1 - t7
-    t9 = (t8 > 1e-12)
-    t10 = casadi.if_else(t9, t5, casadi.if_else((t5 > 0), 1, -1))
-    t11 = casadi.if_else(t9, casadi.sqrt(t8), 0)
-    t12 = casadi.atan2(t11, t10)
-    t13 = 3.141592653589793 - t12
-    t14 = 3.141592653589793 + t12
-    t15 = -t11
-    t16 = -t10
-    t17 = t16
-    t18 = 1 + t17
-    t19 = t2*t18 + t3*t15
-    t20 = t3*t18 - t2*t15
-    t21 = t19**2 + t20**2
-    t22 = t18**2 + t15**2
-    t23 = 1 + t16
-    t24 = t2*t23 + t3*t11
-    t25 = t3*t23 - t2*t11
-    t26 = t24**2 + t25**2
-    t27 = t11**2 + t23**2
-    t28 = 1e-24*t4
-    t29 = casadi.if_else((t21 <= t28*t22), 0, casadi.atan2(t20, t19))
-    t30 = -mu2
-    t31 = 3.141592653589793 + t30
-    t32 = t29 + t14
-    t33 = casadi.if_else((t26 <= t28*t27), 0, casadi.atan2(t25, t24))
-    t34 = t33 + t13
-    t35 = (casadi.fabs(t6) < casadi.inf)
+    t6 = 1 - t5**2
+    t7 = mu2 + mu0 + mu1
+    t8 = (t6 > 1e-12)
+    t9 = casadi.if_else(t8, t5, casadi.if_else((t5 > 0), 1, -1))
+    t10 = casadi.if_else(t8, casadi.sqrt(t6), 0)
+    t11 = casadi.atan2(t10, t9)
+    t12 = 3.141592653589793 + t11
+    t13 = 3.141592653589793 - t11
+    t14 = 1 - t9
+    t15 = t10**2 + t14**2
+    t16 = t2*t14
+    t17 = t3*t10
+    t18 = t16 - t17
+    t19 = t16 + t17
+    t20 = t3*t14
+    t21 = t2*t10
+    t22 = t20 + t21
+    t23 = t18**2 + t22**2
+    t24 = t20 - t21
+    t25 = t19**2 + t24**2
+    t26 = 1e-24*t4*t15
+    t27 = casadi.if_else((t23 <= t26), 0, casadi.atan2(t22, t18))
+    t28 = -mu2
+    t29 = 3.141592653589793 + t28
+    t30 = t27 + t12
+    t31 = casadi.if_else((t25 <= t26), 0, casadi.atan2(t24, t19))
+    t32 = t31 + t13
+    t33 = (casadi.fabs(t7) < casadi.inf)
     q = casadi.SX(2, 3)
-    q[0, 0] = t29
-    q[0, 1] = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t14)) + t14
-    q[0, 2] = -(t30 + t32 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t31 + t32)))
-    q[1, 0] = t33
+    q[0, 0] = t27
+    q[0, 1] = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t12)) + t12
+    q[0, 2] = -(t28 + t30 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t29 + t30)))
+    q[1, 0] = t31
     q[1, 1] = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t13)) + t13
-    q[1, 2] = -(t30 + t34 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t31 + t34)))
+    q[1, 2] = -(t28 + t32 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t29 + t32)))
     valid = casadi.SX(2, 1)
-    valid[0, 0] = casadi.logic_and(t35, (t8 >= -1e-12))
-    valid[1, 0] = casadi.logic_and(t35, t9)
+    valid[0, 0] = casadi.logic_and(t33, (t6 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(t33, t8)
     in_limits = casadi.SX(2, 1)
     in_limits[0, 0] = True
     in_limits[1, 0] = True
@@ -781,13 +779,13 @@ def _ik_nearest(mu, q_seed, weights):
     t0 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
     t1 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
     t2 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
-    t3 = casadi.if_else(casadi.logic_and(lb0, vb0), 1, 0)
+    t3 = casadi.if_else(casadi.logic_and(vb0, lb0), 1, 0)
     t4 = casadi.if_else((t3 > 0), 1, 0)
     t5 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
     t6 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
     t7 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
-    t8 = casadi.if_else(casadi.logic_and(lb1, vb1), 1, 0)
-    t9 = mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qw1 + qw2 + qw3
+    t8 = casadi.if_else(casadi.logic_and(vb1, lb1), 1, 0)
+    t9 = mu2 + mu0 + mu1 + qn1 + qn2 + qn3 + qw1 + qw2 + qw3
     t10 = -qn1
     t11 = -qn2
     t12 = -qn3
@@ -805,15 +803,15 @@ def _ik_nearest(mu, q_seed, weights):
     t24 = casadi.if_else(t23, t5, t16)
     t25 = casadi.if_else(t23, t6, t17)
     t26 = casadi.if_else(t23, t7, t18)
-    t27 = (casadi.fabs(t9) < casadi.inf)
-    t28 = (t22 > 0)
+    t27 = (t22 > 0)
+    t28 = (casadi.fabs(t9) < casadi.inf)
     t29 = casadi.logic_and(t27, t28)
     q = casadi.SX(3, 1)
     q[0, 0] = casadi.if_else(t29, t24, qn1)
     q[1, 0] = casadi.if_else(t29, t25, qn2)
     q[2, 0] = casadi.if_else(t29, t26, qn3)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t27), 2, casadi.if_else(t28, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t28), 2, casadi.if_else(t27, 0, 1))
     return [q, status]
 
 

@@ -1090,7 +1090,7 @@ def _ik_numeric_step(target, q, damping):
     s4 = casadi.sin(q4)
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + s23*c4
-    t0 = qs1 + qs2 + qs3 + qs4 + mu0 + mu1 + mu2 + mu3
+    t0 = qs1 + qs2 + qs3 + qs4 + mu3 + mu0 + mu1 + mu2
     t1 = 0.1*c1
     t2 = c23*t1 + c234*t1
     t3 = c2*t1 + t2
@@ -1222,374 +1222,353 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 840 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 767 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
     mu3 = mu[3]
     t0 = casadi.sin(mu3)
-    t1 = casadi.atan2(mu0, -mu1)
-    t2 = mu0 + mu1 + mu2 + mu3
-    t3 = t0**2
-    t4 = 1 - t3
-    t5 = (t4 > 1e-12)
-    t6 = casadi.if_else(t5, -t0, casadi.if_else((t0 < 0), 1, -1))
-    t7 = casadi.if_else(t5, casadi.sqrt(t4), 0)
-    t8 = casadi.atan2(t7, t6)
-    t9 = t8
-    t10 = t6
-    t11 = t7
-    t12 = mu0**2 + mu1**2
+    t1 = 1 - t0**2
+    t2 = casadi.atan2(mu0, -mu1)
+    t3 = -1.5707963267948966 + t2
+    t4 = mu3 + mu0 + mu1 + mu2
+    t5 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t3)) + t3
+    t6 = -6.283185307179586*casadi.floor(0.15915494309189535*(3.141592653589793 + t5)) + t5
+    t7 = (t1 > 1e-12)
+    t8 = casadi.if_else(t7, -t0, casadi.if_else((t0 < 0), 1, -1))
+    t9 = casadi.if_else(t7, casadi.sqrt(t1), 0)
+    t10 = casadi.atan2(t9, t8)
+    t11 = mu0**2
+    t12 = t11 + mu1**2
     t13 = t12
     t14 = t12 + mu2**2
     t15 = 1e-24*t14
     t16 = (t13 <= t15)
     t17 = casadi.if_else(t16, 1, 1/casadi.sqrt(t13))
-    t18 = casadi.if_else(t16, 0, t1 + 1.5707963267948966)
-    t19 = -1.5707963267948966 + t1
-    t20 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t18)) + t18
-    t21 = -6.283185307179586*casadi.floor(0.15915494309189535*(3.141592653589793 + t20)) + t20
-    t22 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t19)) + t19
-    t23 = -6.283185307179586*casadi.floor(0.15915494309189535*(3.141592653589793 + t22)) + t22
-    t24 = mu0*t17
-    t25 = casadi.if_else(t16, 1, -t24)
-    t26 = t24
-    t27 = mu2*(1 - t25)
-    t28 = t27 + mu2*t25
-    t29 = mu2*(1 - t26)
-    t30 = t29 + mu2*t26
-    t31 = mu1*t17
-    t32 = casadi.if_else(t16, 0, -t31)
-    t33 = t31
-    t34 = mu0*t25 + mu1*t32
-    t35 = mu1*t25 - mu0*t32
-    t36 = mu0*t26 + mu1*t33
-    t37 = mu1*t26 - mu0*t33
-    t38 = 0.1*t11
-    t39 = t38 + t34
-    t40 = t38 + t36
-    t41 = -0.1*t10
-    t42 = t41 + t28
-    t43 = -0.12 + t42
-    t44 = t41 + t30
-    t45 = -0.12 + t44
-    t46 = t35**2
-    t47 = t46 + t39**2 + t43**2
-    t48 = 0.5*(0.02 - t47)
-    t49 = t48**2
-    t50 = 1 - 10000*t49
-    t51 = (t50 > 1e-12)
-    t52 = casadi.if_else(t51, casadi.sqrt(t50), 0)
-    t53 = 100*t48
-    t54 = casadi.if_else(t51, t53, casadi.if_else((t53 > 0), 1, -1))
-    t55 = casadi.atan2(t52, t54)
-    t56 = 3.141592653589793 - t55
-    t57 = 0.22 - 0.1*t54
-    t58 = -0.12 + t57
-    t59 = 0.01*t52**2 + t58**2
-    t60 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t56)) + t56
-    t61 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t60)) + t60
-    t62 = 3.141592653589793 + t55
-    t63 = -t54
-    t64 = -t52
-    t65 = 0.22 + 0.1*t63
-    t66 = -0.12 + t65
-    t67 = 0.01*t64**2 + t66**2
-    t68 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t62)) + t62
-    t69 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t68)) + t68
-    t70 = 0.1*t64
-    t71 = t43*t66 - t70*t39
-    t72 = t39*t66 + t70*t43
-    t73 = t71**2 + t72**2
-    t74 = 0.1*t52
-    t75 = t43*t58 - t74*t39
-    t76 = t39*t58 + t74*t43
-    t77 = t75**2 + t76**2
-    t78 = -0.1*t7
-    t79 = t78 + t34
-    t80 = t78 + t36
-    t81 = -0.1*t6
-    t82 = t81 + t28
-    t83 = -0.12 + t82
-    t84 = t46 + t79**2 + t83**2
-    t85 = 0.5*(0.02 - t84)
-    t86 = t81 + t30
-    t87 = -0.12 + t86
-    t88 = t85**2
-    t89 = 1 - 10000*t88
-    t90 = (t89 > 1e-12)
-    t91 = casadi.if_else(t90, casadi.sqrt(t89), 0)
-    t92 = -t91
-    t93 = 100*t85
-    t94 = casadi.if_else(t90, t93, casadi.if_else((t93 > 0), 1, -1))
-    t95 = casadi.atan2(t91, t94)
-    t96 = 3.141592653589793 + t95
-    t97 = -t94
-    t98 = 3.141592653589793 - t95
-    t99 = 0.22 + 0.1*t97
-    t100 = -0.12 + t99
-    t101 = 0.01*t92**2 + t100**2
-    t102 = 0.22 - 0.1*t94
-    t103 = -0.12 + t102
-    t104 = 0.01*t91**2 + t103**2
-    t105 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t96)) + t96
-    t106 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t105)) + t105
-    t107 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t98)) + t98
-    t108 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t107)) + t107
-    t109 = 0.1*t92
-    t110 = t83*t100 - t109*t79
-    t111 = t79*t100 + t109*t83
-    t112 = t110**2 + t111**2
-    t113 = 0.1*t91
-    t114 = t83*t103 - t113*t79
-    t115 = t79*t103 + t113*t83
-    t116 = t114**2 + t115**2
-    t117 = t37**2
-    t118 = t117 + t40**2 + t45**2
-    t119 = 0.5*(0.02 - t118)
-    t120 = t117 + t80**2 + t87**2
-    t121 = 0.5*(0.02 - t120)
-    t122 = t119**2
-    t123 = 1 - 10000*t122
-    t124 = (t123 > 1e-12)
-    t125 = casadi.if_else(t124, casadi.sqrt(t123), 0)
-    t126 = -t125
-    t127 = 100*t119
-    t128 = casadi.if_else(t124, t127, casadi.if_else((t127 > 0), 1, -1))
-    t129 = casadi.atan2(t125, t128)
-    t130 = 3.141592653589793 + t129
-    t131 = -t128
-    t132 = 3.141592653589793 - t129
-    t133 = 0.22 + 0.1*t131
-    t134 = -0.12 + t133
-    t135 = 0.01*t126**2 + t134**2
-    t136 = 0.22 - 0.1*t128
-    t137 = -0.12 + t136
-    t138 = 0.01*t125**2 + t137**2
-    t139 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t130)) + t130
-    t140 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t139)) + t139
-    t141 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t132)) + t132
-    t142 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t141)) + t141
-    t143 = 0.1*t126
-    t144 = t45*t134 - t143*t40
-    t145 = t40*t134 + t143*t45
-    t146 = t144**2 + t145**2
-    t147 = 0.1*t125
-    t148 = t45*t137 - t147*t40
-    t149 = t40*t137 + t147*t45
-    t150 = t148**2 + t149**2
-    t151 = t121**2
-    t152 = 1 - 10000*t151
-    t153 = (t152 > 1e-12)
-    t154 = casadi.if_else(t153, casadi.sqrt(t152), 0)
-    t155 = -t154
-    t156 = 100*t121
-    t157 = casadi.if_else(t153, t156, casadi.if_else((t156 > 0), 1, -1))
-    t158 = casadi.atan2(t154, t157)
-    t159 = 3.141592653589793 + t158
-    t160 = -t157
-    t161 = 3.141592653589793 - t158
-    t162 = 0.22 + 0.1*t160
-    t163 = -0.12 + t162
-    t164 = 0.01*t155**2 + t163**2
-    t165 = 0.22 - 0.1*t157
-    t166 = -0.12 + t165
-    t167 = 0.01*t154**2 + t166**2
-    t168 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t159)) + t159
-    t169 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t168)) + t168
-    t170 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t161)) + t161
+    t18 = casadi.if_else(t16, 0, 1.5707963267948966 + t2)
+    t19 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t18)) + t18
+    t20 = -6.283185307179586*casadi.floor(0.15915494309189535*(3.141592653589793 + t19)) + t19
+    t21 = mu0*t17
+    t22 = -t21
+    t23 = casadi.if_else(t16, 1, t22)
+    t24 = mu2*(1 - t23)
+    t25 = t24 + mu2*t23
+    t26 = mu2*(1 + t22)
+    t27 = t26 + t21*mu2
+    t28 = mu1*t17
+    t29 = casadi.if_else(t16, 0, -t28)
+    t30 = mu0*t23 + mu1*t29
+    t31 = mu1*t23 - mu0*t29
+    t32 = t11*t17 + mu1*t28
+    t33 = t21*mu1 - t28*mu0
+    t34 = 0.1*t9
+    t35 = t34 + t30
+    t36 = t34 + t32
+    t37 = -0.1*t8
+    t38 = t37 + t25
+    t39 = -0.12 + t38
+    t40 = t37 + t27
+    t41 = -0.12 + t40
+    t42 = t31**2 + t39**2
+    t43 = t42 + t35**2
+    t44 = 0.5*(0.02 - t43)
+    t45 = 1 - 10000*t44**2
+    t46 = (t45 > 1e-12)
+    t47 = casadi.if_else(t46, casadi.sqrt(t45), 0)
+    t48 = 100*t44
+    t49 = casadi.if_else(t46, t48, casadi.if_else((t48 > 0), 1, -1))
+    t50 = casadi.atan2(t47, t49)
+    t51 = 3.141592653589793 + t50
+    t52 = 3.141592653589793 - t50
+    t53 = 0.22 - 0.1*t49
+    t54 = -0.12 + t53
+    t55 = 0.01*t47**2 + t54**2
+    t56 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t51)) + t51
+    t57 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t56)) + t56
+    t58 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t52)) + t52
+    t59 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t58)) + t58
+    t60 = 0.1*t47
+    t61 = t60*t35
+    t62 = t39*t54
+    t63 = t61 + t62
+    t64 = t62 - t61
+    t65 = t35*t54
+    t66 = t60*t39
+    t67 = t65 - t66
+    t68 = t63**2 + t67**2
+    t69 = t65 + t66
+    t70 = t64**2 + t69**2
+    t71 = -t34
+    t72 = t71 + t30
+    t73 = t42 + t72**2
+    t74 = 0.5*(0.02 - t73)
+    t75 = 1 - 10000*t74**2
+    t76 = t71 + t32
+    t77 = (t75 > 1e-12)
+    t78 = casadi.if_else(t77, casadi.sqrt(t75), 0)
+    t79 = 100*t74
+    t80 = casadi.if_else(t77, t79, casadi.if_else((t79 > 0), 1, -1))
+    t81 = casadi.atan2(t78, t80)
+    t82 = 3.141592653589793 + t81
+    t83 = 3.141592653589793 - t81
+    t84 = 0.22 - 0.1*t80
+    t85 = -0.12 + t84
+    t86 = 0.01*t78**2 + t85**2
+    t87 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t82)) + t82
+    t88 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t87)) + t87
+    t89 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t83)) + t83
+    t90 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t89)) + t89
+    t91 = 0.1*t78
+    t92 = t91*t72
+    t93 = t39*t85
+    t94 = t92 + t93
+    t95 = t93 - t92
+    t96 = t72*t85
+    t97 = t91*t39
+    t98 = t96 - t97
+    t99 = t94**2 + t98**2
+    t100 = t96 + t97
+    t101 = t95**2 + t100**2
+    t102 = t33**2 + t41**2
+    t103 = t102 + t36**2
+    t104 = 0.5*(0.02 - t103)
+    t105 = 1 - 10000*t104**2
+    t106 = t102 + t76**2
+    t107 = 0.5*(0.02 - t106)
+    t108 = 1 - 10000*t107**2
+    t109 = (t105 > 1e-12)
+    t110 = casadi.if_else(t109, casadi.sqrt(t105), 0)
+    t111 = 100*t104
+    t112 = casadi.if_else(t109, t111, casadi.if_else((t111 > 0), 1, -1))
+    t113 = casadi.atan2(t110, t112)
+    t114 = 3.141592653589793 + t113
+    t115 = 3.141592653589793 - t113
+    t116 = 0.22 - 0.1*t112
+    t117 = -0.12 + t116
+    t118 = 0.01*t110**2 + t117**2
+    t119 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t114)) + t114
+    t120 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t119)) + t119
+    t121 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t115)) + t115
+    t122 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t121)) + t121
+    t123 = 0.1*t110
+    t124 = t123*t36
+    t125 = t41*t117
+    t126 = t124 + t125
+    t127 = t125 - t124
+    t128 = t36*t117
+    t129 = t123*t41
+    t130 = t128 - t129
+    t131 = t126**2 + t130**2
+    t132 = t128 + t129
+    t133 = t127**2 + t132**2
+    t134 = (t108 > 1e-12)
+    t135 = casadi.if_else(t134, casadi.sqrt(t108), 0)
+    t136 = 100*t107
+    t137 = casadi.if_else(t134, t136, casadi.if_else((t136 > 0), 1, -1))
+    t138 = casadi.atan2(t135, t137)
+    t139 = 3.141592653589793 + t138
+    t140 = 3.141592653589793 - t138
+    t141 = 0.22 - 0.1*t137
+    t142 = -0.12 + t141
+    t143 = 0.01*t135**2 + t142**2
+    t144 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t139)) + t139
+    t145 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t144)) + t144
+    t146 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t140)) + t140
+    t147 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t146)) + t146
+    t148 = 0.1*t135
+    t149 = t148*t76
+    t150 = t41*t142
+    t151 = t149 + t150
+    t152 = t150 - t149
+    t153 = t76*t142
+    t154 = t148*t41
+    t155 = t153 - t154
+    t156 = t151**2 + t155**2
+    t157 = t153 + t154
+    t158 = t152**2 + t157**2
+    t159 = 1e-24*t43*t55
+    t160 = casadi.if_else((t68 <= t159), 0, casadi.atan2(-t67, t63))
+    t161 = t160
+    t162 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t161)) + t161
+    t163 = -t10
+    t164 = 3.141592653589793 + t163
+    t165 = t160 + t51
+    t166 = t163 + t165 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t164 + t165))
+    t167 = -t166
+    t168 = t166 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t167))
+    t169 = casadi.if_else((t70 <= t159), 0, casadi.atan2(-t69, t64))
+    t170 = t169
     t171 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t170)) + t170
-    t172 = 0.1*t155
-    t173 = t87*t163 - t172*t80
-    t174 = t80*t163 + t172*t87
-    t175 = t173**2 + t174**2
-    t176 = 0.1*t154
-    t177 = t87*t166 - t176*t80
-    t178 = t80*t166 + t176*t87
-    t179 = t177**2 + t178**2
-    t180 = 1e-24*t47
-    t181 = casadi.if_else((t73 <= t180*t67), 0, casadi.atan2(-t72, t71))
-    t182 = t181
-    t183 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t182)) + t182
-    t184 = -t9
-    t185 = 3.141592653589793 + t184
-    t186 = t181 + t62
-    t187 = t184 + t186 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t185 + t186))
-    t188 = -t187
-    t189 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t188)) + t187
-    t190 = casadi.if_else((t77 <= t180*t59), 0, casadi.atan2(-t76, t75))
-    t191 = t190
-    t192 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t191)) + t191
-    t193 = t190 + t56
-    t194 = t184 + t193 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t185 + t193))
-    t195 = -t194
-    t196 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t195)) + t194
-    t197 = 1e-24*t84
-    t198 = casadi.if_else((t112 <= t197*t101), 0, casadi.atan2(-t111, t110))
-    t199 = t198
-    t200 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t199)) + t199
-    t201 = 3.141592653589793 + t8
-    t202 = t198 + t96
-    t203 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t201 + t202)) + t8 + t202
-    t204 = -t203
-    t205 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t204)) + t203
-    t206 = casadi.if_else((t116 <= t197*t104), 0, casadi.atan2(-t115, t114))
-    t207 = t206
-    t208 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t207)) + t207
-    t209 = t98 + t206
-    t210 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t201 + t209)) + t8 + t209
-    t211 = -t210
-    t212 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t211)) + t210
-    t213 = 1e-24*t118
-    t214 = casadi.if_else((t146 <= t135*t213), 0, casadi.atan2(-t145, t144))
-    t215 = t214
-    t216 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t215)) + t215
-    t217 = t130 + t214
-    t218 = t184 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t185 + t217)) + t217
-    t219 = -t218
-    t220 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t219)) + t218
-    t221 = casadi.if_else((t150 <= t138*t213), 0, casadi.atan2(-t149, t148))
-    t222 = t221
-    t223 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t222)) + t222
-    t224 = t132 + t221
-    t225 = t184 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t185 + t224)) + t224
-    t226 = -t225
-    t227 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t226)) + t225
-    t228 = 1e-24*t120
-    t229 = casadi.if_else((t175 <= t164*t228), 0, casadi.atan2(-t174, t173))
-    t230 = t229
-    t231 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t230)) + t230
-    t232 = t159 + t229
-    t233 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t201 + t232)) + t8 + t232
-    t234 = -t233
-    t235 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t234)) + t233
-    t236 = casadi.if_else((t179 <= t167*t228), 0, casadi.atan2(-t178, t177))
-    t237 = t236
-    t238 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t237)) + t237
-    t239 = t161 + t236
-    t240 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t201 + t239)) + t8 + t239
-    t241 = -t240
-    t242 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t241)) + t240
-    t243 = (t21 <= 3.141592653589793)
-    t244 = casadi.logic_and((t20 >= -3.141592653589793), (t20 <= 3.141592653589793))
-    t245 = casadi.if_else(casadi.logic_and(t243, casadi.logic_not(t244)), t21, t20)
-    t246 = (t183 <= 2.0943951023931953)
-    t247 = casadi.logic_and((t182 >= -2.0943951023931953), (t182 <= 2.0943951023931953))
-    t248 = (t69 <= 2.0943951023931953)
-    t249 = casadi.logic_and((t68 >= -2.0943951023931953), (t68 <= 2.0943951023931953))
-    t250 = -t189
-    t251 = (t250 <= 2.0943951023931953)
-    t252 = casadi.logic_and((t188 >= -2.0943951023931953), (t188 <= 2.0943951023931953))
-    t253 = (t192 <= 2.0943951023931953)
-    t254 = casadi.logic_and((t191 >= -2.0943951023931953), (t191 <= 2.0943951023931953))
-    t255 = (t61 <= 2.0943951023931953)
-    t256 = casadi.logic_and((t60 >= -2.0943951023931953), (t60 <= 2.0943951023931953))
-    t257 = -t196
-    t258 = (t257 <= 2.0943951023931953)
-    t259 = casadi.logic_and((t195 >= -2.0943951023931953), (t195 <= 2.0943951023931953))
-    t260 = (t200 <= 2.0943951023931953)
-    t261 = casadi.logic_and((t199 >= -2.0943951023931953), (t199 <= 2.0943951023931953))
-    t262 = (t106 <= 2.0943951023931953)
-    t263 = casadi.logic_and((t105 >= -2.0943951023931953), (t105 <= 2.0943951023931953))
-    t264 = -t205
-    t265 = (t264 <= 2.0943951023931953)
-    t266 = casadi.logic_and((t204 >= -2.0943951023931953), (t204 <= 2.0943951023931953))
-    t267 = (t208 <= 2.0943951023931953)
-    t268 = casadi.logic_and((t207 >= -2.0943951023931953), (t207 <= 2.0943951023931953))
-    t269 = (t108 <= 2.0943951023931953)
-    t270 = casadi.logic_and((t107 >= -2.0943951023931953), (t107 <= 2.0943951023931953))
-    t271 = -t212
-    t272 = (t271 <= 2.0943951023931953)
-    t273 = casadi.logic_and((t211 >= -2.0943951023931953), (t211 <= 2.0943951023931953))
-    t274 = (t23 <= 3.141592653589793)
-    t275 = casadi.logic_and((t22 >= -3.141592653589793), (t22 <= 3.141592653589793))
-    t276 = casadi.if_else(casadi.logic_and(t274, casadi.logic_not(t275)), t23, t22)
-    t277 = (t216 <= 2.0943951023931953)
-    t278 = casadi.logic_and((t215 >= -2.0943951023931953), (t215 <= 2.0943951023931953))
-    t279 = (t140 <= 2.0943951023931953)
-    t280 = casadi.logic_and((t139 >= -2.0943951023931953), (t139 <= 2.0943951023931953))
-    t281 = -t220
-    t282 = (t281 <= 2.0943951023931953)
-    t283 = casadi.logic_and((t219 >= -2.0943951023931953), (t219 <= 2.0943951023931953))
-    t284 = (t223 <= 2.0943951023931953)
-    t285 = casadi.logic_and((t222 >= -2.0943951023931953), (t222 <= 2.0943951023931953))
-    t286 = (t142 <= 2.0943951023931953)
-    t287 = casadi.logic_and((t141 >= -2.0943951023931953), (t141 <= 2.0943951023931953))
-    t288 = -t227
-    t289 = (t288 <= 2.0943951023931953)
-    t290 = casadi.logic_and((t226 >= -2.0943951023931953), (t226 <= 2.0943951023931953))
-    t291 = (t231 <= 2.0943951023931953)
-    t292 = casadi.logic_and((t230 >= -2.0943951023931953), (t230 <= 2.0943951023931953))
-    t293 = (t169 <= 2.0943951023931953)
-    t294 = casadi.logic_and((t168 >= -2.0943951023931953), (t168 <= 2.0943951023931953))
-    t295 = -t235
-    t296 = (t295 <= 2.0943951023931953)
-    t297 = casadi.logic_and((t234 >= -2.0943951023931953), (t234 <= 2.0943951023931953))
-    t298 = (t238 <= 2.0943951023931953)
-    t299 = casadi.logic_and((t237 >= -2.0943951023931953), (t237 <= 2.0943951023931953))
-    t300 = (t171 <= 2.0943951023931953)
-    t301 = casadi.logic_and((t170 >= -2.0943951023931953), (t170 <= 2.0943951023931953))
-    t302 = -t242
-    t303 = (t302 <= 2.0943951023931953)
-    t304 = casadi.logic_and((t241 >= -2.0943951023931953), (t241 <= 2.0943951023931953))
-    t305 = (casadi.fabs(t2) < casadi.inf)
-    t306 = (casadi.fabs(mu3) <= 1.5707963267948966)
-    t307 = (t13 > t15)
-    t308 = casadi.logic_or(t307, casadi.logic_and((0 <= 1e-12*t14), t16))
-    t309 = (t4 >= -1e-12)
-    t310 = casadi.logic_or(t243, t244)
-    t311 = casadi.logic_or(t274, t275)
+    t172 = t169 + t52
+    t173 = t163 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t164 + t172)) + t172
+    t174 = -t173
+    t175 = t173 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t174))
+    t176 = 1e-24*t73*t86
+    t177 = casadi.if_else((t99 <= t176), 0, casadi.atan2(-t98, t94))
+    t178 = t177
+    t179 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t178)) + t178
+    t180 = 3.141592653589793 + t10
+    t181 = t82 + t177
+    t182 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t180 + t181)) + t10 + t181
+    t183 = -t182
+    t184 = t182 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t183))
+    t185 = casadi.if_else((t101 <= t176), 0, casadi.atan2(-t100, t95))
+    t186 = t185
+    t187 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t186)) + t186
+    t188 = t83 + t185
+    t189 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t180 + t188)) + t10 + t188
+    t190 = -t189
+    t191 = t189 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t190))
+    t192 = 1e-24*t103*t118
+    t193 = casadi.if_else((t131 <= t192), 0, casadi.atan2(-t130, t126))
+    t194 = t193
+    t195 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t194)) + t194
+    t196 = t114 + t193
+    t197 = t163 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t164 + t196)) + t196
+    t198 = -t197
+    t199 = t197 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t198))
+    t200 = casadi.if_else((t133 <= t192), 0, casadi.atan2(-t132, t127))
+    t201 = t200
+    t202 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t201)) + t201
+    t203 = t115 + t200
+    t204 = t163 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t164 + t203)) + t203
+    t205 = -t204
+    t206 = t204 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t205))
+    t207 = 1e-24*t106*t143
+    t208 = casadi.if_else((t156 <= t207), 0, casadi.atan2(-t155, t151))
+    t209 = t208
+    t210 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t209)) + t209
+    t211 = t139 + t208
+    t212 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t180 + t211)) + t10 + t211
+    t213 = -t212
+    t214 = t212 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t213))
+    t215 = casadi.if_else((t158 <= t207), 0, casadi.atan2(-t157, t152))
+    t216 = t215
+    t217 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t216)) + t216
+    t218 = t140 + t215
+    t219 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t180 + t218)) + t10 + t218
+    t220 = -t219
+    t221 = t219 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t220))
+    t222 = casadi.logic_and((t19 >= -3.141592653589793), (t19 <= 3.141592653589793))
+    t223 = (t20 <= 3.141592653589793)
+    t224 = casadi.if_else(casadi.logic_and(casadi.logic_not(t222), t223), t20, t19)
+    t225 = casadi.logic_and((t161 >= -2.0943951023931953), (t161 <= 2.0943951023931953))
+    t226 = (t162 <= 2.0943951023931953)
+    t227 = casadi.logic_and((t56 >= -2.0943951023931953), (t56 <= 2.0943951023931953))
+    t228 = (t57 <= 2.0943951023931953)
+    t229 = casadi.logic_and((t167 >= -2.0943951023931953), (t167 <= 2.0943951023931953))
+    t230 = -t168
+    t231 = (t230 <= 2.0943951023931953)
+    t232 = casadi.logic_and((t170 >= -2.0943951023931953), (t170 <= 2.0943951023931953))
+    t233 = (t171 <= 2.0943951023931953)
+    t234 = casadi.logic_and((t58 >= -2.0943951023931953), (t58 <= 2.0943951023931953))
+    t235 = (t59 <= 2.0943951023931953)
+    t236 = casadi.logic_and((t174 >= -2.0943951023931953), (t174 <= 2.0943951023931953))
+    t237 = -t175
+    t238 = (t237 <= 2.0943951023931953)
+    t239 = casadi.logic_and((t178 >= -2.0943951023931953), (t178 <= 2.0943951023931953))
+    t240 = (t179 <= 2.0943951023931953)
+    t241 = casadi.logic_and((t87 >= -2.0943951023931953), (t87 <= 2.0943951023931953))
+    t242 = (t88 <= 2.0943951023931953)
+    t243 = casadi.logic_and((t183 >= -2.0943951023931953), (t183 <= 2.0943951023931953))
+    t244 = -t184
+    t245 = (t244 <= 2.0943951023931953)
+    t246 = casadi.logic_and((t186 >= -2.0943951023931953), (t186 <= 2.0943951023931953))
+    t247 = (t187 <= 2.0943951023931953)
+    t248 = casadi.logic_and((t89 >= -2.0943951023931953), (t89 <= 2.0943951023931953))
+    t249 = (t90 <= 2.0943951023931953)
+    t250 = casadi.logic_and((t190 >= -2.0943951023931953), (t190 <= 2.0943951023931953))
+    t251 = -t191
+    t252 = (t251 <= 2.0943951023931953)
+    t253 = casadi.logic_and((t5 >= -3.141592653589793), (t5 <= 3.141592653589793))
+    t254 = (t6 <= 3.141592653589793)
+    t255 = casadi.if_else(casadi.logic_and(casadi.logic_not(t253), t254), t6, t5)
+    t256 = casadi.logic_and((t194 >= -2.0943951023931953), (t194 <= 2.0943951023931953))
+    t257 = (t195 <= 2.0943951023931953)
+    t258 = casadi.logic_and((t119 >= -2.0943951023931953), (t119 <= 2.0943951023931953))
+    t259 = (t120 <= 2.0943951023931953)
+    t260 = casadi.logic_and((t198 >= -2.0943951023931953), (t198 <= 2.0943951023931953))
+    t261 = -t199
+    t262 = (t261 <= 2.0943951023931953)
+    t263 = casadi.logic_and((t201 >= -2.0943951023931953), (t201 <= 2.0943951023931953))
+    t264 = (t202 <= 2.0943951023931953)
+    t265 = casadi.logic_and((t121 >= -2.0943951023931953), (t121 <= 2.0943951023931953))
+    t266 = (t122 <= 2.0943951023931953)
+    t267 = casadi.logic_and((t205 >= -2.0943951023931953), (t205 <= 2.0943951023931953))
+    t268 = -t206
+    t269 = (t268 <= 2.0943951023931953)
+    t270 = casadi.logic_and((t209 >= -2.0943951023931953), (t209 <= 2.0943951023931953))
+    t271 = (t210 <= 2.0943951023931953)
+    t272 = casadi.logic_and((t144 >= -2.0943951023931953), (t144 <= 2.0943951023931953))
+    t273 = (t145 <= 2.0943951023931953)
+    t274 = casadi.logic_and((t213 >= -2.0943951023931953), (t213 <= 2.0943951023931953))
+    t275 = -t214
+    t276 = (t275 <= 2.0943951023931953)
+    t277 = casadi.logic_and((t216 >= -2.0943951023931953), (t216 <= 2.0943951023931953))
+    t278 = (t217 <= 2.0943951023931953)
+    t279 = casadi.logic_and((t146 >= -2.0943951023931953), (t146 <= 2.0943951023931953))
+    t280 = (t147 <= 2.0943951023931953)
+    t281 = casadi.logic_and((t220 >= -2.0943951023931953), (t220 <= 2.0943951023931953))
+    t282 = -t221
+    t283 = (t282 <= 2.0943951023931953)
+    t284 = (casadi.fabs(t4) < casadi.inf)
+    t285 = (casadi.fabs(mu3) <= 1.5707963267948966)
+    t286 = (t13 > t15)
+    t287 = casadi.logic_or(casadi.logic_and(t16, (0 <= 1e-12*t14)), t286)
+    t288 = (t1 >= -1e-12)
+    t289 = casadi.logic_or(t222, t223)
+    t290 = casadi.logic_or(t253, t254)
     q = casadi.SX(8, 4)
-    q[0, 0] = t245
-    q[0, 1] = casadi.if_else(casadi.logic_and(t246, casadi.logic_not(t247)), t183, t182)
-    q[0, 2] = casadi.if_else(casadi.logic_and(t248, casadi.logic_not(t249)), t69, t68)
-    q[0, 3] = casadi.if_else(casadi.logic_and(t251, casadi.logic_not(t252)), t250, t188)
-    q[1, 0] = t245
-    q[1, 1] = casadi.if_else(casadi.logic_and(t253, casadi.logic_not(t254)), t192, t191)
-    q[1, 2] = casadi.if_else(casadi.logic_and(t255, casadi.logic_not(t256)), t61, t60)
-    q[1, 3] = casadi.if_else(casadi.logic_and(t258, casadi.logic_not(t259)), t257, t195)
-    q[2, 0] = t245
-    q[2, 1] = casadi.if_else(casadi.logic_and(t260, casadi.logic_not(t261)), t200, t199)
-    q[2, 2] = casadi.if_else(casadi.logic_and(t262, casadi.logic_not(t263)), t106, t105)
-    q[2, 3] = casadi.if_else(casadi.logic_and(t265, casadi.logic_not(t266)), t264, t204)
-    q[3, 0] = t245
-    q[3, 1] = casadi.if_else(casadi.logic_and(t267, casadi.logic_not(t268)), t208, t207)
-    q[3, 2] = casadi.if_else(casadi.logic_and(t269, casadi.logic_not(t270)), t108, t107)
-    q[3, 3] = casadi.if_else(casadi.logic_and(t272, casadi.logic_not(t273)), t271, t211)
-    q[4, 0] = t276
-    q[4, 1] = casadi.if_else(casadi.logic_and(t277, casadi.logic_not(t278)), t216, t215)
-    q[4, 2] = casadi.if_else(casadi.logic_and(t279, casadi.logic_not(t280)), t140, t139)
-    q[4, 3] = casadi.if_else(casadi.logic_and(t282, casadi.logic_not(t283)), t281, t219)
-    q[5, 0] = t276
-    q[5, 1] = casadi.if_else(casadi.logic_and(t284, casadi.logic_not(t285)), t223, t222)
-    q[5, 2] = casadi.if_else(casadi.logic_and(t286, casadi.logic_not(t287)), t142, t141)
-    q[5, 3] = casadi.if_else(casadi.logic_and(t289, casadi.logic_not(t290)), t288, t226)
-    q[6, 0] = t276
-    q[6, 1] = casadi.if_else(casadi.logic_and(t291, casadi.logic_not(t292)), t231, t230)
-    q[6, 2] = casadi.if_else(casadi.logic_and(t293, casadi.logic_not(t294)), t169, t168)
-    q[6, 3] = casadi.if_else(casadi.logic_and(t296, casadi.logic_not(t297)), t295, t234)
-    q[7, 0] = t276
-    q[7, 1] = casadi.if_else(casadi.logic_and(t298, casadi.logic_not(t299)), t238, t237)
-    q[7, 2] = casadi.if_else(casadi.logic_and(t300, casadi.logic_not(t301)), t171, t170)
-    q[7, 3] = casadi.if_else(casadi.logic_and(t303, casadi.logic_not(t304)), t302, t241)
+    q[0, 0] = t224
+    q[0, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t225), t226), t162, t161)
+    q[0, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t227), t228), t57, t56)
+    q[0, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t229), t231), t230, t167)
+    q[1, 0] = t224
+    q[1, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t232), t233), t171, t170)
+    q[1, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t234), t235), t59, t58)
+    q[1, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t236), t238), t237, t174)
+    q[2, 0] = t224
+    q[2, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t239), t240), t179, t178)
+    q[2, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t241), t242), t88, t87)
+    q[2, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t243), t245), t244, t183)
+    q[3, 0] = t224
+    q[3, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t246), t247), t187, t186)
+    q[3, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t248), t249), t90, t89)
+    q[3, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t250), t252), t251, t190)
+    q[4, 0] = t255
+    q[4, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t256), t257), t195, t194)
+    q[4, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t258), t259), t120, t119)
+    q[4, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t260), t262), t261, t198)
+    q[5, 0] = t255
+    q[5, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t263), t264), t202, t201)
+    q[5, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t265), t266), t122, t121)
+    q[5, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t267), t269), t268, t205)
+    q[6, 0] = t255
+    q[6, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t270), t271), t210, t209)
+    q[6, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t272), t273), t145, t144)
+    q[6, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t274), t276), t275, t213)
+    q[7, 0] = t255
+    q[7, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t277), t278), t217, t216)
+    q[7, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t279), t280), t147, t146)
+    q[7, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t281), t283), t282, t220)
     valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t305, t306), t308), t309), (t50 >= -1e-12))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t305, t51), t306), t308), t309)
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t305, t5), t306), t308), (t89 >= -1e-12))
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t305, t5), t90), t306), t308)
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t305, t307), t306), t309), (t123 >= -1e-12))
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t305, t124), t307), t306), t309)
-    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t305, t5), t307), t306), (t152 >= -1e-12))
-    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t305, t5), t153), t307), t306)
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t284, t285), t287), t288), (t45 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t284, t285), t287), t288), t46)
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t284, t285), t287), t7), (t75 >= -1e-12))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t284, t285), t287), t7), t77)
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t284, t285), t286), t288), (t105 >= -1e-12))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t284, t285), t286), t288), t109)
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t284, t285), t286), t7), (t108 >= -1e-12))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t284, t285), t286), t7), t134)
     in_limits = casadi.SX(8, 1)
-    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t310, casadi.logic_or(t246, t247)), casadi.logic_or(t248, t249)), casadi.logic_or(t251, t252))
-    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t310, casadi.logic_or(t253, t254)), casadi.logic_or(t255, t256)), casadi.logic_or(t258, t259))
-    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t310, casadi.logic_or(t260, t261)), casadi.logic_or(t262, t263)), casadi.logic_or(t265, t266))
-    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t310, casadi.logic_or(t267, t268)), casadi.logic_or(t269, t270)), casadi.logic_or(t272, t273))
-    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t311, casadi.logic_or(t277, t278)), casadi.logic_or(t279, t280)), casadi.logic_or(t282, t283))
-    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t311, casadi.logic_or(t284, t285)), casadi.logic_or(t286, t287)), casadi.logic_or(t289, t290))
-    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t311, casadi.logic_or(t291, t292)), casadi.logic_or(t293, t294)), casadi.logic_or(t296, t297))
-    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t311, casadi.logic_or(t298, t299)), casadi.logic_or(t300, t301)), casadi.logic_or(t303, t304))
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t289, casadi.logic_or(t225, t226)), casadi.logic_or(t227, t228)), casadi.logic_or(t229, t231))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t289, casadi.logic_or(t232, t233)), casadi.logic_or(t234, t235)), casadi.logic_or(t236, t238))
+    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t289, casadi.logic_or(t239, t240)), casadi.logic_or(t241, t242)), casadi.logic_or(t243, t245))
+    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t289, casadi.logic_or(t246, t247)), casadi.logic_or(t248, t249)), casadi.logic_or(t250, t252))
+    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, casadi.logic_or(t256, t257)), casadi.logic_or(t258, t259)), casadi.logic_or(t260, t262))
+    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, casadi.logic_or(t263, t264)), casadi.logic_or(t265, t266)), casadi.logic_or(t267, t269))
+    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, casadi.logic_or(t270, t271)), casadi.logic_or(t272, t273)), casadi.logic_or(t274, t276))
+    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, casadi.logic_or(t277, t278)), casadi.logic_or(t279, t280)), casadi.logic_or(t281, t283))
     return [q, valid, in_limits]
 
 
@@ -1660,44 +1639,44 @@ def _ik_nearest(mu, q_seed, weights):
     t1 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
     t2 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
     t3 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
-    t4 = casadi.if_else(casadi.logic_and(lb0, vb0), 1, 0)
+    t4 = casadi.if_else(casadi.logic_and(vb0, lb0), 1, 0)
     t5 = casadi.if_else((t4 > 0), 1, 0)
     t6 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
     t7 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
     t8 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
     t9 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
-    t10 = casadi.if_else(casadi.logic_and(lb1, vb1), 1, 0)
+    t10 = casadi.if_else(casadi.logic_and(vb1, lb1), 1, 0)
     t11 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
     t12 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
     t13 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
     t14 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
-    t15 = casadi.if_else(casadi.logic_and(lb2, vb2), 1, 0)
+    t15 = casadi.if_else(casadi.logic_and(vb2, lb2), 1, 0)
     t16 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
     t17 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
     t18 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
     t19 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
-    t20 = casadi.if_else(casadi.logic_and(lb3, vb3), 1, 0)
+    t20 = casadi.if_else(casadi.logic_and(vb3, lb3), 1, 0)
     t21 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
     t22 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
     t23 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
     t24 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
-    t25 = casadi.if_else(casadi.logic_and(lb4, vb4), 1, 0)
+    t25 = casadi.if_else(casadi.logic_and(vb4, lb4), 1, 0)
     t26 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
     t27 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
     t28 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
     t29 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
-    t30 = casadi.if_else(casadi.logic_and(lb5, vb5), 1, 0)
+    t30 = casadi.if_else(casadi.logic_and(vb5, lb5), 1, 0)
     t31 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
     t32 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
     t33 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
     t34 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
-    t35 = casadi.if_else(casadi.logic_and(lb6, vb6), 1, 0)
+    t35 = casadi.if_else(casadi.logic_and(vb6, lb6), 1, 0)
     t36 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
     t37 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
     t38 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
     t39 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
-    t40 = casadi.if_else(casadi.logic_and(lb7, vb7), 1, 0)
-    t41 = mu0 + mu1 + mu2 + mu3 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
+    t40 = casadi.if_else(casadi.logic_and(vb7, lb7), 1, 0)
+    t41 = mu3 + mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
     t42 = casadi.if_else((t0 < qn1), 6.283185307179586, -6.283185307179586)
     t43 = t0 + t42
     t44 = -t42 + t0
@@ -1906,8 +1885,8 @@ def _ik_nearest(mu, q_seed, weights):
     t247 = casadi.if_else(t245, t232, t221)
     t248 = casadi.if_else(t245, t236, t222)
     t249 = casadi.if_else(t245, t240, t223)
-    t250 = (casadi.fabs(t41) < casadi.inf)
-    t251 = (t244 > 0)
+    t250 = (t244 > 0)
+    t251 = (casadi.fabs(t41) < casadi.inf)
     t252 = casadi.logic_and(t250, t251)
     q = casadi.SX(4, 1)
     q[0, 0] = casadi.if_else(t252, t246, qn1)
@@ -1915,7 +1894,7 @@ def _ik_nearest(mu, q_seed, weights):
     q[2, 0] = casadi.if_else(t252, t248, qn3)
     q[3, 0] = casadi.if_else(t252, t249, qn4)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t250), 2, casadi.if_else(t251, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t251), 2, casadi.if_else(t250, 0, 1))
     return [q, status]
 
 

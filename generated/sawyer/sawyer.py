@@ -3837,35 +3837,35 @@ def ik_general_limits(q_solution):
     qg7 = q_solution[..., 6]
     t0 = qg1 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg1))
     t1 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t0)) + t0
-    t2 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg2)) + qg2
+    t2 = qg2 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg2))
     t3 = -6.283185307179586*xp.floor(0.15915494309189535*(3.822271061867582 + t2)) + t2
-    t4 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg3)) + qg3
+    t4 = qg3 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg3))
     t5 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t4)) + t4
-    t6 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg4)) + qg4
+    t6 = qg4 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg4))
     t7 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t6)) + t6
-    t8 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg5)) + qg5
+    t8 = qg5 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg5))
     t9 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t8)) + t8
-    t10 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg6)) + qg6
+    t10 = qg6 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + qg6))
     t11 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t10)) + t10
-    t12 = xp.less_equal(t1, 3.0543261909900767)
-    t13 = xp.greater_equal(t0, -3.0543261909900767) & xp.less_equal(t0, 3.0543261909900767)
-    t14 = xp.less_equal(t3, 2.2863813201125716)
-    t15 = xp.greater_equal(t2, -3.822271061867582) & xp.less_equal(t2, 2.2863813201125716)
-    t16 = xp.less_equal(t5, 3.0543261909900767)
-    t17 = xp.greater_equal(t4, -3.0543261909900767) & xp.less_equal(t4, 3.0543261909900767)
-    t18 = xp.less_equal(t7, 3.0543261909900767)
-    t19 = xp.greater_equal(t6, -3.0543261909900767) & xp.less_equal(t6, 3.0543261909900767)
-    t20 = xp.less_equal(t9, 2.9670597283903604)
-    t21 = xp.greater_equal(t8, -2.9670597283903604) & xp.less_equal(t8, 2.9670597283903604)
-    t22 = xp.less_equal(t11, 2.9670597283903604)
-    t23 = xp.greater_equal(t10, -2.9670597283903604) & xp.less_equal(t10, 2.9670597283903604)
+    t12 = xp.greater_equal(t0, -3.0543261909900767) & xp.less_equal(t0, 3.0543261909900767)
+    t13 = xp.less_equal(t1, 3.0543261909900767)
+    t14 = xp.greater_equal(t2, -3.822271061867582) & xp.less_equal(t2, 2.2863813201125716)
+    t15 = xp.less_equal(t3, 2.2863813201125716)
+    t16 = xp.greater_equal(t4, -3.0543261909900767) & xp.less_equal(t4, 3.0543261909900767)
+    t17 = xp.less_equal(t5, 3.0543261909900767)
+    t18 = xp.greater_equal(t6, -3.0543261909900767) & xp.less_equal(t6, 3.0543261909900767)
+    t19 = xp.less_equal(t7, 3.0543261909900767)
+    t20 = xp.greater_equal(t8, -2.9670597283903604) & xp.less_equal(t8, 2.9670597283903604)
+    t21 = xp.less_equal(t9, 2.9670597283903604)
+    t22 = xp.greater_equal(t10, -2.9670597283903604) & xp.less_equal(t10, 2.9670597283903604)
+    t23 = xp.less_equal(t11, 2.9670597283903604)
     q = _stack(xp, [
-        xp.where(t12 & xp.logical_not(t13), t1, t0),  # 0
-        xp.where(t14 & xp.logical_not(t15), t3, t2),  # 1
-        xp.where(t16 & xp.logical_not(t17), t5, t4),  # 2
-        xp.where(t18 & xp.logical_not(t19), t7, t6),  # 3
-        xp.where(t20 & xp.logical_not(t21), t9, t8),  # 4
-        xp.where(t22 & xp.logical_not(t23), t11, t10),  # 5
+        xp.where(xp.logical_not(t12) & t13, t1, t0),  # 0
+        xp.where(xp.logical_not(t14) & t15, t3, t2),  # 1
+        xp.where(xp.logical_not(t16) & t17, t5, t4),  # 2
+        xp.where(xp.logical_not(t18) & t19, t7, t6),  # 3
+        xp.where(xp.logical_not(t20) & t21, t9, t8),  # 4
+        xp.where(xp.logical_not(t22) & t23, t11, t10),  # 5
         qg7,  # 6
     ], (7,))
     in_limits = xp.broadcast_to(xp.greater_equal(qg7, -4.71238898038469) & xp.less_equal(qg7, 4.71238898038469) & (t12 | t13) & (t14 | t15) & (t16 | t17) & (t18 | t19) & (t20 | t21) & (t22 | t23), batch)
@@ -4053,7 +4053,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
     t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
     t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
-    t6 = xp.where(lb0 & vb0, xp.asarray(1, dtype=dtype), 0)
+    t6 = xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0)
     t7 = xp.where(xp.greater(t6, 0), xp.asarray(1, dtype=dtype), 0)
     t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
     t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
@@ -4061,106 +4061,106 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
     t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
     t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
-    t14 = xp.where(lb1 & vb1, xp.asarray(1, dtype=dtype), 0)
+    t14 = xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0)
     t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
     t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
     t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
     t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
     t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
     t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
-    t21 = xp.where(lb2 & vb2, xp.asarray(1, dtype=dtype), 0)
+    t21 = xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0)
     t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
     t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
     t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
     t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
     t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
     t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
-    t28 = xp.where(lb3 & vb3, xp.asarray(1, dtype=dtype), 0)
+    t28 = xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0)
     t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
     t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
     t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
     t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
     t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
     t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
-    t35 = xp.where(lb4 & vb4, xp.asarray(1, dtype=dtype), 0)
+    t35 = xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0)
     t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
     t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
     t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
     t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
     t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
     t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
-    t42 = xp.where(lb5 & vb5, xp.asarray(1, dtype=dtype), 0)
+    t42 = xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0)
     t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
     t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
     t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
     t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
     t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
     t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
-    t49 = xp.where(lb6 & vb6, xp.asarray(1, dtype=dtype), 0)
+    t49 = xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0)
     t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
     t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
     t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
     t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
     t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
     t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
-    t56 = xp.where(lb7 & vb7, xp.asarray(1, dtype=dtype), 0)
+    t56 = xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0)
     t57 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_0 + qn1)) + qb8_0
     t58 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_1 + qn2)) + qb8_1
     t59 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_2 + qn3)) + qb8_2
     t60 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_3 + qn4)) + qb8_3
     t61 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_4 + qn5)) + qb8_4
     t62 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_5 + qn6)) + qb8_5
-    t63 = xp.where(lb8 & vb8, xp.asarray(1, dtype=dtype), 0)
+    t63 = xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0)
     t64 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_0 + qn1)) + qb9_0
     t65 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_1 + qn2)) + qb9_1
     t66 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_2 + qn3)) + qb9_2
     t67 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_3 + qn4)) + qb9_3
     t68 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_4 + qn5)) + qb9_4
     t69 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_5 + qn6)) + qb9_5
-    t70 = xp.where(lb9 & vb9, xp.asarray(1, dtype=dtype), 0)
+    t70 = xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0)
     t71 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_0 + qn1)) + qb10_0
     t72 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_1 + qn2)) + qb10_1
     t73 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_2 + qn3)) + qb10_2
     t74 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_3 + qn4)) + qb10_3
     t75 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_4 + qn5)) + qb10_4
     t76 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_5 + qn6)) + qb10_5
-    t77 = xp.where(lb10 & vb10, xp.asarray(1, dtype=dtype), 0)
+    t77 = xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0)
     t78 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_0 + qn1)) + qb11_0
     t79 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_1 + qn2)) + qb11_1
     t80 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_2 + qn3)) + qb11_2
     t81 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_3 + qn4)) + qb11_3
     t82 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_4 + qn5)) + qb11_4
     t83 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_5 + qn6)) + qb11_5
-    t84 = xp.where(lb11 & vb11, xp.asarray(1, dtype=dtype), 0)
+    t84 = xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0)
     t85 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_0 + qn1)) + qb12_0
     t86 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_1 + qn2)) + qb12_1
     t87 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_2 + qn3)) + qb12_2
     t88 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_3 + qn4)) + qb12_3
     t89 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_4 + qn5)) + qb12_4
     t90 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_5 + qn6)) + qb12_5
-    t91 = xp.where(lb12 & vb12, xp.asarray(1, dtype=dtype), 0)
+    t91 = xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0)
     t92 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_0 + qn1)) + qb13_0
     t93 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_1 + qn2)) + qb13_1
     t94 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_2 + qn3)) + qb13_2
     t95 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_3 + qn4)) + qb13_3
     t96 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_4 + qn5)) + qb13_4
     t97 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_5 + qn6)) + qb13_5
-    t98 = xp.where(lb13 & vb13, xp.asarray(1, dtype=dtype), 0)
+    t98 = xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0)
     t99 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_0 + qn1)) + qb14_0
     t100 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_1 + qn2)) + qb14_1
     t101 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_2 + qn3)) + qb14_2
     t102 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_3 + qn4)) + qb14_3
     t103 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_4 + qn5)) + qb14_4
     t104 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_5 + qn6)) + qb14_5
-    t105 = xp.where(lb14 & vb14, xp.asarray(1, dtype=dtype), 0)
+    t105 = xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0)
     t106 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_0 + qn1)) + qb15_0
     t107 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_1 + qn2)) + qb15_1
     t108 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_2 + qn3)) + qb15_2
     t109 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_3 + qn4)) + qb15_3
     t110 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_4 + qn5)) + qb15_4
     t111 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_5 + qn6)) + qb15_5
-    t112 = xp.where(lb15 & vb15, xp.asarray(1, dtype=dtype), 0)
-    t113 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7 + qn7
+    t112 = xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0)
+    t113 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7
     t114 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t115 = t0 + t114
     t116 = -t114 + t0
@@ -4598,7 +4598,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t548 = xp.where(xp.greater_equal(t83, -2.9670597283903604) & xp.less_equal(t83, 2.9670597283903604), t83, xp.where(xp.greater_equal(t546, -2.9670597283903604) & xp.less_equal(t546, 2.9670597283903604), t546, xp.where(xp.greater_equal(t547, -2.9670597283903604) & xp.less_equal(t547, 2.9670597283903604), t547, qb11_5)))
     t549 = qw1*(t138 + t528)**2 + qw2*(t139 + t532)**2 + qw3*(t140 + t536)**2 + qw4*(t141 + t540)**2 + qw5*(t142 + t544)**2 + qw6*(t143 + t548)**2 + qw7*(t144 + qb11_6)**2
     t550 = xp.greater(t84, 0)
-    t551 = xp.where(t550 & (xp.less(t549, t524) | xp.less(t515, 1)), xp.asarray(1, dtype=dtype), 0)
+    t551 = xp.where(t550 & (xp.less(t515, 1) | xp.less(t549, t524)), xp.asarray(1, dtype=dtype), 0)
     t552 = xp.where(t550, 1, t515)
     t553 = xp.greater(t551, 0)
     t554 = xp.where(t553, t528, t517)
@@ -4756,8 +4756,8 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     t706 = xp.where(t701, t692, t669)
     t707 = xp.where(t701, t696, t670)
     t708 = xp.where(t701, qb15_6, t671)
-    t709 = xp.isfinite(t113)
-    t710 = xp.greater(t700, 0)
+    t709 = xp.greater(t700, 0)
+    t710 = xp.isfinite(t113)
     t711 = t709 & t710
     q = _stack(xp, [
         xp.broadcast_to(xp.where(t711, t702, qn1), batch),  # 0
@@ -4768,7 +4768,7 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
         xp.broadcast_to(xp.where(t711, t707, qn6), batch),  # 5
         xp.broadcast_to(xp.where(t711, t708, qn7), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t709), 2, xp.where(t710, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t710), 2, xp.where(t709, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

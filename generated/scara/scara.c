@@ -862,7 +862,7 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
     const scara_real t2 = s12*c4 - c12*s4;
     const scara_real t3 = -t0 + mu2;
     const scara_real t4 = 1 + damping;
-    const scara_real t5 = qs1 + qs2 + qs3 + qs4 + mu0 + mu1 + mu2 + mu3;
+    const scara_real t5 = qs1 + qs2 + qs3 + qs4 + mu3 + mu0 + mu1 + mu2;
     const scara_real t6 = 0.275*c12;
     const scara_real t7 = t6 + 0.325*c1;
     const scara_real t8 = (t7*t7) + 0.075625*(c12*c12);
@@ -941,7 +941,7 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
 
 void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF], int valid[SCARA_MAX_IK_SOLUTIONS], int in_limits[SCARA_MAX_IK_SOLUTIONS])
 {
-    /* 186 operations */
+    /* 171 operations */
 
     /* Inputs */
     const scara_real mu0 = mu[0];
@@ -952,84 +952,83 @@ void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_M
     /* Intermediate terms */
     const scara_real t0 = 0.149769 + (mu0*mu0) + (mu1*mu1);
     const scara_real t1 = 0.5*(0.331019 - t0);
-    const scara_real t2 = mu0 + mu1 + mu2 + mu3;
-    const scara_real t3 = (t1*t1);
-    const scara_real t4 = 1 - 125.18949581886645*t3;
-    const int t5 = t4 > 1e-12;
-    const scara_real t6 = (t5 ? sqrt(t4) : 0);
-    const scara_real t7 = 11.188811188811188*t1;
-    const scara_real t8 = (t5 ? t7 : (t7 > 0 ? 1 : -1));
-    const scara_real t9 = atan2(t6, t8);
-    const scara_real t10 = 3.141592653589793 - t9;
-    const scara_real t11 = 0.325 - 0.275*t8;
-    const scara_real t12 = 0.149769 + 0.075625*(t6*t6) + (t11*t11);
-    const scara_real t13 = -6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t10)) + t10;
+    const scara_real t2 = 1 - 125.18949581886645*(t1*t1);
+    const scara_real t3 = mu3 + mu0 + mu1 + mu2;
+    const int t4 = t2 > 1e-12;
+    const scara_real t5 = (t4 ? sqrt(t2) : 0);
+    const scara_real t6 = 11.188811188811188*t1;
+    const scara_real t7 = (t4 ? t6 : (t6 > 0 ? 1 : -1));
+    const scara_real t8 = atan2(t5, t7);
+    const scara_real t9 = 3.141592653589793 + t8;
+    const scara_real t10 = 3.141592653589793 - t8;
+    const scara_real t11 = 0.325 - 0.275*t7;
+    const scara_real t12 = 0.149769 + 0.075625*(t5*t5) + (t11*t11);
+    const scara_real t13 = -6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t9)) + t9;
     const scara_real t14 = -6.283185307179586*floor(0.15915494309189535*(1.53588974175501 + t13)) + t13;
-    const scara_real t15 = 3.141592653589793 + t9;
-    const scara_real t16 = -t8;
-    const scara_real t17 = -t6;
-    const scara_real t18 = 0.325 + 0.275*t16;
-    const scara_real t19 = 0.149769 + 0.075625*(t17*t17) + (t18*t18);
-    const scara_real t20 = -6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t15)) + t15;
-    const scara_real t21 = -6.283185307179586*floor(0.15915494309189535*(1.53588974175501 + t20)) + t20;
-    const scara_real t22 = 0.275*t17;
-    const scara_real t23 = 0.149769 + mu0*t18 + t22*mu1;
-    const scara_real t24 = -0.149769 + t23;
-    const scara_real t25 = mu1*t18 - t22*mu0;
-    const scara_real t26 = (t24*t24) + (t25*t25);
-    const scara_real t27 = 0.275*t6;
-    const scara_real t28 = 0.149769 + mu0*t11 + t27*mu1;
-    const scara_real t29 = -0.149769 + t28;
-    const scara_real t30 = mu1*t11 - t27*mu0;
-    const scara_real t31 = (t29*t29) + (t30*t30);
-    const scara_real t32 = 1e-24*t0;
-    const scara_real t33 = (t26 <= t32*t19 ? 0 : atan2(t25, t24));
-    const scara_real t34 = t33;
-    const scara_real t35 = -6.283185307179586*floor(0.15915494309189535*(0.8726646259971648 + t34)) + t34;
-    const scara_real t36 = -mu3;
-    const scara_real t37 = -(t15 + t33 + t36);
-    const scara_real t38 = t37 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t37));
-    const scara_real t39 = -t38;
-    const scara_real t40 = 6.283185307179586*floor(0.15915494309189535*(6.283185307179586 + t39)) + t38;
-    const scara_real t41 = (t31 <= t32*t12 ? 0 : atan2(t30, t29));
-    const scara_real t42 = t41;
-    const scara_real t43 = -6.283185307179586*floor(0.15915494309189535*(0.8726646259971648 + t42)) + t42;
-    const scara_real t44 = -(t10 + t41 + t36);
-    const scara_real t45 = t44 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t44));
-    const scara_real t46 = -t45;
-    const scara_real t47 = 6.283185307179586*floor(0.15915494309189535*(6.283185307179586 + t46)) + t45;
-    const int t48 = t35 <= 0.8726646259971648;
-    const int t49 = t34 >= -0.8726646259971648 && t34 <= 0.8726646259971648;
-    const int t50 = t21 <= 1.53588974175501;
-    const int t51 = t20 >= -1.53588974175501 && t20 <= 1.53588974175501;
-    const scara_real t52 = -(-0.387 + mu2);
-    const scara_real t53 = -t40;
+    const scara_real t15 = -6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t10)) + t10;
+    const scara_real t16 = -6.283185307179586*floor(0.15915494309189535*(1.53588974175501 + t15)) + t15;
+    const scara_real t17 = 0.275*t5;
+    const scara_real t18 = t17*mu1;
+    const scara_real t19 = 0.149769 + mu0*t11;
+    const scara_real t20 = -t18 + t19;
+    const scara_real t21 = -0.149769 + t20;
+    const scara_real t22 = t18 + t19;
+    const scara_real t23 = -0.149769 + t22;
+    const scara_real t24 = mu1*t11;
+    const scara_real t25 = t17*mu0;
+    const scara_real t26 = t24 + t25;
+    const scara_real t27 = (t21*t21) + (t26*t26);
+    const scara_real t28 = t24 - t25;
+    const scara_real t29 = (t23*t23) + (t28*t28);
+    const scara_real t30 = 1e-24*t0*t12;
+    const scara_real t31 = (t27 <= t30 ? 0 : atan2(t26, t21));
+    const scara_real t32 = t31;
+    const scara_real t33 = -6.283185307179586*floor(0.15915494309189535*(0.8726646259971648 + t32)) + t32;
+    const scara_real t34 = -mu3;
+    const scara_real t35 = -(t31 + t9 + t34);
+    const scara_real t36 = t35 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t35));
+    const scara_real t37 = -t36;
+    const scara_real t38 = t36 + 6.283185307179586*floor(0.15915494309189535*(6.283185307179586 + t37));
+    const scara_real t39 = (t29 <= t30 ? 0 : atan2(t28, t23));
+    const scara_real t40 = t39;
+    const scara_real t41 = -6.283185307179586*floor(0.15915494309189535*(0.8726646259971648 + t40)) + t40;
+    const scara_real t42 = -(t39 + t10 + t34);
+    const scara_real t43 = t42 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t42));
+    const scara_real t44 = -t43;
+    const scara_real t45 = t43 + 6.283185307179586*floor(0.15915494309189535*(6.283185307179586 + t44));
+    const int t46 = t32 >= -0.8726646259971648 && t32 <= 0.8726646259971648;
+    const int t47 = t33 <= 0.8726646259971648;
+    const int t48 = t13 >= -1.53588974175501 && t13 <= 1.53588974175501;
+    const int t49 = t14 <= 1.53588974175501;
+    const scara_real t50 = -0.387 + mu2;
+    const scara_real t51 = -t50;
+    const int t52 = t37 >= -6.283185307179586 && t37 <= 6.283185307179586;
+    const scara_real t53 = -t38;
     const int t54 = t53 <= 6.283185307179586;
-    const int t55 = t39 >= -6.283185307179586 && t39 <= 6.283185307179586;
-    const int t56 = t43 <= 0.8726646259971648;
-    const int t57 = t42 >= -0.8726646259971648 && t42 <= 0.8726646259971648;
-    const int t58 = t14 <= 1.53588974175501;
-    const int t59 = t13 >= -1.53588974175501 && t13 <= 1.53588974175501;
-    const scara_real t60 = -t47;
+    const int t55 = t40 >= -0.8726646259971648 && t40 <= 0.8726646259971648;
+    const int t56 = t41 <= 0.8726646259971648;
+    const int t57 = t15 >= -1.53588974175501 && t15 <= 1.53588974175501;
+    const int t58 = t16 <= 1.53588974175501;
+    const int t59 = t44 >= -6.283185307179586 && t44 <= 6.283185307179586;
+    const scara_real t60 = -t45;
     const int t61 = t60 <= 6.283185307179586;
-    const int t62 = t46 >= -6.283185307179586 && t46 <= 6.283185307179586;
-    const int t63 = isfinite(t2);
-    const int t64 = t52 >= 0.0;
-    const int t65 = t52 <= 0.21;
+    const int t62 = isfinite(t3);
+    const int t63 = t50 <= 0.0;
+    const int t64 = t51 <= 0.21;
 
     /* Outputs */
-    q[0] = (t48 && !t49 ? t35 : t34);
-    q[1] = (t50 && !t51 ? t21 : t20);
-    q[2] = t52;
-    q[3] = (t54 && !t55 ? t53 : t39);
-    q[4] = (t56 && !t57 ? t43 : t42);
-    q[5] = (t58 && !t59 ? t14 : t13);
-    q[6] = t52;
-    q[7] = (t61 && !t62 ? t60 : t46);
-    valid[0] = t63 && t4 >= -1e-12;
-    valid[1] = t63 && t5;
-    in_limits[0] = t64 && t65 && (t48 || t49) && (t50 || t51) && (t54 || t55);
-    in_limits[1] = t64 && t65 && (t56 || t57) && (t58 || t59) && (t61 || t62);
+    q[0] = (!t46 && t47 ? t33 : t32);
+    q[1] = (!t48 && t49 ? t14 : t13);
+    q[2] = t51;
+    q[3] = (!t52 && t54 ? t53 : t37);
+    q[4] = (!t55 && t56 ? t41 : t40);
+    q[5] = (!t57 && t58 ? t16 : t15);
+    q[6] = t51;
+    q[7] = (!t59 && t61 ? t60 : t44);
+    valid[0] = t62 && t2 >= -1e-12;
+    valid[1] = t62 && t4;
+    in_limits[0] = (t46 || t47) && (t48 || t49) && t63 && t64 && (t52 || t54);
+    in_limits[1] = (t55 || t56) && (t57 || t58) && t63 && t64 && (t59 || t61);
 }
 
 int scara_ik_nearest(const scara_real mu[SCARA_TASK_DIM], const scara_real q_seed[SCARA_DOF], const scara_real weights[SCARA_DOF], scara_real q[SCARA_DOF])
@@ -1070,13 +1069,13 @@ int scara_ik_nearest(const scara_real mu[SCARA_TASK_DIM], const scara_real q_see
     const scara_real t0 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0;
     const scara_real t1 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1;
     const scara_real t2 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3;
-    const scara_real t3 = (lb0 && vb0 ? 1 : 0);
+    const scara_real t3 = (vb0 && lb0 ? 1 : 0);
     const scara_real t4 = (t3 > 0 ? 1 : 0);
     const scara_real t5 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0;
     const scara_real t6 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1;
     const scara_real t7 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3;
-    const scara_real t8 = (lb1 && vb1 ? 1 : 0);
-    const scara_real t9 = mu0 + mu1 + mu2 + mu3 + qn1 + qn2 + qn4 + qw1 + qw2 + qw3 + qn3 + qw4;
+    const scara_real t8 = (vb1 && lb1 ? 1 : 0);
+    const scara_real t9 = mu3 + mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4;
     const scara_real t10 = (t0 < qn1 ? 6.283185307179586 : -6.283185307179586);
     const scara_real t11 = t0 + t10;
     const scara_real t12 = -t10 + t0;
@@ -1121,8 +1120,8 @@ int scara_ik_nearest(const scara_real mu[SCARA_TASK_DIM], const scara_real q_see
     const scara_real t51 = (t49 ? t40 : t29);
     const scara_real t52 = (t49 ? qb1_2 : t30);
     const scara_real t53 = (t49 ? t44 : t31);
-    const int t54 = isfinite(t9);
-    const int t55 = t48 > 0;
+    const int t54 = t48 > 0;
+    const int t55 = isfinite(t9);
     const int t56 = t54 && t55;
 
     /* Outputs */
@@ -1130,7 +1129,7 @@ int scara_ik_nearest(const scara_real mu[SCARA_TASK_DIM], const scara_real q_see
     q[1] = (t56 ? t51 : qn2);
     q[2] = (t56 ? t52 : qn3);
     q[3] = (t56 ? t53 : qn4);
-    return (!t54 ? 2 : (t55 ? 0 : 1));
+    return (!t55 ? 2 : (t54 ? 0 : 1));
 }
 
 int scara_ik(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF])

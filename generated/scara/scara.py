@@ -869,7 +869,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t2 = s12*c4 - c12*s4
     t3 = -t0 + mu2
     t4 = 1 + damping
-    t5 = qs1 + qs2 + qs3 + qs4 + mu0 + mu1 + mu2 + mu3
+    t5 = qs1 + qs2 + qs3 + qs4 + mu3 + mu0 + mu1 + mu2
     t6 = 0.275*c12
     t7 = t6 + 0.325*c1
     t8 = t7**2 + 0.075625*c12**2
@@ -951,7 +951,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 4 and 2 x 1 and 2 x 1), 186 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 4 and 2 x 1 and 2 x 1), 171 operations."""
     xp, dtype, device, batch, (mu,) = _arguments(("mu", mu, (4,)))
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
@@ -959,87 +959,86 @@ def ik_branches(mu):
     mu3 = mu[..., 3]
     t0 = 0.149769 + mu0**2 + mu1**2
     t1 = 0.5*(0.331019 - t0)
-    t2 = mu0 + mu1 + mu2 + mu3
-    t3 = t1**2
-    t4 = 1 - 125.18949581886645*t3
-    t5 = xp.greater(t4, 1e-12)
-    t6 = xp.where(t5, xp.sqrt(t4), 0)
-    t7 = 11.188811188811188*t1
-    t8 = xp.where(t5, t7, xp.where(xp.greater(t7, 0), xp.asarray(1, dtype=dtype), -1))
-    t9 = xp.atan2(t6, t8)
-    t10 = 3.141592653589793 - t9
-    t11 = 0.325 - 0.275*t8
-    t12 = 0.149769 + 0.075625*t6**2 + t11**2
-    t13 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t10)) + t10
+    t2 = 1 - 125.18949581886645*t1**2
+    t3 = mu3 + mu0 + mu1 + mu2
+    t4 = xp.greater(t2, 1e-12)
+    t5 = xp.where(t4, xp.sqrt(t2), 0)
+    t6 = 11.188811188811188*t1
+    t7 = xp.where(t4, t6, xp.where(xp.greater(t6, 0), xp.asarray(1, dtype=dtype), -1))
+    t8 = xp.atan2(t5, t7)
+    t9 = 3.141592653589793 + t8
+    t10 = 3.141592653589793 - t8
+    t11 = 0.325 - 0.275*t7
+    t12 = 0.149769 + 0.075625*t5**2 + t11**2
+    t13 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t9)) + t9
     t14 = -6.283185307179586*xp.floor(0.15915494309189535*(1.53588974175501 + t13)) + t13
-    t15 = 3.141592653589793 + t9
-    t16 = -t8
-    t17 = -t6
-    t18 = 0.325 + 0.275*t16
-    t19 = 0.149769 + 0.075625*t17**2 + t18**2
-    t20 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t15)) + t15
-    t21 = -6.283185307179586*xp.floor(0.15915494309189535*(1.53588974175501 + t20)) + t20
-    t22 = 0.275*t17
-    t23 = 0.149769 + mu0*t18 + t22*mu1
-    t24 = -0.149769 + t23
-    t25 = mu1*t18 - t22*mu0
-    t26 = t24**2 + t25**2
-    t27 = 0.275*t6
-    t28 = 0.149769 + mu0*t11 + t27*mu1
-    t29 = -0.149769 + t28
-    t30 = mu1*t11 - t27*mu0
-    t31 = t29**2 + t30**2
-    t32 = 1e-24*t0
-    t33 = xp.where(xp.less_equal(t26, t32*t19), 0, xp.atan2(t25, t24))
-    t34 = t33
-    t35 = -6.283185307179586*xp.floor(0.15915494309189535*(0.8726646259971648 + t34)) + t34
-    t36 = -mu3
-    t37 = -(t15 + t33 + t36)
-    t38 = t37 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t37))
-    t39 = -t38
-    t40 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t39)) + t38
-    t41 = xp.where(xp.less_equal(t31, t32*t12), 0, xp.atan2(t30, t29))
-    t42 = t41
-    t43 = -6.283185307179586*xp.floor(0.15915494309189535*(0.8726646259971648 + t42)) + t42
-    t44 = -(t10 + t41 + t36)
-    t45 = t44 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t44))
-    t46 = -t45
-    t47 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t46)) + t45
-    t48 = xp.less_equal(t35, 0.8726646259971648)
-    t49 = xp.greater_equal(t34, -0.8726646259971648) & xp.less_equal(t34, 0.8726646259971648)
-    t50 = xp.less_equal(t21, 1.53588974175501)
-    t51 = xp.greater_equal(t20, -1.53588974175501) & xp.less_equal(t20, 1.53588974175501)
-    t52 = -(-0.387 + mu2)
-    t53 = -t40
+    t15 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t10)) + t10
+    t16 = -6.283185307179586*xp.floor(0.15915494309189535*(1.53588974175501 + t15)) + t15
+    t17 = 0.275*t5
+    t18 = t17*mu1
+    t19 = 0.149769 + mu0*t11
+    t20 = -t18 + t19
+    t21 = -0.149769 + t20
+    t22 = t18 + t19
+    t23 = -0.149769 + t22
+    t24 = mu1*t11
+    t25 = t17*mu0
+    t26 = t24 + t25
+    t27 = t21**2 + t26**2
+    t28 = t24 - t25
+    t29 = t23**2 + t28**2
+    t30 = 1e-24*t0*t12
+    t31 = xp.where(xp.less_equal(t27, t30), 0, xp.atan2(t26, t21))
+    t32 = t31
+    t33 = -6.283185307179586*xp.floor(0.15915494309189535*(0.8726646259971648 + t32)) + t32
+    t34 = -mu3
+    t35 = -(t31 + t9 + t34)
+    t36 = t35 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t35))
+    t37 = -t36
+    t38 = t36 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t37))
+    t39 = xp.where(xp.less_equal(t29, t30), 0, xp.atan2(t28, t23))
+    t40 = t39
+    t41 = -6.283185307179586*xp.floor(0.15915494309189535*(0.8726646259971648 + t40)) + t40
+    t42 = -(t39 + t10 + t34)
+    t43 = t42 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t42))
+    t44 = -t43
+    t45 = t43 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t44))
+    t46 = xp.greater_equal(t32, -0.8726646259971648) & xp.less_equal(t32, 0.8726646259971648)
+    t47 = xp.less_equal(t33, 0.8726646259971648)
+    t48 = xp.greater_equal(t13, -1.53588974175501) & xp.less_equal(t13, 1.53588974175501)
+    t49 = xp.less_equal(t14, 1.53588974175501)
+    t50 = -0.387 + mu2
+    t51 = -t50
+    t52 = xp.greater_equal(t37, -6.283185307179586) & xp.less_equal(t37, 6.283185307179586)
+    t53 = -t38
     t54 = xp.less_equal(t53, 6.283185307179586)
-    t55 = xp.greater_equal(t39, -6.283185307179586) & xp.less_equal(t39, 6.283185307179586)
-    t56 = xp.less_equal(t43, 0.8726646259971648)
-    t57 = xp.greater_equal(t42, -0.8726646259971648) & xp.less_equal(t42, 0.8726646259971648)
-    t58 = xp.less_equal(t14, 1.53588974175501)
-    t59 = xp.greater_equal(t13, -1.53588974175501) & xp.less_equal(t13, 1.53588974175501)
-    t60 = -t47
+    t55 = xp.greater_equal(t40, -0.8726646259971648) & xp.less_equal(t40, 0.8726646259971648)
+    t56 = xp.less_equal(t41, 0.8726646259971648)
+    t57 = xp.greater_equal(t15, -1.53588974175501) & xp.less_equal(t15, 1.53588974175501)
+    t58 = xp.less_equal(t16, 1.53588974175501)
+    t59 = xp.greater_equal(t44, -6.283185307179586) & xp.less_equal(t44, 6.283185307179586)
+    t60 = -t45
     t61 = xp.less_equal(t60, 6.283185307179586)
-    t62 = xp.greater_equal(t46, -6.283185307179586) & xp.less_equal(t46, 6.283185307179586)
-    t63 = xp.isfinite(t2)
-    t64 = xp.greater_equal(t52, 0.0)
-    t65 = xp.less_equal(t52, 0.21)
+    t62 = xp.isfinite(t3)
+    t63 = xp.less_equal(t50, 0.0)
+    t64 = xp.less_equal(t51, 0.21)
     q = _stack(xp, [
-        xp.where(t48 & xp.logical_not(t49), t35, t34),  # 0, 0
-        xp.where(t50 & xp.logical_not(t51), t21, t20),  # 0, 1
-        t52,  # 0, 2
-        xp.where(t54 & xp.logical_not(t55), t53, t39),  # 0, 3
-        xp.where(t56 & xp.logical_not(t57), t43, t42),  # 1, 0
-        xp.where(t58 & xp.logical_not(t59), t14, t13),  # 1, 1
-        t52,  # 1, 2
-        xp.where(t61 & xp.logical_not(t62), t60, t46),  # 1, 3
+        xp.where(xp.logical_not(t46) & t47, t33, t32),  # 0, 0
+        xp.where(xp.logical_not(t48) & t49, t14, t13),  # 0, 1
+        t51,  # 0, 2
+        xp.where(xp.logical_not(t52) & t54, t53, t37),  # 0, 3
+        xp.where(xp.logical_not(t55) & t56, t41, t40),  # 1, 0
+        xp.where(xp.logical_not(t57) & t58, t16, t15),  # 1, 1
+        t51,  # 1, 2
+        xp.where(xp.logical_not(t59) & t61, t60, t44),  # 1, 3
     ], (2, 4))
     valid = _stack(xp, [
-        t63 & xp.greater_equal(t4, -1e-12),  # 0
-        t63 & t5,  # 1
+        t62 & xp.greater_equal(t2, -1e-12),  # 0
+        t62 & t4,  # 1
     ], (2,))
     in_limits = _stack(xp, [
-        t64 & t65 & (t48 | t49) & (t50 | t51) & (t54 | t55),  # 0
-        t64 & t65 & (t56 | t57) & (t58 | t59) & (t61 | t62),  # 1
+        (t46 | t47) & (t48 | t49) & t63 & t64 & (t52 | t54),  # 0
+        (t55 | t56) & (t57 | t58) & t63 & t64 & (t59 | t61),  # 1
     ], (2,))
     return q, valid, in_limits
 
@@ -1076,13 +1075,13 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
     t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
     t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
-    t3 = xp.where(lb0 & vb0, xp.asarray(1, dtype=dtype), 0)
+    t3 = xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0)
     t4 = xp.where(xp.greater(t3, 0), xp.asarray(1, dtype=dtype), 0)
     t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
     t6 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
     t7 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
-    t8 = xp.where(lb1 & vb1, xp.asarray(1, dtype=dtype), 0)
-    t9 = mu0 + mu1 + mu2 + mu3 + qn1 + qn2 + qn4 + qw1 + qw2 + qw3 + qn3 + qw4
+    t8 = xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0)
+    t9 = mu3 + mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
     t10 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
     t11 = t0 + t10
     t12 = -t10 + t0
@@ -1127,8 +1126,8 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t51 = xp.where(t49, t40, t29)
     t52 = xp.where(t49, qb1_2, t30)
     t53 = xp.where(t49, t44, t31)
-    t54 = xp.isfinite(t9)
-    t55 = xp.greater(t48, 0)
+    t54 = xp.greater(t48, 0)
+    t55 = xp.isfinite(t9)
     t56 = t54 & t55
     q = _stack(xp, [
         xp.broadcast_to(xp.where(t56, t50, qn1), batch),  # 0
@@ -1136,7 +1135,7 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
         xp.broadcast_to(xp.where(t56, t52, qn3), batch),  # 2
         xp.broadcast_to(xp.where(t56, t53, qn4), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t54), 2, xp.where(t55, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t55), 2, xp.where(t54, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

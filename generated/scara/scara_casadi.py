@@ -577,7 +577,7 @@ def _ik_numeric_step(target, q, damping):
     t2 = s12*c4 - c12*s4
     t3 = -t0 + mu2
     t4 = 1 + damping
-    t5 = qs1 + qs2 + qs3 + qs4 + mu0 + mu1 + mu2 + mu3
+    t5 = qs1 + qs2 + qs3 + qs4 + mu3 + mu0 + mu1 + mu2
     t6 = 0.275*c12
     t7 = t6 + 0.325*c1
     t8 = t7**2 + 0.075625*c12**2
@@ -657,92 +657,91 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 186 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 171 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
     mu3 = mu[3]
     t0 = 0.149769 + mu0**2 + mu1**2
     t1 = 0.5*(0.331019 - t0)
-    t2 = mu0 + mu1 + mu2 + mu3
-    t3 = t1**2
-    t4 = 1 - 125.18949581886645*t3
-    t5 = (t4 > 1e-12)
-    t6 = casadi.if_else(t5, casadi.sqrt(t4), 0)
-    t7 = 11.188811188811188*t1
-    t8 = casadi.if_else(t5, t7, casadi.if_else((t7 > 0), 1, -1))
-    t9 = casadi.atan2(t6, t8)
-    t10 = 3.141592653589793 - t9
-    t11 = 0.325 - 0.275*t8
-    t12 = 0.149769 + 0.075625*t6**2 + t11**2
-    t13 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t10)) + t10
+    t2 = 1 - 125.18949581886645*t1**2
+    t3 = mu3 + mu0 + mu1 + mu2
+    t4 = (t2 > 1e-12)
+    t5 = casadi.if_else(t4, casadi.sqrt(t2), 0)
+    t6 = 11.188811188811188*t1
+    t7 = casadi.if_else(t4, t6, casadi.if_else((t6 > 0), 1, -1))
+    t8 = casadi.atan2(t5, t7)
+    t9 = 3.141592653589793 + t8
+    t10 = 3.141592653589793 - t8
+    t11 = 0.325 - 0.275*t7
+    t12 = 0.149769 + 0.075625*t5**2 + t11**2
+    t13 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t9)) + t9
     t14 = -6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t13)) + t13
-    t15 = 3.141592653589793 + t9
-    t16 = -t8
-    t17 = -t6
-    t18 = 0.325 + 0.275*t16
-    t19 = 0.149769 + 0.075625*t17**2 + t18**2
-    t20 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t15)) + t15
-    t21 = -6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t20)) + t20
-    t22 = 0.275*t17
-    t23 = 0.149769 + mu0*t18 + t22*mu1
-    t24 = -0.149769 + t23
-    t25 = mu1*t18 - t22*mu0
-    t26 = t24**2 + t25**2
-    t27 = 0.275*t6
-    t28 = 0.149769 + mu0*t11 + t27*mu1
-    t29 = -0.149769 + t28
-    t30 = mu1*t11 - t27*mu0
-    t31 = t29**2 + t30**2
-    t32 = 1e-24*t0
-    t33 = casadi.if_else((t26 <= t32*t19), 0, casadi.atan2(t25, t24))
-    t34 = t33
-    t35 = -6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t34)) + t34
-    t36 = -mu3
-    t37 = -(t15 + t33 + t36)
-    t38 = t37 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t37))
-    t39 = -t38
-    t40 = 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t39)) + t38
-    t41 = casadi.if_else((t31 <= t32*t12), 0, casadi.atan2(t30, t29))
-    t42 = t41
-    t43 = -6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t42)) + t42
-    t44 = -(t10 + t41 + t36)
-    t45 = t44 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t44))
-    t46 = -t45
-    t47 = 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t46)) + t45
-    t48 = (t35 <= 0.8726646259971648)
-    t49 = casadi.logic_and((t34 >= -0.8726646259971648), (t34 <= 0.8726646259971648))
-    t50 = (t21 <= 1.53588974175501)
-    t51 = casadi.logic_and((t20 >= -1.53588974175501), (t20 <= 1.53588974175501))
-    t52 = -(-0.387 + mu2)
-    t53 = -t40
+    t15 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t10)) + t10
+    t16 = -6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t15)) + t15
+    t17 = 0.275*t5
+    t18 = t17*mu1
+    t19 = 0.149769 + mu0*t11
+    t20 = -t18 + t19
+    t21 = -0.149769 + t20
+    t22 = t18 + t19
+    t23 = -0.149769 + t22
+    t24 = mu1*t11
+    t25 = t17*mu0
+    t26 = t24 + t25
+    t27 = t21**2 + t26**2
+    t28 = t24 - t25
+    t29 = t23**2 + t28**2
+    t30 = 1e-24*t0*t12
+    t31 = casadi.if_else((t27 <= t30), 0, casadi.atan2(t26, t21))
+    t32 = t31
+    t33 = -6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t32)) + t32
+    t34 = -mu3
+    t35 = -(t31 + t9 + t34)
+    t36 = t35 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t35))
+    t37 = -t36
+    t38 = t36 + 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t37))
+    t39 = casadi.if_else((t29 <= t30), 0, casadi.atan2(t28, t23))
+    t40 = t39
+    t41 = -6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t40)) + t40
+    t42 = -(t39 + t10 + t34)
+    t43 = t42 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t42))
+    t44 = -t43
+    t45 = t43 + 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t44))
+    t46 = casadi.logic_and((t32 >= -0.8726646259971648), (t32 <= 0.8726646259971648))
+    t47 = (t33 <= 0.8726646259971648)
+    t48 = casadi.logic_and((t13 >= -1.53588974175501), (t13 <= 1.53588974175501))
+    t49 = (t14 <= 1.53588974175501)
+    t50 = -0.387 + mu2
+    t51 = -t50
+    t52 = casadi.logic_and((t37 >= -6.283185307179586), (t37 <= 6.283185307179586))
+    t53 = -t38
     t54 = (t53 <= 6.283185307179586)
-    t55 = casadi.logic_and((t39 >= -6.283185307179586), (t39 <= 6.283185307179586))
-    t56 = (t43 <= 0.8726646259971648)
-    t57 = casadi.logic_and((t42 >= -0.8726646259971648), (t42 <= 0.8726646259971648))
-    t58 = (t14 <= 1.53588974175501)
-    t59 = casadi.logic_and((t13 >= -1.53588974175501), (t13 <= 1.53588974175501))
-    t60 = -t47
+    t55 = casadi.logic_and((t40 >= -0.8726646259971648), (t40 <= 0.8726646259971648))
+    t56 = (t41 <= 0.8726646259971648)
+    t57 = casadi.logic_and((t15 >= -1.53588974175501), (t15 <= 1.53588974175501))
+    t58 = (t16 <= 1.53588974175501)
+    t59 = casadi.logic_and((t44 >= -6.283185307179586), (t44 <= 6.283185307179586))
+    t60 = -t45
     t61 = (t60 <= 6.283185307179586)
-    t62 = casadi.logic_and((t46 >= -6.283185307179586), (t46 <= 6.283185307179586))
-    t63 = (casadi.fabs(t2) < casadi.inf)
-    t64 = (t52 >= 0.0)
-    t65 = (t52 <= 0.21)
+    t62 = (casadi.fabs(t3) < casadi.inf)
+    t63 = (t50 <= 0.0)
+    t64 = (t51 <= 0.21)
     q = casadi.SX(2, 4)
-    q[0, 0] = casadi.if_else(casadi.logic_and(t48, casadi.logic_not(t49)), t35, t34)
-    q[0, 1] = casadi.if_else(casadi.logic_and(t50, casadi.logic_not(t51)), t21, t20)
-    q[0, 2] = t52
-    q[0, 3] = casadi.if_else(casadi.logic_and(t54, casadi.logic_not(t55)), t53, t39)
-    q[1, 0] = casadi.if_else(casadi.logic_and(t56, casadi.logic_not(t57)), t43, t42)
-    q[1, 1] = casadi.if_else(casadi.logic_and(t58, casadi.logic_not(t59)), t14, t13)
-    q[1, 2] = t52
-    q[1, 3] = casadi.if_else(casadi.logic_and(t61, casadi.logic_not(t62)), t60, t46)
+    q[0, 0] = casadi.if_else(casadi.logic_and(casadi.logic_not(t46), t47), t33, t32)
+    q[0, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t48), t49), t14, t13)
+    q[0, 2] = t51
+    q[0, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t52), t54), t53, t37)
+    q[1, 0] = casadi.if_else(casadi.logic_and(casadi.logic_not(t55), t56), t41, t40)
+    q[1, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t57), t58), t16, t15)
+    q[1, 2] = t51
+    q[1, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t59), t61), t60, t44)
     valid = casadi.SX(2, 1)
-    valid[0, 0] = casadi.logic_and(t63, (t4 >= -1e-12))
-    valid[1, 0] = casadi.logic_and(t63, t5)
+    valid[0, 0] = casadi.logic_and(t62, (t2 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(t62, t4)
     in_limits = casadi.SX(2, 1)
-    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t64, t65), casadi.logic_or(t48, t49)), casadi.logic_or(t50, t51)), casadi.logic_or(t54, t55))
-    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t64, t65), casadi.logic_or(t56, t57)), casadi.logic_or(t58, t59)), casadi.logic_or(t61, t62))
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_or(t46, t47), casadi.logic_or(t48, t49)), t63), t64), casadi.logic_or(t52, t54))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_or(t55, t56), casadi.logic_or(t57, t58)), t63), t64), casadi.logic_or(t59, t61))
     return [q, valid, in_limits]
 
 
@@ -776,13 +775,13 @@ def _ik_nearest(mu, q_seed, weights):
     t0 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
     t1 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
     t2 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
-    t3 = casadi.if_else(casadi.logic_and(lb0, vb0), 1, 0)
+    t3 = casadi.if_else(casadi.logic_and(vb0, lb0), 1, 0)
     t4 = casadi.if_else((t3 > 0), 1, 0)
     t5 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
     t6 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
     t7 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
-    t8 = casadi.if_else(casadi.logic_and(lb1, vb1), 1, 0)
-    t9 = mu0 + mu1 + mu2 + mu3 + qn1 + qn2 + qn4 + qw1 + qw2 + qw3 + qn3 + qw4
+    t8 = casadi.if_else(casadi.logic_and(vb1, lb1), 1, 0)
+    t9 = mu3 + mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
     t10 = casadi.if_else((t0 < qn1), 6.283185307179586, -6.283185307179586)
     t11 = t0 + t10
     t12 = -t10 + t0
@@ -827,8 +826,8 @@ def _ik_nearest(mu, q_seed, weights):
     t51 = casadi.if_else(t49, t40, t29)
     t52 = casadi.if_else(t49, qb1_2, t30)
     t53 = casadi.if_else(t49, t44, t31)
-    t54 = (casadi.fabs(t9) < casadi.inf)
-    t55 = (t48 > 0)
+    t54 = (t48 > 0)
+    t55 = (casadi.fabs(t9) < casadi.inf)
     t56 = casadi.logic_and(t54, t55)
     q = casadi.SX(4, 1)
     q[0, 0] = casadi.if_else(t56, t50, qn1)
@@ -836,7 +835,7 @@ def _ik_nearest(mu, q_seed, weights):
     q[2, 0] = casadi.if_else(t56, t52, qn3)
     q[3, 0] = casadi.if_else(t56, t53, qn4)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t54), 2, casadi.if_else(t55, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t55), 2, casadi.if_else(t54, 0, 1))
     return [q, status]
 
 

@@ -1785,13 +1785,13 @@ def _ik_branches(T):
     t88 = T20*t85
     t89 = t88 + T20*t49
     t90 = t68*t51 - t73*t87
-    t91 = t68*t87 + t51*t73
+    t91 = t68*t87 + t73*t51
     t92 = t68*t53 - t73*t89
     t93 = t68*t89 + t73*t53
     t94 = 1 - t68
     t95 = t52*t94
-    t96 = t95 + t52*t68
-    t97 = t94*t54
+    t96 = t95 + t68*t52
+    t97 = t54*t94
     t98 = t97 + t68*t54
     t99 = t94*t80
     t100 = t99 + t68*t80
@@ -1804,29 +1804,29 @@ def _ik_branches(T):
     t107 = casadi.if_else(t106, casadi.sqrt(t105), 0)
     t108 = t103 + t96*t107
     t109 = t104 + t108
-    t110 = t107**2
-    t111 = t103 + t110
-    t112 = t90**2
+    t110 = t90**2
+    t111 = t110 + t96**2 + t103
+    t112 = t107**2
     t113 = t109**2 + t110*t112
-    t114 = t103 + t96**2 + t112
-    t115 = 1e-24*t111
-    t116 = (t113 <= t115*t114)
+    t114 = t103 + t112
+    t115 = 1e-24*t114
+    t116 = (t113 <= t115*t111)
     t117 = casadi.if_else(t116, 1, 1/casadi.sqrt(t113))
     t118 = casadi.if_else(t116, 1, t109*t117)
     t119 = t93*(1 - t118)
     t120 = t119 + t93*t118
-    t121 = t107*t90
+    t121 = t90*t107
     t122 = casadi.if_else(t116, 0, -t121*t117)
-    t123 = t118*t92 + t98*t122
-    t124 = t118*t98 - t92*t122
-    t125 = (t111 <= t115)
-    t126 = casadi.if_else(t125, 1, 1/casadi.sqrt(t111))
+    t123 = t92*t118 + t98*t122
+    t124 = t98*t118 - t92*t122
+    t125 = (t114 <= t115)
+    t126 = casadi.if_else(t125, 1, 1/casadi.sqrt(t114))
     t127 = casadi.if_else(t125, 1, t91*t126)
     t128 = casadi.if_else(t125, 0, -t107*t126)
     t129 = t123*(1 - t127)
-    t130 = t129 + t123*t127
+    t130 = t129 + t127*t123
     t131 = t127*t124 + t128*t120
-    t132 = t127*t120 - t124*t128
+    t132 = t127*t120 - t128*t124
     t133 = t130**2 + t131**2
     t134 = t133
     t135 = t133 + t132**2
@@ -1836,7 +1836,7 @@ def _ik_branches(T):
     t139 = T20*t136
     t140 = t139 + T20*t77
     t141 = t68*t79 - t74*t138
-    t142 = t68*t138 + t79*t74
+    t142 = t68*t138 + t74*t79
     t143 = t68*t81 - t74*t140
     t144 = t68*t140 + t74*t81
     t145 = t142**2
@@ -1846,29 +1846,29 @@ def _ik_branches(T):
     t149 = casadi.if_else(t148, casadi.sqrt(t147), 0)
     t150 = t145 + t100*t149
     t151 = t146 + t150
-    t152 = t149**2
-    t153 = t145 + t152
-    t154 = t141**2
+    t152 = t141**2
+    t153 = t152 + t100**2 + t145
+    t154 = t149**2
     t155 = t151**2 + t152*t154
-    t156 = t145 + t100**2 + t154
-    t157 = 1e-24*t153
-    t158 = (t155 <= t157*t156)
+    t156 = t145 + t154
+    t157 = 1e-24*t156
+    t158 = (t155 <= t157*t153)
     t159 = casadi.if_else(t158, 1, 1/casadi.sqrt(t155))
     t160 = casadi.if_else(t158, 1, t151*t159)
     t161 = t144*(1 - t160)
     t162 = t161 + t144*t160
-    t163 = t149*t141
+    t163 = t141*t149
     t164 = casadi.if_else(t158, 0, -t163*t159)
-    t165 = t160*t143 + t102*t164
-    t166 = t160*t102 - t143*t164
-    t167 = (t153 <= t157)
-    t168 = casadi.if_else(t167, 1, 1/casadi.sqrt(t153))
+    t165 = t143*t160 + t102*t164
+    t166 = t102*t160 - t143*t164
+    t167 = (t156 <= t157)
+    t168 = casadi.if_else(t167, 1, 1/casadi.sqrt(t156))
     t169 = casadi.if_else(t167, 1, t142*t168)
     t170 = casadi.if_else(t167, 0, -t149*t168)
     t171 = t165*(1 - t169)
-    t172 = t171 + t165*t169
+    t172 = t171 + t169*t165
     t173 = t169*t166 + t170*t162
-    t174 = t169*t162 - t166*t170
+    t174 = t169*t162 - t170*t166
     t175 = t172**2 + t173**2
     t176 = t175
     t177 = t175 + t174**2
@@ -1881,13 +1881,13 @@ def _ik_branches(T):
     t184 = casadi.if_else(t178, 0, t183)
     t185 = casadi.if_else(t178, 0, -t183)
     t186 = t51*t180 - t87*t184
-    t187 = t51*t184 + t87*t180
+    t187 = t87*t180 + t51*t184
     t188 = t53*t180 - t89*t184
-    t189 = t53*t184 + t89*t180
+    t189 = t89*t180 + t53*t184
     t190 = t79*t180 - t138*t185
-    t191 = t79*t185 + t138*t180
+    t191 = t138*t180 + t79*t185
     t192 = t81*t180 - t140*t185
-    t193 = t81*t185 + t140*t180
+    t193 = t140*t180 + t81*t185
     t194 = 1 - t180
     t195 = t52*t194
     t196 = t195 + t52*t180
@@ -1904,29 +1904,29 @@ def _ik_branches(T):
     t207 = casadi.if_else(t206, casadi.sqrt(t205), 0)
     t208 = t203 + t196*t207
     t209 = t204 + t208
-    t210 = t207**2
-    t211 = t203 + t210
-    t212 = t186**2
+    t210 = t186**2
+    t211 = t210 + t196**2 + t203
+    t212 = t207**2
     t213 = t209**2 + t210*t212
-    t214 = t203 + t196**2 + t212
-    t215 = 1e-24*t211
-    t216 = (t213 <= t215*t214)
+    t214 = t203 + t212
+    t215 = 1e-24*t214
+    t216 = (t213 <= t215*t211)
     t217 = casadi.if_else(t216, 1, 1/casadi.sqrt(t213))
     t218 = casadi.if_else(t216, 1, t209*t217)
     t219 = t189*(1 - t218)
     t220 = t219 + t189*t218
-    t221 = t207*t186
+    t221 = t186*t207
     t222 = casadi.if_else(t216, 0, -t221*t217)
-    t223 = t218*t188 + t198*t222
-    t224 = t218*t198 - t188*t222
-    t225 = (t211 <= t215)
-    t226 = casadi.if_else(t225, 1, 1/casadi.sqrt(t211))
+    t223 = t188*t218 + t198*t222
+    t224 = t198*t218 - t188*t222
+    t225 = (t214 <= t215)
+    t226 = casadi.if_else(t225, 1, 1/casadi.sqrt(t214))
     t227 = casadi.if_else(t225, 1, t187*t226)
     t228 = casadi.if_else(t225, 0, -t207*t226)
     t229 = t223*(1 - t227)
-    t230 = t229 + t223*t227
+    t230 = t229 + t227*t223
     t231 = t227*t224 + t228*t220
-    t232 = t227*t220 - t224*t228
+    t232 = t227*t220 - t228*t224
     t233 = t230**2 + t231**2
     t234 = t233
     t235 = t233 + t232**2
@@ -1937,29 +1937,29 @@ def _ik_branches(T):
     t240 = casadi.if_else(t239, casadi.sqrt(t238), 0)
     t241 = t236 + t200*t240
     t242 = t237 + t241
-    t243 = t240**2
-    t244 = t236 + t243
-    t245 = t190**2
+    t243 = t190**2
+    t244 = t243 + t200**2 + t236
+    t245 = t240**2
     t246 = t242**2 + t243*t245
-    t247 = t236 + t200**2 + t245
-    t248 = 1e-24*t244
-    t249 = (t246 <= t248*t247)
+    t247 = t236 + t245
+    t248 = 1e-24*t247
+    t249 = (t246 <= t248*t244)
     t250 = casadi.if_else(t249, 1, 1/casadi.sqrt(t246))
     t251 = casadi.if_else(t249, 1, t242*t250)
     t252 = t193*(1 - t251)
     t253 = t252 + t193*t251
-    t254 = t240*t190
+    t254 = t190*t240
     t255 = casadi.if_else(t249, 0, -t254*t250)
-    t256 = t251*t192 + t202*t255
-    t257 = t251*t202 - t192*t255
-    t258 = (t244 <= t248)
-    t259 = casadi.if_else(t258, 1, 1/casadi.sqrt(t244))
+    t256 = t192*t251 + t202*t255
+    t257 = t202*t251 - t192*t255
+    t258 = (t247 <= t248)
+    t259 = casadi.if_else(t258, 1, 1/casadi.sqrt(t247))
     t260 = casadi.if_else(t258, 1, t191*t259)
     t261 = casadi.if_else(t258, 0, -t240*t259)
     t262 = t256*(1 - t260)
-    t263 = t262 + t256*t260
+    t263 = t262 + t260*t256
     t264 = t260*t257 + t261*t253
-    t265 = t260*t253 - t257*t261
+    t265 = t260*t253 - t261*t257
     t266 = t263**2 + t264**2
     t267 = t266
     t268 = t266 + t265**2
@@ -1971,7 +1971,7 @@ def _ik_branches(T):
     t274 = casadi.if_else(t116, 0, casadi.atan2(-t121, t109))
     t275 = t274
     t276 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t275)) + t275
-    t277 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t274) + t274
+    t277 = 3.141592653589793 + t274 - 6.283185307179586*casadi.ceil(0.15915494309189535*t274)
     t278 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t277)) + t277
     t279 = casadi.if_else(t125, 0, casadi.atan2(-t107, t91))
     t280 = t279
@@ -1980,209 +1980,209 @@ def _ik_branches(T):
     t283 = casadi.if_else((t134 <= 1e-24*t135), 0, casadi.atan2(t130, -t131))
     t284 = t283
     t285 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t284)) + t284
-    t286 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t283) + t283
+    t286 = 3.141592653589793 + t283 - 6.283185307179586*casadi.ceil(0.15915494309189535*t283)
     t287 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t286)) + t286
     t288 = -t282
-    t289 = 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t288)) + t282
+    t289 = t282 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t288))
     t290 = casadi.if_else(t158, 0, casadi.atan2(-t163, t151))
     t291 = t290
     t292 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t291)) + t291
-    t293 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t290) + t290
+    t293 = 3.141592653589793 + t290 - 6.283185307179586*casadi.ceil(0.15915494309189535*t290)
     t294 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t293)) + t293
     t295 = casadi.if_else(t167, 0, casadi.atan2(-t149, t142))
     t296 = t295
     t297 = -6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t296)) + t296
-    t298 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t295)) + t295
+    t298 = t295 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t295))
     t299 = casadi.if_else((t176 <= 1e-24*t177), 0, casadi.atan2(t172, -t173))
     t300 = t299
     t301 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t300)) + t300
-    t302 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t299) + t299
+    t302 = 3.141592653589793 + t299 - 6.283185307179586*casadi.ceil(0.15915494309189535*t299)
     t303 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t302)) + t302
     t304 = -t298
-    t305 = 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t304)) + t298
+    t305 = t298 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t304))
     t306 = casadi.if_else(t216, 0, casadi.atan2(-t221, t209))
     t307 = t306
     t308 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t307)) + t307
-    t309 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t306) + t306
+    t309 = 3.141592653589793 + t306 - 6.283185307179586*casadi.ceil(0.15915494309189535*t306)
     t310 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t309)) + t309
     t311 = casadi.if_else(t225, 0, casadi.atan2(-t207, t187))
     t312 = t311
     t313 = -6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t312)) + t312
-    t314 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t311)) + t311
+    t314 = t311 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t311))
     t315 = casadi.if_else((t234 <= 1e-24*t235), 0, casadi.atan2(t230, -t231))
     t316 = t315
     t317 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t316)) + t316
-    t318 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t315) + t315
+    t318 = 3.141592653589793 + t315 - 6.283185307179586*casadi.ceil(0.15915494309189535*t315)
     t319 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t318)) + t318
     t320 = -t314
-    t321 = 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t320)) + t314
+    t321 = t314 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t320))
     t322 = casadi.if_else(t249, 0, casadi.atan2(-t254, t242))
     t323 = t322
     t324 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t323)) + t323
-    t325 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t322) + t322
+    t325 = 3.141592653589793 + t322 - 6.283185307179586*casadi.ceil(0.15915494309189535*t322)
     t326 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t325)) + t325
     t327 = casadi.if_else(t258, 0, casadi.atan2(-t240, t191))
     t328 = t327
     t329 = -6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t328)) + t328
-    t330 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t327)) + t327
+    t330 = t327 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t327))
     t331 = casadi.if_else((t267 <= 1e-24*t268), 0, casadi.atan2(t263, -t264))
     t332 = t331
     t333 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t332)) + t332
-    t334 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t331) + t331
+    t334 = 3.141592653589793 + t331 - 6.283185307179586*casadi.ceil(0.15915494309189535*t331)
     t335 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.9670597283903604 + t334)) + t334
     t336 = -t330
-    t337 = 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t336)) + t330
-    t338 = (t56 <= 2.9670597283903604)
-    t339 = casadi.logic_and((t55 >= -2.9670597283903604), (t55 <= 2.9670597283903604))
-    t340 = casadi.if_else(casadi.logic_and(t338, casadi.logic_not(t339)), t56, t55)
-    t341 = (t271 <= 2.9670597283903604)
-    t342 = casadi.logic_and((t270 >= -2.9670597283903604), (t270 <= 2.9670597283903604))
-    t343 = casadi.if_else(casadi.logic_and(t341, casadi.logic_not(t342)), t271, t270)
-    t344 = (t276 <= 2.9670597283903604)
-    t345 = casadi.logic_and((t275 >= -2.9670597283903604), (t275 <= 2.9670597283903604))
-    t346 = (t281 <= 1.5707963267948966)
-    t347 = casadi.logic_and((t280 >= -1.5707963267948966), (t280 <= 1.5707963267948966))
-    t348 = (t285 <= 2.9670597283903604)
-    t349 = casadi.logic_and((t284 >= -2.9670597283903604), (t284 <= 2.9670597283903604))
-    t350 = (t278 <= 2.9670597283903604)
-    t351 = casadi.logic_and((t277 >= -2.9670597283903604), (t277 <= 2.9670597283903604))
-    t352 = -t289
-    t353 = (t352 <= 1.5707963267948966)
-    t354 = casadi.logic_and((t288 >= -1.5707963267948966), (t288 <= 1.5707963267948966))
-    t355 = (t287 <= 2.9670597283903604)
-    t356 = casadi.logic_and((t286 >= -2.9670597283903604), (t286 <= 2.9670597283903604))
-    t357 = (t84 <= 2.9670597283903604)
-    t358 = casadi.logic_and((t83 >= -2.9670597283903604), (t83 <= 2.9670597283903604))
-    t359 = casadi.if_else(casadi.logic_and(t357, casadi.logic_not(t358)), t84, t83)
-    t360 = (t71 <= 2.9670597283903604)
-    t361 = casadi.logic_and((t70 >= -2.9670597283903604), (t70 <= 2.9670597283903604))
-    t362 = casadi.if_else(casadi.logic_and(t360, casadi.logic_not(t361)), t71, t70)
-    t363 = (t292 <= 2.9670597283903604)
-    t364 = casadi.logic_and((t291 >= -2.9670597283903604), (t291 <= 2.9670597283903604))
-    t365 = (t297 <= 1.5707963267948966)
-    t366 = casadi.logic_and((t296 >= -1.5707963267948966), (t296 <= 1.5707963267948966))
-    t367 = (t301 <= 2.9670597283903604)
-    t368 = casadi.logic_and((t300 >= -2.9670597283903604), (t300 <= 2.9670597283903604))
-    t369 = (t294 <= 2.9670597283903604)
-    t370 = casadi.logic_and((t293 >= -2.9670597283903604), (t293 <= 2.9670597283903604))
-    t371 = -t305
-    t372 = (t371 <= 1.5707963267948966)
-    t373 = casadi.logic_and((t304 >= -1.5707963267948966), (t304 <= 1.5707963267948966))
-    t374 = (t303 <= 2.9670597283903604)
-    t375 = casadi.logic_and((t302 >= -2.9670597283903604), (t302 <= 2.9670597283903604))
-    t376 = (t182 <= 2.9670597283903604)
-    t377 = casadi.logic_and((t181 >= -2.9670597283903604), (t181 <= 2.9670597283903604))
-    t378 = casadi.if_else(casadi.logic_and(t376, casadi.logic_not(t377)), t182, t181)
+    t337 = t330 + 6.283185307179586*casadi.floor(0.15915494309189535*(1.5707963267948966 + t336))
+    t338 = casadi.logic_and((t55 >= -2.9670597283903604), (t55 <= 2.9670597283903604))
+    t339 = (t56 <= 2.9670597283903604)
+    t340 = casadi.if_else(casadi.logic_and(casadi.logic_not(t338), t339), t56, t55)
+    t341 = casadi.logic_and((t270 >= -2.9670597283903604), (t270 <= 2.9670597283903604))
+    t342 = (t271 <= 2.9670597283903604)
+    t343 = casadi.if_else(casadi.logic_and(casadi.logic_not(t341), t342), t271, t270)
+    t344 = casadi.logic_and((t275 >= -2.9670597283903604), (t275 <= 2.9670597283903604))
+    t345 = (t276 <= 2.9670597283903604)
+    t346 = casadi.logic_and((t280 >= -1.5707963267948966), (t280 <= 1.5707963267948966))
+    t347 = (t281 <= 1.5707963267948966)
+    t348 = casadi.logic_and((t284 >= -2.9670597283903604), (t284 <= 2.9670597283903604))
+    t349 = (t285 <= 2.9670597283903604)
+    t350 = casadi.logic_and((t277 >= -2.9670597283903604), (t277 <= 2.9670597283903604))
+    t351 = (t278 <= 2.9670597283903604)
+    t352 = casadi.logic_and((t288 >= -1.5707963267948966), (t288 <= 1.5707963267948966))
+    t353 = -t289
+    t354 = (t353 <= 1.5707963267948966)
+    t355 = casadi.logic_and((t286 >= -2.9670597283903604), (t286 <= 2.9670597283903604))
+    t356 = (t287 <= 2.9670597283903604)
+    t357 = casadi.logic_and((t83 >= -2.9670597283903604), (t83 <= 2.9670597283903604))
+    t358 = (t84 <= 2.9670597283903604)
+    t359 = casadi.if_else(casadi.logic_and(casadi.logic_not(t357), t358), t84, t83)
+    t360 = casadi.logic_and((t70 >= -2.9670597283903604), (t70 <= 2.9670597283903604))
+    t361 = (t71 <= 2.9670597283903604)
+    t362 = casadi.if_else(casadi.logic_and(casadi.logic_not(t360), t361), t71, t70)
+    t363 = casadi.logic_and((t291 >= -2.9670597283903604), (t291 <= 2.9670597283903604))
+    t364 = (t292 <= 2.9670597283903604)
+    t365 = casadi.logic_and((t296 >= -1.5707963267948966), (t296 <= 1.5707963267948966))
+    t366 = (t297 <= 1.5707963267948966)
+    t367 = casadi.logic_and((t300 >= -2.9670597283903604), (t300 <= 2.9670597283903604))
+    t368 = (t301 <= 2.9670597283903604)
+    t369 = casadi.logic_and((t293 >= -2.9670597283903604), (t293 <= 2.9670597283903604))
+    t370 = (t294 <= 2.9670597283903604)
+    t371 = casadi.logic_and((t304 >= -1.5707963267948966), (t304 <= 1.5707963267948966))
+    t372 = -t305
+    t373 = (t372 <= 1.5707963267948966)
+    t374 = casadi.logic_and((t302 >= -2.9670597283903604), (t302 <= 2.9670597283903604))
+    t375 = (t303 <= 2.9670597283903604)
+    t376 = casadi.logic_and((t181 >= -2.9670597283903604), (t181 <= 2.9670597283903604))
+    t377 = (t182 <= 2.9670597283903604)
+    t378 = casadi.if_else(casadi.logic_and(casadi.logic_not(t376), t377), t182, t181)
     t379 = -t21
-    t380 = (t308 <= 2.9670597283903604)
-    t381 = casadi.logic_and((t307 >= -2.9670597283903604), (t307 <= 2.9670597283903604))
-    t382 = (t313 <= 1.5707963267948966)
-    t383 = casadi.logic_and((t312 >= -1.5707963267948966), (t312 <= 1.5707963267948966))
-    t384 = (t317 <= 2.9670597283903604)
-    t385 = casadi.logic_and((t316 >= -2.9670597283903604), (t316 <= 2.9670597283903604))
-    t386 = (t310 <= 2.9670597283903604)
-    t387 = casadi.logic_and((t309 >= -2.9670597283903604), (t309 <= 2.9670597283903604))
-    t388 = -t321
-    t389 = (t388 <= 1.5707963267948966)
-    t390 = casadi.logic_and((t320 >= -1.5707963267948966), (t320 <= 1.5707963267948966))
-    t391 = (t319 <= 2.9670597283903604)
-    t392 = casadi.logic_and((t318 >= -2.9670597283903604), (t318 <= 2.9670597283903604))
-    t393 = (t273 <= 2.9670597283903604)
-    t394 = casadi.logic_and((t272 >= -2.9670597283903604), (t272 <= 2.9670597283903604))
-    t395 = casadi.if_else(casadi.logic_and(t393, casadi.logic_not(t394)), t273, t272)
-    t396 = (t324 <= 2.9670597283903604)
-    t397 = casadi.logic_and((t323 >= -2.9670597283903604), (t323 <= 2.9670597283903604))
-    t398 = (t329 <= 1.5707963267948966)
-    t399 = casadi.logic_and((t328 >= -1.5707963267948966), (t328 <= 1.5707963267948966))
-    t400 = (t333 <= 2.9670597283903604)
-    t401 = casadi.logic_and((t332 >= -2.9670597283903604), (t332 <= 2.9670597283903604))
-    t402 = (t326 <= 2.9670597283903604)
-    t403 = casadi.logic_and((t325 >= -2.9670597283903604), (t325 <= 2.9670597283903604))
-    t404 = -t337
-    t405 = (t404 <= 1.5707963267948966)
-    t406 = casadi.logic_and((t336 >= -1.5707963267948966), (t336 <= 1.5707963267948966))
-    t407 = (t335 <= 2.9670597283903604)
-    t408 = casadi.logic_and((t334 >= -2.9670597283903604), (t334 <= 2.9670597283903604))
+    t380 = casadi.logic_and((t307 >= -2.9670597283903604), (t307 <= 2.9670597283903604))
+    t381 = (t308 <= 2.9670597283903604)
+    t382 = casadi.logic_and((t312 >= -1.5707963267948966), (t312 <= 1.5707963267948966))
+    t383 = (t313 <= 1.5707963267948966)
+    t384 = casadi.logic_and((t316 >= -2.9670597283903604), (t316 <= 2.9670597283903604))
+    t385 = (t317 <= 2.9670597283903604)
+    t386 = casadi.logic_and((t309 >= -2.9670597283903604), (t309 <= 2.9670597283903604))
+    t387 = (t310 <= 2.9670597283903604)
+    t388 = casadi.logic_and((t320 >= -1.5707963267948966), (t320 <= 1.5707963267948966))
+    t389 = -t321
+    t390 = (t389 <= 1.5707963267948966)
+    t391 = casadi.logic_and((t318 >= -2.9670597283903604), (t318 <= 2.9670597283903604))
+    t392 = (t319 <= 2.9670597283903604)
+    t393 = casadi.logic_and((t272 >= -2.9670597283903604), (t272 <= 2.9670597283903604))
+    t394 = (t273 <= 2.9670597283903604)
+    t395 = casadi.if_else(casadi.logic_and(casadi.logic_not(t393), t394), t273, t272)
+    t396 = casadi.logic_and((t323 >= -2.9670597283903604), (t323 <= 2.9670597283903604))
+    t397 = (t324 <= 2.9670597283903604)
+    t398 = casadi.logic_and((t328 >= -1.5707963267948966), (t328 <= 1.5707963267948966))
+    t399 = (t329 <= 1.5707963267948966)
+    t400 = casadi.logic_and((t332 >= -2.9670597283903604), (t332 <= 2.9670597283903604))
+    t401 = (t333 <= 2.9670597283903604)
+    t402 = casadi.logic_and((t325 >= -2.9670597283903604), (t325 <= 2.9670597283903604))
+    t403 = (t326 <= 2.9670597283903604)
+    t404 = casadi.logic_and((t336 >= -1.5707963267948966), (t336 <= 1.5707963267948966))
+    t405 = -t337
+    t406 = (t405 <= 1.5707963267948966)
+    t407 = casadi.logic_and((t334 >= -2.9670597283903604), (t334 <= 2.9670597283903604))
+    t408 = (t335 <= 2.9670597283903604)
     t409 = (casadi.fabs(t0) < casadi.inf)
     t410 = (t18 >= -t19)
     t411 = (t26 >= -t27)
-    t412 = (t21 >= 0.30479999999999996)
-    t413 = (t21 <= 1.27)
-    t414 = casadi.logic_or(t338, t339)
-    t415 = casadi.logic_or(t341, t342)
+    t412 = casadi.logic_or(t338, t339)
+    t413 = casadi.logic_or(t341, t342)
+    t414 = (t21 >= 0.30479999999999996)
+    t415 = (t21 <= 1.27)
     t416 = casadi.logic_or(t357, t358)
     t417 = casadi.logic_or(t360, t361)
-    t418 = (t379 >= 0.30479999999999996)
-    t419 = (t379 <= 1.27)
-    t420 = casadi.logic_or(t376, t377)
+    t418 = casadi.logic_or(t376, t377)
+    t419 = (t379 >= 0.30479999999999996)
+    t420 = (t379 <= 1.27)
     t421 = casadi.logic_or(t393, t394)
     q = casadi.SX(8, 6)
     q[0, 0] = t340
     q[0, 1] = t343
     q[0, 2] = t21
-    q[0, 3] = casadi.if_else(casadi.logic_and(t344, casadi.logic_not(t345)), t276, t275)
-    q[0, 4] = casadi.if_else(casadi.logic_and(t346, casadi.logic_not(t347)), t281, t280)
-    q[0, 5] = casadi.if_else(casadi.logic_and(t348, casadi.logic_not(t349)), t285, t284)
+    q[0, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t344), t345), t276, t275)
+    q[0, 4] = casadi.if_else(casadi.logic_and(casadi.logic_not(t346), t347), t281, t280)
+    q[0, 5] = casadi.if_else(casadi.logic_and(casadi.logic_not(t348), t349), t285, t284)
     q[1, 0] = t340
     q[1, 1] = t343
     q[1, 2] = t21
-    q[1, 3] = casadi.if_else(casadi.logic_and(t350, casadi.logic_not(t351)), t278, t277)
-    q[1, 4] = casadi.if_else(casadi.logic_and(t353, casadi.logic_not(t354)), t352, t288)
-    q[1, 5] = casadi.if_else(casadi.logic_and(t355, casadi.logic_not(t356)), t287, t286)
+    q[1, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t350), t351), t278, t277)
+    q[1, 4] = casadi.if_else(casadi.logic_and(casadi.logic_not(t352), t354), t353, t288)
+    q[1, 5] = casadi.if_else(casadi.logic_and(casadi.logic_not(t355), t356), t287, t286)
     q[2, 0] = t359
     q[2, 1] = t362
     q[2, 2] = t21
-    q[2, 3] = casadi.if_else(casadi.logic_and(t363, casadi.logic_not(t364)), t292, t291)
-    q[2, 4] = casadi.if_else(casadi.logic_and(t365, casadi.logic_not(t366)), t297, t296)
-    q[2, 5] = casadi.if_else(casadi.logic_and(t367, casadi.logic_not(t368)), t301, t300)
+    q[2, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t363), t364), t292, t291)
+    q[2, 4] = casadi.if_else(casadi.logic_and(casadi.logic_not(t365), t366), t297, t296)
+    q[2, 5] = casadi.if_else(casadi.logic_and(casadi.logic_not(t367), t368), t301, t300)
     q[3, 0] = t359
     q[3, 1] = t362
     q[3, 2] = t21
-    q[3, 3] = casadi.if_else(casadi.logic_and(t369, casadi.logic_not(t370)), t294, t293)
-    q[3, 4] = casadi.if_else(casadi.logic_and(t372, casadi.logic_not(t373)), t371, t304)
-    q[3, 5] = casadi.if_else(casadi.logic_and(t374, casadi.logic_not(t375)), t303, t302)
+    q[3, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t369), t370), t294, t293)
+    q[3, 4] = casadi.if_else(casadi.logic_and(casadi.logic_not(t371), t373), t372, t304)
+    q[3, 5] = casadi.if_else(casadi.logic_and(casadi.logic_not(t374), t375), t303, t302)
     q[4, 0] = t340
     q[4, 1] = t378
     q[4, 2] = t379
-    q[4, 3] = casadi.if_else(casadi.logic_and(t380, casadi.logic_not(t381)), t308, t307)
-    q[4, 4] = casadi.if_else(casadi.logic_and(t382, casadi.logic_not(t383)), t313, t312)
-    q[4, 5] = casadi.if_else(casadi.logic_and(t384, casadi.logic_not(t385)), t317, t316)
+    q[4, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t380), t381), t308, t307)
+    q[4, 4] = casadi.if_else(casadi.logic_and(casadi.logic_not(t382), t383), t313, t312)
+    q[4, 5] = casadi.if_else(casadi.logic_and(casadi.logic_not(t384), t385), t317, t316)
     q[5, 0] = t340
     q[5, 1] = t378
     q[5, 2] = t379
-    q[5, 3] = casadi.if_else(casadi.logic_and(t386, casadi.logic_not(t387)), t310, t309)
-    q[5, 4] = casadi.if_else(casadi.logic_and(t389, casadi.logic_not(t390)), t388, t320)
-    q[5, 5] = casadi.if_else(casadi.logic_and(t391, casadi.logic_not(t392)), t319, t318)
+    q[5, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t386), t387), t310, t309)
+    q[5, 4] = casadi.if_else(casadi.logic_and(casadi.logic_not(t388), t390), t389, t320)
+    q[5, 5] = casadi.if_else(casadi.logic_and(casadi.logic_not(t391), t392), t319, t318)
     q[6, 0] = t359
     q[6, 1] = t395
     q[6, 2] = t379
-    q[6, 3] = casadi.if_else(casadi.logic_and(t396, casadi.logic_not(t397)), t324, t323)
-    q[6, 4] = casadi.if_else(casadi.logic_and(t398, casadi.logic_not(t399)), t329, t328)
-    q[6, 5] = casadi.if_else(casadi.logic_and(t400, casadi.logic_not(t401)), t333, t332)
+    q[6, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t396), t397), t324, t323)
+    q[6, 4] = casadi.if_else(casadi.logic_and(casadi.logic_not(t398), t399), t329, t328)
+    q[6, 5] = casadi.if_else(casadi.logic_and(casadi.logic_not(t400), t401), t333, t332)
     q[7, 0] = t359
     q[7, 1] = t395
     q[7, 2] = t379
-    q[7, 3] = casadi.if_else(casadi.logic_and(t402, casadi.logic_not(t403)), t326, t325)
-    q[7, 4] = casadi.if_else(casadi.logic_and(t405, casadi.logic_not(t406)), t404, t336)
-    q[7, 5] = casadi.if_else(casadi.logic_and(t407, casadi.logic_not(t408)), t335, t334)
+    q[7, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t402), t403), t326, t325)
+    q[7, 4] = casadi.if_else(casadi.logic_and(casadi.logic_not(t404), t406), t405, t336)
+    q[7, 5] = casadi.if_else(casadi.logic_and(casadi.logic_not(t407), t408), t335, t334)
     valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, (t105 >= -1e-12)), t410), t411)
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, t106), t410), t411)
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, (t147 >= -1e-12)), t28), t410)
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, t148), t28), t410)
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, (t205 >= -1e-12)), t20), t411)
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, t206), t20), t411)
-    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, (t238 >= -1e-12)), t20), t28)
-    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, t239), t20), t28)
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, t410), t411), (t105 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, t410), t411), t106)
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, t410), t28), (t147 >= -1e-12))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, t410), t28), t148)
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, t20), t411), (t205 >= -1e-12))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, t20), t411), t206)
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, t20), t28), (t238 >= -1e-12))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t409, t20), t28), t239)
     in_limits = casadi.SX(8, 1)
     in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t412, t413), t414), t415), casadi.logic_or(t344, t345)), casadi.logic_or(t346, t347)), casadi.logic_or(t348, t349))
-    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t412, t413), t414), t415), casadi.logic_or(t350, t351)), casadi.logic_or(t355, t356)), casadi.logic_or(t353, t354))
-    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t412, t413), t416), t417), casadi.logic_or(t363, t364)), casadi.logic_or(t365, t366)), casadi.logic_or(t367, t368))
-    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t412, t413), t416), t417), casadi.logic_or(t369, t370)), casadi.logic_or(t374, t375)), casadi.logic_or(t372, t373))
-    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t418, t419), t414), t420), casadi.logic_or(t380, t381)), casadi.logic_or(t382, t383)), casadi.logic_or(t384, t385))
-    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t418, t419), t414), t420), casadi.logic_or(t386, t387)), casadi.logic_or(t391, t392)), casadi.logic_or(t389, t390))
-    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t418, t419), t416), t421), casadi.logic_or(t396, t397)), casadi.logic_or(t398, t399)), casadi.logic_or(t400, t401))
-    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t418, t419), t416), t421), casadi.logic_or(t402, t403)), casadi.logic_or(t407, t408)), casadi.logic_or(t405, t406))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t412, t413), t414), t415), casadi.logic_or(t350, t351)), casadi.logic_or(t352, t354)), casadi.logic_or(t355, t356))
+    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t416, t417), t414), t415), casadi.logic_or(t363, t364)), casadi.logic_or(t365, t366)), casadi.logic_or(t367, t368))
+    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t416, t417), t414), t415), casadi.logic_or(t369, t370)), casadi.logic_or(t371, t373)), casadi.logic_or(t374, t375))
+    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t412, t418), t419), t420), casadi.logic_or(t380, t381)), casadi.logic_or(t382, t383)), casadi.logic_or(t384, t385))
+    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t412, t418), t419), t420), casadi.logic_or(t386, t387)), casadi.logic_or(t388, t390)), casadi.logic_or(t391, t392))
+    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t416, t421), t419), t420), casadi.logic_or(t396, t397)), casadi.logic_or(t398, t399)), casadi.logic_or(t400, t401))
+    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t416, t421), t419), t420), casadi.logic_or(t402, t403)), casadi.logic_or(t404, t406)), casadi.logic_or(t407, t408))
     return [q, valid, in_limits]
 
 
@@ -2282,51 +2282,51 @@ def _ik_nearest(T, q_seed, weights):
     t2 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
     t3 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
     t4 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
-    t5 = casadi.if_else(casadi.logic_and(lb0, vb0), 1, 0)
+    t5 = casadi.if_else(casadi.logic_and(vb0, lb0), 1, 0)
     t6 = casadi.if_else((t5 > 0), 1, 0)
     t7 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
     t8 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
     t9 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
     t10 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
     t11 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
-    t12 = casadi.if_else(casadi.logic_and(lb1, vb1), 1, 0)
+    t12 = casadi.if_else(casadi.logic_and(vb1, lb1), 1, 0)
     t13 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
     t14 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
     t15 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
     t16 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
     t17 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
-    t18 = casadi.if_else(casadi.logic_and(lb2, vb2), 1, 0)
+    t18 = casadi.if_else(casadi.logic_and(vb2, lb2), 1, 0)
     t19 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
     t20 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
     t21 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
     t22 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
     t23 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
-    t24 = casadi.if_else(casadi.logic_and(lb3, vb3), 1, 0)
+    t24 = casadi.if_else(casadi.logic_and(vb3, lb3), 1, 0)
     t25 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
     t26 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
     t27 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
     t28 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
     t29 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
-    t30 = casadi.if_else(casadi.logic_and(lb4, vb4), 1, 0)
+    t30 = casadi.if_else(casadi.logic_and(vb4, lb4), 1, 0)
     t31 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
     t32 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
     t33 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
     t34 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
     t35 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
-    t36 = casadi.if_else(casadi.logic_and(lb5, vb5), 1, 0)
+    t36 = casadi.if_else(casadi.logic_and(vb5, lb5), 1, 0)
     t37 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
     t38 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
     t39 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
     t40 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
     t41 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
-    t42 = casadi.if_else(casadi.logic_and(lb6, vb6), 1, 0)
+    t42 = casadi.if_else(casadi.logic_and(vb6, lb6), 1, 0)
     t43 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
     t44 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
     t45 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
     t46 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
     t47 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
-    t48 = casadi.if_else(casadi.logic_and(lb7, vb7), 1, 0)
-    t49 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qn3 + qw4 + qw5 + qw6
+    t48 = casadi.if_else(casadi.logic_and(vb7, lb7), 1, 0)
+    t49 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
     t50 = casadi.if_else((t0 < qn1), 6.283185307179586, -6.283185307179586)
     t51 = t0 + t50
     t52 = -t50 + t0
@@ -2585,8 +2585,8 @@ def _ik_nearest(T, q_seed, weights):
     t305 = casadi.if_else(t301, t288, t273)
     t306 = casadi.if_else(t301, t292, t274)
     t307 = casadi.if_else(t301, t296, t275)
-    t308 = (casadi.fabs(t49) < casadi.inf)
-    t309 = (t300 > 0)
+    t308 = (t300 > 0)
+    t309 = (casadi.fabs(t49) < casadi.inf)
     t310 = casadi.logic_and(t308, t309)
     q = casadi.SX(6, 1)
     q[0, 0] = casadi.if_else(t310, t302, qn1)
@@ -2596,7 +2596,7 @@ def _ik_nearest(T, q_seed, weights):
     q[4, 0] = casadi.if_else(t310, t306, qn5)
     q[5, 0] = casadi.if_else(t310, t307, qn6)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t308), 2, casadi.if_else(t309, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t309), 2, casadi.if_else(t308, 0, 1))
     return [q, status]
 
 

@@ -9,6 +9,7 @@ import math
 from dataclasses import dataclass
 from functools import cached_property
 
+import numpy
 import sympy
 from sympy.core.parameters import distribute
 
@@ -21,7 +22,7 @@ from jacgen.model import kinematics
 from jacgen.model.joint_ring import joint_atoms, maximal_minors
 from jacgen.model.graph import Node
 from jacgen.model.kinematics import generated_symbol
-from jacgen.model.nodes import Above, AtMost, select
+from jacgen.model.nodes import Above, select
 from jacgen.model.singularities import MINOR_LIMIT, Singularities, singularity_jacobian
 from jacgen.solvers import differential, general6r, ik, ik_limits
 from jacgen.solvers.model import Model
@@ -41,8 +42,11 @@ class Result:
     layers: int = 1  # > 1: a stack of that many matrices (the hessian)
 
 
-def matrix(name: str, value: sympy.Matrix, equals: str = "", layers: int = 1) -> Result:
-    return Result(name, list(value), value.rows, value.cols, "matrix", equals, layers)
+def matrix(name: str, value, equals: str = "", layers: int = 1) -> Result:
+    """A sympy Matrix, or a 2-D array of nodes."""
+    rows, cols = value.shape
+    return Result(name, list(value.flat) if isinstance(value, numpy.ndarray) else list(value), rows, cols, "matrix",
+                  equals, layers)
 
 
 def vector(name: str, values, equals: str = "") -> Result:
@@ -121,7 +125,7 @@ class Generator:
         seed = Argument("q_seed", sympy.Matrix([generated_symbol("qn", i + 1) for i in range(n)]))
         weights = Argument("weights", sympy.Matrix([generated_symbol("qw", i + 1) for i in range(n)]),
                            default="(1.0,) * DOF")
-        sp = Subproblems(self.name)
+        sp = Subproblems(self.graph, self.name_node)
         if form.solver == "general_6r":
             parts, rows = self.general_6r_functions(target, free, bindings, sp), form.info.max_solutions
         else:
@@ -130,7 +134,7 @@ class Generator:
             parts = [self.function("ik_branches", "every branch of the closed-form ik, whether the target allows "
                                    "it and whether it is inside the joint limits", matrix("q", q), vector("valid", valid),
                                    vector("in_limits", inside), arguments=(target, *free), bindings=bindings)]
-            rows = q.rows
+            rows = q.shape[0]
         if not self.generates("ik_nearest"):
             return parts
         # ik_nearest reads ik_branches' results rather than lowering the solver a second time.
@@ -231,7 +235,7 @@ class Generator:
                 q, valid, _ = ik.branches(fast.nominal.robot, fast.form, sp, target.symbols, free_angle)
                 margin = sp.margins[0]
                 for other in sp.margins[1:]:
-                    margin = self.name(select(AtMost(margin, other), margin, other))
+                    margin = self.name_node(self.graph.select(self.graph.relation("<=", margin, other), margin, other))
             parts.append(self.function("ik_general_nominal", "the fast path's starting points: every branch of the "
                                        "nearest special class's closed form (the nominal arm's), whether its target "
                                        "allows it, and the least margin of its subproblems", matrix("q", q),
@@ -291,7 +295,7 @@ class Generator:
             return [goal[i, 3] - tool[i, 3] for i in range(3)] + differential.rotation_vector(rotation, self.graph, self.name_node), \
                 self.jacobian
         mu = kinematics.task_vector(self.robot, self.chain.tool)
-        return [wrapped(goal - value) if component in EULER_ANGLES else goal - value
+        return [wrapped(self.graph.value(goal - value)) if component in EULER_ANGLES else goal - value
                 for goal, value, component in zip(target.symbols, mu, self.robot.task)], task_jacobian
 
     @cached_property

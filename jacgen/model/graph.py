@@ -2,15 +2,17 @@
 
 A node is built once per graph (one per robot): equal values are the same object, so a
 node's identity is its value, hashing is free and a shared subexpression is one node however
-many functions read it. The algorithms build their values in sympy; `Graph.convert` takes
-them over once each, every constant subexpression folded to one number (integers stay
-integers, exponents stay exact), and the lowering (`lowering.py`: CSE, constants, the
-operation count) and the printers work on the graph alone: no sympy object is built,
-evaluated or asked about its assumptions after that.
+many functions read it. The closed-form IK, its limits and `ik_nearest` (`ik.py`,
+`subproblems.py`, `ik_limits.py`) and the inverse differential kinematics (`differential.py`)
+build on the graph, with nodes' arithmetic and the graph's functions; the chain, the
+Jacobians and the singularity functions are still built in sympy, and `Graph.convert` takes
+their values over once each, every constant subexpression folded to one number (integers and
+rationals stay exact, exponents too). The lowering (`lowering.py`: CSE, constants, the
+operation count) and the printers work on the graph alone.
 
-Sums and products keep the order of their terms (sympy's order, for converted values), with
-their number first; what the lowering builds (a negated sum, a shared part of two sums) keeps
-the order it is built in, so the output does not depend on hashing.
+A sum's terms and a product's factors are ordered by when they were built (a*b and b*a are
+one node), with the number first, so the output does not depend on hashing; a sum or product
+is evaluated as sympy's would be (numbers combined, equal terms and bases collected).
 """
 
 import math

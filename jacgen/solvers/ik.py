@@ -13,9 +13,11 @@ import math
 import textwrap
 from dataclasses import dataclass
 
+import numpy
 import sympy
 
-from jacgen.model.nodes import EPS, Above, AtLeast, AtMost, IsFinite, select
+from jacgen.model.graph import AND, Node
+from jacgen.model.nodes import EPS
 from jacgen.model.structure import (E_Z, SOLVERS, Geometry, Nominal, SolverInfo, Structure, classify, is_zero,
                                     nearest_class, readable)
 from jacgen.solvers import general6r
@@ -249,24 +251,24 @@ def documentation(robot, form: ClosedForm, max_name: str) -> list[str]:
 # Each returns the branches in the documented order: (joint values, validity), one per
 # solution the class can have; `k` holds the constants of `closed_form`.
 
-Branches = list[tuple[tuple[sympy.Expr, ...], sympy.Basic]]
+Branches = list[tuple[tuple[Node, ...], Node]]
 
 
 def _planar_branches(sp: Subproblems, k: dict, target, form: ClosedForm, dof: int) -> Branches:
     """The last revolute joint takes the yaw, the first two put its axis on the wrist point
     by SP3 (elbow) and SP1 (shoulder); rotations about z keep heights."""
-    index = dict(form.indices)
+    g, index = sp.graph, dict(form.indices)
     point = (target[0], target[1], k["tool_point"][2])
     if "third" in index:
         phi = sp.name(target[-1] - k["yaw0"])
-        point = sp.sub(point, sp.rot((0, 0, 1), sp.name(sympy.cos(phi)), sp.name(sympy.sin(phi)),
+        point = sp.sub(point, sp.rot(sp.vector((0, 0, 1)), sp.name(g.call("cos", phi)), sp.name(g.call("sin", phi)),
                                      sp.sub(k["tool_point"], k["wrist"])))
     d = sp.sub(point, k["p1"])
     branches = []
     for elbow in sp.sp3(sp.sub(k["wrist"], k["p2"]), sp.sub(k["p1"], k["p2"]), k["k2"], sp.dot(d, d)):
         shoulder = sp.sp1(sp.sub(sp.add(k["p2"], sp.turn(k["k2"], elbow.angle, sp.sub(k["wrist"], k["p2"]))), k["p1"]),
                           d, k["k1"])
-        q = [sympy.Integer(0)] * dof
+        q = [g.number(0)] * dof
         q[index["first"]], q[index["second"]] = shoulder.theta, elbow.angle.theta
         if "third" in index:
             q[index["third"]] = k["sign3"] * (phi - k["sign1"] * shoulder.theta - k["sign2"] * elbow.angle.theta)
@@ -280,9 +282,9 @@ def _yaw_pitch_branches(sp: Subproblems, k: dict, target, form: ClosedForm, dof:
     """The pitch fixes the sum phi of the pitch angles (SP4 on the tool's x axis), the base
     yaw puts the target in the arm's plane (SP4), and the wrist point is reached by SP3
     (elbow) and SP1 (shoulder). A pitch beyond +-pi/2 has no solution."""
-    point = tuple(target[:3])
-    pitch_valid = AtMost(sympy.Abs(target[3]), sympy.pi / 2)
-    approaches = sp.sp4((0, 0, 1), k["tool_x"], k["h2"], sp.name(-sympy.sin(target[3])))
+    g, point = sp.graph, tuple(target[:3])
+    pitch_valid = g.relation("<=", g.call("Abs", target[3]), g.value(sympy.pi / 2))
+    approaches = sp.sp4(sp.vector((0, 0, 1)), k["tool_x"], k["h2"], sp.name(-g.call("sin", target[3])))
     branches = []
     for base in sp.sp4(sp.sub(point, k["p1"]), k["h2"], k["h1"], k["reach"]):
         w = sp.add(k["p1"], sp.turn(k["h1"], base.angle, sp.sub(point, k["p1"]), back=True))
@@ -294,7 +296,7 @@ def _yaw_pitch_branches(sp: Subproblems, k: dict, target, form: ClosedForm, dof:
                                   d, k["h2"])
                 last = k["sign4"] * (phi.angle.theta - shoulder.theta - k["sign3"] * elbow.angle.theta)
                 branches.append(((base.angle.theta, shoulder.theta, elbow.angle.theta, last),
-                                 sympy.And(pitch_valid, base.valid, phi.valid, elbow.valid)))
+                                 g.logic(AND, pitch_valid, base.valid, phi.valid, elbow.valid)))
     return branches
 
 
@@ -310,7 +312,7 @@ def _wrist_branches(sp: Subproblems, k: dict, R, turns, shoulder: tuple, valid) 
     a, b = times(sp, R, k["h6"]), times(sp, R, k["v6"])
     for axis, angle in turns:
         a, b = sp.turn(axis, angle, a, back=True), sp.turn(axis, angle, b, back=True)
-    return [(shoulder + q, sympy.And(valid, wrist_valid))
+    return [(shoulder + q, sp.graph.logic(AND, valid, wrist_valid))
             for q, wrist_valid in sp.wrist(a, b, k["h4"], k["h5"], k["h6"], k["v6"], k.get("wrist_flip"))]
 
 
@@ -329,7 +331,7 @@ def _spherical_wrist_parallel_branches(sp: Subproblems, k: dict, target, form: C
             s23 = t2.s * t3.angle.c + k["sign3"] * t2.c * t3.angle.s
             turns = ((k["h1"], t1.angle), (k["h2"], Angle(None, sp.name(c23), sp.name(s23))))
             branches += _wrist_branches(sp, k, R, turns, (t1.angle.theta, t2.theta, t3.angle.theta),
-                                        sympy.And(t1.valid, t3.valid))
+                                        sp.graph.logic(AND, t1.valid, t3.valid))
     return branches
 
 
@@ -344,7 +346,7 @@ def _spherical_wrist_intersecting_branches(sp: Subproblems, k: dict, target, for
         for t1, t2, valid in sp.sp2(reached, d, k["h1"], k["h2"]):
             turns = ((k["h1"], t1), (k["h2"], t2), (k["h3"], t3.angle))
             branches += _wrist_branches(sp, k, R, turns, (t1.theta, t2.theta, t3.angle.theta),
-                                        sympy.And(t3.valid, valid))
+                                        sp.graph.logic(AND, t3.valid, valid))
     return branches
 
 
@@ -352,20 +354,21 @@ def _spherical_wrist_prismatic_branches(sp: Subproblems, k: dict, target, form: 
     """The wrist centre's distance from the shoulder point fixes q3 (|e + q3 h3| = |d|, a
     quadratic), its position q1 and q2 (SP2); the orientation left to the wrist gives q4,
     q5, q6."""
+    g = sp.graph
     R, _, wc = _pose_start(sp, k, target)
     d = sp.sub(wc, k["shoulder"])
     e = sp.sub(k["centre"], k["shoulder"])
     half, rest = sp.dot(k["h3"], e), sp.name(sp.dot(e, e) - sp.dot(d, d))
     disc = sp.name(half**2 - rest)
     scale = sp.name(sp.dot(e, e) + sp.dot(d, d))
-    two = Above(disc, EPS * scale)
-    root = sp.name(select(two, sympy.sqrt(disc), 0))
+    two = g.relation(">", disc, g.symbol(EPS) * scale)
+    root = sp.name(g.select(two, g.sqrt(disc), g.number(0)))
     branches = []
-    for t3, valid in ((sp.name(-half + root), AtLeast(disc, -EPS * scale)), (sp.name(-half - root), two)):
+    for t3, valid in ((sp.name(-half + root), g.relation(">=", disc, -g.symbol(EPS) * scale)), (sp.name(-half - root), two)):
         reached = sp.add(e, sp.scaled(k["h3"], t3))
         for t1, t2, shoulder_valid in sp.sp2(reached, d, k["h1"], k["h2"]):
             branches += _wrist_branches(sp, k, R, ((k["h1"], t1), (k["h2"], t2)), (t1.theta, t2.theta, t3),
-                                        sympy.And(valid, shoulder_valid))
+                                        g.logic(AND, valid, shoulder_valid))
     return branches
 
 
@@ -394,7 +397,7 @@ def _three_parallel_branches(sp: Subproblems, k: dict, target, form: ClosedForm,
                 t2 = sp.sp1(sp.sub(sp.add(k["p3"], sp.turn(k["h3"], t3.angle, sp.sub(k["p4"], k["p3"]))), k["p2"]), d, h)
                 t4 = k["sign4"] * (total.theta - t2.theta - k["sign3"] * t3.angle.theta)
                 branches.append(((t1.angle.theta, t2.theta, t3.angle.theta, t4, t5.angle.theta, t6.theta),
-                                 sympy.And(t1.valid, t5.valid, t3.valid)))
+                                 sp.graph.logic(AND, t1.valid, t5.valid, t3.valid)))
     return branches
 
 
@@ -408,40 +411,42 @@ _BRANCHES = {
 }
 
 
-def _constant(value: Matrix):
-    """A constant as the solvers use it: a number, a 3-tuple, or a 3x3 matrix."""
+def _constant(g, value: Matrix):
+    """A constant as the solvers use it, on the graph: a number, a 3-tuple, or a 3x3 array."""
     if value.shape == (1, 1):
-        return value[0]
-    return tuple(value) if 1 in value.shape else value
+        return g.value(value[0])
+    return tuple(map(g.value, value)) if 1 in value.shape else g.values(value)
 
 
-def _reversed_target(sp: Subproblems, k: dict, T) -> sympy.Matrix:
+def _reversed_target(sp: Subproblems, k: dict, T) -> numpy.ndarray:
     """T(0) T^-1, the target of a reversed chain (see `structure.Geometry.reversed`)."""
     start, position = k["start_rotation"], k["start_position"]
     rotation = [[sp.name(sum(start[i, m] * T[j, m] for m in range(3))) for j in range(3)] for i in range(3)]
     offset = [sp.name(position[i] - sum(rotation[i][j] * T[j, 3] for j in range(3))) for i in range(3)]
-    return sympy.Matrix([row + [offset[i]] for i, row in enumerate(rotation)] + [[0, 0, 0, 1]])
+    return sp.graph.values([row + [offset[i]] for i, row in enumerate(rotation)] + [[0, 0, 0, 1]])
 
 
-def branches(robot, form: ClosedForm, sp: Subproblems, target, free_angle=None) -> tuple[sympy.Matrix, list, list]:
+def branches(robot, form: ClosedForm, sp: Subproblems, target, free_angle=None) -> tuple[numpy.ndarray, list, list]:
     """Every branch of the solver (MAX_IK_SOLUTIONS x DOF; revolute angles wrapped into
     (-pi, pi] or else into the limits, see `in_limits`; the free joint `free_angle` as given),
     whether the target allows it and whether it is inside the joint limits (MAX_IK_SOLUTIONS
     each). A branch is valid when the target allows it and every entry of the target read
     (not a pose's last row) is finite. `target` is the 4x4 pose or the task vector, as symbols."""
-    k = {name: _constant(value) for name, value in form.constants}
+    g = sp.graph
+    k = {name: _constant(g, value) for name, value in form.constants}
+    target = g.values(target) if form.target == "pose" else g.values(target).flatten()
     solved = _BRANCHES[form.solver](sp, k, _reversed_target(sp, k, target) if "start_rotation" in k else target,
                                     form, len(form.joints))
     if len(solved) != form.info.max_solutions:
         raise AssertionError(f"{form.solver}: {len(solved)} branches, documented {form.info.max_solutions}")
     # One test for all entries: their sum is finite unless one is not (or they exceed 1e307).
-    finite = IsFinite(sp.name(sympy.Add(*(target[:3, :] if form.target == "pose" else target))))
+    finite = g.finite(sp.name(sum((target[:3, :] if form.target == "pose" else target).flat)))
     rows, inside = [], []
     for values, _ in solved:
-        q = [free_angle] * robot.dof
+        q = [None if free_angle is None else g.value(free_angle)] * robot.dof
         for joint, sign, value in zip(form.joints, form.signs, values):
             q[joint] = sign * value
         q, row_inside = limited(robot, sp, q, form.joints, form.free)
         rows.append(q)
         inside.append(row_inside)
-    return sympy.Matrix(rows), [sympy.And(finite, valid) for _, valid in solved], inside
+    return numpy.array(rows, dtype=object), [g.logic(AND, finite, valid) for _, valid in solved], inside

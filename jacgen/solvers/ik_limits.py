@@ -1,11 +1,11 @@
 """Joint limits in the closed-form IK: each branch in ik's form (revolute angles wrapped, or
 moved by whole turns into the limits), whether it is inside the limits, and ik_nearest's
-choice of the solution nearest a seed. Expressions, like the solvers of `ik.py`.
+choice of the solution nearest a seed. On the value graph, like the solvers of `ik.py`.
 """
 
 import sympy
 
-from jacgen.model.nodes import Above, AtLeast, AtMost, Below, Floor, IsFinite, select
+from jacgen.model.graph import AND, OR, Node
 from jacgen.solvers.subproblems import Subproblems, wrapped
 
 # ik_nearest's statuses
@@ -13,78 +13,86 @@ IK_NEAREST_OK, IK_NEAREST_NO_SOLUTION, IK_NEAREST_NOT_FINITE = 0, 1, 2
 TURN = 2 * sympy.pi
 
 
-def _inside(value, limits: tuple[float, float]) -> sympy.Basic:
-    return sympy.And(AtLeast(value, limits[0]), AtMost(value, limits[1]))
+def _inside(value: Node, limits: tuple[float, float]) -> Node:
+    g = value.graph
+    return g.logic(AND, g.relation(">=", value, g.value(limits[0])), g.relation("<=", value, g.value(limits[1])))
 
 
-def in_limits(sp: Subproblems, value, joint) -> tuple[sympy.Expr, sympy.Basic]:
+def in_limits(sp: Subproblems, value: Node, joint) -> tuple[Node, Node]:
     """A joint's value as ik returns it, and whether it is inside the joint's limits.
 
     A revolute angle stays wrapped into (-pi, pi] unless that is outside the limits and its
     lowest equivalent above the lower limit, lower + (angle - lower) mod 2 pi, is inside them
     (the Panda's joint 6, -0.0175 to 3.7525 rad, needs it); a joint without limits is always
     inside."""
-    limits = joint.limits
+    g, limits = sp.graph, joint.limits
     if limits is None:
-        return value, sympy.true
+        return value, g.true
     if not joint.revolute:
         return value, _inside(value, limits)
     value = sp.name(value)
-    shifted = sp.name(value - TURN * Floor((value - limits[0]) / TURN))
-    wrapped_inside, shifted_inside = _inside(value, limits), AtMost(shifted, limits[1])
-    return select(sympy.And(sympy.Not(wrapped_inside), shifted_inside), shifted, value), \
-        sympy.Or(wrapped_inside, shifted_inside)
+    shifted = sp.name(value - TURN * g.call("Floor", (value - limits[0]) / TURN))
+    wrapped_inside, shifted_inside = _inside(value, limits), g.relation("<=", shifted, g.value(limits[1]))
+    return g.select(g.logic(AND, g.negation(wrapped_inside), shifted_inside), shifted, value), \
+        g.logic(OR, wrapped_inside, shifted_inside)
 
 
 def limited(robot, sp: Subproblems, q: list, order: tuple[int, ...], free: int | None = None
-            ) -> tuple[list, sympy.Basic]:
+            ) -> tuple[list, Node]:
     """ik's form of a configuration (revolute angles wrapped, see `in_limits`; the free joint
     as given) and whether it is inside the joint limits; the joints named in `order`."""
-    q = list(q)
+    g = sp.graph
+    q = [g.value(value) for value in q]
     inside = [] if free is None else [_inside(q[free], robot.joints[free].limits) if robot.joints[free].limits
-                                      else sympy.true]
+                                      else g.true]
     for j in order:
         joint = robot.joints[j]
         q[j], joint_inside = in_limits(sp, wrapped(q[j]) if joint.revolute else q[j], joint)
         inside.append(joint_inside)
-    return q, sympy.And(*inside)
+    return q, g.logic(AND, *inside)
 
 
-def _nearest_equivalent(sp: Subproblems, value, given, seed, joint):
+def _nearest_equivalent(sp: Subproblems, value: Node, given: Node, seed: Node, joint) -> Node:
     """The equivalent (modulo 2 pi) of a revolute angle nearest the seed inside the limits: of
     the nearest one and its neighbours on either side, the first inside; else `given` (the
     lowest inside, `in_limits`). A prismatic joint's value as it is."""
     if not joint.revolute:
         return value
-    nearest = sp.name(value + TURN * Floor((seed - value) / TURN + sympy.Rational(1, 2)))
+    g = sp.graph
+    nearest = sp.name(value + TURN * g.call("Floor", (seed - value) / TURN + sympy.Rational(1, 2)))
     limits = joint.limits
     if limits is None:
         return nearest
-    below = Below(nearest, seed)
-    second, third = sp.name(nearest + select(below, TURN, -TURN)), sp.name(nearest - select(below, TURN, -TURN))
-    return select(_inside(nearest, limits), nearest,
-                  select(_inside(second, limits), second, select(_inside(third, limits), third, given)))
+    step = g.select(g.relation("<", nearest, seed), g.value(TURN), g.value(-TURN))
+    second, third = sp.name(nearest + step), sp.name(nearest - step)
+    return g.select(_inside(nearest, limits), nearest,
+                    g.select(_inside(second, limits), second, g.select(_inside(third, limits), third, given)))
 
 
-def nearest(robot, sp: Subproblems, q: sympy.Matrix, valid: list, inside: list, seed, weights,
-            free: int | None, read: list) -> tuple[list, sympy.Expr]:
+def nearest(robot, sp: Subproblems, q, valid: list, inside: list, seed, weights,
+            free: int | None, read: list) -> tuple[list, Node]:
     """ik_nearest: of the valid branches inside the limits, the one nearest the seed by
     sum_j weights_j (q_j - seed_j)^2, each revolute joint at its equivalent nearest the seed
     inside the limits; and the status. No solution, or an entry of the target `read`, a seed
     or a weight that is not finite: q = seed."""
+    g = sp.graph
+    zero, one = g.number(0), g.number(1)
+    q, valid, inside = g.values(q).tolist(), list(g.values(valid)), list(g.values(inside))
+    seed, weights, read = list(g.values(seed)), list(g.values(weights)), list(g.values(read))
     # The running minimum over the rows; truth values carried as named 0/1 numbers, so that
     # no condition grows with the number of rows.
-    best, found, distance = list(seed), sympy.Integer(0), sympy.Integer(0)
-    for row, row_valid, row_inside in zip(q.tolist(), valid, inside):
+    best, found, distance = list(seed), zero, zero
+    for row, row_valid, row_inside in zip(q, valid, inside):
         candidate = [sp.name(value if j == free else _nearest_equivalent(sp, sp.name(value), value, seed[j], joint))
                      for j, (value, joint) in enumerate(zip(row, robot.joints))]
-        cost = sp.name(sympy.Add(*(w * (x - s) ** 2 for w, x, s in zip(weights, candidate, seed))))
-        allowed = Above(sp.name(select(sympy.And(row_valid, row_inside), 1, 0)), 0)
-        take = Above(sp.name(select(sympy.And(allowed, sympy.Or(Below(found, 1), Below(cost, distance))), 1, 0)), 0)
-        best = [sp.name(select(take, x, b)) for x, b in zip(candidate, best)]
-        distance = sp.name(select(take, cost, distance))
-        found = sp.name(select(allowed, 1, found))
-    inputs_finite = IsFinite(sp.name(sympy.Add(*read, *seed, *weights)))
-    status = select(sympy.Not(inputs_finite), IK_NEAREST_NOT_FINITE,
-                    select(Above(found, 0), IK_NEAREST_OK, IK_NEAREST_NO_SOLUTION))
-    return [select(sympy.And(Above(found, 0), inputs_finite), x, s) for x, s in zip(best, seed)], status
+        cost = sp.name(sum(w * (x - s) ** 2 for w, x, s in zip(weights, candidate, seed)))
+        allowed = g.relation(">", sp.name(g.select(g.logic(AND, row_valid, row_inside), one, zero)), zero)
+        closer = g.logic(OR, g.relation("<", found, one), g.relation("<", cost, distance))
+        take = g.relation(">", sp.name(g.select(g.logic(AND, allowed, closer), one, zero)), zero)
+        best = [sp.name(g.select(take, x, b)) for x, b in zip(candidate, best)]
+        distance = sp.name(g.select(take, cost, distance))
+        found = sp.name(g.select(allowed, one, found))
+    inputs_finite = g.finite(sp.name(sum([*read, *seed, *weights])))
+    status = g.select(g.negation(inputs_finite), g.number(IK_NEAREST_NOT_FINITE),
+                      g.select(g.relation(">", found, zero), g.number(IK_NEAREST_OK), g.number(IK_NEAREST_NO_SOLUTION)))
+    return [g.select(g.logic(AND, g.relation(">", found, zero), inputs_finite), x, s) for x, s in zip(best, seed)], status

@@ -1,13 +1,13 @@
-"""Paden-Kahan subproblems as expressions, every root computed, each with its validity.
+"""Paden-Kahan subproblems on the value graph, every root computed, each with its validity.
 
 The closed-form solvers of `ik.py` are written with these once, and every backend prints
 them. Nothing branches: a root the target does not allow is still computed (from clamped
 values) and flagged invalid, a degenerate case is a `select`. So a solver is straight-line
 code, the same in C, over a numpy batch and in CasADi.
 
-Vectors are 3-tuples of expressions, relative to a point of the axis where it matters;
-every intermediate value is passed to `name` (see `generator.Generator.name`), so that no
-expression grows with the depth of the solver. The tolerances are the symbols EPS and TINY,
+Vectors are 3-tuples of nodes (`graph.py`), relative to a point of the axis where it matters;
+every intermediate value is passed to `name` (`Lowering.name_node`), so that the common-
+subexpression elimination sees sums of named values. The tolerances are the symbols EPS and TINY,
 replaced by the numbers of the build's real type when printed (`nodes.TOLERANCES`):
 
 - a discriminant (a squared sine) within EPS of 0 is one double root: its second copy is
@@ -21,18 +21,19 @@ from typing import Callable
 
 import sympy
 
-from jacgen.model.nodes import EPS, TINY, Above, AtLeast, AtMost, Ceiling, Select, select
+from jacgen.model.graph import AND, CALL, NUMBER, OR, SELECT, Graph, Node
+from jacgen.model.nodes import EPS, TINY
 
-Vector = tuple[sympy.Expr, sympy.Expr, sympy.Expr]
+Vector = tuple[Node, Node, Node]
 
 
 @dataclass(frozen=True)
 class Angle:
     """An angle with its cosine and sine (the solvers rotate by c and s, never by theta)."""
 
-    theta: sympy.Expr
-    c: sympy.Expr
-    s: sympy.Expr
+    theta: Node
+    c: Node
+    s: Node
 
     def turned_half(self) -> "Angle":
         """The angle + pi."""
@@ -44,25 +45,24 @@ class Root:
     """One root of a subproblem and whether it exists for this target."""
 
     angle: Angle
-    valid: sympy.Basic
-
-
-ZERO = Angle(sympy.Integer(0), sympy.Integer(1), sympy.Integer(0))
+    valid: Node
 
 
 class Subproblems:
-    """Vector algebra and the subproblems, naming every intermediate with `name`."""
+    """Vector algebra and the subproblems on `graph`, naming every intermediate with `name`."""
 
-    def __init__(self, name: Callable[[sympy.Expr], sympy.Expr]):
-        self.name = lambda value: name(sympy.sympify(value))
+    def __init__(self, graph: Graph, name: Callable[[Node], Node]):
+        self.graph = graph
+        self.name = lambda value: name(graph.value(value))
+        self.eps, self.tiny = graph.symbol(EPS), graph.symbol(TINY)
         # Sizes that are near 0 where the closed form is sensitive to the target, dimensionless,
         # recorded only when the fast path asks (a list here; it reads the least, general6r.FAST_MARGIN):
         # - an SP2 or SP4 discriminant (a squared sine): two roots near one double root;
         # - the rotating part of SP1 or SP4 (the product of the sines of its vectors' angles to
         #   the axis): an angle that is nearly free, as at a wrist singularity.
-        self.margins: list[sympy.Expr] | None = None
+        self.margins: list[Node] | None = None
 
-    def _margin(self, size: Callable[[], sympy.Expr]) -> None:
+    def _margin(self, size: Callable[[], Node]) -> None:
         """Records size() when the margins are asked for (built only then)."""
         if self.margins is not None:
             self.margins.append(size())
@@ -70,7 +70,7 @@ class Subproblems:
     def vector(self, values) -> Vector:
         return tuple(self.name(v) for v in values)
 
-    def dot(self, a: Vector, b: Vector) -> sympy.Expr:
+    def dot(self, a: Vector, b: Vector) -> Node:
         return self.name(a[0] * b[0] + a[1] * b[1] + a[2] * b[2])
 
     def cross(self, a: Vector, b: Vector) -> Vector:
@@ -82,10 +82,10 @@ class Subproblems:
     def sub(self, a: Vector, b: Vector) -> Vector:
         return self.vector(x - y for x, y in zip(a, b))
 
-    def scaled(self, a: Vector, factor: sympy.Expr) -> Vector:
+    def scaled(self, a: Vector, factor: Node) -> Vector:
         return self.vector(factor * x for x in a)
 
-    def rot(self, k: Vector, c: sympy.Expr, s: sympy.Expr, v: Vector) -> Vector:
+    def rot(self, k: Vector, c: Node, s: Node, v: Vector) -> Vector:
         """v turned about the unit axis k by the angle whose cosine and sine are c and s (Rodrigues)."""
         kxv = self.cross(k, v)
         kv = self.name(self.dot(k, v) * (1 - c))
@@ -95,81 +95,88 @@ class Subproblems:
         """v turned about k by `angle` (by -angle when `back`)."""
         return self.rot(k, angle.c, -angle.s if back else angle.s, v)
 
-    def angle(self, c: sympy.Expr, s: sympy.Expr) -> Angle:
+    def angle(self, c: Node, s: Node) -> Angle:
         c, s = self.name(c), self.name(s)
-        return Angle(sympy.atan2(s, c), c, s)
+        return Angle(self.graph.call("atan2", s, c), c, s)
 
     def sp1(self, p: Vector, q: Vector, k: Vector) -> Angle:
         """SP1: the angle turning p into q about the unit axis k (least squares when they
         differ in length or height along k); 0 when p or q lies on the axis (any angle would do)."""
+        g = self.graph
+        zero, one = g.number(0), g.number(1)
         x = self.name(self.dot(p, q) - self.dot(k, p) * self.dot(k, q))
         y = self.dot(k, self.cross(p, q))
         rr = self.name(x * x + y * y)
         pq = self.name(self.dot(p, p) * self.dot(q, q))
-        self._margin(lambda: select(Above(pq, 0), sympy.sqrt(rr / pq), 0))
-        free = AtMost(rr, TINY * pq)
-        scale = self.name(select(free, 1, 1 / sympy.sqrt(rr)))  # never 1/0, even for constant vectors
-        return Angle(select(free, 0, sympy.atan2(y, x)), self.name(select(free, 1, x * scale)),
-                     self.name(select(free, 0, y * scale)))
+        self._margin(lambda: g.select(g.relation(">", pq, zero), g.sqrt(rr / pq), zero))
+        free = g.relation("<=", rr, self.tiny * pq)
+        scale = self.name(g.select(free, one, 1 / g.sqrt(rr)))  # never 1/0, even for constant vectors
+        return Angle(g.select(free, zero, g.call("atan2", y, x)), self.name(g.select(free, one, x * scale)),
+                     self.name(g.select(free, zero, y * scale)))
 
-    def sp4(self, h: Vector, p: Vector, k: Vector, d: sympy.Expr) -> tuple[Root, Root]:
+    def sp4(self, h: Vector, p: Vector, k: Vector, d: Node) -> tuple[Root, Root]:
         """SP4: the angles t with h . rot(k, t) p = d, (phi + alpha, phi - alpha).
 
         h . rot(k, t) p = A cos t + B sin t + C. A double root (sin(alpha)^2 within EPS of 0)
         is the first root only; when the left side does not depend on t, the first root is
         0 if it equals d."""
+        g = self.graph
+        zero, one = g.number(0), g.number(1)
         hk, kp = self.dot(h, k), self.dot(k, p)
         a = self.name(self.dot(h, p) - hk * kp)
         b = self.dot(h, self.cross(k, p))
         rhs = self.name(d - hk * kp)
         r2 = self.name(a * a + b * b)
         scale = self.name(self.dot(h, h) * self.dot(p, p))
-        self._margin(lambda: select(Above(scale, 0), sympy.sqrt(r2 / scale), 0))
-        constant = AtMost(r2, TINY * scale)
-        inverse_r = self.name(select(constant, 1, 1 / sympy.sqrt(r2)))
+        self._margin(lambda: g.select(g.relation(">", scale, zero), g.sqrt(r2 / scale), zero))
+        constant = g.relation("<=", r2, self.tiny * scale)
+        inverse_r = self.name(g.select(constant, one, 1 / g.sqrt(r2)))
         cos_phi, sin_phi = self.name(a * inverse_r), self.name(b * inverse_r)
         cos_alpha = self.name(rhs * inverse_r)
         disc = self.name(1 - cos_alpha**2)
-        self._margin(lambda: sympy.Abs(disc))
-        two = Above(disc, EPS)
+        self._margin(lambda: g.call("Abs", disc))
+        two = g.relation(">", disc, self.eps)
         # a double root: cos(alpha) = +-1, sin(alpha) = 0
-        cos_alpha = self.name(select(two, cos_alpha, select(Above(cos_alpha, 0), 1, -1)))
-        sin_alpha = self.name(select(two, sympy.sqrt(disc), 0))
-        phi, alpha = self.name(sympy.atan2(b, a)), self.name(sympy.atan2(sin_alpha, cos_alpha))
-        plus = Angle(self.name(select(constant, 0, phi + alpha)),
-                     self.name(select(constant, 1, cos_phi * cos_alpha - sin_phi * sin_alpha)),
-                     self.name(select(constant, 0, sin_phi * cos_alpha + cos_phi * sin_alpha)))
+        cos_alpha = self.name(g.select(two, cos_alpha, g.select(g.relation(">", cos_alpha, zero), one, -one)))
+        sin_alpha = self.name(g.select(two, g.sqrt(disc), zero))
+        phi, alpha = self.name(g.call("atan2", b, a)), self.name(g.call("atan2", sin_alpha, cos_alpha))
+        plus = Angle(self.name(g.select(constant, zero, phi + alpha)),
+                     self.name(g.select(constant, one, cos_phi * cos_alpha - sin_phi * sin_alpha)),
+                     self.name(g.select(constant, zero, sin_phi * cos_alpha + cos_phi * sin_alpha)))
         minus = Angle(self.name(phi - alpha), self.name(cos_phi * cos_alpha + sin_phi * sin_alpha),
                       self.name(sin_phi * cos_alpha - cos_phi * sin_alpha))
-        plus_valid = sympy.Or(sympy.And(constant, AtMost(rhs**2, EPS * scale)), sympy.And(sympy.Not(constant), AtLeast(disc, -EPS)))
-        return Root(plus, plus_valid), Root(minus, sympy.And(sympy.Not(constant), two))
+        plus_valid = g.logic(OR, g.logic(AND, constant, g.relation("<=", rhs**2, self.eps * scale)),
+                             g.logic(AND, g.negation(constant), g.relation(">=", disc, -self.eps)))
+        return Root(plus, plus_valid), Root(minus, g.logic(AND, g.negation(constant), two))
 
-    def sp3(self, p: Vector, q: Vector, k: Vector, dd: sympy.Expr) -> tuple[Root, Root]:
+    def sp3(self, p: Vector, q: Vector, k: Vector, dd: Node) -> tuple[Root, Root]:
         """SP3: the angles t with |rot(k, t) p - q|^2 = dd (p, q relative to a point of the axis)."""
         return self.sp4(q, p, k, self.name((self.dot(p, p) + self.dot(q, q) - dd) / 2))
 
-    def sp2(self, p: Vector, q: Vector, k1: Vector, k2: Vector) -> tuple[tuple[Angle, Angle, sympy.Basic], ...]:
+    def sp2(self, p: Vector, q: Vector, k1: Vector, k2: Vector) -> tuple[tuple[Angle, Angle, Node], ...]:
         """SP2: the angle pairs (t1, t2, valid) with rot(k1, t1) rot(k2, t2) p = q, for two axes
         through one point (p, q relative to it): rot(k2, t2) p = rot(k1, -t1) q = c,
         c = alpha k1 + beta k2 +- gamma k1 x k2. One pair when gamma^2 is within EPS of 0."""
+        g = self.graph
+        zero = g.number(0)
         k12 = self.dot(k1, k2)
         nn = self.name(1 - k12**2)
         u, v = self.dot(k1, q), self.dot(k2, p)
         alpha, beta = self.name((u - k12 * v) / nn), self.name((v - k12 * u) / nn)
         pp = self.dot(p, p)
         gg = self.name((pp - alpha**2 - beta**2 - 2 * alpha * beta * k12) / nn)
-        self._margin(lambda: select(Above(pp, 0), sympy.Abs(gg) / pp, 0))
-        two = Above(gg, EPS * pp)
-        gamma = self.name(select(two, sympy.sqrt(gg), 0))
+        self._margin(lambda: g.select(g.relation(">", pp, zero), g.call("Abs", gg) / pp, zero))
+        two = g.relation(">", gg, self.eps * pp)
+        gamma = self.name(g.select(two, g.sqrt(gg), zero))
         normal = self.cross(k1, k2)
         pairs = []
-        for sign, valid in ((1, AtLeast(gg, -EPS * pp)), (-1, two)):
+        for sign, valid in ((1, g.relation(">=", gg, -self.eps * pp)), (-1, two)):
             c = self.vector(alpha * k1[i] + beta * k2[i] + sign * gamma * normal[i] for i in range(3))
             pairs.append((self.sp1(c, q, k1), self.sp1(p, c, k2), valid))
         return tuple(pairs)
 
     def wrist(self, a: Vector, b: Vector, h4: Vector, h5: Vector, h6: Vector, v6: Vector,
-              flip: sympy.Expr | None) -> tuple[tuple[tuple[sympy.Expr, ...], sympy.Basic], ...]:
+              flip: Node | None) -> tuple[tuple[tuple[Node, ...], Node], ...]:
         """Spherical wrist: the angles ((q4, q5, q6), valid) with R4 R5 R6 h6 = a and
         R4 R5 R6 v6 = b (v6 perpendicular to h6): SP2 for (q4, q5), SP1 for q6.
 
@@ -187,7 +194,7 @@ class Subproblems:
         return tuple(solutions)
 
 
-def relative(sp: Subproblems, T: sympy.Matrix, rotation: sympy.Matrix, position: sympy.Matrix):
+def relative(sp: Subproblems, T, rotation, position):
     """T T(0)^-1 = exp(xi_1 q_1) ... exp(xi_n q_n) as (rows of R, t), T(0) = (rotation,
     position) the tool pose at q = 0."""
     R = [sp.vector(sum(T[i, k] * rotation[j, k] for k in range(3)) for j in range(3)) for i in range(3)]
@@ -205,16 +212,16 @@ def times_transposed(sp: Subproblems, R, v: Vector) -> Vector:
     return sp.vector(sum(R[k][i] * v[k] for k in range(3)) for i in range(3))
 
 
-def _in_range(angle: sympy.Expr) -> bool:
+def _in_range(angle: Node) -> bool:
     """An atan2, a number in (-pi, pi], or a select of such."""
-    if isinstance(angle, Select):
+    if angle.kind == SELECT:
         return all(_in_range(value) for value in angle.args[1::2] + angle.args[-1:])
-    return isinstance(angle, sympy.atan2) or (angle.is_Number and -sympy.pi < angle <= sympy.pi)
+    return (angle.kind == CALL and angle.value == "atan2") or (angle.kind == NUMBER and -sympy.pi < angle.value <= sympy.pi)
 
 
-def wrapped(angle: sympy.Expr) -> sympy.Expr:
+def wrapped(angle: Node) -> Node:
     """The angle wrapped into (-pi, pi]: unchanged when it is there by construction (an
     atan2), else angle - 2 pi ceil((angle - pi) / (2 pi))."""
     if _in_range(angle):
         return angle
-    return angle - 2 * sympy.pi * Ceiling((angle - sympy.pi) / (2 * sympy.pi))
+    return angle - 2 * sympy.pi * angle.graph.call("Ceiling", (angle - sympy.pi) / (2 * sympy.pi))
