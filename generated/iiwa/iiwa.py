@@ -787,9 +787,9 @@ def fk_jacobian_dot(q, q_dot):
     t55 = t54
     t56 = -t32*t42 + t22*t45
     t57 = t56
-    t58 = qd5*t55 + qd6*t57
-    t59 = t58 + qd4*t53
-    t60 = t59 + qd3*t51
+    t58 = t57*qd6 + t55*qd5
+    t59 = t58 + t53*qd4
+    t60 = t59 + t51*qd3
     t61 = c1*t47
     t62 = c2*t41 - s2*t61
     t63 = t62
@@ -799,9 +799,9 @@ def fk_jacobian_dot(q, q_dot):
     t67 = t66
     t68 = t13*t45 + t32*t39
     t69 = t68
-    t70 = qd5*t67 + qd6*t69
-    t71 = t70 - qd4*t65
-    t72 = t71 + qd3*t63
+    t70 = t69*qd6 + t67*qd5
+    t71 = t70 - t65*qd4
+    t72 = t71 + t63*qd3
     t73 = c1*t41 + s1*t44
     t74 = t73
     t75 = t44*t9 - t41*t18
@@ -812,10 +812,10 @@ def fk_jacobian_dot(q, q_dot):
     t80 = t79
     t81 = t13*t42 + t22*t39
     t82 = t81
-    t83 = qd5*t80 - qd6*t82
-    t84 = t83 + qd4*t78
-    t85 = t84 + qd3*t76
-    t86 = t85 - qd2*t74
+    t83 = -t82*qd6 + t80*qd5
+    t84 = t83 + t78*qd4
+    t85 = t84 + t76*qd3
+    t86 = t85 - t74*qd2
     t87 = s1*qd2
     t88 = -t87 + t9*qd3
     t89 = t88 + t7*qd4
@@ -898,12 +898,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t34, batch),  # 5, 6
     ], (6, 7))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(c1*t86 - t49*qd1) + qd3*(-qd1*t63 - c2*t72 + t76*t93 + t18*t85) + qd4*(t0*t65 + t94*t78 - t4*t84 + t30*t71) + qd5*(t20*t83 + t95*t80 - t29*t70 - t37*t67) - qd6*(t38*t69 + t96*t82 + t82*t101 + t69*t103) - qd1*t92, batch),  # 0
-        xp.broadcast_to(qd1*t98 + qd2*(s1*t86 + t61*qd1) + qd3*(qd1*t51 + c2*t60 + t76*t87 - t9*t85) - qd4*(-t0*t53 + t88*t78 + t7*t84 + t30*t59) + qd5*(t29*t58 + t37*t55 - t11*t83 - t89*t80) + qd6*(t38*t57 + t90*t82 + t57*t103 - t82*t99), batch),  # 1
-        xp.broadcast_to(-qd2*(c1*t97 + s1*t91) - qd3*(-t9*t72 + t51*t93 + t63*t87 + t18*t60) + qd4*(t7*t71 + t4*t59 - t94*t53 - t88*t65) + qd5*(t11*t70 + t89*t67 - t20*t58 - t95*t55) - qd6*(-t90*t69 + t96*t57 + t69*t99 + t57*t101), batch),  # 2
-        xp.broadcast_to(qd3*(c2*t93 - t18*qd1) + qd4*(t4*t0 - t30*t94) + qd5*(t29*t95 - t20*t37) + qd6*(t32*t96 - t22*t38) + qd7*(t34*t102 - t24*t104) - qd1*t93, batch),  # 3
-        xp.broadcast_to(qd3*(t9*qd1 + c2*t87) + qd4*(t7*t0 + t30*t88) + qd5*(t11*t37 - t29*t89) - qd6*(t13*t38 + t32*t90) + qd7*(t15*t104 - t34*t100) - qd1*t87, batch),  # 4
-        xp.broadcast_to(-qd3*(c1**2*t105 + s1**2*t105) - qd4*(t4*t88 + t7*t94) + qd5*(t20*t89 - t11*t95) + qd6*(t13*t96 + t22*t90) + qd7*(t24*t100 - t15*t102), batch),  # 5
+        xp.broadcast_to(-qd1*t92 + qd2*(-t49*qd1 + c1*t86) + qd3*(t76*t93 - t63*qd1 + t18*t85 - c2*t72) + qd4*(t78*t94 + t65*t0 - t4*t84 + t30*t71) + qd5*(t80*t95 - t67*t37 + t20*t83 - t29*t70) - qd6*(t82*t96 + t69*t38 + t82*t101 + t69*t103), batch),  # 0
+        xp.broadcast_to(qd1*t98 + qd2*(t61*qd1 + s1*t86) + qd3*(t51*qd1 + t76*t87 + c2*t60 - t9*t85) - qd4*(-t53*t0 + t78*t88 + t30*t59 + t7*t84) + qd5*(t55*t37 - t80*t89 + t29*t58 - t11*t83) + qd6*(t57*t38 + t82*t90 + t57*t103 - t82*t99), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t91 + c1*t97) - qd3*(t63*t87 + t51*t93 - t9*t72 + t18*t60) + qd4*(-t65*t88 - t53*t94 + t7*t71 + t4*t59) + qd5*(t67*t89 - t55*t95 + t11*t70 - t20*t58) - qd6*(-t69*t90 + t57*t96 + t69*t99 + t57*t101), batch),  # 2
+        xp.broadcast_to(-qd1*t93 + qd3*(c2*t93 - t18*qd1) + qd4*(-t30*t94 + t4*t0) + qd5*(t29*t95 - t20*t37) + qd6*(t32*t96 - t22*t38) + qd7*(t34*t102 - t24*t104), batch),  # 3
+        xp.broadcast_to(-qd1*t87 + qd3*(t9*qd1 + c2*t87) + qd4*(t7*t0 + t30*t88) + qd5*(t11*t37 - t29*t89) - qd6*(t13*t38 + t32*t90) + qd7*(t15*t104 - t34*t100), batch),  # 4
+        xp.broadcast_to(-qd3*(s1**2*t105 + c1**2*t105) - qd4*(t4*t88 + t7*t94) + qd5*(t20*t89 - t11*t95) + qd6*(t22*t90 + t13*t96) + qd7*(t24*t100 - t15*t102), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -971,10 +971,10 @@ def jacobian_dot(q, q_dot):
     t38 = t4*t31 + t7*t34
     t39 = t11*t34 - t17*t31
     t40 = t13*t33 + t19*t30
-    t41 = qd5*t39 - qd6*t40
-    t42 = t41 + qd4*t38
-    t43 = t42 + qd3*t37
-    t44 = t43 - qd2*t36
+    t41 = -t40*qd6 + t39*qd5
+    t42 = t41 + t38*qd4
+    t43 = t42 + t37*qd3
+    t44 = t43 - t36*qd2
     t45 = 0.126*t27
     t46 = 0.4*t23 + t45
     t47 = 0.42*c2 + t46
@@ -986,12 +986,12 @@ def jacobian_dot(q, q_dot):
     t53 = t7*t46 + t31*t24
     t54 = t23*t31 - t11*t46
     t55 = t13*t45 + t26*t30
-    t56 = qd5*t50 + qd6*t51
-    t57 = qd5*t54 + qd6*t55
-    t58 = t56 + qd4*t49
-    t59 = t57 - qd4*t53
-    t60 = t58 + qd3*t48
-    t61 = t59 + qd3*t52
+    t56 = t51*qd6 + t50*qd5
+    t57 = t55*qd6 + t54*qd5
+    t58 = t56 + t49*qd4
+    t59 = t57 - t53*qd4
+    t60 = t58 + t48*qd3
+    t61 = t59 + t52*qd3
     t62 = s1*qd2
     t63 = -t62 + t9*qd3
     t64 = t63 + t7*qd4
@@ -1015,30 +1015,30 @@ def jacobian_dot(q, q_dot):
     t82 = s2*qd2
     Jd = _stack(xp, [
         xp.broadcast_to(-t67, batch),  # 0, 0
-        xp.broadcast_to(c1*t44 - t47*t80, batch),  # 0, 1
-        xp.broadcast_to(-qd1*t52 - c2*t61 + t68*t37 + t15*t43, batch),  # 0, 2
-        xp.broadcast_to(t0*t53 + t69*t38 - t4*t42 + t24*t59, batch),  # 0, 3
-        xp.broadcast_to(t17*t41 + t70*t39 - t23*t57 - t28*t54, batch),  # 0, 4
-        xp.broadcast_to(-(t29*t55 + t71*t40 + t76*t40 + t78*t55), batch),  # 0, 5
+        xp.broadcast_to(-t47*t80 + c1*t44, batch),  # 0, 1
+        xp.broadcast_to(t68*t37 - t52*qd1 + t15*t43 - c2*t61, batch),  # 0, 2
+        xp.broadcast_to(t38*t69 + t53*t0 - t4*t42 + t24*t59, batch),  # 0, 3
+        xp.broadcast_to(t39*t70 - t54*t28 + t17*t41 - t23*t57, batch),  # 0, 4
+        xp.broadcast_to(-(t40*t71 + t55*t29 + t76*t40 + t78*t55), batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         xp.broadcast_to(t73, batch),  # 1, 0
-        xp.broadcast_to(s1*t44 + t47*t81, batch),  # 1, 1
-        xp.broadcast_to(qd1*t48 + c2*t60 + t62*t37 - t9*t43, batch),  # 1, 2
-        xp.broadcast_to(-(-t0*t49 + t63*t38 + t7*t42 + t24*t58), batch),  # 1, 3
-        xp.broadcast_to(t23*t56 + t28*t50 - t11*t41 - t64*t39, batch),  # 1, 4
-        xp.broadcast_to(t29*t51 + t65*t40 + t78*t51 - t74*t40, batch),  # 1, 5
+        xp.broadcast_to(t47*t81 + s1*t44, batch),  # 1, 1
+        xp.broadcast_to(t48*qd1 + t62*t37 + c2*t60 - t9*t43, batch),  # 1, 2
+        xp.broadcast_to(-(-t49*t0 + t38*t63 + t24*t58 + t7*t42), batch),  # 1, 3
+        xp.broadcast_to(t50*t28 - t39*t64 + t23*t56 - t11*t41, batch),  # 1, 4
+        xp.broadcast_to(t51*t29 + t40*t65 + t78*t51 - t74*t40, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-(c1*t72 + s1*t66), batch),  # 2, 1
-        xp.broadcast_to(-(-t9*t61 + t68*t48 + t62*t52 + t15*t60), batch),  # 2, 2
-        xp.broadcast_to(t7*t59 + t4*t58 - t69*t49 - t63*t53, batch),  # 2, 3
-        xp.broadcast_to(t11*t57 + t64*t54 - t17*t56 - t70*t50, batch),  # 2, 4
-        xp.broadcast_to(-(-t65*t55 + t71*t51 + t74*t55 + t76*t51), batch),  # 2, 5
+        xp.broadcast_to(-(s1*t66 + c1*t72), batch),  # 2, 1
+        xp.broadcast_to(-(t62*t52 + t68*t48 - t9*t61 + t15*t60), batch),  # 2, 2
+        xp.broadcast_to(-t53*t63 - t49*t69 + t7*t59 + t4*t58, batch),  # 2, 3
+        xp.broadcast_to(t54*t64 - t50*t70 + t11*t57 - t17*t56, batch),  # 2, 4
+        xp.broadcast_to(-(-t55*t65 + t51*t71 + t74*t55 + t76*t51), batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(-t81, batch),  # 3, 1
         xp.broadcast_to(c2*t68 - s2*t80, batch),  # 3, 2
-        xp.broadcast_to(t4*t0 - t24*t69, batch),  # 3, 3
+        xp.broadcast_to(-t24*t69 + t4*t0, batch),  # 3, 3
         xp.broadcast_to(t23*t70 - t17*t28, batch),  # 3, 4
         xp.broadcast_to(t26*t71 - t19*t29, batch),  # 3, 5
         xp.broadcast_to(t27*t77 - t20*t79, batch),  # 3, 6
@@ -1051,10 +1051,10 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(t14*t79 - t27*t75, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
-        xp.broadcast_to(-(c1**2*t82 + s1**2*t82), batch),  # 5, 2
+        xp.broadcast_to(-(s1**2*t82 + c1**2*t82), batch),  # 5, 2
         xp.broadcast_to(-(t4*t63 + t7*t69), batch),  # 5, 3
         xp.broadcast_to(t17*t64 - t11*t70, batch),  # 5, 4
-        xp.broadcast_to(t13*t71 + t19*t65, batch),  # 5, 5
+        xp.broadcast_to(t19*t65 + t13*t71, batch),  # 5, 5
         xp.broadcast_to(t20*t75 - t14*t77, batch),  # 5, 6
     ], (6, 7))
     return Jd
@@ -1124,10 +1124,10 @@ def bias_acceleration(q, q_dot):
     t38 = t4*t31 + t7*t34
     t39 = t11*t34 - t17*t31
     t40 = t13*t33 + t19*t30
-    t41 = qd5*t39 - qd6*t40
-    t42 = t41 + qd4*t38
-    t43 = t42 + qd3*t37
-    t44 = t43 - qd2*t36
+    t41 = -t40*qd6 + t39*qd5
+    t42 = t41 + t38*qd4
+    t43 = t42 + t37*qd3
+    t44 = t43 - t36*qd2
     t45 = 0.126*t27
     t46 = 0.4*t23 + t45
     t47 = 0.42*c2 + t46
@@ -1139,12 +1139,12 @@ def bias_acceleration(q, q_dot):
     t53 = t7*t46 + t31*t24
     t54 = t23*t31 - t11*t46
     t55 = t13*t45 + t26*t30
-    t56 = qd5*t50 + qd6*t51
-    t57 = qd5*t54 + qd6*t55
-    t58 = t56 + qd4*t49
-    t59 = t57 - qd4*t53
-    t60 = t58 + qd3*t48
-    t61 = t59 + qd3*t52
+    t56 = t51*qd6 + t50*qd5
+    t57 = t55*qd6 + t54*qd5
+    t58 = t56 + t49*qd4
+    t59 = t57 - t53*qd4
+    t60 = t58 + t48*qd3
+    t61 = t59 + t52*qd3
     t62 = s1*qd2
     t63 = -t62 + t9*qd3
     t64 = t63 + t7*qd4
@@ -1166,12 +1166,12 @@ def bias_acceleration(q, q_dot):
     t80 = t47*qd1
     t81 = s2*qd2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(c1*t44 - s1*t80) + qd3*(-qd1*t52 - c2*t61 + t68*t37 + t15*t43) + qd4*(t0*t53 + t69*t38 - t4*t42 + t24*t59) + qd5*(t17*t41 + t70*t39 - t23*t57 - t28*t54) - qd6*(t29*t55 + t71*t40 + t76*t40 + t78*t55) - qd1*t67, batch),  # 0
-        xp.broadcast_to(qd1*t73 + qd2*(s1*t44 + c1*t80) + qd3*(qd1*t48 + c2*t60 + t62*t37 - t9*t43) - qd4*(-t0*t49 + t63*t38 + t7*t42 + t24*t58) + qd5*(t23*t56 + t28*t50 - t11*t41 - t64*t39) + qd6*(t29*t51 + t65*t40 + t78*t51 - t74*t40), batch),  # 1
-        xp.broadcast_to(-qd2*(c1*t72 + s1*t66) - qd3*(-t9*t61 + t68*t48 + t62*t52 + t15*t60) + qd4*(t7*t59 + t4*t58 - t69*t49 - t63*t53) + qd5*(t11*t57 + t64*t54 - t17*t56 - t70*t50) - qd6*(-t65*t55 + t71*t51 + t74*t55 + t76*t51), batch),  # 2
-        xp.broadcast_to(qd3*(c2*t68 - t15*qd1) + qd4*(t4*t0 - t24*t69) + qd5*(t23*t70 - t17*t28) + qd6*(t26*t71 - t19*t29) + qd7*(t27*t77 - t20*t79) - t68*qd1, batch),  # 3
-        xp.broadcast_to(qd3*(t9*qd1 + c2*t62) + qd4*(t7*t0 + t24*t63) + qd5*(t11*t28 - t23*t64) - qd6*(t13*t29 + t26*t65) + qd7*(t14*t79 - t27*t75) - t62*qd1, batch),  # 4
-        xp.broadcast_to(-qd3*(c1**2*t81 + s1**2*t81) - qd4*(t4*t63 + t7*t69) + qd5*(t17*t64 - t11*t70) + qd6*(t13*t71 + t19*t65) + qd7*(t20*t75 - t14*t77), batch),  # 5
+        xp.broadcast_to(-qd1*t67 + qd2*(-s1*t80 + c1*t44) + qd3*(t68*t37 - t52*qd1 + t15*t43 - c2*t61) + qd4*(t38*t69 + t53*t0 - t4*t42 + t24*t59) + qd5*(t39*t70 - t54*t28 + t17*t41 - t23*t57) - qd6*(t40*t71 + t55*t29 + t76*t40 + t78*t55), batch),  # 0
+        xp.broadcast_to(qd1*t73 + qd2*(c1*t80 + s1*t44) + qd3*(t48*qd1 + t62*t37 + c2*t60 - t9*t43) - qd4*(-t49*t0 + t38*t63 + t24*t58 + t7*t42) + qd5*(t50*t28 - t39*t64 + t23*t56 - t11*t41) + qd6*(t51*t29 + t40*t65 + t78*t51 - t74*t40), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t66 + c1*t72) - qd3*(t62*t52 + t68*t48 - t9*t61 + t15*t60) + qd4*(-t53*t63 - t49*t69 + t7*t59 + t4*t58) + qd5*(t54*t64 - t50*t70 + t11*t57 - t17*t56) - qd6*(-t55*t65 + t51*t71 + t74*t55 + t76*t51), batch),  # 2
+        xp.broadcast_to(-t68*qd1 + qd3*(c2*t68 - t15*qd1) + qd4*(-t24*t69 + t4*t0) + qd5*(t23*t70 - t17*t28) + qd6*(t26*t71 - t19*t29) + qd7*(t27*t77 - t20*t79), batch),  # 3
+        xp.broadcast_to(-t62*qd1 + qd3*(t9*qd1 + c2*t62) + qd4*(t7*t0 + t24*t63) + qd5*(t11*t28 - t23*t64) - qd6*(t13*t29 + t26*t65) + qd7*(t14*t79 - t27*t75), batch),  # 4
+        xp.broadcast_to(-qd3*(s1**2*t81 + c1**2*t81) - qd4*(t4*t63 + t7*t69) + qd5*(t17*t64 - t11*t70) + qd6*(t19*t65 + t13*t71) + qd7*(t20*t75 - t14*t77), batch),  # 5
     ], (6,))
     return a
 
@@ -1247,10 +1247,10 @@ def task_jacobian_dot(q, q_dot):
     t43 = t3*t36 + t6*t39
     t44 = t10*t39 - t18*t36
     t45 = t12*t38 + t20*t35
-    t46 = qd5*t44 - qd6*t45
-    t47 = t46 + qd4*t43
-    t48 = t47 + qd3*t42
-    t49 = t48 - qd2*t41
+    t46 = -t45*qd6 + t44*qd5
+    t47 = t46 + t43*qd4
+    t48 = t47 + t42*qd3
+    t49 = t48 - t41*qd2
     t50 = 0.126*t33
     t51 = 0.4*t28 + t50
     t52 = 0.42*c2 + t51
@@ -1262,53 +1262,53 @@ def task_jacobian_dot(q, q_dot):
     t58 = t6*t51 + t36*t29
     t59 = t28*t36 - t10*t51
     t60 = t12*t50 + t31*t35
-    t61 = qd5*t55 + qd6*t56
-    t62 = qd5*t59 + qd6*t60
-    t63 = t61 + qd4*t54
-    t64 = t62 - qd4*t58
-    t65 = t63 + qd3*t53
-    t66 = t64 + qd3*t57
+    t61 = t56*qd6 + t55*qd5
+    t62 = t60*qd6 + t59*qd5
+    t63 = t61 + t54*qd4
+    t64 = t62 - t58*qd4
+    t65 = t63 + t53*qd3
+    t66 = t64 + t57*qd3
     t67 = s1*qd2
     t68 = t66 + t52*t67
     t69 = t68 + t37*qd1
-    t70 = qd1*t53 + c2*t65 + t67*t42 - t8*t48
+    t70 = t53*qd1 + t67*t42 + c2*t65 - t8*t48
     t71 = t8*qd1 + c2*t67
     t72 = -t67 + t8*qd3
     t73 = t72
     t74 = c1*qd2
     t75 = t65 + t52*t74
     t76 = t75 - t40*qd1
-    t77 = -qd1*t57 - c2*t66 + t74*t42 + t16*t48
-    t78 = c1*t75 + s1*t68
-    t79 = t74*t53 + t67*t57 + t16*t65 - t8*t66
+    t77 = t74*t42 - t57*qd1 + t16*t48 - c2*t66
+    t78 = s1*t68 + c1*t75
+    t79 = t67*t57 + t74*t53 - t8*t66 + t16*t65
     t80 = c2*t74 - t16*qd1
     t81 = t74 + t16*qd3
     t82 = t81
-    t83 = t6*t64 + t3*t63 - t82*t54 - t73*t58
+    t83 = -t58*t73 - t54*t82 + t6*t64 + t3*t63
     t84 = t3*t73 + t6*t82
     t85 = qd1 + c2*qd3
     t86 = t85
-    t87 = t86*t58 + t82*t43 - t3*t47 + t29*t64
-    t88 = t73*t43 + t6*t47 - t86*t54 + t29*t63
-    t89 = t3*t86 - t29*t82
+    t87 = t43*t82 + t58*t86 - t3*t47 + t29*t64
+    t88 = -t54*t86 + t43*t73 + t29*t63 + t6*t47
+    t89 = -t29*t82 + t3*t86
     t90 = t6*t86 + t29*t73
     t91 = t6*qd4
     t92 = t73 + t91
     t93 = -t3*qd4
     t94 = t82 + t93
-    t95 = t10*t62 + t92*t59 - t18*t61 - t94*t55
+    t95 = t59*t92 - t55*t94 + t10*t62 - t18*t61
     t96 = t18*t92 - t10*t94
     t97 = -t29*qd4
     t98 = t86 + t97
-    t99 = t18*t46 + t94*t44 - t28*t62 - t98*t59
-    t100 = t28*t61 + t98*t55 - t10*t46 - t92*t44
+    t99 = t44*t94 - t59*t98 + t18*t46 - t28*t62
+    t100 = t55*t98 - t44*t92 + t28*t61 - t10*t46
     t101 = t28*t94 - t18*t98
     t102 = t10*t98 - t28*t92
     t103 = t10*qd5
     t104 = t92 + t103
     t105 = t18*qd5
     t106 = t94 + t105
-    t107 = t12*t106 + t20*t104
+    t107 = t20*t104 + t12*t106
     t108 = t28*qd5
     t109 = t98 + t108
     t110 = t31*t106 - t20*t109
@@ -1319,24 +1319,24 @@ def task_jacobian_dot(q, q_dot):
     t115 = t72 + t91 + t103 + t113 + t14*qd7
     t116 = t20*qd6
     t117 = t106 + t116
-    t118 = t106*t56 - t104*t60 + t112*t60 + t116*t56
+    t118 = -t60*t104 + t56*t106 + t112*t60 + t116*t56
     t119 = t22*t114 - t14*t117
     t120 = t81 + t93 + t105 + t116 + t22*qd7
     t121 = t23*t115 - t15*t120
     t122 = t31*qd6
     t123 = t109 + t122
-    t124 = t109*t60 + t106*t45 + t116*t45 + t122*t60
-    t125 = t109*t56 + t104*t45 + t122*t56 - t112*t45
+    t124 = t45*t106 + t60*t109 + t116*t45 + t122*t60
+    t125 = t56*t109 + t45*t104 + t122*t56 - t112*t45
     t126 = t33*t117 - t22*t123
     t127 = t14*t123 - t33*t114
     t128 = t85 + t97 + t108 + t122 + t33*qd7
     t129 = t34*t120 - t23*t128
     t130 = t15*t128 - t34*t115
     t131 = t52*qd1
-    t132 = c1*t49 - s1*t131
-    t133 = s1*t49 + c1*t131
+    t132 = -s1*t131 + c1*t49
+    t133 = c1*t131 + s1*t49
     t134 = s2*qd2
-    t135 = c1**2*t134 + s1**2*t134
+    t135 = s1**2*t134 + c1**2*t134
     t136 = c1*t23
     t137 = s1*t15
     t138 = 1/t24
@@ -1357,43 +1357,43 @@ def task_jacobian_dot(q, q_dot):
     t153 = (t12*t23 + t20*t15)*t148
     t154 = (t22*t15 - t14*t23)*t148
     t155 = 2*t139
-    t156 = t138*t129
+    t156 = t129*t138
     t157 = -(s1 + t15*t155)*t156
-    t158 = t138*t130
+    t158 = t130*t138
     t159 = (c1 - t23*t155)*t158
     t160 = qd1*t138
     t161 = t144*t160
     t162 = t145*t160
-    t163 = t15*t138
-    t164 = t80*t163
-    t165 = t23*t138
-    t166 = t71*t165
-    t167 = 2*t146
-    t168 = t156*(t8 - t15*t167)
-    t169 = t158*(t16 - t23*t167)
-    t170 = t89*t163
-    t171 = t90*t165
-    t172 = 2*t140
-    t173 = t156*(t6 - t15*t172)
-    t174 = -t158*(t3 + t23*t172)
-    t175 = t101*t163
-    t176 = t102*t165
-    t177 = 2*t141
-    t178 = t156*(t10 - t15*t177)
-    t179 = t158*(t18 - t23*t177)
-    t180 = t110*t163
-    t181 = 2*t142
-    t182 = -t156*(t12 + t15*t181)
-    t183 = t158*(t20 - t23*t181)
-    t184 = t111*t165
-    t185 = t126*t163
-    t186 = t127*t165
-    t187 = 2*t143
-    t188 = t156*(t14 - t15*t187)
-    t189 = t158*(t22 - t23*t187)
+    t163 = 2*t146
+    t164 = t156*(t8 - t15*t163)
+    t165 = t158*(t16 - t23*t163)
+    t166 = t15*t138
+    t167 = t80*t166
+    t168 = t23*t138
+    t169 = t71*t168
+    t170 = 2*t140
+    t171 = t156*(t6 - t15*t170)
+    t172 = -t158*(t3 + t23*t170)
+    t173 = t89*t166
+    t174 = t90*t168
+    t175 = 2*t141
+    t176 = t156*(t10 - t15*t175)
+    t177 = t158*(t18 - t23*t175)
+    t178 = t101*t166
+    t179 = t102*t168
+    t180 = 2*t142
+    t181 = -t156*(t12 + t15*t180)
+    t182 = t158*(t20 - t23*t180)
+    t183 = t110*t166
+    t184 = t111*t168
+    t185 = 2*t143
+    t186 = t156*(t14 - t15*t185)
+    t187 = t158*(t22 - t23*t185)
+    t188 = t126*t166
+    t189 = t127*t168
     t190 = qd1*t147
-    t191 = t15*t147
-    t192 = t23*t147
+    t191 = t23*t147
+    t192 = t15*t147
     Jd = _stack(xp, [
         xp.broadcast_to(-t69, batch),  # 0, 0
         xp.broadcast_to(t132, batch),  # 0, 1
@@ -1418,25 +1418,25 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t157 + t159 - t161 - t162, batch),  # 3, 1
-        xp.broadcast_to(t164 + t166 + t168 + t169, batch),  # 3, 2
-        xp.broadcast_to(t170 + t171 + t173 + t174, batch),  # 3, 3
-        xp.broadcast_to(t175 + t176 + t178 + t179, batch),  # 3, 4
-        xp.broadcast_to(t180 + t182 + t183 - t184, batch),  # 3, 5
-        xp.broadcast_to(t185 + t186 + t188 + t189, batch),  # 3, 6
+        xp.broadcast_to(t164 + t165 + t167 + t169, batch),  # 3, 2
+        xp.broadcast_to(t171 + t172 + t173 + t174, batch),  # 3, 3
+        xp.broadcast_to(t176 + t177 + t178 + t179, batch),  # 3, 4
+        xp.broadcast_to(t181 + t182 + t183 - t184, batch),  # 3, 5
+        xp.broadcast_to(t186 + t187 + t188 + t189, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t129*(c1*t147 - t15*t149) + t130*(s1*t147 - t23*t149) + t136*t190 - t137*t190, batch),  # 4, 1
-        xp.broadcast_to(t129*(-t15*t150 + t16*t147) - t130*(t23*t150 + t8*t147) + t71*t191 - t80*t192, batch),  # 4, 2
-        xp.broadcast_to(-t129*(t15*t151 + t3*t147) - t130*(t23*t151 + t6*t147) + t90*t191 - t89*t192, batch),  # 4, 3
-        xp.broadcast_to(t129*(t18*t147 - t15*t152) - t130*(t10*t147 + t23*t152) + t102*t191 - t101*t192, batch),  # 4, 4
-        xp.broadcast_to(t129*(t20*t147 - t15*t153) + t130*(t12*t147 - t23*t153) - t110*t192 - t111*t191, batch),  # 4, 5
-        xp.broadcast_to(t129*(t22*t147 - t15*t154) - t130*(t23*t154 + t14*t147) + t127*t191 - t126*t192, batch),  # 4, 6
+        xp.broadcast_to(t129*(t16*t147 - t15*t150) - t130*(t8*t147 + t23*t150) - t80*t191 + t71*t192, batch),  # 4, 2
+        xp.broadcast_to(-t129*(t3*t147 + t15*t151) - t130*(t6*t147 + t23*t151) - t89*t191 + t90*t192, batch),  # 4, 3
+        xp.broadcast_to(t129*(t18*t147 - t15*t152) - t130*(t10*t147 + t23*t152) - t101*t191 + t102*t192, batch),  # 4, 4
+        xp.broadcast_to(t129*(t20*t147 - t15*t153) + t130*(t12*t147 - t23*t153) - t110*t191 - t111*t192, batch),  # 4, 5
+        xp.broadcast_to(t129*(t22*t147 - t15*t154) - t130*(t14*t147 + t23*t154) - t126*t191 + t127*t192, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(t139*t121 + t34*t157 + t34*t159 - t34*t161 - t34*t162), batch),  # 5, 1
-        xp.broadcast_to(-(t135 + t146*t121 + t34*t164 + t34*t166 + t34*t168 + t34*t169), batch),  # 5, 2
-        xp.broadcast_to(-(t84 + t140*t121 + t34*t170 + t34*t171 + t34*t173 + t34*t174), batch),  # 5, 3
-        xp.broadcast_to(-(-t96 + t141*t121 + t34*t175 + t34*t176 + t34*t178 + t34*t179), batch),  # 5, 4
-        xp.broadcast_to(-(-t107 + t142*t121 - t34*t184 + t34*t180 + t34*t182 + t34*t183), batch),  # 5, 5
-        xp.broadcast_to(-(-t119 + t143*t121 + t34*t185 + t34*t186 + t34*t188 + t34*t189), batch),  # 5, 6
+        xp.broadcast_to(-(t34*t157 + t34*t159 + t121*t139 - t34*t161 - t34*t162), batch),  # 5, 1
+        xp.broadcast_to(-(t135 + t34*t164 + t34*t165 + t121*t146 + t34*t167 + t34*t169), batch),  # 5, 2
+        xp.broadcast_to(-(t84 + t34*t171 + t34*t172 + t121*t140 + t34*t173 + t34*t174), batch),  # 5, 3
+        xp.broadcast_to(-(-t96 + t34*t176 + t34*t177 + t121*t141 + t34*t178 + t34*t179), batch),  # 5, 4
+        xp.broadcast_to(-(-t107 + t34*t181 + t34*t182 + t121*t142 + t34*t183 - t34*t184), batch),  # 5, 5
+        xp.broadcast_to(-(-t119 + t34*t186 + t34*t187 + t121*t143 + t34*t188 + t34*t189), batch),  # 5, 6
     ], (6, 7))
     return Jd
 
@@ -1520,30 +1520,30 @@ def hessian(q):
     t60 = s1*t35
     t61 = s1*t36
     t62 = -s1*t37
-    t63 = c1**2
-    t64 = s1**2
-    t65 = -(c1*t48 + s1*t50)
+    t63 = s1**2
+    t64 = c1**2
+    t65 = -(s1*t50 + c1*t48)
     t66 = s1*t44 - c1*t41
-    t67 = -(c1*t42 + s1*t45)
-    t68 = -(c1*t43 + s1*t46)
-    t69 = c2*t44 + t14*t35
-    t70 = -c2*t45 + t14*t36
-    t71 = -(c2*t46 + t14*t37)
+    t67 = -(s1*t45 + c1*t42)
+    t68 = -(s1*t46 + c1*t43)
+    t69 = t14*t35 + c2*t44
+    t70 = t14*t36 - c2*t45
+    t71 = -(t14*t37 + c2*t46)
     t72 = c2*t41 - t8*t35
     t73 = c2*t42 - t8*t36
     t74 = c2*t43 + t8*t37
-    t75 = -(t14*t41 + t8*t44)
+    t75 = -(t8*t44 + t14*t41)
     t76 = t8*t45 - t14*t42
     t77 = t8*t46 - t14*t43
     t78 = s2**2
     t79 = -t3*t36 + t23*t45
     t80 = t3*t37 + t23*t46
-    t81 = -(t6*t36 + t23*t42)
-    t82 = t6*t37 - t23*t43
-    t83 = t3*t42 + t6*t45
-    t84 = t3*t43 + t6*t46
+    t81 = -(t23*t42 + t6*t36)
+    t82 = -t23*t43 + t6*t37
+    t83 = t6*t45 + t3*t42
+    t84 = t6*t46 + t3*t43
     t85 = -(t16*t37 + t22*t46)
-    t86 = t10*t37 + t22*t43
+    t86 = t22*t43 + t10*t37
     t87 = t10*t46 - t16*t43
     H = _stack(xp, [
         -t29,  # 0, 0, 0
@@ -1627,12 +1627,12 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 1
         -(t63*s2 + t64*s2),  # 1, 5, 2
         s1*t3 - c1*t6,  # 1, 5, 3
-        -(c1*t10 + s1*t16),  # 1, 5, 4
-        c1*t12 - s1*t18,  # 1, 5, 5
-        -(c1*t13 + s1*t19),  # 1, 5, 6
+        -(s1*t16 + c1*t10),  # 1, 5, 4
+        -s1*t18 + c1*t12,  # 1, 5, 5
+        -(s1*t19 + c1*t13),  # 1, 5, 6
         t52,  # 2, 0, 0
         t55,  # 2, 0, 1
-        -c2*t50 + t14*t34,  # 2, 0, 2
+        t14*t34 - c2*t50,  # 2, 0, 2
         t69,  # 2, 0, 3
         t70,  # 2, 0, 4
         t71,  # 2, 0, 5
@@ -1654,10 +1654,10 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 2
-        c2*t3 - t0*t78,  # 2, 3, 3
-        -c2*t16 + t22*t14,  # 2, 3, 4
-        -c2*t18 + t25*t14,  # 2, 3, 5
-        -c2*t19 + t26*t14,  # 2, 3, 6
+        -t0*t78 + c2*t3,  # 2, 3, 3
+        t22*t14 - c2*t16,  # 2, 3, 4
+        t25*t14 - c2*t18,  # 2, 3, 5
+        t26*t14 - c2*t19,  # 2, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 2
@@ -1668,9 +1668,9 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 2
-        -(t6*t14 + t3*t8),  # 2, 5, 3
+        -(t3*t8 + t6*t14),  # 2, 5, 3
         t16*t8 - t10*t14,  # 2, 5, 4
-        t12*t14 + t18*t8,  # 2, 5, 5
+        t18*t8 + t12*t14,  # 2, 5, 5
         t19*t8 - t13*t14,  # 2, 5, 6
         t44,  # 3, 0, 0
         t56,  # 3, 0, 1
@@ -1682,14 +1682,14 @@ def hessian(q):
         t41,  # 3, 1, 0
         t60,  # 3, 1, 1
         t72,  # 3, 1, 2
-        -(t6*t35 + t23*t41),  # 3, 1, 3
+        -(t23*t41 + t6*t35),  # 3, 1, 3
         t81,  # 3, 1, 4
         t82,  # 3, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 0
         t66,  # 3, 2, 1
         t75,  # 3, 2, 2
-        t3*t41 - t6*t44,  # 3, 2, 3
+        -t6*t44 + t3*t41,  # 3, 2, 3
         t83,  # 3, 2, 4
         t84,  # 3, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 6
@@ -1704,16 +1704,16 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        -(t6*t22 + t10*t23),  # 3, 4, 4
-        -t6*t25 + t12*t23,  # 3, 4, 5
-        -(t6*t26 + t13*t23),  # 3, 4, 6
+        -(t10*t23 + t6*t22),  # 3, 4, 4
+        t12*t23 - t6*t25,  # 3, 4, 5
+        -(t13*t23 + t6*t26),  # 3, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 3
-        t3*t10 + t6*t16,  # 3, 5, 4
+        t6*t16 + t3*t10,  # 3, 5, 4
         t6*t18 - t3*t12,  # 3, 5, 5
-        t3*t13 + t6*t19,  # 3, 5, 6
+        t6*t19 + t3*t13,  # 3, 5, 6
         t53,  # 4, 0, 0
         t57,  # 4, 0, 1
         t70,  # 4, 0, 2
@@ -1747,7 +1747,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        -(t10*t25 + t22*t12),  # 4, 4, 5
+        -(t22*t12 + t10*t25),  # 4, 4, 5
         t22*t13 - t10*t26,  # 4, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
@@ -1909,118 +1909,118 @@ def singularity_factors(q):
     t46 = t6*t39 + t28*t23
     t47 = t22*t28 - t10*t39
     t48 = t12*t38 + t25*t27
-    t49 = -c2*t16 + t22*t14
-    t50 = c1*t10
-    t51 = c1**2
-    t52 = t51*s2
-    t53 = -(s1*t49 - c2*t50 + t22*t52)
-    t54 = s2**2
-    t55 = c2*t3 - t0*t54
-    t56 = -t3*t22 + t16*t23
-    t57 = t10*t55 - t6*t49 + t8*t56
-    t58 = c1*t6
-    t59 = s2*t5
-    t60 = -(s1*t56 + t22*t58 + t10*t59)
-    t61 = -s1*t55 + c2*t58 + s3*t51*t54
-    t62 = -(-t53*t35 + t33*t57 + t34*t60 + t36*t61)
-    t63 = -t3*t25 + t18*t23
-    t64 = -(s1*t63 + t25*t58 - t12*t59)
-    t65 = t16*t25 - t22*t18
-    t66 = -(-t6*t65 + t10*t63 + t12*t56)
-    t67 = c1*t12
-    t68 = -(s1*t65 + t25*t50 + t22*t67)
-    t69 = t36*t64 + t37*t60 - t33*t66 - t35*t68
-    t70 = -c2*t18 + t25*t14
-    t71 = -(s1*t70 + c2*t67 + t25*t52)
-    t72 = -(t10*t70 + t12*t49 - t8*t65)
-    t73 = t36*t71 + t37*t53 - t33*t72 - t34*t68
-    t74 = -(t12*t55 + t6*t70 - t8*t63)
-    t75 = t35*t71 + t37*t61 - t33*t74 - t34*t64
-    t76 = t34*t66 + t36*t74 + t37*t57 - t35*t72
-    t77 = s1*t40
-    t78 = t10*t18 + t16*t12
-    t79 = t67 - s1*t18
-    t80 = -(t50 + s1*t16)
-    t81 = t33*t78 + t36*t79 + t37*t80
-    t82 = t16*t8 - t10*t14
-    t83 = -(t52 + s1**2*s2)
-    t84 = t33*t82 + t34*t80 - t36*t83
-    t85 = t12*t14 + t18*t8
-    t86 = t33*t85 + t34*t79 + t37*t83
-    t87 = t36*t85 + t37*t82 - t34*t78
-    t88 = t3*t10 + t6*t16
-    t89 = s1*t3 - t58
-    t90 = t33*t88 + t35*t80 - t36*t89
-    t91 = -(t6*t14 + t3*t8)
-    t92 = t33*t91 + t34*t89 - t35*t83
-    t93 = -(-t35*t82 + t34*t88 + t36*t91)
+    t49 = t10*t18 + t16*t12
+    t50 = c1*t12
+    t51 = -s1*t18 + t50
+    t52 = c1*t10
+    t53 = -(s1*t16 + t52)
+    t54 = t49*t33 + t51*t36 + t53*t37
+    t55 = t16*t8 - t10*t14
+    t56 = c1**2
+    t57 = t56*s2
+    t58 = -(s1**2*s2 + t57)
+    t59 = t55*t33 + t53*t34 - t58*t36
+    t60 = t25*t14 - c2*t18
+    t61 = -(s1*t60 + c2*t50 + t25*t57)
+    t62 = t22*t14 - c2*t16
+    t63 = -(s1*t62 - c2*t52 + t22*t57)
+    t64 = t16*t25 - t22*t18
+    t65 = -(t10*t60 + t12*t62 - t8*t64)
+    t66 = -(s1*t64 + t25*t52 + t22*t50)
+    t67 = t36*t61 + t37*t63 - t65*t33 - t66*t34
+    t68 = t18*t8 + t12*t14
+    t69 = t68*t33 + t51*t34 + t58*t37
+    t70 = t68*t36 + t55*t37 - t49*t34
+    t71 = s1*t40
+    t72 = t6*t16 + t3*t10
+    t73 = c1*t6
+    t74 = s1*t3 - t73
+    t75 = t72*t33 + t53*t35 - t74*t36
+    t76 = -(t3*t8 + t6*t14)
+    t77 = t76*t33 + t74*t34 - t58*t35
+    t78 = s2**2
+    t79 = -t0*t78 + c2*t3
+    t80 = -t3*t22 + t16*t23
+    t81 = t10*t79 - t6*t62 + t8*t80
+    t82 = s2*t5
+    t83 = -(s1*t80 + t22*t73 + t10*t82)
+    t84 = -s1*t79 + c2*t73 + s3*t56*t78
+    t85 = -(-t63*t35 + t33*t81 + t34*t83 + t36*t84)
+    t86 = -(-t55*t35 + t72*t34 + t76*t36)
+    t87 = -t3*t25 + t18*t23
+    t88 = -(s1*t87 + t25*t73 - t12*t82)
+    t89 = -(-t6*t64 + t10*t87 + t12*t80)
+    t90 = t36*t88 + t37*t83 - t89*t33 - t66*t35
+    t91 = -(t12*t79 + t6*t60 - t8*t87)
+    t92 = t61*t35 + t37*t84 - t91*t33 - t88*t34
+    t93 = t34*t89 + t36*t91 + t37*t81 - t65*t35
     t94 = t6*t18 - t3*t12
-    t95 = t33*t94 + t35*t79 + t37*t89
-    t96 = t36*t94 + t37*t88 - t35*t78
-    t97 = t35*t85 + t37*t91 - t34*t94
+    t95 = t94*t33 + t51*t35 + t74*t37
+    t96 = t94*t36 + t72*t37 - t49*t35
+    t97 = t68*t35 + t76*t37 - t94*t34
     t98 = c1*t40
-    t99 = -t32*(-t62*t48 + t45*t69 + t46*t73 + t47*t75 - t76*t77) + t42*(t29*t73 + t45*t81 + t48*t84 - t47*t86 - t77*t87) + t44*(t29*t62 + t45*t90 + t46*t84 + t47*t92 - t77*t93) + t41*(-t29*t69 - t48*t90 + t46*t81 + t47*t95 + t77*t96) - t43*(t29*t75 + t45*t95 + t46*t86 + t48*t92 - t77*t97) - t98*(-t29*t76 - t48*t93 + t45*t96 + t46*t87 + t47*t97)
-    t100 = -t3*t26 + t19*t23
-    t101 = -(s1*t100 + t26*t58 + t13*t59)
-    t102 = t16*t26 - t22*t19
-    t103 = t13*t56 + t6*t102 - t10*t100
-    t104 = c1*t13
-    t105 = -(s1*t102 - t22*t104 + t26*t50)
-    t106 = -(-t36*t101 + t33*t103 + t35*t105)
-    t107 = -c2*t19 + t26*t14
-    t108 = -(s1*t107 - c2*t104 + t26*t52)
-    t109 = t13*t49 - t10*t107 + t8*t102
-    t110 = -(-t36*t108 + t33*t109 + t34*t105)
-    t111 = t13*t55 - t6*t107 + t8*t100
-    t112 = -(-t35*t108 + t33*t111 + t34*t101)
-    t113 = t34*t103 + t36*t111 - t35*t109
-    t114 = -(t45*t106 + t46*t110 + t47*t112 - t77*t113)
-    t115 = t10*t19 - t16*t13
-    t116 = -(t104 + s1*t19)
-    t117 = t33*t115 + t36*t116
-    t118 = t19*t8 - t13*t14
-    t119 = t33*t118 + t34*t116
-    t120 = t36*t118 - t34*t115
-    t121 = t29*t110 + t45*t117 - t47*t119 - t77*t120
-    t122 = t3*t13 + t6*t19
-    t123 = t33*t122 + t35*t116
-    t124 = t36*t122 - t35*t115
-    t125 = -(-t29*t106 + t46*t117 + t47*t123 + t77*t124)
-    t126 = t35*t118 - t34*t122
-    t127 = t29*t112 + t45*t123 + t46*t119 - t77*t126
-    t128 = -(-t29*t113 + t45*t124 + t46*t120 + t47*t126)
-    t129 = t32*t114 + t42*t121 - t41*t125 - t43*t127 + t98*t128
-    t130 = t18*t26 - t25*t19
-    t131 = t12*t100 + t13*t63 + t6*t130
-    t132 = -s1*t130 + t26*t67 + t25*t104
-    t133 = -(t33*t131 + t35*t132 + t37*t101)
-    t134 = t12*t107 + t13*t70 + t8*t130
-    t135 = -(t33*t134 + t34*t132 + t37*t108)
-    t136 = -(-t34*t131 + t35*t134 + t37*t111)
-    t137 = -(t45*t133 + t46*t135 + t48*t112 - t77*t136)
-    t138 = -(t12*t19 + t18*t13)
-    t139 = t33*t138 - t37*t116
-    t140 = -(t34*t138 + t37*t118)
-    t141 = t29*t135 + t45*t139 - t48*t119 - t77*t140
-    t142 = -(t35*t138 + t37*t122)
-    t143 = -(-t29*t133 + t46*t139 + t48*t123 + t77*t142)
-    t144 = -(-t29*t136 + t45*t142 + t46*t140 + t48*t126)
-    t145 = t32*t137 + t42*t141 - t41*t143 - t44*t127 + t98*t144
-    t146 = t10*t130 + t12*t102 + t13*t65
-    t147 = -(t33*t146 + t36*t132 + t37*t105)
-    t148 = -(-t34*t146 + t36*t134 + t37*t109)
-    t149 = t47*t135 - t45*t147 - t48*t110 + t77*t148
-    t150 = -(t36*t138 + t37*t115)
-    t151 = t29*t147 + t47*t139 - t48*t117 - t77*t150
-    t152 = t29*t148 + t47*t140 - t45*t150 - t48*t120
-    t153 = t32*t149 + t43*t141 - t41*t151 - t44*t121 + t98*t152
-    t154 = -(-t35*t146 + t36*t131 + t37*t103)
-    t155 = t46*t147 + t47*t133 - t48*t106 + t77*t154
-    t156 = t29*t154 + t46*t150 + t47*t142 - t48*t124
-    t157 = t32*t155 + t43*t143 - t42*t151 - t44*t125 + t98*t156
-    t158 = t45*t154 + t46*t148 + t47*t136 - t48*t113
-    t159 = t32*t158 + t41*t156 + t43*t144 - t42*t152 - t44*t128
-    t160 = t42*t149 + t44*t114 - t41*t155 - t43*t137 + t98*t158
+    t99 = t42*(t45*t54 + t48*t59 + t29*t67 - t69*t47 - t70*t71) + t44*(t45*t75 + t59*t46 + t47*t77 + t29*t85 - t71*t86) - t32*(-t85*t48 + t45*t90 + t67*t46 + t47*t92 - t71*t93) + t41*(-t75*t48 - t29*t90 + t54*t46 + t47*t95 + t71*t96) - t43*(t45*t95 + t69*t46 + t48*t77 + t29*t92 - t71*t97) - t98*(-t86*t48 - t29*t93 + t45*t96 + t70*t46 + t47*t97)
+    t100 = t10*t19 - t16*t13
+    t101 = c1*t13
+    t102 = -(s1*t19 + t101)
+    t103 = t100*t33 + t102*t36
+    t104 = t26*t14 - c2*t19
+    t105 = -(s1*t104 - c2*t101 + t26*t57)
+    t106 = t16*t26 - t22*t19
+    t107 = t13*t62 - t10*t104 + t8*t106
+    t108 = -(s1*t106 - t22*t101 + t26*t52)
+    t109 = -(-t105*t36 + t33*t107 + t34*t108)
+    t110 = t19*t8 - t13*t14
+    t111 = t110*t33 + t102*t34
+    t112 = t110*t36 - t100*t34
+    t113 = t45*t103 + t29*t109 - t111*t47 - t71*t112
+    t114 = -t3*t26 + t19*t23
+    t115 = -(s1*t114 + t26*t73 + t13*t82)
+    t116 = t13*t80 + t6*t106 - t10*t114
+    t117 = -(-t36*t115 + t33*t116 + t35*t108)
+    t118 = t13*t79 - t6*t104 + t8*t114
+    t119 = -(-t105*t35 + t33*t118 + t34*t115)
+    t120 = t34*t116 + t36*t118 - t107*t35
+    t121 = -(t45*t117 + t46*t109 + t47*t119 - t71*t120)
+    t122 = t6*t19 + t3*t13
+    t123 = t122*t33 + t102*t35
+    t124 = t122*t36 - t100*t35
+    t125 = -(-t29*t117 + t46*t103 + t47*t123 + t71*t124)
+    t126 = t110*t35 - t34*t122
+    t127 = t45*t123 + t46*t111 + t29*t119 - t71*t126
+    t128 = -(-t29*t120 + t45*t124 + t46*t112 + t47*t126)
+    t129 = t42*t113 + t32*t121 - t41*t125 - t43*t127 + t98*t128
+    t130 = -(t12*t19 + t18*t13)
+    t131 = t130*t33 - t102*t37
+    t132 = t18*t26 - t25*t19
+    t133 = t12*t104 + t13*t60 + t8*t132
+    t134 = -s1*t132 + t26*t50 + t25*t101
+    t135 = -(t33*t133 + t34*t134 + t37*t105)
+    t136 = -(t130*t34 + t110*t37)
+    t137 = t45*t131 + t29*t135 - t111*t48 - t71*t136
+    t138 = t12*t114 + t13*t87 + t6*t132
+    t139 = -(t33*t138 + t35*t134 + t37*t115)
+    t140 = -(-t34*t138 + t35*t133 + t37*t118)
+    t141 = -(t45*t139 + t46*t135 + t48*t119 - t71*t140)
+    t142 = -(t130*t35 + t122*t37)
+    t143 = -(-t29*t139 + t46*t131 + t48*t123 + t71*t142)
+    t144 = -(-t29*t140 + t45*t142 + t46*t136 + t48*t126)
+    t145 = t42*t137 + t32*t141 - t41*t143 - t44*t127 + t98*t144
+    t146 = t10*t132 + t12*t106 + t13*t64
+    t147 = -(t33*t146 + t36*t134 + t37*t108)
+    t148 = -(-t34*t146 + t36*t133 + t37*t107)
+    t149 = t47*t135 - t45*t147 - t109*t48 + t71*t148
+    t150 = -(t130*t36 + t100*t37)
+    t151 = t47*t131 + t29*t147 - t103*t48 - t71*t150
+    t152 = t47*t136 + t29*t148 - t45*t150 - t48*t112
+    t153 = t43*t137 + t32*t149 - t41*t151 - t44*t113 + t98*t152
+    t154 = -(-t35*t146 + t36*t138 + t37*t116)
+    t155 = t46*t147 + t47*t139 - t48*t117 + t71*t154
+    t156 = t46*t150 + t47*t142 + t29*t154 - t48*t124
+    t157 = t43*t143 + t32*t155 - t42*t151 - t44*t125 + t98*t156
+    t158 = t45*t154 + t46*t148 + t47*t140 - t48*t120
+    t159 = t41*t156 + t43*t144 + t32*t158 - t42*t152 - t44*t128
+    t160 = t42*t149 + t44*t121 - t41*t155 - t43*t141 + t98*t158
     f = _stack(xp, [
         s4,  # 0
         t99**2 + t129**2 + t145**2 + t153**2 + t157**2 + t159**2 + t160**2,  # 1
@@ -2093,118 +2093,118 @@ def manipulability(q):
     t46 = t6*t39 + t28*t23
     t47 = t22*t28 - t10*t39
     t48 = t12*t38 + t25*t27
-    t49 = -c2*t16 + t22*t14
-    t50 = c1*t10
-    t51 = c1**2
-    t52 = t51*s2
-    t53 = -(s1*t49 - c2*t50 + t22*t52)
-    t54 = s2**2
-    t55 = c2*t3 - t0*t54
-    t56 = -t3*t22 + t16*t23
-    t57 = t10*t55 - t6*t49 + t8*t56
-    t58 = c1*t6
-    t59 = s2*t5
-    t60 = -(s1*t56 + t22*t58 + t10*t59)
-    t61 = -s1*t55 + c2*t58 + s3*t51*t54
-    t62 = -(-t53*t35 + t33*t57 + t34*t60 + t36*t61)
-    t63 = -t3*t25 + t18*t23
-    t64 = -(s1*t63 + t25*t58 - t12*t59)
-    t65 = t16*t25 - t22*t18
-    t66 = -(-t6*t65 + t10*t63 + t12*t56)
-    t67 = c1*t12
-    t68 = -(s1*t65 + t25*t50 + t22*t67)
-    t69 = t36*t64 + t37*t60 - t33*t66 - t35*t68
-    t70 = -c2*t18 + t25*t14
-    t71 = -(s1*t70 + c2*t67 + t25*t52)
-    t72 = -(t10*t70 + t12*t49 - t8*t65)
-    t73 = t36*t71 + t37*t53 - t33*t72 - t34*t68
-    t74 = -(t12*t55 + t6*t70 - t8*t63)
-    t75 = t35*t71 + t37*t61 - t33*t74 - t34*t64
-    t76 = t34*t66 + t36*t74 + t37*t57 - t35*t72
-    t77 = s1*t40
-    t78 = t10*t18 + t16*t12
-    t79 = t67 - s1*t18
-    t80 = -(t50 + s1*t16)
-    t81 = t33*t78 + t36*t79 + t37*t80
-    t82 = t16*t8 - t10*t14
-    t83 = -(t52 + s1**2*s2)
-    t84 = t33*t82 + t34*t80 - t36*t83
-    t85 = t12*t14 + t18*t8
-    t86 = t33*t85 + t34*t79 + t37*t83
-    t87 = t36*t85 + t37*t82 - t34*t78
-    t88 = t3*t10 + t6*t16
-    t89 = s1*t3 - t58
-    t90 = t33*t88 + t35*t80 - t36*t89
-    t91 = -(t6*t14 + t3*t8)
-    t92 = t33*t91 + t34*t89 - t35*t83
-    t93 = -(-t35*t82 + t34*t88 + t36*t91)
+    t49 = t10*t18 + t16*t12
+    t50 = c1*t12
+    t51 = -s1*t18 + t50
+    t52 = c1*t10
+    t53 = -(s1*t16 + t52)
+    t54 = t49*t33 + t51*t36 + t53*t37
+    t55 = t16*t8 - t10*t14
+    t56 = c1**2
+    t57 = t56*s2
+    t58 = -(s1**2*s2 + t57)
+    t59 = t55*t33 + t53*t34 - t58*t36
+    t60 = t25*t14 - c2*t18
+    t61 = -(s1*t60 + c2*t50 + t25*t57)
+    t62 = t22*t14 - c2*t16
+    t63 = -(s1*t62 - c2*t52 + t22*t57)
+    t64 = t16*t25 - t22*t18
+    t65 = -(t10*t60 + t12*t62 - t8*t64)
+    t66 = -(s1*t64 + t25*t52 + t22*t50)
+    t67 = t36*t61 + t37*t63 - t65*t33 - t66*t34
+    t68 = t18*t8 + t12*t14
+    t69 = t68*t33 + t51*t34 + t58*t37
+    t70 = t68*t36 + t55*t37 - t49*t34
+    t71 = s1*t40
+    t72 = t6*t16 + t3*t10
+    t73 = c1*t6
+    t74 = s1*t3 - t73
+    t75 = t72*t33 + t53*t35 - t74*t36
+    t76 = -(t3*t8 + t6*t14)
+    t77 = t76*t33 + t74*t34 - t58*t35
+    t78 = s2**2
+    t79 = -t0*t78 + c2*t3
+    t80 = -t3*t22 + t16*t23
+    t81 = t10*t79 - t6*t62 + t8*t80
+    t82 = s2*t5
+    t83 = -(s1*t80 + t22*t73 + t10*t82)
+    t84 = -s1*t79 + c2*t73 + s3*t56*t78
+    t85 = -(-t63*t35 + t33*t81 + t34*t83 + t36*t84)
+    t86 = -(-t55*t35 + t72*t34 + t76*t36)
+    t87 = -t3*t25 + t18*t23
+    t88 = -(s1*t87 + t25*t73 - t12*t82)
+    t89 = -(-t6*t64 + t10*t87 + t12*t80)
+    t90 = t36*t88 + t37*t83 - t89*t33 - t66*t35
+    t91 = -(t12*t79 + t6*t60 - t8*t87)
+    t92 = t61*t35 + t37*t84 - t91*t33 - t88*t34
+    t93 = t34*t89 + t36*t91 + t37*t81 - t65*t35
     t94 = t6*t18 - t3*t12
-    t95 = t33*t94 + t35*t79 + t37*t89
-    t96 = t36*t94 + t37*t88 - t35*t78
-    t97 = t35*t85 + t37*t91 - t34*t94
+    t95 = t94*t33 + t51*t35 + t74*t37
+    t96 = t94*t36 + t72*t37 - t49*t35
+    t97 = t68*t35 + t76*t37 - t94*t34
     t98 = c1*t40
-    t99 = -t32*(-t62*t48 + t45*t69 + t46*t73 + t47*t75 - t76*t77) + t42*(t29*t73 + t45*t81 + t48*t84 - t47*t86 - t77*t87) + t44*(t29*t62 + t45*t90 + t46*t84 + t47*t92 - t77*t93) + t41*(-t29*t69 - t48*t90 + t46*t81 + t47*t95 + t77*t96) - t43*(t29*t75 + t45*t95 + t46*t86 + t48*t92 - t77*t97) - t98*(-t29*t76 - t48*t93 + t45*t96 + t46*t87 + t47*t97)
-    t100 = -t3*t26 + t19*t23
-    t101 = -(s1*t100 + t26*t58 + t13*t59)
-    t102 = t16*t26 - t22*t19
-    t103 = t13*t56 + t6*t102 - t10*t100
-    t104 = c1*t13
-    t105 = -(s1*t102 - t22*t104 + t26*t50)
-    t106 = -(-t36*t101 + t33*t103 + t35*t105)
-    t107 = -c2*t19 + t26*t14
-    t108 = -(s1*t107 - c2*t104 + t26*t52)
-    t109 = t13*t49 - t10*t107 + t8*t102
-    t110 = -(-t36*t108 + t33*t109 + t34*t105)
-    t111 = t13*t55 - t6*t107 + t8*t100
-    t112 = -(-t35*t108 + t33*t111 + t34*t101)
-    t113 = t34*t103 + t36*t111 - t35*t109
-    t114 = -(t45*t106 + t46*t110 + t47*t112 - t77*t113)
-    t115 = t10*t19 - t16*t13
-    t116 = -(t104 + s1*t19)
-    t117 = t33*t115 + t36*t116
-    t118 = t19*t8 - t13*t14
-    t119 = t33*t118 + t34*t116
-    t120 = t36*t118 - t34*t115
-    t121 = t29*t110 + t45*t117 - t47*t119 - t77*t120
-    t122 = t3*t13 + t6*t19
-    t123 = t33*t122 + t35*t116
-    t124 = t36*t122 - t35*t115
-    t125 = -(-t29*t106 + t46*t117 + t47*t123 + t77*t124)
-    t126 = t35*t118 - t34*t122
-    t127 = t29*t112 + t45*t123 + t46*t119 - t77*t126
-    t128 = -(-t29*t113 + t45*t124 + t46*t120 + t47*t126)
-    t129 = t32*t114 + t42*t121 - t41*t125 - t43*t127 + t98*t128
-    t130 = t18*t26 - t25*t19
-    t131 = t12*t100 + t13*t63 + t6*t130
-    t132 = -s1*t130 + t26*t67 + t25*t104
-    t133 = -(t33*t131 + t35*t132 + t37*t101)
-    t134 = t12*t107 + t13*t70 + t8*t130
-    t135 = -(t33*t134 + t34*t132 + t37*t108)
-    t136 = -(-t34*t131 + t35*t134 + t37*t111)
-    t137 = -(t45*t133 + t46*t135 + t48*t112 - t77*t136)
-    t138 = -(t12*t19 + t18*t13)
-    t139 = t33*t138 - t37*t116
-    t140 = -(t34*t138 + t37*t118)
-    t141 = t29*t135 + t45*t139 - t48*t119 - t77*t140
-    t142 = -(t35*t138 + t37*t122)
-    t143 = -(-t29*t133 + t46*t139 + t48*t123 + t77*t142)
-    t144 = -(-t29*t136 + t45*t142 + t46*t140 + t48*t126)
-    t145 = t32*t137 + t42*t141 - t41*t143 - t44*t127 + t98*t144
-    t146 = t10*t130 + t12*t102 + t13*t65
-    t147 = -(t33*t146 + t36*t132 + t37*t105)
-    t148 = -(-t34*t146 + t36*t134 + t37*t109)
-    t149 = t47*t135 - t45*t147 - t48*t110 + t77*t148
-    t150 = -(t36*t138 + t37*t115)
-    t151 = t29*t147 + t47*t139 - t48*t117 - t77*t150
-    t152 = t29*t148 + t47*t140 - t45*t150 - t48*t120
-    t153 = t32*t149 + t43*t141 - t41*t151 - t44*t121 + t98*t152
-    t154 = -(-t35*t146 + t36*t131 + t37*t103)
-    t155 = t46*t147 + t47*t133 - t48*t106 + t77*t154
-    t156 = t29*t154 + t46*t150 + t47*t142 - t48*t124
-    t157 = t32*t155 + t43*t143 - t42*t151 - t44*t125 + t98*t156
-    t158 = t45*t154 + t46*t148 + t47*t136 - t48*t113
-    t159 = t32*t158 + t41*t156 + t43*t144 - t42*t152 - t44*t128
-    t160 = t42*t149 + t44*t114 - t41*t155 - t43*t137 + t98*t158
+    t99 = t42*(t45*t54 + t48*t59 + t29*t67 - t69*t47 - t70*t71) + t44*(t45*t75 + t59*t46 + t47*t77 + t29*t85 - t71*t86) - t32*(-t85*t48 + t45*t90 + t67*t46 + t47*t92 - t71*t93) + t41*(-t75*t48 - t29*t90 + t54*t46 + t47*t95 + t71*t96) - t43*(t45*t95 + t69*t46 + t48*t77 + t29*t92 - t71*t97) - t98*(-t86*t48 - t29*t93 + t45*t96 + t70*t46 + t47*t97)
+    t100 = t10*t19 - t16*t13
+    t101 = c1*t13
+    t102 = -(s1*t19 + t101)
+    t103 = t100*t33 + t102*t36
+    t104 = t26*t14 - c2*t19
+    t105 = -(s1*t104 - c2*t101 + t26*t57)
+    t106 = t16*t26 - t22*t19
+    t107 = t13*t62 - t10*t104 + t8*t106
+    t108 = -(s1*t106 - t22*t101 + t26*t52)
+    t109 = -(-t105*t36 + t33*t107 + t34*t108)
+    t110 = t19*t8 - t13*t14
+    t111 = t110*t33 + t102*t34
+    t112 = t110*t36 - t100*t34
+    t113 = t45*t103 + t29*t109 - t111*t47 - t71*t112
+    t114 = -t3*t26 + t19*t23
+    t115 = -(s1*t114 + t26*t73 + t13*t82)
+    t116 = t13*t80 + t6*t106 - t10*t114
+    t117 = -(-t36*t115 + t33*t116 + t35*t108)
+    t118 = t13*t79 - t6*t104 + t8*t114
+    t119 = -(-t105*t35 + t33*t118 + t34*t115)
+    t120 = t34*t116 + t36*t118 - t107*t35
+    t121 = -(t45*t117 + t46*t109 + t47*t119 - t71*t120)
+    t122 = t6*t19 + t3*t13
+    t123 = t122*t33 + t102*t35
+    t124 = t122*t36 - t100*t35
+    t125 = -(-t29*t117 + t46*t103 + t47*t123 + t71*t124)
+    t126 = t110*t35 - t34*t122
+    t127 = t45*t123 + t46*t111 + t29*t119 - t71*t126
+    t128 = -(-t29*t120 + t45*t124 + t46*t112 + t47*t126)
+    t129 = t42*t113 + t32*t121 - t41*t125 - t43*t127 + t98*t128
+    t130 = -(t12*t19 + t18*t13)
+    t131 = t130*t33 - t102*t37
+    t132 = t18*t26 - t25*t19
+    t133 = t12*t104 + t13*t60 + t8*t132
+    t134 = -s1*t132 + t26*t50 + t25*t101
+    t135 = -(t33*t133 + t34*t134 + t37*t105)
+    t136 = -(t130*t34 + t110*t37)
+    t137 = t45*t131 + t29*t135 - t111*t48 - t71*t136
+    t138 = t12*t114 + t13*t87 + t6*t132
+    t139 = -(t33*t138 + t35*t134 + t37*t115)
+    t140 = -(-t34*t138 + t35*t133 + t37*t118)
+    t141 = -(t45*t139 + t46*t135 + t48*t119 - t71*t140)
+    t142 = -(t130*t35 + t122*t37)
+    t143 = -(-t29*t139 + t46*t131 + t48*t123 + t71*t142)
+    t144 = -(-t29*t140 + t45*t142 + t46*t136 + t48*t126)
+    t145 = t42*t137 + t32*t141 - t41*t143 - t44*t127 + t98*t144
+    t146 = t10*t132 + t12*t106 + t13*t64
+    t147 = -(t33*t146 + t36*t134 + t37*t108)
+    t148 = -(-t34*t146 + t36*t133 + t37*t107)
+    t149 = t47*t135 - t45*t147 - t109*t48 + t71*t148
+    t150 = -(t130*t36 + t100*t37)
+    t151 = t47*t131 + t29*t147 - t103*t48 - t71*t150
+    t152 = t47*t136 + t29*t148 - t45*t150 - t48*t112
+    t153 = t43*t137 + t32*t149 - t41*t151 - t44*t113 + t98*t152
+    t154 = -(-t35*t146 + t36*t138 + t37*t116)
+    t155 = t46*t147 + t47*t139 - t48*t117 + t71*t154
+    t156 = t46*t150 + t47*t142 + t29*t154 - t48*t124
+    t157 = t43*t143 + t32*t155 - t42*t151 - t44*t125 + t98*t156
+    t158 = t45*t154 + t46*t148 + t47*t140 - t48*t120
+    t159 = t41*t156 + t43*t144 + t32*t158 - t42*t152 - t44*t128
+    t160 = t42*t149 + t44*t121 - t41*t155 - t43*t141 + t98*t158
     t161 = t99**2 + t129**2 + t145**2 + t153**2 + t157**2 + t159**2 + t160**2
     w = xp.broadcast_to(xp.sqrt(xp.abs(t161)), batch)
     return w

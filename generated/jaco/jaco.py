@@ -928,33 +928,33 @@ def fk_jacobian_dot(q, q_dot):
     t89 = t88
     t90 = t41*t46 - t47*t40
     t91 = t90
-    t92 = s1*qd3
-    t93 = s1*qd2
-    t94 = t92 - t93
+    t92 = s1*qd2
+    t93 = s1*qd3
+    t94 = -t92 + t93
     t95 = t94 - t13*qd4
     t96 = t95 - t19*qd5
-    t97 = c1*qd3
-    t98 = c1*qd2
-    t99 = t97 - t98
+    t97 = c1*qd2
+    t98 = c1*qd3
+    t99 = -t97 + t98
     t100 = t99 - t14*qd4
     t101 = t100 - t22*qd5
-    t102 = qd6*t75
-    t103 = qd5*t73 + t102
-    t104 = t103 + qd4*t71
-    t105 = -t104 + t55*t97
-    t106 = t105 - t56*t98
+    t102 = t75*qd6
+    t103 = t102 + t73*qd5
+    t104 = t103 + t71*qd4
+    t105 = -t104 + t55*t98
+    t106 = t105 - t56*t97
     t107 = t106 + t69*qd1
-    t108 = qd6*t81
-    t109 = qd5*t79 + t108
-    t110 = t109 + qd4*t77
-    t111 = t110 - t55*t92
-    t112 = t111 + t56*t93
+    t108 = t81*qd6
+    t109 = t108 + t79*qd5
+    t110 = t109 + t77*qd4
+    t111 = t110 - t55*t93
+    t112 = t111 + t56*t92
     t113 = t112 - t68*qd1
-    t114 = qd6*t91
-    t115 = qd5*t89 + t114
-    t116 = t115 + qd4*t87
-    t117 = t116 + qd3*t85
-    t118 = t117 + qd2*t83
+    t114 = t91*qd6
+    t115 = t114 + t89*qd5
+    t116 = t115 + t87*qd4
+    t117 = t116 + t85*qd3
+    t118 = t117 + t83*qd2
     t119 = c1*t56
     t120 = c1*t55
     t121 = s1*t56
@@ -1017,12 +1017,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t52, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd1*t113 + qd2*(-c1*t118 + qd1*t121) - qd3*(-c1*t117 + qd1*t122 + t98*t85) + qd4*(qd1*t77 + t99*t87 - t14*t116 - t4*t110) - qd5*(-t100*t89 + t26*t109 + t22*t115 + t10*t79) - qd6*(-t101*t91 + t28*t81 + t46*t114 + t52*t108), batch),  # 0
-        xp.broadcast_to(qd2*(s1*t118 + t119*qd1) - qd3*(-t93*t85 + s1*t117 + t120*qd1) + qd4*(t13*t116 + qd1*t71 - t4*t104 - t94*t87) - qd5*(-t19*t115 + t26*t103 + t10*t73 + t95*t89) - qd6*(-t40*t114 + t28*t75 + t96*t91 + t52*t102) - qd1*t107, batch),  # 1
-        xp.broadcast_to(qd2*(c1*t106 - s1*t112) + qd3*(s1*t111 - c1*t105 + c1**2*t123 + s1**2*t123) + qd4*(t99*t71 + t94*t77 - t14*t104 - t13*t110) + qd5*(t100*t73 + t95*t79 - t22*t103 - t19*t109) + qd6*(t101*t75 + t96*t81 - t40*t108 - t46*t102), batch),  # 2
-        xp.broadcast_to(qd4*(t4*t99 - t14*qd1) + qd5*(t22*t10 + t26*t100) + qd6*(t46*t28 + t52*t101) + t97*qd1 - t98*qd1, batch),  # 3
-        xp.broadcast_to(qd4*(t13*qd1 - t4*t94) - qd5*(t19*t10 + t26*t95) - qd6*(t40*t28 + t52*t96) + t93*qd1 - t92*qd1, batch),  # 4
-        xp.broadcast_to(qd4*(t13*t99 - t14*t94) + qd5*(t19*t100 - t22*t95) + qd6*(t40*t101 - t46*t96), batch),  # 5
+        xp.broadcast_to(qd1*t113 + qd2*(qd1*t121 - c1*t118) - qd3*(t97*t85 + qd1*t122 - c1*t117) + qd4*(t87*t99 + t77*qd1 - t14*t116 - t4*t110) - qd5*(-t89*t100 + t79*t10 + t22*t115 + t26*t109) - qd6*(-t91*t101 + t81*t28 + t46*t114 + t52*t108), batch),  # 0
+        xp.broadcast_to(-qd1*t107 + qd2*(t119*qd1 + s1*t118) - qd3*(t120*qd1 - t92*t85 + s1*t117) + qd4*(t71*qd1 - t87*t94 - t4*t104 + t13*t116) - qd5*(t73*t10 + t89*t95 + t26*t103 - t19*t115) - qd6*(t75*t28 + t91*t96 + t52*t102 - t40*t114), batch),  # 1
+        xp.broadcast_to(qd2*(-s1*t112 + c1*t106) + qd3*(s1**2*t123 + c1**2*t123 + s1*t111 - c1*t105) + qd4*(t77*t94 + t71*t99 - t13*t110 - t14*t104) + qd5*(t79*t95 + t73*t100 - t19*t109 - t22*t103) + qd6*(t81*t96 + t75*t101 - t40*t108 - t46*t102), batch),  # 2
+        xp.broadcast_to(-t97*qd1 + t98*qd1 + qd4*(t4*t99 - t14*qd1) + qd5*(t26*t100 + t22*t10) + qd6*(t52*t101 + t46*t28), batch),  # 3
+        xp.broadcast_to(t92*qd1 - t93*qd1 + qd4*(t13*qd1 - t4*t94) - qd5*(t19*t10 + t26*t95) - qd6*(t40*t28 + t52*t96), batch),  # 4
+        xp.broadcast_to(qd4*(-t14*t94 + t13*t99) + qd5*(-t22*t95 + t19*t100) + qd6*(-t46*t96 + t40*t101), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -1114,61 +1114,61 @@ def jacobian_dot(q, q_dot):
     t61 = c1*t60 + t37
     t62 = t43 - s1*t60
     t63 = c1*t61 - s1*t62
-    t64 = s1*qd3
-    t65 = s1*qd2
-    t66 = t64 - t65
+    t64 = s1*qd2
+    t65 = s1*qd3
+    t66 = -t64 + t65
     t67 = t66 - t13*qd4
     t68 = t67 - t21*qd5
-    t69 = c1*qd3
-    t70 = c1*qd2
-    t71 = t69 - t70
+    t69 = c1*qd2
+    t70 = c1*qd3
+    t71 = -t69 + t70
     t72 = t71 - t14*qd4
     t73 = t72 - t24*qd5
-    t74 = qd6*t56
-    t75 = qd5*t55 + t74
-    t76 = t75 + qd4*t54
-    t77 = -t76 + t52*t69
-    t78 = t77 - t53*t70
+    t74 = t56*qd6
+    t75 = t74 + t55*qd5
+    t76 = t75 + t54*qd4
+    t77 = -t76 + t52*t70
+    t78 = t77 - t53*t69
     t79 = t78 + t62*qd1
-    t80 = qd6*t59
-    t81 = qd5*t58 + t80
-    t82 = t81 + qd4*t57
-    t83 = t82 - t52*t64
-    t84 = t83 + t53*t65
+    t80 = t59*qd6
+    t81 = t80 + t58*qd5
+    t82 = t81 + t57*qd4
+    t83 = t82 - t52*t65
+    t84 = t83 + t53*t64
     t85 = t84 - t61*qd1
-    t86 = qd6*t47
-    t87 = qd5*t46 + t86
-    t88 = t87 + qd4*t45
-    t89 = t88 + qd3*t44
-    t90 = t89 + qd2*t63
+    t86 = t47*qd6
+    t87 = t86 + t46*qd5
+    t88 = t87 + t45*qd4
+    t89 = t88 + t44*qd3
+    t90 = t89 + t63*qd2
     t91 = s1*qd1
     t92 = c1*qd1
     t93 = t52*qd2
     Jd = _stack(xp, [
         xp.broadcast_to(t85, batch),  # 0, 0
-        xp.broadcast_to(-c1*t90 + t53*t91, batch),  # 0, 1
-        xp.broadcast_to(-(-c1*t89 + t52*t91 + t70*t44), batch),  # 0, 2
-        xp.broadcast_to(qd1*t57 + t71*t45 - t14*t88 - t4*t82, batch),  # 0, 3
-        xp.broadcast_to(-(-t72*t46 + t29*t81 + t24*t87 + t10*t58), batch),  # 0, 4
-        xp.broadcast_to(-(-t73*t47 + t31*t59 + t39*t86 + t49*t80), batch),  # 0, 5
+        xp.broadcast_to(t53*t91 - c1*t90, batch),  # 0, 1
+        xp.broadcast_to(-(t69*t44 + t52*t91 - c1*t89), batch),  # 0, 2
+        xp.broadcast_to(t45*t71 + t57*qd1 - t14*t88 - t4*t82, batch),  # 0, 3
+        xp.broadcast_to(-(-t46*t72 + t58*t10 + t24*t87 + t29*t81), batch),  # 0, 4
+        xp.broadcast_to(-(-t47*t73 + t59*t31 + t39*t86 + t49*t80), batch),  # 0, 5
         xp.broadcast_to(-t79, batch),  # 1, 0
-        xp.broadcast_to(s1*t90 + t53*t92, batch),  # 1, 1
-        xp.broadcast_to(-(-t65*t44 + s1*t89 + t52*t92), batch),  # 1, 2
-        xp.broadcast_to(t13*t88 + qd1*t54 - t4*t76 - t66*t45, batch),  # 1, 3
-        xp.broadcast_to(-(-t21*t87 + t29*t75 + t10*t55 + t67*t46), batch),  # 1, 4
-        xp.broadcast_to(-(-t33*t86 + t31*t56 + t68*t47 + t49*t74), batch),  # 1, 5
+        xp.broadcast_to(t53*t92 + s1*t90, batch),  # 1, 1
+        xp.broadcast_to(-(t52*t92 - t64*t44 + s1*t89), batch),  # 1, 2
+        xp.broadcast_to(t54*qd1 - t45*t66 - t4*t76 + t13*t88, batch),  # 1, 3
+        xp.broadcast_to(-(t55*t10 + t46*t67 + t29*t75 - t21*t87), batch),  # 1, 4
+        xp.broadcast_to(-(t56*t31 + t47*t68 + t49*t74 - t33*t86), batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(c1*t78 - s1*t84, batch),  # 2, 1
-        xp.broadcast_to(s1*t83 - c1*t77 + c1**2*t93 + s1**2*t93, batch),  # 2, 2
-        xp.broadcast_to(t71*t54 + t66*t57 - t14*t76 - t13*t82, batch),  # 2, 3
-        xp.broadcast_to(t72*t55 + t67*t58 - t24*t75 - t21*t81, batch),  # 2, 4
-        xp.broadcast_to(t73*t56 + t68*t59 - t33*t80 - t39*t74, batch),  # 2, 5
+        xp.broadcast_to(-s1*t84 + c1*t78, batch),  # 2, 1
+        xp.broadcast_to(s1**2*t93 + c1**2*t93 + s1*t83 - c1*t77, batch),  # 2, 2
+        xp.broadcast_to(t57*t66 + t54*t71 - t13*t82 - t14*t76, batch),  # 2, 3
+        xp.broadcast_to(t58*t67 + t55*t72 - t21*t81 - t24*t75, batch),  # 2, 4
+        xp.broadcast_to(t59*t68 + t56*t73 - t33*t80 - t39*t74, batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(-t92, batch),  # 3, 1
         xp.broadcast_to(t92, batch),  # 3, 2
         xp.broadcast_to(t4*t71 - t14*qd1, batch),  # 3, 3
-        xp.broadcast_to(t24*t10 + t29*t72, batch),  # 3, 4
-        xp.broadcast_to(t39*t31 + t49*t73, batch),  # 3, 5
+        xp.broadcast_to(t29*t72 + t24*t10, batch),  # 3, 4
+        xp.broadcast_to(t49*t73 + t39*t31, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t91, batch),  # 4, 1
         xp.broadcast_to(-t91, batch),  # 4, 2
@@ -1178,9 +1178,9 @@ def jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
-        xp.broadcast_to(t13*t71 - t14*t66, batch),  # 5, 3
-        xp.broadcast_to(t21*t72 - t24*t67, batch),  # 5, 4
-        xp.broadcast_to(t33*t73 - t39*t68, batch),  # 5, 5
+        xp.broadcast_to(-t14*t66 + t13*t71, batch),  # 5, 3
+        xp.broadcast_to(-t24*t67 + t21*t72, batch),  # 5, 4
+        xp.broadcast_to(-t39*t68 + t33*t73, batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1272,43 +1272,43 @@ def bias_acceleration(q, q_dot):
     t61 = c1*t60 + t37
     t62 = t43 - s1*t60
     t63 = c1*t61 - s1*t62
-    t64 = s1*qd3
-    t65 = s1*qd2
-    t66 = t64 - t65
+    t64 = s1*qd2
+    t65 = s1*qd3
+    t66 = -t64 + t65
     t67 = t66 - t13*qd4
     t68 = t67 - t21*qd5
-    t69 = c1*qd3
-    t70 = c1*qd2
-    t71 = t69 - t70
+    t69 = c1*qd2
+    t70 = c1*qd3
+    t71 = -t69 + t70
     t72 = t71 - t14*qd4
     t73 = t72 - t24*qd5
-    t74 = qd6*t56
-    t75 = qd5*t55 + t74
-    t76 = t75 + qd4*t54
-    t77 = -t76 + t52*t69
-    t78 = t77 - t53*t70
+    t74 = t56*qd6
+    t75 = t74 + t55*qd5
+    t76 = t75 + t54*qd4
+    t77 = -t76 + t52*t70
+    t78 = t77 - t53*t69
     t79 = t78 + t62*qd1
-    t80 = qd6*t59
-    t81 = qd5*t58 + t80
-    t82 = t81 + qd4*t57
-    t83 = t82 - t52*t64
-    t84 = t83 + t53*t65
+    t80 = t59*qd6
+    t81 = t80 + t58*qd5
+    t82 = t81 + t57*qd4
+    t83 = t82 - t52*t65
+    t84 = t83 + t53*t64
     t85 = t84 - t61*qd1
-    t86 = qd6*t47
-    t87 = qd5*t46 + t86
-    t88 = t87 + qd4*t45
-    t89 = t88 + qd3*t44
-    t90 = t89 + qd2*t63
+    t86 = t47*qd6
+    t87 = t86 + t46*qd5
+    t88 = t87 + t45*qd4
+    t89 = t88 + t44*qd3
+    t90 = t89 + t63*qd2
     t91 = s1*qd1
     t92 = c1*qd1
     t93 = t52*qd2
     a = _stack(xp, [
-        xp.broadcast_to(qd1*t85 + qd2*(-c1*t90 + t53*t91) - qd3*(-c1*t89 + t52*t91 + t70*t44) + qd4*(qd1*t57 + t71*t45 - t14*t88 - t4*t82) - qd5*(-t72*t46 + t29*t81 + t24*t87 + t10*t58) - qd6*(-t73*t47 + t31*t59 + t39*t86 + t49*t80), batch),  # 0
-        xp.broadcast_to(qd2*(s1*t90 + t53*t92) - qd3*(-t65*t44 + s1*t89 + t52*t92) + qd4*(t13*t88 + qd1*t54 - t4*t76 - t66*t45) - qd5*(-t21*t87 + t29*t75 + t10*t55 + t67*t46) - qd6*(-t33*t86 + t31*t56 + t68*t47 + t49*t74) - qd1*t79, batch),  # 1
-        xp.broadcast_to(qd2*(c1*t78 - s1*t84) + qd3*(s1*t83 - c1*t77 + c1**2*t93 + s1**2*t93) + qd4*(t71*t54 + t66*t57 - t14*t76 - t13*t82) + qd5*(t72*t55 + t67*t58 - t24*t75 - t21*t81) + qd6*(t73*t56 + t68*t59 - t33*t80 - t39*t74), batch),  # 2
-        xp.broadcast_to(qd4*(t4*t71 - t14*qd1) + qd5*(t24*t10 + t29*t72) + qd6*(t39*t31 + t49*t73) + t69*qd1 - t70*qd1, batch),  # 3
-        xp.broadcast_to(qd4*(t13*qd1 - t4*t66) - qd5*(t21*t10 + t29*t67) - qd6*(t33*t31 + t49*t68) + t65*qd1 - t64*qd1, batch),  # 4
-        xp.broadcast_to(qd4*(t13*t71 - t14*t66) + qd5*(t21*t72 - t24*t67) + qd6*(t33*t73 - t39*t68), batch),  # 5
+        xp.broadcast_to(qd1*t85 + qd2*(t53*t91 - c1*t90) - qd3*(t69*t44 + t52*t91 - c1*t89) + qd4*(t45*t71 + t57*qd1 - t14*t88 - t4*t82) - qd5*(-t46*t72 + t58*t10 + t24*t87 + t29*t81) - qd6*(-t47*t73 + t59*t31 + t39*t86 + t49*t80), batch),  # 0
+        xp.broadcast_to(-qd1*t79 + qd2*(t53*t92 + s1*t90) - qd3*(t52*t92 - t64*t44 + s1*t89) + qd4*(t54*qd1 - t45*t66 - t4*t76 + t13*t88) - qd5*(t55*t10 + t46*t67 + t29*t75 - t21*t87) - qd6*(t56*t31 + t47*t68 + t49*t74 - t33*t86), batch),  # 1
+        xp.broadcast_to(qd2*(-s1*t84 + c1*t78) + qd3*(s1**2*t93 + c1**2*t93 + s1*t83 - c1*t77) + qd4*(t57*t66 + t54*t71 - t13*t82 - t14*t76) + qd5*(t58*t67 + t55*t72 - t21*t81 - t24*t75) + qd6*(t59*t68 + t56*t73 - t33*t80 - t39*t74), batch),  # 2
+        xp.broadcast_to(-t69*qd1 + t70*qd1 + qd4*(t4*t71 - t14*qd1) + qd5*(t29*t72 + t24*t10) + qd6*(t49*t73 + t39*t31), batch),  # 3
+        xp.broadcast_to(t64*qd1 - t65*qd1 + qd4*(t13*qd1 - t4*t66) - qd5*(t21*t10 + t29*t67) - qd6*(t33*t31 + t49*t68), batch),  # 4
+        xp.broadcast_to(qd4*(-t14*t66 + t13*t71) + qd5*(-t24*t67 + t21*t72) + qd6*(-t39*t68 + t33*t73), batch),  # 5
     ], (6,))
     return a
 
@@ -1413,74 +1413,74 @@ def task_jacobian_dot(q, q_dot):
     t71 = c1*t70 + t47
     t72 = t53 - s1*t70
     t73 = c1*t71 - s1*t72
-    t74 = s1*qd3
-    t75 = s1*qd2
-    t76 = t74 - t75
+    t74 = s1*qd2
+    t75 = s1*qd3
+    t76 = -t74 + t75
     t77 = t12*qd1 - t4*t76
-    t78 = c1*qd3
-    t79 = c1*qd2
-    t80 = t78 - t79
+    t78 = c1*qd2
+    t79 = c1*qd3
+    t80 = -t78 + t79
     t81 = t4*t80 - t13*qd1
-    t82 = t12*t80 - t13*t76
+    t82 = -t13*t76 + t12*t80
     t83 = t12*qd4
     t84 = t76 - t83
     t85 = t13*qd4
     t86 = t80 - t85
-    t87 = t18*t86 - t21*t84
+    t87 = -t21*t84 + t18*t86
     t88 = -qd1 + t4*qd4
     t89 = t88
-    t90 = t21*t89 + t25*t86
+    t90 = t25*t86 + t21*t89
     t91 = t18*t89 + t25*t84
     t92 = t18*qd5
     t93 = t84 - t92
-    t94 = t75 + t83 + t92 + t43*qd6 - t74
+    t94 = t74 - t75 + t83 + t92 + t43*qd6
     t95 = t21*qd5
     t96 = t86 - t95
-    t97 = t43*t96 - t49*t93
-    t98 = t79 + t85 + t95 + t49*qd6 - t78
-    t99 = t30*t98 - t34*t94
+    t97 = -t49*t93 + t43*t96
+    t98 = t78 - t79 + t85 + t95 + t49*qd6
+    t99 = -t34*t94 + t30*t98
     t100 = t25*qd5
     t101 = t89 + t100
-    t102 = t49*t101 + t59*t96
+    t102 = t59*t96 + t49*t101
     t103 = t43*t101 + t59*t93
     t104 = t88 + t100 + t59*qd6
     t105 = t41*t98 + t34*t104
-    t106 = t41*t94 + t30*t104
-    t107 = qd6*t66
-    t108 = qd5*t65 + t107
-    t109 = t108 + qd4*t64
-    t110 = -t109 + t62*t78
-    t111 = t110 - t63*t79
+    t106 = t30*t104 + t41*t94
+    t107 = t66*qd6
+    t108 = t107 + t65*qd5
+    t109 = t108 + t64*qd4
+    t110 = -t109 + t62*t79
+    t111 = t110 - t63*t78
     t112 = t111 + t72*qd1
-    t113 = qd6*t69
-    t114 = qd5*t68 + t113
-    t115 = t114 + qd4*t67
-    t116 = t115 - t62*t74
-    t117 = t116 + t63*t75
+    t113 = t69*qd6
+    t114 = t113 + t68*qd5
+    t115 = t114 + t67*qd4
+    t116 = t115 - t62*t75
+    t117 = t116 + t63*t74
     t118 = t117 - t71*qd1
-    t119 = c1*t111 - s1*t117
-    t120 = t80*t64 + t76*t67 - t13*t109 - t12*t115
-    t121 = t86*t65 + t84*t68 - t21*t108 - t18*t114
-    t122 = t96*t66 + t93*t69 - t43*t113 - t49*t107
-    t123 = qd6*t57
-    t124 = qd5*t56 + t123
-    t125 = t124 + qd4*t55
-    t126 = t125 + qd3*t54
-    t127 = t126 + qd2*t73
-    t128 = qd1*t67 + t80*t55 - t13*t125 - t4*t115
-    t129 = t25*t114 + t21*t124 + t89*t68 - t86*t56
-    t130 = t101*t69 - t96*t57 + t49*t123 + t59*t113
-    t131 = t12*t125 + qd1*t64 - t4*t109 - t76*t55
-    t132 = t25*t108 + t89*t65 + t84*t56 - t18*t124
-    t133 = t101*t66 + t93*t57 + t59*t107 - t43*t123
+    t119 = -s1*t117 + c1*t111
+    t120 = t67*t76 + t64*t80 - t12*t115 - t13*t109
+    t121 = t68*t84 + t65*t86 - t18*t114 - t21*t108
+    t122 = t69*t93 + t66*t96 - t43*t113 - t49*t107
+    t123 = t57*qd6
+    t124 = t123 + t56*qd5
+    t125 = t124 + t55*qd4
+    t126 = t125 + t54*qd3
+    t127 = t126 + t73*qd2
+    t128 = t55*t80 + t67*qd1 - t13*t125 - t4*t115
+    t129 = -t56*t86 + t68*t89 + t21*t124 + t25*t114
+    t130 = -t57*t96 + t69*t101 + t49*t123 + t59*t113
+    t131 = t64*qd1 - t55*t76 - t4*t109 + t12*t125
+    t132 = t65*t89 + t56*t84 + t25*t108 - t18*t124
+    t133 = t66*t101 + t57*t93 + t59*t107 - t43*t123
     t134 = s1*qd1
-    t135 = -c1*t127 + t63*t134
-    t136 = -c1*t126 + t62*t134 + t79*t54
+    t135 = t63*t134 - c1*t127
+    t136 = t78*t54 + t62*t134 - c1*t126
     t137 = c1*qd1
-    t138 = s1*t127 + t63*t137
-    t139 = s1*t126 + t62*t137 - t75*t54
+    t138 = t63*t137 + s1*t127
+    t139 = t62*t137 - t74*t54 + s1*t126
     t140 = t62*qd2
-    t141 = s1*t116 - c1*t110 + c1**2*t140 + s1**2*t140
+    t141 = s1**2*t140 + c1**2*t140 + s1*t116 - c1*t110
     t142 = s1*t30
     t143 = c1*t34
     t144 = t142 + t143
@@ -1500,41 +1500,41 @@ def task_jacobian_dot(q, q_dot):
     t158 = (t18*t34 - t21*t30)*t154
     t159 = (t43*t34 - t30*t49)*t154
     t160 = 2*t146
-    t161 = t145*t106
-    t162 = -t161*(c1 + t34*t160)
-    t163 = t145*t105
-    t164 = -(s1 + t30*t160)*t163
+    t161 = t145*t105
+    t162 = -t161*(s1 + t30*t160)
+    t163 = t145*t106
+    t164 = -(c1 + t34*t160)*t163
     t165 = t145*qd1
-    t166 = t151*t165
-    t167 = t152*t165
+    t166 = t152*t165
+    t167 = t151*t165
     t168 = 2*t147
-    t169 = t161*(c1 - t34*t168)
-    t170 = t163*(s1 - t30*t168)
-    t171 = t30*t145
-    t172 = t81*t171
-    t173 = t34*t145
-    t174 = t77*t173
-    t175 = 2*t148
-    t176 = -t161*(t13 + t34*t175)
-    t177 = -t163*(t12 + t30*t175)
-    t178 = t90*t171
-    t179 = 2*t149
-    t180 = -t161*(t21 + t34*t179)
-    t181 = t91*t173
-    t182 = -t163*(t18 + t30*t179)
-    t183 = t102*t171
-    t184 = 2*t150
-    t185 = -t161*(t49 + t34*t184)
-    t186 = t103*t173
-    t187 = -t163*(t43 + t30*t184)
-    t188 = s1*t153
-    t189 = c1*t153
+    t169 = t161*(s1 - t30*t168)
+    t170 = t163*(c1 - t34*t168)
+    t171 = 2*t148
+    t172 = -t161*(t12 + t30*t171)
+    t173 = -t163*(t13 + t34*t171)
+    t174 = t30*t145
+    t175 = t81*t174
+    t176 = t34*t145
+    t177 = t77*t176
+    t178 = 2*t149
+    t179 = -t161*(t18 + t30*t178)
+    t180 = -t163*(t21 + t34*t178)
+    t181 = t90*t174
+    t182 = t91*t176
+    t183 = 2*t150
+    t184 = -t161*(t43 + t30*t183)
+    t185 = -t163*(t49 + t34*t183)
+    t186 = t102*t174
+    t187 = t103*t176
+    t188 = c1*t153
+    t189 = s1*t153
     t190 = t153*qd1
-    t191 = t142*t190 + t143*t190
-    t192 = t30*t153
-    t193 = t34*t153
-    t194 = t41*t167
-    t195 = t41*t166
+    t191 = t143*t190 + t142*t190
+    t192 = t34*t153
+    t193 = t30*t153
+    t194 = t41*t166
+    t195 = t41*t167
     Jd = _stack(xp, [
         xp.broadcast_to(t118, batch),  # 0, 0
         xp.broadcast_to(t135, batch),  # 0, 1
@@ -1555,23 +1555,23 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(t121, batch),  # 2, 4
         xp.broadcast_to(t122, batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(t162 - t164 + t166 - t167, batch),  # 3, 1
-        xp.broadcast_to(t167 + t169 - t170 - t166, batch),  # 3, 2
-        xp.broadcast_to(t172 + t174 + t176 - t177, batch),  # 3, 3
-        xp.broadcast_to(t178 + t180 - t181 - t182, batch),  # 3, 4
-        xp.broadcast_to(t183 + t185 - t186 - t187, batch),  # 3, 5
+        xp.broadcast_to(-t162 + t164 - t166 + t167, batch),  # 3, 1
+        xp.broadcast_to(t166 - t169 + t170 - t167, batch),  # 3, 2
+        xp.broadcast_to(-t172 + t173 + t175 + t177, batch),  # 3, 3
+        xp.broadcast_to(-t179 + t180 + t181 - t182, batch),  # 3, 4
+        xp.broadcast_to(-t184 + t185 + t186 - t187, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t106*(t188 - t34*t155) + t105*(t30*t155 + t189) + t191, batch),  # 4, 1
-        xp.broadcast_to(-(t191 + t106*(t34*t156 + t188) + t105*(t189 - t30*t156)), batch),  # 4, 2
-        xp.broadcast_to(t106*(t12*t153 - t34*t157) + t105*(t13*t153 + t30*t157) + t77*t192 - t81*t193, batch),  # 4, 3
-        xp.broadcast_to(-(-t106*(t18*t153 - t34*t158) - t105*(t30*t158 + t21*t153) + t90*t193 + t91*t192), batch),  # 4, 4
-        xp.broadcast_to(-(-t106*(t43*t153 - t34*t159) - t105*(t30*t159 + t49*t153) + t102*t193 + t103*t192), batch),  # 4, 5
+        xp.broadcast_to(t105*(t188 + t30*t155) + t106*(t189 - t34*t155) + t191, batch),  # 4, 1
+        xp.broadcast_to(-(t191 + t105*(t188 - t30*t156) + t106*(t189 + t34*t156)), batch),  # 4, 2
+        xp.broadcast_to(t105*(t13*t153 + t30*t157) + t106*(t12*t153 - t34*t157) - t81*t192 + t77*t193, batch),  # 4, 3
+        xp.broadcast_to(-(-t105*(t21*t153 + t30*t158) - t106*(t18*t153 - t34*t158) + t90*t192 + t91*t193), batch),  # 4, 4
+        xp.broadcast_to(-(-t105*(t49*t153 + t30*t159) - t106*(t43*t153 - t34*t159) + t102*t192 + t103*t193), batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(t146*t99 - t41*t164 + t41*t162 - t194 + t195), batch),  # 5, 1
-        xp.broadcast_to(-(-t195 + t147*t99 - t41*t170 + t41*t169 + t194), batch),  # 5, 2
-        xp.broadcast_to(-(-t82 + t148*t99 - t41*t177 + t41*t172 + t41*t174 + t41*t176), batch),  # 5, 3
-        xp.broadcast_to(t87 - t149*t99 + t41*t181 + t41*t182 - t41*t178 - t41*t180, batch),  # 5, 4
-        xp.broadcast_to(t97 - t150*t99 + t41*t186 + t41*t187 - t41*t183 - t41*t185, batch),  # 5, 5
+        xp.broadcast_to(-(-t41*t162 + t41*t164 + t99*t146 - t194 + t195), batch),  # 5, 1
+        xp.broadcast_to(-(-t195 - t41*t169 + t41*t170 + t99*t147 + t194), batch),  # 5, 2
+        xp.broadcast_to(-(-t82 - t41*t172 + t41*t173 + t99*t148 + t41*t175 + t41*t177), batch),  # 5, 3
+        xp.broadcast_to(t87 + t41*t179 - t41*t180 - t99*t149 - t41*t181 + t41*t182, batch),  # 5, 4
+        xp.broadcast_to(t97 + t41*t184 - t41*t185 - t99*t150 - t41*t186 + t41*t187, batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1671,14 +1671,14 @@ def hessian(q):
     t75 = s1*t43
     t76 = s1*t44
     t77 = s1*t45
-    t78 = c1**2
-    t79 = s1**2
+    t78 = s1**2
+    t79 = c1**2
     t80 = t78*t50 + t79*t50
-    t81 = c1*t52 + s1*t55
+    t81 = s1*t55 + c1*t52
     t82 = -t81
-    t83 = c1*t53 + s1*t56
+    t83 = s1*t56 + c1*t53
     t84 = -t83
-    t85 = c1*t54 + s1*t57
+    t85 = s1*t57 + c1*t54
     t86 = -t85
     t87 = c1*t4
     t88 = c1*t28
@@ -1695,15 +1695,18 @@ def hessian(q):
     t99 = -t75
     t100 = -t76
     t101 = -t77
-    t102 = -(t13*t44 + t4*t56)
-    t103 = -(t13*t45 + t4*t57)
-    t104 = t12*t44 - t4*t53
-    t105 = t12*t45 - t4*t54
-    t106 = -(t13*t53 + t12*t56)
-    t107 = -(t13*t54 + t12*t57)
-    t108 = -(t23*t45 + t28*t57)
-    t109 = t20*t45 - t28*t54
-    t110 = -(t20*t57 + t23*t54)
+    t102 = t81
+    t103 = t83
+    t104 = t85
+    t105 = -(t13*t44 + t4*t56)
+    t106 = -(t13*t45 + t4*t57)
+    t107 = -t4*t53 + t12*t44
+    t108 = -t4*t54 + t12*t45
+    t109 = -(t12*t56 + t13*t53)
+    t110 = -(t12*t57 + t13*t54)
+    t111 = -(t23*t45 + t28*t57)
+    t112 = -t28*t54 + t20*t45
+    t113 = -(t20*t57 + t23*t54)
     H = _stack(xp, [
         -t59,  # 0, 0, 0
         t62,  # 0, 0, 1
@@ -1792,9 +1795,9 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2, 0
         t80,  # 2, 2, 1
         -t80,  # 2, 2, 2
-        t81,  # 2, 2, 3
-        t83,  # 2, 2, 4
-        t85,  # 2, 2, 5
+        t102,  # 2, 2, 3
+        t103,  # 2, 2, 4
+        t104,  # 2, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 2
@@ -1817,32 +1820,32 @@ def hessian(q):
         t69,  # 3, 0, 1
         t68,  # 3, 0, 2
         -(t13*t43 + t4*t55),  # 3, 0, 3
-        t102,  # 3, 0, 4
-        t103,  # 3, 0, 5
+        t105,  # 3, 0, 4
+        t106,  # 3, 0, 5
         t52,  # 3, 1, 0
         t75,  # 3, 1, 1
         t99,  # 3, 1, 2
-        t12*t43 - t4*t52,  # 3, 1, 3
-        t104,  # 3, 1, 4
-        t105,  # 3, 1, 5
+        -t4*t52 + t12*t43,  # 3, 1, 3
+        t107,  # 3, 1, 4
+        t108,  # 3, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 0
         t82,  # 3, 2, 1
-        t81,  # 3, 2, 2
-        -(t13*t52 + t12*t55),  # 3, 2, 3
-        t106,  # 3, 2, 4
-        t107,  # 3, 2, 5
+        t102,  # 3, 2, 2
+        -(t12*t55 + t13*t52),  # 3, 2, 3
+        t109,  # 3, 2, 4
+        t110,  # 3, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        t4*t23 - t13*t28,  # 3, 3, 4
-        t4*t37 - t13*t47,  # 3, 3, 5
+        -t13*t28 + t4*t23,  # 3, 3, 4
+        -t13*t47 + t4*t37,  # 3, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        t12*t28 - t4*t20,  # 3, 4, 4
-        t12*t47 - t4*t31,  # 3, 4, 5
+        -t4*t20 + t12*t28,  # 3, 4, 4
+        -t4*t31 + t12*t47,  # 3, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
@@ -1852,33 +1855,33 @@ def hessian(q):
         t56,  # 4, 0, 0
         t71,  # 4, 0, 1
         t70,  # 4, 0, 2
-        t102,  # 4, 0, 3
+        t105,  # 4, 0, 3
         -(t23*t44 + t28*t56),  # 4, 0, 4
-        t108,  # 4, 0, 5
+        t111,  # 4, 0, 5
         t53,  # 4, 1, 0
         t76,  # 4, 1, 1
         t100,  # 4, 1, 2
-        t104,  # 4, 1, 3
-        t20*t44 - t28*t53,  # 4, 1, 4
-        t109,  # 4, 1, 5
+        t107,  # 4, 1, 3
+        -t28*t53 + t20*t44,  # 4, 1, 4
+        t112,  # 4, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2, 0
         t84,  # 4, 2, 1
-        t83,  # 4, 2, 2
-        t106,  # 4, 2, 3
+        t103,  # 4, 2, 2
+        t109,  # 4, 2, 3
         -(t20*t56 + t23*t53),  # 4, 2, 4
-        t110,  # 4, 2, 5
+        t113,  # 4, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 4
-        t28*t37 - t23*t47,  # 4, 3, 5
+        -t23*t47 + t28*t37,  # 4, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        t20*t47 - t28*t31,  # 4, 4, 5
+        -t28*t31 + t20*t47,  # 4, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
@@ -1888,20 +1891,20 @@ def hessian(q):
         t57,  # 5, 0, 0
         t73,  # 5, 0, 1
         t72,  # 5, 0, 2
-        t103,  # 5, 0, 3
-        t108,  # 5, 0, 4
+        t106,  # 5, 0, 3
+        t111,  # 5, 0, 4
         -(t37*t45 + t47*t57),  # 5, 0, 5
         t54,  # 5, 1, 0
         t77,  # 5, 1, 1
         t101,  # 5, 1, 2
-        t105,  # 5, 1, 3
-        t109,  # 5, 1, 4
-        t31*t45 - t47*t54,  # 5, 1, 5
+        t108,  # 5, 1, 3
+        t112,  # 5, 1, 4
+        -t47*t54 + t31*t45,  # 5, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2, 0
         t86,  # 5, 2, 1
-        t85,  # 5, 2, 2
-        t107,  # 5, 2, 3
-        t110,  # 5, 2, 4
+        t104,  # 5, 2, 2
+        t110,  # 5, 2, 3
+        t113,  # 5, 2, 4
         -(t31*t57 + t37*t54),  # 5, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3, 1
@@ -2117,7 +2120,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t80 = t77 - t78 + t13*t43 + t23*t44 + t37*t45
     t81 = c1*t51
     t82 = c1*t50
-    t83 = s1*t82 + s1*t81
+    t83 = s1*t81 + s1*t82
     t84 = t83 + t12*t52 + t20*t53 + t31*t54
     t85 = t83 + t13*t55 + t23*t56 + t37*t57
     t86 = t62**2

@@ -730,9 +730,9 @@ def fk_jacobian_dot(q, q_dot):
     t56 = t55
     t57 = t7*t28 + t4*t26
     t58 = t57
-    t59 = qd4*t56 + qd5*t58
-    t60 = t59 - qd3*t54
-    t61 = t60 - qd2*t52
+    t59 = t58*qd5 + t56*qd4
+    t60 = t59 - t54*qd3
+    t61 = t60 - t52*qd2
     t62 = s1*qd2
     t63 = s1*qd3
     t64 = t62 + t63
@@ -745,13 +745,13 @@ def fk_jacobian_dot(q, q_dot):
     t71 = t65 - t70
     t72 = t4*qd5
     t73 = t69 + t72
-    t74 = qd5*t46
-    t75 = qd4*t44 + t74
+    t74 = t46*qd5
+    t75 = t74 + t44*qd4
     t76 = t75 + t32*t67
     t77 = t76 + t33*t66
     t78 = t77 - t42*qd1
-    t79 = qd5*t50
-    t80 = t79 - qd4*t48
+    t79 = t50*qd5
+    t80 = t79 - t48*qd4
     t81 = t80 + t32*t63
     t82 = t81 + t33*t62
     t83 = t82 + t41*qd1
@@ -818,12 +818,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(-t21, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(c1*t61 - qd1*t86) - qd3*(-c1*t60 + qd1*t87 + t66*t54) + qd4*(qd1*t48 + t68*t56 - c23*t80 + t14*t59) + qd5*(t69*t58 - t0*t50 + t72*t58 - t22*t79) - qd1*t83, batch),  # 0
-        xp.broadcast_to(qd1*t78 + qd2*(s1*t61 + t84*qd1) + qd3*(s1*t60 + qd1*t85 - t62*t54) + qd4*(qd1*t44 + t64*t56 + c23*t75 - t9*t59) + qd5*(t0*t46 - t65*t58 + t70*t58 + t22*t74), batch),  # 1
-        xp.broadcast_to(-qd2*(c1*t77 + s1*t82) - qd3*(c1*t76 + s1*t81 + c1**2*t89 + s1**2*t89) + qd4*(t64*t48 - t68*t44 + t9*t80 - t14*t75) - qd5*(-t65*t50 + t69*t46 + t70*t50 + t72*t46), batch),  # 2
-        xp.broadcast_to(qd4*(c23*t68 - t14*qd1) + qd5*(-t4*t0 + t22*t69) - qd6*(t16*t25 + t21*t73) - t66*qd1 - t67*qd1, batch),  # 3
-        xp.broadcast_to(qd4*(c23*t64 + t9*qd1) - qd5*(t7*t0 + t22*t65) + qd6*(t11*t25 + t21*t71) - t62*qd1 - t63*qd1, batch),  # 4
-        xp.broadcast_to(-qd4*(t14*t64 + t9*t68) + qd5*(t7*t69 + t4*t65) + qd6*(t16*t71 - t11*t73), batch),  # 5
+        xp.broadcast_to(-qd1*t83 + qd2*(-qd1*t86 + c1*t61) - qd3*(t66*t54 + qd1*t87 - c1*t60) + qd4*(t56*t68 + t48*qd1 + t14*t59 - c23*t80) + qd5*(t58*t69 - t50*t0 + t72*t58 - t22*t79), batch),  # 0
+        xp.broadcast_to(qd1*t78 + qd2*(t84*qd1 + s1*t61) + qd3*(qd1*t85 - t62*t54 + s1*t60) + qd4*(t44*qd1 + t56*t64 + c23*t75 - t9*t59) + qd5*(t46*t0 - t58*t65 + t22*t74 + t70*t58), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t82 + c1*t77) - qd3*(s1**2*t89 + c1**2*t89 + s1*t81 + c1*t76) + qd4*(t48*t64 - t44*t68 + t9*t80 - t14*t75) - qd5*(-t50*t65 + t46*t69 + t70*t50 + t72*t46), batch),  # 2
+        xp.broadcast_to(-t66*qd1 - t67*qd1 + qd4*(c23*t68 - t14*qd1) + qd5*(t22*t69 - t4*t0) - qd6*(t21*t73 + t16*t25), batch),  # 3
+        xp.broadcast_to(-t62*qd1 - t63*qd1 + qd4*(t9*qd1 + c23*t64) - qd5*(t7*t0 + t22*t65) + qd6*(t11*t25 + t21*t71), batch),  # 4
+        xp.broadcast_to(-qd4*(t14*t64 + t9*t68) + qd5*(t4*t65 + t7*t69) + qd6*(t16*t71 - t11*t73), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -892,9 +892,9 @@ def jacobian_dot(q, q_dot):
     t40 = s1*s23
     t41 = c1*s23
     t42 = t15*t40 - t17*t41
-    t43 = qd4*t42 + qd5*t18
-    t44 = t43 - qd3*t26
-    t45 = t44 - qd2*t32
+    t43 = t18*qd5 + t42*qd4
+    t44 = t43 - t26*qd3
+    t45 = t44 - t32*qd2
     t46 = s1*qd2
     t47 = s1*qd3
     t48 = t46 + t47
@@ -907,13 +907,13 @@ def jacobian_dot(q, q_dot):
     t55 = t49 - t54
     t56 = t5*qd5
     t57 = t53 + t56
-    t58 = qd5*t37
-    t59 = qd4*t34 + t58
+    t58 = t37*qd5
+    t59 = t58 + t34*qd4
     t60 = t59 + t21*t51
     t61 = t60 + t22*t50
     t62 = t61 - t31*qd1
-    t63 = qd5*t38
-    t64 = t63 - qd4*t35
+    t63 = t38*qd5
+    t64 = t63 - t35*qd4
     t65 = t64 + t21*t47
     t66 = t65 + t22*t46
     t67 = t66 + t30*qd1
@@ -924,40 +924,40 @@ def jacobian_dot(q, q_dot):
     t72 = -t68
     Jd = _stack(xp, [
         xp.broadcast_to(-t67, batch),  # 0, 0
-        xp.broadcast_to(c1*t45 - t22*t68, batch),  # 0, 1
-        xp.broadcast_to(-(-c1*t44 + t21*t68 + t50*t26), batch),  # 0, 2
-        xp.broadcast_to(qd1*t35 + t52*t42 - c23*t64 + t40*t43, batch),  # 0, 3
-        xp.broadcast_to(t53*t18 - t1*t38 + t56*t18 - t36*t63, batch),  # 0, 4
+        xp.broadcast_to(-t22*t68 + c1*t45, batch),  # 0, 1
+        xp.broadcast_to(-(t50*t26 + t21*t68 - c1*t44), batch),  # 0, 2
+        xp.broadcast_to(t42*t52 + t35*qd1 + t40*t43 - c23*t64, batch),  # 0, 3
+        xp.broadcast_to(t18*t53 - t38*t1 + t56*t18 - t36*t63, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t62, batch),  # 1, 0
-        xp.broadcast_to(s1*t45 + t22*t69, batch),  # 1, 1
-        xp.broadcast_to(s1*t44 + t21*t69 - t46*t26, batch),  # 1, 2
-        xp.broadcast_to(qd1*t34 + t48*t42 + c23*t59 - t41*t43, batch),  # 1, 3
-        xp.broadcast_to(t1*t37 - t49*t18 + t54*t18 + t36*t58, batch),  # 1, 4
+        xp.broadcast_to(t22*t69 + s1*t45, batch),  # 1, 1
+        xp.broadcast_to(t21*t69 - t46*t26 + s1*t44, batch),  # 1, 2
+        xp.broadcast_to(t34*qd1 + t42*t48 + c23*t59 - t41*t43, batch),  # 1, 3
+        xp.broadcast_to(t37*t1 - t18*t49 + t36*t58 + t54*t18, batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-(c1*t61 + s1*t66), batch),  # 2, 1
-        xp.broadcast_to(-(c1*t60 + s1*t65 + c1**2*t70 + s1**2*t70), batch),  # 2, 2
-        xp.broadcast_to(t48*t35 - t52*t34 + t41*t64 - t40*t59, batch),  # 2, 3
-        xp.broadcast_to(-(-t49*t38 + t53*t37 + t54*t38 + t56*t37), batch),  # 2, 4
+        xp.broadcast_to(-(s1*t66 + c1*t61), batch),  # 2, 1
+        xp.broadcast_to(-(s1**2*t70 + c1**2*t70 + s1*t65 + c1*t60), batch),  # 2, 2
+        xp.broadcast_to(t35*t48 - t34*t52 + t41*t64 - t40*t59, batch),  # 2, 3
+        xp.broadcast_to(-(-t38*t49 + t37*t53 + t54*t38 + t56*t37), batch),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t71, batch),  # 3, 1
         xp.broadcast_to(t71, batch),  # 3, 2
         xp.broadcast_to(c23*t52 - s23*t68, batch),  # 3, 3
-        xp.broadcast_to(-t5*t1 + t36*t53, batch),  # 3, 4
-        xp.broadcast_to(-(t12*t39 + t0*t57), batch),  # 3, 5
+        xp.broadcast_to(t36*t53 - t5*t1, batch),  # 3, 4
+        xp.broadcast_to(-(t0*t57 + t12*t39), batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t72, batch),  # 4, 1
         xp.broadcast_to(t72, batch),  # 4, 2
-        xp.broadcast_to(c23*t48 + s23*t69, batch),  # 4, 3
+        xp.broadcast_to(s23*t69 + c23*t48, batch),  # 4, 3
         xp.broadcast_to(-(t8*t1 + t36*t49), batch),  # 4, 4
         xp.broadcast_to(t11*t39 + t0*t55, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
         xp.broadcast_to(-(t40*t48 + t41*t52), batch),  # 5, 3
-        xp.broadcast_to(t8*t53 + t5*t49, batch),  # 5, 4
+        xp.broadcast_to(t5*t49 + t8*t53, batch),  # 5, 4
         xp.broadcast_to(t12*t55 - t11*t57, batch),  # 5, 5
     ], (6, 6))
     return Jd
@@ -1028,9 +1028,9 @@ def bias_acceleration(q, q_dot):
     t40 = s1*s23
     t41 = c1*s23
     t42 = t15*t40 - t17*t41
-    t43 = qd4*t42 + qd5*t18
-    t44 = t43 - qd3*t26
-    t45 = t44 - qd2*t32
+    t43 = t18*qd5 + t42*qd4
+    t44 = t43 - t26*qd3
+    t45 = t44 - t32*qd2
     t46 = s1*qd2
     t47 = s1*qd3
     t48 = t46 + t47
@@ -1043,13 +1043,13 @@ def bias_acceleration(q, q_dot):
     t55 = t49 - t54
     t56 = t5*qd5
     t57 = t53 + t56
-    t58 = qd5*t37
-    t59 = qd4*t34 + t58
+    t58 = t37*qd5
+    t59 = t58 + t34*qd4
     t60 = t59 + t21*t51
     t61 = t60 + t22*t50
     t62 = t61 - t31*qd1
-    t63 = qd5*t38
-    t64 = t63 - qd4*t35
+    t63 = t38*qd5
+    t64 = t63 - t35*qd4
     t65 = t64 + t21*t47
     t66 = t65 + t22*t46
     t67 = t66 + t30*qd1
@@ -1057,12 +1057,12 @@ def bias_acceleration(q, q_dot):
     t69 = c1*qd1
     t70 = t21*qd2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(c1*t45 - t22*t68) - qd3*(-c1*t44 + t21*t68 + t50*t26) + qd4*(qd1*t35 + t52*t42 - c23*t64 + t40*t43) + qd5*(t53*t18 - t1*t38 + t56*t18 - t36*t63) - qd1*t67, batch),  # 0
-        xp.broadcast_to(qd1*t62 + qd2*(s1*t45 + t22*t69) + qd3*(s1*t44 + t21*t69 - t46*t26) + qd4*(qd1*t34 + t48*t42 + c23*t59 - t41*t43) + qd5*(t1*t37 - t49*t18 + t54*t18 + t36*t58), batch),  # 1
-        xp.broadcast_to(-qd2*(c1*t61 + s1*t66) - qd3*(c1*t60 + s1*t65 + c1**2*t70 + s1**2*t70) + qd4*(t48*t35 - t52*t34 + t41*t64 - t40*t59) - qd5*(-t49*t38 + t53*t37 + t54*t38 + t56*t37), batch),  # 2
-        xp.broadcast_to(qd4*(c23*t52 - t40*qd1) + qd5*(-t5*t1 + t36*t53) - qd6*(t12*t39 + t0*t57) - t50*qd1 - t51*qd1, batch),  # 3
-        xp.broadcast_to(qd4*(c23*t48 + t41*qd1) - qd5*(t8*t1 + t36*t49) + qd6*(t11*t39 + t0*t55) - t46*qd1 - t47*qd1, batch),  # 4
-        xp.broadcast_to(-qd4*(t40*t48 + t41*t52) + qd5*(t8*t53 + t5*t49) + qd6*(t12*t55 - t11*t57), batch),  # 5
+        xp.broadcast_to(-qd1*t67 + qd2*(-t22*t68 + c1*t45) - qd3*(t50*t26 + t21*t68 - c1*t44) + qd4*(t42*t52 + t35*qd1 + t40*t43 - c23*t64) + qd5*(t18*t53 - t38*t1 + t56*t18 - t36*t63), batch),  # 0
+        xp.broadcast_to(qd1*t62 + qd2*(t22*t69 + s1*t45) + qd3*(t21*t69 - t46*t26 + s1*t44) + qd4*(t34*qd1 + t42*t48 + c23*t59 - t41*t43) + qd5*(t37*t1 - t18*t49 + t36*t58 + t54*t18), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t66 + c1*t61) - qd3*(s1**2*t70 + c1**2*t70 + s1*t65 + c1*t60) + qd4*(t35*t48 - t34*t52 + t41*t64 - t40*t59) - qd5*(-t38*t49 + t37*t53 + t54*t38 + t56*t37), batch),  # 2
+        xp.broadcast_to(-t50*qd1 - t51*qd1 + qd4*(c23*t52 - t40*qd1) + qd5*(t36*t53 - t5*t1) - qd6*(t0*t57 + t12*t39), batch),  # 3
+        xp.broadcast_to(-t46*qd1 - t47*qd1 + qd4*(t41*qd1 + c23*t48) - qd5*(t8*t1 + t36*t49) + qd6*(t11*t39 + t0*t55), batch),  # 4
+        xp.broadcast_to(-qd4*(t40*t48 + t41*t52) + qd5*(t5*t49 + t8*t53) + qd6*(t12*t55 - t11*t57), batch),  # 5
     ], (6,))
     return a
 
@@ -1120,7 +1120,7 @@ def task_jacobian_dot(q, q_dot):
     t26 = t25 + 0.62*t12
     t27 = t24*t12 - t26*t8
     t28 = t6*t25 + t3*t23
-    t29 = qd4*t27 + qd5*t28
+    t29 = t28*qd5 + t27*qd4
     t30 = 0.115*t20
     t31 = -0.62*c23 + t30
     t32 = -0.12*s23 + t31
@@ -1133,19 +1133,19 @@ def task_jacobian_dot(q, q_dot):
     t39 = -t24 + c1*t38
     t40 = -t26 + s1*t38
     t41 = c1*t39 + s1*t40
-    t42 = t29 - qd3*t41
+    t42 = t29 - t41*qd3
     t43 = 0.6*c2
     t44 = c1*t43 + t39
     t45 = s1*t43 + t40
     t46 = 0.18*c1 + t44
     t47 = 0.18*s1 + t45
     t48 = c1*t44 + s1*t45
-    t49 = t42 - qd2*t48
+    t49 = t42 - t48*qd2
     t50 = s1*qd2
     t51 = s1*qd3
     t52 = t50 + t51
     t53 = t52
-    t54 = c23*t53 + t8*qd1
+    t54 = t8*qd1 + c23*t53
     t55 = c1*qd2
     t56 = c1*qd3
     t57 = t55 + t56
@@ -1156,51 +1156,51 @@ def task_jacobian_dot(q, q_dot):
     t62 = -t53 + t61
     t63 = t12*qd4
     t64 = t58 + t63
-    t65 = t6*t64 + t3*t62
+    t65 = t3*t62 + t6*t64
     t66 = qd1 + c23*qd4
     t67 = t66
-    t68 = -t3*t67 + t21*t64
+    t68 = t21*t64 - t3*t67
     t69 = t6*t67 + t21*t62
     t70 = t6*qd5
     t71 = t62 - t70
     t72 = -t61 + t52 + t70 - t10*qd6
     t73 = t3*qd5
     t74 = t64 + t73
-    t75 = t64*t35 - t62*t37 + t70*t37 + t73*t35
+    t75 = -t37*t62 + t35*t64 + t70*t37 + t73*t35
     t76 = t14*t71 - t10*t74
     t77 = t57 + t63 + t73 + t14*qd6
     t78 = t15*t72 + t11*t77
     t79 = t21*qd5
     t80 = t67 + t79
-    t81 = t14*t80 + t20*t74
+    t81 = t20*t74 + t14*t80
     t82 = t10*t80 + t20*t71
     t83 = t66 + t79 - t20*qd6
     t84 = t22*t77 - t15*t83
-    t85 = t22*t72 + t11*t83
-    t86 = qd5*t35
-    t87 = qd4*t34 + t86
+    t85 = t11*t83 + t22*t72
+    t86 = t35*qd5
+    t87 = t86 + t34*qd4
     t88 = t87 + t32*t56
     t89 = t88 + t33*t55
     t90 = t89 - t47*qd1
-    t91 = qd1*t34 + t53*t27 + c23*t87 - t8*t29
-    t92 = t67*t35 - t62*t28 + t70*t28 + t21*t86
-    t93 = qd5*t37
-    t94 = t93 - qd4*t36
+    t91 = t34*qd1 + t27*t53 + c23*t87 - t8*t29
+    t92 = t35*t67 - t28*t62 + t21*t86 + t70*t28
+    t93 = t37*qd5
+    t94 = t93 - t36*qd4
     t95 = t94 + t32*t51
     t96 = t95 + t33*t50
     t97 = t96 + t46*qd1
-    t98 = qd1*t36 + t58*t27 - c23*t94 + t12*t29
-    t99 = t64*t28 - t67*t37 + t73*t28 - t21*t93
-    t100 = c1*t89 + s1*t96
-    t101 = t53*t36 - t58*t34 + t8*t94 - t12*t87
+    t98 = t27*t58 + t36*qd1 + t12*t29 - c23*t94
+    t99 = t28*t64 - t37*t67 + t73*t28 - t21*t93
+    t100 = s1*t96 + c1*t89
+    t101 = t36*t53 - t34*t58 + t8*t94 - t12*t87
     t102 = s1*qd1
-    t103 = c1*t49 - t33*t102
-    t104 = -c1*t42 + t32*t102 + t55*t41
+    t103 = -t33*t102 + c1*t49
+    t104 = t55*t41 + t32*t102 - c1*t42
     t105 = c1*qd1
-    t106 = s1*t49 + t33*t105
-    t107 = s1*t42 + t32*t105 - t50*t41
+    t106 = t33*t105 + s1*t49
+    t107 = t32*t105 - t50*t41 + s1*t42
     t108 = t32*qd2
-    t109 = c1*t88 + s1*t95 + c1**2*t108 + s1**2*t108
+    t109 = s1**2*t108 + c1**2*t108 + s1*t95 + c1*t88
     t110 = c1*t15
     t111 = s1*t11
     t112 = 1/t16
@@ -1217,9 +1217,9 @@ def task_jacobian_dot(q, q_dot):
     t123 = (t6*t15 + t3*t11)*t120
     t124 = (t14*t11 - t10*t15)*t120
     t125 = 2*t113
-    t126 = t112*t84
+    t126 = t84*t112
     t127 = -(s1 + t11*t125)*t126
-    t128 = t112*t85
+    t128 = t85*t112
     t129 = (c1 - t15*t125)*t128
     t130 = qd1*t112
     t131 = t116*t130
@@ -1237,16 +1237,16 @@ def task_jacobian_dot(q, q_dot):
     t143 = t128*(t3 - t15*t141)
     t144 = t68*t137
     t145 = t69*t139
-    t146 = t82*t139
-    t147 = 2*t115
-    t148 = t126*(t10 - t11*t147)
-    t149 = t128*(t14 - t15*t147)
-    t150 = t81*t137
+    t146 = 2*t115
+    t147 = t126*(t10 - t11*t146)
+    t148 = t128*(t14 - t15*t146)
+    t149 = t81*t137
+    t150 = t82*t139
     t151 = qd1*t119
     t152 = t84*(c1*t119 - t11*t121) + t85*(s1*t119 - t15*t121) + t110*t151 - t111*t151
-    t153 = t11*t119
-    t154 = t15*t119
-    t155 = t113*t78 - t22*t127 - t22*t129 + t22*t131 + t22*t132
+    t153 = t15*t119
+    t154 = t11*t119
+    t155 = -t22*t127 - t22*t129 + t78*t113 + t22*t131 + t22*t132
     Jd = _stack(xp, [
         xp.broadcast_to(-t97, batch),  # 0, 0
         xp.broadcast_to(t103, batch),  # 0, 1
@@ -1271,19 +1271,19 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(t133, batch),  # 3, 2
         xp.broadcast_to(t135 + t136 + t138 + t140, batch),  # 3, 3
         xp.broadcast_to(t142 + t143 + t144 - t145, batch),  # 3, 4
-        xp.broadcast_to(t146 + t148 + t149 - t150, batch),  # 3, 5
+        xp.broadcast_to(t147 + t148 - t149 + t150, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t152, batch),  # 4, 1
         xp.broadcast_to(t152, batch),  # 4, 2
-        xp.broadcast_to(t84*(-t11*t122 + t12*t119) - t85*(t15*t122 + t8*t119) + t54*t153 - t59*t154, batch),  # 4, 3
-        xp.broadcast_to(t84*(t3*t119 - t11*t123) + t85*(t6*t119 - t15*t123) - t69*t153 - t68*t154, batch),  # 4, 4
-        xp.broadcast_to(t84*(t14*t119 - t11*t124) - t85*(t15*t124 + t10*t119) + t82*t153 + t81*t154, batch),  # 4, 5
+        xp.broadcast_to(t84*(t12*t119 - t11*t122) - t85*(t8*t119 + t15*t122) - t59*t153 + t54*t154, batch),  # 4, 3
+        xp.broadcast_to(t84*(t3*t119 - t11*t123) + t85*(t6*t119 - t15*t123) - t68*t153 - t69*t154, batch),  # 4, 4
+        xp.broadcast_to(t84*(t14*t119 - t11*t124) - t85*(t10*t119 + t15*t124) + t81*t153 + t82*t154, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.broadcast_to(t155, batch),  # 5, 1
         xp.broadcast_to(t155, batch),  # 5, 2
-        xp.broadcast_to(-(t60 - t118*t78 + t22*t135 + t22*t136 + t22*t138 + t22*t140), batch),  # 5, 3
-        xp.broadcast_to(t65 + t114*t78 + t22*t145 - t22*t142 - t22*t143 - t22*t144, batch),  # 5, 4
-        xp.broadcast_to(t76 + t115*t78 + t22*t150 - t22*t146 - t22*t148 - t22*t149, batch),  # 5, 5
+        xp.broadcast_to(-(t60 + t22*t135 + t22*t136 - t78*t118 + t22*t138 + t22*t140), batch),  # 5, 3
+        xp.broadcast_to(t65 - t22*t142 - t22*t143 + t78*t114 - t22*t144 + t22*t145, batch),  # 5, 4
+        xp.broadcast_to(t76 - t22*t147 - t22*t148 + t78*t115 + t22*t149 - t22*t150, batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1356,19 +1356,19 @@ def hessian(q):
     t49 = -s1*t29
     t50 = s1*t17
     t51 = s1*t18
-    t52 = c1**2
-    t53 = s1**2
+    t52 = s1**2
+    t53 = c1**2
     t54 = -(t52*t21 + t53*t21)
     t55 = s1*t24 - c1*t23
-    t56 = -(c1*t37 + s1*t38)
+    t56 = -(s1*t38 + c1*t37)
     t57 = s23*t6
     t58 = -c1*t0
     t59 = s23*t1
     t60 = -s1*t0
     t61 = -(t52*s23 + t53*s23)
-    t62 = c1*t7 - s1*t4
-    t63 = -(c1*t10 + s1*t12)
-    t64 = -c23*t38 + t11*t18
+    t62 = -s1*t4 + c1*t7
+    t63 = -(s1*t12 + c1*t10)
+    t64 = t11*t18 - c23*t38
     t65 = c23*t37 - t9*t18
     t66 = t9*t38 - t11*t37
     t67 = s23**2
@@ -1484,7 +1484,7 @@ def hessian(q):
         t24,  # 3, 0, 0
         t47,  # 3, 0, 1
         t47,  # 3, 0, 2
-        c23*t24 + t11*t17,  # 3, 0, 3
+        t11*t17 + c23*t24,  # 3, 0, 3
         t64,  # 3, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0, 5
         t23,  # 3, 1, 0
@@ -1496,15 +1496,15 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 0
         t55,  # 3, 2, 1
         t55,  # 3, 2, 2
-        -(t11*t23 + t9*t24),  # 3, 2, 3
+        -(t9*t24 + t11*t23),  # 3, 2, 3
         t66,  # 3, 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        -c23*t4 + t1*t67,  # 3, 3, 4
-        -(c23*t12 + t0*t11),  # 3, 3, 5
+        t1*t67 - c23*t4,  # 3, 3, 4
+        -(t0*t11 + c23*t12),  # 3, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
@@ -1515,7 +1515,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 3
-        t7*t11 + t4*t9,  # 3, 5, 4
+        t4*t9 + t7*t11,  # 3, 5, 4
         t12*t9 - t10*t11,  # 3, 5, 5
         t41,  # 4, 0, 0
         t48,  # 4, 0, 1
@@ -1527,7 +1527,7 @@ def hessian(q):
         t51,  # 4, 1, 1
         t51,  # 4, 1, 2
         t65,  # 4, 1, 3
-        t7*t18 + t36*t37,  # 4, 1, 4
+        t36*t37 + t7*t18,  # 4, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2, 0
         t56,  # 4, 2, 1
@@ -1746,8 +1746,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t74 = s23**2
     t75 = t7**2 + t10**2 + 2*t63 + t43*t74
     t76 = t75
-    t77 = 2*s1
-    t78 = -c1*t77 + t49*t74 - t7*t4 + t10*t12
+    t77 = 2*c1
+    t78 = -s1*t77 + t49*t74 - t7*t4 + t10*t12
     t79 = t4**2 + t12**2 + 2*t43 + t63*t74
     t80 = t79
     t81 = c23**2 + t0**2 + t74*s4**2
@@ -2013,7 +2013,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t341 = t340*(t324*t339 + t336*t325)
     t342 = t324 - t339*t341
     t343 = t325 - t336*t341
-    t344 = 1 + t60 - t24 - t34 + t302 + t326 + t272 + q1 + q2 + q3 + c23 + q4 + t9 + t11 + q5 + q6 + t4 + t10 + t12 + t32 + t35 + t55 + t56 + t243 + t246 - t77 + 2*c1 + t23 + t36 + t37 + t17 + t18 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t344 = 1 + t60 - t24 - t34 + t302 + t326 + t272 + q1 + q2 + q3 + c23 + q4 + t9 + t11 + q5 + q6 + t4 + t10 + t12 + t32 + t35 + t55 + t56 + t243 + t246 + t23 + t36 + t37 + t17 + t18 + t77 - 2*s1 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
     t345 = t32*t273
     t346 = t279*(c1*t12 + t345*t278 - s1*t10 - t254*t274)
     t347 = t345 - t278*t346

@@ -878,26 +878,26 @@ def fk_jacobian_dot(q, q_dot):
     t72 = t71
     t73 = t40*t27 - t47*t22
     t74 = t73
-    t75 = qd3*t72 + qd4*t74
+    t75 = t74*qd4 + t72*qd3
     t76 = t0*t34 + t6*t48
     t77 = t76
     t78 = t47*t16 - t33*t27
     t79 = t78
-    t80 = qd4*t79 - qd3*t77
+    t80 = t79*qd4 - t77*qd3
     t81 = c1*t35 + s1*t42
     t82 = t81
     t83 = t6*t41 - t11*t34
     t84 = t83
     t85 = t33*t22 - t40*t16
     t86 = t85
-    t87 = qd3*t84 + qd4*t86
-    t88 = t87 + qd2*t82
+    t87 = t86*qd4 + t84*qd3
+    t88 = t87 + t82*qd2
     t89 = s1*qd2
-    t90 = t6*qd3 + t89
+    t90 = t89 + t6*qd3
     t91 = t80 - t49*t89
     t92 = t91 + t36*qd1
     t93 = c1*qd2
-    t94 = t11*qd3 - t93
+    t94 = -t93 + t11*qd3
     t95 = t75 - t49*t93
     t96 = t95 - t43*qd1
     t97 = t16*qd4
@@ -968,12 +968,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(-t66, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(-c1*t88 + qd1*t107) + qd3*(t0*t80 + qd1*t77 + t11*t87 - t93*t84) + qd4*(t94*t86 - t2*t79 + t79*t103 - t86*t100) - qd1*t92, batch),  # 0
-        xp.broadcast_to(qd1*t96 - qd2*(s1*t88 + qd1*t106) - qd3*(-qd1*t72 + t0*t75 + t6*t87 + t89*t84) + qd4*(t2*t74 - t90*t86 + t86*t97 - t74*t103), batch),  # 1
-        xp.broadcast_to(qd2*(c1*t95 + s1*t91) + qd3*(t6*t80 - t11*t75 + t93*t72 - t89*t77) + qd4*(t90*t79 - t94*t74 + t74*t100 - t79*t97), batch),  # 2
-        xp.broadcast_to(qd3*(-t11*qd1 + t0*t93) + qd4*(t22*t2 - t27*t94) + qd5*(t24*t104 + t29*t101) + qd6*(t59*t105 - t66*t102) + t93*qd1, batch),  # 3
-        xp.broadcast_to(qd3*(t6*qd1 + t0*t89) + qd4*(t27*t90 - t16*t2) - qd5*(t18*t104 + t29*t98) + qd6*(t66*t99 - t52*t105) + t89*qd1, batch),  # 4
-        xp.broadcast_to(qd3*(t6*t93 + t11*t89) + qd4*(t16*t94 - t22*t90) + qd5*(t18*t101 - t24*t98) + qd6*(t52*t102 - t59*t99), batch),  # 5
+        xp.broadcast_to(-qd1*t92 + qd2*(qd1*t107 - c1*t88) + qd3*(-t93*t84 + t77*qd1 + t11*t87 + t0*t80) + qd4*(t86*t94 - t79*t2 - t86*t100 + t79*t103), batch),  # 0
+        xp.broadcast_to(qd1*t96 - qd2*(qd1*t106 + s1*t88) - qd3*(-t72*qd1 + t89*t84 + t0*t75 + t6*t87) + qd4*(t74*t2 - t86*t90 - t74*t103 + t86*t97), batch),  # 1
+        xp.broadcast_to(qd2*(s1*t91 + c1*t95) + qd3*(-t89*t77 + t93*t72 + t6*t80 - t11*t75) + qd4*(t79*t90 - t74*t94 - t79*t97 + t74*t100), batch),  # 2
+        xp.broadcast_to(t93*qd1 + qd3*(t0*t93 - t11*qd1) + qd4*(-t27*t94 + t22*t2) + qd5*(t29*t101 + t24*t104) + qd6*(-t66*t102 + t59*t105), batch),  # 3
+        xp.broadcast_to(t89*qd1 + qd3*(t6*qd1 + t0*t89) + qd4*(-t16*t2 + t27*t90) - qd5*(t18*t104 + t29*t98) + qd6*(-t52*t105 + t66*t99), batch),  # 4
+        xp.broadcast_to(qd3*(t11*t89 + t6*t93) + qd4*(-t22*t90 + t16*t94) + qd5*(-t24*t98 + t18*t101) + qd6*(-t59*t99 + t52*t102), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -1046,8 +1046,8 @@ def jacobian_dot(q, q_dot):
     t46 = c1*t36 + s1*t44
     t47 = t6*t43 - t11*t35
     t48 = t33*t22 - t41*t16
-    t49 = qd3*t47 + qd4*t48
-    t50 = t49 + qd2*t46
+    t49 = t48*qd4 + t47*qd3
+    t50 = t49 + t46*qd2
     t51 = c4*t26
     t52 = s4*t0
     t53 = t51 - t52
@@ -1059,14 +1059,14 @@ def jacobian_dot(q, q_dot):
     t59 = t41*t27 - t54*t22
     t60 = t0*t35 + t6*t56
     t61 = t54*t16 - t33*t27
-    t62 = qd3*t58 + qd4*t59
-    t63 = qd4*t61 - qd3*t60
+    t62 = t59*qd4 + t58*qd3
+    t63 = t61*qd4 - t60*qd3
     t64 = s1*qd2
-    t65 = t6*qd3 + t64
+    t65 = t64 + t6*qd3
     t66 = t63 - t57*t64
     t67 = t66 + t37*qd1
     t68 = c1*qd2
-    t69 = t11*qd3 - t68
+    t69 = -t68 + t11*qd3
     t70 = t62 - t57*t68
     t71 = t70 - t45*qd1
     t72 = t16*qd4
@@ -1082,41 +1082,41 @@ def jacobian_dot(q, q_dot):
     t82 = c1*qd1
     Jd = _stack(xp, [
         xp.broadcast_to(-t67, batch),  # 0, 0
-        xp.broadcast_to(-c1*t50 + t57*t81, batch),  # 0, 1
-        xp.broadcast_to(t0*t63 + qd1*t60 + t11*t49 - t68*t47, batch),  # 0, 2
-        xp.broadcast_to(t69*t48 - t2*t61 + t78*t61 - t75*t48, batch),  # 0, 3
+        xp.broadcast_to(t57*t81 - c1*t50, batch),  # 0, 1
+        xp.broadcast_to(-t68*t47 + t60*qd1 + t11*t49 + t0*t63, batch),  # 0, 2
+        xp.broadcast_to(t48*t69 - t61*t2 - t75*t48 + t78*t61, batch),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t71, batch),  # 1, 0
-        xp.broadcast_to(-(s1*t50 + t57*t82), batch),  # 1, 1
-        xp.broadcast_to(-(-qd1*t58 + t0*t62 + t6*t49 + t64*t47), batch),  # 1, 2
-        xp.broadcast_to(t2*t59 - t65*t48 + t72*t48 - t78*t59, batch),  # 1, 3
+        xp.broadcast_to(-(t57*t82 + s1*t50), batch),  # 1, 1
+        xp.broadcast_to(-(-t58*qd1 + t64*t47 + t0*t62 + t6*t49), batch),  # 1, 2
+        xp.broadcast_to(t59*t2 - t48*t65 - t78*t59 + t72*t48, batch),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(c1*t70 + s1*t66, batch),  # 2, 1
-        xp.broadcast_to(t6*t63 - t11*t62 + t68*t58 - t64*t60, batch),  # 2, 2
-        xp.broadcast_to(t65*t61 - t69*t59 + t75*t59 - t72*t61, batch),  # 2, 3
+        xp.broadcast_to(s1*t66 + c1*t70, batch),  # 2, 1
+        xp.broadcast_to(-t64*t60 + t68*t58 + t6*t63 - t11*t62, batch),  # 2, 2
+        xp.broadcast_to(t61*t65 - t59*t69 - t72*t61 + t75*t59, batch),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t82, batch),  # 3, 1
-        xp.broadcast_to(-t11*qd1 + t0*t68, batch),  # 3, 2
-        xp.broadcast_to(t22*t2 - t27*t69, batch),  # 3, 3
-        xp.broadcast_to(t24*t79 + t29*t76, batch),  # 3, 4
-        xp.broadcast_to(t42*t80 - t55*t77, batch),  # 3, 5
+        xp.broadcast_to(t0*t68 - t11*qd1, batch),  # 3, 2
+        xp.broadcast_to(-t27*t69 + t22*t2, batch),  # 3, 3
+        xp.broadcast_to(t29*t76 + t24*t79, batch),  # 3, 4
+        xp.broadcast_to(-t55*t77 + t42*t80, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t81, batch),  # 4, 1
         xp.broadcast_to(t6*qd1 + t0*t64, batch),  # 4, 2
-        xp.broadcast_to(t27*t65 - t16*t2, batch),  # 4, 3
+        xp.broadcast_to(-t16*t2 + t27*t65, batch),  # 4, 3
         xp.broadcast_to(-(t18*t79 + t29*t73), batch),  # 4, 4
-        xp.broadcast_to(t55*t74 - t34*t80, batch),  # 4, 5
+        xp.broadcast_to(-t34*t80 + t55*t74, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
-        xp.broadcast_to(t6*t68 + t11*t64, batch),  # 5, 2
-        xp.broadcast_to(t16*t69 - t22*t65, batch),  # 5, 3
-        xp.broadcast_to(t18*t76 - t24*t73, batch),  # 5, 4
-        xp.broadcast_to(t34*t77 - t42*t74, batch),  # 5, 5
+        xp.broadcast_to(t11*t64 + t6*t68, batch),  # 5, 2
+        xp.broadcast_to(-t22*t65 + t16*t69, batch),  # 5, 3
+        xp.broadcast_to(-t24*t73 + t18*t76, batch),  # 5, 4
+        xp.broadcast_to(-t42*t74 + t34*t77, batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1190,8 +1190,8 @@ def bias_acceleration(q, q_dot):
     t46 = c1*t36 + s1*t44
     t47 = t6*t43 - t11*t35
     t48 = t33*t22 - t41*t16
-    t49 = qd3*t47 + qd4*t48
-    t50 = t49 + qd2*t46
+    t49 = t48*qd4 + t47*qd3
+    t50 = t49 + t46*qd2
     t51 = c4*t26
     t52 = s4*t0
     t53 = t51 - t52
@@ -1203,14 +1203,14 @@ def bias_acceleration(q, q_dot):
     t59 = t41*t27 - t54*t22
     t60 = t0*t35 + t6*t56
     t61 = t54*t16 - t33*t27
-    t62 = qd3*t58 + qd4*t59
-    t63 = qd4*t61 - qd3*t60
+    t62 = t59*qd4 + t58*qd3
+    t63 = t61*qd4 - t60*qd3
     t64 = s1*qd2
-    t65 = t6*qd3 + t64
+    t65 = t64 + t6*qd3
     t66 = t63 - t57*t64
     t67 = t66 + t37*qd1
     t68 = c1*qd2
-    t69 = t11*qd3 - t68
+    t69 = -t68 + t11*qd3
     t70 = t62 - t57*t68
     t71 = t70 - t45*qd1
     t72 = t16*qd4
@@ -1224,12 +1224,12 @@ def bias_acceleration(q, q_dot):
     t80 = t79 + t29*qd5
     t81 = t57*qd1
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(-c1*t50 + s1*t81) + qd3*(t0*t63 + qd1*t60 + t11*t49 - t68*t47) + qd4*(t69*t48 - t2*t61 + t78*t61 - t75*t48) - qd1*t67, batch),  # 0
-        xp.broadcast_to(qd1*t71 - qd2*(s1*t50 + c1*t81) - qd3*(-qd1*t58 + t0*t62 + t6*t49 + t64*t47) + qd4*(t2*t59 - t65*t48 + t72*t48 - t78*t59), batch),  # 1
-        xp.broadcast_to(qd2*(c1*t70 + s1*t66) + qd3*(t6*t63 - t11*t62 + t68*t58 - t64*t60) + qd4*(t65*t61 - t69*t59 + t75*t59 - t72*t61), batch),  # 2
-        xp.broadcast_to(qd3*(-t11*qd1 + t0*t68) + qd4*(t22*t2 - t27*t69) + qd5*(t24*t79 + t29*t76) + qd6*(t42*t80 - t55*t77) + t68*qd1, batch),  # 3
-        xp.broadcast_to(qd3*(t6*qd1 + t0*t64) + qd4*(t27*t65 - t16*t2) - qd5*(t18*t79 + t29*t73) + qd6*(t55*t74 - t34*t80) + t64*qd1, batch),  # 4
-        xp.broadcast_to(qd3*(t6*t68 + t11*t64) + qd4*(t16*t69 - t22*t65) + qd5*(t18*t76 - t24*t73) + qd6*(t34*t77 - t42*t74), batch),  # 5
+        xp.broadcast_to(-qd1*t67 + qd2*(s1*t81 - c1*t50) + qd3*(-t68*t47 + t60*qd1 + t11*t49 + t0*t63) + qd4*(t48*t69 - t61*t2 - t75*t48 + t78*t61), batch),  # 0
+        xp.broadcast_to(qd1*t71 - qd2*(c1*t81 + s1*t50) - qd3*(-t58*qd1 + t64*t47 + t0*t62 + t6*t49) + qd4*(t59*t2 - t48*t65 - t78*t59 + t72*t48), batch),  # 1
+        xp.broadcast_to(qd2*(s1*t66 + c1*t70) + qd3*(-t64*t60 + t68*t58 + t6*t63 - t11*t62) + qd4*(t61*t65 - t59*t69 - t72*t61 + t75*t59), batch),  # 2
+        xp.broadcast_to(t68*qd1 + qd3*(t0*t68 - t11*qd1) + qd4*(-t27*t69 + t22*t2) + qd5*(t29*t76 + t24*t79) + qd6*(-t55*t77 + t42*t80), batch),  # 3
+        xp.broadcast_to(t64*qd1 + qd3*(t6*qd1 + t0*t64) + qd4*(-t16*t2 + t27*t65) - qd5*(t18*t79 + t29*t73) + qd6*(-t34*t80 + t55*t74), batch),  # 4
+        xp.broadcast_to(qd3*(t11*t64 + t6*t68) + qd4*(-t22*t65 + t16*t69) + qd5*(-t24*t73 + t18*t76) + qd6*(-t42*t74 + t34*t77), batch),  # 5
     ], (6,))
     return a
 
@@ -1302,8 +1302,8 @@ def task_jacobian_dot(q, q_dot):
     t43 = c1*t34 + s1*t41
     t44 = t5*t40 - t10*t33
     t45 = t32*t21 - t39*t15
-    t46 = qd3*t44 + qd4*t45
-    t47 = t46 + qd2*t43
+    t46 = t45*qd4 + t44*qd3
+    t47 = t46 + t43*qd2
     t48 = c4*t25
     t49 = s4*t0
     t50 = t48 - t49
@@ -1314,8 +1314,8 @@ def task_jacobian_dot(q, q_dot):
     t55 = t39*t26 - t51*t21
     t56 = t0*t33 + t5*t52
     t57 = t51*t15 - t32*t26
-    t58 = qd3*t54 + qd4*t55
-    t59 = qd4*t57 - qd3*t56
+    t58 = t55*qd4 + t54*qd3
+    t59 = t57*qd4 - t56*qd3
     t60 = 0.9998476951563913*t16 - 0.01745240643728351*t15
     t61 = t31*c5 + t60*s5
     t62 = t60*c5 - t31*s5
@@ -1330,58 +1330,58 @@ def task_jacobian_dot(q, q_dot):
     t71 = c5*t50 + s5*t70
     t72 = c5*t70 - s5*t50
     t73 = s6*t28 + c6*t71
-    t74 = t5*qd3
-    t75 = s1*qd2
-    t76 = t74 + t75
-    t77 = t59 - t53*t75
-    t78 = t77 + t35*qd1
-    t79 = t0*t58 + t5*t46 - qd1*t54 + t75*t44
-    t80 = t5*qd1 + t0*t75
-    t81 = t10*qd3
-    t82 = c1*qd2
-    t83 = t81 - t82
-    t84 = t58 - t53*t82
-    t85 = t84 - t42*qd1
-    t86 = t0*t59 + qd1*t56 + t10*t46 - t82*t44
-    t87 = c1*t84 + s1*t77
-    t88 = t5*t59 - t10*t58 + t82*t54 - t75*t56
-    t89 = -t10*qd1 + t0*t82
-    t90 = t5*t82 + t10*t75
-    t91 = t15*t83 - t21*t76
+    t74 = s1*qd2
+    t75 = t59 - t53*t74
+    t76 = t75 + t35*qd1
+    t77 = -t54*qd1 + t74*t44 + t0*t58 + t5*t46
+    t78 = t5*qd1 + t0*t74
+    t79 = t5*qd3
+    t80 = t74 + t79
+    t81 = c1*qd2
+    t82 = t58 - t53*t81
+    t83 = t82 - t42*qd1
+    t84 = -t81*t44 + t56*qd1 + t10*t46 + t0*t59
+    t85 = s1*t75 + c1*t82
+    t86 = -t74*t56 + t81*t54 + t5*t59 - t10*t58
+    t87 = t0*t81 - t10*qd1
+    t88 = t10*t74 + t5*t81
+    t89 = t10*qd3
+    t90 = -t81 + t89
+    t91 = -t21*t80 + t15*t90
     t92 = t0*qd3
     t93 = qd1 - t92
-    t94 = t21*t93 - t26*t83
-    t95 = t26*t76 - t15*t93
+    t94 = -t26*t90 + t21*t93
+    t95 = -t15*t93 + t26*t80
     t96 = t15*qd4
-    t97 = t76 - t96
+    t97 = t80 - t96
     t98 = t21*qd4
-    t99 = t83 - t98
-    t100 = t76*t57 - t83*t55 + t98*t55 - t96*t57
-    t101 = t17*t99 - t23*t97
+    t99 = t90 - t98
+    t100 = t57*t80 - t55*t90 - t96*t57 + t98*t55
+    t101 = -t23*t97 + t17*t99
     t102 = t26*qd4
     t103 = t93 - t102
-    t104 = t83*t45 - t93*t57 + t102*t57 - t98*t45
-    t105 = t93*t55 - t76*t45 + t96*t45 - t102*t55
-    t106 = t23*t103 + t28*t99
+    t104 = t45*t90 - t57*t93 - t98*t45 + t102*t57
+    t105 = t55*t93 - t45*t80 - t102*t55 + t96*t45
+    t106 = t28*t99 + t23*t103
     t107 = t17*t103 + t28*t97
     t108 = t17*qd5
     t109 = t97 - t108
-    t110 = t96 + t108 + t62*qd6 - t74 - t75
+    t110 = -t74 - t79 + t96 + t108 + t62*qd6
     t111 = t23*qd5
     t112 = t99 - t111
-    t113 = t62*t112 - t66*t109
-    t114 = t82 + t98 + t111 + t66*qd6 - t81
-    t115 = t63*t114 - t67*t110
+    t113 = -t66*t109 + t62*t112
+    t114 = t81 - t89 + t98 + t111 + t66*qd6
+    t115 = -t67*t110 + t63*t114
     t116 = t28*qd5
     t117 = t103 + t116
-    t118 = t66*t117 - t72*t112
-    t119 = t72*t109 - t62*t117
-    t120 = -qd1 + t92 + t102 + t72*qd6 - t116
-    t121 = t67*t120 - t73*t114
-    t122 = t73*t110 - t63*t120
+    t118 = -t72*t112 + t66*t117
+    t119 = -t62*t117 + t72*t109
+    t120 = -qd1 + t92 + t102 - t116 + t72*qd6
+    t121 = -t73*t114 + t67*t120
+    t122 = -t63*t120 + t73*t110
     t123 = t53*qd1
-    t124 = -c1*t47 + s1*t123
-    t125 = s1*t47 + c1*t123
+    t124 = s1*t123 - c1*t47
+    t125 = c1*t123 + s1*t47
     t126 = s1*t63
     t127 = c1*t67
     t128 = 1/t68
@@ -1407,68 +1407,68 @@ def task_jacobian_dot(q, q_dot):
     t148 = qd1*t128
     t149 = t134*t148
     t150 = t135*t148
-    t151 = t63*t128
-    t152 = t89*t151
-    t153 = t67*t128
-    t154 = t80*t153
-    t155 = 2*t130
-    t156 = t144*(t5 - t63*t155)
-    t157 = t146*(t10 - t67*t155)
-    t158 = t94*t151
-    t159 = t95*t153
-    t160 = 2*t131
-    t161 = -t144*(t15 + t63*t160)
-    t162 = -t146*(t21 + t67*t160)
-    t163 = t106*t151
-    t164 = 2*t132
-    t165 = -t144*(t17 + t63*t164)
-    t166 = -t146*(t23 + t67*t164)
-    t167 = t107*t153
-    t168 = t118*t151
-    t169 = t119*t153
-    t170 = 2*t133
-    t171 = -t144*(t62 + t63*t170)
-    t172 = -t146*(t66 + t67*t170)
+    t151 = 2*t130
+    t152 = t144*(t5 - t63*t151)
+    t153 = t146*(t10 - t67*t151)
+    t154 = t63*t128
+    t155 = t87*t154
+    t156 = t67*t128
+    t157 = t78*t156
+    t158 = 2*t131
+    t159 = -t144*(t15 + t63*t158)
+    t160 = -t146*(t21 + t67*t158)
+    t161 = t94*t154
+    t162 = t95*t156
+    t163 = 2*t132
+    t164 = -t144*(t17 + t63*t163)
+    t165 = -t146*(t23 + t67*t163)
+    t166 = t106*t154
+    t167 = t107*t156
+    t168 = 2*t133
+    t169 = -t144*(t62 + t63*t168)
+    t170 = -t146*(t66 + t67*t168)
+    t171 = t118*t154
+    t172 = t119*t156
     t173 = qd1*t136
-    t174 = t63*t136
-    t175 = t67*t136
+    t174 = t67*t136
+    t175 = t63*t136
     Jd = _stack(xp, [
-        xp.broadcast_to(-t78, batch),  # 0, 0
+        xp.broadcast_to(-t76, batch),  # 0, 0
         xp.broadcast_to(t124, batch),  # 0, 1
-        xp.broadcast_to(t86, batch),  # 0, 2
+        xp.broadcast_to(t84, batch),  # 0, 2
         xp.broadcast_to(t104, batch),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        xp.broadcast_to(t85, batch),  # 1, 0
+        xp.broadcast_to(t83, batch),  # 1, 0
         xp.broadcast_to(-t125, batch),  # 1, 1
-        xp.broadcast_to(-t79, batch),  # 1, 2
+        xp.broadcast_to(-t77, batch),  # 1, 2
         xp.broadcast_to(t105, batch),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(t87, batch),  # 2, 1
-        xp.broadcast_to(t88, batch),  # 2, 2
+        xp.broadcast_to(t85, batch),  # 2, 1
+        xp.broadcast_to(t86, batch),  # 2, 2
         xp.broadcast_to(t100, batch),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t145 + t147 + t149 + t150, batch),  # 3, 1
-        xp.broadcast_to(t152 + t154 + t156 + t157, batch),  # 3, 2
-        xp.broadcast_to(t158 + t159 + t161 + t162, batch),  # 3, 3
-        xp.broadcast_to(t163 + t165 + t166 - t167, batch),  # 3, 4
-        xp.broadcast_to(t168 + t169 + t171 + t172, batch),  # 3, 5
+        xp.broadcast_to(t152 + t153 + t155 + t157, batch),  # 3, 2
+        xp.broadcast_to(t159 + t160 + t161 + t162, batch),  # 3, 3
+        xp.broadcast_to(t164 + t165 + t166 - t167, batch),  # 3, 4
+        xp.broadcast_to(t169 + t170 + t171 + t172, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(-t121*(t63*t138 + c1*t136) - t122*(t67*t138 + s1*t136) + t126*t173 - t127*t173, batch),  # 4, 1
-        xp.broadcast_to(t121*(t10*t136 - t63*t139) - t122*(t67*t139 + t5*t136) + t80*t174 - t89*t175, batch),  # 4, 2
-        xp.broadcast_to(-t121*(t63*t140 + t21*t136) + t122*(t15*t136 - t67*t140) + t95*t174 - t94*t175, batch),  # 4, 3
-        xp.broadcast_to(-t121*(t63*t141 + t23*t136) + t122*(t17*t136 - t67*t141) - t106*t175 - t107*t174, batch),  # 4, 4
-        xp.broadcast_to(-t121*(t63*t142 + t66*t136) + t122*(t62*t136 - t67*t142) + t119*t174 - t118*t175, batch),  # 4, 5
+        xp.broadcast_to(-t121*(c1*t136 + t63*t138) - t122*(s1*t136 + t67*t138) - t127*t173 + t126*t173, batch),  # 4, 1
+        xp.broadcast_to(t121*(t10*t136 - t63*t139) - t122*(t5*t136 + t67*t139) - t87*t174 + t78*t175, batch),  # 4, 2
+        xp.broadcast_to(-t121*(t21*t136 + t63*t140) + t122*(t15*t136 - t67*t140) - t94*t174 + t95*t175, batch),  # 4, 3
+        xp.broadcast_to(-t121*(t23*t136 + t63*t141) + t122*(t17*t136 - t67*t141) - t106*t174 - t107*t175, batch),  # 4, 4
+        xp.broadcast_to(-t121*(t66*t136 + t63*t142) + t122*(t62*t136 - t67*t142) - t118*t174 + t119*t175, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(t129*t115 + t73*t145 + t73*t147 + t73*t149 + t73*t150), batch),  # 5, 1
-        xp.broadcast_to(-(-t90 + t130*t115 + t73*t152 + t73*t154 + t73*t156 + t73*t157), batch),  # 5, 2
-        xp.broadcast_to(-(-t91 + t131*t115 + t73*t158 + t73*t159 + t73*t161 + t73*t162), batch),  # 5, 3
-        xp.broadcast_to(-(-t101 + t132*t115 - t73*t167 + t73*t163 + t73*t165 + t73*t166), batch),  # 5, 4
-        xp.broadcast_to(-(-t113 + t133*t115 + t73*t168 + t73*t169 + t73*t171 + t73*t172), batch),  # 5, 5
+        xp.broadcast_to(-(t73*t145 + t73*t147 + t115*t129 + t73*t149 + t73*t150), batch),  # 5, 1
+        xp.broadcast_to(-(-t88 + t73*t152 + t73*t153 + t115*t130 + t73*t155 + t73*t157), batch),  # 5, 2
+        xp.broadcast_to(-(-t91 + t73*t159 + t73*t160 + t115*t131 + t73*t161 + t73*t162), batch),  # 5, 3
+        xp.broadcast_to(-(-t101 + t73*t164 + t73*t165 + t115*t132 + t73*t166 - t73*t167), batch),  # 5, 4
+        xp.broadcast_to(-(-t113 + t73*t169 + t73*t170 + t115*t133 + t73*t171 + t73*t172), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1553,9 +1553,9 @@ def hessian(q):
     t63 = -c1*t47
     t64 = -s1*t46
     t65 = -s1*t47
-    t66 = c1*t55 - s1*t57
-    t67 = c1*t56 + s1*t58
-    t68 = t0*t58 + t10*t47
+    t66 = -s1*t57 + c1*t55
+    t67 = s1*t58 + c1*t56
+    t68 = t10*t47 + t0*t58
     t69 = -(t0*t56 + t5*t47)
     t70 = t5*t58 - t10*t56
     H = _stack(xp, [
@@ -1608,7 +1608,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -(c1**2*t54 + s1**2*t54),  # 1, 2, 1
+        -(s1**2*t54 + c1**2*t54),  # 1, 2, 1
         t66,  # 1, 2, 2
         t67,  # 1, 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 4
@@ -1627,10 +1627,10 @@ def hessian(q):
         s1*t52,  # 1, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 1
-        c1*t5 + s1*t10,  # 1, 5, 2
-        -(c1*t15 + s1*t21),  # 1, 5, 3
-        -(c1*t17 + s1*t23),  # 1, 5, 4
-        -(c1*t33 + s1*t41),  # 1, 5, 5
+        s1*t10 + c1*t5,  # 1, 5, 2
+        -(s1*t21 + c1*t15),  # 1, 5, 3
+        -(s1*t23 + c1*t17),  # 1, 5, 4
+        -(s1*t41 + c1*t33),  # 1, 5, 5
         t57,  # 2, 0, 0
         t62,  # 2, 0, 1
         t10*t46 - t0*t57,  # 2, 0, 2
@@ -1652,9 +1652,9 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 2
-        -(t0*t21 + t10*t26),  # 2, 3, 3
+        -(t10*t26 + t0*t21),  # 2, 3, 3
         t10*t28 - t0*t23,  # 2, 3, 4
-        -(t0*t41 + t10*t52),  # 2, 3, 5
+        -(t10*t52 + t0*t41),  # 2, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 2
@@ -1664,25 +1664,25 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 2
-        t10*t15 - t5*t21,  # 2, 5, 3
-        t10*t17 - t5*t23,  # 2, 5, 4
-        t10*t33 - t5*t41,  # 2, 5, 5
+        -t5*t21 + t10*t15,  # 2, 5, 3
+        -t5*t23 + t10*t17,  # 2, 5, 4
+        -t5*t41 + t10*t33,  # 2, 5, 5
         t60,  # 3, 0, 0
         t63,  # 3, 0, 1
         t68,  # 3, 0, 2
-        t26*t58 - t21*t47,  # 3, 0, 3
+        -t21*t47 + t26*t58,  # 3, 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0, 5
         t56,  # 3, 1, 0
         t65,  # 3, 1, 1
         t69,  # 3, 1, 2
-        t15*t47 - t26*t56,  # 3, 1, 3
+        -t26*t56 + t15*t47,  # 3, 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 0
         t67,  # 3, 2, 1
         t70,  # 3, 2, 2
-        t21*t56 - t15*t58,  # 3, 2, 3
+        -t15*t58 + t21*t56,  # 3, 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 0
@@ -1695,7 +1695,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        t15*t28 + t26*t17,  # 3, 4, 4
+        t26*t17 + t15*t28,  # 3, 4, 4
         t26*t33 - t15*t52,  # 3, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
@@ -1732,7 +1732,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        -(t17*t52 + t28*t33),  # 4, 4, 5
+        -(t28*t33 + t17*t52),  # 4, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2

@@ -907,9 +907,9 @@ def fk_jacobian_dot(q, q_dot):
     t73 = t72
     t74 = t43*t33 - t28*t48
     t75 = t74
-    t76 = qd5*t73 + qd6*t75
-    t77 = t76 + qd4*t71
-    t78 = t77 + qd3*t69
+    t76 = t75*qd6 + t73*qd5
+    t77 = t76 + t71*qd4
+    t78 = t77 + t69*qd3
     t79 = c1*t51
     t80 = c2*t22 - s2*t79
     t81 = t80
@@ -919,9 +919,9 @@ def fk_jacobian_dot(q, q_dot):
     t85 = t84
     t86 = t14*t48 + t43*t19
     t87 = t86
-    t88 = qd5*t85 - qd6*t87
-    t89 = t88 - qd4*t83
-    t90 = t89 + qd3*t81
+    t88 = -t87*qd6 + t85*qd5
+    t89 = t88 - t83*qd4
+    t90 = t89 + t81*qd3
     t91 = c1*t22 + s1*t36
     t92 = t91
     t93 = t36*t9 - t22*t23
@@ -932,10 +932,10 @@ def fk_jacobian_dot(q, q_dot):
     t98 = t97
     t99 = t14*t33 + t28*t19
     t100 = t99
-    t101 = qd5*t98 + qd6*t100
-    t102 = t101 + qd4*t96
-    t103 = t102 + qd3*t94
-    t104 = t103 - qd2*t92
+    t101 = t100*qd6 + t98*qd5
+    t102 = t101 + t96*qd4
+    t103 = t102 + t94*qd3
+    t104 = t103 - t92*qd2
     t105 = s1*qd2
     t106 = -t105 + t9*qd3
     t107 = t106 + t7*qd4
@@ -1021,12 +1021,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t125, batch),  # 5, 6
     ], (6, 7))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(c1*t104 - t67*qd1) + qd3*(-c2*t90 - qd1*t81 + t23*t103 + t94*t111) + qd4*(t0*t83 + t112*t96 - t4*t102 + t41*t89) + qd5*(t26*t101 + t113*t98 - t40*t88 - t53*t85) + qd6*(t54*t87 + t114*t100 - t100*t119 - t87*t121) - qd1*t110, batch),  # 0
-        xp.broadcast_to(qd1*t116 + qd2*(s1*t104 + t79*qd1) + qd3*(c2*t78 + qd1*t69 + t105*t94 - t9*t103) - qd4*(-t0*t71 + t7*t102 + t106*t96 + t41*t77) + qd5*(t40*t76 + t53*t73 - t12*t101 - t107*t98) - qd6*(-t54*t75 + t108*t100 + t100*t117 + t75*t121), batch),  # 1
-        xp.broadcast_to(-qd2*(c1*t115 + s1*t109) - qd3*(-t9*t90 + t23*t78 + t69*t111 + t105*t81) + qd4*(t4*t77 + t7*t89 - t112*t71 - t106*t83) + qd5*(t12*t88 + t107*t85 - t26*t76 - t113*t73) - qd6*(-t75*t119 + t114*t75 + t108*t87 + t87*t117), batch),  # 2
-        xp.broadcast_to(qd3*(c2*t111 - t23*qd1) + qd4*(t4*t0 - t41*t112) + qd5*(t40*t113 - t26*t53) + qd6*(t28*t54 - t43*t114) + qd7*(t30*t122 - t45*t120) - qd1*t111, batch),  # 3
-        xp.broadcast_to(qd3*(t9*qd1 + c2*t105) + qd4*(t7*t0 + t41*t106) + qd5*(t12*t53 - t40*t107) + qd6*(t14*t54 + t43*t108) + qd7*(t45*t118 - t16*t122) - t105*qd1, batch),  # 4
-        xp.broadcast_to(-qd3*(c1**2*t126 + s1**2*t126) - qd4*(t7*t112 + t4*t106) + qd5*(t26*t107 - t12*t113) - qd6*(t14*t114 + t28*t108) + qd7*(t16*t120 - t30*t118), batch),  # 5
+        xp.broadcast_to(-qd1*t110 + qd2*(-t67*qd1 + c1*t104) + qd3*(t94*t111 - t81*qd1 + t23*t103 - c2*t90) + qd4*(t96*t112 + t83*t0 - t4*t102 + t41*t89) + qd5*(t98*t113 - t85*t53 + t26*t101 - t40*t88) + qd6*(t100*t114 + t87*t54 - t100*t119 - t87*t121), batch),  # 0
+        xp.broadcast_to(qd1*t116 + qd2*(t79*qd1 + s1*t104) + qd3*(t69*qd1 + t105*t94 + c2*t78 - t9*t103) - qd4*(-t71*t0 + t96*t106 + t41*t77 + t7*t102) + qd5*(t73*t53 - t98*t107 + t40*t76 - t12*t101) - qd6*(-t75*t54 + t100*t108 + t75*t121 + t100*t117), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t109 + c1*t115) - qd3*(t105*t81 + t69*t111 - t9*t90 + t23*t78) + qd4*(-t83*t106 - t71*t112 + t7*t89 + t4*t77) + qd5*(t85*t107 - t73*t113 + t12*t88 - t26*t76) - qd6*(t87*t108 + t75*t114 + t87*t117 - t75*t119), batch),  # 2
+        xp.broadcast_to(-qd1*t111 + qd3*(c2*t111 - t23*qd1) + qd4*(-t41*t112 + t4*t0) + qd5*(t40*t113 - t26*t53) + qd6*(-t43*t114 + t28*t54) + qd7*(-t45*t120 + t30*t122), batch),  # 3
+        xp.broadcast_to(-t105*qd1 + qd3*(t9*qd1 + c2*t105) + qd4*(t7*t0 + t41*t106) + qd5*(t12*t53 - t40*t107) + qd6*(t14*t54 + t43*t108) + qd7*(-t16*t122 + t45*t118), batch),  # 4
+        xp.broadcast_to(-qd3*(s1**2*t126 + c1**2*t126) - qd4*(t4*t106 + t7*t112) + qd5*(t26*t107 - t12*t113) - qd6*(t28*t108 + t14*t114) + qd7*(-t30*t118 + t16*t120), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -1096,10 +1096,10 @@ def jacobian_dot(q, q_dot):
     t40 = t4*t25 + t7*t36
     t41 = t18*t35 - t29*t24
     t42 = t20*t34 + t31*t23
-    t43 = qd5*t41 + qd6*t42
-    t44 = t43 + qd4*t40
-    t45 = t44 + qd3*t39
-    t46 = t45 - qd2*t38
+    t43 = t42*qd6 + t41*qd5
+    t44 = t43 + t40*qd4
+    t45 = t44 + t39*qd3
+    t46 = t45 - t38*qd2
     t47 = s3*s2
     t48 = t14*c5 + s5*t47
     t49 = -t14*s5 + c5*t47
@@ -1119,12 +1119,12 @@ def jacobian_dot(q, q_dot):
     t63 = t20*t52 + t49*t23
     t64 = t0 - t47*qd4
     t65 = t64 + t15*qd5
-    t66 = qd5*t58 + qd6*t59
-    t67 = qd5*t62 - qd6*t63
-    t68 = t66 + qd4*t57
-    t69 = t67 - qd4*t61
-    t70 = t68 + qd3*t56
-    t71 = t69 + qd3*t60
+    t66 = t59*qd6 + t58*qd5
+    t67 = -t63*qd6 + t62*qd5
+    t68 = t66 + t57*qd4
+    t69 = t67 - t61*qd4
+    t70 = t68 + t56*qd3
+    t71 = t69 + t60*qd3
     t72 = s1*qd2
     t73 = -t72 + t16*qd3
     t74 = t73 + t7*qd4
@@ -1148,47 +1148,47 @@ def jacobian_dot(q, q_dot):
     t92 = s2*qd2
     Jd = _stack(xp, [
         xp.broadcast_to(-t77, batch),  # 0, 0
-        xp.broadcast_to(c1*t46 - t55*t90, batch),  # 0, 1
-        xp.broadcast_to(-c2*t71 - qd1*t60 + t27*t45 + t78*t39, batch),  # 0, 2
-        xp.broadcast_to(t0*t61 + t79*t40 - t4*t44 + t47*t69, batch),  # 0, 3
-        xp.broadcast_to(t29*t43 + t80*t41 - t15*t67 - t64*t62, batch),  # 0, 4
-        xp.broadcast_to(t65*t63 + t81*t42 - t86*t42 - t88*t63, batch),  # 0, 5
+        xp.broadcast_to(-t55*t90 + c1*t46, batch),  # 0, 1
+        xp.broadcast_to(t78*t39 - t60*qd1 + t27*t45 - c2*t71, batch),  # 0, 2
+        xp.broadcast_to(t40*t79 + t61*t0 - t4*t44 + t47*t69, batch),  # 0, 3
+        xp.broadcast_to(t41*t80 - t62*t64 + t29*t43 - t15*t67, batch),  # 0, 4
+        xp.broadcast_to(t42*t81 + t63*t65 - t86*t42 - t88*t63, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         xp.broadcast_to(t83, batch),  # 1, 0
-        xp.broadcast_to(s1*t46 + t55*t91, batch),  # 1, 1
-        xp.broadcast_to(c2*t70 + qd1*t56 + t72*t39 - t16*t45, batch),  # 1, 2
-        xp.broadcast_to(-(-t0*t57 + t7*t44 + t73*t40 + t47*t68), batch),  # 1, 3
-        xp.broadcast_to(t15*t66 + t64*t58 - t18*t43 - t74*t41, batch),  # 1, 4
-        xp.broadcast_to(-(-t65*t59 + t75*t42 + t84*t42 + t88*t59), batch),  # 1, 5
+        xp.broadcast_to(t55*t91 + s1*t46, batch),  # 1, 1
+        xp.broadcast_to(t56*qd1 + t72*t39 + c2*t70 - t16*t45, batch),  # 1, 2
+        xp.broadcast_to(-(-t57*t0 + t40*t73 + t47*t68 + t7*t44), batch),  # 1, 3
+        xp.broadcast_to(t58*t64 - t41*t74 + t15*t66 - t18*t43, batch),  # 1, 4
+        xp.broadcast_to(-(-t59*t65 + t42*t75 + t88*t59 + t84*t42), batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-(c1*t82 + s1*t76), batch),  # 2, 1
-        xp.broadcast_to(-(-t16*t71 + t27*t70 + t78*t56 + t72*t60), batch),  # 2, 2
-        xp.broadcast_to(t4*t68 + t7*t69 - t79*t57 - t73*t61, batch),  # 2, 3
-        xp.broadcast_to(t18*t67 + t74*t62 - t29*t66 - t80*t58, batch),  # 2, 4
-        xp.broadcast_to(-(-t86*t59 + t81*t59 + t75*t63 + t84*t63), batch),  # 2, 5
+        xp.broadcast_to(-(s1*t76 + c1*t82), batch),  # 2, 1
+        xp.broadcast_to(-(t72*t60 + t78*t56 - t16*t71 + t27*t70), batch),  # 2, 2
+        xp.broadcast_to(-t61*t73 - t57*t79 + t7*t69 + t4*t68, batch),  # 2, 3
+        xp.broadcast_to(t62*t74 - t58*t80 + t18*t67 - t29*t66, batch),  # 2, 4
+        xp.broadcast_to(-(t63*t75 + t59*t81 + t84*t63 - t86*t59), batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(-t91, batch),  # 3, 1
         xp.broadcast_to(c2*t78 - s2*t90, batch),  # 3, 2
-        xp.broadcast_to(t4*t0 - t47*t79, batch),  # 3, 3
+        xp.broadcast_to(-t47*t79 + t4*t0, batch),  # 3, 3
         xp.broadcast_to(t15*t80 - t29*t64, batch),  # 3, 4
-        xp.broadcast_to(t31*t65 - t49*t81, batch),  # 3, 5
-        xp.broadcast_to(t33*t89 - t51*t87, batch),  # 3, 6
+        xp.broadcast_to(-t49*t81 + t31*t65, batch),  # 3, 5
+        xp.broadcast_to(-t51*t87 + t33*t89, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(-t90, batch),  # 4, 1
         xp.broadcast_to(s2*t91 + c2*t72, batch),  # 4, 2
         xp.broadcast_to(t7*t0 + t47*t73, batch),  # 4, 3
         xp.broadcast_to(t18*t64 - t15*t74, batch),  # 4, 4
         xp.broadcast_to(t20*t65 + t49*t75, batch),  # 4, 5
-        xp.broadcast_to(t51*t85 - t22*t89, batch),  # 4, 6
+        xp.broadcast_to(-t22*t89 + t51*t85, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
-        xp.broadcast_to(-(c1**2*t92 + s1**2*t92), batch),  # 5, 2
-        xp.broadcast_to(-(t7*t79 + t4*t73), batch),  # 5, 3
+        xp.broadcast_to(-(s1**2*t92 + c1**2*t92), batch),  # 5, 2
+        xp.broadcast_to(-(t4*t73 + t7*t79), batch),  # 5, 3
         xp.broadcast_to(t29*t74 - t18*t80, batch),  # 5, 4
-        xp.broadcast_to(-(t20*t81 + t31*t75), batch),  # 5, 5
-        xp.broadcast_to(t22*t87 - t33*t85, batch),  # 5, 6
+        xp.broadcast_to(-(t31*t75 + t20*t81), batch),  # 5, 5
+        xp.broadcast_to(-t33*t85 + t22*t87, batch),  # 5, 6
     ], (6, 7))
     return Jd
 
@@ -1259,10 +1259,10 @@ def bias_acceleration(q, q_dot):
     t40 = t4*t25 + t7*t36
     t41 = t18*t35 - t29*t24
     t42 = t20*t34 + t31*t23
-    t43 = qd5*t41 + qd6*t42
-    t44 = t43 + qd4*t40
-    t45 = t44 + qd3*t39
-    t46 = t45 - qd2*t38
+    t43 = t42*qd6 + t41*qd5
+    t44 = t43 + t40*qd4
+    t45 = t44 + t39*qd3
+    t46 = t45 - t38*qd2
     t47 = s3*s2
     t48 = t14*c5 + s5*t47
     t49 = -t14*s5 + c5*t47
@@ -1282,12 +1282,12 @@ def bias_acceleration(q, q_dot):
     t63 = t20*t52 + t49*t23
     t64 = t0 - t47*qd4
     t65 = t64 + t15*qd5
-    t66 = qd5*t58 + qd6*t59
-    t67 = qd5*t62 - qd6*t63
-    t68 = t66 + qd4*t57
-    t69 = t67 - qd4*t61
-    t70 = t68 + qd3*t56
-    t71 = t69 + qd3*t60
+    t66 = t59*qd6 + t58*qd5
+    t67 = -t63*qd6 + t62*qd5
+    t68 = t66 + t57*qd4
+    t69 = t67 - t61*qd4
+    t70 = t68 + t56*qd3
+    t71 = t69 + t60*qd3
     t72 = s1*qd2
     t73 = -t72 + t16*qd3
     t74 = t73 + t7*qd4
@@ -1309,12 +1309,12 @@ def bias_acceleration(q, q_dot):
     t90 = t55*qd1
     t91 = s2*qd2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(c1*t46 - s1*t90) + qd3*(-c2*t71 - qd1*t60 + t27*t45 + t78*t39) + qd4*(t0*t61 + t79*t40 - t4*t44 + t47*t69) + qd5*(t29*t43 + t80*t41 - t15*t67 - t64*t62) + qd6*(t65*t63 + t81*t42 - t86*t42 - t88*t63) - qd1*t77, batch),  # 0
-        xp.broadcast_to(qd1*t83 + qd2*(s1*t46 + c1*t90) + qd3*(c2*t70 + qd1*t56 + t72*t39 - t16*t45) - qd4*(-t0*t57 + t7*t44 + t73*t40 + t47*t68) + qd5*(t15*t66 + t64*t58 - t18*t43 - t74*t41) - qd6*(-t65*t59 + t75*t42 + t84*t42 + t88*t59), batch),  # 1
-        xp.broadcast_to(-qd2*(c1*t82 + s1*t76) - qd3*(-t16*t71 + t27*t70 + t78*t56 + t72*t60) + qd4*(t4*t68 + t7*t69 - t79*t57 - t73*t61) + qd5*(t18*t67 + t74*t62 - t29*t66 - t80*t58) - qd6*(-t86*t59 + t81*t59 + t75*t63 + t84*t63), batch),  # 2
-        xp.broadcast_to(qd3*(c2*t78 - t27*qd1) + qd4*(t4*t0 - t47*t79) + qd5*(t15*t80 - t29*t64) + qd6*(t31*t65 - t49*t81) + qd7*(t33*t89 - t51*t87) - t78*qd1, batch),  # 3
-        xp.broadcast_to(qd3*(t16*qd1 + c2*t72) + qd4*(t7*t0 + t47*t73) + qd5*(t18*t64 - t15*t74) + qd6*(t20*t65 + t49*t75) + qd7*(t51*t85 - t22*t89) - t72*qd1, batch),  # 4
-        xp.broadcast_to(-qd3*(c1**2*t91 + s1**2*t91) - qd4*(t7*t79 + t4*t73) + qd5*(t29*t74 - t18*t80) - qd6*(t20*t81 + t31*t75) + qd7*(t22*t87 - t33*t85), batch),  # 5
+        xp.broadcast_to(-qd1*t77 + qd2*(-s1*t90 + c1*t46) + qd3*(t78*t39 - t60*qd1 + t27*t45 - c2*t71) + qd4*(t40*t79 + t61*t0 - t4*t44 + t47*t69) + qd5*(t41*t80 - t62*t64 + t29*t43 - t15*t67) + qd6*(t42*t81 + t63*t65 - t86*t42 - t88*t63), batch),  # 0
+        xp.broadcast_to(qd1*t83 + qd2*(c1*t90 + s1*t46) + qd3*(t56*qd1 + t72*t39 + c2*t70 - t16*t45) - qd4*(-t57*t0 + t40*t73 + t47*t68 + t7*t44) + qd5*(t58*t64 - t41*t74 + t15*t66 - t18*t43) - qd6*(-t59*t65 + t42*t75 + t88*t59 + t84*t42), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t76 + c1*t82) - qd3*(t72*t60 + t78*t56 - t16*t71 + t27*t70) + qd4*(-t61*t73 - t57*t79 + t7*t69 + t4*t68) + qd5*(t62*t74 - t58*t80 + t18*t67 - t29*t66) - qd6*(t63*t75 + t59*t81 + t84*t63 - t86*t59), batch),  # 2
+        xp.broadcast_to(-t78*qd1 + qd3*(c2*t78 - t27*qd1) + qd4*(-t47*t79 + t4*t0) + qd5*(t15*t80 - t29*t64) + qd6*(-t49*t81 + t31*t65) + qd7*(-t51*t87 + t33*t89), batch),  # 3
+        xp.broadcast_to(-t72*qd1 + qd3*(t16*qd1 + c2*t72) + qd4*(t7*t0 + t47*t73) + qd5*(t18*t64 - t15*t74) + qd6*(t20*t65 + t49*t75) + qd7*(-t22*t89 + t51*t85), batch),  # 4
+        xp.broadcast_to(-qd3*(s1**2*t91 + c1**2*t91) - qd4*(t4*t73 + t7*t79) + qd5*(t29*t74 - t18*t80) - qd6*(t31*t75 + t20*t81) + qd7*(-t33*t85 + t22*t87), batch),  # 5
     ], (6,))
     return a
 
@@ -1387,10 +1387,10 @@ def task_jacobian_dot(q, q_dot):
     t40 = t3*t20 + t6*t35
     t41 = t11*t34 - t26*t19
     t42 = t13*t33 + t28*t18
-    t43 = qd5*t41 + qd6*t42
-    t44 = t43 + qd4*t40
-    t45 = t44 + qd3*t39
-    t46 = t45 - qd2*t38
+    t43 = t42*qd6 + t41*qd5
+    t44 = t43 + t40*qd4
+    t45 = t44 + t39*qd3
+    t46 = t45 - t38*qd2
     t47 = t22**2 + t37**2
     t48 = xp.sqrt(t47)
     t49 = c3*s2
@@ -1417,82 +1417,82 @@ def task_jacobian_dot(q, q_dot):
     t70 = t6*t62 + t20*t53
     t71 = t52*t19 - t11*t61
     t72 = t13*t60 + t55*t18
-    t73 = qd5*t67 + qd6*t68
-    t74 = qd5*t71 - qd6*t72
-    t75 = t73 + qd4*t66
-    t76 = t74 - qd4*t70
-    t77 = t75 + qd3*t65
-    t78 = t76 + qd3*t69
+    t73 = t68*qd6 + t67*qd5
+    t74 = -t72*qd6 + t71*qd5
+    t75 = t73 + t66*qd4
+    t76 = t74 - t70*qd4
+    t77 = t75 + t65*qd3
+    t78 = t76 + t69*qd3
     t79 = s1*qd2
     t80 = t78 + t63*t79
     t81 = t80 + t21*qd1
-    t82 = c2*t77 + qd1*t65 + t79*t39 - t8*t45
+    t82 = t65*qd1 + t79*t39 + c2*t77 - t8*t45
     t83 = t8*qd1 + c2*t79
     t84 = -t79 + t8*qd3
     t85 = t84
     t86 = c1*qd2
     t87 = t77 + t63*t86
     t88 = t87 - t36*qd1
-    t89 = -c2*t78 - qd1*t69 + t23*t45 + t86*t39
-    t90 = c1*t87 + s1*t80
-    t91 = t23*t77 + t86*t65 + t79*t69 - t8*t78
+    t89 = t86*t39 - t69*qd1 + t23*t45 - c2*t78
+    t90 = s1*t80 + c1*t87
+    t91 = t79*t69 + t86*t65 - t8*t78 + t23*t77
     t92 = c2*t86 - t23*qd1
     t93 = t86 + t23*qd3
     t94 = t93
-    t95 = t3*t75 + t6*t76 - t94*t66 - t85*t70
-    t96 = t6*t94 + t3*t85
+    t95 = -t70*t85 - t66*t94 + t6*t76 + t3*t75
+    t96 = t3*t85 + t6*t94
     t97 = qd1 + c2*qd3
     t98 = t97
-    t99 = t98*t70 + t94*t40 - t3*t44 + t53*t76
-    t100 = t6*t44 + t85*t40 - t98*t66 + t53*t75
-    t101 = t3*t98 - t53*t94
+    t99 = t40*t94 + t70*t98 - t3*t44 + t53*t76
+    t100 = -t66*t98 + t40*t85 + t53*t75 + t6*t44
+    t101 = -t53*t94 + t3*t98
     t102 = t6*t98 + t53*t85
     t103 = t6*qd4
     t104 = t85 + t103
     t105 = -t3*qd4
     t106 = t94 + t105
-    t107 = t11*t74 + t104*t71 - t26*t73 - t106*t67
+    t107 = t71*t104 - t67*t106 + t11*t74 - t26*t73
     t108 = t26*t104 - t11*t106
     t109 = -t53*qd4
     t110 = t98 + t109
-    t111 = t26*t43 + t106*t41 - t52*t74 - t110*t71
-    t112 = t52*t73 + t110*t67 - t11*t43 - t104*t41
+    t111 = t41*t106 - t71*t110 + t26*t43 - t52*t74
+    t112 = t67*t110 - t41*t104 + t52*t73 - t11*t43
     t113 = t52*t106 - t26*t110
     t114 = t11*t110 - t52*t104
     t115 = t11*qd5
     t116 = t104 + t115
     t117 = t26*qd5
     t118 = t106 + t117
-    t119 = t13*t118 + t28*t116
+    t119 = t28*t116 + t13*t118
     t120 = t52*qd5
     t121 = t110 + t120
-    t122 = t28*t121 - t55*t118
+    t122 = -t55*t118 + t28*t121
     t123 = t13*t121 + t55*t116
     t124 = t13*qd6
     t125 = t116 + t124
     t126 = t84 + t103 + t115 + t124 - t15*qd7
     t127 = t28*qd6
-    t128 = t118*t68 + t116*t72 + t124*t72 - t127*t68
+    t128 = t72*t116 + t68*t118 + t124*t72 - t127*t68
     t129 = -t127
     t130 = t118 + t129
-    t131 = t15*t130 - t30*t125
+    t131 = -t30*t125 + t15*t130
     t132 = t93 + t105 + t117 + t129 - t30*qd7
     t133 = t37*t126 - t22*t132
     t134 = t55*qd6
-    t135 = t121*t72 + t118*t42 - t127*t42 - t134*t72
-    t136 = t116*t42 - t121*t68 + t124*t42 + t134*t68
+    t135 = t42*t118 + t72*t121 - t127*t42 - t134*t72
+    t136 = -t68*t121 + t42*t116 + t134*t68 + t124*t42
     t137 = -t134
     t138 = t121 + t137
-    t139 = t30*t138 - t57*t130
-    t140 = t57*t125 - t15*t138
+    t139 = -t57*t130 + t30*t138
+    t140 = -t15*t138 + t57*t125
     t141 = t97 + t109 + t120 + t137 - t57*qd7
     t142 = t64*t132 - t37*t141
     t143 = t22*t141 - t64*t126
     t144 = t63*qd1
-    t145 = c1*t46 - s1*t144
-    t146 = s1*t46 + c1*t144
+    t145 = -s1*t144 + c1*t46
+    t146 = c1*t144 + s1*t46
     t147 = s2*qd2
-    t148 = c1**2*t147 + s1**2*t147
+    t148 = s1**2*t147 + c1**2*t147
     t149 = c1*t37
     t150 = s1*t22
     t151 = 1/t47
@@ -1520,36 +1520,36 @@ def task_jacobian_dot(q, q_dot):
     t173 = t151*qd1
     t174 = t157*t173
     t175 = t158*t173
-    t176 = t22*t151
-    t177 = t92*t176
-    t178 = t37*t151
-    t179 = t83*t178
-    t180 = 2*t159
-    t181 = t169*(t8 - t22*t180)
-    t182 = t171*(t23 - t37*t180)
-    t183 = t101*t176
-    t184 = t102*t178
-    t185 = 2*t153
-    t186 = t169*(t6 - t22*t185)
-    t187 = -t171*(t3 + t37*t185)
-    t188 = t113*t176
-    t189 = t114*t178
-    t190 = 2*t154
-    t191 = t169*(t11 - t22*t190)
-    t192 = t171*(t26 - t37*t190)
-    t193 = t122*t176
-    t194 = t123*t178
-    t195 = 2*t155
-    t196 = t169*(t13 - t22*t195)
-    t197 = -t171*(t28 + t37*t195)
-    t198 = t139*t176
-    t199 = t140*t178
-    t200 = 2*t156
-    t201 = -t169*(t15 + t22*t200)
-    t202 = -t171*(t30 + t37*t200)
+    t176 = 2*t159
+    t177 = t169*(t8 - t22*t176)
+    t178 = t171*(t23 - t37*t176)
+    t179 = t22*t151
+    t180 = t92*t179
+    t181 = t37*t151
+    t182 = t83*t181
+    t183 = 2*t153
+    t184 = t169*(t6 - t22*t183)
+    t185 = -t171*(t3 + t37*t183)
+    t186 = t101*t179
+    t187 = t102*t181
+    t188 = 2*t154
+    t189 = t169*(t11 - t22*t188)
+    t190 = t171*(t26 - t37*t188)
+    t191 = t113*t179
+    t192 = t114*t181
+    t193 = 2*t155
+    t194 = t169*(t13 - t22*t193)
+    t195 = -t171*(t28 + t37*t193)
+    t196 = t122*t179
+    t197 = t123*t181
+    t198 = 2*t156
+    t199 = -t169*(t15 + t22*t198)
+    t200 = -t171*(t30 + t37*t198)
+    t201 = t139*t179
+    t202 = t140*t181
     t203 = qd1*t160
-    t204 = t22*t160
-    t205 = t37*t160
+    t204 = t37*t160
+    t205 = t22*t160
     Jd = _stack(xp, [
         xp.broadcast_to(-t81, batch),  # 0, 0
         xp.broadcast_to(t145, batch),  # 0, 1
@@ -1574,25 +1574,25 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t170 + t172 - t174 - t175, batch),  # 3, 1
-        xp.broadcast_to(t177 + t179 + t181 + t182, batch),  # 3, 2
-        xp.broadcast_to(t183 + t184 + t186 + t187, batch),  # 3, 3
-        xp.broadcast_to(t188 + t189 + t191 + t192, batch),  # 3, 4
-        xp.broadcast_to(t193 + t194 + t196 + t197, batch),  # 3, 5
-        xp.broadcast_to(t198 + t199 + t201 + t202, batch),  # 3, 6
+        xp.broadcast_to(t177 + t178 + t180 + t182, batch),  # 3, 2
+        xp.broadcast_to(t184 + t185 + t186 + t187, batch),  # 3, 3
+        xp.broadcast_to(t189 + t190 + t191 + t192, batch),  # 3, 4
+        xp.broadcast_to(t194 + t195 + t196 + t197, batch),  # 3, 5
+        xp.broadcast_to(t199 + t200 + t201 + t202, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t142*(c1*t160 - t22*t162) + t143*(s1*t160 - t37*t162) + t149*t203 - t150*t203, batch),  # 4, 1
-        xp.broadcast_to(t142*(-t22*t163 + t23*t160) - t143*(t37*t163 + t8*t160) + t83*t204 - t92*t205, batch),  # 4, 2
-        xp.broadcast_to(-t142*(t22*t164 + t3*t160) - t143*(t37*t164 + t6*t160) + t102*t204 - t101*t205, batch),  # 4, 3
-        xp.broadcast_to(t142*(t26*t160 - t22*t165) - t143*(t37*t165 + t11*t160) + t114*t204 - t113*t205, batch),  # 4, 4
-        xp.broadcast_to(-t142*(t22*t166 + t28*t160) - t143*(t37*t166 + t13*t160) + t123*t204 - t122*t205, batch),  # 4, 5
-        xp.broadcast_to(-t142*(t22*t167 + t30*t160) + t143*(t15*t160 - t37*t167) + t140*t204 - t139*t205, batch),  # 4, 6
+        xp.broadcast_to(t142*(t23*t160 - t22*t163) - t143*(t8*t160 + t37*t163) - t92*t204 + t83*t205, batch),  # 4, 2
+        xp.broadcast_to(-t142*(t3*t160 + t22*t164) - t143*(t6*t160 + t37*t164) - t101*t204 + t102*t205, batch),  # 4, 3
+        xp.broadcast_to(t142*(t26*t160 - t22*t165) - t143*(t11*t160 + t37*t165) - t113*t204 + t114*t205, batch),  # 4, 4
+        xp.broadcast_to(-t142*(t28*t160 + t22*t166) - t143*(t13*t160 + t37*t166) - t122*t204 + t123*t205, batch),  # 4, 5
+        xp.broadcast_to(-t142*(t30*t160 + t22*t167) + t143*(t15*t160 - t37*t167) - t139*t204 + t140*t205, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(t152*t133 + t64*t170 + t64*t172 - t64*t174 - t64*t175), batch),  # 5, 1
-        xp.broadcast_to(-(t148 + t159*t133 + t64*t177 + t64*t179 + t64*t181 + t64*t182), batch),  # 5, 2
-        xp.broadcast_to(-(t96 + t153*t133 + t64*t183 + t64*t184 + t64*t186 + t64*t187), batch),  # 5, 3
-        xp.broadcast_to(-(-t108 + t154*t133 + t64*t188 + t64*t189 + t64*t191 + t64*t192), batch),  # 5, 4
-        xp.broadcast_to(-(t119 + t155*t133 + t64*t193 + t64*t194 + t64*t196 + t64*t197), batch),  # 5, 5
-        xp.broadcast_to(-(-t131 + t156*t133 + t64*t198 + t64*t199 + t64*t201 + t64*t202), batch),  # 5, 6
+        xp.broadcast_to(-(t64*t170 + t64*t172 + t133*t152 - t64*t174 - t64*t175), batch),  # 5, 1
+        xp.broadcast_to(-(t148 + t64*t177 + t64*t178 + t133*t159 + t64*t180 + t64*t182), batch),  # 5, 2
+        xp.broadcast_to(-(t96 + t64*t184 + t64*t185 + t133*t153 + t64*t186 + t64*t187), batch),  # 5, 3
+        xp.broadcast_to(-(-t108 + t64*t189 + t64*t190 + t133*t154 + t64*t191 + t64*t192), batch),  # 5, 4
+        xp.broadcast_to(-(t119 + t64*t194 + t64*t195 + t133*t155 + t64*t196 + t64*t197), batch),  # 5, 5
+        xp.broadcast_to(-(-t131 + t64*t199 + t64*t200 + t133*t156 + t64*t201 + t64*t202), batch),  # 5, 6
     ], (6, 7))
     return Jd
 
@@ -1684,28 +1684,28 @@ def hessian(q):
     t68 = s1*t34
     t69 = s1*t35
     t70 = s1*t36
-    t71 = c1**2
-    t72 = s1**2
-    t73 = -(c1*t57 + s1*t59)
+    t71 = s1**2
+    t72 = c1**2
+    t73 = -(s1*t59 + c1*t57)
     t74 = s1*t53 - c1*t50
-    t75 = -(c1*t51 + s1*t54)
+    t75 = -(s1*t54 + c1*t51)
     t76 = s1*t55 - c1*t52
-    t77 = c2*t53 + t20*t34
-    t78 = -c2*t54 + t20*t35
-    t79 = c2*t55 + t20*t36
+    t77 = t20*t34 + c2*t53
+    t78 = t20*t35 - c2*t54
+    t79 = t20*t36 + c2*t55
     t80 = c2*t50 - t8*t34
     t81 = c2*t51 - t8*t35
     t82 = c2*t52 - t8*t36
-    t83 = -(t20*t50 + t8*t53)
+    t83 = -(t8*t53 + t20*t50)
     t84 = t8*t54 - t20*t51
-    t85 = -(t20*t52 + t8*t55)
+    t85 = -(t8*t55 + t20*t52)
     t86 = s2**2
     t87 = -t3*t35 + t41*t54
     t88 = -(t3*t36 + t41*t55)
-    t89 = -(t6*t35 + t41*t51)
-    t90 = -(t6*t36 + t41*t52)
+    t89 = -(t41*t51 + t6*t35)
+    t90 = -(t41*t52 + t6*t36)
     t91 = t6*t54 + t3*t51
-    t92 = t3*t52 - t6*t55
+    t92 = -t6*t55 + t3*t52
     t93 = t23*t36 + t40*t55
     t94 = t40*t52 - t11*t36
     t95 = -(t11*t55 + t23*t52)
@@ -1791,12 +1791,12 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 1
         -(t71*s2 + t72*s2),  # 1, 5, 2
         s1*t3 - c1*t6,  # 1, 5, 3
-        -(c1*t11 + s1*t23),  # 1, 5, 4
+        -(s1*t23 + c1*t11),  # 1, 5, 4
         s1*t25 - c1*t13,  # 1, 5, 5
-        c1*t15 + s1*t27,  # 1, 5, 6
+        s1*t27 + c1*t15,  # 1, 5, 6
         t61,  # 2, 0, 0
         t63,  # 2, 0, 1
-        -c2*t59 + t20*t33,  # 2, 0, 2
+        t20*t33 - c2*t59,  # 2, 0, 2
         t77,  # 2, 0, 3
         t78,  # 2, 0, 4
         t79,  # 2, 0, 5
@@ -1818,10 +1818,10 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 2
-        c2*t3 - t0*t86,  # 2, 3, 3
-        -c2*t23 + t40*t20,  # 2, 3, 4
-        c2*t25 - t43*t20,  # 2, 3, 5
-        c2*t27 - t45*t20,  # 2, 3, 6
+        -t0*t86 + c2*t3,  # 2, 3, 3
+        t40*t20 - c2*t23,  # 2, 3, 4
+        -t43*t20 + c2*t25,  # 2, 3, 5
+        -t45*t20 + c2*t27,  # 2, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 2
@@ -1832,10 +1832,10 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 2
-        -(t6*t20 + t3*t8),  # 2, 5, 3
+        -(t3*t8 + t6*t20),  # 2, 5, 3
         t23*t8 - t11*t20,  # 2, 5, 4
-        -(t13*t20 + t25*t8),  # 2, 5, 5
-        t15*t20 - t27*t8,  # 2, 5, 6
+        -(t25*t8 + t13*t20),  # 2, 5, 5
+        -t27*t8 + t15*t20,  # 2, 5, 6
         t53,  # 3, 0, 0
         t64,  # 3, 0, 1
         t77,  # 3, 0, 2
@@ -1846,14 +1846,14 @@ def hessian(q):
         t50,  # 3, 1, 0
         t68,  # 3, 1, 1
         t80,  # 3, 1, 2
-        -(t6*t34 + t41*t50),  # 3, 1, 3
+        -(t41*t50 + t6*t34),  # 3, 1, 3
         t89,  # 3, 1, 4
         t90,  # 3, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 0
         t74,  # 3, 2, 1
         t83,  # 3, 2, 2
-        t3*t50 - t6*t53,  # 3, 2, 3
+        -t6*t53 + t3*t50,  # 3, 2, 3
         t91,  # 3, 2, 4
         t92,  # 3, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 6
@@ -1868,16 +1868,16 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        -(t6*t40 + t11*t41),  # 3, 4, 4
-        t6*t43 - t13*t41,  # 3, 4, 5
-        t6*t45 + t15*t41,  # 3, 4, 6
+        -(t11*t41 + t6*t40),  # 3, 4, 4
+        -t13*t41 + t6*t43,  # 3, 4, 5
+        t15*t41 + t6*t45,  # 3, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 3
-        t3*t11 + t6*t23,  # 3, 5, 4
-        t3*t13 - t6*t25,  # 3, 5, 5
-        -(t3*t15 + t6*t27),  # 3, 5, 6
+        t6*t23 + t3*t11,  # 3, 5, 4
+        -t6*t25 + t3*t13,  # 3, 5, 5
+        -(t6*t27 + t3*t15),  # 3, 5, 6
         t62,  # 4, 0, 0
         t65,  # 4, 0, 1
         t78,  # 4, 0, 2
@@ -1904,22 +1904,22 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 4
-        t40*t25 - t23*t43,  # 4, 3, 5
-        t40*t27 - t23*t45,  # 4, 3, 6
+        -t23*t43 + t40*t25,  # 4, 3, 5
+        -t23*t45 + t40*t27,  # 4, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        t11*t43 + t40*t13,  # 4, 4, 5
-        t11*t45 - t40*t15,  # 4, 4, 6
+        t40*t13 + t11*t43,  # 4, 4, 5
+        -t40*t15 + t11*t45,  # 4, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 4
         -(t11*t25 + t23*t13),  # 4, 5, 5
-        t23*t15 - t11*t27,  # 4, 5, 6
+        -t11*t27 + t23*t15,  # 4, 5, 6
         t55,  # 5, 0, 0
         t66,  # 5, 0, 1
         t79,  # 5, 0, 2
@@ -1932,14 +1932,14 @@ def hessian(q):
         t82,  # 5, 1, 2
         t90,  # 5, 1, 3
         t94,  # 5, 1, 4
-        -(t13*t36 + t43*t52),  # 5, 1, 5
+        -(t43*t52 + t13*t36),  # 5, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2, 0
         t76,  # 5, 2, 1
         t85,  # 5, 2, 2
         t92,  # 5, 2, 3
         t95,  # 5, 2, 4
-        t25*t52 - t13*t55,  # 5, 2, 5
+        -t13*t55 + t25*t52,  # 5, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3, 1
@@ -1954,7 +1954,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4, 5
-        t13*t45 + t43*t15,  # 5, 4, 6
+        t43*t15 + t13*t45,  # 5, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5, 2
@@ -2083,118 +2083,118 @@ def singularity_factors(q):
     t56 = t6*t49 + t24*t42
     t57 = t14*t23 - t17*t48
     t58 = t19*t47 + t44*t22
-    t59 = t3*t44 - t30*t42
-    t60 = c1*t6
-    t61 = s2*t5
-    t62 = -(s1*t59 - t44*t60 + t19*t61)
-    t63 = -t3*t14 + t28*t42
-    t64 = t14*t30 - t28*t44
-    t65 = t19*t63 + t6*t64 - t17*t59
-    t66 = c1*t17
-    t67 = c1*t19
-    t68 = -s1*t64 + t44*t66 + t14*t67
-    t69 = -(s1*t63 + t14*t60 + t17*t61)
-    t70 = -(-t62*t40 + t37*t65 + t39*t68 + t41*t69)
-    t71 = c2*t30 - t44*t26
-    t72 = c1**2
-    t73 = t72*s2
-    t74 = -s1*t71 + c2*t67 + t44*t73
-    t75 = -c2*t28 + t14*t26
-    t76 = t19*t75 - t17*t71 + t15*t64
-    t77 = -(s1*t75 - c2*t66 + t14*t73)
-    t78 = -(-t74*t40 + t37*t76 + t38*t68 + t41*t77)
-    t79 = s2**2
-    t80 = c2*t3 - t0*t79
-    t81 = t19*t80 - t6*t71 + t15*t59
-    t82 = -s1*t80 + c2*t60 + s3*t72*t79
-    t83 = -(-t74*t39 + t37*t81 + t38*t62 + t41*t82)
-    t84 = t17*t80 - t6*t75 + t15*t63
-    t85 = -(-t77*t39 + t37*t84 + t38*t69 + t40*t82)
-    t86 = t38*t65 + t40*t81 - t76*t39 - t41*t84
-    t87 = s1*t50
-    t88 = -(t17*t30 + t28*t19)
-    t89 = s1*t30 - t67
-    t90 = -(t66 + s1*t28)
-    t91 = t37*t88 + t40*t89 - t41*t90
-    t92 = -(t19*t26 + t30*t15)
-    t93 = -(t73 + s1**2*s2)
-    t94 = t37*t92 + t38*t89 - t41*t93
-    t95 = t28*t15 - t17*t26
-    t96 = t37*t95 + t38*t90 - t40*t93
-    t97 = -(-t40*t92 + t38*t88 + t41*t95)
-    t98 = t3*t17 + t6*t28
-    t99 = s1*t3 - t60
-    t100 = t37*t98 + t39*t90 - t40*t99
-    t101 = -(t6*t26 + t3*t15)
-    t102 = t37*t101 + t38*t99 - t39*t93
-    t103 = -(-t39*t95 + t38*t98 + t40*t101)
-    t104 = t3*t19 - t6*t30
-    t105 = t37*t104 + t39*t89 - t41*t99
-    t106 = -(-t40*t104 + t39*t88 + t41*t98)
-    t107 = -(-t39*t92 + t38*t104 + t41*t101)
+    t59 = -(t17*t30 + t28*t19)
+    t60 = c1*t19
+    t61 = s1*t30 - t60
+    t62 = c1*t17
+    t63 = -(s1*t28 + t62)
+    t64 = t59*t37 + t61*t40 - t63*t41
+    t65 = -t44*t26 + c2*t30
+    t66 = c1**2
+    t67 = t66*s2
+    t68 = -s1*t65 + c2*t60 + t44*t67
+    t69 = t14*t26 - c2*t28
+    t70 = -t28*t44 + t14*t30
+    t71 = t19*t69 - t17*t65 + t15*t70
+    t72 = -s1*t70 + t44*t62 + t14*t60
+    t73 = -(s1*t69 - c2*t62 + t14*t67)
+    t74 = -(-t68*t40 + t37*t71 + t38*t72 + t41*t73)
+    t75 = -(t30*t15 + t19*t26)
+    t76 = -(s1**2*s2 + t67)
+    t77 = t75*t37 + t61*t38 - t76*t41
+    t78 = t28*t15 - t17*t26
+    t79 = t78*t37 + t63*t38 - t76*t40
+    t80 = -(-t75*t40 + t59*t38 + t78*t41)
+    t81 = s1*t50
+    t82 = t6*t28 + t3*t17
+    t83 = c1*t6
+    t84 = s1*t3 - t83
+    t85 = t82*t37 + t63*t39 - t84*t40
+    t86 = -(t3*t15 + t6*t26)
+    t87 = t86*t37 + t84*t38 - t76*t39
+    t88 = s2**2
+    t89 = -t0*t88 + c2*t3
+    t90 = -t3*t14 + t28*t42
+    t91 = t17*t89 - t6*t69 + t15*t90
+    t92 = s2*t5
+    t93 = -(s1*t90 + t14*t83 + t17*t92)
+    t94 = -s1*t89 + c2*t83 + s3*t66*t88
+    t95 = -(-t73*t39 + t37*t91 + t38*t93 + t40*t94)
+    t96 = -(-t78*t39 + t82*t38 + t86*t40)
+    t97 = t3*t44 - t30*t42
+    t98 = -(s1*t97 - t44*t83 + t19*t92)
+    t99 = t19*t90 + t6*t70 - t17*t97
+    t100 = -(-t98*t40 + t37*t99 + t72*t39 + t41*t93)
+    t101 = t19*t89 - t6*t65 + t15*t97
+    t102 = -(-t68*t39 + t37*t101 + t38*t98 + t41*t94)
+    t103 = t38*t99 + t40*t101 - t71*t39 - t91*t41
+    t104 = -t6*t30 + t3*t19
+    t105 = t104*t37 + t61*t39 - t84*t41
+    t106 = -(-t104*t40 + t59*t39 + t82*t41)
+    t107 = -(-t75*t39 + t104*t38 + t86*t41)
     t108 = c1*t50
-    t109 = -t36*(t55*t70 + t56*t78 + t57*t83 + t58*t85 - t86*t87) - t52*(-t25*t78 - t55*t91 + t57*t94 + t58*t96 + t87*t97) + t54*(t25*t85 + t55*t100 + t56*t96 + t57*t102 - t87*t103) + t51*(-t25*t70 + t56*t91 + t57*t105 + t58*t100 + t87*t106) - t53*(t25*t83 + t55*t105 + t56*t94 - t58*t102 - t87*t107) - t108*(-t25*t86 + t55*t106 + t56*t97 + t57*t107 + t58*t103)
-    t110 = t3*t46 - t32*t42
-    t111 = -s1*t110 + t46*t60 + t21*t61
-    t112 = t14*t32 - t28*t46
-    t113 = -(-t6*t112 + t17*t110 + t21*t63)
-    t114 = c1*t21
-    t115 = -(s1*t112 - t46*t66 + t14*t114)
-    t116 = -(-t40*t111 + t37*t113 + t39*t115)
-    t117 = c2*t32 - t46*t26
-    t118 = -(s1*t117 - t46*t73 + c2*t114)
-    t119 = -(t17*t117 + t21*t75 - t15*t112)
-    t120 = -(-t40*t118 + t37*t119 + t38*t115)
-    t121 = -(t21*t80 + t6*t117 - t15*t110)
-    t122 = -(-t39*t118 + t37*t121 + t38*t111)
-    t123 = t38*t113 + t40*t121 - t39*t119
-    t124 = -(t55*t116 + t56*t120 + t57*t122 - t87*t123)
-    t125 = t28*t21 - t17*t32
-    t126 = t114 + s1*t32
-    t127 = t37*t125 + t40*t126
-    t128 = t21*t26 - t32*t15
-    t129 = t37*t128 + t38*t126
-    t130 = t40*t128 - t38*t125
-    t131 = t25*t120 + t55*t127 - t57*t129 - t87*t130
-    t132 = -(t3*t21 + t6*t32)
-    t133 = t37*t132 + t39*t126
-    t134 = t40*t132 - t39*t125
-    t135 = -(-t25*t116 + t56*t127 + t57*t133 + t87*t134)
-    t136 = t39*t128 - t38*t132
-    t137 = t25*t122 + t55*t133 + t56*t129 - t87*t136
-    t138 = -(-t25*t123 + t55*t134 + t56*t130 + t57*t136)
-    t139 = t36*t124 + t52*t131 - t51*t135 - t53*t137 + t108*t138
-    t140 = t30*t46 - t44*t32
-    t141 = -(-t6*t140 + t19*t110 + t21*t59)
-    t142 = -s1*t140 + t46*t67 + t44*t114
-    t143 = -(-t41*t111 + t37*t141 + t39*t142)
-    t144 = -(t19*t117 + t21*t71 - t15*t140)
-    t145 = -(-t41*t118 + t37*t144 + t38*t142)
-    t146 = t38*t141 + t41*t121 - t39*t144
-    t147 = t58*t122 - t55*t143 - t56*t145 + t87*t146
-    t148 = -(t19*t32 + t30*t21)
-    t149 = t37*t148 + t41*t126
-    t150 = t41*t128 - t38*t148
-    t151 = t25*t145 + t55*t149 + t58*t129 - t87*t150
-    t152 = t41*t132 - t39*t148
-    t153 = t25*t143 + t58*t133 - t56*t149 - t87*t152
-    t154 = t25*t146 + t58*t136 - t55*t152 - t56*t150
-    t155 = t36*t147 + t52*t151 - t51*t153 - t54*t137 + t108*t154
-    t156 = -(-t17*t140 + t19*t112 + t21*t64)
-    t157 = -(-t41*t115 + t37*t156 + t40*t142)
-    t158 = t38*t156 + t41*t119 - t40*t144
-    t159 = t57*t145 + t58*t120 - t55*t157 + t87*t158
-    t160 = t41*t125 - t40*t148
-    t161 = t25*t157 + t57*t149 + t58*t127 - t87*t160
-    t162 = t25*t158 + t57*t150 + t58*t130 - t55*t160
-    t163 = t36*t159 + t53*t151 - t51*t161 - t54*t131 + t108*t162
-    t164 = t39*t156 + t41*t113 - t40*t141
-    t165 = t56*t157 + t57*t143 + t58*t116 + t87*t164
-    t166 = t25*t164 + t56*t160 + t57*t152 + t58*t134
-    t167 = t36*t165 + t53*t153 - t52*t161 - t54*t135 + t108*t166
-    t168 = t55*t164 + t56*t158 + t57*t146 + t58*t123
-    t169 = t36*t168 + t51*t166 + t53*t154 - t52*t162 - t54*t138
-    t170 = t52*t159 + t54*t124 - t51*t165 - t53*t147 + t108*t168
+    t109 = -t52*(-t64*t55 - t25*t74 + t57*t77 + t58*t79 + t80*t81) + t54*(t55*t85 + t79*t56 + t57*t87 + t25*t95 - t81*t96) - t36*(t55*t100 + t74*t56 + t57*t102 + t58*t95 - t81*t103) + t51*(-t25*t100 + t64*t56 + t57*t105 + t58*t85 + t81*t106) - t53*(t55*t105 + t77*t56 + t25*t102 - t87*t58 - t81*t107) - t108*(-t25*t103 + t55*t106 + t80*t56 + t57*t107 + t58*t96)
+    t110 = -t17*t32 + t28*t21
+    t111 = c1*t21
+    t112 = s1*t32 + t111
+    t113 = t110*t37 + t112*t40
+    t114 = -t46*t26 + c2*t32
+    t115 = -(s1*t114 - t46*t67 + c2*t111)
+    t116 = -t28*t46 + t14*t32
+    t117 = -(t17*t114 + t21*t69 - t15*t116)
+    t118 = -(s1*t116 - t46*t62 + t14*t111)
+    t119 = -(-t115*t40 + t37*t117 + t38*t118)
+    t120 = -t32*t15 + t21*t26
+    t121 = t120*t37 + t112*t38
+    t122 = t120*t40 - t110*t38
+    t123 = t55*t113 + t25*t119 - t121*t57 - t81*t122
+    t124 = t3*t46 - t32*t42
+    t125 = -s1*t124 + t46*t83 + t21*t92
+    t126 = -(-t6*t116 + t17*t124 + t21*t90)
+    t127 = -(-t40*t125 + t37*t126 + t39*t118)
+    t128 = -(t21*t89 + t6*t114 - t15*t124)
+    t129 = -(-t115*t39 + t37*t128 + t38*t125)
+    t130 = t38*t126 + t40*t128 - t117*t39
+    t131 = -(t55*t127 + t56*t119 + t57*t129 - t81*t130)
+    t132 = -(t6*t32 + t3*t21)
+    t133 = t132*t37 + t112*t39
+    t134 = t132*t40 - t110*t39
+    t135 = -(-t25*t127 + t56*t113 + t57*t133 + t81*t134)
+    t136 = t120*t39 - t38*t132
+    t137 = t55*t133 + t56*t121 + t25*t129 - t81*t136
+    t138 = -(-t25*t130 + t55*t134 + t56*t122 + t57*t136)
+    t139 = t52*t123 + t36*t131 - t51*t135 - t53*t137 + t108*t138
+    t140 = -(t19*t32 + t30*t21)
+    t141 = t140*t37 + t112*t41
+    t142 = t30*t46 - t44*t32
+    t143 = -(t19*t114 + t21*t65 - t15*t142)
+    t144 = -s1*t142 + t46*t60 + t44*t111
+    t145 = -(-t115*t41 + t37*t143 + t38*t144)
+    t146 = t120*t41 - t38*t140
+    t147 = t55*t141 + t58*t121 + t25*t145 - t81*t146
+    t148 = -(-t6*t142 + t19*t124 + t21*t97)
+    t149 = -(-t41*t125 + t37*t148 + t39*t144)
+    t150 = t38*t148 + t41*t128 - t39*t143
+    t151 = t58*t129 - t55*t149 - t56*t145 + t81*t150
+    t152 = t132*t41 - t39*t140
+    t153 = t58*t133 + t25*t149 - t56*t141 - t81*t152
+    t154 = t58*t136 + t25*t150 - t55*t152 - t56*t146
+    t155 = t52*t147 + t36*t151 - t51*t153 - t54*t137 + t108*t154
+    t156 = -(-t17*t142 + t19*t116 + t21*t70)
+    t157 = -(-t118*t41 + t37*t156 + t40*t144)
+    t158 = t38*t156 + t41*t117 - t40*t143
+    t159 = t57*t145 + t58*t119 - t55*t157 + t81*t158
+    t160 = t110*t41 - t40*t140
+    t161 = t57*t141 + t58*t113 + t25*t157 - t81*t160
+    t162 = t57*t146 + t58*t122 + t25*t158 - t55*t160
+    t163 = t53*t147 + t36*t159 - t51*t161 - t54*t123 + t108*t162
+    t164 = t39*t156 + t41*t126 - t40*t148
+    t165 = t56*t157 + t57*t149 + t58*t127 + t81*t164
+    t166 = t56*t160 + t57*t152 + t58*t134 + t25*t164
+    t167 = t53*t153 + t36*t165 - t52*t161 - t54*t135 + t108*t166
+    t168 = t55*t164 + t56*t158 + t57*t150 + t58*t130
+    t169 = t51*t166 + t53*t154 + t36*t168 - t52*t162 - t54*t138
+    t170 = t52*t159 + t54*t131 - t51*t165 - t53*t151 + t108*t168
     f = _stack(xp, [
         t109**2 + t139**2 + t155**2 + t163**2 + t167**2 + t169**2 + t170**2,  # 0
     ], (1,))
@@ -2276,118 +2276,118 @@ def manipulability(q):
     t56 = t6*t49 + t24*t42
     t57 = t14*t23 - t17*t48
     t58 = t19*t47 + t44*t22
-    t59 = t3*t44 - t30*t42
-    t60 = c1*t6
-    t61 = s2*t5
-    t62 = -(s1*t59 - t44*t60 + t19*t61)
-    t63 = -t3*t14 + t28*t42
-    t64 = t14*t30 - t28*t44
-    t65 = t19*t63 + t6*t64 - t17*t59
-    t66 = c1*t17
-    t67 = c1*t19
-    t68 = -s1*t64 + t44*t66 + t14*t67
-    t69 = -(s1*t63 + t14*t60 + t17*t61)
-    t70 = -(-t62*t40 + t37*t65 + t39*t68 + t41*t69)
-    t71 = c2*t30 - t44*t26
-    t72 = c1**2
-    t73 = t72*s2
-    t74 = -s1*t71 + c2*t67 + t44*t73
-    t75 = -c2*t28 + t14*t26
-    t76 = t19*t75 - t17*t71 + t15*t64
-    t77 = -(s1*t75 - c2*t66 + t14*t73)
-    t78 = -(-t74*t40 + t37*t76 + t38*t68 + t41*t77)
-    t79 = s2**2
-    t80 = c2*t3 - t0*t79
-    t81 = t19*t80 - t6*t71 + t15*t59
-    t82 = -s1*t80 + c2*t60 + s3*t72*t79
-    t83 = -(-t74*t39 + t37*t81 + t38*t62 + t41*t82)
-    t84 = t17*t80 - t6*t75 + t15*t63
-    t85 = -(-t77*t39 + t37*t84 + t38*t69 + t40*t82)
-    t86 = t38*t65 + t40*t81 - t76*t39 - t41*t84
-    t87 = s1*t50
-    t88 = -(t17*t30 + t28*t19)
-    t89 = s1*t30 - t67
-    t90 = -(t66 + s1*t28)
-    t91 = t37*t88 + t40*t89 - t41*t90
-    t92 = -(t19*t26 + t30*t15)
-    t93 = -(t73 + s1**2*s2)
-    t94 = t37*t92 + t38*t89 - t41*t93
-    t95 = t28*t15 - t17*t26
-    t96 = t37*t95 + t38*t90 - t40*t93
-    t97 = -(-t40*t92 + t38*t88 + t41*t95)
-    t98 = t3*t17 + t6*t28
-    t99 = s1*t3 - t60
-    t100 = t37*t98 + t39*t90 - t40*t99
-    t101 = -(t6*t26 + t3*t15)
-    t102 = t37*t101 + t38*t99 - t39*t93
-    t103 = -(-t39*t95 + t38*t98 + t40*t101)
-    t104 = t3*t19 - t6*t30
-    t105 = t37*t104 + t39*t89 - t41*t99
-    t106 = -(-t40*t104 + t39*t88 + t41*t98)
-    t107 = -(-t39*t92 + t38*t104 + t41*t101)
+    t59 = -(t17*t30 + t28*t19)
+    t60 = c1*t19
+    t61 = s1*t30 - t60
+    t62 = c1*t17
+    t63 = -(s1*t28 + t62)
+    t64 = t59*t37 + t61*t40 - t63*t41
+    t65 = -t44*t26 + c2*t30
+    t66 = c1**2
+    t67 = t66*s2
+    t68 = -s1*t65 + c2*t60 + t44*t67
+    t69 = t14*t26 - c2*t28
+    t70 = -t28*t44 + t14*t30
+    t71 = t19*t69 - t17*t65 + t15*t70
+    t72 = -s1*t70 + t44*t62 + t14*t60
+    t73 = -(s1*t69 - c2*t62 + t14*t67)
+    t74 = -(-t68*t40 + t37*t71 + t38*t72 + t41*t73)
+    t75 = -(t30*t15 + t19*t26)
+    t76 = -(s1**2*s2 + t67)
+    t77 = t75*t37 + t61*t38 - t76*t41
+    t78 = t28*t15 - t17*t26
+    t79 = t78*t37 + t63*t38 - t76*t40
+    t80 = -(-t75*t40 + t59*t38 + t78*t41)
+    t81 = s1*t50
+    t82 = t6*t28 + t3*t17
+    t83 = c1*t6
+    t84 = s1*t3 - t83
+    t85 = t82*t37 + t63*t39 - t84*t40
+    t86 = -(t3*t15 + t6*t26)
+    t87 = t86*t37 + t84*t38 - t76*t39
+    t88 = s2**2
+    t89 = -t0*t88 + c2*t3
+    t90 = -t3*t14 + t28*t42
+    t91 = t17*t89 - t6*t69 + t15*t90
+    t92 = s2*t5
+    t93 = -(s1*t90 + t14*t83 + t17*t92)
+    t94 = -s1*t89 + c2*t83 + s3*t66*t88
+    t95 = -(-t73*t39 + t37*t91 + t38*t93 + t40*t94)
+    t96 = -(-t78*t39 + t82*t38 + t86*t40)
+    t97 = t3*t44 - t30*t42
+    t98 = -(s1*t97 - t44*t83 + t19*t92)
+    t99 = t19*t90 + t6*t70 - t17*t97
+    t100 = -(-t98*t40 + t37*t99 + t72*t39 + t41*t93)
+    t101 = t19*t89 - t6*t65 + t15*t97
+    t102 = -(-t68*t39 + t37*t101 + t38*t98 + t41*t94)
+    t103 = t38*t99 + t40*t101 - t71*t39 - t91*t41
+    t104 = -t6*t30 + t3*t19
+    t105 = t104*t37 + t61*t39 - t84*t41
+    t106 = -(-t104*t40 + t59*t39 + t82*t41)
+    t107 = -(-t75*t39 + t104*t38 + t86*t41)
     t108 = c1*t50
-    t109 = -t36*(t55*t70 + t56*t78 + t57*t83 + t58*t85 - t86*t87) - t52*(-t25*t78 - t55*t91 + t57*t94 + t58*t96 + t87*t97) + t54*(t25*t85 + t55*t100 + t56*t96 + t57*t102 - t87*t103) + t51*(-t25*t70 + t56*t91 + t57*t105 + t58*t100 + t87*t106) - t53*(t25*t83 + t55*t105 + t56*t94 - t58*t102 - t87*t107) - t108*(-t25*t86 + t55*t106 + t56*t97 + t57*t107 + t58*t103)
-    t110 = t3*t46 - t32*t42
-    t111 = -s1*t110 + t46*t60 + t21*t61
-    t112 = t14*t32 - t28*t46
-    t113 = -(-t6*t112 + t17*t110 + t21*t63)
-    t114 = c1*t21
-    t115 = -(s1*t112 - t46*t66 + t14*t114)
-    t116 = -(-t40*t111 + t37*t113 + t39*t115)
-    t117 = c2*t32 - t46*t26
-    t118 = -(s1*t117 - t46*t73 + c2*t114)
-    t119 = -(t17*t117 + t21*t75 - t15*t112)
-    t120 = -(-t40*t118 + t37*t119 + t38*t115)
-    t121 = -(t21*t80 + t6*t117 - t15*t110)
-    t122 = -(-t39*t118 + t37*t121 + t38*t111)
-    t123 = t38*t113 + t40*t121 - t39*t119
-    t124 = -(t55*t116 + t56*t120 + t57*t122 - t87*t123)
-    t125 = t28*t21 - t17*t32
-    t126 = t114 + s1*t32
-    t127 = t37*t125 + t40*t126
-    t128 = t21*t26 - t32*t15
-    t129 = t37*t128 + t38*t126
-    t130 = t40*t128 - t38*t125
-    t131 = t25*t120 + t55*t127 - t57*t129 - t87*t130
-    t132 = -(t3*t21 + t6*t32)
-    t133 = t37*t132 + t39*t126
-    t134 = t40*t132 - t39*t125
-    t135 = -(-t25*t116 + t56*t127 + t57*t133 + t87*t134)
-    t136 = t39*t128 - t38*t132
-    t137 = t25*t122 + t55*t133 + t56*t129 - t87*t136
-    t138 = -(-t25*t123 + t55*t134 + t56*t130 + t57*t136)
-    t139 = t36*t124 + t52*t131 - t51*t135 - t53*t137 + t108*t138
-    t140 = t30*t46 - t44*t32
-    t141 = -(-t6*t140 + t19*t110 + t21*t59)
-    t142 = -s1*t140 + t46*t67 + t44*t114
-    t143 = -(-t41*t111 + t37*t141 + t39*t142)
-    t144 = -(t19*t117 + t21*t71 - t15*t140)
-    t145 = -(-t41*t118 + t37*t144 + t38*t142)
-    t146 = t38*t141 + t41*t121 - t39*t144
-    t147 = t58*t122 - t55*t143 - t56*t145 + t87*t146
-    t148 = -(t19*t32 + t30*t21)
-    t149 = t37*t148 + t41*t126
-    t150 = t41*t128 - t38*t148
-    t151 = t25*t145 + t55*t149 + t58*t129 - t87*t150
-    t152 = t41*t132 - t39*t148
-    t153 = t25*t143 + t58*t133 - t56*t149 - t87*t152
-    t154 = t25*t146 + t58*t136 - t55*t152 - t56*t150
-    t155 = t36*t147 + t52*t151 - t51*t153 - t54*t137 + t108*t154
-    t156 = -(-t17*t140 + t19*t112 + t21*t64)
-    t157 = -(-t41*t115 + t37*t156 + t40*t142)
-    t158 = t38*t156 + t41*t119 - t40*t144
-    t159 = t57*t145 + t58*t120 - t55*t157 + t87*t158
-    t160 = t41*t125 - t40*t148
-    t161 = t25*t157 + t57*t149 + t58*t127 - t87*t160
-    t162 = t25*t158 + t57*t150 + t58*t130 - t55*t160
-    t163 = t36*t159 + t53*t151 - t51*t161 - t54*t131 + t108*t162
-    t164 = t39*t156 + t41*t113 - t40*t141
-    t165 = t56*t157 + t57*t143 + t58*t116 + t87*t164
-    t166 = t25*t164 + t56*t160 + t57*t152 + t58*t134
-    t167 = t36*t165 + t53*t153 - t52*t161 - t54*t135 + t108*t166
-    t168 = t55*t164 + t56*t158 + t57*t146 + t58*t123
-    t169 = t36*t168 + t51*t166 + t53*t154 - t52*t162 - t54*t138
-    t170 = t52*t159 + t54*t124 - t51*t165 - t53*t147 + t108*t168
+    t109 = -t52*(-t64*t55 - t25*t74 + t57*t77 + t58*t79 + t80*t81) + t54*(t55*t85 + t79*t56 + t57*t87 + t25*t95 - t81*t96) - t36*(t55*t100 + t74*t56 + t57*t102 + t58*t95 - t81*t103) + t51*(-t25*t100 + t64*t56 + t57*t105 + t58*t85 + t81*t106) - t53*(t55*t105 + t77*t56 + t25*t102 - t87*t58 - t81*t107) - t108*(-t25*t103 + t55*t106 + t80*t56 + t57*t107 + t58*t96)
+    t110 = -t17*t32 + t28*t21
+    t111 = c1*t21
+    t112 = s1*t32 + t111
+    t113 = t110*t37 + t112*t40
+    t114 = -t46*t26 + c2*t32
+    t115 = -(s1*t114 - t46*t67 + c2*t111)
+    t116 = -t28*t46 + t14*t32
+    t117 = -(t17*t114 + t21*t69 - t15*t116)
+    t118 = -(s1*t116 - t46*t62 + t14*t111)
+    t119 = -(-t115*t40 + t37*t117 + t38*t118)
+    t120 = -t32*t15 + t21*t26
+    t121 = t120*t37 + t112*t38
+    t122 = t120*t40 - t110*t38
+    t123 = t55*t113 + t25*t119 - t121*t57 - t81*t122
+    t124 = t3*t46 - t32*t42
+    t125 = -s1*t124 + t46*t83 + t21*t92
+    t126 = -(-t6*t116 + t17*t124 + t21*t90)
+    t127 = -(-t40*t125 + t37*t126 + t39*t118)
+    t128 = -(t21*t89 + t6*t114 - t15*t124)
+    t129 = -(-t115*t39 + t37*t128 + t38*t125)
+    t130 = t38*t126 + t40*t128 - t117*t39
+    t131 = -(t55*t127 + t56*t119 + t57*t129 - t81*t130)
+    t132 = -(t6*t32 + t3*t21)
+    t133 = t132*t37 + t112*t39
+    t134 = t132*t40 - t110*t39
+    t135 = -(-t25*t127 + t56*t113 + t57*t133 + t81*t134)
+    t136 = t120*t39 - t38*t132
+    t137 = t55*t133 + t56*t121 + t25*t129 - t81*t136
+    t138 = -(-t25*t130 + t55*t134 + t56*t122 + t57*t136)
+    t139 = t52*t123 + t36*t131 - t51*t135 - t53*t137 + t108*t138
+    t140 = -(t19*t32 + t30*t21)
+    t141 = t140*t37 + t112*t41
+    t142 = t30*t46 - t44*t32
+    t143 = -(t19*t114 + t21*t65 - t15*t142)
+    t144 = -s1*t142 + t46*t60 + t44*t111
+    t145 = -(-t115*t41 + t37*t143 + t38*t144)
+    t146 = t120*t41 - t38*t140
+    t147 = t55*t141 + t58*t121 + t25*t145 - t81*t146
+    t148 = -(-t6*t142 + t19*t124 + t21*t97)
+    t149 = -(-t41*t125 + t37*t148 + t39*t144)
+    t150 = t38*t148 + t41*t128 - t39*t143
+    t151 = t58*t129 - t55*t149 - t56*t145 + t81*t150
+    t152 = t132*t41 - t39*t140
+    t153 = t58*t133 + t25*t149 - t56*t141 - t81*t152
+    t154 = t58*t136 + t25*t150 - t55*t152 - t56*t146
+    t155 = t52*t147 + t36*t151 - t51*t153 - t54*t137 + t108*t154
+    t156 = -(-t17*t142 + t19*t116 + t21*t70)
+    t157 = -(-t118*t41 + t37*t156 + t40*t144)
+    t158 = t38*t156 + t41*t117 - t40*t143
+    t159 = t57*t145 + t58*t119 - t55*t157 + t81*t158
+    t160 = t110*t41 - t40*t140
+    t161 = t57*t141 + t58*t113 + t25*t157 - t81*t160
+    t162 = t57*t146 + t58*t122 + t25*t158 - t55*t160
+    t163 = t53*t147 + t36*t159 - t51*t161 - t54*t123 + t108*t162
+    t164 = t39*t156 + t41*t126 - t40*t148
+    t165 = t56*t157 + t57*t149 + t58*t127 + t81*t164
+    t166 = t56*t160 + t57*t152 + t58*t134 + t25*t164
+    t167 = t53*t153 + t36*t165 - t52*t161 - t54*t135 + t108*t166
+    t168 = t55*t164 + t56*t158 + t57*t150 + t58*t130
+    t169 = t51*t166 + t53*t154 + t36*t168 - t52*t162 - t54*t138
+    t170 = t52*t159 + t54*t131 - t51*t165 - t53*t151 + t108*t168
     t171 = t109**2 + t139**2 + t155**2 + t163**2 + t167**2 + t169**2 + t170**2
     w = xp.broadcast_to(xp.sqrt(xp.abs(t171)), batch)
     return w

@@ -225,9 +225,9 @@ void planar_2r_fk_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const plan
     const planar_2r_real t0 = c1 + c12;
     const planar_2r_real t1 = s1 + s12;
     const planar_2r_real t2 = s12*qd2;
-    const planar_2r_real t3 = t1*qd1 + t2;
+    const planar_2r_real t3 = t2 + t1*qd1;
     const planar_2r_real t4 = c12*qd2;
-    const planar_2r_real t5 = t0*qd1 + t4;
+    const planar_2r_real t5 = t4 + t0*qd1;
     const planar_2r_real t6 = -s12;
 
     /* Outputs */
@@ -259,8 +259,8 @@ void planar_2r_fk_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const plan
     J[9] = 0;
     J[10] = 1;
     J[11] = 1;
-    a[0] = -qd2*(c12*qd1 + t4) - qd1*t5;
-    a[1] = -qd2*(s12*qd1 + t2) - qd1*t3;
+    a[0] = -qd1*t5 - qd2*(c12*qd1 + t4);
+    a[1] = -qd1*t3 - qd2*(t2 + s12*qd1);
     a[2] = 0;
     a[3] = 0;
     a[4] = 0;
@@ -287,15 +287,15 @@ void planar_2r_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const planar_
     const planar_2r_real t0 = c1 + c12;
     const planar_2r_real t1 = s1 + s12;
     const planar_2r_real t2 = s12*qd2;
-    const planar_2r_real t3 = t1*qd1 + t2;
+    const planar_2r_real t3 = t2 + t1*qd1;
     const planar_2r_real t4 = c12*qd2;
-    const planar_2r_real t5 = t0*qd1 + t4;
+    const planar_2r_real t5 = t4 + t0*qd1;
 
     /* Outputs */
     Jd[0] = -t5;
     Jd[1] = -(c12*qd1 + t4);
     Jd[2] = -t3;
-    Jd[3] = -(s12*qd1 + t2);
+    Jd[3] = -(t2 + s12*qd1);
     Jd[4] = 0;
     Jd[5] = 0;
     Jd[6] = 0;
@@ -326,13 +326,13 @@ void planar_2r_bias_acceleration(const planar_2r_real q[PLANAR_2R_DOF], const pl
     const planar_2r_real t0 = c1 + c12;
     const planar_2r_real t1 = s1 + s12;
     const planar_2r_real t2 = s12*qd2;
-    const planar_2r_real t3 = t1*qd1 + t2;
+    const planar_2r_real t3 = t2 + t1*qd1;
     const planar_2r_real t4 = c12*qd2;
-    const planar_2r_real t5 = t0*qd1 + t4;
+    const planar_2r_real t5 = t4 + t0*qd1;
 
     /* Outputs */
-    a[0] = -qd2*(c12*qd1 + t4) - qd1*t5;
-    a[1] = -qd2*(s12*qd1 + t2) - qd1*t3;
+    a[0] = -qd1*t5 - qd2*(c12*qd1 + t4);
+    a[1] = -qd1*t3 - qd2*(t2 + s12*qd1);
     a[2] = 0;
     a[3] = 0;
     a[4] = 0;
@@ -359,11 +359,11 @@ void planar_2r_task_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const pl
     const planar_2r_real t0 = c1 + c12;
     const planar_2r_real t1 = s1 + s12;
     const planar_2r_real t2 = s12*qd2;
-    const planar_2r_real t3 = t1*qd1 + t2;
+    const planar_2r_real t3 = t2 + t1*qd1;
     const planar_2r_real t4 = t2 + s12*qd1;
     const planar_2r_real t5 = c12*qd2;
-    const planar_2r_real t6 = t0*qd1 + t5;
-    const planar_2r_real t7 = t5 + c12*qd1;
+    const planar_2r_real t6 = t5 + t0*qd1;
+    const planar_2r_real t7 = c12*qd1 + t5;
 
     /* Outputs */
     Jd[0] = -t6;
@@ -490,30 +490,30 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const planar_2r_real t9 = (c12*c12) + t6;
     const planar_2r_real t10 = t9;
     const planar_2r_real t11 = sqrt(t4 + t9);
-    const planar_2r_real t12 = (damping*damping);
-    const planar_2r_real t13 = t12 + t5;
-    const planar_2r_real t14 = (t13*t13);
-    const planar_2r_real t15 = t12 + t10;
-    const planar_2r_real t16 = (t2*t2);
-    const planar_2r_real t17 = sqrt(t14 + (t15*t15) + 2*t16);
-    const planar_2r_real t18 = sqrt(t16 + t14);
-    const planar_2r_real t19 = t18*(t13 >= 0 ? 1 : -1);
-    const planar_2r_real t20 = t19 + t13;
-    const planar_2r_real t21 = (t18 > 0 ? 1/(t18*(t18 + fabs(t13))) : 0);
-    const planar_2r_real t22 = -t21*(t2*t20 + t2*t15);
-    const planar_2r_real t23 = t2 + t20*t22;
-    const planar_2r_real t24 = t2*t22 + t15;
-    const planar_2r_real t25 = t21*(mu_dot0*t20 - mu_dot1*t2);
-    const planar_2r_real t26 = mu_dot0 - t20*t25;
-    const planar_2r_real t27 = mu_dot1 + t2*t25;
-    const planar_2r_real t28 = fabs(t24);
+    const planar_2r_real t12 = (t2*t2);
+    const planar_2r_real t13 = (damping*damping);
+    const planar_2r_real t14 = t13 + t5;
+    const planar_2r_real t15 = (t14*t14);
+    const planar_2r_real t16 = sqrt(t12 + t15);
+    const planar_2r_real t17 = t16*(t14 >= 0 ? 1 : -1);
+    const planar_2r_real t18 = t17 + t14;
+    const planar_2r_real t19 = (t16 > 0 ? 1/(t16*(t16 + fabs(t14))) : 0);
+    const planar_2r_real t20 = t19*(mu_dot0*t18 - mu_dot1*t2);
+    const planar_2r_real t21 = mu_dot0 - t18*t20;
+    const planar_2r_real t22 = mu_dot1 + t2*t20;
+    const planar_2r_real t23 = t13 + t10;
+    const planar_2r_real t24 = sqrt(2*t12 + t15 + (t23*t23));
+    const planar_2r_real t25 = -t19*(t2*t18 + t2*t23);
+    const planar_2r_real t26 = t2 + t18*t25;
+    const planar_2r_real t27 = t2*t25 + t23;
+    const planar_2r_real t28 = fabs(t27);
     const planar_2r_real t29 = t28;
-    const planar_2r_real t30 = t29*(t24 >= 0 ? 1 : -1);
-    const planar_2r_real t31 = t24 + t30;
+    const planar_2r_real t30 = t29*(t27 >= 0 ? 1 : -1);
+    const planar_2r_real t31 = t27 + t30;
     const planar_2r_real t32 = (t29 > 0 ? 1/(t29*(t28 + t29)) : 0);
-    const planar_2r_real t33 = t27 - t27*(t31*t31)*t32;
+    const planar_2r_real t33 = t22 - t22*(t31*t31)*t32;
     const planar_2r_real t34 = (t30 != 0 ? -t33/t30 : 0);
-    const planar_2r_real t35 = (t19 != 0 ? -(t26 + t23*t34)/t19 : 0);
+    const planar_2r_real t35 = (t17 != 0 ? -(t21 + t26*t34)/t17 : 0);
     const planar_2r_real t36 = -t1*t35 + t0*t34;
     const planar_2r_real t37 = -s12*t35 + c12*t34;
     const planar_2r_real t38 = -t1;
@@ -537,9 +537,9 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const int t56 = isfinite(t47);
     const int t57 = damping >= 0;
     const int t58 = damping > 0;
-    const planar_2r_real t59 = 1e-12*t17;
+    const planar_2r_real t59 = 1e-12*t24;
     const planar_2r_real t60 = 1e-12*t11;
-    const int t61 = (t58 && ((t18 <= t59) || (t29 <= t59))) || (damping <= 0 && ((t7 <= t60) || (t49 <= t60)));
+    const int t61 = (t58 && ((t16 <= t59) || (t29 <= t59))) || (damping <= 0 && ((t7 <= t60) || (t49 <= t60)));
     const int t62 = t56 && t57 && !t61;
 
     /* Outputs */

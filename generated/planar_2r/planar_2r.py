@@ -267,9 +267,9 @@ def fk_jacobian_dot(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = s12*qd2
-    t3 = t1*qd1 + t2
+    t3 = t2 + t1*qd1
     t4 = c12*qd2
-    t5 = t0*qd1 + t4
+    t5 = t4 + t0*qd1
     t6 = -s12
     T = _stack(xp, [
         xp.broadcast_to(c12, batch),  # 0, 0
@@ -304,8 +304,8 @@ def fk_jacobian_dot(q, q_dot):
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 1
     ], (6, 2))
     a = _stack(xp, [
-        xp.broadcast_to(-qd2*(c12*qd1 + t4) - qd1*t5, batch),  # 0
-        xp.broadcast_to(-qd2*(s12*qd1 + t2) - qd1*t3, batch),  # 1
+        xp.broadcast_to(-qd1*t5 - qd2*(c12*qd1 + t4), batch),  # 0
+        xp.broadcast_to(-qd1*t3 - qd2*(t2 + s12*qd1), batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -329,14 +329,14 @@ def jacobian_dot(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = s12*qd2
-    t3 = t1*qd1 + t2
+    t3 = t2 + t1*qd1
     t4 = c12*qd2
-    t5 = t0*qd1 + t4
+    t5 = t4 + t0*qd1
     Jd = _stack(xp, [
         xp.broadcast_to(-t5, batch),  # 0, 0
         xp.broadcast_to(-(c12*qd1 + t4), batch),  # 0, 1
         xp.broadcast_to(-t3, batch),  # 1, 0
-        xp.broadcast_to(-(s12*qd1 + t2), batch),  # 1, 1
+        xp.broadcast_to(-(t2 + s12*qd1), batch),  # 1, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
@@ -364,12 +364,12 @@ def bias_acceleration(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = s12*qd2
-    t3 = t1*qd1 + t2
+    t3 = t2 + t1*qd1
     t4 = c12*qd2
-    t5 = t0*qd1 + t4
+    t5 = t4 + t0*qd1
     a = _stack(xp, [
-        xp.broadcast_to(-qd2*(c12*qd1 + t4) - qd1*t5, batch),  # 0
-        xp.broadcast_to(-qd2*(s12*qd1 + t2) - qd1*t3, batch),  # 1
+        xp.broadcast_to(-qd1*t5 - qd2*(c12*qd1 + t4), batch),  # 0
+        xp.broadcast_to(-qd1*t3 - qd2*(t2 + s12*qd1), batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -393,11 +393,11 @@ def task_jacobian_dot(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = s12*qd2
-    t3 = t1*qd1 + t2
+    t3 = t2 + t1*qd1
     t4 = t2 + s12*qd1
     t5 = c12*qd2
-    t6 = t0*qd1 + t5
-    t7 = t5 + c12*qd1
+    t6 = t5 + t0*qd1
+    t7 = c12*qd1 + t5
     Jd = _stack(xp, [
         xp.broadcast_to(-t6, batch),  # 0, 0
         xp.broadcast_to(-t7, batch),  # 0, 1
@@ -506,30 +506,30 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t9 = c12**2 + t6
     t10 = t9
     t11 = xp.sqrt(t4 + t9)
-    t12 = damping**2
-    t13 = t12 + t5
-    t14 = t13**2
-    t15 = t12 + t10
-    t16 = t2**2
-    t17 = xp.sqrt(t14 + t15**2 + 2*t16)
-    t18 = xp.sqrt(t16 + t14)
-    t19 = t18*xp.where(xp.greater_equal(t13, 0), xp.asarray(1, dtype=dtype), -1)
-    t20 = t19 + t13
-    t21 = xp.where(xp.greater(t18, 0), 1/(t18*(t18 + xp.abs(t13))), 0)
-    t22 = -t21*(t2*t20 + t2*t15)
-    t23 = t2 + t20*t22
-    t24 = t2*t22 + t15
-    t25 = t21*(mu_dot0*t20 - mu_dot1*t2)
-    t26 = mu_dot0 - t20*t25
-    t27 = mu_dot1 + t2*t25
-    t28 = xp.abs(t24)
+    t12 = t2**2
+    t13 = damping**2
+    t14 = t13 + t5
+    t15 = t14**2
+    t16 = xp.sqrt(t12 + t15)
+    t17 = t16*xp.where(xp.greater_equal(t14, 0), xp.asarray(1, dtype=dtype), -1)
+    t18 = t17 + t14
+    t19 = xp.where(xp.greater(t16, 0), 1/(t16*(t16 + xp.abs(t14))), 0)
+    t20 = t19*(mu_dot0*t18 - mu_dot1*t2)
+    t21 = mu_dot0 - t18*t20
+    t22 = mu_dot1 + t2*t20
+    t23 = t13 + t10
+    t24 = xp.sqrt(2*t12 + t15 + t23**2)
+    t25 = -t19*(t2*t18 + t2*t23)
+    t26 = t2 + t18*t25
+    t27 = t2*t25 + t23
+    t28 = xp.abs(t27)
     t29 = t28
-    t30 = t29*xp.where(xp.greater_equal(t24, 0), xp.asarray(1, dtype=dtype), -1)
-    t31 = t24 + t30
+    t30 = t29*xp.where(xp.greater_equal(t27, 0), xp.asarray(1, dtype=dtype), -1)
+    t31 = t27 + t30
     t32 = xp.where(xp.greater(t29, 0), 1/(t29*(t28 + t29)), 0)
-    t33 = t27 - t27*t31**2*t32
+    t33 = t22 - t22*t31**2*t32
     t34 = xp.where(xp.not_equal(t30, 0), -t33/t30, 0)
-    t35 = xp.where(xp.not_equal(t19, 0), -(t26 + t23*t34)/t19, 0)
+    t35 = xp.where(xp.not_equal(t17, 0), -(t21 + t26*t34)/t17, 0)
     t36 = -t1*t35 + t0*t34
     t37 = -s12*t35 + c12*t34
     t38 = -t1
@@ -553,9 +553,9 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t56 = xp.isfinite(t47)
     t57 = xp.greater_equal(damping, 0)
     t58 = xp.greater(damping, 0)
-    t59 = 1e-12*t17
+    t59 = 1e-12*t24
     t60 = 1e-12*t11
-    t61 = (t58 & (xp.less_equal(t18, t59) | xp.less_equal(t29, t59))) | (xp.less_equal(damping, 0) & (xp.less_equal(t7, t60) | xp.less_equal(t49, t60)))
+    t61 = (t58 & (xp.less_equal(t16, t59) | xp.less_equal(t29, t59))) | (xp.less_equal(damping, 0) & (xp.less_equal(t7, t60) | xp.less_equal(t49, t60)))
     t62 = t56 & t57 & xp.logical_not(t61)
     q_dot = _stack(xp, [
         xp.broadcast_to(xp.where(t62, xp.where(t58, t36, t55), 0), batch),  # 0

@@ -168,9 +168,9 @@ def _fk_jacobian_dot(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = s12*qd2
-    t3 = t1*qd1 + t2
+    t3 = t2 + t1*qd1
     t4 = c12*qd2
-    t5 = t0*qd1 + t4
+    t5 = t4 + t0*qd1
     t6 = -s12
     T = casadi.SX(4, 4)
     T[0, 0] = c12
@@ -189,8 +189,8 @@ def _fk_jacobian_dot(q, q_dot):
     J[5, 0] = 1
     J[5, 1] = 1
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd2*(c12*qd1 + t4) - qd1*t5
-    a[1, 0] = -qd2*(s12*qd1 + t2) - qd1*t3
+    a[0, 0] = -qd1*t5 - qd2*(c12*qd1 + t4)
+    a[1, 0] = -qd1*t3 - qd2*(t2 + s12*qd1)
     return [T, J, a]
 
 
@@ -209,14 +209,14 @@ def _jacobian_dot(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = s12*qd2
-    t3 = t1*qd1 + t2
+    t3 = t2 + t1*qd1
     t4 = c12*qd2
-    t5 = t0*qd1 + t4
+    t5 = t4 + t0*qd1
     Jd = casadi.SX(6, 2)
     Jd[0, 0] = -t5
     Jd[0, 1] = -(c12*qd1 + t4)
     Jd[1, 0] = -t3
-    Jd[1, 1] = -(s12*qd1 + t2)
+    Jd[1, 1] = -(t2 + s12*qd1)
     return [Jd]
 
 
@@ -235,12 +235,12 @@ def _bias_acceleration(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = s12*qd2
-    t3 = t1*qd1 + t2
+    t3 = t2 + t1*qd1
     t4 = c12*qd2
-    t5 = t0*qd1 + t4
+    t5 = t4 + t0*qd1
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd2*(c12*qd1 + t4) - qd1*t5
-    a[1, 0] = -qd2*(s12*qd1 + t2) - qd1*t3
+    a[0, 0] = -qd1*t5 - qd2*(c12*qd1 + t4)
+    a[1, 0] = -qd1*t3 - qd2*(t2 + s12*qd1)
     return [a]
 
 
@@ -259,11 +259,11 @@ def _task_jacobian_dot(q, q_dot):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = s12*qd2
-    t3 = t1*qd1 + t2
+    t3 = t2 + t1*qd1
     t4 = t2 + s12*qd1
     t5 = c12*qd2
-    t6 = t0*qd1 + t5
-    t7 = t5 + c12*qd1
+    t6 = t5 + t0*qd1
+    t7 = c12*qd1 + t5
     Jd = casadi.SX(2, 2)
     Jd[0, 0] = -t6
     Jd[0, 1] = -t7
@@ -349,30 +349,30 @@ def _velocity_ik(q, mu_dot, damping):
     t9 = c12**2 + t6
     t10 = t9
     t11 = casadi.sqrt(t4 + t9)
-    t12 = damping**2
-    t13 = t12 + t5
-    t14 = t13**2
-    t15 = t12 + t10
-    t16 = t2**2
-    t17 = casadi.sqrt(t14 + t15**2 + 2*t16)
-    t18 = casadi.sqrt(t16 + t14)
-    t19 = t18*casadi.if_else((t13 >= 0), 1, -1)
-    t20 = t19 + t13
-    t21 = casadi.if_else((t18 > 0), 1/(t18*(t18 + casadi.fabs(t13))), 0)
-    t22 = -t21*(t2*t20 + t2*t15)
-    t23 = t2 + t20*t22
-    t24 = t2*t22 + t15
-    t25 = t21*(mu_dot0*t20 - mu_dot1*t2)
-    t26 = mu_dot0 - t20*t25
-    t27 = mu_dot1 + t2*t25
-    t28 = casadi.fabs(t24)
+    t12 = t2**2
+    t13 = damping**2
+    t14 = t13 + t5
+    t15 = t14**2
+    t16 = casadi.sqrt(t12 + t15)
+    t17 = t16*casadi.if_else((t14 >= 0), 1, -1)
+    t18 = t17 + t14
+    t19 = casadi.if_else((t16 > 0), 1/(t16*(t16 + casadi.fabs(t14))), 0)
+    t20 = t19*(mu_dot0*t18 - mu_dot1*t2)
+    t21 = mu_dot0 - t18*t20
+    t22 = mu_dot1 + t2*t20
+    t23 = t13 + t10
+    t24 = casadi.sqrt(2*t12 + t15 + t23**2)
+    t25 = -t19*(t2*t18 + t2*t23)
+    t26 = t2 + t18*t25
+    t27 = t2*t25 + t23
+    t28 = casadi.fabs(t27)
     t29 = t28
-    t30 = t29*casadi.if_else((t24 >= 0), 1, -1)
-    t31 = t24 + t30
+    t30 = t29*casadi.if_else((t27 >= 0), 1, -1)
+    t31 = t27 + t30
     t32 = casadi.if_else((t29 > 0), 1/(t29*(t28 + t29)), 0)
-    t33 = t27 - t27*t31**2*t32
+    t33 = t22 - t22*t31**2*t32
     t34 = casadi.if_else((t30 != 0), -t33/t30, 0)
-    t35 = casadi.if_else((t19 != 0), -(t26 + t23*t34)/t19, 0)
+    t35 = casadi.if_else((t17 != 0), -(t21 + t26*t34)/t17, 0)
     t36 = -t1*t35 + t0*t34
     t37 = -s12*t35 + c12*t34
     t38 = -t1
@@ -396,9 +396,9 @@ def _velocity_ik(q, mu_dot, damping):
     t56 = (casadi.fabs(t47) < casadi.inf)
     t57 = (damping >= 0)
     t58 = (damping > 0)
-    t59 = 1e-12*t17
+    t59 = 1e-12*t24
     t60 = 1e-12*t11
-    t61 = casadi.logic_or(casadi.logic_and(t58, casadi.logic_or((t18 <= t59), (t29 <= t59))), casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t60), (t49 <= t60))))
+    t61 = casadi.logic_or(casadi.logic_and(t58, casadi.logic_or((t16 <= t59), (t29 <= t59))), casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t60), (t49 <= t60))))
     t62 = casadi.logic_and(casadi.logic_and(t56, t57), casadi.logic_not(t61))
     q_dot = casadi.SX(2, 1)
     q_dot[0, 0] = casadi.if_else(t62, casadi.if_else(t58, t36, t55), 0)

@@ -300,10 +300,10 @@ void planar_3r_fk_jacobian_dot(const planar_3r_real q[PLANAR_3R_DOF], const plan
     const planar_3r_real t3 = s1 + t1;
     const planar_3r_real t4 = qd1 + qd2;
     const planar_3r_real t5 = s123*qd3;
-    const planar_3r_real t6 = t1*qd2 + t5;
+    const planar_3r_real t6 = t5 + t1*qd2;
     const planar_3r_real t7 = t6 + t3*qd1;
     const planar_3r_real t8 = c123*qd3;
-    const planar_3r_real t9 = t0*qd2 + t8;
+    const planar_3r_real t9 = t8 + t0*qd2;
     const planar_3r_real t10 = t9 + t2*qd1;
     const planar_3r_real t11 = -s123;
 
@@ -342,8 +342,8 @@ void planar_3r_fk_jacobian_dot(const planar_3r_real q[PLANAR_3R_DOF], const plan
     J[15] = 1;
     J[16] = 1;
     J[17] = 1;
-    a[0] = -qd2*(t9 + t0*qd1) - qd3*(c123*t4 + t8) - qd1*t10;
-    a[1] = -qd2*(t6 + t1*qd1) - qd3*(s123*t4 + t5) - qd1*t7;
+    a[0] = -qd1*t10 - qd2*(t9 + t0*qd1) - qd3*(c123*t4 + t8);
+    a[1] = -qd1*t7 - qd2*(t6 + t1*qd1) - qd3*(t5 + s123*t4);
     a[2] = 0;
     a[3] = 0;
     a[4] = 0;
@@ -379,10 +379,10 @@ void planar_3r_jacobian_dot(const planar_3r_real q[PLANAR_3R_DOF], const planar_
     const planar_3r_real t3 = s1 + t1;
     const planar_3r_real t4 = qd1 + qd2;
     const planar_3r_real t5 = s123*qd3;
-    const planar_3r_real t6 = t1*qd2 + t5;
+    const planar_3r_real t6 = t5 + t1*qd2;
     const planar_3r_real t7 = t6 + t3*qd1;
     const planar_3r_real t8 = c123*qd3;
-    const planar_3r_real t9 = t0*qd2 + t8;
+    const planar_3r_real t9 = t8 + t0*qd2;
     const planar_3r_real t10 = t9 + t2*qd1;
 
     /* Outputs */
@@ -391,7 +391,7 @@ void planar_3r_jacobian_dot(const planar_3r_real q[PLANAR_3R_DOF], const planar_
     Jd[2] = -(c123*t4 + t8);
     Jd[3] = -t7;
     Jd[4] = -(t6 + t1*qd1);
-    Jd[5] = -(s123*t4 + t5);
+    Jd[5] = -(t5 + s123*t4);
     Jd[6] = 0;
     Jd[7] = 0;
     Jd[8] = 0;
@@ -435,15 +435,15 @@ void planar_3r_bias_acceleration(const planar_3r_real q[PLANAR_3R_DOF], const pl
     const planar_3r_real t3 = s1 + t1;
     const planar_3r_real t4 = qd1 + qd2;
     const planar_3r_real t5 = s123*qd3;
-    const planar_3r_real t6 = t1*qd2 + t5;
+    const planar_3r_real t6 = t5 + t1*qd2;
     const planar_3r_real t7 = t6 + t3*qd1;
     const planar_3r_real t8 = c123*qd3;
-    const planar_3r_real t9 = t0*qd2 + t8;
+    const planar_3r_real t9 = t8 + t0*qd2;
     const planar_3r_real t10 = t9 + t2*qd1;
 
     /* Outputs */
-    a[0] = -qd2*(t9 + t0*qd1) - qd3*(c123*t4 + t8) - qd1*t10;
-    a[1] = -qd2*(t6 + t1*qd1) - qd3*(s123*t4 + t5) - qd1*t7;
+    a[0] = -qd1*t10 - qd2*(t9 + t0*qd1) - qd3*(c123*t4 + t8);
+    a[1] = -qd1*t7 - qd2*(t6 + t1*qd1) - qd3*(t5 + s123*t4);
     a[2] = 0;
     a[3] = 0;
     a[4] = 0;
@@ -479,15 +479,15 @@ void planar_3r_task_jacobian_dot(const planar_3r_real q[PLANAR_3R_DOF], const pl
     const planar_3r_real t3 = s1 + t1;
     const planar_3r_real t4 = qd1 + qd2;
     const planar_3r_real t5 = s123*qd3;
-    const planar_3r_real t6 = t1*qd2 + t5;
+    const planar_3r_real t6 = t5 + t1*qd2;
     const planar_3r_real t7 = t6 + t3*qd1;
     const planar_3r_real t8 = t6 + t1*qd1;
     const planar_3r_real t9 = t5 + s123*t4;
     const planar_3r_real t10 = c123*qd3;
-    const planar_3r_real t11 = t0*qd2 + t10;
+    const planar_3r_real t11 = t10 + t0*qd2;
     const planar_3r_real t12 = t11 + t2*qd1;
     const planar_3r_real t13 = t11 + t0*qd1;
-    const planar_3r_real t14 = t10 + c123*t4;
+    const planar_3r_real t14 = c123*t4 + t10;
 
     /* Outputs */
     Jd[0] = -t12;

@@ -335,10 +335,10 @@ def fk_jacobian_dot(q, q_dot):
     t3 = s1 + t1
     t4 = qd1 + qd2
     t5 = s123*qd3
-    t6 = t1*qd2 + t5
+    t6 = t5 + t1*qd2
     t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t0*qd2 + t8
+    t9 = t8 + t0*qd2
     t10 = t9 + t2*qd1
     t11 = -s123
     T = _stack(xp, [
@@ -380,8 +380,8 @@ def fk_jacobian_dot(q, q_dot):
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 2
     ], (6, 3))
     a = _stack(xp, [
-        xp.broadcast_to(-qd2*(t9 + t0*qd1) - qd3*(c123*t4 + t8) - qd1*t10, batch),  # 0
-        xp.broadcast_to(-qd2*(t6 + t1*qd1) - qd3*(s123*t4 + t5) - qd1*t7, batch),  # 1
+        xp.broadcast_to(-qd1*t10 - qd2*(t9 + t0*qd1) - qd3*(c123*t4 + t8), batch),  # 0
+        xp.broadcast_to(-qd1*t7 - qd2*(t6 + t1*qd1) - qd3*(t5 + s123*t4), batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -413,10 +413,10 @@ def jacobian_dot(q, q_dot):
     t3 = s1 + t1
     t4 = qd1 + qd2
     t5 = s123*qd3
-    t6 = t1*qd2 + t5
+    t6 = t5 + t1*qd2
     t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t0*qd2 + t8
+    t9 = t8 + t0*qd2
     t10 = t9 + t2*qd1
     Jd = _stack(xp, [
         xp.broadcast_to(-t10, batch),  # 0, 0
@@ -424,7 +424,7 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(-(c123*t4 + t8), batch),  # 0, 2
         xp.broadcast_to(-t7, batch),  # 1, 0
         xp.broadcast_to(-(t6 + t1*qd1), batch),  # 1, 1
-        xp.broadcast_to(-(s123*t4 + t5), batch),  # 1, 2
+        xp.broadcast_to(-(t5 + s123*t4), batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2
@@ -464,14 +464,14 @@ def bias_acceleration(q, q_dot):
     t3 = s1 + t1
     t4 = qd1 + qd2
     t5 = s123*qd3
-    t6 = t1*qd2 + t5
+    t6 = t5 + t1*qd2
     t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t0*qd2 + t8
+    t9 = t8 + t0*qd2
     t10 = t9 + t2*qd1
     a = _stack(xp, [
-        xp.broadcast_to(-qd2*(t9 + t0*qd1) - qd3*(c123*t4 + t8) - qd1*t10, batch),  # 0
-        xp.broadcast_to(-qd2*(t6 + t1*qd1) - qd3*(s123*t4 + t5) - qd1*t7, batch),  # 1
+        xp.broadcast_to(-qd1*t10 - qd2*(t9 + t0*qd1) - qd3*(c123*t4 + t8), batch),  # 0
+        xp.broadcast_to(-qd1*t7 - qd2*(t6 + t1*qd1) - qd3*(t5 + s123*t4), batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -503,15 +503,15 @@ def task_jacobian_dot(q, q_dot):
     t3 = s1 + t1
     t4 = qd1 + qd2
     t5 = s123*qd3
-    t6 = t1*qd2 + t5
+    t6 = t5 + t1*qd2
     t7 = t6 + t3*qd1
     t8 = t6 + t1*qd1
     t9 = t5 + s123*t4
     t10 = c123*qd3
-    t11 = t0*qd2 + t10
+    t11 = t10 + t0*qd2
     t12 = t11 + t2*qd1
     t13 = t11 + t0*qd1
-    t14 = t10 + c123*t4
+    t14 = c123*t4 + t10
     Jd = _stack(xp, [
         xp.broadcast_to(-t12, batch),  # 0, 0
         xp.broadcast_to(-t13, batch),  # 0, 1

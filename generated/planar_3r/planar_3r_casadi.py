@@ -234,10 +234,10 @@ def _fk_jacobian_dot(q, q_dot):
     t3 = s1 + t1
     t4 = qd1 + qd2
     t5 = s123*qd3
-    t6 = t1*qd2 + t5
+    t6 = t5 + t1*qd2
     t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t0*qd2 + t8
+    t9 = t8 + t0*qd2
     t10 = t9 + t2*qd1
     t11 = -s123
     T = casadi.SX(4, 4)
@@ -260,8 +260,8 @@ def _fk_jacobian_dot(q, q_dot):
     J[5, 1] = 1
     J[5, 2] = 1
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd2*(t9 + t0*qd1) - qd3*(c123*t4 + t8) - qd1*t10
-    a[1, 0] = -qd2*(t6 + t1*qd1) - qd3*(s123*t4 + t5) - qd1*t7
+    a[0, 0] = -qd1*t10 - qd2*(t9 + t0*qd1) - qd3*(c123*t4 + t8)
+    a[1, 0] = -qd1*t7 - qd2*(t6 + t1*qd1) - qd3*(t5 + s123*t4)
     return [T, J, a]
 
 
@@ -289,10 +289,10 @@ def _jacobian_dot(q, q_dot):
     t3 = s1 + t1
     t4 = qd1 + qd2
     t5 = s123*qd3
-    t6 = t1*qd2 + t5
+    t6 = t5 + t1*qd2
     t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t0*qd2 + t8
+    t9 = t8 + t0*qd2
     t10 = t9 + t2*qd1
     Jd = casadi.SX(6, 3)
     Jd[0, 0] = -t10
@@ -300,7 +300,7 @@ def _jacobian_dot(q, q_dot):
     Jd[0, 2] = -(c123*t4 + t8)
     Jd[1, 0] = -t7
     Jd[1, 1] = -(t6 + t1*qd1)
-    Jd[1, 2] = -(s123*t4 + t5)
+    Jd[1, 2] = -(t5 + s123*t4)
     return [Jd]
 
 
@@ -328,14 +328,14 @@ def _bias_acceleration(q, q_dot):
     t3 = s1 + t1
     t4 = qd1 + qd2
     t5 = s123*qd3
-    t6 = t1*qd2 + t5
+    t6 = t5 + t1*qd2
     t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t0*qd2 + t8
+    t9 = t8 + t0*qd2
     t10 = t9 + t2*qd1
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd2*(t9 + t0*qd1) - qd3*(c123*t4 + t8) - qd1*t10
-    a[1, 0] = -qd2*(t6 + t1*qd1) - qd3*(s123*t4 + t5) - qd1*t7
+    a[0, 0] = -qd1*t10 - qd2*(t9 + t0*qd1) - qd3*(c123*t4 + t8)
+    a[1, 0] = -qd1*t7 - qd2*(t6 + t1*qd1) - qd3*(t5 + s123*t4)
     return [a]
 
 
@@ -363,15 +363,15 @@ def _task_jacobian_dot(q, q_dot):
     t3 = s1 + t1
     t4 = qd1 + qd2
     t5 = s123*qd3
-    t6 = t1*qd2 + t5
+    t6 = t5 + t1*qd2
     t7 = t6 + t3*qd1
     t8 = t6 + t1*qd1
     t9 = t5 + s123*t4
     t10 = c123*qd3
-    t11 = t0*qd2 + t10
+    t11 = t10 + t0*qd2
     t12 = t11 + t2*qd1
     t13 = t11 + t0*qd1
-    t14 = t10 + c123*t4
+    t14 = c123*t4 + t10
     Jd = casadi.SX(3, 3)
     Jd[0, 0] = -t12
     Jd[0, 1] = -t13

@@ -659,7 +659,7 @@ void puma560_fk_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_re
     const puma560_real t38 = t37;
     const puma560_real t39 = c1*t20 + s1*t26;
     const puma560_real t40 = t39;
-    const puma560_real t41 = qd2*t38 + qd3*t40;
+    const puma560_real t41 = t40*qd3 + t38*qd2;
     const puma560_real t42 = s1*qd2;
     const puma560_real t43 = s1*qd3;
     const puma560_real t44 = t42 + t43;
@@ -681,9 +681,9 @@ void puma560_fk_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_re
     const puma560_real t60 = s1*t1;
     const puma560_real t61 = s1*t0;
     const puma560_real t62 = -c1;
-    const puma560_real t63 = (c1*c1);
+    const puma560_real t63 = (s1*s1);
     const puma560_real t64 = t0*qd2;
-    const puma560_real t65 = (s1*s1);
+    const puma560_real t65 = (c1*c1);
     const puma560_real t66 = t0*qd3;
 
     /* Outputs */
@@ -739,12 +739,12 @@ void puma560_fk_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_re
     J[33] = c23;
     J[34] = t30;
     J[35] = t29;
-    a[0] = qd2*(-c1*t41 + t60*qd1) - qd3*(-t61*qd1 + t49*t40 + t50*t40) - qd1*t48;
-    a[1] = -qd2*(s1*t41 + t58*qd1) - qd3*(t59*qd1 + t42*t40 + t43*t40) - qd1*t55;
-    a[2] = -qd2*(c1*t54 + s1*t47) - qd3*(t63*t64 + t64*t65 + t63*t66 + t65*t66);
-    a[3] = qd4*(-c23*t51 + t21*qd1) + qd5*(t10*t3 - t30*t52) + qd6*(t23*t33 - t29*t53) + t49*qd1 + t50*qd1;
-    a[4] = -qd4*(c23*t44 + t15*qd1) + qd5*(t13*t3 - t30*t45) - qd6*(t17*t33 + t29*t46) + t42*qd1 + t43*qd1;
-    a[5] = -qd4*(t21*t44 + t15*t51) + qd5*(t13*t52 - t10*t45) - qd6*(t17*t53 + t23*t46);
+    a[0] = -qd1*t48 + qd2*(t60*qd1 - c1*t41) - qd3*(t49*t40 - t61*qd1 + t50*t40);
+    a[1] = -qd1*t55 - qd2*(t58*qd1 + s1*t41) - qd3*(t59*qd1 + t42*t40 + t43*t40);
+    a[2] = -qd2*(s1*t47 + c1*t54) - qd3*(t63*t64 + t64*t65 + t63*t66 + t65*t66);
+    a[3] = t49*qd1 + t50*qd1 + qd4*(-c23*t51 + t21*qd1) + qd5*(-t30*t52 + t10*t3) + qd6*(-t29*t53 + t23*t33);
+    a[4] = t42*qd1 + t43*qd1 - qd4*(t15*qd1 + c23*t44) + qd5*(t13*t3 - t30*t45) - qd6*(t17*t33 + t29*t46);
+    a[5] = -qd4*(t21*t44 + t15*t51) + qd5*(-t10*t45 + t13*t52) - qd6*(t23*t46 + t17*t53);
 }
 
 void puma560_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_real q_dot[PUMA560_DOF], puma560_real Jd[6 * PUMA560_DOF])
@@ -802,7 +802,7 @@ void puma560_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_real 
     const puma560_real t23 = c1*t22 + t19;
     const puma560_real t24 = s1*t22 + t20;
     const puma560_real t25 = c1*t23 + s1*t24;
-    const puma560_real t26 = qd2*t25 + qd3*t21;
+    const puma560_real t26 = t21*qd3 + t25*qd2;
     const puma560_real t27 = s1*qd2;
     const puma560_real t28 = s1*qd3;
     const puma560_real t29 = t27 + t28;
@@ -822,26 +822,26 @@ void puma560_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_real 
     const puma560_real t43 = t3 + t42*qd5;
     const puma560_real t44 = s1*qd1;
     const puma560_real t45 = c1*qd1;
-    const puma560_real t46 = (c1*c1);
+    const puma560_real t46 = (s1*s1);
     const puma560_real t47 = t1*qd2;
-    const puma560_real t48 = (s1*s1);
+    const puma560_real t48 = (c1*c1);
     const puma560_real t49 = t1*qd3;
 
     /* Outputs */
     Jd[0] = -t31;
-    Jd[1] = -c1*t26 + t2*t44;
-    Jd[2] = -(-t1*t44 + t32*t21 + t33*t21);
+    Jd[1] = t2*t44 - c1*t26;
+    Jd[2] = -(t32*t21 - t1*t44 + t33*t21);
     Jd[3] = 0;
     Jd[4] = 0;
     Jd[5] = 0;
     Jd[6] = -t36;
-    Jd[7] = -(s1*t26 + t2*t45);
+    Jd[7] = -(t2*t45 + s1*t26);
     Jd[8] = -(t1*t45 + t27*t21 + t28*t21);
     Jd[9] = 0;
     Jd[10] = 0;
     Jd[11] = 0;
     Jd[12] = 0;
-    Jd[13] = -(c1*t35 + s1*t30);
+    Jd[13] = -(s1*t30 + c1*t35);
     Jd[14] = -(t46*t47 + t47*t48 + t46*t49 + t48*t49);
     Jd[15] = 0;
     Jd[16] = 0;
@@ -850,20 +850,20 @@ void puma560_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_real 
     Jd[19] = t45;
     Jd[20] = t45;
     Jd[21] = -c23*t34 + s23*t44;
-    Jd[22] = t10*t3 - t42*t39;
-    Jd[23] = t17*t43 - t0*t41;
+    Jd[22] = -t42*t39 + t10*t3;
+    Jd[23] = -t0*t41 + t17*t43;
     Jd[24] = 0;
     Jd[25] = t44;
     Jd[26] = t44;
-    Jd[27] = -(c23*t29 + s23*t45);
+    Jd[27] = -(s23*t45 + c23*t29);
     Jd[28] = t13*t3 - t42*t38;
     Jd[29] = -(t16*t43 + t0*t40);
     Jd[30] = 0;
     Jd[31] = 0;
     Jd[32] = 0;
     Jd[33] = -(s1*s23*t29 + c1*s23*t34);
-    Jd[34] = t13*t39 - t10*t38;
-    Jd[35] = -(t16*t41 + t17*t40);
+    Jd[34] = -t10*t38 + t13*t39;
+    Jd[35] = -(t17*t40 + t16*t41);
 }
 
 void puma560_bias_acceleration(const puma560_real q[PUMA560_DOF], const puma560_real q_dot[PUMA560_DOF], puma560_real a[6])
@@ -922,7 +922,7 @@ void puma560_bias_acceleration(const puma560_real q[PUMA560_DOF], const puma560_
     const puma560_real t23 = c1*t22 + t19;
     const puma560_real t24 = s1*t22 + t20;
     const puma560_real t25 = c1*t23 + s1*t24;
-    const puma560_real t26 = qd2*t25 + qd3*t21;
+    const puma560_real t26 = t21*qd3 + t25*qd2;
     const puma560_real t27 = s1*qd2;
     const puma560_real t28 = s1*qd3;
     const puma560_real t29 = t27 + t28;
@@ -942,18 +942,18 @@ void puma560_bias_acceleration(const puma560_real q[PUMA560_DOF], const puma560_
     const puma560_real t43 = t3 + t42*qd5;
     const puma560_real t44 = s1*qd1;
     const puma560_real t45 = c1*qd1;
-    const puma560_real t46 = (c1*c1);
+    const puma560_real t46 = (s1*s1);
     const puma560_real t47 = t1*qd2;
-    const puma560_real t48 = (s1*s1);
+    const puma560_real t48 = (c1*c1);
     const puma560_real t49 = t1*qd3;
 
     /* Outputs */
-    a[0] = qd2*(-c1*t26 + t2*t44) - qd3*(-t1*t44 + t32*t21 + t33*t21) - qd1*t31;
-    a[1] = -qd2*(s1*t26 + t2*t45) - qd3*(t1*t45 + t27*t21 + t28*t21) - qd1*t36;
-    a[2] = -qd2*(c1*t35 + s1*t30) - qd3*(t46*t47 + t47*t48 + t46*t49 + t48*t49);
-    a[3] = qd4*(-c23*t34 + s23*t44) + qd5*(t10*t3 - t42*t39) + qd6*(t17*t43 - t0*t41) + t32*qd1 + t33*qd1;
-    a[4] = -qd4*(c23*t29 + s23*t45) + qd5*(t13*t3 - t42*t38) - qd6*(t16*t43 + t0*t40) + t27*qd1 + t28*qd1;
-    a[5] = -qd4*(s1*s23*t29 + c1*s23*t34) + qd5*(t13*t39 - t10*t38) - qd6*(t16*t41 + t17*t40);
+    a[0] = -qd1*t31 + qd2*(t2*t44 - c1*t26) - qd3*(t32*t21 - t1*t44 + t33*t21);
+    a[1] = -qd1*t36 - qd2*(t2*t45 + s1*t26) - qd3*(t1*t45 + t27*t21 + t28*t21);
+    a[2] = -qd2*(s1*t30 + c1*t35) - qd3*(t46*t47 + t47*t48 + t46*t49 + t48*t49);
+    a[3] = t32*qd1 + t33*qd1 + qd4*(-c23*t34 + s23*t44) + qd5*(-t42*t39 + t10*t3) + qd6*(-t0*t41 + t17*t43);
+    a[4] = t27*qd1 + t28*qd1 - qd4*(s23*t45 + c23*t29) + qd5*(t13*t3 - t42*t38) - qd6*(t16*t43 + t0*t40);
+    a[5] = -qd4*(s1*s23*t29 + c1*s23*t34) + qd5*(-t10*t38 + t13*t39) - qd6*(t17*t40 + t16*t41);
 }
 
 void puma560_task_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_real q_dot[PUMA560_DOF], puma560_real Jd[PUMA560_TASK_DIM * PUMA560_DOF])
@@ -1024,19 +1024,19 @@ void puma560_task_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_
     const puma560_real t32 = c1*t31 + t17;
     const puma560_real t33 = s1*t31 + t22;
     const puma560_real t34 = c1*t32 + s1*t33;
-    const puma560_real t35 = qd2*t34 + qd3*t23;
+    const puma560_real t35 = t23*qd3 + t34*qd2;
     const puma560_real t36 = s1*qd2;
     const puma560_real t37 = s1*qd3;
     const puma560_real t38 = t0*t37 + t1*t36;
     const puma560_real t39 = -t38 + t32*qd1;
     const puma560_real t40 = t36 + t37;
     const puma560_real t41 = t40;
-    const puma560_real t42 = c23*t41 + t13*qd1;
+    const puma560_real t42 = t13*qd1 + c23*t41;
     const puma560_real t43 = c1*qd2;
     const puma560_real t44 = c1*qd3;
     const puma560_real t45 = t0*t44 + t1*t43;
     const puma560_real t46 = t45 + t33*qd1;
-    const puma560_real t47 = c1*t45 + s1*t38;
+    const puma560_real t47 = s1*t38 + c1*t45;
     const puma560_real t48 = t43 + t44;
     const puma560_real t49 = t48;
     const puma560_real t50 = -c23*t49 + t18*qd1;
@@ -1045,35 +1045,35 @@ void puma560_task_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_
     const puma560_real t53 = t41 + t52;
     const puma560_real t54 = t18*qd4;
     const puma560_real t55 = t49 + t54;
-    const puma560_real t56 = t11*t55 - t8*t53;
+    const puma560_real t56 = -t8*t53 + t11*t55;
     const puma560_real t57 = qd1 + c23*qd4;
     const puma560_real t58 = t57;
-    const puma560_real t59 = t8*t58 - t29*t55;
+    const puma560_real t59 = -t29*t55 + t8*t58;
     const puma560_real t60 = t11*t58 - t29*t53;
     const puma560_real t61 = t11*qd5;
     const puma560_real t62 = t53 + t61;
     const puma560_real t63 = t40 + t52 + t61 - t15*qd6;
     const puma560_real t64 = t8*qd5;
     const puma560_real t65 = t55 + t64;
-    const puma560_real t66 = t15*t65 + t20*t62;
+    const puma560_real t66 = t20*t62 + t15*t65;
     const puma560_real t67 = t48 + t54 + t64 + t20*qd6;
-    const puma560_real t68 = t16*t67 + t21*t63;
+    const puma560_real t68 = t21*t63 + t16*t67;
     const puma560_real t69 = t29*qd5;
     const puma560_real t70 = t58 + t69;
-    const puma560_real t71 = t20*t70 - t28*t65;
+    const puma560_real t71 = -t28*t65 + t20*t70;
     const puma560_real t72 = t15*t70 + t28*t62;
     const puma560_real t73 = t57 + t69 + t28*qd6;
-    const puma560_real t74 = t21*t73 + t30*t67;
+    const puma560_real t74 = t30*t67 + t21*t73;
     const puma560_real t75 = t16*t73 - t30*t63;
     const puma560_real t76 = s1*qd1;
-    const puma560_real t77 = -c1*t35 + t1*t76;
-    const puma560_real t78 = t43*t23 + t44*t23 - t0*t76;
+    const puma560_real t77 = t1*t76 - c1*t35;
+    const puma560_real t78 = t43*t23 - t0*t76 + t44*t23;
     const puma560_real t79 = c1*qd1;
-    const puma560_real t80 = s1*t35 + t1*t79;
+    const puma560_real t80 = t1*t79 + s1*t35;
     const puma560_real t81 = t0*t79 + t36*t23 + t37*t23;
-    const puma560_real t82 = (c1*c1);
+    const puma560_real t82 = (s1*s1);
     const puma560_real t83 = t0*qd2;
-    const puma560_real t84 = (s1*s1);
+    const puma560_real t84 = (c1*c1);
     const puma560_real t85 = t0*qd3;
     const puma560_real t86 = t82*t83 + t83*t84 + t82*t85 + t84*t85;
     const puma560_real t87 = s1*t16;
@@ -1092,36 +1092,36 @@ void puma560_task_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_
     const puma560_real t100 = -(t11*t21 + t8*t16)*t97;
     const puma560_real t101 = (t15*t21 - t16*t20)*t97;
     const puma560_real t102 = 2*t90;
-    const puma560_real t103 = t75*t89;
-    const puma560_real t104 = -(c1 + t21*t102)*t103;
-    const puma560_real t105 = t74*t89;
-    const puma560_real t106 = (s1 - t16*t102)*t105;
+    const puma560_real t103 = t74*t89;
+    const puma560_real t104 = (s1 - t16*t102)*t103;
+    const puma560_real t105 = t75*t89;
+    const puma560_real t106 = -(c1 + t21*t102)*t105;
     const puma560_real t107 = qd1*t89;
     const puma560_real t108 = t93*t107;
     const puma560_real t109 = t94*t107;
-    const puma560_real t110 = t104 - t106 + t108 + t109;
-    const puma560_real t111 = t16*t89;
-    const puma560_real t112 = t50*t111;
-    const puma560_real t113 = 2*t95;
-    const puma560_real t114 = -t103*(t18 + t21*t113);
-    const puma560_real t115 = t21*t89;
-    const puma560_real t116 = t42*t115;
-    const puma560_real t117 = -t105*(t13 + t16*t113);
-    const puma560_real t118 = t59*t111;
-    const puma560_real t119 = t60*t115;
-    const puma560_real t120 = 2*t91;
-    const puma560_real t121 = -t103*(t8 + t21*t120);
-    const puma560_real t122 = t105*(t11 - t16*t120);
-    const puma560_real t123 = t71*t111;
-    const puma560_real t124 = 2*t92;
-    const puma560_real t125 = -t103*(t20 + t21*t124);
-    const puma560_real t126 = t72*t115;
-    const puma560_real t127 = -t105*(t15 + t16*t124);
+    const puma560_real t110 = -t104 + t106 + t108 + t109;
+    const puma560_real t111 = 2*t95;
+    const puma560_real t112 = -t103*(t13 + t16*t111);
+    const puma560_real t113 = -t105*(t18 + t21*t111);
+    const puma560_real t114 = t16*t89;
+    const puma560_real t115 = t50*t114;
+    const puma560_real t116 = t21*t89;
+    const puma560_real t117 = t42*t116;
+    const puma560_real t118 = 2*t91;
+    const puma560_real t119 = t103*(t11 - t16*t118);
+    const puma560_real t120 = -t105*(t8 + t21*t118);
+    const puma560_real t121 = t59*t114;
+    const puma560_real t122 = t60*t116;
+    const puma560_real t123 = 2*t92;
+    const puma560_real t124 = -t103*(t15 + t16*t123);
+    const puma560_real t125 = -t105*(t20 + t21*t123);
+    const puma560_real t126 = t71*t114;
+    const puma560_real t127 = t72*t116;
     const puma560_real t128 = qd1*t96;
-    const puma560_real t129 = -t75*(t21*t98 + s1*t96) + t74*(t16*t98 + c1*t96) + t87*t128 - t88*t128;
-    const puma560_real t130 = t16*t96;
-    const puma560_real t131 = t21*t96;
-    const puma560_real t132 = -(t90*t68 - t30*t106 + t30*t104 + t30*t108 + t30*t109);
+    const puma560_real t129 = t74*(c1*t96 + t16*t98) - t75*(s1*t96 + t21*t98) - t88*t128 + t87*t128;
+    const puma560_real t130 = t21*t96;
+    const puma560_real t131 = t16*t96;
+    const puma560_real t132 = -(-t30*t104 + t30*t106 + t68*t90 + t30*t108 + t30*t109);
 
     /* Outputs */
     Jd[0] = -t39;
@@ -1145,21 +1145,21 @@ void puma560_task_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_
     Jd[18] = 0;
     Jd[19] = t110;
     Jd[20] = t110;
-    Jd[21] = t112 + t114 - t116 - t117;
-    Jd[22] = t118 + t119 + t121 - t122;
-    Jd[23] = t123 + t125 - t126 - t127;
+    Jd[21] = -t112 + t113 + t115 - t117;
+    Jd[22] = -t119 + t120 + t121 + t122;
+    Jd[23] = -t124 + t125 + t126 - t127;
     Jd[24] = 0;
     Jd[25] = t129;
     Jd[26] = t129;
-    Jd[27] = -(-t75*(-t21*t99 + t13*t96) - t74*(t16*t99 + t18*t96) + t42*t130 + t50*t131);
-    Jd[28] = -t75*(t11*t96 + t21*t100) + t74*(t8*t96 + t16*t100) + t60*t130 - t59*t131;
-    Jd[29] = -(-t75*(t15*t96 - t21*t101) - t74*(t20*t96 + t16*t101) + t72*t130 + t71*t131);
+    Jd[27] = -(-t74*(t18*t96 + t16*t99) - t75*(t13*t96 - t21*t99) + t50*t130 + t42*t131);
+    Jd[28] = t74*(t8*t96 + t16*t100) - t75*(t11*t96 + t21*t100) - t59*t130 + t60*t131;
+    Jd[29] = -(-t74*(t20*t96 + t16*t101) - t75*(t15*t96 - t21*t101) + t71*t130 + t72*t131);
     Jd[30] = 0;
     Jd[31] = t132;
     Jd[32] = t132;
-    Jd[33] = -(t51 + t95*t68 - t30*t116 - t30*t117 + t30*t112 + t30*t114);
-    Jd[34] = -(-t56 + t91*t68 - t30*t122 + t30*t118 + t30*t119 + t30*t121);
-    Jd[35] = -(t66 + t92*t68 - t30*t126 - t30*t127 + t30*t123 + t30*t125);
+    Jd[33] = -(t51 - t30*t112 + t30*t113 + t68*t95 + t30*t115 - t30*t117);
+    Jd[34] = -(-t56 - t30*t119 + t30*t120 + t68*t91 + t30*t121 + t30*t122);
+    Jd[35] = -(t66 - t30*t124 + t30*t125 + t68*t92 + t30*t126 - t30*t127);
 }
 
 void puma560_hessian(const puma560_real q[PUMA560_DOF], puma560_real H[PUMA560_DOF * 6 * PUMA560_DOF])
@@ -1218,8 +1218,8 @@ void puma560_hessian(const puma560_real q[PUMA560_DOF], puma560_real H[PUMA560_D
     const puma560_real t29 = -c1*t1;
     const puma560_real t30 = -c1*t21;
     const puma560_real t31 = -s1*t21;
-    const puma560_real t32 = (c1*c1);
-    const puma560_real t33 = (s1*s1);
+    const puma560_real t32 = (s1*s1);
+    const puma560_real t33 = (c1*c1);
     const puma560_real t34 = -(t32*t1 + t33*t1);
     const puma560_real t35 = -t3;
     const puma560_real t36 = -s23*t12;
@@ -1228,8 +1228,8 @@ void puma560_hessian(const puma560_real q[PUMA560_DOF], puma560_real H[PUMA560_D
     const puma560_real t39 = -s23*t7;
     const puma560_real t40 = -s1*t0;
     const puma560_real t41 = -(t32*s23 + t33*s23);
-    const puma560_real t42 = c1*t13 - s1*t10;
-    const puma560_real t43 = -(c1*t16 + s1*t19);
+    const puma560_real t42 = -s1*t10 + c1*t13;
+    const puma560_real t43 = -(s1*t19 + c1*t16);
     const puma560_real t44 = (s23*s23);
     const puma560_real t45 = s23*s4;
 
@@ -1364,8 +1364,8 @@ void puma560_hessian(const puma560_real q[PUMA560_DOF], puma560_real H[PUMA560_D
     H[127] = 0;
     H[128] = 0;
     H[129] = 0;
-    H[130] = c23*t10 - t7*t44;
-    H[131] = c23*t19 - t0*t18;
+    H[130] = -t7*t44 + c23*t10;
+    H[131] = -t0*t18 + c23*t19;
     H[132] = 0;
     H[133] = 0;
     H[134] = 0;
@@ -1376,7 +1376,7 @@ void puma560_hessian(const puma560_real q[PUMA560_DOF], puma560_real H[PUMA560_D
     H[139] = 0;
     H[140] = 0;
     H[141] = 0;
-    H[142] = t13*t18 + t10*t15;
+    H[142] = t10*t15 + t13*t18;
     H[143] = t19*t15 - t16*t18;
     H[144] = 0;
     H[145] = 0;
@@ -1407,7 +1407,7 @@ void puma560_hessian(const puma560_real q[PUMA560_DOF], puma560_real H[PUMA560_D
     H[170] = 0;
     H[171] = 0;
     H[172] = 0;
-    H[173] = -(t13*t0 + t16*t45);
+    H[173] = -(t16*t45 + t13*t0);
     H[174] = 0;
     H[175] = 0;
     H[176] = 0;
@@ -1608,8 +1608,8 @@ int puma560_velocity_ik(const puma560_real q[PUMA560_DOF], const puma560_real mu
     const puma560_real t56 = (s23*s23);
     const puma560_real t57 = (t12*t12) + (t15*t15) + 2*t45 + t26*t56;
     const puma560_real t58 = t57;
-    const puma560_real t59 = 2*c1;
-    const puma560_real t60 = -s1*t59 + t33*t56 - t12*t9 + t15*t18;
+    const puma560_real t59 = 2*s1;
+    const puma560_real t60 = -c1*t59 + t33*t56 - t12*t9 + t15*t18;
     const puma560_real t61 = s23*s4;
     const puma560_real t62 = c23*t14 - t12*t61 + t15*t0;
     const puma560_real t63 = c23*t17 + t9*t61 + t18*t0;
@@ -1850,7 +1850,7 @@ int puma560_velocity_ik(const puma560_real q[PUMA560_DOF], const puma560_real mu
     const puma560_real t298 = t252 + t237*t295;
     const puma560_real t299 = -t18;
     const puma560_real t300 = t299 + c1*t295;
-    const puma560_real t301 = 1 + t234 - t15 + t292 + t299 + q1 + q2 + q3 + c23 + q4 + q5 + q6 + t12 + t22 + t0 + t61 - t39 - t40 - t229 - t232 - t14 + t285 - t59 + 2*s1 + t24 + t20 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping;
+    const puma560_real t301 = 1 + t234 - t15 + t292 + t299 + q1 + q2 + q3 + c23 + q4 + q5 + q6 + t12 + t22 + t0 + t61 - t39 - t40 - t229 - t232 - t14 + t285 + t24 + t20 + t59 - 2*c1 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping;
     const puma560_real t302 = t24*t281;
     const puma560_real t303 = t274*(-t302*t273 - t262*t283 + t263*t286 + t264*t284);
     const puma560_real t304 = t302 + t273*t303;

@@ -674,7 +674,7 @@ def fk_jacobian_dot(q, q_dot):
     t38 = t37
     t39 = c1*t20 + s1*t26
     t40 = t39
-    t41 = qd2*t38 + qd3*t40
+    t41 = t40*qd3 + t38*qd2
     t42 = s1*qd2
     t43 = s1*qd3
     t44 = t42 + t43
@@ -696,9 +696,9 @@ def fk_jacobian_dot(q, q_dot):
     t60 = s1*t1
     t61 = s1*t0
     t62 = -c1
-    t63 = c1**2
+    t63 = s1**2
     t64 = t0*qd2
-    t65 = s1**2
+    t65 = c1**2
     t66 = t0*qd3
     T = _stack(xp, [
         xp.broadcast_to(t18, batch),  # 0, 0
@@ -757,12 +757,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t29, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(-c1*t41 + t60*qd1) - qd3*(-t61*qd1 + t49*t40 + t50*t40) - qd1*t48, batch),  # 0
-        xp.broadcast_to(-qd2*(s1*t41 + t58*qd1) - qd3*(t59*qd1 + t42*t40 + t43*t40) - qd1*t55, batch),  # 1
-        xp.broadcast_to(-qd2*(c1*t54 + s1*t47) - qd3*(t63*t64 + t64*t65 + t63*t66 + t65*t66), batch),  # 2
-        xp.broadcast_to(qd4*(-c23*t51 + t21*qd1) + qd5*(t10*t3 - t30*t52) + qd6*(t23*t33 - t29*t53) + t49*qd1 + t50*qd1, batch),  # 3
-        xp.broadcast_to(-qd4*(c23*t44 + t15*qd1) + qd5*(t13*t3 - t30*t45) - qd6*(t17*t33 + t29*t46) + t42*qd1 + t43*qd1, batch),  # 4
-        xp.broadcast_to(-qd4*(t21*t44 + t15*t51) + qd5*(t13*t52 - t10*t45) - qd6*(t17*t53 + t23*t46), batch),  # 5
+        xp.broadcast_to(-qd1*t48 + qd2*(t60*qd1 - c1*t41) - qd3*(t49*t40 - t61*qd1 + t50*t40), batch),  # 0
+        xp.broadcast_to(-qd1*t55 - qd2*(t58*qd1 + s1*t41) - qd3*(t59*qd1 + t42*t40 + t43*t40), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t47 + c1*t54) - qd3*(t63*t64 + t64*t65 + t63*t66 + t65*t66), batch),  # 2
+        xp.broadcast_to(t49*qd1 + t50*qd1 + qd4*(-c23*t51 + t21*qd1) + qd5*(-t30*t52 + t10*t3) + qd6*(-t29*t53 + t23*t33), batch),  # 3
+        xp.broadcast_to(t42*qd1 + t43*qd1 - qd4*(t15*qd1 + c23*t44) + qd5*(t13*t3 - t30*t45) - qd6*(t17*t33 + t29*t46), batch),  # 4
+        xp.broadcast_to(-qd4*(t21*t44 + t15*t51) + qd5*(-t10*t45 + t13*t52) - qd6*(t23*t46 + t17*t53), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -814,7 +814,7 @@ def jacobian_dot(q, q_dot):
     t23 = c1*t22 + t19
     t24 = s1*t22 + t20
     t25 = c1*t23 + s1*t24
-    t26 = qd2*t25 + qd3*t21
+    t26 = t21*qd3 + t25*qd2
     t27 = s1*qd2
     t28 = s1*qd3
     t29 = t27 + t28
@@ -834,25 +834,25 @@ def jacobian_dot(q, q_dot):
     t43 = t3 + t42*qd5
     t44 = s1*qd1
     t45 = c1*qd1
-    t46 = c1**2
+    t46 = s1**2
     t47 = t1*qd2
-    t48 = s1**2
+    t48 = c1**2
     t49 = t1*qd3
     Jd = _stack(xp, [
         xp.broadcast_to(-t31, batch),  # 0, 0
-        xp.broadcast_to(-c1*t26 + t2*t44, batch),  # 0, 1
-        xp.broadcast_to(-(-t1*t44 + t32*t21 + t33*t21), batch),  # 0, 2
+        xp.broadcast_to(t2*t44 - c1*t26, batch),  # 0, 1
+        xp.broadcast_to(-(t32*t21 - t1*t44 + t33*t21), batch),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(-t36, batch),  # 1, 0
-        xp.broadcast_to(-(s1*t26 + t2*t45), batch),  # 1, 1
+        xp.broadcast_to(-(t2*t45 + s1*t26), batch),  # 1, 1
         xp.broadcast_to(-(t1*t45 + t27*t21 + t28*t21), batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-(c1*t35 + s1*t30), batch),  # 2, 1
+        xp.broadcast_to(-(s1*t30 + c1*t35), batch),  # 2, 1
         xp.broadcast_to(-(t46*t47 + t47*t48 + t46*t49 + t48*t49), batch),  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
@@ -861,20 +861,20 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(t45, batch),  # 3, 1
         xp.broadcast_to(t45, batch),  # 3, 2
         xp.broadcast_to(-c23*t34 + s23*t44, batch),  # 3, 3
-        xp.broadcast_to(t10*t3 - t42*t39, batch),  # 3, 4
-        xp.broadcast_to(t17*t43 - t0*t41, batch),  # 3, 5
+        xp.broadcast_to(-t42*t39 + t10*t3, batch),  # 3, 4
+        xp.broadcast_to(-t0*t41 + t17*t43, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t44, batch),  # 4, 1
         xp.broadcast_to(t44, batch),  # 4, 2
-        xp.broadcast_to(-(c23*t29 + s23*t45), batch),  # 4, 3
+        xp.broadcast_to(-(s23*t45 + c23*t29), batch),  # 4, 3
         xp.broadcast_to(t13*t3 - t42*t38, batch),  # 4, 4
         xp.broadcast_to(-(t16*t43 + t0*t40), batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
         xp.broadcast_to(-(s1*s23*t29 + c1*s23*t34), batch),  # 5, 3
-        xp.broadcast_to(t13*t39 - t10*t38, batch),  # 5, 4
-        xp.broadcast_to(-(t16*t41 + t17*t40), batch),  # 5, 5
+        xp.broadcast_to(-t10*t38 + t13*t39, batch),  # 5, 4
+        xp.broadcast_to(-(t17*t40 + t16*t41), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -927,7 +927,7 @@ def bias_acceleration(q, q_dot):
     t23 = c1*t22 + t19
     t24 = s1*t22 + t20
     t25 = c1*t23 + s1*t24
-    t26 = qd2*t25 + qd3*t21
+    t26 = t21*qd3 + t25*qd2
     t27 = s1*qd2
     t28 = s1*qd3
     t29 = t27 + t28
@@ -947,17 +947,17 @@ def bias_acceleration(q, q_dot):
     t43 = t3 + t42*qd5
     t44 = s1*qd1
     t45 = c1*qd1
-    t46 = c1**2
+    t46 = s1**2
     t47 = t1*qd2
-    t48 = s1**2
+    t48 = c1**2
     t49 = t1*qd3
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(-c1*t26 + t2*t44) - qd3*(-t1*t44 + t32*t21 + t33*t21) - qd1*t31, batch),  # 0
-        xp.broadcast_to(-qd2*(s1*t26 + t2*t45) - qd3*(t1*t45 + t27*t21 + t28*t21) - qd1*t36, batch),  # 1
-        xp.broadcast_to(-qd2*(c1*t35 + s1*t30) - qd3*(t46*t47 + t47*t48 + t46*t49 + t48*t49), batch),  # 2
-        xp.broadcast_to(qd4*(-c23*t34 + s23*t44) + qd5*(t10*t3 - t42*t39) + qd6*(t17*t43 - t0*t41) + t32*qd1 + t33*qd1, batch),  # 3
-        xp.broadcast_to(-qd4*(c23*t29 + s23*t45) + qd5*(t13*t3 - t42*t38) - qd6*(t16*t43 + t0*t40) + t27*qd1 + t28*qd1, batch),  # 4
-        xp.broadcast_to(-qd4*(s1*s23*t29 + c1*s23*t34) + qd5*(t13*t39 - t10*t38) - qd6*(t16*t41 + t17*t40), batch),  # 5
+        xp.broadcast_to(-qd1*t31 + qd2*(t2*t44 - c1*t26) - qd3*(t32*t21 - t1*t44 + t33*t21), batch),  # 0
+        xp.broadcast_to(-qd1*t36 - qd2*(t2*t45 + s1*t26) - qd3*(t1*t45 + t27*t21 + t28*t21), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t30 + c1*t35) - qd3*(t46*t47 + t47*t48 + t46*t49 + t48*t49), batch),  # 2
+        xp.broadcast_to(t32*qd1 + t33*qd1 + qd4*(-c23*t34 + s23*t44) + qd5*(-t42*t39 + t10*t3) + qd6*(-t0*t41 + t17*t43), batch),  # 3
+        xp.broadcast_to(t27*qd1 + t28*qd1 - qd4*(s23*t45 + c23*t29) + qd5*(t13*t3 - t42*t38) - qd6*(t16*t43 + t0*t40), batch),  # 4
+        xp.broadcast_to(-qd4*(s1*s23*t29 + c1*s23*t34) + qd5*(-t10*t38 + t13*t39) - qd6*(t17*t40 + t16*t41), batch),  # 5
     ], (6,))
     return a
 
@@ -1021,19 +1021,19 @@ def task_jacobian_dot(q, q_dot):
     t32 = c1*t31 + t17
     t33 = s1*t31 + t22
     t34 = c1*t32 + s1*t33
-    t35 = qd2*t34 + qd3*t23
+    t35 = t23*qd3 + t34*qd2
     t36 = s1*qd2
     t37 = s1*qd3
     t38 = t0*t37 + t1*t36
     t39 = -t38 + t32*qd1
     t40 = t36 + t37
     t41 = t40
-    t42 = c23*t41 + t13*qd1
+    t42 = t13*qd1 + c23*t41
     t43 = c1*qd2
     t44 = c1*qd3
     t45 = t0*t44 + t1*t43
     t46 = t45 + t33*qd1
-    t47 = c1*t45 + s1*t38
+    t47 = s1*t38 + c1*t45
     t48 = t43 + t44
     t49 = t48
     t50 = -c23*t49 + t18*qd1
@@ -1042,35 +1042,35 @@ def task_jacobian_dot(q, q_dot):
     t53 = t41 + t52
     t54 = t18*qd4
     t55 = t49 + t54
-    t56 = t11*t55 - t8*t53
+    t56 = -t8*t53 + t11*t55
     t57 = qd1 + c23*qd4
     t58 = t57
-    t59 = t8*t58 - t29*t55
+    t59 = -t29*t55 + t8*t58
     t60 = t11*t58 - t29*t53
     t61 = t11*qd5
     t62 = t53 + t61
     t63 = t40 + t52 + t61 - t15*qd6
     t64 = t8*qd5
     t65 = t55 + t64
-    t66 = t15*t65 + t20*t62
+    t66 = t20*t62 + t15*t65
     t67 = t48 + t54 + t64 + t20*qd6
-    t68 = t16*t67 + t21*t63
+    t68 = t21*t63 + t16*t67
     t69 = t29*qd5
     t70 = t58 + t69
-    t71 = t20*t70 - t28*t65
+    t71 = -t28*t65 + t20*t70
     t72 = t15*t70 + t28*t62
     t73 = t57 + t69 + t28*qd6
-    t74 = t21*t73 + t30*t67
+    t74 = t30*t67 + t21*t73
     t75 = t16*t73 - t30*t63
     t76 = s1*qd1
-    t77 = -c1*t35 + t1*t76
-    t78 = t43*t23 + t44*t23 - t0*t76
+    t77 = t1*t76 - c1*t35
+    t78 = t43*t23 - t0*t76 + t44*t23
     t79 = c1*qd1
-    t80 = s1*t35 + t1*t79
+    t80 = t1*t79 + s1*t35
     t81 = t0*t79 + t36*t23 + t37*t23
-    t82 = c1**2
+    t82 = s1**2
     t83 = t0*qd2
-    t84 = s1**2
+    t84 = c1**2
     t85 = t0*qd3
     t86 = t82*t83 + t83*t84 + t82*t85 + t84*t85
     t87 = s1*t16
@@ -1089,36 +1089,36 @@ def task_jacobian_dot(q, q_dot):
     t100 = -(t11*t21 + t8*t16)*t97
     t101 = (t15*t21 - t16*t20)*t97
     t102 = 2*t90
-    t103 = t75*t89
-    t104 = -(c1 + t21*t102)*t103
-    t105 = t74*t89
-    t106 = (s1 - t16*t102)*t105
+    t103 = t74*t89
+    t104 = (s1 - t16*t102)*t103
+    t105 = t75*t89
+    t106 = -(c1 + t21*t102)*t105
     t107 = qd1*t89
     t108 = t93*t107
     t109 = t94*t107
-    t110 = t104 - t106 + t108 + t109
-    t111 = t16*t89
-    t112 = t50*t111
-    t113 = 2*t95
-    t114 = -t103*(t18 + t21*t113)
-    t115 = t21*t89
-    t116 = t42*t115
-    t117 = -t105*(t13 + t16*t113)
-    t118 = t59*t111
-    t119 = t60*t115
-    t120 = 2*t91
-    t121 = -t103*(t8 + t21*t120)
-    t122 = t105*(t11 - t16*t120)
-    t123 = t71*t111
-    t124 = 2*t92
-    t125 = -t103*(t20 + t21*t124)
-    t126 = t72*t115
-    t127 = -t105*(t15 + t16*t124)
+    t110 = -t104 + t106 + t108 + t109
+    t111 = 2*t95
+    t112 = -t103*(t13 + t16*t111)
+    t113 = -t105*(t18 + t21*t111)
+    t114 = t16*t89
+    t115 = t50*t114
+    t116 = t21*t89
+    t117 = t42*t116
+    t118 = 2*t91
+    t119 = t103*(t11 - t16*t118)
+    t120 = -t105*(t8 + t21*t118)
+    t121 = t59*t114
+    t122 = t60*t116
+    t123 = 2*t92
+    t124 = -t103*(t15 + t16*t123)
+    t125 = -t105*(t20 + t21*t123)
+    t126 = t71*t114
+    t127 = t72*t116
     t128 = qd1*t96
-    t129 = -t75*(t21*t98 + s1*t96) + t74*(t16*t98 + c1*t96) + t87*t128 - t88*t128
-    t130 = t16*t96
-    t131 = t21*t96
-    t132 = -(t90*t68 - t30*t106 + t30*t104 + t30*t108 + t30*t109)
+    t129 = t74*(c1*t96 + t16*t98) - t75*(s1*t96 + t21*t98) - t88*t128 + t87*t128
+    t130 = t21*t96
+    t131 = t16*t96
+    t132 = -(-t30*t104 + t30*t106 + t68*t90 + t30*t108 + t30*t109)
     Jd = _stack(xp, [
         xp.broadcast_to(-t39, batch),  # 0, 0
         xp.broadcast_to(t77, batch),  # 0, 1
@@ -1141,21 +1141,21 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t110, batch),  # 3, 1
         xp.broadcast_to(t110, batch),  # 3, 2
-        xp.broadcast_to(t112 + t114 - t116 - t117, batch),  # 3, 3
-        xp.broadcast_to(t118 + t119 + t121 - t122, batch),  # 3, 4
-        xp.broadcast_to(t123 + t125 - t126 - t127, batch),  # 3, 5
+        xp.broadcast_to(-t112 + t113 + t115 - t117, batch),  # 3, 3
+        xp.broadcast_to(-t119 + t120 + t121 + t122, batch),  # 3, 4
+        xp.broadcast_to(-t124 + t125 + t126 - t127, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t129, batch),  # 4, 1
         xp.broadcast_to(t129, batch),  # 4, 2
-        xp.broadcast_to(-(-t75*(-t21*t99 + t13*t96) - t74*(t16*t99 + t18*t96) + t42*t130 + t50*t131), batch),  # 4, 3
-        xp.broadcast_to(-t75*(t11*t96 + t21*t100) + t74*(t8*t96 + t16*t100) + t60*t130 - t59*t131, batch),  # 4, 4
-        xp.broadcast_to(-(-t75*(t15*t96 - t21*t101) - t74*(t20*t96 + t16*t101) + t72*t130 + t71*t131), batch),  # 4, 5
+        xp.broadcast_to(-(-t74*(t18*t96 + t16*t99) - t75*(t13*t96 - t21*t99) + t50*t130 + t42*t131), batch),  # 4, 3
+        xp.broadcast_to(t74*(t8*t96 + t16*t100) - t75*(t11*t96 + t21*t100) - t59*t130 + t60*t131, batch),  # 4, 4
+        xp.broadcast_to(-(-t74*(t20*t96 + t16*t101) - t75*(t15*t96 - t21*t101) + t71*t130 + t72*t131), batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.broadcast_to(t132, batch),  # 5, 1
         xp.broadcast_to(t132, batch),  # 5, 2
-        xp.broadcast_to(-(t51 + t95*t68 - t30*t116 - t30*t117 + t30*t112 + t30*t114), batch),  # 5, 3
-        xp.broadcast_to(-(-t56 + t91*t68 - t30*t122 + t30*t118 + t30*t119 + t30*t121), batch),  # 5, 4
-        xp.broadcast_to(-(t66 + t92*t68 - t30*t126 - t30*t127 + t30*t123 + t30*t125), batch),  # 5, 5
+        xp.broadcast_to(-(t51 - t30*t112 + t30*t113 + t68*t95 + t30*t115 - t30*t117), batch),  # 5, 3
+        xp.broadcast_to(-(-t56 - t30*t119 + t30*t120 + t68*t91 + t30*t121 + t30*t122), batch),  # 5, 4
+        xp.broadcast_to(-(t66 - t30*t124 + t30*t125 + t68*t92 + t30*t126 - t30*t127), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1208,8 +1208,8 @@ def hessian(q):
     t29 = -c1*t1
     t30 = -c1*t21
     t31 = -s1*t21
-    t32 = c1**2
-    t33 = s1**2
+    t32 = s1**2
+    t33 = c1**2
     t34 = -(t32*t1 + t33*t1)
     t35 = -t3
     t36 = -s23*t12
@@ -1218,8 +1218,8 @@ def hessian(q):
     t39 = -s23*t7
     t40 = -s1*t0
     t41 = -(t32*s23 + t33*s23)
-    t42 = c1*t13 - s1*t10
-    t43 = -(c1*t16 + s1*t19)
+    t42 = -s1*t10 + c1*t13
+    t43 = -(s1*t19 + c1*t16)
     t44 = s23**2
     t45 = s23*s4
     H = _stack(xp, [
@@ -1353,8 +1353,8 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        c23*t10 - t7*t44,  # 3, 3, 4
-        c23*t19 - t0*t18,  # 3, 3, 5
+        -t7*t44 + c23*t10,  # 3, 3, 4
+        -t0*t18 + c23*t19,  # 3, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
@@ -1365,7 +1365,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 3
-        t13*t18 + t10*t15,  # 3, 5, 4
+        t10*t15 + t13*t18,  # 3, 5, 4
         t19*t15 - t16*t18,  # 3, 5, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0, 1
@@ -1396,7 +1396,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        -(t13*t0 + t16*t45),  # 4, 4, 5
+        -(t16*t45 + t13*t0),  # 4, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
@@ -1578,8 +1578,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t56 = s23**2
     t57 = t12**2 + t15**2 + 2*t45 + t26*t56
     t58 = t57
-    t59 = 2*c1
-    t60 = -s1*t59 + t33*t56 - t12*t9 + t15*t18
+    t59 = 2*s1
+    t60 = -c1*t59 + t33*t56 - t12*t9 + t15*t18
     t61 = s23*s4
     t62 = c23*t14 - t12*t61 + t15*t0
     t63 = c23*t17 + t9*t61 + t18*t0
@@ -1820,7 +1820,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t298 = t252 + t237*t295
     t299 = -t18
     t300 = t299 + c1*t295
-    t301 = 1 + t234 - t15 + t292 + t299 + q1 + q2 + q3 + c23 + q4 + q5 + q6 + t12 + t22 + t0 + t61 - t39 - t40 - t229 - t232 - t14 + t285 - t59 + 2*s1 + t24 + t20 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t301 = 1 + t234 - t15 + t292 + t299 + q1 + q2 + q3 + c23 + q4 + q5 + q6 + t12 + t22 + t0 + t61 - t39 - t40 - t229 - t232 - t14 + t285 + t24 + t20 + t59 - 2*c1 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
     t302 = t24*t281
     t303 = t274*(-t302*t273 - t262*t283 + t263*t286 + t264*t284)
     t304 = t302 + t273*t303

@@ -430,16 +430,16 @@ void rexarm_fk_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q
     const rexarm_real t25 = c1*qd3;
     const rexarm_real t26 = t24 + t25;
     const rexarm_real t27 = c1*t5;
-    const rexarm_real t28 = t6*t25 + t27*qd4;
+    const rexarm_real t28 = t27*qd4 + t6*t25;
     const rexarm_real t29 = t28 + t7*t24;
     const rexarm_real t30 = t29 + t11*qd1;
     const rexarm_real t31 = s1*t5;
-    const rexarm_real t32 = t6*t22 + t31*qd4;
+    const rexarm_real t32 = t31*qd4 + t6*t22;
     const rexarm_real t33 = t32 + t7*t21;
     const rexarm_real t34 = -t33 + t10*qd1;
-    const rexarm_real t35 = qd4*t20;
-    const rexarm_real t36 = qd3*t15 + t35;
-    const rexarm_real t37 = t36 + qd2*t13;
+    const rexarm_real t35 = t20*qd4;
+    const rexarm_real t36 = t35 + t15*qd3;
+    const rexarm_real t37 = t36 + t13*qd2;
     const rexarm_real t38 = c1*t7;
     const rexarm_real t39 = c1*t6;
     const rexarm_real t40 = s1*t7;
@@ -447,7 +447,7 @@ void rexarm_fk_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q
     const rexarm_real t42 = -c1;
     const rexarm_real t43 = t6*qd2;
     const rexarm_real t44 = t5*qd4;
-    const rexarm_real t45 = qd4*qd1;
+    const rexarm_real t45 = qd1*qd4;
 
     /* Outputs */
     T[0] = t1;
@@ -490,12 +490,12 @@ void rexarm_fk_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q
     J[21] = 0;
     J[22] = 0;
     J[23] = 0;
-    a[0] = qd2*(-c1*t37 + qd1*t40) - qd3*(-qd1*t41 + c1*t36 + t24*t15) - qd4*(t26*t20 + c1*t35 - 0.1*s1*s234*qd1) - qd1*t34;
-    a[1] = -qd2*(s1*t37 + qd1*t38) - qd3*(s1*t36 + qd1*t39 + t21*t15) - qd4*(t23*t20 + s1*t35 + t27*qd1) - qd1*t30;
-    a[2] = -qd2*(c1*t29 + s1*t33) - qd3*(c1*t28 + s1*t32 + t16*t43 + t18*t43) - qd4*(t31*t23 + t27*t26 + t16*t44 + t18*t44);
+    a[0] = -qd1*t34 + qd2*(qd1*t40 - c1*t37) - qd3*(t24*t15 - qd1*t41 + c1*t36) - qd4*(t20*t26 - 0.1*s1*s234*qd1 + c1*t35);
+    a[1] = -qd1*t30 - qd2*(qd1*t38 + s1*t37) - qd3*(qd1*t39 + t21*t15 + s1*t36) - qd4*(t27*qd1 + t20*t23 + s1*t35);
+    a[2] = -qd2*(s1*t33 + c1*t29) - qd3*(t18*t43 + t16*t43 + s1*t32 + c1*t28) - qd4*(t31*t23 + t27*t26 + t18*t44 + t16*t44);
     a[3] = t24*qd1 + t25*qd1 + c1*t45;
     a[4] = t21*qd1 + t22*qd1 + s1*t45;
-    a[5] = qd4*(s1*t26 - c1*t23);
+    a[5] = qd4*(-c1*t23 + s1*t26);
 }
 
 void rexarm_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real Jd[6 * REXARM_DOF])
@@ -547,32 +547,32 @@ void rexarm_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_do
     const rexarm_real t19 = c1*qd3;
     const rexarm_real t20 = t18 + t19;
     const rexarm_real t21 = t8*qd4;
-    const rexarm_real t22 = t9*t19 + c1*t21;
-    const rexarm_real t23 = t9*t16 + s1*t21;
+    const rexarm_real t22 = c1*t21 + t9*t19;
+    const rexarm_real t23 = s1*t21 + t9*t16;
     const rexarm_real t24 = t22 + t10*t18;
     const rexarm_real t25 = t23 + t10*t15;
     const rexarm_real t26 = t24 + t5*qd1;
     const rexarm_real t27 = -t25 + t2*qd1;
-    const rexarm_real t28 = qd4*t14;
-    const rexarm_real t29 = qd3*t7 + t28;
-    const rexarm_real t30 = t29 + qd2*t6;
+    const rexarm_real t28 = t14*qd4;
+    const rexarm_real t29 = t28 + t7*qd3;
+    const rexarm_real t30 = t29 + t6*qd2;
     const rexarm_real t31 = s1*qd1;
     const rexarm_real t32 = c1*qd1;
     const rexarm_real t33 = t9*qd2;
 
     /* Outputs */
     Jd[0] = -t27;
-    Jd[1] = -c1*t30 + t10*t31;
-    Jd[2] = -(-t9*t31 + c1*t29 + t18*t7);
-    Jd[3] = -(t20*t14 + c1*t28 - 0.1*s1*s234*qd1);
+    Jd[1] = t10*t31 - c1*t30;
+    Jd[2] = -(t18*t7 - t9*t31 + c1*t29);
+    Jd[3] = -(t14*t20 - 0.1*s1*s234*qd1 + c1*t28);
     Jd[4] = -t26;
-    Jd[5] = -(s1*t30 + t10*t32);
-    Jd[6] = -(s1*t29 + t9*t32 + t15*t7);
-    Jd[7] = -(t17*t14 + s1*t28 + t8*t32);
+    Jd[5] = -(t10*t32 + s1*t30);
+    Jd[6] = -(t9*t32 + t15*t7 + s1*t29);
+    Jd[7] = -(t8*t32 + t14*t17 + s1*t28);
     Jd[8] = 0;
-    Jd[9] = -(c1*t24 + s1*t25);
-    Jd[10] = -(c1*t22 + s1*t23 + t11*t33 + t13*t33);
-    Jd[11] = -(s1*t8*t17 + c1*t8*t20 + t11*t21 + t13*t21);
+    Jd[9] = -(s1*t25 + c1*t24);
+    Jd[10] = -(t13*t33 + t11*t33 + s1*t23 + c1*t22);
+    Jd[11] = -(s1*t8*t17 + c1*t8*t20 + t13*t21 + t11*t21);
     Jd[12] = 0;
     Jd[13] = t32;
     Jd[14] = t32;
@@ -584,7 +584,7 @@ void rexarm_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_do
     Jd[20] = 0;
     Jd[21] = 0;
     Jd[22] = 0;
-    Jd[23] = s1*t20 - c1*t17;
+    Jd[23] = -c1*t17 + s1*t20;
 }
 
 void rexarm_bias_acceleration(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real a[6])
@@ -636,31 +636,31 @@ void rexarm_bias_acceleration(const rexarm_real q[REXARM_DOF], const rexarm_real
     const rexarm_real t19 = c1*qd3;
     const rexarm_real t20 = t18 + t19;
     const rexarm_real t21 = t8*qd4;
-    const rexarm_real t22 = t9*t19 + c1*t21;
-    const rexarm_real t23 = t9*t16 + s1*t21;
+    const rexarm_real t22 = c1*t21 + t9*t19;
+    const rexarm_real t23 = s1*t21 + t9*t16;
     const rexarm_real t24 = t22 + t10*t18;
     const rexarm_real t25 = t23 + t10*t15;
     const rexarm_real t26 = t24 + t5*qd1;
     const rexarm_real t27 = -t25 + t2*qd1;
-    const rexarm_real t28 = qd4*t14;
-    const rexarm_real t29 = qd3*t7 + t28;
-    const rexarm_real t30 = t29 + qd2*t6;
+    const rexarm_real t28 = t14*qd4;
+    const rexarm_real t29 = t28 + t7*qd3;
+    const rexarm_real t30 = t29 + t6*qd2;
     const rexarm_real t31 = s1*qd1;
     const rexarm_real t32 = c1*qd1;
     const rexarm_real t33 = t9*qd2;
 
     /* Outputs */
-    a[0] = qd2*(-c1*t30 + t10*t31) - qd3*(-t9*t31 + c1*t29 + t18*t7) - qd4*(t20*t14 + c1*t28 - 0.1*s1*s234*qd1) - qd1*t27;
-    a[1] = -qd2*(s1*t30 + t10*t32) - qd3*(s1*t29 + t9*t32 + t15*t7) - qd4*(t17*t14 + s1*t28 + t8*t32) - qd1*t26;
-    a[2] = -qd2*(c1*t24 + s1*t25) - qd3*(c1*t22 + s1*t23 + t11*t33 + t13*t33) - qd4*(s1*t8*t17 + c1*t8*t20 + t11*t21 + t13*t21);
+    a[0] = -qd1*t27 + qd2*(t10*t31 - c1*t30) - qd3*(t18*t7 - t9*t31 + c1*t29) - qd4*(t14*t20 - 0.1*s1*s234*qd1 + c1*t28);
+    a[1] = -qd1*t26 - qd2*(t10*t32 + s1*t30) - qd3*(t9*t32 + t15*t7 + s1*t29) - qd4*(t8*t32 + t14*t17 + s1*t28);
+    a[2] = -qd2*(s1*t25 + c1*t24) - qd3*(t13*t33 + t11*t33 + s1*t23 + c1*t22) - qd4*(s1*t8*t17 + c1*t8*t20 + t13*t21 + t11*t21);
     a[3] = t18*qd1 + t19*qd1 + t32*qd4;
     a[4] = t15*qd1 + t16*qd1 + t31*qd4;
-    a[5] = qd4*(s1*t20 - c1*t17);
+    a[5] = qd4*(-c1*t17 + s1*t20);
 }
 
 void rexarm_task_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real Jd[REXARM_TASK_DIM * REXARM_DOF])
 {
-    /* 166 operations */
+    /* 170 operations */
 
     /* Inputs */
     const rexarm_real q1 = q[0];
@@ -689,79 +689,82 @@ void rexarm_task_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real
     const rexarm_real t1 = c23*t0 + c234*t0;
     const rexarm_real t2 = c2*t0 + t1;
     const rexarm_real t3 = 0.1*s1;
-    const rexarm_real t4 = c23*t3 + c234*t3;
-    const rexarm_real t5 = c2*t3 + t4;
-    const rexarm_real t6 = c1*t2 + s1*t5;
-    const rexarm_real t7 = c1*t1 + s1*t4;
-    const rexarm_real t8 = 0.1*s234;
-    const rexarm_real t9 = 0.1*s23 + t8;
-    const rexarm_real t10 = 0.1*s2 + t9;
-    const rexarm_real t11 = (c1*c1);
-    const rexarm_real t12 = t11*c234;
-    const rexarm_real t13 = (s1*s1);
-    const rexarm_real t14 = t13*c234;
-    const rexarm_real t15 = 0.1*t12 + 0.1*t14;
-    const rexarm_real t16 = s1*qd2;
-    const rexarm_real t17 = s1*qd3;
-    const rexarm_real t18 = t16 + t17;
-    const rexarm_real t19 = t18;
-    const rexarm_real t20 = c1*qd2;
-    const rexarm_real t21 = c1*qd3;
-    const rexarm_real t22 = t20 + t21;
-    const rexarm_real t23 = t22;
-    const rexarm_real t24 = c1*qd4;
-    const rexarm_real t25 = t9*t21 + t8*t24;
-    const rexarm_real t26 = t25 + t10*t20;
-    const rexarm_real t27 = t26 + t5*qd1;
-    const rexarm_real t28 = t22 + t24;
-    const rexarm_real t29 = s1*qd4;
-    const rexarm_real t30 = t9*t17 + t8*t29;
-    const rexarm_real t31 = t30 + t10*t16;
-    const rexarm_real t32 = -t31 + t2*qd1;
-    const rexarm_real t33 = c1*t26 + s1*t31;
-    const rexarm_real t34 = t18 + t29;
-    const rexarm_real t35 = qd4*t15;
-    const rexarm_real t36 = qd3*t7 + t35;
-    const rexarm_real t37 = t36 + qd2*t6;
-    const rexarm_real t38 = s1*qd1;
-    const rexarm_real t39 = -c1*t37 + t10*t38;
-    const rexarm_real t40 = c1*t36 + t20*t7 - t9*t38;
-    const rexarm_real t41 = t23*t15 + c1*t35 - t8*t38;
-    const rexarm_real t42 = s234*t28 + c234*t38;
+    const rexarm_real t4 = s1*c234;
+    const rexarm_real t5 = c23*t3 + 0.1*t4;
+    const rexarm_real t6 = c2*t3 + t5;
+    const rexarm_real t7 = c1*t2 + s1*t6;
+    const rexarm_real t8 = c1*t1 + s1*t5;
+    const rexarm_real t9 = 0.1*s234;
+    const rexarm_real t10 = 0.1*s23 + t9;
+    const rexarm_real t11 = 0.1*s2 + t10;
+    const rexarm_real t12 = (c1*c1);
+    const rexarm_real t13 = t12*c234;
+    const rexarm_real t14 = (s1*s1);
+    const rexarm_real t15 = t14*c234;
+    const rexarm_real t16 = 0.1*t13 + 0.1*t15;
+    const rexarm_real t17 = s1*qd2;
+    const rexarm_real t18 = s1*qd3;
+    const rexarm_real t19 = t17 + t18;
+    const rexarm_real t20 = t19;
+    const rexarm_real t21 = c1*qd2;
+    const rexarm_real t22 = c1*qd3;
+    const rexarm_real t23 = t21 + t22;
+    const rexarm_real t24 = t23;
+    const rexarm_real t25 = c1*qd4;
+    const rexarm_real t26 = t9*t25 + t10*t22;
+    const rexarm_real t27 = t26 + t11*t21;
+    const rexarm_real t28 = t27 + t6*qd1;
+    const rexarm_real t29 = t23 + t25;
+    const rexarm_real t30 = s1*qd4;
+    const rexarm_real t31 = t9*t30 + t10*t18;
+    const rexarm_real t32 = t31 + t11*t17;
+    const rexarm_real t33 = -t32 + t2*qd1;
+    const rexarm_real t34 = s1*t32 + c1*t27;
+    const rexarm_real t35 = t19 + t30;
+    const rexarm_real t36 = t16*qd4;
+    const rexarm_real t37 = t36 + t8*qd3;
+    const rexarm_real t38 = t37 + t7*qd2;
+    const rexarm_real t39 = s1*qd1;
+    const rexarm_real t40 = t11*t39 - c1*t38;
+    const rexarm_real t41 = t21*t8 - t10*t39 + c1*t37;
+    const rexarm_real t42 = t16*t24 - t9*t39 + c1*t36;
     const rexarm_real t43 = c1*qd1;
-    const rexarm_real t44 = s1*t37 + t10*t43;
-    const rexarm_real t45 = s1*t36 + t9*t43 + t16*t7;
-    const rexarm_real t46 = t19*t15 + s1*t35 + t8*t43;
-    const rexarm_real t47 = -s234*t34 + c234*t43;
-    const rexarm_real t48 = t9*qd2;
-    const rexarm_real t49 = c1*t25 + s1*t30 + t11*t48 + t13*t48;
-    const rexarm_real t50 = t8*qd4;
-    const rexarm_real t51 = s1*t8*t19 + c1*t8*t23 + t11*t50 + t13*t50;
-    const rexarm_real t52 = (c234*c234);
-    const rexarm_real t53 = t11*t52 + t13*t52;
-    const rexarm_real t54 = sqrt(t53);
-    const rexarm_real t55 = 1.0/t54;
-    const rexarm_real t56 = -(t12 + t14)*t55/t53;
-    const rexarm_real t57 = c234*t56;
-    const rexarm_real t58 = -t47*(s1*t55 + s1*t57) + t42*(c1*t55 + c1*t57);
+    const rexarm_real t44 = t11*t43 + s1*t38;
+    const rexarm_real t45 = t10*t43 + t17*t8 + s1*t37;
+    const rexarm_real t46 = t9*t43 + t16*t20 + s1*t36;
+    const rexarm_real t47 = c234*t43 - s234*t35;
+    const rexarm_real t48 = t10*qd2;
+    const rexarm_real t49 = t14*t48 + t12*t48 + s1*t31 + c1*t26;
+    const rexarm_real t50 = t9*qd4;
+    const rexarm_real t51 = s1*t9*t20 + c1*t9*t24 + t14*t50 + t12*t50;
+    const rexarm_real t52 = t4*qd1;
+    const rexarm_real t53 = s234*t29 + t52;
+    const rexarm_real t54 = (c234*c234);
+    const rexarm_real t55 = t12*t54 + t14*t54;
+    const rexarm_real t56 = sqrt(t55);
+    const rexarm_real t57 = 1.0/t56;
+    const rexarm_real t58 = -t57*(t13 + t15)/t55;
+    const rexarm_real t59 = c1*t57;
+    const rexarm_real t60 = t52*t59;
+    const rexarm_real t61 = t53*(t59 + c1*c234*t58) - t47*(s1*t57 + t4*t58) - t60 + t60;
 
     /* Outputs */
-    Jd[0] = -t32;
-    Jd[1] = t39;
-    Jd[2] = -t40;
-    Jd[3] = -t41;
-    Jd[4] = -t27;
+    Jd[0] = -t33;
+    Jd[1] = t40;
+    Jd[2] = -t41;
+    Jd[3] = -t42;
+    Jd[4] = -t28;
     Jd[5] = -t44;
     Jd[6] = -t45;
     Jd[7] = -t46;
     Jd[8] = 0;
-    Jd[9] = -t33;
+    Jd[9] = -t34;
     Jd[10] = -t49;
     Jd[11] = -t51;
     Jd[12] = 0;
-    Jd[13] = t58;
-    Jd[14] = t58;
-    Jd[15] = t58;
+    Jd[13] = t61;
+    Jd[14] = t61;
+    Jd[15] = t61;
 }
 
 void rexarm_hessian(const rexarm_real q[REXARM_DOF], rexarm_real H[REXARM_DOF * 6 * REXARM_DOF])
@@ -812,8 +815,8 @@ void rexarm_hessian(const rexarm_real q[REXARM_DOF], rexarm_real H[REXARM_DOF * 
     const rexarm_real t22 = -c1*t14;
     const rexarm_real t23 = -s1*t7;
     const rexarm_real t24 = -s1*t14;
-    const rexarm_real t25 = -(t11*t9 + t13*t9);
-    const rexarm_real t26 = -(t8*t11 + t8*t13);
+    const rexarm_real t25 = -(t13*t9 + t11*t9);
+    const rexarm_real t26 = -(t8*t13 + t8*t11);
 
     /* Outputs */
     H[0] = -t2;
@@ -849,7 +852,7 @@ void rexarm_hessian(const rexarm_real q[REXARM_DOF], rexarm_real H[REXARM_DOF * 
     H[30] = t23;
     H[31] = t24;
     H[32] = 0;
-    H[33] = -(t11*t10 + t13*t10);
+    H[33] = -(t13*t10 + t11*t10);
     H[34] = t25;
     H[35] = t26;
     H[36] = 0;
@@ -1066,7 +1069,7 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
     const rexarm_real t35 = s1*t10;
     const rexarm_real t36 = s1*t9;
     const rexarm_real t37 = s1*t8;
-    const rexarm_real t38 = t35*t6 + t36*t7 + t37*t15;
+    const rexarm_real t38 = t6*t35 + t7*t36 + t15*t37;
     const rexarm_real t39 = t35*t17 + t36*t17 + t37*t17;
     const rexarm_real t40 = (t6*t6);
     const rexarm_real t41 = t40 + (t7*t7) + (t15*t15);
@@ -1295,7 +1298,7 @@ rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], co
     const rexarm_real t39 = s1*t13;
     const rexarm_real t40 = s1*t12;
     const rexarm_real t41 = s1*t11;
-    const rexarm_real t42 = t39*t8 + t40*t9 + t41*t20;
+    const rexarm_real t42 = t39*t8 + t40*t9 + t20*t41;
     const rexarm_real t43 = t39*t24 + t40*t24 + t41*t24;
     const rexarm_real t44 = -mu3 + atan2(-s234, t23);
     const rexarm_real t45 = t44 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t44));

@@ -69,7 +69,7 @@ void rexarm_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_do
 void rexarm_bias_acceleration(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 4 x 4 row-major, element (r, c) at Jd[r * 4 + c]. 166 operations. */
+ * Result: Jd: 4 x 4 row-major, element (r, c) at Jd[r * 4 + c]. 170 operations. */
 void rexarm_task_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real Jd[REXARM_TASK_DIM * REXARM_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).

@@ -465,16 +465,16 @@ def fk_jacobian_dot(q, q_dot):
     t25 = c1*qd3
     t26 = t24 + t25
     t27 = c1*t5
-    t28 = t6*t25 + t27*qd4
+    t28 = t27*qd4 + t6*t25
     t29 = t28 + t7*t24
     t30 = t29 + t11*qd1
     t31 = s1*t5
-    t32 = t6*t22 + t31*qd4
+    t32 = t31*qd4 + t6*t22
     t33 = t32 + t7*t21
     t34 = -t33 + t10*qd1
-    t35 = qd4*t20
-    t36 = qd3*t15 + t35
-    t37 = t36 + qd2*t13
+    t35 = t20*qd4
+    t36 = t35 + t15*qd3
+    t37 = t36 + t13*qd2
     t38 = c1*t7
     t39 = c1*t6
     t40 = s1*t7
@@ -482,7 +482,7 @@ def fk_jacobian_dot(q, q_dot):
     t42 = -c1
     t43 = t6*qd2
     t44 = t5*qd4
-    t45 = qd4*qd1
+    t45 = qd1*qd4
     T = _stack(xp, [
         xp.broadcast_to(t1, batch),  # 0, 0
         xp.broadcast_to(-s1, batch),  # 0, 1
@@ -528,12 +528,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3
     ], (6, 4))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(-c1*t37 + qd1*t40) - qd3*(-qd1*t41 + c1*t36 + t24*t15) - qd4*(t26*t20 + c1*t35 - 0.1*s1*s234*qd1) - qd1*t34, batch),  # 0
-        xp.broadcast_to(-qd2*(s1*t37 + qd1*t38) - qd3*(s1*t36 + qd1*t39 + t21*t15) - qd4*(t23*t20 + s1*t35 + t27*qd1) - qd1*t30, batch),  # 1
-        xp.broadcast_to(-qd2*(c1*t29 + s1*t33) - qd3*(c1*t28 + s1*t32 + t16*t43 + t18*t43) - qd4*(t31*t23 + t27*t26 + t16*t44 + t18*t44), batch),  # 2
+        xp.broadcast_to(-qd1*t34 + qd2*(qd1*t40 - c1*t37) - qd3*(t24*t15 - qd1*t41 + c1*t36) - qd4*(t20*t26 - 0.1*s1*s234*qd1 + c1*t35), batch),  # 0
+        xp.broadcast_to(-qd1*t30 - qd2*(qd1*t38 + s1*t37) - qd3*(qd1*t39 + t21*t15 + s1*t36) - qd4*(t27*qd1 + t20*t23 + s1*t35), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t33 + c1*t29) - qd3*(t18*t43 + t16*t43 + s1*t32 + c1*t28) - qd4*(t31*t23 + t27*t26 + t18*t44 + t16*t44), batch),  # 2
         xp.broadcast_to(t24*qd1 + t25*qd1 + c1*t45, batch),  # 3
         xp.broadcast_to(t21*qd1 + t22*qd1 + s1*t45, batch),  # 4
-        xp.broadcast_to(qd4*(s1*t26 - c1*t23), batch),  # 5
+        xp.broadcast_to(qd4*(-c1*t23 + s1*t26), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -581,31 +581,31 @@ def jacobian_dot(q, q_dot):
     t19 = c1*qd3
     t20 = t18 + t19
     t21 = t8*qd4
-    t22 = t9*t19 + c1*t21
-    t23 = t9*t16 + s1*t21
+    t22 = c1*t21 + t9*t19
+    t23 = s1*t21 + t9*t16
     t24 = t22 + t10*t18
     t25 = t23 + t10*t15
     t26 = t24 + t5*qd1
     t27 = -t25 + t2*qd1
-    t28 = qd4*t14
-    t29 = qd3*t7 + t28
-    t30 = t29 + qd2*t6
+    t28 = t14*qd4
+    t29 = t28 + t7*qd3
+    t30 = t29 + t6*qd2
     t31 = s1*qd1
     t32 = c1*qd1
     t33 = t9*qd2
     Jd = _stack(xp, [
         xp.broadcast_to(-t27, batch),  # 0, 0
-        xp.broadcast_to(-c1*t30 + t10*t31, batch),  # 0, 1
-        xp.broadcast_to(-(-t9*t31 + c1*t29 + t18*t7), batch),  # 0, 2
-        xp.broadcast_to(-(t20*t14 + c1*t28 - 0.1*s1*s234*qd1), batch),  # 0, 3
+        xp.broadcast_to(t10*t31 - c1*t30, batch),  # 0, 1
+        xp.broadcast_to(-(t18*t7 - t9*t31 + c1*t29), batch),  # 0, 2
+        xp.broadcast_to(-(t14*t20 - 0.1*s1*s234*qd1 + c1*t28), batch),  # 0, 3
         xp.broadcast_to(-t26, batch),  # 1, 0
-        xp.broadcast_to(-(s1*t30 + t10*t32), batch),  # 1, 1
-        xp.broadcast_to(-(s1*t29 + t9*t32 + t15*t7), batch),  # 1, 2
-        xp.broadcast_to(-(t17*t14 + s1*t28 + t8*t32), batch),  # 1, 3
+        xp.broadcast_to(-(t10*t32 + s1*t30), batch),  # 1, 1
+        xp.broadcast_to(-(t9*t32 + t15*t7 + s1*t29), batch),  # 1, 2
+        xp.broadcast_to(-(t8*t32 + t14*t17 + s1*t28), batch),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-(c1*t24 + s1*t25), batch),  # 2, 1
-        xp.broadcast_to(-(c1*t22 + s1*t23 + t11*t33 + t13*t33), batch),  # 2, 2
-        xp.broadcast_to(-(s1*t8*t17 + c1*t8*t20 + t11*t21 + t13*t21), batch),  # 2, 3
+        xp.broadcast_to(-(s1*t25 + c1*t24), batch),  # 2, 1
+        xp.broadcast_to(-(t13*t33 + t11*t33 + s1*t23 + c1*t22), batch),  # 2, 2
+        xp.broadcast_to(-(s1*t8*t17 + c1*t8*t20 + t13*t21 + t11*t21), batch),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t32, batch),  # 3, 1
         xp.broadcast_to(t32, batch),  # 3, 2
@@ -617,7 +617,7 @@ def jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
-        xp.broadcast_to(s1*t20 - c1*t17, batch),  # 5, 3
+        xp.broadcast_to(-c1*t17 + s1*t20, batch),  # 5, 3
     ], (6, 4))
     return Jd
 
@@ -665,31 +665,31 @@ def bias_acceleration(q, q_dot):
     t19 = c1*qd3
     t20 = t18 + t19
     t21 = t8*qd4
-    t22 = t9*t19 + c1*t21
-    t23 = t9*t16 + s1*t21
+    t22 = c1*t21 + t9*t19
+    t23 = s1*t21 + t9*t16
     t24 = t22 + t10*t18
     t25 = t23 + t10*t15
     t26 = t24 + t5*qd1
     t27 = -t25 + t2*qd1
-    t28 = qd4*t14
-    t29 = qd3*t7 + t28
-    t30 = t29 + qd2*t6
+    t28 = t14*qd4
+    t29 = t28 + t7*qd3
+    t30 = t29 + t6*qd2
     t31 = s1*qd1
     t32 = c1*qd1
     t33 = t9*qd2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(-c1*t30 + t10*t31) - qd3*(-t9*t31 + c1*t29 + t18*t7) - qd4*(t20*t14 + c1*t28 - 0.1*s1*s234*qd1) - qd1*t27, batch),  # 0
-        xp.broadcast_to(-qd2*(s1*t30 + t10*t32) - qd3*(s1*t29 + t9*t32 + t15*t7) - qd4*(t17*t14 + s1*t28 + t8*t32) - qd1*t26, batch),  # 1
-        xp.broadcast_to(-qd2*(c1*t24 + s1*t25) - qd3*(c1*t22 + s1*t23 + t11*t33 + t13*t33) - qd4*(s1*t8*t17 + c1*t8*t20 + t11*t21 + t13*t21), batch),  # 2
+        xp.broadcast_to(-qd1*t27 + qd2*(t10*t31 - c1*t30) - qd3*(t18*t7 - t9*t31 + c1*t29) - qd4*(t14*t20 - 0.1*s1*s234*qd1 + c1*t28), batch),  # 0
+        xp.broadcast_to(-qd1*t26 - qd2*(t10*t32 + s1*t30) - qd3*(t9*t32 + t15*t7 + s1*t29) - qd4*(t8*t32 + t14*t17 + s1*t28), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t25 + c1*t24) - qd3*(t13*t33 + t11*t33 + s1*t23 + c1*t22) - qd4*(s1*t8*t17 + c1*t8*t20 + t13*t21 + t11*t21), batch),  # 2
         xp.broadcast_to(t18*qd1 + t19*qd1 + t32*qd4, batch),  # 3
         xp.broadcast_to(t15*qd1 + t16*qd1 + t31*qd4, batch),  # 4
-        xp.broadcast_to(qd4*(s1*t20 - c1*t17), batch),  # 5
+        xp.broadcast_to(qd4*(-c1*t17 + s1*t20), batch),  # 5
     ], (6,))
     return a
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q': (4 x 4), 166 operations."""
+    """time derivative of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q': (4 x 4), 170 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (4,)), ("q_dot", q_dot, (4,)))
     q2 = q[..., 1]
     qd1 = q_dot[..., 0]
@@ -713,78 +713,81 @@ def task_jacobian_dot(q, q_dot):
     t1 = c23*t0 + c234*t0
     t2 = c2*t0 + t1
     t3 = 0.1*s1
-    t4 = c23*t3 + c234*t3
-    t5 = c2*t3 + t4
-    t6 = c1*t2 + s1*t5
-    t7 = c1*t1 + s1*t4
-    t8 = 0.1*s234
-    t9 = 0.1*s23 + t8
-    t10 = 0.1*s2 + t9
-    t11 = c1**2
-    t12 = t11*c234
-    t13 = s1**2
-    t14 = t13*c234
-    t15 = 0.1*t12 + 0.1*t14
-    t16 = s1*qd2
-    t17 = s1*qd3
-    t18 = t16 + t17
-    t19 = t18
-    t20 = c1*qd2
-    t21 = c1*qd3
-    t22 = t20 + t21
-    t23 = t22
-    t24 = c1*qd4
-    t25 = t9*t21 + t8*t24
-    t26 = t25 + t10*t20
-    t27 = t26 + t5*qd1
-    t28 = t22 + t24
-    t29 = s1*qd4
-    t30 = t9*t17 + t8*t29
-    t31 = t30 + t10*t16
-    t32 = -t31 + t2*qd1
-    t33 = c1*t26 + s1*t31
-    t34 = t18 + t29
-    t35 = qd4*t15
-    t36 = qd3*t7 + t35
-    t37 = t36 + qd2*t6
-    t38 = s1*qd1
-    t39 = -c1*t37 + t10*t38
-    t40 = c1*t36 + t20*t7 - t9*t38
-    t41 = t23*t15 + c1*t35 - t8*t38
-    t42 = s234*t28 + c234*t38
+    t4 = s1*c234
+    t5 = c23*t3 + 0.1*t4
+    t6 = c2*t3 + t5
+    t7 = c1*t2 + s1*t6
+    t8 = c1*t1 + s1*t5
+    t9 = 0.1*s234
+    t10 = 0.1*s23 + t9
+    t11 = 0.1*s2 + t10
+    t12 = c1**2
+    t13 = t12*c234
+    t14 = s1**2
+    t15 = t14*c234
+    t16 = 0.1*t13 + 0.1*t15
+    t17 = s1*qd2
+    t18 = s1*qd3
+    t19 = t17 + t18
+    t20 = t19
+    t21 = c1*qd2
+    t22 = c1*qd3
+    t23 = t21 + t22
+    t24 = t23
+    t25 = c1*qd4
+    t26 = t9*t25 + t10*t22
+    t27 = t26 + t11*t21
+    t28 = t27 + t6*qd1
+    t29 = t23 + t25
+    t30 = s1*qd4
+    t31 = t9*t30 + t10*t18
+    t32 = t31 + t11*t17
+    t33 = -t32 + t2*qd1
+    t34 = s1*t32 + c1*t27
+    t35 = t19 + t30
+    t36 = t16*qd4
+    t37 = t36 + t8*qd3
+    t38 = t37 + t7*qd2
+    t39 = s1*qd1
+    t40 = t11*t39 - c1*t38
+    t41 = t21*t8 - t10*t39 + c1*t37
+    t42 = t16*t24 - t9*t39 + c1*t36
     t43 = c1*qd1
-    t44 = s1*t37 + t10*t43
-    t45 = s1*t36 + t9*t43 + t16*t7
-    t46 = t19*t15 + s1*t35 + t8*t43
-    t47 = -s234*t34 + c234*t43
-    t48 = t9*qd2
-    t49 = c1*t25 + s1*t30 + t11*t48 + t13*t48
-    t50 = t8*qd4
-    t51 = s1*t8*t19 + c1*t8*t23 + t11*t50 + t13*t50
-    t52 = c234**2
-    t53 = t11*t52 + t13*t52
-    t54 = xp.sqrt(t53)
-    t55 = 1/t54
-    t56 = -(t12 + t14)*t55/t53
-    t57 = c234*t56
-    t58 = -t47*(s1*t55 + s1*t57) + t42*(c1*t55 + c1*t57)
+    t44 = t11*t43 + s1*t38
+    t45 = t10*t43 + t17*t8 + s1*t37
+    t46 = t9*t43 + t16*t20 + s1*t36
+    t47 = c234*t43 - s234*t35
+    t48 = t10*qd2
+    t49 = t14*t48 + t12*t48 + s1*t31 + c1*t26
+    t50 = t9*qd4
+    t51 = s1*t9*t20 + c1*t9*t24 + t14*t50 + t12*t50
+    t52 = t4*qd1
+    t53 = s234*t29 + t52
+    t54 = c234**2
+    t55 = t12*t54 + t14*t54
+    t56 = xp.sqrt(t55)
+    t57 = 1/t56
+    t58 = -t57*(t13 + t15)/t55
+    t59 = c1*t57
+    t60 = t52*t59
+    t61 = t53*(t59 + c1*c234*t58) - t47*(s1*t57 + t4*t58) - t60 + t60
     Jd = _stack(xp, [
-        xp.broadcast_to(-t32, batch),  # 0, 0
-        xp.broadcast_to(t39, batch),  # 0, 1
-        xp.broadcast_to(-t40, batch),  # 0, 2
-        xp.broadcast_to(-t41, batch),  # 0, 3
-        xp.broadcast_to(-t27, batch),  # 1, 0
+        xp.broadcast_to(-t33, batch),  # 0, 0
+        xp.broadcast_to(t40, batch),  # 0, 1
+        xp.broadcast_to(-t41, batch),  # 0, 2
+        xp.broadcast_to(-t42, batch),  # 0, 3
+        xp.broadcast_to(-t28, batch),  # 1, 0
         xp.broadcast_to(-t44, batch),  # 1, 1
         xp.broadcast_to(-t45, batch),  # 1, 2
         xp.broadcast_to(-t46, batch),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t33, batch),  # 2, 1
+        xp.broadcast_to(-t34, batch),  # 2, 1
         xp.broadcast_to(-t49, batch),  # 2, 2
         xp.broadcast_to(-t51, batch),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(t58, batch),  # 3, 1
-        xp.broadcast_to(t58, batch),  # 3, 2
-        xp.broadcast_to(t58, batch),  # 3, 3
+        xp.broadcast_to(t61, batch),  # 3, 1
+        xp.broadcast_to(t61, batch),  # 3, 2
+        xp.broadcast_to(t61, batch),  # 3, 3
     ], (4, 4))
     return Jd
 
@@ -831,8 +834,8 @@ def hessian(q):
     t22 = -c1*t14
     t23 = -s1*t7
     t24 = -s1*t14
-    t25 = -(t11*t9 + t13*t9)
-    t26 = -(t8*t11 + t8*t13)
+    t25 = -(t13*t9 + t11*t9)
+    t26 = -(t8*t13 + t8*t11)
     H = _stack(xp, [
         -t2,  # 0, 0, 0
         t15,  # 0, 0, 1
@@ -867,7 +870,7 @@ def hessian(q):
         t23,  # 1, 1, 2
         t24,  # 1, 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -(t11*t10 + t13*t10),  # 1, 2, 1
+        -(t13*t10 + t11*t10),  # 1, 2, 1
         t25,  # 1, 2, 2
         t26,  # 1, 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 0
@@ -1066,7 +1069,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t35 = s1*t10
     t36 = s1*t9
     t37 = s1*t8
-    t38 = t35*t6 + t36*t7 + t37*t15
+    t38 = t6*t35 + t7*t36 + t15*t37
     t39 = t35*t17 + t36*t17 + t37*t17
     t40 = t6**2
     t41 = t40 + t7**2 + t15**2
@@ -1293,7 +1296,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t39 = s1*t13
     t40 = s1*t12
     t41 = s1*t11
-    t42 = t39*t8 + t40*t9 + t41*t20
+    t42 = t39*t8 + t40*t9 + t20*t41
     t43 = t39*t24 + t40*t24 + t41*t24
     t44 = -mu3 + xp.atan2(-s234, t23)
     t45 = t44 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t44))

@@ -845,9 +845,9 @@ def fk_jacobian_dot(q, q_dot):
     t62 = t61
     t63 = t44*t33 - t28*t49
     t64 = t63
-    t65 = qd5*t62 + qd6*t64
-    t66 = t65 - qd4*t60
-    t67 = t66 + qd3*t58
+    t65 = t64*qd6 + t62*qd5
+    t66 = t65 - t60*qd4
+    t67 = t66 + t58*qd3
     t68 = c1*t52
     t69 = -c2*t21 + s2*t68
     t70 = t69
@@ -857,9 +857,9 @@ def fk_jacobian_dot(q, q_dot):
     t74 = t73
     t75 = t44*t18 - t13*t49
     t76 = t75
-    t77 = qd5*t74 + qd6*t76
-    t78 = t77 + qd4*t72
-    t79 = t78 + qd3*t70
+    t77 = t76*qd6 + t74*qd5
+    t78 = t77 + t72*qd4
+    t79 = t78 + t70*qd3
     t80 = c1*t22 + s1*t37
     t81 = t80
     t82 = t21*t24 - t36*t9
@@ -870,10 +870,10 @@ def fk_jacobian_dot(q, q_dot):
     t87 = t86
     t88 = t28*t18 - t13*t33
     t89 = t88
-    t90 = qd5*t87 + qd6*t89
-    t91 = t90 + qd4*t85
-    t92 = t91 + qd3*t83
-    t93 = t92 - qd2*t81
+    t90 = t89*qd6 + t87*qd5
+    t91 = t90 + t85*qd4
+    t92 = t91 + t83*qd3
+    t93 = t92 - t81*qd2
     t94 = s1*qd2
     t95 = t94 + t9*qd3
     t96 = -t95 + t7*qd4
@@ -959,12 +959,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t114, batch),  # 5, 6
     ], (6, 7))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(c1*t93 - t56*qd1) + qd3*(c2*t79 - qd1*t70 + t83*t100 - t24*t92) - qd4*(-t101*t85 + t4*t91 + t0*t72 + t42*t78) + qd5*(t26*t90 + t102*t87 - t41*t77 - t54*t74) + qd6*(t103*t89 - t55*t76 + t89*t108 + t76*t110) - qd1*t99, batch),  # 0
-        xp.broadcast_to(qd1*t105 + qd2*(s1*t93 + t68*qd1) + qd3*(qd1*t58 - c2*t67 + t9*t92 + t83*t94) + qd4*(t95*t85 - t7*t91 - t0*t60 + t42*t66) + qd5*(t41*t65 + t54*t62 - t11*t90 - t96*t87) + qd6*(t55*t64 - t97*t89 + t89*t106 - t64*t110), batch),  # 1
-        xp.broadcast_to(-qd2*(c1*t104 + s1*t98) - qd3*(-t24*t67 + t9*t79 + t58*t100 + t70*t94) + qd4*(t4*t66 + t7*t78 + t101*t60 - t95*t72) + qd5*(t11*t77 + t96*t74 - t26*t65 - t102*t62) - qd6*(-t97*t76 + t103*t64 + t76*t106 + t64*t108), batch),  # 2
-        xp.broadcast_to(qd3*(t24*qd1 - c2*t100) + qd4*(t4*t0 + t42*t101) + qd5*(t41*t102 - t26*t54) - qd6*(t28*t55 + t44*t103) + qd7*(t30*t111 - t46*t109) - qd1*t100, batch),  # 3
-        xp.broadcast_to(-qd3*(t9*qd1 + c2*t94) + qd4*(t7*t0 + t42*t95) + qd5*(t11*t54 - t41*t96) + qd6*(t44*t97 - t13*t55) + qd7*(t46*t107 - t15*t111) - qd1*t94, batch),  # 4
-        xp.broadcast_to(qd3*(c1**2*t115 + s1**2*t115) + qd4*(t4*t95 - t7*t101) + qd5*(t26*t96 - t11*t102) + qd6*(t13*t103 + t28*t97) + qd7*(t15*t109 - t30*t107), batch),  # 5
+        xp.broadcast_to(-qd1*t99 + qd2*(-t56*qd1 + c1*t93) + qd3*(t83*t100 - t70*qd1 - t24*t92 + c2*t79) - qd4*(-t85*t101 + t72*t0 + t4*t91 + t42*t78) + qd5*(t87*t102 - t74*t54 + t26*t90 - t41*t77) + qd6*(t89*t103 - t76*t55 + t89*t108 + t76*t110), batch),  # 0
+        xp.broadcast_to(qd1*t105 + qd2*(t68*qd1 + s1*t93) + qd3*(t58*qd1 + t83*t94 - c2*t67 + t9*t92) + qd4*(-t60*t0 + t85*t95 + t42*t66 - t7*t91) + qd5*(t62*t54 - t87*t96 + t41*t65 - t11*t90) + qd6*(t64*t55 - t89*t97 - t64*t110 + t89*t106), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t98 + c1*t104) - qd3*(t70*t94 + t58*t100 + t9*t79 - t24*t67) + qd4*(-t72*t95 + t60*t101 + t7*t78 + t4*t66) + qd5*(t74*t96 - t62*t102 + t11*t77 - t26*t65) - qd6*(-t76*t97 + t64*t103 + t76*t106 + t64*t108), batch),  # 2
+        xp.broadcast_to(-qd1*t100 + qd3*(-c2*t100 + t24*qd1) + qd4*(t42*t101 + t4*t0) + qd5*(t41*t102 - t26*t54) - qd6*(t44*t103 + t28*t55) + qd7*(-t46*t109 + t30*t111), batch),  # 3
+        xp.broadcast_to(-qd1*t94 - qd3*(t9*qd1 + c2*t94) + qd4*(t7*t0 + t42*t95) + qd5*(t11*t54 - t41*t96) + qd6*(-t13*t55 + t44*t97) + qd7*(-t15*t111 + t46*t107), batch),  # 4
+        xp.broadcast_to(qd3*(s1**2*t115 + c1**2*t115) + qd4*(t4*t95 - t7*t101) + qd5*(t26*t96 - t11*t102) + qd6*(t28*t97 + t13*t103) + qd7*(-t30*t107 + t15*t109), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -1029,10 +1029,10 @@ def jacobian_dot(q, q_dot):
     t35 = t4*t17 + t7*t29
     t36 = t11*t28 - t23*t16
     t37 = t25*t15 - t13*t27
-    t38 = qd5*t36 + qd6*t37
-    t39 = t38 + qd4*t35
-    t40 = t39 + qd3*t34
-    t41 = t40 - qd2*t33
+    t38 = t37*qd6 + t36*qd5
+    t39 = t38 + t35*qd4
+    t40 = t39 + t34*qd3
+    t41 = t40 - t33*qd2
     t42 = c3*s2
     t43 = c2*s4 - c4*t42
     t44 = c2*c4 + s4*t42
@@ -1054,12 +1054,12 @@ def jacobian_dot(q, q_dot):
     t60 = t47*t15 - t13*t49
     t61 = t0 + t45*qd4
     t62 = t61 + t44*qd5
-    t63 = qd5*t55 + qd6*t56
-    t64 = qd5*t59 + qd6*t60
-    t65 = t63 - qd4*t54
-    t66 = t64 + qd4*t58
-    t67 = t65 + qd3*t53
-    t68 = t66 + qd3*t57
+    t63 = t56*qd6 + t55*qd5
+    t64 = t60*qd6 + t59*qd5
+    t65 = t63 - t54*qd4
+    t66 = t64 + t58*qd4
+    t67 = t65 + t53*qd3
+    t68 = t66 + t57*qd3
     t69 = s1*qd2
     t70 = t69 + t9*qd3
     t71 = -t70 + t7*qd4
@@ -1083,47 +1083,47 @@ def jacobian_dot(q, q_dot):
     t89 = s2*qd2
     Jd = _stack(xp, [
         xp.broadcast_to(-t74, batch),  # 0, 0
-        xp.broadcast_to(c1*t41 - t52*t87, batch),  # 0, 1
-        xp.broadcast_to(c2*t68 - qd1*t57 + t75*t34 - t21*t40, batch),  # 0, 2
-        xp.broadcast_to(-(-t76*t35 + t4*t39 + t0*t58 + t45*t66), batch),  # 0, 3
-        xp.broadcast_to(t23*t38 + t77*t36 - t44*t64 - t61*t59, batch),  # 0, 4
-        xp.broadcast_to(t78*t37 - t62*t60 + t83*t37 + t85*t60, batch),  # 0, 5
+        xp.broadcast_to(-t52*t87 + c1*t41, batch),  # 0, 1
+        xp.broadcast_to(t75*t34 - t57*qd1 - t21*t40 + c2*t68, batch),  # 0, 2
+        xp.broadcast_to(-(-t35*t76 + t58*t0 + t4*t39 + t45*t66), batch),  # 0, 3
+        xp.broadcast_to(t36*t77 - t59*t61 + t23*t38 - t44*t64, batch),  # 0, 4
+        xp.broadcast_to(t37*t78 - t60*t62 + t83*t37 + t85*t60, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         xp.broadcast_to(t80, batch),  # 1, 0
-        xp.broadcast_to(s1*t41 + t52*t88, batch),  # 1, 1
-        xp.broadcast_to(qd1*t53 - c2*t67 + t9*t40 + t69*t34, batch),  # 1, 2
-        xp.broadcast_to(t70*t35 - t7*t39 - t0*t54 + t45*t65, batch),  # 1, 3
-        xp.broadcast_to(t44*t63 + t61*t55 - t11*t38 - t71*t36, batch),  # 1, 4
-        xp.broadcast_to(t62*t56 - t72*t37 + t81*t37 - t85*t56, batch),  # 1, 5
+        xp.broadcast_to(t52*t88 + s1*t41, batch),  # 1, 1
+        xp.broadcast_to(t53*qd1 + t69*t34 - c2*t67 + t9*t40, batch),  # 1, 2
+        xp.broadcast_to(-t54*t0 + t35*t70 + t45*t65 - t7*t39, batch),  # 1, 3
+        xp.broadcast_to(t55*t61 - t36*t71 + t44*t63 - t11*t38, batch),  # 1, 4
+        xp.broadcast_to(t56*t62 - t37*t72 - t85*t56 + t81*t37, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-(c1*t79 + s1*t73), batch),  # 2, 1
-        xp.broadcast_to(-(-t21*t67 + t9*t68 + t75*t53 + t69*t57), batch),  # 2, 2
-        xp.broadcast_to(t4*t65 + t7*t66 + t76*t54 - t70*t58, batch),  # 2, 3
-        xp.broadcast_to(t11*t64 + t71*t59 - t23*t63 - t77*t55, batch),  # 2, 4
-        xp.broadcast_to(-(-t72*t60 + t78*t56 + t81*t60 + t83*t56), batch),  # 2, 5
+        xp.broadcast_to(-(s1*t73 + c1*t79), batch),  # 2, 1
+        xp.broadcast_to(-(t69*t57 + t75*t53 + t9*t68 - t21*t67), batch),  # 2, 2
+        xp.broadcast_to(-t58*t70 + t54*t76 + t7*t66 + t4*t65, batch),  # 2, 3
+        xp.broadcast_to(t59*t71 - t55*t77 + t11*t64 - t23*t63, batch),  # 2, 4
+        xp.broadcast_to(-(-t60*t72 + t56*t78 + t81*t60 + t83*t56), batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(-t88, batch),  # 3, 1
-        xp.broadcast_to(s2*t87 - c2*t75, batch),  # 3, 2
-        xp.broadcast_to(t4*t0 + t45*t76, batch),  # 3, 3
+        xp.broadcast_to(-c2*t75 + s2*t87, batch),  # 3, 2
+        xp.broadcast_to(t45*t76 + t4*t0, batch),  # 3, 3
         xp.broadcast_to(t44*t77 - t23*t61, batch),  # 3, 4
-        xp.broadcast_to(-(t25*t62 + t47*t78), batch),  # 3, 5
-        xp.broadcast_to(t26*t86 - t48*t84, batch),  # 3, 6
+        xp.broadcast_to(-(t47*t78 + t25*t62), batch),  # 3, 5
+        xp.broadcast_to(-t48*t84 + t26*t86, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(-t87, batch),  # 4, 1
         xp.broadcast_to(-(s2*t88 + c2*t69), batch),  # 4, 2
         xp.broadcast_to(t7*t0 + t45*t70, batch),  # 4, 3
         xp.broadcast_to(t11*t61 - t44*t71, batch),  # 4, 4
-        xp.broadcast_to(t47*t72 - t13*t62, batch),  # 4, 5
-        xp.broadcast_to(t48*t82 - t14*t86, batch),  # 4, 6
+        xp.broadcast_to(-t13*t62 + t47*t72, batch),  # 4, 5
+        xp.broadcast_to(-t14*t86 + t48*t82, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
-        xp.broadcast_to(c1**2*t89 + s1**2*t89, batch),  # 5, 2
+        xp.broadcast_to(s1**2*t89 + c1**2*t89, batch),  # 5, 2
         xp.broadcast_to(t4*t70 - t7*t76, batch),  # 5, 3
         xp.broadcast_to(t23*t71 - t11*t77, batch),  # 5, 4
-        xp.broadcast_to(t13*t78 + t25*t72, batch),  # 5, 5
-        xp.broadcast_to(t14*t84 - t26*t82, batch),  # 5, 6
+        xp.broadcast_to(t25*t72 + t13*t78, batch),  # 5, 5
+        xp.broadcast_to(-t26*t82 + t14*t84, batch),  # 5, 6
     ], (6, 7))
     return Jd
 
@@ -1189,10 +1189,10 @@ def bias_acceleration(q, q_dot):
     t35 = t4*t17 + t7*t29
     t36 = t11*t28 - t23*t16
     t37 = t25*t15 - t13*t27
-    t38 = qd5*t36 + qd6*t37
-    t39 = t38 + qd4*t35
-    t40 = t39 + qd3*t34
-    t41 = t40 - qd2*t33
+    t38 = t37*qd6 + t36*qd5
+    t39 = t38 + t35*qd4
+    t40 = t39 + t34*qd3
+    t41 = t40 - t33*qd2
     t42 = c3*s2
     t43 = c2*s4 - c4*t42
     t44 = c2*c4 + s4*t42
@@ -1214,12 +1214,12 @@ def bias_acceleration(q, q_dot):
     t60 = t47*t15 - t13*t49
     t61 = t0 + t45*qd4
     t62 = t61 + t44*qd5
-    t63 = qd5*t55 + qd6*t56
-    t64 = qd5*t59 + qd6*t60
-    t65 = t63 - qd4*t54
-    t66 = t64 + qd4*t58
-    t67 = t65 + qd3*t53
-    t68 = t66 + qd3*t57
+    t63 = t56*qd6 + t55*qd5
+    t64 = t60*qd6 + t59*qd5
+    t65 = t63 - t54*qd4
+    t66 = t64 + t58*qd4
+    t67 = t65 + t53*qd3
+    t68 = t66 + t57*qd3
     t69 = s1*qd2
     t70 = t69 + t9*qd3
     t71 = -t70 + t7*qd4
@@ -1241,12 +1241,12 @@ def bias_acceleration(q, q_dot):
     t87 = t52*qd1
     t88 = s2*qd2
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(c1*t41 - s1*t87) + qd3*(c2*t68 - qd1*t57 + t75*t34 - t21*t40) - qd4*(-t76*t35 + t4*t39 + t0*t58 + t45*t66) + qd5*(t23*t38 + t77*t36 - t44*t64 - t61*t59) + qd6*(t78*t37 - t62*t60 + t83*t37 + t85*t60) - qd1*t74, batch),  # 0
-        xp.broadcast_to(qd1*t80 + qd2*(s1*t41 + c1*t87) + qd3*(qd1*t53 - c2*t67 + t9*t40 + t69*t34) + qd4*(t70*t35 - t7*t39 - t0*t54 + t45*t65) + qd5*(t44*t63 + t61*t55 - t11*t38 - t71*t36) + qd6*(t62*t56 - t72*t37 + t81*t37 - t85*t56), batch),  # 1
-        xp.broadcast_to(-qd2*(c1*t79 + s1*t73) - qd3*(-t21*t67 + t9*t68 + t75*t53 + t69*t57) + qd4*(t4*t65 + t7*t66 + t76*t54 - t70*t58) + qd5*(t11*t64 + t71*t59 - t23*t63 - t77*t55) - qd6*(-t72*t60 + t78*t56 + t81*t60 + t83*t56), batch),  # 2
-        xp.broadcast_to(qd3*(t21*qd1 - c2*t75) + qd4*(t4*t0 + t45*t76) + qd5*(t44*t77 - t23*t61) - qd6*(t25*t62 + t47*t78) + qd7*(t26*t86 - t48*t84) - t75*qd1, batch),  # 3
-        xp.broadcast_to(-qd3*(t9*qd1 + c2*t69) + qd4*(t7*t0 + t45*t70) + qd5*(t11*t61 - t44*t71) + qd6*(t47*t72 - t13*t62) + qd7*(t48*t82 - t14*t86) - t69*qd1, batch),  # 4
-        xp.broadcast_to(qd3*(c1**2*t88 + s1**2*t88) + qd4*(t4*t70 - t7*t76) + qd5*(t23*t71 - t11*t77) + qd6*(t13*t78 + t25*t72) + qd7*(t14*t84 - t26*t82), batch),  # 5
+        xp.broadcast_to(-qd1*t74 + qd2*(-s1*t87 + c1*t41) + qd3*(t75*t34 - t57*qd1 - t21*t40 + c2*t68) - qd4*(-t35*t76 + t58*t0 + t4*t39 + t45*t66) + qd5*(t36*t77 - t59*t61 + t23*t38 - t44*t64) + qd6*(t37*t78 - t60*t62 + t83*t37 + t85*t60), batch),  # 0
+        xp.broadcast_to(qd1*t80 + qd2*(c1*t87 + s1*t41) + qd3*(t53*qd1 + t69*t34 - c2*t67 + t9*t40) + qd4*(-t54*t0 + t35*t70 + t45*t65 - t7*t39) + qd5*(t55*t61 - t36*t71 + t44*t63 - t11*t38) + qd6*(t56*t62 - t37*t72 - t85*t56 + t81*t37), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t73 + c1*t79) - qd3*(t69*t57 + t75*t53 + t9*t68 - t21*t67) + qd4*(-t58*t70 + t54*t76 + t7*t66 + t4*t65) + qd5*(t59*t71 - t55*t77 + t11*t64 - t23*t63) - qd6*(-t60*t72 + t56*t78 + t81*t60 + t83*t56), batch),  # 2
+        xp.broadcast_to(-t75*qd1 + qd3*(-c2*t75 + t21*qd1) + qd4*(t45*t76 + t4*t0) + qd5*(t44*t77 - t23*t61) - qd6*(t47*t78 + t25*t62) + qd7*(-t48*t84 + t26*t86), batch),  # 3
+        xp.broadcast_to(-t69*qd1 - qd3*(t9*qd1 + c2*t69) + qd4*(t7*t0 + t45*t70) + qd5*(t11*t61 - t44*t71) + qd6*(-t13*t62 + t47*t72) + qd7*(-t14*t86 + t48*t82), batch),  # 4
+        xp.broadcast_to(qd3*(s1**2*t88 + c1**2*t88) + qd4*(t4*t70 - t7*t76) + qd5*(t23*t71 - t11*t77) + qd6*(t25*t72 + t13*t78) + qd7*(-t26*t82 + t14*t84), batch),  # 5
     ], (6,))
     return a
 
@@ -1317,10 +1317,10 @@ def task_jacobian_dot(q, q_dot):
     t38 = t3*t18 + t6*t32
     t39 = t10*t31 - t24*t17
     t40 = t26*t16 - t12*t30
-    t41 = qd5*t39 + qd6*t40
-    t42 = t41 + qd4*t38
-    t43 = t42 + qd3*t37
-    t44 = t43 - qd2*t36
+    t41 = t40*qd6 + t39*qd5
+    t42 = t41 + t38*qd4
+    t43 = t42 + t37*qd3
+    t44 = t43 - t36*qd2
     t45 = t15**2 + t29**2
     t46 = xp.sqrt(t45)
     t47 = c3*s2
@@ -1344,81 +1344,81 @@ def task_jacobian_dot(q, q_dot):
     t65 = -t6*t58 + t18*t50
     t66 = t49*t17 - t10*t57
     t67 = t52*t16 - t12*t56
-    t68 = qd5*t62 + qd6*t63
-    t69 = qd5*t66 + qd6*t67
-    t70 = t68 - qd4*t61
-    t71 = t69 + qd4*t65
-    t72 = t70 + qd3*t60
-    t73 = t71 + qd3*t64
+    t68 = t63*qd6 + t62*qd5
+    t69 = t67*qd6 + t66*qd5
+    t70 = t68 - t61*qd4
+    t71 = t69 + t65*qd4
+    t72 = t70 + t60*qd3
+    t73 = t71 + t64*qd3
     t74 = s1*qd2
     t75 = t73 + t59*t74
     t76 = t75 + t21*qd1
-    t77 = qd1*t60 - c2*t72 + t8*t43 + t74*t37
+    t77 = t60*qd1 + t74*t37 - c2*t72 + t8*t43
     t78 = t8*qd1 + c2*t74
     t79 = t74 + t8*qd3
     t80 = t79
     t81 = c1*qd2
     t82 = t72 + t59*t81
     t83 = t82 - t35*qd1
-    t84 = c2*t73 - qd1*t64 + t81*t37 - t22*t43
-    t85 = c1*t82 + s1*t75
-    t86 = t8*t73 + t81*t60 + t74*t64 - t22*t72
-    t87 = t22*qd1 - c2*t81
+    t84 = t81*t37 - t64*qd1 - t22*t43 + c2*t73
+    t85 = s1*t75 + c1*t82
+    t86 = t74*t64 + t81*t60 + t8*t73 - t22*t72
+    t87 = -c2*t81 + t22*qd1
     t88 = t81 - t22*qd3
     t89 = t88
-    t90 = t3*t70 + t6*t71 + t89*t61 - t80*t65
+    t90 = -t65*t80 + t61*t89 + t6*t71 + t3*t70
     t91 = t3*t80 - t6*t89
     t92 = qd1 - c2*qd3
     t93 = t92
-    t94 = t3*t42 + t93*t65 - t89*t38 + t50*t71
-    t95 = t80*t38 - t6*t42 - t93*t61 + t50*t70
-    t96 = t3*t93 + t50*t89
+    t94 = -t38*t89 + t65*t93 + t3*t42 + t50*t71
+    t95 = -t61*t93 + t38*t80 + t50*t70 - t6*t42
+    t96 = t50*t89 + t3*t93
     t97 = t6*t93 + t50*t80
     t98 = t6*qd4
     t99 = -t80 + t98
     t100 = -t3*qd4
     t101 = t89 + t100
-    t102 = t10*t69 + t99*t66 - t24*t68 - t101*t62
+    t102 = t66*t99 - t62*t101 + t10*t69 - t24*t68
     t103 = t24*t99 - t10*t101
     t104 = t50*qd4
     t105 = t93 + t104
-    t106 = t24*t41 + t101*t39 - t49*t69 - t105*t66
-    t107 = t49*t68 + t105*t62 - t10*t41 - t99*t39
+    t106 = t39*t101 - t66*t105 + t24*t41 - t49*t69
+    t107 = t62*t105 - t39*t99 + t49*t68 - t10*t41
     t108 = t49*t101 - t24*t105
     t109 = t10*t105 - t49*t99
     t110 = t10*qd5
     t111 = t99 + t110
     t112 = t24*qd5
     t113 = t101 + t112
-    t114 = t12*t113 + t26*t111
+    t114 = t26*t111 + t12*t113
     t115 = t49*qd5
     t116 = t105 + t115
-    t117 = t26*t116 + t52*t113
-    t118 = t52*t111 - t12*t116
+    t117 = t52*t113 + t26*t116
+    t118 = -t12*t116 + t52*t111
     t119 = t12*qd6
     t120 = t111 - t119
-    t121 = -t110 - t98 + t79 + t119 + t14*qd7
+    t121 = -t98 - t110 + t79 + t119 + t14*qd7
     t122 = t26*qd6
     t123 = t113 + t122
-    t124 = t113*t63 - t111*t67 + t119*t67 + t122*t63
-    t125 = t14*t123 - t28*t120
+    t124 = -t67*t111 + t63*t113 + t119*t67 + t122*t63
+    t125 = -t28*t120 + t14*t123
     t126 = t88 + t100 + t112 + t122 - t28*qd7
     t127 = t29*t121 + t15*t126
     t128 = t52*qd6
-    t129 = t113*t40 - t116*t67 + t122*t40 + t128*t67
-    t130 = t116*t63 - t111*t40 + t119*t40 - t128*t63
+    t129 = t40*t113 - t67*t116 + t122*t40 + t128*t67
+    t130 = t63*t116 - t40*t111 - t128*t63 + t119*t40
     t131 = -t128
     t132 = t116 + t131
-    t133 = t28*t132 - t54*t123
-    t134 = t54*t120 - t14*t132
+    t133 = -t54*t123 + t28*t132
+    t134 = -t14*t132 + t54*t120
     t135 = t92 + t104 + t115 + t131 - t54*qd7
     t136 = t55*t126 - t29*t135
-    t137 = t55*t121 + t15*t135
+    t137 = t15*t135 + t55*t121
     t138 = t59*qd1
-    t139 = c1*t44 - s1*t138
-    t140 = s1*t44 + c1*t138
+    t139 = -s1*t138 + c1*t44
+    t140 = c1*t138 + s1*t44
     t141 = s2*qd2
-    t142 = c1**2*t141 + s1**2*t141
+    t142 = s1**2*t141 + c1**2*t141
     t143 = c1*t29
     t144 = s1*t15
     t145 = 1/t45
@@ -1439,40 +1439,40 @@ def task_jacobian_dot(q, q_dot):
     t160 = (t12*t29 + t26*t15)*t155
     t161 = (t14*t29 - t28*t15)*t155
     t162 = 2*t146
-    t163 = t145*t136
+    t163 = t136*t145
     t164 = -(s1 + t15*t162)*t163
-    t165 = t145*t137
+    t165 = t137*t145
     t166 = (c1 - t29*t162)*t165
     t167 = qd1*t145
     t168 = t151*t167
     t169 = t152*t167
-    t170 = t15*t145
-    t171 = t87*t170
-    t172 = 2*t153
-    t173 = -t163*(t8 + t15*t172)
-    t174 = -t165*(t22 + t29*t172)
+    t170 = 2*t153
+    t171 = -t163*(t8 + t15*t170)
+    t172 = -t165*(t22 + t29*t170)
+    t173 = t15*t145
+    t174 = t87*t173
     t175 = t29*t145
     t176 = t78*t175
-    t177 = t96*t170
-    t178 = t97*t175
-    t179 = 2*t147
-    t180 = t163*(t6 - t15*t179)
-    t181 = -t165*(t3 + t29*t179)
-    t182 = t108*t170
-    t183 = t109*t175
-    t184 = 2*t148
-    t185 = t163*(t10 - t15*t184)
-    t186 = t165*(t24 - t29*t184)
-    t187 = t118*t175
-    t188 = 2*t149
-    t189 = -t163*(t12 + t15*t188)
-    t190 = t165*(t26 - t29*t188)
-    t191 = t117*t170
-    t192 = t133*t170
-    t193 = t134*t175
-    t194 = 2*t150
-    t195 = -t163*(t14 + t15*t194)
-    t196 = -t165*(t28 + t29*t194)
+    t177 = 2*t147
+    t178 = t163*(t6 - t15*t177)
+    t179 = -t165*(t3 + t29*t177)
+    t180 = t96*t173
+    t181 = t97*t175
+    t182 = 2*t148
+    t183 = t163*(t10 - t15*t182)
+    t184 = t165*(t24 - t29*t182)
+    t185 = t108*t173
+    t186 = t109*t175
+    t187 = 2*t149
+    t188 = -t163*(t12 + t15*t187)
+    t189 = t165*(t26 - t29*t187)
+    t190 = t117*t173
+    t191 = t118*t175
+    t192 = 2*t150
+    t193 = -t163*(t14 + t15*t192)
+    t194 = -t165*(t28 + t29*t192)
+    t195 = t133*t173
+    t196 = t134*t175
     t197 = qd1*t154
     t198 = t29*t154
     t199 = t15*t154
@@ -1500,25 +1500,25 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t164 + t166 - t168 - t169, batch),  # 3, 1
-        xp.broadcast_to(t171 + t173 + t174 - t176, batch),  # 3, 2
-        xp.broadcast_to(t177 + t178 + t180 + t181, batch),  # 3, 3
-        xp.broadcast_to(t182 + t183 + t185 + t186, batch),  # 3, 4
-        xp.broadcast_to(t187 + t189 + t190 - t191, batch),  # 3, 5
-        xp.broadcast_to(t192 + t193 + t195 + t196, batch),  # 3, 6
+        xp.broadcast_to(t171 + t172 + t174 - t176, batch),  # 3, 2
+        xp.broadcast_to(t178 + t179 + t180 + t181, batch),  # 3, 3
+        xp.broadcast_to(t183 + t184 + t185 + t186, batch),  # 3, 4
+        xp.broadcast_to(t188 + t189 - t190 + t191, batch),  # 3, 5
+        xp.broadcast_to(t193 + t194 + t195 + t196, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t136*(c1*t154 - t15*t156) + t137*(s1*t154 - t29*t156) + t143*t197 - t144*t197, batch),  # 4, 1
-        xp.broadcast_to(-t136*(t15*t157 + t22*t154) + t137*(-t29*t157 + t8*t154) - t87*t198 - t78*t199, batch),  # 4, 2
-        xp.broadcast_to(-t136*(t3*t154 + t15*t158) - t137*(t29*t158 + t6*t154) + t97*t199 - t96*t198, batch),  # 4, 3
-        xp.broadcast_to(t136*(t24*t154 - t15*t159) - t137*(t29*t159 + t10*t154) + t109*t199 - t108*t198, batch),  # 4, 4
+        xp.broadcast_to(-t136*(t22*t154 + t15*t157) + t137*(t8*t154 - t29*t157) - t87*t198 - t78*t199, batch),  # 4, 2
+        xp.broadcast_to(-t136*(t3*t154 + t15*t158) - t137*(t6*t154 + t29*t158) - t96*t198 + t97*t199, batch),  # 4, 3
+        xp.broadcast_to(t136*(t24*t154 - t15*t159) - t137*(t10*t154 + t29*t159) - t108*t198 + t109*t199, batch),  # 4, 4
         xp.broadcast_to(t136*(t26*t154 - t15*t160) + t137*(t12*t154 - t29*t160) + t117*t198 + t118*t199, batch),  # 4, 5
-        xp.broadcast_to(-t136*(t15*t161 + t28*t154) + t137*(t14*t154 - t29*t161) + t134*t199 - t133*t198, batch),  # 4, 6
+        xp.broadcast_to(-t136*(t28*t154 + t15*t161) + t137*(t14*t154 - t29*t161) - t133*t198 + t134*t199, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t146*t127 - t55*t164 - t55*t166 + t55*t168 + t55*t169, batch),  # 5, 1
-        xp.broadcast_to(t142 + t153*t127 + t55*t176 - t55*t171 - t55*t173 - t55*t174, batch),  # 5, 2
-        xp.broadcast_to(-(-t91 - t147*t127 + t55*t177 + t55*t178 + t55*t180 + t55*t181), batch),  # 5, 3
-        xp.broadcast_to(-(-t103 - t148*t127 + t55*t182 + t55*t183 + t55*t185 + t55*t186), batch),  # 5, 4
-        xp.broadcast_to(t114 + t149*t127 + t55*t191 - t55*t187 - t55*t189 - t55*t190, batch),  # 5, 5
-        xp.broadcast_to(-(-t125 - t150*t127 + t55*t192 + t55*t193 + t55*t195 + t55*t196), batch),  # 5, 6
+        xp.broadcast_to(-t55*t164 - t55*t166 + t127*t146 + t55*t168 + t55*t169, batch),  # 5, 1
+        xp.broadcast_to(t142 - t55*t171 - t55*t172 + t127*t153 - t55*t174 + t55*t176, batch),  # 5, 2
+        xp.broadcast_to(-(-t91 + t55*t178 + t55*t179 - t127*t147 + t55*t180 + t55*t181), batch),  # 5, 3
+        xp.broadcast_to(-(-t103 + t55*t183 + t55*t184 - t127*t148 + t55*t185 + t55*t186), batch),  # 5, 4
+        xp.broadcast_to(t114 - t55*t188 - t55*t189 + t127*t149 + t55*t190 - t55*t191, batch),  # 5, 5
+        xp.broadcast_to(-(-t125 + t55*t193 + t55*t194 - t127*t150 + t55*t195 + t55*t196), batch),  # 5, 6
     ], (6, 7))
     return Jd
 
@@ -1611,28 +1611,28 @@ def hessian(q):
     t69 = s1*t34
     t70 = s1*t35
     t71 = s1*t36
-    t72 = c1**2
-    t73 = s1**2
-    t74 = -(c1*t55 + s1*t57)
-    t75 = c1*t48 - s1*t51
-    t76 = -(c1*t49 + s1*t52)
-    t77 = -(c1*t50 + s1*t53)
-    t78 = c2*t51 - t20*t34
-    t79 = c2*t52 - t20*t35
-    t80 = c2*t53 - t20*t36
+    t72 = s1**2
+    t73 = c1**2
+    t74 = -(s1*t57 + c1*t55)
+    t75 = -s1*t51 + c1*t48
+    t76 = -(s1*t52 + c1*t49)
+    t77 = -(s1*t53 + c1*t50)
+    t78 = -t20*t34 + c2*t51
+    t79 = -t20*t35 + c2*t52
+    t80 = -t20*t36 + c2*t53
     t81 = c2*t48 + t8*t34
     t82 = -c2*t49 + t8*t35
     t83 = -c2*t50 + t8*t36
-    t84 = -(t20*t48 + t8*t51)
-    t85 = t20*t49 - t8*t52
-    t86 = t20*t50 - t8*t53
+    t84 = -(t8*t51 + t20*t48)
+    t85 = -t8*t52 + t20*t49
+    t86 = -t8*t53 + t20*t50
     t87 = s2**2
     t88 = -(t3*t35 + t40*t52)
     t89 = -(t3*t36 + t40*t53)
-    t90 = -t6*t35 + t40*t49
-    t91 = -t6*t36 + t40*t50
-    t92 = t3*t49 + t6*t52
-    t93 = t3*t50 + t6*t53
+    t90 = t40*t49 - t6*t35
+    t91 = t40*t50 - t6*t36
+    t92 = t6*t52 + t3*t49
+    t93 = t6*t53 + t3*t50
     t94 = t22*t36 - t39*t53
     t95 = t39*t50 - t10*t36
     t96 = t10*t53 - t22*t50
@@ -1718,12 +1718,12 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 1
         t72*s2 + t73*s2,  # 1, 5, 2
         s1*t3 - c1*t6,  # 1, 5, 3
-        -(c1*t10 + s1*t22),  # 1, 5, 4
-        c1*t12 - s1*t24,  # 1, 5, 5
-        c1*t13 + s1*t25,  # 1, 5, 6
+        -(s1*t22 + c1*t10),  # 1, 5, 4
+        -s1*t24 + c1*t12,  # 1, 5, 5
+        s1*t25 + c1*t13,  # 1, 5, 6
         t59,  # 2, 0, 0
         t64,  # 2, 0, 1
-        c2*t57 - t20*t33,  # 2, 0, 2
+        -t20*t33 + c2*t57,  # 2, 0, 2
         t78,  # 2, 0, 3
         t79,  # 2, 0, 4
         t80,  # 2, 0, 5
@@ -1737,7 +1737,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2, 0
         t74,  # 2, 2, 1
-        t20*t55 - t8*t57,  # 2, 2, 2
+        -t8*t57 + t20*t55,  # 2, 2, 2
         t84,  # 2, 2, 3
         t85,  # 2, 2, 4
         t86,  # 2, 2, 5
@@ -1745,10 +1745,10 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 2
-        -(c2*t3 + t0*t87),  # 2, 3, 3
-        c2*t22 - t39*t20,  # 2, 3, 4
-        c2*t24 + t42*t20,  # 2, 3, 5
-        -c2*t25 + t43*t20,  # 2, 3, 6
+        -(t0*t87 + c2*t3),  # 2, 3, 3
+        -t39*t20 + c2*t22,  # 2, 3, 4
+        t42*t20 + c2*t24,  # 2, 3, 5
+        t43*t20 - c2*t25,  # 2, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4, 2
@@ -1760,8 +1760,8 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5, 2
         t3*t8 + t6*t20,  # 2, 5, 3
-        t10*t20 - t22*t8,  # 2, 5, 4
-        -(t12*t20 + t24*t8),  # 2, 5, 5
+        -t22*t8 + t10*t20,  # 2, 5, 4
+        -(t24*t8 + t12*t20),  # 2, 5, 5
         t25*t8 - t13*t20,  # 2, 5, 6
         t60,  # 3, 0, 0
         t65,  # 3, 0, 1
@@ -1773,7 +1773,7 @@ def hessian(q):
         t63,  # 3, 1, 0
         t69,  # 3, 1, 1
         t81,  # 3, 1, 2
-        -(t6*t34 + t40*t48),  # 3, 1, 3
+        -(t40*t48 + t6*t34),  # 3, 1, 3
         t90,  # 3, 1, 4
         t91,  # 3, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1, 6
@@ -1795,16 +1795,16 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 3
-        -t6*t39 + t10*t40,  # 3, 4, 4
-        t6*t42 - t12*t40,  # 3, 4, 5
-        t6*t43 - t13*t40,  # 3, 4, 6
+        t10*t40 - t6*t39,  # 3, 4, 4
+        -t12*t40 + t6*t42,  # 3, 4, 5
+        -t13*t40 + t6*t43,  # 3, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5, 3
-        t3*t10 + t6*t22,  # 3, 5, 4
+        t6*t22 + t3*t10,  # 3, 5, 4
         t6*t24 - t3*t12,  # 3, 5, 5
-        -(t3*t13 + t6*t25),  # 3, 5, 6
+        -(t6*t25 + t3*t13),  # 3, 5, 6
         t61,  # 4, 0, 0
         t66,  # 4, 0, 1
         t79,  # 4, 0, 2
@@ -1832,21 +1832,21 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 4
         -(t22*t42 + t39*t24),  # 4, 3, 5
-        t39*t25 - t22*t43,  # 4, 3, 6
+        -t22*t43 + t39*t25,  # 4, 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        t10*t42 - t39*t12,  # 4, 4, 5
-        t10*t43 - t39*t13,  # 4, 4, 6
+        -t39*t12 + t10*t42,  # 4, 4, 5
+        -t39*t13 + t10*t43,  # 4, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 4
         t10*t24 + t22*t12,  # 4, 5, 5
-        t22*t13 - t10*t25,  # 4, 5, 6
+        -t10*t25 + t22*t13,  # 4, 5, 6
         t62,  # 5, 0, 0
         t67,  # 5, 0, 1
         t80,  # 5, 0, 2
@@ -1859,7 +1859,7 @@ def hessian(q):
         t83,  # 5, 1, 2
         t91,  # 5, 1, 3
         t95,  # 5, 1, 4
-        t12*t36 - t42*t50,  # 5, 1, 5
+        -t42*t50 + t12*t36,  # 5, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2, 0
         t77,  # 5, 2, 1
@@ -2007,117 +2007,117 @@ def singularity_factors(q):
     t53 = -t6*t46 + t16*t40
     t54 = t39*t15 - t10*t45
     t55 = t42*t14 - t12*t44
-    t56 = t3*t42 - t24*t40
-    t57 = c1*t6
-    t58 = s2*t5
-    t59 = -(s1*t56 - t42*t57 + t12*t58)
-    t60 = -(t22*t42 + t39*t24)
-    t61 = -(t3*t39 + t22*t40)
-    t62 = -(-t6*t60 + t10*t56 + t12*t61)
-    t63 = c1*t10
-    t64 = c1*t12
-    t65 = -(s1*t60 - t42*t63 + t39*t64)
-    t66 = -(s1*t61 + t39*t57 - t10*t58)
-    t67 = -(-t59*t35 + t32*t62 + t34*t65 + t36*t66)
-    t68 = t10*t24 + t22*t12
-    t69 = t64 - s1*t24
-    t70 = -(t63 + s1*t22)
-    t71 = t32*t68 + t35*t69 - t70*t36
-    t72 = t3*t10 + t6*t22
-    t73 = s1*t3 - t57
-    t74 = t32*t72 + t34*t70 - t35*t73
+    t56 = t10*t24 + t22*t12
+    t57 = c1*t12
+    t58 = -s1*t24 + t57
+    t59 = c1*t10
+    t60 = -(s1*t22 + t59)
+    t61 = t56*t32 + t58*t35 - t60*t36
+    t62 = t6*t22 + t3*t10
+    t63 = c1*t6
+    t64 = s1*t3 - t63
+    t65 = t62*t32 + t60*t34 - t64*t35
+    t66 = t3*t42 - t24*t40
+    t67 = s2*t5
+    t68 = -(s1*t66 - t42*t63 + t12*t67)
+    t69 = -(t22*t42 + t39*t24)
+    t70 = -(t3*t39 + t22*t40)
+    t71 = -(-t6*t69 + t10*t66 + t12*t70)
+    t72 = -(s1*t69 - t42*t59 + t39*t57)
+    t73 = -(s1*t70 + t39*t63 - t10*t67)
+    t74 = -(-t68*t35 + t32*t71 + t34*t72 + t36*t73)
     t75 = t6*t24 - t3*t12
-    t76 = t32*t75 + t34*t69 - t36*t73
-    t77 = -(-t35*t75 + t34*t68 + t36*t72)
+    t76 = t75*t32 + t58*t34 - t64*t36
+    t77 = -(-t75*t35 + t56*t34 + t62*t36)
     t78 = s1*t47
-    t79 = c2*t24 + t42*t20
+    t79 = -t22*t8 + t10*t20
     t80 = c1**2
     t81 = t80*s2
-    t82 = -(s1*t79 - c2*t64 + t42*t81)
-    t83 = c2*t22 - t39*t20
-    t84 = -(t10*t79 + t12*t83 + t8*t60)
-    t85 = -(s1*t83 - t39*t81 + c2*t63)
-    t86 = -(-t35*t82 + t32*t84 + t33*t65 + t36*t85)
-    t87 = t10*t20 - t22*t8
-    t88 = t81 + s1**2*s2
-    t89 = t32*t87 + t33*t70 - t35*t88
-    t90 = -(t12*t20 + t24*t8)
-    t91 = t32*t90 + t33*t69 - t36*t88
-    t92 = -(-t35*t90 + t33*t68 + t36*t87)
-    t93 = s2**2
-    t94 = -(c2*t3 + t0*t93)
-    t95 = -(t12*t94 + t6*t79 + t8*t56)
-    t96 = -(s1*t94 - s3*t80*t93 + c2*t57)
-    t97 = -(-t34*t82 + t32*t95 + t33*t59 + t36*t96)
-    t98 = t3*t8 + t6*t20
-    t99 = t32*t98 + t33*t73 - t34*t88
-    t100 = -(-t34*t90 + t33*t75 + t36*t98)
-    t101 = -(-t10*t94 + t6*t83 + t8*t61)
-    t102 = -(-t34*t85 + t32*t101 + t33*t66 + t35*t96)
-    t103 = t33*t62 + t35*t95 - t34*t84 - t36*t101
-    t104 = -(-t34*t87 + t33*t72 + t35*t98)
+    t82 = s1**2*s2 + t81
+    t83 = t79*t32 + t60*t33 - t82*t35
+    t84 = t42*t20 + c2*t24
+    t85 = -(s1*t84 - c2*t57 + t42*t81)
+    t86 = -t39*t20 + c2*t22
+    t87 = -(t10*t84 + t12*t86 + t8*t69)
+    t88 = -(s1*t86 - t39*t81 + c2*t59)
+    t89 = -(-t85*t35 + t32*t87 + t72*t33 + t36*t88)
+    t90 = -(t24*t8 + t12*t20)
+    t91 = t90*t32 + t58*t33 - t82*t36
+    t92 = -(-t90*t35 + t56*t33 + t79*t36)
+    t93 = t3*t8 + t6*t20
+    t94 = t93*t32 + t64*t33 - t82*t34
+    t95 = s2**2
+    t96 = -(t0*t95 + c2*t3)
+    t97 = -(t12*t96 + t6*t84 + t8*t66)
+    t98 = -(s1*t96 - s3*t80*t95 + c2*t63)
+    t99 = -(-t85*t34 + t32*t97 + t68*t33 + t36*t98)
+    t100 = -(-t90*t34 + t75*t33 + t93*t36)
+    t101 = -(-t10*t96 + t6*t86 + t8*t70)
+    t102 = -(-t88*t34 + t32*t101 + t73*t33 + t35*t98)
+    t103 = -(-t79*t34 + t62*t33 + t93*t35)
+    t104 = t71*t33 + t35*t97 - t87*t34 - t101*t36
     t105 = c1*t47
-    t106 = t48*(t19*t67 + t53*t71 + t55*t74 - t54*t76 - t77*t78) + t49*(t19*t86 + t52*t71 + t55*t89 - t54*t91 - t78*t92) + t50*(t19*t97 + t52*t76 + t55*t99 - t53*t91 - t78*t100) - t31*(t53*t86 + t55*t102 - t67*t52 - t54*t97 + t78*t103) - t51*(t19*t102 + t52*t74 + t54*t99 - t53*t89 - t78*t104) - t105*(t19*t103 + t53*t92 + t55*t104 - t52*t77 - t54*t100)
-    t107 = t3*t43 + t25*t40
-    t108 = -(s1*t107 - t43*t57 + t13*t58)
-    t109 = t39*t25 - t22*t43
-    t110 = -(-t6*t109 + t10*t107 + t13*t61)
-    t111 = c1*t13
-    t112 = -(s1*t109 - t43*t63 + t39*t111)
-    t113 = -(-t35*t108 + t32*t110 + t34*t112)
-    t114 = t22*t13 - t10*t25
-    t115 = t111 + s1*t25
-    t116 = t32*t114 + t35*t115
-    t117 = -(t3*t13 + t6*t25)
-    t118 = t32*t117 + t34*t115
-    t119 = t35*t117 - t34*t114
-    t120 = t19*t113 + t53*t116 - t54*t118 - t78*t119
-    t121 = -c2*t25 + t43*t20
-    t122 = -(s1*t121 - c2*t111 + t43*t81)
-    t123 = -(t10*t121 + t13*t83 + t8*t109)
-    t124 = -(-t35*t122 + t32*t123 + t33*t112)
+    t106 = t48*(t53*t61 + t55*t65 + t19*t74 - t76*t54 - t77*t78) + t49*(t61*t52 + t55*t83 + t19*t89 - t91*t54 - t78*t92) + t50*(t76*t52 + t55*t94 + t19*t99 - t91*t53 - t78*t100) - t51*(t65*t52 + t54*t94 + t19*t102 - t83*t53 - t78*t103) - t31*(t53*t89 + t55*t102 - t74*t52 - t99*t54 + t78*t104) - t105*(t53*t92 + t55*t103 + t19*t104 - t77*t52 - t100*t54)
+    t107 = -t10*t25 + t22*t13
+    t108 = c1*t13
+    t109 = s1*t25 + t108
+    t110 = t107*t32 + t109*t35
+    t111 = t3*t43 + t25*t40
+    t112 = -(s1*t111 - t43*t63 + t13*t67)
+    t113 = -t22*t43 + t39*t25
+    t114 = -(-t6*t113 + t10*t111 + t13*t70)
+    t115 = -(s1*t113 - t43*t59 + t39*t108)
+    t116 = -(-t112*t35 + t32*t114 + t34*t115)
+    t117 = -(t6*t25 + t3*t13)
+    t118 = t117*t32 + t109*t34
+    t119 = t117*t35 - t107*t34
+    t120 = t53*t110 + t19*t116 - t118*t54 - t78*t119
+    t121 = t43*t20 - c2*t25
+    t122 = -(s1*t121 - c2*t108 + t43*t81)
+    t123 = -(t10*t121 + t13*t86 + t8*t113)
+    t124 = -(-t35*t122 + t32*t123 + t33*t115)
     t125 = t25*t8 - t13*t20
-    t126 = t32*t125 + t33*t115
-    t127 = t35*t125 - t33*t114
-    t128 = t19*t124 + t52*t116 - t54*t126 - t78*t127
-    t129 = -(t13*t94 + t6*t121 + t8*t107)
-    t130 = -(-t34*t122 + t32*t129 + t33*t108)
-    t131 = t34*t125 - t33*t117
-    t132 = t19*t130 + t52*t118 - t53*t126 - t78*t131
-    t133 = t33*t110 + t35*t129 - t34*t123
-    t134 = t53*t124 - t52*t113 - t54*t130 + t78*t133
-    t135 = t19*t133 + t53*t127 - t52*t119 - t54*t131
+    t126 = t125*t32 + t109*t33
+    t127 = t125*t35 - t107*t33
+    t128 = t52*t110 + t19*t124 - t54*t126 - t78*t127
+    t129 = -(t13*t96 + t6*t121 + t8*t111)
+    t130 = -(-t34*t122 + t32*t129 + t33*t112)
+    t131 = t125*t34 - t117*t33
+    t132 = t52*t118 + t19*t130 - t53*t126 - t78*t131
+    t133 = t33*t114 + t35*t129 - t34*t123
+    t134 = t53*t124 - t116*t52 - t54*t130 + t78*t133
+    t135 = t53*t127 + t19*t133 - t52*t119 - t54*t131
     t136 = t48*t120 + t49*t128 + t50*t132 - t31*t134 - t105*t135
-    t137 = -(t24*t43 + t42*t25)
-    t138 = t12*t107 + t6*t137 - t13*t56
-    t139 = -(s1*t137 - t42*t111 + t43*t64)
-    t140 = -(-t36*t108 + t32*t138 + t34*t139)
-    t141 = t12*t25 + t24*t13
-    t142 = t32*t141 + t36*t115
-    t143 = t36*t117 - t34*t141
-    t144 = t19*t140 + t53*t142 - t55*t118 - t78*t143
-    t145 = -(-t12*t121 + t13*t79 + t8*t137)
-    t146 = -(-t36*t122 + t32*t145 + t33*t139)
-    t147 = t36*t125 - t33*t141
-    t148 = t19*t146 + t52*t142 - t55*t126 - t78*t147
-    t149 = t33*t138 + t36*t129 - t34*t145
-    t150 = t53*t146 - t52*t140 - t55*t130 + t78*t149
-    t151 = t19*t149 + t53*t147 - t52*t143 - t55*t131
+    t137 = t12*t25 + t24*t13
+    t138 = t137*t32 + t109*t36
+    t139 = -(t24*t43 + t42*t25)
+    t140 = t12*t111 + t6*t139 - t13*t66
+    t141 = -(s1*t139 - t42*t108 + t43*t57)
+    t142 = -(-t112*t36 + t32*t140 + t34*t141)
+    t143 = t117*t36 - t34*t137
+    t144 = t53*t138 + t19*t142 - t118*t55 - t78*t143
+    t145 = -(-t12*t121 + t13*t84 + t8*t139)
+    t146 = -(-t36*t122 + t32*t145 + t33*t141)
+    t147 = t125*t36 - t33*t137
+    t148 = t52*t138 + t19*t146 - t55*t126 - t78*t147
+    t149 = t33*t140 + t36*t129 - t34*t145
+    t150 = t53*t146 - t52*t142 - t55*t130 + t78*t149
+    t151 = t53*t147 + t19*t149 - t52*t143 - t55*t131
     t152 = t48*t144 + t49*t148 + t51*t132 - t31*t150 - t105*t151
-    t153 = t10*t137 + t12*t109 - t13*t60
-    t154 = -(-t36*t112 + t32*t153 + t35*t139)
+    t153 = t10*t139 + t12*t113 - t13*t69
+    t154 = -(-t115*t36 + t32*t153 + t35*t141)
     t155 = t33*t153 + t36*t123 - t35*t145
     t156 = t54*t146 - t52*t154 - t55*t124 + t78*t155
-    t157 = t36*t114 - t35*t141
-    t158 = t19*t154 + t54*t142 - t55*t116 - t78*t157
-    t159 = t19*t155 + t54*t147 - t52*t157 - t55*t127
-    t160 = t31*t156 + t50*t148 - t48*t158 - t51*t128 + t105*t159
-    t161 = t34*t153 + t36*t110 - t35*t138
-    t162 = t54*t140 - t53*t154 - t55*t113 + t78*t161
-    t163 = t19*t161 + t54*t143 - t53*t157 - t55*t119
-    t164 = t31*t162 + t49*t158 + t50*t144 - t51*t120 + t105*t163
+    t157 = t107*t36 - t35*t137
+    t158 = t54*t138 + t19*t154 - t110*t55 - t78*t157
+    t159 = t54*t147 + t19*t155 - t52*t157 - t55*t127
+    t160 = t50*t148 + t31*t156 - t48*t158 - t51*t128 + t105*t159
+    t161 = t34*t153 + t36*t114 - t35*t140
+    t162 = t54*t142 - t53*t154 - t116*t55 + t78*t161
+    t163 = t54*t143 + t19*t161 - t53*t157 - t55*t119
+    t164 = t49*t158 + t50*t144 + t31*t162 - t51*t120 + t105*t163
     t165 = t52*t161 + t54*t149 - t53*t155 - t55*t133
-    t166 = t31*t165 + t48*t163 + t49*t159 + t50*t151 - t51*t135
+    t166 = t48*t163 + t49*t159 + t50*t151 + t31*t165 - t51*t135
     t167 = t48*t162 + t49*t156 + t50*t150 - t51*t134 - t105*t165
     f = _stack(xp, [
         t106**2 + t136**2 + t152**2 + t160**2 + t164**2 + t166**2 + t167**2,  # 0
@@ -2197,117 +2197,117 @@ def manipulability(q):
     t53 = -t6*t46 + t16*t40
     t54 = t39*t15 - t10*t45
     t55 = t42*t14 - t12*t44
-    t56 = t3*t42 - t24*t40
-    t57 = c1*t6
-    t58 = s2*t5
-    t59 = -(s1*t56 - t42*t57 + t12*t58)
-    t60 = -(t22*t42 + t39*t24)
-    t61 = -(t3*t39 + t22*t40)
-    t62 = -(-t6*t60 + t10*t56 + t12*t61)
-    t63 = c1*t10
-    t64 = c1*t12
-    t65 = -(s1*t60 - t42*t63 + t39*t64)
-    t66 = -(s1*t61 + t39*t57 - t10*t58)
-    t67 = -(-t59*t35 + t32*t62 + t34*t65 + t36*t66)
-    t68 = t10*t24 + t22*t12
-    t69 = t64 - s1*t24
-    t70 = -(t63 + s1*t22)
-    t71 = t32*t68 + t35*t69 - t70*t36
-    t72 = t3*t10 + t6*t22
-    t73 = s1*t3 - t57
-    t74 = t32*t72 + t34*t70 - t35*t73
+    t56 = t10*t24 + t22*t12
+    t57 = c1*t12
+    t58 = -s1*t24 + t57
+    t59 = c1*t10
+    t60 = -(s1*t22 + t59)
+    t61 = t56*t32 + t58*t35 - t60*t36
+    t62 = t6*t22 + t3*t10
+    t63 = c1*t6
+    t64 = s1*t3 - t63
+    t65 = t62*t32 + t60*t34 - t64*t35
+    t66 = t3*t42 - t24*t40
+    t67 = s2*t5
+    t68 = -(s1*t66 - t42*t63 + t12*t67)
+    t69 = -(t22*t42 + t39*t24)
+    t70 = -(t3*t39 + t22*t40)
+    t71 = -(-t6*t69 + t10*t66 + t12*t70)
+    t72 = -(s1*t69 - t42*t59 + t39*t57)
+    t73 = -(s1*t70 + t39*t63 - t10*t67)
+    t74 = -(-t68*t35 + t32*t71 + t34*t72 + t36*t73)
     t75 = t6*t24 - t3*t12
-    t76 = t32*t75 + t34*t69 - t36*t73
-    t77 = -(-t35*t75 + t34*t68 + t36*t72)
+    t76 = t75*t32 + t58*t34 - t64*t36
+    t77 = -(-t75*t35 + t56*t34 + t62*t36)
     t78 = s1*t47
-    t79 = c2*t24 + t42*t20
+    t79 = -t22*t8 + t10*t20
     t80 = c1**2
     t81 = t80*s2
-    t82 = -(s1*t79 - c2*t64 + t42*t81)
-    t83 = c2*t22 - t39*t20
-    t84 = -(t10*t79 + t12*t83 + t8*t60)
-    t85 = -(s1*t83 - t39*t81 + c2*t63)
-    t86 = -(-t35*t82 + t32*t84 + t33*t65 + t36*t85)
-    t87 = t10*t20 - t22*t8
-    t88 = t81 + s1**2*s2
-    t89 = t32*t87 + t33*t70 - t35*t88
-    t90 = -(t12*t20 + t24*t8)
-    t91 = t32*t90 + t33*t69 - t36*t88
-    t92 = -(-t35*t90 + t33*t68 + t36*t87)
-    t93 = s2**2
-    t94 = -(c2*t3 + t0*t93)
-    t95 = -(t12*t94 + t6*t79 + t8*t56)
-    t96 = -(s1*t94 - s3*t80*t93 + c2*t57)
-    t97 = -(-t34*t82 + t32*t95 + t33*t59 + t36*t96)
-    t98 = t3*t8 + t6*t20
-    t99 = t32*t98 + t33*t73 - t34*t88
-    t100 = -(-t34*t90 + t33*t75 + t36*t98)
-    t101 = -(-t10*t94 + t6*t83 + t8*t61)
-    t102 = -(-t34*t85 + t32*t101 + t33*t66 + t35*t96)
-    t103 = t33*t62 + t35*t95 - t34*t84 - t36*t101
-    t104 = -(-t34*t87 + t33*t72 + t35*t98)
+    t82 = s1**2*s2 + t81
+    t83 = t79*t32 + t60*t33 - t82*t35
+    t84 = t42*t20 + c2*t24
+    t85 = -(s1*t84 - c2*t57 + t42*t81)
+    t86 = -t39*t20 + c2*t22
+    t87 = -(t10*t84 + t12*t86 + t8*t69)
+    t88 = -(s1*t86 - t39*t81 + c2*t59)
+    t89 = -(-t85*t35 + t32*t87 + t72*t33 + t36*t88)
+    t90 = -(t24*t8 + t12*t20)
+    t91 = t90*t32 + t58*t33 - t82*t36
+    t92 = -(-t90*t35 + t56*t33 + t79*t36)
+    t93 = t3*t8 + t6*t20
+    t94 = t93*t32 + t64*t33 - t82*t34
+    t95 = s2**2
+    t96 = -(t0*t95 + c2*t3)
+    t97 = -(t12*t96 + t6*t84 + t8*t66)
+    t98 = -(s1*t96 - s3*t80*t95 + c2*t63)
+    t99 = -(-t85*t34 + t32*t97 + t68*t33 + t36*t98)
+    t100 = -(-t90*t34 + t75*t33 + t93*t36)
+    t101 = -(-t10*t96 + t6*t86 + t8*t70)
+    t102 = -(-t88*t34 + t32*t101 + t73*t33 + t35*t98)
+    t103 = -(-t79*t34 + t62*t33 + t93*t35)
+    t104 = t71*t33 + t35*t97 - t87*t34 - t101*t36
     t105 = c1*t47
-    t106 = t48*(t19*t67 + t53*t71 + t55*t74 - t54*t76 - t77*t78) + t49*(t19*t86 + t52*t71 + t55*t89 - t54*t91 - t78*t92) + t50*(t19*t97 + t52*t76 + t55*t99 - t53*t91 - t78*t100) - t31*(t53*t86 + t55*t102 - t67*t52 - t54*t97 + t78*t103) - t51*(t19*t102 + t52*t74 + t54*t99 - t53*t89 - t78*t104) - t105*(t19*t103 + t53*t92 + t55*t104 - t52*t77 - t54*t100)
-    t107 = t3*t43 + t25*t40
-    t108 = -(s1*t107 - t43*t57 + t13*t58)
-    t109 = t39*t25 - t22*t43
-    t110 = -(-t6*t109 + t10*t107 + t13*t61)
-    t111 = c1*t13
-    t112 = -(s1*t109 - t43*t63 + t39*t111)
-    t113 = -(-t35*t108 + t32*t110 + t34*t112)
-    t114 = t22*t13 - t10*t25
-    t115 = t111 + s1*t25
-    t116 = t32*t114 + t35*t115
-    t117 = -(t3*t13 + t6*t25)
-    t118 = t32*t117 + t34*t115
-    t119 = t35*t117 - t34*t114
-    t120 = t19*t113 + t53*t116 - t54*t118 - t78*t119
-    t121 = -c2*t25 + t43*t20
-    t122 = -(s1*t121 - c2*t111 + t43*t81)
-    t123 = -(t10*t121 + t13*t83 + t8*t109)
-    t124 = -(-t35*t122 + t32*t123 + t33*t112)
+    t106 = t48*(t53*t61 + t55*t65 + t19*t74 - t76*t54 - t77*t78) + t49*(t61*t52 + t55*t83 + t19*t89 - t91*t54 - t78*t92) + t50*(t76*t52 + t55*t94 + t19*t99 - t91*t53 - t78*t100) - t51*(t65*t52 + t54*t94 + t19*t102 - t83*t53 - t78*t103) - t31*(t53*t89 + t55*t102 - t74*t52 - t99*t54 + t78*t104) - t105*(t53*t92 + t55*t103 + t19*t104 - t77*t52 - t100*t54)
+    t107 = -t10*t25 + t22*t13
+    t108 = c1*t13
+    t109 = s1*t25 + t108
+    t110 = t107*t32 + t109*t35
+    t111 = t3*t43 + t25*t40
+    t112 = -(s1*t111 - t43*t63 + t13*t67)
+    t113 = -t22*t43 + t39*t25
+    t114 = -(-t6*t113 + t10*t111 + t13*t70)
+    t115 = -(s1*t113 - t43*t59 + t39*t108)
+    t116 = -(-t112*t35 + t32*t114 + t34*t115)
+    t117 = -(t6*t25 + t3*t13)
+    t118 = t117*t32 + t109*t34
+    t119 = t117*t35 - t107*t34
+    t120 = t53*t110 + t19*t116 - t118*t54 - t78*t119
+    t121 = t43*t20 - c2*t25
+    t122 = -(s1*t121 - c2*t108 + t43*t81)
+    t123 = -(t10*t121 + t13*t86 + t8*t113)
+    t124 = -(-t35*t122 + t32*t123 + t33*t115)
     t125 = t25*t8 - t13*t20
-    t126 = t32*t125 + t33*t115
-    t127 = t35*t125 - t33*t114
-    t128 = t19*t124 + t52*t116 - t54*t126 - t78*t127
-    t129 = -(t13*t94 + t6*t121 + t8*t107)
-    t130 = -(-t34*t122 + t32*t129 + t33*t108)
-    t131 = t34*t125 - t33*t117
-    t132 = t19*t130 + t52*t118 - t53*t126 - t78*t131
-    t133 = t33*t110 + t35*t129 - t34*t123
-    t134 = t53*t124 - t52*t113 - t54*t130 + t78*t133
-    t135 = t19*t133 + t53*t127 - t52*t119 - t54*t131
+    t126 = t125*t32 + t109*t33
+    t127 = t125*t35 - t107*t33
+    t128 = t52*t110 + t19*t124 - t54*t126 - t78*t127
+    t129 = -(t13*t96 + t6*t121 + t8*t111)
+    t130 = -(-t34*t122 + t32*t129 + t33*t112)
+    t131 = t125*t34 - t117*t33
+    t132 = t52*t118 + t19*t130 - t53*t126 - t78*t131
+    t133 = t33*t114 + t35*t129 - t34*t123
+    t134 = t53*t124 - t116*t52 - t54*t130 + t78*t133
+    t135 = t53*t127 + t19*t133 - t52*t119 - t54*t131
     t136 = t48*t120 + t49*t128 + t50*t132 - t31*t134 - t105*t135
-    t137 = -(t24*t43 + t42*t25)
-    t138 = t12*t107 + t6*t137 - t13*t56
-    t139 = -(s1*t137 - t42*t111 + t43*t64)
-    t140 = -(-t36*t108 + t32*t138 + t34*t139)
-    t141 = t12*t25 + t24*t13
-    t142 = t32*t141 + t36*t115
-    t143 = t36*t117 - t34*t141
-    t144 = t19*t140 + t53*t142 - t55*t118 - t78*t143
-    t145 = -(-t12*t121 + t13*t79 + t8*t137)
-    t146 = -(-t36*t122 + t32*t145 + t33*t139)
-    t147 = t36*t125 - t33*t141
-    t148 = t19*t146 + t52*t142 - t55*t126 - t78*t147
-    t149 = t33*t138 + t36*t129 - t34*t145
-    t150 = t53*t146 - t52*t140 - t55*t130 + t78*t149
-    t151 = t19*t149 + t53*t147 - t52*t143 - t55*t131
+    t137 = t12*t25 + t24*t13
+    t138 = t137*t32 + t109*t36
+    t139 = -(t24*t43 + t42*t25)
+    t140 = t12*t111 + t6*t139 - t13*t66
+    t141 = -(s1*t139 - t42*t108 + t43*t57)
+    t142 = -(-t112*t36 + t32*t140 + t34*t141)
+    t143 = t117*t36 - t34*t137
+    t144 = t53*t138 + t19*t142 - t118*t55 - t78*t143
+    t145 = -(-t12*t121 + t13*t84 + t8*t139)
+    t146 = -(-t36*t122 + t32*t145 + t33*t141)
+    t147 = t125*t36 - t33*t137
+    t148 = t52*t138 + t19*t146 - t55*t126 - t78*t147
+    t149 = t33*t140 + t36*t129 - t34*t145
+    t150 = t53*t146 - t52*t142 - t55*t130 + t78*t149
+    t151 = t53*t147 + t19*t149 - t52*t143 - t55*t131
     t152 = t48*t144 + t49*t148 + t51*t132 - t31*t150 - t105*t151
-    t153 = t10*t137 + t12*t109 - t13*t60
-    t154 = -(-t36*t112 + t32*t153 + t35*t139)
+    t153 = t10*t139 + t12*t113 - t13*t69
+    t154 = -(-t115*t36 + t32*t153 + t35*t141)
     t155 = t33*t153 + t36*t123 - t35*t145
     t156 = t54*t146 - t52*t154 - t55*t124 + t78*t155
-    t157 = t36*t114 - t35*t141
-    t158 = t19*t154 + t54*t142 - t55*t116 - t78*t157
-    t159 = t19*t155 + t54*t147 - t52*t157 - t55*t127
-    t160 = t31*t156 + t50*t148 - t48*t158 - t51*t128 + t105*t159
-    t161 = t34*t153 + t36*t110 - t35*t138
-    t162 = t54*t140 - t53*t154 - t55*t113 + t78*t161
-    t163 = t19*t161 + t54*t143 - t53*t157 - t55*t119
-    t164 = t31*t162 + t49*t158 + t50*t144 - t51*t120 + t105*t163
+    t157 = t107*t36 - t35*t137
+    t158 = t54*t138 + t19*t154 - t110*t55 - t78*t157
+    t159 = t54*t147 + t19*t155 - t52*t157 - t55*t127
+    t160 = t50*t148 + t31*t156 - t48*t158 - t51*t128 + t105*t159
+    t161 = t34*t153 + t36*t114 - t35*t140
+    t162 = t54*t142 - t53*t154 - t116*t55 + t78*t161
+    t163 = t54*t143 + t19*t161 - t53*t157 - t55*t119
+    t164 = t49*t158 + t50*t144 + t31*t162 - t51*t120 + t105*t163
     t165 = t52*t161 + t54*t149 - t53*t155 - t55*t133
-    t166 = t31*t165 + t48*t163 + t49*t159 + t50*t151 - t51*t135
+    t166 = t48*t163 + t49*t159 + t50*t151 + t31*t165 - t51*t135
     t167 = t48*t162 + t49*t156 + t50*t150 - t51*t134 - t105*t165
     t168 = t106**2 + t136**2 + t152**2 + t160**2 + t164**2 + t166**2 + t167**2
     w = xp.broadcast_to(xp.sqrt(xp.abs(t168)), batch)

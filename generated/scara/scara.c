@@ -317,9 +317,9 @@ void scara_fk_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot
     const scara_real t5 = 0.275*s12;
     const scara_real t6 = t5 + 0.325*s1;
     const scara_real t7 = t5*qd2;
-    const scara_real t8 = t6*qd1 + t7;
+    const scara_real t8 = t7 + t6*qd1;
     const scara_real t9 = t3*qd2;
-    const scara_real t10 = t4*qd1 + t9;
+    const scara_real t10 = t9 + t4*qd1;
 
     /* Outputs */
     T[0] = t1;
@@ -362,8 +362,8 @@ void scara_fk_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot
     J[21] = 1;
     J[22] = 0;
     J[23] = -1;
-    a[0] = -qd2*(t3*qd1 + t9) - qd1*t10;
-    a[1] = -qd2*(t5*qd1 + t7) - qd1*t8;
+    a[0] = -qd1*t10 - qd2*(t9 + t3*qd1);
+    a[1] = -qd1*t8 - qd2*(t7 + t5*qd1);
     a[2] = 0;
     a[3] = 0;
     a[4] = 0;
@@ -392,17 +392,17 @@ void scara_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_dot[SC
     const scara_real t2 = 0.275*s12;
     const scara_real t3 = t2 + 0.325*s1;
     const scara_real t4 = t2*qd2;
-    const scara_real t5 = t3*qd1 + t4;
+    const scara_real t5 = t4 + t3*qd1;
     const scara_real t6 = t0*qd2;
-    const scara_real t7 = t1*qd1 + t6;
+    const scara_real t7 = t6 + t1*qd1;
 
     /* Outputs */
     Jd[0] = -t7;
-    Jd[1] = -(t0*qd1 + t6);
+    Jd[1] = -(t6 + t0*qd1);
     Jd[2] = 0;
     Jd[3] = 0;
     Jd[4] = -t5;
-    Jd[5] = -(t2*qd1 + t4);
+    Jd[5] = -(t4 + t2*qd1);
     Jd[6] = 0;
     Jd[7] = 0;
     Jd[8] = 0;
@@ -445,13 +445,13 @@ void scara_bias_acceleration(const scara_real q[SCARA_DOF], const scara_real q_d
     const scara_real t2 = 0.275*s12;
     const scara_real t3 = t2 + 0.325*s1;
     const scara_real t4 = t2*qd2;
-    const scara_real t5 = t3*qd1 + t4;
+    const scara_real t5 = t4 + t3*qd1;
     const scara_real t6 = t0*qd2;
-    const scara_real t7 = t1*qd1 + t6;
+    const scara_real t7 = t6 + t1*qd1;
 
     /* Outputs */
-    a[0] = -qd2*(t0*qd1 + t6) - qd1*t7;
-    a[1] = -qd2*(t2*qd1 + t4) - qd1*t5;
+    a[0] = -qd1*t7 - qd2*(t6 + t0*qd1);
+    a[1] = -qd1*t5 - qd2*(t4 + t2*qd1);
     a[2] = 0;
     a[3] = 0;
     a[4] = 0;
@@ -480,10 +480,10 @@ void scara_task_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_d
     const scara_real t2 = 0.275*s12;
     const scara_real t3 = t2 + 0.325*s1;
     const scara_real t4 = t2*qd2;
-    const scara_real t5 = t3*qd1 + t4;
+    const scara_real t5 = t4 + t3*qd1;
     const scara_real t6 = t4 + t2*qd1;
     const scara_real t7 = t0*qd2;
-    const scara_real t8 = t1*qd1 + t7;
+    const scara_real t8 = t7 + t1*qd1;
     const scara_real t9 = t7 + t0*qd1;
 
     /* Outputs */

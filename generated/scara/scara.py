@@ -354,9 +354,9 @@ def fk_jacobian_dot(q, q_dot):
     t5 = 0.275*s12
     t6 = t5 + 0.325*s1
     t7 = t5*qd2
-    t8 = t6*qd1 + t7
+    t8 = t7 + t6*qd1
     t9 = t3*qd2
-    t10 = t4*qd1 + t9
+    t10 = t9 + t4*qd1
     T = _stack(xp, [
         xp.broadcast_to(t1, batch),  # 0, 0
         xp.broadcast_to(t2, batch),  # 0, 1
@@ -402,8 +402,8 @@ def fk_jacobian_dot(q, q_dot):
         xp.full(batch, -1, dtype=dtype, device=device),  # 5, 3
     ], (6, 4))
     a = _stack(xp, [
-        xp.broadcast_to(-qd2*(t3*qd1 + t9) - qd1*t10, batch),  # 0
-        xp.broadcast_to(-qd2*(t5*qd1 + t7) - qd1*t8, batch),  # 1
+        xp.broadcast_to(-qd1*t10 - qd2*(t9 + t3*qd1), batch),  # 0
+        xp.broadcast_to(-qd1*t8 - qd2*(t7 + t5*qd1), batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -429,16 +429,16 @@ def jacobian_dot(q, q_dot):
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
     t4 = t2*qd2
-    t5 = t3*qd1 + t4
+    t5 = t4 + t3*qd1
     t6 = t0*qd2
-    t7 = t1*qd1 + t6
+    t7 = t6 + t1*qd1
     Jd = _stack(xp, [
         xp.broadcast_to(-t7, batch),  # 0, 0
-        xp.broadcast_to(-(t0*qd1 + t6), batch),  # 0, 1
+        xp.broadcast_to(-(t6 + t0*qd1), batch),  # 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.broadcast_to(-t5, batch),  # 1, 0
-        xp.broadcast_to(-(t2*qd1 + t4), batch),  # 1, 1
+        xp.broadcast_to(-(t4 + t2*qd1), batch),  # 1, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
@@ -478,12 +478,12 @@ def bias_acceleration(q, q_dot):
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
     t4 = t2*qd2
-    t5 = t3*qd1 + t4
+    t5 = t4 + t3*qd1
     t6 = t0*qd2
-    t7 = t1*qd1 + t6
+    t7 = t6 + t1*qd1
     a = _stack(xp, [
-        xp.broadcast_to(-qd2*(t0*qd1 + t6) - qd1*t7, batch),  # 0
-        xp.broadcast_to(-qd2*(t2*qd1 + t4) - qd1*t5, batch),  # 1
+        xp.broadcast_to(-qd1*t7 - qd2*(t6 + t0*qd1), batch),  # 0
+        xp.broadcast_to(-qd1*t5 - qd2*(t4 + t2*qd1), batch),  # 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4
@@ -509,10 +509,10 @@ def task_jacobian_dot(q, q_dot):
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
     t4 = t2*qd2
-    t5 = t3*qd1 + t4
+    t5 = t4 + t3*qd1
     t6 = t4 + t2*qd1
     t7 = t0*qd2
-    t8 = t1*qd1 + t7
+    t8 = t7 + t1*qd1
     t9 = t7 + t0*qd1
     Jd = _stack(xp, [
         xp.broadcast_to(-t8, batch),  # 0, 0

@@ -225,9 +225,9 @@ def _fk_jacobian_dot(q, q_dot):
     t5 = 0.275*s12
     t6 = t5 + 0.325*s1
     t7 = t5*qd2
-    t8 = t6*qd1 + t7
+    t8 = t7 + t6*qd1
     t9 = t3*qd2
-    t10 = t4*qd1 + t9
+    t10 = t9 + t4*qd1
     T = casadi.SX(4, 4)
     T[0, 0] = t1
     T[0, 1] = t2
@@ -248,8 +248,8 @@ def _fk_jacobian_dot(q, q_dot):
     J[5, 1] = 1
     J[5, 3] = -1
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd2*(t3*qd1 + t9) - qd1*t10
-    a[1, 0] = -qd2*(t5*qd1 + t7) - qd1*t8
+    a[0, 0] = -qd1*t10 - qd2*(t9 + t3*qd1)
+    a[1, 0] = -qd1*t8 - qd2*(t7 + t5*qd1)
     return [T, J, a]
 
 
@@ -270,14 +270,14 @@ def _jacobian_dot(q, q_dot):
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
     t4 = t2*qd2
-    t5 = t3*qd1 + t4
+    t5 = t4 + t3*qd1
     t6 = t0*qd2
-    t7 = t1*qd1 + t6
+    t7 = t6 + t1*qd1
     Jd = casadi.SX(6, 4)
     Jd[0, 0] = -t7
-    Jd[0, 1] = -(t0*qd1 + t6)
+    Jd[0, 1] = -(t6 + t0*qd1)
     Jd[1, 0] = -t5
-    Jd[1, 1] = -(t2*qd1 + t4)
+    Jd[1, 1] = -(t4 + t2*qd1)
     return [Jd]
 
 
@@ -298,12 +298,12 @@ def _bias_acceleration(q, q_dot):
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
     t4 = t2*qd2
-    t5 = t3*qd1 + t4
+    t5 = t4 + t3*qd1
     t6 = t0*qd2
-    t7 = t1*qd1 + t6
+    t7 = t6 + t1*qd1
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd2*(t0*qd1 + t6) - qd1*t7
-    a[1, 0] = -qd2*(t2*qd1 + t4) - qd1*t5
+    a[0, 0] = -qd1*t7 - qd2*(t6 + t0*qd1)
+    a[1, 0] = -qd1*t5 - qd2*(t4 + t2*qd1)
     return [a]
 
 
@@ -324,10 +324,10 @@ def _task_jacobian_dot(q, q_dot):
     t2 = 0.275*s12
     t3 = t2 + 0.325*s1
     t4 = t2*qd2
-    t5 = t3*qd1 + t4
+    t5 = t4 + t3*qd1
     t6 = t4 + t2*qd1
     t7 = t0*qd2
-    t8 = t1*qd1 + t7
+    t8 = t7 + t1*qd1
     t9 = t7 + t0*qd1
     Jd = casadi.SX(4, 4)
     Jd[0, 0] = -t8

@@ -566,7 +566,7 @@ void stanford_fk_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanfor
     const stanford_real t29 = t0 - t26*qd5;
     const stanford_real t30 = c1*t2 + s1*t4;
     const stanford_real t31 = t30;
-    const stanford_real t32 = c2*qd3 - qd2*t31;
+    const stanford_real t32 = c2*qd3 - t31*qd2;
     const stanford_real t33 = s1*qd2;
     const stanford_real t34 = -t33 + t1*qd4;
     const stanford_real t35 = t34 + t15*qd5;
@@ -583,7 +583,7 @@ void stanford_fk_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanfor
     const stanford_real t46 = c2*t38 - t3*qd1;
     const stanford_real t47 = t1*qd1 + c2*t33;
     const stanford_real t48 = s2*qd2;
-    const stanford_real t49 = -((c1*c1)*t48 + (s1*s1)*t48);
+    const stanford_real t49 = -((s1*s1)*t48 + (c1*c1)*t48);
 
     /* Outputs */
     T[0] = t19;
@@ -638,11 +638,11 @@ void stanford_fk_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanfor
     J[33] = c2;
     J[34] = -t26;
     J[35] = t43;
-    a[0] = qd2*(c1*t32 - t45*qd1) + qd3*t46 - qd1*t37;
-    a[1] = qd1*t42 + qd2*(s1*t32 + t44*qd1) + qd3*t47;
-    a[2] = -qd2*(c1*t41 + s1*t36) + qd3*t49;
-    a[3] = qd4*t46 - qd5*(t10*t0 + t26*t39) - qd6*(t18*t29 + t25*t40) - t38*qd1;
-    a[4] = qd4*t47 + qd5*(t15*t0 + t26*t34) + qd6*(t12*t29 + t25*t35) - t33*qd1;
+    a[0] = -qd1*t37 + qd2*(-t45*qd1 + c1*t32) + qd3*t46;
+    a[1] = qd1*t42 + qd2*(t44*qd1 + s1*t32) + qd3*t47;
+    a[2] = -qd2*(s1*t36 + c1*t41) + qd3*t49;
+    a[3] = -t38*qd1 + qd4*t46 - qd5*(t26*t39 + t10*t0) - qd6*(t25*t40 + t18*t29);
+    a[4] = -t33*qd1 + qd4*t47 + qd5*(t15*t0 + t26*t34) + qd6*(t12*t29 + t25*t35);
     a[5] = qd4*t49 + qd5*(t10*t34 - t15*t39) + qd6*(t18*t35 - t12*t40);
 }
 
@@ -677,7 +677,7 @@ void stanford_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanford_r
     const stanford_real t3 = -0.1337*s1 + c1*t2;
     const stanford_real t4 = 0.1337*c1 + s1*t2;
     const stanford_real t5 = c1*t3 + s1*t4;
-    const stanford_real t6 = c2*qd3 - qd2*t5;
+    const stanford_real t6 = c2*qd3 - t5*qd2;
     const stanford_real t7 = s1*c4;
     const stanford_real t8 = c1*s4;
     const stanford_real t9 = t7 + c2*t8;
@@ -711,23 +711,23 @@ void stanford_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanford_r
     const stanford_real t37 = c1*qd1;
     const stanford_real t38 = s2*t37 + t31;
     const stanford_real t39 = s2*qd2;
-    const stanford_real t40 = -((c1*c1)*t39 + (s1*s1)*t39);
+    const stanford_real t40 = -((s1*s1)*t39 + (c1*c1)*t39);
 
     /* Outputs */
     Jd[0] = -t33;
-    Jd[1] = c1*t6 - t34*t35;
+    Jd[1] = -t34*t35 + c1*t6;
     Jd[2] = t36;
     Jd[3] = 0;
     Jd[4] = 0;
     Jd[5] = 0;
     Jd[6] = t30;
-    Jd[7] = s1*t6 + t35*t37;
+    Jd[7] = t35*t37 + s1*t6;
     Jd[8] = t38;
     Jd[9] = 0;
     Jd[10] = 0;
     Jd[11] = 0;
     Jd[12] = 0;
-    Jd[13] = -(c1*t29 + s1*t32);
+    Jd[13] = -(s1*t32 + c1*t29);
     Jd[14] = t40;
     Jd[15] = 0;
     Jd[16] = 0;
@@ -736,8 +736,8 @@ void stanford_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanford_r
     Jd[19] = -t37;
     Jd[20] = 0;
     Jd[21] = t36;
-    Jd[22] = -(t10*t1 + t25*t23);
-    Jd[23] = -(t17*t26 + t0*t24);
+    Jd[22] = -(t25*t23 + t10*t1);
+    Jd[23] = -(t0*t24 + t17*t26);
     Jd[24] = 0;
     Jd[25] = -t34;
     Jd[26] = 0;
@@ -784,7 +784,7 @@ void stanford_bias_acceleration(const stanford_real q[STANFORD_DOF], const stanf
     const stanford_real t3 = -0.1337*s1 + c1*t2;
     const stanford_real t4 = 0.1337*c1 + s1*t2;
     const stanford_real t5 = c1*t3 + s1*t4;
-    const stanford_real t6 = c2*qd3 - qd2*t5;
+    const stanford_real t6 = c2*qd3 - t5*qd2;
     const stanford_real t7 = s1*c4;
     const stanford_real t8 = c1*s4;
     const stanford_real t9 = t7 + c2*t8;
@@ -817,14 +817,14 @@ void stanford_bias_acceleration(const stanford_real q[STANFORD_DOF], const stanf
     const stanford_real t36 = t28 - s1*t35;
     const stanford_real t37 = c1*t35 + t31;
     const stanford_real t38 = s2*qd2;
-    const stanford_real t39 = -((c1*c1)*t38 + (s1*s1)*t38);
+    const stanford_real t39 = -((s1*s1)*t38 + (c1*c1)*t38);
 
     /* Outputs */
-    a[0] = qd2*(c1*t6 - s1*t34) + qd3*t36 - qd1*t33;
-    a[1] = qd1*t30 + qd2*(s1*t6 + c1*t34) + qd3*t37;
-    a[2] = -qd2*(c1*t29 + s1*t32) + qd3*t39;
-    a[3] = qd4*t36 - qd5*(t10*t1 + t25*t23) - qd6*(t17*t26 + t0*t24) - t22*qd1;
-    a[4] = qd4*t37 + qd5*(t13*t1 + t25*t20) + qd6*(t16*t26 + t0*t21) - t18*qd1;
+    a[0] = -qd1*t33 + qd2*(-s1*t34 + c1*t6) + qd3*t36;
+    a[1] = qd1*t30 + qd2*(c1*t34 + s1*t6) + qd3*t37;
+    a[2] = -qd2*(s1*t32 + c1*t29) + qd3*t39;
+    a[3] = -t22*qd1 + qd4*t36 - qd5*(t25*t23 + t10*t1) - qd6*(t0*t24 + t17*t26);
+    a[4] = -t18*qd1 + qd4*t37 + qd5*(t13*t1 + t25*t20) + qd6*(t16*t26 + t0*t21);
     a[5] = qd4*t39 + qd5*(t10*t20 - t13*t23) + qd6*(t17*t21 - t16*t24);
 }
 
@@ -862,7 +862,7 @@ void stanford_task_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanf
     const stanford_real t2 = s1*s2;
     const stanford_real t3 = 0.1337*c1 + q3*t2;
     const stanford_real t4 = c1*t1 + s1*t3;
-    const stanford_real t5 = c2*qd3 - qd2*t4;
+    const stanford_real t5 = c2*qd3 - t4*qd2;
     const stanford_real t6 = s1*c4;
     const stanford_real t7 = c1*s4;
     const stanford_real t8 = t6 + c2*t7;
@@ -893,7 +893,7 @@ void stanford_task_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanf
     const stanford_real t33 = t9*t29 - t14*t32;
     const stanford_real t34 = qd1 + c2*qd4;
     const stanford_real t35 = t34;
-    const stanford_real t36 = t9*t35 + t25*t32;
+    const stanford_real t36 = t25*t32 + t9*t35;
     const stanford_real t37 = t14*t35 + t25*t29;
     const stanford_real t38 = t14*qd5;
     const stanford_real t39 = t29 + t38;
@@ -905,10 +905,10 @@ void stanford_task_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanf
     const stanford_real t45 = t19*t40 - t18*t44;
     const stanford_real t46 = -t25*qd5;
     const stanford_real t47 = t35 + t46;
-    const stanford_real t48 = t17*t47 + t24*t42;
+    const stanford_real t48 = t24*t42 + t17*t47;
     const stanford_real t49 = t11*t47 + t24*t39;
     const stanford_real t50 = t34 + t46 - t24*qd6;
-    const stanford_real t51 = t19*t50 + t26*t44;
+    const stanford_real t51 = t26*t44 + t19*t50;
     const stanford_real t52 = t18*t50 + t26*t40;
     const stanford_real t53 = c2*t30;
     const stanford_real t54 = t0*qd3 + q3*t53;
@@ -918,12 +918,12 @@ void stanford_task_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanf
     const stanford_real t58 = t2*qd3 + q3*t57;
     const stanford_real t59 = t58 + t1*qd1;
     const stanford_real t60 = t0*qd1 + t57;
-    const stanford_real t61 = c1*t54 + s1*t58;
+    const stanford_real t61 = s1*t58 + c1*t54;
     const stanford_real t62 = q3*c2*qd1;
-    const stanford_real t63 = c1*t5 - s1*t62;
-    const stanford_real t64 = s1*t5 + c1*t62;
+    const stanford_real t63 = -s1*t62 + c1*t5;
+    const stanford_real t64 = c1*t62 + s1*t5;
     const stanford_real t65 = s2*qd2;
-    const stanford_real t66 = (c1*c1)*t65 + (s1*s1)*t65;
+    const stanford_real t66 = (s1*s1)*t65 + (c1*c1)*t65;
     const stanford_real t67 = c1*t19;
     const stanford_real t68 = s1*t18;
     const stanford_real t69 = 1.0/t20;
@@ -941,33 +941,33 @@ void stanford_task_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanf
     const stanford_real t81 = (t18*t17 - t11*t19)*t77;
     const stanford_real t82 = -t66;
     const stanford_real t83 = 2*t70;
-    const stanford_real t84 = t52*t69;
-    const stanford_real t85 = (c1 - t19*t83)*t84;
-    const stanford_real t86 = t51*t69;
-    const stanford_real t87 = -(s1 + t18*t83)*t86;
+    const stanford_real t84 = t51*t69;
+    const stanford_real t85 = -(s1 + t18*t83)*t84;
+    const stanford_real t86 = t52*t69;
+    const stanford_real t87 = (c1 - t19*t83)*t86;
     const stanford_real t88 = qd1*t69;
     const stanford_real t89 = t73*t88;
     const stanford_real t90 = t74*t88;
-    const stanford_real t91 = t18*t69;
-    const stanford_real t92 = t56*t91;
-    const stanford_real t93 = t19*t69;
-    const stanford_real t94 = t60*t93;
-    const stanford_real t95 = 2*t75;
-    const stanford_real t96 = t84*(t2 - t19*t95);
-    const stanford_real t97 = t86*(t0 - t18*t95);
-    const stanford_real t98 = t37*t93;
-    const stanford_real t99 = 2*t71;
-    const stanford_real t100 = t84*(t9 - t19*t99);
-    const stanford_real t101 = t36*t91;
-    const stanford_real t102 = t86*(t14 - t18*t99);
-    const stanford_real t103 = t49*t93;
-    const stanford_real t104 = 2*t72;
-    const stanford_real t105 = t84*(t17 - t19*t104);
-    const stanford_real t106 = t48*t91;
-    const stanford_real t107 = t86*(t11 - t18*t104);
+    const stanford_real t91 = 2*t75;
+    const stanford_real t92 = t84*(t0 - t18*t91);
+    const stanford_real t93 = t86*(t2 - t19*t91);
+    const stanford_real t94 = t18*t69;
+    const stanford_real t95 = t56*t94;
+    const stanford_real t96 = t19*t69;
+    const stanford_real t97 = t60*t96;
+    const stanford_real t98 = 2*t71;
+    const stanford_real t99 = t84*(t14 - t18*t98);
+    const stanford_real t100 = t86*(t9 - t19*t98);
+    const stanford_real t101 = t36*t94;
+    const stanford_real t102 = t37*t96;
+    const stanford_real t103 = 2*t72;
+    const stanford_real t104 = t84*(t11 - t18*t103);
+    const stanford_real t105 = t86*(t17 - t19*t103);
+    const stanford_real t106 = t48*t94;
+    const stanford_real t107 = t49*t96;
     const stanford_real t108 = qd1*t76;
-    const stanford_real t109 = t18*t76;
-    const stanford_real t110 = t19*t76;
+    const stanford_real t109 = t19*t76;
+    const stanford_real t110 = t18*t76;
 
     /* Outputs */
     Jd[0] = -t59;
@@ -989,23 +989,23 @@ void stanford_task_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanf
     Jd[16] = 0;
     Jd[17] = 0;
     Jd[18] = 0;
-    Jd[19] = -(-t85 + t87 + t89 + t90);
+    Jd[19] = -(t85 - t87 + t89 + t90);
     Jd[20] = 0;
-    Jd[21] = t92 + t94 + t96 - t97;
-    Jd[22] = t98 + t100 - t101 - t102;
-    Jd[23] = t103 + t105 - t106 - t107;
+    Jd[21] = -t92 + t93 + t95 + t97;
+    Jd[22] = -t99 + t100 - t101 + t102;
+    Jd[23] = -t104 + t105 - t106 + t107;
     Jd[24] = 0;
-    Jd[25] = t52*(s1*t76 - t19*t78) - t51*(c1*t76 - t18*t78) + t67*t108 - t68*t108;
+    Jd[25] = -t51*(c1*t76 - t18*t78) + t52*(s1*t76 - t19*t78) + t67*t108 - t68*t108;
     Jd[26] = 0;
-    Jd[27] = -t52*(t19*t79 + t0*t76) - t51*(-t18*t79 + t2*t76) + t60*t109 - t56*t110;
-    Jd[28] = -t52*(t14*t76 + t19*t80) - t51*(t9*t76 - t18*t80) + t37*t109 + t36*t110;
-    Jd[29] = -t52*(t11*t76 + t19*t81) - t51*(t17*t76 - t18*t81) + t49*t109 + t48*t110;
+    Jd[27] = -t51*(t2*t76 - t18*t79) - t52*(t0*t76 + t19*t79) - t56*t109 + t60*t110;
+    Jd[28] = -t51*(t9*t76 - t18*t80) - t52*(t14*t76 + t19*t80) + t36*t109 + t37*t110;
+    Jd[29] = -t51*(t17*t76 - t18*t81) - t52*(t11*t76 + t19*t81) + t48*t109 + t49*t110;
     Jd[30] = 0;
-    Jd[31] = -(t70*t45 - t26*t85 + t26*t87 + t26*t89 + t26*t90);
+    Jd[31] = -(t26*t85 - t26*t87 + t45*t70 + t26*t89 + t26*t90);
     Jd[32] = 0;
-    Jd[33] = t82 - t75*t45 + t26*t92 + t26*t94 + t26*t96 - t26*t97;
-    Jd[34] = t33 - t71*t45 + t26*t98 + t26*t100 - t26*t101 - t26*t102;
-    Jd[35] = t43 - t72*t45 + t26*t103 + t26*t105 - t26*t106 - t26*t107;
+    Jd[33] = t82 - t26*t92 + t26*t93 - t45*t75 + t26*t95 + t26*t97;
+    Jd[34] = t33 - t26*t99 + t26*t100 - t45*t71 - t26*t101 + t26*t102;
+    Jd[35] = t43 - t26*t104 + t26*t105 - t45*t72 - t26*t106 + t26*t107;
 }
 
 void stanford_hessian(const stanford_real q[STANFORD_DOF], stanford_real H[STANFORD_DOF * 6 * STANFORD_DOF])
@@ -1049,9 +1049,9 @@ void stanford_hessian(const stanford_real q[STANFORD_DOF], stanford_real H[STANF
     const stanford_real t18 = -t3;
     const stanford_real t19 = c1*c2;
     const stanford_real t20 = q3*t19;
-    const stanford_real t21 = (c1*c1);
+    const stanford_real t21 = (s1*s1);
     const stanford_real t22 = q3*c2;
-    const stanford_real t23 = (s1*s1);
+    const stanford_real t23 = (c1*c1);
     const stanford_real t24 = -(t21*s2 + t23*s2);
     const stanford_real t25 = (s2*s2);
     const stanford_real t26 = s2*c4;
@@ -1127,8 +1127,8 @@ void stanford_hessian(const stanford_real q[STANFORD_DOF], stanford_real H[STANF
     H[67] = 0;
     H[68] = 0;
     H[69] = t24;
-    H[70] = -(c1*t13 + s1*t9);
-    H[71] = -(c1*t10 + s1*t15);
+    H[70] = -(s1*t9 + c1*t13);
+    H[71] = -(s1*t15 + c1*t10);
     H[72] = t18;
     H[73] = t19;
     H[74] = 0;
@@ -1187,8 +1187,8 @@ void stanford_hessian(const stanford_real q[STANFORD_DOF], stanford_real H[STANF
     H[127] = 0;
     H[128] = 0;
     H[129] = 0;
-    H[130] = -(c2*t9 + t6*t25);
-    H[131] = -(c2*t15 + t0*t3);
+    H[130] = -(t6*t25 + c2*t9);
+    H[131] = -(t0*t3 + c2*t15);
     H[132] = 0;
     H[133] = 0;
     H[134] = 0;
@@ -1230,7 +1230,7 @@ void stanford_hessian(const stanford_real q[STANFORD_DOF], stanford_real H[STANF
     H[170] = 0;
     H[171] = 0;
     H[172] = 0;
-    H[173] = t13*t0 - t10*t26;
+    H[173] = -t10*t26 + t13*t0;
     H[174] = 0;
     H[175] = 0;
     H[176] = 0;

@@ -588,7 +588,7 @@ def fk_jacobian_dot(q, q_dot):
     t29 = t0 - t26*qd5
     t30 = c1*t2 + s1*t4
     t31 = t30
-    t32 = c2*qd3 - qd2*t31
+    t32 = c2*qd3 - t31*qd2
     t33 = s1*qd2
     t34 = -t33 + t1*qd4
     t35 = t34 + t15*qd5
@@ -605,7 +605,7 @@ def fk_jacobian_dot(q, q_dot):
     t46 = c2*t38 - t3*qd1
     t47 = t1*qd1 + c2*t33
     t48 = s2*qd2
-    t49 = -(c1**2*t48 + s1**2*t48)
+    t49 = -(s1**2*t48 + c1**2*t48)
     T = _stack(xp, [
         xp.broadcast_to(t19, batch),  # 0, 0
         xp.broadcast_to(t20, batch),  # 0, 1
@@ -663,11 +663,11 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t43, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(c1*t32 - t45*qd1) + qd3*t46 - qd1*t37, batch),  # 0
-        xp.broadcast_to(qd1*t42 + qd2*(s1*t32 + t44*qd1) + qd3*t47, batch),  # 1
-        xp.broadcast_to(-qd2*(c1*t41 + s1*t36) + qd3*t49, batch),  # 2
-        xp.broadcast_to(qd4*t46 - qd5*(t10*t0 + t26*t39) - qd6*(t18*t29 + t25*t40) - t38*qd1, batch),  # 3
-        xp.broadcast_to(qd4*t47 + qd5*(t15*t0 + t26*t34) + qd6*(t12*t29 + t25*t35) - t33*qd1, batch),  # 4
+        xp.broadcast_to(-qd1*t37 + qd2*(-t45*qd1 + c1*t32) + qd3*t46, batch),  # 0
+        xp.broadcast_to(qd1*t42 + qd2*(t44*qd1 + s1*t32) + qd3*t47, batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t36 + c1*t41) + qd3*t49, batch),  # 2
+        xp.broadcast_to(-t38*qd1 + qd4*t46 - qd5*(t26*t39 + t10*t0) - qd6*(t25*t40 + t18*t29), batch),  # 3
+        xp.broadcast_to(-t33*qd1 + qd4*t47 + qd5*(t15*t0 + t26*t34) + qd6*(t12*t29 + t25*t35), batch),  # 4
         xp.broadcast_to(qd4*t49 + qd5*(t10*t34 - t15*t39) + qd6*(t18*t35 - t12*t40), batch),  # 5
     ], (6,))
     return T, J, a
@@ -697,7 +697,7 @@ def jacobian_dot(q, q_dot):
     t3 = -0.1337*s1 + c1*t2
     t4 = 0.1337*c1 + s1*t2
     t5 = c1*t3 + s1*t4
-    t6 = c2*qd3 - qd2*t5
+    t6 = c2*qd3 - t5*qd2
     t7 = s1*c4
     t8 = c1*s4
     t9 = t7 + c2*t8
@@ -731,22 +731,22 @@ def jacobian_dot(q, q_dot):
     t37 = c1*qd1
     t38 = s2*t37 + t31
     t39 = s2*qd2
-    t40 = -(c1**2*t39 + s1**2*t39)
+    t40 = -(s1**2*t39 + c1**2*t39)
     Jd = _stack(xp, [
         xp.broadcast_to(-t33, batch),  # 0, 0
-        xp.broadcast_to(c1*t6 - t34*t35, batch),  # 0, 1
+        xp.broadcast_to(-t34*t35 + c1*t6, batch),  # 0, 1
         xp.broadcast_to(t36, batch),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t30, batch),  # 1, 0
-        xp.broadcast_to(s1*t6 + t35*t37, batch),  # 1, 1
+        xp.broadcast_to(t35*t37 + s1*t6, batch),  # 1, 1
         xp.broadcast_to(t38, batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-(c1*t29 + s1*t32), batch),  # 2, 1
+        xp.broadcast_to(-(s1*t32 + c1*t29), batch),  # 2, 1
         xp.broadcast_to(t40, batch),  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
@@ -755,8 +755,8 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(-t37, batch),  # 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
         xp.broadcast_to(t36, batch),  # 3, 3
-        xp.broadcast_to(-(t10*t1 + t25*t23), batch),  # 3, 4
-        xp.broadcast_to(-(t17*t26 + t0*t24), batch),  # 3, 5
+        xp.broadcast_to(-(t25*t23 + t10*t1), batch),  # 3, 4
+        xp.broadcast_to(-(t0*t24 + t17*t26), batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(-t34, batch),  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
@@ -798,7 +798,7 @@ def bias_acceleration(q, q_dot):
     t3 = -0.1337*s1 + c1*t2
     t4 = 0.1337*c1 + s1*t2
     t5 = c1*t3 + s1*t4
-    t6 = c2*qd3 - qd2*t5
+    t6 = c2*qd3 - t5*qd2
     t7 = s1*c4
     t8 = c1*s4
     t9 = t7 + c2*t8
@@ -831,13 +831,13 @@ def bias_acceleration(q, q_dot):
     t36 = t28 - s1*t35
     t37 = c1*t35 + t31
     t38 = s2*qd2
-    t39 = -(c1**2*t38 + s1**2*t38)
+    t39 = -(s1**2*t38 + c1**2*t38)
     a = _stack(xp, [
-        xp.broadcast_to(qd2*(c1*t6 - s1*t34) + qd3*t36 - qd1*t33, batch),  # 0
-        xp.broadcast_to(qd1*t30 + qd2*(s1*t6 + c1*t34) + qd3*t37, batch),  # 1
-        xp.broadcast_to(-qd2*(c1*t29 + s1*t32) + qd3*t39, batch),  # 2
-        xp.broadcast_to(qd4*t36 - qd5*(t10*t1 + t25*t23) - qd6*(t17*t26 + t0*t24) - t22*qd1, batch),  # 3
-        xp.broadcast_to(qd4*t37 + qd5*(t13*t1 + t25*t20) + qd6*(t16*t26 + t0*t21) - t18*qd1, batch),  # 4
+        xp.broadcast_to(-qd1*t33 + qd2*(-s1*t34 + c1*t6) + qd3*t36, batch),  # 0
+        xp.broadcast_to(qd1*t30 + qd2*(c1*t34 + s1*t6) + qd3*t37, batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t32 + c1*t29) + qd3*t39, batch),  # 2
+        xp.broadcast_to(-t22*qd1 + qd4*t36 - qd5*(t25*t23 + t10*t1) - qd6*(t0*t24 + t17*t26), batch),  # 3
+        xp.broadcast_to(-t18*qd1 + qd4*t37 + qd5*(t13*t1 + t25*t20) + qd6*(t16*t26 + t0*t21), batch),  # 4
         xp.broadcast_to(qd4*t39 + qd5*(t10*t20 - t13*t23) + qd6*(t17*t21 - t16*t24), batch),  # 5
     ], (6,))
     return a
@@ -869,7 +869,7 @@ def task_jacobian_dot(q, q_dot):
     t2 = s1*s2
     t3 = 0.1337*c1 + q3*t2
     t4 = c1*t1 + s1*t3
-    t5 = c2*qd3 - qd2*t4
+    t5 = c2*qd3 - t4*qd2
     t6 = s1*c4
     t7 = c1*s4
     t8 = t6 + c2*t7
@@ -900,7 +900,7 @@ def task_jacobian_dot(q, q_dot):
     t33 = t9*t29 - t14*t32
     t34 = qd1 + c2*qd4
     t35 = t34
-    t36 = t9*t35 + t25*t32
+    t36 = t25*t32 + t9*t35
     t37 = t14*t35 + t25*t29
     t38 = t14*qd5
     t39 = t29 + t38
@@ -912,10 +912,10 @@ def task_jacobian_dot(q, q_dot):
     t45 = t19*t40 - t18*t44
     t46 = -t25*qd5
     t47 = t35 + t46
-    t48 = t17*t47 + t24*t42
+    t48 = t24*t42 + t17*t47
     t49 = t11*t47 + t24*t39
     t50 = t34 + t46 - t24*qd6
-    t51 = t19*t50 + t26*t44
+    t51 = t26*t44 + t19*t50
     t52 = t18*t50 + t26*t40
     t53 = c2*t30
     t54 = t0*qd3 + q3*t53
@@ -925,12 +925,12 @@ def task_jacobian_dot(q, q_dot):
     t58 = t2*qd3 + q3*t57
     t59 = t58 + t1*qd1
     t60 = t0*qd1 + t57
-    t61 = c1*t54 + s1*t58
+    t61 = s1*t58 + c1*t54
     t62 = q3*c2*qd1
-    t63 = c1*t5 - s1*t62
-    t64 = s1*t5 + c1*t62
+    t63 = -s1*t62 + c1*t5
+    t64 = c1*t62 + s1*t5
     t65 = s2*qd2
-    t66 = c1**2*t65 + s1**2*t65
+    t66 = s1**2*t65 + c1**2*t65
     t67 = c1*t19
     t68 = s1*t18
     t69 = 1/t20
@@ -948,33 +948,33 @@ def task_jacobian_dot(q, q_dot):
     t81 = (t18*t17 - t11*t19)*t77
     t82 = -t66
     t83 = 2*t70
-    t84 = t52*t69
-    t85 = (c1 - t19*t83)*t84
-    t86 = t51*t69
-    t87 = -(s1 + t18*t83)*t86
+    t84 = t51*t69
+    t85 = -(s1 + t18*t83)*t84
+    t86 = t52*t69
+    t87 = (c1 - t19*t83)*t86
     t88 = qd1*t69
     t89 = t73*t88
     t90 = t74*t88
-    t91 = t18*t69
-    t92 = t56*t91
-    t93 = t19*t69
-    t94 = t60*t93
-    t95 = 2*t75
-    t96 = t84*(t2 - t19*t95)
-    t97 = t86*(t0 - t18*t95)
-    t98 = t37*t93
-    t99 = 2*t71
-    t100 = t84*(t9 - t19*t99)
-    t101 = t36*t91
-    t102 = t86*(t14 - t18*t99)
-    t103 = t49*t93
-    t104 = 2*t72
-    t105 = t84*(t17 - t19*t104)
-    t106 = t48*t91
-    t107 = t86*(t11 - t18*t104)
+    t91 = 2*t75
+    t92 = t84*(t0 - t18*t91)
+    t93 = t86*(t2 - t19*t91)
+    t94 = t18*t69
+    t95 = t56*t94
+    t96 = t19*t69
+    t97 = t60*t96
+    t98 = 2*t71
+    t99 = t84*(t14 - t18*t98)
+    t100 = t86*(t9 - t19*t98)
+    t101 = t36*t94
+    t102 = t37*t96
+    t103 = 2*t72
+    t104 = t84*(t11 - t18*t103)
+    t105 = t86*(t17 - t19*t103)
+    t106 = t48*t94
+    t107 = t49*t96
     t108 = qd1*t76
-    t109 = t18*t76
-    t110 = t19*t76
+    t109 = t19*t76
+    t110 = t18*t76
     Jd = _stack(xp, [
         xp.broadcast_to(-t59, batch),  # 0, 0
         xp.broadcast_to(t63, batch),  # 0, 1
@@ -995,23 +995,23 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(-(-t85 + t87 + t89 + t90), batch),  # 3, 1
+        xp.broadcast_to(-(t85 - t87 + t89 + t90), batch),  # 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
-        xp.broadcast_to(t92 + t94 + t96 - t97, batch),  # 3, 3
-        xp.broadcast_to(t98 + t100 - t101 - t102, batch),  # 3, 4
-        xp.broadcast_to(t103 + t105 - t106 - t107, batch),  # 3, 5
+        xp.broadcast_to(-t92 + t93 + t95 + t97, batch),  # 3, 3
+        xp.broadcast_to(-t99 + t100 - t101 + t102, batch),  # 3, 4
+        xp.broadcast_to(-t104 + t105 - t106 + t107, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t52*(s1*t76 - t19*t78) - t51*(c1*t76 - t18*t78) + t67*t108 - t68*t108, batch),  # 4, 1
+        xp.broadcast_to(-t51*(c1*t76 - t18*t78) + t52*(s1*t76 - t19*t78) + t67*t108 - t68*t108, batch),  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
-        xp.broadcast_to(-t52*(t19*t79 + t0*t76) - t51*(-t18*t79 + t2*t76) + t60*t109 - t56*t110, batch),  # 4, 3
-        xp.broadcast_to(-t52*(t14*t76 + t19*t80) - t51*(t9*t76 - t18*t80) + t37*t109 + t36*t110, batch),  # 4, 4
-        xp.broadcast_to(-t52*(t11*t76 + t19*t81) - t51*(t17*t76 - t18*t81) + t49*t109 + t48*t110, batch),  # 4, 5
+        xp.broadcast_to(-t51*(t2*t76 - t18*t79) - t52*(t0*t76 + t19*t79) - t56*t109 + t60*t110, batch),  # 4, 3
+        xp.broadcast_to(-t51*(t9*t76 - t18*t80) - t52*(t14*t76 + t19*t80) + t36*t109 + t37*t110, batch),  # 4, 4
+        xp.broadcast_to(-t51*(t17*t76 - t18*t81) - t52*(t11*t76 + t19*t81) + t48*t109 + t49*t110, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(t70*t45 - t26*t85 + t26*t87 + t26*t89 + t26*t90), batch),  # 5, 1
+        xp.broadcast_to(-(t26*t85 - t26*t87 + t45*t70 + t26*t89 + t26*t90), batch),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
-        xp.broadcast_to(t82 - t75*t45 + t26*t92 + t26*t94 + t26*t96 - t26*t97, batch),  # 5, 3
-        xp.broadcast_to(t33 - t71*t45 + t26*t98 + t26*t100 - t26*t101 - t26*t102, batch),  # 5, 4
-        xp.broadcast_to(t43 - t72*t45 + t26*t103 + t26*t105 - t26*t106 - t26*t107, batch),  # 5, 5
+        xp.broadcast_to(t82 - t26*t92 + t26*t93 - t45*t75 + t26*t95 + t26*t97, batch),  # 5, 3
+        xp.broadcast_to(t33 - t26*t99 + t26*t100 - t45*t71 - t26*t101 + t26*t102, batch),  # 5, 4
+        xp.broadcast_to(t43 - t26*t104 + t26*t105 - t45*t72 - t26*t106 + t26*t107, batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1050,9 +1050,9 @@ def hessian(q):
     t18 = -t3
     t19 = c1*c2
     t20 = q3*t19
-    t21 = c1**2
+    t21 = s1**2
     t22 = q3*c2
-    t23 = s1**2
+    t23 = c1**2
     t24 = -(t21*s2 + t23*s2)
     t25 = s2**2
     t26 = s2*c4
@@ -1127,8 +1127,8 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 2
         t24,  # 1, 5, 3
-        -(c1*t13 + s1*t9),  # 1, 5, 4
-        -(c1*t10 + s1*t15),  # 1, 5, 5
+        -(s1*t9 + c1*t13),  # 1, 5, 4
+        -(s1*t15 + c1*t10),  # 1, 5, 5
         t18,  # 2, 0, 0
         t19,  # 2, 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0, 2
@@ -1187,8 +1187,8 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        -(c2*t9 + t6*t25),  # 3, 3, 4
-        -(c2*t15 + t0*t3),  # 3, 3, 5
+        -(t6*t25 + c2*t9),  # 3, 3, 4
+        -(t0*t3 + c2*t15),  # 3, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
@@ -1230,7 +1230,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        t13*t0 - t10*t26,  # 4, 4, 5
+        -t10*t26 + t13*t0,  # 4, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2

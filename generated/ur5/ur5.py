@@ -698,20 +698,20 @@ def fk_jacobian_dot(q, q_dot):
     t57 = -t56 + t13*qd5
     t58 = c234*qd5
     t59 = qd1 - t58
-    t60 = qd5*t34
+    t60 = t34*qd5
     t61 = t60 + t22*t55
     t62 = t61 + t23*t50
     t63 = t62 + t24*t49
     t64 = t63 - t31*qd1
-    t65 = qd5*t37
+    t65 = t37*qd5
     t66 = t65 + t22*t52
     t67 = t66 + t23*t47
     t68 = t67 + t24*t46
     t69 = t68 + t30*qd1
-    t70 = qd5*t45
-    t71 = qd4*t43 + t70
-    t72 = t71 + qd3*t41
-    t73 = t72 + qd2*t39
+    t70 = t45*qd5
+    t71 = t70 + t43*qd4
+    t72 = t71 + t41*qd3
+    t73 = t72 + t39*qd2
     t74 = -t3
     t75 = -t21
     t76 = c1*t24
@@ -777,12 +777,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t75, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(-qd2*(c1*t73 + qd1*t78) - qd3*(c1*t72 + qd1*t79 + t49*t41) - qd4*(t51*t43 + c1*t71 + t32*qd1) + qd5*(-qd1*t37 - t56*t45 + t58*t37 + t13*t70) - qd1*t69, batch),  # 0
-        xp.broadcast_to(qd1*t64 + qd2*(-s1*t73 + qd1*t76) - qd3*(-qd1*t77 + s1*t72 + t46*t41) - qd4*(-t35*qd1 + t48*t43 + s1*t71) - qd5*(-qd1*t34 + t53*t45 + t58*t34 + t8*t70), batch),  # 1
-        xp.broadcast_to(qd2*(c1*t63 + s1*t68) + qd3*(c1*t62 + s1*t67 + c1**2*t81 + s1**2*t81) + qd4*(c1*t61 + s1*t66 + t32*t48 + t35*t51) + qd5*(t56*t34 + t53*t37 + t8*t65 - t13*t60), batch),  # 2
-        xp.broadcast_to(qd5*(c234*t56 - t13*qd1) + qd6*(t3*t59 - t21*t57) + t49*qd1 + t50*qd1 + t55*qd1, batch),  # 3
-        xp.broadcast_to(qd5*(c234*t53 + t8*qd1) + qd6*(t6*t59 + t21*t54) + t46*qd1 + t47*qd1 + t52*qd1, batch),  # 4
-        xp.broadcast_to(qd4*(s1*t51 - c1*t48) + qd5*(t13*t53 + t8*t56) - qd6*(t6*t57 + t3*t54), batch),  # 5
+        xp.broadcast_to(-qd1*t69 - qd2*(qd1*t78 + c1*t73) - qd3*(t49*t41 + qd1*t79 + c1*t72) - qd4*(t43*t51 + t32*qd1 + c1*t71) + qd5*(-t45*t56 - t37*qd1 + t13*t70 + t58*t37), batch),  # 0
+        xp.broadcast_to(qd1*t64 + qd2*(qd1*t76 - s1*t73) - qd3*(-qd1*t77 + t46*t41 + s1*t72) - qd4*(-t35*qd1 + t43*t48 + s1*t71) - qd5*(-t34*qd1 + t45*t53 + t58*t34 + t8*t70), batch),  # 1
+        xp.broadcast_to(qd2*(s1*t68 + c1*t63) + qd3*(s1**2*t81 + c1**2*t81 + s1*t67 + c1*t62) + qd4*(t32*t48 + t35*t51 + s1*t66 + c1*t61) + qd5*(t37*t53 + t34*t56 + t8*t65 - t13*t60), batch),  # 2
+        xp.broadcast_to(t49*qd1 + t50*qd1 + t55*qd1 + qd5*(c234*t56 - t13*qd1) + qd6*(-t21*t57 + t3*t59), batch),  # 3
+        xp.broadcast_to(t46*qd1 + t47*qd1 + t52*qd1 + qd5*(t8*qd1 + c234*t53) + qd6*(t6*t59 + t21*t54), batch),  # 4
+        xp.broadcast_to(qd4*(-c1*t48 + s1*t51) + qd5*(t13*t53 + t8*t56) - qd6*(t3*t54 + t6*t57), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -851,60 +851,60 @@ def jacobian_dot(q, q_dot):
     t38 = -t37 + t25*qd5
     t39 = c234*qd5
     t40 = qd1 - t39
-    t41 = qd5*t22
+    t41 = t22*qd5
     t42 = t41 + t10*t36
     t43 = t42 + t11*t31
     t44 = t43 + t12*t30
     t45 = t44 - t19*qd1
-    t46 = qd5*t23
+    t46 = t23*qd5
     t47 = t46 + t10*t33
     t48 = t47 + t11*t28
     t49 = t48 + t12*t27
     t50 = t49 + t18*qd1
-    t51 = qd5*t26
-    t52 = qd4*t8 + t51
-    t53 = t52 + qd3*t16
-    t54 = t53 + qd2*t20
+    t51 = t26*qd5
+    t52 = t51 + t8*qd4
+    t53 = t52 + t16*qd3
+    t54 = t53 + t20*qd2
     t55 = s1*qd1
     t56 = c1*qd1
     t57 = t11*qd2
     Jd = _stack(xp, [
         xp.broadcast_to(-t50, batch),  # 0, 0
-        xp.broadcast_to(-(c1*t54 + t12*t55), batch),  # 0, 1
-        xp.broadcast_to(-(c1*t53 + t11*t55 + t30*t16), batch),  # 0, 2
-        xp.broadcast_to(-(t32*t8 + c1*t52 + t10*t55), batch),  # 0, 3
-        xp.broadcast_to(-qd1*t23 - t37*t26 + t39*t23 + t25*t51, batch),  # 0, 4
+        xp.broadcast_to(-(t12*t55 + c1*t54), batch),  # 0, 1
+        xp.broadcast_to(-(t30*t16 + t11*t55 + c1*t53), batch),  # 0, 2
+        xp.broadcast_to(-(t8*t32 + t10*t55 + c1*t52), batch),  # 0, 3
+        xp.broadcast_to(-t26*t37 - t23*qd1 + t25*t51 + t39*t23, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t45, batch),  # 1, 0
-        xp.broadcast_to(-s1*t54 + t12*t56, batch),  # 1, 1
-        xp.broadcast_to(-(-t11*t56 + s1*t53 + t27*t16), batch),  # 1, 2
-        xp.broadcast_to(-(-t10*t56 + t29*t8 + s1*t52), batch),  # 1, 3
-        xp.broadcast_to(-(-qd1*t22 + t34*t26 + t39*t22 + t24*t51), batch),  # 1, 4
+        xp.broadcast_to(t12*t56 - s1*t54, batch),  # 1, 1
+        xp.broadcast_to(-(-t11*t56 + t27*t16 + s1*t53), batch),  # 1, 2
+        xp.broadcast_to(-(-t10*t56 + t8*t29 + s1*t52), batch),  # 1, 3
+        xp.broadcast_to(-(-t22*qd1 + t26*t34 + t39*t22 + t24*t51), batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(c1*t44 + s1*t49, batch),  # 2, 1
-        xp.broadcast_to(c1*t43 + s1*t48 + c1**2*t57 + s1**2*t57, batch),  # 2, 2
-        xp.broadcast_to(c1*t42 + s1*t47 + s1*t10*t29 + c1*t10*t32, batch),  # 2, 3
-        xp.broadcast_to(t37*t22 + t34*t23 + t24*t46 - t25*t41, batch),  # 2, 4
+        xp.broadcast_to(s1*t49 + c1*t44, batch),  # 2, 1
+        xp.broadcast_to(s1**2*t57 + c1**2*t57 + s1*t48 + c1*t43, batch),  # 2, 2
+        xp.broadcast_to(s1*t10*t29 + c1*t10*t32 + s1*t47 + c1*t42, batch),  # 2, 3
+        xp.broadcast_to(t23*t34 + t22*t37 + t24*t46 - t25*t41, batch),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t56, batch),  # 3, 1
         xp.broadcast_to(t56, batch),  # 3, 2
         xp.broadcast_to(t56, batch),  # 3, 3
         xp.broadcast_to(c234*t37 - s234*t55, batch),  # 3, 4
-        xp.broadcast_to(t2*t40 - t9*t38, batch),  # 3, 5
+        xp.broadcast_to(-t9*t38 + t2*t40, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t55, batch),  # 4, 1
         xp.broadcast_to(t55, batch),  # 4, 2
         xp.broadcast_to(t55, batch),  # 4, 3
-        xp.broadcast_to(c234*t34 + s234*t56, batch),  # 4, 4
+        xp.broadcast_to(s234*t56 + c234*t34, batch),  # 4, 4
         xp.broadcast_to(t1*t40 + t9*t35, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
-        xp.broadcast_to(s1*t32 - c1*t29, batch),  # 5, 3
+        xp.broadcast_to(-c1*t29 + s1*t32, batch),  # 5, 3
         xp.broadcast_to(t25*t34 + t24*t37, batch),  # 5, 4
-        xp.broadcast_to(-(t1*t38 + t2*t35), batch),  # 5, 5
+        xp.broadcast_to(-(t2*t35 + t1*t38), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -974,30 +974,30 @@ def bias_acceleration(q, q_dot):
     t38 = -t37 + t25*qd5
     t39 = c234*qd5
     t40 = qd1 - t39
-    t41 = qd5*t22
+    t41 = t22*qd5
     t42 = t41 + t10*t36
     t43 = t42 + t11*t31
     t44 = t43 + t12*t30
     t45 = t44 - t19*qd1
-    t46 = qd5*t23
+    t46 = t23*qd5
     t47 = t46 + t10*t33
     t48 = t47 + t11*t28
     t49 = t48 + t12*t27
     t50 = t49 + t18*qd1
-    t51 = qd5*t26
-    t52 = qd4*t8 + t51
-    t53 = t52 + qd3*t16
-    t54 = t53 + qd2*t20
+    t51 = t26*qd5
+    t52 = t51 + t8*qd4
+    t53 = t52 + t16*qd3
+    t54 = t53 + t20*qd2
     t55 = s1*qd1
     t56 = c1*qd1
     t57 = t11*qd2
     a = _stack(xp, [
-        xp.broadcast_to(-qd2*(c1*t54 + t12*t55) - qd3*(c1*t53 + t11*t55 + t30*t16) - qd4*(t32*t8 + c1*t52 + t10*t55) + qd5*(-qd1*t23 - t37*t26 + t39*t23 + t25*t51) - qd1*t50, batch),  # 0
-        xp.broadcast_to(qd1*t45 + qd2*(-s1*t54 + t12*t56) - qd3*(-t11*t56 + s1*t53 + t27*t16) - qd4*(-t10*t56 + t29*t8 + s1*t52) - qd5*(-qd1*t22 + t34*t26 + t39*t22 + t24*t51), batch),  # 1
-        xp.broadcast_to(qd2*(c1*t44 + s1*t49) + qd3*(c1*t43 + s1*t48 + c1**2*t57 + s1**2*t57) + qd4*(c1*t42 + s1*t47 + s1*t10*t29 + c1*t10*t32) + qd5*(t37*t22 + t34*t23 + t24*t46 - t25*t41), batch),  # 2
-        xp.broadcast_to(qd5*(c234*t37 - t25*qd1) + qd6*(t2*t40 - t9*t38) + t30*qd1 + t31*qd1 + t36*qd1, batch),  # 3
-        xp.broadcast_to(qd5*(c234*t34 + t24*qd1) + qd6*(t1*t40 + t9*t35) + t27*qd1 + t28*qd1 + t33*qd1, batch),  # 4
-        xp.broadcast_to(qd4*(s1*t32 - c1*t29) + qd5*(t25*t34 + t24*t37) - qd6*(t1*t38 + t2*t35), batch),  # 5
+        xp.broadcast_to(-qd1*t50 - qd2*(t12*t55 + c1*t54) - qd3*(t30*t16 + t11*t55 + c1*t53) - qd4*(t8*t32 + t10*t55 + c1*t52) + qd5*(-t26*t37 - t23*qd1 + t25*t51 + t39*t23), batch),  # 0
+        xp.broadcast_to(qd1*t45 + qd2*(t12*t56 - s1*t54) - qd3*(-t11*t56 + t27*t16 + s1*t53) - qd4*(-t10*t56 + t8*t29 + s1*t52) - qd5*(-t22*qd1 + t26*t34 + t39*t22 + t24*t51), batch),  # 1
+        xp.broadcast_to(qd2*(s1*t49 + c1*t44) + qd3*(s1**2*t57 + c1**2*t57 + s1*t48 + c1*t43) + qd4*(s1*t10*t29 + c1*t10*t32 + s1*t47 + c1*t42) + qd5*(t23*t34 + t22*t37 + t24*t46 - t25*t41), batch),  # 2
+        xp.broadcast_to(t30*qd1 + t31*qd1 + t36*qd1 + qd5*(c234*t37 - t25*qd1) + qd6*(-t9*t38 + t2*t40), batch),  # 3
+        xp.broadcast_to(t27*qd1 + t28*qd1 + t33*qd1 + qd5*(t24*qd1 + c234*t34) + qd6*(t1*t40 + t9*t35), batch),  # 4
+        xp.broadcast_to(qd4*(-c1*t29 + s1*t32) + qd5*(t25*t34 + t24*t37) - qd6*(t2*t35 + t1*t38), batch),  # 5
     ], (6,))
     return a
 
@@ -1071,10 +1071,10 @@ def task_jacobian_dot(q, q_dot):
     t40 = c1*qd3
     t41 = t39 + t40
     t42 = t41
-    t43 = s1*t42 - c1*t38
+    t43 = -c1*t38 + s1*t42
     t44 = s1*qd4
     t45 = t38 + t44
-    t46 = c234*t45 + t9*qd1
+    t46 = t9*qd1 + c234*t45
     t47 = c1*qd4
     t48 = t42 + t47
     t49 = c234*t48 - t13*qd1
@@ -1084,45 +1084,45 @@ def task_jacobian_dot(q, q_dot):
     t53 = t37 + t44 + t51 + t7*qd6
     t54 = t13*qd5
     t55 = -t48 + t54
-    t56 = t7*t55 + t4*t52
+    t56 = t4*t52 + t7*t55
     t57 = -t54 + t41 + t47 + t4*qd6
-    t58 = t10*t57 + t14*t53
+    t58 = t14*t53 + t10*t57
     t59 = c234*qd5
     t60 = qd1 - t59
-    t61 = t4*t60 - t21*t55
+    t61 = -t21*t55 + t4*t60
     t62 = t7*t60 + t21*t52
     t63 = -qd1 + t59 + t21*qd6
-    t64 = t14*t63 - t0*t57
+    t64 = -t0*t57 + t14*t63
     t65 = t10*t63 + t0*t53
-    t66 = qd5*t25
+    t66 = t25*qd5
     t67 = t66 + t22*t47
     t68 = t67 + t23*t40
     t69 = t68 + t24*t39
     t70 = t69 - t33*qd1
-    t71 = qd5*t26
+    t71 = t26*qd5
     t72 = t71 + t22*t44
     t73 = t72 + t23*t36
     t74 = t73 + t24*t35
     t75 = t74 + t32*qd1
-    t76 = c1*t69 + s1*t74
-    t77 = c1*t67 + s1*t72 + s1*t22*t38 + c1*t22*t42
-    t78 = t48*t25 + t45*t26 + t9*t71 - t13*t66
-    t79 = qd5*t18
-    t80 = qd4*t17 + t79
-    t81 = t80 + qd3*t30
-    t82 = t81 + qd2*t34
-    t83 = -qd1*t26 - t48*t18 + t59*t26 + t13*t79
-    t84 = t45*t18 - qd1*t25 + t59*t25 + t9*t79
+    t76 = s1*t74 + c1*t69
+    t77 = s1*t22*t38 + c1*t22*t42 + s1*t72 + c1*t67
+    t78 = t26*t45 + t25*t48 + t9*t71 - t13*t66
+    t79 = t18*qd5
+    t80 = t79 + t17*qd4
+    t81 = t80 + t30*qd3
+    t82 = t81 + t34*qd2
+    t83 = -t18*t48 - t26*qd1 + t13*t79 + t59*t26
+    t84 = -t25*qd1 + t18*t45 + t59*t25 + t9*t79
     t85 = s1*qd1
-    t86 = c1*t82 + t24*t85
-    t87 = c1*t81 + t23*t85 + t39*t30
-    t88 = t42*t17 + c1*t80 + t22*t85
+    t86 = t24*t85 + c1*t82
+    t87 = t39*t30 + t23*t85 + c1*t81
+    t88 = t17*t42 + t22*t85 + c1*t80
     t89 = c1*qd1
-    t90 = -s1*t82 + t24*t89
-    t91 = s1*t81 + t35*t30 - t23*t89
-    t92 = t38*t17 + s1*t80 - t22*t89
+    t90 = t24*t89 - s1*t82
+    t91 = -t23*t89 + t35*t30 + s1*t81
+    t92 = -t22*t89 + t17*t38 + s1*t80
     t93 = t23*qd2
-    t94 = c1*t68 + s1*t73 + c1**2*t93 + s1**2*t93
+    t94 = s1**2*t93 + c1**2*t93 + s1*t73 + c1*t68
     t95 = s1*t10
     t96 = c1*t14
     t97 = 1/t19
@@ -1137,31 +1137,31 @@ def task_jacobian_dot(q, q_dot):
     t106 = t104*(s234*t95 - s234*t96)
     t107 = -(t7*t14 + t4*t10)*t104
     t108 = 2*t98
-    t109 = t97*t64
+    t109 = t64*t97
     t110 = t109*(s1 - t10*t108)
-    t111 = t97*t65
+    t111 = t65*t97
     t112 = -(c1 + t14*t108)*t111
     t113 = qd1*t97
     t114 = t100*t113
     t115 = t101*t113
     t116 = t110 - t112 + t114 + t115
-    t117 = t10*t97
-    t118 = t49*t117
-    t119 = t14*t97
-    t120 = t46*t119
-    t121 = 2*t102
-    t122 = t109*(t9 - t10*t121)
-    t123 = t111*(t13 - t14*t121)
-    t124 = t61*t117
-    t125 = t62*t119
-    t126 = 2*t99
-    t127 = t109*(t7 - t10*t126)
-    t128 = -t111*(t4 + t14*t126)
+    t117 = 2*t102
+    t118 = t109*(t9 - t10*t117)
+    t119 = t111*(t13 - t14*t117)
+    t120 = t10*t97
+    t121 = t49*t120
+    t122 = t14*t97
+    t123 = t46*t122
+    t124 = 2*t99
+    t125 = t109*(t7 - t10*t124)
+    t126 = -t111*(t4 + t14*t124)
+    t127 = t61*t120
+    t128 = t62*t122
     t129 = qd1*t103
-    t130 = -t64*(t10*t105 + c1*t103) + t65*(t14*t105 + s1*t103) + t95*t129 - t96*t129
-    t131 = t10*t103
-    t132 = t14*t103
-    t133 = t98*t58 - t0*t112 + t0*t110 + t0*t114 + t0*t115
+    t130 = -t64*(c1*t103 + t10*t105) + t65*(s1*t103 + t14*t105) - t96*t129 + t95*t129
+    t131 = t14*t103
+    t132 = t10*t103
+    t133 = t0*t110 - t0*t112 + t58*t98 + t0*t114 + t0*t115
     t134 = -t133
     Jd = _stack(xp, [
         xp.broadcast_to(-t75, batch),  # 0, 0
@@ -1186,20 +1186,20 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(t116, batch),  # 3, 1
         xp.broadcast_to(t116, batch),  # 3, 2
         xp.broadcast_to(t116, batch),  # 3, 3
-        xp.broadcast_to(t118 + t120 + t122 - t123, batch),  # 3, 4
-        xp.broadcast_to(t124 + t125 + t127 - t128, batch),  # 3, 5
+        xp.broadcast_to(t118 - t119 + t121 + t123, batch),  # 3, 4
+        xp.broadcast_to(t125 - t126 + t127 + t128, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t130, batch),  # 4, 1
         xp.broadcast_to(t130, batch),  # 4, 2
         xp.broadcast_to(t130, batch),  # 4, 3
-        xp.broadcast_to(t64*(-t10*t106 + t13*t103) + t65*(t14*t106 + t9*t103) + t46*t131 - t49*t132, batch),  # 4, 4
-        xp.broadcast_to(-t64*(t10*t107 + t4*t103) + t65*(t14*t107 + t7*t103) + t62*t131 - t61*t132, batch),  # 4, 5
+        xp.broadcast_to(t64*(t13*t103 - t10*t106) + t65*(t9*t103 + t14*t106) - t49*t131 + t46*t132, batch),  # 4, 4
+        xp.broadcast_to(-t64*(t4*t103 + t10*t107) + t65*(t7*t103 + t14*t107) - t61*t131 + t62*t132, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.broadcast_to(t134, batch),  # 5, 1
         xp.broadcast_to(t134, batch),  # 5, 2
         xp.broadcast_to(-(-t43 + t133), batch),  # 5, 3
-        xp.broadcast_to(-(-t50 + t102*t58 - t0*t123 + t0*t118 + t0*t120 + t0*t122), batch),  # 5, 4
-        xp.broadcast_to(-(t56 + t99*t58 - t0*t128 + t0*t124 + t0*t125 + t0*t127), batch),  # 5, 5
+        xp.broadcast_to(-(-t50 + t0*t118 - t0*t119 + t58*t102 + t0*t121 + t0*t123), batch),  # 5, 4
+        xp.broadcast_to(-(t56 + t0*t125 - t0*t126 + t58*t99 + t0*t127 + t0*t128), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1261,11 +1261,11 @@ def hessian(q):
     t36 = -s1*t18
     t37 = -s1*t13
     t38 = -s1*t14
-    t39 = c1**2
-    t40 = s1**2
+    t39 = s1**2
+    t40 = c1**2
     t41 = t39*t1 + t40*t1
     t42 = t39*t0 + t40*t0
-    t43 = c1*t24 + s1*t26
+    t43 = s1*t26 + c1*t24
     t44 = s5*t7
     t45 = s5*t10
     t46 = t39*s234 + t40*s234
@@ -1420,7 +1420,7 @@ def hessian(q):
         t35,  # 4, 0, 1
         t35,  # 4, 0, 2
         t35,  # 4, 0, 3
-        c234*t26 + t10*t14,  # 4, 0, 4
+        t10*t14 + c234*t26,  # 4, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0, 5
         t24,  # 4, 1, 0
         t38,  # 4, 1, 1
@@ -1439,7 +1439,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 4
-        -(c234*t6 + s1*t48),  # 4, 3, 5
+        -(s1*t48 + c234*t6),  # 4, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
@@ -1451,7 +1451,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 4
-        -(t4*t10 + t6*t7),  # 4, 5, 5
+        -(t6*t7 + t4*t10),  # 4, 5, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0, 2

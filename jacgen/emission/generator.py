@@ -20,7 +20,7 @@ from jacgen.inputs.robot import EULER_ANGLES, Robot
 from jacgen.inputs.transforms import rot_z, twist
 from jacgen.model import kinematics
 from jacgen.model.joint_ring import joint_atoms, maximal_minors
-from jacgen.model.graph import Node
+from jacgen.model.graph import Node, elementwise
 from jacgen.model.kinematics import generated_symbol
 from jacgen.model.nodes import Above, select
 from jacgen.model.singularities import MINOR_LIMIT, Singularities, singularity_jacobian
@@ -310,14 +310,16 @@ class Generator:
         robot, n, m = self.robot, self.robot.dof, len(self.robot.task)
         q_dot = Argument("q_dot", sympy.Matrix([generated_symbol("qd", i + 1) for i in range(n)]))
         arguments = (Argument("q", sympy.Matrix(self.q)), q_dot)
-        with distribute(False):
-            columns = self.jacobian.applyfunc(self.name)
-            rates = list(q_dot.symbols)
-            jacobian_dot = kinematics.jacobian_dot(robot, self.chain, columns, rates, self.name)
-            bias = jacobian_dot * q_dot.symbols
-            task_jacobian_dot = kinematics.task_jacobian_dot(robot, self.chain.tool, columns,
-                                                             jacobian_dot.applyfunc(self.name), rates, self.name)
-            hessian = sympy.Matrix.vstack(*kinematics.hessian(robot, columns))
+        g = self.graph
+        name = lambda value: self.name_node(g.value(value))  # noqa: E731
+        columns = elementwise(name, g.values(self.jacobian))
+        rates = g.values(q_dot.symbols).flatten()
+        axes = [g.values(axis[:3, 2]).flatten() for axis in self.chain.axes]
+        jacobian_dot = kinematics.jacobian_dot(robot, axes, columns, rates, name)
+        bias = jacobian_dot @ rates
+        task_jacobian_dot = kinematics.task_jacobian_dot(robot, g.values(self.chain.tool), columns,
+                                                         elementwise(name, jacobian_dot), rates, name)
+        hessian = numpy.concatenate(kinematics.hessian(robot, columns))
         return [
             self.function("fk_jacobian_dot", "fk, jacobian and bias_acceleration in one pass, sharing their terms",
                           matrix("T", self.chain.tool, equals="fk"), matrix("J", self.jacobian, equals="jacobian"),

@@ -207,7 +207,7 @@ class Lowering:
         graph = self.graph
         values = dict(self.definitions)
         values.update((symbol, graph.convert(value)) for symbol, value in bindings.items())
-        outputs = [graph.convert(e) for e in outputs]
+        outputs = [graph.value(e) for e in outputs]
         needed, frontier = set(), set().union(*(e.free_symbols for e in outputs))
         while frontier:
             symbol = frontier.pop()

@@ -187,7 +187,7 @@ class Graph:
     def values(self, values):
         """`values` (a sympy Matrix or nested lists) as an array of nodes, for + - * @ and .T."""
         values = values.tolist() if isinstance(values, sympy.MatrixBase) else values
-        return numpy.vectorize(self.value, otypes=[object])(numpy.array(values, dtype=object))
+        return elementwise(self.value, numpy.array(values, dtype=object))
 
     # -- the functions an algorithm calls ---------------------------------------------------------
     def power(self, base: Node, exponent) -> Node:
@@ -422,6 +422,11 @@ class Graph:
                 args = tuple(self.substitute(arg, values, distribute, done) for arg in node.args)
                 done[node] = self.rebuilt(node, args, distribute)
         return done[node]
+
+
+def elementwise(function, values: numpy.ndarray) -> numpy.ndarray:
+    """function applied to every entry of an array of values (naming a vector of nodes)."""
+    return numpy.vectorize(function, otypes=[object])(values)
 
 
 def _combined(operation, values):

@@ -10,12 +10,14 @@ from dataclasses import dataclass
 from functools import cached_property
 from typing import Callable
 
+import numpy
 import sympy
 from sympy.simplify.fu import TR10i
 
 from jacgen.inputs import names
 from jacgen.inputs.robot import TASK_COMPONENTS, Robot
 from jacgen.inputs.transforms import exact_trig, pose_transform, rot_x, rot_z, translation
+from jacgen.model.graph import elementwise
 
 Matrix = sympy.Matrix
 CosSin = Callable[[int], tuple[sympy.Expr, sympy.Expr]]
@@ -166,59 +168,58 @@ def column_jacobian(robot: Robot, chain: Chain) -> Matrix:
     return Matrix.hstack(*columns)
 
 
-def _prefix_angular(robot: Robot, chain: Chain, q_dot, name) -> list[Matrix]:
+def _prefix_angular(robot: Robot, axes: list, q_dot, name) -> list:
     """omega_i: the angular velocity of the link that carries axis i (the sum of z_j qd_j
     over the revolute joints before i), each sum named once."""
-    omegas, omega = [], sympy.zeros(3, 1)
-    for joint, axis, rate in zip(robot.joints, chain.axes, q_dot):
+    omegas, omega = [], numpy.zeros(3, dtype=object)
+    for joint, z, rate in zip(robot.joints, axes, q_dot):
         omegas.append(omega)
         if joint.revolute:
-            omega = (omega + axis[:3, 2] * rate).applyfunc(name)
+            omega = elementwise(name, omega + z * rate)
     return omegas
 
 
-def jacobian_dot(robot: Robot, chain: Chain, jacobian: Matrix, q_dot, name=lambda e: e) -> Matrix:
-    """dJ/dt of the world geometric Jacobian along q_dot, column by column from the chain:
-    z_i' = w_i x z_i and (p - o_i)' = w_i x (p - o_i) + S_i, where w_i is the angular velocity
-    of the link carrying axis i and S_i = sum_{j >= i} Jv_j qd_j the velocity of the tool
-    origin relative to that link. By the Jacobi identity a revolute column is then
-    [w_i x Jv_i + z_i x S_i; w_i x z_i], a prismatic one [w_i x z_i; 0]. Prefix and suffix
-    sums are named once, so each column costs O(1) on top of J."""
+def jacobian_dot(robot: Robot, axes: list, jacobian: numpy.ndarray, q_dot, name) -> numpy.ndarray:
+    """dJ/dt of the world geometric Jacobian along q_dot, column by column from the chain's
+    axes z_i (arrays of nodes, as J): z_i' = w_i x z_i and (p - o_i)' = w_i x (p - o_i) + S_i,
+    where w_i is the angular velocity of the link carrying axis i and
+    S_i = sum_{j >= i} Jv_j qd_j the velocity of the tool origin relative to that link. By the
+    Jacobi identity a revolute column is then [w_i x Jv_i + z_i x S_i; w_i x z_i], a prismatic
+    one [w_i x z_i; 0]. Prefix and suffix sums are named once, so each column costs O(1) on
+    top of J."""
     n = robot.dof
-    omegas = _prefix_angular(robot, chain, q_dot, name)
-    suffix, sums = sympy.zeros(3, 1), [None] * n
+    omegas = _prefix_angular(robot, axes, q_dot, name)
+    suffix, sums = numpy.zeros(3, dtype=object), [None] * n
     for i in reversed(range(n)):
-        suffix = (suffix + jacobian[:3, i] * q_dot[i]).applyfunc(name)
+        suffix = elementwise(name, suffix + jacobian[:3, i] * q_dot[i])
         sums[i] = suffix
     columns = []
     for i, joint in enumerate(robot.joints):
-        z, omega = chain.axes[i][:3, 2], omegas[i]
-        turn = omega.cross(z)
+        z, omega = axes[i], omegas[i]
+        turn = numpy.cross(omega, z)
         if joint.revolute:
-            columns.append(Matrix.vstack(omega.cross(jacobian[:3, i]) + z.cross(sums[i]), turn))
+            columns.append(numpy.concatenate([numpy.cross(omega, jacobian[:3, i]) + numpy.cross(z, sums[i]), turn]))
         else:
-            columns.append(Matrix.vstack(turn, sympy.zeros(3, 1)))
-    return Matrix.hstack(*columns)
+            columns.append(numpy.concatenate([turn, numpy.zeros(3, dtype=object)]))
+    return numpy.stack(columns, axis=1)
 
 
-def hessian(robot: Robot, jacobian: Matrix) -> list[Matrix]:
+def hessian(robot: Robot, jacobian: numpy.ndarray) -> list[numpy.ndarray]:
     """d J / d q_k for each k (6 x n each), from the columns of J alone: rotating about axis k
     turns every column after it (z_k x each half), and a joint k at or after a revolute
     column c moves the tool point, so c's linear part changes by z_c x Jv_k."""
-    layers = []
+    layers, zero = [], numpy.zeros(3, dtype=object)
     for k, moving in enumerate(robot.joints):
         columns = []
         for c, joint in enumerate(robot.joints):
-            if k < c:
+            if k < c and moving.revolute:
                 z_k = jacobian[3:, k]
-                column = (Matrix.vstack(z_k.cross(jacobian[:3, c]), z_k.cross(jacobian[3:, c])) if moving.revolute
-                          else sympy.zeros(6, 1))
-            elif joint.revolute:
-                column = Matrix.vstack(jacobian[3:, c].cross(jacobian[:3, k]), sympy.zeros(3, 1))
+                columns.append(numpy.concatenate([numpy.cross(z_k, jacobian[:3, c]), numpy.cross(z_k, jacobian[3:, c])]))
+            elif k >= c and joint.revolute:
+                columns.append(numpy.concatenate([numpy.cross(jacobian[3:, c], jacobian[:3, k]), zero]))
             else:
-                column = sympy.zeros(6, 1)
-            columns.append(column)
-        layers.append(Matrix.hstack(*columns))
+                columns.append(numpy.concatenate([zero, zero]))
+        layers.append(numpy.stack(columns, axis=1))
     return layers
 
 
@@ -286,39 +287,39 @@ def task_jacobian(robot: Robot, pose: Matrix, jacobian: Matrix) -> Matrix:
     return Matrix.vstack(*(rows[name] for name in robot.task))
 
 
-def rpy_rate_partials(column, angular, name=lambda e: e) -> tuple[Matrix, Matrix]:
+def rpy_rate_partials(column, angular, name) -> tuple[numpy.ndarray, numpy.ndarray]:
     """The partial derivatives of `rpy_rates`' three rows by r, the first column of R, and by w,
-    one column of angular rows, written out (sympy's differentiation costs more than the rest
-    of the function): with c = r0^2 + r1^2 and the heading rate h = (r0 wx + r1 wy) / c, the
-    rows are h, (r0 wy - r1 wx) / sqrt(c) and wz - r2 h."""
+    one column of angular rows (nodes), written out: with c = r0^2 + r1^2 and the heading rate
+    h = (r0 wx + r1 wy) / c, the rows are h, (r0 wy - r1 wx) / sqrt(c) and wz - r2 h."""
     (r0, r1, r2), (wx, wy, _) = column, angular
     c = name(r0**2 + r1**2)
-    root = name(sympy.sqrt(c))
+    root = name(c.graph.sqrt(c))
     heading = name((r0 * wx + r1 * wy) / c)
     pitch_over_c = name((r0 * wy - r1 * wx) / (c * root))
     dh = [(wx - 2 * r0 * heading) / c, (wy - 2 * r1 * heading) / c, 0]
-    by_r = Matrix([dh, [wy / root - r0 * pitch_over_c, -wx / root - r1 * pitch_over_c, 0],
-                   [-r2 * dh[0], -r2 * dh[1], -heading]])
-    by_w = Matrix([[r0 / c, r1 / c, 0], [-r1 / root, r0 / root, 0], [-r2 * r0 / c, -r2 * r1 / c, 1]])
+    by_r = numpy.array([dh, [wy / root - r0 * pitch_over_c, -wx / root - r1 * pitch_over_c, 0],
+                        [-r2 * dh[0], -r2 * dh[1], -heading]], dtype=object)
+    by_w = numpy.array([[r0 / c, r1 / c, 0], [-r1 / root, r0 / root, 0], [-r2 * r0 / c, -r2 * r1 / c, 1]],
+                       dtype=object)
     return by_r, by_w
 
 
-def task_jacobian_dot(robot: Robot, pose: Matrix, jacobian: Matrix, jacobian_dot: Matrix, q_dot,
-                      name=lambda e: e) -> Matrix:
-    """d/dt of task_jacobian: the position rows of J', and for the angles the Euler-angle rates
-    differentiated through what they read, the first column r of R (r' = w x r with
-    w = Jw q_dot) and the angular rows of J (whose rate is that of J')."""
+def task_jacobian_dot(robot: Robot, pose: numpy.ndarray, jacobian: numpy.ndarray, jacobian_dot: numpy.ndarray,
+                      q_dot, name) -> numpy.ndarray:
+    """d/dt of task_jacobian (arrays of nodes): the position rows of J', and for the angles the
+    Euler-angle rates differentiated through what they read, the first column r of R
+    (r' = w x r with w = Jw q_dot) and the angular rows of J (whose rate is that of J')."""
     column = pose[:3, 0]
-    omega = (jacobian[3:, :] * Matrix(q_dot)).applyfunc(name)
-    column_rate = omega.cross(column).applyfunc(name)
+    omega = elementwise(name, jacobian[3:, :] @ q_dot)
+    column_rate = elementwise(name, numpy.cross(omega, column))
     angle_rows = []
     for c in range(robot.dof):
         by_r, by_w = rpy_rate_partials(column, jacobian[3:, c], name)
-        angle_rows.append(by_r * column_rate + by_w * jacobian_dot[3:, c])
-    rates_dot = Matrix.hstack(*angle_rows)
+        angle_rows.append(by_r @ column_rate + by_w @ jacobian_dot[3:, c])
+    rates_dot = numpy.stack(angle_rows, axis=1)
     rows = {name_: jacobian_dot[i, :] for i, name_ in enumerate(("x", "y", "z"))}
     rows.update({name_: rates_dot[i, :] for i, name_ in enumerate(("roll", "pitch", "yaw"))})
-    return Matrix.vstack(*(rows[component] for component in robot.task))
+    return numpy.stack([rows[component] for component in robot.task])
 
 
 READABLE_TERMS = 64  # a sum with more terms stays expanded: TR10i's pairing grows with their square

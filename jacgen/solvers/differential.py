@@ -16,7 +16,7 @@ from typing import Callable
 import numpy
 import sympy
 
-from jacgen.model.graph import AND, OR, Graph, Node
+from jacgen.model.graph import AND, OR, Graph, Node, elementwise
 from jacgen.model.nodes import RANK
 from jacgen.tolerances import IK_NUMERIC_DEFAULT
 
@@ -75,12 +75,12 @@ def velocity_ik(js: sympy.Matrix, q: list, mu_dot: list, damping: sympy.Symbol, 
     computed, one selected); m < n: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; m > n:
     (Js^T Js + damping^2 I)^-1 Js^T mu_dot."""
     m, n = js.shape
-    js, q, mu_dot, damping = _named(g.values(js), name), g.values(q), g.values(mu_dot), g.value(damping)
+    js, q, mu_dot, damping = elementwise(name, g.values(js)), g.values(q), g.values(mu_dot), g.value(damping)
     k = min(m, n)
-    gram = _named(js @ js.T if m <= n else js.T @ js, name) + numpy.eye(k, dtype=int) * damping**2
-    rhs = list(mu_dot) if m <= n else list(_named(js.T @ mu_dot, name))
+    gram = elementwise(name, js @ js.T if m <= n else js.T @ js) + numpy.eye(k, dtype=int) * damping**2
+    rhs = list(mu_dot) if m <= n else list(elementwise(name, js.T @ mu_dot))
     x, singular = householder_solve(gram.tolist(), rhs, g, name)
-    q_dot = list(_named(js.T @ numpy.array(x, dtype=object), name)) if m <= n else x
+    q_dot = list(elementwise(name, js.T @ numpy.array(x, dtype=object))) if m <= n else x
     if m == n:
         direct, direct_singular = householder_solve(js.tolist(), list(mu_dot), g, name)
         damped = g.relation(">", damping, g.number(0))
@@ -94,10 +94,6 @@ def velocity_ik(js: sympy.Matrix, q: list, mu_dot: list, damping: sympy.Symbol, 
     return [g.select(ok, e, g.number(0)) for e in q_dot], status
 
 
-def _named(values: numpy.ndarray, name: Callable) -> numpy.ndarray:
-    return numpy.vectorize(name, otypes=[object])(values)
-
-
 def rotation_vector(E, g: Graph, name: Callable) -> list[Node]:
     """The rotation vector (axis times angle in [0, pi]) of the rotation matrix E.
 
@@ -105,7 +101,7 @@ def rotation_vector(E, g: Graph, name: Callable) -> list[Node]:
     near one (sin(angle) <= 1e-6 with cos(angle) <= 0) v vanishes and the axis is the
     column of (E + I) / 2 = u u^T with the largest diagonal entry (the first of equals),
     signed along v. Both are computed; a select takes one."""
-    E = _named(g.values(E), name)
+    E = elementwise(name, g.values(E))
     v = [name((E[2, 1] - E[1, 2]) / 2), name((E[0, 2] - E[2, 0]) / 2), name((E[1, 0] - E[0, 1]) / 2)]
     cos = name((E[0, 0] + E[1, 1] + E[2, 2] - 1) / 2)
     sin = name(g.sqrt(v[0]**2 + v[1]**2 + v[2]**2))
@@ -130,14 +126,15 @@ def ik_numeric_step(error: list, jacobian: sympy.Matrix, q: list, damping: sympy
     the joints clamped to `limits` ((low, high), None: none). `error` and `jacobian` are
     those of clamp(q), which the caller substitutes."""
     m, n = jacobian.shape
-    jacobian, error, damping = _named(g.values(jacobian), name), _named(g.values(error), name), g.value(damping)
+    jacobian, error = elementwise(name, g.values(jacobian)), elementwise(name, g.values(error))
+    damping = g.value(damping)
     if m <= n:
-        gram = _named(jacobian @ jacobian.T, name) + numpy.eye(m, dtype=int) * damping
+        gram = elementwise(name, jacobian @ jacobian.T) + numpy.eye(m, dtype=int) * damping
         x, _ = householder_solve(gram.tolist(), list(error), g, name)
         step = list(jacobian.T @ numpy.array(x, dtype=object))
     else:
-        gram = _named(jacobian.T @ jacobian, name) + numpy.eye(n, dtype=int) * damping
-        step, _ = householder_solve(gram.tolist(), list(_named(jacobian.T @ error, name)), g, name)
+        gram = elementwise(name, jacobian.T @ jacobian) + numpy.eye(n, dtype=int) * damping
+        step, _ = householder_solve(gram.tolist(), list(elementwise(name, jacobian.T @ error)), g, name)
     trial = [clamp(name(g.value(qi) + si), bounds, g) for qi, si, bounds in zip(q, step, limits)]
     return trial, name(sum(e**2 for e in error))
 
