@@ -280,8 +280,9 @@ class Graph:
                 continue
             coefficient, rest = self._split(term)
             collected.setdefault(rest, []).append(coefficient)
-        number = _combined(sum, numbers)
-        collected = {rest: _combined(sum, coefficients) for rest, coefficients in collected.items()}
+        number = _combined(sum, numbers) if numbers else 0
+        collected = {rest: coefficients[0] if len(coefficients) == 1 else _combined(sum, coefficients)
+                     for rest, coefficients in collected.items()}
         parts = [rest if c == 1 else self.mul(self.number(c), rest) for rest, c in collected.items() if c != 0]
         parts.sort(key=_order)
         if number != 0:
@@ -309,7 +310,7 @@ class Graph:
                 continue
             base, exponent = (factor.args[0], factor.args[1].value) if factor.kind == POW else (factor, 1)
             collected[base] = collected.get(base, 0) + exponent
-        number = _combined(math.prod, numbers)
+        number = (numbers[0] if len(numbers) == 1 else _combined(math.prod, numbers)) if numbers else 1
         if number == 0:
             return self.number(number)
         parts = sorted((base if e == 1 else self.node(POW, (base, self.number(sympy.Rational(e))))
