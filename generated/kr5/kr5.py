@@ -125,8 +125,8 @@ def fk(q):
     t31 = -t13 + c1*t30
     t32 = -t19 + s1*t30
     t33 = 0.6*c2
-    t34 = c1*t33 + t31
-    t35 = s1*t33 + t32
+    t34 = t31 + c1*t33
+    t35 = t32 + s1*t33
     t36 = 0.18*c1 + t34
     t37 = 0.18*s1 + t35
     T = _stack(xp, [
@@ -180,9 +180,9 @@ def jacobian(q):
     t11 = s1*s23
     t12 = s5*t8 + c5*t11
     t13 = 0.115*t10
-    t14 = t13 + 0.62*t9
+    t14 = 0.62*t9 + t13
     t15 = 0.115*t12
-    t16 = t15 + 0.62*t11
+    t16 = 0.62*t11 + t15
     t17 = 0.115*t0
     t18 = -0.62*c23 + t17
     t19 = -0.12*s23 + t18
@@ -191,8 +191,8 @@ def jacobian(q):
     t22 = -t14 + c1*t21
     t23 = -t16 + s1*t21
     t24 = 0.6*c2
-    t25 = c1*t24 + t22
-    t26 = s1*t24 + t23
+    t25 = t22 + c1*t24
+    t26 = t23 + s1*t24
     t27 = 0.18*c1 + t25
     t28 = 0.18*s1 + t26
     t29 = s23*s4
@@ -281,9 +281,9 @@ def fk_jacobian(q):
     t22 = -c6*t19 + s6*t21
     t23 = s6*t19 + c6*t21
     t24 = 0.115*t10
-    t25 = t24 + 0.62*t8
+    t25 = 0.62*t8 + t24
     t26 = 0.115*t15
-    t27 = t26 + 0.62*t13
+    t27 = 0.62*t13 + t26
     t28 = 0.115*t20
     t29 = -0.62*c23 + t28
     t30 = -0.12*s23 + t29
@@ -293,8 +293,8 @@ def fk_jacobian(q):
     t34 = -t25 + c1*t33
     t35 = -t27 + s1*t33
     t36 = 0.6*c2
-    t37 = c1*t36 + t34
-    t38 = s1*t36 + t35
+    t37 = t34 + c1*t36
+    t38 = t35 + s1*t36
     t39 = 0.18*c1 + t37
     t40 = 0.18*s1 + t38
     t41 = -s1
@@ -333,7 +333,7 @@ def fk_jacobian(q):
         -(c1*t37 + s1*t38),  # 2, 1
         -(c1*t34 + s1*t35),  # 2, 2
         t25*t13 - t27*t8,  # 2, 3
-        t6*t26 + t3*t24,  # 2, 4
+        t3*t24 + t6*t26,  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         t41,  # 3, 1
@@ -400,9 +400,9 @@ def jacobian_tool(q):
     t22 = -c6*t19 + s6*t21
     t23 = s6*t19 + c6*t21
     t24 = 0.115*t10
-    t25 = t24 + 0.62*t8
+    t25 = 0.62*t8 + t24
     t26 = 0.115*t15
-    t27 = t26 + 0.62*t13
+    t27 = 0.62*t13 + t26
     t28 = 0.115*t20
     t29 = -0.62*c23 + t28
     t30 = -0.12*s23 + t29
@@ -411,8 +411,8 @@ def jacobian_tool(q):
     t33 = -t25 + c1*t32
     t34 = -t27 + s1*t32
     t35 = 0.6*c2
-    t36 = c1*t35 + t33
-    t37 = s1*t35 + t34
+    t36 = t33 + c1*t35
+    t37 = t34 + s1*t35
     t38 = 0.18*c1 + t36
     t39 = 0.18*s1 + t37
     t40 = -(c1*t36 + s1*t37)
@@ -424,7 +424,7 @@ def jacobian_tool(q):
     t46 = t25*t13 - t27*t8
     t47 = t3*t28 + t21*t26
     t48 = t6*t28 - t21*t24
-    t49 = t6*t26 + t3*t24
+    t49 = t3*t24 + t6*t26
     t50 = c1*t12
     t51 = s1*t17
     t52 = c1*t10
@@ -466,7 +466,7 @@ def jacobian_tool(q):
         t20,  # 5, 0
         t56,  # 5, 1
         t56,  # 5, 2
-        -(-c23*t20 + t10*t8 + t15*t13),  # 5, 3
+        -(t10*t8 + t15*t13 - c23*t20),  # 5, 3
         t6*t10 - t3*t15 + t20*t21,  # 5, 4
         -(t10**2 + t15**2 + t20**2),  # 5, 5
     ], (6, 6))
@@ -523,8 +523,8 @@ def task(q):
     t29 = -t12 + c1*t28
     t30 = -t17 + s1*t28
     t31 = 0.6*c2
-    t32 = c1*t31 + t29
-    t33 = s1*t31 + t30
+    t32 = t29 + c1*t31
+    t33 = t30 + s1*t31
     t34 = 0.18*c1 + t32
     t35 = 0.18*s1 + t33
     mu = _stack(xp, [
@@ -578,9 +578,9 @@ def task_jacobian(q):
     t19 = s23*s4
     t20 = -c6*t17 + s6*t19
     t21 = 0.115*t10
-    t22 = t21 + 0.62*t8
+    t22 = 0.62*t8 + t21
     t23 = 0.115*t14
-    t24 = t23 + 0.62*t12
+    t24 = 0.62*t12 + t23
     t25 = 0.115*t18
     t26 = -0.62*c23 + t25
     t27 = -0.12*s23 + t26
@@ -589,15 +589,15 @@ def task_jacobian(q):
     t30 = -t22 + c1*t29
     t31 = -t24 + s1*t29
     t32 = 0.6*c2
-    t33 = c1*t32 + t30
-    t34 = s1*t32 + t31
+    t33 = t30 + c1*t32
+    t34 = t31 + s1*t32
     t35 = 0.18*c1 + t33
     t36 = 0.18*s1 + t34
     t37 = c1*t15
     t38 = s1*t11
     t39 = t11**2 + t15**2
     t40 = 1/t39
-    t41 = (t37 - t38)*t40
+    t41 = t40*(-t38 + t37)
     t42 = c1*t11
     t43 = s1*t15
     t44 = t40*(s23*t42 + s23*t43)
@@ -623,7 +623,7 @@ def task_jacobian(q):
         -(c1*t33 + s1*t34),  # 2, 1
         -(c1*t30 + s1*t31),  # 2, 2
         t22*t12 - t24*t8,  # 2, 3
-        t6*t23 + t3*t21,  # 2, 4
+        t3*t21 + t6*t23,  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         t41,  # 3, 1
@@ -698,9 +698,9 @@ def fk_jacobian_dot(q, q_dot):
     t24 = s6*t20 + c6*t22
     t25 = t0 + t22*qd5
     t26 = 0.115*t11
-    t27 = t26 + 0.62*t9
+    t27 = 0.62*t9 + t26
     t28 = 0.115*t16
-    t29 = t28 + 0.62*t14
+    t29 = 0.62*t14 + t28
     t30 = 0.115*t21
     t31 = -0.62*c23 + t30
     t32 = -0.12*s23 + t31
@@ -710,8 +710,8 @@ def fk_jacobian_dot(q, q_dot):
     t36 = -t27 + c1*t35
     t37 = -t29 + s1*t35
     t38 = 0.6*c2
-    t39 = c1*t38 + t36
-    t40 = s1*t38 + t37
+    t39 = t36 + c1*t38
+    t40 = t37 + s1*t38
     t41 = 0.18*c1 + t39
     t42 = 0.18*s1 + t40
     t43 = c23*t29 + t31*t14
@@ -728,7 +728,7 @@ def fk_jacobian_dot(q, q_dot):
     t54 = t53
     t55 = t27*t14 - t29*t9
     t56 = t55
-    t57 = t7*t28 + t4*t26
+    t57 = t4*t26 + t7*t28
     t58 = t57
     t59 = t58*qd5 + t56*qd4
     t60 = t59 - t54*qd3
@@ -742,13 +742,13 @@ def fk_jacobian_dot(q, q_dot):
     t68 = t66 + t67
     t69 = t68 + t14*qd4
     t70 = t7*qd5
-    t71 = t65 - t70
+    t71 = -t70 + t65
     t72 = t4*qd5
-    t73 = t69 + t72
+    t73 = t72 + t69
     t74 = t46*qd5
     t75 = t74 + t44*qd4
-    t76 = t75 + t32*t67
-    t77 = t76 + t33*t66
+    t76 = t32*t67 + t75
+    t77 = t33*t66 + t76
     t78 = t77 - t42*qd1
     t79 = t50*qd5
     t80 = t79 - t48*qd4
@@ -818,12 +818,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(-t21, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t83 + qd2*(-qd1*t86 + c1*t61) - qd3*(t66*t54 + qd1*t87 - c1*t60) + qd4*(t56*t68 + t48*qd1 + t14*t59 - c23*t80) + qd5*(t58*t69 - t50*t0 + t72*t58 - t22*t79), batch),  # 0
-        xp.broadcast_to(qd1*t78 + qd2*(t84*qd1 + s1*t61) + qd3*(qd1*t85 - t62*t54 + s1*t60) + qd4*(t44*qd1 + t56*t64 + c23*t75 - t9*t59) + qd5*(t46*t0 - t58*t65 + t22*t74 + t70*t58), batch),  # 1
-        xp.broadcast_to(-qd2*(s1*t82 + c1*t77) - qd3*(s1**2*t89 + c1**2*t89 + s1*t81 + c1*t76) + qd4*(t48*t64 - t44*t68 + t9*t80 - t14*t75) - qd5*(-t50*t65 + t46*t69 + t70*t50 + t72*t46), batch),  # 2
-        xp.broadcast_to(-t66*qd1 - t67*qd1 + qd4*(c23*t68 - t14*qd1) + qd5*(t22*t69 - t4*t0) - qd6*(t21*t73 + t16*t25), batch),  # 3
-        xp.broadcast_to(-t62*qd1 - t63*qd1 + qd4*(t9*qd1 + c23*t64) - qd5*(t7*t0 + t22*t65) + qd6*(t11*t25 + t21*t71), batch),  # 4
-        xp.broadcast_to(-qd4*(t14*t64 + t9*t68) + qd5*(t4*t65 + t7*t69) + qd6*(t16*t71 - t11*t73), batch),  # 5
+        xp.broadcast_to(-qd1*t83 + qd2*(c1*t61 - qd1*t86) - qd3*(t66*t54 + qd1*t87 - c1*t60) + qd4*(t56*t68 + t48*qd1 - c23*t80 + t14*t59) + qd5*(t58*t69 - t50*t0 + t72*t58 - t22*t79), batch),  # 0
+        xp.broadcast_to(qd1*t78 + qd2*(s1*t61 + t84*qd1) + qd3*(s1*t60 + qd1*t85 - t62*t54) + qd4*(t44*qd1 + t56*t64 + c23*t75 - t9*t59) + qd5*(t46*t0 - t58*t65 + t22*t74 + t70*t58), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t82 + c1*t77) - qd3*(c1*t76 + s1*t81 + s1**2*t89 + c1**2*t89) + qd4*(t48*t64 - t44*t68 + t9*t80 - t14*t75) - qd5*(t46*t69 + t70*t50 + t72*t46 - t50*t65), batch),  # 2
+        xp.broadcast_to(-t66*qd1 - t67*qd1 + qd4*(c23*t68 - t14*qd1) + qd5*(-t4*t0 + t22*t69) - qd6*(t21*t73 + t16*t25), batch),  # 3
+        xp.broadcast_to(qd6*(t11*t25 + t21*t71) - t62*qd1 - t63*qd1 + qd4*(c23*t64 + t9*qd1) - qd5*(t7*t0 + t22*t65), batch),  # 4
+        xp.broadcast_to(qd5*(t4*t65 + t7*t69) + qd6*(t16*t71 - t11*t73) - qd4*(t14*t64 + t9*t68), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -877,8 +877,8 @@ def jacobian_dot(q, q_dot):
     t25 = -t17 + s1*t23
     t26 = c1*t24 + s1*t25
     t27 = 0.6*c2
-    t28 = c1*t27 + t24
-    t29 = s1*t27 + t25
+    t28 = t24 + c1*t27
+    t29 = t25 + s1*t27
     t30 = 0.18*c1 + t28
     t31 = 0.18*s1 + t29
     t32 = c1*t28 + s1*t29
@@ -904,9 +904,9 @@ def jacobian_dot(q, q_dot):
     t52 = t50 + t51
     t53 = t52 + t40*qd4
     t54 = t8*qd5
-    t55 = t49 - t54
+    t55 = -t54 + t49
     t56 = t5*qd5
-    t57 = t53 + t56
+    t57 = t56 + t53
     t58 = t37*qd5
     t59 = t58 + t34*qd4
     t60 = t59 + t21*t51
@@ -915,7 +915,7 @@ def jacobian_dot(q, q_dot):
     t63 = t38*qd5
     t64 = t63 - t35*qd4
     t65 = t64 + t21*t47
-    t66 = t65 + t22*t46
+    t66 = t22*t46 + t65
     t67 = t66 + t30*qd1
     t68 = s1*qd1
     t69 = c1*qd1
@@ -925,32 +925,32 @@ def jacobian_dot(q, q_dot):
     Jd = _stack(xp, [
         xp.broadcast_to(-t67, batch),  # 0, 0
         xp.broadcast_to(-t22*t68 + c1*t45, batch),  # 0, 1
-        xp.broadcast_to(-(t50*t26 + t21*t68 - c1*t44), batch),  # 0, 2
-        xp.broadcast_to(t42*t52 + t35*qd1 + t40*t43 - c23*t64, batch),  # 0, 3
+        xp.broadcast_to(-(t21*t68 - c1*t44 + t50*t26), batch),  # 0, 2
+        xp.broadcast_to(t42*t52 + t35*qd1 - c23*t64 + t40*t43, batch),  # 0, 3
         xp.broadcast_to(t18*t53 - t38*t1 + t56*t18 - t36*t63, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t62, batch),  # 1, 0
         xp.broadcast_to(t22*t69 + s1*t45, batch),  # 1, 1
-        xp.broadcast_to(t21*t69 - t46*t26 + s1*t44, batch),  # 1, 2
+        xp.broadcast_to(t21*t69 + s1*t44 - t46*t26, batch),  # 1, 2
         xp.broadcast_to(t34*qd1 + t42*t48 + c23*t59 - t41*t43, batch),  # 1, 3
         xp.broadcast_to(t37*t1 - t18*t49 + t36*t58 + t54*t18, batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(-(s1*t66 + c1*t61), batch),  # 2, 1
-        xp.broadcast_to(-(s1**2*t70 + c1**2*t70 + s1*t65 + c1*t60), batch),  # 2, 2
+        xp.broadcast_to(-(c1*t60 + s1*t65 + s1**2*t70 + c1**2*t70), batch),  # 2, 2
         xp.broadcast_to(t35*t48 - t34*t52 + t41*t64 - t40*t59, batch),  # 2, 3
-        xp.broadcast_to(-(-t38*t49 + t37*t53 + t54*t38 + t56*t37), batch),  # 2, 4
+        xp.broadcast_to(-(t37*t53 - t38*t49 + t54*t38 + t56*t37), batch),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t71, batch),  # 3, 1
         xp.broadcast_to(t71, batch),  # 3, 2
         xp.broadcast_to(c23*t52 - s23*t68, batch),  # 3, 3
-        xp.broadcast_to(t36*t53 - t5*t1, batch),  # 3, 4
+        xp.broadcast_to(-t5*t1 + t36*t53, batch),  # 3, 4
         xp.broadcast_to(-(t0*t57 + t12*t39), batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t72, batch),  # 4, 1
         xp.broadcast_to(t72, batch),  # 4, 2
-        xp.broadcast_to(s23*t69 + c23*t48, batch),  # 4, 3
+        xp.broadcast_to(c23*t48 + s23*t69, batch),  # 4, 3
         xp.broadcast_to(-(t8*t1 + t36*t49), batch),  # 4, 4
         xp.broadcast_to(t11*t39 + t0*t55, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
@@ -1013,8 +1013,8 @@ def bias_acceleration(q, q_dot):
     t25 = -t17 + s1*t23
     t26 = c1*t24 + s1*t25
     t27 = 0.6*c2
-    t28 = c1*t27 + t24
-    t29 = s1*t27 + t25
+    t28 = t24 + c1*t27
+    t29 = t25 + s1*t27
     t30 = 0.18*c1 + t28
     t31 = 0.18*s1 + t29
     t32 = c1*t28 + s1*t29
@@ -1040,9 +1040,9 @@ def bias_acceleration(q, q_dot):
     t52 = t50 + t51
     t53 = t52 + t40*qd4
     t54 = t8*qd5
-    t55 = t49 - t54
+    t55 = -t54 + t49
     t56 = t5*qd5
-    t57 = t53 + t56
+    t57 = t56 + t53
     t58 = t37*qd5
     t59 = t58 + t34*qd4
     t60 = t59 + t21*t51
@@ -1051,18 +1051,18 @@ def bias_acceleration(q, q_dot):
     t63 = t38*qd5
     t64 = t63 - t35*qd4
     t65 = t64 + t21*t47
-    t66 = t65 + t22*t46
+    t66 = t22*t46 + t65
     t67 = t66 + t30*qd1
     t68 = s1*qd1
     t69 = c1*qd1
     t70 = t21*qd2
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t67 + qd2*(-t22*t68 + c1*t45) - qd3*(t50*t26 + t21*t68 - c1*t44) + qd4*(t42*t52 + t35*qd1 + t40*t43 - c23*t64) + qd5*(t18*t53 - t38*t1 + t56*t18 - t36*t63), batch),  # 0
-        xp.broadcast_to(qd1*t62 + qd2*(t22*t69 + s1*t45) + qd3*(t21*t69 - t46*t26 + s1*t44) + qd4*(t34*qd1 + t42*t48 + c23*t59 - t41*t43) + qd5*(t37*t1 - t18*t49 + t36*t58 + t54*t18), batch),  # 1
-        xp.broadcast_to(-qd2*(s1*t66 + c1*t61) - qd3*(s1**2*t70 + c1**2*t70 + s1*t65 + c1*t60) + qd4*(t35*t48 - t34*t52 + t41*t64 - t40*t59) - qd5*(-t38*t49 + t37*t53 + t54*t38 + t56*t37), batch),  # 2
-        xp.broadcast_to(-t50*qd1 - t51*qd1 + qd4*(c23*t52 - t40*qd1) + qd5*(t36*t53 - t5*t1) - qd6*(t0*t57 + t12*t39), batch),  # 3
-        xp.broadcast_to(-t46*qd1 - t47*qd1 + qd4*(t41*qd1 + c23*t48) - qd5*(t8*t1 + t36*t49) + qd6*(t11*t39 + t0*t55), batch),  # 4
-        xp.broadcast_to(-qd4*(t40*t48 + t41*t52) + qd5*(t5*t49 + t8*t53) + qd6*(t12*t55 - t11*t57), batch),  # 5
+        xp.broadcast_to(-qd1*t67 + qd2*(-t22*t68 + c1*t45) - qd3*(t21*t68 - c1*t44 + t50*t26) + qd4*(t42*t52 + t35*qd1 - c23*t64 + t40*t43) + qd5*(t18*t53 - t38*t1 + t56*t18 - t36*t63), batch),  # 0
+        xp.broadcast_to(qd1*t62 + qd2*(t22*t69 + s1*t45) + qd3*(t21*t69 + s1*t44 - t46*t26) + qd4*(t34*qd1 + t42*t48 + c23*t59 - t41*t43) + qd5*(t37*t1 - t18*t49 + t36*t58 + t54*t18), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t66 + c1*t61) - qd3*(c1*t60 + s1*t65 + s1**2*t70 + c1**2*t70) + qd4*(t35*t48 - t34*t52 + t41*t64 - t40*t59) - qd5*(t37*t53 - t38*t49 + t54*t38 + t56*t37), batch),  # 2
+        xp.broadcast_to(-qd6*(t0*t57 + t12*t39) - t50*qd1 - t51*qd1 + qd4*(c23*t52 - t40*qd1) + qd5*(-t5*t1 + t36*t53), batch),  # 3
+        xp.broadcast_to(qd6*(t11*t39 + t0*t55) - t46*qd1 - t47*qd1 + qd4*(c23*t48 + t41*qd1) - qd5*(t8*t1 + t36*t49), batch),  # 4
+        xp.broadcast_to(qd5*(t5*t49 + t8*t53) + qd6*(t12*t55 - t11*t57) - qd4*(t40*t48 + t41*t52), batch),  # 5
     ], (6,))
     return a
 
@@ -1115,11 +1115,11 @@ def task_jacobian_dot(q, q_dot):
     t21 = s23*s4
     t22 = -c6*t19 + s6*t21
     t23 = 0.115*t10
-    t24 = t23 + 0.62*t8
+    t24 = 0.62*t8 + t23
     t25 = 0.115*t14
-    t26 = t25 + 0.62*t12
+    t26 = 0.62*t12 + t25
     t27 = t24*t12 - t26*t8
-    t28 = t6*t25 + t3*t23
+    t28 = t3*t23 + t6*t25
     t29 = t28*qd5 + t27*qd4
     t30 = 0.115*t20
     t31 = -0.62*c23 + t30
@@ -1135,8 +1135,8 @@ def task_jacobian_dot(q, q_dot):
     t41 = c1*t39 + s1*t40
     t42 = t29 - t41*qd3
     t43 = 0.6*c2
-    t44 = c1*t43 + t39
-    t45 = s1*t43 + t40
+    t44 = t39 + c1*t43
+    t45 = t40 + s1*t43
     t46 = 0.18*c1 + t44
     t47 = 0.18*s1 + t45
     t48 = c1*t44 + s1*t45
@@ -1145,7 +1145,7 @@ def task_jacobian_dot(q, q_dot):
     t51 = s1*qd3
     t52 = t50 + t51
     t53 = t52
-    t54 = t8*qd1 + c23*t53
+    t54 = c23*t53 + t8*qd1
     t55 = c1*qd2
     t56 = c1*qd3
     t57 = t55 + t56
@@ -1155,23 +1155,23 @@ def task_jacobian_dot(q, q_dot):
     t61 = t8*qd4
     t62 = -t53 + t61
     t63 = t12*qd4
-    t64 = t58 + t63
+    t64 = t63 + t58
     t65 = t3*t62 + t6*t64
     t66 = qd1 + c23*qd4
     t67 = t66
-    t68 = t21*t64 - t3*t67
+    t68 = -t3*t67 + t21*t64
     t69 = t6*t67 + t21*t62
     t70 = t6*qd5
-    t71 = t62 - t70
+    t71 = -t70 + t62
     t72 = -t61 + t52 + t70 - t10*qd6
     t73 = t3*qd5
-    t74 = t64 + t73
-    t75 = -t37*t62 + t35*t64 + t70*t37 + t73*t35
+    t74 = t73 + t64
+    t75 = t35*t64 - t37*t62 + t70*t37 + t73*t35
     t76 = t14*t71 - t10*t74
     t77 = t57 + t63 + t73 + t14*qd6
     t78 = t15*t72 + t11*t77
     t79 = t21*qd5
-    t80 = t67 + t79
+    t80 = t79 + t67
     t81 = t20*t74 + t14*t80
     t82 = t10*t80 + t20*t71
     t83 = t66 + t79 - t20*qd6
@@ -1186,30 +1186,30 @@ def task_jacobian_dot(q, q_dot):
     t92 = t35*t67 - t28*t62 + t21*t86 + t70*t28
     t93 = t37*qd5
     t94 = t93 - t36*qd4
-    t95 = t94 + t32*t51
+    t95 = t32*t51 + t94
     t96 = t95 + t33*t50
     t97 = t96 + t46*qd1
-    t98 = t27*t58 + t36*qd1 + t12*t29 - c23*t94
+    t98 = t27*t58 + t36*qd1 - c23*t94 + t12*t29
     t99 = t28*t64 - t37*t67 + t73*t28 - t21*t93
     t100 = s1*t96 + c1*t89
     t101 = t36*t53 - t34*t58 + t8*t94 - t12*t87
     t102 = s1*qd1
-    t103 = -t33*t102 + c1*t49
-    t104 = t55*t41 + t32*t102 - c1*t42
+    t103 = c1*t49 - t33*t102
+    t104 = -c1*t42 + t55*t41 + t32*t102
     t105 = c1*qd1
-    t106 = t33*t105 + s1*t49
-    t107 = t32*t105 - t50*t41 + s1*t42
+    t106 = s1*t49 + t33*t105
+    t107 = s1*t42 + t32*t105 - t50*t41
     t108 = t32*qd2
-    t109 = s1**2*t108 + c1**2*t108 + s1*t95 + c1*t88
+    t109 = c1*t88 + s1*t95 + s1**2*t108 + c1**2*t108
     t110 = c1*t15
     t111 = s1*t11
     t112 = 1/t16
-    t113 = (t110 - t111)*t112
+    t113 = t112*(-t111 + t110)
     t114 = (t3*t15 - t6*t11)*t112
     t115 = (t10*t11 + t14*t15)*t112
     t116 = c1*t11
     t117 = s1*t15
-    t118 = (s23*t116 + s23*t117)*t112
+    t118 = t112*(s23*t116 + s23*t117)
     t119 = 1/t17
     t120 = t112*t119
     t121 = (t116 + t117)*t120
@@ -1224,7 +1224,7 @@ def task_jacobian_dot(q, q_dot):
     t130 = qd1*t112
     t131 = t116*t130
     t132 = t117*t130
-    t133 = t127 + t129 - t131 - t132
+    t133 = -t131 - t132 + t127 + t129
     t134 = 2*t118
     t135 = t126*(t8 - t11*t134)
     t136 = t128*(t12 - t15*t134)
@@ -1243,10 +1243,10 @@ def task_jacobian_dot(q, q_dot):
     t149 = t81*t137
     t150 = t82*t139
     t151 = qd1*t119
-    t152 = t84*(c1*t119 - t11*t121) + t85*(s1*t119 - t15*t121) + t110*t151 - t111*t151
+    t152 = t84*(-t11*t121 + c1*t119) + t85*(-t15*t121 + s1*t119) + t110*t151 - t111*t151
     t153 = t15*t119
     t154 = t11*t119
-    t155 = -t22*t127 - t22*t129 + t78*t113 + t22*t131 + t22*t132
+    t155 = t78*t113 - t22*t127 - t22*t129 + t22*t131 + t22*t132
     Jd = _stack(xp, [
         xp.broadcast_to(-t97, batch),  # 0, 0
         xp.broadcast_to(t103, batch),  # 0, 1
@@ -1270,20 +1270,20 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(t133, batch),  # 3, 1
         xp.broadcast_to(t133, batch),  # 3, 2
         xp.broadcast_to(t135 + t136 + t138 + t140, batch),  # 3, 3
-        xp.broadcast_to(t142 + t143 + t144 - t145, batch),  # 3, 4
-        xp.broadcast_to(t147 + t148 - t149 + t150, batch),  # 3, 5
+        xp.broadcast_to(-t145 + t142 + t143 + t144, batch),  # 3, 4
+        xp.broadcast_to(-t149 + t147 + t148 + t150, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t152, batch),  # 4, 1
         xp.broadcast_to(t152, batch),  # 4, 2
-        xp.broadcast_to(t84*(t12*t119 - t11*t122) - t85*(t8*t119 + t15*t122) - t59*t153 + t54*t154, batch),  # 4, 3
-        xp.broadcast_to(t84*(t3*t119 - t11*t123) + t85*(t6*t119 - t15*t123) - t68*t153 - t69*t154, batch),  # 4, 4
-        xp.broadcast_to(t84*(t14*t119 - t11*t124) - t85*(t10*t119 + t15*t124) + t81*t153 + t82*t154, batch),  # 4, 5
+        xp.broadcast_to(t84*(-t11*t122 + t12*t119) - t85*(t15*t122 + t8*t119) - t59*t153 + t54*t154, batch),  # 4, 3
+        xp.broadcast_to(t84*(-t11*t123 + t3*t119) + t85*(-t15*t123 + t6*t119) - t68*t153 - t69*t154, batch),  # 4, 4
+        xp.broadcast_to(t84*(-t11*t124 + t14*t119) - t85*(t15*t124 + t10*t119) + t81*t153 + t82*t154, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.broadcast_to(t155, batch),  # 5, 1
         xp.broadcast_to(t155, batch),  # 5, 2
-        xp.broadcast_to(-(t60 + t22*t135 + t22*t136 - t78*t118 + t22*t138 + t22*t140), batch),  # 5, 3
-        xp.broadcast_to(t65 - t22*t142 - t22*t143 + t78*t114 - t22*t144 + t22*t145, batch),  # 5, 4
-        xp.broadcast_to(t76 - t22*t147 - t22*t148 + t78*t115 + t22*t149 - t22*t150, batch),  # 5, 5
+        xp.broadcast_to(-(t60 + t22*t135 + t22*t136 + t22*t138 + t22*t140 - t78*t118), batch),  # 5, 3
+        xp.broadcast_to(t65 + t78*t114 - t22*t142 - t22*t143 - t22*t144 + t22*t145, batch),  # 5, 4
+        xp.broadcast_to(t76 + t78*t115 - t22*t147 - t22*t148 + t22*t149 - t22*t150, batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1318,9 +1318,9 @@ def hessian(q):
     t11 = s1*s23
     t12 = s5*t8 + c5*t11
     t13 = 0.115*t10
-    t14 = t13 + 0.62*t9
+    t14 = 0.62*t9 + t13
     t15 = 0.115*t12
-    t16 = t15 + 0.62*t11
+    t16 = 0.62*t11 + t15
     t17 = t14*t11 - t16*t9
     t18 = t7*t15 + t4*t13
     t19 = 0.115*t0
@@ -1335,8 +1335,8 @@ def hessian(q):
     t28 = -t16 + 0.12*t27
     t29 = c1*t26 + s1*t28
     t30 = 0.6*c2
-    t31 = c1*t30 + t26
-    t32 = s1*t30 + t28
+    t31 = t26 + c1*t30
+    t32 = t28 + s1*t30
     t33 = 0.18*c1 + t31
     t34 = 0.18*s1 + t32
     t35 = c1*t31 + s1*t32
@@ -1358,17 +1358,17 @@ def hessian(q):
     t51 = s1*t18
     t52 = s1**2
     t53 = c1**2
-    t54 = -(t52*t21 + t53*t21)
+    t54 = -(t21*t52 + t21*t53)
     t55 = s1*t24 - c1*t23
     t56 = -(s1*t38 + c1*t37)
     t57 = s23*t6
     t58 = -c1*t0
     t59 = s23*t1
     t60 = -s1*t0
-    t61 = -(t52*s23 + t53*s23)
+    t61 = -(s23*t52 + s23*t53)
     t62 = -s1*t4 + c1*t7
     t63 = -(s1*t12 + c1*t10)
-    t64 = t11*t18 - c23*t38
+    t64 = -c23*t38 + t11*t18
     t65 = c23*t37 - t9*t18
     t66 = t9*t38 - t11*t37
     t67 = s23**2
@@ -1422,7 +1422,7 @@ def hessian(q):
         t51,  # 1, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -(t52*t22 + t53*t22),  # 1, 2, 1
+        -(t22*t52 + t22*t53),  # 1, 2, 1
         t54,  # 1, 2, 2
         t55,  # 1, 2, 3
         t56,  # 1, 2, 4
@@ -1484,7 +1484,7 @@ def hessian(q):
         t24,  # 3, 0, 0
         t47,  # 3, 0, 1
         t47,  # 3, 0, 2
-        t11*t17 + c23*t24,  # 3, 0, 3
+        c23*t24 + t11*t17,  # 3, 0, 3
         t64,  # 3, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0, 5
         t23,  # 3, 1, 0
@@ -1503,8 +1503,8 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        t1*t67 - c23*t4,  # 3, 3, 4
-        -(t0*t11 + c23*t12),  # 3, 3, 5
+        -c23*t4 + t1*t67,  # 3, 3, 4
+        -(c23*t12 + t0*t11),  # 3, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
@@ -1527,7 +1527,7 @@ def hessian(q):
         t51,  # 4, 1, 1
         t51,  # 4, 1, 2
         t65,  # 4, 1, 3
-        t36*t37 + t7*t18,  # 4, 1, 4
+        t7*t18 + t36*t37,  # 4, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2, 0
         t56,  # 4, 2, 1
@@ -1546,7 +1546,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        t10*t36 - t7*t0,  # 4, 4, 5
+        -t7*t0 + t10*t36,  # 4, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
@@ -1606,7 +1606,7 @@ def singularity_factors(q):
     f = _stack(xp, [
         c3 + t0,  # 0
         s5,  # 1
-        0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - s2*c3 - s2*t0 + 0.1935483870967742*c2*c3,  # 2
+        0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - s2*c3 + 0.1935483870967742*c2*c3 - s2*t0,  # 2
     ], (3,))
     return f
 
@@ -1621,7 +1621,7 @@ def manipulability(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.1935483870967742*s3
-    t1 = 0.23064*s5*(c3 + t0)*(0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - s2*c3 - s2*t0 + 0.1935483870967742*c2*c3)
+    t1 = 0.23064*s5*(c3 + t0)*(0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - s2*c3 + 0.1935483870967742*c2*c3 - s2*t0)
     w = xp.broadcast_to(xp.abs(t1), batch)
     return w
 
@@ -1636,7 +1636,7 @@ def jacobian_det(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.1935483870967742*s3
-    d = xp.broadcast_to(-0.23064*s5*(c3 + t0)*(0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - s2*c3 - s2*t0 + 0.1935483870967742*c2*c3), batch)
+    d = xp.broadcast_to(-0.23064*s5*(c3 + t0)*(0.2903225806451613 + 0.967741935483871*c2 - c2*s3 - s2*c3 + 0.1935483870967742*c2*c3 - s2*t0), batch)
     return d
 
 
@@ -1683,9 +1683,9 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t11 = s1*s23
     t12 = s5*t8 + c5*t11
     t13 = 0.115*t10
-    t14 = t13 + 0.62*t9
+    t14 = 0.62*t9 + t13
     t15 = 0.115*t12
-    t16 = t15 + 0.62*t11
+    t16 = 0.62*t11 + t15
     t17 = t14*t11 - t16*t9
     t18 = t7*t15 + t4*t13
     t19 = 0.115*t0
@@ -1699,8 +1699,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t27 = -t16 + s1*t25
     t28 = c1*t26 + s1*t27
     t29 = 0.6*c2
-    t30 = c1*t29 + t26
-    t31 = s1*t29 + t27
+    t30 = t26 + c1*t29
+    t31 = t27 + s1*t29
     t32 = 0.18*c1 + t30
     t33 = 0.18*s1 + t31
     t34 = c1*t30 + s1*t31
@@ -1709,21 +1709,21 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t37 = t7*t19 - t13*t35
     t38 = t32 - c23*t24 + t35*t37
     t39 = c23*t17 + t35*t18
-    t40 = -c23*t9 + t7*t35 + t10*t0
-    t41 = c23*t11 + t4*t35 - t12*t0
+    t40 = t10*t0 - c23*t9 + t7*t35
+    t41 = -t12*t0 + c23*t11 + t4*t35
     t42 = t33**2
     t43 = c1**2
-    t44 = t43*t22 + t43*t21 + t11*t23 + t4*t36
+    t44 = t4*t36 + t22*t43 + t11*t23 + t21*t43
     t45 = t22**2
     t46 = t21**2
     t47 = t23**2 + t36**2 + t43*t45 + t43*t46
     t48 = t42 + t47
     t49 = c1*s1
-    t50 = -t32*t33 + t45*t49 + t46*t49 - t23*t24 + t36*t37
+    t50 = -t32*t33 - t23*t24 + t36*t37 + t45*t49 + t46*t49
     t51 = c1*t34
     t52 = c1*t28
-    t53 = -t22*t51 - t21*t52 + t23*t17 + t36*t18
-    t54 = -t51 - t52 + t11*t17 + t4*t18
+    t53 = t23*t17 + t36*t18 - t22*t51 - t21*t52
+    t54 = -t51 - t52 + t4*t18 + t11*t17
     t55 = c1*t22
     t56 = c1*t21
     t57 = s1*t55 + s1*t56
@@ -1733,13 +1733,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t61 = t60 + c23*t23 + t35*t36
     t62 = t32**2
     t63 = s1**2
-    t64 = t63*t22 + t63*t21 + t9*t24 + t7*t37
-    t65 = t24**2 + t37**2 + t63*t45 + t63*t46
+    t64 = t22*t63 + t21*t63 + t7*t37 + t9*t24
+    t65 = t24**2 + t37**2 + t45*t63 + t46*t63
     t66 = t62 + t65
     t67 = s1*t34
     t68 = s1*t28
     t69 = t22*t67 + t21*t68 + t24*t17 - t37*t18
-    t70 = t67 + t68 + t9*t17 - t7*t18
+    t70 = t67 + t68 - t7*t18 + t9*t17
     t71 = t34**2
     t72 = t71 + t28**2 + t17**2 + t18**2
     t73 = t72
@@ -1747,10 +1747,10 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t75 = t7**2 + t10**2 + 2*t63 + t43*t74
     t76 = t75
     t77 = 2*c1
-    t78 = -s1*t77 + t49*t74 - t7*t4 + t10*t12
+    t78 = -t7*t4 + t10*t12 - s1*t77 + t49*t74
     t79 = t4**2 + t12**2 + 2*t43 + t63*t74
     t80 = t79
-    t81 = c23**2 + t0**2 + t74*s4**2
+    t81 = c23**2 + t0**2 + s4**2*t74
     t82 = 1 + t81
     t83 = t50**2
     t84 = t53**2
@@ -1772,7 +1772,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t100 = mu_dot4 - t44*t95
     t101 = mu_dot5 - t61*t95
     t102 = t88 + t66
-    t103 = t94*(t50*t93 + t50*t102 - t53*t69 + t58*t64 + t44*t59 + t61*t38)
+    t103 = t94*(t50*t93 - t53*t69 + t58*t64 + t44*t59 + t61*t38 + t102*t50)
     t104 = t50 - t93*t103
     t105 = t102 - t50*t103
     t106 = t69 + t53*t103
@@ -1790,7 +1790,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t118 = t100 - t108*t114
     t119 = t101 - t109*t114
     t120 = t88 + t73
-    t121 = t94*(t53*t93 - t50*t69 + t53*t120 - t58*t70 + t44*t54 + t61*t39)
+    t121 = t94*(t53*t93 - t50*t69 - t58*t70 + t44*t54 + t61*t39 + t120*t53)
     t122 = t53 - t93*t121
     t123 = t69 + t50*t121
     t124 = t120 - t53*t121
@@ -1813,7 +1813,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t141 = t118 - t132*t138
     t142 = t119 - t133*t138
     t143 = t88 + t76
-    t144 = -t94*(t58*t93 + t50*t64 - t53*t70 + t58*t143 - t44*t78 + t61*t40)
+    t144 = -t94*(t58*t93 + t50*t64 + t61*t40 + t143*t58 - t53*t70 - t44*t78)
     t145 = t58 + t93*t144
     t146 = t64 + t50*t144
     t147 = t70 - t53*t144
@@ -1840,7 +1840,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t168 = t141 - t160*t166
     t169 = t142 + t161*t166
     t170 = t88 + t80
-    t171 = t94*(t44*t93 + t50*t59 + t53*t54 - t58*t78 + t44*t170 + t61*t41)
+    t171 = t94*(t44*t93 + t50*t59 + t53*t54 - t58*t78 + t61*t41 + t170*t44)
     t172 = t44 - t93*t171
     t173 = t59 - t50*t171
     t174 = t54 - t53*t171
@@ -1871,7 +1871,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t199 = t169 - t192*t197
     t200 = t88 + t82
     t201 = xp.sqrt(2*t83 + 2*t84 + 2*t69**2 + 2*t85 + 2*t64**2 + 2*t70**2 + 2*t86 + 2*t59**2 + 2*t54**2 + 2*t78**2 + 2*t87 + 2*t38**2 + 2*t39**2 + 2*t40**2 + 2*t41**2 + t90 + t102**2 + t120**2 + t143**2 + t170**2 + t200**2)
-    t202 = t94*(t61*t93 + t50*t38 + t53*t39 + t58*t40 + t44*t41 + t61*t200)
+    t202 = t94*(t61*t93 + t50*t38 + t53*t39 + t58*t40 + t44*t41 + t200*t61)
     t203 = t61 - t93*t202
     t204 = t38 - t50*t202
     t205 = t39 - t53*t202
@@ -1909,7 +1909,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t237 = xp.where(xp.not_equal(t111, 0), -(-(-t129*t236 - t152*t235 + t179*t234 + t210*t233) + t115)/t111, 0)
     t238 = xp.where(xp.not_equal(t92, 0), -(-(t104*t237 + t122*t236 - t145*t235 + t172*t234 + t203*t233) + t96)/t92, 0)
     t239 = t233 - t33*t238 + t32*t237
-    t240 = t23*t238 - t24*t237 + t17*t236 + t9*t235 + t11*t234 + c23*t233
+    t240 = t23*t238 - t24*t237 + t17*t236 + c23*t233 + t9*t235 + t11*t234
     t241 = t36*t238 + t37*t237 + t18*t236 - t7*t235 + t4*t234 + t35*t233
     t242 = t10*t235 + t12*t234 - t0*t233
     t243 = s1*t22
@@ -1917,12 +1917,12 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t245 = t244 - t34*t236 + t55*t238 + t243*t237
     t246 = s1*t21
     t247 = t244 - t28*t236 + t56*t238 + t246*t237
-    t248 = 1 + t62 + t42
+    t248 = 1 + t42 + t62
     t249 = xp.sqrt(t47 + t65 + t72 + t75 + t79 + t81 + t248)
     t250 = xp.sqrt(t248)
     t251 = t250*xp.where(xp.less_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)
     t252 = t60 + t251
-    t253 = xp.where(xp.greater(t250, 0), 1/(t250*(t250 + xp.abs(t60))), 0)
+    t253 = xp.where(xp.greater(t250, 0), 1/(t250*(t250 + xp.abs(t33))), 0)
     t254 = t253*(t55*t252 + t32*t243)
     t255 = t55 - t252*t254
     t256 = t243 - t32*t254
@@ -2013,15 +2013,15 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t341 = t340*(t324*t339 + t336*t325)
     t342 = t324 - t339*t341
     t343 = t325 - t336*t341
-    t344 = 1 + t60 - t24 - t34 + t302 + t326 + t272 + q1 + q2 + q3 + c23 + q4 + t9 + t11 + q5 + q6 + t4 + t10 + t12 + t32 + t35 + t55 + t56 + t243 + t246 + t23 + t36 + t37 + t17 + t18 + t77 - 2*s1 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t344 = 1 - t24 - t34 + q1 + q2 + q3 + c23 + q4 + q5 + q6 + t4 + t10 + t12 + t32 + t9 + t11 + t35 + t55 + t56 + t60 + t23 + t36 + t37 + t17 + t18 - 2*s1 + t77 + t243 + t246 + t272 + t302 + t326 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
     t345 = t32*t273
-    t346 = t279*(c1*t12 + t345*t278 - s1*t10 - t254*t274)
+    t346 = t279*(c1*t12 - s1*t10 - t254*t274 + t345*t278)
     t347 = t345 - t278*t346
     t348 = t10 + s1*t346
     t349 = t12 - c1*t346
     t350 = t274 + t254*t346
     t351 = t34*t346
-    t352 = t307*(t351*t306 + t282*t348 + t283*t349 + t284*t350)
+    t352 = t307*(t282*t348 + t283*t349 + t284*t350 + t351*t306)
     t353 = t351 - t306*t352
     t354 = t348 - t282*t352
     t355 = t349 - t283*t352
@@ -2128,9 +2128,9 @@ def ik_numeric_step(target, q, damping=0.0):
     t19 = s5*t8 + c5*t17
     t20 = s6*t4 + c6*t18
     t21 = c6*t4 - s6*t18
-    t22 = -t20*T00 + t21*T01 + t19*T02
-    t23 = -t20*T10 + t21*T11 + t19*T12
-    t24 = -t20*T20 + t21*T21 + t19*T22
+    t22 = t21*T01 + t19*T02 - t20*T00
+    t23 = t21*T11 + t19*T12 - t20*T10
+    t24 = t21*T21 + t19*T22 - t20*T20
     t25 = 0.5*(t22 + t15)
     t26 = s23*c4
     t27 = c23*s5 + c5*t26
@@ -2138,8 +2138,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t29 = s23*s4
     t30 = -c6*t27 + s6*t29
     t31 = s6*t27 + c6*t29
-    t32 = -c23*t9 + t7*t29 + t11*t28
-    t33 = c23*t17 + t4*t29 - t19*t28
+    t32 = t7*t29 + t11*t28 - c23*t9
+    t33 = -t19*t28 + c23*t17 + t4*t29
     t34 = t30*T00 - t31*T01 + t28*T02
     t35 = t30*T10 - t31*T11 + t28*T12
     t36 = t30*T20 - t31*T21 + t28*T22
@@ -2147,11 +2147,11 @@ def ik_numeric_step(target, q, damping=0.0):
     t38 = 0.5*(-t16 + t34)
     t39 = xp.sqrt(t37**2 + t38**2 + t25**2)
     t40 = 0.115*t11
-    t41 = t40 + 0.62*t9
+    t41 = 0.62*t9 + t40
     t42 = 0.115*t19
-    t43 = t42 + 0.62*t17
+    t43 = 0.62*t17 + t42
     t44 = t41*t17 - t43*t9
-    t45 = t7*t42 + t4*t40
+    t45 = t4*t40 + t7*t42
     t46 = c23*t44 + t29*t45
     t47 = 0.115*t28
     t48 = -0.62*c23 + t47
@@ -2168,8 +2168,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t59 = -t43 + s1*t57
     t60 = c1*t58 + s1*t59
     t61 = 0.6*c2
-    t62 = c1*t61 + t58
-    t63 = s1*t61 + t59
+    t62 = t58 + c1*t61
+    t63 = t59 + s1*t61
     t64 = 0.18*c1 + t62
     t65 = 0.18*s1 + t63
     t66 = c1*t62 + s1*t63
@@ -2177,16 +2177,16 @@ def ik_numeric_step(target, q, damping=0.0):
     t68 = t66**2 + t60**2 + t44**2 + t45**2
     t69 = -t64 + T03
     t70 = c1**2
-    t71 = t70*t50 + t70*t49 + t17*t52 + t4*t53
+    t71 = t4*t53 + t50*t70 + t17*t52 + t49*t70
     t72 = t50**2
     t73 = t49**2
     t74 = t65**2 + t52**2 + t53**2 + t70*t72 + t70*t73
     t75 = c1*s1
-    t76 = -t64*t65 + t72*t75 + t73*t75 - t52*t54 + t53*t55
+    t76 = -t64*t65 - t52*t54 + t53*t55 + t72*t75 + t73*t75
     t77 = c1*t66
     t78 = c1*t60
-    t79 = -t50*t77 - t49*t78 + t52*t44 + t53*t45
-    t80 = -t77 - t78 + t17*t44 + t4*t45
+    t79 = t52*t44 + t53*t45 - t50*t77 - t49*t78
+    t80 = -t77 - t78 + t4*t45 + t17*t44
     t81 = t49*t75 + t50*t75
     t82 = t81 + t7*t53 - t9*t52
     t83 = t81 + t4*t55 - t17*t54
@@ -2194,17 +2194,17 @@ def ik_numeric_step(target, q, damping=0.0):
     t85 = t84 + c23*t52 + t29*t53
     t86 = t84 + T13
     t87 = s1**2
-    t88 = t64**2 + t54**2 + t55**2 + t87*t72 + t87*t73
-    t89 = t87*t50 + t87*t49 + t9*t54 + t7*t55
+    t88 = t64**2 + t54**2 + t55**2 + t72*t87 + t73*t87
+    t89 = t7*t55 + t50*t87 + t9*t54 + t49*t87
     t90 = s1*t66
     t91 = s1*t60
-    t92 = t50*t90 + t49*t91 + t54*t44 - t55*t45
-    t93 = t90 + t91 + t9*t44 - t7*t45
+    t92 = t49*t91 + t54*t44 - t55*t45 + t50*t90
+    t93 = t90 + t91 - t7*t45 + t9*t44
     t94 = s23**2
     t95 = t7**2 + t11**2 + 2*t87 + t70*t94
-    t96 = -2*t75 + t75*t94 - t7*t4 + t11*t19
+    t96 = -2*t75 - t7*t4 + t11*t19 + t75*t94
     t97 = t4**2 + t19**2 + 2*t70 + t87*t94
-    t98 = 1 + c23**2 + t28**2 + t94*s4**2
+    t98 = 1 + c23**2 + t28**2 + s4**2*t94
     t99 = -t23
     t100 = 0.5*(-1 + t99 + t14 + t36)
     t101 = xp.atan2(t39, t100)
@@ -2223,7 +2223,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t114 = xp.where(t110, t25*t102, t111*t107)
     t115 = t112**2 + t113**2 + t114**2 + t69**2 + t86**2 + t56**2
     t116 = damping + t74
-    t117 = xp.sqrt(t76**2 + t79**2 + t82**2 + t71**2 + t85**2 + t116**2)
+    t117 = xp.sqrt(t116**2 + t76**2 + t79**2 + t82**2 + t71**2 + t85**2)
     t118 = t117*xp.where(xp.greater_equal(t116, 0), xp.asarray(1, dtype=dtype), -1)
     t119 = t116 + t118
     t120 = xp.where(xp.greater(t117, 0), 1/(t117*(t117 + xp.abs(t116))), 0)
@@ -2235,7 +2235,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t126 = t113 - t71*t121
     t127 = t114 - t85*t121
     t128 = damping + t88
-    t129 = t120*(-t79*t92 + t82*t89 + t71*t83 + t85*t67 + t76*t119 + t76*t128)
+    t129 = t120*(-t79*t92 + t82*t89 + t71*t83 + t85*t67 + t76*t119 + t128*t76)
     t130 = t76 - t119*t129
     t131 = t128 - t76*t129
     t132 = t92 + t79*t129
@@ -2253,7 +2253,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t144 = t126 - t134*t140
     t145 = t127 - t135*t140
     t146 = damping + t68
-    t147 = t120*(-t76*t92 - t82*t93 + t71*t80 + t85*t46 + t79*t119 + t79*t146)
+    t147 = t120*(-t76*t92 - t82*t93 + t71*t80 + t85*t46 + t79*t119 + t146*t79)
     t148 = t79 - t119*t147
     t149 = t92 + t76*t147
     t150 = t146 - t79*t147
@@ -2276,7 +2276,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t167 = t144 - t158*t164
     t168 = t145 - t159*t164
     t169 = damping + t95
-    t170 = -t120*(t76*t89 - t79*t93 - t71*t96 + t85*t32 + t82*t119 + t82*t169)
+    t170 = -t120*(t76*t89 + t85*t32 - t79*t93 - t71*t96 + t82*t119 + t169*t82)
     t171 = t82 + t119*t170
     t172 = t89 + t76*t170
     t173 = t93 - t79*t170
@@ -2303,7 +2303,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t194 = t167 - t186*t192
     t195 = t168 + t187*t192
     t196 = damping + t97
-    t197 = t120*(t76*t83 + t79*t80 - t82*t96 + t85*t33 + t71*t119 + t71*t196)
+    t197 = t120*(t76*t83 + t79*t80 - t82*t96 + t85*t33 + t71*t119 + t196*t71)
     t198 = t71 - t119*t197
     t199 = t83 - t76*t197
     t200 = t80 - t79*t197
@@ -2333,7 +2333,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t224 = t194 - t221*t223
     t225 = t195 - t218*t223
     t226 = damping + t98
-    t227 = t120*(t76*t67 + t79*t46 + t82*t32 + t71*t33 + t85*t119 + t85*t226)
+    t227 = t120*(t76*t67 + t79*t46 + t82*t32 + t71*t33 + t85*t119 + t226*t85)
     t228 = t85 - t119*t227
     t229 = t67 - t76*t227
     t230 = t46 - t79*t227
@@ -2371,7 +2371,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t262 = xp.where(xp.not_equal(t137, 0), -(-(-t155*t261 - t178*t260 + t205*t259 + t235*t258) + t141)/t137, 0)
     t263 = xp.where(xp.not_equal(t118, 0), -(-(t130*t262 + t148*t261 - t171*t260 + t198*t259 + t228*t258) + t122)/t118, 0)
     t264 = q1 + t258 - t65*t263 + t64*t262
-    t265 = q4 + t52*t263 - t54*t262 + t44*t261 + t9*t260 + t17*t259 + c23*t258
+    t265 = q4 + t52*t263 - t54*t262 + t44*t261 + c23*t258 + t9*t260 + t17*t259
     t266 = q5 + t53*t263 + t55*t262 + t45*t261 - t7*t260 + t4*t259 + t29*t258
     t267 = q6 + t11*t260 + t19*t259 - t28*t258
     t268 = c1*t263
@@ -2461,15 +2461,15 @@ def ik_branches(T):
     t43 = t30*T00 + t32*T10
     t44 = -t30*T10 + t32*T00
     t45 = 1 - t31
-    t46 = t16*t45
+    t46 = t45*t16
     t47 = t46 + t16*t31
     t48 = -0.4 + t47
     t49 = t35**2 + t36**2 + t48**2
     t50 = 0.5*(0.7588 - t49)
     t51 = 1 - 6.965340465841971*t50**2
-    t52 = T22*t45
+    t52 = t45*T22
     t53 = t52 + T22*t31
-    t54 = T20*t45
+    t54 = t45*T20
     t55 = t54 + T20*t31
     t56 = xp.greater(t51, 1e-12)
     t57 = xp.where(t56, xp.sqrt(t51), 0)
@@ -2489,7 +2489,7 @@ def ik_branches(T):
     t71 = 0.1900219065658609*t57
     t72 = 0.9817798505902814*t59
     t73 = -t71 + t72
-    t74 = t72 + t71
+    t74 = t71 + t72
     t75 = 0.12*t69 + 0.62*t73
     t76 = -0.12*t73 + 0.62*t69
     t77 = 0.78 - t75
@@ -2524,9 +2524,9 @@ def ik_branches(T):
     t106 = xp.where(t96, 0, xp.atan2(t82, t81))
     t107 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t106)) + t106
     t108 = 1 + t100
-    t109 = t38*t108
+    t109 = t108*t38
     t110 = t109 - t100*t38
-    t111 = t40*t108
+    t111 = t108*t40
     t112 = t111 - t100*t40
     t113 = t103**2
     t114 = -t113
@@ -2536,7 +2536,7 @@ def ik_branches(T):
     t118 = t113 - t102*t117
     t119 = t114 + t118
     t120 = t110**2
-    t121 = t102**2 + t120 + t113
+    t121 = t113 + t120 + t102**2
     t122 = t117**2
     t123 = t119**2 + t120*t122
     t124 = t113 + t122
@@ -2574,9 +2574,9 @@ def ik_branches(T):
     t156 = xp.where(t146, 0, xp.atan2(t92, t91))
     t157 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t156)) + t156
     t158 = 1 - t150
-    t159 = t38*t158
+    t159 = t158*t38
     t160 = t159 + t38*t150
-    t161 = t40*t158
+    t161 = t158*t40
     t162 = t161 + t40*t150
     t163 = t153**2
     t164 = -t163
@@ -2586,7 +2586,7 @@ def ik_branches(T):
     t168 = t163 - t152*t167
     t169 = t164 + t168
     t170 = t160**2
-    t171 = t152**2 + t170 + t163
+    t171 = t163 + t170 + t152**2
     t172 = t167**2
     t173 = t169**2 + t170*t172
     t174 = t163 + t172
@@ -2612,15 +2612,15 @@ def ik_branches(T):
     t194 = t193
     t195 = t193 + t192**2
     t196 = 1 + t30
-    t197 = t16*t196
+    t197 = t196*t16
     t198 = t197 - t30*t16
     t199 = -0.4 + t198
     t200 = t27**2 + t199**2
     t201 = 0.5*(0.7588 - t200)
     t202 = 1 - 6.965340465841971*t201**2
-    t203 = T22*t196
+    t203 = t196*T22
     t204 = -t203 + t30*T22
-    t205 = T20*t196
+    t205 = t196*T20
     t206 = t205 - t30*T20
     t207 = xp.greater(t202, 1e-12)
     t208 = xp.where(t207, xp.sqrt(t202), 0)
@@ -2640,7 +2640,7 @@ def ik_branches(T):
     t222 = 0.1900219065658609*t208
     t223 = 0.9817798505902814*t210
     t224 = -t222 + t223
-    t225 = t223 + t222
+    t225 = t222 + t223
     t226 = 0.12*t220 + 0.62*t224
     t227 = -0.12*t224 + 0.62*t220
     t228 = 0.78 - t226
@@ -2675,9 +2675,9 @@ def ik_branches(T):
     t257 = xp.where(t247, 0, xp.atan2(-t233, t232))
     t258 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t257)) + t257
     t259 = 1 + t251
-    t260 = t42*t259
+    t260 = t259*t42
     t261 = t260 - t251*t42
-    t262 = t44*t259
+    t262 = t259*t44
     t263 = t262 - t251*t44
     t264 = t254**2
     t265 = -t264
@@ -2687,7 +2687,7 @@ def ik_branches(T):
     t269 = t264 + t253*t268
     t270 = t265 + t269
     t271 = t261**2
-    t272 = t253**2 + t271 + t264
+    t272 = t264 + t271 + t253**2
     t273 = t268**2
     t274 = t270**2 + t271*t273
     t275 = t264 + t273
@@ -2725,9 +2725,9 @@ def ik_branches(T):
     t307 = xp.where(t297, 0, xp.atan2(-t243, t242))
     t308 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t307)) + t307
     t309 = 1 - t301
-    t310 = t42*t309
+    t310 = t309*t42
     t311 = t310 + t42*t301
-    t312 = t44*t309
+    t312 = t309*t44
     t313 = t312 + t44*t301
     t314 = t304**2
     t315 = -t314
@@ -2737,7 +2737,7 @@ def ik_branches(T):
     t319 = t314 - t303*t318
     t320 = t315 + t319
     t321 = t311**2
-    t322 = t303**2 + t321 + t314
+    t322 = t314 + t321 + t303**2
     t323 = t318**2
     t324 = t320**2 + t321*t323
     t325 = t314 + t323
@@ -2765,67 +2765,67 @@ def ik_branches(T):
     t347 = xp.where(t126, 0, xp.atan2(-t131, t119))
     t348 = t347
     t349 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t348)) + t348
-    t350 = 3.141592653589793 + t347 - 6.283185307179586*xp.ceil(0.15915494309189535*t347)
+    t350 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t347) + t347
     t351 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t350)) + t350
     t352 = xp.where(t135, 0, xp.atan2(-t117, t103))
     t353 = t352
     t354 = -6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t353)) + t353
-    t355 = t352 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t352))
+    t355 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t352)) + t352
     t356 = xp.where(xp.less_equal(t144, 1e-24*t145), 0, xp.atan2(t141, t140))
     t357 = t356
     t358 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t357)) + t357
-    t359 = 3.141592653589793 + t356 - 6.283185307179586*xp.ceil(0.15915494309189535*t356)
+    t359 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t356) + t356
     t360 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t359)) + t359
     t361 = -t355
-    t362 = t355 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t361))
+    t362 = 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t361)) + t355
     t363 = xp.where(t176, 0, xp.atan2(-t181, t169))
     t364 = t363
     t365 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t364)) + t364
-    t366 = 3.141592653589793 + t363 - 6.283185307179586*xp.ceil(0.15915494309189535*t363)
+    t366 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t363) + t363
     t367 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t366)) + t366
     t368 = xp.where(t185, 0, xp.atan2(-t167, -t153))
     t369 = t368
     t370 = -6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t369)) + t369
-    t371 = t368 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t368))
+    t371 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t368)) + t368
     t372 = xp.where(xp.less_equal(t194, 1e-24*t195), 0, xp.atan2(t191, t190))
     t373 = t372
     t374 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t373)) + t373
-    t375 = 3.141592653589793 + t372 - 6.283185307179586*xp.ceil(0.15915494309189535*t372)
+    t375 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t372) + t372
     t376 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t375)) + t375
     t377 = -t371
-    t378 = t371 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t377))
+    t378 = 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t377)) + t371
     t379 = xp.where(t277, 0, xp.atan2(-t282, t270))
     t380 = t379
     t381 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t380)) + t380
-    t382 = 3.141592653589793 + t379 - 6.283185307179586*xp.ceil(0.15915494309189535*t379)
+    t382 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t379) + t379
     t383 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t382)) + t382
     t384 = xp.where(t286, 0, xp.atan2(-t268, t254))
     t385 = t384
     t386 = -6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t385)) + t385
-    t387 = t384 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t384))
+    t387 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t384)) + t384
     t388 = xp.where(xp.less_equal(t295, 1e-24*t296), 0, xp.atan2(t292, t291))
     t389 = t388
     t390 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t389)) + t389
-    t391 = 3.141592653589793 + t388 - 6.283185307179586*xp.ceil(0.15915494309189535*t388)
+    t391 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t388) + t388
     t392 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t391)) + t391
     t393 = -t387
-    t394 = t387 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t393))
+    t394 = 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t393)) + t387
     t395 = xp.where(t327, 0, xp.atan2(-t332, t320))
     t396 = t395
     t397 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t396)) + t396
-    t398 = 3.141592653589793 + t395 - 6.283185307179586*xp.ceil(0.15915494309189535*t395)
+    t398 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t395) + t395
     t399 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t398)) + t398
     t400 = xp.where(t336, 0, xp.atan2(-t318, t304))
     t401 = t400
     t402 = -6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t401)) + t401
-    t403 = t400 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t400))
+    t403 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t400)) + t400
     t404 = xp.where(xp.less_equal(t345, 1e-24*t346), 0, xp.atan2(t342, t341))
     t405 = t404
     t406 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t405)) + t405
-    t407 = 3.141592653589793 + t404 - 6.283185307179586*xp.ceil(0.15915494309189535*t404)
+    t407 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t404) + t404
     t408 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t407)) + t407
     t409 = -t403
-    t410 = t403 + 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t409))
+    t410 = 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t409)) + t403
     t411 = xp.greater_equal(t28, -2.705260340591211) & xp.less_equal(t28, 2.705260340591211)
     t412 = xp.less_equal(t29, 2.705260340591211)
     t413 = xp.where(xp.logical_not(t411) & t412, t29, t28)
@@ -3148,27 +3148,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t56 = xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0)
     t57 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
     t58 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t59 = t0 + t58
+    t59 = t58 + t0
     t60 = -t58 + t0
     t61 = xp.where(xp.greater_equal(t0, -2.705260340591211) & xp.less_equal(t0, 2.705260340591211), t0, xp.where(xp.greater_equal(t59, -2.705260340591211) & xp.less_equal(t59, 2.705260340591211), t59, xp.where(xp.greater_equal(t60, -2.705260340591211) & xp.less_equal(t60, 2.705260340591211), t60, qb0_0)))
     t62 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t63 = t1 + t62
+    t63 = t62 + t1
     t64 = -t62 + t1
     t65 = xp.where(xp.greater_equal(t1, -3.141592653589793) & xp.less_equal(t1, 1.1344640137963142), t1, xp.where(xp.greater_equal(t63, -3.141592653589793) & xp.less_equal(t63, 1.1344640137963142), t63, xp.where(xp.greater_equal(t64, -3.141592653589793) & xp.less_equal(t64, 1.1344640137963142), t64, qb0_1)))
     t66 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t67 = t2 + t66
+    t67 = t66 + t2
     t68 = -t66 + t2
     t69 = xp.where(xp.greater_equal(t2, -0.2617993877991494) & xp.less_equal(t2, 2.7576202181510405), t2, xp.where(xp.greater_equal(t67, -0.2617993877991494) & xp.less_equal(t67, 2.7576202181510405), t67, xp.where(xp.greater_equal(t68, -0.2617993877991494) & xp.less_equal(t68, 2.7576202181510405), t68, qb0_2)))
     t70 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t71 = t3 + t70
+    t71 = t70 + t3
     t72 = -t70 + t3
     t73 = xp.where(xp.greater_equal(t3, -6.1086523819801535) & xp.less_equal(t3, 6.1086523819801535), t3, xp.where(xp.greater_equal(t71, -6.1086523819801535) & xp.less_equal(t71, 6.1086523819801535), t71, xp.where(xp.greater_equal(t72, -6.1086523819801535) & xp.less_equal(t72, 6.1086523819801535), t72, qb0_3)))
     t74 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t75 = t4 + t74
+    t75 = t74 + t4
     t76 = -t74 + t4
     t77 = xp.where(xp.greater_equal(t4, -2.2689280275926285) & xp.less_equal(t4, 2.2689280275926285), t4, xp.where(xp.greater_equal(t75, -2.2689280275926285) & xp.less_equal(t75, 2.2689280275926285), t75, xp.where(xp.greater_equal(t76, -2.2689280275926285) & xp.less_equal(t76, 2.2689280275926285), t76, qb0_4)))
     t78 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t79 = t5 + t78
+    t79 = t78 + t5
     t80 = -t78 + t5
     t81 = xp.where(xp.greater_equal(t5, -6.1086523819801535) & xp.less_equal(t5, 6.1086523819801535), t5, xp.where(xp.greater_equal(t79, -6.1086523819801535) & xp.less_equal(t79, 6.1086523819801535), t79, xp.where(xp.greater_equal(t80, -6.1086523819801535) & xp.less_equal(t80, 6.1086523819801535), t80, qb0_5)))
     t82 = -qn1
@@ -3187,27 +3187,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t95 = xp.where(t89, t81, qn6)
     t96 = xp.where(t89, t88, 0)
     t97 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t98 = t8 + t97
+    t98 = t97 + t8
     t99 = -t97 + t8
     t100 = xp.where(xp.greater_equal(t8, -2.705260340591211) & xp.less_equal(t8, 2.705260340591211), t8, xp.where(xp.greater_equal(t98, -2.705260340591211) & xp.less_equal(t98, 2.705260340591211), t98, xp.where(xp.greater_equal(t99, -2.705260340591211) & xp.less_equal(t99, 2.705260340591211), t99, qb1_0)))
     t101 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t102 = t9 + t101
+    t102 = t101 + t9
     t103 = -t101 + t9
     t104 = xp.where(xp.greater_equal(t9, -3.141592653589793) & xp.less_equal(t9, 1.1344640137963142), t9, xp.where(xp.greater_equal(t102, -3.141592653589793) & xp.less_equal(t102, 1.1344640137963142), t102, xp.where(xp.greater_equal(t103, -3.141592653589793) & xp.less_equal(t103, 1.1344640137963142), t103, qb1_1)))
     t105 = xp.where(xp.less(t10, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t106 = t10 + t105
+    t106 = t105 + t10
     t107 = -t105 + t10
     t108 = xp.where(xp.greater_equal(t10, -0.2617993877991494) & xp.less_equal(t10, 2.7576202181510405), t10, xp.where(xp.greater_equal(t106, -0.2617993877991494) & xp.less_equal(t106, 2.7576202181510405), t106, xp.where(xp.greater_equal(t107, -0.2617993877991494) & xp.less_equal(t107, 2.7576202181510405), t107, qb1_2)))
     t109 = xp.where(xp.less(t11, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t110 = t11 + t109
+    t110 = t109 + t11
     t111 = -t109 + t11
     t112 = xp.where(xp.greater_equal(t11, -6.1086523819801535) & xp.less_equal(t11, 6.1086523819801535), t11, xp.where(xp.greater_equal(t110, -6.1086523819801535) & xp.less_equal(t110, 6.1086523819801535), t110, xp.where(xp.greater_equal(t111, -6.1086523819801535) & xp.less_equal(t111, 6.1086523819801535), t111, qb1_3)))
     t113 = xp.where(xp.less(t12, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t114 = t12 + t113
+    t114 = t113 + t12
     t115 = -t113 + t12
     t116 = xp.where(xp.greater_equal(t12, -2.2689280275926285) & xp.less_equal(t12, 2.2689280275926285), t12, xp.where(xp.greater_equal(t114, -2.2689280275926285) & xp.less_equal(t114, 2.2689280275926285), t114, xp.where(xp.greater_equal(t115, -2.2689280275926285) & xp.less_equal(t115, 2.2689280275926285), t115, qb1_4)))
     t117 = xp.where(xp.less(t13, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t118 = t13 + t117
+    t118 = t117 + t13
     t119 = -t117 + t13
     t120 = xp.where(xp.greater_equal(t13, -6.1086523819801535) & xp.less_equal(t13, 6.1086523819801535), t13, xp.where(xp.greater_equal(t118, -6.1086523819801535) & xp.less_equal(t118, 6.1086523819801535), t118, xp.where(xp.greater_equal(t119, -6.1086523819801535) & xp.less_equal(t119, 6.1086523819801535), t119, qb1_5)))
     t121 = qw1*(t82 + t100)**2 + qw2*(t83 + t104)**2 + qw3*(t84 + t108)**2 + qw4*(t85 + t112)**2 + qw5*(t86 + t116)**2 + qw6*(t87 + t120)**2
@@ -3223,27 +3223,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t131 = xp.where(t125, t120, t95)
     t132 = xp.where(t125, t121, t96)
     t133 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t134 = t15 + t133
+    t134 = t133 + t15
     t135 = -t133 + t15
     t136 = xp.where(xp.greater_equal(t15, -2.705260340591211) & xp.less_equal(t15, 2.705260340591211), t15, xp.where(xp.greater_equal(t134, -2.705260340591211) & xp.less_equal(t134, 2.705260340591211), t134, xp.where(xp.greater_equal(t135, -2.705260340591211) & xp.less_equal(t135, 2.705260340591211), t135, qb2_0)))
     t137 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t138 = t16 + t137
+    t138 = t137 + t16
     t139 = -t137 + t16
     t140 = xp.where(xp.greater_equal(t16, -3.141592653589793) & xp.less_equal(t16, 1.1344640137963142), t16, xp.where(xp.greater_equal(t138, -3.141592653589793) & xp.less_equal(t138, 1.1344640137963142), t138, xp.where(xp.greater_equal(t139, -3.141592653589793) & xp.less_equal(t139, 1.1344640137963142), t139, qb2_1)))
     t141 = xp.where(xp.less(t17, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t142 = t17 + t141
+    t142 = t141 + t17
     t143 = -t141 + t17
     t144 = xp.where(xp.greater_equal(t17, -0.2617993877991494) & xp.less_equal(t17, 2.7576202181510405), t17, xp.where(xp.greater_equal(t142, -0.2617993877991494) & xp.less_equal(t142, 2.7576202181510405), t142, xp.where(xp.greater_equal(t143, -0.2617993877991494) & xp.less_equal(t143, 2.7576202181510405), t143, qb2_2)))
     t145 = xp.where(xp.less(t18, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t146 = t18 + t145
+    t146 = t145 + t18
     t147 = -t145 + t18
     t148 = xp.where(xp.greater_equal(t18, -6.1086523819801535) & xp.less_equal(t18, 6.1086523819801535), t18, xp.where(xp.greater_equal(t146, -6.1086523819801535) & xp.less_equal(t146, 6.1086523819801535), t146, xp.where(xp.greater_equal(t147, -6.1086523819801535) & xp.less_equal(t147, 6.1086523819801535), t147, qb2_3)))
     t149 = xp.where(xp.less(t19, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t150 = t19 + t149
+    t150 = t149 + t19
     t151 = -t149 + t19
     t152 = xp.where(xp.greater_equal(t19, -2.2689280275926285) & xp.less_equal(t19, 2.2689280275926285), t19, xp.where(xp.greater_equal(t150, -2.2689280275926285) & xp.less_equal(t150, 2.2689280275926285), t150, xp.where(xp.greater_equal(t151, -2.2689280275926285) & xp.less_equal(t151, 2.2689280275926285), t151, qb2_4)))
     t153 = xp.where(xp.less(t20, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t154 = t20 + t153
+    t154 = t153 + t20
     t155 = -t153 + t20
     t156 = xp.where(xp.greater_equal(t20, -6.1086523819801535) & xp.less_equal(t20, 6.1086523819801535), t20, xp.where(xp.greater_equal(t154, -6.1086523819801535) & xp.less_equal(t154, 6.1086523819801535), t154, xp.where(xp.greater_equal(t155, -6.1086523819801535) & xp.less_equal(t155, 6.1086523819801535), t155, qb2_5)))
     t157 = qw1*(t82 + t136)**2 + qw2*(t83 + t140)**2 + qw3*(t84 + t144)**2 + qw4*(t85 + t148)**2 + qw5*(t86 + t152)**2 + qw6*(t87 + t156)**2
@@ -3259,27 +3259,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t167 = xp.where(t161, t156, t131)
     t168 = xp.where(t161, t157, t132)
     t169 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t170 = t22 + t169
+    t170 = t169 + t22
     t171 = -t169 + t22
     t172 = xp.where(xp.greater_equal(t22, -2.705260340591211) & xp.less_equal(t22, 2.705260340591211), t22, xp.where(xp.greater_equal(t170, -2.705260340591211) & xp.less_equal(t170, 2.705260340591211), t170, xp.where(xp.greater_equal(t171, -2.705260340591211) & xp.less_equal(t171, 2.705260340591211), t171, qb3_0)))
     t173 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t174 = t23 + t173
+    t174 = t173 + t23
     t175 = -t173 + t23
     t176 = xp.where(xp.greater_equal(t23, -3.141592653589793) & xp.less_equal(t23, 1.1344640137963142), t23, xp.where(xp.greater_equal(t174, -3.141592653589793) & xp.less_equal(t174, 1.1344640137963142), t174, xp.where(xp.greater_equal(t175, -3.141592653589793) & xp.less_equal(t175, 1.1344640137963142), t175, qb3_1)))
     t177 = xp.where(xp.less(t24, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t178 = t24 + t177
+    t178 = t177 + t24
     t179 = -t177 + t24
     t180 = xp.where(xp.greater_equal(t24, -0.2617993877991494) & xp.less_equal(t24, 2.7576202181510405), t24, xp.where(xp.greater_equal(t178, -0.2617993877991494) & xp.less_equal(t178, 2.7576202181510405), t178, xp.where(xp.greater_equal(t179, -0.2617993877991494) & xp.less_equal(t179, 2.7576202181510405), t179, qb3_2)))
     t181 = xp.where(xp.less(t25, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t182 = t25 + t181
+    t182 = t181 + t25
     t183 = -t181 + t25
     t184 = xp.where(xp.greater_equal(t25, -6.1086523819801535) & xp.less_equal(t25, 6.1086523819801535), t25, xp.where(xp.greater_equal(t182, -6.1086523819801535) & xp.less_equal(t182, 6.1086523819801535), t182, xp.where(xp.greater_equal(t183, -6.1086523819801535) & xp.less_equal(t183, 6.1086523819801535), t183, qb3_3)))
     t185 = xp.where(xp.less(t26, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t186 = t26 + t185
+    t186 = t185 + t26
     t187 = -t185 + t26
     t188 = xp.where(xp.greater_equal(t26, -2.2689280275926285) & xp.less_equal(t26, 2.2689280275926285), t26, xp.where(xp.greater_equal(t186, -2.2689280275926285) & xp.less_equal(t186, 2.2689280275926285), t186, xp.where(xp.greater_equal(t187, -2.2689280275926285) & xp.less_equal(t187, 2.2689280275926285), t187, qb3_4)))
     t189 = xp.where(xp.less(t27, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t190 = t27 + t189
+    t190 = t189 + t27
     t191 = -t189 + t27
     t192 = xp.where(xp.greater_equal(t27, -6.1086523819801535) & xp.less_equal(t27, 6.1086523819801535), t27, xp.where(xp.greater_equal(t190, -6.1086523819801535) & xp.less_equal(t190, 6.1086523819801535), t190, xp.where(xp.greater_equal(t191, -6.1086523819801535) & xp.less_equal(t191, 6.1086523819801535), t191, qb3_5)))
     t193 = qw1*(t82 + t172)**2 + qw2*(t83 + t176)**2 + qw3*(t84 + t180)**2 + qw4*(t85 + t184)**2 + qw5*(t86 + t188)**2 + qw6*(t87 + t192)**2
@@ -3295,27 +3295,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t203 = xp.where(t197, t192, t167)
     t204 = xp.where(t197, t193, t168)
     t205 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t206 = t29 + t205
+    t206 = t205 + t29
     t207 = -t205 + t29
     t208 = xp.where(xp.greater_equal(t29, -2.705260340591211) & xp.less_equal(t29, 2.705260340591211), t29, xp.where(xp.greater_equal(t206, -2.705260340591211) & xp.less_equal(t206, 2.705260340591211), t206, xp.where(xp.greater_equal(t207, -2.705260340591211) & xp.less_equal(t207, 2.705260340591211), t207, qb4_0)))
     t209 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t210 = t30 + t209
+    t210 = t209 + t30
     t211 = -t209 + t30
     t212 = xp.where(xp.greater_equal(t30, -3.141592653589793) & xp.less_equal(t30, 1.1344640137963142), t30, xp.where(xp.greater_equal(t210, -3.141592653589793) & xp.less_equal(t210, 1.1344640137963142), t210, xp.where(xp.greater_equal(t211, -3.141592653589793) & xp.less_equal(t211, 1.1344640137963142), t211, qb4_1)))
     t213 = xp.where(xp.less(t31, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t214 = t31 + t213
+    t214 = t213 + t31
     t215 = -t213 + t31
     t216 = xp.where(xp.greater_equal(t31, -0.2617993877991494) & xp.less_equal(t31, 2.7576202181510405), t31, xp.where(xp.greater_equal(t214, -0.2617993877991494) & xp.less_equal(t214, 2.7576202181510405), t214, xp.where(xp.greater_equal(t215, -0.2617993877991494) & xp.less_equal(t215, 2.7576202181510405), t215, qb4_2)))
     t217 = xp.where(xp.less(t32, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t218 = t32 + t217
+    t218 = t217 + t32
     t219 = -t217 + t32
     t220 = xp.where(xp.greater_equal(t32, -6.1086523819801535) & xp.less_equal(t32, 6.1086523819801535), t32, xp.where(xp.greater_equal(t218, -6.1086523819801535) & xp.less_equal(t218, 6.1086523819801535), t218, xp.where(xp.greater_equal(t219, -6.1086523819801535) & xp.less_equal(t219, 6.1086523819801535), t219, qb4_3)))
     t221 = xp.where(xp.less(t33, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t222 = t33 + t221
+    t222 = t221 + t33
     t223 = -t221 + t33
     t224 = xp.where(xp.greater_equal(t33, -2.2689280275926285) & xp.less_equal(t33, 2.2689280275926285), t33, xp.where(xp.greater_equal(t222, -2.2689280275926285) & xp.less_equal(t222, 2.2689280275926285), t222, xp.where(xp.greater_equal(t223, -2.2689280275926285) & xp.less_equal(t223, 2.2689280275926285), t223, qb4_4)))
     t225 = xp.where(xp.less(t34, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t226 = t34 + t225
+    t226 = t225 + t34
     t227 = -t225 + t34
     t228 = xp.where(xp.greater_equal(t34, -6.1086523819801535) & xp.less_equal(t34, 6.1086523819801535), t34, xp.where(xp.greater_equal(t226, -6.1086523819801535) & xp.less_equal(t226, 6.1086523819801535), t226, xp.where(xp.greater_equal(t227, -6.1086523819801535) & xp.less_equal(t227, 6.1086523819801535), t227, qb4_5)))
     t229 = qw1*(t82 + t208)**2 + qw2*(t83 + t212)**2 + qw3*(t84 + t216)**2 + qw4*(t85 + t220)**2 + qw5*(t86 + t224)**2 + qw6*(t87 + t228)**2
@@ -3331,27 +3331,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t239 = xp.where(t233, t228, t203)
     t240 = xp.where(t233, t229, t204)
     t241 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t242 = t36 + t241
+    t242 = t241 + t36
     t243 = -t241 + t36
     t244 = xp.where(xp.greater_equal(t36, -2.705260340591211) & xp.less_equal(t36, 2.705260340591211), t36, xp.where(xp.greater_equal(t242, -2.705260340591211) & xp.less_equal(t242, 2.705260340591211), t242, xp.where(xp.greater_equal(t243, -2.705260340591211) & xp.less_equal(t243, 2.705260340591211), t243, qb5_0)))
     t245 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t246 = t37 + t245
+    t246 = t245 + t37
     t247 = -t245 + t37
     t248 = xp.where(xp.greater_equal(t37, -3.141592653589793) & xp.less_equal(t37, 1.1344640137963142), t37, xp.where(xp.greater_equal(t246, -3.141592653589793) & xp.less_equal(t246, 1.1344640137963142), t246, xp.where(xp.greater_equal(t247, -3.141592653589793) & xp.less_equal(t247, 1.1344640137963142), t247, qb5_1)))
     t249 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t250 = t38 + t249
+    t250 = t249 + t38
     t251 = -t249 + t38
     t252 = xp.where(xp.greater_equal(t38, -0.2617993877991494) & xp.less_equal(t38, 2.7576202181510405), t38, xp.where(xp.greater_equal(t250, -0.2617993877991494) & xp.less_equal(t250, 2.7576202181510405), t250, xp.where(xp.greater_equal(t251, -0.2617993877991494) & xp.less_equal(t251, 2.7576202181510405), t251, qb5_2)))
     t253 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t254 = t39 + t253
+    t254 = t253 + t39
     t255 = -t253 + t39
     t256 = xp.where(xp.greater_equal(t39, -6.1086523819801535) & xp.less_equal(t39, 6.1086523819801535), t39, xp.where(xp.greater_equal(t254, -6.1086523819801535) & xp.less_equal(t254, 6.1086523819801535), t254, xp.where(xp.greater_equal(t255, -6.1086523819801535) & xp.less_equal(t255, 6.1086523819801535), t255, qb5_3)))
     t257 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t258 = t40 + t257
+    t258 = t257 + t40
     t259 = -t257 + t40
     t260 = xp.where(xp.greater_equal(t40, -2.2689280275926285) & xp.less_equal(t40, 2.2689280275926285), t40, xp.where(xp.greater_equal(t258, -2.2689280275926285) & xp.less_equal(t258, 2.2689280275926285), t258, xp.where(xp.greater_equal(t259, -2.2689280275926285) & xp.less_equal(t259, 2.2689280275926285), t259, qb5_4)))
     t261 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t262 = t41 + t261
+    t262 = t261 + t41
     t263 = -t261 + t41
     t264 = xp.where(xp.greater_equal(t41, -6.1086523819801535) & xp.less_equal(t41, 6.1086523819801535), t41, xp.where(xp.greater_equal(t262, -6.1086523819801535) & xp.less_equal(t262, 6.1086523819801535), t262, xp.where(xp.greater_equal(t263, -6.1086523819801535) & xp.less_equal(t263, 6.1086523819801535), t263, qb5_5)))
     t265 = qw1*(t82 + t244)**2 + qw2*(t83 + t248)**2 + qw3*(t84 + t252)**2 + qw4*(t85 + t256)**2 + qw5*(t86 + t260)**2 + qw6*(t87 + t264)**2
@@ -3367,27 +3367,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t275 = xp.where(t269, t264, t239)
     t276 = xp.where(t269, t265, t240)
     t277 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t278 = t43 + t277
+    t278 = t277 + t43
     t279 = -t277 + t43
     t280 = xp.where(xp.greater_equal(t43, -2.705260340591211) & xp.less_equal(t43, 2.705260340591211), t43, xp.where(xp.greater_equal(t278, -2.705260340591211) & xp.less_equal(t278, 2.705260340591211), t278, xp.where(xp.greater_equal(t279, -2.705260340591211) & xp.less_equal(t279, 2.705260340591211), t279, qb6_0)))
     t281 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t282 = t44 + t281
+    t282 = t281 + t44
     t283 = -t281 + t44
     t284 = xp.where(xp.greater_equal(t44, -3.141592653589793) & xp.less_equal(t44, 1.1344640137963142), t44, xp.where(xp.greater_equal(t282, -3.141592653589793) & xp.less_equal(t282, 1.1344640137963142), t282, xp.where(xp.greater_equal(t283, -3.141592653589793) & xp.less_equal(t283, 1.1344640137963142), t283, qb6_1)))
     t285 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t286 = t45 + t285
+    t286 = t285 + t45
     t287 = -t285 + t45
     t288 = xp.where(xp.greater_equal(t45, -0.2617993877991494) & xp.less_equal(t45, 2.7576202181510405), t45, xp.where(xp.greater_equal(t286, -0.2617993877991494) & xp.less_equal(t286, 2.7576202181510405), t286, xp.where(xp.greater_equal(t287, -0.2617993877991494) & xp.less_equal(t287, 2.7576202181510405), t287, qb6_2)))
     t289 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t290 = t46 + t289
+    t290 = t289 + t46
     t291 = -t289 + t46
     t292 = xp.where(xp.greater_equal(t46, -6.1086523819801535) & xp.less_equal(t46, 6.1086523819801535), t46, xp.where(xp.greater_equal(t290, -6.1086523819801535) & xp.less_equal(t290, 6.1086523819801535), t290, xp.where(xp.greater_equal(t291, -6.1086523819801535) & xp.less_equal(t291, 6.1086523819801535), t291, qb6_3)))
     t293 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t294 = t47 + t293
+    t294 = t293 + t47
     t295 = -t293 + t47
     t296 = xp.where(xp.greater_equal(t47, -2.2689280275926285) & xp.less_equal(t47, 2.2689280275926285), t47, xp.where(xp.greater_equal(t294, -2.2689280275926285) & xp.less_equal(t294, 2.2689280275926285), t294, xp.where(xp.greater_equal(t295, -2.2689280275926285) & xp.less_equal(t295, 2.2689280275926285), t295, qb6_4)))
     t297 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t298 = t48 + t297
+    t298 = t297 + t48
     t299 = -t297 + t48
     t300 = xp.where(xp.greater_equal(t48, -6.1086523819801535) & xp.less_equal(t48, 6.1086523819801535), t48, xp.where(xp.greater_equal(t298, -6.1086523819801535) & xp.less_equal(t298, 6.1086523819801535), t298, xp.where(xp.greater_equal(t299, -6.1086523819801535) & xp.less_equal(t299, 6.1086523819801535), t299, qb6_5)))
     t301 = qw1*(t82 + t280)**2 + qw2*(t83 + t284)**2 + qw3*(t84 + t288)**2 + qw4*(t85 + t292)**2 + qw5*(t86 + t296)**2 + qw6*(t87 + t300)**2
@@ -3403,27 +3403,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t311 = xp.where(t305, t300, t275)
     t312 = xp.where(t305, t301, t276)
     t313 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t314 = t50 + t313
+    t314 = t313 + t50
     t315 = -t313 + t50
     t316 = xp.where(xp.greater_equal(t50, -2.705260340591211) & xp.less_equal(t50, 2.705260340591211), t50, xp.where(xp.greater_equal(t314, -2.705260340591211) & xp.less_equal(t314, 2.705260340591211), t314, xp.where(xp.greater_equal(t315, -2.705260340591211) & xp.less_equal(t315, 2.705260340591211), t315, qb7_0)))
     t317 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t318 = t51 + t317
+    t318 = t317 + t51
     t319 = -t317 + t51
     t320 = xp.where(xp.greater_equal(t51, -3.141592653589793) & xp.less_equal(t51, 1.1344640137963142), t51, xp.where(xp.greater_equal(t318, -3.141592653589793) & xp.less_equal(t318, 1.1344640137963142), t318, xp.where(xp.greater_equal(t319, -3.141592653589793) & xp.less_equal(t319, 1.1344640137963142), t319, qb7_1)))
     t321 = xp.where(xp.less(t52, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t322 = t52 + t321
+    t322 = t321 + t52
     t323 = -t321 + t52
     t324 = xp.where(xp.greater_equal(t52, -0.2617993877991494) & xp.less_equal(t52, 2.7576202181510405), t52, xp.where(xp.greater_equal(t322, -0.2617993877991494) & xp.less_equal(t322, 2.7576202181510405), t322, xp.where(xp.greater_equal(t323, -0.2617993877991494) & xp.less_equal(t323, 2.7576202181510405), t323, qb7_2)))
     t325 = xp.where(xp.less(t53, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t326 = t53 + t325
+    t326 = t325 + t53
     t327 = -t325 + t53
     t328 = xp.where(xp.greater_equal(t53, -6.1086523819801535) & xp.less_equal(t53, 6.1086523819801535), t53, xp.where(xp.greater_equal(t326, -6.1086523819801535) & xp.less_equal(t326, 6.1086523819801535), t326, xp.where(xp.greater_equal(t327, -6.1086523819801535) & xp.less_equal(t327, 6.1086523819801535), t327, qb7_3)))
     t329 = xp.where(xp.less(t54, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t330 = t54 + t329
+    t330 = t329 + t54
     t331 = -t329 + t54
     t332 = xp.where(xp.greater_equal(t54, -2.2689280275926285) & xp.less_equal(t54, 2.2689280275926285), t54, xp.where(xp.greater_equal(t330, -2.2689280275926285) & xp.less_equal(t330, 2.2689280275926285), t330, xp.where(xp.greater_equal(t331, -2.2689280275926285) & xp.less_equal(t331, 2.2689280275926285), t331, qb7_4)))
     t333 = xp.where(xp.less(t55, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t334 = t55 + t333
+    t334 = t333 + t55
     t335 = -t333 + t55
     t336 = xp.where(xp.greater_equal(t55, -6.1086523819801535) & xp.less_equal(t55, 6.1086523819801535), t55, xp.where(xp.greater_equal(t334, -6.1086523819801535) & xp.less_equal(t334, 6.1086523819801535), t334, xp.where(xp.greater_equal(t335, -6.1086523819801535) & xp.less_equal(t335, 6.1086523819801535), t335, qb7_5)))
     t337 = qw1*(t82 + t316)**2 + qw2*(t83 + t320)**2 + qw3*(t84 + t324)**2 + qw4*(t85 + t328)**2 + qw5*(t86 + t332)**2 + qw6*(t87 + t336)**2

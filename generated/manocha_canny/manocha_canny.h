@@ -83,7 +83,7 @@ void manocha_canny_hessian(const manocha_canny_real q[MANOCHA_CANNY_DOF], manoch
 void manocha_canny_singularity_factors(const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real f[MANOCHA_CANNY_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability |det(Js)|.
- * Result: returned as a scalar. 94 operations. */
+ * Result: returned as a scalar. 95 operations. */
 manocha_canny_real manocha_canny_manipulability(const manocha_canny_real q[MANOCHA_CANNY_DOF]);
 
 /* Det(Js).
@@ -91,7 +91,7 @@ manocha_canny_real manocha_canny_manipulability(const manocha_canny_real q[MANOC
 manocha_canny_real manocha_canny_jacobian_det(const manocha_canny_real q[MANOCHA_CANNY_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1375 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1373 operations. */
 int manocha_canny_velocity_ik(const manocha_canny_real q[MANOCHA_CANNY_DOF], const manocha_canny_real mu_dot[MANOCHA_CANNY_TASK_DIM], manocha_canny_real damping, manocha_canny_real q_dot[MANOCHA_CANNY_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).

@@ -227,7 +227,7 @@ void planar_2r_fk_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const plan
     const planar_2r_real t2 = s12*qd2;
     const planar_2r_real t3 = t2 + t1*qd1;
     const planar_2r_real t4 = c12*qd2;
-    const planar_2r_real t5 = t4 + t0*qd1;
+    const planar_2r_real t5 = t0*qd1 + t4;
     const planar_2r_real t6 = -s12;
 
     /* Outputs */
@@ -289,7 +289,7 @@ void planar_2r_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const planar_
     const planar_2r_real t2 = s12*qd2;
     const planar_2r_real t3 = t2 + t1*qd1;
     const planar_2r_real t4 = c12*qd2;
-    const planar_2r_real t5 = t4 + t0*qd1;
+    const planar_2r_real t5 = t0*qd1 + t4;
 
     /* Outputs */
     Jd[0] = -t5;
@@ -328,7 +328,7 @@ void planar_2r_bias_acceleration(const planar_2r_real q[PLANAR_2R_DOF], const pl
     const planar_2r_real t2 = s12*qd2;
     const planar_2r_real t3 = t2 + t1*qd1;
     const planar_2r_real t4 = c12*qd2;
-    const planar_2r_real t5 = t4 + t0*qd1;
+    const planar_2r_real t5 = t0*qd1 + t4;
 
     /* Outputs */
     a[0] = -qd1*t5 - qd2*(c12*qd1 + t4);
@@ -362,7 +362,7 @@ void planar_2r_task_jacobian_dot(const planar_2r_real q[PLANAR_2R_DOF], const pl
     const planar_2r_real t3 = t2 + t1*qd1;
     const planar_2r_real t4 = t2 + s12*qd1;
     const planar_2r_real t5 = c12*qd2;
-    const planar_2r_real t6 = t5 + t0*qd1;
+    const planar_2r_real t6 = t0*qd1 + t5;
     const planar_2r_real t7 = c12*qd1 + t5;
 
     /* Outputs */
@@ -485,66 +485,66 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const planar_2r_real t4 = (s12*s12) + t3;
     const planar_2r_real t5 = t4;
     const planar_2r_real t6 = (t0*t0);
-    const planar_2r_real t7 = sqrt(t6 + t3);
+    const planar_2r_real t7 = sqrt(t3 + t6);
     const planar_2r_real t8 = t7*(t1 <= 0 ? 1 : -1);
-    const planar_2r_real t9 = (c12*c12) + t6;
-    const planar_2r_real t10 = t9;
-    const planar_2r_real t11 = sqrt(t4 + t9);
-    const planar_2r_real t12 = (t2*t2);
-    const planar_2r_real t13 = (damping*damping);
-    const planar_2r_real t14 = t13 + t5;
-    const planar_2r_real t15 = (t14*t14);
-    const planar_2r_real t16 = sqrt(t12 + t15);
-    const planar_2r_real t17 = t16*(t14 >= 0 ? 1 : -1);
-    const planar_2r_real t18 = t17 + t14;
-    const planar_2r_real t19 = (t16 > 0 ? 1/(t16*(t16 + fabs(t14))) : 0);
-    const planar_2r_real t20 = t19*(mu_dot0*t18 - mu_dot1*t2);
-    const planar_2r_real t21 = mu_dot0 - t18*t20;
-    const planar_2r_real t22 = mu_dot1 + t2*t20;
-    const planar_2r_real t23 = t13 + t10;
-    const planar_2r_real t24 = sqrt(2*t12 + t15 + (t23*t23));
-    const planar_2r_real t25 = -t19*(t2*t18 + t2*t23);
-    const planar_2r_real t26 = t2 + t18*t25;
-    const planar_2r_real t27 = t2*t25 + t23;
-    const planar_2r_real t28 = fabs(t27);
-    const planar_2r_real t29 = t28;
-    const planar_2r_real t30 = t29*(t27 >= 0 ? 1 : -1);
-    const planar_2r_real t31 = t27 + t30;
-    const planar_2r_real t32 = (t29 > 0 ? 1/(t29*(t28 + t29)) : 0);
-    const planar_2r_real t33 = t22 - t22*(t31*t31)*t32;
-    const planar_2r_real t34 = (t30 != 0 ? -t33/t30 : 0);
-    const planar_2r_real t35 = (t17 != 0 ? -(t21 + t26*t34)/t17 : 0);
-    const planar_2r_real t36 = -t1*t35 + t0*t34;
-    const planar_2r_real t37 = -s12*t35 + c12*t34;
-    const planar_2r_real t38 = -t1;
-    const planar_2r_real t39 = t38 + t8;
-    const planar_2r_real t40 = (t7 > 0 ? 1/(t7*(t7 + fabs(t38))) : 0);
-    const planar_2r_real t41 = t40*(c12*t0 - s12*t39);
-    const planar_2r_real t42 = s12 + t39*t41;
+    const planar_2r_real t9 = (t7 > 0 ? 1/(t7*(t7 + fabs(t1))) : 0);
+    const planar_2r_real t10 = (c12*c12) + t6;
+    const planar_2r_real t11 = t10;
+    const planar_2r_real t12 = sqrt(t4 + t10);
+    const planar_2r_real t13 = (t2*t2);
+    const planar_2r_real t14 = (damping*damping);
+    const planar_2r_real t15 = t5 + t14;
+    const planar_2r_real t16 = (t15*t15);
+    const planar_2r_real t17 = sqrt(t13 + t16);
+    const planar_2r_real t18 = t17*(t15 >= 0 ? 1 : -1);
+    const planar_2r_real t19 = t18 + t15;
+    const planar_2r_real t20 = (t17 > 0 ? 1/(t17*(t17 + fabs(t15))) : 0);
+    const planar_2r_real t21 = t20*(mu_dot0*t19 - mu_dot1*t2);
+    const planar_2r_real t22 = mu_dot0 - t19*t21;
+    const planar_2r_real t23 = mu_dot1 + t2*t21;
+    const planar_2r_real t24 = t11 + t14;
+    const planar_2r_real t25 = sqrt(2*t13 + t16 + (t24*t24));
+    const planar_2r_real t26 = -t20*(t2*t19 + t2*t24);
+    const planar_2r_real t27 = t2 + t19*t26;
+    const planar_2r_real t28 = t2*t26 + t24;
+    const planar_2r_real t29 = fabs(t28);
+    const planar_2r_real t30 = t29;
+    const planar_2r_real t31 = t30*(t28 >= 0 ? 1 : -1);
+    const planar_2r_real t32 = t28 + t31;
+    const planar_2r_real t33 = (t30 > 0 ? 1/(t30*(t30 + t29)) : 0);
+    const planar_2r_real t34 = t23 - t23*(t32*t32)*t33;
+    const planar_2r_real t35 = (t31 != 0 ? -t34/t31 : 0);
+    const planar_2r_real t36 = (t18 != 0 ? -(t22 + t27*t35)/t18 : 0);
+    const planar_2r_real t37 = -t1*t36 + t0*t35;
+    const planar_2r_real t38 = -s12*t36 + c12*t35;
+    const planar_2r_real t39 = -t1;
+    const planar_2r_real t40 = t8 + t39;
+    const planar_2r_real t41 = t9*(c12*t0 - s12*t40);
+    const planar_2r_real t42 = s12 + t40*t41;
     const planar_2r_real t43 = c12 - t0*t41;
-    const planar_2r_real t44 = t40*(mu_dot0*t39 + t0*mu_dot1);
-    const planar_2r_real t45 = mu_dot0 - t39*t44;
+    const planar_2r_real t44 = t9*(mu_dot0*t40 + t0*mu_dot1);
+    const planar_2r_real t45 = mu_dot0 - t40*t44;
     const planar_2r_real t46 = mu_dot1 - t0*t44;
-    const planar_2r_real t47 = t38 - s12 + q1 + q2 + c12 + t0 + mu_dot0 + mu_dot1 + damping;
+    const planar_2r_real t47 = -s12 + q1 + q2 + c12 + t0 + mu_dot0 + mu_dot1 + damping + t39;
     const planar_2r_real t48 = fabs(t43);
     const planar_2r_real t49 = t48;
     const planar_2r_real t50 = t49*(t43 >= 0 ? 1 : -1);
     const planar_2r_real t51 = t43 + t50;
-    const planar_2r_real t52 = (t49 > 0 ? 1/(t49*(t48 + t49)) : 0);
+    const planar_2r_real t52 = (t49 > 0 ? 1/(t49*(t49 + t48)) : 0);
     const planar_2r_real t53 = t46 - t46*(t51*t51)*t52;
     const planar_2r_real t54 = (t50 != 0 ? -t53/t50 : 0);
     const planar_2r_real t55 = (t8 != 0 ? -(t45 + t42*t54)/t8 : 0);
     const int t56 = isfinite(t47);
     const int t57 = damping >= 0;
     const int t58 = damping > 0;
-    const planar_2r_real t59 = 1e-12*t24;
-    const planar_2r_real t60 = 1e-12*t11;
-    const int t61 = (t58 && ((t16 <= t59) || (t29 <= t59))) || (damping <= 0 && ((t7 <= t60) || (t49 <= t60)));
+    const planar_2r_real t59 = 1e-12*t25;
+    const planar_2r_real t60 = 1e-12*t12;
+    const int t61 = (t58 && ((t17 <= t59) || (t30 <= t59))) || (damping <= 0 && ((t7 <= t60) || (t49 <= t60)));
     const int t62 = t56 && t57 && !t61;
 
     /* Outputs */
-    q_dot[0] = (t62 ? (t58 ? t36 : t55) : 0);
-    q_dot[1] = (t62 ? (t58 ? t37 : t54) : 0);
+    q_dot[0] = (t62 ? (t58 ? t37 : t55) : 0);
+    q_dot[1] = (t62 ? (t58 ? t38 : t54) : 0);
     return (!(t56 && t57) ? 2 : (t61 ? 1 : 0));
 }
 
@@ -577,7 +577,7 @@ planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_T
     const planar_2r_real t7 = (t5*t5) + (t6*t6);
     const planar_2r_real t8 = qs1 + qs2 + mu0 + mu1;
     const planar_2r_real t9 = damping + t2;
-    const planar_2r_real t10 = sqrt((t3*t3) + (t9*t9));
+    const planar_2r_real t10 = sqrt((t9*t9) + (t3*t3));
     const planar_2r_real t11 = t10*(t9 >= 0 ? 1 : -1);
     const planar_2r_real t12 = t9 + t11;
     const planar_2r_real t13 = (t10 > 0 ? 1/(t10*(t10 + fabs(t9))) : 0);
@@ -585,7 +585,7 @@ planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_T
     const planar_2r_real t15 = t5 - t12*t14;
     const planar_2r_real t16 = t6 + t3*t14;
     const planar_2r_real t17 = damping + t4;
-    const planar_2r_real t18 = -t13*(t3*t12 + t3*t17);
+    const planar_2r_real t18 = -t13*(t3*t12 + t17*t3);
     const planar_2r_real t19 = t3 + t12*t18;
     const planar_2r_real t20 = t17 + t3*t18;
     const planar_2r_real t21 = fabs(t20);
@@ -630,13 +630,13 @@ void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2
     const planar_2r_real t11 = (t6*t6) + (t10*t10);
     const planar_2r_real t12 = mu0*t10;
     const planar_2r_real t13 = mu1*t6;
-    const planar_2r_real t14 = t12 - t13;
+    const planar_2r_real t14 = -t13 + t12;
     const planar_2r_real t15 = t12 + t13;
     const planar_2r_real t16 = mu1*t10;
     const planar_2r_real t17 = mu0*t6;
     const planar_2r_real t18 = t16 + t17;
     const planar_2r_real t19 = (t14*t14) + (t18*t18);
-    const planar_2r_real t20 = t16 - t17;
+    const planar_2r_real t20 = -t17 + t16;
     const planar_2r_real t21 = (t15*t15) + (t20*t20);
     const planar_2r_real t22 = 1e-24*t0*t11;
     const int t23 = isfinite(t3);

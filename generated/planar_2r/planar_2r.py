@@ -269,7 +269,7 @@ def fk_jacobian_dot(q, q_dot):
     t2 = s12*qd2
     t3 = t2 + t1*qd1
     t4 = c12*qd2
-    t5 = t4 + t0*qd1
+    t5 = t0*qd1 + t4
     t6 = -s12
     T = _stack(xp, [
         xp.broadcast_to(c12, batch),  # 0, 0
@@ -331,7 +331,7 @@ def jacobian_dot(q, q_dot):
     t2 = s12*qd2
     t3 = t2 + t1*qd1
     t4 = c12*qd2
-    t5 = t4 + t0*qd1
+    t5 = t0*qd1 + t4
     Jd = _stack(xp, [
         xp.broadcast_to(-t5, batch),  # 0, 0
         xp.broadcast_to(-(c12*qd1 + t4), batch),  # 0, 1
@@ -366,7 +366,7 @@ def bias_acceleration(q, q_dot):
     t2 = s12*qd2
     t3 = t2 + t1*qd1
     t4 = c12*qd2
-    t5 = t4 + t0*qd1
+    t5 = t0*qd1 + t4
     a = _stack(xp, [
         xp.broadcast_to(-qd1*t5 - qd2*(c12*qd1 + t4), batch),  # 0
         xp.broadcast_to(-qd1*t3 - qd2*(t2 + s12*qd1), batch),  # 1
@@ -396,7 +396,7 @@ def task_jacobian_dot(q, q_dot):
     t3 = t2 + t1*qd1
     t4 = t2 + s12*qd1
     t5 = c12*qd2
-    t6 = t5 + t0*qd1
+    t6 = t0*qd1 + t5
     t7 = c12*qd1 + t5
     Jd = _stack(xp, [
         xp.broadcast_to(-t6, batch),  # 0, 0
@@ -501,65 +501,65 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t4 = s12**2 + t3
     t5 = t4
     t6 = t0**2
-    t7 = xp.sqrt(t6 + t3)
+    t7 = xp.sqrt(t3 + t6)
     t8 = t7*xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)
-    t9 = c12**2 + t6
-    t10 = t9
-    t11 = xp.sqrt(t4 + t9)
-    t12 = t2**2
-    t13 = damping**2
-    t14 = t13 + t5
-    t15 = t14**2
-    t16 = xp.sqrt(t12 + t15)
-    t17 = t16*xp.where(xp.greater_equal(t14, 0), xp.asarray(1, dtype=dtype), -1)
-    t18 = t17 + t14
-    t19 = xp.where(xp.greater(t16, 0), 1/(t16*(t16 + xp.abs(t14))), 0)
-    t20 = t19*(mu_dot0*t18 - mu_dot1*t2)
-    t21 = mu_dot0 - t18*t20
-    t22 = mu_dot1 + t2*t20
-    t23 = t13 + t10
-    t24 = xp.sqrt(2*t12 + t15 + t23**2)
-    t25 = -t19*(t2*t18 + t2*t23)
-    t26 = t2 + t18*t25
-    t27 = t2*t25 + t23
-    t28 = xp.abs(t27)
-    t29 = t28
-    t30 = t29*xp.where(xp.greater_equal(t27, 0), xp.asarray(1, dtype=dtype), -1)
-    t31 = t27 + t30
-    t32 = xp.where(xp.greater(t29, 0), 1/(t29*(t28 + t29)), 0)
-    t33 = t22 - t22*t31**2*t32
-    t34 = xp.where(xp.not_equal(t30, 0), -t33/t30, 0)
-    t35 = xp.where(xp.not_equal(t17, 0), -(t21 + t26*t34)/t17, 0)
-    t36 = -t1*t35 + t0*t34
-    t37 = -s12*t35 + c12*t34
-    t38 = -t1
-    t39 = t38 + t8
-    t40 = xp.where(xp.greater(t7, 0), 1/(t7*(t7 + xp.abs(t38))), 0)
-    t41 = t40*(c12*t0 - s12*t39)
-    t42 = s12 + t39*t41
+    t9 = xp.where(xp.greater(t7, 0), 1/(t7*(t7 + xp.abs(t1))), 0)
+    t10 = c12**2 + t6
+    t11 = t10
+    t12 = xp.sqrt(t4 + t10)
+    t13 = t2**2
+    t14 = damping**2
+    t15 = t5 + t14
+    t16 = t15**2
+    t17 = xp.sqrt(t13 + t16)
+    t18 = t17*xp.where(xp.greater_equal(t15, 0), xp.asarray(1, dtype=dtype), -1)
+    t19 = t18 + t15
+    t20 = xp.where(xp.greater(t17, 0), 1/(t17*(t17 + xp.abs(t15))), 0)
+    t21 = t20*(mu_dot0*t19 - mu_dot1*t2)
+    t22 = mu_dot0 - t19*t21
+    t23 = mu_dot1 + t2*t21
+    t24 = t11 + t14
+    t25 = xp.sqrt(2*t13 + t16 + t24**2)
+    t26 = -t20*(t2*t19 + t2*t24)
+    t27 = t2 + t19*t26
+    t28 = t2*t26 + t24
+    t29 = xp.abs(t28)
+    t30 = t29
+    t31 = t30*xp.where(xp.greater_equal(t28, 0), xp.asarray(1, dtype=dtype), -1)
+    t32 = t28 + t31
+    t33 = xp.where(xp.greater(t30, 0), 1/(t30*(t30 + t29)), 0)
+    t34 = t23 - t23*t32**2*t33
+    t35 = xp.where(xp.not_equal(t31, 0), -t34/t31, 0)
+    t36 = xp.where(xp.not_equal(t18, 0), -(t22 + t27*t35)/t18, 0)
+    t37 = -t1*t36 + t0*t35
+    t38 = -s12*t36 + c12*t35
+    t39 = -t1
+    t40 = t8 + t39
+    t41 = t9*(c12*t0 - s12*t40)
+    t42 = s12 + t40*t41
     t43 = c12 - t0*t41
-    t44 = t40*(mu_dot0*t39 + t0*mu_dot1)
-    t45 = mu_dot0 - t39*t44
+    t44 = t9*(mu_dot0*t40 + t0*mu_dot1)
+    t45 = mu_dot0 - t40*t44
     t46 = mu_dot1 - t0*t44
-    t47 = t38 - s12 + q1 + q2 + c12 + t0 + mu_dot0 + mu_dot1 + damping
+    t47 = -s12 + q1 + q2 + c12 + t0 + mu_dot0 + mu_dot1 + damping + t39
     t48 = xp.abs(t43)
     t49 = t48
     t50 = t49*xp.where(xp.greater_equal(t43, 0), xp.asarray(1, dtype=dtype), -1)
     t51 = t43 + t50
-    t52 = xp.where(xp.greater(t49, 0), 1/(t49*(t48 + t49)), 0)
+    t52 = xp.where(xp.greater(t49, 0), 1/(t49*(t49 + t48)), 0)
     t53 = t46 - t46*t51**2*t52
     t54 = xp.where(xp.not_equal(t50, 0), -t53/t50, 0)
     t55 = xp.where(xp.not_equal(t8, 0), -(t45 + t42*t54)/t8, 0)
     t56 = xp.isfinite(t47)
     t57 = xp.greater_equal(damping, 0)
     t58 = xp.greater(damping, 0)
-    t59 = 1e-12*t24
-    t60 = 1e-12*t11
-    t61 = (t58 & (xp.less_equal(t16, t59) | xp.less_equal(t29, t59))) | (xp.less_equal(damping, 0) & (xp.less_equal(t7, t60) | xp.less_equal(t49, t60)))
+    t59 = 1e-12*t25
+    t60 = 1e-12*t12
+    t61 = (t58 & (xp.less_equal(t17, t59) | xp.less_equal(t30, t59))) | (xp.less_equal(damping, 0) & (xp.less_equal(t7, t60) | xp.less_equal(t49, t60)))
     t62 = t56 & t57 & xp.logical_not(t61)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t62, xp.where(t58, t36, t55), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t62, xp.where(t58, t37, t54), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t62, xp.where(t58, t37, t55), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t62, xp.where(t58, t38, t54), 0), batch),  # 1
     ], (2,))
     status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t56 & t57), 2, xp.where(t61, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
@@ -591,7 +591,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t7 = t5**2 + t6**2
     t8 = qs1 + qs2 + mu0 + mu1
     t9 = damping + t2
-    t10 = xp.sqrt(t3**2 + t9**2)
+    t10 = xp.sqrt(t9**2 + t3**2)
     t11 = t10*xp.where(xp.greater_equal(t9, 0), xp.asarray(1, dtype=dtype), -1)
     t12 = t9 + t11
     t13 = xp.where(xp.greater(t10, 0), 1/(t10*(t10 + xp.abs(t9))), 0)
@@ -599,7 +599,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t15 = t5 - t12*t14
     t16 = t6 + t3*t14
     t17 = damping + t4
-    t18 = -t13*(t3*t12 + t3*t17)
+    t18 = -t13*(t3*t12 + t17*t3)
     t19 = t3 + t12*t18
     t20 = t17 + t3*t18
     t21 = xp.abs(t20)
@@ -644,13 +644,13 @@ def ik_branches(mu):
     t11 = t6**2 + t10**2
     t12 = mu0*t10
     t13 = mu1*t6
-    t14 = t12 - t13
+    t14 = -t13 + t12
     t15 = t12 + t13
     t16 = mu1*t10
     t17 = mu0*t6
     t18 = t16 + t17
     t19 = t14**2 + t18**2
-    t20 = t16 - t17
+    t20 = -t17 + t16
     t21 = t15**2 + t20**2
     t22 = 1e-24*t0*t11
     t23 = xp.isfinite(t3)

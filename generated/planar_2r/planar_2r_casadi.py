@@ -170,7 +170,7 @@ def _fk_jacobian_dot(q, q_dot):
     t2 = s12*qd2
     t3 = t2 + t1*qd1
     t4 = c12*qd2
-    t5 = t4 + t0*qd1
+    t5 = t0*qd1 + t4
     t6 = -s12
     T = casadi.SX(4, 4)
     T[0, 0] = c12
@@ -211,7 +211,7 @@ def _jacobian_dot(q, q_dot):
     t2 = s12*qd2
     t3 = t2 + t1*qd1
     t4 = c12*qd2
-    t5 = t4 + t0*qd1
+    t5 = t0*qd1 + t4
     Jd = casadi.SX(6, 2)
     Jd[0, 0] = -t5
     Jd[0, 1] = -(c12*qd1 + t4)
@@ -237,7 +237,7 @@ def _bias_acceleration(q, q_dot):
     t2 = s12*qd2
     t3 = t2 + t1*qd1
     t4 = c12*qd2
-    t5 = t4 + t0*qd1
+    t5 = t0*qd1 + t4
     a = casadi.SX(6, 1)
     a[0, 0] = -qd1*t5 - qd2*(c12*qd1 + t4)
     a[1, 0] = -qd1*t3 - qd2*(t2 + s12*qd1)
@@ -262,7 +262,7 @@ def _task_jacobian_dot(q, q_dot):
     t3 = t2 + t1*qd1
     t4 = t2 + s12*qd1
     t5 = c12*qd2
-    t6 = t5 + t0*qd1
+    t6 = t0*qd1 + t5
     t7 = c12*qd1 + t5
     Jd = casadi.SX(2, 2)
     Jd[0, 0] = -t6
@@ -344,65 +344,65 @@ def _velocity_ik(q, mu_dot, damping):
     t4 = s12**2 + t3
     t5 = t4
     t6 = t0**2
-    t7 = casadi.sqrt(t6 + t3)
+    t7 = casadi.sqrt(t3 + t6)
     t8 = t7*casadi.if_else((t1 <= 0), 1, -1)
-    t9 = c12**2 + t6
-    t10 = t9
-    t11 = casadi.sqrt(t4 + t9)
-    t12 = t2**2
-    t13 = damping**2
-    t14 = t13 + t5
-    t15 = t14**2
-    t16 = casadi.sqrt(t12 + t15)
-    t17 = t16*casadi.if_else((t14 >= 0), 1, -1)
-    t18 = t17 + t14
-    t19 = casadi.if_else((t16 > 0), 1/(t16*(t16 + casadi.fabs(t14))), 0)
-    t20 = t19*(mu_dot0*t18 - mu_dot1*t2)
-    t21 = mu_dot0 - t18*t20
-    t22 = mu_dot1 + t2*t20
-    t23 = t13 + t10
-    t24 = casadi.sqrt(2*t12 + t15 + t23**2)
-    t25 = -t19*(t2*t18 + t2*t23)
-    t26 = t2 + t18*t25
-    t27 = t2*t25 + t23
-    t28 = casadi.fabs(t27)
-    t29 = t28
-    t30 = t29*casadi.if_else((t27 >= 0), 1, -1)
-    t31 = t27 + t30
-    t32 = casadi.if_else((t29 > 0), 1/(t29*(t28 + t29)), 0)
-    t33 = t22 - t22*t31**2*t32
-    t34 = casadi.if_else((t30 != 0), -t33/t30, 0)
-    t35 = casadi.if_else((t17 != 0), -(t21 + t26*t34)/t17, 0)
-    t36 = -t1*t35 + t0*t34
-    t37 = -s12*t35 + c12*t34
-    t38 = -t1
-    t39 = t38 + t8
-    t40 = casadi.if_else((t7 > 0), 1/(t7*(t7 + casadi.fabs(t38))), 0)
-    t41 = t40*(c12*t0 - s12*t39)
-    t42 = s12 + t39*t41
+    t9 = casadi.if_else((t7 > 0), 1/(t7*(t7 + casadi.fabs(t1))), 0)
+    t10 = c12**2 + t6
+    t11 = t10
+    t12 = casadi.sqrt(t4 + t10)
+    t13 = t2**2
+    t14 = damping**2
+    t15 = t5 + t14
+    t16 = t15**2
+    t17 = casadi.sqrt(t13 + t16)
+    t18 = t17*casadi.if_else((t15 >= 0), 1, -1)
+    t19 = t18 + t15
+    t20 = casadi.if_else((t17 > 0), 1/(t17*(t17 + casadi.fabs(t15))), 0)
+    t21 = t20*(mu_dot0*t19 - mu_dot1*t2)
+    t22 = mu_dot0 - t19*t21
+    t23 = mu_dot1 + t2*t21
+    t24 = t11 + t14
+    t25 = casadi.sqrt(2*t13 + t16 + t24**2)
+    t26 = -t20*(t2*t19 + t2*t24)
+    t27 = t2 + t19*t26
+    t28 = t2*t26 + t24
+    t29 = casadi.fabs(t28)
+    t30 = t29
+    t31 = t30*casadi.if_else((t28 >= 0), 1, -1)
+    t32 = t28 + t31
+    t33 = casadi.if_else((t30 > 0), 1/(t30*(t30 + t29)), 0)
+    t34 = t23 - t23*t32**2*t33
+    t35 = casadi.if_else((t31 != 0), -t34/t31, 0)
+    t36 = casadi.if_else((t18 != 0), -(t22 + t27*t35)/t18, 0)
+    t37 = -t1*t36 + t0*t35
+    t38 = -s12*t36 + c12*t35
+    t39 = -t1
+    t40 = t8 + t39
+    t41 = t9*(c12*t0 - s12*t40)
+    t42 = s12 + t40*t41
     t43 = c12 - t0*t41
-    t44 = t40*(mu_dot0*t39 + t0*mu_dot1)
-    t45 = mu_dot0 - t39*t44
+    t44 = t9*(mu_dot0*t40 + t0*mu_dot1)
+    t45 = mu_dot0 - t40*t44
     t46 = mu_dot1 - t0*t44
-    t47 = t38 - s12 + q1 + q2 + c12 + t0 + mu_dot0 + mu_dot1 + damping
+    t47 = -s12 + q1 + q2 + c12 + t0 + mu_dot0 + mu_dot1 + damping + t39
     t48 = casadi.fabs(t43)
     t49 = t48
     t50 = t49*casadi.if_else((t43 >= 0), 1, -1)
     t51 = t43 + t50
-    t52 = casadi.if_else((t49 > 0), 1/(t49*(t48 + t49)), 0)
+    t52 = casadi.if_else((t49 > 0), 1/(t49*(t49 + t48)), 0)
     t53 = t46 - t46*t51**2*t52
     t54 = casadi.if_else((t50 != 0), -t53/t50, 0)
     t55 = casadi.if_else((t8 != 0), -(t45 + t42*t54)/t8, 0)
     t56 = (casadi.fabs(t47) < casadi.inf)
     t57 = (damping >= 0)
     t58 = (damping > 0)
-    t59 = 1e-12*t24
-    t60 = 1e-12*t11
-    t61 = casadi.logic_or(casadi.logic_and(t58, casadi.logic_or((t16 <= t59), (t29 <= t59))), casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t60), (t49 <= t60))))
+    t59 = 1e-12*t25
+    t60 = 1e-12*t12
+    t61 = casadi.logic_or(casadi.logic_and(t58, casadi.logic_or((t17 <= t59), (t30 <= t59))), casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t60), (t49 <= t60))))
     t62 = casadi.logic_and(casadi.logic_and(t56, t57), casadi.logic_not(t61))
     q_dot = casadi.SX(2, 1)
-    q_dot[0, 0] = casadi.if_else(t62, casadi.if_else(t58, t36, t55), 0)
-    q_dot[1, 0] = casadi.if_else(t62, casadi.if_else(t58, t37, t54), 0)
+    q_dot[0, 0] = casadi.if_else(t62, casadi.if_else(t58, t37, t55), 0)
+    q_dot[1, 0] = casadi.if_else(t62, casadi.if_else(t58, t38, t54), 0)
     status = casadi.SX(1, 1)
     status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t56, t57)), 2, casadi.if_else(t61, 1, 0))
     return [q_dot, status]
@@ -432,7 +432,7 @@ def _ik_numeric_step(target, q, damping):
     t7 = t5**2 + t6**2
     t8 = qs1 + qs2 + mu0 + mu1
     t9 = damping + t2
-    t10 = casadi.sqrt(t3**2 + t9**2)
+    t10 = casadi.sqrt(t9**2 + t3**2)
     t11 = t10*casadi.if_else((t9 >= 0), 1, -1)
     t12 = t9 + t11
     t13 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t9))), 0)
@@ -440,7 +440,7 @@ def _ik_numeric_step(target, q, damping):
     t15 = t5 - t12*t14
     t16 = t6 + t3*t14
     t17 = damping + t4
-    t18 = -t13*(t3*t12 + t3*t17)
+    t18 = -t13*(t3*t12 + t17*t3)
     t19 = t3 + t12*t18
     t20 = t17 + t3*t18
     t21 = casadi.fabs(t20)
@@ -482,13 +482,13 @@ def _ik_branches(mu):
     t11 = t6**2 + t10**2
     t12 = mu0*t10
     t13 = mu1*t6
-    t14 = t12 - t13
+    t14 = -t13 + t12
     t15 = t12 + t13
     t16 = mu1*t10
     t17 = mu0*t6
     t18 = t16 + t17
     t19 = t14**2 + t18**2
-    t20 = t16 - t17
+    t20 = -t17 + t16
     t21 = t15**2 + t20**2
     t22 = 1e-24*t0*t11
     t23 = (casadi.fabs(t3) < casadi.inf)

@@ -338,7 +338,7 @@ def fk_jacobian_dot(q, q_dot):
     t6 = t5 + t1*qd2
     t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t8 + t0*qd2
+    t9 = t0*qd2 + t8
     t10 = t9 + t2*qd1
     t11 = -s123
     T = _stack(xp, [
@@ -416,7 +416,7 @@ def jacobian_dot(q, q_dot):
     t6 = t5 + t1*qd2
     t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t8 + t0*qd2
+    t9 = t0*qd2 + t8
     t10 = t9 + t2*qd1
     Jd = _stack(xp, [
         xp.broadcast_to(-t10, batch),  # 0, 0
@@ -467,7 +467,7 @@ def bias_acceleration(q, q_dot):
     t6 = t5 + t1*qd2
     t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t8 + t0*qd2
+    t9 = t0*qd2 + t8
     t10 = t9 + t2*qd1
     a = _stack(xp, [
         xp.broadcast_to(-qd1*t10 - qd2*(t9 + t0*qd1) - qd3*(c123*t4 + t8), batch),  # 0
@@ -508,7 +508,7 @@ def task_jacobian_dot(q, q_dot):
     t8 = t6 + t1*qd1
     t9 = t5 + s123*t4
     t10 = c123*qd3
-    t11 = t10 + t0*qd2
+    t11 = t0*qd2 + t10
     t12 = t11 + t2*qd1
     t13 = t11 + t0*qd1
     t14 = c123*t4 + t10
@@ -686,72 +686,72 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t7 = s123**2 + t1**2 + t6
     t8 = t7
     t9 = t2**2
-    t10 = xp.sqrt(1 + t9 + t6)
+    t10 = xp.sqrt(1 + t6 + t9)
     t11 = t10*xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)
-    t12 = c123**2 + t0**2 + t9
-    t13 = t12
-    t14 = xp.sqrt(3 + t7 + t12)
-    t15 = c123 + t0 + t2
-    t16 = t15
-    t17 = t4**2
-    t18 = t5**2
-    t19 = damping**2
-    t20 = t19 + t8
-    t21 = t20**2
-    t22 = xp.sqrt(t17 + t18 + t21)
-    t23 = t22*xp.where(xp.greater_equal(t20, 0), xp.asarray(1, dtype=dtype), -1)
-    t24 = t23 + t20
-    t25 = xp.where(xp.greater(t22, 0), 1/(t22*(t22 + xp.abs(t20))), 0)
-    t26 = -t25*(-mu_dot0*t24 + mu_dot1*t4 + mu_dot2*t5)
-    t27 = mu_dot0 - t24*t26
-    t28 = mu_dot1 + t4*t26
-    t29 = mu_dot2 + t5*t26
-    t30 = t19 + t13
-    t31 = -t25*(t4*t24 + t4*t30 + t5*t16)
-    t32 = t4 + t24*t31
-    t33 = t4*t31 + t30
-    t34 = t16 + t5*t31
-    t35 = xp.sqrt(t33**2 + t34**2)
-    t36 = t35*xp.where(xp.greater_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)
-    t37 = t33 + t36
-    t38 = xp.where(xp.greater(t35, 0), 1/(t35*(t35 + xp.abs(t33))), 0)
-    t39 = t38*(t28*t37 + t34*t29)
-    t40 = t28 - t37*t39
-    t41 = t29 - t34*t39
-    t42 = 3 + t19
-    t43 = xp.sqrt(2*t17 + 2*t18 + 2*t16**2 + t21 + t30**2 + t42**2)
-    t44 = -t25*(t5*t24 + t4*t16 + t5*t42)
-    t45 = t5 + t24*t44
-    t46 = t16 + t4*t44
-    t47 = t5*t44 + t42
-    t48 = t38*(t46*t37 + t34*t47)
-    t49 = t46 - t37*t48
-    t50 = t47 - t34*t48
-    t51 = xp.abs(t50)
-    t52 = t51
-    t53 = t52*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
-    t54 = t50 + t53
-    t55 = xp.where(xp.greater(t52, 0), 1/(t52*(t51 + t52)), 0)
-    t56 = t41 - t41*t54**2*t55
-    t57 = xp.where(xp.not_equal(t53, 0), -t56/t53, 0)
-    t58 = xp.where(xp.not_equal(t36, 0), -(t40 - t49*t57)/t36, 0)
-    t59 = xp.where(xp.not_equal(t23, 0), -(t27 + t32*t58 + t45*t57)/t23, 0)
-    t60 = t57 - t3*t59 + t2*t58
-    t61 = t57 - t1*t59 + t0*t58
-    t62 = t57 - s123*t59 + c123*t58
-    t63 = -t3
-    t64 = t63 + t11
-    t65 = xp.where(xp.greater(t10, 0), 1/(t10*(t10 + xp.abs(t63))), 0)
-    t66 = t65*(1 - t1*t64 + t0*t2)
-    t67 = t1 + t64*t66
+    t12 = xp.where(xp.greater(t10, 0), 1/(t10*(t10 + xp.abs(t3))), 0)
+    t13 = c123**2 + t0**2 + t9
+    t14 = t13
+    t15 = xp.sqrt(3 + t7 + t13)
+    t16 = c123 + t0 + t2
+    t17 = t16
+    t18 = t4**2
+    t19 = t5**2
+    t20 = damping**2
+    t21 = t8 + t20
+    t22 = t21**2
+    t23 = xp.sqrt(t18 + t19 + t22)
+    t24 = t23*xp.where(xp.greater_equal(t21, 0), xp.asarray(1, dtype=dtype), -1)
+    t25 = t24 + t21
+    t26 = xp.where(xp.greater(t23, 0), 1/(t23*(t23 + xp.abs(t21))), 0)
+    t27 = -t26*(-mu_dot0*t25 + mu_dot1*t4 + mu_dot2*t5)
+    t28 = mu_dot0 - t25*t27
+    t29 = mu_dot1 + t4*t27
+    t30 = mu_dot2 + t5*t27
+    t31 = t14 + t20
+    t32 = -t26*(t4*t25 + t5*t17 + t4*t31)
+    t33 = t4 + t25*t32
+    t34 = t4*t32 + t31
+    t35 = t17 + t5*t32
+    t36 = xp.sqrt(t34**2 + t35**2)
+    t37 = t36*xp.where(xp.greater_equal(t34, 0), xp.asarray(1, dtype=dtype), -1)
+    t38 = t34 + t37
+    t39 = xp.where(xp.greater(t36, 0), 1/(t36*(t36 + xp.abs(t34))), 0)
+    t40 = t39*(t29*t38 + t35*t30)
+    t41 = t29 - t38*t40
+    t42 = t30 - t35*t40
+    t43 = 3 + t20
+    t44 = xp.sqrt(2*t18 + 2*t19 + 2*t17**2 + t22 + t31**2 + t43**2)
+    t45 = -t26*(t5*t25 + t4*t17 + t5*t43)
+    t46 = t5 + t25*t45
+    t47 = t17 + t4*t45
+    t48 = t5*t45 + t43
+    t49 = t39*(t47*t38 + t35*t48)
+    t50 = t47 - t38*t49
+    t51 = t48 - t35*t49
+    t52 = xp.abs(t51)
+    t53 = t52
+    t54 = t53*xp.where(xp.greater_equal(t51, 0), xp.asarray(1, dtype=dtype), -1)
+    t55 = t51 + t54
+    t56 = xp.where(xp.greater(t53, 0), 1/(t53*(t53 + t52)), 0)
+    t57 = t42 - t42*t55**2*t56
+    t58 = xp.where(xp.not_equal(t54, 0), -t57/t54, 0)
+    t59 = xp.where(xp.not_equal(t37, 0), -(t41 - t50*t58)/t37, 0)
+    t60 = xp.where(xp.not_equal(t24, 0), -(t28 + t33*t59 + t46*t58)/t24, 0)
+    t61 = t58 - t3*t60 + t2*t59
+    t62 = t58 - t1*t60 + t0*t59
+    t63 = t58 - s123*t60 + c123*t59
+    t64 = -t3
+    t65 = t11 + t64
+    t66 = t12*(1 - t1*t65 + t0*t2)
+    t67 = t1 + t65*t66
     t68 = t0 - t2*t66
     t69 = 1 - t66
-    t70 = t65*(1 + c123*t2 - s123*t64)
-    t71 = s123 + t64*t70
+    t70 = t12*(1 + c123*t2 - s123*t65)
+    t71 = s123 + t65*t70
     t72 = c123 - t2*t70
     t73 = 1 - t70
-    t74 = t65*(mu_dot2 + mu_dot0*t64 + t2*mu_dot1)
-    t75 = mu_dot0 - t64*t74
+    t74 = t12*(mu_dot2 + mu_dot0*t65 + t2*mu_dot1)
+    t75 = mu_dot0 - t65*t74
     t76 = mu_dot1 - t2*t74
     t77 = -t74 + mu_dot2
     t78 = xp.sqrt(t68**2 + t69**2)
@@ -764,12 +764,12 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t85 = t81*(t76*t80 + t69*t77)
     t86 = t76 - t80*t85
     t87 = t77 - t69*t85
-    t88 = 3 - t1 - s123 + q1 + q2 + q3 + mu_dot0 + mu_dot1 + mu_dot2 + damping + t15 + t63
+    t88 = 3 - t1 - s123 + q1 + q2 + q3 + mu_dot0 + mu_dot1 + mu_dot2 + damping + t16 + t64
     t89 = xp.abs(t84)
     t90 = t89
     t91 = t90*xp.where(xp.greater_equal(t84, 0), xp.asarray(1, dtype=dtype), -1)
     t92 = t84 + t91
-    t93 = xp.where(xp.greater(t90, 0), 1/(t90*(t89 + t90)), 0)
+    t93 = xp.where(xp.greater(t90, 0), 1/(t90*(t90 + t89)), 0)
     t94 = t87 - t87*t92**2*t93
     t95 = xp.where(xp.not_equal(t91, 0), -t94/t91, 0)
     t96 = xp.where(xp.not_equal(t79, 0), -(t86 - t83*t95)/t79, 0)
@@ -777,14 +777,14 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t98 = xp.isfinite(t88)
     t99 = xp.greater_equal(damping, 0)
     t100 = xp.greater(damping, 0)
-    t101 = 1e-12*t43
-    t102 = 1e-12*t14
-    t103 = (t100 & (xp.less_equal(t22, t101) | xp.less_equal(t35, t101) | xp.less_equal(t52, t101))) | (xp.less_equal(damping, 0) & (xp.less_equal(t10, t102) | xp.less_equal(t78, t102) | xp.less_equal(t90, t102)))
+    t101 = 1e-12*t44
+    t102 = 1e-12*t15
+    t103 = (t100 & (xp.less_equal(t23, t101) | xp.less_equal(t36, t101) | xp.less_equal(t53, t101))) | (xp.less_equal(damping, 0) & (xp.less_equal(t10, t102) | xp.less_equal(t78, t102) | xp.less_equal(t90, t102)))
     t104 = t98 & t99 & xp.logical_not(t103)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t104, xp.where(t100, t60, t97), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t104, xp.where(t100, t61, t96), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t104, xp.where(t100, t62, t95), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t104, xp.where(t100, t61, t97), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t104, xp.where(t100, t62, t96), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t104, xp.where(t100, t63, t95), 0), batch),  # 2
     ], (3,))
     status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t98 & t99), 2, xp.where(t103, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
@@ -829,7 +829,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t13 = t12 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t12))
     t14 = t9**2 + t10**2 + t13**2
     t15 = damping + t4
-    t16 = xp.sqrt(t5**2 + t6**2 + t15**2)
+    t16 = xp.sqrt(t15**2 + t5**2 + t6**2)
     t17 = t16*xp.where(xp.greater_equal(t15, 0), xp.asarray(1, dtype=dtype), -1)
     t18 = t15 + t17
     t19 = xp.where(xp.greater(t16, 0), 1/(t16*(t16 + xp.abs(t15))), 0)
@@ -838,7 +838,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t22 = t10 + t5*t20
     t23 = -t13 + t6*t20
     t24 = damping + t7
-    t25 = -t19*(t6*t8 + t5*t18 + t5*t24)
+    t25 = -t19*(t6*t8 + t5*t18 + t24*t5)
     t26 = t5 + t18*t25
     t27 = t24 + t5*t25
     t28 = t8 + t6*t25
@@ -850,7 +850,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t34 = t22 - t31*t33
     t35 = t23 - t28*t33
     t36 = 3 + damping
-    t37 = -t19*(t5*t8 + t6*t18 + t6*t36)
+    t37 = -t19*(t5*t8 + t6*t18 + t36*t6)
     t38 = t6 + t18*t37
     t39 = t8 + t5*t37
     t40 = t36 + t6*t37
@@ -908,13 +908,13 @@ def ik_branches(mu):
     t15 = t10**2 + t14**2
     t16 = t2*t14
     t17 = t3*t10
-    t18 = t16 - t17
+    t18 = -t17 + t16
     t19 = t16 + t17
     t20 = t3*t14
     t21 = t2*t10
     t22 = t20 + t21
     t23 = t18**2 + t22**2
-    t24 = t20 - t21
+    t24 = -t21 + t20
     t25 = t19**2 + t24**2
     t26 = 1e-24*t4*t15
     t27 = xp.where(xp.less_equal(t23, t26), 0, xp.atan2(t22, t18))

@@ -237,7 +237,7 @@ def _fk_jacobian_dot(q, q_dot):
     t6 = t5 + t1*qd2
     t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t8 + t0*qd2
+    t9 = t0*qd2 + t8
     t10 = t9 + t2*qd1
     t11 = -s123
     T = casadi.SX(4, 4)
@@ -292,7 +292,7 @@ def _jacobian_dot(q, q_dot):
     t6 = t5 + t1*qd2
     t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t8 + t0*qd2
+    t9 = t0*qd2 + t8
     t10 = t9 + t2*qd1
     Jd = casadi.SX(6, 3)
     Jd[0, 0] = -t10
@@ -331,7 +331,7 @@ def _bias_acceleration(q, q_dot):
     t6 = t5 + t1*qd2
     t7 = t6 + t3*qd1
     t8 = c123*qd3
-    t9 = t8 + t0*qd2
+    t9 = t0*qd2 + t8
     t10 = t9 + t2*qd1
     a = casadi.SX(6, 1)
     a[0, 0] = -qd1*t10 - qd2*(t9 + t0*qd1) - qd3*(c123*t4 + t8)
@@ -368,7 +368,7 @@ def _task_jacobian_dot(q, q_dot):
     t8 = t6 + t1*qd1
     t9 = t5 + s123*t4
     t10 = c123*qd3
-    t11 = t10 + t0*qd2
+    t11 = t0*qd2 + t10
     t12 = t11 + t2*qd1
     t13 = t11 + t0*qd1
     t14 = c123*t4 + t10
@@ -505,72 +505,72 @@ def _velocity_ik(q, mu_dot, damping):
     t7 = s123**2 + t1**2 + t6
     t8 = t7
     t9 = t2**2
-    t10 = casadi.sqrt(1 + t9 + t6)
+    t10 = casadi.sqrt(1 + t6 + t9)
     t11 = t10*casadi.if_else((t3 <= 0), 1, -1)
-    t12 = c123**2 + t0**2 + t9
-    t13 = t12
-    t14 = casadi.sqrt(3 + t7 + t12)
-    t15 = c123 + t0 + t2
-    t16 = t15
-    t17 = t4**2
-    t18 = t5**2
-    t19 = damping**2
-    t20 = t19 + t8
-    t21 = t20**2
-    t22 = casadi.sqrt(t17 + t18 + t21)
-    t23 = t22*casadi.if_else((t20 >= 0), 1, -1)
-    t24 = t23 + t20
-    t25 = casadi.if_else((t22 > 0), 1/(t22*(t22 + casadi.fabs(t20))), 0)
-    t26 = -t25*(-mu_dot0*t24 + mu_dot1*t4 + mu_dot2*t5)
-    t27 = mu_dot0 - t24*t26
-    t28 = mu_dot1 + t4*t26
-    t29 = mu_dot2 + t5*t26
-    t30 = t19 + t13
-    t31 = -t25*(t4*t24 + t4*t30 + t5*t16)
-    t32 = t4 + t24*t31
-    t33 = t4*t31 + t30
-    t34 = t16 + t5*t31
-    t35 = casadi.sqrt(t33**2 + t34**2)
-    t36 = t35*casadi.if_else((t33 >= 0), 1, -1)
-    t37 = t33 + t36
-    t38 = casadi.if_else((t35 > 0), 1/(t35*(t35 + casadi.fabs(t33))), 0)
-    t39 = t38*(t28*t37 + t34*t29)
-    t40 = t28 - t37*t39
-    t41 = t29 - t34*t39
-    t42 = 3 + t19
-    t43 = casadi.sqrt(2*t17 + 2*t18 + 2*t16**2 + t21 + t30**2 + t42**2)
-    t44 = -t25*(t5*t24 + t4*t16 + t5*t42)
-    t45 = t5 + t24*t44
-    t46 = t16 + t4*t44
-    t47 = t5*t44 + t42
-    t48 = t38*(t46*t37 + t34*t47)
-    t49 = t46 - t37*t48
-    t50 = t47 - t34*t48
-    t51 = casadi.fabs(t50)
-    t52 = t51
-    t53 = t52*casadi.if_else((t50 >= 0), 1, -1)
-    t54 = t50 + t53
-    t55 = casadi.if_else((t52 > 0), 1/(t52*(t51 + t52)), 0)
-    t56 = t41 - t41*t54**2*t55
-    t57 = casadi.if_else((t53 != 0), -t56/t53, 0)
-    t58 = casadi.if_else((t36 != 0), -(t40 - t49*t57)/t36, 0)
-    t59 = casadi.if_else((t23 != 0), -(t27 + t32*t58 + t45*t57)/t23, 0)
-    t60 = t57 - t3*t59 + t2*t58
-    t61 = t57 - t1*t59 + t0*t58
-    t62 = t57 - s123*t59 + c123*t58
-    t63 = -t3
-    t64 = t63 + t11
-    t65 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t63))), 0)
-    t66 = t65*(1 - t1*t64 + t0*t2)
-    t67 = t1 + t64*t66
+    t12 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t3))), 0)
+    t13 = c123**2 + t0**2 + t9
+    t14 = t13
+    t15 = casadi.sqrt(3 + t7 + t13)
+    t16 = c123 + t0 + t2
+    t17 = t16
+    t18 = t4**2
+    t19 = t5**2
+    t20 = damping**2
+    t21 = t8 + t20
+    t22 = t21**2
+    t23 = casadi.sqrt(t18 + t19 + t22)
+    t24 = t23*casadi.if_else((t21 >= 0), 1, -1)
+    t25 = t24 + t21
+    t26 = casadi.if_else((t23 > 0), 1/(t23*(t23 + casadi.fabs(t21))), 0)
+    t27 = -t26*(-mu_dot0*t25 + mu_dot1*t4 + mu_dot2*t5)
+    t28 = mu_dot0 - t25*t27
+    t29 = mu_dot1 + t4*t27
+    t30 = mu_dot2 + t5*t27
+    t31 = t14 + t20
+    t32 = -t26*(t4*t25 + t5*t17 + t4*t31)
+    t33 = t4 + t25*t32
+    t34 = t4*t32 + t31
+    t35 = t17 + t5*t32
+    t36 = casadi.sqrt(t34**2 + t35**2)
+    t37 = t36*casadi.if_else((t34 >= 0), 1, -1)
+    t38 = t34 + t37
+    t39 = casadi.if_else((t36 > 0), 1/(t36*(t36 + casadi.fabs(t34))), 0)
+    t40 = t39*(t29*t38 + t35*t30)
+    t41 = t29 - t38*t40
+    t42 = t30 - t35*t40
+    t43 = 3 + t20
+    t44 = casadi.sqrt(2*t18 + 2*t19 + 2*t17**2 + t22 + t31**2 + t43**2)
+    t45 = -t26*(t5*t25 + t4*t17 + t5*t43)
+    t46 = t5 + t25*t45
+    t47 = t17 + t4*t45
+    t48 = t5*t45 + t43
+    t49 = t39*(t47*t38 + t35*t48)
+    t50 = t47 - t38*t49
+    t51 = t48 - t35*t49
+    t52 = casadi.fabs(t51)
+    t53 = t52
+    t54 = t53*casadi.if_else((t51 >= 0), 1, -1)
+    t55 = t51 + t54
+    t56 = casadi.if_else((t53 > 0), 1/(t53*(t53 + t52)), 0)
+    t57 = t42 - t42*t55**2*t56
+    t58 = casadi.if_else((t54 != 0), -t57/t54, 0)
+    t59 = casadi.if_else((t37 != 0), -(t41 - t50*t58)/t37, 0)
+    t60 = casadi.if_else((t24 != 0), -(t28 + t33*t59 + t46*t58)/t24, 0)
+    t61 = t58 - t3*t60 + t2*t59
+    t62 = t58 - t1*t60 + t0*t59
+    t63 = t58 - s123*t60 + c123*t59
+    t64 = -t3
+    t65 = t11 + t64
+    t66 = t12*(1 - t1*t65 + t0*t2)
+    t67 = t1 + t65*t66
     t68 = t0 - t2*t66
     t69 = 1 - t66
-    t70 = t65*(1 + c123*t2 - s123*t64)
-    t71 = s123 + t64*t70
+    t70 = t12*(1 + c123*t2 - s123*t65)
+    t71 = s123 + t65*t70
     t72 = c123 - t2*t70
     t73 = 1 - t70
-    t74 = t65*(mu_dot2 + mu_dot0*t64 + t2*mu_dot1)
-    t75 = mu_dot0 - t64*t74
+    t74 = t12*(mu_dot2 + mu_dot0*t65 + t2*mu_dot1)
+    t75 = mu_dot0 - t65*t74
     t76 = mu_dot1 - t2*t74
     t77 = -t74 + mu_dot2
     t78 = casadi.sqrt(t68**2 + t69**2)
@@ -583,12 +583,12 @@ def _velocity_ik(q, mu_dot, damping):
     t85 = t81*(t76*t80 + t69*t77)
     t86 = t76 - t80*t85
     t87 = t77 - t69*t85
-    t88 = 3 - t1 - s123 + q1 + q2 + q3 + mu_dot0 + mu_dot1 + mu_dot2 + damping + t15 + t63
+    t88 = 3 - t1 - s123 + q1 + q2 + q3 + mu_dot0 + mu_dot1 + mu_dot2 + damping + t16 + t64
     t89 = casadi.fabs(t84)
     t90 = t89
     t91 = t90*casadi.if_else((t84 >= 0), 1, -1)
     t92 = t84 + t91
-    t93 = casadi.if_else((t90 > 0), 1/(t90*(t89 + t90)), 0)
+    t93 = casadi.if_else((t90 > 0), 1/(t90*(t90 + t89)), 0)
     t94 = t87 - t87*t92**2*t93
     t95 = casadi.if_else((t91 != 0), -t94/t91, 0)
     t96 = casadi.if_else((t79 != 0), -(t86 - t83*t95)/t79, 0)
@@ -596,14 +596,14 @@ def _velocity_ik(q, mu_dot, damping):
     t98 = (casadi.fabs(t88) < casadi.inf)
     t99 = (damping >= 0)
     t100 = (damping > 0)
-    t101 = 1e-12*t43
-    t102 = 1e-12*t14
-    t103 = casadi.logic_or(casadi.logic_and(t100, casadi.logic_or(casadi.logic_or((t22 <= t101), (t35 <= t101)), (t52 <= t101))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t10 <= t102), (t78 <= t102)), (t90 <= t102))))
+    t101 = 1e-12*t44
+    t102 = 1e-12*t15
+    t103 = casadi.logic_or(casadi.logic_and(t100, casadi.logic_or(casadi.logic_or((t23 <= t101), (t36 <= t101)), (t53 <= t101))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t10 <= t102), (t78 <= t102)), (t90 <= t102))))
     t104 = casadi.logic_and(casadi.logic_and(t98, t99), casadi.logic_not(t103))
     q_dot = casadi.SX(3, 1)
-    q_dot[0, 0] = casadi.if_else(t104, casadi.if_else(t100, t60, t97), 0)
-    q_dot[1, 0] = casadi.if_else(t104, casadi.if_else(t100, t61, t96), 0)
-    q_dot[2, 0] = casadi.if_else(t104, casadi.if_else(t100, t62, t95), 0)
+    q_dot[0, 0] = casadi.if_else(t104, casadi.if_else(t100, t61, t97), 0)
+    q_dot[1, 0] = casadi.if_else(t104, casadi.if_else(t100, t62, t96), 0)
+    q_dot[2, 0] = casadi.if_else(t104, casadi.if_else(t100, t63, t95), 0)
     status = casadi.SX(1, 1)
     status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t98, t99)), 2, casadi.if_else(t103, 1, 0))
     return [q_dot, status]
@@ -646,7 +646,7 @@ def _ik_numeric_step(target, q, damping):
     t13 = t12 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t12))
     t14 = t9**2 + t10**2 + t13**2
     t15 = damping + t4
-    t16 = casadi.sqrt(t5**2 + t6**2 + t15**2)
+    t16 = casadi.sqrt(t15**2 + t5**2 + t6**2)
     t17 = t16*casadi.if_else((t15 >= 0), 1, -1)
     t18 = t15 + t17
     t19 = casadi.if_else((t16 > 0), 1/(t16*(t16 + casadi.fabs(t15))), 0)
@@ -655,7 +655,7 @@ def _ik_numeric_step(target, q, damping):
     t22 = t10 + t5*t20
     t23 = -t13 + t6*t20
     t24 = damping + t7
-    t25 = -t19*(t6*t8 + t5*t18 + t5*t24)
+    t25 = -t19*(t6*t8 + t5*t18 + t24*t5)
     t26 = t5 + t18*t25
     t27 = t24 + t5*t25
     t28 = t8 + t6*t25
@@ -667,7 +667,7 @@ def _ik_numeric_step(target, q, damping):
     t34 = t22 - t31*t33
     t35 = t23 - t28*t33
     t36 = 3 + damping
-    t37 = -t19*(t5*t8 + t6*t18 + t6*t36)
+    t37 = -t19*(t5*t8 + t6*t18 + t36*t6)
     t38 = t6 + t18*t37
     t39 = t8 + t5*t37
     t40 = t36 + t6*t37
@@ -722,13 +722,13 @@ def _ik_branches(mu):
     t15 = t10**2 + t14**2
     t16 = t2*t14
     t17 = t3*t10
-    t18 = t16 - t17
+    t18 = -t17 + t16
     t19 = t16 + t17
     t20 = t3*t14
     t21 = t2*t10
     t22 = t20 + t21
     t23 = t18**2 + t22**2
-    t24 = t20 - t21
+    t24 = -t21 + t20
     t25 = t19**2 + t24**2
     t26 = 1e-24*t4*t15
     t27 = casadi.if_else((t23 <= t26), 0, casadi.atan2(t22, t18))

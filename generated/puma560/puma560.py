@@ -124,8 +124,8 @@ def fk(q):
     t30 = c6*t27 - s6*t29
     t31 = s6*t27 + c6*t29
     t32 = 0.4318*c2
-    t33 = c1*t32 + t19
-    t34 = s1*t32 + t25
+    t33 = t19 + c1*t32
+    t34 = t25 + s1*t32
     T = _stack(xp, [
         t17,  # 0, 0
         -t18,  # 0, 1
@@ -184,8 +184,8 @@ def jacobian(q):
     t18 = s5*t13 + c5*t17
     t19 = t5 - 0.4318*t17
     t20 = 0.4318*c2
-    t21 = c1*t20 + t16
-    t22 = s1*t20 + t19
+    t21 = t16 + c1*t20
+    t22 = t19 + s1*t20
     t23 = -c1
     J = _stack(xp, [
         -t22,  # 0, 0
@@ -279,8 +279,8 @@ def fk_jacobian(q):
     t30 = c6*t27 - s6*t29
     t31 = s6*t27 + c6*t29
     t32 = 0.4318*c2
-    t33 = c1*t32 + t19
-    t34 = s1*t32 + t25
+    t33 = t19 + c1*t32
+    t34 = t25 + s1*t32
     t35 = -t16
     t36 = -t22
     t37 = -c1
@@ -393,8 +393,8 @@ def jacobian_tool(q):
     t29 = c6*t26 - s6*t28
     t30 = s6*t26 + c6*t28
     t31 = 0.4318*c2
-    t32 = c1*t31 + t18
-    t33 = s1*t31 + t24
+    t32 = t18 + c1*t31
+    t33 = t24 + s1*t31
     t34 = c1*t32 + s1*t33
     t35 = c1*t16
     t36 = s1*t22
@@ -428,7 +428,7 @@ def jacobian_tool(q):
         t29,  # 3, 0
         t42,  # 3, 1
         t42,  # 3, 2
-        -(-c23*t29 + t16*t13 + t22*t19),  # 3, 3
+        -(t16*t13 + t22*t19 - c23*t29),  # 3, 3
         t11*t16 - t8*t22 + t29*t28,  # 3, 4
         -(-t29*t27 + t16*t15 + t22*t21),  # 3, 5
         -t30,  # 4, 0
@@ -493,8 +493,8 @@ def task(q):
     t25 = t5 - c1*t24
     t26 = t6 - s1*t24
     t27 = 0.4318*c2
-    t28 = c1*t27 + t25
-    t29 = s1*t27 + t26
+    t28 = t25 + c1*t27
+    t29 = t26 + s1*t27
     mu = _stack(xp, [
         t28,  # 0
         t29,  # 1
@@ -553,13 +553,13 @@ def task_jacobian(q):
     t26 = s23*s4
     t27 = c6*t24 - s6*t26
     t28 = 0.4318*c2
-    t29 = c1*t28 + t17
-    t30 = s1*t28 + t22
+    t29 = t17 + c1*t28
+    t30 = t22 + s1*t28
     t31 = s1*t16
     t32 = c1*t21
     t33 = t16**2 + t21**2
     t34 = 1/t33
-    t35 = (t31 - t32)*t34
+    t35 = t34*(-t32 + t31)
     t36 = c1*t16
     t37 = s1*t21
     t38 = -t34*(s23*t36 + s23*t37)
@@ -668,8 +668,8 @@ def fk_jacobian_dot(q, q_dot):
     t32 = s6*t28 + c6*t30
     t33 = t3 + t30*qd5
     t34 = 0.4318*c2
-    t35 = c1*t34 + t20
-    t36 = s1*t34 + t26
+    t35 = t20 + c1*t34
+    t36 = t26 + s1*t34
     t37 = c1*t35 + s1*t36
     t38 = t37
     t39 = c1*t20 + s1*t26
@@ -680,14 +680,14 @@ def fk_jacobian_dot(q, q_dot):
     t44 = t42 + t43
     t45 = t44 - t15*qd4
     t46 = t45 + t13*qd5
-    t47 = t0*t43 + t1*t42
+    t47 = t1*t42 + t0*t43
     t48 = -t47 + t35*qd1
     t49 = c1*qd2
     t50 = c1*qd3
     t51 = t49 + t50
     t52 = t51 + t21*qd4
     t53 = t52 + t10*qd5
-    t54 = t0*t50 + t1*t49
+    t54 = t1*t49 + t0*t50
     t55 = t54 + t36*qd1
     t56 = -t17
     t57 = -t23
@@ -757,12 +757,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t29, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t48 + qd2*(t60*qd1 - c1*t41) - qd3*(t49*t40 - t61*qd1 + t50*t40), batch),  # 0
-        xp.broadcast_to(-qd1*t55 - qd2*(t58*qd1 + s1*t41) - qd3*(t59*qd1 + t42*t40 + t43*t40), batch),  # 1
+        xp.broadcast_to(-qd1*t48 + qd2*(-c1*t41 + t60*qd1) - qd3*(t49*t40 - t61*qd1 + t50*t40), batch),  # 0
+        xp.broadcast_to(-qd1*t55 - qd2*(s1*t41 + t58*qd1) - qd3*(t59*qd1 + t42*t40 + t43*t40), batch),  # 1
         xp.broadcast_to(-qd2*(s1*t47 + c1*t54) - qd3*(t63*t64 + t64*t65 + t63*t66 + t65*t66), batch),  # 2
-        xp.broadcast_to(t49*qd1 + t50*qd1 + qd4*(-c23*t51 + t21*qd1) + qd5*(-t30*t52 + t10*t3) + qd6*(-t29*t53 + t23*t33), batch),  # 3
-        xp.broadcast_to(t42*qd1 + t43*qd1 - qd4*(t15*qd1 + c23*t44) + qd5*(t13*t3 - t30*t45) - qd6*(t17*t33 + t29*t46), batch),  # 4
-        xp.broadcast_to(-qd4*(t21*t44 + t15*t51) + qd5*(-t10*t45 + t13*t52) - qd6*(t23*t46 + t17*t53), batch),  # 5
+        xp.broadcast_to(qd6*(-t29*t53 + t23*t33) + t49*qd1 + t50*qd1 + qd4*(-c23*t51 + t21*qd1) + qd5*(t10*t3 - t30*t52), batch),  # 3
+        xp.broadcast_to(t42*qd1 + t43*qd1 - qd4*(c23*t44 + t15*qd1) + qd5*(t13*t3 - t30*t45) - qd6*(t17*t33 + t29*t46), batch),  # 4
+        xp.broadcast_to(qd5*(-t10*t45 + t13*t52) - qd4*(t21*t44 + t15*t51) - qd6*(t23*t46 + t17*t53), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -811,8 +811,8 @@ def jacobian_dot(q, q_dot):
     t20 = t6 - s1*t18
     t21 = c1*t19 + s1*t20
     t22 = 0.4318*c2
-    t23 = c1*t22 + t19
-    t24 = s1*t22 + t20
+    t23 = t19 + c1*t22
+    t24 = t20 + s1*t22
     t25 = c1*t23 + s1*t24
     t26 = t21*qd3 + t25*qd2
     t27 = s1*qd2
@@ -841,7 +841,7 @@ def jacobian_dot(q, q_dot):
     Jd = _stack(xp, [
         xp.broadcast_to(-t31, batch),  # 0, 0
         xp.broadcast_to(t2*t44 - c1*t26, batch),  # 0, 1
-        xp.broadcast_to(-(t32*t21 - t1*t44 + t33*t21), batch),  # 0, 2
+        xp.broadcast_to(-(-t1*t44 + t32*t21 + t33*t21), batch),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
@@ -861,7 +861,7 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(t45, batch),  # 3, 1
         xp.broadcast_to(t45, batch),  # 3, 2
         xp.broadcast_to(-c23*t34 + s23*t44, batch),  # 3, 3
-        xp.broadcast_to(-t42*t39 + t10*t3, batch),  # 3, 4
+        xp.broadcast_to(t10*t3 - t42*t39, batch),  # 3, 4
         xp.broadcast_to(-t0*t41 + t17*t43, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t44, batch),  # 4, 1
@@ -924,8 +924,8 @@ def bias_acceleration(q, q_dot):
     t20 = t6 - s1*t18
     t21 = c1*t19 + s1*t20
     t22 = 0.4318*c2
-    t23 = c1*t22 + t19
-    t24 = s1*t22 + t20
+    t23 = t19 + c1*t22
+    t24 = t20 + s1*t22
     t25 = c1*t23 + s1*t24
     t26 = t21*qd3 + t25*qd2
     t27 = s1*qd2
@@ -952,12 +952,12 @@ def bias_acceleration(q, q_dot):
     t48 = c1**2
     t49 = t1*qd3
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t31 + qd2*(t2*t44 - c1*t26) - qd3*(t32*t21 - t1*t44 + t33*t21), batch),  # 0
+        xp.broadcast_to(-qd1*t31 + qd2*(t2*t44 - c1*t26) - qd3*(-t1*t44 + t32*t21 + t33*t21), batch),  # 0
         xp.broadcast_to(-qd1*t36 - qd2*(t2*t45 + s1*t26) - qd3*(t1*t45 + t27*t21 + t28*t21), batch),  # 1
         xp.broadcast_to(-qd2*(s1*t30 + c1*t35) - qd3*(t46*t47 + t47*t48 + t46*t49 + t48*t49), batch),  # 2
-        xp.broadcast_to(t32*qd1 + t33*qd1 + qd4*(-c23*t34 + s23*t44) + qd5*(-t42*t39 + t10*t3) + qd6*(-t0*t41 + t17*t43), batch),  # 3
-        xp.broadcast_to(t27*qd1 + t28*qd1 - qd4*(s23*t45 + c23*t29) + qd5*(t13*t3 - t42*t38) - qd6*(t16*t43 + t0*t40), batch),  # 4
-        xp.broadcast_to(-qd4*(s1*s23*t29 + c1*s23*t34) + qd5*(-t10*t38 + t13*t39) - qd6*(t17*t40 + t16*t41), batch),  # 5
+        xp.broadcast_to(qd6*(-t0*t41 + t17*t43) + t32*qd1 + t33*qd1 + qd4*(-c23*t34 + s23*t44) + qd5*(t10*t3 - t42*t39), batch),  # 3
+        xp.broadcast_to(-qd6*(t16*t43 + t0*t40) + t27*qd1 + t28*qd1 - qd4*(s23*t45 + c23*t29) + qd5*(t13*t3 - t42*t38), batch),  # 4
+        xp.broadcast_to(qd5*(-t10*t38 + t13*t39) - qd6*(t17*t40 + t16*t41) - qd4*(s1*s23*t29 + c1*s23*t34), batch),  # 5
     ], (6,))
     return a
 
@@ -1018,8 +1018,8 @@ def task_jacobian_dot(q, q_dot):
     t29 = s23*s4
     t30 = c6*t27 - s6*t29
     t31 = 0.4318*c2
-    t32 = c1*t31 + t17
-    t33 = s1*t31 + t22
+    t32 = t17 + c1*t31
+    t33 = t22 + s1*t31
     t34 = c1*t32 + s1*t33
     t35 = t23*qd3 + t34*qd2
     t36 = s1*qd2
@@ -1028,7 +1028,7 @@ def task_jacobian_dot(q, q_dot):
     t39 = -t38 + t32*qd1
     t40 = t36 + t37
     t41 = t40
-    t42 = t13*qd1 + c23*t41
+    t42 = c23*t41 + t13*qd1
     t43 = c1*qd2
     t44 = c1*qd3
     t45 = t0*t44 + t1*t43
@@ -1039,35 +1039,35 @@ def task_jacobian_dot(q, q_dot):
     t50 = -c23*t49 + t18*qd1
     t51 = t18*t41 + t13*t49
     t52 = -t13*qd4
-    t53 = t41 + t52
+    t53 = t52 + t41
     t54 = t18*qd4
-    t55 = t49 + t54
+    t55 = t54 + t49
     t56 = -t8*t53 + t11*t55
     t57 = qd1 + c23*qd4
     t58 = t57
-    t59 = -t29*t55 + t8*t58
+    t59 = t8*t58 - t29*t55
     t60 = t11*t58 - t29*t53
     t61 = t11*qd5
-    t62 = t53 + t61
+    t62 = t61 + t53
     t63 = t40 + t52 + t61 - t15*qd6
     t64 = t8*qd5
-    t65 = t55 + t64
+    t65 = t64 + t55
     t66 = t20*t62 + t15*t65
     t67 = t48 + t54 + t64 + t20*qd6
     t68 = t21*t63 + t16*t67
     t69 = t29*qd5
-    t70 = t58 + t69
+    t70 = t69 + t58
     t71 = -t28*t65 + t20*t70
     t72 = t15*t70 + t28*t62
     t73 = t57 + t69 + t28*qd6
     t74 = t30*t67 + t21*t73
     t75 = t16*t73 - t30*t63
     t76 = s1*qd1
-    t77 = t1*t76 - c1*t35
-    t78 = t43*t23 - t0*t76 + t44*t23
+    t77 = -c1*t35 + t1*t76
+    t78 = t44*t23 + t43*t23 - t0*t76
     t79 = c1*qd1
-    t80 = t1*t79 + s1*t35
-    t81 = t0*t79 + t36*t23 + t37*t23
+    t80 = s1*t35 + t1*t79
+    t81 = t36*t23 + t37*t23 + t0*t79
     t82 = s1**2
     t83 = t0*qd2
     t84 = c1**2
@@ -1076,7 +1076,7 @@ def task_jacobian_dot(q, q_dot):
     t87 = s1*t16
     t88 = c1*t21
     t89 = 1/t24
-    t90 = (t87 - t88)*t89
+    t90 = (-t88 + t87)*t89
     t91 = (t11*t16 - t8*t21)*t89
     t92 = -(t16*t15 + t21*t20)*t89
     t93 = c1*t16
@@ -1115,10 +1115,10 @@ def task_jacobian_dot(q, q_dot):
     t126 = t71*t114
     t127 = t72*t116
     t128 = qd1*t96
-    t129 = t74*(c1*t96 + t16*t98) - t75*(s1*t96 + t21*t98) - t88*t128 + t87*t128
+    t129 = t74*(t16*t98 + c1*t96) - t75*(t21*t98 + s1*t96) - t88*t128 + t87*t128
     t130 = t21*t96
     t131 = t16*t96
-    t132 = -(-t30*t104 + t30*t106 + t68*t90 + t30*t108 + t30*t109)
+    t132 = -(t68*t90 - t30*t104 + t30*t106 + t30*t108 + t30*t109)
     Jd = _stack(xp, [
         xp.broadcast_to(-t39, batch),  # 0, 0
         xp.broadcast_to(t77, batch),  # 0, 1
@@ -1141,21 +1141,21 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t110, batch),  # 3, 1
         xp.broadcast_to(t110, batch),  # 3, 2
-        xp.broadcast_to(-t112 + t113 + t115 - t117, batch),  # 3, 3
+        xp.broadcast_to(-t112 - t117 + t113 + t115, batch),  # 3, 3
         xp.broadcast_to(-t119 + t120 + t121 + t122, batch),  # 3, 4
-        xp.broadcast_to(-t124 + t125 + t126 - t127, batch),  # 3, 5
+        xp.broadcast_to(-t124 - t127 + t125 + t126, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t129, batch),  # 4, 1
         xp.broadcast_to(t129, batch),  # 4, 2
-        xp.broadcast_to(-(-t74*(t18*t96 + t16*t99) - t75*(t13*t96 - t21*t99) + t50*t130 + t42*t131), batch),  # 4, 3
-        xp.broadcast_to(t74*(t8*t96 + t16*t100) - t75*(t11*t96 + t21*t100) - t59*t130 + t60*t131, batch),  # 4, 4
-        xp.broadcast_to(-(-t74*(t20*t96 + t16*t101) - t75*(t15*t96 - t21*t101) + t71*t130 + t72*t131), batch),  # 4, 5
+        xp.broadcast_to(-(-t74*(t16*t99 + t18*t96) - t75*(-t21*t99 + t13*t96) + t50*t130 + t42*t131), batch),  # 4, 3
+        xp.broadcast_to(t74*(t16*t100 + t8*t96) - t75*(t21*t100 + t11*t96) - t59*t130 + t60*t131, batch),  # 4, 4
+        xp.broadcast_to(-(-t74*(t16*t101 + t20*t96) - t75*(-t21*t101 + t15*t96) + t71*t130 + t72*t131), batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.broadcast_to(t132, batch),  # 5, 1
         xp.broadcast_to(t132, batch),  # 5, 2
-        xp.broadcast_to(-(t51 - t30*t112 + t30*t113 + t68*t95 + t30*t115 - t30*t117), batch),  # 5, 3
-        xp.broadcast_to(-(-t56 - t30*t119 + t30*t120 + t68*t91 + t30*t121 + t30*t122), batch),  # 5, 4
-        xp.broadcast_to(-(t66 - t30*t124 + t30*t125 + t68*t92 + t30*t126 - t30*t127), batch),  # 5, 5
+        xp.broadcast_to(-(t51 + t68*t95 - t30*t112 + t30*t113 + t30*t115 - t30*t117), batch),  # 5, 3
+        xp.broadcast_to(-(-t56 + t68*t91 - t30*t119 + t30*t120 + t30*t121 + t30*t122), batch),  # 5, 4
+        xp.broadcast_to(-(t66 + t68*t92 - t30*t124 + t30*t125 + t30*t126 - t30*t127), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1182,7 +1182,7 @@ def hessian(q):
     t3 = c1*c23
     t4 = 0.15005*s1 + 0.0203*t3
     t5 = s1*c23
-    t6 = -0.15005*c1 + 0.0203*t5
+    t6 = 0.0203*t5 - 0.15005*c1
     t7 = s1*s4
     t8 = c1*c4
     t9 = -t7 + c23*t8
@@ -1190,7 +1190,7 @@ def hessian(q):
     t11 = s1*c4
     t12 = c1*s4
     t13 = t11 + c23*t12
-    t14 = t12 + c23*t11
+    t14 = c23*t11 + t12
     t15 = c1*s23
     t16 = t9*s5 + c5*t15
     t17 = t4 - 0.4318*t15
@@ -1199,8 +1199,8 @@ def hessian(q):
     t20 = t6 - 0.4318*t18
     t21 = c1*t17 + s1*t20
     t22 = 0.4318*c2
-    t23 = c1*t22 + t17
-    t24 = s1*t22 + t20
+    t23 = t17 + c1*t22
+    t24 = t20 + s1*t22
     t25 = c1*t23 + s1*t24
     t26 = s1*t2
     t27 = s1*t1
@@ -1210,14 +1210,14 @@ def hessian(q):
     t31 = -s1*t21
     t32 = s1**2
     t33 = c1**2
-    t34 = -(t32*t1 + t33*t1)
+    t34 = -(t1*t32 + t1*t33)
     t35 = -t3
     t36 = -s23*t12
     t37 = -c1*t0
     t38 = -t5
     t39 = -s23*t7
     t40 = -s1*t0
-    t41 = -(t32*s23 + t33*s23)
+    t41 = -(s23*t32 + s23*t33)
     t42 = -s1*t10 + c1*t13
     t43 = -(s1*t19 + c1*t16)
     t44 = s23**2
@@ -1272,7 +1272,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -(t32*t2 + t33*t2),  # 1, 2, 1
+        -(t2*t32 + t2*t33),  # 1, 2, 1
         t34,  # 1, 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 4
@@ -1353,8 +1353,8 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        -t7*t44 + c23*t10,  # 3, 3, 4
-        -t0*t18 + c23*t19,  # 3, 3, 5
+        c23*t10 - t7*t44,  # 3, 3, 4
+        c23*t19 - t0*t18,  # 3, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
@@ -1396,7 +1396,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        -(t16*t45 + t13*t0),  # 4, 4, 5
+        -(t13*t0 + t16*t45),  # 4, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
@@ -1456,7 +1456,7 @@ def singularity_factors(q):
     f = _stack(xp, [
         c3 + t0,  # 0
         s5,  # 1
-        -(-c2 + c2*s3 + s2*c3 + s2*t0 - 0.04701250578971746*c2*c3),  # 2
+        -(-c2 + c2*s3 + s2*c3 - 0.04701250578971746*c2*c3 + s2*t0),  # 2
     ], (3,))
     return f
 
@@ -1471,7 +1471,7 @@ def manipulability(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.04701250578971746*s3
-    t1 = -0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + s2*c3 + s2*t0 - 0.04701250578971746*c2*c3)
+    t1 = -0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + s2*c3 - 0.04701250578971746*c2*c3 + s2*t0)
     w = xp.broadcast_to(xp.abs(t1), batch)
     return w
 
@@ -1486,13 +1486,13 @@ def jacobian_det(q):
     s3 = trig[..., 5]
     s5 = trig[..., 9]
     t0 = 0.04701250578971746*s3
-    d = xp.broadcast_to(-0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + s2*c3 + s2*t0 - 0.04701250578971746*c2*c3), batch)
+    d = xp.broadcast_to(-0.080509645432*s5*(c3 + t0)*(-c2 + c2*s3 + s2*c3 - 0.04701250578971746*c2*c3 + s2*t0), batch)
     return d
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1221 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1219 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -1541,12 +1541,12 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t19 = t5 - 0.4318*t17
     t20 = c1*t16 + s1*t19
     t21 = 0.4318*c2
-    t22 = c1*t21 + t16
-    t23 = s1*t21 + t19
+    t22 = t16 + c1*t21
+    t23 = t19 + s1*t21
     t24 = c1*t22 + s1*t23
     t25 = t23**2
     t26 = c1**2
-    t27 = t26*t2 + t26*t1
+    t27 = t1*t26 + t2*t26
     t28 = t2**2
     t29 = t1**2
     t30 = t25 + t26*t28 + t26*t29
@@ -1562,338 +1562,336 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t40 = c1*t1
     t41 = s1*t39 + s1*t40
     t42 = t22**2
-    t43 = xp.sqrt(1 + t42 + t25)
+    t43 = xp.sqrt(1 + t25 + t42)
     t44 = t43*xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)
-    t45 = s1**2
-    t46 = t45*t2 + t45*t1
-    t47 = t42 + t45*t28 + t45*t29
-    t48 = t47
-    t49 = s1*t24
-    t50 = s1*t20
-    t51 = t2*t49 + t1*t50
-    t52 = t49 + t50
-    t53 = t24**2
-    t54 = t53 + t20**2
-    t55 = t54
-    t56 = s23**2
-    t57 = t12**2 + t15**2 + 2*t45 + t26*t56
-    t58 = t57
-    t59 = 2*s1
-    t60 = -c1*t59 + t33*t56 - t12*t9 + t15*t18
-    t61 = s23*s4
-    t62 = c23*t14 - t12*t61 + t15*t0
-    t63 = c23*t17 + t9*t61 + t18*t0
-    t64 = t9**2 + t18**2 + 2*t26 + t45*t56
-    t65 = t64
-    t66 = 1 + c23**2 + t0**2 + t56*s4**2
-    t67 = t66
-    t68 = xp.sqrt(t30 + t47 + t54 + t57 + t64 + t66)
-    t69 = t34**2
-    t70 = t37**2
-    t71 = t27**2
-    t72 = damping**2
-    t73 = t72 + t31
-    t74 = t73**2
-    t75 = t72 + t48
-    t76 = t72 + t55
-    t77 = t72 + t58
-    t78 = t72 + t65
-    t79 = t72 + t67
-    t80 = t41**2
-    t81 = xp.sqrt(2*t42 + 2*t25 + 2*t69 + 2*t70 + 2*t51**2 + 2*t46**2 + 2*t52**2 + 2*t71 + 2*t38**2 + 2*t60**2 + 2*t62**2 + 2*t63**2 + t74 + t75**2 + t76**2 + t77**2 + t78**2 + t79**2 + 4*t80)
-    t82 = xp.sqrt(t25 + t69 + t70 + t80 + t71 + t74)
-    t83 = t82*xp.where(xp.greater_equal(t73, 0), xp.asarray(1, dtype=dtype), -1)
-    t84 = t73 + t83
-    t85 = xp.where(xp.greater(t82, 0), 1/(t82*(t82 + xp.abs(t73))), 0)
-    t86 = t85*(t32 + t34*t84 + t34*t75 + t37*t51 + t41*t46 + t41*t27)
-    t87 = t34 - t84*t86
-    t88 = t75 - t34*t86
-    t89 = -t51 + t37*t86
-    t90 = -t46 + t41*t86
-    t91 = t41 - t27*t86
-    t92 = t22 + t23*t86
-    t93 = -t85*(t37*t84 + t34*t51 + t37*t76 + t41*t52 + t27*t38)
-    t94 = t37 + t84*t93
-    t95 = t51 + t34*t93
-    t96 = t76 + t37*t93
-    t97 = t52 + t41*t93
-    t98 = t38 + t27*t93
-    t99 = -t85*(t41*t84 + t34*t46 + t37*t52 + t41*t77 - t27*t60 - t23*t62)
-    t100 = t41 + t84*t99
-    t101 = t46 + t34*t99
-    t102 = t52 + t37*t99
-    t103 = t77 + t41*t99
-    t104 = t60 - t27*t99
-    t105 = t85*(t27*t84 + t34*t41 + t37*t38 - t41*t60 + t27*t78 + t23*t63)
-    t106 = t27 - t84*t105
-    t107 = t41 - t34*t105
-    t108 = -t38 + t37*t105
-    t109 = t60 + t41*t105
-    t110 = t78 - t27*t105
-    t111 = -t63 + t23*t105
-    t112 = -t85*(t23*t84 - t22*t34 - t41*t62 + t27*t63 + t23*t79)
-    t113 = t23 + t84*t112
-    t114 = t22 - t34*t112
-    t115 = t63 + t27*t112
-    t116 = t79 + t23*t112
-    t117 = t85*(mu_dot0*t84 + mu_dot1*t34 - mu_dot2*t37 - mu_dot3*t41 + mu_dot4*t27 - t23*mu_dot5)
-    t118 = mu_dot0 - t84*t117
-    t119 = mu_dot1 - t34*t117
-    t120 = mu_dot2 + t37*t117
-    t121 = mu_dot3 + t41*t117
-    t122 = mu_dot4 - t27*t117
-    t123 = mu_dot5 + t23*t117
-    t124 = xp.sqrt(t88**2 + t89**2 + t90**2 + t91**2 + t92**2)
-    t125 = t124*xp.where(xp.greater_equal(t88, 0), xp.asarray(1, dtype=dtype), -1)
-    t126 = t88 + t125
-    t127 = xp.where(xp.greater(t124, 0), 1/(t124*(t124 + xp.abs(t88))), 0)
-    t128 = t127*(t107*t126 + t89*t108 + t90*t109 + t91*t110 + t92*t111)
-    t129 = t107 - t126*t128
-    t130 = t108 - t89*t128
-    t131 = t109 - t90*t128
-    t132 = t110 - t91*t128
-    t133 = t111 - t92*t128
-    t134 = t127*(t119*t126 + t89*t120 + t90*t121 + t91*t122 + t92*t123)
-    t135 = t119 - t126*t134
-    t136 = t120 - t89*t134
-    t137 = t121 - t90*t134
-    t138 = t122 - t91*t134
-    t139 = t123 - t92*t134
-    t140 = -t62
-    t141 = t140 + t23*t99
-    t142 = t140 + t41*t112
-    t143 = t127*(-t101*t126 + t89*t102 + t90*t103 + t91*t104 + t92*t141)
-    t144 = t101 + t126*t143
-    t145 = t102 - t89*t143
-    t146 = t103 - t90*t143
-    t147 = t104 - t91*t143
-    t148 = t141 - t92*t143
-    t149 = t23*t93
-    t150 = t127*(-t95*t126 + t89*t96 + t90*t97 - t91*t98 + t149*t92)
-    t151 = t95 + t126*t150
-    t152 = t96 - t89*t150
-    t153 = t97 - t90*t150
-    t154 = t98 + t91*t150
-    t155 = t149 - t92*t150
-    t156 = xp.sqrt(t152**2 + t153**2 + t154**2 + t155**2)
-    t157 = t156*xp.where(xp.greater_equal(t152, 0), xp.asarray(1, dtype=dtype), -1)
-    t158 = t152 + t157
-    t159 = xp.where(xp.greater(t156, 0), 1/(t156*(t156 + xp.abs(t152))), 0)
-    t160 = t159*(t145*t158 + t153*t146 - t154*t147 + t155*t148)
-    t161 = t145 - t158*t160
-    t162 = t146 - t153*t160
-    t163 = t147 + t154*t160
-    t164 = t148 - t155*t160
-    t165 = t159*(t130*t158 + t153*t131 - t154*t132 + t155*t133)
-    t166 = t130 - t158*t165
-    t167 = t131 - t153*t165
-    t168 = t132 + t154*t165
-    t169 = t133 - t155*t165
-    t170 = t159*(t136*t158 + t153*t137 - t154*t138 + t155*t139)
-    t171 = t136 - t158*t170
-    t172 = t137 - t153*t170
-    t173 = t138 + t154*t170
-    t174 = t139 - t155*t170
-    t175 = xp.sqrt(t162**2 + t163**2 + t164**2)
-    t176 = t175*xp.where(xp.greater_equal(t162, 0), xp.asarray(1, dtype=dtype), -1)
-    t177 = t162 + t176
-    t178 = xp.where(xp.greater(t175, 0), 1/(t175*(t175 + xp.abs(t162))), 0)
-    t179 = t178*(t167*t177 + t163*t168 + t164*t169)
-    t180 = t167 - t177*t179
-    t181 = t168 - t163*t179
-    t182 = t169 - t164*t179
-    t183 = t178*(t172*t177 + t163*t173 + t164*t174)
-    t184 = t172 - t177*t183
-    t185 = t173 - t163*t183
-    t186 = t174 - t164*t183
-    t187 = xp.sqrt(t181**2 + t182**2)
-    t188 = t187*xp.where(xp.greater_equal(t181, 0), xp.asarray(1, dtype=dtype), -1)
-    t189 = t181 + t188
-    t190 = xp.where(xp.greater(t187, 0), 1/(t187*(t187 + xp.abs(t181))), 0)
-    t191 = t190*(t185*t189 + t182*t186)
-    t192 = t185 - t189*t191
-    t193 = t186 - t182*t191
-    t194 = t37*t112
-    t195 = t127*(t114*t126 + t194*t89 + t90*t142 - t91*t115 + t92*t116)
-    t196 = t114 - t126*t195
-    t197 = t194 - t89*t195
-    t198 = t142 - t90*t195
-    t199 = t115 + t91*t195
-    t200 = t116 - t92*t195
-    t201 = t159*(t197*t158 + t153*t198 + t154*t199 + t155*t200)
-    t202 = t197 - t158*t201
-    t203 = t198 - t153*t201
-    t204 = -t199 + t154*t201
-    t205 = t200 - t155*t201
-    t206 = t178*(t203*t177 + t163*t204 + t164*t205)
-    t207 = t203 - t177*t206
-    t208 = t204 - t163*t206
-    t209 = t205 - t164*t206
-    t210 = t190*(t208*t189 + t182*t209)
-    t211 = t208 - t189*t210
-    t212 = t209 - t182*t210
-    t213 = xp.abs(t212)
-    t214 = t213
-    t215 = t214*xp.where(xp.greater_equal(t212, 0), xp.asarray(1, dtype=dtype), -1)
-    t216 = t212 + t215
-    t217 = xp.where(xp.greater(t214, 0), 1/(t214*(t213 + t214)), 0)
-    t218 = t193 - t193*t216**2*t217
-    t219 = xp.where(xp.not_equal(t215, 0), -t218/t215, 0)
-    t220 = xp.where(xp.not_equal(t188, 0), -(t192 - t211*t219)/t188, 0)
-    t221 = xp.where(xp.not_equal(t176, 0), -(-(t180*t220 + t207*t219) + t184)/t176, 0)
-    t222 = xp.where(xp.not_equal(t157, 0), -(-(t161*t221 + t166*t220 + t202*t219) + t171)/t157, 0)
-    t223 = xp.where(xp.not_equal(t125, 0), -(-(-t151*t222 - t144*t221 + t129*t220 + t196*t219) + t135)/t125, 0)
-    t224 = xp.where(xp.not_equal(t83, 0), -(t118 + t94*t222 + t100*t221 + t113*t219 - t87*t223 - t106*t220)/t83, 0)
-    t225 = t219 - t23*t224 + t22*t223
-    t226 = t14*t221 + t17*t220 - c23*t219
-    t227 = t12*t221 - t9*t220 + t61*t219
-    t228 = t15*t221 + t18*t220 - t0*t219
-    t229 = s1*t2
-    t230 = c1*t220 - s1*t221
-    t231 = t230 + t39*t224 + t229*t223 - t24*t222
-    t232 = s1*t1
-    t233 = t230 + t40*t224 + t232*t223 - t20*t222
-    t234 = -t23
-    t235 = t234 + t44
-    t236 = xp.where(xp.greater(t43, 0), 1/(t43*(t43 + xp.abs(t234))), 0)
-    t237 = -t236*(t39*t235 + t22*t229)
-    t238 = t39 + t235*t237
-    t239 = t229 + t22*t237
-    t240 = -t236*(t40*t235 + t22*t232)
-    t241 = t40 + t235*t240
-    t242 = t232 + t22*t240
-    t243 = t236*(mu_dot5 + mu_dot0*t235 + t22*mu_dot1)
-    t244 = mu_dot0 - t235*t243
+    t45 = xp.where(xp.greater(t43, 0), 1/(t43*(t43 + xp.abs(t23))), 0)
+    t46 = s1**2
+    t47 = t2*t46 + t1*t46
+    t48 = t42 + t28*t46 + t29*t46
+    t49 = t48
+    t50 = s1*t24
+    t51 = s1*t20
+    t52 = t2*t50 + t1*t51
+    t53 = t50 + t51
+    t54 = t24**2
+    t55 = t20**2 + t54
+    t56 = t55
+    t57 = s23**2
+    t58 = t12**2 + t15**2 + 2*t46 + t26*t57
+    t59 = t58
+    t60 = 2*s1
+    t61 = -t12*t9 + t15*t18 - c1*t60 + t33*t57
+    t62 = s23*s4
+    t63 = c23*t14 + t15*t0 - t12*t62
+    t64 = t18*t0 + c23*t17 + t9*t62
+    t65 = t9**2 + t18**2 + 2*t26 + t46*t57
+    t66 = t65
+    t67 = 1 + c23**2 + t0**2 + s4**2*t57
+    t68 = t67
+    t69 = xp.sqrt(t30 + t48 + t55 + t58 + t65 + t67)
+    t70 = t34**2
+    t71 = t37**2
+    t72 = t27**2
+    t73 = damping**2
+    t74 = t73 + t31
+    t75 = t74**2
+    t76 = t73 + t49
+    t77 = t73 + t56
+    t78 = t73 + t59
+    t79 = t73 + t66
+    t80 = t73 + t68
+    t81 = t41**2
+    t82 = xp.sqrt(2*t42 + 2*t25 + 2*t70 + 2*t71 + 2*t52**2 + 2*t47**2 + 2*t53**2 + 2*t72 + 2*t38**2 + 2*t61**2 + 2*t63**2 + 2*t64**2 + t75 + t76**2 + t77**2 + t78**2 + t79**2 + t80**2 + 4*t81)
+    t83 = xp.sqrt(t25 + t70 + t71 + t72 + t75 + t81)
+    t84 = t83*xp.where(xp.greater_equal(t74, 0), xp.asarray(1, dtype=dtype), -1)
+    t85 = t74 + t84
+    t86 = xp.where(xp.greater(t83, 0), 1/(t83*(t83 + xp.abs(t74))), 0)
+    t87 = t86*(t32 + t34*t85 + t37*t52 + t41*t47 + t41*t27 + t76*t34)
+    t88 = t34 - t85*t87
+    t89 = t76 - t34*t87
+    t90 = -t52 + t37*t87
+    t91 = -t47 + t41*t87
+    t92 = t41 - t27*t87
+    t93 = t22 + t23*t87
+    t94 = -t86*(t37*t85 + t34*t52 + t41*t53 + t27*t38 + t77*t37)
+    t95 = t37 + t85*t94
+    t96 = t52 + t34*t94
+    t97 = t77 + t37*t94
+    t98 = t53 + t41*t94
+    t99 = t38 + t27*t94
+    t100 = -t86*(t41*t85 + t34*t47 + t37*t53 + t78*t41 - t27*t61 - t23*t63)
+    t101 = t41 + t85*t100
+    t102 = t47 + t34*t100
+    t103 = t53 + t37*t100
+    t104 = t78 + t41*t100
+    t105 = t61 - t27*t100
+    t106 = t86*(t27*t85 + t34*t41 + t37*t38 - t41*t61 + t23*t64 + t79*t27)
+    t107 = t27 - t85*t106
+    t108 = t41 - t34*t106
+    t109 = -t38 + t37*t106
+    t110 = t61 + t41*t106
+    t111 = t79 - t27*t106
+    t112 = -t64 + t23*t106
+    t113 = -t86*(t23*t85 + t27*t64 + t23*t80 - t22*t34 - t41*t63)
+    t114 = t23 + t85*t113
+    t115 = t22 - t34*t113
+    t116 = t64 + t27*t113
+    t117 = t80 + t23*t113
+    t118 = t86*(mu_dot0*t85 + mu_dot1*t34 - mu_dot2*t37 - mu_dot3*t41 + mu_dot4*t27 - t23*mu_dot5)
+    t119 = mu_dot0 - t85*t118
+    t120 = mu_dot1 - t34*t118
+    t121 = mu_dot2 + t37*t118
+    t122 = mu_dot3 + t41*t118
+    t123 = mu_dot4 - t27*t118
+    t124 = mu_dot5 + t23*t118
+    t125 = xp.sqrt(t89**2 + t90**2 + t91**2 + t92**2 + t93**2)
+    t126 = t125*xp.where(xp.greater_equal(t89, 0), xp.asarray(1, dtype=dtype), -1)
+    t127 = t89 + t126
+    t128 = xp.where(xp.greater(t125, 0), 1/(t125*(t125 + xp.abs(t89))), 0)
+    t129 = t128*(t108*t127 + t90*t109 + t91*t110 + t92*t111 + t93*t112)
+    t130 = t108 - t127*t129
+    t131 = t109 - t90*t129
+    t132 = t110 - t91*t129
+    t133 = t111 - t92*t129
+    t134 = t112 - t93*t129
+    t135 = t128*(t120*t127 + t90*t121 + t91*t122 + t92*t123 + t93*t124)
+    t136 = t120 - t127*t135
+    t137 = t121 - t90*t135
+    t138 = t122 - t91*t135
+    t139 = t123 - t92*t135
+    t140 = t124 - t93*t135
+    t141 = -t63
+    t142 = t141 + t23*t100
+    t143 = t141 + t41*t113
+    t144 = t128*(-t102*t127 + t90*t103 + t91*t104 + t92*t105 + t93*t142)
+    t145 = t102 + t127*t144
+    t146 = t103 - t90*t144
+    t147 = t104 - t91*t144
+    t148 = t105 - t92*t144
+    t149 = t142 - t93*t144
+    t150 = t23*t94
+    t151 = t128*(-t96*t127 + t90*t97 + t91*t98 - t92*t99 + t150*t93)
+    t152 = t96 + t127*t151
+    t153 = t97 - t90*t151
+    t154 = t98 - t91*t151
+    t155 = t99 + t92*t151
+    t156 = t150 - t93*t151
+    t157 = xp.sqrt(t153**2 + t154**2 + t155**2 + t156**2)
+    t158 = t157*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
+    t159 = t153 + t158
+    t160 = xp.where(xp.greater(t157, 0), 1/(t157*(t157 + xp.abs(t153))), 0)
+    t161 = t160*(t146*t159 + t154*t147 - t155*t148 + t156*t149)
+    t162 = t146 - t159*t161
+    t163 = t147 - t154*t161
+    t164 = t148 + t155*t161
+    t165 = t149 - t156*t161
+    t166 = t160*(t131*t159 + t154*t132 - t155*t133 + t156*t134)
+    t167 = t131 - t159*t166
+    t168 = t132 - t154*t166
+    t169 = t133 + t155*t166
+    t170 = t134 - t156*t166
+    t171 = t160*(t137*t159 + t154*t138 - t155*t139 + t156*t140)
+    t172 = t137 - t159*t171
+    t173 = t138 - t154*t171
+    t174 = t139 + t155*t171
+    t175 = t140 - t156*t171
+    t176 = xp.sqrt(t163**2 + t164**2 + t165**2)
+    t177 = t176*xp.where(xp.greater_equal(t163, 0), xp.asarray(1, dtype=dtype), -1)
+    t178 = t163 + t177
+    t179 = xp.where(xp.greater(t176, 0), 1/(t176*(t176 + xp.abs(t163))), 0)
+    t180 = t179*(t168*t178 + t164*t169 + t165*t170)
+    t181 = t168 - t178*t180
+    t182 = t169 - t164*t180
+    t183 = t170 - t165*t180
+    t184 = t179*(t173*t178 + t164*t174 + t165*t175)
+    t185 = t173 - t178*t184
+    t186 = t174 - t164*t184
+    t187 = t175 - t165*t184
+    t188 = xp.sqrt(t182**2 + t183**2)
+    t189 = t188*xp.where(xp.greater_equal(t182, 0), xp.asarray(1, dtype=dtype), -1)
+    t190 = t182 + t189
+    t191 = xp.where(xp.greater(t188, 0), 1/(t188*(t188 + xp.abs(t182))), 0)
+    t192 = t191*(t186*t190 + t183*t187)
+    t193 = t186 - t190*t192
+    t194 = t187 - t183*t192
+    t195 = t37*t113
+    t196 = t128*(t115*t127 + t91*t143 - t92*t116 + t93*t117 + t195*t90)
+    t197 = t115 - t127*t196
+    t198 = t195 - t90*t196
+    t199 = t143 - t91*t196
+    t200 = t116 + t92*t196
+    t201 = t117 - t93*t196
+    t202 = t160*(t198*t159 + t154*t199 + t155*t200 + t156*t201)
+    t203 = t198 - t159*t202
+    t204 = t199 - t154*t202
+    t205 = -t200 + t155*t202
+    t206 = t201 - t156*t202
+    t207 = t179*(t204*t178 + t164*t205 + t165*t206)
+    t208 = t204 - t178*t207
+    t209 = t205 - t164*t207
+    t210 = t206 - t165*t207
+    t211 = t191*(t209*t190 + t183*t210)
+    t212 = t209 - t190*t211
+    t213 = t210 - t183*t211
+    t214 = xp.abs(t213)
+    t215 = t214
+    t216 = t215*xp.where(xp.greater_equal(t213, 0), xp.asarray(1, dtype=dtype), -1)
+    t217 = t213 + t216
+    t218 = xp.where(xp.greater(t215, 0), 1/(t215*(t214 + t215)), 0)
+    t219 = t194 - t194*t217**2*t218
+    t220 = xp.where(xp.not_equal(t216, 0), -t219/t216, 0)
+    t221 = xp.where(xp.not_equal(t189, 0), -(t193 - t212*t220)/t189, 0)
+    t222 = xp.where(xp.not_equal(t177, 0), -(-(t181*t221 + t208*t220) + t185)/t177, 0)
+    t223 = xp.where(xp.not_equal(t158, 0), -(-(t162*t222 + t167*t221 + t203*t220) + t172)/t158, 0)
+    t224 = xp.where(xp.not_equal(t126, 0), -(-(-t152*t223 - t145*t222 + t130*t221 + t197*t220) + t136)/t126, 0)
+    t225 = xp.where(xp.not_equal(t84, 0), -(t119 + t95*t223 + t101*t222 + t114*t220 - t88*t224 - t107*t221)/t84, 0)
+    t226 = t220 - t23*t225 + t22*t224
+    t227 = t14*t222 + t17*t221 - c23*t220
+    t228 = t12*t222 - t9*t221 + t62*t220
+    t229 = t15*t222 + t18*t221 - t0*t220
+    t230 = s1*t2
+    t231 = c1*t221 - s1*t222
+    t232 = t231 + t39*t225 + t230*t224 - t24*t223
+    t233 = s1*t1
+    t234 = t231 + t40*t225 + t233*t224 - t20*t223
+    t235 = -t23
+    t236 = t235 + t44
+    t237 = -t45*(t39*t236 + t22*t230)
+    t238 = t39 + t236*t237
+    t239 = t230 + t22*t237
+    t240 = -t45*(t40*t236 + t22*t233)
+    t241 = t40 + t236*t240
+    t242 = t233 + t22*t240
+    t243 = t45*(mu_dot5 + mu_dot0*t236 + t22*mu_dot1)
+    t244 = mu_dot0 - t236*t243
     t245 = mu_dot1 - t22*t243
     t246 = -t243 + mu_dot5
-    t247 = c23*t236
-    t248 = c23 - t247
-    t249 = t61*t236
-    t250 = t61 - t249
-    t251 = t0*t236
-    t252 = t0 - t251
-    t253 = t26 + t45
-    t254 = xp.sqrt(t53 + t253 + t237**2 + t239**2)
+    t247 = c23*t45
+    t248 = -t247 + c23
+    t249 = t62*t45
+    t250 = -t249 + t62
+    t251 = t0*t45
+    t252 = -t251 + t0
+    t253 = t26 + t46
+    t254 = xp.sqrt(t54 + t253 + t237**2 + t239**2)
     t255 = t254*xp.where(xp.less_equal(t239, 0), xp.asarray(1, dtype=dtype), -1)
-    t256 = -t239
-    t257 = t256 + t255
-    t258 = xp.where(xp.greater(t254, 0), 1/(t254*(t254 + xp.abs(t256))), 0)
-    t259 = t258*(t253 - t242*t257 + t24*t20 + t237*t240)
-    t260 = t242 + t257*t259
-    t261 = t20 - t24*t259
-    t262 = s1 - s1*t259
-    t263 = -c1 + c1*t259
-    t264 = -t240 + t237*t259
-    t265 = t258*(t245*t257 + t24*mu_dot2 + s1*mu_dot3 - c1*mu_dot4 - t237*t246)
-    t266 = t245 - t257*t265
-    t267 = mu_dot2 - t24*t265
-    t268 = mu_dot3 - s1*t265
-    t269 = mu_dot4 + c1*t265
-    t270 = t246 + t237*t265
-    t271 = xp.sqrt(t261**2 + t262**2 + t263**2 + t264**2)
-    t272 = t271*xp.where(xp.greater_equal(t261, 0), xp.asarray(1, dtype=dtype), -1)
-    t273 = t261 + t272
-    t274 = xp.where(xp.greater(t271, 0), 1/(t271*(t271 + xp.abs(t261))), 0)
-    t275 = t274*(t267*t273 + t262*t268 + t263*t269 + t264*t270)
-    t276 = t267 - t273*t275
-    t277 = t268 - t262*t275
-    t278 = t269 - t263*t275
-    t279 = t270 - t264*t275
-    t280 = t22*t247
-    t281 = -t258*(t280*t257 + t237*t248)
-    t282 = t280 + t257*t281
-    t283 = t14 + s1*t281
-    t284 = t248 + t237*t281
-    t285 = -t17
-    t286 = t285 + c1*t281
-    t287 = t22*t249
-    t288 = t258*(-t287*t257 + s1*t12 + c1*t9 - t237*t250)
-    t289 = t287 + t257*t288
-    t290 = t12 - s1*t288
-    t291 = t250 + t237*t288
-    t292 = -t9
-    t293 = t292 + c1*t288
-    t294 = t22*t251
-    t295 = -t258*(-c1*t18 + s1*t15 + t294*t257 + t237*t252)
-    t296 = t294 + t257*t295
-    t297 = t15 + s1*t295
-    t298 = t252 + t237*t295
-    t299 = -t18
-    t300 = t299 + c1*t295
-    t301 = 1 + t234 - t15 + t292 + t299 + q1 + q2 + q3 + c23 + q4 + q5 + q6 + t12 + t22 + t0 + t61 - t39 - t40 - t229 - t232 - t14 + t285 + t24 + t20 + t59 - 2*c1 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t302 = t24*t281
-    t303 = t274*(-t302*t273 - t262*t283 + t263*t286 + t264*t284)
-    t304 = t302 + t273*t303
-    t305 = t283 + t262*t303
-    t306 = t286 - t263*t303
-    t307 = t284 - t264*t303
-    t308 = xp.sqrt(t305**2 + t306**2 + t307**2)
-    t309 = t308*xp.where(xp.less_equal(t305, 0), xp.asarray(1, dtype=dtype), -1)
-    t310 = t24*t288
-    t311 = t274*(-t310*t273 + t262*t290 + t263*t293 + t264*t291)
-    t312 = t310 + t273*t311
-    t313 = t290 - t262*t311
-    t314 = t293 - t263*t311
-    t315 = t291 - t264*t311
-    t316 = t24*t295
-    t317 = t274*(-t316*t273 - t262*t297 + t263*t300 + t264*t298)
-    t318 = t316 + t273*t317
-    t319 = t297 + t262*t317
-    t320 = t300 - t263*t317
-    t321 = t298 - t264*t317
-    t322 = -t305
-    t323 = t322 + t309
-    t324 = xp.where(xp.greater(t308, 0), 1/(t308*(t308 + xp.abs(t322))), 0)
-    t325 = t324*(t313*t323 + t306*t314 + t307*t315)
-    t326 = t313 - t323*t325
-    t327 = t314 - t306*t325
-    t328 = t315 - t307*t325
-    t329 = t324*(-t319*t323 + t306*t320 + t307*t321)
-    t330 = t319 + t323*t329
-    t331 = t320 - t306*t329
-    t332 = t321 - t307*t329
-    t333 = t324*(t277*t323 + t306*t278 + t307*t279)
-    t334 = t277 - t323*t333
-    t335 = t278 - t306*t333
-    t336 = t279 - t307*t333
-    t337 = xp.sqrt(t327**2 + t328**2)
-    t338 = t337*xp.where(xp.greater_equal(t327, 0), xp.asarray(1, dtype=dtype), -1)
-    t339 = t327 + t338
-    t340 = xp.where(xp.greater(t337, 0), 1/(t337*(t337 + xp.abs(t327))), 0)
-    t341 = t340*(t331*t339 + t328*t332)
-    t342 = t331 - t339*t341
-    t343 = t332 - t328*t341
-    t344 = t340*(t335*t339 + t328*t336)
-    t345 = t335 - t339*t344
-    t346 = t336 - t328*t344
-    t347 = xp.abs(t343)
-    t348 = t347
-    t349 = t348*xp.where(xp.greater_equal(t343, 0), xp.asarray(1, dtype=dtype), -1)
-    t350 = t343 + t349
-    t351 = xp.where(xp.greater(t348, 0), 1/(t348*(t347 + t348)), 0)
-    t352 = t346 - t346*t350**2*t351
-    t353 = xp.where(xp.not_equal(t349, 0), -t352/t349, 0)
-    t354 = xp.where(xp.not_equal(t338, 0), -(t345 - t342*t353)/t338, 0)
-    t355 = xp.where(xp.not_equal(t309, 0), -(-(t326*t354 - t330*t353) + t334)/t309, 0)
-    t356 = xp.where(xp.not_equal(t272, 0), -(t276 + t304*t355 + t312*t354 + t318*t353)/t272, 0)
-    t357 = xp.where(xp.not_equal(t255, 0), -(t266 + t260*t356 + t282*t355 + t289*t354 + t296*t353)/t255, 0)
-    t358 = xp.where(xp.not_equal(t44, 0), -(t244 + t238*t357 + t241*t356 + t247*t235*t355 + t249*t235*t354 + t251*t235*t353)/t44, 0)
-    t359 = xp.isfinite(t301)
-    t360 = xp.greater_equal(damping, 0)
-    t361 = xp.greater(damping, 0)
-    t362 = 1e-12*t81
-    t363 = 1e-12*t68
-    t364 = (t361 & (xp.less_equal(t82, t362) | xp.less_equal(t124, t362) | xp.less_equal(t156, t362) | xp.less_equal(t175, t362) | xp.less_equal(t187, t362) | xp.less_equal(t214, t362))) | (xp.less_equal(damping, 0) & (xp.less_equal(t43, t363) | xp.less_equal(t254, t363) | xp.less_equal(t271, t363) | xp.less_equal(t308, t363) | xp.less_equal(t337, t363) | xp.less_equal(t348, t363)))
-    t365 = t359 & t360 & xp.logical_not(t364)
+    t256 = -t239 + t255
+    t257 = xp.where(xp.greater(t254, 0), 1/(t254*(t254 + xp.abs(t239))), 0)
+    t258 = t257*(t253 - t242*t256 + t24*t20 + t237*t240)
+    t259 = t242 + t256*t258
+    t260 = t20 - t24*t258
+    t261 = s1 - s1*t258
+    t262 = -c1 + c1*t258
+    t263 = -t240 + t237*t258
+    t264 = t257*(t245*t256 + t24*mu_dot2 + s1*mu_dot3 - c1*mu_dot4 - t237*t246)
+    t265 = t245 - t256*t264
+    t266 = mu_dot2 - t24*t264
+    t267 = mu_dot3 - s1*t264
+    t268 = mu_dot4 + c1*t264
+    t269 = t246 + t237*t264
+    t270 = xp.sqrt(t260**2 + t261**2 + t262**2 + t263**2)
+    t271 = t270*xp.where(xp.greater_equal(t260, 0), xp.asarray(1, dtype=dtype), -1)
+    t272 = t260 + t271
+    t273 = xp.where(xp.greater(t270, 0), 1/(t270*(t270 + xp.abs(t260))), 0)
+    t274 = t273*(t266*t272 + t261*t267 + t262*t268 + t263*t269)
+    t275 = t266 - t272*t274
+    t276 = t267 - t261*t274
+    t277 = t268 - t262*t274
+    t278 = t269 - t263*t274
+    t279 = t22*t247
+    t280 = -t257*(t237*t248 + t279*t256)
+    t281 = t279 + t256*t280
+    t282 = t14 + s1*t280
+    t283 = t248 + t237*t280
+    t284 = -t17
+    t285 = t284 + c1*t280
+    t286 = t22*t249
+    t287 = t257*(s1*t12 + c1*t9 - t237*t250 - t286*t256)
+    t288 = t286 + t256*t287
+    t289 = t12 - s1*t287
+    t290 = t250 + t237*t287
+    t291 = -t9
+    t292 = t291 + c1*t287
+    t293 = t22*t251
+    t294 = -t257*(s1*t15 + t237*t252 + t293*t256 - c1*t18)
+    t295 = t293 + t256*t294
+    t296 = t15 + s1*t294
+    t297 = t252 + t237*t294
+    t298 = -t18
+    t299 = t298 + c1*t294
+    t300 = 1 - t15 - t39 - t40 - t230 - t233 - t14 + q1 + q2 + q3 + c23 + q4 + q5 + q6 + t12 + t22 + t0 + t24 + t20 - 2*c1 + t60 + t62 + t235 + t284 + t291 + t298 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t301 = t24*t280
+    t302 = t273*(-t261*t282 + t262*t285 + t263*t283 - t301*t272)
+    t303 = t301 + t272*t302
+    t304 = t282 + t261*t302
+    t305 = t285 - t262*t302
+    t306 = t283 - t263*t302
+    t307 = xp.sqrt(t304**2 + t305**2 + t306**2)
+    t308 = t307*xp.where(xp.less_equal(t304, 0), xp.asarray(1, dtype=dtype), -1)
+    t309 = -t304 + t308
+    t310 = xp.where(xp.greater(t307, 0), 1/(t307*(t307 + xp.abs(t304))), 0)
+    t311 = t310*(t276*t309 + t305*t277 + t306*t278)
+    t312 = t276 - t309*t311
+    t313 = t277 - t305*t311
+    t314 = t278 - t306*t311
+    t315 = t24*t287
+    t316 = t273*(t261*t289 + t262*t292 + t263*t290 - t315*t272)
+    t317 = t315 + t272*t316
+    t318 = t289 - t261*t316
+    t319 = t292 - t262*t316
+    t320 = t290 - t263*t316
+    t321 = t310*(t318*t309 + t305*t319 + t306*t320)
+    t322 = t318 - t309*t321
+    t323 = t319 - t305*t321
+    t324 = t320 - t306*t321
+    t325 = xp.sqrt(t323**2 + t324**2)
+    t326 = t325*xp.where(xp.greater_equal(t323, 0), xp.asarray(1, dtype=dtype), -1)
+    t327 = t323 + t326
+    t328 = xp.where(xp.greater(t325, 0), 1/(t325*(t325 + xp.abs(t323))), 0)
+    t329 = t328*(t313*t327 + t324*t314)
+    t330 = t313 - t327*t329
+    t331 = t314 - t324*t329
+    t332 = t24*t294
+    t333 = t273*(-t261*t296 + t262*t299 + t263*t297 - t332*t272)
+    t334 = t332 + t272*t333
+    t335 = t296 + t261*t333
+    t336 = t299 - t262*t333
+    t337 = t297 - t263*t333
+    t338 = t310*(-t335*t309 + t305*t336 + t306*t337)
+    t339 = t335 + t309*t338
+    t340 = t336 - t305*t338
+    t341 = t337 - t306*t338
+    t342 = t328*(t340*t327 + t324*t341)
+    t343 = t340 - t327*t342
+    t344 = t341 - t324*t342
+    t345 = xp.abs(t344)
+    t346 = t345
+    t347 = t346*xp.where(xp.greater_equal(t344, 0), xp.asarray(1, dtype=dtype), -1)
+    t348 = t344 + t347
+    t349 = xp.where(xp.greater(t346, 0), 1/(t346*(t345 + t346)), 0)
+    t350 = t331 - t331*t348**2*t349
+    t351 = xp.where(xp.not_equal(t347, 0), -t350/t347, 0)
+    t352 = xp.where(xp.not_equal(t326, 0), -(t330 - t343*t351)/t326, 0)
+    t353 = xp.where(xp.not_equal(t308, 0), -(-(t322*t352 - t339*t351) + t312)/t308, 0)
+    t354 = xp.where(xp.not_equal(t271, 0), -(t275 + t303*t353 + t317*t352 + t334*t351)/t271, 0)
+    t355 = xp.where(xp.not_equal(t255, 0), -(t265 + t259*t354 + t281*t353 + t288*t352 + t295*t351)/t255, 0)
+    t356 = xp.where(xp.not_equal(t44, 0), -(t244 + t238*t355 + t241*t354 + t247*t236*t353 + t249*t236*t352 + t251*t236*t351)/t44, 0)
+    t357 = xp.isfinite(t300)
+    t358 = xp.greater_equal(damping, 0)
+    t359 = xp.greater(damping, 0)
+    t360 = 1e-12*t82
+    t361 = 1e-12*t69
+    t362 = (t359 & (xp.less_equal(t83, t360) | xp.less_equal(t125, t360) | xp.less_equal(t157, t360) | xp.less_equal(t176, t360) | xp.less_equal(t188, t360) | xp.less_equal(t215, t360))) | (xp.less_equal(damping, 0) & (xp.less_equal(t43, t361) | xp.less_equal(t254, t361) | xp.less_equal(t270, t361) | xp.less_equal(t307, t361) | xp.less_equal(t325, t361) | xp.less_equal(t346, t361)))
+    t363 = t357 & t358 & xp.logical_not(t362)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t365, xp.where(t361, t225, t358), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t365, xp.where(t361, -t231, t357), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t365, xp.where(t361, -t233, t356), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t365, xp.where(t361, -t226, t355), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t365, xp.where(t361, t227, t354), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t365, xp.where(t361, -t228, t353), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t363, xp.where(t359, t226, t356), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t363, xp.where(t359, -t232, t355), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t363, xp.where(t359, -t234, t354), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t363, xp.where(t359, -t227, t353), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t363, xp.where(t359, t228, t352), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t363, xp.where(t359, -t229, t351), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t359 & t360), 2, xp.where(t364, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t357 & t358), 2, xp.where(t362, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -1961,9 +1959,9 @@ def ik_numeric_step(target, q, damping=0.0):
     t19 = t17*c6 - t14*s6
     t20 = c6*t14 + t17*s6
     t21 = t6 - 0.4318*t16
-    t22 = -t19*T00 + t20*T01 + t18*T02
-    t23 = -t19*T10 + t20*T11 + t18*T12
-    t24 = -t19*T20 + t20*T21 + t18*T22
+    t22 = t20*T01 + t18*T02 - t19*T00
+    t23 = t20*T11 + t18*T12 - t19*T10
+    t24 = t20*T21 + t18*T22 - t19*T20
     t25 = s1*s23
     t26 = c5*t15 - s5*t25
     t27 = s5*t15 + c5*t25
@@ -1981,8 +1979,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t39 = s23*s4
     t40 = c6*t37 - s6*t39
     t41 = s6*t37 + c6*t39
-    t42 = c23*t16 - t14*t39 + t18*t38
-    t43 = c23*t25 + t11*t39 + t27*t38
+    t42 = c23*t16 + t18*t38 - t14*t39
+    t43 = t27*t38 + c23*t25 + t11*t39
     t44 = t40*T00 - t41*T01 + t38*T02
     t45 = t40*T10 - t41*T11 + t38*T12
     t46 = t40*T20 - t41*T21 + t38*T22
@@ -1990,18 +1988,18 @@ def ik_numeric_step(target, q, damping=0.0):
     t48 = 0.5*(t44 + t24)
     t49 = xp.sqrt(t47**2 + t48**2 + t35**2)
     t50 = 0.4318*c2
-    t51 = c1*t50 + t21
-    t52 = s1*t50 + t30
+    t51 = t21 + c1*t50
+    t52 = t30 + s1*t50
     t53 = c1*t51 + s1*t52
     t54 = t53**2 + t31**2
     t55 = -t51 + T03
     t56 = -t52 + T13
     t57 = t52**2
     t58 = c1**2
-    t59 = t58*t1 + t58*t0
+    t59 = t1*t58 + t0*t58
     t60 = t1**2
     t61 = t0**2
-    t62 = t57 + t58*t60 + t58*t61
+    t62 = t57 + t58*t61 + t58*t60
     t63 = -t51*t52
     t64 = s1*c1
     t65 = t63 + t60*t64 + t61*t64
@@ -2011,17 +2009,17 @@ def ik_numeric_step(target, q, damping=0.0):
     t69 = t1*t67 + t0*t68
     t70 = t67 + t68
     t71 = s1**2
-    t72 = t51**2 + t71*t60 + t71*t61
-    t73 = t71*t1 + t71*t0
+    t72 = t51**2 + t60*t71 + t61*t71
+    t73 = t1*t71 + t0*t71
     t74 = s1*t53
     t75 = s1*t31
-    t76 = t1*t74 + t0*t75
+    t76 = t0*t75 + t1*t74
     t77 = t74 + t75
     t78 = s23**2
     t79 = t14**2 + t18**2 + 2*t71 + t58*t78
-    t80 = -2*t64 + t64*t78 - t14*t11 + t18*t27
+    t80 = -2*t64 - t14*t11 + t18*t27 + t64*t78
     t81 = t11**2 + t27**2 + 2*t58 + t71*t78
-    t82 = 1 + c23**2 + t38**2 + t78*s4**2
+    t82 = 1 + c23**2 + t38**2 + s4**2*t78
     t83 = -t22
     t84 = 0.5*(-1 + t83 + t33 + t46)
     t85 = xp.atan2(t49, t84)
@@ -2040,7 +2038,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t98 = xp.where(t94, t35*t86, t95*t91)
     t99 = t96**2 + t97**2 + t98**2 + t55**2 + t56**2 + t3**2
     t100 = damping + t62
-    t101 = xp.sqrt(t57 + t65**2 + t69**2 + t66**2 + t59**2 + t100**2)
+    t101 = xp.sqrt(t57 + t100**2 + t65**2 + t69**2 + t66**2 + t59**2)
     t102 = t101*xp.where(xp.greater_equal(t100, 0), xp.asarray(1, dtype=dtype), -1)
     t103 = t100 + t102
     t104 = xp.where(xp.greater(t101, 0), 1/(t101*(t101 + xp.abs(t100))), 0)
@@ -2052,7 +2050,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t110 = t97 - t59*t105
     t111 = t98 + t52*t105
     t112 = damping + t72
-    t113 = t104*(t63 + t69*t76 + t66*t73 + t66*t59 + t65*t103 + t65*t112)
+    t113 = t104*(t63 + t69*t76 + t66*t73 + t66*t59 + t65*t103 + t112*t65)
     t114 = t65 - t103*t113
     t115 = t112 - t65*t113
     t116 = -t76 + t69*t113
@@ -2070,14 +2068,14 @@ def ik_numeric_step(target, q, damping=0.0):
     t128 = t110 - t118*t124
     t129 = t111 - t119*t124
     t130 = damping + t54
-    t131 = -t104*(t65*t76 + t66*t77 + t59*t70 + t69*t103 + t69*t130)
+    t131 = -t104*(t65*t76 + t66*t77 + t59*t70 + t69*t103 + t130*t69)
     t132 = t69 + t103*t131
     t133 = t76 + t65*t131
     t134 = t130 + t69*t131
     t135 = t77 + t66*t131
     t136 = t70 + t59*t131
     t137 = damping + t79
-    t138 = -t104*(t65*t73 + t69*t77 - t59*t80 - t52*t42 + t66*t103 + t66*t137)
+    t138 = -t104*(t65*t73 + t69*t77 - t59*t80 - t52*t42 + t66*t103 + t137*t66)
     t139 = t66 + t103*t138
     t140 = t73 + t65*t138
     t141 = t77 + t69*t138
@@ -2092,7 +2090,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t150 = t143 - t118*t146
     t151 = t145 - t119*t146
     t152 = damping + t81
-    t153 = t104*(t65*t66 + t69*t70 - t66*t80 + t52*t43 + t59*t103 + t59*t152)
+    t153 = t104*(t65*t66 + t69*t70 - t66*t80 + t52*t43 + t59*t103 + t152*t59)
     t154 = t59 - t103*t153
     t155 = t66 - t65*t153
     t156 = -t70 + t69*t153
@@ -2106,7 +2104,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t164 = t158 - t118*t160
     t165 = t159 - t119*t160
     t166 = damping + t82
-    t167 = -t104*(-t51*t65 - t66*t42 + t59*t43 + t52*t103 + t52*t166)
+    t167 = -t104*(t59*t43 - t51*t65 - t66*t42 + t52*t103 + t52*t166)
     t168 = t52 + t103*t167
     t169 = t51 - t65*t167
     t170 = t144 + t66*t167
@@ -2158,7 +2156,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t216 = t209 - t213*t215
     t217 = t210 - t206*t215
     t218 = t69*t167
-    t219 = t123*(t169*t122 + t218*t116 + t117*t170 - t118*t171 + t119*t172)
+    t219 = t123*(t169*t122 + t117*t170 - t118*t171 + t119*t172 + t218*t116)
     t220 = t169 - t122*t219
     t221 = t218 - t116*t219
     t222 = t170 - t117*t219
@@ -2189,7 +2187,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t247 = xp.where(xp.not_equal(t121, 0), -(-(-t175*t246 - t147*t245 + t161*t244 + t220*t243) + t125)/t121, 0)
     t248 = xp.where(xp.not_equal(t102, 0), -(t106 + t132*t246 + t139*t245 + t168*t243 - t114*t247 - t154*t244)/t102, 0)
     t249 = q1 + t243 - t52*t248 + t51*t247
-    t250 = q4 - t16*t245 - t25*t244 + c23*t243
+    t250 = q4 + c23*t243 - t16*t245 - t25*t244
     t251 = q5 + t14*t245 - t11*t244 + t39*t243
     t252 = q6 - t18*t245 - t27*t244 + t38*t243
     t253 = c1*t248
@@ -2273,7 +2271,7 @@ def ik_branches(T):
     t37 = -t33 + t35
     t38 = t32*t4
     t39 = t34*t8
-    t40 = xp.where(t18, 0, t38 - t39)
+    t40 = xp.where(t18, 0, -t39 + t38)
     t41 = t38 + t39
     t42 = t4*t36 + t8*t40
     t43 = t8*t36 - t4*t40
@@ -2288,15 +2286,15 @@ def ik_branches(T):
     t52 = T00*t37 + T10*t41
     t53 = T10*t37 - T00*t41
     t54 = 1 - t36
-    t55 = t13*t54
+    t55 = t54*t13
     t56 = t55 + t13*t36
     t57 = -0.67183 + t56
     t58 = t42**2 + t43**2 + t57**2
     t59 = 0.5*(0.3958295725 - t58)
     t60 = 1 - 28.701899543227718*t59**2
-    t61 = T22*t54
+    t61 = t54*T22
     t62 = t61 + T22*t36
-    t63 = T20*t54
+    t63 = t54*T20
     t64 = t63 + T20*t36
     t65 = xp.greater(t60, 1e-12)
     t66 = xp.where(t65, xp.sqrt(t60), 0)
@@ -2320,7 +2318,7 @@ def ik_branches(T):
     t84 = 0.04696063880130675*t66
     t85 = 0.9988967406110469*t68
     t86 = -t84 + t85
-    t87 = t85 + t84
+    t87 = t84 + t85
     t88 = 0.4318*t86 + 0.0203*t78
     t89 = 0.0203*t86 - 0.4318*t78
     t90 = 0.4318 - t88
@@ -2336,8 +2334,8 @@ def ik_branches(T):
     t100 = t42*t99 - t57*t97
     t101 = t83**2 + t97**2 + t99**2
     t102 = t43*t81
-    t103 = t42*t90 + t102 + t57*t92
-    t104 = t103 - t102
+    t103 = t102 + t42*t90 + t57*t92
+    t104 = -t102 + t103
     t105 = t104**2 + t93**2
     t106 = 1e-24*t58
     t107 = xp.less_equal(t105, t106*t94)
@@ -2353,9 +2351,9 @@ def ik_branches(T):
     t117 = xp.where(t107, 0, xp.atan2(-t93, t104))
     t118 = -6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t117)) + t117
     t119 = 1 + t111
-    t120 = t45*t119
+    t120 = t119*t45
     t121 = t120 - t111*t45
-    t122 = t47*t119
+    t122 = t119*t47
     t123 = t122 - t111*t47
     t124 = t114**2
     t125 = -t124
@@ -2365,7 +2363,7 @@ def ik_branches(T):
     t129 = t124 + t113*t128
     t130 = t125 + t129
     t131 = t121**2
-    t132 = t113**2 + t131 + t124
+    t132 = t124 + t131 + t113**2
     t133 = t128**2
     t134 = t130**2 + t131*t133
     t135 = t124 + t133
@@ -2391,7 +2389,7 @@ def ik_branches(T):
     t155 = t154
     t156 = t154 + t153**2
     t157 = t43*t83
-    t158 = t42*t97 - t157 + t57*t99
+    t158 = -t157 + t42*t97 + t57*t99
     t159 = t157 + t158
     t160 = t159**2 + t100**2
     t161 = xp.less_equal(t160, t106*t101)
@@ -2407,9 +2405,9 @@ def ik_branches(T):
     t171 = xp.where(t161, 0, xp.atan2(-t100, t159))
     t172 = -6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t171)) + t171
     t173 = 1 - t165
-    t174 = t45*t173
+    t174 = t173*t45
     t175 = t174 + t45*t165
-    t176 = t47*t173
+    t176 = t173*t47
     t177 = t176 + t47*t165
     t178 = t168**2
     t179 = -t178
@@ -2419,7 +2417,7 @@ def ik_branches(T):
     t183 = t178 + t167*t182
     t184 = t179 + t183
     t185 = t175**2
-    t186 = t167**2 + t185 + t178
+    t186 = t178 + t185 + t167**2
     t187 = t182**2
     t188 = t184**2 + t185*t187
     t189 = t178 + t187
@@ -2445,15 +2443,15 @@ def ik_branches(T):
     t209 = t208
     t210 = t208 + t207**2
     t211 = 1 - t37
-    t212 = t13*t211
+    t212 = t211*t13
     t213 = t212 + t13*t37
     t214 = -0.67183 + t213
     t215 = t48**2 + t49**2 + t214**2
     t216 = 0.5*(0.3958295725 - t215)
     t217 = 1 - 28.701899543227718*t216**2
-    t218 = T22*t211
+    t218 = t211*T22
     t219 = t218 + T22*t37
-    t220 = T20*t211
+    t220 = t211*T20
     t221 = t220 + T20*t37
     t222 = xp.greater(t217, 1e-12)
     t223 = xp.where(t222, xp.sqrt(t217), 0)
@@ -2477,7 +2475,7 @@ def ik_branches(T):
     t241 = 0.04696063880130675*t223
     t242 = 0.9988967406110469*t225
     t243 = -t241 + t242
-    t244 = t242 + t241
+    t244 = t241 + t242
     t245 = 0.4318*t243 + 0.0203*t235
     t246 = 0.0203*t243 - 0.4318*t235
     t247 = 0.4318 - t245
@@ -2493,8 +2491,8 @@ def ik_branches(T):
     t257 = t48*t256 - t214*t254
     t258 = t240**2 + t254**2 + t256**2
     t259 = t49*t238
-    t260 = t48*t247 + t259 + t214*t249
-    t261 = t260 - t259
+    t260 = t259 + t48*t247 + t214*t249
+    t261 = -t259 + t260
     t262 = t261**2 + t250**2
     t263 = 1e-24*t215
     t264 = xp.less_equal(t262, t263*t251)
@@ -2510,9 +2508,9 @@ def ik_branches(T):
     t274 = xp.where(t264, 0, xp.atan2(-t250, t261))
     t275 = -6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t274)) + t274
     t276 = 1 + t268
-    t277 = t51*t276
+    t277 = t276*t51
     t278 = t277 - t268*t51
-    t279 = t53*t276
+    t279 = t276*t53
     t280 = t279 - t268*t53
     t281 = t271**2
     t282 = -t281
@@ -2522,7 +2520,7 @@ def ik_branches(T):
     t286 = t281 + t270*t285
     t287 = t282 + t286
     t288 = t278**2
-    t289 = t270**2 + t288 + t281
+    t289 = t281 + t288 + t270**2
     t290 = t285**2
     t291 = t287**2 + t288*t290
     t292 = t281 + t290
@@ -2548,7 +2546,7 @@ def ik_branches(T):
     t312 = t311
     t313 = t311 + t310**2
     t314 = t49*t240
-    t315 = t48*t254 - t314 + t214*t256
+    t315 = -t314 + t48*t254 + t214*t256
     t316 = t314 + t315
     t317 = t316**2 + t257**2
     t318 = xp.less_equal(t317, t263*t258)
@@ -2564,9 +2562,9 @@ def ik_branches(T):
     t328 = xp.where(t318, 0, xp.atan2(-t257, t316))
     t329 = -6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t328)) + t328
     t330 = 1 - t322
-    t331 = t51*t330
+    t331 = t330*t51
     t332 = t331 + t51*t322
-    t333 = t53*t330
+    t333 = t330*t53
     t334 = t333 + t53*t322
     t335 = t325**2
     t336 = -t335
@@ -2574,9 +2572,9 @@ def ik_branches(T):
     t338 = xp.greater(t337, 1e-12)
     t339 = xp.where(t338, xp.sqrt(t337), 0)
     t340 = t335 + t324*t339
-    t341 = t336 + t340
+    t341 = t340 + t336
     t342 = t332**2
-    t343 = t324**2 + t342 + t335
+    t343 = t335 + t324**2 + t342
     t344 = t339**2
     t345 = t341**2 + t342*t344
     t346 = t335 + t344
@@ -2604,67 +2602,67 @@ def ik_branches(T):
     t368 = xp.where(t137, 0, xp.atan2(t142, t130))
     t369 = t368
     t370 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t369)) + t369
-    t371 = 3.141592653589793 + t368 - 6.283185307179586*xp.ceil(0.15915494309189535*t368)
+    t371 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t368) + t368
     t372 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t371)) + t371
     t373 = xp.where(t146, 0, xp.atan2(-t128, -t114))
     t374 = t373
     t375 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t374)) + t374
-    t376 = t373 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t373))
+    t376 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t373)) + t373
     t377 = xp.where(xp.less_equal(t155, 1e-24*t156), 0, xp.atan2(t152, t151))
     t378 = t377
     t379 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t378)) + t378
-    t380 = 3.141592653589793 + t377 - 6.283185307179586*xp.ceil(0.15915494309189535*t377)
+    t380 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t377) + t377
     t381 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t380)) + t380
     t382 = -t376
-    t383 = t376 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t382))
+    t383 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t382)) + t376
     t384 = xp.where(t191, 0, xp.atan2(t196, t184))
     t385 = t384
     t386 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t385)) + t385
-    t387 = 3.141592653589793 + t384 - 6.283185307179586*xp.ceil(0.15915494309189535*t384)
+    t387 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t384) + t384
     t388 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t387)) + t387
     t389 = xp.where(t200, 0, xp.atan2(-t182, t168))
     t390 = t389
     t391 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t390)) + t390
-    t392 = t389 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t389))
+    t392 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t389)) + t389
     t393 = xp.where(xp.less_equal(t209, 1e-24*t210), 0, xp.atan2(t206, t205))
     t394 = t393
     t395 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t394)) + t394
-    t396 = 3.141592653589793 + t393 - 6.283185307179586*xp.ceil(0.15915494309189535*t393)
+    t396 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t393) + t393
     t397 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t396)) + t396
     t398 = -t392
-    t399 = t392 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t398))
+    t399 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t398)) + t392
     t400 = xp.where(t294, 0, xp.atan2(t299, t287))
     t401 = t400
     t402 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t401)) + t401
-    t403 = 3.141592653589793 + t400 - 6.283185307179586*xp.ceil(0.15915494309189535*t400)
+    t403 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t400) + t400
     t404 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t403)) + t403
     t405 = xp.where(t303, 0, xp.atan2(-t285, -t271))
     t406 = t405
     t407 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t406)) + t406
-    t408 = t405 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t405))
+    t408 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t405)) + t405
     t409 = xp.where(xp.less_equal(t312, 1e-24*t313), 0, xp.atan2(t309, t308))
     t410 = t409
     t411 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t410)) + t410
-    t412 = 3.141592653589793 + t409 - 6.283185307179586*xp.ceil(0.15915494309189535*t409)
+    t412 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t409) + t409
     t413 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t412)) + t412
     t414 = -t408
-    t415 = t408 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t414))
+    t415 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t414)) + t408
     t416 = xp.where(t348, 0, xp.atan2(t353, t341))
     t417 = t416
     t418 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t417)) + t417
-    t419 = 3.141592653589793 + t416 - 6.283185307179586*xp.ceil(0.15915494309189535*t416)
+    t419 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t416) + t416
     t420 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t419)) + t419
     t421 = xp.where(t357, 0, xp.atan2(-t339, t325))
     t422 = t421
     t423 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t422)) + t422
-    t424 = t421 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t421))
+    t424 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t421)) + t421
     t425 = xp.where(xp.less_equal(t366, 1e-24*t367), 0, xp.atan2(t363, t362))
     t426 = t425
     t427 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t426)) + t426
-    t428 = 3.141592653589793 + t425 - 6.283185307179586*xp.ceil(0.15915494309189535*t425)
+    t428 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t425) + t425
     t429 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t428)) + t428
     t430 = -t424
-    t431 = t424 + 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t430))
+    t431 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t430)) + t424
     t432 = xp.greater_equal(t28, -2.792526803190927) & xp.less_equal(t28, 2.792526803190927)
     t433 = xp.less_equal(t29, 2.792526803190927)
     t434 = xp.where(xp.logical_not(t432) & t433, t29, t28)
@@ -2987,27 +2985,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t56 = xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0)
     t57 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
     t58 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t59 = t0 + t58
+    t59 = t58 + t0
     t60 = -t58 + t0
     t61 = xp.where(xp.greater_equal(t0, -2.792526803190927) & xp.less_equal(t0, 2.792526803190927), t0, xp.where(xp.greater_equal(t59, -2.792526803190927) & xp.less_equal(t59, 2.792526803190927), t59, xp.where(xp.greater_equal(t60, -2.792526803190927) & xp.less_equal(t60, 2.792526803190927), t60, qb0_0)))
     t62 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t63 = t1 + t62
+    t63 = t62 + t1
     t64 = -t62 + t1
     t65 = xp.where(xp.greater_equal(t1, -0.7853981633974483) & xp.less_equal(t1, 3.9269908169872414), t1, xp.where(xp.greater_equal(t63, -0.7853981633974483) & xp.less_equal(t63, 3.9269908169872414), t63, xp.where(xp.greater_equal(t64, -0.7853981633974483) & xp.less_equal(t64, 3.9269908169872414), t64, qb0_1)))
     t66 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t67 = t2 + t66
+    t67 = t66 + t2
     t68 = -t66 + t2
     t69 = xp.where(xp.greater_equal(t2, -3.9269908169872414) & xp.less_equal(t2, 0.7853981633974483), t2, xp.where(xp.greater_equal(t67, -3.9269908169872414) & xp.less_equal(t67, 0.7853981633974483), t67, xp.where(xp.greater_equal(t68, -3.9269908169872414) & xp.less_equal(t68, 0.7853981633974483), t68, qb0_2)))
     t70 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t71 = t3 + t70
+    t71 = t70 + t3
     t72 = -t70 + t3
     t73 = xp.where(xp.greater_equal(t3, -1.9198621771937625) & xp.less_equal(t3, 2.9670597283903604), t3, xp.where(xp.greater_equal(t71, -1.9198621771937625) & xp.less_equal(t71, 2.9670597283903604), t71, xp.where(xp.greater_equal(t72, -1.9198621771937625) & xp.less_equal(t72, 2.9670597283903604), t72, qb0_3)))
     t74 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t75 = t4 + t74
+    t75 = t74 + t4
     t76 = -t74 + t4
     t77 = xp.where(xp.greater_equal(t4, -1.7453292519943295) & xp.less_equal(t4, 1.7453292519943295), t4, xp.where(xp.greater_equal(t75, -1.7453292519943295) & xp.less_equal(t75, 1.7453292519943295), t75, xp.where(xp.greater_equal(t76, -1.7453292519943295) & xp.less_equal(t76, 1.7453292519943295), t76, qb0_4)))
     t78 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t79 = t5 + t78
+    t79 = t78 + t5
     t80 = -t78 + t5
     t81 = xp.where(xp.greater_equal(t5, -4.642575810304916) & xp.less_equal(t5, 4.642575810304916), t5, xp.where(xp.greater_equal(t79, -4.642575810304916) & xp.less_equal(t79, 4.642575810304916), t79, xp.where(xp.greater_equal(t80, -4.642575810304916) & xp.less_equal(t80, 4.642575810304916), t80, qb0_5)))
     t82 = -qn1
@@ -3026,27 +3024,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t95 = xp.where(t89, t81, qn6)
     t96 = xp.where(t89, t88, 0)
     t97 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t98 = t8 + t97
+    t98 = t97 + t8
     t99 = -t97 + t8
     t100 = xp.where(xp.greater_equal(t8, -2.792526803190927) & xp.less_equal(t8, 2.792526803190927), t8, xp.where(xp.greater_equal(t98, -2.792526803190927) & xp.less_equal(t98, 2.792526803190927), t98, xp.where(xp.greater_equal(t99, -2.792526803190927) & xp.less_equal(t99, 2.792526803190927), t99, qb1_0)))
     t101 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t102 = t9 + t101
+    t102 = t101 + t9
     t103 = -t101 + t9
     t104 = xp.where(xp.greater_equal(t9, -0.7853981633974483) & xp.less_equal(t9, 3.9269908169872414), t9, xp.where(xp.greater_equal(t102, -0.7853981633974483) & xp.less_equal(t102, 3.9269908169872414), t102, xp.where(xp.greater_equal(t103, -0.7853981633974483) & xp.less_equal(t103, 3.9269908169872414), t103, qb1_1)))
     t105 = xp.where(xp.less(t10, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t106 = t10 + t105
+    t106 = t105 + t10
     t107 = -t105 + t10
     t108 = xp.where(xp.greater_equal(t10, -3.9269908169872414) & xp.less_equal(t10, 0.7853981633974483), t10, xp.where(xp.greater_equal(t106, -3.9269908169872414) & xp.less_equal(t106, 0.7853981633974483), t106, xp.where(xp.greater_equal(t107, -3.9269908169872414) & xp.less_equal(t107, 0.7853981633974483), t107, qb1_2)))
     t109 = xp.where(xp.less(t11, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t110 = t11 + t109
+    t110 = t109 + t11
     t111 = -t109 + t11
     t112 = xp.where(xp.greater_equal(t11, -1.9198621771937625) & xp.less_equal(t11, 2.9670597283903604), t11, xp.where(xp.greater_equal(t110, -1.9198621771937625) & xp.less_equal(t110, 2.9670597283903604), t110, xp.where(xp.greater_equal(t111, -1.9198621771937625) & xp.less_equal(t111, 2.9670597283903604), t111, qb1_3)))
     t113 = xp.where(xp.less(t12, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t114 = t12 + t113
+    t114 = t113 + t12
     t115 = -t113 + t12
     t116 = xp.where(xp.greater_equal(t12, -1.7453292519943295) & xp.less_equal(t12, 1.7453292519943295), t12, xp.where(xp.greater_equal(t114, -1.7453292519943295) & xp.less_equal(t114, 1.7453292519943295), t114, xp.where(xp.greater_equal(t115, -1.7453292519943295) & xp.less_equal(t115, 1.7453292519943295), t115, qb1_4)))
     t117 = xp.where(xp.less(t13, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t118 = t13 + t117
+    t118 = t117 + t13
     t119 = -t117 + t13
     t120 = xp.where(xp.greater_equal(t13, -4.642575810304916) & xp.less_equal(t13, 4.642575810304916), t13, xp.where(xp.greater_equal(t118, -4.642575810304916) & xp.less_equal(t118, 4.642575810304916), t118, xp.where(xp.greater_equal(t119, -4.642575810304916) & xp.less_equal(t119, 4.642575810304916), t119, qb1_5)))
     t121 = qw1*(t82 + t100)**2 + qw2*(t83 + t104)**2 + qw3*(t84 + t108)**2 + qw4*(t85 + t112)**2 + qw5*(t86 + t116)**2 + qw6*(t87 + t120)**2
@@ -3062,27 +3060,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t131 = xp.where(t125, t120, t95)
     t132 = xp.where(t125, t121, t96)
     t133 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t134 = t15 + t133
+    t134 = t133 + t15
     t135 = -t133 + t15
     t136 = xp.where(xp.greater_equal(t15, -2.792526803190927) & xp.less_equal(t15, 2.792526803190927), t15, xp.where(xp.greater_equal(t134, -2.792526803190927) & xp.less_equal(t134, 2.792526803190927), t134, xp.where(xp.greater_equal(t135, -2.792526803190927) & xp.less_equal(t135, 2.792526803190927), t135, qb2_0)))
     t137 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t138 = t16 + t137
+    t138 = t137 + t16
     t139 = -t137 + t16
     t140 = xp.where(xp.greater_equal(t16, -0.7853981633974483) & xp.less_equal(t16, 3.9269908169872414), t16, xp.where(xp.greater_equal(t138, -0.7853981633974483) & xp.less_equal(t138, 3.9269908169872414), t138, xp.where(xp.greater_equal(t139, -0.7853981633974483) & xp.less_equal(t139, 3.9269908169872414), t139, qb2_1)))
     t141 = xp.where(xp.less(t17, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t142 = t17 + t141
+    t142 = t141 + t17
     t143 = -t141 + t17
     t144 = xp.where(xp.greater_equal(t17, -3.9269908169872414) & xp.less_equal(t17, 0.7853981633974483), t17, xp.where(xp.greater_equal(t142, -3.9269908169872414) & xp.less_equal(t142, 0.7853981633974483), t142, xp.where(xp.greater_equal(t143, -3.9269908169872414) & xp.less_equal(t143, 0.7853981633974483), t143, qb2_2)))
     t145 = xp.where(xp.less(t18, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t146 = t18 + t145
+    t146 = t145 + t18
     t147 = -t145 + t18
     t148 = xp.where(xp.greater_equal(t18, -1.9198621771937625) & xp.less_equal(t18, 2.9670597283903604), t18, xp.where(xp.greater_equal(t146, -1.9198621771937625) & xp.less_equal(t146, 2.9670597283903604), t146, xp.where(xp.greater_equal(t147, -1.9198621771937625) & xp.less_equal(t147, 2.9670597283903604), t147, qb2_3)))
     t149 = xp.where(xp.less(t19, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t150 = t19 + t149
+    t150 = t149 + t19
     t151 = -t149 + t19
     t152 = xp.where(xp.greater_equal(t19, -1.7453292519943295) & xp.less_equal(t19, 1.7453292519943295), t19, xp.where(xp.greater_equal(t150, -1.7453292519943295) & xp.less_equal(t150, 1.7453292519943295), t150, xp.where(xp.greater_equal(t151, -1.7453292519943295) & xp.less_equal(t151, 1.7453292519943295), t151, qb2_4)))
     t153 = xp.where(xp.less(t20, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t154 = t20 + t153
+    t154 = t153 + t20
     t155 = -t153 + t20
     t156 = xp.where(xp.greater_equal(t20, -4.642575810304916) & xp.less_equal(t20, 4.642575810304916), t20, xp.where(xp.greater_equal(t154, -4.642575810304916) & xp.less_equal(t154, 4.642575810304916), t154, xp.where(xp.greater_equal(t155, -4.642575810304916) & xp.less_equal(t155, 4.642575810304916), t155, qb2_5)))
     t157 = qw1*(t82 + t136)**2 + qw2*(t83 + t140)**2 + qw3*(t84 + t144)**2 + qw4*(t85 + t148)**2 + qw5*(t86 + t152)**2 + qw6*(t87 + t156)**2
@@ -3098,27 +3096,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t167 = xp.where(t161, t156, t131)
     t168 = xp.where(t161, t157, t132)
     t169 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t170 = t22 + t169
+    t170 = t169 + t22
     t171 = -t169 + t22
     t172 = xp.where(xp.greater_equal(t22, -2.792526803190927) & xp.less_equal(t22, 2.792526803190927), t22, xp.where(xp.greater_equal(t170, -2.792526803190927) & xp.less_equal(t170, 2.792526803190927), t170, xp.where(xp.greater_equal(t171, -2.792526803190927) & xp.less_equal(t171, 2.792526803190927), t171, qb3_0)))
     t173 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t174 = t23 + t173
+    t174 = t173 + t23
     t175 = -t173 + t23
     t176 = xp.where(xp.greater_equal(t23, -0.7853981633974483) & xp.less_equal(t23, 3.9269908169872414), t23, xp.where(xp.greater_equal(t174, -0.7853981633974483) & xp.less_equal(t174, 3.9269908169872414), t174, xp.where(xp.greater_equal(t175, -0.7853981633974483) & xp.less_equal(t175, 3.9269908169872414), t175, qb3_1)))
     t177 = xp.where(xp.less(t24, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t178 = t24 + t177
+    t178 = t177 + t24
     t179 = -t177 + t24
     t180 = xp.where(xp.greater_equal(t24, -3.9269908169872414) & xp.less_equal(t24, 0.7853981633974483), t24, xp.where(xp.greater_equal(t178, -3.9269908169872414) & xp.less_equal(t178, 0.7853981633974483), t178, xp.where(xp.greater_equal(t179, -3.9269908169872414) & xp.less_equal(t179, 0.7853981633974483), t179, qb3_2)))
     t181 = xp.where(xp.less(t25, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t182 = t25 + t181
+    t182 = t181 + t25
     t183 = -t181 + t25
     t184 = xp.where(xp.greater_equal(t25, -1.9198621771937625) & xp.less_equal(t25, 2.9670597283903604), t25, xp.where(xp.greater_equal(t182, -1.9198621771937625) & xp.less_equal(t182, 2.9670597283903604), t182, xp.where(xp.greater_equal(t183, -1.9198621771937625) & xp.less_equal(t183, 2.9670597283903604), t183, qb3_3)))
     t185 = xp.where(xp.less(t26, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t186 = t26 + t185
+    t186 = t185 + t26
     t187 = -t185 + t26
     t188 = xp.where(xp.greater_equal(t26, -1.7453292519943295) & xp.less_equal(t26, 1.7453292519943295), t26, xp.where(xp.greater_equal(t186, -1.7453292519943295) & xp.less_equal(t186, 1.7453292519943295), t186, xp.where(xp.greater_equal(t187, -1.7453292519943295) & xp.less_equal(t187, 1.7453292519943295), t187, qb3_4)))
     t189 = xp.where(xp.less(t27, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t190 = t27 + t189
+    t190 = t189 + t27
     t191 = -t189 + t27
     t192 = xp.where(xp.greater_equal(t27, -4.642575810304916) & xp.less_equal(t27, 4.642575810304916), t27, xp.where(xp.greater_equal(t190, -4.642575810304916) & xp.less_equal(t190, 4.642575810304916), t190, xp.where(xp.greater_equal(t191, -4.642575810304916) & xp.less_equal(t191, 4.642575810304916), t191, qb3_5)))
     t193 = qw1*(t82 + t172)**2 + qw2*(t83 + t176)**2 + qw3*(t84 + t180)**2 + qw4*(t85 + t184)**2 + qw5*(t86 + t188)**2 + qw6*(t87 + t192)**2
@@ -3134,27 +3132,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t203 = xp.where(t197, t192, t167)
     t204 = xp.where(t197, t193, t168)
     t205 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t206 = t29 + t205
+    t206 = t205 + t29
     t207 = -t205 + t29
     t208 = xp.where(xp.greater_equal(t29, -2.792526803190927) & xp.less_equal(t29, 2.792526803190927), t29, xp.where(xp.greater_equal(t206, -2.792526803190927) & xp.less_equal(t206, 2.792526803190927), t206, xp.where(xp.greater_equal(t207, -2.792526803190927) & xp.less_equal(t207, 2.792526803190927), t207, qb4_0)))
     t209 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t210 = t30 + t209
+    t210 = t209 + t30
     t211 = -t209 + t30
     t212 = xp.where(xp.greater_equal(t30, -0.7853981633974483) & xp.less_equal(t30, 3.9269908169872414), t30, xp.where(xp.greater_equal(t210, -0.7853981633974483) & xp.less_equal(t210, 3.9269908169872414), t210, xp.where(xp.greater_equal(t211, -0.7853981633974483) & xp.less_equal(t211, 3.9269908169872414), t211, qb4_1)))
     t213 = xp.where(xp.less(t31, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t214 = t31 + t213
+    t214 = t213 + t31
     t215 = -t213 + t31
     t216 = xp.where(xp.greater_equal(t31, -3.9269908169872414) & xp.less_equal(t31, 0.7853981633974483), t31, xp.where(xp.greater_equal(t214, -3.9269908169872414) & xp.less_equal(t214, 0.7853981633974483), t214, xp.where(xp.greater_equal(t215, -3.9269908169872414) & xp.less_equal(t215, 0.7853981633974483), t215, qb4_2)))
     t217 = xp.where(xp.less(t32, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t218 = t32 + t217
+    t218 = t217 + t32
     t219 = -t217 + t32
     t220 = xp.where(xp.greater_equal(t32, -1.9198621771937625) & xp.less_equal(t32, 2.9670597283903604), t32, xp.where(xp.greater_equal(t218, -1.9198621771937625) & xp.less_equal(t218, 2.9670597283903604), t218, xp.where(xp.greater_equal(t219, -1.9198621771937625) & xp.less_equal(t219, 2.9670597283903604), t219, qb4_3)))
     t221 = xp.where(xp.less(t33, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t222 = t33 + t221
+    t222 = t221 + t33
     t223 = -t221 + t33
     t224 = xp.where(xp.greater_equal(t33, -1.7453292519943295) & xp.less_equal(t33, 1.7453292519943295), t33, xp.where(xp.greater_equal(t222, -1.7453292519943295) & xp.less_equal(t222, 1.7453292519943295), t222, xp.where(xp.greater_equal(t223, -1.7453292519943295) & xp.less_equal(t223, 1.7453292519943295), t223, qb4_4)))
     t225 = xp.where(xp.less(t34, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t226 = t34 + t225
+    t226 = t225 + t34
     t227 = -t225 + t34
     t228 = xp.where(xp.greater_equal(t34, -4.642575810304916) & xp.less_equal(t34, 4.642575810304916), t34, xp.where(xp.greater_equal(t226, -4.642575810304916) & xp.less_equal(t226, 4.642575810304916), t226, xp.where(xp.greater_equal(t227, -4.642575810304916) & xp.less_equal(t227, 4.642575810304916), t227, qb4_5)))
     t229 = qw1*(t82 + t208)**2 + qw2*(t83 + t212)**2 + qw3*(t84 + t216)**2 + qw4*(t85 + t220)**2 + qw5*(t86 + t224)**2 + qw6*(t87 + t228)**2
@@ -3170,27 +3168,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t239 = xp.where(t233, t228, t203)
     t240 = xp.where(t233, t229, t204)
     t241 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t242 = t36 + t241
+    t242 = t241 + t36
     t243 = -t241 + t36
     t244 = xp.where(xp.greater_equal(t36, -2.792526803190927) & xp.less_equal(t36, 2.792526803190927), t36, xp.where(xp.greater_equal(t242, -2.792526803190927) & xp.less_equal(t242, 2.792526803190927), t242, xp.where(xp.greater_equal(t243, -2.792526803190927) & xp.less_equal(t243, 2.792526803190927), t243, qb5_0)))
     t245 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t246 = t37 + t245
+    t246 = t245 + t37
     t247 = -t245 + t37
     t248 = xp.where(xp.greater_equal(t37, -0.7853981633974483) & xp.less_equal(t37, 3.9269908169872414), t37, xp.where(xp.greater_equal(t246, -0.7853981633974483) & xp.less_equal(t246, 3.9269908169872414), t246, xp.where(xp.greater_equal(t247, -0.7853981633974483) & xp.less_equal(t247, 3.9269908169872414), t247, qb5_1)))
     t249 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t250 = t38 + t249
+    t250 = t249 + t38
     t251 = -t249 + t38
     t252 = xp.where(xp.greater_equal(t38, -3.9269908169872414) & xp.less_equal(t38, 0.7853981633974483), t38, xp.where(xp.greater_equal(t250, -3.9269908169872414) & xp.less_equal(t250, 0.7853981633974483), t250, xp.where(xp.greater_equal(t251, -3.9269908169872414) & xp.less_equal(t251, 0.7853981633974483), t251, qb5_2)))
     t253 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t254 = t39 + t253
+    t254 = t253 + t39
     t255 = -t253 + t39
     t256 = xp.where(xp.greater_equal(t39, -1.9198621771937625) & xp.less_equal(t39, 2.9670597283903604), t39, xp.where(xp.greater_equal(t254, -1.9198621771937625) & xp.less_equal(t254, 2.9670597283903604), t254, xp.where(xp.greater_equal(t255, -1.9198621771937625) & xp.less_equal(t255, 2.9670597283903604), t255, qb5_3)))
     t257 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t258 = t40 + t257
+    t258 = t257 + t40
     t259 = -t257 + t40
     t260 = xp.where(xp.greater_equal(t40, -1.7453292519943295) & xp.less_equal(t40, 1.7453292519943295), t40, xp.where(xp.greater_equal(t258, -1.7453292519943295) & xp.less_equal(t258, 1.7453292519943295), t258, xp.where(xp.greater_equal(t259, -1.7453292519943295) & xp.less_equal(t259, 1.7453292519943295), t259, qb5_4)))
     t261 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t262 = t41 + t261
+    t262 = t261 + t41
     t263 = -t261 + t41
     t264 = xp.where(xp.greater_equal(t41, -4.642575810304916) & xp.less_equal(t41, 4.642575810304916), t41, xp.where(xp.greater_equal(t262, -4.642575810304916) & xp.less_equal(t262, 4.642575810304916), t262, xp.where(xp.greater_equal(t263, -4.642575810304916) & xp.less_equal(t263, 4.642575810304916), t263, qb5_5)))
     t265 = qw1*(t82 + t244)**2 + qw2*(t83 + t248)**2 + qw3*(t84 + t252)**2 + qw4*(t85 + t256)**2 + qw5*(t86 + t260)**2 + qw6*(t87 + t264)**2
@@ -3206,27 +3204,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t275 = xp.where(t269, t264, t239)
     t276 = xp.where(t269, t265, t240)
     t277 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t278 = t43 + t277
+    t278 = t277 + t43
     t279 = -t277 + t43
     t280 = xp.where(xp.greater_equal(t43, -2.792526803190927) & xp.less_equal(t43, 2.792526803190927), t43, xp.where(xp.greater_equal(t278, -2.792526803190927) & xp.less_equal(t278, 2.792526803190927), t278, xp.where(xp.greater_equal(t279, -2.792526803190927) & xp.less_equal(t279, 2.792526803190927), t279, qb6_0)))
     t281 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t282 = t44 + t281
+    t282 = t281 + t44
     t283 = -t281 + t44
     t284 = xp.where(xp.greater_equal(t44, -0.7853981633974483) & xp.less_equal(t44, 3.9269908169872414), t44, xp.where(xp.greater_equal(t282, -0.7853981633974483) & xp.less_equal(t282, 3.9269908169872414), t282, xp.where(xp.greater_equal(t283, -0.7853981633974483) & xp.less_equal(t283, 3.9269908169872414), t283, qb6_1)))
     t285 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t286 = t45 + t285
+    t286 = t285 + t45
     t287 = -t285 + t45
     t288 = xp.where(xp.greater_equal(t45, -3.9269908169872414) & xp.less_equal(t45, 0.7853981633974483), t45, xp.where(xp.greater_equal(t286, -3.9269908169872414) & xp.less_equal(t286, 0.7853981633974483), t286, xp.where(xp.greater_equal(t287, -3.9269908169872414) & xp.less_equal(t287, 0.7853981633974483), t287, qb6_2)))
     t289 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t290 = t46 + t289
+    t290 = t289 + t46
     t291 = -t289 + t46
     t292 = xp.where(xp.greater_equal(t46, -1.9198621771937625) & xp.less_equal(t46, 2.9670597283903604), t46, xp.where(xp.greater_equal(t290, -1.9198621771937625) & xp.less_equal(t290, 2.9670597283903604), t290, xp.where(xp.greater_equal(t291, -1.9198621771937625) & xp.less_equal(t291, 2.9670597283903604), t291, qb6_3)))
     t293 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t294 = t47 + t293
+    t294 = t293 + t47
     t295 = -t293 + t47
     t296 = xp.where(xp.greater_equal(t47, -1.7453292519943295) & xp.less_equal(t47, 1.7453292519943295), t47, xp.where(xp.greater_equal(t294, -1.7453292519943295) & xp.less_equal(t294, 1.7453292519943295), t294, xp.where(xp.greater_equal(t295, -1.7453292519943295) & xp.less_equal(t295, 1.7453292519943295), t295, qb6_4)))
     t297 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t298 = t48 + t297
+    t298 = t297 + t48
     t299 = -t297 + t48
     t300 = xp.where(xp.greater_equal(t48, -4.642575810304916) & xp.less_equal(t48, 4.642575810304916), t48, xp.where(xp.greater_equal(t298, -4.642575810304916) & xp.less_equal(t298, 4.642575810304916), t298, xp.where(xp.greater_equal(t299, -4.642575810304916) & xp.less_equal(t299, 4.642575810304916), t299, qb6_5)))
     t301 = qw1*(t82 + t280)**2 + qw2*(t83 + t284)**2 + qw3*(t84 + t288)**2 + qw4*(t85 + t292)**2 + qw5*(t86 + t296)**2 + qw6*(t87 + t300)**2
@@ -3242,27 +3240,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t311 = xp.where(t305, t300, t275)
     t312 = xp.where(t305, t301, t276)
     t313 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t314 = t50 + t313
+    t314 = t313 + t50
     t315 = -t313 + t50
     t316 = xp.where(xp.greater_equal(t50, -2.792526803190927) & xp.less_equal(t50, 2.792526803190927), t50, xp.where(xp.greater_equal(t314, -2.792526803190927) & xp.less_equal(t314, 2.792526803190927), t314, xp.where(xp.greater_equal(t315, -2.792526803190927) & xp.less_equal(t315, 2.792526803190927), t315, qb7_0)))
     t317 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t318 = t51 + t317
+    t318 = t317 + t51
     t319 = -t317 + t51
     t320 = xp.where(xp.greater_equal(t51, -0.7853981633974483) & xp.less_equal(t51, 3.9269908169872414), t51, xp.where(xp.greater_equal(t318, -0.7853981633974483) & xp.less_equal(t318, 3.9269908169872414), t318, xp.where(xp.greater_equal(t319, -0.7853981633974483) & xp.less_equal(t319, 3.9269908169872414), t319, qb7_1)))
     t321 = xp.where(xp.less(t52, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t322 = t52 + t321
+    t322 = t321 + t52
     t323 = -t321 + t52
     t324 = xp.where(xp.greater_equal(t52, -3.9269908169872414) & xp.less_equal(t52, 0.7853981633974483), t52, xp.where(xp.greater_equal(t322, -3.9269908169872414) & xp.less_equal(t322, 0.7853981633974483), t322, xp.where(xp.greater_equal(t323, -3.9269908169872414) & xp.less_equal(t323, 0.7853981633974483), t323, qb7_2)))
     t325 = xp.where(xp.less(t53, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t326 = t53 + t325
+    t326 = t325 + t53
     t327 = -t325 + t53
     t328 = xp.where(xp.greater_equal(t53, -1.9198621771937625) & xp.less_equal(t53, 2.9670597283903604), t53, xp.where(xp.greater_equal(t326, -1.9198621771937625) & xp.less_equal(t326, 2.9670597283903604), t326, xp.where(xp.greater_equal(t327, -1.9198621771937625) & xp.less_equal(t327, 2.9670597283903604), t327, qb7_3)))
     t329 = xp.where(xp.less(t54, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t330 = t54 + t329
+    t330 = t329 + t54
     t331 = -t329 + t54
     t332 = xp.where(xp.greater_equal(t54, -1.7453292519943295) & xp.less_equal(t54, 1.7453292519943295), t54, xp.where(xp.greater_equal(t330, -1.7453292519943295) & xp.less_equal(t330, 1.7453292519943295), t330, xp.where(xp.greater_equal(t331, -1.7453292519943295) & xp.less_equal(t331, 1.7453292519943295), t331, qb7_4)))
     t333 = xp.where(xp.less(t55, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t334 = t55 + t333
+    t334 = t333 + t55
     t335 = -t333 + t55
     t336 = xp.where(xp.greater_equal(t55, -4.642575810304916) & xp.less_equal(t55, 4.642575810304916), t55, xp.where(xp.greater_equal(t334, -4.642575810304916) & xp.less_equal(t334, 4.642575810304916), t334, xp.where(xp.greater_equal(t335, -4.642575810304916) & xp.less_equal(t335, 4.642575810304916), t335, qb7_5)))
     t337 = qw1*(t82 + t316)**2 + qw2*(t83 + t320)**2 + qw3*(t84 + t324)**2 + qw4*(t85 + t328)**2 + qw5*(t86 + t332)**2 + qw6*(t87 + t336)**2

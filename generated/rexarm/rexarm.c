@@ -32,12 +32,12 @@ void rexarm_fk(const rexarm_real q[REXARM_DOF], rexarm_real T[16])
     const rexarm_real t2 = 0.12 + t1;
     const rexarm_real t3 = 0.1*c23;
     const rexarm_real t4 = c1*c234;
-    const rexarm_real t5 = c1*t3 + 0.1*t4;
+    const rexarm_real t5 = 0.1*t4 + c1*t3;
     const rexarm_real t6 = s1*c234;
-    const rexarm_real t7 = s1*t3 + 0.1*t6;
+    const rexarm_real t7 = 0.1*t6 + s1*t3;
     const rexarm_real t8 = 0.1*c2;
-    const rexarm_real t9 = c1*t8 + t5;
-    const rexarm_real t10 = s1*t8 + t7;
+    const rexarm_real t9 = t5 + c1*t8;
+    const rexarm_real t10 = t7 + s1*t8;
 
     /* Outputs */
     T[0] = t4;
@@ -83,10 +83,10 @@ void rexarm_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real J[6 * REXARM_D
     const rexarm_real s234 = c23*s4 + s23*c4;
     const rexarm_real t0 = 0.1*c1;
     const rexarm_real t1 = c23*t0 + c234*t0;
-    const rexarm_real t2 = c2*t0 + t1;
+    const rexarm_real t2 = t1 + c2*t0;
     const rexarm_real t3 = 0.1*s1;
     const rexarm_real t4 = c23*t3 + c234*t3;
-    const rexarm_real t5 = c2*t3 + t4;
+    const rexarm_real t5 = t4 + c2*t3;
     const rexarm_real t6 = 0.1*s234;
     const rexarm_real t7 = 0.1*s23 + t6;
     const rexarm_real t8 = 0.1*s2 + t7;
@@ -145,16 +145,16 @@ void rexarm_fk_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real T[16], rexa
     const rexarm_real s234 = c23*s4 + s23*c4;
     const rexarm_real t0 = 0.1*c23;
     const rexarm_real t1 = c1*c234;
-    const rexarm_real t2 = c1*t0 + 0.1*t1;
+    const rexarm_real t2 = 0.1*t1 + c1*t0;
     const rexarm_real t3 = s1*c234;
-    const rexarm_real t4 = s1*t0 + 0.1*t3;
+    const rexarm_real t4 = 0.1*t3 + s1*t0;
     const rexarm_real t5 = 0.1*s234;
     const rexarm_real t6 = 0.1*s23 + t5;
     const rexarm_real t7 = 0.1*s2 + t6;
     const rexarm_real t8 = 0.12 + t7;
     const rexarm_real t9 = 0.1*c2;
-    const rexarm_real t10 = c1*t9 + t2;
-    const rexarm_real t11 = s1*t9 + t4;
+    const rexarm_real t10 = t2 + c1*t9;
+    const rexarm_real t11 = t4 + s1*t9;
     const rexarm_real t12 = 0.1*c234;
     const rexarm_real t13 = -c1;
 
@@ -226,10 +226,10 @@ void rexarm_jacobian_tool(const rexarm_real q[REXARM_DOF], rexarm_real J[6 * REX
     const rexarm_real s234 = c23*s4 + s23*c4;
     const rexarm_real t0 = 0.1*c1;
     const rexarm_real t1 = c23*t0 + c234*t0;
-    const rexarm_real t2 = c2*t0 + t1;
+    const rexarm_real t2 = t1 + c2*t0;
     const rexarm_real t3 = 0.1*s1;
     const rexarm_real t4 = c23*t3 + c234*t3;
-    const rexarm_real t5 = c2*t3 + t4;
+    const rexarm_real t5 = t4 + c2*t3;
     const rexarm_real t6 = 0.1*s234;
     const rexarm_real t7 = 0.1*s23 + t6;
     const rexarm_real t8 = 0.1*s2 + t7;
@@ -304,10 +304,10 @@ void rexarm_task(const rexarm_real q[REXARM_DOF], rexarm_real mu[REXARM_TASK_DIM
     const rexarm_real t2 = 0.12 + t1;
     const rexarm_real t3 = 0.1*c1;
     const rexarm_real t4 = c23*t3 + c234*t3;
-    const rexarm_real t5 = c2*t3 + t4;
+    const rexarm_real t5 = t4 + c2*t3;
     const rexarm_real t6 = 0.1*s1;
     const rexarm_real t7 = c23*t6 + c234*t6;
-    const rexarm_real t8 = c2*t6 + t7;
+    const rexarm_real t8 = t7 + c2*t6;
     const rexarm_real t9 = (c234*c234);
 
     /* Outputs */
@@ -342,17 +342,17 @@ void rexarm_task_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real J[REXARM_
     const rexarm_real s234 = c23*s4 + s23*c4;
     const rexarm_real t0 = 0.1*c1;
     const rexarm_real t1 = c23*t0 + c234*t0;
-    const rexarm_real t2 = c2*t0 + t1;
+    const rexarm_real t2 = t1 + c2*t0;
     const rexarm_real t3 = 0.1*s1;
     const rexarm_real t4 = c23*t3 + c234*t3;
-    const rexarm_real t5 = c2*t3 + t4;
+    const rexarm_real t5 = t4 + c2*t3;
     const rexarm_real t6 = 0.1*s234;
     const rexarm_real t7 = 0.1*s23 + t6;
     const rexarm_real t8 = 0.1*s2 + t7;
     const rexarm_real t9 = (c1*c1);
-    const rexarm_real t10 = t9*c234;
+    const rexarm_real t10 = c234*t9;
     const rexarm_real t11 = (s1*s1);
-    const rexarm_real t12 = t11*c234;
+    const rexarm_real t12 = c234*t11;
     const rexarm_real t13 = (c234*c234);
     const rexarm_real t14 = -(t10 + t12)/sqrt(t9*t13 + t11*t13);
 
@@ -404,16 +404,16 @@ void rexarm_fk_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q
     const rexarm_real s234 = c23*s4 + s23*c4;
     const rexarm_real t0 = 0.1*c23;
     const rexarm_real t1 = c1*c234;
-    const rexarm_real t2 = c1*t0 + 0.1*t1;
+    const rexarm_real t2 = 0.1*t1 + c1*t0;
     const rexarm_real t3 = s1*c234;
-    const rexarm_real t4 = s1*t0 + 0.1*t3;
+    const rexarm_real t4 = 0.1*t3 + s1*t0;
     const rexarm_real t5 = 0.1*s234;
     const rexarm_real t6 = 0.1*s23 + t5;
     const rexarm_real t7 = 0.1*s2 + t6;
     const rexarm_real t8 = 0.12 + t7;
     const rexarm_real t9 = 0.1*c2;
-    const rexarm_real t10 = c1*t9 + t2;
-    const rexarm_real t11 = s1*t9 + t4;
+    const rexarm_real t10 = t2 + c1*t9;
+    const rexarm_real t11 = t4 + s1*t9;
     const rexarm_real t12 = c1*t10 + s1*t11;
     const rexarm_real t13 = t12;
     const rexarm_real t14 = c1*t2 + s1*t4;
@@ -490,9 +490,9 @@ void rexarm_fk_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q
     J[21] = 0;
     J[22] = 0;
     J[23] = 0;
-    a[0] = -qd1*t34 + qd2*(qd1*t40 - c1*t37) - qd3*(t24*t15 - qd1*t41 + c1*t36) - qd4*(t20*t26 - 0.1*s1*s234*qd1 + c1*t35);
-    a[1] = -qd1*t30 - qd2*(qd1*t38 + s1*t37) - qd3*(qd1*t39 + t21*t15 + s1*t36) - qd4*(t27*qd1 + t20*t23 + s1*t35);
-    a[2] = -qd2*(s1*t33 + c1*t29) - qd3*(t18*t43 + t16*t43 + s1*t32 + c1*t28) - qd4*(t31*t23 + t27*t26 + t18*t44 + t16*t44);
+    a[0] = -qd1*t34 + qd2*(-c1*t37 + qd1*t40) - qd3*(c1*t36 + t24*t15 - qd1*t41) - qd4*(-0.1*s1*s234*qd1 + t20*t26 + c1*t35);
+    a[1] = -qd1*t30 - qd2*(s1*t37 + qd1*t38) - qd3*(s1*t36 + qd1*t39 + t21*t15) - qd4*(t20*t23 + t27*qd1 + s1*t35);
+    a[2] = -qd2*(s1*t33 + c1*t29) - qd3*(c1*t28 + s1*t32 + t18*t43 + t16*t43) - qd4*(t31*t23 + t27*t26 + t18*t44 + t16*t44);
     a[3] = t24*qd1 + t25*qd1 + c1*t45;
     a[4] = t21*qd1 + t22*qd1 + s1*t45;
     a[5] = qd4*(-c1*t23 + s1*t26);
@@ -527,10 +527,10 @@ void rexarm_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_do
     const rexarm_real s234 = c23*s4 + s23*c4;
     const rexarm_real t0 = 0.1*c1;
     const rexarm_real t1 = c23*t0 + c234*t0;
-    const rexarm_real t2 = c2*t0 + t1;
+    const rexarm_real t2 = t1 + c2*t0;
     const rexarm_real t3 = 0.1*s1;
     const rexarm_real t4 = c23*t3 + c234*t3;
-    const rexarm_real t5 = c2*t3 + t4;
+    const rexarm_real t5 = t4 + c2*t3;
     const rexarm_real t6 = c1*t2 + s1*t5;
     const rexarm_real t7 = c1*t1 + s1*t4;
     const rexarm_real t8 = 0.1*s234;
@@ -562,16 +562,16 @@ void rexarm_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_do
 
     /* Outputs */
     Jd[0] = -t27;
-    Jd[1] = t10*t31 - c1*t30;
-    Jd[2] = -(t18*t7 - t9*t31 + c1*t29);
-    Jd[3] = -(t14*t20 - 0.1*s1*s234*qd1 + c1*t28);
+    Jd[1] = -c1*t30 + t10*t31;
+    Jd[2] = -(c1*t29 + t18*t7 - t9*t31);
+    Jd[3] = -(-0.1*s1*s234*qd1 + t14*t20 + c1*t28);
     Jd[4] = -t26;
-    Jd[5] = -(t10*t32 + s1*t30);
-    Jd[6] = -(t9*t32 + t15*t7 + s1*t29);
-    Jd[7] = -(t8*t32 + t14*t17 + s1*t28);
+    Jd[5] = -(s1*t30 + t10*t32);
+    Jd[6] = -(s1*t29 + t9*t32 + t15*t7);
+    Jd[7] = -(t14*t17 + t8*t32 + s1*t28);
     Jd[8] = 0;
     Jd[9] = -(s1*t25 + c1*t24);
-    Jd[10] = -(t13*t33 + t11*t33 + s1*t23 + c1*t22);
+    Jd[10] = -(c1*t22 + s1*t23 + t13*t33 + t11*t33);
     Jd[11] = -(s1*t8*t17 + c1*t8*t20 + t13*t21 + t11*t21);
     Jd[12] = 0;
     Jd[13] = t32;
@@ -616,10 +616,10 @@ void rexarm_bias_acceleration(const rexarm_real q[REXARM_DOF], const rexarm_real
     const rexarm_real s234 = c23*s4 + s23*c4;
     const rexarm_real t0 = 0.1*c1;
     const rexarm_real t1 = c23*t0 + c234*t0;
-    const rexarm_real t2 = c2*t0 + t1;
+    const rexarm_real t2 = t1 + c2*t0;
     const rexarm_real t3 = 0.1*s1;
     const rexarm_real t4 = c23*t3 + c234*t3;
-    const rexarm_real t5 = c2*t3 + t4;
+    const rexarm_real t5 = t4 + c2*t3;
     const rexarm_real t6 = c1*t2 + s1*t5;
     const rexarm_real t7 = c1*t1 + s1*t4;
     const rexarm_real t8 = 0.1*s234;
@@ -650,9 +650,9 @@ void rexarm_bias_acceleration(const rexarm_real q[REXARM_DOF], const rexarm_real
     const rexarm_real t33 = t9*qd2;
 
     /* Outputs */
-    a[0] = -qd1*t27 + qd2*(t10*t31 - c1*t30) - qd3*(t18*t7 - t9*t31 + c1*t29) - qd4*(t14*t20 - 0.1*s1*s234*qd1 + c1*t28);
-    a[1] = -qd1*t26 - qd2*(t10*t32 + s1*t30) - qd3*(t9*t32 + t15*t7 + s1*t29) - qd4*(t8*t32 + t14*t17 + s1*t28);
-    a[2] = -qd2*(s1*t25 + c1*t24) - qd3*(t13*t33 + t11*t33 + s1*t23 + c1*t22) - qd4*(s1*t8*t17 + c1*t8*t20 + t13*t21 + t11*t21);
+    a[0] = -qd1*t27 + qd2*(-c1*t30 + t10*t31) - qd3*(c1*t29 + t18*t7 - t9*t31) - qd4*(-0.1*s1*s234*qd1 + t14*t20 + c1*t28);
+    a[1] = -qd1*t26 - qd2*(s1*t30 + t10*t32) - qd3*(s1*t29 + t9*t32 + t15*t7) - qd4*(t14*t17 + t8*t32 + s1*t28);
+    a[2] = -qd2*(s1*t25 + c1*t24) - qd3*(c1*t22 + s1*t23 + t13*t33 + t11*t33) - qd4*(s1*t8*t17 + c1*t8*t20 + t13*t21 + t11*t21);
     a[3] = t18*qd1 + t19*qd1 + t32*qd4;
     a[4] = t15*qd1 + t16*qd1 + t31*qd4;
     a[5] = qd4*(-c1*t17 + s1*t20);
@@ -660,7 +660,7 @@ void rexarm_bias_acceleration(const rexarm_real q[REXARM_DOF], const rexarm_real
 
 void rexarm_task_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real Jd[REXARM_TASK_DIM * REXARM_DOF])
 {
-    /* 170 operations */
+    /* 167 operations */
 
     /* Inputs */
     const rexarm_real q1 = q[0];
@@ -687,20 +687,20 @@ void rexarm_task_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real
     const rexarm_real s234 = c23*s4 + s23*c4;
     const rexarm_real t0 = 0.1*c1;
     const rexarm_real t1 = c23*t0 + c234*t0;
-    const rexarm_real t2 = c2*t0 + t1;
+    const rexarm_real t2 = t1 + c2*t0;
     const rexarm_real t3 = 0.1*s1;
     const rexarm_real t4 = s1*c234;
-    const rexarm_real t5 = c23*t3 + 0.1*t4;
-    const rexarm_real t6 = c2*t3 + t5;
+    const rexarm_real t5 = 0.1*t4 + c23*t3;
+    const rexarm_real t6 = t5 + c2*t3;
     const rexarm_real t7 = c1*t2 + s1*t6;
     const rexarm_real t8 = c1*t1 + s1*t5;
     const rexarm_real t9 = 0.1*s234;
     const rexarm_real t10 = 0.1*s23 + t9;
     const rexarm_real t11 = 0.1*s2 + t10;
     const rexarm_real t12 = (c1*c1);
-    const rexarm_real t13 = t12*c234;
+    const rexarm_real t13 = c234*t12;
     const rexarm_real t14 = (s1*s1);
-    const rexarm_real t15 = t14*c234;
+    const rexarm_real t15 = c234*t14;
     const rexarm_real t16 = 0.1*t13 + 0.1*t15;
     const rexarm_real t17 = s1*qd2;
     const rexarm_real t18 = s1*qd3;
@@ -711,12 +711,12 @@ void rexarm_task_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real
     const rexarm_real t23 = t21 + t22;
     const rexarm_real t24 = t23;
     const rexarm_real t25 = c1*qd4;
-    const rexarm_real t26 = t9*t25 + t10*t22;
+    const rexarm_real t26 = t10*t22 + t9*t25;
     const rexarm_real t27 = t26 + t11*t21;
     const rexarm_real t28 = t27 + t6*qd1;
     const rexarm_real t29 = t23 + t25;
     const rexarm_real t30 = s1*qd4;
-    const rexarm_real t31 = t9*t30 + t10*t18;
+    const rexarm_real t31 = t10*t18 + t9*t30;
     const rexarm_real t32 = t31 + t11*t17;
     const rexarm_real t33 = -t32 + t2*qd1;
     const rexarm_real t34 = s1*t32 + c1*t27;
@@ -725,16 +725,16 @@ void rexarm_task_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real
     const rexarm_real t37 = t36 + t8*qd3;
     const rexarm_real t38 = t37 + t7*qd2;
     const rexarm_real t39 = s1*qd1;
-    const rexarm_real t40 = t11*t39 - c1*t38;
-    const rexarm_real t41 = t21*t8 - t10*t39 + c1*t37;
+    const rexarm_real t40 = -c1*t38 + t11*t39;
+    const rexarm_real t41 = c1*t37 + t21*t8 - t10*t39;
     const rexarm_real t42 = t16*t24 - t9*t39 + c1*t36;
     const rexarm_real t43 = c1*qd1;
-    const rexarm_real t44 = t11*t43 + s1*t38;
-    const rexarm_real t45 = t10*t43 + t17*t8 + s1*t37;
-    const rexarm_real t46 = t9*t43 + t16*t20 + s1*t36;
-    const rexarm_real t47 = c234*t43 - s234*t35;
+    const rexarm_real t44 = s1*t38 + t11*t43;
+    const rexarm_real t45 = s1*t37 + t17*t8 + t10*t43;
+    const rexarm_real t46 = t16*t20 + t9*t43 + s1*t36;
+    const rexarm_real t47 = -s234*t35 + c234*t43;
     const rexarm_real t48 = t10*qd2;
-    const rexarm_real t49 = t14*t48 + t12*t48 + s1*t31 + c1*t26;
+    const rexarm_real t49 = c1*t26 + s1*t31 + t14*t48 + t12*t48;
     const rexarm_real t50 = t9*qd4;
     const rexarm_real t51 = s1*t9*t20 + c1*t9*t24 + t14*t50 + t12*t50;
     const rexarm_real t52 = t4*qd1;
@@ -745,8 +745,7 @@ void rexarm_task_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real
     const rexarm_real t57 = 1.0/t56;
     const rexarm_real t58 = -t57*(t13 + t15)/t55;
     const rexarm_real t59 = c1*t57;
-    const rexarm_real t60 = t52*t59;
-    const rexarm_real t61 = t53*(t59 + c1*c234*t58) - t47*(s1*t57 + t4*t58) - t60 + t60;
+    const rexarm_real t60 = t53*(c1*c234*t58 + t59) - t47*(s1*t57 + t4*t58);
 
     /* Outputs */
     Jd[0] = -t33;
@@ -762,9 +761,9 @@ void rexarm_task_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real
     Jd[10] = -t49;
     Jd[11] = -t51;
     Jd[12] = 0;
-    Jd[13] = t61;
-    Jd[14] = t61;
-    Jd[15] = t61;
+    Jd[13] = t60;
+    Jd[14] = t60;
+    Jd[15] = t60;
 }
 
 void rexarm_hessian(const rexarm_real q[REXARM_DOF], rexarm_real H[REXARM_DOF * 6 * REXARM_DOF])
@@ -792,10 +791,10 @@ void rexarm_hessian(const rexarm_real q[REXARM_DOF], rexarm_real H[REXARM_DOF * 
     const rexarm_real s234 = c23*s4 + s23*c4;
     const rexarm_real t0 = 0.1*c1;
     const rexarm_real t1 = c23*t0 + c234*t0;
-    const rexarm_real t2 = c2*t0 + t1;
+    const rexarm_real t2 = t1 + c2*t0;
     const rexarm_real t3 = 0.1*s1;
     const rexarm_real t4 = c23*t3 + c234*t3;
-    const rexarm_real t5 = c2*t3 + t4;
+    const rexarm_real t5 = t4 + c2*t3;
     const rexarm_real t6 = c1*t2 + s1*t5;
     const rexarm_real t7 = c1*t1 + s1*t4;
     const rexarm_real t8 = 0.1*s234;
@@ -815,7 +814,7 @@ void rexarm_hessian(const rexarm_real q[REXARM_DOF], rexarm_real H[REXARM_DOF * 
     const rexarm_real t22 = -c1*t14;
     const rexarm_real t23 = -s1*t7;
     const rexarm_real t24 = -s1*t14;
-    const rexarm_real t25 = -(t13*t9 + t11*t9);
+    const rexarm_real t25 = -(t9*t13 + t9*t11);
     const rexarm_real t26 = -(t8*t13 + t8*t11);
 
     /* Outputs */
@@ -852,7 +851,7 @@ void rexarm_hessian(const rexarm_real q[REXARM_DOF], rexarm_real H[REXARM_DOF * 
     H[30] = t23;
     H[31] = t24;
     H[32] = 0;
-    H[33] = -(t13*t10 + t11*t10);
+    H[33] = -(t10*t13 + t10*t11);
     H[34] = t25;
     H[35] = t26;
     H[36] = 0;
@@ -938,7 +937,7 @@ void rexarm_singularity_factors(const rexarm_real q[REXARM_DOF], rexarm_real f[R
 
     /* Outputs */
     f[0] = s3;
-    f[1] = -(-c2 - t0 + t1 - c4*t0 + c2*s3*s4 + s2*c3*s4 + c4*t1);
+    f[1] = -(-c2 - t0 + t1 + c2*s3*s4 + s2*c3*s4 - c4*t0 + c4*t1);
 }
 
 rexarm_real rexarm_manipulability(const rexarm_real q[REXARM_DOF])
@@ -966,7 +965,7 @@ rexarm_real rexarm_manipulability(const rexarm_real q[REXARM_DOF])
     const rexarm_real t0 = (c234*c234);
     const rexarm_real t1 = c2*c3;
     const rexarm_real t2 = s2*s3;
-    const rexarm_real t3 = -c4*t1 + c2*s3*s4 + s2*c3*s4 + c4*t2;
+    const rexarm_real t3 = c2*s3*s4 + s2*c3*s4 - c4*t1 + c4*t2;
     const rexarm_real t4 = 0.001*s3*t3*(-c2 - t1 + t2 + t3)/sqrt((c1*c1)*t0 + (s1*s1)*t0);
 
     /* Outputs */
@@ -998,7 +997,7 @@ rexarm_real rexarm_jacobian_det(const rexarm_real q[REXARM_DOF])
     const rexarm_real t0 = (c234*c234);
     const rexarm_real t1 = c2*c3;
     const rexarm_real t2 = s2*s3;
-    const rexarm_real t3 = -c4*t1 + c2*s3*s4 + s2*c3*s4 + c4*t2;
+    const rexarm_real t3 = c2*s3*s4 + s2*c3*s4 - c4*t1 + c4*t2;
 
     /* Outputs */
     return 0.001*s3*t3*(-c2 - t1 + t2 + t3)/sqrt((c1*c1)*t0 + (s1*s1)*t0);
@@ -1006,7 +1005,7 @@ rexarm_real rexarm_jacobian_det(const rexarm_real q[REXARM_DOF])
 
 int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], rexarm_real damping, rexarm_real q_dot[REXARM_DOF])
 {
-    /* 600 operations */
+    /* 599 operations */
 
     /* Inputs */
     const rexarm_real q1 = q[0];
@@ -1033,23 +1032,23 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
     const rexarm_real s234 = c23*s4 + s23*c4;
     const rexarm_real t0 = 0.1*c1;
     const rexarm_real t1 = c23*t0 + c234*t0;
-    const rexarm_real t2 = c2*t0 + t1;
+    const rexarm_real t2 = t1 + c2*t0;
     const rexarm_real t3 = 0.1*s1;
     const rexarm_real t4 = c23*t3 + c234*t3;
-    const rexarm_real t5 = c2*t3 + t4;
+    const rexarm_real t5 = t4 + c2*t3;
     const rexarm_real t6 = c1*t2 + s1*t5;
     const rexarm_real t7 = c1*t1 + s1*t4;
     const rexarm_real t8 = 0.1*s234;
     const rexarm_real t9 = 0.1*s23 + t8;
     const rexarm_real t10 = 0.1*s2 + t9;
     const rexarm_real t11 = (c1*c1);
-    const rexarm_real t12 = t11*c234;
+    const rexarm_real t12 = c234*t11;
     const rexarm_real t13 = (s1*s1);
-    const rexarm_real t14 = t13*c234;
+    const rexarm_real t14 = c234*t13;
     const rexarm_real t15 = 0.1*t12 + 0.1*t14;
     const rexarm_real t16 = (c234*c234);
     const rexarm_real t17 = -(t12 + t14)/sqrt(t11*t16 + t13*t16);
-    const rexarm_real t18 = t6*t17 + t7*t17 + t15*t17;
+    const rexarm_real t18 = t7*t17 + t15*t17 + t6*t17;
     const rexarm_real t19 = (t5*t5);
     const rexarm_real t20 = (t10*t10);
     const rexarm_real t21 = (t9*t9);
@@ -1072,7 +1071,7 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
     const rexarm_real t38 = t6*t35 + t7*t36 + t15*t37;
     const rexarm_real t39 = t35*t17 + t36*t17 + t37*t17;
     const rexarm_real t40 = (t6*t6);
-    const rexarm_real t41 = t40 + (t7*t7) + (t15*t15);
+    const rexarm_real t41 = (t7*t7) + (t15*t15) + t40;
     const rexarm_real t42 = t41;
     const rexarm_real t43 = (t17*t17);
     const rexarm_real t44 = 3*t43;
@@ -1081,7 +1080,7 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
     const rexarm_real t47 = (t30*t30);
     const rexarm_real t48 = (t31*t31);
     const rexarm_real t49 = (damping*damping);
-    const rexarm_real t50 = t49 + t24;
+    const rexarm_real t50 = t24 + t49;
     const rexarm_real t51 = (t50*t50);
     const rexarm_real t52 = sqrt(t46 + t47 + t48 + t51);
     const rexarm_real t53 = t52*(t50 >= 0 ? 1 : -1);
@@ -1092,8 +1091,8 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
     const rexarm_real t58 = mu_dot1 - t26*t56;
     const rexarm_real t59 = mu_dot2 + t30*t56;
     const rexarm_real t60 = mu_dot3 + t31*t56;
-    const rexarm_real t61 = t49 + t34;
-    const rexarm_real t62 = t55*(t26*t54 + t26*t61 + t30*t38 + t31*t39);
+    const rexarm_real t61 = t34 + t49;
+    const rexarm_real t62 = t55*(t26*t54 + t30*t38 + t31*t39 + t26*t61);
     const rexarm_real t63 = t26 - t54*t62;
     const rexarm_real t64 = -t26*t62 + t61;
     const rexarm_real t65 = -t38 + t30*t62;
@@ -1106,8 +1105,8 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
     const rexarm_real t72 = t58 - t69*t71;
     const rexarm_real t73 = t59 - t65*t71;
     const rexarm_real t74 = t60 - t66*t71;
-    const rexarm_real t75 = t49 + t42;
-    const rexarm_real t76 = -t55*(t30*t54 + t26*t38 + t30*t75 + t31*t18);
+    const rexarm_real t75 = t42 + t49;
+    const rexarm_real t76 = -t55*(t30*t54 + t26*t38 + t31*t18 + t30*t75);
     const rexarm_real t77 = t30 + t54*t76;
     const rexarm_real t78 = t38 + t26*t76;
     const rexarm_real t79 = t30*t76 + t75;
@@ -1123,7 +1122,7 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
     const rexarm_real t89 = t88*(t73*t87 + t84*t74);
     const rexarm_real t90 = t73 - t87*t89;
     const rexarm_real t91 = t74 - t84*t89;
-    const rexarm_real t92 = t49 + t45;
+    const rexarm_real t92 = t45 + t49;
     const rexarm_real t93 = sqrt(2*t46 + 2*t47 + 2*(t38*t38) + 2*t48 + 2*(t39*t39) + 2*(t18*t18) + t51 + (t61*t61) + (t75*t75) + (t92*t92));
     const rexarm_real t94 = -t55*(t31*t54 + t26*t39 + t30*t18 + t31*t92);
     const rexarm_real t95 = t31 + t54*t94;
@@ -1141,7 +1140,7 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
     const rexarm_real t107 = t106;
     const rexarm_real t108 = t107*(t105 >= 0 ? 1 : -1);
     const rexarm_real t109 = t105 + t108;
-    const rexarm_real t110 = (t107 > 0 ? 1/(t107*(t106 + t107)) : 0);
+    const rexarm_real t110 = (t107 > 0 ? 1/(t107*(t107 + t106)) : 0);
     const rexarm_real t111 = t91 - t91*(t109*t109)*t110;
     const rexarm_real t112 = (t108 != 0 ? -t111/t108 : 0);
     const rexarm_real t113 = (t86 != 0 ? -(t90 - t104*t112)/t86 : 0);
@@ -1149,80 +1148,79 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
     const rexarm_real t115 = (t53 != 0 ? -(t57 + t77*t113 + t95*t112 - t63*t114)/t53 : 0);
     const rexarm_real t116 = -t5*t115 + t2*t114;
     const rexarm_real t117 = t17*t112;
-    const rexarm_real t118 = -t27*t115 - t35*t114 + t6*t113 + t117;
-    const rexarm_real t119 = t117 - t28*t115 - t36*t114 + t7*t113;
-    const rexarm_real t120 = t117 - t29*t115 - t37*t114 + t15*t113;
-    const rexarm_real t121 = t32 + t19;
+    const rexarm_real t118 = t6*t113 - t27*t115 - t35*t114 + t117;
+    const rexarm_real t119 = t7*t113 + t117 - t28*t115 - t36*t114;
+    const rexarm_real t120 = t15*t113 + t117 - t29*t115 - t37*t114;
+    const rexarm_real t121 = t19 + t32;
     const rexarm_real t122 = sqrt(t23 + t33 + t41 + t44 + t121);
     const rexarm_real t123 = sqrt(t121);
     const rexarm_real t124 = t123*(t5 <= 0 ? 1 : -1);
-    const rexarm_real t125 = -t5;
-    const rexarm_real t126 = t125 + t124;
-    const rexarm_real t127 = (t123 > 0 ? 1/(t123*(t123 + fabs(t125))) : 0);
-    const rexarm_real t128 = -t127*(t27*t126 + t2*t35);
-    const rexarm_real t129 = t27 + t126*t128;
+    const rexarm_real t125 = (t123 > 0 ? 1/(t123*(t123 + fabs(t5))) : 0);
+    const rexarm_real t126 = -t5;
+    const rexarm_real t127 = t124 + t126;
+    const rexarm_real t128 = -t125*(t27*t127 + t2*t35);
+    const rexarm_real t129 = t27 + t127*t128;
     const rexarm_real t130 = t35 + t2*t128;
-    const rexarm_real t131 = -t127*(t28*t126 + t2*t36);
-    const rexarm_real t132 = t28 + t126*t131;
+    const rexarm_real t131 = -t125*(t28*t127 + t2*t36);
+    const rexarm_real t132 = t28 + t127*t131;
     const rexarm_real t133 = t36 + t2*t131;
-    const rexarm_real t134 = -t127*(t29*t126 + t2*t37);
-    const rexarm_real t135 = t29 + t126*t134;
+    const rexarm_real t134 = -t125*(t29*t127 + t2*t37);
+    const rexarm_real t135 = t29 + t127*t134;
     const rexarm_real t136 = t37 + t2*t134;
-    const rexarm_real t137 = t127*(mu_dot0*t126 + t2*mu_dot1);
-    const rexarm_real t138 = mu_dot0 - t126*t137;
+    const rexarm_real t137 = t125*(mu_dot0*t127 + t2*mu_dot1);
+    const rexarm_real t138 = mu_dot0 - t127*t137;
     const rexarm_real t139 = mu_dot1 - t2*t137;
     const rexarm_real t140 = sqrt(t40 + t43 + (t130*t130));
     const rexarm_real t141 = t140*(t130 <= 0 ? 1 : -1);
-    const rexarm_real t142 = t125 + q1 + q2 + q3 + q4 + t2 - t27 - t28 - t29 - t35 - t36 - t37 + t6 + t7 + t15 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + 3*t17;
-    const rexarm_real t143 = -t130;
-    const rexarm_real t144 = t143 + t141;
-    const rexarm_real t145 = (t140 > 0 ? 1/(t140*(t140 + fabs(t143))) : 0);
-    const rexarm_real t146 = t145*(t43 - t133*t144 + t6*t7);
-    const rexarm_real t147 = t133 + t144*t146;
-    const rexarm_real t148 = t7 - t6*t146;
-    const rexarm_real t149 = t17 - t17*t146;
-    const rexarm_real t150 = t145*(t43 - t136*t144 + t6*t15);
-    const rexarm_real t151 = t136 + t144*t150;
-    const rexarm_real t152 = t15 - t6*t150;
-    const rexarm_real t153 = t17 - t17*t150;
-    const rexarm_real t154 = t145*(t139*t144 + t6*mu_dot2 + t17*mu_dot3);
-    const rexarm_real t155 = t139 - t144*t154;
-    const rexarm_real t156 = mu_dot2 - t6*t154;
-    const rexarm_real t157 = mu_dot3 - t17*t154;
-    const rexarm_real t158 = sqrt((t148*t148) + (t149*t149));
-    const rexarm_real t159 = t158*(t148 >= 0 ? 1 : -1);
-    const rexarm_real t160 = t148 + t159;
-    const rexarm_real t161 = (t158 > 0 ? 1/(t158*(t158 + fabs(t148))) : 0);
-    const rexarm_real t162 = t161*(t152*t160 + t149*t153);
-    const rexarm_real t163 = t152 - t160*t162;
-    const rexarm_real t164 = t153 - t149*t162;
-    const rexarm_real t165 = t161*(t156*t160 + t149*t157);
-    const rexarm_real t166 = t156 - t160*t165;
-    const rexarm_real t167 = t157 - t149*t165;
-    const rexarm_real t168 = fabs(t164);
-    const rexarm_real t169 = t168;
-    const rexarm_real t170 = t169*(t164 >= 0 ? 1 : -1);
-    const rexarm_real t171 = t164 + t170;
-    const rexarm_real t172 = (t169 > 0 ? 1/(t169*(t168 + t169)) : 0);
-    const rexarm_real t173 = t167 - t167*(t171*t171)*t172;
-    const rexarm_real t174 = (t170 != 0 ? -t173/t170 : 0);
-    const rexarm_real t175 = (t159 != 0 ? -(t166 - t163*t174)/t159 : 0);
-    const rexarm_real t176 = (t141 != 0 ? -(t155 + t147*t175 + t151*t174)/t141 : 0);
-    const rexarm_real t177 = (t124 != 0 ? -(t138 + t129*t176 + t132*t175 + t135*t174)/t124 : 0);
-    const int t178 = isfinite(t142);
-    const int t179 = damping >= 0;
-    const int t180 = damping > 0;
-    const rexarm_real t181 = 1e-12*t93;
-    const rexarm_real t182 = 1e-12*t122;
-    const int t183 = (t180 && ((t52 <= t181) || (t67 <= t181) || (t85 <= t181) || (t107 <= t181))) || (damping <= 0 && ((t123 <= t182) || (t140 <= t182) || (t158 <= t182) || (t169 <= t182)));
-    const int t184 = t178 && t179 && !t183;
+    const rexarm_real t142 = -t130 + t141;
+    const rexarm_real t143 = (t140 > 0 ? 1/(t140*(t140 + fabs(t130))) : 0);
+    const rexarm_real t144 = t143*(t43 - t133*t142 + t6*t7);
+    const rexarm_real t145 = t133 + t142*t144;
+    const rexarm_real t146 = t7 - t6*t144;
+    const rexarm_real t147 = t17 - t17*t144;
+    const rexarm_real t148 = t143*(t43 - t136*t142 + t6*t15);
+    const rexarm_real t149 = t136 + t142*t148;
+    const rexarm_real t150 = t15 - t6*t148;
+    const rexarm_real t151 = t17 - t17*t148;
+    const rexarm_real t152 = t143*(t139*t142 + t6*mu_dot2 + t17*mu_dot3);
+    const rexarm_real t153 = t139 - t142*t152;
+    const rexarm_real t154 = mu_dot2 - t6*t152;
+    const rexarm_real t155 = mu_dot3 - t17*t152;
+    const rexarm_real t156 = sqrt((t146*t146) + (t147*t147));
+    const rexarm_real t157 = t156*(t146 >= 0 ? 1 : -1);
+    const rexarm_real t158 = t146 + t157;
+    const rexarm_real t159 = (t156 > 0 ? 1/(t156*(t156 + fabs(t146))) : 0);
+    const rexarm_real t160 = t159*(t150*t158 + t147*t151);
+    const rexarm_real t161 = t150 - t158*t160;
+    const rexarm_real t162 = t151 - t147*t160;
+    const rexarm_real t163 = t159*(t154*t158 + t147*t155);
+    const rexarm_real t164 = t154 - t158*t163;
+    const rexarm_real t165 = t155 - t147*t163;
+    const rexarm_real t166 = -t27 - t28 - t29 - t35 - t36 - t37 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + 3*t17 + t126;
+    const rexarm_real t167 = fabs(t162);
+    const rexarm_real t168 = t167;
+    const rexarm_real t169 = t168*(t162 >= 0 ? 1 : -1);
+    const rexarm_real t170 = t162 + t169;
+    const rexarm_real t171 = (t168 > 0 ? 1/(t168*(t168 + t167)) : 0);
+    const rexarm_real t172 = t165 - t165*(t170*t170)*t171;
+    const rexarm_real t173 = (t169 != 0 ? -t172/t169 : 0);
+    const rexarm_real t174 = (t157 != 0 ? -(t164 - t161*t173)/t157 : 0);
+    const rexarm_real t175 = (t141 != 0 ? -(t153 + t145*t174 + t149*t173)/t141 : 0);
+    const rexarm_real t176 = (t124 != 0 ? -(t138 + t129*t175 + t132*t174 + t135*t173)/t124 : 0);
+    const int t177 = isfinite(t166);
+    const int t178 = damping >= 0;
+    const int t179 = damping > 0;
+    const rexarm_real t180 = 1e-12*t93;
+    const rexarm_real t181 = 1e-12*t122;
+    const int t182 = (t179 && ((t52 <= t180) || (t67 <= t180) || (t85 <= t180) || (t107 <= t180))) || (damping <= 0 && ((t123 <= t181) || (t140 <= t181) || (t156 <= t181) || (t168 <= t181)));
+    const int t183 = t177 && t178 && !t182;
 
     /* Outputs */
-    q_dot[0] = (t184 ? (t180 ? t116 : t177) : 0);
-    q_dot[1] = (t184 ? (t180 ? t118 : t176) : 0);
-    q_dot[2] = (t184 ? (t180 ? t119 : t175) : 0);
-    q_dot[3] = (t184 ? (t180 ? t120 : t174) : 0);
-    return (!(t178 && t179) ? 2 : (t183 ? 1 : 0));
+    q_dot[0] = (t183 ? (t179 ? t116 : t176) : 0);
+    q_dot[1] = (t183 ? (t179 ? t118 : t175) : 0);
+    q_dot[2] = (t183 ? (t179 ? t119 : t174) : 0);
+    q_dot[3] = (t183 ? (t179 ? t120 : t173) : 0);
+    return (!(t177 && t178) ? 2 : (t182 ? 1 : 0));
 }
 
 rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], const rexarm_real q[REXARM_DOF], rexarm_real damping, rexarm_real q_start[REXARM_DOF], rexarm_real q_next[REXARM_DOF])
@@ -1259,11 +1257,11 @@ rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], co
     const rexarm_real t0 = qs1 + qs2 + qs3 + qs4 + mu3 + mu0 + mu1 + mu2;
     const rexarm_real t1 = 0.1*c1;
     const rexarm_real t2 = c23*t1 + c234*t1;
-    const rexarm_real t3 = c2*t1 + t2;
+    const rexarm_real t3 = t2 + c2*t1;
     const rexarm_real t4 = -t3 + mu0;
     const rexarm_real t5 = 0.1*s1;
     const rexarm_real t6 = c23*t5 + c234*t5;
-    const rexarm_real t7 = c2*t5 + t6;
+    const rexarm_real t7 = t6 + c2*t5;
     const rexarm_real t8 = c1*t3 + s1*t7;
     const rexarm_real t9 = c1*t2 + s1*t6;
     const rexarm_real t10 = -t7 + mu1;
@@ -1273,28 +1271,28 @@ rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], co
     const rexarm_real t14 = 0.12 + t13;
     const rexarm_real t15 = -t14 + mu2;
     const rexarm_real t16 = (c1*c1);
-    const rexarm_real t17 = t16*c234;
+    const rexarm_real t17 = c234*t16;
     const rexarm_real t18 = (s1*s1);
-    const rexarm_real t19 = t18*c234;
+    const rexarm_real t19 = c234*t18;
     const rexarm_real t20 = 0.1*t17 + 0.1*t19;
     const rexarm_real t21 = (t8*t8) + (t9*t9) + (t20*t20);
     const rexarm_real t22 = (c234*c234);
     const rexarm_real t23 = sqrt(t16*t22 + t18*t22);
     const rexarm_real t24 = -(t17 + t19)/t23;
-    const rexarm_real t25 = t8*t24 + t9*t24 + t20*t24;
+    const rexarm_real t25 = t9*t24 + t20*t24 + t8*t24;
     const rexarm_real t26 = 3*(t24*t24);
     const rexarm_real t27 = (t13*t13);
     const rexarm_real t28 = (t12*t12);
     const rexarm_real t29 = 0.01*(s234*s234);
-    const rexarm_real t30 = (t7*t7) + t16*t27 + t16*t28 + t16*t29;
-    const rexarm_real t31 = (t3*t3) + t18*t27 + t18*t28 + t18*t29;
+    const rexarm_real t30 = (t7*t7) + t16*t28 + t16*t29 + t16*t27;
+    const rexarm_real t31 = (t3*t3) + t18*t28 + t18*t27 + t18*t29;
     const rexarm_real t32 = c1*s1;
     const rexarm_real t33 = -t3*t7 + t27*t32 + t28*t32 + t29*t32;
     const rexarm_real t34 = c1*t13;
     const rexarm_real t35 = c1*t12;
     const rexarm_real t36 = c1*t11;
     const rexarm_real t37 = t34*t8 + t35*t9 + t36*t20;
-    const rexarm_real t38 = t34*t24 + t35*t24 + t36*t24;
+    const rexarm_real t38 = t35*t24 + t36*t24 + t34*t24;
     const rexarm_real t39 = s1*t13;
     const rexarm_real t40 = s1*t12;
     const rexarm_real t41 = s1*t11;
@@ -1304,7 +1302,7 @@ rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], co
     const rexarm_real t45 = t44 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t44));
     const rexarm_real t46 = (t4*t4) + (t10*t10) + (t15*t15) + (t45*t45);
     const rexarm_real t47 = damping + t30;
-    const rexarm_real t48 = sqrt((t33*t33) + (t37*t37) + (t38*t38) + (t47*t47));
+    const rexarm_real t48 = sqrt((t47*t47) + (t33*t33) + (t37*t37) + (t38*t38));
     const rexarm_real t49 = t48*(t47 >= 0 ? 1 : -1);
     const rexarm_real t50 = t47 + t49;
     const rexarm_real t51 = (t48 > 0 ? 1/(t48*(t48 + fabs(t47))) : 0);
@@ -1314,7 +1312,7 @@ rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], co
     const rexarm_real t55 = t15 + t37*t52;
     const rexarm_real t56 = -t45 + t38*t52;
     const rexarm_real t57 = damping + t31;
-    const rexarm_real t58 = t51*(t37*t42 + t38*t43 + t33*t50 + t33*t57);
+    const rexarm_real t58 = t51*(t37*t42 + t38*t43 + t33*t50 + t57*t33);
     const rexarm_real t59 = t33 - t50*t58;
     const rexarm_real t60 = t57 - t33*t58;
     const rexarm_real t61 = -t42 + t37*t58;
@@ -1328,7 +1326,7 @@ rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], co
     const rexarm_real t69 = t55 - t61*t67;
     const rexarm_real t70 = t56 - t62*t67;
     const rexarm_real t71 = damping + t21;
-    const rexarm_real t72 = -t51*(t33*t42 + t38*t25 + t37*t50 + t37*t71);
+    const rexarm_real t72 = -t51*(t33*t42 + t38*t25 + t37*t50 + t71*t37);
     const rexarm_real t73 = t37 + t50*t72;
     const rexarm_real t74 = t42 + t33*t72;
     const rexarm_real t75 = t71 + t37*t72;
@@ -1345,7 +1343,7 @@ rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], co
     const rexarm_real t86 = t69 - t83*t85;
     const rexarm_real t87 = t70 - t80*t85;
     const rexarm_real t88 = damping + t26;
-    const rexarm_real t89 = -t51*(t33*t43 + t37*t25 + t38*t50 + t38*t88);
+    const rexarm_real t89 = -t51*(t33*t43 + t37*t25 + t38*t50 + t88*t38);
     const rexarm_real t90 = t38 + t50*t89;
     const rexarm_real t91 = t43 + t33*t89;
     const rexarm_real t92 = t25 + t37*t89;
@@ -1369,9 +1367,9 @@ rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], co
     const rexarm_real t110 = (t49 != 0 ? -(t53 + t73*t108 + t90*t107 - t59*t109)/t49 : 0);
     const rexarm_real t111 = q1 - t7*t110 + t3*t109;
     const rexarm_real t112 = t24*t107;
-    const rexarm_real t113 = q2 - t34*t110 - t39*t109 + t8*t108 + t112;
-    const rexarm_real t114 = q3 + t112 - t35*t110 - t40*t109 + t9*t108;
-    const rexarm_real t115 = q4 + t112 - t36*t110 - t41*t109 + t20*t108;
+    const rexarm_real t113 = q2 + t112 + t8*t108 - t34*t110 - t39*t109;
+    const rexarm_real t114 = q3 + t112 + t9*t108 - t35*t110 - t40*t109;
+    const rexarm_real t115 = q4 + t112 + t20*t108 - t36*t110 - t41*t109;
 
     /* Outputs */
     q_start[0] = q1;
@@ -1428,7 +1426,7 @@ void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REX
     const rexarm_real t29 = (t16 ? 0 : -t28);
     const rexarm_real t30 = mu0*t23 + mu1*t29;
     const rexarm_real t31 = mu1*t23 - mu0*t29;
-    const rexarm_real t32 = t11*t17 + mu1*t28;
+    const rexarm_real t32 = t11*t17 + t28*mu1;
     const rexarm_real t33 = t21*mu1 - t28*mu0;
     const rexarm_real t34 = 0.1*t9;
     const rexarm_real t35 = t34 + t30;
@@ -1460,10 +1458,10 @@ void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REX
     const rexarm_real t61 = t60*t35;
     const rexarm_real t62 = t39*t54;
     const rexarm_real t63 = t61 + t62;
-    const rexarm_real t64 = t62 - t61;
+    const rexarm_real t64 = -t61 + t62;
     const rexarm_real t65 = t35*t54;
     const rexarm_real t66 = t60*t39;
-    const rexarm_real t67 = t65 - t66;
+    const rexarm_real t67 = -t66 + t65;
     const rexarm_real t68 = (t63*t63) + (t67*t67);
     const rexarm_real t69 = t65 + t66;
     const rexarm_real t70 = (t64*t64) + (t69*t69);
@@ -1491,10 +1489,10 @@ void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REX
     const rexarm_real t92 = t91*t72;
     const rexarm_real t93 = t39*t85;
     const rexarm_real t94 = t92 + t93;
-    const rexarm_real t95 = t93 - t92;
+    const rexarm_real t95 = -t92 + t93;
     const rexarm_real t96 = t72*t85;
     const rexarm_real t97 = t91*t39;
-    const rexarm_real t98 = t96 - t97;
+    const rexarm_real t98 = -t97 + t96;
     const rexarm_real t99 = (t94*t94) + (t98*t98);
     const rexarm_real t100 = t96 + t97;
     const rexarm_real t101 = (t95*t95) + (t100*t100);
@@ -1523,10 +1521,10 @@ void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REX
     const rexarm_real t124 = t123*t36;
     const rexarm_real t125 = t41*t117;
     const rexarm_real t126 = t124 + t125;
-    const rexarm_real t127 = t125 - t124;
+    const rexarm_real t127 = -t124 + t125;
     const rexarm_real t128 = t36*t117;
     const rexarm_real t129 = t123*t41;
-    const rexarm_real t130 = t128 - t129;
+    const rexarm_real t130 = -t129 + t128;
     const rexarm_real t131 = (t126*t126) + (t130*t130);
     const rexarm_real t132 = t128 + t129;
     const rexarm_real t133 = (t127*t127) + (t132*t132);
@@ -1548,10 +1546,10 @@ void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REX
     const rexarm_real t149 = t148*t76;
     const rexarm_real t150 = t41*t142;
     const rexarm_real t151 = t149 + t150;
-    const rexarm_real t152 = t150 - t149;
+    const rexarm_real t152 = -t149 + t150;
     const rexarm_real t153 = t76*t142;
     const rexarm_real t154 = t148*t41;
-    const rexarm_real t155 = t153 - t154;
+    const rexarm_real t155 = -t154 + t153;
     const rexarm_real t156 = (t151*t151) + (t155*t155);
     const rexarm_real t157 = t153 + t154;
     const rexarm_real t158 = (t152*t152) + (t157*t157);
@@ -1564,14 +1562,14 @@ void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REX
     const rexarm_real t165 = t160 + t51;
     const rexarm_real t166 = t163 + t165 + 6.283185307179586*ceil(-0.15915494309189535*(t164 + t165));
     const rexarm_real t167 = -t166;
-    const rexarm_real t168 = t166 + 6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t167));
+    const rexarm_real t168 = 6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t167)) + t166;
     const rexarm_real t169 = (t70 <= t159 ? 0 : atan2(-t69, t64));
     const rexarm_real t170 = t169;
     const rexarm_real t171 = -6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t170)) + t170;
-    const rexarm_real t172 = t169 + t52;
+    const rexarm_real t172 = t52 + t169;
     const rexarm_real t173 = t163 + 6.283185307179586*ceil(-0.15915494309189535*(t164 + t172)) + t172;
     const rexarm_real t174 = -t173;
-    const rexarm_real t175 = t173 + 6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t174));
+    const rexarm_real t175 = 6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t174)) + t173;
     const rexarm_real t176 = 1e-24*t73*t86;
     const rexarm_real t177 = (t99 <= t176 ? 0 : atan2(-t98, t94));
     const rexarm_real t178 = t177;
@@ -1580,14 +1578,14 @@ void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REX
     const rexarm_real t181 = t82 + t177;
     const rexarm_real t182 = 6.283185307179586*ceil(-0.15915494309189535*(t180 + t181)) + t10 + t181;
     const rexarm_real t183 = -t182;
-    const rexarm_real t184 = t182 + 6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t183));
+    const rexarm_real t184 = 6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t183)) + t182;
     const rexarm_real t185 = (t101 <= t176 ? 0 : atan2(-t100, t95));
     const rexarm_real t186 = t185;
     const rexarm_real t187 = -6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t186)) + t186;
     const rexarm_real t188 = t83 + t185;
     const rexarm_real t189 = 6.283185307179586*ceil(-0.15915494309189535*(t180 + t188)) + t10 + t188;
     const rexarm_real t190 = -t189;
-    const rexarm_real t191 = t189 + 6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t190));
+    const rexarm_real t191 = 6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t190)) + t189;
     const rexarm_real t192 = 1e-24*t103*t118;
     const rexarm_real t193 = (t131 <= t192 ? 0 : atan2(-t130, t126));
     const rexarm_real t194 = t193;
@@ -1595,14 +1593,14 @@ void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REX
     const rexarm_real t196 = t114 + t193;
     const rexarm_real t197 = t163 + 6.283185307179586*ceil(-0.15915494309189535*(t164 + t196)) + t196;
     const rexarm_real t198 = -t197;
-    const rexarm_real t199 = t197 + 6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t198));
+    const rexarm_real t199 = 6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t198)) + t197;
     const rexarm_real t200 = (t133 <= t192 ? 0 : atan2(-t132, t127));
     const rexarm_real t201 = t200;
     const rexarm_real t202 = -6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t201)) + t201;
     const rexarm_real t203 = t115 + t200;
     const rexarm_real t204 = t163 + 6.283185307179586*ceil(-0.15915494309189535*(t164 + t203)) + t203;
     const rexarm_real t205 = -t204;
-    const rexarm_real t206 = t204 + 6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t205));
+    const rexarm_real t206 = 6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t205)) + t204;
     const rexarm_real t207 = 1e-24*t106*t143;
     const rexarm_real t208 = (t156 <= t207 ? 0 : atan2(-t155, t151));
     const rexarm_real t209 = t208;
@@ -1610,14 +1608,14 @@ void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REX
     const rexarm_real t211 = t139 + t208;
     const rexarm_real t212 = 6.283185307179586*ceil(-0.15915494309189535*(t180 + t211)) + t10 + t211;
     const rexarm_real t213 = -t212;
-    const rexarm_real t214 = t212 + 6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t213));
+    const rexarm_real t214 = 6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t213)) + t212;
     const rexarm_real t215 = (t158 <= t207 ? 0 : atan2(-t157, t152));
     const rexarm_real t216 = t215;
     const rexarm_real t217 = -6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t216)) + t216;
     const rexarm_real t218 = t140 + t215;
     const rexarm_real t219 = 6.283185307179586*ceil(-0.15915494309189535*(t180 + t218)) + t10 + t218;
     const rexarm_real t220 = -t219;
-    const rexarm_real t221 = t219 + 6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t220));
+    const rexarm_real t221 = 6.283185307179586*floor(0.15915494309189535*(2.0943951023931953 + t220)) + t219;
     const int t222 = t19 >= -3.141592653589793 && t19 <= 3.141592653589793;
     const int t223 = t20 <= 3.141592653589793;
     const rexarm_real t224 = (!t222 && t223 ? t20 : t19);
@@ -1853,19 +1851,19 @@ int rexarm_ik_nearest(const rexarm_real mu[REXARM_TASK_DIM], const rexarm_real q
     const rexarm_real t40 = (vb7 && lb7 ? 1 : 0);
     const rexarm_real t41 = mu3 + mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4;
     const rexarm_real t42 = (t0 < qn1 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t43 = t0 + t42;
+    const rexarm_real t43 = t42 + t0;
     const rexarm_real t44 = -t42 + t0;
     const rexarm_real t45 = (t0 >= -3.141592653589793 && t0 <= 3.141592653589793 ? t0 : (t43 >= -3.141592653589793 && t43 <= 3.141592653589793 ? t43 : (t44 >= -3.141592653589793 && t44 <= 3.141592653589793 ? t44 : qb0_0)));
     const rexarm_real t46 = (t1 < qn2 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t47 = t1 + t46;
+    const rexarm_real t47 = t46 + t1;
     const rexarm_real t48 = -t46 + t1;
     const rexarm_real t49 = (t1 >= -2.0943951023931953 && t1 <= 2.0943951023931953 ? t1 : (t47 >= -2.0943951023931953 && t47 <= 2.0943951023931953 ? t47 : (t48 >= -2.0943951023931953 && t48 <= 2.0943951023931953 ? t48 : qb0_1)));
     const rexarm_real t50 = (t2 < qn3 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t51 = t2 + t50;
+    const rexarm_real t51 = t50 + t2;
     const rexarm_real t52 = -t50 + t2;
     const rexarm_real t53 = (t2 >= -2.0943951023931953 && t2 <= 2.0943951023931953 ? t2 : (t51 >= -2.0943951023931953 && t51 <= 2.0943951023931953 ? t51 : (t52 >= -2.0943951023931953 && t52 <= 2.0943951023931953 ? t52 : qb0_2)));
     const rexarm_real t54 = (t3 < qn4 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t55 = t3 + t54;
+    const rexarm_real t55 = t54 + t3;
     const rexarm_real t56 = -t54 + t3;
     const rexarm_real t57 = (t3 >= -2.0943951023931953 && t3 <= 2.0943951023931953 ? t3 : (t55 >= -2.0943951023931953 && t55 <= 2.0943951023931953 ? t55 : (t56 >= -2.0943951023931953 && t56 <= 2.0943951023931953 ? t56 : qb0_3)));
     const rexarm_real t58 = -qn1;
@@ -1880,19 +1878,19 @@ int rexarm_ik_nearest(const rexarm_real mu[REXARM_TASK_DIM], const rexarm_real q
     const rexarm_real t67 = (t63 ? t57 : qn4);
     const rexarm_real t68 = (t63 ? t62 : 0);
     const rexarm_real t69 = (t6 < qn1 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t70 = t6 + t69;
+    const rexarm_real t70 = t69 + t6;
     const rexarm_real t71 = -t69 + t6;
     const rexarm_real t72 = (t6 >= -3.141592653589793 && t6 <= 3.141592653589793 ? t6 : (t70 >= -3.141592653589793 && t70 <= 3.141592653589793 ? t70 : (t71 >= -3.141592653589793 && t71 <= 3.141592653589793 ? t71 : qb1_0)));
     const rexarm_real t73 = (t7 < qn2 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t74 = t7 + t73;
+    const rexarm_real t74 = t73 + t7;
     const rexarm_real t75 = -t73 + t7;
     const rexarm_real t76 = (t7 >= -2.0943951023931953 && t7 <= 2.0943951023931953 ? t7 : (t74 >= -2.0943951023931953 && t74 <= 2.0943951023931953 ? t74 : (t75 >= -2.0943951023931953 && t75 <= 2.0943951023931953 ? t75 : qb1_1)));
     const rexarm_real t77 = (t8 < qn3 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t78 = t8 + t77;
+    const rexarm_real t78 = t77 + t8;
     const rexarm_real t79 = -t77 + t8;
     const rexarm_real t80 = (t8 >= -2.0943951023931953 && t8 <= 2.0943951023931953 ? t8 : (t78 >= -2.0943951023931953 && t78 <= 2.0943951023931953 ? t78 : (t79 >= -2.0943951023931953 && t79 <= 2.0943951023931953 ? t79 : qb1_2)));
     const rexarm_real t81 = (t9 < qn4 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t82 = t9 + t81;
+    const rexarm_real t82 = t81 + t9;
     const rexarm_real t83 = -t81 + t9;
     const rexarm_real t84 = (t9 >= -2.0943951023931953 && t9 <= 2.0943951023931953 ? t9 : (t82 >= -2.0943951023931953 && t82 <= 2.0943951023931953 ? t82 : (t83 >= -2.0943951023931953 && t83 <= 2.0943951023931953 ? t83 : qb1_3)));
     const rexarm_real t85 = qw1*((t58 + t72)*(t58 + t72)) + qw2*((t59 + t76)*(t59 + t76)) + qw3*((t60 + t80)*(t60 + t80)) + qw4*((t61 + t84)*(t61 + t84));
@@ -1906,19 +1904,19 @@ int rexarm_ik_nearest(const rexarm_real mu[REXARM_TASK_DIM], const rexarm_real q
     const rexarm_real t93 = (t89 ? t84 : t67);
     const rexarm_real t94 = (t89 ? t85 : t68);
     const rexarm_real t95 = (t11 < qn1 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t96 = t11 + t95;
+    const rexarm_real t96 = t95 + t11;
     const rexarm_real t97 = -t95 + t11;
     const rexarm_real t98 = (t11 >= -3.141592653589793 && t11 <= 3.141592653589793 ? t11 : (t96 >= -3.141592653589793 && t96 <= 3.141592653589793 ? t96 : (t97 >= -3.141592653589793 && t97 <= 3.141592653589793 ? t97 : qb2_0)));
     const rexarm_real t99 = (t12 < qn2 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t100 = t12 + t99;
+    const rexarm_real t100 = t99 + t12;
     const rexarm_real t101 = -t99 + t12;
     const rexarm_real t102 = (t12 >= -2.0943951023931953 && t12 <= 2.0943951023931953 ? t12 : (t100 >= -2.0943951023931953 && t100 <= 2.0943951023931953 ? t100 : (t101 >= -2.0943951023931953 && t101 <= 2.0943951023931953 ? t101 : qb2_1)));
     const rexarm_real t103 = (t13 < qn3 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t104 = t13 + t103;
+    const rexarm_real t104 = t103 + t13;
     const rexarm_real t105 = -t103 + t13;
     const rexarm_real t106 = (t13 >= -2.0943951023931953 && t13 <= 2.0943951023931953 ? t13 : (t104 >= -2.0943951023931953 && t104 <= 2.0943951023931953 ? t104 : (t105 >= -2.0943951023931953 && t105 <= 2.0943951023931953 ? t105 : qb2_2)));
     const rexarm_real t107 = (t14 < qn4 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t108 = t14 + t107;
+    const rexarm_real t108 = t107 + t14;
     const rexarm_real t109 = -t107 + t14;
     const rexarm_real t110 = (t14 >= -2.0943951023931953 && t14 <= 2.0943951023931953 ? t14 : (t108 >= -2.0943951023931953 && t108 <= 2.0943951023931953 ? t108 : (t109 >= -2.0943951023931953 && t109 <= 2.0943951023931953 ? t109 : qb2_3)));
     const rexarm_real t111 = qw1*((t58 + t98)*(t58 + t98)) + qw2*((t59 + t102)*(t59 + t102)) + qw3*((t60 + t106)*(t60 + t106)) + qw4*((t61 + t110)*(t61 + t110));
@@ -1932,19 +1930,19 @@ int rexarm_ik_nearest(const rexarm_real mu[REXARM_TASK_DIM], const rexarm_real q
     const rexarm_real t119 = (t115 ? t110 : t93);
     const rexarm_real t120 = (t115 ? t111 : t94);
     const rexarm_real t121 = (t16 < qn1 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t122 = t16 + t121;
+    const rexarm_real t122 = t121 + t16;
     const rexarm_real t123 = -t121 + t16;
     const rexarm_real t124 = (t16 >= -3.141592653589793 && t16 <= 3.141592653589793 ? t16 : (t122 >= -3.141592653589793 && t122 <= 3.141592653589793 ? t122 : (t123 >= -3.141592653589793 && t123 <= 3.141592653589793 ? t123 : qb3_0)));
     const rexarm_real t125 = (t17 < qn2 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t126 = t17 + t125;
+    const rexarm_real t126 = t125 + t17;
     const rexarm_real t127 = -t125 + t17;
     const rexarm_real t128 = (t17 >= -2.0943951023931953 && t17 <= 2.0943951023931953 ? t17 : (t126 >= -2.0943951023931953 && t126 <= 2.0943951023931953 ? t126 : (t127 >= -2.0943951023931953 && t127 <= 2.0943951023931953 ? t127 : qb3_1)));
     const rexarm_real t129 = (t18 < qn3 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t130 = t18 + t129;
+    const rexarm_real t130 = t129 + t18;
     const rexarm_real t131 = -t129 + t18;
     const rexarm_real t132 = (t18 >= -2.0943951023931953 && t18 <= 2.0943951023931953 ? t18 : (t130 >= -2.0943951023931953 && t130 <= 2.0943951023931953 ? t130 : (t131 >= -2.0943951023931953 && t131 <= 2.0943951023931953 ? t131 : qb3_2)));
     const rexarm_real t133 = (t19 < qn4 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t134 = t19 + t133;
+    const rexarm_real t134 = t133 + t19;
     const rexarm_real t135 = -t133 + t19;
     const rexarm_real t136 = (t19 >= -2.0943951023931953 && t19 <= 2.0943951023931953 ? t19 : (t134 >= -2.0943951023931953 && t134 <= 2.0943951023931953 ? t134 : (t135 >= -2.0943951023931953 && t135 <= 2.0943951023931953 ? t135 : qb3_3)));
     const rexarm_real t137 = qw1*((t58 + t124)*(t58 + t124)) + qw2*((t59 + t128)*(t59 + t128)) + qw3*((t60 + t132)*(t60 + t132)) + qw4*((t61 + t136)*(t61 + t136));
@@ -1958,19 +1956,19 @@ int rexarm_ik_nearest(const rexarm_real mu[REXARM_TASK_DIM], const rexarm_real q
     const rexarm_real t145 = (t141 ? t136 : t119);
     const rexarm_real t146 = (t141 ? t137 : t120);
     const rexarm_real t147 = (t21 < qn1 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t148 = t21 + t147;
+    const rexarm_real t148 = t147 + t21;
     const rexarm_real t149 = -t147 + t21;
     const rexarm_real t150 = (t21 >= -3.141592653589793 && t21 <= 3.141592653589793 ? t21 : (t148 >= -3.141592653589793 && t148 <= 3.141592653589793 ? t148 : (t149 >= -3.141592653589793 && t149 <= 3.141592653589793 ? t149 : qb4_0)));
     const rexarm_real t151 = (t22 < qn2 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t152 = t22 + t151;
+    const rexarm_real t152 = t151 + t22;
     const rexarm_real t153 = -t151 + t22;
     const rexarm_real t154 = (t22 >= -2.0943951023931953 && t22 <= 2.0943951023931953 ? t22 : (t152 >= -2.0943951023931953 && t152 <= 2.0943951023931953 ? t152 : (t153 >= -2.0943951023931953 && t153 <= 2.0943951023931953 ? t153 : qb4_1)));
     const rexarm_real t155 = (t23 < qn3 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t156 = t23 + t155;
+    const rexarm_real t156 = t155 + t23;
     const rexarm_real t157 = -t155 + t23;
     const rexarm_real t158 = (t23 >= -2.0943951023931953 && t23 <= 2.0943951023931953 ? t23 : (t156 >= -2.0943951023931953 && t156 <= 2.0943951023931953 ? t156 : (t157 >= -2.0943951023931953 && t157 <= 2.0943951023931953 ? t157 : qb4_2)));
     const rexarm_real t159 = (t24 < qn4 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t160 = t24 + t159;
+    const rexarm_real t160 = t159 + t24;
     const rexarm_real t161 = -t159 + t24;
     const rexarm_real t162 = (t24 >= -2.0943951023931953 && t24 <= 2.0943951023931953 ? t24 : (t160 >= -2.0943951023931953 && t160 <= 2.0943951023931953 ? t160 : (t161 >= -2.0943951023931953 && t161 <= 2.0943951023931953 ? t161 : qb4_3)));
     const rexarm_real t163 = qw1*((t58 + t150)*(t58 + t150)) + qw2*((t59 + t154)*(t59 + t154)) + qw3*((t60 + t158)*(t60 + t158)) + qw4*((t61 + t162)*(t61 + t162));
@@ -1984,19 +1982,19 @@ int rexarm_ik_nearest(const rexarm_real mu[REXARM_TASK_DIM], const rexarm_real q
     const rexarm_real t171 = (t167 ? t162 : t145);
     const rexarm_real t172 = (t167 ? t163 : t146);
     const rexarm_real t173 = (t26 < qn1 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t174 = t26 + t173;
+    const rexarm_real t174 = t173 + t26;
     const rexarm_real t175 = -t173 + t26;
     const rexarm_real t176 = (t26 >= -3.141592653589793 && t26 <= 3.141592653589793 ? t26 : (t174 >= -3.141592653589793 && t174 <= 3.141592653589793 ? t174 : (t175 >= -3.141592653589793 && t175 <= 3.141592653589793 ? t175 : qb5_0)));
     const rexarm_real t177 = (t27 < qn2 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t178 = t27 + t177;
+    const rexarm_real t178 = t177 + t27;
     const rexarm_real t179 = -t177 + t27;
     const rexarm_real t180 = (t27 >= -2.0943951023931953 && t27 <= 2.0943951023931953 ? t27 : (t178 >= -2.0943951023931953 && t178 <= 2.0943951023931953 ? t178 : (t179 >= -2.0943951023931953 && t179 <= 2.0943951023931953 ? t179 : qb5_1)));
     const rexarm_real t181 = (t28 < qn3 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t182 = t28 + t181;
+    const rexarm_real t182 = t181 + t28;
     const rexarm_real t183 = -t181 + t28;
     const rexarm_real t184 = (t28 >= -2.0943951023931953 && t28 <= 2.0943951023931953 ? t28 : (t182 >= -2.0943951023931953 && t182 <= 2.0943951023931953 ? t182 : (t183 >= -2.0943951023931953 && t183 <= 2.0943951023931953 ? t183 : qb5_2)));
     const rexarm_real t185 = (t29 < qn4 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t186 = t29 + t185;
+    const rexarm_real t186 = t185 + t29;
     const rexarm_real t187 = -t185 + t29;
     const rexarm_real t188 = (t29 >= -2.0943951023931953 && t29 <= 2.0943951023931953 ? t29 : (t186 >= -2.0943951023931953 && t186 <= 2.0943951023931953 ? t186 : (t187 >= -2.0943951023931953 && t187 <= 2.0943951023931953 ? t187 : qb5_3)));
     const rexarm_real t189 = qw1*((t58 + t176)*(t58 + t176)) + qw2*((t59 + t180)*(t59 + t180)) + qw3*((t60 + t184)*(t60 + t184)) + qw4*((t61 + t188)*(t61 + t188));
@@ -2010,19 +2008,19 @@ int rexarm_ik_nearest(const rexarm_real mu[REXARM_TASK_DIM], const rexarm_real q
     const rexarm_real t197 = (t193 ? t188 : t171);
     const rexarm_real t198 = (t193 ? t189 : t172);
     const rexarm_real t199 = (t31 < qn1 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t200 = t31 + t199;
+    const rexarm_real t200 = t199 + t31;
     const rexarm_real t201 = -t199 + t31;
     const rexarm_real t202 = (t31 >= -3.141592653589793 && t31 <= 3.141592653589793 ? t31 : (t200 >= -3.141592653589793 && t200 <= 3.141592653589793 ? t200 : (t201 >= -3.141592653589793 && t201 <= 3.141592653589793 ? t201 : qb6_0)));
     const rexarm_real t203 = (t32 < qn2 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t204 = t32 + t203;
+    const rexarm_real t204 = t203 + t32;
     const rexarm_real t205 = -t203 + t32;
     const rexarm_real t206 = (t32 >= -2.0943951023931953 && t32 <= 2.0943951023931953 ? t32 : (t204 >= -2.0943951023931953 && t204 <= 2.0943951023931953 ? t204 : (t205 >= -2.0943951023931953 && t205 <= 2.0943951023931953 ? t205 : qb6_1)));
     const rexarm_real t207 = (t33 < qn3 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t208 = t33 + t207;
+    const rexarm_real t208 = t207 + t33;
     const rexarm_real t209 = -t207 + t33;
     const rexarm_real t210 = (t33 >= -2.0943951023931953 && t33 <= 2.0943951023931953 ? t33 : (t208 >= -2.0943951023931953 && t208 <= 2.0943951023931953 ? t208 : (t209 >= -2.0943951023931953 && t209 <= 2.0943951023931953 ? t209 : qb6_2)));
     const rexarm_real t211 = (t34 < qn4 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t212 = t34 + t211;
+    const rexarm_real t212 = t211 + t34;
     const rexarm_real t213 = -t211 + t34;
     const rexarm_real t214 = (t34 >= -2.0943951023931953 && t34 <= 2.0943951023931953 ? t34 : (t212 >= -2.0943951023931953 && t212 <= 2.0943951023931953 ? t212 : (t213 >= -2.0943951023931953 && t213 <= 2.0943951023931953 ? t213 : qb6_3)));
     const rexarm_real t215 = qw1*((t58 + t202)*(t58 + t202)) + qw2*((t59 + t206)*(t59 + t206)) + qw3*((t60 + t210)*(t60 + t210)) + qw4*((t61 + t214)*(t61 + t214));
@@ -2036,19 +2034,19 @@ int rexarm_ik_nearest(const rexarm_real mu[REXARM_TASK_DIM], const rexarm_real q
     const rexarm_real t223 = (t219 ? t214 : t197);
     const rexarm_real t224 = (t219 ? t215 : t198);
     const rexarm_real t225 = (t36 < qn1 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t226 = t36 + t225;
+    const rexarm_real t226 = t225 + t36;
     const rexarm_real t227 = -t225 + t36;
     const rexarm_real t228 = (t36 >= -3.141592653589793 && t36 <= 3.141592653589793 ? t36 : (t226 >= -3.141592653589793 && t226 <= 3.141592653589793 ? t226 : (t227 >= -3.141592653589793 && t227 <= 3.141592653589793 ? t227 : qb7_0)));
     const rexarm_real t229 = (t37 < qn2 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t230 = t37 + t229;
+    const rexarm_real t230 = t229 + t37;
     const rexarm_real t231 = -t229 + t37;
     const rexarm_real t232 = (t37 >= -2.0943951023931953 && t37 <= 2.0943951023931953 ? t37 : (t230 >= -2.0943951023931953 && t230 <= 2.0943951023931953 ? t230 : (t231 >= -2.0943951023931953 && t231 <= 2.0943951023931953 ? t231 : qb7_1)));
     const rexarm_real t233 = (t38 < qn3 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t234 = t38 + t233;
+    const rexarm_real t234 = t233 + t38;
     const rexarm_real t235 = -t233 + t38;
     const rexarm_real t236 = (t38 >= -2.0943951023931953 && t38 <= 2.0943951023931953 ? t38 : (t234 >= -2.0943951023931953 && t234 <= 2.0943951023931953 ? t234 : (t235 >= -2.0943951023931953 && t235 <= 2.0943951023931953 ? t235 : qb7_2)));
     const rexarm_real t237 = (t39 < qn4 ? 6.283185307179586 : -6.283185307179586);
-    const rexarm_real t238 = t39 + t237;
+    const rexarm_real t238 = t237 + t39;
     const rexarm_real t239 = -t237 + t39;
     const rexarm_real t240 = (t39 >= -2.0943951023931953 && t39 <= 2.0943951023931953 ? t39 : (t238 >= -2.0943951023931953 && t238 <= 2.0943951023931953 ? t238 : (t239 >= -2.0943951023931953 && t239 <= 2.0943951023931953 ? t239 : qb7_3)));
     const rexarm_real t241 = qw1*((t58 + t228)*(t58 + t228)) + qw2*((t59 + t232)*(t59 + t232)) + qw3*((t60 + t236)*(t60 + t236)) + qw4*((t61 + t240)*(t61 + t240));

@@ -95,12 +95,12 @@ def fk(q):
     t2 = 0.12 + t1
     t3 = 0.1*c23
     t4 = c1*c234
-    t5 = c1*t3 + 0.1*t4
+    t5 = 0.1*t4 + c1*t3
     t6 = s1*c234
-    t7 = s1*t3 + 0.1*t6
+    t7 = 0.1*t6 + s1*t3
     t8 = 0.1*c2
-    t9 = c1*t8 + t5
-    t10 = s1*t8 + t7
+    t9 = t5 + c1*t8
+    t10 = t7 + s1*t8
     T = _stack(xp, [
         t4,  # 0, 0
         -s1,  # 0, 1
@@ -141,10 +141,10 @@ def jacobian(q):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = c2*t0 + t1
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = c2*t3 + t4
+    t5 = t4 + c2*t3
     t6 = 0.1*s234
     t7 = 0.1*s23 + t6
     t8 = 0.1*s2 + t7
@@ -198,16 +198,16 @@ def fk_jacobian(q):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c23
     t1 = c1*c234
-    t2 = c1*t0 + 0.1*t1
+    t2 = 0.1*t1 + c1*t0
     t3 = s1*c234
-    t4 = s1*t0 + 0.1*t3
+    t4 = 0.1*t3 + s1*t0
     t5 = 0.1*s234
     t6 = 0.1*s23 + t5
     t7 = 0.1*s2 + t6
     t8 = 0.12 + t7
     t9 = 0.1*c2
-    t10 = c1*t9 + t2
-    t11 = s1*t9 + t4
+    t10 = t2 + c1*t9
+    t11 = t4 + s1*t9
     t12 = 0.1*c234
     t13 = -c1
     T = _stack(xp, [
@@ -276,10 +276,10 @@ def jacobian_tool(q):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = c2*t0 + t1
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = c2*t3 + t4
+    t5 = t4 + c2*t3
     t6 = 0.1*s234
     t7 = 0.1*s23 + t6
     t8 = 0.1*s2 + t7
@@ -349,10 +349,10 @@ def task(q):
     t2 = 0.12 + t1
     t3 = 0.1*c1
     t4 = c23*t3 + c234*t3
-    t5 = c2*t3 + t4
+    t5 = t4 + c2*t3
     t6 = 0.1*s1
     t7 = c23*t6 + c234*t6
-    t8 = c2*t6 + t7
+    t8 = t7 + c2*t6
     t9 = c234**2
     mu = _stack(xp, [
         t5,  # 0
@@ -382,17 +382,17 @@ def task_jacobian(q):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = c2*t0 + t1
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = c2*t3 + t4
+    t5 = t4 + c2*t3
     t6 = 0.1*s234
     t7 = 0.1*s23 + t6
     t8 = 0.1*s2 + t7
     t9 = c1**2
-    t10 = t9*c234
+    t10 = c234*t9
     t11 = s1**2
-    t12 = t11*c234
+    t12 = c234*t11
     t13 = c234**2
     t14 = -(t10 + t12)/xp.sqrt(t9*t13 + t11*t13)
     J = _stack(xp, [
@@ -439,16 +439,16 @@ def fk_jacobian_dot(q, q_dot):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c23
     t1 = c1*c234
-    t2 = c1*t0 + 0.1*t1
+    t2 = 0.1*t1 + c1*t0
     t3 = s1*c234
-    t4 = s1*t0 + 0.1*t3
+    t4 = 0.1*t3 + s1*t0
     t5 = 0.1*s234
     t6 = 0.1*s23 + t5
     t7 = 0.1*s2 + t6
     t8 = 0.12 + t7
     t9 = 0.1*c2
-    t10 = c1*t9 + t2
-    t11 = s1*t9 + t4
+    t10 = t2 + c1*t9
+    t11 = t4 + s1*t9
     t12 = c1*t10 + s1*t11
     t13 = t12
     t14 = c1*t2 + s1*t4
@@ -528,9 +528,9 @@ def fk_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3
     ], (6, 4))
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t34 + qd2*(qd1*t40 - c1*t37) - qd3*(t24*t15 - qd1*t41 + c1*t36) - qd4*(t20*t26 - 0.1*s1*s234*qd1 + c1*t35), batch),  # 0
-        xp.broadcast_to(-qd1*t30 - qd2*(qd1*t38 + s1*t37) - qd3*(qd1*t39 + t21*t15 + s1*t36) - qd4*(t27*qd1 + t20*t23 + s1*t35), batch),  # 1
-        xp.broadcast_to(-qd2*(s1*t33 + c1*t29) - qd3*(t18*t43 + t16*t43 + s1*t32 + c1*t28) - qd4*(t31*t23 + t27*t26 + t18*t44 + t16*t44), batch),  # 2
+        xp.broadcast_to(-qd1*t34 + qd2*(-c1*t37 + qd1*t40) - qd3*(c1*t36 + t24*t15 - qd1*t41) - qd4*(-0.1*s1*s234*qd1 + t20*t26 + c1*t35), batch),  # 0
+        xp.broadcast_to(-qd1*t30 - qd2*(s1*t37 + qd1*t38) - qd3*(s1*t36 + qd1*t39 + t21*t15) - qd4*(t20*t23 + t27*qd1 + s1*t35), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t33 + c1*t29) - qd3*(c1*t28 + s1*t32 + t18*t43 + t16*t43) - qd4*(t31*t23 + t27*t26 + t18*t44 + t16*t44), batch),  # 2
         xp.broadcast_to(t24*qd1 + t25*qd1 + c1*t45, batch),  # 3
         xp.broadcast_to(t21*qd1 + t22*qd1 + s1*t45, batch),  # 4
         xp.broadcast_to(qd4*(-c1*t23 + s1*t26), batch),  # 5
@@ -561,10 +561,10 @@ def jacobian_dot(q, q_dot):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = c2*t0 + t1
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = c2*t3 + t4
+    t5 = t4 + c2*t3
     t6 = c1*t2 + s1*t5
     t7 = c1*t1 + s1*t4
     t8 = 0.1*s234
@@ -595,16 +595,16 @@ def jacobian_dot(q, q_dot):
     t33 = t9*qd2
     Jd = _stack(xp, [
         xp.broadcast_to(-t27, batch),  # 0, 0
-        xp.broadcast_to(t10*t31 - c1*t30, batch),  # 0, 1
-        xp.broadcast_to(-(t18*t7 - t9*t31 + c1*t29), batch),  # 0, 2
-        xp.broadcast_to(-(t14*t20 - 0.1*s1*s234*qd1 + c1*t28), batch),  # 0, 3
+        xp.broadcast_to(-c1*t30 + t10*t31, batch),  # 0, 1
+        xp.broadcast_to(-(c1*t29 + t18*t7 - t9*t31), batch),  # 0, 2
+        xp.broadcast_to(-(-0.1*s1*s234*qd1 + t14*t20 + c1*t28), batch),  # 0, 3
         xp.broadcast_to(-t26, batch),  # 1, 0
-        xp.broadcast_to(-(t10*t32 + s1*t30), batch),  # 1, 1
-        xp.broadcast_to(-(t9*t32 + t15*t7 + s1*t29), batch),  # 1, 2
-        xp.broadcast_to(-(t8*t32 + t14*t17 + s1*t28), batch),  # 1, 3
+        xp.broadcast_to(-(s1*t30 + t10*t32), batch),  # 1, 1
+        xp.broadcast_to(-(s1*t29 + t9*t32 + t15*t7), batch),  # 1, 2
+        xp.broadcast_to(-(t14*t17 + t8*t32 + s1*t28), batch),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(-(s1*t25 + c1*t24), batch),  # 2, 1
-        xp.broadcast_to(-(t13*t33 + t11*t33 + s1*t23 + c1*t22), batch),  # 2, 2
+        xp.broadcast_to(-(c1*t22 + s1*t23 + t13*t33 + t11*t33), batch),  # 2, 2
         xp.broadcast_to(-(s1*t8*t17 + c1*t8*t20 + t13*t21 + t11*t21), batch),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(t32, batch),  # 3, 1
@@ -645,10 +645,10 @@ def bias_acceleration(q, q_dot):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = c2*t0 + t1
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = c2*t3 + t4
+    t5 = t4 + c2*t3
     t6 = c1*t2 + s1*t5
     t7 = c1*t1 + s1*t4
     t8 = 0.1*s234
@@ -678,9 +678,9 @@ def bias_acceleration(q, q_dot):
     t32 = c1*qd1
     t33 = t9*qd2
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t27 + qd2*(t10*t31 - c1*t30) - qd3*(t18*t7 - t9*t31 + c1*t29) - qd4*(t14*t20 - 0.1*s1*s234*qd1 + c1*t28), batch),  # 0
-        xp.broadcast_to(-qd1*t26 - qd2*(t10*t32 + s1*t30) - qd3*(t9*t32 + t15*t7 + s1*t29) - qd4*(t8*t32 + t14*t17 + s1*t28), batch),  # 1
-        xp.broadcast_to(-qd2*(s1*t25 + c1*t24) - qd3*(t13*t33 + t11*t33 + s1*t23 + c1*t22) - qd4*(s1*t8*t17 + c1*t8*t20 + t13*t21 + t11*t21), batch),  # 2
+        xp.broadcast_to(-qd1*t27 + qd2*(-c1*t30 + t10*t31) - qd3*(c1*t29 + t18*t7 - t9*t31) - qd4*(-0.1*s1*s234*qd1 + t14*t20 + c1*t28), batch),  # 0
+        xp.broadcast_to(-qd1*t26 - qd2*(s1*t30 + t10*t32) - qd3*(s1*t29 + t9*t32 + t15*t7) - qd4*(t14*t17 + t8*t32 + s1*t28), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t25 + c1*t24) - qd3*(c1*t22 + s1*t23 + t13*t33 + t11*t33) - qd4*(s1*t8*t17 + c1*t8*t20 + t13*t21 + t11*t21), batch),  # 2
         xp.broadcast_to(t18*qd1 + t19*qd1 + t32*qd4, batch),  # 3
         xp.broadcast_to(t15*qd1 + t16*qd1 + t31*qd4, batch),  # 4
         xp.broadcast_to(qd4*(-c1*t17 + s1*t20), batch),  # 5
@@ -689,7 +689,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q': (4 x 4), 170 operations."""
+    """time derivative of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q': (4 x 4), 167 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (4,)), ("q_dot", q_dot, (4,)))
     q2 = q[..., 1]
     qd1 = q_dot[..., 0]
@@ -711,20 +711,20 @@ def task_jacobian_dot(q, q_dot):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = c2*t0 + t1
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
     t4 = s1*c234
-    t5 = c23*t3 + 0.1*t4
-    t6 = c2*t3 + t5
+    t5 = 0.1*t4 + c23*t3
+    t6 = t5 + c2*t3
     t7 = c1*t2 + s1*t6
     t8 = c1*t1 + s1*t5
     t9 = 0.1*s234
     t10 = 0.1*s23 + t9
     t11 = 0.1*s2 + t10
     t12 = c1**2
-    t13 = t12*c234
+    t13 = c234*t12
     t14 = s1**2
-    t15 = t14*c234
+    t15 = c234*t14
     t16 = 0.1*t13 + 0.1*t15
     t17 = s1*qd2
     t18 = s1*qd3
@@ -735,12 +735,12 @@ def task_jacobian_dot(q, q_dot):
     t23 = t21 + t22
     t24 = t23
     t25 = c1*qd4
-    t26 = t9*t25 + t10*t22
+    t26 = t10*t22 + t9*t25
     t27 = t26 + t11*t21
     t28 = t27 + t6*qd1
     t29 = t23 + t25
     t30 = s1*qd4
-    t31 = t9*t30 + t10*t18
+    t31 = t10*t18 + t9*t30
     t32 = t31 + t11*t17
     t33 = -t32 + t2*qd1
     t34 = s1*t32 + c1*t27
@@ -749,16 +749,16 @@ def task_jacobian_dot(q, q_dot):
     t37 = t36 + t8*qd3
     t38 = t37 + t7*qd2
     t39 = s1*qd1
-    t40 = t11*t39 - c1*t38
-    t41 = t21*t8 - t10*t39 + c1*t37
+    t40 = -c1*t38 + t11*t39
+    t41 = c1*t37 + t21*t8 - t10*t39
     t42 = t16*t24 - t9*t39 + c1*t36
     t43 = c1*qd1
-    t44 = t11*t43 + s1*t38
-    t45 = t10*t43 + t17*t8 + s1*t37
-    t46 = t9*t43 + t16*t20 + s1*t36
-    t47 = c234*t43 - s234*t35
+    t44 = s1*t38 + t11*t43
+    t45 = s1*t37 + t17*t8 + t10*t43
+    t46 = t16*t20 + t9*t43 + s1*t36
+    t47 = -s234*t35 + c234*t43
     t48 = t10*qd2
-    t49 = t14*t48 + t12*t48 + s1*t31 + c1*t26
+    t49 = c1*t26 + s1*t31 + t14*t48 + t12*t48
     t50 = t9*qd4
     t51 = s1*t9*t20 + c1*t9*t24 + t14*t50 + t12*t50
     t52 = t4*qd1
@@ -769,8 +769,7 @@ def task_jacobian_dot(q, q_dot):
     t57 = 1/t56
     t58 = -t57*(t13 + t15)/t55
     t59 = c1*t57
-    t60 = t52*t59
-    t61 = t53*(t59 + c1*c234*t58) - t47*(s1*t57 + t4*t58) - t60 + t60
+    t60 = t53*(c1*c234*t58 + t59) - t47*(s1*t57 + t4*t58)
     Jd = _stack(xp, [
         xp.broadcast_to(-t33, batch),  # 0, 0
         xp.broadcast_to(t40, batch),  # 0, 1
@@ -785,9 +784,9 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(-t49, batch),  # 2, 2
         xp.broadcast_to(-t51, batch),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(t61, batch),  # 3, 1
-        xp.broadcast_to(t61, batch),  # 3, 2
-        xp.broadcast_to(t61, batch),  # 3, 3
+        xp.broadcast_to(t60, batch),  # 3, 1
+        xp.broadcast_to(t60, batch),  # 3, 2
+        xp.broadcast_to(t60, batch),  # 3, 3
     ], (4, 4))
     return Jd
 
@@ -811,10 +810,10 @@ def hessian(q):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = c2*t0 + t1
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = c2*t3 + t4
+    t5 = t4 + c2*t3
     t6 = c1*t2 + s1*t5
     t7 = c1*t1 + s1*t4
     t8 = 0.1*s234
@@ -834,7 +833,7 @@ def hessian(q):
     t22 = -c1*t14
     t23 = -s1*t7
     t24 = -s1*t14
-    t25 = -(t13*t9 + t11*t9)
+    t25 = -(t9*t13 + t9*t11)
     t26 = -(t8*t13 + t8*t11)
     H = _stack(xp, [
         -t2,  # 0, 0, 0
@@ -870,7 +869,7 @@ def hessian(q):
         t23,  # 1, 1, 2
         t24,  # 1, 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -(t13*t10 + t11*t10),  # 1, 2, 1
+        -(t10*t13 + t10*t11),  # 1, 2, 1
         t25,  # 1, 2, 2
         t26,  # 1, 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 0
@@ -952,7 +951,7 @@ def singularity_factors(q):
     t1 = s2*s3
     f = _stack(xp, [
         s3,  # 0
-        -(-c2 - t0 + t1 - c4*t0 + c2*s3*s4 + s2*c3*s4 + c4*t1),  # 1
+        -(-c2 - t0 + t1 + c2*s3*s4 + s2*c3*s4 - c4*t0 + c4*t1),  # 1
     ], (2,))
     return f
 
@@ -976,7 +975,7 @@ def manipulability(q):
     t0 = c234**2
     t1 = c2*c3
     t2 = s2*s3
-    t3 = -c4*t1 + c2*s3*s4 + s2*c3*s4 + c4*t2
+    t3 = c2*s3*s4 + s2*c3*s4 - c4*t1 + c4*t2
     t4 = 0.001*s3*t3*(-c2 - t1 + t2 + t3)/xp.sqrt(c1**2*t0 + s1**2*t0)
     w = xp.broadcast_to(xp.abs(t4), batch)
     return w
@@ -1001,14 +1000,14 @@ def jacobian_det(q):
     t0 = c234**2
     t1 = c2*c3
     t2 = s2*s3
-    t3 = -c4*t1 + c2*s3*s4 + s2*c3*s4 + c4*t2
+    t3 = c2*s3*s4 + s2*c3*s4 - c4*t1 + c4*t2
     d = xp.broadcast_to(0.001*s3*t3*(-c2 - t1 + t2 + t3)/xp.sqrt(c1**2*t0 + s1**2*t0), batch)
     return d
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 600 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 599 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (4,)), ("mu_dot", mu_dot, (4,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -1033,23 +1032,23 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = c2*t0 + t1
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = c2*t3 + t4
+    t5 = t4 + c2*t3
     t6 = c1*t2 + s1*t5
     t7 = c1*t1 + s1*t4
     t8 = 0.1*s234
     t9 = 0.1*s23 + t8
     t10 = 0.1*s2 + t9
     t11 = c1**2
-    t12 = t11*c234
+    t12 = c234*t11
     t13 = s1**2
-    t14 = t13*c234
+    t14 = c234*t13
     t15 = 0.1*t12 + 0.1*t14
     t16 = c234**2
     t17 = -(t12 + t14)/xp.sqrt(t11*t16 + t13*t16)
-    t18 = t6*t17 + t7*t17 + t15*t17
+    t18 = t7*t17 + t15*t17 + t6*t17
     t19 = t5**2
     t20 = t10**2
     t21 = t9**2
@@ -1072,7 +1071,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t38 = t6*t35 + t7*t36 + t15*t37
     t39 = t35*t17 + t36*t17 + t37*t17
     t40 = t6**2
-    t41 = t40 + t7**2 + t15**2
+    t41 = t7**2 + t15**2 + t40
     t42 = t41
     t43 = t17**2
     t44 = 3*t43
@@ -1081,7 +1080,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t47 = t30**2
     t48 = t31**2
     t49 = damping**2
-    t50 = t49 + t24
+    t50 = t24 + t49
     t51 = t50**2
     t52 = xp.sqrt(t46 + t47 + t48 + t51)
     t53 = t52*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
@@ -1092,8 +1091,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t58 = mu_dot1 - t26*t56
     t59 = mu_dot2 + t30*t56
     t60 = mu_dot3 + t31*t56
-    t61 = t49 + t34
-    t62 = t55*(t26*t54 + t26*t61 + t30*t38 + t31*t39)
+    t61 = t34 + t49
+    t62 = t55*(t26*t54 + t30*t38 + t31*t39 + t26*t61)
     t63 = t26 - t54*t62
     t64 = -t26*t62 + t61
     t65 = -t38 + t30*t62
@@ -1106,8 +1105,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t72 = t58 - t69*t71
     t73 = t59 - t65*t71
     t74 = t60 - t66*t71
-    t75 = t49 + t42
-    t76 = -t55*(t30*t54 + t26*t38 + t30*t75 + t31*t18)
+    t75 = t42 + t49
+    t76 = -t55*(t30*t54 + t26*t38 + t31*t18 + t30*t75)
     t77 = t30 + t54*t76
     t78 = t38 + t26*t76
     t79 = t30*t76 + t75
@@ -1123,7 +1122,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t89 = t88*(t73*t87 + t84*t74)
     t90 = t73 - t87*t89
     t91 = t74 - t84*t89
-    t92 = t49 + t45
+    t92 = t45 + t49
     t93 = xp.sqrt(2*t46 + 2*t47 + 2*t38**2 + 2*t48 + 2*t39**2 + 2*t18**2 + t51 + t61**2 + t75**2 + t92**2)
     t94 = -t55*(t31*t54 + t26*t39 + t30*t18 + t31*t92)
     t95 = t31 + t54*t94
@@ -1141,7 +1140,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t107 = t106
     t108 = t107*xp.where(xp.greater_equal(t105, 0), xp.asarray(1, dtype=dtype), -1)
     t109 = t105 + t108
-    t110 = xp.where(xp.greater(t107, 0), 1/(t107*(t106 + t107)), 0)
+    t110 = xp.where(xp.greater(t107, 0), 1/(t107*(t107 + t106)), 0)
     t111 = t91 - t91*t109**2*t110
     t112 = xp.where(xp.not_equal(t108, 0), -t111/t108, 0)
     t113 = xp.where(xp.not_equal(t86, 0), -(t90 - t104*t112)/t86, 0)
@@ -1149,80 +1148,79 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t115 = xp.where(xp.not_equal(t53, 0), -(t57 + t77*t113 + t95*t112 - t63*t114)/t53, 0)
     t116 = -t5*t115 + t2*t114
     t117 = t17*t112
-    t118 = -t27*t115 - t35*t114 + t6*t113 + t117
-    t119 = t117 - t28*t115 - t36*t114 + t7*t113
-    t120 = t117 - t29*t115 - t37*t114 + t15*t113
-    t121 = t32 + t19
+    t118 = t6*t113 - t27*t115 - t35*t114 + t117
+    t119 = t7*t113 + t117 - t28*t115 - t36*t114
+    t120 = t15*t113 + t117 - t29*t115 - t37*t114
+    t121 = t19 + t32
     t122 = xp.sqrt(t23 + t33 + t41 + t44 + t121)
     t123 = xp.sqrt(t121)
     t124 = t123*xp.where(xp.less_equal(t5, 0), xp.asarray(1, dtype=dtype), -1)
-    t125 = -t5
-    t126 = t125 + t124
-    t127 = xp.where(xp.greater(t123, 0), 1/(t123*(t123 + xp.abs(t125))), 0)
-    t128 = -t127*(t27*t126 + t2*t35)
-    t129 = t27 + t126*t128
+    t125 = xp.where(xp.greater(t123, 0), 1/(t123*(t123 + xp.abs(t5))), 0)
+    t126 = -t5
+    t127 = t124 + t126
+    t128 = -t125*(t27*t127 + t2*t35)
+    t129 = t27 + t127*t128
     t130 = t35 + t2*t128
-    t131 = -t127*(t28*t126 + t2*t36)
-    t132 = t28 + t126*t131
+    t131 = -t125*(t28*t127 + t2*t36)
+    t132 = t28 + t127*t131
     t133 = t36 + t2*t131
-    t134 = -t127*(t29*t126 + t2*t37)
-    t135 = t29 + t126*t134
+    t134 = -t125*(t29*t127 + t2*t37)
+    t135 = t29 + t127*t134
     t136 = t37 + t2*t134
-    t137 = t127*(mu_dot0*t126 + t2*mu_dot1)
-    t138 = mu_dot0 - t126*t137
+    t137 = t125*(mu_dot0*t127 + t2*mu_dot1)
+    t138 = mu_dot0 - t127*t137
     t139 = mu_dot1 - t2*t137
     t140 = xp.sqrt(t40 + t43 + t130**2)
     t141 = t140*xp.where(xp.less_equal(t130, 0), xp.asarray(1, dtype=dtype), -1)
-    t142 = t125 + q1 + q2 + q3 + q4 + t2 - t27 - t28 - t29 - t35 - t36 - t37 + t6 + t7 + t15 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + 3*t17
-    t143 = -t130
-    t144 = t143 + t141
-    t145 = xp.where(xp.greater(t140, 0), 1/(t140*(t140 + xp.abs(t143))), 0)
-    t146 = t145*(t43 - t133*t144 + t6*t7)
-    t147 = t133 + t144*t146
-    t148 = t7 - t6*t146
-    t149 = t17 - t17*t146
-    t150 = t145*(t43 - t136*t144 + t6*t15)
-    t151 = t136 + t144*t150
-    t152 = t15 - t6*t150
-    t153 = t17 - t17*t150
-    t154 = t145*(t139*t144 + t6*mu_dot2 + t17*mu_dot3)
-    t155 = t139 - t144*t154
-    t156 = mu_dot2 - t6*t154
-    t157 = mu_dot3 - t17*t154
-    t158 = xp.sqrt(t148**2 + t149**2)
-    t159 = t158*xp.where(xp.greater_equal(t148, 0), xp.asarray(1, dtype=dtype), -1)
-    t160 = t148 + t159
-    t161 = xp.where(xp.greater(t158, 0), 1/(t158*(t158 + xp.abs(t148))), 0)
-    t162 = t161*(t152*t160 + t149*t153)
-    t163 = t152 - t160*t162
-    t164 = t153 - t149*t162
-    t165 = t161*(t156*t160 + t149*t157)
-    t166 = t156 - t160*t165
-    t167 = t157 - t149*t165
-    t168 = xp.abs(t164)
-    t169 = t168
-    t170 = t169*xp.where(xp.greater_equal(t164, 0), xp.asarray(1, dtype=dtype), -1)
-    t171 = t164 + t170
-    t172 = xp.where(xp.greater(t169, 0), 1/(t169*(t168 + t169)), 0)
-    t173 = t167 - t167*t171**2*t172
-    t174 = xp.where(xp.not_equal(t170, 0), -t173/t170, 0)
-    t175 = xp.where(xp.not_equal(t159, 0), -(t166 - t163*t174)/t159, 0)
-    t176 = xp.where(xp.not_equal(t141, 0), -(t155 + t147*t175 + t151*t174)/t141, 0)
-    t177 = xp.where(xp.not_equal(t124, 0), -(t138 + t129*t176 + t132*t175 + t135*t174)/t124, 0)
-    t178 = xp.isfinite(t142)
-    t179 = xp.greater_equal(damping, 0)
-    t180 = xp.greater(damping, 0)
-    t181 = 1e-12*t93
-    t182 = 1e-12*t122
-    t183 = (t180 & (xp.less_equal(t52, t181) | xp.less_equal(t67, t181) | xp.less_equal(t85, t181) | xp.less_equal(t107, t181))) | (xp.less_equal(damping, 0) & (xp.less_equal(t123, t182) | xp.less_equal(t140, t182) | xp.less_equal(t158, t182) | xp.less_equal(t169, t182)))
-    t184 = t178 & t179 & xp.logical_not(t183)
+    t142 = -t130 + t141
+    t143 = xp.where(xp.greater(t140, 0), 1/(t140*(t140 + xp.abs(t130))), 0)
+    t144 = t143*(t43 - t133*t142 + t6*t7)
+    t145 = t133 + t142*t144
+    t146 = t7 - t6*t144
+    t147 = t17 - t17*t144
+    t148 = t143*(t43 - t136*t142 + t6*t15)
+    t149 = t136 + t142*t148
+    t150 = t15 - t6*t148
+    t151 = t17 - t17*t148
+    t152 = t143*(t139*t142 + t6*mu_dot2 + t17*mu_dot3)
+    t153 = t139 - t142*t152
+    t154 = mu_dot2 - t6*t152
+    t155 = mu_dot3 - t17*t152
+    t156 = xp.sqrt(t146**2 + t147**2)
+    t157 = t156*xp.where(xp.greater_equal(t146, 0), xp.asarray(1, dtype=dtype), -1)
+    t158 = t146 + t157
+    t159 = xp.where(xp.greater(t156, 0), 1/(t156*(t156 + xp.abs(t146))), 0)
+    t160 = t159*(t150*t158 + t147*t151)
+    t161 = t150 - t158*t160
+    t162 = t151 - t147*t160
+    t163 = t159*(t154*t158 + t147*t155)
+    t164 = t154 - t158*t163
+    t165 = t155 - t147*t163
+    t166 = -t27 - t28 - t29 - t35 - t36 - t37 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + 3*t17 + t126
+    t167 = xp.abs(t162)
+    t168 = t167
+    t169 = t168*xp.where(xp.greater_equal(t162, 0), xp.asarray(1, dtype=dtype), -1)
+    t170 = t162 + t169
+    t171 = xp.where(xp.greater(t168, 0), 1/(t168*(t168 + t167)), 0)
+    t172 = t165 - t165*t170**2*t171
+    t173 = xp.where(xp.not_equal(t169, 0), -t172/t169, 0)
+    t174 = xp.where(xp.not_equal(t157, 0), -(t164 - t161*t173)/t157, 0)
+    t175 = xp.where(xp.not_equal(t141, 0), -(t153 + t145*t174 + t149*t173)/t141, 0)
+    t176 = xp.where(xp.not_equal(t124, 0), -(t138 + t129*t175 + t132*t174 + t135*t173)/t124, 0)
+    t177 = xp.isfinite(t166)
+    t178 = xp.greater_equal(damping, 0)
+    t179 = xp.greater(damping, 0)
+    t180 = 1e-12*t93
+    t181 = 1e-12*t122
+    t182 = (t179 & (xp.less_equal(t52, t180) | xp.less_equal(t67, t180) | xp.less_equal(t85, t180) | xp.less_equal(t107, t180))) | (xp.less_equal(damping, 0) & (xp.less_equal(t123, t181) | xp.less_equal(t140, t181) | xp.less_equal(t156, t181) | xp.less_equal(t168, t181)))
+    t183 = t177 & t178 & xp.logical_not(t182)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t184, xp.where(t180, t116, t177), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t184, xp.where(t180, t118, t176), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t184, xp.where(t180, t119, t175), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t184, xp.where(t180, t120, t174), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t183, xp.where(t179, t116, t176), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t183, xp.where(t179, t118, t175), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t183, xp.where(t179, t119, t174), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t183, xp.where(t179, t120, t173), 0), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t178 & t179), 2, xp.where(t183, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t177 & t178), 2, xp.where(t182, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -1257,11 +1255,11 @@ def ik_numeric_step(target, q, damping=0.0):
     t0 = qs1 + qs2 + qs3 + qs4 + mu3 + mu0 + mu1 + mu2
     t1 = 0.1*c1
     t2 = c23*t1 + c234*t1
-    t3 = c2*t1 + t2
+    t3 = t2 + c2*t1
     t4 = -t3 + mu0
     t5 = 0.1*s1
     t6 = c23*t5 + c234*t5
-    t7 = c2*t5 + t6
+    t7 = t6 + c2*t5
     t8 = c1*t3 + s1*t7
     t9 = c1*t2 + s1*t6
     t10 = -t7 + mu1
@@ -1271,28 +1269,28 @@ def ik_numeric_step(target, q, damping=0.0):
     t14 = 0.12 + t13
     t15 = -t14 + mu2
     t16 = c1**2
-    t17 = t16*c234
+    t17 = c234*t16
     t18 = s1**2
-    t19 = t18*c234
+    t19 = c234*t18
     t20 = 0.1*t17 + 0.1*t19
     t21 = t8**2 + t9**2 + t20**2
     t22 = c234**2
     t23 = xp.sqrt(t16*t22 + t18*t22)
     t24 = -(t17 + t19)/t23
-    t25 = t8*t24 + t9*t24 + t20*t24
+    t25 = t9*t24 + t20*t24 + t8*t24
     t26 = 3*t24**2
     t27 = t13**2
     t28 = t12**2
     t29 = 0.01*s234**2
-    t30 = t7**2 + t16*t27 + t16*t28 + t16*t29
-    t31 = t3**2 + t18*t27 + t18*t28 + t18*t29
+    t30 = t7**2 + t16*t28 + t16*t29 + t16*t27
+    t31 = t3**2 + t18*t28 + t18*t27 + t18*t29
     t32 = c1*s1
     t33 = -t3*t7 + t27*t32 + t28*t32 + t29*t32
     t34 = c1*t13
     t35 = c1*t12
     t36 = c1*t11
     t37 = t34*t8 + t35*t9 + t36*t20
-    t38 = t34*t24 + t35*t24 + t36*t24
+    t38 = t35*t24 + t36*t24 + t34*t24
     t39 = s1*t13
     t40 = s1*t12
     t41 = s1*t11
@@ -1302,7 +1300,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t45 = t44 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t44))
     t46 = t4**2 + t10**2 + t15**2 + t45**2
     t47 = damping + t30
-    t48 = xp.sqrt(t33**2 + t37**2 + t38**2 + t47**2)
+    t48 = xp.sqrt(t47**2 + t33**2 + t37**2 + t38**2)
     t49 = t48*xp.where(xp.greater_equal(t47, 0), xp.asarray(1, dtype=dtype), -1)
     t50 = t47 + t49
     t51 = xp.where(xp.greater(t48, 0), 1/(t48*(t48 + xp.abs(t47))), 0)
@@ -1312,7 +1310,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t55 = t15 + t37*t52
     t56 = -t45 + t38*t52
     t57 = damping + t31
-    t58 = t51*(t37*t42 + t38*t43 + t33*t50 + t33*t57)
+    t58 = t51*(t37*t42 + t38*t43 + t33*t50 + t57*t33)
     t59 = t33 - t50*t58
     t60 = t57 - t33*t58
     t61 = -t42 + t37*t58
@@ -1326,7 +1324,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t69 = t55 - t61*t67
     t70 = t56 - t62*t67
     t71 = damping + t21
-    t72 = -t51*(t33*t42 + t38*t25 + t37*t50 + t37*t71)
+    t72 = -t51*(t33*t42 + t38*t25 + t37*t50 + t71*t37)
     t73 = t37 + t50*t72
     t74 = t42 + t33*t72
     t75 = t71 + t37*t72
@@ -1343,7 +1341,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t86 = t69 - t83*t85
     t87 = t70 - t80*t85
     t88 = damping + t26
-    t89 = -t51*(t33*t43 + t37*t25 + t38*t50 + t38*t88)
+    t89 = -t51*(t33*t43 + t37*t25 + t38*t50 + t88*t38)
     t90 = t38 + t50*t89
     t91 = t43 + t33*t89
     t92 = t25 + t37*t89
@@ -1367,9 +1365,9 @@ def ik_numeric_step(target, q, damping=0.0):
     t110 = xp.where(xp.not_equal(t49, 0), -(t53 + t73*t108 + t90*t107 - t59*t109)/t49, 0)
     t111 = q1 - t7*t110 + t3*t109
     t112 = t24*t107
-    t113 = q2 - t34*t110 - t39*t109 + t8*t108 + t112
-    t114 = q3 + t112 - t35*t110 - t40*t109 + t9*t108
-    t115 = q4 + t112 - t36*t110 - t41*t109 + t20*t108
+    t113 = q2 + t112 + t8*t108 - t34*t110 - t39*t109
+    t114 = q3 + t112 + t9*t108 - t35*t110 - t40*t109
+    t115 = q4 + t112 + t20*t108 - t36*t110 - t41*t109
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -1426,7 +1424,7 @@ def ik_branches(mu):
     t29 = xp.where(t16, 0, -t28)
     t30 = mu0*t23 + mu1*t29
     t31 = mu1*t23 - mu0*t29
-    t32 = t11*t17 + mu1*t28
+    t32 = t11*t17 + t28*mu1
     t33 = t21*mu1 - t28*mu0
     t34 = 0.1*t9
     t35 = t34 + t30
@@ -1458,10 +1456,10 @@ def ik_branches(mu):
     t61 = t60*t35
     t62 = t39*t54
     t63 = t61 + t62
-    t64 = t62 - t61
+    t64 = -t61 + t62
     t65 = t35*t54
     t66 = t60*t39
-    t67 = t65 - t66
+    t67 = -t66 + t65
     t68 = t63**2 + t67**2
     t69 = t65 + t66
     t70 = t64**2 + t69**2
@@ -1489,10 +1487,10 @@ def ik_branches(mu):
     t92 = t91*t72
     t93 = t39*t85
     t94 = t92 + t93
-    t95 = t93 - t92
+    t95 = -t92 + t93
     t96 = t72*t85
     t97 = t91*t39
-    t98 = t96 - t97
+    t98 = -t97 + t96
     t99 = t94**2 + t98**2
     t100 = t96 + t97
     t101 = t95**2 + t100**2
@@ -1521,10 +1519,10 @@ def ik_branches(mu):
     t124 = t123*t36
     t125 = t41*t117
     t126 = t124 + t125
-    t127 = t125 - t124
+    t127 = -t124 + t125
     t128 = t36*t117
     t129 = t123*t41
-    t130 = t128 - t129
+    t130 = -t129 + t128
     t131 = t126**2 + t130**2
     t132 = t128 + t129
     t133 = t127**2 + t132**2
@@ -1546,10 +1544,10 @@ def ik_branches(mu):
     t149 = t148*t76
     t150 = t41*t142
     t151 = t149 + t150
-    t152 = t150 - t149
+    t152 = -t149 + t150
     t153 = t76*t142
     t154 = t148*t41
-    t155 = t153 - t154
+    t155 = -t154 + t153
     t156 = t151**2 + t155**2
     t157 = t153 + t154
     t158 = t152**2 + t157**2
@@ -1562,14 +1560,14 @@ def ik_branches(mu):
     t165 = t160 + t51
     t166 = t163 + t165 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t164 + t165))
     t167 = -t166
-    t168 = t166 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t167))
+    t168 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t167)) + t166
     t169 = xp.where(xp.less_equal(t70, t159), 0, xp.atan2(-t69, t64))
     t170 = t169
     t171 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t170)) + t170
-    t172 = t169 + t52
+    t172 = t52 + t169
     t173 = t163 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t164 + t172)) + t172
     t174 = -t173
-    t175 = t173 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t174))
+    t175 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t174)) + t173
     t176 = 1e-24*t73*t86
     t177 = xp.where(xp.less_equal(t99, t176), 0, xp.atan2(-t98, t94))
     t178 = t177
@@ -1578,14 +1576,14 @@ def ik_branches(mu):
     t181 = t82 + t177
     t182 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t180 + t181)) + t10 + t181
     t183 = -t182
-    t184 = t182 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t183))
+    t184 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t183)) + t182
     t185 = xp.where(xp.less_equal(t101, t176), 0, xp.atan2(-t100, t95))
     t186 = t185
     t187 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t186)) + t186
     t188 = t83 + t185
     t189 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t180 + t188)) + t10 + t188
     t190 = -t189
-    t191 = t189 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t190))
+    t191 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t190)) + t189
     t192 = 1e-24*t103*t118
     t193 = xp.where(xp.less_equal(t131, t192), 0, xp.atan2(-t130, t126))
     t194 = t193
@@ -1593,14 +1591,14 @@ def ik_branches(mu):
     t196 = t114 + t193
     t197 = t163 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t164 + t196)) + t196
     t198 = -t197
-    t199 = t197 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t198))
+    t199 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t198)) + t197
     t200 = xp.where(xp.less_equal(t133, t192), 0, xp.atan2(-t132, t127))
     t201 = t200
     t202 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t201)) + t201
     t203 = t115 + t200
     t204 = t163 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t164 + t203)) + t203
     t205 = -t204
-    t206 = t204 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t205))
+    t206 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t205)) + t204
     t207 = 1e-24*t106*t143
     t208 = xp.where(xp.less_equal(t156, t207), 0, xp.atan2(-t155, t151))
     t209 = t208
@@ -1608,14 +1606,14 @@ def ik_branches(mu):
     t211 = t139 + t208
     t212 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t180 + t211)) + t10 + t211
     t213 = -t212
-    t214 = t212 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t213))
+    t214 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t213)) + t212
     t215 = xp.where(xp.less_equal(t158, t207), 0, xp.atan2(-t157, t152))
     t216 = t215
     t217 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t216)) + t216
     t218 = t140 + t215
     t219 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t180 + t218)) + t10 + t218
     t220 = -t219
-    t221 = t219 + 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t220))
+    t221 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t220)) + t219
     t222 = xp.greater_equal(t19, -3.141592653589793) & xp.less_equal(t19, 3.141592653589793)
     t223 = xp.less_equal(t20, 3.141592653589793)
     t224 = xp.where(xp.logical_not(t222) & t223, t20, t19)
@@ -1850,19 +1848,19 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t40 = xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0)
     t41 = mu3 + mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
     t42 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t43 = t0 + t42
+    t43 = t42 + t0
     t44 = -t42 + t0
     t45 = xp.where(xp.greater_equal(t0, -3.141592653589793) & xp.less_equal(t0, 3.141592653589793), t0, xp.where(xp.greater_equal(t43, -3.141592653589793) & xp.less_equal(t43, 3.141592653589793), t43, xp.where(xp.greater_equal(t44, -3.141592653589793) & xp.less_equal(t44, 3.141592653589793), t44, qb0_0)))
     t46 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t47 = t1 + t46
+    t47 = t46 + t1
     t48 = -t46 + t1
     t49 = xp.where(xp.greater_equal(t1, -2.0943951023931953) & xp.less_equal(t1, 2.0943951023931953), t1, xp.where(xp.greater_equal(t47, -2.0943951023931953) & xp.less_equal(t47, 2.0943951023931953), t47, xp.where(xp.greater_equal(t48, -2.0943951023931953) & xp.less_equal(t48, 2.0943951023931953), t48, qb0_1)))
     t50 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t51 = t2 + t50
+    t51 = t50 + t2
     t52 = -t50 + t2
     t53 = xp.where(xp.greater_equal(t2, -2.0943951023931953) & xp.less_equal(t2, 2.0943951023931953), t2, xp.where(xp.greater_equal(t51, -2.0943951023931953) & xp.less_equal(t51, 2.0943951023931953), t51, xp.where(xp.greater_equal(t52, -2.0943951023931953) & xp.less_equal(t52, 2.0943951023931953), t52, qb0_2)))
     t54 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t55 = t3 + t54
+    t55 = t54 + t3
     t56 = -t54 + t3
     t57 = xp.where(xp.greater_equal(t3, -2.0943951023931953) & xp.less_equal(t3, 2.0943951023931953), t3, xp.where(xp.greater_equal(t55, -2.0943951023931953) & xp.less_equal(t55, 2.0943951023931953), t55, xp.where(xp.greater_equal(t56, -2.0943951023931953) & xp.less_equal(t56, 2.0943951023931953), t56, qb0_3)))
     t58 = -qn1
@@ -1877,19 +1875,19 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t67 = xp.where(t63, t57, qn4)
     t68 = xp.where(t63, t62, 0)
     t69 = xp.where(xp.less(t6, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t70 = t6 + t69
+    t70 = t69 + t6
     t71 = -t69 + t6
     t72 = xp.where(xp.greater_equal(t6, -3.141592653589793) & xp.less_equal(t6, 3.141592653589793), t6, xp.where(xp.greater_equal(t70, -3.141592653589793) & xp.less_equal(t70, 3.141592653589793), t70, xp.where(xp.greater_equal(t71, -3.141592653589793) & xp.less_equal(t71, 3.141592653589793), t71, qb1_0)))
     t73 = xp.where(xp.less(t7, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t74 = t7 + t73
+    t74 = t73 + t7
     t75 = -t73 + t7
     t76 = xp.where(xp.greater_equal(t7, -2.0943951023931953) & xp.less_equal(t7, 2.0943951023931953), t7, xp.where(xp.greater_equal(t74, -2.0943951023931953) & xp.less_equal(t74, 2.0943951023931953), t74, xp.where(xp.greater_equal(t75, -2.0943951023931953) & xp.less_equal(t75, 2.0943951023931953), t75, qb1_1)))
     t77 = xp.where(xp.less(t8, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t78 = t8 + t77
+    t78 = t77 + t8
     t79 = -t77 + t8
     t80 = xp.where(xp.greater_equal(t8, -2.0943951023931953) & xp.less_equal(t8, 2.0943951023931953), t8, xp.where(xp.greater_equal(t78, -2.0943951023931953) & xp.less_equal(t78, 2.0943951023931953), t78, xp.where(xp.greater_equal(t79, -2.0943951023931953) & xp.less_equal(t79, 2.0943951023931953), t79, qb1_2)))
     t81 = xp.where(xp.less(t9, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t82 = t9 + t81
+    t82 = t81 + t9
     t83 = -t81 + t9
     t84 = xp.where(xp.greater_equal(t9, -2.0943951023931953) & xp.less_equal(t9, 2.0943951023931953), t9, xp.where(xp.greater_equal(t82, -2.0943951023931953) & xp.less_equal(t82, 2.0943951023931953), t82, xp.where(xp.greater_equal(t83, -2.0943951023931953) & xp.less_equal(t83, 2.0943951023931953), t83, qb1_3)))
     t85 = qw1*(t58 + t72)**2 + qw2*(t59 + t76)**2 + qw3*(t60 + t80)**2 + qw4*(t61 + t84)**2
@@ -1903,19 +1901,19 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t93 = xp.where(t89, t84, t67)
     t94 = xp.where(t89, t85, t68)
     t95 = xp.where(xp.less(t11, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t96 = t11 + t95
+    t96 = t95 + t11
     t97 = -t95 + t11
     t98 = xp.where(xp.greater_equal(t11, -3.141592653589793) & xp.less_equal(t11, 3.141592653589793), t11, xp.where(xp.greater_equal(t96, -3.141592653589793) & xp.less_equal(t96, 3.141592653589793), t96, xp.where(xp.greater_equal(t97, -3.141592653589793) & xp.less_equal(t97, 3.141592653589793), t97, qb2_0)))
     t99 = xp.where(xp.less(t12, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t100 = t12 + t99
+    t100 = t99 + t12
     t101 = -t99 + t12
     t102 = xp.where(xp.greater_equal(t12, -2.0943951023931953) & xp.less_equal(t12, 2.0943951023931953), t12, xp.where(xp.greater_equal(t100, -2.0943951023931953) & xp.less_equal(t100, 2.0943951023931953), t100, xp.where(xp.greater_equal(t101, -2.0943951023931953) & xp.less_equal(t101, 2.0943951023931953), t101, qb2_1)))
     t103 = xp.where(xp.less(t13, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t104 = t13 + t103
+    t104 = t103 + t13
     t105 = -t103 + t13
     t106 = xp.where(xp.greater_equal(t13, -2.0943951023931953) & xp.less_equal(t13, 2.0943951023931953), t13, xp.where(xp.greater_equal(t104, -2.0943951023931953) & xp.less_equal(t104, 2.0943951023931953), t104, xp.where(xp.greater_equal(t105, -2.0943951023931953) & xp.less_equal(t105, 2.0943951023931953), t105, qb2_2)))
     t107 = xp.where(xp.less(t14, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t108 = t14 + t107
+    t108 = t107 + t14
     t109 = -t107 + t14
     t110 = xp.where(xp.greater_equal(t14, -2.0943951023931953) & xp.less_equal(t14, 2.0943951023931953), t14, xp.where(xp.greater_equal(t108, -2.0943951023931953) & xp.less_equal(t108, 2.0943951023931953), t108, xp.where(xp.greater_equal(t109, -2.0943951023931953) & xp.less_equal(t109, 2.0943951023931953), t109, qb2_3)))
     t111 = qw1*(t58 + t98)**2 + qw2*(t59 + t102)**2 + qw3*(t60 + t106)**2 + qw4*(t61 + t110)**2
@@ -1929,19 +1927,19 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t119 = xp.where(t115, t110, t93)
     t120 = xp.where(t115, t111, t94)
     t121 = xp.where(xp.less(t16, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t122 = t16 + t121
+    t122 = t121 + t16
     t123 = -t121 + t16
     t124 = xp.where(xp.greater_equal(t16, -3.141592653589793) & xp.less_equal(t16, 3.141592653589793), t16, xp.where(xp.greater_equal(t122, -3.141592653589793) & xp.less_equal(t122, 3.141592653589793), t122, xp.where(xp.greater_equal(t123, -3.141592653589793) & xp.less_equal(t123, 3.141592653589793), t123, qb3_0)))
     t125 = xp.where(xp.less(t17, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t126 = t17 + t125
+    t126 = t125 + t17
     t127 = -t125 + t17
     t128 = xp.where(xp.greater_equal(t17, -2.0943951023931953) & xp.less_equal(t17, 2.0943951023931953), t17, xp.where(xp.greater_equal(t126, -2.0943951023931953) & xp.less_equal(t126, 2.0943951023931953), t126, xp.where(xp.greater_equal(t127, -2.0943951023931953) & xp.less_equal(t127, 2.0943951023931953), t127, qb3_1)))
     t129 = xp.where(xp.less(t18, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t130 = t18 + t129
+    t130 = t129 + t18
     t131 = -t129 + t18
     t132 = xp.where(xp.greater_equal(t18, -2.0943951023931953) & xp.less_equal(t18, 2.0943951023931953), t18, xp.where(xp.greater_equal(t130, -2.0943951023931953) & xp.less_equal(t130, 2.0943951023931953), t130, xp.where(xp.greater_equal(t131, -2.0943951023931953) & xp.less_equal(t131, 2.0943951023931953), t131, qb3_2)))
     t133 = xp.where(xp.less(t19, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t134 = t19 + t133
+    t134 = t133 + t19
     t135 = -t133 + t19
     t136 = xp.where(xp.greater_equal(t19, -2.0943951023931953) & xp.less_equal(t19, 2.0943951023931953), t19, xp.where(xp.greater_equal(t134, -2.0943951023931953) & xp.less_equal(t134, 2.0943951023931953), t134, xp.where(xp.greater_equal(t135, -2.0943951023931953) & xp.less_equal(t135, 2.0943951023931953), t135, qb3_3)))
     t137 = qw1*(t58 + t124)**2 + qw2*(t59 + t128)**2 + qw3*(t60 + t132)**2 + qw4*(t61 + t136)**2
@@ -1955,19 +1953,19 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t145 = xp.where(t141, t136, t119)
     t146 = xp.where(t141, t137, t120)
     t147 = xp.where(xp.less(t21, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t148 = t21 + t147
+    t148 = t147 + t21
     t149 = -t147 + t21
     t150 = xp.where(xp.greater_equal(t21, -3.141592653589793) & xp.less_equal(t21, 3.141592653589793), t21, xp.where(xp.greater_equal(t148, -3.141592653589793) & xp.less_equal(t148, 3.141592653589793), t148, xp.where(xp.greater_equal(t149, -3.141592653589793) & xp.less_equal(t149, 3.141592653589793), t149, qb4_0)))
     t151 = xp.where(xp.less(t22, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t152 = t22 + t151
+    t152 = t151 + t22
     t153 = -t151 + t22
     t154 = xp.where(xp.greater_equal(t22, -2.0943951023931953) & xp.less_equal(t22, 2.0943951023931953), t22, xp.where(xp.greater_equal(t152, -2.0943951023931953) & xp.less_equal(t152, 2.0943951023931953), t152, xp.where(xp.greater_equal(t153, -2.0943951023931953) & xp.less_equal(t153, 2.0943951023931953), t153, qb4_1)))
     t155 = xp.where(xp.less(t23, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t156 = t23 + t155
+    t156 = t155 + t23
     t157 = -t155 + t23
     t158 = xp.where(xp.greater_equal(t23, -2.0943951023931953) & xp.less_equal(t23, 2.0943951023931953), t23, xp.where(xp.greater_equal(t156, -2.0943951023931953) & xp.less_equal(t156, 2.0943951023931953), t156, xp.where(xp.greater_equal(t157, -2.0943951023931953) & xp.less_equal(t157, 2.0943951023931953), t157, qb4_2)))
     t159 = xp.where(xp.less(t24, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t160 = t24 + t159
+    t160 = t159 + t24
     t161 = -t159 + t24
     t162 = xp.where(xp.greater_equal(t24, -2.0943951023931953) & xp.less_equal(t24, 2.0943951023931953), t24, xp.where(xp.greater_equal(t160, -2.0943951023931953) & xp.less_equal(t160, 2.0943951023931953), t160, xp.where(xp.greater_equal(t161, -2.0943951023931953) & xp.less_equal(t161, 2.0943951023931953), t161, qb4_3)))
     t163 = qw1*(t58 + t150)**2 + qw2*(t59 + t154)**2 + qw3*(t60 + t158)**2 + qw4*(t61 + t162)**2
@@ -1981,19 +1979,19 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t171 = xp.where(t167, t162, t145)
     t172 = xp.where(t167, t163, t146)
     t173 = xp.where(xp.less(t26, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t174 = t26 + t173
+    t174 = t173 + t26
     t175 = -t173 + t26
     t176 = xp.where(xp.greater_equal(t26, -3.141592653589793) & xp.less_equal(t26, 3.141592653589793), t26, xp.where(xp.greater_equal(t174, -3.141592653589793) & xp.less_equal(t174, 3.141592653589793), t174, xp.where(xp.greater_equal(t175, -3.141592653589793) & xp.less_equal(t175, 3.141592653589793), t175, qb5_0)))
     t177 = xp.where(xp.less(t27, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t178 = t27 + t177
+    t178 = t177 + t27
     t179 = -t177 + t27
     t180 = xp.where(xp.greater_equal(t27, -2.0943951023931953) & xp.less_equal(t27, 2.0943951023931953), t27, xp.where(xp.greater_equal(t178, -2.0943951023931953) & xp.less_equal(t178, 2.0943951023931953), t178, xp.where(xp.greater_equal(t179, -2.0943951023931953) & xp.less_equal(t179, 2.0943951023931953), t179, qb5_1)))
     t181 = xp.where(xp.less(t28, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t182 = t28 + t181
+    t182 = t181 + t28
     t183 = -t181 + t28
     t184 = xp.where(xp.greater_equal(t28, -2.0943951023931953) & xp.less_equal(t28, 2.0943951023931953), t28, xp.where(xp.greater_equal(t182, -2.0943951023931953) & xp.less_equal(t182, 2.0943951023931953), t182, xp.where(xp.greater_equal(t183, -2.0943951023931953) & xp.less_equal(t183, 2.0943951023931953), t183, qb5_2)))
     t185 = xp.where(xp.less(t29, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t186 = t29 + t185
+    t186 = t185 + t29
     t187 = -t185 + t29
     t188 = xp.where(xp.greater_equal(t29, -2.0943951023931953) & xp.less_equal(t29, 2.0943951023931953), t29, xp.where(xp.greater_equal(t186, -2.0943951023931953) & xp.less_equal(t186, 2.0943951023931953), t186, xp.where(xp.greater_equal(t187, -2.0943951023931953) & xp.less_equal(t187, 2.0943951023931953), t187, qb5_3)))
     t189 = qw1*(t58 + t176)**2 + qw2*(t59 + t180)**2 + qw3*(t60 + t184)**2 + qw4*(t61 + t188)**2
@@ -2007,19 +2005,19 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t197 = xp.where(t193, t188, t171)
     t198 = xp.where(t193, t189, t172)
     t199 = xp.where(xp.less(t31, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t200 = t31 + t199
+    t200 = t199 + t31
     t201 = -t199 + t31
     t202 = xp.where(xp.greater_equal(t31, -3.141592653589793) & xp.less_equal(t31, 3.141592653589793), t31, xp.where(xp.greater_equal(t200, -3.141592653589793) & xp.less_equal(t200, 3.141592653589793), t200, xp.where(xp.greater_equal(t201, -3.141592653589793) & xp.less_equal(t201, 3.141592653589793), t201, qb6_0)))
     t203 = xp.where(xp.less(t32, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t204 = t32 + t203
+    t204 = t203 + t32
     t205 = -t203 + t32
     t206 = xp.where(xp.greater_equal(t32, -2.0943951023931953) & xp.less_equal(t32, 2.0943951023931953), t32, xp.where(xp.greater_equal(t204, -2.0943951023931953) & xp.less_equal(t204, 2.0943951023931953), t204, xp.where(xp.greater_equal(t205, -2.0943951023931953) & xp.less_equal(t205, 2.0943951023931953), t205, qb6_1)))
     t207 = xp.where(xp.less(t33, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t208 = t33 + t207
+    t208 = t207 + t33
     t209 = -t207 + t33
     t210 = xp.where(xp.greater_equal(t33, -2.0943951023931953) & xp.less_equal(t33, 2.0943951023931953), t33, xp.where(xp.greater_equal(t208, -2.0943951023931953) & xp.less_equal(t208, 2.0943951023931953), t208, xp.where(xp.greater_equal(t209, -2.0943951023931953) & xp.less_equal(t209, 2.0943951023931953), t209, qb6_2)))
     t211 = xp.where(xp.less(t34, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t212 = t34 + t211
+    t212 = t211 + t34
     t213 = -t211 + t34
     t214 = xp.where(xp.greater_equal(t34, -2.0943951023931953) & xp.less_equal(t34, 2.0943951023931953), t34, xp.where(xp.greater_equal(t212, -2.0943951023931953) & xp.less_equal(t212, 2.0943951023931953), t212, xp.where(xp.greater_equal(t213, -2.0943951023931953) & xp.less_equal(t213, 2.0943951023931953), t213, qb6_3)))
     t215 = qw1*(t58 + t202)**2 + qw2*(t59 + t206)**2 + qw3*(t60 + t210)**2 + qw4*(t61 + t214)**2
@@ -2033,19 +2031,19 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t223 = xp.where(t219, t214, t197)
     t224 = xp.where(t219, t215, t198)
     t225 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t226 = t36 + t225
+    t226 = t225 + t36
     t227 = -t225 + t36
     t228 = xp.where(xp.greater_equal(t36, -3.141592653589793) & xp.less_equal(t36, 3.141592653589793), t36, xp.where(xp.greater_equal(t226, -3.141592653589793) & xp.less_equal(t226, 3.141592653589793), t226, xp.where(xp.greater_equal(t227, -3.141592653589793) & xp.less_equal(t227, 3.141592653589793), t227, qb7_0)))
     t229 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t230 = t37 + t229
+    t230 = t229 + t37
     t231 = -t229 + t37
     t232 = xp.where(xp.greater_equal(t37, -2.0943951023931953) & xp.less_equal(t37, 2.0943951023931953), t37, xp.where(xp.greater_equal(t230, -2.0943951023931953) & xp.less_equal(t230, 2.0943951023931953), t230, xp.where(xp.greater_equal(t231, -2.0943951023931953) & xp.less_equal(t231, 2.0943951023931953), t231, qb7_1)))
     t233 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t234 = t38 + t233
+    t234 = t233 + t38
     t235 = -t233 + t38
     t236 = xp.where(xp.greater_equal(t38, -2.0943951023931953) & xp.less_equal(t38, 2.0943951023931953), t38, xp.where(xp.greater_equal(t234, -2.0943951023931953) & xp.less_equal(t234, 2.0943951023931953), t234, xp.where(xp.greater_equal(t235, -2.0943951023931953) & xp.less_equal(t235, 2.0943951023931953), t235, qb7_2)))
     t237 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t238 = t39 + t237
+    t238 = t237 + t39
     t239 = -t237 + t39
     t240 = xp.where(xp.greater_equal(t39, -2.0943951023931953) & xp.less_equal(t39, 2.0943951023931953), t39, xp.where(xp.greater_equal(t238, -2.0943951023931953) & xp.less_equal(t238, 2.0943951023931953), t238, xp.where(xp.greater_equal(t239, -2.0943951023931953) & xp.less_equal(t239, 2.0943951023931953), t239, qb7_3)))
     t241 = qw1*(t58 + t228)**2 + qw2*(t59 + t232)**2 + qw3*(t60 + t236)**2 + qw4*(t61 + t240)**2

@@ -39,12 +39,12 @@ def _fk(q):
     t2 = 0.12 + t1
     t3 = 0.1*c23
     t4 = c1*c234
-    t5 = c1*t3 + 0.1*t4
+    t5 = 0.1*t4 + c1*t3
     t6 = s1*c234
-    t7 = s1*t3 + 0.1*t6
+    t7 = 0.1*t6 + s1*t3
     t8 = 0.1*c2
-    t9 = c1*t8 + t5
-    t10 = s1*t8 + t7
+    t9 = t5 + c1*t8
+    t10 = t7 + s1*t8
     T = casadi.SX(4, 4)
     T[0, 0] = t4
     T[0, 1] = -s1
@@ -81,10 +81,10 @@ def _jacobian(q):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = c2*t0 + t1
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = c2*t3 + t4
+    t5 = t4 + c2*t3
     t6 = 0.1*s234
     t7 = 0.1*s23 + t6
     t8 = 0.1*s2 + t7
@@ -132,16 +132,16 @@ def _fk_jacobian(q):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c23
     t1 = c1*c234
-    t2 = c1*t0 + 0.1*t1
+    t2 = 0.1*t1 + c1*t0
     t3 = s1*c234
-    t4 = s1*t0 + 0.1*t3
+    t4 = 0.1*t3 + s1*t0
     t5 = 0.1*s234
     t6 = 0.1*s23 + t5
     t7 = 0.1*s2 + t6
     t8 = 0.12 + t7
     t9 = 0.1*c2
-    t10 = c1*t9 + t2
-    t11 = s1*t9 + t4
+    t10 = t2 + c1*t9
+    t11 = t4 + s1*t9
     t12 = 0.1*c234
     t13 = -c1
     T = casadi.SX(4, 4)
@@ -199,10 +199,10 @@ def _jacobian_tool(q):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = c2*t0 + t1
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = c2*t3 + t4
+    t5 = t4 + c2*t3
     t6 = 0.1*s234
     t7 = 0.1*s23 + t6
     t8 = 0.1*s2 + t7
@@ -262,10 +262,10 @@ def _task(q):
     t2 = 0.12 + t1
     t3 = 0.1*c1
     t4 = c23*t3 + c234*t3
-    t5 = c2*t3 + t4
+    t5 = t4 + c2*t3
     t6 = 0.1*s1
     t7 = c23*t6 + c234*t6
-    t8 = c2*t6 + t7
+    t8 = t7 + c2*t6
     t9 = c234**2
     mu = casadi.SX(4, 1)
     mu[0, 0] = t5
@@ -295,17 +295,17 @@ def _task_jacobian(q):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = c2*t0 + t1
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = c2*t3 + t4
+    t5 = t4 + c2*t3
     t6 = 0.1*s234
     t7 = 0.1*s23 + t6
     t8 = 0.1*s2 + t7
     t9 = c1**2
-    t10 = t9*c234
+    t10 = c234*t9
     t11 = s1**2
-    t12 = t11*c234
+    t12 = c234*t11
     t13 = c234**2
     t14 = -(t10 + t12)/casadi.sqrt(t9*t13 + t11*t13)
     J = casadi.SX(4, 4)
@@ -350,16 +350,16 @@ def _fk_jacobian_dot(q, q_dot):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c23
     t1 = c1*c234
-    t2 = c1*t0 + 0.1*t1
+    t2 = 0.1*t1 + c1*t0
     t3 = s1*c234
-    t4 = s1*t0 + 0.1*t3
+    t4 = 0.1*t3 + s1*t0
     t5 = 0.1*s234
     t6 = 0.1*s23 + t5
     t7 = 0.1*s2 + t6
     t8 = 0.12 + t7
     t9 = 0.1*c2
-    t10 = c1*t9 + t2
-    t11 = s1*t9 + t4
+    t10 = t2 + c1*t9
+    t11 = t4 + s1*t9
     t12 = c1*t10 + s1*t11
     t13 = t12
     t14 = c1*t2 + s1*t4
@@ -427,9 +427,9 @@ def _fk_jacobian_dot(q, q_dot):
     J[4, 3] = t42
     J[5, 0] = 1
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd1*t34 + qd2*(qd1*t40 - c1*t37) - qd3*(t24*t15 - qd1*t41 + c1*t36) - qd4*(t20*t26 - 0.1*s1*s234*qd1 + c1*t35)
-    a[1, 0] = -qd1*t30 - qd2*(qd1*t38 + s1*t37) - qd3*(qd1*t39 + t21*t15 + s1*t36) - qd4*(t27*qd1 + t20*t23 + s1*t35)
-    a[2, 0] = -qd2*(s1*t33 + c1*t29) - qd3*(t18*t43 + t16*t43 + s1*t32 + c1*t28) - qd4*(t31*t23 + t27*t26 + t18*t44 + t16*t44)
+    a[0, 0] = -qd1*t34 + qd2*(-c1*t37 + qd1*t40) - qd3*(c1*t36 + t24*t15 - qd1*t41) - qd4*(-0.1*s1*s234*qd1 + t20*t26 + c1*t35)
+    a[1, 0] = -qd1*t30 - qd2*(s1*t37 + qd1*t38) - qd3*(s1*t36 + qd1*t39 + t21*t15) - qd4*(t20*t23 + t27*qd1 + s1*t35)
+    a[2, 0] = -qd2*(s1*t33 + c1*t29) - qd3*(c1*t28 + s1*t32 + t18*t43 + t16*t43) - qd4*(t31*t23 + t27*t26 + t18*t44 + t16*t44)
     a[3, 0] = t24*qd1 + t25*qd1 + c1*t45
     a[4, 0] = t21*qd1 + t22*qd1 + s1*t45
     a[5, 0] = qd4*(-c1*t23 + s1*t26)
@@ -460,10 +460,10 @@ def _jacobian_dot(q, q_dot):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = c2*t0 + t1
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = c2*t3 + t4
+    t5 = t4 + c2*t3
     t6 = c1*t2 + s1*t5
     t7 = c1*t1 + s1*t4
     t8 = 0.1*s234
@@ -494,15 +494,15 @@ def _jacobian_dot(q, q_dot):
     t33 = t9*qd2
     Jd = casadi.SX(6, 4)
     Jd[0, 0] = -t27
-    Jd[0, 1] = t10*t31 - c1*t30
-    Jd[0, 2] = -(t18*t7 - t9*t31 + c1*t29)
-    Jd[0, 3] = -(t14*t20 - 0.1*s1*s234*qd1 + c1*t28)
+    Jd[0, 1] = -c1*t30 + t10*t31
+    Jd[0, 2] = -(c1*t29 + t18*t7 - t9*t31)
+    Jd[0, 3] = -(-0.1*s1*s234*qd1 + t14*t20 + c1*t28)
     Jd[1, 0] = -t26
-    Jd[1, 1] = -(t10*t32 + s1*t30)
-    Jd[1, 2] = -(t9*t32 + t15*t7 + s1*t29)
-    Jd[1, 3] = -(t8*t32 + t14*t17 + s1*t28)
+    Jd[1, 1] = -(s1*t30 + t10*t32)
+    Jd[1, 2] = -(s1*t29 + t9*t32 + t15*t7)
+    Jd[1, 3] = -(t14*t17 + t8*t32 + s1*t28)
     Jd[2, 1] = -(s1*t25 + c1*t24)
-    Jd[2, 2] = -(t13*t33 + t11*t33 + s1*t23 + c1*t22)
+    Jd[2, 2] = -(c1*t22 + s1*t23 + t13*t33 + t11*t33)
     Jd[2, 3] = -(s1*t8*t17 + c1*t8*t20 + t13*t21 + t11*t21)
     Jd[3, 1] = t32
     Jd[3, 2] = t32
@@ -538,10 +538,10 @@ def _bias_acceleration(q, q_dot):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = c2*t0 + t1
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = c2*t3 + t4
+    t5 = t4 + c2*t3
     t6 = c1*t2 + s1*t5
     t7 = c1*t1 + s1*t4
     t8 = 0.1*s234
@@ -571,9 +571,9 @@ def _bias_acceleration(q, q_dot):
     t32 = c1*qd1
     t33 = t9*qd2
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd1*t27 + qd2*(t10*t31 - c1*t30) - qd3*(t18*t7 - t9*t31 + c1*t29) - qd4*(t14*t20 - 0.1*s1*s234*qd1 + c1*t28)
-    a[1, 0] = -qd1*t26 - qd2*(t10*t32 + s1*t30) - qd3*(t9*t32 + t15*t7 + s1*t29) - qd4*(t8*t32 + t14*t17 + s1*t28)
-    a[2, 0] = -qd2*(s1*t25 + c1*t24) - qd3*(t13*t33 + t11*t33 + s1*t23 + c1*t22) - qd4*(s1*t8*t17 + c1*t8*t20 + t13*t21 + t11*t21)
+    a[0, 0] = -qd1*t27 + qd2*(-c1*t30 + t10*t31) - qd3*(c1*t29 + t18*t7 - t9*t31) - qd4*(-0.1*s1*s234*qd1 + t14*t20 + c1*t28)
+    a[1, 0] = -qd1*t26 - qd2*(s1*t30 + t10*t32) - qd3*(s1*t29 + t9*t32 + t15*t7) - qd4*(t14*t17 + t8*t32 + s1*t28)
+    a[2, 0] = -qd2*(s1*t25 + c1*t24) - qd3*(c1*t22 + s1*t23 + t13*t33 + t11*t33) - qd4*(s1*t8*t17 + c1*t8*t20 + t13*t21 + t11*t21)
     a[3, 0] = t18*qd1 + t19*qd1 + t32*qd4
     a[4, 0] = t15*qd1 + t16*qd1 + t31*qd4
     a[5, 0] = qd4*(-c1*t17 + s1*t20)
@@ -581,7 +581,7 @@ def _bias_acceleration(q, q_dot):
 
 
 def _task_jacobian_dot(q, q_dot):
-    """Time derivative of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q': 170 operations."""
+    """Time derivative of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q': 167 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -604,20 +604,20 @@ def _task_jacobian_dot(q, q_dot):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = c2*t0 + t1
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
     t4 = s1*c234
-    t5 = c23*t3 + 0.1*t4
-    t6 = c2*t3 + t5
+    t5 = 0.1*t4 + c23*t3
+    t6 = t5 + c2*t3
     t7 = c1*t2 + s1*t6
     t8 = c1*t1 + s1*t5
     t9 = 0.1*s234
     t10 = 0.1*s23 + t9
     t11 = 0.1*s2 + t10
     t12 = c1**2
-    t13 = t12*c234
+    t13 = c234*t12
     t14 = s1**2
-    t15 = t14*c234
+    t15 = c234*t14
     t16 = 0.1*t13 + 0.1*t15
     t17 = s1*qd2
     t18 = s1*qd3
@@ -628,12 +628,12 @@ def _task_jacobian_dot(q, q_dot):
     t23 = t21 + t22
     t24 = t23
     t25 = c1*qd4
-    t26 = t9*t25 + t10*t22
+    t26 = t10*t22 + t9*t25
     t27 = t26 + t11*t21
     t28 = t27 + t6*qd1
     t29 = t23 + t25
     t30 = s1*qd4
-    t31 = t9*t30 + t10*t18
+    t31 = t10*t18 + t9*t30
     t32 = t31 + t11*t17
     t33 = -t32 + t2*qd1
     t34 = s1*t32 + c1*t27
@@ -642,16 +642,16 @@ def _task_jacobian_dot(q, q_dot):
     t37 = t36 + t8*qd3
     t38 = t37 + t7*qd2
     t39 = s1*qd1
-    t40 = t11*t39 - c1*t38
-    t41 = t21*t8 - t10*t39 + c1*t37
+    t40 = -c1*t38 + t11*t39
+    t41 = c1*t37 + t21*t8 - t10*t39
     t42 = t16*t24 - t9*t39 + c1*t36
     t43 = c1*qd1
-    t44 = t11*t43 + s1*t38
-    t45 = t10*t43 + t17*t8 + s1*t37
-    t46 = t9*t43 + t16*t20 + s1*t36
-    t47 = c234*t43 - s234*t35
+    t44 = s1*t38 + t11*t43
+    t45 = s1*t37 + t17*t8 + t10*t43
+    t46 = t16*t20 + t9*t43 + s1*t36
+    t47 = -s234*t35 + c234*t43
     t48 = t10*qd2
-    t49 = t14*t48 + t12*t48 + s1*t31 + c1*t26
+    t49 = c1*t26 + s1*t31 + t14*t48 + t12*t48
     t50 = t9*qd4
     t51 = s1*t9*t20 + c1*t9*t24 + t14*t50 + t12*t50
     t52 = t4*qd1
@@ -662,8 +662,7 @@ def _task_jacobian_dot(q, q_dot):
     t57 = 1/t56
     t58 = -t57*(t13 + t15)/t55
     t59 = c1*t57
-    t60 = t52*t59
-    t61 = t53*(t59 + c1*c234*t58) - t47*(s1*t57 + t4*t58) - t60 + t60
+    t60 = t53*(c1*c234*t58 + t59) - t47*(s1*t57 + t4*t58)
     Jd = casadi.SX(4, 4)
     Jd[0, 0] = -t33
     Jd[0, 1] = t40
@@ -676,9 +675,9 @@ def _task_jacobian_dot(q, q_dot):
     Jd[2, 1] = -t34
     Jd[2, 2] = -t49
     Jd[2, 3] = -t51
-    Jd[3, 1] = t61
-    Jd[3, 2] = t61
-    Jd[3, 3] = t61
+    Jd[3, 1] = t60
+    Jd[3, 2] = t60
+    Jd[3, 3] = t60
     return [Jd]
 
 
@@ -702,10 +701,10 @@ def _hessian(q):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = c2*t0 + t1
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = c2*t3 + t4
+    t5 = t4 + c2*t3
     t6 = c1*t2 + s1*t5
     t7 = c1*t1 + s1*t4
     t8 = 0.1*s234
@@ -725,7 +724,7 @@ def _hessian(q):
     t22 = -c1*t14
     t23 = -s1*t7
     t24 = -s1*t14
-    t25 = -(t13*t9 + t11*t9)
+    t25 = -(t9*t13 + t9*t11)
     t26 = -(t8*t13 + t8*t11)
     H = casadi.SX(24, 4)
     H[0, 0] = -t2
@@ -750,7 +749,7 @@ def _hessian(q):
     H[7, 1] = -s1*t6
     H[7, 2] = t23
     H[7, 3] = t24
-    H[8, 1] = -(t13*t10 + t11*t10)
+    H[8, 1] = -(t10*t13 + t10*t11)
     H[8, 2] = t25
     H[8, 3] = t26
     H[12, 0] = t16
@@ -793,7 +792,7 @@ def _singularity_factors(q):
     t1 = s2*s3
     f = casadi.SX(2, 1)
     f[0, 0] = s3
-    f[1, 0] = -(-c2 - t0 + t1 - c4*t0 + c2*s3*s4 + s2*c3*s4 + c4*t1)
+    f[1, 0] = -(-c2 - t0 + t1 + c2*s3*s4 + s2*c3*s4 - c4*t0 + c4*t1)
     return [f]
 
 
@@ -817,7 +816,7 @@ def _manipulability(q):
     t0 = c234**2
     t1 = c2*c3
     t2 = s2*s3
-    t3 = -c4*t1 + c2*s3*s4 + s2*c3*s4 + c4*t2
+    t3 = c2*s3*s4 + s2*c3*s4 - c4*t1 + c4*t2
     t4 = 0.001*s3*t3*(-c2 - t1 + t2 + t3)/casadi.sqrt(c1**2*t0 + s1**2*t0)
     w = casadi.SX(1, 1)
     w[0, 0] = casadi.fabs(t4)
@@ -844,14 +843,14 @@ def _jacobian_det(q):
     t0 = c234**2
     t1 = c2*c3
     t2 = s2*s3
-    t3 = -c4*t1 + c2*s3*s4 + s2*c3*s4 + c4*t2
+    t3 = c2*s3*s4 + s2*c3*s4 - c4*t1 + c4*t2
     d = casadi.SX(1, 1)
     d[0, 0] = 0.001*s3*t3*(-c2 - t1 + t2 + t3)/casadi.sqrt(c1**2*t0 + s1**2*t0)
     return [d]
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 600 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 599 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -874,23 +873,23 @@ def _velocity_ik(q, mu_dot, damping):
     s234 = c23*s4 + s23*c4
     t0 = 0.1*c1
     t1 = c23*t0 + c234*t0
-    t2 = c2*t0 + t1
+    t2 = t1 + c2*t0
     t3 = 0.1*s1
     t4 = c23*t3 + c234*t3
-    t5 = c2*t3 + t4
+    t5 = t4 + c2*t3
     t6 = c1*t2 + s1*t5
     t7 = c1*t1 + s1*t4
     t8 = 0.1*s234
     t9 = 0.1*s23 + t8
     t10 = 0.1*s2 + t9
     t11 = c1**2
-    t12 = t11*c234
+    t12 = c234*t11
     t13 = s1**2
-    t14 = t13*c234
+    t14 = c234*t13
     t15 = 0.1*t12 + 0.1*t14
     t16 = c234**2
     t17 = -(t12 + t14)/casadi.sqrt(t11*t16 + t13*t16)
-    t18 = t6*t17 + t7*t17 + t15*t17
+    t18 = t7*t17 + t15*t17 + t6*t17
     t19 = t5**2
     t20 = t10**2
     t21 = t9**2
@@ -913,7 +912,7 @@ def _velocity_ik(q, mu_dot, damping):
     t38 = t6*t35 + t7*t36 + t15*t37
     t39 = t35*t17 + t36*t17 + t37*t17
     t40 = t6**2
-    t41 = t40 + t7**2 + t15**2
+    t41 = t7**2 + t15**2 + t40
     t42 = t41
     t43 = t17**2
     t44 = 3*t43
@@ -922,7 +921,7 @@ def _velocity_ik(q, mu_dot, damping):
     t47 = t30**2
     t48 = t31**2
     t49 = damping**2
-    t50 = t49 + t24
+    t50 = t24 + t49
     t51 = t50**2
     t52 = casadi.sqrt(t46 + t47 + t48 + t51)
     t53 = t52*casadi.if_else((t50 >= 0), 1, -1)
@@ -933,8 +932,8 @@ def _velocity_ik(q, mu_dot, damping):
     t58 = mu_dot1 - t26*t56
     t59 = mu_dot2 + t30*t56
     t60 = mu_dot3 + t31*t56
-    t61 = t49 + t34
-    t62 = t55*(t26*t54 + t26*t61 + t30*t38 + t31*t39)
+    t61 = t34 + t49
+    t62 = t55*(t26*t54 + t30*t38 + t31*t39 + t26*t61)
     t63 = t26 - t54*t62
     t64 = -t26*t62 + t61
     t65 = -t38 + t30*t62
@@ -947,8 +946,8 @@ def _velocity_ik(q, mu_dot, damping):
     t72 = t58 - t69*t71
     t73 = t59 - t65*t71
     t74 = t60 - t66*t71
-    t75 = t49 + t42
-    t76 = -t55*(t30*t54 + t26*t38 + t30*t75 + t31*t18)
+    t75 = t42 + t49
+    t76 = -t55*(t30*t54 + t26*t38 + t31*t18 + t30*t75)
     t77 = t30 + t54*t76
     t78 = t38 + t26*t76
     t79 = t30*t76 + t75
@@ -964,7 +963,7 @@ def _velocity_ik(q, mu_dot, damping):
     t89 = t88*(t73*t87 + t84*t74)
     t90 = t73 - t87*t89
     t91 = t74 - t84*t89
-    t92 = t49 + t45
+    t92 = t45 + t49
     t93 = casadi.sqrt(2*t46 + 2*t47 + 2*t38**2 + 2*t48 + 2*t39**2 + 2*t18**2 + t51 + t61**2 + t75**2 + t92**2)
     t94 = -t55*(t31*t54 + t26*t39 + t30*t18 + t31*t92)
     t95 = t31 + t54*t94
@@ -982,7 +981,7 @@ def _velocity_ik(q, mu_dot, damping):
     t107 = t106
     t108 = t107*casadi.if_else((t105 >= 0), 1, -1)
     t109 = t105 + t108
-    t110 = casadi.if_else((t107 > 0), 1/(t107*(t106 + t107)), 0)
+    t110 = casadi.if_else((t107 > 0), 1/(t107*(t107 + t106)), 0)
     t111 = t91 - t91*t109**2*t110
     t112 = casadi.if_else((t108 != 0), -t111/t108, 0)
     t113 = casadi.if_else((t86 != 0), -(t90 - t104*t112)/t86, 0)
@@ -990,80 +989,79 @@ def _velocity_ik(q, mu_dot, damping):
     t115 = casadi.if_else((t53 != 0), -(t57 + t77*t113 + t95*t112 - t63*t114)/t53, 0)
     t116 = -t5*t115 + t2*t114
     t117 = t17*t112
-    t118 = -t27*t115 - t35*t114 + t6*t113 + t117
-    t119 = t117 - t28*t115 - t36*t114 + t7*t113
-    t120 = t117 - t29*t115 - t37*t114 + t15*t113
-    t121 = t32 + t19
+    t118 = t6*t113 - t27*t115 - t35*t114 + t117
+    t119 = t7*t113 + t117 - t28*t115 - t36*t114
+    t120 = t15*t113 + t117 - t29*t115 - t37*t114
+    t121 = t19 + t32
     t122 = casadi.sqrt(t23 + t33 + t41 + t44 + t121)
     t123 = casadi.sqrt(t121)
     t124 = t123*casadi.if_else((t5 <= 0), 1, -1)
-    t125 = -t5
-    t126 = t125 + t124
-    t127 = casadi.if_else((t123 > 0), 1/(t123*(t123 + casadi.fabs(t125))), 0)
-    t128 = -t127*(t27*t126 + t2*t35)
-    t129 = t27 + t126*t128
+    t125 = casadi.if_else((t123 > 0), 1/(t123*(t123 + casadi.fabs(t5))), 0)
+    t126 = -t5
+    t127 = t124 + t126
+    t128 = -t125*(t27*t127 + t2*t35)
+    t129 = t27 + t127*t128
     t130 = t35 + t2*t128
-    t131 = -t127*(t28*t126 + t2*t36)
-    t132 = t28 + t126*t131
+    t131 = -t125*(t28*t127 + t2*t36)
+    t132 = t28 + t127*t131
     t133 = t36 + t2*t131
-    t134 = -t127*(t29*t126 + t2*t37)
-    t135 = t29 + t126*t134
+    t134 = -t125*(t29*t127 + t2*t37)
+    t135 = t29 + t127*t134
     t136 = t37 + t2*t134
-    t137 = t127*(mu_dot0*t126 + t2*mu_dot1)
-    t138 = mu_dot0 - t126*t137
+    t137 = t125*(mu_dot0*t127 + t2*mu_dot1)
+    t138 = mu_dot0 - t127*t137
     t139 = mu_dot1 - t2*t137
     t140 = casadi.sqrt(t40 + t43 + t130**2)
     t141 = t140*casadi.if_else((t130 <= 0), 1, -1)
-    t142 = t125 + q1 + q2 + q3 + q4 + t2 - t27 - t28 - t29 - t35 - t36 - t37 + t6 + t7 + t15 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + 3*t17
-    t143 = -t130
-    t144 = t143 + t141
-    t145 = casadi.if_else((t140 > 0), 1/(t140*(t140 + casadi.fabs(t143))), 0)
-    t146 = t145*(t43 - t133*t144 + t6*t7)
-    t147 = t133 + t144*t146
-    t148 = t7 - t6*t146
-    t149 = t17 - t17*t146
-    t150 = t145*(t43 - t136*t144 + t6*t15)
-    t151 = t136 + t144*t150
-    t152 = t15 - t6*t150
-    t153 = t17 - t17*t150
-    t154 = t145*(t139*t144 + t6*mu_dot2 + t17*mu_dot3)
-    t155 = t139 - t144*t154
-    t156 = mu_dot2 - t6*t154
-    t157 = mu_dot3 - t17*t154
-    t158 = casadi.sqrt(t148**2 + t149**2)
-    t159 = t158*casadi.if_else((t148 >= 0), 1, -1)
-    t160 = t148 + t159
-    t161 = casadi.if_else((t158 > 0), 1/(t158*(t158 + casadi.fabs(t148))), 0)
-    t162 = t161*(t152*t160 + t149*t153)
-    t163 = t152 - t160*t162
-    t164 = t153 - t149*t162
-    t165 = t161*(t156*t160 + t149*t157)
-    t166 = t156 - t160*t165
-    t167 = t157 - t149*t165
-    t168 = casadi.fabs(t164)
-    t169 = t168
-    t170 = t169*casadi.if_else((t164 >= 0), 1, -1)
-    t171 = t164 + t170
-    t172 = casadi.if_else((t169 > 0), 1/(t169*(t168 + t169)), 0)
-    t173 = t167 - t167*t171**2*t172
-    t174 = casadi.if_else((t170 != 0), -t173/t170, 0)
-    t175 = casadi.if_else((t159 != 0), -(t166 - t163*t174)/t159, 0)
-    t176 = casadi.if_else((t141 != 0), -(t155 + t147*t175 + t151*t174)/t141, 0)
-    t177 = casadi.if_else((t124 != 0), -(t138 + t129*t176 + t132*t175 + t135*t174)/t124, 0)
-    t178 = (casadi.fabs(t142) < casadi.inf)
-    t179 = (damping >= 0)
-    t180 = (damping > 0)
-    t181 = 1e-12*t93
-    t182 = 1e-12*t122
-    t183 = casadi.logic_or(casadi.logic_and(t180, casadi.logic_or(casadi.logic_or(casadi.logic_or((t52 <= t181), (t67 <= t181)), (t85 <= t181)), (t107 <= t181))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t123 <= t182), (t140 <= t182)), (t158 <= t182)), (t169 <= t182))))
-    t184 = casadi.logic_and(casadi.logic_and(t178, t179), casadi.logic_not(t183))
+    t142 = -t130 + t141
+    t143 = casadi.if_else((t140 > 0), 1/(t140*(t140 + casadi.fabs(t130))), 0)
+    t144 = t143*(t43 - t133*t142 + t6*t7)
+    t145 = t133 + t142*t144
+    t146 = t7 - t6*t144
+    t147 = t17 - t17*t144
+    t148 = t143*(t43 - t136*t142 + t6*t15)
+    t149 = t136 + t142*t148
+    t150 = t15 - t6*t148
+    t151 = t17 - t17*t148
+    t152 = t143*(t139*t142 + t6*mu_dot2 + t17*mu_dot3)
+    t153 = t139 - t142*t152
+    t154 = mu_dot2 - t6*t152
+    t155 = mu_dot3 - t17*t152
+    t156 = casadi.sqrt(t146**2 + t147**2)
+    t157 = t156*casadi.if_else((t146 >= 0), 1, -1)
+    t158 = t146 + t157
+    t159 = casadi.if_else((t156 > 0), 1/(t156*(t156 + casadi.fabs(t146))), 0)
+    t160 = t159*(t150*t158 + t147*t151)
+    t161 = t150 - t158*t160
+    t162 = t151 - t147*t160
+    t163 = t159*(t154*t158 + t147*t155)
+    t164 = t154 - t158*t163
+    t165 = t155 - t147*t163
+    t166 = -t27 - t28 - t29 - t35 - t36 - t37 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + 3*t17 + t126
+    t167 = casadi.fabs(t162)
+    t168 = t167
+    t169 = t168*casadi.if_else((t162 >= 0), 1, -1)
+    t170 = t162 + t169
+    t171 = casadi.if_else((t168 > 0), 1/(t168*(t168 + t167)), 0)
+    t172 = t165 - t165*t170**2*t171
+    t173 = casadi.if_else((t169 != 0), -t172/t169, 0)
+    t174 = casadi.if_else((t157 != 0), -(t164 - t161*t173)/t157, 0)
+    t175 = casadi.if_else((t141 != 0), -(t153 + t145*t174 + t149*t173)/t141, 0)
+    t176 = casadi.if_else((t124 != 0), -(t138 + t129*t175 + t132*t174 + t135*t173)/t124, 0)
+    t177 = (casadi.fabs(t166) < casadi.inf)
+    t178 = (damping >= 0)
+    t179 = (damping > 0)
+    t180 = 1e-12*t93
+    t181 = 1e-12*t122
+    t182 = casadi.logic_or(casadi.logic_and(t179, casadi.logic_or(casadi.logic_or(casadi.logic_or((t52 <= t180), (t67 <= t180)), (t85 <= t180)), (t107 <= t180))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t123 <= t181), (t140 <= t181)), (t156 <= t181)), (t168 <= t181))))
+    t183 = casadi.logic_and(casadi.logic_and(t177, t178), casadi.logic_not(t182))
     q_dot = casadi.SX(4, 1)
-    q_dot[0, 0] = casadi.if_else(t184, casadi.if_else(t180, t116, t177), 0)
-    q_dot[1, 0] = casadi.if_else(t184, casadi.if_else(t180, t118, t176), 0)
-    q_dot[2, 0] = casadi.if_else(t184, casadi.if_else(t180, t119, t175), 0)
-    q_dot[3, 0] = casadi.if_else(t184, casadi.if_else(t180, t120, t174), 0)
+    q_dot[0, 0] = casadi.if_else(t183, casadi.if_else(t179, t116, t176), 0)
+    q_dot[1, 0] = casadi.if_else(t183, casadi.if_else(t179, t118, t175), 0)
+    q_dot[2, 0] = casadi.if_else(t183, casadi.if_else(t179, t119, t174), 0)
+    q_dot[3, 0] = casadi.if_else(t183, casadi.if_else(t179, t120, t173), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t178, t179)), 2, casadi.if_else(t183, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t177, t178)), 2, casadi.if_else(t182, 1, 0))
     return [q_dot, status]
 
 
@@ -1096,11 +1094,11 @@ def _ik_numeric_step(target, q, damping):
     t0 = qs1 + qs2 + qs3 + qs4 + mu3 + mu0 + mu1 + mu2
     t1 = 0.1*c1
     t2 = c23*t1 + c234*t1
-    t3 = c2*t1 + t2
+    t3 = t2 + c2*t1
     t4 = -t3 + mu0
     t5 = 0.1*s1
     t6 = c23*t5 + c234*t5
-    t7 = c2*t5 + t6
+    t7 = t6 + c2*t5
     t8 = c1*t3 + s1*t7
     t9 = c1*t2 + s1*t6
     t10 = -t7 + mu1
@@ -1110,28 +1108,28 @@ def _ik_numeric_step(target, q, damping):
     t14 = 0.12 + t13
     t15 = -t14 + mu2
     t16 = c1**2
-    t17 = t16*c234
+    t17 = c234*t16
     t18 = s1**2
-    t19 = t18*c234
+    t19 = c234*t18
     t20 = 0.1*t17 + 0.1*t19
     t21 = t8**2 + t9**2 + t20**2
     t22 = c234**2
     t23 = casadi.sqrt(t16*t22 + t18*t22)
     t24 = -(t17 + t19)/t23
-    t25 = t8*t24 + t9*t24 + t20*t24
+    t25 = t9*t24 + t20*t24 + t8*t24
     t26 = 3*t24**2
     t27 = t13**2
     t28 = t12**2
     t29 = 0.01*s234**2
-    t30 = t7**2 + t16*t27 + t16*t28 + t16*t29
-    t31 = t3**2 + t18*t27 + t18*t28 + t18*t29
+    t30 = t7**2 + t16*t28 + t16*t29 + t16*t27
+    t31 = t3**2 + t18*t28 + t18*t27 + t18*t29
     t32 = c1*s1
     t33 = -t3*t7 + t27*t32 + t28*t32 + t29*t32
     t34 = c1*t13
     t35 = c1*t12
     t36 = c1*t11
     t37 = t34*t8 + t35*t9 + t36*t20
-    t38 = t34*t24 + t35*t24 + t36*t24
+    t38 = t35*t24 + t36*t24 + t34*t24
     t39 = s1*t13
     t40 = s1*t12
     t41 = s1*t11
@@ -1141,7 +1139,7 @@ def _ik_numeric_step(target, q, damping):
     t45 = t44 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t44))
     t46 = t4**2 + t10**2 + t15**2 + t45**2
     t47 = damping + t30
-    t48 = casadi.sqrt(t33**2 + t37**2 + t38**2 + t47**2)
+    t48 = casadi.sqrt(t47**2 + t33**2 + t37**2 + t38**2)
     t49 = t48*casadi.if_else((t47 >= 0), 1, -1)
     t50 = t47 + t49
     t51 = casadi.if_else((t48 > 0), 1/(t48*(t48 + casadi.fabs(t47))), 0)
@@ -1151,7 +1149,7 @@ def _ik_numeric_step(target, q, damping):
     t55 = t15 + t37*t52
     t56 = -t45 + t38*t52
     t57 = damping + t31
-    t58 = t51*(t37*t42 + t38*t43 + t33*t50 + t33*t57)
+    t58 = t51*(t37*t42 + t38*t43 + t33*t50 + t57*t33)
     t59 = t33 - t50*t58
     t60 = t57 - t33*t58
     t61 = -t42 + t37*t58
@@ -1165,7 +1163,7 @@ def _ik_numeric_step(target, q, damping):
     t69 = t55 - t61*t67
     t70 = t56 - t62*t67
     t71 = damping + t21
-    t72 = -t51*(t33*t42 + t38*t25 + t37*t50 + t37*t71)
+    t72 = -t51*(t33*t42 + t38*t25 + t37*t50 + t71*t37)
     t73 = t37 + t50*t72
     t74 = t42 + t33*t72
     t75 = t71 + t37*t72
@@ -1182,7 +1180,7 @@ def _ik_numeric_step(target, q, damping):
     t86 = t69 - t83*t85
     t87 = t70 - t80*t85
     t88 = damping + t26
-    t89 = -t51*(t33*t43 + t37*t25 + t38*t50 + t38*t88)
+    t89 = -t51*(t33*t43 + t37*t25 + t38*t50 + t88*t38)
     t90 = t38 + t50*t89
     t91 = t43 + t33*t89
     t92 = t25 + t37*t89
@@ -1206,9 +1204,9 @@ def _ik_numeric_step(target, q, damping):
     t110 = casadi.if_else((t49 != 0), -(t53 + t73*t108 + t90*t107 - t59*t109)/t49, 0)
     t111 = q1 - t7*t110 + t3*t109
     t112 = t24*t107
-    t113 = q2 - t34*t110 - t39*t109 + t8*t108 + t112
-    t114 = q3 + t112 - t35*t110 - t40*t109 + t9*t108
-    t115 = q4 + t112 - t36*t110 - t41*t109 + t20*t108
+    t113 = q2 + t112 + t8*t108 - t34*t110 - t39*t109
+    t114 = q3 + t112 + t9*t108 - t35*t110 - t40*t109
+    t115 = q4 + t112 + t20*t108 - t36*t110 - t41*t109
     q_start = casadi.SX(4, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -1262,7 +1260,7 @@ def _ik_branches(mu):
     t29 = casadi.if_else(t16, 0, -t28)
     t30 = mu0*t23 + mu1*t29
     t31 = mu1*t23 - mu0*t29
-    t32 = t11*t17 + mu1*t28
+    t32 = t11*t17 + t28*mu1
     t33 = t21*mu1 - t28*mu0
     t34 = 0.1*t9
     t35 = t34 + t30
@@ -1294,10 +1292,10 @@ def _ik_branches(mu):
     t61 = t60*t35
     t62 = t39*t54
     t63 = t61 + t62
-    t64 = t62 - t61
+    t64 = -t61 + t62
     t65 = t35*t54
     t66 = t60*t39
-    t67 = t65 - t66
+    t67 = -t66 + t65
     t68 = t63**2 + t67**2
     t69 = t65 + t66
     t70 = t64**2 + t69**2
@@ -1325,10 +1323,10 @@ def _ik_branches(mu):
     t92 = t91*t72
     t93 = t39*t85
     t94 = t92 + t93
-    t95 = t93 - t92
+    t95 = -t92 + t93
     t96 = t72*t85
     t97 = t91*t39
-    t98 = t96 - t97
+    t98 = -t97 + t96
     t99 = t94**2 + t98**2
     t100 = t96 + t97
     t101 = t95**2 + t100**2
@@ -1357,10 +1355,10 @@ def _ik_branches(mu):
     t124 = t123*t36
     t125 = t41*t117
     t126 = t124 + t125
-    t127 = t125 - t124
+    t127 = -t124 + t125
     t128 = t36*t117
     t129 = t123*t41
-    t130 = t128 - t129
+    t130 = -t129 + t128
     t131 = t126**2 + t130**2
     t132 = t128 + t129
     t133 = t127**2 + t132**2
@@ -1382,10 +1380,10 @@ def _ik_branches(mu):
     t149 = t148*t76
     t150 = t41*t142
     t151 = t149 + t150
-    t152 = t150 - t149
+    t152 = -t149 + t150
     t153 = t76*t142
     t154 = t148*t41
-    t155 = t153 - t154
+    t155 = -t154 + t153
     t156 = t151**2 + t155**2
     t157 = t153 + t154
     t158 = t152**2 + t157**2
@@ -1398,14 +1396,14 @@ def _ik_branches(mu):
     t165 = t160 + t51
     t166 = t163 + t165 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t164 + t165))
     t167 = -t166
-    t168 = t166 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t167))
+    t168 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t167)) + t166
     t169 = casadi.if_else((t70 <= t159), 0, casadi.atan2(-t69, t64))
     t170 = t169
     t171 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t170)) + t170
-    t172 = t169 + t52
+    t172 = t52 + t169
     t173 = t163 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t164 + t172)) + t172
     t174 = -t173
-    t175 = t173 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t174))
+    t175 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t174)) + t173
     t176 = 1e-24*t73*t86
     t177 = casadi.if_else((t99 <= t176), 0, casadi.atan2(-t98, t94))
     t178 = t177
@@ -1414,14 +1412,14 @@ def _ik_branches(mu):
     t181 = t82 + t177
     t182 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t180 + t181)) + t10 + t181
     t183 = -t182
-    t184 = t182 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t183))
+    t184 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t183)) + t182
     t185 = casadi.if_else((t101 <= t176), 0, casadi.atan2(-t100, t95))
     t186 = t185
     t187 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t186)) + t186
     t188 = t83 + t185
     t189 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t180 + t188)) + t10 + t188
     t190 = -t189
-    t191 = t189 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t190))
+    t191 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t190)) + t189
     t192 = 1e-24*t103*t118
     t193 = casadi.if_else((t131 <= t192), 0, casadi.atan2(-t130, t126))
     t194 = t193
@@ -1429,14 +1427,14 @@ def _ik_branches(mu):
     t196 = t114 + t193
     t197 = t163 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t164 + t196)) + t196
     t198 = -t197
-    t199 = t197 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t198))
+    t199 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t198)) + t197
     t200 = casadi.if_else((t133 <= t192), 0, casadi.atan2(-t132, t127))
     t201 = t200
     t202 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t201)) + t201
     t203 = t115 + t200
     t204 = t163 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t164 + t203)) + t203
     t205 = -t204
-    t206 = t204 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t205))
+    t206 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t205)) + t204
     t207 = 1e-24*t106*t143
     t208 = casadi.if_else((t156 <= t207), 0, casadi.atan2(-t155, t151))
     t209 = t208
@@ -1444,14 +1442,14 @@ def _ik_branches(mu):
     t211 = t139 + t208
     t212 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t180 + t211)) + t10 + t211
     t213 = -t212
-    t214 = t212 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t213))
+    t214 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t213)) + t212
     t215 = casadi.if_else((t158 <= t207), 0, casadi.atan2(-t157, t152))
     t216 = t215
     t217 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t216)) + t216
     t218 = t140 + t215
     t219 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t180 + t218)) + t10 + t218
     t220 = -t219
-    t221 = t219 + 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t220))
+    t221 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t220)) + t219
     t222 = casadi.logic_and((t19 >= -3.141592653589793), (t19 <= 3.141592653589793))
     t223 = (t20 <= 3.141592653589793)
     t224 = casadi.if_else(casadi.logic_and(casadi.logic_not(t222), t223), t20, t19)
@@ -1681,19 +1679,19 @@ def _ik_nearest(mu, q_seed, weights):
     t40 = casadi.if_else(casadi.logic_and(vb7, lb7), 1, 0)
     t41 = mu3 + mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
     t42 = casadi.if_else((t0 < qn1), 6.283185307179586, -6.283185307179586)
-    t43 = t0 + t42
+    t43 = t42 + t0
     t44 = -t42 + t0
     t45 = casadi.if_else(casadi.logic_and((t0 >= -3.141592653589793), (t0 <= 3.141592653589793)), t0, casadi.if_else(casadi.logic_and((t43 >= -3.141592653589793), (t43 <= 3.141592653589793)), t43, casadi.if_else(casadi.logic_and((t44 >= -3.141592653589793), (t44 <= 3.141592653589793)), t44, qb0_0)))
     t46 = casadi.if_else((t1 < qn2), 6.283185307179586, -6.283185307179586)
-    t47 = t1 + t46
+    t47 = t46 + t1
     t48 = -t46 + t1
     t49 = casadi.if_else(casadi.logic_and((t1 >= -2.0943951023931953), (t1 <= 2.0943951023931953)), t1, casadi.if_else(casadi.logic_and((t47 >= -2.0943951023931953), (t47 <= 2.0943951023931953)), t47, casadi.if_else(casadi.logic_and((t48 >= -2.0943951023931953), (t48 <= 2.0943951023931953)), t48, qb0_1)))
     t50 = casadi.if_else((t2 < qn3), 6.283185307179586, -6.283185307179586)
-    t51 = t2 + t50
+    t51 = t50 + t2
     t52 = -t50 + t2
     t53 = casadi.if_else(casadi.logic_and((t2 >= -2.0943951023931953), (t2 <= 2.0943951023931953)), t2, casadi.if_else(casadi.logic_and((t51 >= -2.0943951023931953), (t51 <= 2.0943951023931953)), t51, casadi.if_else(casadi.logic_and((t52 >= -2.0943951023931953), (t52 <= 2.0943951023931953)), t52, qb0_2)))
     t54 = casadi.if_else((t3 < qn4), 6.283185307179586, -6.283185307179586)
-    t55 = t3 + t54
+    t55 = t54 + t3
     t56 = -t54 + t3
     t57 = casadi.if_else(casadi.logic_and((t3 >= -2.0943951023931953), (t3 <= 2.0943951023931953)), t3, casadi.if_else(casadi.logic_and((t55 >= -2.0943951023931953), (t55 <= 2.0943951023931953)), t55, casadi.if_else(casadi.logic_and((t56 >= -2.0943951023931953), (t56 <= 2.0943951023931953)), t56, qb0_3)))
     t58 = -qn1
@@ -1708,19 +1706,19 @@ def _ik_nearest(mu, q_seed, weights):
     t67 = casadi.if_else(t63, t57, qn4)
     t68 = casadi.if_else(t63, t62, 0)
     t69 = casadi.if_else((t6 < qn1), 6.283185307179586, -6.283185307179586)
-    t70 = t6 + t69
+    t70 = t69 + t6
     t71 = -t69 + t6
     t72 = casadi.if_else(casadi.logic_and((t6 >= -3.141592653589793), (t6 <= 3.141592653589793)), t6, casadi.if_else(casadi.logic_and((t70 >= -3.141592653589793), (t70 <= 3.141592653589793)), t70, casadi.if_else(casadi.logic_and((t71 >= -3.141592653589793), (t71 <= 3.141592653589793)), t71, qb1_0)))
     t73 = casadi.if_else((t7 < qn2), 6.283185307179586, -6.283185307179586)
-    t74 = t7 + t73
+    t74 = t73 + t7
     t75 = -t73 + t7
     t76 = casadi.if_else(casadi.logic_and((t7 >= -2.0943951023931953), (t7 <= 2.0943951023931953)), t7, casadi.if_else(casadi.logic_and((t74 >= -2.0943951023931953), (t74 <= 2.0943951023931953)), t74, casadi.if_else(casadi.logic_and((t75 >= -2.0943951023931953), (t75 <= 2.0943951023931953)), t75, qb1_1)))
     t77 = casadi.if_else((t8 < qn3), 6.283185307179586, -6.283185307179586)
-    t78 = t8 + t77
+    t78 = t77 + t8
     t79 = -t77 + t8
     t80 = casadi.if_else(casadi.logic_and((t8 >= -2.0943951023931953), (t8 <= 2.0943951023931953)), t8, casadi.if_else(casadi.logic_and((t78 >= -2.0943951023931953), (t78 <= 2.0943951023931953)), t78, casadi.if_else(casadi.logic_and((t79 >= -2.0943951023931953), (t79 <= 2.0943951023931953)), t79, qb1_2)))
     t81 = casadi.if_else((t9 < qn4), 6.283185307179586, -6.283185307179586)
-    t82 = t9 + t81
+    t82 = t81 + t9
     t83 = -t81 + t9
     t84 = casadi.if_else(casadi.logic_and((t9 >= -2.0943951023931953), (t9 <= 2.0943951023931953)), t9, casadi.if_else(casadi.logic_and((t82 >= -2.0943951023931953), (t82 <= 2.0943951023931953)), t82, casadi.if_else(casadi.logic_and((t83 >= -2.0943951023931953), (t83 <= 2.0943951023931953)), t83, qb1_3)))
     t85 = qw1*(t58 + t72)**2 + qw2*(t59 + t76)**2 + qw3*(t60 + t80)**2 + qw4*(t61 + t84)**2
@@ -1734,19 +1732,19 @@ def _ik_nearest(mu, q_seed, weights):
     t93 = casadi.if_else(t89, t84, t67)
     t94 = casadi.if_else(t89, t85, t68)
     t95 = casadi.if_else((t11 < qn1), 6.283185307179586, -6.283185307179586)
-    t96 = t11 + t95
+    t96 = t95 + t11
     t97 = -t95 + t11
     t98 = casadi.if_else(casadi.logic_and((t11 >= -3.141592653589793), (t11 <= 3.141592653589793)), t11, casadi.if_else(casadi.logic_and((t96 >= -3.141592653589793), (t96 <= 3.141592653589793)), t96, casadi.if_else(casadi.logic_and((t97 >= -3.141592653589793), (t97 <= 3.141592653589793)), t97, qb2_0)))
     t99 = casadi.if_else((t12 < qn2), 6.283185307179586, -6.283185307179586)
-    t100 = t12 + t99
+    t100 = t99 + t12
     t101 = -t99 + t12
     t102 = casadi.if_else(casadi.logic_and((t12 >= -2.0943951023931953), (t12 <= 2.0943951023931953)), t12, casadi.if_else(casadi.logic_and((t100 >= -2.0943951023931953), (t100 <= 2.0943951023931953)), t100, casadi.if_else(casadi.logic_and((t101 >= -2.0943951023931953), (t101 <= 2.0943951023931953)), t101, qb2_1)))
     t103 = casadi.if_else((t13 < qn3), 6.283185307179586, -6.283185307179586)
-    t104 = t13 + t103
+    t104 = t103 + t13
     t105 = -t103 + t13
     t106 = casadi.if_else(casadi.logic_and((t13 >= -2.0943951023931953), (t13 <= 2.0943951023931953)), t13, casadi.if_else(casadi.logic_and((t104 >= -2.0943951023931953), (t104 <= 2.0943951023931953)), t104, casadi.if_else(casadi.logic_and((t105 >= -2.0943951023931953), (t105 <= 2.0943951023931953)), t105, qb2_2)))
     t107 = casadi.if_else((t14 < qn4), 6.283185307179586, -6.283185307179586)
-    t108 = t14 + t107
+    t108 = t107 + t14
     t109 = -t107 + t14
     t110 = casadi.if_else(casadi.logic_and((t14 >= -2.0943951023931953), (t14 <= 2.0943951023931953)), t14, casadi.if_else(casadi.logic_and((t108 >= -2.0943951023931953), (t108 <= 2.0943951023931953)), t108, casadi.if_else(casadi.logic_and((t109 >= -2.0943951023931953), (t109 <= 2.0943951023931953)), t109, qb2_3)))
     t111 = qw1*(t58 + t98)**2 + qw2*(t59 + t102)**2 + qw3*(t60 + t106)**2 + qw4*(t61 + t110)**2
@@ -1760,19 +1758,19 @@ def _ik_nearest(mu, q_seed, weights):
     t119 = casadi.if_else(t115, t110, t93)
     t120 = casadi.if_else(t115, t111, t94)
     t121 = casadi.if_else((t16 < qn1), 6.283185307179586, -6.283185307179586)
-    t122 = t16 + t121
+    t122 = t121 + t16
     t123 = -t121 + t16
     t124 = casadi.if_else(casadi.logic_and((t16 >= -3.141592653589793), (t16 <= 3.141592653589793)), t16, casadi.if_else(casadi.logic_and((t122 >= -3.141592653589793), (t122 <= 3.141592653589793)), t122, casadi.if_else(casadi.logic_and((t123 >= -3.141592653589793), (t123 <= 3.141592653589793)), t123, qb3_0)))
     t125 = casadi.if_else((t17 < qn2), 6.283185307179586, -6.283185307179586)
-    t126 = t17 + t125
+    t126 = t125 + t17
     t127 = -t125 + t17
     t128 = casadi.if_else(casadi.logic_and((t17 >= -2.0943951023931953), (t17 <= 2.0943951023931953)), t17, casadi.if_else(casadi.logic_and((t126 >= -2.0943951023931953), (t126 <= 2.0943951023931953)), t126, casadi.if_else(casadi.logic_and((t127 >= -2.0943951023931953), (t127 <= 2.0943951023931953)), t127, qb3_1)))
     t129 = casadi.if_else((t18 < qn3), 6.283185307179586, -6.283185307179586)
-    t130 = t18 + t129
+    t130 = t129 + t18
     t131 = -t129 + t18
     t132 = casadi.if_else(casadi.logic_and((t18 >= -2.0943951023931953), (t18 <= 2.0943951023931953)), t18, casadi.if_else(casadi.logic_and((t130 >= -2.0943951023931953), (t130 <= 2.0943951023931953)), t130, casadi.if_else(casadi.logic_and((t131 >= -2.0943951023931953), (t131 <= 2.0943951023931953)), t131, qb3_2)))
     t133 = casadi.if_else((t19 < qn4), 6.283185307179586, -6.283185307179586)
-    t134 = t19 + t133
+    t134 = t133 + t19
     t135 = -t133 + t19
     t136 = casadi.if_else(casadi.logic_and((t19 >= -2.0943951023931953), (t19 <= 2.0943951023931953)), t19, casadi.if_else(casadi.logic_and((t134 >= -2.0943951023931953), (t134 <= 2.0943951023931953)), t134, casadi.if_else(casadi.logic_and((t135 >= -2.0943951023931953), (t135 <= 2.0943951023931953)), t135, qb3_3)))
     t137 = qw1*(t58 + t124)**2 + qw2*(t59 + t128)**2 + qw3*(t60 + t132)**2 + qw4*(t61 + t136)**2
@@ -1786,19 +1784,19 @@ def _ik_nearest(mu, q_seed, weights):
     t145 = casadi.if_else(t141, t136, t119)
     t146 = casadi.if_else(t141, t137, t120)
     t147 = casadi.if_else((t21 < qn1), 6.283185307179586, -6.283185307179586)
-    t148 = t21 + t147
+    t148 = t147 + t21
     t149 = -t147 + t21
     t150 = casadi.if_else(casadi.logic_and((t21 >= -3.141592653589793), (t21 <= 3.141592653589793)), t21, casadi.if_else(casadi.logic_and((t148 >= -3.141592653589793), (t148 <= 3.141592653589793)), t148, casadi.if_else(casadi.logic_and((t149 >= -3.141592653589793), (t149 <= 3.141592653589793)), t149, qb4_0)))
     t151 = casadi.if_else((t22 < qn2), 6.283185307179586, -6.283185307179586)
-    t152 = t22 + t151
+    t152 = t151 + t22
     t153 = -t151 + t22
     t154 = casadi.if_else(casadi.logic_and((t22 >= -2.0943951023931953), (t22 <= 2.0943951023931953)), t22, casadi.if_else(casadi.logic_and((t152 >= -2.0943951023931953), (t152 <= 2.0943951023931953)), t152, casadi.if_else(casadi.logic_and((t153 >= -2.0943951023931953), (t153 <= 2.0943951023931953)), t153, qb4_1)))
     t155 = casadi.if_else((t23 < qn3), 6.283185307179586, -6.283185307179586)
-    t156 = t23 + t155
+    t156 = t155 + t23
     t157 = -t155 + t23
     t158 = casadi.if_else(casadi.logic_and((t23 >= -2.0943951023931953), (t23 <= 2.0943951023931953)), t23, casadi.if_else(casadi.logic_and((t156 >= -2.0943951023931953), (t156 <= 2.0943951023931953)), t156, casadi.if_else(casadi.logic_and((t157 >= -2.0943951023931953), (t157 <= 2.0943951023931953)), t157, qb4_2)))
     t159 = casadi.if_else((t24 < qn4), 6.283185307179586, -6.283185307179586)
-    t160 = t24 + t159
+    t160 = t159 + t24
     t161 = -t159 + t24
     t162 = casadi.if_else(casadi.logic_and((t24 >= -2.0943951023931953), (t24 <= 2.0943951023931953)), t24, casadi.if_else(casadi.logic_and((t160 >= -2.0943951023931953), (t160 <= 2.0943951023931953)), t160, casadi.if_else(casadi.logic_and((t161 >= -2.0943951023931953), (t161 <= 2.0943951023931953)), t161, qb4_3)))
     t163 = qw1*(t58 + t150)**2 + qw2*(t59 + t154)**2 + qw3*(t60 + t158)**2 + qw4*(t61 + t162)**2
@@ -1812,19 +1810,19 @@ def _ik_nearest(mu, q_seed, weights):
     t171 = casadi.if_else(t167, t162, t145)
     t172 = casadi.if_else(t167, t163, t146)
     t173 = casadi.if_else((t26 < qn1), 6.283185307179586, -6.283185307179586)
-    t174 = t26 + t173
+    t174 = t173 + t26
     t175 = -t173 + t26
     t176 = casadi.if_else(casadi.logic_and((t26 >= -3.141592653589793), (t26 <= 3.141592653589793)), t26, casadi.if_else(casadi.logic_and((t174 >= -3.141592653589793), (t174 <= 3.141592653589793)), t174, casadi.if_else(casadi.logic_and((t175 >= -3.141592653589793), (t175 <= 3.141592653589793)), t175, qb5_0)))
     t177 = casadi.if_else((t27 < qn2), 6.283185307179586, -6.283185307179586)
-    t178 = t27 + t177
+    t178 = t177 + t27
     t179 = -t177 + t27
     t180 = casadi.if_else(casadi.logic_and((t27 >= -2.0943951023931953), (t27 <= 2.0943951023931953)), t27, casadi.if_else(casadi.logic_and((t178 >= -2.0943951023931953), (t178 <= 2.0943951023931953)), t178, casadi.if_else(casadi.logic_and((t179 >= -2.0943951023931953), (t179 <= 2.0943951023931953)), t179, qb5_1)))
     t181 = casadi.if_else((t28 < qn3), 6.283185307179586, -6.283185307179586)
-    t182 = t28 + t181
+    t182 = t181 + t28
     t183 = -t181 + t28
     t184 = casadi.if_else(casadi.logic_and((t28 >= -2.0943951023931953), (t28 <= 2.0943951023931953)), t28, casadi.if_else(casadi.logic_and((t182 >= -2.0943951023931953), (t182 <= 2.0943951023931953)), t182, casadi.if_else(casadi.logic_and((t183 >= -2.0943951023931953), (t183 <= 2.0943951023931953)), t183, qb5_2)))
     t185 = casadi.if_else((t29 < qn4), 6.283185307179586, -6.283185307179586)
-    t186 = t29 + t185
+    t186 = t185 + t29
     t187 = -t185 + t29
     t188 = casadi.if_else(casadi.logic_and((t29 >= -2.0943951023931953), (t29 <= 2.0943951023931953)), t29, casadi.if_else(casadi.logic_and((t186 >= -2.0943951023931953), (t186 <= 2.0943951023931953)), t186, casadi.if_else(casadi.logic_and((t187 >= -2.0943951023931953), (t187 <= 2.0943951023931953)), t187, qb5_3)))
     t189 = qw1*(t58 + t176)**2 + qw2*(t59 + t180)**2 + qw3*(t60 + t184)**2 + qw4*(t61 + t188)**2
@@ -1838,19 +1836,19 @@ def _ik_nearest(mu, q_seed, weights):
     t197 = casadi.if_else(t193, t188, t171)
     t198 = casadi.if_else(t193, t189, t172)
     t199 = casadi.if_else((t31 < qn1), 6.283185307179586, -6.283185307179586)
-    t200 = t31 + t199
+    t200 = t199 + t31
     t201 = -t199 + t31
     t202 = casadi.if_else(casadi.logic_and((t31 >= -3.141592653589793), (t31 <= 3.141592653589793)), t31, casadi.if_else(casadi.logic_and((t200 >= -3.141592653589793), (t200 <= 3.141592653589793)), t200, casadi.if_else(casadi.logic_and((t201 >= -3.141592653589793), (t201 <= 3.141592653589793)), t201, qb6_0)))
     t203 = casadi.if_else((t32 < qn2), 6.283185307179586, -6.283185307179586)
-    t204 = t32 + t203
+    t204 = t203 + t32
     t205 = -t203 + t32
     t206 = casadi.if_else(casadi.logic_and((t32 >= -2.0943951023931953), (t32 <= 2.0943951023931953)), t32, casadi.if_else(casadi.logic_and((t204 >= -2.0943951023931953), (t204 <= 2.0943951023931953)), t204, casadi.if_else(casadi.logic_and((t205 >= -2.0943951023931953), (t205 <= 2.0943951023931953)), t205, qb6_1)))
     t207 = casadi.if_else((t33 < qn3), 6.283185307179586, -6.283185307179586)
-    t208 = t33 + t207
+    t208 = t207 + t33
     t209 = -t207 + t33
     t210 = casadi.if_else(casadi.logic_and((t33 >= -2.0943951023931953), (t33 <= 2.0943951023931953)), t33, casadi.if_else(casadi.logic_and((t208 >= -2.0943951023931953), (t208 <= 2.0943951023931953)), t208, casadi.if_else(casadi.logic_and((t209 >= -2.0943951023931953), (t209 <= 2.0943951023931953)), t209, qb6_2)))
     t211 = casadi.if_else((t34 < qn4), 6.283185307179586, -6.283185307179586)
-    t212 = t34 + t211
+    t212 = t211 + t34
     t213 = -t211 + t34
     t214 = casadi.if_else(casadi.logic_and((t34 >= -2.0943951023931953), (t34 <= 2.0943951023931953)), t34, casadi.if_else(casadi.logic_and((t212 >= -2.0943951023931953), (t212 <= 2.0943951023931953)), t212, casadi.if_else(casadi.logic_and((t213 >= -2.0943951023931953), (t213 <= 2.0943951023931953)), t213, qb6_3)))
     t215 = qw1*(t58 + t202)**2 + qw2*(t59 + t206)**2 + qw3*(t60 + t210)**2 + qw4*(t61 + t214)**2
@@ -1864,19 +1862,19 @@ def _ik_nearest(mu, q_seed, weights):
     t223 = casadi.if_else(t219, t214, t197)
     t224 = casadi.if_else(t219, t215, t198)
     t225 = casadi.if_else((t36 < qn1), 6.283185307179586, -6.283185307179586)
-    t226 = t36 + t225
+    t226 = t225 + t36
     t227 = -t225 + t36
     t228 = casadi.if_else(casadi.logic_and((t36 >= -3.141592653589793), (t36 <= 3.141592653589793)), t36, casadi.if_else(casadi.logic_and((t226 >= -3.141592653589793), (t226 <= 3.141592653589793)), t226, casadi.if_else(casadi.logic_and((t227 >= -3.141592653589793), (t227 <= 3.141592653589793)), t227, qb7_0)))
     t229 = casadi.if_else((t37 < qn2), 6.283185307179586, -6.283185307179586)
-    t230 = t37 + t229
+    t230 = t229 + t37
     t231 = -t229 + t37
     t232 = casadi.if_else(casadi.logic_and((t37 >= -2.0943951023931953), (t37 <= 2.0943951023931953)), t37, casadi.if_else(casadi.logic_and((t230 >= -2.0943951023931953), (t230 <= 2.0943951023931953)), t230, casadi.if_else(casadi.logic_and((t231 >= -2.0943951023931953), (t231 <= 2.0943951023931953)), t231, qb7_1)))
     t233 = casadi.if_else((t38 < qn3), 6.283185307179586, -6.283185307179586)
-    t234 = t38 + t233
+    t234 = t233 + t38
     t235 = -t233 + t38
     t236 = casadi.if_else(casadi.logic_and((t38 >= -2.0943951023931953), (t38 <= 2.0943951023931953)), t38, casadi.if_else(casadi.logic_and((t234 >= -2.0943951023931953), (t234 <= 2.0943951023931953)), t234, casadi.if_else(casadi.logic_and((t235 >= -2.0943951023931953), (t235 <= 2.0943951023931953)), t235, qb7_2)))
     t237 = casadi.if_else((t39 < qn4), 6.283185307179586, -6.283185307179586)
-    t238 = t39 + t237
+    t238 = t237 + t39
     t239 = -t237 + t39
     t240 = casadi.if_else(casadi.logic_and((t39 >= -2.0943951023931953), (t39 <= 2.0943951023931953)), t39, casadi.if_else(casadi.logic_and((t238 >= -2.0943951023931953), (t238 <= 2.0943951023931953)), t238, casadi.if_else(casadi.logic_and((t239 >= -2.0943951023931953), (t239 <= 2.0943951023931953)), t239, qb7_3)))
     t241 = qw1*(t58 + t228)**2 + qw2*(t59 + t232)**2 + qw3*(t60 + t236)**2 + qw4*(t61 + t240)**2

@@ -123,9 +123,9 @@ def jacobian(q):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = t0 + 0.325*c1
+    t1 = 0.325*c1 + t0
     t2 = 0.275*s12
-    t3 = t2 + 0.325*s1
+    t3 = 0.325*s1 + t2
     J = _stack(xp, [
         -t3,  # 0, 0
         -t2,  # 0, 1
@@ -172,9 +172,9 @@ def fk_jacobian(q):
     t1 = c12*c4 + s12*s4
     t2 = s12*c4 - c12*s4
     t3 = 0.275*c12
-    t4 = t3 + 0.325*c1
+    t4 = 0.325*c1 + t3
     t5 = 0.275*s12
-    t6 = t5 + 0.325*s1
+    t6 = 0.325*s1 + t5
     T = _stack(xp, [
         t1,  # 0, 0
         t2,  # 0, 1
@@ -237,9 +237,9 @@ def jacobian_tool(q):
     t0 = c12*c4 + s12*s4
     t1 = s12*c4 - c12*s4
     t2 = 0.275*c12
-    t3 = t2 + 0.325*c1
+    t3 = 0.325*c1 + t2
     t4 = 0.275*s12
-    t5 = t4 + 0.325*s1
+    t5 = 0.325*s1 + t4
     J = _stack(xp, [
         t1*t3 - t0*t5,  # 0, 0
         -t0*t4 + t1*t2,  # 0, 1
@@ -307,9 +307,9 @@ def task_jacobian(q):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = t0 + 0.325*c1
+    t1 = 0.325*c1 + t0
     t2 = 0.275*s12
-    t3 = t2 + 0.325*s1
+    t3 = 0.325*s1 + t2
     J = _stack(xp, [
         -t3,  # 0, 0
         -t2,  # 0, 1
@@ -350,13 +350,13 @@ def fk_jacobian_dot(q, q_dot):
     t1 = c12*c4 + s12*s4
     t2 = s12*c4 - c12*s4
     t3 = 0.275*c12
-    t4 = t3 + 0.325*c1
+    t4 = 0.325*c1 + t3
     t5 = 0.275*s12
-    t6 = t5 + 0.325*s1
+    t6 = 0.325*s1 + t5
     t7 = t5*qd2
-    t8 = t7 + t6*qd1
+    t8 = t6*qd1 + t7
     t9 = t3*qd2
-    t10 = t9 + t4*qd1
+    t10 = t4*qd1 + t9
     T = _stack(xp, [
         xp.broadcast_to(t1, batch),  # 0, 0
         xp.broadcast_to(t2, batch),  # 0, 1
@@ -425,13 +425,13 @@ def jacobian_dot(q, q_dot):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = t0 + 0.325*c1
+    t1 = 0.325*c1 + t0
     t2 = 0.275*s12
-    t3 = t2 + 0.325*s1
+    t3 = 0.325*s1 + t2
     t4 = t2*qd2
-    t5 = t4 + t3*qd1
+    t5 = t3*qd1 + t4
     t6 = t0*qd2
-    t7 = t6 + t1*qd1
+    t7 = t1*qd1 + t6
     Jd = _stack(xp, [
         xp.broadcast_to(-t7, batch),  # 0, 0
         xp.broadcast_to(-(t6 + t0*qd1), batch),  # 0, 1
@@ -474,13 +474,13 @@ def bias_acceleration(q, q_dot):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = t0 + 0.325*c1
+    t1 = 0.325*c1 + t0
     t2 = 0.275*s12
-    t3 = t2 + 0.325*s1
+    t3 = 0.325*s1 + t2
     t4 = t2*qd2
-    t5 = t4 + t3*qd1
+    t5 = t3*qd1 + t4
     t6 = t0*qd2
-    t7 = t6 + t1*qd1
+    t7 = t1*qd1 + t6
     a = _stack(xp, [
         xp.broadcast_to(-qd1*t7 - qd2*(t6 + t0*qd1), batch),  # 0
         xp.broadcast_to(-qd1*t5 - qd2*(t4 + t2*qd1), batch),  # 1
@@ -505,14 +505,14 @@ def task_jacobian_dot(q, q_dot):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = t0 + 0.325*c1
+    t1 = 0.325*c1 + t0
     t2 = 0.275*s12
-    t3 = t2 + 0.325*s1
+    t3 = 0.325*s1 + t2
     t4 = t2*qd2
-    t5 = t4 + t3*qd1
+    t5 = t3*qd1 + t4
     t6 = t4 + t2*qd1
     t7 = t0*qd2
-    t8 = t7 + t1*qd1
+    t8 = t1*qd1 + t7
     t9 = t7 + t0*qd1
     Jd = _stack(xp, [
         xp.broadcast_to(-t8, batch),  # 0, 0
@@ -546,9 +546,9 @@ def hessian(q):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = t0 + 0.325*c1
+    t1 = 0.325*c1 + t0
     t2 = 0.275*s12
-    t3 = t2 + 0.325*s1
+    t3 = 0.325*s1 + t2
     t4 = -t0
     t5 = -t2
     H = _stack(xp, [
@@ -674,9 +674,9 @@ def manipulability(q):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = t0 + 0.325*c1
+    t1 = 0.325*c1 + t0
     t2 = 0.275*s12
-    t3 = t2 + 0.325*s1
+    t3 = 0.325*s1 + t2
     t4 = -t3*t0 + t1*t2
     w = xp.broadcast_to(xp.abs(t4), batch)
     return w
@@ -693,9 +693,9 @@ def jacobian_det(q):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = t0 + 0.325*c1
+    t1 = 0.325*c1 + t0
     t2 = 0.275*s12
-    t3 = t2 + 0.325*s1
+    t3 = 0.325*s1 + t2
     d = xp.broadcast_to(-t3*t0 + t1*t2, batch)
     return d
 
@@ -720,121 +720,121 @@ def velocity_ik(q, mu_dot, damping=0.0):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = t0 + 0.325*c1
+    t1 = 0.325*c1 + t0
     t2 = 0.275*s12
-    t3 = t2 + 0.325*s1
+    t3 = 0.325*s1 + t2
     t4 = t1*t3 + 0.075625*c12*s12
     t5 = t3 + t2
     t6 = t3**2
     t7 = t6 + 0.075625*s12**2
     t8 = t7
     t9 = t1**2
-    t10 = xp.sqrt(1 + t9 + t6)
+    t10 = xp.sqrt(1 + t6 + t9)
     t11 = t10*xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)
-    t12 = t9 + 0.075625*c12**2
-    t13 = t12
-    t14 = xp.sqrt(4 + t7 + t12)
-    t15 = t0 + t1
-    t16 = t15
-    t17 = t4**2
-    t18 = t5**2
-    t19 = damping**2
-    t20 = t19 + t8
-    t21 = t20**2
-    t22 = xp.sqrt(t17 + t18 + t21)
-    t23 = t22*xp.where(xp.greater_equal(t20, 0), xp.asarray(1, dtype=dtype), -1)
-    t24 = t23 + t20
-    t25 = xp.where(xp.greater(t22, 0), 1/(t22*(t22 + xp.abs(t20))), 0)
-    t26 = -t25*(-mu_dot0*t24 + mu_dot1*t4 + mu_dot3*t5)
-    t27 = mu_dot0 - t24*t26
-    t28 = mu_dot1 + t4*t26
-    t29 = mu_dot3 + t5*t26
-    t30 = t19 + t13
-    t31 = -t25*(t4*t24 + t4*t30 + t5*t16)
-    t32 = t4 + t24*t31
-    t33 = t4*t31 + t30
-    t34 = t16 + t5*t31
-    t35 = xp.sqrt(t33**2 + t34**2)
-    t36 = t35*xp.where(xp.greater_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)
-    t37 = t33 + t36
-    t38 = xp.where(xp.greater(t35, 0), 1/(t35*(t35 + xp.abs(t33))), 0)
-    t39 = t38*(t28*t37 + t34*t29)
-    t40 = t28 - t37*t39
-    t41 = t29 - t34*t39
-    t42 = 1 + t19
-    t43 = t42
-    t44 = 3 + t19
-    t45 = xp.sqrt(2*t17 + 2*t18 + 2*t16**2 + t21 + t30**2 + t42**2 + t44**2)
-    t46 = -t25*(t5*t24 + t4*t16 + t5*t44)
-    t47 = t5 + t24*t46
-    t48 = t16 + t4*t46
-    t49 = t5*t46 + t44
-    t50 = t38*(t48*t37 + t34*t49)
-    t51 = t48 - t37*t50
-    t52 = t49 - t34*t50
-    t53 = xp.abs(t43)
-    t54 = t53
-    t55 = t54*xp.where(xp.greater_equal(t43, 0), xp.asarray(1, dtype=dtype), -1)
-    t56 = t43 + t55
-    t57 = xp.where(xp.greater(t54, 0), 1/(t54*(t53 + t54)), 0)
-    t58 = mu_dot2 - mu_dot2*t56**2*t57
-    t59 = xp.where(xp.not_equal(t55, 0), -t58/t55, 0)
-    t60 = xp.abs(t52)
-    t61 = t60
-    t62 = t61*xp.where(xp.greater_equal(t52, 0), xp.asarray(1, dtype=dtype), -1)
-    t63 = t52 + t62
-    t64 = xp.where(xp.greater(t61, 0), 1/(t61*(t60 + t61)), 0)
-    t65 = t41 - t41*t63**2*t64
-    t66 = xp.where(xp.not_equal(t62, 0), -t65/t62, 0)
-    t67 = xp.where(xp.not_equal(t36, 0), -(t40 - t51*t66)/t36, 0)
-    t68 = xp.where(xp.not_equal(t23, 0), -(t27 + t32*t67 + t47*t66)/t23, 0)
-    t69 = t66 - t3*t68 + t1*t67
-    t70 = t66 - t2*t68 + t0*t67
-    t71 = -t3
-    t72 = t71 + t11
-    t73 = xp.where(xp.greater(t10, 0), 1/(t10*(t10 + xp.abs(t71))), 0)
-    t74 = t73*(1 - t2*t72 + t1*t0)
-    t75 = t2 + t72*t74
-    t76 = t0 - t1*t74
-    t77 = 1 - t74
-    t78 = -1 + t73
-    t79 = t73*(mu_dot3 + mu_dot0*t72 + t1*mu_dot1)
-    t80 = mu_dot0 - t72*t79
+    t12 = xp.where(xp.greater(t10, 0), 1/(t10*(t10 + xp.abs(t3))), 0)
+    t13 = -1 + t12
+    t14 = 0.075625*c12**2 + t9
+    t15 = t14
+    t16 = xp.sqrt(4 + t7 + t14)
+    t17 = t1 + t0
+    t18 = t17
+    t19 = t4**2
+    t20 = t5**2
+    t21 = damping**2
+    t22 = t8 + t21
+    t23 = t22**2
+    t24 = xp.sqrt(t19 + t20 + t23)
+    t25 = t24*xp.where(xp.greater_equal(t22, 0), xp.asarray(1, dtype=dtype), -1)
+    t26 = t25 + t22
+    t27 = xp.where(xp.greater(t24, 0), 1/(t24*(t24 + xp.abs(t22))), 0)
+    t28 = -t27*(-mu_dot0*t26 + mu_dot1*t4 + mu_dot3*t5)
+    t29 = mu_dot0 - t26*t28
+    t30 = mu_dot1 + t4*t28
+    t31 = mu_dot3 + t5*t28
+    t32 = t15 + t21
+    t33 = -t27*(t4*t26 + t5*t18 + t4*t32)
+    t34 = t4 + t26*t33
+    t35 = t4*t33 + t32
+    t36 = t18 + t5*t33
+    t37 = xp.sqrt(t35**2 + t36**2)
+    t38 = t37*xp.where(xp.greater_equal(t35, 0), xp.asarray(1, dtype=dtype), -1)
+    t39 = t35 + t38
+    t40 = xp.where(xp.greater(t37, 0), 1/(t37*(t37 + xp.abs(t35))), 0)
+    t41 = t40*(t30*t39 + t36*t31)
+    t42 = t30 - t39*t41
+    t43 = t31 - t36*t41
+    t44 = 1 + t21
+    t45 = t44
+    t46 = 3 + t21
+    t47 = xp.sqrt(2*t19 + 2*t20 + 2*t18**2 + t23 + t32**2 + t44**2 + t46**2)
+    t48 = -t27*(t5*t26 + t4*t18 + t5*t46)
+    t49 = t5 + t26*t48
+    t50 = t18 + t4*t48
+    t51 = t5*t48 + t46
+    t52 = t40*(t50*t39 + t36*t51)
+    t53 = t50 - t39*t52
+    t54 = t51 - t36*t52
+    t55 = xp.abs(t45)
+    t56 = t55
+    t57 = t56*xp.where(xp.greater_equal(t45, 0), xp.asarray(1, dtype=dtype), -1)
+    t58 = t45 + t57
+    t59 = xp.where(xp.greater(t56, 0), 1/(t56*(t56 + t55)), 0)
+    t60 = mu_dot2 - mu_dot2*t58**2*t59
+    t61 = xp.where(xp.not_equal(t57, 0), -t60/t57, 0)
+    t62 = xp.abs(t54)
+    t63 = t62
+    t64 = t63*xp.where(xp.greater_equal(t54, 0), xp.asarray(1, dtype=dtype), -1)
+    t65 = t54 + t64
+    t66 = xp.where(xp.greater(t63, 0), 1/(t63*(t63 + t62)), 0)
+    t67 = t43 - t43*t65**2*t66
+    t68 = xp.where(xp.not_equal(t64, 0), -t67/t64, 0)
+    t69 = xp.where(xp.not_equal(t38, 0), -(t42 - t53*t68)/t38, 0)
+    t70 = xp.where(xp.not_equal(t25, 0), -(t29 + t34*t69 + t49*t68)/t25, 0)
+    t71 = t68 - t3*t70 + t1*t69
+    t72 = t68 - t2*t70 + t0*t69
+    t73 = -t3
+    t74 = t11 + t73
+    t75 = t12*(1 - t2*t74 + t1*t0)
+    t76 = t2 + t74*t75
+    t77 = t0 - t1*t75
+    t78 = 1 - t75
+    t79 = t12*(mu_dot3 + mu_dot0*t74 + t1*mu_dot1)
+    t80 = mu_dot0 - t74*t79
     t81 = mu_dot1 - t1*t79
     t82 = -t79 + mu_dot3
-    t83 = xp.sqrt(t76**2 + t77**2)
-    t84 = t83*xp.where(xp.greater_equal(t76, 0), xp.asarray(1, dtype=dtype), -1)
-    t85 = t76 + t84
-    t86 = xp.where(xp.greater(t83, 0), 1/(t83*(t83 + xp.abs(t76))), 0)
-    t87 = t86*(t81*t85 + t77*t82)
+    t83 = xp.sqrt(t77**2 + t78**2)
+    t84 = t83*xp.where(xp.greater_equal(t77, 0), xp.asarray(1, dtype=dtype), -1)
+    t85 = t77 + t84
+    t86 = xp.where(xp.greater(t83, 0), 1/(t83*(t83 + xp.abs(t77))), 0)
+    t87 = t86*(t81*t85 + t78*t82)
     t88 = t81 - t85*t87
-    t89 = t82 - t77*t87
-    t90 = -t2 + q1 + q2 + q3 + q4 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + t15 + t71
-    t91 = t1*t73
-    t92 = t86*(t85*t91 + t77*t78)
-    t93 = t91 - t85*t92
-    t94 = t78 - t77*t92
+    t89 = t82 - t78*t87
+    t90 = -t2 + q1 + q2 + q3 + q4 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + t17 + t73
+    t91 = t1*t12
+    t92 = t86*(t78*t13 + t85*t91)
+    t93 = -t85*t92 + t91
+    t94 = t13 - t78*t92
     t95 = xp.abs(t94)
     t96 = t95
     t97 = t96*xp.where(xp.greater_equal(t94, 0), xp.asarray(1, dtype=dtype), -1)
     t98 = t94 + t97
-    t99 = xp.where(xp.greater(t96, 0), 1/(t96*(t95 + t96)), 0)
+    t99 = xp.where(xp.greater(t96, 0), 1/(t96*(t96 + t95)), 0)
     t100 = t89 - t89*t98**2*t99
     t101 = xp.where(xp.not_equal(t97, 0), -t100/t97, 0)
     t102 = xp.where(xp.not_equal(t84, 0), -(t88 - t93*t101)/t84, 0)
-    t103 = xp.where(xp.not_equal(t11, 0), -(-(-t75*t102 + t72*t73*t101) + t80)/t11, 0)
+    t103 = xp.where(xp.not_equal(t11, 0), -(-(-t76*t102 + t74*t12*t101) + t80)/t11, 0)
     t104 = xp.isfinite(t90)
     t105 = xp.greater_equal(damping, 0)
     t106 = xp.greater(damping, 0)
-    t107 = 1e-12*t45
-    t108 = 1e-12*t14
-    t109 = (t106 & (xp.less_equal(t22, t107) | xp.less_equal(t35, t107) | xp.less_equal(t54, t107) | xp.less_equal(t61, t107))) | (xp.less_equal(damping, 0) & (xp.less_equal(t10, t108) | xp.less_equal(t83, t108) | xp.less_equal(1, t108) | xp.less_equal(t96, t108)))
+    t107 = 1e-12*t47
+    t108 = 1e-12*t16
+    t109 = (t106 & (xp.less_equal(t24, t107) | xp.less_equal(t37, t107) | xp.less_equal(t56, t107) | xp.less_equal(t63, t107))) | (xp.less_equal(damping, 0) & (xp.less_equal(t10, t108) | xp.less_equal(t83, t108) | xp.less_equal(1, t108) | xp.less_equal(t96, t108)))
     t110 = t104 & t105 & xp.logical_not(t109)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t110, xp.where(t106, t69, t103), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t110, xp.where(t106, t70, t102), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t110, xp.where(t106, -t59, -mu_dot2), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t110, xp.where(t106, -t66, t101), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t110, xp.where(t106, t71, t103), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t110, xp.where(t106, t72, t102), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t110, xp.where(t106, -t61, -mu_dot2), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t110, xp.where(t106, -t68, t101), 0), batch),  # 3
     ], (4,))
     status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t104 & t105), 2, xp.where(t109, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
@@ -871,12 +871,12 @@ def ik_numeric_step(target, q, damping=0.0):
     t4 = 1 + damping
     t5 = qs1 + qs2 + qs3 + qs4 + mu3 + mu0 + mu1 + mu2
     t6 = 0.275*c12
-    t7 = t6 + 0.325*c1
+    t7 = 0.325*c1 + t6
     t8 = t7**2 + 0.075625*c12**2
-    t9 = t6 + t7
+    t9 = t7 + t6
     t10 = -t7 + mu0
     t11 = 0.275*s12
-    t12 = t11 + 0.325*s1
+    t12 = 0.325*s1 + t11
     t13 = t12**2 + 0.075625*s12**2
     t14 = t7*t12 + 0.075625*c12*s12
     t15 = t12 + t11
@@ -885,7 +885,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t18 = t17 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t17))
     t19 = t10**2 + t16**2 + t3**2 + t18**2
     t20 = damping + t13
-    t21 = xp.sqrt(t14**2 + t15**2 + t20**2)
+    t21 = xp.sqrt(t20**2 + t14**2 + t15**2)
     t22 = t21*xp.where(xp.greater_equal(t20, 0), xp.asarray(1, dtype=dtype), -1)
     t23 = t20 + t22
     t24 = xp.where(xp.greater(t21, 0), 1/(t21*(t21 + xp.abs(t20))), 0)
@@ -985,24 +985,24 @@ def ik_branches(mu):
     t25 = t17*mu0
     t26 = t24 + t25
     t27 = t21**2 + t26**2
-    t28 = t24 - t25
+    t28 = -t25 + t24
     t29 = t23**2 + t28**2
     t30 = 1e-24*t0*t12
     t31 = xp.where(xp.less_equal(t27, t30), 0, xp.atan2(t26, t21))
     t32 = t31
     t33 = -6.283185307179586*xp.floor(0.15915494309189535*(0.8726646259971648 + t32)) + t32
     t34 = -mu3
-    t35 = -(t31 + t9 + t34)
+    t35 = -(t31 + t34 + t9)
     t36 = t35 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t35))
     t37 = -t36
-    t38 = t36 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t37))
+    t38 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t37)) + t36
     t39 = xp.where(xp.less_equal(t29, t30), 0, xp.atan2(t28, t23))
     t40 = t39
     t41 = -6.283185307179586*xp.floor(0.15915494309189535*(0.8726646259971648 + t40)) + t40
-    t42 = -(t39 + t10 + t34)
+    t42 = -(t34 + t39 + t10)
     t43 = t42 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t42))
     t44 = -t43
-    t45 = t43 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t44))
+    t45 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t44)) + t43
     t46 = xp.greater_equal(t32, -0.8726646259971648) & xp.less_equal(t32, 0.8726646259971648)
     t47 = xp.less_equal(t33, 0.8726646259971648)
     t48 = xp.greater_equal(t13, -1.53588974175501) & xp.less_equal(t13, 1.53588974175501)
@@ -1083,15 +1083,15 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t8 = xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0)
     t9 = mu3 + mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
     t10 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t11 = t0 + t10
+    t11 = t10 + t0
     t12 = -t10 + t0
     t13 = xp.where(xp.greater_equal(t0, -0.8726646259971648) & xp.less_equal(t0, 0.8726646259971648), t0, xp.where(xp.greater_equal(t11, -0.8726646259971648) & xp.less_equal(t11, 0.8726646259971648), t11, xp.where(xp.greater_equal(t12, -0.8726646259971648) & xp.less_equal(t12, 0.8726646259971648), t12, qb0_0)))
     t14 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t15 = t1 + t14
+    t15 = t14 + t1
     t16 = -t14 + t1
     t17 = xp.where(xp.greater_equal(t1, -1.53588974175501) & xp.less_equal(t1, 1.53588974175501), t1, xp.where(xp.greater_equal(t15, -1.53588974175501) & xp.less_equal(t15, 1.53588974175501), t15, xp.where(xp.greater_equal(t16, -1.53588974175501) & xp.less_equal(t16, 1.53588974175501), t16, qb0_1)))
     t18 = xp.where(xp.less(t2, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t19 = t2 + t18
+    t19 = t18 + t2
     t20 = -t18 + t2
     t21 = xp.where(xp.greater_equal(t2, -6.283185307179586) & xp.less_equal(t2, 6.283185307179586), t2, xp.where(xp.greater_equal(t19, -6.283185307179586) & xp.less_equal(t19, 6.283185307179586), t19, xp.where(xp.greater_equal(t20, -6.283185307179586) & xp.less_equal(t20, 6.283185307179586), t20, qb0_3)))
     t22 = -qn1
@@ -1106,15 +1106,15 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     t31 = xp.where(t27, t21, qn4)
     t32 = xp.where(t27, t26, 0)
     t33 = xp.where(xp.less(t5, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t34 = t5 + t33
+    t34 = t33 + t5
     t35 = -t33 + t5
     t36 = xp.where(xp.greater_equal(t5, -0.8726646259971648) & xp.less_equal(t5, 0.8726646259971648), t5, xp.where(xp.greater_equal(t34, -0.8726646259971648) & xp.less_equal(t34, 0.8726646259971648), t34, xp.where(xp.greater_equal(t35, -0.8726646259971648) & xp.less_equal(t35, 0.8726646259971648), t35, qb1_0)))
     t37 = xp.where(xp.less(t6, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t38 = t6 + t37
+    t38 = t37 + t6
     t39 = -t37 + t6
     t40 = xp.where(xp.greater_equal(t6, -1.53588974175501) & xp.less_equal(t6, 1.53588974175501), t6, xp.where(xp.greater_equal(t38, -1.53588974175501) & xp.less_equal(t38, 1.53588974175501), t38, xp.where(xp.greater_equal(t39, -1.53588974175501) & xp.less_equal(t39, 1.53588974175501), t39, qb1_1)))
     t41 = xp.where(xp.less(t7, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t42 = t7 + t41
+    t42 = t41 + t7
     t43 = -t41 + t7
     t44 = xp.where(xp.greater_equal(t7, -6.283185307179586) & xp.less_equal(t7, 6.283185307179586), t7, xp.where(xp.greater_equal(t42, -6.283185307179586) & xp.less_equal(t42, 6.283185307179586), t42, xp.where(xp.greater_equal(t43, -6.283185307179586) & xp.less_equal(t43, 6.283185307179586), t43, qb1_3)))
     t45 = qw1*(t22 + t36)**2 + qw2*(t23 + t40)**2 + qw3*(t24 + qb1_2)**2 + qw4*(t25 + t44)**2

@@ -59,9 +59,9 @@ def _jacobian(q):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = t0 + 0.325*c1
+    t1 = 0.325*c1 + t0
     t2 = 0.275*s12
-    t3 = t2 + 0.325*s1
+    t3 = 0.325*s1 + t2
     J = casadi.SX(6, 4)
     J[0, 0] = -t3
     J[0, 1] = -t2
@@ -92,9 +92,9 @@ def _fk_jacobian(q):
     t1 = c12*c4 + s12*s4
     t2 = s12*c4 - c12*s4
     t3 = 0.275*c12
-    t4 = t3 + 0.325*c1
+    t4 = 0.325*c1 + t3
     t5 = 0.275*s12
-    t6 = t5 + 0.325*s1
+    t6 = 0.325*s1 + t5
     T = casadi.SX(4, 4)
     T[0, 0] = t1
     T[0, 1] = t2
@@ -133,9 +133,9 @@ def _jacobian_tool(q):
     t0 = c12*c4 + s12*s4
     t1 = s12*c4 - c12*s4
     t2 = 0.275*c12
-    t3 = t2 + 0.325*c1
+    t3 = 0.325*c1 + t2
     t4 = 0.275*s12
-    t5 = t4 + 0.325*s1
+    t5 = 0.325*s1 + t4
     J = casadi.SX(6, 4)
     J[0, 0] = t1*t3 - t0*t5
     J[0, 1] = -t0*t4 + t1*t2
@@ -186,9 +186,9 @@ def _task_jacobian(q):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = t0 + 0.325*c1
+    t1 = 0.325*c1 + t0
     t2 = 0.275*s12
-    t3 = t2 + 0.325*s1
+    t3 = 0.325*s1 + t2
     J = casadi.SX(4, 4)
     J[0, 0] = -t3
     J[0, 1] = -t2
@@ -221,13 +221,13 @@ def _fk_jacobian_dot(q, q_dot):
     t1 = c12*c4 + s12*s4
     t2 = s12*c4 - c12*s4
     t3 = 0.275*c12
-    t4 = t3 + 0.325*c1
+    t4 = 0.325*c1 + t3
     t5 = 0.275*s12
-    t6 = t5 + 0.325*s1
+    t6 = 0.325*s1 + t5
     t7 = t5*qd2
-    t8 = t7 + t6*qd1
+    t8 = t6*qd1 + t7
     t9 = t3*qd2
-    t10 = t9 + t4*qd1
+    t10 = t4*qd1 + t9
     T = casadi.SX(4, 4)
     T[0, 0] = t1
     T[0, 1] = t2
@@ -266,13 +266,13 @@ def _jacobian_dot(q, q_dot):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = t0 + 0.325*c1
+    t1 = 0.325*c1 + t0
     t2 = 0.275*s12
-    t3 = t2 + 0.325*s1
+    t3 = 0.325*s1 + t2
     t4 = t2*qd2
-    t5 = t4 + t3*qd1
+    t5 = t3*qd1 + t4
     t6 = t0*qd2
-    t7 = t6 + t1*qd1
+    t7 = t1*qd1 + t6
     Jd = casadi.SX(6, 4)
     Jd[0, 0] = -t7
     Jd[0, 1] = -(t6 + t0*qd1)
@@ -294,13 +294,13 @@ def _bias_acceleration(q, q_dot):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = t0 + 0.325*c1
+    t1 = 0.325*c1 + t0
     t2 = 0.275*s12
-    t3 = t2 + 0.325*s1
+    t3 = 0.325*s1 + t2
     t4 = t2*qd2
-    t5 = t4 + t3*qd1
+    t5 = t3*qd1 + t4
     t6 = t0*qd2
-    t7 = t6 + t1*qd1
+    t7 = t1*qd1 + t6
     a = casadi.SX(6, 1)
     a[0, 0] = -qd1*t7 - qd2*(t6 + t0*qd1)
     a[1, 0] = -qd1*t5 - qd2*(t4 + t2*qd1)
@@ -320,14 +320,14 @@ def _task_jacobian_dot(q, q_dot):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = t0 + 0.325*c1
+    t1 = 0.325*c1 + t0
     t2 = 0.275*s12
-    t3 = t2 + 0.325*s1
+    t3 = 0.325*s1 + t2
     t4 = t2*qd2
-    t5 = t4 + t3*qd1
+    t5 = t3*qd1 + t4
     t6 = t4 + t2*qd1
     t7 = t0*qd2
-    t8 = t7 + t1*qd1
+    t8 = t1*qd1 + t7
     t9 = t7 + t0*qd1
     Jd = casadi.SX(4, 4)
     Jd[0, 0] = -t8
@@ -348,9 +348,9 @@ def _hessian(q):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = t0 + 0.325*c1
+    t1 = 0.325*c1 + t0
     t2 = 0.275*s12
-    t3 = t2 + 0.325*s1
+    t3 = 0.325*s1 + t2
     t4 = -t0
     t5 = -t2
     H = casadi.SX(24, 4)
@@ -385,9 +385,9 @@ def _manipulability(q):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = t0 + 0.325*c1
+    t1 = 0.325*c1 + t0
     t2 = 0.275*s12
-    t3 = t2 + 0.325*s1
+    t3 = 0.325*s1 + t2
     t4 = -t3*t0 + t1*t2
     w = casadi.SX(1, 1)
     w[0, 0] = casadi.fabs(t4)
@@ -405,9 +405,9 @@ def _jacobian_det(q):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = t0 + 0.325*c1
+    t1 = 0.325*c1 + t0
     t2 = 0.275*s12
-    t3 = t2 + 0.325*s1
+    t3 = 0.325*s1 + t2
     d = casadi.SX(1, 1)
     d[0, 0] = -t3*t0 + t1*t2
     return [d]
@@ -430,121 +430,121 @@ def _velocity_ik(q, mu_dot, damping):
     c12 = c1*c2 - s1*s2
     s12 = c1*s2 + c2*s1
     t0 = 0.275*c12
-    t1 = t0 + 0.325*c1
+    t1 = 0.325*c1 + t0
     t2 = 0.275*s12
-    t3 = t2 + 0.325*s1
+    t3 = 0.325*s1 + t2
     t4 = t1*t3 + 0.075625*c12*s12
     t5 = t3 + t2
     t6 = t3**2
     t7 = t6 + 0.075625*s12**2
     t8 = t7
     t9 = t1**2
-    t10 = casadi.sqrt(1 + t9 + t6)
+    t10 = casadi.sqrt(1 + t6 + t9)
     t11 = t10*casadi.if_else((t3 <= 0), 1, -1)
-    t12 = t9 + 0.075625*c12**2
-    t13 = t12
-    t14 = casadi.sqrt(4 + t7 + t12)
-    t15 = t0 + t1
-    t16 = t15
-    t17 = t4**2
-    t18 = t5**2
-    t19 = damping**2
-    t20 = t19 + t8
-    t21 = t20**2
-    t22 = casadi.sqrt(t17 + t18 + t21)
-    t23 = t22*casadi.if_else((t20 >= 0), 1, -1)
-    t24 = t23 + t20
-    t25 = casadi.if_else((t22 > 0), 1/(t22*(t22 + casadi.fabs(t20))), 0)
-    t26 = -t25*(-mu_dot0*t24 + mu_dot1*t4 + mu_dot3*t5)
-    t27 = mu_dot0 - t24*t26
-    t28 = mu_dot1 + t4*t26
-    t29 = mu_dot3 + t5*t26
-    t30 = t19 + t13
-    t31 = -t25*(t4*t24 + t4*t30 + t5*t16)
-    t32 = t4 + t24*t31
-    t33 = t4*t31 + t30
-    t34 = t16 + t5*t31
-    t35 = casadi.sqrt(t33**2 + t34**2)
-    t36 = t35*casadi.if_else((t33 >= 0), 1, -1)
-    t37 = t33 + t36
-    t38 = casadi.if_else((t35 > 0), 1/(t35*(t35 + casadi.fabs(t33))), 0)
-    t39 = t38*(t28*t37 + t34*t29)
-    t40 = t28 - t37*t39
-    t41 = t29 - t34*t39
-    t42 = 1 + t19
-    t43 = t42
-    t44 = 3 + t19
-    t45 = casadi.sqrt(2*t17 + 2*t18 + 2*t16**2 + t21 + t30**2 + t42**2 + t44**2)
-    t46 = -t25*(t5*t24 + t4*t16 + t5*t44)
-    t47 = t5 + t24*t46
-    t48 = t16 + t4*t46
-    t49 = t5*t46 + t44
-    t50 = t38*(t48*t37 + t34*t49)
-    t51 = t48 - t37*t50
-    t52 = t49 - t34*t50
-    t53 = casadi.fabs(t43)
-    t54 = t53
-    t55 = t54*casadi.if_else((t43 >= 0), 1, -1)
-    t56 = t43 + t55
-    t57 = casadi.if_else((t54 > 0), 1/(t54*(t53 + t54)), 0)
-    t58 = mu_dot2 - mu_dot2*t56**2*t57
-    t59 = casadi.if_else((t55 != 0), -t58/t55, 0)
-    t60 = casadi.fabs(t52)
-    t61 = t60
-    t62 = t61*casadi.if_else((t52 >= 0), 1, -1)
-    t63 = t52 + t62
-    t64 = casadi.if_else((t61 > 0), 1/(t61*(t60 + t61)), 0)
-    t65 = t41 - t41*t63**2*t64
-    t66 = casadi.if_else((t62 != 0), -t65/t62, 0)
-    t67 = casadi.if_else((t36 != 0), -(t40 - t51*t66)/t36, 0)
-    t68 = casadi.if_else((t23 != 0), -(t27 + t32*t67 + t47*t66)/t23, 0)
-    t69 = t66 - t3*t68 + t1*t67
-    t70 = t66 - t2*t68 + t0*t67
-    t71 = -t3
-    t72 = t71 + t11
-    t73 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t71))), 0)
-    t74 = t73*(1 - t2*t72 + t1*t0)
-    t75 = t2 + t72*t74
-    t76 = t0 - t1*t74
-    t77 = 1 - t74
-    t78 = -1 + t73
-    t79 = t73*(mu_dot3 + mu_dot0*t72 + t1*mu_dot1)
-    t80 = mu_dot0 - t72*t79
+    t12 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t3))), 0)
+    t13 = -1 + t12
+    t14 = 0.075625*c12**2 + t9
+    t15 = t14
+    t16 = casadi.sqrt(4 + t7 + t14)
+    t17 = t1 + t0
+    t18 = t17
+    t19 = t4**2
+    t20 = t5**2
+    t21 = damping**2
+    t22 = t8 + t21
+    t23 = t22**2
+    t24 = casadi.sqrt(t19 + t20 + t23)
+    t25 = t24*casadi.if_else((t22 >= 0), 1, -1)
+    t26 = t25 + t22
+    t27 = casadi.if_else((t24 > 0), 1/(t24*(t24 + casadi.fabs(t22))), 0)
+    t28 = -t27*(-mu_dot0*t26 + mu_dot1*t4 + mu_dot3*t5)
+    t29 = mu_dot0 - t26*t28
+    t30 = mu_dot1 + t4*t28
+    t31 = mu_dot3 + t5*t28
+    t32 = t15 + t21
+    t33 = -t27*(t4*t26 + t5*t18 + t4*t32)
+    t34 = t4 + t26*t33
+    t35 = t4*t33 + t32
+    t36 = t18 + t5*t33
+    t37 = casadi.sqrt(t35**2 + t36**2)
+    t38 = t37*casadi.if_else((t35 >= 0), 1, -1)
+    t39 = t35 + t38
+    t40 = casadi.if_else((t37 > 0), 1/(t37*(t37 + casadi.fabs(t35))), 0)
+    t41 = t40*(t30*t39 + t36*t31)
+    t42 = t30 - t39*t41
+    t43 = t31 - t36*t41
+    t44 = 1 + t21
+    t45 = t44
+    t46 = 3 + t21
+    t47 = casadi.sqrt(2*t19 + 2*t20 + 2*t18**2 + t23 + t32**2 + t44**2 + t46**2)
+    t48 = -t27*(t5*t26 + t4*t18 + t5*t46)
+    t49 = t5 + t26*t48
+    t50 = t18 + t4*t48
+    t51 = t5*t48 + t46
+    t52 = t40*(t50*t39 + t36*t51)
+    t53 = t50 - t39*t52
+    t54 = t51 - t36*t52
+    t55 = casadi.fabs(t45)
+    t56 = t55
+    t57 = t56*casadi.if_else((t45 >= 0), 1, -1)
+    t58 = t45 + t57
+    t59 = casadi.if_else((t56 > 0), 1/(t56*(t56 + t55)), 0)
+    t60 = mu_dot2 - mu_dot2*t58**2*t59
+    t61 = casadi.if_else((t57 != 0), -t60/t57, 0)
+    t62 = casadi.fabs(t54)
+    t63 = t62
+    t64 = t63*casadi.if_else((t54 >= 0), 1, -1)
+    t65 = t54 + t64
+    t66 = casadi.if_else((t63 > 0), 1/(t63*(t63 + t62)), 0)
+    t67 = t43 - t43*t65**2*t66
+    t68 = casadi.if_else((t64 != 0), -t67/t64, 0)
+    t69 = casadi.if_else((t38 != 0), -(t42 - t53*t68)/t38, 0)
+    t70 = casadi.if_else((t25 != 0), -(t29 + t34*t69 + t49*t68)/t25, 0)
+    t71 = t68 - t3*t70 + t1*t69
+    t72 = t68 - t2*t70 + t0*t69
+    t73 = -t3
+    t74 = t11 + t73
+    t75 = t12*(1 - t2*t74 + t1*t0)
+    t76 = t2 + t74*t75
+    t77 = t0 - t1*t75
+    t78 = 1 - t75
+    t79 = t12*(mu_dot3 + mu_dot0*t74 + t1*mu_dot1)
+    t80 = mu_dot0 - t74*t79
     t81 = mu_dot1 - t1*t79
     t82 = -t79 + mu_dot3
-    t83 = casadi.sqrt(t76**2 + t77**2)
-    t84 = t83*casadi.if_else((t76 >= 0), 1, -1)
-    t85 = t76 + t84
-    t86 = casadi.if_else((t83 > 0), 1/(t83*(t83 + casadi.fabs(t76))), 0)
-    t87 = t86*(t81*t85 + t77*t82)
+    t83 = casadi.sqrt(t77**2 + t78**2)
+    t84 = t83*casadi.if_else((t77 >= 0), 1, -1)
+    t85 = t77 + t84
+    t86 = casadi.if_else((t83 > 0), 1/(t83*(t83 + casadi.fabs(t77))), 0)
+    t87 = t86*(t81*t85 + t78*t82)
     t88 = t81 - t85*t87
-    t89 = t82 - t77*t87
-    t90 = -t2 + q1 + q2 + q3 + q4 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + t15 + t71
-    t91 = t1*t73
-    t92 = t86*(t85*t91 + t77*t78)
-    t93 = t91 - t85*t92
-    t94 = t78 - t77*t92
+    t89 = t82 - t78*t87
+    t90 = -t2 + q1 + q2 + q3 + q4 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + t17 + t73
+    t91 = t1*t12
+    t92 = t86*(t78*t13 + t85*t91)
+    t93 = -t85*t92 + t91
+    t94 = t13 - t78*t92
     t95 = casadi.fabs(t94)
     t96 = t95
     t97 = t96*casadi.if_else((t94 >= 0), 1, -1)
     t98 = t94 + t97
-    t99 = casadi.if_else((t96 > 0), 1/(t96*(t95 + t96)), 0)
+    t99 = casadi.if_else((t96 > 0), 1/(t96*(t96 + t95)), 0)
     t100 = t89 - t89*t98**2*t99
     t101 = casadi.if_else((t97 != 0), -t100/t97, 0)
     t102 = casadi.if_else((t84 != 0), -(t88 - t93*t101)/t84, 0)
-    t103 = casadi.if_else((t11 != 0), -(-(-t75*t102 + t72*t73*t101) + t80)/t11, 0)
+    t103 = casadi.if_else((t11 != 0), -(-(-t76*t102 + t74*t12*t101) + t80)/t11, 0)
     t104 = (casadi.fabs(t90) < casadi.inf)
     t105 = (damping >= 0)
     t106 = (damping > 0)
-    t107 = 1e-12*t45
-    t108 = 1e-12*t14
-    t109 = casadi.logic_or(casadi.logic_and(t106, casadi.logic_or(casadi.logic_or(casadi.logic_or((t22 <= t107), (t35 <= t107)), (t54 <= t107)), (t61 <= t107))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t10 <= t108), (t83 <= t108)), (1 <= t108)), (t96 <= t108))))
+    t107 = 1e-12*t47
+    t108 = 1e-12*t16
+    t109 = casadi.logic_or(casadi.logic_and(t106, casadi.logic_or(casadi.logic_or(casadi.logic_or((t24 <= t107), (t37 <= t107)), (t56 <= t107)), (t63 <= t107))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t10 <= t108), (t83 <= t108)), (1 <= t108)), (t96 <= t108))))
     t110 = casadi.logic_and(casadi.logic_and(t104, t105), casadi.logic_not(t109))
     q_dot = casadi.SX(4, 1)
-    q_dot[0, 0] = casadi.if_else(t110, casadi.if_else(t106, t69, t103), 0)
-    q_dot[1, 0] = casadi.if_else(t110, casadi.if_else(t106, t70, t102), 0)
-    q_dot[2, 0] = casadi.if_else(t110, casadi.if_else(t106, -t59, -mu_dot2), 0)
-    q_dot[3, 0] = casadi.if_else(t110, casadi.if_else(t106, -t66, t101), 0)
+    q_dot[0, 0] = casadi.if_else(t110, casadi.if_else(t106, t71, t103), 0)
+    q_dot[1, 0] = casadi.if_else(t110, casadi.if_else(t106, t72, t102), 0)
+    q_dot[2, 0] = casadi.if_else(t110, casadi.if_else(t106, -t61, -mu_dot2), 0)
+    q_dot[3, 0] = casadi.if_else(t110, casadi.if_else(t106, -t68, t101), 0)
     status = casadi.SX(1, 1)
     status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t104, t105)), 2, casadi.if_else(t109, 1, 0))
     return [q_dot, status]
@@ -579,12 +579,12 @@ def _ik_numeric_step(target, q, damping):
     t4 = 1 + damping
     t5 = qs1 + qs2 + qs3 + qs4 + mu3 + mu0 + mu1 + mu2
     t6 = 0.275*c12
-    t7 = t6 + 0.325*c1
+    t7 = 0.325*c1 + t6
     t8 = t7**2 + 0.075625*c12**2
-    t9 = t6 + t7
+    t9 = t7 + t6
     t10 = -t7 + mu0
     t11 = 0.275*s12
-    t12 = t11 + 0.325*s1
+    t12 = 0.325*s1 + t11
     t13 = t12**2 + 0.075625*s12**2
     t14 = t7*t12 + 0.075625*c12*s12
     t15 = t12 + t11
@@ -593,7 +593,7 @@ def _ik_numeric_step(target, q, damping):
     t18 = t17 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t17))
     t19 = t10**2 + t16**2 + t3**2 + t18**2
     t20 = damping + t13
-    t21 = casadi.sqrt(t14**2 + t15**2 + t20**2)
+    t21 = casadi.sqrt(t20**2 + t14**2 + t15**2)
     t22 = t21*casadi.if_else((t20 >= 0), 1, -1)
     t23 = t20 + t22
     t24 = casadi.if_else((t21 > 0), 1/(t21*(t21 + casadi.fabs(t20))), 0)
@@ -690,24 +690,24 @@ def _ik_branches(mu):
     t25 = t17*mu0
     t26 = t24 + t25
     t27 = t21**2 + t26**2
-    t28 = t24 - t25
+    t28 = -t25 + t24
     t29 = t23**2 + t28**2
     t30 = 1e-24*t0*t12
     t31 = casadi.if_else((t27 <= t30), 0, casadi.atan2(t26, t21))
     t32 = t31
     t33 = -6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t32)) + t32
     t34 = -mu3
-    t35 = -(t31 + t9 + t34)
+    t35 = -(t31 + t34 + t9)
     t36 = t35 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t35))
     t37 = -t36
-    t38 = t36 + 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t37))
+    t38 = 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t37)) + t36
     t39 = casadi.if_else((t29 <= t30), 0, casadi.atan2(t28, t23))
     t40 = t39
     t41 = -6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t40)) + t40
-    t42 = -(t39 + t10 + t34)
+    t42 = -(t34 + t39 + t10)
     t43 = t42 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t42))
     t44 = -t43
-    t45 = t43 + 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t44))
+    t45 = 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t44)) + t43
     t46 = casadi.logic_and((t32 >= -0.8726646259971648), (t32 <= 0.8726646259971648))
     t47 = (t33 <= 0.8726646259971648)
     t48 = casadi.logic_and((t13 >= -1.53588974175501), (t13 <= 1.53588974175501))
@@ -783,15 +783,15 @@ def _ik_nearest(mu, q_seed, weights):
     t8 = casadi.if_else(casadi.logic_and(vb1, lb1), 1, 0)
     t9 = mu3 + mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
     t10 = casadi.if_else((t0 < qn1), 6.283185307179586, -6.283185307179586)
-    t11 = t0 + t10
+    t11 = t10 + t0
     t12 = -t10 + t0
     t13 = casadi.if_else(casadi.logic_and((t0 >= -0.8726646259971648), (t0 <= 0.8726646259971648)), t0, casadi.if_else(casadi.logic_and((t11 >= -0.8726646259971648), (t11 <= 0.8726646259971648)), t11, casadi.if_else(casadi.logic_and((t12 >= -0.8726646259971648), (t12 <= 0.8726646259971648)), t12, qb0_0)))
     t14 = casadi.if_else((t1 < qn2), 6.283185307179586, -6.283185307179586)
-    t15 = t1 + t14
+    t15 = t14 + t1
     t16 = -t14 + t1
     t17 = casadi.if_else(casadi.logic_and((t1 >= -1.53588974175501), (t1 <= 1.53588974175501)), t1, casadi.if_else(casadi.logic_and((t15 >= -1.53588974175501), (t15 <= 1.53588974175501)), t15, casadi.if_else(casadi.logic_and((t16 >= -1.53588974175501), (t16 <= 1.53588974175501)), t16, qb0_1)))
     t18 = casadi.if_else((t2 < qn4), 6.283185307179586, -6.283185307179586)
-    t19 = t2 + t18
+    t19 = t18 + t2
     t20 = -t18 + t2
     t21 = casadi.if_else(casadi.logic_and((t2 >= -6.283185307179586), (t2 <= 6.283185307179586)), t2, casadi.if_else(casadi.logic_and((t19 >= -6.283185307179586), (t19 <= 6.283185307179586)), t19, casadi.if_else(casadi.logic_and((t20 >= -6.283185307179586), (t20 <= 6.283185307179586)), t20, qb0_3)))
     t22 = -qn1
@@ -806,15 +806,15 @@ def _ik_nearest(mu, q_seed, weights):
     t31 = casadi.if_else(t27, t21, qn4)
     t32 = casadi.if_else(t27, t26, 0)
     t33 = casadi.if_else((t5 < qn1), 6.283185307179586, -6.283185307179586)
-    t34 = t5 + t33
+    t34 = t33 + t5
     t35 = -t33 + t5
     t36 = casadi.if_else(casadi.logic_and((t5 >= -0.8726646259971648), (t5 <= 0.8726646259971648)), t5, casadi.if_else(casadi.logic_and((t34 >= -0.8726646259971648), (t34 <= 0.8726646259971648)), t34, casadi.if_else(casadi.logic_and((t35 >= -0.8726646259971648), (t35 <= 0.8726646259971648)), t35, qb1_0)))
     t37 = casadi.if_else((t6 < qn2), 6.283185307179586, -6.283185307179586)
-    t38 = t6 + t37
+    t38 = t37 + t6
     t39 = -t37 + t6
     t40 = casadi.if_else(casadi.logic_and((t6 >= -1.53588974175501), (t6 <= 1.53588974175501)), t6, casadi.if_else(casadi.logic_and((t38 >= -1.53588974175501), (t38 <= 1.53588974175501)), t38, casadi.if_else(casadi.logic_and((t39 >= -1.53588974175501), (t39 <= 1.53588974175501)), t39, qb1_1)))
     t41 = casadi.if_else((t7 < qn4), 6.283185307179586, -6.283185307179586)
-    t42 = t7 + t41
+    t42 = t41 + t7
     t43 = -t41 + t7
     t44 = casadi.if_else(casadi.logic_and((t7 >= -6.283185307179586), (t7 <= 6.283185307179586)), t7, casadi.if_else(casadi.logic_and((t42 >= -6.283185307179586), (t42 <= 6.283185307179586)), t42, casadi.if_else(casadi.logic_and((t43 >= -6.283185307179586), (t43 <= 6.283185307179586)), t43, qb1_3)))
     t45 = qw1*(t22 + t36)**2 + qw2*(t23 + t40)**2 + qw3*(t24 + qb1_2)**2 + qw4*(t25 + t44)**2

@@ -158,7 +158,7 @@ def jacobian(q):
     t5 = s1*c4
     t6 = c1*s4
     t7 = t5 + c2*t6
-    t8 = t6 + c2*t5
+    t8 = c2*t5 + t6
     t9 = t7*s5 + c5*t1
     t10 = s1*s4
     t11 = c1*c4
@@ -470,7 +470,7 @@ def task_jacobian(q):
     t4 = s1*c4
     t5 = c1*s4
     t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
+    t7 = c2*t4 + t5
     t8 = t6*c5 - s5*t0
     t9 = t6*s5 + c5*t0
     t10 = s1*s4
@@ -663,12 +663,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t43, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t37 + qd2*(-t45*qd1 + c1*t32) + qd3*t46, batch),  # 0
-        xp.broadcast_to(qd1*t42 + qd2*(t44*qd1 + s1*t32) + qd3*t47, batch),  # 1
+        xp.broadcast_to(-qd1*t37 + qd2*(c1*t32 - t45*qd1) + t46*qd3, batch),  # 0
+        xp.broadcast_to(qd1*t42 + qd2*(s1*t32 + t44*qd1) + qd3*t47, batch),  # 1
         xp.broadcast_to(-qd2*(s1*t36 + c1*t41) + qd3*t49, batch),  # 2
-        xp.broadcast_to(-t38*qd1 + qd4*t46 - qd5*(t26*t39 + t10*t0) - qd6*(t25*t40 + t18*t29), batch),  # 3
-        xp.broadcast_to(-t33*qd1 + qd4*t47 + qd5*(t15*t0 + t26*t34) + qd6*(t12*t29 + t25*t35), batch),  # 4
-        xp.broadcast_to(qd4*t49 + qd5*(t10*t34 - t15*t39) + qd6*(t18*t35 - t12*t40), batch),  # 5
+        xp.broadcast_to(-t38*qd1 + t46*qd4 - qd5*(t10*t0 + t26*t39) - qd6*(t25*t40 + t18*t29), batch),  # 3
+        xp.broadcast_to(qd6*(t12*t29 + t25*t35) - t33*qd1 + qd4*t47 + qd5*(t15*t0 + t26*t34), batch),  # 4
+        xp.broadcast_to(qd5*(t10*t34 - t15*t39) + qd6*(t18*t35 - t12*t40) + qd4*t49, batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -729,18 +729,18 @@ def jacobian_dot(q, q_dot):
     t35 = q3*c2
     t36 = t28 - s2*t34
     t37 = c1*qd1
-    t38 = s2*t37 + t31
+    t38 = t31 + s2*t37
     t39 = s2*qd2
     t40 = -(s1**2*t39 + c1**2*t39)
     Jd = _stack(xp, [
         xp.broadcast_to(-t33, batch),  # 0, 0
-        xp.broadcast_to(-t34*t35 + c1*t6, batch),  # 0, 1
+        xp.broadcast_to(c1*t6 - t34*t35, batch),  # 0, 1
         xp.broadcast_to(t36, batch),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t30, batch),  # 1, 0
-        xp.broadcast_to(t35*t37 + s1*t6, batch),  # 1, 1
+        xp.broadcast_to(s1*t6 + t35*t37, batch),  # 1, 1
         xp.broadcast_to(t38, batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
@@ -755,7 +755,7 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(-t37, batch),  # 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
         xp.broadcast_to(t36, batch),  # 3, 3
-        xp.broadcast_to(-(t25*t23 + t10*t1), batch),  # 3, 4
+        xp.broadcast_to(-(t10*t1 + t25*t23), batch),  # 3, 4
         xp.broadcast_to(-(t0*t24 + t17*t26), batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(-t34, batch),  # 4, 1
@@ -829,16 +829,16 @@ def bias_acceleration(q, q_dot):
     t34 = q3*c2*qd1
     t35 = s2*qd1
     t36 = t28 - s1*t35
-    t37 = c1*t35 + t31
+    t37 = t31 + c1*t35
     t38 = s2*qd2
     t39 = -(s1**2*t38 + c1**2*t38)
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t33 + qd2*(-s1*t34 + c1*t6) + qd3*t36, batch),  # 0
-        xp.broadcast_to(qd1*t30 + qd2*(c1*t34 + s1*t6) + qd3*t37, batch),  # 1
+        xp.broadcast_to(-qd1*t33 + t36*qd3 + qd2*(c1*t6 - s1*t34), batch),  # 0
+        xp.broadcast_to(qd1*t30 + qd3*t37 + qd2*(s1*t6 + c1*t34), batch),  # 1
         xp.broadcast_to(-qd2*(s1*t32 + c1*t29) + qd3*t39, batch),  # 2
-        xp.broadcast_to(-t22*qd1 + qd4*t36 - qd5*(t25*t23 + t10*t1) - qd6*(t0*t24 + t17*t26), batch),  # 3
-        xp.broadcast_to(-t18*qd1 + qd4*t37 + qd5*(t13*t1 + t25*t20) + qd6*(t16*t26 + t0*t21), batch),  # 4
-        xp.broadcast_to(qd4*t39 + qd5*(t10*t20 - t13*t23) + qd6*(t17*t21 - t16*t24), batch),  # 5
+        xp.broadcast_to(t36*qd4 - qd6*(t0*t24 + t17*t26) - t22*qd1 - qd5*(t10*t1 + t25*t23), batch),  # 3
+        xp.broadcast_to(qd6*(t16*t26 + t0*t21) + qd4*t37 - t18*qd1 + qd5*(t13*t1 + t25*t20), batch),  # 4
+        xp.broadcast_to(qd5*(t10*t20 - t13*t23) + qd6*(t17*t21 - t16*t24) + qd4*t39, batch),  # 5
     ], (6,))
     return a
 
@@ -873,7 +873,7 @@ def task_jacobian_dot(q, q_dot):
     t6 = s1*c4
     t7 = c1*s4
     t8 = t6 + c2*t7
-    t9 = t7 + c2*t6
+    t9 = c2*t6 + t7
     t10 = t8*c5 - s5*t0
     t11 = t8*s5 + c5*t0
     t12 = s1*s4
@@ -900,18 +900,18 @@ def task_jacobian_dot(q, q_dot):
     t33 = t9*t29 - t14*t32
     t34 = qd1 + c2*qd4
     t35 = t34
-    t36 = t25*t32 + t9*t35
+    t36 = t9*t35 + t25*t32
     t37 = t14*t35 + t25*t29
     t38 = t14*qd5
-    t39 = t29 + t38
+    t39 = t38 + t29
     t40 = t28 + t38 + t11*qd6
     t41 = t9*qd5
-    t42 = t32 + t41
+    t42 = t41 + t32
     t43 = t17*t39 - t11*t42
     t44 = t31 + t41 + t17*qd6
     t45 = t19*t40 - t18*t44
     t46 = -t25*qd5
-    t47 = t35 + t46
+    t47 = t46 + t35
     t48 = t24*t42 + t17*t47
     t49 = t11*t47 + t24*t39
     t50 = t34 + t46 - t24*qd6
@@ -920,26 +920,26 @@ def task_jacobian_dot(q, q_dot):
     t53 = c2*t30
     t54 = t0*qd3 + q3*t53
     t55 = t54 - t3*qd1
-    t56 = t53 - t2*qd1
+    t56 = -t2*qd1 + t53
     t57 = c2*t27
     t58 = t2*qd3 + q3*t57
     t59 = t58 + t1*qd1
     t60 = t0*qd1 + t57
     t61 = s1*t58 + c1*t54
     t62 = q3*c2*qd1
-    t63 = -s1*t62 + c1*t5
-    t64 = c1*t62 + s1*t5
+    t63 = c1*t5 - s1*t62
+    t64 = s1*t5 + c1*t62
     t65 = s2*qd2
     t66 = s1**2*t65 + c1**2*t65
     t67 = c1*t19
     t68 = s1*t18
     t69 = 1/t20
-    t70 = (t67 - t68)*t69
+    t70 = (-t68 + t67)*t69
     t71 = (t14*t18 + t9*t19)*t69
     t72 = (t18*t11 + t19*t17)*t69
     t73 = c1*t18
     t74 = s1*t19
-    t75 = (s2*t73 + s2*t74)*t69
+    t75 = t69*(s2*t73 + s2*t74)
     t76 = 1/t21
     t77 = t69*t76
     t78 = (t73 + t74)*t77
@@ -995,23 +995,23 @@ def task_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(-(t85 - t87 + t89 + t90), batch),  # 3, 1
+        xp.broadcast_to(-(-t87 + t85 + t89 + t90), batch),  # 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
         xp.broadcast_to(-t92 + t93 + t95 + t97, batch),  # 3, 3
-        xp.broadcast_to(-t99 + t100 - t101 + t102, batch),  # 3, 4
-        xp.broadcast_to(-t104 + t105 - t106 + t107, batch),  # 3, 5
+        xp.broadcast_to(-t99 - t101 + t100 + t102, batch),  # 3, 4
+        xp.broadcast_to(-t104 - t106 + t105 + t107, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(-t51*(c1*t76 - t18*t78) + t52*(s1*t76 - t19*t78) + t67*t108 - t68*t108, batch),  # 4, 1
+        xp.broadcast_to(-t51*(-t18*t78 + c1*t76) + t52*(-t19*t78 + s1*t76) + t67*t108 - t68*t108, batch),  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
-        xp.broadcast_to(-t51*(t2*t76 - t18*t79) - t52*(t0*t76 + t19*t79) - t56*t109 + t60*t110, batch),  # 4, 3
-        xp.broadcast_to(-t51*(t9*t76 - t18*t80) - t52*(t14*t76 + t19*t80) + t36*t109 + t37*t110, batch),  # 4, 4
-        xp.broadcast_to(-t51*(t17*t76 - t18*t81) - t52*(t11*t76 + t19*t81) + t48*t109 + t49*t110, batch),  # 4, 5
+        xp.broadcast_to(-t51*(-t18*t79 + t2*t76) - t52*(t19*t79 + t0*t76) - t56*t109 + t60*t110, batch),  # 4, 3
+        xp.broadcast_to(-t51*(-t18*t80 + t9*t76) - t52*(t19*t80 + t14*t76) + t36*t109 + t37*t110, batch),  # 4, 4
+        xp.broadcast_to(-t51*(-t18*t81 + t17*t76) - t52*(t19*t81 + t11*t76) + t48*t109 + t49*t110, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(t26*t85 - t26*t87 + t45*t70 + t26*t89 + t26*t90), batch),  # 5, 1
+        xp.broadcast_to(-(t45*t70 + t26*t85 - t26*t87 + t26*t89 + t26*t90), batch),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
-        xp.broadcast_to(t82 - t26*t92 + t26*t93 - t45*t75 + t26*t95 + t26*t97, batch),  # 5, 3
-        xp.broadcast_to(t33 - t26*t99 + t26*t100 - t45*t71 - t26*t101 + t26*t102, batch),  # 5, 4
-        xp.broadcast_to(t43 - t26*t104 + t26*t105 - t45*t72 - t26*t106 + t26*t107, batch),  # 5, 5
+        xp.broadcast_to(-t45*t75 + t82 - t26*t92 + t26*t93 + t26*t95 + t26*t97, batch),  # 5, 3
+        xp.broadcast_to(t33 - t45*t71 - t26*t99 + t26*t100 - t26*t101 + t26*t102, batch),  # 5, 4
+        xp.broadcast_to(t43 - t45*t72 - t26*t104 + t26*t105 - t26*t106 + t26*t107, batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1038,7 +1038,7 @@ def hessian(q):
     t6 = s1*c4
     t7 = c1*s4
     t8 = t6 + c2*t7
-    t9 = t7 + c2*t6
+    t9 = c2*t6 + t7
     t10 = t8*s5 + c5*t1
     t11 = s1*s4
     t12 = c1*c4
@@ -1053,7 +1053,7 @@ def hessian(q):
     t21 = s1**2
     t22 = q3*c2
     t23 = c1**2
-    t24 = -(t21*s2 + t23*s2)
+    t24 = -(s2*t23 + s2*t21)
     t25 = s2**2
     t26 = s2*c4
     H = _stack(xp, [
@@ -1187,8 +1187,8 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 3
-        -(t6*t25 + c2*t9),  # 3, 3, 4
-        -(t0*t3 + c2*t15),  # 3, 3, 5
+        -(c2*t9 + t6*t25),  # 3, 3, 4
+        -(c2*t15 + t0*t3),  # 3, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4, 2
@@ -1230,7 +1230,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 4
-        -t10*t26 + t13*t0,  # 4, 4, 5
+        t13*t0 - t10*t26,  # 4, 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5, 2
@@ -1349,7 +1349,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t6 = s1*c4
     t7 = c1*s4
     t8 = t6 + c2*t7
-    t9 = t7 + c2*t6
+    t9 = c2*t6 + t7
     t10 = t8*s5 + c5*t1
     t11 = s1*s4
     t12 = c1*c4
@@ -1368,217 +1368,217 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t25 = -t2*t4
     t26 = s1*c1
     t27 = t17*t26
-    t28 = t25 + t21*t26 + t27
-    t29 = t27 - t26 + t13*t9 + t10*t15
+    t28 = t25 + t27 + t21*t26
+    t29 = -t26 + t27 + t13*t9 + t10*t15
     t30 = c1*t5
     t31 = q3*c2
     t32 = t16*t31
     t33 = c2*t1
-    t34 = -t30*t31 + t33
+    t34 = t33 - t30*t31
     t35 = s1**2
-    t36 = t35*t17
+    t36 = t17*t35
     t37 = t2**2
-    t38 = xp.sqrt(1 + t37 + t19)
+    t38 = xp.sqrt(1 + t19 + t37)
     t39 = t38*xp.where(xp.less_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)
-    t40 = t37 + t21*t35
-    t41 = t36 + t40
-    t42 = s1*t5
-    t43 = c2*t3
-    t44 = -t31*t42 + t43
-    t45 = t31*t35
-    t46 = t45
-    t47 = t5**2
-    t48 = t20 + t47
-    t49 = t13**2 + t10**2 + t35
-    t50 = t18 + t49
-    t51 = s2*c4
-    t52 = -t33 + t13*t51 + t10*t0
-    t53 = -t43 + t9*t51 + t15*t0
-    t54 = t9**2 + t15**2 + t16
-    t55 = t36 + t54
-    t56 = 1 + t0**2 + t17*c4**2
-    t57 = t20 + t56
-    t58 = xp.sqrt(t23 + 2*t20 + 2*t18 + 2*t36 + t40 + t47 + t49 + t54 + t56)
-    t59 = t28**2
-    t60 = t34**2
-    t61 = t32**2
-    t62 = damping**2
-    t63 = t62 + t24
-    t64 = t63**2
-    t65 = t62 + t41
-    t66 = t62 + t48
-    t67 = t62 + t50
-    t68 = t62 + t55
-    t69 = t62 + t57
-    t70 = 2*t47
-    t71 = t22*t35
-    t72 = xp.sqrt(2*t37 + 2*t19 + 2*t59 + 2*t60 + 2*t44**2 + 2*t46**2 + 2*t61 + 2*t29**2 + 2*t52**2 + 2*t53**2 + t64 + t65**2 + t66**2 + t67**2 + t68**2 + t69**2 + t35*t70 + 4*t71 + t16*t70)
-    t73 = xp.sqrt(t19 + t59 + t60 + t61 + t64 + t71)
-    t74 = t73*xp.where(xp.greater_equal(t63, 0), xp.asarray(1, dtype=dtype), -1)
-    t75 = t63 + t74
-    t76 = xp.where(xp.greater(t73, 0), 1/(t73*(t73 + xp.abs(t63))), 0)
-    t77 = t76*(t34*t75 + t28*t44 + t34*t66 - t30*t45 - t30*t32)
-    t78 = t34 - t75*t77
-    t79 = t44 - t28*t77
-    t80 = t66 - t34*t77
-    t81 = t30 + t32*t77
-    t82 = t26*t31
-    t83 = t76*(t25 + t28*t75 + t28*t65 + t34*t44 + t82*t46 + t82*t32)
-    t84 = t28 - t75*t83
-    t85 = t65 - t28*t83
-    t86 = t44 - t34*t83
-    t87 = -t46 + t82*t83
-    t88 = t82 - t32*t83
-    t89 = t2 + t4*t83
-    t90 = t42 + t82*t77
-    t91 = t76*(-t82*t75 - t28*t46 + t42*t34 - t67*t82 + t32*t29 + t4*t52)
-    t92 = t82 + t75*t91
-    t93 = t46 + t28*t91
-    t94 = t42 - t34*t91
-    t95 = t67 + t82*t91
-    t96 = t29 - t32*t91
-    t97 = t76*(t32*t75 + t82*t28 - t30*t34 - t82*t29 + t32*t68 + t4*t53)
-    t98 = t32 - t75*t97
-    t99 = t82 - t28*t97
-    t100 = t30 + t34*t97
-    t101 = t29 + t82*t97
-    t102 = t68 - t32*t97
-    t103 = -t53 + t4*t97
-    t104 = -t76*(t4*t75 - t2*t28 - t82*t52 + t32*t53 + t4*t69)
-    t105 = t4 + t75*t104
-    t106 = t2 - t28*t104
-    t107 = t53 + t32*t104
-    t108 = t69 + t4*t104
-    t109 = t76*(mu_dot0*t75 + mu_dot1*t28 + mu_dot2*t34 - t82*mu_dot3 + mu_dot4*t32 - t4*mu_dot5)
-    t110 = mu_dot0 - t75*t109
-    t111 = mu_dot1 - t28*t109
-    t112 = mu_dot2 - t34*t109
-    t113 = mu_dot3 + t82*t109
-    t114 = mu_dot4 - t32*t109
-    t115 = mu_dot5 + t4*t109
-    t116 = xp.sqrt(t85**2 + t86**2 + t87**2 + t88**2 + t89**2)
-    t117 = t116*xp.where(xp.greater_equal(t85, 0), xp.asarray(1, dtype=dtype), -1)
-    t118 = t85 + t117
-    t119 = xp.where(xp.greater(t116, 0), 1/(t116*(t116 + xp.abs(t85))), 0)
-    t120 = t119*(t99*t118 - t86*t100 + t87*t101 + t88*t102 + t89*t103)
-    t121 = t99 - t118*t120
-    t122 = t100 + t86*t120
-    t123 = t101 - t87*t120
-    t124 = t102 - t88*t120
-    t125 = t103 - t89*t120
-    t126 = t119*(t111*t118 + t86*t112 + t87*t113 + t88*t114 + t89*t115)
-    t127 = t111 - t118*t126
-    t128 = t112 - t86*t126
-    t129 = t113 - t87*t126
-    t130 = t114 - t88*t126
-    t131 = t115 - t89*t126
-    t132 = -t52
-    t133 = t132 + t4*t91
-    t134 = t132 + t82*t104
-    t135 = t119*(-t93*t118 + t86*t94 + t87*t95 + t88*t96 + t89*t133)
-    t136 = t93 + t118*t135
-    t137 = t94 - t86*t135
-    t138 = t95 - t87*t135
-    t139 = t96 - t88*t135
-    t140 = t133 - t89*t135
-    t141 = t4*t77
-    t142 = t119*(t79*t118 + t86*t80 + t87*t90 - t88*t81 + t141*t89)
-    t143 = t79 - t118*t142
-    t144 = t80 - t86*t142
-    t145 = t90 - t87*t142
-    t146 = t81 + t88*t142
-    t147 = t141 - t89*t142
-    t148 = xp.sqrt(t144**2 + t145**2 + t146**2 + t147**2)
-    t149 = t148*xp.where(xp.greater_equal(t144, 0), xp.asarray(1, dtype=dtype), -1)
-    t150 = t144 + t149
-    t151 = xp.where(xp.greater(t148, 0), 1/(t148*(t148 + xp.abs(t144))), 0)
-    t152 = t151*(t137*t150 + t145*t138 - t146*t139 + t147*t140)
-    t153 = t137 - t150*t152
-    t154 = t138 - t145*t152
-    t155 = t139 + t146*t152
-    t156 = t140 - t147*t152
-    t157 = t151*(-t122*t150 + t145*t123 - t146*t124 + t147*t125)
-    t158 = t122 + t150*t157
-    t159 = t123 - t145*t157
-    t160 = t124 + t146*t157
-    t161 = t125 - t147*t157
-    t162 = t151*(t128*t150 + t145*t129 - t146*t130 + t147*t131)
-    t163 = t128 - t150*t162
-    t164 = t129 - t145*t162
-    t165 = t130 + t146*t162
-    t166 = t131 - t147*t162
-    t167 = xp.sqrt(t154**2 + t155**2 + t156**2)
-    t168 = t167*xp.where(xp.greater_equal(t154, 0), xp.asarray(1, dtype=dtype), -1)
-    t169 = t154 + t168
-    t170 = xp.where(xp.greater(t167, 0), 1/(t167*(t167 + xp.abs(t154))), 0)
-    t171 = t170*(t159*t169 + t155*t160 + t156*t161)
-    t172 = t159 - t169*t171
-    t173 = t160 - t155*t171
-    t174 = t161 - t156*t171
-    t175 = t170*(t164*t169 + t155*t165 + t156*t166)
-    t176 = t164 - t169*t175
-    t177 = t165 - t155*t175
-    t178 = t166 - t156*t175
-    t179 = xp.sqrt(t173**2 + t174**2)
-    t180 = t179*xp.where(xp.greater_equal(t173, 0), xp.asarray(1, dtype=dtype), -1)
-    t181 = t173 + t180
-    t182 = xp.where(xp.greater(t179, 0), 1/(t179*(t179 + xp.abs(t173))), 0)
-    t183 = t182*(t177*t181 + t174*t178)
-    t184 = t177 - t181*t183
-    t185 = t178 - t174*t183
-    t186 = t34*t104
-    t187 = t119*(t106*t118 - t186*t86 + t87*t134 - t88*t107 + t89*t108)
-    t188 = t106 - t118*t187
-    t189 = t186 + t86*t187
-    t190 = t134 - t87*t187
-    t191 = t107 + t88*t187
-    t192 = t108 - t89*t187
-    t193 = t151*(-t189*t150 + t145*t190 + t146*t191 + t147*t192)
-    t194 = t189 + t150*t193
-    t195 = t190 - t145*t193
-    t196 = -t191 + t146*t193
-    t197 = t192 - t147*t193
-    t198 = t170*(t195*t169 + t155*t196 + t156*t197)
-    t199 = t195 - t169*t198
-    t200 = t196 - t155*t198
-    t201 = t197 - t156*t198
-    t202 = t182*(t200*t181 + t174*t201)
-    t203 = t200 - t181*t202
-    t204 = t201 - t174*t202
-    t205 = xp.abs(t204)
-    t206 = t205
-    t207 = t206*xp.where(xp.greater_equal(t204, 0), xp.asarray(1, dtype=dtype), -1)
-    t208 = t204 + t207
-    t209 = xp.where(xp.greater(t206, 0), 1/(t206*(t205 + t206)), 0)
-    t210 = t185 - t185*t208**2*t209
-    t211 = xp.where(xp.not_equal(t207, 0), -t210/t207, 0)
-    t212 = xp.where(xp.not_equal(t180, 0), -(t184 - t203*t211)/t180, 0)
-    t213 = xp.where(xp.not_equal(t168, 0), -(-(t172*t212 + t199*t211) + t176)/t168, 0)
-    t214 = xp.where(xp.not_equal(t149, 0), -(t163 + t158*t212 + t194*t211 - t153*t213)/t149, 0)
-    t215 = xp.where(xp.not_equal(t117, 0), -(-(t143*t214 - t136*t213 + t121*t212 + t188*t211) + t127)/t117, 0)
-    t216 = xp.where(xp.not_equal(t74, 0), -(-(t84*t215 + t78*t214 - t92*t213 + t98*t212 - t105*t211) + t110)/t74, 0)
-    t217 = t211 - t4*t216 + t2*t215
-    t218 = t1*t216 + t3*t215 + c2*t214
-    t219 = t1*t213 + t3*t212 + c2*t211
-    t220 = t13*t213 + t9*t212 - t51*t211
-    t221 = t10*t213 + t15*t212 - t0*t211
-    t222 = c1*t31
-    t223 = s1*t31
-    t224 = t222*t216 + t223*t215 - t5*t214 - s1*t213 + c1*t212
-    t225 = -t4
-    t226 = t225 + t39
-    t227 = xp.where(xp.greater(t38, 0), 1/(t38*(t38 + xp.abs(t225))), 0)
-    t228 = t227*(t222*t226 + t2*t223)
-    t229 = t222 - t226*t228
-    t230 = t223 - t2*t228
-    t231 = t227*(t1*t226 + t2*t3)
-    t232 = t1 - t226*t231
+    t40 = xp.where(xp.greater(t38, 0), 1/(t38*(t38 + xp.abs(t4))), 0)
+    t41 = t37 + t21*t35
+    t42 = t36 + t41
+    t43 = s1*t5
+    t44 = c2*t3
+    t45 = t44 - t31*t43
+    t46 = t31*t35
+    t47 = t46
+    t48 = t5**2
+    t49 = t20 + t48
+    t50 = t13**2 + t10**2 + t35
+    t51 = t18 + t50
+    t52 = s2*c4
+    t53 = -t33 + t10*t0 + t13*t52
+    t54 = -t44 + t15*t0 + t9*t52
+    t55 = t9**2 + t15**2 + t16
+    t56 = t36 + t55
+    t57 = 1 + t0**2 + c4**2*t17
+    t58 = t20 + t57
+    t59 = xp.sqrt(t23 + 2*t20 + 2*t18 + 2*t36 + t41 + t48 + t50 + t55 + t57)
+    t60 = t28**2
+    t61 = t34**2
+    t62 = t32**2
+    t63 = damping**2
+    t64 = t63 + t24
+    t65 = t64**2
+    t66 = t63 + t42
+    t67 = t63 + t49
+    t68 = t63 + t51
+    t69 = t63 + t56
+    t70 = t63 + t58
+    t71 = 2*t48
+    t72 = t22*t35
+    t73 = xp.sqrt(2*t37 + 2*t19 + 2*t60 + 2*t61 + 2*t45**2 + 2*t47**2 + 2*t62 + 2*t29**2 + 2*t53**2 + 2*t54**2 + t65 + t66**2 + t67**2 + t68**2 + t69**2 + t70**2 + 4*t72 + t35*t71 + t16*t71)
+    t74 = xp.sqrt(t19 + t60 + t61 + t62 + t65 + t72)
+    t75 = t74*xp.where(xp.greater_equal(t64, 0), xp.asarray(1, dtype=dtype), -1)
+    t76 = t64 + t75
+    t77 = xp.where(xp.greater(t74, 0), 1/(t74*(t74 + xp.abs(t64))), 0)
+    t78 = t77*(t34*t76 + t28*t45 + t67*t34 - t30*t46 - t30*t32)
+    t79 = t34 - t76*t78
+    t80 = t45 - t28*t78
+    t81 = t67 - t34*t78
+    t82 = t30 + t32*t78
+    t83 = t26*t31
+    t84 = t77*(t25 + t28*t76 + t34*t45 + t66*t28 + t83*t47 + t83*t32)
+    t85 = t28 - t76*t84
+    t86 = t66 - t28*t84
+    t87 = t45 - t34*t84
+    t88 = -t47 + t83*t84
+    t89 = t83 - t32*t84
+    t90 = t2 + t4*t84
+    t91 = t43 + t83*t78
+    t92 = t77*(-t28*t47 + t32*t29 + t4*t53 - t83*t76 + t43*t34 - t68*t83)
+    t93 = t83 + t76*t92
+    t94 = t47 + t28*t92
+    t95 = t43 - t34*t92
+    t96 = t68 + t83*t92
+    t97 = t29 - t32*t92
+    t98 = t77*(t32*t76 + t4*t54 + t83*t28 - t30*t34 - t83*t29 + t69*t32)
+    t99 = t32 - t76*t98
+    t100 = t83 - t28*t98
+    t101 = t30 + t34*t98
+    t102 = t29 + t83*t98
+    t103 = t69 - t32*t98
+    t104 = -t54 + t4*t98
+    t105 = -t77*(t4*t76 + t32*t54 - t83*t53 + t4*t70 - t2*t28)
+    t106 = t4 + t76*t105
+    t107 = t2 - t28*t105
+    t108 = t54 + t32*t105
+    t109 = t70 + t4*t105
+    t110 = t77*(mu_dot0*t76 + mu_dot1*t28 + mu_dot2*t34 + mu_dot4*t32 - t4*mu_dot5 - t83*mu_dot3)
+    t111 = mu_dot0 - t76*t110
+    t112 = mu_dot1 - t28*t110
+    t113 = mu_dot2 - t34*t110
+    t114 = mu_dot3 + t83*t110
+    t115 = mu_dot4 - t32*t110
+    t116 = mu_dot5 + t4*t110
+    t117 = xp.sqrt(t86**2 + t87**2 + t88**2 + t89**2 + t90**2)
+    t118 = t117*xp.where(xp.greater_equal(t86, 0), xp.asarray(1, dtype=dtype), -1)
+    t119 = t86 + t118
+    t120 = xp.where(xp.greater(t117, 0), 1/(t117*(t117 + xp.abs(t86))), 0)
+    t121 = t120*(t100*t119 - t87*t101 + t88*t102 + t89*t103 + t90*t104)
+    t122 = t100 - t119*t121
+    t123 = t101 + t87*t121
+    t124 = t102 - t88*t121
+    t125 = t103 - t89*t121
+    t126 = t104 - t90*t121
+    t127 = t120*(t112*t119 + t87*t113 + t88*t114 + t89*t115 + t90*t116)
+    t128 = t112 - t119*t127
+    t129 = t113 - t87*t127
+    t130 = t114 - t88*t127
+    t131 = t115 - t89*t127
+    t132 = t116 - t90*t127
+    t133 = -t53
+    t134 = t133 + t4*t92
+    t135 = t133 + t83*t105
+    t136 = t120*(-t94*t119 + t87*t95 + t88*t96 + t89*t97 + t90*t134)
+    t137 = t94 + t119*t136
+    t138 = t95 - t87*t136
+    t139 = t96 - t88*t136
+    t140 = t97 - t89*t136
+    t141 = t134 - t90*t136
+    t142 = t4*t78
+    t143 = t120*(t80*t119 + t87*t81 + t88*t91 - t89*t82 + t142*t90)
+    t144 = t80 - t119*t143
+    t145 = t81 - t87*t143
+    t146 = t91 - t88*t143
+    t147 = t82 + t89*t143
+    t148 = t142 - t90*t143
+    t149 = xp.sqrt(t145**2 + t146**2 + t147**2 + t148**2)
+    t150 = t149*xp.where(xp.greater_equal(t145, 0), xp.asarray(1, dtype=dtype), -1)
+    t151 = t145 + t150
+    t152 = xp.where(xp.greater(t149, 0), 1/(t149*(t149 + xp.abs(t145))), 0)
+    t153 = t152*(t138*t151 + t146*t139 - t147*t140 + t148*t141)
+    t154 = t138 - t151*t153
+    t155 = t139 - t146*t153
+    t156 = t140 + t147*t153
+    t157 = t141 - t148*t153
+    t158 = t152*(-t123*t151 + t146*t124 - t147*t125 + t148*t126)
+    t159 = t123 + t151*t158
+    t160 = t124 - t146*t158
+    t161 = t125 + t147*t158
+    t162 = t126 - t148*t158
+    t163 = t152*(t129*t151 + t146*t130 - t147*t131 + t148*t132)
+    t164 = t129 - t151*t163
+    t165 = t130 - t146*t163
+    t166 = t131 + t147*t163
+    t167 = t132 - t148*t163
+    t168 = xp.sqrt(t155**2 + t156**2 + t157**2)
+    t169 = t168*xp.where(xp.greater_equal(t155, 0), xp.asarray(1, dtype=dtype), -1)
+    t170 = t155 + t169
+    t171 = xp.where(xp.greater(t168, 0), 1/(t168*(t168 + xp.abs(t155))), 0)
+    t172 = t171*(t160*t170 + t156*t161 + t157*t162)
+    t173 = t160 - t170*t172
+    t174 = t161 - t156*t172
+    t175 = t162 - t157*t172
+    t176 = t171*(t165*t170 + t156*t166 + t157*t167)
+    t177 = t165 - t170*t176
+    t178 = t166 - t156*t176
+    t179 = t167 - t157*t176
+    t180 = xp.sqrt(t174**2 + t175**2)
+    t181 = t180*xp.where(xp.greater_equal(t174, 0), xp.asarray(1, dtype=dtype), -1)
+    t182 = t174 + t181
+    t183 = xp.where(xp.greater(t180, 0), 1/(t180*(t180 + xp.abs(t174))), 0)
+    t184 = t183*(t178*t182 + t175*t179)
+    t185 = t178 - t182*t184
+    t186 = t179 - t175*t184
+    t187 = t34*t105
+    t188 = t120*(t107*t119 + t88*t135 - t89*t108 + t90*t109 - t187*t87)
+    t189 = t107 - t119*t188
+    t190 = t187 + t87*t188
+    t191 = t135 - t88*t188
+    t192 = t108 + t89*t188
+    t193 = t109 - t90*t188
+    t194 = t152*(-t190*t151 + t146*t191 + t147*t192 + t148*t193)
+    t195 = t190 + t151*t194
+    t196 = t191 - t146*t194
+    t197 = -t192 + t147*t194
+    t198 = t193 - t148*t194
+    t199 = t171*(t196*t170 + t156*t197 + t157*t198)
+    t200 = t196 - t170*t199
+    t201 = t197 - t156*t199
+    t202 = t198 - t157*t199
+    t203 = t183*(t201*t182 + t175*t202)
+    t204 = t201 - t182*t203
+    t205 = t202 - t175*t203
+    t206 = xp.abs(t205)
+    t207 = t206
+    t208 = t207*xp.where(xp.greater_equal(t205, 0), xp.asarray(1, dtype=dtype), -1)
+    t209 = t205 + t208
+    t210 = xp.where(xp.greater(t207, 0), 1/(t207*(t206 + t207)), 0)
+    t211 = t186 - t186*t209**2*t210
+    t212 = xp.where(xp.not_equal(t208, 0), -t211/t208, 0)
+    t213 = xp.where(xp.not_equal(t181, 0), -(t185 - t204*t212)/t181, 0)
+    t214 = xp.where(xp.not_equal(t169, 0), -(-(t173*t213 + t200*t212) + t177)/t169, 0)
+    t215 = xp.where(xp.not_equal(t150, 0), -(t164 + t159*t213 + t195*t212 - t154*t214)/t150, 0)
+    t216 = xp.where(xp.not_equal(t118, 0), -(-(t144*t215 - t137*t214 + t122*t213 + t189*t212) + t128)/t118, 0)
+    t217 = xp.where(xp.not_equal(t75, 0), -(-(t85*t216 + t79*t215 - t93*t214 + t99*t213 - t106*t212) + t111)/t75, 0)
+    t218 = t212 - t4*t217 + t2*t216
+    t219 = c2*t215 + t1*t217 + t3*t216
+    t220 = c2*t212 + t1*t214 + t3*t213
+    t221 = t13*t214 + t9*t213 - t52*t212
+    t222 = t10*t214 + t15*t213 - t0*t212
+    t223 = c1*t31
+    t224 = s1*t31
+    t225 = -t5*t215 - s1*t214 + c1*t213 + t223*t217 + t224*t216
+    t226 = -t4
+    t227 = t226 + t39
+    t228 = t40*(t223*t227 + t2*t224)
+    t229 = t223 - t227*t228
+    t230 = t224 - t2*t228
+    t231 = t40*(t1*t227 + t2*t3)
+    t232 = t1 - t227*t231
     t233 = t3 - t2*t231
-    t234 = t227*(mu_dot5 + mu_dot0*t226 + t2*mu_dot1)
-    t235 = mu_dot0 - t226*t234
+    t234 = t40*(mu_dot5 + mu_dot0*t227 + t2*mu_dot1)
+    t235 = mu_dot0 - t227*t234
     t236 = mu_dot1 - t2*t234
     t237 = -t234 + mu_dot5
-    t238 = xp.sqrt(t35 + t16 + t47 + t228**2 + t230**2)
+    t238 = xp.sqrt(t16 + t35 + t48 + t228**2 + t230**2)
     t239 = t238*xp.where(xp.greater_equal(t230, 0), xp.asarray(1, dtype=dtype), -1)
     t240 = t230 + t239
     t241 = xp.where(xp.greater(t238, 0), 1/(t238*(t238 + xp.abs(t230))), 0)
@@ -1592,30 +1592,30 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t249 = mu_dot3 + s1*t246
     t250 = mu_dot4 - c1*t246
     t251 = t237 + t228*t246
-    t252 = c2*t227
-    t253 = c2 - t252
-    t254 = -t51
-    t255 = t51*t227
+    t252 = c2*t40
+    t253 = -t252 + c2
+    t254 = -t52
+    t255 = t52*t40
     t256 = t254 + t255
     t257 = -t0
-    t258 = 1 + t225 - t5 - s1 + t257 + q1 + q2 + c1 + q3 + q4 + q5 + q6 + t13 + t9 + t10 + t2 + t15 + t222 + t223 + t254 + 2*c2 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + 2*t1 + 2*t3
-    t259 = t0*t227
+    t258 = 1 - t5 - s1 + q1 + q2 + c1 + q3 + q4 + q5 + q6 + t13 + t9 + t10 + t2 + t15 + 2*c2 + 2*t1 + 2*t3 + t223 + t224 + t226 + t254 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + t257
+    t259 = t0*t40
     t260 = t257 + t259
     t261 = t2*t252
-    t262 = -t241*(t240*t261 + t228*t253)
-    t263 = t261 + t240*t262
+    t262 = -t241*(t228*t253 + t240*t261)
+    t263 = t240*t262 + t261
     t264 = t1 + s1*t262
     t265 = t3 - c1*t262
     t266 = t253 + t228*t262
     t267 = t2*t255
-    t268 = t241*(t240*t267 - s1*t13 + c1*t9 - t228*t256)
-    t269 = t267 - t240*t268
+    t268 = t241*(-s1*t13 + c1*t9 - t228*t256 + t240*t267)
+    t269 = -t240*t268 + t267
     t270 = t13 + s1*t268
     t271 = t9 - c1*t268
     t272 = t256 + t228*t268
     t273 = t2*t259
-    t274 = t241*(c1*t15 - s1*t10 + t240*t273 - t228*t260)
-    t275 = t273 - t240*t274
+    t274 = t241*(c1*t15 - s1*t10 - t228*t260 + t240*t273)
+    t275 = -t240*t274 + t273
     t276 = t10 + s1*t274
     t277 = t15 - c1*t274
     t278 = t260 + t228*t274
@@ -1627,12 +1627,12 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t284 = t5*t262
     t285 = s1*t242
     t286 = c1*t242
-    t287 = t283*(t282*t284 + t264*t285 - t265*t286 + t245*t266)
-    t288 = t284 - t282*t287
+    t287 = t283*(t245*t266 + t282*t284 + t264*t285 - t265*t286)
+    t288 = -t282*t287 + t284
     t289 = t264 - t287*t285
     t290 = t265 + t287*t286
     t291 = t266 - t245*t287
-    t292 = t283*(t248*t282 + t249*t285 - t250*t286 + t245*t251)
+    t292 = t283*(t248*t282 + t245*t251 + t249*t285 - t250*t286)
     t293 = t248 - t282*t292
     t294 = t249 - t292*t285
     t295 = t250 + t292*t286
@@ -1646,8 +1646,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t303 = t295 - t290*t301
     t304 = t296 - t291*t301
     t305 = t5*t268
-    t306 = t283*(t282*t305 + t270*t285 - t271*t286 + t245*t272)
-    t307 = t305 - t282*t306
+    t306 = t283*(t245*t272 + t282*t305 + t270*t285 - t271*t286)
+    t307 = -t282*t306 + t305
     t308 = t270 - t306*t285
     t309 = t271 + t306*t286
     t310 = t272 - t245*t306
@@ -1663,8 +1663,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t320 = t303 - t317*t319
     t321 = t304 - t314*t319
     t322 = t5*t274
-    t323 = t283*(t282*t322 + t276*t285 - t277*t286 + t245*t278)
-    t324 = t322 - t282*t323
+    t323 = t283*(t245*t278 + t282*t322 + t276*t285 - t277*t286)
+    t324 = -t282*t323 + t322
     t325 = t276 - t323*t285
     t326 = t277 + t323*t286
     t327 = t278 - t245*t323
@@ -1679,28 +1679,28 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t336 = t335
     t337 = t336*xp.where(xp.greater_equal(t334, 0), xp.asarray(1, dtype=dtype), -1)
     t338 = t334 + t337
-    t339 = xp.where(xp.greater(t336, 0), 1/(t336*(t335 + t336)), 0)
+    t339 = xp.where(xp.greater(t336, 0), 1/(t336*(t336 + t335)), 0)
     t340 = t321 - t321*t338**2*t339
     t341 = xp.where(xp.not_equal(t337, 0), -t340/t337, 0)
     t342 = xp.where(xp.not_equal(t316, 0), -(t320 - t333*t341)/t316, 0)
     t343 = xp.where(xp.not_equal(t298, 0), -(-(t312*t342 + t329*t341) + t302)/t298, 0)
     t344 = xp.where(xp.not_equal(t281, 0), -(-(t288*t343 + t307*t342 + t324*t341) + t293)/t281, 0)
     t345 = xp.where(xp.not_equal(t239, 0), -(-(t243*t344 - t263*t343 + t269*t342 + t275*t341) + t247)/t239, 0)
-    t346 = xp.where(xp.not_equal(t39, 0), -(-(t229*t345 + t232*t344 - t252*t226*t343 + t255*t226*t342 + t226*t341*t259) + t235)/t39, 0)
+    t346 = xp.where(xp.not_equal(t39, 0), -(-(t229*t345 + t232*t344 - t252*t227*t343 + t255*t227*t342 + t227*t341*t259) + t235)/t39, 0)
     t347 = xp.isfinite(t258)
     t348 = xp.greater_equal(damping, 0)
     t349 = xp.greater(damping, 0)
-    t350 = 1e-12*t72
-    t351 = 1e-12*t58
-    t352 = (t349 & (xp.less_equal(t73, t350) | xp.less_equal(t116, t350) | xp.less_equal(t148, t350) | xp.less_equal(t167, t350) | xp.less_equal(t179, t350) | xp.less_equal(t206, t350))) | (xp.less_equal(damping, 0) & (xp.less_equal(t38, t351) | xp.less_equal(t238, t351) | xp.less_equal(t280, t351) | xp.less_equal(t297, t351) | xp.less_equal(t315, t351) | xp.less_equal(t336, t351)))
+    t350 = 1e-12*t73
+    t351 = 1e-12*t59
+    t352 = (t349 & (xp.less_equal(t74, t350) | xp.less_equal(t117, t350) | xp.less_equal(t149, t350) | xp.less_equal(t168, t350) | xp.less_equal(t180, t350) | xp.less_equal(t207, t350))) | (xp.less_equal(damping, 0) & (xp.less_equal(t38, t351) | xp.less_equal(t238, t351) | xp.less_equal(t280, t351) | xp.less_equal(t297, t351) | xp.less_equal(t315, t351) | xp.less_equal(t336, t351)))
     t353 = t347 & t348 & xp.logical_not(t352)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t353, xp.where(t349, t217, t346), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t353, xp.where(t349, t224, t345), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t353, xp.where(t349, t218, t344), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t353, xp.where(t349, t219, t343), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t353, xp.where(t349, t220, t342), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t353, xp.where(t349, t221, t341), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t353, xp.where(t349, t218, t346), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t353, xp.where(t349, t225, t345), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t353, xp.where(t349, t219, t344), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t353, xp.where(t349, t220, t343), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t353, xp.where(t349, t221, t342), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t353, xp.where(t349, t222, t341), 0), batch),  # 5
     ], (6,))
     status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t347 & t348), 2, xp.where(t352, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
@@ -1757,7 +1757,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t10 = s1*c4
     t11 = c1*s4
     t12 = t10 + c2*t11
-    t13 = t11 + c2*t10
+    t13 = c2*t10 + t11
     t14 = s1*s4
     t15 = c1*c4
     t16 = -t14 + c2*t15
@@ -1785,9 +1785,9 @@ def ik_numeric_step(target, q, damping=0.0):
     t38 = s2*c4
     t39 = c6*t36 + s6*t38
     t40 = s6*t36 - c6*t38
-    t41 = t39*T00 - t40*T01 + t37*T02
-    t42 = t39*T10 - t40*T11 + t37*T12
-    t43 = t39*T20 - t40*T21 + t37*T22
+    t41 = t39*T00 + t37*T02 - t40*T01
+    t42 = t39*T10 + t37*T12 - t40*T11
+    t43 = t39*T20 + t37*T22 - t40*T21
     t44 = 0.5*(t42 + t33)
     t45 = -0.5*(t41 + t25)
     t46 = xp.sqrt(t44**2 + t45**2 + t34**2)
@@ -1799,27 +1799,27 @@ def ik_numeric_step(target, q, damping=0.0):
     t52 = q3**2*t50
     t53 = t48*t52
     t54 = s2**2
-    t55 = 1 + t50 + t37**2 + t54*c4**2
+    t55 = 1 + t37**2 + t50 + c4**2*t54
     t56 = t48*t54
     t57 = t47 + t53 + t56
     t58 = -t2*t3
     t59 = s1*c1
     t60 = t54*t59
-    t61 = t58 + t52*t59 + t60
-    t62 = t60 - t59 + t16*t13 + t20*t28
+    t61 = t58 + t60 + t52*t59
+    t62 = -t59 + t60 + t16*t13 + t20*t28
     t63 = c1*t4
     t64 = c2*t18
-    t65 = -t7*t63 + t64
-    t66 = -t64 + t16*t38 + t20*t37
+    t65 = t64 - t7*t63
+    t66 = -t64 + t20*t37 + t16*t38
     t67 = s1**2
-    t68 = t67 + t16**2 + t20**2 + t56
-    t69 = t67*t54
-    t70 = t2**2 + t52*t67 + t69
-    t71 = t48 + t13**2 + t28**2 + t69
+    t68 = t16**2 + t20**2 + t56 + t67
+    t69 = t54*t67
+    t70 = t2**2 + t69 + t52*t67
+    t71 = t13**2 + t28**2 + t48 + t69
     t72 = s1*t4
     t73 = c2*t26
-    t74 = -t7*t72 + t73
-    t75 = -t73 + t13*t38 + t28*t37
+    t74 = t73 - t7*t72
+    t75 = -t73 + t28*t37 + t13*t38
     t76 = t7*t67
     t77 = t76
     t78 = -t43
@@ -1840,12 +1840,12 @@ def ik_numeric_step(target, q, damping=0.0):
     t93 = xp.where(t89, t34*t81, t90*t86)
     t94 = t91**2 + t92**2 + t93**2 + t5**2 + t6**2 + t9**2
     t95 = damping + t57
-    t96 = xp.sqrt(t47 + t61**2 + t65**2 + t49**2 + t53*t67 + t95**2)
+    t96 = xp.sqrt(t47 + t95**2 + t61**2 + t65**2 + t49**2 + t53*t67)
     t97 = t96*xp.where(xp.greater_equal(t95, 0), xp.asarray(1, dtype=dtype), -1)
     t98 = t95 + t97
     t99 = xp.where(xp.greater(t96, 0), 1/(t96*(t96 + xp.abs(t95))), 0)
     t100 = t7*t59
-    t101 = t99*(t5*t98 + t61*t6 + t65*t9 - t100*t91 + t49*t92 - t3*t93)
+    t101 = t99*(t5*t98 + t61*t6 + t65*t9 + t49*t92 - t3*t93 - t100*t91)
     t102 = t5 - t98*t101
     t103 = t6 - t61*t101
     t104 = t9 - t65*t101
@@ -1853,7 +1853,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t106 = t92 - t49*t101
     t107 = t93 + t3*t101
     t108 = damping + t70
-    t109 = t99*(t58 + t65*t74 + t100*t77 + t100*t49 + t61*t98 + t61*t108)
+    t109 = t99*(t58 + t65*t74 + t61*t98 + t100*t77 + t100*t49 + t108*t61)
     t110 = t61 - t98*t109
     t111 = t108 - t61*t109
     t112 = t74 - t65*t109
@@ -1871,14 +1871,14 @@ def ik_numeric_step(target, q, damping=0.0):
     t124 = t106 - t114*t120
     t125 = t107 - t115*t120
     t126 = damping + t51
-    t127 = t99*(t61*t74 - t63*t76 - t63*t49 + t65*t98 + t65*t126)
+    t127 = t99*(t61*t74 + t65*t98 - t63*t76 - t63*t49 + t126*t65)
     t128 = t65 - t98*t127
     t129 = t74 - t61*t127
     t130 = t126 - t65*t127
     t131 = t72 + t100*t127
     t132 = t63 + t49*t127
     t133 = damping + t68
-    t134 = t99*(-t61*t77 + t72*t65 + t49*t62 + t3*t66 - t100*t98 - t100*t133)
+    t134 = t99*(-t61*t77 + t49*t62 + t3*t66 + t72*t65 - t100*t98 - t100*t133)
     t135 = t100 + t98*t134
     t136 = t77 + t61*t134
     t137 = t72 - t65*t134
@@ -1893,7 +1893,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t146 = t139 - t114*t142
     t147 = t141 - t115*t142
     t148 = damping + t71
-    t149 = t99*(t100*t61 - t63*t65 - t100*t62 + t3*t75 + t49*t98 + t49*t148)
+    t149 = t99*(t3*t75 + t49*t98 + t100*t61 - t63*t65 - t100*t62 + t148*t49)
     t150 = t49 - t98*t149
     t151 = t100 - t61*t149
     t152 = t63 + t65*t149
@@ -1907,7 +1907,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t160 = t154 - t114*t156
     t161 = t155 - t115*t156
     t162 = damping + t55
-    t163 = -t99*(-t2*t61 - t100*t66 + t49*t75 + t3*t98 + t3*t162)
+    t163 = -t99*(t49*t75 - t2*t61 + t3*t98 - t100*t66 + t3*t162)
     t164 = t3 + t98*t163
     t165 = t2 - t61*t163
     t166 = t140 + t100*t163
@@ -1959,7 +1959,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t212 = t205 - t209*t211
     t213 = t206 - t202*t211
     t214 = t65*t163
-    t215 = t119*(t165*t118 - t214*t112 + t113*t166 - t114*t167 + t115*t168)
+    t215 = t119*(t165*t118 + t113*t166 - t114*t167 + t115*t168 - t214*t112)
     t216 = t165 - t118*t215
     t217 = t214 + t112*t215
     t218 = t166 - t113*t215
@@ -1990,9 +1990,9 @@ def ik_numeric_step(target, q, damping=0.0):
     t243 = xp.where(xp.not_equal(t117, 0), -(-(t171*t242 - t143*t241 + t157*t240 + t216*t239) + t121)/t117, 0)
     t244 = xp.where(xp.not_equal(t97, 0), -(-(t110*t243 + t128*t242 - t135*t241 + t150*t240 - t164*t239) + t102)/t97, 0)
     t245 = q1 + t239 - t3*t244 + t2*t243
-    t246 = q2 + c1*t7*t244 + s1*t7*t243 - t4*t242 - s1*t241 + c1*t240
-    t247 = q3 + t18*t244 + t26*t243 + c2*t242
-    t248 = q4 + t18*t241 + t26*t240 + c2*t239
+    t246 = q2 - t4*t242 - s1*t241 + c1*t240 + c1*t7*t244 + s1*t7*t243
+    t247 = q3 + c2*t242 + t18*t244 + t26*t243
+    t248 = q4 + c2*t239 + t18*t241 + t26*t240
     t249 = q5 + t16*t241 + t13*t240 - t38*t239
     t250 = q6 + t20*t241 + t28*t240 - t37*t239
     q_start = _stack(xp, [
@@ -2046,7 +2046,7 @@ def ik_branches(T):
     t12 = t10 + t11
     t13 = -0.412 + t12
     t14 = t13**2
-    t15 = t4**2 + t8**2 + t14
+    t15 = t14 + t4**2 + t8**2
     t16 = 0.01787569 - t15
     t17 = 0.01787569 + t15
     t18 = -t16
@@ -2094,7 +2094,7 @@ def ik_branches(T):
     t60 = 0.01787569 - t57
     t61 = -0.01787569 + t60
     t62 = t22*t43
-    t63 = t59**2 + t62
+    t63 = t62 + t59**2
     t64 = t62 + t61**2
     t65 = t45*t23
     t66 = xp.less_equal(t63, t65)
@@ -2117,18 +2117,18 @@ def ik_branches(T):
     t83 = xp.where(t75, 0, xp.atan2(t41, t36))
     t84 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t83)) + t83
     t85 = 1 - t49
-    t86 = T22*t85
+    t86 = t85*T22
     t87 = t86 + T22*t49
-    t88 = T20*t85
+    t88 = t85*T20
     t89 = t88 + T20*t49
     t90 = t68*t51 - t73*t87
     t91 = t68*t87 + t73*t51
     t92 = t68*t53 - t73*t89
     t93 = t68*t89 + t73*t53
     t94 = 1 - t68
-    t95 = t52*t94
+    t95 = t94*t52
     t96 = t95 + t68*t52
-    t97 = t54*t94
+    t97 = t94*t54
     t98 = t97 + t68*t54
     t99 = t94*t80
     t100 = t99 + t68*t80
@@ -2142,7 +2142,7 @@ def ik_branches(T):
     t108 = t103 + t96*t107
     t109 = t104 + t108
     t110 = t90**2
-    t111 = t110 + t96**2 + t103
+    t111 = t103 + t110 + t96**2
     t112 = t107**2
     t113 = t109**2 + t110*t112
     t114 = t103 + t112
@@ -2168,9 +2168,9 @@ def ik_branches(T):
     t134 = t133
     t135 = t133 + t132**2
     t136 = 1 - t77
-    t137 = T22*t136
+    t137 = t136*T22
     t138 = t137 + T22*t77
-    t139 = T20*t136
+    t139 = t136*T20
     t140 = t139 + T20*t77
     t141 = t68*t79 - t74*t138
     t142 = t68*t138 + t74*t79
@@ -2184,7 +2184,7 @@ def ik_branches(T):
     t150 = t145 + t100*t149
     t151 = t146 + t150
     t152 = t141**2
-    t153 = t152 + t100**2 + t145
+    t153 = t145 + t152 + t100**2
     t154 = t149**2
     t155 = t151**2 + t152*t154
     t156 = t145 + t154
@@ -2226,13 +2226,13 @@ def ik_branches(T):
     t192 = t81*t180 - t140*t185
     t193 = t140*t180 + t81*t185
     t194 = 1 - t180
-    t195 = t52*t194
+    t195 = t194*t52
     t196 = t195 + t52*t180
-    t197 = t54*t194
+    t197 = t194*t54
     t198 = t197 + t54*t180
-    t199 = t80*t194
+    t199 = t194*t80
     t200 = t199 + t80*t180
-    t201 = t82*t194
+    t201 = t194*t82
     t202 = t201 + t82*t180
     t203 = t187**2
     t204 = -t203
@@ -2242,7 +2242,7 @@ def ik_branches(T):
     t208 = t203 + t196*t207
     t209 = t204 + t208
     t210 = t186**2
-    t211 = t210 + t196**2 + t203
+    t211 = t203 + t210 + t196**2
     t212 = t207**2
     t213 = t209**2 + t210*t212
     t214 = t203 + t212
@@ -2275,7 +2275,7 @@ def ik_branches(T):
     t241 = t236 + t200*t240
     t242 = t237 + t241
     t243 = t190**2
-    t244 = t243 + t200**2 + t236
+    t244 = t236 + t243 + t200**2
     t245 = t240**2
     t246 = t242**2 + t243*t245
     t247 = t236 + t245
@@ -2308,67 +2308,67 @@ def ik_branches(T):
     t274 = xp.where(t116, 0, xp.atan2(-t121, t109))
     t275 = t274
     t276 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t275)) + t275
-    t277 = 3.141592653589793 + t274 - 6.283185307179586*xp.ceil(0.15915494309189535*t274)
+    t277 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t274) + t274
     t278 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t277)) + t277
     t279 = xp.where(t125, 0, xp.atan2(-t107, t91))
     t280 = t279
     t281 = -6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t280)) + t280
-    t282 = t279 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t279))
+    t282 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t279)) + t279
     t283 = xp.where(xp.less_equal(t134, 1e-24*t135), 0, xp.atan2(t130, -t131))
     t284 = t283
     t285 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t284)) + t284
-    t286 = 3.141592653589793 + t283 - 6.283185307179586*xp.ceil(0.15915494309189535*t283)
+    t286 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t283) + t283
     t287 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t286)) + t286
     t288 = -t282
-    t289 = t282 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t288))
+    t289 = 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t288)) + t282
     t290 = xp.where(t158, 0, xp.atan2(-t163, t151))
     t291 = t290
     t292 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t291)) + t291
-    t293 = 3.141592653589793 + t290 - 6.283185307179586*xp.ceil(0.15915494309189535*t290)
+    t293 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t290) + t290
     t294 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t293)) + t293
     t295 = xp.where(t167, 0, xp.atan2(-t149, t142))
     t296 = t295
     t297 = -6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t296)) + t296
-    t298 = t295 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t295))
+    t298 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t295)) + t295
     t299 = xp.where(xp.less_equal(t176, 1e-24*t177), 0, xp.atan2(t172, -t173))
     t300 = t299
     t301 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t300)) + t300
-    t302 = 3.141592653589793 + t299 - 6.283185307179586*xp.ceil(0.15915494309189535*t299)
+    t302 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t299) + t299
     t303 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t302)) + t302
     t304 = -t298
-    t305 = t298 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t304))
+    t305 = 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t304)) + t298
     t306 = xp.where(t216, 0, xp.atan2(-t221, t209))
     t307 = t306
     t308 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t307)) + t307
-    t309 = 3.141592653589793 + t306 - 6.283185307179586*xp.ceil(0.15915494309189535*t306)
+    t309 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t306) + t306
     t310 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t309)) + t309
     t311 = xp.where(t225, 0, xp.atan2(-t207, t187))
     t312 = t311
     t313 = -6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t312)) + t312
-    t314 = t311 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t311))
+    t314 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t311)) + t311
     t315 = xp.where(xp.less_equal(t234, 1e-24*t235), 0, xp.atan2(t230, -t231))
     t316 = t315
     t317 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t316)) + t316
-    t318 = 3.141592653589793 + t315 - 6.283185307179586*xp.ceil(0.15915494309189535*t315)
+    t318 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t315) + t315
     t319 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t318)) + t318
     t320 = -t314
-    t321 = t314 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t320))
+    t321 = 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t320)) + t314
     t322 = xp.where(t249, 0, xp.atan2(-t254, t242))
     t323 = t322
     t324 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t323)) + t323
-    t325 = 3.141592653589793 + t322 - 6.283185307179586*xp.ceil(0.15915494309189535*t322)
+    t325 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t322) + t322
     t326 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t325)) + t325
     t327 = xp.where(t258, 0, xp.atan2(-t240, t191))
     t328 = t327
     t329 = -6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t328)) + t328
-    t330 = t327 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t327))
+    t330 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t327)) + t327
     t331 = xp.where(xp.less_equal(t267, 1e-24*t268), 0, xp.atan2(t263, -t264))
     t332 = t331
     t333 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t332)) + t332
-    t334 = 3.141592653589793 + t331 - 6.283185307179586*xp.ceil(0.15915494309189535*t331)
+    t334 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t331) + t331
     t335 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t334)) + t334
     t336 = -t330
-    t337 = t330 + 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t336))
+    t337 = 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t336)) + t330
     t338 = xp.greater_equal(t55, -2.9670597283903604) & xp.less_equal(t55, 2.9670597283903604)
     t339 = xp.less_equal(t56, 2.9670597283903604)
     t340 = xp.where(xp.logical_not(t338) & t339, t56, t55)
@@ -2670,23 +2670,23 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t48 = xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0)
     t49 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
     t50 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t51 = t0 + t50
+    t51 = t50 + t0
     t52 = -t50 + t0
     t53 = xp.where(xp.greater_equal(t0, -2.9670597283903604) & xp.less_equal(t0, 2.9670597283903604), t0, xp.where(xp.greater_equal(t51, -2.9670597283903604) & xp.less_equal(t51, 2.9670597283903604), t51, xp.where(xp.greater_equal(t52, -2.9670597283903604) & xp.less_equal(t52, 2.9670597283903604), t52, qb0_0)))
     t54 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t55 = t1 + t54
+    t55 = t54 + t1
     t56 = -t54 + t1
     t57 = xp.where(xp.greater_equal(t1, -2.9670597283903604) & xp.less_equal(t1, 2.9670597283903604), t1, xp.where(xp.greater_equal(t55, -2.9670597283903604) & xp.less_equal(t55, 2.9670597283903604), t55, xp.where(xp.greater_equal(t56, -2.9670597283903604) & xp.less_equal(t56, 2.9670597283903604), t56, qb0_1)))
     t58 = xp.where(xp.less(t2, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t59 = t2 + t58
+    t59 = t58 + t2
     t60 = -t58 + t2
     t61 = xp.where(xp.greater_equal(t2, -2.9670597283903604) & xp.less_equal(t2, 2.9670597283903604), t2, xp.where(xp.greater_equal(t59, -2.9670597283903604) & xp.less_equal(t59, 2.9670597283903604), t59, xp.where(xp.greater_equal(t60, -2.9670597283903604) & xp.less_equal(t60, 2.9670597283903604), t60, qb0_3)))
     t62 = xp.where(xp.less(t3, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t63 = t3 + t62
+    t63 = t62 + t3
     t64 = -t62 + t3
     t65 = xp.where(xp.greater_equal(t3, -1.5707963267948966) & xp.less_equal(t3, 1.5707963267948966), t3, xp.where(xp.greater_equal(t63, -1.5707963267948966) & xp.less_equal(t63, 1.5707963267948966), t63, xp.where(xp.greater_equal(t64, -1.5707963267948966) & xp.less_equal(t64, 1.5707963267948966), t64, qb0_4)))
     t66 = xp.where(xp.less(t4, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t67 = t4 + t66
+    t67 = t66 + t4
     t68 = -t66 + t4
     t69 = xp.where(xp.greater_equal(t4, -2.9670597283903604) & xp.less_equal(t4, 2.9670597283903604), t4, xp.where(xp.greater_equal(t67, -2.9670597283903604) & xp.less_equal(t67, 2.9670597283903604), t67, xp.where(xp.greater_equal(t68, -2.9670597283903604) & xp.less_equal(t68, 2.9670597283903604), t68, qb0_5)))
     t70 = -qn1
@@ -2705,23 +2705,23 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t83 = xp.where(t77, t69, qn6)
     t84 = xp.where(t77, t76, 0)
     t85 = xp.where(xp.less(t7, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t86 = t7 + t85
+    t86 = t85 + t7
     t87 = -t85 + t7
     t88 = xp.where(xp.greater_equal(t7, -2.9670597283903604) & xp.less_equal(t7, 2.9670597283903604), t7, xp.where(xp.greater_equal(t86, -2.9670597283903604) & xp.less_equal(t86, 2.9670597283903604), t86, xp.where(xp.greater_equal(t87, -2.9670597283903604) & xp.less_equal(t87, 2.9670597283903604), t87, qb1_0)))
     t89 = xp.where(xp.less(t8, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t90 = t8 + t89
+    t90 = t89 + t8
     t91 = -t89 + t8
     t92 = xp.where(xp.greater_equal(t8, -2.9670597283903604) & xp.less_equal(t8, 2.9670597283903604), t8, xp.where(xp.greater_equal(t90, -2.9670597283903604) & xp.less_equal(t90, 2.9670597283903604), t90, xp.where(xp.greater_equal(t91, -2.9670597283903604) & xp.less_equal(t91, 2.9670597283903604), t91, qb1_1)))
     t93 = xp.where(xp.less(t9, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t94 = t9 + t93
+    t94 = t93 + t9
     t95 = -t93 + t9
     t96 = xp.where(xp.greater_equal(t9, -2.9670597283903604) & xp.less_equal(t9, 2.9670597283903604), t9, xp.where(xp.greater_equal(t94, -2.9670597283903604) & xp.less_equal(t94, 2.9670597283903604), t94, xp.where(xp.greater_equal(t95, -2.9670597283903604) & xp.less_equal(t95, 2.9670597283903604), t95, qb1_3)))
     t97 = xp.where(xp.less(t10, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t98 = t10 + t97
+    t98 = t97 + t10
     t99 = -t97 + t10
     t100 = xp.where(xp.greater_equal(t10, -1.5707963267948966) & xp.less_equal(t10, 1.5707963267948966), t10, xp.where(xp.greater_equal(t98, -1.5707963267948966) & xp.less_equal(t98, 1.5707963267948966), t98, xp.where(xp.greater_equal(t99, -1.5707963267948966) & xp.less_equal(t99, 1.5707963267948966), t99, qb1_4)))
     t101 = xp.where(xp.less(t11, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t102 = t11 + t101
+    t102 = t101 + t11
     t103 = -t101 + t11
     t104 = xp.where(xp.greater_equal(t11, -2.9670597283903604) & xp.less_equal(t11, 2.9670597283903604), t11, xp.where(xp.greater_equal(t102, -2.9670597283903604) & xp.less_equal(t102, 2.9670597283903604), t102, xp.where(xp.greater_equal(t103, -2.9670597283903604) & xp.less_equal(t103, 2.9670597283903604), t103, qb1_5)))
     t105 = qw1*(t70 + t88)**2 + qw2*(t71 + t92)**2 + qw3*(t72 + qb1_2)**2 + qw4*(t73 + t96)**2 + qw5*(t74 + t100)**2 + qw6*(t75 + t104)**2
@@ -2737,23 +2737,23 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t115 = xp.where(t109, t104, t83)
     t116 = xp.where(t109, t105, t84)
     t117 = xp.where(xp.less(t13, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t118 = t13 + t117
+    t118 = t117 + t13
     t119 = -t117 + t13
     t120 = xp.where(xp.greater_equal(t13, -2.9670597283903604) & xp.less_equal(t13, 2.9670597283903604), t13, xp.where(xp.greater_equal(t118, -2.9670597283903604) & xp.less_equal(t118, 2.9670597283903604), t118, xp.where(xp.greater_equal(t119, -2.9670597283903604) & xp.less_equal(t119, 2.9670597283903604), t119, qb2_0)))
     t121 = xp.where(xp.less(t14, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t122 = t14 + t121
+    t122 = t121 + t14
     t123 = -t121 + t14
     t124 = xp.where(xp.greater_equal(t14, -2.9670597283903604) & xp.less_equal(t14, 2.9670597283903604), t14, xp.where(xp.greater_equal(t122, -2.9670597283903604) & xp.less_equal(t122, 2.9670597283903604), t122, xp.where(xp.greater_equal(t123, -2.9670597283903604) & xp.less_equal(t123, 2.9670597283903604), t123, qb2_1)))
     t125 = xp.where(xp.less(t15, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t126 = t15 + t125
+    t126 = t125 + t15
     t127 = -t125 + t15
     t128 = xp.where(xp.greater_equal(t15, -2.9670597283903604) & xp.less_equal(t15, 2.9670597283903604), t15, xp.where(xp.greater_equal(t126, -2.9670597283903604) & xp.less_equal(t126, 2.9670597283903604), t126, xp.where(xp.greater_equal(t127, -2.9670597283903604) & xp.less_equal(t127, 2.9670597283903604), t127, qb2_3)))
     t129 = xp.where(xp.less(t16, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t130 = t16 + t129
+    t130 = t129 + t16
     t131 = -t129 + t16
     t132 = xp.where(xp.greater_equal(t16, -1.5707963267948966) & xp.less_equal(t16, 1.5707963267948966), t16, xp.where(xp.greater_equal(t130, -1.5707963267948966) & xp.less_equal(t130, 1.5707963267948966), t130, xp.where(xp.greater_equal(t131, -1.5707963267948966) & xp.less_equal(t131, 1.5707963267948966), t131, qb2_4)))
     t133 = xp.where(xp.less(t17, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t134 = t17 + t133
+    t134 = t133 + t17
     t135 = -t133 + t17
     t136 = xp.where(xp.greater_equal(t17, -2.9670597283903604) & xp.less_equal(t17, 2.9670597283903604), t17, xp.where(xp.greater_equal(t134, -2.9670597283903604) & xp.less_equal(t134, 2.9670597283903604), t134, xp.where(xp.greater_equal(t135, -2.9670597283903604) & xp.less_equal(t135, 2.9670597283903604), t135, qb2_5)))
     t137 = qw1*(t70 + t120)**2 + qw2*(t71 + t124)**2 + qw3*(t72 + qb2_2)**2 + qw4*(t73 + t128)**2 + qw5*(t74 + t132)**2 + qw6*(t75 + t136)**2
@@ -2769,23 +2769,23 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t147 = xp.where(t141, t136, t115)
     t148 = xp.where(t141, t137, t116)
     t149 = xp.where(xp.less(t19, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t150 = t19 + t149
+    t150 = t149 + t19
     t151 = -t149 + t19
     t152 = xp.where(xp.greater_equal(t19, -2.9670597283903604) & xp.less_equal(t19, 2.9670597283903604), t19, xp.where(xp.greater_equal(t150, -2.9670597283903604) & xp.less_equal(t150, 2.9670597283903604), t150, xp.where(xp.greater_equal(t151, -2.9670597283903604) & xp.less_equal(t151, 2.9670597283903604), t151, qb3_0)))
     t153 = xp.where(xp.less(t20, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t154 = t20 + t153
+    t154 = t153 + t20
     t155 = -t153 + t20
     t156 = xp.where(xp.greater_equal(t20, -2.9670597283903604) & xp.less_equal(t20, 2.9670597283903604), t20, xp.where(xp.greater_equal(t154, -2.9670597283903604) & xp.less_equal(t154, 2.9670597283903604), t154, xp.where(xp.greater_equal(t155, -2.9670597283903604) & xp.less_equal(t155, 2.9670597283903604), t155, qb3_1)))
     t157 = xp.where(xp.less(t21, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t158 = t21 + t157
+    t158 = t157 + t21
     t159 = -t157 + t21
     t160 = xp.where(xp.greater_equal(t21, -2.9670597283903604) & xp.less_equal(t21, 2.9670597283903604), t21, xp.where(xp.greater_equal(t158, -2.9670597283903604) & xp.less_equal(t158, 2.9670597283903604), t158, xp.where(xp.greater_equal(t159, -2.9670597283903604) & xp.less_equal(t159, 2.9670597283903604), t159, qb3_3)))
     t161 = xp.where(xp.less(t22, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t162 = t22 + t161
+    t162 = t161 + t22
     t163 = -t161 + t22
     t164 = xp.where(xp.greater_equal(t22, -1.5707963267948966) & xp.less_equal(t22, 1.5707963267948966), t22, xp.where(xp.greater_equal(t162, -1.5707963267948966) & xp.less_equal(t162, 1.5707963267948966), t162, xp.where(xp.greater_equal(t163, -1.5707963267948966) & xp.less_equal(t163, 1.5707963267948966), t163, qb3_4)))
     t165 = xp.where(xp.less(t23, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t166 = t23 + t165
+    t166 = t165 + t23
     t167 = -t165 + t23
     t168 = xp.where(xp.greater_equal(t23, -2.9670597283903604) & xp.less_equal(t23, 2.9670597283903604), t23, xp.where(xp.greater_equal(t166, -2.9670597283903604) & xp.less_equal(t166, 2.9670597283903604), t166, xp.where(xp.greater_equal(t167, -2.9670597283903604) & xp.less_equal(t167, 2.9670597283903604), t167, qb3_5)))
     t169 = qw1*(t70 + t152)**2 + qw2*(t71 + t156)**2 + qw3*(t72 + qb3_2)**2 + qw4*(t73 + t160)**2 + qw5*(t74 + t164)**2 + qw6*(t75 + t168)**2
@@ -2801,23 +2801,23 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t179 = xp.where(t173, t168, t147)
     t180 = xp.where(t173, t169, t148)
     t181 = xp.where(xp.less(t25, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t182 = t25 + t181
+    t182 = t181 + t25
     t183 = -t181 + t25
     t184 = xp.where(xp.greater_equal(t25, -2.9670597283903604) & xp.less_equal(t25, 2.9670597283903604), t25, xp.where(xp.greater_equal(t182, -2.9670597283903604) & xp.less_equal(t182, 2.9670597283903604), t182, xp.where(xp.greater_equal(t183, -2.9670597283903604) & xp.less_equal(t183, 2.9670597283903604), t183, qb4_0)))
     t185 = xp.where(xp.less(t26, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t186 = t26 + t185
+    t186 = t185 + t26
     t187 = -t185 + t26
     t188 = xp.where(xp.greater_equal(t26, -2.9670597283903604) & xp.less_equal(t26, 2.9670597283903604), t26, xp.where(xp.greater_equal(t186, -2.9670597283903604) & xp.less_equal(t186, 2.9670597283903604), t186, xp.where(xp.greater_equal(t187, -2.9670597283903604) & xp.less_equal(t187, 2.9670597283903604), t187, qb4_1)))
     t189 = xp.where(xp.less(t27, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t190 = t27 + t189
+    t190 = t189 + t27
     t191 = -t189 + t27
     t192 = xp.where(xp.greater_equal(t27, -2.9670597283903604) & xp.less_equal(t27, 2.9670597283903604), t27, xp.where(xp.greater_equal(t190, -2.9670597283903604) & xp.less_equal(t190, 2.9670597283903604), t190, xp.where(xp.greater_equal(t191, -2.9670597283903604) & xp.less_equal(t191, 2.9670597283903604), t191, qb4_3)))
     t193 = xp.where(xp.less(t28, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t194 = t28 + t193
+    t194 = t193 + t28
     t195 = -t193 + t28
     t196 = xp.where(xp.greater_equal(t28, -1.5707963267948966) & xp.less_equal(t28, 1.5707963267948966), t28, xp.where(xp.greater_equal(t194, -1.5707963267948966) & xp.less_equal(t194, 1.5707963267948966), t194, xp.where(xp.greater_equal(t195, -1.5707963267948966) & xp.less_equal(t195, 1.5707963267948966), t195, qb4_4)))
     t197 = xp.where(xp.less(t29, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t198 = t29 + t197
+    t198 = t197 + t29
     t199 = -t197 + t29
     t200 = xp.where(xp.greater_equal(t29, -2.9670597283903604) & xp.less_equal(t29, 2.9670597283903604), t29, xp.where(xp.greater_equal(t198, -2.9670597283903604) & xp.less_equal(t198, 2.9670597283903604), t198, xp.where(xp.greater_equal(t199, -2.9670597283903604) & xp.less_equal(t199, 2.9670597283903604), t199, qb4_5)))
     t201 = qw1*(t70 + t184)**2 + qw2*(t71 + t188)**2 + qw3*(t72 + qb4_2)**2 + qw4*(t73 + t192)**2 + qw5*(t74 + t196)**2 + qw6*(t75 + t200)**2
@@ -2833,23 +2833,23 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t211 = xp.where(t205, t200, t179)
     t212 = xp.where(t205, t201, t180)
     t213 = xp.where(xp.less(t31, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t214 = t31 + t213
+    t214 = t213 + t31
     t215 = -t213 + t31
     t216 = xp.where(xp.greater_equal(t31, -2.9670597283903604) & xp.less_equal(t31, 2.9670597283903604), t31, xp.where(xp.greater_equal(t214, -2.9670597283903604) & xp.less_equal(t214, 2.9670597283903604), t214, xp.where(xp.greater_equal(t215, -2.9670597283903604) & xp.less_equal(t215, 2.9670597283903604), t215, qb5_0)))
     t217 = xp.where(xp.less(t32, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t218 = t32 + t217
+    t218 = t217 + t32
     t219 = -t217 + t32
     t220 = xp.where(xp.greater_equal(t32, -2.9670597283903604) & xp.less_equal(t32, 2.9670597283903604), t32, xp.where(xp.greater_equal(t218, -2.9670597283903604) & xp.less_equal(t218, 2.9670597283903604), t218, xp.where(xp.greater_equal(t219, -2.9670597283903604) & xp.less_equal(t219, 2.9670597283903604), t219, qb5_1)))
     t221 = xp.where(xp.less(t33, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t222 = t33 + t221
+    t222 = t221 + t33
     t223 = -t221 + t33
     t224 = xp.where(xp.greater_equal(t33, -2.9670597283903604) & xp.less_equal(t33, 2.9670597283903604), t33, xp.where(xp.greater_equal(t222, -2.9670597283903604) & xp.less_equal(t222, 2.9670597283903604), t222, xp.where(xp.greater_equal(t223, -2.9670597283903604) & xp.less_equal(t223, 2.9670597283903604), t223, qb5_3)))
     t225 = xp.where(xp.less(t34, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t226 = t34 + t225
+    t226 = t225 + t34
     t227 = -t225 + t34
     t228 = xp.where(xp.greater_equal(t34, -1.5707963267948966) & xp.less_equal(t34, 1.5707963267948966), t34, xp.where(xp.greater_equal(t226, -1.5707963267948966) & xp.less_equal(t226, 1.5707963267948966), t226, xp.where(xp.greater_equal(t227, -1.5707963267948966) & xp.less_equal(t227, 1.5707963267948966), t227, qb5_4)))
     t229 = xp.where(xp.less(t35, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t230 = t35 + t229
+    t230 = t229 + t35
     t231 = -t229 + t35
     t232 = xp.where(xp.greater_equal(t35, -2.9670597283903604) & xp.less_equal(t35, 2.9670597283903604), t35, xp.where(xp.greater_equal(t230, -2.9670597283903604) & xp.less_equal(t230, 2.9670597283903604), t230, xp.where(xp.greater_equal(t231, -2.9670597283903604) & xp.less_equal(t231, 2.9670597283903604), t231, qb5_5)))
     t233 = qw1*(t70 + t216)**2 + qw2*(t71 + t220)**2 + qw3*(t72 + qb5_2)**2 + qw4*(t73 + t224)**2 + qw5*(t74 + t228)**2 + qw6*(t75 + t232)**2
@@ -2865,23 +2865,23 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t243 = xp.where(t237, t232, t211)
     t244 = xp.where(t237, t233, t212)
     t245 = xp.where(xp.less(t37, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t246 = t37 + t245
+    t246 = t245 + t37
     t247 = -t245 + t37
     t248 = xp.where(xp.greater_equal(t37, -2.9670597283903604) & xp.less_equal(t37, 2.9670597283903604), t37, xp.where(xp.greater_equal(t246, -2.9670597283903604) & xp.less_equal(t246, 2.9670597283903604), t246, xp.where(xp.greater_equal(t247, -2.9670597283903604) & xp.less_equal(t247, 2.9670597283903604), t247, qb6_0)))
     t249 = xp.where(xp.less(t38, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t250 = t38 + t249
+    t250 = t249 + t38
     t251 = -t249 + t38
     t252 = xp.where(xp.greater_equal(t38, -2.9670597283903604) & xp.less_equal(t38, 2.9670597283903604), t38, xp.where(xp.greater_equal(t250, -2.9670597283903604) & xp.less_equal(t250, 2.9670597283903604), t250, xp.where(xp.greater_equal(t251, -2.9670597283903604) & xp.less_equal(t251, 2.9670597283903604), t251, qb6_1)))
     t253 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t254 = t39 + t253
+    t254 = t253 + t39
     t255 = -t253 + t39
     t256 = xp.where(xp.greater_equal(t39, -2.9670597283903604) & xp.less_equal(t39, 2.9670597283903604), t39, xp.where(xp.greater_equal(t254, -2.9670597283903604) & xp.less_equal(t254, 2.9670597283903604), t254, xp.where(xp.greater_equal(t255, -2.9670597283903604) & xp.less_equal(t255, 2.9670597283903604), t255, qb6_3)))
     t257 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t258 = t40 + t257
+    t258 = t257 + t40
     t259 = -t257 + t40
     t260 = xp.where(xp.greater_equal(t40, -1.5707963267948966) & xp.less_equal(t40, 1.5707963267948966), t40, xp.where(xp.greater_equal(t258, -1.5707963267948966) & xp.less_equal(t258, 1.5707963267948966), t258, xp.where(xp.greater_equal(t259, -1.5707963267948966) & xp.less_equal(t259, 1.5707963267948966), t259, qb6_4)))
     t261 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t262 = t41 + t261
+    t262 = t261 + t41
     t263 = -t261 + t41
     t264 = xp.where(xp.greater_equal(t41, -2.9670597283903604) & xp.less_equal(t41, 2.9670597283903604), t41, xp.where(xp.greater_equal(t262, -2.9670597283903604) & xp.less_equal(t262, 2.9670597283903604), t262, xp.where(xp.greater_equal(t263, -2.9670597283903604) & xp.less_equal(t263, 2.9670597283903604), t263, qb6_5)))
     t265 = qw1*(t70 + t248)**2 + qw2*(t71 + t252)**2 + qw3*(t72 + qb6_2)**2 + qw4*(t73 + t256)**2 + qw5*(t74 + t260)**2 + qw6*(t75 + t264)**2
@@ -2897,23 +2897,23 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t275 = xp.where(t269, t264, t243)
     t276 = xp.where(t269, t265, t244)
     t277 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t278 = t43 + t277
+    t278 = t277 + t43
     t279 = -t277 + t43
     t280 = xp.where(xp.greater_equal(t43, -2.9670597283903604) & xp.less_equal(t43, 2.9670597283903604), t43, xp.where(xp.greater_equal(t278, -2.9670597283903604) & xp.less_equal(t278, 2.9670597283903604), t278, xp.where(xp.greater_equal(t279, -2.9670597283903604) & xp.less_equal(t279, 2.9670597283903604), t279, qb7_0)))
     t281 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t282 = t44 + t281
+    t282 = t281 + t44
     t283 = -t281 + t44
     t284 = xp.where(xp.greater_equal(t44, -2.9670597283903604) & xp.less_equal(t44, 2.9670597283903604), t44, xp.where(xp.greater_equal(t282, -2.9670597283903604) & xp.less_equal(t282, 2.9670597283903604), t282, xp.where(xp.greater_equal(t283, -2.9670597283903604) & xp.less_equal(t283, 2.9670597283903604), t283, qb7_1)))
     t285 = xp.where(xp.less(t45, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t286 = t45 + t285
+    t286 = t285 + t45
     t287 = -t285 + t45
     t288 = xp.where(xp.greater_equal(t45, -2.9670597283903604) & xp.less_equal(t45, 2.9670597283903604), t45, xp.where(xp.greater_equal(t286, -2.9670597283903604) & xp.less_equal(t286, 2.9670597283903604), t286, xp.where(xp.greater_equal(t287, -2.9670597283903604) & xp.less_equal(t287, 2.9670597283903604), t287, qb7_3)))
     t289 = xp.where(xp.less(t46, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t290 = t46 + t289
+    t290 = t289 + t46
     t291 = -t289 + t46
     t292 = xp.where(xp.greater_equal(t46, -1.5707963267948966) & xp.less_equal(t46, 1.5707963267948966), t46, xp.where(xp.greater_equal(t290, -1.5707963267948966) & xp.less_equal(t290, 1.5707963267948966), t290, xp.where(xp.greater_equal(t291, -1.5707963267948966) & xp.less_equal(t291, 1.5707963267948966), t291, qb7_4)))
     t293 = xp.where(xp.less(t47, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t294 = t47 + t293
+    t294 = t293 + t47
     t295 = -t293 + t47
     t296 = xp.where(xp.greater_equal(t47, -2.9670597283903604) & xp.less_equal(t47, 2.9670597283903604), t47, xp.where(xp.greater_equal(t294, -2.9670597283903604) & xp.less_equal(t294, 2.9670597283903604), t294, xp.where(xp.greater_equal(t295, -2.9670597283903604) & xp.less_equal(t295, 2.9670597283903604), t295, qb7_5)))
     t297 = qw1*(t70 + t280)**2 + qw2*(t71 + t284)**2 + qw3*(t72 + qb7_2)**2 + qw4*(t73 + t288)**2 + qw5*(t74 + t292)**2 + qw6*(t75 + t296)**2

@@ -433,13 +433,13 @@ def jacobian_tool(q):
         t43,  # 3, 2
         t43,  # 3, 3
         -c234*t19 + t9*t8 + t14*t13,  # 3, 4
-        -(-t6*t9 + t3*t14 + t19*t21),  # 3, 5
+        -(t3*t14 + t19*t21 - t6*t9),  # 3, 5
         t20,  # 4, 0
         t44,  # 4, 1
         t44,  # 4, 2
         t44,  # 4, 3
         -(c234*t20 + t10*t8 + t15*t13),  # 4, 4
-        -(-t3*t15 + t6*t10 + t20*t21),  # 4, 5
+        -(t6*t10 + t20*t21 - t3*t15),  # 4, 5
         -t21,  # 5, 0
         t45,  # 5, 1
         t45,  # 5, 2
@@ -484,8 +484,8 @@ def task(q):
     t11 = c6*t8 - s1*t9
     t12 = c234*c6 - c5*t9
     t13 = 0.09465*s234
-    t14 = c1*t13 + 0.0823*t7
-    t15 = s1*t13 - 0.0823*t4
+    t14 = 0.0823*t7 + c1*t13
+    t15 = -0.0823*t4 + s1*t13
     t16 = 0.10915*s1 + t14
     t17 = t15 - 0.10915*c1
     t18 = s5*s234
@@ -543,8 +543,8 @@ def task_jacobian(q):
     t10 = t3*c6 - c1*t9
     t11 = c6*t8 - s1*t9
     t12 = 0.09465*s234
-    t13 = c1*t12 + 0.0823*t7
-    t14 = s1*t12 - 0.0823*t4
+    t13 = 0.0823*t7 + c1*t12
+    t14 = -0.0823*t4 + s1*t12
     t15 = 0.10915*s1 + t13
     t16 = t14 - 0.10915*c1
     t17 = s5*s234
@@ -563,7 +563,7 @@ def task_jacobian(q):
     t30 = c1*t11
     t31 = t10**2 + t11**2
     t32 = 1/t31
-    t33 = (t29 - t30)*t32
+    t33 = t32*(-t30 + t29)
     t34 = c1*t10
     t35 = s1*t11
     t36 = t32*(s234*t34 + s234*t35)
@@ -691,25 +691,25 @@ def fk_jacobian_dot(q, q_dot):
     t50 = c1*qd3
     t51 = t49 + t50
     t52 = s1*qd4
-    t53 = t48 + t52
+    t53 = t52 + t48
     t54 = t53 + t8*qd5
     t55 = c1*qd4
-    t56 = t51 + t55
+    t56 = t55 + t51
     t57 = -t56 + t13*qd5
     t58 = c234*qd5
-    t59 = qd1 - t58
+    t59 = -t58 + qd1
     t60 = t34*qd5
     t61 = t60 + t22*t55
-    t62 = t61 + t23*t50
-    t63 = t62 + t24*t49
+    t62 = t23*t50 + t61
+    t63 = t24*t49 + t62
     t64 = t63 - t31*qd1
     t65 = t37*qd5
     t66 = t65 + t22*t52
-    t67 = t66 + t23*t47
-    t68 = t67 + t24*t46
+    t67 = t23*t47 + t66
+    t68 = t24*t46 + t67
     t69 = t68 + t30*qd1
     t70 = t45*qd5
-    t71 = t70 + t43*qd4
+    t71 = t43*qd4 + t70
     t72 = t71 + t41*qd3
     t73 = t72 + t39*qd2
     t74 = -t3
@@ -777,11 +777,11 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t75, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t69 - qd2*(qd1*t78 + c1*t73) - qd3*(t49*t41 + qd1*t79 + c1*t72) - qd4*(t43*t51 + t32*qd1 + c1*t71) + qd5*(-t45*t56 - t37*qd1 + t13*t70 + t58*t37), batch),  # 0
-        xp.broadcast_to(qd1*t64 + qd2*(qd1*t76 - s1*t73) - qd3*(-qd1*t77 + t46*t41 + s1*t72) - qd4*(-t35*qd1 + t43*t48 + s1*t71) - qd5*(-t34*qd1 + t45*t53 + t58*t34 + t8*t70), batch),  # 1
-        xp.broadcast_to(qd2*(s1*t68 + c1*t63) + qd3*(s1**2*t81 + c1**2*t81 + s1*t67 + c1*t62) + qd4*(t32*t48 + t35*t51 + s1*t66 + c1*t61) + qd5*(t37*t53 + t34*t56 + t8*t65 - t13*t60), batch),  # 2
-        xp.broadcast_to(t49*qd1 + t50*qd1 + t55*qd1 + qd5*(c234*t56 - t13*qd1) + qd6*(-t21*t57 + t3*t59), batch),  # 3
-        xp.broadcast_to(t46*qd1 + t47*qd1 + t52*qd1 + qd5*(t8*qd1 + c234*t53) + qd6*(t6*t59 + t21*t54), batch),  # 4
+        xp.broadcast_to(-qd1*t69 - qd2*(c1*t73 + qd1*t78) - qd3*(c1*t72 + t49*t41 + qd1*t79) - qd4*(t43*t51 + c1*t71 + t32*qd1) + qd5*(-t45*t56 - t37*qd1 + t13*t70 + t58*t37), batch),  # 0
+        xp.broadcast_to(qd1*t64 + qd2*(-s1*t73 + qd1*t76) - qd3*(s1*t72 - qd1*t77 + t46*t41) - qd4*(t43*t48 + s1*t71 - t35*qd1) - qd5*(t45*t53 + t58*t34 + t8*t70 - t34*qd1), batch),  # 1
+        xp.broadcast_to(qd2*(s1*t68 + c1*t63) + qd3*(s1*t67 + c1*t62 + s1**2*t81 + c1**2*t81) + qd4*(s1*t66 + c1*t61 + t32*t48 + t35*t51) + qd5*(t37*t53 + t34*t56 + t8*t65 - t13*t60), batch),  # 2
+        xp.broadcast_to(t49*qd1 + t50*qd1 + t55*qd1 + qd5*(c234*t56 - t13*qd1) + qd6*(t3*t59 - t21*t57), batch),  # 3
+        xp.broadcast_to(t46*qd1 + t47*qd1 + t52*qd1 + qd5*(c234*t53 + t8*qd1) + qd6*(t6*t59 + t21*t54), batch),  # 4
         xp.broadcast_to(qd4*(-c1*t48 + s1*t51) + qd5*(t13*t53 + t8*t56) - qd6*(t3*t54 + t6*t57), batch),  # 5
     ], (6,))
     return T, J, a
@@ -814,8 +814,8 @@ def jacobian_dot(q, q_dot):
     t1 = s1*c5 - c1*t0
     t2 = c1*c5 + s1*t0
     t3 = 0.09465*s234
-    t4 = c1*t3 + 0.0823*t1
-    t5 = s1*t3 - 0.0823*t2
+    t4 = 0.0823*t1 + c1*t3
+    t5 = -0.0823*t2 + s1*t3
     t6 = 0.10915*s1 + t4
     t7 = t5 - 0.10915*c1
     t8 = c1*t6 + s1*t7
@@ -844,20 +844,20 @@ def jacobian_dot(q, q_dot):
     t31 = c1*qd3
     t32 = t30 + t31
     t33 = s1*qd4
-    t34 = t29 + t33
+    t34 = t33 + t29
     t35 = t34 + t24*qd5
     t36 = c1*qd4
-    t37 = t32 + t36
+    t37 = t36 + t32
     t38 = -t37 + t25*qd5
     t39 = c234*qd5
-    t40 = qd1 - t39
+    t40 = -t39 + qd1
     t41 = t22*qd5
     t42 = t41 + t10*t36
-    t43 = t42 + t11*t31
+    t43 = t11*t31 + t42
     t44 = t43 + t12*t30
     t45 = t44 - t19*qd1
     t46 = t23*qd5
-    t47 = t46 + t10*t33
+    t47 = t10*t33 + t46
     t48 = t47 + t11*t28
     t49 = t48 + t12*t27
     t50 = t49 + t18*qd1
@@ -871,19 +871,19 @@ def jacobian_dot(q, q_dot):
     Jd = _stack(xp, [
         xp.broadcast_to(-t50, batch),  # 0, 0
         xp.broadcast_to(-(t12*t55 + c1*t54), batch),  # 0, 1
-        xp.broadcast_to(-(t30*t16 + t11*t55 + c1*t53), batch),  # 0, 2
-        xp.broadcast_to(-(t8*t32 + t10*t55 + c1*t52), batch),  # 0, 3
-        xp.broadcast_to(-t26*t37 - t23*qd1 + t25*t51 + t39*t23, batch),  # 0, 4
+        xp.broadcast_to(-(t11*t55 + c1*t53 + t30*t16), batch),  # 0, 2
+        xp.broadcast_to(-(t10*t55 + t8*t32 + c1*t52), batch),  # 0, 3
+        xp.broadcast_to(t25*t51 - t26*t37 - t23*qd1 + t39*t23, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t45, batch),  # 1, 0
         xp.broadcast_to(t12*t56 - s1*t54, batch),  # 1, 1
-        xp.broadcast_to(-(-t11*t56 + t27*t16 + s1*t53), batch),  # 1, 2
-        xp.broadcast_to(-(-t10*t56 + t8*t29 + s1*t52), batch),  # 1, 3
-        xp.broadcast_to(-(-t22*qd1 + t26*t34 + t39*t22 + t24*t51), batch),  # 1, 4
+        xp.broadcast_to(-(s1*t53 - t11*t56 + t27*t16), batch),  # 1, 2
+        xp.broadcast_to(-(t8*t29 + s1*t52 - t10*t56), batch),  # 1, 3
+        xp.broadcast_to(-(t26*t34 - t22*qd1 + t39*t22 + t24*t51), batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(s1*t49 + c1*t44, batch),  # 2, 1
-        xp.broadcast_to(s1**2*t57 + c1**2*t57 + s1*t48 + c1*t43, batch),  # 2, 2
+        xp.broadcast_to(s1*t48 + c1*t43 + s1**2*t57 + c1**2*t57, batch),  # 2, 2
         xp.broadcast_to(s1*t10*t29 + c1*t10*t32 + s1*t47 + c1*t42, batch),  # 2, 3
         xp.broadcast_to(t23*t34 + t22*t37 + t24*t46 - t25*t41, batch),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
@@ -892,12 +892,12 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(t56, batch),  # 3, 2
         xp.broadcast_to(t56, batch),  # 3, 3
         xp.broadcast_to(c234*t37 - s234*t55, batch),  # 3, 4
-        xp.broadcast_to(-t9*t38 + t2*t40, batch),  # 3, 5
+        xp.broadcast_to(t2*t40 - t9*t38, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t55, batch),  # 4, 1
         xp.broadcast_to(t55, batch),  # 4, 2
         xp.broadcast_to(t55, batch),  # 4, 3
-        xp.broadcast_to(s234*t56 + c234*t34, batch),  # 4, 4
+        xp.broadcast_to(c234*t34 + s234*t56, batch),  # 4, 4
         xp.broadcast_to(t1*t40 + t9*t35, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
@@ -937,8 +937,8 @@ def bias_acceleration(q, q_dot):
     t1 = s1*c5 - c1*t0
     t2 = c1*c5 + s1*t0
     t3 = 0.09465*s234
-    t4 = c1*t3 + 0.0823*t1
-    t5 = s1*t3 - 0.0823*t2
+    t4 = 0.0823*t1 + c1*t3
+    t5 = -0.0823*t2 + s1*t3
     t6 = 0.10915*s1 + t4
     t7 = t5 - 0.10915*c1
     t8 = c1*t6 + s1*t7
@@ -967,20 +967,20 @@ def bias_acceleration(q, q_dot):
     t31 = c1*qd3
     t32 = t30 + t31
     t33 = s1*qd4
-    t34 = t29 + t33
+    t34 = t33 + t29
     t35 = t34 + t24*qd5
     t36 = c1*qd4
-    t37 = t32 + t36
+    t37 = t36 + t32
     t38 = -t37 + t25*qd5
     t39 = c234*qd5
-    t40 = qd1 - t39
+    t40 = -t39 + qd1
     t41 = t22*qd5
     t42 = t41 + t10*t36
-    t43 = t42 + t11*t31
+    t43 = t11*t31 + t42
     t44 = t43 + t12*t30
     t45 = t44 - t19*qd1
     t46 = t23*qd5
-    t47 = t46 + t10*t33
+    t47 = t10*t33 + t46
     t48 = t47 + t11*t28
     t49 = t48 + t12*t27
     t50 = t49 + t18*qd1
@@ -992,12 +992,12 @@ def bias_acceleration(q, q_dot):
     t56 = c1*qd1
     t57 = t11*qd2
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t50 - qd2*(t12*t55 + c1*t54) - qd3*(t30*t16 + t11*t55 + c1*t53) - qd4*(t8*t32 + t10*t55 + c1*t52) + qd5*(-t26*t37 - t23*qd1 + t25*t51 + t39*t23), batch),  # 0
-        xp.broadcast_to(qd1*t45 + qd2*(t12*t56 - s1*t54) - qd3*(-t11*t56 + t27*t16 + s1*t53) - qd4*(-t10*t56 + t8*t29 + s1*t52) - qd5*(-t22*qd1 + t26*t34 + t39*t22 + t24*t51), batch),  # 1
-        xp.broadcast_to(qd2*(s1*t49 + c1*t44) + qd3*(s1**2*t57 + c1**2*t57 + s1*t48 + c1*t43) + qd4*(s1*t10*t29 + c1*t10*t32 + s1*t47 + c1*t42) + qd5*(t23*t34 + t22*t37 + t24*t46 - t25*t41), batch),  # 2
-        xp.broadcast_to(t30*qd1 + t31*qd1 + t36*qd1 + qd5*(c234*t37 - t25*qd1) + qd6*(-t9*t38 + t2*t40), batch),  # 3
-        xp.broadcast_to(t27*qd1 + t28*qd1 + t33*qd1 + qd5*(t24*qd1 + c234*t34) + qd6*(t1*t40 + t9*t35), batch),  # 4
-        xp.broadcast_to(qd4*(-c1*t29 + s1*t32) + qd5*(t25*t34 + t24*t37) - qd6*(t2*t35 + t1*t38), batch),  # 5
+        xp.broadcast_to(-qd1*t50 - qd2*(t12*t55 + c1*t54) - qd3*(t11*t55 + c1*t53 + t30*t16) - qd4*(t10*t55 + t8*t32 + c1*t52) + qd5*(t25*t51 - t26*t37 - t23*qd1 + t39*t23), batch),  # 0
+        xp.broadcast_to(qd1*t45 + qd2*(t12*t56 - s1*t54) - qd3*(s1*t53 - t11*t56 + t27*t16) - qd4*(t8*t29 + s1*t52 - t10*t56) - qd5*(t26*t34 - t22*qd1 + t39*t22 + t24*t51), batch),  # 1
+        xp.broadcast_to(qd2*(s1*t49 + c1*t44) + qd4*(s1*t10*t29 + c1*t10*t32 + s1*t47 + c1*t42) + qd3*(s1*t48 + c1*t43 + s1**2*t57 + c1**2*t57) + qd5*(t23*t34 + t22*t37 + t24*t46 - t25*t41), batch),  # 2
+        xp.broadcast_to(t30*qd1 + t31*qd1 + t36*qd1 + qd5*(c234*t37 - t25*qd1) + qd6*(t2*t40 - t9*t38), batch),  # 3
+        xp.broadcast_to(t33*qd1 + t27*qd1 + t28*qd1 + qd5*(c234*t34 + t24*qd1) + qd6*(t1*t40 + t9*t35), batch),  # 4
+        xp.broadcast_to(qd4*(-c1*t29 + s1*t32) - qd6*(t2*t35 + t1*t38) + qd5*(t25*t34 + t24*t37), batch),  # 5
     ], (6,))
     return a
 
@@ -1073,14 +1073,14 @@ def task_jacobian_dot(q, q_dot):
     t42 = t41
     t43 = -c1*t38 + s1*t42
     t44 = s1*qd4
-    t45 = t38 + t44
-    t46 = t9*qd1 + c234*t45
+    t45 = t44 + t38
+    t46 = c234*t45 + t9*qd1
     t47 = c1*qd4
-    t48 = t42 + t47
+    t48 = t47 + t42
     t49 = c234*t48 - t13*qd1
     t50 = t13*t45 + t9*t48
     t51 = t9*qd5
-    t52 = t45 + t51
+    t52 = t51 + t45
     t53 = t37 + t44 + t51 + t7*qd6
     t54 = t13*qd5
     t55 = -t48 + t54
@@ -1088,8 +1088,8 @@ def task_jacobian_dot(q, q_dot):
     t57 = -t54 + t41 + t47 + t4*qd6
     t58 = t14*t53 + t10*t57
     t59 = c234*qd5
-    t60 = qd1 - t59
-    t61 = -t21*t55 + t4*t60
+    t60 = -t59 + qd1
+    t61 = t4*t60 - t21*t55
     t62 = t7*t60 + t21*t52
     t63 = -qd1 + t59 + t21*qd6
     t64 = -t0*t57 + t14*t63
@@ -1097,7 +1097,7 @@ def task_jacobian_dot(q, q_dot):
     t66 = t25*qd5
     t67 = t66 + t22*t47
     t68 = t67 + t23*t40
-    t69 = t68 + t24*t39
+    t69 = t24*t39 + t68
     t70 = t69 - t33*qd1
     t71 = t26*qd5
     t72 = t71 + t22*t44
@@ -1112,25 +1112,25 @@ def task_jacobian_dot(q, q_dot):
     t81 = t80 + t30*qd3
     t82 = t81 + t34*qd2
     t83 = -t18*t48 - t26*qd1 + t13*t79 + t59*t26
-    t84 = -t25*qd1 + t18*t45 + t59*t25 + t9*t79
+    t84 = t18*t45 - t25*qd1 + t59*t25 + t9*t79
     t85 = s1*qd1
-    t86 = t24*t85 + c1*t82
-    t87 = t39*t30 + t23*t85 + c1*t81
-    t88 = t17*t42 + t22*t85 + c1*t80
+    t86 = c1*t82 + t24*t85
+    t87 = c1*t81 + t39*t30 + t23*t85
+    t88 = t17*t42 + c1*t80 + t22*t85
     t89 = c1*qd1
-    t90 = t24*t89 - s1*t82
-    t91 = -t23*t89 + t35*t30 + s1*t81
-    t92 = -t22*t89 + t17*t38 + s1*t80
+    t90 = -s1*t82 + t24*t89
+    t91 = s1*t81 - t23*t89 + t35*t30
+    t92 = t17*t38 + s1*t80 - t22*t89
     t93 = t23*qd2
-    t94 = s1**2*t93 + c1**2*t93 + s1*t73 + c1*t68
+    t94 = s1*t73 + c1*t68 + s1**2*t93 + c1**2*t93
     t95 = s1*t10
     t96 = c1*t14
     t97 = 1/t19
-    t98 = (t95 - t96)*t97
+    t98 = t97*(-t96 + t95)
     t99 = (t7*t10 - t4*t14)*t97
     t100 = c1*t10
     t101 = s1*t14
-    t102 = (s234*t100 + s234*t101)*t97
+    t102 = t97*(s234*t100 + s234*t101)
     t103 = 1/t20
     t104 = t97*t103
     t105 = -t104*(t100 + t101)
@@ -1144,7 +1144,7 @@ def task_jacobian_dot(q, q_dot):
     t113 = qd1*t97
     t114 = t100*t113
     t115 = t101*t113
-    t116 = t110 - t112 + t114 + t115
+    t116 = -t112 + t110 + t114 + t115
     t117 = 2*t102
     t118 = t109*(t9 - t10*t117)
     t119 = t111*(t13 - t14*t117)
@@ -1158,10 +1158,10 @@ def task_jacobian_dot(q, q_dot):
     t127 = t61*t120
     t128 = t62*t122
     t129 = qd1*t103
-    t130 = -t64*(c1*t103 + t10*t105) + t65*(s1*t103 + t14*t105) - t96*t129 + t95*t129
+    t130 = -t64*(t10*t105 + c1*t103) + t65*(t14*t105 + s1*t103) - t96*t129 + t95*t129
     t131 = t14*t103
     t132 = t10*t103
-    t133 = t0*t110 - t0*t112 + t58*t98 + t0*t114 + t0*t115
+    t133 = t58*t98 + t0*t110 - t0*t112 + t0*t114 + t0*t115
     t134 = -t133
     Jd = _stack(xp, [
         xp.broadcast_to(-t75, batch),  # 0, 0
@@ -1186,20 +1186,20 @@ def task_jacobian_dot(q, q_dot):
         xp.broadcast_to(t116, batch),  # 3, 1
         xp.broadcast_to(t116, batch),  # 3, 2
         xp.broadcast_to(t116, batch),  # 3, 3
-        xp.broadcast_to(t118 - t119 + t121 + t123, batch),  # 3, 4
-        xp.broadcast_to(t125 - t126 + t127 + t128, batch),  # 3, 5
+        xp.broadcast_to(-t119 + t118 + t121 + t123, batch),  # 3, 4
+        xp.broadcast_to(-t126 + t125 + t127 + t128, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(t130, batch),  # 4, 1
         xp.broadcast_to(t130, batch),  # 4, 2
         xp.broadcast_to(t130, batch),  # 4, 3
-        xp.broadcast_to(t64*(t13*t103 - t10*t106) + t65*(t9*t103 + t14*t106) - t49*t131 + t46*t132, batch),  # 4, 4
-        xp.broadcast_to(-t64*(t4*t103 + t10*t107) + t65*(t7*t103 + t14*t107) - t61*t131 + t62*t132, batch),  # 4, 5
+        xp.broadcast_to(t64*(-t10*t106 + t13*t103) + t65*(t14*t106 + t9*t103) - t49*t131 + t46*t132, batch),  # 4, 4
+        xp.broadcast_to(-t64*(t10*t107 + t4*t103) + t65*(t14*t107 + t7*t103) - t61*t131 + t62*t132, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.broadcast_to(t134, batch),  # 5, 1
         xp.broadcast_to(t134, batch),  # 5, 2
         xp.broadcast_to(-(-t43 + t133), batch),  # 5, 3
-        xp.broadcast_to(-(-t50 + t0*t118 - t0*t119 + t58*t102 + t0*t121 + t0*t123), batch),  # 5, 4
-        xp.broadcast_to(-(t56 + t0*t125 - t0*t126 + t58*t99 + t0*t127 + t0*t128), batch),  # 5, 5
+        xp.broadcast_to(-(-t50 + t58*t102 + t0*t118 - t0*t119 + t0*t121 + t0*t123), batch),  # 5, 4
+        xp.broadcast_to(-(t56 + t58*t99 + t0*t125 - t0*t126 + t0*t127 + t0*t128), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1263,12 +1263,12 @@ def hessian(q):
     t38 = -s1*t14
     t39 = s1**2
     t40 = c1**2
-    t41 = t39*t1 + t40*t1
-    t42 = t39*t0 + t40*t0
+    t41 = t1*t39 + t1*t40
+    t42 = t0*t39 + t0*t40
     t43 = s1*t26 + c1*t24
     t44 = s5*t7
     t45 = s5*t10
-    t46 = t39*s234 + t40*s234
+    t46 = s234*t39 + s234*t40
     t47 = c1*t4 - s1*t6
     t48 = s5*s234**2
     H = _stack(xp, [
@@ -1321,7 +1321,7 @@ def hessian(q):
         t38,  # 1, 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        t39*t2 + t40*t2,  # 1, 2, 1
+        t2*t39 + t2*t40,  # 1, 2, 1
         t41,  # 1, 2, 2
         t42,  # 1, 2, 3
         t43,  # 1, 2, 4
@@ -1420,7 +1420,7 @@ def hessian(q):
         t35,  # 4, 0, 1
         t35,  # 4, 0, 2
         t35,  # 4, 0, 3
-        t10*t14 + c234*t26,  # 4, 0, 4
+        c234*t26 + t10*t14,  # 4, 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0, 5
         t24,  # 4, 1, 0
         t38,  # 4, 1, 1
@@ -1439,7 +1439,7 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 4
-        -(s1*t48 + c234*t6),  # 4, 3, 5
+        -(c234*t6 + s1*t48),  # 4, 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4, 2
@@ -1618,18 +1618,18 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t30 = t22 - c234*t29
     t31 = t23**2
     t32 = c1**2
-    t33 = t32*t14 + t32*t13 + t32*t12 - t6*t26
+    t33 = t13*t32 + t14*t32 + t12*t32 - t6*t26
     t34 = t14**2
     t35 = t13**2
     t36 = t12**2
     t37 = t26**2 + t32*t34 + t32*t35 + t32*t36
     t38 = t31 + t37
     t39 = c1*s1
-    t40 = -t22*t23 + t34*t39 + t35*t39 + t36*t39 + t26*t29
+    t40 = -t22*t23 + t26*t29 + t34*t39 + t35*t39 + t36*t39
     t41 = c1*t24
     t42 = c1*t20
     t43 = c1*t9
-    t44 = t14*t41 + t13*t42 + t12*t43 + t26*t10
+    t44 = t26*t10 + t14*t41 + t13*t42 + t12*t43
     t45 = t41 + t42 + t43 - t6*t10
     t46 = c1*t14
     t47 = c1*t13
@@ -1638,23 +1638,23 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t50 = t48 - t6*t29
     t51 = t22**2
     t52 = s1**2
-    t53 = t52*t14 + t52*t13 + t52*t12 + t3*t29
-    t54 = t29**2 + t52*t34 + t52*t35 + t52*t36
+    t53 = t12*t52 + t14*t52 + t13*t52 + t3*t29
+    t54 = t29**2 + t34*t52 + t35*t52 + t36*t52
     t55 = t51 + t54
     t56 = s1*t24
     t57 = s1*t20
     t58 = s1*t9
-    t59 = t14*t56 + t13*t57 + t12*t58 + t29*t10
+    t59 = t14*t56 + t29*t10 + t13*t57 + t12*t58
     t60 = t56 + t57 + t58 + t3*t10
     t61 = t24**2
     t62 = t10**2
-    t63 = t61 + t20**2 + t9**2 + t62
+    t63 = t20**2 + t9**2 + t61 + t62
     t64 = t63
     t65 = s234**2
     t66 = t1**2 + 3*t52 + t32*t65
     t67 = t66
     t68 = 3*s1
-    t69 = c1*t68 - t39*t65 + t1*t2
+    t69 = t1*t2 + c1*t68 - t39*t65
     t70 = t2**2 + 3*t32 + t52*t65
     t71 = t70
     t72 = c234**2
@@ -1680,7 +1680,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t92 = mu_dot4 + t33*t87
     t93 = mu_dot5 + t27*t87
     t94 = t80 + t55
-    t95 = t86*(t40*t85 + t40*t94 + t44*t59 + t49*t53 + t33*t50 - t27*t30)
+    t95 = t86*(t40*t85 + t44*t59 + t49*t53 + t33*t50 - t27*t30 + t94*t40)
     t96 = t40 - t85*t95
     t97 = t94 - t40*t95
     t98 = t59 - t44*t95
@@ -1699,7 +1699,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t111 = t93 - t101*t106
     t112 = t80 + t64
     t113 = t80 + t67
-    t114 = t86*(t49*t85 + t40*t53 + t44*t60 + t49*t113 + t33*t69 + t27*t15)
+    t114 = t86*(t49*t85 + t40*t53 + t44*t60 + t33*t69 + t27*t15 + t113*t49)
     t115 = t49 - t85*t114
     t116 = t53 - t40*t114
     t117 = t60 - t44*t114
@@ -1713,7 +1713,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t125 = t119 - t100*t121
     t126 = t120 - t101*t121
     t127 = t80 + t71
-    t128 = -t86*(t33*t85 + t40*t50 + t44*t45 + t49*t69 + t33*t127 + t27*t16)
+    t128 = -t86*(t33*t85 + t40*t50 + t44*t45 + t49*t69 + t27*t16 + t127*t33)
     t129 = t33 + t85*t128
     t130 = t50 + t40*t128
     t131 = t45 + t44*t128
@@ -1727,16 +1727,16 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t139 = t133 - t100*t135
     t140 = t134 - t101*t135
     t141 = t80 + t74
-    t142 = xp.sqrt(2*t75 + 2*t76 + 2*t59**2 + 2*t77 + 2*t53**2 + 2*t60**2 + 2*t78 + 2*t50**2 + 2*t45**2 + 2*t69**2 + 2*t79 + 2*t30**2 + 2*t15**2 + 2*t16**2 + t82 + t94**2 + t112**2 + t113**2 + t127**2 + t141**2 + 2*t72*t62)
+    t142 = xp.sqrt(2*t75 + 2*t76 + 2*t59**2 + 2*t77 + 2*t53**2 + 2*t60**2 + 2*t78 + 2*t50**2 + 2*t45**2 + 2*t69**2 + 2*t79 + 2*t30**2 + 2*t15**2 + 2*t16**2 + t82 + t94**2 + t112**2 + t113**2 + t127**2 + t141**2 + 2*t62*t72)
     t143 = c234*t10
-    t144 = t86*(t44*t85 + t40*t59 + t44*t112 + t49*t60 + t33*t45 + t143*t27)
+    t144 = t86*(t44*t85 + t40*t59 + t49*t60 + t33*t45 + t112*t44 + t143*t27)
     t145 = t44 - t85*t144
     t146 = t59 - t40*t144
     t147 = t112 - t44*t144
     t148 = t60 - t49*t144
     t149 = -t45 + t33*t144
     t150 = -t143 + t27*t144
-    t151 = -t86*(t27*t85 - t40*t30 + t143*t44 + t49*t15 + t33*t16 + t27*t141)
+    t151 = -t86*(t27*t85 + t49*t15 + t33*t16 + t143*t44 + t141*t27 - t40*t30)
     t152 = t27 + t85*t151
     t153 = t30 - t40*t151
     t154 = t143 + t44*t151
@@ -1818,8 +1818,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t230 = xp.where(xp.not_equal(t103, 0), -(-(t159*t229 + t122*t228 - t136*t227 + t165*t226) + t107)/t103, 0)
     t231 = xp.where(xp.not_equal(t84, 0), -(-(t96*t230 + t145*t229 + t115*t228 - t129*t227 - t152*t226) + t88)/t84, 0)
     t232 = t226 - t23*t231 + t22*t230
-    t233 = t26*t231 + t29*t230 + t10*t229 + t3*t228 + t6*t227 - c234*t226
-    t234 = -t1*t228 + t2*t227 + t11*t226
+    t233 = t26*t231 + t29*t230 + t10*t229 - c234*t226 + t3*t228 + t6*t227
+    t234 = t2*t227 - t1*t228 + t11*t226
     t235 = s1*t14
     t236 = s1*t228 - c1*t227
     t237 = t236 + t24*t229 + t46*t231 + t235*t230
@@ -1830,29 +1830,29 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t242 = xp.sqrt(t37 + t54 + t63 + t66 + t70 + t73 + t241)
     t243 = xp.sqrt(1 + t241)
     t244 = t243*xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)
-    t245 = -t23
-    t246 = t245 + t244
-    t247 = xp.where(xp.greater(t243, 0), 1/(t243*(t243 + xp.abs(t245))), 0)
-    t248 = t247*(t46*t246 + t22*t235)
-    t249 = t46 - t246*t248
+    t245 = xp.where(xp.greater(t243, 0), 1/(t243*(t243 + xp.abs(t23))), 0)
+    t246 = -t23
+    t247 = t246 + t244
+    t248 = t245*(t46*t247 + t22*t235)
+    t249 = t46 - t247*t248
     t250 = t235 - t22*t248
-    t251 = t247*(t47*t246 + t22*t239)
-    t252 = t47 - t246*t251
+    t251 = t245*(t47*t247 + t22*t239)
+    t252 = t47 - t247*t251
     t253 = t239 - t22*t251
-    t254 = t247*(t28*t246 + t22*t25)
-    t255 = t28 - t246*t254
+    t254 = t245*(t28*t247 + t22*t25)
+    t255 = t28 - t247*t254
     t256 = t25 - t22*t254
-    t257 = t247*(mu_dot5 + mu_dot0*t246 + t22*mu_dot1)
-    t258 = mu_dot0 - t246*t257
+    t257 = t245*(mu_dot5 + mu_dot0*t247 + t22*mu_dot1)
+    t258 = mu_dot0 - t247*t257
     t259 = mu_dot1 - t22*t257
     t260 = -t257 + mu_dot5
     t261 = -c234
-    t262 = t247*(t261 + t26*t246 + t22*t29)
-    t263 = t26 - t246*t262
+    t262 = t245*(t261 + t26*t247 + t22*t29)
+    t263 = t26 - t247*t262
     t264 = t29 - t22*t262
     t265 = c234 + t262
     t266 = -t11
-    t267 = t11*t247
+    t267 = t11*t245
     t268 = t266 + t267
     t269 = t32 + t52
     t270 = xp.sqrt(t61 + t269 + t248**2 + t250**2)
@@ -1882,8 +1882,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t294 = mu_dot4 + c1*t290
     t295 = t260 + t248*t290
     t296 = -c1
-    t297 = t296 + c1*t274
-    t298 = t296 + c1*t279
+    t297 = c1*t274 + t296
+    t298 = c1*t279 + t296
     t299 = xp.sqrt(t276**2 + t277**2 + t297**2 + t278**2)
     t300 = t299*xp.where(xp.greater_equal(t276, 0), xp.asarray(1, dtype=dtype), -1)
     t301 = t276 + t300
@@ -1923,16 +1923,16 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t335 = t328 - t332*t334
     t336 = t329 - t325*t334
     t337 = t22*t267
-    t338 = t273*(s1*t1 + c1*t2 + t272*t337 - t248*t268)
-    t339 = t337 - t272*t338
+    t338 = t273*(s1*t1 + c1*t2 - t248*t268 + t272*t337)
+    t339 = -t272*t338 + t337
     t340 = t1 - s1*t338
     t341 = t268 + t248*t338
     t342 = -t2
-    t343 = t342 + c1*t338
-    t344 = 1 + t245 + t342 + t261 + q1 + q2 + q3 + q4 + q5 + t3 + t6 + q6 + t1 + t22 + t266 + t46 + t47 + t28 + t235 + t239 + t25 + t26 + t29 + t24 + t20 + t9 + t10 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + t68 - 3*c1
+    t343 = c1*t338 + t342
+    t344 = 1 + q1 + q2 + q3 + q4 + q5 + q6 + t1 + t22 + t3 + t6 + t25 + t28 + t46 + t47 + t26 + t29 + t24 + t20 + t9 + t10 + t68 + t235 + t239 + t246 + t261 + t266 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping - 3*c1 + t342
     t345 = t24*t338
-    t346 = t302*(-t301*t345 + t277*t340 + t297*t343 + t278*t341)
-    t347 = t345 + t301*t346
+    t346 = t302*(t277*t340 + t297*t343 + t278*t341 - t301*t345)
+    t347 = t301*t346 + t345
     t348 = t340 - t277*t346
     t349 = t343 - t297*t346
     t350 = t341 - t278*t346
@@ -1947,14 +1947,14 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t359 = t358
     t360 = t359*xp.where(xp.greater_equal(t357, 0), xp.asarray(1, dtype=dtype), -1)
     t361 = t357 + t360
-    t362 = xp.where(xp.greater(t359, 0), 1/(t359*(t358 + t359)), 0)
+    t362 = xp.where(xp.greater(t359, 0), 1/(t359*(t359 + t358)), 0)
     t363 = t336 - t336*t361**2*t362
     t364 = xp.where(xp.not_equal(t360, 0), -t363/t360, 0)
     t365 = xp.where(xp.not_equal(t331, 0), -(t335 - t356*t364)/t331, 0)
     t366 = xp.where(xp.not_equal(t319, 0), -(-(t323*t365 + t352*t364) + t327)/t319, 0)
     t367 = xp.where(xp.not_equal(t300, 0), -(-(t304*t366 + t309*t365 - t347*t364) + t314)/t300, 0)
     t368 = xp.where(xp.not_equal(t271, 0), -(-(t275*t367 + t280*t366 + t285*t365 + t339*t364) + t291)/t271, 0)
-    t369 = xp.where(xp.not_equal(t244, 0), -(-(t249*t368 + t252*t367 + t255*t366 + t263*t365 + t267*t246*t364) + t258)/t244, 0)
+    t369 = xp.where(xp.not_equal(t244, 0), -(-(t249*t368 + t252*t367 + t255*t366 + t263*t365 + t267*t247*t364) + t258)/t244, 0)
     t370 = xp.isfinite(t344)
     t371 = xp.greater_equal(damping, 0)
     t372 = xp.greater(damping, 0)
@@ -2042,9 +2042,9 @@ def ik_numeric_step(target, q, damping=0.0):
     t21 = t20 - 0.10915*c1
     t22 = c1*t13 + s1*t21
     t23 = t20*t9 - t12*t17
-    t24 = -t18*T00 + t19*T01 + t4*T02
-    t25 = -t18*T10 + t19*T11 + t4*T12
-    t26 = -t18*T20 + t19*T21 + t4*T22
+    t24 = t19*T01 + t4*T02 - t18*T00
+    t25 = t19*T11 + t4*T12 - t18*T10
+    t26 = t19*T21 + t4*T22 - t18*T20
     t27 = 0.5*(t24 + t15)
     t28 = c5*s234
     t29 = c234*s6 + c6*t28
@@ -2079,24 +2079,24 @@ def ik_numeric_step(target, q, damping=0.0):
     t58 = -t52 + T03
     t59 = -t53 + T13
     t60 = c1**2
-    t61 = t60*t34 + t60*t33 + t60*t32 - t17*t36
+    t61 = t34*t60 + t33*t60 + t32*t60 - t17*t36
     t62 = t34**2
     t63 = t33**2
     t64 = t32**2
     t65 = t53**2 + t36**2 + t60*t62 + t60*t63 + t60*t64
     t66 = c1*s1
-    t67 = -t52*t53 + t62*t66 + t63*t66 + t64*t66 + t36*t37
+    t67 = -t52*t53 + t36*t37 + t62*t66 + t63*t66 + t64*t66
     t68 = c1*t54
     t69 = c1*t50
     t70 = c1*t22
-    t71 = t34*t68 + t33*t69 + t32*t70 + t36*t23
+    t71 = t36*t23 + t34*t68 + t33*t69 + t32*t70
     t72 = t68 + t69 + t70 - t17*t23
     t73 = t34*t66 + t33*t66 + t32*t66
     t74 = t73 + t9*t36
     t75 = t73 - t17*t37
     t76 = s1**2
-    t77 = t52**2 + t37**2 + t76*t62 + t76*t63 + t76*t64
-    t78 = t76*t34 + t76*t33 + t76*t32 + t9*t37
+    t77 = t52**2 + t37**2 + t62*t76 + t63*t76 + t64*t76
+    t78 = t34*t76 + t33*t76 + t32*t76 + t9*t37
     t79 = s1*t54
     t80 = s1*t50
     t81 = s1*t22
@@ -2104,7 +2104,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t83 = t79 + t80 + t81 + t9*t23
     t84 = s234**2
     t85 = t7**2 + 3*t76 + t60*t84
-    t86 = 3*t66 - t66*t84 + t7*t4
+    t86 = 3*t66 + t7*t4 - t66*t84
     t87 = t4**2 + 3*t60 + t76*t84
     t88 = 1 + c234**2 + s5**2*t84
     t89 = -t25
@@ -2125,7 +2125,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t104 = xp.where(t100, t27*t92, t101*t97)
     t105 = t102**2 + t103**2 + t104**2 + t58**2 + t59**2 + t46**2
     t106 = damping + t65
-    t107 = xp.sqrt(t67**2 + t71**2 + t74**2 + t61**2 + t55**2 + t106**2)
+    t107 = xp.sqrt(t106**2 + t67**2 + t71**2 + t74**2 + t61**2 + t55**2)
     t108 = t107*xp.where(xp.greater_equal(t106, 0), xp.asarray(1, dtype=dtype), -1)
     t109 = t106 + t108
     t110 = xp.where(xp.greater(t107, 0), 1/(t107*(t107 + xp.abs(t106))), 0)
@@ -2137,7 +2137,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t116 = t103 + t61*t111
     t117 = t104 + t55*t111
     t118 = damping + t77
-    t119 = t110*(t71*t82 + t74*t78 + t61*t75 - t55*t56 + t67*t109 + t67*t118)
+    t119 = t110*(t71*t82 + t74*t78 + t61*t75 - t55*t56 + t67*t109 + t118*t67)
     t120 = t67 - t109*t119
     t121 = t118 - t67*t119
     t122 = t82 - t71*t119
@@ -2156,7 +2156,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t135 = t117 - t125*t130
     t136 = c234*t23
     t137 = damping + t57
-    t138 = t110*(t67*t82 + t74*t83 + t61*t72 + t136*t55 + t71*t109 + t71*t137)
+    t138 = t110*(t67*t82 + t74*t83 + t61*t72 + t71*t109 + t136*t55 + t137*t71)
     t139 = t71 - t109*t138
     t140 = t82 - t67*t138
     t141 = t137 - t71*t138
@@ -2179,7 +2179,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t158 = t134 - t149*t155
     t159 = t135 - t150*t155
     t160 = damping + t85
-    t161 = t110*(t67*t78 + t71*t83 + t61*t86 + t55*t38 + t74*t109 + t74*t160)
+    t161 = t110*(t67*t78 + t71*t83 + t61*t86 + t55*t38 + t74*t109 + t160*t74)
     t162 = t74 - t109*t161
     t163 = t78 - t67*t161
     t164 = t83 - t71*t161
@@ -2206,7 +2206,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t185 = t158 - t177*t183
     t186 = t159 - t178*t183
     t187 = damping + t87
-    t188 = -t110*(t67*t75 + t71*t72 + t74*t86 + t55*t39 + t61*t109 + t61*t187)
+    t188 = -t110*(t67*t75 + t71*t72 + t74*t86 + t55*t39 + t61*t109 + t187*t61)
     t189 = t61 + t109*t188
     t190 = t75 + t67*t188
     t191 = t72 + t71*t188
@@ -2236,7 +2236,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t215 = t185 - t212*t214
     t216 = t186 - t209*t214
     t217 = damping + t88
-    t218 = -t110*(-t67*t56 + t136*t71 + t74*t38 + t61*t39 + t55*t109 + t55*t217)
+    t218 = -t110*(t74*t38 + t61*t39 - t67*t56 + t55*t109 + t136*t71 + t217*t55)
     t219 = t55 + t109*t218
     t220 = t56 - t67*t218
     t221 = t136 + t71*t218
@@ -2274,7 +2274,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t253 = xp.where(xp.not_equal(t127, 0), -(-(t146*t252 + t169*t251 - t196*t250 + t226*t249) + t131)/t127, 0)
     t254 = xp.where(xp.not_equal(t108, 0), -(-(t120*t253 + t139*t252 + t162*t251 - t189*t250 - t219*t249) + t112)/t108, 0)
     t255 = q1 + t249 - t53*t254 + t52*t253
-    t256 = q5 + t36*t254 + t37*t253 + t23*t252 + t9*t251 + t17*t250 - c234*t249
+    t256 = q5 + t36*t254 + t37*t253 + t23*t252 - c234*t249 + t9*t251 + t17*t250
     t257 = q6 + t7*t251 - t4*t250 - t31*t249
     t258 = c1*t254
     t259 = s1*t253
@@ -2358,7 +2358,7 @@ def ik_branches(T):
     t37 = -t33 + t35
     t38 = t32*t4
     t39 = t34*t8
-    t40 = xp.where(t18, 0, t38 - t39)
+    t40 = xp.where(t18, 0, -t39 + t38)
     t41 = t38 + t39
     t42 = t4*t36 + t8*t40
     t43 = t8*t36 - t4*t40
@@ -2369,13 +2369,13 @@ def ik_branches(T):
     t48 = T00*t41 - T10*t37
     t49 = T01*t41 - T11*t37
     t50 = 1 - t36
-    t51 = t13*t50
+    t51 = t50*t13
     t52 = t51 + t13*t36
     t53 = T02*t40
     t54 = T12*t36
-    t55 = t53 - t54
+    t55 = -t54 + t53
     t56 = 1 - t55**2
-    t57 = t54 - t53
+    t57 = -t53 + t54
     t58 = xp.greater(t56, 1e-12)
     t59 = xp.where(t58, t55, xp.where(xp.greater(t55, 0), xp.asarray(1, dtype=dtype), -1))
     t60 = xp.where(t58, xp.sqrt(t56), 0)
@@ -2384,13 +2384,13 @@ def ik_branches(T):
     t63 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t62)) + t62
     t64 = t61 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t61))
     t65 = t59*t57
-    t66 = t60*t44 - t65
+    t66 = -t65 + t60*t44
     t67 = t65 + t66
     t68 = t60**2
-    t69 = t59**2 + t68
+    t69 = t68 + t59**2
     t70 = t45**2
     t71 = t67**2 + t68*t70
-    t72 = t44**2 + t57**2 + t70
+    t72 = t70 + t44**2 + t57**2
     t73 = xp.less_equal(t71, 1e-24*t72*t69)
     t74 = xp.where(t73, 1, 1/xp.sqrt(t71))
     t75 = xp.where(t73, 1, t67*t74)
@@ -2400,9 +2400,9 @@ def ik_branches(T):
     t79 = xp.where(t73, 0, -t78*t74)
     t80 = t59*t75
     t81 = t59*t79
-    t82 = -t80*T00 + T02*t77 + t81*T01
-    t83 = -t80*T10 + T12*t77 + t81*T11
-    t84 = -t80*T20 + T22*t77 + t81*T21
+    t82 = T02*t77 - t80*T00 + t81*T01
+    t83 = T12*t77 - t80*T10 + t81*T11
+    t84 = T22*t77 - t80*T20 + t81*T21
     t85 = t50*t84
     t86 = t36*t82 + t40*t83
     t87 = -t36*t83 + t40*t82
@@ -2417,7 +2417,7 @@ def ik_branches(T):
     t96 = 0.10915*(1 - t94)
     t97 = 0.10915*(1 + t94)
     t98 = 0.10915*t94
-    t99 = t96 + t98
+    t99 = t98 + t96
     t100 = t43 + t99
     t101 = -t97 + t98
     t102 = -t101 + t43
@@ -2456,7 +2456,7 @@ def ik_branches(T):
     t135 = t134 + t108*t131
     t136 = t134 + t108*t133
     t137 = -t108*t124
-    t138 = t104*t131 + t137
+    t138 = t137 + t104*t131
     t139 = t135**2 + t138**2
     t140 = t137 + t104*t133
     t141 = t136**2 + t140**2
@@ -2480,7 +2480,7 @@ def ik_branches(T):
     t159 = t158 + t113*t155
     t160 = t158 + t113*t157
     t161 = -t113*t152
-    t162 = t105*t155 + t161
+    t162 = t161 + t105*t155
     t163 = t159**2 + t162**2
     t164 = t161 + t105*t157
     t165 = t160**2 + t164**2
@@ -2488,13 +2488,13 @@ def ik_branches(T):
     t167 = t166 + t155**2
     t168 = t166 + t157**2
     t169 = 1 - t37
-    t170 = t13*t169
+    t170 = t169*t13
     t171 = t170 + t13*t37
     t172 = T02*t41
     t173 = T12*t37
-    t174 = t172 - t173
+    t174 = -t173 + t172
     t175 = 1 - t174**2
-    t176 = t173 - t172
+    t176 = -t172 + t173
     t177 = xp.greater(t175, 1e-12)
     t178 = xp.where(t177, t174, xp.where(xp.greater(t174, 0), xp.asarray(1, dtype=dtype), -1))
     t179 = xp.where(t177, xp.sqrt(t175), 0)
@@ -2503,13 +2503,13 @@ def ik_branches(T):
     t182 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t181)) + t181
     t183 = t180 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t180))
     t184 = t178*t176
-    t185 = t179*t48 - t184
+    t185 = -t184 + t179*t48
     t186 = t184 + t185
     t187 = t179**2
-    t188 = t178**2 + t187
+    t188 = t187 + t178**2
     t189 = t49**2
     t190 = t186**2 + t187*t189
-    t191 = t48**2 + t176**2 + t189
+    t191 = t189 + t48**2 + t176**2
     t192 = xp.less_equal(t190, 1e-24*t191*t188)
     t193 = xp.where(t192, 1, 1/xp.sqrt(t190))
     t194 = xp.where(t192, 1, t186*t193)
@@ -2519,9 +2519,9 @@ def ik_branches(T):
     t198 = xp.where(t192, 0, -t197*t193)
     t199 = t178*t194
     t200 = t178*t198
-    t201 = -t199*T00 + T02*t196 + t200*T01
-    t202 = -t199*T10 + T12*t196 + t200*T11
-    t203 = -t199*T20 + T22*t196 + t200*T21
+    t201 = T02*t196 - t199*T00 + t200*T01
+    t202 = T12*t196 - t199*T10 + t200*T11
+    t203 = T22*t196 - t199*T20 + t200*T21
     t204 = t169*t203
     t205 = t37*t201 + t41*t202
     t206 = -t37*t202 + t41*t201
@@ -2536,7 +2536,7 @@ def ik_branches(T):
     t215 = 0.10915*(1 - t213)
     t216 = 0.10915*(1 + t213)
     t217 = 0.10915*t213
-    t218 = t215 + t217
+    t218 = t217 + t215
     t219 = t47 + t218
     t220 = -t216 + t217
     t221 = -t220 + t47
@@ -2575,7 +2575,7 @@ def ik_branches(T):
     t254 = t253 + t227*t250
     t255 = t253 + t227*t252
     t256 = -t227*t243
-    t257 = t223*t250 + t256
+    t257 = t256 + t223*t250
     t258 = t254**2 + t257**2
     t259 = t256 + t223*t252
     t260 = t255**2 + t259**2
@@ -2599,7 +2599,7 @@ def ik_branches(T):
     t278 = t277 + t232*t274
     t279 = t277 + t232*t276
     t280 = -t232*t271
-    t281 = t224*t274 + t280
+    t281 = t280 + t224*t274
     t282 = t278**2 + t281**2
     t283 = t280 + t224*t276
     t284 = t279**2 + t283**2
@@ -2615,11 +2615,11 @@ def ik_branches(T):
     t294 = t289 + t122
     t295 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t293 + t294)) + t292 + t294
     t296 = -t295
-    t297 = t295 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t296))
+    t297 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t296)) + t295
     t298 = xp.where(t73, 0, xp.atan2(-t78, t67))
     t299 = t298
     t300 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t299)) + t299
-    t301 = 3.141592653589793 + t298 - 6.283185307179586*xp.ceil(0.15915494309189535*t298)
+    t301 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t298) + t298
     t302 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t301)) + t301
     t303 = xp.where(xp.less_equal(t141, t288*t144), 0, xp.atan2(-t140, t136))
     t304 = t303
@@ -2627,7 +2627,7 @@ def ik_branches(T):
     t306 = t123 + t303
     t307 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t293 + t306)) + t292 + t306
     t308 = -t307
-    t309 = t307 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t308))
+    t309 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t308)) + t307
     t310 = 1e-24*t114
     t311 = xp.where(xp.less_equal(t163, t167*t310), 0, xp.atan2(-t162, t159))
     t312 = t311
@@ -2638,9 +2638,9 @@ def ik_branches(T):
     t317 = t292 + t311
     t318 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t150 + t317)) + t314 + t317
     t319 = -t318
-    t320 = t318 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t319))
+    t320 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t319)) + t318
     t321 = -t64
-    t322 = t64 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t321))
+    t322 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t321)) + t64
     t323 = xp.where(xp.less_equal(t165, t168*t310), 0, xp.atan2(-t164, t160))
     t324 = t323
     t325 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t324)) + t324
@@ -2650,7 +2650,7 @@ def ik_branches(T):
     t329 = t292 + t323
     t330 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t151 + t329)) + t326 + t329
     t331 = -t330
-    t332 = t330 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t331))
+    t332 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t331)) + t330
     t333 = 1e-24*t228
     t334 = xp.where(xp.less_equal(t258, t262*t333), 0, xp.atan2(-t257, t254))
     t335 = t334
@@ -2660,11 +2660,11 @@ def ik_branches(T):
     t339 = t241 + t334
     t340 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t338 + t339)) + t337 + t339
     t341 = -t340
-    t342 = t340 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t341))
+    t342 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t341)) + t340
     t343 = xp.where(t192, 0, xp.atan2(-t197, t186))
     t344 = t343
     t345 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t344)) + t344
-    t346 = 3.141592653589793 + t343 - 6.283185307179586*xp.ceil(0.15915494309189535*t343)
+    t346 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t343) + t343
     t347 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t346)) + t346
     t348 = xp.where(xp.less_equal(t260, t263*t333), 0, xp.atan2(-t259, t255))
     t349 = t348
@@ -2672,7 +2672,7 @@ def ik_branches(T):
     t351 = t242 + t348
     t352 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t338 + t351)) + t337 + t351
     t353 = -t352
-    t354 = t352 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t353))
+    t354 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t353)) + t352
     t355 = 1e-24*t233
     t356 = xp.where(xp.less_equal(t282, t286*t355), 0, xp.atan2(-t281, t278))
     t357 = t356
@@ -2683,9 +2683,9 @@ def ik_branches(T):
     t362 = t337 + t356
     t363 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t269 + t362)) + t359 + t362
     t364 = -t363
-    t365 = t363 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t364))
+    t365 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t364)) + t363
     t366 = -t183
-    t367 = t183 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t366))
+    t367 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t366)) + t183
     t368 = xp.where(xp.less_equal(t284, t287*t355), 0, xp.atan2(-t283, t279))
     t369 = t368
     t370 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t369)) + t369
@@ -2695,7 +2695,7 @@ def ik_branches(T):
     t374 = t337 + t368
     t375 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t270 + t374)) + t371 + t374
     t376 = -t375
-    t377 = t375 + 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t376))
+    t377 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t376)) + t375
     t378 = xp.greater_equal(t28, -6.283185307179586) & xp.less_equal(t28, 6.283185307179586)
     t379 = xp.less_equal(t29, 6.283185307179586)
     t380 = xp.where(xp.logical_not(t378) & t379, t29, t28)
@@ -3024,27 +3024,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t56 = xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0)
     t57 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
     t58 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t59 = t0 + t58
+    t59 = t58 + t0
     t60 = -t58 + t0
     t61 = xp.where(xp.greater_equal(t0, -6.283185307179586) & xp.less_equal(t0, 6.283185307179586), t0, xp.where(xp.greater_equal(t59, -6.283185307179586) & xp.less_equal(t59, 6.283185307179586), t59, xp.where(xp.greater_equal(t60, -6.283185307179586) & xp.less_equal(t60, 6.283185307179586), t60, qb0_0)))
     t62 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t63 = t1 + t62
+    t63 = t62 + t1
     t64 = -t62 + t1
     t65 = xp.where(xp.greater_equal(t1, -6.283185307179586) & xp.less_equal(t1, 6.283185307179586), t1, xp.where(xp.greater_equal(t63, -6.283185307179586) & xp.less_equal(t63, 6.283185307179586), t63, xp.where(xp.greater_equal(t64, -6.283185307179586) & xp.less_equal(t64, 6.283185307179586), t64, qb0_1)))
     t66 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t67 = t2 + t66
+    t67 = t66 + t2
     t68 = -t66 + t2
     t69 = xp.where(xp.greater_equal(t2, -6.283185307179586) & xp.less_equal(t2, 6.283185307179586), t2, xp.where(xp.greater_equal(t67, -6.283185307179586) & xp.less_equal(t67, 6.283185307179586), t67, xp.where(xp.greater_equal(t68, -6.283185307179586) & xp.less_equal(t68, 6.283185307179586), t68, qb0_2)))
     t70 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t71 = t3 + t70
+    t71 = t70 + t3
     t72 = -t70 + t3
     t73 = xp.where(xp.greater_equal(t3, -6.283185307179586) & xp.less_equal(t3, 6.283185307179586), t3, xp.where(xp.greater_equal(t71, -6.283185307179586) & xp.less_equal(t71, 6.283185307179586), t71, xp.where(xp.greater_equal(t72, -6.283185307179586) & xp.less_equal(t72, 6.283185307179586), t72, qb0_3)))
     t74 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t75 = t4 + t74
+    t75 = t74 + t4
     t76 = -t74 + t4
     t77 = xp.where(xp.greater_equal(t4, -6.283185307179586) & xp.less_equal(t4, 6.283185307179586), t4, xp.where(xp.greater_equal(t75, -6.283185307179586) & xp.less_equal(t75, 6.283185307179586), t75, xp.where(xp.greater_equal(t76, -6.283185307179586) & xp.less_equal(t76, 6.283185307179586), t76, qb0_4)))
     t78 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t79 = t5 + t78
+    t79 = t78 + t5
     t80 = -t78 + t5
     t81 = xp.where(xp.greater_equal(t5, -6.283185307179586) & xp.less_equal(t5, 6.283185307179586), t5, xp.where(xp.greater_equal(t79, -6.283185307179586) & xp.less_equal(t79, 6.283185307179586), t79, xp.where(xp.greater_equal(t80, -6.283185307179586) & xp.less_equal(t80, 6.283185307179586), t80, qb0_5)))
     t82 = -qn1
@@ -3063,27 +3063,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t95 = xp.where(t89, t81, qn6)
     t96 = xp.where(t89, t88, 0)
     t97 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t98 = t8 + t97
+    t98 = t97 + t8
     t99 = -t97 + t8
     t100 = xp.where(xp.greater_equal(t8, -6.283185307179586) & xp.less_equal(t8, 6.283185307179586), t8, xp.where(xp.greater_equal(t98, -6.283185307179586) & xp.less_equal(t98, 6.283185307179586), t98, xp.where(xp.greater_equal(t99, -6.283185307179586) & xp.less_equal(t99, 6.283185307179586), t99, qb1_0)))
     t101 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t102 = t9 + t101
+    t102 = t101 + t9
     t103 = -t101 + t9
     t104 = xp.where(xp.greater_equal(t9, -6.283185307179586) & xp.less_equal(t9, 6.283185307179586), t9, xp.where(xp.greater_equal(t102, -6.283185307179586) & xp.less_equal(t102, 6.283185307179586), t102, xp.where(xp.greater_equal(t103, -6.283185307179586) & xp.less_equal(t103, 6.283185307179586), t103, qb1_1)))
     t105 = xp.where(xp.less(t10, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t106 = t10 + t105
+    t106 = t105 + t10
     t107 = -t105 + t10
     t108 = xp.where(xp.greater_equal(t10, -6.283185307179586) & xp.less_equal(t10, 6.283185307179586), t10, xp.where(xp.greater_equal(t106, -6.283185307179586) & xp.less_equal(t106, 6.283185307179586), t106, xp.where(xp.greater_equal(t107, -6.283185307179586) & xp.less_equal(t107, 6.283185307179586), t107, qb1_2)))
     t109 = xp.where(xp.less(t11, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t110 = t11 + t109
+    t110 = t109 + t11
     t111 = -t109 + t11
     t112 = xp.where(xp.greater_equal(t11, -6.283185307179586) & xp.less_equal(t11, 6.283185307179586), t11, xp.where(xp.greater_equal(t110, -6.283185307179586) & xp.less_equal(t110, 6.283185307179586), t110, xp.where(xp.greater_equal(t111, -6.283185307179586) & xp.less_equal(t111, 6.283185307179586), t111, qb1_3)))
     t113 = xp.where(xp.less(t12, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t114 = t12 + t113
+    t114 = t113 + t12
     t115 = -t113 + t12
     t116 = xp.where(xp.greater_equal(t12, -6.283185307179586) & xp.less_equal(t12, 6.283185307179586), t12, xp.where(xp.greater_equal(t114, -6.283185307179586) & xp.less_equal(t114, 6.283185307179586), t114, xp.where(xp.greater_equal(t115, -6.283185307179586) & xp.less_equal(t115, 6.283185307179586), t115, qb1_4)))
     t117 = xp.where(xp.less(t13, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t118 = t13 + t117
+    t118 = t117 + t13
     t119 = -t117 + t13
     t120 = xp.where(xp.greater_equal(t13, -6.283185307179586) & xp.less_equal(t13, 6.283185307179586), t13, xp.where(xp.greater_equal(t118, -6.283185307179586) & xp.less_equal(t118, 6.283185307179586), t118, xp.where(xp.greater_equal(t119, -6.283185307179586) & xp.less_equal(t119, 6.283185307179586), t119, qb1_5)))
     t121 = qw1*(t82 + t100)**2 + qw2*(t83 + t104)**2 + qw3*(t84 + t108)**2 + qw4*(t85 + t112)**2 + qw5*(t86 + t116)**2 + qw6*(t87 + t120)**2
@@ -3099,27 +3099,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t131 = xp.where(t125, t120, t95)
     t132 = xp.where(t125, t121, t96)
     t133 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t134 = t15 + t133
+    t134 = t133 + t15
     t135 = -t133 + t15
     t136 = xp.where(xp.greater_equal(t15, -6.283185307179586) & xp.less_equal(t15, 6.283185307179586), t15, xp.where(xp.greater_equal(t134, -6.283185307179586) & xp.less_equal(t134, 6.283185307179586), t134, xp.where(xp.greater_equal(t135, -6.283185307179586) & xp.less_equal(t135, 6.283185307179586), t135, qb2_0)))
     t137 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t138 = t16 + t137
+    t138 = t137 + t16
     t139 = -t137 + t16
     t140 = xp.where(xp.greater_equal(t16, -6.283185307179586) & xp.less_equal(t16, 6.283185307179586), t16, xp.where(xp.greater_equal(t138, -6.283185307179586) & xp.less_equal(t138, 6.283185307179586), t138, xp.where(xp.greater_equal(t139, -6.283185307179586) & xp.less_equal(t139, 6.283185307179586), t139, qb2_1)))
     t141 = xp.where(xp.less(t17, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t142 = t17 + t141
+    t142 = t141 + t17
     t143 = -t141 + t17
     t144 = xp.where(xp.greater_equal(t17, -6.283185307179586) & xp.less_equal(t17, 6.283185307179586), t17, xp.where(xp.greater_equal(t142, -6.283185307179586) & xp.less_equal(t142, 6.283185307179586), t142, xp.where(xp.greater_equal(t143, -6.283185307179586) & xp.less_equal(t143, 6.283185307179586), t143, qb2_2)))
     t145 = xp.where(xp.less(t18, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t146 = t18 + t145
+    t146 = t145 + t18
     t147 = -t145 + t18
     t148 = xp.where(xp.greater_equal(t18, -6.283185307179586) & xp.less_equal(t18, 6.283185307179586), t18, xp.where(xp.greater_equal(t146, -6.283185307179586) & xp.less_equal(t146, 6.283185307179586), t146, xp.where(xp.greater_equal(t147, -6.283185307179586) & xp.less_equal(t147, 6.283185307179586), t147, qb2_3)))
     t149 = xp.where(xp.less(t19, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t150 = t19 + t149
+    t150 = t149 + t19
     t151 = -t149 + t19
     t152 = xp.where(xp.greater_equal(t19, -6.283185307179586) & xp.less_equal(t19, 6.283185307179586), t19, xp.where(xp.greater_equal(t150, -6.283185307179586) & xp.less_equal(t150, 6.283185307179586), t150, xp.where(xp.greater_equal(t151, -6.283185307179586) & xp.less_equal(t151, 6.283185307179586), t151, qb2_4)))
     t153 = xp.where(xp.less(t20, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t154 = t20 + t153
+    t154 = t153 + t20
     t155 = -t153 + t20
     t156 = xp.where(xp.greater_equal(t20, -6.283185307179586) & xp.less_equal(t20, 6.283185307179586), t20, xp.where(xp.greater_equal(t154, -6.283185307179586) & xp.less_equal(t154, 6.283185307179586), t154, xp.where(xp.greater_equal(t155, -6.283185307179586) & xp.less_equal(t155, 6.283185307179586), t155, qb2_5)))
     t157 = qw1*(t82 + t136)**2 + qw2*(t83 + t140)**2 + qw3*(t84 + t144)**2 + qw4*(t85 + t148)**2 + qw5*(t86 + t152)**2 + qw6*(t87 + t156)**2
@@ -3135,27 +3135,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t167 = xp.where(t161, t156, t131)
     t168 = xp.where(t161, t157, t132)
     t169 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t170 = t22 + t169
+    t170 = t169 + t22
     t171 = -t169 + t22
     t172 = xp.where(xp.greater_equal(t22, -6.283185307179586) & xp.less_equal(t22, 6.283185307179586), t22, xp.where(xp.greater_equal(t170, -6.283185307179586) & xp.less_equal(t170, 6.283185307179586), t170, xp.where(xp.greater_equal(t171, -6.283185307179586) & xp.less_equal(t171, 6.283185307179586), t171, qb3_0)))
     t173 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t174 = t23 + t173
+    t174 = t173 + t23
     t175 = -t173 + t23
     t176 = xp.where(xp.greater_equal(t23, -6.283185307179586) & xp.less_equal(t23, 6.283185307179586), t23, xp.where(xp.greater_equal(t174, -6.283185307179586) & xp.less_equal(t174, 6.283185307179586), t174, xp.where(xp.greater_equal(t175, -6.283185307179586) & xp.less_equal(t175, 6.283185307179586), t175, qb3_1)))
     t177 = xp.where(xp.less(t24, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t178 = t24 + t177
+    t178 = t177 + t24
     t179 = -t177 + t24
     t180 = xp.where(xp.greater_equal(t24, -6.283185307179586) & xp.less_equal(t24, 6.283185307179586), t24, xp.where(xp.greater_equal(t178, -6.283185307179586) & xp.less_equal(t178, 6.283185307179586), t178, xp.where(xp.greater_equal(t179, -6.283185307179586) & xp.less_equal(t179, 6.283185307179586), t179, qb3_2)))
     t181 = xp.where(xp.less(t25, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t182 = t25 + t181
+    t182 = t181 + t25
     t183 = -t181 + t25
     t184 = xp.where(xp.greater_equal(t25, -6.283185307179586) & xp.less_equal(t25, 6.283185307179586), t25, xp.where(xp.greater_equal(t182, -6.283185307179586) & xp.less_equal(t182, 6.283185307179586), t182, xp.where(xp.greater_equal(t183, -6.283185307179586) & xp.less_equal(t183, 6.283185307179586), t183, qb3_3)))
     t185 = xp.where(xp.less(t26, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t186 = t26 + t185
+    t186 = t185 + t26
     t187 = -t185 + t26
     t188 = xp.where(xp.greater_equal(t26, -6.283185307179586) & xp.less_equal(t26, 6.283185307179586), t26, xp.where(xp.greater_equal(t186, -6.283185307179586) & xp.less_equal(t186, 6.283185307179586), t186, xp.where(xp.greater_equal(t187, -6.283185307179586) & xp.less_equal(t187, 6.283185307179586), t187, qb3_4)))
     t189 = xp.where(xp.less(t27, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t190 = t27 + t189
+    t190 = t189 + t27
     t191 = -t189 + t27
     t192 = xp.where(xp.greater_equal(t27, -6.283185307179586) & xp.less_equal(t27, 6.283185307179586), t27, xp.where(xp.greater_equal(t190, -6.283185307179586) & xp.less_equal(t190, 6.283185307179586), t190, xp.where(xp.greater_equal(t191, -6.283185307179586) & xp.less_equal(t191, 6.283185307179586), t191, qb3_5)))
     t193 = qw1*(t82 + t172)**2 + qw2*(t83 + t176)**2 + qw3*(t84 + t180)**2 + qw4*(t85 + t184)**2 + qw5*(t86 + t188)**2 + qw6*(t87 + t192)**2
@@ -3171,27 +3171,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t203 = xp.where(t197, t192, t167)
     t204 = xp.where(t197, t193, t168)
     t205 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t206 = t29 + t205
+    t206 = t205 + t29
     t207 = -t205 + t29
     t208 = xp.where(xp.greater_equal(t29, -6.283185307179586) & xp.less_equal(t29, 6.283185307179586), t29, xp.where(xp.greater_equal(t206, -6.283185307179586) & xp.less_equal(t206, 6.283185307179586), t206, xp.where(xp.greater_equal(t207, -6.283185307179586) & xp.less_equal(t207, 6.283185307179586), t207, qb4_0)))
     t209 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t210 = t30 + t209
+    t210 = t209 + t30
     t211 = -t209 + t30
     t212 = xp.where(xp.greater_equal(t30, -6.283185307179586) & xp.less_equal(t30, 6.283185307179586), t30, xp.where(xp.greater_equal(t210, -6.283185307179586) & xp.less_equal(t210, 6.283185307179586), t210, xp.where(xp.greater_equal(t211, -6.283185307179586) & xp.less_equal(t211, 6.283185307179586), t211, qb4_1)))
     t213 = xp.where(xp.less(t31, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t214 = t31 + t213
+    t214 = t213 + t31
     t215 = -t213 + t31
     t216 = xp.where(xp.greater_equal(t31, -6.283185307179586) & xp.less_equal(t31, 6.283185307179586), t31, xp.where(xp.greater_equal(t214, -6.283185307179586) & xp.less_equal(t214, 6.283185307179586), t214, xp.where(xp.greater_equal(t215, -6.283185307179586) & xp.less_equal(t215, 6.283185307179586), t215, qb4_2)))
     t217 = xp.where(xp.less(t32, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t218 = t32 + t217
+    t218 = t217 + t32
     t219 = -t217 + t32
     t220 = xp.where(xp.greater_equal(t32, -6.283185307179586) & xp.less_equal(t32, 6.283185307179586), t32, xp.where(xp.greater_equal(t218, -6.283185307179586) & xp.less_equal(t218, 6.283185307179586), t218, xp.where(xp.greater_equal(t219, -6.283185307179586) & xp.less_equal(t219, 6.283185307179586), t219, qb4_3)))
     t221 = xp.where(xp.less(t33, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t222 = t33 + t221
+    t222 = t221 + t33
     t223 = -t221 + t33
     t224 = xp.where(xp.greater_equal(t33, -6.283185307179586) & xp.less_equal(t33, 6.283185307179586), t33, xp.where(xp.greater_equal(t222, -6.283185307179586) & xp.less_equal(t222, 6.283185307179586), t222, xp.where(xp.greater_equal(t223, -6.283185307179586) & xp.less_equal(t223, 6.283185307179586), t223, qb4_4)))
     t225 = xp.where(xp.less(t34, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t226 = t34 + t225
+    t226 = t225 + t34
     t227 = -t225 + t34
     t228 = xp.where(xp.greater_equal(t34, -6.283185307179586) & xp.less_equal(t34, 6.283185307179586), t34, xp.where(xp.greater_equal(t226, -6.283185307179586) & xp.less_equal(t226, 6.283185307179586), t226, xp.where(xp.greater_equal(t227, -6.283185307179586) & xp.less_equal(t227, 6.283185307179586), t227, qb4_5)))
     t229 = qw1*(t82 + t208)**2 + qw2*(t83 + t212)**2 + qw3*(t84 + t216)**2 + qw4*(t85 + t220)**2 + qw5*(t86 + t224)**2 + qw6*(t87 + t228)**2
@@ -3207,27 +3207,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t239 = xp.where(t233, t228, t203)
     t240 = xp.where(t233, t229, t204)
     t241 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t242 = t36 + t241
+    t242 = t241 + t36
     t243 = -t241 + t36
     t244 = xp.where(xp.greater_equal(t36, -6.283185307179586) & xp.less_equal(t36, 6.283185307179586), t36, xp.where(xp.greater_equal(t242, -6.283185307179586) & xp.less_equal(t242, 6.283185307179586), t242, xp.where(xp.greater_equal(t243, -6.283185307179586) & xp.less_equal(t243, 6.283185307179586), t243, qb5_0)))
     t245 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t246 = t37 + t245
+    t246 = t245 + t37
     t247 = -t245 + t37
     t248 = xp.where(xp.greater_equal(t37, -6.283185307179586) & xp.less_equal(t37, 6.283185307179586), t37, xp.where(xp.greater_equal(t246, -6.283185307179586) & xp.less_equal(t246, 6.283185307179586), t246, xp.where(xp.greater_equal(t247, -6.283185307179586) & xp.less_equal(t247, 6.283185307179586), t247, qb5_1)))
     t249 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t250 = t38 + t249
+    t250 = t249 + t38
     t251 = -t249 + t38
     t252 = xp.where(xp.greater_equal(t38, -6.283185307179586) & xp.less_equal(t38, 6.283185307179586), t38, xp.where(xp.greater_equal(t250, -6.283185307179586) & xp.less_equal(t250, 6.283185307179586), t250, xp.where(xp.greater_equal(t251, -6.283185307179586) & xp.less_equal(t251, 6.283185307179586), t251, qb5_2)))
     t253 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t254 = t39 + t253
+    t254 = t253 + t39
     t255 = -t253 + t39
     t256 = xp.where(xp.greater_equal(t39, -6.283185307179586) & xp.less_equal(t39, 6.283185307179586), t39, xp.where(xp.greater_equal(t254, -6.283185307179586) & xp.less_equal(t254, 6.283185307179586), t254, xp.where(xp.greater_equal(t255, -6.283185307179586) & xp.less_equal(t255, 6.283185307179586), t255, qb5_3)))
     t257 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t258 = t40 + t257
+    t258 = t257 + t40
     t259 = -t257 + t40
     t260 = xp.where(xp.greater_equal(t40, -6.283185307179586) & xp.less_equal(t40, 6.283185307179586), t40, xp.where(xp.greater_equal(t258, -6.283185307179586) & xp.less_equal(t258, 6.283185307179586), t258, xp.where(xp.greater_equal(t259, -6.283185307179586) & xp.less_equal(t259, 6.283185307179586), t259, qb5_4)))
     t261 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t262 = t41 + t261
+    t262 = t261 + t41
     t263 = -t261 + t41
     t264 = xp.where(xp.greater_equal(t41, -6.283185307179586) & xp.less_equal(t41, 6.283185307179586), t41, xp.where(xp.greater_equal(t262, -6.283185307179586) & xp.less_equal(t262, 6.283185307179586), t262, xp.where(xp.greater_equal(t263, -6.283185307179586) & xp.less_equal(t263, 6.283185307179586), t263, qb5_5)))
     t265 = qw1*(t82 + t244)**2 + qw2*(t83 + t248)**2 + qw3*(t84 + t252)**2 + qw4*(t85 + t256)**2 + qw5*(t86 + t260)**2 + qw6*(t87 + t264)**2
@@ -3243,27 +3243,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t275 = xp.where(t269, t264, t239)
     t276 = xp.where(t269, t265, t240)
     t277 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t278 = t43 + t277
+    t278 = t277 + t43
     t279 = -t277 + t43
     t280 = xp.where(xp.greater_equal(t43, -6.283185307179586) & xp.less_equal(t43, 6.283185307179586), t43, xp.where(xp.greater_equal(t278, -6.283185307179586) & xp.less_equal(t278, 6.283185307179586), t278, xp.where(xp.greater_equal(t279, -6.283185307179586) & xp.less_equal(t279, 6.283185307179586), t279, qb6_0)))
     t281 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t282 = t44 + t281
+    t282 = t281 + t44
     t283 = -t281 + t44
     t284 = xp.where(xp.greater_equal(t44, -6.283185307179586) & xp.less_equal(t44, 6.283185307179586), t44, xp.where(xp.greater_equal(t282, -6.283185307179586) & xp.less_equal(t282, 6.283185307179586), t282, xp.where(xp.greater_equal(t283, -6.283185307179586) & xp.less_equal(t283, 6.283185307179586), t283, qb6_1)))
     t285 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t286 = t45 + t285
+    t286 = t285 + t45
     t287 = -t285 + t45
     t288 = xp.where(xp.greater_equal(t45, -6.283185307179586) & xp.less_equal(t45, 6.283185307179586), t45, xp.where(xp.greater_equal(t286, -6.283185307179586) & xp.less_equal(t286, 6.283185307179586), t286, xp.where(xp.greater_equal(t287, -6.283185307179586) & xp.less_equal(t287, 6.283185307179586), t287, qb6_2)))
     t289 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t290 = t46 + t289
+    t290 = t289 + t46
     t291 = -t289 + t46
     t292 = xp.where(xp.greater_equal(t46, -6.283185307179586) & xp.less_equal(t46, 6.283185307179586), t46, xp.where(xp.greater_equal(t290, -6.283185307179586) & xp.less_equal(t290, 6.283185307179586), t290, xp.where(xp.greater_equal(t291, -6.283185307179586) & xp.less_equal(t291, 6.283185307179586), t291, qb6_3)))
     t293 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t294 = t47 + t293
+    t294 = t293 + t47
     t295 = -t293 + t47
     t296 = xp.where(xp.greater_equal(t47, -6.283185307179586) & xp.less_equal(t47, 6.283185307179586), t47, xp.where(xp.greater_equal(t294, -6.283185307179586) & xp.less_equal(t294, 6.283185307179586), t294, xp.where(xp.greater_equal(t295, -6.283185307179586) & xp.less_equal(t295, 6.283185307179586), t295, qb6_4)))
     t297 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t298 = t48 + t297
+    t298 = t297 + t48
     t299 = -t297 + t48
     t300 = xp.where(xp.greater_equal(t48, -6.283185307179586) & xp.less_equal(t48, 6.283185307179586), t48, xp.where(xp.greater_equal(t298, -6.283185307179586) & xp.less_equal(t298, 6.283185307179586), t298, xp.where(xp.greater_equal(t299, -6.283185307179586) & xp.less_equal(t299, 6.283185307179586), t299, qb6_5)))
     t301 = qw1*(t82 + t280)**2 + qw2*(t83 + t284)**2 + qw3*(t84 + t288)**2 + qw4*(t85 + t292)**2 + qw5*(t86 + t296)**2 + qw6*(t87 + t300)**2
@@ -3279,27 +3279,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     t311 = xp.where(t305, t300, t275)
     t312 = xp.where(t305, t301, t276)
     t313 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t314 = t50 + t313
+    t314 = t313 + t50
     t315 = -t313 + t50
     t316 = xp.where(xp.greater_equal(t50, -6.283185307179586) & xp.less_equal(t50, 6.283185307179586), t50, xp.where(xp.greater_equal(t314, -6.283185307179586) & xp.less_equal(t314, 6.283185307179586), t314, xp.where(xp.greater_equal(t315, -6.283185307179586) & xp.less_equal(t315, 6.283185307179586), t315, qb7_0)))
     t317 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t318 = t51 + t317
+    t318 = t317 + t51
     t319 = -t317 + t51
     t320 = xp.where(xp.greater_equal(t51, -6.283185307179586) & xp.less_equal(t51, 6.283185307179586), t51, xp.where(xp.greater_equal(t318, -6.283185307179586) & xp.less_equal(t318, 6.283185307179586), t318, xp.where(xp.greater_equal(t319, -6.283185307179586) & xp.less_equal(t319, 6.283185307179586), t319, qb7_1)))
     t321 = xp.where(xp.less(t52, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t322 = t52 + t321
+    t322 = t321 + t52
     t323 = -t321 + t52
     t324 = xp.where(xp.greater_equal(t52, -6.283185307179586) & xp.less_equal(t52, 6.283185307179586), t52, xp.where(xp.greater_equal(t322, -6.283185307179586) & xp.less_equal(t322, 6.283185307179586), t322, xp.where(xp.greater_equal(t323, -6.283185307179586) & xp.less_equal(t323, 6.283185307179586), t323, qb7_2)))
     t325 = xp.where(xp.less(t53, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t326 = t53 + t325
+    t326 = t325 + t53
     t327 = -t325 + t53
     t328 = xp.where(xp.greater_equal(t53, -6.283185307179586) & xp.less_equal(t53, 6.283185307179586), t53, xp.where(xp.greater_equal(t326, -6.283185307179586) & xp.less_equal(t326, 6.283185307179586), t326, xp.where(xp.greater_equal(t327, -6.283185307179586) & xp.less_equal(t327, 6.283185307179586), t327, qb7_3)))
     t329 = xp.where(xp.less(t54, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t330 = t54 + t329
+    t330 = t329 + t54
     t331 = -t329 + t54
     t332 = xp.where(xp.greater_equal(t54, -6.283185307179586) & xp.less_equal(t54, 6.283185307179586), t54, xp.where(xp.greater_equal(t330, -6.283185307179586) & xp.less_equal(t330, 6.283185307179586), t330, xp.where(xp.greater_equal(t331, -6.283185307179586) & xp.less_equal(t331, 6.283185307179586), t331, qb7_4)))
     t333 = xp.where(xp.less(t55, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t334 = t55 + t333
+    t334 = t333 + t55
     t335 = -t333 + t55
     t336 = xp.where(xp.greater_equal(t55, -6.283185307179586) & xp.less_equal(t55, 6.283185307179586), t55, xp.where(xp.greater_equal(t334, -6.283185307179586) & xp.less_equal(t334, 6.283185307179586), t334, xp.where(xp.greater_equal(t335, -6.283185307179586) & xp.less_equal(t335, 6.283185307179586), t335, qb7_5)))
     t337 = qw1*(t82 + t316)**2 + qw2*(t83 + t320)**2 + qw3*(t84 + t324)**2 + qw4*(t85 + t328)**2 + qw5*(t86 + t332)**2 + qw6*(t87 + t336)**2

@@ -20,9 +20,8 @@ from jacgen.inputs.robot import EULER_ANGLES, Robot
 from jacgen.inputs.transforms import rot_z, twist
 from jacgen.model import kinematics
 from jacgen.model.joint_ring import joint_atoms, maximal_minors
-from jacgen.model.graph import Node, elementwise
+from jacgen.model.graph import Node, elementwise, is_zero
 from jacgen.model.kinematics import generated_symbol
-from jacgen.model.nodes import Above, select
 from jacgen.model.singularities import MINOR_LIMIT, Singularities, singularity_jacobian
 from jacgen.solvers import differential, general6r, ik, ik_limits
 from jacgen.solvers.model import Model
@@ -338,7 +337,7 @@ class Generator:
     def singularities(self) -> Singularities:
         return self.model.singularities
 
-    def rank_determinant(self, js: sympy.Matrix) -> sympy.Expr:
+    def rank_determinant(self, js: sympy.Matrix) -> Node:
         """det(Js) for square Js, else the Gram determinant det(Js Js^T) or det(Js^T Js), by
         Laplace expansion (memoised minors: division-free, at most 6 * 2^5 products per
         determinant) over the named entries: a fixed cost on top of Js, whatever the arm.
@@ -351,26 +350,27 @@ class Generator:
         square root, the manipulability, good only to sqrt(eps) * |Js|^m).
         """
         m, n = js.shape
+        g = self.graph
+        name = lambda value: self.name_node(g.value(value))  # noqa: E731
         if m == n or math.comb(max(m, n), min(m, n)) <= MINOR_LIMIT:
-            named = [[self.name(entry) for entry in row] for row in js.tolist()]
-            minors = maximal_minors(named, sympy.Integer(0), sympy.Integer(1))
-            return minors[0] if m == n else sympy.Add(*(self.name(minor) ** 2 for minor in minors))
+            named = [[0 if is_zero(entry) else entry for entry in row] for row in elementwise(name, g.values(js))]
+            minors = maximal_minors(named, g.number(0), g.number(1))
+            return minors[0] if m == n else sum(name(minor) ** 2 for minor in minors)
         tall = js.T if m < n else js
-        columns = [[self.name(entry) for entry in tall[:, k]] for k in range(tall.cols)]
+        columns = [list(column) for column in elementwise(name, g.values(tall)).T]
         squared_diagonal = []
         for k, column in enumerate(columns):
-            norm = self.name(sympy.Add(*(entry**2 for entry in column)))
+            norm = name(sum(entry**2 for entry in column))
             squared_diagonal.append(norm)
-            divisor = self.name(select(Above(norm, 0), norm, sympy.Integer(1)))
+            divisor = name(g.select(g.relation(">", norm, g.number(0)), norm, g.number(1)))
             for j in range(k + 1, len(columns)):  # the part of column j orthogonal to column k
-                share = self.name(sympy.Add(*(a * b for a, b in zip(columns[j], column))) / divisor)
-                columns[j] = [self.name(entry - share * value) for entry, value in zip(columns[j], column)]
-        return sympy.Mul(*squared_diagonal)
+                share = name(sum(a * b for a, b in zip(columns[j], column)) / divisor)
+                columns[j] = [name(entry - share * value) for entry, value in zip(columns[j], column)]
+        return g.mul(*squared_diagonal)
 
-    def magnitude(self, value: sympy.Expr) -> sympy.Expr:
-        """|value| of a named value: sympy's sign analysis of a large determinant (at every
-        rebuild in CSE) takes seconds, or recurses past Python's limit."""
-        return sympy.Abs(self.name(value))
+    def magnitude(self, value) -> Node:
+        """|value|, of a named value."""
+        return self.graph.call("Abs", self.name_node(self.graph.value(value)))
 
     def singularity_functions(self, js: sympy.Matrix) -> list[Function]:
         """singularity_factors, manipulability and (square Js) jacobian_det, from Js.
@@ -385,7 +385,7 @@ class Generator:
         for i, symbols in enumerate(joint_atoms(self.robot)):
             if len(symbols) == 2:
                 atoms.update(zip(symbols, self.cos_sin((i,))))
-        numeric = sympy.Integer(0) if singular.everywhere else self.rank_determinant(js)
+        numeric = self.graph.number(0) if singular.everywhere else self.rank_determinant(js)
         factors = [f.polynomial.xreplace(atoms) for f in singular.factors]
         if not singular.complete or singular.everywhere:
             factors.append(numeric)
@@ -394,14 +394,14 @@ class Generator:
                                    vector("f", factors or [1]))]
         if m != n:
             return functions + [self.function("manipulability", f"manipulability sqrt({singular.kind})",
-                                              scalar("w", sympy.sqrt(self.magnitude(numeric))))]
+                                              scalar("w", self.graph.sqrt(self.magnitude(numeric))))]
         determinant = numeric
         if singular.complete and not singular.everywhere:
             rotation = self.chain.tool[:3, :3]
             cos_pitch = sympy.sqrt(rotation[0, 0] ** 2 + rotation[1, 0] ** 2)
             exact = singular.constant.xreplace(atoms) * sympy.Mul(
                 *(p.xreplace(atoms) ** k for p, k in singular.determinant)) / cos_pitch**singular.euler_power
-            if self.lower(sympy.Matrix([exact])).operation_count <= self.lower(sympy.Matrix([numeric])).operation_count:
+            if self.lower([exact]).operation_count <= self.lower([numeric]).operation_count:
                 determinant = exact
         return functions + [
             self.function("manipulability", "manipulability |det(Js)|", scalar("w", self.magnitude(determinant))),

@@ -395,11 +395,9 @@ def _negation(graph: Graph, node: Node) -> Node | None:
 
 
 def _rebuilt(graph: Graph, form: Node, args: list[Node]) -> Node:
-    """form with new arguments, evaluated only where something can combine: a call or select
-    of temporaries as it is (one of numbers was folded before), a sum or product whose
-    arguments cannot combine (no repeats, no nested sum or product of its kind, no number
-    after the first) as it is; anything else as its kind evaluates (`Graph.rebuilt`)."""
-    if form.kind in (CALL, SELECT) or (form.kind in (ADD, MUL) and len(set(args)) == len(args) and not any(
-            arg.kind == form.kind or (k and arg.kind == NUMBER) for k, arg in enumerate(args))):
+    """form with new arguments: a call or select of temporaries as it is (one of numbers was
+    folded before); anything else as its kind evaluates (`Graph.rebuilt`), so that a sum whose
+    terms became the same temporary, x - x, is 0."""
+    if form.kind in (CALL, SELECT):
         return graph.node(form.kind, tuple(args), form.value)
     return graph.rebuilt(form, tuple(args))

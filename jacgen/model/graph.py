@@ -211,9 +211,11 @@ class Graph:
         return self.power(value, sympy.S.Half)
 
     def call(self, name: str, *args: Node) -> Node:
-        """name(args) of MATH's functions: of numbers, folded exactly by sympy."""
+        """name(args) of MATH's functions: of numbers, folded exactly by sympy; |-x| is |x|."""
         if all(arg.kind == NUMBER for arg in args):
             return self.convert(getattr(sympy, name)(*(sympy.Rational(arg.value) for arg in args)))
+        if name == "Abs" and negative_coefficient(args[0]):  # |-x| = |x|
+            return self.node(CALL, (self.negate(args[0]),), name)
         return self.node(CALL, args, name)
 
     def negation(self, condition: Node) -> Node:
