@@ -9,7 +9,7 @@ from numpy.testing import assert_allclose
 
 from jacgen.checking import reference
 from jacgen.emission.backends.casadi import CasadiPrinter
-from jacgen.model.nodes import Select
+from jacgen.model.graph import AND, Graph
 from jacgen.inputs.robot import load_robot
 from jacgen.checking.verify import compare
 
@@ -95,8 +95,10 @@ def test_printer():
     printer = CasadiPrinter()
     assert printed(printer, sympy.atan2(x, sympy.sqrt(y)) + 0.4318 / x**2) == \
         "0.4318/x**2 + casadi.atan2(x, casadi.sqrt(y))"  # terms in sympy's stored order
-    assert printed(printer, Select((x > 0) & (y <= 1), x, y)) == \
-        "casadi.if_else(casadi.logic_and((y <= 1), (x > 0)), x, y)"
+    g = Graph()
+    X, Y = g.symbol(x), g.symbol(y)
+    assert printer.doprint(g.select(g.logic(AND, g.relation(">", X, g.number(0)), g.relation("<=", Y, g.number(1))),
+                                    X, Y)) == "casadi.if_else(casadi.logic_and((x > 0), (y <= 1)), x, y)"
     for unsupported in (sympy.gamma(x), sympy.Mod(x, y), sympy.Max(x, y)):
         with pytest.raises(Exception, match="[Uu]nsupported|not supported"):
             printed(printer, unsupported)

@@ -23,7 +23,7 @@ import numpy
 import sympy
 from sympy.logic.boolalg import Boolean
 
-from jacgen.model.nodes import TOLERANCE_SYMBOLS, TOLERANCES, IsFinite, Select
+from jacgen.model.nodes import TOLERANCE_SYMBOLS, TOLERANCES
 
 # The kinds of node. A number's value is an int, a Fraction (an exact rational, as sympy's
 # Rational), a Folded (a constant folded from sympy's floats and irrationals, see Folded) or, as
@@ -44,7 +44,7 @@ RELATIONS = {">=": operator.ge, ">": operator.gt, "<=": operator.le, "<": operat
 MATH = {"sin": math.sin, "cos": math.cos, "tan": math.tan, "asin": math.asin, "acos": math.acos, "atan": math.atan,
         "atan2": math.atan2, "exp": math.exp, "log": math.log, "Abs": abs, "Floor": math.floor, "Ceiling": math.ceil,
         ADD: math.fsum}
-BOOLEANS = {sympy.And: AND, sympy.Or: OR, sympy.Not: NOT, IsFinite: FINITE}
+BOOLEANS = {sympy.And: AND, sympy.Or: OR, sympy.Not: NOT}  # in sympy's values taken over
 
 
 class Folded(Fraction):
@@ -266,8 +266,6 @@ class Graph:
             args = [self.convert(arg) for arg in expr.args]
             return self.add(*args) if expr.is_Add else self.mul(*args)
         args = tuple(self.convert(arg) for arg in expr.args)
-        if isinstance(expr, Select):
-            return self.node(SELECT, args)
         if isinstance(expr, sympy.Function):
             return self.node(CALL, args, type(expr).__name__)
         raise ValueError(f"unsupported in generated code: {type(expr).__name__} ({expr})")
@@ -335,7 +333,8 @@ class Graph:
         return self.node(MUL, (self.minus_one, node))
 
     def select(self, *args: Node) -> Node:
-        """`Select`'s evaluation: false pairs dropped, a true one ends the list, a select in the
+        """A select (args: condition, value, ..., otherwise: the value of the first condition that
+        holds, every value computed), evaluated: false pairs dropped, a true one ends the list, a select in the
         otherwise position joined, one value for every case is that value."""
         *pairs, otherwise = args
         pairs = list(zip(pairs[::2], pairs[1::2]))

@@ -5,12 +5,21 @@ the graph's operation count and common-subexpression elimination."""
 from fractions import Fraction
 
 import sympy
+from sympy.logic.boolalg import BooleanFunction
 
 from jacgen.model import graph
-from jacgen.model.nodes import PLAIN, Ceiling, Floor, IsFinite, Select
 
-CALLS = {"Floor": Floor, "Ceiling": Ceiling}
-RELATIONS = {cls.kind.rel_op: cls for cls in PLAIN.values()}
+
+class Select(sympy.Function):
+    """A select, as sympy counts it: a function of its conditions and values."""
+
+
+class IsFinite(BooleanFunction):
+    """isfinite(x), as sympy counts it: a function of x."""
+
+
+CALLS = {"Floor": sympy.floor, "Ceiling": sympy.ceiling}
+RELATIONS = {">=": sympy.Ge, ">": sympy.Gt, "<=": sympy.Le, "<": sympy.Lt, "==": sympy.Eq, "!=": sympy.Ne}
 
 
 def to_sympy(node: graph.Node, _done: dict | None = None) -> sympy.Basic:
