@@ -138,5 +138,5 @@ def _on_the_side(frame) -> bool:
     return False
 
 
-_SIDE_MODULES = ("traceback", "weakref", "warnings", "logging", "_pytest", "pluggy")
+_SIDE_MODULES = ("traceback", "weakref", "_weakrefset", "warnings", "logging", "_pytest", "pluggy")
 _BOOKKEEPING = (within_budget.__code__, _arm.__code__)
