@@ -89,3 +89,13 @@ def test_eliminate_common_as_sympy_cse(exprs):
         values[symbol] = evaluate(value, values)
     for node, expected in zip(reduced, exprs):
         assert evaluate(node, values) == pytest.approx(float(sympy.N(expected.subs(point), 30)), rel=1e-12, abs=1e-12)
+
+
+def test_calls_of_numbers_fold_exactly():
+    """A call of numbers is one number, for every function the printers know (floor and ceiling
+    are sympy's floor and ceiling): the IK wraps constant angles too."""
+    g = Graph()
+    assert g.call("Floor", g.value(sympy.Rational(7, 2))).value == 3
+    assert g.call("Ceiling", g.value(-2.5)).value == -2
+    assert g.call("Abs", g.number(-3)).value == 3
+    assert float(g.call("atan2", g.number(1), g.number(1)).value) == pytest.approx(0.7853981633974483, abs=0)

@@ -44,6 +44,8 @@ RELATIONS = {">=": operator.ge, ">": operator.gt, "<=": operator.le, "<": operat
 MATH = {"sin": math.sin, "cos": math.cos, "tan": math.tan, "asin": math.asin, "acos": math.acos, "atan": math.atan,
         "atan2": math.atan2, "exp": math.exp, "log": math.log, "Abs": abs, "Floor": math.floor, "Ceiling": math.ceil,
         ADD: math.fsum}
+# sympy's function of each call whose name is not sympy's own, to fold a call of numbers.
+SYMPY_CALLS = {"Floor": sympy.floor, "Ceiling": sympy.ceiling}
 BOOLEANS = {sympy.And: AND, sympy.Or: OR, sympy.Not: NOT}  # in sympy's values taken over
 
 
@@ -197,8 +199,8 @@ class Graph:
         exponent = sympy.Rational(exponent)
         if exponent == 1:
             return base
-        if base.kind == NUMBER:
-            return self.rebuilt(self.node(POW, (base, self.number(exponent))), (base, self.number(exponent)))
+        if base.kind == NUMBER and not (base.value == 0 and exponent < 0):
+            return self._number_power(base.value, exponent)
         if exponent.q == 1 and base.kind == MUL:
             return self.mul(*(self.power(factor, exponent) for factor in base.args))
         if base.kind == POW and (exponent.q == 1 or (exponent == sympy.S.Half and base.args[1].value % 2 == 0)):
@@ -207,13 +209,21 @@ class Graph:
             return self.power(self.call("Abs", base.args[0]), base.args[1].value / 2)  # sqrt(x^2) = |x|, x real
         return self.node(POW, (base, self.number(exponent)))
 
+    def _number_power(self, base, exponent: sympy.Rational) -> Node:
+        """A number to a rational power, exactly (Folded if the base is)."""
+        if exponent.q == 1:
+            return self.number(number_of(Fraction(base) ** int(exponent), isinstance(base, Folded)))
+        root = self.convert(sympy.Rational(Fraction(base).numerator, Fraction(base).denominator) ** exponent)
+        return self.number(number_of(root.value, isinstance(base, Folded)))
+
     def sqrt(self, value: Node) -> Node:
         return self.power(value, sympy.S.Half)
 
     def call(self, name: str, *args: Node) -> Node:
         """name(args) of MATH's functions: of numbers, folded exactly by sympy; |-x| is |x|."""
         if all(arg.kind == NUMBER for arg in args):
-            return self.convert(getattr(sympy, name)(*(sympy.Rational(arg.value) for arg in args)))
+            folded = SYMPY_CALLS.get(name) or getattr(sympy, name)
+            return self.convert(folded(*(sympy.Rational(arg.value) for arg in args)))
         if name == "Abs" and negative_coefficient(args[0]):  # |-x| = |x|
             return self.node(CALL, (self.negate(args[0]),), name)
         return self.node(CALL, args, name)
@@ -387,11 +397,7 @@ class Graph:
         if kind == MUL:
             return self.mul(*args, distribute=distribute)
         if kind == POW and args[0].kind == NUMBER and not (args[0].value == 0 and args[1].value < 0):  # 1/0 stays
-            base, exponent = args[0].value, args[1].value
-            if exponent.q == 1:
-                return self.number(number_of(Fraction(base) ** int(exponent), isinstance(base, Folded)))
-            root = self.convert(sympy.Rational(Fraction(base).numerator, Fraction(base).denominator) ** exponent)
-            return self.number(number_of(root.value, isinstance(base, Folded)))
+            return self._number_power(args[0].value, args[1].value)
         if kind == SELECT:
             return self.select(*args)
         if kind == RELATION:
