@@ -310,7 +310,7 @@ class Generator:
         q_dot = Argument("q_dot", sympy.Matrix([generated_symbol("qd", i + 1) for i in range(n)]))
         arguments = (Argument("q", sympy.Matrix(self.q)), q_dot)
         g = self.graph
-        name = lambda value: self.name_node(g.value(value))  # noqa: E731
+        name = self.name_node
         columns = elementwise(name, g.values(self.jacobian))
         rates = g.values(q_dot.symbols).flatten()
         axes = [g.values(axis[:3, 2]).flatten() for axis in self.chain.axes]
@@ -351,7 +351,7 @@ class Generator:
         """
         m, n = js.shape
         g = self.graph
-        name = lambda value: self.name_node(g.value(value))  # noqa: E731
+        name = self.name_node
         if m == n or math.comb(max(m, n), min(m, n)) <= MINOR_LIMIT:
             named = [[0 if is_zero(entry) else entry for entry in row] for row in elementwise(name, g.values(js))]
             minors = maximal_minors(named, g.number(0), g.number(1))
@@ -370,7 +370,7 @@ class Generator:
 
     def magnitude(self, value) -> Node:
         """|value|, of a named value."""
-        return self.graph.call("Abs", self.name_node(self.graph.value(value)))
+        return self.graph.call("Abs", self.name_node(value))
 
     def singularity_functions(self, js: sympy.Matrix) -> list[Function]:
         """singularity_factors, manipulability and (square Js) jacobian_det, from Js.

@@ -172,9 +172,11 @@ class Lowering:
         self._named.add(symbol)
         return symbol
 
-    def name_node(self, node: Node) -> Node:
-        """`name` for a value on the graph: its symbol's node, or minus it (a sum is known by its
-        terms, whatever their order, and a mostly negative one is named as its negation)."""
+    def name_node(self, value) -> Node:
+        """`name` for a value on the graph (a node, or a number or sympy value taken onto it): its
+        symbol's node, or minus it (a sum is known by its terms, whatever their order, and a
+        mostly negative one is named as its negation)."""
+        node = self.graph.value(value)
         if not node.args or (node.kind == MUL and all(not arg.args for arg in node.args)):
             return node
         graph, key = self.graph, _key(node)

@@ -51,9 +51,9 @@ class Root:
 class Subproblems:
     """Vector algebra and the subproblems on `graph`, naming every intermediate with `name`."""
 
-    def __init__(self, graph: Graph, name: Callable[[Node], Node]):
+    def __init__(self, graph: Graph, name: Callable[[object], Node]):
         self.graph = graph
-        self.name = lambda value: name(graph.value(value))
+        self.name = name
         self.eps, self.tiny = graph.symbol(EPS), graph.symbol(TINY)
         # Sizes that are near 0 where the closed form is sensitive to the target, dimensionless,
         # recorded only when the fast path asks (a list here; it reads the least, general6r.FAST_MARGIN):
