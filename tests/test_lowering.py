@@ -8,7 +8,7 @@ from sympy.core.parameters import distribute
 
 from jacgen.emission.generator import Generator
 from jacgen.model.graph import AND, OR, Graph, Node, evaluate
-from jacgen.emission.lowering import eliminate_common, operation_count
+from jacgen.emission.lowering import _reusing_temporaries, eliminate_common, operation_count
 from jacgen.inputs.robot import load_robot, parse_robot
 from conftest import ROOT
 from support.graph_sympy import to_sympy
@@ -99,3 +99,24 @@ def test_calls_of_numbers_fold_exactly():
     assert g.call("Ceiling", g.value(-2.5)).value == -2
     assert g.call("Abs", g.number(-3)).value == 3
     assert float(g.call("atan2", g.number(1), g.number(1)).value) == pytest.approx(0.7853981633974483, abs=0)
+
+
+def test_products_and_sums_read_the_temporaries_they_hold():
+    """CSE's greedy matching leaves some products holding every factor of a temporary
+    (manocha_canny's 0.07*c2*s5*s4**2 beside t = c2*s5): they read it, also through the product
+    temporaries they read (a*c*e*r1 with r1 = c*d holds r2 = a*d*e), and sums read the
+    temporaries whose terms they hold, with the same values."""
+    g = Graph()
+    a, b, c, d, e = (g.symbol(s) for s in sympy.symbols("a b c d e", real=True))
+    r = sympy.symbols("r0:4", real=True)
+    r0, r1, r2, r3 = map(g.symbol, r)
+    replacements = [(r[0], a * b), (r[1], c * d), (r[2], a * d * e), (r[3], a + b + c)]
+    outputs = [0.5 * a * b * c**2, a * c * e * r1, a + b + c + e, b * d]
+    reused, reduced = _reusing_temporaries(g, replacements, outputs)
+    assert reduced == [0.5 * r0 * c**2, r2 * c**2, r3 + e, b * d]
+    assert reused == replacements
+    values = {s: 0.3 + 0.29 * k for k, s in enumerate(sympy.symbols("a b c d e", real=True))}
+    for symbol, value in replacements:
+        values[symbol] = evaluate(value, values)
+    for before, after in zip(outputs, reduced):
+        assert evaluate(after, values) == pytest.approx(evaluate(before, values), rel=1e-15)

@@ -688,7 +688,7 @@ void iiwa_task_jacobian(const iiwa_real q[IIWA_DOF], iiwa_real J[IIWA_TASK_DIM *
 
 void iiwa_fk_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real T[16], iiwa_real J[6 * IIWA_DOF], iiwa_real a[6])
 {
-    /* 428 operations */
+    /* 425 operations */
 
     /* Inputs */
     const iiwa_real q1 = q[0];
@@ -826,7 +826,6 @@ void iiwa_fk_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIW
     const iiwa_real t102 = t96 + t101;
     const iiwa_real t103 = t32*qd6;
     const iiwa_real t104 = t38 + t103;
-    const iiwa_real t105 = s2*qd2;
 
     /* Outputs */
     T[0] = t16;
@@ -892,12 +891,12 @@ void iiwa_fk_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIW
     a[2] = qd4*(-t65*t88 - t53*t94 + t7*t71 + t4*t59) + qd5*(t67*t89 - t55*t95 + t11*t70 - t20*t58) - qd2*(s1*t91 + c1*t97) - qd3*(t63*t87 + t51*t93 - t9*t72 + t18*t60) - qd6*(t57*t96 + t69*t99 + t57*t101 - t69*t90);
     a[3] = qd5*(t29*t95 - t20*t37) + qd6*(t32*t96 - t22*t38) + qd7*(t34*t102 - t24*t104) - qd1*t93 + qd3*(c2*t93 - t18*qd1) + qd4*(t4*t0 - t30*t94);
     a[4] = qd5*(t11*t37 - t29*t89) + qd7*(t15*t104 - t34*t100) - qd1*t87 + qd3*(t9*qd1 + c2*t87) + qd4*(t7*t0 + t30*t88) - qd6*(t13*t38 + t32*t90);
-    a[5] = qd5*(t20*t89 - t11*t95) + qd6*(t22*t90 + t13*t96) + qd7*(t24*t100 - t15*t102) - qd3*((s1*s1)*t105 + (c1*c1)*t105) - qd4*(t4*t88 + t7*t94);
+    a[5] = qd5*(t20*t89 - t11*t95) + qd6*(t22*t90 + t13*t96) + qd7*(t24*t100 - t15*t102) - qd4*(t4*t88 + t7*t94) - qd3*(t18*t87 + t9*t93);
 }
 
 void iiwa_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real Jd[6 * IIWA_DOF])
 {
-    /* 325 operations */
+    /* 322 operations */
 
     /* Inputs */
     const iiwa_real q1 = q[0];
@@ -1008,7 +1007,6 @@ void iiwa_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_D
     const iiwa_real t79 = t78 + t29;
     const iiwa_real t80 = s1*qd1;
     const iiwa_real t81 = c1*qd1;
-    const iiwa_real t82 = s2*qd2;
 
     /* Outputs */
     Jd[0] = -t67;
@@ -1048,7 +1046,7 @@ void iiwa_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_D
     Jd[34] = t14*t79 - t27*t75;
     Jd[35] = 0;
     Jd[36] = 0;
-    Jd[37] = -((s1*s1)*t82 + (c1*c1)*t82);
+    Jd[37] = -(t15*t62 + t9*t68);
     Jd[38] = -(t4*t63 + t7*t69);
     Jd[39] = t17*t64 - t11*t70;
     Jd[40] = t19*t65 + t13*t71;
@@ -1057,7 +1055,7 @@ void iiwa_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_D
 
 void iiwa_bias_acceleration(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real a[6])
 {
-    /* 388 operations */
+    /* 385 operations */
 
     /* Inputs */
     const iiwa_real q1 = q[0];
@@ -1168,7 +1166,6 @@ void iiwa_bias_acceleration(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[I
     const iiwa_real t78 = t26*qd6;
     const iiwa_real t79 = t78 + t29;
     const iiwa_real t80 = t47*qd1;
-    const iiwa_real t81 = s2*qd2;
 
     /* Outputs */
     a[0] = -qd1*t67 + qd5*(t39*t70 - t54*t28 + t17*t41 - t23*t57) + qd4*(t38*t69 + t53*t0 - t4*t42 + t24*t59) + qd2*(c1*t44 - s1*t80) + qd3*(-t52*qd1 - c2*t61 + t15*t43 + t68*t37) - qd6*(t55*t29 + t40*t71 + t76*t40 + t78*t55);
@@ -1176,12 +1173,12 @@ void iiwa_bias_acceleration(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[I
     a[2] = qd4*(-t53*t63 - t49*t69 + t7*t59 + t4*t58) + qd5*(t54*t64 - t50*t70 + t11*t57 - t17*t56) - qd2*(s1*t66 + c1*t72) - qd3*(-t9*t61 + t15*t60 + t62*t52 + t68*t48) - qd6*(t51*t71 - t55*t65 + t74*t55 + t76*t51);
     a[3] = qd5*(t23*t70 - t17*t28) + qd6*(t26*t71 - t19*t29) + qd7*(t27*t77 - t20*t79) + qd4*(t4*t0 - t24*t69) - t68*qd1 + qd3*(-t15*qd1 + c2*t68);
     a[4] = qd5*(t11*t28 - t23*t64) + qd7*(t14*t79 - t27*t75) - t62*qd1 + qd4*(t7*t0 + t24*t63) - qd6*(t13*t29 + t26*t65) + qd3*(t9*qd1 + c2*t62);
-    a[5] = qd5*(t17*t64 - t11*t70) + qd6*(t19*t65 + t13*t71) + qd7*(t20*t75 - t14*t77) - qd4*(t4*t63 + t7*t69) - qd3*((s1*s1)*t81 + (c1*c1)*t81);
+    a[5] = qd5*(t17*t64 - t11*t70) + qd6*(t19*t65 + t13*t71) + qd7*(t20*t75 - t14*t77) - qd4*(t4*t63 + t7*t69) - qd3*(t15*t62 + t9*t68);
 }
 
 void iiwa_task_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real Jd[IIWA_TASK_DIM * IIWA_DOF])
 {
-    /* 639 operations */
+    /* 636 operations */
 
     /* Inputs */
     const iiwa_real q1 = q[0];
@@ -1295,162 +1292,161 @@ void iiwa_task_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[I
     const iiwa_real t78 = s1*t68 + c1*t75;
     const iiwa_real t79 = -t8*t66 + t16*t65 + t67*t57 + t74*t53;
     const iiwa_real t80 = -t16*qd1 + c2*t74;
-    const iiwa_real t81 = t74 + t16*qd3;
-    const iiwa_real t82 = t81;
-    const iiwa_real t83 = -t58*t73 - t54*t82 + t6*t64 + t3*t63;
-    const iiwa_real t84 = t3*t73 + t6*t82;
-    const iiwa_real t85 = qd1 + c2*qd3;
-    const iiwa_real t86 = t85;
-    const iiwa_real t87 = t43*t82 + t58*t86 - t3*t47 + t29*t64;
-    const iiwa_real t88 = t43*t73 + t6*t47 + t29*t63 - t54*t86;
-    const iiwa_real t89 = t3*t86 - t29*t82;
-    const iiwa_real t90 = t6*t86 + t29*t73;
-    const iiwa_real t91 = t6*qd4;
-    const iiwa_real t92 = t91 + t73;
-    const iiwa_real t93 = -t3*qd4;
-    const iiwa_real t94 = t93 + t82;
-    const iiwa_real t95 = t59*t92 - t55*t94 + t10*t62 - t18*t61;
-    const iiwa_real t96 = t18*t92 - t10*t94;
-    const iiwa_real t97 = -t29*qd4;
-    const iiwa_real t98 = t97 + t86;
-    const iiwa_real t99 = t44*t94 - t59*t98 + t18*t46 - t28*t62;
-    const iiwa_real t100 = t55*t98 - t44*t92 + t28*t61 - t10*t46;
-    const iiwa_real t101 = t28*t94 - t18*t98;
-    const iiwa_real t102 = t10*t98 - t28*t92;
-    const iiwa_real t103 = t10*qd5;
-    const iiwa_real t104 = t103 + t92;
-    const iiwa_real t105 = t18*qd5;
-    const iiwa_real t106 = t105 + t94;
-    const iiwa_real t107 = t20*t104 + t12*t106;
-    const iiwa_real t108 = t28*qd5;
-    const iiwa_real t109 = t108 + t98;
-    const iiwa_real t110 = t31*t106 - t20*t109;
-    const iiwa_real t111 = t12*t109 + t31*t104;
-    const iiwa_real t112 = t12*qd6;
-    const iiwa_real t113 = -t112;
-    const iiwa_real t114 = t113 + t104;
-    const iiwa_real t115 = t72 + t91 + t103 + t113 + t14*qd7;
-    const iiwa_real t116 = t20*qd6;
-    const iiwa_real t117 = t116 + t106;
-    const iiwa_real t118 = t56*t106 - t60*t104 + t112*t60 + t116*t56;
-    const iiwa_real t119 = t22*t114 - t14*t117;
-    const iiwa_real t120 = t81 + t93 + t105 + t116 + t22*qd7;
-    const iiwa_real t121 = t23*t115 - t15*t120;
-    const iiwa_real t122 = t31*qd6;
-    const iiwa_real t123 = t122 + t109;
-    const iiwa_real t124 = t60*t109 + t45*t106 + t116*t45 + t122*t60;
-    const iiwa_real t125 = t56*t109 + t45*t104 + t122*t56 - t112*t45;
-    const iiwa_real t126 = t33*t117 - t22*t123;
-    const iiwa_real t127 = t14*t123 - t33*t114;
-    const iiwa_real t128 = t85 + t97 + t108 + t122 + t33*qd7;
-    const iiwa_real t129 = t34*t120 - t23*t128;
-    const iiwa_real t130 = t15*t128 - t34*t115;
-    const iiwa_real t131 = t52*qd1;
-    const iiwa_real t132 = c1*t49 - s1*t131;
-    const iiwa_real t133 = s1*t49 + c1*t131;
-    const iiwa_real t134 = s2*qd2;
-    const iiwa_real t135 = (s1*s1)*t134 + (c1*c1)*t134;
-    const iiwa_real t136 = c1*t23;
-    const iiwa_real t137 = s1*t15;
-    const iiwa_real t138 = 1.0/t24;
-    const iiwa_real t139 = t138*(-t137 + t136);
-    const iiwa_real t140 = (t6*t15 - t3*t23)*t138;
-    const iiwa_real t141 = (t10*t15 + t18*t23)*t138;
-    const iiwa_real t142 = (t20*t23 - t12*t15)*t138;
-    const iiwa_real t143 = (t14*t15 + t22*t23)*t138;
-    const iiwa_real t144 = c1*t15;
-    const iiwa_real t145 = s1*t23;
-    const iiwa_real t146 = t138*(s2*t144 + s2*t145);
-    const iiwa_real t147 = 1.0/t25;
-    const iiwa_real t148 = t138*t147;
-    const iiwa_real t149 = (t144 + t145)*t148;
-    const iiwa_real t150 = t148*(s2*t137 - s2*t136);
-    const iiwa_real t151 = -(t3*t15 + t6*t23)*t148;
-    const iiwa_real t152 = (t18*t15 - t10*t23)*t148;
-    const iiwa_real t153 = (t12*t23 + t20*t15)*t148;
-    const iiwa_real t154 = (t22*t15 - t14*t23)*t148;
-    const iiwa_real t155 = 2*t139;
-    const iiwa_real t156 = t129*t138;
-    const iiwa_real t157 = -(s1 + t15*t155)*t156;
-    const iiwa_real t158 = t130*t138;
-    const iiwa_real t159 = (c1 - t23*t155)*t158;
-    const iiwa_real t160 = qd1*t138;
-    const iiwa_real t161 = t144*t160;
-    const iiwa_real t162 = t145*t160;
-    const iiwa_real t163 = 2*t146;
-    const iiwa_real t164 = t156*(t8 - t15*t163);
-    const iiwa_real t165 = t158*(t16 - t23*t163);
-    const iiwa_real t166 = t15*t138;
-    const iiwa_real t167 = t80*t166;
-    const iiwa_real t168 = t23*t138;
-    const iiwa_real t169 = t71*t168;
-    const iiwa_real t170 = 2*t140;
-    const iiwa_real t171 = t156*(t6 - t15*t170);
-    const iiwa_real t172 = -t158*(t3 + t23*t170);
-    const iiwa_real t173 = t89*t166;
-    const iiwa_real t174 = t90*t168;
-    const iiwa_real t175 = 2*t141;
-    const iiwa_real t176 = t156*(t10 - t15*t175);
-    const iiwa_real t177 = t158*(t18 - t23*t175);
-    const iiwa_real t178 = t101*t166;
-    const iiwa_real t179 = t102*t168;
-    const iiwa_real t180 = 2*t142;
-    const iiwa_real t181 = -t156*(t12 + t15*t180);
-    const iiwa_real t182 = t158*(t20 - t23*t180);
-    const iiwa_real t183 = t110*t166;
-    const iiwa_real t184 = t111*t168;
-    const iiwa_real t185 = 2*t143;
-    const iiwa_real t186 = t156*(t14 - t15*t185);
-    const iiwa_real t187 = t158*(t22 - t23*t185);
-    const iiwa_real t188 = t126*t166;
-    const iiwa_real t189 = t127*t168;
-    const iiwa_real t190 = qd1*t147;
-    const iiwa_real t191 = t23*t147;
-    const iiwa_real t192 = t15*t147;
+    const iiwa_real t81 = t16*t67 + t8*t74;
+    const iiwa_real t82 = t74 + t16*qd3;
+    const iiwa_real t83 = t82;
+    const iiwa_real t84 = -t58*t73 - t54*t83 + t6*t64 + t3*t63;
+    const iiwa_real t85 = t3*t73 + t6*t83;
+    const iiwa_real t86 = qd1 + c2*qd3;
+    const iiwa_real t87 = t86;
+    const iiwa_real t88 = t43*t83 + t58*t87 - t3*t47 + t29*t64;
+    const iiwa_real t89 = t43*t73 + t6*t47 + t29*t63 - t54*t87;
+    const iiwa_real t90 = t3*t87 - t29*t83;
+    const iiwa_real t91 = t6*t87 + t29*t73;
+    const iiwa_real t92 = t6*qd4;
+    const iiwa_real t93 = t92 + t73;
+    const iiwa_real t94 = -t3*qd4;
+    const iiwa_real t95 = t94 + t83;
+    const iiwa_real t96 = t59*t93 - t55*t95 + t10*t62 - t18*t61;
+    const iiwa_real t97 = t18*t93 - t10*t95;
+    const iiwa_real t98 = -t29*qd4;
+    const iiwa_real t99 = t98 + t87;
+    const iiwa_real t100 = t44*t95 - t59*t99 + t18*t46 - t28*t62;
+    const iiwa_real t101 = t55*t99 - t44*t93 + t28*t61 - t10*t46;
+    const iiwa_real t102 = t28*t95 - t18*t99;
+    const iiwa_real t103 = t10*t99 - t28*t93;
+    const iiwa_real t104 = t10*qd5;
+    const iiwa_real t105 = t104 + t93;
+    const iiwa_real t106 = t18*qd5;
+    const iiwa_real t107 = t106 + t95;
+    const iiwa_real t108 = t20*t105 + t12*t107;
+    const iiwa_real t109 = t28*qd5;
+    const iiwa_real t110 = t109 + t99;
+    const iiwa_real t111 = t31*t107 - t20*t110;
+    const iiwa_real t112 = t12*t110 + t31*t105;
+    const iiwa_real t113 = t12*qd6;
+    const iiwa_real t114 = -t113;
+    const iiwa_real t115 = t114 + t105;
+    const iiwa_real t116 = t72 + t92 + t104 + t114 + t14*qd7;
+    const iiwa_real t117 = t20*qd6;
+    const iiwa_real t118 = t117 + t107;
+    const iiwa_real t119 = t56*t107 - t60*t105 + t113*t60 + t117*t56;
+    const iiwa_real t120 = t22*t115 - t14*t118;
+    const iiwa_real t121 = t82 + t94 + t106 + t117 + t22*qd7;
+    const iiwa_real t122 = t23*t116 - t15*t121;
+    const iiwa_real t123 = t31*qd6;
+    const iiwa_real t124 = t123 + t110;
+    const iiwa_real t125 = t60*t110 + t45*t107 + t117*t45 + t123*t60;
+    const iiwa_real t126 = t56*t110 + t45*t105 + t123*t56 - t113*t45;
+    const iiwa_real t127 = t33*t118 - t22*t124;
+    const iiwa_real t128 = t14*t124 - t33*t115;
+    const iiwa_real t129 = t86 + t98 + t109 + t123 + t33*qd7;
+    const iiwa_real t130 = t34*t121 - t23*t129;
+    const iiwa_real t131 = t15*t129 - t34*t116;
+    const iiwa_real t132 = t52*qd1;
+    const iiwa_real t133 = c1*t49 - s1*t132;
+    const iiwa_real t134 = s1*t49 + c1*t132;
+    const iiwa_real t135 = c1*t23;
+    const iiwa_real t136 = s1*t15;
+    const iiwa_real t137 = 1.0/t24;
+    const iiwa_real t138 = t137*(-t136 + t135);
+    const iiwa_real t139 = (t6*t15 - t3*t23)*t137;
+    const iiwa_real t140 = (t10*t15 + t18*t23)*t137;
+    const iiwa_real t141 = (t20*t23 - t12*t15)*t137;
+    const iiwa_real t142 = (t14*t15 + t22*t23)*t137;
+    const iiwa_real t143 = c1*t15;
+    const iiwa_real t144 = s1*t23;
+    const iiwa_real t145 = t137*(s2*t143 + s2*t144);
+    const iiwa_real t146 = 1.0/t25;
+    const iiwa_real t147 = t137*t146;
+    const iiwa_real t148 = (t143 + t144)*t147;
+    const iiwa_real t149 = t147*(s2*t136 - s2*t135);
+    const iiwa_real t150 = -(t3*t15 + t6*t23)*t147;
+    const iiwa_real t151 = (t18*t15 - t10*t23)*t147;
+    const iiwa_real t152 = (t12*t23 + t20*t15)*t147;
+    const iiwa_real t153 = (t22*t15 - t14*t23)*t147;
+    const iiwa_real t154 = 2*t138;
+    const iiwa_real t155 = t130*t137;
+    const iiwa_real t156 = -(s1 + t15*t154)*t155;
+    const iiwa_real t157 = t131*t137;
+    const iiwa_real t158 = (c1 - t23*t154)*t157;
+    const iiwa_real t159 = qd1*t137;
+    const iiwa_real t160 = t143*t159;
+    const iiwa_real t161 = t144*t159;
+    const iiwa_real t162 = 2*t145;
+    const iiwa_real t163 = t155*(t8 - t15*t162);
+    const iiwa_real t164 = t157*(t16 - t23*t162);
+    const iiwa_real t165 = t15*t137;
+    const iiwa_real t166 = t80*t165;
+    const iiwa_real t167 = t23*t137;
+    const iiwa_real t168 = t71*t167;
+    const iiwa_real t169 = 2*t139;
+    const iiwa_real t170 = t155*(t6 - t15*t169);
+    const iiwa_real t171 = -t157*(t3 + t23*t169);
+    const iiwa_real t172 = t90*t165;
+    const iiwa_real t173 = t91*t167;
+    const iiwa_real t174 = 2*t140;
+    const iiwa_real t175 = t155*(t10 - t15*t174);
+    const iiwa_real t176 = t157*(t18 - t23*t174);
+    const iiwa_real t177 = t102*t165;
+    const iiwa_real t178 = t103*t167;
+    const iiwa_real t179 = 2*t141;
+    const iiwa_real t180 = -t155*(t12 + t15*t179);
+    const iiwa_real t181 = t157*(t20 - t23*t179);
+    const iiwa_real t182 = t111*t165;
+    const iiwa_real t183 = t112*t167;
+    const iiwa_real t184 = 2*t142;
+    const iiwa_real t185 = t155*(t14 - t15*t184);
+    const iiwa_real t186 = t157*(t22 - t23*t184);
+    const iiwa_real t187 = t127*t165;
+    const iiwa_real t188 = t128*t167;
+    const iiwa_real t189 = qd1*t146;
+    const iiwa_real t190 = t23*t146;
+    const iiwa_real t191 = t15*t146;
 
     /* Outputs */
     Jd[0] = -t69;
-    Jd[1] = t132;
+    Jd[1] = t133;
     Jd[2] = t77;
-    Jd[3] = t87;
-    Jd[4] = t99;
-    Jd[5] = -t124;
+    Jd[3] = t88;
+    Jd[4] = t100;
+    Jd[5] = -t125;
     Jd[6] = 0;
     Jd[7] = t76;
-    Jd[8] = t133;
+    Jd[8] = t134;
     Jd[9] = t70;
-    Jd[10] = -t88;
-    Jd[11] = t100;
-    Jd[12] = t125;
+    Jd[10] = -t89;
+    Jd[11] = t101;
+    Jd[12] = t126;
     Jd[13] = 0;
     Jd[14] = 0;
     Jd[15] = -t78;
     Jd[16] = -t79;
-    Jd[17] = t83;
-    Jd[18] = t95;
-    Jd[19] = -t118;
+    Jd[17] = t84;
+    Jd[18] = t96;
+    Jd[19] = -t119;
     Jd[20] = 0;
     Jd[21] = 0;
-    Jd[22] = -t161 - t162 + t157 + t159;
-    Jd[23] = t164 + t165 + t167 + t169;
-    Jd[24] = t171 + t172 + t173 + t174;
-    Jd[25] = t176 + t177 + t178 + t179;
-    Jd[26] = -t184 + t181 + t182 + t183;
-    Jd[27] = t186 + t187 + t188 + t189;
+    Jd[22] = -t160 - t161 + t156 + t158;
+    Jd[23] = t163 + t164 + t166 + t168;
+    Jd[24] = t170 + t171 + t172 + t173;
+    Jd[25] = t175 + t176 + t177 + t178;
+    Jd[26] = -t183 + t180 + t181 + t182;
+    Jd[27] = t185 + t186 + t187 + t188;
     Jd[28] = 0;
-    Jd[29] = t129*(-t15*t149 + c1*t147) + t130*(-t23*t149 + s1*t147) + t136*t190 - t137*t190;
-    Jd[30] = t129*(-t15*t150 + t16*t147) - t130*(t23*t150 + t8*t147) - t80*t191 + t71*t192;
-    Jd[31] = -t129*(t15*t151 + t3*t147) - t130*(t23*t151 + t6*t147) - t89*t191 + t90*t192;
-    Jd[32] = t129*(-t15*t152 + t18*t147) - t130*(t23*t152 + t10*t147) - t101*t191 + t102*t192;
-    Jd[33] = t129*(-t15*t153 + t20*t147) + t130*(-t23*t153 + t12*t147) - t110*t191 - t111*t192;
-    Jd[34] = t129*(-t15*t154 + t22*t147) - t130*(t23*t154 + t14*t147) - t126*t191 + t127*t192;
+    Jd[29] = t130*(-t15*t148 + c1*t146) + t131*(-t23*t148 + s1*t146) + t135*t189 - t136*t189;
+    Jd[30] = t130*(-t15*t149 + t16*t146) - t131*(t23*t149 + t8*t146) - t80*t190 + t71*t191;
+    Jd[31] = -t130*(t15*t150 + t3*t146) - t131*(t23*t150 + t6*t146) - t90*t190 + t91*t191;
+    Jd[32] = t130*(-t15*t151 + t18*t146) - t131*(t23*t151 + t10*t146) - t102*t190 + t103*t191;
+    Jd[33] = t130*(-t15*t152 + t20*t146) + t131*(-t23*t152 + t12*t146) - t111*t190 - t112*t191;
+    Jd[34] = t130*(-t15*t153 + t22*t146) - t131*(t23*t153 + t14*t146) - t127*t190 + t128*t191;
     Jd[35] = 0;
-    Jd[36] = -(t121*t139 + t34*t157 + t34*t159 - t34*t161 - t34*t162);
-    Jd[37] = -(t135 + t121*t146 + t34*t164 + t34*t165 + t34*t167 + t34*t169);
-    Jd[38] = -(t84 + t121*t140 + t34*t171 + t34*t172 + t34*t173 + t34*t174);
-    Jd[39] = -(-t96 + t121*t141 + t34*t176 + t34*t177 + t34*t178 + t34*t179);
-    Jd[40] = -(-t107 + t121*t142 + t34*t181 + t34*t182 + t34*t183 - t34*t184);
-    Jd[41] = -(-t119 + t121*t143 + t34*t186 + t34*t187 + t34*t188 + t34*t189);
+    Jd[36] = -(t122*t138 + t34*t156 + t34*t158 - t34*t160 - t34*t161);
+    Jd[37] = -(t81 + t122*t145 + t34*t163 + t34*t164 + t34*t166 + t34*t168);
+    Jd[38] = -(t85 + t122*t139 + t34*t170 + t34*t171 + t34*t172 + t34*t173);
+    Jd[39] = -(-t97 + t122*t140 + t34*t175 + t34*t176 + t34*t177 + t34*t178);
+    Jd[40] = -(-t108 + t122*t141 + t34*t180 + t34*t181 + t34*t182 - t34*t183);
+    Jd[41] = -(-t120 + t122*t142 + t34*t185 + t34*t186 + t34*t187 + t34*t188);
 }
 
 void iiwa_hessian(const iiwa_real q[IIWA_DOF], iiwa_real H[IIWA_DOF * 6 * IIWA_DOF])
@@ -1866,7 +1862,7 @@ void iiwa_hessian(const iiwa_real q[IIWA_DOF], iiwa_real H[IIWA_DOF * 6 * IIWA_D
 
 void iiwa_singularity_factors(const iiwa_real q[IIWA_DOF], iiwa_real f[IIWA_NUM_SINGULARITY_FACTORS])
 {
-    /* 697 operations */
+    /* 696 operations */
 
     /* Inputs */
     const iiwa_real q1 = q[0];
@@ -1984,7 +1980,7 @@ void iiwa_singularity_factors(const iiwa_real q[IIWA_DOF], iiwa_real f[IIWA_NUM_
     const iiwa_real t92 = -t65 + s1*t3;
     const iiwa_real t93 = t33*t79 + t35*t89 + t37*t92;
     const iiwa_real t94 = t33*t80 + t35*t90 - t36*t92;
-    const iiwa_real t95 = -((s1*s1)*s2 + t71);
+    const iiwa_real t95 = -(t71 + s1*t14);
     const iiwa_real t96 = t33*t82 + t34*t89 + t37*t95;
     const iiwa_real t97 = t33*t83 + t34*t90 - t36*t95;
     const iiwa_real t98 = t33*t85 + t34*t92 - t35*t95;
@@ -2058,7 +2054,7 @@ void iiwa_singularity_factors(const iiwa_real q[IIWA_DOF], iiwa_real f[IIWA_NUM_
 
 iiwa_real iiwa_manipulability(const iiwa_real q[IIWA_DOF])
 {
-    /* 700 operations */
+    /* 699 operations */
 
     /* Inputs */
     const iiwa_real q1 = q[0];
@@ -2176,7 +2172,7 @@ iiwa_real iiwa_manipulability(const iiwa_real q[IIWA_DOF])
     const iiwa_real t92 = -t65 + s1*t3;
     const iiwa_real t93 = t33*t79 + t35*t89 + t37*t92;
     const iiwa_real t94 = t33*t80 + t35*t90 - t36*t92;
-    const iiwa_real t95 = -((s1*s1)*s2 + t71);
+    const iiwa_real t95 = -(t71 + s1*t14);
     const iiwa_real t96 = t33*t82 + t34*t89 + t37*t95;
     const iiwa_real t97 = t33*t83 + t34*t90 - t36*t95;
     const iiwa_real t98 = t33*t85 + t34*t92 - t35*t95;

@@ -61,19 +61,19 @@ void iiwa_task(const iiwa_real q[IIWA_DOF], iiwa_real mu[IIWA_TASK_DIM]);
 void iiwa_task_jacobian(const iiwa_real q[IIWA_DOF], iiwa_real J[IIWA_TASK_DIM * IIWA_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]; a[i], i < 6. 428 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]; a[i], i < 6. 425 operations. */
 void iiwa_fk_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real T[16], iiwa_real J[6 * IIWA_DOF], iiwa_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 325 operations. */
+ * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 322 operations. */
 void iiwa_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real Jd[6 * IIWA_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
- * Result: a[i], i < 6. 388 operations. */
+ * Result: a[i], i < 6. 385 operations. */
 void iiwa_bias_acceleration(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 639 operations. */
+ * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 636 operations. */
 void iiwa_task_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real Jd[IIWA_TASK_DIM * IIWA_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
@@ -81,11 +81,11 @@ void iiwa_task_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[I
 void iiwa_hessian(const iiwa_real q[IIWA_DOF], iiwa_real H[IIWA_DOF * 6 * IIWA_DOF]);
 
 /* Factors of det(Js Js^T): the robot is singular where one is 0.
- * Result: f[i], i < 2. 697 operations. */
+ * Result: f[i], i < 2. 696 operations. */
 void iiwa_singularity_factors(const iiwa_real q[IIWA_DOF], iiwa_real f[IIWA_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability sqrt(det(Js Js^T)).
- * Result: returned as a scalar. 700 operations. */
+ * Result: returned as a scalar. 699 operations. */
 iiwa_real iiwa_manipulability(const iiwa_real q[IIWA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

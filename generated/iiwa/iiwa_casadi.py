@@ -641,7 +641,7 @@ def _task_jacobian(q):
 
 
 def _fk_jacobian_dot(q, q_dot):
-    """Fk, jacobian and bias_acceleration in one pass, sharing their terms: 428 operations."""
+    """Fk, jacobian and bias_acceleration in one pass, sharing their terms: 425 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -775,7 +775,6 @@ def _fk_jacobian_dot(q, q_dot):
     t102 = t96 + t101
     t103 = t32*qd6
     t104 = t38 + t103
-    t105 = s2*qd2
     T = casadi.SX(4, 4)
     T[0, 0] = t16
     T[0, 1] = -t17
@@ -832,12 +831,12 @@ def _fk_jacobian_dot(q, q_dot):
     a[2, 0] = qd4*(-t65*t88 - t53*t94 + t7*t71 + t4*t59) + qd5*(t67*t89 - t55*t95 + t11*t70 - t20*t58) - qd2*(s1*t91 + c1*t97) - qd3*(t63*t87 + t51*t93 - t9*t72 + t18*t60) - qd6*(t57*t96 + t69*t99 + t57*t101 - t69*t90)
     a[3, 0] = qd5*(t29*t95 - t20*t37) + qd6*(t32*t96 - t22*t38) + qd7*(t34*t102 - t24*t104) - qd1*t93 + qd3*(c2*t93 - t18*qd1) + qd4*(t4*t0 - t30*t94)
     a[4, 0] = qd5*(t11*t37 - t29*t89) + qd7*(t15*t104 - t34*t100) - qd1*t87 + qd3*(t9*qd1 + c2*t87) + qd4*(t7*t0 + t30*t88) - qd6*(t13*t38 + t32*t90)
-    a[5, 0] = qd5*(t20*t89 - t11*t95) + qd6*(t22*t90 + t13*t96) + qd7*(t24*t100 - t15*t102) - qd3*(s1**2*t105 + c1**2*t105) - qd4*(t4*t88 + t7*t94)
+    a[5, 0] = qd5*(t20*t89 - t11*t95) + qd6*(t22*t90 + t13*t96) + qd7*(t24*t100 - t15*t102) - qd4*(t4*t88 + t7*t94) - qd3*(t18*t87 + t9*t93)
     return [T, J, a]
 
 
 def _jacobian_dot(q, q_dot):
-    """Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 325 operations."""
+    """Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 322 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -944,7 +943,6 @@ def _jacobian_dot(q, q_dot):
     t79 = t78 + t29
     t80 = s1*qd1
     t81 = c1*qd1
-    t82 = s2*qd2
     Jd = casadi.SX(6, 7)
     Jd[0, 0] = -t67
     Jd[0, 1] = c1*t44 - t47*t80
@@ -975,7 +973,7 @@ def _jacobian_dot(q, q_dot):
     Jd[4, 4] = t11*t28 - t23*t64
     Jd[4, 5] = -(t13*t29 + t26*t65)
     Jd[4, 6] = t14*t79 - t27*t75
-    Jd[5, 2] = -(s1**2*t82 + c1**2*t82)
+    Jd[5, 2] = -(t15*t62 + t9*t68)
     Jd[5, 3] = -(t4*t63 + t7*t69)
     Jd[5, 4] = t17*t64 - t11*t70
     Jd[5, 5] = t19*t65 + t13*t71
@@ -984,7 +982,7 @@ def _jacobian_dot(q, q_dot):
 
 
 def _bias_acceleration(q, q_dot):
-    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): 388 operations."""
+    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): 385 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1091,19 +1089,18 @@ def _bias_acceleration(q, q_dot):
     t78 = t26*qd6
     t79 = t78 + t29
     t80 = t47*qd1
-    t81 = s2*qd2
     a = casadi.SX(6, 1)
     a[0, 0] = -qd1*t67 + qd5*(t39*t70 - t54*t28 + t17*t41 - t23*t57) + qd4*(t38*t69 + t53*t0 - t4*t42 + t24*t59) + qd2*(c1*t44 - s1*t80) + qd3*(-t52*qd1 - c2*t61 + t15*t43 + t68*t37) - qd6*(t55*t29 + t40*t71 + t76*t40 + t78*t55)
     a[1, 0] = qd1*t73 + qd5*(t50*t28 - t39*t64 + t23*t56 - t11*t41) - qd4*(t38*t63 + t7*t42 + t24*t58 - t49*t0) + qd2*(s1*t44 + c1*t80) + qd3*(t48*qd1 + c2*t60 - t9*t43 + t62*t37) + qd6*(t51*t29 + t40*t65 + t78*t51 - t74*t40)
     a[2, 0] = qd4*(-t53*t63 - t49*t69 + t7*t59 + t4*t58) + qd5*(t54*t64 - t50*t70 + t11*t57 - t17*t56) - qd2*(s1*t66 + c1*t72) - qd3*(-t9*t61 + t15*t60 + t62*t52 + t68*t48) - qd6*(t51*t71 - t55*t65 + t74*t55 + t76*t51)
     a[3, 0] = qd5*(t23*t70 - t17*t28) + qd6*(t26*t71 - t19*t29) + qd7*(t27*t77 - t20*t79) + qd4*(t4*t0 - t24*t69) - t68*qd1 + qd3*(-t15*qd1 + c2*t68)
     a[4, 0] = qd5*(t11*t28 - t23*t64) + qd7*(t14*t79 - t27*t75) - t62*qd1 + qd4*(t7*t0 + t24*t63) - qd6*(t13*t29 + t26*t65) + qd3*(t9*qd1 + c2*t62)
-    a[5, 0] = qd5*(t17*t64 - t11*t70) + qd6*(t19*t65 + t13*t71) + qd7*(t20*t75 - t14*t77) - qd4*(t4*t63 + t7*t69) - qd3*(s1**2*t81 + c1**2*t81)
+    a[5, 0] = qd5*(t17*t64 - t11*t70) + qd6*(t19*t65 + t13*t71) + qd7*(t20*t75 - t14*t77) - qd4*(t4*t63 + t7*t69) - qd3*(t15*t62 + t9*t68)
     return [a]
 
 
 def _task_jacobian_dot(q, q_dot):
-    """Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': 639 operations."""
+    """Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': 636 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1213,154 +1210,153 @@ def _task_jacobian_dot(q, q_dot):
     t78 = s1*t68 + c1*t75
     t79 = -t8*t66 + t16*t65 + t67*t57 + t74*t53
     t80 = -t16*qd1 + c2*t74
-    t81 = t74 + t16*qd3
-    t82 = t81
-    t83 = -t58*t73 - t54*t82 + t6*t64 + t3*t63
-    t84 = t3*t73 + t6*t82
-    t85 = qd1 + c2*qd3
-    t86 = t85
-    t87 = t43*t82 + t58*t86 - t3*t47 + t29*t64
-    t88 = t43*t73 + t6*t47 + t29*t63 - t54*t86
-    t89 = t3*t86 - t29*t82
-    t90 = t6*t86 + t29*t73
-    t91 = t6*qd4
-    t92 = t91 + t73
-    t93 = -t3*qd4
-    t94 = t93 + t82
-    t95 = t59*t92 - t55*t94 + t10*t62 - t18*t61
-    t96 = t18*t92 - t10*t94
-    t97 = -t29*qd4
-    t98 = t97 + t86
-    t99 = t44*t94 - t59*t98 + t18*t46 - t28*t62
-    t100 = t55*t98 - t44*t92 + t28*t61 - t10*t46
-    t101 = t28*t94 - t18*t98
-    t102 = t10*t98 - t28*t92
-    t103 = t10*qd5
-    t104 = t103 + t92
-    t105 = t18*qd5
-    t106 = t105 + t94
-    t107 = t20*t104 + t12*t106
-    t108 = t28*qd5
-    t109 = t108 + t98
-    t110 = t31*t106 - t20*t109
-    t111 = t12*t109 + t31*t104
-    t112 = t12*qd6
-    t113 = -t112
-    t114 = t113 + t104
-    t115 = t72 + t91 + t103 + t113 + t14*qd7
-    t116 = t20*qd6
-    t117 = t116 + t106
-    t118 = t56*t106 - t60*t104 + t112*t60 + t116*t56
-    t119 = t22*t114 - t14*t117
-    t120 = t81 + t93 + t105 + t116 + t22*qd7
-    t121 = t23*t115 - t15*t120
-    t122 = t31*qd6
-    t123 = t122 + t109
-    t124 = t60*t109 + t45*t106 + t116*t45 + t122*t60
-    t125 = t56*t109 + t45*t104 + t122*t56 - t112*t45
-    t126 = t33*t117 - t22*t123
-    t127 = t14*t123 - t33*t114
-    t128 = t85 + t97 + t108 + t122 + t33*qd7
-    t129 = t34*t120 - t23*t128
-    t130 = t15*t128 - t34*t115
-    t131 = t52*qd1
-    t132 = c1*t49 - s1*t131
-    t133 = s1*t49 + c1*t131
-    t134 = s2*qd2
-    t135 = s1**2*t134 + c1**2*t134
-    t136 = c1*t23
-    t137 = s1*t15
-    t138 = 1/t24
-    t139 = t138*(-t137 + t136)
-    t140 = (t6*t15 - t3*t23)*t138
-    t141 = (t10*t15 + t18*t23)*t138
-    t142 = (t20*t23 - t12*t15)*t138
-    t143 = (t14*t15 + t22*t23)*t138
-    t144 = c1*t15
-    t145 = s1*t23
-    t146 = t138*(s2*t144 + s2*t145)
-    t147 = 1/t25
-    t148 = t138*t147
-    t149 = (t144 + t145)*t148
-    t150 = t148*(s2*t137 - s2*t136)
-    t151 = -(t3*t15 + t6*t23)*t148
-    t152 = (t18*t15 - t10*t23)*t148
-    t153 = (t12*t23 + t20*t15)*t148
-    t154 = (t22*t15 - t14*t23)*t148
-    t155 = 2*t139
-    t156 = t129*t138
-    t157 = -(s1 + t15*t155)*t156
-    t158 = t130*t138
-    t159 = (c1 - t23*t155)*t158
-    t160 = qd1*t138
-    t161 = t144*t160
-    t162 = t145*t160
-    t163 = 2*t146
-    t164 = t156*(t8 - t15*t163)
-    t165 = t158*(t16 - t23*t163)
-    t166 = t15*t138
-    t167 = t80*t166
-    t168 = t23*t138
-    t169 = t71*t168
-    t170 = 2*t140
-    t171 = t156*(t6 - t15*t170)
-    t172 = -t158*(t3 + t23*t170)
-    t173 = t89*t166
-    t174 = t90*t168
-    t175 = 2*t141
-    t176 = t156*(t10 - t15*t175)
-    t177 = t158*(t18 - t23*t175)
-    t178 = t101*t166
-    t179 = t102*t168
-    t180 = 2*t142
-    t181 = -t156*(t12 + t15*t180)
-    t182 = t158*(t20 - t23*t180)
-    t183 = t110*t166
-    t184 = t111*t168
-    t185 = 2*t143
-    t186 = t156*(t14 - t15*t185)
-    t187 = t158*(t22 - t23*t185)
-    t188 = t126*t166
-    t189 = t127*t168
-    t190 = qd1*t147
-    t191 = t23*t147
-    t192 = t15*t147
+    t81 = t16*t67 + t8*t74
+    t82 = t74 + t16*qd3
+    t83 = t82
+    t84 = -t58*t73 - t54*t83 + t6*t64 + t3*t63
+    t85 = t3*t73 + t6*t83
+    t86 = qd1 + c2*qd3
+    t87 = t86
+    t88 = t43*t83 + t58*t87 - t3*t47 + t29*t64
+    t89 = t43*t73 + t6*t47 + t29*t63 - t54*t87
+    t90 = t3*t87 - t29*t83
+    t91 = t6*t87 + t29*t73
+    t92 = t6*qd4
+    t93 = t92 + t73
+    t94 = -t3*qd4
+    t95 = t94 + t83
+    t96 = t59*t93 - t55*t95 + t10*t62 - t18*t61
+    t97 = t18*t93 - t10*t95
+    t98 = -t29*qd4
+    t99 = t98 + t87
+    t100 = t44*t95 - t59*t99 + t18*t46 - t28*t62
+    t101 = t55*t99 - t44*t93 + t28*t61 - t10*t46
+    t102 = t28*t95 - t18*t99
+    t103 = t10*t99 - t28*t93
+    t104 = t10*qd5
+    t105 = t104 + t93
+    t106 = t18*qd5
+    t107 = t106 + t95
+    t108 = t20*t105 + t12*t107
+    t109 = t28*qd5
+    t110 = t109 + t99
+    t111 = t31*t107 - t20*t110
+    t112 = t12*t110 + t31*t105
+    t113 = t12*qd6
+    t114 = -t113
+    t115 = t114 + t105
+    t116 = t72 + t92 + t104 + t114 + t14*qd7
+    t117 = t20*qd6
+    t118 = t117 + t107
+    t119 = t56*t107 - t60*t105 + t113*t60 + t117*t56
+    t120 = t22*t115 - t14*t118
+    t121 = t82 + t94 + t106 + t117 + t22*qd7
+    t122 = t23*t116 - t15*t121
+    t123 = t31*qd6
+    t124 = t123 + t110
+    t125 = t60*t110 + t45*t107 + t117*t45 + t123*t60
+    t126 = t56*t110 + t45*t105 + t123*t56 - t113*t45
+    t127 = t33*t118 - t22*t124
+    t128 = t14*t124 - t33*t115
+    t129 = t86 + t98 + t109 + t123 + t33*qd7
+    t130 = t34*t121 - t23*t129
+    t131 = t15*t129 - t34*t116
+    t132 = t52*qd1
+    t133 = c1*t49 - s1*t132
+    t134 = s1*t49 + c1*t132
+    t135 = c1*t23
+    t136 = s1*t15
+    t137 = 1/t24
+    t138 = t137*(-t136 + t135)
+    t139 = (t6*t15 - t3*t23)*t137
+    t140 = (t10*t15 + t18*t23)*t137
+    t141 = (t20*t23 - t12*t15)*t137
+    t142 = (t14*t15 + t22*t23)*t137
+    t143 = c1*t15
+    t144 = s1*t23
+    t145 = t137*(s2*t143 + s2*t144)
+    t146 = 1/t25
+    t147 = t137*t146
+    t148 = (t143 + t144)*t147
+    t149 = t147*(s2*t136 - s2*t135)
+    t150 = -(t3*t15 + t6*t23)*t147
+    t151 = (t18*t15 - t10*t23)*t147
+    t152 = (t12*t23 + t20*t15)*t147
+    t153 = (t22*t15 - t14*t23)*t147
+    t154 = 2*t138
+    t155 = t130*t137
+    t156 = -(s1 + t15*t154)*t155
+    t157 = t131*t137
+    t158 = (c1 - t23*t154)*t157
+    t159 = qd1*t137
+    t160 = t143*t159
+    t161 = t144*t159
+    t162 = 2*t145
+    t163 = t155*(t8 - t15*t162)
+    t164 = t157*(t16 - t23*t162)
+    t165 = t15*t137
+    t166 = t80*t165
+    t167 = t23*t137
+    t168 = t71*t167
+    t169 = 2*t139
+    t170 = t155*(t6 - t15*t169)
+    t171 = -t157*(t3 + t23*t169)
+    t172 = t90*t165
+    t173 = t91*t167
+    t174 = 2*t140
+    t175 = t155*(t10 - t15*t174)
+    t176 = t157*(t18 - t23*t174)
+    t177 = t102*t165
+    t178 = t103*t167
+    t179 = 2*t141
+    t180 = -t155*(t12 + t15*t179)
+    t181 = t157*(t20 - t23*t179)
+    t182 = t111*t165
+    t183 = t112*t167
+    t184 = 2*t142
+    t185 = t155*(t14 - t15*t184)
+    t186 = t157*(t22 - t23*t184)
+    t187 = t127*t165
+    t188 = t128*t167
+    t189 = qd1*t146
+    t190 = t23*t146
+    t191 = t15*t146
     Jd = casadi.SX(6, 7)
     Jd[0, 0] = -t69
-    Jd[0, 1] = t132
+    Jd[0, 1] = t133
     Jd[0, 2] = t77
-    Jd[0, 3] = t87
-    Jd[0, 4] = t99
-    Jd[0, 5] = -t124
+    Jd[0, 3] = t88
+    Jd[0, 4] = t100
+    Jd[0, 5] = -t125
     Jd[1, 0] = t76
-    Jd[1, 1] = t133
+    Jd[1, 1] = t134
     Jd[1, 2] = t70
-    Jd[1, 3] = -t88
-    Jd[1, 4] = t100
-    Jd[1, 5] = t125
+    Jd[1, 3] = -t89
+    Jd[1, 4] = t101
+    Jd[1, 5] = t126
     Jd[2, 1] = -t78
     Jd[2, 2] = -t79
-    Jd[2, 3] = t83
-    Jd[2, 4] = t95
-    Jd[2, 5] = -t118
-    Jd[3, 1] = -t161 - t162 + t157 + t159
-    Jd[3, 2] = t164 + t165 + t167 + t169
-    Jd[3, 3] = t171 + t172 + t173 + t174
-    Jd[3, 4] = t176 + t177 + t178 + t179
-    Jd[3, 5] = -t184 + t181 + t182 + t183
-    Jd[3, 6] = t186 + t187 + t188 + t189
-    Jd[4, 1] = t129*(-t15*t149 + c1*t147) + t130*(-t23*t149 + s1*t147) + t136*t190 - t137*t190
-    Jd[4, 2] = t129*(-t15*t150 + t16*t147) - t130*(t23*t150 + t8*t147) - t80*t191 + t71*t192
-    Jd[4, 3] = -t129*(t15*t151 + t3*t147) - t130*(t23*t151 + t6*t147) - t89*t191 + t90*t192
-    Jd[4, 4] = t129*(-t15*t152 + t18*t147) - t130*(t23*t152 + t10*t147) - t101*t191 + t102*t192
-    Jd[4, 5] = t129*(-t15*t153 + t20*t147) + t130*(-t23*t153 + t12*t147) - t110*t191 - t111*t192
-    Jd[4, 6] = t129*(-t15*t154 + t22*t147) - t130*(t23*t154 + t14*t147) - t126*t191 + t127*t192
-    Jd[5, 1] = -(t121*t139 + t34*t157 + t34*t159 - t34*t161 - t34*t162)
-    Jd[5, 2] = -(t135 + t121*t146 + t34*t164 + t34*t165 + t34*t167 + t34*t169)
-    Jd[5, 3] = -(t84 + t121*t140 + t34*t171 + t34*t172 + t34*t173 + t34*t174)
-    Jd[5, 4] = -(-t96 + t121*t141 + t34*t176 + t34*t177 + t34*t178 + t34*t179)
-    Jd[5, 5] = -(-t107 + t121*t142 + t34*t181 + t34*t182 + t34*t183 - t34*t184)
-    Jd[5, 6] = -(-t119 + t121*t143 + t34*t186 + t34*t187 + t34*t188 + t34*t189)
+    Jd[2, 3] = t84
+    Jd[2, 4] = t96
+    Jd[2, 5] = -t119
+    Jd[3, 1] = -t160 - t161 + t156 + t158
+    Jd[3, 2] = t163 + t164 + t166 + t168
+    Jd[3, 3] = t170 + t171 + t172 + t173
+    Jd[3, 4] = t175 + t176 + t177 + t178
+    Jd[3, 5] = -t183 + t180 + t181 + t182
+    Jd[3, 6] = t185 + t186 + t187 + t188
+    Jd[4, 1] = t130*(-t15*t148 + c1*t146) + t131*(-t23*t148 + s1*t146) + t135*t189 - t136*t189
+    Jd[4, 2] = t130*(-t15*t149 + t16*t146) - t131*(t23*t149 + t8*t146) - t80*t190 + t71*t191
+    Jd[4, 3] = -t130*(t15*t150 + t3*t146) - t131*(t23*t150 + t6*t146) - t90*t190 + t91*t191
+    Jd[4, 4] = t130*(-t15*t151 + t18*t146) - t131*(t23*t151 + t10*t146) - t102*t190 + t103*t191
+    Jd[4, 5] = t130*(-t15*t152 + t20*t146) + t131*(-t23*t152 + t12*t146) - t111*t190 - t112*t191
+    Jd[4, 6] = t130*(-t15*t153 + t22*t146) - t131*(t23*t153 + t14*t146) - t127*t190 + t128*t191
+    Jd[5, 1] = -(t122*t138 + t34*t156 + t34*t158 - t34*t160 - t34*t161)
+    Jd[5, 2] = -(t81 + t122*t145 + t34*t163 + t34*t164 + t34*t166 + t34*t168)
+    Jd[5, 3] = -(t85 + t122*t139 + t34*t170 + t34*t171 + t34*t172 + t34*t173)
+    Jd[5, 4] = -(-t97 + t122*t140 + t34*t175 + t34*t176 + t34*t177 + t34*t178)
+    Jd[5, 5] = -(-t108 + t122*t141 + t34*t180 + t34*t181 + t34*t182 - t34*t183)
+    Jd[5, 6] = -(-t120 + t122*t142 + t34*t185 + t34*t186 + t34*t187 + t34*t188)
     return [Jd]
 
 
@@ -1631,7 +1627,7 @@ def _hessian(q):
 
 
 def _singularity_factors(q):
-    """Factors of det(Js Js^T): the robot is singular where one is 0: 697 operations."""
+    """Factors of det(Js Js^T): the robot is singular where one is 0: 696 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1745,7 +1741,7 @@ def _singularity_factors(q):
     t92 = -t65 + s1*t3
     t93 = t33*t79 + t35*t89 + t37*t92
     t94 = t33*t80 + t35*t90 - t36*t92
-    t95 = -(s1**2*s2 + t71)
+    t95 = -(t71 + s1*t14)
     t96 = t33*t82 + t34*t89 + t37*t95
     t97 = t33*t83 + t34*t90 - t36*t95
     t98 = t33*t85 + t34*t92 - t35*t95
@@ -1818,7 +1814,7 @@ def _singularity_factors(q):
 
 
 def _manipulability(q):
-    """Manipulability sqrt(det(Js Js^T)): 700 operations."""
+    """Manipulability sqrt(det(Js Js^T)): 699 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1932,7 +1928,7 @@ def _manipulability(q):
     t92 = -t65 + s1*t3
     t93 = t33*t79 + t35*t89 + t37*t92
     t94 = t33*t80 + t35*t90 - t36*t92
-    t95 = -(s1**2*s2 + t71)
+    t95 = -(t71 + s1*t14)
     t96 = t33*t82 + t34*t89 + t37*t95
     t97 = t33*t83 + t34*t90 - t36*t95
     t98 = t33*t85 + t34*t92 - t35*t95

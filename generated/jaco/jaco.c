@@ -1100,7 +1100,7 @@ void jaco_task(const jaco_real q[JACO_DOF], jaco_real mu[JACO_TASK_DIM])
 
 void jaco_task_jacobian(const jaco_real q[JACO_DOF], jaco_real J[JACO_TASK_DIM * JACO_DOF])
 {
-    /* 243 operations */
+    /* 242 operations */
 
     /* Inputs */
     const jaco_real q1 = q[0];
@@ -1187,8 +1187,8 @@ void jaco_task_jacobian(const jaco_real q[JACO_DOF], jaco_real J[JACO_TASK_DIM *
     const jaco_real t61 = s1*t30 + c1*t34;
     const jaco_real t62 = (t30*t30) + (t34*t34);
     const jaco_real t63 = 1.0/t62;
-    const jaco_real t64 = -t61*t63;
-    const jaco_real t65 = t61*t63;
+    const jaco_real t64 = t61*t63;
+    const jaco_real t65 = -t64;
     const jaco_real t66 = -t63*(t13*t34 + t12*t30);
     const jaco_real t67 = -t63*(t18*t30 + t21*t34);
     const jaco_real t68 = -t63*(t30*t41 + t34*t47);
@@ -1216,8 +1216,8 @@ void jaco_task_jacobian(const jaco_real q[JACO_DOF], jaco_real J[JACO_TASK_DIM *
     J[16] = t21*t43 - t18*t49;
     J[17] = t42*t47 - t48*t41;
     J[18] = 0;
-    J[19] = t64;
-    J[20] = t65;
+    J[19] = t65;
+    J[20] = t64;
     J[21] = t66;
     J[22] = t67;
     J[23] = t68;
@@ -1228,8 +1228,8 @@ void jaco_task_jacobian(const jaco_real q[JACO_DOF], jaco_real J[JACO_TASK_DIM *
     J[28] = t69*(t18*t34 - t21*t30);
     J[29] = t69*(t41*t34 - t30*t47);
     J[30] = -1;
-    J[31] = -t39*t64;
-    J[32] = -t39*t65;
+    J[31] = -t39*t65;
+    J[32] = -t39*t64;
     J[33] = t4 - t39*t66;
     J[34] = t25 - t39*t67;
     J[35] = t53 - t39*t68;
@@ -1237,7 +1237,7 @@ void jaco_task_jacobian(const jaco_real q[JACO_DOF], jaco_real J[JACO_TASK_DIM *
 
 void jaco_fk_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JACO_DOF], jaco_real T[16], jaco_real J[6 * JACO_DOF], jaco_real a[6])
 {
-    /* 434 operations */
+    /* 431 operations */
 
     /* Inputs */
     const jaco_real q1 = q[0];
@@ -1389,7 +1389,6 @@ void jaco_fk_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JAC
     const jaco_real t120 = c1*t55;
     const jaco_real t121 = s1*t56;
     const jaco_real t122 = s1*t55;
-    const jaco_real t123 = t55*qd2;
 
     /* Outputs */
     T[0] = t59;
@@ -1446,7 +1445,7 @@ void jaco_fk_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JAC
     J[35] = t52;
     a[0] = qd1*t113 + qd4*(t87*t99 + t77*qd1 - t14*t116 - t4*t110) + qd2*(-c1*t118 + qd1*t121) - qd3*(t97*t85 + qd1*t122 - c1*t117) - qd5*(-t89*t100 + t79*t10 + t22*t115 + t26*t109) - qd6*(t81*t28 + t46*t114 + t52*t108 - t91*t101);
     a[1] = -qd1*t107 + qd4*(t71*qd1 - t87*t94 - t4*t104 + t13*t116) + qd2*(s1*t118 + t119*qd1) - qd3*(s1*t117 + t120*qd1 - t92*t85) - qd5*(t73*t10 + t89*t95 + t26*t103 - t19*t115) - qd6*(t91*t96 + t75*t28 + t52*t102 - t40*t114);
-    a[2] = qd2*(-s1*t112 + c1*t106) + qd4*(t77*t94 + t71*t99 - t13*t110 - t14*t104) + qd5*(t79*t95 + t73*t100 - t19*t109 - t22*t103) + qd3*(s1*t111 - c1*t105 + (s1*s1)*t123 + (c1*c1)*t123) + qd6*(t81*t96 + t75*t101 - t40*t108 - t46*t102);
+    a[2] = qd2*(-s1*t112 + c1*t106) + qd4*(t77*t94 + t71*t99 - t13*t110 - t14*t104) + qd5*(t79*t95 + t73*t100 - t19*t109 - t22*t103) + qd6*(t81*t96 + t75*t101 - t40*t108 - t46*t102) + qd3*(s1*t111 - c1*t105 + t92*t122 + t97*t120);
     a[3] = qd4*(t4*t99 - t14*qd1) + qd5*(t26*t100 + t22*t10) + qd6*(t52*t101 + t46*t28) - t97*qd1 + t98*qd1;
     a[4] = qd4*(t13*qd1 - t4*t94) + t92*qd1 - t93*qd1 - qd5*(t19*t10 + t26*t95) - qd6*(t40*t28 + t52*t96);
     a[5] = qd4*(-t14*t94 + t13*t99) + qd5*(-t22*t95 + t19*t100) + qd6*(-t46*t96 + t40*t101);
@@ -2371,7 +2370,7 @@ void jaco_hessian(const jaco_real q[JACO_DOF], jaco_real H[JACO_DOF * 6 * JACO_D
 
 void jaco_singularity_factors(const jaco_real q[JACO_DOF], jaco_real f[JACO_NUM_SINGULARITY_FACTORS])
 {
-    /* 57 operations */
+    /* 54 operations */
 
     /* Inputs */
     const jaco_real q2 = q[1];
@@ -2394,7 +2393,7 @@ void jaco_singularity_factors(const jaco_real q[JACO_DOF], jaco_real f[JACO_NUM_
     const jaco_real t3 = (s3*s3);
 
     /* Outputs */
-    f[0] = -(0.07333133870465747*s2*s5 - 0.030463*c2*s3*s4*s5 - 0.018589646387558636*s2*c3*s3*s4*s5 - 0.03517564250064714*c2*c3*c4*s4*c5 - 0.07333133870465747*c2*c3*s3*s5 + 0.0008407836500154682*c5*t0 + 0.10258082125032357*c3*t1 + 0.0004203918250077341*c4*t2 + 0.01758782125032357*c3*s5*t0 + 0.018589646387558636*t2*t3 - 0.07333133870465747*s2*s5*t3);
+    f[0] = -(0.07333133870465747*s2*s5 - 0.018589646387558636*s2*c3*s3*s4*s5 - 0.03517564250064714*c2*c3*c4*s4*c5 + 0.0008407836500154682*c5*t0 + 0.10258082125032357*c3*t1 + 0.0004203918250077341*c4*t2 + 0.01758782125032357*c3*s5*t0 + 0.018589646387558636*t2*t3 - 0.07333133870465747*s2*s5*t3 - 0.030463*s3*t2 - 0.07333133870465747*c3*s3*t1);
 }
 
 jaco_real jaco_manipulability(const jaco_real q[JACO_DOF])

@@ -55,11 +55,11 @@ void jaco_jacobian_tool(const jaco_real q[JACO_DOF], jaco_real J[6 * JACO_DOF]);
 void jaco_task(const jaco_real q[JACO_DOF], jaco_real mu[JACO_TASK_DIM]);
 
 /* Analytic Jacobian d mu / d q (6 x DOF).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 243 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 242 operations. */
 void jaco_task_jacobian(const jaco_real q[JACO_DOF], jaco_real J[JACO_TASK_DIM * JACO_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 434 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 431 operations. */
 void jaco_fk_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JACO_DOF], jaco_real T[16], jaco_real J[6 * JACO_DOF], jaco_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
@@ -79,7 +79,7 @@ void jaco_task_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
 void jaco_hessian(const jaco_real q[JACO_DOF], jaco_real H[JACO_DOF * 6 * JACO_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.
- * Result: f[i], i < 1. 57 operations. */
+ * Result: f[i], i < 1. 54 operations. */
 void jaco_singularity_factors(const jaco_real q[JACO_DOF], jaco_real f[JACO_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability |det(Js)|.

@@ -678,7 +678,7 @@ def task(q):
 
 
 def task_jacobian(q):
-    """analytic Jacobian d mu / d q (6 x DOF): (6 x 6), 243 operations."""
+    """analytic Jacobian d mu / d q (6 x DOF): (6 x 6), 242 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -761,8 +761,8 @@ def task_jacobian(q):
     t61 = s1*t30 + c1*t34
     t62 = t30**2 + t34**2
     t63 = 1/t62
-    t64 = -t61*t63
-    t65 = t61*t63
+    t64 = t61*t63
+    t65 = -t64
     t66 = -t63*(t13*t34 + t12*t30)
     t67 = -t63*(t18*t30 + t21*t34)
     t68 = -t63*(t30*t41 + t34*t47)
@@ -789,8 +789,8 @@ def task_jacobian(q):
         t21*t43 - t18*t49,  # 2, 4
         t42*t47 - t48*t41,  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        t64,  # 3, 1
-        t65,  # 3, 2
+        t65,  # 3, 1
+        t64,  # 3, 2
         t66,  # 3, 3
         t67,  # 3, 4
         t68,  # 3, 5
@@ -801,8 +801,8 @@ def task_jacobian(q):
         t69*(t18*t34 - t21*t30),  # 4, 4
         t69*(t41*t34 - t30*t47),  # 4, 5
         xp.full(batch, -1, dtype=dtype, device=device),  # 5, 0
-        -t39*t64,  # 5, 1
-        -t39*t65,  # 5, 2
+        -t39*t65,  # 5, 1
+        -t39*t64,  # 5, 2
         t4 - t39*t66,  # 5, 3
         t25 - t39*t67,  # 5, 4
         t53 - t39*t68,  # 5, 5
@@ -811,7 +811,7 @@ def task_jacobian(q):
 
 
 def fk_jacobian_dot(q, q_dot):
-    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 6 and 6 x 1), 434 operations."""
+    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 6 and 6 x 1), 431 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -959,7 +959,6 @@ def fk_jacobian_dot(q, q_dot):
     t120 = c1*t55
     t121 = s1*t56
     t122 = s1*t55
-    t123 = t55*qd2
     T = _stack(xp, [
         xp.broadcast_to(t59, batch),  # 0, 0
         xp.broadcast_to(-t60, batch),  # 0, 1
@@ -1019,7 +1018,7 @@ def fk_jacobian_dot(q, q_dot):
     a = _stack(xp, [
         xp.broadcast_to(qd1*t113 + qd4*(t87*t99 + t77*qd1 - t14*t116 - t4*t110) + qd2*(-c1*t118 + qd1*t121) - qd3*(t97*t85 + qd1*t122 - c1*t117) - qd5*(-t89*t100 + t79*t10 + t22*t115 + t26*t109) - qd6*(t81*t28 + t46*t114 + t52*t108 - t91*t101), batch),  # 0
         xp.broadcast_to(-qd1*t107 + qd4*(t71*qd1 - t87*t94 - t4*t104 + t13*t116) + qd2*(s1*t118 + t119*qd1) - qd3*(s1*t117 + t120*qd1 - t92*t85) - qd5*(t73*t10 + t89*t95 + t26*t103 - t19*t115) - qd6*(t91*t96 + t75*t28 + t52*t102 - t40*t114), batch),  # 1
-        xp.broadcast_to(qd2*(-s1*t112 + c1*t106) + qd4*(t77*t94 + t71*t99 - t13*t110 - t14*t104) + qd5*(t79*t95 + t73*t100 - t19*t109 - t22*t103) + qd3*(s1*t111 - c1*t105 + s1**2*t123 + c1**2*t123) + qd6*(t81*t96 + t75*t101 - t40*t108 - t46*t102), batch),  # 2
+        xp.broadcast_to(qd2*(-s1*t112 + c1*t106) + qd4*(t77*t94 + t71*t99 - t13*t110 - t14*t104) + qd5*(t79*t95 + t73*t100 - t19*t109 - t22*t103) + qd6*(t81*t96 + t75*t101 - t40*t108 - t46*t102) + qd3*(s1*t111 - c1*t105 + t92*t122 + t97*t120), batch),  # 2
         xp.broadcast_to(qd4*(t4*t99 - t14*qd1) + qd5*(t26*t100 + t22*t10) + qd6*(t52*t101 + t46*t28) - t97*qd1 + t98*qd1, batch),  # 3
         xp.broadcast_to(qd4*(t13*qd1 - t4*t94) + t92*qd1 - t93*qd1 - qd5*(t19*t10 + t26*t95) - qd6*(t40*t28 + t52*t96), batch),  # 4
         xp.broadcast_to(qd4*(-t14*t94 + t13*t99) + qd5*(-t22*t95 + t19*t100) + qd6*(-t46*t96 + t40*t101), batch),  # 5
@@ -1929,7 +1928,7 @@ def hessian(q):
 
 
 def singularity_factors(q):
-    """factors of det(Js): the robot is singular where one is 0: (1 x 1), 57 operations."""
+    """factors of det(Js): the robot is singular where one is 0: (1 x 1), 54 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -1948,7 +1947,7 @@ def singularity_factors(q):
     t2 = s4*t1
     t3 = s3**2
     f = _stack(xp, [
-        -(0.07333133870465747*s2*s5 - 0.030463*c2*s3*s4*s5 - 0.018589646387558636*s2*c3*s3*s4*s5 - 0.03517564250064714*c2*c3*c4*s4*c5 - 0.07333133870465747*c2*c3*s3*s5 + 0.0008407836500154682*c5*t0 + 0.10258082125032357*c3*t1 + 0.0004203918250077341*c4*t2 + 0.01758782125032357*c3*s5*t0 + 0.018589646387558636*t2*t3 - 0.07333133870465747*s2*s5*t3),  # 0
+        -(0.07333133870465747*s2*s5 - 0.018589646387558636*s2*c3*s3*s4*s5 - 0.03517564250064714*c2*c3*c4*s4*c5 + 0.0008407836500154682*c5*t0 + 0.10258082125032357*c3*t1 + 0.0004203918250077341*c4*t2 + 0.01758782125032357*c3*s5*t0 + 0.018589646387558636*t2*t3 - 0.07333133870465747*s2*s5*t3 - 0.030463*s3*t2 - 0.07333133870465747*c3*s3*t1),  # 0
     ], (1,))
     return f
 

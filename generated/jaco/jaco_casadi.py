@@ -599,7 +599,7 @@ def _task(q):
 
 
 def _task_jacobian(q):
-    """Analytic Jacobian d mu / d q (6 x DOF): 243 operations."""
+    """Analytic Jacobian d mu / d q (6 x DOF): 242 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -682,8 +682,8 @@ def _task_jacobian(q):
     t61 = s1*t30 + c1*t34
     t62 = t30**2 + t34**2
     t63 = 1/t62
-    t64 = -t61*t63
-    t65 = t61*t63
+    t64 = t61*t63
+    t65 = -t64
     t66 = -t63*(t13*t34 + t12*t30)
     t67 = -t63*(t18*t30 + t21*t34)
     t68 = -t63*(t30*t41 + t34*t47)
@@ -708,8 +708,8 @@ def _task_jacobian(q):
     J[2, 3] = t13*t44 - t12*t50
     J[2, 4] = t21*t43 - t18*t49
     J[2, 5] = t42*t47 - t48*t41
-    J[3, 1] = t64
-    J[3, 2] = t65
+    J[3, 1] = t65
+    J[3, 2] = t64
     J[3, 3] = t66
     J[3, 4] = t67
     J[3, 5] = t68
@@ -719,8 +719,8 @@ def _task_jacobian(q):
     J[4, 4] = t69*(t18*t34 - t21*t30)
     J[4, 5] = t69*(t41*t34 - t30*t47)
     J[5, 0] = -1
-    J[5, 1] = -t39*t64
-    J[5, 2] = -t39*t65
+    J[5, 1] = -t39*t65
+    J[5, 2] = -t39*t64
     J[5, 3] = t4 - t39*t66
     J[5, 4] = t25 - t39*t67
     J[5, 5] = t53 - t39*t68
@@ -728,7 +728,7 @@ def _task_jacobian(q):
 
 
 def _fk_jacobian_dot(q, q_dot):
-    """Fk, jacobian and bias_acceleration in one pass, sharing their terms: 434 operations."""
+    """Fk, jacobian and bias_acceleration in one pass, sharing their terms: 431 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -876,7 +876,6 @@ def _fk_jacobian_dot(q, q_dot):
     t120 = c1*t55
     t121 = s1*t56
     t122 = s1*t55
-    t123 = t55*qd2
     T = casadi.SX(4, 4)
     T[0, 0] = t59
     T[0, 1] = -t60
@@ -926,7 +925,7 @@ def _fk_jacobian_dot(q, q_dot):
     a = casadi.SX(6, 1)
     a[0, 0] = qd1*t113 + qd4*(t87*t99 + t77*qd1 - t14*t116 - t4*t110) + qd2*(-c1*t118 + qd1*t121) - qd3*(t97*t85 + qd1*t122 - c1*t117) - qd5*(-t89*t100 + t79*t10 + t22*t115 + t26*t109) - qd6*(t81*t28 + t46*t114 + t52*t108 - t91*t101)
     a[1, 0] = -qd1*t107 + qd4*(t71*qd1 - t87*t94 - t4*t104 + t13*t116) + qd2*(s1*t118 + t119*qd1) - qd3*(s1*t117 + t120*qd1 - t92*t85) - qd5*(t73*t10 + t89*t95 + t26*t103 - t19*t115) - qd6*(t91*t96 + t75*t28 + t52*t102 - t40*t114)
-    a[2, 0] = qd2*(-s1*t112 + c1*t106) + qd4*(t77*t94 + t71*t99 - t13*t110 - t14*t104) + qd5*(t79*t95 + t73*t100 - t19*t109 - t22*t103) + qd3*(s1*t111 - c1*t105 + s1**2*t123 + c1**2*t123) + qd6*(t81*t96 + t75*t101 - t40*t108 - t46*t102)
+    a[2, 0] = qd2*(-s1*t112 + c1*t106) + qd4*(t77*t94 + t71*t99 - t13*t110 - t14*t104) + qd5*(t79*t95 + t73*t100 - t19*t109 - t22*t103) + qd6*(t81*t96 + t75*t101 - t40*t108 - t46*t102) + qd3*(s1*t111 - c1*t105 + t92*t122 + t97*t120)
     a[3, 0] = qd4*(t4*t99 - t14*qd1) + qd5*(t26*t100 + t22*t10) + qd6*(t52*t101 + t46*t28) - t97*qd1 + t98*qd1
     a[4, 0] = qd4*(t13*qd1 - t4*t94) + t92*qd1 - t93*qd1 - qd5*(t19*t10 + t26*t95) - qd6*(t40*t28 + t52*t96)
     a[5, 0] = qd4*(-t14*t94 + t13*t99) + qd5*(-t22*t95 + t19*t100) + qd6*(-t46*t96 + t40*t101)
@@ -1739,7 +1738,7 @@ def _hessian(q):
 
 
 def _singularity_factors(q):
-    """Factors of det(Js): the robot is singular where one is 0: 57 operations."""
+    """Factors of det(Js): the robot is singular where one is 0: 54 operations."""
     q2 = q[1]
     q3 = q[2]
     q4 = q[3]
@@ -1757,7 +1756,7 @@ def _singularity_factors(q):
     t2 = s4*t1
     t3 = s3**2
     f = casadi.SX(1, 1)
-    f[0, 0] = -(0.07333133870465747*s2*s5 - 0.030463*c2*s3*s4*s5 - 0.018589646387558636*s2*c3*s3*s4*s5 - 0.03517564250064714*c2*c3*c4*s4*c5 - 0.07333133870465747*c2*c3*s3*s5 + 0.0008407836500154682*c5*t0 + 0.10258082125032357*c3*t1 + 0.0004203918250077341*c4*t2 + 0.01758782125032357*c3*s5*t0 + 0.018589646387558636*t2*t3 - 0.07333133870465747*s2*s5*t3)
+    f[0, 0] = -(0.07333133870465747*s2*s5 - 0.018589646387558636*s2*c3*s3*s4*s5 - 0.03517564250064714*c2*c3*c4*s4*c5 + 0.0008407836500154682*c5*t0 + 0.10258082125032357*c3*t1 + 0.0004203918250077341*c4*t2 + 0.01758782125032357*c3*s5*t0 + 0.018589646387558636*t2*t3 - 0.07333133870465747*s2*s5*t3 - 0.030463*s3*t2 - 0.07333133870465747*c3*s3*t1)
     return [f]
 
 

@@ -59,7 +59,7 @@ void kr5_task(const kr5_real q[KR5_DOF], kr5_real mu[KR5_TASK_DIM]);
 void kr5_task_jacobian(const kr5_real q[KR5_DOF], kr5_real J[KR5_TASK_DIM * KR5_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 326 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 323 operations. */
 void kr5_fk_jacobian_dot(const kr5_real q[KR5_DOF], const kr5_real q_dot[KR5_DOF], kr5_real T[16], kr5_real J[6 * KR5_DOF], kr5_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).

@@ -1949,7 +1949,7 @@ void manocha_canny_task_jacobian_dot(const manocha_canny_real q[MANOCHA_CANNY_DO
 
 void manocha_canny_hessian(const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real H[MANOCHA_CANNY_DOF * 6 * MANOCHA_CANNY_DOF])
 {
-    /* 269 operations */
+    /* 268 operations */
 
     /* Inputs */
     const manocha_canny_real q1 = q[0];
@@ -2091,7 +2091,7 @@ void manocha_canny_hessian(const manocha_canny_real q[MANOCHA_CANNY_DOF], manoch
     H[46] = 0;
     H[47] = 0;
     H[48] = 0;
-    H[49] = -((s1*s1)*t54 + (c1*c1)*t54);
+    H[49] = -((c1*c1)*t54 + s1*t59);
     H[50] = t66;
     H[51] = t67;
     H[52] = 0;
@@ -2262,7 +2262,7 @@ void manocha_canny_hessian(const manocha_canny_real q[MANOCHA_CANNY_DOF], manoch
 
 void manocha_canny_singularity_factors(const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real f[MANOCHA_CANNY_NUM_SINGULARITY_FACTORS])
 {
-    /* 97 operations */
+    /* 89 operations */
 
     /* Inputs */
     const manocha_canny_real q2 = q[1];
@@ -2292,12 +2292,12 @@ void manocha_canny_singularity_factors(const manocha_canny_real q[MANOCHA_CANNY_
     const manocha_canny_real t10 = s4*t7;
 
     /* Outputs */
-    f[0] = -(t0 + 0.00023266331135000646*t1 + 0.06665651301042608*t6 + 4.568797356782025e-05*t8 + 0.0017452406437283513*t9 + 0.0017452406437283513*t5 + 6.0917298090427e-06*t10 + 0.0026174622526875728*s3*s4*c5 - 0.0011633165567500323*s2*c3*c4*s4*s5 - 0.008726203218641756*s2*c3*s4*c5 - 0.09998476951563913*c3*c4*s4*s5 - 0.3332825650521304*c2*c3*c4*s4*s5 - 6.090802009086827e-06*s5*t2 + 2.0305766030142333e-05*t1*t3 + t0*t4 - 0.00023266331135000646*s2*s5*t2 + 0.0003489418134011367*s4*t5 - 0.1*c3*c5*t2 - 0.06665651301042608*c2*s5*t2 + 0.5*c2*t8 + 0.005817468812427838*t3*t6 + 0.06666666666666667*c2*t10 + 0.0003489949670250097*s3*c5*t2 + 0.00023269875249711352*s4*t9 - 0.3333333333333333*c2*c3*c5*t2 - 0.0011634937624855676*s2*c3*c5*t2 + 0.49992384757819563*s2*s3*c5*t4);
+    f[0] = -(t0 + 0.00023266331135000646*t1 + 0.06665651301042608*t6 + 4.568797356782025e-05*t8 + 0.0017452406437283513*t9 + 0.0017452406437283513*t5 + 6.0917298090427e-06*t10 + 0.0026174622526875728*s3*s4*c5 - 0.008726203218641756*s2*c3*s4*c5 - 6.090802009086827e-06*s5*t2 + 2.0305766030142333e-05*t1*t3 + t0*t4 + 0.0003489418134011367*s4*t5 - 0.1*c3*c5*t2 + 0.5*c2*t8 + 0.005817468812427838*t3*t6 + 0.06666666666666667*c2*t10 + 0.0003489949670250097*s3*c5*t2 + 0.00023269875249711352*s4*t9 - 0.3333333333333333*c2*c3*c5*t2 - 0.0011634937624855676*s2*c3*c5*t2 - 0.0011633165567500323*s4*t1*t4 - 0.09998476951563913*s4*s5*t4 - 0.3332825650521304*s4*t4*t6 - 0.00023266331135000646*t1*t2 - 0.06665651301042608*t2*t6 + 0.49992384757819563*s3*c3*t9);
 }
 
 manocha_canny_real manocha_canny_manipulability(const manocha_canny_real q[MANOCHA_CANNY_DOF])
 {
-    /* 95 operations */
+    /* 94 operations */
 
     /* Inputs */
     const manocha_canny_real q2 = q[1];
@@ -2331,7 +2331,7 @@ manocha_canny_real manocha_canny_manipulability(const manocha_canny_real q[MANOC
     const manocha_canny_real t14 = c5*t3;
     const manocha_canny_real t15 = c3*t14;
     const manocha_canny_real t16 = s4*c5;
-    const manocha_canny_real t17 = t0 + t2 + t9 + t0*t4 + 0.0002055958810551911*t11 + 0.00785358289677758*t12 + 0.00785358289677758*t6 + 2.741278414069215e-05*t13 - 0.45*t15 - t0*t3 + 9.13759471356405e-05*t1*t5 - t2*t3 + 0.0015702381603051154*s4*t6 - 0.0052349245053751456*t1*t7 - t3*t9 + 0.011778580137094078*s3*t16 + 2.25*c2*t11 + 0.0015704773516125438*s3*t14 + 0.02617860965592527*t5*t8 + 0.3*c2*t13 + 0.0010471443862370108*s4*t12 - 1.5*c2*t15 - 0.005235721931185054*s2*t15 - 0.0392679144838879*s2*c3*t16 - 0.44993146282037605*s5*t7 + 2.24965731410188*s2*s3*c5*t4 - 1.4997715427345868*t7*t8;
+    const manocha_canny_real t17 = t0 + t2 + t9 + t0*t4 + 0.0002055958810551911*t11 + 0.00785358289677758*t12 + 0.00785358289677758*t6 + 2.741278414069215e-05*t13 - 0.45*t15 - t0*t3 + 9.13759471356405e-05*t1*t5 - t2*t3 + 0.0015702381603051154*s4*t6 - 0.0052349245053751456*t1*t7 - t3*t9 + 0.011778580137094078*s3*t16 + 2.25*c2*t11 + 0.0015704773516125438*s3*t14 + 0.02617860965592527*t5*t8 + 0.3*c2*t13 + 0.0010471443862370108*s4*t12 - 1.5*c2*t15 - 0.005235721931185054*s2*t15 - 0.0392679144838879*s2*c3*t16 - 0.44993146282037605*s5*t7 - 1.4997715427345868*t7*t8 + 2.24965731410188*s3*c3*t12;
 
     /* Outputs */
     return fabs(t17);
@@ -2339,7 +2339,7 @@ manocha_canny_real manocha_canny_manipulability(const manocha_canny_real q[MANOC
 
 manocha_canny_real manocha_canny_jacobian_det(const manocha_canny_real q[MANOCHA_CANNY_DOF])
 {
-    /* 97 operations */
+    /* 89 operations */
 
     /* Inputs */
     const manocha_canny_real q2 = q[1];
@@ -2369,7 +2369,7 @@ manocha_canny_real manocha_canny_jacobian_det(const manocha_canny_real q[MANOCHA
     const manocha_canny_real t10 = s4*t7;
 
     /* Outputs */
-    return -(t0 + 0.0010469849010750292*t1 + 0.29995430854691735*t6 + 0.0002055958810551911*t8 + 0.00785358289677758*t9 + 0.00785358289677758*t5 + 2.741278414069215e-05*t10 + 0.011778580137094078*s3*s4*c5 - 0.0052349245053751456*s2*c3*c4*s4*s5 - 0.0392679144838879*s2*c3*s4*c5 - 0.44993146282037605*c3*c4*s4*s5 - 1.4997715427345868*c2*c3*c4*s4*s5 - 2.740860904089072e-05*s5*t2 + t0*t3 + 9.13759471356405e-05*t1*t4 - 0.0010469849010750292*s2*s5*t2 + 0.0015702381603051154*s4*t5 - 0.29995430854691735*c2*s5*t2 - 0.45*c3*c5*t2 + 2.25*c2*t8 + 0.0015704773516125438*s3*c5*t2 + 0.02617860965592527*t4*t6 + 0.3*c2*t10 + 0.0010471443862370108*s4*t9 - 1.5*c2*c3*c5*t2 - 0.005235721931185054*s2*c3*c5*t2 + 2.24965731410188*s2*s3*c5*t3);
+    return -(t0 + 0.0010469849010750292*t1 + 0.29995430854691735*t6 + 0.0002055958810551911*t8 + 0.00785358289677758*t9 + 0.00785358289677758*t5 + 2.741278414069215e-05*t10 + 0.011778580137094078*s3*s4*c5 - 0.0392679144838879*s2*c3*s4*c5 - 2.740860904089072e-05*s5*t2 + t0*t3 + 9.13759471356405e-05*t1*t4 + 0.0015702381603051154*s4*t5 - 0.45*c3*c5*t2 + 2.25*c2*t8 + 0.0015704773516125438*s3*c5*t2 + 0.02617860965592527*t4*t6 + 0.3*c2*t10 + 0.0010471443862370108*s4*t9 - 1.5*c2*c3*c5*t2 - 0.005235721931185054*s2*c3*c5*t2 - 0.0052349245053751456*s4*t1*t3 - 0.44993146282037605*s4*s5*t3 - 1.4997715427345868*s4*t3*t6 - 0.0010469849010750292*t1*t2 - 0.29995430854691735*t2*t6 + 2.24965731410188*s3*c3*t9);
 }
 
 int manocha_canny_velocity_ik(const manocha_canny_real q[MANOCHA_CANNY_DOF], const manocha_canny_real mu_dot[MANOCHA_CANNY_TASK_DIM], manocha_canny_real damping, manocha_canny_real q_dot[MANOCHA_CANNY_DOF])
@@ -3163,7 +3163,7 @@ manocha_canny_real manocha_canny_ik_numeric_step(const manocha_canny_real target
 
 void manocha_canny_ik_general_equations(const manocha_canny_real T[16], manocha_canny_real P[378], manocha_canny_real Q[112])
 {
-    /* 303 operations */
+    /* 298 operations */
 
     /* Inputs */
     const manocha_canny_real T01 = T[1];
@@ -3356,7 +3356,7 @@ void manocha_canny_ik_general_equations(const manocha_canny_real T[16], manocha_
     P[113] = 0;
     P[114] = 0;
     P[115] = 0;
-    P[116] = -(t9 + 0.010471443862370108*t10 - 0.010471443862370108*T13*t0);
+    P[116] = -(t9 + 0.010471443862370108*t10 - 0.010471443862370108*t12);
     P[117] = -2.29;
     P[118] = 0;
     P[119] = 0;
@@ -3697,7 +3697,7 @@ void manocha_canny_ik_general_equations(const manocha_canny_real T[16], manocha_
     Q[76] = t37;
     Q[77] = -t38;
     Q[78] = 0;
-    Q[79] = -(t19 - 0.9998476951563913*T03*t1 + t15*T13);
+    Q[79] = -(-0.9998476951563913*t10 + t19 + t15*T13);
     Q[80] = t38;
     Q[81] = -0.005235721931185054*t0;
     Q[82] = t37;
@@ -3705,7 +3705,7 @@ void manocha_canny_ik_general_equations(const manocha_canny_real T[16], manocha_
     Q[84] = -t36;
     Q[85] = t35;
     Q[86] = 0;
-    Q[87] = -(t18 - 0.01745240643728351*T13*t0 + t17*T03);
+    Q[87] = -(-0.01745240643728351*t12 + t18 + t17*T03);
     Q[88] = 0.6*t34 - t26*t2;
     Q[89] = -(1.09*t1 - t3*t1 - t5*t1 + t4*t1 + t6*t24 + t8*t24);
     Q[90] = 0.6*t31 - t27*t2;
@@ -3717,7 +3717,7 @@ void manocha_canny_ik_general_equations(const manocha_canny_real T[16], manocha_
     Q[96] = t40 - 0.9098614025923161*t1;
     Q[97] = 0.010471443862370108*t0 + 0.5999086170938347*t34 - t9*T13;
     Q[98] = -t43 - t44 - t45 + t41 + t42 + t47 + t48 - 0.9098614025923161*t0;
-    Q[99] = -(0.010471443862370108*t1 - 0.5999086170938347*T23*t0 + t9*T03);
+    Q[99] = -(-0.5999086170938347*t31 + 0.010471443862370108*t1 + t9*T03);
     Q[100] = t50 + 0.01902312301663903*t0;
     Q[101] = -t53 - t54 - t55 + t51 + t52 + t57 + t58 - 0.01902312301663903*t1;
     Q[102] = -(0.5999086170938347*t6 + 0.5999086170938347*t7 + 0.5999086170938347*t8);
@@ -3725,7 +3725,7 @@ void manocha_canny_ik_general_equations(const manocha_canny_real T[16], manocha_
     Q[104] = -t51 - t52 - t57 - t58 + t53 + t54 + t55 + 0.015881689857927997*t1;
     Q[105] = -0.010471443862370108*t34 + 0.5999086170938347*t0 + t11*T13;
     Q[106] = t50 + 0.015881689857927997*t0;
-    Q[107] = -(0.010471443862370108*t31 + 0.5999086170938347*t1 - 0.010471443862370108*T03*t2);
+    Q[107] = -(0.010471443862370108*t31 - 0.010471443862370108*t32 + 0.5999086170938347*t1);
     Q[108] = -t41 - t42 - t47 - t48 + t43 + t44 + t45 + 1.0898339877204664*t0;
     Q[109] = t40 - 1.0898339877204664*t1;
     Q[110] = 0.010471443862370108*t6 + 0.010471443862370108*t7 + 0.010471443862370108*t8;

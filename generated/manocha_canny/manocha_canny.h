@@ -75,19 +75,19 @@ void manocha_canny_bias_acceleration(const manocha_canny_real q[MANOCHA_CANNY_DO
 void manocha_canny_task_jacobian_dot(const manocha_canny_real q[MANOCHA_CANNY_DOF], const manocha_canny_real q_dot[MANOCHA_CANNY_DOF], manocha_canny_real Jd[MANOCHA_CANNY_TASK_DIM * MANOCHA_CANNY_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
- * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 269 operations. */
+ * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 268 operations. */
 void manocha_canny_hessian(const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real H[MANOCHA_CANNY_DOF * 6 * MANOCHA_CANNY_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.
- * Result: f[i], i < 1. 97 operations. */
+ * Result: f[i], i < 1. 89 operations. */
 void manocha_canny_singularity_factors(const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real f[MANOCHA_CANNY_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability |det(Js)|.
- * Result: returned as a scalar. 95 operations. */
+ * Result: returned as a scalar. 94 operations. */
 manocha_canny_real manocha_canny_manipulability(const manocha_canny_real q[MANOCHA_CANNY_DOF]);
 
 /* Det(Js).
- * Result: returned as a scalar. 97 operations. */
+ * Result: returned as a scalar. 89 operations. */
 manocha_canny_real manocha_canny_jacobian_det(const manocha_canny_real q[MANOCHA_CANNY_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
@@ -99,7 +99,7 @@ int manocha_canny_velocity_ik(const manocha_canny_real q[MANOCHA_CANNY_DOF], con
 manocha_canny_real manocha_canny_ik_numeric_step(const manocha_canny_real target[16], const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real damping, manocha_canny_real q_start[MANOCHA_CANNY_DOF], manocha_canny_real q_next[MANOCHA_CANNY_DOF]);
 
 /* The general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9).
- * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 303 operations. */
+ * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 298 operations. */
 void manocha_canny_ik_general_equations(const manocha_canny_real T[16], manocha_canny_real P[378], manocha_canny_real Q[112]);
 
 /* The configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop).

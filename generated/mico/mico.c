@@ -1100,7 +1100,7 @@ void mico_task(const mico_real q[MICO_DOF], mico_real mu[MICO_TASK_DIM])
 
 void mico_task_jacobian(const mico_real q[MICO_DOF], mico_real J[MICO_TASK_DIM * MICO_DOF])
 {
-    /* 243 operations */
+    /* 242 operations */
 
     /* Inputs */
     const mico_real q1 = q[0];
@@ -1187,8 +1187,8 @@ void mico_task_jacobian(const mico_real q[MICO_DOF], mico_real J[MICO_TASK_DIM *
     const mico_real t61 = s1*t30 + c1*t34;
     const mico_real t62 = (t30*t30) + (t34*t34);
     const mico_real t63 = 1.0/t62;
-    const mico_real t64 = -t61*t63;
-    const mico_real t65 = t61*t63;
+    const mico_real t64 = t61*t63;
+    const mico_real t65 = -t64;
     const mico_real t66 = -t63*(t13*t34 + t12*t30);
     const mico_real t67 = -t63*(t18*t30 + t21*t34);
     const mico_real t68 = -t63*(t30*t41 + t34*t47);
@@ -1216,8 +1216,8 @@ void mico_task_jacobian(const mico_real q[MICO_DOF], mico_real J[MICO_TASK_DIM *
     J[16] = t21*t43 - t18*t49;
     J[17] = t42*t47 - t48*t41;
     J[18] = 0;
-    J[19] = t64;
-    J[20] = t65;
+    J[19] = t65;
+    J[20] = t64;
     J[21] = t66;
     J[22] = t67;
     J[23] = t68;
@@ -1228,8 +1228,8 @@ void mico_task_jacobian(const mico_real q[MICO_DOF], mico_real J[MICO_TASK_DIM *
     J[28] = t69*(t18*t34 - t21*t30);
     J[29] = t69*(t41*t34 - t30*t47);
     J[30] = -1;
-    J[31] = -t39*t64;
-    J[32] = -t39*t65;
+    J[31] = -t39*t65;
+    J[32] = -t39*t64;
     J[33] = t4 - t39*t66;
     J[34] = t25 - t39*t67;
     J[35] = t53 - t39*t68;
@@ -1237,7 +1237,7 @@ void mico_task_jacobian(const mico_real q[MICO_DOF], mico_real J[MICO_TASK_DIM *
 
 void mico_fk_jacobian_dot(const mico_real q[MICO_DOF], const mico_real q_dot[MICO_DOF], mico_real T[16], mico_real J[6 * MICO_DOF], mico_real a[6])
 {
-    /* 434 operations */
+    /* 431 operations */
 
     /* Inputs */
     const mico_real q1 = q[0];
@@ -1389,7 +1389,6 @@ void mico_fk_jacobian_dot(const mico_real q[MICO_DOF], const mico_real q_dot[MIC
     const mico_real t120 = c1*t55;
     const mico_real t121 = s1*t56;
     const mico_real t122 = s1*t55;
-    const mico_real t123 = t55*qd2;
 
     /* Outputs */
     T[0] = t59;
@@ -1446,7 +1445,7 @@ void mico_fk_jacobian_dot(const mico_real q[MICO_DOF], const mico_real q_dot[MIC
     J[35] = t52;
     a[0] = qd1*t113 + qd4*(t87*t99 + t77*qd1 - t14*t116 - t4*t110) + qd2*(-c1*t118 + qd1*t121) - qd3*(t97*t85 + qd1*t122 - c1*t117) - qd5*(-t89*t100 + t79*t10 + t22*t115 + t26*t109) - qd6*(t81*t28 + t46*t114 + t52*t108 - t91*t101);
     a[1] = -qd1*t107 + qd4*(t71*qd1 - t87*t94 - t4*t104 + t13*t116) + qd2*(s1*t118 + t119*qd1) - qd3*(s1*t117 + t120*qd1 - t92*t85) - qd5*(t73*t10 + t89*t95 + t26*t103 - t19*t115) - qd6*(t91*t96 + t75*t28 + t52*t102 - t40*t114);
-    a[2] = qd2*(-s1*t112 + c1*t106) + qd4*(t77*t94 + t71*t99 - t13*t110 - t14*t104) + qd5*(t79*t95 + t73*t100 - t19*t109 - t22*t103) + qd3*(s1*t111 - c1*t105 + (s1*s1)*t123 + (c1*c1)*t123) + qd6*(t81*t96 + t75*t101 - t40*t108 - t46*t102);
+    a[2] = qd2*(-s1*t112 + c1*t106) + qd4*(t77*t94 + t71*t99 - t13*t110 - t14*t104) + qd5*(t79*t95 + t73*t100 - t19*t109 - t22*t103) + qd6*(t81*t96 + t75*t101 - t40*t108 - t46*t102) + qd3*(s1*t111 - c1*t105 + t92*t122 + t97*t120);
     a[3] = qd4*(t4*t99 - t14*qd1) + qd5*(t26*t100 + t22*t10) + qd6*(t52*t101 + t46*t28) - t97*qd1 + t98*qd1;
     a[4] = qd4*(t13*qd1 - t4*t94) + t92*qd1 - t93*qd1 - qd5*(t19*t10 + t26*t95) - qd6*(t40*t28 + t52*t96);
     a[5] = qd4*(-t14*t94 + t13*t99) + qd5*(-t22*t95 + t19*t100) + qd6*(-t46*t96 + t40*t101);
@@ -2371,7 +2370,7 @@ void mico_hessian(const mico_real q[MICO_DOF], mico_real H[MICO_DOF * 6 * MICO_D
 
 void mico_singularity_factors(const mico_real q[MICO_DOF], mico_real f[MICO_NUM_SINGULARITY_FACTORS])
 {
-    /* 57 operations */
+    /* 54 operations */
 
     /* Inputs */
     const mico_real q2 = q[1];
@@ -2394,7 +2393,7 @@ void mico_singularity_factors(const mico_real q[MICO_DOF], mico_real f[MICO_NUM_
     const mico_real t3 = (s3*s3);
 
     /* Outputs */
-    f[0] = -(0.03468836416487728*s2*s5 - 0.021489*c2*s3*s4*s5 - 0.01230665063156909*s2*c3*s3*s4*s5 - 0.024813359869231735*c2*c3*c4*s4*c5 - 0.03468836416487728*c2*c3*s3*s5 + 0.0005989431692573178*c5*t0 + 0.048163679934615865*c3*t1 + 0.012406679934615868*c3*s5*t0 + 0.0002994715846286589*c4*t2 + 0.01230665063156909*t2*t3 - 0.03468836416487728*s2*s5*t3);
+    f[0] = -(0.03468836416487728*s2*s5 - 0.01230665063156909*s2*c3*s3*s4*s5 - 0.024813359869231735*c2*c3*c4*s4*c5 + 0.0005989431692573178*c5*t0 + 0.048163679934615865*c3*t1 + 0.012406679934615868*c3*s5*t0 + 0.0002994715846286589*c4*t2 + 0.01230665063156909*t2*t3 - 0.03468836416487728*s2*s5*t3 - 0.021489*s3*t2 - 0.03468836416487728*c3*s3*t1);
 }
 
 mico_real mico_manipulability(const mico_real q[MICO_DOF])

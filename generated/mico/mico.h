@@ -55,11 +55,11 @@ void mico_jacobian_tool(const mico_real q[MICO_DOF], mico_real J[6 * MICO_DOF]);
 void mico_task(const mico_real q[MICO_DOF], mico_real mu[MICO_TASK_DIM]);
 
 /* Analytic Jacobian d mu / d q (6 x DOF).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 243 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 242 operations. */
 void mico_task_jacobian(const mico_real q[MICO_DOF], mico_real J[MICO_TASK_DIM * MICO_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 434 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 431 operations. */
 void mico_fk_jacobian_dot(const mico_real q[MICO_DOF], const mico_real q_dot[MICO_DOF], mico_real T[16], mico_real J[6 * MICO_DOF], mico_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
@@ -79,7 +79,7 @@ void mico_task_jacobian_dot(const mico_real q[MICO_DOF], const mico_real q_dot[M
 void mico_hessian(const mico_real q[MICO_DOF], mico_real H[MICO_DOF * 6 * MICO_DOF]);
 
 /* Factors of det(Js): the robot is singular where one is 0.
- * Result: f[i], i < 1. 57 operations. */
+ * Result: f[i], i < 1. 54 operations. */
 void mico_singularity_factors(const mico_real q[MICO_DOF], mico_real f[MICO_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability |det(Js)|.

@@ -790,7 +790,7 @@ void panda_task_jacobian(const panda_real q[PANDA_DOF], panda_real J[PANDA_TASK_
 
 void panda_fk_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot[PANDA_DOF], panda_real T[16], panda_real J[6 * PANDA_DOF], panda_real a[6])
 {
-    /* 461 operations */
+    /* 458 operations */
 
     /* Inputs */
     const panda_real q1 = q[0];
@@ -949,7 +949,6 @@ void panda_fk_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot
     const panda_real t123 = -t16;
     const panda_real t124 = -t30;
     const panda_real t125 = -t45;
-    const panda_real t126 = s2*qd2;
 
     /* Outputs */
     T[0] = t57;
@@ -1015,12 +1014,12 @@ void panda_fk_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot
     a[2] = qd4*(-t83*t106 - t71*t112 + t7*t89 + t4*t77) + qd5*(t85*t107 - t73*t113 + t12*t88 - t26*t76) - qd2*(s1*t109 + c1*t115) - qd3*(t105*t81 + t69*t111 - t9*t90 + t23*t78) - qd6*(t75*t114 + t87*t108 + t87*t117 - t75*t119);
     a[3] = qd5*(t40*t113 - t26*t53) + qd6*(-t43*t114 + t28*t54) + qd7*(-t45*t120 + t30*t122) - qd1*t111 + qd3*(c2*t111 - t23*qd1) + qd4*(t4*t0 - t41*t112);
     a[4] = qd5*(t12*t53 - t40*t107) + qd6*(t14*t54 + t43*t108) + qd7*(-t16*t122 + t45*t118) - t105*qd1 + qd3*(t9*qd1 + c2*t105) + qd4*(t7*t0 + t41*t106);
-    a[5] = qd5*(t26*t107 - t12*t113) + qd7*(-t30*t118 + t16*t120) - qd3*((s1*s1)*t126 + (c1*c1)*t126) - qd4*(t4*t106 + t7*t112) - qd6*(t28*t108 + t14*t114);
+    a[5] = qd5*(t26*t107 - t12*t113) + qd7*(-t30*t118 + t16*t120) - qd4*(t4*t106 + t7*t112) - qd6*(t28*t108 + t14*t114) - qd3*(t23*t105 + t9*t111);
 }
 
 void panda_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot[PANDA_DOF], panda_real Jd[6 * PANDA_DOF])
 {
-    /* 354 operations */
+    /* 351 operations */
 
     /* Inputs */
     const panda_real q1 = q[0];
@@ -1141,7 +1140,6 @@ void panda_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot[PA
     const panda_real t89 = -t88 + t65;
     const panda_real t90 = s1*qd1;
     const panda_real t91 = c1*qd1;
-    const panda_real t92 = s2*qd2;
 
     /* Outputs */
     Jd[0] = -t77;
@@ -1181,7 +1179,7 @@ void panda_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot[PA
     Jd[34] = -t22*t89 + t51*t85;
     Jd[35] = 0;
     Jd[36] = 0;
-    Jd[37] = -((s1*s1)*t92 + (c1*c1)*t92);
+    Jd[37] = -(t27*t72 + t16*t78);
     Jd[38] = -(t4*t73 + t7*t79);
     Jd[39] = t29*t74 - t18*t80;
     Jd[40] = -(t31*t75 + t20*t81);
@@ -1190,7 +1188,7 @@ void panda_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot[PA
 
 void panda_bias_acceleration(const panda_real q[PANDA_DOF], const panda_real q_dot[PANDA_DOF], panda_real a[6])
 {
-    /* 416 operations */
+    /* 413 operations */
 
     /* Inputs */
     const panda_real q1 = q[0];
@@ -1311,7 +1309,6 @@ void panda_bias_acceleration(const panda_real q[PANDA_DOF], const panda_real q_d
     const panda_real t88 = t49*qd6;
     const panda_real t89 = -t88 + t65;
     const panda_real t90 = t55*qd1;
-    const panda_real t91 = s2*qd2;
 
     /* Outputs */
     a[0] = -qd1*t77 + qd5*(t41*t80 - t62*t64 + t29*t43 - t15*t67) + qd2*(c1*t46 - s1*t90) + qd3*(-t60*qd1 - c2*t71 + t78*t39 + t27*t45) + qd4*(t40*t79 + t61*t0 - t4*t44 + t47*t69) + qd6*(t42*t81 + t63*t65 - t86*t42 - t88*t63);
@@ -1319,12 +1316,12 @@ void panda_bias_acceleration(const panda_real q[PANDA_DOF], const panda_real q_d
     a[2] = qd4*(-t61*t73 - t57*t79 + t7*t69 + t4*t68) + qd5*(t62*t74 - t58*t80 + t18*t67 - t29*t66) - qd2*(s1*t76 + c1*t82) - qd3*(t72*t60 + t78*t56 - t16*t71 + t27*t70) - qd6*(t59*t81 + t63*t75 + t84*t63 - t86*t59);
     a[3] = qd5*(t15*t80 - t29*t64) + qd6*(-t49*t81 + t31*t65) + qd7*(-t51*t87 + t33*t89) - t78*qd1 + qd3*(c2*t78 - t27*qd1) + qd4*(t4*t0 - t47*t79);
     a[4] = qd5*(t18*t64 - t15*t74) + qd6*(t20*t65 + t49*t75) + qd7*(-t22*t89 + t51*t85) - t72*qd1 + qd3*(c2*t72 + t16*qd1) + qd4*(t7*t0 + t47*t73);
-    a[5] = qd5*(t29*t74 - t18*t80) + qd7*(-t33*t85 + t22*t87) - qd4*(t4*t73 + t7*t79) - qd6*(t31*t75 + t20*t81) - qd3*((s1*s1)*t91 + (c1*c1)*t91);
+    a[5] = qd5*(t29*t74 - t18*t80) + qd7*(-t33*t85 + t22*t87) - qd4*(t4*t73 + t7*t79) - qd6*(t31*t75 + t20*t81) - qd3*(t27*t72 + t16*t78);
 }
 
 void panda_task_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot[PANDA_DOF], panda_real Jd[PANDA_TASK_DIM * PANDA_DOF])
 {
-    /* 678 operations */
+    /* 675 operations */
 
     /* Inputs */
     const panda_real q1 = q[0];
@@ -1450,163 +1447,162 @@ void panda_task_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_d
     const panda_real t90 = s1*t80 + c1*t87;
     const panda_real t91 = -t8*t78 + t23*t77 + t86*t65 + t79*t69;
     const panda_real t92 = -t23*qd1 + c2*t86;
-    const panda_real t93 = t86 + t23*qd3;
-    const panda_real t94 = t93;
-    const panda_real t95 = -t70*t85 - t66*t94 + t6*t76 + t3*t75;
-    const panda_real t96 = t3*t85 + t6*t94;
-    const panda_real t97 = qd1 + c2*qd3;
-    const panda_real t98 = t97;
-    const panda_real t99 = t40*t94 + t70*t98 - t3*t44 + t53*t76;
-    const panda_real t100 = t40*t85 + t6*t44 + t53*t75 - t66*t98;
-    const panda_real t101 = t3*t98 - t53*t94;
-    const panda_real t102 = t6*t98 + t53*t85;
-    const panda_real t103 = t6*qd4;
-    const panda_real t104 = t103 + t85;
-    const panda_real t105 = -t3*qd4;
-    const panda_real t106 = t105 + t94;
-    const panda_real t107 = t71*t104 - t67*t106 + t11*t74 - t26*t73;
-    const panda_real t108 = t26*t104 - t11*t106;
-    const panda_real t109 = -t53*qd4;
-    const panda_real t110 = t109 + t98;
-    const panda_real t111 = t41*t106 - t71*t110 + t26*t43 - t52*t74;
-    const panda_real t112 = t67*t110 - t41*t104 + t52*t73 - t11*t43;
-    const panda_real t113 = t52*t106 - t26*t110;
-    const panda_real t114 = t11*t110 - t52*t104;
-    const panda_real t115 = t11*qd5;
-    const panda_real t116 = t115 + t104;
-    const panda_real t117 = t26*qd5;
-    const panda_real t118 = t117 + t106;
-    const panda_real t119 = t28*t116 + t13*t118;
-    const panda_real t120 = t52*qd5;
-    const panda_real t121 = t120 + t110;
-    const panda_real t122 = -t55*t118 + t28*t121;
-    const panda_real t123 = t13*t121 + t55*t116;
-    const panda_real t124 = t13*qd6;
-    const panda_real t125 = t124 + t116;
-    const panda_real t126 = t84 + t103 + t115 + t124 - t15*qd7;
-    const panda_real t127 = t28*qd6;
-    const panda_real t128 = t68*t118 + t72*t116 + t124*t72 - t127*t68;
-    const panda_real t129 = -t127;
-    const panda_real t130 = t129 + t118;
-    const panda_real t131 = -t30*t125 + t15*t130;
-    const panda_real t132 = t93 + t105 + t117 + t129 - t30*qd7;
-    const panda_real t133 = t37*t126 - t22*t132;
-    const panda_real t134 = t55*qd6;
-    const panda_real t135 = t42*t118 + t72*t121 - t127*t42 - t134*t72;
-    const panda_real t136 = t42*t116 - t68*t121 + t134*t68 + t124*t42;
-    const panda_real t137 = -t134;
-    const panda_real t138 = t137 + t121;
-    const panda_real t139 = -t57*t130 + t30*t138;
-    const panda_real t140 = -t15*t138 + t57*t125;
-    const panda_real t141 = t97 + t109 + t120 + t137 - t57*qd7;
-    const panda_real t142 = t64*t132 - t37*t141;
-    const panda_real t143 = t22*t141 - t64*t126;
-    const panda_real t144 = t63*qd1;
-    const panda_real t145 = c1*t46 - s1*t144;
-    const panda_real t146 = s1*t46 + c1*t144;
-    const panda_real t147 = s2*qd2;
-    const panda_real t148 = (s1*s1)*t147 + (c1*c1)*t147;
-    const panda_real t149 = c1*t37;
-    const panda_real t150 = s1*t22;
-    const panda_real t151 = 1.0/t47;
-    const panda_real t152 = t151*(-t150 + t149);
-    const panda_real t153 = t151*(t6*t22 - t3*t37);
-    const panda_real t154 = t151*(t11*t22 + t26*t37);
-    const panda_real t155 = t151*(t13*t22 - t28*t37);
-    const panda_real t156 = -t151*(t15*t22 + t30*t37);
-    const panda_real t157 = c1*t22;
-    const panda_real t158 = s1*t37;
-    const panda_real t159 = t151*(s2*t157 + s2*t158);
-    const panda_real t160 = 1.0/t48;
-    const panda_real t161 = t151*t160;
-    const panda_real t162 = t161*(t157 + t158);
-    const panda_real t163 = t161*(s2*t150 - s2*t149);
-    const panda_real t164 = -(t6*t37 + t3*t22)*t161;
-    const panda_real t165 = (t26*t22 - t11*t37)*t161;
-    const panda_real t166 = -(t13*t37 + t28*t22)*t161;
-    const panda_real t167 = (t15*t37 - t30*t22)*t161;
-    const panda_real t168 = 2*t152;
-    const panda_real t169 = t151*t142;
-    const panda_real t170 = -t169*(s1 + t22*t168);
-    const panda_real t171 = t151*t143;
-    const panda_real t172 = t171*(c1 - t37*t168);
-    const panda_real t173 = t151*qd1;
-    const panda_real t174 = t157*t173;
-    const panda_real t175 = t158*t173;
-    const panda_real t176 = 2*t159;
-    const panda_real t177 = t169*(t8 - t22*t176);
-    const panda_real t178 = t171*(t23 - t37*t176);
-    const panda_real t179 = t22*t151;
-    const panda_real t180 = t92*t179;
-    const panda_real t181 = t37*t151;
-    const panda_real t182 = t83*t181;
-    const panda_real t183 = 2*t153;
-    const panda_real t184 = t169*(t6 - t22*t183);
-    const panda_real t185 = -t171*(t3 + t37*t183);
-    const panda_real t186 = t101*t179;
-    const panda_real t187 = t102*t181;
-    const panda_real t188 = 2*t154;
-    const panda_real t189 = t169*(t11 - t22*t188);
-    const panda_real t190 = t171*(t26 - t37*t188);
-    const panda_real t191 = t113*t179;
-    const panda_real t192 = t114*t181;
-    const panda_real t193 = 2*t155;
-    const panda_real t194 = t169*(t13 - t22*t193);
-    const panda_real t195 = -t171*(t28 + t37*t193);
-    const panda_real t196 = t122*t179;
-    const panda_real t197 = t123*t181;
-    const panda_real t198 = 2*t156;
-    const panda_real t199 = -t169*(t15 + t22*t198);
-    const panda_real t200 = -t171*(t30 + t37*t198);
-    const panda_real t201 = t139*t179;
-    const panda_real t202 = t140*t181;
-    const panda_real t203 = qd1*t160;
-    const panda_real t204 = t37*t160;
-    const panda_real t205 = t22*t160;
+    const panda_real t93 = t23*t79 + t8*t86;
+    const panda_real t94 = t86 + t23*qd3;
+    const panda_real t95 = t94;
+    const panda_real t96 = -t70*t85 - t66*t95 + t6*t76 + t3*t75;
+    const panda_real t97 = t3*t85 + t6*t95;
+    const panda_real t98 = qd1 + c2*qd3;
+    const panda_real t99 = t98;
+    const panda_real t100 = t40*t95 + t70*t99 - t3*t44 + t53*t76;
+    const panda_real t101 = t40*t85 + t6*t44 + t53*t75 - t66*t99;
+    const panda_real t102 = t3*t99 - t53*t95;
+    const panda_real t103 = t6*t99 + t53*t85;
+    const panda_real t104 = t6*qd4;
+    const panda_real t105 = t104 + t85;
+    const panda_real t106 = -t3*qd4;
+    const panda_real t107 = t106 + t95;
+    const panda_real t108 = t71*t105 - t67*t107 + t11*t74 - t26*t73;
+    const panda_real t109 = t26*t105 - t11*t107;
+    const panda_real t110 = -t53*qd4;
+    const panda_real t111 = t110 + t99;
+    const panda_real t112 = t41*t107 - t71*t111 + t26*t43 - t52*t74;
+    const panda_real t113 = t67*t111 - t41*t105 + t52*t73 - t11*t43;
+    const panda_real t114 = t52*t107 - t26*t111;
+    const panda_real t115 = t11*t111 - t52*t105;
+    const panda_real t116 = t11*qd5;
+    const panda_real t117 = t116 + t105;
+    const panda_real t118 = t26*qd5;
+    const panda_real t119 = t118 + t107;
+    const panda_real t120 = t28*t117 + t13*t119;
+    const panda_real t121 = t52*qd5;
+    const panda_real t122 = t121 + t111;
+    const panda_real t123 = -t55*t119 + t28*t122;
+    const panda_real t124 = t13*t122 + t55*t117;
+    const panda_real t125 = t13*qd6;
+    const panda_real t126 = t125 + t117;
+    const panda_real t127 = t84 + t104 + t116 + t125 - t15*qd7;
+    const panda_real t128 = t28*qd6;
+    const panda_real t129 = t68*t119 + t72*t117 + t125*t72 - t128*t68;
+    const panda_real t130 = -t128;
+    const panda_real t131 = t130 + t119;
+    const panda_real t132 = -t30*t126 + t15*t131;
+    const panda_real t133 = t94 + t106 + t118 + t130 - t30*qd7;
+    const panda_real t134 = t37*t127 - t22*t133;
+    const panda_real t135 = t55*qd6;
+    const panda_real t136 = t42*t119 + t72*t122 - t128*t42 - t135*t72;
+    const panda_real t137 = t42*t117 - t68*t122 + t135*t68 + t125*t42;
+    const panda_real t138 = -t135;
+    const panda_real t139 = t138 + t122;
+    const panda_real t140 = -t57*t131 + t30*t139;
+    const panda_real t141 = -t15*t139 + t57*t126;
+    const panda_real t142 = t98 + t110 + t121 + t138 - t57*qd7;
+    const panda_real t143 = t64*t133 - t37*t142;
+    const panda_real t144 = t22*t142 - t64*t127;
+    const panda_real t145 = t63*qd1;
+    const panda_real t146 = c1*t46 - s1*t145;
+    const panda_real t147 = s1*t46 + c1*t145;
+    const panda_real t148 = c1*t37;
+    const panda_real t149 = s1*t22;
+    const panda_real t150 = 1.0/t47;
+    const panda_real t151 = t150*(-t149 + t148);
+    const panda_real t152 = t150*(t6*t22 - t3*t37);
+    const panda_real t153 = t150*(t11*t22 + t26*t37);
+    const panda_real t154 = t150*(t13*t22 - t28*t37);
+    const panda_real t155 = -t150*(t15*t22 + t30*t37);
+    const panda_real t156 = c1*t22;
+    const panda_real t157 = s1*t37;
+    const panda_real t158 = t150*(s2*t156 + s2*t157);
+    const panda_real t159 = 1.0/t48;
+    const panda_real t160 = t150*t159;
+    const panda_real t161 = t160*(t156 + t157);
+    const panda_real t162 = t160*(s2*t149 - s2*t148);
+    const panda_real t163 = -(t6*t37 + t3*t22)*t160;
+    const panda_real t164 = (t26*t22 - t11*t37)*t160;
+    const panda_real t165 = -(t13*t37 + t28*t22)*t160;
+    const panda_real t166 = (t15*t37 - t30*t22)*t160;
+    const panda_real t167 = 2*t151;
+    const panda_real t168 = t150*t143;
+    const panda_real t169 = -t168*(s1 + t22*t167);
+    const panda_real t170 = t150*t144;
+    const panda_real t171 = t170*(c1 - t37*t167);
+    const panda_real t172 = t150*qd1;
+    const panda_real t173 = t156*t172;
+    const panda_real t174 = t157*t172;
+    const panda_real t175 = 2*t158;
+    const panda_real t176 = t168*(t8 - t22*t175);
+    const panda_real t177 = t170*(t23 - t37*t175);
+    const panda_real t178 = t22*t150;
+    const panda_real t179 = t92*t178;
+    const panda_real t180 = t37*t150;
+    const panda_real t181 = t83*t180;
+    const panda_real t182 = 2*t152;
+    const panda_real t183 = t168*(t6 - t22*t182);
+    const panda_real t184 = -t170*(t3 + t37*t182);
+    const panda_real t185 = t102*t178;
+    const panda_real t186 = t103*t180;
+    const panda_real t187 = 2*t153;
+    const panda_real t188 = t168*(t11 - t22*t187);
+    const panda_real t189 = t170*(t26 - t37*t187);
+    const panda_real t190 = t114*t178;
+    const panda_real t191 = t115*t180;
+    const panda_real t192 = 2*t154;
+    const panda_real t193 = t168*(t13 - t22*t192);
+    const panda_real t194 = -t170*(t28 + t37*t192);
+    const panda_real t195 = t123*t178;
+    const panda_real t196 = t124*t180;
+    const panda_real t197 = 2*t155;
+    const panda_real t198 = -t168*(t15 + t22*t197);
+    const panda_real t199 = -t170*(t30 + t37*t197);
+    const panda_real t200 = t140*t178;
+    const panda_real t201 = t141*t180;
+    const panda_real t202 = qd1*t159;
+    const panda_real t203 = t37*t159;
+    const panda_real t204 = t22*t159;
 
     /* Outputs */
     Jd[0] = -t81;
-    Jd[1] = t145;
+    Jd[1] = t146;
     Jd[2] = t89;
-    Jd[3] = t99;
-    Jd[4] = t111;
-    Jd[5] = t135;
+    Jd[3] = t100;
+    Jd[4] = t112;
+    Jd[5] = t136;
     Jd[6] = 0;
     Jd[7] = t88;
-    Jd[8] = t146;
+    Jd[8] = t147;
     Jd[9] = t82;
-    Jd[10] = -t100;
-    Jd[11] = t112;
-    Jd[12] = -t136;
+    Jd[10] = -t101;
+    Jd[11] = t113;
+    Jd[12] = -t137;
     Jd[13] = 0;
     Jd[14] = 0;
     Jd[15] = -t90;
     Jd[16] = -t91;
-    Jd[17] = t95;
-    Jd[18] = t107;
-    Jd[19] = -t128;
+    Jd[17] = t96;
+    Jd[18] = t108;
+    Jd[19] = -t129;
     Jd[20] = 0;
     Jd[21] = 0;
-    Jd[22] = -t174 - t175 + t170 + t172;
-    Jd[23] = t177 + t178 + t180 + t182;
-    Jd[24] = t184 + t185 + t186 + t187;
-    Jd[25] = t189 + t190 + t191 + t192;
-    Jd[26] = t194 + t195 + t196 + t197;
-    Jd[27] = t199 + t200 + t201 + t202;
+    Jd[22] = -t173 - t174 + t169 + t171;
+    Jd[23] = t176 + t177 + t179 + t181;
+    Jd[24] = t183 + t184 + t185 + t186;
+    Jd[25] = t188 + t189 + t190 + t191;
+    Jd[26] = t193 + t194 + t195 + t196;
+    Jd[27] = t198 + t199 + t200 + t201;
     Jd[28] = 0;
-    Jd[29] = t142*(-t22*t162 + c1*t160) + t143*(-t37*t162 + s1*t160) + t149*t203 - t150*t203;
-    Jd[30] = t142*(-t22*t163 + t23*t160) - t143*(t37*t163 + t8*t160) - t92*t204 + t83*t205;
-    Jd[31] = -t142*(t22*t164 + t3*t160) - t143*(t37*t164 + t6*t160) - t101*t204 + t102*t205;
-    Jd[32] = t142*(-t22*t165 + t26*t160) - t143*(t37*t165 + t11*t160) - t113*t204 + t114*t205;
-    Jd[33] = -t142*(t22*t166 + t28*t160) - t143*(t37*t166 + t13*t160) - t122*t204 + t123*t205;
-    Jd[34] = -t142*(t22*t167 + t30*t160) + t143*(-t37*t167 + t15*t160) - t139*t204 + t140*t205;
+    Jd[29] = t143*(-t22*t161 + c1*t159) + t144*(-t37*t161 + s1*t159) + t148*t202 - t149*t202;
+    Jd[30] = t143*(-t22*t162 + t23*t159) - t144*(t37*t162 + t8*t159) - t92*t203 + t83*t204;
+    Jd[31] = -t143*(t22*t163 + t3*t159) - t144*(t37*t163 + t6*t159) - t102*t203 + t103*t204;
+    Jd[32] = t143*(-t22*t164 + t26*t159) - t144*(t37*t164 + t11*t159) - t114*t203 + t115*t204;
+    Jd[33] = -t143*(t22*t165 + t28*t159) - t144*(t37*t165 + t13*t159) - t123*t203 + t124*t204;
+    Jd[34] = -t143*(t22*t166 + t30*t159) + t144*(-t37*t166 + t15*t159) - t140*t203 + t141*t204;
     Jd[35] = 0;
-    Jd[36] = -(t133*t152 + t64*t170 + t64*t172 - t64*t174 - t64*t175);
-    Jd[37] = -(t148 + t133*t159 + t64*t177 + t64*t178 + t64*t180 + t64*t182);
-    Jd[38] = -(t96 + t133*t153 + t64*t184 + t64*t185 + t64*t186 + t64*t187);
-    Jd[39] = -(-t108 + t133*t154 + t64*t189 + t64*t190 + t64*t191 + t64*t192);
-    Jd[40] = -(t119 + t133*t155 + t64*t194 + t64*t195 + t64*t196 + t64*t197);
-    Jd[41] = -(-t131 + t133*t156 + t64*t199 + t64*t200 + t64*t201 + t64*t202);
+    Jd[36] = -(t134*t151 + t64*t169 + t64*t171 - t64*t173 - t64*t174);
+    Jd[37] = -(t93 + t134*t158 + t64*t176 + t64*t177 + t64*t179 + t64*t181);
+    Jd[38] = -(t97 + t134*t152 + t64*t183 + t64*t184 + t64*t185 + t64*t186);
+    Jd[39] = -(-t109 + t134*t153 + t64*t188 + t64*t189 + t64*t190 + t64*t191);
+    Jd[40] = -(t120 + t134*t154 + t64*t193 + t64*t194 + t64*t195 + t64*t196);
+    Jd[41] = -(-t132 + t134*t155 + t64*t198 + t64*t199 + t64*t200 + t64*t201);
 }
 
 void panda_hessian(const panda_real q[PANDA_DOF], panda_real H[PANDA_DOF * 6 * PANDA_DOF])
@@ -2030,7 +2026,7 @@ void panda_hessian(const panda_real q[PANDA_DOF], panda_real H[PANDA_DOF * 6 * P
 
 void panda_singularity_factors(const panda_real q[PANDA_DOF], panda_real f[PANDA_NUM_SINGULARITY_FACTORS])
 {
-    /* 731 operations */
+    /* 730 operations */
 
     /* Inputs */
     const panda_real q1 = q[0];
@@ -2158,7 +2154,7 @@ void panda_singularity_factors(const panda_real q[PANDA_DOF], panda_real f[PANDA
     const panda_real t102 = -t75 + s1*t3;
     const panda_real t103 = t37*t89 + t39*t99 - t41*t102;
     const panda_real t104 = t37*t90 + t39*t100 - t40*t102;
-    const panda_real t105 = -((s1*s1)*s2 + t81);
+    const panda_real t105 = -(t81 + s1*t26);
     const panda_real t106 = t37*t92 + t38*t99 - t41*t105;
     const panda_real t107 = t37*t93 + t38*t100 - t40*t105;
     const panda_real t108 = t37*t95 + t38*t102 - t39*t105;
@@ -2231,7 +2227,7 @@ void panda_singularity_factors(const panda_real q[PANDA_DOF], panda_real f[PANDA
 
 panda_real panda_manipulability(const panda_real q[PANDA_DOF])
 {
-    /* 734 operations */
+    /* 733 operations */
 
     /* Inputs */
     const panda_real q1 = q[0];
@@ -2359,7 +2355,7 @@ panda_real panda_manipulability(const panda_real q[PANDA_DOF])
     const panda_real t102 = -t75 + s1*t3;
     const panda_real t103 = t37*t89 + t39*t99 - t41*t102;
     const panda_real t104 = t37*t90 + t39*t100 - t40*t102;
-    const panda_real t105 = -((s1*s1)*s2 + t81);
+    const panda_real t105 = -(t81 + s1*t26);
     const panda_real t106 = t37*t92 + t38*t99 - t41*t105;
     const panda_real t107 = t37*t93 + t38*t100 - t40*t105;
     const panda_real t108 = t37*t95 + t38*t102 - t39*t105;

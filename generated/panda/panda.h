@@ -61,19 +61,19 @@ void panda_task(const panda_real q[PANDA_DOF], panda_real mu[PANDA_TASK_DIM]);
 void panda_task_jacobian(const panda_real q[PANDA_DOF], panda_real J[PANDA_TASK_DIM * PANDA_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]; a[i], i < 6. 461 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]; a[i], i < 6. 458 operations. */
 void panda_fk_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot[PANDA_DOF], panda_real T[16], panda_real J[6 * PANDA_DOF], panda_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 354 operations. */
+ * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 351 operations. */
 void panda_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot[PANDA_DOF], panda_real Jd[6 * PANDA_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
- * Result: a[i], i < 6. 416 operations. */
+ * Result: a[i], i < 6. 413 operations. */
 void panda_bias_acceleration(const panda_real q[PANDA_DOF], const panda_real q_dot[PANDA_DOF], panda_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 678 operations. */
+ * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 675 operations. */
 void panda_task_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot[PANDA_DOF], panda_real Jd[PANDA_TASK_DIM * PANDA_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
@@ -81,11 +81,11 @@ void panda_task_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_d
 void panda_hessian(const panda_real q[PANDA_DOF], panda_real H[PANDA_DOF * 6 * PANDA_DOF]);
 
 /* Factors of det(Js Js^T): the robot is singular where one is 0.
- * Result: f[i], i < 1. 731 operations. */
+ * Result: f[i], i < 1. 730 operations. */
 void panda_singularity_factors(const panda_real q[PANDA_DOF], panda_real f[PANDA_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability sqrt(det(Js Js^T)).
- * Result: returned as a scalar. 734 operations. */
+ * Result: returned as a scalar. 733 operations. */
 panda_real panda_manipulability(const panda_real q[PANDA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

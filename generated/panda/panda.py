@@ -807,7 +807,7 @@ def task_jacobian(q):
 
 
 def fk_jacobian_dot(q, q_dot):
-    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 7 and 6 x 1), 461 operations."""
+    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 7 and 6 x 1), 458 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -957,7 +957,6 @@ def fk_jacobian_dot(q, q_dot):
     t123 = -t16
     t124 = -t30
     t125 = -t45
-    t126 = s2*qd2
     T = _stack(xp, [
         xp.broadcast_to(t57, batch),  # 0, 0
         xp.broadcast_to(t58, batch),  # 0, 1
@@ -1026,13 +1025,13 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(qd4*(-t83*t106 - t71*t112 + t7*t89 + t4*t77) + qd5*(t85*t107 - t73*t113 + t12*t88 - t26*t76) - qd2*(s1*t109 + c1*t115) - qd3*(t105*t81 + t69*t111 - t9*t90 + t23*t78) - qd6*(t75*t114 + t87*t108 + t87*t117 - t75*t119), batch),  # 2
         xp.broadcast_to(qd5*(t40*t113 - t26*t53) + qd6*(-t43*t114 + t28*t54) + qd7*(-t45*t120 + t30*t122) - qd1*t111 + qd3*(c2*t111 - t23*qd1) + qd4*(t4*t0 - t41*t112), batch),  # 3
         xp.broadcast_to(qd5*(t12*t53 - t40*t107) + qd6*(t14*t54 + t43*t108) + qd7*(-t16*t122 + t45*t118) - t105*qd1 + qd3*(t9*qd1 + c2*t105) + qd4*(t7*t0 + t41*t106), batch),  # 4
-        xp.broadcast_to(qd5*(t26*t107 - t12*t113) + qd7*(-t30*t118 + t16*t120) - qd3*(s1**2*t126 + c1**2*t126) - qd4*(t4*t106 + t7*t112) - qd6*(t28*t108 + t14*t114), batch),  # 5
+        xp.broadcast_to(qd5*(t26*t107 - t12*t113) + qd7*(-t30*t118 + t16*t120) - qd4*(t4*t106 + t7*t112) - qd6*(t28*t108 + t14*t114) - qd3*(t23*t105 + t9*t111), batch),  # 5
     ], (6,))
     return T, J, a
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 7), 354 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 7), 351 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1145,7 +1144,6 @@ def jacobian_dot(q, q_dot):
     t89 = -t88 + t65
     t90 = s1*qd1
     t91 = c1*qd1
-    t92 = s2*qd2
     Jd = _stack(xp, [
         xp.broadcast_to(-t77, batch),  # 0, 0
         xp.broadcast_to(c1*t46 - t55*t90, batch),  # 0, 1
@@ -1184,7 +1182,7 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(-t22*t89 + t51*t85, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
-        xp.broadcast_to(-(s1**2*t92 + c1**2*t92), batch),  # 5, 2
+        xp.broadcast_to(-(t27*t72 + t16*t78), batch),  # 5, 2
         xp.broadcast_to(-(t4*t73 + t7*t79), batch),  # 5, 3
         xp.broadcast_to(t29*t74 - t18*t80, batch),  # 5, 4
         xp.broadcast_to(-(t31*t75 + t20*t81), batch),  # 5, 5
@@ -1194,7 +1192,7 @@ def jacobian_dot(q, q_dot):
 
 
 def bias_acceleration(q, q_dot):
-    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 416 operations."""
+    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 413 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1307,20 +1305,19 @@ def bias_acceleration(q, q_dot):
     t88 = t49*qd6
     t89 = -t88 + t65
     t90 = t55*qd1
-    t91 = s2*qd2
     a = _stack(xp, [
         xp.broadcast_to(-qd1*t77 + qd5*(t41*t80 - t62*t64 + t29*t43 - t15*t67) + qd2*(c1*t46 - s1*t90) + qd3*(-t60*qd1 - c2*t71 + t78*t39 + t27*t45) + qd4*(t40*t79 + t61*t0 - t4*t44 + t47*t69) + qd6*(t42*t81 + t63*t65 - t86*t42 - t88*t63), batch),  # 0
         xp.broadcast_to(qd1*t83 + qd5*(t58*t64 - t41*t74 + t15*t66 - t18*t43) + qd2*(s1*t46 + c1*t90) + qd3*(t56*qd1 + c2*t70 + t72*t39 - t16*t45) - qd4*(t40*t73 + t7*t44 - t57*t0 + t47*t68) - qd6*(t42*t75 - t59*t65 + t88*t59 + t84*t42), batch),  # 1
         xp.broadcast_to(qd4*(-t61*t73 - t57*t79 + t7*t69 + t4*t68) + qd5*(t62*t74 - t58*t80 + t18*t67 - t29*t66) - qd2*(s1*t76 + c1*t82) - qd3*(t72*t60 + t78*t56 - t16*t71 + t27*t70) - qd6*(t59*t81 + t63*t75 + t84*t63 - t86*t59), batch),  # 2
         xp.broadcast_to(qd5*(t15*t80 - t29*t64) + qd6*(-t49*t81 + t31*t65) + qd7*(-t51*t87 + t33*t89) - t78*qd1 + qd3*(c2*t78 - t27*qd1) + qd4*(t4*t0 - t47*t79), batch),  # 3
         xp.broadcast_to(qd5*(t18*t64 - t15*t74) + qd6*(t20*t65 + t49*t75) + qd7*(-t22*t89 + t51*t85) - t72*qd1 + qd3*(c2*t72 + t16*qd1) + qd4*(t7*t0 + t47*t73), batch),  # 4
-        xp.broadcast_to(qd5*(t29*t74 - t18*t80) + qd7*(-t33*t85 + t22*t87) - qd4*(t4*t73 + t7*t79) - qd6*(t31*t75 + t20*t81) - qd3*(s1**2*t91 + c1**2*t91), batch),  # 5
+        xp.broadcast_to(qd5*(t29*t74 - t18*t80) + qd7*(-t33*t85 + t22*t87) - qd4*(t4*t73 + t7*t79) - qd6*(t31*t75 + t20*t81) - qd3*(t27*t72 + t16*t78), batch),  # 5
     ], (6,))
     return a
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 678 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 675 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1437,162 +1434,161 @@ def task_jacobian_dot(q, q_dot):
     t90 = s1*t80 + c1*t87
     t91 = -t8*t78 + t23*t77 + t86*t65 + t79*t69
     t92 = -t23*qd1 + c2*t86
-    t93 = t86 + t23*qd3
-    t94 = t93
-    t95 = -t70*t85 - t66*t94 + t6*t76 + t3*t75
-    t96 = t3*t85 + t6*t94
-    t97 = qd1 + c2*qd3
-    t98 = t97
-    t99 = t40*t94 + t70*t98 - t3*t44 + t53*t76
-    t100 = t40*t85 + t6*t44 + t53*t75 - t66*t98
-    t101 = t3*t98 - t53*t94
-    t102 = t6*t98 + t53*t85
-    t103 = t6*qd4
-    t104 = t103 + t85
-    t105 = -t3*qd4
-    t106 = t105 + t94
-    t107 = t71*t104 - t67*t106 + t11*t74 - t26*t73
-    t108 = t26*t104 - t11*t106
-    t109 = -t53*qd4
-    t110 = t109 + t98
-    t111 = t41*t106 - t71*t110 + t26*t43 - t52*t74
-    t112 = t67*t110 - t41*t104 + t52*t73 - t11*t43
-    t113 = t52*t106 - t26*t110
-    t114 = t11*t110 - t52*t104
-    t115 = t11*qd5
-    t116 = t115 + t104
-    t117 = t26*qd5
-    t118 = t117 + t106
-    t119 = t28*t116 + t13*t118
-    t120 = t52*qd5
-    t121 = t120 + t110
-    t122 = -t55*t118 + t28*t121
-    t123 = t13*t121 + t55*t116
-    t124 = t13*qd6
-    t125 = t124 + t116
-    t126 = t84 + t103 + t115 + t124 - t15*qd7
-    t127 = t28*qd6
-    t128 = t68*t118 + t72*t116 + t124*t72 - t127*t68
-    t129 = -t127
-    t130 = t129 + t118
-    t131 = -t30*t125 + t15*t130
-    t132 = t93 + t105 + t117 + t129 - t30*qd7
-    t133 = t37*t126 - t22*t132
-    t134 = t55*qd6
-    t135 = t42*t118 + t72*t121 - t127*t42 - t134*t72
-    t136 = t42*t116 - t68*t121 + t134*t68 + t124*t42
-    t137 = -t134
-    t138 = t137 + t121
-    t139 = -t57*t130 + t30*t138
-    t140 = -t15*t138 + t57*t125
-    t141 = t97 + t109 + t120 + t137 - t57*qd7
-    t142 = t64*t132 - t37*t141
-    t143 = t22*t141 - t64*t126
-    t144 = t63*qd1
-    t145 = c1*t46 - s1*t144
-    t146 = s1*t46 + c1*t144
-    t147 = s2*qd2
-    t148 = s1**2*t147 + c1**2*t147
-    t149 = c1*t37
-    t150 = s1*t22
-    t151 = 1/t47
-    t152 = t151*(-t150 + t149)
-    t153 = t151*(t6*t22 - t3*t37)
-    t154 = t151*(t11*t22 + t26*t37)
-    t155 = t151*(t13*t22 - t28*t37)
-    t156 = -t151*(t15*t22 + t30*t37)
-    t157 = c1*t22
-    t158 = s1*t37
-    t159 = t151*(s2*t157 + s2*t158)
-    t160 = 1/t48
-    t161 = t151*t160
-    t162 = t161*(t157 + t158)
-    t163 = t161*(s2*t150 - s2*t149)
-    t164 = -(t6*t37 + t3*t22)*t161
-    t165 = (t26*t22 - t11*t37)*t161
-    t166 = -(t13*t37 + t28*t22)*t161
-    t167 = (t15*t37 - t30*t22)*t161
-    t168 = 2*t152
-    t169 = t151*t142
-    t170 = -t169*(s1 + t22*t168)
-    t171 = t151*t143
-    t172 = t171*(c1 - t37*t168)
-    t173 = t151*qd1
-    t174 = t157*t173
-    t175 = t158*t173
-    t176 = 2*t159
-    t177 = t169*(t8 - t22*t176)
-    t178 = t171*(t23 - t37*t176)
-    t179 = t22*t151
-    t180 = t92*t179
-    t181 = t37*t151
-    t182 = t83*t181
-    t183 = 2*t153
-    t184 = t169*(t6 - t22*t183)
-    t185 = -t171*(t3 + t37*t183)
-    t186 = t101*t179
-    t187 = t102*t181
-    t188 = 2*t154
-    t189 = t169*(t11 - t22*t188)
-    t190 = t171*(t26 - t37*t188)
-    t191 = t113*t179
-    t192 = t114*t181
-    t193 = 2*t155
-    t194 = t169*(t13 - t22*t193)
-    t195 = -t171*(t28 + t37*t193)
-    t196 = t122*t179
-    t197 = t123*t181
-    t198 = 2*t156
-    t199 = -t169*(t15 + t22*t198)
-    t200 = -t171*(t30 + t37*t198)
-    t201 = t139*t179
-    t202 = t140*t181
-    t203 = qd1*t160
-    t204 = t37*t160
-    t205 = t22*t160
+    t93 = t23*t79 + t8*t86
+    t94 = t86 + t23*qd3
+    t95 = t94
+    t96 = -t70*t85 - t66*t95 + t6*t76 + t3*t75
+    t97 = t3*t85 + t6*t95
+    t98 = qd1 + c2*qd3
+    t99 = t98
+    t100 = t40*t95 + t70*t99 - t3*t44 + t53*t76
+    t101 = t40*t85 + t6*t44 + t53*t75 - t66*t99
+    t102 = t3*t99 - t53*t95
+    t103 = t6*t99 + t53*t85
+    t104 = t6*qd4
+    t105 = t104 + t85
+    t106 = -t3*qd4
+    t107 = t106 + t95
+    t108 = t71*t105 - t67*t107 + t11*t74 - t26*t73
+    t109 = t26*t105 - t11*t107
+    t110 = -t53*qd4
+    t111 = t110 + t99
+    t112 = t41*t107 - t71*t111 + t26*t43 - t52*t74
+    t113 = t67*t111 - t41*t105 + t52*t73 - t11*t43
+    t114 = t52*t107 - t26*t111
+    t115 = t11*t111 - t52*t105
+    t116 = t11*qd5
+    t117 = t116 + t105
+    t118 = t26*qd5
+    t119 = t118 + t107
+    t120 = t28*t117 + t13*t119
+    t121 = t52*qd5
+    t122 = t121 + t111
+    t123 = -t55*t119 + t28*t122
+    t124 = t13*t122 + t55*t117
+    t125 = t13*qd6
+    t126 = t125 + t117
+    t127 = t84 + t104 + t116 + t125 - t15*qd7
+    t128 = t28*qd6
+    t129 = t68*t119 + t72*t117 + t125*t72 - t128*t68
+    t130 = -t128
+    t131 = t130 + t119
+    t132 = -t30*t126 + t15*t131
+    t133 = t94 + t106 + t118 + t130 - t30*qd7
+    t134 = t37*t127 - t22*t133
+    t135 = t55*qd6
+    t136 = t42*t119 + t72*t122 - t128*t42 - t135*t72
+    t137 = t42*t117 - t68*t122 + t135*t68 + t125*t42
+    t138 = -t135
+    t139 = t138 + t122
+    t140 = -t57*t131 + t30*t139
+    t141 = -t15*t139 + t57*t126
+    t142 = t98 + t110 + t121 + t138 - t57*qd7
+    t143 = t64*t133 - t37*t142
+    t144 = t22*t142 - t64*t127
+    t145 = t63*qd1
+    t146 = c1*t46 - s1*t145
+    t147 = s1*t46 + c1*t145
+    t148 = c1*t37
+    t149 = s1*t22
+    t150 = 1/t47
+    t151 = t150*(-t149 + t148)
+    t152 = t150*(t6*t22 - t3*t37)
+    t153 = t150*(t11*t22 + t26*t37)
+    t154 = t150*(t13*t22 - t28*t37)
+    t155 = -t150*(t15*t22 + t30*t37)
+    t156 = c1*t22
+    t157 = s1*t37
+    t158 = t150*(s2*t156 + s2*t157)
+    t159 = 1/t48
+    t160 = t150*t159
+    t161 = t160*(t156 + t157)
+    t162 = t160*(s2*t149 - s2*t148)
+    t163 = -(t6*t37 + t3*t22)*t160
+    t164 = (t26*t22 - t11*t37)*t160
+    t165 = -(t13*t37 + t28*t22)*t160
+    t166 = (t15*t37 - t30*t22)*t160
+    t167 = 2*t151
+    t168 = t150*t143
+    t169 = -t168*(s1 + t22*t167)
+    t170 = t150*t144
+    t171 = t170*(c1 - t37*t167)
+    t172 = t150*qd1
+    t173 = t156*t172
+    t174 = t157*t172
+    t175 = 2*t158
+    t176 = t168*(t8 - t22*t175)
+    t177 = t170*(t23 - t37*t175)
+    t178 = t22*t150
+    t179 = t92*t178
+    t180 = t37*t150
+    t181 = t83*t180
+    t182 = 2*t152
+    t183 = t168*(t6 - t22*t182)
+    t184 = -t170*(t3 + t37*t182)
+    t185 = t102*t178
+    t186 = t103*t180
+    t187 = 2*t153
+    t188 = t168*(t11 - t22*t187)
+    t189 = t170*(t26 - t37*t187)
+    t190 = t114*t178
+    t191 = t115*t180
+    t192 = 2*t154
+    t193 = t168*(t13 - t22*t192)
+    t194 = -t170*(t28 + t37*t192)
+    t195 = t123*t178
+    t196 = t124*t180
+    t197 = 2*t155
+    t198 = -t168*(t15 + t22*t197)
+    t199 = -t170*(t30 + t37*t197)
+    t200 = t140*t178
+    t201 = t141*t180
+    t202 = qd1*t159
+    t203 = t37*t159
+    t204 = t22*t159
     Jd = _stack(xp, [
         xp.broadcast_to(-t81, batch),  # 0, 0
-        xp.broadcast_to(t145, batch),  # 0, 1
+        xp.broadcast_to(t146, batch),  # 0, 1
         xp.broadcast_to(t89, batch),  # 0, 2
-        xp.broadcast_to(t99, batch),  # 0, 3
-        xp.broadcast_to(t111, batch),  # 0, 4
-        xp.broadcast_to(t135, batch),  # 0, 5
+        xp.broadcast_to(t100, batch),  # 0, 3
+        xp.broadcast_to(t112, batch),  # 0, 4
+        xp.broadcast_to(t136, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         xp.broadcast_to(t88, batch),  # 1, 0
-        xp.broadcast_to(t146, batch),  # 1, 1
+        xp.broadcast_to(t147, batch),  # 1, 1
         xp.broadcast_to(t82, batch),  # 1, 2
-        xp.broadcast_to(-t100, batch),  # 1, 3
-        xp.broadcast_to(t112, batch),  # 1, 4
-        xp.broadcast_to(-t136, batch),  # 1, 5
+        xp.broadcast_to(-t101, batch),  # 1, 3
+        xp.broadcast_to(t113, batch),  # 1, 4
+        xp.broadcast_to(-t137, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(-t90, batch),  # 2, 1
         xp.broadcast_to(-t91, batch),  # 2, 2
-        xp.broadcast_to(t95, batch),  # 2, 3
-        xp.broadcast_to(t107, batch),  # 2, 4
-        xp.broadcast_to(-t128, batch),  # 2, 5
+        xp.broadcast_to(t96, batch),  # 2, 3
+        xp.broadcast_to(t108, batch),  # 2, 4
+        xp.broadcast_to(-t129, batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(-t174 - t175 + t170 + t172, batch),  # 3, 1
-        xp.broadcast_to(t177 + t178 + t180 + t182, batch),  # 3, 2
-        xp.broadcast_to(t184 + t185 + t186 + t187, batch),  # 3, 3
-        xp.broadcast_to(t189 + t190 + t191 + t192, batch),  # 3, 4
-        xp.broadcast_to(t194 + t195 + t196 + t197, batch),  # 3, 5
-        xp.broadcast_to(t199 + t200 + t201 + t202, batch),  # 3, 6
+        xp.broadcast_to(-t173 - t174 + t169 + t171, batch),  # 3, 1
+        xp.broadcast_to(t176 + t177 + t179 + t181, batch),  # 3, 2
+        xp.broadcast_to(t183 + t184 + t185 + t186, batch),  # 3, 3
+        xp.broadcast_to(t188 + t189 + t190 + t191, batch),  # 3, 4
+        xp.broadcast_to(t193 + t194 + t195 + t196, batch),  # 3, 5
+        xp.broadcast_to(t198 + t199 + t200 + t201, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t142*(-t22*t162 + c1*t160) + t143*(-t37*t162 + s1*t160) + t149*t203 - t150*t203, batch),  # 4, 1
-        xp.broadcast_to(t142*(-t22*t163 + t23*t160) - t143*(t37*t163 + t8*t160) - t92*t204 + t83*t205, batch),  # 4, 2
-        xp.broadcast_to(-t142*(t22*t164 + t3*t160) - t143*(t37*t164 + t6*t160) - t101*t204 + t102*t205, batch),  # 4, 3
-        xp.broadcast_to(t142*(-t22*t165 + t26*t160) - t143*(t37*t165 + t11*t160) - t113*t204 + t114*t205, batch),  # 4, 4
-        xp.broadcast_to(-t142*(t22*t166 + t28*t160) - t143*(t37*t166 + t13*t160) - t122*t204 + t123*t205, batch),  # 4, 5
-        xp.broadcast_to(-t142*(t22*t167 + t30*t160) + t143*(-t37*t167 + t15*t160) - t139*t204 + t140*t205, batch),  # 4, 6
+        xp.broadcast_to(t143*(-t22*t161 + c1*t159) + t144*(-t37*t161 + s1*t159) + t148*t202 - t149*t202, batch),  # 4, 1
+        xp.broadcast_to(t143*(-t22*t162 + t23*t159) - t144*(t37*t162 + t8*t159) - t92*t203 + t83*t204, batch),  # 4, 2
+        xp.broadcast_to(-t143*(t22*t163 + t3*t159) - t144*(t37*t163 + t6*t159) - t102*t203 + t103*t204, batch),  # 4, 3
+        xp.broadcast_to(t143*(-t22*t164 + t26*t159) - t144*(t37*t164 + t11*t159) - t114*t203 + t115*t204, batch),  # 4, 4
+        xp.broadcast_to(-t143*(t22*t165 + t28*t159) - t144*(t37*t165 + t13*t159) - t123*t203 + t124*t204, batch),  # 4, 5
+        xp.broadcast_to(-t143*(t22*t166 + t30*t159) + t144*(-t37*t166 + t15*t159) - t140*t203 + t141*t204, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(t133*t152 + t64*t170 + t64*t172 - t64*t174 - t64*t175), batch),  # 5, 1
-        xp.broadcast_to(-(t148 + t133*t159 + t64*t177 + t64*t178 + t64*t180 + t64*t182), batch),  # 5, 2
-        xp.broadcast_to(-(t96 + t133*t153 + t64*t184 + t64*t185 + t64*t186 + t64*t187), batch),  # 5, 3
-        xp.broadcast_to(-(-t108 + t133*t154 + t64*t189 + t64*t190 + t64*t191 + t64*t192), batch),  # 5, 4
-        xp.broadcast_to(-(t119 + t133*t155 + t64*t194 + t64*t195 + t64*t196 + t64*t197), batch),  # 5, 5
-        xp.broadcast_to(-(-t131 + t133*t156 + t64*t199 + t64*t200 + t64*t201 + t64*t202), batch),  # 5, 6
+        xp.broadcast_to(-(t134*t151 + t64*t169 + t64*t171 - t64*t173 - t64*t174), batch),  # 5, 1
+        xp.broadcast_to(-(t93 + t134*t158 + t64*t176 + t64*t177 + t64*t179 + t64*t181), batch),  # 5, 2
+        xp.broadcast_to(-(t97 + t134*t152 + t64*t183 + t64*t184 + t64*t185 + t64*t186), batch),  # 5, 3
+        xp.broadcast_to(-(-t109 + t134*t153 + t64*t188 + t64*t189 + t64*t190 + t64*t191), batch),  # 5, 4
+        xp.broadcast_to(-(t120 + t134*t154 + t64*t193 + t64*t194 + t64*t195 + t64*t196), batch),  # 5, 5
+        xp.broadcast_to(-(-t132 + t134*t155 + t64*t198 + t64*t199 + t64*t200 + t64*t201), batch),  # 5, 6
     ], (6, 7))
     return Jd
 
@@ -2009,7 +2005,7 @@ def hessian(q):
 
 
 def singularity_factors(q):
-    """factors of det(Js Js^T): the robot is singular where one is 0: (1 x 1), 731 operations."""
+    """factors of det(Js Js^T): the robot is singular where one is 0: (1 x 1), 730 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -2129,7 +2125,7 @@ def singularity_factors(q):
     t102 = -t75 + s1*t3
     t103 = t37*t89 + t39*t99 - t41*t102
     t104 = t37*t90 + t39*t100 - t40*t102
-    t105 = -(s1**2*s2 + t81)
+    t105 = -(t81 + s1*t26)
     t106 = t37*t92 + t38*t99 - t41*t105
     t107 = t37*t93 + t38*t100 - t40*t105
     t108 = t37*t95 + t38*t102 - t39*t105
@@ -2202,7 +2198,7 @@ def singularity_factors(q):
 
 
 def manipulability(q):
-    """manipulability sqrt(det(Js Js^T)): (1 x 1), 734 operations."""
+    """manipulability sqrt(det(Js Js^T)): (1 x 1), 733 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -2322,7 +2318,7 @@ def manipulability(q):
     t102 = -t75 + s1*t3
     t103 = t37*t89 + t39*t99 - t41*t102
     t104 = t37*t90 + t39*t100 - t40*t102
-    t105 = -(s1**2*s2 + t81)
+    t105 = -(t81 + s1*t26)
     t106 = t37*t92 + t38*t99 - t41*t105
     t107 = t37*t93 + t38*t100 - t40*t105
     t108 = t37*t95 + t38*t102 - t39*t105

@@ -73,7 +73,7 @@ void panda_calibrated_jacobian_dot(const panda_calibrated_real q[PANDA_CALIBRATE
 void panda_calibrated_bias_acceleration(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF], panda_calibrated_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 915 operations. */
+ * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 914 operations. */
 void panda_calibrated_task_jacobian_dot(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF], panda_calibrated_real Jd[PANDA_CALIBRATED_TASK_DIM * PANDA_CALIBRATED_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
@@ -97,7 +97,7 @@ int panda_calibrated_velocity_ik(const panda_calibrated_real q[PANDA_CALIBRATED_
 panda_calibrated_real panda_calibrated_ik_numeric_step(const panda_calibrated_real target[16], const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real damping, panda_calibrated_real q_start[PANDA_CALIBRATED_DOF], panda_calibrated_real q_next[PANDA_CALIBRATED_DOF]);
 
 /* The general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9).
- * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 1105 operations. */
+ * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 1082 operations. */
 void panda_calibrated_ik_general_equations(const panda_calibrated_real T[16], panda_calibrated_real q_free, panda_calibrated_real P[378], panda_calibrated_real Q[112]);
 
 /* The configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop).

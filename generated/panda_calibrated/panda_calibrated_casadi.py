@@ -1982,7 +1982,7 @@ def _bias_acceleration(q, q_dot):
 
 
 def _task_jacobian_dot(q, q_dot):
-    """Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': 915 operations."""
+    """Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': 914 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -2349,7 +2349,7 @@ def _task_jacobian_dot(q, q_dot):
     Jd[4, 5] = t206*(-t144*t268 + t80*t256) - t207*(t148*t268 + t78*t256) - t191*t299 + t192*t300
     Jd[4, 6] = t206*(-t144*t269 + t105*t256) - t207*(t148*t269 + t96*t256) - t203*t299 + t204*t300
     Jd[5, 0] = -(t154*t272 + t154*t275 - t200*t255)
-    Jd[5, 1] = -(t200*t261 + t154*t276 + t154*t277 - t154*t278 + t6*t155 - 0.9999999550000004*t6*t148*t154*t248*qd1)
+    Jd[5, 1] = -(t200*t261 + t154*t276 + t154*t277 - t154*t278 + t6*t155 - 0.9999999550000004*t6*t154*qd1*t254)
     Jd[5, 2] = -(t165 + t200*t249 + t154*t279 + t154*t280 + t154*t281 + t154*t282)
     Jd[5, 3] = -(-t170 + t200*t250 + t154*t283 + t154*t284 + t154*t285 + t154*t286)
     Jd[5, 4] = -(-t179 + t200*t251 + t154*t287 + t154*t288 + t154*t289 + t154*t290)

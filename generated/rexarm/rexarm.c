@@ -500,7 +500,7 @@ void rexarm_fk_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q
 
 void rexarm_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real Jd[6 * REXARM_DOF])
 {
-    /* 125 operations */
+    /* 124 operations */
 
     /* Inputs */
     const rexarm_real q1 = q[0];
@@ -564,7 +564,7 @@ void rexarm_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_do
     Jd[0] = -t27;
     Jd[1] = -c1*t30 + t10*t31;
     Jd[2] = -(c1*t29 + t18*t7 - t9*t31);
-    Jd[3] = -(-0.1*s1*s234*qd1 + t14*t20 + c1*t28);
+    Jd[3] = -(t14*t20 + c1*t28 - 0.1*s234*t31);
     Jd[4] = -t26;
     Jd[5] = -(s1*t30 + t10*t32);
     Jd[6] = -(s1*t29 + t9*t32 + t15*t7);
@@ -589,7 +589,7 @@ void rexarm_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_do
 
 void rexarm_bias_acceleration(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real a[6])
 {
-    /* 161 operations */
+    /* 160 operations */
 
     /* Inputs */
     const rexarm_real q1 = q[0];
@@ -650,7 +650,7 @@ void rexarm_bias_acceleration(const rexarm_real q[REXARM_DOF], const rexarm_real
     const rexarm_real t33 = t9*qd2;
 
     /* Outputs */
-    a[0] = -qd1*t27 + qd2*(-c1*t30 + t10*t31) - qd3*(c1*t29 + t18*t7 - t9*t31) - qd4*(-0.1*s1*s234*qd1 + t14*t20 + c1*t28);
+    a[0] = -qd1*t27 + qd2*(-c1*t30 + t10*t31) - qd3*(c1*t29 + t18*t7 - t9*t31) - qd4*(t14*t20 + c1*t28 - 0.1*s234*t31);
     a[1] = -qd1*t26 - qd2*(s1*t30 + t10*t32) - qd3*(s1*t29 + t9*t32 + t15*t7) - qd4*(t14*t17 + t8*t32 + s1*t28);
     a[2] = -qd2*(s1*t25 + c1*t24) - qd3*(c1*t22 + s1*t23 + t13*t33 + t11*t33) - qd4*(s1*t8*t17 + c1*t8*t20 + t13*t21 + t11*t21);
     a[3] = t18*qd1 + t19*qd1 + t32*qd4;

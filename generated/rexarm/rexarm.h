@@ -61,11 +61,11 @@ void rexarm_task_jacobian(const rexarm_real q[REXARM_DOF], rexarm_real J[REXARM_
 void rexarm_fk_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real T[16], rexarm_real J[6 * REXARM_DOF], rexarm_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 4 row-major, element (r, c) at Jd[r * 4 + c]. 125 operations. */
+ * Result: Jd: 6 x 4 row-major, element (r, c) at Jd[r * 4 + c]. 124 operations. */
 void rexarm_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real Jd[6 * REXARM_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
- * Result: a[i], i < 6. 161 operations. */
+ * Result: a[i], i < 6. 160 operations. */
 void rexarm_bias_acceleration(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q'.

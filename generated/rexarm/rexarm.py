@@ -539,7 +539,7 @@ def fk_jacobian_dot(q, q_dot):
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 4), 125 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 4), 124 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (4,)), ("q_dot", q_dot, (4,)))
     q2 = q[..., 1]
     qd1 = q_dot[..., 0]
@@ -597,7 +597,7 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(-t27, batch),  # 0, 0
         xp.broadcast_to(-c1*t30 + t10*t31, batch),  # 0, 1
         xp.broadcast_to(-(c1*t29 + t18*t7 - t9*t31), batch),  # 0, 2
-        xp.broadcast_to(-(-0.1*s1*s234*qd1 + t14*t20 + c1*t28), batch),  # 0, 3
+        xp.broadcast_to(-(t14*t20 + c1*t28 - 0.1*s234*t31), batch),  # 0, 3
         xp.broadcast_to(-t26, batch),  # 1, 0
         xp.broadcast_to(-(s1*t30 + t10*t32), batch),  # 1, 1
         xp.broadcast_to(-(s1*t29 + t9*t32 + t15*t7), batch),  # 1, 2
@@ -623,7 +623,7 @@ def jacobian_dot(q, q_dot):
 
 
 def bias_acceleration(q, q_dot):
-    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 161 operations."""
+    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 160 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (4,)), ("q_dot", q_dot, (4,)))
     q2 = q[..., 1]
     qd1 = q_dot[..., 0]
@@ -678,7 +678,7 @@ def bias_acceleration(q, q_dot):
     t32 = c1*qd1
     t33 = t9*qd2
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t27 + qd2*(-c1*t30 + t10*t31) - qd3*(c1*t29 + t18*t7 - t9*t31) - qd4*(-0.1*s1*s234*qd1 + t14*t20 + c1*t28), batch),  # 0
+        xp.broadcast_to(-qd1*t27 + qd2*(-c1*t30 + t10*t31) - qd3*(c1*t29 + t18*t7 - t9*t31) - qd4*(t14*t20 + c1*t28 - 0.1*s234*t31), batch),  # 0
         xp.broadcast_to(-qd1*t26 - qd2*(s1*t30 + t10*t32) - qd3*(s1*t29 + t9*t32 + t15*t7) - qd4*(t14*t17 + t8*t32 + s1*t28), batch),  # 1
         xp.broadcast_to(-qd2*(s1*t25 + c1*t24) - qd3*(c1*t22 + s1*t23 + t13*t33 + t11*t33) - qd4*(s1*t8*t17 + c1*t8*t20 + t13*t21 + t11*t21), batch),  # 2
         xp.broadcast_to(t18*qd1 + t19*qd1 + t32*qd4, batch),  # 3

@@ -437,7 +437,7 @@ def _fk_jacobian_dot(q, q_dot):
 
 
 def _jacobian_dot(q, q_dot):
-    """Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 125 operations."""
+    """Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 124 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -496,7 +496,7 @@ def _jacobian_dot(q, q_dot):
     Jd[0, 0] = -t27
     Jd[0, 1] = -c1*t30 + t10*t31
     Jd[0, 2] = -(c1*t29 + t18*t7 - t9*t31)
-    Jd[0, 3] = -(-0.1*s1*s234*qd1 + t14*t20 + c1*t28)
+    Jd[0, 3] = -(t14*t20 + c1*t28 - 0.1*s234*t31)
     Jd[1, 0] = -t26
     Jd[1, 1] = -(s1*t30 + t10*t32)
     Jd[1, 2] = -(s1*t29 + t9*t32 + t15*t7)
@@ -515,7 +515,7 @@ def _jacobian_dot(q, q_dot):
 
 
 def _bias_acceleration(q, q_dot):
-    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): 161 operations."""
+    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): 160 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -571,7 +571,7 @@ def _bias_acceleration(q, q_dot):
     t32 = c1*qd1
     t33 = t9*qd2
     a = casadi.SX(6, 1)
-    a[0, 0] = -qd1*t27 + qd2*(-c1*t30 + t10*t31) - qd3*(c1*t29 + t18*t7 - t9*t31) - qd4*(-0.1*s1*s234*qd1 + t14*t20 + c1*t28)
+    a[0, 0] = -qd1*t27 + qd2*(-c1*t30 + t10*t31) - qd3*(c1*t29 + t18*t7 - t9*t31) - qd4*(t14*t20 + c1*t28 - 0.1*s234*t31)
     a[1, 0] = -qd1*t26 - qd2*(s1*t30 + t10*t32) - qd3*(s1*t29 + t9*t32 + t15*t7) - qd4*(t14*t17 + t8*t32 + s1*t28)
     a[2, 0] = -qd2*(s1*t25 + c1*t24) - qd3*(c1*t22 + s1*t23 + t13*t33 + t11*t33) - qd4*(s1*t8*t17 + c1*t8*t20 + t13*t21 + t11*t21)
     a[3, 0] = t18*qd1 + t19*qd1 + t32*qd4

@@ -1211,7 +1211,7 @@ void sawyer_task_jacobian(const sawyer_real q[SAWYER_DOF], sawyer_real J[SAWYER_
 
 void sawyer_fk_jacobian_dot(const sawyer_real q[SAWYER_DOF], const sawyer_real q_dot[SAWYER_DOF], sawyer_real T[16], sawyer_real J[6 * SAWYER_DOF], sawyer_real a[6])
 {
-    /* 453 operations */
+    /* 450 operations */
 
     /* Inputs */
     const sawyer_real q1 = q[0];
@@ -1359,7 +1359,6 @@ void sawyer_fk_jacobian_dot(const sawyer_real q[SAWYER_DOF], const sawyer_real q
     const sawyer_real t112 = -t15;
     const sawyer_real t113 = -t30;
     const sawyer_real t114 = -t46;
-    const sawyer_real t115 = s2*qd2;
 
     /* Outputs */
     T[0] = t16;
@@ -1425,12 +1424,12 @@ void sawyer_fk_jacobian_dot(const sawyer_real q[SAWYER_DOF], const sawyer_real q
     a[2] = qd4*(-t72*t95 + t60*t101 + t7*t78 + t4*t66) + qd5*(t74*t96 - t62*t102 + t11*t77 - t26*t65) - qd2*(s1*t98 + c1*t104) - qd3*(t70*t94 + t58*t100 + t9*t79 - t24*t67) - qd6*(t64*t103 + t76*t106 + t64*t108 - t76*t97);
     a[3] = qd5*(t41*t102 - t26*t54) + qd7*(-t46*t109 + t30*t111) - qd1*t100 + qd3*(-c2*t100 + t24*qd1) + qd4*(t4*t0 + t42*t101) - qd6*(t44*t103 + t28*t55);
     a[4] = qd5*(t11*t54 - t41*t96) + qd6*(-t13*t55 + t44*t97) + qd7*(-t15*t111 + t46*t107) - qd1*t94 - qd3*(t9*qd1 + c2*t94) + qd4*(t7*t0 + t42*t95);
-    a[5] = qd4*(t4*t95 - t7*t101) + qd5*(t26*t96 - t11*t102) + qd6*(t28*t97 + t13*t103) + qd7*(-t30*t107 + t15*t109) + qd3*((s1*s1)*t115 + (c1*c1)*t115);
+    a[5] = qd4*(t4*t95 - t7*t101) + qd5*(t26*t96 - t11*t102) + qd6*(t28*t97 + t13*t103) + qd7*(-t30*t107 + t15*t109) + qd3*(t24*t94 + t9*t100);
 }
 
 void sawyer_jacobian_dot(const sawyer_real q[SAWYER_DOF], const sawyer_real q_dot[SAWYER_DOF], sawyer_real Jd[6 * SAWYER_DOF])
 {
-    /* 347 operations */
+    /* 344 operations */
 
     /* Inputs */
     const sawyer_real q1 = q[0];
@@ -1548,7 +1547,6 @@ void sawyer_jacobian_dot(const sawyer_real q[SAWYER_DOF], const sawyer_real q_do
     const sawyer_real t86 = -t85 + t62;
     const sawyer_real t87 = s1*qd1;
     const sawyer_real t88 = c1*qd1;
-    const sawyer_real t89 = s2*qd2;
 
     /* Outputs */
     Jd[0] = -t74;
@@ -1588,7 +1586,7 @@ void sawyer_jacobian_dot(const sawyer_real q[SAWYER_DOF], const sawyer_real q_do
     Jd[34] = -t14*t86 + t48*t82;
     Jd[35] = 0;
     Jd[36] = 0;
-    Jd[37] = (s1*s1)*t89 + (c1*c1)*t89;
+    Jd[37] = t21*t69 + t9*t75;
     Jd[38] = t4*t70 - t7*t76;
     Jd[39] = t23*t71 - t11*t77;
     Jd[40] = t25*t72 + t13*t78;
@@ -1597,7 +1595,7 @@ void sawyer_jacobian_dot(const sawyer_real q[SAWYER_DOF], const sawyer_real q_do
 
 void sawyer_bias_acceleration(const sawyer_real q[SAWYER_DOF], const sawyer_real q_dot[SAWYER_DOF], sawyer_real a[6])
 {
-    /* 408 operations */
+    /* 405 operations */
 
     /* Inputs */
     const sawyer_real q1 = q[0];
@@ -1715,7 +1713,6 @@ void sawyer_bias_acceleration(const sawyer_real q[SAWYER_DOF], const sawyer_real
     const sawyer_real t85 = t47*qd6;
     const sawyer_real t86 = -t85 + t62;
     const sawyer_real t87 = t52*qd1;
-    const sawyer_real t88 = s2*qd2;
 
     /* Outputs */
     a[0] = -qd1*t74 + qd5*(t36*t77 - t59*t61 + t23*t38 - t44*t64) - qd4*(t58*t0 + t4*t39 + t45*t66 - t35*t76) + qd2*(c1*t41 - s1*t87) + qd3*(-t57*qd1 + c2*t68 - t21*t40 + t75*t34) + qd6*(t37*t78 - t60*t62 + t83*t37 + t85*t60);
@@ -1723,12 +1720,12 @@ void sawyer_bias_acceleration(const sawyer_real q[SAWYER_DOF], const sawyer_real
     a[2] = qd4*(-t58*t70 + t54*t76 + t7*t66 + t4*t65) + qd5*(t59*t71 - t55*t77 + t11*t64 - t23*t63) - qd2*(s1*t73 + c1*t79) - qd3*(t9*t68 - t21*t67 + t69*t57 + t75*t53) - qd6*(t56*t78 - t60*t72 + t81*t60 + t83*t56);
     a[3] = qd5*(t44*t77 - t23*t61) + qd7*(-t48*t84 + t26*t86) + qd4*(t4*t0 + t45*t76) - qd6*(t47*t78 + t25*t62) - t75*qd1 + qd3*(t21*qd1 - c2*t75);
     a[4] = qd5*(t11*t61 - t44*t71) + qd6*(-t13*t62 + t47*t72) + qd7*(-t14*t86 + t48*t82) - t69*qd1 + qd4*(t7*t0 + t45*t70) - qd3*(t9*qd1 + c2*t69);
-    a[5] = qd4*(t4*t70 - t7*t76) + qd5*(t23*t71 - t11*t77) + qd6*(t25*t72 + t13*t78) + qd7*(-t26*t82 + t14*t84) + qd3*((s1*s1)*t88 + (c1*c1)*t88);
+    a[5] = qd4*(t4*t70 - t7*t76) + qd5*(t23*t71 - t11*t77) + qd6*(t25*t72 + t13*t78) + qd7*(-t26*t82 + t14*t84) + qd3*(t21*t69 + t9*t75);
 }
 
 void sawyer_task_jacobian_dot(const sawyer_real q[SAWYER_DOF], const sawyer_real q_dot[SAWYER_DOF], sawyer_real Jd[SAWYER_TASK_DIM * SAWYER_DOF])
 {
-    /* 674 operations */
+    /* 671 operations */
 
     /* Inputs */
     const sawyer_real q1 = q[0];
@@ -1849,162 +1846,161 @@ void sawyer_task_jacobian_dot(const sawyer_real q[SAWYER_DOF], const sawyer_real
     const sawyer_real t85 = s1*t75 + c1*t82;
     const sawyer_real t86 = t8*t73 - t22*t72 + t74*t64 + t81*t60;
     const sawyer_real t87 = t22*qd1 - c2*t81;
-    const sawyer_real t88 = t81 - t22*qd3;
-    const sawyer_real t89 = t88;
-    const sawyer_real t90 = -t65*t80 + t61*t89 + t6*t71 + t3*t70;
-    const sawyer_real t91 = t3*t80 - t6*t89;
-    const sawyer_real t92 = qd1 - c2*qd3;
-    const sawyer_real t93 = t92;
-    const sawyer_real t94 = t65*t93 + t3*t42 + t50*t71 - t38*t89;
-    const sawyer_real t95 = -t61*t93 + t38*t80 - t6*t42 + t50*t70;
-    const sawyer_real t96 = t3*t93 + t50*t89;
-    const sawyer_real t97 = t6*t93 + t50*t80;
-    const sawyer_real t98 = t6*qd4;
-    const sawyer_real t99 = -t80 + t98;
-    const sawyer_real t100 = -t3*qd4;
-    const sawyer_real t101 = t100 + t89;
-    const sawyer_real t102 = t66*t99 - t62*t101 + t10*t69 - t24*t68;
-    const sawyer_real t103 = t24*t99 - t10*t101;
-    const sawyer_real t104 = t50*qd4;
-    const sawyer_real t105 = t104 + t93;
-    const sawyer_real t106 = t39*t101 - t66*t105 + t24*t41 - t49*t69;
-    const sawyer_real t107 = t62*t105 - t39*t99 + t49*t68 - t10*t41;
-    const sawyer_real t108 = t49*t101 - t24*t105;
-    const sawyer_real t109 = t10*t105 - t49*t99;
-    const sawyer_real t110 = t10*qd5;
-    const sawyer_real t111 = t110 + t99;
-    const sawyer_real t112 = t24*qd5;
-    const sawyer_real t113 = t112 + t101;
-    const sawyer_real t114 = t26*t111 + t12*t113;
-    const sawyer_real t115 = t49*qd5;
-    const sawyer_real t116 = t115 + t105;
-    const sawyer_real t117 = t52*t113 + t26*t116;
-    const sawyer_real t118 = -t12*t116 + t52*t111;
-    const sawyer_real t119 = t12*qd6;
-    const sawyer_real t120 = -t119 + t111;
-    const sawyer_real t121 = -t98 - t110 + t79 + t119 + t14*qd7;
-    const sawyer_real t122 = t26*qd6;
-    const sawyer_real t123 = t122 + t113;
-    const sawyer_real t124 = t63*t113 - t67*t111 + t119*t67 + t122*t63;
-    const sawyer_real t125 = -t28*t120 + t14*t123;
-    const sawyer_real t126 = t88 + t100 + t112 + t122 - t28*qd7;
-    const sawyer_real t127 = t29*t121 + t15*t126;
-    const sawyer_real t128 = t52*qd6;
-    const sawyer_real t129 = t40*t113 - t67*t116 + t122*t40 + t128*t67;
-    const sawyer_real t130 = t63*t116 - t40*t111 - t128*t63 + t119*t40;
-    const sawyer_real t131 = -t128;
-    const sawyer_real t132 = t131 + t116;
-    const sawyer_real t133 = -t54*t123 + t28*t132;
-    const sawyer_real t134 = -t14*t132 + t54*t120;
-    const sawyer_real t135 = t92 + t104 + t115 + t131 - t54*qd7;
-    const sawyer_real t136 = t55*t126 - t29*t135;
-    const sawyer_real t137 = t15*t135 + t55*t121;
-    const sawyer_real t138 = t59*qd1;
-    const sawyer_real t139 = c1*t44 - s1*t138;
-    const sawyer_real t140 = s1*t44 + c1*t138;
-    const sawyer_real t141 = s2*qd2;
-    const sawyer_real t142 = (s1*s1)*t141 + (c1*c1)*t141;
-    const sawyer_real t143 = c1*t29;
-    const sawyer_real t144 = s1*t15;
-    const sawyer_real t145 = 1.0/t45;
-    const sawyer_real t146 = t145*(-t144 + t143);
-    const sawyer_real t147 = (t6*t15 - t3*t29)*t145;
-    const sawyer_real t148 = (t10*t15 + t24*t29)*t145;
-    const sawyer_real t149 = (t26*t29 - t12*t15)*t145;
-    const sawyer_real t150 = -(t14*t15 + t28*t29)*t145;
-    const sawyer_real t151 = c1*t15;
-    const sawyer_real t152 = s1*t29;
-    const sawyer_real t153 = -t145*(s2*t151 + s2*t152);
-    const sawyer_real t154 = 1.0/t46;
-    const sawyer_real t155 = t145*t154;
-    const sawyer_real t156 = t155*(t151 + t152);
-    const sawyer_real t157 = t155*(s2*t143 - s2*t144);
-    const sawyer_real t158 = -(t3*t15 + t6*t29)*t155;
-    const sawyer_real t159 = (t24*t15 - t10*t29)*t155;
-    const sawyer_real t160 = (t12*t29 + t26*t15)*t155;
-    const sawyer_real t161 = (t14*t29 - t28*t15)*t155;
-    const sawyer_real t162 = 2*t146;
-    const sawyer_real t163 = t136*t145;
-    const sawyer_real t164 = -(s1 + t15*t162)*t163;
-    const sawyer_real t165 = t137*t145;
-    const sawyer_real t166 = (c1 - t29*t162)*t165;
-    const sawyer_real t167 = qd1*t145;
-    const sawyer_real t168 = t151*t167;
-    const sawyer_real t169 = t152*t167;
-    const sawyer_real t170 = 2*t153;
-    const sawyer_real t171 = -t163*(t8 + t15*t170);
-    const sawyer_real t172 = -t165*(t22 + t29*t170);
-    const sawyer_real t173 = t15*t145;
-    const sawyer_real t174 = t87*t173;
-    const sawyer_real t175 = t29*t145;
-    const sawyer_real t176 = t78*t175;
-    const sawyer_real t177 = 2*t147;
-    const sawyer_real t178 = t163*(t6 - t15*t177);
-    const sawyer_real t179 = -t165*(t3 + t29*t177);
-    const sawyer_real t180 = t96*t173;
-    const sawyer_real t181 = t97*t175;
-    const sawyer_real t182 = 2*t148;
-    const sawyer_real t183 = t163*(t10 - t15*t182);
-    const sawyer_real t184 = t165*(t24 - t29*t182);
-    const sawyer_real t185 = t108*t173;
-    const sawyer_real t186 = t109*t175;
-    const sawyer_real t187 = 2*t149;
-    const sawyer_real t188 = -t163*(t12 + t15*t187);
-    const sawyer_real t189 = t165*(t26 - t29*t187);
-    const sawyer_real t190 = t117*t173;
-    const sawyer_real t191 = t118*t175;
-    const sawyer_real t192 = 2*t150;
-    const sawyer_real t193 = -t163*(t14 + t15*t192);
-    const sawyer_real t194 = -t165*(t28 + t29*t192);
-    const sawyer_real t195 = t133*t173;
-    const sawyer_real t196 = t134*t175;
-    const sawyer_real t197 = qd1*t154;
-    const sawyer_real t198 = t29*t154;
-    const sawyer_real t199 = t15*t154;
+    const sawyer_real t88 = t22*t74 + t8*t81;
+    const sawyer_real t89 = t81 - t22*qd3;
+    const sawyer_real t90 = t89;
+    const sawyer_real t91 = -t65*t80 + t61*t90 + t6*t71 + t3*t70;
+    const sawyer_real t92 = t3*t80 - t6*t90;
+    const sawyer_real t93 = qd1 - c2*qd3;
+    const sawyer_real t94 = t93;
+    const sawyer_real t95 = t65*t94 + t3*t42 + t50*t71 - t38*t90;
+    const sawyer_real t96 = -t61*t94 + t38*t80 - t6*t42 + t50*t70;
+    const sawyer_real t97 = t3*t94 + t50*t90;
+    const sawyer_real t98 = t6*t94 + t50*t80;
+    const sawyer_real t99 = t6*qd4;
+    const sawyer_real t100 = -t80 + t99;
+    const sawyer_real t101 = -t3*qd4;
+    const sawyer_real t102 = t101 + t90;
+    const sawyer_real t103 = t66*t100 - t62*t102 + t10*t69 - t24*t68;
+    const sawyer_real t104 = t24*t100 - t10*t102;
+    const sawyer_real t105 = t50*qd4;
+    const sawyer_real t106 = t105 + t94;
+    const sawyer_real t107 = t39*t102 - t66*t106 + t24*t41 - t49*t69;
+    const sawyer_real t108 = t62*t106 - t39*t100 + t49*t68 - t10*t41;
+    const sawyer_real t109 = t49*t102 - t24*t106;
+    const sawyer_real t110 = t10*t106 - t49*t100;
+    const sawyer_real t111 = t10*qd5;
+    const sawyer_real t112 = t111 + t100;
+    const sawyer_real t113 = t24*qd5;
+    const sawyer_real t114 = t113 + t102;
+    const sawyer_real t115 = t26*t112 + t12*t114;
+    const sawyer_real t116 = t49*qd5;
+    const sawyer_real t117 = t116 + t106;
+    const sawyer_real t118 = t52*t114 + t26*t117;
+    const sawyer_real t119 = -t12*t117 + t52*t112;
+    const sawyer_real t120 = t12*qd6;
+    const sawyer_real t121 = -t120 + t112;
+    const sawyer_real t122 = -t99 - t111 + t79 + t120 + t14*qd7;
+    const sawyer_real t123 = t26*qd6;
+    const sawyer_real t124 = t123 + t114;
+    const sawyer_real t125 = t63*t114 - t67*t112 + t120*t67 + t123*t63;
+    const sawyer_real t126 = -t28*t121 + t14*t124;
+    const sawyer_real t127 = t89 + t101 + t113 + t123 - t28*qd7;
+    const sawyer_real t128 = t29*t122 + t15*t127;
+    const sawyer_real t129 = t52*qd6;
+    const sawyer_real t130 = t40*t114 - t67*t117 + t123*t40 + t129*t67;
+    const sawyer_real t131 = t63*t117 - t40*t112 - t129*t63 + t120*t40;
+    const sawyer_real t132 = -t129;
+    const sawyer_real t133 = t132 + t117;
+    const sawyer_real t134 = -t54*t124 + t28*t133;
+    const sawyer_real t135 = -t14*t133 + t54*t121;
+    const sawyer_real t136 = t93 + t105 + t116 + t132 - t54*qd7;
+    const sawyer_real t137 = t55*t127 - t29*t136;
+    const sawyer_real t138 = t15*t136 + t55*t122;
+    const sawyer_real t139 = t59*qd1;
+    const sawyer_real t140 = c1*t44 - s1*t139;
+    const sawyer_real t141 = s1*t44 + c1*t139;
+    const sawyer_real t142 = c1*t29;
+    const sawyer_real t143 = s1*t15;
+    const sawyer_real t144 = 1.0/t45;
+    const sawyer_real t145 = t144*(-t143 + t142);
+    const sawyer_real t146 = (t6*t15 - t3*t29)*t144;
+    const sawyer_real t147 = (t10*t15 + t24*t29)*t144;
+    const sawyer_real t148 = (t26*t29 - t12*t15)*t144;
+    const sawyer_real t149 = -(t14*t15 + t28*t29)*t144;
+    const sawyer_real t150 = c1*t15;
+    const sawyer_real t151 = s1*t29;
+    const sawyer_real t152 = -t144*(s2*t150 + s2*t151);
+    const sawyer_real t153 = 1.0/t46;
+    const sawyer_real t154 = t144*t153;
+    const sawyer_real t155 = t154*(t150 + t151);
+    const sawyer_real t156 = t154*(s2*t142 - s2*t143);
+    const sawyer_real t157 = -(t3*t15 + t6*t29)*t154;
+    const sawyer_real t158 = (t24*t15 - t10*t29)*t154;
+    const sawyer_real t159 = (t12*t29 + t26*t15)*t154;
+    const sawyer_real t160 = (t14*t29 - t28*t15)*t154;
+    const sawyer_real t161 = 2*t145;
+    const sawyer_real t162 = t137*t144;
+    const sawyer_real t163 = -(s1 + t15*t161)*t162;
+    const sawyer_real t164 = t138*t144;
+    const sawyer_real t165 = (c1 - t29*t161)*t164;
+    const sawyer_real t166 = qd1*t144;
+    const sawyer_real t167 = t150*t166;
+    const sawyer_real t168 = t151*t166;
+    const sawyer_real t169 = 2*t152;
+    const sawyer_real t170 = -t162*(t8 + t15*t169);
+    const sawyer_real t171 = -t164*(t22 + t29*t169);
+    const sawyer_real t172 = t15*t144;
+    const sawyer_real t173 = t87*t172;
+    const sawyer_real t174 = t29*t144;
+    const sawyer_real t175 = t78*t174;
+    const sawyer_real t176 = 2*t146;
+    const sawyer_real t177 = t162*(t6 - t15*t176);
+    const sawyer_real t178 = -t164*(t3 + t29*t176);
+    const sawyer_real t179 = t97*t172;
+    const sawyer_real t180 = t98*t174;
+    const sawyer_real t181 = 2*t147;
+    const sawyer_real t182 = t162*(t10 - t15*t181);
+    const sawyer_real t183 = t164*(t24 - t29*t181);
+    const sawyer_real t184 = t109*t172;
+    const sawyer_real t185 = t110*t174;
+    const sawyer_real t186 = 2*t148;
+    const sawyer_real t187 = -t162*(t12 + t15*t186);
+    const sawyer_real t188 = t164*(t26 - t29*t186);
+    const sawyer_real t189 = t118*t172;
+    const sawyer_real t190 = t119*t174;
+    const sawyer_real t191 = 2*t149;
+    const sawyer_real t192 = -t162*(t14 + t15*t191);
+    const sawyer_real t193 = -t164*(t28 + t29*t191);
+    const sawyer_real t194 = t134*t172;
+    const sawyer_real t195 = t135*t174;
+    const sawyer_real t196 = qd1*t153;
+    const sawyer_real t197 = t29*t153;
+    const sawyer_real t198 = t15*t153;
 
     /* Outputs */
     Jd[0] = -t76;
-    Jd[1] = t139;
+    Jd[1] = t140;
     Jd[2] = t84;
-    Jd[3] = -t94;
-    Jd[4] = t106;
-    Jd[5] = t129;
+    Jd[3] = -t95;
+    Jd[4] = t107;
+    Jd[5] = t130;
     Jd[6] = 0;
     Jd[7] = t83;
-    Jd[8] = t140;
+    Jd[8] = t141;
     Jd[9] = t77;
-    Jd[10] = t95;
-    Jd[11] = t107;
-    Jd[12] = t130;
+    Jd[10] = t96;
+    Jd[11] = t108;
+    Jd[12] = t131;
     Jd[13] = 0;
     Jd[14] = 0;
     Jd[15] = -t85;
     Jd[16] = -t86;
-    Jd[17] = t90;
-    Jd[18] = t102;
-    Jd[19] = -t124;
+    Jd[17] = t91;
+    Jd[18] = t103;
+    Jd[19] = -t125;
     Jd[20] = 0;
     Jd[21] = 0;
-    Jd[22] = -t168 - t169 + t164 + t166;
-    Jd[23] = -t176 + t171 + t172 + t174;
-    Jd[24] = t178 + t179 + t180 + t181;
-    Jd[25] = t183 + t184 + t185 + t186;
-    Jd[26] = -t190 + t188 + t189 + t191;
-    Jd[27] = t193 + t194 + t195 + t196;
+    Jd[22] = -t167 - t168 + t163 + t165;
+    Jd[23] = -t175 + t170 + t171 + t173;
+    Jd[24] = t177 + t178 + t179 + t180;
+    Jd[25] = t182 + t183 + t184 + t185;
+    Jd[26] = -t189 + t187 + t188 + t190;
+    Jd[27] = t192 + t193 + t194 + t195;
     Jd[28] = 0;
-    Jd[29] = t136*(-t15*t156 + c1*t154) + t137*(-t29*t156 + s1*t154) + t143*t197 - t144*t197;
-    Jd[30] = -t136*(t15*t157 + t22*t154) + t137*(-t29*t157 + t8*t154) - t87*t198 - t78*t199;
-    Jd[31] = -t136*(t15*t158 + t3*t154) - t137*(t29*t158 + t6*t154) - t96*t198 + t97*t199;
-    Jd[32] = t136*(-t15*t159 + t24*t154) - t137*(t29*t159 + t10*t154) - t108*t198 + t109*t199;
-    Jd[33] = t136*(-t15*t160 + t26*t154) + t137*(-t29*t160 + t12*t154) + t117*t198 + t118*t199;
-    Jd[34] = -t136*(t15*t161 + t28*t154) + t137*(-t29*t161 + t14*t154) - t133*t198 + t134*t199;
+    Jd[29] = t137*(-t15*t155 + c1*t153) + t138*(-t29*t155 + s1*t153) + t142*t196 - t143*t196;
+    Jd[30] = -t137*(t15*t156 + t22*t153) + t138*(-t29*t156 + t8*t153) - t87*t197 - t78*t198;
+    Jd[31] = -t137*(t15*t157 + t3*t153) - t138*(t29*t157 + t6*t153) - t97*t197 + t98*t198;
+    Jd[32] = t137*(-t15*t158 + t24*t153) - t138*(t29*t158 + t10*t153) - t109*t197 + t110*t198;
+    Jd[33] = t137*(-t15*t159 + t26*t153) + t138*(-t29*t159 + t12*t153) + t118*t197 + t119*t198;
+    Jd[34] = -t137*(t15*t160 + t28*t153) + t138*(-t29*t160 + t14*t153) - t134*t197 + t135*t198;
     Jd[35] = 0;
-    Jd[36] = t127*t146 - t55*t164 - t55*t166 + t55*t168 + t55*t169;
-    Jd[37] = t142 + t127*t153 - t55*t171 - t55*t172 - t55*t174 + t55*t176;
-    Jd[38] = -(-t91 + t55*t178 + t55*t179 + t55*t180 + t55*t181 - t127*t147);
-    Jd[39] = -(-t103 + t55*t183 + t55*t184 + t55*t185 + t55*t186 - t127*t148);
-    Jd[40] = t114 + t127*t149 - t55*t188 - t55*t189 + t55*t190 - t55*t191;
-    Jd[41] = -(-t125 + t55*t193 + t55*t194 + t55*t195 + t55*t196 - t127*t150);
+    Jd[36] = t128*t145 - t55*t163 - t55*t165 + t55*t167 + t55*t168;
+    Jd[37] = t88 + t128*t152 - t55*t170 - t55*t171 - t55*t173 + t55*t175;
+    Jd[38] = -(-t92 + t55*t177 + t55*t178 + t55*t179 + t55*t180 - t128*t146);
+    Jd[39] = -(-t104 + t55*t182 + t55*t183 + t55*t184 + t55*t185 - t128*t147);
+    Jd[40] = t115 + t128*t148 - t55*t187 - t55*t188 + t55*t189 - t55*t190;
+    Jd[41] = -(-t126 + t55*t192 + t55*t193 + t55*t194 + t55*t195 - t128*t149);
 }
 
 void sawyer_hessian(const sawyer_real q[SAWYER_DOF], sawyer_real H[SAWYER_DOF * 6 * SAWYER_DOF])
@@ -2429,7 +2425,7 @@ void sawyer_hessian(const sawyer_real q[SAWYER_DOF], sawyer_real H[SAWYER_DOF * 
 
 void sawyer_singularity_factors(const sawyer_real q[SAWYER_DOF], sawyer_real f[SAWYER_NUM_SINGULARITY_FACTORS])
 {
-    /* 723 operations */
+    /* 722 operations */
 
     /* Inputs */
     const sawyer_real q1 = q[0];
@@ -2554,7 +2550,7 @@ void sawyer_singularity_factors(const sawyer_real q[SAWYER_DOF], sawyer_real f[S
     const sawyer_real t99 = -t72 + s1*t3;
     const sawyer_real t100 = t32*t86 + t34*t96 - t36*t99;
     const sawyer_real t101 = t32*t87 + t34*t97 - t35*t99;
-    const sawyer_real t102 = (s1*s1)*s2 + t78;
+    const sawyer_real t102 = t78 + s1*t20;
     const sawyer_real t103 = t32*t89 + t33*t96 - t36*t102;
     const sawyer_real t104 = t32*t90 + t33*t97 - t35*t102;
     const sawyer_real t105 = t32*t92 + t33*t99 - t34*t102;
@@ -2627,7 +2623,7 @@ void sawyer_singularity_factors(const sawyer_real q[SAWYER_DOF], sawyer_real f[S
 
 sawyer_real sawyer_manipulability(const sawyer_real q[SAWYER_DOF])
 {
-    /* 726 operations */
+    /* 725 operations */
 
     /* Inputs */
     const sawyer_real q1 = q[0];
@@ -2752,7 +2748,7 @@ sawyer_real sawyer_manipulability(const sawyer_real q[SAWYER_DOF])
     const sawyer_real t99 = -t72 + s1*t3;
     const sawyer_real t100 = t32*t86 + t34*t96 - t36*t99;
     const sawyer_real t101 = t32*t87 + t34*t97 - t35*t99;
-    const sawyer_real t102 = (s1*s1)*s2 + t78;
+    const sawyer_real t102 = t78 + s1*t20;
     const sawyer_real t103 = t32*t89 + t33*t96 - t36*t102;
     const sawyer_real t104 = t32*t90 + t33*t97 - t35*t102;
     const sawyer_real t105 = t32*t92 + t33*t99 - t34*t102;
@@ -3477,7 +3473,7 @@ sawyer_real sawyer_ik_numeric_step(const sawyer_real target[16], const sawyer_re
 
 void sawyer_ik_general_equations(const sawyer_real T[16], sawyer_real q_free, sawyer_real P[378], sawyer_real Q[112])
 {
-    /* 412 operations */
+    /* 408 operations */
 
     /* Inputs */
     const sawyer_real T00 = T[0];
@@ -4094,9 +4090,9 @@ void sawyer_ik_general_equations(const sawyer_real T[16], sawyer_real q_free, sa
     Q[101] = -0.26705*t9 + t20*t9 - t18*t9 - t19*t9 + t23*t112 + t25*t112 + t60*t72 + t58*t78 - t23*t80 - t25*t80;
     Q[102] = t21*t5 - t37*t9;
     Q[103] = t38*t9 - t22*t5;
-    Q[104] = -(-t82 - t83 + t84 + t86 + t87 + t88 + t89 + 0.05295*t0 - 0.634*T02*t2*t16 - 0.634*t2*t5*t17);
+    Q[104] = -(-t82 - t83 + t84 + t86 + t87 + t88 + t89 + 0.05295*t0 - 0.634*t27*t2 - 0.634*t41*t2);
     Q[105] = -t69 - t70 - t73 - t74 + t71 + t76 + t77 + t79 + t81 + 0.05295*T02;
-    Q[106] = -(-t99 - t100 + t101 + t102 + t103 + t104 + t105 + 0.05295*t1 - 0.634*T12*t2*t16 - 0.634*t2*t9*t17);
+    Q[106] = -(-t99 - t100 + t101 + t102 + t103 + t104 + t105 + 0.05295*t1 - 0.634*t23*t2 - 0.634*t39*t2);
     Q[107] = -t90 - t91 - t93 - t94 + t92 + t95 + t96 + t97 + t98 + 0.05295*T12;
     Q[108] = 0.8*t41 + t45*T02 + t44*t0;
     Q[109] = 0.8*t39 + t45*T12 + t44*t1;

@@ -61,19 +61,19 @@ void sawyer_task(const sawyer_real q[SAWYER_DOF], sawyer_real mu[SAWYER_TASK_DIM
 void sawyer_task_jacobian(const sawyer_real q[SAWYER_DOF], sawyer_real J[SAWYER_TASK_DIM * SAWYER_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]; a[i], i < 6. 453 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 7 row-major, element (r, c) at J[r * 7 + c]; a[i], i < 6. 450 operations. */
 void sawyer_fk_jacobian_dot(const sawyer_real q[SAWYER_DOF], const sawyer_real q_dot[SAWYER_DOF], sawyer_real T[16], sawyer_real J[6 * SAWYER_DOF], sawyer_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).
- * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 347 operations. */
+ * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 344 operations. */
 void sawyer_jacobian_dot(const sawyer_real q[SAWYER_DOF], const sawyer_real q_dot[SAWYER_DOF], sawyer_real Jd[6 * SAWYER_DOF]);
 
 /* J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6).
- * Result: a[i], i < 6. 408 operations. */
+ * Result: a[i], i < 6. 405 operations. */
 void sawyer_bias_acceleration(const sawyer_real q[SAWYER_DOF], const sawyer_real q_dot[SAWYER_DOF], sawyer_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 674 operations. */
+ * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 671 operations. */
 void sawyer_task_jacobian_dot(const sawyer_real q[SAWYER_DOF], const sawyer_real q_dot[SAWYER_DOF], sawyer_real Jd[SAWYER_TASK_DIM * SAWYER_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).
@@ -81,11 +81,11 @@ void sawyer_task_jacobian_dot(const sawyer_real q[SAWYER_DOF], const sawyer_real
 void sawyer_hessian(const sawyer_real q[SAWYER_DOF], sawyer_real H[SAWYER_DOF * 6 * SAWYER_DOF]);
 
 /* Factors of det(Js Js^T): the robot is singular where one is 0.
- * Result: f[i], i < 1. 723 operations. */
+ * Result: f[i], i < 1. 722 operations. */
 void sawyer_singularity_factors(const sawyer_real q[SAWYER_DOF], sawyer_real f[SAWYER_NUM_SINGULARITY_FACTORS]);
 
 /* Manipulability sqrt(det(Js Js^T)).
- * Result: returned as a scalar. 726 operations. */
+ * Result: returned as a scalar. 725 operations. */
 sawyer_real sawyer_manipulability(const sawyer_real q[SAWYER_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
@@ -97,7 +97,7 @@ int sawyer_velocity_ik(const sawyer_real q[SAWYER_DOF], const sawyer_real mu_dot
 sawyer_real sawyer_ik_numeric_step(const sawyer_real target[16], const sawyer_real q[SAWYER_DOF], sawyer_real damping, sawyer_real q_start[SAWYER_DOF], sawyer_real q_next[SAWYER_DOF]);
 
 /* The general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9).
- * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 412 operations. */
+ * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 408 operations. */
 void sawyer_ik_general_equations(const sawyer_real T[16], sawyer_real q_free, sawyer_real P[378], sawyer_real Q[112]);
 
 /* The configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop).

@@ -756,7 +756,7 @@ def task_jacobian(q):
 
 
 def fk_jacobian_dot(q, q_dot):
-    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 7 and 6 x 1), 453 operations."""
+    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 7 and 6 x 1), 450 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -895,7 +895,6 @@ def fk_jacobian_dot(q, q_dot):
     t112 = -t15
     t113 = -t30
     t114 = -t46
-    t115 = s2*qd2
     T = _stack(xp, [
         xp.broadcast_to(t16, batch),  # 0, 0
         xp.broadcast_to(t17, batch),  # 0, 1
@@ -964,13 +963,13 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(qd4*(-t72*t95 + t60*t101 + t7*t78 + t4*t66) + qd5*(t74*t96 - t62*t102 + t11*t77 - t26*t65) - qd2*(s1*t98 + c1*t104) - qd3*(t70*t94 + t58*t100 + t9*t79 - t24*t67) - qd6*(t64*t103 + t76*t106 + t64*t108 - t76*t97), batch),  # 2
         xp.broadcast_to(qd5*(t41*t102 - t26*t54) + qd7*(-t46*t109 + t30*t111) - qd1*t100 + qd3*(-c2*t100 + t24*qd1) + qd4*(t4*t0 + t42*t101) - qd6*(t44*t103 + t28*t55), batch),  # 3
         xp.broadcast_to(qd5*(t11*t54 - t41*t96) + qd6*(-t13*t55 + t44*t97) + qd7*(-t15*t111 + t46*t107) - qd1*t94 - qd3*(t9*qd1 + c2*t94) + qd4*(t7*t0 + t42*t95), batch),  # 4
-        xp.broadcast_to(qd4*(t4*t95 - t7*t101) + qd5*(t26*t96 - t11*t102) + qd6*(t28*t97 + t13*t103) + qd7*(-t30*t107 + t15*t109) + qd3*(s1**2*t115 + c1**2*t115), batch),  # 5
+        xp.broadcast_to(qd4*(t4*t95 - t7*t101) + qd5*(t26*t96 - t11*t102) + qd6*(t28*t97 + t13*t103) + qd7*(-t30*t107 + t15*t109) + qd3*(t24*t94 + t9*t100), batch),  # 5
     ], (6,))
     return T, J, a
 
 
 def jacobian_dot(q, q_dot):
-    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 7), 347 operations."""
+    """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 7), 344 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1080,7 +1079,6 @@ def jacobian_dot(q, q_dot):
     t86 = -t85 + t62
     t87 = s1*qd1
     t88 = c1*qd1
-    t89 = s2*qd2
     Jd = _stack(xp, [
         xp.broadcast_to(-t74, batch),  # 0, 0
         xp.broadcast_to(c1*t41 - t52*t87, batch),  # 0, 1
@@ -1119,7 +1117,7 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(-t14*t86 + t48*t82, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
-        xp.broadcast_to(s1**2*t89 + c1**2*t89, batch),  # 5, 2
+        xp.broadcast_to(t21*t69 + t9*t75, batch),  # 5, 2
         xp.broadcast_to(t4*t70 - t7*t76, batch),  # 5, 3
         xp.broadcast_to(t23*t71 - t11*t77, batch),  # 5, 4
         xp.broadcast_to(t25*t72 + t13*t78, batch),  # 5, 5
@@ -1129,7 +1127,7 @@ def jacobian_dot(q, q_dot):
 
 
 def bias_acceleration(q, q_dot):
-    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 408 operations."""
+    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 405 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1239,20 +1237,19 @@ def bias_acceleration(q, q_dot):
     t85 = t47*qd6
     t86 = -t85 + t62
     t87 = t52*qd1
-    t88 = s2*qd2
     a = _stack(xp, [
         xp.broadcast_to(-qd1*t74 + qd5*(t36*t77 - t59*t61 + t23*t38 - t44*t64) - qd4*(t58*t0 + t4*t39 + t45*t66 - t35*t76) + qd2*(c1*t41 - s1*t87) + qd3*(-t57*qd1 + c2*t68 - t21*t40 + t75*t34) + qd6*(t37*t78 - t60*t62 + t83*t37 + t85*t60), batch),  # 0
         xp.broadcast_to(qd1*t80 + qd5*(t55*t61 - t36*t71 + t44*t63 - t11*t38) + qd4*(-t54*t0 + t35*t70 - t7*t39 + t45*t65) + qd2*(s1*t41 + c1*t87) + qd3*(t53*qd1 - c2*t67 + t9*t40 + t69*t34) + qd6*(t56*t62 - t37*t72 - t85*t56 + t81*t37), batch),  # 1
         xp.broadcast_to(qd4*(-t58*t70 + t54*t76 + t7*t66 + t4*t65) + qd5*(t59*t71 - t55*t77 + t11*t64 - t23*t63) - qd2*(s1*t73 + c1*t79) - qd3*(t9*t68 - t21*t67 + t69*t57 + t75*t53) - qd6*(t56*t78 - t60*t72 + t81*t60 + t83*t56), batch),  # 2
         xp.broadcast_to(qd5*(t44*t77 - t23*t61) + qd7*(-t48*t84 + t26*t86) + qd4*(t4*t0 + t45*t76) - qd6*(t47*t78 + t25*t62) - t75*qd1 + qd3*(t21*qd1 - c2*t75), batch),  # 3
         xp.broadcast_to(qd5*(t11*t61 - t44*t71) + qd6*(-t13*t62 + t47*t72) + qd7*(-t14*t86 + t48*t82) - t69*qd1 + qd4*(t7*t0 + t45*t70) - qd3*(t9*qd1 + c2*t69), batch),  # 4
-        xp.broadcast_to(qd4*(t4*t70 - t7*t76) + qd5*(t23*t71 - t11*t77) + qd6*(t25*t72 + t13*t78) + qd7*(-t26*t82 + t14*t84) + qd3*(s1**2*t88 + c1**2*t88), batch),  # 5
+        xp.broadcast_to(qd4*(t4*t70 - t7*t76) + qd5*(t23*t71 - t11*t77) + qd6*(t25*t72 + t13*t78) + qd7*(-t26*t82 + t14*t84) + qd3*(t21*t69 + t9*t75), batch),  # 5
     ], (6,))
     return a
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 674 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 671 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1364,161 +1361,160 @@ def task_jacobian_dot(q, q_dot):
     t85 = s1*t75 + c1*t82
     t86 = t8*t73 - t22*t72 + t74*t64 + t81*t60
     t87 = t22*qd1 - c2*t81
-    t88 = t81 - t22*qd3
-    t89 = t88
-    t90 = -t65*t80 + t61*t89 + t6*t71 + t3*t70
-    t91 = t3*t80 - t6*t89
-    t92 = qd1 - c2*qd3
-    t93 = t92
-    t94 = t65*t93 + t3*t42 + t50*t71 - t38*t89
-    t95 = -t61*t93 + t38*t80 - t6*t42 + t50*t70
-    t96 = t3*t93 + t50*t89
-    t97 = t6*t93 + t50*t80
-    t98 = t6*qd4
-    t99 = -t80 + t98
-    t100 = -t3*qd4
-    t101 = t100 + t89
-    t102 = t66*t99 - t62*t101 + t10*t69 - t24*t68
-    t103 = t24*t99 - t10*t101
-    t104 = t50*qd4
-    t105 = t104 + t93
-    t106 = t39*t101 - t66*t105 + t24*t41 - t49*t69
-    t107 = t62*t105 - t39*t99 + t49*t68 - t10*t41
-    t108 = t49*t101 - t24*t105
-    t109 = t10*t105 - t49*t99
-    t110 = t10*qd5
-    t111 = t110 + t99
-    t112 = t24*qd5
-    t113 = t112 + t101
-    t114 = t26*t111 + t12*t113
-    t115 = t49*qd5
-    t116 = t115 + t105
-    t117 = t52*t113 + t26*t116
-    t118 = -t12*t116 + t52*t111
-    t119 = t12*qd6
-    t120 = -t119 + t111
-    t121 = -t98 - t110 + t79 + t119 + t14*qd7
-    t122 = t26*qd6
-    t123 = t122 + t113
-    t124 = t63*t113 - t67*t111 + t119*t67 + t122*t63
-    t125 = -t28*t120 + t14*t123
-    t126 = t88 + t100 + t112 + t122 - t28*qd7
-    t127 = t29*t121 + t15*t126
-    t128 = t52*qd6
-    t129 = t40*t113 - t67*t116 + t122*t40 + t128*t67
-    t130 = t63*t116 - t40*t111 - t128*t63 + t119*t40
-    t131 = -t128
-    t132 = t131 + t116
-    t133 = -t54*t123 + t28*t132
-    t134 = -t14*t132 + t54*t120
-    t135 = t92 + t104 + t115 + t131 - t54*qd7
-    t136 = t55*t126 - t29*t135
-    t137 = t15*t135 + t55*t121
-    t138 = t59*qd1
-    t139 = c1*t44 - s1*t138
-    t140 = s1*t44 + c1*t138
-    t141 = s2*qd2
-    t142 = s1**2*t141 + c1**2*t141
-    t143 = c1*t29
-    t144 = s1*t15
-    t145 = 1/t45
-    t146 = t145*(-t144 + t143)
-    t147 = (t6*t15 - t3*t29)*t145
-    t148 = (t10*t15 + t24*t29)*t145
-    t149 = (t26*t29 - t12*t15)*t145
-    t150 = -(t14*t15 + t28*t29)*t145
-    t151 = c1*t15
-    t152 = s1*t29
-    t153 = -t145*(s2*t151 + s2*t152)
-    t154 = 1/t46
-    t155 = t145*t154
-    t156 = t155*(t151 + t152)
-    t157 = t155*(s2*t143 - s2*t144)
-    t158 = -(t3*t15 + t6*t29)*t155
-    t159 = (t24*t15 - t10*t29)*t155
-    t160 = (t12*t29 + t26*t15)*t155
-    t161 = (t14*t29 - t28*t15)*t155
-    t162 = 2*t146
-    t163 = t136*t145
-    t164 = -(s1 + t15*t162)*t163
-    t165 = t137*t145
-    t166 = (c1 - t29*t162)*t165
-    t167 = qd1*t145
-    t168 = t151*t167
-    t169 = t152*t167
-    t170 = 2*t153
-    t171 = -t163*(t8 + t15*t170)
-    t172 = -t165*(t22 + t29*t170)
-    t173 = t15*t145
-    t174 = t87*t173
-    t175 = t29*t145
-    t176 = t78*t175
-    t177 = 2*t147
-    t178 = t163*(t6 - t15*t177)
-    t179 = -t165*(t3 + t29*t177)
-    t180 = t96*t173
-    t181 = t97*t175
-    t182 = 2*t148
-    t183 = t163*(t10 - t15*t182)
-    t184 = t165*(t24 - t29*t182)
-    t185 = t108*t173
-    t186 = t109*t175
-    t187 = 2*t149
-    t188 = -t163*(t12 + t15*t187)
-    t189 = t165*(t26 - t29*t187)
-    t190 = t117*t173
-    t191 = t118*t175
-    t192 = 2*t150
-    t193 = -t163*(t14 + t15*t192)
-    t194 = -t165*(t28 + t29*t192)
-    t195 = t133*t173
-    t196 = t134*t175
-    t197 = qd1*t154
-    t198 = t29*t154
-    t199 = t15*t154
+    t88 = t22*t74 + t8*t81
+    t89 = t81 - t22*qd3
+    t90 = t89
+    t91 = -t65*t80 + t61*t90 + t6*t71 + t3*t70
+    t92 = t3*t80 - t6*t90
+    t93 = qd1 - c2*qd3
+    t94 = t93
+    t95 = t65*t94 + t3*t42 + t50*t71 - t38*t90
+    t96 = -t61*t94 + t38*t80 - t6*t42 + t50*t70
+    t97 = t3*t94 + t50*t90
+    t98 = t6*t94 + t50*t80
+    t99 = t6*qd4
+    t100 = -t80 + t99
+    t101 = -t3*qd4
+    t102 = t101 + t90
+    t103 = t66*t100 - t62*t102 + t10*t69 - t24*t68
+    t104 = t24*t100 - t10*t102
+    t105 = t50*qd4
+    t106 = t105 + t94
+    t107 = t39*t102 - t66*t106 + t24*t41 - t49*t69
+    t108 = t62*t106 - t39*t100 + t49*t68 - t10*t41
+    t109 = t49*t102 - t24*t106
+    t110 = t10*t106 - t49*t100
+    t111 = t10*qd5
+    t112 = t111 + t100
+    t113 = t24*qd5
+    t114 = t113 + t102
+    t115 = t26*t112 + t12*t114
+    t116 = t49*qd5
+    t117 = t116 + t106
+    t118 = t52*t114 + t26*t117
+    t119 = -t12*t117 + t52*t112
+    t120 = t12*qd6
+    t121 = -t120 + t112
+    t122 = -t99 - t111 + t79 + t120 + t14*qd7
+    t123 = t26*qd6
+    t124 = t123 + t114
+    t125 = t63*t114 - t67*t112 + t120*t67 + t123*t63
+    t126 = -t28*t121 + t14*t124
+    t127 = t89 + t101 + t113 + t123 - t28*qd7
+    t128 = t29*t122 + t15*t127
+    t129 = t52*qd6
+    t130 = t40*t114 - t67*t117 + t123*t40 + t129*t67
+    t131 = t63*t117 - t40*t112 - t129*t63 + t120*t40
+    t132 = -t129
+    t133 = t132 + t117
+    t134 = -t54*t124 + t28*t133
+    t135 = -t14*t133 + t54*t121
+    t136 = t93 + t105 + t116 + t132 - t54*qd7
+    t137 = t55*t127 - t29*t136
+    t138 = t15*t136 + t55*t122
+    t139 = t59*qd1
+    t140 = c1*t44 - s1*t139
+    t141 = s1*t44 + c1*t139
+    t142 = c1*t29
+    t143 = s1*t15
+    t144 = 1/t45
+    t145 = t144*(-t143 + t142)
+    t146 = (t6*t15 - t3*t29)*t144
+    t147 = (t10*t15 + t24*t29)*t144
+    t148 = (t26*t29 - t12*t15)*t144
+    t149 = -(t14*t15 + t28*t29)*t144
+    t150 = c1*t15
+    t151 = s1*t29
+    t152 = -t144*(s2*t150 + s2*t151)
+    t153 = 1/t46
+    t154 = t144*t153
+    t155 = t154*(t150 + t151)
+    t156 = t154*(s2*t142 - s2*t143)
+    t157 = -(t3*t15 + t6*t29)*t154
+    t158 = (t24*t15 - t10*t29)*t154
+    t159 = (t12*t29 + t26*t15)*t154
+    t160 = (t14*t29 - t28*t15)*t154
+    t161 = 2*t145
+    t162 = t137*t144
+    t163 = -(s1 + t15*t161)*t162
+    t164 = t138*t144
+    t165 = (c1 - t29*t161)*t164
+    t166 = qd1*t144
+    t167 = t150*t166
+    t168 = t151*t166
+    t169 = 2*t152
+    t170 = -t162*(t8 + t15*t169)
+    t171 = -t164*(t22 + t29*t169)
+    t172 = t15*t144
+    t173 = t87*t172
+    t174 = t29*t144
+    t175 = t78*t174
+    t176 = 2*t146
+    t177 = t162*(t6 - t15*t176)
+    t178 = -t164*(t3 + t29*t176)
+    t179 = t97*t172
+    t180 = t98*t174
+    t181 = 2*t147
+    t182 = t162*(t10 - t15*t181)
+    t183 = t164*(t24 - t29*t181)
+    t184 = t109*t172
+    t185 = t110*t174
+    t186 = 2*t148
+    t187 = -t162*(t12 + t15*t186)
+    t188 = t164*(t26 - t29*t186)
+    t189 = t118*t172
+    t190 = t119*t174
+    t191 = 2*t149
+    t192 = -t162*(t14 + t15*t191)
+    t193 = -t164*(t28 + t29*t191)
+    t194 = t134*t172
+    t195 = t135*t174
+    t196 = qd1*t153
+    t197 = t29*t153
+    t198 = t15*t153
     Jd = _stack(xp, [
         xp.broadcast_to(-t76, batch),  # 0, 0
-        xp.broadcast_to(t139, batch),  # 0, 1
+        xp.broadcast_to(t140, batch),  # 0, 1
         xp.broadcast_to(t84, batch),  # 0, 2
-        xp.broadcast_to(-t94, batch),  # 0, 3
-        xp.broadcast_to(t106, batch),  # 0, 4
-        xp.broadcast_to(t129, batch),  # 0, 5
+        xp.broadcast_to(-t95, batch),  # 0, 3
+        xp.broadcast_to(t107, batch),  # 0, 4
+        xp.broadcast_to(t130, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         xp.broadcast_to(t83, batch),  # 1, 0
-        xp.broadcast_to(t140, batch),  # 1, 1
+        xp.broadcast_to(t141, batch),  # 1, 1
         xp.broadcast_to(t77, batch),  # 1, 2
-        xp.broadcast_to(t95, batch),  # 1, 3
-        xp.broadcast_to(t107, batch),  # 1, 4
-        xp.broadcast_to(t130, batch),  # 1, 5
+        xp.broadcast_to(t96, batch),  # 1, 3
+        xp.broadcast_to(t108, batch),  # 1, 4
+        xp.broadcast_to(t131, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(-t85, batch),  # 2, 1
         xp.broadcast_to(-t86, batch),  # 2, 2
-        xp.broadcast_to(t90, batch),  # 2, 3
-        xp.broadcast_to(t102, batch),  # 2, 4
-        xp.broadcast_to(-t124, batch),  # 2, 5
+        xp.broadcast_to(t91, batch),  # 2, 3
+        xp.broadcast_to(t103, batch),  # 2, 4
+        xp.broadcast_to(-t125, batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(-t168 - t169 + t164 + t166, batch),  # 3, 1
-        xp.broadcast_to(-t176 + t171 + t172 + t174, batch),  # 3, 2
-        xp.broadcast_to(t178 + t179 + t180 + t181, batch),  # 3, 3
-        xp.broadcast_to(t183 + t184 + t185 + t186, batch),  # 3, 4
-        xp.broadcast_to(-t190 + t188 + t189 + t191, batch),  # 3, 5
-        xp.broadcast_to(t193 + t194 + t195 + t196, batch),  # 3, 6
+        xp.broadcast_to(-t167 - t168 + t163 + t165, batch),  # 3, 1
+        xp.broadcast_to(-t175 + t170 + t171 + t173, batch),  # 3, 2
+        xp.broadcast_to(t177 + t178 + t179 + t180, batch),  # 3, 3
+        xp.broadcast_to(t182 + t183 + t184 + t185, batch),  # 3, 4
+        xp.broadcast_to(-t189 + t187 + t188 + t190, batch),  # 3, 5
+        xp.broadcast_to(t192 + t193 + t194 + t195, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t136*(-t15*t156 + c1*t154) + t137*(-t29*t156 + s1*t154) + t143*t197 - t144*t197, batch),  # 4, 1
-        xp.broadcast_to(-t136*(t15*t157 + t22*t154) + t137*(-t29*t157 + t8*t154) - t87*t198 - t78*t199, batch),  # 4, 2
-        xp.broadcast_to(-t136*(t15*t158 + t3*t154) - t137*(t29*t158 + t6*t154) - t96*t198 + t97*t199, batch),  # 4, 3
-        xp.broadcast_to(t136*(-t15*t159 + t24*t154) - t137*(t29*t159 + t10*t154) - t108*t198 + t109*t199, batch),  # 4, 4
-        xp.broadcast_to(t136*(-t15*t160 + t26*t154) + t137*(-t29*t160 + t12*t154) + t117*t198 + t118*t199, batch),  # 4, 5
-        xp.broadcast_to(-t136*(t15*t161 + t28*t154) + t137*(-t29*t161 + t14*t154) - t133*t198 + t134*t199, batch),  # 4, 6
+        xp.broadcast_to(t137*(-t15*t155 + c1*t153) + t138*(-t29*t155 + s1*t153) + t142*t196 - t143*t196, batch),  # 4, 1
+        xp.broadcast_to(-t137*(t15*t156 + t22*t153) + t138*(-t29*t156 + t8*t153) - t87*t197 - t78*t198, batch),  # 4, 2
+        xp.broadcast_to(-t137*(t15*t157 + t3*t153) - t138*(t29*t157 + t6*t153) - t97*t197 + t98*t198, batch),  # 4, 3
+        xp.broadcast_to(t137*(-t15*t158 + t24*t153) - t138*(t29*t158 + t10*t153) - t109*t197 + t110*t198, batch),  # 4, 4
+        xp.broadcast_to(t137*(-t15*t159 + t26*t153) + t138*(-t29*t159 + t12*t153) + t118*t197 + t119*t198, batch),  # 4, 5
+        xp.broadcast_to(-t137*(t15*t160 + t28*t153) + t138*(-t29*t160 + t14*t153) - t134*t197 + t135*t198, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t127*t146 - t55*t164 - t55*t166 + t55*t168 + t55*t169, batch),  # 5, 1
-        xp.broadcast_to(t142 + t127*t153 - t55*t171 - t55*t172 - t55*t174 + t55*t176, batch),  # 5, 2
-        xp.broadcast_to(-(-t91 + t55*t178 + t55*t179 + t55*t180 + t55*t181 - t127*t147), batch),  # 5, 3
-        xp.broadcast_to(-(-t103 + t55*t183 + t55*t184 + t55*t185 + t55*t186 - t127*t148), batch),  # 5, 4
-        xp.broadcast_to(t114 + t127*t149 - t55*t188 - t55*t189 + t55*t190 - t55*t191, batch),  # 5, 5
-        xp.broadcast_to(-(-t125 + t55*t193 + t55*t194 + t55*t195 + t55*t196 - t127*t150), batch),  # 5, 6
+        xp.broadcast_to(t128*t145 - t55*t163 - t55*t165 + t55*t167 + t55*t168, batch),  # 5, 1
+        xp.broadcast_to(t88 + t128*t152 - t55*t170 - t55*t171 - t55*t173 + t55*t175, batch),  # 5, 2
+        xp.broadcast_to(-(-t92 + t55*t177 + t55*t178 + t55*t179 + t55*t180 - t128*t146), batch),  # 5, 3
+        xp.broadcast_to(-(-t104 + t55*t182 + t55*t183 + t55*t184 + t55*t185 - t128*t147), batch),  # 5, 4
+        xp.broadcast_to(t115 + t128*t148 - t55*t187 - t55*t188 + t55*t189 - t55*t190, batch),  # 5, 5
+        xp.broadcast_to(-(-t126 + t55*t192 + t55*t193 + t55*t194 + t55*t195 - t128*t149), batch),  # 5, 6
     ], (6, 7))
     return Jd
 
@@ -1936,7 +1932,7 @@ def hessian(q):
 
 
 def singularity_factors(q):
-    """factors of det(Js Js^T): the robot is singular where one is 0: (1 x 1), 723 operations."""
+    """factors of det(Js Js^T): the robot is singular where one is 0: (1 x 1), 722 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -2053,7 +2049,7 @@ def singularity_factors(q):
     t99 = -t72 + s1*t3
     t100 = t32*t86 + t34*t96 - t36*t99
     t101 = t32*t87 + t34*t97 - t35*t99
-    t102 = s1**2*s2 + t78
+    t102 = t78 + s1*t20
     t103 = t32*t89 + t33*t96 - t36*t102
     t104 = t32*t90 + t33*t97 - t35*t102
     t105 = t32*t92 + t33*t99 - t34*t102
@@ -2126,7 +2122,7 @@ def singularity_factors(q):
 
 
 def manipulability(q):
-    """manipulability sqrt(det(Js Js^T)): (1 x 1), 726 operations."""
+    """manipulability sqrt(det(Js Js^T)): (1 x 1), 725 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (7,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -2243,7 +2239,7 @@ def manipulability(q):
     t99 = -t72 + s1*t3
     t100 = t32*t86 + t34*t96 - t36*t99
     t101 = t32*t87 + t34*t97 - t35*t99
-    t102 = s1**2*s2 + t78
+    t102 = t78 + s1*t20
     t103 = t32*t89 + t33*t96 - t36*t102
     t104 = t32*t90 + t33*t97 - t35*t102
     t105 = t32*t92 + t33*t99 - t34*t102
@@ -2965,7 +2961,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 
 def ik_general_equations(T, q_free):
-    """the general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9): (42 x 9 and 14 x 8), 412 operations."""
+    """the general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9): (42 x 9 and 14 x 8), 408 operations."""
     xp, dtype, device, batch, (T, q_free,) = _arguments(("T", T, (4, 4)), ("q_free", q_free, ()))
     T00 = T[..., 0, 0]
     T01 = T[..., 0, 1]
@@ -3580,9 +3576,9 @@ def ik_general_equations(T, q_free):
         -0.26705*t9 + t20*t9 - t18*t9 - t19*t9 + t23*t112 + t25*t112 + t60*t72 + t58*t78 - t23*t80 - t25*t80,  # 12, 5
         t21*t5 - t37*t9,  # 12, 6
         t38*t9 - t22*t5,  # 12, 7
-        -(-t82 - t83 + t84 + t86 + t87 + t88 + t89 + 0.05295*t0 - 0.634*T02*t2*t16 - 0.634*t2*t5*t17),  # 13, 0
+        -(-t82 - t83 + t84 + t86 + t87 + t88 + t89 + 0.05295*t0 - 0.634*t27*t2 - 0.634*t41*t2),  # 13, 0
         -t69 - t70 - t73 - t74 + t71 + t76 + t77 + t79 + t81 + 0.05295*T02,  # 13, 1
-        -(-t99 - t100 + t101 + t102 + t103 + t104 + t105 + 0.05295*t1 - 0.634*T12*t2*t16 - 0.634*t2*t9*t17),  # 13, 2
+        -(-t99 - t100 + t101 + t102 + t103 + t104 + t105 + 0.05295*t1 - 0.634*t23*t2 - 0.634*t39*t2),  # 13, 2
         -t90 - t91 - t93 - t94 + t92 + t95 + t96 + t97 + t98 + 0.05295*T12,  # 13, 3
         0.8*t41 + t45*T02 + t44*t0,  # 13, 4
         0.8*t39 + t45*T12 + t44*t1,  # 13, 5

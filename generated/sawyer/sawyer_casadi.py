@@ -692,7 +692,7 @@ def _task_jacobian(q):
 
 
 def _fk_jacobian_dot(q, q_dot):
-    """Fk, jacobian and bias_acceleration in one pass, sharing their terms: 453 operations."""
+    """Fk, jacobian and bias_acceleration in one pass, sharing their terms: 450 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -836,7 +836,6 @@ def _fk_jacobian_dot(q, q_dot):
     t112 = -t15
     t113 = -t30
     t114 = -t46
-    t115 = s2*qd2
     T = casadi.SX(4, 4)
     T[0, 0] = t16
     T[0, 1] = t17
@@ -893,12 +892,12 @@ def _fk_jacobian_dot(q, q_dot):
     a[2, 0] = qd4*(-t72*t95 + t60*t101 + t7*t78 + t4*t66) + qd5*(t74*t96 - t62*t102 + t11*t77 - t26*t65) - qd2*(s1*t98 + c1*t104) - qd3*(t70*t94 + t58*t100 + t9*t79 - t24*t67) - qd6*(t64*t103 + t76*t106 + t64*t108 - t76*t97)
     a[3, 0] = qd5*(t41*t102 - t26*t54) + qd7*(-t46*t109 + t30*t111) - qd1*t100 + qd3*(-c2*t100 + t24*qd1) + qd4*(t4*t0 + t42*t101) - qd6*(t44*t103 + t28*t55)
     a[4, 0] = qd5*(t11*t54 - t41*t96) + qd6*(-t13*t55 + t44*t97) + qd7*(-t15*t111 + t46*t107) - qd1*t94 - qd3*(t9*qd1 + c2*t94) + qd4*(t7*t0 + t42*t95)
-    a[5, 0] = qd4*(t4*t95 - t7*t101) + qd5*(t26*t96 - t11*t102) + qd6*(t28*t97 + t13*t103) + qd7*(-t30*t107 + t15*t109) + qd3*(s1**2*t115 + c1**2*t115)
+    a[5, 0] = qd4*(t4*t95 - t7*t101) + qd5*(t26*t96 - t11*t102) + qd6*(t28*t97 + t13*t103) + qd7*(-t30*t107 + t15*t109) + qd3*(t24*t94 + t9*t100)
     return [T, J, a]
 
 
 def _jacobian_dot(q, q_dot):
-    """Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 347 operations."""
+    """Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): 344 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1012,7 +1011,6 @@ def _jacobian_dot(q, q_dot):
     t86 = -t85 + t62
     t87 = s1*qd1
     t88 = c1*qd1
-    t89 = s2*qd2
     Jd = casadi.SX(6, 7)
     Jd[0, 0] = -t74
     Jd[0, 1] = c1*t41 - t52*t87
@@ -1043,7 +1041,7 @@ def _jacobian_dot(q, q_dot):
     Jd[4, 4] = t11*t61 - t44*t71
     Jd[4, 5] = -t13*t62 + t47*t72
     Jd[4, 6] = -t14*t86 + t48*t82
-    Jd[5, 2] = s1**2*t89 + c1**2*t89
+    Jd[5, 2] = t21*t69 + t9*t75
     Jd[5, 3] = t4*t70 - t7*t76
     Jd[5, 4] = t23*t71 - t11*t77
     Jd[5, 5] = t25*t72 + t13*t78
@@ -1052,7 +1050,7 @@ def _jacobian_dot(q, q_dot):
 
 
 def _bias_acceleration(q, q_dot):
-    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): 408 operations."""
+    """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): 405 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1166,19 +1164,18 @@ def _bias_acceleration(q, q_dot):
     t85 = t47*qd6
     t86 = -t85 + t62
     t87 = t52*qd1
-    t88 = s2*qd2
     a = casadi.SX(6, 1)
     a[0, 0] = -qd1*t74 + qd5*(t36*t77 - t59*t61 + t23*t38 - t44*t64) - qd4*(t58*t0 + t4*t39 + t45*t66 - t35*t76) + qd2*(c1*t41 - s1*t87) + qd3*(-t57*qd1 + c2*t68 - t21*t40 + t75*t34) + qd6*(t37*t78 - t60*t62 + t83*t37 + t85*t60)
     a[1, 0] = qd1*t80 + qd5*(t55*t61 - t36*t71 + t44*t63 - t11*t38) + qd4*(-t54*t0 + t35*t70 - t7*t39 + t45*t65) + qd2*(s1*t41 + c1*t87) + qd3*(t53*qd1 - c2*t67 + t9*t40 + t69*t34) + qd6*(t56*t62 - t37*t72 - t85*t56 + t81*t37)
     a[2, 0] = qd4*(-t58*t70 + t54*t76 + t7*t66 + t4*t65) + qd5*(t59*t71 - t55*t77 + t11*t64 - t23*t63) - qd2*(s1*t73 + c1*t79) - qd3*(t9*t68 - t21*t67 + t69*t57 + t75*t53) - qd6*(t56*t78 - t60*t72 + t81*t60 + t83*t56)
     a[3, 0] = qd5*(t44*t77 - t23*t61) + qd7*(-t48*t84 + t26*t86) + qd4*(t4*t0 + t45*t76) - qd6*(t47*t78 + t25*t62) - t75*qd1 + qd3*(t21*qd1 - c2*t75)
     a[4, 0] = qd5*(t11*t61 - t44*t71) + qd6*(-t13*t62 + t47*t72) + qd7*(-t14*t86 + t48*t82) - t69*qd1 + qd4*(t7*t0 + t45*t70) - qd3*(t9*qd1 + c2*t69)
-    a[5, 0] = qd4*(t4*t70 - t7*t76) + qd5*(t23*t71 - t11*t77) + qd6*(t25*t72 + t13*t78) + qd7*(-t26*t82 + t14*t84) + qd3*(s1**2*t88 + c1**2*t88)
+    a[5, 0] = qd4*(t4*t70 - t7*t76) + qd5*(t23*t71 - t11*t77) + qd6*(t25*t72 + t13*t78) + qd7*(-t26*t82 + t14*t84) + qd3*(t21*t69 + t9*t75)
     return [a]
 
 
 def _task_jacobian_dot(q, q_dot):
-    """Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': 674 operations."""
+    """Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': 671 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1295,154 +1292,153 @@ def _task_jacobian_dot(q, q_dot):
     t85 = s1*t75 + c1*t82
     t86 = t8*t73 - t22*t72 + t74*t64 + t81*t60
     t87 = t22*qd1 - c2*t81
-    t88 = t81 - t22*qd3
-    t89 = t88
-    t90 = -t65*t80 + t61*t89 + t6*t71 + t3*t70
-    t91 = t3*t80 - t6*t89
-    t92 = qd1 - c2*qd3
-    t93 = t92
-    t94 = t65*t93 + t3*t42 + t50*t71 - t38*t89
-    t95 = -t61*t93 + t38*t80 - t6*t42 + t50*t70
-    t96 = t3*t93 + t50*t89
-    t97 = t6*t93 + t50*t80
-    t98 = t6*qd4
-    t99 = -t80 + t98
-    t100 = -t3*qd4
-    t101 = t100 + t89
-    t102 = t66*t99 - t62*t101 + t10*t69 - t24*t68
-    t103 = t24*t99 - t10*t101
-    t104 = t50*qd4
-    t105 = t104 + t93
-    t106 = t39*t101 - t66*t105 + t24*t41 - t49*t69
-    t107 = t62*t105 - t39*t99 + t49*t68 - t10*t41
-    t108 = t49*t101 - t24*t105
-    t109 = t10*t105 - t49*t99
-    t110 = t10*qd5
-    t111 = t110 + t99
-    t112 = t24*qd5
-    t113 = t112 + t101
-    t114 = t26*t111 + t12*t113
-    t115 = t49*qd5
-    t116 = t115 + t105
-    t117 = t52*t113 + t26*t116
-    t118 = -t12*t116 + t52*t111
-    t119 = t12*qd6
-    t120 = -t119 + t111
-    t121 = -t98 - t110 + t79 + t119 + t14*qd7
-    t122 = t26*qd6
-    t123 = t122 + t113
-    t124 = t63*t113 - t67*t111 + t119*t67 + t122*t63
-    t125 = -t28*t120 + t14*t123
-    t126 = t88 + t100 + t112 + t122 - t28*qd7
-    t127 = t29*t121 + t15*t126
-    t128 = t52*qd6
-    t129 = t40*t113 - t67*t116 + t122*t40 + t128*t67
-    t130 = t63*t116 - t40*t111 - t128*t63 + t119*t40
-    t131 = -t128
-    t132 = t131 + t116
-    t133 = -t54*t123 + t28*t132
-    t134 = -t14*t132 + t54*t120
-    t135 = t92 + t104 + t115 + t131 - t54*qd7
-    t136 = t55*t126 - t29*t135
-    t137 = t15*t135 + t55*t121
-    t138 = t59*qd1
-    t139 = c1*t44 - s1*t138
-    t140 = s1*t44 + c1*t138
-    t141 = s2*qd2
-    t142 = s1**2*t141 + c1**2*t141
-    t143 = c1*t29
-    t144 = s1*t15
-    t145 = 1/t45
-    t146 = t145*(-t144 + t143)
-    t147 = (t6*t15 - t3*t29)*t145
-    t148 = (t10*t15 + t24*t29)*t145
-    t149 = (t26*t29 - t12*t15)*t145
-    t150 = -(t14*t15 + t28*t29)*t145
-    t151 = c1*t15
-    t152 = s1*t29
-    t153 = -t145*(s2*t151 + s2*t152)
-    t154 = 1/t46
-    t155 = t145*t154
-    t156 = t155*(t151 + t152)
-    t157 = t155*(s2*t143 - s2*t144)
-    t158 = -(t3*t15 + t6*t29)*t155
-    t159 = (t24*t15 - t10*t29)*t155
-    t160 = (t12*t29 + t26*t15)*t155
-    t161 = (t14*t29 - t28*t15)*t155
-    t162 = 2*t146
-    t163 = t136*t145
-    t164 = -(s1 + t15*t162)*t163
-    t165 = t137*t145
-    t166 = (c1 - t29*t162)*t165
-    t167 = qd1*t145
-    t168 = t151*t167
-    t169 = t152*t167
-    t170 = 2*t153
-    t171 = -t163*(t8 + t15*t170)
-    t172 = -t165*(t22 + t29*t170)
-    t173 = t15*t145
-    t174 = t87*t173
-    t175 = t29*t145
-    t176 = t78*t175
-    t177 = 2*t147
-    t178 = t163*(t6 - t15*t177)
-    t179 = -t165*(t3 + t29*t177)
-    t180 = t96*t173
-    t181 = t97*t175
-    t182 = 2*t148
-    t183 = t163*(t10 - t15*t182)
-    t184 = t165*(t24 - t29*t182)
-    t185 = t108*t173
-    t186 = t109*t175
-    t187 = 2*t149
-    t188 = -t163*(t12 + t15*t187)
-    t189 = t165*(t26 - t29*t187)
-    t190 = t117*t173
-    t191 = t118*t175
-    t192 = 2*t150
-    t193 = -t163*(t14 + t15*t192)
-    t194 = -t165*(t28 + t29*t192)
-    t195 = t133*t173
-    t196 = t134*t175
-    t197 = qd1*t154
-    t198 = t29*t154
-    t199 = t15*t154
+    t88 = t22*t74 + t8*t81
+    t89 = t81 - t22*qd3
+    t90 = t89
+    t91 = -t65*t80 + t61*t90 + t6*t71 + t3*t70
+    t92 = t3*t80 - t6*t90
+    t93 = qd1 - c2*qd3
+    t94 = t93
+    t95 = t65*t94 + t3*t42 + t50*t71 - t38*t90
+    t96 = -t61*t94 + t38*t80 - t6*t42 + t50*t70
+    t97 = t3*t94 + t50*t90
+    t98 = t6*t94 + t50*t80
+    t99 = t6*qd4
+    t100 = -t80 + t99
+    t101 = -t3*qd4
+    t102 = t101 + t90
+    t103 = t66*t100 - t62*t102 + t10*t69 - t24*t68
+    t104 = t24*t100 - t10*t102
+    t105 = t50*qd4
+    t106 = t105 + t94
+    t107 = t39*t102 - t66*t106 + t24*t41 - t49*t69
+    t108 = t62*t106 - t39*t100 + t49*t68 - t10*t41
+    t109 = t49*t102 - t24*t106
+    t110 = t10*t106 - t49*t100
+    t111 = t10*qd5
+    t112 = t111 + t100
+    t113 = t24*qd5
+    t114 = t113 + t102
+    t115 = t26*t112 + t12*t114
+    t116 = t49*qd5
+    t117 = t116 + t106
+    t118 = t52*t114 + t26*t117
+    t119 = -t12*t117 + t52*t112
+    t120 = t12*qd6
+    t121 = -t120 + t112
+    t122 = -t99 - t111 + t79 + t120 + t14*qd7
+    t123 = t26*qd6
+    t124 = t123 + t114
+    t125 = t63*t114 - t67*t112 + t120*t67 + t123*t63
+    t126 = -t28*t121 + t14*t124
+    t127 = t89 + t101 + t113 + t123 - t28*qd7
+    t128 = t29*t122 + t15*t127
+    t129 = t52*qd6
+    t130 = t40*t114 - t67*t117 + t123*t40 + t129*t67
+    t131 = t63*t117 - t40*t112 - t129*t63 + t120*t40
+    t132 = -t129
+    t133 = t132 + t117
+    t134 = -t54*t124 + t28*t133
+    t135 = -t14*t133 + t54*t121
+    t136 = t93 + t105 + t116 + t132 - t54*qd7
+    t137 = t55*t127 - t29*t136
+    t138 = t15*t136 + t55*t122
+    t139 = t59*qd1
+    t140 = c1*t44 - s1*t139
+    t141 = s1*t44 + c1*t139
+    t142 = c1*t29
+    t143 = s1*t15
+    t144 = 1/t45
+    t145 = t144*(-t143 + t142)
+    t146 = (t6*t15 - t3*t29)*t144
+    t147 = (t10*t15 + t24*t29)*t144
+    t148 = (t26*t29 - t12*t15)*t144
+    t149 = -(t14*t15 + t28*t29)*t144
+    t150 = c1*t15
+    t151 = s1*t29
+    t152 = -t144*(s2*t150 + s2*t151)
+    t153 = 1/t46
+    t154 = t144*t153
+    t155 = t154*(t150 + t151)
+    t156 = t154*(s2*t142 - s2*t143)
+    t157 = -(t3*t15 + t6*t29)*t154
+    t158 = (t24*t15 - t10*t29)*t154
+    t159 = (t12*t29 + t26*t15)*t154
+    t160 = (t14*t29 - t28*t15)*t154
+    t161 = 2*t145
+    t162 = t137*t144
+    t163 = -(s1 + t15*t161)*t162
+    t164 = t138*t144
+    t165 = (c1 - t29*t161)*t164
+    t166 = qd1*t144
+    t167 = t150*t166
+    t168 = t151*t166
+    t169 = 2*t152
+    t170 = -t162*(t8 + t15*t169)
+    t171 = -t164*(t22 + t29*t169)
+    t172 = t15*t144
+    t173 = t87*t172
+    t174 = t29*t144
+    t175 = t78*t174
+    t176 = 2*t146
+    t177 = t162*(t6 - t15*t176)
+    t178 = -t164*(t3 + t29*t176)
+    t179 = t97*t172
+    t180 = t98*t174
+    t181 = 2*t147
+    t182 = t162*(t10 - t15*t181)
+    t183 = t164*(t24 - t29*t181)
+    t184 = t109*t172
+    t185 = t110*t174
+    t186 = 2*t148
+    t187 = -t162*(t12 + t15*t186)
+    t188 = t164*(t26 - t29*t186)
+    t189 = t118*t172
+    t190 = t119*t174
+    t191 = 2*t149
+    t192 = -t162*(t14 + t15*t191)
+    t193 = -t164*(t28 + t29*t191)
+    t194 = t134*t172
+    t195 = t135*t174
+    t196 = qd1*t153
+    t197 = t29*t153
+    t198 = t15*t153
     Jd = casadi.SX(6, 7)
     Jd[0, 0] = -t76
-    Jd[0, 1] = t139
+    Jd[0, 1] = t140
     Jd[0, 2] = t84
-    Jd[0, 3] = -t94
-    Jd[0, 4] = t106
-    Jd[0, 5] = t129
+    Jd[0, 3] = -t95
+    Jd[0, 4] = t107
+    Jd[0, 5] = t130
     Jd[1, 0] = t83
-    Jd[1, 1] = t140
+    Jd[1, 1] = t141
     Jd[1, 2] = t77
-    Jd[1, 3] = t95
-    Jd[1, 4] = t107
-    Jd[1, 5] = t130
+    Jd[1, 3] = t96
+    Jd[1, 4] = t108
+    Jd[1, 5] = t131
     Jd[2, 1] = -t85
     Jd[2, 2] = -t86
-    Jd[2, 3] = t90
-    Jd[2, 4] = t102
-    Jd[2, 5] = -t124
-    Jd[3, 1] = -t168 - t169 + t164 + t166
-    Jd[3, 2] = -t176 + t171 + t172 + t174
-    Jd[3, 3] = t178 + t179 + t180 + t181
-    Jd[3, 4] = t183 + t184 + t185 + t186
-    Jd[3, 5] = -t190 + t188 + t189 + t191
-    Jd[3, 6] = t193 + t194 + t195 + t196
-    Jd[4, 1] = t136*(-t15*t156 + c1*t154) + t137*(-t29*t156 + s1*t154) + t143*t197 - t144*t197
-    Jd[4, 2] = -t136*(t15*t157 + t22*t154) + t137*(-t29*t157 + t8*t154) - t87*t198 - t78*t199
-    Jd[4, 3] = -t136*(t15*t158 + t3*t154) - t137*(t29*t158 + t6*t154) - t96*t198 + t97*t199
-    Jd[4, 4] = t136*(-t15*t159 + t24*t154) - t137*(t29*t159 + t10*t154) - t108*t198 + t109*t199
-    Jd[4, 5] = t136*(-t15*t160 + t26*t154) + t137*(-t29*t160 + t12*t154) + t117*t198 + t118*t199
-    Jd[4, 6] = -t136*(t15*t161 + t28*t154) + t137*(-t29*t161 + t14*t154) - t133*t198 + t134*t199
-    Jd[5, 1] = t127*t146 - t55*t164 - t55*t166 + t55*t168 + t55*t169
-    Jd[5, 2] = t142 + t127*t153 - t55*t171 - t55*t172 - t55*t174 + t55*t176
-    Jd[5, 3] = -(-t91 + t55*t178 + t55*t179 + t55*t180 + t55*t181 - t127*t147)
-    Jd[5, 4] = -(-t103 + t55*t183 + t55*t184 + t55*t185 + t55*t186 - t127*t148)
-    Jd[5, 5] = t114 + t127*t149 - t55*t188 - t55*t189 + t55*t190 - t55*t191
-    Jd[5, 6] = -(-t125 + t55*t193 + t55*t194 + t55*t195 + t55*t196 - t127*t150)
+    Jd[2, 3] = t91
+    Jd[2, 4] = t103
+    Jd[2, 5] = -t125
+    Jd[3, 1] = -t167 - t168 + t163 + t165
+    Jd[3, 2] = -t175 + t170 + t171 + t173
+    Jd[3, 3] = t177 + t178 + t179 + t180
+    Jd[3, 4] = t182 + t183 + t184 + t185
+    Jd[3, 5] = -t189 + t187 + t188 + t190
+    Jd[3, 6] = t192 + t193 + t194 + t195
+    Jd[4, 1] = t137*(-t15*t155 + c1*t153) + t138*(-t29*t155 + s1*t153) + t142*t196 - t143*t196
+    Jd[4, 2] = -t137*(t15*t156 + t22*t153) + t138*(-t29*t156 + t8*t153) - t87*t197 - t78*t198
+    Jd[4, 3] = -t137*(t15*t157 + t3*t153) - t138*(t29*t157 + t6*t153) - t97*t197 + t98*t198
+    Jd[4, 4] = t137*(-t15*t158 + t24*t153) - t138*(t29*t158 + t10*t153) - t109*t197 + t110*t198
+    Jd[4, 5] = t137*(-t15*t159 + t26*t153) + t138*(-t29*t159 + t12*t153) + t118*t197 + t119*t198
+    Jd[4, 6] = -t137*(t15*t160 + t28*t153) + t138*(-t29*t160 + t14*t153) - t134*t197 + t135*t198
+    Jd[5, 1] = t128*t145 - t55*t163 - t55*t165 + t55*t167 + t55*t168
+    Jd[5, 2] = t88 + t128*t152 - t55*t170 - t55*t171 - t55*t173 + t55*t175
+    Jd[5, 3] = -(-t92 + t55*t177 + t55*t178 + t55*t179 + t55*t180 - t128*t146)
+    Jd[5, 4] = -(-t104 + t55*t182 + t55*t183 + t55*t184 + t55*t185 - t128*t147)
+    Jd[5, 5] = t115 + t128*t148 - t55*t187 - t55*t188 + t55*t189 - t55*t190
+    Jd[5, 6] = -(-t126 + t55*t192 + t55*t193 + t55*t194 + t55*t195 - t128*t149)
     return [Jd]
 
 
@@ -1722,7 +1718,7 @@ def _hessian(q):
 
 
 def _singularity_factors(q):
-    """Factors of det(Js Js^T): the robot is singular where one is 0: 723 operations."""
+    """Factors of det(Js Js^T): the robot is singular where one is 0: 722 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1843,7 +1839,7 @@ def _singularity_factors(q):
     t99 = -t72 + s1*t3
     t100 = t32*t86 + t34*t96 - t36*t99
     t101 = t32*t87 + t34*t97 - t35*t99
-    t102 = s1**2*s2 + t78
+    t102 = t78 + s1*t20
     t103 = t32*t89 + t33*t96 - t36*t102
     t104 = t32*t90 + t33*t97 - t35*t102
     t105 = t32*t92 + t33*t99 - t34*t102
@@ -1915,7 +1911,7 @@ def _singularity_factors(q):
 
 
 def _manipulability(q):
-    """Manipulability sqrt(det(Js Js^T)): 726 operations."""
+    """Manipulability sqrt(det(Js Js^T)): 725 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -2036,7 +2032,7 @@ def _manipulability(q):
     t99 = -t72 + s1*t3
     t100 = t32*t86 + t34*t96 - t36*t99
     t101 = t32*t87 + t34*t97 - t35*t99
-    t102 = s1**2*s2 + t78
+    t102 = t78 + s1*t20
     t103 = t32*t89 + t33*t96 - t36*t102
     t104 = t32*t90 + t33*t97 - t35*t102
     t105 = t32*t92 + t33*t99 - t34*t102

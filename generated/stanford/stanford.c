@@ -507,7 +507,7 @@ void stanford_task_jacobian(const stanford_real q[STANFORD_DOF], stanford_real J
 
 void stanford_fk_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanford_real q_dot[STANFORD_DOF], stanford_real T[16], stanford_real J[6 * STANFORD_DOF], stanford_real a[6])
 {
-    /* 179 operations */
+    /* 176 operations */
 
     /* Inputs */
     const stanford_real q1 = q[0];
@@ -582,8 +582,7 @@ void stanford_fk_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanfor
     const stanford_real t45 = s1*t5;
     const stanford_real t46 = c2*t38 - t3*qd1;
     const stanford_real t47 = t1*qd1 + c2*t33;
-    const stanford_real t48 = s2*qd2;
-    const stanford_real t49 = -((s1*s1)*t48 + (c1*c1)*t48);
+    const stanford_real t48 = -(t3*t33 + t1*t38);
 
     /* Outputs */
     T[0] = t19;
@@ -640,10 +639,10 @@ void stanford_fk_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanfor
     J[35] = t43;
     a[0] = -qd1*t37 + qd2*(c1*t32 - t45*qd1) + t46*qd3;
     a[1] = qd1*t42 + qd2*(s1*t32 + t44*qd1) + qd3*t47;
-    a[2] = -qd2*(s1*t36 + c1*t41) + qd3*t49;
+    a[2] = -qd2*(s1*t36 + c1*t41) + qd3*t48;
     a[3] = -t38*qd1 + t46*qd4 - qd5*(t10*t0 + t26*t39) - qd6*(t25*t40 + t18*t29);
     a[4] = qd6*(t12*t29 + t25*t35) - t33*qd1 + qd4*t47 + qd5*(t15*t0 + t26*t34);
-    a[5] = qd5*(t10*t34 - t15*t39) + qd6*(t18*t35 - t12*t40) + qd4*t49;
+    a[5] = qd5*(t10*t34 - t15*t39) + qd6*(t18*t35 - t12*t40) + qd4*t48;
 }
 
 void stanford_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanford_real q_dot[STANFORD_DOF], stanford_real Jd[6 * STANFORD_DOF])
@@ -830,7 +829,7 @@ void stanford_bias_acceleration(const stanford_real q[STANFORD_DOF], const stanf
 
 void stanford_task_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanford_real q_dot[STANFORD_DOF], stanford_real Jd[STANFORD_TASK_DIM * STANFORD_DOF])
 {
-    /* 337 operations */
+    /* 334 operations */
 
     /* Inputs */
     const stanford_real q1 = q[0];
@@ -888,124 +887,123 @@ void stanford_task_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanf
     const stanford_real t28 = -t27 + t0*qd4;
     const stanford_real t29 = t28;
     const stanford_real t30 = c1*qd2;
-    const stanford_real t31 = t30 + t2*qd4;
-    const stanford_real t32 = t31;
-    const stanford_real t33 = t9*t29 - t14*t32;
-    const stanford_real t34 = qd1 + c2*qd4;
-    const stanford_real t35 = t34;
-    const stanford_real t36 = t9*t35 + t25*t32;
-    const stanford_real t37 = t14*t35 + t25*t29;
-    const stanford_real t38 = t14*qd5;
-    const stanford_real t39 = t38 + t29;
-    const stanford_real t40 = t28 + t38 + t11*qd6;
-    const stanford_real t41 = t9*qd5;
-    const stanford_real t42 = t41 + t32;
-    const stanford_real t43 = t17*t39 - t11*t42;
-    const stanford_real t44 = t31 + t41 + t17*qd6;
-    const stanford_real t45 = t19*t40 - t18*t44;
-    const stanford_real t46 = -t25*qd5;
-    const stanford_real t47 = t46 + t35;
-    const stanford_real t48 = t24*t42 + t17*t47;
-    const stanford_real t49 = t11*t47 + t24*t39;
-    const stanford_real t50 = t34 + t46 - t24*qd6;
-    const stanford_real t51 = t26*t44 + t19*t50;
-    const stanford_real t52 = t18*t50 + t26*t40;
-    const stanford_real t53 = c2*t30;
-    const stanford_real t54 = t0*qd3 + q3*t53;
-    const stanford_real t55 = t54 - t3*qd1;
-    const stanford_real t56 = -t2*qd1 + t53;
-    const stanford_real t57 = c2*t27;
-    const stanford_real t58 = t2*qd3 + q3*t57;
-    const stanford_real t59 = t58 + t1*qd1;
-    const stanford_real t60 = t0*qd1 + t57;
-    const stanford_real t61 = s1*t58 + c1*t54;
-    const stanford_real t62 = q3*c2*qd1;
-    const stanford_real t63 = c1*t5 - s1*t62;
-    const stanford_real t64 = s1*t5 + c1*t62;
-    const stanford_real t65 = s2*qd2;
-    const stanford_real t66 = (s1*s1)*t65 + (c1*c1)*t65;
-    const stanford_real t67 = c1*t19;
-    const stanford_real t68 = s1*t18;
-    const stanford_real t69 = 1.0/t20;
-    const stanford_real t70 = (-t68 + t67)*t69;
-    const stanford_real t71 = (t14*t18 + t9*t19)*t69;
-    const stanford_real t72 = (t18*t11 + t19*t17)*t69;
-    const stanford_real t73 = c1*t18;
-    const stanford_real t74 = s1*t19;
-    const stanford_real t75 = t69*(s2*t73 + s2*t74);
-    const stanford_real t76 = 1.0/t21;
-    const stanford_real t77 = t69*t76;
-    const stanford_real t78 = (t73 + t74)*t77;
-    const stanford_real t79 = t77*(s2*t68 - s2*t67);
-    const stanford_real t80 = (t9*t18 - t14*t19)*t77;
-    const stanford_real t81 = (t18*t17 - t11*t19)*t77;
-    const stanford_real t82 = -t66;
-    const stanford_real t83 = 2*t70;
-    const stanford_real t84 = t51*t69;
-    const stanford_real t85 = -(s1 + t18*t83)*t84;
-    const stanford_real t86 = t52*t69;
-    const stanford_real t87 = (c1 - t19*t83)*t86;
-    const stanford_real t88 = qd1*t69;
-    const stanford_real t89 = t73*t88;
-    const stanford_real t90 = t74*t88;
-    const stanford_real t91 = 2*t75;
-    const stanford_real t92 = t84*(t0 - t18*t91);
-    const stanford_real t93 = t86*(t2 - t19*t91);
-    const stanford_real t94 = t18*t69;
-    const stanford_real t95 = t56*t94;
-    const stanford_real t96 = t19*t69;
-    const stanford_real t97 = t60*t96;
-    const stanford_real t98 = 2*t71;
-    const stanford_real t99 = t84*(t14 - t18*t98);
-    const stanford_real t100 = t86*(t9 - t19*t98);
-    const stanford_real t101 = t36*t94;
-    const stanford_real t102 = t37*t96;
-    const stanford_real t103 = 2*t72;
-    const stanford_real t104 = t84*(t11 - t18*t103);
-    const stanford_real t105 = t86*(t17 - t19*t103);
-    const stanford_real t106 = t48*t94;
-    const stanford_real t107 = t49*t96;
-    const stanford_real t108 = qd1*t76;
-    const stanford_real t109 = t19*t76;
-    const stanford_real t110 = t18*t76;
+    const stanford_real t31 = t2*t27 + t0*t30;
+    const stanford_real t32 = t30 + t2*qd4;
+    const stanford_real t33 = t32;
+    const stanford_real t34 = t9*t29 - t14*t33;
+    const stanford_real t35 = qd1 + c2*qd4;
+    const stanford_real t36 = t35;
+    const stanford_real t37 = t9*t36 + t25*t33;
+    const stanford_real t38 = t14*t36 + t25*t29;
+    const stanford_real t39 = t14*qd5;
+    const stanford_real t40 = t39 + t29;
+    const stanford_real t41 = t28 + t39 + t11*qd6;
+    const stanford_real t42 = t9*qd5;
+    const stanford_real t43 = t42 + t33;
+    const stanford_real t44 = t17*t40 - t11*t43;
+    const stanford_real t45 = t32 + t42 + t17*qd6;
+    const stanford_real t46 = t19*t41 - t18*t45;
+    const stanford_real t47 = -t25*qd5;
+    const stanford_real t48 = t47 + t36;
+    const stanford_real t49 = t24*t43 + t17*t48;
+    const stanford_real t50 = t11*t48 + t24*t40;
+    const stanford_real t51 = t35 + t47 - t24*qd6;
+    const stanford_real t52 = t26*t45 + t19*t51;
+    const stanford_real t53 = t18*t51 + t26*t41;
+    const stanford_real t54 = c2*t30;
+    const stanford_real t55 = t0*qd3 + q3*t54;
+    const stanford_real t56 = t55 - t3*qd1;
+    const stanford_real t57 = -t2*qd1 + t54;
+    const stanford_real t58 = c2*t27;
+    const stanford_real t59 = t2*qd3 + q3*t58;
+    const stanford_real t60 = t59 + t1*qd1;
+    const stanford_real t61 = t0*qd1 + t58;
+    const stanford_real t62 = s1*t59 + c1*t55;
+    const stanford_real t63 = q3*c2*qd1;
+    const stanford_real t64 = c1*t5 - s1*t63;
+    const stanford_real t65 = s1*t5 + c1*t63;
+    const stanford_real t66 = c1*t19;
+    const stanford_real t67 = s1*t18;
+    const stanford_real t68 = 1.0/t20;
+    const stanford_real t69 = (-t67 + t66)*t68;
+    const stanford_real t70 = (t14*t18 + t9*t19)*t68;
+    const stanford_real t71 = (t18*t11 + t19*t17)*t68;
+    const stanford_real t72 = c1*t18;
+    const stanford_real t73 = s1*t19;
+    const stanford_real t74 = t68*(s2*t72 + s2*t73);
+    const stanford_real t75 = 1.0/t21;
+    const stanford_real t76 = t68*t75;
+    const stanford_real t77 = (t72 + t73)*t76;
+    const stanford_real t78 = t76*(s2*t67 - s2*t66);
+    const stanford_real t79 = (t9*t18 - t14*t19)*t76;
+    const stanford_real t80 = (t18*t17 - t11*t19)*t76;
+    const stanford_real t81 = -t31;
+    const stanford_real t82 = 2*t69;
+    const stanford_real t83 = t52*t68;
+    const stanford_real t84 = -(s1 + t18*t82)*t83;
+    const stanford_real t85 = t53*t68;
+    const stanford_real t86 = (c1 - t19*t82)*t85;
+    const stanford_real t87 = qd1*t68;
+    const stanford_real t88 = t72*t87;
+    const stanford_real t89 = t73*t87;
+    const stanford_real t90 = 2*t74;
+    const stanford_real t91 = t83*(t0 - t18*t90);
+    const stanford_real t92 = t85*(t2 - t19*t90);
+    const stanford_real t93 = t18*t68;
+    const stanford_real t94 = t57*t93;
+    const stanford_real t95 = t19*t68;
+    const stanford_real t96 = t61*t95;
+    const stanford_real t97 = 2*t70;
+    const stanford_real t98 = t83*(t14 - t18*t97);
+    const stanford_real t99 = t85*(t9 - t19*t97);
+    const stanford_real t100 = t37*t93;
+    const stanford_real t101 = t38*t95;
+    const stanford_real t102 = 2*t71;
+    const stanford_real t103 = t83*(t11 - t18*t102);
+    const stanford_real t104 = t85*(t17 - t19*t102);
+    const stanford_real t105 = t49*t93;
+    const stanford_real t106 = t50*t95;
+    const stanford_real t107 = qd1*t75;
+    const stanford_real t108 = t19*t75;
+    const stanford_real t109 = t18*t75;
 
     /* Outputs */
-    Jd[0] = -t59;
-    Jd[1] = t63;
-    Jd[2] = t56;
+    Jd[0] = -t60;
+    Jd[1] = t64;
+    Jd[2] = t57;
     Jd[3] = 0;
     Jd[4] = 0;
     Jd[5] = 0;
-    Jd[6] = t55;
-    Jd[7] = t64;
-    Jd[8] = t60;
+    Jd[6] = t56;
+    Jd[7] = t65;
+    Jd[8] = t61;
     Jd[9] = 0;
     Jd[10] = 0;
     Jd[11] = 0;
     Jd[12] = 0;
-    Jd[13] = -t61;
-    Jd[14] = t82;
+    Jd[13] = -t62;
+    Jd[14] = t81;
     Jd[15] = 0;
     Jd[16] = 0;
     Jd[17] = 0;
     Jd[18] = 0;
-    Jd[19] = -(-t87 + t85 + t89 + t90);
+    Jd[19] = -(-t86 + t84 + t88 + t89);
     Jd[20] = 0;
-    Jd[21] = -t92 + t93 + t95 + t97;
-    Jd[22] = -t99 - t101 + t100 + t102;
-    Jd[23] = -t104 - t106 + t105 + t107;
+    Jd[21] = -t91 + t92 + t94 + t96;
+    Jd[22] = -t98 - t100 + t99 + t101;
+    Jd[23] = -t103 - t105 + t104 + t106;
     Jd[24] = 0;
-    Jd[25] = -t51*(-t18*t78 + c1*t76) + t52*(-t19*t78 + s1*t76) + t67*t108 - t68*t108;
+    Jd[25] = -t52*(-t18*t77 + c1*t75) + t53*(-t19*t77 + s1*t75) + t66*t107 - t67*t107;
     Jd[26] = 0;
-    Jd[27] = -t51*(-t18*t79 + t2*t76) - t52*(t19*t79 + t0*t76) - t56*t109 + t60*t110;
-    Jd[28] = -t51*(-t18*t80 + t9*t76) - t52*(t19*t80 + t14*t76) + t36*t109 + t37*t110;
-    Jd[29] = -t51*(-t18*t81 + t17*t76) - t52*(t19*t81 + t11*t76) + t48*t109 + t49*t110;
+    Jd[27] = -t52*(-t18*t78 + t2*t75) - t53*(t19*t78 + t0*t75) - t57*t108 + t61*t109;
+    Jd[28] = -t52*(-t18*t79 + t9*t75) - t53*(t19*t79 + t14*t75) + t37*t108 + t38*t109;
+    Jd[29] = -t52*(-t18*t80 + t17*t75) - t53*(t19*t80 + t11*t75) + t49*t108 + t50*t109;
     Jd[30] = 0;
-    Jd[31] = -(t45*t70 + t26*t85 - t26*t87 + t26*t89 + t26*t90);
+    Jd[31] = -(t46*t69 + t26*t84 - t26*t86 + t26*t88 + t26*t89);
     Jd[32] = 0;
-    Jd[33] = -t45*t75 + t82 - t26*t92 + t26*t93 + t26*t95 + t26*t97;
-    Jd[34] = t33 - t45*t71 - t26*t99 + t26*t100 - t26*t101 + t26*t102;
-    Jd[35] = t43 - t45*t72 - t26*t104 + t26*t105 - t26*t106 + t26*t107;
+    Jd[33] = -t46*t74 + t81 - t26*t91 + t26*t92 + t26*t94 + t26*t96;
+    Jd[34] = t34 - t46*t70 - t26*t98 + t26*t99 - t26*t100 + t26*t101;
+    Jd[35] = t44 - t46*t71 - t26*t103 + t26*t104 - t26*t105 + t26*t106;
 }
 
 void stanford_hessian(const stanford_real q[STANFORD_DOF], stanford_real H[STANFORD_DOF * 6 * STANFORD_DOF])

@@ -536,7 +536,7 @@ def task_jacobian(q):
 
 
 def fk_jacobian_dot(q, q_dot):
-    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 6 and 6 x 1), 179 operations."""
+    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 6 and 6 x 1), 176 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     q3 = q[..., 2]
     qd1 = q_dot[..., 0]
@@ -604,8 +604,7 @@ def fk_jacobian_dot(q, q_dot):
     t45 = s1*t5
     t46 = c2*t38 - t3*qd1
     t47 = t1*qd1 + c2*t33
-    t48 = s2*qd2
-    t49 = -(s1**2*t48 + c1**2*t48)
+    t48 = -(t3*t33 + t1*t38)
     T = _stack(xp, [
         xp.broadcast_to(t19, batch),  # 0, 0
         xp.broadcast_to(t20, batch),  # 0, 1
@@ -665,10 +664,10 @@ def fk_jacobian_dot(q, q_dot):
     a = _stack(xp, [
         xp.broadcast_to(-qd1*t37 + qd2*(c1*t32 - t45*qd1) + t46*qd3, batch),  # 0
         xp.broadcast_to(qd1*t42 + qd2*(s1*t32 + t44*qd1) + qd3*t47, batch),  # 1
-        xp.broadcast_to(-qd2*(s1*t36 + c1*t41) + qd3*t49, batch),  # 2
+        xp.broadcast_to(-qd2*(s1*t36 + c1*t41) + qd3*t48, batch),  # 2
         xp.broadcast_to(-t38*qd1 + t46*qd4 - qd5*(t10*t0 + t26*t39) - qd6*(t25*t40 + t18*t29), batch),  # 3
         xp.broadcast_to(qd6*(t12*t29 + t25*t35) - t33*qd1 + qd4*t47 + qd5*(t15*t0 + t26*t34), batch),  # 4
-        xp.broadcast_to(qd5*(t10*t34 - t15*t39) + qd6*(t18*t35 - t12*t40) + qd4*t49, batch),  # 5
+        xp.broadcast_to(qd5*(t10*t34 - t15*t39) + qd6*(t18*t35 - t12*t40) + qd4*t48, batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -844,7 +843,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 337 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 334 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     q3 = q[..., 2]
     qd1 = q_dot[..., 0]
@@ -895,123 +894,122 @@ def task_jacobian_dot(q, q_dot):
     t28 = -t27 + t0*qd4
     t29 = t28
     t30 = c1*qd2
-    t31 = t30 + t2*qd4
-    t32 = t31
-    t33 = t9*t29 - t14*t32
-    t34 = qd1 + c2*qd4
-    t35 = t34
-    t36 = t9*t35 + t25*t32
-    t37 = t14*t35 + t25*t29
-    t38 = t14*qd5
-    t39 = t38 + t29
-    t40 = t28 + t38 + t11*qd6
-    t41 = t9*qd5
-    t42 = t41 + t32
-    t43 = t17*t39 - t11*t42
-    t44 = t31 + t41 + t17*qd6
-    t45 = t19*t40 - t18*t44
-    t46 = -t25*qd5
-    t47 = t46 + t35
-    t48 = t24*t42 + t17*t47
-    t49 = t11*t47 + t24*t39
-    t50 = t34 + t46 - t24*qd6
-    t51 = t26*t44 + t19*t50
-    t52 = t18*t50 + t26*t40
-    t53 = c2*t30
-    t54 = t0*qd3 + q3*t53
-    t55 = t54 - t3*qd1
-    t56 = -t2*qd1 + t53
-    t57 = c2*t27
-    t58 = t2*qd3 + q3*t57
-    t59 = t58 + t1*qd1
-    t60 = t0*qd1 + t57
-    t61 = s1*t58 + c1*t54
-    t62 = q3*c2*qd1
-    t63 = c1*t5 - s1*t62
-    t64 = s1*t5 + c1*t62
-    t65 = s2*qd2
-    t66 = s1**2*t65 + c1**2*t65
-    t67 = c1*t19
-    t68 = s1*t18
-    t69 = 1/t20
-    t70 = (-t68 + t67)*t69
-    t71 = (t14*t18 + t9*t19)*t69
-    t72 = (t18*t11 + t19*t17)*t69
-    t73 = c1*t18
-    t74 = s1*t19
-    t75 = t69*(s2*t73 + s2*t74)
-    t76 = 1/t21
-    t77 = t69*t76
-    t78 = (t73 + t74)*t77
-    t79 = t77*(s2*t68 - s2*t67)
-    t80 = (t9*t18 - t14*t19)*t77
-    t81 = (t18*t17 - t11*t19)*t77
-    t82 = -t66
-    t83 = 2*t70
-    t84 = t51*t69
-    t85 = -(s1 + t18*t83)*t84
-    t86 = t52*t69
-    t87 = (c1 - t19*t83)*t86
-    t88 = qd1*t69
-    t89 = t73*t88
-    t90 = t74*t88
-    t91 = 2*t75
-    t92 = t84*(t0 - t18*t91)
-    t93 = t86*(t2 - t19*t91)
-    t94 = t18*t69
-    t95 = t56*t94
-    t96 = t19*t69
-    t97 = t60*t96
-    t98 = 2*t71
-    t99 = t84*(t14 - t18*t98)
-    t100 = t86*(t9 - t19*t98)
-    t101 = t36*t94
-    t102 = t37*t96
-    t103 = 2*t72
-    t104 = t84*(t11 - t18*t103)
-    t105 = t86*(t17 - t19*t103)
-    t106 = t48*t94
-    t107 = t49*t96
-    t108 = qd1*t76
-    t109 = t19*t76
-    t110 = t18*t76
+    t31 = t2*t27 + t0*t30
+    t32 = t30 + t2*qd4
+    t33 = t32
+    t34 = t9*t29 - t14*t33
+    t35 = qd1 + c2*qd4
+    t36 = t35
+    t37 = t9*t36 + t25*t33
+    t38 = t14*t36 + t25*t29
+    t39 = t14*qd5
+    t40 = t39 + t29
+    t41 = t28 + t39 + t11*qd6
+    t42 = t9*qd5
+    t43 = t42 + t33
+    t44 = t17*t40 - t11*t43
+    t45 = t32 + t42 + t17*qd6
+    t46 = t19*t41 - t18*t45
+    t47 = -t25*qd5
+    t48 = t47 + t36
+    t49 = t24*t43 + t17*t48
+    t50 = t11*t48 + t24*t40
+    t51 = t35 + t47 - t24*qd6
+    t52 = t26*t45 + t19*t51
+    t53 = t18*t51 + t26*t41
+    t54 = c2*t30
+    t55 = t0*qd3 + q3*t54
+    t56 = t55 - t3*qd1
+    t57 = -t2*qd1 + t54
+    t58 = c2*t27
+    t59 = t2*qd3 + q3*t58
+    t60 = t59 + t1*qd1
+    t61 = t0*qd1 + t58
+    t62 = s1*t59 + c1*t55
+    t63 = q3*c2*qd1
+    t64 = c1*t5 - s1*t63
+    t65 = s1*t5 + c1*t63
+    t66 = c1*t19
+    t67 = s1*t18
+    t68 = 1/t20
+    t69 = (-t67 + t66)*t68
+    t70 = (t14*t18 + t9*t19)*t68
+    t71 = (t18*t11 + t19*t17)*t68
+    t72 = c1*t18
+    t73 = s1*t19
+    t74 = t68*(s2*t72 + s2*t73)
+    t75 = 1/t21
+    t76 = t68*t75
+    t77 = (t72 + t73)*t76
+    t78 = t76*(s2*t67 - s2*t66)
+    t79 = (t9*t18 - t14*t19)*t76
+    t80 = (t18*t17 - t11*t19)*t76
+    t81 = -t31
+    t82 = 2*t69
+    t83 = t52*t68
+    t84 = -(s1 + t18*t82)*t83
+    t85 = t53*t68
+    t86 = (c1 - t19*t82)*t85
+    t87 = qd1*t68
+    t88 = t72*t87
+    t89 = t73*t87
+    t90 = 2*t74
+    t91 = t83*(t0 - t18*t90)
+    t92 = t85*(t2 - t19*t90)
+    t93 = t18*t68
+    t94 = t57*t93
+    t95 = t19*t68
+    t96 = t61*t95
+    t97 = 2*t70
+    t98 = t83*(t14 - t18*t97)
+    t99 = t85*(t9 - t19*t97)
+    t100 = t37*t93
+    t101 = t38*t95
+    t102 = 2*t71
+    t103 = t83*(t11 - t18*t102)
+    t104 = t85*(t17 - t19*t102)
+    t105 = t49*t93
+    t106 = t50*t95
+    t107 = qd1*t75
+    t108 = t19*t75
+    t109 = t18*t75
     Jd = _stack(xp, [
-        xp.broadcast_to(-t59, batch),  # 0, 0
-        xp.broadcast_to(t63, batch),  # 0, 1
-        xp.broadcast_to(t56, batch),  # 0, 2
+        xp.broadcast_to(-t60, batch),  # 0, 0
+        xp.broadcast_to(t64, batch),  # 0, 1
+        xp.broadcast_to(t57, batch),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        xp.broadcast_to(t55, batch),  # 1, 0
-        xp.broadcast_to(t64, batch),  # 1, 1
-        xp.broadcast_to(t60, batch),  # 1, 2
+        xp.broadcast_to(t56, batch),  # 1, 0
+        xp.broadcast_to(t65, batch),  # 1, 1
+        xp.broadcast_to(t61, batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t61, batch),  # 2, 1
-        xp.broadcast_to(t82, batch),  # 2, 2
+        xp.broadcast_to(-t62, batch),  # 2, 1
+        xp.broadcast_to(t81, batch),  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(-(-t87 + t85 + t89 + t90), batch),  # 3, 1
+        xp.broadcast_to(-(-t86 + t84 + t88 + t89), batch),  # 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
-        xp.broadcast_to(-t92 + t93 + t95 + t97, batch),  # 3, 3
-        xp.broadcast_to(-t99 - t101 + t100 + t102, batch),  # 3, 4
-        xp.broadcast_to(-t104 - t106 + t105 + t107, batch),  # 3, 5
+        xp.broadcast_to(-t91 + t92 + t94 + t96, batch),  # 3, 3
+        xp.broadcast_to(-t98 - t100 + t99 + t101, batch),  # 3, 4
+        xp.broadcast_to(-t103 - t105 + t104 + t106, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(-t51*(-t18*t78 + c1*t76) + t52*(-t19*t78 + s1*t76) + t67*t108 - t68*t108, batch),  # 4, 1
+        xp.broadcast_to(-t52*(-t18*t77 + c1*t75) + t53*(-t19*t77 + s1*t75) + t66*t107 - t67*t107, batch),  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
-        xp.broadcast_to(-t51*(-t18*t79 + t2*t76) - t52*(t19*t79 + t0*t76) - t56*t109 + t60*t110, batch),  # 4, 3
-        xp.broadcast_to(-t51*(-t18*t80 + t9*t76) - t52*(t19*t80 + t14*t76) + t36*t109 + t37*t110, batch),  # 4, 4
-        xp.broadcast_to(-t51*(-t18*t81 + t17*t76) - t52*(t19*t81 + t11*t76) + t48*t109 + t49*t110, batch),  # 4, 5
+        xp.broadcast_to(-t52*(-t18*t78 + t2*t75) - t53*(t19*t78 + t0*t75) - t57*t108 + t61*t109, batch),  # 4, 3
+        xp.broadcast_to(-t52*(-t18*t79 + t9*t75) - t53*(t19*t79 + t14*t75) + t37*t108 + t38*t109, batch),  # 4, 4
+        xp.broadcast_to(-t52*(-t18*t80 + t17*t75) - t53*(t19*t80 + t11*t75) + t49*t108 + t50*t109, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(t45*t70 + t26*t85 - t26*t87 + t26*t89 + t26*t90), batch),  # 5, 1
+        xp.broadcast_to(-(t46*t69 + t26*t84 - t26*t86 + t26*t88 + t26*t89), batch),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
-        xp.broadcast_to(-t45*t75 + t82 - t26*t92 + t26*t93 + t26*t95 + t26*t97, batch),  # 5, 3
-        xp.broadcast_to(t33 - t45*t71 - t26*t99 + t26*t100 - t26*t101 + t26*t102, batch),  # 5, 4
-        xp.broadcast_to(t43 - t45*t72 - t26*t104 + t26*t105 - t26*t106 + t26*t107, batch),  # 5, 5
+        xp.broadcast_to(-t46*t74 + t81 - t26*t91 + t26*t92 + t26*t94 + t26*t96, batch),  # 5, 3
+        xp.broadcast_to(t34 - t46*t70 - t26*t98 + t26*t99 - t26*t100 + t26*t101, batch),  # 5, 4
+        xp.broadcast_to(t44 - t46*t71 - t26*t103 + t26*t104 - t26*t105 + t26*t106, batch),  # 5, 5
     ], (6, 6))
     return Jd
 

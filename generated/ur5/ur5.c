@@ -297,7 +297,7 @@ void ur5_fk_jacobian(const ur5_real q[UR5_DOF], ur5_real T[16], ur5_real J[6 * U
 
 void ur5_jacobian_tool(const ur5_real q[UR5_DOF], ur5_real J[6 * UR5_DOF])
 {
-    /* 219 operations */
+    /* 217 operations */
 
     /* Inputs */
     const ur5_real q1 = q[0];
@@ -407,7 +407,7 @@ void ur5_jacobian_tool(const ur5_real q[UR5_DOF], ur5_real J[6 * UR5_DOF])
     J[32] = t45;
     J[33] = t45;
     J[34] = t6*t8 + c234*t21 - t3*t13;
-    J[35] = (t6*t6) + (t3*t3) + (s5*s5)*(s234*s234);
+    J[35] = (t6*t6) + (t3*t3) + (t21*t21);
 }
 
 void ur5_task(const ur5_real q[UR5_DOF], ur5_real mu[UR5_TASK_DIM])
@@ -590,7 +590,7 @@ void ur5_task_jacobian(const ur5_real q[UR5_DOF], ur5_real J[UR5_TASK_DIM * UR5_
 
 void ur5_fk_jacobian_dot(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_DOF], ur5_real T[16], ur5_real J[6 * UR5_DOF], ur5_real a[6])
 {
-    /* 294 operations */
+    /* 291 operations */
 
     /* Inputs */
     const ur5_real q1 = q[0];
@@ -704,7 +704,6 @@ void ur5_fk_jacobian_dot(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_DOF
     const ur5_real t78 = s1*t24;
     const ur5_real t79 = s1*t23;
     const ur5_real t80 = -c1;
-    const ur5_real t81 = t23*qd2;
 
     /* Outputs */
     T[0] = t9;
@@ -761,7 +760,7 @@ void ur5_fk_jacobian_dot(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_DOF
     J[35] = t75;
     a[0] = -qd1*t69 - qd2*(c1*t73 + qd1*t78) - qd3*(c1*t72 + t49*t41 + qd1*t79) - qd4*(t43*t51 + c1*t71 + t32*qd1) + qd5*(-t45*t56 - t37*qd1 + t13*t70 + t58*t37);
     a[1] = qd1*t64 + qd2*(-s1*t73 + qd1*t76) - qd3*(s1*t72 - qd1*t77 + t46*t41) - qd4*(t43*t48 + s1*t71 - t35*qd1) - qd5*(t45*t53 + t58*t34 + t8*t70 - t34*qd1);
-    a[2] = qd2*(s1*t68 + c1*t63) + qd3*(s1*t67 + c1*t62 + (s1*s1)*t81 + (c1*c1)*t81) + qd4*(s1*t66 + c1*t61 + t32*t48 + t35*t51) + qd5*(t37*t53 + t34*t56 + t8*t65 - t13*t60);
+    a[2] = qd2*(s1*t68 + c1*t63) + qd4*(s1*t66 + c1*t61 + t32*t48 + t35*t51) + qd5*(t37*t53 + t34*t56 + t8*t65 - t13*t60) + qd3*(s1*t67 + c1*t62 + t46*t79 + t49*t77);
     a[3] = t49*qd1 + t50*qd1 + t55*qd1 + qd5*(c234*t56 - t13*qd1) + qd6*(t3*t59 - t21*t57);
     a[4] = t46*qd1 + t47*qd1 + t52*qd1 + qd5*(c234*t53 + t8*qd1) + qd6*(t6*t59 + t21*t54);
     a[5] = qd4*(-c1*t48 + s1*t51) + qd5*(t13*t53 + t8*t56) - qd6*(t3*t54 + t6*t57);

@@ -47,7 +47,7 @@ void ur5_jacobian(const ur5_real q[UR5_DOF], ur5_real J[6 * UR5_DOF]);
 void ur5_fk_jacobian(const ur5_real q[UR5_DOF], ur5_real T[16], ur5_real J[6 * UR5_DOF]);
 
 /* Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz).
- * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 219 operations. */
+ * Result: J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 217 operations. */
 void ur5_jacobian_tool(const ur5_real q[UR5_DOF], ur5_real J[6 * UR5_DOF]);
 
 /* Task vector mu = (x, y, z, roll, pitch, yaw).
@@ -59,7 +59,7 @@ void ur5_task(const ur5_real q[UR5_DOF], ur5_real mu[UR5_TASK_DIM]);
 void ur5_task_jacobian(const ur5_real q[UR5_DOF], ur5_real J[UR5_TASK_DIM * UR5_DOF]);
 
 /* Fk, jacobian and bias_acceleration in one pass, sharing their terms.
- * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 294 operations. */
+ * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]; a[i], i < 6. 291 operations. */
 void ur5_fk_jacobian_dot(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_DOF], ur5_real T[16], ur5_real J[6 * UR5_DOF], ur5_real a[6]);
 
 /* Time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF).

@@ -344,7 +344,7 @@ def fk_jacobian(q):
 
 
 def jacobian_tool(q):
-    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 219 operations."""
+    """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 217 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -445,7 +445,7 @@ def jacobian_tool(q):
         t45,  # 5, 2
         t45,  # 5, 3
         t6*t8 + c234*t21 - t3*t13,  # 5, 4
-        t6**2 + t3**2 + s5**2*s234**2,  # 5, 5
+        t6**2 + t3**2 + t21**2,  # 5, 5
     ], (6, 6))
     return J
 
@@ -613,7 +613,7 @@ def task_jacobian(q):
 
 
 def fk_jacobian_dot(q, q_dot):
-    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 6 and 6 x 1), 294 operations."""
+    """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 6 and 6 x 1), 291 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -719,7 +719,6 @@ def fk_jacobian_dot(q, q_dot):
     t78 = s1*t24
     t79 = s1*t23
     t80 = -c1
-    t81 = t23*qd2
     T = _stack(xp, [
         xp.broadcast_to(t9, batch),  # 0, 0
         xp.broadcast_to(-t10, batch),  # 0, 1
@@ -779,7 +778,7 @@ def fk_jacobian_dot(q, q_dot):
     a = _stack(xp, [
         xp.broadcast_to(-qd1*t69 - qd2*(c1*t73 + qd1*t78) - qd3*(c1*t72 + t49*t41 + qd1*t79) - qd4*(t43*t51 + c1*t71 + t32*qd1) + qd5*(-t45*t56 - t37*qd1 + t13*t70 + t58*t37), batch),  # 0
         xp.broadcast_to(qd1*t64 + qd2*(-s1*t73 + qd1*t76) - qd3*(s1*t72 - qd1*t77 + t46*t41) - qd4*(t43*t48 + s1*t71 - t35*qd1) - qd5*(t45*t53 + t58*t34 + t8*t70 - t34*qd1), batch),  # 1
-        xp.broadcast_to(qd2*(s1*t68 + c1*t63) + qd3*(s1*t67 + c1*t62 + s1**2*t81 + c1**2*t81) + qd4*(s1*t66 + c1*t61 + t32*t48 + t35*t51) + qd5*(t37*t53 + t34*t56 + t8*t65 - t13*t60), batch),  # 2
+        xp.broadcast_to(qd2*(s1*t68 + c1*t63) + qd4*(s1*t66 + c1*t61 + t32*t48 + t35*t51) + qd5*(t37*t53 + t34*t56 + t8*t65 - t13*t60) + qd3*(s1*t67 + c1*t62 + t46*t79 + t49*t77), batch),  # 2
         xp.broadcast_to(t49*qd1 + t50*qd1 + t55*qd1 + qd5*(c234*t56 - t13*qd1) + qd6*(t3*t59 - t21*t57), batch),  # 3
         xp.broadcast_to(t46*qd1 + t47*qd1 + t52*qd1 + qd5*(c234*t53 + t8*qd1) + qd6*(t6*t59 + t21*t54), batch),  # 4
         xp.broadcast_to(qd4*(-c1*t48 + s1*t51) + qd5*(t13*t53 + t8*t56) - qd6*(t3*t54 + t6*t57), batch),  # 5

@@ -270,7 +270,7 @@ def _fk_jacobian(q):
 
 
 def _jacobian_tool(q):
-    """Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): 219 operations."""
+    """Geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): 217 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -372,7 +372,7 @@ def _jacobian_tool(q):
     J[5, 2] = t45
     J[5, 3] = t45
     J[5, 4] = t6*t8 + c234*t21 - t3*t13
-    J[5, 5] = t6**2 + t3**2 + s5**2*s234**2
+    J[5, 5] = t6**2 + t3**2 + t21**2
     return [J]
 
 
@@ -539,7 +539,7 @@ def _task_jacobian(q):
 
 
 def _fk_jacobian_dot(q, q_dot):
-    """Fk, jacobian and bias_acceleration in one pass, sharing their terms: 294 operations."""
+    """Fk, jacobian and bias_acceleration in one pass, sharing their terms: 291 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -649,7 +649,6 @@ def _fk_jacobian_dot(q, q_dot):
     t78 = s1*t24
     t79 = s1*t23
     t80 = -c1
-    t81 = t23*qd2
     T = casadi.SX(4, 4)
     T[0, 0] = t9
     T[0, 1] = -t10
@@ -695,7 +694,7 @@ def _fk_jacobian_dot(q, q_dot):
     a = casadi.SX(6, 1)
     a[0, 0] = -qd1*t69 - qd2*(c1*t73 + qd1*t78) - qd3*(c1*t72 + t49*t41 + qd1*t79) - qd4*(t43*t51 + c1*t71 + t32*qd1) + qd5*(-t45*t56 - t37*qd1 + t13*t70 + t58*t37)
     a[1, 0] = qd1*t64 + qd2*(-s1*t73 + qd1*t76) - qd3*(s1*t72 - qd1*t77 + t46*t41) - qd4*(t43*t48 + s1*t71 - t35*qd1) - qd5*(t45*t53 + t58*t34 + t8*t70 - t34*qd1)
-    a[2, 0] = qd2*(s1*t68 + c1*t63) + qd3*(s1*t67 + c1*t62 + s1**2*t81 + c1**2*t81) + qd4*(s1*t66 + c1*t61 + t32*t48 + t35*t51) + qd5*(t37*t53 + t34*t56 + t8*t65 - t13*t60)
+    a[2, 0] = qd2*(s1*t68 + c1*t63) + qd4*(s1*t66 + c1*t61 + t32*t48 + t35*t51) + qd5*(t37*t53 + t34*t56 + t8*t65 - t13*t60) + qd3*(s1*t67 + c1*t62 + t46*t79 + t49*t77)
     a[3, 0] = t49*qd1 + t50*qd1 + t55*qd1 + qd5*(c234*t56 - t13*qd1) + qd6*(t3*t59 - t21*t57)
     a[4, 0] = t46*qd1 + t47*qd1 + t52*qd1 + qd5*(c234*t53 + t8*qd1) + qd6*(t6*t59 + t21*t54)
     a[5, 0] = qd4*(-c1*t48 + s1*t51) + qd5*(t13*t53 + t8*t56) - qd6*(t3*t54 + t6*t57)

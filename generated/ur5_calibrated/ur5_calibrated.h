@@ -99,7 +99,7 @@ int ur5_calibrated_velocity_ik(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], 
 ur5_calibrated_real ur5_calibrated_ik_numeric_step(const ur5_calibrated_real target[16], const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real damping, ur5_calibrated_real q_start[UR5_CALIBRATED_DOF], ur5_calibrated_real q_next[UR5_CALIBRATED_DOF]);
 
 /* The general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9).
- * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 1360 operations. */
+ * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 1328 operations. */
 void ur5_calibrated_ik_general_equations(const ur5_calibrated_real T[16], ur5_calibrated_real P[378], ur5_calibrated_real Q[112]);
 
 /* The configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop).

@@ -9,6 +9,7 @@ language.
 """
 
 import heapq
+from collections import Counter
 from fractions import Fraction
 from dataclasses import dataclass
 from functools import cached_property
@@ -381,7 +382,87 @@ def eliminate_common(graph: Graph, exprs: list[Node], symbols, negations: dict) 
             return named[node]
         return new
 
-    return replacements, [rebuild(expr) for expr in exprs]
+    outputs = [rebuild(expr) for expr in exprs]
+    return _reusing_temporaries(graph, replacements, outputs)
+
+
+def _reusing_temporaries(graph: Graph, replacements: list, outputs: list[Node]) -> tuple[list, list[Node]]:
+    """Sums and products read the temporaries CSE made where that costs fewer operations:
+    `match_common_args` is greedy and leaves some (0.07*c2*s5*t2 beside t6 = c2*s5). A sum
+    holding all of a temporary's terms reads it, the largest first; a product is written out
+    to its factors (product temporaries without a number expanded: s2*s3*c5*t4, t4 = c3*c4)
+    and covered by the largest temporaries that fit (t12*c3*s3, t12 = s2*c4*c5), if that has
+    fewer factors. A product temporary reads only smaller ones, so none reads itself."""
+    values = {graph.symbol(symbol): value for symbol, value in replacements}
+    sums = {}  # a first term -> the sum temporaries starting with it: (symbol, terms)
+    written: dict[Node, Counter] = {}  # a product temporary without a number -> its factors written out
+    leaves: dict[Node, Counter] = {}  # any other factor -> itself (a power: its base, so many times)
+
+    def written_out(node: Node) -> Counter:
+        value = values.get(node)
+        if value is not None and value.kind == MUL and value.args[0].kind != NUMBER:
+            if node not in written:
+                written[node] = sum((written_out(factor) for factor in value.args), Counter())
+            return written[node]
+        if node not in leaves:
+            power = node.kind == POW and node.args[1].value.is_integer and node.args[1].value > 0
+            leaves[node] = Counter({node.args[0]: int(node.args[1].value)} if power else {node: 1})
+        return leaves[node]
+
+    for symbol, value in values.items():
+        if value.kind == ADD:
+            sums.setdefault(value.args[0], []).append((symbol, frozenset(value.args)))
+        elif value.kind == MUL and value.args[0].kind != NUMBER:
+            written_out(symbol)
+    products = {}  # a factor -> the product temporaries written out with it
+    for symbol, counter in written.items():
+        products.setdefault(min(counter, key=lambda n: n.index), []).append(symbol)
+    done: dict[Node, Node] = {}
+
+    sizes = {t: sum(counter.values()) for t, counter in written.items()}
+
+    def covered(node: Node, own: Node | None) -> Node:
+        number = node.args[:1] if node.args[0].kind == NUMBER else ()
+        left = Counter()
+        for factor in node.args[len(number):]:
+            left.update(written_out(factor))
+        candidates = {t for factor in left for t in products.get(factor, ())
+                      if t is not own and (own not in sizes or (sizes[t], t.index) < (sizes[own], own.index))}
+        if not candidates:
+            return node
+        used = []
+        for t in sorted(candidates, key=lambda t: (-sizes[t], t.index)):
+            while all(left[f] >= k for f, k in written[t].items()):
+                left -= written[t]
+                used.append(t)
+        factors = used + [base if k == 1 else graph.power(base, k) for base, k in left.items()]
+        cost = lambda fs: len(fs) + sum(f.kind == POW for f in fs)  # noqa: E731
+        return graph.mul(*number, *factors) if used and cost(factors) < cost(node.args[len(number):]) else node
+
+    def reusing(node: Node, own: Node | None = None) -> Node:
+        if not node.args:
+            return node
+        if own is None and node in done:
+            return done[node]
+        args = [reusing(arg) if arg.args else arg for arg in node.args]
+        new = node if all(a is b for a, b in zip(args, node.args)) else _rebuilt(graph, node, args)
+        if new.kind == MUL and products:
+            new = covered(new, own)
+        elif new.kind == ADD and sums:
+            terms, used = set(new.args), []
+            for symbol, parts in sorted({c for term in new.args for c in sums.get(term, ())},
+                                        key=lambda c: (-len(c[1]), c[0].index)):
+                if symbol is not own and parts < frozenset(new.args) and parts <= terms:
+                    terms -= parts
+                    used.append(symbol)
+            if used:
+                new = graph.add(*(term for term in new.args if term in terms), *used)
+        if own is None:
+            done[node] = new
+        return new
+
+    replacements = [(symbol, reusing(value, graph.symbol(symbol))) for symbol, value in replacements]
+    return replacements, [reusing(expr) for expr in outputs]
 
 
 def _negation(graph: Graph, node: Node) -> Node | None:
