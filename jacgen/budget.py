@@ -25,6 +25,7 @@ A fallback makes the output depend on the machine's speed: the warning says so, 
 generated files are otherwise byte-identical everywhere.
 """
 
+import gc
 import signal
 import sys
 import threading
@@ -129,10 +130,13 @@ def _on_alarm(signum, frame) -> None:
 
 def _on_the_side(frame) -> bool:
     """Whether `frame` runs beside the work rather than in it: a finalizer, or a hook that Python
-    calls on the side (an exception raised there is only printed, "Exception ignored in ...",
-    and the work goes on). The next tick, 5 ms later, lands in the work instead."""
+    calls on the side, a garbage collector's callback among them (an exception raised there is
+    only printed, "Exception ignored in ...", and the work goes on). The next tick, 5 ms later,
+    lands in the work instead."""
+    collector = {getattr(callback, "__code__", None) for callback in gc.callbacks}
     while frame is not None and frame.f_code is not within_budget.__code__:
-        if frame.f_code.co_name == "__del__" or frame.f_globals.get("__name__", "").startswith(_SIDE_MODULES):
+        if (frame.f_code.co_name == "__del__" or frame.f_code in collector
+                or frame.f_globals.get("__name__", "").startswith(_SIDE_MODULES)):
             return True
         frame = frame.f_back
     return False

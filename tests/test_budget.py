@@ -1,8 +1,10 @@
 """The time budget of symbolic steps: runaway sympy work is interrupted on time, the cheaper
 fallback is used with one warning, and everything else behaves as if there were no budget."""
 
+import gc
 import random
 import signal
+import sys
 import threading
 import time
 
@@ -138,3 +140,31 @@ def test_analysis_out_of_budget_falls_back_to_the_numeric_condition(capsys):
         budget.set_seconds(budget.DEFAULT_SECONDS)
     assert not singular.complete and not singular.factors and "--budget" in singular.note
     assert "the singularity analysis of panda took longer than 0.01 s" in capsys.readouterr().err
+
+
+
+def test_an_alarm_in_a_garbage_collector_callback_waits_for_the_work(monkeypatch):
+    """A gc callback runs inside whatever allocation triggered the collection; an interruption
+    raised there would only be printed ("Exception ignored in ...") and lost. The alarm waits
+    for the next tick, in the work, which falls back."""
+    ignored = []
+    monkeypatch.setattr(sys, "unraisablehook", ignored.append)
+
+    def slow_callback(phase, info):
+        if phase == "start":
+            spin(0.02)
+
+    def work():
+        end = time.monotonic() + 5
+        while time.monotonic() < end:
+            cycle = []
+            cycle.append(cycle)  # garbage that only the collector frees
+        return "finished"
+
+    gc.callbacks.append(slow_callback)
+    try:
+        result = budget.within_budget(work, lambda: "fallback", what="a gc test", seconds=0.3)
+    finally:
+        gc.callbacks.remove(slow_callback)
+    assert result == "fallback"
+    assert ignored == []
