@@ -143,7 +143,7 @@ void planar_2r_jacobian_tool(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_re
     const planar_2r_real t1 = s1 + s12;
 
     /* Outputs */
-    J[0] = s12*t0 - c12*t1;
+    J[0] = t0*s12 - c12*t1;
     J[1] = 0;
     J[2] = c12*t0 + s12*t1;
     J[3] = (c12*c12) + (s12*s12);

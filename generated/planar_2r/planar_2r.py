@@ -196,7 +196,7 @@ def jacobian_tool(q):
     t0 = c1 + c12
     t1 = s1 + s12
     J = _stack(xp, [
-        s12*t0 - c12*t1,  # 0, 0
+        t0*s12 - c12*t1,  # 0, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 1
         c12*t0 + s12*t1,  # 1, 0
         c12**2 + s12**2,  # 1, 1

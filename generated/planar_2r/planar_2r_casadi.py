@@ -107,7 +107,7 @@ def _jacobian_tool(q):
     t0 = c1 + c12
     t1 = s1 + s12
     J = casadi.SX(6, 2)
-    J[0, 0] = s12*t0 - c12*t1
+    J[0, 0] = t0*s12 - c12*t1
     J[1, 0] = c12*t0 + s12*t1
     J[1, 1] = c12**2 + s12**2
     J[5, 0] = 1

@@ -191,11 +191,11 @@ void scara_jacobian_tool(const scara_real q[SCARA_DOF], scara_real J[6 * SCARA_D
     const scara_real t5 = 0.325*s1 + t4;
 
     /* Outputs */
-    J[0] = t1*t3 - t0*t5;
+    J[0] = t3*t1 - t5*t0;
     J[1] = -t0*t4 + t1*t2;
     J[2] = 0;
     J[3] = 0;
-    J[4] = -(t0*t3 + t1*t5);
+    J[4] = -(t3*t0 + t5*t1);
     J[5] = -(t0*t2 + t1*t4);
     J[6] = 0;
     J[7] = 0;

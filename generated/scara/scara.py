@@ -241,11 +241,11 @@ def jacobian_tool(q):
     t4 = 0.275*s12
     t5 = 0.325*s1 + t4
     J = _stack(xp, [
-        t1*t3 - t0*t5,  # 0, 0
+        t3*t1 - t5*t0,  # 0, 0
         -t0*t4 + t1*t2,  # 0, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
-        -(t0*t3 + t1*t5),  # 1, 0
+        -(t3*t0 + t5*t1),  # 1, 0
         -(t0*t2 + t1*t4),  # 1, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3

@@ -43,18 +43,18 @@ void stanford_fk(const stanford_real q[STANFORD_DOF], stanford_real T[16])
     const stanford_real t13 = t6*c5 - s5*t12;
     const stanford_real t14 = t6*s5 + c5*t12;
     const stanford_real t15 = t10*s6 + t13*c6;
-    const stanford_real t16 = t10*c6 - s6*t13;
+    const stanford_real t16 = t10*c6 - t13*s6;
     const stanford_real t17 = s1*s2;
-    const stanford_real t18 = c5*t11 - s5*t17;
-    const stanford_real t19 = s5*t11 + c5*t17;
-    const stanford_real t20 = s6*t7 + c6*t18;
-    const stanford_real t21 = c6*t7 - s6*t18;
+    const stanford_real t18 = t11*c5 - s5*t17;
+    const stanford_real t19 = t11*s5 + c5*t17;
+    const stanford_real t20 = t7*s6 + t18*c6;
+    const stanford_real t21 = t7*c6 - t18*s6;
     const stanford_real t22 = s2*s4;
     const stanford_real t23 = c2*s5 + c5*t22;
     const stanford_real t24 = -c2*c5 + s5*t22;
     const stanford_real t25 = s2*c4;
-    const stanford_real t26 = c6*t23 + s6*t25;
-    const stanford_real t27 = s6*t23 - c6*t25;
+    const stanford_real t26 = t23*c6 + s6*t25;
+    const stanford_real t27 = t23*s6 - c6*t25;
 
     /* Outputs */
     T[0] = t15;
@@ -109,7 +109,7 @@ void stanford_jacobian(const stanford_real q[STANFORD_DOF], stanford_real J[6 * 
     const stanford_real t11 = c1*c4;
     const stanford_real t12 = -t10 + c2*t11;
     const stanford_real t13 = -t11 + c2*t10;
-    const stanford_real t14 = s5*t13 + c5*t3;
+    const stanford_real t14 = t13*s5 + c5*t3;
     const stanford_real t15 = q3*c2;
 
     /* Outputs */
@@ -190,18 +190,18 @@ void stanford_fk_jacobian(const stanford_real q[STANFORD_DOF], stanford_real T[1
     const stanford_real t13 = c1*c4;
     const stanford_real t14 = -t12 + c2*t13;
     const stanford_real t15 = -t13 + c2*t12;
-    const stanford_real t16 = c5*t15 - s5*t2;
-    const stanford_real t17 = s5*t15 + c5*t2;
+    const stanford_real t16 = t15*c5 - s5*t2;
+    const stanford_real t17 = t15*s5 + c5*t2;
     const stanford_real t18 = t14*s6 + t10*c6;
-    const stanford_real t19 = t14*c6 - s6*t10;
-    const stanford_real t20 = s6*t9 + c6*t16;
-    const stanford_real t21 = c6*t9 - s6*t16;
+    const stanford_real t19 = t14*c6 - t10*s6;
+    const stanford_real t20 = t9*s6 + t16*c6;
+    const stanford_real t21 = t9*c6 - t16*s6;
     const stanford_real t22 = s2*s4;
     const stanford_real t23 = c2*s5 + c5*t22;
     const stanford_real t24 = -c2*c5 + s5*t22;
     const stanford_real t25 = s2*c4;
-    const stanford_real t26 = c6*t23 + s6*t25;
-    const stanford_real t27 = s6*t23 - c6*t25;
+    const stanford_real t26 = t23*c6 + s6*t25;
+    const stanford_real t27 = t23*s6 - c6*t25;
     const stanford_real t28 = -t24;
 
     /* Outputs */
@@ -297,18 +297,18 @@ void stanford_jacobian_tool(const stanford_real q[STANFORD_DOF], stanford_real J
     const stanford_real t12 = t5*c5 - s5*t11;
     const stanford_real t13 = t5*s5 + c5*t11;
     const stanford_real t14 = t9*s6 + t12*c6;
-    const stanford_real t15 = t9*c6 - s6*t12;
+    const stanford_real t15 = t9*c6 - t12*s6;
     const stanford_real t16 = s1*s2;
-    const stanford_real t17 = c5*t10 - s5*t16;
-    const stanford_real t18 = s5*t10 + c5*t16;
-    const stanford_real t19 = s6*t6 + c6*t17;
-    const stanford_real t20 = c6*t6 - s6*t17;
+    const stanford_real t17 = t10*c5 - s5*t16;
+    const stanford_real t18 = t10*s5 + c5*t16;
+    const stanford_real t19 = t6*s6 + t17*c6;
+    const stanford_real t20 = t6*c6 - t17*s6;
     const stanford_real t21 = s2*s4;
     const stanford_real t22 = c2*s5 + c5*t21;
     const stanford_real t23 = -c2*c5 + s5*t21;
     const stanford_real t24 = s2*c4;
-    const stanford_real t25 = c6*t22 + s6*t24;
-    const stanford_real t26 = s6*t22 - c6*t24;
+    const stanford_real t25 = t22*c6 + s6*t24;
+    const stanford_real t26 = t22*s6 - c6*t24;
     const stanford_real t27 = -(c1*t1 + s1*t2);
     const stanford_real t28 = q3*c2;
     const stanford_real t29 = c1*t28;
@@ -318,19 +318,19 @@ void stanford_jacobian_tool(const stanford_real q[STANFORD_DOF], stanford_real J
     const stanford_real t33 = -c2*t23 + t13*t11 + t18*t16;
 
     /* Outputs */
-    J[0] = t1*t19 - t14*t2;
+    J[0] = t1*t19 - t2*t14;
     J[1] = -t25*t27 + t14*t29 + t19*t30;
     J[2] = t31;
     J[3] = 0;
     J[4] = 0;
     J[5] = 0;
-    J[6] = t1*t20 - t15*t2;
+    J[6] = t1*t20 - t2*t15;
     J[7] = t26*t27 + t15*t29 + t20*t30;
     J[8] = t32;
     J[9] = 0;
     J[10] = 0;
     J[11] = 0;
-    J[12] = t1*t18 - t13*t2;
+    J[12] = t1*t18 - t2*t13;
     J[13] = -t23*t27 + t13*t29 + t18*t30;
     J[14] = t33;
     J[15] = 0;
@@ -341,13 +341,13 @@ void stanford_jacobian_tool(const stanford_real q[STANFORD_DOF], stanford_real J
     J[20] = 0;
     J[21] = t31;
     J[22] = t9*t14 + t6*t19 + t25*t24;
-    J[23] = t14*t13 + t19*t18 + t25*t23;
+    J[23] = t13*t14 + t18*t19 + t23*t25;
     J[24] = t26;
     J[25] = c1*t20 - s1*t15;
     J[26] = 0;
     J[27] = t32;
     J[28] = t9*t15 + t6*t20 - t26*t24;
-    J[29] = t15*t13 + t20*t18 - t26*t23;
+    J[29] = t13*t15 + t18*t20 - t23*t26;
     J[30] = -t23;
     J[31] = c1*t18 - s1*t13;
     J[32] = 0;
@@ -394,13 +394,13 @@ void stanford_task(const stanford_real q[STANFORD_DOF], stanford_real mu[STANFOR
     const stanford_real t12 = -t10 + c2*t9;
     const stanford_real t13 = s2*s5;
     const stanford_real t14 = t7*c5 - c1*t13;
-    const stanford_real t15 = c5*t12 - s1*t13;
+    const stanford_real t15 = t12*c5 - s1*t13;
     const stanford_real t16 = -c2*c5 + s4*t13;
     const stanford_real t17 = t11*s6 + t14*c6;
-    const stanford_real t18 = s6*t8 + c6*t15;
+    const stanford_real t18 = t8*s6 + t15*c6;
     const stanford_real t19 = s2*c4;
-    const stanford_real t20 = c6*t1 + s6*t19;
-    const stanford_real t21 = s6*t1 - c6*t19;
+    const stanford_real t20 = t1*c6 + s6*t19;
+    const stanford_real t21 = t1*s6 - c6*t19;
 
     /* Outputs */
     mu[0] = t3;
@@ -448,22 +448,22 @@ void stanford_task_jacobian(const stanford_real q[STANFORD_DOF], stanford_real J
     const stanford_real t11 = c1*c4;
     const stanford_real t12 = -t10 + c2*t11;
     const stanford_real t13 = -t11 + c2*t10;
-    const stanford_real t14 = c5*t13 - s5*t2;
-    const stanford_real t15 = s5*t13 + c5*t2;
+    const stanford_real t14 = t13*c5 - s5*t2;
+    const stanford_real t15 = t13*s5 + c5*t2;
     const stanford_real t16 = t12*s6 + t8*c6;
-    const stanford_real t17 = s6*t7 + c6*t14;
+    const stanford_real t17 = t7*s6 + t14*c6;
     const stanford_real t18 = s2*s4;
     const stanford_real t19 = c2*s5 + c5*t18;
     const stanford_real t20 = -c2*c5 + s5*t18;
     const stanford_real t21 = s2*c4;
-    const stanford_real t22 = c6*t19 + s6*t21;
+    const stanford_real t22 = t19*c6 + s6*t21;
     const stanford_real t23 = q3*c2;
     const stanford_real t24 = (t16*t16) + (t17*t17);
     const stanford_real t25 = 1.0/t24;
     const stanford_real t26 = (c1*t17 - s1*t16)*t25;
     const stanford_real t27 = t25*(t16*t0 + t17*t2);
     const stanford_real t28 = t25*(t12*t16 + t7*t17);
-    const stanford_real t29 = t25*(t16*t9 + t17*t15);
+    const stanford_real t29 = t25*(t9*t16 + t15*t17);
     const stanford_real t30 = 1.0/sqrt(t24);
 
     /* Outputs */
@@ -496,7 +496,7 @@ void stanford_task_jacobian(const stanford_real q[STANFORD_DOF], stanford_real J
     J[26] = 0;
     J[27] = t30*(t16*t2 - t17*t0);
     J[28] = t30*(t7*t16 - t12*t17);
-    J[29] = t30*(t16*t15 - t9*t17);
+    J[29] = t30*(t15*t16 - t9*t17);
     J[30] = 1;
     J[31] = t22*t26;
     J[32] = 0;
@@ -551,18 +551,18 @@ void stanford_fk_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanfor
     const stanford_real t14 = c1*c4;
     const stanford_real t15 = -t13 + c2*t14;
     const stanford_real t16 = -t14 + c2*t13;
-    const stanford_real t17 = c5*t16 - s5*t3;
-    const stanford_real t18 = s5*t16 + c5*t3;
+    const stanford_real t17 = t16*c5 - s5*t3;
+    const stanford_real t18 = t16*s5 + c5*t3;
     const stanford_real t19 = t15*s6 + t11*c6;
-    const stanford_real t20 = t15*c6 - s6*t11;
-    const stanford_real t21 = s6*t10 + c6*t17;
-    const stanford_real t22 = c6*t10 - s6*t17;
+    const stanford_real t20 = t15*c6 - t11*s6;
+    const stanford_real t21 = t10*s6 + t17*c6;
+    const stanford_real t22 = t10*c6 - t17*s6;
     const stanford_real t23 = s2*s4;
     const stanford_real t24 = c2*s5 + c5*t23;
     const stanford_real t25 = -c2*c5 + s5*t23;
     const stanford_real t26 = s2*c4;
-    const stanford_real t27 = c6*t24 + s6*t26;
-    const stanford_real t28 = s6*t24 - c6*t26;
+    const stanford_real t27 = t24*c6 + s6*t26;
+    const stanford_real t28 = t24*s6 - c6*t26;
     const stanford_real t29 = t0 - t26*qd5;
     const stanford_real t30 = c1*t2 + s1*t4;
     const stanford_real t31 = t30;
@@ -687,7 +687,7 @@ void stanford_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanford_r
     const stanford_real t14 = -t12 + c2*t11;
     const stanford_real t15 = s2*c5;
     const stanford_real t16 = t9*s5 + c1*t15;
-    const stanford_real t17 = s5*t14 + s1*t15;
+    const stanford_real t17 = t14*s5 + s1*t15;
     const stanford_real t18 = s1*qd2;
     const stanford_real t19 = s2*qd4;
     const stanford_real t20 = -t18 + c1*t19;
@@ -794,7 +794,7 @@ void stanford_bias_acceleration(const stanford_real q[STANFORD_DOF], const stanf
     const stanford_real t14 = -t12 + c2*t11;
     const stanford_real t15 = s2*c5;
     const stanford_real t16 = t9*s5 + c1*t15;
-    const stanford_real t17 = s5*t14 + s1*t15;
+    const stanford_real t17 = t14*s5 + s1*t15;
     const stanford_real t18 = s1*qd2;
     const stanford_real t19 = s2*qd4;
     const stanford_real t20 = -t18 + c1*t19;
@@ -872,17 +872,17 @@ void stanford_task_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanf
     const stanford_real t13 = c1*c4;
     const stanford_real t14 = -t12 + c2*t13;
     const stanford_real t15 = -t13 + c2*t12;
-    const stanford_real t16 = c5*t15 - s5*t2;
-    const stanford_real t17 = s5*t15 + c5*t2;
+    const stanford_real t16 = t15*c5 - s5*t2;
+    const stanford_real t17 = t15*s5 + c5*t2;
     const stanford_real t18 = t14*s6 + t10*c6;
-    const stanford_real t19 = s6*t9 + c6*t16;
+    const stanford_real t19 = t9*s6 + t16*c6;
     const stanford_real t20 = (t18*t18) + (t19*t19);
     const stanford_real t21 = sqrt(t20);
     const stanford_real t22 = s2*s4;
     const stanford_real t23 = c2*s5 + c5*t22;
     const stanford_real t24 = -c2*c5 + s5*t22;
     const stanford_real t25 = s2*c4;
-    const stanford_real t26 = c6*t23 + s6*t25;
+    const stanford_real t26 = t23*c6 + s6*t25;
     const stanford_real t27 = s1*qd2;
     const stanford_real t28 = -t27 + t0*qd4;
     const stanford_real t29 = t28;
@@ -927,7 +927,7 @@ void stanford_task_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanf
     const stanford_real t68 = 1.0/t20;
     const stanford_real t69 = (-t67 + t66)*t68;
     const stanford_real t70 = (t14*t18 + t9*t19)*t68;
-    const stanford_real t71 = (t18*t11 + t19*t17)*t68;
+    const stanford_real t71 = (t11*t18 + t17*t19)*t68;
     const stanford_real t72 = c1*t18;
     const stanford_real t73 = s1*t19;
     const stanford_real t74 = t68*(s2*t72 + s2*t73);
@@ -936,7 +936,7 @@ void stanford_task_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanf
     const stanford_real t77 = (t72 + t73)*t76;
     const stanford_real t78 = t76*(s2*t67 - s2*t66);
     const stanford_real t79 = (t9*t18 - t14*t19)*t76;
-    const stanford_real t80 = (t18*t17 - t11*t19)*t76;
+    const stanford_real t80 = (t17*t18 - t11*t19)*t76;
     const stanford_real t81 = -t31;
     const stanford_real t82 = 2*t69;
     const stanford_real t83 = t52*t68;
@@ -1041,7 +1041,7 @@ void stanford_hessian(const stanford_real q[STANFORD_DOF], stanford_real H[STANF
     const stanford_real t12 = c1*c4;
     const stanford_real t13 = -t11 + c2*t12;
     const stanford_real t14 = -t12 + c2*t11;
-    const stanford_real t15 = s5*t14 + c5*t3;
+    const stanford_real t15 = t14*s5 + c5*t3;
     const stanford_real t16 = s1*c2;
     const stanford_real t17 = -q3*t16;
     const stanford_real t18 = -t3;
@@ -1369,7 +1369,7 @@ int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_rea
     const stanford_real t12 = c1*c4;
     const stanford_real t13 = -t11 + c2*t12;
     const stanford_real t14 = -t12 + c2*t11;
-    const stanford_real t15 = s5*t14 + c5*t3;
+    const stanford_real t15 = t14*s5 + c5*t3;
     const stanford_real t16 = (c1*c1);
     const stanford_real t17 = (s2*s2);
     const stanford_real t18 = t16*t17;
@@ -1612,7 +1612,7 @@ int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_rea
     const stanford_real t255 = t52*t40;
     const stanford_real t256 = t254 + t255;
     const stanford_real t257 = -t0;
-    const stanford_real t258 = 1 - t5 - s1 + q1 + q2 + c1 + q3 + q4 + q5 + q6 + t13 + t9 + t10 + t2 + t15 + 2*c2 + 2*t1 + 2*t3 + t223 + t224 + t226 + t254 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + t257;
+    const stanford_real t258 = 1 - t5 - s1 + q1 + q2 + c1 + q3 + t2 + q4 + t13 + t9 + q5 + t10 + t15 + q6 + 2*c2 + 2*t1 + 2*t3 + t223 + t224 + t226 + t254 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + t257;
     const stanford_real t259 = t0*t40;
     const stanford_real t260 = t257 + t259;
     const stanford_real t261 = t2*t252;
@@ -1782,15 +1782,15 @@ stanford_real stanford_ik_numeric_step(const stanford_real target[16], const sta
     const stanford_real t19 = t12*c5 - s5*t18;
     const stanford_real t20 = t12*s5 + c5*t18;
     const stanford_real t21 = t16*s6 + t19*c6;
-    const stanford_real t22 = t16*c6 - s6*t19;
+    const stanford_real t22 = t16*c6 - t19*s6;
     const stanford_real t23 = t21*T00 + t22*T01 + t20*T02;
     const stanford_real t24 = t21*T10 + t22*T11 + t20*T12;
     const stanford_real t25 = t21*T20 + t22*T21 + t20*T22;
     const stanford_real t26 = s1*s2;
-    const stanford_real t27 = c5*t17 - s5*t26;
-    const stanford_real t28 = s5*t17 + c5*t26;
-    const stanford_real t29 = s6*t13 + c6*t27;
-    const stanford_real t30 = c6*t13 - s6*t27;
+    const stanford_real t27 = t17*c5 - s5*t26;
+    const stanford_real t28 = t17*s5 + c5*t26;
+    const stanford_real t29 = t13*s6 + t27*c6;
+    const stanford_real t30 = t13*c6 - t27*s6;
     const stanford_real t31 = t29*T00 + t30*T01 + t28*T02;
     const stanford_real t32 = t29*T10 + t30*T11 + t28*T12;
     const stanford_real t33 = t29*T20 + t30*T21 + t28*T22;
@@ -1799,8 +1799,8 @@ stanford_real stanford_ik_numeric_step(const stanford_real target[16], const sta
     const stanford_real t36 = c2*s5 + c5*t35;
     const stanford_real t37 = -c2*c5 + s5*t35;
     const stanford_real t38 = s2*c4;
-    const stanford_real t39 = c6*t36 + s6*t38;
-    const stanford_real t40 = s6*t36 - c6*t38;
+    const stanford_real t39 = t36*c6 + s6*t38;
+    const stanford_real t40 = t36*s6 - c6*t38;
     const stanford_real t41 = t39*T00 + t37*T02 - t40*T01;
     const stanford_real t42 = t39*T10 + t37*T12 - t40*T11;
     const stanford_real t43 = t39*T20 + t37*T22 - t40*T21;

@@ -104,18 +104,18 @@ def fk(q):
     t13 = t6*c5 - s5*t12
     t14 = t6*s5 + c5*t12
     t15 = t10*s6 + t13*c6
-    t16 = t10*c6 - s6*t13
+    t16 = t10*c6 - t13*s6
     t17 = s1*s2
-    t18 = c5*t11 - s5*t17
-    t19 = s5*t11 + c5*t17
-    t20 = s6*t7 + c6*t18
-    t21 = c6*t7 - s6*t18
+    t18 = t11*c5 - s5*t17
+    t19 = t11*s5 + c5*t17
+    t20 = t7*s6 + t18*c6
+    t21 = t7*c6 - t18*s6
     t22 = s2*s4
     t23 = c2*s5 + c5*t22
     t24 = -c2*c5 + s5*t22
     t25 = s2*c4
-    t26 = c6*t23 + s6*t25
-    t27 = s6*t23 - c6*t25
+    t26 = t23*c6 + s6*t25
+    t27 = t23*s6 - c6*t25
     T = _stack(xp, [
         t15,  # 0, 0
         t16,  # 0, 1
@@ -164,7 +164,7 @@ def jacobian(q):
     t11 = c1*c4
     t12 = -t10 + c2*t11
     t13 = -t11 + c2*t10
-    t14 = s5*t13 + c5*t3
+    t14 = t13*s5 + c5*t3
     t15 = q3*c2
     J = _stack(xp, [
         -t4,  # 0, 0
@@ -238,18 +238,18 @@ def fk_jacobian(q):
     t13 = c1*c4
     t14 = -t12 + c2*t13
     t15 = -t13 + c2*t12
-    t16 = c5*t15 - s5*t2
-    t17 = s5*t15 + c5*t2
+    t16 = t15*c5 - s5*t2
+    t17 = t15*s5 + c5*t2
     t18 = t14*s6 + t10*c6
-    t19 = t14*c6 - s6*t10
-    t20 = s6*t9 + c6*t16
-    t21 = c6*t9 - s6*t16
+    t19 = t14*c6 - t10*s6
+    t20 = t9*s6 + t16*c6
+    t21 = t9*c6 - t16*s6
     t22 = s2*s4
     t23 = c2*s5 + c5*t22
     t24 = -c2*c5 + s5*t22
     t25 = s2*c4
-    t26 = c6*t23 + s6*t25
-    t27 = s6*t23 - c6*t25
+    t26 = t23*c6 + s6*t25
+    t27 = t23*s6 - c6*t25
     t28 = -t24
     T = _stack(xp, [
         t18,  # 0, 0
@@ -340,18 +340,18 @@ def jacobian_tool(q):
     t12 = t5*c5 - s5*t11
     t13 = t5*s5 + c5*t11
     t14 = t9*s6 + t12*c6
-    t15 = t9*c6 - s6*t12
+    t15 = t9*c6 - t12*s6
     t16 = s1*s2
-    t17 = c5*t10 - s5*t16
-    t18 = s5*t10 + c5*t16
-    t19 = s6*t6 + c6*t17
-    t20 = c6*t6 - s6*t17
+    t17 = t10*c5 - s5*t16
+    t18 = t10*s5 + c5*t16
+    t19 = t6*s6 + t17*c6
+    t20 = t6*c6 - t17*s6
     t21 = s2*s4
     t22 = c2*s5 + c5*t21
     t23 = -c2*c5 + s5*t21
     t24 = s2*c4
-    t25 = c6*t22 + s6*t24
-    t26 = s6*t22 - c6*t24
+    t25 = t22*c6 + s6*t24
+    t26 = t22*s6 - c6*t24
     t27 = -(c1*t1 + s1*t2)
     t28 = q3*c2
     t29 = c1*t28
@@ -360,19 +360,19 @@ def jacobian_tool(q):
     t32 = c2*t26 + t15*t11 + t20*t16
     t33 = -c2*t23 + t13*t11 + t18*t16
     J = _stack(xp, [
-        t1*t19 - t14*t2,  # 0, 0
+        t1*t19 - t2*t14,  # 0, 0
         -t25*t27 + t14*t29 + t19*t30,  # 0, 1
         t31,  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        t1*t20 - t15*t2,  # 1, 0
+        t1*t20 - t2*t15,  # 1, 0
         t26*t27 + t15*t29 + t20*t30,  # 1, 1
         t32,  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
-        t1*t18 - t13*t2,  # 2, 0
+        t1*t18 - t2*t13,  # 2, 0
         -t23*t27 + t13*t29 + t18*t30,  # 2, 1
         t33,  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
@@ -383,13 +383,13 @@ def jacobian_tool(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
         t31,  # 3, 3
         t9*t14 + t6*t19 + t25*t24,  # 3, 4
-        t14*t13 + t19*t18 + t25*t23,  # 3, 5
+        t13*t14 + t18*t19 + t23*t25,  # 3, 5
         t26,  # 4, 0
         c1*t20 - s1*t15,  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
         t32,  # 4, 3
         t9*t15 + t6*t20 - t26*t24,  # 4, 4
-        t15*t13 + t20*t18 - t26*t23,  # 4, 5
+        t13*t15 + t18*t20 - t23*t26,  # 4, 5
         -t23,  # 5, 0
         c1*t18 - s1*t13,  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
@@ -430,13 +430,13 @@ def task(q):
     t12 = -t10 + c2*t9
     t13 = s2*s5
     t14 = t7*c5 - c1*t13
-    t15 = c5*t12 - s1*t13
+    t15 = t12*c5 - s1*t13
     t16 = -c2*c5 + s4*t13
     t17 = t11*s6 + t14*c6
-    t18 = s6*t8 + c6*t15
+    t18 = t8*s6 + t15*c6
     t19 = s2*c4
-    t20 = c6*t1 + s6*t19
-    t21 = s6*t1 - c6*t19
+    t20 = t1*c6 + s6*t19
+    t21 = t1*s6 - c6*t19
     mu = _stack(xp, [
         t3,  # 0
         t4,  # 1
@@ -477,22 +477,22 @@ def task_jacobian(q):
     t11 = c1*c4
     t12 = -t10 + c2*t11
     t13 = -t11 + c2*t10
-    t14 = c5*t13 - s5*t2
-    t15 = s5*t13 + c5*t2
+    t14 = t13*c5 - s5*t2
+    t15 = t13*s5 + c5*t2
     t16 = t12*s6 + t8*c6
-    t17 = s6*t7 + c6*t14
+    t17 = t7*s6 + t14*c6
     t18 = s2*s4
     t19 = c2*s5 + c5*t18
     t20 = -c2*c5 + s5*t18
     t21 = s2*c4
-    t22 = c6*t19 + s6*t21
+    t22 = t19*c6 + s6*t21
     t23 = q3*c2
     t24 = t16**2 + t17**2
     t25 = 1/t24
     t26 = (c1*t17 - s1*t16)*t25
     t27 = t25*(t16*t0 + t17*t2)
     t28 = t25*(t12*t16 + t7*t17)
-    t29 = t25*(t16*t9 + t17*t15)
+    t29 = t25*(t9*t16 + t15*t17)
     t30 = 1/xp.sqrt(t24)
     J = _stack(xp, [
         -t3,  # 0, 0
@@ -524,7 +524,7 @@ def task_jacobian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
         t30*(t16*t2 - t17*t0),  # 4, 3
         t30*(t7*t16 - t12*t17),  # 4, 4
-        t30*(t16*t15 - t9*t17),  # 4, 5
+        t30*(t15*t16 - t9*t17),  # 4, 5
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
         t22*t26,  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
@@ -573,18 +573,18 @@ def fk_jacobian_dot(q, q_dot):
     t14 = c1*c4
     t15 = -t13 + c2*t14
     t16 = -t14 + c2*t13
-    t17 = c5*t16 - s5*t3
-    t18 = s5*t16 + c5*t3
+    t17 = t16*c5 - s5*t3
+    t18 = t16*s5 + c5*t3
     t19 = t15*s6 + t11*c6
-    t20 = t15*c6 - s6*t11
-    t21 = s6*t10 + c6*t17
-    t22 = c6*t10 - s6*t17
+    t20 = t15*c6 - t11*s6
+    t21 = t10*s6 + t17*c6
+    t22 = t10*c6 - t17*s6
     t23 = s2*s4
     t24 = c2*s5 + c5*t23
     t25 = -c2*c5 + s5*t23
     t26 = s2*c4
-    t27 = c6*t24 + s6*t26
-    t28 = s6*t24 - c6*t26
+    t27 = t24*c6 + s6*t26
+    t28 = t24*s6 - c6*t26
     t29 = t0 - t26*qd5
     t30 = c1*t2 + s1*t4
     t31 = t30
@@ -707,7 +707,7 @@ def jacobian_dot(q, q_dot):
     t14 = -t12 + c2*t11
     t15 = s2*c5
     t16 = t9*s5 + c1*t15
-    t17 = s5*t14 + s1*t15
+    t17 = t14*s5 + s1*t15
     t18 = s1*qd2
     t19 = s2*qd4
     t20 = -t18 + c1*t19
@@ -808,7 +808,7 @@ def bias_acceleration(q, q_dot):
     t14 = -t12 + c2*t11
     t15 = s2*c5
     t16 = t9*s5 + c1*t15
-    t17 = s5*t14 + s1*t15
+    t17 = t14*s5 + s1*t15
     t18 = s1*qd2
     t19 = s2*qd4
     t20 = -t18 + c1*t19
@@ -879,17 +879,17 @@ def task_jacobian_dot(q, q_dot):
     t13 = c1*c4
     t14 = -t12 + c2*t13
     t15 = -t13 + c2*t12
-    t16 = c5*t15 - s5*t2
-    t17 = s5*t15 + c5*t2
+    t16 = t15*c5 - s5*t2
+    t17 = t15*s5 + c5*t2
     t18 = t14*s6 + t10*c6
-    t19 = s6*t9 + c6*t16
+    t19 = t9*s6 + t16*c6
     t20 = t18**2 + t19**2
     t21 = xp.sqrt(t20)
     t22 = s2*s4
     t23 = c2*s5 + c5*t22
     t24 = -c2*c5 + s5*t22
     t25 = s2*c4
-    t26 = c6*t23 + s6*t25
+    t26 = t23*c6 + s6*t25
     t27 = s1*qd2
     t28 = -t27 + t0*qd4
     t29 = t28
@@ -934,7 +934,7 @@ def task_jacobian_dot(q, q_dot):
     t68 = 1/t20
     t69 = (-t67 + t66)*t68
     t70 = (t14*t18 + t9*t19)*t68
-    t71 = (t18*t11 + t19*t17)*t68
+    t71 = (t11*t18 + t17*t19)*t68
     t72 = c1*t18
     t73 = s1*t19
     t74 = t68*(s2*t72 + s2*t73)
@@ -943,7 +943,7 @@ def task_jacobian_dot(q, q_dot):
     t77 = (t72 + t73)*t76
     t78 = t76*(s2*t67 - s2*t66)
     t79 = (t9*t18 - t14*t19)*t76
-    t80 = (t18*t17 - t11*t19)*t76
+    t80 = (t17*t18 - t11*t19)*t76
     t81 = -t31
     t82 = 2*t69
     t83 = t52*t68
@@ -1042,7 +1042,7 @@ def hessian(q):
     t12 = c1*c4
     t13 = -t11 + c2*t12
     t14 = -t12 + c2*t11
-    t15 = s5*t14 + c5*t3
+    t15 = t14*s5 + c5*t3
     t16 = s1*c2
     t17 = -q3*t16
     t18 = -t3
@@ -1353,7 +1353,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t12 = c1*c4
     t13 = -t11 + c2*t12
     t14 = -t12 + c2*t11
-    t15 = s5*t14 + c5*t3
+    t15 = t14*s5 + c5*t3
     t16 = c1**2
     t17 = s2**2
     t18 = t16*t17
@@ -1596,7 +1596,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t255 = t52*t40
     t256 = t254 + t255
     t257 = -t0
-    t258 = 1 - t5 - s1 + q1 + q2 + c1 + q3 + q4 + q5 + q6 + t13 + t9 + t10 + t2 + t15 + 2*c2 + 2*t1 + 2*t3 + t223 + t224 + t226 + t254 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + t257
+    t258 = 1 - t5 - s1 + q1 + q2 + c1 + q3 + t2 + q4 + t13 + t9 + q5 + t10 + t15 + q6 + 2*c2 + 2*t1 + 2*t3 + t223 + t224 + t226 + t254 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + t257
     t259 = t0*t40
     t260 = t257 + t259
     t261 = t2*t252
@@ -1764,15 +1764,15 @@ def ik_numeric_step(target, q, damping=0.0):
     t19 = t12*c5 - s5*t18
     t20 = t12*s5 + c5*t18
     t21 = t16*s6 + t19*c6
-    t22 = t16*c6 - s6*t19
+    t22 = t16*c6 - t19*s6
     t23 = t21*T00 + t22*T01 + t20*T02
     t24 = t21*T10 + t22*T11 + t20*T12
     t25 = t21*T20 + t22*T21 + t20*T22
     t26 = s1*s2
-    t27 = c5*t17 - s5*t26
-    t28 = s5*t17 + c5*t26
-    t29 = s6*t13 + c6*t27
-    t30 = c6*t13 - s6*t27
+    t27 = t17*c5 - s5*t26
+    t28 = t17*s5 + c5*t26
+    t29 = t13*s6 + t27*c6
+    t30 = t13*c6 - t27*s6
     t31 = t29*T00 + t30*T01 + t28*T02
     t32 = t29*T10 + t30*T11 + t28*T12
     t33 = t29*T20 + t30*T21 + t28*T22
@@ -1781,8 +1781,8 @@ def ik_numeric_step(target, q, damping=0.0):
     t36 = c2*s5 + c5*t35
     t37 = -c2*c5 + s5*t35
     t38 = s2*c4
-    t39 = c6*t36 + s6*t38
-    t40 = s6*t36 - c6*t38
+    t39 = t36*c6 + s6*t38
+    t40 = t36*s6 - c6*t38
     t41 = t39*T00 + t37*T02 - t40*T01
     t42 = t39*T10 + t37*T12 - t40*T11
     t43 = t39*T20 + t37*T22 - t40*T21

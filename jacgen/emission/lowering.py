@@ -18,7 +18,7 @@ import sympy
 from sympy.logic.boolalg import Boolean
 from sympy.simplify.cse_main import Unevaluated, match_common_args
 
-from jacgen.model.graph import (ADD, AND, FINITE, MUL, NOT, NUMBER, OR, POW, RELATION, SELECT, TRUTH, CALL,
+from jacgen.model.graph import (ADD, AND, FINITE, MUL, NOT, NUMBER, OR, POW, RELATION, SELECT, SYMBOL, TRUTH, CALL,
                                    TOLERANCE_VALUES, Graph, Node, evaluate, negative_coefficient)
 from jacgen.inputs import names
 
@@ -143,7 +143,7 @@ class Lowering:
         self.definitions: list[tuple[sympy.Symbol, Node]] = []  # in an order that defines before use
         self.graph = Graph()
         self._names: dict[sympy.Expr, sympy.Symbol] = {}  # named values (see `name`)
-        self._named: set[sympy.Symbol] = set()
+        self._named_symbols: set[sympy.Symbol] = set()
         self._negations: dict[Node, Node | None] = {}  # eliminate_common's, shared by every lowering
         self._lowered: dict[tuple, Body] = {}
 
@@ -154,45 +154,41 @@ class Lowering:
         self.definitions.append((symbol, self.graph.convert(value)))
 
     def name(self, value: sympy.Expr) -> sympy.Expr:
-        """`value` as a symbol of its own (an atom, a number or a product of atoms stays as it
-        is; -x is named as x). The chain names its rotations, steps and levers, so that every
-        expression the algorithms build has a bounded size: written out, sympy flattens the
-        nested sums and each lever would repeat the rest of the chain."""
+        """`name_node` for a sympy value (the chain's), as a sympy value: its symbol, or minus it.
+        A product of sympy's atoms stays as it is; an exact irrational constant (cos(pi/180)) is
+        no atom, so its products are named (computed once, not folded into every reader)."""
         if value.is_Atom or (value.is_Mul and all(arg.is_Atom for arg in value.args)):
             return value
-        if value in self._names:
-            return self._names[value]
-        negated = sympy.Add(*(-term for term in value.args)) if value.is_Add else -value
-        if negated in self._names:
-            return -self._names[negated]
-        if _mostly_negative(value):
-            return -self.name(negated)
-        symbol = sympy.Symbol(f"{names.INTERNAL_PREFIX}n{len(self.definitions)}", real=True)
-        self.definitions.append((symbol, self.graph.convert(value)))
-        self._names[value] = symbol
-        self._named.add(symbol)
-        return symbol
+        node = self._named(self.graph.convert(value), _mostly_negative(value))
+        return node.value if node.kind == SYMBOL else -node.args[1].value
 
     def name_node(self, value) -> Node:
-        """`name` for a value on the graph (a node, or a number or sympy value taken onto it): its
-        symbol's node, or minus it (a sum is known by its terms, whatever their order, and a
-        mostly negative one is named as its negation)."""
+        """`value` (a node, or a number or sympy value taken onto the graph) as a symbol of its
+        own, or minus it: a leaf, or a product of leaves, stays as it is. The algorithms name
+        every intermediate value, so that every expression they build has a bounded size:
+        written out, sums flatten into their readers and each lever of the chain would repeat
+        the rest of the chain."""
         node = self.graph.value(value)
         if not node.args or (node.kind == MUL and all(not arg.args for arg in node.args)):
             return node
+        terms = node.args if node.kind == ADD else (node,)
+        return self._named(node, 2 * sum(map(negative_coefficient, terms)) > len(terms))
+
+    def _named(self, node: Node, mostly_negative: bool) -> Node:
+        """The symbol of `node`'s value, defined on first use, or minus it: a sum is known by its
+        terms, whatever their order, and one with mostly negative terms is named as its negation."""
         graph, key = self.graph, _key(node)
         if key in self._names:
             return graph.symbol(self._names[key])
         negated = graph.node(ADD, tuple(map(graph.negate, node.args))) if node.kind == ADD else graph.negate(node)
         if _key(negated) in self._names:
             return graph.negate(graph.symbol(self._names[_key(negated)]))
-        terms = node.args if node.kind == ADD else (node,)
-        if 2 * sum(map(negative_coefficient, terms)) > len(terms):
-            return graph.negate(self.name_node(negated))
+        if mostly_negative:
+            return graph.negate(self._named(negated, False))
         symbol = sympy.Symbol(f"{names.INTERNAL_PREFIX}n{len(self.definitions)}", real=True)
         self.definitions.append((symbol, node))
         self._names[key] = symbol
-        self._named.add(symbol)
+        self._named_symbols.add(symbol)
         return graph.symbol(symbol)
 
     def lower(self, outputs: list[sympy.Basic], bindings: dict | None = None) -> Body:
@@ -222,11 +218,11 @@ class Lowering:
         ordered = [(s, values[s]) for s in bindings if s in needed] + [(s, v) for s, v in self.definitions
                                                                        if s in needed and s not in bindings]
         definitions, outputs = _without_constants(graph, _in_dependency_order(ordered), outputs, distribute=False)
-        named = [(s, v) for s, v in definitions if s in self._named]
+        named = [(s, v) for s, v in definitions if s in self._named_symbols]
         replacements, reduced = eliminate_common(graph, [v for _, v in named] + outputs,
                                                  sympy.numbered_symbols(f"{names.INTERNAL_PREFIX}r", real=True),
                                                  self._negations)
-        definitions = _in_dependency_order([(s, v) for s, v in definitions if s not in self._named]
+        definitions = _in_dependency_order([(s, v) for s, v in definitions if s not in self._named_symbols]
                                            + list(zip((s for s, _ in named), reduced)) + replacements)
         definitions, reduced = _without_constants(graph, definitions, reduced[len(named):], distribute=True)
         temporaries = [symbol for symbol, _ in definitions if symbol.name.startswith(names.INTERNAL_PREFIX)]
@@ -241,8 +237,8 @@ def _key(node: Node):
 
 
 def _mostly_negative(value: sympy.Expr) -> bool:
-    """A product with a negative coefficient, or a sum with more such terms than others (sympy's
-    `could_extract_minus_sign` decides ties by sorting, which costs more than naming saves)."""
+    """A product with a negative coefficient, or a sum with more such terms than others, by the
+    terms of sympy's value (an exact irrational coefficient, -cos(pi/180), counts as none)."""
     terms = value.args if value.is_Add else (value,)
     negative = sum(bool((term.args[0] if term.is_Mul else term).is_extended_negative) for term in terms
                    if term.is_Number or term.is_Mul and term.args[0].is_Number)
