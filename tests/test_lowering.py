@@ -8,7 +8,7 @@ from sympy.core.parameters import distribute
 
 from jacgen.emission.generator import Generator
 from jacgen.model.graph import AND, OR, Graph, Node, evaluate
-from jacgen.emission.lowering import _reusing_temporaries, eliminate_common, operation_count
+from jacgen.emission.lowering import Lowering, _reusing_temporaries, eliminate_common, operation_count
 from jacgen.inputs.robot import load_robot, parse_robot
 from conftest import ROOT
 from support.graph_sympy import to_sympy
@@ -120,3 +120,15 @@ def test_products_and_sums_read_the_temporaries_they_hold():
         values[symbol] = evaluate(value, values)
     for before, after in zip(outputs, reduced):
         assert evaluate(after, values) == pytest.approx(evaluate(before, values), rel=1e-15)
+
+
+def test_a_value_and_its_negation_are_named_once():
+    """c - a*b built either way (the product negated as a whole, or its factor) is one named
+    value, and a*b - c is minus it: the solvers' Householder steps build both."""
+    lowering = Lowering()
+    g = lowering.graph
+    a, b, c = (g.symbol(s) for s in sympy.symbols("a b c", real=True))
+    first = lowering.name_node(c + (-a) * b)
+    assert lowering.name_node(c - a * b) is first
+    assert lowering.name_node(a * b - c) is g.negate(first)
+    assert len(lowering.definitions) == 1

@@ -887,8 +887,8 @@ void iiwa_fk_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIW
     J[40] = t32;
     J[41] = t34;
     a[0] = -qd1*t92 + qd5*(t80*t95 - t67*t37 + t20*t83 - t29*t70) + qd2*(c1*t86 - t49*qd1) + qd3*(-t63*qd1 - c2*t72 + t76*t93 + t18*t85) + qd4*(t78*t94 + t65*t0 - t4*t84 + t30*t71) - qd6*(t69*t38 + t82*t96 + t82*t101 + t69*t103);
-    a[1] = qd1*t98 + qd5*(t55*t37 - t80*t89 + t29*t58 - t11*t83) + qd2*(s1*t86 + t61*qd1) + qd3*(t51*qd1 + c2*t60 + t76*t87 - t9*t85) - qd4*(t78*t88 + t7*t84 + t30*t59 - t53*t0) + qd6*(t57*t38 + t82*t90 + t57*t103 - t82*t99);
-    a[2] = qd4*(-t65*t88 - t53*t94 + t7*t71 + t4*t59) + qd5*(t67*t89 - t55*t95 + t11*t70 - t20*t58) - qd2*(s1*t91 + c1*t97) - qd3*(t63*t87 + t51*t93 - t9*t72 + t18*t60) - qd6*(t57*t96 + t69*t99 + t57*t101 - t69*t90);
+    a[1] = qd1*t98 + qd5*(t55*t37 - t80*t89 + t29*t58 - t11*t83) + qd2*(s1*t86 + t61*qd1) + qd3*(t51*qd1 + c2*t60 + t76*t87 - t9*t85) - qd4*(t78*t88 + t7*t84 - t53*t0 + t30*t59) + qd6*(t57*t38 + t82*t90 + t57*t103 - t82*t99);
+    a[2] = qd4*(-t65*t88 - t53*t94 + t7*t71 + t4*t59) + qd5*(t67*t89 - t55*t95 + t11*t70 - t20*t58) - qd2*(s1*t91 + c1*t97) - qd3*(t63*t87 + t51*t93 - t9*t72 + t18*t60) - qd6*(t57*t96 - t69*t90 + t69*t99 + t57*t101);
     a[3] = qd5*(t29*t95 - t20*t37) + qd6*(t32*t96 - t22*t38) + qd7*(t34*t102 - t24*t104) - qd1*t93 + qd3*(c2*t93 - t18*qd1) + qd4*(t4*t0 - t30*t94);
     a[4] = qd5*(t11*t37 - t29*t89) + qd7*(t15*t104 - t34*t100) - qd1*t87 + qd3*(t9*qd1 + c2*t87) + qd4*(t7*t0 + t30*t88) - qd6*(t13*t38 + t32*t90);
     a[5] = qd5*(t20*t89 - t11*t95) + qd6*(t22*t90 + t13*t96) + qd7*(t24*t100 - t15*t102) - qd4*(t4*t88 + t7*t94) - qd3*(t18*t87 + t9*t93);
@@ -1019,7 +1019,7 @@ void iiwa_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_D
     Jd[7] = t73;
     Jd[8] = s1*t44 + t47*t81;
     Jd[9] = t48*qd1 + c2*t60 - t9*t43 + t62*t37;
-    Jd[10] = -(t38*t63 + t7*t42 + t24*t58 - t49*t0);
+    Jd[10] = -(t38*t63 + t7*t42 - t49*t0 + t24*t58);
     Jd[11] = t50*t28 - t39*t64 + t23*t56 - t11*t41;
     Jd[12] = t51*t29 + t40*t65 + t78*t51 - t74*t40;
     Jd[13] = 0;
@@ -1169,7 +1169,7 @@ void iiwa_bias_acceleration(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[I
 
     /* Outputs */
     a[0] = -qd1*t67 + qd5*(t39*t70 - t54*t28 + t17*t41 - t23*t57) + qd4*(t38*t69 + t53*t0 - t4*t42 + t24*t59) + qd2*(c1*t44 - s1*t80) + qd3*(-t52*qd1 - c2*t61 + t15*t43 + t68*t37) - qd6*(t55*t29 + t40*t71 + t76*t40 + t78*t55);
-    a[1] = qd1*t73 + qd5*(t50*t28 - t39*t64 + t23*t56 - t11*t41) - qd4*(t38*t63 + t7*t42 + t24*t58 - t49*t0) + qd2*(s1*t44 + c1*t80) + qd3*(t48*qd1 + c2*t60 - t9*t43 + t62*t37) + qd6*(t51*t29 + t40*t65 + t78*t51 - t74*t40);
+    a[1] = qd1*t73 + qd5*(t50*t28 - t39*t64 + t23*t56 - t11*t41) - qd4*(t38*t63 + t7*t42 - t49*t0 + t24*t58) + qd2*(s1*t44 + c1*t80) + qd3*(t48*qd1 + c2*t60 - t9*t43 + t62*t37) + qd6*(t51*t29 + t40*t65 + t78*t51 - t74*t40);
     a[2] = qd4*(-t53*t63 - t49*t69 + t7*t59 + t4*t58) + qd5*(t54*t64 - t50*t70 + t11*t57 - t17*t56) - qd2*(s1*t66 + c1*t72) - qd3*(-t9*t61 + t15*t60 + t62*t52 + t68*t48) - qd6*(t51*t71 - t55*t65 + t74*t55 + t76*t51);
     a[3] = qd5*(t23*t70 - t17*t28) + qd6*(t26*t71 - t19*t29) + qd7*(t27*t77 - t20*t79) + qd4*(t4*t0 - t24*t69) - t68*qd1 + qd3*(-t15*qd1 + c2*t68);
     a[4] = qd5*(t11*t28 - t23*t64) + qd7*(t14*t79 - t27*t75) - t62*qd1 + qd4*(t7*t0 + t24*t63) - qd6*(t13*t29 + t26*t65) + qd3*(t9*qd1 + c2*t62);
@@ -1300,7 +1300,7 @@ void iiwa_task_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[I
     const iiwa_real t86 = qd1 + c2*qd3;
     const iiwa_real t87 = t86;
     const iiwa_real t88 = t43*t83 + t58*t87 - t3*t47 + t29*t64;
-    const iiwa_real t89 = t43*t73 + t6*t47 + t29*t63 - t54*t87;
+    const iiwa_real t89 = t43*t73 + t6*t47 - t54*t87 + t29*t63;
     const iiwa_real t90 = t3*t87 - t29*t83;
     const iiwa_real t91 = t6*t87 + t29*t73;
     const iiwa_real t92 = t6*qd4;
@@ -2338,7 +2338,7 @@ int iiwa_velocity_ik(const iiwa_real q[IIWA_DOF], const iiwa_real mu_dot[IIWA_TA
     const iiwa_real t59 = -t31*t34 + t45*t49 - t46*t50 + t47*t51 + t48*t52 + t56*t58;
     const iiwa_real t60 = c1*t35;
     const iiwa_real t61 = t45*t36 + t46*t37 + t47*t38 - t48*t39 - t44*t60;
-    const iiwa_real t62 = t60 + t3*t37 + t18*t39 - t14*t36 - t16*t38;
+    const iiwa_real t62 = t60 + t3*t37 + t18*t39 - t16*t38 - t14*t36;
     const iiwa_real t63 = t44*t58;
     const iiwa_real t64 = -t63 + t6*t46 + t10*t47 - t12*t48 + t8*t45;
     const iiwa_real t65 = t63 + t3*t50 + t16*t51 + t18*t52 + t14*t49;
@@ -2346,9 +2346,9 @@ int iiwa_velocity_ik(const iiwa_real q[IIWA_DOF], const iiwa_real mu_dot[IIWA_TA
     const iiwa_real t67 = t66 + c2*t45 + t22*t47 + t25*t48 - t23*t46;
     const iiwa_real t68 = (s1*s1);
     const iiwa_real t69 = (t31*t31) + (t49*t49) + (t50*t50) + (t51*t51) + (t52*t52) + t56*t68;
-    const iiwa_real t70 = t6*t50 + t12*t52 + t44*t68 - t8*t49 - t10*t51;
+    const iiwa_real t70 = t6*t50 + t12*t52 + t44*t68 - t10*t51 - t8*t49;
     const iiwa_real t71 = s1*t35;
-    const iiwa_real t72 = t50*t37 + t52*t39 + t44*t71 - t49*t36 - t51*t38;
+    const iiwa_real t72 = t50*t37 + t52*t39 - t49*t36 - t51*t38 + t44*t71;
     const iiwa_real t73 = t71 + t6*t37 + t10*t38 + t12*t39 + t8*t36;
     const iiwa_real t74 = (s2*s2);
     const iiwa_real t75 = (t6*t6) + (t10*t10) + (t12*t12) + (t13*t13) + t68 + t54*t74;
@@ -2676,7 +2676,7 @@ iiwa_real iiwa_ik_numeric_step(const iiwa_real target[16], const iiwa_real q[IIW
     const iiwa_real t88 = -t57*t61 + t73*t77 - t74*t78 + t75*t79 + t76*t80 + t85*t87;
     const iiwa_real t89 = c1*t62;
     const iiwa_real t90 = t73*t63 + t74*t64 + t75*t65 - t76*t66 - t71*t89;
-    const iiwa_real t91 = t89 + t4*t64 + t25*t66 - t21*t63 - t23*t65;
+    const iiwa_real t91 = t89 + t4*t64 + t25*t66 - t23*t65 - t21*t63;
     const iiwa_real t92 = t71*t87;
     const iiwa_real t93 = -t92 + t7*t74 + t11*t75 - t13*t76 + t9*t73;
     const iiwa_real t94 = t92 + t4*t78 + t23*t79 + t25*t80 + t21*t77;
@@ -2685,9 +2685,9 @@ iiwa_real iiwa_ik_numeric_step(const iiwa_real target[16], const iiwa_real q[IIW
     const iiwa_real t97 = t95 + T13;
     const iiwa_real t98 = (s1*s1);
     const iiwa_real t99 = (t57*t57) + (t77*t77) + (t78*t78) + (t79*t79) + (t80*t80) + t85*t98;
-    const iiwa_real t100 = t7*t78 + t13*t80 + t71*t98 - t9*t77 - t11*t79;
+    const iiwa_real t100 = t7*t78 + t13*t80 + t71*t98 - t11*t79 - t9*t77;
     const iiwa_real t101 = s1*t62;
-    const iiwa_real t102 = t78*t64 + t80*t66 + t71*t101 - t77*t63 - t79*t65;
+    const iiwa_real t102 = t78*t64 + t80*t66 - t77*t63 - t79*t65 + t71*t101;
     const iiwa_real t103 = t101 + t7*t64 + t11*t65 + t13*t66 + t9*t63;
     const iiwa_real t104 = (s2*s2);
     const iiwa_real t105 = (t7*t7) + (t11*t11) + (t13*t13) + (t15*t15) + t98 + t83*t104;
@@ -3055,10 +3055,10 @@ void iiwa_ik_branches(const iiwa_real T[16], iiwa_real q_free, iiwa_real q[IIWA_
     const iiwa_real t149 = t148*t143;
     const iiwa_real t150 = t148*t146;
     const iiwa_real t151 = t22*t134;
-    const iiwa_real t152 = t24*t133 + c3*t151 - s3*t149;
+    const iiwa_real t152 = t24*t133 - s3*t149 + c3*t151;
     const iiwa_real t153 = t24*t139 + c3*t149 + s3*t151;
     const iiwa_real t154 = t22*t136;
-    const iiwa_real t155 = t24*t135 + c3*t154 - s3*t150;
+    const iiwa_real t155 = t24*t135 - s3*t150 + c3*t154;
     const iiwa_real t156 = t24*t141 + c3*t150 + s3*t154;
     const iiwa_real t157 = (t144*t144);
     const iiwa_real t158 = t157 + (t152*t152) + (t153*t153);
@@ -3123,10 +3123,10 @@ void iiwa_ik_branches(const iiwa_real T[16], iiwa_real q_free, iiwa_real q[IIWA_
     const iiwa_real t217 = t148*t216;
     const iiwa_real t218 = -t24*t205 + t22*t215;
     const iiwa_real t219 = t22*t203;
-    const iiwa_real t220 = t24*t202 + c3*t219 - s3*t213;
+    const iiwa_real t220 = t24*t202 - s3*t213 + c3*t219;
     const iiwa_real t221 = t24*t208 + c3*t213 + s3*t219;
     const iiwa_real t222 = t22*t205;
-    const iiwa_real t223 = t24*t204 + c3*t222 - s3*t217;
+    const iiwa_real t223 = t24*t204 - s3*t217 + c3*t222;
     const iiwa_real t224 = t24*t210 + c3*t217 + s3*t222;
     const iiwa_real t225 = (t214*t214);
     const iiwa_real t226 = t225 + (t220*t220) + (t221*t221);

@@ -898,8 +898,8 @@ def fk_jacobian_dot(q, q_dot):
     ], (6, 7))
     a = _stack(xp, [
         xp.broadcast_to(-qd1*t92 + qd5*(t80*t95 - t67*t37 + t20*t83 - t29*t70) + qd2*(c1*t86 - t49*qd1) + qd3*(-t63*qd1 - c2*t72 + t76*t93 + t18*t85) + qd4*(t78*t94 + t65*t0 - t4*t84 + t30*t71) - qd6*(t69*t38 + t82*t96 + t82*t101 + t69*t103), batch),  # 0
-        xp.broadcast_to(qd1*t98 + qd5*(t55*t37 - t80*t89 + t29*t58 - t11*t83) + qd2*(s1*t86 + t61*qd1) + qd3*(t51*qd1 + c2*t60 + t76*t87 - t9*t85) - qd4*(t78*t88 + t7*t84 + t30*t59 - t53*t0) + qd6*(t57*t38 + t82*t90 + t57*t103 - t82*t99), batch),  # 1
-        xp.broadcast_to(qd4*(-t65*t88 - t53*t94 + t7*t71 + t4*t59) + qd5*(t67*t89 - t55*t95 + t11*t70 - t20*t58) - qd2*(s1*t91 + c1*t97) - qd3*(t63*t87 + t51*t93 - t9*t72 + t18*t60) - qd6*(t57*t96 + t69*t99 + t57*t101 - t69*t90), batch),  # 2
+        xp.broadcast_to(qd1*t98 + qd5*(t55*t37 - t80*t89 + t29*t58 - t11*t83) + qd2*(s1*t86 + t61*qd1) + qd3*(t51*qd1 + c2*t60 + t76*t87 - t9*t85) - qd4*(t78*t88 + t7*t84 - t53*t0 + t30*t59) + qd6*(t57*t38 + t82*t90 + t57*t103 - t82*t99), batch),  # 1
+        xp.broadcast_to(qd4*(-t65*t88 - t53*t94 + t7*t71 + t4*t59) + qd5*(t67*t89 - t55*t95 + t11*t70 - t20*t58) - qd2*(s1*t91 + c1*t97) - qd3*(t63*t87 + t51*t93 - t9*t72 + t18*t60) - qd6*(t57*t96 - t69*t90 + t69*t99 + t57*t101), batch),  # 2
         xp.broadcast_to(qd5*(t29*t95 - t20*t37) + qd6*(t32*t96 - t22*t38) + qd7*(t34*t102 - t24*t104) - qd1*t93 + qd3*(c2*t93 - t18*qd1) + qd4*(t4*t0 - t30*t94), batch),  # 3
         xp.broadcast_to(qd5*(t11*t37 - t29*t89) + qd7*(t15*t104 - t34*t100) - qd1*t87 + qd3*(t9*qd1 + c2*t87) + qd4*(t7*t0 + t30*t88) - qd6*(t13*t38 + t32*t90), batch),  # 4
         xp.broadcast_to(qd5*(t20*t89 - t11*t95) + qd6*(t22*t90 + t13*t96) + qd7*(t24*t100 - t15*t102) - qd4*(t4*t88 + t7*t94) - qd3*(t18*t87 + t9*t93), batch),  # 5
@@ -1022,7 +1022,7 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(t73, batch),  # 1, 0
         xp.broadcast_to(s1*t44 + t47*t81, batch),  # 1, 1
         xp.broadcast_to(t48*qd1 + c2*t60 - t9*t43 + t62*t37, batch),  # 1, 2
-        xp.broadcast_to(-(t38*t63 + t7*t42 + t24*t58 - t49*t0), batch),  # 1, 3
+        xp.broadcast_to(-(t38*t63 + t7*t42 - t49*t0 + t24*t58), batch),  # 1, 3
         xp.broadcast_to(t50*t28 - t39*t64 + t23*t56 - t11*t41, batch),  # 1, 4
         xp.broadcast_to(t51*t29 + t40*t65 + t78*t51 - t74*t40, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
@@ -1164,7 +1164,7 @@ def bias_acceleration(q, q_dot):
     t80 = t47*qd1
     a = _stack(xp, [
         xp.broadcast_to(-qd1*t67 + qd5*(t39*t70 - t54*t28 + t17*t41 - t23*t57) + qd4*(t38*t69 + t53*t0 - t4*t42 + t24*t59) + qd2*(c1*t44 - s1*t80) + qd3*(-t52*qd1 - c2*t61 + t15*t43 + t68*t37) - qd6*(t55*t29 + t40*t71 + t76*t40 + t78*t55), batch),  # 0
-        xp.broadcast_to(qd1*t73 + qd5*(t50*t28 - t39*t64 + t23*t56 - t11*t41) - qd4*(t38*t63 + t7*t42 + t24*t58 - t49*t0) + qd2*(s1*t44 + c1*t80) + qd3*(t48*qd1 + c2*t60 - t9*t43 + t62*t37) + qd6*(t51*t29 + t40*t65 + t78*t51 - t74*t40), batch),  # 1
+        xp.broadcast_to(qd1*t73 + qd5*(t50*t28 - t39*t64 + t23*t56 - t11*t41) - qd4*(t38*t63 + t7*t42 - t49*t0 + t24*t58) + qd2*(s1*t44 + c1*t80) + qd3*(t48*qd1 + c2*t60 - t9*t43 + t62*t37) + qd6*(t51*t29 + t40*t65 + t78*t51 - t74*t40), batch),  # 1
         xp.broadcast_to(qd4*(-t53*t63 - t49*t69 + t7*t59 + t4*t58) + qd5*(t54*t64 - t50*t70 + t11*t57 - t17*t56) - qd2*(s1*t66 + c1*t72) - qd3*(-t9*t61 + t15*t60 + t62*t52 + t68*t48) - qd6*(t51*t71 - t55*t65 + t74*t55 + t76*t51), batch),  # 2
         xp.broadcast_to(qd5*(t23*t70 - t17*t28) + qd6*(t26*t71 - t19*t29) + qd7*(t27*t77 - t20*t79) + qd4*(t4*t0 - t24*t69) - t68*qd1 + qd3*(-t15*qd1 + c2*t68), batch),  # 3
         xp.broadcast_to(qd5*(t11*t28 - t23*t64) + qd7*(t14*t79 - t27*t75) - t62*qd1 + qd4*(t7*t0 + t24*t63) - qd6*(t13*t29 + t26*t65) + qd3*(t9*qd1 + c2*t62), batch),  # 4
@@ -1287,7 +1287,7 @@ def task_jacobian_dot(q, q_dot):
     t86 = qd1 + c2*qd3
     t87 = t86
     t88 = t43*t83 + t58*t87 - t3*t47 + t29*t64
-    t89 = t43*t73 + t6*t47 + t29*t63 - t54*t87
+    t89 = t43*t73 + t6*t47 - t54*t87 + t29*t63
     t90 = t3*t87 - t29*t83
     t91 = t6*t87 + t29*t73
     t92 = t6*qd4
@@ -2298,7 +2298,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t59 = -t31*t34 + t45*t49 - t46*t50 + t47*t51 + t48*t52 + t56*t58
     t60 = c1*t35
     t61 = t45*t36 + t46*t37 + t47*t38 - t48*t39 - t44*t60
-    t62 = t60 + t3*t37 + t18*t39 - t14*t36 - t16*t38
+    t62 = t60 + t3*t37 + t18*t39 - t16*t38 - t14*t36
     t63 = t44*t58
     t64 = -t63 + t6*t46 + t10*t47 - t12*t48 + t8*t45
     t65 = t63 + t3*t50 + t16*t51 + t18*t52 + t14*t49
@@ -2306,9 +2306,9 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t67 = t66 + c2*t45 + t22*t47 + t25*t48 - t23*t46
     t68 = s1**2
     t69 = t31**2 + t49**2 + t50**2 + t51**2 + t52**2 + t56*t68
-    t70 = t6*t50 + t12*t52 + t44*t68 - t8*t49 - t10*t51
+    t70 = t6*t50 + t12*t52 + t44*t68 - t10*t51 - t8*t49
     t71 = s1*t35
-    t72 = t50*t37 + t52*t39 + t44*t71 - t49*t36 - t51*t38
+    t72 = t50*t37 + t52*t39 - t49*t36 - t51*t38 + t44*t71
     t73 = t71 + t6*t37 + t10*t38 + t12*t39 + t8*t36
     t74 = s2**2
     t75 = t6**2 + t10**2 + t12**2 + t13**2 + t68 + t54*t74
@@ -2634,7 +2634,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t88 = -t57*t61 + t73*t77 - t74*t78 + t75*t79 + t76*t80 + t85*t87
     t89 = c1*t62
     t90 = t73*t63 + t74*t64 + t75*t65 - t76*t66 - t71*t89
-    t91 = t89 + t4*t64 + t25*t66 - t21*t63 - t23*t65
+    t91 = t89 + t4*t64 + t25*t66 - t23*t65 - t21*t63
     t92 = t71*t87
     t93 = -t92 + t7*t74 + t11*t75 - t13*t76 + t9*t73
     t94 = t92 + t4*t78 + t23*t79 + t25*t80 + t21*t77
@@ -2643,9 +2643,9 @@ def ik_numeric_step(target, q, damping=0.0):
     t97 = t95 + T13
     t98 = s1**2
     t99 = t57**2 + t77**2 + t78**2 + t79**2 + t80**2 + t85*t98
-    t100 = t7*t78 + t13*t80 + t71*t98 - t9*t77 - t11*t79
+    t100 = t7*t78 + t13*t80 + t71*t98 - t11*t79 - t9*t77
     t101 = s1*t62
-    t102 = t78*t64 + t80*t66 + t71*t101 - t77*t63 - t79*t65
+    t102 = t78*t64 + t80*t66 - t77*t63 - t79*t65 + t71*t101
     t103 = t101 + t7*t64 + t11*t65 + t13*t66 + t9*t63
     t104 = s2**2
     t105 = t7**2 + t11**2 + t13**2 + t15**2 + t98 + t83*t104
@@ -3013,10 +3013,10 @@ def ik_branches(T, q_free):
     t149 = t148*t143
     t150 = t148*t146
     t151 = t22*t134
-    t152 = t24*t133 + c3*t151 - s3*t149
+    t152 = t24*t133 - s3*t149 + c3*t151
     t153 = t24*t139 + c3*t149 + s3*t151
     t154 = t22*t136
-    t155 = t24*t135 + c3*t154 - s3*t150
+    t155 = t24*t135 - s3*t150 + c3*t154
     t156 = t24*t141 + c3*t150 + s3*t154
     t157 = t144**2
     t158 = t157 + t152**2 + t153**2
@@ -3081,10 +3081,10 @@ def ik_branches(T, q_free):
     t217 = t148*t216
     t218 = -t24*t205 + t22*t215
     t219 = t22*t203
-    t220 = t24*t202 + c3*t219 - s3*t213
+    t220 = t24*t202 - s3*t213 + c3*t219
     t221 = t24*t208 + c3*t213 + s3*t219
     t222 = t22*t205
-    t223 = t24*t204 + c3*t222 - s3*t217
+    t223 = t24*t204 - s3*t217 + c3*t222
     t224 = t24*t210 + c3*t217 + s3*t222
     t225 = t214**2
     t226 = t225 + t220**2 + t221**2

@@ -799,9 +799,9 @@ void kr5_fk_jacobian_dot(const kr5_real q[KR5_DOF], const kr5_real q_dot[KR5_DOF
     J[33] = c23;
     J[34] = t22;
     J[35] = -t21;
-    a[0] = -qd1*t83 + qd2*(c1*t61 - qd1*t86) - qd3*(t66*t54 + qd1*t87 - c1*t60) + qd4*(t56*t68 + t48*qd1 - c23*t80 + t14*t59) + qd5*(t58*t69 - t50*t0 + t72*t58 - t22*t79);
+    a[0] = -qd1*t83 + qd2*(c1*t61 - qd1*t86) - qd3*(-c1*t60 + t66*t54 + qd1*t87) + qd4*(t56*t68 + t48*qd1 - c23*t80 + t14*t59) + qd5*(t58*t69 - t50*t0 + t72*t58 - t22*t79);
     a[1] = qd1*t78 + qd2*(s1*t61 + t84*qd1) + qd3*(s1*t60 + qd1*t85 - t62*t54) + qd4*(t44*qd1 + t56*t64 + c23*t75 - t9*t59) + qd5*(t46*t0 - t58*t65 + t22*t74 + t70*t58);
-    a[2] = -qd2*(s1*t82 + c1*t77) + qd4*(t48*t64 - t44*t68 + t9*t80 - t14*t75) - qd5*(t46*t69 + t70*t50 + t72*t46 - t50*t65) - qd3*(c1*t76 + s1*t81 + t62*t87 + t66*t85);
+    a[2] = -qd2*(s1*t82 + c1*t77) + qd4*(t48*t64 - t44*t68 + t9*t80 - t14*t75) - qd5*(t46*t69 - t50*t65 + t70*t50 + t72*t46) - qd3*(c1*t76 + s1*t81 + t62*t87 + t66*t85);
     a[3] = -t66*qd1 - t67*qd1 + qd4*(c23*t68 - t14*qd1) + qd5*(-t4*t0 + t22*t69) - qd6*(t21*t73 + t16*t25);
     a[4] = qd6*(t11*t25 + t21*t71) - t62*qd1 - t63*qd1 + qd4*(c23*t64 + t9*qd1) - qd5*(t7*t0 + t22*t65);
     a[5] = qd5*(t4*t65 + t7*t69) + qd6*(t16*t71 - t11*t73) - qd4*(t14*t64 + t9*t68);

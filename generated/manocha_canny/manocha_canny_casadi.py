@@ -876,7 +876,7 @@ def _fk_jacobian_dot(q, q_dot):
     J[5, 5] = -t66
     a = casadi.SX(6, 1)
     a[0, 0] = -qd1*t92 + qd2*(-c1*t88 + qd1*t107) + qd3*(t77*qd1 + t11*t87 + t0*t80 - t93*t84) + qd4*(t86*t94 - t79*t2 - t86*t100 + t79*t103)
-    a[1, 0] = qd1*t96 - qd2*(s1*t88 + qd1*t106) - qd3*(t6*t87 + t0*t75 + t89*t84 - t72*qd1) + qd4*(t74*t2 - t86*t90 - t74*t103 + t86*t97)
+    a[1, 0] = qd1*t96 - qd2*(s1*t88 + qd1*t106) - qd3*(t6*t87 + t0*t75 - t72*qd1 + t89*t84) + qd4*(t74*t2 - t86*t90 - t74*t103 + t86*t97)
     a[2, 0] = qd2*(s1*t91 + c1*t95) + qd3*(t6*t80 - t11*t75 - t89*t77 + t93*t72) + qd4*(t79*t90 - t74*t94 - t79*t97 + t74*t100)
     a[3, 0] = qd4*(-t27*t94 + t22*t2) + qd5*(t29*t101 + t24*t104) + qd6*(-t66*t102 + t59*t105) + t93*qd1 + qd3*(-t11*qd1 + t0*t93)
     a[4, 0] = qd4*(-t16*t2 + t27*t90) + qd6*(-t52*t105 + t66*t99) + t89*qd1 + qd3*(t6*qd1 + t0*t89) - qd5*(t18*t104 + t29*t98)
@@ -1918,7 +1918,7 @@ def _velocity_ik(q, mu_dot, damping):
     t256 = t33*t248 + t41*t247 + t53*t246
     t257 = c1*t55
     t258 = s1*t55
-    t259 = c1*t247 + t257*t251 + t258*t250 - t45*t249 - s1*t248
+    t259 = c1*t247 - t45*t249 - s1*t248 + t257*t251 + t258*t250
     t260 = 1 + t64 + t79
     t261 = casadi.sqrt(t68 + t82 + t88 + t90 + t92 + t94 + t260)
     t262 = casadi.sqrt(t260)

@@ -1016,7 +1016,7 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t52, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(qd1*t113 + qd4*(t87*t99 + t77*qd1 - t14*t116 - t4*t110) + qd2*(-c1*t118 + qd1*t121) - qd3*(t97*t85 + qd1*t122 - c1*t117) - qd5*(-t89*t100 + t79*t10 + t22*t115 + t26*t109) - qd6*(t81*t28 + t46*t114 + t52*t108 - t91*t101), batch),  # 0
+        xp.broadcast_to(qd1*t113 + qd4*(t87*t99 + t77*qd1 - t14*t116 - t4*t110) + qd2*(-c1*t118 + qd1*t121) - qd3*(-c1*t117 + t97*t85 + qd1*t122) - qd5*(-t89*t100 + t79*t10 + t22*t115 + t26*t109) - qd6*(t81*t28 - t91*t101 + t46*t114 + t52*t108), batch),  # 0
         xp.broadcast_to(-qd1*t107 + qd4*(t71*qd1 - t87*t94 - t4*t104 + t13*t116) + qd2*(s1*t118 + t119*qd1) - qd3*(s1*t117 + t120*qd1 - t92*t85) - qd5*(t73*t10 + t89*t95 + t26*t103 - t19*t115) - qd6*(t91*t96 + t75*t28 + t52*t102 - t40*t114), batch),  # 1
         xp.broadcast_to(qd2*(-s1*t112 + c1*t106) + qd4*(t77*t94 + t71*t99 - t13*t110 - t14*t104) + qd5*(t79*t95 + t73*t100 - t19*t109 - t22*t103) + qd6*(t81*t96 + t75*t101 - t40*t108 - t46*t102) + qd3*(s1*t111 - c1*t105 + t92*t122 + t97*t120), batch),  # 2
         xp.broadcast_to(qd4*(t4*t99 - t14*qd1) + qd5*(t26*t100 + t22*t10) + qd6*(t52*t101 + t46*t28) - t97*qd1 + t98*qd1, batch),  # 3
@@ -2302,7 +2302,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t263 = -t54*t259 + t57*t258 + t45*t257 - t31*t256 - t37*t255 + t47*t254
     t264 = s1*t51
     t265 = s1*t256 + c1*t255
-    t266 = t265 + t81*t259 - t264*t258 - t64*t257
+    t266 = t265 - t64*t257 + t81*t259 - t264*t258
     t267 = s1*t50
     t268 = t265 + t42*t257 + t82*t259 - t267*t258
     t269 = 1 + t67 + t86

@@ -1010,7 +1010,7 @@ void panda_fk_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot
     J[40] = -t43;
     J[41] = t125;
     a[0] = -qd1*t110 + qd5*(t98*t113 - t85*t53 + t26*t101 - t40*t88) + qd2*(c1*t104 - t67*qd1) + qd3*(-t81*qd1 - c2*t90 + t94*t111 + t23*t103) + qd4*(t96*t112 + t83*t0 - t4*t102 + t41*t89) + qd6*(t100*t114 + t87*t54 - t100*t119 - t87*t121);
-    a[1] = qd1*t116 + qd5*(t73*t53 - t98*t107 + t40*t76 - t12*t101) + qd2*(s1*t104 + t79*qd1) + qd3*(t69*qd1 + c2*t78 + t105*t94 - t9*t103) - qd4*(t96*t106 + t7*t102 + t41*t77 - t71*t0) - qd6*(t100*t108 + t75*t121 + t100*t117 - t75*t54);
+    a[1] = qd1*t116 + qd5*(t73*t53 - t98*t107 + t40*t76 - t12*t101) + qd2*(s1*t104 + t79*qd1) + qd3*(t69*qd1 + c2*t78 + t105*t94 - t9*t103) - qd4*(t96*t106 + t7*t102 - t71*t0 + t41*t77) - qd6*(t100*t108 - t75*t54 + t75*t121 + t100*t117);
     a[2] = qd4*(-t83*t106 - t71*t112 + t7*t89 + t4*t77) + qd5*(t85*t107 - t73*t113 + t12*t88 - t26*t76) - qd2*(s1*t109 + c1*t115) - qd3*(t105*t81 + t69*t111 - t9*t90 + t23*t78) - qd6*(t75*t114 + t87*t108 + t87*t117 - t75*t119);
     a[3] = qd5*(t40*t113 - t26*t53) + qd6*(-t43*t114 + t28*t54) + qd7*(-t45*t120 + t30*t122) - qd1*t111 + qd3*(c2*t111 - t23*qd1) + qd4*(t4*t0 - t41*t112);
     a[4] = qd5*(t12*t53 - t40*t107) + qd6*(t14*t54 + t43*t108) + qd7*(-t16*t122 + t45*t118) - t105*qd1 + qd3*(t9*qd1 + c2*t105) + qd4*(t7*t0 + t41*t106);
@@ -1455,7 +1455,7 @@ void panda_task_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_d
     const panda_real t98 = qd1 + c2*qd3;
     const panda_real t99 = t98;
     const panda_real t100 = t40*t95 + t70*t99 - t3*t44 + t53*t76;
-    const panda_real t101 = t40*t85 + t6*t44 + t53*t75 - t66*t99;
+    const panda_real t101 = t40*t85 + t6*t44 - t66*t99 + t53*t75;
     const panda_real t102 = t3*t99 - t53*t95;
     const panda_real t103 = t6*t99 + t53*t85;
     const panda_real t104 = t6*qd4;
@@ -2531,13 +2531,13 @@ int panda_velocity_ik(const panda_real q[PANDA_DOF], const panda_real mu_dot[PAN
     const panda_real t69 = -t19*t31 + t51*t55 - t52*t56 + t53*t57 - t54*t58 + t66*t68;
     const panda_real t70 = c1*t32;
     const panda_real t71 = t51*t33 + t52*t34 + t53*t35 + t54*t36 - t50*t70;
-    const panda_real t72 = t70 + t3*t34 + t25*t36 - t20*t33 - t23*t35;
+    const panda_real t72 = t70 + t3*t34 + t25*t36 - t23*t35 - t20*t33;
     const panda_real t73 = t50*t68;
     const panda_real t74 = -t73 + t6*t52 + t11*t53 + t13*t54 + t8*t51;
     const panda_real t75 = t73 + t3*t56 + t23*t57 + t25*t58 + t20*t55;
     const panda_real t76 = (s1*s1);
     const panda_real t77 = (t19*t19) + (t55*t55) + (t56*t56) + (t57*t57) + (t58*t58) + t66*t76;
-    const panda_real t78 = t6*t56 + t13*t58 + t50*t76 - t8*t55 - t11*t57;
+    const panda_real t78 = t6*t56 + t13*t58 - t11*t57 + t50*t76 - t8*t55;
     const panda_real t79 = s1*t32;
     const panda_real t80 = t50*t79 + t56*t34 + t58*t36 - t55*t33 - t57*t35;
     const panda_real t81 = t79 + t6*t34 + t11*t35 + t13*t36 + t8*t33;

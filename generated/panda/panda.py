@@ -1021,7 +1021,7 @@ def fk_jacobian_dot(q, q_dot):
     ], (6, 7))
     a = _stack(xp, [
         xp.broadcast_to(-qd1*t110 + qd5*(t98*t113 - t85*t53 + t26*t101 - t40*t88) + qd2*(c1*t104 - t67*qd1) + qd3*(-t81*qd1 - c2*t90 + t94*t111 + t23*t103) + qd4*(t96*t112 + t83*t0 - t4*t102 + t41*t89) + qd6*(t100*t114 + t87*t54 - t100*t119 - t87*t121), batch),  # 0
-        xp.broadcast_to(qd1*t116 + qd5*(t73*t53 - t98*t107 + t40*t76 - t12*t101) + qd2*(s1*t104 + t79*qd1) + qd3*(t69*qd1 + c2*t78 + t105*t94 - t9*t103) - qd4*(t96*t106 + t7*t102 + t41*t77 - t71*t0) - qd6*(t100*t108 + t75*t121 + t100*t117 - t75*t54), batch),  # 1
+        xp.broadcast_to(qd1*t116 + qd5*(t73*t53 - t98*t107 + t40*t76 - t12*t101) + qd2*(s1*t104 + t79*qd1) + qd3*(t69*qd1 + c2*t78 + t105*t94 - t9*t103) - qd4*(t96*t106 + t7*t102 - t71*t0 + t41*t77) - qd6*(t100*t108 - t75*t54 + t75*t121 + t100*t117), batch),  # 1
         xp.broadcast_to(qd4*(-t83*t106 - t71*t112 + t7*t89 + t4*t77) + qd5*(t85*t107 - t73*t113 + t12*t88 - t26*t76) - qd2*(s1*t109 + c1*t115) - qd3*(t105*t81 + t69*t111 - t9*t90 + t23*t78) - qd6*(t75*t114 + t87*t108 + t87*t117 - t75*t119), batch),  # 2
         xp.broadcast_to(qd5*(t40*t113 - t26*t53) + qd6*(-t43*t114 + t28*t54) + qd7*(-t45*t120 + t30*t122) - qd1*t111 + qd3*(c2*t111 - t23*qd1) + qd4*(t4*t0 - t41*t112), batch),  # 3
         xp.broadcast_to(qd5*(t12*t53 - t40*t107) + qd6*(t14*t54 + t43*t108) + qd7*(-t16*t122 + t45*t118) - t105*qd1 + qd3*(t9*qd1 + c2*t105) + qd4*(t7*t0 + t41*t106), batch),  # 4
@@ -1442,7 +1442,7 @@ def task_jacobian_dot(q, q_dot):
     t98 = qd1 + c2*qd3
     t99 = t98
     t100 = t40*t95 + t70*t99 - t3*t44 + t53*t76
-    t101 = t40*t85 + t6*t44 + t53*t75 - t66*t99
+    t101 = t40*t85 + t6*t44 - t66*t99 + t53*t75
     t102 = t3*t99 - t53*t95
     t103 = t6*t99 + t53*t85
     t104 = t6*qd4
@@ -2491,13 +2491,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t69 = -t19*t31 + t51*t55 - t52*t56 + t53*t57 - t54*t58 + t66*t68
     t70 = c1*t32
     t71 = t51*t33 + t52*t34 + t53*t35 + t54*t36 - t50*t70
-    t72 = t70 + t3*t34 + t25*t36 - t20*t33 - t23*t35
+    t72 = t70 + t3*t34 + t25*t36 - t23*t35 - t20*t33
     t73 = t50*t68
     t74 = -t73 + t6*t52 + t11*t53 + t13*t54 + t8*t51
     t75 = t73 + t3*t56 + t23*t57 + t25*t58 + t20*t55
     t76 = s1**2
     t77 = t19**2 + t55**2 + t56**2 + t57**2 + t58**2 + t66*t76
-    t78 = t6*t56 + t13*t58 + t50*t76 - t8*t55 - t11*t57
+    t78 = t6*t56 + t13*t58 - t11*t57 + t50*t76 - t8*t55
     t79 = s1*t32
     t80 = t50*t79 + t56*t34 + t58*t36 - t55*t33 - t57*t35
     t81 = t79 + t6*t34 + t11*t35 + t13*t36 + t8*t33

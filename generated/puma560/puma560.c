@@ -1776,14 +1776,14 @@ int puma560_velocity_ik(const puma560_real q[PUMA560_DOF], const puma560_real mu
     const puma560_real t224 = (t126 != 0 ? -(-(-t152*t223 - t145*t222 + t130*t221 + t197*t220) + t136)/t126 : 0);
     const puma560_real t225 = (t84 != 0 ? -(t119 + t95*t223 + t101*t222 + t114*t220 - t88*t224 - t107*t221)/t84 : 0);
     const puma560_real t226 = t220 - t23*t225 + t22*t224;
-    const puma560_real t227 = t14*t222 + t17*t221 - c23*t220;
+    const puma560_real t227 = -c23*t220 + t14*t222 + t17*t221;
     const puma560_real t228 = t12*t222 - t9*t221 + t62*t220;
     const puma560_real t229 = t15*t222 + t18*t221 - t0*t220;
     const puma560_real t230 = s1*t2;
     const puma560_real t231 = c1*t221 - s1*t222;
-    const puma560_real t232 = t231 + t39*t225 + t230*t224 - t24*t223;
+    const puma560_real t232 = t231 - t24*t223 + t39*t225 + t230*t224;
     const puma560_real t233 = s1*t1;
-    const puma560_real t234 = t231 + t40*t225 + t233*t224 - t20*t223;
+    const puma560_real t234 = t231 - t20*t223 + t40*t225 + t233*t224;
     const puma560_real t235 = -t23;
     const puma560_real t236 = t235 + t44;
     const puma560_real t237 = -t45*(t39*t236 + t22*t230);

@@ -1419,9 +1419,9 @@ void sawyer_fk_jacobian_dot(const sawyer_real q[SAWYER_DOF], const sawyer_real q
     J[39] = t41;
     J[40] = -t44;
     J[41] = t114;
-    a[0] = -qd1*t99 + qd5*(t87*t102 - t74*t54 + t26*t90 - t41*t77) + qd2*(c1*t93 - t56*qd1) + qd3*(-t70*qd1 + c2*t79 + t83*t100 - t24*t92) - qd4*(t72*t0 + t4*t91 + t42*t78 - t85*t101) + qd6*(t89*t103 - t76*t55 + t89*t108 + t76*t110);
+    a[0] = -qd1*t99 + qd5*(t87*t102 - t74*t54 + t26*t90 - t41*t77) + qd2*(c1*t93 - t56*qd1) + qd3*(-t70*qd1 + c2*t79 + t83*t100 - t24*t92) - qd4*(t72*t0 + t4*t91 - t85*t101 + t42*t78) + qd6*(t89*t103 - t76*t55 + t89*t108 + t76*t110);
     a[1] = qd1*t105 + qd5*(t62*t54 - t87*t96 + t41*t65 - t11*t90) + qd2*(s1*t93 + t68*qd1) + qd3*(t58*qd1 - c2*t67 + t83*t94 + t9*t92) + qd4*(-t60*t0 + t85*t95 - t7*t91 + t42*t66) + qd6*(t64*t55 - t89*t97 - t64*t110 + t89*t106);
-    a[2] = qd4*(-t72*t95 + t60*t101 + t7*t78 + t4*t66) + qd5*(t74*t96 - t62*t102 + t11*t77 - t26*t65) - qd2*(s1*t98 + c1*t104) - qd3*(t70*t94 + t58*t100 + t9*t79 - t24*t67) - qd6*(t64*t103 + t76*t106 + t64*t108 - t76*t97);
+    a[2] = qd4*(-t72*t95 + t60*t101 + t7*t78 + t4*t66) + qd5*(t74*t96 - t62*t102 + t11*t77 - t26*t65) - qd2*(s1*t98 + c1*t104) - qd3*(t70*t94 + t58*t100 + t9*t79 - t24*t67) - qd6*(t64*t103 - t76*t97 + t76*t106 + t64*t108);
     a[3] = qd5*(t41*t102 - t26*t54) + qd7*(-t46*t109 + t30*t111) - qd1*t100 + qd3*(-c2*t100 + t24*qd1) + qd4*(t4*t0 + t42*t101) - qd6*(t44*t103 + t28*t55);
     a[4] = qd5*(t11*t54 - t41*t96) + qd6*(-t13*t55 + t44*t97) + qd7*(-t15*t111 + t46*t107) - qd1*t94 - qd3*(t9*qd1 + c2*t94) + qd4*(t7*t0 + t42*t95);
     a[5] = qd4*(t4*t95 - t7*t101) + qd5*(t26*t96 - t11*t102) + qd6*(t28*t97 + t13*t103) + qd7*(-t30*t107 + t15*t109) + qd3*(t24*t94 + t9*t100);
@@ -1552,7 +1552,7 @@ void sawyer_jacobian_dot(const sawyer_real q[SAWYER_DOF], const sawyer_real q_do
     Jd[0] = -t74;
     Jd[1] = c1*t41 - t52*t87;
     Jd[2] = -t57*qd1 + c2*t68 - t21*t40 + t75*t34;
-    Jd[3] = -(t58*t0 + t4*t39 + t45*t66 - t35*t76);
+    Jd[3] = -(t58*t0 + t4*t39 - t35*t76 + t45*t66);
     Jd[4] = t36*t77 - t59*t61 + t23*t38 - t44*t64;
     Jd[5] = t37*t78 - t60*t62 + t83*t37 + t85*t60;
     Jd[6] = 0;
@@ -1715,7 +1715,7 @@ void sawyer_bias_acceleration(const sawyer_real q[SAWYER_DOF], const sawyer_real
     const sawyer_real t87 = t52*qd1;
 
     /* Outputs */
-    a[0] = -qd1*t74 + qd5*(t36*t77 - t59*t61 + t23*t38 - t44*t64) - qd4*(t58*t0 + t4*t39 + t45*t66 - t35*t76) + qd2*(c1*t41 - s1*t87) + qd3*(-t57*qd1 + c2*t68 - t21*t40 + t75*t34) + qd6*(t37*t78 - t60*t62 + t83*t37 + t85*t60);
+    a[0] = -qd1*t74 + qd5*(t36*t77 - t59*t61 + t23*t38 - t44*t64) - qd4*(t58*t0 + t4*t39 - t35*t76 + t45*t66) + qd2*(c1*t41 - s1*t87) + qd3*(-t57*qd1 + c2*t68 - t21*t40 + t75*t34) + qd6*(t37*t78 - t60*t62 + t83*t37 + t85*t60);
     a[1] = qd1*t80 + qd5*(t55*t61 - t36*t71 + t44*t63 - t11*t38) + qd4*(-t54*t0 + t35*t70 - t7*t39 + t45*t65) + qd2*(s1*t41 + c1*t87) + qd3*(t53*qd1 - c2*t67 + t9*t40 + t69*t34) + qd6*(t56*t62 - t37*t72 - t85*t56 + t81*t37);
     a[2] = qd4*(-t58*t70 + t54*t76 + t7*t66 + t4*t65) + qd5*(t59*t71 - t55*t77 + t11*t64 - t23*t63) - qd2*(s1*t73 + c1*t79) - qd3*(t9*t68 - t21*t67 + t69*t57 + t75*t53) - qd6*(t56*t78 - t60*t72 + t81*t60 + t83*t56);
     a[3] = qd5*(t44*t77 - t23*t61) + qd7*(-t48*t84 + t26*t86) + qd4*(t4*t0 + t45*t76) - qd6*(t47*t78 + t25*t62) - t75*qd1 + qd3*(t21*qd1 - c2*t75);
@@ -1853,7 +1853,7 @@ void sawyer_task_jacobian_dot(const sawyer_real q[SAWYER_DOF], const sawyer_real
     const sawyer_real t92 = t3*t80 - t6*t90;
     const sawyer_real t93 = qd1 - c2*qd3;
     const sawyer_real t94 = t93;
-    const sawyer_real t95 = t65*t94 + t3*t42 + t50*t71 - t38*t90;
+    const sawyer_real t95 = t65*t94 + t3*t42 - t38*t90 + t50*t71;
     const sawyer_real t96 = -t61*t94 + t38*t80 - t6*t42 + t50*t70;
     const sawyer_real t97 = t3*t94 + t50*t90;
     const sawyer_real t98 = t6*t94 + t50*t80;
@@ -2927,11 +2927,11 @@ int sawyer_velocity_ik(const sawyer_real q[SAWYER_DOF], const sawyer_real mu_dot
     const sawyer_real t72 = -t48*t71 + t59*t33 - t49*t34 + t50*t35 + t51*t36;
     const sawyer_real t73 = t71 + t3*t34 + t20*t33 - t22*t35 - t24*t36;
     const sawyer_real t74 = t48*t69;
-    const sawyer_real t75 = t74 + t6*t49 + t12*t51 + t8*t59 - t10*t50;
+    const sawyer_real t75 = t74 + t6*t49 + t12*t51 - t10*t50 + t8*t59;
     const sawyer_real t76 = t74 - t3*t52 + t22*t53 + t24*t54 - t20*t62;
     const sawyer_real t77 = (s1*s1);
     const sawyer_real t78 = (t19*t19) + (t62*t62) + (t52*t52) + (t53*t53) + (t54*t54) + t67*t77;
-    const sawyer_real t79 = t12*t54 + t8*t62 + t48*t77 - t6*t52 - t10*t53;
+    const sawyer_real t79 = t12*t54 + t8*t62 - t6*t52 - t10*t53 + t48*t77;
     const sawyer_real t80 = s1*t32;
     const sawyer_real t81 = t62*t33 + t52*t34 + t53*t35 + t54*t36 - t48*t80;
     const sawyer_real t82 = t80 + t6*t34 + t10*t35 - t12*t36 - t8*t33;
@@ -3266,7 +3266,7 @@ sawyer_real sawyer_ik_numeric_step(const sawyer_real target[16], const sawyer_re
     const sawyer_real t96 = t69*t44 - t70*t45 + t71*t46 + t72*t47 - t67*t95;
     const sawyer_real t97 = t95 + t4*t45 + t28*t44 - t30*t46 - t32*t47;
     const sawyer_real t98 = t67*t93;
-    const sawyer_real t99 = t98 + t7*t70 + t13*t72 + t9*t69 - t11*t71;
+    const sawyer_real t99 = t98 + t7*t70 + t13*t72 - t11*t71 + t9*t69;
     const sawyer_real t100 = t98 - t4*t74 + t30*t75 + t32*t76 - t28*t73;
     const sawyer_real t101 = (s1*s1);
     const sawyer_real t102 = (t23*t23) + (t73*t73) + (t74*t74) + (t75*t75) + (t76*t76) + t91*t101;

@@ -958,9 +958,9 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t114, batch),  # 5, 6
     ], (6, 7))
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t99 + qd5*(t87*t102 - t74*t54 + t26*t90 - t41*t77) + qd2*(c1*t93 - t56*qd1) + qd3*(-t70*qd1 + c2*t79 + t83*t100 - t24*t92) - qd4*(t72*t0 + t4*t91 + t42*t78 - t85*t101) + qd6*(t89*t103 - t76*t55 + t89*t108 + t76*t110), batch),  # 0
+        xp.broadcast_to(-qd1*t99 + qd5*(t87*t102 - t74*t54 + t26*t90 - t41*t77) + qd2*(c1*t93 - t56*qd1) + qd3*(-t70*qd1 + c2*t79 + t83*t100 - t24*t92) - qd4*(t72*t0 + t4*t91 - t85*t101 + t42*t78) + qd6*(t89*t103 - t76*t55 + t89*t108 + t76*t110), batch),  # 0
         xp.broadcast_to(qd1*t105 + qd5*(t62*t54 - t87*t96 + t41*t65 - t11*t90) + qd2*(s1*t93 + t68*qd1) + qd3*(t58*qd1 - c2*t67 + t83*t94 + t9*t92) + qd4*(-t60*t0 + t85*t95 - t7*t91 + t42*t66) + qd6*(t64*t55 - t89*t97 - t64*t110 + t89*t106), batch),  # 1
-        xp.broadcast_to(qd4*(-t72*t95 + t60*t101 + t7*t78 + t4*t66) + qd5*(t74*t96 - t62*t102 + t11*t77 - t26*t65) - qd2*(s1*t98 + c1*t104) - qd3*(t70*t94 + t58*t100 + t9*t79 - t24*t67) - qd6*(t64*t103 + t76*t106 + t64*t108 - t76*t97), batch),  # 2
+        xp.broadcast_to(qd4*(-t72*t95 + t60*t101 + t7*t78 + t4*t66) + qd5*(t74*t96 - t62*t102 + t11*t77 - t26*t65) - qd2*(s1*t98 + c1*t104) - qd3*(t70*t94 + t58*t100 + t9*t79 - t24*t67) - qd6*(t64*t103 - t76*t97 + t76*t106 + t64*t108), batch),  # 2
         xp.broadcast_to(qd5*(t41*t102 - t26*t54) + qd7*(-t46*t109 + t30*t111) - qd1*t100 + qd3*(-c2*t100 + t24*qd1) + qd4*(t4*t0 + t42*t101) - qd6*(t44*t103 + t28*t55), batch),  # 3
         xp.broadcast_to(qd5*(t11*t54 - t41*t96) + qd6*(-t13*t55 + t44*t97) + qd7*(-t15*t111 + t46*t107) - qd1*t94 - qd3*(t9*qd1 + c2*t94) + qd4*(t7*t0 + t42*t95), batch),  # 4
         xp.broadcast_to(qd4*(t4*t95 - t7*t101) + qd5*(t26*t96 - t11*t102) + qd6*(t28*t97 + t13*t103) + qd7*(-t30*t107 + t15*t109) + qd3*(t24*t94 + t9*t100), batch),  # 5
@@ -1083,7 +1083,7 @@ def jacobian_dot(q, q_dot):
         xp.broadcast_to(-t74, batch),  # 0, 0
         xp.broadcast_to(c1*t41 - t52*t87, batch),  # 0, 1
         xp.broadcast_to(-t57*qd1 + c2*t68 - t21*t40 + t75*t34, batch),  # 0, 2
-        xp.broadcast_to(-(t58*t0 + t4*t39 + t45*t66 - t35*t76), batch),  # 0, 3
+        xp.broadcast_to(-(t58*t0 + t4*t39 - t35*t76 + t45*t66), batch),  # 0, 3
         xp.broadcast_to(t36*t77 - t59*t61 + t23*t38 - t44*t64, batch),  # 0, 4
         xp.broadcast_to(t37*t78 - t60*t62 + t83*t37 + t85*t60, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
@@ -1238,7 +1238,7 @@ def bias_acceleration(q, q_dot):
     t86 = -t85 + t62
     t87 = t52*qd1
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t74 + qd5*(t36*t77 - t59*t61 + t23*t38 - t44*t64) - qd4*(t58*t0 + t4*t39 + t45*t66 - t35*t76) + qd2*(c1*t41 - s1*t87) + qd3*(-t57*qd1 + c2*t68 - t21*t40 + t75*t34) + qd6*(t37*t78 - t60*t62 + t83*t37 + t85*t60), batch),  # 0
+        xp.broadcast_to(-qd1*t74 + qd5*(t36*t77 - t59*t61 + t23*t38 - t44*t64) - qd4*(t58*t0 + t4*t39 - t35*t76 + t45*t66) + qd2*(c1*t41 - s1*t87) + qd3*(-t57*qd1 + c2*t68 - t21*t40 + t75*t34) + qd6*(t37*t78 - t60*t62 + t83*t37 + t85*t60), batch),  # 0
         xp.broadcast_to(qd1*t80 + qd5*(t55*t61 - t36*t71 + t44*t63 - t11*t38) + qd4*(-t54*t0 + t35*t70 - t7*t39 + t45*t65) + qd2*(s1*t41 + c1*t87) + qd3*(t53*qd1 - c2*t67 + t9*t40 + t69*t34) + qd6*(t56*t62 - t37*t72 - t85*t56 + t81*t37), batch),  # 1
         xp.broadcast_to(qd4*(-t58*t70 + t54*t76 + t7*t66 + t4*t65) + qd5*(t59*t71 - t55*t77 + t11*t64 - t23*t63) - qd2*(s1*t73 + c1*t79) - qd3*(t9*t68 - t21*t67 + t69*t57 + t75*t53) - qd6*(t56*t78 - t60*t72 + t81*t60 + t83*t56), batch),  # 2
         xp.broadcast_to(qd5*(t44*t77 - t23*t61) + qd7*(-t48*t84 + t26*t86) + qd4*(t4*t0 + t45*t76) - qd6*(t47*t78 + t25*t62) - t75*qd1 + qd3*(t21*qd1 - c2*t75), batch),  # 3
@@ -1368,7 +1368,7 @@ def task_jacobian_dot(q, q_dot):
     t92 = t3*t80 - t6*t90
     t93 = qd1 - c2*qd3
     t94 = t93
-    t95 = t65*t94 + t3*t42 + t50*t71 - t38*t90
+    t95 = t65*t94 + t3*t42 - t38*t90 + t50*t71
     t96 = -t61*t94 + t38*t80 - t6*t42 + t50*t70
     t97 = t3*t94 + t50*t90
     t98 = t6*t94 + t50*t80
@@ -2415,11 +2415,11 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t72 = -t48*t71 + t59*t33 - t49*t34 + t50*t35 + t51*t36
     t73 = t71 + t3*t34 + t20*t33 - t22*t35 - t24*t36
     t74 = t48*t69
-    t75 = t74 + t6*t49 + t12*t51 + t8*t59 - t10*t50
+    t75 = t74 + t6*t49 + t12*t51 - t10*t50 + t8*t59
     t76 = t74 - t3*t52 + t22*t53 + t24*t54 - t20*t62
     t77 = s1**2
     t78 = t19**2 + t62**2 + t52**2 + t53**2 + t54**2 + t67*t77
-    t79 = t12*t54 + t8*t62 + t48*t77 - t6*t52 - t10*t53
+    t79 = t12*t54 + t8*t62 - t6*t52 - t10*t53 + t48*t77
     t80 = s1*t32
     t81 = t62*t33 + t52*t34 + t53*t35 + t54*t36 - t48*t80
     t82 = t80 + t6*t34 + t10*t35 - t12*t36 - t8*t33
@@ -2752,7 +2752,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t96 = t69*t44 - t70*t45 + t71*t46 + t72*t47 - t67*t95
     t97 = t95 + t4*t45 + t28*t44 - t30*t46 - t32*t47
     t98 = t67*t93
-    t99 = t98 + t7*t70 + t13*t72 + t9*t69 - t11*t71
+    t99 = t98 + t7*t70 + t13*t72 - t11*t71 + t9*t69
     t100 = t98 - t4*t74 + t30*t75 + t32*t76 - t28*t73
     t101 = s1**2
     t102 = t23**2 + t73**2 + t74**2 + t75**2 + t76**2 + t91*t101

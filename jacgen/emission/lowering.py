@@ -177,12 +177,12 @@ class Lowering:
     def _named(self, node: Node, mostly_negative: bool) -> Node:
         """The symbol of `node`'s value, defined on first use, or minus it: a sum is known by its
         terms, whatever their order, and one with mostly negative terms is named as its negation."""
-        graph, key = self.graph, _key(node)
+        graph, key = self.graph, _key(self.graph, node)
         if key in self._names:
             return graph.symbol(self._names[key])
         negated = graph.node(ADD, tuple(map(graph.negate, node.args))) if node.kind == ADD else graph.negate(node)
-        if _key(negated) in self._names:
-            return graph.negate(graph.symbol(self._names[_key(negated)]))
+        if _key(graph, negated) in self._names:
+            return graph.negate(graph.symbol(self._names[_key(graph, negated)]))
         if mostly_negative:
             return graph.negate(self._named(negated, False))
         symbol = sympy.Symbol(f"{names.INTERNAL_PREFIX}n{len(self.definitions)}", real=True)
@@ -231,9 +231,16 @@ class Lowering:
                     {symbol: f"t{k}" for k, symbol in enumerate(temporaries)})
 
 
-def _key(node: Node):
-    """What names a value on the graph: a sum by its set of terms."""
-    return (ADD, frozenset(node.args)) if node.kind == ADD else node
+def _key(graph: Graph, node: Node):
+    """What names a value on the graph: a sum by its set of terms; a negated product, -1*(a*b)
+    as `Graph.negate` builds it, as the product -1*a*b."""
+    if node.kind == ADD:
+        return ADD, frozenset(_flat(graph, term) for term in node.args)
+    return _flat(graph, node)
+
+
+def _flat(graph: Graph, node: Node) -> Node:
+    return graph.mul(*node.args) if node.kind == MUL and any(arg.kind == MUL for arg in node.args) else node
 
 
 def _mostly_negative(value: sympy.Expr) -> bool:
