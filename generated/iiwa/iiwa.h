@@ -73,7 +73,7 @@ void iiwa_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_D
 void iiwa_bias_acceleration(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 636 operations. */
+ * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 624 operations. */
 void iiwa_task_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real Jd[IIWA_TASK_DIM * IIWA_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).

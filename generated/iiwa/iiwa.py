@@ -1174,7 +1174,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 636 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 624 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1198,241 +1198,231 @@ def task_jacobian_dot(q, q_dot):
     s6 = trig[..., 11]
     c7 = trig[..., 12]
     s7 = trig[..., 13]
-    t0 = s1*s3
-    t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
-    t4 = s1*c3
-    t5 = s3*c1
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
-    t8 = c1*s2
-    t9 = t2*c4 + s4*t8
-    t10 = -t2*s4 + c4*t8
-    t11 = t9*c5 - t6*s5
-    t12 = t9*s5 + t6*c5
-    t13 = t11*c6 - t10*s6
-    t14 = t10*c6 + t11*s6
-    t15 = t13*c7 - t12*s7
-    t16 = s1*s2
-    t17 = t7*c4 + s4*t16
-    t18 = -t7*s4 + c4*t16
-    t19 = t17*c5 + t3*s5
-    t20 = t3*c5 - t17*s5
-    t21 = t19*c6 - t18*s6
-    t22 = t18*c6 + t19*s6
-    t23 = t20*s7 + t21*c7
-    t24 = t15**2 + t23**2
-    t25 = xp.sqrt(t24)
-    t26 = c3*s2
-    t27 = c2*s4 - c4*t26
-    t28 = c2*c4 + s4*t26
-    t29 = s3*s2
-    t30 = t27*c5 + s5*t29
-    t31 = -t27*s5 + c5*t29
-    t32 = t30*c6 - t28*s6
-    t33 = t28*c6 + t30*s6
-    t34 = t31*s7 + t32*c7
-    t35 = 0.126*t14
-    t36 = 0.4*t10 + t35
-    t37 = 0.42*t8 + t36
-    t38 = 0.126*t22
-    t39 = 0.4*t18 + t38
-    t40 = 0.42*t16 + t39
-    t41 = c1*t37 + s1*t40
-    t42 = t40*t8 - t37*t16
-    t43 = t3*t36 + t6*t39
-    t44 = t10*t39 - t18*t36
-    t45 = t12*t38 + t20*t35
-    t46 = -t45*qd6 + t44*qd5
-    t47 = t46 + t43*qd4
-    t48 = t47 + t42*qd3
-    t49 = t48 - t41*qd2
-    t50 = 0.126*t33
-    t51 = 0.4*t28 + t50
-    t52 = 0.42*c2 + t51
-    t53 = -c2*t40 + t52*t16
-    t54 = -t3*t51 + t39*t29
-    t55 = t18*t51 - t28*t39
-    t56 = -t31*t38 + t20*t50
-    t57 = c2*t37 - t52*t8
-    t58 = t6*t51 + t36*t29
-    t59 = t28*t36 - t10*t51
-    t60 = t12*t50 + t31*t35
-    t61 = t56*qd6 + t55*qd5
-    t62 = t60*qd6 + t59*qd5
-    t63 = t61 + t54*qd4
-    t64 = t62 - t58*qd4
-    t65 = t63 + t53*qd3
-    t66 = t64 + t57*qd3
-    t67 = s1*qd2
-    t68 = t66 + t52*t67
-    t69 = t68 + t37*qd1
-    t70 = t53*qd1 + c2*t65 - t8*t48 + t67*t42
-    t71 = t8*qd1 + c2*t67
-    t72 = -t67 + t8*qd3
-    t73 = t72
-    t74 = c1*qd2
-    t75 = t65 + t52*t74
-    t76 = t75 - t40*qd1
-    t77 = -t57*qd1 - c2*t66 + t16*t48 + t74*t42
-    t78 = s1*t68 + c1*t75
-    t79 = -t8*t66 + t16*t65 + t67*t57 + t74*t53
-    t80 = -t16*qd1 + c2*t74
-    t81 = t16*t67 + t8*t74
-    t82 = t74 + t16*qd3
-    t83 = t82
-    t84 = -t58*t73 - t54*t83 + t6*t64 + t3*t63
-    t85 = t3*t73 + t6*t83
-    t86 = qd1 + c2*qd3
-    t87 = t86
-    t88 = t43*t83 + t58*t87 - t3*t47 + t29*t64
-    t89 = t43*t73 + t6*t47 - t54*t87 + t29*t63
-    t90 = t3*t87 - t29*t83
-    t91 = t6*t87 + t29*t73
-    t92 = t6*qd4
-    t93 = t92 + t73
-    t94 = -t3*qd4
-    t95 = t94 + t83
-    t96 = t59*t93 - t55*t95 + t10*t62 - t18*t61
-    t97 = t18*t93 - t10*t95
-    t98 = -t29*qd4
-    t99 = t98 + t87
-    t100 = t44*t95 - t59*t99 + t18*t46 - t28*t62
-    t101 = t55*t99 - t44*t93 + t28*t61 - t10*t46
-    t102 = t28*t95 - t18*t99
-    t103 = t10*t99 - t28*t93
-    t104 = t10*qd5
-    t105 = t104 + t93
-    t106 = t18*qd5
-    t107 = t106 + t95
-    t108 = t20*t105 + t12*t107
-    t109 = t28*qd5
-    t110 = t109 + t99
-    t111 = t31*t107 - t20*t110
-    t112 = t12*t110 + t31*t105
-    t113 = t12*qd6
-    t114 = -t113
-    t115 = t114 + t105
-    t116 = t72 + t92 + t104 + t114 + t14*qd7
-    t117 = t20*qd6
-    t118 = t117 + t107
-    t119 = t56*t107 - t60*t105 + t113*t60 + t117*t56
-    t120 = t22*t115 - t14*t118
-    t121 = t82 + t94 + t106 + t117 + t22*qd7
-    t122 = t23*t116 - t15*t121
-    t123 = t31*qd6
-    t124 = t123 + t110
-    t125 = t60*t110 + t45*t107 + t117*t45 + t123*t60
-    t126 = t56*t110 + t45*t105 + t123*t56 - t113*t45
-    t127 = t33*t118 - t22*t124
-    t128 = t14*t124 - t33*t115
-    t129 = t86 + t98 + t109 + t123 + t33*qd7
-    t130 = t34*t121 - t23*t129
-    t131 = t15*t129 - t34*t116
-    t132 = t52*qd1
-    t133 = c1*t49 - s1*t132
-    t134 = s1*t49 + c1*t132
-    t135 = c1*t23
-    t136 = s1*t15
-    t137 = 1/t24
-    t138 = t137*(-t136 + t135)
-    t139 = (t6*t15 - t3*t23)*t137
-    t140 = (t10*t15 + t18*t23)*t137
-    t141 = (t20*t23 - t12*t15)*t137
-    t142 = (t14*t15 + t22*t23)*t137
-    t143 = c1*t15
-    t144 = s1*t23
-    t145 = t137*(s2*t143 + s2*t144)
-    t146 = 1/t25
-    t147 = t137*t146
-    t148 = (t143 + t144)*t147
-    t149 = t147*(s2*t136 - s2*t135)
-    t150 = -(t3*t15 + t6*t23)*t147
-    t151 = (t18*t15 - t10*t23)*t147
-    t152 = (t12*t23 + t20*t15)*t147
-    t153 = (t22*t15 - t14*t23)*t147
-    t154 = 2*t138
-    t155 = t130*t137
-    t156 = -(s1 + t15*t154)*t155
-    t157 = t131*t137
-    t158 = (c1 - t23*t154)*t157
-    t159 = qd1*t137
-    t160 = t143*t159
-    t161 = t144*t159
-    t162 = 2*t145
-    t163 = t155*(t8 - t15*t162)
-    t164 = t157*(t16 - t23*t162)
-    t165 = t15*t137
-    t166 = t80*t165
-    t167 = t23*t137
-    t168 = t71*t167
-    t169 = 2*t139
-    t170 = t155*(t6 - t15*t169)
-    t171 = -t157*(t3 + t23*t169)
-    t172 = t90*t165
-    t173 = t91*t167
-    t174 = 2*t140
-    t175 = t155*(t10 - t15*t174)
-    t176 = t157*(t18 - t23*t174)
-    t177 = t102*t165
-    t178 = t103*t167
-    t179 = 2*t141
-    t180 = -t155*(t12 + t15*t179)
-    t181 = t157*(t20 - t23*t179)
-    t182 = t111*t165
-    t183 = t112*t167
-    t184 = 2*t142
-    t185 = t155*(t14 - t15*t184)
-    t186 = t157*(t22 - t23*t184)
-    t187 = t127*t165
-    t188 = t128*t167
-    t189 = qd1*t146
-    t190 = t23*t146
-    t191 = t15*t146
+    t0 = qd1 + c2*qd3
+    t1 = s1*s3
+    t2 = c1*c3
+    t3 = -t1 + c2*t2
+    t4 = t2 - c2*t1
+    t5 = s1*c3
+    t6 = s3*c1
+    t7 = t5 + c2*t6
+    t8 = t6 + c2*t5
+    t9 = c1*s2
+    t10 = t3*c4 + s4*t9
+    t11 = -t3*s4 + c4*t9
+    t12 = t10*c5 - t7*s5
+    t13 = t10*s5 + t7*c5
+    t14 = t12*c6 - t11*s6
+    t15 = t11*c6 + t12*s6
+    t16 = t14*c7 - t13*s7
+    t17 = s1*s2
+    t18 = t8*c4 + s4*t17
+    t19 = -t8*s4 + c4*t17
+    t20 = t18*c5 + t4*s5
+    t21 = t4*c5 - t18*s5
+    t22 = t20*c6 - t19*s6
+    t23 = t19*c6 + t20*s6
+    t24 = t21*s7 + t22*c7
+    t25 = t16**2 + t24**2
+    t26 = xp.sqrt(t25)
+    t27 = c3*s2
+    t28 = c2*s4 - c4*t27
+    t29 = c2*c4 + s4*t27
+    t30 = s3*s2
+    t31 = t28*c5 + s5*t30
+    t32 = -t28*s5 + c5*t30
+    t33 = t31*c6 - t29*s6
+    t34 = t29*c6 + t31*s6
+    t35 = t32*s7 + t33*c7
+    t36 = t0 - t30*qd4
+    t37 = t36 + t29*qd5
+    t38 = 0.126*t15
+    t39 = 0.4*t11 + t38
+    t40 = 0.42*t9 + t39
+    t41 = 0.126*t23
+    t42 = 0.4*t19 + t41
+    t43 = 0.42*t17 + t42
+    t44 = c1*t40 + s1*t43
+    t45 = t43*t9 - t40*t17
+    t46 = t4*t39 + t7*t42
+    t47 = t11*t42 - t19*t39
+    t48 = t13*t41 + t21*t38
+    t49 = -t48*qd6 + t47*qd5
+    t50 = t49 + t46*qd4
+    t51 = t50 + t45*qd3
+    t52 = t51 - t44*qd2
+    t53 = 0.126*t34
+    t54 = 0.4*t29 + t53
+    t55 = 0.42*c2 + t54
+    t56 = -c2*t43 + t55*t17
+    t57 = -t4*t54 + t42*t30
+    t58 = t19*t54 - t29*t42
+    t59 = -t32*t41 + t21*t53
+    t60 = c2*t40 - t55*t9
+    t61 = t7*t54 + t39*t30
+    t62 = t29*t39 - t11*t54
+    t63 = t13*t53 + t32*t38
+    t64 = t59*qd6 + t58*qd5
+    t65 = t63*qd6 + t62*qd5
+    t66 = t64 + t57*qd4
+    t67 = t65 - t61*qd4
+    t68 = t66 + t56*qd3
+    t69 = t67 + t60*qd3
+    t70 = s1*qd2
+    t71 = -t70 + t9*qd3
+    t72 = t71 + t7*qd4
+    t73 = t72 + t11*qd5
+    t74 = t69 + t55*t70
+    t75 = t74 + t40*qd1
+    t76 = t56*qd1 + c2*t68 - t9*t51 + t70*t45
+    t77 = t46*t71 + t7*t50 - t57*t0 + t30*t66
+    t78 = t58*t36 - t47*t72 + t29*t64 - t11*t49
+    t79 = t9*qd1 + c2*t70
+    t80 = t7*t0 + t30*t71
+    t81 = t11*t36 - t29*t72
+    t82 = t13*t37 + t32*t73
+    t83 = c1*qd2
+    t84 = t83 + t17*qd3
+    t85 = t84 - t4*qd4
+    t86 = t85 + t19*qd5
+    t87 = t68 + t55*t83
+    t88 = t87 - t43*qd1
+    t89 = -t60*qd1 - c2*t69 + t17*t51 + t83*t45
+    t90 = t46*t84 + t61*t0 - t4*t50 + t30*t67
+    t91 = t47*t85 - t62*t36 + t19*t49 - t29*t65
+    t92 = s1*t74 + c1*t87
+    t93 = -t9*t69 + t17*t68 + t70*t60 + t83*t56
+    t94 = -t61*t71 - t57*t84 + t7*t67 + t4*t66
+    t95 = t62*t72 - t58*t85 + t11*t65 - t19*t64
+    t96 = -t17*qd1 + c2*t83
+    t97 = t4*t0 - t30*t84
+    t98 = t29*t85 - t19*t36
+    t99 = t32*t86 - t21*t37
+    t100 = t17*t70 + t9*t83
+    t101 = t4*t71 + t7*t84
+    t102 = t19*t72 - t11*t85
+    t103 = t21*t73 + t13*t86
+    t104 = t13*qd6
+    t105 = -t104 + t73
+    t106 = t105 + t15*qd7
+    t107 = t21*qd6
+    t108 = t107 + t86
+    t109 = t108 + t23*qd7
+    t110 = t59*t86 - t63*t73 + t104*t63 + t107*t59
+    t111 = t23*t105 - t15*t108
+    t112 = t24*t106 - t16*t109
+    t113 = t32*qd6
+    t114 = t113 + t37
+    t115 = t114 + t34*qd7
+    t116 = t63*t37 + t48*t86 + t107*t48 + t113*t63
+    t117 = t59*t37 + t48*t73 + t113*t59 - t104*t48
+    t118 = t34*t108 - t23*t114
+    t119 = t15*t114 - t34*t105
+    t120 = t35*t109 - t24*t115
+    t121 = t16*t115 - t35*t106
+    t122 = t55*qd1
+    t123 = c1*t52 - s1*t122
+    t124 = s1*t52 + c1*t122
+    t125 = c1*t24
+    t126 = s1*t16
+    t127 = 1/t25
+    t128 = t127*(-t126 + t125)
+    t129 = t127*(t7*t16 - t4*t24)
+    t130 = t127*(t11*t16 + t19*t24)
+    t131 = t127*(t21*t24 - t13*t16)
+    t132 = t127*(t15*t16 + t23*t24)
+    t133 = c1*t16
+    t134 = s1*t24
+    t135 = t127*(s2*t133 + s2*t134)
+    t136 = 1/t26
+    t137 = t127*t136
+    t138 = t137*(t133 + t134)
+    t139 = t137*(s2*t126 - s2*t125)
+    t140 = -t137*(t4*t16 + t7*t24)
+    t141 = t137*(t19*t16 - t11*t24)
+    t142 = t137*(t13*t24 + t21*t16)
+    t143 = t137*(t23*t16 - t15*t24)
+    t144 = 2*t128
+    t145 = t127*t120
+    t146 = -t145*(s1 + t16*t144)
+    t147 = t127*t121
+    t148 = t147*(c1 - t24*t144)
+    t149 = t127*qd1
+    t150 = t133*t149
+    t151 = t134*t149
+    t152 = 2*t135
+    t153 = t145*(t9 - t16*t152)
+    t154 = t147*(t17 - t24*t152)
+    t155 = t16*t127
+    t156 = t96*t155
+    t157 = t24*t127
+    t158 = t79*t157
+    t159 = 2*t129
+    t160 = t145*(t7 - t16*t159)
+    t161 = -t147*(t4 + t24*t159)
+    t162 = t97*t155
+    t163 = t80*t157
+    t164 = 2*t130
+    t165 = t145*(t11 - t16*t164)
+    t166 = t147*(t19 - t24*t164)
+    t167 = t98*t155
+    t168 = t81*t157
+    t169 = 2*t131
+    t170 = -t145*(t13 + t16*t169)
+    t171 = t147*(t21 - t24*t169)
+    t172 = t99*t155
+    t173 = t82*t157
+    t174 = 2*t132
+    t175 = t145*(t15 - t16*t174)
+    t176 = t147*(t23 - t24*t174)
+    t177 = t118*t155
+    t178 = t119*t157
+    t179 = t136*qd1
+    t180 = t24*t136
+    t181 = t16*t136
     Jd = _stack(xp, [
-        xp.broadcast_to(-t69, batch),  # 0, 0
-        xp.broadcast_to(t133, batch),  # 0, 1
-        xp.broadcast_to(t77, batch),  # 0, 2
-        xp.broadcast_to(t88, batch),  # 0, 3
-        xp.broadcast_to(t100, batch),  # 0, 4
-        xp.broadcast_to(-t125, batch),  # 0, 5
+        xp.broadcast_to(-t75, batch),  # 0, 0
+        xp.broadcast_to(t123, batch),  # 0, 1
+        xp.broadcast_to(t89, batch),  # 0, 2
+        xp.broadcast_to(t90, batch),  # 0, 3
+        xp.broadcast_to(t91, batch),  # 0, 4
+        xp.broadcast_to(-t116, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
-        xp.broadcast_to(t76, batch),  # 1, 0
-        xp.broadcast_to(t134, batch),  # 1, 1
-        xp.broadcast_to(t70, batch),  # 1, 2
-        xp.broadcast_to(-t89, batch),  # 1, 3
-        xp.broadcast_to(t101, batch),  # 1, 4
-        xp.broadcast_to(t126, batch),  # 1, 5
+        xp.broadcast_to(t88, batch),  # 1, 0
+        xp.broadcast_to(t124, batch),  # 1, 1
+        xp.broadcast_to(t76, batch),  # 1, 2
+        xp.broadcast_to(-t77, batch),  # 1, 3
+        xp.broadcast_to(t78, batch),  # 1, 4
+        xp.broadcast_to(t117, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t78, batch),  # 2, 1
-        xp.broadcast_to(-t79, batch),  # 2, 2
-        xp.broadcast_to(t84, batch),  # 2, 3
-        xp.broadcast_to(t96, batch),  # 2, 4
-        xp.broadcast_to(-t119, batch),  # 2, 5
+        xp.broadcast_to(-t92, batch),  # 2, 1
+        xp.broadcast_to(-t93, batch),  # 2, 2
+        xp.broadcast_to(t94, batch),  # 2, 3
+        xp.broadcast_to(t95, batch),  # 2, 4
+        xp.broadcast_to(-t110, batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(-t160 - t161 + t156 + t158, batch),  # 3, 1
-        xp.broadcast_to(t163 + t164 + t166 + t168, batch),  # 3, 2
-        xp.broadcast_to(t170 + t171 + t172 + t173, batch),  # 3, 3
-        xp.broadcast_to(t175 + t176 + t177 + t178, batch),  # 3, 4
-        xp.broadcast_to(-t183 + t180 + t181 + t182, batch),  # 3, 5
-        xp.broadcast_to(t185 + t186 + t187 + t188, batch),  # 3, 6
+        xp.broadcast_to(-t150 - t151 + t146 + t148, batch),  # 3, 1
+        xp.broadcast_to(t153 + t154 + t156 + t158, batch),  # 3, 2
+        xp.broadcast_to(t160 + t161 + t162 + t163, batch),  # 3, 3
+        xp.broadcast_to(t165 + t166 + t167 + t168, batch),  # 3, 4
+        xp.broadcast_to(-t173 + t170 + t171 + t172, batch),  # 3, 5
+        xp.broadcast_to(t175 + t176 + t177 + t178, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t130*(-t15*t148 + c1*t146) + t131*(-t23*t148 + s1*t146) + t135*t189 - t136*t189, batch),  # 4, 1
-        xp.broadcast_to(t130*(-t15*t149 + t16*t146) - t131*(t23*t149 + t8*t146) - t80*t190 + t71*t191, batch),  # 4, 2
-        xp.broadcast_to(-t130*(t15*t150 + t3*t146) - t131*(t23*t150 + t6*t146) - t90*t190 + t91*t191, batch),  # 4, 3
-        xp.broadcast_to(t130*(-t15*t151 + t18*t146) - t131*(t23*t151 + t10*t146) - t102*t190 + t103*t191, batch),  # 4, 4
-        xp.broadcast_to(t130*(-t15*t152 + t20*t146) + t131*(-t23*t152 + t12*t146) - t111*t190 - t112*t191, batch),  # 4, 5
-        xp.broadcast_to(t130*(-t15*t153 + t22*t146) - t131*(t23*t153 + t14*t146) - t127*t190 + t128*t191, batch),  # 4, 6
+        xp.broadcast_to(t120*(-t16*t138 + c1*t136) + t121*(-t24*t138 + s1*t136) + t125*t179 - t126*t179, batch),  # 4, 1
+        xp.broadcast_to(t120*(-t16*t139 + t17*t136) - t121*(t24*t139 + t9*t136) - t96*t180 + t79*t181, batch),  # 4, 2
+        xp.broadcast_to(-t120*(t16*t140 + t4*t136) - t121*(t24*t140 + t7*t136) - t97*t180 + t80*t181, batch),  # 4, 3
+        xp.broadcast_to(t120*(-t16*t141 + t19*t136) - t121*(t24*t141 + t11*t136) - t98*t180 + t81*t181, batch),  # 4, 4
+        xp.broadcast_to(t120*(-t16*t142 + t21*t136) + t121*(-t24*t142 + t13*t136) - t99*t180 - t82*t181, batch),  # 4, 5
+        xp.broadcast_to(t120*(-t16*t143 + t23*t136) - t121*(t15*t136 + t24*t143) - t118*t180 + t119*t181, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(t122*t138 + t34*t156 + t34*t158 - t34*t160 - t34*t161), batch),  # 5, 1
-        xp.broadcast_to(-(t81 + t122*t145 + t34*t163 + t34*t164 + t34*t166 + t34*t168), batch),  # 5, 2
-        xp.broadcast_to(-(t85 + t122*t139 + t34*t170 + t34*t171 + t34*t172 + t34*t173), batch),  # 5, 3
-        xp.broadcast_to(-(-t97 + t122*t140 + t34*t175 + t34*t176 + t34*t177 + t34*t178), batch),  # 5, 4
-        xp.broadcast_to(-(-t108 + t122*t141 + t34*t180 + t34*t181 + t34*t182 - t34*t183), batch),  # 5, 5
-        xp.broadcast_to(-(-t120 + t122*t142 + t34*t185 + t34*t186 + t34*t187 + t34*t188), batch),  # 5, 6
+        xp.broadcast_to(-(t112*t128 + t35*t146 + t35*t148 - t35*t150 - t35*t151), batch),  # 5, 1
+        xp.broadcast_to(-(t100 + t112*t135 + t35*t153 + t35*t154 + t35*t156 + t35*t158), batch),  # 5, 2
+        xp.broadcast_to(-(t101 + t112*t129 + t35*t160 + t35*t161 + t35*t162 + t35*t163), batch),  # 5, 3
+        xp.broadcast_to(-(-t102 + t112*t130 + t35*t165 + t35*t166 + t35*t167 + t35*t168), batch),  # 5, 4
+        xp.broadcast_to(-(-t103 + t112*t131 + t35*t170 + t35*t171 + t35*t172 - t35*t173), batch),  # 5, 5
+        xp.broadcast_to(-(-t111 + t112*t132 + t35*t175 + t35*t176 + t35*t177 + t35*t178), batch),  # 5, 6
     ], (6, 7))
     return Jd
 

@@ -71,7 +71,7 @@ void jaco_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JACO_D
 void jaco_bias_acceleration(const jaco_real q[JACO_DOF], const jaco_real q_dot[JACO_DOF], jaco_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 600 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 588 operations. */
 void jaco_task_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[JACO_DOF], jaco_real Jd[JACO_TASK_DIM * JACO_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).

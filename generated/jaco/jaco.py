@@ -1313,7 +1313,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 600 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 588 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -1348,229 +1348,224 @@ def task_jacobian_dot(q, q_dot):
     t7 = c1*s4 - t3*c4
     t8 = t3*s4 + c1*c4
     t9 = -0.25019712500078917*t4
-    t10 = s2*c3
-    t11 = c2*s3
-    t12 = c1*t10 - c1*t11
-    t13 = s1*t11 - s1*t10
-    t14 = -t11 + t10
-    t15 = -0.25019712500078917*t12
+    t10 = -qd1 + t4*qd4
+    t11 = s2*c3
+    t12 = c2*s3
+    t13 = c1*t11 - c1*t12
+    t14 = s1*t12 - s1*t11
+    t15 = -t12 + t11
     t16 = -0.25019712500078917*t13
-    t17 = 0.5*t12 + 0.8660254037844386*t6
-    t18 = t17
-    t19 = -0.08579425000157839*t17
-    t20 = 0.5*t13 + 0.8660254037844386*t8
-    t21 = t20
-    t22 = -0.08579425000157839*t20
-    t23 = t14*s4
-    t24 = 0.5*t4 + 0.8660254037844386*t23
-    t25 = t24
-    t26 = 0.08579425000157839*t24
-    t27 = 0.5*t6 - 0.8660254037844386*t12
-    t28 = t5*c5 + s5*t27
-    t29 = -t5*s5 + c5*t27
-    t30 = t28*c6 + (0.5*t29 - 0.8660254037844386*t18)*s6
-    t31 = 0.5*t8 - 0.8660254037844386*t13
-    t32 = t7*c5 + s5*t31
-    t33 = -t7*s5 + c5*t31
-    t34 = t32*c6 + (0.5*t33 - 0.8660254037844386*t21)*s6
-    t35 = t30**2 + t34**2
-    t36 = xp.sqrt(t35)
-    t37 = -0.5*t23 + 0.8660254037844386*t4
-    t38 = t14*c4
-    t39 = s5*t37 + c5*t38
-    t40 = c5*t37 - s5*t38
-    t41 = t39*c6 + (0.5*t40 + 0.8660254037844386*t25)*s6
-    t42 = 0.5*t18 + 0.8660254037844386*t29
-    t43 = t42
-    t44 = 0.2115971250007892*t42
-    t45 = -t19 + t44
-    t46 = -t15 + t45
-    t47 = -0.0098*s1 + t46
-    t48 = 0.5*t21 + 0.8660254037844386*t33
-    t49 = t48
-    t50 = 0.2115971250007892*t48
-    t51 = -t22 + t50
-    t52 = -t16 + t51
-    t53 = -0.0098*c1 + t52
-    t54 = s1*t53 - c1*t47
-    t55 = t13*t46 - t12*t52
-    t56 = t21*t45 - t18*t51
-    t57 = t49*t44 - t43*t50
-    t58 = 0.5*t25 - 0.8660254037844386*t40
-    t59 = t58
-    t60 = -0.2115971250007892*t58
-    t61 = -t26 + t60
-    t62 = t9 + t61
-    t63 = 0.41*s2 + t62
-    t64 = t13*t62 + t4*t52
-    t65 = t21*t61 + t25*t51
-    t66 = t49*t60 + t59*t50
-    t67 = t4*t46 + t12*t62
-    t68 = t18*t61 + t25*t45
-    t69 = t43*t60 + t59*t44
-    t70 = 0.41*c2
-    t71 = t47 + c1*t70
-    t72 = t53 - s1*t70
-    t73 = c1*t71 - s1*t72
-    t74 = s1*qd2
-    t75 = s1*qd3
-    t76 = -t74 + t75
-    t77 = t12*qd1 - t4*t76
-    t78 = c1*qd2
-    t79 = c1*qd3
-    t80 = -t78 + t79
-    t81 = t4*t80 - t13*qd1
-    t82 = -t13*t76 + t12*t80
-    t83 = t12*qd4
-    t84 = -t83 + t76
-    t85 = t13*qd4
-    t86 = -t85 + t80
-    t87 = -t21*t84 + t18*t86
-    t88 = -qd1 + t4*qd4
-    t89 = t88
-    t90 = t25*t86 + t21*t89
-    t91 = t18*t89 + t25*t84
-    t92 = t18*qd5
-    t93 = -t92 + t84
-    t94 = -t75 + t74 + t83 + t92 + t43*qd6
-    t95 = t21*qd5
-    t96 = -t95 + t86
-    t97 = -t49*t93 + t43*t96
-    t98 = -t79 + t78 + t85 + t95 + t49*qd6
-    t99 = -t34*t94 + t30*t98
-    t100 = t25*qd5
-    t101 = t100 + t89
-    t102 = t59*t96 + t49*t101
-    t103 = t43*t101 + t59*t93
-    t104 = t88 + t100 + t59*qd6
-    t105 = t41*t98 + t34*t104
-    t106 = t30*t104 + t41*t94
-    t107 = t66*qd6
-    t108 = t107 + t65*qd5
-    t109 = t108 + t64*qd4
-    t110 = -t109 + t62*t79
-    t111 = t110 - t63*t78
-    t112 = t111 + t72*qd1
-    t113 = t69*qd6
-    t114 = t113 + t68*qd5
-    t115 = t114 + t67*qd4
-    t116 = t115 - t62*t75
-    t117 = t116 + t63*t74
-    t118 = t117 - t71*qd1
-    t119 = -s1*t117 + c1*t111
-    t120 = t67*t76 + t64*t80 - t12*t115 - t13*t109
-    t121 = t68*t84 + t65*t86 - t18*t114 - t21*t108
-    t122 = t69*t93 + t66*t96 - t43*t113 - t49*t107
-    t123 = t57*qd6
-    t124 = t123 + t56*qd5
-    t125 = t124 + t55*qd4
-    t126 = t125 + t54*qd3
-    t127 = t126 + t73*qd2
-    t128 = t55*t80 + t67*qd1 - t13*t125 - t4*t115
-    t129 = t68*t89 + t25*t114 + t21*t124 - t56*t86
-    t130 = t69*t101 - t57*t96 + t49*t123 + t59*t113
-    t131 = t64*qd1 - t55*t76 - t4*t109 + t12*t125
-    t132 = t56*t84 + t65*t89 - t18*t124 + t25*t108
-    t133 = t57*t93 + t66*t101 + t59*t107 - t43*t123
-    t134 = s1*qd1
-    t135 = -c1*t127 + t63*t134
-    t136 = -c1*t126 + t78*t54 + t62*t134
-    t137 = c1*qd1
-    t138 = s1*t127 + t63*t137
-    t139 = s1*t126 + t62*t137 - t74*t54
-    t140 = t62*qd2
-    t141 = s1*t116 - c1*t110 + s1**2*t140 + c1**2*t140
-    t142 = s1*t30
-    t143 = c1*t34
-    t144 = t142 + t143
-    t145 = 1/t35
-    t146 = -t144*t145
-    t147 = t144*t145
-    t148 = -t145*(t13*t34 + t12*t30)
-    t149 = -t145*(t18*t30 + t21*t34)
-    t150 = -t145*(t43*t30 + t49*t34)
-    t151 = s1*t34
-    t152 = c1*t30
-    t153 = 1/t36
-    t154 = t145*t153
-    t155 = t154*(-t152 + t151)
-    t156 = t154*(-t151 + t152)
-    t157 = (t12*t34 - t13*t30)*t154
-    t158 = (t18*t34 - t21*t30)*t154
-    t159 = (t43*t34 - t49*t30)*t154
-    t160 = 2*t146
-    t161 = t145*t105
-    t162 = -t161*(s1 + t30*t160)
-    t163 = t145*t106
-    t164 = -(c1 + t34*t160)*t163
-    t165 = t145*qd1
-    t166 = t152*t165
-    t167 = t151*t165
-    t168 = 2*t147
-    t169 = t161*(s1 - t30*t168)
-    t170 = t163*(c1 - t34*t168)
-    t171 = 2*t148
-    t172 = -t161*(t12 + t30*t171)
-    t173 = -t163*(t13 + t34*t171)
-    t174 = t30*t145
-    t175 = t81*t174
-    t176 = t34*t145
-    t177 = t77*t176
-    t178 = 2*t149
-    t179 = -t161*(t18 + t30*t178)
-    t180 = -t163*(t21 + t34*t178)
-    t181 = t90*t174
-    t182 = t91*t176
-    t183 = 2*t150
-    t184 = -t161*(t43 + t30*t183)
-    t185 = -t163*(t49 + t34*t183)
-    t186 = t102*t174
-    t187 = t103*t176
-    t188 = c1*t153
-    t189 = s1*t153
-    t190 = t153*qd1
-    t191 = t143*t190 + t142*t190
-    t192 = t34*t153
-    t193 = t30*t153
-    t194 = t41*t166
-    t195 = t41*t167
+    t17 = -0.25019712500078917*t14
+    t18 = 0.5*t13 + 0.8660254037844386*t6
+    t19 = t18
+    t20 = -0.08579425000157839*t18
+    t21 = 0.5*t14 + 0.8660254037844386*t8
+    t22 = t21
+    t23 = -0.08579425000157839*t21
+    t24 = t15*s4
+    t25 = 0.5*t4 + 0.8660254037844386*t24
+    t26 = t25
+    t27 = 0.08579425000157839*t25
+    t28 = t10 + t26*qd5
+    t29 = 0.5*t6 - 0.8660254037844386*t13
+    t30 = t5*c5 + s5*t29
+    t31 = -t5*s5 + c5*t29
+    t32 = t30*c6 + (0.5*t31 - 0.8660254037844386*t19)*s6
+    t33 = 0.5*t8 - 0.8660254037844386*t14
+    t34 = t7*c5 + s5*t33
+    t35 = -t7*s5 + c5*t33
+    t36 = t34*c6 + (0.5*t35 - 0.8660254037844386*t22)*s6
+    t37 = t32**2 + t36**2
+    t38 = xp.sqrt(t37)
+    t39 = -0.5*t24 + 0.8660254037844386*t4
+    t40 = t15*c4
+    t41 = s5*t39 + c5*t40
+    t42 = c5*t39 - s5*t40
+    t43 = t41*c6 + (0.5*t42 + 0.8660254037844386*t26)*s6
+    t44 = 0.5*t19 + 0.8660254037844386*t31
+    t45 = t44
+    t46 = 0.2115971250007892*t44
+    t47 = -t20 + t46
+    t48 = -t16 + t47
+    t49 = -0.0098*s1 + t48
+    t50 = 0.5*t22 + 0.8660254037844386*t35
+    t51 = t50
+    t52 = 0.2115971250007892*t50
+    t53 = -t23 + t52
+    t54 = -t17 + t53
+    t55 = -0.0098*c1 + t54
+    t56 = s1*t55 - c1*t49
+    t57 = t14*t48 - t13*t54
+    t58 = t22*t47 - t19*t53
+    t59 = t51*t46 - t45*t52
+    t60 = t59*qd6 + t58*qd5
+    t61 = t60 + t57*qd4
+    t62 = t61 + t56*qd3
+    t63 = 0.5*t26 - 0.8660254037844386*t42
+    t64 = t63
+    t65 = -0.2115971250007892*t63
+    t66 = -t27 + t65
+    t67 = t9 + t66
+    t68 = 0.41*s2 + t67
+    t69 = t14*t67 + t4*t54
+    t70 = t22*t66 + t26*t53
+    t71 = t51*t65 + t64*t52
+    t72 = t4*t48 + t13*t67
+    t73 = t19*t66 + t26*t47
+    t74 = t45*t65 + t64*t46
+    t75 = t71*qd6 + t70*qd5
+    t76 = t74*qd6 + t73*qd5
+    t77 = t75 + t69*qd4
+    t78 = t76 + t72*qd4
+    t79 = 0.41*c2
+    t80 = t49 + c1*t79
+    t81 = t55 - s1*t79
+    t82 = c1*t80 - s1*t81
+    t83 = t62 + t82*qd2
+    t84 = s1*qd2
+    t85 = s1*qd3
+    t86 = -t84 + t85
+    t87 = t86 - t13*qd4
+    t88 = t87 - t19*qd5
+    t89 = t78 - t67*t85
+    t90 = t89 + t68*t84
+    t91 = t90 - t80*qd1
+    t92 = t69*qd1 - t57*t86 - t4*t77 + t13*t61
+    t93 = t58*t87 + t70*t10 - t19*t60 + t26*t75
+    t94 = t13*qd1 - t4*t86
+    t95 = t19*t10 + t26*t87
+    t96 = t45*t28 + t64*t88
+    t97 = c1*qd2
+    t98 = c1*qd3
+    t99 = -t97 + t98
+    t100 = t99 - t14*qd4
+    t101 = t100 - t22*qd5
+    t102 = -t77 + t67*t98
+    t103 = t102 - t68*t97
+    t104 = t103 + t81*qd1
+    t105 = t57*t99 + t72*qd1 - t14*t61 - t4*t78
+    t106 = t73*t10 + t26*t76 + t22*t60 - t58*t100
+    t107 = -s1*t90 + c1*t103
+    t108 = t72*t86 + t69*t99 - t13*t78 - t14*t77
+    t109 = t73*t87 + t70*t100 - t19*t76 - t22*t75
+    t110 = t4*t99 - t14*qd1
+    t111 = t26*t100 + t22*t10
+    t112 = t64*t101 + t51*t28
+    t113 = -t14*t86 + t13*t99
+    t114 = -t22*t87 + t19*t100
+    t115 = -t51*t88 + t45*t101
+    t116 = t45*qd6
+    t117 = -t116 + t88
+    t118 = t51*qd6
+    t119 = -t118 + t101
+    t120 = t74*t88 + t71*t101 - t116*t74 - t118*t71
+    t121 = t36*t117 - t32*t119
+    t122 = t64*qd6
+    t123 = t122 + t28
+    t124 = t74*t28 - t59*t101 + t118*t59 + t122*t74
+    t125 = t59*t88 + t71*t28 + t122*t71 - t116*t59
+    t126 = t43*t119 - t36*t123
+    t127 = t32*t123 - t43*t117
+    t128 = s1*qd1
+    t129 = -c1*t83 + t68*t128
+    t130 = -c1*t62 + t97*t56 + t67*t128
+    t131 = c1*qd1
+    t132 = s1*t83 + t68*t131
+    t133 = s1*t62 + t67*t131 - t84*t56
+    t134 = t67*qd2
+    t135 = s1*t89 - c1*t102 + s1**2*t134 + c1**2*t134
+    t136 = s1*t32
+    t137 = c1*t36
+    t138 = t136 + t137
+    t139 = 1/t37
+    t140 = -t138*t139
+    t141 = t138*t139
+    t142 = -t139*(t14*t36 + t13*t32)
+    t143 = -t139*(t19*t32 + t22*t36)
+    t144 = -t139*(t45*t32 + t51*t36)
+    t145 = s1*t36
+    t146 = c1*t32
+    t147 = 1/t38
+    t148 = t139*t147
+    t149 = t148*(-t146 + t145)
+    t150 = t148*(-t145 + t146)
+    t151 = t148*(t13*t36 - t14*t32)
+    t152 = t148*(t19*t36 - t22*t32)
+    t153 = t148*(t45*t36 - t51*t32)
+    t154 = 2*t140
+    t155 = t139*t126
+    t156 = -t155*(s1 + t32*t154)
+    t157 = t139*t127
+    t158 = -t157*(c1 + t36*t154)
+    t159 = t139*qd1
+    t160 = t146*t159
+    t161 = t145*t159
+    t162 = 2*t141
+    t163 = t155*(s1 - t32*t162)
+    t164 = t157*(c1 - t36*t162)
+    t165 = 2*t142
+    t166 = -t155*(t13 + t32*t165)
+    t167 = -t157*(t14 + t36*t165)
+    t168 = t32*t139
+    t169 = t110*t168
+    t170 = t36*t139
+    t171 = t94*t170
+    t172 = 2*t143
+    t173 = -t155*(t19 + t32*t172)
+    t174 = -t157*(t22 + t36*t172)
+    t175 = t111*t168
+    t176 = t95*t170
+    t177 = 2*t144
+    t178 = -t155*(t45 + t32*t177)
+    t179 = -t157*(t51 + t36*t177)
+    t180 = t112*t168
+    t181 = t96*t170
+    t182 = c1*t147
+    t183 = s1*t147
+    t184 = t147*qd1
+    t185 = t137*t184
+    t186 = t136*t184
+    t187 = t36*t147
+    t188 = t32*t147
+    t189 = t43*t160
+    t190 = t43*t161
     Jd = _stack(xp, [
-        xp.broadcast_to(t118, batch),  # 0, 0
-        xp.broadcast_to(t135, batch),  # 0, 1
-        xp.broadcast_to(-t136, batch),  # 0, 2
-        xp.broadcast_to(t128, batch),  # 0, 3
-        xp.broadcast_to(-t129, batch),  # 0, 4
-        xp.broadcast_to(-t130, batch),  # 0, 5
-        xp.broadcast_to(-t112, batch),  # 1, 0
-        xp.broadcast_to(t138, batch),  # 1, 1
-        xp.broadcast_to(-t139, batch),  # 1, 2
-        xp.broadcast_to(t131, batch),  # 1, 3
-        xp.broadcast_to(-t132, batch),  # 1, 4
-        xp.broadcast_to(-t133, batch),  # 1, 5
+        xp.broadcast_to(t91, batch),  # 0, 0
+        xp.broadcast_to(t129, batch),  # 0, 1
+        xp.broadcast_to(-t130, batch),  # 0, 2
+        xp.broadcast_to(t105, batch),  # 0, 3
+        xp.broadcast_to(-t106, batch),  # 0, 4
+        xp.broadcast_to(-t124, batch),  # 0, 5
+        xp.broadcast_to(-t104, batch),  # 1, 0
+        xp.broadcast_to(t132, batch),  # 1, 1
+        xp.broadcast_to(-t133, batch),  # 1, 2
+        xp.broadcast_to(t92, batch),  # 1, 3
+        xp.broadcast_to(-t93, batch),  # 1, 4
+        xp.broadcast_to(-t125, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(t119, batch),  # 2, 1
-        xp.broadcast_to(t141, batch),  # 2, 2
-        xp.broadcast_to(t120, batch),  # 2, 3
-        xp.broadcast_to(t121, batch),  # 2, 4
-        xp.broadcast_to(t122, batch),  # 2, 5
+        xp.broadcast_to(t107, batch),  # 2, 1
+        xp.broadcast_to(t135, batch),  # 2, 2
+        xp.broadcast_to(t108, batch),  # 2, 3
+        xp.broadcast_to(t109, batch),  # 2, 4
+        xp.broadcast_to(t120, batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(-t162 - t166 + t164 + t167, batch),  # 3, 1
-        xp.broadcast_to(-t169 - t167 + t166 + t170, batch),  # 3, 2
-        xp.broadcast_to(-t172 + t173 + t175 + t177, batch),  # 3, 3
-        xp.broadcast_to(-t179 - t182 + t180 + t181, batch),  # 3, 4
-        xp.broadcast_to(-t184 - t187 + t185 + t186, batch),  # 3, 5
+        xp.broadcast_to(-t160 + t156 + t158 + t161, batch),  # 3, 1
+        xp.broadcast_to(-t161 + t160 + t163 + t164, batch),  # 3, 2
+        xp.broadcast_to(t166 + t167 + t169 + t171, batch),  # 3, 3
+        xp.broadcast_to(-t176 + t173 + t174 + t175, batch),  # 3, 4
+        xp.broadcast_to(-t181 + t178 + t179 + t180, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t105*(t30*t155 + t188) + t106*(-t34*t155 + t189) + t191, batch),  # 4, 1
-        xp.broadcast_to(-(t191 + t105*(-t30*t156 + t188) + t106*(t34*t156 + t189)), batch),  # 4, 2
-        xp.broadcast_to(t105*(t30*t157 + t13*t153) + t106*(-t34*t157 + t12*t153) - t81*t192 + t77*t193, batch),  # 4, 3
-        xp.broadcast_to(-(-t105*(t30*t158 + t21*t153) - t106*(-t34*t158 + t18*t153) + t90*t192 + t91*t193), batch),  # 4, 4
-        xp.broadcast_to(-(-t105*(t30*t159 + t49*t153) - t106*(-t34*t159 + t43*t153) + t102*t192 + t103*t193), batch),  # 4, 5
+        xp.broadcast_to(-t126*(t32*t149 + t182) + t127*(-t36*t149 + t183) + t185 + t186, batch),  # 4, 1
+        xp.broadcast_to(-t185 - t186 + t126*(-t32*t150 + t182) - t127*(t36*t150 + t183), batch),  # 4, 2
+        xp.broadcast_to(-t126*(t32*t151 + t14*t147) + t127*(-t36*t151 + t13*t147) - t110*t187 + t94*t188, batch),  # 4, 3
+        xp.broadcast_to(-t126*(t32*t152 + t22*t147) + t127*(-t36*t152 + t19*t147) - t111*t187 - t95*t188, batch),  # 4, 4
+        xp.broadcast_to(-t126*(t32*t153 + t51*t147) + t127*(-t36*t153 + t45*t147) - t112*t187 - t96*t188, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(-t194 + t99*t146 - t41*t162 + t41*t164 + t195), batch),  # 5, 1
-        xp.broadcast_to(-(-t195 + t99*t147 + t194 - t41*t169 + t41*t170), batch),  # 5, 2
-        xp.broadcast_to(-(-t82 + t99*t148 - t41*t172 + t41*t173 + t41*t175 + t41*t177), batch),  # 5, 3
-        xp.broadcast_to(t87 - t99*t149 + t41*t179 - t41*t180 - t41*t181 + t41*t182, batch),  # 5, 4
-        xp.broadcast_to(t97 - t99*t150 + t41*t184 - t41*t185 - t41*t186 + t41*t187, batch),  # 5, 5
+        xp.broadcast_to(-(-t189 + t121*t140 + t43*t156 + t43*t158 + t190), batch),  # 5, 1
+        xp.broadcast_to(-(-t190 + t121*t141 + t189 + t43*t163 + t43*t164), batch),  # 5, 2
+        xp.broadcast_to(-(-t113 + t121*t142 + t43*t166 + t43*t167 + t43*t169 + t43*t171), batch),  # 5, 3
+        xp.broadcast_to(-(-t114 + t121*t143 + t43*t173 + t43*t174 + t43*t175 - t43*t176), batch),  # 5, 4
+        xp.broadcast_to(-(-t115 + t121*t144 + t43*t178 + t43*t179 + t43*t180 - t43*t181), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1672,7 +1667,7 @@ def hessian(q):
     t77 = s1*t45
     t78 = s1**2
     t79 = c1**2
-    t80 = t50*t79 + t50*t78
+    t80 = t50*t78 + t50*t79
     t81 = s1*t55 + c1*t52
     t82 = -t81
     t83 = s1*t56 + c1*t53
@@ -1756,7 +1751,7 @@ def hessian(q):
         t76,  # 1, 1, 4
         t77,  # 1, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
-        -(t51*t79 + t51*t78),  # 1, 2, 1
+        -(t51*t78 + t51*t79),  # 1, 2, 1
         t80,  # 1, 2, 2
         t82,  # 1, 2, 3
         t84,  # 1, 2, 4
@@ -2610,7 +2605,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t111 = 2*t109 + t13*t14 + t19*t22 + t39*t45
     t112 = c1*t97
     t113 = c1*t50
-    t114 = t61*t51 + t62*t52 + t63*t53 + t59*t112 - t58*t113
+    t114 = t59*t112 + t61*t51 + t62*t52 + t63*t53 - t58*t113
     t115 = -t113 + t112 + t14*t51 + t22*t52 + t45*t53
     t116 = t59*t109 + t58*t109
     t117 = t116 + t13*t61 + t19*t62 + t39*t63

@@ -71,7 +71,7 @@ void kr5_jacobian_dot(const kr5_real q[KR5_DOF], const kr5_real q_dot[KR5_DOF], 
 void kr5_bias_acceleration(const kr5_real q[KR5_DOF], const kr5_real q_dot[KR5_DOF], kr5_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 466 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 455 operations. */
 void kr5_task_jacobian_dot(const kr5_real q[KR5_DOF], const kr5_real q_dot[KR5_DOF], kr5_real Jd[KR5_TASK_DIM * KR5_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).

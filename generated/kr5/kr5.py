@@ -1067,7 +1067,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 466 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 455 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1090,199 +1090,193 @@ def task_jacobian_dot(q, q_dot):
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = s1*s4
-    t1 = c1*c4
-    t2 = -t0 + c23*t1
-    t3 = t1 - c23*t0
-    t4 = s1*c4
-    t5 = c1*s4
-    t6 = t4 + c23*t5
-    t7 = t5 + c23*t4
-    t8 = c1*s23
-    t9 = t2*c5 - s5*t8
-    t10 = t2*s5 + c5*t8
-    t11 = t9*c6 - t6*s6
-    t12 = s1*s23
-    t13 = t7*c5 - s5*t12
-    t14 = t7*s5 + c5*t12
-    t15 = t3*s6 + t13*c6
-    t16 = t11**2 + t15**2
-    t17 = xp.sqrt(t16)
-    t18 = s23*c4
-    t19 = c23*s5 + c5*t18
-    t20 = -c23*c5 + s5*t18
-    t21 = s23*s4
-    t22 = -t19*c6 + s6*t21
-    t23 = 0.115*t10
-    t24 = 0.62*t8 + t23
-    t25 = 0.115*t14
-    t26 = 0.62*t12 + t25
-    t27 = t24*t12 - t26*t8
-    t28 = t3*t23 + t6*t25
-    t29 = t28*qd5 + t27*qd4
-    t30 = 0.115*t20
-    t31 = -0.62*c23 + t30
-    t32 = -0.12*s23 + t31
-    t33 = -0.6*s2 + t32
-    t34 = c23*t26 + t31*t12
-    t35 = t3*t30 + t21*t25
-    t36 = c23*t24 + t31*t8
-    t37 = t6*t30 - t21*t23
-    t38 = 0.12*c23
-    t39 = -t24 + c1*t38
-    t40 = -t26 + s1*t38
-    t41 = c1*t39 + s1*t40
-    t42 = t29 - t41*qd3
-    t43 = 0.6*c2
-    t44 = t39 + c1*t43
-    t45 = t40 + s1*t43
-    t46 = 0.18*c1 + t44
-    t47 = 0.18*s1 + t45
-    t48 = c1*t44 + s1*t45
-    t49 = t42 - t48*qd2
-    t50 = s1*qd2
-    t51 = s1*qd3
-    t52 = t50 + t51
-    t53 = t52
-    t54 = c23*t53 + t8*qd1
-    t55 = c1*qd2
-    t56 = c1*qd3
-    t57 = t55 + t56
-    t58 = t57
-    t59 = c23*t58 - t12*qd1
-    t60 = t12*t53 + t8*t58
-    t61 = t8*qd4
-    t62 = -t53 + t61
-    t63 = t12*qd4
-    t64 = t63 + t58
-    t65 = t3*t62 + t6*t64
-    t66 = qd1 + c23*qd4
-    t67 = t66
-    t68 = -t3*t67 + t21*t64
-    t69 = t6*t67 + t21*t62
-    t70 = t6*qd5
-    t71 = -t70 + t62
-    t72 = -t61 + t52 + t70 - t10*qd6
-    t73 = t3*qd5
-    t74 = t73 + t64
-    t75 = t35*t64 - t37*t62 + t70*t37 + t73*t35
-    t76 = t14*t71 - t10*t74
-    t77 = t57 + t63 + t73 + t14*qd6
-    t78 = t15*t72 + t11*t77
-    t79 = t21*qd5
-    t80 = t79 + t67
-    t81 = t20*t74 + t14*t80
-    t82 = t10*t80 + t20*t71
-    t83 = t66 + t79 - t20*qd6
-    t84 = t22*t77 - t15*t83
-    t85 = t11*t83 + t22*t72
-    t86 = t35*qd5
-    t87 = t86 + t34*qd4
-    t88 = t87 + t32*t56
-    t89 = t88 + t33*t55
-    t90 = t89 - t47*qd1
-    t91 = t34*qd1 + t27*t53 + c23*t87 - t8*t29
-    t92 = t35*t67 - t28*t62 + t21*t86 + t70*t28
-    t93 = t37*qd5
-    t94 = t93 - t36*qd4
-    t95 = t32*t51 + t94
-    t96 = t95 + t33*t50
-    t97 = t96 + t46*qd1
-    t98 = t27*t58 + t36*qd1 - c23*t94 + t12*t29
-    t99 = t28*t64 - t37*t67 + t73*t28 - t21*t93
-    t100 = s1*t96 + c1*t89
-    t101 = t36*t53 - t34*t58 + t8*t94 - t12*t87
-    t102 = s1*qd1
-    t103 = c1*t49 - t33*t102
-    t104 = -c1*t42 + t55*t41 + t32*t102
-    t105 = c1*qd1
-    t106 = s1*t49 + t33*t105
-    t107 = s1*t42 + t32*t105 - t50*t41
-    t108 = t32*qd2
-    t109 = c1*t88 + s1*t95 + s1**2*t108 + c1**2*t108
-    t110 = c1*t15
-    t111 = s1*t11
-    t112 = 1/t16
-    t113 = t112*(-t111 + t110)
-    t114 = (t3*t15 - t6*t11)*t112
-    t115 = (t10*t11 + t14*t15)*t112
-    t116 = c1*t11
-    t117 = s1*t15
-    t118 = t112*(s23*t116 + s23*t117)
-    t119 = 1/t17
-    t120 = t112*t119
-    t121 = (t116 + t117)*t120
-    t122 = t120*(s23*t111 - s23*t110)
-    t123 = (t6*t15 + t3*t11)*t120
-    t124 = (t14*t11 - t10*t15)*t120
-    t125 = 2*t113
-    t126 = t84*t112
-    t127 = -(s1 + t11*t125)*t126
-    t128 = t85*t112
-    t129 = (c1 - t15*t125)*t128
-    t130 = qd1*t112
-    t131 = t116*t130
-    t132 = t117*t130
-    t133 = -t131 - t132 + t127 + t129
-    t134 = 2*t118
-    t135 = t126*(t8 - t11*t134)
-    t136 = t128*(t12 - t15*t134)
-    t137 = t11*t112
-    t138 = t59*t137
-    t139 = t15*t112
-    t140 = t54*t139
-    t141 = 2*t114
-    t142 = -t126*(t6 + t11*t141)
-    t143 = t128*(t3 - t15*t141)
-    t144 = t68*t137
-    t145 = t69*t139
-    t146 = 2*t115
-    t147 = t126*(t10 - t11*t146)
-    t148 = t128*(t14 - t15*t146)
-    t149 = t81*t137
-    t150 = t82*t139
-    t151 = qd1*t119
-    t152 = t84*(-t11*t121 + c1*t119) + t85*(-t15*t121 + s1*t119) + t110*t151 - t111*t151
-    t153 = t15*t119
-    t154 = t11*t119
-    t155 = t78*t113 - t22*t127 - t22*t129 + t22*t131 + t22*t132
+    t0 = qd1 + c23*qd4
+    t1 = s1*s4
+    t2 = c1*c4
+    t3 = -t1 + c23*t2
+    t4 = t2 - c23*t1
+    t5 = s1*c4
+    t6 = c1*s4
+    t7 = t5 + c23*t6
+    t8 = t6 + c23*t5
+    t9 = c1*s23
+    t10 = t3*c5 - s5*t9
+    t11 = t3*s5 + c5*t9
+    t12 = t10*c6 - t7*s6
+    t13 = s1*s23
+    t14 = t8*c5 - s5*t13
+    t15 = t8*s5 + c5*t13
+    t16 = t4*s6 + t14*c6
+    t17 = t12**2 + t16**2
+    t18 = xp.sqrt(t17)
+    t19 = s23*c4
+    t20 = c23*s5 + c5*t19
+    t21 = -c23*c5 + s5*t19
+    t22 = s23*s4
+    t23 = -t20*c6 + s6*t22
+    t24 = t0 + t22*qd5
+    t25 = t24 - t21*qd6
+    t26 = 0.115*t11
+    t27 = 0.62*t9 + t26
+    t28 = 0.115*t15
+    t29 = 0.62*t13 + t28
+    t30 = t27*t13 - t29*t9
+    t31 = t4*t26 + t7*t28
+    t32 = t31*qd5 + t30*qd4
+    t33 = 0.115*t21
+    t34 = -0.62*c23 + t33
+    t35 = -0.12*s23 + t34
+    t36 = -0.6*s2 + t35
+    t37 = c23*t29 + t34*t13
+    t38 = t4*t33 + t22*t28
+    t39 = c23*t27 + t34*t9
+    t40 = t7*t33 - t22*t26
+    t41 = 0.12*c23
+    t42 = -t27 + c1*t41
+    t43 = -t29 + s1*t41
+    t44 = c1*t42 + s1*t43
+    t45 = t32 - t44*qd3
+    t46 = 0.6*c2
+    t47 = t42 + c1*t46
+    t48 = t43 + s1*t46
+    t49 = 0.18*c1 + t47
+    t50 = 0.18*s1 + t48
+    t51 = c1*t47 + s1*t48
+    t52 = t45 - t51*qd2
+    t53 = s1*qd2
+    t54 = s1*qd3
+    t55 = t53 + t54
+    t56 = -t55 + t9*qd4
+    t57 = c23*t55 + t9*qd1
+    t58 = t7*t0 + t22*t56
+    t59 = c1*qd2
+    t60 = c1*qd3
+    t61 = t59 + t60
+    t62 = t61 + t13*qd4
+    t63 = c23*t61 - t13*qd1
+    t64 = -t4*t0 + t22*t62
+    t65 = t13*t55 + t9*t61
+    t66 = t4*t56 + t7*t62
+    t67 = t7*qd5
+    t68 = -t67 + t56
+    t69 = t68 + t11*qd6
+    t70 = t11*t24 + t21*t68
+    t71 = t12*t25 - t23*t69
+    t72 = t4*qd5
+    t73 = t72 + t62
+    t74 = t73 + t15*qd6
+    t75 = t38*t62 - t40*t56 + t67*t40 + t72*t38
+    t76 = t21*t73 + t15*t24
+    t77 = t15*t68 - t11*t73
+    t78 = t23*t74 - t16*t25
+    t79 = t16*t69 - t12*t74
+    t80 = t38*qd5
+    t81 = t80 + t37*qd4
+    t82 = t81 + t35*t60
+    t83 = t36*t59 + t82
+    t84 = t83 - t50*qd1
+    t85 = t37*qd1 + t30*t55 + c23*t81 - t9*t32
+    t86 = t38*t0 - t31*t56 + t22*t80 + t67*t31
+    t87 = t40*qd5
+    t88 = t87 - t39*qd4
+    t89 = t35*t54 + t88
+    t90 = t89 + t36*t53
+    t91 = t90 + t49*qd1
+    t92 = t30*t61 + t39*qd1 - c23*t88 + t13*t32
+    t93 = t31*t62 - t40*t0 + t72*t31 - t22*t87
+    t94 = s1*t90 + c1*t83
+    t95 = t39*t55 - t37*t61 + t9*t88 - t13*t81
+    t96 = s1*qd1
+    t97 = c1*t52 - t36*t96
+    t98 = -c1*t45 + t59*t44 + t35*t96
+    t99 = c1*qd1
+    t100 = s1*t52 + t36*t99
+    t101 = s1*t45 + t35*t99 - t53*t44
+    t102 = t35*qd2
+    t103 = c1*t82 + s1*t89 + s1**2*t102 + c1**2*t102
+    t104 = c1*t16
+    t105 = s1*t12
+    t106 = 1/t17
+    t107 = t106*(-t105 + t104)
+    t108 = t106*(t4*t16 - t7*t12)
+    t109 = t106*(t11*t12 + t15*t16)
+    t110 = c1*t12
+    t111 = s1*t16
+    t112 = t106*(s23*t110 + s23*t111)
+    t113 = 1/t18
+    t114 = t106*t113
+    t115 = t114*(t110 + t111)
+    t116 = t114*(s23*t105 - s23*t104)
+    t117 = (t7*t16 + t4*t12)*t114
+    t118 = (t15*t12 - t11*t16)*t114
+    t119 = 2*t107
+    t120 = t106*t78
+    t121 = -t120*(s1 + t12*t119)
+    t122 = t106*t71
+    t123 = t122*(c1 - t16*t119)
+    t124 = t106*qd1
+    t125 = t110*t124
+    t126 = t111*t124
+    t127 = -t125 - t126 + t121 + t123
+    t128 = 2*t112
+    t129 = t120*(t9 - t12*t128)
+    t130 = t122*(t13 - t16*t128)
+    t131 = t12*t106
+    t132 = t63*t131
+    t133 = t16*t106
+    t134 = t57*t133
+    t135 = 2*t108
+    t136 = -t120*(t7 + t12*t135)
+    t137 = t122*(t4 - t16*t135)
+    t138 = t64*t131
+    t139 = t58*t133
+    t140 = 2*t109
+    t141 = t120*(t11 - t12*t140)
+    t142 = t122*(t15 - t16*t140)
+    t143 = t76*t131
+    t144 = t70*t133
+    t145 = t113*qd1
+    t146 = t78*(-t12*t115 + c1*t113) + t71*(-t16*t115 + s1*t113) + t104*t145 - t105*t145
+    t147 = t16*t113
+    t148 = t12*t113
+    t149 = -(t79*t107 + t23*t121 + t23*t123 - t23*t125 - t23*t126)
     Jd = _stack(xp, [
-        xp.broadcast_to(-t97, batch),  # 0, 0
-        xp.broadcast_to(t103, batch),  # 0, 1
-        xp.broadcast_to(-t104, batch),  # 0, 2
-        xp.broadcast_to(t98, batch),  # 0, 3
-        xp.broadcast_to(t99, batch),  # 0, 4
+        xp.broadcast_to(-t91, batch),  # 0, 0
+        xp.broadcast_to(t97, batch),  # 0, 1
+        xp.broadcast_to(-t98, batch),  # 0, 2
+        xp.broadcast_to(t92, batch),  # 0, 3
+        xp.broadcast_to(t93, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        xp.broadcast_to(t90, batch),  # 1, 0
-        xp.broadcast_to(t106, batch),  # 1, 1
-        xp.broadcast_to(t107, batch),  # 1, 2
-        xp.broadcast_to(t91, batch),  # 1, 3
-        xp.broadcast_to(t92, batch),  # 1, 4
+        xp.broadcast_to(t84, batch),  # 1, 0
+        xp.broadcast_to(t100, batch),  # 1, 1
+        xp.broadcast_to(t101, batch),  # 1, 2
+        xp.broadcast_to(t85, batch),  # 1, 3
+        xp.broadcast_to(t86, batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t100, batch),  # 2, 1
-        xp.broadcast_to(-t109, batch),  # 2, 2
-        xp.broadcast_to(t101, batch),  # 2, 3
+        xp.broadcast_to(-t94, batch),  # 2, 1
+        xp.broadcast_to(-t103, batch),  # 2, 2
+        xp.broadcast_to(t95, batch),  # 2, 3
         xp.broadcast_to(-t75, batch),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(t133, batch),  # 3, 1
-        xp.broadcast_to(t133, batch),  # 3, 2
-        xp.broadcast_to(t135 + t136 + t138 + t140, batch),  # 3, 3
-        xp.broadcast_to(-t145 + t142 + t143 + t144, batch),  # 3, 4
-        xp.broadcast_to(-t149 + t147 + t148 + t150, batch),  # 3, 5
+        xp.broadcast_to(t127, batch),  # 3, 1
+        xp.broadcast_to(t127, batch),  # 3, 2
+        xp.broadcast_to(t129 + t130 + t132 + t134, batch),  # 3, 3
+        xp.broadcast_to(-t139 + t136 + t137 + t138, batch),  # 3, 4
+        xp.broadcast_to(-t143 + t141 + t142 + t144, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t152, batch),  # 4, 1
-        xp.broadcast_to(t152, batch),  # 4, 2
-        xp.broadcast_to(t84*(-t11*t122 + t12*t119) - t85*(t15*t122 + t8*t119) - t59*t153 + t54*t154, batch),  # 4, 3
-        xp.broadcast_to(t84*(-t11*t123 + t3*t119) + t85*(-t15*t123 + t6*t119) - t68*t153 - t69*t154, batch),  # 4, 4
-        xp.broadcast_to(t84*(-t11*t124 + t14*t119) - t85*(t15*t124 + t10*t119) + t81*t153 + t82*t154, batch),  # 4, 5
+        xp.broadcast_to(t146, batch),  # 4, 1
+        xp.broadcast_to(t146, batch),  # 4, 2
+        xp.broadcast_to(t78*(-t12*t116 + t13*t113) - t71*(t16*t116 + t9*t113) - t63*t147 + t57*t148, batch),  # 4, 3
+        xp.broadcast_to(t78*(-t12*t117 + t4*t113) + t71*(-t16*t117 + t7*t113) - t64*t147 - t58*t148, batch),  # 4, 4
+        xp.broadcast_to(t78*(-t12*t118 + t15*t113) - t71*(t16*t118 + t11*t113) + t76*t147 + t70*t148, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t155, batch),  # 5, 1
-        xp.broadcast_to(t155, batch),  # 5, 2
-        xp.broadcast_to(-(t60 + t22*t135 + t22*t136 + t22*t138 + t22*t140 - t78*t118), batch),  # 5, 3
-        xp.broadcast_to(t65 + t78*t114 - t22*t142 - t22*t143 - t22*t144 + t22*t145, batch),  # 5, 4
-        xp.broadcast_to(t76 + t78*t115 - t22*t147 - t22*t148 + t22*t149 - t22*t150, batch),  # 5, 5
+        xp.broadcast_to(t149, batch),  # 5, 1
+        xp.broadcast_to(t149, batch),  # 5, 2
+        xp.broadcast_to(-(t65 + t79*t112 + t23*t129 + t23*t130 + t23*t132 + t23*t134), batch),  # 5, 3
+        xp.broadcast_to(-(-t66 + t79*t108 + t23*t136 + t23*t137 + t23*t138 - t23*t139), batch),  # 5, 4
+        xp.broadcast_to(-(-t77 + t79*t109 + t23*t141 + t23*t142 - t23*t143 + t23*t144), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1364,7 +1358,7 @@ def hessian(q):
     t58 = -c1*t0
     t59 = s23*t1
     t60 = -s1*t0
-    t61 = -(s23*t52 + s23*t53)
+    t61 = -(s23*t53 + s23*t52)
     t62 = -s1*t4 + c1*t7
     t63 = -(s1*t12 + c1*t10)
     t64 = -c23*t38 + t11*t18
@@ -1737,7 +1731,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t66 = t62 + t65
     t67 = s1*t34
     t68 = s1*t28
-    t69 = t22*t67 + t21*t68 + t24*t17 - t37*t18
+    t69 = t22*t67 + t24*t17 - t37*t18 + t21*t68
     t70 = t67 + t68 - t7*t18 + t9*t17
     t71 = t34**2
     t72 = t71 + t28**2 + t17**2 + t18**2
@@ -2194,10 +2188,10 @@ def ik_numeric_step(target, q, damping=0.0):
     t86 = t84 + T13
     t87 = s1**2
     t88 = t64**2 + t54**2 + t55**2 + t72*t87 + t73*t87
-    t89 = t7*t55 + t50*t87 + t9*t54 + t49*t87
+    t89 = t7*t55 + t50*t87 + t49*t87 + t9*t54
     t90 = s1*t66
     t91 = s1*t60
-    t92 = t49*t91 + t54*t44 - t55*t45 + t50*t90
+    t92 = t49*t91 + t50*t90 + t54*t44 - t55*t45
     t93 = t90 + t91 - t7*t45 + t9*t44
     t94 = s23**2
     t95 = t7**2 + t11**2 + 2*t87 + t70*t94

@@ -71,7 +71,7 @@ void manocha_canny_jacobian_dot(const manocha_canny_real q[MANOCHA_CANNY_DOF], c
 void manocha_canny_bias_acceleration(const manocha_canny_real q[MANOCHA_CANNY_DOF], const manocha_canny_real q_dot[MANOCHA_CANNY_DOF], manocha_canny_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 533 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 524 operations. */
 void manocha_canny_task_jacobian_dot(const manocha_canny_real q[MANOCHA_CANNY_DOF], const manocha_canny_real q_dot[MANOCHA_CANNY_DOF], manocha_canny_real Jd[MANOCHA_CANNY_TASK_DIM * MANOCHA_CANNY_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).

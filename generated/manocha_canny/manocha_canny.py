@@ -1235,7 +1235,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 533 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 524 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1258,217 +1258,211 @@ def task_jacobian_dot(q, q_dot):
     s6 = trig[..., 11]
     t0 = 0.01745240643728351*c2
     t1 = 0.0034904812874567027*c2
-    t2 = 0.9998476951563913*s1
-    t3 = 0.01745240643728351*c1
-    t4 = t2 + s2*t3
-    t5 = t4
-    t6 = 0.2*t4
-    t7 = 0.9998476951563913*c1
-    t8 = 0.01745240643728351*s1
-    t9 = -t7 + s2*t8
-    t10 = t9
-    t11 = 0.2*t9
-    t12 = t8 - s2*t7
-    t13 = c1*c2
-    t14 = s3*t12 + c3*t13
-    t15 = c3*t12 - s3*t13
-    t16 = t5*c4 - t14*s4
-    t17 = 0.9998476951563913*t15 + 0.01745240643728351*t16
-    t18 = -(t3 + s2*t2)
-    t19 = c2*s1
-    t20 = s3*t18 + c3*t19
-    t21 = c3*t18 - s3*t19
-    t22 = t10*c4 - t20*s4
-    t23 = 0.9998476951563913*t21 + 0.01745240643728351*t22
-    t24 = 0.9998476951563913*c2
-    t25 = s2*c3 + s3*t24
-    t26 = -s2*s3 + c3*t24
-    t27 = t0*c4 + t25*s4
-    t28 = 0.01745240643728351*t27 - 0.9998476951563913*t26
-    t29 = t14*c4
-    t30 = t5*s4
-    t31 = t29 + t30
-    t32 = 1.5*t29 + 1.5*t30
-    t33 = t6 + t32
-    t34 = t33 + t13
-    t35 = 0.3*c1 + t34
-    t36 = t20*c4
-    t37 = t10*s4
-    t38 = t36 + t37
-    t39 = 1.5*t36 + 1.5*t37
-    t40 = t11 + t39
-    t41 = t40 + t19
-    t42 = 0.3*s1 + t41
-    t43 = c1*t34 + s1*t41
-    t44 = t5*t40 - t10*t33
-    t45 = t21*t32 - t15*t39
-    t46 = t45*qd4 + t44*qd3
-    t47 = t46 + t43*qd2
-    t48 = t25*c4
-    t49 = t0*s4
-    t50 = -t49 + t48
-    t51 = 1.5*t48 - 1.5*t49
-    t52 = -t1 + t51
-    t53 = s2 + t52
-    t54 = t0*t40 + t10*t52
-    t55 = t26*t39 - t21*t51
-    t56 = t0*t33 + t5*t52
-    t57 = t15*t51 - t26*t32
-    t58 = t55*qd4 + t54*qd3
-    t59 = t57*qd4 - t56*qd3
-    t60 = 0.9998476951563913*t16 - 0.01745240643728351*t15
-    t61 = t31*c5 + s5*t60
-    t62 = -t31*s5 + c5*t60
-    t63 = t61*c6 - t17*s6
-    t64 = 0.9998476951563913*t22 - 0.01745240643728351*t21
-    t65 = t38*c5 + s5*t64
-    t66 = -t38*s5 + c5*t64
-    t67 = t65*c6 - t23*s6
-    t68 = t63**2 + t67**2
-    t69 = xp.sqrt(t68)
-    t70 = -(0.9998476951563913*t27 + 0.01745240643728351*t26)
-    t71 = t50*c5 + s5*t70
-    t72 = -t50*s5 + c5*t70
-    t73 = t28*s6 + t71*c6
-    t74 = s1*qd2
-    t75 = t59 - t53*t74
-    t76 = t75 + t35*qd1
-    t77 = t5*t46 + t0*t58 - t54*qd1 + t74*t44
-    t78 = t5*qd1 + t0*t74
-    t79 = t5*qd3
-    t80 = t74 + t79
-    t81 = c1*qd2
-    t82 = t58 - t53*t81
-    t83 = t82 - t42*qd1
-    t84 = t56*qd1 + t10*t46 + t0*t59 - t81*t44
-    t85 = s1*t75 + c1*t82
-    t86 = t5*t59 - t10*t58 - t74*t56 + t81*t54
-    t87 = -t10*qd1 + t0*t81
-    t88 = t10*t74 + t5*t81
-    t89 = t10*qd3
-    t90 = -t81 + t89
-    t91 = -t21*t80 + t15*t90
-    t92 = t0*qd3
-    t93 = -t92 + qd1
-    t94 = -t26*t90 + t21*t93
-    t95 = -t15*t93 + t26*t80
-    t96 = t15*qd4
-    t97 = -t96 + t80
-    t98 = t21*qd4
-    t99 = -t98 + t90
-    t100 = t57*t80 - t55*t90 - t96*t57 + t98*t55
-    t101 = -t23*t97 + t17*t99
-    t102 = t26*qd4
-    t103 = -t102 + t93
-    t104 = t45*t90 - t57*t93 - t98*t45 + t102*t57
-    t105 = t55*t93 - t45*t80 - t102*t55 + t96*t45
-    t106 = t28*t99 + t23*t103
-    t107 = t17*t103 + t28*t97
-    t108 = t17*qd5
-    t109 = -t108 + t97
-    t110 = -t74 - t79 + t96 + t108 + t62*qd6
-    t111 = t23*qd5
-    t112 = -t111 + t99
-    t113 = -t66*t109 + t62*t112
-    t114 = -t89 + t81 + t98 + t66*qd6 + t111
-    t115 = -t67*t110 + t63*t114
-    t116 = t28*qd5
-    t117 = t103 + t116
-    t118 = -t72*t112 + t66*t117
-    t119 = -t62*t117 + t72*t109
-    t120 = -qd1 - t116 + t92 + t102 + t72*qd6
-    t121 = -t73*t114 + t67*t120
-    t122 = -t63*t120 + t73*t110
-    t123 = t53*qd1
-    t124 = -c1*t47 + s1*t123
-    t125 = s1*t47 + c1*t123
-    t126 = s1*t63
-    t127 = c1*t67
-    t128 = 1/t68
-    t129 = (-t127 + t126)*t128
-    t130 = (t5*t63 + t10*t67)*t128
-    t131 = -(t15*t63 + t21*t67)*t128
-    t132 = -(t17*t63 + t23*t67)*t128
-    t133 = -(t62*t63 + t66*t67)*t128
-    t134 = c1*t63
-    t135 = s1*t67
-    t136 = 1/t69
-    t137 = t128*t136
-    t138 = -(t134 + t135)*t137
-    t139 = (t10*t63 - t5*t67)*t137
-    t140 = (t15*t67 - t21*t63)*t137
-    t141 = (t17*t67 - t23*t63)*t137
-    t142 = (t62*t67 - t66*t63)*t137
-    t143 = 2*t129
-    t144 = t121*t128
-    t145 = (s1 - t63*t143)*t144
-    t146 = t122*t128
-    t147 = -(c1 + t67*t143)*t146
-    t148 = qd1*t128
-    t149 = t134*t148
-    t150 = t135*t148
-    t151 = 2*t130
-    t152 = t144*(t5 - t63*t151)
-    t153 = t146*(t10 - t67*t151)
-    t154 = t63*t128
-    t155 = t87*t154
-    t156 = t67*t128
-    t157 = t78*t156
-    t158 = 2*t131
-    t159 = -t144*(t15 + t63*t158)
-    t160 = -t146*(t21 + t67*t158)
-    t161 = t94*t154
-    t162 = t95*t156
-    t163 = 2*t132
-    t164 = -t144*(t17 + t63*t163)
-    t165 = -t146*(t23 + t67*t163)
-    t166 = t106*t154
-    t167 = t107*t156
-    t168 = 2*t133
-    t169 = -t144*(t62 + t63*t168)
-    t170 = -t146*(t66 + t67*t168)
-    t171 = t118*t154
-    t172 = t119*t156
-    t173 = qd1*t136
-    t174 = t67*t136
-    t175 = t63*t136
+    t2 = qd1 - t0*qd3
+    t3 = 0.9998476951563913*s1
+    t4 = 0.01745240643728351*c1
+    t5 = t3 + s2*t4
+    t6 = t5
+    t7 = 0.2*t5
+    t8 = 0.9998476951563913*c1
+    t9 = 0.01745240643728351*s1
+    t10 = -t8 + s2*t9
+    t11 = t10
+    t12 = 0.2*t10
+    t13 = t9 - s2*t8
+    t14 = c1*c2
+    t15 = s3*t13 + c3*t14
+    t16 = c3*t13 - s3*t14
+    t17 = t6*c4 - t15*s4
+    t18 = 0.9998476951563913*t16 + 0.01745240643728351*t17
+    t19 = -(t4 + s2*t3)
+    t20 = c2*s1
+    t21 = s3*t19 + c3*t20
+    t22 = c3*t19 - s3*t20
+    t23 = t11*c4 - t21*s4
+    t24 = 0.9998476951563913*t22 + 0.01745240643728351*t23
+    t25 = 0.9998476951563913*c2
+    t26 = s2*c3 + s3*t25
+    t27 = -s2*s3 + c3*t25
+    t28 = t0*c4 + t26*s4
+    t29 = 0.01745240643728351*t28 - 0.9998476951563913*t27
+    t30 = t15*c4
+    t31 = t6*s4
+    t32 = t30 + t31
+    t33 = 1.5*t30 + 1.5*t31
+    t34 = t7 + t33
+    t35 = t34 + t14
+    t36 = 0.3*c1 + t35
+    t37 = t21*c4
+    t38 = t11*s4
+    t39 = t37 + t38
+    t40 = 1.5*t37 + 1.5*t38
+    t41 = t12 + t40
+    t42 = t41 + t20
+    t43 = 0.3*s1 + t42
+    t44 = c1*t35 + s1*t42
+    t45 = t6*t41 - t11*t34
+    t46 = t22*t33 - t16*t40
+    t47 = t46*qd4 + t45*qd3
+    t48 = t47 + t44*qd2
+    t49 = t26*c4
+    t50 = t0*s4
+    t51 = -t50 + t49
+    t52 = 1.5*t49 - 1.5*t50
+    t53 = -t1 + t52
+    t54 = s2 + t53
+    t55 = t0*t41 + t11*t53
+    t56 = t27*t40 - t22*t52
+    t57 = t0*t34 + t6*t53
+    t58 = t16*t52 - t27*t33
+    t59 = t56*qd4 + t55*qd3
+    t60 = t58*qd4 - t57*qd3
+    t61 = 0.9998476951563913*t17 - 0.01745240643728351*t16
+    t62 = t32*c5 + s5*t61
+    t63 = -t32*s5 + c5*t61
+    t64 = t62*c6 - t18*s6
+    t65 = 0.9998476951563913*t23 - 0.01745240643728351*t22
+    t66 = t39*c5 + s5*t65
+    t67 = -t39*s5 + c5*t65
+    t68 = t66*c6 - t24*s6
+    t69 = t64**2 + t68**2
+    t70 = xp.sqrt(t69)
+    t71 = -(0.9998476951563913*t28 + 0.01745240643728351*t27)
+    t72 = t51*c5 + s5*t71
+    t73 = -t51*s5 + c5*t71
+    t74 = t29*s6 + t72*c6
+    t75 = s1*qd2
+    t76 = t75 + t6*qd3
+    t77 = t60 - t54*t75
+    t78 = t77 + t36*qd1
+    t79 = t6*t47 + t0*t59 - t55*qd1 + t75*t45
+    t80 = t6*qd1 + t0*t75
+    t81 = -t16*t2 + t27*t76
+    t82 = c1*qd2
+    t83 = -t82 + t11*qd3
+    t84 = t59 - t54*t82
+    t85 = t84 - t43*qd1
+    t86 = t57*qd1 + t11*t47 + t0*t60 - t82*t45
+    t87 = s1*t77 + c1*t84
+    t88 = t6*t60 - t11*t59 - t75*t57 + t82*t55
+    t89 = -t11*qd1 + t0*t82
+    t90 = -t27*t83 + t22*t2
+    t91 = t11*t75 + t6*t82
+    t92 = -t22*t76 + t16*t83
+    t93 = t16*qd4
+    t94 = -t93 + t76
+    t95 = t94 - t18*qd5
+    t96 = t95 - t63*qd6
+    t97 = t22*qd4
+    t98 = -t97 + t83
+    t99 = t98 - t24*qd5
+    t100 = t99 - t67*qd6
+    t101 = t58*t76 - t56*t83 - t93*t58 + t97*t56
+    t102 = -t24*t94 + t18*t98
+    t103 = -t67*t95 + t63*t99
+    t104 = t68*t96 - t64*t100
+    t105 = t27*qd4
+    t106 = -t105 + t2
+    t107 = t106 + t29*qd5
+    t108 = t107 - t73*qd6
+    t109 = t46*t83 - t58*t2 - t97*t46 + t105*t58
+    t110 = t56*t2 - t46*t76 - t105*t56 + t93*t46
+    t111 = t29*t98 + t24*t106
+    t112 = -t73*t99 + t67*t107
+    t113 = t18*t106 + t29*t94
+    t114 = -t63*t107 + t73*t95
+    t115 = t74*t100 - t68*t108
+    t116 = t64*t108 - t74*t96
+    t117 = t54*qd1
+    t118 = -c1*t48 + s1*t117
+    t119 = s1*t48 + c1*t117
+    t120 = s1*t64
+    t121 = c1*t68
+    t122 = 1/t69
+    t123 = t122*(-t121 + t120)
+    t124 = t122*(t6*t64 + t11*t68)
+    t125 = -t122*(t16*t64 + t22*t68)
+    t126 = -t122*(t18*t64 + t24*t68)
+    t127 = -t122*(t63*t64 + t67*t68)
+    t128 = c1*t64
+    t129 = s1*t68
+    t130 = 1/t70
+    t131 = t122*t130
+    t132 = -t131*(t128 + t129)
+    t133 = (t11*t64 - t6*t68)*t131
+    t134 = (t16*t68 - t22*t64)*t131
+    t135 = (t18*t68 - t24*t64)*t131
+    t136 = (t63*t68 - t67*t64)*t131
+    t137 = 2*t123
+    t138 = t122*t115
+    t139 = (s1 - t64*t137)*t138
+    t140 = t122*t116
+    t141 = -(c1 + t68*t137)*t140
+    t142 = t122*qd1
+    t143 = t128*t142
+    t144 = t129*t142
+    t145 = 2*t124
+    t146 = t138*(t6 - t64*t145)
+    t147 = t140*(t11 - t68*t145)
+    t148 = t64*t122
+    t149 = t89*t148
+    t150 = t68*t122
+    t151 = t80*t150
+    t152 = 2*t125
+    t153 = -t138*(t16 + t64*t152)
+    t154 = -t140*(t22 + t68*t152)
+    t155 = t90*t148
+    t156 = t81*t150
+    t157 = 2*t126
+    t158 = -t138*(t18 + t64*t157)
+    t159 = -t140*(t24 + t68*t157)
+    t160 = t111*t148
+    t161 = t113*t150
+    t162 = 2*t127
+    t163 = -t138*(t63 + t64*t162)
+    t164 = -t140*(t67 + t68*t162)
+    t165 = t112*t148
+    t166 = t114*t150
+    t167 = qd1*t130
+    t168 = t68*t130
+    t169 = t64*t130
     Jd = _stack(xp, [
-        xp.broadcast_to(-t76, batch),  # 0, 0
-        xp.broadcast_to(t124, batch),  # 0, 1
-        xp.broadcast_to(t84, batch),  # 0, 2
-        xp.broadcast_to(t104, batch),  # 0, 3
+        xp.broadcast_to(-t78, batch),  # 0, 0
+        xp.broadcast_to(t118, batch),  # 0, 1
+        xp.broadcast_to(t86, batch),  # 0, 2
+        xp.broadcast_to(t109, batch),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        xp.broadcast_to(t83, batch),  # 1, 0
-        xp.broadcast_to(-t125, batch),  # 1, 1
-        xp.broadcast_to(-t77, batch),  # 1, 2
-        xp.broadcast_to(t105, batch),  # 1, 3
+        xp.broadcast_to(t85, batch),  # 1, 0
+        xp.broadcast_to(-t119, batch),  # 1, 1
+        xp.broadcast_to(-t79, batch),  # 1, 2
+        xp.broadcast_to(t110, batch),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(t85, batch),  # 2, 1
-        xp.broadcast_to(t86, batch),  # 2, 2
-        xp.broadcast_to(t100, batch),  # 2, 3
+        xp.broadcast_to(t87, batch),  # 2, 1
+        xp.broadcast_to(t88, batch),  # 2, 2
+        xp.broadcast_to(t101, batch),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(t145 + t147 + t149 + t150, batch),  # 3, 1
-        xp.broadcast_to(t152 + t153 + t155 + t157, batch),  # 3, 2
-        xp.broadcast_to(t159 + t160 + t161 + t162, batch),  # 3, 3
-        xp.broadcast_to(-t167 + t164 + t165 + t166, batch),  # 3, 4
-        xp.broadcast_to(t169 + t170 + t171 + t172, batch),  # 3, 5
+        xp.broadcast_to(t139 + t141 + t143 + t144, batch),  # 3, 1
+        xp.broadcast_to(t146 + t147 + t149 + t151, batch),  # 3, 2
+        xp.broadcast_to(t153 + t154 + t155 + t156, batch),  # 3, 3
+        xp.broadcast_to(-t161 + t158 + t159 + t160, batch),  # 3, 4
+        xp.broadcast_to(t163 + t164 + t165 + t166, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(-t121*(t63*t138 + c1*t136) - t122*(t67*t138 + s1*t136) - t127*t173 + t126*t173, batch),  # 4, 1
-        xp.broadcast_to(t121*(-t63*t139 + t10*t136) - t122*(t67*t139 + t5*t136) - t87*t174 + t78*t175, batch),  # 4, 2
-        xp.broadcast_to(-t121*(t63*t140 + t21*t136) + t122*(-t67*t140 + t15*t136) - t94*t174 + t95*t175, batch),  # 4, 3
-        xp.broadcast_to(-t121*(t63*t141 + t23*t136) + t122*(-t67*t141 + t17*t136) - t106*t174 - t107*t175, batch),  # 4, 4
-        xp.broadcast_to(-t121*(t63*t142 + t66*t136) + t122*(-t67*t142 + t62*t136) - t118*t174 + t119*t175, batch),  # 4, 5
+        xp.broadcast_to(-t115*(t64*t132 + c1*t130) - t116*(t68*t132 + s1*t130) - t121*t167 + t120*t167, batch),  # 4, 1
+        xp.broadcast_to(t115*(-t64*t133 + t11*t130) - t116*(t68*t133 + t6*t130) - t89*t168 + t80*t169, batch),  # 4, 2
+        xp.broadcast_to(-t115*(t64*t134 + t22*t130) + t116*(-t68*t134 + t16*t130) - t90*t168 + t81*t169, batch),  # 4, 3
+        xp.broadcast_to(-t115*(t64*t135 + t24*t130) + t116*(-t68*t135 + t18*t130) - t111*t168 - t113*t169, batch),  # 4, 4
+        xp.broadcast_to(-t115*(t64*t136 + t67*t130) + t116*(-t68*t136 + t63*t130) - t112*t168 + t114*t169, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(t115*t129 + t73*t145 + t73*t147 + t73*t149 + t73*t150), batch),  # 5, 1
-        xp.broadcast_to(-(-t88 + t115*t130 + t73*t152 + t73*t153 + t73*t155 + t73*t157), batch),  # 5, 2
-        xp.broadcast_to(-(-t91 + t115*t131 + t73*t159 + t73*t160 + t73*t161 + t73*t162), batch),  # 5, 3
-        xp.broadcast_to(-(-t101 + t115*t132 + t73*t164 + t73*t165 + t73*t166 - t73*t167), batch),  # 5, 4
-        xp.broadcast_to(-(-t113 + t115*t133 + t73*t169 + t73*t170 + t73*t171 + t73*t172), batch),  # 5, 5
+        xp.broadcast_to(-(t104*t123 + t74*t139 + t74*t141 + t74*t143 + t74*t144), batch),  # 5, 1
+        xp.broadcast_to(-(-t91 + t104*t124 + t74*t146 + t74*t147 + t74*t149 + t74*t151), batch),  # 5, 2
+        xp.broadcast_to(-(-t92 + t104*t125 + t74*t153 + t74*t154 + t74*t155 + t74*t156), batch),  # 5, 3
+        xp.broadcast_to(-(-t102 + t104*t126 + t74*t158 + t74*t159 + t74*t160 - t74*t161), batch),  # 5, 4
+        xp.broadcast_to(-(-t103 + t104*t127 + t74*t163 + t74*t164 + t74*t165 + t74*t166), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1970,7 +1964,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t71 = -t36*t44 - t56*t58 + t57*t59 + t67*t70
     t72 = -t70 + t5*t10 + t15*t21 + t17*t23 + t33*t41
     t73 = c1*t45
-    t74 = -t55*t73 + t56*t46 + t57*t47
+    t74 = t56*t46 + t57*t47 - t55*t73
     t75 = t73 + t21*t47 - t10*t46
     t76 = t55*t70
     t77 = t76 + t15*t57 - t5*t56

@@ -71,7 +71,7 @@ void mico_jacobian_dot(const mico_real q[MICO_DOF], const mico_real q_dot[MICO_D
 void mico_bias_acceleration(const mico_real q[MICO_DOF], const mico_real q_dot[MICO_DOF], mico_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 600 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 588 operations. */
 void mico_task_jacobian_dot(const mico_real q[MICO_DOF], const mico_real q_dot[MICO_DOF], mico_real Jd[MICO_TASK_DIM * MICO_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).

@@ -73,7 +73,7 @@ void panda_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot[PA
 void panda_bias_acceleration(const panda_real q[PANDA_DOF], const panda_real q_dot[PANDA_DOF], panda_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 675 operations. */
+ * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 662 operations. */
 void panda_task_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_dot[PANDA_DOF], panda_real Jd[PANDA_TASK_DIM * PANDA_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).

@@ -1317,7 +1317,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 675 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 662 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1341,254 +1341,243 @@ def task_jacobian_dot(q, q_dot):
     s6 = trig[..., 11]
     c7 = trig[..., 12]
     s7 = trig[..., 13]
-    t0 = s1*s3
-    t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
-    t4 = s1*c3
-    t5 = s3*c1
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
-    t8 = c1*s2
-    t9 = 0.0825*t2 + 0.316*t8
-    t10 = t2*c4 + s4*t8
-    t11 = -t2*s4 + c4*t8
-    t12 = t10*c5 - t6*s5
-    t13 = t10*s5 + t6*c5
-    t14 = t11*s6 + t12*c6
-    t15 = t11*c6 - t12*s6
-    t16 = t13*s7 + t14*c7
-    t17 = t13*c7 - t14*s7
-    t18 = 0.088*t14 - 0.21*t15
-    t19 = 0.384*t11 + t18
-    t20 = -0.0825*t10 + t19
-    t21 = t9 + t20
-    t22 = 0.7071067811865476*t16 - 0.7071067811865476*t17
-    t23 = s1*s2
-    t24 = 0.0825*t7 + 0.316*t23
-    t25 = t7*c4 + s4*t23
-    t26 = -t7*s4 + c4*t23
-    t27 = t25*c5 + t3*s5
-    t28 = t3*c5 - t25*s5
-    t29 = t26*s6 + t27*c6
-    t30 = t26*c6 - t27*s6
-    t31 = t29*c7 - t28*s7
-    t32 = t28*c7 + t29*s7
-    t33 = 0.088*t29 - 0.21*t30
-    t34 = 0.384*t26 + t33
-    t35 = -0.0825*t25 + t34
-    t36 = t24 + t35
-    t37 = 0.7071067811865476*t31 + 0.7071067811865476*t32
-    t38 = c1*t21 + s1*t36
-    t39 = t36*t8 - t21*t23
-    t40 = t3*t20 + t6*t35
-    t41 = t11*t34 - t26*t19
-    t42 = t13*t33 + t28*t18
-    t43 = t42*qd6 + t41*qd5
-    t44 = t43 + t40*qd4
-    t45 = t44 + t39*qd3
-    t46 = t45 - t38*qd2
-    t47 = t22**2 + t37**2
-    t48 = xp.sqrt(t47)
-    t49 = c3*s2
-    t50 = 0.316*c2 - 0.0825*t49
-    t51 = c2*s4 - c4*t49
-    t52 = c2*c4 + s4*t49
-    t53 = s3*s2
-    t54 = t51*c5 + s5*t53
-    t55 = -t51*s5 + c5*t53
-    t56 = t52*s6 + t54*c6
-    t57 = t52*c6 - t54*s6
-    t58 = t56*c7 - t55*s7
-    t59 = t55*c7 + t56*s7
-    t60 = 0.088*t56 - 0.21*t57
-    t61 = 0.384*t52 + t60
-    t62 = -0.0825*t51 + t61
-    t63 = t50 + t62
-    t64 = 0.7071067811865476*t58 + 0.7071067811865476*t59
-    t65 = -c2*t36 + t63*t23
-    t66 = -t3*t62 + t35*t53
-    t67 = t26*t61 - t52*t34
-    t68 = t55*t33 - t28*t60
-    t69 = c2*t21 - t63*t8
-    t70 = t6*t62 + t20*t53
-    t71 = t52*t19 - t11*t61
-    t72 = t13*t60 + t55*t18
-    t73 = t68*qd6 + t67*qd5
-    t74 = -t72*qd6 + t71*qd5
-    t75 = t73 + t66*qd4
-    t76 = t74 - t70*qd4
-    t77 = t75 + t65*qd3
-    t78 = t76 + t69*qd3
-    t79 = s1*qd2
-    t80 = t78 + t63*t79
-    t81 = t80 + t21*qd1
-    t82 = t65*qd1 + c2*t77 - t8*t45 + t79*t39
-    t83 = t8*qd1 + c2*t79
-    t84 = -t79 + t8*qd3
-    t85 = t84
-    t86 = c1*qd2
-    t87 = t77 + t63*t86
-    t88 = t87 - t36*qd1
-    t89 = -t69*qd1 - c2*t78 + t23*t45 + t86*t39
-    t90 = s1*t80 + c1*t87
-    t91 = -t8*t78 + t23*t77 + t86*t65 + t79*t69
-    t92 = -t23*qd1 + c2*t86
-    t93 = t23*t79 + t8*t86
-    t94 = t86 + t23*qd3
-    t95 = t94
-    t96 = -t70*t85 - t66*t95 + t6*t76 + t3*t75
-    t97 = t3*t85 + t6*t95
-    t98 = qd1 + c2*qd3
-    t99 = t98
-    t100 = t40*t95 + t70*t99 - t3*t44 + t53*t76
-    t101 = t40*t85 + t6*t44 - t66*t99 + t53*t75
-    t102 = t3*t99 - t53*t95
-    t103 = t6*t99 + t53*t85
-    t104 = t6*qd4
-    t105 = t104 + t85
-    t106 = -t3*qd4
-    t107 = t106 + t95
-    t108 = t71*t105 - t67*t107 + t11*t74 - t26*t73
-    t109 = t26*t105 - t11*t107
-    t110 = -t53*qd4
-    t111 = t110 + t99
-    t112 = t41*t107 - t71*t111 + t26*t43 - t52*t74
-    t113 = t67*t111 - t41*t105 + t52*t73 - t11*t43
-    t114 = t52*t107 - t26*t111
-    t115 = t11*t111 - t52*t105
-    t116 = t11*qd5
-    t117 = t116 + t105
-    t118 = t26*qd5
-    t119 = t118 + t107
-    t120 = t28*t117 + t13*t119
-    t121 = t52*qd5
-    t122 = t121 + t111
-    t123 = -t55*t119 + t28*t122
-    t124 = t13*t122 + t55*t117
-    t125 = t13*qd6
-    t126 = t125 + t117
-    t127 = t84 + t104 + t116 + t125 - t15*qd7
-    t128 = t28*qd6
-    t129 = t68*t119 + t72*t117 + t125*t72 - t128*t68
-    t130 = -t128
-    t131 = t130 + t119
-    t132 = -t30*t126 + t15*t131
-    t133 = t94 + t106 + t118 + t130 - t30*qd7
-    t134 = t37*t127 - t22*t133
-    t135 = t55*qd6
-    t136 = t42*t119 + t72*t122 - t128*t42 - t135*t72
-    t137 = t42*t117 - t68*t122 + t135*t68 + t125*t42
-    t138 = -t135
-    t139 = t138 + t122
-    t140 = -t57*t131 + t30*t139
-    t141 = -t15*t139 + t57*t126
-    t142 = t98 + t110 + t121 + t138 - t57*qd7
-    t143 = t64*t133 - t37*t142
-    t144 = t22*t142 - t64*t127
-    t145 = t63*qd1
-    t146 = c1*t46 - s1*t145
-    t147 = s1*t46 + c1*t145
-    t148 = c1*t37
-    t149 = s1*t22
-    t150 = 1/t47
-    t151 = t150*(-t149 + t148)
-    t152 = t150*(t6*t22 - t3*t37)
-    t153 = t150*(t11*t22 + t26*t37)
-    t154 = t150*(t13*t22 - t28*t37)
-    t155 = -t150*(t15*t22 + t30*t37)
-    t156 = c1*t22
-    t157 = s1*t37
-    t158 = t150*(s2*t156 + s2*t157)
-    t159 = 1/t48
-    t160 = t150*t159
-    t161 = t160*(t156 + t157)
-    t162 = t160*(s2*t149 - s2*t148)
-    t163 = -(t6*t37 + t3*t22)*t160
-    t164 = (t26*t22 - t11*t37)*t160
-    t165 = -(t13*t37 + t28*t22)*t160
-    t166 = (t15*t37 - t30*t22)*t160
-    t167 = 2*t151
-    t168 = t150*t143
-    t169 = -t168*(s1 + t22*t167)
-    t170 = t150*t144
-    t171 = t170*(c1 - t37*t167)
-    t172 = t150*qd1
-    t173 = t156*t172
-    t174 = t157*t172
-    t175 = 2*t158
-    t176 = t168*(t8 - t22*t175)
-    t177 = t170*(t23 - t37*t175)
-    t178 = t22*t150
-    t179 = t92*t178
-    t180 = t37*t150
-    t181 = t83*t180
-    t182 = 2*t152
-    t183 = t168*(t6 - t22*t182)
-    t184 = -t170*(t3 + t37*t182)
-    t185 = t102*t178
-    t186 = t103*t180
-    t187 = 2*t153
-    t188 = t168*(t11 - t22*t187)
-    t189 = t170*(t26 - t37*t187)
-    t190 = t114*t178
-    t191 = t115*t180
-    t192 = 2*t154
-    t193 = t168*(t13 - t22*t192)
-    t194 = -t170*(t28 + t37*t192)
-    t195 = t123*t178
-    t196 = t124*t180
-    t197 = 2*t155
-    t198 = -t168*(t15 + t22*t197)
-    t199 = -t170*(t30 + t37*t197)
-    t200 = t140*t178
-    t201 = t141*t180
-    t202 = qd1*t159
-    t203 = t37*t159
-    t204 = t22*t159
+    t0 = qd1 + c2*qd3
+    t1 = s1*s3
+    t2 = c1*c3
+    t3 = -t1 + c2*t2
+    t4 = t2 - c2*t1
+    t5 = s1*c3
+    t6 = s3*c1
+    t7 = t5 + c2*t6
+    t8 = t6 + c2*t5
+    t9 = c1*s2
+    t10 = 0.0825*t3 + 0.316*t9
+    t11 = t3*c4 + s4*t9
+    t12 = -t3*s4 + c4*t9
+    t13 = t11*c5 - t7*s5
+    t14 = t11*s5 + t7*c5
+    t15 = t12*s6 + t13*c6
+    t16 = t12*c6 - t13*s6
+    t17 = t14*s7 + t15*c7
+    t18 = t14*c7 - t15*s7
+    t19 = 0.088*t15 - 0.21*t16
+    t20 = 0.384*t12 + t19
+    t21 = -0.0825*t11 + t20
+    t22 = t10 + t21
+    t23 = 0.7071067811865476*t17 - 0.7071067811865476*t18
+    t24 = s1*s2
+    t25 = 0.0825*t8 + 0.316*t24
+    t26 = t8*c4 + s4*t24
+    t27 = -t8*s4 + c4*t24
+    t28 = t26*c5 + t4*s5
+    t29 = t4*c5 - t26*s5
+    t30 = t27*s6 + t28*c6
+    t31 = t27*c6 - t28*s6
+    t32 = t30*c7 - t29*s7
+    t33 = t29*c7 + t30*s7
+    t34 = 0.088*t30 - 0.21*t31
+    t35 = 0.384*t27 + t34
+    t36 = -0.0825*t26 + t35
+    t37 = t25 + t36
+    t38 = 0.7071067811865476*t32 + 0.7071067811865476*t33
+    t39 = c1*t22 + s1*t37
+    t40 = t37*t9 - t22*t24
+    t41 = t4*t21 + t7*t36
+    t42 = t12*t35 - t27*t20
+    t43 = t14*t34 + t29*t19
+    t44 = t43*qd6 + t42*qd5
+    t45 = t44 + t41*qd4
+    t46 = t45 + t40*qd3
+    t47 = t46 - t39*qd2
+    t48 = t23**2 + t38**2
+    t49 = xp.sqrt(t48)
+    t50 = c3*s2
+    t51 = 0.316*c2 - 0.0825*t50
+    t52 = c2*s4 - c4*t50
+    t53 = c2*c4 + s4*t50
+    t54 = s3*s2
+    t55 = t52*c5 + s5*t54
+    t56 = -t52*s5 + c5*t54
+    t57 = t53*s6 + t55*c6
+    t58 = t53*c6 - t55*s6
+    t59 = t57*c7 - t56*s7
+    t60 = t56*c7 + t57*s7
+    t61 = 0.088*t57 - 0.21*t58
+    t62 = 0.384*t53 + t61
+    t63 = -0.0825*t52 + t62
+    t64 = t51 + t63
+    t65 = 0.7071067811865476*t59 + 0.7071067811865476*t60
+    t66 = -c2*t37 + t64*t24
+    t67 = -t4*t63 + t36*t54
+    t68 = t27*t62 - t53*t35
+    t69 = t56*t34 - t29*t61
+    t70 = c2*t22 - t64*t9
+    t71 = t7*t63 + t21*t54
+    t72 = t53*t20 - t12*t62
+    t73 = t14*t61 + t56*t19
+    t74 = t0 - t54*qd4
+    t75 = t74 + t53*qd5
+    t76 = t69*qd6 + t68*qd5
+    t77 = -t73*qd6 + t72*qd5
+    t78 = t76 + t67*qd4
+    t79 = t77 - t71*qd4
+    t80 = t78 + t66*qd3
+    t81 = t79 + t70*qd3
+    t82 = s1*qd2
+    t83 = -t82 + t9*qd3
+    t84 = t83 + t7*qd4
+    t85 = t84 + t12*qd5
+    t86 = t81 + t64*t82
+    t87 = t86 + t22*qd1
+    t88 = t66*qd1 + c2*t80 - t9*t46 + t82*t40
+    t89 = t41*t83 + t7*t45 - t67*t0 + t54*t78
+    t90 = t68*t74 - t42*t84 + t53*t76 - t12*t44
+    t91 = t9*qd1 + c2*t82
+    t92 = t7*t0 + t54*t83
+    t93 = t12*t74 - t53*t84
+    t94 = t14*t75 + t56*t85
+    t95 = c1*qd2
+    t96 = t95 + t24*qd3
+    t97 = t96 - t4*qd4
+    t98 = t97 + t27*qd5
+    t99 = t80 + t64*t95
+    t100 = t99 - t37*qd1
+    t101 = -t70*qd1 - c2*t81 + t24*t46 + t95*t40
+    t102 = t41*t96 + t71*t0 - t4*t45 + t54*t79
+    t103 = t42*t97 - t72*t74 + t27*t44 - t53*t77
+    t104 = s1*t86 + c1*t99
+    t105 = -t9*t81 + t24*t80 + t82*t70 + t95*t66
+    t106 = -t71*t83 - t67*t96 + t7*t79 + t4*t78
+    t107 = t72*t84 - t68*t97 + t12*t77 - t27*t76
+    t108 = -t24*qd1 + c2*t95
+    t109 = t4*t0 - t54*t96
+    t110 = t53*t97 - t27*t74
+    t111 = -t56*t98 + t29*t75
+    t112 = t24*t82 + t9*t95
+    t113 = t4*t83 + t7*t96
+    t114 = t27*t84 - t12*t97
+    t115 = t29*t85 + t14*t98
+    t116 = t14*qd6
+    t117 = t116 + t85
+    t118 = t117 - t16*qd7
+    t119 = t29*qd6
+    t120 = -t119 + t98
+    t121 = t120 - t31*qd7
+    t122 = t69*t98 + t73*t85 + t116*t73 - t119*t69
+    t123 = -t31*t117 + t16*t120
+    t124 = t38*t118 - t23*t121
+    t125 = t56*qd6
+    t126 = -t125 + t75
+    t127 = t126 - t58*qd7
+    t128 = t43*t98 + t73*t75 - t119*t43 - t125*t73
+    t129 = t43*t85 - t69*t75 + t125*t69 + t116*t43
+    t130 = -t58*t120 + t31*t126
+    t131 = -t16*t126 + t58*t117
+    t132 = t65*t121 - t38*t127
+    t133 = t23*t127 - t65*t118
+    t134 = t64*qd1
+    t135 = c1*t47 - s1*t134
+    t136 = s1*t47 + c1*t134
+    t137 = c1*t38
+    t138 = s1*t23
+    t139 = 1/t48
+    t140 = t139*(-t138 + t137)
+    t141 = t139*(t7*t23 - t4*t38)
+    t142 = t139*(t12*t23 + t27*t38)
+    t143 = t139*(t14*t23 - t29*t38)
+    t144 = -t139*(t16*t23 + t31*t38)
+    t145 = c1*t23
+    t146 = s1*t38
+    t147 = t139*(s2*t145 + s2*t146)
+    t148 = 1/t49
+    t149 = t139*t148
+    t150 = t149*(t145 + t146)
+    t151 = t149*(s2*t138 - s2*t137)
+    t152 = -t149*(t7*t38 + t4*t23)
+    t153 = t149*(t27*t23 - t12*t38)
+    t154 = -t149*(t14*t38 + t29*t23)
+    t155 = t149*(t16*t38 - t31*t23)
+    t156 = 2*t140
+    t157 = t139*t132
+    t158 = -t157*(s1 + t23*t156)
+    t159 = t139*t133
+    t160 = t159*(c1 - t38*t156)
+    t161 = t139*qd1
+    t162 = t145*t161
+    t163 = t146*t161
+    t164 = 2*t147
+    t165 = t157*(t9 - t23*t164)
+    t166 = t159*(t24 - t38*t164)
+    t167 = t23*t139
+    t168 = t108*t167
+    t169 = t38*t139
+    t170 = t91*t169
+    t171 = 2*t141
+    t172 = t157*(t7 - t23*t171)
+    t173 = -t159*(t4 + t38*t171)
+    t174 = t109*t167
+    t175 = t92*t169
+    t176 = 2*t142
+    t177 = t157*(t12 - t23*t176)
+    t178 = t159*(t27 - t38*t176)
+    t179 = t110*t167
+    t180 = t93*t169
+    t181 = 2*t143
+    t182 = t157*(t14 - t23*t181)
+    t183 = -t159*(t29 + t38*t181)
+    t184 = t111*t167
+    t185 = t94*t169
+    t186 = 2*t144
+    t187 = -t157*(t16 + t23*t186)
+    t188 = -t159*(t31 + t38*t186)
+    t189 = t130*t167
+    t190 = t131*t169
+    t191 = t148*qd1
+    t192 = t38*t148
+    t193 = t23*t148
     Jd = _stack(xp, [
-        xp.broadcast_to(-t81, batch),  # 0, 0
-        xp.broadcast_to(t146, batch),  # 0, 1
-        xp.broadcast_to(t89, batch),  # 0, 2
-        xp.broadcast_to(t100, batch),  # 0, 3
-        xp.broadcast_to(t112, batch),  # 0, 4
-        xp.broadcast_to(t136, batch),  # 0, 5
+        xp.broadcast_to(-t87, batch),  # 0, 0
+        xp.broadcast_to(t135, batch),  # 0, 1
+        xp.broadcast_to(t101, batch),  # 0, 2
+        xp.broadcast_to(t102, batch),  # 0, 3
+        xp.broadcast_to(t103, batch),  # 0, 4
+        xp.broadcast_to(t128, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
-        xp.broadcast_to(t88, batch),  # 1, 0
-        xp.broadcast_to(t147, batch),  # 1, 1
-        xp.broadcast_to(t82, batch),  # 1, 2
-        xp.broadcast_to(-t101, batch),  # 1, 3
-        xp.broadcast_to(t113, batch),  # 1, 4
-        xp.broadcast_to(-t137, batch),  # 1, 5
+        xp.broadcast_to(t100, batch),  # 1, 0
+        xp.broadcast_to(t136, batch),  # 1, 1
+        xp.broadcast_to(t88, batch),  # 1, 2
+        xp.broadcast_to(-t89, batch),  # 1, 3
+        xp.broadcast_to(t90, batch),  # 1, 4
+        xp.broadcast_to(-t129, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t90, batch),  # 2, 1
-        xp.broadcast_to(-t91, batch),  # 2, 2
-        xp.broadcast_to(t96, batch),  # 2, 3
-        xp.broadcast_to(t108, batch),  # 2, 4
-        xp.broadcast_to(-t129, batch),  # 2, 5
+        xp.broadcast_to(-t104, batch),  # 2, 1
+        xp.broadcast_to(-t105, batch),  # 2, 2
+        xp.broadcast_to(t106, batch),  # 2, 3
+        xp.broadcast_to(t107, batch),  # 2, 4
+        xp.broadcast_to(-t122, batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(-t173 - t174 + t169 + t171, batch),  # 3, 1
-        xp.broadcast_to(t176 + t177 + t179 + t181, batch),  # 3, 2
-        xp.broadcast_to(t183 + t184 + t185 + t186, batch),  # 3, 3
-        xp.broadcast_to(t188 + t189 + t190 + t191, batch),  # 3, 4
-        xp.broadcast_to(t193 + t194 + t195 + t196, batch),  # 3, 5
-        xp.broadcast_to(t198 + t199 + t200 + t201, batch),  # 3, 6
+        xp.broadcast_to(-t162 - t163 + t158 + t160, batch),  # 3, 1
+        xp.broadcast_to(t165 + t166 + t168 + t170, batch),  # 3, 2
+        xp.broadcast_to(t172 + t173 + t174 + t175, batch),  # 3, 3
+        xp.broadcast_to(t177 + t178 + t179 + t180, batch),  # 3, 4
+        xp.broadcast_to(t182 + t183 + t184 + t185, batch),  # 3, 5
+        xp.broadcast_to(t187 + t188 + t189 + t190, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t143*(-t22*t161 + c1*t159) + t144*(-t37*t161 + s1*t159) + t148*t202 - t149*t202, batch),  # 4, 1
-        xp.broadcast_to(t143*(-t22*t162 + t23*t159) - t144*(t37*t162 + t8*t159) - t92*t203 + t83*t204, batch),  # 4, 2
-        xp.broadcast_to(-t143*(t22*t163 + t3*t159) - t144*(t37*t163 + t6*t159) - t102*t203 + t103*t204, batch),  # 4, 3
-        xp.broadcast_to(t143*(-t22*t164 + t26*t159) - t144*(t37*t164 + t11*t159) - t114*t203 + t115*t204, batch),  # 4, 4
-        xp.broadcast_to(-t143*(t22*t165 + t28*t159) - t144*(t37*t165 + t13*t159) - t123*t203 + t124*t204, batch),  # 4, 5
-        xp.broadcast_to(-t143*(t22*t166 + t30*t159) + t144*(-t37*t166 + t15*t159) - t140*t203 + t141*t204, batch),  # 4, 6
+        xp.broadcast_to(t132*(-t23*t150 + c1*t148) + t133*(-t38*t150 + s1*t148) + t137*t191 - t138*t191, batch),  # 4, 1
+        xp.broadcast_to(t132*(-t23*t151 + t24*t148) - t133*(t38*t151 + t9*t148) - t108*t192 + t91*t193, batch),  # 4, 2
+        xp.broadcast_to(-t132*(t23*t152 + t4*t148) - t133*(t38*t152 + t7*t148) - t109*t192 + t92*t193, batch),  # 4, 3
+        xp.broadcast_to(t132*(-t23*t153 + t27*t148) - t133*(t38*t153 + t12*t148) - t110*t192 + t93*t193, batch),  # 4, 4
+        xp.broadcast_to(-t132*(t23*t154 + t29*t148) - t133*(t38*t154 + t14*t148) - t111*t192 + t94*t193, batch),  # 4, 5
+        xp.broadcast_to(-t132*(t23*t155 + t31*t148) + t133*(-t38*t155 + t16*t148) - t130*t192 + t131*t193, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(t134*t151 + t64*t169 + t64*t171 - t64*t173 - t64*t174), batch),  # 5, 1
-        xp.broadcast_to(-(t93 + t134*t158 + t64*t176 + t64*t177 + t64*t179 + t64*t181), batch),  # 5, 2
-        xp.broadcast_to(-(t97 + t134*t152 + t64*t183 + t64*t184 + t64*t185 + t64*t186), batch),  # 5, 3
-        xp.broadcast_to(-(-t109 + t134*t153 + t64*t188 + t64*t189 + t64*t190 + t64*t191), batch),  # 5, 4
-        xp.broadcast_to(-(t120 + t134*t154 + t64*t193 + t64*t194 + t64*t195 + t64*t196), batch),  # 5, 5
-        xp.broadcast_to(-(-t132 + t134*t155 + t64*t198 + t64*t199 + t64*t200 + t64*t201), batch),  # 5, 6
+        xp.broadcast_to(-(t65*t160 + t124*t140 + t65*t158 - t65*t162 - t65*t163), batch),  # 5, 1
+        xp.broadcast_to(-(t112 + t124*t147 + t65*t165 + t65*t166 + t65*t168 + t65*t170), batch),  # 5, 2
+        xp.broadcast_to(-(t113 + t124*t141 + t65*t172 + t65*t173 + t65*t174 + t65*t175), batch),  # 5, 3
+        xp.broadcast_to(-(-t114 + t124*t142 + t65*t177 + t65*t178 + t65*t179 + t65*t180), batch),  # 5, 4
+        xp.broadcast_to(-(t115 + t124*t143 + t65*t182 + t65*t183 + t65*t184 + t65*t185), batch),  # 5, 5
+        xp.broadcast_to(-(-t123 + t124*t144 + t65*t187 + t65*t188 + t65*t189 + t65*t190), batch),  # 5, 6
     ], (6, 7))
     return Jd
 

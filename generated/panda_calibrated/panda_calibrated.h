@@ -73,7 +73,7 @@ void panda_calibrated_jacobian_dot(const panda_calibrated_real q[PANDA_CALIBRATE
 void panda_calibrated_bias_acceleration(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF], panda_calibrated_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 914 operations. */
+ * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 903 operations. */
 void panda_calibrated_task_jacobian_dot(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF], panda_calibrated_real Jd[PANDA_CALIBRATED_TASK_DIM * PANDA_CALIBRATED_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).

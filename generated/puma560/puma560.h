@@ -71,7 +71,7 @@ void puma560_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_real 
 void puma560_bias_acceleration(const puma560_real q[PUMA560_DOF], const puma560_real q_dot[PUMA560_DOF], puma560_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 395 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 389 operations. */
 void puma560_task_jacobian_dot(const puma560_real q[PUMA560_DOF], const puma560_real q_dot[PUMA560_DOF], puma560_real Jd[PUMA560_TASK_DIM * PUMA560_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).

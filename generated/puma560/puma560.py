@@ -963,7 +963,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 395 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 389 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -988,174 +988,166 @@ def task_jacobian_dot(q, q_dot):
     s6 = trig[..., 11]
     t0 = 0.4318*c23 + 0.0203*s23
     t1 = 0.4318*s2 + t0
-    t2 = 0.0203*c23
-    t3 = 0.15005*s1 + c1*t2
-    t4 = -0.15005*c1 + s1*t2
-    t5 = s1*s4
-    t6 = c1*c4
-    t7 = -t5 + c23*t6
-    t8 = t6 - c23*t5
-    t9 = s1*c4
-    t10 = c1*s4
-    t11 = t9 + c23*t10
-    t12 = t10 + c23*t9
-    t13 = c1*s23
-    t14 = t7*c5 - s5*t13
-    t15 = t7*s5 + c5*t13
-    t16 = t14*c6 - t11*s6
-    t17 = -0.4318*t13 + t3
-    t18 = s1*s23
-    t19 = t12*c5 - s5*t18
-    t20 = t12*s5 + c5*t18
-    t21 = t8*s6 + t19*c6
-    t22 = -0.4318*t18 + t4
-    t23 = c1*t17 + s1*t22
-    t24 = t16**2 + t21**2
-    t25 = xp.sqrt(t24)
-    t26 = s23*c4
-    t27 = c23*s5 + c5*t26
-    t28 = c23*c5 - s5*t26
-    t29 = s23*s4
-    t30 = t27*c6 - s6*t29
-    t31 = 0.4318*c2
-    t32 = t17 + c1*t31
-    t33 = t22 + s1*t31
-    t34 = c1*t32 + s1*t33
-    t35 = t23*qd3 + t34*qd2
-    t36 = s1*qd2
-    t37 = s1*qd3
-    t38 = t0*t37 + t1*t36
-    t39 = -t38 + t32*qd1
-    t40 = t36 + t37
-    t41 = t40
-    t42 = c23*t41 + t13*qd1
-    t43 = c1*qd2
-    t44 = c1*qd3
-    t45 = t0*t44 + t1*t43
-    t46 = t45 + t33*qd1
-    t47 = s1*t38 + c1*t45
-    t48 = t43 + t44
-    t49 = t48
-    t50 = -c23*t49 + t18*qd1
-    t51 = t18*t41 + t13*t49
-    t52 = -t13*qd4
-    t53 = t52 + t41
-    t54 = t18*qd4
-    t55 = t54 + t49
-    t56 = -t8*t53 + t11*t55
-    t57 = qd1 + c23*qd4
-    t58 = t57
-    t59 = t8*t58 - t29*t55
-    t60 = t11*t58 - t29*t53
-    t61 = t11*qd5
-    t62 = t61 + t53
-    t63 = t40 + t52 + t61 - t15*qd6
-    t64 = t8*qd5
-    t65 = t64 + t55
-    t66 = t20*t62 + t15*t65
-    t67 = t48 + t54 + t64 + t20*qd6
-    t68 = t21*t63 + t16*t67
-    t69 = t29*qd5
-    t70 = t69 + t58
-    t71 = -t28*t65 + t20*t70
-    t72 = t15*t70 + t28*t62
-    t73 = t57 + t69 + t28*qd6
-    t74 = t30*t67 + t21*t73
-    t75 = t16*t73 - t30*t63
-    t76 = s1*qd1
-    t77 = -c1*t35 + t1*t76
-    t78 = t44*t23 + t43*t23 - t0*t76
-    t79 = c1*qd1
-    t80 = s1*t35 + t1*t79
-    t81 = t36*t23 + t37*t23 + t0*t79
-    t82 = s1**2
-    t83 = t0*qd2
-    t84 = c1**2
-    t85 = t0*qd3
-    t86 = t82*t83 + t83*t84 + t82*t85 + t84*t85
-    t87 = s1*t16
-    t88 = c1*t21
-    t89 = 1/t24
-    t90 = (-t88 + t87)*t89
-    t91 = (t11*t16 - t8*t21)*t89
-    t92 = -(t15*t16 + t20*t21)*t89
-    t93 = c1*t16
-    t94 = s1*t21
-    t95 = -t89*(s23*t93 + s23*t94)
-    t96 = 1/t25
-    t97 = t89*t96
-    t98 = -(t93 + t94)*t97
-    t99 = t97*(s23*t88 - s23*t87)
-    t100 = -(t11*t21 + t8*t16)*t97
-    t101 = (t15*t21 - t20*t16)*t97
-    t102 = 2*t90
-    t103 = t74*t89
-    t104 = (s1 - t16*t102)*t103
-    t105 = t75*t89
-    t106 = -(c1 + t21*t102)*t105
-    t107 = qd1*t89
-    t108 = t93*t107
-    t109 = t94*t107
-    t110 = -t104 + t106 + t108 + t109
-    t111 = 2*t95
-    t112 = -t103*(t13 + t16*t111)
-    t113 = -t105*(t18 + t21*t111)
-    t114 = t16*t89
-    t115 = t50*t114
-    t116 = t21*t89
-    t117 = t42*t116
-    t118 = 2*t91
-    t119 = t103*(t11 - t16*t118)
-    t120 = -t105*(t8 + t21*t118)
-    t121 = t59*t114
-    t122 = t60*t116
-    t123 = 2*t92
-    t124 = -t103*(t15 + t16*t123)
-    t125 = -t105*(t20 + t21*t123)
-    t126 = t71*t114
-    t127 = t72*t116
-    t128 = qd1*t96
-    t129 = t74*(t16*t98 + c1*t96) - t75*(t21*t98 + s1*t96) - t88*t128 + t87*t128
-    t130 = t21*t96
-    t131 = t16*t96
-    t132 = -(t68*t90 - t30*t104 + t30*t106 + t30*t108 + t30*t109)
+    t2 = qd1 + c23*qd4
+    t3 = 0.0203*c23
+    t4 = 0.15005*s1 + c1*t3
+    t5 = -0.15005*c1 + s1*t3
+    t6 = s1*s4
+    t7 = c1*c4
+    t8 = -t6 + c23*t7
+    t9 = t7 - c23*t6
+    t10 = s1*c4
+    t11 = c1*s4
+    t12 = t10 + c23*t11
+    t13 = t11 + c23*t10
+    t14 = c1*s23
+    t15 = t8*c5 - s5*t14
+    t16 = t8*s5 + c5*t14
+    t17 = t15*c6 - t12*s6
+    t18 = -0.4318*t14 + t4
+    t19 = s1*s23
+    t20 = t13*c5 - s5*t19
+    t21 = t13*s5 + c5*t19
+    t22 = t9*s6 + t20*c6
+    t23 = -0.4318*t19 + t5
+    t24 = c1*t18 + s1*t23
+    t25 = t17**2 + t22**2
+    t26 = xp.sqrt(t25)
+    t27 = s23*c4
+    t28 = c23*s5 + c5*t27
+    t29 = c23*c5 - s5*t27
+    t30 = s23*s4
+    t31 = t28*c6 - s6*t30
+    t32 = t2 + t30*qd5
+    t33 = t32 + t29*qd6
+    t34 = 0.4318*c2
+    t35 = t18 + c1*t34
+    t36 = t23 + s1*t34
+    t37 = c1*t35 + s1*t36
+    t38 = t24*qd3 + t37*qd2
+    t39 = s1*qd2
+    t40 = s1*qd3
+    t41 = t39 + t40
+    t42 = t41 - t14*qd4
+    t43 = t42 + t12*qd5
+    t44 = t43 - t16*qd6
+    t45 = t0*t40 + t1*t39
+    t46 = -t45 + t35*qd1
+    t47 = c23*t41 + t14*qd1
+    t48 = t12*t2 - t30*t42
+    t49 = t16*t32 + t29*t43
+    t50 = t17*t33 - t31*t44
+    t51 = c1*qd2
+    t52 = c1*qd3
+    t53 = t51 + t52
+    t54 = t53 + t19*qd4
+    t55 = t54 + t9*qd5
+    t56 = t55 + t21*qd6
+    t57 = t1*t51 + t0*t52
+    t58 = t57 + t36*qd1
+    t59 = s1*t45 + c1*t57
+    t60 = -c23*t53 + t19*qd1
+    t61 = t9*t2 - t30*t54
+    t62 = -t29*t55 + t21*t32
+    t63 = t19*t41 + t14*t53
+    t64 = -t9*t42 + t12*t54
+    t65 = t21*t43 + t16*t55
+    t66 = t31*t56 + t22*t33
+    t67 = t22*t44 + t17*t56
+    t68 = s1*qd1
+    t69 = t1*t68 - c1*t38
+    t70 = -t0*t68 + t51*t24 + t52*t24
+    t71 = c1*qd1
+    t72 = t1*t71 + s1*t38
+    t73 = t0*t71 + t39*t24 + t40*t24
+    t74 = s1**2
+    t75 = t0*qd2
+    t76 = c1**2
+    t77 = t0*qd3
+    t78 = t74*t75 + t75*t76 + t74*t77 + t76*t77
+    t79 = s1*t17
+    t80 = c1*t22
+    t81 = 1/t25
+    t82 = t81*(-t80 + t79)
+    t83 = (t12*t17 - t9*t22)*t81
+    t84 = -(t16*t17 + t21*t22)*t81
+    t85 = c1*t17
+    t86 = s1*t22
+    t87 = -t81*(s23*t85 + s23*t86)
+    t88 = 1/t26
+    t89 = t81*t88
+    t90 = -t89*(t85 + t86)
+    t91 = t89*(s23*t80 - s23*t79)
+    t92 = -(t12*t22 + t9*t17)*t89
+    t93 = (t16*t22 - t21*t17)*t89
+    t94 = 2*t82
+    t95 = t81*t66
+    t96 = (s1 - t17*t94)*t95
+    t97 = t81*t50
+    t98 = -(c1 + t22*t94)*t97
+    t99 = t81*qd1
+    t100 = t85*t99
+    t101 = t86*t99
+    t102 = -t96 + t98 + t100 + t101
+    t103 = 2*t87
+    t104 = -t95*(t14 + t17*t103)
+    t105 = -t97*(t19 + t22*t103)
+    t106 = t17*t81
+    t107 = t60*t106
+    t108 = t22*t81
+    t109 = t47*t108
+    t110 = 2*t83
+    t111 = t95*(t12 - t17*t110)
+    t112 = -t97*(t9 + t22*t110)
+    t113 = t61*t106
+    t114 = t48*t108
+    t115 = 2*t84
+    t116 = -t95*(t16 + t17*t115)
+    t117 = -t97*(t21 + t22*t115)
+    t118 = t62*t106
+    t119 = t49*t108
+    t120 = qd1*t88
+    t121 = t66*(t17*t90 + c1*t88) - t50*(t22*t90 + s1*t88) - t80*t120 + t79*t120
+    t122 = t22*t88
+    t123 = t17*t88
+    t124 = -(t67*t82 - t31*t96 + t31*t98 + t31*t100 + t31*t101)
     Jd = _stack(xp, [
-        xp.broadcast_to(-t39, batch),  # 0, 0
-        xp.broadcast_to(t77, batch),  # 0, 1
-        xp.broadcast_to(-t78, batch),  # 0, 2
+        xp.broadcast_to(-t46, batch),  # 0, 0
+        xp.broadcast_to(t69, batch),  # 0, 1
+        xp.broadcast_to(-t70, batch),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        xp.broadcast_to(-t46, batch),  # 1, 0
-        xp.broadcast_to(-t80, batch),  # 1, 1
-        xp.broadcast_to(-t81, batch),  # 1, 2
+        xp.broadcast_to(-t58, batch),  # 1, 0
+        xp.broadcast_to(-t72, batch),  # 1, 1
+        xp.broadcast_to(-t73, batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t47, batch),  # 2, 1
-        xp.broadcast_to(-t86, batch),  # 2, 2
+        xp.broadcast_to(-t59, batch),  # 2, 1
+        xp.broadcast_to(-t78, batch),  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(t110, batch),  # 3, 1
-        xp.broadcast_to(t110, batch),  # 3, 2
-        xp.broadcast_to(-t112 - t117 + t113 + t115, batch),  # 3, 3
-        xp.broadcast_to(-t119 + t120 + t121 + t122, batch),  # 3, 4
-        xp.broadcast_to(-t124 - t127 + t125 + t126, batch),  # 3, 5
+        xp.broadcast_to(t102, batch),  # 3, 1
+        xp.broadcast_to(t102, batch),  # 3, 2
+        xp.broadcast_to(-t104 - t109 + t105 + t107, batch),  # 3, 3
+        xp.broadcast_to(-t111 + t112 + t113 + t114, batch),  # 3, 4
+        xp.broadcast_to(-t116 - t119 + t117 + t118, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t129, batch),  # 4, 1
-        xp.broadcast_to(t129, batch),  # 4, 2
-        xp.broadcast_to(-(-t74*(t16*t99 + t18*t96) - t75*(-t21*t99 + t13*t96) + t50*t130 + t42*t131), batch),  # 4, 3
-        xp.broadcast_to(t74*(t16*t100 + t8*t96) - t75*(t21*t100 + t11*t96) - t59*t130 + t60*t131, batch),  # 4, 4
-        xp.broadcast_to(-(-t74*(t16*t101 + t20*t96) - t75*(-t21*t101 + t15*t96) + t71*t130 + t72*t131), batch),  # 4, 5
+        xp.broadcast_to(t121, batch),  # 4, 1
+        xp.broadcast_to(t121, batch),  # 4, 2
+        xp.broadcast_to(-(-t66*(t17*t91 + t19*t88) - t50*(-t22*t91 + t14*t88) + t60*t122 + t47*t123), batch),  # 4, 3
+        xp.broadcast_to(t66*(t17*t92 + t9*t88) - t50*(t22*t92 + t12*t88) - t61*t122 + t48*t123, batch),  # 4, 4
+        xp.broadcast_to(-(-t66*(t17*t93 + t21*t88) - t50*(-t22*t93 + t16*t88) + t62*t122 + t49*t123), batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t132, batch),  # 5, 1
-        xp.broadcast_to(t132, batch),  # 5, 2
-        xp.broadcast_to(-(t51 + t68*t95 - t30*t112 + t30*t113 + t30*t115 - t30*t117), batch),  # 5, 3
-        xp.broadcast_to(-(-t56 + t68*t91 - t30*t119 + t30*t120 + t30*t121 + t30*t122), batch),  # 5, 4
-        xp.broadcast_to(-(t66 + t68*t92 - t30*t124 + t30*t125 + t30*t126 - t30*t127), batch),  # 5, 5
+        xp.broadcast_to(t124, batch),  # 5, 1
+        xp.broadcast_to(t124, batch),  # 5, 2
+        xp.broadcast_to(-(t63 + t67*t87 - t31*t104 + t31*t105 + t31*t107 - t31*t109), batch),  # 5, 3
+        xp.broadcast_to(-(-t64 + t67*t83 - t31*t111 + t31*t112 + t31*t113 + t31*t114), batch),  # 5, 4
+        xp.broadcast_to(-(t65 + t67*t84 - t31*t116 + t31*t117 + t31*t118 - t31*t119), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1806,23 +1798,23 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t284 = -t17
     t285 = t284 + c1*t280
     t286 = t22*t249
-    t287 = t257*(s1*t12 + c1*t9 - t237*t250 - t286*t256)
-    t288 = t286 + t256*t287
+    t287 = t257*(s1*t12 + c1*t9 - t237*t250 - t256*t286)
+    t288 = t256*t287 + t286
     t289 = t12 - s1*t287
     t290 = t250 + t237*t287
     t291 = -t9
-    t292 = t291 + c1*t287
+    t292 = c1*t287 + t291
     t293 = t22*t251
-    t294 = -t257*(s1*t15 + t237*t252 + t293*t256 - c1*t18)
-    t295 = t293 + t256*t294
+    t294 = -t257*(s1*t15 + t237*t252 + t256*t293 - c1*t18)
+    t295 = t256*t294 + t293
     t296 = t15 + s1*t294
     t297 = t252 + t237*t294
     t298 = -t18
-    t299 = t298 + c1*t294
-    t300 = 1 - t15 - t39 - t40 - t230 - t233 - t14 + q1 + q2 + q3 + c23 + q4 + t12 + q5 + t0 + q6 + t22 + t24 + t20 - 2*c1 + t60 + t62 + t235 + t284 + t291 + t298 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t299 = c1*t294 + t298
+    t300 = 1 - t15 - t39 - t40 - t230 - t233 - t14 + q1 + q2 + q3 + c23 + q4 + t12 + q5 + t0 + q6 + t22 + t24 + t20 - 2*c1 + t60 + t62 + t235 + t284 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + t291 + t298
     t301 = t24*t280
-    t302 = t273*(-t261*t282 + t262*t285 + t263*t283 - t301*t272)
-    t303 = t301 + t272*t302
+    t302 = t273*(-t261*t282 + t262*t285 + t263*t283 - t272*t301)
+    t303 = t272*t302 + t301
     t304 = t282 + t261*t302
     t305 = t285 - t262*t302
     t306 = t283 - t263*t302
@@ -1835,8 +1827,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t313 = t277 - t305*t311
     t314 = t278 - t306*t311
     t315 = t24*t287
-    t316 = t273*(t261*t289 + t262*t292 + t263*t290 - t315*t272)
-    t317 = t315 + t272*t316
+    t316 = t273*(t261*t289 + t262*t292 + t263*t290 - t272*t315)
+    t317 = t272*t316 + t315
     t318 = t289 - t261*t316
     t319 = t292 - t262*t316
     t320 = t290 - t263*t316
@@ -1852,8 +1844,8 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t330 = t313 - t327*t329
     t331 = t314 - t324*t329
     t332 = t24*t294
-    t333 = t273*(-t261*t296 + t262*t299 + t263*t297 - t332*t272)
-    t334 = t332 + t272*t333
+    t333 = t273*(-t261*t296 + t262*t299 + t263*t297 - t272*t332)
+    t334 = t272*t333 + t332
     t335 = t296 + t261*t333
     t336 = t299 - t262*t333
     t337 = t297 - t263*t333
@@ -1868,7 +1860,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t346 = t345
     t347 = t346*xp.where(xp.greater_equal(t344, 0), xp.asarray(1, dtype=dtype), -1)
     t348 = t344 + t347
-    t349 = xp.where(xp.greater(t346, 0), 1/(t346*(t345 + t346)), 0)
+    t349 = xp.where(xp.greater(t346, 0), 1/(t346*(t346 + t345)), 0)
     t350 = t331 - t331*t348**2*t349
     t351 = xp.where(xp.not_equal(t347, 0), -t350/t347, 0)
     t352 = xp.where(xp.not_equal(t326, 0), -(t330 - t343*t351)/t326, 0)

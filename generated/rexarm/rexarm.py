@@ -726,67 +726,64 @@ def task_jacobian_dot(q, q_dot):
     t14 = s1**2
     t15 = c234*t14
     t16 = 0.1*t13 + 0.1*t15
-    t17 = s1*qd2
-    t18 = s1*qd3
-    t19 = t17 + t18
-    t20 = t19
-    t21 = c1*qd2
-    t22 = c1*qd3
-    t23 = t21 + t22
-    t24 = t23
-    t25 = c1*qd4
-    t26 = t10*t22 + t9*t25
-    t27 = t26 + t11*t21
-    t28 = t27 + t6*qd1
-    t29 = t23 + t25
-    t30 = s1*qd4
-    t31 = t10*t18 + t9*t30
-    t32 = t31 + t11*t17
-    t33 = -t32 + t2*qd1
-    t34 = s1*t32 + c1*t27
-    t35 = t19 + t30
-    t36 = t16*qd4
-    t37 = t36 + t8*qd3
-    t38 = t37 + t7*qd2
-    t39 = s1*qd1
-    t40 = -c1*t38 + t11*t39
-    t41 = c1*t37 + t21*t8 - t10*t39
-    t42 = t16*t24 - t9*t39 + c1*t36
-    t43 = c1*qd1
-    t44 = s1*t38 + t11*t43
-    t45 = s1*t37 + t17*t8 + t10*t43
-    t46 = t16*t20 + t9*t43 + s1*t36
-    t47 = -s234*t35 + c234*t43
-    t48 = t10*qd2
-    t49 = c1*t26 + s1*t31 + t14*t48 + t12*t48
-    t50 = t9*qd4
-    t51 = s1*t9*t20 + c1*t9*t24 + t14*t50 + t12*t50
-    t52 = t4*qd1
-    t53 = s234*t29 + t52
-    t54 = c234**2
-    t55 = t12*t54 + t14*t54
-    t56 = xp.sqrt(t55)
-    t57 = 1/t56
-    t58 = -t57*(t13 + t15)/t55
-    t59 = c1*t57
-    t60 = t53*(c1*c234*t58 + t59) - t47*(s1*t57 + t4*t58)
+    t17 = t16*qd4 + t8*qd3
+    t18 = t17 + t7*qd2
+    t19 = s1*qd2
+    t20 = s1*qd3
+    t21 = t19 + t20
+    t22 = c1*qd2
+    t23 = c1*qd3
+    t24 = t22 + t23
+    t25 = s1*qd4
+    t26 = t25 + t21
+    t27 = t10*t20 + t9*t25
+    t28 = t27 + t11*t19
+    t29 = -t28 + t2*qd1
+    t30 = c1*qd4
+    t31 = t30 + t24
+    t32 = t9*t30 + t10*t23
+    t33 = t32 + t11*t22
+    t34 = t33 + t6*qd1
+    t35 = s1*t28 + c1*t33
+    t36 = s1*qd1
+    t37 = -c1*t18 + t11*t36
+    t38 = c1*t17 + t22*t8 - t10*t36
+    t39 = t16*t24 - t9*t36 + t30*t16
+    t40 = c1*qd1
+    t41 = s1*t18 + t11*t40
+    t42 = s1*t17 + t19*t8 + t10*t40
+    t43 = t16*t21 + t9*t40 + t25*t16
+    t44 = -s234*t26 + c234*t40
+    t45 = t10*qd2
+    t46 = t14*t45 + c1*t32 + s1*t27 + t12*t45
+    t47 = t9*qd4
+    t48 = s1*t9*t21 + c1*t9*t24 + t14*t47 + t12*t47
+    t49 = t4*qd1
+    t50 = s234*t31 + t49
+    t51 = c234**2
+    t52 = t12*t51 + t14*t51
+    t53 = xp.sqrt(t52)
+    t54 = 1/t53
+    t55 = -t54*(t13 + t15)/t52
+    t56 = c1*t54
+    t57 = t50*(c1*c234*t55 + t56) - t44*(s1*t54 + t4*t55)
     Jd = _stack(xp, [
-        xp.broadcast_to(-t33, batch),  # 0, 0
-        xp.broadcast_to(t40, batch),  # 0, 1
-        xp.broadcast_to(-t41, batch),  # 0, 2
-        xp.broadcast_to(-t42, batch),  # 0, 3
-        xp.broadcast_to(-t28, batch),  # 1, 0
-        xp.broadcast_to(-t44, batch),  # 1, 1
-        xp.broadcast_to(-t45, batch),  # 1, 2
-        xp.broadcast_to(-t46, batch),  # 1, 3
+        xp.broadcast_to(-t29, batch),  # 0, 0
+        xp.broadcast_to(t37, batch),  # 0, 1
+        xp.broadcast_to(-t38, batch),  # 0, 2
+        xp.broadcast_to(-t39, batch),  # 0, 3
+        xp.broadcast_to(-t34, batch),  # 1, 0
+        xp.broadcast_to(-t41, batch),  # 1, 1
+        xp.broadcast_to(-t42, batch),  # 1, 2
+        xp.broadcast_to(-t43, batch),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t34, batch),  # 2, 1
-        xp.broadcast_to(-t49, batch),  # 2, 2
-        xp.broadcast_to(-t51, batch),  # 2, 3
+        xp.broadcast_to(-t35, batch),  # 2, 1
+        xp.broadcast_to(-t46, batch),  # 2, 2
+        xp.broadcast_to(-t48, batch),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(t60, batch),  # 3, 1
-        xp.broadcast_to(t60, batch),  # 3, 2
-        xp.broadcast_to(t60, batch),  # 3, 3
+        xp.broadcast_to(t57, batch),  # 3, 1
+        xp.broadcast_to(t57, batch),  # 3, 2
+        xp.broadcast_to(t57, batch),  # 3, 3
     ], (4, 4))
     return Jd
 

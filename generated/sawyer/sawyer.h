@@ -73,7 +73,7 @@ void sawyer_jacobian_dot(const sawyer_real q[SAWYER_DOF], const sawyer_real q_do
 void sawyer_bias_acceleration(const sawyer_real q[SAWYER_DOF], const sawyer_real q_dot[SAWYER_DOF], sawyer_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 671 operations. */
+ * Result: Jd: 6 x 7 row-major, element (r, c) at Jd[r * 7 + c]. 652 operations. */
 void sawyer_task_jacobian_dot(const sawyer_real q[SAWYER_DOF], const sawyer_real q_dot[SAWYER_DOF], sawyer_real Jd[SAWYER_TASK_DIM * SAWYER_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).

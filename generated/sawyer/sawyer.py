@@ -1249,7 +1249,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 671 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 7), 652 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (7,)), ("q_dot", q_dot, (7,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1273,248 +1273,238 @@ def task_jacobian_dot(q, q_dot):
     s6 = trig[..., 11]
     c7 = trig[..., 12]
     s7 = trig[..., 13]
-    t0 = s1*s3
-    t1 = c1*c3
-    t2 = t0 + c2*t1
-    t3 = t1 + c2*t0
-    t4 = s1*c3
-    t5 = c1*s3
-    t6 = t4 - c2*t5
-    t7 = -t5 + c2*t4
-    t8 = c1*s2
-    t9 = t2*c4 + s4*t8
-    t10 = -t2*s4 + c4*t8
-    t11 = t9*c5 - t6*s5
-    t12 = t9*s5 + t6*c5
-    t13 = t11*c6 - t10*s6
-    t14 = t10*c6 + t11*s6
-    t15 = t12*s7 + t13*c7
-    t16 = 0.1363*t12 + 0.13375*t14
-    t17 = -t16 + 0.4*t10
-    t18 = 0.1685*t6 + t17
-    t19 = -0.4*t8 + t18
-    t20 = -0.1925*s1 + t19
-    t21 = 0.081*c1 + t20
-    t22 = s1*s2
-    t23 = t7*c4 + s4*t22
-    t24 = -t7*s4 + c4*t22
-    t25 = t3*s5 + t23*c5
-    t26 = t3*c5 - t23*s5
-    t27 = t25*c6 - t24*s6
-    t28 = t24*c6 + t25*s6
-    t29 = t27*c7 - t26*s7
-    t30 = 0.1363*t26 - 0.13375*t28
-    t31 = 0.4*t24 + t30
-    t32 = -0.1685*t3 + t31
-    t33 = -0.4*t22 + t32
-    t34 = 0.1925*c1 + t33
-    t35 = 0.081*s1 + t34
-    t36 = c1*t20 + s1*t34
-    t37 = t19*t22 - t33*t8
-    t38 = t3*t18 + t6*t32
-    t39 = t10*t31 - t24*t17
-    t40 = t26*t16 - t12*t30
-    t41 = t40*qd6 + t39*qd5
-    t42 = t41 + t38*qd4
-    t43 = t42 + t37*qd3
-    t44 = t43 - t36*qd2
-    t45 = t15**2 + t29**2
-    t46 = xp.sqrt(t45)
-    t47 = c3*s2
-    t48 = c2*s4 - c4*t47
-    t49 = c2*c4 + s4*t47
-    t50 = s3*s2
-    t51 = t48*c5 - s5*t50
-    t52 = t48*s5 + c5*t50
-    t53 = t51*c6 - t49*s6
-    t54 = t49*c6 + t51*s6
-    t55 = t52*s7 + t53*c7
-    t56 = 0.1363*t52 + 0.13375*t54
-    t57 = -t56 + 0.4*t49
-    t58 = 0.1685*t50 + t57
-    t59 = -0.4*c2 + t58
-    t60 = c2*t33 - t59*t22
-    t61 = t3*t58 + t32*t50
-    t62 = t24*t57 - t49*t31
-    t63 = t52*t30 - t26*t56
-    t64 = -c2*t19 + t59*t8
-    t65 = -t6*t58 + t18*t50
-    t66 = t49*t17 - t10*t57
-    t67 = t52*t16 - t12*t56
-    t68 = t63*qd6 + t62*qd5
-    t69 = t67*qd6 + t66*qd5
-    t70 = t68 - t61*qd4
-    t71 = t69 + t65*qd4
-    t72 = t70 + t60*qd3
-    t73 = t71 + t64*qd3
-    t74 = s1*qd2
-    t75 = t73 + t59*t74
-    t76 = t75 + t21*qd1
-    t77 = t60*qd1 - c2*t72 + t8*t43 + t74*t37
-    t78 = t8*qd1 + c2*t74
-    t79 = t74 + t8*qd3
-    t80 = t79
-    t81 = c1*qd2
-    t82 = t72 + t59*t81
-    t83 = t82 - t35*qd1
-    t84 = -t64*qd1 + c2*t73 - t22*t43 + t81*t37
-    t85 = s1*t75 + c1*t82
-    t86 = t8*t73 - t22*t72 + t74*t64 + t81*t60
-    t87 = t22*qd1 - c2*t81
-    t88 = t22*t74 + t8*t81
-    t89 = t81 - t22*qd3
-    t90 = t89
-    t91 = -t65*t80 + t61*t90 + t6*t71 + t3*t70
-    t92 = t3*t80 - t6*t90
-    t93 = qd1 - c2*qd3
-    t94 = t93
-    t95 = t65*t94 + t3*t42 - t38*t90 + t50*t71
-    t96 = -t61*t94 + t38*t80 - t6*t42 + t50*t70
-    t97 = t3*t94 + t50*t90
-    t98 = t6*t94 + t50*t80
-    t99 = t6*qd4
-    t100 = -t80 + t99
-    t101 = -t3*qd4
-    t102 = t101 + t90
-    t103 = t66*t100 - t62*t102 + t10*t69 - t24*t68
-    t104 = t24*t100 - t10*t102
-    t105 = t50*qd4
-    t106 = t105 + t94
-    t107 = t39*t102 - t66*t106 + t24*t41 - t49*t69
-    t108 = t62*t106 - t39*t100 + t49*t68 - t10*t41
-    t109 = t49*t102 - t24*t106
-    t110 = t10*t106 - t49*t100
-    t111 = t10*qd5
-    t112 = t111 + t100
-    t113 = t24*qd5
-    t114 = t113 + t102
-    t115 = t26*t112 + t12*t114
-    t116 = t49*qd5
-    t117 = t116 + t106
-    t118 = t52*t114 + t26*t117
-    t119 = -t12*t117 + t52*t112
-    t120 = t12*qd6
-    t121 = -t120 + t112
-    t122 = -t99 - t111 + t79 + t120 + t14*qd7
-    t123 = t26*qd6
-    t124 = t123 + t114
-    t125 = t63*t114 - t67*t112 + t120*t67 + t123*t63
-    t126 = -t28*t121 + t14*t124
-    t127 = t89 + t101 + t113 + t123 - t28*qd7
-    t128 = t29*t122 + t15*t127
-    t129 = t52*qd6
-    t130 = t40*t114 - t67*t117 + t123*t40 + t129*t67
-    t131 = t63*t117 - t40*t112 - t129*t63 + t120*t40
-    t132 = -t129
-    t133 = t132 + t117
-    t134 = -t54*t124 + t28*t133
-    t135 = -t14*t133 + t54*t121
-    t136 = t93 + t105 + t116 + t132 - t54*qd7
-    t137 = t55*t127 - t29*t136
-    t138 = t15*t136 + t55*t122
-    t139 = t59*qd1
-    t140 = c1*t44 - s1*t139
-    t141 = s1*t44 + c1*t139
-    t142 = c1*t29
-    t143 = s1*t15
-    t144 = 1/t45
-    t145 = t144*(-t143 + t142)
-    t146 = (t6*t15 - t3*t29)*t144
-    t147 = (t10*t15 + t24*t29)*t144
-    t148 = (t26*t29 - t12*t15)*t144
-    t149 = -(t14*t15 + t28*t29)*t144
-    t150 = c1*t15
-    t151 = s1*t29
-    t152 = -t144*(s2*t150 + s2*t151)
-    t153 = 1/t46
-    t154 = t144*t153
-    t155 = t154*(t150 + t151)
-    t156 = t154*(s2*t142 - s2*t143)
-    t157 = -(t3*t15 + t6*t29)*t154
-    t158 = (t24*t15 - t10*t29)*t154
-    t159 = (t12*t29 + t26*t15)*t154
-    t160 = (t14*t29 - t28*t15)*t154
-    t161 = 2*t145
-    t162 = t137*t144
-    t163 = -(s1 + t15*t161)*t162
-    t164 = t138*t144
-    t165 = (c1 - t29*t161)*t164
-    t166 = qd1*t144
-    t167 = t150*t166
-    t168 = t151*t166
-    t169 = 2*t152
-    t170 = -t162*(t8 + t15*t169)
-    t171 = -t164*(t22 + t29*t169)
-    t172 = t15*t144
-    t173 = t87*t172
-    t174 = t29*t144
-    t175 = t78*t174
-    t176 = 2*t146
-    t177 = t162*(t6 - t15*t176)
-    t178 = -t164*(t3 + t29*t176)
-    t179 = t97*t172
-    t180 = t98*t174
-    t181 = 2*t147
-    t182 = t162*(t10 - t15*t181)
-    t183 = t164*(t24 - t29*t181)
-    t184 = t109*t172
-    t185 = t110*t174
-    t186 = 2*t148
-    t187 = -t162*(t12 + t15*t186)
-    t188 = t164*(t26 - t29*t186)
-    t189 = t118*t172
-    t190 = t119*t174
-    t191 = 2*t149
-    t192 = -t162*(t14 + t15*t191)
-    t193 = -t164*(t28 + t29*t191)
-    t194 = t134*t172
-    t195 = t135*t174
-    t196 = qd1*t153
-    t197 = t29*t153
-    t198 = t15*t153
+    t0 = qd1 - c2*qd3
+    t1 = s1*s3
+    t2 = c1*c3
+    t3 = t1 + c2*t2
+    t4 = t2 + c2*t1
+    t5 = s1*c3
+    t6 = c1*s3
+    t7 = t5 - c2*t6
+    t8 = -t6 + c2*t5
+    t9 = c1*s2
+    t10 = t3*c4 + s4*t9
+    t11 = -t3*s4 + c4*t9
+    t12 = t10*c5 - t7*s5
+    t13 = t10*s5 + t7*c5
+    t14 = t12*c6 - t11*s6
+    t15 = t11*c6 + t12*s6
+    t16 = t13*s7 + t14*c7
+    t17 = 0.1363*t13 + 0.13375*t15
+    t18 = -t17 + 0.4*t11
+    t19 = 0.1685*t7 + t18
+    t20 = -0.4*t9 + t19
+    t21 = -0.1925*s1 + t20
+    t22 = 0.081*c1 + t21
+    t23 = s1*s2
+    t24 = t8*c4 + s4*t23
+    t25 = -t8*s4 + c4*t23
+    t26 = t4*s5 + t24*c5
+    t27 = t4*c5 - t24*s5
+    t28 = t26*c6 - t25*s6
+    t29 = t25*c6 + t26*s6
+    t30 = t28*c7 - t27*s7
+    t31 = 0.1363*t27 - 0.13375*t29
+    t32 = 0.4*t25 + t31
+    t33 = -0.1685*t4 + t32
+    t34 = -0.4*t23 + t33
+    t35 = 0.1925*c1 + t34
+    t36 = 0.081*s1 + t35
+    t37 = c1*t21 + s1*t35
+    t38 = t20*t23 - t34*t9
+    t39 = t4*t19 + t7*t33
+    t40 = t11*t32 - t25*t18
+    t41 = t27*t17 - t13*t31
+    t42 = t41*qd6 + t40*qd5
+    t43 = t42 + t39*qd4
+    t44 = t43 + t38*qd3
+    t45 = t44 - t37*qd2
+    t46 = t16**2 + t30**2
+    t47 = xp.sqrt(t46)
+    t48 = c3*s2
+    t49 = c2*s4 - c4*t48
+    t50 = c2*c4 + s4*t48
+    t51 = s3*s2
+    t52 = t49*c5 - s5*t51
+    t53 = t49*s5 + c5*t51
+    t54 = t52*c6 - t50*s6
+    t55 = t50*c6 + t52*s6
+    t56 = t53*s7 + t54*c7
+    t57 = 0.1363*t53 + 0.13375*t55
+    t58 = -t57 + 0.4*t50
+    t59 = 0.1685*t51 + t58
+    t60 = -0.4*c2 + t59
+    t61 = c2*t34 - t60*t23
+    t62 = t4*t59 + t33*t51
+    t63 = t25*t58 - t50*t32
+    t64 = t53*t31 - t27*t57
+    t65 = -c2*t20 + t60*t9
+    t66 = -t7*t59 + t19*t51
+    t67 = t50*t18 - t11*t58
+    t68 = t53*t17 - t13*t57
+    t69 = t0 + t51*qd4
+    t70 = t69 + t50*qd5
+    t71 = t64*qd6 + t63*qd5
+    t72 = t68*qd6 + t67*qd5
+    t73 = t71 - t62*qd4
+    t74 = t72 + t66*qd4
+    t75 = t73 + t61*qd3
+    t76 = t74 + t65*qd3
+    t77 = s1*qd2
+    t78 = t77 + t9*qd3
+    t79 = -t78 + t7*qd4
+    t80 = t79 + t11*qd5
+    t81 = t76 + t60*t77
+    t82 = t81 + t22*qd1
+    t83 = t61*qd1 - c2*t75 + t9*t44 + t77*t38
+    t84 = -t62*t0 + t39*t78 - t7*t43 + t51*t73
+    t85 = t63*t69 - t40*t79 + t50*t71 - t11*t42
+    t86 = t9*qd1 + c2*t77
+    t87 = t7*t0 + t51*t78
+    t88 = t11*t69 - t50*t79
+    t89 = -t13*t70 + t53*t80
+    t90 = c1*qd2
+    t91 = t90 - t23*qd3
+    t92 = t91 - t4*qd4
+    t93 = t92 + t25*qd5
+    t94 = t75 + t60*t90
+    t95 = t94 - t36*qd1
+    t96 = -t65*qd1 + c2*t76 - t23*t44 + t90*t38
+    t97 = t66*t0 + t4*t43 - t39*t91 + t51*t74
+    t98 = t40*t92 - t67*t69 + t25*t42 - t50*t72
+    t99 = s1*t81 + c1*t94
+    t100 = t9*t76 - t23*t75 + t77*t65 + t90*t61
+    t101 = -t66*t78 + t62*t91 + t7*t74 + t4*t73
+    t102 = t67*t79 - t63*t92 + t11*t72 - t25*t71
+    t103 = t23*qd1 - c2*t90
+    t104 = t4*t0 + t51*t91
+    t105 = t50*t92 - t25*t69
+    t106 = t53*t93 + t27*t70
+    t107 = t23*t77 + t9*t90
+    t108 = t4*t78 - t7*t91
+    t109 = t25*t79 - t11*t92
+    t110 = t27*t80 + t13*t93
+    t111 = t13*qd6
+    t112 = -t111 + t80
+    t113 = t112 - t15*qd7
+    t114 = t27*qd6
+    t115 = t114 + t93
+    t116 = t115 - t29*qd7
+    t117 = t64*t93 - t68*t80 + t111*t68 + t114*t64
+    t118 = -t29*t112 + t15*t115
+    t119 = t30*t113 - t16*t116
+    t120 = t53*qd6
+    t121 = -t120 + t70
+    t122 = t121 - t55*qd7
+    t123 = t41*t93 - t68*t70 + t114*t41 + t120*t68
+    t124 = t64*t70 - t41*t80 - t120*t64 + t111*t41
+    t125 = -t55*t115 + t29*t121
+    t126 = -t15*t121 + t55*t112
+    t127 = t56*t116 - t30*t122
+    t128 = t16*t122 - t56*t113
+    t129 = t60*qd1
+    t130 = c1*t45 - s1*t129
+    t131 = s1*t45 + c1*t129
+    t132 = c1*t30
+    t133 = s1*t16
+    t134 = 1/t46
+    t135 = t134*(-t133 + t132)
+    t136 = t134*(t7*t16 - t4*t30)
+    t137 = t134*(t11*t16 + t25*t30)
+    t138 = t134*(t27*t30 - t13*t16)
+    t139 = -t134*(t15*t16 + t29*t30)
+    t140 = c1*t16
+    t141 = s1*t30
+    t142 = -t134*(s2*t140 + s2*t141)
+    t143 = 1/t47
+    t144 = t134*t143
+    t145 = t144*(t140 + t141)
+    t146 = t144*(s2*t132 - s2*t133)
+    t147 = -t144*(t4*t16 + t7*t30)
+    t148 = t144*(t25*t16 - t11*t30)
+    t149 = t144*(t13*t30 + t27*t16)
+    t150 = t144*(t15*t30 - t29*t16)
+    t151 = 2*t135
+    t152 = t134*t127
+    t153 = -t152*(s1 + t16*t151)
+    t154 = t134*t128
+    t155 = t154*(c1 - t30*t151)
+    t156 = t134*qd1
+    t157 = t140*t156
+    t158 = t141*t156
+    t159 = 2*t142
+    t160 = -t152*(t9 + t16*t159)
+    t161 = -t154*(t23 + t30*t159)
+    t162 = t16*t134
+    t163 = t103*t162
+    t164 = t30*t134
+    t165 = t86*t164
+    t166 = 2*t136
+    t167 = t152*(t7 - t16*t166)
+    t168 = -t154*(t4 + t30*t166)
+    t169 = t104*t162
+    t170 = t87*t164
+    t171 = 2*t137
+    t172 = t152*(t11 - t16*t171)
+    t173 = t154*(t25 - t30*t171)
+    t174 = t105*t162
+    t175 = t88*t164
+    t176 = 2*t138
+    t177 = -t152*(t13 + t16*t176)
+    t178 = t154*(t27 - t30*t176)
+    t179 = t106*t162
+    t180 = t89*t164
+    t181 = 2*t139
+    t182 = -t152*(t15 + t16*t181)
+    t183 = -t154*(t29 + t30*t181)
+    t184 = t125*t162
+    t185 = t126*t164
+    t186 = t143*qd1
+    t187 = t30*t143
+    t188 = t16*t143
     Jd = _stack(xp, [
-        xp.broadcast_to(-t76, batch),  # 0, 0
-        xp.broadcast_to(t140, batch),  # 0, 1
-        xp.broadcast_to(t84, batch),  # 0, 2
-        xp.broadcast_to(-t95, batch),  # 0, 3
-        xp.broadcast_to(t107, batch),  # 0, 4
-        xp.broadcast_to(t130, batch),  # 0, 5
+        xp.broadcast_to(-t82, batch),  # 0, 0
+        xp.broadcast_to(t130, batch),  # 0, 1
+        xp.broadcast_to(t96, batch),  # 0, 2
+        xp.broadcast_to(-t97, batch),  # 0, 3
+        xp.broadcast_to(t98, batch),  # 0, 4
+        xp.broadcast_to(t123, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
-        xp.broadcast_to(t83, batch),  # 1, 0
-        xp.broadcast_to(t141, batch),  # 1, 1
-        xp.broadcast_to(t77, batch),  # 1, 2
-        xp.broadcast_to(t96, batch),  # 1, 3
-        xp.broadcast_to(t108, batch),  # 1, 4
-        xp.broadcast_to(t131, batch),  # 1, 5
+        xp.broadcast_to(t95, batch),  # 1, 0
+        xp.broadcast_to(t131, batch),  # 1, 1
+        xp.broadcast_to(t83, batch),  # 1, 2
+        xp.broadcast_to(t84, batch),  # 1, 3
+        xp.broadcast_to(t85, batch),  # 1, 4
+        xp.broadcast_to(t124, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t85, batch),  # 2, 1
-        xp.broadcast_to(-t86, batch),  # 2, 2
-        xp.broadcast_to(t91, batch),  # 2, 3
-        xp.broadcast_to(t103, batch),  # 2, 4
-        xp.broadcast_to(-t125, batch),  # 2, 5
+        xp.broadcast_to(-t99, batch),  # 2, 1
+        xp.broadcast_to(-t100, batch),  # 2, 2
+        xp.broadcast_to(t101, batch),  # 2, 3
+        xp.broadcast_to(t102, batch),  # 2, 4
+        xp.broadcast_to(-t117, batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(-t167 - t168 + t163 + t165, batch),  # 3, 1
-        xp.broadcast_to(-t175 + t170 + t171 + t173, batch),  # 3, 2
-        xp.broadcast_to(t177 + t178 + t179 + t180, batch),  # 3, 3
-        xp.broadcast_to(t182 + t183 + t184 + t185, batch),  # 3, 4
-        xp.broadcast_to(-t189 + t187 + t188 + t190, batch),  # 3, 5
-        xp.broadcast_to(t192 + t193 + t194 + t195, batch),  # 3, 6
+        xp.broadcast_to(-t157 - t158 + t153 + t155, batch),  # 3, 1
+        xp.broadcast_to(-t165 + t160 + t161 + t163, batch),  # 3, 2
+        xp.broadcast_to(t167 + t168 + t169 + t170, batch),  # 3, 3
+        xp.broadcast_to(t172 + t173 + t174 + t175, batch),  # 3, 4
+        xp.broadcast_to(-t179 + t177 + t178 + t180, batch),  # 3, 5
+        xp.broadcast_to(t182 + t183 + t184 + t185, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t137*(-t15*t155 + c1*t153) + t138*(-t29*t155 + s1*t153) + t142*t196 - t143*t196, batch),  # 4, 1
-        xp.broadcast_to(-t137*(t15*t156 + t22*t153) + t138*(-t29*t156 + t8*t153) - t87*t197 - t78*t198, batch),  # 4, 2
-        xp.broadcast_to(-t137*(t15*t157 + t3*t153) - t138*(t29*t157 + t6*t153) - t97*t197 + t98*t198, batch),  # 4, 3
-        xp.broadcast_to(t137*(-t15*t158 + t24*t153) - t138*(t29*t158 + t10*t153) - t109*t197 + t110*t198, batch),  # 4, 4
-        xp.broadcast_to(t137*(-t15*t159 + t26*t153) + t138*(-t29*t159 + t12*t153) + t118*t197 + t119*t198, batch),  # 4, 5
-        xp.broadcast_to(-t137*(t15*t160 + t28*t153) + t138*(-t29*t160 + t14*t153) - t134*t197 + t135*t198, batch),  # 4, 6
+        xp.broadcast_to(t127*(-t16*t145 + c1*t143) + t128*(-t30*t145 + s1*t143) + t132*t186 - t133*t186, batch),  # 4, 1
+        xp.broadcast_to(-t127*(t16*t146 + t23*t143) + t128*(-t30*t146 + t9*t143) - t103*t187 - t86*t188, batch),  # 4, 2
+        xp.broadcast_to(-t127*(t16*t147 + t4*t143) - t128*(t30*t147 + t7*t143) - t104*t187 + t87*t188, batch),  # 4, 3
+        xp.broadcast_to(t127*(-t16*t148 + t25*t143) - t128*(t30*t148 + t11*t143) - t105*t187 + t88*t188, batch),  # 4, 4
+        xp.broadcast_to(t127*(-t16*t149 + t27*t143) + t128*(-t30*t149 + t13*t143) + t106*t187 + t89*t188, batch),  # 4, 5
+        xp.broadcast_to(-t127*(t16*t150 + t29*t143) + t128*(t15*t143 - t30*t150) - t125*t187 + t126*t188, batch),  # 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t128*t145 - t55*t163 - t55*t165 + t55*t167 + t55*t168, batch),  # 5, 1
-        xp.broadcast_to(t88 + t128*t152 - t55*t170 - t55*t171 - t55*t173 + t55*t175, batch),  # 5, 2
-        xp.broadcast_to(-(-t92 + t55*t177 + t55*t178 + t55*t179 + t55*t180 - t128*t146), batch),  # 5, 3
-        xp.broadcast_to(-(-t104 + t55*t182 + t55*t183 + t55*t184 + t55*t185 - t128*t147), batch),  # 5, 4
-        xp.broadcast_to(t115 + t128*t148 - t55*t187 - t55*t188 + t55*t189 - t55*t190, batch),  # 5, 5
-        xp.broadcast_to(-(-t126 + t55*t192 + t55*t193 + t55*t194 + t55*t195 - t128*t149), batch),  # 5, 6
+        xp.broadcast_to(-(t119*t135 + t56*t153 + t56*t155 - t56*t157 - t56*t158), batch),  # 5, 1
+        xp.broadcast_to(-(-t107 + t119*t142 + t56*t160 + t56*t161 + t56*t163 - t56*t165), batch),  # 5, 2
+        xp.broadcast_to(-(-t108 + t119*t136 + t56*t167 + t56*t168 + t56*t169 + t56*t170), batch),  # 5, 3
+        xp.broadcast_to(-(-t109 + t119*t137 + t56*t172 + t56*t173 + t56*t174 + t56*t175), batch),  # 5, 4
+        xp.broadcast_to(-(-t110 + t119*t138 + t56*t177 + t56*t178 - t56*t179 + t56*t180), batch),  # 5, 5
+        xp.broadcast_to(-(-t118 + t119*t139 + t56*t182 + t56*t183 + t56*t184 + t56*t185), batch),  # 5, 6
     ], (6, 7))
     return Jd
 
@@ -1712,7 +1702,7 @@ def hessian(q):
         -s1*t43,  # 1, 4, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5, 1
-        s2*t73 + s2*t72,  # 1, 5, 2
+        s2*t72 + s2*t73,  # 1, 5, 2
         s1*t3 - c1*t6,  # 1, 5, 3
         -(s1*t22 + c1*t10),  # 1, 5, 4
         -s1*t24 + c1*t12,  # 1, 5, 5

@@ -71,7 +71,7 @@ void stanford_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanford_r
 void stanford_bias_acceleration(const stanford_real q[STANFORD_DOF], const stanford_real q_dot[STANFORD_DOF], stanford_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 334 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 330 operations. */
 void stanford_task_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanford_real q_dot[STANFORD_DOF], stanford_real Jd[STANFORD_TASK_DIM * STANFORD_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).

@@ -843,7 +843,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 334 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 330 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     q3 = q[..., 2]
     qd1 = q_dot[..., 0]
@@ -863,153 +863,147 @@ def task_jacobian_dot(q, q_dot):
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = c1*s2
-    t1 = -0.1337*s1 + q3*t0
-    t2 = s1*s2
-    t3 = 0.1337*c1 + q3*t2
-    t4 = c1*t1 + s1*t3
-    t5 = c2*qd3 - t4*qd2
-    t6 = s1*c4
-    t7 = c1*s4
-    t8 = t6 + c2*t7
-    t9 = c2*t6 + t7
-    t10 = t8*c5 - s5*t0
-    t11 = t8*s5 + c5*t0
-    t12 = s1*s4
-    t13 = c1*c4
-    t14 = -t12 + c2*t13
-    t15 = -t13 + c2*t12
-    t16 = t15*c5 - s5*t2
-    t17 = t15*s5 + c5*t2
-    t18 = t14*s6 + t10*c6
-    t19 = t9*s6 + t16*c6
-    t20 = t18**2 + t19**2
-    t21 = xp.sqrt(t20)
-    t22 = s2*s4
-    t23 = c2*s5 + c5*t22
-    t24 = -c2*c5 + s5*t22
-    t25 = s2*c4
-    t26 = t23*c6 + s6*t25
-    t27 = s1*qd2
-    t28 = -t27 + t0*qd4
-    t29 = t28
-    t30 = c1*qd2
-    t31 = t2*t27 + t0*t30
-    t32 = t30 + t2*qd4
-    t33 = t32
-    t34 = t9*t29 - t14*t33
-    t35 = qd1 + c2*qd4
-    t36 = t35
-    t37 = t9*t36 + t25*t33
-    t38 = t14*t36 + t25*t29
-    t39 = t14*qd5
-    t40 = t39 + t29
-    t41 = t28 + t39 + t11*qd6
-    t42 = t9*qd5
-    t43 = t42 + t33
-    t44 = t17*t40 - t11*t43
-    t45 = t32 + t42 + t17*qd6
-    t46 = t19*t41 - t18*t45
-    t47 = -t25*qd5
-    t48 = t47 + t36
-    t49 = t24*t43 + t17*t48
-    t50 = t11*t48 + t24*t40
-    t51 = t35 + t47 - t24*qd6
-    t52 = t26*t45 + t19*t51
-    t53 = t18*t51 + t26*t41
-    t54 = c2*t30
-    t55 = t0*qd3 + q3*t54
-    t56 = t55 - t3*qd1
-    t57 = -t2*qd1 + t54
-    t58 = c2*t27
-    t59 = t2*qd3 + q3*t58
-    t60 = t59 + t1*qd1
-    t61 = t0*qd1 + t58
-    t62 = s1*t59 + c1*t55
-    t63 = q3*c2*qd1
-    t64 = c1*t5 - s1*t63
-    t65 = s1*t5 + c1*t63
+    t0 = qd1 + c2*qd4
+    t1 = c1*s2
+    t2 = -0.1337*s1 + q3*t1
+    t3 = s1*s2
+    t4 = 0.1337*c1 + q3*t3
+    t5 = c1*t2 + s1*t4
+    t6 = c2*qd3 - t5*qd2
+    t7 = s1*c4
+    t8 = c1*s4
+    t9 = t7 + c2*t8
+    t10 = c2*t7 + t8
+    t11 = t9*c5 - s5*t1
+    t12 = t9*s5 + c5*t1
+    t13 = s1*s4
+    t14 = c1*c4
+    t15 = -t13 + c2*t14
+    t16 = -t14 + c2*t13
+    t17 = t16*c5 - s5*t3
+    t18 = t16*s5 + c5*t3
+    t19 = t15*s6 + t11*c6
+    t20 = t10*s6 + t17*c6
+    t21 = t19**2 + t20**2
+    t22 = xp.sqrt(t21)
+    t23 = s2*s4
+    t24 = c2*s5 + c5*t23
+    t25 = -c2*c5 + s5*t23
+    t26 = s2*c4
+    t27 = t24*c6 + s6*t26
+    t28 = t0 - t26*qd5
+    t29 = t28 - t25*qd6
+    t30 = s1*qd2
+    t31 = -t30 + t1*qd4
+    t32 = t31 + t15*qd5
+    t33 = t32 + t12*qd6
+    t34 = t15*t0 + t26*t31
+    t35 = t12*t28 + t25*t32
+    t36 = t19*t29 + t27*t33
+    t37 = c1*qd2
+    t38 = t37 + t3*qd4
+    t39 = t38 + t10*qd5
+    t40 = t39 + t18*qd6
+    t41 = t3*t30 + t1*t37
+    t42 = t10*t0 + t26*t38
+    t43 = t25*t39 + t18*t28
+    t44 = t10*t31 - t15*t38
+    t45 = t18*t32 - t12*t39
+    t46 = t27*t40 + t20*t29
+    t47 = t20*t33 - t19*t40
+    t48 = c2*t37
+    t49 = t1*qd3 + q3*t48
+    t50 = t49 - t4*qd1
+    t51 = t48 - t3*qd1
+    t52 = c2*t30
+    t53 = t3*qd3 + q3*t52
+    t54 = t53 + t2*qd1
+    t55 = t52 + t1*qd1
+    t56 = s1*t53 + c1*t49
+    t57 = q3*c2*qd1
+    t58 = c1*t6 - s1*t57
+    t59 = s1*t6 + c1*t57
+    t60 = c1*t20
+    t61 = s1*t19
+    t62 = 1/t21
+    t63 = t62*(-t61 + t60)
+    t64 = (t15*t19 + t10*t20)*t62
+    t65 = (t12*t19 + t18*t20)*t62
     t66 = c1*t19
-    t67 = s1*t18
-    t68 = 1/t20
-    t69 = (-t67 + t66)*t68
-    t70 = (t14*t18 + t9*t19)*t68
-    t71 = (t11*t18 + t17*t19)*t68
-    t72 = c1*t18
-    t73 = s1*t19
-    t74 = t68*(s2*t72 + s2*t73)
-    t75 = 1/t21
-    t76 = t68*t75
-    t77 = (t72 + t73)*t76
-    t78 = t76*(s2*t67 - s2*t66)
-    t79 = (t9*t18 - t14*t19)*t76
-    t80 = (t17*t18 - t11*t19)*t76
-    t81 = -t31
-    t82 = 2*t69
-    t83 = t52*t68
-    t84 = -(s1 + t18*t82)*t83
-    t85 = t53*t68
-    t86 = (c1 - t19*t82)*t85
-    t87 = qd1*t68
-    t88 = t72*t87
-    t89 = t73*t87
-    t90 = 2*t74
-    t91 = t83*(t0 - t18*t90)
-    t92 = t85*(t2 - t19*t90)
-    t93 = t18*t68
-    t94 = t57*t93
-    t95 = t19*t68
-    t96 = t61*t95
-    t97 = 2*t70
-    t98 = t83*(t14 - t18*t97)
-    t99 = t85*(t9 - t19*t97)
-    t100 = t37*t93
-    t101 = t38*t95
-    t102 = 2*t71
-    t103 = t83*(t11 - t18*t102)
-    t104 = t85*(t17 - t19*t102)
-    t105 = t49*t93
-    t106 = t50*t95
-    t107 = qd1*t75
-    t108 = t19*t75
-    t109 = t18*t75
+    t67 = s1*t20
+    t68 = t62*(s2*t66 + s2*t67)
+    t69 = 1/t22
+    t70 = t62*t69
+    t71 = (t66 + t67)*t70
+    t72 = t70*(s2*t61 - s2*t60)
+    t73 = (t10*t19 - t15*t20)*t70
+    t74 = (t18*t19 - t12*t20)*t70
+    t75 = -t41
+    t76 = 2*t63
+    t77 = t46*t62
+    t78 = -(s1 + t19*t76)*t77
+    t79 = t36*t62
+    t80 = (c1 - t20*t76)*t79
+    t81 = qd1*t62
+    t82 = t66*t81
+    t83 = t67*t81
+    t84 = 2*t68
+    t85 = t77*(t1 - t19*t84)
+    t86 = t79*(t3 - t20*t84)
+    t87 = t19*t62
+    t88 = t51*t87
+    t89 = t20*t62
+    t90 = t55*t89
+    t91 = 2*t64
+    t92 = t77*(t15 - t19*t91)
+    t93 = t79*(t10 - t20*t91)
+    t94 = t42*t87
+    t95 = t34*t89
+    t96 = 2*t65
+    t97 = t77*(t12 - t19*t96)
+    t98 = t79*(t18 - t20*t96)
+    t99 = t43*t87
+    t100 = t35*t89
+    t101 = qd1*t69
+    t102 = t20*t69
+    t103 = t19*t69
     Jd = _stack(xp, [
-        xp.broadcast_to(-t60, batch),  # 0, 0
-        xp.broadcast_to(t64, batch),  # 0, 1
-        xp.broadcast_to(t57, batch),  # 0, 2
+        xp.broadcast_to(-t54, batch),  # 0, 0
+        xp.broadcast_to(t58, batch),  # 0, 1
+        xp.broadcast_to(t51, batch),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        xp.broadcast_to(t56, batch),  # 1, 0
-        xp.broadcast_to(t65, batch),  # 1, 1
-        xp.broadcast_to(t61, batch),  # 1, 2
+        xp.broadcast_to(t50, batch),  # 1, 0
+        xp.broadcast_to(t59, batch),  # 1, 1
+        xp.broadcast_to(t55, batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t62, batch),  # 2, 1
-        xp.broadcast_to(t81, batch),  # 2, 2
+        xp.broadcast_to(-t56, batch),  # 2, 1
+        xp.broadcast_to(t75, batch),  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(-(-t86 + t84 + t88 + t89), batch),  # 3, 1
+        xp.broadcast_to(-(-t80 + t78 + t82 + t83), batch),  # 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
-        xp.broadcast_to(-t91 + t92 + t94 + t96, batch),  # 3, 3
-        xp.broadcast_to(-t98 - t100 + t99 + t101, batch),  # 3, 4
-        xp.broadcast_to(-t103 - t105 + t104 + t106, batch),  # 3, 5
+        xp.broadcast_to(-t85 + t86 + t88 + t90, batch),  # 3, 3
+        xp.broadcast_to(-t92 - t94 + t93 + t95, batch),  # 3, 4
+        xp.broadcast_to(-t97 - t99 + t98 + t100, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(-t52*(-t18*t77 + c1*t75) + t53*(-t19*t77 + s1*t75) + t66*t107 - t67*t107, batch),  # 4, 1
+        xp.broadcast_to(-t46*(-t19*t71 + c1*t69) + t36*(-t20*t71 + s1*t69) + t60*t101 - t61*t101, batch),  # 4, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
-        xp.broadcast_to(-t52*(-t18*t78 + t2*t75) - t53*(t19*t78 + t0*t75) - t57*t108 + t61*t109, batch),  # 4, 3
-        xp.broadcast_to(-t52*(-t18*t79 + t9*t75) - t53*(t19*t79 + t14*t75) + t37*t108 + t38*t109, batch),  # 4, 4
-        xp.broadcast_to(-t52*(-t18*t80 + t17*t75) - t53*(t19*t80 + t11*t75) + t49*t108 + t50*t109, batch),  # 4, 5
+        xp.broadcast_to(-t46*(-t19*t72 + t3*t69) - t36*(t20*t72 + t1*t69) - t51*t102 + t55*t103, batch),  # 4, 3
+        xp.broadcast_to(-t46*(-t19*t73 + t10*t69) - t36*(t20*t73 + t15*t69) + t42*t102 + t34*t103, batch),  # 4, 4
+        xp.broadcast_to(-t46*(-t19*t74 + t18*t69) - t36*(t20*t74 + t12*t69) + t43*t102 + t35*t103, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(-(t46*t69 + t26*t84 - t26*t86 + t26*t88 + t26*t89), batch),  # 5, 1
+        xp.broadcast_to(-(t47*t63 + t27*t78 - t27*t80 + t27*t82 + t27*t83), batch),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
-        xp.broadcast_to(-t46*t74 + t81 - t26*t91 + t26*t92 + t26*t94 + t26*t96, batch),  # 5, 3
-        xp.broadcast_to(t34 - t46*t70 - t26*t98 + t26*t99 - t26*t100 + t26*t101, batch),  # 5, 4
-        xp.broadcast_to(t44 - t46*t71 - t26*t103 + t26*t104 - t26*t105 + t26*t106, batch),  # 5, 5
+        xp.broadcast_to(-t47*t68 + t75 - t27*t85 + t27*t86 + t27*t88 + t27*t90, batch),  # 5, 3
+        xp.broadcast_to(t44 - t47*t64 - t27*t92 + t27*t93 - t27*t94 + t27*t95, batch),  # 5, 4
+        xp.broadcast_to(t45 - t47*t65 - t27*t97 + t27*t98 - t27*t99 + t27*t100, batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1563,12 +1557,12 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t222 = t10*t214 + t15*t213 - t0*t212
     t223 = c1*t31
     t224 = s1*t31
-    t225 = -t5*t215 - s1*t214 + c1*t213 + t223*t217 + t224*t216
+    t225 = -t5*t215 - s1*t214 + c1*t213 + t217*t223 + t216*t224
     t226 = -t4
-    t227 = t226 + t39
-    t228 = t40*(t223*t227 + t2*t224)
-    t229 = t223 - t227*t228
-    t230 = t224 - t2*t228
+    t227 = t39 + t226
+    t228 = t40*(t227*t223 + t2*t224)
+    t229 = -t227*t228 + t223
+    t230 = -t2*t228 + t224
     t231 = t40*(t1*t227 + t2*t3)
     t232 = t1 - t227*t231
     t233 = t3 - t2*t231
@@ -1596,7 +1590,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t255 = t52*t40
     t256 = t254 + t255
     t257 = -t0
-    t258 = 1 - t5 - s1 + q1 + q2 + c1 + q3 + t2 + q4 + t13 + t9 + q5 + t10 + t15 + q6 + 2*c2 + 2*t1 + 2*t3 + t223 + t224 + t226 + t254 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + t257
+    t258 = 1 - t5 - s1 + q1 + q2 + c1 + q3 + t2 + q4 + t13 + t9 + q5 + t10 + t15 + q6 + 2*c2 + 2*t1 + 2*t3 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + t223 + t224 + t226 + t254 + t257
     t259 = t0*t40
     t260 = t257 + t259
     t261 = t2*t252
@@ -1684,7 +1678,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t343 = xp.where(xp.not_equal(t298, 0), -(-(t312*t342 + t329*t341) + t302)/t298, 0)
     t344 = xp.where(xp.not_equal(t281, 0), -(-(t288*t343 + t307*t342 + t324*t341) + t293)/t281, 0)
     t345 = xp.where(xp.not_equal(t239, 0), -(-(t243*t344 - t263*t343 + t269*t342 + t275*t341) + t247)/t239, 0)
-    t346 = xp.where(xp.not_equal(t39, 0), -(-(t229*t345 + t232*t344 - t252*t227*t343 + t255*t227*t342 + t227*t341*t259) + t235)/t39, 0)
+    t346 = xp.where(xp.not_equal(t39, 0), -(-(t229*t345 + t232*t344 - t227*t343*t252 + t227*t342*t255 + t227*t341*t259) + t235)/t39, 0)
     t347 = xp.isfinite(t258)
     t348 = xp.greater_equal(damping, 0)
     t349 = xp.greater(damping, 0)

@@ -71,7 +71,7 @@ void ur5_jacobian_dot(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_DOF], 
 void ur5_bias_acceleration(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_DOF], ur5_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 400 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 393 operations. */
 void ur5_task_jacobian_dot(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_DOF], ur5_real Jd[UR5_TASK_DIM * UR5_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).

@@ -1002,7 +1002,7 @@ def bias_acceleration(q, q_dot):
 
 
 def task_jacobian_dot(q, q_dot):
-    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 400 operations."""
+    """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 393 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
@@ -1065,140 +1065,136 @@ def task_jacobian_dot(q, q_dot):
     t35 = s1*qd2
     t36 = s1*qd3
     t37 = t35 + t36
-    t38 = t37
-    t39 = c1*qd2
-    t40 = c1*qd3
-    t41 = t39 + t40
-    t42 = t41
-    t43 = -c1*t38 + s1*t42
-    t44 = s1*qd4
-    t45 = t44 + t38
-    t46 = c234*t45 + t9*qd1
+    t38 = c1*qd2
+    t39 = c1*qd3
+    t40 = t38 + t39
+    t41 = -c1*t37 + s1*t40
+    t42 = s1*qd4
+    t43 = t42 + t37
+    t44 = t43 + t9*qd5
+    t45 = t44 + t7*qd6
+    t46 = c234*t43 + t9*qd1
     t47 = c1*qd4
-    t48 = t47 + t42
-    t49 = c234*t48 - t13*qd1
-    t50 = t13*t45 + t9*t48
-    t51 = t9*qd5
-    t52 = t51 + t45
-    t53 = t37 + t44 + t51 + t7*qd6
-    t54 = t13*qd5
-    t55 = -t48 + t54
-    t56 = t4*t52 + t7*t55
-    t57 = -t54 + t41 + t47 + t4*qd6
-    t58 = t14*t53 + t10*t57
-    t59 = c234*qd5
-    t60 = -t59 + qd1
-    t61 = t4*t60 - t21*t55
-    t62 = t7*t60 + t21*t52
-    t63 = -qd1 + t59 + t21*qd6
-    t64 = -t0*t57 + t14*t63
-    t65 = t10*t63 + t0*t53
-    t66 = t25*qd5
-    t67 = t66 + t22*t47
-    t68 = t67 + t23*t40
-    t69 = t24*t39 + t68
-    t70 = t69 - t33*qd1
-    t71 = t26*qd5
-    t72 = t71 + t22*t44
-    t73 = t72 + t23*t36
-    t74 = t73 + t24*t35
-    t75 = t74 + t32*qd1
-    t76 = s1*t74 + c1*t69
-    t77 = s1*t22*t38 + c1*t22*t42 + s1*t72 + c1*t67
-    t78 = t26*t45 + t25*t48 + t9*t71 - t13*t66
-    t79 = t18*qd5
-    t80 = t79 + t17*qd4
-    t81 = t80 + t30*qd3
-    t82 = t81 + t34*qd2
-    t83 = -t18*t48 - t26*qd1 + t13*t79 + t59*t26
-    t84 = t18*t45 - t25*qd1 + t59*t25 + t9*t79
-    t85 = s1*qd1
-    t86 = c1*t82 + t24*t85
-    t87 = c1*t81 + t39*t30 + t23*t85
-    t88 = t17*t42 + c1*t80 + t22*t85
-    t89 = c1*qd1
-    t90 = -s1*t82 + t24*t89
-    t91 = s1*t81 - t23*t89 + t35*t30
-    t92 = t17*t38 + s1*t80 - t22*t89
-    t93 = t23*qd2
-    t94 = s1*t73 + c1*t68 + s1**2*t93 + c1**2*t93
-    t95 = s1*t10
-    t96 = c1*t14
-    t97 = 1/t19
-    t98 = t97*(-t96 + t95)
-    t99 = (t7*t10 - t4*t14)*t97
-    t100 = c1*t10
-    t101 = s1*t14
-    t102 = t97*(s234*t100 + s234*t101)
-    t103 = 1/t20
-    t104 = t97*t103
-    t105 = -t104*(t100 + t101)
-    t106 = t104*(s234*t95 - s234*t96)
-    t107 = -(t7*t14 + t4*t10)*t104
-    t108 = 2*t98
-    t109 = t64*t97
-    t110 = t109*(s1 - t10*t108)
-    t111 = t65*t97
-    t112 = -(c1 + t14*t108)*t111
-    t113 = qd1*t97
-    t114 = t100*t113
-    t115 = t101*t113
-    t116 = -t112 + t110 + t114 + t115
-    t117 = 2*t102
-    t118 = t109*(t9 - t10*t117)
-    t119 = t111*(t13 - t14*t117)
-    t120 = t10*t97
-    t121 = t49*t120
-    t122 = t14*t97
-    t123 = t46*t122
-    t124 = 2*t99
-    t125 = t109*(t7 - t10*t124)
-    t126 = -t111*(t4 + t14*t124)
-    t127 = t61*t120
-    t128 = t62*t122
-    t129 = qd1*t103
-    t130 = -t64*(t10*t105 + c1*t103) + t65*(t14*t105 + s1*t103) - t96*t129 + t95*t129
-    t131 = t14*t103
-    t132 = t10*t103
-    t133 = t58*t98 + t0*t110 - t0*t112 + t0*t114 + t0*t115
-    t134 = -t133
+    t48 = t47 + t40
+    t49 = -t48 + t13*qd5
+    t50 = t49 - t4*qd6
+    t51 = c234*t48 - t13*qd1
+    t52 = t13*t43 + t9*t48
+    t53 = t4*t44 + t7*t49
+    t54 = t14*t45 - t10*t50
+    t55 = c234*qd5
+    t56 = -t55 + qd1
+    t57 = t56 - t21*qd6
+    t58 = t4*t56 - t21*t49
+    t59 = t7*t56 + t21*t44
+    t60 = t0*t50 - t14*t57
+    t61 = t10*t57 - t0*t45
+    t62 = t25*qd5
+    t63 = t62 + t22*t47
+    t64 = t23*t39 + t63
+    t65 = t24*t38 + t64
+    t66 = t65 - t33*qd1
+    t67 = t26*qd5
+    t68 = t67 + t22*t42
+    t69 = t68 + t23*t36
+    t70 = t69 + t24*t35
+    t71 = t70 + t32*qd1
+    t72 = s1*t70 + c1*t65
+    t73 = s1*t22*t37 + c1*t22*t40 + s1*t68 + c1*t63
+    t74 = t26*t43 + t25*t48 + t9*t67 - t13*t62
+    t75 = t18*qd5
+    t76 = t75 + t17*qd4
+    t77 = t76 + t30*qd3
+    t78 = t77 + t34*qd2
+    t79 = -t18*t48 - t26*qd1 + t13*t75 + t55*t26
+    t80 = t18*t43 - t25*qd1 + t55*t25 + t9*t75
+    t81 = s1*qd1
+    t82 = t24*t81 + c1*t78
+    t83 = t23*t81 + c1*t77 + t38*t30
+    t84 = t22*t81 + t17*t40 + c1*t76
+    t85 = c1*qd1
+    t86 = t24*t85 - s1*t78
+    t87 = -t23*t85 + s1*t77 + t35*t30
+    t88 = -t22*t85 + t17*t37 + s1*t76
+    t89 = t23*qd2
+    t90 = s1*t69 + c1*t64 + s1**2*t89 + c1**2*t89
+    t91 = s1*t10
+    t92 = c1*t14
+    t93 = 1/t19
+    t94 = t93*(-t92 + t91)
+    t95 = t93*(t7*t10 - t4*t14)
+    t96 = c1*t10
+    t97 = s1*t14
+    t98 = t93*(s234*t96 + s234*t97)
+    t99 = 1/t20
+    t100 = t93*t99
+    t101 = -t100*(t96 + t97)
+    t102 = t100*(s234*t91 - s234*t92)
+    t103 = -(t7*t14 + t4*t10)*t100
+    t104 = 2*t94
+    t105 = t93*t60
+    t106 = t105*(s1 - t10*t104)
+    t107 = t93*t61
+    t108 = -t107*(c1 + t14*t104)
+    t109 = t93*qd1
+    t110 = t96*t109
+    t111 = t97*t109
+    t112 = t106 + t108 + t110 + t111
+    t113 = 2*t98
+    t114 = t105*(t9 - t10*t113)
+    t115 = t107*(t13 - t14*t113)
+    t116 = t10*t93
+    t117 = t51*t116
+    t118 = t14*t93
+    t119 = t46*t118
+    t120 = 2*t95
+    t121 = t105*(t7 - t10*t120)
+    t122 = -t107*(t4 + t14*t120)
+    t123 = t58*t116
+    t124 = t59*t118
+    t125 = qd1*t99
+    t126 = -t60*(t10*t101 + c1*t99) - t61*(t14*t101 + s1*t99) - t92*t125 + t91*t125
+    t127 = t14*t99
+    t128 = t10*t99
+    t129 = t54*t94 + t0*t106 + t0*t108 + t0*t110 + t0*t111
+    t130 = -t129
     Jd = _stack(xp, [
-        xp.broadcast_to(-t75, batch),  # 0, 0
-        xp.broadcast_to(-t86, batch),  # 0, 1
-        xp.broadcast_to(-t87, batch),  # 0, 2
-        xp.broadcast_to(-t88, batch),  # 0, 3
-        xp.broadcast_to(t83, batch),  # 0, 4
+        xp.broadcast_to(-t71, batch),  # 0, 0
+        xp.broadcast_to(-t82, batch),  # 0, 1
+        xp.broadcast_to(-t83, batch),  # 0, 2
+        xp.broadcast_to(-t84, batch),  # 0, 3
+        xp.broadcast_to(t79, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
-        xp.broadcast_to(t70, batch),  # 1, 0
-        xp.broadcast_to(t90, batch),  # 1, 1
-        xp.broadcast_to(-t91, batch),  # 1, 2
-        xp.broadcast_to(-t92, batch),  # 1, 3
-        xp.broadcast_to(-t84, batch),  # 1, 4
+        xp.broadcast_to(t66, batch),  # 1, 0
+        xp.broadcast_to(t86, batch),  # 1, 1
+        xp.broadcast_to(-t87, batch),  # 1, 2
+        xp.broadcast_to(-t88, batch),  # 1, 3
+        xp.broadcast_to(-t80, batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(t76, batch),  # 2, 1
-        xp.broadcast_to(t94, batch),  # 2, 2
-        xp.broadcast_to(t77, batch),  # 2, 3
-        xp.broadcast_to(t78, batch),  # 2, 4
+        xp.broadcast_to(t72, batch),  # 2, 1
+        xp.broadcast_to(t90, batch),  # 2, 2
+        xp.broadcast_to(t73, batch),  # 2, 3
+        xp.broadcast_to(t74, batch),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(t116, batch),  # 3, 1
-        xp.broadcast_to(t116, batch),  # 3, 2
-        xp.broadcast_to(t116, batch),  # 3, 3
-        xp.broadcast_to(-t119 + t118 + t121 + t123, batch),  # 3, 4
-        xp.broadcast_to(-t126 + t125 + t127 + t128, batch),  # 3, 5
+        xp.broadcast_to(t112, batch),  # 3, 1
+        xp.broadcast_to(t112, batch),  # 3, 2
+        xp.broadcast_to(t112, batch),  # 3, 3
+        xp.broadcast_to(t114 + t115 + t117 + t119, batch),  # 3, 4
+        xp.broadcast_to(t121 + t122 + t123 + t124, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t130, batch),  # 4, 1
-        xp.broadcast_to(t130, batch),  # 4, 2
-        xp.broadcast_to(t130, batch),  # 4, 3
-        xp.broadcast_to(t64*(-t10*t106 + t13*t103) + t65*(t14*t106 + t9*t103) - t49*t131 + t46*t132, batch),  # 4, 4
-        xp.broadcast_to(-t64*(t10*t107 + t4*t103) + t65*(t14*t107 + t7*t103) - t61*t131 + t62*t132, batch),  # 4, 5
+        xp.broadcast_to(t126, batch),  # 4, 1
+        xp.broadcast_to(t126, batch),  # 4, 2
+        xp.broadcast_to(t126, batch),  # 4, 3
+        xp.broadcast_to(t60*(-t10*t102 + t13*t99) - t61*(t14*t102 + t9*t99) - t51*t127 + t46*t128, batch),  # 4, 4
+        xp.broadcast_to(-t60*(t10*t103 + t4*t99) - t61*(t14*t103 + t7*t99) - t58*t127 + t59*t128, batch),  # 4, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
-        xp.broadcast_to(t134, batch),  # 5, 1
-        xp.broadcast_to(t134, batch),  # 5, 2
-        xp.broadcast_to(-(-t43 + t133), batch),  # 5, 3
-        xp.broadcast_to(-(-t50 + t58*t102 + t0*t118 - t0*t119 + t0*t121 + t0*t123), batch),  # 5, 4
-        xp.broadcast_to(-(t56 + t58*t99 + t0*t125 - t0*t126 + t0*t127 + t0*t128), batch),  # 5, 5
+        xp.broadcast_to(t130, batch),  # 5, 1
+        xp.broadcast_to(t130, batch),  # 5, 2
+        xp.broadcast_to(-(-t41 + t129), batch),  # 5, 3
+        xp.broadcast_to(-(-t52 + t54*t98 + t0*t114 + t0*t115 + t0*t117 + t0*t119), batch),  # 5, 4
+        xp.broadcast_to(-(t53 + t54*t95 + t0*t121 + t0*t122 + t0*t123 + t0*t124), batch),  # 5, 5
     ], (6, 6))
     return Jd
 
@@ -1643,7 +1639,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t56 = s1*t24
     t57 = s1*t20
     t58 = s1*t9
-    t59 = t14*t56 + t29*t10 + t13*t57 + t12*t58
+    t59 = t29*t10 + t14*t56 + t13*t57 + t12*t58
     t60 = t56 + t57 + t58 + t3*t10
     t61 = t24**2
     t62 = t10**2
@@ -1846,7 +1842,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t259 = mu_dot1 - t22*t257
     t260 = -t257 + mu_dot5
     t261 = -c234
-    t262 = t245*(t261 + t26*t247 + t22*t29)
+    t262 = t245*(t26*t247 + t22*t29 + t261)
     t263 = t26 - t247*t262
     t264 = t29 - t22*t262
     t265 = c234 + t262
@@ -1854,16 +1850,16 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t267 = t11*t245
     t268 = t266 + t267
     t269 = t32 + t52
-    t270 = xp.sqrt(t61 + t269 + t248**2 + t250**2)
+    t270 = xp.sqrt(t61 + t248**2 + t250**2 + t269)
     t271 = t270*xp.where(xp.greater_equal(t250, 0), xp.asarray(1, dtype=dtype), -1)
     t272 = t250 + t271
     t273 = xp.where(xp.greater(t270, 0), 1/(t270*(t270 + xp.abs(t250))), 0)
-    t274 = t273*(t269 + t253*t272 + t24*t20 + t248*t251)
+    t274 = t273*(t253*t272 + t24*t20 + t248*t251 + t269)
     t275 = t253 - t272*t274
     t276 = t20 - t24*t274
     t277 = s1 - s1*t274
     t278 = -t251 + t248*t274
-    t279 = t273*(t269 + t256*t272 + t24*t9 + t248*t254)
+    t279 = t273*(t256*t272 + t24*t9 + t248*t254 + t269)
     t280 = t256 - t272*t279
     t281 = t9 - t24*t279
     t282 = s1 - s1*t279
@@ -1928,7 +1924,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t341 = t268 + t248*t338
     t342 = -t2
     t343 = c1*t338 + t342
-    t344 = 1 + q1 + q2 + q3 + q4 + q5 + t1 + q6 + t22 + t3 + t6 + t25 + t28 + t46 + t47 + t26 + t29 + t24 + t20 + t9 + t10 + t68 + t235 + t239 + t246 + t261 + t266 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping - 3*c1 + t342
+    t344 = 1 + q1 + q2 + q3 + q4 + q5 + t1 + q6 + t22 + t3 + t6 + t25 + t28 + t46 + t47 + t26 + t29 + t24 + t20 + t9 + t10 + t68 + t235 + t239 + t246 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping - 3*c1 + t261 + t266 + t342
     t345 = t24*t338
     t346 = t302*(t277*t340 + t297*t343 + t278*t341 - t301*t345)
     t347 = t301*t346 + t345
@@ -1953,7 +1949,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t366 = xp.where(xp.not_equal(t319, 0), -(-(t323*t365 + t352*t364) + t327)/t319, 0)
     t367 = xp.where(xp.not_equal(t300, 0), -(-(t304*t366 + t309*t365 - t347*t364) + t314)/t300, 0)
     t368 = xp.where(xp.not_equal(t271, 0), -(-(t275*t367 + t280*t366 + t285*t365 + t339*t364) + t291)/t271, 0)
-    t369 = xp.where(xp.not_equal(t244, 0), -(-(t249*t368 + t252*t367 + t255*t366 + t263*t365 + t267*t247*t364) + t258)/t244, 0)
+    t369 = xp.where(xp.not_equal(t244, 0), -(-(t249*t368 + t252*t367 + t255*t366 + t263*t365 + t247*t364*t267) + t258)/t244, 0)
     t370 = xp.isfinite(t344)
     t371 = xp.greater_equal(damping, 0)
     t372 = xp.greater(damping, 0)
@@ -2090,7 +2086,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t70 = c1*t22
     t71 = t36*t23 + t34*t68 + t33*t69 + t32*t70
     t72 = t68 + t69 + t70 - t17*t23
-    t73 = t34*t66 + t33*t66 + t32*t66
+    t73 = t32*t66 + t34*t66 + t33*t66
     t74 = t73 + t9*t36
     t75 = t73 - t17*t37
     t76 = s1**2

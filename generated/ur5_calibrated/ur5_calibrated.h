@@ -71,7 +71,7 @@ void ur5_calibrated_jacobian_dot(const ur5_calibrated_real q[UR5_CALIBRATED_DOF]
 void ur5_calibrated_bias_acceleration(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], const ur5_calibrated_real q_dot[UR5_CALIBRATED_DOF], ur5_calibrated_real a[6]);
 
 /* Time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q'.
- * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 724 operations. */
+ * Result: Jd: 6 x 6 row-major, element (r, c) at Jd[r * 6 + c]. 717 operations. */
 void ur5_calibrated_task_jacobian_dot(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], const ur5_calibrated_real q_dot[UR5_CALIBRATED_DOF], ur5_calibrated_real Jd[UR5_CALIBRATED_TASK_DIM * UR5_CALIBRATED_DOF]);
 
 /* Partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]).

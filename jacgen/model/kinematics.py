@@ -168,15 +168,16 @@ def column_jacobian(robot: Robot, chain: Chain) -> Matrix:
     return Matrix.hstack(*columns)
 
 
-def _prefix_angular(robot: Robot, axes: list, q_dot, name) -> list:
-    """omega_i: the angular velocity of the link that carries axis i (the sum of z_j qd_j
-    over the revolute joints before i), each sum named once."""
+def angular_velocities(robot: Robot, axes: list, q_dot, name) -> list:
+    """omega_i for i = 0..n: the angular velocity of the link that carries axis i (the sum of
+    z_j qd_j over the revolute joints before i), the last one the tool's; each partial sum
+    named once, so that every function reading them shares them."""
     omegas, omega = [], numpy.zeros(3, dtype=object)
     for joint, z, rate in zip(robot.joints, axes, q_dot):
         omegas.append(omega)
         if joint.revolute:
             omega = elementwise(name, omega + z * rate)
-    return omegas
+    return omegas + [omega]
 
 
 def jacobian_dot(robot: Robot, axes: list, jacobian: numpy.ndarray, q_dot, name) -> numpy.ndarray:
@@ -188,7 +189,7 @@ def jacobian_dot(robot: Robot, axes: list, jacobian: numpy.ndarray, q_dot, name)
     one [w_i x z_i; 0]. Prefix and suffix sums are named once, so each column costs O(1) on
     top of J."""
     n = robot.dof
-    omegas = _prefix_angular(robot, axes, q_dot, name)
+    omegas = angular_velocities(robot, axes, q_dot, name)
     suffix, sums = numpy.zeros(3, dtype=object), [None] * n
     for i in reversed(range(n)):
         suffix = elementwise(name, suffix + jacobian[:3, i] * q_dot[i])
@@ -308,9 +309,10 @@ def task_jacobian_dot(robot: Robot, pose: numpy.ndarray, jacobian: numpy.ndarray
                       q_dot, name) -> numpy.ndarray:
     """d/dt of task_jacobian (arrays of nodes): the position rows of J', and for the angles the
     Euler-angle rates differentiated through what they read, the first column r of R
-    (r' = w x r with w = Jw q_dot) and the angular rows of J (whose rate is that of J')."""
+    (r' = w x r with w = Jw q_dot, the tool's angular velocity, added up as jacobian_dot's
+    partial sums are) and the angular rows of J (whose rate is that of J')."""
     column = pose[:3, 0]
-    omega = elementwise(name, jacobian[3:, :] @ q_dot)
+    omega = angular_velocities(robot, list(jacobian[3:, :].T), q_dot, name)[-1]
     column_rate = elementwise(name, numpy.cross(omega, column))
     angle_rows = []
     for c in range(robot.dof):
