@@ -780,60 +780,47 @@ def fk_jacobian_dot(q, q_dot):
     t48 = 0.36 + t47
     t49 = s1*t47
     t50 = -c2*t44 + s2*t49
-    t51 = t50
-    t52 = -t4*t46 + t43*t30
-    t53 = t52
-    t54 = t20*t46 - t29*t43
-    t55 = t54
-    t56 = -t32*t42 + t22*t45
-    t57 = t56
-    t58 = t57*qd6 + t55*qd5
-    t59 = t58 + t53*qd4
-    t60 = t59 + t51*qd3
-    t61 = c1*t47
-    t62 = c2*t41 - s2*t61
-    t63 = t62
-    t64 = t7*t46 + t40*t30
-    t65 = t64
-    t66 = t29*t40 - t11*t46
-    t67 = t66
-    t68 = t13*t45 + t32*t39
-    t69 = t68
-    t70 = t69*qd6 + t67*qd5
-    t71 = t70 - t65*qd4
-    t72 = t71 + t63*qd3
-    t73 = c1*t41 + s1*t44
-    t74 = t73
-    t75 = t44*t9 - t41*t18
-    t76 = t75
-    t77 = t4*t40 + t7*t43
-    t78 = t77
-    t79 = t11*t43 - t20*t40
-    t80 = t79
-    t81 = t13*t42 + t22*t39
-    t82 = t81
-    t83 = -t82*qd6 + t80*qd5
-    t84 = t83 + t78*qd4
-    t85 = t84 + t76*qd3
-    t86 = t85 - t74*qd2
-    t87 = s1*qd2
-    t88 = -t87 + t9*qd3
-    t89 = t88 + t7*qd4
-    t90 = t89 + t11*qd5
-    t91 = t72 + t47*t87
-    t92 = t91 + t41*qd1
-    t93 = c1*qd2
-    t94 = t93 + t18*qd3
-    t95 = t94 - t4*qd4
-    t96 = t95 + t20*qd5
-    t97 = t60 + t47*t93
-    t98 = t97 - t44*qd1
-    t99 = t13*qd6
-    t100 = -t99 + t90
-    t101 = t22*qd6
-    t102 = t96 + t101
-    t103 = t32*qd6
-    t104 = t38 + t103
+    t51 = -t4*t46 + t43*t30
+    t52 = t20*t46 - t29*t43
+    t53 = -t32*t42 + t22*t45
+    t54 = t53*qd6 + t52*qd5
+    t55 = t54 + t51*qd4
+    t56 = t55 + t50*qd3
+    t57 = c1*t47
+    t58 = c2*t41 - s2*t57
+    t59 = t7*t46 + t40*t30
+    t60 = t29*t40 - t11*t46
+    t61 = t13*t45 + t32*t39
+    t62 = t61*qd6 + t60*qd5
+    t63 = t62 - t59*qd4
+    t64 = t63 + t58*qd3
+    t65 = c1*t41 + s1*t44
+    t66 = t44*t9 - t41*t18
+    t67 = t4*t40 + t7*t43
+    t68 = t11*t43 - t20*t40
+    t69 = t13*t42 + t22*t39
+    t70 = -t69*qd6 + t68*qd5
+    t71 = t70 + t67*qd4
+    t72 = t71 + t66*qd3
+    t73 = t72 - t65*qd2
+    t74 = s1*qd2
+    t75 = -t74 + t9*qd3
+    t76 = t75 + t7*qd4
+    t77 = t76 + t11*qd5
+    t78 = t64 + t47*t74
+    t79 = t78 + t41*qd1
+    t80 = c1*qd2
+    t81 = t80 + t18*qd3
+    t82 = t81 - t4*qd4
+    t83 = t82 + t20*qd5
+    t84 = t56 + t47*t80
+    t85 = t84 - t44*qd1
+    t86 = t13*qd6
+    t87 = -t86 + t77
+    t88 = t22*qd6
+    t89 = t83 + t88
+    t90 = t32*qd6
+    t91 = t38 + t90
     T = _stack(xp, [
         xp.broadcast_to(t16, batch),  # 0, 0
         xp.broadcast_to(-t17, batch),  # 0, 1
@@ -854,25 +841,25 @@ def fk_jacobian_dot(q, q_dot):
     ], (4, 4))
     J = _stack(xp, [
         xp.broadcast_to(-t44, batch),  # 0, 0
-        xp.broadcast_to(t61, batch),  # 0, 1
+        xp.broadcast_to(t57, batch),  # 0, 1
         xp.broadcast_to(t50, batch),  # 0, 2
-        xp.broadcast_to(t52, batch),  # 0, 3
-        xp.broadcast_to(t54, batch),  # 0, 4
-        xp.broadcast_to(t56, batch),  # 0, 5
+        xp.broadcast_to(t51, batch),  # 0, 3
+        xp.broadcast_to(t52, batch),  # 0, 4
+        xp.broadcast_to(t53, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         xp.broadcast_to(t41, batch),  # 1, 0
         xp.broadcast_to(t49, batch),  # 1, 1
-        xp.broadcast_to(t62, batch),  # 1, 2
-        xp.broadcast_to(-t64, batch),  # 1, 3
-        xp.broadcast_to(t66, batch),  # 1, 4
-        xp.broadcast_to(t68, batch),  # 1, 5
+        xp.broadcast_to(t58, batch),  # 1, 2
+        xp.broadcast_to(-t59, batch),  # 1, 3
+        xp.broadcast_to(t60, batch),  # 1, 4
+        xp.broadcast_to(t61, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t73, batch),  # 2, 1
-        xp.broadcast_to(t75, batch),  # 2, 2
-        xp.broadcast_to(t77, batch),  # 2, 3
-        xp.broadcast_to(t79, batch),  # 2, 4
-        xp.broadcast_to(-t81, batch),  # 2, 5
+        xp.broadcast_to(-t65, batch),  # 2, 1
+        xp.broadcast_to(t66, batch),  # 2, 2
+        xp.broadcast_to(t67, batch),  # 2, 3
+        xp.broadcast_to(t68, batch),  # 2, 4
+        xp.broadcast_to(-t69, batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(-s1, batch),  # 3, 1
@@ -897,12 +884,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t34, batch),  # 5, 6
     ], (6, 7))
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t92 + qd5*(t80*t95 - t67*t37 + t20*t83 - t29*t70) + qd2*(c1*t86 - t49*qd1) + qd3*(-t63*qd1 - c2*t72 + t76*t93 + t18*t85) + qd4*(t78*t94 + t65*t0 - t4*t84 + t30*t71) - qd6*(t69*t38 + t82*t96 + t82*t101 + t69*t103), batch),  # 0
-        xp.broadcast_to(qd1*t98 + qd5*(t55*t37 - t80*t89 + t29*t58 - t11*t83) + qd2*(s1*t86 + t61*qd1) + qd3*(t51*qd1 + c2*t60 + t76*t87 - t9*t85) - qd4*(t78*t88 + t7*t84 - t53*t0 + t30*t59) + qd6*(t57*t38 + t82*t90 + t57*t103 - t82*t99), batch),  # 1
-        xp.broadcast_to(qd4*(-t65*t88 - t53*t94 + t7*t71 + t4*t59) + qd5*(t67*t89 - t55*t95 + t11*t70 - t20*t58) - qd2*(s1*t91 + c1*t97) - qd3*(t63*t87 + t51*t93 - t9*t72 + t18*t60) - qd6*(t57*t96 - t69*t90 + t69*t99 + t57*t101), batch),  # 2
-        xp.broadcast_to(qd5*(t29*t95 - t20*t37) + qd6*(t32*t96 - t22*t38) + qd7*(t34*t102 - t24*t104) - qd1*t93 + qd3*(c2*t93 - t18*qd1) + qd4*(t4*t0 - t30*t94), batch),  # 3
-        xp.broadcast_to(qd5*(t11*t37 - t29*t89) + qd7*(t15*t104 - t34*t100) - qd1*t87 + qd3*(t9*qd1 + c2*t87) + qd4*(t7*t0 + t30*t88) - qd6*(t13*t38 + t32*t90), batch),  # 4
-        xp.broadcast_to(qd5*(t20*t89 - t11*t95) + qd6*(t22*t90 + t13*t96) + qd7*(t24*t100 - t15*t102) - qd4*(t4*t88 + t7*t94) - qd3*(t18*t87 + t9*t93), batch),  # 5
+        xp.broadcast_to(-qd1*t79 + qd2*(c1*t73 - t49*qd1) + qd5*(t20*t70 - t29*t62 + t68*t82 - t60*t37) + qd3*(-c2*t64 + t18*t72 - t58*qd1 + t66*t80) + qd4*(-t4*t71 + t30*t63 + t67*t81 + t59*t0) - qd6*(t61*t38 + t69*t83 + t69*t88 + t61*t90), batch),  # 0
+        xp.broadcast_to(qd1*t85 + qd2*(s1*t73 + t57*qd1) + qd5*(t29*t54 - t11*t70 + t52*t37 - t68*t76) + qd3*(c2*t56 - t9*t72 + t50*qd1 + t66*t74) - qd4*(t7*t71 + t30*t55 + t67*t75 - t51*t0) + qd6*(t53*t38 + t69*t77 + t53*t90 - t69*t86), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t78 + c1*t84) + qd4*(t7*t63 + t4*t55 - t59*t75 - t51*t81) + qd5*(t11*t62 - t20*t54 + t60*t76 - t52*t82) - qd3*(-t9*t64 + t18*t56 + t58*t74 + t50*t80) - qd6*(t53*t83 - t61*t77 + t61*t86 + t53*t88), batch),  # 2
+        xp.broadcast_to(qd5*(t29*t82 - t20*t37) + qd6*(t32*t83 - t22*t38) + qd7*(t34*t89 - t24*t91) - qd1*t80 + qd3*(c2*t80 - t18*qd1) + qd4*(t4*t0 - t30*t81), batch),  # 3
+        xp.broadcast_to(qd5*(t11*t37 - t29*t76) + qd7*(t15*t91 - t34*t87) - qd1*t74 + qd3*(t9*qd1 + c2*t74) + qd4*(t7*t0 + t30*t75) - qd6*(t13*t38 + t32*t77), batch),  # 4
+        xp.broadcast_to(qd5*(t20*t76 - t11*t82) + qd6*(t22*t77 + t13*t83) + qd7*(t24*t87 - t15*t89) - qd4*(t4*t75 + t7*t81) - qd3*(t18*t74 + t9*t80), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -2450,42 +2437,41 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t221 = t218 - t191*t220
     t222 = t219 - t188*t220
     t223 = xp.abs(t222)
-    t224 = t223
-    t225 = t224*xp.where(xp.greater_equal(t222, 0), xp.asarray(1, dtype=dtype), -1)
-    t226 = t222 + t225
-    t227 = xp.where(xp.greater(t224, 0), 1/(t224*(t223 + t224)), 0)
-    t228 = t195 - t195*t226**2*t227
-    t229 = xp.where(xp.not_equal(t225, 0), -t228/t225, 0)
-    t230 = xp.where(xp.not_equal(t190, 0), -(t194 - t221*t229)/t190, 0)
-    t231 = xp.where(xp.not_equal(t159, 0), -(-(t186*t230 + t217*t229) + t163)/t159, 0)
-    t232 = xp.where(xp.not_equal(t131, 0), -(-(t154*t231 + t181*t230 + t212*t229) + t135)/t131, 0)
-    t233 = xp.where(xp.not_equal(t107, 0), -(-(-t125*t232 - t148*t231 + t175*t230 + t206*t229) + t111)/t107, 0)
-    t234 = xp.where(xp.not_equal(t88, 0), -(-(t100*t233 + t118*t232 + t141*t231 + t168*t230 + t199*t229) + t92)/t88, 0)
-    t235 = t229 - t34*t234 + t31*t233
-    t236 = t45*t234 + t49*t233 + t36*t232 + c2*t229 + t8*t231 + t14*t230
-    t237 = t46*t234 - t50*t233 + t37*t232 + t6*t231 - t3*t230 - t23*t229
-    t238 = t47*t234 + t51*t233 + t38*t232 + t10*t231 + t16*t230 + t22*t229
-    t239 = t48*t234 + t52*t233 - t39*t232 - t12*t231 + t18*t230 + t25*t229
-    t240 = t13*t231 + t19*t230 + t26*t229
-    t241 = c1*t44
-    t242 = s1*t44
-    t243 = -t35*t232 - s1*t231 + c1*t230 + t241*t234 + t242*t233
-    t244 = 1 - t50 - t35 - t39 - s1 - t12 - t3 - t23 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t10 + t16 + t22 + q5 + t18 + t25 + q6 + t13 + t19 + t26 + q7 + t31 + t8 + t14 + t66 + t45 + t46 + t47 + t48 + t49 + t51 + t52 + t36 + t37 + t38 + t241 + t242 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t245 = xp.isfinite(t244)
-    t246 = xp.greater_equal(damping, 0)
-    t247 = 1e-12*t197
-    t248 = xp.less_equal(t87, t247) | xp.less_equal(t106, t247) | xp.less_equal(t130, t247) | xp.less_equal(t158, t247) | xp.less_equal(t189, t247) | xp.less_equal(t224, t247)
-    t249 = t245 & t246 & xp.logical_not(t248)
+    t224 = t223*xp.where(xp.greater_equal(t222, 0), xp.asarray(1, dtype=dtype), -1)
+    t225 = t222 + t224
+    t226 = xp.where(xp.greater(t223, 0), 1/(t223*2*t223), 0)
+    t227 = t195 - t195*t225**2*t226
+    t228 = xp.where(xp.not_equal(t224, 0), -t227/t224, 0)
+    t229 = xp.where(xp.not_equal(t190, 0), -(t194 - t221*t228)/t190, 0)
+    t230 = xp.where(xp.not_equal(t159, 0), -(-(t186*t229 + t217*t228) + t163)/t159, 0)
+    t231 = xp.where(xp.not_equal(t131, 0), -(-(t154*t230 + t181*t229 + t212*t228) + t135)/t131, 0)
+    t232 = xp.where(xp.not_equal(t107, 0), -(-(-t125*t231 - t148*t230 + t175*t229 + t206*t228) + t111)/t107, 0)
+    t233 = xp.where(xp.not_equal(t88, 0), -(-(t100*t232 + t118*t231 + t141*t230 + t168*t229 + t199*t228) + t92)/t88, 0)
+    t234 = t228 - t34*t233 + t31*t232
+    t235 = t45*t233 + t49*t232 + t36*t231 + c2*t228 + t8*t230 + t14*t229
+    t236 = t46*t233 - t50*t232 + t37*t231 + t6*t230 - t3*t229 - t23*t228
+    t237 = t47*t233 + t51*t232 + t38*t231 + t10*t230 + t16*t229 + t22*t228
+    t238 = t48*t233 + t52*t232 - t39*t231 - t12*t230 + t18*t229 + t25*t228
+    t239 = t13*t230 + t19*t229 + t26*t228
+    t240 = c1*t44
+    t241 = s1*t44
+    t242 = -t35*t231 - s1*t230 + c1*t229 + t240*t233 + t241*t232
+    t243 = 1 - t50 - t35 - t39 - s1 - t12 - t3 - t23 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t10 + t16 + t22 + q5 + t18 + t25 + q6 + t13 + t19 + t26 + q7 + t31 + t8 + t14 + t66 + t45 + t46 + t47 + t48 + t49 + t51 + t52 + t36 + t37 + t38 + t240 + t241 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t244 = xp.isfinite(t243)
+    t245 = xp.greater_equal(damping, 0)
+    t246 = 1e-12*t197
+    t247 = xp.less_equal(t87, t246) | xp.less_equal(t106, t246) | xp.less_equal(t130, t246) | xp.less_equal(t158, t246) | xp.less_equal(t189, t246) | xp.less_equal(t223, t246)
+    t248 = t244 & t245 & xp.logical_not(t247)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t249, t235, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t249, t243, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t249, t236, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t249, t237, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t249, t238, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t249, t239, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t249, t240, 0), batch),  # 6
+        xp.broadcast_to(xp.where(t248, t234, 0), batch),  # 0
+        xp.broadcast_to(xp.where(t248, t242, 0), batch),  # 1
+        xp.broadcast_to(xp.where(t248, t235, 0), batch),  # 2
+        xp.broadcast_to(xp.where(t248, t236, 0), batch),  # 3
+        xp.broadcast_to(xp.where(t248, t237, 0), batch),  # 4
+        xp.broadcast_to(xp.where(t248, t238, 0), batch),  # 5
+        xp.broadcast_to(xp.where(t248, t239, 0), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t245 & t246), 2, xp.where(t248, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t244 & t245), 2, xp.where(t247, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -2792,24 +2778,23 @@ def ik_numeric_step(target, q, damping=0.0):
     t256 = t253 - t227*t255
     t257 = t254 - t224*t255
     t258 = xp.abs(t257)
-    t259 = t258
-    t260 = t259*xp.where(xp.greater_equal(t257, 0), xp.asarray(1, dtype=dtype), -1)
-    t261 = t257 + t260
-    t262 = xp.where(xp.greater(t259, 0), 1/(t259*(t258 + t259)), 0)
-    t263 = t231 - t231*t261**2*t262
-    t264 = xp.where(xp.not_equal(t260, 0), -t263/t260, 0)
-    t265 = xp.where(xp.not_equal(t226, 0), -(t230 - t256*t264)/t226, 0)
-    t266 = xp.where(xp.not_equal(t195, 0), -(-(t222*t265 + t252*t264) + t199)/t195, 0)
-    t267 = xp.where(xp.not_equal(t167, 0), -(-(t190*t266 + t217*t265 + t247*t264) + t171)/t167, 0)
-    t268 = xp.where(xp.not_equal(t143, 0), -(-(-t161*t267 - t184*t266 + t211*t265 + t241*t264) + t147)/t143, 0)
-    t269 = xp.where(xp.not_equal(t124, 0), -(-(t136*t268 + t154*t267 + t177*t266 + t204*t265 + t234*t264) + t128)/t124, 0)
-    t270 = q1 + t264 - t61*t269 + t57*t268
-    t271 = q2 + c1*t71*t269 + s1*t71*t268 - t62*t267 - s1*t266 + c1*t265
-    t272 = q3 + t73*t269 + t77*t268 + t63*t267 + c2*t264 + t9*t266 + t21*t265
-    t273 = q4 + t74*t269 - t78*t268 + t64*t267 + t7*t266 - t4*t265 - t37*t264
-    t274 = q5 + t75*t269 + t79*t268 + t65*t267 + t11*t266 + t23*t265 + t36*t264
-    t275 = q6 + t76*t269 + t80*t268 - t66*t267 - t13*t266 + t25*t265 + t39*t264
-    t276 = q7 + t15*t266 + t27*t265 + t41*t264
+    t259 = t258*xp.where(xp.greater_equal(t257, 0), xp.asarray(1, dtype=dtype), -1)
+    t260 = t257 + t259
+    t261 = xp.where(xp.greater(t258, 0), 1/(t258*2*t258), 0)
+    t262 = t231 - t231*t260**2*t261
+    t263 = xp.where(xp.not_equal(t259, 0), -t262/t259, 0)
+    t264 = xp.where(xp.not_equal(t226, 0), -(t230 - t256*t263)/t226, 0)
+    t265 = xp.where(xp.not_equal(t195, 0), -(-(t222*t264 + t252*t263) + t199)/t195, 0)
+    t266 = xp.where(xp.not_equal(t167, 0), -(-(t190*t265 + t217*t264 + t247*t263) + t171)/t167, 0)
+    t267 = xp.where(xp.not_equal(t143, 0), -(-(-t161*t266 - t184*t265 + t211*t264 + t241*t263) + t147)/t143, 0)
+    t268 = xp.where(xp.not_equal(t124, 0), -(-(t136*t267 + t154*t266 + t177*t265 + t204*t264 + t234*t263) + t128)/t124, 0)
+    t269 = q1 + t263 - t61*t268 + t57*t267
+    t270 = q2 + c1*t71*t268 + s1*t71*t267 - t62*t266 - s1*t265 + c1*t264
+    t271 = q3 + t73*t268 + t77*t267 + t63*t266 + c2*t263 + t9*t265 + t21*t264
+    t272 = q4 + t74*t268 - t78*t267 + t64*t266 + t7*t265 - t4*t264 - t37*t263
+    t273 = q5 + t75*t268 + t79*t267 + t65*t266 + t11*t265 + t23*t264 + t36*t263
+    t274 = q6 + t76*t268 + t80*t267 - t66*t266 - t13*t265 + t25*t264 + t39*t263
+    t275 = q7 + t15*t265 + t27*t264 + t41*t263
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -2820,13 +2805,13 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q7, batch),  # 6
     ], (7,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t270, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t270, 2.9670597283903604), 2.9670597283903604, t270)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t271, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t271, 2.0943951023931953), 2.0943951023931953, t271)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t272, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t272, 2.9670597283903604), 2.9670597283903604, t272)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t273, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t273, 2.0943951023931953), 2.0943951023931953, t273)), batch),  # 3
-        xp.broadcast_to(xp.where(xp.less(t274, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t274, 2.9670597283903604), 2.9670597283903604, t274)), batch),  # 4
-        xp.broadcast_to(xp.where(xp.less(t275, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t275, 2.0943951023931953), 2.0943951023931953, t275)), batch),  # 5
-        xp.broadcast_to(xp.where(xp.less(t276, -3.0543261909900767), -3.0543261909900767, xp.where(xp.greater(t276, 3.0543261909900767), 3.0543261909900767, t276)), batch),  # 6
+        xp.broadcast_to(xp.where(xp.less(t269, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t269, 2.9670597283903604), 2.9670597283903604, t269)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t270, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t270, 2.0943951023931953), 2.0943951023931953, t270)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t271, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t271, 2.9670597283903604), 2.9670597283903604, t271)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t272, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t272, 2.0943951023931953), 2.0943951023931953, t272)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t273, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t273, 2.9670597283903604), 2.9670597283903604, t273)), batch),  # 4
+        xp.broadcast_to(xp.where(xp.less(t274, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t274, 2.0943951023931953), 2.0943951023931953, t274)), batch),  # 5
+        xp.broadcast_to(xp.where(xp.less(t275, -3.0543261909900767), -3.0543261909900767, xp.where(xp.greater(t275, 3.0543261909900767), 3.0543261909900767, t275)), batch),  # 6
     ], (7,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t0), t121, -1), batch)
     return q_start, q_next, cost
@@ -3271,244 +3256,232 @@ def ik_branches(T, q_free):
     t417 = t415**2 + t416**2
     t418 = t413**2 + t414**2 + t411**2
     t419 = xp.where(t174, 0, xp.atan2(t169, t168))
-    t420 = t419
-    t421 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t420)) + t420
-    t422 = 3.141592653589793 + t419 - 6.283185307179586*xp.ceil(0.15915494309189535*t419)
-    t423 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t422)) + t422
-    t424 = xp.where(t184, 0, xp.atan2(-t163, t144))
-    t425 = t424
-    t426 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t425)) + t425
-    t427 = t424 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t424))
-    t428 = 1e-24*t37
-    t429 = xp.where(xp.less_equal(t195, t428*t196), 0, xp.atan2(t194, t193))
-    t430 = t429
-    t431 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t430)) + t430
-    t432 = 3.141592653589793 + t429 - 6.283185307179586*xp.ceil(0.15915494309189535*t429)
-    t433 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t432)) + t432
-    t434 = -t427
-    t435 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t434)) + t427
-    t436 = xp.where(t242, 0, xp.atan2(t237, t236))
-    t437 = t436
-    t438 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t437)) + t437
-    t439 = 3.141592653589793 + t436 - 6.283185307179586*xp.ceil(0.15915494309189535*t436)
-    t440 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t439)) + t439
-    t441 = xp.where(t252, 0, xp.atan2(-t231, t214))
-    t442 = t441
-    t443 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t442)) + t442
-    t444 = t441 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t441))
-    t445 = xp.where(xp.less_equal(t263, t428*t264), 0, xp.atan2(t262, t261))
-    t446 = t445
-    t447 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t446)) + t446
-    t448 = 3.141592653589793 + t445 - 6.283185307179586*xp.ceil(0.15915494309189535*t445)
-    t449 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t448)) + t448
-    t450 = -t444
-    t451 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t450)) + t444
-    t452 = xp.where(t333, 0, xp.atan2(t328, t327))
-    t453 = t452
-    t454 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t453)) + t453
-    t455 = 3.141592653589793 + t452 - 6.283185307179586*xp.ceil(0.15915494309189535*t452)
-    t456 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t455)) + t455
-    t457 = xp.where(t343, 0, xp.atan2(-t322, -t305))
-    t458 = t457
-    t459 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t458)) + t458
-    t460 = t457 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t457))
-    t461 = xp.where(xp.less_equal(t354, t428*t355), 0, xp.atan2(-t353, t352))
-    t462 = t461
-    t463 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t462)) + t462
-    t464 = 3.141592653589793 + t461 - 6.283185307179586*xp.ceil(0.15915494309189535*t461)
-    t465 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t464)) + t464
-    t466 = -t460
-    t467 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t466)) + t460
-    t468 = xp.where(t396, 0, xp.atan2(t391, t390))
-    t469 = t468
-    t470 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t469)) + t469
-    t471 = 3.141592653589793 + t468 - 6.283185307179586*xp.ceil(0.15915494309189535*t468)
-    t472 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t471)) + t471
-    t473 = xp.where(t406, 0, xp.atan2(-t385, -t368))
-    t474 = t473
-    t475 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t474)) + t474
-    t476 = t473 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t473))
-    t477 = xp.where(xp.less_equal(t417, t428*t418), 0, xp.atan2(-t416, t415))
-    t478 = t477
-    t479 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t478)) + t478
-    t480 = 3.141592653589793 + t477 - 6.283185307179586*xp.ceil(0.15915494309189535*t477)
-    t481 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t480)) + t480
-    t482 = -t476
-    t483 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t482)) + t476
-    t484 = xp.greater_equal(t78, -2.9670597283903604) & xp.less_equal(t78, 2.9670597283903604)
-    t485 = xp.less_equal(t79, 2.9670597283903604)
-    t486 = xp.where(xp.logical_not(t484) & t485, t79, t78)
-    t487 = xp.greater_equal(t98, -2.0943951023931953) & xp.less_equal(t98, 2.0943951023931953)
-    t488 = xp.less_equal(t99, 2.0943951023931953)
-    t489 = xp.where(xp.logical_not(t487) & t488, t99, t98)
-    t490 = xp.greater_equal(t30, -2.0943951023931953) & xp.less_equal(t30, 2.0943951023931953)
-    t491 = xp.less_equal(t31, 2.0943951023931953)
-    t492 = xp.where(xp.logical_not(t490) & t491, t31, t30)
-    t493 = xp.greater_equal(t420, -2.9670597283903604) & xp.less_equal(t420, 2.9670597283903604)
-    t494 = xp.less_equal(t421, 2.9670597283903604)
-    t495 = xp.greater_equal(t425, -2.0943951023931953) & xp.less_equal(t425, 2.0943951023931953)
-    t496 = xp.less_equal(t426, 2.0943951023931953)
-    t497 = xp.greater_equal(t430, -3.0543261909900767) & xp.less_equal(t430, 3.0543261909900767)
-    t498 = xp.less_equal(t431, 3.0543261909900767)
-    t499 = xp.greater_equal(t422, -2.9670597283903604) & xp.less_equal(t422, 2.9670597283903604)
-    t500 = xp.less_equal(t423, 2.9670597283903604)
-    t501 = xp.greater_equal(t434, -2.0943951023931953) & xp.less_equal(t434, 2.0943951023931953)
-    t502 = -t435
-    t503 = xp.less_equal(t502, 2.0943951023931953)
-    t504 = xp.greater_equal(t432, -3.0543261909900767) & xp.less_equal(t432, 3.0543261909900767)
-    t505 = xp.less_equal(t433, 3.0543261909900767)
-    t506 = xp.greater_equal(t116, -2.9670597283903604) & xp.less_equal(t116, 2.9670597283903604)
-    t507 = xp.less_equal(t117, 2.9670597283903604)
-    t508 = xp.where(xp.logical_not(t506) & t507, t117, t116)
-    t509 = xp.greater_equal(t121, -2.0943951023931953) & xp.less_equal(t121, 2.0943951023931953)
-    t510 = xp.less_equal(t122, 2.0943951023931953)
-    t511 = xp.where(xp.logical_not(t509) & t510, t122, t121)
-    t512 = xp.greater_equal(t437, -2.9670597283903604) & xp.less_equal(t437, 2.9670597283903604)
-    t513 = xp.less_equal(t438, 2.9670597283903604)
-    t514 = xp.greater_equal(t442, -2.0943951023931953) & xp.less_equal(t442, 2.0943951023931953)
-    t515 = xp.less_equal(t443, 2.0943951023931953)
-    t516 = xp.greater_equal(t446, -3.0543261909900767) & xp.less_equal(t446, 3.0543261909900767)
-    t517 = xp.less_equal(t447, 3.0543261909900767)
-    t518 = xp.greater_equal(t439, -2.9670597283903604) & xp.less_equal(t439, 2.9670597283903604)
-    t519 = xp.less_equal(t440, 2.9670597283903604)
-    t520 = xp.greater_equal(t450, -2.0943951023931953) & xp.less_equal(t450, 2.0943951023931953)
-    t521 = -t451
-    t522 = xp.less_equal(t521, 2.0943951023931953)
-    t523 = xp.greater_equal(t448, -3.0543261909900767) & xp.less_equal(t448, 3.0543261909900767)
-    t524 = xp.less_equal(t449, 3.0543261909900767)
-    t525 = xp.greater_equal(t277, -2.9670597283903604) & xp.less_equal(t277, 2.9670597283903604)
-    t526 = xp.less_equal(t278, 2.9670597283903604)
-    t527 = xp.where(xp.logical_not(t525) & t526, t278, t277)
-    t528 = xp.greater_equal(t123, -2.0943951023931953) & xp.less_equal(t123, 2.0943951023931953)
-    t529 = xp.less_equal(t124, 2.0943951023931953)
-    t530 = xp.where(xp.logical_not(t528) & t529, t124, t123)
-    t531 = xp.greater_equal(t32, -2.0943951023931953) & xp.less_equal(t32, 2.0943951023931953)
-    t532 = xp.less_equal(t33, 2.0943951023931953)
-    t533 = xp.where(xp.logical_not(t531) & t532, t33, t32)
-    t534 = xp.greater_equal(t453, -2.9670597283903604) & xp.less_equal(t453, 2.9670597283903604)
-    t535 = xp.less_equal(t454, 2.9670597283903604)
-    t536 = xp.greater_equal(t458, -2.0943951023931953) & xp.less_equal(t458, 2.0943951023931953)
-    t537 = xp.less_equal(t459, 2.0943951023931953)
-    t538 = xp.greater_equal(t462, -3.0543261909900767) & xp.less_equal(t462, 3.0543261909900767)
-    t539 = xp.less_equal(t463, 3.0543261909900767)
-    t540 = xp.greater_equal(t455, -2.9670597283903604) & xp.less_equal(t455, 2.9670597283903604)
-    t541 = xp.less_equal(t456, 2.9670597283903604)
-    t542 = xp.greater_equal(t466, -2.0943951023931953) & xp.less_equal(t466, 2.0943951023931953)
-    t543 = -t467
-    t544 = xp.less_equal(t543, 2.0943951023931953)
-    t545 = xp.greater_equal(t464, -3.0543261909900767) & xp.less_equal(t464, 3.0543261909900767)
-    t546 = xp.less_equal(t465, 3.0543261909900767)
-    t547 = xp.greater_equal(t291, -2.9670597283903604) & xp.less_equal(t291, 2.9670597283903604)
-    t548 = xp.less_equal(t292, 2.9670597283903604)
-    t549 = xp.where(xp.logical_not(t547) & t548, t292, t291)
-    t550 = xp.greater_equal(t100, -2.0943951023931953) & xp.less_equal(t100, 2.0943951023931953)
-    t551 = xp.less_equal(t101, 2.0943951023931953)
-    t552 = xp.where(xp.logical_not(t550) & t551, t101, t100)
-    t553 = xp.greater_equal(t469, -2.9670597283903604) & xp.less_equal(t469, 2.9670597283903604)
-    t554 = xp.less_equal(t470, 2.9670597283903604)
-    t555 = xp.greater_equal(t474, -2.0943951023931953) & xp.less_equal(t474, 2.0943951023931953)
-    t556 = xp.less_equal(t475, 2.0943951023931953)
-    t557 = xp.greater_equal(t478, -3.0543261909900767) & xp.less_equal(t478, 3.0543261909900767)
-    t558 = xp.less_equal(t479, 3.0543261909900767)
-    t559 = xp.greater_equal(t471, -2.9670597283903604) & xp.less_equal(t471, 2.9670597283903604)
-    t560 = xp.less_equal(t472, 2.9670597283903604)
-    t561 = xp.greater_equal(t482, -2.0943951023931953) & xp.less_equal(t482, 2.0943951023931953)
-    t562 = -t483
-    t563 = xp.less_equal(t562, 2.0943951023931953)
-    t564 = xp.greater_equal(t480, -3.0543261909900767) & xp.less_equal(t480, 3.0543261909900767)
-    t565 = xp.less_equal(t481, 3.0543261909900767)
-    t566 = xp.isfinite(t16)
-    t567 = xp.greater_equal(t20, -1e-12)
-    t568 = xp.greater_equal(t42, -t43)
-    t569 = xp.greater_equal(q3, -2.9670597283903604)
-    t570 = xp.less_equal(q3, 2.9670597283903604)
-    t571 = t484 | t485
-    t572 = t487 | t488
-    t573 = t490 | t491
-    t574 = t506 | t507
-    t575 = t509 | t510
-    t576 = t525 | t526
-    t577 = t528 | t529
-    t578 = t531 | t532
-    t579 = t547 | t548
-    t580 = t550 | t551
+    t420 = t419 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t419))
+    t421 = 3.141592653589793 + t419 - 6.283185307179586*xp.ceil(0.15915494309189535*t419)
+    t422 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t421)) + t421
+    t423 = xp.where(t184, 0, xp.atan2(-t163, t144))
+    t424 = t423 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t423))
+    t425 = t423 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t423))
+    t426 = 1e-24*t37
+    t427 = xp.where(xp.less_equal(t195, t426*t196), 0, xp.atan2(t194, t193))
+    t428 = t427 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t427))
+    t429 = 3.141592653589793 + t427 - 6.283185307179586*xp.ceil(0.15915494309189535*t427)
+    t430 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t429)) + t429
+    t431 = -t425
+    t432 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t431)) + t425
+    t433 = xp.where(t242, 0, xp.atan2(t237, t236))
+    t434 = t433 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t433))
+    t435 = 3.141592653589793 + t433 - 6.283185307179586*xp.ceil(0.15915494309189535*t433)
+    t436 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t435)) + t435
+    t437 = xp.where(t252, 0, xp.atan2(-t231, t214))
+    t438 = t437 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t437))
+    t439 = t437 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t437))
+    t440 = xp.where(xp.less_equal(t263, t426*t264), 0, xp.atan2(t262, t261))
+    t441 = t440 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t440))
+    t442 = 3.141592653589793 + t440 - 6.283185307179586*xp.ceil(0.15915494309189535*t440)
+    t443 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t442)) + t442
+    t444 = -t439
+    t445 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t444)) + t439
+    t446 = xp.where(t333, 0, xp.atan2(t328, t327))
+    t447 = t446 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t446))
+    t448 = 3.141592653589793 + t446 - 6.283185307179586*xp.ceil(0.15915494309189535*t446)
+    t449 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t448)) + t448
+    t450 = xp.where(t343, 0, xp.atan2(-t322, -t305))
+    t451 = t450 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t450))
+    t452 = t450 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t450))
+    t453 = xp.where(xp.less_equal(t354, t426*t355), 0, xp.atan2(-t353, t352))
+    t454 = t453 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t453))
+    t455 = 3.141592653589793 + t453 - 6.283185307179586*xp.ceil(0.15915494309189535*t453)
+    t456 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t455)) + t455
+    t457 = -t452
+    t458 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t457)) + t452
+    t459 = xp.where(t396, 0, xp.atan2(t391, t390))
+    t460 = t459 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t459))
+    t461 = 3.141592653589793 + t459 - 6.283185307179586*xp.ceil(0.15915494309189535*t459)
+    t462 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t461)) + t461
+    t463 = xp.where(t406, 0, xp.atan2(-t385, -t368))
+    t464 = t463 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t463))
+    t465 = t463 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t463))
+    t466 = xp.where(xp.less_equal(t417, t426*t418), 0, xp.atan2(-t416, t415))
+    t467 = t466 - 6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t466))
+    t468 = 3.141592653589793 + t466 - 6.283185307179586*xp.ceil(0.15915494309189535*t466)
+    t469 = -6.283185307179586*xp.floor(0.15915494309189535*(3.0543261909900767 + t468)) + t468
+    t470 = -t465
+    t471 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t470)) + t465
+    t472 = xp.greater_equal(t78, -2.9670597283903604) & xp.less_equal(t78, 2.9670597283903604)
+    t473 = xp.less_equal(t79, 2.9670597283903604)
+    t474 = xp.where(xp.logical_not(t472) & t473, t79, t78)
+    t475 = xp.greater_equal(t98, -2.0943951023931953) & xp.less_equal(t98, 2.0943951023931953)
+    t476 = xp.less_equal(t99, 2.0943951023931953)
+    t477 = xp.where(xp.logical_not(t475) & t476, t99, t98)
+    t478 = xp.greater_equal(t30, -2.0943951023931953) & xp.less_equal(t30, 2.0943951023931953)
+    t479 = xp.less_equal(t31, 2.0943951023931953)
+    t480 = xp.where(xp.logical_not(t478) & t479, t31, t30)
+    t481 = xp.greater_equal(t419, -2.9670597283903604) & xp.less_equal(t419, 2.9670597283903604)
+    t482 = xp.less_equal(t420, 2.9670597283903604)
+    t483 = xp.greater_equal(t423, -2.0943951023931953) & xp.less_equal(t423, 2.0943951023931953)
+    t484 = xp.less_equal(t424, 2.0943951023931953)
+    t485 = xp.greater_equal(t427, -3.0543261909900767) & xp.less_equal(t427, 3.0543261909900767)
+    t486 = xp.less_equal(t428, 3.0543261909900767)
+    t487 = xp.greater_equal(t421, -2.9670597283903604) & xp.less_equal(t421, 2.9670597283903604)
+    t488 = xp.less_equal(t422, 2.9670597283903604)
+    t489 = xp.greater_equal(t431, -2.0943951023931953) & xp.less_equal(t431, 2.0943951023931953)
+    t490 = -t432
+    t491 = xp.less_equal(t490, 2.0943951023931953)
+    t492 = xp.greater_equal(t429, -3.0543261909900767) & xp.less_equal(t429, 3.0543261909900767)
+    t493 = xp.less_equal(t430, 3.0543261909900767)
+    t494 = xp.greater_equal(t116, -2.9670597283903604) & xp.less_equal(t116, 2.9670597283903604)
+    t495 = xp.less_equal(t117, 2.9670597283903604)
+    t496 = xp.where(xp.logical_not(t494) & t495, t117, t116)
+    t497 = xp.greater_equal(t121, -2.0943951023931953) & xp.less_equal(t121, 2.0943951023931953)
+    t498 = xp.less_equal(t122, 2.0943951023931953)
+    t499 = xp.where(xp.logical_not(t497) & t498, t122, t121)
+    t500 = xp.greater_equal(t433, -2.9670597283903604) & xp.less_equal(t433, 2.9670597283903604)
+    t501 = xp.less_equal(t434, 2.9670597283903604)
+    t502 = xp.greater_equal(t437, -2.0943951023931953) & xp.less_equal(t437, 2.0943951023931953)
+    t503 = xp.less_equal(t438, 2.0943951023931953)
+    t504 = xp.greater_equal(t440, -3.0543261909900767) & xp.less_equal(t440, 3.0543261909900767)
+    t505 = xp.less_equal(t441, 3.0543261909900767)
+    t506 = xp.greater_equal(t435, -2.9670597283903604) & xp.less_equal(t435, 2.9670597283903604)
+    t507 = xp.less_equal(t436, 2.9670597283903604)
+    t508 = xp.greater_equal(t444, -2.0943951023931953) & xp.less_equal(t444, 2.0943951023931953)
+    t509 = -t445
+    t510 = xp.less_equal(t509, 2.0943951023931953)
+    t511 = xp.greater_equal(t442, -3.0543261909900767) & xp.less_equal(t442, 3.0543261909900767)
+    t512 = xp.less_equal(t443, 3.0543261909900767)
+    t513 = xp.greater_equal(t277, -2.9670597283903604) & xp.less_equal(t277, 2.9670597283903604)
+    t514 = xp.less_equal(t278, 2.9670597283903604)
+    t515 = xp.where(xp.logical_not(t513) & t514, t278, t277)
+    t516 = xp.greater_equal(t123, -2.0943951023931953) & xp.less_equal(t123, 2.0943951023931953)
+    t517 = xp.less_equal(t124, 2.0943951023931953)
+    t518 = xp.where(xp.logical_not(t516) & t517, t124, t123)
+    t519 = xp.greater_equal(t32, -2.0943951023931953) & xp.less_equal(t32, 2.0943951023931953)
+    t520 = xp.less_equal(t33, 2.0943951023931953)
+    t521 = xp.where(xp.logical_not(t519) & t520, t33, t32)
+    t522 = xp.greater_equal(t446, -2.9670597283903604) & xp.less_equal(t446, 2.9670597283903604)
+    t523 = xp.less_equal(t447, 2.9670597283903604)
+    t524 = xp.greater_equal(t450, -2.0943951023931953) & xp.less_equal(t450, 2.0943951023931953)
+    t525 = xp.less_equal(t451, 2.0943951023931953)
+    t526 = xp.greater_equal(t453, -3.0543261909900767) & xp.less_equal(t453, 3.0543261909900767)
+    t527 = xp.less_equal(t454, 3.0543261909900767)
+    t528 = xp.greater_equal(t448, -2.9670597283903604) & xp.less_equal(t448, 2.9670597283903604)
+    t529 = xp.less_equal(t449, 2.9670597283903604)
+    t530 = xp.greater_equal(t457, -2.0943951023931953) & xp.less_equal(t457, 2.0943951023931953)
+    t531 = -t458
+    t532 = xp.less_equal(t531, 2.0943951023931953)
+    t533 = xp.greater_equal(t455, -3.0543261909900767) & xp.less_equal(t455, 3.0543261909900767)
+    t534 = xp.less_equal(t456, 3.0543261909900767)
+    t535 = xp.greater_equal(t291, -2.9670597283903604) & xp.less_equal(t291, 2.9670597283903604)
+    t536 = xp.less_equal(t292, 2.9670597283903604)
+    t537 = xp.where(xp.logical_not(t535) & t536, t292, t291)
+    t538 = xp.greater_equal(t100, -2.0943951023931953) & xp.less_equal(t100, 2.0943951023931953)
+    t539 = xp.less_equal(t101, 2.0943951023931953)
+    t540 = xp.where(xp.logical_not(t538) & t539, t101, t100)
+    t541 = xp.greater_equal(t459, -2.9670597283903604) & xp.less_equal(t459, 2.9670597283903604)
+    t542 = xp.less_equal(t460, 2.9670597283903604)
+    t543 = xp.greater_equal(t463, -2.0943951023931953) & xp.less_equal(t463, 2.0943951023931953)
+    t544 = xp.less_equal(t464, 2.0943951023931953)
+    t545 = xp.greater_equal(t466, -3.0543261909900767) & xp.less_equal(t466, 3.0543261909900767)
+    t546 = xp.less_equal(t467, 3.0543261909900767)
+    t547 = xp.greater_equal(t461, -2.9670597283903604) & xp.less_equal(t461, 2.9670597283903604)
+    t548 = xp.less_equal(t462, 2.9670597283903604)
+    t549 = xp.greater_equal(t470, -2.0943951023931953) & xp.less_equal(t470, 2.0943951023931953)
+    t550 = -t471
+    t551 = xp.less_equal(t550, 2.0943951023931953)
+    t552 = xp.greater_equal(t468, -3.0543261909900767) & xp.less_equal(t468, 3.0543261909900767)
+    t553 = xp.less_equal(t469, 3.0543261909900767)
+    t554 = xp.isfinite(t16)
+    t555 = xp.greater_equal(t20, -1e-12)
+    t556 = xp.greater_equal(t42, -t43)
+    t557 = xp.greater_equal(q3, -2.9670597283903604)
+    t558 = xp.less_equal(q3, 2.9670597283903604)
+    t559 = t472 | t473
+    t560 = t475 | t476
+    t561 = t478 | t479
+    t562 = t494 | t495
+    t563 = t497 | t498
+    t564 = t513 | t514
+    t565 = t516 | t517
+    t566 = t519 | t520
+    t567 = t535 | t536
+    t568 = t538 | t539
     q = _stack(xp, [
-        t486,  # 0, 0
-        t489,  # 0, 1
+        t474,  # 0, 0
+        t477,  # 0, 1
         q3,  # 0, 2
-        t492,  # 0, 3
-        xp.where(xp.logical_not(t493) & t494, t421, t420),  # 0, 4
-        xp.where(xp.logical_not(t495) & t496, t426, t425),  # 0, 5
-        xp.where(xp.logical_not(t497) & t498, t431, t430),  # 0, 6
-        t486,  # 1, 0
-        t489,  # 1, 1
+        t480,  # 0, 3
+        xp.where(xp.logical_not(t481) & t482, t420, t419),  # 0, 4
+        xp.where(xp.logical_not(t483) & t484, t424, t423),  # 0, 5
+        xp.where(xp.logical_not(t485) & t486, t428, t427),  # 0, 6
+        t474,  # 1, 0
+        t477,  # 1, 1
         q3,  # 1, 2
-        t492,  # 1, 3
-        xp.where(xp.logical_not(t499) & t500, t423, t422),  # 1, 4
-        xp.where(xp.logical_not(t501) & t503, t502, t434),  # 1, 5
-        xp.where(xp.logical_not(t504) & t505, t433, t432),  # 1, 6
-        t508,  # 2, 0
-        t511,  # 2, 1
+        t480,  # 1, 3
+        xp.where(xp.logical_not(t487) & t488, t422, t421),  # 1, 4
+        xp.where(xp.logical_not(t489) & t491, t490, t431),  # 1, 5
+        xp.where(xp.logical_not(t492) & t493, t430, t429),  # 1, 6
+        t496,  # 2, 0
+        t499,  # 2, 1
         q3,  # 2, 2
-        t492,  # 2, 3
-        xp.where(xp.logical_not(t512) & t513, t438, t437),  # 2, 4
-        xp.where(xp.logical_not(t514) & t515, t443, t442),  # 2, 5
-        xp.where(xp.logical_not(t516) & t517, t447, t446),  # 2, 6
-        t508,  # 3, 0
-        t511,  # 3, 1
+        t480,  # 2, 3
+        xp.where(xp.logical_not(t500) & t501, t434, t433),  # 2, 4
+        xp.where(xp.logical_not(t502) & t503, t438, t437),  # 2, 5
+        xp.where(xp.logical_not(t504) & t505, t441, t440),  # 2, 6
+        t496,  # 3, 0
+        t499,  # 3, 1
         q3,  # 3, 2
-        t492,  # 3, 3
-        xp.where(xp.logical_not(t518) & t519, t440, t439),  # 3, 4
-        xp.where(xp.logical_not(t520) & t522, t521, t450),  # 3, 5
-        xp.where(xp.logical_not(t523) & t524, t449, t448),  # 3, 6
-        t527,  # 4, 0
-        t530,  # 4, 1
+        t480,  # 3, 3
+        xp.where(xp.logical_not(t506) & t507, t436, t435),  # 3, 4
+        xp.where(xp.logical_not(t508) & t510, t509, t444),  # 3, 5
+        xp.where(xp.logical_not(t511) & t512, t443, t442),  # 3, 6
+        t515,  # 4, 0
+        t518,  # 4, 1
         q3,  # 4, 2
-        t533,  # 4, 3
-        xp.where(xp.logical_not(t534) & t535, t454, t453),  # 4, 4
-        xp.where(xp.logical_not(t536) & t537, t459, t458),  # 4, 5
-        xp.where(xp.logical_not(t538) & t539, t463, t462),  # 4, 6
-        t527,  # 5, 0
-        t530,  # 5, 1
+        t521,  # 4, 3
+        xp.where(xp.logical_not(t522) & t523, t447, t446),  # 4, 4
+        xp.where(xp.logical_not(t524) & t525, t451, t450),  # 4, 5
+        xp.where(xp.logical_not(t526) & t527, t454, t453),  # 4, 6
+        t515,  # 5, 0
+        t518,  # 5, 1
         q3,  # 5, 2
-        t533,  # 5, 3
-        xp.where(xp.logical_not(t540) & t541, t456, t455),  # 5, 4
-        xp.where(xp.logical_not(t542) & t544, t543, t466),  # 5, 5
-        xp.where(xp.logical_not(t545) & t546, t465, t464),  # 5, 6
-        t549,  # 6, 0
-        t552,  # 6, 1
+        t521,  # 5, 3
+        xp.where(xp.logical_not(t528) & t529, t449, t448),  # 5, 4
+        xp.where(xp.logical_not(t530) & t532, t531, t457),  # 5, 5
+        xp.where(xp.logical_not(t533) & t534, t456, t455),  # 5, 6
+        t537,  # 6, 0
+        t540,  # 6, 1
         q3,  # 6, 2
-        t533,  # 6, 3
-        xp.where(xp.logical_not(t553) & t554, t470, t469),  # 6, 4
-        xp.where(xp.logical_not(t555) & t556, t475, t474),  # 6, 5
-        xp.where(xp.logical_not(t557) & t558, t479, t478),  # 6, 6
-        t549,  # 7, 0
-        t552,  # 7, 1
+        t521,  # 6, 3
+        xp.where(xp.logical_not(t541) & t542, t460, t459),  # 6, 4
+        xp.where(xp.logical_not(t543) & t544, t464, t463),  # 6, 5
+        xp.where(xp.logical_not(t545) & t546, t467, t466),  # 6, 6
+        t537,  # 7, 0
+        t540,  # 7, 1
         q3,  # 7, 2
-        t533,  # 7, 3
-        xp.where(xp.logical_not(t559) & t560, t472, t471),  # 7, 4
-        xp.where(xp.logical_not(t561) & t563, t562, t482),  # 7, 5
-        xp.where(xp.logical_not(t564) & t565, t481, t480),  # 7, 6
+        t521,  # 7, 3
+        xp.where(xp.logical_not(t547) & t548, t462, t461),  # 7, 4
+        xp.where(xp.logical_not(t549) & t551, t550, t470),  # 7, 5
+        xp.where(xp.logical_not(t552) & t553, t469, t468),  # 7, 6
     ], (8, 7))
     valid = _stack(xp, [
-        t566 & t567 & t568 & xp.greater_equal(t160, -1e-12),  # 0
-        t566 & t567 & t568 & t161,  # 1
-        t566 & t567 & t44 & xp.greater_equal(t228, -1e-12),  # 2
-        t566 & t567 & t44 & t229,  # 3
-        t566 & t21 & t568 & xp.greater_equal(t319, -1e-12),  # 4
-        t566 & t21 & t568 & t320,  # 5
-        t566 & t21 & t44 & xp.greater_equal(t382, -1e-12),  # 6
-        t566 & t21 & t44 & t383,  # 7
+        t554 & t555 & t556 & xp.greater_equal(t160, -1e-12),  # 0
+        t554 & t555 & t556 & t161,  # 1
+        t554 & t555 & t44 & xp.greater_equal(t228, -1e-12),  # 2
+        t554 & t555 & t44 & t229,  # 3
+        t554 & t21 & t556 & xp.greater_equal(t319, -1e-12),  # 4
+        t554 & t21 & t556 & t320,  # 5
+        t554 & t21 & t44 & xp.greater_equal(t382, -1e-12),  # 6
+        t554 & t21 & t44 & t383,  # 7
     ], (8,))
     in_limits = _stack(xp, [
-        t569 & t570 & t571 & t572 & t573 & (t493 | t494) & (t495 | t496) & (t497 | t498),  # 0
-        t569 & t570 & t571 & t572 & t573 & (t499 | t500) & (t501 | t503) & (t504 | t505),  # 1
-        t569 & t570 & t574 & t575 & t573 & (t512 | t513) & (t514 | t515) & (t516 | t517),  # 2
-        t569 & t570 & t574 & t575 & t573 & (t518 | t519) & (t520 | t522) & (t523 | t524),  # 3
-        t569 & t570 & t576 & t577 & t578 & (t534 | t535) & (t536 | t537) & (t538 | t539),  # 4
-        t569 & t570 & t576 & t577 & t578 & (t540 | t541) & (t542 | t544) & (t545 | t546),  # 5
-        t569 & t570 & t579 & t580 & t578 & (t553 | t554) & (t555 | t556) & (t557 | t558),  # 6
-        t569 & t570 & t579 & t580 & t578 & (t559 | t560) & (t561 | t563) & (t564 | t565),  # 7
+        t557 & t558 & t559 & t560 & t561 & (t481 | t482) & (t483 | t484) & (t485 | t486),  # 0
+        t557 & t558 & t559 & t560 & t561 & (t487 | t488) & (t489 | t491) & (t492 | t493),  # 1
+        t557 & t558 & t562 & t563 & t561 & (t500 | t501) & (t502 | t503) & (t504 | t505),  # 2
+        t557 & t558 & t562 & t563 & t561 & (t506 | t507) & (t508 | t510) & (t511 | t512),  # 3
+        t557 & t558 & t564 & t565 & t566 & (t522 | t523) & (t524 | t525) & (t526 | t527),  # 4
+        t557 & t558 & t564 & t565 & t566 & (t528 | t529) & (t530 | t532) & (t533 | t534),  # 5
+        t557 & t558 & t567 & t568 & t566 & (t541 | t542) & (t543 | t544) & (t545 | t546),  # 6
+        t557 & t558 & t567 & t568 & t566 & (t547 | t548) & (t549 | t551) & (t552 | t553),  # 7
     ], (8,))
     return q, valid, in_limits
 

@@ -715,51 +715,43 @@ def fk_jacobian_dot(q, q_dot):
     t41 = 0.18*c1 + t39
     t42 = 0.18*s1 + t40
     t43 = c23*t29 + t31*t14
-    t44 = t43
-    t45 = t4*t30 + t22*t28
-    t46 = t45
-    t47 = c23*t27 + t31*t9
-    t48 = t47
-    t49 = t7*t30 - t22*t26
-    t50 = t49
-    t51 = c1*t39 + s1*t40
-    t52 = t51
-    t53 = c1*t36 + s1*t37
-    t54 = t53
-    t55 = t27*t14 - t29*t9
-    t56 = t55
-    t57 = t4*t26 + t7*t28
-    t58 = t57
-    t59 = t58*qd5 + t56*qd4
-    t60 = t59 - t54*qd3
-    t61 = t60 - t52*qd2
-    t62 = s1*qd2
-    t63 = s1*qd3
-    t64 = t62 + t63
-    t65 = -t64 + t9*qd4
-    t66 = c1*qd2
-    t67 = c1*qd3
-    t68 = t66 + t67
-    t69 = t68 + t14*qd4
-    t70 = t7*qd5
-    t71 = -t70 + t65
-    t72 = t4*qd5
-    t73 = t72 + t69
-    t74 = t46*qd5
-    t75 = t74 + t44*qd4
-    t76 = t32*t67 + t75
-    t77 = t33*t66 + t76
-    t78 = t77 - t42*qd1
-    t79 = t50*qd5
-    t80 = t79 - t48*qd4
-    t81 = t80 + t32*t63
-    t82 = t81 + t33*t62
-    t83 = t82 + t41*qd1
-    t84 = c1*t33
-    t85 = c1*t32
-    t86 = s1*t33
-    t87 = s1*t32
-    t88 = -s1
+    t44 = t4*t30 + t22*t28
+    t45 = c23*t27 + t31*t9
+    t46 = t7*t30 - t22*t26
+    t47 = c1*t39 + s1*t40
+    t48 = c1*t36 + s1*t37
+    t49 = t27*t14 - t29*t9
+    t50 = t4*t26 + t7*t28
+    t51 = t50*qd5 + t49*qd4
+    t52 = t51 - t48*qd3
+    t53 = t52 - t47*qd2
+    t54 = s1*qd2
+    t55 = s1*qd3
+    t56 = t54 + t55
+    t57 = -t56 + t9*qd4
+    t58 = c1*qd2
+    t59 = c1*qd3
+    t60 = t58 + t59
+    t61 = t60 + t14*qd4
+    t62 = t7*qd5
+    t63 = -t62 + t57
+    t64 = t4*qd5
+    t65 = t64 + t61
+    t66 = t44*qd5
+    t67 = t66 + t43*qd4
+    t68 = t32*t59 + t67
+    t69 = t33*t58 + t68
+    t70 = t69 - t42*qd1
+    t71 = t46*qd5
+    t72 = t71 - t45*qd4
+    t73 = t72 + t32*t55
+    t74 = t73 + t33*t54
+    t75 = t74 + t41*qd1
+    t76 = c1*t33
+    t77 = c1*t32
+    t78 = s1*t33
+    t79 = s1*t32
+    t80 = -s1
     T = _stack(xp, [
         xp.broadcast_to(t12, batch),  # 0, 0
         xp.broadcast_to(t13, batch),  # 0, 1
@@ -780,26 +772,26 @@ def fk_jacobian_dot(q, q_dot):
     ], (4, 4))
     J = _stack(xp, [
         xp.broadcast_to(-t42, batch),  # 0, 0
-        xp.broadcast_to(t84, batch),  # 0, 1
-        xp.broadcast_to(t85, batch),  # 0, 2
+        xp.broadcast_to(t76, batch),  # 0, 1
+        xp.broadcast_to(t77, batch),  # 0, 2
         xp.broadcast_to(t43, batch),  # 0, 3
-        xp.broadcast_to(t45, batch),  # 0, 4
+        xp.broadcast_to(t44, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t41, batch),  # 1, 0
-        xp.broadcast_to(t86, batch),  # 1, 1
-        xp.broadcast_to(t87, batch),  # 1, 2
-        xp.broadcast_to(-t47, batch),  # 1, 3
-        xp.broadcast_to(t49, batch),  # 1, 4
+        xp.broadcast_to(t78, batch),  # 1, 1
+        xp.broadcast_to(t79, batch),  # 1, 2
+        xp.broadcast_to(-t45, batch),  # 1, 3
+        xp.broadcast_to(t46, batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t51, batch),  # 2, 1
-        xp.broadcast_to(-t53, batch),  # 2, 2
-        xp.broadcast_to(t55, batch),  # 2, 3
-        xp.broadcast_to(t57, batch),  # 2, 4
+        xp.broadcast_to(-t47, batch),  # 2, 1
+        xp.broadcast_to(-t48, batch),  # 2, 2
+        xp.broadcast_to(t49, batch),  # 2, 3
+        xp.broadcast_to(t50, batch),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
-        xp.broadcast_to(t88, batch),  # 3, 1
-        xp.broadcast_to(t88, batch),  # 3, 2
+        xp.broadcast_to(t80, batch),  # 3, 1
+        xp.broadcast_to(t80, batch),  # 3, 2
         xp.broadcast_to(t9, batch),  # 3, 3
         xp.broadcast_to(-t7, batch),  # 3, 4
         xp.broadcast_to(t11, batch),  # 3, 5
@@ -817,12 +809,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(-t21, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t83 + qd2*(c1*t61 - qd1*t86) - qd3*(-c1*t60 + t66*t54 + qd1*t87) + qd4*(t56*t68 + t48*qd1 - c23*t80 + t14*t59) + qd5*(t58*t69 - t50*t0 + t72*t58 - t22*t79), batch),  # 0
-        xp.broadcast_to(qd1*t78 + qd2*(s1*t61 + t84*qd1) + qd3*(s1*t60 + qd1*t85 - t62*t54) + qd4*(t44*qd1 + t56*t64 + c23*t75 - t9*t59) + qd5*(t46*t0 - t58*t65 + t22*t74 + t70*t58), batch),  # 1
-        xp.broadcast_to(-qd2*(s1*t82 + c1*t77) + qd4*(t48*t64 - t44*t68 + t9*t80 - t14*t75) - qd5*(t46*t69 - t50*t65 + t70*t50 + t72*t46) - qd3*(c1*t76 + s1*t81 + t62*t87 + t66*t85), batch),  # 2
-        xp.broadcast_to(-t66*qd1 - t67*qd1 + qd4*(c23*t68 - t14*qd1) + qd5*(-t4*t0 + t22*t69) - qd6*(t21*t73 + t16*t25), batch),  # 3
-        xp.broadcast_to(qd6*(t11*t25 + t21*t71) - t62*qd1 - t63*qd1 + qd4*(c23*t64 + t9*qd1) - qd5*(t7*t0 + t22*t65), batch),  # 4
-        xp.broadcast_to(qd5*(t4*t65 + t7*t69) + qd6*(t16*t71 - t11*t73) - qd4*(t14*t64 + t9*t68), batch),  # 5
+        xp.broadcast_to(-qd1*t75 + qd2*(c1*t53 - qd1*t78) - qd3*(-c1*t52 + qd1*t79 + t48*t58) + qd4*(-c23*t72 + t14*t51 + t49*t60 + t45*qd1) + qd5*(-t22*t71 + t50*t61 - t46*t0 + t50*t64), batch),  # 0
+        xp.broadcast_to(qd1*t70 + qd2*(s1*t53 + t76*qd1) + qd3*(s1*t52 + qd1*t77 - t48*t54) + qd4*(c23*t67 - t9*t51 + t43*qd1 + t49*t56) + qd5*(t22*t66 + t44*t0 - t50*t57 + t50*t62), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t74 + c1*t69) - qd3*(c1*t68 + s1*t73 + t54*t79 + t58*t77) + qd4*(t9*t72 - t14*t67 + t45*t56 - t43*t60) - qd5*(t44*t61 - t46*t57 + t46*t62 + t44*t64), batch),  # 2
+        xp.broadcast_to(-t58*qd1 - t59*qd1 + qd4*(c23*t60 - t14*qd1) + qd5*(-t4*t0 + t22*t61) - qd6*(t21*t65 + t16*t25), batch),  # 3
+        xp.broadcast_to(qd6*(t11*t25 + t21*t63) - t54*qd1 - t55*qd1 + qd4*(c23*t56 + t9*qd1) - qd5*(t7*t0 + t22*t57), batch),  # 4
+        xp.broadcast_to(qd5*(t4*t57 + t7*t61) + qd6*(t16*t63 - t11*t65) - qd4*(t14*t56 + t9*t60), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -1735,325 +1727,320 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t70 = t67 + t68 - t7*t18 + t9*t17
     t71 = t34**2
     t72 = t71 + t28**2 + t17**2 + t18**2
-    t73 = t72
-    t74 = s23**2
-    t75 = t7**2 + t10**2 + 2*t63 + t43*t74
-    t76 = t75
-    t77 = 2*c1
-    t78 = -t7*t4 + t10*t12 - s1*t77 + t49*t74
-    t79 = t4**2 + t12**2 + 2*t43 + t63*t74
-    t80 = t79
-    t81 = c23**2 + t0**2 + s4**2*t74
-    t82 = 1 + t81
-    t83 = t50**2
-    t84 = t53**2
-    t85 = t58**2
-    t86 = t44**2
-    t87 = t61**2
-    t88 = damping**2
-    t89 = t88 + t48
-    t90 = t89**2
-    t91 = xp.sqrt(t83 + t84 + t85 + t86 + t87 + t90)
-    t92 = t91*xp.where(xp.greater_equal(t89, 0), xp.asarray(1, dtype=dtype), -1)
-    t93 = t89 + t92
-    t94 = xp.where(xp.greater(t91, 0), 1/(t91*(t91 + xp.abs(t89))), 0)
-    t95 = t94*(mu_dot0*t93 + mu_dot1*t50 + mu_dot2*t53 - mu_dot3*t58 + mu_dot4*t44 + mu_dot5*t61)
-    t96 = mu_dot0 - t93*t95
-    t97 = mu_dot1 - t50*t95
-    t98 = mu_dot2 - t53*t95
-    t99 = mu_dot3 + t58*t95
-    t100 = mu_dot4 - t44*t95
-    t101 = mu_dot5 - t61*t95
-    t102 = t88 + t66
-    t103 = t94*(t50*t93 - t53*t69 + t58*t64 + t44*t59 + t61*t38 + t102*t50)
-    t104 = t50 - t93*t103
-    t105 = t102 - t50*t103
-    t106 = t69 + t53*t103
-    t107 = -t64 + t58*t103
-    t108 = t59 - t44*t103
-    t109 = t38 - t61*t103
-    t110 = xp.sqrt(t105**2 + t106**2 + t107**2 + t108**2 + t109**2)
-    t111 = t110*xp.where(xp.greater_equal(t105, 0), xp.asarray(1, dtype=dtype), -1)
-    t112 = t105 + t111
-    t113 = xp.where(xp.greater(t110, 0), 1/(t110*(t110 + xp.abs(t105))), 0)
-    t114 = t113*(t97*t112 - t106*t98 + t107*t99 + t108*t100 + t109*t101)
-    t115 = t97 - t112*t114
-    t116 = t98 + t106*t114
-    t117 = t99 - t107*t114
-    t118 = t100 - t108*t114
-    t119 = t101 - t109*t114
-    t120 = t88 + t73
-    t121 = t94*(t53*t93 - t50*t69 - t58*t70 + t44*t54 + t61*t39 + t120*t53)
-    t122 = t53 - t93*t121
-    t123 = t69 + t50*t121
-    t124 = t120 - t53*t121
-    t125 = t70 + t58*t121
-    t126 = t54 - t44*t121
-    t127 = t39 - t61*t121
-    t128 = t113*(-t123*t112 - t106*t124 + t107*t125 + t108*t126 + t109*t127)
-    t129 = t123 + t112*t128
-    t130 = t124 + t106*t128
-    t131 = t125 - t107*t128
-    t132 = t126 - t108*t128
-    t133 = t127 - t109*t128
-    t134 = xp.sqrt(t130**2 + t131**2 + t132**2 + t133**2)
-    t135 = t134*xp.where(xp.greater_equal(t130, 0), xp.asarray(1, dtype=dtype), -1)
-    t136 = t130 + t135
-    t137 = xp.where(xp.greater(t134, 0), 1/(t134*(t134 + xp.abs(t130))), 0)
-    t138 = t137*(t116*t136 + t131*t117 + t132*t118 + t133*t119)
-    t139 = t116 - t136*t138
-    t140 = t117 - t131*t138
-    t141 = t118 - t132*t138
-    t142 = t119 - t133*t138
-    t143 = t88 + t76
-    t144 = -t94*(t58*t93 + t50*t64 + t61*t40 + t143*t58 - t53*t70 - t44*t78)
-    t145 = t58 + t93*t144
-    t146 = t64 + t50*t144
-    t147 = t70 - t53*t144
-    t148 = t143 + t58*t144
-    t149 = t78 - t44*t144
-    t150 = t40 + t61*t144
-    t151 = -t113*(t146*t112 + t106*t147 - t107*t148 - t108*t149 + t109*t150)
-    t152 = t146 + t112*t151
-    t153 = t147 + t106*t151
-    t154 = t148 - t107*t151
-    t155 = t149 - t108*t151
-    t156 = t150 + t109*t151
-    t157 = t137*(t153*t136 + t131*t154 + t132*t155 - t133*t156)
-    t158 = t153 - t136*t157
-    t159 = t154 - t131*t157
-    t160 = t155 - t132*t157
-    t161 = t156 + t133*t157
-    t162 = xp.sqrt(t159**2 + t160**2 + t161**2)
-    t163 = t162*xp.where(xp.greater_equal(t159, 0), xp.asarray(1, dtype=dtype), -1)
-    t164 = t159 + t163
-    t165 = xp.where(xp.greater(t162, 0), 1/(t162*(t162 + xp.abs(t159))), 0)
-    t166 = t165*(t140*t164 + t160*t141 - t161*t142)
-    t167 = t140 - t164*t166
-    t168 = t141 - t160*t166
-    t169 = t142 + t161*t166
-    t170 = t88 + t80
-    t171 = t94*(t44*t93 + t50*t59 + t53*t54 - t58*t78 + t61*t41 + t170*t44)
-    t172 = t44 - t93*t171
-    t173 = t59 - t50*t171
-    t174 = t54 - t53*t171
-    t175 = t78 + t58*t171
-    t176 = t170 - t44*t171
-    t177 = t41 - t61*t171
-    t178 = t113*(t173*t112 - t106*t174 + t107*t175 + t108*t176 + t109*t177)
-    t179 = t173 - t112*t178
-    t180 = t174 + t106*t178
-    t181 = t175 - t107*t178
-    t182 = t176 - t108*t178
-    t183 = t177 - t109*t178
-    t184 = t137*(t180*t136 + t131*t181 + t132*t182 + t133*t183)
-    t185 = t180 - t136*t184
-    t186 = t181 - t131*t184
-    t187 = t182 - t132*t184
-    t188 = t183 - t133*t184
-    t189 = t165*(t186*t164 + t160*t187 - t161*t188)
-    t190 = t186 - t164*t189
-    t191 = t187 - t160*t189
-    t192 = t188 + t161*t189
-    t193 = xp.sqrt(t191**2 + t192**2)
-    t194 = t193*xp.where(xp.greater_equal(t191, 0), xp.asarray(1, dtype=dtype), -1)
-    t195 = t191 + t194
-    t196 = xp.where(xp.greater(t193, 0), 1/(t193*(t193 + xp.abs(t191))), 0)
-    t197 = t196*(t168*t195 + t192*t169)
-    t198 = t168 - t195*t197
-    t199 = t169 - t192*t197
-    t200 = t88 + t82
-    t201 = xp.sqrt(2*t83 + 2*t84 + 2*t69**2 + 2*t85 + 2*t64**2 + 2*t70**2 + 2*t86 + 2*t59**2 + 2*t54**2 + 2*t78**2 + 2*t87 + 2*t38**2 + 2*t39**2 + 2*t40**2 + 2*t41**2 + t90 + t102**2 + t120**2 + t143**2 + t170**2 + t200**2)
-    t202 = t94*(t61*t93 + t50*t38 + t53*t39 + t58*t40 + t44*t41 + t200*t61)
-    t203 = t61 - t93*t202
-    t204 = t38 - t50*t202
-    t205 = t39 - t53*t202
-    t206 = -t40 + t58*t202
-    t207 = t41 - t44*t202
-    t208 = t200 - t61*t202
-    t209 = t113*(t204*t112 - t106*t205 + t107*t206 + t108*t207 + t109*t208)
-    t210 = t204 - t112*t209
-    t211 = t205 + t106*t209
-    t212 = t206 - t107*t209
-    t213 = t207 - t108*t209
-    t214 = t208 - t109*t209
-    t215 = t137*(t211*t136 + t131*t212 + t132*t213 + t133*t214)
-    t216 = t211 - t136*t215
-    t217 = t212 - t131*t215
-    t218 = t213 - t132*t215
-    t219 = t214 - t133*t215
-    t220 = t165*(t217*t164 + t160*t218 - t161*t219)
-    t221 = t217 - t164*t220
-    t222 = t218 - t160*t220
-    t223 = t219 + t161*t220
-    t224 = t196*(t222*t195 + t192*t223)
-    t225 = t222 - t195*t224
-    t226 = t223 - t192*t224
-    t227 = xp.abs(t226)
-    t228 = t227
-    t229 = t228*xp.where(xp.greater_equal(t226, 0), xp.asarray(1, dtype=dtype), -1)
-    t230 = t226 + t229
-    t231 = xp.where(xp.greater(t228, 0), 1/(t228*(t227 + t228)), 0)
-    t232 = t199 - t199*t230**2*t231
-    t233 = xp.where(xp.not_equal(t229, 0), -t232/t229, 0)
-    t234 = xp.where(xp.not_equal(t194, 0), -(t198 - t225*t233)/t194, 0)
-    t235 = xp.where(xp.not_equal(t163, 0), -(-(t190*t234 + t221*t233) + t167)/t163, 0)
-    t236 = xp.where(xp.not_equal(t135, 0), -(-(t158*t235 + t185*t234 + t216*t233) + t139)/t135, 0)
-    t237 = xp.where(xp.not_equal(t111, 0), -(-(-t129*t236 - t152*t235 + t179*t234 + t210*t233) + t115)/t111, 0)
-    t238 = xp.where(xp.not_equal(t92, 0), -(-(t104*t237 + t122*t236 - t145*t235 + t172*t234 + t203*t233) + t96)/t92, 0)
-    t239 = t233 - t33*t238 + t32*t237
-    t240 = t23*t238 - t24*t237 + t17*t236 + c23*t233 + t9*t235 + t11*t234
-    t241 = t36*t238 + t37*t237 + t18*t236 - t7*t235 + t4*t234 + t35*t233
-    t242 = t10*t235 + t12*t234 - t0*t233
-    t243 = s1*t22
-    t244 = -s1*t235 + c1*t234
-    t245 = t244 - t34*t236 + t55*t238 + t243*t237
-    t246 = s1*t21
-    t247 = t244 - t28*t236 + t56*t238 + t246*t237
-    t248 = 1 + t42 + t62
-    t249 = xp.sqrt(t47 + t65 + t72 + t75 + t79 + t81 + t248)
-    t250 = xp.sqrt(t248)
-    t251 = t250*xp.where(xp.less_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)
-    t252 = t60 + t251
-    t253 = xp.where(xp.greater(t250, 0), 1/(t250*(t250 + xp.abs(t33))), 0)
-    t254 = t253*(t55*t252 + t32*t243)
-    t255 = t55 - t252*t254
-    t256 = t243 - t32*t254
-    t257 = t253*(t56*t252 + t32*t246)
-    t258 = t56 - t252*t257
-    t259 = t246 - t32*t257
-    t260 = t253*(c23 + t23*t252 - t32*t24)
-    t261 = t23 - t252*t260
-    t262 = t24 + t32*t260
-    t263 = -t260 + c23
-    t264 = t253*(t35 + t36*t252 + t32*t37)
-    t265 = t36 - t252*t264
-    t266 = t37 - t32*t264
-    t267 = -t264 + t35
-    t268 = t253*(mu_dot5 + mu_dot0*t252 + t32*mu_dot1)
-    t269 = mu_dot0 - t252*t268
-    t270 = mu_dot1 - t32*t268
-    t271 = -t268 + mu_dot5
-    t272 = -t0
-    t273 = t0*t253
-    t274 = t272 + t273
-    t275 = t43 + t63
-    t276 = xp.sqrt(t71 + t275 + t254**2 + t256**2)
-    t277 = t276*xp.where(xp.greater_equal(t256, 0), xp.asarray(1, dtype=dtype), -1)
-    t278 = t256 + t277
-    t279 = xp.where(xp.greater(t276, 0), 1/(t276*(t276 + xp.abs(t256))), 0)
-    t280 = t279*(t275 + t259*t278 + t34*t28 + t254*t257)
-    t281 = t259 - t278*t280
-    t282 = -s1 + s1*t280
-    t283 = c1 - c1*t280
-    t284 = -t257 + t254*t280
-    t285 = -t279*(t262*t278 + t34*t17 + t254*t263)
-    t286 = t262 + t278*t285
-    t287 = t17 + t34*t285
-    t288 = t9 + s1*t285
-    t289 = t11 - c1*t285
-    t290 = t263 + t254*t285
-    t291 = t279*(t266*t278 - t34*t18 + s1*t7 + c1*t4 - t254*t267)
-    t292 = t266 - t278*t291
-    t293 = t18 + t34*t291
-    t294 = t4 - c1*t291
-    t295 = t267 + t254*t291
-    t296 = -t279*(-t270*t278 + t34*mu_dot2 + s1*mu_dot3 - c1*mu_dot4 + t254*t271)
-    t297 = t270 - t278*t296
-    t298 = mu_dot2 + t34*t296
-    t299 = mu_dot3 + s1*t296
-    t300 = mu_dot4 - c1*t296
-    t301 = t271 + t254*t296
-    t302 = -t28
-    t303 = t302 + t34*t280
-    t304 = xp.sqrt(t303**2 + t282**2 + t283**2 + t284**2)
-    t305 = t304*xp.where(xp.greater_equal(t303, 0), xp.asarray(1, dtype=dtype), -1)
-    t306 = t303 + t305
-    t307 = xp.where(xp.greater(t304, 0), 1/(t304*(t304 + xp.abs(t303))), 0)
-    t308 = t307*(t287*t306 + t282*t288 + t283*t289 + t284*t290)
-    t309 = t287 - t306*t308
-    t310 = t288 - t282*t308
-    t311 = t289 - t283*t308
-    t312 = t290 - t284*t308
-    t313 = t307*(t298*t306 + t282*t299 + t283*t300 + t284*t301)
-    t314 = t298 - t306*t313
-    t315 = t299 - t282*t313
-    t316 = t300 - t283*t313
-    t317 = t301 - t284*t313
-    t318 = xp.sqrt(t310**2 + t311**2 + t312**2)
-    t319 = t318*xp.where(xp.greater_equal(t310, 0), xp.asarray(1, dtype=dtype), -1)
-    t320 = t310 + t319
-    t321 = xp.where(xp.greater(t318, 0), 1/(t318*(t318 + xp.abs(t310))), 0)
-    t322 = t321*(t315*t320 + t311*t316 + t312*t317)
-    t323 = t315 - t320*t322
-    t324 = t316 - t311*t322
-    t325 = t317 - t312*t322
-    t326 = -t7
-    t327 = t326 + s1*t291
-    t328 = t307*(t293*t306 + t282*t327 + t283*t294 + t284*t295)
-    t329 = t293 - t306*t328
-    t330 = t327 - t282*t328
-    t331 = t294 - t283*t328
-    t332 = t295 - t284*t328
-    t333 = t321*(t330*t320 + t311*t331 + t312*t332)
-    t334 = t330 - t320*t333
-    t335 = t331 - t311*t333
-    t336 = t332 - t312*t333
-    t337 = xp.sqrt(t335**2 + t336**2)
-    t338 = t337*xp.where(xp.greater_equal(t335, 0), xp.asarray(1, dtype=dtype), -1)
-    t339 = t335 + t338
-    t340 = xp.where(xp.greater(t337, 0), 1/(t337*(t337 + xp.abs(t335))), 0)
-    t341 = t340*(t324*t339 + t336*t325)
-    t342 = t324 - t339*t341
-    t343 = t325 - t336*t341
-    t344 = 1 - t24 - t34 + q1 + q2 + q3 + c23 + q4 + t4 + q5 + t10 + t12 + q6 + t32 + t9 + t11 + t35 + t55 + t56 + t60 + t23 + t36 + t37 + t17 + t18 - 2*s1 + t77 + t243 + t246 + t272 + t302 + t326 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t345 = t32*t273
-    t346 = t279*(c1*t12 - s1*t10 - t254*t274 + t345*t278)
-    t347 = t345 - t278*t346
-    t348 = t10 + s1*t346
-    t349 = t12 - c1*t346
-    t350 = t274 + t254*t346
-    t351 = t34*t346
-    t352 = t307*(t282*t348 + t283*t349 + t284*t350 + t351*t306)
-    t353 = t351 - t306*t352
-    t354 = t348 - t282*t352
-    t355 = t349 - t283*t352
-    t356 = t350 - t284*t352
-    t357 = t321*(t354*t320 + t311*t355 + t312*t356)
-    t358 = t354 - t320*t357
-    t359 = t355 - t311*t357
-    t360 = t356 - t312*t357
-    t361 = t340*(t359*t339 + t336*t360)
-    t362 = t359 - t339*t361
-    t363 = t360 - t336*t361
-    t364 = xp.abs(t363)
-    t365 = t364
-    t366 = t365*xp.where(xp.greater_equal(t363, 0), xp.asarray(1, dtype=dtype), -1)
-    t367 = t363 + t366
-    t368 = xp.where(xp.greater(t365, 0), 1/(t365*(t364 + t365)), 0)
-    t369 = t343 - t343*t367**2*t368
-    t370 = xp.where(xp.not_equal(t366, 0), -t369/t366, 0)
-    t371 = xp.where(xp.not_equal(t338, 0), -(t342 - t362*t370)/t338, 0)
-    t372 = xp.where(xp.not_equal(t319, 0), -(-(t334*t371 + t358*t370) + t323)/t319, 0)
-    t373 = xp.where(xp.not_equal(t305, 0), -(-(t309*t372 + t329*t371 + t353*t370) + t314)/t305, 0)
-    t374 = xp.where(xp.not_equal(t277, 0), -(-(t281*t373 - t286*t372 + t292*t371 + t347*t370) + t297)/t277, 0)
-    t375 = xp.where(xp.not_equal(t251, 0), -(-(t255*t374 + t258*t373 + t261*t372 + t265*t371 + t273*t252*t370) + t269)/t251, 0)
-    t376 = xp.isfinite(t344)
-    t377 = xp.greater_equal(damping, 0)
-    t378 = xp.greater(damping, 0)
-    t379 = 1e-12*t201
-    t380 = 1e-12*t249
-    t381 = (t378 & (xp.less_equal(t91, t379) | xp.less_equal(t110, t379) | xp.less_equal(t134, t379) | xp.less_equal(t162, t379) | xp.less_equal(t193, t379) | xp.less_equal(t228, t379))) | (xp.less_equal(damping, 0) & (xp.less_equal(t250, t380) | xp.less_equal(t276, t380) | xp.less_equal(t304, t380) | xp.less_equal(t318, t380) | xp.less_equal(t337, t380) | xp.less_equal(t365, t380)))
-    t382 = t376 & t377 & xp.logical_not(t381)
+    t73 = s23**2
+    t74 = t7**2 + t10**2 + 2*t63 + t43*t73
+    t75 = 2*c1
+    t76 = -t7*t4 + t10*t12 - s1*t75 + t49*t73
+    t77 = t4**2 + t12**2 + 2*t43 + t63*t73
+    t78 = c23**2 + t0**2 + s4**2*t73
+    t79 = 1 + t78
+    t80 = t50**2
+    t81 = t53**2
+    t82 = t58**2
+    t83 = t44**2
+    t84 = t61**2
+    t85 = damping**2
+    t86 = t85 + t48
+    t87 = t86**2
+    t88 = xp.sqrt(t80 + t81 + t82 + t83 + t84 + t87)
+    t89 = t88*xp.where(xp.greater_equal(t86, 0), xp.asarray(1, dtype=dtype), -1)
+    t90 = t86 + t89
+    t91 = xp.where(xp.greater(t88, 0), 1/(t88*(t88 + xp.abs(t86))), 0)
+    t92 = t91*(mu_dot0*t90 + mu_dot1*t50 + mu_dot2*t53 - mu_dot3*t58 + mu_dot4*t44 + mu_dot5*t61)
+    t93 = mu_dot0 - t90*t92
+    t94 = mu_dot1 - t50*t92
+    t95 = mu_dot2 - t53*t92
+    t96 = mu_dot3 + t58*t92
+    t97 = mu_dot4 - t44*t92
+    t98 = mu_dot5 - t61*t92
+    t99 = t85 + t66
+    t100 = t91*(t50*t90 - t53*t69 + t58*t64 + t44*t59 + t61*t38 + t99*t50)
+    t101 = t50 - t90*t100
+    t102 = t99 - t50*t100
+    t103 = t69 + t53*t100
+    t104 = -t64 + t58*t100
+    t105 = t59 - t44*t100
+    t106 = t38 - t61*t100
+    t107 = xp.sqrt(t102**2 + t103**2 + t104**2 + t105**2 + t106**2)
+    t108 = t107*xp.where(xp.greater_equal(t102, 0), xp.asarray(1, dtype=dtype), -1)
+    t109 = t102 + t108
+    t110 = xp.where(xp.greater(t107, 0), 1/(t107*(t107 + xp.abs(t102))), 0)
+    t111 = t110*(t94*t109 - t103*t95 + t104*t96 + t105*t97 + t106*t98)
+    t112 = t94 - t109*t111
+    t113 = t95 + t103*t111
+    t114 = t96 - t104*t111
+    t115 = t97 - t105*t111
+    t116 = t98 - t106*t111
+    t117 = t72 + t85
+    t118 = t91*(t53*t90 - t50*t69 - t58*t70 + t44*t54 + t61*t39 + t117*t53)
+    t119 = t53 - t90*t118
+    t120 = t69 + t50*t118
+    t121 = t117 - t53*t118
+    t122 = t70 + t58*t118
+    t123 = t54 - t44*t118
+    t124 = t39 - t61*t118
+    t125 = t110*(-t120*t109 - t103*t121 + t104*t122 + t105*t123 + t106*t124)
+    t126 = t120 + t109*t125
+    t127 = t121 + t103*t125
+    t128 = t122 - t104*t125
+    t129 = t123 - t105*t125
+    t130 = t124 - t106*t125
+    t131 = xp.sqrt(t127**2 + t128**2 + t129**2 + t130**2)
+    t132 = t131*xp.where(xp.greater_equal(t127, 0), xp.asarray(1, dtype=dtype), -1)
+    t133 = t127 + t132
+    t134 = xp.where(xp.greater(t131, 0), 1/(t131*(t131 + xp.abs(t127))), 0)
+    t135 = t134*(t113*t133 + t128*t114 + t129*t115 + t130*t116)
+    t136 = t113 - t133*t135
+    t137 = t114 - t128*t135
+    t138 = t115 - t129*t135
+    t139 = t116 - t130*t135
+    t140 = t74 + t85
+    t141 = -t91*(t58*t90 + t50*t64 + t61*t40 + t140*t58 - t53*t70 - t44*t76)
+    t142 = t58 + t90*t141
+    t143 = t64 + t50*t141
+    t144 = t70 - t53*t141
+    t145 = t140 + t58*t141
+    t146 = t76 - t44*t141
+    t147 = t40 + t61*t141
+    t148 = -t110*(t143*t109 + t103*t144 - t104*t145 - t105*t146 + t106*t147)
+    t149 = t143 + t109*t148
+    t150 = t144 + t103*t148
+    t151 = t145 - t104*t148
+    t152 = t146 - t105*t148
+    t153 = t147 + t106*t148
+    t154 = t134*(t150*t133 + t128*t151 + t129*t152 - t130*t153)
+    t155 = t150 - t133*t154
+    t156 = t151 - t128*t154
+    t157 = t152 - t129*t154
+    t158 = t153 + t130*t154
+    t159 = xp.sqrt(t156**2 + t157**2 + t158**2)
+    t160 = t159*xp.where(xp.greater_equal(t156, 0), xp.asarray(1, dtype=dtype), -1)
+    t161 = t156 + t160
+    t162 = xp.where(xp.greater(t159, 0), 1/(t159*(t159 + xp.abs(t156))), 0)
+    t163 = t162*(t137*t161 + t157*t138 - t158*t139)
+    t164 = t137 - t161*t163
+    t165 = t138 - t157*t163
+    t166 = t139 + t158*t163
+    t167 = t77 + t85
+    t168 = t91*(t44*t90 + t50*t59 + t53*t54 - t58*t76 + t61*t41 + t167*t44)
+    t169 = t44 - t90*t168
+    t170 = t59 - t50*t168
+    t171 = t54 - t53*t168
+    t172 = t76 + t58*t168
+    t173 = t167 - t44*t168
+    t174 = t41 - t61*t168
+    t175 = t110*(t170*t109 - t103*t171 + t104*t172 + t105*t173 + t106*t174)
+    t176 = t170 - t109*t175
+    t177 = t171 + t103*t175
+    t178 = t172 - t104*t175
+    t179 = t173 - t105*t175
+    t180 = t174 - t106*t175
+    t181 = t134*(t177*t133 + t128*t178 + t129*t179 + t130*t180)
+    t182 = t177 - t133*t181
+    t183 = t178 - t128*t181
+    t184 = t179 - t129*t181
+    t185 = t180 - t130*t181
+    t186 = t162*(t183*t161 + t157*t184 - t158*t185)
+    t187 = t183 - t161*t186
+    t188 = t184 - t157*t186
+    t189 = t185 + t158*t186
+    t190 = xp.sqrt(t188**2 + t189**2)
+    t191 = t190*xp.where(xp.greater_equal(t188, 0), xp.asarray(1, dtype=dtype), -1)
+    t192 = t188 + t191
+    t193 = xp.where(xp.greater(t190, 0), 1/(t190*(t190 + xp.abs(t188))), 0)
+    t194 = t193*(t165*t192 + t189*t166)
+    t195 = t165 - t192*t194
+    t196 = t166 - t189*t194
+    t197 = t85 + t79
+    t198 = xp.sqrt(2*t80 + 2*t81 + 2*t69**2 + 2*t82 + 2*t64**2 + 2*t70**2 + 2*t83 + 2*t59**2 + 2*t54**2 + 2*t76**2 + 2*t84 + 2*t38**2 + 2*t39**2 + 2*t40**2 + 2*t41**2 + t87 + t99**2 + t117**2 + t140**2 + t167**2 + t197**2)
+    t199 = t91*(t61*t90 + t50*t38 + t53*t39 + t58*t40 + t44*t41 + t197*t61)
+    t200 = t61 - t90*t199
+    t201 = t38 - t50*t199
+    t202 = t39 - t53*t199
+    t203 = -t40 + t58*t199
+    t204 = t41 - t44*t199
+    t205 = t197 - t61*t199
+    t206 = t110*(t201*t109 - t103*t202 + t104*t203 + t105*t204 + t106*t205)
+    t207 = t201 - t109*t206
+    t208 = t202 + t103*t206
+    t209 = t203 - t104*t206
+    t210 = t204 - t105*t206
+    t211 = t205 - t106*t206
+    t212 = t134*(t208*t133 + t128*t209 + t129*t210 + t130*t211)
+    t213 = t208 - t133*t212
+    t214 = t209 - t128*t212
+    t215 = t210 - t129*t212
+    t216 = t211 - t130*t212
+    t217 = t162*(t214*t161 + t157*t215 - t158*t216)
+    t218 = t214 - t161*t217
+    t219 = t215 - t157*t217
+    t220 = t216 + t158*t217
+    t221 = t193*(t219*t192 + t189*t220)
+    t222 = t219 - t192*t221
+    t223 = t220 - t189*t221
+    t224 = xp.abs(t223)
+    t225 = t224*xp.where(xp.greater_equal(t223, 0), xp.asarray(1, dtype=dtype), -1)
+    t226 = t223 + t225
+    t227 = xp.where(xp.greater(t224, 0), 1/(t224*2*t224), 0)
+    t228 = t196 - t196*t226**2*t227
+    t229 = xp.where(xp.not_equal(t225, 0), -t228/t225, 0)
+    t230 = xp.where(xp.not_equal(t191, 0), -(t195 - t222*t229)/t191, 0)
+    t231 = xp.where(xp.not_equal(t160, 0), -(-(t187*t230 + t218*t229) + t164)/t160, 0)
+    t232 = xp.where(xp.not_equal(t132, 0), -(-(t155*t231 + t182*t230 + t213*t229) + t136)/t132, 0)
+    t233 = xp.where(xp.not_equal(t108, 0), -(-(-t126*t232 - t149*t231 + t176*t230 + t207*t229) + t112)/t108, 0)
+    t234 = xp.where(xp.not_equal(t89, 0), -(-(t101*t233 + t119*t232 - t142*t231 + t169*t230 + t200*t229) + t93)/t89, 0)
+    t235 = t229 - t33*t234 + t32*t233
+    t236 = t23*t234 - t24*t233 + t17*t232 + c23*t229 + t9*t231 + t11*t230
+    t237 = t36*t234 + t37*t233 + t18*t232 - t7*t231 + t4*t230 + t35*t229
+    t238 = t10*t231 + t12*t230 - t0*t229
+    t239 = s1*t22
+    t240 = -s1*t231 + c1*t230
+    t241 = t240 - t34*t232 + t55*t234 + t239*t233
+    t242 = s1*t21
+    t243 = t240 - t28*t232 + t56*t234 + t242*t233
+    t244 = 1 + t42 + t62
+    t245 = xp.sqrt(t47 + t65 + t72 + t74 + t77 + t78 + t244)
+    t246 = xp.sqrt(t244)
+    t247 = t246*xp.where(xp.less_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)
+    t248 = t60 + t247
+    t249 = xp.where(xp.greater(t246, 0), 1/(t246*(t246 + xp.abs(t33))), 0)
+    t250 = t249*(t55*t248 + t32*t239)
+    t251 = t55 - t248*t250
+    t252 = t239 - t32*t250
+    t253 = t249*(t56*t248 + t32*t242)
+    t254 = t56 - t248*t253
+    t255 = t242 - t32*t253
+    t256 = t249*(c23 + t23*t248 - t32*t24)
+    t257 = t23 - t248*t256
+    t258 = t24 + t32*t256
+    t259 = -t256 + c23
+    t260 = t249*(t35 + t36*t248 + t32*t37)
+    t261 = t36 - t248*t260
+    t262 = t37 - t32*t260
+    t263 = -t260 + t35
+    t264 = t249*(mu_dot5 + mu_dot0*t248 + t32*mu_dot1)
+    t265 = mu_dot0 - t248*t264
+    t266 = mu_dot1 - t32*t264
+    t267 = -t264 + mu_dot5
+    t268 = -t0
+    t269 = t0*t249
+    t270 = t268 + t269
+    t271 = t43 + t63
+    t272 = xp.sqrt(t71 + t271 + t250**2 + t252**2)
+    t273 = t272*xp.where(xp.greater_equal(t252, 0), xp.asarray(1, dtype=dtype), -1)
+    t274 = t252 + t273
+    t275 = xp.where(xp.greater(t272, 0), 1/(t272*(t272 + xp.abs(t252))), 0)
+    t276 = t275*(t271 + t255*t274 + t34*t28 + t250*t253)
+    t277 = t255 - t274*t276
+    t278 = -s1 + s1*t276
+    t279 = c1 - c1*t276
+    t280 = -t253 + t250*t276
+    t281 = -t275*(t258*t274 + t34*t17 + t250*t259)
+    t282 = t258 + t274*t281
+    t283 = t17 + t34*t281
+    t284 = t9 + s1*t281
+    t285 = t11 - c1*t281
+    t286 = t259 + t250*t281
+    t287 = t275*(t262*t274 - t34*t18 + s1*t7 + c1*t4 - t250*t263)
+    t288 = t262 - t274*t287
+    t289 = t18 + t34*t287
+    t290 = t4 - c1*t287
+    t291 = t263 + t250*t287
+    t292 = -t275*(-t266*t274 + t34*mu_dot2 + s1*mu_dot3 - c1*mu_dot4 + t250*t267)
+    t293 = t266 - t274*t292
+    t294 = mu_dot2 + t34*t292
+    t295 = mu_dot3 + s1*t292
+    t296 = mu_dot4 - c1*t292
+    t297 = t267 + t250*t292
+    t298 = -t28
+    t299 = t298 + t34*t276
+    t300 = xp.sqrt(t299**2 + t278**2 + t279**2 + t280**2)
+    t301 = t300*xp.where(xp.greater_equal(t299, 0), xp.asarray(1, dtype=dtype), -1)
+    t302 = t299 + t301
+    t303 = xp.where(xp.greater(t300, 0), 1/(t300*(t300 + xp.abs(t299))), 0)
+    t304 = t303*(t283*t302 + t278*t284 + t279*t285 + t280*t286)
+    t305 = t283 - t302*t304
+    t306 = t284 - t278*t304
+    t307 = t285 - t279*t304
+    t308 = t286 - t280*t304
+    t309 = t303*(t294*t302 + t278*t295 + t279*t296 + t280*t297)
+    t310 = t294 - t302*t309
+    t311 = t295 - t278*t309
+    t312 = t296 - t279*t309
+    t313 = t297 - t280*t309
+    t314 = xp.sqrt(t306**2 + t307**2 + t308**2)
+    t315 = t314*xp.where(xp.greater_equal(t306, 0), xp.asarray(1, dtype=dtype), -1)
+    t316 = t306 + t315
+    t317 = xp.where(xp.greater(t314, 0), 1/(t314*(t314 + xp.abs(t306))), 0)
+    t318 = t317*(t311*t316 + t307*t312 + t308*t313)
+    t319 = t311 - t316*t318
+    t320 = t312 - t307*t318
+    t321 = t313 - t308*t318
+    t322 = -t7
+    t323 = t322 + s1*t287
+    t324 = t303*(t289*t302 + t278*t323 + t279*t290 + t280*t291)
+    t325 = t289 - t302*t324
+    t326 = t323 - t278*t324
+    t327 = t290 - t279*t324
+    t328 = t291 - t280*t324
+    t329 = t317*(t326*t316 + t307*t327 + t308*t328)
+    t330 = t326 - t316*t329
+    t331 = t327 - t307*t329
+    t332 = t328 - t308*t329
+    t333 = xp.sqrt(t331**2 + t332**2)
+    t334 = t333*xp.where(xp.greater_equal(t331, 0), xp.asarray(1, dtype=dtype), -1)
+    t335 = t331 + t334
+    t336 = xp.where(xp.greater(t333, 0), 1/(t333*(t333 + xp.abs(t331))), 0)
+    t337 = t336*(t320*t335 + t332*t321)
+    t338 = t320 - t335*t337
+    t339 = t321 - t332*t337
+    t340 = 1 - t24 - t34 + q1 + q2 + q3 + c23 + q4 + t4 + q5 + t10 + t12 + q6 + t32 + t9 + t11 + t35 + t55 + t56 + t60 + t23 + t36 + t37 + t17 + t18 - 2*s1 + t75 + t239 + t242 + t268 + t298 + t322 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t341 = t32*t269
+    t342 = t275*(c1*t12 - s1*t10 - t250*t270 + t341*t274)
+    t343 = t341 - t274*t342
+    t344 = t10 + s1*t342
+    t345 = t12 - c1*t342
+    t346 = t270 + t250*t342
+    t347 = t34*t342
+    t348 = t303*(t278*t344 + t279*t345 + t280*t346 + t347*t302)
+    t349 = t347 - t302*t348
+    t350 = t344 - t278*t348
+    t351 = t345 - t279*t348
+    t352 = t346 - t280*t348
+    t353 = t317*(t350*t316 + t307*t351 + t308*t352)
+    t354 = t350 - t316*t353
+    t355 = t351 - t307*t353
+    t356 = t352 - t308*t353
+    t357 = t336*(t355*t335 + t332*t356)
+    t358 = t355 - t335*t357
+    t359 = t356 - t332*t357
+    t360 = xp.abs(t359)
+    t361 = t360*xp.where(xp.greater_equal(t359, 0), xp.asarray(1, dtype=dtype), -1)
+    t362 = t359 + t361
+    t363 = xp.where(xp.greater(t360, 0), 1/(t360*2*t360), 0)
+    t364 = t339 - t339*t362**2*t363
+    t365 = xp.where(xp.not_equal(t361, 0), -t364/t361, 0)
+    t366 = xp.where(xp.not_equal(t334, 0), -(t338 - t358*t365)/t334, 0)
+    t367 = xp.where(xp.not_equal(t315, 0), -(-(t330*t366 + t354*t365) + t319)/t315, 0)
+    t368 = xp.where(xp.not_equal(t301, 0), -(-(t305*t367 + t325*t366 + t349*t365) + t310)/t301, 0)
+    t369 = xp.where(xp.not_equal(t273, 0), -(-(t277*t368 - t282*t367 + t288*t366 + t343*t365) + t293)/t273, 0)
+    t370 = xp.where(xp.not_equal(t247, 0), -(-(t251*t369 + t254*t368 + t257*t367 + t261*t366 + t269*t248*t365) + t265)/t247, 0)
+    t371 = xp.isfinite(t340)
+    t372 = xp.greater_equal(damping, 0)
+    t373 = xp.greater(damping, 0)
+    t374 = 1e-12*t198
+    t375 = 1e-12*t245
+    t376 = (t373 & (xp.less_equal(t88, t374) | xp.less_equal(t107, t374) | xp.less_equal(t131, t374) | xp.less_equal(t159, t374) | xp.less_equal(t190, t374) | xp.less_equal(t224, t374))) | (xp.less_equal(damping, 0) & (xp.less_equal(t246, t375) | xp.less_equal(t272, t375) | xp.less_equal(t300, t375) | xp.less_equal(t314, t375) | xp.less_equal(t333, t375) | xp.less_equal(t360, t375)))
+    t377 = t371 & t372 & xp.logical_not(t376)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t382, xp.where(t378, t239, t375), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t382, xp.where(t378, t245, t374), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t382, xp.where(t378, t247, t373), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t382, xp.where(t378, t240, t372), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t382, xp.where(t378, t241, t371), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t382, xp.where(t378, t242, t370), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t377, xp.where(t373, t235, t370), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t377, xp.where(t373, t241, t369), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t377, xp.where(t373, t243, t368), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t377, xp.where(t373, t236, t367), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t377, xp.where(t373, t237, t366), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t377, xp.where(t373, t238, t365), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t376 & t377), 2, xp.where(t381, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t371 & t372), 2, xp.where(t376, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -2352,26 +2339,25 @@ def ik_numeric_step(target, q, damping=0.0):
     t250 = t247 - t221*t249
     t251 = t248 - t218*t249
     t252 = xp.abs(t251)
-    t253 = t252
-    t254 = t253*xp.where(xp.greater_equal(t251, 0), xp.asarray(1, dtype=dtype), -1)
-    t255 = t251 + t254
-    t256 = xp.where(xp.greater(t253, 0), 1/(t253*(t252 + t253)), 0)
-    t257 = t225 - t225*t255**2*t256
-    t258 = xp.where(xp.not_equal(t254, 0), -t257/t254, 0)
-    t259 = xp.where(xp.not_equal(t220, 0), -(t224 - t250*t258)/t220, 0)
-    t260 = xp.where(xp.not_equal(t189, 0), -(-(t216*t259 + t246*t258) + t193)/t189, 0)
-    t261 = xp.where(xp.not_equal(t161, 0), -(-(t184*t260 + t211*t259 + t241*t258) + t165)/t161, 0)
-    t262 = xp.where(xp.not_equal(t137, 0), -(-(-t155*t261 - t178*t260 + t205*t259 + t235*t258) + t141)/t137, 0)
-    t263 = xp.where(xp.not_equal(t118, 0), -(-(t130*t262 + t148*t261 - t171*t260 + t198*t259 + t228*t258) + t122)/t118, 0)
-    t264 = q1 + t258 - t65*t263 + t64*t262
-    t265 = q4 + t52*t263 - t54*t262 + t44*t261 + c23*t258 + t9*t260 + t17*t259
-    t266 = q5 + t53*t263 + t55*t262 + t45*t261 - t7*t260 + t4*t259 + t29*t258
-    t267 = q6 + t11*t260 + t19*t259 - t28*t258
-    t268 = c1*t263
-    t269 = s1*t262
-    t270 = -s1*t260 + c1*t259
-    t271 = q2 + t270 - t66*t261 + t50*t268 + t50*t269
-    t272 = q3 + t270 - t60*t261 + t49*t268 + t49*t269
+    t253 = t252*xp.where(xp.greater_equal(t251, 0), xp.asarray(1, dtype=dtype), -1)
+    t254 = t251 + t253
+    t255 = xp.where(xp.greater(t252, 0), 1/(t252*2*t252), 0)
+    t256 = t225 - t225*t254**2*t255
+    t257 = xp.where(xp.not_equal(t253, 0), -t256/t253, 0)
+    t258 = xp.where(xp.not_equal(t220, 0), -(t224 - t250*t257)/t220, 0)
+    t259 = xp.where(xp.not_equal(t189, 0), -(-(t216*t258 + t246*t257) + t193)/t189, 0)
+    t260 = xp.where(xp.not_equal(t161, 0), -(-(t184*t259 + t211*t258 + t241*t257) + t165)/t161, 0)
+    t261 = xp.where(xp.not_equal(t137, 0), -(-(-t155*t260 - t178*t259 + t205*t258 + t235*t257) + t141)/t137, 0)
+    t262 = xp.where(xp.not_equal(t118, 0), -(-(t130*t261 + t148*t260 - t171*t259 + t198*t258 + t228*t257) + t122)/t118, 0)
+    t263 = q1 + t257 - t65*t262 + t64*t261
+    t264 = q4 + t52*t262 - t54*t261 + t44*t260 + c23*t257 + t9*t259 + t17*t258
+    t265 = q5 + t53*t262 + t55*t261 + t45*t260 - t7*t259 + t4*t258 + t29*t257
+    t266 = q6 + t11*t259 + t19*t258 - t28*t257
+    t267 = c1*t262
+    t268 = s1*t261
+    t269 = -s1*t259 + c1*t258
+    t270 = q2 + t269 - t66*t260 + t50*t267 + t50*t268
+    t271 = q3 + t269 - t60*t260 + t49*t267 + t49*t268
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -2381,12 +2367,12 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q6, batch),  # 5
     ], (6,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t264, -2.705260340591211), -2.705260340591211, xp.where(xp.greater(t264, 2.705260340591211), 2.705260340591211, t264)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t271, -3.141592653589793), -3.141592653589793, xp.where(xp.greater(t271, 1.1344640137963142), 1.1344640137963142, t271)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t272, -0.2617993877991494), -0.2617993877991494, xp.where(xp.greater(t272, 2.7576202181510405), 2.7576202181510405, t272)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t265, -6.1086523819801535), -6.1086523819801535, xp.where(xp.greater(t265, 6.1086523819801535), 6.1086523819801535, t265)), batch),  # 3
-        xp.broadcast_to(xp.where(xp.less(t266, -2.2689280275926285), -2.2689280275926285, xp.where(xp.greater(t266, 2.2689280275926285), 2.2689280275926285, t266)), batch),  # 4
-        xp.broadcast_to(xp.where(xp.less(t267, -6.1086523819801535), -6.1086523819801535, xp.where(xp.greater(t267, 6.1086523819801535), 6.1086523819801535, t267)), batch),  # 5
+        xp.broadcast_to(xp.where(xp.less(t263, -2.705260340591211), -2.705260340591211, xp.where(xp.greater(t263, 2.705260340591211), 2.705260340591211, t263)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t270, -3.141592653589793), -3.141592653589793, xp.where(xp.greater(t270, 1.1344640137963142), 1.1344640137963142, t270)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t271, -0.2617993877991494), -0.2617993877991494, xp.where(xp.greater(t271, 2.7576202181510405), 2.7576202181510405, t271)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t264, -6.1086523819801535), -6.1086523819801535, xp.where(xp.greater(t264, 6.1086523819801535), 6.1086523819801535, t264)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t265, -2.2689280275926285), -2.2689280275926285, xp.where(xp.greater(t265, 2.2689280275926285), 2.2689280275926285, t265)), batch),  # 4
+        xp.broadcast_to(xp.where(xp.less(t266, -6.1086523819801535), -6.1086523819801535, xp.where(xp.greater(t266, 6.1086523819801535), 6.1086523819801535, t266)), batch),  # 5
     ], (6,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t0), t115, -1), batch)
     return q_start, q_next, cost
@@ -2428,563 +2414,546 @@ def ik_branches(T):
     t17 = t4**2
     t18 = t8**2
     t19 = t17 + t18
-    t20 = t19
-    t21 = t19 + t16**2
-    t22 = 1e-24*t21
-    t23 = xp.less_equal(t20, t22)
-    t24 = xp.where(t23, 1, 1/xp.sqrt(t20))
-    t25 = xp.where(t23, 0, 1.5707963267948966 + t9)
-    t26 = t17*t24 + t18*t24
-    t27 = 0.18 + t26
-    t28 = t25 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t25))
-    t29 = -6.283185307179586*xp.floor(0.15915494309189535*(2.705260340591211 + t28)) + t28
-    t30 = t4*t24
-    t31 = xp.where(t23, 1, t30)
-    t32 = t8*t24
-    t33 = xp.where(t23, 0, t32)
-    t34 = t4*t31 + t8*t33
-    t35 = t8*t31 - t4*t33
-    t36 = -0.18 + t34
-    t37 = T02*t31 + T12*t33
-    t38 = -T12*t31 + T02*t33
-    t39 = T00*t31 + T10*t33
-    t40 = T10*t31 - T00*t33
-    t41 = t30*T02 + t32*T12
-    t42 = t30*T12 - t32*T02
-    t43 = t30*T00 + t32*T10
-    t44 = -t30*T10 + t32*T00
-    t45 = 1 - t31
-    t46 = t45*t16
-    t47 = t46 + t16*t31
-    t48 = -0.4 + t47
-    t49 = t35**2 + t36**2 + t48**2
-    t50 = 0.5*(0.7588 - t49)
-    t51 = 1 - 6.965340465841971*t50**2
-    t52 = t45*T22
-    t53 = t52 + T22*t31
-    t54 = t45*T20
-    t55 = t54 + T20*t31
-    t56 = xp.greater(t51, 1e-12)
-    t57 = xp.where(t56, xp.sqrt(t51), 0)
-    t58 = 2.639193146748068*t50
-    t59 = xp.where(t56, t58, xp.where(xp.greater(t58, 0), xp.asarray(1, dtype=dtype), -1))
-    t60 = xp.atan2(t57, t59)
-    t61 = 1.761980786391911 + t60
-    t62 = 1.761980786391911 - t60
-    t63 = t61 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t61))
-    t64 = -6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t63)) + t63
-    t65 = t62 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t62))
-    t66 = -6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t65)) + t65
-    t67 = 0.1900219065658609*t59
-    t68 = 0.9817798505902814*t57
-    t69 = t67 + t68
-    t70 = -t67 + t68
-    t71 = 0.1900219065658609*t57
-    t72 = 0.9817798505902814*t59
-    t73 = -t71 + t72
-    t74 = t71 + t72
-    t75 = 0.12*t69 + 0.62*t73
-    t76 = -0.12*t73 + 0.62*t69
-    t77 = 0.78 - t75
-    t78 = 0.4 + t76
-    t79 = -0.18 + t77
-    t80 = -0.4 + t78
-    t81 = t36*t79 + t48*t80
-    t82 = t36*t80 - t48*t79
-    t83 = t81**2 + t82**2
-    t84 = t79**2 + t80**2
-    t85 = 0.12*t70 - 0.62*t74
-    t86 = 0.12*t74 + 0.62*t70
-    t87 = 0.78 + t85
-    t88 = 0.4 - t86
-    t89 = -0.18 + t87
-    t90 = -0.4 + t88
-    t91 = t36*t89 + t48*t90
-    t92 = t36*t90 - t48*t89
-    t93 = t91**2 + t92**2
-    t94 = t89**2 + t90**2
-    t95 = 1e-24*t49
-    t96 = xp.less_equal(t83, t95*t84)
-    t97 = xp.where(t96, 1, 1/xp.sqrt(t83))
-    t98 = xp.where(t96, 1, t81*t97)
-    t99 = xp.where(t96, 0, t82*t97)
-    t100 = t69*t98 + t73*t99
-    t101 = -t69*t99 + t73*t98
-    t102 = t100*t37 + t101*t53
-    t103 = t100*t53 - t101*t37
-    t104 = t100*t39 + t101*t55
-    t105 = -t100*t55 + t101*t39
-    t106 = xp.where(t96, 0, xp.atan2(t82, t81))
-    t107 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t106)) + t106
-    t108 = 1 + t100
-    t109 = t108*t38
-    t110 = t109 - t100*t38
-    t111 = t108*t40
-    t112 = t111 - t100*t40
-    t113 = t103**2
-    t114 = -t113
-    t115 = 1 + t114
-    t116 = xp.greater(t115, 1e-12)
-    t117 = xp.where(t116, xp.sqrt(t115), 0)
-    t118 = t113 - t102*t117
-    t119 = t114 + t118
-    t120 = t110**2
-    t121 = t113 + t120 + t102**2
-    t122 = t117**2
-    t123 = t119**2 + t120*t122
-    t124 = t113 + t122
-    t125 = 1e-24*t124
-    t126 = xp.less_equal(t123, t125*t121)
-    t127 = xp.where(t126, 1, 1/xp.sqrt(t123))
-    t128 = xp.where(t126, 1, t119*t127)
-    t129 = t105*(1 - t128)
-    t130 = t129 + t105*t128
-    t131 = t110*t117
-    t132 = xp.where(t126, 0, -t131*t127)
-    t133 = -t104*t128 + t112*t132
-    t134 = t112*t128 + t104*t132
-    t135 = xp.less_equal(t124, t125)
-    t136 = xp.where(t135, 1, 1/xp.sqrt(t124))
-    t137 = xp.where(t135, 1, t103*t136)
-    t138 = xp.where(t135, 0, -t117*t136)
-    t139 = t134*(1 - t137)
-    t140 = t137*t133 - t138*t130
-    t141 = t139 + t137*t134
-    t142 = t137*t130 + t138*t133
-    t143 = t140**2 + t141**2
-    t144 = t143
-    t145 = t143 + t142**2
-    t146 = xp.less_equal(t93, t95*t94)
-    t147 = xp.where(t146, 1, 1/xp.sqrt(t93))
-    t148 = xp.where(t146, 1, t91*t147)
-    t149 = xp.where(t146, 0, t92*t147)
-    t150 = t70*t148 - t74*t149
-    t151 = t70*t149 + t74*t148
-    t152 = -t37*t150 + t53*t151
-    t153 = t53*t150 + t37*t151
-    t154 = t39*t150 - t55*t151
-    t155 = t55*t150 + t39*t151
-    t156 = xp.where(t146, 0, xp.atan2(t92, t91))
-    t157 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t156)) + t156
-    t158 = 1 - t150
-    t159 = t158*t38
-    t160 = t159 + t38*t150
-    t161 = t158*t40
-    t162 = t161 + t40*t150
-    t163 = t153**2
-    t164 = -t163
-    t165 = 1 + t164
-    t166 = xp.greater(t165, 1e-12)
-    t167 = xp.where(t166, xp.sqrt(t165), 0)
-    t168 = t163 - t152*t167
-    t169 = t164 + t168
-    t170 = t160**2
-    t171 = t163 + t170 + t152**2
-    t172 = t167**2
-    t173 = t169**2 + t170*t172
-    t174 = t163 + t172
-    t175 = 1e-24*t174
-    t176 = xp.less_equal(t173, t175*t171)
-    t177 = xp.where(t176, 1, 1/xp.sqrt(t173))
-    t178 = xp.where(t176, 1, t169*t177)
-    t179 = t155*(1 - t178)
-    t180 = t179 + t155*t178
-    t181 = t160*t167
-    t182 = xp.where(t176, 0, -t181*t177)
-    t183 = t154*t178 + t162*t182
-    t184 = t162*t178 - t154*t182
-    t185 = xp.less_equal(t174, t175)
-    t186 = xp.where(t185, 1, 1/xp.sqrt(t174))
-    t187 = xp.where(t185, 1, -t153*t186)
-    t188 = xp.where(t185, 0, -t167*t186)
-    t189 = t184*(1 - t187)
-    t190 = t187*t183 - t188*t180
-    t191 = t189 + t187*t184
-    t192 = t187*t180 + t188*t183
-    t193 = t190**2 + t191**2
-    t194 = t193
-    t195 = t193 + t192**2
-    t196 = 1 + t30
-    t197 = t196*t16
-    t198 = t197 - t30*t16
-    t199 = -0.4 + t198
-    t200 = t27**2 + t199**2
-    t201 = 0.5*(0.7588 - t200)
-    t202 = 1 - 6.965340465841971*t201**2
-    t203 = t196*T22
-    t204 = -t203 + t30*T22
-    t205 = t196*T20
-    t206 = t205 - t30*T20
-    t207 = xp.greater(t202, 1e-12)
-    t208 = xp.where(t207, xp.sqrt(t202), 0)
-    t209 = 2.639193146748068*t201
-    t210 = xp.where(t207, t209, xp.where(xp.greater(t209, 0), xp.asarray(1, dtype=dtype), -1))
-    t211 = xp.atan2(t208, t210)
-    t212 = 1.761980786391911 + t211
-    t213 = 1.761980786391911 - t211
-    t214 = t212 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t212))
-    t215 = -6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t214)) + t214
-    t216 = t213 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t213))
-    t217 = -6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t216)) + t216
-    t218 = 0.1900219065658609*t210
-    t219 = 0.9817798505902814*t208
-    t220 = t218 + t219
-    t221 = -t218 + t219
-    t222 = 0.1900219065658609*t208
-    t223 = 0.9817798505902814*t210
-    t224 = -t222 + t223
-    t225 = t222 + t223
-    t226 = 0.12*t220 + 0.62*t224
-    t227 = -0.12*t224 + 0.62*t220
-    t228 = 0.78 - t226
-    t229 = 0.4 + t227
-    t230 = -0.18 + t228
-    t231 = -0.4 + t229
-    t232 = -t27*t230 + t199*t231
-    t233 = t27*t231 + t199*t230
-    t234 = t232**2 + t233**2
-    t235 = t230**2 + t231**2
-    t236 = 0.12*t221 - 0.62*t225
-    t237 = 0.12*t225 + 0.62*t221
-    t238 = 0.78 + t236
-    t239 = 0.4 - t237
-    t240 = -0.18 + t238
-    t241 = -0.4 + t239
-    t242 = -t27*t240 + t199*t241
-    t243 = t27*t241 + t199*t240
-    t244 = t242**2 + t243**2
-    t245 = t240**2 + t241**2
-    t246 = 1e-24*t200
-    t247 = xp.less_equal(t234, t246*t235)
-    t248 = xp.where(t247, 1, 1/xp.sqrt(t234))
-    t249 = xp.where(t247, 1, t232*t248)
-    t250 = xp.where(t247, 0, -t233*t248)
-    t251 = t220*t249 + t224*t250
-    t252 = -t220*t250 + t224*t249
-    t253 = t251*t41 + t252*t204
-    t254 = -t251*t204 + t252*t41
-    t255 = t251*t43 - t252*t206
-    t256 = t251*t206 + t252*t43
-    t257 = xp.where(t247, 0, xp.atan2(-t233, t232))
-    t258 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t257)) + t257
-    t259 = 1 + t251
-    t260 = t259*t42
-    t261 = t260 - t251*t42
-    t262 = t259*t44
-    t263 = t262 - t251*t44
-    t264 = t254**2
-    t265 = -t264
-    t266 = 1 + t265
-    t267 = xp.greater(t266, 1e-12)
-    t268 = xp.where(t267, xp.sqrt(t266), 0)
-    t269 = t264 + t253*t268
-    t270 = t265 + t269
-    t271 = t261**2
-    t272 = t264 + t271 + t253**2
-    t273 = t268**2
-    t274 = t270**2 + t271*t273
-    t275 = t264 + t273
-    t276 = 1e-24*t275
-    t277 = xp.less_equal(t274, t276*t272)
-    t278 = xp.where(t277, 1, 1/xp.sqrt(t274))
-    t279 = xp.where(t277, 1, t270*t278)
-    t280 = t256*(1 - t279)
-    t281 = t280 + t256*t279
-    t282 = t261*t268
-    t283 = xp.where(t277, 0, -t282*t278)
-    t284 = t255*t279 + t263*t283
-    t285 = t263*t279 - t255*t283
-    t286 = xp.less_equal(t275, t276)
-    t287 = xp.where(t286, 1, 1/xp.sqrt(t275))
-    t288 = xp.where(t286, 1, t254*t287)
-    t289 = xp.where(t286, 0, -t268*t287)
-    t290 = t285*(1 - t288)
-    t291 = t288*t284 + t289*t281
-    t292 = t290 + t288*t285
-    t293 = -t288*t281 + t289*t284
-    t294 = t291**2 + t292**2
-    t295 = t294
-    t296 = t294 + t293**2
-    t297 = xp.less_equal(t244, t246*t245)
-    t298 = xp.where(t297, 1, 1/xp.sqrt(t244))
-    t299 = xp.where(t297, 1, t242*t298)
-    t300 = xp.where(t297, 0, -t243*t298)
-    t301 = t221*t299 - t225*t300
-    t302 = t221*t300 + t225*t299
-    t303 = t41*t301 - t204*t302
-    t304 = t204*t301 + t41*t302
-    t305 = t43*t301 + t206*t302
-    t306 = t206*t301 - t43*t302
-    t307 = xp.where(t297, 0, xp.atan2(-t243, t242))
-    t308 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t307)) + t307
-    t309 = 1 - t301
-    t310 = t309*t42
-    t311 = t310 + t42*t301
-    t312 = t309*t44
-    t313 = t312 + t44*t301
-    t314 = t304**2
-    t315 = -t314
-    t316 = 1 + t315
-    t317 = xp.greater(t316, 1e-12)
-    t318 = xp.where(t317, xp.sqrt(t316), 0)
-    t319 = t314 - t303*t318
-    t320 = t315 + t319
-    t321 = t311**2
-    t322 = t314 + t321 + t303**2
-    t323 = t318**2
-    t324 = t320**2 + t321*t323
-    t325 = t314 + t323
-    t326 = 1e-24*t325
-    t327 = xp.less_equal(t324, t322*t326)
-    t328 = xp.where(t327, 1, 1/xp.sqrt(t324))
-    t329 = xp.where(t327, 1, t320*t328)
-    t330 = t306*(1 - t329)
-    t331 = t330 + t306*t329
-    t332 = t311*t318
-    t333 = xp.where(t327, 0, -t328*t332)
-    t334 = -t305*t329 + t313*t333
-    t335 = t313*t329 + t305*t333
-    t336 = xp.less_equal(t325, t326)
-    t337 = xp.where(t336, 1, 1/xp.sqrt(t325))
-    t338 = xp.where(t336, 1, t304*t337)
-    t339 = xp.where(t336, 0, -t318*t337)
-    t340 = t335*(1 - t338)
-    t341 = t338*t334 - t339*t331
-    t342 = t340 + t338*t335
-    t343 = t338*t331 + t339*t334
-    t344 = t341**2 + t342**2
-    t345 = t344
-    t346 = t343**2 + t344
-    t347 = xp.where(t126, 0, xp.atan2(-t131, t119))
-    t348 = t347
-    t349 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t348)) + t348
-    t350 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t347) + t347
-    t351 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t350)) + t350
-    t352 = xp.where(t135, 0, xp.atan2(-t117, t103))
-    t353 = t352
-    t354 = -6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t353)) + t353
-    t355 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t352)) + t352
-    t356 = xp.where(xp.less_equal(t144, 1e-24*t145), 0, xp.atan2(t141, t140))
-    t357 = t356
+    t20 = t19 + t16**2
+    t21 = 1e-24*t20
+    t22 = xp.less_equal(t19, t21)
+    t23 = xp.where(t22, 1, 1/xp.sqrt(t19))
+    t24 = xp.where(t22, 0, 1.5707963267948966 + t9)
+    t25 = t17*t23 + t18*t23
+    t26 = 0.18 + t25
+    t27 = t24 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t24))
+    t28 = -6.283185307179586*xp.floor(0.15915494309189535*(2.705260340591211 + t27)) + t27
+    t29 = t4*t23
+    t30 = xp.where(t22, 1, t29)
+    t31 = t8*t23
+    t32 = xp.where(t22, 0, t31)
+    t33 = t4*t30 + t8*t32
+    t34 = t8*t30 - t4*t32
+    t35 = -0.18 + t33
+    t36 = T02*t30 + T12*t32
+    t37 = -T12*t30 + T02*t32
+    t38 = T00*t30 + T10*t32
+    t39 = T10*t30 - T00*t32
+    t40 = t29*T02 + t31*T12
+    t41 = t29*T12 - t31*T02
+    t42 = t29*T00 + t31*T10
+    t43 = -t29*T10 + t31*T00
+    t44 = 1 - t30
+    t45 = t44*t16
+    t46 = t45 + t16*t30
+    t47 = -0.4 + t46
+    t48 = t34**2 + t35**2 + t47**2
+    t49 = 0.5*(0.7588 - t48)
+    t50 = 1 - 6.965340465841971*t49**2
+    t51 = t44*T22
+    t52 = t51 + T22*t30
+    t53 = t44*T20
+    t54 = t53 + T20*t30
+    t55 = xp.greater(t50, 1e-12)
+    t56 = xp.where(t55, xp.sqrt(t50), 0)
+    t57 = 2.639193146748068*t49
+    t58 = xp.where(t55, t57, xp.where(xp.greater(t57, 0), xp.asarray(1, dtype=dtype), -1))
+    t59 = xp.atan2(t56, t58)
+    t60 = 1.761980786391911 + t59
+    t61 = 1.761980786391911 - t59
+    t62 = t60 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t60))
+    t63 = -6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t62)) + t62
+    t64 = t61 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t61))
+    t65 = -6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t64)) + t64
+    t66 = 0.1900219065658609*t58
+    t67 = 0.9817798505902814*t56
+    t68 = t66 + t67
+    t69 = -t66 + t67
+    t70 = 0.1900219065658609*t56
+    t71 = 0.9817798505902814*t58
+    t72 = -t70 + t71
+    t73 = t70 + t71
+    t74 = 0.12*t68 + 0.62*t72
+    t75 = -0.12*t72 + 0.62*t68
+    t76 = 0.78 - t74
+    t77 = 0.4 + t75
+    t78 = -0.18 + t76
+    t79 = -0.4 + t77
+    t80 = t35*t78 + t47*t79
+    t81 = t35*t79 - t47*t78
+    t82 = t80**2 + t81**2
+    t83 = t78**2 + t79**2
+    t84 = 0.12*t69 - 0.62*t73
+    t85 = 0.12*t73 + 0.62*t69
+    t86 = 0.78 + t84
+    t87 = 0.4 - t85
+    t88 = -0.18 + t86
+    t89 = -0.4 + t87
+    t90 = t35*t88 + t47*t89
+    t91 = t35*t89 - t47*t88
+    t92 = t90**2 + t91**2
+    t93 = t88**2 + t89**2
+    t94 = 1e-24*t48
+    t95 = xp.less_equal(t82, t94*t83)
+    t96 = xp.where(t95, 1, 1/xp.sqrt(t82))
+    t97 = xp.where(t95, 1, t80*t96)
+    t98 = xp.where(t95, 0, t81*t96)
+    t99 = t68*t97 + t72*t98
+    t100 = -t68*t98 + t72*t97
+    t101 = t99*t36 + t100*t52
+    t102 = t99*t52 - t100*t36
+    t103 = t99*t38 + t100*t54
+    t104 = -t99*t54 + t100*t38
+    t105 = xp.where(t95, 0, xp.atan2(t81, t80))
+    t106 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t105)) + t105
+    t107 = 1 + t99
+    t108 = t107*t37
+    t109 = t108 - t99*t37
+    t110 = t107*t39
+    t111 = t110 - t99*t39
+    t112 = t102**2
+    t113 = -t112
+    t114 = 1 + t113
+    t115 = xp.greater(t114, 1e-12)
+    t116 = xp.where(t115, xp.sqrt(t114), 0)
+    t117 = t112 - t101*t116
+    t118 = t113 + t117
+    t119 = t109**2
+    t120 = t112 + t119 + t101**2
+    t121 = t116**2
+    t122 = t118**2 + t119*t121
+    t123 = t112 + t121
+    t124 = 1e-24*t123
+    t125 = xp.less_equal(t122, t124*t120)
+    t126 = xp.where(t125, 1, 1/xp.sqrt(t122))
+    t127 = xp.where(t125, 1, t118*t126)
+    t128 = t104*(1 - t127)
+    t129 = t128 + t104*t127
+    t130 = t109*t116
+    t131 = xp.where(t125, 0, -t130*t126)
+    t132 = -t103*t127 + t111*t131
+    t133 = t111*t127 + t103*t131
+    t134 = xp.less_equal(t123, t124)
+    t135 = xp.where(t134, 1, 1/xp.sqrt(t123))
+    t136 = xp.where(t134, 1, t102*t135)
+    t137 = xp.where(t134, 0, -t116*t135)
+    t138 = t133*(1 - t136)
+    t139 = t136*t132 - t137*t129
+    t140 = t138 + t136*t133
+    t141 = t136*t129 + t137*t132
+    t142 = t139**2 + t140**2
+    t143 = t142 + t141**2
+    t144 = xp.less_equal(t92, t94*t93)
+    t145 = xp.where(t144, 1, 1/xp.sqrt(t92))
+    t146 = xp.where(t144, 1, t90*t145)
+    t147 = xp.where(t144, 0, t91*t145)
+    t148 = t69*t146 - t73*t147
+    t149 = t69*t147 + t73*t146
+    t150 = -t36*t148 + t52*t149
+    t151 = t52*t148 + t36*t149
+    t152 = t38*t148 - t54*t149
+    t153 = t54*t148 + t38*t149
+    t154 = xp.where(t144, 0, xp.atan2(t91, t90))
+    t155 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t154)) + t154
+    t156 = 1 - t148
+    t157 = t156*t37
+    t158 = t157 + t37*t148
+    t159 = t156*t39
+    t160 = t159 + t39*t148
+    t161 = t151**2
+    t162 = -t161
+    t163 = 1 + t162
+    t164 = xp.greater(t163, 1e-12)
+    t165 = xp.where(t164, xp.sqrt(t163), 0)
+    t166 = t161 - t150*t165
+    t167 = t162 + t166
+    t168 = t158**2
+    t169 = t161 + t168 + t150**2
+    t170 = t165**2
+    t171 = t167**2 + t168*t170
+    t172 = t161 + t170
+    t173 = 1e-24*t172
+    t174 = xp.less_equal(t171, t173*t169)
+    t175 = xp.where(t174, 1, 1/xp.sqrt(t171))
+    t176 = xp.where(t174, 1, t167*t175)
+    t177 = t153*(1 - t176)
+    t178 = t177 + t153*t176
+    t179 = t158*t165
+    t180 = xp.where(t174, 0, -t179*t175)
+    t181 = t152*t176 + t160*t180
+    t182 = t160*t176 - t152*t180
+    t183 = xp.less_equal(t172, t173)
+    t184 = xp.where(t183, 1, 1/xp.sqrt(t172))
+    t185 = xp.where(t183, 1, -t151*t184)
+    t186 = xp.where(t183, 0, -t165*t184)
+    t187 = t182*(1 - t185)
+    t188 = t185*t181 - t186*t178
+    t189 = t187 + t185*t182
+    t190 = t185*t178 + t186*t181
+    t191 = t188**2 + t189**2
+    t192 = t191 + t190**2
+    t193 = 1 + t29
+    t194 = t193*t16
+    t195 = t194 - t29*t16
+    t196 = -0.4 + t195
+    t197 = t26**2 + t196**2
+    t198 = 0.5*(0.7588 - t197)
+    t199 = 1 - 6.965340465841971*t198**2
+    t200 = t193*T22
+    t201 = -t200 + t29*T22
+    t202 = t193*T20
+    t203 = t202 - t29*T20
+    t204 = xp.greater(t199, 1e-12)
+    t205 = xp.where(t204, xp.sqrt(t199), 0)
+    t206 = 2.639193146748068*t198
+    t207 = xp.where(t204, t206, xp.where(xp.greater(t206, 0), xp.asarray(1, dtype=dtype), -1))
+    t208 = xp.atan2(t205, t207)
+    t209 = 1.761980786391911 + t208
+    t210 = 1.761980786391911 - t208
+    t211 = t209 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t209))
+    t212 = -6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t211)) + t211
+    t213 = t210 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t210))
+    t214 = -6.283185307179586*xp.floor(0.15915494309189535*(0.2617993877991494 + t213)) + t213
+    t215 = 0.1900219065658609*t207
+    t216 = 0.9817798505902814*t205
+    t217 = t215 + t216
+    t218 = -t215 + t216
+    t219 = 0.1900219065658609*t205
+    t220 = 0.9817798505902814*t207
+    t221 = -t219 + t220
+    t222 = t219 + t220
+    t223 = 0.12*t217 + 0.62*t221
+    t224 = -0.12*t221 + 0.62*t217
+    t225 = 0.78 - t223
+    t226 = 0.4 + t224
+    t227 = -0.18 + t225
+    t228 = -0.4 + t226
+    t229 = -t26*t227 + t196*t228
+    t230 = t26*t228 + t196*t227
+    t231 = t229**2 + t230**2
+    t232 = t227**2 + t228**2
+    t233 = 0.12*t218 - 0.62*t222
+    t234 = 0.12*t222 + 0.62*t218
+    t235 = 0.78 + t233
+    t236 = 0.4 - t234
+    t237 = -0.18 + t235
+    t238 = -0.4 + t236
+    t239 = -t26*t237 + t196*t238
+    t240 = t26*t238 + t196*t237
+    t241 = t239**2 + t240**2
+    t242 = t237**2 + t238**2
+    t243 = 1e-24*t197
+    t244 = xp.less_equal(t231, t243*t232)
+    t245 = xp.where(t244, 1, 1/xp.sqrt(t231))
+    t246 = xp.where(t244, 1, t229*t245)
+    t247 = xp.where(t244, 0, -t230*t245)
+    t248 = t217*t246 + t221*t247
+    t249 = -t217*t247 + t221*t246
+    t250 = t248*t40 + t249*t201
+    t251 = -t248*t201 + t249*t40
+    t252 = t248*t42 - t249*t203
+    t253 = t248*t203 + t249*t42
+    t254 = xp.where(t244, 0, xp.atan2(-t230, t229))
+    t255 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t254)) + t254
+    t256 = 1 + t248
+    t257 = t256*t41
+    t258 = t257 - t248*t41
+    t259 = t256*t43
+    t260 = t259 - t248*t43
+    t261 = t251**2
+    t262 = -t261
+    t263 = 1 + t262
+    t264 = xp.greater(t263, 1e-12)
+    t265 = xp.where(t264, xp.sqrt(t263), 0)
+    t266 = t261 + t250*t265
+    t267 = t262 + t266
+    t268 = t258**2
+    t269 = t261 + t268 + t250**2
+    t270 = t265**2
+    t271 = t267**2 + t268*t270
+    t272 = t261 + t270
+    t273 = 1e-24*t272
+    t274 = xp.less_equal(t271, t273*t269)
+    t275 = xp.where(t274, 1, 1/xp.sqrt(t271))
+    t276 = xp.where(t274, 1, t267*t275)
+    t277 = t253*(1 - t276)
+    t278 = t277 + t253*t276
+    t279 = t258*t265
+    t280 = xp.where(t274, 0, -t279*t275)
+    t281 = t252*t276 + t260*t280
+    t282 = t260*t276 - t252*t280
+    t283 = xp.less_equal(t272, t273)
+    t284 = xp.where(t283, 1, 1/xp.sqrt(t272))
+    t285 = xp.where(t283, 1, t251*t284)
+    t286 = xp.where(t283, 0, -t265*t284)
+    t287 = t282*(1 - t285)
+    t288 = t285*t281 + t286*t278
+    t289 = t287 + t285*t282
+    t290 = -t285*t278 + t286*t281
+    t291 = t288**2 + t289**2
+    t292 = t291 + t290**2
+    t293 = xp.less_equal(t241, t243*t242)
+    t294 = xp.where(t293, 1, 1/xp.sqrt(t241))
+    t295 = xp.where(t293, 1, t239*t294)
+    t296 = xp.where(t293, 0, -t240*t294)
+    t297 = t218*t295 - t222*t296
+    t298 = t218*t296 + t222*t295
+    t299 = t40*t297 - t201*t298
+    t300 = t201*t297 + t40*t298
+    t301 = t42*t297 + t203*t298
+    t302 = t203*t297 - t42*t298
+    t303 = xp.where(t293, 0, xp.atan2(-t240, t239))
+    t304 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t303)) + t303
+    t305 = 1 - t297
+    t306 = t305*t41
+    t307 = t306 + t41*t297
+    t308 = t305*t43
+    t309 = t308 + t43*t297
+    t310 = t300**2
+    t311 = -t310
+    t312 = 1 + t311
+    t313 = xp.greater(t312, 1e-12)
+    t314 = xp.where(t313, xp.sqrt(t312), 0)
+    t315 = t310 - t299*t314
+    t316 = t311 + t315
+    t317 = t307**2
+    t318 = t310 + t317 + t299**2
+    t319 = t314**2
+    t320 = t316**2 + t317*t319
+    t321 = t310 + t319
+    t322 = 1e-24*t321
+    t323 = xp.less_equal(t320, t318*t322)
+    t324 = xp.where(t323, 1, 1/xp.sqrt(t320))
+    t325 = xp.where(t323, 1, t316*t324)
+    t326 = t302*(1 - t325)
+    t327 = t326 + t302*t325
+    t328 = t307*t314
+    t329 = xp.where(t323, 0, -t324*t328)
+    t330 = -t301*t325 + t309*t329
+    t331 = t309*t325 + t301*t329
+    t332 = xp.less_equal(t321, t322)
+    t333 = xp.where(t332, 1, 1/xp.sqrt(t321))
+    t334 = xp.where(t332, 1, t300*t333)
+    t335 = xp.where(t332, 0, -t314*t333)
+    t336 = t331*(1 - t334)
+    t337 = t334*t330 - t335*t327
+    t338 = t336 + t334*t331
+    t339 = t334*t327 + t335*t330
+    t340 = t337**2 + t338**2
+    t341 = t339**2 + t340
+    t342 = xp.where(t125, 0, xp.atan2(-t130, t118))
+    t343 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t342)) + t342
+    t344 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t342) + t342
+    t345 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t344)) + t344
+    t346 = xp.where(t134, 0, xp.atan2(-t116, t102))
+    t347 = -6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t346)) + t346
+    t348 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t346)) + t346
+    t349 = xp.where(xp.less_equal(t142, 1e-24*t143), 0, xp.atan2(t140, t139))
+    t350 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t349)) + t349
+    t351 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t349) + t349
+    t352 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t351)) + t351
+    t353 = -t348
+    t354 = 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t353)) + t348
+    t355 = xp.where(t174, 0, xp.atan2(-t179, t167))
+    t356 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t355)) + t355
+    t357 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t355) + t355
     t358 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t357)) + t357
-    t359 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t356) + t356
-    t360 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t359)) + t359
-    t361 = -t355
-    t362 = 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t361)) + t355
-    t363 = xp.where(t176, 0, xp.atan2(-t181, t169))
-    t364 = t363
+    t359 = xp.where(t183, 0, xp.atan2(-t165, -t151))
+    t360 = -6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t359)) + t359
+    t361 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t359)) + t359
+    t362 = xp.where(xp.less_equal(t191, 1e-24*t192), 0, xp.atan2(t189, t188))
+    t363 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t362)) + t362
+    t364 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t362) + t362
     t365 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t364)) + t364
-    t366 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t363) + t363
-    t367 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t366)) + t366
-    t368 = xp.where(t185, 0, xp.atan2(-t167, -t153))
-    t369 = t368
-    t370 = -6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t369)) + t369
-    t371 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t368)) + t368
-    t372 = xp.where(xp.less_equal(t194, 1e-24*t195), 0, xp.atan2(t191, t190))
-    t373 = t372
-    t374 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t373)) + t373
-    t375 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t372) + t372
+    t366 = -t361
+    t367 = 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t366)) + t361
+    t368 = xp.where(t274, 0, xp.atan2(-t279, t267))
+    t369 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t368)) + t368
+    t370 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t368) + t368
+    t371 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t370)) + t370
+    t372 = xp.where(t283, 0, xp.atan2(-t265, t251))
+    t373 = -6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t372)) + t372
+    t374 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t372)) + t372
+    t375 = xp.where(xp.less_equal(t291, 1e-24*t292), 0, xp.atan2(t289, t288))
     t376 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t375)) + t375
-    t377 = -t371
-    t378 = 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t377)) + t371
-    t379 = xp.where(t277, 0, xp.atan2(-t282, t270))
-    t380 = t379
-    t381 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t380)) + t380
-    t382 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t379) + t379
-    t383 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t382)) + t382
-    t384 = xp.where(t286, 0, xp.atan2(-t268, t254))
-    t385 = t384
+    t377 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t375) + t375
+    t378 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t377)) + t377
+    t379 = -t374
+    t380 = 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t379)) + t374
+    t381 = xp.where(t323, 0, xp.atan2(-t328, t316))
+    t382 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t381)) + t381
+    t383 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t381) + t381
+    t384 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t383)) + t383
+    t385 = xp.where(t332, 0, xp.atan2(-t314, t300))
     t386 = -6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t385)) + t385
-    t387 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t384)) + t384
-    t388 = xp.where(xp.less_equal(t295, 1e-24*t296), 0, xp.atan2(t292, t291))
-    t389 = t388
-    t390 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t389)) + t389
-    t391 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t388) + t388
-    t392 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t391)) + t391
-    t393 = -t387
-    t394 = 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t393)) + t387
-    t395 = xp.where(t327, 0, xp.atan2(-t332, t320))
-    t396 = t395
-    t397 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t396)) + t396
-    t398 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t395) + t395
-    t399 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t398)) + t398
-    t400 = xp.where(t336, 0, xp.atan2(-t318, t304))
-    t401 = t400
-    t402 = -6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t401)) + t401
-    t403 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t400)) + t400
-    t404 = xp.where(xp.less_equal(t345, 1e-24*t346), 0, xp.atan2(t342, t341))
-    t405 = t404
-    t406 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t405)) + t405
-    t407 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t404) + t404
-    t408 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t407)) + t407
-    t409 = -t403
-    t410 = 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t409)) + t403
-    t411 = xp.greater_equal(t28, -2.705260340591211) & xp.less_equal(t28, 2.705260340591211)
-    t412 = xp.less_equal(t29, 2.705260340591211)
-    t413 = xp.where(xp.logical_not(t411) & t412, t29, t28)
-    t414 = xp.greater_equal(t106, -3.141592653589793) & xp.less_equal(t106, 1.1344640137963142)
-    t415 = xp.less_equal(t107, 1.1344640137963142)
-    t416 = xp.where(xp.logical_not(t414) & t415, t107, t106)
-    t417 = xp.greater_equal(t63, -0.2617993877991494) & xp.less_equal(t63, 2.7576202181510405)
-    t418 = xp.less_equal(t64, 2.7576202181510405)
-    t419 = xp.where(xp.logical_not(t417) & t418, t64, t63)
-    t420 = xp.greater_equal(t348, -6.1086523819801535) & xp.less_equal(t348, 6.1086523819801535)
-    t421 = xp.less_equal(t349, 6.1086523819801535)
-    t422 = xp.greater_equal(t353, -2.2689280275926285) & xp.less_equal(t353, 2.2689280275926285)
-    t423 = xp.less_equal(t354, 2.2689280275926285)
-    t424 = xp.greater_equal(t357, -6.1086523819801535) & xp.less_equal(t357, 6.1086523819801535)
-    t425 = xp.less_equal(t358, 6.1086523819801535)
-    t426 = xp.greater_equal(t350, -6.1086523819801535) & xp.less_equal(t350, 6.1086523819801535)
-    t427 = xp.less_equal(t351, 6.1086523819801535)
-    t428 = xp.greater_equal(t361, -2.2689280275926285) & xp.less_equal(t361, 2.2689280275926285)
-    t429 = -t362
-    t430 = xp.less_equal(t429, 2.2689280275926285)
-    t431 = xp.greater_equal(t359, -6.1086523819801535) & xp.less_equal(t359, 6.1086523819801535)
-    t432 = xp.less_equal(t360, 6.1086523819801535)
-    t433 = xp.greater_equal(t156, -3.141592653589793) & xp.less_equal(t156, 1.1344640137963142)
-    t434 = xp.less_equal(t157, 1.1344640137963142)
-    t435 = xp.where(xp.logical_not(t433) & t434, t157, t156)
-    t436 = xp.greater_equal(t65, -0.2617993877991494) & xp.less_equal(t65, 2.7576202181510405)
-    t437 = xp.less_equal(t66, 2.7576202181510405)
-    t438 = xp.where(xp.logical_not(t436) & t437, t66, t65)
-    t439 = xp.greater_equal(t364, -6.1086523819801535) & xp.less_equal(t364, 6.1086523819801535)
-    t440 = xp.less_equal(t365, 6.1086523819801535)
-    t441 = xp.greater_equal(t369, -2.2689280275926285) & xp.less_equal(t369, 2.2689280275926285)
-    t442 = xp.less_equal(t370, 2.2689280275926285)
-    t443 = xp.greater_equal(t373, -6.1086523819801535) & xp.less_equal(t373, 6.1086523819801535)
-    t444 = xp.less_equal(t374, 6.1086523819801535)
-    t445 = xp.greater_equal(t366, -6.1086523819801535) & xp.less_equal(t366, 6.1086523819801535)
-    t446 = xp.less_equal(t367, 6.1086523819801535)
-    t447 = xp.greater_equal(t377, -2.2689280275926285) & xp.less_equal(t377, 2.2689280275926285)
-    t448 = -t378
-    t449 = xp.less_equal(t448, 2.2689280275926285)
-    t450 = xp.greater_equal(t375, -6.1086523819801535) & xp.less_equal(t375, 6.1086523819801535)
-    t451 = xp.less_equal(t376, 6.1086523819801535)
-    t452 = xp.greater_equal(t11, -2.705260340591211) & xp.less_equal(t11, 2.705260340591211)
-    t453 = xp.less_equal(t12, 2.705260340591211)
-    t454 = xp.where(xp.logical_not(t452) & t453, t12, t11)
-    t455 = xp.greater_equal(t257, -3.141592653589793) & xp.less_equal(t257, 1.1344640137963142)
-    t456 = xp.less_equal(t258, 1.1344640137963142)
-    t457 = xp.where(xp.logical_not(t455) & t456, t258, t257)
-    t458 = xp.greater_equal(t214, -0.2617993877991494) & xp.less_equal(t214, 2.7576202181510405)
-    t459 = xp.less_equal(t215, 2.7576202181510405)
-    t460 = xp.where(xp.logical_not(t458) & t459, t215, t214)
-    t461 = xp.greater_equal(t380, -6.1086523819801535) & xp.less_equal(t380, 6.1086523819801535)
-    t462 = xp.less_equal(t381, 6.1086523819801535)
-    t463 = xp.greater_equal(t385, -2.2689280275926285) & xp.less_equal(t385, 2.2689280275926285)
-    t464 = xp.less_equal(t386, 2.2689280275926285)
-    t465 = xp.greater_equal(t389, -6.1086523819801535) & xp.less_equal(t389, 6.1086523819801535)
-    t466 = xp.less_equal(t390, 6.1086523819801535)
-    t467 = xp.greater_equal(t382, -6.1086523819801535) & xp.less_equal(t382, 6.1086523819801535)
-    t468 = xp.less_equal(t383, 6.1086523819801535)
-    t469 = xp.greater_equal(t393, -2.2689280275926285) & xp.less_equal(t393, 2.2689280275926285)
-    t470 = -t394
-    t471 = xp.less_equal(t470, 2.2689280275926285)
-    t472 = xp.greater_equal(t391, -6.1086523819801535) & xp.less_equal(t391, 6.1086523819801535)
-    t473 = xp.less_equal(t392, 6.1086523819801535)
-    t474 = xp.greater_equal(t307, -3.141592653589793) & xp.less_equal(t307, 1.1344640137963142)
-    t475 = xp.less_equal(t308, 1.1344640137963142)
-    t476 = xp.where(xp.logical_not(t474) & t475, t308, t307)
-    t477 = xp.greater_equal(t216, -0.2617993877991494) & xp.less_equal(t216, 2.7576202181510405)
-    t478 = xp.less_equal(t217, 2.7576202181510405)
-    t479 = xp.where(xp.logical_not(t477) & t478, t217, t216)
-    t480 = xp.greater_equal(t396, -6.1086523819801535) & xp.less_equal(t396, 6.1086523819801535)
-    t481 = xp.less_equal(t397, 6.1086523819801535)
-    t482 = xp.greater_equal(t401, -2.2689280275926285) & xp.less_equal(t401, 2.2689280275926285)
-    t483 = xp.less_equal(t402, 2.2689280275926285)
-    t484 = xp.greater_equal(t405, -6.1086523819801535) & xp.less_equal(t405, 6.1086523819801535)
-    t485 = xp.less_equal(t406, 6.1086523819801535)
-    t486 = xp.greater_equal(t398, -6.1086523819801535) & xp.less_equal(t398, 6.1086523819801535)
-    t487 = xp.less_equal(t399, 6.1086523819801535)
-    t488 = xp.greater_equal(t409, -2.2689280275926285) & xp.less_equal(t409, 2.2689280275926285)
-    t489 = -t410
-    t490 = xp.less_equal(t489, 2.2689280275926285)
-    t491 = xp.greater_equal(t407, -6.1086523819801535) & xp.less_equal(t407, 6.1086523819801535)
-    t492 = xp.less_equal(t408, 6.1086523819801535)
-    t493 = xp.isfinite(t0)
-    t494 = xp.greater(t20, t22)
-    t495 = (t23 & xp.less_equal(0, 1e-12*t21)) | t494
-    t496 = xp.greater_equal(t51, -1e-12)
-    t497 = xp.greater_equal(t202, -1e-12)
-    t498 = t411 | t412
-    t499 = t414 | t415
-    t500 = t417 | t418
-    t501 = t433 | t434
-    t502 = t436 | t437
-    t503 = t452 | t453
-    t504 = t455 | t456
-    t505 = t458 | t459
-    t506 = t474 | t475
-    t507 = t477 | t478
+    t387 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t385)) + t385
+    t388 = xp.where(xp.less_equal(t340, 1e-24*t341), 0, xp.atan2(t338, t337))
+    t389 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t388)) + t388
+    t390 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t388) + t388
+    t391 = -6.283185307179586*xp.floor(0.15915494309189535*(6.1086523819801535 + t390)) + t390
+    t392 = -t387
+    t393 = 6.283185307179586*xp.floor(0.15915494309189535*(2.2689280275926285 + t392)) + t387
+    t394 = xp.greater_equal(t27, -2.705260340591211) & xp.less_equal(t27, 2.705260340591211)
+    t395 = xp.less_equal(t28, 2.705260340591211)
+    t396 = xp.where(xp.logical_not(t394) & t395, t28, t27)
+    t397 = xp.greater_equal(t105, -3.141592653589793) & xp.less_equal(t105, 1.1344640137963142)
+    t398 = xp.less_equal(t106, 1.1344640137963142)
+    t399 = xp.where(xp.logical_not(t397) & t398, t106, t105)
+    t400 = xp.greater_equal(t62, -0.2617993877991494) & xp.less_equal(t62, 2.7576202181510405)
+    t401 = xp.less_equal(t63, 2.7576202181510405)
+    t402 = xp.where(xp.logical_not(t400) & t401, t63, t62)
+    t403 = xp.greater_equal(t342, -6.1086523819801535) & xp.less_equal(t342, 6.1086523819801535)
+    t404 = xp.less_equal(t343, 6.1086523819801535)
+    t405 = xp.greater_equal(t346, -2.2689280275926285) & xp.less_equal(t346, 2.2689280275926285)
+    t406 = xp.less_equal(t347, 2.2689280275926285)
+    t407 = xp.greater_equal(t349, -6.1086523819801535) & xp.less_equal(t349, 6.1086523819801535)
+    t408 = xp.less_equal(t350, 6.1086523819801535)
+    t409 = xp.greater_equal(t344, -6.1086523819801535) & xp.less_equal(t344, 6.1086523819801535)
+    t410 = xp.less_equal(t345, 6.1086523819801535)
+    t411 = xp.greater_equal(t353, -2.2689280275926285) & xp.less_equal(t353, 2.2689280275926285)
+    t412 = -t354
+    t413 = xp.less_equal(t412, 2.2689280275926285)
+    t414 = xp.greater_equal(t351, -6.1086523819801535) & xp.less_equal(t351, 6.1086523819801535)
+    t415 = xp.less_equal(t352, 6.1086523819801535)
+    t416 = xp.greater_equal(t154, -3.141592653589793) & xp.less_equal(t154, 1.1344640137963142)
+    t417 = xp.less_equal(t155, 1.1344640137963142)
+    t418 = xp.where(xp.logical_not(t416) & t417, t155, t154)
+    t419 = xp.greater_equal(t64, -0.2617993877991494) & xp.less_equal(t64, 2.7576202181510405)
+    t420 = xp.less_equal(t65, 2.7576202181510405)
+    t421 = xp.where(xp.logical_not(t419) & t420, t65, t64)
+    t422 = xp.greater_equal(t355, -6.1086523819801535) & xp.less_equal(t355, 6.1086523819801535)
+    t423 = xp.less_equal(t356, 6.1086523819801535)
+    t424 = xp.greater_equal(t359, -2.2689280275926285) & xp.less_equal(t359, 2.2689280275926285)
+    t425 = xp.less_equal(t360, 2.2689280275926285)
+    t426 = xp.greater_equal(t362, -6.1086523819801535) & xp.less_equal(t362, 6.1086523819801535)
+    t427 = xp.less_equal(t363, 6.1086523819801535)
+    t428 = xp.greater_equal(t357, -6.1086523819801535) & xp.less_equal(t357, 6.1086523819801535)
+    t429 = xp.less_equal(t358, 6.1086523819801535)
+    t430 = xp.greater_equal(t366, -2.2689280275926285) & xp.less_equal(t366, 2.2689280275926285)
+    t431 = -t367
+    t432 = xp.less_equal(t431, 2.2689280275926285)
+    t433 = xp.greater_equal(t364, -6.1086523819801535) & xp.less_equal(t364, 6.1086523819801535)
+    t434 = xp.less_equal(t365, 6.1086523819801535)
+    t435 = xp.greater_equal(t11, -2.705260340591211) & xp.less_equal(t11, 2.705260340591211)
+    t436 = xp.less_equal(t12, 2.705260340591211)
+    t437 = xp.where(xp.logical_not(t435) & t436, t12, t11)
+    t438 = xp.greater_equal(t254, -3.141592653589793) & xp.less_equal(t254, 1.1344640137963142)
+    t439 = xp.less_equal(t255, 1.1344640137963142)
+    t440 = xp.where(xp.logical_not(t438) & t439, t255, t254)
+    t441 = xp.greater_equal(t211, -0.2617993877991494) & xp.less_equal(t211, 2.7576202181510405)
+    t442 = xp.less_equal(t212, 2.7576202181510405)
+    t443 = xp.where(xp.logical_not(t441) & t442, t212, t211)
+    t444 = xp.greater_equal(t368, -6.1086523819801535) & xp.less_equal(t368, 6.1086523819801535)
+    t445 = xp.less_equal(t369, 6.1086523819801535)
+    t446 = xp.greater_equal(t372, -2.2689280275926285) & xp.less_equal(t372, 2.2689280275926285)
+    t447 = xp.less_equal(t373, 2.2689280275926285)
+    t448 = xp.greater_equal(t375, -6.1086523819801535) & xp.less_equal(t375, 6.1086523819801535)
+    t449 = xp.less_equal(t376, 6.1086523819801535)
+    t450 = xp.greater_equal(t370, -6.1086523819801535) & xp.less_equal(t370, 6.1086523819801535)
+    t451 = xp.less_equal(t371, 6.1086523819801535)
+    t452 = xp.greater_equal(t379, -2.2689280275926285) & xp.less_equal(t379, 2.2689280275926285)
+    t453 = -t380
+    t454 = xp.less_equal(t453, 2.2689280275926285)
+    t455 = xp.greater_equal(t377, -6.1086523819801535) & xp.less_equal(t377, 6.1086523819801535)
+    t456 = xp.less_equal(t378, 6.1086523819801535)
+    t457 = xp.greater_equal(t303, -3.141592653589793) & xp.less_equal(t303, 1.1344640137963142)
+    t458 = xp.less_equal(t304, 1.1344640137963142)
+    t459 = xp.where(xp.logical_not(t457) & t458, t304, t303)
+    t460 = xp.greater_equal(t213, -0.2617993877991494) & xp.less_equal(t213, 2.7576202181510405)
+    t461 = xp.less_equal(t214, 2.7576202181510405)
+    t462 = xp.where(xp.logical_not(t460) & t461, t214, t213)
+    t463 = xp.greater_equal(t381, -6.1086523819801535) & xp.less_equal(t381, 6.1086523819801535)
+    t464 = xp.less_equal(t382, 6.1086523819801535)
+    t465 = xp.greater_equal(t385, -2.2689280275926285) & xp.less_equal(t385, 2.2689280275926285)
+    t466 = xp.less_equal(t386, 2.2689280275926285)
+    t467 = xp.greater_equal(t388, -6.1086523819801535) & xp.less_equal(t388, 6.1086523819801535)
+    t468 = xp.less_equal(t389, 6.1086523819801535)
+    t469 = xp.greater_equal(t383, -6.1086523819801535) & xp.less_equal(t383, 6.1086523819801535)
+    t470 = xp.less_equal(t384, 6.1086523819801535)
+    t471 = xp.greater_equal(t392, -2.2689280275926285) & xp.less_equal(t392, 2.2689280275926285)
+    t472 = -t393
+    t473 = xp.less_equal(t472, 2.2689280275926285)
+    t474 = xp.greater_equal(t390, -6.1086523819801535) & xp.less_equal(t390, 6.1086523819801535)
+    t475 = xp.less_equal(t391, 6.1086523819801535)
+    t476 = xp.isfinite(t0)
+    t477 = xp.greater(t19, t21)
+    t478 = (t22 & xp.less_equal(0, 1e-12*t20)) | t477
+    t479 = xp.greater_equal(t50, -1e-12)
+    t480 = xp.greater_equal(t199, -1e-12)
+    t481 = t394 | t395
+    t482 = t397 | t398
+    t483 = t400 | t401
+    t484 = t416 | t417
+    t485 = t419 | t420
+    t486 = t435 | t436
+    t487 = t438 | t439
+    t488 = t441 | t442
+    t489 = t457 | t458
+    t490 = t460 | t461
     q = _stack(xp, [
-        t413,  # 0, 0
-        t416,  # 0, 1
-        t419,  # 0, 2
-        xp.where(xp.logical_not(t420) & t421, t349, t348),  # 0, 3
-        xp.where(xp.logical_not(t422) & t423, t354, t353),  # 0, 4
-        xp.where(xp.logical_not(t424) & t425, t358, t357),  # 0, 5
-        t413,  # 1, 0
-        t416,  # 1, 1
-        t419,  # 1, 2
-        xp.where(xp.logical_not(t426) & t427, t351, t350),  # 1, 3
-        xp.where(xp.logical_not(t428) & t430, t429, t361),  # 1, 4
-        xp.where(xp.logical_not(t431) & t432, t360, t359),  # 1, 5
-        t413,  # 2, 0
-        t435,  # 2, 1
-        t438,  # 2, 2
-        xp.where(xp.logical_not(t439) & t440, t365, t364),  # 2, 3
-        xp.where(xp.logical_not(t441) & t442, t370, t369),  # 2, 4
-        xp.where(xp.logical_not(t443) & t444, t374, t373),  # 2, 5
-        t413,  # 3, 0
-        t435,  # 3, 1
-        t438,  # 3, 2
-        xp.where(xp.logical_not(t445) & t446, t367, t366),  # 3, 3
-        xp.where(xp.logical_not(t447) & t449, t448, t377),  # 3, 4
-        xp.where(xp.logical_not(t450) & t451, t376, t375),  # 3, 5
-        t454,  # 4, 0
-        t457,  # 4, 1
-        t460,  # 4, 2
-        xp.where(xp.logical_not(t461) & t462, t381, t380),  # 4, 3
-        xp.where(xp.logical_not(t463) & t464, t386, t385),  # 4, 4
-        xp.where(xp.logical_not(t465) & t466, t390, t389),  # 4, 5
-        t454,  # 5, 0
-        t457,  # 5, 1
-        t460,  # 5, 2
-        xp.where(xp.logical_not(t467) & t468, t383, t382),  # 5, 3
-        xp.where(xp.logical_not(t469) & t471, t470, t393),  # 5, 4
-        xp.where(xp.logical_not(t472) & t473, t392, t391),  # 5, 5
-        t454,  # 6, 0
-        t476,  # 6, 1
-        t479,  # 6, 2
-        xp.where(xp.logical_not(t480) & t481, t397, t396),  # 6, 3
-        xp.where(xp.logical_not(t482) & t483, t402, t401),  # 6, 4
-        xp.where(xp.logical_not(t484) & t485, t406, t405),  # 6, 5
-        t454,  # 7, 0
-        t476,  # 7, 1
-        t479,  # 7, 2
-        xp.where(xp.logical_not(t486) & t487, t399, t398),  # 7, 3
-        xp.where(xp.logical_not(t488) & t490, t489, t409),  # 7, 4
-        xp.where(xp.logical_not(t491) & t492, t408, t407),  # 7, 5
+        t396,  # 0, 0
+        t399,  # 0, 1
+        t402,  # 0, 2
+        xp.where(xp.logical_not(t403) & t404, t343, t342),  # 0, 3
+        xp.where(xp.logical_not(t405) & t406, t347, t346),  # 0, 4
+        xp.where(xp.logical_not(t407) & t408, t350, t349),  # 0, 5
+        t396,  # 1, 0
+        t399,  # 1, 1
+        t402,  # 1, 2
+        xp.where(xp.logical_not(t409) & t410, t345, t344),  # 1, 3
+        xp.where(xp.logical_not(t411) & t413, t412, t353),  # 1, 4
+        xp.where(xp.logical_not(t414) & t415, t352, t351),  # 1, 5
+        t396,  # 2, 0
+        t418,  # 2, 1
+        t421,  # 2, 2
+        xp.where(xp.logical_not(t422) & t423, t356, t355),  # 2, 3
+        xp.where(xp.logical_not(t424) & t425, t360, t359),  # 2, 4
+        xp.where(xp.logical_not(t426) & t427, t363, t362),  # 2, 5
+        t396,  # 3, 0
+        t418,  # 3, 1
+        t421,  # 3, 2
+        xp.where(xp.logical_not(t428) & t429, t358, t357),  # 3, 3
+        xp.where(xp.logical_not(t430) & t432, t431, t366),  # 3, 4
+        xp.where(xp.logical_not(t433) & t434, t365, t364),  # 3, 5
+        t437,  # 4, 0
+        t440,  # 4, 1
+        t443,  # 4, 2
+        xp.where(xp.logical_not(t444) & t445, t369, t368),  # 4, 3
+        xp.where(xp.logical_not(t446) & t447, t373, t372),  # 4, 4
+        xp.where(xp.logical_not(t448) & t449, t376, t375),  # 4, 5
+        t437,  # 5, 0
+        t440,  # 5, 1
+        t443,  # 5, 2
+        xp.where(xp.logical_not(t450) & t451, t371, t370),  # 5, 3
+        xp.where(xp.logical_not(t452) & t454, t453, t379),  # 5, 4
+        xp.where(xp.logical_not(t455) & t456, t378, t377),  # 5, 5
+        t437,  # 6, 0
+        t459,  # 6, 1
+        t462,  # 6, 2
+        xp.where(xp.logical_not(t463) & t464, t382, t381),  # 6, 3
+        xp.where(xp.logical_not(t465) & t466, t386, t385),  # 6, 4
+        xp.where(xp.logical_not(t467) & t468, t389, t388),  # 6, 5
+        t437,  # 7, 0
+        t459,  # 7, 1
+        t462,  # 7, 2
+        xp.where(xp.logical_not(t469) & t470, t384, t383),  # 7, 3
+        xp.where(xp.logical_not(t471) & t473, t472, t392),  # 7, 4
+        xp.where(xp.logical_not(t474) & t475, t391, t390),  # 7, 5
     ], (8, 6))
     valid = _stack(xp, [
-        t493 & t495 & t496 & xp.greater_equal(t115, -1e-12),  # 0
-        t493 & t495 & t496 & t116,  # 1
-        t493 & t495 & t56 & xp.greater_equal(t165, -1e-12),  # 2
-        t493 & t495 & t56 & t166,  # 3
-        t493 & t494 & t497 & xp.greater_equal(t266, -1e-12),  # 4
-        t493 & t494 & t497 & t267,  # 5
-        t493 & t494 & t207 & xp.greater_equal(t316, -1e-12),  # 6
-        t493 & t494 & t207 & t317,  # 7
+        t476 & t478 & t479 & xp.greater_equal(t114, -1e-12),  # 0
+        t476 & t478 & t479 & t115,  # 1
+        t476 & t478 & t55 & xp.greater_equal(t163, -1e-12),  # 2
+        t476 & t478 & t55 & t164,  # 3
+        t476 & t477 & t480 & xp.greater_equal(t263, -1e-12),  # 4
+        t476 & t477 & t480 & t264,  # 5
+        t476 & t477 & t204 & xp.greater_equal(t312, -1e-12),  # 6
+        t476 & t477 & t204 & t313,  # 7
     ], (8,))
     in_limits = _stack(xp, [
-        t498 & t499 & t500 & (t420 | t421) & (t422 | t423) & (t424 | t425),  # 0
-        t498 & t499 & t500 & (t426 | t427) & (t428 | t430) & (t431 | t432),  # 1
-        t498 & t501 & t502 & (t439 | t440) & (t441 | t442) & (t443 | t444),  # 2
-        t498 & t501 & t502 & (t445 | t446) & (t447 | t449) & (t450 | t451),  # 3
-        t503 & t504 & t505 & (t461 | t462) & (t463 | t464) & (t465 | t466),  # 4
-        t503 & t504 & t505 & (t467 | t468) & (t469 | t471) & (t472 | t473),  # 5
-        t503 & t506 & t507 & (t480 | t481) & (t482 | t483) & (t484 | t485),  # 6
-        t503 & t506 & t507 & (t486 | t487) & (t488 | t490) & (t491 | t492),  # 7
+        t481 & t482 & t483 & (t403 | t404) & (t405 | t406) & (t407 | t408),  # 0
+        t481 & t482 & t483 & (t409 | t410) & (t411 | t413) & (t414 | t415),  # 1
+        t481 & t484 & t485 & (t422 | t423) & (t424 | t425) & (t426 | t427),  # 2
+        t481 & t484 & t485 & (t428 | t429) & (t430 | t432) & (t433 | t434),  # 3
+        t486 & t487 & t488 & (t444 | t445) & (t446 | t447) & (t448 | t449),  # 4
+        t486 & t487 & t488 & (t450 | t451) & (t452 | t454) & (t455 | t456),  # 5
+        t486 & t489 & t490 & (t463 | t464) & (t465 | t466) & (t467 | t468),  # 6
+        t486 & t489 & t490 & (t469 | t470) & (t471 | t473) & (t474 | t475),  # 7
     ], (8,))
     return q, valid, in_limits
 

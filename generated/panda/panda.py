@@ -900,75 +900,62 @@ def fk_jacobian_dot(q, q_dot):
     t66 = -t64 + t63
     t67 = s1*t51
     t68 = -c2*t36 + s2*t67
-    t69 = t68
-    t70 = -t4*t50 + t35*t41
-    t71 = t70
-    t72 = t26*t49 - t40*t34
-    t73 = t72
-    t74 = t43*t33 - t28*t48
-    t75 = t74
-    t76 = t75*qd6 + t73*qd5
-    t77 = t76 + t71*qd4
-    t78 = t77 + t69*qd3
-    t79 = c1*t51
-    t80 = c2*t22 - s2*t79
-    t81 = t80
-    t82 = t7*t50 + t21*t41
-    t83 = t82
-    t84 = t40*t20 - t12*t49
-    t85 = t84
-    t86 = t14*t48 + t43*t19
-    t87 = t86
-    t88 = -t87*qd6 + t85*qd5
-    t89 = t88 - t83*qd4
-    t90 = t89 + t81*qd3
-    t91 = c1*t22 + s1*t36
-    t92 = t91
-    t93 = t36*t9 - t22*t23
-    t94 = t93
-    t95 = t4*t21 + t7*t35
-    t96 = t95
-    t97 = t12*t34 - t26*t20
-    t98 = t97
-    t99 = t14*t33 + t28*t19
-    t100 = t99
-    t101 = t100*qd6 + t98*qd5
-    t102 = t101 + t96*qd4
-    t103 = t102 + t94*qd3
-    t104 = t103 - t92*qd2
-    t105 = s1*qd2
-    t106 = -t105 + t9*qd3
-    t107 = t106 + t7*qd4
-    t108 = t107 + t12*qd5
-    t109 = t90 + t51*t105
-    t110 = t109 + t22*qd1
-    t111 = c1*qd2
-    t112 = t111 + t23*qd3
-    t113 = t112 - t4*qd4
-    t114 = t113 + t26*qd5
-    t115 = t78 + t51*t111
-    t116 = t115 - t36*qd1
-    t117 = t14*qd6
-    t118 = t108 + t117
-    t119 = t28*qd6
-    t120 = -t119 + t114
-    t121 = t43*qd6
-    t122 = -t121 + t54
-    t123 = -t16
-    t124 = -t30
-    t125 = -t45
+    t69 = -t4*t50 + t35*t41
+    t70 = t26*t49 - t40*t34
+    t71 = t43*t33 - t28*t48
+    t72 = t71*qd6 + t70*qd5
+    t73 = t72 + t69*qd4
+    t74 = t73 + t68*qd3
+    t75 = c1*t51
+    t76 = c2*t22 - s2*t75
+    t77 = t7*t50 + t21*t41
+    t78 = t40*t20 - t12*t49
+    t79 = t14*t48 + t43*t19
+    t80 = -t79*qd6 + t78*qd5
+    t81 = t80 - t77*qd4
+    t82 = t81 + t76*qd3
+    t83 = c1*t22 + s1*t36
+    t84 = t36*t9 - t22*t23
+    t85 = t4*t21 + t7*t35
+    t86 = t12*t34 - t26*t20
+    t87 = t14*t33 + t28*t19
+    t88 = t87*qd6 + t86*qd5
+    t89 = t88 + t85*qd4
+    t90 = t89 + t84*qd3
+    t91 = t90 - t83*qd2
+    t92 = s1*qd2
+    t93 = -t92 + t9*qd3
+    t94 = t93 + t7*qd4
+    t95 = t94 + t12*qd5
+    t96 = t82 + t51*t92
+    t97 = t96 + t22*qd1
+    t98 = c1*qd2
+    t99 = t98 + t23*qd3
+    t100 = t99 - t4*qd4
+    t101 = t100 + t26*qd5
+    t102 = t74 + t51*t98
+    t103 = t102 - t36*qd1
+    t104 = t14*qd6
+    t105 = t95 + t104
+    t106 = t28*qd6
+    t107 = -t106 + t101
+    t108 = t43*qd6
+    t109 = -t108 + t54
+    t110 = -t16
+    t111 = -t30
+    t112 = -t45
     T = _stack(xp, [
         xp.broadcast_to(t57, batch),  # 0, 0
         xp.broadcast_to(t58, batch),  # 0, 1
-        xp.broadcast_to(t123, batch),  # 0, 2
+        xp.broadcast_to(t110, batch),  # 0, 2
         xp.broadcast_to(t22, batch),  # 0, 3
         xp.broadcast_to(t61, batch),  # 1, 0
         xp.broadcast_to(t62, batch),  # 1, 1
-        xp.broadcast_to(t124, batch),  # 1, 2
+        xp.broadcast_to(t111, batch),  # 1, 2
         xp.broadcast_to(t36, batch),  # 1, 3
         xp.broadcast_to(t65, batch),  # 2, 0
         xp.broadcast_to(t66, batch),  # 2, 1
-        xp.broadcast_to(t125, batch),  # 2, 2
+        xp.broadcast_to(t112, batch),  # 2, 2
         xp.broadcast_to(t52, batch),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1
@@ -977,25 +964,25 @@ def fk_jacobian_dot(q, q_dot):
     ], (4, 4))
     J = _stack(xp, [
         xp.broadcast_to(-t36, batch),  # 0, 0
-        xp.broadcast_to(t79, batch),  # 0, 1
+        xp.broadcast_to(t75, batch),  # 0, 1
         xp.broadcast_to(t68, batch),  # 0, 2
-        xp.broadcast_to(t70, batch),  # 0, 3
-        xp.broadcast_to(t72, batch),  # 0, 4
-        xp.broadcast_to(t74, batch),  # 0, 5
+        xp.broadcast_to(t69, batch),  # 0, 3
+        xp.broadcast_to(t70, batch),  # 0, 4
+        xp.broadcast_to(t71, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         xp.broadcast_to(t22, batch),  # 1, 0
         xp.broadcast_to(t67, batch),  # 1, 1
-        xp.broadcast_to(t80, batch),  # 1, 2
-        xp.broadcast_to(-t82, batch),  # 1, 3
-        xp.broadcast_to(t84, batch),  # 1, 4
-        xp.broadcast_to(-t86, batch),  # 1, 5
+        xp.broadcast_to(t76, batch),  # 1, 2
+        xp.broadcast_to(-t77, batch),  # 1, 3
+        xp.broadcast_to(t78, batch),  # 1, 4
+        xp.broadcast_to(-t79, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t91, batch),  # 2, 1
-        xp.broadcast_to(t93, batch),  # 2, 2
-        xp.broadcast_to(t95, batch),  # 2, 3
-        xp.broadcast_to(t97, batch),  # 2, 4
-        xp.broadcast_to(t99, batch),  # 2, 5
+        xp.broadcast_to(-t83, batch),  # 2, 1
+        xp.broadcast_to(t84, batch),  # 2, 2
+        xp.broadcast_to(t85, batch),  # 2, 3
+        xp.broadcast_to(t86, batch),  # 2, 4
+        xp.broadcast_to(t87, batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(-s1, batch),  # 3, 1
@@ -1003,29 +990,29 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t7, batch),  # 3, 3
         xp.broadcast_to(t12, batch),  # 3, 4
         xp.broadcast_to(t14, batch),  # 3, 5
-        xp.broadcast_to(t123, batch),  # 3, 6
+        xp.broadcast_to(t110, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(c1, batch),  # 4, 1
         xp.broadcast_to(t23, batch),  # 4, 2
         xp.broadcast_to(-t4, batch),  # 4, 3
         xp.broadcast_to(t26, batch),  # 4, 4
         xp.broadcast_to(-t28, batch),  # 4, 5
-        xp.broadcast_to(t124, batch),  # 4, 6
+        xp.broadcast_to(t111, batch),  # 4, 6
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.broadcast_to(c2, batch),  # 5, 2
         xp.broadcast_to(-t41, batch),  # 5, 3
         xp.broadcast_to(t40, batch),  # 5, 4
         xp.broadcast_to(-t43, batch),  # 5, 5
-        xp.broadcast_to(t125, batch),  # 5, 6
+        xp.broadcast_to(t112, batch),  # 5, 6
     ], (6, 7))
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t110 + qd5*(t98*t113 - t85*t53 + t26*t101 - t40*t88) + qd2*(c1*t104 - t67*qd1) + qd3*(-t81*qd1 - c2*t90 + t94*t111 + t23*t103) + qd4*(t96*t112 + t83*t0 - t4*t102 + t41*t89) + qd6*(t100*t114 + t87*t54 - t100*t119 - t87*t121), batch),  # 0
-        xp.broadcast_to(qd1*t116 + qd5*(t73*t53 - t98*t107 + t40*t76 - t12*t101) + qd2*(s1*t104 + t79*qd1) + qd3*(t69*qd1 + c2*t78 + t105*t94 - t9*t103) - qd4*(t96*t106 + t7*t102 - t71*t0 + t41*t77) - qd6*(t100*t108 - t75*t54 + t75*t121 + t100*t117), batch),  # 1
-        xp.broadcast_to(qd4*(-t83*t106 - t71*t112 + t7*t89 + t4*t77) + qd5*(t85*t107 - t73*t113 + t12*t88 - t26*t76) - qd2*(s1*t109 + c1*t115) - qd3*(t105*t81 + t69*t111 - t9*t90 + t23*t78) - qd6*(t75*t114 + t87*t108 + t87*t117 - t75*t119), batch),  # 2
-        xp.broadcast_to(qd5*(t40*t113 - t26*t53) + qd6*(-t43*t114 + t28*t54) + qd7*(-t45*t120 + t30*t122) - qd1*t111 + qd3*(c2*t111 - t23*qd1) + qd4*(t4*t0 - t41*t112), batch),  # 3
-        xp.broadcast_to(qd5*(t12*t53 - t40*t107) + qd6*(t14*t54 + t43*t108) + qd7*(-t16*t122 + t45*t118) - t105*qd1 + qd3*(t9*qd1 + c2*t105) + qd4*(t7*t0 + t41*t106), batch),  # 4
-        xp.broadcast_to(qd5*(t26*t107 - t12*t113) + qd7*(-t30*t118 + t16*t120) - qd4*(t4*t106 + t7*t112) - qd6*(t28*t108 + t14*t114) - qd3*(t23*t105 + t9*t111), batch),  # 5
+        xp.broadcast_to(-qd1*t97 + qd2*(c1*t91 - t67*qd1) + qd5*(t26*t88 - t40*t80 + t86*t100 - t78*t53) + qd3*(-c2*t82 + t23*t90 - t76*qd1 + t84*t98) + qd4*(-t4*t89 + t41*t81 + t85*t99 + t77*t0) + qd6*(t87*t101 + t79*t54 - t87*t106 - t79*t108), batch),  # 0
+        xp.broadcast_to(qd1*t103 + qd2*(s1*t91 + t75*qd1) + qd5*(t40*t72 - t12*t88 + t70*t53 - t86*t94) + qd3*(c2*t74 - t9*t90 + t68*qd1 + t84*t92) - qd4*(t7*t89 + t41*t73 + t85*t93 - t69*t0) - qd6*(t87*t95 - t71*t54 + t71*t108 + t87*t104), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t96 + c1*t102) + qd4*(t7*t81 + t4*t73 - t77*t93 - t69*t99) + qd5*(t12*t80 - t26*t72 + t78*t94 - t70*t100) - qd3*(-t9*t82 + t23*t74 + t76*t92 + t68*t98) - qd6*(t71*t101 + t79*t95 + t79*t104 - t71*t106), batch),  # 2
+        xp.broadcast_to(qd5*(t40*t100 - t26*t53) + qd6*(-t43*t101 + t28*t54) + qd7*(-t45*t107 + t30*t109) - qd1*t98 + qd3*(c2*t98 - t23*qd1) + qd4*(t4*t0 - t41*t99), batch),  # 3
+        xp.broadcast_to(qd5*(t12*t53 - t40*t94) + qd6*(t14*t54 + t43*t95) + qd7*(-t16*t109 + t45*t105) - t92*qd1 + qd3*(t9*qd1 + c2*t92) + qd4*(t7*t0 + t41*t93), batch),  # 4
+        xp.broadcast_to(qd5*(t26*t94 - t12*t100) + qd7*(-t30*t105 + t16*t107) - qd4*(t4*t93 + t7*t99) - qd6*(t28*t95 + t14*t101) - qd3*(t23*t92 + t9*t98), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -2640,42 +2627,41 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t229 = t226 - t199*t228
     t230 = t227 - t196*t228
     t231 = xp.abs(t230)
-    t232 = t231
-    t233 = t232*xp.where(xp.greater_equal(t230, 0), xp.asarray(1, dtype=dtype), -1)
-    t234 = t230 + t233
-    t235 = xp.where(xp.greater(t232, 0), 1/(t232*(t231 + t232)), 0)
-    t236 = t203 - t203*t234**2*t235
-    t237 = xp.where(xp.not_equal(t233, 0), -t236/t233, 0)
-    t238 = xp.where(xp.not_equal(t198, 0), -(t202 - t229*t237)/t198, 0)
-    t239 = xp.where(xp.not_equal(t167, 0), -(-(t194*t238 + t225*t237) + t171)/t167, 0)
-    t240 = xp.where(xp.not_equal(t139, 0), -(-(t162*t239 + t189*t238 + t220*t237) + t143)/t139, 0)
-    t241 = xp.where(xp.not_equal(t115, 0), -(-(-t133*t240 - t156*t239 + t183*t238 + t214*t237) + t119)/t115, 0)
-    t242 = xp.where(xp.not_equal(t96, 0), -(-(t108*t241 + t126*t240 + t149*t239 + t176*t238 - t207*t237) + t100)/t96, 0)
-    t243 = t237 - t31*t242 + t19*t241
-    t244 = t51*t242 + t55*t241 + t33*t240 + c2*t237 + t8*t239 + t20*t238
-    t245 = t52*t242 - t56*t241 + t34*t240 + t6*t239 - t3*t238 - t42*t237
-    t246 = t53*t242 + t57*t241 + t35*t240 + t11*t239 + t23*t238 + t41*t237
-    t247 = t54*t242 - t58*t241 + t36*t240 + t13*t239 - t25*t238 - t44*t237
-    t248 = t15*t239 + t27*t238 + t46*t237
-    t249 = c1*t50
-    t250 = s1*t50
-    t251 = -t32*t240 - s1*t239 + c1*t238 + t249*t242 + t250*t241
-    t252 = 1 - t31 - t56 - t58 - t32 - s1 - t15 - t3 - t25 - t27 - t44 - t46 - t42 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t11 + t23 + t41 + q5 + t13 + q6 + q7 + t19 + t8 + t20 + t51 + t52 + t53 + t54 + t55 + t57 + t33 + t34 + t35 + t36 + t249 + t250 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t253 = xp.isfinite(t252)
-    t254 = xp.greater_equal(damping, 0)
-    t255 = 1e-12*t205
-    t256 = xp.less_equal(t95, t255) | xp.less_equal(t114, t255) | xp.less_equal(t138, t255) | xp.less_equal(t166, t255) | xp.less_equal(t197, t255) | xp.less_equal(t232, t255)
-    t257 = t253 & t254 & xp.logical_not(t256)
+    t232 = t231*xp.where(xp.greater_equal(t230, 0), xp.asarray(1, dtype=dtype), -1)
+    t233 = t230 + t232
+    t234 = xp.where(xp.greater(t231, 0), 1/(t231*2*t231), 0)
+    t235 = t203 - t203*t233**2*t234
+    t236 = xp.where(xp.not_equal(t232, 0), -t235/t232, 0)
+    t237 = xp.where(xp.not_equal(t198, 0), -(t202 - t229*t236)/t198, 0)
+    t238 = xp.where(xp.not_equal(t167, 0), -(-(t194*t237 + t225*t236) + t171)/t167, 0)
+    t239 = xp.where(xp.not_equal(t139, 0), -(-(t162*t238 + t189*t237 + t220*t236) + t143)/t139, 0)
+    t240 = xp.where(xp.not_equal(t115, 0), -(-(-t133*t239 - t156*t238 + t183*t237 + t214*t236) + t119)/t115, 0)
+    t241 = xp.where(xp.not_equal(t96, 0), -(-(t108*t240 + t126*t239 + t149*t238 + t176*t237 - t207*t236) + t100)/t96, 0)
+    t242 = t236 - t31*t241 + t19*t240
+    t243 = t51*t241 + t55*t240 + t33*t239 + c2*t236 + t8*t238 + t20*t237
+    t244 = t52*t241 - t56*t240 + t34*t239 + t6*t238 - t3*t237 - t42*t236
+    t245 = t53*t241 + t57*t240 + t35*t239 + t11*t238 + t23*t237 + t41*t236
+    t246 = t54*t241 - t58*t240 + t36*t239 + t13*t238 - t25*t237 - t44*t236
+    t247 = t15*t238 + t27*t237 + t46*t236
+    t248 = c1*t50
+    t249 = s1*t50
+    t250 = -t32*t239 - s1*t238 + c1*t237 + t248*t241 + t249*t240
+    t251 = 1 - t31 - t56 - t58 - t32 - s1 - t15 - t3 - t25 - t27 - t44 - t46 - t42 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t11 + t23 + t41 + q5 + t13 + q6 + q7 + t19 + t8 + t20 + t51 + t52 + t53 + t54 + t55 + t57 + t33 + t34 + t35 + t36 + t248 + t249 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t252 = xp.isfinite(t251)
+    t253 = xp.greater_equal(damping, 0)
+    t254 = 1e-12*t205
+    t255 = xp.less_equal(t95, t254) | xp.less_equal(t114, t254) | xp.less_equal(t138, t254) | xp.less_equal(t166, t254) | xp.less_equal(t197, t254) | xp.less_equal(t231, t254)
+    t256 = t252 & t253 & xp.logical_not(t255)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t257, t243, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t257, t251, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t257, t244, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t257, t245, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t257, t246, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t257, t247, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t257, -t248, 0), batch),  # 6
+        xp.broadcast_to(xp.where(t256, t242, 0), batch),  # 0
+        xp.broadcast_to(xp.where(t256, t250, 0), batch),  # 1
+        xp.broadcast_to(xp.where(t256, t243, 0), batch),  # 2
+        xp.broadcast_to(xp.where(t256, t244, 0), batch),  # 3
+        xp.broadcast_to(xp.where(t256, t245, 0), batch),  # 4
+        xp.broadcast_to(xp.where(t256, t246, 0), batch),  # 5
+        xp.broadcast_to(xp.where(t256, -t247, 0), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t253 & t254), 2, xp.where(t256, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t252 & t253), 2, xp.where(t255, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -3000,25 +2986,24 @@ def ik_numeric_step(target, q, damping=0.0):
     t274 = t271 - t245*t273
     t275 = t272 - t242*t273
     t276 = xp.abs(t275)
-    t277 = t276
-    t278 = t277*xp.where(xp.greater_equal(t275, 0), xp.asarray(1, dtype=dtype), -1)
-    t279 = t275 + t278
-    t280 = xp.where(xp.greater(t277, 0), 1/(t277*(t276 + t277)), 0)
-    t281 = t249 - t249*t279**2*t280
-    t282 = xp.where(xp.not_equal(t278, 0), -t281/t278, 0)
-    t283 = xp.where(xp.not_equal(t244, 0), -(t248 - t274*t282)/t244, 0)
-    t284 = xp.where(xp.not_equal(t213, 0), -(-(t240*t283 + t270*t282) + t217)/t213, 0)
-    t285 = xp.where(xp.not_equal(t185, 0), -(-(t208*t284 + t235*t283 + t265*t282) + t189)/t185, 0)
-    t286 = xp.where(xp.not_equal(t161, 0), -(-(-t179*t285 - t202*t284 + t229*t283 + t259*t282) + t165)/t161, 0)
-    t287 = xp.where(xp.not_equal(t142, 0), -(-(t154*t286 + t172*t285 + t195*t284 + t222*t283 - t252*t282) + t146)/t142, 0)
-    t288 = q1 + t282 - t42*t287 + t28*t286
-    t289 = q2 + c1*t60*t287 + s1*t60*t286 - t43*t285 - s1*t284 + c1*t283
-    t290 = q3 + t62*t287 + t66*t286 + t44*t285 + c2*t282 + t16*t284 + t30*t283
-    t291 = q4 + t63*t287 - t67*t286 + t45*t285 + t7*t284 - t4*t283 - t50*t282
-    t292 = q5 + t64*t287 + t68*t286 + t46*t285 + t18*t284 + t32*t283 + t15*t282
-    t293 = q6 + t65*t287 - t69*t286 + t47*t285 + t20*t284 - t34*t283 - t52*t282
-    t294 = -q7 + t22*t284 + t36*t283 + t54*t282
-    t295 = -t294
+    t277 = t276*xp.where(xp.greater_equal(t275, 0), xp.asarray(1, dtype=dtype), -1)
+    t278 = t275 + t277
+    t279 = xp.where(xp.greater(t276, 0), 1/(t276*2*t276), 0)
+    t280 = t249 - t249*t278**2*t279
+    t281 = xp.where(xp.not_equal(t277, 0), -t280/t277, 0)
+    t282 = xp.where(xp.not_equal(t244, 0), -(t248 - t274*t281)/t244, 0)
+    t283 = xp.where(xp.not_equal(t213, 0), -(-(t240*t282 + t270*t281) + t217)/t213, 0)
+    t284 = xp.where(xp.not_equal(t185, 0), -(-(t208*t283 + t235*t282 + t265*t281) + t189)/t185, 0)
+    t285 = xp.where(xp.not_equal(t161, 0), -(-(-t179*t284 - t202*t283 + t229*t282 + t259*t281) + t165)/t161, 0)
+    t286 = xp.where(xp.not_equal(t142, 0), -(-(t154*t285 + t172*t284 + t195*t283 + t222*t282 - t252*t281) + t146)/t142, 0)
+    t287 = q1 + t281 - t42*t286 + t28*t285
+    t288 = q2 + c1*t60*t286 + s1*t60*t285 - t43*t284 - s1*t283 + c1*t282
+    t289 = q3 + t62*t286 + t66*t285 + t44*t284 + c2*t281 + t16*t283 + t30*t282
+    t290 = q4 + t63*t286 - t67*t285 + t45*t284 + t7*t283 - t4*t282 - t50*t281
+    t291 = q5 + t64*t286 + t68*t285 + t46*t284 + t18*t283 + t32*t282 + t15*t281
+    t292 = q6 + t65*t286 - t69*t285 + t47*t284 + t20*t283 - t34*t282 - t52*t281
+    t293 = -q7 + t22*t283 + t36*t282 + t54*t281
+    t294 = -t293
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -3029,13 +3014,13 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q7, batch),  # 6
     ], (7,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t288, -2.8973), -2.8973, xp.where(xp.greater(t288, 2.8973), 2.8973, t288)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t289, -1.7627999999999997), -1.7627999999999997, xp.where(xp.greater(t289, 1.7627999999999997), 1.7627999999999997, t289)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t290, -2.8973), -2.8973, xp.where(xp.greater(t290, 2.8973), 2.8973, t290)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t291, -3.0718), -3.0718, xp.where(xp.greater(t291, -0.0698), -0.0698, t291)), batch),  # 3
-        xp.broadcast_to(xp.where(xp.less(t292, -2.8973), -2.8973, xp.where(xp.greater(t292, 2.8973), 2.8973, t292)), batch),  # 4
-        xp.broadcast_to(xp.where(xp.less(t293, -0.0175), -0.0175, xp.where(xp.greater(t293, 3.7525000000000004), 3.7525000000000004, t293)), batch),  # 5
-        xp.broadcast_to(xp.where(xp.less(t295, -2.8973), -2.8973, xp.where(xp.greater(t295, 2.8973), 2.8973, t295)), batch),  # 6
+        xp.broadcast_to(xp.where(xp.less(t287, -2.8973), -2.8973, xp.where(xp.greater(t287, 2.8973), 2.8973, t287)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t288, -1.7627999999999997), -1.7627999999999997, xp.where(xp.greater(t288, 1.7627999999999997), 1.7627999999999997, t288)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t289, -2.8973), -2.8973, xp.where(xp.greater(t289, 2.8973), 2.8973, t289)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t290, -3.0718), -3.0718, xp.where(xp.greater(t290, -0.0698), -0.0698, t290)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t291, -2.8973), -2.8973, xp.where(xp.greater(t291, 2.8973), 2.8973, t291)), batch),  # 4
+        xp.broadcast_to(xp.where(xp.less(t292, -0.0175), -0.0175, xp.where(xp.greater(t292, 3.7525000000000004), 3.7525000000000004, t292)), batch),  # 5
+        xp.broadcast_to(xp.where(xp.less(t294, -2.8973), -2.8973, xp.where(xp.greater(t294, 2.8973), 2.8973, t294)), batch),  # 6
     ], (7,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t0), t139, -1), batch)
     return q_start, q_next, cost
@@ -3225,555 +3210,547 @@ def ik_branches(T, q_free):
     t162 = t160 + t158*t155
     t163 = t158*t151 + t159*t154
     t164 = t161**2 + t162**2
-    t165 = t164
-    t166 = t164 + t163**2
-    t167 = 1 - t101
-    t168 = t167*t16
-    t169 = t168 + t16*t101
-    t170 = t167*t14
-    t171 = t170 + t14*t101
-    t172 = t109*t103 + t110*t169
-    t173 = t109*t169 - t110*t103
-    t174 = t109*t105 + t110*t171
-    t175 = t109*t171 - t110*t105
-    t176 = t129*t173
-    t177 = t176 + t35*t173
-    t178 = t129*t175
-    t179 = t178 + t35*t175
-    t180 = 1 - t109
-    t181 = t180*t104
-    t182 = t181 + t109*t104
-    t183 = t180*t106
-    t184 = t183 + t109*t106
-    t185 = t35*t172 + t39*t182
-    t186 = -t35*t182 + t39*t172
-    t187 = t35*t174 + t39*t184
-    t188 = -t35*t184 + t39*t174
-    t189 = t186**2
-    t190 = -t189
-    t191 = 1 + t190
-    t192 = xp.greater(t191, 1e-12)
-    t193 = xp.where(t192, xp.sqrt(t191), 0)
-    t194 = t189 - t185*t193
-    t195 = t190 + t194
-    t196 = t177**2
-    t197 = t189 + t196 + t185**2
-    t198 = t193**2
-    t199 = t195**2 + t196*t198
-    t200 = t189 + t198
-    t201 = 1e-24*t200
-    t202 = xp.less_equal(t199, t201*t197)
-    t203 = xp.where(t202, 1, 1/xp.sqrt(t199))
-    t204 = xp.where(t202, 1, t195*t203)
-    t205 = t188*(1 - t204)
-    t206 = t205 + t188*t204
-    t207 = t177*t193
-    t208 = xp.where(t202, 0, -t207*t203)
-    t209 = t187*t204 + t179*t208
-    t210 = t179*t204 - t187*t208
-    t211 = xp.less_equal(t200, t201)
-    t212 = xp.where(t211, 1, 1/xp.sqrt(t200))
-    t213 = xp.where(t211, 1, t186*t212)
-    t214 = xp.where(t211, 0, -t193*t212)
-    t215 = t210*(1 - t213)
-    t216 = t213*t209 - t214*t206
-    t217 = t215 + t213*t210
-    t218 = t213*t206 + t214*t209
-    t219 = t216**2 + t217**2
-    t220 = t219
-    t221 = t219 + t218**2
-    t222 = t48**2
-    t223 = t50**2
-    t224 = t222 + t223
-    t225 = t19 + t223
-    t226 = -t224 + t225
-    t227 = -t226
-    t228 = 1e-12*t224
-    t229 = xp.greater(t227, t228)
-    t230 = xp.where(t229, xp.sqrt(t227), 0)
-    t231 = t225 + t230**2
-    t232 = t12*t230
-    t233 = t19 + t2*t50
-    t234 = -t232 + t233
+    t165 = t164 + t163**2
+    t166 = 1 - t101
+    t167 = t166*t16
+    t168 = t167 + t16*t101
+    t169 = t166*t14
+    t170 = t169 + t14*t101
+    t171 = t109*t103 + t110*t168
+    t172 = t109*t168 - t110*t103
+    t173 = t109*t105 + t110*t170
+    t174 = t109*t170 - t110*t105
+    t175 = t129*t172
+    t176 = t175 + t35*t172
+    t177 = t129*t174
+    t178 = t177 + t35*t174
+    t179 = 1 - t109
+    t180 = t179*t104
+    t181 = t180 + t109*t104
+    t182 = t179*t106
+    t183 = t182 + t109*t106
+    t184 = t35*t171 + t39*t181
+    t185 = -t35*t181 + t39*t171
+    t186 = t35*t173 + t39*t183
+    t187 = -t35*t183 + t39*t173
+    t188 = t185**2
+    t189 = -t188
+    t190 = 1 + t189
+    t191 = xp.greater(t190, 1e-12)
+    t192 = xp.where(t191, xp.sqrt(t190), 0)
+    t193 = t188 - t184*t192
+    t194 = t189 + t193
+    t195 = t176**2
+    t196 = t188 + t195 + t184**2
+    t197 = t192**2
+    t198 = t194**2 + t195*t197
+    t199 = t188 + t197
+    t200 = 1e-24*t199
+    t201 = xp.less_equal(t198, t200*t196)
+    t202 = xp.where(t201, 1, 1/xp.sqrt(t198))
+    t203 = xp.where(t201, 1, t194*t202)
+    t204 = t187*(1 - t203)
+    t205 = t204 + t187*t203
+    t206 = t176*t192
+    t207 = xp.where(t201, 0, -t206*t202)
+    t208 = t186*t203 + t178*t207
+    t209 = t178*t203 - t186*t207
+    t210 = xp.less_equal(t199, t200)
+    t211 = xp.where(t210, 1, 1/xp.sqrt(t199))
+    t212 = xp.where(t210, 1, t185*t211)
+    t213 = xp.where(t210, 0, -t192*t211)
+    t214 = t209*(1 - t212)
+    t215 = t212*t208 - t213*t205
+    t216 = t214 + t212*t209
+    t217 = t212*t205 + t213*t208
+    t218 = t215**2 + t216**2
+    t219 = t218 + t217**2
+    t220 = t48**2
+    t221 = t50**2
+    t222 = t220 + t221
+    t223 = t19 + t221
+    t224 = -t222 + t223
+    t225 = -t224
+    t226 = 1e-12*t222
+    t227 = xp.greater(t225, t226)
+    t228 = xp.where(t227, xp.sqrt(t225), 0)
+    t229 = t223 + t228**2
+    t230 = t12*t228
+    t231 = t19 + t2*t50
+    t232 = -t230 + t231
+    t233 = t65 + t232
+    t234 = t230 + t231
     t235 = t65 + t234
-    t236 = t232 + t233
-    t237 = t65 + t236
-    t238 = t12*t50
-    t239 = t2*t230
-    t240 = t238 + t239
+    t236 = t12*t50
+    t237 = t2*t228
+    t238 = t236 + t237
+    t239 = t233**2 + t238**2
+    t240 = -t237 + t236
     t241 = t235**2 + t240**2
-    t242 = -t239 + t238
-    t243 = t237**2 + t242**2
-    t244 = 1e-24*t231
-    t245 = t244*t20
-    t246 = xp.less_equal(t241, t245)
-    t247 = xp.where(t246, 1, 1/xp.sqrt(t241))
-    t248 = xp.where(t246, 1, t235*t247)
-    t249 = xp.where(t246, 0, -t240*t247)
-    t250 = t10*t248 - T22*t249
-    t251 = T22*t248 + t10*t249
-    t252 = t8*t248 - T02*t249
-    t253 = T02*t248 + t8*t249
-    t254 = t48*t230
-    t255 = -t254 + t223
-    t256 = t223 + t254
-    t257 = -t223
-    t258 = t257 + t255
-    t259 = t257 + t256
-    t260 = t19*t222
-    t261 = t260 + t258**2
-    t262 = t260 + t259**2
-    t263 = t244*t224
-    t264 = xp.less_equal(t261, t263)
-    t265 = xp.where(t264, 1, 1/xp.sqrt(t261))
-    t266 = xp.where(t264, 1, t258*t265)
-    t267 = t18*t48
-    t268 = xp.where(t264, 0, t267*t265)
-    t269 = xp.less_equal(t243, t245)
-    t270 = xp.where(t269, 1, 1/xp.sqrt(t243))
-    t271 = xp.where(t269, 1, t237*t270)
-    t272 = xp.where(t269, 0, -t242*t270)
-    t273 = t10*t271 - T22*t272
-    t274 = T22*t271 + t10*t272
-    t275 = t8*t271 - T02*t272
-    t276 = T02*t271 + t8*t272
-    t277 = xp.less_equal(t262, t263)
-    t278 = xp.where(t277, 1, 1/xp.sqrt(t262))
-    t279 = xp.where(t277, 1, t259*t278)
-    t280 = xp.where(t277, 0, t267*t278)
-    t281 = 1 - t248
-    t282 = t281*t16
-    t283 = t282 + t16*t248
-    t284 = t281*t14
-    t285 = t284 + t14*t248
-    t286 = t266*t250 + t268*t283
-    t287 = t266*t283 - t268*t250
-    t288 = t266*t252 + t268*t285
-    t289 = t266*t285 - t268*t252
-    t290 = 1 - t266
-    t291 = t290*t251
-    t292 = t291 + t266*t251
-    t293 = t290*t253
-    t294 = t293 + t266*t253
+    t242 = 1e-24*t229
+    t243 = t242*t20
+    t244 = xp.less_equal(t239, t243)
+    t245 = xp.where(t244, 1, 1/xp.sqrt(t239))
+    t246 = xp.where(t244, 1, t233*t245)
+    t247 = xp.where(t244, 0, -t238*t245)
+    t248 = t10*t246 - T22*t247
+    t249 = T22*t246 + t10*t247
+    t250 = t8*t246 - T02*t247
+    t251 = T02*t246 + t8*t247
+    t252 = t48*t228
+    t253 = -t252 + t221
+    t254 = t221 + t252
+    t255 = -t221
+    t256 = t255 + t253
+    t257 = t255 + t254
+    t258 = t19*t220
+    t259 = t258 + t256**2
+    t260 = t258 + t257**2
+    t261 = t242*t222
+    t262 = xp.less_equal(t259, t261)
+    t263 = xp.where(t262, 1, 1/xp.sqrt(t259))
+    t264 = xp.where(t262, 1, t256*t263)
+    t265 = t18*t48
+    t266 = xp.where(t262, 0, t265*t263)
+    t267 = xp.less_equal(t241, t243)
+    t268 = xp.where(t267, 1, 1/xp.sqrt(t241))
+    t269 = xp.where(t267, 1, t235*t268)
+    t270 = xp.where(t267, 0, -t240*t268)
+    t271 = t10*t269 - T22*t270
+    t272 = T22*t269 + t10*t270
+    t273 = t8*t269 - T02*t270
+    t274 = T02*t269 + t8*t270
+    t275 = xp.less_equal(t260, t261)
+    t276 = xp.where(t275, 1, 1/xp.sqrt(t260))
+    t277 = xp.where(t275, 1, t257*t276)
+    t278 = xp.where(t275, 0, t265*t276)
+    t279 = 1 - t246
+    t280 = t279*t16
+    t281 = t280 + t16*t246
+    t282 = t279*t14
+    t283 = t282 + t14*t246
+    t284 = t264*t248 + t266*t281
+    t285 = t264*t281 - t266*t248
+    t286 = t264*t250 + t266*t283
+    t287 = t264*t283 - t266*t250
+    t288 = 1 - t264
+    t289 = t288*t249
+    t290 = t289 + t264*t249
+    t291 = t288*t251
+    t292 = t291 + t264*t251
+    t293 = t36*t284 + t40*t290
+    t294 = t36*t290 - t40*t284
     t295 = t36*t286 + t40*t292
     t296 = t36*t292 - t40*t286
-    t297 = t36*t288 + t40*t294
-    t298 = t36*t294 - t40*t288
-    t299 = 1 + t36
-    t300 = t299*t287
+    t297 = 1 + t36
+    t298 = t297*t285
+    t299 = t298 - t36*t285
+    t300 = t297*t287
     t301 = t300 - t36*t287
-    t302 = t299*t289
-    t303 = t302 - t36*t289
-    t304 = t296**2
-    t305 = -t304
-    t306 = 1 + t305
-    t307 = xp.greater(t306, 1e-12)
-    t308 = xp.where(t307, xp.sqrt(t306), 0)
-    t309 = t304 + t295*t308
-    t310 = t305 + t309
-    t311 = t301**2
-    t312 = t304 + t311 + t295**2
-    t313 = t308**2
-    t314 = t310**2 + t311*t313
-    t315 = t304 + t313
-    t316 = 1e-24*t315
-    t317 = xp.less_equal(t314, t316*t312)
-    t318 = xp.where(t317, 1, 1/xp.sqrt(t314))
-    t319 = xp.where(t317, 1, t310*t318)
-    t320 = t298*(1 - t319)
-    t321 = t320 + t298*t319
-    t322 = t301*t308
-    t323 = xp.where(t317, 0, -t322*t318)
-    t324 = -t297*t319 + t303*t323
-    t325 = t303*t319 + t297*t323
-    t326 = xp.less_equal(t315, t316)
-    t327 = xp.where(t326, 1, 1/xp.sqrt(t315))
-    t328 = xp.where(t326, 1, t296*t327)
-    t329 = xp.where(t326, 0, -t308*t327)
-    t330 = t325*(1 - t328)
-    t331 = t328*t324 - t329*t321
-    t332 = t330 + t328*t325
-    t333 = t328*t321 + t329*t324
-    t334 = t331**2 + t332**2
-    t335 = t334
-    t336 = t334 + t333**2
-    t337 = 1 - t271
-    t338 = t337*t16
-    t339 = t338 + t16*t271
-    t340 = t337*t14
-    t341 = t340 + t14*t271
-    t342 = t279*t273 + t280*t339
-    t343 = t279*t339 - t280*t273
-    t344 = t279*t275 + t280*t341
-    t345 = t279*t341 - t280*t275
-    t346 = t299*t343
-    t347 = t346 - t36*t343
-    t348 = t299*t345
-    t349 = t348 - t36*t345
-    t350 = 1 - t279
-    t351 = t350*t274
-    t352 = t351 + t279*t274
-    t353 = t350*t276
-    t354 = t353 + t279*t276
-    t355 = t36*t342 + t40*t352
-    t356 = t36*t352 - t40*t342
-    t357 = t36*t344 + t40*t354
-    t358 = t36*t354 - t40*t344
-    t359 = t356**2
-    t360 = -t359
-    t361 = 1 + t360
-    t362 = xp.greater(t361, 1e-12)
-    t363 = xp.where(t362, xp.sqrt(t361), 0)
-    t364 = t359 + t355*t363
-    t365 = t360 + t364
-    t366 = t347**2
-    t367 = t359 + t366 + t355**2
-    t368 = t363**2
-    t369 = t365**2 + t366*t368
-    t370 = t359 + t368
-    t371 = 1e-24*t370
-    t372 = xp.less_equal(t369, t371*t367)
-    t373 = xp.where(t372, 1, 1/xp.sqrt(t369))
-    t374 = xp.where(t372, 1, t365*t373)
-    t375 = t358*(1 - t374)
-    t376 = t375 + t358*t374
-    t377 = t347*t363
-    t378 = xp.where(t372, 0, -t377*t373)
-    t379 = -t357*t374 + t349*t378
-    t380 = t349*t374 + t357*t378
-    t381 = xp.less_equal(t370, t371)
-    t382 = xp.where(t381, 1, 1/xp.sqrt(t370))
-    t383 = xp.where(t381, 1, t356*t382)
-    t384 = xp.where(t381, 0, -t363*t382)
-    t385 = t380*(1 - t383)
-    t386 = t383*t379 - t384*t376
-    t387 = t385 + t383*t380
-    t388 = t383*t376 + t384*t379
-    t389 = t386**2 + t387**2
-    t390 = t389
-    t391 = t389 + t388**2
-    t392 = xp.where(t76, 0, xp.atan2(-t70, t66))
+    t302 = t294**2
+    t303 = -t302
+    t304 = 1 + t303
+    t305 = xp.greater(t304, 1e-12)
+    t306 = xp.where(t305, xp.sqrt(t304), 0)
+    t307 = t302 + t293*t306
+    t308 = t303 + t307
+    t309 = t299**2
+    t310 = t302 + t309 + t293**2
+    t311 = t306**2
+    t312 = t308**2 + t309*t311
+    t313 = t302 + t311
+    t314 = 1e-24*t313
+    t315 = xp.less_equal(t312, t314*t310)
+    t316 = xp.where(t315, 1, 1/xp.sqrt(t312))
+    t317 = xp.where(t315, 1, t308*t316)
+    t318 = t296*(1 - t317)
+    t319 = t318 + t296*t317
+    t320 = t299*t306
+    t321 = xp.where(t315, 0, -t320*t316)
+    t322 = -t295*t317 + t301*t321
+    t323 = t301*t317 + t295*t321
+    t324 = xp.less_equal(t313, t314)
+    t325 = xp.where(t324, 1, 1/xp.sqrt(t313))
+    t326 = xp.where(t324, 1, t294*t325)
+    t327 = xp.where(t324, 0, -t306*t325)
+    t328 = t323*(1 - t326)
+    t329 = t326*t322 - t327*t319
+    t330 = t328 + t326*t323
+    t331 = t326*t319 + t327*t322
+    t332 = t329**2 + t330**2
+    t333 = t332 + t331**2
+    t334 = 1 - t269
+    t335 = t334*t16
+    t336 = t335 + t16*t269
+    t337 = t334*t14
+    t338 = t337 + t14*t269
+    t339 = t277*t271 + t278*t336
+    t340 = t277*t336 - t278*t271
+    t341 = t277*t273 + t278*t338
+    t342 = t277*t338 - t278*t273
+    t343 = t297*t340
+    t344 = t343 - t36*t340
+    t345 = t297*t342
+    t346 = t345 - t36*t342
+    t347 = 1 - t277
+    t348 = t347*t272
+    t349 = t348 + t277*t272
+    t350 = t347*t274
+    t351 = t350 + t277*t274
+    t352 = t36*t339 + t40*t349
+    t353 = t36*t349 - t40*t339
+    t354 = t36*t341 + t40*t351
+    t355 = t36*t351 - t40*t341
+    t356 = t353**2
+    t357 = -t356
+    t358 = 1 + t357
+    t359 = xp.greater(t358, 1e-12)
+    t360 = xp.where(t359, xp.sqrt(t358), 0)
+    t361 = t356 + t352*t360
+    t362 = t357 + t361
+    t363 = t344**2
+    t364 = t356 + t363 + t352**2
+    t365 = t360**2
+    t366 = t362**2 + t363*t365
+    t367 = t356 + t365
+    t368 = 1e-24*t367
+    t369 = xp.less_equal(t366, t368*t364)
+    t370 = xp.where(t369, 1, 1/xp.sqrt(t366))
+    t371 = xp.where(t369, 1, t362*t370)
+    t372 = t355*(1 - t371)
+    t373 = t372 + t355*t371
+    t374 = t344*t360
+    t375 = xp.where(t369, 0, -t374*t370)
+    t376 = -t354*t371 + t346*t375
+    t377 = t346*t371 + t354*t375
+    t378 = xp.less_equal(t367, t368)
+    t379 = xp.where(t378, 1, 1/xp.sqrt(t367))
+    t380 = xp.where(t378, 1, t353*t379)
+    t381 = xp.where(t378, 0, -t360*t379)
+    t382 = t377*(1 - t380)
+    t383 = t380*t376 - t381*t373
+    t384 = t382 + t380*t377
+    t385 = t380*t373 + t381*t376
+    t386 = t383**2 + t384**2
+    t387 = t386 + t385**2
+    t388 = xp.where(t76, 0, xp.atan2(-t70, t66))
+    t389 = t388 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t388))
+    t390 = -t389
+    t391 = 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t390)) + t389
+    t392 = xp.where(t94, 0, xp.atan2(t97, t88))
     t393 = t392 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t392))
     t394 = -t393
-    t395 = 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t394)) + t393
-    t396 = xp.where(t94, 0, xp.atan2(t97, t88))
-    t397 = t396 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t396))
-    t398 = -t397
-    t399 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t398)) + t397
-    t400 = -t30
-    t401 = 6.283185307179586*xp.floor(0.15915494309189535*(3.0718 + t400)) + t30
-    t402 = xp.where(t147, 0, xp.atan2(-t152, t140))
-    t403 = 3.141592653589793 + t402
-    t404 = t402 + 6.283185307179586*xp.ceil(-0.15915494309189535*t403)
-    t405 = t403 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t403))
-    t406 = -t404
-    t407 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t406)) + t404
-    t408 = xp.where(t156, 0, xp.atan2(-t138, t126))
-    t409 = t408 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t408))
-    t410 = t408
-    t411 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t410)) + t410
-    t412 = -t409
-    t413 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t412)) + t409
-    t414 = xp.where(xp.less_equal(t165, 1e-24*t166), 0, xp.atan2(t162, t161))
-    t415 = 3.141592653589793 + t414
-    t416 = 6.283185307179586*xp.ceil(-0.15915494309189535*t415) + t414
-    t417 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t415)) + t415
-    t418 = -t416
-    t419 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t418)) + t416
-    t420 = -t405
-    t421 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t420)) + t405
-    t422 = -t417
-    t423 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t422)) + t417
-    t424 = xp.where(t99, 0, xp.atan2(-t72, t67))
-    t425 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t424)) + t424
-    t426 = -t425
-    t427 = 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t426)) + t425
-    t428 = xp.where(t107, 0, xp.atan2(t97, t89))
-    t429 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t428)) + t428
-    t430 = -t429
-    t431 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t430)) + t429
-    t432 = xp.where(t202, 0, xp.atan2(-t207, t195))
-    t433 = 3.141592653589793 + t432
-    t434 = 6.283185307179586*xp.ceil(-0.15915494309189535*t433) + t432
-    t435 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t433)) + t433
+    t395 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t394)) + t393
+    t396 = -t30
+    t397 = 6.283185307179586*xp.floor(0.15915494309189535*(3.0718 + t396)) + t30
+    t398 = xp.where(t147, 0, xp.atan2(-t152, t140))
+    t399 = 3.141592653589793 + t398
+    t400 = t398 + 6.283185307179586*xp.ceil(-0.15915494309189535*t399)
+    t401 = t399 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t399))
+    t402 = -t400
+    t403 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t402)) + t400
+    t404 = xp.where(t156, 0, xp.atan2(-t138, t126))
+    t405 = t404 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t404))
+    t406 = t404 - 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t404))
+    t407 = -t405
+    t408 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t407)) + t405
+    t409 = xp.where(xp.less_equal(t164, 1e-24*t165), 0, xp.atan2(t162, t161))
+    t410 = 3.141592653589793 + t409
+    t411 = 6.283185307179586*xp.ceil(-0.15915494309189535*t410) + t409
+    t412 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t410)) + t410
+    t413 = -t411
+    t414 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t413)) + t411
+    t415 = -t401
+    t416 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t415)) + t401
+    t417 = -t412
+    t418 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t417)) + t412
+    t419 = xp.where(t99, 0, xp.atan2(-t72, t67))
+    t420 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t419)) + t419
+    t421 = -t420
+    t422 = 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t421)) + t420
+    t423 = xp.where(t107, 0, xp.atan2(t97, t89))
+    t424 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t423)) + t423
+    t425 = -t424
+    t426 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t425)) + t424
+    t427 = xp.where(t201, 0, xp.atan2(-t206, t194))
+    t428 = 3.141592653589793 + t427
+    t429 = 6.283185307179586*xp.ceil(-0.15915494309189535*t428) + t427
+    t430 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t428)) + t428
+    t431 = -t429
+    t432 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t431)) + t429
+    t433 = xp.where(t210, 0, xp.atan2(-t192, t185))
+    t434 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t433)) + t433
+    t435 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t433)) + t433
     t436 = -t434
-    t437 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t436)) + t434
-    t438 = xp.where(t211, 0, xp.atan2(-t193, t186))
-    t439 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t438)) + t438
-    t440 = t438
-    t441 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t440)) + t440
-    t442 = -t439
-    t443 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t442)) + t439
-    t444 = xp.where(xp.less_equal(t220, 1e-24*t221), 0, xp.atan2(t217, t216))
-    t445 = 3.141592653589793 + t444
-    t446 = 6.283185307179586*xp.ceil(-0.15915494309189535*t445) + t444
-    t447 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t445)) + t445
-    t448 = -t446
-    t449 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t448)) + t446
-    t450 = -t435
-    t451 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t450)) + t435
-    t452 = -t447
-    t453 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t452)) + t447
-    t454 = xp.where(t246, 0, xp.atan2(-t240, t235))
-    t455 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t454)) + t454
-    t456 = -t455
-    t457 = 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t456)) + t455
-    t458 = xp.where(t264, 0, xp.atan2(t267, t258))
-    t459 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t458)) + t458
-    t460 = -t459
-    t461 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t460)) + t459
-    t462 = xp.where(t317, 0, xp.atan2(-t322, t310))
-    t463 = 3.141592653589793 + t462
-    t464 = 6.283185307179586*xp.ceil(-0.15915494309189535*t463) + t462
-    t465 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t463)) + t463
-    t466 = -t464
-    t467 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t466)) + t464
-    t468 = xp.where(t326, 0, xp.atan2(-t308, t296))
-    t469 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t468)) + t468
-    t470 = t468
-    t471 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t470)) + t470
-    t472 = -t469
-    t473 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t472)) + t469
-    t474 = xp.where(xp.less_equal(t335, 1e-24*t336), 0, xp.atan2(t332, t331))
-    t475 = 3.141592653589793 + t474
-    t476 = 6.283185307179586*xp.ceil(-0.15915494309189535*t475) + t474
-    t477 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t475)) + t475
-    t478 = -t476
-    t479 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t478)) + t476
-    t480 = -t465
-    t481 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t480)) + t465
-    t482 = -t477
-    t483 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t482)) + t477
-    t484 = xp.where(t269, 0, xp.atan2(-t242, t237))
-    t485 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t484)) + t484
-    t486 = -t485
-    t487 = 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t486)) + t485
-    t488 = xp.where(t277, 0, xp.atan2(t267, t259))
-    t489 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t488)) + t488
-    t490 = -t489
-    t491 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t490)) + t489
-    t492 = xp.where(t372, 0, xp.atan2(-t377, t365))
-    t493 = 3.141592653589793 + t492
-    t494 = 6.283185307179586*xp.ceil(-0.15915494309189535*t493) + t492
-    t495 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t493)) + t493
-    t496 = -t494
-    t497 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t496)) + t494
-    t498 = xp.where(t381, 0, xp.atan2(-t363, t356))
-    t499 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t498)) + t498
-    t500 = t498
-    t501 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t500)) + t500
-    t502 = -t499
-    t503 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t502)) + t499
-    t504 = xp.where(xp.less_equal(t390, 1e-24*t391), 0, xp.atan2(t387, t386))
-    t505 = 3.141592653589793 + t504
-    t506 = 6.283185307179586*xp.ceil(-0.15915494309189535*t505) + t504
-    t507 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t505)) + t505
-    t508 = -t506
-    t509 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t508)) + t506
-    t510 = -t495
-    t511 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t510)) + t495
-    t512 = -t507
-    t513 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t512)) + t507
-    t514 = xp.greater_equal(t418, -2.8973) & xp.less_equal(t418, 2.8973)
-    t515 = -t419
-    t516 = xp.less_equal(t515, 2.8973)
-    t517 = xp.greater_equal(t412, -1.7627999999999997) & xp.less_equal(t412, 1.7627999999999997)
-    t518 = -t413
-    t519 = xp.less_equal(t518, 1.7627999999999997)
-    t520 = xp.greater_equal(t406, -2.8973) & xp.less_equal(t406, 2.8973)
-    t521 = -t407
-    t522 = xp.less_equal(t521, 2.8973)
-    t523 = xp.greater_equal(t400, -3.0718) & xp.less_equal(t400, -0.0698)
-    t524 = -t401
-    t525 = xp.less_equal(t524, -0.0698)
-    t526 = xp.where(xp.logical_not(t523) & t525, t524, t400)
-    t527 = xp.greater_equal(t398, -2.8973) & xp.less_equal(t398, 2.8973)
-    t528 = -t399
+    t437 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t436)) + t434
+    t438 = xp.where(xp.less_equal(t218, 1e-24*t219), 0, xp.atan2(t216, t215))
+    t439 = 3.141592653589793 + t438
+    t440 = 6.283185307179586*xp.ceil(-0.15915494309189535*t439) + t438
+    t441 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t439)) + t439
+    t442 = -t440
+    t443 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t442)) + t440
+    t444 = -t430
+    t445 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t444)) + t430
+    t446 = -t441
+    t447 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t446)) + t441
+    t448 = xp.where(t244, 0, xp.atan2(-t238, t233))
+    t449 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t448)) + t448
+    t450 = -t449
+    t451 = 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t450)) + t449
+    t452 = xp.where(t262, 0, xp.atan2(t265, t256))
+    t453 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t452)) + t452
+    t454 = -t453
+    t455 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t454)) + t453
+    t456 = xp.where(t315, 0, xp.atan2(-t320, t308))
+    t457 = 3.141592653589793 + t456
+    t458 = 6.283185307179586*xp.ceil(-0.15915494309189535*t457) + t456
+    t459 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t457)) + t457
+    t460 = -t458
+    t461 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t460)) + t458
+    t462 = xp.where(t324, 0, xp.atan2(-t306, t294))
+    t463 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t462)) + t462
+    t464 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t462)) + t462
+    t465 = -t463
+    t466 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t465)) + t463
+    t467 = xp.where(xp.less_equal(t332, 1e-24*t333), 0, xp.atan2(t330, t329))
+    t468 = 3.141592653589793 + t467
+    t469 = 6.283185307179586*xp.ceil(-0.15915494309189535*t468) + t467
+    t470 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t468)) + t468
+    t471 = -t469
+    t472 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t471)) + t469
+    t473 = -t459
+    t474 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t473)) + t459
+    t475 = -t470
+    t476 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t475)) + t470
+    t477 = xp.where(t267, 0, xp.atan2(-t240, t235))
+    t478 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t477)) + t477
+    t479 = -t478
+    t480 = 6.283185307179586*xp.floor(0.15915494309189535*(0.0175 + t479)) + t478
+    t481 = xp.where(t275, 0, xp.atan2(t265, t257))
+    t482 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t481)) + t481
+    t483 = -t482
+    t484 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t483)) + t482
+    t485 = xp.where(t369, 0, xp.atan2(-t374, t362))
+    t486 = 3.141592653589793 + t485
+    t487 = 6.283185307179586*xp.ceil(-0.15915494309189535*t486) + t485
+    t488 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t486)) + t486
+    t489 = -t487
+    t490 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t489)) + t487
+    t491 = xp.where(t378, 0, xp.atan2(-t360, t353))
+    t492 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t491)) + t491
+    t493 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t491)) + t491
+    t494 = -t492
+    t495 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7627999999999997 + t494)) + t492
+    t496 = xp.where(xp.less_equal(t386, 1e-24*t387), 0, xp.atan2(t384, t383))
+    t497 = 3.141592653589793 + t496
+    t498 = 6.283185307179586*xp.ceil(-0.15915494309189535*t497) + t496
+    t499 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t497)) + t497
+    t500 = -t498
+    t501 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t500)) + t498
+    t502 = -t488
+    t503 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t502)) + t488
+    t504 = -t499
+    t505 = 6.283185307179586*xp.floor(0.15915494309189535*(2.8973 + t504)) + t499
+    t506 = xp.greater_equal(t413, -2.8973) & xp.less_equal(t413, 2.8973)
+    t507 = -t414
+    t508 = xp.less_equal(t507, 2.8973)
+    t509 = xp.greater_equal(t407, -1.7627999999999997) & xp.less_equal(t407, 1.7627999999999997)
+    t510 = -t408
+    t511 = xp.less_equal(t510, 1.7627999999999997)
+    t512 = xp.greater_equal(t402, -2.8973) & xp.less_equal(t402, 2.8973)
+    t513 = -t403
+    t514 = xp.less_equal(t513, 2.8973)
+    t515 = xp.greater_equal(t396, -3.0718) & xp.less_equal(t396, -0.0698)
+    t516 = -t397
+    t517 = xp.less_equal(t516, -0.0698)
+    t518 = xp.where(xp.logical_not(t515) & t517, t516, t396)
+    t519 = xp.greater_equal(t394, -2.8973) & xp.less_equal(t394, 2.8973)
+    t520 = -t395
+    t521 = xp.less_equal(t520, 2.8973)
+    t522 = xp.where(xp.logical_not(t519) & t521, t520, t394)
+    t523 = xp.greater_equal(t390, -0.0175) & xp.less_equal(t390, 3.7525000000000004)
+    t524 = -t391
+    t525 = xp.less_equal(t524, 3.7525000000000004)
+    t526 = xp.where(xp.logical_not(t523) & t525, t524, t390)
+    t527 = xp.greater_equal(t417, -2.8973) & xp.less_equal(t417, 2.8973)
+    t528 = -t418
     t529 = xp.less_equal(t528, 2.8973)
-    t530 = xp.where(xp.logical_not(t527) & t529, t528, t398)
-    t531 = xp.greater_equal(t394, -0.0175) & xp.less_equal(t394, 3.7525000000000004)
-    t532 = -t395
-    t533 = xp.less_equal(t532, 3.7525000000000004)
-    t534 = xp.where(xp.logical_not(t531) & t533, t532, t394)
-    t535 = xp.greater_equal(t422, -2.8973) & xp.less_equal(t422, 2.8973)
-    t536 = -t423
+    t530 = xp.greater_equal(t404, -1.7627999999999997) & xp.less_equal(t404, 1.7627999999999997)
+    t531 = xp.less_equal(t406, 1.7627999999999997)
+    t532 = xp.greater_equal(t415, -2.8973) & xp.less_equal(t415, 2.8973)
+    t533 = -t416
+    t534 = xp.less_equal(t533, 2.8973)
+    t535 = xp.greater_equal(t442, -2.8973) & xp.less_equal(t442, 2.8973)
+    t536 = -t443
     t537 = xp.less_equal(t536, 2.8973)
-    t538 = xp.greater_equal(t410, -1.7627999999999997) & xp.less_equal(t410, 1.7627999999999997)
-    t539 = xp.less_equal(t411, 1.7627999999999997)
-    t540 = xp.greater_equal(t420, -2.8973) & xp.less_equal(t420, 2.8973)
-    t541 = -t421
-    t542 = xp.less_equal(t541, 2.8973)
-    t543 = xp.greater_equal(t448, -2.8973) & xp.less_equal(t448, 2.8973)
-    t544 = -t449
-    t545 = xp.less_equal(t544, 2.8973)
-    t546 = xp.greater_equal(t442, -1.7627999999999997) & xp.less_equal(t442, 1.7627999999999997)
-    t547 = -t443
-    t548 = xp.less_equal(t547, 1.7627999999999997)
-    t549 = xp.greater_equal(t436, -2.8973) & xp.less_equal(t436, 2.8973)
-    t550 = -t437
-    t551 = xp.less_equal(t550, 2.8973)
-    t552 = xp.greater_equal(t430, -2.8973) & xp.less_equal(t430, 2.8973)
-    t553 = -t431
+    t538 = xp.greater_equal(t436, -1.7627999999999997) & xp.less_equal(t436, 1.7627999999999997)
+    t539 = -t437
+    t540 = xp.less_equal(t539, 1.7627999999999997)
+    t541 = xp.greater_equal(t431, -2.8973) & xp.less_equal(t431, 2.8973)
+    t542 = -t432
+    t543 = xp.less_equal(t542, 2.8973)
+    t544 = xp.greater_equal(t425, -2.8973) & xp.less_equal(t425, 2.8973)
+    t545 = -t426
+    t546 = xp.less_equal(t545, 2.8973)
+    t547 = xp.where(xp.logical_not(t544) & t546, t545, t425)
+    t548 = xp.greater_equal(t421, -0.0175) & xp.less_equal(t421, 3.7525000000000004)
+    t549 = -t422
+    t550 = xp.less_equal(t549, 3.7525000000000004)
+    t551 = xp.where(xp.logical_not(t548) & t550, t549, t421)
+    t552 = xp.greater_equal(t446, -2.8973) & xp.less_equal(t446, 2.8973)
+    t553 = -t447
     t554 = xp.less_equal(t553, 2.8973)
-    t555 = xp.where(xp.logical_not(t552) & t554, t553, t430)
-    t556 = xp.greater_equal(t426, -0.0175) & xp.less_equal(t426, 3.7525000000000004)
-    t557 = -t427
-    t558 = xp.less_equal(t557, 3.7525000000000004)
-    t559 = xp.where(xp.logical_not(t556) & t558, t557, t426)
-    t560 = xp.greater_equal(t452, -2.8973) & xp.less_equal(t452, 2.8973)
-    t561 = -t453
+    t555 = xp.greater_equal(t433, -1.7627999999999997) & xp.less_equal(t433, 1.7627999999999997)
+    t556 = xp.less_equal(t435, 1.7627999999999997)
+    t557 = xp.greater_equal(t444, -2.8973) & xp.less_equal(t444, 2.8973)
+    t558 = -t445
+    t559 = xp.less_equal(t558, 2.8973)
+    t560 = xp.greater_equal(t471, -2.8973) & xp.less_equal(t471, 2.8973)
+    t561 = -t472
     t562 = xp.less_equal(t561, 2.8973)
-    t563 = xp.greater_equal(t440, -1.7627999999999997) & xp.less_equal(t440, 1.7627999999999997)
-    t564 = xp.less_equal(t441, 1.7627999999999997)
-    t565 = xp.greater_equal(t450, -2.8973) & xp.less_equal(t450, 2.8973)
-    t566 = -t451
-    t567 = xp.less_equal(t566, 2.8973)
-    t568 = xp.greater_equal(t478, -2.8973) & xp.less_equal(t478, 2.8973)
-    t569 = -t479
-    t570 = xp.less_equal(t569, 2.8973)
-    t571 = xp.greater_equal(t472, -1.7627999999999997) & xp.less_equal(t472, 1.7627999999999997)
-    t572 = -t473
-    t573 = xp.less_equal(t572, 1.7627999999999997)
-    t574 = xp.greater_equal(t466, -2.8973) & xp.less_equal(t466, 2.8973)
-    t575 = -t467
-    t576 = xp.less_equal(t575, 2.8973)
-    t577 = xp.greater_equal(t31, -3.0718) & xp.less_equal(t31, -0.0698)
-    t578 = xp.less_equal(t32, -0.0698)
-    t579 = xp.where(xp.logical_not(t577) & t578, t32, t31)
-    t580 = xp.greater_equal(t460, -2.8973) & xp.less_equal(t460, 2.8973)
-    t581 = -t461
+    t563 = xp.greater_equal(t465, -1.7627999999999997) & xp.less_equal(t465, 1.7627999999999997)
+    t564 = -t466
+    t565 = xp.less_equal(t564, 1.7627999999999997)
+    t566 = xp.greater_equal(t460, -2.8973) & xp.less_equal(t460, 2.8973)
+    t567 = -t461
+    t568 = xp.less_equal(t567, 2.8973)
+    t569 = xp.greater_equal(t31, -3.0718) & xp.less_equal(t31, -0.0698)
+    t570 = xp.less_equal(t32, -0.0698)
+    t571 = xp.where(xp.logical_not(t569) & t570, t32, t31)
+    t572 = xp.greater_equal(t454, -2.8973) & xp.less_equal(t454, 2.8973)
+    t573 = -t455
+    t574 = xp.less_equal(t573, 2.8973)
+    t575 = xp.where(xp.logical_not(t572) & t574, t573, t454)
+    t576 = xp.greater_equal(t450, -0.0175) & xp.less_equal(t450, 3.7525000000000004)
+    t577 = -t451
+    t578 = xp.less_equal(t577, 3.7525000000000004)
+    t579 = xp.where(xp.logical_not(t576) & t578, t577, t450)
+    t580 = xp.greater_equal(t475, -2.8973) & xp.less_equal(t475, 2.8973)
+    t581 = -t476
     t582 = xp.less_equal(t581, 2.8973)
-    t583 = xp.where(xp.logical_not(t580) & t582, t581, t460)
-    t584 = xp.greater_equal(t456, -0.0175) & xp.less_equal(t456, 3.7525000000000004)
-    t585 = -t457
-    t586 = xp.less_equal(t585, 3.7525000000000004)
-    t587 = xp.where(xp.logical_not(t584) & t586, t585, t456)
-    t588 = xp.greater_equal(t482, -2.8973) & xp.less_equal(t482, 2.8973)
-    t589 = -t483
+    t583 = xp.greater_equal(t462, -1.7627999999999997) & xp.less_equal(t462, 1.7627999999999997)
+    t584 = xp.less_equal(t464, 1.7627999999999997)
+    t585 = xp.greater_equal(t473, -2.8973) & xp.less_equal(t473, 2.8973)
+    t586 = -t474
+    t587 = xp.less_equal(t586, 2.8973)
+    t588 = xp.greater_equal(t500, -2.8973) & xp.less_equal(t500, 2.8973)
+    t589 = -t501
     t590 = xp.less_equal(t589, 2.8973)
-    t591 = xp.greater_equal(t470, -1.7627999999999997) & xp.less_equal(t470, 1.7627999999999997)
-    t592 = xp.less_equal(t471, 1.7627999999999997)
-    t593 = xp.greater_equal(t480, -2.8973) & xp.less_equal(t480, 2.8973)
-    t594 = -t481
-    t595 = xp.less_equal(t594, 2.8973)
-    t596 = xp.greater_equal(t508, -2.8973) & xp.less_equal(t508, 2.8973)
-    t597 = -t509
-    t598 = xp.less_equal(t597, 2.8973)
-    t599 = xp.greater_equal(t502, -1.7627999999999997) & xp.less_equal(t502, 1.7627999999999997)
-    t600 = -t503
-    t601 = xp.less_equal(t600, 1.7627999999999997)
-    t602 = xp.greater_equal(t496, -2.8973) & xp.less_equal(t496, 2.8973)
-    t603 = -t497
-    t604 = xp.less_equal(t603, 2.8973)
-    t605 = xp.greater_equal(t490, -2.8973) & xp.less_equal(t490, 2.8973)
-    t606 = -t491
+    t591 = xp.greater_equal(t494, -1.7627999999999997) & xp.less_equal(t494, 1.7627999999999997)
+    t592 = -t495
+    t593 = xp.less_equal(t592, 1.7627999999999997)
+    t594 = xp.greater_equal(t489, -2.8973) & xp.less_equal(t489, 2.8973)
+    t595 = -t490
+    t596 = xp.less_equal(t595, 2.8973)
+    t597 = xp.greater_equal(t483, -2.8973) & xp.less_equal(t483, 2.8973)
+    t598 = -t484
+    t599 = xp.less_equal(t598, 2.8973)
+    t600 = xp.where(xp.logical_not(t597) & t599, t598, t483)
+    t601 = xp.greater_equal(t479, -0.0175) & xp.less_equal(t479, 3.7525000000000004)
+    t602 = -t480
+    t603 = xp.less_equal(t602, 3.7525000000000004)
+    t604 = xp.where(xp.logical_not(t601) & t603, t602, t479)
+    t605 = xp.greater_equal(t504, -2.8973) & xp.less_equal(t504, 2.8973)
+    t606 = -t505
     t607 = xp.less_equal(t606, 2.8973)
-    t608 = xp.where(xp.logical_not(t605) & t607, t606, t490)
-    t609 = xp.greater_equal(t486, -0.0175) & xp.less_equal(t486, 3.7525000000000004)
-    t610 = -t487
-    t611 = xp.less_equal(t610, 3.7525000000000004)
-    t612 = xp.where(xp.logical_not(t609) & t611, t610, t486)
-    t613 = xp.greater_equal(t512, -2.8973) & xp.less_equal(t512, 2.8973)
-    t614 = -t513
-    t615 = xp.less_equal(t614, 2.8973)
-    t616 = xp.greater_equal(t500, -1.7627999999999997) & xp.less_equal(t500, 1.7627999999999997)
-    t617 = xp.less_equal(t501, 1.7627999999999997)
-    t618 = xp.greater_equal(t510, -2.8973) & xp.less_equal(t510, 2.8973)
-    t619 = -t511
-    t620 = xp.less_equal(t619, 2.8973)
-    t621 = xp.isfinite(t3)
-    t622 = xp.greater_equal(t22, -1e-12)
-    t623 = xp.greater_equal(t56, -t57)
-    t624 = xp.greater_equal(t227, -t228)
-    t625 = xp.greater_equal(q7, -2.8973)
-    t626 = xp.less_equal(q7, 2.8973)
-    t627 = t531 | t533
-    t628 = t527 | t529
-    t629 = t523 | t525
-    t630 = t556 | t558
-    t631 = t552 | t554
-    t632 = t584 | t586
-    t633 = t580 | t582
-    t634 = t577 | t578
-    t635 = t609 | t611
-    t636 = t605 | t607
+    t608 = xp.greater_equal(t491, -1.7627999999999997) & xp.less_equal(t491, 1.7627999999999997)
+    t609 = xp.less_equal(t493, 1.7627999999999997)
+    t610 = xp.greater_equal(t502, -2.8973) & xp.less_equal(t502, 2.8973)
+    t611 = -t503
+    t612 = xp.less_equal(t611, 2.8973)
+    t613 = xp.isfinite(t3)
+    t614 = xp.greater_equal(t22, -1e-12)
+    t615 = xp.greater_equal(t56, -t57)
+    t616 = xp.greater_equal(t225, -t226)
+    t617 = xp.greater_equal(q7, -2.8973)
+    t618 = xp.less_equal(q7, 2.8973)
+    t619 = t523 | t525
+    t620 = t519 | t521
+    t621 = t515 | t517
+    t622 = t548 | t550
+    t623 = t544 | t546
+    t624 = t576 | t578
+    t625 = t572 | t574
+    t626 = t569 | t570
+    t627 = t601 | t603
+    t628 = t597 | t599
     q = _stack(xp, [
-        xp.where(xp.logical_not(t514) & t516, t515, t418),  # 0, 0
-        xp.where(xp.logical_not(t517) & t519, t518, t412),  # 0, 1
-        xp.where(xp.logical_not(t520) & t522, t521, t406),  # 0, 2
-        t526,  # 0, 3
-        t530,  # 0, 4
-        t534,  # 0, 5
+        xp.where(xp.logical_not(t506) & t508, t507, t413),  # 0, 0
+        xp.where(xp.logical_not(t509) & t511, t510, t407),  # 0, 1
+        xp.where(xp.logical_not(t512) & t514, t513, t402),  # 0, 2
+        t518,  # 0, 3
+        t522,  # 0, 4
+        t526,  # 0, 5
         q7,  # 0, 6
-        xp.where(xp.logical_not(t535) & t537, t536, t422),  # 1, 0
-        xp.where(xp.logical_not(t538) & t539, t411, t410),  # 1, 1
-        xp.where(xp.logical_not(t540) & t542, t541, t420),  # 1, 2
-        t526,  # 1, 3
-        t530,  # 1, 4
-        t534,  # 1, 5
+        xp.where(xp.logical_not(t527) & t529, t528, t417),  # 1, 0
+        xp.where(xp.logical_not(t530) & t531, t406, t404),  # 1, 1
+        xp.where(xp.logical_not(t532) & t534, t533, t415),  # 1, 2
+        t518,  # 1, 3
+        t522,  # 1, 4
+        t526,  # 1, 5
         q7,  # 1, 6
-        xp.where(xp.logical_not(t543) & t545, t544, t448),  # 2, 0
-        xp.where(xp.logical_not(t546) & t548, t547, t442),  # 2, 1
-        xp.where(xp.logical_not(t549) & t551, t550, t436),  # 2, 2
-        t526,  # 2, 3
-        t555,  # 2, 4
-        t559,  # 2, 5
+        xp.where(xp.logical_not(t535) & t537, t536, t442),  # 2, 0
+        xp.where(xp.logical_not(t538) & t540, t539, t436),  # 2, 1
+        xp.where(xp.logical_not(t541) & t543, t542, t431),  # 2, 2
+        t518,  # 2, 3
+        t547,  # 2, 4
+        t551,  # 2, 5
         q7,  # 2, 6
-        xp.where(xp.logical_not(t560) & t562, t561, t452),  # 3, 0
-        xp.where(xp.logical_not(t563) & t564, t441, t440),  # 3, 1
-        xp.where(xp.logical_not(t565) & t567, t566, t450),  # 3, 2
-        t526,  # 3, 3
-        t555,  # 3, 4
-        t559,  # 3, 5
+        xp.where(xp.logical_not(t552) & t554, t553, t446),  # 3, 0
+        xp.where(xp.logical_not(t555) & t556, t435, t433),  # 3, 1
+        xp.where(xp.logical_not(t557) & t559, t558, t444),  # 3, 2
+        t518,  # 3, 3
+        t547,  # 3, 4
+        t551,  # 3, 5
         q7,  # 3, 6
-        xp.where(xp.logical_not(t568) & t570, t569, t478),  # 4, 0
-        xp.where(xp.logical_not(t571) & t573, t572, t472),  # 4, 1
-        xp.where(xp.logical_not(t574) & t576, t575, t466),  # 4, 2
-        t579,  # 4, 3
-        t583,  # 4, 4
-        t587,  # 4, 5
+        xp.where(xp.logical_not(t560) & t562, t561, t471),  # 4, 0
+        xp.where(xp.logical_not(t563) & t565, t564, t465),  # 4, 1
+        xp.where(xp.logical_not(t566) & t568, t567, t460),  # 4, 2
+        t571,  # 4, 3
+        t575,  # 4, 4
+        t579,  # 4, 5
         q7,  # 4, 6
-        xp.where(xp.logical_not(t588) & t590, t589, t482),  # 5, 0
-        xp.where(xp.logical_not(t591) & t592, t471, t470),  # 5, 1
-        xp.where(xp.logical_not(t593) & t595, t594, t480),  # 5, 2
-        t579,  # 5, 3
-        t583,  # 5, 4
-        t587,  # 5, 5
+        xp.where(xp.logical_not(t580) & t582, t581, t475),  # 5, 0
+        xp.where(xp.logical_not(t583) & t584, t464, t462),  # 5, 1
+        xp.where(xp.logical_not(t585) & t587, t586, t473),  # 5, 2
+        t571,  # 5, 3
+        t575,  # 5, 4
+        t579,  # 5, 5
         q7,  # 5, 6
-        xp.where(xp.logical_not(t596) & t598, t597, t508),  # 6, 0
-        xp.where(xp.logical_not(t599) & t601, t600, t502),  # 6, 1
-        xp.where(xp.logical_not(t602) & t604, t603, t496),  # 6, 2
-        t579,  # 6, 3
-        t608,  # 6, 4
-        t612,  # 6, 5
+        xp.where(xp.logical_not(t588) & t590, t589, t500),  # 6, 0
+        xp.where(xp.logical_not(t591) & t593, t592, t494),  # 6, 1
+        xp.where(xp.logical_not(t594) & t596, t595, t489),  # 6, 2
+        t571,  # 6, 3
+        t600,  # 6, 4
+        t604,  # 6, 5
         q7,  # 6, 6
-        xp.where(xp.logical_not(t613) & t615, t614, t512),  # 7, 0
-        xp.where(xp.logical_not(t616) & t617, t501, t500),  # 7, 1
-        xp.where(xp.logical_not(t618) & t620, t619, t510),  # 7, 2
-        t579,  # 7, 3
-        t608,  # 7, 4
-        t612,  # 7, 5
+        xp.where(xp.logical_not(t605) & t607, t606, t504),  # 7, 0
+        xp.where(xp.logical_not(t608) & t609, t493, t491),  # 7, 1
+        xp.where(xp.logical_not(t610) & t612, t611, t502),  # 7, 2
+        t571,  # 7, 3
+        t600,  # 7, 4
+        t604,  # 7, 5
         q7,  # 7, 6
     ], (8, 7))
     valid = _stack(xp, [
-        t621 & t622 & t623 & xp.greater_equal(t136, -1e-12),  # 0
-        t621 & t622 & t623 & t137,  # 1
-        t621 & t622 & t58 & xp.greater_equal(t191, -1e-12),  # 2
-        t621 & t622 & t58 & t192,  # 3
-        t621 & t23 & t624 & xp.greater_equal(t306, -1e-12),  # 4
-        t621 & t23 & t624 & t307,  # 5
-        t621 & t23 & t229 & xp.greater_equal(t361, -1e-12),  # 6
-        t621 & t23 & t229 & t362,  # 7
+        t613 & t614 & t615 & xp.greater_equal(t136, -1e-12),  # 0
+        t613 & t614 & t615 & t137,  # 1
+        t613 & t614 & t58 & xp.greater_equal(t190, -1e-12),  # 2
+        t613 & t614 & t58 & t191,  # 3
+        t613 & t23 & t616 & xp.greater_equal(t304, -1e-12),  # 4
+        t613 & t23 & t616 & t305,  # 5
+        t613 & t23 & t227 & xp.greater_equal(t358, -1e-12),  # 6
+        t613 & t23 & t227 & t359,  # 7
     ], (8,))
     in_limits = _stack(xp, [
-        t625 & t626 & t627 & t628 & t629 & (t520 | t522) & (t517 | t519) & (t514 | t516),  # 0
-        t625 & t626 & t627 & t628 & t629 & (t540 | t542) & (t538 | t539) & (t535 | t537),  # 1
-        t625 & t626 & t630 & t631 & t629 & (t549 | t551) & (t546 | t548) & (t543 | t545),  # 2
-        t625 & t626 & t630 & t631 & t629 & (t565 | t567) & (t563 | t564) & (t560 | t562),  # 3
-        t625 & t626 & t632 & t633 & t634 & (t574 | t576) & (t571 | t573) & (t568 | t570),  # 4
-        t625 & t626 & t632 & t633 & t634 & (t593 | t595) & (t591 | t592) & (t588 | t590),  # 5
-        t625 & t626 & t635 & t636 & t634 & (t602 | t604) & (t599 | t601) & (t596 | t598),  # 6
-        t625 & t626 & t635 & t636 & t634 & (t618 | t620) & (t616 | t617) & (t613 | t615),  # 7
+        t617 & t618 & t619 & t620 & t621 & (t512 | t514) & (t509 | t511) & (t506 | t508),  # 0
+        t617 & t618 & t619 & t620 & t621 & (t532 | t534) & (t530 | t531) & (t527 | t529),  # 1
+        t617 & t618 & t622 & t623 & t621 & (t541 | t543) & (t538 | t540) & (t535 | t537),  # 2
+        t617 & t618 & t622 & t623 & t621 & (t557 | t559) & (t555 | t556) & (t552 | t554),  # 3
+        t617 & t618 & t624 & t625 & t626 & (t566 | t568) & (t563 | t565) & (t560 | t562),  # 4
+        t617 & t618 & t624 & t625 & t626 & (t585 | t587) & (t583 | t584) & (t580 | t582),  # 5
+        t617 & t618 & t627 & t628 & t626 & (t594 | t596) & (t591 | t593) & (t588 | t590),  # 6
+        t617 & t618 & t627 & t628 & t626 & (t610 | t612) & (t608 | t609) & (t605 | t607),  # 7
     ], (8,))
     return q, valid, in_limits
 

@@ -499,69 +499,65 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t2 = t0*t1 + c12*s12
     t3 = t1**2
     t4 = s12**2 + t3
-    t5 = t4
-    t6 = t0**2
-    t7 = xp.sqrt(t3 + t6)
-    t8 = t7*xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)
-    t9 = xp.where(xp.greater(t7, 0), 1/(t7*(t7 + xp.abs(t1))), 0)
-    t10 = c12**2 + t6
-    t11 = t10
-    t12 = xp.sqrt(t4 + t10)
-    t13 = t2**2
-    t14 = damping**2
-    t15 = t5 + t14
-    t16 = t15**2
-    t17 = xp.sqrt(t13 + t16)
-    t18 = t17*xp.where(xp.greater_equal(t15, 0), xp.asarray(1, dtype=dtype), -1)
-    t19 = t18 + t15
-    t20 = xp.where(xp.greater(t17, 0), 1/(t17*(t17 + xp.abs(t15))), 0)
-    t21 = t20*(mu_dot0*t19 - mu_dot1*t2)
-    t22 = mu_dot0 - t19*t21
-    t23 = mu_dot1 + t2*t21
-    t24 = t11 + t14
-    t25 = xp.sqrt(2*t13 + t16 + t24**2)
-    t26 = -t20*(t2*t19 + t2*t24)
-    t27 = t2 + t19*t26
-    t28 = t2*t26 + t24
-    t29 = xp.abs(t28)
-    t30 = t29
-    t31 = t30*xp.where(xp.greater_equal(t28, 0), xp.asarray(1, dtype=dtype), -1)
-    t32 = t28 + t31
-    t33 = xp.where(xp.greater(t30, 0), 1/(t30*(t30 + t29)), 0)
-    t34 = t23 - t23*t32**2*t33
-    t35 = xp.where(xp.not_equal(t31, 0), -t34/t31, 0)
-    t36 = xp.where(xp.not_equal(t18, 0), -(t22 + t27*t35)/t18, 0)
-    t37 = -t1*t36 + t0*t35
-    t38 = -s12*t36 + c12*t35
-    t39 = -t1
-    t40 = t8 + t39
-    t41 = t9*(c12*t0 - s12*t40)
-    t42 = s12 + t40*t41
-    t43 = c12 - t0*t41
-    t44 = t9*(mu_dot0*t40 + t0*mu_dot1)
-    t45 = mu_dot0 - t40*t44
-    t46 = mu_dot1 - t0*t44
-    t47 = -s12 + q1 + q2 + c12 + t0 + mu_dot0 + mu_dot1 + damping + t39
-    t48 = xp.abs(t43)
-    t49 = t48
-    t50 = t49*xp.where(xp.greater_equal(t43, 0), xp.asarray(1, dtype=dtype), -1)
-    t51 = t43 + t50
-    t52 = xp.where(xp.greater(t49, 0), 1/(t49*(t49 + t48)), 0)
-    t53 = t46 - t46*t51**2*t52
-    t54 = xp.where(xp.not_equal(t50, 0), -t53/t50, 0)
-    t55 = xp.where(xp.not_equal(t8, 0), -(t45 + t42*t54)/t8, 0)
-    t56 = xp.isfinite(t47)
-    t57 = xp.greater_equal(damping, 0)
-    t58 = xp.greater(damping, 0)
-    t59 = 1e-12*t25
-    t60 = 1e-12*t12
-    t61 = (t58 & (xp.less_equal(t17, t59) | xp.less_equal(t30, t59))) | (xp.less_equal(damping, 0) & (xp.less_equal(t7, t60) | xp.less_equal(t49, t60)))
-    t62 = t56 & t57 & xp.logical_not(t61)
+    t5 = t0**2
+    t6 = xp.sqrt(t3 + t5)
+    t7 = t6*xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)
+    t8 = xp.where(xp.greater(t6, 0), 1/(t6*(t6 + xp.abs(t1))), 0)
+    t9 = c12**2 + t5
+    t10 = xp.sqrt(t4 + t9)
+    t11 = t2**2
+    t12 = damping**2
+    t13 = t4 + t12
+    t14 = t13**2
+    t15 = xp.sqrt(t11 + t14)
+    t16 = t15*xp.where(xp.greater_equal(t13, 0), xp.asarray(1, dtype=dtype), -1)
+    t17 = t16 + t13
+    t18 = xp.where(xp.greater(t15, 0), 1/(t15*(t15 + xp.abs(t13))), 0)
+    t19 = t18*(mu_dot0*t17 - mu_dot1*t2)
+    t20 = mu_dot0 - t17*t19
+    t21 = mu_dot1 + t2*t19
+    t22 = t9 + t12
+    t23 = xp.sqrt(2*t11 + t14 + t22**2)
+    t24 = -t18*(t2*t17 + t2*t22)
+    t25 = t2 + t17*t24
+    t26 = t2*t24 + t22
+    t27 = xp.abs(t26)
+    t28 = xp.where(xp.greater_equal(t26, 0), xp.asarray(1, dtype=dtype), -1)*t27
+    t29 = t26 + t28
+    t30 = xp.where(xp.greater(t27, 0), 1/(t27*2*t27), 0)
+    t31 = t21 - t21*t29**2*t30
+    t32 = xp.where(xp.not_equal(t28, 0), -t31/t28, 0)
+    t33 = xp.where(xp.not_equal(t16, 0), -(t20 + t25*t32)/t16, 0)
+    t34 = -t1*t33 + t0*t32
+    t35 = -s12*t33 + c12*t32
+    t36 = -t1
+    t37 = t7 + t36
+    t38 = t8*(c12*t0 - s12*t37)
+    t39 = s12 + t37*t38
+    t40 = c12 - t0*t38
+    t41 = t8*(mu_dot0*t37 + t0*mu_dot1)
+    t42 = mu_dot0 - t37*t41
+    t43 = mu_dot1 - t0*t41
+    t44 = -s12 + q1 + q2 + c12 + t0 + mu_dot0 + mu_dot1 + damping + t36
+    t45 = xp.abs(t40)
+    t46 = xp.where(xp.greater_equal(t40, 0), xp.asarray(1, dtype=dtype), -1)*t45
+    t47 = t40 + t46
+    t48 = xp.where(xp.greater(t45, 0), 1/(t45*2*t45), 0)
+    t49 = t43 - t43*t47**2*t48
+    t50 = xp.where(xp.not_equal(t46, 0), -t49/t46, 0)
+    t51 = xp.where(xp.not_equal(t7, 0), -(t42 + t39*t50)/t7, 0)
+    t52 = xp.isfinite(t44)
+    t53 = xp.greater_equal(damping, 0)
+    t54 = xp.greater(damping, 0)
+    t55 = 1e-12*t23
+    t56 = 1e-12*t10
+    t57 = (t54 & (xp.less_equal(t15, t55) | xp.less_equal(t27, t55))) | (xp.less_equal(damping, 0) & (xp.less_equal(t6, t56) | xp.less_equal(t45, t56)))
+    t58 = t52 & t53 & xp.logical_not(t57)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t62, xp.where(t58, t37, t55), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t62, xp.where(t58, t38, t54), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t58, xp.where(t54, t34, t51), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t58, xp.where(t54, t35, t50), 0), batch),  # 1
     ], (2,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t56 & t57), 2, xp.where(t61, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t52 & t53), 2, xp.where(t57, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -603,22 +599,21 @@ def ik_numeric_step(target, q, damping=0.0):
     t19 = t3 + t12*t18
     t20 = t17 + t3*t18
     t21 = xp.abs(t20)
-    t22 = t21
-    t23 = t22*xp.where(xp.greater_equal(t20, 0), xp.asarray(1, dtype=dtype), -1)
-    t24 = t20 + t23
-    t25 = xp.where(xp.greater(t22, 0), 1/(t22*(t21 + t22)), 0)
-    t26 = t16 - t16*t24**2*t25
-    t27 = xp.where(xp.not_equal(t23, 0), -t26/t23, 0)
-    t28 = xp.where(xp.not_equal(t11, 0), -(t15 + t19*t27)/t11, 0)
-    t29 = q1 - t1*t28 + t0*t27
-    t30 = q2 - s12*t28 + c12*t27
+    t22 = t21*xp.where(xp.greater_equal(t20, 0), xp.asarray(1, dtype=dtype), -1)
+    t23 = t20 + t22
+    t24 = xp.where(xp.greater(t21, 0), 1/(t21*2*t21), 0)
+    t25 = t16 - t16*t23**2*t24
+    t26 = xp.where(xp.not_equal(t22, 0), -t25/t22, 0)
+    t27 = xp.where(xp.not_equal(t11, 0), -(t15 + t19*t26)/t11, 0)
+    t28 = q1 - t1*t27 + t0*t26
+    t29 = q2 - s12*t27 + c12*t26
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
     ], (2,))
     q_next = _stack(xp, [
-        xp.broadcast_to(t29, batch),  # 0
-        xp.broadcast_to(t30, batch),  # 1
+        xp.broadcast_to(t28, batch),  # 0
+        xp.broadcast_to(t29, batch),  # 1
     ], (2,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t8), t7, -1), batch)
     return q_start, q_next, cost

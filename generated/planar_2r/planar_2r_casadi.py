@@ -342,69 +342,65 @@ def _velocity_ik(q, mu_dot, damping):
     t2 = t0*t1 + c12*s12
     t3 = t1**2
     t4 = s12**2 + t3
-    t5 = t4
-    t6 = t0**2
-    t7 = casadi.sqrt(t3 + t6)
-    t8 = t7*casadi.if_else((t1 <= 0), 1, -1)
-    t9 = casadi.if_else((t7 > 0), 1/(t7*(t7 + casadi.fabs(t1))), 0)
-    t10 = c12**2 + t6
-    t11 = t10
-    t12 = casadi.sqrt(t4 + t10)
-    t13 = t2**2
-    t14 = damping**2
-    t15 = t5 + t14
-    t16 = t15**2
-    t17 = casadi.sqrt(t13 + t16)
-    t18 = t17*casadi.if_else((t15 >= 0), 1, -1)
-    t19 = t18 + t15
-    t20 = casadi.if_else((t17 > 0), 1/(t17*(t17 + casadi.fabs(t15))), 0)
-    t21 = t20*(mu_dot0*t19 - mu_dot1*t2)
-    t22 = mu_dot0 - t19*t21
-    t23 = mu_dot1 + t2*t21
-    t24 = t11 + t14
-    t25 = casadi.sqrt(2*t13 + t16 + t24**2)
-    t26 = -t20*(t2*t19 + t2*t24)
-    t27 = t2 + t19*t26
-    t28 = t2*t26 + t24
-    t29 = casadi.fabs(t28)
-    t30 = t29
-    t31 = t30*casadi.if_else((t28 >= 0), 1, -1)
-    t32 = t28 + t31
-    t33 = casadi.if_else((t30 > 0), 1/(t30*(t30 + t29)), 0)
-    t34 = t23 - t23*t32**2*t33
-    t35 = casadi.if_else((t31 != 0), -t34/t31, 0)
-    t36 = casadi.if_else((t18 != 0), -(t22 + t27*t35)/t18, 0)
-    t37 = -t1*t36 + t0*t35
-    t38 = -s12*t36 + c12*t35
-    t39 = -t1
-    t40 = t8 + t39
-    t41 = t9*(c12*t0 - s12*t40)
-    t42 = s12 + t40*t41
-    t43 = c12 - t0*t41
-    t44 = t9*(mu_dot0*t40 + t0*mu_dot1)
-    t45 = mu_dot0 - t40*t44
-    t46 = mu_dot1 - t0*t44
-    t47 = -s12 + q1 + q2 + c12 + t0 + mu_dot0 + mu_dot1 + damping + t39
-    t48 = casadi.fabs(t43)
-    t49 = t48
-    t50 = t49*casadi.if_else((t43 >= 0), 1, -1)
-    t51 = t43 + t50
-    t52 = casadi.if_else((t49 > 0), 1/(t49*(t49 + t48)), 0)
-    t53 = t46 - t46*t51**2*t52
-    t54 = casadi.if_else((t50 != 0), -t53/t50, 0)
-    t55 = casadi.if_else((t8 != 0), -(t45 + t42*t54)/t8, 0)
-    t56 = (casadi.fabs(t47) < casadi.inf)
-    t57 = (damping >= 0)
-    t58 = (damping > 0)
-    t59 = 1e-12*t25
-    t60 = 1e-12*t12
-    t61 = casadi.logic_or(casadi.logic_and(t58, casadi.logic_or((t17 <= t59), (t30 <= t59))), casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t60), (t49 <= t60))))
-    t62 = casadi.logic_and(casadi.logic_and(t56, t57), casadi.logic_not(t61))
+    t5 = t0**2
+    t6 = casadi.sqrt(t3 + t5)
+    t7 = t6*casadi.if_else((t1 <= 0), 1, -1)
+    t8 = casadi.if_else((t6 > 0), 1/(t6*(t6 + casadi.fabs(t1))), 0)
+    t9 = c12**2 + t5
+    t10 = casadi.sqrt(t4 + t9)
+    t11 = t2**2
+    t12 = damping**2
+    t13 = t4 + t12
+    t14 = t13**2
+    t15 = casadi.sqrt(t11 + t14)
+    t16 = t15*casadi.if_else((t13 >= 0), 1, -1)
+    t17 = t16 + t13
+    t18 = casadi.if_else((t15 > 0), 1/(t15*(t15 + casadi.fabs(t13))), 0)
+    t19 = t18*(mu_dot0*t17 - mu_dot1*t2)
+    t20 = mu_dot0 - t17*t19
+    t21 = mu_dot1 + t2*t19
+    t22 = t9 + t12
+    t23 = casadi.sqrt(2*t11 + t14 + t22**2)
+    t24 = -t18*(t2*t17 + t2*t22)
+    t25 = t2 + t17*t24
+    t26 = t2*t24 + t22
+    t27 = casadi.fabs(t26)
+    t28 = casadi.if_else((t26 >= 0), 1, -1)*t27
+    t29 = t26 + t28
+    t30 = casadi.if_else((t27 > 0), 1/(t27*2*t27), 0)
+    t31 = t21 - t21*t29**2*t30
+    t32 = casadi.if_else((t28 != 0), -t31/t28, 0)
+    t33 = casadi.if_else((t16 != 0), -(t20 + t25*t32)/t16, 0)
+    t34 = -t1*t33 + t0*t32
+    t35 = -s12*t33 + c12*t32
+    t36 = -t1
+    t37 = t7 + t36
+    t38 = t8*(c12*t0 - s12*t37)
+    t39 = s12 + t37*t38
+    t40 = c12 - t0*t38
+    t41 = t8*(mu_dot0*t37 + t0*mu_dot1)
+    t42 = mu_dot0 - t37*t41
+    t43 = mu_dot1 - t0*t41
+    t44 = -s12 + q1 + q2 + c12 + t0 + mu_dot0 + mu_dot1 + damping + t36
+    t45 = casadi.fabs(t40)
+    t46 = casadi.if_else((t40 >= 0), 1, -1)*t45
+    t47 = t40 + t46
+    t48 = casadi.if_else((t45 > 0), 1/(t45*2*t45), 0)
+    t49 = t43 - t43*t47**2*t48
+    t50 = casadi.if_else((t46 != 0), -t49/t46, 0)
+    t51 = casadi.if_else((t7 != 0), -(t42 + t39*t50)/t7, 0)
+    t52 = (casadi.fabs(t44) < casadi.inf)
+    t53 = (damping >= 0)
+    t54 = (damping > 0)
+    t55 = 1e-12*t23
+    t56 = 1e-12*t10
+    t57 = casadi.logic_or(casadi.logic_and(t54, casadi.logic_or((t15 <= t55), (t27 <= t55))), casadi.logic_and((damping <= 0), casadi.logic_or((t6 <= t56), (t45 <= t56))))
+    t58 = casadi.logic_and(casadi.logic_and(t52, t53), casadi.logic_not(t57))
     q_dot = casadi.SX(2, 1)
-    q_dot[0, 0] = casadi.if_else(t62, casadi.if_else(t58, t37, t55), 0)
-    q_dot[1, 0] = casadi.if_else(t62, casadi.if_else(t58, t38, t54), 0)
+    q_dot[0, 0] = casadi.if_else(t58, casadi.if_else(t54, t34, t51), 0)
+    q_dot[1, 0] = casadi.if_else(t58, casadi.if_else(t54, t35, t50), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t56, t57)), 2, casadi.if_else(t61, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t52, t53)), 2, casadi.if_else(t57, 1, 0))
     return [q_dot, status]
 
 
@@ -444,21 +440,20 @@ def _ik_numeric_step(target, q, damping):
     t19 = t3 + t12*t18
     t20 = t17 + t3*t18
     t21 = casadi.fabs(t20)
-    t22 = t21
-    t23 = t22*casadi.if_else((t20 >= 0), 1, -1)
-    t24 = t20 + t23
-    t25 = casadi.if_else((t22 > 0), 1/(t22*(t21 + t22)), 0)
-    t26 = t16 - t16*t24**2*t25
-    t27 = casadi.if_else((t23 != 0), -t26/t23, 0)
-    t28 = casadi.if_else((t11 != 0), -(t15 + t19*t27)/t11, 0)
-    t29 = q1 - t1*t28 + t0*t27
-    t30 = q2 - s12*t28 + c12*t27
+    t22 = t21*casadi.if_else((t20 >= 0), 1, -1)
+    t23 = t20 + t22
+    t24 = casadi.if_else((t21 > 0), 1/(t21*2*t21), 0)
+    t25 = t16 - t16*t23**2*t24
+    t26 = casadi.if_else((t22 != 0), -t25/t22, 0)
+    t27 = casadi.if_else((t11 != 0), -(t15 + t19*t26)/t11, 0)
+    t28 = q1 - t1*t27 + t0*t26
+    t29 = q2 - s12*t27 + c12*t26
     q_start = casadi.SX(2, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
     q_next = casadi.SX(2, 1)
-    q_next[0, 0] = t29
-    q_next[1, 0] = t30
+    q_next[0, 0] = t28
+    q_next[1, 0] = t29
     cost = casadi.SX(1, 1)
     cost[0, 0] = casadi.if_else((casadi.fabs(t8) < casadi.inf), t7, -1)
     return [q_start, q_next, cost]

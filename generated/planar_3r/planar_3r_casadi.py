@@ -503,109 +503,104 @@ def _velocity_ik(q, mu_dot, damping):
     t5 = t3 + t1 + s123
     t6 = t3**2
     t7 = s123**2 + t1**2 + t6
-    t8 = t7
-    t9 = t2**2
-    t10 = casadi.sqrt(1 + t6 + t9)
-    t11 = t10*casadi.if_else((t3 <= 0), 1, -1)
-    t12 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t3))), 0)
-    t13 = c123**2 + t0**2 + t9
-    t14 = t13
-    t15 = casadi.sqrt(3 + t7 + t13)
-    t16 = c123 + t0 + t2
-    t17 = t16
-    t18 = t4**2
-    t19 = t5**2
-    t20 = damping**2
-    t21 = t8 + t20
-    t22 = t21**2
-    t23 = casadi.sqrt(t18 + t19 + t22)
-    t24 = t23*casadi.if_else((t21 >= 0), 1, -1)
-    t25 = t24 + t21
-    t26 = casadi.if_else((t23 > 0), 1/(t23*(t23 + casadi.fabs(t21))), 0)
-    t27 = -t26*(-mu_dot0*t25 + mu_dot1*t4 + mu_dot2*t5)
-    t28 = mu_dot0 - t25*t27
-    t29 = mu_dot1 + t4*t27
-    t30 = mu_dot2 + t5*t27
-    t31 = t14 + t20
-    t32 = -t26*(t4*t25 + t5*t17 + t4*t31)
-    t33 = t4 + t25*t32
-    t34 = t4*t32 + t31
-    t35 = t17 + t5*t32
-    t36 = casadi.sqrt(t34**2 + t35**2)
-    t37 = t36*casadi.if_else((t34 >= 0), 1, -1)
-    t38 = t34 + t37
-    t39 = casadi.if_else((t36 > 0), 1/(t36*(t36 + casadi.fabs(t34))), 0)
-    t40 = t39*(t29*t38 + t35*t30)
-    t41 = t29 - t38*t40
-    t42 = t30 - t35*t40
-    t43 = 3 + t20
-    t44 = casadi.sqrt(2*t18 + 2*t19 + 2*t17**2 + t22 + t31**2 + t43**2)
-    t45 = -t26*(t5*t25 + t4*t17 + t5*t43)
-    t46 = t5 + t25*t45
-    t47 = t17 + t4*t45
-    t48 = t5*t45 + t43
-    t49 = t39*(t47*t38 + t35*t48)
-    t50 = t47 - t38*t49
-    t51 = t48 - t35*t49
-    t52 = casadi.fabs(t51)
-    t53 = t52
-    t54 = t53*casadi.if_else((t51 >= 0), 1, -1)
-    t55 = t51 + t54
-    t56 = casadi.if_else((t53 > 0), 1/(t53*(t53 + t52)), 0)
-    t57 = t42 - t42*t55**2*t56
-    t58 = casadi.if_else((t54 != 0), -t57/t54, 0)
-    t59 = casadi.if_else((t37 != 0), -(t41 - t50*t58)/t37, 0)
-    t60 = casadi.if_else((t24 != 0), -(t28 + t33*t59 + t46*t58)/t24, 0)
-    t61 = t58 - t3*t60 + t2*t59
-    t62 = t58 - t1*t60 + t0*t59
-    t63 = t58 - s123*t60 + c123*t59
-    t64 = -t3
-    t65 = t11 + t64
-    t66 = t12*(1 - t1*t65 + t0*t2)
-    t67 = t1 + t65*t66
-    t68 = t0 - t2*t66
+    t8 = t2**2
+    t9 = casadi.sqrt(1 + t6 + t8)
+    t10 = t9*casadi.if_else((t3 <= 0), 1, -1)
+    t11 = casadi.if_else((t9 > 0), 1/(t9*(t9 + casadi.fabs(t3))), 0)
+    t12 = c123**2 + t0**2 + t8
+    t13 = casadi.sqrt(3 + t7 + t12)
+    t14 = c123 + t0 + t2
+    t15 = t4**2
+    t16 = t5**2
+    t17 = damping**2
+    t18 = t7 + t17
+    t19 = t18**2
+    t20 = casadi.sqrt(t15 + t16 + t19)
+    t21 = t20*casadi.if_else((t18 >= 0), 1, -1)
+    t22 = t21 + t18
+    t23 = casadi.if_else((t20 > 0), 1/(t20*(t20 + casadi.fabs(t18))), 0)
+    t24 = -t23*(-mu_dot0*t22 + mu_dot1*t4 + mu_dot2*t5)
+    t25 = mu_dot0 - t22*t24
+    t26 = mu_dot1 + t4*t24
+    t27 = mu_dot2 + t5*t24
+    t28 = t12 + t17
+    t29 = -t23*(t4*t22 + t4*t28 + t5*t14)
+    t30 = t4 + t22*t29
+    t31 = t4*t29 + t28
+    t32 = t5*t29 + t14
+    t33 = casadi.sqrt(t31**2 + t32**2)
+    t34 = t33*casadi.if_else((t31 >= 0), 1, -1)
+    t35 = t31 + t34
+    t36 = casadi.if_else((t33 > 0), 1/(t33*(t33 + casadi.fabs(t31))), 0)
+    t37 = t36*(t26*t35 + t32*t27)
+    t38 = t26 - t35*t37
+    t39 = t27 - t32*t37
+    t40 = 3 + t17
+    t41 = casadi.sqrt(2*t15 + 2*t16 + 2*t14**2 + t19 + t28**2 + t40**2)
+    t42 = -t23*(t5*t22 + t5*t40 + t4*t14)
+    t43 = t5 + t22*t42
+    t44 = t4*t42 + t14
+    t45 = t5*t42 + t40
+    t46 = t36*(t44*t35 + t32*t45)
+    t47 = t44 - t35*t46
+    t48 = t45 - t32*t46
+    t49 = casadi.fabs(t48)
+    t50 = casadi.if_else((t48 >= 0), 1, -1)*t49
+    t51 = t48 + t50
+    t52 = casadi.if_else((t49 > 0), 1/(t49*2*t49), 0)
+    t53 = t39 - t39*t51**2*t52
+    t54 = casadi.if_else((t50 != 0), -t53/t50, 0)
+    t55 = casadi.if_else((t34 != 0), -(t38 - t47*t54)/t34, 0)
+    t56 = casadi.if_else((t21 != 0), -(t25 + t30*t55 + t43*t54)/t21, 0)
+    t57 = t54 - t3*t56 + t2*t55
+    t58 = t54 - t1*t56 + t0*t55
+    t59 = t54 - s123*t56 + c123*t55
+    t60 = -t3
+    t61 = t10 + t60
+    t62 = t11*(1 - t1*t61 + t0*t2)
+    t63 = t1 + t61*t62
+    t64 = t0 - t2*t62
+    t65 = 1 - t62
+    t66 = t11*(1 + c123*t2 - s123*t61)
+    t67 = s123 + t61*t66
+    t68 = c123 - t2*t66
     t69 = 1 - t66
-    t70 = t12*(1 + c123*t2 - s123*t65)
-    t71 = s123 + t65*t70
-    t72 = c123 - t2*t70
-    t73 = 1 - t70
-    t74 = t12*(mu_dot2 + mu_dot0*t65 + t2*mu_dot1)
-    t75 = mu_dot0 - t65*t74
-    t76 = mu_dot1 - t2*t74
-    t77 = -t74 + mu_dot2
-    t78 = casadi.sqrt(t68**2 + t69**2)
-    t79 = t78*casadi.if_else((t68 >= 0), 1, -1)
-    t80 = t68 + t79
-    t81 = casadi.if_else((t78 > 0), 1/(t78*(t78 + casadi.fabs(t68))), 0)
-    t82 = t81*(t72*t80 + t69*t73)
-    t83 = t72 - t80*t82
-    t84 = t73 - t69*t82
-    t85 = t81*(t76*t80 + t69*t77)
-    t86 = t76 - t80*t85
-    t87 = t77 - t69*t85
-    t88 = 3 - t1 - s123 + q1 + q2 + q3 + mu_dot0 + mu_dot1 + mu_dot2 + damping + t16 + t64
-    t89 = casadi.fabs(t84)
-    t90 = t89
-    t91 = t90*casadi.if_else((t84 >= 0), 1, -1)
-    t92 = t84 + t91
-    t93 = casadi.if_else((t90 > 0), 1/(t90*(t90 + t89)), 0)
-    t94 = t87 - t87*t92**2*t93
-    t95 = casadi.if_else((t91 != 0), -t94/t91, 0)
-    t96 = casadi.if_else((t79 != 0), -(t86 - t83*t95)/t79, 0)
-    t97 = casadi.if_else((t11 != 0), -(t75 + t67*t96 + t71*t95)/t11, 0)
-    t98 = (casadi.fabs(t88) < casadi.inf)
-    t99 = (damping >= 0)
-    t100 = (damping > 0)
-    t101 = 1e-12*t44
-    t102 = 1e-12*t15
-    t103 = casadi.logic_or(casadi.logic_and(t100, casadi.logic_or(casadi.logic_or((t23 <= t101), (t36 <= t101)), (t53 <= t101))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t10 <= t102), (t78 <= t102)), (t90 <= t102))))
-    t104 = casadi.logic_and(casadi.logic_and(t98, t99), casadi.logic_not(t103))
+    t70 = t11*(mu_dot2 + mu_dot0*t61 + t2*mu_dot1)
+    t71 = mu_dot0 - t61*t70
+    t72 = mu_dot1 - t2*t70
+    t73 = -t70 + mu_dot2
+    t74 = casadi.sqrt(t64**2 + t65**2)
+    t75 = t74*casadi.if_else((t64 >= 0), 1, -1)
+    t76 = t64 + t75
+    t77 = casadi.if_else((t74 > 0), 1/(t74*(t74 + casadi.fabs(t64))), 0)
+    t78 = t77*(t68*t76 + t65*t69)
+    t79 = t68 - t76*t78
+    t80 = t69 - t65*t78
+    t81 = t77*(t72*t76 + t65*t73)
+    t82 = t72 - t76*t81
+    t83 = t73 - t65*t81
+    t84 = 3 - t1 - s123 + q1 + q2 + q3 + mu_dot0 + mu_dot1 + mu_dot2 + damping + t14 + t60
+    t85 = casadi.fabs(t80)
+    t86 = casadi.if_else((t80 >= 0), 1, -1)*t85
+    t87 = t80 + t86
+    t88 = casadi.if_else((t85 > 0), 1/(t85*2*t85), 0)
+    t89 = t83 - t83*t87**2*t88
+    t90 = casadi.if_else((t86 != 0), -t89/t86, 0)
+    t91 = casadi.if_else((t75 != 0), -(t82 - t79*t90)/t75, 0)
+    t92 = casadi.if_else((t10 != 0), -(t71 + t63*t91 + t67*t90)/t10, 0)
+    t93 = (casadi.fabs(t84) < casadi.inf)
+    t94 = (damping >= 0)
+    t95 = (damping > 0)
+    t96 = 1e-12*t41
+    t97 = 1e-12*t13
+    t98 = casadi.logic_or(casadi.logic_and(t95, casadi.logic_or(casadi.logic_or((t20 <= t96), (t33 <= t96)), (t49 <= t96))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t9 <= t97), (t74 <= t97)), (t85 <= t97))))
+    t99 = casadi.logic_and(casadi.logic_and(t93, t94), casadi.logic_not(t98))
     q_dot = casadi.SX(3, 1)
-    q_dot[0, 0] = casadi.if_else(t104, casadi.if_else(t100, t61, t97), 0)
-    q_dot[1, 0] = casadi.if_else(t104, casadi.if_else(t100, t62, t96), 0)
-    q_dot[2, 0] = casadi.if_else(t104, casadi.if_else(t100, t63, t95), 0)
+    q_dot[0, 0] = casadi.if_else(t99, casadi.if_else(t95, t57, t92), 0)
+    q_dot[1, 0] = casadi.if_else(t99, casadi.if_else(t95, t58, t91), 0)
+    q_dot[2, 0] = casadi.if_else(t99, casadi.if_else(t95, t59, t90), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t98, t99)), 2, casadi.if_else(t103, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t93, t94)), 2, casadi.if_else(t98, 1, 0))
     return [q_dot, status]
 
 
@@ -675,25 +670,24 @@ def _ik_numeric_step(target, q, damping):
     t42 = t39 - t31*t41
     t43 = t40 - t28*t41
     t44 = casadi.fabs(t43)
-    t45 = t44
-    t46 = t45*casadi.if_else((t43 >= 0), 1, -1)
-    t47 = t43 + t46
-    t48 = casadi.if_else((t45 > 0), 1/(t45*(t44 + t45)), 0)
-    t49 = t35 - t35*t47**2*t48
-    t50 = casadi.if_else((t46 != 0), -t49/t46, 0)
-    t51 = casadi.if_else((t30 != 0), -(t34 - t42*t50)/t30, 0)
-    t52 = casadi.if_else((t17 != 0), -(t21 + t26*t51 + t38*t50)/t17, 0)
-    t53 = q1 + t50 - t3*t52 + t2*t51
-    t54 = q2 + t50 - t1*t52 + t0*t51
-    t55 = q3 + t50 - s123*t52 + c123*t51
+    t45 = t44*casadi.if_else((t43 >= 0), 1, -1)
+    t46 = t43 + t45
+    t47 = casadi.if_else((t44 > 0), 1/(t44*2*t44), 0)
+    t48 = t35 - t35*t46**2*t47
+    t49 = casadi.if_else((t45 != 0), -t48/t45, 0)
+    t50 = casadi.if_else((t30 != 0), -(t34 - t42*t49)/t30, 0)
+    t51 = casadi.if_else((t17 != 0), -(t21 + t26*t50 + t38*t49)/t17, 0)
+    t52 = q1 + t49 - t3*t51 + t2*t50
+    t53 = q2 + t49 - t1*t51 + t0*t50
+    t54 = q3 + t49 - s123*t51 + c123*t50
     q_start = casadi.SX(3, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
     q_start[2, 0] = q3
     q_next = casadi.SX(3, 1)
-    q_next[0, 0] = t53
-    q_next[1, 0] = t54
-    q_next[2, 0] = t55
+    q_next[0, 0] = t52
+    q_next[1, 0] = t53
+    q_next[2, 0] = t54
     cost = casadi.SX(1, 1)
     cost[0, 0] = casadi.if_else((casadi.fabs(t11) < casadi.inf), t14, -1)
     return [q_start, q_next, cost]

@@ -671,43 +671,41 @@ def fk_jacobian_dot(q, q_dot):
     t35 = t20 + c1*t34
     t36 = t26 + s1*t34
     t37 = c1*t35 + s1*t36
-    t38 = t37
-    t39 = c1*t20 + s1*t26
-    t40 = t39
-    t41 = t40*qd3 + t38*qd2
-    t42 = s1*qd2
-    t43 = s1*qd3
-    t44 = t42 + t43
-    t45 = t44 - t15*qd4
-    t46 = t45 + t13*qd5
-    t47 = t1*t42 + t0*t43
-    t48 = -t47 + t35*qd1
-    t49 = c1*qd2
-    t50 = c1*qd3
-    t51 = t49 + t50
-    t52 = t51 + t21*qd4
-    t53 = t52 + t10*qd5
-    t54 = t1*t49 + t0*t50
-    t55 = t54 + t36*qd1
-    t56 = -t17
-    t57 = -t23
-    t58 = c1*t1
-    t59 = c1*t0
-    t60 = s1*t1
-    t61 = s1*t0
-    t62 = -c1
-    t63 = s1**2
-    t64 = t0*qd2
-    t65 = c1**2
-    t66 = t0*qd3
+    t38 = c1*t20 + s1*t26
+    t39 = t38*qd3 + t37*qd2
+    t40 = s1*qd2
+    t41 = s1*qd3
+    t42 = t40 + t41
+    t43 = t42 - t15*qd4
+    t44 = t43 + t13*qd5
+    t45 = t1*t40 + t0*t41
+    t46 = -t45 + t35*qd1
+    t47 = c1*qd2
+    t48 = c1*qd3
+    t49 = t47 + t48
+    t50 = t49 + t21*qd4
+    t51 = t50 + t10*qd5
+    t52 = t1*t47 + t0*t48
+    t53 = t52 + t36*qd1
+    t54 = -t17
+    t55 = -t23
+    t56 = c1*t1
+    t57 = c1*t0
+    t58 = s1*t1
+    t59 = s1*t0
+    t60 = -c1
+    t61 = s1**2
+    t62 = t0*qd2
+    t63 = c1**2
+    t64 = t0*qd3
     T = _stack(xp, [
         xp.broadcast_to(t18, batch),  # 0, 0
         xp.broadcast_to(-t19, batch),  # 0, 1
-        xp.broadcast_to(t56, batch),  # 0, 2
+        xp.broadcast_to(t54, batch),  # 0, 2
         xp.broadcast_to(t35, batch),  # 0, 3
         xp.broadcast_to(t24, batch),  # 1, 0
         xp.broadcast_to(t25, batch),  # 1, 1
-        xp.broadcast_to(t57, batch),  # 1, 2
+        xp.broadcast_to(t55, batch),  # 1, 2
         xp.broadcast_to(t36, batch),  # 1, 3
         xp.broadcast_to(t31, batch),  # 2, 0
         xp.broadcast_to(-t32, batch),  # 2, 1
@@ -720,20 +718,20 @@ def fk_jacobian_dot(q, q_dot):
     ], (4, 4))
     J = _stack(xp, [
         xp.broadcast_to(-t36, batch),  # 0, 0
-        xp.broadcast_to(-t58, batch),  # 0, 1
-        xp.broadcast_to(-t59, batch),  # 0, 2
+        xp.broadcast_to(-t56, batch),  # 0, 1
+        xp.broadcast_to(-t57, batch),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t35, batch),  # 1, 0
-        xp.broadcast_to(-t60, batch),  # 1, 1
-        xp.broadcast_to(-t61, batch),  # 1, 2
+        xp.broadcast_to(-t58, batch),  # 1, 1
+        xp.broadcast_to(-t59, batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(t37, batch),  # 2, 1
-        xp.broadcast_to(t39, batch),  # 2, 2
+        xp.broadcast_to(t38, batch),  # 2, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
@@ -742,13 +740,13 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(s1, batch),  # 3, 2
         xp.broadcast_to(-t15, batch),  # 3, 3
         xp.broadcast_to(t13, batch),  # 3, 4
-        xp.broadcast_to(t56, batch),  # 3, 5
+        xp.broadcast_to(t54, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t62, batch),  # 4, 1
-        xp.broadcast_to(t62, batch),  # 4, 2
+        xp.broadcast_to(t60, batch),  # 4, 1
+        xp.broadcast_to(t60, batch),  # 4, 2
         xp.broadcast_to(-t21, batch),  # 4, 3
         xp.broadcast_to(-t10, batch),  # 4, 4
-        xp.broadcast_to(t57, batch),  # 4, 5
+        xp.broadcast_to(t55, batch),  # 4, 5
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
@@ -757,12 +755,12 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t29, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t48 + qd2*(-c1*t41 + t60*qd1) - qd3*(t49*t40 - t61*qd1 + t50*t40), batch),  # 0
-        xp.broadcast_to(-qd1*t55 - qd2*(s1*t41 + t58*qd1) - qd3*(t59*qd1 + t42*t40 + t43*t40), batch),  # 1
-        xp.broadcast_to(-qd2*(s1*t47 + c1*t54) - qd3*(t63*t64 + t64*t65 + t63*t66 + t65*t66), batch),  # 2
-        xp.broadcast_to(qd6*(-t29*t53 + t23*t33) + t49*qd1 + t50*qd1 + qd4*(-c23*t51 + t21*qd1) + qd5*(t10*t3 - t30*t52), batch),  # 3
-        xp.broadcast_to(t42*qd1 + t43*qd1 - qd4*(c23*t44 + t15*qd1) + qd5*(t13*t3 - t30*t45) - qd6*(t17*t33 + t29*t46), batch),  # 4
-        xp.broadcast_to(qd5*(-t10*t45 + t13*t52) - qd4*(t21*t44 + t15*t51) - qd6*(t23*t46 + t17*t53), batch),  # 5
+        xp.broadcast_to(-qd1*t46 + qd2*(-c1*t39 + t58*qd1) - qd3*(-t59*qd1 + t38*t47 + t38*t48), batch),  # 0
+        xp.broadcast_to(-qd1*t53 - qd2*(s1*t39 + t56*qd1) - qd3*(t57*qd1 + t38*t40 + t38*t41), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t45 + c1*t52) - qd3*(t61*t62 + t62*t63 + t61*t64 + t63*t64), batch),  # 2
+        xp.broadcast_to(qd6*(-t29*t51 + t23*t33) + t47*qd1 + t48*qd1 + qd4*(-c23*t49 + t21*qd1) + qd5*(t10*t3 - t30*t50), batch),  # 3
+        xp.broadcast_to(t40*qd1 + t41*qd1 - qd4*(c23*t42 + t15*qd1) + qd5*(t13*t3 - t30*t43) - qd6*(t17*t33 + t29*t44), batch),  # 4
+        xp.broadcast_to(qd5*(-t10*t43 + t13*t50) - qd4*(t21*t42 + t15*t49) - qd6*(t23*t44 + t17*t51), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -1542,348 +1540,340 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t28 = t2**2
     t29 = t1**2
     t30 = t25 + t26*t28 + t26*t29
-    t31 = t30
-    t32 = -t22*t23
-    t33 = s1*c1
-    t34 = t32 + t28*t33 + t29*t33
-    t35 = c1*t24
-    t36 = c1*t20
-    t37 = t2*t35 + t1*t36
-    t38 = t35 + t36
-    t39 = c1*t2
-    t40 = c1*t1
-    t41 = s1*t39 + s1*t40
-    t42 = t22**2
-    t43 = xp.sqrt(1 + t25 + t42)
-    t44 = t43*xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)
-    t45 = xp.where(xp.greater(t43, 0), 1/(t43*(t43 + xp.abs(t23))), 0)
-    t46 = s1**2
-    t47 = t2*t46 + t1*t46
-    t48 = t42 + t28*t46 + t29*t46
-    t49 = t48
-    t50 = s1*t24
-    t51 = s1*t20
-    t52 = t2*t50 + t1*t51
-    t53 = t50 + t51
-    t54 = t24**2
-    t55 = t20**2 + t54
-    t56 = t55
-    t57 = s23**2
-    t58 = t12**2 + t15**2 + 2*t46 + t26*t57
-    t59 = t58
-    t60 = 2*s1
-    t61 = -t12*t9 + t15*t18 - c1*t60 + t33*t57
-    t62 = s23*s4
-    t63 = c23*t14 + t15*t0 - t12*t62
-    t64 = t18*t0 + c23*t17 + t9*t62
-    t65 = t9**2 + t18**2 + 2*t26 + t46*t57
-    t66 = t65
-    t67 = 1 + c23**2 + t0**2 + s4**2*t57
-    t68 = t67
-    t69 = xp.sqrt(t30 + t48 + t55 + t58 + t65 + t67)
-    t70 = t34**2
-    t71 = t37**2
-    t72 = t27**2
-    t73 = damping**2
-    t74 = t73 + t31
-    t75 = t74**2
-    t76 = t73 + t49
-    t77 = t73 + t56
-    t78 = t73 + t59
-    t79 = t73 + t66
-    t80 = t73 + t68
-    t81 = t41**2
-    t82 = xp.sqrt(2*t42 + 2*t25 + 2*t70 + 2*t71 + 2*t52**2 + 2*t47**2 + 2*t53**2 + 2*t72 + 2*t38**2 + 2*t61**2 + 2*t63**2 + 2*t64**2 + t75 + t76**2 + t77**2 + t78**2 + t79**2 + t80**2 + 4*t81)
-    t83 = xp.sqrt(t25 + t70 + t71 + t72 + t75 + t81)
-    t84 = t83*xp.where(xp.greater_equal(t74, 0), xp.asarray(1, dtype=dtype), -1)
-    t85 = t74 + t84
-    t86 = xp.where(xp.greater(t83, 0), 1/(t83*(t83 + xp.abs(t74))), 0)
-    t87 = t86*(t32 + t34*t85 + t37*t52 + t41*t47 + t41*t27 + t76*t34)
-    t88 = t34 - t85*t87
-    t89 = t76 - t34*t87
-    t90 = -t52 + t37*t87
-    t91 = -t47 + t41*t87
-    t92 = t41 - t27*t87
-    t93 = t22 + t23*t87
-    t94 = -t86*(t37*t85 + t34*t52 + t41*t53 + t27*t38 + t77*t37)
-    t95 = t37 + t85*t94
-    t96 = t52 + t34*t94
-    t97 = t77 + t37*t94
-    t98 = t53 + t41*t94
-    t99 = t38 + t27*t94
-    t100 = -t86*(t41*t85 + t34*t47 + t37*t53 + t78*t41 - t27*t61 - t23*t63)
-    t101 = t41 + t85*t100
-    t102 = t47 + t34*t100
-    t103 = t53 + t37*t100
-    t104 = t78 + t41*t100
-    t105 = t61 - t27*t100
-    t106 = t86*(t27*t85 + t34*t41 + t37*t38 - t41*t61 + t23*t64 + t79*t27)
-    t107 = t27 - t85*t106
-    t108 = t41 - t34*t106
-    t109 = -t38 + t37*t106
-    t110 = t61 + t41*t106
-    t111 = t79 - t27*t106
-    t112 = -t64 + t23*t106
-    t113 = -t86*(t23*t85 + t27*t64 + t23*t80 - t22*t34 - t41*t63)
-    t114 = t23 + t85*t113
-    t115 = t22 - t34*t113
-    t116 = t64 + t27*t113
-    t117 = t80 + t23*t113
-    t118 = t86*(mu_dot0*t85 + mu_dot1*t34 - mu_dot2*t37 - mu_dot3*t41 + mu_dot4*t27 - t23*mu_dot5)
-    t119 = mu_dot0 - t85*t118
-    t120 = mu_dot1 - t34*t118
-    t121 = mu_dot2 + t37*t118
-    t122 = mu_dot3 + t41*t118
-    t123 = mu_dot4 - t27*t118
-    t124 = mu_dot5 + t23*t118
-    t125 = xp.sqrt(t89**2 + t90**2 + t91**2 + t92**2 + t93**2)
-    t126 = t125*xp.where(xp.greater_equal(t89, 0), xp.asarray(1, dtype=dtype), -1)
-    t127 = t89 + t126
-    t128 = xp.where(xp.greater(t125, 0), 1/(t125*(t125 + xp.abs(t89))), 0)
-    t129 = t128*(t108*t127 + t90*t109 + t91*t110 + t92*t111 + t93*t112)
-    t130 = t108 - t127*t129
-    t131 = t109 - t90*t129
-    t132 = t110 - t91*t129
-    t133 = t111 - t92*t129
-    t134 = t112 - t93*t129
-    t135 = t128*(t120*t127 + t90*t121 + t91*t122 + t92*t123 + t93*t124)
-    t136 = t120 - t127*t135
-    t137 = t121 - t90*t135
-    t138 = t122 - t91*t135
-    t139 = t123 - t92*t135
-    t140 = t124 - t93*t135
-    t141 = -t63
-    t142 = t141 + t23*t100
-    t143 = t141 + t41*t113
-    t144 = t128*(-t102*t127 + t90*t103 + t91*t104 + t92*t105 + t93*t142)
-    t145 = t102 + t127*t144
-    t146 = t103 - t90*t144
-    t147 = t104 - t91*t144
-    t148 = t105 - t92*t144
-    t149 = t142 - t93*t144
-    t150 = t23*t94
-    t151 = t128*(-t96*t127 + t90*t97 + t91*t98 - t92*t99 + t150*t93)
-    t152 = t96 + t127*t151
-    t153 = t97 - t90*t151
-    t154 = t98 - t91*t151
-    t155 = t99 + t92*t151
-    t156 = t150 - t93*t151
-    t157 = xp.sqrt(t153**2 + t154**2 + t155**2 + t156**2)
-    t158 = t157*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
-    t159 = t153 + t158
-    t160 = xp.where(xp.greater(t157, 0), 1/(t157*(t157 + xp.abs(t153))), 0)
-    t161 = t160*(t146*t159 + t154*t147 - t155*t148 + t156*t149)
-    t162 = t146 - t159*t161
-    t163 = t147 - t154*t161
-    t164 = t148 + t155*t161
-    t165 = t149 - t156*t161
-    t166 = t160*(t131*t159 + t154*t132 - t155*t133 + t156*t134)
-    t167 = t131 - t159*t166
-    t168 = t132 - t154*t166
-    t169 = t133 + t155*t166
-    t170 = t134 - t156*t166
-    t171 = t160*(t137*t159 + t154*t138 - t155*t139 + t156*t140)
-    t172 = t137 - t159*t171
-    t173 = t138 - t154*t171
-    t174 = t139 + t155*t171
-    t175 = t140 - t156*t171
-    t176 = xp.sqrt(t163**2 + t164**2 + t165**2)
-    t177 = t176*xp.where(xp.greater_equal(t163, 0), xp.asarray(1, dtype=dtype), -1)
-    t178 = t163 + t177
-    t179 = xp.where(xp.greater(t176, 0), 1/(t176*(t176 + xp.abs(t163))), 0)
-    t180 = t179*(t168*t178 + t164*t169 + t165*t170)
-    t181 = t168 - t178*t180
-    t182 = t169 - t164*t180
-    t183 = t170 - t165*t180
-    t184 = t179*(t173*t178 + t164*t174 + t165*t175)
-    t185 = t173 - t178*t184
-    t186 = t174 - t164*t184
-    t187 = t175 - t165*t184
-    t188 = xp.sqrt(t182**2 + t183**2)
-    t189 = t188*xp.where(xp.greater_equal(t182, 0), xp.asarray(1, dtype=dtype), -1)
-    t190 = t182 + t189
-    t191 = xp.where(xp.greater(t188, 0), 1/(t188*(t188 + xp.abs(t182))), 0)
-    t192 = t191*(t186*t190 + t183*t187)
-    t193 = t186 - t190*t192
-    t194 = t187 - t183*t192
-    t195 = t37*t113
-    t196 = t128*(t115*t127 + t91*t143 - t92*t116 + t93*t117 + t195*t90)
-    t197 = t115 - t127*t196
-    t198 = t195 - t90*t196
-    t199 = t143 - t91*t196
-    t200 = t116 + t92*t196
-    t201 = t117 - t93*t196
-    t202 = t160*(t198*t159 + t154*t199 + t155*t200 + t156*t201)
-    t203 = t198 - t159*t202
-    t204 = t199 - t154*t202
-    t205 = -t200 + t155*t202
-    t206 = t201 - t156*t202
-    t207 = t179*(t204*t178 + t164*t205 + t165*t206)
-    t208 = t204 - t178*t207
-    t209 = t205 - t164*t207
-    t210 = t206 - t165*t207
-    t211 = t191*(t209*t190 + t183*t210)
-    t212 = t209 - t190*t211
-    t213 = t210 - t183*t211
-    t214 = xp.abs(t213)
-    t215 = t214
-    t216 = t215*xp.where(xp.greater_equal(t213, 0), xp.asarray(1, dtype=dtype), -1)
-    t217 = t213 + t216
-    t218 = xp.where(xp.greater(t215, 0), 1/(t215*(t214 + t215)), 0)
-    t219 = t194 - t194*t217**2*t218
-    t220 = xp.where(xp.not_equal(t216, 0), -t219/t216, 0)
-    t221 = xp.where(xp.not_equal(t189, 0), -(t193 - t212*t220)/t189, 0)
-    t222 = xp.where(xp.not_equal(t177, 0), -(-(t181*t221 + t208*t220) + t185)/t177, 0)
-    t223 = xp.where(xp.not_equal(t158, 0), -(-(t162*t222 + t167*t221 + t203*t220) + t172)/t158, 0)
-    t224 = xp.where(xp.not_equal(t126, 0), -(-(-t152*t223 - t145*t222 + t130*t221 + t197*t220) + t136)/t126, 0)
-    t225 = xp.where(xp.not_equal(t84, 0), -(t119 + t95*t223 + t101*t222 + t114*t220 - t88*t224 - t107*t221)/t84, 0)
-    t226 = t220 - t23*t225 + t22*t224
-    t227 = -c23*t220 + t14*t222 + t17*t221
-    t228 = t12*t222 - t9*t221 + t62*t220
-    t229 = t15*t222 + t18*t221 - t0*t220
-    t230 = s1*t2
-    t231 = c1*t221 - s1*t222
-    t232 = t231 - t24*t223 + t39*t225 + t230*t224
-    t233 = s1*t1
-    t234 = t231 - t20*t223 + t40*t225 + t233*t224
-    t235 = -t23
-    t236 = t235 + t44
-    t237 = -t45*(t39*t236 + t22*t230)
-    t238 = t39 + t236*t237
-    t239 = t230 + t22*t237
-    t240 = -t45*(t40*t236 + t22*t233)
-    t241 = t40 + t236*t240
-    t242 = t233 + t22*t240
-    t243 = t45*(mu_dot5 + mu_dot0*t236 + t22*mu_dot1)
-    t244 = mu_dot0 - t236*t243
-    t245 = mu_dot1 - t22*t243
-    t246 = -t243 + mu_dot5
-    t247 = c23*t45
-    t248 = -t247 + c23
-    t249 = t62*t45
-    t250 = -t249 + t62
-    t251 = t0*t45
-    t252 = -t251 + t0
-    t253 = t26 + t46
-    t254 = xp.sqrt(t54 + t253 + t237**2 + t239**2)
-    t255 = t254*xp.where(xp.less_equal(t239, 0), xp.asarray(1, dtype=dtype), -1)
-    t256 = -t239 + t255
-    t257 = xp.where(xp.greater(t254, 0), 1/(t254*(t254 + xp.abs(t239))), 0)
-    t258 = t257*(t253 - t242*t256 + t24*t20 + t237*t240)
-    t259 = t242 + t256*t258
-    t260 = t20 - t24*t258
-    t261 = s1 - s1*t258
-    t262 = -c1 + c1*t258
-    t263 = -t240 + t237*t258
-    t264 = t257*(t245*t256 + t24*mu_dot2 + s1*mu_dot3 - c1*mu_dot4 - t237*t246)
-    t265 = t245 - t256*t264
-    t266 = mu_dot2 - t24*t264
-    t267 = mu_dot3 - s1*t264
-    t268 = mu_dot4 + c1*t264
-    t269 = t246 + t237*t264
-    t270 = xp.sqrt(t260**2 + t261**2 + t262**2 + t263**2)
-    t271 = t270*xp.where(xp.greater_equal(t260, 0), xp.asarray(1, dtype=dtype), -1)
-    t272 = t260 + t271
-    t273 = xp.where(xp.greater(t270, 0), 1/(t270*(t270 + xp.abs(t260))), 0)
-    t274 = t273*(t266*t272 + t261*t267 + t262*t268 + t263*t269)
-    t275 = t266 - t272*t274
-    t276 = t267 - t261*t274
-    t277 = t268 - t262*t274
-    t278 = t269 - t263*t274
-    t279 = t22*t247
-    t280 = -t257*(t237*t248 + t279*t256)
-    t281 = t279 + t256*t280
-    t282 = t14 + s1*t280
-    t283 = t248 + t237*t280
-    t284 = -t17
-    t285 = t284 + c1*t280
-    t286 = t22*t249
-    t287 = t257*(s1*t12 + c1*t9 - t237*t250 - t256*t286)
-    t288 = t256*t287 + t286
-    t289 = t12 - s1*t287
-    t290 = t250 + t237*t287
-    t291 = -t9
+    t31 = -t22*t23
+    t32 = s1*c1
+    t33 = t31 + t29*t32 + t28*t32
+    t34 = c1*t24
+    t35 = c1*t20
+    t36 = t2*t34 + t1*t35
+    t37 = t34 + t35
+    t38 = c1*t2
+    t39 = c1*t1
+    t40 = s1*t38 + s1*t39
+    t41 = t22**2
+    t42 = xp.sqrt(1 + t25 + t41)
+    t43 = t42*xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)
+    t44 = xp.where(xp.greater(t42, 0), 1/(t42*(t42 + xp.abs(t23))), 0)
+    t45 = s1**2
+    t46 = t2*t45 + t1*t45
+    t47 = t41 + t28*t45 + t29*t45
+    t48 = s1*t24
+    t49 = s1*t20
+    t50 = t2*t48 + t1*t49
+    t51 = t48 + t49
+    t52 = t24**2
+    t53 = t20**2 + t52
+    t54 = s23**2
+    t55 = t12**2 + t15**2 + 2*t45 + t26*t54
+    t56 = 2*s1
+    t57 = -t12*t9 + t15*t18 - c1*t56 + t32*t54
+    t58 = s23*s4
+    t59 = c23*t14 + t15*t0 - t12*t58
+    t60 = t18*t0 + c23*t17 + t9*t58
+    t61 = t9**2 + t18**2 + 2*t26 + t45*t54
+    t62 = 1 + c23**2 + t0**2 + s4**2*t54
+    t63 = xp.sqrt(t30 + t47 + t53 + t55 + t61 + t62)
+    t64 = t33**2
+    t65 = t36**2
+    t66 = t27**2
+    t67 = damping**2
+    t68 = t30 + t67
+    t69 = t68**2
+    t70 = t47 + t67
+    t71 = t53 + t67
+    t72 = t55 + t67
+    t73 = t61 + t67
+    t74 = t62 + t67
+    t75 = t40**2
+    t76 = xp.sqrt(2*t41 + 2*t25 + 2*t64 + 2*t65 + 2*t50**2 + 2*t46**2 + 2*t51**2 + 2*t66 + 2*t37**2 + 2*t57**2 + 2*t59**2 + 2*t60**2 + t69 + t70**2 + t71**2 + t72**2 + t73**2 + t74**2 + 4*t75)
+    t77 = xp.sqrt(t25 + t64 + t65 + t66 + t69 + t75)
+    t78 = t77*xp.where(xp.greater_equal(t68, 0), xp.asarray(1, dtype=dtype), -1)
+    t79 = t68 + t78
+    t80 = xp.where(xp.greater(t77, 0), 1/(t77*(t77 + xp.abs(t68))), 0)
+    t81 = t80*(t31 + t33*t79 + t36*t50 + t40*t46 + t40*t27 + t70*t33)
+    t82 = t33 - t79*t81
+    t83 = t70 - t33*t81
+    t84 = -t50 + t36*t81
+    t85 = -t46 + t40*t81
+    t86 = t40 - t27*t81
+    t87 = t22 + t23*t81
+    t88 = -t80*(t36*t79 + t33*t50 + t40*t51 + t27*t37 + t71*t36)
+    t89 = t36 + t79*t88
+    t90 = t50 + t33*t88
+    t91 = t71 + t36*t88
+    t92 = t51 + t40*t88
+    t93 = t37 + t27*t88
+    t94 = -t80*(t40*t79 + t33*t46 + t36*t51 + t72*t40 - t27*t57 - t23*t59)
+    t95 = t40 + t79*t94
+    t96 = t46 + t33*t94
+    t97 = t51 + t36*t94
+    t98 = t72 + t40*t94
+    t99 = t57 - t27*t94
+    t100 = t80*(t27*t79 + t33*t40 + t36*t37 - t40*t57 + t23*t60 + t73*t27)
+    t101 = t27 - t79*t100
+    t102 = t40 - t33*t100
+    t103 = -t37 + t36*t100
+    t104 = t57 + t40*t100
+    t105 = t73 - t27*t100
+    t106 = -t60 + t23*t100
+    t107 = -t80*(t23*t79 + t27*t60 + t23*t74 - t22*t33 - t40*t59)
+    t108 = t23 + t79*t107
+    t109 = t22 - t33*t107
+    t110 = t60 + t27*t107
+    t111 = t74 + t23*t107
+    t112 = t80*(mu_dot0*t79 + mu_dot1*t33 - mu_dot2*t36 - mu_dot3*t40 + mu_dot4*t27 - t23*mu_dot5)
+    t113 = mu_dot0 - t79*t112
+    t114 = mu_dot1 - t33*t112
+    t115 = mu_dot2 + t36*t112
+    t116 = mu_dot3 + t40*t112
+    t117 = mu_dot4 - t27*t112
+    t118 = mu_dot5 + t23*t112
+    t119 = xp.sqrt(t83**2 + t84**2 + t85**2 + t86**2 + t87**2)
+    t120 = t119*xp.where(xp.greater_equal(t83, 0), xp.asarray(1, dtype=dtype), -1)
+    t121 = t83 + t120
+    t122 = xp.where(xp.greater(t119, 0), 1/(t119*(t119 + xp.abs(t83))), 0)
+    t123 = t122*(t102*t121 + t84*t103 + t85*t104 + t86*t105 + t87*t106)
+    t124 = t102 - t121*t123
+    t125 = t103 - t84*t123
+    t126 = t104 - t85*t123
+    t127 = t105 - t86*t123
+    t128 = t106 - t87*t123
+    t129 = t122*(t114*t121 + t84*t115 + t85*t116 + t86*t117 + t87*t118)
+    t130 = t114 - t121*t129
+    t131 = t115 - t84*t129
+    t132 = t116 - t85*t129
+    t133 = t117 - t86*t129
+    t134 = t118 - t87*t129
+    t135 = -t59
+    t136 = t135 + t23*t94
+    t137 = t135 + t40*t107
+    t138 = t122*(-t96*t121 + t84*t97 + t85*t98 + t86*t99 + t87*t136)
+    t139 = t96 + t121*t138
+    t140 = t97 - t84*t138
+    t141 = t98 - t85*t138
+    t142 = t99 - t86*t138
+    t143 = t136 - t87*t138
+    t144 = t23*t88
+    t145 = t122*(-t90*t121 + t84*t91 + t85*t92 - t86*t93 + t144*t87)
+    t146 = t90 + t121*t145
+    t147 = t91 - t84*t145
+    t148 = t92 - t85*t145
+    t149 = t93 + t86*t145
+    t150 = t144 - t87*t145
+    t151 = xp.sqrt(t147**2 + t148**2 + t149**2 + t150**2)
+    t152 = t151*xp.where(xp.greater_equal(t147, 0), xp.asarray(1, dtype=dtype), -1)
+    t153 = t147 + t152
+    t154 = xp.where(xp.greater(t151, 0), 1/(t151*(t151 + xp.abs(t147))), 0)
+    t155 = t154*(t140*t153 + t148*t141 - t149*t142 + t150*t143)
+    t156 = t140 - t153*t155
+    t157 = t141 - t148*t155
+    t158 = t142 + t149*t155
+    t159 = t143 - t150*t155
+    t160 = t154*(t125*t153 + t148*t126 - t149*t127 + t150*t128)
+    t161 = t125 - t153*t160
+    t162 = t126 - t148*t160
+    t163 = t127 + t149*t160
+    t164 = t128 - t150*t160
+    t165 = t154*(t131*t153 + t148*t132 - t149*t133 + t150*t134)
+    t166 = t131 - t153*t165
+    t167 = t132 - t148*t165
+    t168 = t133 + t149*t165
+    t169 = t134 - t150*t165
+    t170 = xp.sqrt(t157**2 + t158**2 + t159**2)
+    t171 = t170*xp.where(xp.greater_equal(t157, 0), xp.asarray(1, dtype=dtype), -1)
+    t172 = t157 + t171
+    t173 = xp.where(xp.greater(t170, 0), 1/(t170*(t170 + xp.abs(t157))), 0)
+    t174 = t173*(t162*t172 + t158*t163 + t159*t164)
+    t175 = t162 - t172*t174
+    t176 = t163 - t158*t174
+    t177 = t164 - t159*t174
+    t178 = t173*(t167*t172 + t158*t168 + t159*t169)
+    t179 = t167 - t172*t178
+    t180 = t168 - t158*t178
+    t181 = t169 - t159*t178
+    t182 = xp.sqrt(t176**2 + t177**2)
+    t183 = t182*xp.where(xp.greater_equal(t176, 0), xp.asarray(1, dtype=dtype), -1)
+    t184 = t176 + t183
+    t185 = xp.where(xp.greater(t182, 0), 1/(t182*(t182 + xp.abs(t176))), 0)
+    t186 = t185*(t180*t184 + t177*t181)
+    t187 = t180 - t184*t186
+    t188 = t181 - t177*t186
+    t189 = t36*t107
+    t190 = t122*(t109*t121 + t85*t137 - t86*t110 + t87*t111 + t189*t84)
+    t191 = t109 - t121*t190
+    t192 = t189 - t84*t190
+    t193 = t137 - t85*t190
+    t194 = t110 + t86*t190
+    t195 = t111 - t87*t190
+    t196 = t154*(t192*t153 + t148*t193 + t149*t194 + t150*t195)
+    t197 = t192 - t153*t196
+    t198 = t193 - t148*t196
+    t199 = -t194 + t149*t196
+    t200 = t195 - t150*t196
+    t201 = t173*(t198*t172 + t158*t199 + t159*t200)
+    t202 = t198 - t172*t201
+    t203 = t199 - t158*t201
+    t204 = t200 - t159*t201
+    t205 = t185*(t203*t184 + t177*t204)
+    t206 = t203 - t184*t205
+    t207 = t204 - t177*t205
+    t208 = xp.abs(t207)
+    t209 = t208*xp.where(xp.greater_equal(t207, 0), xp.asarray(1, dtype=dtype), -1)
+    t210 = t207 + t209
+    t211 = xp.where(xp.greater(t208, 0), 1/(t208*2*t208), 0)
+    t212 = t188 - t188*t210**2*t211
+    t213 = xp.where(xp.not_equal(t209, 0), -t212/t209, 0)
+    t214 = xp.where(xp.not_equal(t183, 0), -(t187 - t206*t213)/t183, 0)
+    t215 = xp.where(xp.not_equal(t171, 0), -(-(t175*t214 + t202*t213) + t179)/t171, 0)
+    t216 = xp.where(xp.not_equal(t152, 0), -(-(t156*t215 + t161*t214 + t197*t213) + t166)/t152, 0)
+    t217 = xp.where(xp.not_equal(t120, 0), -(-(-t146*t216 - t139*t215 + t124*t214 + t191*t213) + t130)/t120, 0)
+    t218 = xp.where(xp.not_equal(t78, 0), -(t113 + t89*t216 + t95*t215 + t108*t213 - t82*t217 - t101*t214)/t78, 0)
+    t219 = t213 - t23*t218 + t22*t217
+    t220 = -c23*t213 + t14*t215 + t17*t214
+    t221 = t12*t215 - t9*t214 + t58*t213
+    t222 = t15*t215 + t18*t214 - t0*t213
+    t223 = s1*t2
+    t224 = c1*t214 - s1*t215
+    t225 = t224 - t24*t216 + t38*t218 + t223*t217
+    t226 = s1*t1
+    t227 = t224 - t20*t216 + t39*t218 + t226*t217
+    t228 = -t23
+    t229 = t228 + t43
+    t230 = -t44*(t38*t229 + t22*t223)
+    t231 = t38 + t229*t230
+    t232 = t223 + t22*t230
+    t233 = -t44*(t39*t229 + t22*t226)
+    t234 = t39 + t229*t233
+    t235 = t226 + t22*t233
+    t236 = t44*(mu_dot5 + mu_dot0*t229 + t22*mu_dot1)
+    t237 = mu_dot0 - t229*t236
+    t238 = mu_dot1 - t22*t236
+    t239 = -t236 + mu_dot5
+    t240 = c23*t44
+    t241 = -t240 + c23
+    t242 = t58*t44
+    t243 = -t242 + t58
+    t244 = t0*t44
+    t245 = -t244 + t0
+    t246 = t26 + t45
+    t247 = xp.sqrt(t52 + t246 + t230**2 + t232**2)
+    t248 = t247*xp.where(xp.less_equal(t232, 0), xp.asarray(1, dtype=dtype), -1)
+    t249 = -t232 + t248
+    t250 = xp.where(xp.greater(t247, 0), 1/(t247*(t247 + xp.abs(t232))), 0)
+    t251 = t250*(t246 - t235*t249 + t24*t20 + t230*t233)
+    t252 = t235 + t249*t251
+    t253 = t20 - t24*t251
+    t254 = s1 - s1*t251
+    t255 = -c1 + c1*t251
+    t256 = -t233 + t230*t251
+    t257 = t250*(t238*t249 + t24*mu_dot2 + s1*mu_dot3 - c1*mu_dot4 - t230*t239)
+    t258 = t238 - t249*t257
+    t259 = mu_dot2 - t24*t257
+    t260 = mu_dot3 - s1*t257
+    t261 = mu_dot4 + c1*t257
+    t262 = t239 + t230*t257
+    t263 = xp.sqrt(t253**2 + t254**2 + t255**2 + t256**2)
+    t264 = t263*xp.where(xp.greater_equal(t253, 0), xp.asarray(1, dtype=dtype), -1)
+    t265 = t253 + t264
+    t266 = xp.where(xp.greater(t263, 0), 1/(t263*(t263 + xp.abs(t253))), 0)
+    t267 = t266*(t259*t265 + t254*t260 + t255*t261 + t256*t262)
+    t268 = t259 - t265*t267
+    t269 = t260 - t254*t267
+    t270 = t261 - t255*t267
+    t271 = t262 - t256*t267
+    t272 = t22*t240
+    t273 = -t250*(t230*t241 + t272*t249)
+    t274 = t272 + t249*t273
+    t275 = t14 + s1*t273
+    t276 = t241 + t230*t273
+    t277 = -t17
+    t278 = t277 + c1*t273
+    t279 = t22*t242
+    t280 = t250*(s1*t12 + c1*t9 - t230*t243 - t249*t279)
+    t281 = t249*t280 + t279
+    t282 = t12 - s1*t280
+    t283 = t243 + t230*t280
+    t284 = -t9
+    t285 = c1*t280 + t284
+    t286 = t22*t244
+    t287 = -t250*(s1*t15 + t230*t245 + t249*t286 - c1*t18)
+    t288 = t249*t287 + t286
+    t289 = t15 + s1*t287
+    t290 = t245 + t230*t287
+    t291 = -t18
     t292 = c1*t287 + t291
-    t293 = t22*t251
-    t294 = -t257*(s1*t15 + t237*t252 + t256*t293 - c1*t18)
-    t295 = t256*t294 + t293
-    t296 = t15 + s1*t294
-    t297 = t252 + t237*t294
-    t298 = -t18
-    t299 = c1*t294 + t298
-    t300 = 1 - t15 - t39 - t40 - t230 - t233 - t14 + q1 + q2 + q3 + c23 + q4 + t12 + q5 + t0 + q6 + t22 + t24 + t20 - 2*c1 + t60 + t62 + t235 + t284 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + t291 + t298
-    t301 = t24*t280
-    t302 = t273*(-t261*t282 + t262*t285 + t263*t283 - t272*t301)
-    t303 = t272*t302 + t301
-    t304 = t282 + t261*t302
-    t305 = t285 - t262*t302
-    t306 = t283 - t263*t302
-    t307 = xp.sqrt(t304**2 + t305**2 + t306**2)
-    t308 = t307*xp.where(xp.less_equal(t304, 0), xp.asarray(1, dtype=dtype), -1)
-    t309 = -t304 + t308
-    t310 = xp.where(xp.greater(t307, 0), 1/(t307*(t307 + xp.abs(t304))), 0)
-    t311 = t310*(t276*t309 + t305*t277 + t306*t278)
-    t312 = t276 - t309*t311
-    t313 = t277 - t305*t311
-    t314 = t278 - t306*t311
-    t315 = t24*t287
-    t316 = t273*(t261*t289 + t262*t292 + t263*t290 - t272*t315)
-    t317 = t272*t316 + t315
-    t318 = t289 - t261*t316
-    t319 = t292 - t262*t316
-    t320 = t290 - t263*t316
-    t321 = t310*(t318*t309 + t305*t319 + t306*t320)
-    t322 = t318 - t309*t321
-    t323 = t319 - t305*t321
-    t324 = t320 - t306*t321
-    t325 = xp.sqrt(t323**2 + t324**2)
-    t326 = t325*xp.where(xp.greater_equal(t323, 0), xp.asarray(1, dtype=dtype), -1)
-    t327 = t323 + t326
-    t328 = xp.where(xp.greater(t325, 0), 1/(t325*(t325 + xp.abs(t323))), 0)
-    t329 = t328*(t313*t327 + t324*t314)
-    t330 = t313 - t327*t329
-    t331 = t314 - t324*t329
-    t332 = t24*t294
-    t333 = t273*(-t261*t296 + t262*t299 + t263*t297 - t272*t332)
-    t334 = t272*t333 + t332
-    t335 = t296 + t261*t333
-    t336 = t299 - t262*t333
-    t337 = t297 - t263*t333
-    t338 = t310*(-t335*t309 + t305*t336 + t306*t337)
-    t339 = t335 + t309*t338
-    t340 = t336 - t305*t338
-    t341 = t337 - t306*t338
-    t342 = t328*(t340*t327 + t324*t341)
-    t343 = t340 - t327*t342
-    t344 = t341 - t324*t342
-    t345 = xp.abs(t344)
-    t346 = t345
-    t347 = t346*xp.where(xp.greater_equal(t344, 0), xp.asarray(1, dtype=dtype), -1)
-    t348 = t344 + t347
-    t349 = xp.where(xp.greater(t346, 0), 1/(t346*(t346 + t345)), 0)
-    t350 = t331 - t331*t348**2*t349
-    t351 = xp.where(xp.not_equal(t347, 0), -t350/t347, 0)
-    t352 = xp.where(xp.not_equal(t326, 0), -(t330 - t343*t351)/t326, 0)
-    t353 = xp.where(xp.not_equal(t308, 0), -(-(t322*t352 - t339*t351) + t312)/t308, 0)
-    t354 = xp.where(xp.not_equal(t271, 0), -(t275 + t303*t353 + t317*t352 + t334*t351)/t271, 0)
-    t355 = xp.where(xp.not_equal(t255, 0), -(t265 + t259*t354 + t281*t353 + t288*t352 + t295*t351)/t255, 0)
-    t356 = xp.where(xp.not_equal(t44, 0), -(t244 + t238*t355 + t241*t354 + t247*t236*t353 + t249*t236*t352 + t251*t236*t351)/t44, 0)
-    t357 = xp.isfinite(t300)
-    t358 = xp.greater_equal(damping, 0)
-    t359 = xp.greater(damping, 0)
-    t360 = 1e-12*t82
-    t361 = 1e-12*t69
-    t362 = (t359 & (xp.less_equal(t83, t360) | xp.less_equal(t125, t360) | xp.less_equal(t157, t360) | xp.less_equal(t176, t360) | xp.less_equal(t188, t360) | xp.less_equal(t215, t360))) | (xp.less_equal(damping, 0) & (xp.less_equal(t43, t361) | xp.less_equal(t254, t361) | xp.less_equal(t270, t361) | xp.less_equal(t307, t361) | xp.less_equal(t325, t361) | xp.less_equal(t346, t361)))
-    t363 = t357 & t358 & xp.logical_not(t362)
+    t293 = 1 - t15 - t38 - t39 - t223 - t226 - t14 + q1 + q2 + q3 + c23 + q4 + t12 + q5 + t0 + q6 + t22 + t24 + t20 - 2*c1 + t56 + t58 + t228 + t277 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + t284 + t291
+    t294 = t24*t273
+    t295 = t266*(-t254*t275 + t255*t278 + t256*t276 - t265*t294)
+    t296 = t265*t295 + t294
+    t297 = t275 + t254*t295
+    t298 = t278 - t255*t295
+    t299 = t276 - t256*t295
+    t300 = xp.sqrt(t297**2 + t298**2 + t299**2)
+    t301 = t300*xp.where(xp.less_equal(t297, 0), xp.asarray(1, dtype=dtype), -1)
+    t302 = -t297 + t301
+    t303 = xp.where(xp.greater(t300, 0), 1/(t300*(t300 + xp.abs(t297))), 0)
+    t304 = t303*(t269*t302 + t298*t270 + t299*t271)
+    t305 = t269 - t302*t304
+    t306 = t270 - t298*t304
+    t307 = t271 - t299*t304
+    t308 = t24*t280
+    t309 = t266*(t254*t282 + t255*t285 + t256*t283 - t265*t308)
+    t310 = t265*t309 + t308
+    t311 = t282 - t254*t309
+    t312 = t285 - t255*t309
+    t313 = t283 - t256*t309
+    t314 = t303*(t311*t302 + t298*t312 + t299*t313)
+    t315 = t311 - t302*t314
+    t316 = t312 - t298*t314
+    t317 = t313 - t299*t314
+    t318 = xp.sqrt(t316**2 + t317**2)
+    t319 = t318*xp.where(xp.greater_equal(t316, 0), xp.asarray(1, dtype=dtype), -1)
+    t320 = t316 + t319
+    t321 = xp.where(xp.greater(t318, 0), 1/(t318*(t318 + xp.abs(t316))), 0)
+    t322 = t321*(t306*t320 + t317*t307)
+    t323 = t306 - t320*t322
+    t324 = t307 - t317*t322
+    t325 = t24*t287
+    t326 = t266*(-t254*t289 + t255*t292 + t256*t290 - t265*t325)
+    t327 = t265*t326 + t325
+    t328 = t289 + t254*t326
+    t329 = t292 - t255*t326
+    t330 = t290 - t256*t326
+    t331 = t303*(-t328*t302 + t298*t329 + t299*t330)
+    t332 = t328 + t302*t331
+    t333 = t329 - t298*t331
+    t334 = t330 - t299*t331
+    t335 = t321*(t333*t320 + t317*t334)
+    t336 = t333 - t320*t335
+    t337 = t334 - t317*t335
+    t338 = xp.abs(t337)
+    t339 = xp.where(xp.greater_equal(t337, 0), xp.asarray(1, dtype=dtype), -1)*t338
+    t340 = t337 + t339
+    t341 = xp.where(xp.greater(t338, 0), 1/(t338*2*t338), 0)
+    t342 = t324 - t324*t340**2*t341
+    t343 = xp.where(xp.not_equal(t339, 0), -t342/t339, 0)
+    t344 = xp.where(xp.not_equal(t319, 0), -(t323 - t336*t343)/t319, 0)
+    t345 = xp.where(xp.not_equal(t301, 0), -(-(t315*t344 - t332*t343) + t305)/t301, 0)
+    t346 = xp.where(xp.not_equal(t264, 0), -(t268 + t296*t345 + t310*t344 + t327*t343)/t264, 0)
+    t347 = xp.where(xp.not_equal(t248, 0), -(t258 + t252*t346 + t274*t345 + t281*t344 + t288*t343)/t248, 0)
+    t348 = xp.where(xp.not_equal(t43, 0), -(t237 + t231*t347 + t234*t346 + t240*t229*t345 + t242*t229*t344 + t244*t229*t343)/t43, 0)
+    t349 = xp.isfinite(t293)
+    t350 = xp.greater_equal(damping, 0)
+    t351 = xp.greater(damping, 0)
+    t352 = 1e-12*t76
+    t353 = 1e-12*t63
+    t354 = (t351 & (xp.less_equal(t77, t352) | xp.less_equal(t119, t352) | xp.less_equal(t151, t352) | xp.less_equal(t170, t352) | xp.less_equal(t182, t352) | xp.less_equal(t208, t352))) | (xp.less_equal(damping, 0) & (xp.less_equal(t42, t353) | xp.less_equal(t247, t353) | xp.less_equal(t263, t353) | xp.less_equal(t300, t353) | xp.less_equal(t318, t353) | xp.less_equal(t338, t353)))
+    t355 = t349 & t350 & xp.logical_not(t354)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t363, xp.where(t359, t226, t356), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t363, xp.where(t359, -t232, t355), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t363, xp.where(t359, -t234, t354), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t363, xp.where(t359, -t227, t353), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t363, xp.where(t359, t228, t352), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t363, xp.where(t359, -t229, t351), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t355, xp.where(t351, t219, t348), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t355, xp.where(t351, -t225, t347), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t355, xp.where(t351, -t227, t346), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t355, xp.where(t351, -t220, t345), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t355, xp.where(t351, t221, t344), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t355, xp.where(t351, -t222, t343), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t357 & t358), 2, xp.where(t362, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t349 & t350), 2, xp.where(t354, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -1991,7 +1981,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t59 = t1*t58 + t0*t58
     t60 = t1**2
     t61 = t0**2
-    t62 = t57 + t58*t61 + t58*t60
+    t62 = t57 + t58*t60 + t58*t61
     t63 = -t51*t52
     t64 = s1*c1
     t65 = t63 + t60*t64 + t61*t64
@@ -2167,26 +2157,25 @@ def ik_numeric_step(target, q, damping=0.0):
     t235 = t232 - t213*t234
     t236 = t233 - t206*t234
     t237 = xp.abs(t236)
-    t238 = t237
-    t239 = t238*xp.where(xp.greater_equal(t236, 0), xp.asarray(1, dtype=dtype), -1)
-    t240 = t236 + t239
-    t241 = xp.where(xp.greater(t238, 0), 1/(t238*(t237 + t238)), 0)
-    t242 = t217 - t217*t240**2*t241
-    t243 = xp.where(xp.not_equal(t239, 0), -t242/t239, 0)
-    t244 = xp.where(xp.not_equal(t212, 0), -(t216 - t235*t243)/t212, 0)
-    t245 = xp.where(xp.not_equal(t200, 0), -(-(t204*t244 + t231*t243) + t208)/t200, 0)
-    t246 = xp.where(xp.not_equal(t181, 0), -(-(t185*t245 + t190*t244 + t226*t243) + t195)/t181, 0)
-    t247 = xp.where(xp.not_equal(t121, 0), -(-(-t175*t246 - t147*t245 + t161*t244 + t220*t243) + t125)/t121, 0)
-    t248 = xp.where(xp.not_equal(t102, 0), -(t106 + t132*t246 + t139*t245 + t168*t243 - t114*t247 - t154*t244)/t102, 0)
-    t249 = q1 + t243 - t52*t248 + t51*t247
-    t250 = q4 + c23*t243 - t16*t245 - t25*t244
-    t251 = q5 + t14*t245 - t11*t244 + t39*t243
-    t252 = q6 - t18*t245 - t27*t244 + t38*t243
-    t253 = c1*t248
-    t254 = s1*t247
-    t255 = s1*t245 - c1*t244
-    t256 = q2 + t255 + t53*t246 - t1*t253 - t1*t254
-    t257 = q3 + t255 + t31*t246 - t0*t253 - t0*t254
+    t238 = t237*xp.where(xp.greater_equal(t236, 0), xp.asarray(1, dtype=dtype), -1)
+    t239 = t236 + t238
+    t240 = xp.where(xp.greater(t237, 0), 1/(t237*2*t237), 0)
+    t241 = t217 - t217*t239**2*t240
+    t242 = xp.where(xp.not_equal(t238, 0), -t241/t238, 0)
+    t243 = xp.where(xp.not_equal(t212, 0), -(t216 - t235*t242)/t212, 0)
+    t244 = xp.where(xp.not_equal(t200, 0), -(-(t204*t243 + t231*t242) + t208)/t200, 0)
+    t245 = xp.where(xp.not_equal(t181, 0), -(-(t185*t244 + t190*t243 + t226*t242) + t195)/t181, 0)
+    t246 = xp.where(xp.not_equal(t121, 0), -(-(-t175*t245 - t147*t244 + t161*t243 + t220*t242) + t125)/t121, 0)
+    t247 = xp.where(xp.not_equal(t102, 0), -(t106 + t132*t245 + t139*t244 + t168*t242 - t114*t246 - t154*t243)/t102, 0)
+    t248 = q1 + t242 - t52*t247 + t51*t246
+    t249 = q4 + c23*t242 - t16*t244 - t25*t243
+    t250 = q5 + t14*t244 - t11*t243 + t39*t242
+    t251 = q6 - t18*t244 - t27*t243 + t38*t242
+    t252 = c1*t247
+    t253 = s1*t246
+    t254 = s1*t244 - c1*t243
+    t255 = q2 + t254 + t53*t245 - t1*t252 - t1*t253
+    t256 = q3 + t254 + t31*t245 - t0*t252 - t0*t253
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -2196,12 +2185,12 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q6, batch),  # 5
     ], (6,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t249, -2.792526803190927), -2.792526803190927, xp.where(xp.greater(t249, 2.792526803190927), 2.792526803190927, t249)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t256, -0.7853981633974483), -0.7853981633974483, xp.where(xp.greater(t256, 3.9269908169872414), 3.9269908169872414, t256)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t257, -3.9269908169872414), -3.9269908169872414, xp.where(xp.greater(t257, 0.7853981633974483), 0.7853981633974483, t257)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t250, -1.9198621771937625), -1.9198621771937625, xp.where(xp.greater(t250, 2.9670597283903604), 2.9670597283903604, t250)), batch),  # 3
-        xp.broadcast_to(xp.where(xp.less(t251, -1.7453292519943295), -1.7453292519943295, xp.where(xp.greater(t251, 1.7453292519943295), 1.7453292519943295, t251)), batch),  # 4
-        xp.broadcast_to(xp.where(xp.less(t252, -4.642575810304916), -4.642575810304916, xp.where(xp.greater(t252, 4.642575810304916), 4.642575810304916, t252)), batch),  # 5
+        xp.broadcast_to(xp.where(xp.less(t248, -2.792526803190927), -2.792526803190927, xp.where(xp.greater(t248, 2.792526803190927), 2.792526803190927, t248)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t255, -0.7853981633974483), -0.7853981633974483, xp.where(xp.greater(t255, 3.9269908169872414), 3.9269908169872414, t255)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t256, -3.9269908169872414), -3.9269908169872414, xp.where(xp.greater(t256, 0.7853981633974483), 0.7853981633974483, t256)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t249, -1.9198621771937625), -1.9198621771937625, xp.where(xp.greater(t249, 2.9670597283903604), 2.9670597283903604, t249)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t250, -1.7453292519943295), -1.7453292519943295, xp.where(xp.greater(t250, 1.7453292519943295), 1.7453292519943295, t250)), batch),  # 4
+        xp.broadcast_to(xp.where(xp.less(t251, -4.642575810304916), -4.642575810304916, xp.where(xp.greater(t251, 4.642575810304916), 4.642575810304916, t251)), batch),  # 5
     ], (6,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t4), t99, -1), batch)
     return q_start, q_next, cost
@@ -2226,601 +2215,581 @@ def ik_branches(T):
     t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23
     t1 = -0.15005*T01 + 0.4521*T00 + 1.10363*T02
     t2 = -t1 + T03
-    t3 = t1
-    t4 = t2 + t3
-    t5 = -0.15005*T11 + 0.4521*T10 + 1.10363*T12
-    t6 = -t5 + T13
-    t7 = t5
-    t8 = t6 + t7
-    t9 = xp.atan2(t4, -t8)
-    t10 = -0.15005*T21 + 0.4521*T20 + 1.10363*T22
-    t11 = -t10 + T23
-    t12 = t10
-    t13 = t11 + t12
-    t14 = t4**2 + t8**2
-    t15 = t14
-    t16 = t14 + t13**2
-    t17 = 1e-24*t16
-    t18 = xp.less_equal(t15, t17)
-    t19 = xp.where(t18, 1, 1/xp.sqrt(t15))
-    t20 = 1 - 0.0225150025*t19**2
-    t21 = xp.greater(t20, 1e-12)
-    t22 = xp.where(t21, xp.sqrt(t20), 0)
-    t23 = 0.15005*t19
-    t24 = xp.where(t21, t23, xp.where(xp.greater(t23, 0), xp.asarray(1, dtype=dtype), -1))
-    t25 = xp.atan2(t22, t24)
-    t26 = xp.where(t18, 0, t9 + t25)
-    t27 = -t25 + t9
-    t28 = t26 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t26))
-    t29 = -6.283185307179586*xp.floor(0.15915494309189535*(2.792526803190927 + t28)) + t28
-    t30 = t27 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t27))
-    t31 = -6.283185307179586*xp.floor(0.15915494309189535*(2.792526803190927 + t30)) + t30
-    t32 = t19*t24
-    t33 = t32*t8
-    t34 = t19*t22
-    t35 = t34*t4
-    t36 = xp.where(t18, 1, -(t33 + t35))
-    t37 = -t33 + t35
-    t38 = t32*t4
-    t39 = t34*t8
-    t40 = xp.where(t18, 0, -t39 + t38)
-    t41 = t38 + t39
-    t42 = t4*t36 + t8*t40
-    t43 = t8*t36 - t4*t40
-    t44 = T02*t36 + T12*t40
-    t45 = T12*t36 - T02*t40
-    t46 = T00*t36 + T10*t40
-    t47 = T10*t36 - T00*t40
-    t48 = t4*t37 + t8*t41
-    t49 = t8*t37 - t4*t41
-    t50 = T02*t37 + T12*t41
-    t51 = T12*t37 - T02*t41
-    t52 = T00*t37 + T10*t41
-    t53 = T10*t37 - T00*t41
-    t54 = 1 - t36
-    t55 = t54*t13
-    t56 = t55 + t13*t36
-    t57 = -0.67183 + t56
-    t58 = t42**2 + t43**2 + t57**2
-    t59 = 0.5*(0.3958295725 - t58)
-    t60 = 1 - 28.701899543227718*t59**2
-    t61 = t54*T22
-    t62 = t61 + T22*t36
-    t63 = t54*T20
-    t64 = t63 + T20*t36
-    t65 = xp.greater(t60, 1e-12)
-    t66 = xp.where(t65, xp.sqrt(t60), 0)
-    t67 = 5.357415379007653*t59
-    t68 = xp.where(t65, t67, xp.where(xp.greater(t67, 0), xp.asarray(1, dtype=dtype), -1))
-    t69 = xp.atan2(t66, t68)
-    t70 = 1.6177742431429796 + t69
-    t71 = 1.6177742431429796 - t69
-    t72 = t70 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t70))
-    t73 = -6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t72)) + t72
-    t74 = t71 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t71))
-    t75 = -6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t74)) + t74
-    t76 = 0.04696063880130675*t68
-    t77 = 0.9988967406110469*t66
-    t78 = t76 + t77
-    t79 = -t76 + t77
-    t80 = 0.15005*(1 + t78)
-    t81 = -t80 + 0.15005*t78
-    t82 = 0.15005*(1 - t79)
-    t83 = t82 + 0.15005*t79
-    t84 = 0.04696063880130675*t66
-    t85 = 0.9988967406110469*t68
-    t86 = -t84 + t85
-    t87 = t84 + t85
-    t88 = 0.4318*t86 + 0.0203*t78
-    t89 = -0.4318*t78 + 0.0203*t86
-    t90 = 0.4318 - t88
-    t91 = 0.67183 + t89
-    t92 = -0.67183 + t91
-    t93 = t42*t92 - t57*t90
-    t94 = t81**2 + t90**2 + t92**2
-    t95 = -0.4318*t87 + 0.0203*t79
-    t96 = 0.4318*t79 + 0.0203*t87
-    t97 = 0.4318 + t95
-    t98 = 0.67183 + t96
-    t99 = -0.67183 + t98
-    t100 = t42*t99 - t57*t97
-    t101 = t83**2 + t97**2 + t99**2
-    t102 = t43*t81
-    t103 = t102 + t42*t90 + t57*t92
-    t104 = -t102 + t103
-    t105 = t104**2 + t93**2
-    t106 = 1e-24*t58
-    t107 = xp.less_equal(t105, t106*t94)
-    t108 = xp.where(t107, 1, 1/xp.sqrt(t105))
-    t109 = xp.where(t107, 1, t104*t108)
-    t110 = xp.where(t107, 0, -t93*t108)
-    t111 = t78*t109 + t86*t110
-    t112 = -t78*t110 + t86*t109
-    t113 = -t111*t44 + t112*t62
-    t114 = t111*t62 + t112*t44
-    t115 = -t111*t46 + t112*t64
-    t116 = t111*t64 + t112*t46
-    t117 = xp.where(t107, 0, xp.atan2(-t93, t104))
-    t118 = -6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t117)) + t117
-    t119 = 1 + t111
-    t120 = t119*t45
-    t121 = t120 - t111*t45
-    t122 = t119*t47
-    t123 = t122 - t111*t47
-    t124 = t114**2
-    t125 = -t124
-    t126 = 1 + t125
-    t127 = xp.greater(t126, 1e-12)
-    t128 = xp.where(t127, xp.sqrt(t126), 0)
-    t129 = t124 + t113*t128
-    t130 = t125 + t129
-    t131 = t121**2
-    t132 = t124 + t131 + t113**2
-    t133 = t128**2
-    t134 = t130**2 + t131*t133
-    t135 = t124 + t133
-    t136 = 1e-24*t135
-    t137 = xp.less_equal(t134, t136*t132)
-    t138 = xp.where(t137, 1, 1/xp.sqrt(t134))
-    t139 = xp.where(t137, 1, t130*t138)
-    t140 = t116*(1 - t139)
-    t141 = t140 + t116*t139
-    t142 = t121*t128
-    t143 = xp.where(t137, 0, t142*t138)
-    t144 = t115*t139 + t123*t143
-    t145 = t123*t139 - t115*t143
-    t146 = xp.less_equal(t135, t136)
-    t147 = xp.where(t146, 1, 1/xp.sqrt(t135))
-    t148 = xp.where(t146, 1, -t114*t147)
-    t149 = xp.where(t146, 0, -t128*t147)
-    t150 = t145*(1 - t148)
-    t151 = t148*t144 - t149*t141
-    t152 = t150 + t148*t145
-    t153 = t148*t141 + t149*t144
-    t154 = t151**2 + t152**2
-    t155 = t154
-    t156 = t154 + t153**2
-    t157 = t43*t83
-    t158 = -t157 + t42*t97 + t57*t99
-    t159 = t157 + t158
-    t160 = t159**2 + t100**2
-    t161 = xp.less_equal(t160, t106*t101)
-    t162 = xp.where(t161, 1, 1/xp.sqrt(t160))
-    t163 = xp.where(t161, 1, t159*t162)
-    t164 = xp.where(t161, 0, -t100*t162)
-    t165 = t79*t163 - t87*t164
-    t166 = t79*t164 + t87*t163
-    t167 = t44*t165 + t62*t166
-    t168 = t62*t165 - t44*t166
-    t169 = t46*t165 + t64*t166
-    t170 = t64*t165 - t46*t166
-    t171 = xp.where(t161, 0, xp.atan2(-t100, t159))
-    t172 = -6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t171)) + t171
-    t173 = 1 - t165
-    t174 = t173*t45
-    t175 = t174 + t45*t165
-    t176 = t173*t47
-    t177 = t176 + t47*t165
-    t178 = t168**2
-    t179 = -t178
-    t180 = 1 + t179
-    t181 = xp.greater(t180, 1e-12)
-    t182 = xp.where(t181, xp.sqrt(t180), 0)
-    t183 = t178 + t167*t182
-    t184 = t179 + t183
-    t185 = t175**2
-    t186 = t178 + t185 + t167**2
-    t187 = t182**2
-    t188 = t184**2 + t185*t187
-    t189 = t178 + t187
-    t190 = 1e-24*t189
-    t191 = xp.less_equal(t188, t190*t186)
-    t192 = xp.where(t191, 1, 1/xp.sqrt(t188))
-    t193 = xp.where(t191, 1, t184*t192)
-    t194 = t170*(1 - t193)
-    t195 = t194 + t170*t193
-    t196 = t175*t182
-    t197 = xp.where(t191, 0, t196*t192)
-    t198 = t169*t193 + t177*t197
-    t199 = t177*t193 - t169*t197
-    t200 = xp.less_equal(t189, t190)
-    t201 = xp.where(t200, 1, 1/xp.sqrt(t189))
-    t202 = xp.where(t200, 1, t168*t201)
-    t203 = xp.where(t200, 0, -t182*t201)
-    t204 = t199*(1 - t202)
-    t205 = t202*t198 + t203*t195
-    t206 = t204 + t202*t199
-    t207 = t202*t195 - t203*t198
-    t208 = t205**2 + t206**2
-    t209 = t208
-    t210 = t208 + t207**2
-    t211 = 1 - t37
-    t212 = t211*t13
-    t213 = t212 + t13*t37
-    t214 = -0.67183 + t213
-    t215 = t48**2 + t49**2 + t214**2
-    t216 = 0.5*(0.3958295725 - t215)
-    t217 = 1 - 28.701899543227718*t216**2
-    t218 = t211*T22
-    t219 = t218 + T22*t37
-    t220 = t211*T20
-    t221 = t220 + T20*t37
-    t222 = xp.greater(t217, 1e-12)
-    t223 = xp.where(t222, xp.sqrt(t217), 0)
-    t224 = 5.357415379007653*t216
-    t225 = xp.where(t222, t224, xp.where(xp.greater(t224, 0), xp.asarray(1, dtype=dtype), -1))
-    t226 = xp.atan2(t223, t225)
-    t227 = 1.6177742431429796 + t226
-    t228 = 1.6177742431429796 - t226
-    t229 = t227 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t227))
-    t230 = -6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t229)) + t229
-    t231 = t228 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t228))
-    t232 = -6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t231)) + t231
-    t233 = 0.04696063880130675*t225
-    t234 = 0.9988967406110469*t223
-    t235 = t233 + t234
-    t236 = -t233 + t234
-    t237 = 0.15005*(1 + t235)
-    t238 = -t237 + 0.15005*t235
-    t239 = 0.15005*(1 - t236)
-    t240 = t239 + 0.15005*t236
-    t241 = 0.04696063880130675*t223
-    t242 = 0.9988967406110469*t225
-    t243 = -t241 + t242
-    t244 = t241 + t242
-    t245 = 0.4318*t243 + 0.0203*t235
-    t246 = -0.4318*t235 + 0.0203*t243
-    t247 = 0.4318 - t245
-    t248 = 0.67183 + t246
-    t249 = -0.67183 + t248
-    t250 = t48*t249 - t214*t247
-    t251 = t238**2 + t247**2 + t249**2
-    t252 = -0.4318*t244 + 0.0203*t236
-    t253 = 0.4318*t236 + 0.0203*t244
-    t254 = 0.4318 + t252
-    t255 = 0.67183 + t253
-    t256 = -0.67183 + t255
-    t257 = t48*t256 - t214*t254
-    t258 = t240**2 + t254**2 + t256**2
-    t259 = t49*t238
-    t260 = t259 + t48*t247 + t214*t249
-    t261 = -t259 + t260
-    t262 = t261**2 + t250**2
-    t263 = 1e-24*t215
-    t264 = xp.less_equal(t262, t263*t251)
-    t265 = xp.where(t264, 1, 1/xp.sqrt(t262))
-    t266 = xp.where(t264, 1, t261*t265)
-    t267 = xp.where(t264, 0, -t250*t265)
-    t268 = t235*t266 + t243*t267
-    t269 = -t235*t267 + t243*t266
-    t270 = -t268*t50 + t269*t219
-    t271 = t268*t219 + t269*t50
-    t272 = -t268*t52 + t269*t221
-    t273 = t268*t221 + t269*t52
-    t274 = xp.where(t264, 0, xp.atan2(-t250, t261))
-    t275 = -6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t274)) + t274
-    t276 = 1 + t268
-    t277 = t276*t51
-    t278 = t277 - t268*t51
-    t279 = t276*t53
-    t280 = t279 - t268*t53
-    t281 = t271**2
-    t282 = -t281
-    t283 = 1 + t282
-    t284 = xp.greater(t283, 1e-12)
-    t285 = xp.where(t284, xp.sqrt(t283), 0)
-    t286 = t281 + t270*t285
-    t287 = t282 + t286
-    t288 = t278**2
-    t289 = t281 + t288 + t270**2
-    t290 = t285**2
-    t291 = t287**2 + t288*t290
-    t292 = t281 + t290
-    t293 = 1e-24*t292
-    t294 = xp.less_equal(t291, t293*t289)
-    t295 = xp.where(t294, 1, 1/xp.sqrt(t291))
-    t296 = xp.where(t294, 1, t287*t295)
-    t297 = t273*(1 - t296)
-    t298 = t297 + t273*t296
-    t299 = t278*t285
-    t300 = xp.where(t294, 0, t299*t295)
-    t301 = t272*t296 + t280*t300
-    t302 = t280*t296 - t272*t300
-    t303 = xp.less_equal(t292, t293)
-    t304 = xp.where(t303, 1, 1/xp.sqrt(t292))
-    t305 = xp.where(t303, 1, -t271*t304)
-    t306 = xp.where(t303, 0, -t285*t304)
-    t307 = t302*(1 - t305)
-    t308 = t305*t301 - t306*t298
-    t309 = t307 + t305*t302
-    t310 = t305*t298 + t306*t301
-    t311 = t308**2 + t309**2
-    t312 = t311
-    t313 = t311 + t310**2
-    t314 = t49*t240
-    t315 = -t314 + t48*t254 + t214*t256
-    t316 = t314 + t315
-    t317 = t316**2 + t257**2
-    t318 = xp.less_equal(t317, t263*t258)
-    t319 = xp.where(t318, 1, 1/xp.sqrt(t317))
-    t320 = xp.where(t318, 1, t316*t319)
-    t321 = xp.where(t318, 0, -t257*t319)
-    t322 = t236*t320 - t244*t321
-    t323 = t236*t321 + t244*t320
-    t324 = t50*t322 + t219*t323
-    t325 = t219*t322 - t50*t323
-    t326 = t52*t322 + t221*t323
-    t327 = t221*t322 - t52*t323
-    t328 = xp.where(t318, 0, xp.atan2(-t257, t316))
-    t329 = -6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t328)) + t328
-    t330 = 1 - t322
-    t331 = t330*t51
-    t332 = t331 + t51*t322
-    t333 = t330*t53
-    t334 = t333 + t53*t322
+    t3 = t1 + t2
+    t4 = -0.15005*T11 + 0.4521*T10 + 1.10363*T12
+    t5 = -t4 + T13
+    t6 = t4 + t5
+    t7 = xp.atan2(t3, -t6)
+    t8 = -0.15005*T21 + 0.4521*T20 + 1.10363*T22
+    t9 = -t8 + T23
+    t10 = t8 + t9
+    t11 = t3**2 + t6**2
+    t12 = t11 + t10**2
+    t13 = 1e-24*t12
+    t14 = xp.less_equal(t11, t13)
+    t15 = xp.where(t14, 1, 1/xp.sqrt(t11))
+    t16 = 1 - 0.0225150025*t15**2
+    t17 = xp.greater(t16, 1e-12)
+    t18 = xp.where(t17, xp.sqrt(t16), 0)
+    t19 = 0.15005*t15
+    t20 = xp.where(t17, t19, xp.where(xp.greater(t19, 0), xp.asarray(1, dtype=dtype), -1))
+    t21 = xp.atan2(t18, t20)
+    t22 = xp.where(t14, 0, t7 + t21)
+    t23 = -t21 + t7
+    t24 = t22 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t22))
+    t25 = -6.283185307179586*xp.floor(0.15915494309189535*(2.792526803190927 + t24)) + t24
+    t26 = t23 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t23))
+    t27 = -6.283185307179586*xp.floor(0.15915494309189535*(2.792526803190927 + t26)) + t26
+    t28 = t15*t20
+    t29 = t28*t6
+    t30 = t15*t18
+    t31 = t30*t3
+    t32 = xp.where(t14, 1, -(t29 + t31))
+    t33 = -t29 + t31
+    t34 = t28*t3
+    t35 = t30*t6
+    t36 = xp.where(t14, 0, -t35 + t34)
+    t37 = t34 + t35
+    t38 = t3*t32 + t6*t36
+    t39 = t6*t32 - t3*t36
+    t40 = T02*t32 + T12*t36
+    t41 = T12*t32 - T02*t36
+    t42 = T00*t32 + T10*t36
+    t43 = T10*t32 - T00*t36
+    t44 = t3*t33 + t6*t37
+    t45 = t6*t33 - t3*t37
+    t46 = T02*t33 + T12*t37
+    t47 = T12*t33 - T02*t37
+    t48 = T00*t33 + T10*t37
+    t49 = T10*t33 - T00*t37
+    t50 = 1 - t32
+    t51 = t50*t10
+    t52 = t51 + t10*t32
+    t53 = -0.67183 + t52
+    t54 = t38**2 + t39**2 + t53**2
+    t55 = 0.5*(0.3958295725 - t54)
+    t56 = 1 - 28.701899543227718*t55**2
+    t57 = t50*T22
+    t58 = t57 + T22*t32
+    t59 = t50*T20
+    t60 = t59 + T20*t32
+    t61 = xp.greater(t56, 1e-12)
+    t62 = xp.where(t61, xp.sqrt(t56), 0)
+    t63 = 5.357415379007653*t55
+    t64 = xp.where(t61, t63, xp.where(xp.greater(t63, 0), xp.asarray(1, dtype=dtype), -1))
+    t65 = xp.atan2(t62, t64)
+    t66 = 1.6177742431429796 + t65
+    t67 = 1.6177742431429796 - t65
+    t68 = t66 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t66))
+    t69 = -6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t68)) + t68
+    t70 = t67 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t67))
+    t71 = -6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t70)) + t70
+    t72 = 0.04696063880130675*t64
+    t73 = 0.9988967406110469*t62
+    t74 = t72 + t73
+    t75 = -t72 + t73
+    t76 = 0.15005*(1 + t74)
+    t77 = -t76 + 0.15005*t74
+    t78 = 0.15005*(1 - t75)
+    t79 = t78 + 0.15005*t75
+    t80 = 0.04696063880130675*t62
+    t81 = 0.9988967406110469*t64
+    t82 = -t80 + t81
+    t83 = t80 + t81
+    t84 = 0.4318*t82 + 0.0203*t74
+    t85 = -0.4318*t74 + 0.0203*t82
+    t86 = 0.4318 - t84
+    t87 = 0.67183 + t85
+    t88 = -0.67183 + t87
+    t89 = t38*t88 - t53*t86
+    t90 = t77**2 + t86**2 + t88**2
+    t91 = -0.4318*t83 + 0.0203*t75
+    t92 = 0.4318*t75 + 0.0203*t83
+    t93 = 0.4318 + t91
+    t94 = 0.67183 + t92
+    t95 = -0.67183 + t94
+    t96 = t38*t95 - t53*t93
+    t97 = t79**2 + t93**2 + t95**2
+    t98 = t39*t77
+    t99 = t98 + t38*t86 + t53*t88
+    t100 = -t98 + t99
+    t101 = t100**2 + t89**2
+    t102 = 1e-24*t54
+    t103 = xp.less_equal(t101, t102*t90)
+    t104 = xp.where(t103, 1, 1/xp.sqrt(t101))
+    t105 = xp.where(t103, 1, t100*t104)
+    t106 = xp.where(t103, 0, -t89*t104)
+    t107 = t74*t105 + t82*t106
+    t108 = -t74*t106 + t82*t105
+    t109 = -t107*t40 + t108*t58
+    t110 = t107*t58 + t108*t40
+    t111 = -t107*t42 + t108*t60
+    t112 = t107*t60 + t108*t42
+    t113 = xp.where(t103, 0, xp.atan2(-t89, t100))
+    t114 = -6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t113)) + t113
+    t115 = 1 + t107
+    t116 = t115*t41
+    t117 = t116 - t107*t41
+    t118 = t115*t43
+    t119 = t118 - t107*t43
+    t120 = t110**2
+    t121 = -t120
+    t122 = 1 + t121
+    t123 = xp.greater(t122, 1e-12)
+    t124 = xp.where(t123, xp.sqrt(t122), 0)
+    t125 = t120 + t109*t124
+    t126 = t121 + t125
+    t127 = t117**2
+    t128 = t120 + t127 + t109**2
+    t129 = t124**2
+    t130 = t126**2 + t127*t129
+    t131 = t120 + t129
+    t132 = 1e-24*t131
+    t133 = xp.less_equal(t130, t132*t128)
+    t134 = xp.where(t133, 1, 1/xp.sqrt(t130))
+    t135 = xp.where(t133, 1, t126*t134)
+    t136 = t112*(1 - t135)
+    t137 = t136 + t112*t135
+    t138 = t117*t124
+    t139 = xp.where(t133, 0, t138*t134)
+    t140 = t111*t135 + t119*t139
+    t141 = t119*t135 - t111*t139
+    t142 = xp.less_equal(t131, t132)
+    t143 = xp.where(t142, 1, 1/xp.sqrt(t131))
+    t144 = xp.where(t142, 1, -t110*t143)
+    t145 = xp.where(t142, 0, -t124*t143)
+    t146 = t141*(1 - t144)
+    t147 = t144*t140 - t145*t137
+    t148 = t146 + t144*t141
+    t149 = t144*t137 + t145*t140
+    t150 = t147**2 + t148**2
+    t151 = t150 + t149**2
+    t152 = t39*t79
+    t153 = -t152 + t38*t93 + t53*t95
+    t154 = t152 + t153
+    t155 = t154**2 + t96**2
+    t156 = xp.less_equal(t155, t102*t97)
+    t157 = xp.where(t156, 1, 1/xp.sqrt(t155))
+    t158 = xp.where(t156, 1, t154*t157)
+    t159 = xp.where(t156, 0, -t96*t157)
+    t160 = t75*t158 - t83*t159
+    t161 = t75*t159 + t83*t158
+    t162 = t40*t160 + t58*t161
+    t163 = t58*t160 - t40*t161
+    t164 = t42*t160 + t60*t161
+    t165 = t60*t160 - t42*t161
+    t166 = xp.where(t156, 0, xp.atan2(-t96, t154))
+    t167 = -6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t166)) + t166
+    t168 = 1 - t160
+    t169 = t168*t41
+    t170 = t169 + t41*t160
+    t171 = t168*t43
+    t172 = t171 + t43*t160
+    t173 = t163**2
+    t174 = -t173
+    t175 = 1 + t174
+    t176 = xp.greater(t175, 1e-12)
+    t177 = xp.where(t176, xp.sqrt(t175), 0)
+    t178 = t173 + t162*t177
+    t179 = t174 + t178
+    t180 = t170**2
+    t181 = t173 + t180 + t162**2
+    t182 = t177**2
+    t183 = t179**2 + t180*t182
+    t184 = t173 + t182
+    t185 = 1e-24*t184
+    t186 = xp.less_equal(t183, t185*t181)
+    t187 = xp.where(t186, 1, 1/xp.sqrt(t183))
+    t188 = xp.where(t186, 1, t179*t187)
+    t189 = t165*(1 - t188)
+    t190 = t189 + t165*t188
+    t191 = t170*t177
+    t192 = xp.where(t186, 0, t191*t187)
+    t193 = t164*t188 + t172*t192
+    t194 = t172*t188 - t164*t192
+    t195 = xp.less_equal(t184, t185)
+    t196 = xp.where(t195, 1, 1/xp.sqrt(t184))
+    t197 = xp.where(t195, 1, t163*t196)
+    t198 = xp.where(t195, 0, -t177*t196)
+    t199 = t194*(1 - t197)
+    t200 = t197*t193 + t198*t190
+    t201 = t199 + t197*t194
+    t202 = t197*t190 - t198*t193
+    t203 = t200**2 + t201**2
+    t204 = t203 + t202**2
+    t205 = 1 - t33
+    t206 = t205*t10
+    t207 = t206 + t10*t33
+    t208 = -0.67183 + t207
+    t209 = t44**2 + t45**2 + t208**2
+    t210 = 0.5*(0.3958295725 - t209)
+    t211 = 1 - 28.701899543227718*t210**2
+    t212 = t205*T22
+    t213 = t212 + T22*t33
+    t214 = t205*T20
+    t215 = t214 + T20*t33
+    t216 = xp.greater(t211, 1e-12)
+    t217 = xp.where(t216, xp.sqrt(t211), 0)
+    t218 = 5.357415379007653*t210
+    t219 = xp.where(t216, t218, xp.where(xp.greater(t218, 0), xp.asarray(1, dtype=dtype), -1))
+    t220 = xp.atan2(t217, t219)
+    t221 = 1.6177742431429796 + t220
+    t222 = 1.6177742431429796 - t220
+    t223 = t221 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t221))
+    t224 = -6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t223)) + t223
+    t225 = t222 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t222))
+    t226 = -6.283185307179586*xp.floor(0.15915494309189535*(3.9269908169872414 + t225)) + t225
+    t227 = 0.04696063880130675*t219
+    t228 = 0.9988967406110469*t217
+    t229 = t227 + t228
+    t230 = -t227 + t228
+    t231 = 0.15005*(1 + t229)
+    t232 = -t231 + 0.15005*t229
+    t233 = 0.15005*(1 - t230)
+    t234 = t233 + 0.15005*t230
+    t235 = 0.04696063880130675*t217
+    t236 = 0.9988967406110469*t219
+    t237 = -t235 + t236
+    t238 = t235 + t236
+    t239 = 0.4318*t237 + 0.0203*t229
+    t240 = -0.4318*t229 + 0.0203*t237
+    t241 = 0.4318 - t239
+    t242 = 0.67183 + t240
+    t243 = -0.67183 + t242
+    t244 = t44*t243 - t208*t241
+    t245 = t232**2 + t241**2 + t243**2
+    t246 = -0.4318*t238 + 0.0203*t230
+    t247 = 0.4318*t230 + 0.0203*t238
+    t248 = 0.4318 + t246
+    t249 = 0.67183 + t247
+    t250 = -0.67183 + t249
+    t251 = t44*t250 - t208*t248
+    t252 = t234**2 + t248**2 + t250**2
+    t253 = t45*t232
+    t254 = t253 + t44*t241 + t208*t243
+    t255 = -t253 + t254
+    t256 = t255**2 + t244**2
+    t257 = 1e-24*t209
+    t258 = xp.less_equal(t256, t257*t245)
+    t259 = xp.where(t258, 1, 1/xp.sqrt(t256))
+    t260 = xp.where(t258, 1, t255*t259)
+    t261 = xp.where(t258, 0, -t244*t259)
+    t262 = t229*t260 + t237*t261
+    t263 = -t229*t261 + t237*t260
+    t264 = -t262*t46 + t263*t213
+    t265 = t262*t213 + t263*t46
+    t266 = -t262*t48 + t263*t215
+    t267 = t262*t215 + t263*t48
+    t268 = xp.where(t258, 0, xp.atan2(-t244, t255))
+    t269 = -6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t268)) + t268
+    t270 = 1 + t262
+    t271 = t270*t47
+    t272 = t271 - t262*t47
+    t273 = t270*t49
+    t274 = t273 - t262*t49
+    t275 = t265**2
+    t276 = -t275
+    t277 = 1 + t276
+    t278 = xp.greater(t277, 1e-12)
+    t279 = xp.where(t278, xp.sqrt(t277), 0)
+    t280 = t275 + t264*t279
+    t281 = t276 + t280
+    t282 = t272**2
+    t283 = t275 + t282 + t264**2
+    t284 = t279**2
+    t285 = t281**2 + t282*t284
+    t286 = t275 + t284
+    t287 = 1e-24*t286
+    t288 = xp.less_equal(t285, t287*t283)
+    t289 = xp.where(t288, 1, 1/xp.sqrt(t285))
+    t290 = xp.where(t288, 1, t281*t289)
+    t291 = t267*(1 - t290)
+    t292 = t291 + t267*t290
+    t293 = t272*t279
+    t294 = xp.where(t288, 0, t293*t289)
+    t295 = t266*t290 + t274*t294
+    t296 = t274*t290 - t266*t294
+    t297 = xp.less_equal(t286, t287)
+    t298 = xp.where(t297, 1, 1/xp.sqrt(t286))
+    t299 = xp.where(t297, 1, -t265*t298)
+    t300 = xp.where(t297, 0, -t279*t298)
+    t301 = t296*(1 - t299)
+    t302 = t299*t295 - t300*t292
+    t303 = t301 + t299*t296
+    t304 = t299*t292 + t300*t295
+    t305 = t302**2 + t303**2
+    t306 = t305 + t304**2
+    t307 = t45*t234
+    t308 = -t307 + t44*t248 + t208*t250
+    t309 = t307 + t308
+    t310 = t309**2 + t251**2
+    t311 = xp.less_equal(t310, t257*t252)
+    t312 = xp.where(t311, 1, 1/xp.sqrt(t310))
+    t313 = xp.where(t311, 1, t309*t312)
+    t314 = xp.where(t311, 0, -t251*t312)
+    t315 = t230*t313 - t238*t314
+    t316 = t230*t314 + t238*t313
+    t317 = t46*t315 + t213*t316
+    t318 = t213*t315 - t46*t316
+    t319 = t48*t315 + t215*t316
+    t320 = t215*t315 - t48*t316
+    t321 = xp.where(t311, 0, xp.atan2(-t251, t309))
+    t322 = -6.283185307179586*xp.floor(0.15915494309189535*(0.7853981633974483 + t321)) + t321
+    t323 = 1 - t315
+    t324 = t323*t47
+    t325 = t324 + t47*t315
+    t326 = t323*t49
+    t327 = t326 + t49*t315
+    t328 = t318**2
+    t329 = -t328
+    t330 = 1 + t329
+    t331 = xp.greater(t330, 1e-12)
+    t332 = xp.where(t331, xp.sqrt(t330), 0)
+    t333 = t328 + t317*t332
+    t334 = t333 + t329
     t335 = t325**2
-    t336 = -t335
-    t337 = 1 + t336
-    t338 = xp.greater(t337, 1e-12)
-    t339 = xp.where(t338, xp.sqrt(t337), 0)
-    t340 = t335 + t324*t339
-    t341 = t340 + t336
-    t342 = t332**2
-    t343 = t335 + t324**2 + t342
-    t344 = t339**2
-    t345 = t341**2 + t342*t344
-    t346 = t335 + t344
-    t347 = 1e-24*t346
-    t348 = xp.less_equal(t345, t343*t347)
-    t349 = xp.where(t348, 1, 1/xp.sqrt(t345))
-    t350 = xp.where(t348, 1, t341*t349)
-    t351 = t327*(1 - t350)
-    t352 = t351 + t327*t350
-    t353 = t332*t339
-    t354 = xp.where(t348, 0, t349*t353)
-    t355 = t326*t350 + t334*t354
-    t356 = t334*t350 - t326*t354
-    t357 = xp.less_equal(t346, t347)
-    t358 = xp.where(t357, 1, 1/xp.sqrt(t346))
-    t359 = xp.where(t357, 1, t325*t358)
-    t360 = xp.where(t357, 0, -t339*t358)
-    t361 = t356*(1 - t359)
-    t362 = t359*t355 + t360*t352
-    t363 = t361 + t359*t356
-    t364 = t359*t352 - t360*t355
-    t365 = t362**2 + t363**2
-    t366 = t365
-    t367 = t364**2 + t365
-    t368 = xp.where(t137, 0, xp.atan2(t142, t130))
-    t369 = t368
-    t370 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t369)) + t369
-    t371 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t368) + t368
-    t372 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t371)) + t371
-    t373 = xp.where(t146, 0, xp.atan2(-t128, -t114))
-    t374 = t373
-    t375 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t374)) + t374
-    t376 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t373)) + t373
-    t377 = xp.where(xp.less_equal(t155, 1e-24*t156), 0, xp.atan2(t152, t151))
-    t378 = t377
-    t379 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t378)) + t378
-    t380 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t377) + t377
+    t336 = t328 + t317**2 + t335
+    t337 = t332**2
+    t338 = t334**2 + t335*t337
+    t339 = t328 + t337
+    t340 = 1e-24*t339
+    t341 = xp.less_equal(t338, t336*t340)
+    t342 = xp.where(t341, 1, 1/xp.sqrt(t338))
+    t343 = xp.where(t341, 1, t334*t342)
+    t344 = t320*(1 - t343)
+    t345 = t344 + t320*t343
+    t346 = t325*t332
+    t347 = xp.where(t341, 0, t342*t346)
+    t348 = t319*t343 + t327*t347
+    t349 = t327*t343 - t319*t347
+    t350 = xp.less_equal(t339, t340)
+    t351 = xp.where(t350, 1, 1/xp.sqrt(t339))
+    t352 = xp.where(t350, 1, t318*t351)
+    t353 = xp.where(t350, 0, -t332*t351)
+    t354 = t349*(1 - t352)
+    t355 = t352*t348 + t353*t345
+    t356 = t354 + t352*t349
+    t357 = t352*t345 - t353*t348
+    t358 = t355**2 + t356**2
+    t359 = t357**2 + t358
+    t360 = xp.where(t133, 0, xp.atan2(t138, t126))
+    t361 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t360)) + t360
+    t362 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t360) + t360
+    t363 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t362)) + t362
+    t364 = xp.where(t142, 0, xp.atan2(-t124, -t110))
+    t365 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t364)) + t364
+    t366 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t364)) + t364
+    t367 = xp.where(xp.less_equal(t150, 1e-24*t151), 0, xp.atan2(t148, t147))
+    t368 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t367)) + t367
+    t369 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t367) + t367
+    t370 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t369)) + t369
+    t371 = -t366
+    t372 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t371)) + t366
+    t373 = xp.where(t186, 0, xp.atan2(t191, t179))
+    t374 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t373)) + t373
+    t375 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t373) + t373
+    t376 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t375)) + t375
+    t377 = xp.where(t195, 0, xp.atan2(-t177, t163))
+    t378 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t377)) + t377
+    t379 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t377)) + t377
+    t380 = xp.where(xp.less_equal(t203, 1e-24*t204), 0, xp.atan2(t201, t200))
     t381 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t380)) + t380
-    t382 = -t376
-    t383 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t382)) + t376
-    t384 = xp.where(t191, 0, xp.atan2(t196, t184))
-    t385 = t384
-    t386 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t385)) + t385
-    t387 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t384) + t384
-    t388 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t387)) + t387
-    t389 = xp.where(t200, 0, xp.atan2(-t182, t168))
-    t390 = t389
+    t382 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t380) + t380
+    t383 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t382)) + t382
+    t384 = -t379
+    t385 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t384)) + t379
+    t386 = xp.where(t288, 0, xp.atan2(t293, t281))
+    t387 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t386)) + t386
+    t388 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t386) + t386
+    t389 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t388)) + t388
+    t390 = xp.where(t297, 0, xp.atan2(-t279, -t265))
     t391 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t390)) + t390
-    t392 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t389)) + t389
-    t393 = xp.where(xp.less_equal(t209, 1e-24*t210), 0, xp.atan2(t206, t205))
-    t394 = t393
-    t395 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t394)) + t394
-    t396 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t393) + t393
-    t397 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t396)) + t396
-    t398 = -t392
-    t399 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t398)) + t392
-    t400 = xp.where(t294, 0, xp.atan2(t299, t287))
-    t401 = t400
+    t392 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t390)) + t390
+    t393 = xp.where(xp.less_equal(t305, 1e-24*t306), 0, xp.atan2(t303, t302))
+    t394 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t393)) + t393
+    t395 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t393) + t393
+    t396 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t395)) + t395
+    t397 = -t392
+    t398 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t397)) + t392
+    t399 = xp.where(t341, 0, xp.atan2(t346, t334))
+    t400 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t399)) + t399
+    t401 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t399) + t399
     t402 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t401)) + t401
-    t403 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t400) + t400
-    t404 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t403)) + t403
-    t405 = xp.where(t303, 0, xp.atan2(-t285, -t271))
-    t406 = t405
-    t407 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t406)) + t406
-    t408 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t405)) + t405
-    t409 = xp.where(xp.less_equal(t312, 1e-24*t313), 0, xp.atan2(t309, t308))
-    t410 = t409
-    t411 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t410)) + t410
-    t412 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t409) + t409
-    t413 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t412)) + t412
-    t414 = -t408
-    t415 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t414)) + t408
-    t416 = xp.where(t348, 0, xp.atan2(t353, t341))
-    t417 = t416
-    t418 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t417)) + t417
-    t419 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t416) + t416
-    t420 = -6.283185307179586*xp.floor(0.15915494309189535*(1.9198621771937625 + t419)) + t419
-    t421 = xp.where(t357, 0, xp.atan2(-t339, t325))
-    t422 = t421
-    t423 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t422)) + t422
-    t424 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t421)) + t421
-    t425 = xp.where(xp.less_equal(t366, 1e-24*t367), 0, xp.atan2(t363, t362))
-    t426 = t425
-    t427 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t426)) + t426
-    t428 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t425) + t425
-    t429 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t428)) + t428
-    t430 = -t424
-    t431 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t430)) + t424
-    t432 = xp.greater_equal(t28, -2.792526803190927) & xp.less_equal(t28, 2.792526803190927)
-    t433 = xp.less_equal(t29, 2.792526803190927)
-    t434 = xp.where(xp.logical_not(t432) & t433, t29, t28)
-    t435 = xp.greater_equal(t117, -0.7853981633974483) & xp.less_equal(t117, 3.9269908169872414)
-    t436 = xp.less_equal(t118, 3.9269908169872414)
-    t437 = xp.where(xp.logical_not(t435) & t436, t118, t117)
-    t438 = xp.greater_equal(t72, -3.9269908169872414) & xp.less_equal(t72, 0.7853981633974483)
-    t439 = xp.less_equal(t73, 0.7853981633974483)
-    t440 = xp.where(xp.logical_not(t438) & t439, t73, t72)
-    t441 = xp.greater_equal(t369, -1.9198621771937625) & xp.less_equal(t369, 2.9670597283903604)
-    t442 = xp.less_equal(t370, 2.9670597283903604)
-    t443 = xp.greater_equal(t374, -1.7453292519943295) & xp.less_equal(t374, 1.7453292519943295)
-    t444 = xp.less_equal(t375, 1.7453292519943295)
-    t445 = xp.greater_equal(t378, -4.642575810304916) & xp.less_equal(t378, 4.642575810304916)
-    t446 = xp.less_equal(t379, 4.642575810304916)
-    t447 = xp.greater_equal(t371, -1.9198621771937625) & xp.less_equal(t371, 2.9670597283903604)
-    t448 = xp.less_equal(t372, 2.9670597283903604)
-    t449 = xp.greater_equal(t382, -1.7453292519943295) & xp.less_equal(t382, 1.7453292519943295)
-    t450 = -t383
-    t451 = xp.less_equal(t450, 1.7453292519943295)
-    t452 = xp.greater_equal(t380, -4.642575810304916) & xp.less_equal(t380, 4.642575810304916)
-    t453 = xp.less_equal(t381, 4.642575810304916)
-    t454 = xp.greater_equal(t171, -0.7853981633974483) & xp.less_equal(t171, 3.9269908169872414)
-    t455 = xp.less_equal(t172, 3.9269908169872414)
-    t456 = xp.where(xp.logical_not(t454) & t455, t172, t171)
-    t457 = xp.greater_equal(t74, -3.9269908169872414) & xp.less_equal(t74, 0.7853981633974483)
-    t458 = xp.less_equal(t75, 0.7853981633974483)
-    t459 = xp.where(xp.logical_not(t457) & t458, t75, t74)
-    t460 = xp.greater_equal(t385, -1.9198621771937625) & xp.less_equal(t385, 2.9670597283903604)
-    t461 = xp.less_equal(t386, 2.9670597283903604)
-    t462 = xp.greater_equal(t390, -1.7453292519943295) & xp.less_equal(t390, 1.7453292519943295)
-    t463 = xp.less_equal(t391, 1.7453292519943295)
-    t464 = xp.greater_equal(t394, -4.642575810304916) & xp.less_equal(t394, 4.642575810304916)
-    t465 = xp.less_equal(t395, 4.642575810304916)
-    t466 = xp.greater_equal(t387, -1.9198621771937625) & xp.less_equal(t387, 2.9670597283903604)
-    t467 = xp.less_equal(t388, 2.9670597283903604)
-    t468 = xp.greater_equal(t398, -1.7453292519943295) & xp.less_equal(t398, 1.7453292519943295)
-    t469 = -t399
-    t470 = xp.less_equal(t469, 1.7453292519943295)
-    t471 = xp.greater_equal(t396, -4.642575810304916) & xp.less_equal(t396, 4.642575810304916)
-    t472 = xp.less_equal(t397, 4.642575810304916)
-    t473 = xp.greater_equal(t30, -2.792526803190927) & xp.less_equal(t30, 2.792526803190927)
-    t474 = xp.less_equal(t31, 2.792526803190927)
-    t475 = xp.where(xp.logical_not(t473) & t474, t31, t30)
-    t476 = xp.greater_equal(t274, -0.7853981633974483) & xp.less_equal(t274, 3.9269908169872414)
-    t477 = xp.less_equal(t275, 3.9269908169872414)
-    t478 = xp.where(xp.logical_not(t476) & t477, t275, t274)
-    t479 = xp.greater_equal(t229, -3.9269908169872414) & xp.less_equal(t229, 0.7853981633974483)
-    t480 = xp.less_equal(t230, 0.7853981633974483)
-    t481 = xp.where(xp.logical_not(t479) & t480, t230, t229)
-    t482 = xp.greater_equal(t401, -1.9198621771937625) & xp.less_equal(t401, 2.9670597283903604)
-    t483 = xp.less_equal(t402, 2.9670597283903604)
-    t484 = xp.greater_equal(t406, -1.7453292519943295) & xp.less_equal(t406, 1.7453292519943295)
-    t485 = xp.less_equal(t407, 1.7453292519943295)
-    t486 = xp.greater_equal(t410, -4.642575810304916) & xp.less_equal(t410, 4.642575810304916)
-    t487 = xp.less_equal(t411, 4.642575810304916)
-    t488 = xp.greater_equal(t403, -1.9198621771937625) & xp.less_equal(t403, 2.9670597283903604)
-    t489 = xp.less_equal(t404, 2.9670597283903604)
-    t490 = xp.greater_equal(t414, -1.7453292519943295) & xp.less_equal(t414, 1.7453292519943295)
-    t491 = -t415
-    t492 = xp.less_equal(t491, 1.7453292519943295)
-    t493 = xp.greater_equal(t412, -4.642575810304916) & xp.less_equal(t412, 4.642575810304916)
-    t494 = xp.less_equal(t413, 4.642575810304916)
-    t495 = xp.greater_equal(t328, -0.7853981633974483) & xp.less_equal(t328, 3.9269908169872414)
-    t496 = xp.less_equal(t329, 3.9269908169872414)
-    t497 = xp.where(xp.logical_not(t495) & t496, t329, t328)
-    t498 = xp.greater_equal(t231, -3.9269908169872414) & xp.less_equal(t231, 0.7853981633974483)
-    t499 = xp.less_equal(t232, 0.7853981633974483)
-    t500 = xp.where(xp.logical_not(t498) & t499, t232, t231)
-    t501 = xp.greater_equal(t417, -1.9198621771937625) & xp.less_equal(t417, 2.9670597283903604)
-    t502 = xp.less_equal(t418, 2.9670597283903604)
-    t503 = xp.greater_equal(t422, -1.7453292519943295) & xp.less_equal(t422, 1.7453292519943295)
-    t504 = xp.less_equal(t423, 1.7453292519943295)
-    t505 = xp.greater_equal(t426, -4.642575810304916) & xp.less_equal(t426, 4.642575810304916)
-    t506 = xp.less_equal(t427, 4.642575810304916)
-    t507 = xp.greater_equal(t419, -1.9198621771937625) & xp.less_equal(t419, 2.9670597283903604)
-    t508 = xp.less_equal(t420, 2.9670597283903604)
-    t509 = xp.greater_equal(t430, -1.7453292519943295) & xp.less_equal(t430, 1.7453292519943295)
-    t510 = -t431
-    t511 = xp.less_equal(t510, 1.7453292519943295)
-    t512 = xp.greater_equal(t428, -4.642575810304916) & xp.less_equal(t428, 4.642575810304916)
-    t513 = xp.less_equal(t429, 4.642575810304916)
-    t514 = xp.isfinite(t0)
-    t515 = xp.greater(t15, t17)
-    t516 = (t18 & xp.less_equal(0.0225150025, 1e-12*t16)) | (t515 & xp.greater_equal(t20, -1e-12))
-    t517 = xp.greater_equal(t60, -1e-12)
-    t518 = xp.greater_equal(t217, -1e-12)
-    t519 = t432 | t433
-    t520 = t435 | t436
-    t521 = t438 | t439
-    t522 = t454 | t455
-    t523 = t457 | t458
-    t524 = t473 | t474
-    t525 = t476 | t477
-    t526 = t479 | t480
-    t527 = t495 | t496
-    t528 = t498 | t499
+    t403 = xp.where(t350, 0, xp.atan2(-t332, t318))
+    t404 = -6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t403)) + t403
+    t405 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t403)) + t403
+    t406 = xp.where(xp.less_equal(t358, 1e-24*t359), 0, xp.atan2(t356, t355))
+    t407 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t406)) + t406
+    t408 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t406) + t406
+    t409 = -6.283185307179586*xp.floor(0.15915494309189535*(4.642575810304916 + t408)) + t408
+    t410 = -t405
+    t411 = 6.283185307179586*xp.floor(0.15915494309189535*(1.7453292519943295 + t410)) + t405
+    t412 = xp.greater_equal(t24, -2.792526803190927) & xp.less_equal(t24, 2.792526803190927)
+    t413 = xp.less_equal(t25, 2.792526803190927)
+    t414 = xp.where(xp.logical_not(t412) & t413, t25, t24)
+    t415 = xp.greater_equal(t113, -0.7853981633974483) & xp.less_equal(t113, 3.9269908169872414)
+    t416 = xp.less_equal(t114, 3.9269908169872414)
+    t417 = xp.where(xp.logical_not(t415) & t416, t114, t113)
+    t418 = xp.greater_equal(t68, -3.9269908169872414) & xp.less_equal(t68, 0.7853981633974483)
+    t419 = xp.less_equal(t69, 0.7853981633974483)
+    t420 = xp.where(xp.logical_not(t418) & t419, t69, t68)
+    t421 = xp.greater_equal(t360, -1.9198621771937625) & xp.less_equal(t360, 2.9670597283903604)
+    t422 = xp.less_equal(t361, 2.9670597283903604)
+    t423 = xp.greater_equal(t364, -1.7453292519943295) & xp.less_equal(t364, 1.7453292519943295)
+    t424 = xp.less_equal(t365, 1.7453292519943295)
+    t425 = xp.greater_equal(t367, -4.642575810304916) & xp.less_equal(t367, 4.642575810304916)
+    t426 = xp.less_equal(t368, 4.642575810304916)
+    t427 = xp.greater_equal(t362, -1.9198621771937625) & xp.less_equal(t362, 2.9670597283903604)
+    t428 = xp.less_equal(t363, 2.9670597283903604)
+    t429 = xp.greater_equal(t371, -1.7453292519943295) & xp.less_equal(t371, 1.7453292519943295)
+    t430 = -t372
+    t431 = xp.less_equal(t430, 1.7453292519943295)
+    t432 = xp.greater_equal(t369, -4.642575810304916) & xp.less_equal(t369, 4.642575810304916)
+    t433 = xp.less_equal(t370, 4.642575810304916)
+    t434 = xp.greater_equal(t166, -0.7853981633974483) & xp.less_equal(t166, 3.9269908169872414)
+    t435 = xp.less_equal(t167, 3.9269908169872414)
+    t436 = xp.where(xp.logical_not(t434) & t435, t167, t166)
+    t437 = xp.greater_equal(t70, -3.9269908169872414) & xp.less_equal(t70, 0.7853981633974483)
+    t438 = xp.less_equal(t71, 0.7853981633974483)
+    t439 = xp.where(xp.logical_not(t437) & t438, t71, t70)
+    t440 = xp.greater_equal(t373, -1.9198621771937625) & xp.less_equal(t373, 2.9670597283903604)
+    t441 = xp.less_equal(t374, 2.9670597283903604)
+    t442 = xp.greater_equal(t377, -1.7453292519943295) & xp.less_equal(t377, 1.7453292519943295)
+    t443 = xp.less_equal(t378, 1.7453292519943295)
+    t444 = xp.greater_equal(t380, -4.642575810304916) & xp.less_equal(t380, 4.642575810304916)
+    t445 = xp.less_equal(t381, 4.642575810304916)
+    t446 = xp.greater_equal(t375, -1.9198621771937625) & xp.less_equal(t375, 2.9670597283903604)
+    t447 = xp.less_equal(t376, 2.9670597283903604)
+    t448 = xp.greater_equal(t384, -1.7453292519943295) & xp.less_equal(t384, 1.7453292519943295)
+    t449 = -t385
+    t450 = xp.less_equal(t449, 1.7453292519943295)
+    t451 = xp.greater_equal(t382, -4.642575810304916) & xp.less_equal(t382, 4.642575810304916)
+    t452 = xp.less_equal(t383, 4.642575810304916)
+    t453 = xp.greater_equal(t26, -2.792526803190927) & xp.less_equal(t26, 2.792526803190927)
+    t454 = xp.less_equal(t27, 2.792526803190927)
+    t455 = xp.where(xp.logical_not(t453) & t454, t27, t26)
+    t456 = xp.greater_equal(t268, -0.7853981633974483) & xp.less_equal(t268, 3.9269908169872414)
+    t457 = xp.less_equal(t269, 3.9269908169872414)
+    t458 = xp.where(xp.logical_not(t456) & t457, t269, t268)
+    t459 = xp.greater_equal(t223, -3.9269908169872414) & xp.less_equal(t223, 0.7853981633974483)
+    t460 = xp.less_equal(t224, 0.7853981633974483)
+    t461 = xp.where(xp.logical_not(t459) & t460, t224, t223)
+    t462 = xp.greater_equal(t386, -1.9198621771937625) & xp.less_equal(t386, 2.9670597283903604)
+    t463 = xp.less_equal(t387, 2.9670597283903604)
+    t464 = xp.greater_equal(t390, -1.7453292519943295) & xp.less_equal(t390, 1.7453292519943295)
+    t465 = xp.less_equal(t391, 1.7453292519943295)
+    t466 = xp.greater_equal(t393, -4.642575810304916) & xp.less_equal(t393, 4.642575810304916)
+    t467 = xp.less_equal(t394, 4.642575810304916)
+    t468 = xp.greater_equal(t388, -1.9198621771937625) & xp.less_equal(t388, 2.9670597283903604)
+    t469 = xp.less_equal(t389, 2.9670597283903604)
+    t470 = xp.greater_equal(t397, -1.7453292519943295) & xp.less_equal(t397, 1.7453292519943295)
+    t471 = -t398
+    t472 = xp.less_equal(t471, 1.7453292519943295)
+    t473 = xp.greater_equal(t395, -4.642575810304916) & xp.less_equal(t395, 4.642575810304916)
+    t474 = xp.less_equal(t396, 4.642575810304916)
+    t475 = xp.greater_equal(t321, -0.7853981633974483) & xp.less_equal(t321, 3.9269908169872414)
+    t476 = xp.less_equal(t322, 3.9269908169872414)
+    t477 = xp.where(xp.logical_not(t475) & t476, t322, t321)
+    t478 = xp.greater_equal(t225, -3.9269908169872414) & xp.less_equal(t225, 0.7853981633974483)
+    t479 = xp.less_equal(t226, 0.7853981633974483)
+    t480 = xp.where(xp.logical_not(t478) & t479, t226, t225)
+    t481 = xp.greater_equal(t399, -1.9198621771937625) & xp.less_equal(t399, 2.9670597283903604)
+    t482 = xp.less_equal(t400, 2.9670597283903604)
+    t483 = xp.greater_equal(t403, -1.7453292519943295) & xp.less_equal(t403, 1.7453292519943295)
+    t484 = xp.less_equal(t404, 1.7453292519943295)
+    t485 = xp.greater_equal(t406, -4.642575810304916) & xp.less_equal(t406, 4.642575810304916)
+    t486 = xp.less_equal(t407, 4.642575810304916)
+    t487 = xp.greater_equal(t401, -1.9198621771937625) & xp.less_equal(t401, 2.9670597283903604)
+    t488 = xp.less_equal(t402, 2.9670597283903604)
+    t489 = xp.greater_equal(t410, -1.7453292519943295) & xp.less_equal(t410, 1.7453292519943295)
+    t490 = -t411
+    t491 = xp.less_equal(t490, 1.7453292519943295)
+    t492 = xp.greater_equal(t408, -4.642575810304916) & xp.less_equal(t408, 4.642575810304916)
+    t493 = xp.less_equal(t409, 4.642575810304916)
+    t494 = xp.isfinite(t0)
+    t495 = xp.greater(t11, t13)
+    t496 = (t14 & xp.less_equal(0.0225150025, 1e-12*t12)) | (t495 & xp.greater_equal(t16, -1e-12))
+    t497 = xp.greater_equal(t56, -1e-12)
+    t498 = xp.greater_equal(t211, -1e-12)
+    t499 = t412 | t413
+    t500 = t415 | t416
+    t501 = t418 | t419
+    t502 = t434 | t435
+    t503 = t437 | t438
+    t504 = t453 | t454
+    t505 = t456 | t457
+    t506 = t459 | t460
+    t507 = t475 | t476
+    t508 = t478 | t479
     q = _stack(xp, [
-        t434,  # 0, 0
-        t437,  # 0, 1
-        t440,  # 0, 2
-        xp.where(xp.logical_not(t441) & t442, t370, t369),  # 0, 3
-        xp.where(xp.logical_not(t443) & t444, t375, t374),  # 0, 4
-        xp.where(xp.logical_not(t445) & t446, t379, t378),  # 0, 5
-        t434,  # 1, 0
-        t437,  # 1, 1
-        t440,  # 1, 2
-        xp.where(xp.logical_not(t447) & t448, t372, t371),  # 1, 3
-        xp.where(xp.logical_not(t449) & t451, t450, t382),  # 1, 4
-        xp.where(xp.logical_not(t452) & t453, t381, t380),  # 1, 5
-        t434,  # 2, 0
-        t456,  # 2, 1
-        t459,  # 2, 2
-        xp.where(xp.logical_not(t460) & t461, t386, t385),  # 2, 3
-        xp.where(xp.logical_not(t462) & t463, t391, t390),  # 2, 4
-        xp.where(xp.logical_not(t464) & t465, t395, t394),  # 2, 5
-        t434,  # 3, 0
-        t456,  # 3, 1
-        t459,  # 3, 2
-        xp.where(xp.logical_not(t466) & t467, t388, t387),  # 3, 3
-        xp.where(xp.logical_not(t468) & t470, t469, t398),  # 3, 4
-        xp.where(xp.logical_not(t471) & t472, t397, t396),  # 3, 5
-        t475,  # 4, 0
-        t478,  # 4, 1
-        t481,  # 4, 2
-        xp.where(xp.logical_not(t482) & t483, t402, t401),  # 4, 3
-        xp.where(xp.logical_not(t484) & t485, t407, t406),  # 4, 4
-        xp.where(xp.logical_not(t486) & t487, t411, t410),  # 4, 5
-        t475,  # 5, 0
-        t478,  # 5, 1
-        t481,  # 5, 2
-        xp.where(xp.logical_not(t488) & t489, t404, t403),  # 5, 3
-        xp.where(xp.logical_not(t490) & t492, t491, t414),  # 5, 4
-        xp.where(xp.logical_not(t493) & t494, t413, t412),  # 5, 5
-        t475,  # 6, 0
-        t497,  # 6, 1
-        t500,  # 6, 2
-        xp.where(xp.logical_not(t501) & t502, t418, t417),  # 6, 3
-        xp.where(xp.logical_not(t503) & t504, t423, t422),  # 6, 4
-        xp.where(xp.logical_not(t505) & t506, t427, t426),  # 6, 5
-        t475,  # 7, 0
-        t497,  # 7, 1
-        t500,  # 7, 2
-        xp.where(xp.logical_not(t507) & t508, t420, t419),  # 7, 3
-        xp.where(xp.logical_not(t509) & t511, t510, t430),  # 7, 4
-        xp.where(xp.logical_not(t512) & t513, t429, t428),  # 7, 5
+        t414,  # 0, 0
+        t417,  # 0, 1
+        t420,  # 0, 2
+        xp.where(xp.logical_not(t421) & t422, t361, t360),  # 0, 3
+        xp.where(xp.logical_not(t423) & t424, t365, t364),  # 0, 4
+        xp.where(xp.logical_not(t425) & t426, t368, t367),  # 0, 5
+        t414,  # 1, 0
+        t417,  # 1, 1
+        t420,  # 1, 2
+        xp.where(xp.logical_not(t427) & t428, t363, t362),  # 1, 3
+        xp.where(xp.logical_not(t429) & t431, t430, t371),  # 1, 4
+        xp.where(xp.logical_not(t432) & t433, t370, t369),  # 1, 5
+        t414,  # 2, 0
+        t436,  # 2, 1
+        t439,  # 2, 2
+        xp.where(xp.logical_not(t440) & t441, t374, t373),  # 2, 3
+        xp.where(xp.logical_not(t442) & t443, t378, t377),  # 2, 4
+        xp.where(xp.logical_not(t444) & t445, t381, t380),  # 2, 5
+        t414,  # 3, 0
+        t436,  # 3, 1
+        t439,  # 3, 2
+        xp.where(xp.logical_not(t446) & t447, t376, t375),  # 3, 3
+        xp.where(xp.logical_not(t448) & t450, t449, t384),  # 3, 4
+        xp.where(xp.logical_not(t451) & t452, t383, t382),  # 3, 5
+        t455,  # 4, 0
+        t458,  # 4, 1
+        t461,  # 4, 2
+        xp.where(xp.logical_not(t462) & t463, t387, t386),  # 4, 3
+        xp.where(xp.logical_not(t464) & t465, t391, t390),  # 4, 4
+        xp.where(xp.logical_not(t466) & t467, t394, t393),  # 4, 5
+        t455,  # 5, 0
+        t458,  # 5, 1
+        t461,  # 5, 2
+        xp.where(xp.logical_not(t468) & t469, t389, t388),  # 5, 3
+        xp.where(xp.logical_not(t470) & t472, t471, t397),  # 5, 4
+        xp.where(xp.logical_not(t473) & t474, t396, t395),  # 5, 5
+        t455,  # 6, 0
+        t477,  # 6, 1
+        t480,  # 6, 2
+        xp.where(xp.logical_not(t481) & t482, t400, t399),  # 6, 3
+        xp.where(xp.logical_not(t483) & t484, t404, t403),  # 6, 4
+        xp.where(xp.logical_not(t485) & t486, t407, t406),  # 6, 5
+        t455,  # 7, 0
+        t477,  # 7, 1
+        t480,  # 7, 2
+        xp.where(xp.logical_not(t487) & t488, t402, t401),  # 7, 3
+        xp.where(xp.logical_not(t489) & t491, t490, t410),  # 7, 4
+        xp.where(xp.logical_not(t492) & t493, t409, t408),  # 7, 5
     ], (8, 6))
     valid = _stack(xp, [
-        t514 & t516 & t517 & xp.greater_equal(t126, -1e-12),  # 0
-        t514 & t516 & t517 & t127,  # 1
-        t514 & t516 & t65 & xp.greater_equal(t180, -1e-12),  # 2
-        t514 & t516 & t65 & t181,  # 3
-        t514 & t515 & t21 & t518 & xp.greater_equal(t283, -1e-12),  # 4
-        t514 & t515 & t21 & t518 & t284,  # 5
-        t514 & t515 & t21 & t222 & xp.greater_equal(t337, -1e-12),  # 6
-        t514 & t515 & t21 & t222 & t338,  # 7
+        t494 & t496 & t497 & xp.greater_equal(t122, -1e-12),  # 0
+        t494 & t496 & t497 & t123,  # 1
+        t494 & t496 & t61 & xp.greater_equal(t175, -1e-12),  # 2
+        t494 & t496 & t61 & t176,  # 3
+        t494 & t495 & t17 & t498 & xp.greater_equal(t277, -1e-12),  # 4
+        t494 & t495 & t17 & t498 & t278,  # 5
+        t494 & t495 & t17 & t216 & xp.greater_equal(t330, -1e-12),  # 6
+        t494 & t495 & t17 & t216 & t331,  # 7
     ], (8,))
     in_limits = _stack(xp, [
-        t519 & t520 & t521 & (t441 | t442) & (t443 | t444) & (t445 | t446),  # 0
-        t519 & t520 & t521 & (t447 | t448) & (t449 | t451) & (t452 | t453),  # 1
-        t519 & t522 & t523 & (t460 | t461) & (t462 | t463) & (t464 | t465),  # 2
-        t519 & t522 & t523 & (t466 | t467) & (t468 | t470) & (t471 | t472),  # 3
-        t524 & t525 & t526 & (t482 | t483) & (t484 | t485) & (t486 | t487),  # 4
-        t524 & t525 & t526 & (t488 | t489) & (t490 | t492) & (t493 | t494),  # 5
-        t524 & t527 & t528 & (t501 | t502) & (t503 | t504) & (t505 | t506),  # 6
-        t524 & t527 & t528 & (t507 | t508) & (t509 | t511) & (t512 | t513),  # 7
+        t499 & t500 & t501 & (t421 | t422) & (t423 | t424) & (t425 | t426),  # 0
+        t499 & t500 & t501 & (t427 | t428) & (t429 | t431) & (t432 | t433),  # 1
+        t499 & t502 & t503 & (t440 | t441) & (t442 | t443) & (t444 | t445),  # 2
+        t499 & t502 & t503 & (t446 | t447) & (t448 | t450) & (t451 | t452),  # 3
+        t504 & t505 & t506 & (t462 | t463) & (t464 | t465) & (t466 | t467),  # 4
+        t504 & t505 & t506 & (t468 | t469) & (t470 | t472) & (t473 | t474),  # 5
+        t504 & t507 & t508 & (t481 | t482) & (t483 | t484) & (t485 | t486),  # 6
+        t504 & t507 & t508 & (t487 | t488) & (t489 | t491) & (t492 | t493),  # 7
     ], (8,))
     return q, valid, in_limits
 

@@ -450,39 +450,36 @@ def fk_jacobian_dot(q, q_dot):
     t10 = t2 + c1*t9
     t11 = t4 + s1*t9
     t12 = c1*t10 + s1*t11
-    t13 = t12
-    t14 = c1*t2 + s1*t4
-    t15 = t14
-    t16 = c1**2
-    t17 = 0.1*c234
-    t18 = s1**2
-    t19 = t16*t17 + t17*t18
-    t20 = t19
-    t21 = s1*qd2
-    t22 = s1*qd3
+    t13 = c1*t2 + s1*t4
+    t14 = c1**2
+    t15 = 0.1*c234
+    t16 = s1**2
+    t17 = t14*t15 + t15*t16
+    t18 = s1*qd2
+    t19 = s1*qd3
+    t20 = t18 + t19
+    t21 = c1*qd2
+    t22 = c1*qd3
     t23 = t21 + t22
-    t24 = c1*qd2
-    t25 = c1*qd3
-    t26 = t24 + t25
-    t27 = c1*t5
-    t28 = t27*qd4 + t6*t25
-    t29 = t28 + t7*t24
-    t30 = t29 + t11*qd1
-    t31 = s1*t5
-    t32 = t31*qd4 + t6*t22
-    t33 = t32 + t7*t21
-    t34 = -t33 + t10*qd1
-    t35 = t20*qd4
-    t36 = t35 + t15*qd3
-    t37 = t36 + t13*qd2
-    t38 = c1*t7
-    t39 = c1*t6
-    t40 = s1*t7
-    t41 = s1*t6
-    t42 = -c1
-    t43 = t6*qd2
-    t44 = t5*qd4
-    t45 = qd1*qd4
+    t24 = c1*t5
+    t25 = t24*qd4 + t6*t22
+    t26 = t25 + t7*t21
+    t27 = t26 + t11*qd1
+    t28 = s1*t5
+    t29 = t28*qd4 + t6*t19
+    t30 = t29 + t7*t18
+    t31 = -t30 + t10*qd1
+    t32 = t17*qd4
+    t33 = t32 + t13*qd3
+    t34 = t33 + t12*qd2
+    t35 = c1*t7
+    t36 = c1*t6
+    t37 = s1*t7
+    t38 = s1*t6
+    t39 = -c1
+    t40 = t6*qd2
+    t41 = t5*qd4
+    t42 = qd1*qd4
     T = _stack(xp, [
         xp.broadcast_to(t1, batch),  # 0, 0
         xp.broadcast_to(-s1, batch),  # 0, 1
@@ -503,37 +500,37 @@ def fk_jacobian_dot(q, q_dot):
     ], (4, 4))
     J = _stack(xp, [
         xp.broadcast_to(-t11, batch),  # 0, 0
-        xp.broadcast_to(-t38, batch),  # 0, 1
-        xp.broadcast_to(-t39, batch),  # 0, 2
-        xp.broadcast_to(-t27, batch),  # 0, 3
+        xp.broadcast_to(-t35, batch),  # 0, 1
+        xp.broadcast_to(-t36, batch),  # 0, 2
+        xp.broadcast_to(-t24, batch),  # 0, 3
         xp.broadcast_to(t10, batch),  # 1, 0
-        xp.broadcast_to(-t40, batch),  # 1, 1
-        xp.broadcast_to(-t41, batch),  # 1, 2
-        xp.broadcast_to(-t31, batch),  # 1, 3
+        xp.broadcast_to(-t37, batch),  # 1, 1
+        xp.broadcast_to(-t38, batch),  # 1, 2
+        xp.broadcast_to(-t28, batch),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
         xp.broadcast_to(t12, batch),  # 2, 1
-        xp.broadcast_to(t14, batch),  # 2, 2
-        xp.broadcast_to(t19, batch),  # 2, 3
+        xp.broadcast_to(t13, batch),  # 2, 2
+        xp.broadcast_to(t17, batch),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(s1, batch),  # 3, 1
         xp.broadcast_to(s1, batch),  # 3, 2
         xp.broadcast_to(s1, batch),  # 3, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t42, batch),  # 4, 1
-        xp.broadcast_to(t42, batch),  # 4, 2
-        xp.broadcast_to(t42, batch),  # 4, 3
+        xp.broadcast_to(t39, batch),  # 4, 1
+        xp.broadcast_to(t39, batch),  # 4, 2
+        xp.broadcast_to(t39, batch),  # 4, 3
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3
     ], (6, 4))
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t34 + qd2*(-c1*t37 + qd1*t40) - qd3*(c1*t36 + t24*t15 - qd1*t41) - qd4*(-0.1*s1*s234*qd1 + t20*t26 + c1*t35), batch),  # 0
-        xp.broadcast_to(-qd1*t30 - qd2*(s1*t37 + qd1*t38) - qd3*(s1*t36 + qd1*t39 + t21*t15) - qd4*(t20*t23 + t27*qd1 + s1*t35), batch),  # 1
-        xp.broadcast_to(-qd2*(s1*t33 + c1*t29) - qd3*(c1*t28 + s1*t32 + t18*t43 + t16*t43) - qd4*(t31*t23 + t27*t26 + t18*t44 + t16*t44), batch),  # 2
-        xp.broadcast_to(t24*qd1 + t25*qd1 + c1*t45, batch),  # 3
-        xp.broadcast_to(t21*qd1 + t22*qd1 + s1*t45, batch),  # 4
-        xp.broadcast_to(qd4*(-c1*t23 + s1*t26), batch),  # 5
+        xp.broadcast_to(-qd1*t31 + qd2*(-c1*t34 + qd1*t37) - qd3*(t13*t21 + c1*t33 - qd1*t38) - qd4*(-0.1*s1*s234*qd1 + c1*t32 + t17*t23), batch),  # 0
+        xp.broadcast_to(-qd1*t27 - qd2*(s1*t34 + qd1*t35) - qd3*(t13*t18 + s1*t33 + qd1*t36) - qd4*(t24*qd1 + s1*t32 + t17*t20), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t30 + c1*t26) - qd3*(c1*t25 + s1*t29 + t16*t40 + t14*t40) - qd4*(t28*t20 + t24*t23 + t16*t41 + t14*t41), batch),  # 2
+        xp.broadcast_to(t21*qd1 + t22*qd1 + c1*t42, batch),  # 3
+        xp.broadcast_to(t18*qd1 + t19*qd1 + s1*t42, batch),  # 4
+        xp.broadcast_to(qd4*(-c1*t20 + s1*t23), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -1069,155 +1066,151 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t39 = t35*t17 + t36*t17 + t37*t17
     t40 = t6**2
     t41 = t7**2 + t15**2 + t40
-    t42 = t41
-    t43 = t17**2
-    t44 = 3*t43
-    t45 = t44
-    t46 = t26**2
-    t47 = t30**2
-    t48 = t31**2
-    t49 = damping**2
-    t50 = t24 + t49
-    t51 = t50**2
-    t52 = xp.sqrt(t46 + t47 + t48 + t51)
-    t53 = t52*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
-    t54 = t53 + t50
-    t55 = xp.where(xp.greater(t52, 0), 1/(t52*(t52 + xp.abs(t50))), 0)
-    t56 = t55*(mu_dot0*t54 + mu_dot1*t26 - mu_dot2*t30 - mu_dot3*t31)
-    t57 = mu_dot0 - t54*t56
-    t58 = mu_dot1 - t26*t56
-    t59 = mu_dot2 + t30*t56
-    t60 = mu_dot3 + t31*t56
-    t61 = t34 + t49
-    t62 = t55*(t26*t54 + t30*t38 + t31*t39 + t26*t61)
-    t63 = t26 - t54*t62
-    t64 = -t26*t62 + t61
-    t65 = -t38 + t30*t62
-    t66 = -t39 + t31*t62
-    t67 = xp.sqrt(t64**2 + t65**2 + t66**2)
-    t68 = t67*xp.where(xp.greater_equal(t64, 0), xp.asarray(1, dtype=dtype), -1)
-    t69 = t64 + t68
-    t70 = xp.where(xp.greater(t67, 0), 1/(t67*(t67 + xp.abs(t64))), 0)
-    t71 = t70*(t58*t69 + t65*t59 + t66*t60)
-    t72 = t58 - t69*t71
-    t73 = t59 - t65*t71
-    t74 = t60 - t66*t71
-    t75 = t42 + t49
-    t76 = -t55*(t30*t54 + t26*t38 + t31*t18 + t30*t75)
-    t77 = t30 + t54*t76
-    t78 = t38 + t26*t76
-    t79 = t30*t76 + t75
-    t80 = t18 + t31*t76
-    t81 = t70*(-t78*t69 + t65*t79 + t66*t80)
-    t82 = t78 + t69*t81
-    t83 = t79 - t65*t81
-    t84 = t80 - t66*t81
-    t85 = xp.sqrt(t83**2 + t84**2)
-    t86 = t85*xp.where(xp.greater_equal(t83, 0), xp.asarray(1, dtype=dtype), -1)
-    t87 = t83 + t86
-    t88 = xp.where(xp.greater(t85, 0), 1/(t85*(t85 + xp.abs(t83))), 0)
-    t89 = t88*(t73*t87 + t84*t74)
-    t90 = t73 - t87*t89
-    t91 = t74 - t84*t89
-    t92 = t45 + t49
-    t93 = xp.sqrt(2*t46 + 2*t47 + 2*t38**2 + 2*t48 + 2*t39**2 + 2*t18**2 + t51 + t61**2 + t75**2 + t92**2)
-    t94 = -t55*(t31*t54 + t26*t39 + t30*t18 + t31*t92)
-    t95 = t31 + t54*t94
-    t96 = t39 + t26*t94
-    t97 = t18 + t30*t94
-    t98 = t31*t94 + t92
-    t99 = t70*(-t96*t69 + t65*t97 + t66*t98)
-    t100 = t96 + t69*t99
-    t101 = t97 - t65*t99
-    t102 = t98 - t66*t99
-    t103 = t88*(t101*t87 + t84*t102)
-    t104 = t101 - t87*t103
-    t105 = t102 - t84*t103
-    t106 = xp.abs(t105)
-    t107 = t106
-    t108 = t107*xp.where(xp.greater_equal(t105, 0), xp.asarray(1, dtype=dtype), -1)
-    t109 = t105 + t108
-    t110 = xp.where(xp.greater(t107, 0), 1/(t107*(t107 + t106)), 0)
-    t111 = t91 - t91*t109**2*t110
-    t112 = xp.where(xp.not_equal(t108, 0), -t111/t108, 0)
-    t113 = xp.where(xp.not_equal(t86, 0), -(t90 - t104*t112)/t86, 0)
-    t114 = xp.where(xp.not_equal(t68, 0), -(t72 + t82*t113 + t100*t112)/t68, 0)
-    t115 = xp.where(xp.not_equal(t53, 0), -(t57 + t77*t113 + t95*t112 - t63*t114)/t53, 0)
-    t116 = -t5*t115 + t2*t114
-    t117 = t17*t112
-    t118 = t6*t113 - t27*t115 - t35*t114 + t117
-    t119 = t7*t113 + t117 - t28*t115 - t36*t114
-    t120 = t15*t113 + t117 - t29*t115 - t37*t114
-    t121 = t19 + t32
-    t122 = xp.sqrt(t23 + t33 + t41 + t44 + t121)
-    t123 = xp.sqrt(t121)
-    t124 = t123*xp.where(xp.less_equal(t5, 0), xp.asarray(1, dtype=dtype), -1)
-    t125 = xp.where(xp.greater(t123, 0), 1/(t123*(t123 + xp.abs(t5))), 0)
-    t126 = -t5
-    t127 = t124 + t126
-    t128 = -t125*(t27*t127 + t2*t35)
-    t129 = t27 + t127*t128
-    t130 = t35 + t2*t128
-    t131 = -t125*(t28*t127 + t2*t36)
-    t132 = t28 + t127*t131
-    t133 = t36 + t2*t131
-    t134 = -t125*(t29*t127 + t2*t37)
-    t135 = t29 + t127*t134
-    t136 = t37 + t2*t134
-    t137 = t125*(mu_dot0*t127 + t2*mu_dot1)
-    t138 = mu_dot0 - t127*t137
-    t139 = mu_dot1 - t2*t137
-    t140 = xp.sqrt(t40 + t43 + t130**2)
-    t141 = t140*xp.where(xp.less_equal(t130, 0), xp.asarray(1, dtype=dtype), -1)
-    t142 = -t130 + t141
-    t143 = xp.where(xp.greater(t140, 0), 1/(t140*(t140 + xp.abs(t130))), 0)
-    t144 = t143*(t43 - t133*t142 + t6*t7)
-    t145 = t133 + t142*t144
-    t146 = t7 - t6*t144
-    t147 = t17 - t17*t144
-    t148 = t143*(t43 - t136*t142 + t6*t15)
-    t149 = t136 + t142*t148
-    t150 = t15 - t6*t148
-    t151 = t17 - t17*t148
-    t152 = t143*(t139*t142 + t6*mu_dot2 + t17*mu_dot3)
-    t153 = t139 - t142*t152
-    t154 = mu_dot2 - t6*t152
-    t155 = mu_dot3 - t17*t152
-    t156 = xp.sqrt(t146**2 + t147**2)
-    t157 = t156*xp.where(xp.greater_equal(t146, 0), xp.asarray(1, dtype=dtype), -1)
-    t158 = t146 + t157
-    t159 = xp.where(xp.greater(t156, 0), 1/(t156*(t156 + xp.abs(t146))), 0)
-    t160 = t159*(t150*t158 + t147*t151)
-    t161 = t150 - t158*t160
-    t162 = t151 - t147*t160
-    t163 = t159*(t154*t158 + t147*t155)
-    t164 = t154 - t158*t163
-    t165 = t155 - t147*t163
-    t166 = -t27 - t28 - t29 - t35 - t36 - t37 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + 3*t17 + t126
-    t167 = xp.abs(t162)
-    t168 = t167
-    t169 = t168*xp.where(xp.greater_equal(t162, 0), xp.asarray(1, dtype=dtype), -1)
-    t170 = t162 + t169
-    t171 = xp.where(xp.greater(t168, 0), 1/(t168*(t168 + t167)), 0)
-    t172 = t165 - t165*t170**2*t171
-    t173 = xp.where(xp.not_equal(t169, 0), -t172/t169, 0)
-    t174 = xp.where(xp.not_equal(t157, 0), -(t164 - t161*t173)/t157, 0)
-    t175 = xp.where(xp.not_equal(t141, 0), -(t153 + t145*t174 + t149*t173)/t141, 0)
-    t176 = xp.where(xp.not_equal(t124, 0), -(t138 + t129*t175 + t132*t174 + t135*t173)/t124, 0)
-    t177 = xp.isfinite(t166)
-    t178 = xp.greater_equal(damping, 0)
-    t179 = xp.greater(damping, 0)
-    t180 = 1e-12*t93
-    t181 = 1e-12*t122
-    t182 = (t179 & (xp.less_equal(t52, t180) | xp.less_equal(t67, t180) | xp.less_equal(t85, t180) | xp.less_equal(t107, t180))) | (xp.less_equal(damping, 0) & (xp.less_equal(t123, t181) | xp.less_equal(t140, t181) | xp.less_equal(t156, t181) | xp.less_equal(t168, t181)))
-    t183 = t177 & t178 & xp.logical_not(t182)
+    t42 = t17**2
+    t43 = 3*t42
+    t44 = t26**2
+    t45 = t30**2
+    t46 = t31**2
+    t47 = damping**2
+    t48 = t24 + t47
+    t49 = t48**2
+    t50 = xp.sqrt(t44 + t45 + t46 + t49)
+    t51 = t50*xp.where(xp.greater_equal(t48, 0), xp.asarray(1, dtype=dtype), -1)
+    t52 = t51 + t48
+    t53 = xp.where(xp.greater(t50, 0), 1/(t50*(t50 + xp.abs(t48))), 0)
+    t54 = t53*(mu_dot0*t52 + mu_dot1*t26 - mu_dot2*t30 - mu_dot3*t31)
+    t55 = mu_dot0 - t52*t54
+    t56 = mu_dot1 - t26*t54
+    t57 = mu_dot2 + t30*t54
+    t58 = mu_dot3 + t31*t54
+    t59 = t34 + t47
+    t60 = t53*(t26*t52 + t30*t38 + t31*t39 + t26*t59)
+    t61 = t26 - t52*t60
+    t62 = -t26*t60 + t59
+    t63 = -t38 + t30*t60
+    t64 = -t39 + t31*t60
+    t65 = xp.sqrt(t62**2 + t63**2 + t64**2)
+    t66 = t65*xp.where(xp.greater_equal(t62, 0), xp.asarray(1, dtype=dtype), -1)
+    t67 = t62 + t66
+    t68 = xp.where(xp.greater(t65, 0), 1/(t65*(t65 + xp.abs(t62))), 0)
+    t69 = t68*(t56*t67 + t63*t57 + t64*t58)
+    t70 = t56 - t67*t69
+    t71 = t57 - t63*t69
+    t72 = t58 - t64*t69
+    t73 = t41 + t47
+    t74 = -t53*(t30*t52 + t26*t38 + t31*t18 + t30*t73)
+    t75 = t30 + t52*t74
+    t76 = t38 + t26*t74
+    t77 = t30*t74 + t73
+    t78 = t18 + t31*t74
+    t79 = t68*(-t76*t67 + t63*t77 + t64*t78)
+    t80 = t76 + t67*t79
+    t81 = t77 - t63*t79
+    t82 = t78 - t64*t79
+    t83 = xp.sqrt(t81**2 + t82**2)
+    t84 = t83*xp.where(xp.greater_equal(t81, 0), xp.asarray(1, dtype=dtype), -1)
+    t85 = t81 + t84
+    t86 = xp.where(xp.greater(t83, 0), 1/(t83*(t83 + xp.abs(t81))), 0)
+    t87 = t86*(t71*t85 + t82*t72)
+    t88 = t71 - t85*t87
+    t89 = t72 - t82*t87
+    t90 = t43 + t47
+    t91 = xp.sqrt(2*t44 + 2*t45 + 2*t38**2 + 2*t46 + 2*t39**2 + 2*t18**2 + t49 + t59**2 + t73**2 + t90**2)
+    t92 = -t53*(t31*t52 + t26*t39 + t30*t18 + t31*t90)
+    t93 = t31 + t52*t92
+    t94 = t39 + t26*t92
+    t95 = t18 + t30*t92
+    t96 = t31*t92 + t90
+    t97 = t68*(-t94*t67 + t63*t95 + t64*t96)
+    t98 = t94 + t67*t97
+    t99 = t95 - t63*t97
+    t100 = t96 - t64*t97
+    t101 = t86*(t99*t85 + t82*t100)
+    t102 = t99 - t85*t101
+    t103 = t100 - t82*t101
+    t104 = xp.abs(t103)
+    t105 = xp.where(xp.greater_equal(t103, 0), xp.asarray(1, dtype=dtype), -1)*t104
+    t106 = t103 + t105
+    t107 = xp.where(xp.greater(t104, 0), 1/(t104*2*t104), 0)
+    t108 = t89 - t89*t106**2*t107
+    t109 = xp.where(xp.not_equal(t105, 0), -t108/t105, 0)
+    t110 = xp.where(xp.not_equal(t84, 0), -(t88 - t102*t109)/t84, 0)
+    t111 = xp.where(xp.not_equal(t66, 0), -(t70 + t80*t110 + t98*t109)/t66, 0)
+    t112 = xp.where(xp.not_equal(t51, 0), -(t55 + t75*t110 + t93*t109 - t61*t111)/t51, 0)
+    t113 = -t5*t112 + t2*t111
+    t114 = t17*t109
+    t115 = t6*t110 - t27*t112 - t35*t111 + t114
+    t116 = t7*t110 + t114 - t28*t112 - t36*t111
+    t117 = t15*t110 + t114 - t29*t112 - t37*t111
+    t118 = t19 + t32
+    t119 = xp.sqrt(t23 + t33 + t41 + t43 + t118)
+    t120 = xp.sqrt(t118)
+    t121 = t120*xp.where(xp.less_equal(t5, 0), xp.asarray(1, dtype=dtype), -1)
+    t122 = xp.where(xp.greater(t120, 0), 1/(t120*(t120 + xp.abs(t5))), 0)
+    t123 = -t5
+    t124 = t121 + t123
+    t125 = -t122*(t27*t124 + t2*t35)
+    t126 = t27 + t124*t125
+    t127 = t35 + t2*t125
+    t128 = -t122*(t28*t124 + t2*t36)
+    t129 = t28 + t124*t128
+    t130 = t36 + t2*t128
+    t131 = -t122*(t29*t124 + t2*t37)
+    t132 = t29 + t124*t131
+    t133 = t37 + t2*t131
+    t134 = t122*(mu_dot0*t124 + t2*mu_dot1)
+    t135 = mu_dot0 - t124*t134
+    t136 = mu_dot1 - t2*t134
+    t137 = xp.sqrt(t40 + t42 + t127**2)
+    t138 = t137*xp.where(xp.less_equal(t127, 0), xp.asarray(1, dtype=dtype), -1)
+    t139 = -t127 + t138
+    t140 = xp.where(xp.greater(t137, 0), 1/(t137*(t137 + xp.abs(t127))), 0)
+    t141 = t140*(t42 - t130*t139 + t6*t7)
+    t142 = t130 + t139*t141
+    t143 = t7 - t6*t141
+    t144 = t17 - t17*t141
+    t145 = t140*(t42 - t133*t139 + t6*t15)
+    t146 = t133 + t139*t145
+    t147 = t15 - t6*t145
+    t148 = t17 - t17*t145
+    t149 = t140*(t136*t139 + t6*mu_dot2 + t17*mu_dot3)
+    t150 = t136 - t139*t149
+    t151 = mu_dot2 - t6*t149
+    t152 = mu_dot3 - t17*t149
+    t153 = xp.sqrt(t143**2 + t144**2)
+    t154 = t153*xp.where(xp.greater_equal(t143, 0), xp.asarray(1, dtype=dtype), -1)
+    t155 = t143 + t154
+    t156 = xp.where(xp.greater(t153, 0), 1/(t153*(t153 + xp.abs(t143))), 0)
+    t157 = t156*(t147*t155 + t144*t148)
+    t158 = t147 - t155*t157
+    t159 = t148 - t144*t157
+    t160 = t156*(t151*t155 + t144*t152)
+    t161 = t151 - t155*t160
+    t162 = t152 - t144*t160
+    t163 = -t27 - t28 - t29 - t35 - t36 - t37 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + 3*t17 + t123
+    t164 = xp.abs(t159)
+    t165 = xp.where(xp.greater_equal(t159, 0), xp.asarray(1, dtype=dtype), -1)*t164
+    t166 = t159 + t165
+    t167 = xp.where(xp.greater(t164, 0), 1/(t164*2*t164), 0)
+    t168 = t162 - t162*t166**2*t167
+    t169 = xp.where(xp.not_equal(t165, 0), -t168/t165, 0)
+    t170 = xp.where(xp.not_equal(t154, 0), -(t161 - t158*t169)/t154, 0)
+    t171 = xp.where(xp.not_equal(t138, 0), -(t150 + t142*t170 + t146*t169)/t138, 0)
+    t172 = xp.where(xp.not_equal(t121, 0), -(t135 + t126*t171 + t129*t170 + t132*t169)/t121, 0)
+    t173 = xp.isfinite(t163)
+    t174 = xp.greater_equal(damping, 0)
+    t175 = xp.greater(damping, 0)
+    t176 = 1e-12*t91
+    t177 = 1e-12*t119
+    t178 = (t175 & (xp.less_equal(t50, t176) | xp.less_equal(t65, t176) | xp.less_equal(t83, t176) | xp.less_equal(t104, t176))) | (xp.less_equal(damping, 0) & (xp.less_equal(t120, t177) | xp.less_equal(t137, t177) | xp.less_equal(t153, t177) | xp.less_equal(t164, t177)))
+    t179 = t173 & t174 & xp.logical_not(t178)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t183, xp.where(t179, t116, t176), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t183, xp.where(t179, t118, t175), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t183, xp.where(t179, t119, t174), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t183, xp.where(t179, t120, t173), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t179, xp.where(t175, t113, t172), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t179, xp.where(t175, t115, t171), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t179, xp.where(t175, t116, t170), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t179, xp.where(t175, t117, t169), 0), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t177 & t178), 2, xp.where(t182, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t173 & t174), 2, xp.where(t178, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -1351,20 +1344,19 @@ def ik_numeric_step(target, q, damping=0.0):
     t99 = t96 - t83*t98
     t100 = t97 - t80*t98
     t101 = xp.abs(t100)
-    t102 = t101
-    t103 = t102*xp.where(xp.greater_equal(t100, 0), xp.asarray(1, dtype=dtype), -1)
-    t104 = t100 + t103
-    t105 = xp.where(xp.greater(t102, 0), 1/(t102*(t101 + t102)), 0)
-    t106 = t87 - t87*t104**2*t105
-    t107 = xp.where(xp.not_equal(t103, 0), -t106/t103, 0)
-    t108 = xp.where(xp.not_equal(t82, 0), -(t86 - t99*t107)/t82, 0)
-    t109 = xp.where(xp.not_equal(t64, 0), -(t68 + t78*t108 + t95*t107)/t64, 0)
-    t110 = xp.where(xp.not_equal(t49, 0), -(t53 + t73*t108 + t90*t107 - t59*t109)/t49, 0)
-    t111 = q1 - t7*t110 + t3*t109
-    t112 = t24*t107
-    t113 = q2 + t112 + t8*t108 - t34*t110 - t39*t109
-    t114 = q3 + t112 + t9*t108 - t35*t110 - t40*t109
-    t115 = q4 + t112 + t20*t108 - t36*t110 - t41*t109
+    t102 = t101*xp.where(xp.greater_equal(t100, 0), xp.asarray(1, dtype=dtype), -1)
+    t103 = t100 + t102
+    t104 = xp.where(xp.greater(t101, 0), 1/(t101*2*t101), 0)
+    t105 = t87 - t87*t103**2*t104
+    t106 = xp.where(xp.not_equal(t102, 0), -t105/t102, 0)
+    t107 = xp.where(xp.not_equal(t82, 0), -(t86 - t99*t106)/t82, 0)
+    t108 = xp.where(xp.not_equal(t64, 0), -(t68 + t78*t107 + t95*t106)/t64, 0)
+    t109 = xp.where(xp.not_equal(t49, 0), -(t53 + t73*t107 + t90*t106 - t59*t108)/t49, 0)
+    t110 = q1 - t7*t109 + t3*t108
+    t111 = t24*t106
+    t112 = q2 + t111 + t8*t107 - t34*t109 - t39*t108
+    t113 = q3 + t111 + t9*t107 - t35*t109 - t40*t108
+    t114 = q4 + t111 + t20*t107 - t36*t109 - t41*t108
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -1372,10 +1364,10 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q4, batch),  # 3
     ], (4,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t111, -3.141592653589793), -3.141592653589793, xp.where(xp.greater(t111, 3.141592653589793), 3.141592653589793, t111)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t113, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t113, 2.0943951023931953), 2.0943951023931953, t113)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t114, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t114, 2.0943951023931953), 2.0943951023931953, t114)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t115, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t115, 2.0943951023931953), 2.0943951023931953, t115)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t110, -3.141592653589793), -3.141592653589793, xp.where(xp.greater(t110, 3.141592653589793), 3.141592653589793, t110)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t112, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t112, 2.0943951023931953), 2.0943951023931953, t112)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t113, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t113, 2.0943951023931953), 2.0943951023931953, t113)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t114, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t114, 2.0943951023931953), 2.0943951023931953, t114)), batch),  # 3
     ], (4,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t0), t46, -1), batch)
     return q_start, q_next, cost
@@ -1402,337 +1394,328 @@ def ik_branches(mu):
     t10 = xp.atan2(t9, t8)
     t11 = mu0**2
     t12 = t11 + mu1**2
-    t13 = t12
-    t14 = t12 + mu2**2
-    t15 = 1e-24*t14
-    t16 = xp.less_equal(t13, t15)
-    t17 = xp.where(t16, 1, 1/xp.sqrt(t13))
-    t18 = xp.where(t16, 0, 1.5707963267948966 + t2)
-    t19 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t18)) + t18
-    t20 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t19)) + t19
-    t21 = mu0*t17
-    t22 = -t21
-    t23 = xp.where(t16, 1, t22)
-    t24 = mu2*(1 - t23)
-    t25 = t24 + mu2*t23
-    t26 = mu2*(1 + t22)
-    t27 = t26 + t21*mu2
-    t28 = mu1*t17
-    t29 = xp.where(t16, 0, -t28)
-    t30 = mu0*t23 + mu1*t29
-    t31 = mu1*t23 - mu0*t29
-    t32 = t11*t17 + t28*mu1
-    t33 = t21*mu1 - t28*mu0
-    t34 = 0.1*t9
-    t35 = t34 + t30
-    t36 = t34 + t32
-    t37 = -0.1*t8
-    t38 = t37 + t25
-    t39 = -0.12 + t38
-    t40 = t37 + t27
-    t41 = -0.12 + t40
-    t42 = t31**2 + t39**2
-    t43 = t42 + t35**2
-    t44 = 0.5*(0.02 - t43)
-    t45 = 1 - 10000*t44**2
-    t46 = xp.greater(t45, 1e-12)
-    t47 = xp.where(t46, xp.sqrt(t45), 0)
-    t48 = 100*t44
-    t49 = xp.where(t46, t48, xp.where(xp.greater(t48, 0), xp.asarray(1, dtype=dtype), -1))
-    t50 = xp.atan2(t47, t49)
-    t51 = 3.141592653589793 + t50
-    t52 = 3.141592653589793 - t50
-    t53 = 0.22 - 0.1*t49
-    t54 = -0.12 + t53
-    t55 = 0.01*t47**2 + t54**2
-    t56 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t51)) + t51
-    t57 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t56)) + t56
-    t58 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t52)) + t52
-    t59 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t58)) + t58
-    t60 = 0.1*t47
-    t61 = t60*t35
-    t62 = t39*t54
-    t63 = t61 + t62
-    t64 = -t61 + t62
-    t65 = t35*t54
-    t66 = t60*t39
-    t67 = -t66 + t65
-    t68 = t63**2 + t67**2
-    t69 = t65 + t66
-    t70 = t64**2 + t69**2
-    t71 = -t34
-    t72 = t71 + t30
-    t73 = t42 + t72**2
-    t74 = 0.5*(0.02 - t73)
-    t75 = 1 - 10000*t74**2
-    t76 = t71 + t32
-    t77 = xp.greater(t75, 1e-12)
-    t78 = xp.where(t77, xp.sqrt(t75), 0)
-    t79 = 100*t74
-    t80 = xp.where(t77, t79, xp.where(xp.greater(t79, 0), xp.asarray(1, dtype=dtype), -1))
-    t81 = xp.atan2(t78, t80)
-    t82 = 3.141592653589793 + t81
-    t83 = 3.141592653589793 - t81
-    t84 = 0.22 - 0.1*t80
-    t85 = -0.12 + t84
-    t86 = 0.01*t78**2 + t85**2
-    t87 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t82)) + t82
-    t88 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t87)) + t87
-    t89 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t83)) + t83
-    t90 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t89)) + t89
-    t91 = 0.1*t78
-    t92 = t91*t72
-    t93 = t39*t85
-    t94 = t92 + t93
-    t95 = -t92 + t93
-    t96 = t72*t85
-    t97 = t91*t39
-    t98 = -t97 + t96
-    t99 = t94**2 + t98**2
-    t100 = t96 + t97
-    t101 = t95**2 + t100**2
-    t102 = t33**2 + t41**2
-    t103 = t102 + t36**2
-    t104 = 0.5*(0.02 - t103)
-    t105 = 1 - 10000*t104**2
-    t106 = t102 + t76**2
-    t107 = 0.5*(0.02 - t106)
-    t108 = 1 - 10000*t107**2
-    t109 = xp.greater(t105, 1e-12)
-    t110 = xp.where(t109, xp.sqrt(t105), 0)
-    t111 = 100*t104
-    t112 = xp.where(t109, t111, xp.where(xp.greater(t111, 0), xp.asarray(1, dtype=dtype), -1))
-    t113 = xp.atan2(t110, t112)
-    t114 = 3.141592653589793 + t113
-    t115 = 3.141592653589793 - t113
-    t116 = 0.22 - 0.1*t112
-    t117 = -0.12 + t116
-    t118 = 0.01*t110**2 + t117**2
-    t119 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t114)) + t114
-    t120 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t119)) + t119
-    t121 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t115)) + t115
-    t122 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t121)) + t121
-    t123 = 0.1*t110
-    t124 = t123*t36
-    t125 = t41*t117
-    t126 = t124 + t125
-    t127 = -t124 + t125
-    t128 = t36*t117
-    t129 = t123*t41
-    t130 = -t129 + t128
-    t131 = t126**2 + t130**2
-    t132 = t128 + t129
-    t133 = t127**2 + t132**2
-    t134 = xp.greater(t108, 1e-12)
-    t135 = xp.where(t134, xp.sqrt(t108), 0)
-    t136 = 100*t107
-    t137 = xp.where(t134, t136, xp.where(xp.greater(t136, 0), xp.asarray(1, dtype=dtype), -1))
-    t138 = xp.atan2(t135, t137)
-    t139 = 3.141592653589793 + t138
-    t140 = 3.141592653589793 - t138
-    t141 = 0.22 - 0.1*t137
-    t142 = -0.12 + t141
-    t143 = 0.01*t135**2 + t142**2
-    t144 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t139)) + t139
-    t145 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t144)) + t144
-    t146 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t140)) + t140
-    t147 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t146)) + t146
-    t148 = 0.1*t135
-    t149 = t148*t76
-    t150 = t41*t142
-    t151 = t149 + t150
-    t152 = -t149 + t150
-    t153 = t76*t142
-    t154 = t148*t41
-    t155 = -t154 + t153
-    t156 = t151**2 + t155**2
-    t157 = t153 + t154
-    t158 = t152**2 + t157**2
-    t159 = 1e-24*t43*t55
-    t160 = xp.where(xp.less_equal(t68, t159), 0, xp.atan2(-t67, t63))
-    t161 = t160
-    t162 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t161)) + t161
-    t163 = -t10
-    t164 = 3.141592653589793 + t163
-    t165 = t160 + t51
-    t166 = t163 + t165 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t164 + t165))
-    t167 = -t166
-    t168 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t167)) + t166
-    t169 = xp.where(xp.less_equal(t70, t159), 0, xp.atan2(-t69, t64))
-    t170 = t169
-    t171 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t170)) + t170
-    t172 = t52 + t169
-    t173 = t163 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t164 + t172)) + t172
-    t174 = -t173
-    t175 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t174)) + t173
-    t176 = 1e-24*t73*t86
-    t177 = xp.where(xp.less_equal(t99, t176), 0, xp.atan2(-t98, t94))
-    t178 = t177
-    t179 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t178)) + t178
-    t180 = 3.141592653589793 + t10
-    t181 = t82 + t177
-    t182 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t180 + t181)) + t10 + t181
-    t183 = -t182
-    t184 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t183)) + t182
-    t185 = xp.where(xp.less_equal(t101, t176), 0, xp.atan2(-t100, t95))
-    t186 = t185
-    t187 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t186)) + t186
-    t188 = t83 + t185
-    t189 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t180 + t188)) + t10 + t188
-    t190 = -t189
-    t191 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t190)) + t189
-    t192 = 1e-24*t103*t118
-    t193 = xp.where(xp.less_equal(t131, t192), 0, xp.atan2(-t130, t126))
-    t194 = t193
+    t13 = t12 + mu2**2
+    t14 = 1e-24*t13
+    t15 = xp.less_equal(t12, t14)
+    t16 = xp.where(t15, 1, 1/xp.sqrt(t12))
+    t17 = xp.where(t15, 0, 1.5707963267948966 + t2)
+    t18 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t17)) + t17
+    t19 = -6.283185307179586*xp.floor(0.15915494309189535*(3.141592653589793 + t18)) + t18
+    t20 = mu0*t16
+    t21 = -t20
+    t22 = xp.where(t15, 1, t21)
+    t23 = mu2*(1 - t22)
+    t24 = t23 + mu2*t22
+    t25 = mu2*(1 + t21)
+    t26 = t25 + t20*mu2
+    t27 = mu1*t16
+    t28 = xp.where(t15, 0, -t27)
+    t29 = mu0*t22 + mu1*t28
+    t30 = mu1*t22 - mu0*t28
+    t31 = t11*t16 + t27*mu1
+    t32 = t20*mu1 - t27*mu0
+    t33 = 0.1*t9
+    t34 = t33 + t29
+    t35 = t33 + t31
+    t36 = -0.1*t8
+    t37 = t36 + t24
+    t38 = -0.12 + t37
+    t39 = t36 + t26
+    t40 = -0.12 + t39
+    t41 = t30**2 + t38**2
+    t42 = t41 + t34**2
+    t43 = 0.5*(0.02 - t42)
+    t44 = 1 - 10000*t43**2
+    t45 = xp.greater(t44, 1e-12)
+    t46 = xp.where(t45, xp.sqrt(t44), 0)
+    t47 = 100*t43
+    t48 = xp.where(t45, t47, xp.where(xp.greater(t47, 0), xp.asarray(1, dtype=dtype), -1))
+    t49 = xp.atan2(t46, t48)
+    t50 = 3.141592653589793 + t49
+    t51 = 3.141592653589793 - t49
+    t52 = 0.22 - 0.1*t48
+    t53 = -0.12 + t52
+    t54 = 0.01*t46**2 + t53**2
+    t55 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t50)) + t50
+    t56 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t55)) + t55
+    t57 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t51)) + t51
+    t58 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t57)) + t57
+    t59 = 0.1*t46
+    t60 = t59*t34
+    t61 = t38*t53
+    t62 = t60 + t61
+    t63 = -t60 + t61
+    t64 = t34*t53
+    t65 = t59*t38
+    t66 = -t65 + t64
+    t67 = t62**2 + t66**2
+    t68 = t64 + t65
+    t69 = t63**2 + t68**2
+    t70 = -t33
+    t71 = t70 + t29
+    t72 = t41 + t71**2
+    t73 = 0.5*(0.02 - t72)
+    t74 = 1 - 10000*t73**2
+    t75 = t70 + t31
+    t76 = xp.greater(t74, 1e-12)
+    t77 = xp.where(t76, xp.sqrt(t74), 0)
+    t78 = 100*t73
+    t79 = xp.where(t76, t78, xp.where(xp.greater(t78, 0), xp.asarray(1, dtype=dtype), -1))
+    t80 = xp.atan2(t77, t79)
+    t81 = 3.141592653589793 + t80
+    t82 = 3.141592653589793 - t80
+    t83 = 0.22 - 0.1*t79
+    t84 = -0.12 + t83
+    t85 = 0.01*t77**2 + t84**2
+    t86 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t81)) + t81
+    t87 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t86)) + t86
+    t88 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t82)) + t82
+    t89 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t88)) + t88
+    t90 = 0.1*t77
+    t91 = t90*t71
+    t92 = t38*t84
+    t93 = t91 + t92
+    t94 = -t91 + t92
+    t95 = t71*t84
+    t96 = t90*t38
+    t97 = -t96 + t95
+    t98 = t93**2 + t97**2
+    t99 = t95 + t96
+    t100 = t94**2 + t99**2
+    t101 = t32**2 + t40**2
+    t102 = t101 + t35**2
+    t103 = 0.5*(0.02 - t102)
+    t104 = 1 - 10000*t103**2
+    t105 = t101 + t75**2
+    t106 = 0.5*(0.02 - t105)
+    t107 = 1 - 10000*t106**2
+    t108 = xp.greater(t104, 1e-12)
+    t109 = xp.where(t108, xp.sqrt(t104), 0)
+    t110 = 100*t103
+    t111 = xp.where(t108, t110, xp.where(xp.greater(t110, 0), xp.asarray(1, dtype=dtype), -1))
+    t112 = xp.atan2(t109, t111)
+    t113 = 3.141592653589793 + t112
+    t114 = 3.141592653589793 - t112
+    t115 = 0.22 - 0.1*t111
+    t116 = -0.12 + t115
+    t117 = 0.01*t109**2 + t116**2
+    t118 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t113)) + t113
+    t119 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t118)) + t118
+    t120 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t114)) + t114
+    t121 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t120)) + t120
+    t122 = 0.1*t109
+    t123 = t122*t35
+    t124 = t40*t116
+    t125 = t123 + t124
+    t126 = -t123 + t124
+    t127 = t35*t116
+    t128 = t122*t40
+    t129 = -t128 + t127
+    t130 = t125**2 + t129**2
+    t131 = t127 + t128
+    t132 = t126**2 + t131**2
+    t133 = xp.greater(t107, 1e-12)
+    t134 = xp.where(t133, xp.sqrt(t107), 0)
+    t135 = 100*t106
+    t136 = xp.where(t133, t135, xp.where(xp.greater(t135, 0), xp.asarray(1, dtype=dtype), -1))
+    t137 = xp.atan2(t134, t136)
+    t138 = 3.141592653589793 + t137
+    t139 = 3.141592653589793 - t137
+    t140 = 0.22 - 0.1*t136
+    t141 = -0.12 + t140
+    t142 = 0.01*t134**2 + t141**2
+    t143 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t138)) + t138
+    t144 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t143)) + t143
+    t145 = -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t139)) + t139
+    t146 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t145)) + t145
+    t147 = 0.1*t134
+    t148 = t147*t75
+    t149 = t40*t141
+    t150 = t148 + t149
+    t151 = -t148 + t149
+    t152 = t75*t141
+    t153 = t147*t40
+    t154 = -t153 + t152
+    t155 = t150**2 + t154**2
+    t156 = t152 + t153
+    t157 = t151**2 + t156**2
+    t158 = 1e-24*t42*t54
+    t159 = xp.where(xp.less_equal(t67, t158), 0, xp.atan2(-t66, t62))
+    t160 = t159 - 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t159))
+    t161 = -t10
+    t162 = 3.141592653589793 + t161
+    t163 = t159 + t50
+    t164 = t161 + t163 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t162 + t163))
+    t165 = -t164
+    t166 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t165)) + t164
+    t167 = xp.where(xp.less_equal(t69, t158), 0, xp.atan2(-t68, t63))
+    t168 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t167)) + t167
+    t169 = t51 + t167
+    t170 = t161 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t162 + t169)) + t169
+    t171 = -t170
+    t172 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t171)) + t170
+    t173 = 1e-24*t72*t85
+    t174 = xp.where(xp.less_equal(t98, t173), 0, xp.atan2(-t97, t93))
+    t175 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t174)) + t174
+    t176 = 3.141592653589793 + t10
+    t177 = t81 + t174
+    t178 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t176 + t177)) + t10 + t177
+    t179 = -t178
+    t180 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t179)) + t178
+    t181 = xp.where(xp.less_equal(t100, t173), 0, xp.atan2(-t99, t94))
+    t182 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t181)) + t181
+    t183 = t82 + t181
+    t184 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t176 + t183)) + t10 + t183
+    t185 = -t184
+    t186 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t185)) + t184
+    t187 = 1e-24*t102*t117
+    t188 = xp.where(xp.less_equal(t130, t187), 0, xp.atan2(-t129, t125))
+    t189 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t188)) + t188
+    t190 = t113 + t188
+    t191 = t161 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t162 + t190)) + t190
+    t192 = -t191
+    t193 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t192)) + t191
+    t194 = xp.where(xp.less_equal(t132, t187), 0, xp.atan2(-t131, t126))
     t195 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t194)) + t194
-    t196 = t114 + t193
-    t197 = t163 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t164 + t196)) + t196
+    t196 = t114 + t194
+    t197 = t161 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t162 + t196)) + t196
     t198 = -t197
     t199 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t198)) + t197
-    t200 = xp.where(xp.less_equal(t133, t192), 0, xp.atan2(-t132, t127))
-    t201 = t200
+    t200 = 1e-24*t105*t142
+    t201 = xp.where(xp.less_equal(t155, t200), 0, xp.atan2(-t154, t150))
     t202 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t201)) + t201
-    t203 = t115 + t200
-    t204 = t163 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t164 + t203)) + t203
+    t203 = t138 + t201
+    t204 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t176 + t203)) + t10 + t203
     t205 = -t204
     t206 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t205)) + t204
-    t207 = 1e-24*t106*t143
-    t208 = xp.where(xp.less_equal(t156, t207), 0, xp.atan2(-t155, t151))
-    t209 = t208
-    t210 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t209)) + t209
-    t211 = t139 + t208
-    t212 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t180 + t211)) + t10 + t211
-    t213 = -t212
-    t214 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t213)) + t212
-    t215 = xp.where(xp.less_equal(t158, t207), 0, xp.atan2(-t157, t152))
-    t216 = t215
-    t217 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t216)) + t216
-    t218 = t140 + t215
-    t219 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t180 + t218)) + t10 + t218
-    t220 = -t219
-    t221 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t220)) + t219
-    t222 = xp.greater_equal(t19, -3.141592653589793) & xp.less_equal(t19, 3.141592653589793)
-    t223 = xp.less_equal(t20, 3.141592653589793)
-    t224 = xp.where(xp.logical_not(t222) & t223, t20, t19)
-    t225 = xp.greater_equal(t161, -2.0943951023931953) & xp.less_equal(t161, 2.0943951023931953)
-    t226 = xp.less_equal(t162, 2.0943951023931953)
-    t227 = xp.greater_equal(t56, -2.0943951023931953) & xp.less_equal(t56, 2.0943951023931953)
-    t228 = xp.less_equal(t57, 2.0943951023931953)
-    t229 = xp.greater_equal(t167, -2.0943951023931953) & xp.less_equal(t167, 2.0943951023931953)
-    t230 = -t168
-    t231 = xp.less_equal(t230, 2.0943951023931953)
-    t232 = xp.greater_equal(t170, -2.0943951023931953) & xp.less_equal(t170, 2.0943951023931953)
-    t233 = xp.less_equal(t171, 2.0943951023931953)
-    t234 = xp.greater_equal(t58, -2.0943951023931953) & xp.less_equal(t58, 2.0943951023931953)
-    t235 = xp.less_equal(t59, 2.0943951023931953)
-    t236 = xp.greater_equal(t174, -2.0943951023931953) & xp.less_equal(t174, 2.0943951023931953)
-    t237 = -t175
-    t238 = xp.less_equal(t237, 2.0943951023931953)
-    t239 = xp.greater_equal(t178, -2.0943951023931953) & xp.less_equal(t178, 2.0943951023931953)
-    t240 = xp.less_equal(t179, 2.0943951023931953)
-    t241 = xp.greater_equal(t87, -2.0943951023931953) & xp.less_equal(t87, 2.0943951023931953)
-    t242 = xp.less_equal(t88, 2.0943951023931953)
-    t243 = xp.greater_equal(t183, -2.0943951023931953) & xp.less_equal(t183, 2.0943951023931953)
-    t244 = -t184
-    t245 = xp.less_equal(t244, 2.0943951023931953)
-    t246 = xp.greater_equal(t186, -2.0943951023931953) & xp.less_equal(t186, 2.0943951023931953)
-    t247 = xp.less_equal(t187, 2.0943951023931953)
-    t248 = xp.greater_equal(t89, -2.0943951023931953) & xp.less_equal(t89, 2.0943951023931953)
-    t249 = xp.less_equal(t90, 2.0943951023931953)
-    t250 = xp.greater_equal(t190, -2.0943951023931953) & xp.less_equal(t190, 2.0943951023931953)
-    t251 = -t191
-    t252 = xp.less_equal(t251, 2.0943951023931953)
-    t253 = xp.greater_equal(t5, -3.141592653589793) & xp.less_equal(t5, 3.141592653589793)
-    t254 = xp.less_equal(t6, 3.141592653589793)
-    t255 = xp.where(xp.logical_not(t253) & t254, t6, t5)
-    t256 = xp.greater_equal(t194, -2.0943951023931953) & xp.less_equal(t194, 2.0943951023931953)
-    t257 = xp.less_equal(t195, 2.0943951023931953)
-    t258 = xp.greater_equal(t119, -2.0943951023931953) & xp.less_equal(t119, 2.0943951023931953)
-    t259 = xp.less_equal(t120, 2.0943951023931953)
-    t260 = xp.greater_equal(t198, -2.0943951023931953) & xp.less_equal(t198, 2.0943951023931953)
-    t261 = -t199
-    t262 = xp.less_equal(t261, 2.0943951023931953)
-    t263 = xp.greater_equal(t201, -2.0943951023931953) & xp.less_equal(t201, 2.0943951023931953)
-    t264 = xp.less_equal(t202, 2.0943951023931953)
-    t265 = xp.greater_equal(t121, -2.0943951023931953) & xp.less_equal(t121, 2.0943951023931953)
-    t266 = xp.less_equal(t122, 2.0943951023931953)
-    t267 = xp.greater_equal(t205, -2.0943951023931953) & xp.less_equal(t205, 2.0943951023931953)
-    t268 = -t206
-    t269 = xp.less_equal(t268, 2.0943951023931953)
-    t270 = xp.greater_equal(t209, -2.0943951023931953) & xp.less_equal(t209, 2.0943951023931953)
-    t271 = xp.less_equal(t210, 2.0943951023931953)
-    t272 = xp.greater_equal(t144, -2.0943951023931953) & xp.less_equal(t144, 2.0943951023931953)
-    t273 = xp.less_equal(t145, 2.0943951023931953)
-    t274 = xp.greater_equal(t213, -2.0943951023931953) & xp.less_equal(t213, 2.0943951023931953)
-    t275 = -t214
-    t276 = xp.less_equal(t275, 2.0943951023931953)
-    t277 = xp.greater_equal(t216, -2.0943951023931953) & xp.less_equal(t216, 2.0943951023931953)
-    t278 = xp.less_equal(t217, 2.0943951023931953)
-    t279 = xp.greater_equal(t146, -2.0943951023931953) & xp.less_equal(t146, 2.0943951023931953)
-    t280 = xp.less_equal(t147, 2.0943951023931953)
-    t281 = xp.greater_equal(t220, -2.0943951023931953) & xp.less_equal(t220, 2.0943951023931953)
-    t282 = -t221
-    t283 = xp.less_equal(t282, 2.0943951023931953)
-    t284 = xp.isfinite(t4)
-    t285 = xp.less_equal(xp.abs(mu3), 1.5707963267948966)
-    t286 = xp.greater(t13, t15)
-    t287 = (t16 & xp.less_equal(0, 1e-12*t14)) | t286
-    t288 = xp.greater_equal(t1, -1e-12)
-    t289 = t222 | t223
-    t290 = t253 | t254
+    t207 = xp.where(xp.less_equal(t157, t200), 0, xp.atan2(-t156, t151))
+    t208 = -6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t207)) + t207
+    t209 = t139 + t207
+    t210 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t176 + t209)) + t10 + t209
+    t211 = -t210
+    t212 = 6.283185307179586*xp.floor(0.15915494309189535*(2.0943951023931953 + t211)) + t210
+    t213 = xp.greater_equal(t18, -3.141592653589793) & xp.less_equal(t18, 3.141592653589793)
+    t214 = xp.less_equal(t19, 3.141592653589793)
+    t215 = xp.where(xp.logical_not(t213) & t214, t19, t18)
+    t216 = xp.greater_equal(t159, -2.0943951023931953) & xp.less_equal(t159, 2.0943951023931953)
+    t217 = xp.less_equal(t160, 2.0943951023931953)
+    t218 = xp.greater_equal(t55, -2.0943951023931953) & xp.less_equal(t55, 2.0943951023931953)
+    t219 = xp.less_equal(t56, 2.0943951023931953)
+    t220 = xp.greater_equal(t165, -2.0943951023931953) & xp.less_equal(t165, 2.0943951023931953)
+    t221 = -t166
+    t222 = xp.less_equal(t221, 2.0943951023931953)
+    t223 = xp.greater_equal(t167, -2.0943951023931953) & xp.less_equal(t167, 2.0943951023931953)
+    t224 = xp.less_equal(t168, 2.0943951023931953)
+    t225 = xp.greater_equal(t57, -2.0943951023931953) & xp.less_equal(t57, 2.0943951023931953)
+    t226 = xp.less_equal(t58, 2.0943951023931953)
+    t227 = xp.greater_equal(t171, -2.0943951023931953) & xp.less_equal(t171, 2.0943951023931953)
+    t228 = -t172
+    t229 = xp.less_equal(t228, 2.0943951023931953)
+    t230 = xp.greater_equal(t174, -2.0943951023931953) & xp.less_equal(t174, 2.0943951023931953)
+    t231 = xp.less_equal(t175, 2.0943951023931953)
+    t232 = xp.greater_equal(t86, -2.0943951023931953) & xp.less_equal(t86, 2.0943951023931953)
+    t233 = xp.less_equal(t87, 2.0943951023931953)
+    t234 = xp.greater_equal(t179, -2.0943951023931953) & xp.less_equal(t179, 2.0943951023931953)
+    t235 = -t180
+    t236 = xp.less_equal(t235, 2.0943951023931953)
+    t237 = xp.greater_equal(t181, -2.0943951023931953) & xp.less_equal(t181, 2.0943951023931953)
+    t238 = xp.less_equal(t182, 2.0943951023931953)
+    t239 = xp.greater_equal(t88, -2.0943951023931953) & xp.less_equal(t88, 2.0943951023931953)
+    t240 = xp.less_equal(t89, 2.0943951023931953)
+    t241 = xp.greater_equal(t185, -2.0943951023931953) & xp.less_equal(t185, 2.0943951023931953)
+    t242 = -t186
+    t243 = xp.less_equal(t242, 2.0943951023931953)
+    t244 = xp.greater_equal(t5, -3.141592653589793) & xp.less_equal(t5, 3.141592653589793)
+    t245 = xp.less_equal(t6, 3.141592653589793)
+    t246 = xp.where(xp.logical_not(t244) & t245, t6, t5)
+    t247 = xp.greater_equal(t188, -2.0943951023931953) & xp.less_equal(t188, 2.0943951023931953)
+    t248 = xp.less_equal(t189, 2.0943951023931953)
+    t249 = xp.greater_equal(t118, -2.0943951023931953) & xp.less_equal(t118, 2.0943951023931953)
+    t250 = xp.less_equal(t119, 2.0943951023931953)
+    t251 = xp.greater_equal(t192, -2.0943951023931953) & xp.less_equal(t192, 2.0943951023931953)
+    t252 = -t193
+    t253 = xp.less_equal(t252, 2.0943951023931953)
+    t254 = xp.greater_equal(t194, -2.0943951023931953) & xp.less_equal(t194, 2.0943951023931953)
+    t255 = xp.less_equal(t195, 2.0943951023931953)
+    t256 = xp.greater_equal(t120, -2.0943951023931953) & xp.less_equal(t120, 2.0943951023931953)
+    t257 = xp.less_equal(t121, 2.0943951023931953)
+    t258 = xp.greater_equal(t198, -2.0943951023931953) & xp.less_equal(t198, 2.0943951023931953)
+    t259 = -t199
+    t260 = xp.less_equal(t259, 2.0943951023931953)
+    t261 = xp.greater_equal(t201, -2.0943951023931953) & xp.less_equal(t201, 2.0943951023931953)
+    t262 = xp.less_equal(t202, 2.0943951023931953)
+    t263 = xp.greater_equal(t143, -2.0943951023931953) & xp.less_equal(t143, 2.0943951023931953)
+    t264 = xp.less_equal(t144, 2.0943951023931953)
+    t265 = xp.greater_equal(t205, -2.0943951023931953) & xp.less_equal(t205, 2.0943951023931953)
+    t266 = -t206
+    t267 = xp.less_equal(t266, 2.0943951023931953)
+    t268 = xp.greater_equal(t207, -2.0943951023931953) & xp.less_equal(t207, 2.0943951023931953)
+    t269 = xp.less_equal(t208, 2.0943951023931953)
+    t270 = xp.greater_equal(t145, -2.0943951023931953) & xp.less_equal(t145, 2.0943951023931953)
+    t271 = xp.less_equal(t146, 2.0943951023931953)
+    t272 = xp.greater_equal(t211, -2.0943951023931953) & xp.less_equal(t211, 2.0943951023931953)
+    t273 = -t212
+    t274 = xp.less_equal(t273, 2.0943951023931953)
+    t275 = xp.isfinite(t4)
+    t276 = xp.less_equal(xp.abs(mu3), 1.5707963267948966)
+    t277 = xp.greater(t12, t14)
+    t278 = (t15 & xp.less_equal(0, 1e-12*t13)) | t277
+    t279 = xp.greater_equal(t1, -1e-12)
+    t280 = t213 | t214
+    t281 = t244 | t245
     q = _stack(xp, [
-        t224,  # 0, 0
-        xp.where(xp.logical_not(t225) & t226, t162, t161),  # 0, 1
-        xp.where(xp.logical_not(t227) & t228, t57, t56),  # 0, 2
-        xp.where(xp.logical_not(t229) & t231, t230, t167),  # 0, 3
-        t224,  # 1, 0
-        xp.where(xp.logical_not(t232) & t233, t171, t170),  # 1, 1
-        xp.where(xp.logical_not(t234) & t235, t59, t58),  # 1, 2
-        xp.where(xp.logical_not(t236) & t238, t237, t174),  # 1, 3
-        t224,  # 2, 0
-        xp.where(xp.logical_not(t239) & t240, t179, t178),  # 2, 1
-        xp.where(xp.logical_not(t241) & t242, t88, t87),  # 2, 2
-        xp.where(xp.logical_not(t243) & t245, t244, t183),  # 2, 3
-        t224,  # 3, 0
-        xp.where(xp.logical_not(t246) & t247, t187, t186),  # 3, 1
-        xp.where(xp.logical_not(t248) & t249, t90, t89),  # 3, 2
-        xp.where(xp.logical_not(t250) & t252, t251, t190),  # 3, 3
-        t255,  # 4, 0
-        xp.where(xp.logical_not(t256) & t257, t195, t194),  # 4, 1
-        xp.where(xp.logical_not(t258) & t259, t120, t119),  # 4, 2
-        xp.where(xp.logical_not(t260) & t262, t261, t198),  # 4, 3
-        t255,  # 5, 0
-        xp.where(xp.logical_not(t263) & t264, t202, t201),  # 5, 1
-        xp.where(xp.logical_not(t265) & t266, t122, t121),  # 5, 2
-        xp.where(xp.logical_not(t267) & t269, t268, t205),  # 5, 3
-        t255,  # 6, 0
-        xp.where(xp.logical_not(t270) & t271, t210, t209),  # 6, 1
-        xp.where(xp.logical_not(t272) & t273, t145, t144),  # 6, 2
-        xp.where(xp.logical_not(t274) & t276, t275, t213),  # 6, 3
-        t255,  # 7, 0
-        xp.where(xp.logical_not(t277) & t278, t217, t216),  # 7, 1
-        xp.where(xp.logical_not(t279) & t280, t147, t146),  # 7, 2
-        xp.where(xp.logical_not(t281) & t283, t282, t220),  # 7, 3
+        t215,  # 0, 0
+        xp.where(xp.logical_not(t216) & t217, t160, t159),  # 0, 1
+        xp.where(xp.logical_not(t218) & t219, t56, t55),  # 0, 2
+        xp.where(xp.logical_not(t220) & t222, t221, t165),  # 0, 3
+        t215,  # 1, 0
+        xp.where(xp.logical_not(t223) & t224, t168, t167),  # 1, 1
+        xp.where(xp.logical_not(t225) & t226, t58, t57),  # 1, 2
+        xp.where(xp.logical_not(t227) & t229, t228, t171),  # 1, 3
+        t215,  # 2, 0
+        xp.where(xp.logical_not(t230) & t231, t175, t174),  # 2, 1
+        xp.where(xp.logical_not(t232) & t233, t87, t86),  # 2, 2
+        xp.where(xp.logical_not(t234) & t236, t235, t179),  # 2, 3
+        t215,  # 3, 0
+        xp.where(xp.logical_not(t237) & t238, t182, t181),  # 3, 1
+        xp.where(xp.logical_not(t239) & t240, t89, t88),  # 3, 2
+        xp.where(xp.logical_not(t241) & t243, t242, t185),  # 3, 3
+        t246,  # 4, 0
+        xp.where(xp.logical_not(t247) & t248, t189, t188),  # 4, 1
+        xp.where(xp.logical_not(t249) & t250, t119, t118),  # 4, 2
+        xp.where(xp.logical_not(t251) & t253, t252, t192),  # 4, 3
+        t246,  # 5, 0
+        xp.where(xp.logical_not(t254) & t255, t195, t194),  # 5, 1
+        xp.where(xp.logical_not(t256) & t257, t121, t120),  # 5, 2
+        xp.where(xp.logical_not(t258) & t260, t259, t198),  # 5, 3
+        t246,  # 6, 0
+        xp.where(xp.logical_not(t261) & t262, t202, t201),  # 6, 1
+        xp.where(xp.logical_not(t263) & t264, t144, t143),  # 6, 2
+        xp.where(xp.logical_not(t265) & t267, t266, t205),  # 6, 3
+        t246,  # 7, 0
+        xp.where(xp.logical_not(t268) & t269, t208, t207),  # 7, 1
+        xp.where(xp.logical_not(t270) & t271, t146, t145),  # 7, 2
+        xp.where(xp.logical_not(t272) & t274, t273, t211),  # 7, 3
     ], (8, 4))
     valid = _stack(xp, [
-        t284 & t285 & t287 & t288 & xp.greater_equal(t45, -1e-12),  # 0
-        t284 & t285 & t287 & t288 & t46,  # 1
-        t284 & t285 & t287 & t7 & xp.greater_equal(t75, -1e-12),  # 2
-        t284 & t285 & t287 & t7 & t77,  # 3
-        t284 & t285 & t286 & t288 & xp.greater_equal(t105, -1e-12),  # 4
-        t284 & t285 & t286 & t288 & t109,  # 5
-        t284 & t285 & t286 & t7 & xp.greater_equal(t108, -1e-12),  # 6
-        t284 & t285 & t286 & t7 & t134,  # 7
+        t275 & t276 & t278 & t279 & xp.greater_equal(t44, -1e-12),  # 0
+        t275 & t276 & t278 & t279 & t45,  # 1
+        t275 & t276 & t278 & t7 & xp.greater_equal(t74, -1e-12),  # 2
+        t275 & t276 & t278 & t7 & t76,  # 3
+        t275 & t276 & t277 & t279 & xp.greater_equal(t104, -1e-12),  # 4
+        t275 & t276 & t277 & t279 & t108,  # 5
+        t275 & t276 & t277 & t7 & xp.greater_equal(t107, -1e-12),  # 6
+        t275 & t276 & t277 & t7 & t133,  # 7
     ], (8,))
     in_limits = _stack(xp, [
-        t289 & (t225 | t226) & (t227 | t228) & (t229 | t231),  # 0
-        t289 & (t232 | t233) & (t234 | t235) & (t236 | t238),  # 1
-        t289 & (t239 | t240) & (t241 | t242) & (t243 | t245),  # 2
-        t289 & (t246 | t247) & (t248 | t249) & (t250 | t252),  # 3
-        t290 & (t256 | t257) & (t258 | t259) & (t260 | t262),  # 4
-        t290 & (t263 | t264) & (t265 | t266) & (t267 | t269),  # 5
-        t290 & (t270 | t271) & (t272 | t273) & (t274 | t276),  # 6
-        t290 & (t277 | t278) & (t279 | t280) & (t281 | t283),  # 7
+        t280 & (t216 | t217) & (t218 | t219) & (t220 | t222),  # 0
+        t280 & (t223 | t224) & (t225 | t226) & (t227 | t229),  # 1
+        t280 & (t230 | t231) & (t232 | t233) & (t234 | t236),  # 2
+        t280 & (t237 | t238) & (t239 | t240) & (t241 | t243),  # 3
+        t281 & (t247 | t248) & (t249 | t250) & (t251 | t253),  # 4
+        t281 & (t254 | t255) & (t256 | t257) & (t258 | t260),  # 5
+        t281 & (t261 | t262) & (t263 | t264) & (t265 | t267),  # 6
+        t281 & (t268 | t269) & (t270 | t271) & (t272 | t274),  # 7
     ], (8,))
     return q, valid, in_limits
 

@@ -838,75 +838,62 @@ def fk_jacobian_dot(q, q_dot):
     t55 = t54 + t41*qd5
     t56 = s1*t52
     t57 = c2*t36 - s2*t56
-    t58 = t57
-    t59 = t4*t51 + t35*t42
-    t60 = t59
-    t61 = t26*t50 - t41*t34
-    t62 = t61
-    t63 = t44*t33 - t28*t49
-    t64 = t63
-    t65 = t64*qd6 + t62*qd5
-    t66 = t65 - t60*qd4
-    t67 = t66 + t58*qd3
-    t68 = c1*t52
-    t69 = -c2*t21 + s2*t68
-    t70 = t69
-    t71 = -t7*t51 + t20*t42
-    t72 = t71
-    t73 = t41*t19 - t11*t50
-    t74 = t73
-    t75 = t44*t18 - t13*t49
-    t76 = t75
-    t77 = t76*qd6 + t74*qd5
-    t78 = t77 + t72*qd4
-    t79 = t78 + t70*qd3
-    t80 = c1*t22 + s1*t37
-    t81 = t80
-    t82 = t21*t24 - t36*t9
-    t83 = t82
-    t84 = t4*t20 + t7*t35
-    t85 = t84
-    t86 = t11*t34 - t26*t19
-    t87 = t86
-    t88 = t28*t18 - t13*t33
-    t89 = t88
-    t90 = t89*qd6 + t87*qd5
-    t91 = t90 + t85*qd4
-    t92 = t91 + t83*qd3
-    t93 = t92 - t81*qd2
-    t94 = s1*qd2
-    t95 = t94 + t9*qd3
-    t96 = -t95 + t7*qd4
-    t97 = t96 + t11*qd5
-    t98 = t79 + t52*t94
-    t99 = t98 + t23*qd1
-    t100 = c1*qd2
-    t101 = t100 - t24*qd3
-    t102 = t101 - t4*qd4
-    t103 = t102 + t26*qd5
-    t104 = t67 + t52*t100
-    t105 = t104 - t38*qd1
-    t106 = t13*qd6
-    t107 = -t106 + t97
-    t108 = t28*qd6
-    t109 = t103 + t108
-    t110 = t44*qd6
-    t111 = -t110 + t55
-    t112 = -t15
-    t113 = -t30
-    t114 = -t46
+    t58 = t4*t51 + t35*t42
+    t59 = t26*t50 - t41*t34
+    t60 = t44*t33 - t28*t49
+    t61 = t60*qd6 + t59*qd5
+    t62 = t61 - t58*qd4
+    t63 = t62 + t57*qd3
+    t64 = c1*t52
+    t65 = -c2*t21 + s2*t64
+    t66 = -t7*t51 + t20*t42
+    t67 = t41*t19 - t11*t50
+    t68 = t44*t18 - t13*t49
+    t69 = t68*qd6 + t67*qd5
+    t70 = t69 + t66*qd4
+    t71 = t70 + t65*qd3
+    t72 = c1*t22 + s1*t37
+    t73 = t21*t24 - t36*t9
+    t74 = t4*t20 + t7*t35
+    t75 = t11*t34 - t26*t19
+    t76 = t28*t18 - t13*t33
+    t77 = t76*qd6 + t75*qd5
+    t78 = t77 + t74*qd4
+    t79 = t78 + t73*qd3
+    t80 = t79 - t72*qd2
+    t81 = s1*qd2
+    t82 = t81 + t9*qd3
+    t83 = -t82 + t7*qd4
+    t84 = t83 + t11*qd5
+    t85 = t71 + t52*t81
+    t86 = t85 + t23*qd1
+    t87 = c1*qd2
+    t88 = t87 - t24*qd3
+    t89 = t88 - t4*qd4
+    t90 = t89 + t26*qd5
+    t91 = t63 + t52*t87
+    t92 = t91 - t38*qd1
+    t93 = t13*qd6
+    t94 = -t93 + t84
+    t95 = t28*qd6
+    t96 = t90 + t95
+    t97 = t44*qd6
+    t98 = -t97 + t55
+    t99 = -t15
+    t100 = -t30
+    t101 = -t46
     T = _stack(xp, [
         xp.broadcast_to(t16, batch),  # 0, 0
         xp.broadcast_to(t17, batch),  # 0, 1
-        xp.broadcast_to(t112, batch),  # 0, 2
+        xp.broadcast_to(t99, batch),  # 0, 2
         xp.broadcast_to(t23, batch),  # 0, 3
         xp.broadcast_to(t31, batch),  # 1, 0
         xp.broadcast_to(-t32, batch),  # 1, 1
-        xp.broadcast_to(t113, batch),  # 1, 2
+        xp.broadcast_to(t100, batch),  # 1, 2
         xp.broadcast_to(t38, batch),  # 1, 3
         xp.broadcast_to(t47, batch),  # 2, 0
         xp.broadcast_to(t48, batch),  # 2, 1
-        xp.broadcast_to(t114, batch),  # 2, 2
+        xp.broadcast_to(t101, batch),  # 2, 2
         xp.broadcast_to(t53, batch),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1
@@ -915,25 +902,25 @@ def fk_jacobian_dot(q, q_dot):
     ], (4, 4))
     J = _stack(xp, [
         xp.broadcast_to(-t38, batch),  # 0, 0
-        xp.broadcast_to(t68, batch),  # 0, 1
+        xp.broadcast_to(t64, batch),  # 0, 1
         xp.broadcast_to(t57, batch),  # 0, 2
-        xp.broadcast_to(-t59, batch),  # 0, 3
-        xp.broadcast_to(t61, batch),  # 0, 4
-        xp.broadcast_to(t63, batch),  # 0, 5
+        xp.broadcast_to(-t58, batch),  # 0, 3
+        xp.broadcast_to(t59, batch),  # 0, 4
+        xp.broadcast_to(t60, batch),  # 0, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
         xp.broadcast_to(t23, batch),  # 1, 0
         xp.broadcast_to(t56, batch),  # 1, 1
-        xp.broadcast_to(t69, batch),  # 1, 2
-        xp.broadcast_to(t71, batch),  # 1, 3
-        xp.broadcast_to(t73, batch),  # 1, 4
-        xp.broadcast_to(t75, batch),  # 1, 5
+        xp.broadcast_to(t65, batch),  # 1, 2
+        xp.broadcast_to(t66, batch),  # 1, 3
+        xp.broadcast_to(t67, batch),  # 1, 4
+        xp.broadcast_to(t68, batch),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(-t80, batch),  # 2, 1
-        xp.broadcast_to(t82, batch),  # 2, 2
-        xp.broadcast_to(t84, batch),  # 2, 3
-        xp.broadcast_to(t86, batch),  # 2, 4
-        xp.broadcast_to(t88, batch),  # 2, 5
+        xp.broadcast_to(-t72, batch),  # 2, 1
+        xp.broadcast_to(t73, batch),  # 2, 2
+        xp.broadcast_to(t74, batch),  # 2, 3
+        xp.broadcast_to(t75, batch),  # 2, 4
+        xp.broadcast_to(t76, batch),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(-s1, batch),  # 3, 1
@@ -941,29 +928,29 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t7, batch),  # 3, 3
         xp.broadcast_to(t11, batch),  # 3, 4
         xp.broadcast_to(-t13, batch),  # 3, 5
-        xp.broadcast_to(t112, batch),  # 3, 6
+        xp.broadcast_to(t99, batch),  # 3, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
         xp.broadcast_to(c1, batch),  # 4, 1
         xp.broadcast_to(-t24, batch),  # 4, 2
         xp.broadcast_to(-t4, batch),  # 4, 3
         xp.broadcast_to(t26, batch),  # 4, 4
         xp.broadcast_to(t28, batch),  # 4, 5
-        xp.broadcast_to(t113, batch),  # 4, 6
+        xp.broadcast_to(t100, batch),  # 4, 6
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.broadcast_to(-c2, batch),  # 5, 2
         xp.broadcast_to(t42, batch),  # 5, 3
         xp.broadcast_to(t41, batch),  # 5, 4
         xp.broadcast_to(-t44, batch),  # 5, 5
-        xp.broadcast_to(t114, batch),  # 5, 6
+        xp.broadcast_to(t101, batch),  # 5, 6
     ], (6, 7))
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t99 + qd5*(t87*t102 - t74*t54 + t26*t90 - t41*t77) + qd2*(c1*t93 - t56*qd1) + qd3*(-t70*qd1 + c2*t79 + t83*t100 - t24*t92) - qd4*(t72*t0 + t4*t91 - t85*t101 + t42*t78) + qd6*(t89*t103 - t76*t55 + t89*t108 + t76*t110), batch),  # 0
-        xp.broadcast_to(qd1*t105 + qd5*(t62*t54 - t87*t96 + t41*t65 - t11*t90) + qd2*(s1*t93 + t68*qd1) + qd3*(t58*qd1 - c2*t67 + t83*t94 + t9*t92) + qd4*(-t60*t0 + t85*t95 - t7*t91 + t42*t66) + qd6*(t64*t55 - t89*t97 - t64*t110 + t89*t106), batch),  # 1
-        xp.broadcast_to(qd4*(-t72*t95 + t60*t101 + t7*t78 + t4*t66) + qd5*(t74*t96 - t62*t102 + t11*t77 - t26*t65) - qd2*(s1*t98 + c1*t104) - qd3*(t70*t94 + t58*t100 + t9*t79 - t24*t67) - qd6*(t64*t103 - t76*t97 + t76*t106 + t64*t108), batch),  # 2
-        xp.broadcast_to(qd5*(t41*t102 - t26*t54) + qd7*(-t46*t109 + t30*t111) - qd1*t100 + qd3*(-c2*t100 + t24*qd1) + qd4*(t4*t0 + t42*t101) - qd6*(t44*t103 + t28*t55), batch),  # 3
-        xp.broadcast_to(qd5*(t11*t54 - t41*t96) + qd6*(-t13*t55 + t44*t97) + qd7*(-t15*t111 + t46*t107) - qd1*t94 - qd3*(t9*qd1 + c2*t94) + qd4*(t7*t0 + t42*t95), batch),  # 4
-        xp.broadcast_to(qd4*(t4*t95 - t7*t101) + qd5*(t26*t96 - t11*t102) + qd6*(t28*t97 + t13*t103) + qd7*(-t30*t107 + t15*t109) + qd3*(t24*t94 + t9*t100), batch),  # 5
+        xp.broadcast_to(-qd1*t86 + qd2*(c1*t80 - t56*qd1) + qd5*(t26*t77 - t41*t69 + t75*t89 - t67*t54) + qd3*(c2*t71 - t24*t79 - t65*qd1 + t73*t87) - qd4*(t4*t78 + t42*t70 + t66*t0 - t74*t88) + qd6*(t76*t90 - t68*t55 + t76*t95 + t68*t97), batch),  # 0
+        xp.broadcast_to(qd1*t92 + qd2*(s1*t80 + t64*qd1) + qd5*(t41*t61 - t11*t77 + t59*t54 - t75*t83) + qd3*(-c2*t63 + t9*t79 + t57*qd1 + t73*t81) + qd4*(-t7*t78 + t42*t62 - t58*t0 + t74*t82) + qd6*(t60*t55 - t76*t84 - t60*t97 + t76*t93), batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t85 + c1*t91) + qd4*(t7*t70 + t4*t62 - t66*t82 + t58*t88) + qd5*(t11*t69 - t26*t61 + t67*t83 - t59*t89) - qd3*(t9*t71 - t24*t63 + t65*t81 + t57*t87) - qd6*(t60*t90 - t68*t84 + t68*t93 + t60*t95), batch),  # 2
+        xp.broadcast_to(qd5*(t41*t89 - t26*t54) + qd7*(-t46*t96 + t30*t98) - qd1*t87 + qd3*(-c2*t87 + t24*qd1) + qd4*(t4*t0 + t42*t88) - qd6*(t44*t90 + t28*t55), batch),  # 3
+        xp.broadcast_to(qd5*(t11*t54 - t41*t83) + qd6*(-t13*t55 + t44*t84) + qd7*(-t15*t98 + t46*t94) - qd1*t81 - qd3*(t9*qd1 + c2*t81) + qd4*(t7*t0 + t42*t82), batch),  # 4
+        xp.broadcast_to(qd4*(t4*t82 - t7*t88) + qd5*(t26*t83 - t11*t89) + qd6*(t28*t84 + t13*t90) + qd7*(-t30*t94 + t15*t96) + qd3*(t24*t81 + t9*t87), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -2563,39 +2550,38 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t230 = t227 - t200*t229
     t231 = t228 - t197*t229
     t232 = xp.abs(t231)
-    t233 = t232
-    t234 = t233*xp.where(xp.greater_equal(t231, 0), xp.asarray(1, dtype=dtype), -1)
-    t235 = t231 + t234
-    t236 = xp.where(xp.greater(t233, 0), 1/(t233*(t232 + t233)), 0)
-    t237 = t204 - t204*t235**2*t236
-    t238 = xp.where(xp.not_equal(t234, 0), -t237/t234, 0)
-    t239 = xp.where(xp.not_equal(t199, 0), -(t203 - t230*t238)/t199, 0)
-    t240 = xp.where(xp.not_equal(t168, 0), -(-(t195*t239 + t226*t238) + t172)/t168, 0)
-    t241 = xp.where(xp.not_equal(t140, 0), -(-(t163*t240 - t190*t239 + t221*t238) + t144)/t140, 0)
-    t242 = xp.where(xp.not_equal(t116, 0), -(-(t134*t241 - t157*t240 + t184*t239 + t215*t238) + t120)/t116, 0)
-    t243 = xp.where(xp.not_equal(t97, 0), -(-(t109*t242 + t127*t241 - t150*t240 + t177*t239 - t208*t238) + t101)/t97, 0)
-    t244 = t238 - t31*t243 + t19*t242
-    t245 = -t32*t241 - s1*t240 + c1*t239 + t61*t243 + t58*t242
-    t246 = t59*t243 + t62*t242 + t33*t241 - c2*t238 - t8*t240 - t20*t239
-    t247 = -t49*t243 + t52*t242 + t34*t241 + t6*t240 - t3*t239 + t41*t238
-    t248 = t50*t243 + t53*t242 + t35*t241 + t10*t240 + t22*t239 + t40*t238
-    t249 = t51*t243 + t54*t242 + t36*t241 - t12*t240 + t24*t239 - t43*t238
-    t250 = t13*t240 + t25*t239 + t44*t238
-    t251 = xp.isfinite(t64)
-    t252 = xp.greater_equal(damping, 0)
-    t253 = 1e-12*t206
-    t254 = xp.less_equal(t96, t253) | xp.less_equal(t115, t253) | xp.less_equal(t139, t253) | xp.less_equal(t167, t253) | xp.less_equal(t198, t253) | xp.less_equal(t233, t253)
-    t255 = t251 & t252 & xp.logical_not(t254)
+    t233 = t232*xp.where(xp.greater_equal(t231, 0), xp.asarray(1, dtype=dtype), -1)
+    t234 = t231 + t233
+    t235 = xp.where(xp.greater(t232, 0), 1/(t232*2*t232), 0)
+    t236 = t204 - t204*t234**2*t235
+    t237 = xp.where(xp.not_equal(t233, 0), -t236/t233, 0)
+    t238 = xp.where(xp.not_equal(t199, 0), -(t203 - t230*t237)/t199, 0)
+    t239 = xp.where(xp.not_equal(t168, 0), -(-(t195*t238 + t226*t237) + t172)/t168, 0)
+    t240 = xp.where(xp.not_equal(t140, 0), -(-(t163*t239 - t190*t238 + t221*t237) + t144)/t140, 0)
+    t241 = xp.where(xp.not_equal(t116, 0), -(-(t134*t240 - t157*t239 + t184*t238 + t215*t237) + t120)/t116, 0)
+    t242 = xp.where(xp.not_equal(t97, 0), -(-(t109*t241 + t127*t240 - t150*t239 + t177*t238 - t208*t237) + t101)/t97, 0)
+    t243 = t237 - t31*t242 + t19*t241
+    t244 = -t32*t240 - s1*t239 + c1*t238 + t61*t242 + t58*t241
+    t245 = t59*t242 + t62*t241 + t33*t240 - c2*t237 - t8*t239 - t20*t238
+    t246 = -t49*t242 + t52*t241 + t34*t240 + t6*t239 - t3*t238 + t41*t237
+    t247 = t50*t242 + t53*t241 + t35*t240 + t10*t239 + t22*t238 + t40*t237
+    t248 = t51*t242 + t54*t241 + t36*t240 - t12*t239 + t24*t238 - t43*t237
+    t249 = t13*t239 + t25*t238 + t44*t237
+    t250 = xp.isfinite(t64)
+    t251 = xp.greater_equal(damping, 0)
+    t252 = 1e-12*t206
+    t253 = xp.less_equal(t96, t252) | xp.less_equal(t115, t252) | xp.less_equal(t139, t252) | xp.less_equal(t167, t252) | xp.less_equal(t198, t252) | xp.less_equal(t232, t252)
+    t254 = t250 & t251 & xp.logical_not(t253)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t255, t244, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t255, t245, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t255, t246, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t255, t247, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t255, t248, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t255, t249, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t255, -t250, 0), batch),  # 6
+        xp.broadcast_to(xp.where(t254, t243, 0), batch),  # 0
+        xp.broadcast_to(xp.where(t254, t244, 0), batch),  # 1
+        xp.broadcast_to(xp.where(t254, t245, 0), batch),  # 2
+        xp.broadcast_to(xp.where(t254, t246, 0), batch),  # 3
+        xp.broadcast_to(xp.where(t254, t247, 0), batch),  # 4
+        xp.broadcast_to(xp.where(t254, t248, 0), batch),  # 5
+        xp.broadcast_to(xp.where(t254, -t249, 0), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t251 & t252), 2, xp.where(t254, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t250 & t251), 2, xp.where(t253, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -2909,25 +2895,24 @@ def ik_numeric_step(target, q, damping=0.0):
     t263 = t260 - t234*t262
     t264 = t261 - t231*t262
     t265 = xp.abs(t264)
-    t266 = t265
-    t267 = t266*xp.where(xp.greater_equal(t264, 0), xp.asarray(1, dtype=dtype), -1)
-    t268 = t264 + t267
-    t269 = xp.where(xp.greater(t266, 0), 1/(t266*(t265 + t266)), 0)
-    t270 = t238 - t238*t268**2*t269
-    t271 = xp.where(xp.not_equal(t267, 0), -t270/t267, 0)
-    t272 = xp.where(xp.not_equal(t233, 0), -(t237 - t263*t271)/t233, 0)
-    t273 = xp.where(xp.not_equal(t202, 0), -(-(t229*t272 + t259*t271) + t206)/t202, 0)
-    t274 = xp.where(xp.not_equal(t174, 0), -(-(t197*t273 - t224*t272 + t254*t271) + t178)/t174, 0)
-    t275 = xp.where(xp.not_equal(t150, 0), -(-(t168*t274 - t191*t273 + t218*t272 + t248*t271) + t154)/t150, 0)
-    t276 = xp.where(xp.not_equal(t131, 0), -(-(t143*t275 + t161*t274 - t184*t273 + t211*t272 - t241*t271) + t135)/t131, 0)
-    t277 = q1 + t271 - t42*t276 + t23*t275
-    t278 = q2 + c1*t67*t276 + s1*t67*t275 - t43*t274 - s1*t273 + c1*t272
-    t279 = q3 + t69*t276 + t73*t275 + t44*t274 - c2*t271 - t9*t273 - t28*t272
-    t280 = q4 - t70*t276 + t74*t275 + t45*t274 + t7*t273 - t4*t272 + t57*t271
-    t281 = q5 + t71*t276 + t75*t275 + t46*t274 + t11*t273 + t30*t272 + t56*t271
-    t282 = q6 + t72*t276 + t76*t275 + t47*t274 - t13*t273 + t32*t272 - t59*t271
-    t283 = -q7 + t15*t273 + t34*t272 + t61*t271
-    t284 = -t283
+    t266 = t265*xp.where(xp.greater_equal(t264, 0), xp.asarray(1, dtype=dtype), -1)
+    t267 = t264 + t266
+    t268 = xp.where(xp.greater(t265, 0), 1/(t265*2*t265), 0)
+    t269 = t238 - t238*t267**2*t268
+    t270 = xp.where(xp.not_equal(t266, 0), -t269/t266, 0)
+    t271 = xp.where(xp.not_equal(t233, 0), -(t237 - t263*t270)/t233, 0)
+    t272 = xp.where(xp.not_equal(t202, 0), -(-(t229*t271 + t259*t270) + t206)/t202, 0)
+    t273 = xp.where(xp.not_equal(t174, 0), -(-(t197*t272 - t224*t271 + t254*t270) + t178)/t174, 0)
+    t274 = xp.where(xp.not_equal(t150, 0), -(-(t168*t273 - t191*t272 + t218*t271 + t248*t270) + t154)/t150, 0)
+    t275 = xp.where(xp.not_equal(t131, 0), -(-(t143*t274 + t161*t273 - t184*t272 + t211*t271 - t241*t270) + t135)/t131, 0)
+    t276 = q1 + t270 - t42*t275 + t23*t274
+    t277 = q2 + c1*t67*t275 + s1*t67*t274 - t43*t273 - s1*t272 + c1*t271
+    t278 = q3 + t69*t275 + t73*t274 + t44*t273 - c2*t270 - t9*t272 - t28*t271
+    t279 = q4 - t70*t275 + t74*t274 + t45*t273 + t7*t272 - t4*t271 + t57*t270
+    t280 = q5 + t71*t275 + t75*t274 + t46*t273 + t11*t272 + t30*t271 + t56*t270
+    t281 = q6 + t72*t275 + t76*t274 + t47*t273 - t13*t272 + t32*t271 - t59*t270
+    t282 = -q7 + t15*t272 + t34*t271 + t61*t270
+    t283 = -t282
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -2938,13 +2923,13 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q7, batch),  # 6
     ], (7,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t277, -3.0543261909900767), -3.0543261909900767, xp.where(xp.greater(t277, 3.0543261909900767), 3.0543261909900767, t277)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t278, -3.822271061867582), -3.822271061867582, xp.where(xp.greater(t278, 2.2863813201125716), 2.2863813201125716, t278)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t279, -3.0543261909900767), -3.0543261909900767, xp.where(xp.greater(t279, 3.0543261909900767), 3.0543261909900767, t279)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t280, -3.0543261909900767), -3.0543261909900767, xp.where(xp.greater(t280, 3.0543261909900767), 3.0543261909900767, t280)), batch),  # 3
-        xp.broadcast_to(xp.where(xp.less(t281, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t281, 2.9670597283903604), 2.9670597283903604, t281)), batch),  # 4
-        xp.broadcast_to(xp.where(xp.less(t282, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t282, 2.9670597283903604), 2.9670597283903604, t282)), batch),  # 5
-        xp.broadcast_to(xp.where(xp.less(t284, -4.71238898038469), -4.71238898038469, xp.where(xp.greater(t284, 4.71238898038469), 4.71238898038469, t284)), batch),  # 6
+        xp.broadcast_to(xp.where(xp.less(t276, -3.0543261909900767), -3.0543261909900767, xp.where(xp.greater(t276, 3.0543261909900767), 3.0543261909900767, t276)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t277, -3.822271061867582), -3.822271061867582, xp.where(xp.greater(t277, 2.2863813201125716), 2.2863813201125716, t277)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t278, -3.0543261909900767), -3.0543261909900767, xp.where(xp.greater(t278, 3.0543261909900767), 3.0543261909900767, t278)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t279, -3.0543261909900767), -3.0543261909900767, xp.where(xp.greater(t279, 3.0543261909900767), 3.0543261909900767, t279)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t280, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t280, 2.9670597283903604), 2.9670597283903604, t280)), batch),  # 4
+        xp.broadcast_to(xp.where(xp.less(t281, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t281, 2.9670597283903604), 2.9670597283903604, t281)), batch),  # 5
+        xp.broadcast_to(xp.where(xp.less(t283, -4.71238898038469), -4.71238898038469, xp.where(xp.greater(t283, 4.71238898038469), 4.71238898038469, t283)), batch),  # 6
     ], (7,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t0), t128, -1), batch)
     return q_start, q_next, cost

@@ -727,116 +727,109 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t5 = t3 + t2
     t6 = t3**2
     t7 = t6 + 0.075625*s12**2
-    t8 = t7
-    t9 = t1**2
-    t10 = xp.sqrt(1 + t6 + t9)
-    t11 = t10*xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)
-    t12 = xp.where(xp.greater(t10, 0), 1/(t10*(t10 + xp.abs(t3))), 0)
-    t13 = -1 + t12
-    t14 = 0.075625*c12**2 + t9
-    t15 = t14
-    t16 = xp.sqrt(4 + t7 + t14)
-    t17 = t1 + t0
-    t18 = t17
-    t19 = t4**2
-    t20 = t5**2
-    t21 = damping**2
-    t22 = t8 + t21
-    t23 = t22**2
-    t24 = xp.sqrt(t19 + t20 + t23)
-    t25 = t24*xp.where(xp.greater_equal(t22, 0), xp.asarray(1, dtype=dtype), -1)
-    t26 = t25 + t22
-    t27 = xp.where(xp.greater(t24, 0), 1/(t24*(t24 + xp.abs(t22))), 0)
-    t28 = -t27*(-mu_dot0*t26 + mu_dot1*t4 + mu_dot3*t5)
-    t29 = mu_dot0 - t26*t28
-    t30 = mu_dot1 + t4*t28
-    t31 = mu_dot3 + t5*t28
-    t32 = t15 + t21
-    t33 = -t27*(t4*t26 + t5*t18 + t4*t32)
-    t34 = t4 + t26*t33
-    t35 = t4*t33 + t32
-    t36 = t18 + t5*t33
-    t37 = xp.sqrt(t35**2 + t36**2)
-    t38 = t37*xp.where(xp.greater_equal(t35, 0), xp.asarray(1, dtype=dtype), -1)
-    t39 = t35 + t38
-    t40 = xp.where(xp.greater(t37, 0), 1/(t37*(t37 + xp.abs(t35))), 0)
-    t41 = t40*(t30*t39 + t36*t31)
-    t42 = t30 - t39*t41
-    t43 = t31 - t36*t41
-    t44 = 1 + t21
-    t45 = t44
-    t46 = 3 + t21
-    t47 = xp.sqrt(2*t19 + 2*t20 + 2*t18**2 + t23 + t32**2 + t44**2 + t46**2)
-    t48 = -t27*(t5*t26 + t4*t18 + t5*t46)
-    t49 = t5 + t26*t48
-    t50 = t18 + t4*t48
-    t51 = t5*t48 + t46
-    t52 = t40*(t50*t39 + t36*t51)
-    t53 = t50 - t39*t52
-    t54 = t51 - t36*t52
-    t55 = xp.abs(t45)
-    t56 = t55
-    t57 = t56*xp.where(xp.greater_equal(t45, 0), xp.asarray(1, dtype=dtype), -1)
-    t58 = t45 + t57
-    t59 = xp.where(xp.greater(t56, 0), 1/(t56*(t56 + t55)), 0)
-    t60 = mu_dot2 - mu_dot2*t58**2*t59
-    t61 = xp.where(xp.not_equal(t57, 0), -t60/t57, 0)
-    t62 = xp.abs(t54)
-    t63 = t62
-    t64 = t63*xp.where(xp.greater_equal(t54, 0), xp.asarray(1, dtype=dtype), -1)
-    t65 = t54 + t64
-    t66 = xp.where(xp.greater(t63, 0), 1/(t63*(t63 + t62)), 0)
-    t67 = t43 - t43*t65**2*t66
-    t68 = xp.where(xp.not_equal(t64, 0), -t67/t64, 0)
-    t69 = xp.where(xp.not_equal(t38, 0), -(t42 - t53*t68)/t38, 0)
-    t70 = xp.where(xp.not_equal(t25, 0), -(t29 + t34*t69 + t49*t68)/t25, 0)
-    t71 = t68 - t3*t70 + t1*t69
-    t72 = t68 - t2*t70 + t0*t69
-    t73 = -t3
-    t74 = t11 + t73
-    t75 = t12*(1 - t2*t74 + t1*t0)
-    t76 = t2 + t74*t75
-    t77 = t0 - t1*t75
-    t78 = 1 - t75
-    t79 = t12*(mu_dot3 + mu_dot0*t74 + t1*mu_dot1)
-    t80 = mu_dot0 - t74*t79
-    t81 = mu_dot1 - t1*t79
-    t82 = -t79 + mu_dot3
-    t83 = xp.sqrt(t77**2 + t78**2)
-    t84 = t83*xp.where(xp.greater_equal(t77, 0), xp.asarray(1, dtype=dtype), -1)
-    t85 = t77 + t84
-    t86 = xp.where(xp.greater(t83, 0), 1/(t83*(t83 + xp.abs(t77))), 0)
-    t87 = t86*(t81*t85 + t78*t82)
-    t88 = t81 - t85*t87
-    t89 = t82 - t78*t87
-    t90 = -t2 + q1 + q2 + q3 + q4 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + t17 + t73
-    t91 = t1*t12
-    t92 = t86*(t78*t13 + t85*t91)
-    t93 = -t85*t92 + t91
-    t94 = t13 - t78*t92
-    t95 = xp.abs(t94)
-    t96 = t95
-    t97 = t96*xp.where(xp.greater_equal(t94, 0), xp.asarray(1, dtype=dtype), -1)
-    t98 = t94 + t97
-    t99 = xp.where(xp.greater(t96, 0), 1/(t96*(t96 + t95)), 0)
-    t100 = t89 - t89*t98**2*t99
-    t101 = xp.where(xp.not_equal(t97, 0), -t100/t97, 0)
-    t102 = xp.where(xp.not_equal(t84, 0), -(t88 - t93*t101)/t84, 0)
-    t103 = xp.where(xp.not_equal(t11, 0), -(-(-t76*t102 + t74*t12*t101) + t80)/t11, 0)
-    t104 = xp.isfinite(t90)
-    t105 = xp.greater_equal(damping, 0)
-    t106 = xp.greater(damping, 0)
-    t107 = 1e-12*t47
-    t108 = 1e-12*t16
-    t109 = (t106 & (xp.less_equal(t24, t107) | xp.less_equal(t37, t107) | xp.less_equal(t56, t107) | xp.less_equal(t63, t107))) | (xp.less_equal(damping, 0) & (xp.less_equal(t10, t108) | xp.less_equal(t83, t108) | xp.less_equal(1, t108) | xp.less_equal(t96, t108)))
-    t110 = t104 & t105 & xp.logical_not(t109)
+    t8 = t1**2
+    t9 = xp.sqrt(1 + t6 + t8)
+    t10 = t9*xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)
+    t11 = xp.where(xp.greater(t9, 0), 1/(t9*(t9 + xp.abs(t3))), 0)
+    t12 = -1 + t11
+    t13 = 0.075625*c12**2 + t8
+    t14 = xp.sqrt(4 + t7 + t13)
+    t15 = t1 + t0
+    t16 = t4**2
+    t17 = t5**2
+    t18 = damping**2
+    t19 = t7 + t18
+    t20 = t19**2
+    t21 = xp.sqrt(t16 + t17 + t20)
+    t22 = t21*xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)
+    t23 = t22 + t19
+    t24 = xp.where(xp.greater(t21, 0), 1/(t21*(t21 + xp.abs(t19))), 0)
+    t25 = -t24*(-mu_dot0*t23 + mu_dot1*t4 + mu_dot3*t5)
+    t26 = mu_dot0 - t23*t25
+    t27 = mu_dot1 + t4*t25
+    t28 = mu_dot3 + t5*t25
+    t29 = t13 + t18
+    t30 = -t24*(t4*t23 + t4*t29 + t5*t15)
+    t31 = t4 + t23*t30
+    t32 = t4*t30 + t29
+    t33 = t5*t30 + t15
+    t34 = xp.sqrt(t32**2 + t33**2)
+    t35 = t34*xp.where(xp.greater_equal(t32, 0), xp.asarray(1, dtype=dtype), -1)
+    t36 = t32 + t35
+    t37 = xp.where(xp.greater(t34, 0), 1/(t34*(t34 + xp.abs(t32))), 0)
+    t38 = t37*(t27*t36 + t33*t28)
+    t39 = t27 - t36*t38
+    t40 = t28 - t33*t38
+    t41 = 1 + t18
+    t42 = 3 + t18
+    t43 = xp.sqrt(2*t16 + 2*t17 + 2*t15**2 + t20 + t29**2 + t41**2 + t42**2)
+    t44 = -t24*(t5*t23 + t5*t42 + t4*t15)
+    t45 = t5 + t23*t44
+    t46 = t4*t44 + t15
+    t47 = t5*t44 + t42
+    t48 = t37*(t46*t36 + t33*t47)
+    t49 = t46 - t36*t48
+    t50 = t47 - t33*t48
+    t51 = xp.abs(t41)
+    t52 = t51*xp.where(xp.greater_equal(t41, 0), xp.asarray(1, dtype=dtype), -1)
+    t53 = t52 + t41
+    t54 = xp.where(xp.greater(t51, 0), 1/(t51*2*t51), 0)
+    t55 = mu_dot2 - mu_dot2*t53**2*t54
+    t56 = xp.where(xp.not_equal(t52, 0), -t55/t52, 0)
+    t57 = xp.abs(t50)
+    t58 = xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)*t57
+    t59 = t50 + t58
+    t60 = xp.where(xp.greater(t57, 0), 1/(t57*2*t57), 0)
+    t61 = t40 - t40*t59**2*t60
+    t62 = xp.where(xp.not_equal(t58, 0), -t61/t58, 0)
+    t63 = xp.where(xp.not_equal(t35, 0), -(t39 - t49*t62)/t35, 0)
+    t64 = xp.where(xp.not_equal(t22, 0), -(t26 + t31*t63 + t45*t62)/t22, 0)
+    t65 = t62 - t3*t64 + t1*t63
+    t66 = t62 - t2*t64 + t0*t63
+    t67 = -t3
+    t68 = t10 + t67
+    t69 = t11*(1 - t2*t68 + t1*t0)
+    t70 = t2 + t68*t69
+    t71 = t0 - t1*t69
+    t72 = 1 - t69
+    t73 = t11*(mu_dot3 + mu_dot0*t68 + t1*mu_dot1)
+    t74 = mu_dot0 - t68*t73
+    t75 = mu_dot1 - t1*t73
+    t76 = -t73 + mu_dot3
+    t77 = xp.sqrt(t71**2 + t72**2)
+    t78 = t77*xp.where(xp.greater_equal(t71, 0), xp.asarray(1, dtype=dtype), -1)
+    t79 = t71 + t78
+    t80 = xp.where(xp.greater(t77, 0), 1/(t77*(t77 + xp.abs(t71))), 0)
+    t81 = t80*(t75*t79 + t72*t76)
+    t82 = t75 - t79*t81
+    t83 = t76 - t72*t81
+    t84 = -t2 + q1 + q2 + q3 + q4 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + t15 + t67
+    t85 = t1*t11
+    t86 = t80*(t72*t12 + t79*t85)
+    t87 = -t79*t86 + t85
+    t88 = t12 - t72*t86
+    t89 = xp.abs(t88)
+    t90 = xp.where(xp.greater_equal(t88, 0), xp.asarray(1, dtype=dtype), -1)*t89
+    t91 = t88 + t90
+    t92 = xp.where(xp.greater(t89, 0), 1/(t89*2*t89), 0)
+    t93 = t83 - t83*t91**2*t92
+    t94 = xp.where(xp.not_equal(t90, 0), -t93/t90, 0)
+    t95 = xp.where(xp.not_equal(t78, 0), -(t82 - t87*t94)/t78, 0)
+    t96 = xp.where(xp.not_equal(t10, 0), -(-(-t70*t95 + t68*t11*t94) + t74)/t10, 0)
+    t97 = xp.isfinite(t84)
+    t98 = xp.greater_equal(damping, 0)
+    t99 = xp.greater(damping, 0)
+    t100 = 1e-12*t43
+    t101 = 1e-12*t14
+    t102 = (t99 & (xp.less_equal(t21, t100) | xp.less_equal(t34, t100) | xp.less_equal(t51, t100) | xp.less_equal(t57, t100))) | (xp.less_equal(damping, 0) & (xp.less_equal(t9, t101) | xp.less_equal(t77, t101) | xp.less_equal(1, t101) | xp.less_equal(t89, t101)))
+    t103 = t97 & t98 & xp.logical_not(t102)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t110, xp.where(t106, t71, t103), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t110, xp.where(t106, t72, t102), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t110, xp.where(t106, -t61, -mu_dot2), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t110, xp.where(t106, -t68, t101), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t103, xp.where(t99, t65, t96), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t103, xp.where(t99, t66, t95), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t103, xp.where(t99, -t56, -mu_dot2), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t103, xp.where(t99, -t62, t94), 0), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t104 & t105), 2, xp.where(t109, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t97 & t98), 2, xp.where(t102, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -914,25 +907,23 @@ def ik_numeric_step(target, q, damping=0.0):
     t47 = t44 - t36*t46
     t48 = t45 - t33*t46
     t49 = xp.abs(t4)
-    t50 = t49
-    t51 = t50*xp.where(xp.greater_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)
-    t52 = t4 + t51
-    t53 = xp.where(xp.greater(t50, 0), 1/(t50*(t49 + t50)), 0)
-    t54 = t3 - t3*t52**2*t53
-    t55 = xp.where(xp.not_equal(t51, 0), -t54/t51, 0)
-    t56 = -t55 + q3
-    t57 = xp.abs(t48)
-    t58 = t57
-    t59 = t58*xp.where(xp.greater_equal(t48, 0), xp.asarray(1, dtype=dtype), -1)
-    t60 = t48 + t59
-    t61 = xp.where(xp.greater(t58, 0), 1/(t58*(t57 + t58)), 0)
-    t62 = t40 - t40*t60**2*t61
-    t63 = xp.where(xp.not_equal(t59, 0), -t62/t59, 0)
-    t64 = xp.where(xp.not_equal(t35, 0), -(t39 - t47*t63)/t35, 0)
-    t65 = xp.where(xp.not_equal(t22, 0), -(t26 + t31*t64 + t43*t63)/t22, 0)
-    t66 = q1 + t63 - t12*t65 + t7*t64
-    t67 = q2 + t63 - t11*t65 + t6*t64
-    t68 = -t63 + q4
+    t50 = t49*xp.where(xp.greater_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)
+    t51 = t4 + t50
+    t52 = xp.where(xp.greater(t49, 0), 1/(t49*2*t49), 0)
+    t53 = t3 - t3*t51**2*t52
+    t54 = xp.where(xp.not_equal(t50, 0), -t53/t50, 0)
+    t55 = -t54 + q3
+    t56 = xp.abs(t48)
+    t57 = t56*xp.where(xp.greater_equal(t48, 0), xp.asarray(1, dtype=dtype), -1)
+    t58 = t48 + t57
+    t59 = xp.where(xp.greater(t56, 0), 1/(t56*2*t56), 0)
+    t60 = t40 - t40*t58**2*t59
+    t61 = xp.where(xp.not_equal(t57, 0), -t60/t57, 0)
+    t62 = xp.where(xp.not_equal(t35, 0), -(t39 - t47*t61)/t35, 0)
+    t63 = xp.where(xp.not_equal(t22, 0), -(t26 + t31*t62 + t43*t61)/t22, 0)
+    t64 = q1 + t61 - t12*t63 + t7*t62
+    t65 = q2 + t61 - t11*t63 + t6*t62
+    t66 = -t61 + q4
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -940,10 +931,10 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q4, batch),  # 3
     ], (4,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t66, -0.8726646259971648), -0.8726646259971648, xp.where(xp.greater(t66, 0.8726646259971648), 0.8726646259971648, t66)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t67, -1.53588974175501), -1.53588974175501, xp.where(xp.greater(t67, 1.53588974175501), 1.53588974175501, t67)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t56, 0.0), 0.0, xp.where(xp.greater(t56, 0.21), 0.21, t56)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t68, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t68, 6.283185307179586), 6.283185307179586, t68)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t64, -0.8726646259971648), -0.8726646259971648, xp.where(xp.greater(t64, 0.8726646259971648), 0.8726646259971648, t64)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t65, -1.53588974175501), -1.53588974175501, xp.where(xp.greater(t65, 1.53588974175501), 1.53588974175501, t65)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t55, 0.0), 0.0, xp.where(xp.greater(t55, 0.21), 0.21, t55)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t66, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t66, 6.283185307179586), 6.283185307179586, t66)), batch),  # 3
     ], (4,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t5), t19, -1), batch)
     return q_start, q_next, cost
@@ -989,56 +980,54 @@ def ik_branches(mu):
     t29 = t23**2 + t28**2
     t30 = 1e-24*t0*t12
     t31 = xp.where(xp.less_equal(t27, t30), 0, xp.atan2(t26, t21))
-    t32 = t31
-    t33 = -6.283185307179586*xp.floor(0.15915494309189535*(0.8726646259971648 + t32)) + t32
-    t34 = -mu3
-    t35 = -(t31 + t34 + t9)
-    t36 = t35 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t35))
-    t37 = -t36
-    t38 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t37)) + t36
-    t39 = xp.where(xp.less_equal(t29, t30), 0, xp.atan2(t28, t23))
-    t40 = t39
-    t41 = -6.283185307179586*xp.floor(0.15915494309189535*(0.8726646259971648 + t40)) + t40
-    t42 = -(t34 + t39 + t10)
-    t43 = t42 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t42))
-    t44 = -t43
-    t45 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t44)) + t43
-    t46 = xp.greater_equal(t32, -0.8726646259971648) & xp.less_equal(t32, 0.8726646259971648)
-    t47 = xp.less_equal(t33, 0.8726646259971648)
-    t48 = xp.greater_equal(t13, -1.53588974175501) & xp.less_equal(t13, 1.53588974175501)
-    t49 = xp.less_equal(t14, 1.53588974175501)
-    t50 = -0.387 + mu2
-    t51 = -t50
-    t52 = xp.greater_equal(t37, -6.283185307179586) & xp.less_equal(t37, 6.283185307179586)
-    t53 = -t38
-    t54 = xp.less_equal(t53, 6.283185307179586)
-    t55 = xp.greater_equal(t40, -0.8726646259971648) & xp.less_equal(t40, 0.8726646259971648)
-    t56 = xp.less_equal(t41, 0.8726646259971648)
-    t57 = xp.greater_equal(t15, -1.53588974175501) & xp.less_equal(t15, 1.53588974175501)
-    t58 = xp.less_equal(t16, 1.53588974175501)
-    t59 = xp.greater_equal(t44, -6.283185307179586) & xp.less_equal(t44, 6.283185307179586)
-    t60 = -t45
-    t61 = xp.less_equal(t60, 6.283185307179586)
-    t62 = xp.isfinite(t3)
-    t63 = xp.less_equal(t50, 0.0)
-    t64 = xp.less_equal(t51, 0.21)
+    t32 = t31 - 6.283185307179586*xp.floor(0.15915494309189535*(0.8726646259971648 + t31))
+    t33 = -mu3
+    t34 = -(t31 + t33 + t9)
+    t35 = t34 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t34))
+    t36 = -t35
+    t37 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t36)) + t35
+    t38 = xp.where(xp.less_equal(t29, t30), 0, xp.atan2(t28, t23))
+    t39 = t38 - 6.283185307179586*xp.floor(0.15915494309189535*(0.8726646259971648 + t38))
+    t40 = -(t33 + t38 + t10)
+    t41 = t40 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t40))
+    t42 = -t41
+    t43 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t42)) + t41
+    t44 = xp.greater_equal(t31, -0.8726646259971648) & xp.less_equal(t31, 0.8726646259971648)
+    t45 = xp.less_equal(t32, 0.8726646259971648)
+    t46 = xp.greater_equal(t13, -1.53588974175501) & xp.less_equal(t13, 1.53588974175501)
+    t47 = xp.less_equal(t14, 1.53588974175501)
+    t48 = -0.387 + mu2
+    t49 = -t48
+    t50 = xp.greater_equal(t36, -6.283185307179586) & xp.less_equal(t36, 6.283185307179586)
+    t51 = -t37
+    t52 = xp.less_equal(t51, 6.283185307179586)
+    t53 = xp.greater_equal(t38, -0.8726646259971648) & xp.less_equal(t38, 0.8726646259971648)
+    t54 = xp.less_equal(t39, 0.8726646259971648)
+    t55 = xp.greater_equal(t15, -1.53588974175501) & xp.less_equal(t15, 1.53588974175501)
+    t56 = xp.less_equal(t16, 1.53588974175501)
+    t57 = xp.greater_equal(t42, -6.283185307179586) & xp.less_equal(t42, 6.283185307179586)
+    t58 = -t43
+    t59 = xp.less_equal(t58, 6.283185307179586)
+    t60 = xp.isfinite(t3)
+    t61 = xp.less_equal(t48, 0.0)
+    t62 = xp.less_equal(t49, 0.21)
     q = _stack(xp, [
-        xp.where(xp.logical_not(t46) & t47, t33, t32),  # 0, 0
-        xp.where(xp.logical_not(t48) & t49, t14, t13),  # 0, 1
-        t51,  # 0, 2
-        xp.where(xp.logical_not(t52) & t54, t53, t37),  # 0, 3
-        xp.where(xp.logical_not(t55) & t56, t41, t40),  # 1, 0
-        xp.where(xp.logical_not(t57) & t58, t16, t15),  # 1, 1
-        t51,  # 1, 2
-        xp.where(xp.logical_not(t59) & t61, t60, t44),  # 1, 3
+        xp.where(xp.logical_not(t44) & t45, t32, t31),  # 0, 0
+        xp.where(xp.logical_not(t46) & t47, t14, t13),  # 0, 1
+        t49,  # 0, 2
+        xp.where(xp.logical_not(t50) & t52, t51, t36),  # 0, 3
+        xp.where(xp.logical_not(t53) & t54, t39, t38),  # 1, 0
+        xp.where(xp.logical_not(t55) & t56, t16, t15),  # 1, 1
+        t49,  # 1, 2
+        xp.where(xp.logical_not(t57) & t59, t58, t42),  # 1, 3
     ], (2, 4))
     valid = _stack(xp, [
-        t62 & xp.greater_equal(t2, -1e-12),  # 0
-        t62 & t4,  # 1
+        t60 & xp.greater_equal(t2, -1e-12),  # 0
+        t60 & t4,  # 1
     ], (2,))
     in_limits = _stack(xp, [
-        (t46 | t47) & (t48 | t49) & t63 & t64 & (t52 | t54),  # 0
-        (t55 | t56) & (t57 | t58) & t63 & t64 & (t59 | t61),  # 1
+        (t44 | t45) & (t46 | t47) & t61 & t62 & (t50 | t52),  # 0
+        (t53 | t54) & (t55 | t56) & t61 & t62 & (t57 | t59),  # 1
     ], (2,))
     return q, valid, in_limits
 

@@ -587,24 +587,23 @@ def fk_jacobian_dot(q, q_dot):
     t28 = t24*s6 - c6*t26
     t29 = t0 - t26*qd5
     t30 = c1*t2 + s1*t4
-    t31 = t30
-    t32 = c2*qd3 - t31*qd2
-    t33 = s1*qd2
-    t34 = -t33 + t1*qd4
-    t35 = t34 + t15*qd5
-    t36 = t3*qd3 + t5*t33
-    t37 = t36 + t2*qd1
-    t38 = c1*qd2
-    t39 = t38 + t3*qd4
-    t40 = t39 + t10*qd5
-    t41 = t1*qd3 + t5*t38
-    t42 = t41 - t4*qd1
-    t43 = -t25
-    t44 = c1*t5
-    t45 = s1*t5
-    t46 = c2*t38 - t3*qd1
-    t47 = t1*qd1 + c2*t33
-    t48 = -(t3*t33 + t1*t38)
+    t31 = c2*qd3 - t30*qd2
+    t32 = s1*qd2
+    t33 = -t32 + t1*qd4
+    t34 = t33 + t15*qd5
+    t35 = t3*qd3 + t5*t32
+    t36 = t35 + t2*qd1
+    t37 = c1*qd2
+    t38 = t37 + t3*qd4
+    t39 = t38 + t10*qd5
+    t40 = t1*qd3 + t5*t37
+    t41 = t40 - t4*qd1
+    t42 = -t25
+    t43 = c1*t5
+    t44 = s1*t5
+    t45 = c2*t37 - t3*qd1
+    t46 = t1*qd1 + c2*t32
+    t47 = -(t3*t32 + t1*t37)
     T = _stack(xp, [
         xp.broadcast_to(t19, batch),  # 0, 0
         xp.broadcast_to(t20, batch),  # 0, 1
@@ -616,7 +615,7 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t4, batch),  # 1, 3
         xp.broadcast_to(-t27, batch),  # 2, 0
         xp.broadcast_to(t28, batch),  # 2, 1
-        xp.broadcast_to(t43, batch),  # 2, 2
+        xp.broadcast_to(t42, batch),  # 2, 2
         xp.broadcast_to(t6, batch),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1
@@ -625,13 +624,13 @@ def fk_jacobian_dot(q, q_dot):
     ], (4, 4))
     J = _stack(xp, [
         xp.broadcast_to(-t4, batch),  # 0, 0
-        xp.broadcast_to(t44, batch),  # 0, 1
+        xp.broadcast_to(t43, batch),  # 0, 1
         xp.broadcast_to(t1, batch),  # 0, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t2, batch),  # 1, 0
-        xp.broadcast_to(t45, batch),  # 1, 1
+        xp.broadcast_to(t44, batch),  # 1, 1
         xp.broadcast_to(t3, batch),  # 1, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
@@ -659,15 +658,15 @@ def fk_jacobian_dot(q, q_dot):
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
         xp.broadcast_to(c2, batch),  # 5, 3
         xp.broadcast_to(-t26, batch),  # 5, 4
-        xp.broadcast_to(t43, batch),  # 5, 5
+        xp.broadcast_to(t42, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t37 + qd2*(c1*t32 - t45*qd1) + t46*qd3, batch),  # 0
-        xp.broadcast_to(qd1*t42 + qd2*(s1*t32 + t44*qd1) + qd3*t47, batch),  # 1
-        xp.broadcast_to(-qd2*(s1*t36 + c1*t41) + qd3*t48, batch),  # 2
-        xp.broadcast_to(-t38*qd1 + t46*qd4 - qd5*(t10*t0 + t26*t39) - qd6*(t25*t40 + t18*t29), batch),  # 3
-        xp.broadcast_to(qd6*(t12*t29 + t25*t35) - t33*qd1 + qd4*t47 + qd5*(t15*t0 + t26*t34), batch),  # 4
-        xp.broadcast_to(qd5*(t10*t34 - t15*t39) + qd6*(t18*t35 - t12*t40) + qd4*t48, batch),  # 5
+        xp.broadcast_to(-qd1*t36 + qd2*(c1*t31 - t44*qd1) + t45*qd3, batch),  # 0
+        xp.broadcast_to(qd1*t41 + qd2*(s1*t31 + t43*qd1) + qd3*t46, batch),  # 1
+        xp.broadcast_to(-qd2*(s1*t35 + c1*t40) + qd3*t47, batch),  # 2
+        xp.broadcast_to(-t37*qd1 + t45*qd4 - qd5*(t10*t0 + t26*t38) - qd6*(t25*t39 + t18*t29), batch),  # 3
+        xp.broadcast_to(qd6*(t12*t29 + t25*t34) - t32*qd1 + qd4*t46 + qd5*(t15*t0 + t26*t33), batch),  # 4
+        xp.broadcast_to(qd5*(t10*t33 - t15*t38) + qd6*(t18*t34 - t12*t39) + qd4*t47, batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -1379,322 +1378,319 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t44 = c2*t3
     t45 = t44 - t31*t43
     t46 = t31*t35
-    t47 = t46
-    t48 = t5**2
-    t49 = t20 + t48
-    t50 = t13**2 + t10**2 + t35
-    t51 = t18 + t50
-    t52 = s2*c4
-    t53 = -t33 + t10*t0 + t13*t52
-    t54 = -t44 + t15*t0 + t9*t52
-    t55 = t9**2 + t15**2 + t16
-    t56 = t36 + t55
-    t57 = 1 + t0**2 + c4**2*t17
-    t58 = t20 + t57
-    t59 = xp.sqrt(t23 + 2*t20 + 2*t18 + 2*t36 + t41 + t48 + t50 + t55 + t57)
-    t60 = t28**2
-    t61 = t34**2
-    t62 = t32**2
-    t63 = damping**2
-    t64 = t63 + t24
-    t65 = t64**2
-    t66 = t63 + t42
-    t67 = t63 + t49
-    t68 = t63 + t51
-    t69 = t63 + t56
-    t70 = t63 + t58
-    t71 = 2*t48
-    t72 = t22*t35
-    t73 = xp.sqrt(2*t37 + 2*t19 + 2*t60 + 2*t61 + 2*t45**2 + 2*t47**2 + 2*t62 + 2*t29**2 + 2*t53**2 + 2*t54**2 + t65 + t66**2 + t67**2 + t68**2 + t69**2 + t70**2 + 4*t72 + t35*t71 + t16*t71)
-    t74 = xp.sqrt(t19 + t60 + t61 + t62 + t65 + t72)
-    t75 = t74*xp.where(xp.greater_equal(t64, 0), xp.asarray(1, dtype=dtype), -1)
-    t76 = t64 + t75
-    t77 = xp.where(xp.greater(t74, 0), 1/(t74*(t74 + xp.abs(t64))), 0)
-    t78 = t77*(t34*t76 + t28*t45 + t67*t34 - t30*t46 - t30*t32)
-    t79 = t34 - t76*t78
-    t80 = t45 - t28*t78
-    t81 = t67 - t34*t78
-    t82 = t30 + t32*t78
-    t83 = t26*t31
-    t84 = t77*(t25 + t28*t76 + t34*t45 + t66*t28 + t83*t47 + t83*t32)
-    t85 = t28 - t76*t84
-    t86 = t66 - t28*t84
-    t87 = t45 - t34*t84
-    t88 = -t47 + t83*t84
-    t89 = t83 - t32*t84
-    t90 = t2 + t4*t84
-    t91 = t43 + t83*t78
-    t92 = t77*(-t28*t47 + t32*t29 + t4*t53 - t83*t76 + t43*t34 - t68*t83)
-    t93 = t83 + t76*t92
-    t94 = t47 + t28*t92
-    t95 = t43 - t34*t92
-    t96 = t68 + t83*t92
-    t97 = t29 - t32*t92
-    t98 = t77*(t32*t76 + t4*t54 + t83*t28 - t30*t34 - t83*t29 + t69*t32)
-    t99 = t32 - t76*t98
-    t100 = t83 - t28*t98
-    t101 = t30 + t34*t98
-    t102 = t29 + t83*t98
-    t103 = t69 - t32*t98
-    t104 = -t54 + t4*t98
-    t105 = -t77*(t4*t76 + t32*t54 - t83*t53 + t4*t70 - t2*t28)
-    t106 = t4 + t76*t105
-    t107 = t2 - t28*t105
-    t108 = t54 + t32*t105
-    t109 = t70 + t4*t105
-    t110 = t77*(mu_dot0*t76 + mu_dot1*t28 + mu_dot2*t34 + mu_dot4*t32 - t4*mu_dot5 - t83*mu_dot3)
-    t111 = mu_dot0 - t76*t110
-    t112 = mu_dot1 - t28*t110
-    t113 = mu_dot2 - t34*t110
-    t114 = mu_dot3 + t83*t110
-    t115 = mu_dot4 - t32*t110
-    t116 = mu_dot5 + t4*t110
-    t117 = xp.sqrt(t86**2 + t87**2 + t88**2 + t89**2 + t90**2)
-    t118 = t117*xp.where(xp.greater_equal(t86, 0), xp.asarray(1, dtype=dtype), -1)
-    t119 = t86 + t118
-    t120 = xp.where(xp.greater(t117, 0), 1/(t117*(t117 + xp.abs(t86))), 0)
-    t121 = t120*(t100*t119 - t87*t101 + t88*t102 + t89*t103 + t90*t104)
-    t122 = t100 - t119*t121
-    t123 = t101 + t87*t121
-    t124 = t102 - t88*t121
-    t125 = t103 - t89*t121
-    t126 = t104 - t90*t121
-    t127 = t120*(t112*t119 + t87*t113 + t88*t114 + t89*t115 + t90*t116)
-    t128 = t112 - t119*t127
-    t129 = t113 - t87*t127
-    t130 = t114 - t88*t127
-    t131 = t115 - t89*t127
-    t132 = t116 - t90*t127
-    t133 = -t53
-    t134 = t133 + t4*t92
-    t135 = t133 + t83*t105
-    t136 = t120*(-t94*t119 + t87*t95 + t88*t96 + t89*t97 + t90*t134)
-    t137 = t94 + t119*t136
-    t138 = t95 - t87*t136
-    t139 = t96 - t88*t136
-    t140 = t97 - t89*t136
-    t141 = t134 - t90*t136
-    t142 = t4*t78
-    t143 = t120*(t80*t119 + t87*t81 + t88*t91 - t89*t82 + t142*t90)
-    t144 = t80 - t119*t143
-    t145 = t81 - t87*t143
-    t146 = t91 - t88*t143
-    t147 = t82 + t89*t143
-    t148 = t142 - t90*t143
-    t149 = xp.sqrt(t145**2 + t146**2 + t147**2 + t148**2)
-    t150 = t149*xp.where(xp.greater_equal(t145, 0), xp.asarray(1, dtype=dtype), -1)
-    t151 = t145 + t150
-    t152 = xp.where(xp.greater(t149, 0), 1/(t149*(t149 + xp.abs(t145))), 0)
-    t153 = t152*(t138*t151 + t146*t139 - t147*t140 + t148*t141)
-    t154 = t138 - t151*t153
-    t155 = t139 - t146*t153
-    t156 = t140 + t147*t153
-    t157 = t141 - t148*t153
-    t158 = t152*(-t123*t151 + t146*t124 - t147*t125 + t148*t126)
-    t159 = t123 + t151*t158
-    t160 = t124 - t146*t158
-    t161 = t125 + t147*t158
-    t162 = t126 - t148*t158
-    t163 = t152*(t129*t151 + t146*t130 - t147*t131 + t148*t132)
-    t164 = t129 - t151*t163
-    t165 = t130 - t146*t163
-    t166 = t131 + t147*t163
-    t167 = t132 - t148*t163
-    t168 = xp.sqrt(t155**2 + t156**2 + t157**2)
-    t169 = t168*xp.where(xp.greater_equal(t155, 0), xp.asarray(1, dtype=dtype), -1)
-    t170 = t155 + t169
-    t171 = xp.where(xp.greater(t168, 0), 1/(t168*(t168 + xp.abs(t155))), 0)
-    t172 = t171*(t160*t170 + t156*t161 + t157*t162)
-    t173 = t160 - t170*t172
-    t174 = t161 - t156*t172
-    t175 = t162 - t157*t172
-    t176 = t171*(t165*t170 + t156*t166 + t157*t167)
-    t177 = t165 - t170*t176
-    t178 = t166 - t156*t176
-    t179 = t167 - t157*t176
-    t180 = xp.sqrt(t174**2 + t175**2)
-    t181 = t180*xp.where(xp.greater_equal(t174, 0), xp.asarray(1, dtype=dtype), -1)
-    t182 = t174 + t181
-    t183 = xp.where(xp.greater(t180, 0), 1/(t180*(t180 + xp.abs(t174))), 0)
-    t184 = t183*(t178*t182 + t175*t179)
-    t185 = t178 - t182*t184
-    t186 = t179 - t175*t184
-    t187 = t34*t105
-    t188 = t120*(t107*t119 + t88*t135 - t89*t108 + t90*t109 - t187*t87)
-    t189 = t107 - t119*t188
-    t190 = t187 + t87*t188
-    t191 = t135 - t88*t188
-    t192 = t108 + t89*t188
-    t193 = t109 - t90*t188
-    t194 = t152*(-t190*t151 + t146*t191 + t147*t192 + t148*t193)
-    t195 = t190 + t151*t194
-    t196 = t191 - t146*t194
-    t197 = -t192 + t147*t194
-    t198 = t193 - t148*t194
-    t199 = t171*(t196*t170 + t156*t197 + t157*t198)
-    t200 = t196 - t170*t199
-    t201 = t197 - t156*t199
-    t202 = t198 - t157*t199
-    t203 = t183*(t201*t182 + t175*t202)
-    t204 = t201 - t182*t203
-    t205 = t202 - t175*t203
-    t206 = xp.abs(t205)
-    t207 = t206
-    t208 = t207*xp.where(xp.greater_equal(t205, 0), xp.asarray(1, dtype=dtype), -1)
-    t209 = t205 + t208
-    t210 = xp.where(xp.greater(t207, 0), 1/(t207*(t206 + t207)), 0)
-    t211 = t186 - t186*t209**2*t210
-    t212 = xp.where(xp.not_equal(t208, 0), -t211/t208, 0)
-    t213 = xp.where(xp.not_equal(t181, 0), -(t185 - t204*t212)/t181, 0)
-    t214 = xp.where(xp.not_equal(t169, 0), -(-(t173*t213 + t200*t212) + t177)/t169, 0)
-    t215 = xp.where(xp.not_equal(t150, 0), -(t164 + t159*t213 + t195*t212 - t154*t214)/t150, 0)
-    t216 = xp.where(xp.not_equal(t118, 0), -(-(t144*t215 - t137*t214 + t122*t213 + t189*t212) + t128)/t118, 0)
-    t217 = xp.where(xp.not_equal(t75, 0), -(-(t85*t216 + t79*t215 - t93*t214 + t99*t213 - t106*t212) + t111)/t75, 0)
-    t218 = t212 - t4*t217 + t2*t216
-    t219 = c2*t215 + t1*t217 + t3*t216
-    t220 = c2*t212 + t1*t214 + t3*t213
-    t221 = t13*t214 + t9*t213 - t52*t212
-    t222 = t10*t214 + t15*t213 - t0*t212
-    t223 = c1*t31
-    t224 = s1*t31
-    t225 = -t5*t215 - s1*t214 + c1*t213 + t217*t223 + t216*t224
-    t226 = -t4
-    t227 = t39 + t226
-    t228 = t40*(t227*t223 + t2*t224)
-    t229 = -t227*t228 + t223
-    t230 = -t2*t228 + t224
-    t231 = t40*(t1*t227 + t2*t3)
-    t232 = t1 - t227*t231
-    t233 = t3 - t2*t231
-    t234 = t40*(mu_dot5 + mu_dot0*t227 + t2*mu_dot1)
-    t235 = mu_dot0 - t227*t234
-    t236 = mu_dot1 - t2*t234
-    t237 = -t234 + mu_dot5
-    t238 = xp.sqrt(t16 + t35 + t48 + t228**2 + t230**2)
-    t239 = t238*xp.where(xp.greater_equal(t230, 0), xp.asarray(1, dtype=dtype), -1)
-    t240 = t230 + t239
-    t241 = xp.where(xp.greater(t238, 0), 1/(t238*(t238 + xp.abs(t230))), 0)
-    t242 = t241*(t233*t240 - c2*t5 + t228*t231)
-    t243 = t233 - t240*t242
-    t244 = c2 + t5*t242
-    t245 = -t231 + t228*t242
-    t246 = -t241*(-t236*t240 + t5*mu_dot2 + s1*mu_dot3 - c1*mu_dot4 + t228*t237)
-    t247 = t236 - t240*t246
-    t248 = mu_dot2 + t5*t246
-    t249 = mu_dot3 + s1*t246
-    t250 = mu_dot4 - c1*t246
-    t251 = t237 + t228*t246
-    t252 = c2*t40
-    t253 = -t252 + c2
-    t254 = -t52
-    t255 = t52*t40
-    t256 = t254 + t255
-    t257 = -t0
-    t258 = 1 - t5 - s1 + q1 + q2 + c1 + q3 + t2 + q4 + t13 + t9 + q5 + t10 + t15 + q6 + 2*c2 + 2*t1 + 2*t3 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + t223 + t224 + t226 + t254 + t257
-    t259 = t0*t40
-    t260 = t257 + t259
-    t261 = t2*t252
-    t262 = -t241*(t228*t253 + t240*t261)
-    t263 = t240*t262 + t261
-    t264 = t1 + s1*t262
-    t265 = t3 - c1*t262
-    t266 = t253 + t228*t262
-    t267 = t2*t255
-    t268 = t241*(-s1*t13 + c1*t9 - t228*t256 + t240*t267)
-    t269 = -t240*t268 + t267
-    t270 = t13 + s1*t268
-    t271 = t9 - c1*t268
-    t272 = t256 + t228*t268
-    t273 = t2*t259
-    t274 = t241*(c1*t15 - s1*t10 - t228*t260 + t240*t273)
-    t275 = -t240*t274 + t273
-    t276 = t10 + s1*t274
-    t277 = t15 - c1*t274
-    t278 = t260 + t228*t274
-    t279 = t242**2
-    t280 = xp.sqrt(t244**2 + t245**2 + t35*t279 + t16*t279)
-    t281 = t280*xp.where(xp.greater_equal(t244, 0), xp.asarray(1, dtype=dtype), -1)
-    t282 = t244 + t281
-    t283 = xp.where(xp.greater(t280, 0), 1/(t280*(t280 + xp.abs(t244))), 0)
-    t284 = t5*t262
-    t285 = s1*t242
-    t286 = c1*t242
-    t287 = t283*(t245*t266 + t282*t284 + t264*t285 - t265*t286)
-    t288 = -t282*t287 + t284
-    t289 = t264 - t287*t285
-    t290 = t265 + t287*t286
-    t291 = t266 - t245*t287
-    t292 = t283*(t248*t282 + t245*t251 + t249*t285 - t250*t286)
-    t293 = t248 - t282*t292
-    t294 = t249 - t292*t285
-    t295 = t250 + t292*t286
-    t296 = t251 - t245*t292
-    t297 = xp.sqrt(t289**2 + t290**2 + t291**2)
-    t298 = t297*xp.where(xp.greater_equal(t289, 0), xp.asarray(1, dtype=dtype), -1)
-    t299 = t289 + t298
-    t300 = xp.where(xp.greater(t297, 0), 1/(t297*(t297 + xp.abs(t289))), 0)
-    t301 = t300*(t294*t299 + t290*t295 + t291*t296)
-    t302 = t294 - t299*t301
-    t303 = t295 - t290*t301
-    t304 = t296 - t291*t301
-    t305 = t5*t268
-    t306 = t283*(t245*t272 + t282*t305 + t270*t285 - t271*t286)
-    t307 = -t282*t306 + t305
-    t308 = t270 - t306*t285
-    t309 = t271 + t306*t286
-    t310 = t272 - t245*t306
-    t311 = t300*(t308*t299 + t290*t309 + t291*t310)
-    t312 = t308 - t299*t311
-    t313 = t309 - t290*t311
-    t314 = t310 - t291*t311
-    t315 = xp.sqrt(t313**2 + t314**2)
-    t316 = t315*xp.where(xp.greater_equal(t313, 0), xp.asarray(1, dtype=dtype), -1)
-    t317 = t313 + t316
-    t318 = xp.where(xp.greater(t315, 0), 1/(t315*(t315 + xp.abs(t313))), 0)
-    t319 = t318*(t303*t317 + t314*t304)
-    t320 = t303 - t317*t319
-    t321 = t304 - t314*t319
-    t322 = t5*t274
-    t323 = t283*(t245*t278 + t282*t322 + t276*t285 - t277*t286)
-    t324 = -t282*t323 + t322
-    t325 = t276 - t323*t285
-    t326 = t277 + t323*t286
-    t327 = t278 - t245*t323
-    t328 = t300*(t325*t299 + t290*t326 + t291*t327)
-    t329 = t325 - t299*t328
-    t330 = t326 - t290*t328
-    t331 = t327 - t291*t328
-    t332 = t318*(t330*t317 + t314*t331)
-    t333 = t330 - t317*t332
-    t334 = t331 - t314*t332
-    t335 = xp.abs(t334)
-    t336 = t335
-    t337 = t336*xp.where(xp.greater_equal(t334, 0), xp.asarray(1, dtype=dtype), -1)
-    t338 = t334 + t337
-    t339 = xp.where(xp.greater(t336, 0), 1/(t336*(t336 + t335)), 0)
-    t340 = t321 - t321*t338**2*t339
-    t341 = xp.where(xp.not_equal(t337, 0), -t340/t337, 0)
-    t342 = xp.where(xp.not_equal(t316, 0), -(t320 - t333*t341)/t316, 0)
-    t343 = xp.where(xp.not_equal(t298, 0), -(-(t312*t342 + t329*t341) + t302)/t298, 0)
-    t344 = xp.where(xp.not_equal(t281, 0), -(-(t288*t343 + t307*t342 + t324*t341) + t293)/t281, 0)
-    t345 = xp.where(xp.not_equal(t239, 0), -(-(t243*t344 - t263*t343 + t269*t342 + t275*t341) + t247)/t239, 0)
-    t346 = xp.where(xp.not_equal(t39, 0), -(-(t229*t345 + t232*t344 - t227*t343*t252 + t227*t342*t255 + t227*t341*t259) + t235)/t39, 0)
-    t347 = xp.isfinite(t258)
-    t348 = xp.greater_equal(damping, 0)
-    t349 = xp.greater(damping, 0)
-    t350 = 1e-12*t73
-    t351 = 1e-12*t59
-    t352 = (t349 & (xp.less_equal(t74, t350) | xp.less_equal(t117, t350) | xp.less_equal(t149, t350) | xp.less_equal(t168, t350) | xp.less_equal(t180, t350) | xp.less_equal(t207, t350))) | (xp.less_equal(damping, 0) & (xp.less_equal(t38, t351) | xp.less_equal(t238, t351) | xp.less_equal(t280, t351) | xp.less_equal(t297, t351) | xp.less_equal(t315, t351) | xp.less_equal(t336, t351)))
-    t353 = t347 & t348 & xp.logical_not(t352)
+    t47 = t5**2
+    t48 = t20 + t47
+    t49 = t13**2 + t10**2 + t35
+    t50 = t18 + t49
+    t51 = s2*c4
+    t52 = -t33 + t10*t0 + t13*t51
+    t53 = -t44 + t15*t0 + t9*t51
+    t54 = t9**2 + t15**2 + t16
+    t55 = t36 + t54
+    t56 = 1 + t0**2 + c4**2*t17
+    t57 = t20 + t56
+    t58 = xp.sqrt(t23 + 2*t20 + 2*t18 + 2*t36 + t41 + t47 + t49 + t54 + t56)
+    t59 = t28**2
+    t60 = t34**2
+    t61 = t32**2
+    t62 = damping**2
+    t63 = t62 + t24
+    t64 = t63**2
+    t65 = t62 + t42
+    t66 = t62 + t48
+    t67 = t62 + t50
+    t68 = t62 + t55
+    t69 = t62 + t57
+    t70 = 2*t47
+    t71 = t22*t35
+    t72 = xp.sqrt(2*t37 + 2*t19 + 2*t59 + 2*t60 + 2*t45**2 + 2*t46**2 + 2*t61 + 2*t29**2 + 2*t52**2 + 2*t53**2 + t64 + t65**2 + t66**2 + t67**2 + t68**2 + t69**2 + 4*t71 + t35*t70 + t16*t70)
+    t73 = xp.sqrt(t19 + t59 + t60 + t61 + t64 + t71)
+    t74 = t73*xp.where(xp.greater_equal(t63, 0), xp.asarray(1, dtype=dtype), -1)
+    t75 = t63 + t74
+    t76 = xp.where(xp.greater(t73, 0), 1/(t73*(t73 + xp.abs(t63))), 0)
+    t77 = t76*(t34*t75 + t28*t45 + t66*t34 - t30*t46 - t30*t32)
+    t78 = t34 - t75*t77
+    t79 = t45 - t28*t77
+    t80 = t66 - t34*t77
+    t81 = t30 + t32*t77
+    t82 = t26*t31
+    t83 = t76*(t25 + t28*t75 + t34*t45 + t65*t28 + t82*t32 + t46*t82)
+    t84 = t28 - t75*t83
+    t85 = t65 - t28*t83
+    t86 = t45 - t34*t83
+    t87 = -t46 + t82*t83
+    t88 = t82 - t32*t83
+    t89 = t2 + t4*t83
+    t90 = t43 + t82*t77
+    t91 = t76*(t32*t29 + t4*t52 - t82*t75 + t43*t34 - t67*t82 - t46*t28)
+    t92 = t82 + t75*t91
+    t93 = t46 + t28*t91
+    t94 = t43 - t34*t91
+    t95 = t67 + t82*t91
+    t96 = t29 - t32*t91
+    t97 = t76*(t32*t75 + t4*t53 + t82*t28 - t30*t34 - t82*t29 + t68*t32)
+    t98 = t32 - t75*t97
+    t99 = t82 - t28*t97
+    t100 = t30 + t34*t97
+    t101 = t29 + t82*t97
+    t102 = t68 - t32*t97
+    t103 = -t53 + t4*t97
+    t104 = -t76*(t4*t75 + t32*t53 - t82*t52 + t4*t69 - t2*t28)
+    t105 = t4 + t75*t104
+    t106 = t2 - t28*t104
+    t107 = t53 + t32*t104
+    t108 = t69 + t4*t104
+    t109 = t76*(mu_dot0*t75 + mu_dot1*t28 + mu_dot2*t34 + mu_dot4*t32 - t4*mu_dot5 - t82*mu_dot3)
+    t110 = mu_dot0 - t75*t109
+    t111 = mu_dot1 - t28*t109
+    t112 = mu_dot2 - t34*t109
+    t113 = mu_dot3 + t82*t109
+    t114 = mu_dot4 - t32*t109
+    t115 = mu_dot5 + t4*t109
+    t116 = xp.sqrt(t85**2 + t86**2 + t87**2 + t88**2 + t89**2)
+    t117 = t116*xp.where(xp.greater_equal(t85, 0), xp.asarray(1, dtype=dtype), -1)
+    t118 = t85 + t117
+    t119 = xp.where(xp.greater(t116, 0), 1/(t116*(t116 + xp.abs(t85))), 0)
+    t120 = t119*(t99*t118 - t86*t100 + t87*t101 + t88*t102 + t89*t103)
+    t121 = t99 - t118*t120
+    t122 = t100 + t86*t120
+    t123 = t101 - t87*t120
+    t124 = t102 - t88*t120
+    t125 = t103 - t89*t120
+    t126 = t119*(t111*t118 + t86*t112 + t87*t113 + t88*t114 + t89*t115)
+    t127 = t111 - t118*t126
+    t128 = t112 - t86*t126
+    t129 = t113 - t87*t126
+    t130 = t114 - t88*t126
+    t131 = t115 - t89*t126
+    t132 = -t52
+    t133 = t132 + t4*t91
+    t134 = t132 + t82*t104
+    t135 = t119*(-t93*t118 + t86*t94 + t87*t95 + t88*t96 + t89*t133)
+    t136 = t93 + t118*t135
+    t137 = t94 - t86*t135
+    t138 = t95 - t87*t135
+    t139 = t96 - t88*t135
+    t140 = t133 - t89*t135
+    t141 = t4*t77
+    t142 = t119*(t79*t118 + t86*t80 + t87*t90 - t88*t81 + t141*t89)
+    t143 = t79 - t118*t142
+    t144 = t80 - t86*t142
+    t145 = t90 - t87*t142
+    t146 = t81 + t88*t142
+    t147 = t141 - t89*t142
+    t148 = xp.sqrt(t144**2 + t145**2 + t146**2 + t147**2)
+    t149 = t148*xp.where(xp.greater_equal(t144, 0), xp.asarray(1, dtype=dtype), -1)
+    t150 = t144 + t149
+    t151 = xp.where(xp.greater(t148, 0), 1/(t148*(t148 + xp.abs(t144))), 0)
+    t152 = t151*(t137*t150 + t145*t138 - t146*t139 + t147*t140)
+    t153 = t137 - t150*t152
+    t154 = t138 - t145*t152
+    t155 = t139 + t146*t152
+    t156 = t140 - t147*t152
+    t157 = t151*(-t122*t150 + t145*t123 - t146*t124 + t147*t125)
+    t158 = t122 + t150*t157
+    t159 = t123 - t145*t157
+    t160 = t124 + t146*t157
+    t161 = t125 - t147*t157
+    t162 = t151*(t128*t150 + t145*t129 - t146*t130 + t147*t131)
+    t163 = t128 - t150*t162
+    t164 = t129 - t145*t162
+    t165 = t130 + t146*t162
+    t166 = t131 - t147*t162
+    t167 = xp.sqrt(t154**2 + t155**2 + t156**2)
+    t168 = t167*xp.where(xp.greater_equal(t154, 0), xp.asarray(1, dtype=dtype), -1)
+    t169 = t154 + t168
+    t170 = xp.where(xp.greater(t167, 0), 1/(t167*(t167 + xp.abs(t154))), 0)
+    t171 = t170*(t159*t169 + t155*t160 + t156*t161)
+    t172 = t159 - t169*t171
+    t173 = t160 - t155*t171
+    t174 = t161 - t156*t171
+    t175 = t170*(t164*t169 + t155*t165 + t156*t166)
+    t176 = t164 - t169*t175
+    t177 = t165 - t155*t175
+    t178 = t166 - t156*t175
+    t179 = xp.sqrt(t173**2 + t174**2)
+    t180 = t179*xp.where(xp.greater_equal(t173, 0), xp.asarray(1, dtype=dtype), -1)
+    t181 = t173 + t180
+    t182 = xp.where(xp.greater(t179, 0), 1/(t179*(t179 + xp.abs(t173))), 0)
+    t183 = t182*(t177*t181 + t174*t178)
+    t184 = t177 - t181*t183
+    t185 = t178 - t174*t183
+    t186 = t34*t104
+    t187 = t119*(t106*t118 + t87*t134 - t88*t107 + t89*t108 - t186*t86)
+    t188 = t106 - t118*t187
+    t189 = t186 + t86*t187
+    t190 = t134 - t87*t187
+    t191 = t107 + t88*t187
+    t192 = t108 - t89*t187
+    t193 = t151*(-t189*t150 + t145*t190 + t146*t191 + t147*t192)
+    t194 = t189 + t150*t193
+    t195 = t190 - t145*t193
+    t196 = -t191 + t146*t193
+    t197 = t192 - t147*t193
+    t198 = t170*(t195*t169 + t155*t196 + t156*t197)
+    t199 = t195 - t169*t198
+    t200 = t196 - t155*t198
+    t201 = t197 - t156*t198
+    t202 = t182*(t200*t181 + t174*t201)
+    t203 = t200 - t181*t202
+    t204 = t201 - t174*t202
+    t205 = xp.abs(t204)
+    t206 = t205*xp.where(xp.greater_equal(t204, 0), xp.asarray(1, dtype=dtype), -1)
+    t207 = t204 + t206
+    t208 = xp.where(xp.greater(t205, 0), 1/(t205*2*t205), 0)
+    t209 = t185 - t185*t207**2*t208
+    t210 = xp.where(xp.not_equal(t206, 0), -t209/t206, 0)
+    t211 = xp.where(xp.not_equal(t180, 0), -(t184 - t203*t210)/t180, 0)
+    t212 = xp.where(xp.not_equal(t168, 0), -(-(t172*t211 + t199*t210) + t176)/t168, 0)
+    t213 = xp.where(xp.not_equal(t149, 0), -(t163 + t158*t211 + t194*t210 - t153*t212)/t149, 0)
+    t214 = xp.where(xp.not_equal(t117, 0), -(-(t143*t213 - t136*t212 + t121*t211 + t188*t210) + t127)/t117, 0)
+    t215 = xp.where(xp.not_equal(t74, 0), -(-(t84*t214 + t78*t213 - t92*t212 + t98*t211 - t105*t210) + t110)/t74, 0)
+    t216 = t210 - t4*t215 + t2*t214
+    t217 = c2*t213 + t1*t215 + t3*t214
+    t218 = c2*t210 + t1*t212 + t3*t211
+    t219 = t13*t212 + t9*t211 - t51*t210
+    t220 = t10*t212 + t15*t211 - t0*t210
+    t221 = c1*t31
+    t222 = s1*t31
+    t223 = -t5*t213 - s1*t212 + c1*t211 + t215*t221 + t214*t222
+    t224 = -t4
+    t225 = t39 + t224
+    t226 = t40*(t225*t221 + t2*t222)
+    t227 = -t225*t226 + t221
+    t228 = -t2*t226 + t222
+    t229 = t40*(t1*t225 + t2*t3)
+    t230 = t1 - t225*t229
+    t231 = t3 - t2*t229
+    t232 = t40*(mu_dot5 + mu_dot0*t225 + t2*mu_dot1)
+    t233 = mu_dot0 - t225*t232
+    t234 = mu_dot1 - t2*t232
+    t235 = -t232 + mu_dot5
+    t236 = xp.sqrt(t16 + t35 + t47 + t226**2 + t228**2)
+    t237 = t236*xp.where(xp.greater_equal(t228, 0), xp.asarray(1, dtype=dtype), -1)
+    t238 = t228 + t237
+    t239 = xp.where(xp.greater(t236, 0), 1/(t236*(t236 + xp.abs(t228))), 0)
+    t240 = t239*(t231*t238 - c2*t5 + t226*t229)
+    t241 = t231 - t238*t240
+    t242 = c2 + t5*t240
+    t243 = -t229 + t226*t240
+    t244 = -t239*(-t234*t238 + t5*mu_dot2 + s1*mu_dot3 - c1*mu_dot4 + t226*t235)
+    t245 = t234 - t238*t244
+    t246 = mu_dot2 + t5*t244
+    t247 = mu_dot3 + s1*t244
+    t248 = mu_dot4 - c1*t244
+    t249 = t235 + t226*t244
+    t250 = c2*t40
+    t251 = -t250 + c2
+    t252 = -t51
+    t253 = t51*t40
+    t254 = t252 + t253
+    t255 = -t0
+    t256 = 1 - t5 - s1 + q1 + q2 + c1 + q3 + t2 + q4 + t13 + t9 + q5 + t10 + t15 + q6 + 2*c2 + 2*t1 + 2*t3 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + t221 + t222 + t224 + t252 + t255
+    t257 = t0*t40
+    t258 = t255 + t257
+    t259 = t2*t250
+    t260 = -t239*(t226*t251 + t238*t259)
+    t261 = t238*t260 + t259
+    t262 = t1 + s1*t260
+    t263 = t3 - c1*t260
+    t264 = t251 + t226*t260
+    t265 = t2*t253
+    t266 = t239*(-s1*t13 + c1*t9 - t226*t254 + t238*t265)
+    t267 = -t238*t266 + t265
+    t268 = t13 + s1*t266
+    t269 = t9 - c1*t266
+    t270 = t254 + t226*t266
+    t271 = t2*t257
+    t272 = t239*(c1*t15 - s1*t10 - t226*t258 + t238*t271)
+    t273 = -t238*t272 + t271
+    t274 = t10 + s1*t272
+    t275 = t15 - c1*t272
+    t276 = t258 + t226*t272
+    t277 = t240**2
+    t278 = xp.sqrt(t242**2 + t243**2 + t35*t277 + t16*t277)
+    t279 = t278*xp.where(xp.greater_equal(t242, 0), xp.asarray(1, dtype=dtype), -1)
+    t280 = t242 + t279
+    t281 = xp.where(xp.greater(t278, 0), 1/(t278*(t278 + xp.abs(t242))), 0)
+    t282 = t5*t260
+    t283 = s1*t240
+    t284 = c1*t240
+    t285 = t281*(t243*t264 + t280*t282 + t262*t283 - t263*t284)
+    t286 = -t280*t285 + t282
+    t287 = t262 - t285*t283
+    t288 = t263 + t285*t284
+    t289 = t264 - t243*t285
+    t290 = t281*(t246*t280 + t243*t249 + t247*t283 - t248*t284)
+    t291 = t246 - t280*t290
+    t292 = t247 - t290*t283
+    t293 = t248 + t290*t284
+    t294 = t249 - t243*t290
+    t295 = xp.sqrt(t287**2 + t288**2 + t289**2)
+    t296 = t295*xp.where(xp.greater_equal(t287, 0), xp.asarray(1, dtype=dtype), -1)
+    t297 = t287 + t296
+    t298 = xp.where(xp.greater(t295, 0), 1/(t295*(t295 + xp.abs(t287))), 0)
+    t299 = t298*(t292*t297 + t288*t293 + t289*t294)
+    t300 = t292 - t297*t299
+    t301 = t293 - t288*t299
+    t302 = t294 - t289*t299
+    t303 = t5*t266
+    t304 = t281*(t243*t270 + t280*t303 + t268*t283 - t269*t284)
+    t305 = -t280*t304 + t303
+    t306 = t268 - t304*t283
+    t307 = t269 + t304*t284
+    t308 = t270 - t243*t304
+    t309 = t298*(t306*t297 + t288*t307 + t289*t308)
+    t310 = t306 - t297*t309
+    t311 = t307 - t288*t309
+    t312 = t308 - t289*t309
+    t313 = xp.sqrt(t311**2 + t312**2)
+    t314 = t313*xp.where(xp.greater_equal(t311, 0), xp.asarray(1, dtype=dtype), -1)
+    t315 = t311 + t314
+    t316 = xp.where(xp.greater(t313, 0), 1/(t313*(t313 + xp.abs(t311))), 0)
+    t317 = t316*(t301*t315 + t312*t302)
+    t318 = t301 - t315*t317
+    t319 = t302 - t312*t317
+    t320 = t5*t272
+    t321 = t281*(t243*t276 + t280*t320 + t274*t283 - t275*t284)
+    t322 = -t280*t321 + t320
+    t323 = t274 - t321*t283
+    t324 = t275 + t321*t284
+    t325 = t276 - t243*t321
+    t326 = t298*(t323*t297 + t288*t324 + t289*t325)
+    t327 = t323 - t297*t326
+    t328 = t324 - t288*t326
+    t329 = t325 - t289*t326
+    t330 = t316*(t328*t315 + t312*t329)
+    t331 = t328 - t315*t330
+    t332 = t329 - t312*t330
+    t333 = xp.abs(t332)
+    t334 = xp.where(xp.greater_equal(t332, 0), xp.asarray(1, dtype=dtype), -1)*t333
+    t335 = t332 + t334
+    t336 = xp.where(xp.greater(t333, 0), 1/(t333*2*t333), 0)
+    t337 = t319 - t319*t335**2*t336
+    t338 = xp.where(xp.not_equal(t334, 0), -t337/t334, 0)
+    t339 = xp.where(xp.not_equal(t314, 0), -(t318 - t331*t338)/t314, 0)
+    t340 = xp.where(xp.not_equal(t296, 0), -(-(t310*t339 + t327*t338) + t300)/t296, 0)
+    t341 = xp.where(xp.not_equal(t279, 0), -(-(t286*t340 + t305*t339 + t322*t338) + t291)/t279, 0)
+    t342 = xp.where(xp.not_equal(t237, 0), -(-(t241*t341 - t261*t340 + t267*t339 + t273*t338) + t245)/t237, 0)
+    t343 = xp.where(xp.not_equal(t39, 0), -(-(t227*t342 + t230*t341 - t225*t340*t250 + t225*t339*t253 + t225*t338*t257) + t233)/t39, 0)
+    t344 = xp.isfinite(t256)
+    t345 = xp.greater_equal(damping, 0)
+    t346 = xp.greater(damping, 0)
+    t347 = 1e-12*t72
+    t348 = 1e-12*t58
+    t349 = (t346 & (xp.less_equal(t73, t347) | xp.less_equal(t116, t347) | xp.less_equal(t148, t347) | xp.less_equal(t167, t347) | xp.less_equal(t179, t347) | xp.less_equal(t205, t347))) | (xp.less_equal(damping, 0) & (xp.less_equal(t38, t348) | xp.less_equal(t236, t348) | xp.less_equal(t278, t348) | xp.less_equal(t295, t348) | xp.less_equal(t313, t348) | xp.less_equal(t333, t348)))
+    t350 = t344 & t345 & xp.logical_not(t349)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t353, xp.where(t349, t218, t346), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t353, xp.where(t349, t225, t345), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t353, xp.where(t349, t219, t344), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t353, xp.where(t349, t220, t343), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t353, xp.where(t349, t221, t342), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t353, xp.where(t349, t222, t341), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t350, xp.where(t346, t216, t343), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t350, xp.where(t346, t223, t342), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t350, xp.where(t346, t217, t341), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t350, xp.where(t346, t218, t340), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t350, xp.where(t346, t219, t339), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t350, xp.where(t346, t220, t338), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t347 & t348), 2, xp.where(t352, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t344 & t345), 2, xp.where(t349, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -1813,180 +1809,178 @@ def ik_numeric_step(target, q, damping=0.0):
     t74 = t73 - t7*t72
     t75 = -t73 + t28*t37 + t13*t38
     t76 = t7*t67
-    t77 = t76
-    t78 = -t43
-    t79 = 0.5*(-1 + t78 + t23 + t32)
-    t80 = xp.atan2(t46, t79)
-    t81 = xp.where(xp.greater(t46, 0), t80/t46, 1)
-    t82 = xp.greater_equal(t23, t32) & xp.greater_equal(t23, t78)
-    t83 = xp.greater_equal(t32, t78)
-    t84 = xp.where(t82, 0.5*(1 + t23), xp.where(t83, 0.5*t31, -0.5*t41))
-    t85 = xp.where(t82, 0.5*t24, xp.where(t83, 0.5*(1 + t32), -0.5*t42))
-    t86 = xp.where(t82, 0.5*t25, xp.where(t83, 0.5*t33, 0.5*(1 + t78)))
-    t87 = xp.sqrt(t84**2 + t85**2 + t86**2)
-    t88 = xp.where(xp.greater_equal(t44*t84 + t45*t85 + t34*t86, 0), xp.asarray(1, dtype=dtype), -1)
-    t89 = xp.greater(t46, 1e-06) | xp.greater(t79, 0)
-    t90 = t80*t88/t87
-    t91 = xp.where(t89, t44*t81, t90*t84)
-    t92 = xp.where(t89, t45*t81, t90*t85)
-    t93 = xp.where(t89, t34*t81, t90*t86)
-    t94 = t91**2 + t92**2 + t93**2 + t5**2 + t6**2 + t9**2
-    t95 = damping + t57
-    t96 = xp.sqrt(t47 + t95**2 + t61**2 + t65**2 + t49**2 + t53*t67)
-    t97 = t96*xp.where(xp.greater_equal(t95, 0), xp.asarray(1, dtype=dtype), -1)
-    t98 = t95 + t97
-    t99 = xp.where(xp.greater(t96, 0), 1/(t96*(t96 + xp.abs(t95))), 0)
-    t100 = t7*t59
-    t101 = t99*(t5*t98 + t61*t6 + t65*t9 + t49*t92 - t3*t93 - t100*t91)
-    t102 = t5 - t98*t101
-    t103 = t6 - t61*t101
-    t104 = t9 - t65*t101
-    t105 = t91 + t100*t101
-    t106 = t92 - t49*t101
-    t107 = t93 + t3*t101
-    t108 = damping + t70
-    t109 = t99*(t58 + t65*t74 + t61*t98 + t100*t77 + t100*t49 + t108*t61)
-    t110 = t61 - t98*t109
-    t111 = t108 - t61*t109
-    t112 = t74 - t65*t109
-    t113 = -t77 + t100*t109
-    t114 = t100 - t49*t109
-    t115 = t2 + t3*t109
-    t116 = xp.sqrt(t111**2 + t112**2 + t113**2 + t114**2 + t115**2)
-    t117 = t116*xp.where(xp.greater_equal(t111, 0), xp.asarray(1, dtype=dtype), -1)
-    t118 = t111 + t117
-    t119 = xp.where(xp.greater(t116, 0), 1/(t116*(t116 + xp.abs(t111))), 0)
-    t120 = t119*(t103*t118 + t112*t104 + t113*t105 + t114*t106 + t115*t107)
-    t121 = t103 - t118*t120
-    t122 = t104 - t112*t120
-    t123 = t105 - t113*t120
-    t124 = t106 - t114*t120
-    t125 = t107 - t115*t120
-    t126 = damping + t51
-    t127 = t99*(t61*t74 + t65*t98 - t63*t76 - t63*t49 + t126*t65)
-    t128 = t65 - t98*t127
-    t129 = t74 - t61*t127
-    t130 = t126 - t65*t127
-    t131 = t72 + t100*t127
-    t132 = t63 + t49*t127
-    t133 = damping + t68
-    t134 = t99*(-t61*t77 + t49*t62 + t3*t66 + t72*t65 - t100*t98 - t100*t133)
-    t135 = t100 + t98*t134
-    t136 = t77 + t61*t134
-    t137 = t72 - t65*t134
-    t138 = t133 + t100*t134
-    t139 = t62 - t49*t134
-    t140 = -t66
-    t141 = t140 + t3*t134
-    t142 = t119*(-t136*t118 + t112*t137 + t113*t138 + t114*t139 + t115*t141)
-    t143 = t136 + t118*t142
-    t144 = t137 - t112*t142
-    t145 = t138 - t113*t142
-    t146 = t139 - t114*t142
-    t147 = t141 - t115*t142
-    t148 = damping + t71
-    t149 = t99*(t3*t75 + t49*t98 + t100*t61 - t63*t65 - t100*t62 + t148*t49)
-    t150 = t49 - t98*t149
-    t151 = t100 - t61*t149
-    t152 = t63 + t65*t149
-    t153 = t62 + t100*t149
-    t154 = t148 - t49*t149
-    t155 = -t75 + t3*t149
-    t156 = t119*(t151*t118 - t112*t152 + t113*t153 + t114*t154 + t115*t155)
-    t157 = t151 - t118*t156
-    t158 = t152 + t112*t156
-    t159 = t153 - t113*t156
-    t160 = t154 - t114*t156
-    t161 = t155 - t115*t156
-    t162 = damping + t55
-    t163 = -t99*(t49*t75 - t2*t61 + t3*t98 - t100*t66 + t3*t162)
-    t164 = t3 + t98*t163
-    t165 = t2 - t61*t163
-    t166 = t140 + t100*t163
-    t167 = t75 + t49*t163
-    t168 = t162 + t3*t163
-    t169 = t3*t127
-    t170 = t119*(t129*t118 + t112*t130 + t113*t131 - t114*t132 + t169*t115)
-    t171 = t129 - t118*t170
-    t172 = t130 - t112*t170
-    t173 = t131 - t113*t170
-    t174 = t132 + t114*t170
-    t175 = t169 - t115*t170
-    t176 = xp.sqrt(t172**2 + t173**2 + t174**2 + t175**2)
-    t177 = t176*xp.where(xp.greater_equal(t172, 0), xp.asarray(1, dtype=dtype), -1)
-    t178 = t172 + t177
-    t179 = xp.where(xp.greater(t176, 0), 1/(t176*(t176 + xp.abs(t172))), 0)
-    t180 = t179*(t144*t178 + t173*t145 - t174*t146 + t175*t147)
-    t181 = t144 - t178*t180
-    t182 = t145 - t173*t180
-    t183 = t146 + t174*t180
-    t184 = t147 - t175*t180
-    t185 = t179*(-t158*t178 + t173*t159 - t174*t160 + t175*t161)
-    t186 = t158 + t178*t185
-    t187 = t159 - t173*t185
-    t188 = t160 + t174*t185
-    t189 = t161 - t175*t185
-    t190 = t179*(t122*t178 + t173*t123 - t174*t124 + t175*t125)
-    t191 = t122 - t178*t190
-    t192 = t123 - t173*t190
-    t193 = t124 + t174*t190
-    t194 = t125 - t175*t190
-    t195 = xp.sqrt(t182**2 + t183**2 + t184**2)
-    t196 = t195*xp.where(xp.greater_equal(t182, 0), xp.asarray(1, dtype=dtype), -1)
-    t197 = t182 + t196
-    t198 = xp.where(xp.greater(t195, 0), 1/(t195*(t195 + xp.abs(t182))), 0)
-    t199 = t198*(t187*t197 + t183*t188 + t184*t189)
-    t200 = t187 - t197*t199
-    t201 = t188 - t183*t199
-    t202 = t189 - t184*t199
-    t203 = t198*(t192*t197 + t183*t193 + t184*t194)
-    t204 = t192 - t197*t203
-    t205 = t193 - t183*t203
-    t206 = t194 - t184*t203
-    t207 = xp.sqrt(t201**2 + t202**2)
-    t208 = t207*xp.where(xp.greater_equal(t201, 0), xp.asarray(1, dtype=dtype), -1)
-    t209 = t201 + t208
-    t210 = xp.where(xp.greater(t207, 0), 1/(t207*(t207 + xp.abs(t201))), 0)
-    t211 = t210*(t205*t209 + t202*t206)
-    t212 = t205 - t209*t211
-    t213 = t206 - t202*t211
-    t214 = t65*t163
-    t215 = t119*(t165*t118 + t113*t166 - t114*t167 + t115*t168 - t214*t112)
-    t216 = t165 - t118*t215
-    t217 = t214 + t112*t215
-    t218 = t166 - t113*t215
-    t219 = t167 + t114*t215
-    t220 = t168 - t115*t215
-    t221 = t179*(-t217*t178 + t173*t218 + t174*t219 + t175*t220)
-    t222 = t217 + t178*t221
-    t223 = t218 - t173*t221
-    t224 = -t219 + t174*t221
-    t225 = t220 - t175*t221
-    t226 = t198*(t223*t197 + t183*t224 + t184*t225)
-    t227 = t223 - t197*t226
-    t228 = t224 - t183*t226
-    t229 = t225 - t184*t226
-    t230 = t210*(t228*t209 + t202*t229)
-    t231 = t228 - t209*t230
-    t232 = t229 - t202*t230
-    t233 = xp.abs(t232)
-    t234 = t233
-    t235 = t234*xp.where(xp.greater_equal(t232, 0), xp.asarray(1, dtype=dtype), -1)
-    t236 = t232 + t235
-    t237 = xp.where(xp.greater(t234, 0), 1/(t234*(t233 + t234)), 0)
-    t238 = t213 - t213*t236**2*t237
-    t239 = xp.where(xp.not_equal(t235, 0), -t238/t235, 0)
-    t240 = xp.where(xp.not_equal(t208, 0), -(t212 - t231*t239)/t208, 0)
-    t241 = xp.where(xp.not_equal(t196, 0), -(-(t200*t240 + t227*t239) + t204)/t196, 0)
-    t242 = xp.where(xp.not_equal(t177, 0), -(t191 + t186*t240 + t222*t239 - t181*t241)/t177, 0)
-    t243 = xp.where(xp.not_equal(t117, 0), -(-(t171*t242 - t143*t241 + t157*t240 + t216*t239) + t121)/t117, 0)
-    t244 = xp.where(xp.not_equal(t97, 0), -(-(t110*t243 + t128*t242 - t135*t241 + t150*t240 - t164*t239) + t102)/t97, 0)
-    t245 = q1 + t239 - t3*t244 + t2*t243
-    t246 = q2 - t4*t242 - s1*t241 + c1*t240 + c1*t7*t244 + s1*t7*t243
-    t247 = q3 + c2*t242 + t18*t244 + t26*t243
-    t248 = q4 + c2*t239 + t18*t241 + t26*t240
-    t249 = q5 + t16*t241 + t13*t240 - t38*t239
-    t250 = q6 + t20*t241 + t28*t240 - t37*t239
+    t77 = -t43
+    t78 = 0.5*(-1 + t77 + t23 + t32)
+    t79 = xp.atan2(t46, t78)
+    t80 = xp.where(xp.greater(t46, 0), t79/t46, 1)
+    t81 = xp.greater_equal(t23, t32) & xp.greater_equal(t23, t77)
+    t82 = xp.greater_equal(t32, t77)
+    t83 = xp.where(t81, 0.5*(1 + t23), xp.where(t82, 0.5*t31, -0.5*t41))
+    t84 = xp.where(t81, 0.5*t24, xp.where(t82, 0.5*(1 + t32), -0.5*t42))
+    t85 = xp.where(t81, 0.5*t25, xp.where(t82, 0.5*t33, 0.5*(1 + t77)))
+    t86 = xp.sqrt(t83**2 + t84**2 + t85**2)
+    t87 = xp.where(xp.greater_equal(t44*t83 + t45*t84 + t34*t85, 0), xp.asarray(1, dtype=dtype), -1)
+    t88 = xp.greater(t46, 1e-06) | xp.greater(t78, 0)
+    t89 = t79*t87/t86
+    t90 = xp.where(t88, t44*t80, t89*t83)
+    t91 = xp.where(t88, t45*t80, t89*t84)
+    t92 = xp.where(t88, t34*t80, t89*t85)
+    t93 = t90**2 + t91**2 + t92**2 + t5**2 + t6**2 + t9**2
+    t94 = damping + t57
+    t95 = xp.sqrt(t47 + t94**2 + t61**2 + t65**2 + t49**2 + t53*t67)
+    t96 = t95*xp.where(xp.greater_equal(t94, 0), xp.asarray(1, dtype=dtype), -1)
+    t97 = t94 + t96
+    t98 = xp.where(xp.greater(t95, 0), 1/(t95*(t95 + xp.abs(t94))), 0)
+    t99 = t7*t59
+    t100 = t98*(t5*t97 + t61*t6 + t65*t9 + t49*t91 - t3*t92 - t99*t90)
+    t101 = t5 - t97*t100
+    t102 = t6 - t61*t100
+    t103 = t9 - t65*t100
+    t104 = t90 + t99*t100
+    t105 = t91 - t49*t100
+    t106 = t92 + t3*t100
+    t107 = damping + t70
+    t108 = t98*(t58 + t65*t74 + t61*t97 + t99*t49 + t107*t61 + t76*t99)
+    t109 = t61 - t97*t108
+    t110 = t107 - t61*t108
+    t111 = t74 - t65*t108
+    t112 = -t76 + t99*t108
+    t113 = t99 - t49*t108
+    t114 = t2 + t3*t108
+    t115 = xp.sqrt(t110**2 + t111**2 + t112**2 + t113**2 + t114**2)
+    t116 = t115*xp.where(xp.greater_equal(t110, 0), xp.asarray(1, dtype=dtype), -1)
+    t117 = t110 + t116
+    t118 = xp.where(xp.greater(t115, 0), 1/(t115*(t115 + xp.abs(t110))), 0)
+    t119 = t118*(t102*t117 + t111*t103 + t112*t104 + t113*t105 + t114*t106)
+    t120 = t102 - t117*t119
+    t121 = t103 - t111*t119
+    t122 = t104 - t112*t119
+    t123 = t105 - t113*t119
+    t124 = t106 - t114*t119
+    t125 = damping + t51
+    t126 = t98*(t61*t74 + t65*t97 - t63*t76 - t63*t49 + t125*t65)
+    t127 = t65 - t97*t126
+    t128 = t74 - t61*t126
+    t129 = t125 - t65*t126
+    t130 = t72 + t99*t126
+    t131 = t63 + t49*t126
+    t132 = damping + t68
+    t133 = t98*(t49*t62 + t3*t66 + t72*t65 - t76*t61 - t99*t97 - t99*t132)
+    t134 = t99 + t97*t133
+    t135 = t76 + t61*t133
+    t136 = t72 - t65*t133
+    t137 = t132 + t99*t133
+    t138 = t62 - t49*t133
+    t139 = -t66
+    t140 = t139 + t3*t133
+    t141 = t118*(-t135*t117 + t111*t136 + t112*t137 + t113*t138 + t114*t140)
+    t142 = t135 + t117*t141
+    t143 = t136 - t111*t141
+    t144 = t137 - t112*t141
+    t145 = t138 - t113*t141
+    t146 = t140 - t114*t141
+    t147 = damping + t71
+    t148 = t98*(t3*t75 + t49*t97 + t99*t61 - t63*t65 - t99*t62 + t147*t49)
+    t149 = t49 - t97*t148
+    t150 = t99 - t61*t148
+    t151 = t63 + t65*t148
+    t152 = t62 + t99*t148
+    t153 = t147 - t49*t148
+    t154 = -t75 + t3*t148
+    t155 = t118*(t150*t117 - t111*t151 + t112*t152 + t113*t153 + t114*t154)
+    t156 = t150 - t117*t155
+    t157 = t151 + t111*t155
+    t158 = t152 - t112*t155
+    t159 = t153 - t113*t155
+    t160 = t154 - t114*t155
+    t161 = damping + t55
+    t162 = -t98*(t49*t75 - t2*t61 + t3*t97 - t99*t66 + t3*t161)
+    t163 = t3 + t97*t162
+    t164 = t2 - t61*t162
+    t165 = t139 + t99*t162
+    t166 = t75 + t49*t162
+    t167 = t161 + t3*t162
+    t168 = t3*t126
+    t169 = t118*(t128*t117 + t111*t129 + t112*t130 - t113*t131 + t168*t114)
+    t170 = t128 - t117*t169
+    t171 = t129 - t111*t169
+    t172 = t130 - t112*t169
+    t173 = t131 + t113*t169
+    t174 = t168 - t114*t169
+    t175 = xp.sqrt(t171**2 + t172**2 + t173**2 + t174**2)
+    t176 = t175*xp.where(xp.greater_equal(t171, 0), xp.asarray(1, dtype=dtype), -1)
+    t177 = t171 + t176
+    t178 = xp.where(xp.greater(t175, 0), 1/(t175*(t175 + xp.abs(t171))), 0)
+    t179 = t178*(t143*t177 + t172*t144 - t173*t145 + t174*t146)
+    t180 = t143 - t177*t179
+    t181 = t144 - t172*t179
+    t182 = t145 + t173*t179
+    t183 = t146 - t174*t179
+    t184 = t178*(-t157*t177 + t172*t158 - t173*t159 + t174*t160)
+    t185 = t157 + t177*t184
+    t186 = t158 - t172*t184
+    t187 = t159 + t173*t184
+    t188 = t160 - t174*t184
+    t189 = t178*(t121*t177 + t172*t122 - t173*t123 + t174*t124)
+    t190 = t121 - t177*t189
+    t191 = t122 - t172*t189
+    t192 = t123 + t173*t189
+    t193 = t124 - t174*t189
+    t194 = xp.sqrt(t181**2 + t182**2 + t183**2)
+    t195 = t194*xp.where(xp.greater_equal(t181, 0), xp.asarray(1, dtype=dtype), -1)
+    t196 = t181 + t195
+    t197 = xp.where(xp.greater(t194, 0), 1/(t194*(t194 + xp.abs(t181))), 0)
+    t198 = t197*(t186*t196 + t182*t187 + t183*t188)
+    t199 = t186 - t196*t198
+    t200 = t187 - t182*t198
+    t201 = t188 - t183*t198
+    t202 = t197*(t191*t196 + t182*t192 + t183*t193)
+    t203 = t191 - t196*t202
+    t204 = t192 - t182*t202
+    t205 = t193 - t183*t202
+    t206 = xp.sqrt(t200**2 + t201**2)
+    t207 = t206*xp.where(xp.greater_equal(t200, 0), xp.asarray(1, dtype=dtype), -1)
+    t208 = t200 + t207
+    t209 = xp.where(xp.greater(t206, 0), 1/(t206*(t206 + xp.abs(t200))), 0)
+    t210 = t209*(t204*t208 + t201*t205)
+    t211 = t204 - t208*t210
+    t212 = t205 - t201*t210
+    t213 = t65*t162
+    t214 = t118*(t164*t117 + t112*t165 - t113*t166 + t114*t167 - t213*t111)
+    t215 = t164 - t117*t214
+    t216 = t213 + t111*t214
+    t217 = t165 - t112*t214
+    t218 = t166 + t113*t214
+    t219 = t167 - t114*t214
+    t220 = t178*(-t216*t177 + t172*t217 + t173*t218 + t174*t219)
+    t221 = t216 + t177*t220
+    t222 = t217 - t172*t220
+    t223 = -t218 + t173*t220
+    t224 = t219 - t174*t220
+    t225 = t197*(t222*t196 + t182*t223 + t183*t224)
+    t226 = t222 - t196*t225
+    t227 = t223 - t182*t225
+    t228 = t224 - t183*t225
+    t229 = t209*(t227*t208 + t201*t228)
+    t230 = t227 - t208*t229
+    t231 = t228 - t201*t229
+    t232 = xp.abs(t231)
+    t233 = t232*xp.where(xp.greater_equal(t231, 0), xp.asarray(1, dtype=dtype), -1)
+    t234 = t231 + t233
+    t235 = xp.where(xp.greater(t232, 0), 1/(t232*2*t232), 0)
+    t236 = t212 - t212*t234**2*t235
+    t237 = xp.where(xp.not_equal(t233, 0), -t236/t233, 0)
+    t238 = xp.where(xp.not_equal(t207, 0), -(t211 - t230*t237)/t207, 0)
+    t239 = xp.where(xp.not_equal(t195, 0), -(-(t199*t238 + t226*t237) + t203)/t195, 0)
+    t240 = xp.where(xp.not_equal(t176, 0), -(t190 + t185*t238 + t221*t237 - t180*t239)/t176, 0)
+    t241 = xp.where(xp.not_equal(t116, 0), -(-(t170*t240 - t142*t239 + t156*t238 + t215*t237) + t120)/t116, 0)
+    t242 = xp.where(xp.not_equal(t96, 0), -(-(t109*t241 + t127*t240 - t134*t239 + t149*t238 - t163*t237) + t101)/t96, 0)
+    t243 = q1 + t237 - t3*t242 + t2*t241
+    t244 = q2 - t4*t240 - s1*t239 + c1*t238 + c1*t7*t242 + s1*t7*t241
+    t245 = q3 + c2*t240 + t18*t242 + t26*t241
+    t246 = q4 + c2*t237 + t18*t239 + t26*t238
+    t247 = q5 + t16*t239 + t13*t238 - t38*t237
+    t248 = q6 + t20*t239 + t28*t238 - t37*t237
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -1996,14 +1990,14 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q6, batch),  # 5
     ], (6,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t245, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t245, 2.9670597283903604), 2.9670597283903604, t245)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t246, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t246, 2.9670597283903604), 2.9670597283903604, t246)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t247, 0.30479999999999996), 0.30479999999999996, xp.where(xp.greater(t247, 1.27), 1.27, t247)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t248, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t248, 2.9670597283903604), 2.9670597283903604, t248)), batch),  # 3
-        xp.broadcast_to(xp.where(xp.less(t249, -1.5707963267948966), -1.5707963267948966, xp.where(xp.greater(t249, 1.5707963267948966), 1.5707963267948966, t249)), batch),  # 4
-        xp.broadcast_to(xp.where(xp.less(t250, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t250, 2.9670597283903604), 2.9670597283903604, t250)), batch),  # 5
+        xp.broadcast_to(xp.where(xp.less(t243, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t243, 2.9670597283903604), 2.9670597283903604, t243)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t244, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t244, 2.9670597283903604), 2.9670597283903604, t244)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t245, 0.30479999999999996), 0.30479999999999996, xp.where(xp.greater(t245, 1.27), 1.27, t245)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t246, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t246, 2.9670597283903604), 2.9670597283903604, t246)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t247, -1.5707963267948966), -1.5707963267948966, xp.where(xp.greater(t247, 1.5707963267948966), 1.5707963267948966, t247)), batch),  # 4
+        xp.broadcast_to(xp.where(xp.less(t248, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t248, 2.9670597283903604), 2.9670597283903604, t248)), batch),  # 5
     ], (6,))
-    cost = xp.broadcast_to(xp.where(xp.isfinite(t0), t94, -1), batch)
+    cost = xp.broadcast_to(xp.where(xp.isfinite(t0), t93, -1), batch)
     return q_start, q_next, cost
 
 
@@ -2026,494 +2020,475 @@ def ik_branches(T):
     t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23
     t1 = -0.1337*T00 + 0.412*T02
     t2 = -t1 + T03
-    t3 = t1
-    t4 = t2 + t3
-    t5 = -0.1337*T10 + 0.412*T12
-    t6 = -t5 + T13
-    t7 = t5
-    t8 = t6 + t7
-    t9 = -0.1337*T20 + 0.412*T22
-    t10 = -t9 + T23
-    t11 = t9
-    t12 = t10 + t11
-    t13 = -0.412 + t12
-    t14 = t13**2
-    t15 = t14 + t4**2 + t8**2
-    t16 = 0.01787569 - t15
-    t17 = 0.01787569 + t15
-    t18 = -t16
-    t19 = 1e-12*t17
-    t20 = xp.greater(t18, t19)
-    t21 = xp.where(t20, xp.sqrt(t18), 0)
-    t22 = t21**2
-    t23 = 0.01787569 + t22
-    t24 = 0.01787569 + t14
-    t25 = -t23 + t24
-    t26 = -t25
-    t27 = 1e-12*t23
-    t28 = xp.greater(t26, t27)
-    t29 = xp.where(t28, xp.sqrt(t26), 0)
-    t30 = t4*t29
-    t31 = 0.1337*t8 + t14
-    t32 = -t30 + t31
-    t33 = t30 + t31
-    t34 = -t14
-    t35 = t34 + t32
-    t36 = t34 + t33
-    t37 = 0.1337*t4
-    t38 = t8*t29
-    t39 = t37 + t38
-    t40 = t35**2 + t39**2
-    t41 = -t37 + t38
-    t42 = t36**2 + t41**2
-    t43 = t29**2
-    t44 = t24 + t43
-    t45 = 1e-24*t44
-    t46 = t45*t15
-    t47 = xp.less_equal(t40, t46)
-    t48 = xp.where(t47, 1, 1/xp.sqrt(t40))
-    t49 = xp.where(t47, 1, t35*t48)
-    t50 = xp.where(t47, 0, -t39*t48)
-    t51 = T02*t49 + T12*t50
-    t52 = T12*t49 - T02*t50
-    t53 = T00*t49 + T10*t50
-    t54 = T10*t49 - T00*t50
-    t55 = xp.where(t47, 0, xp.atan2(-t39, t35))
-    t56 = t55 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t55))
-    t57 = t13*t21
-    t58 = 0.01787569 + t57
-    t59 = -0.01787569 + t58
-    t60 = 0.01787569 - t57
-    t61 = -0.01787569 + t60
-    t62 = t22*t43
-    t63 = t62 + t59**2
-    t64 = t62 + t61**2
-    t65 = t45*t23
-    t66 = xp.less_equal(t63, t65)
-    t67 = xp.where(t66, 1, 1/xp.sqrt(t63))
-    t68 = xp.where(t66, 1, t59*t67)
-    t69 = t21*t29
-    t70 = xp.where(t66, 0, xp.atan2(t69, t59))
-    t71 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t70)) + t70
-    t72 = t69*t67
-    t73 = xp.where(t66, 0, -t72)
-    t74 = xp.where(t66, 0, t72)
-    t75 = xp.less_equal(t42, t46)
-    t76 = xp.where(t75, 1, 1/xp.sqrt(t42))
-    t77 = xp.where(t75, 1, t36*t76)
-    t78 = xp.where(t75, 0, t41*t76)
-    t79 = T02*t77 + T12*t78
-    t80 = T12*t77 - T02*t78
-    t81 = T00*t77 + T10*t78
-    t82 = T10*t77 - T00*t78
-    t83 = xp.where(t75, 0, xp.atan2(t41, t36))
-    t84 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t83)) + t83
-    t85 = 1 - t49
-    t86 = t85*T22
-    t87 = t86 + T22*t49
-    t88 = t85*T20
-    t89 = t88 + T20*t49
-    t90 = t68*t51 - t73*t87
-    t91 = t68*t87 + t73*t51
-    t92 = t68*t53 - t73*t89
-    t93 = t68*t89 + t73*t53
-    t94 = 1 - t68
-    t95 = t94*t52
-    t96 = t95 + t68*t52
-    t97 = t94*t54
-    t98 = t97 + t68*t54
-    t99 = t94*t80
-    t100 = t99 + t68*t80
-    t101 = t94*t82
-    t102 = t101 + t68*t82
-    t103 = t91**2
-    t104 = -t103
-    t105 = 1 + t104
-    t106 = xp.greater(t105, 1e-12)
-    t107 = xp.where(t106, xp.sqrt(t105), 0)
-    t108 = t103 + t96*t107
-    t109 = t104 + t108
-    t110 = t90**2
-    t111 = t103 + t110 + t96**2
-    t112 = t107**2
-    t113 = t109**2 + t110*t112
-    t114 = t103 + t112
-    t115 = 1e-24*t114
-    t116 = xp.less_equal(t113, t115*t111)
-    t117 = xp.where(t116, 1, 1/xp.sqrt(t113))
-    t118 = xp.where(t116, 1, t109*t117)
-    t119 = t93*(1 - t118)
-    t120 = t119 + t93*t118
-    t121 = t90*t107
-    t122 = xp.where(t116, 0, -t121*t117)
-    t123 = t92*t118 + t98*t122
-    t124 = t98*t118 - t92*t122
-    t125 = xp.less_equal(t114, t115)
-    t126 = xp.where(t125, 1, 1/xp.sqrt(t114))
-    t127 = xp.where(t125, 1, t91*t126)
-    t128 = xp.where(t125, 0, -t107*t126)
-    t129 = t123*(1 - t127)
-    t130 = t129 + t127*t123
-    t131 = t127*t124 + t128*t120
-    t132 = t127*t120 - t128*t124
-    t133 = t130**2 + t131**2
-    t134 = t133
-    t135 = t133 + t132**2
-    t136 = 1 - t77
-    t137 = t136*T22
-    t138 = t137 + T22*t77
-    t139 = t136*T20
-    t140 = t139 + T20*t77
-    t141 = t68*t79 - t74*t138
-    t142 = t68*t138 + t74*t79
-    t143 = t68*t81 - t74*t140
-    t144 = t68*t140 + t74*t81
-    t145 = t142**2
-    t146 = -t145
-    t147 = 1 + t146
-    t148 = xp.greater(t147, 1e-12)
-    t149 = xp.where(t148, xp.sqrt(t147), 0)
-    t150 = t145 + t100*t149
-    t151 = t146 + t150
-    t152 = t141**2
-    t153 = t145 + t152 + t100**2
-    t154 = t149**2
-    t155 = t151**2 + t152*t154
-    t156 = t145 + t154
-    t157 = 1e-24*t156
-    t158 = xp.less_equal(t155, t157*t153)
-    t159 = xp.where(t158, 1, 1/xp.sqrt(t155))
-    t160 = xp.where(t158, 1, t151*t159)
-    t161 = t144*(1 - t160)
-    t162 = t161 + t144*t160
-    t163 = t141*t149
-    t164 = xp.where(t158, 0, -t163*t159)
-    t165 = t143*t160 + t102*t164
-    t166 = t102*t160 - t143*t164
-    t167 = xp.less_equal(t156, t157)
-    t168 = xp.where(t167, 1, 1/xp.sqrt(t156))
-    t169 = xp.where(t167, 1, t142*t168)
-    t170 = xp.where(t167, 0, -t149*t168)
-    t171 = t165*(1 - t169)
-    t172 = t171 + t169*t165
-    t173 = t169*t166 + t170*t162
-    t174 = t169*t162 - t170*t166
-    t175 = t172**2 + t173**2
-    t176 = t175
-    t177 = t175 + t174**2
-    t178 = xp.less_equal(t64, t65)
-    t179 = xp.where(t178, 1, 1/xp.sqrt(t64))
-    t180 = xp.where(t178, 1, t61*t179)
-    t181 = xp.where(t178, 0, xp.atan2(t69, t61))
-    t182 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t181)) + t181
-    t183 = t69*t179
-    t184 = xp.where(t178, 0, t183)
-    t185 = xp.where(t178, 0, -t183)
-    t186 = t51*t180 - t87*t184
-    t187 = t87*t180 + t51*t184
-    t188 = t53*t180 - t89*t184
-    t189 = t89*t180 + t53*t184
-    t190 = t79*t180 - t138*t185
-    t191 = t138*t180 + t79*t185
-    t192 = t81*t180 - t140*t185
-    t193 = t140*t180 + t81*t185
-    t194 = 1 - t180
-    t195 = t194*t52
-    t196 = t195 + t52*t180
-    t197 = t194*t54
-    t198 = t197 + t54*t180
-    t199 = t194*t80
-    t200 = t199 + t80*t180
-    t201 = t194*t82
-    t202 = t201 + t82*t180
-    t203 = t187**2
-    t204 = -t203
-    t205 = 1 + t204
-    t206 = xp.greater(t205, 1e-12)
-    t207 = xp.where(t206, xp.sqrt(t205), 0)
-    t208 = t203 + t196*t207
-    t209 = t204 + t208
-    t210 = t186**2
-    t211 = t203 + t210 + t196**2
-    t212 = t207**2
-    t213 = t209**2 + t210*t212
-    t214 = t203 + t212
-    t215 = 1e-24*t214
-    t216 = xp.less_equal(t213, t215*t211)
-    t217 = xp.where(t216, 1, 1/xp.sqrt(t213))
-    t218 = xp.where(t216, 1, t209*t217)
-    t219 = t189*(1 - t218)
-    t220 = t219 + t189*t218
-    t221 = t186*t207
-    t222 = xp.where(t216, 0, -t221*t217)
-    t223 = t188*t218 + t198*t222
-    t224 = t198*t218 - t188*t222
-    t225 = xp.less_equal(t214, t215)
-    t226 = xp.where(t225, 1, 1/xp.sqrt(t214))
-    t227 = xp.where(t225, 1, t187*t226)
-    t228 = xp.where(t225, 0, -t207*t226)
-    t229 = t223*(1 - t227)
-    t230 = t229 + t227*t223
-    t231 = t227*t224 + t228*t220
-    t232 = t227*t220 - t228*t224
-    t233 = t230**2 + t231**2
-    t234 = t233
-    t235 = t233 + t232**2
-    t236 = t191**2
-    t237 = -t236
-    t238 = 1 + t237
-    t239 = xp.greater(t238, 1e-12)
-    t240 = xp.where(t239, xp.sqrt(t238), 0)
-    t241 = t236 + t200*t240
-    t242 = t237 + t241
-    t243 = t190**2
-    t244 = t236 + t243 + t200**2
-    t245 = t240**2
-    t246 = t242**2 + t243*t245
-    t247 = t236 + t245
-    t248 = 1e-24*t247
-    t249 = xp.less_equal(t246, t248*t244)
-    t250 = xp.where(t249, 1, 1/xp.sqrt(t246))
-    t251 = xp.where(t249, 1, t242*t250)
-    t252 = t193*(1 - t251)
-    t253 = t252 + t193*t251
-    t254 = t190*t240
-    t255 = xp.where(t249, 0, -t254*t250)
-    t256 = t192*t251 + t202*t255
-    t257 = t202*t251 - t192*t255
-    t258 = xp.less_equal(t247, t248)
-    t259 = xp.where(t258, 1, 1/xp.sqrt(t247))
-    t260 = xp.where(t258, 1, t191*t259)
-    t261 = xp.where(t258, 0, -t240*t259)
-    t262 = t256*(1 - t260)
-    t263 = t262 + t260*t256
-    t264 = t260*t257 + t261*t253
-    t265 = t260*t253 - t261*t257
-    t266 = t263**2 + t264**2
-    t267 = t266
-    t268 = t266 + t265**2
-    t269 = -t69
-    t270 = xp.where(t66, 0, xp.atan2(t269, t59))
-    t271 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t270)) + t270
-    t272 = xp.where(t178, 0, xp.atan2(t269, t61))
-    t273 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t272)) + t272
-    t274 = xp.where(t116, 0, xp.atan2(-t121, t109))
-    t275 = t274
-    t276 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t275)) + t275
-    t277 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t274) + t274
-    t278 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t277)) + t277
-    t279 = xp.where(t125, 0, xp.atan2(-t107, t91))
-    t280 = t279
-    t281 = -6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t280)) + t280
-    t282 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t279)) + t279
-    t283 = xp.where(xp.less_equal(t134, 1e-24*t135), 0, xp.atan2(t130, -t131))
-    t284 = t283
-    t285 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t284)) + t284
-    t286 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t283) + t283
-    t287 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t286)) + t286
-    t288 = -t282
-    t289 = 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t288)) + t282
-    t290 = xp.where(t158, 0, xp.atan2(-t163, t151))
-    t291 = t290
-    t292 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t291)) + t291
-    t293 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t290) + t290
+    t3 = t1 + t2
+    t4 = -0.1337*T10 + 0.412*T12
+    t5 = -t4 + T13
+    t6 = t4 + t5
+    t7 = -0.1337*T20 + 0.412*T22
+    t8 = -t7 + T23
+    t9 = t7 + t8
+    t10 = -0.412 + t9
+    t11 = t10**2
+    t12 = t11 + t3**2 + t6**2
+    t13 = 0.01787569 - t12
+    t14 = 0.01787569 + t12
+    t15 = -t13
+    t16 = 1e-12*t14
+    t17 = xp.greater(t15, t16)
+    t18 = xp.where(t17, xp.sqrt(t15), 0)
+    t19 = t18**2
+    t20 = 0.01787569 + t19
+    t21 = 0.01787569 + t11
+    t22 = -t20 + t21
+    t23 = -t22
+    t24 = 1e-12*t20
+    t25 = xp.greater(t23, t24)
+    t26 = xp.where(t25, xp.sqrt(t23), 0)
+    t27 = t3*t26
+    t28 = 0.1337*t6 + t11
+    t29 = -t27 + t28
+    t30 = t27 + t28
+    t31 = -t11
+    t32 = t31 + t29
+    t33 = t31 + t30
+    t34 = 0.1337*t3
+    t35 = t6*t26
+    t36 = t34 + t35
+    t37 = t32**2 + t36**2
+    t38 = -t34 + t35
+    t39 = t33**2 + t38**2
+    t40 = t26**2
+    t41 = t21 + t40
+    t42 = 1e-24*t41
+    t43 = t42*t12
+    t44 = xp.less_equal(t37, t43)
+    t45 = xp.where(t44, 1, 1/xp.sqrt(t37))
+    t46 = xp.where(t44, 1, t32*t45)
+    t47 = xp.where(t44, 0, -t36*t45)
+    t48 = T02*t46 + T12*t47
+    t49 = T12*t46 - T02*t47
+    t50 = T00*t46 + T10*t47
+    t51 = T10*t46 - T00*t47
+    t52 = xp.where(t44, 0, xp.atan2(-t36, t32))
+    t53 = t52 - 6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t52))
+    t54 = t10*t18
+    t55 = 0.01787569 + t54
+    t56 = -0.01787569 + t55
+    t57 = 0.01787569 - t54
+    t58 = -0.01787569 + t57
+    t59 = t19*t40
+    t60 = t59 + t56**2
+    t61 = t59 + t58**2
+    t62 = t42*t20
+    t63 = xp.less_equal(t60, t62)
+    t64 = xp.where(t63, 1, 1/xp.sqrt(t60))
+    t65 = xp.where(t63, 1, t56*t64)
+    t66 = t18*t26
+    t67 = xp.where(t63, 0, xp.atan2(t66, t56))
+    t68 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t67)) + t67
+    t69 = t66*t64
+    t70 = xp.where(t63, 0, -t69)
+    t71 = xp.where(t63, 0, t69)
+    t72 = xp.less_equal(t39, t43)
+    t73 = xp.where(t72, 1, 1/xp.sqrt(t39))
+    t74 = xp.where(t72, 1, t33*t73)
+    t75 = xp.where(t72, 0, t38*t73)
+    t76 = T02*t74 + T12*t75
+    t77 = T12*t74 - T02*t75
+    t78 = T00*t74 + T10*t75
+    t79 = T10*t74 - T00*t75
+    t80 = xp.where(t72, 0, xp.atan2(t38, t33))
+    t81 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t80)) + t80
+    t82 = 1 - t46
+    t83 = t82*T22
+    t84 = t83 + T22*t46
+    t85 = t82*T20
+    t86 = t85 + T20*t46
+    t87 = t65*t48 - t70*t84
+    t88 = t65*t84 + t70*t48
+    t89 = t65*t50 - t70*t86
+    t90 = t65*t86 + t70*t50
+    t91 = 1 - t65
+    t92 = t91*t49
+    t93 = t92 + t65*t49
+    t94 = t91*t51
+    t95 = t94 + t65*t51
+    t96 = t91*t77
+    t97 = t96 + t65*t77
+    t98 = t91*t79
+    t99 = t98 + t65*t79
+    t100 = t88**2
+    t101 = -t100
+    t102 = 1 + t101
+    t103 = xp.greater(t102, 1e-12)
+    t104 = xp.where(t103, xp.sqrt(t102), 0)
+    t105 = t100 + t93*t104
+    t106 = t101 + t105
+    t107 = t87**2
+    t108 = t100 + t107 + t93**2
+    t109 = t104**2
+    t110 = t106**2 + t107*t109
+    t111 = t100 + t109
+    t112 = 1e-24*t111
+    t113 = xp.less_equal(t110, t112*t108)
+    t114 = xp.where(t113, 1, 1/xp.sqrt(t110))
+    t115 = xp.where(t113, 1, t106*t114)
+    t116 = t90*(1 - t115)
+    t117 = t116 + t90*t115
+    t118 = t87*t104
+    t119 = xp.where(t113, 0, -t118*t114)
+    t120 = t89*t115 + t95*t119
+    t121 = t95*t115 - t89*t119
+    t122 = xp.less_equal(t111, t112)
+    t123 = xp.where(t122, 1, 1/xp.sqrt(t111))
+    t124 = xp.where(t122, 1, t88*t123)
+    t125 = xp.where(t122, 0, -t104*t123)
+    t126 = t120*(1 - t124)
+    t127 = t126 + t124*t120
+    t128 = t124*t121 + t125*t117
+    t129 = t124*t117 - t125*t121
+    t130 = t127**2 + t128**2
+    t131 = t130 + t129**2
+    t132 = 1 - t74
+    t133 = t132*T22
+    t134 = t133 + T22*t74
+    t135 = t132*T20
+    t136 = t135 + T20*t74
+    t137 = t65*t76 - t71*t134
+    t138 = t65*t134 + t71*t76
+    t139 = t65*t78 - t71*t136
+    t140 = t65*t136 + t71*t78
+    t141 = t138**2
+    t142 = -t141
+    t143 = 1 + t142
+    t144 = xp.greater(t143, 1e-12)
+    t145 = xp.where(t144, xp.sqrt(t143), 0)
+    t146 = t141 + t97*t145
+    t147 = t142 + t146
+    t148 = t137**2
+    t149 = t141 + t148 + t97**2
+    t150 = t145**2
+    t151 = t147**2 + t148*t150
+    t152 = t141 + t150
+    t153 = 1e-24*t152
+    t154 = xp.less_equal(t151, t153*t149)
+    t155 = xp.where(t154, 1, 1/xp.sqrt(t151))
+    t156 = xp.where(t154, 1, t147*t155)
+    t157 = t140*(1 - t156)
+    t158 = t157 + t140*t156
+    t159 = t137*t145
+    t160 = xp.where(t154, 0, -t159*t155)
+    t161 = t139*t156 + t99*t160
+    t162 = t99*t156 - t139*t160
+    t163 = xp.less_equal(t152, t153)
+    t164 = xp.where(t163, 1, 1/xp.sqrt(t152))
+    t165 = xp.where(t163, 1, t138*t164)
+    t166 = xp.where(t163, 0, -t145*t164)
+    t167 = t161*(1 - t165)
+    t168 = t167 + t165*t161
+    t169 = t165*t162 + t166*t158
+    t170 = t165*t158 - t166*t162
+    t171 = t168**2 + t169**2
+    t172 = t171 + t170**2
+    t173 = xp.less_equal(t61, t62)
+    t174 = xp.where(t173, 1, 1/xp.sqrt(t61))
+    t175 = xp.where(t173, 1, t58*t174)
+    t176 = xp.where(t173, 0, xp.atan2(t66, t58))
+    t177 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t176)) + t176
+    t178 = t66*t174
+    t179 = xp.where(t173, 0, t178)
+    t180 = xp.where(t173, 0, -t178)
+    t181 = t48*t175 - t84*t179
+    t182 = t84*t175 + t48*t179
+    t183 = t50*t175 - t86*t179
+    t184 = t86*t175 + t50*t179
+    t185 = t76*t175 - t134*t180
+    t186 = t134*t175 + t76*t180
+    t187 = t78*t175 - t136*t180
+    t188 = t136*t175 + t78*t180
+    t189 = 1 - t175
+    t190 = t189*t49
+    t191 = t190 + t49*t175
+    t192 = t189*t51
+    t193 = t192 + t51*t175
+    t194 = t189*t77
+    t195 = t194 + t77*t175
+    t196 = t189*t79
+    t197 = t196 + t79*t175
+    t198 = t182**2
+    t199 = -t198
+    t200 = 1 + t199
+    t201 = xp.greater(t200, 1e-12)
+    t202 = xp.where(t201, xp.sqrt(t200), 0)
+    t203 = t198 + t191*t202
+    t204 = t199 + t203
+    t205 = t181**2
+    t206 = t198 + t205 + t191**2
+    t207 = t202**2
+    t208 = t204**2 + t205*t207
+    t209 = t198 + t207
+    t210 = 1e-24*t209
+    t211 = xp.less_equal(t208, t210*t206)
+    t212 = xp.where(t211, 1, 1/xp.sqrt(t208))
+    t213 = xp.where(t211, 1, t204*t212)
+    t214 = t184*(1 - t213)
+    t215 = t214 + t184*t213
+    t216 = t181*t202
+    t217 = xp.where(t211, 0, -t216*t212)
+    t218 = t183*t213 + t193*t217
+    t219 = t193*t213 - t183*t217
+    t220 = xp.less_equal(t209, t210)
+    t221 = xp.where(t220, 1, 1/xp.sqrt(t209))
+    t222 = xp.where(t220, 1, t182*t221)
+    t223 = xp.where(t220, 0, -t202*t221)
+    t224 = t218*(1 - t222)
+    t225 = t224 + t222*t218
+    t226 = t222*t219 + t223*t215
+    t227 = t222*t215 - t223*t219
+    t228 = t225**2 + t226**2
+    t229 = t228 + t227**2
+    t230 = t186**2
+    t231 = -t230
+    t232 = 1 + t231
+    t233 = xp.greater(t232, 1e-12)
+    t234 = xp.where(t233, xp.sqrt(t232), 0)
+    t235 = t230 + t195*t234
+    t236 = t231 + t235
+    t237 = t185**2
+    t238 = t230 + t237 + t195**2
+    t239 = t234**2
+    t240 = t236**2 + t237*t239
+    t241 = t230 + t239
+    t242 = 1e-24*t241
+    t243 = xp.less_equal(t240, t242*t238)
+    t244 = xp.where(t243, 1, 1/xp.sqrt(t240))
+    t245 = xp.where(t243, 1, t236*t244)
+    t246 = t188*(1 - t245)
+    t247 = t246 + t188*t245
+    t248 = t185*t234
+    t249 = xp.where(t243, 0, -t248*t244)
+    t250 = t187*t245 + t197*t249
+    t251 = t197*t245 - t187*t249
+    t252 = xp.less_equal(t241, t242)
+    t253 = xp.where(t252, 1, 1/xp.sqrt(t241))
+    t254 = xp.where(t252, 1, t186*t253)
+    t255 = xp.where(t252, 0, -t234*t253)
+    t256 = t250*(1 - t254)
+    t257 = t256 + t254*t250
+    t258 = t254*t251 + t255*t247
+    t259 = t254*t247 - t255*t251
+    t260 = t257**2 + t258**2
+    t261 = t260 + t259**2
+    t262 = -t66
+    t263 = xp.where(t63, 0, xp.atan2(t262, t56))
+    t264 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t263)) + t263
+    t265 = xp.where(t173, 0, xp.atan2(t262, t58))
+    t266 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t265)) + t265
+    t267 = xp.where(t113, 0, xp.atan2(-t118, t106))
+    t268 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t267)) + t267
+    t269 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t267) + t267
+    t270 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t269)) + t269
+    t271 = xp.where(t122, 0, xp.atan2(-t104, t88))
+    t272 = -6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t271)) + t271
+    t273 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t271)) + t271
+    t274 = xp.where(xp.less_equal(t130, 1e-24*t131), 0, xp.atan2(t127, -t128))
+    t275 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t274)) + t274
+    t276 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t274) + t274
+    t277 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t276)) + t276
+    t278 = -t273
+    t279 = 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t278)) + t273
+    t280 = xp.where(t154, 0, xp.atan2(-t159, t147))
+    t281 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t280)) + t280
+    t282 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t280) + t280
+    t283 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t282)) + t282
+    t284 = xp.where(t163, 0, xp.atan2(-t145, t138))
+    t285 = -6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t284)) + t284
+    t286 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t284)) + t284
+    t287 = xp.where(xp.less_equal(t171, 1e-24*t172), 0, xp.atan2(t168, -t169))
+    t288 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t287)) + t287
+    t289 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t287) + t287
+    t290 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t289)) + t289
+    t291 = -t286
+    t292 = 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t291)) + t286
+    t293 = xp.where(t211, 0, xp.atan2(-t216, t204))
     t294 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t293)) + t293
-    t295 = xp.where(t167, 0, xp.atan2(-t149, t142))
-    t296 = t295
-    t297 = -6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t296)) + t296
-    t298 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t295)) + t295
-    t299 = xp.where(xp.less_equal(t176, 1e-24*t177), 0, xp.atan2(t172, -t173))
-    t300 = t299
+    t295 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t293) + t293
+    t296 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t295)) + t295
+    t297 = xp.where(t220, 0, xp.atan2(-t202, t182))
+    t298 = -6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t297)) + t297
+    t299 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t297)) + t297
+    t300 = xp.where(xp.less_equal(t228, 1e-24*t229), 0, xp.atan2(t225, -t226))
     t301 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t300)) + t300
-    t302 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t299) + t299
+    t302 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t300) + t300
     t303 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t302)) + t302
-    t304 = -t298
-    t305 = 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t304)) + t298
-    t306 = xp.where(t216, 0, xp.atan2(-t221, t209))
-    t307 = t306
-    t308 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t307)) + t307
-    t309 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t306) + t306
-    t310 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t309)) + t309
-    t311 = xp.where(t225, 0, xp.atan2(-t207, t187))
-    t312 = t311
-    t313 = -6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t312)) + t312
-    t314 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t311)) + t311
-    t315 = xp.where(xp.less_equal(t234, 1e-24*t235), 0, xp.atan2(t230, -t231))
-    t316 = t315
-    t317 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t316)) + t316
-    t318 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t315) + t315
-    t319 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t318)) + t318
-    t320 = -t314
-    t321 = 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t320)) + t314
-    t322 = xp.where(t249, 0, xp.atan2(-t254, t242))
-    t323 = t322
-    t324 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t323)) + t323
-    t325 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t322) + t322
-    t326 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t325)) + t325
-    t327 = xp.where(t258, 0, xp.atan2(-t240, t191))
-    t328 = t327
-    t329 = -6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t328)) + t328
-    t330 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t327)) + t327
-    t331 = xp.where(xp.less_equal(t267, 1e-24*t268), 0, xp.atan2(t263, -t264))
-    t332 = t331
-    t333 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t332)) + t332
-    t334 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t331) + t331
-    t335 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t334)) + t334
-    t336 = -t330
-    t337 = 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t336)) + t330
-    t338 = xp.greater_equal(t55, -2.9670597283903604) & xp.less_equal(t55, 2.9670597283903604)
-    t339 = xp.less_equal(t56, 2.9670597283903604)
-    t340 = xp.where(xp.logical_not(t338) & t339, t56, t55)
-    t341 = xp.greater_equal(t270, -2.9670597283903604) & xp.less_equal(t270, 2.9670597283903604)
-    t342 = xp.less_equal(t271, 2.9670597283903604)
-    t343 = xp.where(xp.logical_not(t341) & t342, t271, t270)
-    t344 = xp.greater_equal(t275, -2.9670597283903604) & xp.less_equal(t275, 2.9670597283903604)
-    t345 = xp.less_equal(t276, 2.9670597283903604)
-    t346 = xp.greater_equal(t280, -1.5707963267948966) & xp.less_equal(t280, 1.5707963267948966)
-    t347 = xp.less_equal(t281, 1.5707963267948966)
-    t348 = xp.greater_equal(t284, -2.9670597283903604) & xp.less_equal(t284, 2.9670597283903604)
-    t349 = xp.less_equal(t285, 2.9670597283903604)
-    t350 = xp.greater_equal(t277, -2.9670597283903604) & xp.less_equal(t277, 2.9670597283903604)
-    t351 = xp.less_equal(t278, 2.9670597283903604)
-    t352 = xp.greater_equal(t288, -1.5707963267948966) & xp.less_equal(t288, 1.5707963267948966)
-    t353 = -t289
+    t304 = -t299
+    t305 = 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t304)) + t299
+    t306 = xp.where(t243, 0, xp.atan2(-t248, t236))
+    t307 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t306)) + t306
+    t308 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t306) + t306
+    t309 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t308)) + t308
+    t310 = xp.where(t252, 0, xp.atan2(-t234, t186))
+    t311 = -6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t310)) + t310
+    t312 = 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t310)) + t310
+    t313 = xp.where(xp.less_equal(t260, 1e-24*t261), 0, xp.atan2(t257, -t258))
+    t314 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t313)) + t313
+    t315 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t313) + t313
+    t316 = -6.283185307179586*xp.floor(0.15915494309189535*(2.9670597283903604 + t315)) + t315
+    t317 = -t312
+    t318 = 6.283185307179586*xp.floor(0.15915494309189535*(1.5707963267948966 + t317)) + t312
+    t319 = xp.greater_equal(t52, -2.9670597283903604) & xp.less_equal(t52, 2.9670597283903604)
+    t320 = xp.less_equal(t53, 2.9670597283903604)
+    t321 = xp.where(xp.logical_not(t319) & t320, t53, t52)
+    t322 = xp.greater_equal(t263, -2.9670597283903604) & xp.less_equal(t263, 2.9670597283903604)
+    t323 = xp.less_equal(t264, 2.9670597283903604)
+    t324 = xp.where(xp.logical_not(t322) & t323, t264, t263)
+    t325 = xp.greater_equal(t267, -2.9670597283903604) & xp.less_equal(t267, 2.9670597283903604)
+    t326 = xp.less_equal(t268, 2.9670597283903604)
+    t327 = xp.greater_equal(t271, -1.5707963267948966) & xp.less_equal(t271, 1.5707963267948966)
+    t328 = xp.less_equal(t272, 1.5707963267948966)
+    t329 = xp.greater_equal(t274, -2.9670597283903604) & xp.less_equal(t274, 2.9670597283903604)
+    t330 = xp.less_equal(t275, 2.9670597283903604)
+    t331 = xp.greater_equal(t269, -2.9670597283903604) & xp.less_equal(t269, 2.9670597283903604)
+    t332 = xp.less_equal(t270, 2.9670597283903604)
+    t333 = xp.greater_equal(t278, -1.5707963267948966) & xp.less_equal(t278, 1.5707963267948966)
+    t334 = -t279
+    t335 = xp.less_equal(t334, 1.5707963267948966)
+    t336 = xp.greater_equal(t276, -2.9670597283903604) & xp.less_equal(t276, 2.9670597283903604)
+    t337 = xp.less_equal(t277, 2.9670597283903604)
+    t338 = xp.greater_equal(t80, -2.9670597283903604) & xp.less_equal(t80, 2.9670597283903604)
+    t339 = xp.less_equal(t81, 2.9670597283903604)
+    t340 = xp.where(xp.logical_not(t338) & t339, t81, t80)
+    t341 = xp.greater_equal(t67, -2.9670597283903604) & xp.less_equal(t67, 2.9670597283903604)
+    t342 = xp.less_equal(t68, 2.9670597283903604)
+    t343 = xp.where(xp.logical_not(t341) & t342, t68, t67)
+    t344 = xp.greater_equal(t280, -2.9670597283903604) & xp.less_equal(t280, 2.9670597283903604)
+    t345 = xp.less_equal(t281, 2.9670597283903604)
+    t346 = xp.greater_equal(t284, -1.5707963267948966) & xp.less_equal(t284, 1.5707963267948966)
+    t347 = xp.less_equal(t285, 1.5707963267948966)
+    t348 = xp.greater_equal(t287, -2.9670597283903604) & xp.less_equal(t287, 2.9670597283903604)
+    t349 = xp.less_equal(t288, 2.9670597283903604)
+    t350 = xp.greater_equal(t282, -2.9670597283903604) & xp.less_equal(t282, 2.9670597283903604)
+    t351 = xp.less_equal(t283, 2.9670597283903604)
+    t352 = xp.greater_equal(t291, -1.5707963267948966) & xp.less_equal(t291, 1.5707963267948966)
+    t353 = -t292
     t354 = xp.less_equal(t353, 1.5707963267948966)
-    t355 = xp.greater_equal(t286, -2.9670597283903604) & xp.less_equal(t286, 2.9670597283903604)
-    t356 = xp.less_equal(t287, 2.9670597283903604)
-    t357 = xp.greater_equal(t83, -2.9670597283903604) & xp.less_equal(t83, 2.9670597283903604)
-    t358 = xp.less_equal(t84, 2.9670597283903604)
-    t359 = xp.where(xp.logical_not(t357) & t358, t84, t83)
-    t360 = xp.greater_equal(t70, -2.9670597283903604) & xp.less_equal(t70, 2.9670597283903604)
-    t361 = xp.less_equal(t71, 2.9670597283903604)
-    t362 = xp.where(xp.logical_not(t360) & t361, t71, t70)
-    t363 = xp.greater_equal(t291, -2.9670597283903604) & xp.less_equal(t291, 2.9670597283903604)
-    t364 = xp.less_equal(t292, 2.9670597283903604)
-    t365 = xp.greater_equal(t296, -1.5707963267948966) & xp.less_equal(t296, 1.5707963267948966)
-    t366 = xp.less_equal(t297, 1.5707963267948966)
-    t367 = xp.greater_equal(t300, -2.9670597283903604) & xp.less_equal(t300, 2.9670597283903604)
-    t368 = xp.less_equal(t301, 2.9670597283903604)
-    t369 = xp.greater_equal(t293, -2.9670597283903604) & xp.less_equal(t293, 2.9670597283903604)
-    t370 = xp.less_equal(t294, 2.9670597283903604)
-    t371 = xp.greater_equal(t304, -1.5707963267948966) & xp.less_equal(t304, 1.5707963267948966)
-    t372 = -t305
-    t373 = xp.less_equal(t372, 1.5707963267948966)
-    t374 = xp.greater_equal(t302, -2.9670597283903604) & xp.less_equal(t302, 2.9670597283903604)
-    t375 = xp.less_equal(t303, 2.9670597283903604)
-    t376 = xp.greater_equal(t181, -2.9670597283903604) & xp.less_equal(t181, 2.9670597283903604)
-    t377 = xp.less_equal(t182, 2.9670597283903604)
-    t378 = xp.where(xp.logical_not(t376) & t377, t182, t181)
-    t379 = -t21
-    t380 = xp.greater_equal(t307, -2.9670597283903604) & xp.less_equal(t307, 2.9670597283903604)
-    t381 = xp.less_equal(t308, 2.9670597283903604)
-    t382 = xp.greater_equal(t312, -1.5707963267948966) & xp.less_equal(t312, 1.5707963267948966)
-    t383 = xp.less_equal(t313, 1.5707963267948966)
-    t384 = xp.greater_equal(t316, -2.9670597283903604) & xp.less_equal(t316, 2.9670597283903604)
-    t385 = xp.less_equal(t317, 2.9670597283903604)
-    t386 = xp.greater_equal(t309, -2.9670597283903604) & xp.less_equal(t309, 2.9670597283903604)
-    t387 = xp.less_equal(t310, 2.9670597283903604)
-    t388 = xp.greater_equal(t320, -1.5707963267948966) & xp.less_equal(t320, 1.5707963267948966)
-    t389 = -t321
-    t390 = xp.less_equal(t389, 1.5707963267948966)
-    t391 = xp.greater_equal(t318, -2.9670597283903604) & xp.less_equal(t318, 2.9670597283903604)
-    t392 = xp.less_equal(t319, 2.9670597283903604)
-    t393 = xp.greater_equal(t272, -2.9670597283903604) & xp.less_equal(t272, 2.9670597283903604)
-    t394 = xp.less_equal(t273, 2.9670597283903604)
-    t395 = xp.where(xp.logical_not(t393) & t394, t273, t272)
-    t396 = xp.greater_equal(t323, -2.9670597283903604) & xp.less_equal(t323, 2.9670597283903604)
-    t397 = xp.less_equal(t324, 2.9670597283903604)
-    t398 = xp.greater_equal(t328, -1.5707963267948966) & xp.less_equal(t328, 1.5707963267948966)
-    t399 = xp.less_equal(t329, 1.5707963267948966)
-    t400 = xp.greater_equal(t332, -2.9670597283903604) & xp.less_equal(t332, 2.9670597283903604)
-    t401 = xp.less_equal(t333, 2.9670597283903604)
-    t402 = xp.greater_equal(t325, -2.9670597283903604) & xp.less_equal(t325, 2.9670597283903604)
-    t403 = xp.less_equal(t326, 2.9670597283903604)
-    t404 = xp.greater_equal(t336, -1.5707963267948966) & xp.less_equal(t336, 1.5707963267948966)
-    t405 = -t337
-    t406 = xp.less_equal(t405, 1.5707963267948966)
-    t407 = xp.greater_equal(t334, -2.9670597283903604) & xp.less_equal(t334, 2.9670597283903604)
-    t408 = xp.less_equal(t335, 2.9670597283903604)
-    t409 = xp.isfinite(t0)
-    t410 = xp.greater_equal(t18, -t19)
-    t411 = xp.greater_equal(t26, -t27)
-    t412 = t338 | t339
-    t413 = t341 | t342
-    t414 = xp.greater_equal(t21, 0.30479999999999996)
-    t415 = xp.less_equal(t21, 1.27)
-    t416 = t357 | t358
-    t417 = t360 | t361
-    t418 = t376 | t377
-    t419 = xp.greater_equal(t379, 0.30479999999999996)
-    t420 = xp.less_equal(t379, 1.27)
-    t421 = t393 | t394
+    t355 = xp.greater_equal(t289, -2.9670597283903604) & xp.less_equal(t289, 2.9670597283903604)
+    t356 = xp.less_equal(t290, 2.9670597283903604)
+    t357 = xp.greater_equal(t176, -2.9670597283903604) & xp.less_equal(t176, 2.9670597283903604)
+    t358 = xp.less_equal(t177, 2.9670597283903604)
+    t359 = xp.where(xp.logical_not(t357) & t358, t177, t176)
+    t360 = -t18
+    t361 = xp.greater_equal(t293, -2.9670597283903604) & xp.less_equal(t293, 2.9670597283903604)
+    t362 = xp.less_equal(t294, 2.9670597283903604)
+    t363 = xp.greater_equal(t297, -1.5707963267948966) & xp.less_equal(t297, 1.5707963267948966)
+    t364 = xp.less_equal(t298, 1.5707963267948966)
+    t365 = xp.greater_equal(t300, -2.9670597283903604) & xp.less_equal(t300, 2.9670597283903604)
+    t366 = xp.less_equal(t301, 2.9670597283903604)
+    t367 = xp.greater_equal(t295, -2.9670597283903604) & xp.less_equal(t295, 2.9670597283903604)
+    t368 = xp.less_equal(t296, 2.9670597283903604)
+    t369 = xp.greater_equal(t304, -1.5707963267948966) & xp.less_equal(t304, 1.5707963267948966)
+    t370 = -t305
+    t371 = xp.less_equal(t370, 1.5707963267948966)
+    t372 = xp.greater_equal(t302, -2.9670597283903604) & xp.less_equal(t302, 2.9670597283903604)
+    t373 = xp.less_equal(t303, 2.9670597283903604)
+    t374 = xp.greater_equal(t265, -2.9670597283903604) & xp.less_equal(t265, 2.9670597283903604)
+    t375 = xp.less_equal(t266, 2.9670597283903604)
+    t376 = xp.where(xp.logical_not(t374) & t375, t266, t265)
+    t377 = xp.greater_equal(t306, -2.9670597283903604) & xp.less_equal(t306, 2.9670597283903604)
+    t378 = xp.less_equal(t307, 2.9670597283903604)
+    t379 = xp.greater_equal(t310, -1.5707963267948966) & xp.less_equal(t310, 1.5707963267948966)
+    t380 = xp.less_equal(t311, 1.5707963267948966)
+    t381 = xp.greater_equal(t313, -2.9670597283903604) & xp.less_equal(t313, 2.9670597283903604)
+    t382 = xp.less_equal(t314, 2.9670597283903604)
+    t383 = xp.greater_equal(t308, -2.9670597283903604) & xp.less_equal(t308, 2.9670597283903604)
+    t384 = xp.less_equal(t309, 2.9670597283903604)
+    t385 = xp.greater_equal(t317, -1.5707963267948966) & xp.less_equal(t317, 1.5707963267948966)
+    t386 = -t318
+    t387 = xp.less_equal(t386, 1.5707963267948966)
+    t388 = xp.greater_equal(t315, -2.9670597283903604) & xp.less_equal(t315, 2.9670597283903604)
+    t389 = xp.less_equal(t316, 2.9670597283903604)
+    t390 = xp.isfinite(t0)
+    t391 = xp.greater_equal(t15, -t16)
+    t392 = xp.greater_equal(t23, -t24)
+    t393 = t319 | t320
+    t394 = t322 | t323
+    t395 = xp.greater_equal(t18, 0.30479999999999996)
+    t396 = xp.less_equal(t18, 1.27)
+    t397 = t338 | t339
+    t398 = t341 | t342
+    t399 = t357 | t358
+    t400 = xp.greater_equal(t360, 0.30479999999999996)
+    t401 = xp.less_equal(t360, 1.27)
+    t402 = t374 | t375
     q = _stack(xp, [
-        t340,  # 0, 0
-        t343,  # 0, 1
-        t21,  # 0, 2
-        xp.where(xp.logical_not(t344) & t345, t276, t275),  # 0, 3
-        xp.where(xp.logical_not(t346) & t347, t281, t280),  # 0, 4
-        xp.where(xp.logical_not(t348) & t349, t285, t284),  # 0, 5
-        t340,  # 1, 0
-        t343,  # 1, 1
-        t21,  # 1, 2
-        xp.where(xp.logical_not(t350) & t351, t278, t277),  # 1, 3
-        xp.where(xp.logical_not(t352) & t354, t353, t288),  # 1, 4
-        xp.where(xp.logical_not(t355) & t356, t287, t286),  # 1, 5
-        t359,  # 2, 0
-        t362,  # 2, 1
-        t21,  # 2, 2
-        xp.where(xp.logical_not(t363) & t364, t292, t291),  # 2, 3
-        xp.where(xp.logical_not(t365) & t366, t297, t296),  # 2, 4
-        xp.where(xp.logical_not(t367) & t368, t301, t300),  # 2, 5
-        t359,  # 3, 0
-        t362,  # 3, 1
-        t21,  # 3, 2
-        xp.where(xp.logical_not(t369) & t370, t294, t293),  # 3, 3
-        xp.where(xp.logical_not(t371) & t373, t372, t304),  # 3, 4
-        xp.where(xp.logical_not(t374) & t375, t303, t302),  # 3, 5
-        t340,  # 4, 0
-        t378,  # 4, 1
-        t379,  # 4, 2
-        xp.where(xp.logical_not(t380) & t381, t308, t307),  # 4, 3
-        xp.where(xp.logical_not(t382) & t383, t313, t312),  # 4, 4
-        xp.where(xp.logical_not(t384) & t385, t317, t316),  # 4, 5
-        t340,  # 5, 0
-        t378,  # 5, 1
-        t379,  # 5, 2
-        xp.where(xp.logical_not(t386) & t387, t310, t309),  # 5, 3
-        xp.where(xp.logical_not(t388) & t390, t389, t320),  # 5, 4
-        xp.where(xp.logical_not(t391) & t392, t319, t318),  # 5, 5
-        t359,  # 6, 0
-        t395,  # 6, 1
-        t379,  # 6, 2
-        xp.where(xp.logical_not(t396) & t397, t324, t323),  # 6, 3
-        xp.where(xp.logical_not(t398) & t399, t329, t328),  # 6, 4
-        xp.where(xp.logical_not(t400) & t401, t333, t332),  # 6, 5
-        t359,  # 7, 0
-        t395,  # 7, 1
-        t379,  # 7, 2
-        xp.where(xp.logical_not(t402) & t403, t326, t325),  # 7, 3
-        xp.where(xp.logical_not(t404) & t406, t405, t336),  # 7, 4
-        xp.where(xp.logical_not(t407) & t408, t335, t334),  # 7, 5
+        t321,  # 0, 0
+        t324,  # 0, 1
+        t18,  # 0, 2
+        xp.where(xp.logical_not(t325) & t326, t268, t267),  # 0, 3
+        xp.where(xp.logical_not(t327) & t328, t272, t271),  # 0, 4
+        xp.where(xp.logical_not(t329) & t330, t275, t274),  # 0, 5
+        t321,  # 1, 0
+        t324,  # 1, 1
+        t18,  # 1, 2
+        xp.where(xp.logical_not(t331) & t332, t270, t269),  # 1, 3
+        xp.where(xp.logical_not(t333) & t335, t334, t278),  # 1, 4
+        xp.where(xp.logical_not(t336) & t337, t277, t276),  # 1, 5
+        t340,  # 2, 0
+        t343,  # 2, 1
+        t18,  # 2, 2
+        xp.where(xp.logical_not(t344) & t345, t281, t280),  # 2, 3
+        xp.where(xp.logical_not(t346) & t347, t285, t284),  # 2, 4
+        xp.where(xp.logical_not(t348) & t349, t288, t287),  # 2, 5
+        t340,  # 3, 0
+        t343,  # 3, 1
+        t18,  # 3, 2
+        xp.where(xp.logical_not(t350) & t351, t283, t282),  # 3, 3
+        xp.where(xp.logical_not(t352) & t354, t353, t291),  # 3, 4
+        xp.where(xp.logical_not(t355) & t356, t290, t289),  # 3, 5
+        t321,  # 4, 0
+        t359,  # 4, 1
+        t360,  # 4, 2
+        xp.where(xp.logical_not(t361) & t362, t294, t293),  # 4, 3
+        xp.where(xp.logical_not(t363) & t364, t298, t297),  # 4, 4
+        xp.where(xp.logical_not(t365) & t366, t301, t300),  # 4, 5
+        t321,  # 5, 0
+        t359,  # 5, 1
+        t360,  # 5, 2
+        xp.where(xp.logical_not(t367) & t368, t296, t295),  # 5, 3
+        xp.where(xp.logical_not(t369) & t371, t370, t304),  # 5, 4
+        xp.where(xp.logical_not(t372) & t373, t303, t302),  # 5, 5
+        t340,  # 6, 0
+        t376,  # 6, 1
+        t360,  # 6, 2
+        xp.where(xp.logical_not(t377) & t378, t307, t306),  # 6, 3
+        xp.where(xp.logical_not(t379) & t380, t311, t310),  # 6, 4
+        xp.where(xp.logical_not(t381) & t382, t314, t313),  # 6, 5
+        t340,  # 7, 0
+        t376,  # 7, 1
+        t360,  # 7, 2
+        xp.where(xp.logical_not(t383) & t384, t309, t308),  # 7, 3
+        xp.where(xp.logical_not(t385) & t387, t386, t317),  # 7, 4
+        xp.where(xp.logical_not(t388) & t389, t316, t315),  # 7, 5
     ], (8, 6))
     valid = _stack(xp, [
-        t409 & t410 & t411 & xp.greater_equal(t105, -1e-12),  # 0
-        t409 & t410 & t411 & t106,  # 1
-        t409 & t410 & t28 & xp.greater_equal(t147, -1e-12),  # 2
-        t409 & t410 & t28 & t148,  # 3
-        t409 & t20 & t411 & xp.greater_equal(t205, -1e-12),  # 4
-        t409 & t20 & t411 & t206,  # 5
-        t409 & t20 & t28 & xp.greater_equal(t238, -1e-12),  # 6
-        t409 & t20 & t28 & t239,  # 7
+        t390 & t391 & t392 & xp.greater_equal(t102, -1e-12),  # 0
+        t390 & t391 & t392 & t103,  # 1
+        t390 & t391 & t25 & xp.greater_equal(t143, -1e-12),  # 2
+        t390 & t391 & t25 & t144,  # 3
+        t390 & t17 & t392 & xp.greater_equal(t200, -1e-12),  # 4
+        t390 & t17 & t392 & t201,  # 5
+        t390 & t17 & t25 & xp.greater_equal(t232, -1e-12),  # 6
+        t390 & t17 & t25 & t233,  # 7
     ], (8,))
     in_limits = _stack(xp, [
-        t412 & t413 & t414 & t415 & (t344 | t345) & (t346 | t347) & (t348 | t349),  # 0
-        t412 & t413 & t414 & t415 & (t350 | t351) & (t352 | t354) & (t355 | t356),  # 1
-        t416 & t417 & t414 & t415 & (t363 | t364) & (t365 | t366) & (t367 | t368),  # 2
-        t416 & t417 & t414 & t415 & (t369 | t370) & (t371 | t373) & (t374 | t375),  # 3
-        t412 & t418 & t419 & t420 & (t380 | t381) & (t382 | t383) & (t384 | t385),  # 4
-        t412 & t418 & t419 & t420 & (t386 | t387) & (t388 | t390) & (t391 | t392),  # 5
-        t416 & t421 & t419 & t420 & (t396 | t397) & (t398 | t399) & (t400 | t401),  # 6
-        t416 & t421 & t419 & t420 & (t402 | t403) & (t404 | t406) & (t407 | t408),  # 7
+        t393 & t394 & t395 & t396 & (t325 | t326) & (t327 | t328) & (t329 | t330),  # 0
+        t393 & t394 & t395 & t396 & (t331 | t332) & (t333 | t335) & (t336 | t337),  # 1
+        t397 & t398 & t395 & t396 & (t344 | t345) & (t346 | t347) & (t348 | t349),  # 2
+        t397 & t398 & t395 & t396 & (t350 | t351) & (t352 | t354) & (t355 | t356),  # 3
+        t393 & t399 & t400 & t401 & (t361 | t362) & (t363 | t364) & (t365 | t366),  # 4
+        t393 & t399 & t400 & t401 & (t367 | t368) & (t369 | t371) & (t372 | t373),  # 5
+        t397 & t402 & t400 & t401 & (t377 | t378) & (t379 | t380) & (t381 | t382),  # 6
+        t397 & t402 & t400 & t401 & (t383 | t384) & (t385 | t387) & (t388 | t389),  # 7
     ], (8,))
     return q, valid, in_limits
 

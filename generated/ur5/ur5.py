@@ -672,53 +672,47 @@ def fk_jacobian_dot(q, q_dot):
     t31 = t28 - s1*t29
     t32 = s1*t22
     t33 = c234*t16 - s234*t32
-    t34 = t33
-    t35 = c1*t22
-    t36 = -c234*t11 + s234*t35
-    t37 = t36
-    t38 = c1*t30 + s1*t31
-    t39 = t38
-    t40 = c1*t27 + s1*t28
-    t41 = t40
-    t42 = c1*t12 + s1*t17
-    t43 = t42
-    t44 = t16*t8 - t11*t13
-    t45 = t44
-    t46 = s1*qd2
-    t47 = s1*qd3
-    t48 = t46 + t47
-    t49 = c1*qd2
-    t50 = c1*qd3
-    t51 = t49 + t50
-    t52 = s1*qd4
-    t53 = t52 + t48
-    t54 = t53 + t8*qd5
-    t55 = c1*qd4
-    t56 = t55 + t51
-    t57 = -t56 + t13*qd5
-    t58 = c234*qd5
-    t59 = -t58 + qd1
-    t60 = t34*qd5
-    t61 = t60 + t22*t55
-    t62 = t23*t50 + t61
-    t63 = t24*t49 + t62
-    t64 = t63 - t31*qd1
-    t65 = t37*qd5
-    t66 = t65 + t22*t52
-    t67 = t23*t47 + t66
-    t68 = t24*t46 + t67
-    t69 = t68 + t30*qd1
-    t70 = t45*qd5
-    t71 = t43*qd4 + t70
-    t72 = t71 + t41*qd3
-    t73 = t72 + t39*qd2
-    t74 = -t3
-    t75 = -t21
-    t76 = c1*t24
-    t77 = c1*t23
-    t78 = s1*t24
-    t79 = s1*t23
-    t80 = -c1
+    t34 = c1*t22
+    t35 = -c234*t11 + s234*t34
+    t36 = c1*t30 + s1*t31
+    t37 = c1*t27 + s1*t28
+    t38 = c1*t12 + s1*t17
+    t39 = t16*t8 - t11*t13
+    t40 = s1*qd2
+    t41 = s1*qd3
+    t42 = t40 + t41
+    t43 = c1*qd2
+    t44 = c1*qd3
+    t45 = t43 + t44
+    t46 = s1*qd4
+    t47 = t46 + t42
+    t48 = t47 + t8*qd5
+    t49 = c1*qd4
+    t50 = t49 + t45
+    t51 = -t50 + t13*qd5
+    t52 = c234*qd5
+    t53 = -t52 + qd1
+    t54 = t33*qd5
+    t55 = t54 + t22*t49
+    t56 = t23*t44 + t55
+    t57 = t24*t43 + t56
+    t58 = t57 - t31*qd1
+    t59 = t35*qd5
+    t60 = t59 + t22*t46
+    t61 = t23*t41 + t60
+    t62 = t24*t40 + t61
+    t63 = t62 + t30*qd1
+    t64 = t39*qd5
+    t65 = t64 + t38*qd4
+    t66 = t65 + t37*qd3
+    t67 = t66 + t36*qd2
+    t68 = -t3
+    t69 = -t21
+    t70 = c1*t24
+    t71 = c1*t23
+    t72 = s1*t24
+    t73 = s1*t23
+    t74 = -c1
     T = _stack(xp, [
         xp.broadcast_to(t9, batch),  # 0, 0
         xp.broadcast_to(-t10, batch),  # 0, 1
@@ -726,11 +720,11 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t30, batch),  # 0, 3
         xp.broadcast_to(t14, batch),  # 1, 0
         xp.broadcast_to(-t15, batch),  # 1, 1
-        xp.broadcast_to(t74, batch),  # 1, 2
+        xp.broadcast_to(t68, batch),  # 1, 2
         xp.broadcast_to(t31, batch),  # 1, 3
         xp.broadcast_to(t19, batch),  # 2, 0
         xp.broadcast_to(t20, batch),  # 2, 1
-        xp.broadcast_to(t75, batch),  # 2, 2
+        xp.broadcast_to(t69, batch),  # 2, 2
         xp.broadcast_to(t25, batch),  # 2, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1
@@ -739,22 +733,22 @@ def fk_jacobian_dot(q, q_dot):
     ], (4, 4))
     J = _stack(xp, [
         xp.broadcast_to(-t31, batch),  # 0, 0
-        xp.broadcast_to(t76, batch),  # 0, 1
-        xp.broadcast_to(t77, batch),  # 0, 2
-        xp.broadcast_to(t35, batch),  # 0, 3
+        xp.broadcast_to(t70, batch),  # 0, 1
+        xp.broadcast_to(t71, batch),  # 0, 2
+        xp.broadcast_to(t34, batch),  # 0, 3
         xp.broadcast_to(t33, batch),  # 0, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
         xp.broadcast_to(t30, batch),  # 1, 0
-        xp.broadcast_to(t78, batch),  # 1, 1
-        xp.broadcast_to(t79, batch),  # 1, 2
+        xp.broadcast_to(t72, batch),  # 1, 1
+        xp.broadcast_to(t73, batch),  # 1, 2
         xp.broadcast_to(t32, batch),  # 1, 3
-        xp.broadcast_to(t36, batch),  # 1, 4
+        xp.broadcast_to(t35, batch),  # 1, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
-        xp.broadcast_to(t38, batch),  # 2, 1
-        xp.broadcast_to(t40, batch),  # 2, 2
-        xp.broadcast_to(t42, batch),  # 2, 3
-        xp.broadcast_to(t44, batch),  # 2, 4
+        xp.broadcast_to(t36, batch),  # 2, 1
+        xp.broadcast_to(t37, batch),  # 2, 2
+        xp.broadcast_to(t38, batch),  # 2, 3
+        xp.broadcast_to(t39, batch),  # 2, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
         xp.broadcast_to(s1, batch),  # 3, 1
@@ -763,25 +757,25 @@ def fk_jacobian_dot(q, q_dot):
         xp.broadcast_to(t8, batch),  # 3, 4
         xp.broadcast_to(t6, batch),  # 3, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
-        xp.broadcast_to(t80, batch),  # 4, 1
-        xp.broadcast_to(t80, batch),  # 4, 2
-        xp.broadcast_to(t80, batch),  # 4, 3
+        xp.broadcast_to(t74, batch),  # 4, 1
+        xp.broadcast_to(t74, batch),  # 4, 2
+        xp.broadcast_to(t74, batch),  # 4, 3
         xp.broadcast_to(t13, batch),  # 4, 4
-        xp.broadcast_to(t74, batch),  # 4, 5
+        xp.broadcast_to(t68, batch),  # 4, 5
         xp.full(batch, 1, dtype=dtype, device=device),  # 5, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3
         xp.broadcast_to(-c234, batch),  # 5, 4
-        xp.broadcast_to(t75, batch),  # 5, 5
+        xp.broadcast_to(t69, batch),  # 5, 5
     ], (6, 6))
     a = _stack(xp, [
-        xp.broadcast_to(-qd1*t69 - qd2*(c1*t73 + qd1*t78) - qd3*(c1*t72 + t49*t41 + qd1*t79) - qd4*(t43*t51 + c1*t71 + t32*qd1) + qd5*(-t45*t56 - t37*qd1 + t13*t70 + t58*t37), batch),  # 0
-        xp.broadcast_to(qd1*t64 + qd2*(-s1*t73 + qd1*t76) - qd3*(s1*t72 - qd1*t77 + t46*t41) - qd4*(t43*t48 + s1*t71 - t35*qd1) - qd5*(t45*t53 - t34*qd1 + t58*t34 + t8*t70), batch),  # 1
-        xp.broadcast_to(qd2*(s1*t68 + c1*t63) + qd4*(s1*t66 + c1*t61 + t32*t48 + t35*t51) + qd5*(t37*t53 + t34*t56 + t8*t65 - t13*t60) + qd3*(s1*t67 + c1*t62 + t46*t79 + t49*t77), batch),  # 2
-        xp.broadcast_to(t49*qd1 + t50*qd1 + t55*qd1 + qd5*(c234*t56 - t13*qd1) + qd6*(t3*t59 - t21*t57), batch),  # 3
-        xp.broadcast_to(t46*qd1 + t47*qd1 + t52*qd1 + qd5*(c234*t53 + t8*qd1) + qd6*(t6*t59 + t21*t54), batch),  # 4
-        xp.broadcast_to(qd4*(-c1*t48 + s1*t51) + qd5*(t13*t53 + t8*t56) - qd6*(t3*t54 + t6*t57), batch),  # 5
+        xp.broadcast_to(-qd1*t63 - qd2*(c1*t67 + qd1*t72) - qd3*(c1*t66 + qd1*t73 + t37*t43) - qd4*(c1*t65 + t32*qd1 + t38*t45) + qd5*(t13*t64 - t39*t50 - t35*qd1 + t35*t52), batch),  # 0
+        xp.broadcast_to(qd1*t58 + qd2*(-s1*t67 + qd1*t70) - qd3*(s1*t66 - qd1*t71 + t37*t40) - qd4*(s1*t65 - t34*qd1 + t38*t42) - qd5*(t8*t64 + t39*t47 - t33*qd1 + t33*t52), batch),  # 1
+        xp.broadcast_to(qd2*(s1*t62 + c1*t57) + qd4*(s1*t60 + c1*t55 + t32*t42 + t34*t45) + qd3*(s1*t61 + c1*t56 + t40*t73 + t43*t71) + qd5*(t8*t59 - t13*t54 + t35*t47 + t33*t50), batch),  # 2
+        xp.broadcast_to(t43*qd1 + t44*qd1 + t49*qd1 + qd5*(c234*t50 - t13*qd1) + qd6*(t3*t53 - t21*t51), batch),  # 3
+        xp.broadcast_to(t40*qd1 + t41*qd1 + t46*qd1 + qd5*(c234*t47 + t8*qd1) + qd6*(t6*t53 + t21*t48), batch),  # 4
+        xp.broadcast_to(qd4*(-c1*t42 + s1*t45) + qd5*(t13*t47 + t8*t50) - qd6*(t3*t48 + t6*t51), batch),  # 5
     ], (6,))
     return T, J, a
 
@@ -994,7 +988,7 @@ def bias_acceleration(q, q_dot):
         xp.broadcast_to(-qd1*t50 - qd2*(t12*t55 + c1*t54) - qd3*(t11*t55 + c1*t53 + t30*t16) - qd4*(t10*t55 + t8*t32 + c1*t52) + qd5*(t25*t51 - t26*t37 - t23*qd1 + t39*t23), batch),  # 0
         xp.broadcast_to(qd1*t45 + qd2*(t12*t56 - s1*t54) - qd3*(s1*t53 - t11*t56 + t27*t16) - qd4*(t8*t29 + s1*t52 - t10*t56) - qd5*(t26*t34 - t22*qd1 + t39*t22 + t24*t51), batch),  # 1
         xp.broadcast_to(qd2*(s1*t49 + c1*t44) + qd4*(s1*t10*t29 + c1*t10*t32 + s1*t47 + c1*t42) + qd3*(s1*t48 + c1*t43 + s1**2*t57 + c1**2*t57) + qd5*(t23*t34 + t22*t37 + t24*t46 - t25*t41), batch),  # 2
-        xp.broadcast_to(t30*qd1 + t31*qd1 + t36*qd1 + qd5*(c234*t37 - t25*qd1) + qd6*(t2*t40 - t9*t38), batch),  # 3
+        xp.broadcast_to(t30*qd1 + t36*qd1 + t31*qd1 + qd5*(c234*t37 - t25*qd1) + qd6*(t2*t40 - t9*t38), batch),  # 3
         xp.broadcast_to(t33*qd1 + t27*qd1 + t28*qd1 + qd5*(c234*t34 + t24*qd1) + qd6*(t1*t40 + t9*t35), batch),  # 4
         xp.broadcast_to(qd4*(-c1*t29 + s1*t32) - qd6*(t2*t35 + t1*t38) + qd5*(t25*t34 + t24*t37), batch),  # 5
     ], (6,))
@@ -1644,328 +1638,322 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t61 = t24**2
     t62 = t10**2
     t63 = t20**2 + t9**2 + t61 + t62
-    t64 = t63
-    t65 = s234**2
-    t66 = t1**2 + 3*t52 + t32*t65
-    t67 = t66
-    t68 = 3*s1
-    t69 = t1*t2 + c1*t68 - t39*t65
-    t70 = t2**2 + 3*t32 + t52*t65
-    t71 = t70
-    t72 = c234**2
-    t73 = 1 + t72 + s5**2*t65
-    t74 = t73
-    t75 = t40**2
-    t76 = t44**2
-    t77 = t49**2
-    t78 = t33**2
-    t79 = t27**2
-    t80 = damping**2
-    t81 = t80 + t38
-    t82 = t81**2
-    t83 = xp.sqrt(t75 + t76 + t77 + t78 + t79 + t82)
-    t84 = t83*xp.where(xp.greater_equal(t81, 0), xp.asarray(1, dtype=dtype), -1)
-    t85 = t81 + t84
-    t86 = xp.where(xp.greater(t83, 0), 1/(t83*(t83 + xp.abs(t81))), 0)
-    t87 = t86*(mu_dot0*t85 + mu_dot1*t40 + mu_dot2*t44 + mu_dot3*t49 - mu_dot4*t33 - mu_dot5*t27)
-    t88 = mu_dot0 - t85*t87
-    t89 = mu_dot1 - t40*t87
-    t90 = mu_dot2 - t44*t87
-    t91 = mu_dot3 - t49*t87
-    t92 = mu_dot4 + t33*t87
-    t93 = mu_dot5 + t27*t87
-    t94 = t80 + t55
-    t95 = t86*(t40*t85 + t44*t59 + t49*t53 + t33*t50 - t27*t30 + t94*t40)
-    t96 = t40 - t85*t95
-    t97 = t94 - t40*t95
-    t98 = t59 - t44*t95
-    t99 = t53 - t49*t95
-    t100 = -t50 + t33*t95
-    t101 = t30 + t27*t95
-    t102 = xp.sqrt(t97**2 + t98**2 + t99**2 + t100**2 + t101**2)
-    t103 = t102*xp.where(xp.greater_equal(t97, 0), xp.asarray(1, dtype=dtype), -1)
-    t104 = t97 + t103
-    t105 = xp.where(xp.greater(t102, 0), 1/(t102*(t102 + xp.abs(t97))), 0)
-    t106 = t105*(t89*t104 + t98*t90 + t99*t91 + t100*t92 + t101*t93)
-    t107 = t89 - t104*t106
-    t108 = t90 - t98*t106
-    t109 = t91 - t99*t106
-    t110 = t92 - t100*t106
-    t111 = t93 - t101*t106
-    t112 = t80 + t64
-    t113 = t80 + t67
-    t114 = t86*(t49*t85 + t40*t53 + t44*t60 + t33*t69 + t27*t15 + t113*t49)
-    t115 = t49 - t85*t114
-    t116 = t53 - t40*t114
-    t117 = t60 - t44*t114
-    t118 = t113 - t49*t114
-    t119 = -t69 + t33*t114
-    t120 = -t15 + t27*t114
-    t121 = t105*(t116*t104 + t98*t117 + t99*t118 + t100*t119 + t101*t120)
-    t122 = t116 - t104*t121
-    t123 = t117 - t98*t121
-    t124 = t118 - t99*t121
-    t125 = t119 - t100*t121
-    t126 = t120 - t101*t121
-    t127 = t80 + t71
-    t128 = -t86*(t33*t85 + t40*t50 + t44*t45 + t49*t69 + t27*t16 + t127*t33)
-    t129 = t33 + t85*t128
-    t130 = t50 + t40*t128
-    t131 = t45 + t44*t128
-    t132 = t69 + t49*t128
-    t133 = t127 + t33*t128
-    t134 = t16 + t27*t128
-    t135 = -t105*(t130*t104 + t98*t131 + t99*t132 - t100*t133 - t101*t134)
-    t136 = t130 + t104*t135
-    t137 = t131 + t98*t135
-    t138 = t132 + t99*t135
-    t139 = t133 - t100*t135
-    t140 = t134 - t101*t135
-    t141 = t80 + t74
-    t142 = xp.sqrt(2*t75 + 2*t76 + 2*t59**2 + 2*t77 + 2*t53**2 + 2*t60**2 + 2*t78 + 2*t50**2 + 2*t45**2 + 2*t69**2 + 2*t79 + 2*t30**2 + 2*t15**2 + 2*t16**2 + t82 + t94**2 + t112**2 + t113**2 + t127**2 + t141**2 + 2*t62*t72)
-    t143 = c234*t10
-    t144 = t86*(t44*t85 + t40*t59 + t49*t60 + t33*t45 + t112*t44 + t143*t27)
-    t145 = t44 - t85*t144
-    t146 = t59 - t40*t144
-    t147 = t112 - t44*t144
-    t148 = t60 - t49*t144
-    t149 = -t45 + t33*t144
-    t150 = -t143 + t27*t144
-    t151 = -t86*(t27*t85 + t49*t15 + t33*t16 + t143*t44 + t141*t27 - t40*t30)
-    t152 = t27 + t85*t151
-    t153 = t30 - t40*t151
-    t154 = t143 + t44*t151
-    t155 = t15 + t49*t151
-    t156 = t16 + t33*t151
-    t157 = t141 + t27*t151
-    t158 = t105*(t146*t104 + t98*t147 + t99*t148 + t100*t149 + t101*t150)
-    t159 = t146 - t104*t158
-    t160 = t147 - t98*t158
-    t161 = t148 - t99*t158
-    t162 = t149 - t100*t158
-    t163 = t150 - t101*t158
-    t164 = t105*(t153*t104 - t98*t154 - t99*t155 + t100*t156 + t101*t157)
-    t165 = t153 - t104*t164
-    t166 = t154 + t98*t164
-    t167 = t155 + t99*t164
-    t168 = t156 - t100*t164
-    t169 = t157 - t101*t164
-    t170 = xp.sqrt(t160**2 + t161**2 + t162**2 + t163**2)
-    t171 = t170*xp.where(xp.greater_equal(t160, 0), xp.asarray(1, dtype=dtype), -1)
-    t172 = t160 + t171
-    t173 = xp.where(xp.greater(t170, 0), 1/(t170*(t170 + xp.abs(t160))), 0)
-    t174 = t173*(t123*t172 + t161*t124 + t162*t125 + t163*t126)
-    t175 = t123 - t172*t174
-    t176 = t124 - t161*t174
-    t177 = t125 - t162*t174
-    t178 = t126 - t163*t174
-    t179 = t173*(-t137*t172 - t161*t138 + t162*t139 + t163*t140)
-    t180 = t137 + t172*t179
-    t181 = t138 + t161*t179
-    t182 = t139 - t162*t179
-    t183 = t140 - t163*t179
-    t184 = t173*(-t166*t172 - t161*t167 + t162*t168 + t163*t169)
-    t185 = t166 + t172*t184
-    t186 = t167 + t161*t184
-    t187 = t168 - t162*t184
-    t188 = t169 - t163*t184
-    t189 = t173*(t108*t172 + t161*t109 + t162*t110 + t163*t111)
-    t190 = t108 - t172*t189
-    t191 = t109 - t161*t189
-    t192 = t110 - t162*t189
-    t193 = t111 - t163*t189
-    t194 = xp.sqrt(t176**2 + t177**2 + t178**2)
-    t195 = t194*xp.where(xp.greater_equal(t176, 0), xp.asarray(1, dtype=dtype), -1)
-    t196 = t176 + t195
-    t197 = xp.where(xp.greater(t194, 0), 1/(t194*(t194 + xp.abs(t176))), 0)
-    t198 = t197*(-t181*t196 + t177*t182 + t178*t183)
-    t199 = t181 + t196*t198
-    t200 = t182 - t177*t198
-    t201 = t183 - t178*t198
-    t202 = t197*(-t186*t196 + t177*t187 + t178*t188)
-    t203 = t186 + t196*t202
-    t204 = t187 - t177*t202
-    t205 = t188 - t178*t202
-    t206 = t197*(t191*t196 + t177*t192 + t178*t193)
-    t207 = t191 - t196*t206
-    t208 = t192 - t177*t206
-    t209 = t193 - t178*t206
-    t210 = xp.sqrt(t200**2 + t201**2)
-    t211 = t210*xp.where(xp.greater_equal(t200, 0), xp.asarray(1, dtype=dtype), -1)
-    t212 = t200 + t211
-    t213 = xp.where(xp.greater(t210, 0), 1/(t210*(t210 + xp.abs(t200))), 0)
-    t214 = t213*(t204*t212 + t201*t205)
-    t215 = t204 - t212*t214
-    t216 = t205 - t201*t214
-    t217 = t213*(t208*t212 + t201*t209)
-    t218 = t208 - t212*t217
-    t219 = t209 - t201*t217
-    t220 = xp.abs(t216)
-    t221 = t220
-    t222 = t221*xp.where(xp.greater_equal(t216, 0), xp.asarray(1, dtype=dtype), -1)
-    t223 = t216 + t222
-    t224 = xp.where(xp.greater(t221, 0), 1/(t221*(t220 + t221)), 0)
-    t225 = t219 - t219*t223**2*t224
-    t226 = xp.where(xp.not_equal(t222, 0), -t225/t222, 0)
-    t227 = xp.where(xp.not_equal(t211, 0), -(t218 - t215*t226)/t211, 0)
-    t228 = xp.where(xp.not_equal(t195, 0), -(t207 + t199*t227 + t203*t226)/t195, 0)
-    t229 = xp.where(xp.not_equal(t171, 0), -(t190 + t180*t227 + t185*t226 - t175*t228)/t171, 0)
-    t230 = xp.where(xp.not_equal(t103, 0), -(-(t159*t229 + t122*t228 - t136*t227 + t165*t226) + t107)/t103, 0)
-    t231 = xp.where(xp.not_equal(t84, 0), -(-(t96*t230 + t145*t229 + t115*t228 - t129*t227 - t152*t226) + t88)/t84, 0)
-    t232 = t226 - t23*t231 + t22*t230
-    t233 = t26*t231 + t29*t230 + t10*t229 - c234*t226 + t3*t228 + t6*t227
-    t234 = t2*t227 - t1*t228 + t11*t226
-    t235 = s1*t14
-    t236 = s1*t228 - c1*t227
-    t237 = t236 + t24*t229 + t46*t231 + t235*t230
-    t238 = t236 + t9*t229 + t28*t231 + t25*t230
-    t239 = s1*t13
-    t240 = t236 + t20*t229 + t47*t231 + t239*t230
-    t241 = t31 + t51
-    t242 = xp.sqrt(t37 + t54 + t63 + t66 + t70 + t73 + t241)
-    t243 = xp.sqrt(1 + t241)
-    t244 = t243*xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)
-    t245 = xp.where(xp.greater(t243, 0), 1/(t243*(t243 + xp.abs(t23))), 0)
-    t246 = -t23
-    t247 = t246 + t244
-    t248 = t245*(t46*t247 + t22*t235)
-    t249 = t46 - t247*t248
-    t250 = t235 - t22*t248
-    t251 = t245*(t47*t247 + t22*t239)
-    t252 = t47 - t247*t251
-    t253 = t239 - t22*t251
-    t254 = t245*(t28*t247 + t22*t25)
-    t255 = t28 - t247*t254
-    t256 = t25 - t22*t254
-    t257 = t245*(mu_dot5 + mu_dot0*t247 + t22*mu_dot1)
-    t258 = mu_dot0 - t247*t257
-    t259 = mu_dot1 - t22*t257
-    t260 = -t257 + mu_dot5
-    t261 = -c234
-    t262 = t245*(t26*t247 + t22*t29 + t261)
-    t263 = t26 - t247*t262
-    t264 = t29 - t22*t262
-    t265 = c234 + t262
-    t266 = -t11
-    t267 = t11*t245
-    t268 = t266 + t267
-    t269 = t32 + t52
-    t270 = xp.sqrt(t61 + t248**2 + t250**2 + t269)
-    t271 = t270*xp.where(xp.greater_equal(t250, 0), xp.asarray(1, dtype=dtype), -1)
-    t272 = t250 + t271
-    t273 = xp.where(xp.greater(t270, 0), 1/(t270*(t270 + xp.abs(t250))), 0)
-    t274 = t273*(t253*t272 + t24*t20 + t248*t251 + t269)
-    t275 = t253 - t272*t274
-    t276 = t20 - t24*t274
+    t64 = s234**2
+    t65 = t1**2 + 3*t52 + t32*t64
+    t66 = 3*s1
+    t67 = t1*t2 + c1*t66 - t39*t64
+    t68 = t2**2 + 3*t32 + t52*t64
+    t69 = c234**2
+    t70 = 1 + t69 + s5**2*t64
+    t71 = t40**2
+    t72 = t44**2
+    t73 = t49**2
+    t74 = t33**2
+    t75 = t27**2
+    t76 = damping**2
+    t77 = t76 + t38
+    t78 = t77**2
+    t79 = xp.sqrt(t71 + t72 + t73 + t74 + t75 + t78)
+    t80 = t79*xp.where(xp.greater_equal(t77, 0), xp.asarray(1, dtype=dtype), -1)
+    t81 = t77 + t80
+    t82 = xp.where(xp.greater(t79, 0), 1/(t79*(t79 + xp.abs(t77))), 0)
+    t83 = t82*(mu_dot0*t81 + mu_dot1*t40 + mu_dot2*t44 + mu_dot3*t49 - mu_dot4*t33 - mu_dot5*t27)
+    t84 = mu_dot0 - t81*t83
+    t85 = mu_dot1 - t40*t83
+    t86 = mu_dot2 - t44*t83
+    t87 = mu_dot3 - t49*t83
+    t88 = mu_dot4 + t33*t83
+    t89 = mu_dot5 + t27*t83
+    t90 = t76 + t55
+    t91 = t82*(t40*t81 + t44*t59 + t49*t53 + t33*t50 - t27*t30 + t90*t40)
+    t92 = t40 - t81*t91
+    t93 = t90 - t40*t91
+    t94 = t59 - t44*t91
+    t95 = t53 - t49*t91
+    t96 = -t50 + t33*t91
+    t97 = t30 + t27*t91
+    t98 = xp.sqrt(t93**2 + t94**2 + t95**2 + t96**2 + t97**2)
+    t99 = t98*xp.where(xp.greater_equal(t93, 0), xp.asarray(1, dtype=dtype), -1)
+    t100 = t93 + t99
+    t101 = xp.where(xp.greater(t98, 0), 1/(t98*(t98 + xp.abs(t93))), 0)
+    t102 = t101*(t85*t100 + t94*t86 + t95*t87 + t96*t88 + t97*t89)
+    t103 = t85 - t100*t102
+    t104 = t86 - t94*t102
+    t105 = t87 - t95*t102
+    t106 = t88 - t96*t102
+    t107 = t89 - t97*t102
+    t108 = t63 + t76
+    t109 = t65 + t76
+    t110 = t82*(t49*t81 + t40*t53 + t44*t60 + t33*t67 + t27*t15 + t109*t49)
+    t111 = t49 - t81*t110
+    t112 = t53 - t40*t110
+    t113 = t60 - t44*t110
+    t114 = t109 - t49*t110
+    t115 = -t67 + t33*t110
+    t116 = -t15 + t27*t110
+    t117 = t101*(t112*t100 + t94*t113 + t95*t114 + t96*t115 + t97*t116)
+    t118 = t112 - t100*t117
+    t119 = t113 - t94*t117
+    t120 = t114 - t95*t117
+    t121 = t115 - t96*t117
+    t122 = t116 - t97*t117
+    t123 = t68 + t76
+    t124 = -t82*(t33*t81 + t40*t50 + t44*t45 + t49*t67 + t27*t16 + t123*t33)
+    t125 = t33 + t81*t124
+    t126 = t50 + t40*t124
+    t127 = t45 + t44*t124
+    t128 = t67 + t49*t124
+    t129 = t123 + t33*t124
+    t130 = t16 + t27*t124
+    t131 = -t101*(t126*t100 + t94*t127 + t95*t128 - t96*t129 - t97*t130)
+    t132 = t126 + t100*t131
+    t133 = t127 + t94*t131
+    t134 = t128 + t95*t131
+    t135 = t129 - t96*t131
+    t136 = t130 - t97*t131
+    t137 = t70 + t76
+    t138 = xp.sqrt(2*t71 + 2*t72 + 2*t59**2 + 2*t73 + 2*t53**2 + 2*t60**2 + 2*t74 + 2*t50**2 + 2*t45**2 + 2*t67**2 + 2*t75 + 2*t30**2 + 2*t15**2 + 2*t16**2 + t78 + t90**2 + t108**2 + t109**2 + t123**2 + t137**2 + 2*t62*t69)
+    t139 = c234*t10
+    t140 = t82*(t44*t81 + t40*t59 + t49*t60 + t33*t45 + t108*t44 + t139*t27)
+    t141 = t44 - t81*t140
+    t142 = t59 - t40*t140
+    t143 = t108 - t44*t140
+    t144 = t60 - t49*t140
+    t145 = -t45 + t33*t140
+    t146 = -t139 + t27*t140
+    t147 = -t82*(t27*t81 + t49*t15 + t33*t16 + t139*t44 + t137*t27 - t40*t30)
+    t148 = t27 + t81*t147
+    t149 = t30 - t40*t147
+    t150 = t139 + t44*t147
+    t151 = t15 + t49*t147
+    t152 = t16 + t33*t147
+    t153 = t137 + t27*t147
+    t154 = t101*(t142*t100 + t94*t143 + t95*t144 + t96*t145 + t97*t146)
+    t155 = t142 - t100*t154
+    t156 = t143 - t94*t154
+    t157 = t144 - t95*t154
+    t158 = t145 - t96*t154
+    t159 = t146 - t97*t154
+    t160 = t101*(t149*t100 - t94*t150 - t95*t151 + t96*t152 + t97*t153)
+    t161 = t149 - t100*t160
+    t162 = t150 + t94*t160
+    t163 = t151 + t95*t160
+    t164 = t152 - t96*t160
+    t165 = t153 - t97*t160
+    t166 = xp.sqrt(t156**2 + t157**2 + t158**2 + t159**2)
+    t167 = t166*xp.where(xp.greater_equal(t156, 0), xp.asarray(1, dtype=dtype), -1)
+    t168 = t156 + t167
+    t169 = xp.where(xp.greater(t166, 0), 1/(t166*(t166 + xp.abs(t156))), 0)
+    t170 = t169*(t119*t168 + t157*t120 + t158*t121 + t159*t122)
+    t171 = t119 - t168*t170
+    t172 = t120 - t157*t170
+    t173 = t121 - t158*t170
+    t174 = t122 - t159*t170
+    t175 = t169*(-t133*t168 - t157*t134 + t158*t135 + t159*t136)
+    t176 = t133 + t168*t175
+    t177 = t134 + t157*t175
+    t178 = t135 - t158*t175
+    t179 = t136 - t159*t175
+    t180 = t169*(-t162*t168 - t157*t163 + t158*t164 + t159*t165)
+    t181 = t162 + t168*t180
+    t182 = t163 + t157*t180
+    t183 = t164 - t158*t180
+    t184 = t165 - t159*t180
+    t185 = t169*(t104*t168 + t157*t105 + t158*t106 + t159*t107)
+    t186 = t104 - t168*t185
+    t187 = t105 - t157*t185
+    t188 = t106 - t158*t185
+    t189 = t107 - t159*t185
+    t190 = xp.sqrt(t172**2 + t173**2 + t174**2)
+    t191 = t190*xp.where(xp.greater_equal(t172, 0), xp.asarray(1, dtype=dtype), -1)
+    t192 = t172 + t191
+    t193 = xp.where(xp.greater(t190, 0), 1/(t190*(t190 + xp.abs(t172))), 0)
+    t194 = t193*(-t177*t192 + t173*t178 + t174*t179)
+    t195 = t177 + t192*t194
+    t196 = t178 - t173*t194
+    t197 = t179 - t174*t194
+    t198 = t193*(-t182*t192 + t173*t183 + t174*t184)
+    t199 = t182 + t192*t198
+    t200 = t183 - t173*t198
+    t201 = t184 - t174*t198
+    t202 = t193*(t187*t192 + t173*t188 + t174*t189)
+    t203 = t187 - t192*t202
+    t204 = t188 - t173*t202
+    t205 = t189 - t174*t202
+    t206 = xp.sqrt(t196**2 + t197**2)
+    t207 = t206*xp.where(xp.greater_equal(t196, 0), xp.asarray(1, dtype=dtype), -1)
+    t208 = t196 + t207
+    t209 = xp.where(xp.greater(t206, 0), 1/(t206*(t206 + xp.abs(t196))), 0)
+    t210 = t209*(t200*t208 + t197*t201)
+    t211 = t200 - t208*t210
+    t212 = t201 - t197*t210
+    t213 = t209*(t204*t208 + t197*t205)
+    t214 = t204 - t208*t213
+    t215 = t205 - t197*t213
+    t216 = xp.abs(t212)
+    t217 = t216*xp.where(xp.greater_equal(t212, 0), xp.asarray(1, dtype=dtype), -1)
+    t218 = t212 + t217
+    t219 = xp.where(xp.greater(t216, 0), 1/(t216*2*t216), 0)
+    t220 = t215 - t215*t218**2*t219
+    t221 = xp.where(xp.not_equal(t217, 0), -t220/t217, 0)
+    t222 = xp.where(xp.not_equal(t207, 0), -(t214 - t211*t221)/t207, 0)
+    t223 = xp.where(xp.not_equal(t191, 0), -(t203 + t195*t222 + t199*t221)/t191, 0)
+    t224 = xp.where(xp.not_equal(t167, 0), -(t186 + t176*t222 + t181*t221 - t171*t223)/t167, 0)
+    t225 = xp.where(xp.not_equal(t99, 0), -(-(t155*t224 + t118*t223 - t132*t222 + t161*t221) + t103)/t99, 0)
+    t226 = xp.where(xp.not_equal(t80, 0), -(-(t92*t225 + t141*t224 + t111*t223 - t125*t222 - t148*t221) + t84)/t80, 0)
+    t227 = t221 - t23*t226 + t22*t225
+    t228 = t26*t226 + t29*t225 + t10*t224 - c234*t221 + t3*t223 + t6*t222
+    t229 = t2*t222 - t1*t223 + t11*t221
+    t230 = s1*t14
+    t231 = s1*t223 - c1*t222
+    t232 = t231 + t24*t224 + t46*t226 + t230*t225
+    t233 = t231 + t9*t224 + t28*t226 + t25*t225
+    t234 = s1*t13
+    t235 = t231 + t20*t224 + t47*t226 + t234*t225
+    t236 = t31 + t51
+    t237 = xp.sqrt(t37 + t54 + t63 + t65 + t68 + t70 + t236)
+    t238 = xp.sqrt(1 + t236)
+    t239 = t238*xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)
+    t240 = xp.where(xp.greater(t238, 0), 1/(t238*(t238 + xp.abs(t23))), 0)
+    t241 = -t23
+    t242 = t241 + t239
+    t243 = t240*(t46*t242 + t22*t230)
+    t244 = t46 - t242*t243
+    t245 = t230 - t22*t243
+    t246 = t240*(t47*t242 + t22*t234)
+    t247 = t47 - t242*t246
+    t248 = t234 - t22*t246
+    t249 = t240*(t28*t242 + t22*t25)
+    t250 = t28 - t242*t249
+    t251 = t25 - t22*t249
+    t252 = t240*(mu_dot5 + mu_dot0*t242 + t22*mu_dot1)
+    t253 = mu_dot0 - t242*t252
+    t254 = mu_dot1 - t22*t252
+    t255 = -t252 + mu_dot5
+    t256 = -c234
+    t257 = t240*(t26*t242 + t22*t29 + t256)
+    t258 = t26 - t242*t257
+    t259 = t29 - t22*t257
+    t260 = c234 + t257
+    t261 = -t11
+    t262 = t11*t240
+    t263 = t261 + t262
+    t264 = t32 + t52
+    t265 = xp.sqrt(t61 + t243**2 + t245**2 + t264)
+    t266 = t265*xp.where(xp.greater_equal(t245, 0), xp.asarray(1, dtype=dtype), -1)
+    t267 = t245 + t266
+    t268 = xp.where(xp.greater(t265, 0), 1/(t265*(t265 + xp.abs(t245))), 0)
+    t269 = t268*(t248*t267 + t24*t20 + t243*t246 + t264)
+    t270 = t248 - t267*t269
+    t271 = t20 - t24*t269
+    t272 = s1 - s1*t269
+    t273 = -t246 + t243*t269
+    t274 = t268*(t251*t267 + t24*t9 + t243*t249 + t264)
+    t275 = t251 - t267*t274
+    t276 = t9 - t24*t274
     t277 = s1 - s1*t274
-    t278 = -t251 + t248*t274
-    t279 = t273*(t256*t272 + t24*t9 + t248*t254 + t269)
-    t280 = t256 - t272*t279
-    t281 = t9 - t24*t279
-    t282 = s1 - s1*t279
-    t283 = -t254 + t248*t279
-    t284 = t273*(t264*t272 + t24*t10 + t248*t265)
-    t285 = t264 - t272*t284
-    t286 = t10 - t24*t284
-    t287 = t3 - s1*t284
-    t288 = t6 + c1*t284
-    t289 = -t265 + t248*t284
-    t290 = t273*(t259*t272 + t24*mu_dot2 + s1*mu_dot3 - c1*mu_dot4 - t248*t260)
-    t291 = t259 - t272*t290
-    t292 = mu_dot2 - t24*t290
-    t293 = mu_dot3 - s1*t290
-    t294 = mu_dot4 + c1*t290
-    t295 = t260 + t248*t290
-    t296 = -c1
-    t297 = c1*t274 + t296
-    t298 = c1*t279 + t296
-    t299 = xp.sqrt(t276**2 + t277**2 + t297**2 + t278**2)
-    t300 = t299*xp.where(xp.greater_equal(t276, 0), xp.asarray(1, dtype=dtype), -1)
-    t301 = t276 + t300
-    t302 = xp.where(xp.greater(t299, 0), 1/(t299*(t299 + xp.abs(t276))), 0)
-    t303 = t302*(t281*t301 + t277*t282 + t297*t298 + t278*t283)
-    t304 = t281 - t301*t303
-    t305 = t282 - t277*t303
-    t306 = t298 - t297*t303
-    t307 = t283 - t278*t303
-    t308 = t302*(t286*t301 + t277*t287 + t297*t288 + t278*t289)
-    t309 = t286 - t301*t308
-    t310 = t287 - t277*t308
-    t311 = t288 - t297*t308
-    t312 = t289 - t278*t308
-    t313 = t302*(t292*t301 + t277*t293 + t297*t294 + t278*t295)
-    t314 = t292 - t301*t313
-    t315 = t293 - t277*t313
-    t316 = t294 - t297*t313
-    t317 = t295 - t278*t313
-    t318 = xp.sqrt(t305**2 + t306**2 + t307**2)
-    t319 = t318*xp.where(xp.greater_equal(t305, 0), xp.asarray(1, dtype=dtype), -1)
-    t320 = t305 + t319
-    t321 = xp.where(xp.greater(t318, 0), 1/(t318*(t318 + xp.abs(t305))), 0)
-    t322 = t321*(t310*t320 + t306*t311 + t307*t312)
-    t323 = t310 - t320*t322
-    t324 = t311 - t306*t322
-    t325 = t312 - t307*t322
-    t326 = t321*(t315*t320 + t306*t316 + t307*t317)
-    t327 = t315 - t320*t326
-    t328 = t316 - t306*t326
-    t329 = t317 - t307*t326
-    t330 = xp.sqrt(t324**2 + t325**2)
-    t331 = t330*xp.where(xp.greater_equal(t324, 0), xp.asarray(1, dtype=dtype), -1)
-    t332 = t324 + t331
-    t333 = xp.where(xp.greater(t330, 0), 1/(t330*(t330 + xp.abs(t324))), 0)
-    t334 = t333*(t328*t332 + t325*t329)
-    t335 = t328 - t332*t334
-    t336 = t329 - t325*t334
-    t337 = t22*t267
-    t338 = t273*(s1*t1 + c1*t2 - t248*t268 + t272*t337)
-    t339 = -t272*t338 + t337
-    t340 = t1 - s1*t338
-    t341 = t268 + t248*t338
-    t342 = -t2
-    t343 = c1*t338 + t342
-    t344 = 1 + q1 + q2 + q3 + q4 + q5 + t1 + q6 + t22 + t3 + t6 + t25 + t28 + t46 + t47 + t26 + t29 + t24 + t20 + t9 + t10 + t68 + t235 + t239 + t246 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping - 3*c1 + t261 + t266 + t342
-    t345 = t24*t338
-    t346 = t302*(t277*t340 + t297*t343 + t278*t341 - t301*t345)
-    t347 = t301*t346 + t345
-    t348 = t340 - t277*t346
-    t349 = t343 - t297*t346
-    t350 = t341 - t278*t346
-    t351 = t321*(t348*t320 + t306*t349 + t307*t350)
-    t352 = t348 - t320*t351
-    t353 = t349 - t306*t351
-    t354 = t350 - t307*t351
-    t355 = t333*(t353*t332 + t325*t354)
-    t356 = t353 - t332*t355
-    t357 = t354 - t325*t355
-    t358 = xp.abs(t357)
-    t359 = t358
-    t360 = t359*xp.where(xp.greater_equal(t357, 0), xp.asarray(1, dtype=dtype), -1)
-    t361 = t357 + t360
-    t362 = xp.where(xp.greater(t359, 0), 1/(t359*(t359 + t358)), 0)
-    t363 = t336 - t336*t361**2*t362
-    t364 = xp.where(xp.not_equal(t360, 0), -t363/t360, 0)
-    t365 = xp.where(xp.not_equal(t331, 0), -(t335 - t356*t364)/t331, 0)
-    t366 = xp.where(xp.not_equal(t319, 0), -(-(t323*t365 + t352*t364) + t327)/t319, 0)
-    t367 = xp.where(xp.not_equal(t300, 0), -(-(t304*t366 + t309*t365 - t347*t364) + t314)/t300, 0)
-    t368 = xp.where(xp.not_equal(t271, 0), -(-(t275*t367 + t280*t366 + t285*t365 + t339*t364) + t291)/t271, 0)
-    t369 = xp.where(xp.not_equal(t244, 0), -(-(t249*t368 + t252*t367 + t255*t366 + t263*t365 + t247*t364*t267) + t258)/t244, 0)
-    t370 = xp.isfinite(t344)
-    t371 = xp.greater_equal(damping, 0)
-    t372 = xp.greater(damping, 0)
-    t373 = 1e-12*t142
-    t374 = 1e-12*t242
-    t375 = (t372 & (xp.less_equal(t83, t373) | xp.less_equal(t102, t373) | xp.less_equal(t170, t373) | xp.less_equal(t194, t373) | xp.less_equal(t210, t373) | xp.less_equal(t221, t373))) | (xp.less_equal(damping, 0) & (xp.less_equal(t243, t374) | xp.less_equal(t270, t374) | xp.less_equal(t299, t374) | xp.less_equal(t318, t374) | xp.less_equal(t330, t374) | xp.less_equal(t359, t374)))
-    t376 = t370 & t371 & xp.logical_not(t375)
+    t278 = -t249 + t243*t274
+    t279 = t268*(t259*t267 + t24*t10 + t243*t260)
+    t280 = t259 - t267*t279
+    t281 = t10 - t24*t279
+    t282 = t3 - s1*t279
+    t283 = t6 + c1*t279
+    t284 = -t260 + t243*t279
+    t285 = t268*(t254*t267 + t24*mu_dot2 + s1*mu_dot3 - c1*mu_dot4 - t243*t255)
+    t286 = t254 - t267*t285
+    t287 = mu_dot2 - t24*t285
+    t288 = mu_dot3 - s1*t285
+    t289 = mu_dot4 + c1*t285
+    t290 = t255 + t243*t285
+    t291 = -c1
+    t292 = c1*t269 + t291
+    t293 = c1*t274 + t291
+    t294 = xp.sqrt(t271**2 + t272**2 + t292**2 + t273**2)
+    t295 = t294*xp.where(xp.greater_equal(t271, 0), xp.asarray(1, dtype=dtype), -1)
+    t296 = t271 + t295
+    t297 = xp.where(xp.greater(t294, 0), 1/(t294*(t294 + xp.abs(t271))), 0)
+    t298 = t297*(t276*t296 + t272*t277 + t292*t293 + t273*t278)
+    t299 = t276 - t296*t298
+    t300 = t277 - t272*t298
+    t301 = t293 - t292*t298
+    t302 = t278 - t273*t298
+    t303 = t297*(t281*t296 + t272*t282 + t292*t283 + t273*t284)
+    t304 = t281 - t296*t303
+    t305 = t282 - t272*t303
+    t306 = t283 - t292*t303
+    t307 = t284 - t273*t303
+    t308 = t297*(t287*t296 + t272*t288 + t292*t289 + t273*t290)
+    t309 = t287 - t296*t308
+    t310 = t288 - t272*t308
+    t311 = t289 - t292*t308
+    t312 = t290 - t273*t308
+    t313 = xp.sqrt(t300**2 + t301**2 + t302**2)
+    t314 = t313*xp.where(xp.greater_equal(t300, 0), xp.asarray(1, dtype=dtype), -1)
+    t315 = t300 + t314
+    t316 = xp.where(xp.greater(t313, 0), 1/(t313*(t313 + xp.abs(t300))), 0)
+    t317 = t316*(t305*t315 + t301*t306 + t302*t307)
+    t318 = t305 - t315*t317
+    t319 = t306 - t301*t317
+    t320 = t307 - t302*t317
+    t321 = t316*(t310*t315 + t301*t311 + t302*t312)
+    t322 = t310 - t315*t321
+    t323 = t311 - t301*t321
+    t324 = t312 - t302*t321
+    t325 = xp.sqrt(t319**2 + t320**2)
+    t326 = t325*xp.where(xp.greater_equal(t319, 0), xp.asarray(1, dtype=dtype), -1)
+    t327 = t319 + t326
+    t328 = xp.where(xp.greater(t325, 0), 1/(t325*(t325 + xp.abs(t319))), 0)
+    t329 = t328*(t323*t327 + t320*t324)
+    t330 = t323 - t327*t329
+    t331 = t324 - t320*t329
+    t332 = t22*t262
+    t333 = t268*(s1*t1 + c1*t2 - t243*t263 + t267*t332)
+    t334 = -t267*t333 + t332
+    t335 = t1 - s1*t333
+    t336 = t263 + t243*t333
+    t337 = -t2
+    t338 = c1*t333 + t337
+    t339 = 1 + q1 + q2 + q3 + q4 + q5 + t1 + q6 + t22 + t3 + t6 + t25 + t28 + t46 + t47 + t26 + t29 + t24 + t20 + t9 + t10 + t66 + t230 + t234 + t241 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping - 3*c1 + t256 + t261 + t337
+    t340 = t24*t333
+    t341 = t297*(t272*t335 + t292*t338 + t273*t336 - t296*t340)
+    t342 = t296*t341 + t340
+    t343 = t335 - t272*t341
+    t344 = t338 - t292*t341
+    t345 = t336 - t273*t341
+    t346 = t316*(t343*t315 + t301*t344 + t302*t345)
+    t347 = t343 - t315*t346
+    t348 = t344 - t301*t346
+    t349 = t345 - t302*t346
+    t350 = t328*(t348*t327 + t320*t349)
+    t351 = t348 - t327*t350
+    t352 = t349 - t320*t350
+    t353 = xp.abs(t352)
+    t354 = xp.where(xp.greater_equal(t352, 0), xp.asarray(1, dtype=dtype), -1)*t353
+    t355 = t352 + t354
+    t356 = xp.where(xp.greater(t353, 0), 1/(t353*2*t353), 0)
+    t357 = t331 - t331*t355**2*t356
+    t358 = xp.where(xp.not_equal(t354, 0), -t357/t354, 0)
+    t359 = xp.where(xp.not_equal(t326, 0), -(t330 - t351*t358)/t326, 0)
+    t360 = xp.where(xp.not_equal(t314, 0), -(-(t318*t359 + t347*t358) + t322)/t314, 0)
+    t361 = xp.where(xp.not_equal(t295, 0), -(-(t299*t360 + t304*t359 - t342*t358) + t309)/t295, 0)
+    t362 = xp.where(xp.not_equal(t266, 0), -(-(t270*t361 + t275*t360 + t280*t359 + t334*t358) + t286)/t266, 0)
+    t363 = xp.where(xp.not_equal(t239, 0), -(-(t244*t362 + t247*t361 + t250*t360 + t258*t359 + t242*t358*t262) + t253)/t239, 0)
+    t364 = xp.isfinite(t339)
+    t365 = xp.greater_equal(damping, 0)
+    t366 = xp.greater(damping, 0)
+    t367 = 1e-12*t138
+    t368 = 1e-12*t237
+    t369 = (t366 & (xp.less_equal(t79, t367) | xp.less_equal(t98, t367) | xp.less_equal(t166, t367) | xp.less_equal(t190, t367) | xp.less_equal(t206, t367) | xp.less_equal(t216, t367))) | (xp.less_equal(damping, 0) & (xp.less_equal(t238, t368) | xp.less_equal(t265, t368) | xp.less_equal(t294, t368) | xp.less_equal(t313, t368) | xp.less_equal(t325, t368) | xp.less_equal(t353, t368)))
+    t370 = t364 & t365 & xp.logical_not(t369)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t376, xp.where(t372, t232, t369), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t376, xp.where(t372, t237, t368), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t376, xp.where(t372, t240, t367), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t376, xp.where(t372, t238, t366), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t376, xp.where(t372, t233, t365), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t376, xp.where(t372, -t234, t364), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t370, xp.where(t366, t227, t363), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t370, xp.where(t366, t232, t362), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t370, xp.where(t366, t235, t361), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t370, xp.where(t366, t233, t360), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t370, xp.where(t366, t228, t359), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t370, xp.where(t366, -t229, t358), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t370 & t371), 2, xp.where(t375, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t364 & t365), 2, xp.where(t369, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -2257,26 +2245,25 @@ def ik_numeric_step(target, q, damping=0.0):
     t241 = t238 - t212*t240
     t242 = t239 - t209*t240
     t243 = xp.abs(t242)
-    t244 = t243
-    t245 = t244*xp.where(xp.greater_equal(t242, 0), xp.asarray(1, dtype=dtype), -1)
-    t246 = t242 + t245
-    t247 = xp.where(xp.greater(t244, 0), 1/(t244*(t243 + t244)), 0)
-    t248 = t216 - t216*t246**2*t247
-    t249 = xp.where(xp.not_equal(t245, 0), -t248/t245, 0)
-    t250 = xp.where(xp.not_equal(t211, 0), -(t215 - t241*t249)/t211, 0)
-    t251 = xp.where(xp.not_equal(t180, 0), -(t184 + t207*t250 + t237*t249)/t180, 0)
-    t252 = xp.where(xp.not_equal(t152, 0), -(t156 + t202*t250 + t232*t249 - t175*t251)/t152, 0)
-    t253 = xp.where(xp.not_equal(t127, 0), -(-(t146*t252 + t169*t251 - t196*t250 + t226*t249) + t131)/t127, 0)
-    t254 = xp.where(xp.not_equal(t108, 0), -(-(t120*t253 + t139*t252 + t162*t251 - t189*t250 - t219*t249) + t112)/t108, 0)
-    t255 = q1 + t249 - t53*t254 + t52*t253
-    t256 = q5 + t36*t254 + t37*t253 + t23*t252 - c234*t249 + t9*t251 + t17*t250
-    t257 = q6 + t7*t251 - t4*t250 - t31*t249
-    t258 = c1*t254
-    t259 = s1*t253
-    t260 = s1*t251 - c1*t250
-    t261 = q2 + t260 + t54*t252 + t34*t258 + t34*t259
-    t262 = q3 + t260 + t50*t252 + t33*t258 + t33*t259
-    t263 = q4 + t260 + t22*t252 + t32*t258 + t32*t259
+    t244 = t243*xp.where(xp.greater_equal(t242, 0), xp.asarray(1, dtype=dtype), -1)
+    t245 = t242 + t244
+    t246 = xp.where(xp.greater(t243, 0), 1/(t243*2*t243), 0)
+    t247 = t216 - t216*t245**2*t246
+    t248 = xp.where(xp.not_equal(t244, 0), -t247/t244, 0)
+    t249 = xp.where(xp.not_equal(t211, 0), -(t215 - t241*t248)/t211, 0)
+    t250 = xp.where(xp.not_equal(t180, 0), -(t184 + t207*t249 + t237*t248)/t180, 0)
+    t251 = xp.where(xp.not_equal(t152, 0), -(t156 + t202*t249 + t232*t248 - t175*t250)/t152, 0)
+    t252 = xp.where(xp.not_equal(t127, 0), -(-(t146*t251 + t169*t250 - t196*t249 + t226*t248) + t131)/t127, 0)
+    t253 = xp.where(xp.not_equal(t108, 0), -(-(t120*t252 + t139*t251 + t162*t250 - t189*t249 - t219*t248) + t112)/t108, 0)
+    t254 = q1 + t248 - t53*t253 + t52*t252
+    t255 = q5 + t36*t253 + t37*t252 + t23*t251 - c234*t248 + t9*t250 + t17*t249
+    t256 = q6 + t7*t250 - t4*t249 - t31*t248
+    t257 = c1*t253
+    t258 = s1*t252
+    t259 = s1*t250 - c1*t249
+    t260 = q2 + t259 + t54*t251 + t34*t257 + t34*t258
+    t261 = q3 + t259 + t50*t251 + t33*t257 + t33*t258
+    t262 = q4 + t259 + t22*t251 + t32*t257 + t32*t258
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -2286,12 +2273,12 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q6, batch),  # 5
     ], (6,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t255, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t255, 6.283185307179586), 6.283185307179586, t255)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t261, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t261, 6.283185307179586), 6.283185307179586, t261)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t262, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t262, 6.283185307179586), 6.283185307179586, t262)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t263, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t263, 6.283185307179586), 6.283185307179586, t263)), batch),  # 3
-        xp.broadcast_to(xp.where(xp.less(t256, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t256, 6.283185307179586), 6.283185307179586, t256)), batch),  # 4
-        xp.broadcast_to(xp.where(xp.less(t257, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t257, 6.283185307179586), 6.283185307179586, t257)), batch),  # 5
+        xp.broadcast_to(xp.where(xp.less(t254, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t254, 6.283185307179586), 6.283185307179586, t254)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t260, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t260, 6.283185307179586), 6.283185307179586, t260)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t261, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t261, 6.283185307179586), 6.283185307179586, t261)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t262, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t262, 6.283185307179586), 6.283185307179586, t262)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t255, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t255, 6.283185307179586), 6.283185307179586, t255)), batch),  # 4
+        xp.broadcast_to(xp.where(xp.less(t256, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t256, 6.283185307179586), 6.283185307179586, t256)), batch),  # 5
     ], (6,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t0), t105, -1), batch)
     return q_start, q_next, cost
@@ -2328,537 +2315,524 @@ def ik_branches(T):
     t12 = -0.10915*T22 + t10
     t13 = -t12 + t11
     t14 = t4**2 + t8**2
-    t15 = t14
-    t16 = t14 + t13**2
-    t17 = 1e-24*t16
-    t18 = xp.less_equal(t15, t17)
-    t19 = xp.where(t18, 1, 1/xp.sqrt(t15))
-    t20 = 1 - 0.0119137225*t19**2
-    t21 = xp.greater(t20, 1e-12)
-    t22 = xp.where(t21, xp.sqrt(t20), 0)
-    t23 = 0.10915*t19
-    t24 = xp.where(t21, t23, xp.where(xp.greater(t23, 0), xp.asarray(1, dtype=dtype), -1))
-    t25 = xp.atan2(t22, t24)
-    t26 = xp.where(t18, 0, t9 + t25)
-    t27 = -t25 + t9
-    t28 = t26 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t26))
-    t29 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t28)) + t28
-    t30 = t27 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t27))
-    t31 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t30)) + t30
-    t32 = t19*t24
-    t33 = t32*t8
-    t34 = t19*t22
-    t35 = t34*t4
-    t36 = xp.where(t18, 1, -(t33 + t35))
-    t37 = -t33 + t35
-    t38 = t32*t4
-    t39 = t34*t8
-    t40 = xp.where(t18, 0, -t39 + t38)
-    t41 = t38 + t39
-    t42 = t4*t36 + t8*t40
-    t43 = t8*t36 - t4*t40
-    t44 = T02*t40 - T12*t36
-    t45 = T00*t40 - T10*t36
-    t46 = T01*t40 - T11*t36
-    t47 = t4*t37 + t8*t41
-    t48 = t8*t37 - t4*t41
-    t49 = T02*t41 - T12*t37
-    t50 = T00*t41 - T10*t37
-    t51 = T01*t41 - T11*t37
-    t52 = 1 - t36
-    t53 = t52*t13
-    t54 = t53 + t13*t36
-    t55 = t44**2
-    t56 = 1 - t55
-    t57 = xp.greater(t56, 1e-12)
-    t58 = xp.where(t57, t44, xp.where(xp.greater(t44, 0), xp.asarray(1, dtype=dtype), -1))
-    t59 = xp.where(t57, xp.sqrt(t56), 0)
-    t60 = xp.atan2(t59, t58)
-    t61 = t60 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t60))
-    t62 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t61)) + t61
-    t63 = t60 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t60))
-    t64 = t44*t58
-    t65 = t64 + t59*t45
-    t66 = -t64 + t65
-    t67 = t59**2
-    t68 = t67 + t58**2
-    t69 = t46**2
-    t70 = t66**2 + t67*t69
-    t71 = t55 + t69 + t45**2
-    t72 = xp.less_equal(t70, 1e-24*t71*t68)
-    t73 = xp.where(t72, 1, 1/xp.sqrt(t70))
-    t74 = xp.where(t72, 1, t66*t73)
-    t75 = t59*(1 - t74)
-    t76 = t75 + t59*t74
-    t77 = t59*t46
-    t78 = xp.where(t72, 0, -t77*t73)
-    t79 = t58*t74
-    t80 = t58*t78
-    t81 = T02*t76 - t79*T00 + t80*T01
-    t82 = T12*t76 - t79*T10 + t80*T11
-    t83 = T22*t76 - t79*T20 + t80*T21
-    t84 = t52*t83
-    t85 = t36*t81 + t40*t82
-    t86 = -t36*t82 + t40*t81
-    t87 = t84 + t36*t83
-    t88 = t85**2 + t87**2
-    t89 = t88
-    t90 = t88 + t86**2
-    t91 = xp.less_equal(t89, 1e-24*t90)
-    t92 = xp.where(t91, 1, 1/xp.sqrt(t89))
-    t93 = xp.where(t91, 1, -t85*t92)
-    t94 = xp.where(t91, 0, -t87*t92)
-    t95 = 0.10915*(1 - t93)
-    t96 = 0.10915*(1 + t93)
-    t97 = 0.10915*t93
-    t98 = t97 + t95
-    t99 = t43 + t98
-    t100 = -t96 + t97
-    t101 = -t100 + t43
-    t102 = 0.09465*t94
-    t103 = -t102 + t42
-    t104 = t102 + t42
-    t105 = 0.09465*t93
-    t106 = t105 + t54
-    t107 = -0.089459 + t106
-    t108 = t103**2 + t99**2 + t107**2
-    t109 = 0.5*(0.3344850625 - t108)
-    t110 = 1 - 35.98290608994648*t109**2
-    t111 = -t105 + t54
-    t112 = -0.089459 + t111
-    t113 = t104**2 + t101**2 + t112**2
-    t114 = 0.5*(0.3344850625 - t113)
-    t115 = 1 - 35.98290608994648*t114**2
-    t116 = xp.greater(t110, 1e-12)
-    t117 = xp.where(t116, xp.sqrt(t110), 0)
-    t118 = 5.99857533835714*t109
-    t119 = xp.where(t116, t118, xp.where(xp.greater(t118, 0), xp.asarray(1, dtype=dtype), -1))
-    t120 = xp.atan2(t117, t119)
-    t121 = 3.141592653589793 + t120
-    t122 = 3.141592653589793 - t120
-    t123 = -0.425 + 0.39225*t119
-    t124 = t121 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t121))
+    t15 = t14 + t13**2
+    t16 = 1e-24*t15
+    t17 = xp.less_equal(t14, t16)
+    t18 = xp.where(t17, 1, 1/xp.sqrt(t14))
+    t19 = 1 - 0.0119137225*t18**2
+    t20 = xp.greater(t19, 1e-12)
+    t21 = xp.where(t20, xp.sqrt(t19), 0)
+    t22 = 0.10915*t18
+    t23 = xp.where(t20, t22, xp.where(xp.greater(t22, 0), xp.asarray(1, dtype=dtype), -1))
+    t24 = xp.atan2(t21, t23)
+    t25 = xp.where(t17, 0, t9 + t24)
+    t26 = -t24 + t9
+    t27 = t25 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t25))
+    t28 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t27)) + t27
+    t29 = t26 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t26))
+    t30 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t29)) + t29
+    t31 = t18*t23
+    t32 = t31*t8
+    t33 = t18*t21
+    t34 = t33*t4
+    t35 = xp.where(t17, 1, -(t32 + t34))
+    t36 = -t32 + t34
+    t37 = t31*t4
+    t38 = t33*t8
+    t39 = xp.where(t17, 0, -t38 + t37)
+    t40 = t37 + t38
+    t41 = t4*t35 + t8*t39
+    t42 = t8*t35 - t4*t39
+    t43 = T02*t39 - T12*t35
+    t44 = T00*t39 - T10*t35
+    t45 = T01*t39 - T11*t35
+    t46 = t4*t36 + t8*t40
+    t47 = t8*t36 - t4*t40
+    t48 = T02*t40 - T12*t36
+    t49 = T00*t40 - T10*t36
+    t50 = T01*t40 - T11*t36
+    t51 = 1 - t35
+    t52 = t51*t13
+    t53 = t52 + t13*t35
+    t54 = t43**2
+    t55 = 1 - t54
+    t56 = xp.greater(t55, 1e-12)
+    t57 = xp.where(t56, t43, xp.where(xp.greater(t43, 0), xp.asarray(1, dtype=dtype), -1))
+    t58 = xp.where(t56, xp.sqrt(t55), 0)
+    t59 = xp.atan2(t58, t57)
+    t60 = t59 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t59))
+    t61 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t60)) + t60
+    t62 = t59 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t59))
+    t63 = t43*t57
+    t64 = t63 + t58*t44
+    t65 = -t63 + t64
+    t66 = t58**2
+    t67 = t66 + t57**2
+    t68 = t45**2
+    t69 = t65**2 + t66*t68
+    t70 = t54 + t68 + t44**2
+    t71 = xp.less_equal(t69, 1e-24*t70*t67)
+    t72 = xp.where(t71, 1, 1/xp.sqrt(t69))
+    t73 = xp.where(t71, 1, t65*t72)
+    t74 = t58*(1 - t73)
+    t75 = t74 + t58*t73
+    t76 = t58*t45
+    t77 = xp.where(t71, 0, -t76*t72)
+    t78 = t57*t73
+    t79 = t57*t77
+    t80 = T02*t75 - t78*T00 + t79*T01
+    t81 = T12*t75 - t78*T10 + t79*T11
+    t82 = T22*t75 - t78*T20 + t79*T21
+    t83 = t51*t82
+    t84 = t35*t80 + t39*t81
+    t85 = -t35*t81 + t39*t80
+    t86 = t83 + t35*t82
+    t87 = t84**2 + t86**2
+    t88 = t87 + t85**2
+    t89 = xp.less_equal(t87, 1e-24*t88)
+    t90 = xp.where(t89, 1, 1/xp.sqrt(t87))
+    t91 = xp.where(t89, 1, -t84*t90)
+    t92 = xp.where(t89, 0, -t86*t90)
+    t93 = 0.10915*(1 - t91)
+    t94 = 0.10915*(1 + t91)
+    t95 = 0.10915*t91
+    t96 = t95 + t93
+    t97 = t42 + t96
+    t98 = -t94 + t95
+    t99 = -t98 + t42
+    t100 = 0.09465*t92
+    t101 = -t100 + t41
+    t102 = t100 + t41
+    t103 = 0.09465*t91
+    t104 = t103 + t53
+    t105 = -0.089459 + t104
+    t106 = t101**2 + t97**2 + t105**2
+    t107 = 0.5*(0.3344850625 - t106)
+    t108 = 1 - 35.98290608994648*t107**2
+    t109 = -t103 + t53
+    t110 = -0.089459 + t109
+    t111 = t102**2 + t99**2 + t110**2
+    t112 = 0.5*(0.3344850625 - t111)
+    t113 = 1 - 35.98290608994648*t112**2
+    t114 = xp.greater(t108, 1e-12)
+    t115 = xp.where(t114, xp.sqrt(t108), 0)
+    t116 = 5.99857533835714*t107
+    t117 = xp.where(t114, t116, xp.where(xp.greater(t116, 0), xp.asarray(1, dtype=dtype), -1))
+    t118 = xp.atan2(t115, t117)
+    t119 = 3.141592653589793 + t118
+    t120 = 3.141592653589793 - t118
+    t121 = -0.425 + 0.39225*t117
+    t122 = t119 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t119))
+    t123 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t122)) + t122
+    t124 = t120 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t120))
     t125 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t124)) + t124
-    t126 = t122 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t122))
-    t127 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t126)) + t126
-    t128 = 0.39225*t117
-    t129 = 0.089459 + t128
+    t126 = 0.39225*t115
+    t127 = 0.089459 + t126
+    t128 = -0.089459 + t127
+    t129 = 0.089459 - t126
     t130 = -0.089459 + t129
-    t131 = 0.089459 - t128
-    t132 = -0.089459 + t131
-    t133 = t103*t123
-    t134 = t133 + t107*t130
-    t135 = t133 + t107*t132
-    t136 = -t107*t123
-    t137 = t136 + t103*t130
-    t138 = t134**2 + t137**2
-    t139 = t136 + t103*t132
-    t140 = t135**2 + t139**2
-    t141 = t123**2
-    t142 = t141 + t130**2
-    t143 = t141 + t132**2
-    t144 = xp.greater(t115, 1e-12)
-    t145 = xp.where(t144, xp.sqrt(t115), 0)
-    t146 = 5.99857533835714*t114
-    t147 = xp.where(t144, t146, xp.where(xp.greater(t146, 0), xp.asarray(1, dtype=dtype), -1))
-    t148 = xp.atan2(t145, t147)
-    t149 = 3.141592653589793 + t148
-    t150 = 3.141592653589793 - t148
-    t151 = -0.425 + 0.39225*t147
-    t152 = 0.39225*t145
-    t153 = 0.089459 + t152
+    t131 = t101*t121
+    t132 = t131 + t105*t128
+    t133 = t131 + t105*t130
+    t134 = -t105*t121
+    t135 = t134 + t101*t128
+    t136 = t132**2 + t135**2
+    t137 = t134 + t101*t130
+    t138 = t133**2 + t137**2
+    t139 = t121**2
+    t140 = t139 + t128**2
+    t141 = t139 + t130**2
+    t142 = xp.greater(t113, 1e-12)
+    t143 = xp.where(t142, xp.sqrt(t113), 0)
+    t144 = 5.99857533835714*t112
+    t145 = xp.where(t142, t144, xp.where(xp.greater(t144, 0), xp.asarray(1, dtype=dtype), -1))
+    t146 = xp.atan2(t143, t145)
+    t147 = 3.141592653589793 + t146
+    t148 = 3.141592653589793 - t146
+    t149 = -0.425 + 0.39225*t145
+    t150 = 0.39225*t143
+    t151 = 0.089459 + t150
+    t152 = -0.089459 + t151
+    t153 = 0.089459 - t150
     t154 = -0.089459 + t153
-    t155 = 0.089459 - t152
-    t156 = -0.089459 + t155
-    t157 = t104*t151
-    t158 = t157 + t112*t154
-    t159 = t157 + t112*t156
-    t160 = -t112*t151
-    t161 = t160 + t104*t154
-    t162 = t158**2 + t161**2
-    t163 = t160 + t104*t156
-    t164 = t159**2 + t163**2
-    t165 = t151**2
-    t166 = t165 + t154**2
-    t167 = t165 + t156**2
-    t168 = 1 - t37
-    t169 = t168*t13
-    t170 = t169 + t13*t37
-    t171 = t49**2
-    t172 = 1 - t171
-    t173 = xp.greater(t172, 1e-12)
-    t174 = xp.where(t173, t49, xp.where(xp.greater(t49, 0), xp.asarray(1, dtype=dtype), -1))
-    t175 = xp.where(t173, xp.sqrt(t172), 0)
-    t176 = xp.atan2(t175, t174)
-    t177 = t176 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t176))
-    t178 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t177)) + t177
-    t179 = t176 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t176))
-    t180 = t49*t174
-    t181 = t180 + t175*t50
-    t182 = -t180 + t181
-    t183 = t175**2
-    t184 = t183 + t174**2
-    t185 = t51**2
-    t186 = t182**2 + t183*t185
-    t187 = t171 + t185 + t50**2
-    t188 = xp.less_equal(t186, 1e-24*t187*t184)
-    t189 = xp.where(t188, 1, 1/xp.sqrt(t186))
-    t190 = xp.where(t188, 1, t182*t189)
-    t191 = t175*(1 - t190)
-    t192 = t191 + t175*t190
-    t193 = t175*t51
-    t194 = xp.where(t188, 0, -t193*t189)
-    t195 = t174*t190
-    t196 = t174*t194
-    t197 = T02*t192 - t195*T00 + t196*T01
-    t198 = T12*t192 - t195*T10 + t196*T11
-    t199 = T22*t192 - t195*T20 + t196*T21
-    t200 = t168*t199
-    t201 = t37*t197 + t41*t198
-    t202 = -t37*t198 + t41*t197
-    t203 = t200 + t37*t199
-    t204 = t201**2 + t203**2
-    t205 = t204
-    t206 = t204 + t202**2
-    t207 = xp.less_equal(t205, 1e-24*t206)
-    t208 = xp.where(t207, 1, 1/xp.sqrt(t205))
-    t209 = xp.where(t207, 1, -t201*t208)
-    t210 = xp.where(t207, 0, -t203*t208)
-    t211 = 0.10915*(1 - t209)
-    t212 = 0.10915*(1 + t209)
-    t213 = 0.10915*t209
-    t214 = t213 + t211
-    t215 = t48 + t214
-    t216 = -t212 + t213
-    t217 = -t216 + t48
-    t218 = 0.09465*t210
-    t219 = -t218 + t47
-    t220 = t218 + t47
-    t221 = 0.09465*t209
-    t222 = t221 + t170
-    t223 = -0.089459 + t222
-    t224 = t219**2 + t215**2 + t223**2
-    t225 = 0.5*(0.3344850625 - t224)
-    t226 = 1 - 35.98290608994648*t225**2
-    t227 = -t221 + t170
-    t228 = -0.089459 + t227
-    t229 = t220**2 + t217**2 + t228**2
-    t230 = 0.5*(0.3344850625 - t229)
-    t231 = 1 - 35.98290608994648*t230**2
-    t232 = xp.greater(t226, 1e-12)
-    t233 = xp.where(t232, xp.sqrt(t226), 0)
-    t234 = 5.99857533835714*t225
-    t235 = xp.where(t232, t234, xp.where(xp.greater(t234, 0), xp.asarray(1, dtype=dtype), -1))
-    t236 = xp.atan2(t233, t235)
-    t237 = 3.141592653589793 + t236
-    t238 = 3.141592653589793 - t236
-    t239 = -0.425 + 0.39225*t235
-    t240 = t237 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t237))
-    t241 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t240)) + t240
-    t242 = t238 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t238))
-    t243 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t242)) + t242
-    t244 = 0.39225*t233
-    t245 = 0.089459 + t244
-    t246 = -0.089459 + t245
-    t247 = 0.089459 - t244
-    t248 = -0.089459 + t247
-    t249 = t219*t239
-    t250 = t249 + t223*t246
-    t251 = t249 + t223*t248
-    t252 = -t223*t239
-    t253 = t252 + t219*t246
-    t254 = t250**2 + t253**2
-    t255 = t252 + t219*t248
-    t256 = t251**2 + t255**2
-    t257 = t239**2
-    t258 = t257 + t246**2
-    t259 = t257 + t248**2
-    t260 = xp.greater(t231, 1e-12)
-    t261 = xp.where(t260, xp.sqrt(t231), 0)
-    t262 = 5.99857533835714*t230
-    t263 = xp.where(t260, t262, xp.where(xp.greater(t262, 0), xp.asarray(1, dtype=dtype), -1))
-    t264 = xp.atan2(t261, t263)
-    t265 = 3.141592653589793 + t264
-    t266 = 3.141592653589793 - t264
-    t267 = -0.425 + 0.39225*t263
-    t268 = 0.39225*t261
-    t269 = 0.089459 + t268
-    t270 = -0.089459 + t269
-    t271 = 0.089459 - t268
-    t272 = -0.089459 + t271
-    t273 = t220*t267
-    t274 = t273 + t228*t270
-    t275 = t273 + t228*t272
-    t276 = -t228*t267
-    t277 = t276 + t220*t270
-    t278 = t274**2 + t277**2
-    t279 = t276 + t220*t272
-    t280 = t275**2 + t279**2
-    t281 = t267**2
-    t282 = t281 + t270**2
-    t283 = t281 + t272**2
-    t284 = 1e-24*t108
-    t285 = xp.where(xp.less_equal(t138, t284*t142), 0, xp.atan2(-t137, t134))
-    t286 = t285
-    t287 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t286)) + t286
-    t288 = -xp.where(t91, 0, xp.atan2(-t87, -t85))
-    t289 = 3.141592653589793 + t288
-    t290 = t285 + t121
-    t291 = t288 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t289 + t290)) + t290
-    t292 = -t291
-    t293 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t292)) + t291
-    t294 = xp.where(t72, 0, xp.atan2(-t77, t66))
-    t295 = t294
-    t296 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t295)) + t295
-    t297 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t294) + t294
-    t298 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t297)) + t297
-    t299 = xp.where(xp.less_equal(t140, t284*t143), 0, xp.atan2(-t139, t135))
-    t300 = t299
-    t301 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t300)) + t300
-    t302 = t122 + t299
-    t303 = t288 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t289 + t302)) + t302
-    t304 = -t303
-    t305 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t304)) + t303
-    t306 = 1e-24*t113
-    t307 = xp.where(xp.less_equal(t162, t166*t306), 0, xp.atan2(-t161, t158))
-    t308 = t307
-    t309 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t308)) + t308
-    t310 = -3.141592653589793 + t149
-    t311 = t149 - 6.283185307179586*xp.ceil(0.15915494309189535*t310)
-    t312 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t311)) + t311
-    t313 = t288 + t307
-    t314 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t149 + t313)) + t310 + t313
-    t315 = -t314
-    t316 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t315)) + t314
-    t317 = -t63
-    t318 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t317)) + t63
-    t319 = xp.where(xp.less_equal(t164, t167*t306), 0, xp.atan2(-t163, t159))
-    t320 = t319
-    t321 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t320)) + t320
-    t322 = -3.141592653589793 + t150
-    t323 = t150 - 6.283185307179586*xp.ceil(0.15915494309189535*t322)
-    t324 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t323)) + t323
-    t325 = t288 + t319
-    t326 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t150 + t325)) + t322 + t325
-    t327 = -t326
-    t328 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t327)) + t326
-    t329 = 1e-24*t224
-    t330 = xp.where(xp.less_equal(t254, t258*t329), 0, xp.atan2(-t253, t250))
-    t331 = t330
-    t332 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t331)) + t331
-    t333 = -xp.where(t207, 0, xp.atan2(-t203, -t201))
-    t334 = 3.141592653589793 + t333
-    t335 = t237 + t330
-    t336 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t334 + t335)) + t333 + t335
-    t337 = -t336
-    t338 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t337)) + t336
-    t339 = xp.where(t188, 0, xp.atan2(-t193, t182))
-    t340 = t339
-    t341 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t340)) + t340
-    t342 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t339) + t339
-    t343 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t342)) + t342
-    t344 = xp.where(xp.less_equal(t256, t259*t329), 0, xp.atan2(-t255, t251))
-    t345 = t344
-    t346 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t345)) + t345
-    t347 = t238 + t344
-    t348 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t334 + t347)) + t333 + t347
-    t349 = -t348
-    t350 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t349)) + t348
-    t351 = 1e-24*t229
-    t352 = xp.where(xp.less_equal(t278, t282*t351), 0, xp.atan2(-t277, t274))
-    t353 = t352
-    t354 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t353)) + t353
-    t355 = -3.141592653589793 + t265
-    t356 = t265 - 6.283185307179586*xp.ceil(0.15915494309189535*t355)
-    t357 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t356)) + t356
-    t358 = t333 + t352
-    t359 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t265 + t358)) + t355 + t358
-    t360 = -t359
-    t361 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t360)) + t359
-    t362 = -t179
-    t363 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t362)) + t179
-    t364 = xp.where(xp.less_equal(t280, t283*t351), 0, xp.atan2(-t279, t275))
-    t365 = t364
-    t366 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t365)) + t365
-    t367 = -3.141592653589793 + t266
-    t368 = t266 - 6.283185307179586*xp.ceil(0.15915494309189535*t367)
-    t369 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t368)) + t368
-    t370 = t333 + t364
-    t371 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t266 + t370)) + t367 + t370
-    t372 = -t371
-    t373 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t372)) + t371
-    t374 = xp.greater_equal(t28, -6.283185307179586) & xp.less_equal(t28, 6.283185307179586)
-    t375 = xp.less_equal(t29, 6.283185307179586)
-    t376 = xp.where(xp.logical_not(t374) & t375, t29, t28)
-    t377 = xp.greater_equal(t286, -6.283185307179586) & xp.less_equal(t286, 6.283185307179586)
-    t378 = xp.less_equal(t287, 6.283185307179586)
+    t155 = t102*t149
+    t156 = t155 + t110*t152
+    t157 = t155 + t110*t154
+    t158 = -t110*t149
+    t159 = t158 + t102*t152
+    t160 = t156**2 + t159**2
+    t161 = t158 + t102*t154
+    t162 = t157**2 + t161**2
+    t163 = t149**2
+    t164 = t163 + t152**2
+    t165 = t163 + t154**2
+    t166 = 1 - t36
+    t167 = t166*t13
+    t168 = t167 + t13*t36
+    t169 = t48**2
+    t170 = 1 - t169
+    t171 = xp.greater(t170, 1e-12)
+    t172 = xp.where(t171, t48, xp.where(xp.greater(t48, 0), xp.asarray(1, dtype=dtype), -1))
+    t173 = xp.where(t171, xp.sqrt(t170), 0)
+    t174 = xp.atan2(t173, t172)
+    t175 = t174 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t174))
+    t176 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t175)) + t175
+    t177 = t174 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t174))
+    t178 = t48*t172
+    t179 = t178 + t173*t49
+    t180 = -t178 + t179
+    t181 = t173**2
+    t182 = t181 + t172**2
+    t183 = t50**2
+    t184 = t180**2 + t181*t183
+    t185 = t169 + t183 + t49**2
+    t186 = xp.less_equal(t184, 1e-24*t185*t182)
+    t187 = xp.where(t186, 1, 1/xp.sqrt(t184))
+    t188 = xp.where(t186, 1, t180*t187)
+    t189 = t173*(1 - t188)
+    t190 = t189 + t173*t188
+    t191 = t173*t50
+    t192 = xp.where(t186, 0, -t191*t187)
+    t193 = t172*t188
+    t194 = t172*t192
+    t195 = T02*t190 - t193*T00 + t194*T01
+    t196 = T12*t190 - t193*T10 + t194*T11
+    t197 = T22*t190 - t193*T20 + t194*T21
+    t198 = t166*t197
+    t199 = t36*t195 + t40*t196
+    t200 = -t36*t196 + t40*t195
+    t201 = t198 + t36*t197
+    t202 = t199**2 + t201**2
+    t203 = t202 + t200**2
+    t204 = xp.less_equal(t202, 1e-24*t203)
+    t205 = xp.where(t204, 1, 1/xp.sqrt(t202))
+    t206 = xp.where(t204, 1, -t199*t205)
+    t207 = xp.where(t204, 0, -t201*t205)
+    t208 = 0.10915*(1 - t206)
+    t209 = 0.10915*(1 + t206)
+    t210 = 0.10915*t206
+    t211 = t210 + t208
+    t212 = t47 + t211
+    t213 = -t209 + t210
+    t214 = -t213 + t47
+    t215 = 0.09465*t207
+    t216 = -t215 + t46
+    t217 = t215 + t46
+    t218 = 0.09465*t206
+    t219 = t218 + t168
+    t220 = -0.089459 + t219
+    t221 = t216**2 + t212**2 + t220**2
+    t222 = 0.5*(0.3344850625 - t221)
+    t223 = 1 - 35.98290608994648*t222**2
+    t224 = -t218 + t168
+    t225 = -0.089459 + t224
+    t226 = t217**2 + t214**2 + t225**2
+    t227 = 0.5*(0.3344850625 - t226)
+    t228 = 1 - 35.98290608994648*t227**2
+    t229 = xp.greater(t223, 1e-12)
+    t230 = xp.where(t229, xp.sqrt(t223), 0)
+    t231 = 5.99857533835714*t222
+    t232 = xp.where(t229, t231, xp.where(xp.greater(t231, 0), xp.asarray(1, dtype=dtype), -1))
+    t233 = xp.atan2(t230, t232)
+    t234 = 3.141592653589793 + t233
+    t235 = 3.141592653589793 - t233
+    t236 = -0.425 + 0.39225*t232
+    t237 = t234 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t234))
+    t238 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t237)) + t237
+    t239 = t235 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t235))
+    t240 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t239)) + t239
+    t241 = 0.39225*t230
+    t242 = 0.089459 + t241
+    t243 = -0.089459 + t242
+    t244 = 0.089459 - t241
+    t245 = -0.089459 + t244
+    t246 = t216*t236
+    t247 = t246 + t220*t243
+    t248 = t246 + t220*t245
+    t249 = -t220*t236
+    t250 = t249 + t216*t243
+    t251 = t247**2 + t250**2
+    t252 = t249 + t216*t245
+    t253 = t248**2 + t252**2
+    t254 = t236**2
+    t255 = t254 + t243**2
+    t256 = t254 + t245**2
+    t257 = xp.greater(t228, 1e-12)
+    t258 = xp.where(t257, xp.sqrt(t228), 0)
+    t259 = 5.99857533835714*t227
+    t260 = xp.where(t257, t259, xp.where(xp.greater(t259, 0), xp.asarray(1, dtype=dtype), -1))
+    t261 = xp.atan2(t258, t260)
+    t262 = 3.141592653589793 + t261
+    t263 = 3.141592653589793 - t261
+    t264 = -0.425 + 0.39225*t260
+    t265 = 0.39225*t258
+    t266 = 0.089459 + t265
+    t267 = -0.089459 + t266
+    t268 = 0.089459 - t265
+    t269 = -0.089459 + t268
+    t270 = t217*t264
+    t271 = t270 + t225*t267
+    t272 = t270 + t225*t269
+    t273 = -t225*t264
+    t274 = t273 + t217*t267
+    t275 = t271**2 + t274**2
+    t276 = t273 + t217*t269
+    t277 = t272**2 + t276**2
+    t278 = t264**2
+    t279 = t278 + t267**2
+    t280 = t278 + t269**2
+    t281 = 1e-24*t106
+    t282 = xp.where(xp.less_equal(t136, t281*t140), 0, xp.atan2(-t135, t132))
+    t283 = t282 - 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t282))
+    t284 = -xp.where(t89, 0, xp.atan2(-t86, -t84))
+    t285 = 3.141592653589793 + t284
+    t286 = t282 + t119
+    t287 = t284 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t285 + t286)) + t286
+    t288 = -t287
+    t289 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t288)) + t287
+    t290 = xp.where(t71, 0, xp.atan2(-t76, t65))
+    t291 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t290)) + t290
+    t292 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t290) + t290
+    t293 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t292)) + t292
+    t294 = xp.where(xp.less_equal(t138, t281*t141), 0, xp.atan2(-t137, t133))
+    t295 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t294)) + t294
+    t296 = t120 + t294
+    t297 = t284 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t285 + t296)) + t296
+    t298 = -t297
+    t299 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t298)) + t297
+    t300 = 1e-24*t111
+    t301 = xp.where(xp.less_equal(t160, t164*t300), 0, xp.atan2(-t159, t156))
+    t302 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t301)) + t301
+    t303 = -3.141592653589793 + t147
+    t304 = t147 - 6.283185307179586*xp.ceil(0.15915494309189535*t303)
+    t305 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t304)) + t304
+    t306 = t284 + t301
+    t307 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t147 + t306)) + t303 + t306
+    t308 = -t307
+    t309 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t308)) + t307
+    t310 = -t62
+    t311 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t310)) + t62
+    t312 = xp.where(xp.less_equal(t162, t165*t300), 0, xp.atan2(-t161, t157))
+    t313 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t312)) + t312
+    t314 = -3.141592653589793 + t148
+    t315 = t148 - 6.283185307179586*xp.ceil(0.15915494309189535*t314)
+    t316 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t315)) + t315
+    t317 = t284 + t312
+    t318 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t148 + t317)) + t314 + t317
+    t319 = -t318
+    t320 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t319)) + t318
+    t321 = 1e-24*t221
+    t322 = xp.where(xp.less_equal(t251, t255*t321), 0, xp.atan2(-t250, t247))
+    t323 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t322)) + t322
+    t324 = -xp.where(t204, 0, xp.atan2(-t201, -t199))
+    t325 = 3.141592653589793 + t324
+    t326 = t234 + t322
+    t327 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t325 + t326)) + t324 + t326
+    t328 = -t327
+    t329 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t328)) + t327
+    t330 = xp.where(t186, 0, xp.atan2(-t191, t180))
+    t331 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t330)) + t330
+    t332 = 3.141592653589793 - 6.283185307179586*xp.ceil(0.15915494309189535*t330) + t330
+    t333 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t332)) + t332
+    t334 = xp.where(xp.less_equal(t253, t256*t321), 0, xp.atan2(-t252, t248))
+    t335 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t334)) + t334
+    t336 = t235 + t334
+    t337 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t325 + t336)) + t324 + t336
+    t338 = -t337
+    t339 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t338)) + t337
+    t340 = 1e-24*t226
+    t341 = xp.where(xp.less_equal(t275, t279*t340), 0, xp.atan2(-t274, t271))
+    t342 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t341)) + t341
+    t343 = -3.141592653589793 + t262
+    t344 = t262 - 6.283185307179586*xp.ceil(0.15915494309189535*t343)
+    t345 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t344)) + t344
+    t346 = t324 + t341
+    t347 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t262 + t346)) + t343 + t346
+    t348 = -t347
+    t349 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t348)) + t347
+    t350 = -t177
+    t351 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t350)) + t177
+    t352 = xp.where(xp.less_equal(t277, t280*t340), 0, xp.atan2(-t276, t272))
+    t353 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t352)) + t352
+    t354 = -3.141592653589793 + t263
+    t355 = t263 - 6.283185307179586*xp.ceil(0.15915494309189535*t354)
+    t356 = -6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t355)) + t355
+    t357 = t324 + t352
+    t358 = 6.283185307179586*xp.ceil(-0.15915494309189535*(t263 + t357)) + t354 + t357
+    t359 = -t358
+    t360 = 6.283185307179586*xp.floor(0.15915494309189535*(6.283185307179586 + t359)) + t358
+    t361 = xp.greater_equal(t27, -6.283185307179586) & xp.less_equal(t27, 6.283185307179586)
+    t362 = xp.less_equal(t28, 6.283185307179586)
+    t363 = xp.where(xp.logical_not(t361) & t362, t28, t27)
+    t364 = xp.greater_equal(t282, -6.283185307179586) & xp.less_equal(t282, 6.283185307179586)
+    t365 = xp.less_equal(t283, 6.283185307179586)
+    t366 = xp.greater_equal(t122, -6.283185307179586) & xp.less_equal(t122, 6.283185307179586)
+    t367 = xp.less_equal(t123, 6.283185307179586)
+    t368 = xp.greater_equal(t288, -6.283185307179586) & xp.less_equal(t288, 6.283185307179586)
+    t369 = -t289
+    t370 = xp.less_equal(t369, 6.283185307179586)
+    t371 = xp.greater_equal(t60, -6.283185307179586) & xp.less_equal(t60, 6.283185307179586)
+    t372 = xp.less_equal(t61, 6.283185307179586)
+    t373 = xp.where(xp.logical_not(t371) & t372, t61, t60)
+    t374 = xp.greater_equal(t290, -6.283185307179586) & xp.less_equal(t290, 6.283185307179586)
+    t375 = xp.less_equal(t291, 6.283185307179586)
+    t376 = xp.where(xp.logical_not(t374) & t375, t291, t290)
+    t377 = xp.greater_equal(t294, -6.283185307179586) & xp.less_equal(t294, 6.283185307179586)
+    t378 = xp.less_equal(t295, 6.283185307179586)
     t379 = xp.greater_equal(t124, -6.283185307179586) & xp.less_equal(t124, 6.283185307179586)
     t380 = xp.less_equal(t125, 6.283185307179586)
-    t381 = xp.greater_equal(t292, -6.283185307179586) & xp.less_equal(t292, 6.283185307179586)
-    t382 = -t293
+    t381 = xp.greater_equal(t298, -6.283185307179586) & xp.less_equal(t298, 6.283185307179586)
+    t382 = -t299
     t383 = xp.less_equal(t382, 6.283185307179586)
-    t384 = xp.greater_equal(t61, -6.283185307179586) & xp.less_equal(t61, 6.283185307179586)
-    t385 = xp.less_equal(t62, 6.283185307179586)
-    t386 = xp.where(xp.logical_not(t384) & t385, t62, t61)
-    t387 = xp.greater_equal(t295, -6.283185307179586) & xp.less_equal(t295, 6.283185307179586)
-    t388 = xp.less_equal(t296, 6.283185307179586)
-    t389 = xp.where(xp.logical_not(t387) & t388, t296, t295)
-    t390 = xp.greater_equal(t300, -6.283185307179586) & xp.less_equal(t300, 6.283185307179586)
-    t391 = xp.less_equal(t301, 6.283185307179586)
-    t392 = xp.greater_equal(t126, -6.283185307179586) & xp.less_equal(t126, 6.283185307179586)
-    t393 = xp.less_equal(t127, 6.283185307179586)
-    t394 = xp.greater_equal(t304, -6.283185307179586) & xp.less_equal(t304, 6.283185307179586)
-    t395 = -t305
-    t396 = xp.less_equal(t395, 6.283185307179586)
-    t397 = xp.greater_equal(t308, -6.283185307179586) & xp.less_equal(t308, 6.283185307179586)
-    t398 = xp.less_equal(t309, 6.283185307179586)
-    t399 = xp.greater_equal(t311, -6.283185307179586) & xp.less_equal(t311, 6.283185307179586)
-    t400 = xp.less_equal(t312, 6.283185307179586)
-    t401 = xp.greater_equal(t315, -6.283185307179586) & xp.less_equal(t315, 6.283185307179586)
-    t402 = -t316
-    t403 = xp.less_equal(t402, 6.283185307179586)
-    t404 = xp.greater_equal(t317, -6.283185307179586) & xp.less_equal(t317, 6.283185307179586)
-    t405 = -t318
-    t406 = xp.less_equal(t405, 6.283185307179586)
-    t407 = xp.where(xp.logical_not(t404) & t406, t405, t317)
-    t408 = xp.greater_equal(t297, -6.283185307179586) & xp.less_equal(t297, 6.283185307179586)
-    t409 = xp.less_equal(t298, 6.283185307179586)
-    t410 = xp.where(xp.logical_not(t408) & t409, t298, t297)
-    t411 = xp.greater_equal(t320, -6.283185307179586) & xp.less_equal(t320, 6.283185307179586)
-    t412 = xp.less_equal(t321, 6.283185307179586)
-    t413 = xp.greater_equal(t323, -6.283185307179586) & xp.less_equal(t323, 6.283185307179586)
-    t414 = xp.less_equal(t324, 6.283185307179586)
-    t415 = xp.greater_equal(t327, -6.283185307179586) & xp.less_equal(t327, 6.283185307179586)
-    t416 = -t328
-    t417 = xp.less_equal(t416, 6.283185307179586)
-    t418 = xp.greater_equal(t30, -6.283185307179586) & xp.less_equal(t30, 6.283185307179586)
-    t419 = xp.less_equal(t31, 6.283185307179586)
-    t420 = xp.where(xp.logical_not(t418) & t419, t31, t30)
-    t421 = xp.greater_equal(t331, -6.283185307179586) & xp.less_equal(t331, 6.283185307179586)
-    t422 = xp.less_equal(t332, 6.283185307179586)
-    t423 = xp.greater_equal(t240, -6.283185307179586) & xp.less_equal(t240, 6.283185307179586)
-    t424 = xp.less_equal(t241, 6.283185307179586)
-    t425 = xp.greater_equal(t337, -6.283185307179586) & xp.less_equal(t337, 6.283185307179586)
-    t426 = -t338
+    t384 = xp.greater_equal(t301, -6.283185307179586) & xp.less_equal(t301, 6.283185307179586)
+    t385 = xp.less_equal(t302, 6.283185307179586)
+    t386 = xp.greater_equal(t304, -6.283185307179586) & xp.less_equal(t304, 6.283185307179586)
+    t387 = xp.less_equal(t305, 6.283185307179586)
+    t388 = xp.greater_equal(t308, -6.283185307179586) & xp.less_equal(t308, 6.283185307179586)
+    t389 = -t309
+    t390 = xp.less_equal(t389, 6.283185307179586)
+    t391 = xp.greater_equal(t310, -6.283185307179586) & xp.less_equal(t310, 6.283185307179586)
+    t392 = -t311
+    t393 = xp.less_equal(t392, 6.283185307179586)
+    t394 = xp.where(xp.logical_not(t391) & t393, t392, t310)
+    t395 = xp.greater_equal(t292, -6.283185307179586) & xp.less_equal(t292, 6.283185307179586)
+    t396 = xp.less_equal(t293, 6.283185307179586)
+    t397 = xp.where(xp.logical_not(t395) & t396, t293, t292)
+    t398 = xp.greater_equal(t312, -6.283185307179586) & xp.less_equal(t312, 6.283185307179586)
+    t399 = xp.less_equal(t313, 6.283185307179586)
+    t400 = xp.greater_equal(t315, -6.283185307179586) & xp.less_equal(t315, 6.283185307179586)
+    t401 = xp.less_equal(t316, 6.283185307179586)
+    t402 = xp.greater_equal(t319, -6.283185307179586) & xp.less_equal(t319, 6.283185307179586)
+    t403 = -t320
+    t404 = xp.less_equal(t403, 6.283185307179586)
+    t405 = xp.greater_equal(t29, -6.283185307179586) & xp.less_equal(t29, 6.283185307179586)
+    t406 = xp.less_equal(t30, 6.283185307179586)
+    t407 = xp.where(xp.logical_not(t405) & t406, t30, t29)
+    t408 = xp.greater_equal(t322, -6.283185307179586) & xp.less_equal(t322, 6.283185307179586)
+    t409 = xp.less_equal(t323, 6.283185307179586)
+    t410 = xp.greater_equal(t237, -6.283185307179586) & xp.less_equal(t237, 6.283185307179586)
+    t411 = xp.less_equal(t238, 6.283185307179586)
+    t412 = xp.greater_equal(t328, -6.283185307179586) & xp.less_equal(t328, 6.283185307179586)
+    t413 = -t329
+    t414 = xp.less_equal(t413, 6.283185307179586)
+    t415 = xp.greater_equal(t175, -6.283185307179586) & xp.less_equal(t175, 6.283185307179586)
+    t416 = xp.less_equal(t176, 6.283185307179586)
+    t417 = xp.where(xp.logical_not(t415) & t416, t176, t175)
+    t418 = xp.greater_equal(t330, -6.283185307179586) & xp.less_equal(t330, 6.283185307179586)
+    t419 = xp.less_equal(t331, 6.283185307179586)
+    t420 = xp.where(xp.logical_not(t418) & t419, t331, t330)
+    t421 = xp.greater_equal(t334, -6.283185307179586) & xp.less_equal(t334, 6.283185307179586)
+    t422 = xp.less_equal(t335, 6.283185307179586)
+    t423 = xp.greater_equal(t239, -6.283185307179586) & xp.less_equal(t239, 6.283185307179586)
+    t424 = xp.less_equal(t240, 6.283185307179586)
+    t425 = xp.greater_equal(t338, -6.283185307179586) & xp.less_equal(t338, 6.283185307179586)
+    t426 = -t339
     t427 = xp.less_equal(t426, 6.283185307179586)
-    t428 = xp.greater_equal(t177, -6.283185307179586) & xp.less_equal(t177, 6.283185307179586)
-    t429 = xp.less_equal(t178, 6.283185307179586)
-    t430 = xp.where(xp.logical_not(t428) & t429, t178, t177)
-    t431 = xp.greater_equal(t340, -6.283185307179586) & xp.less_equal(t340, 6.283185307179586)
-    t432 = xp.less_equal(t341, 6.283185307179586)
-    t433 = xp.where(xp.logical_not(t431) & t432, t341, t340)
-    t434 = xp.greater_equal(t345, -6.283185307179586) & xp.less_equal(t345, 6.283185307179586)
-    t435 = xp.less_equal(t346, 6.283185307179586)
-    t436 = xp.greater_equal(t242, -6.283185307179586) & xp.less_equal(t242, 6.283185307179586)
-    t437 = xp.less_equal(t243, 6.283185307179586)
-    t438 = xp.greater_equal(t349, -6.283185307179586) & xp.less_equal(t349, 6.283185307179586)
-    t439 = -t350
-    t440 = xp.less_equal(t439, 6.283185307179586)
-    t441 = xp.greater_equal(t353, -6.283185307179586) & xp.less_equal(t353, 6.283185307179586)
-    t442 = xp.less_equal(t354, 6.283185307179586)
-    t443 = xp.greater_equal(t356, -6.283185307179586) & xp.less_equal(t356, 6.283185307179586)
-    t444 = xp.less_equal(t357, 6.283185307179586)
-    t445 = xp.greater_equal(t360, -6.283185307179586) & xp.less_equal(t360, 6.283185307179586)
-    t446 = -t361
-    t447 = xp.less_equal(t446, 6.283185307179586)
-    t448 = xp.greater_equal(t362, -6.283185307179586) & xp.less_equal(t362, 6.283185307179586)
-    t449 = -t363
-    t450 = xp.less_equal(t449, 6.283185307179586)
-    t451 = xp.where(xp.logical_not(t448) & t450, t449, t362)
-    t452 = xp.greater_equal(t342, -6.283185307179586) & xp.less_equal(t342, 6.283185307179586)
-    t453 = xp.less_equal(t343, 6.283185307179586)
-    t454 = xp.where(xp.logical_not(t452) & t453, t343, t342)
-    t455 = xp.greater_equal(t365, -6.283185307179586) & xp.less_equal(t365, 6.283185307179586)
-    t456 = xp.less_equal(t366, 6.283185307179586)
-    t457 = xp.greater_equal(t368, -6.283185307179586) & xp.less_equal(t368, 6.283185307179586)
-    t458 = xp.less_equal(t369, 6.283185307179586)
-    t459 = xp.greater_equal(t372, -6.283185307179586) & xp.less_equal(t372, 6.283185307179586)
-    t460 = -t373
-    t461 = xp.less_equal(t460, 6.283185307179586)
-    t462 = xp.isfinite(t0)
-    t463 = xp.greater(t15, t17)
-    t464 = (t18 & xp.less_equal(0.0119137225, 1e-12*t16)) | (t463 & xp.greater_equal(t20, -1e-12))
-    t465 = xp.greater_equal(t56, -1e-12)
-    t466 = xp.greater_equal(t172, -1e-12)
-    t467 = t374 | t375
-    t468 = t384 | t385
-    t469 = t387 | t388
-    t470 = t404 | t406
-    t471 = t408 | t409
-    t472 = t418 | t419
-    t473 = t428 | t429
-    t474 = t431 | t432
-    t475 = t448 | t450
-    t476 = t452 | t453
+    t428 = xp.greater_equal(t341, -6.283185307179586) & xp.less_equal(t341, 6.283185307179586)
+    t429 = xp.less_equal(t342, 6.283185307179586)
+    t430 = xp.greater_equal(t344, -6.283185307179586) & xp.less_equal(t344, 6.283185307179586)
+    t431 = xp.less_equal(t345, 6.283185307179586)
+    t432 = xp.greater_equal(t348, -6.283185307179586) & xp.less_equal(t348, 6.283185307179586)
+    t433 = -t349
+    t434 = xp.less_equal(t433, 6.283185307179586)
+    t435 = xp.greater_equal(t350, -6.283185307179586) & xp.less_equal(t350, 6.283185307179586)
+    t436 = -t351
+    t437 = xp.less_equal(t436, 6.283185307179586)
+    t438 = xp.where(xp.logical_not(t435) & t437, t436, t350)
+    t439 = xp.greater_equal(t332, -6.283185307179586) & xp.less_equal(t332, 6.283185307179586)
+    t440 = xp.less_equal(t333, 6.283185307179586)
+    t441 = xp.where(xp.logical_not(t439) & t440, t333, t332)
+    t442 = xp.greater_equal(t352, -6.283185307179586) & xp.less_equal(t352, 6.283185307179586)
+    t443 = xp.less_equal(t353, 6.283185307179586)
+    t444 = xp.greater_equal(t355, -6.283185307179586) & xp.less_equal(t355, 6.283185307179586)
+    t445 = xp.less_equal(t356, 6.283185307179586)
+    t446 = xp.greater_equal(t359, -6.283185307179586) & xp.less_equal(t359, 6.283185307179586)
+    t447 = -t360
+    t448 = xp.less_equal(t447, 6.283185307179586)
+    t449 = xp.isfinite(t0)
+    t450 = xp.greater(t14, t16)
+    t451 = (t17 & xp.less_equal(0.0119137225, 1e-12*t15)) | (t450 & xp.greater_equal(t19, -1e-12))
+    t452 = xp.greater_equal(t55, -1e-12)
+    t453 = xp.greater_equal(t170, -1e-12)
+    t454 = t361 | t362
+    t455 = t371 | t372
+    t456 = t374 | t375
+    t457 = t391 | t393
+    t458 = t395 | t396
+    t459 = t405 | t406
+    t460 = t415 | t416
+    t461 = t418 | t419
+    t462 = t435 | t437
+    t463 = t439 | t440
     q = _stack(xp, [
-        t376,  # 0, 0
-        xp.where(xp.logical_not(t377) & t378, t287, t286),  # 0, 1
-        xp.where(xp.logical_not(t379) & t380, t125, t124),  # 0, 2
-        xp.where(xp.logical_not(t381) & t383, t382, t292),  # 0, 3
-        t386,  # 0, 4
-        t389,  # 0, 5
-        t376,  # 1, 0
-        xp.where(xp.logical_not(t390) & t391, t301, t300),  # 1, 1
-        xp.where(xp.logical_not(t392) & t393, t127, t126),  # 1, 2
-        xp.where(xp.logical_not(t394) & t396, t395, t304),  # 1, 3
-        t386,  # 1, 4
-        t389,  # 1, 5
-        t376,  # 2, 0
-        xp.where(xp.logical_not(t397) & t398, t309, t308),  # 2, 1
-        xp.where(xp.logical_not(t399) & t400, t312, t311),  # 2, 2
-        xp.where(xp.logical_not(t401) & t403, t402, t315),  # 2, 3
-        t407,  # 2, 4
-        t410,  # 2, 5
-        t376,  # 3, 0
-        xp.where(xp.logical_not(t411) & t412, t321, t320),  # 3, 1
-        xp.where(xp.logical_not(t413) & t414, t324, t323),  # 3, 2
-        xp.where(xp.logical_not(t415) & t417, t416, t327),  # 3, 3
-        t407,  # 3, 4
-        t410,  # 3, 5
-        t420,  # 4, 0
-        xp.where(xp.logical_not(t421) & t422, t332, t331),  # 4, 1
-        xp.where(xp.logical_not(t423) & t424, t241, t240),  # 4, 2
-        xp.where(xp.logical_not(t425) & t427, t426, t337),  # 4, 3
-        t430,  # 4, 4
-        t433,  # 4, 5
-        t420,  # 5, 0
-        xp.where(xp.logical_not(t434) & t435, t346, t345),  # 5, 1
-        xp.where(xp.logical_not(t436) & t437, t243, t242),  # 5, 2
-        xp.where(xp.logical_not(t438) & t440, t439, t349),  # 5, 3
-        t430,  # 5, 4
-        t433,  # 5, 5
-        t420,  # 6, 0
-        xp.where(xp.logical_not(t441) & t442, t354, t353),  # 6, 1
-        xp.where(xp.logical_not(t443) & t444, t357, t356),  # 6, 2
-        xp.where(xp.logical_not(t445) & t447, t446, t360),  # 6, 3
-        t451,  # 6, 4
-        t454,  # 6, 5
-        t420,  # 7, 0
-        xp.where(xp.logical_not(t455) & t456, t366, t365),  # 7, 1
-        xp.where(xp.logical_not(t457) & t458, t369, t368),  # 7, 2
-        xp.where(xp.logical_not(t459) & t461, t460, t372),  # 7, 3
-        t451,  # 7, 4
-        t454,  # 7, 5
+        t363,  # 0, 0
+        xp.where(xp.logical_not(t364) & t365, t283, t282),  # 0, 1
+        xp.where(xp.logical_not(t366) & t367, t123, t122),  # 0, 2
+        xp.where(xp.logical_not(t368) & t370, t369, t288),  # 0, 3
+        t373,  # 0, 4
+        t376,  # 0, 5
+        t363,  # 1, 0
+        xp.where(xp.logical_not(t377) & t378, t295, t294),  # 1, 1
+        xp.where(xp.logical_not(t379) & t380, t125, t124),  # 1, 2
+        xp.where(xp.logical_not(t381) & t383, t382, t298),  # 1, 3
+        t373,  # 1, 4
+        t376,  # 1, 5
+        t363,  # 2, 0
+        xp.where(xp.logical_not(t384) & t385, t302, t301),  # 2, 1
+        xp.where(xp.logical_not(t386) & t387, t305, t304),  # 2, 2
+        xp.where(xp.logical_not(t388) & t390, t389, t308),  # 2, 3
+        t394,  # 2, 4
+        t397,  # 2, 5
+        t363,  # 3, 0
+        xp.where(xp.logical_not(t398) & t399, t313, t312),  # 3, 1
+        xp.where(xp.logical_not(t400) & t401, t316, t315),  # 3, 2
+        xp.where(xp.logical_not(t402) & t404, t403, t319),  # 3, 3
+        t394,  # 3, 4
+        t397,  # 3, 5
+        t407,  # 4, 0
+        xp.where(xp.logical_not(t408) & t409, t323, t322),  # 4, 1
+        xp.where(xp.logical_not(t410) & t411, t238, t237),  # 4, 2
+        xp.where(xp.logical_not(t412) & t414, t413, t328),  # 4, 3
+        t417,  # 4, 4
+        t420,  # 4, 5
+        t407,  # 5, 0
+        xp.where(xp.logical_not(t421) & t422, t335, t334),  # 5, 1
+        xp.where(xp.logical_not(t423) & t424, t240, t239),  # 5, 2
+        xp.where(xp.logical_not(t425) & t427, t426, t338),  # 5, 3
+        t417,  # 5, 4
+        t420,  # 5, 5
+        t407,  # 6, 0
+        xp.where(xp.logical_not(t428) & t429, t342, t341),  # 6, 1
+        xp.where(xp.logical_not(t430) & t431, t345, t344),  # 6, 2
+        xp.where(xp.logical_not(t432) & t434, t433, t348),  # 6, 3
+        t438,  # 6, 4
+        t441,  # 6, 5
+        t407,  # 7, 0
+        xp.where(xp.logical_not(t442) & t443, t353, t352),  # 7, 1
+        xp.where(xp.logical_not(t444) & t445, t356, t355),  # 7, 2
+        xp.where(xp.logical_not(t446) & t448, t447, t359),  # 7, 3
+        t438,  # 7, 4
+        t441,  # 7, 5
     ], (8, 6))
     valid = _stack(xp, [
-        t462 & t464 & t465 & xp.greater_equal(t110, -1e-12),  # 0
-        t462 & t464 & t465 & t116,  # 1
-        t462 & t464 & t57 & xp.greater_equal(t115, -1e-12),  # 2
-        t462 & t464 & t57 & t144,  # 3
-        t462 & t463 & t21 & t466 & xp.greater_equal(t226, -1e-12),  # 4
-        t462 & t463 & t21 & t466 & t232,  # 5
-        t462 & t463 & t21 & t173 & xp.greater_equal(t231, -1e-12),  # 6
-        t462 & t463 & t21 & t173 & t260,  # 7
+        t449 & t451 & t452 & xp.greater_equal(t108, -1e-12),  # 0
+        t449 & t451 & t452 & t114,  # 1
+        t449 & t451 & t56 & xp.greater_equal(t113, -1e-12),  # 2
+        t449 & t451 & t56 & t142,  # 3
+        t449 & t450 & t20 & t453 & xp.greater_equal(t223, -1e-12),  # 4
+        t449 & t450 & t20 & t453 & t229,  # 5
+        t449 & t450 & t20 & t171 & xp.greater_equal(t228, -1e-12),  # 6
+        t449 & t450 & t20 & t171 & t257,  # 7
     ], (8,))
     in_limits = _stack(xp, [
-        t467 & (t377 | t378) & (t379 | t380) & (t381 | t383) & t468 & t469,  # 0
-        t467 & (t390 | t391) & (t392 | t393) & (t394 | t396) & t468 & t469,  # 1
-        t467 & (t397 | t398) & (t399 | t400) & (t401 | t403) & t470 & t471,  # 2
-        t467 & (t411 | t412) & (t413 | t414) & (t415 | t417) & t470 & t471,  # 3
-        t472 & (t421 | t422) & (t423 | t424) & (t425 | t427) & t473 & t474,  # 4
-        t472 & (t434 | t435) & (t436 | t437) & (t438 | t440) & t473 & t474,  # 5
-        t472 & (t441 | t442) & (t443 | t444) & (t445 | t447) & t475 & t476,  # 6
-        t472 & (t455 | t456) & (t457 | t458) & (t459 | t461) & t475 & t476,  # 7
+        t454 & (t364 | t365) & (t366 | t367) & (t368 | t370) & t455 & t456,  # 0
+        t454 & (t377 | t378) & (t379 | t380) & (t381 | t383) & t455 & t456,  # 1
+        t454 & (t384 | t385) & (t386 | t387) & (t388 | t390) & t457 & t458,  # 2
+        t454 & (t398 | t399) & (t400 | t401) & (t402 | t404) & t457 & t458,  # 3
+        t459 & (t408 | t409) & (t410 | t411) & (t412 | t414) & t460 & t461,  # 4
+        t459 & (t421 | t422) & (t423 | t424) & (t425 | t427) & t460 & t461,  # 5
+        t459 & (t428 | t429) & (t430 | t431) & (t432 | t434) & t462 & t463,  # 6
+        t459 & (t442 | t443) & (t444 | t445) & (t446 | t448) & t462 & t463,  # 7
     ], (8,))
     return q, valid, in_limits
 

@@ -222,9 +222,17 @@ class Lowering:
         replacements, reduced = eliminate_common(graph, [v for _, v in named] + outputs,
                                                  sympy.numbered_symbols(f"{names.INTERNAL_PREFIX}r", real=True),
                                                  self._negations)
-        definitions = _in_dependency_order([(s, v) for s, v in definitions if s not in self._named_symbols]
-                                           + list(zip((s for s, _ in named), reduced)) + replacements)
-        definitions, reduced = _without_constants(graph, definitions, reduced[len(named):], distribute=True)
+        named = list(zip((s for s, _ in named), reduced))
+        reduced = reduced[len(named):]
+        # A named value that CSE found elsewhere too is its temporary: read that, not a copy of it.
+        temporaries = {symbol for symbol, _ in replacements}
+        copies = {s: v for s, v in named if v.kind == SYMBOL and v.value in temporaries}
+        definitions = [(s, v) for s, v in definitions if s not in self._named_symbols] + named + replacements
+        if copies:
+            definitions = [(s, graph.substitute(v, copies, False)) for s, v in definitions if s not in copies]
+            reduced = [graph.substitute(e, copies, False) for e in reduced]
+        definitions = _in_dependency_order(definitions)
+        definitions, reduced = _without_constants(graph, definitions, reduced, distribute=True)
         temporaries = [symbol for symbol, _ in definitions if symbol.name.startswith(names.INTERNAL_PREFIX)]
         read = set().union(*(e.free_symbols for _, e in definitions), *(e.free_symbols for e in reduced))
         return Body(frozenset(read - {symbol for symbol, _ in definitions}), tuple(definitions), tuple(reduced),
