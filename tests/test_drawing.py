@@ -276,3 +276,21 @@ def test_q_must_be_finite_numbers(q, tmp_path):
     assert run.output.strip().splitlines()[-1] == (
         f"jacgen: error: Invalid value for '--q': expected comma-separated finite numbers, got '{q}'")
     assert not (tmp_path / "a.png").exists()
+
+
+def test_the_dh_table_writes_exact_angles_in_degrees(tmp_path):
+    """The report's DH table: an angle that is a rational number of degrees is written in
+    degrees (the robot file's pi/2 and -14.5341 deg alike), one in plain radians as it is."""
+    from jacgen.inputs.robot import parse_robot
+    from jacgen.reports.description import dh_table
+
+    text = """name: angles
+convention: standard
+task: [x, y, z]
+joints:
+  - {type: revolute, a: 0, alpha: pi/2, d: 0}
+  - {type: revolute, a: 0, alpha: -16149*pi/200000, d: 0}
+  - {type: revolute, a: 0, alpha: 0.5, d: 0}
+"""
+    robot = parse_robot(text.encode(), "angles.yaml")
+    assert [row[4] for row in dh_table(robot)] == ["90 deg", "-14.5341 deg", "1/2"]

@@ -17,7 +17,9 @@ DH_HEADER = ["#", "name", "type", "a", "alpha", "d", "theta", "offset", "limits"
 
 
 def _angle(value) -> str:
-    degrees = sympy.nsimplify(value.exact * 180 / sympy.pi) if not value.exact.free_symbols else None
+    """An exact angle in degrees when it is a rational number of them (pi/2, 2159*pi/5000),
+    else as it is (no nsimplify: its search took seconds on long arms, and found nothing)."""
+    degrees = value.exact * 180 / sympy.pi if not value.exact.free_symbols else None
     if degrees is not None and degrees.is_Rational:
         return f"{degrees} deg" if degrees.q == 1 else f"{float(degrees):.6g} deg"
     return str(value.exact)
