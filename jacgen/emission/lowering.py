@@ -142,7 +142,7 @@ class Lowering:
     def __init__(self):
         self.definitions: list[tuple[sympy.Symbol, Node]] = []  # in an order that defines before use
         self.graph = Graph()
-        self._names: dict[sympy.Expr, sympy.Symbol] = {}  # named values (see `name`)
+        self._names: dict[object, sympy.Symbol] = {}  # named values, by `_key`
         self._named_symbols: set[sympy.Symbol] = set()
         self._negations: dict[Node, Node | None] = {}  # eliminate_common's, shared by every lowering
         self._lowered: dict[tuple, Body] = {}
@@ -222,11 +222,10 @@ class Lowering:
         replacements, reduced = eliminate_common(graph, [v for _, v in named] + outputs,
                                                  sympy.numbered_symbols(f"{names.INTERNAL_PREFIX}r", real=True),
                                                  self._negations)
-        named = list(zip((s for s, _ in named), reduced))
-        reduced = reduced[len(named):]
+        named, reduced = list(zip((s for s, _ in named), reduced)), reduced[len(named):]
         # A named value that CSE found elsewhere too is its temporary: read that, not a copy of it.
-        temporaries = {symbol for symbol, _ in replacements}
-        copies = {s: v for s, v in named if v.kind == SYMBOL and v.value in temporaries}
+        shared = {symbol for symbol, _ in replacements}
+        copies = {s: v for s, v in named if v.kind == SYMBOL and v.value in shared}
         definitions = [(s, v) for s, v in definitions if s not in self._named_symbols] + named + replacements
         if copies:
             definitions = [(s, graph.substitute(v, copies, False)) for s, v in definitions if s not in copies]
@@ -428,9 +427,8 @@ def _reusing_temporaries(graph: Graph, replacements: list, outputs: list[Node]) 
     products = {}  # a factor -> the product temporaries written out with it
     for symbol, counter in written.items():
         products.setdefault(min(counter, key=lambda n: n.index), []).append(symbol)
-    done: dict[Node, Node] = {}
-
     sizes = {t: sum(counter.values()) for t, counter in written.items()}
+    done: dict[Node, Node] = {}
 
     def covered(node: Node, own: Node | None) -> Node:
         number = node.args[:1] if node.args[0].kind == NUMBER else ()
