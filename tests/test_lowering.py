@@ -43,13 +43,15 @@ def test_logic_counts_as_count_ops():
 
 @pytest.mark.parametrize("source", ["ur5", "stanford", "planar_2r", 3, 5])
 def test_every_body_counts_as_count_ops(source):
-    """Every generated function of shipped and random arms (prismatic joints, symbolic lengths)."""
+    """Every generated function of shipped and random arms (prismatic joints, symbolic lengths),
+    and no temporary is a copy of another (t34 = t33)."""
     robot = load_robot(ROOT / "robots" / f"{source}.yaml") if isinstance(source, str) \
         else parse_robot(random_arm_text(source).encode(), f"arm{source}.yaml")
     for function in Generator(robot).functions():
         body = function.body
         expressions = [e for _, e in body.definitions] + list(body.outputs)
         assert body.operation_count == sympy.count_ops([to_sympy(e) for e in expressions]), function.name
+        assert not [s for s, e in body.definitions if s in body.names and e.kind == "symbol"], function.name
 
 
 def _dh_chain_jacobian(joints: int) -> list[sympy.Expr]:

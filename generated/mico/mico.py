@@ -1614,18 +1614,15 @@ def hessian(q):
     t93 = -t69
     t94 = -t70
     t95 = -t71
-    t96 = t75
-    t97 = t77
-    t98 = t79
-    t99 = -(t13*t39 + t4*t50)
-    t100 = -(t13*t40 + t4*t51)
-    t101 = -t4*t47 + t12*t39
-    t102 = -t4*t48 + t12*t40
-    t103 = -(t12*t50 + t13*t47)
-    t104 = -(t12*t51 + t13*t48)
-    t105 = -(t21*t40 + t25*t51)
-    t106 = -t25*t48 + t19*t40
-    t107 = -(t19*t51 + t21*t48)
+    t96 = -(t13*t39 + t4*t50)
+    t97 = -(t13*t40 + t4*t51)
+    t98 = -t4*t47 + t12*t39
+    t99 = -t4*t48 + t12*t40
+    t100 = -(t12*t50 + t13*t47)
+    t101 = -(t12*t51 + t13*t48)
+    t102 = -(t21*t40 + t25*t51)
+    t103 = -t25*t48 + t19*t40
+    t104 = -(t19*t51 + t21*t48)
     H = _stack(xp, [
         -t53,  # 0, 0, 0
         t56,  # 0, 0, 1
@@ -1714,9 +1711,9 @@ def hessian(q):
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2, 0
         t74,  # 2, 2, 1
         -t74,  # 2, 2, 2
-        t96,  # 2, 2, 3
-        t97,  # 2, 2, 4
-        t98,  # 2, 2, 5
+        t75,  # 2, 2, 3
+        t77,  # 2, 2, 4
+        t79,  # 2, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 2
@@ -1739,20 +1736,20 @@ def hessian(q):
         t63,  # 3, 0, 1
         t62,  # 3, 0, 2
         -(t13*t38 + t4*t49),  # 3, 0, 3
-        t99,  # 3, 0, 4
-        t100,  # 3, 0, 5
+        t96,  # 3, 0, 4
+        t97,  # 3, 0, 5
         t46,  # 3, 1, 0
         t69,  # 3, 1, 1
         t93,  # 3, 1, 2
         -t4*t46 + t12*t38,  # 3, 1, 3
-        t101,  # 3, 1, 4
-        t102,  # 3, 1, 5
+        t98,  # 3, 1, 4
+        t99,  # 3, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 0
         t76,  # 3, 2, 1
-        t96,  # 3, 2, 2
+        t75,  # 3, 2, 2
         -(t12*t49 + t13*t46),  # 3, 2, 3
-        t103,  # 3, 2, 4
-        t104,  # 3, 2, 5
+        t100,  # 3, 2, 4
+        t101,  # 3, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
@@ -1774,21 +1771,21 @@ def hessian(q):
         t50,  # 4, 0, 0
         t65,  # 4, 0, 1
         t64,  # 4, 0, 2
-        t99,  # 4, 0, 3
+        t96,  # 4, 0, 3
         -(t21*t39 + t25*t50),  # 4, 0, 4
-        t105,  # 4, 0, 5
+        t102,  # 4, 0, 5
         t47,  # 4, 1, 0
         t70,  # 4, 1, 1
         t94,  # 4, 1, 2
-        t101,  # 4, 1, 3
+        t98,  # 4, 1, 3
         -t25*t47 + t19*t39,  # 4, 1, 4
-        t106,  # 4, 1, 5
+        t103,  # 4, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2, 0
         t78,  # 4, 2, 1
-        t97,  # 4, 2, 2
-        t103,  # 4, 2, 3
+        t77,  # 4, 2, 2
+        t100,  # 4, 2, 3
         -(t19*t50 + t21*t47),  # 4, 2, 4
-        t107,  # 4, 2, 5
+        t104,  # 4, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3, 2
@@ -1810,20 +1807,20 @@ def hessian(q):
         t51,  # 5, 0, 0
         t67,  # 5, 0, 1
         t66,  # 5, 0, 2
-        t100,  # 5, 0, 3
-        t105,  # 5, 0, 4
+        t97,  # 5, 0, 3
+        t102,  # 5, 0, 4
         -(t32*t40 + t41*t51),  # 5, 0, 5
         t48,  # 5, 1, 0
         t71,  # 5, 1, 1
         t95,  # 5, 1, 2
-        t102,  # 5, 1, 3
-        t106,  # 5, 1, 4
+        t99,  # 5, 1, 3
+        t103,  # 5, 1, 4
         -t41*t48 + t27*t40,  # 5, 1, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2, 0
         t80,  # 5, 2, 1
-        t98,  # 5, 2, 2
-        t104,  # 5, 2, 3
-        t107,  # 5, 2, 4
+        t79,  # 5, 2, 2
+        t101,  # 5, 2, 3
+        t104,  # 5, 2, 4
         -(t27*t51 + t32*t48),  # 5, 2, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3, 1

@@ -223,9 +223,13 @@ class Lowering:
                                                  sympy.numbered_symbols(f"{names.INTERNAL_PREFIX}r", real=True),
                                                  self._negations)
         named, reduced = list(zip((s for s, _ in named), reduced)), reduced[len(named):]
-        # A named value that CSE found elsewhere too is its temporary: read that, not a copy of it.
+        # A named value that CSE found elsewhere too is its temporary, and a temporary that the
+        # reuse pass found equal to another is that one: read it, not a copy of it.
         shared = {symbol for symbol, _ in replacements}
-        copies = {s: v for s, v in named if v.kind == SYMBOL and v.value in shared}
+        copies = {s: v for s, v in named + replacements if v.kind == SYMBOL and v.value in shared}
+        for s, v in copies.items():
+            while v.value in copies:
+                v = copies[s] = copies[v.value]
         definitions = [(s, v) for s, v in definitions if s not in self._named_symbols] + named + replacements
         if copies:
             definitions = [(s, graph.substitute(v, copies, False)) for s, v in definitions if s not in copies]
