@@ -15,7 +15,7 @@ from sympy.core.parameters import distribute
 
 from jacgen.emission.catalogue import (CALLEES, EXTENTS, FUNCTION_NAMES, SECOND_ORDER, Argument, Call, Function, Loop,
                                        Output, extent_of, with_callees)
-from jacgen.emission.lowering import Lowering, is_boolean
+from jacgen.emission.lowering import Lowering
 from jacgen.inputs.robot import EULER_ANGLES, Robot
 from jacgen.inputs.transforms import rot_z, twist
 from jacgen.model import kinematics
@@ -48,17 +48,22 @@ def matrix(name: str, value, equals: str = "", layers: int = 1) -> Result:
                   equals, layers)
 
 
+def _entry(value):
+    """A node as it is; a number or sympy value as sympy's (the lowering takes both onto the graph)."""
+    return value if isinstance(value, Node) else sympy.sympify(value)
+
+
 def vector(name: str, values, equals: str = "") -> Result:
-    values = [value if isinstance(value, Node) else sympy.sympify(value) for value in values]
+    values = [_entry(value) for value in values]
     return Result(name, values, len(values), 1, "vector", equals)
 
 
 def scalar(name: str, value) -> Result:
-    return Result(name, [value if isinstance(value, Node) else sympy.sympify(value)], 1, 1, "scalar")
+    return Result(name, [_entry(value)], 1, 1, "scalar")
 
 
 def status(name: str, value) -> Result:
-    return Result(name, [value if isinstance(value, Node) else sympy.sympify(value)], 1, 1, "status")
+    return Result(name, [_entry(value)], 1, 1, "status")
 
 
 class Generator:
@@ -128,8 +133,7 @@ class Generator:
         if form.solver == "general_6r":
             parts, rows = self.general_6r_functions(target, free, bindings, sp), form.info.max_solutions
         else:
-            with distribute(False):
-                q, valid, inside = ik.branches(self.robot, form, sp, target.symbols, free_angle)
+            q, valid, inside = ik.branches(self.robot, form, sp, target.symbols, free_angle)
             parts = [self.function("ik_branches", "every branch of the closed-form ik, whether the target allows "
                                    "it and whether it is inside the joint limits", matrix("q", q), vector("valid", valid),
                                    vector("in_limits", inside), arguments=(target, *free), bindings=bindings)]
@@ -143,10 +147,9 @@ class Generator:
             Argument("branches_valid", sympy.Matrix([generated_symbol("vb", r, real=None) for r in range(rows)])),
             Argument("branches_in_limits", sympy.Matrix([generated_symbol("lb", r, real=None) for r in range(rows)]))))
         table_q, table_valid, table_inside = (result.symbols for result in table.results)
-        with distribute(False):
-            read = target.symbols[:3, :] if form.target == "pose" else target.symbols
-            closest, outcome = ik_limits.nearest(self.robot, sp, table_q, list(table_valid), list(table_inside),
-                                                 list(seed.symbols), list(weights.symbols), form.free, list(read))
+        read = target.symbols[:3, :] if form.target == "pose" else target.symbols
+        closest, outcome = ik_limits.nearest(self.robot, sp, table_q, list(table_valid), list(table_inside),
+                                             list(seed.symbols), list(weights.symbols), form.free, list(read))
         nearest = self.function("ik_nearest", "the closed-form ik solution inside the joint limits nearest q_seed "
                                 "(sum of weights_j (q_j - q_seed_j)^2), and the status", vector("q", closest),
                                 status("status", outcome), arguments=(target, seed, *free, weights), calls=(table,))
@@ -211,8 +214,7 @@ class Generator:
         dof = self.robot.dof
         target_pose = self._ik_target()
         given = Argument("q", sympy.Matrix([generated_symbol("qs", i + 1) for i in range(dof)]))
-        with distribute(False):
-            error, jacobian = self._task_error(target_pose, None)
+        error, jacobian = self._task_error(target_pose, None)
         step = self.function("ik_general_residual", "the pose error e at q (the position error and the rotation "
                              "vector of R_target R^T, world frame) and the geometric Jacobian J of the six joints "
                              "ik solves: the Newton step of the solver's polish is q + J^-1 e",
@@ -220,8 +222,7 @@ class Generator:
                              arguments=(target_pose, given), bindings=dict(zip(self.q, given.symbols)),
                              part_of="ik_branches")
         given = Argument("q_solution", sympy.Matrix([generated_symbol("qg", i + 1) for i in range(dof)]))
-        with distribute(False):
-            limited, inside = ik_limits.limited(self.robot, sp, list(given.symbols), six, form.free)
+        limited, inside = ik_limits.limited(self.robot, sp, list(given.symbols), six, form.free)
         limits = self.function("ik_general_limits", "ik's form of q (revolute angles wrapped, or into the limits) "
                                "and whether it is inside the joint limits", vector("q", limited),
                                scalar("in_limits", inside), arguments=(given,),
@@ -230,11 +231,10 @@ class Generator:
         if fast := form.fast_path:
             sp.margins = []
             free_angle = None if form.free is None else self.q[form.free]
-            with distribute(False):
-                q, valid, _ = ik.branches(fast.nominal.robot, fast.form, sp, target.symbols, free_angle)
-                margin = sp.margins[0]
-                for other in sp.margins[1:]:
-                    margin = self.name_node(self.graph.select(self.graph.relation("<=", margin, other), margin, other))
+            q, valid, _ = ik.branches(fast.nominal.robot, fast.form, sp, target.symbols, free_angle)
+            margin = sp.margins[0]
+            for other in sp.margins[1:]:
+                margin = self.name_node(self.graph.select(self.graph.relation("<=", margin, other), margin, other))
             parts.append(self.function("ik_general_nominal", "the fast path's starting points: every branch of the "
                                        "nearest special class's closed form (the nominal arm's), whether its target "
                                        "allows it, and the least margin of its subproblems", matrix("q", q),
@@ -247,9 +247,8 @@ class Generator:
         m, n = js.shape
         mu_dot = Argument("mu_dot", sympy.Matrix([generated_symbol("mu_dot", i) for i in range(m)]))
         damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True, default="0.0")
-        with distribute(False):
-            q_dot, outcome = differential.velocity_ik(js, list(self.q), list(mu_dot.symbols), damping.symbols[0],
-                                                      self.graph, self.name_node)
+        q_dot, outcome = differential.velocity_ik(js, list(self.q), list(mu_dot.symbols), damping.symbols[0],
+                                                  self.graph, self.name_node)
         form = "Js^-1 mu_dot (damping 0) or " if m == n else ""
         form += ("Js^T (Js Js^T + damping^2 I)^-1 mu_dot" if m <= n else "(Js^T Js + damping^2 I)^-1 Js^T mu_dot")
         return self.function("velocity_ik", f"joint rates q_dot solving Js q_dot = mu_dot: {form}; and the status",
@@ -265,12 +264,11 @@ class Generator:
         limits = [joint.limits for joint in robot.joints]
         bindings = {qi: differential.clamp(given_i, bounds, self.graph)
                     for qi, given_i, bounds in zip(self.q, given.symbols, limits)}
-        with distribute(False):
-            error, jacobian = self._task_error(target, task_jacobian)
-            trial, cost = differential.ik_numeric_step(error, jacobian, list(self.q), damping.symbols[0], limits,
-                                                       self.graph, self.name_node)
-            read = target.symbols[:3, :] if len(robot.task) == 6 else target.symbols
-            cost = differential.flagged_cost(cost, [*given.symbols, *read], self.graph, self.name_node)
+        error, jacobian = self._task_error(target, task_jacobian)
+        trial, cost = differential.ik_numeric_step(error, jacobian, list(self.q), damping.symbols[0], limits,
+                                                   self.graph, self.name_node)
+        read = target.symbols[:3, :] if len(robot.task) == 6 else target.symbols
+        cost = differential.flagged_cost(cost, [*given.symbols, *read], self.graph, self.name_node)
         step = "J^T (J J^T + damping I)^-1 e" if jacobian.rows <= n else "(J^T J + damping I)^-1 J^T e"
         summary = (f"one step of ik_numeric: q clamped to the limits, then q + {step} clamped, and |e|^2 at "
                    "the clamped q (-1 when target or q is not finite)")
@@ -288,14 +286,15 @@ class Generator:
         """The error e that ik's iterations drive to 0, at the chain's q, and its Jacobian: for a
         pose, the position error and the rotation vector of R_target R^T (world frame) with the
         geometric Jacobian; else the task error (Euler angles wrapped) with the task Jacobian."""
-        if len(self.robot.task) == 6:
-            tool, goal = self.chain.tool, target.symbols
-            rotation = self.graph.values(goal[:3, :3]) @ self.graph.values(tool[:3, :3]).T
-            return [goal[i, 3] - tool[i, 3] for i in range(3)] + differential.rotation_vector(rotation, self.graph, self.name_node), \
-                self.jacobian
-        mu = kinematics.task_vector(self.robot, self.chain.tool)
-        return [wrapped(self.graph.value(goal - value)) if component in EULER_ANGLES else goal - value
-                for goal, value, component in zip(target.symbols, mu, self.robot.task)], task_jacobian
+        with distribute(False):  # the error's sympy differences: numbers not distributed over sums
+            if len(self.robot.task) == 6:
+                tool, goal = self.chain.tool, target.symbols
+                rotation = self.graph.values(goal[:3, :3]) @ self.graph.values(tool[:3, :3]).T
+                return [goal[i, 3] - tool[i, 3] for i in range(3)] + differential.rotation_vector(
+                    rotation, self.graph, self.name_node), self.jacobian
+            mu = kinematics.task_vector(self.robot, self.chain.tool)
+            return [wrapped(self.graph.value(goal - value)) if component in EULER_ANGLES else goal - value
+                    for goal, value, component in zip(target.symbols, mu, self.robot.task)], task_jacobian
 
     @cached_property
     def jacobian(self) -> sympy.Matrix:
@@ -399,8 +398,8 @@ class Generator:
         if singular.complete and not singular.everywhere:
             rotation = self.chain.tool[:3, :3]
             cos_pitch = sympy.sqrt(rotation[0, 0] ** 2 + rotation[1, 0] ** 2)
-            exact = singular.constant.xreplace(atoms) * sympy.Mul(
-                *(p.xreplace(atoms) ** k for p, k in singular.determinant)) / cos_pitch**singular.euler_power
+            exact = self.graph.value(singular.constant.xreplace(atoms) * sympy.Mul(
+                *(p.xreplace(atoms) ** k for p, k in singular.determinant)) / cos_pitch**singular.euler_power)
             if self.lower([exact]).operation_count <= self.lower([numeric]).operation_count:
                 determinant = exact
         return functions + [
@@ -420,12 +419,13 @@ class Generator:
             return None
         outputs, values = [], []
         for result in results:
-            boolean = all(map(is_boolean, result.values))
+            nodes = [self.graph.value(value) for value in result.values]
+            boolean = all(node.boolean for node in nodes)
             key, size = f"{name}.{result.name}", result.rows * result.cols
             outputs.append(Output(result.name, result.rows, result.cols, result.shape in ("scalar", "status"),
                                   result.shape == "vector" or boolean, result.equals, boolean, result.shape == "status",
                                   result.layers, extent_of(key if key in EXTENTS else result.equals or name, size)))
-            values += result.values
+            values += nodes
         return Function(name, summary, tuple(outputs), self.lower(values, bindings or {}),
                         arguments or (Argument("q", sympy.Matrix(self.q)),), calls)
 

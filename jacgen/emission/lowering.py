@@ -15,7 +15,6 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import sympy
-from sympy.logic.boolalg import Boolean
 from sympy.simplify.cse_main import Unevaluated, match_common_args
 
 from jacgen.model.graph import (ADD, AND, FINITE, MUL, NOT, NUMBER, OR, POW, RELATION, SELECT, SYMBOL, TRUTH, CALL,
@@ -126,13 +125,6 @@ def _negated(product: Node) -> list[Node]:
     """The factors of -product, for a product with a negative number (-1 dropped)."""
     coefficient, *rest = product.args
     return rest if coefficient.value == -1 else [Node(NUMBER, (), -coefficient.value), *rest]
-
-
-def is_boolean(value) -> bool:
-    """A truth value (a comparison, And, Or, ...), of sympy's or a node."""
-    if isinstance(value, Node):
-        return value.boolean
-    return isinstance(value, Boolean) and not isinstance(value, sympy.Expr)
 
 
 class Lowering:

@@ -80,7 +80,7 @@ class Printer:
         if kind == graph.MUL:
             return self._product(node.args)
         if kind == graph.POW:
-            return self._power(*node.args)
+            return self._power(node.args[0], node.args[1].value)
         if kind == graph.SELECT:
             return self._select(list(zip(node.args[:-1:2], node.args[1:-1:2])), node.args[-1]), ATOM
         if kind != graph.CALL or node.value not in self.functions:
@@ -120,9 +120,7 @@ class Printer:
         return sign + text, SUM if sign else PRODUCT
 
     def _power(self, base: Node, exponent) -> tuple[str, int]:
-        """base ** exponent (a sympy Rational, or the node of one)."""
-        if isinstance(exponent, Node):
-            exponent = exponent.value
+        """base ** exponent (a sympy Rational)."""
         if exponent == 1:
             return self._print(base)
         if exponent == sympy.S.Half:
