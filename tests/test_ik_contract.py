@@ -127,7 +127,8 @@ SINGULAR = {
         "puma560", [0.3, 0.5, -0.4, 0.6, 0.0, -0.2], 7, [0.3, 0.5, -0.4, 0.0, 0.0, 0.4]),
     "elbow stretched (puma): 2 shoulders x 1 elbow x 2 wrists": (
         "puma560", [0.3, 0.5, np.arctan2(0.0203, 0.4318) - np.pi / 2, 0.6, 0.4, -0.2], 4, None),
-    "wrist (ur5 q5 = 0): the other shoulder branch regular, 2 + 4": ("ur5", [0.3, -1.0, 1.2, 0.4, 0.0, 0.7], 6, None),
+    "wrist (ur5 q5 = 0): 4 + 4, each wrist and its flip (q4, q6 + pi: the elbow elsewhere)": (
+        "ur5", [0.3, -1.0, 1.2, 0.4, 0.0, 0.7], 8, None),
     "stretched planar 3R arm": ("planar_3r", [0.3, 0.0, 1.0], 1, None),
     "stretched planar 2R arm": ("planar_2r", [0.3, 0.0], 1, None),
 }

@@ -97,7 +97,7 @@ int iiwa_velocity_ik(const iiwa_real q[IIWA_DOF], const iiwa_real mu_dot[IIWA_TA
 iiwa_real iiwa_ik_numeric_step(const iiwa_real target[16], const iiwa_real q[IIWA_DOF], iiwa_real damping, iiwa_real q_start[IIWA_DOF], iiwa_real q_next[IIWA_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 7 row-major, element (r, c) at q[r * 7 + c]; valid[i], i < 8; in_limits[i], i < 8. 1547 operations. */
+ * Result: q: 8 x 7 row-major, element (r, c) at q[r * 7 + c]; valid[i], i < 8; in_limits[i], i < 8. 1520 operations. */
 void iiwa_ik_branches(const iiwa_real T[16], iiwa_real q_free, iiwa_real q[IIWA_MAX_IK_SOLUTIONS * IIWA_DOF], int valid[IIWA_MAX_IK_SOLUTIONS], int in_limits[IIWA_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

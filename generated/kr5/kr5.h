@@ -99,7 +99,7 @@ int kr5_velocity_ik(const kr5_real q[KR5_DOF], const kr5_real mu_dot[KR5_TASK_DI
 kr5_real kr5_ik_numeric_step(const kr5_real target[16], const kr5_real q[KR5_DOF], kr5_real damping, kr5_real q_start[KR5_DOF], kr5_real q_next[KR5_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1289 operations. */
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1307 operations. */
 void kr5_ik_branches(const kr5_real T[16], kr5_real q[KR5_MAX_IK_SOLUTIONS * KR5_DOF], int valid[KR5_MAX_IK_SOLUTIONS], int in_limits[KR5_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

@@ -2175,7 +2175,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(T):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 1289 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 1307 operations."""
     T00 = T[0, 0]
     T01 = T[0, 1]
     T02 = T[0, 2]
@@ -2209,7 +2209,7 @@ def _ik_branches(T):
     t18 = t8**2
     t19 = t17 + t18
     t20 = t19 + t16**2
-    t21 = 1e-24*t20
+    t21 = 1e-40*t20
     t22 = (t19 <= t21)
     t23 = casadi.if_else(t22, 1, 1/casadi.sqrt(t19))
     t24 = casadi.if_else(t22, 0, 1.5707963267948966 + t9)
@@ -2237,144 +2237,144 @@ def _ik_branches(T):
     t46 = t45 + t16*t30
     t47 = -0.4 + t46
     t48 = t34**2 + t35**2 + t47**2
-    t49 = 0.5*(0.7588 - t48)
-    t50 = 1 - 6.965340465841971*t49**2
-    t51 = t44*T22
-    t52 = t51 + T22*t30
-    t53 = t44*T20
-    t54 = t53 + T20*t30
-    t55 = (t50 > 1e-12)
-    t56 = casadi.if_else(t55, casadi.sqrt(t50), 0)
-    t57 = 2.639193146748068*t49
-    t58 = casadi.if_else(t55, t57, casadi.if_else((t57 > 0), 1, -1))
-    t59 = casadi.atan2(t56, t58)
-    t60 = 1.761980786391911 + t59
-    t61 = 1.761980786391911 - t59
-    t62 = t60 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t60))
-    t63 = -6.283185307179586*casadi.floor(0.15915494309189535*(0.2617993877991494 + t62)) + t62
-    t64 = t61 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t61))
+    t49 = casadi.if_else((t48 > 0), casadi.sqrt(t48), 0)
+    t50 = 0.25*(-0.03150613615387776 + t49)*(0.03150613615387776 + t49)*(1.2315061361538777 - t49)*(1.2315061361538777 + t49)
+    t51 = 0.5*(0.7588 - t48)
+    t52 = t44*T22
+    t53 = t52 + T22*t30
+    t54 = t44*T20
+    t55 = t54 + T20*t30
+    t56 = 6.965340465841971*t50
+    t57 = (t56 > 0)
+    t58 = casadi.if_else(t57, casadi.sqrt(t56), 0)
+    t59 = 2.639193146748068*t51
+    t60 = casadi.if_else(t57, t59, casadi.if_else((t59 > 0), 1, -1))
+    t61 = casadi.atan2(t58, t60)
+    t62 = 1.761980786391911 + t61
+    t63 = 1.761980786391911 - t61
+    t64 = t62 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t62))
     t65 = -6.283185307179586*casadi.floor(0.15915494309189535*(0.2617993877991494 + t64)) + t64
-    t66 = 0.1900219065658609*t58
-    t67 = 0.9817798505902814*t56
-    t68 = t66 + t67
-    t69 = -t66 + t67
-    t70 = 0.1900219065658609*t56
-    t71 = 0.9817798505902814*t58
-    t72 = -t70 + t71
-    t73 = t70 + t71
-    t74 = 0.12*t68 + 0.62*t72
-    t75 = -0.12*t72 + 0.62*t68
-    t76 = 0.78 - t74
-    t77 = 0.4 + t75
-    t78 = -0.18 + t76
-    t79 = -0.4 + t77
-    t80 = t35*t78 + t47*t79
-    t81 = t35*t79 - t47*t78
-    t82 = t80**2 + t81**2
-    t83 = t78**2 + t79**2
-    t84 = 0.12*t69 - 0.62*t73
-    t85 = 0.12*t73 + 0.62*t69
-    t86 = 0.78 + t84
-    t87 = 0.4 - t85
-    t88 = -0.18 + t86
-    t89 = -0.4 + t87
-    t90 = t35*t88 + t47*t89
-    t91 = t35*t89 - t47*t88
-    t92 = t90**2 + t91**2
-    t93 = t88**2 + t89**2
-    t94 = 1e-24*t48
-    t95 = (t82 <= t94*t83)
-    t96 = casadi.if_else(t95, 1, 1/casadi.sqrt(t82))
-    t97 = casadi.if_else(t95, 1, t80*t96)
-    t98 = casadi.if_else(t95, 0, t81*t96)
-    t99 = t68*t97 + t72*t98
-    t100 = -t68*t98 + t72*t97
-    t101 = t99*t36 + t100*t52
-    t102 = t99*t52 - t100*t36
-    t103 = t99*t38 + t100*t54
-    t104 = -t99*t54 + t100*t38
-    t105 = casadi.if_else(t95, 0, casadi.atan2(t81, t80))
-    t106 = -6.283185307179586*casadi.floor(0.15915494309189535*(3.141592653589793 + t105)) + t105
-    t107 = 1 + t99
-    t108 = t107*t37
-    t109 = t108 - t99*t37
-    t110 = t107*t39
-    t111 = t110 - t99*t39
-    t112 = t102**2
-    t113 = -t112
-    t114 = 1 + t113
-    t115 = (t114 > 1e-12)
-    t116 = casadi.if_else(t115, casadi.sqrt(t114), 0)
-    t117 = t112 - t101*t116
-    t118 = t113 + t117
-    t119 = t109**2
-    t120 = t112 + t119 + t101**2
-    t121 = t116**2
-    t122 = t118**2 + t119*t121
-    t123 = t112 + t121
-    t124 = 1e-24*t123
+    t66 = t63 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t63))
+    t67 = -6.283185307179586*casadi.floor(0.15915494309189535*(0.2617993877991494 + t66)) + t66
+    t68 = 0.1900219065658609*t60
+    t69 = 0.9817798505902814*t58
+    t70 = t68 + t69
+    t71 = -t68 + t69
+    t72 = 0.1900219065658609*t58
+    t73 = 0.9817798505902814*t60
+    t74 = -t72 + t73
+    t75 = t72 + t73
+    t76 = 0.12*t70 + 0.62*t74
+    t77 = -0.12*t74 + 0.62*t70
+    t78 = 0.78 - t76
+    t79 = 0.4 + t77
+    t80 = -0.18 + t78
+    t81 = -0.4 + t79
+    t82 = t35*t80 + t47*t81
+    t83 = t35*t81 - t47*t80
+    t84 = t82**2 + t83**2
+    t85 = t80**2 + t81**2
+    t86 = 0.12*t71 - 0.62*t75
+    t87 = 0.12*t75 + 0.62*t71
+    t88 = 0.78 + t86
+    t89 = 0.4 - t87
+    t90 = -0.18 + t88
+    t91 = -0.4 + t89
+    t92 = t35*t90 + t47*t91
+    t93 = t35*t91 - t47*t90
+    t94 = t92**2 + t93**2
+    t95 = t90**2 + t91**2
+    t96 = 1e-40*t48
+    t97 = (t84 <= t96*t85)
+    t98 = casadi.if_else(t97, 1, 1/casadi.sqrt(t84))
+    t99 = casadi.if_else(t97, 1, t82*t98)
+    t100 = casadi.if_else(t97, 0, t83*t98)
+    t101 = t70*t99 + t74*t100
+    t102 = -t70*t100 + t74*t99
+    t103 = t101*t36 + t102*t53
+    t104 = t101*t53 - t102*t36
+    t105 = t101*t38 + t102*t55
+    t106 = -t101*t55 + t102*t38
+    t107 = casadi.if_else(t97, 0, casadi.atan2(t83, t82))
+    t108 = -6.283185307179586*casadi.floor(0.15915494309189535*(3.141592653589793 + t107)) + t107
+    t109 = 1 + t101
+    t110 = t109*t37
+    t111 = t110 - t101*t37
+    t112 = t109*t39
+    t113 = t112 - t101*t39
+    t114 = t103**2
+    t115 = t111**2
+    t116 = t114 + t115
+    t117 = t104**2
+    t118 = casadi.if_else((1 < t116), 1 - t117, t116)
+    t119 = casadi.if_else((t118 > 0), casadi.sqrt(t118), 0)
+    t120 = t116 + t117
+    t121 = t119**2
+    t122 = t114*t121 + t115*t121
+    t123 = t117 + t121
+    t124 = 1e-40*t123
     t125 = (t122 <= t124*t120)
     t126 = casadi.if_else(t125, 1, 1/casadi.sqrt(t122))
-    t127 = casadi.if_else(t125, 1, t118*t126)
-    t128 = t104*(1 - t127)
-    t129 = t128 + t104*t127
-    t130 = t109*t116
-    t131 = casadi.if_else(t125, 0, -t130*t126)
-    t132 = -t103*t127 + t111*t131
-    t133 = t111*t127 + t103*t131
-    t134 = (t123 <= t124)
-    t135 = casadi.if_else(t134, 1, 1/casadi.sqrt(t123))
-    t136 = casadi.if_else(t134, 1, t102*t135)
-    t137 = casadi.if_else(t134, 0, -t116*t135)
-    t138 = t133*(1 - t136)
-    t139 = t136*t132 - t137*t129
-    t140 = t138 + t136*t133
-    t141 = t136*t129 + t137*t132
-    t142 = t139**2 + t140**2
-    t143 = t142 + t141**2
-    t144 = (t92 <= t94*t93)
-    t145 = casadi.if_else(t144, 1, 1/casadi.sqrt(t92))
-    t146 = casadi.if_else(t144, 1, t90*t145)
-    t147 = casadi.if_else(t144, 0, t91*t145)
-    t148 = t69*t146 - t73*t147
-    t149 = t69*t147 + t73*t146
-    t150 = -t36*t148 + t52*t149
-    t151 = t52*t148 + t36*t149
-    t152 = t38*t148 - t54*t149
-    t153 = t54*t148 + t38*t149
-    t154 = casadi.if_else(t144, 0, casadi.atan2(t91, t90))
-    t155 = -6.283185307179586*casadi.floor(0.15915494309189535*(3.141592653589793 + t154)) + t154
-    t156 = 1 - t148
-    t157 = t156*t37
-    t158 = t157 + t37*t148
-    t159 = t156*t39
-    t160 = t159 + t39*t148
-    t161 = t151**2
-    t162 = -t161
-    t163 = 1 + t162
-    t164 = (t163 > 1e-12)
-    t165 = casadi.if_else(t164, casadi.sqrt(t163), 0)
-    t166 = t161 - t150*t165
-    t167 = t162 + t166
-    t168 = t158**2
-    t169 = t161 + t168 + t150**2
-    t170 = t165**2
-    t171 = t167**2 + t168*t170
-    t172 = t161 + t170
-    t173 = 1e-24*t172
-    t174 = (t171 <= t173*t169)
-    t175 = casadi.if_else(t174, 1, 1/casadi.sqrt(t171))
-    t176 = casadi.if_else(t174, 1, t167*t175)
-    t177 = t153*(1 - t176)
-    t178 = t177 + t153*t176
-    t179 = t158*t165
-    t180 = casadi.if_else(t174, 0, -t179*t175)
-    t181 = t152*t176 + t160*t180
-    t182 = t160*t176 - t152*t180
-    t183 = (t172 <= t173)
-    t184 = casadi.if_else(t183, 1, 1/casadi.sqrt(t172))
-    t185 = casadi.if_else(t183, 1, -t151*t184)
-    t186 = casadi.if_else(t183, 0, -t165*t184)
+    t127 = t103*t119
+    t128 = casadi.if_else(t125, 1, -t127*t126)
+    t129 = t106*(1 - t128)
+    t130 = t129 + t106*t128
+    t131 = t111*t119
+    t132 = casadi.if_else(t125, 0, -t131*t126)
+    t133 = -t105*t128 + t113*t132
+    t134 = t113*t128 + t105*t132
+    t135 = (t123 <= t124)
+    t136 = casadi.if_else(t135, 1, 1/casadi.sqrt(t123))
+    t137 = casadi.if_else(t135, 1, t104*t136)
+    t138 = casadi.if_else(t135, 0, -t119*t136)
+    t139 = t134*(1 - t137)
+    t140 = t137*t133 - t138*t130
+    t141 = t139 + t137*t134
+    t142 = t137*t130 + t138*t133
+    t143 = t140**2 + t141**2
+    t144 = t143 + t142**2
+    t145 = (t94 <= t96*t95)
+    t146 = casadi.if_else(t145, 1, 1/casadi.sqrt(t94))
+    t147 = casadi.if_else(t145, 1, t92*t146)
+    t148 = casadi.if_else(t145, 0, t93*t146)
+    t149 = t71*t147 - t75*t148
+    t150 = t71*t148 + t75*t147
+    t151 = -t36*t149 + t53*t150
+    t152 = t53*t149 + t36*t150
+    t153 = t38*t149 - t55*t150
+    t154 = t55*t149 + t38*t150
+    t155 = casadi.if_else(t145, 0, casadi.atan2(t93, t92))
+    t156 = -6.283185307179586*casadi.floor(0.15915494309189535*(3.141592653589793 + t155)) + t155
+    t157 = 1 - t149
+    t158 = t157*t37
+    t159 = t158 + t37*t149
+    t160 = t157*t39
+    t161 = t160 + t39*t149
+    t162 = t151**2
+    t163 = t159**2
+    t164 = t162 + t163
+    t165 = t152**2
+    t166 = casadi.if_else((1 < t164), 1 - t165, t164)
+    t167 = casadi.if_else((t166 > 0), casadi.sqrt(t166), 0)
+    t168 = t164 + t165
+    t169 = t167**2
+    t170 = t162*t169 + t163*t169
+    t171 = t165 + t169
+    t172 = 1e-40*t171
+    t173 = (t170 <= t172*t168)
+    t174 = casadi.if_else(t173, 1, 1/casadi.sqrt(t170))
+    t175 = t151*t167
+    t176 = casadi.if_else(t173, 1, -t175*t174)
+    t177 = t154*(1 - t176)
+    t178 = t177 + t154*t176
+    t179 = t159*t167
+    t180 = casadi.if_else(t173, 0, -t179*t174)
+    t181 = t153*t176 + t161*t180
+    t182 = t161*t176 - t153*t180
+    t183 = (t171 <= t172)
+    t184 = casadi.if_else(t183, 1, 1/casadi.sqrt(t171))
+    t185 = casadi.if_else(t183, 1, -t152*t184)
+    t186 = casadi.if_else(t183, 0, -t167*t184)
     t187 = t182*(1 - t185)
     t188 = t185*t181 - t186*t178
     t189 = t187 + t185*t182
@@ -2386,197 +2386,197 @@ def _ik_branches(T):
     t195 = t194 - t29*t16
     t196 = -0.4 + t195
     t197 = t26**2 + t196**2
-    t198 = 0.5*(0.7588 - t197)
-    t199 = 1 - 6.965340465841971*t198**2
-    t200 = t193*T22
-    t201 = -t200 + t29*T22
-    t202 = t193*T20
-    t203 = t202 - t29*T20
-    t204 = (t199 > 1e-12)
-    t205 = casadi.if_else(t204, casadi.sqrt(t199), 0)
-    t206 = 2.639193146748068*t198
-    t207 = casadi.if_else(t204, t206, casadi.if_else((t206 > 0), 1, -1))
-    t208 = casadi.atan2(t205, t207)
-    t209 = 1.761980786391911 + t208
-    t210 = 1.761980786391911 - t208
-    t211 = t209 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t209))
-    t212 = -6.283185307179586*casadi.floor(0.15915494309189535*(0.2617993877991494 + t211)) + t211
-    t213 = t210 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t210))
+    t198 = casadi.if_else((t197 > 0), casadi.sqrt(t197), 0)
+    t199 = 0.25*(-0.03150613615387776 + t198)*(0.03150613615387776 + t198)*(1.2315061361538777 - t198)*(1.2315061361538777 + t198)
+    t200 = 0.5*(0.7588 - t197)
+    t201 = t193*T22
+    t202 = -t201 + t29*T22
+    t203 = t193*T20
+    t204 = t203 - t29*T20
+    t205 = 6.965340465841971*t199
+    t206 = (t205 > 0)
+    t207 = casadi.if_else(t206, casadi.sqrt(t205), 0)
+    t208 = 2.639193146748068*t200
+    t209 = casadi.if_else(t206, t208, casadi.if_else((t208 > 0), 1, -1))
+    t210 = casadi.atan2(t207, t209)
+    t211 = 1.761980786391911 + t210
+    t212 = 1.761980786391911 - t210
+    t213 = t211 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t211))
     t214 = -6.283185307179586*casadi.floor(0.15915494309189535*(0.2617993877991494 + t213)) + t213
-    t215 = 0.1900219065658609*t207
-    t216 = 0.9817798505902814*t205
-    t217 = t215 + t216
-    t218 = -t215 + t216
-    t219 = 0.1900219065658609*t205
-    t220 = 0.9817798505902814*t207
-    t221 = -t219 + t220
-    t222 = t219 + t220
-    t223 = 0.12*t217 + 0.62*t221
-    t224 = -0.12*t221 + 0.62*t217
-    t225 = 0.78 - t223
-    t226 = 0.4 + t224
-    t227 = -0.18 + t225
-    t228 = -0.4 + t226
-    t229 = -t26*t227 + t196*t228
-    t230 = t26*t228 + t196*t227
-    t231 = t229**2 + t230**2
-    t232 = t227**2 + t228**2
-    t233 = 0.12*t218 - 0.62*t222
-    t234 = 0.12*t222 + 0.62*t218
-    t235 = 0.78 + t233
-    t236 = 0.4 - t234
-    t237 = -0.18 + t235
-    t238 = -0.4 + t236
-    t239 = -t26*t237 + t196*t238
-    t240 = t26*t238 + t196*t237
-    t241 = t239**2 + t240**2
-    t242 = t237**2 + t238**2
-    t243 = 1e-24*t197
-    t244 = (t231 <= t243*t232)
-    t245 = casadi.if_else(t244, 1, 1/casadi.sqrt(t231))
-    t246 = casadi.if_else(t244, 1, t229*t245)
-    t247 = casadi.if_else(t244, 0, -t230*t245)
-    t248 = t217*t246 + t221*t247
-    t249 = -t217*t247 + t221*t246
-    t250 = t248*t40 + t249*t201
-    t251 = -t248*t201 + t249*t40
-    t252 = t248*t42 - t249*t203
-    t253 = t248*t203 + t249*t42
-    t254 = casadi.if_else(t244, 0, casadi.atan2(-t230, t229))
-    t255 = -6.283185307179586*casadi.floor(0.15915494309189535*(3.141592653589793 + t254)) + t254
-    t256 = 1 + t248
-    t257 = t256*t41
-    t258 = t257 - t248*t41
-    t259 = t256*t43
-    t260 = t259 - t248*t43
-    t261 = t251**2
-    t262 = -t261
-    t263 = 1 + t262
-    t264 = (t263 > 1e-12)
-    t265 = casadi.if_else(t264, casadi.sqrt(t263), 0)
-    t266 = t261 + t250*t265
-    t267 = t262 + t266
-    t268 = t258**2
-    t269 = t261 + t268 + t250**2
-    t270 = t265**2
-    t271 = t267**2 + t268*t270
-    t272 = t261 + t270
-    t273 = 1e-24*t272
+    t215 = t212 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t212))
+    t216 = -6.283185307179586*casadi.floor(0.15915494309189535*(0.2617993877991494 + t215)) + t215
+    t217 = 0.1900219065658609*t209
+    t218 = 0.9817798505902814*t207
+    t219 = t217 + t218
+    t220 = -t217 + t218
+    t221 = 0.1900219065658609*t207
+    t222 = 0.9817798505902814*t209
+    t223 = -t221 + t222
+    t224 = t221 + t222
+    t225 = 0.12*t219 + 0.62*t223
+    t226 = -0.12*t223 + 0.62*t219
+    t227 = 0.78 - t225
+    t228 = 0.4 + t226
+    t229 = -0.18 + t227
+    t230 = -0.4 + t228
+    t231 = -t26*t229 + t196*t230
+    t232 = t26*t230 + t196*t229
+    t233 = t231**2 + t232**2
+    t234 = t229**2 + t230**2
+    t235 = 0.12*t220 - 0.62*t224
+    t236 = 0.12*t224 + 0.62*t220
+    t237 = 0.78 + t235
+    t238 = 0.4 - t236
+    t239 = -0.18 + t237
+    t240 = -0.4 + t238
+    t241 = -t26*t239 + t196*t240
+    t242 = t26*t240 + t196*t239
+    t243 = t241**2 + t242**2
+    t244 = t239**2 + t240**2
+    t245 = 1e-40*t197
+    t246 = (t233 <= t245*t234)
+    t247 = casadi.if_else(t246, 1, 1/casadi.sqrt(t233))
+    t248 = casadi.if_else(t246, 1, t231*t247)
+    t249 = casadi.if_else(t246, 0, -t232*t247)
+    t250 = t219*t248 + t223*t249
+    t251 = -t219*t249 + t223*t248
+    t252 = t250*t40 + t251*t202
+    t253 = -t250*t202 + t251*t40
+    t254 = t250*t42 - t251*t204
+    t255 = t250*t204 + t251*t42
+    t256 = casadi.if_else(t246, 0, casadi.atan2(-t232, t231))
+    t257 = -6.283185307179586*casadi.floor(0.15915494309189535*(3.141592653589793 + t256)) + t256
+    t258 = 1 + t250
+    t259 = t258*t41
+    t260 = t259 - t250*t41
+    t261 = t258*t43
+    t262 = t261 - t250*t43
+    t263 = t252**2
+    t264 = t260**2
+    t265 = t263 + t264
+    t266 = t253**2
+    t267 = casadi.if_else((1 < t265), 1 - t266, t265)
+    t268 = casadi.if_else((t267 > 0), casadi.sqrt(t267), 0)
+    t269 = t265 + t266
+    t270 = t268**2
+    t271 = t263*t270 + t264*t270
+    t272 = t266 + t270
+    t273 = 1e-40*t272
     t274 = (t271 <= t273*t269)
     t275 = casadi.if_else(t274, 1, 1/casadi.sqrt(t271))
-    t276 = casadi.if_else(t274, 1, t267*t275)
-    t277 = t253*(1 - t276)
-    t278 = t277 + t253*t276
-    t279 = t258*t265
-    t280 = casadi.if_else(t274, 0, -t279*t275)
-    t281 = t252*t276 + t260*t280
-    t282 = t260*t276 - t252*t280
-    t283 = (t272 <= t273)
-    t284 = casadi.if_else(t283, 1, 1/casadi.sqrt(t272))
-    t285 = casadi.if_else(t283, 1, t251*t284)
-    t286 = casadi.if_else(t283, 0, -t265*t284)
-    t287 = t282*(1 - t285)
-    t288 = t285*t281 + t286*t278
-    t289 = t287 + t285*t282
-    t290 = -t285*t278 + t286*t281
-    t291 = t288**2 + t289**2
-    t292 = t291 + t290**2
-    t293 = (t241 <= t243*t242)
-    t294 = casadi.if_else(t293, 1, 1/casadi.sqrt(t241))
-    t295 = casadi.if_else(t293, 1, t239*t294)
-    t296 = casadi.if_else(t293, 0, -t240*t294)
-    t297 = t218*t295 - t222*t296
-    t298 = t218*t296 + t222*t295
-    t299 = t40*t297 - t201*t298
-    t300 = t201*t297 + t40*t298
-    t301 = t42*t297 + t203*t298
-    t302 = t203*t297 - t42*t298
-    t303 = casadi.if_else(t293, 0, casadi.atan2(-t240, t239))
-    t304 = -6.283185307179586*casadi.floor(0.15915494309189535*(3.141592653589793 + t303)) + t303
-    t305 = 1 - t297
-    t306 = t305*t41
-    t307 = t306 + t41*t297
-    t308 = t305*t43
-    t309 = t308 + t43*t297
-    t310 = t300**2
-    t311 = -t310
-    t312 = 1 + t311
-    t313 = (t312 > 1e-12)
-    t314 = casadi.if_else(t313, casadi.sqrt(t312), 0)
-    t315 = t310 - t299*t314
-    t316 = t311 + t315
-    t317 = t307**2
-    t318 = t310 + t317 + t299**2
-    t319 = t314**2
-    t320 = t316**2 + t317*t319
-    t321 = t310 + t319
-    t322 = 1e-24*t321
-    t323 = (t320 <= t318*t322)
-    t324 = casadi.if_else(t323, 1, 1/casadi.sqrt(t320))
-    t325 = casadi.if_else(t323, 1, t316*t324)
-    t326 = t302*(1 - t325)
-    t327 = t326 + t302*t325
-    t328 = t307*t314
-    t329 = casadi.if_else(t323, 0, -t324*t328)
-    t330 = -t301*t325 + t309*t329
-    t331 = t309*t325 + t301*t329
-    t332 = (t321 <= t322)
-    t333 = casadi.if_else(t332, 1, 1/casadi.sqrt(t321))
-    t334 = casadi.if_else(t332, 1, t300*t333)
-    t335 = casadi.if_else(t332, 0, -t314*t333)
+    t276 = t252*t268
+    t277 = casadi.if_else(t274, 1, t276*t275)
+    t278 = t255*(1 - t277)
+    t279 = t278 + t255*t277
+    t280 = t260*t268
+    t281 = casadi.if_else(t274, 0, -t280*t275)
+    t282 = t254*t277 + t262*t281
+    t283 = t262*t277 - t254*t281
+    t284 = (t272 <= t273)
+    t285 = casadi.if_else(t284, 1, 1/casadi.sqrt(t272))
+    t286 = casadi.if_else(t284, 1, t253*t285)
+    t287 = casadi.if_else(t284, 0, -t268*t285)
+    t288 = t283*(1 - t286)
+    t289 = t286*t282 + t287*t279
+    t290 = t288 + t286*t283
+    t291 = -t286*t279 + t287*t282
+    t292 = t289**2 + t290**2
+    t293 = t292 + t291**2
+    t294 = (t243 <= t245*t244)
+    t295 = casadi.if_else(t294, 1, 1/casadi.sqrt(t243))
+    t296 = casadi.if_else(t294, 1, t241*t295)
+    t297 = casadi.if_else(t294, 0, -t242*t295)
+    t298 = t220*t296 - t224*t297
+    t299 = t220*t297 + t224*t296
+    t300 = t40*t298 - t202*t299
+    t301 = t202*t298 + t40*t299
+    t302 = t42*t298 + t204*t299
+    t303 = t204*t298 - t42*t299
+    t304 = casadi.if_else(t294, 0, casadi.atan2(-t242, t241))
+    t305 = -6.283185307179586*casadi.floor(0.15915494309189535*(3.141592653589793 + t304)) + t304
+    t306 = 1 - t298
+    t307 = t306*t41
+    t308 = t307 + t41*t298
+    t309 = t306*t43
+    t310 = t309 + t43*t298
+    t311 = t300**2
+    t312 = t308**2
+    t313 = t311 + t312
+    t314 = t301**2
+    t315 = casadi.if_else((1 < t313), 1 - t314, t313)
+    t316 = casadi.if_else((t315 > 0), casadi.sqrt(t315), 0)
+    t317 = t313 + t314
+    t318 = t316**2
+    t319 = t311*t318 + t312*t318
+    t320 = t314 + t318
+    t321 = 1e-40*t320
+    t322 = (t319 <= t317*t321)
+    t323 = casadi.if_else(t322, 1, 1/casadi.sqrt(t319))
+    t324 = t300*t316
+    t325 = casadi.if_else(t322, 1, -t323*t324)
+    t326 = t303*(1 - t325)
+    t327 = t326 + t303*t325
+    t328 = t308*t316
+    t329 = casadi.if_else(t322, 0, -t323*t328)
+    t330 = -t302*t325 + t310*t329
+    t331 = t310*t325 + t302*t329
+    t332 = (t320 <= t321)
+    t333 = casadi.if_else(t332, 1, 1/casadi.sqrt(t320))
+    t334 = casadi.if_else(t332, 1, t301*t333)
+    t335 = casadi.if_else(t332, 0, -t316*t333)
     t336 = t331*(1 - t334)
     t337 = t334*t330 - t335*t327
     t338 = t336 + t334*t331
     t339 = t334*t327 + t335*t330
     t340 = t337**2 + t338**2
     t341 = t339**2 + t340
-    t342 = casadi.if_else(t125, 0, casadi.atan2(-t130, t118))
+    t342 = casadi.if_else(t125, 0, casadi.atan2(-t131, -t127))
     t343 = -6.283185307179586*casadi.floor(0.15915494309189535*(6.1086523819801535 + t342)) + t342
     t344 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t342) + t342
     t345 = -6.283185307179586*casadi.floor(0.15915494309189535*(6.1086523819801535 + t344)) + t344
-    t346 = casadi.if_else(t134, 0, casadi.atan2(-t116, t102))
+    t346 = casadi.if_else(t135, 0, casadi.atan2(-t119, t104))
     t347 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.2689280275926285 + t346)) + t346
     t348 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t346)) + t346
-    t349 = casadi.if_else((t142 <= 1e-24*t143), 0, casadi.atan2(t140, t139))
+    t349 = casadi.if_else((t143 <= 1e-40*t144), 0, casadi.atan2(t141, t140))
     t350 = -6.283185307179586*casadi.floor(0.15915494309189535*(6.1086523819801535 + t349)) + t349
     t351 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t349) + t349
     t352 = -6.283185307179586*casadi.floor(0.15915494309189535*(6.1086523819801535 + t351)) + t351
     t353 = -t348
     t354 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.2689280275926285 + t353)) + t348
-    t355 = casadi.if_else(t174, 0, casadi.atan2(-t179, t167))
+    t355 = casadi.if_else(t173, 0, casadi.atan2(-t179, -t175))
     t356 = -6.283185307179586*casadi.floor(0.15915494309189535*(6.1086523819801535 + t355)) + t355
     t357 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t355) + t355
     t358 = -6.283185307179586*casadi.floor(0.15915494309189535*(6.1086523819801535 + t357)) + t357
-    t359 = casadi.if_else(t183, 0, casadi.atan2(-t165, -t151))
+    t359 = casadi.if_else(t183, 0, casadi.atan2(-t167, -t152))
     t360 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.2689280275926285 + t359)) + t359
     t361 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t359)) + t359
-    t362 = casadi.if_else((t191 <= 1e-24*t192), 0, casadi.atan2(t189, t188))
+    t362 = casadi.if_else((t191 <= 1e-40*t192), 0, casadi.atan2(t189, t188))
     t363 = -6.283185307179586*casadi.floor(0.15915494309189535*(6.1086523819801535 + t362)) + t362
     t364 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t362) + t362
     t365 = -6.283185307179586*casadi.floor(0.15915494309189535*(6.1086523819801535 + t364)) + t364
     t366 = -t361
     t367 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.2689280275926285 + t366)) + t361
-    t368 = casadi.if_else(t274, 0, casadi.atan2(-t279, t267))
+    t368 = casadi.if_else(t274, 0, casadi.atan2(-t280, t276))
     t369 = -6.283185307179586*casadi.floor(0.15915494309189535*(6.1086523819801535 + t368)) + t368
     t370 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t368) + t368
     t371 = -6.283185307179586*casadi.floor(0.15915494309189535*(6.1086523819801535 + t370)) + t370
-    t372 = casadi.if_else(t283, 0, casadi.atan2(-t265, t251))
+    t372 = casadi.if_else(t284, 0, casadi.atan2(-t268, t253))
     t373 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.2689280275926285 + t372)) + t372
     t374 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t372)) + t372
-    t375 = casadi.if_else((t291 <= 1e-24*t292), 0, casadi.atan2(t289, t288))
+    t375 = casadi.if_else((t292 <= 1e-40*t293), 0, casadi.atan2(t290, t289))
     t376 = -6.283185307179586*casadi.floor(0.15915494309189535*(6.1086523819801535 + t375)) + t375
     t377 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t375) + t375
     t378 = -6.283185307179586*casadi.floor(0.15915494309189535*(6.1086523819801535 + t377)) + t377
     t379 = -t374
     t380 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.2689280275926285 + t379)) + t374
-    t381 = casadi.if_else(t323, 0, casadi.atan2(-t328, t316))
+    t381 = casadi.if_else(t322, 0, casadi.atan2(-t328, -t324))
     t382 = -6.283185307179586*casadi.floor(0.15915494309189535*(6.1086523819801535 + t381)) + t381
     t383 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t381) + t381
     t384 = -6.283185307179586*casadi.floor(0.15915494309189535*(6.1086523819801535 + t383)) + t383
-    t385 = casadi.if_else(t332, 0, casadi.atan2(-t314, t300))
+    t385 = casadi.if_else(t332, 0, casadi.atan2(-t316, t301))
     t386 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.2689280275926285 + t385)) + t385
     t387 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t385)) + t385
-    t388 = casadi.if_else((t340 <= 1e-24*t341), 0, casadi.atan2(t338, t337))
+    t388 = casadi.if_else((t340 <= 1e-40*t341), 0, casadi.atan2(t338, t337))
     t389 = -6.283185307179586*casadi.floor(0.15915494309189535*(6.1086523819801535 + t388)) + t388
     t390 = 3.141592653589793 - 6.283185307179586*casadi.ceil(0.15915494309189535*t388) + t388
     t391 = -6.283185307179586*casadi.floor(0.15915494309189535*(6.1086523819801535 + t390)) + t390
@@ -2585,12 +2585,12 @@ def _ik_branches(T):
     t394 = casadi.logic_and((t27 >= -2.705260340591211), (t27 <= 2.705260340591211))
     t395 = (t28 <= 2.705260340591211)
     t396 = casadi.if_else(casadi.logic_and(casadi.logic_not(t394), t395), t28, t27)
-    t397 = casadi.logic_and((t105 >= -3.141592653589793), (t105 <= 1.1344640137963142))
-    t398 = (t106 <= 1.1344640137963142)
-    t399 = casadi.if_else(casadi.logic_and(casadi.logic_not(t397), t398), t106, t105)
-    t400 = casadi.logic_and((t62 >= -0.2617993877991494), (t62 <= 2.7576202181510405))
-    t401 = (t63 <= 2.7576202181510405)
-    t402 = casadi.if_else(casadi.logic_and(casadi.logic_not(t400), t401), t63, t62)
+    t397 = casadi.logic_and((t107 >= -3.141592653589793), (t107 <= 1.1344640137963142))
+    t398 = (t108 <= 1.1344640137963142)
+    t399 = casadi.if_else(casadi.logic_and(casadi.logic_not(t397), t398), t108, t107)
+    t400 = casadi.logic_and((t64 >= -0.2617993877991494), (t64 <= 2.7576202181510405))
+    t401 = (t65 <= 2.7576202181510405)
+    t402 = casadi.if_else(casadi.logic_and(casadi.logic_not(t400), t401), t65, t64)
     t403 = casadi.logic_and((t342 >= -6.1086523819801535), (t342 <= 6.1086523819801535))
     t404 = (t343 <= 6.1086523819801535)
     t405 = casadi.logic_and((t346 >= -2.2689280275926285), (t346 <= 2.2689280275926285))
@@ -2604,12 +2604,12 @@ def _ik_branches(T):
     t413 = (t412 <= 2.2689280275926285)
     t414 = casadi.logic_and((t351 >= -6.1086523819801535), (t351 <= 6.1086523819801535))
     t415 = (t352 <= 6.1086523819801535)
-    t416 = casadi.logic_and((t154 >= -3.141592653589793), (t154 <= 1.1344640137963142))
-    t417 = (t155 <= 1.1344640137963142)
-    t418 = casadi.if_else(casadi.logic_and(casadi.logic_not(t416), t417), t155, t154)
-    t419 = casadi.logic_and((t64 >= -0.2617993877991494), (t64 <= 2.7576202181510405))
-    t420 = (t65 <= 2.7576202181510405)
-    t421 = casadi.if_else(casadi.logic_and(casadi.logic_not(t419), t420), t65, t64)
+    t416 = casadi.logic_and((t155 >= -3.141592653589793), (t155 <= 1.1344640137963142))
+    t417 = (t156 <= 1.1344640137963142)
+    t418 = casadi.if_else(casadi.logic_and(casadi.logic_not(t416), t417), t156, t155)
+    t419 = casadi.logic_and((t66 >= -0.2617993877991494), (t66 <= 2.7576202181510405))
+    t420 = (t67 <= 2.7576202181510405)
+    t421 = casadi.if_else(casadi.logic_and(casadi.logic_not(t419), t420), t67, t66)
     t422 = casadi.logic_and((t355 >= -6.1086523819801535), (t355 <= 6.1086523819801535))
     t423 = (t356 <= 6.1086523819801535)
     t424 = casadi.logic_and((t359 >= -2.2689280275926285), (t359 <= 2.2689280275926285))
@@ -2626,12 +2626,12 @@ def _ik_branches(T):
     t435 = casadi.logic_and((t11 >= -2.705260340591211), (t11 <= 2.705260340591211))
     t436 = (t12 <= 2.705260340591211)
     t437 = casadi.if_else(casadi.logic_and(casadi.logic_not(t435), t436), t12, t11)
-    t438 = casadi.logic_and((t254 >= -3.141592653589793), (t254 <= 1.1344640137963142))
-    t439 = (t255 <= 1.1344640137963142)
-    t440 = casadi.if_else(casadi.logic_and(casadi.logic_not(t438), t439), t255, t254)
-    t441 = casadi.logic_and((t211 >= -0.2617993877991494), (t211 <= 2.7576202181510405))
-    t442 = (t212 <= 2.7576202181510405)
-    t443 = casadi.if_else(casadi.logic_and(casadi.logic_not(t441), t442), t212, t211)
+    t438 = casadi.logic_and((t256 >= -3.141592653589793), (t256 <= 1.1344640137963142))
+    t439 = (t257 <= 1.1344640137963142)
+    t440 = casadi.if_else(casadi.logic_and(casadi.logic_not(t438), t439), t257, t256)
+    t441 = casadi.logic_and((t213 >= -0.2617993877991494), (t213 <= 2.7576202181510405))
+    t442 = (t214 <= 2.7576202181510405)
+    t443 = casadi.if_else(casadi.logic_and(casadi.logic_not(t441), t442), t214, t213)
     t444 = casadi.logic_and((t368 >= -6.1086523819801535), (t368 <= 6.1086523819801535))
     t445 = (t369 <= 6.1086523819801535)
     t446 = casadi.logic_and((t372 >= -2.2689280275926285), (t372 <= 2.2689280275926285))
@@ -2645,12 +2645,12 @@ def _ik_branches(T):
     t454 = (t453 <= 2.2689280275926285)
     t455 = casadi.logic_and((t377 >= -6.1086523819801535), (t377 <= 6.1086523819801535))
     t456 = (t378 <= 6.1086523819801535)
-    t457 = casadi.logic_and((t303 >= -3.141592653589793), (t303 <= 1.1344640137963142))
-    t458 = (t304 <= 1.1344640137963142)
-    t459 = casadi.if_else(casadi.logic_and(casadi.logic_not(t457), t458), t304, t303)
-    t460 = casadi.logic_and((t213 >= -0.2617993877991494), (t213 <= 2.7576202181510405))
-    t461 = (t214 <= 2.7576202181510405)
-    t462 = casadi.if_else(casadi.logic_and(casadi.logic_not(t460), t461), t214, t213)
+    t457 = casadi.logic_and((t304 >= -3.141592653589793), (t304 <= 1.1344640137963142))
+    t458 = (t305 <= 1.1344640137963142)
+    t459 = casadi.if_else(casadi.logic_and(casadi.logic_not(t457), t458), t305, t304)
+    t460 = casadi.logic_and((t215 >= -0.2617993877991494), (t215 <= 2.7576202181510405))
+    t461 = (t216 <= 2.7576202181510405)
+    t462 = casadi.if_else(casadi.logic_and(casadi.logic_not(t460), t461), t216, t215)
     t463 = casadi.logic_and((t381 >= -6.1086523819801535), (t381 <= 6.1086523819801535))
     t464 = (t382 <= 6.1086523819801535)
     t465 = casadi.logic_and((t385 >= -2.2689280275926285), (t385 <= 2.2689280275926285))
@@ -2667,18 +2667,20 @@ def _ik_branches(T):
     t476 = (casadi.fabs(t0) < casadi.inf)
     t477 = (t19 > t21)
     t478 = casadi.logic_or(casadi.logic_and(t22, (0 <= 1e-12*t20)), t477)
-    t479 = (t50 >= -1e-12)
-    t480 = (t199 >= -1e-12)
-    t481 = casadi.logic_or(t394, t395)
-    t482 = casadi.logic_or(t397, t398)
-    t483 = casadi.logic_or(t400, t401)
-    t484 = casadi.logic_or(t416, t417)
-    t485 = casadi.logic_or(t419, t420)
-    t486 = casadi.logic_or(t435, t436)
-    t487 = casadi.logic_or(t438, t439)
-    t488 = casadi.logic_or(t441, t442)
-    t489 = casadi.logic_or(t457, t458)
-    t490 = casadi.logic_or(t460, t461)
+    t479 = (t56 >= -1e-12)
+    t480 = (t56 > 1e-12)
+    t481 = (t205 >= -1e-12)
+    t482 = (t205 > 1e-12)
+    t483 = casadi.logic_or(t394, t395)
+    t484 = casadi.logic_or(t397, t398)
+    t485 = casadi.logic_or(t400, t401)
+    t486 = casadi.logic_or(t416, t417)
+    t487 = casadi.logic_or(t419, t420)
+    t488 = casadi.logic_or(t435, t436)
+    t489 = casadi.logic_or(t438, t439)
+    t490 = casadi.logic_or(t441, t442)
+    t491 = casadi.logic_or(t457, t458)
+    t492 = casadi.logic_or(t460, t461)
     q = casadi.SX(8, 6)
     q[0, 0] = t396
     q[0, 1] = t399
@@ -2729,23 +2731,23 @@ def _ik_branches(T):
     q[7, 4] = casadi.if_else(casadi.logic_and(casadi.logic_not(t471), t473), t472, t392)
     q[7, 5] = casadi.if_else(casadi.logic_and(casadi.logic_not(t474), t475), t391, t390)
     valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t476, t478), t479), (t114 >= -1e-12))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t476, t478), t479), t115)
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t476, t478), t55), (t163 >= -1e-12))
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t476, t478), t55), t164)
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t476, t477), t480), (t263 >= -1e-12))
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t476, t477), t480), t264)
-    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t476, t477), t204), (t312 >= -1e-12))
-    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t476, t477), t204), t313)
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t476, t478), t479), (t118 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t476, t478), t479), (t118 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t476, t478), t480), (t166 >= -1e-12))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t476, t478), t480), (t166 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t476, t477), t481), (t267 >= -1e-12))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t476, t477), t481), (t267 > 1e-12))
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t476, t477), t482), (t315 >= -1e-12))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t476, t477), t482), (t315 > 1e-12))
     in_limits = casadi.SX(8, 1)
-    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t481, t482), t483), casadi.logic_or(t403, t404)), casadi.logic_or(t405, t406)), casadi.logic_or(t407, t408))
-    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t481, t482), t483), casadi.logic_or(t409, t410)), casadi.logic_or(t411, t413)), casadi.logic_or(t414, t415))
-    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t481, t484), t485), casadi.logic_or(t422, t423)), casadi.logic_or(t424, t425)), casadi.logic_or(t426, t427))
-    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t481, t484), t485), casadi.logic_or(t428, t429)), casadi.logic_or(t430, t432)), casadi.logic_or(t433, t434))
-    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t486, t487), t488), casadi.logic_or(t444, t445)), casadi.logic_or(t446, t447)), casadi.logic_or(t448, t449))
-    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t486, t487), t488), casadi.logic_or(t450, t451)), casadi.logic_or(t452, t454)), casadi.logic_or(t455, t456))
-    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t486, t489), t490), casadi.logic_or(t463, t464)), casadi.logic_or(t465, t466)), casadi.logic_or(t467, t468))
-    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t486, t489), t490), casadi.logic_or(t469, t470)), casadi.logic_or(t471, t473)), casadi.logic_or(t474, t475))
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t483, t484), t485), casadi.logic_or(t403, t404)), casadi.logic_or(t405, t406)), casadi.logic_or(t407, t408))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t483, t484), t485), casadi.logic_or(t409, t410)), casadi.logic_or(t411, t413)), casadi.logic_or(t414, t415))
+    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t483, t486), t487), casadi.logic_or(t422, t423)), casadi.logic_or(t424, t425)), casadi.logic_or(t426, t427))
+    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t483, t486), t487), casadi.logic_or(t428, t429)), casadi.logic_or(t430, t432)), casadi.logic_or(t433, t434))
+    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t488, t489), t490), casadi.logic_or(t444, t445)), casadi.logic_or(t446, t447)), casadi.logic_or(t448, t449))
+    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t488, t489), t490), casadi.logic_or(t450, t451)), casadi.logic_or(t452, t454)), casadi.logic_or(t455, t456))
+    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t488, t491), t492), casadi.logic_or(t463, t464)), casadi.logic_or(t465, t466)), casadi.logic_or(t467, t468))
+    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t488, t491), t492), casadi.logic_or(t469, t470)), casadi.logic_or(t471, t473)), casadi.logic_or(t474, t475))
     return [q, valid, in_limits]
 
 

@@ -97,7 +97,7 @@ int panda_velocity_ik(const panda_real q[PANDA_DOF], const panda_real mu_dot[PAN
 panda_real panda_ik_numeric_step(const panda_real target[16], const panda_real q[PANDA_DOF], panda_real damping, panda_real q_start[PANDA_DOF], panda_real q_next[PANDA_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 7 row-major, element (r, c) at q[r * 7 + c]; valid[i], i < 8; in_limits[i], i < 8. 1535 operations. */
+ * Result: q: 8 x 7 row-major, element (r, c) at q[r * 7 + c]; valid[i], i < 8; in_limits[i], i < 8. 1511 operations. */
 void panda_ik_branches(const panda_real T[16], panda_real q_free, panda_real q[PANDA_MAX_IK_SOLUTIONS * PANDA_DOF], int valid[PANDA_MAX_IK_SOLUTIONS], int in_limits[PANDA_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

@@ -604,7 +604,7 @@ planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_T
 
 void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF], int valid[PLANAR_2R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_2R_MAX_IK_SOLUTIONS])
 {
-    /* 56 operations */
+    /* 64 operations */
 
     /* Inputs */
     const planar_2r_real mu0 = mu[0];
@@ -612,37 +612,38 @@ void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2
 
     /* Intermediate terms */
     const planar_2r_real t0 = (mu0*mu0) + (mu1*mu1);
-    const planar_2r_real t1 = 0.5*(2 - t0);
-    const planar_2r_real t2 = 1 - (t1*t1);
-    const planar_2r_real t3 = mu0 + mu1;
-    const int t4 = t2 > 1e-12;
-    const planar_2r_real t5 = (t4 ? t1 : (t1 > 0 ? 1 : -1));
-    const planar_2r_real t6 = (t4 ? sqrt(t2) : 0);
-    const planar_2r_real t7 = atan2(t6, t5);
-    const planar_2r_real t8 = 3.141592653589793 + t7;
-    const planar_2r_real t9 = 3.141592653589793 - t7;
-    const planar_2r_real t10 = 1 - t5;
-    const planar_2r_real t11 = (t6*t6) + (t10*t10);
-    const planar_2r_real t12 = mu0*t10;
-    const planar_2r_real t13 = mu1*t6;
-    const planar_2r_real t14 = -t13 + t12;
-    const planar_2r_real t15 = t12 + t13;
-    const planar_2r_real t16 = mu1*t10;
-    const planar_2r_real t17 = mu0*t6;
-    const planar_2r_real t18 = t16 + t17;
-    const planar_2r_real t19 = (t14*t14) + (t18*t18);
-    const planar_2r_real t20 = -t17 + t16;
-    const planar_2r_real t21 = (t15*t15) + (t20*t20);
-    const planar_2r_real t22 = 1e-24*t0*t11;
-    const int t23 = isfinite(t3);
+    const planar_2r_real t1 = (t0 > 0 ? sqrt(t0) : 0);
+    const planar_2r_real t2 = 0.25*(t1*t1)*(2 - t1)*(2 + t1);
+    const planar_2r_real t3 = 0.5*(2 - t0);
+    const planar_2r_real t4 = mu0 + mu1;
+    const int t5 = t2 > 0;
+    const planar_2r_real t6 = (t5 ? t3 : (t3 > 0 ? 1 : -1));
+    const planar_2r_real t7 = (t5 ? sqrt(t2) : 0);
+    const planar_2r_real t8 = atan2(t7, t6);
+    const planar_2r_real t9 = 3.141592653589793 + t8;
+    const planar_2r_real t10 = 3.141592653589793 - t8;
+    const planar_2r_real t11 = 1 - t6;
+    const planar_2r_real t12 = (t7*t7) + (t11*t11);
+    const planar_2r_real t13 = mu0*t11;
+    const planar_2r_real t14 = mu1*t7;
+    const planar_2r_real t15 = -t14 + t13;
+    const planar_2r_real t16 = t13 + t14;
+    const planar_2r_real t17 = mu1*t11;
+    const planar_2r_real t18 = mu0*t7;
+    const planar_2r_real t19 = t17 + t18;
+    const planar_2r_real t20 = (t15*t15) + (t19*t19);
+    const planar_2r_real t21 = -t18 + t17;
+    const planar_2r_real t22 = (t16*t16) + (t21*t21);
+    const planar_2r_real t23 = 1e-40*t0*t12;
+    const int t24 = isfinite(t4);
 
     /* Outputs */
-    q[0] = (t19 <= t22 ? 0 : atan2(t18, t14));
-    q[1] = t8 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t8));
-    q[2] = (t21 <= t22 ? 0 : atan2(t20, t15));
-    q[3] = t9 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t9));
-    valid[0] = t23 && t2 >= -1e-12;
-    valid[1] = t23 && t4;
+    q[0] = (t20 <= t23 ? 0 : atan2(t19, t15));
+    q[1] = t9 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t9));
+    q[2] = (t22 <= t23 ? 0 : atan2(t21, t16));
+    q[3] = t10 - 6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t10));
+    valid[0] = t24 && t2 >= -1e-12;
+    valid[1] = t24 && t2 > 1e-12;
     in_limits[0] = 1;
     in_limits[1] = 1;
 }

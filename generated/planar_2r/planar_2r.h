@@ -94,7 +94,7 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
 planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_start[PLANAR_2R_DOF], planar_2r_real q_next[PLANAR_2R_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 2 x 2 row-major, element (r, c) at q[r * 2 + c]; valid[i], i < 2; in_limits[i], i < 2. 56 operations. */
+ * Result: q: 2 x 2 row-major, element (r, c) at q[r * 2 + c]; valid[i], i < 2; in_limits[i], i < 2. 64 operations. */
 void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF], int valid[PLANAR_2R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_2R_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

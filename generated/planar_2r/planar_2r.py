@@ -621,43 +621,44 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 2 and 2 x 1 and 2 x 1), 56 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 2 and 2 x 1 and 2 x 1), 64 operations."""
     xp, dtype, device, batch, (mu,) = _arguments(("mu", mu, (2,)))
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
     t0 = mu0**2 + mu1**2
-    t1 = 0.5*(2 - t0)
-    t2 = 1 - t1**2
-    t3 = mu0 + mu1
-    t4 = xp.greater(t2, 1e-12)
-    t5 = xp.where(t4, t1, xp.where(xp.greater(t1, 0), xp.asarray(1, dtype=dtype), -1))
-    t6 = xp.where(t4, xp.sqrt(t2), 0)
-    t7 = xp.atan2(t6, t5)
-    t8 = 3.141592653589793 + t7
-    t9 = 3.141592653589793 - t7
-    t10 = 1 - t5
-    t11 = t6**2 + t10**2
-    t12 = mu0*t10
-    t13 = mu1*t6
-    t14 = -t13 + t12
-    t15 = t12 + t13
-    t16 = mu1*t10
-    t17 = mu0*t6
-    t18 = t16 + t17
-    t19 = t14**2 + t18**2
-    t20 = -t17 + t16
-    t21 = t15**2 + t20**2
-    t22 = 1e-24*t0*t11
-    t23 = xp.isfinite(t3)
+    t1 = xp.where(xp.greater(t0, 0), xp.sqrt(t0), 0)
+    t2 = 0.25*t1**2*(2 - t1)*(2 + t1)
+    t3 = 0.5*(2 - t0)
+    t4 = mu0 + mu1
+    t5 = xp.greater(t2, 0)
+    t6 = xp.where(t5, t3, xp.where(xp.greater(t3, 0), xp.asarray(1, dtype=dtype), -1))
+    t7 = xp.where(t5, xp.sqrt(t2), 0)
+    t8 = xp.atan2(t7, t6)
+    t9 = 3.141592653589793 + t8
+    t10 = 3.141592653589793 - t8
+    t11 = 1 - t6
+    t12 = t7**2 + t11**2
+    t13 = mu0*t11
+    t14 = mu1*t7
+    t15 = -t14 + t13
+    t16 = t13 + t14
+    t17 = mu1*t11
+    t18 = mu0*t7
+    t19 = t17 + t18
+    t20 = t15**2 + t19**2
+    t21 = -t18 + t17
+    t22 = t16**2 + t21**2
+    t23 = 1e-40*t0*t12
+    t24 = xp.isfinite(t4)
     q = _stack(xp, [
-        xp.where(xp.less_equal(t19, t22), 0, xp.atan2(t18, t14)),  # 0, 0
-        t8 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t8)),  # 0, 1
-        xp.where(xp.less_equal(t21, t22), 0, xp.atan2(t20, t15)),  # 1, 0
-        t9 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t9)),  # 1, 1
+        xp.where(xp.less_equal(t20, t23), 0, xp.atan2(t19, t15)),  # 0, 0
+        t9 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t9)),  # 0, 1
+        xp.where(xp.less_equal(t22, t23), 0, xp.atan2(t21, t16)),  # 1, 0
+        t10 - 6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t10)),  # 1, 1
     ], (2, 2))
     valid = _stack(xp, [
-        t23 & xp.greater_equal(t2, -1e-12),  # 0
-        t23 & t4,  # 1
+        t24 & xp.greater_equal(t2, -1e-12),  # 0
+        t24 & xp.greater(t2, 1e-12),  # 1
     ], (2,))
     in_limits = _stack(xp, [
         xp.full(batch, True, dtype=xp.bool, device=device),  # 0

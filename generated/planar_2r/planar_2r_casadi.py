@@ -460,41 +460,42 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 56 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 64 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     t0 = mu0**2 + mu1**2
-    t1 = 0.5*(2 - t0)
-    t2 = 1 - t1**2
-    t3 = mu0 + mu1
-    t4 = (t2 > 1e-12)
-    t5 = casadi.if_else(t4, t1, casadi.if_else((t1 > 0), 1, -1))
-    t6 = casadi.if_else(t4, casadi.sqrt(t2), 0)
-    t7 = casadi.atan2(t6, t5)
-    t8 = 3.141592653589793 + t7
-    t9 = 3.141592653589793 - t7
-    t10 = 1 - t5
-    t11 = t6**2 + t10**2
-    t12 = mu0*t10
-    t13 = mu1*t6
-    t14 = -t13 + t12
-    t15 = t12 + t13
-    t16 = mu1*t10
-    t17 = mu0*t6
-    t18 = t16 + t17
-    t19 = t14**2 + t18**2
-    t20 = -t17 + t16
-    t21 = t15**2 + t20**2
-    t22 = 1e-24*t0*t11
-    t23 = (casadi.fabs(t3) < casadi.inf)
+    t1 = casadi.if_else((t0 > 0), casadi.sqrt(t0), 0)
+    t2 = 0.25*t1**2*(2 - t1)*(2 + t1)
+    t3 = 0.5*(2 - t0)
+    t4 = mu0 + mu1
+    t5 = (t2 > 0)
+    t6 = casadi.if_else(t5, t3, casadi.if_else((t3 > 0), 1, -1))
+    t7 = casadi.if_else(t5, casadi.sqrt(t2), 0)
+    t8 = casadi.atan2(t7, t6)
+    t9 = 3.141592653589793 + t8
+    t10 = 3.141592653589793 - t8
+    t11 = 1 - t6
+    t12 = t7**2 + t11**2
+    t13 = mu0*t11
+    t14 = mu1*t7
+    t15 = -t14 + t13
+    t16 = t13 + t14
+    t17 = mu1*t11
+    t18 = mu0*t7
+    t19 = t17 + t18
+    t20 = t15**2 + t19**2
+    t21 = -t18 + t17
+    t22 = t16**2 + t21**2
+    t23 = 1e-40*t0*t12
+    t24 = (casadi.fabs(t4) < casadi.inf)
     q = casadi.SX(2, 2)
-    q[0, 0] = casadi.if_else((t19 <= t22), 0, casadi.atan2(t18, t14))
-    q[0, 1] = t8 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t8))
-    q[1, 0] = casadi.if_else((t21 <= t22), 0, casadi.atan2(t20, t15))
-    q[1, 1] = t9 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t9))
+    q[0, 0] = casadi.if_else((t20 <= t23), 0, casadi.atan2(t19, t15))
+    q[0, 1] = t9 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t9))
+    q[1, 0] = casadi.if_else((t22 <= t23), 0, casadi.atan2(t21, t16))
+    q[1, 1] = t10 - 6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t10))
     valid = casadi.SX(2, 1)
-    valid[0, 0] = casadi.logic_and(t23, (t2 >= -1e-12))
-    valid[1, 0] = casadi.logic_and(t23, t4)
+    valid[0, 0] = casadi.logic_and(t24, (t2 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(t24, (t2 > 1e-12))
     in_limits = casadi.SX(2, 1)
     in_limits[0, 0] = True
     in_limits[1, 0] = True

@@ -877,7 +877,7 @@ planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_T
 
 void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF], int valid[PLANAR_3R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_3R_MAX_IK_SOLUTIONS])
 {
-    /* 77 operations */
+    /* 85 operations */
 
     /* Inputs */
     const planar_3r_real mu0 = mu[0];
@@ -890,45 +890,46 @@ void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3
     const planar_3r_real t2 = -t0 + mu0;
     const planar_3r_real t3 = -t1 + mu1;
     const planar_3r_real t4 = (t2*t2) + (t3*t3);
-    const planar_3r_real t5 = 0.5*(2 - t4);
-    const planar_3r_real t6 = 1 - (t5*t5);
-    const planar_3r_real t7 = mu2 + mu0 + mu1;
-    const int t8 = t6 > 1e-12;
-    const planar_3r_real t9 = (t8 ? t5 : (t5 > 0 ? 1 : -1));
-    const planar_3r_real t10 = (t8 ? sqrt(t6) : 0);
-    const planar_3r_real t11 = atan2(t10, t9);
-    const planar_3r_real t12 = 3.141592653589793 + t11;
-    const planar_3r_real t13 = 3.141592653589793 - t11;
-    const planar_3r_real t14 = 1 - t9;
-    const planar_3r_real t15 = (t10*t10) + (t14*t14);
-    const planar_3r_real t16 = t2*t14;
-    const planar_3r_real t17 = t3*t10;
-    const planar_3r_real t18 = -t17 + t16;
-    const planar_3r_real t19 = t16 + t17;
-    const planar_3r_real t20 = t3*t14;
-    const planar_3r_real t21 = t2*t10;
-    const planar_3r_real t22 = t20 + t21;
-    const planar_3r_real t23 = (t18*t18) + (t22*t22);
-    const planar_3r_real t24 = -t21 + t20;
-    const planar_3r_real t25 = (t19*t19) + (t24*t24);
-    const planar_3r_real t26 = 1e-24*t4*t15;
-    const planar_3r_real t27 = (t23 <= t26 ? 0 : atan2(t22, t18));
-    const planar_3r_real t28 = -mu2;
-    const planar_3r_real t29 = 3.141592653589793 + t28;
-    const planar_3r_real t30 = t27 + t12;
-    const planar_3r_real t31 = (t25 <= t26 ? 0 : atan2(t24, t19));
-    const planar_3r_real t32 = t31 + t13;
-    const int t33 = isfinite(t7);
+    const planar_3r_real t5 = (t4 > 0 ? sqrt(t4) : 0);
+    const planar_3r_real t6 = 0.25*(t5*t5)*(2 - t5)*(2 + t5);
+    const planar_3r_real t7 = 0.5*(2 - t4);
+    const planar_3r_real t8 = mu2 + mu0 + mu1;
+    const int t9 = t6 > 0;
+    const planar_3r_real t10 = (t9 ? t7 : (t7 > 0 ? 1 : -1));
+    const planar_3r_real t11 = (t9 ? sqrt(t6) : 0);
+    const planar_3r_real t12 = atan2(t11, t10);
+    const planar_3r_real t13 = 3.141592653589793 + t12;
+    const planar_3r_real t14 = 3.141592653589793 - t12;
+    const planar_3r_real t15 = 1 - t10;
+    const planar_3r_real t16 = (t11*t11) + (t15*t15);
+    const planar_3r_real t17 = t2*t15;
+    const planar_3r_real t18 = t3*t11;
+    const planar_3r_real t19 = -t18 + t17;
+    const planar_3r_real t20 = t17 + t18;
+    const planar_3r_real t21 = t3*t15;
+    const planar_3r_real t22 = t2*t11;
+    const planar_3r_real t23 = t21 + t22;
+    const planar_3r_real t24 = (t19*t19) + (t23*t23);
+    const planar_3r_real t25 = -t22 + t21;
+    const planar_3r_real t26 = (t20*t20) + (t25*t25);
+    const planar_3r_real t27 = 1e-40*t4*t16;
+    const planar_3r_real t28 = (t24 <= t27 ? 0 : atan2(t23, t19));
+    const planar_3r_real t29 = -mu2;
+    const planar_3r_real t30 = 3.141592653589793 + t29;
+    const planar_3r_real t31 = t28 + t13;
+    const planar_3r_real t32 = (t26 <= t27 ? 0 : atan2(t25, t20));
+    const planar_3r_real t33 = t32 + t14;
+    const int t34 = isfinite(t8);
 
     /* Outputs */
-    q[0] = t27;
-    q[1] = -6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t12)) + t12;
-    q[2] = -(t28 + t30 + 6.283185307179586*ceil(-0.15915494309189535*(t29 + t30)));
-    q[3] = t31;
-    q[4] = -6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t13)) + t13;
-    q[5] = -(t28 + t32 + 6.283185307179586*ceil(-0.15915494309189535*(t29 + t32)));
-    valid[0] = t33 && t6 >= -1e-12;
-    valid[1] = t33 && t8;
+    q[0] = t28;
+    q[1] = -6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t13)) + t13;
+    q[2] = -(t29 + t31 + 6.283185307179586*ceil(-0.15915494309189535*(t30 + t31)));
+    q[3] = t32;
+    q[4] = -6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t14)) + t14;
+    q[5] = -(t29 + t33 + 6.283185307179586*ceil(-0.15915494309189535*(t30 + t33)));
+    valid[0] = t34 && t6 >= -1e-12;
+    valid[1] = t34 && t6 > 1e-12;
     in_limits[0] = 1;
     in_limits[1] = 1;
 }

@@ -96,7 +96,7 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
 planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_start[PLANAR_3R_DOF], planar_3r_real q_next[PLANAR_3R_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 2 x 3 row-major, element (r, c) at q[r * 3 + c]; valid[i], i < 2; in_limits[i], i < 2. 77 operations. */
+ * Result: q: 2 x 3 row-major, element (r, c) at q[r * 3 + c]; valid[i], i < 2; in_limits[i], i < 2. 85 operations. */
 void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF], int valid[PLANAR_3R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_3R_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

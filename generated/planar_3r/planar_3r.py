@@ -879,7 +879,7 @@ def ik_numeric_step(target, q, damping=0.0):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_branches(mu):
-    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 3 and 2 x 1 and 2 x 1), 77 operations."""
+    """every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: (2 x 3 and 2 x 1 and 2 x 1), 85 operations."""
     xp, dtype, device, batch, (mu,) = _arguments(("mu", mu, (3,)))
     mu0 = mu[..., 0]
     mu1 = mu[..., 1]
@@ -889,46 +889,47 @@ def ik_branches(mu):
     t2 = -t0 + mu0
     t3 = -t1 + mu1
     t4 = t2**2 + t3**2
-    t5 = 0.5*(2 - t4)
-    t6 = 1 - t5**2
-    t7 = mu2 + mu0 + mu1
-    t8 = xp.greater(t6, 1e-12)
-    t9 = xp.where(t8, t5, xp.where(xp.greater(t5, 0), xp.asarray(1, dtype=dtype), -1))
-    t10 = xp.where(t8, xp.sqrt(t6), 0)
-    t11 = xp.atan2(t10, t9)
-    t12 = 3.141592653589793 + t11
-    t13 = 3.141592653589793 - t11
-    t14 = 1 - t9
-    t15 = t10**2 + t14**2
-    t16 = t2*t14
-    t17 = t3*t10
-    t18 = -t17 + t16
-    t19 = t16 + t17
-    t20 = t3*t14
-    t21 = t2*t10
-    t22 = t20 + t21
-    t23 = t18**2 + t22**2
-    t24 = -t21 + t20
-    t25 = t19**2 + t24**2
-    t26 = 1e-24*t4*t15
-    t27 = xp.where(xp.less_equal(t23, t26), 0, xp.atan2(t22, t18))
-    t28 = -mu2
-    t29 = 3.141592653589793 + t28
-    t30 = t27 + t12
-    t31 = xp.where(xp.less_equal(t25, t26), 0, xp.atan2(t24, t19))
-    t32 = t31 + t13
-    t33 = xp.isfinite(t7)
+    t5 = xp.where(xp.greater(t4, 0), xp.sqrt(t4), 0)
+    t6 = 0.25*t5**2*(2 - t5)*(2 + t5)
+    t7 = 0.5*(2 - t4)
+    t8 = mu2 + mu0 + mu1
+    t9 = xp.greater(t6, 0)
+    t10 = xp.where(t9, t7, xp.where(xp.greater(t7, 0), xp.asarray(1, dtype=dtype), -1))
+    t11 = xp.where(t9, xp.sqrt(t6), 0)
+    t12 = xp.atan2(t11, t10)
+    t13 = 3.141592653589793 + t12
+    t14 = 3.141592653589793 - t12
+    t15 = 1 - t10
+    t16 = t11**2 + t15**2
+    t17 = t2*t15
+    t18 = t3*t11
+    t19 = -t18 + t17
+    t20 = t17 + t18
+    t21 = t3*t15
+    t22 = t2*t11
+    t23 = t21 + t22
+    t24 = t19**2 + t23**2
+    t25 = -t22 + t21
+    t26 = t20**2 + t25**2
+    t27 = 1e-40*t4*t16
+    t28 = xp.where(xp.less_equal(t24, t27), 0, xp.atan2(t23, t19))
+    t29 = -mu2
+    t30 = 3.141592653589793 + t29
+    t31 = t28 + t13
+    t32 = xp.where(xp.less_equal(t26, t27), 0, xp.atan2(t25, t20))
+    t33 = t32 + t14
+    t34 = xp.isfinite(t8)
     q = _stack(xp, [
-        t27,  # 0, 0
-        -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t12)) + t12,  # 0, 1
-        -(t28 + t30 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t29 + t30))),  # 0, 2
-        t31,  # 1, 0
-        -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t13)) + t13,  # 1, 1
-        -(t28 + t32 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t29 + t32))),  # 1, 2
+        t28,  # 0, 0
+        -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t13)) + t13,  # 0, 1
+        -(t29 + t31 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t30 + t31))),  # 0, 2
+        t32,  # 1, 0
+        -6.283185307179586*xp.ceil(0.15915494309189535*(-3.141592653589793 + t14)) + t14,  # 1, 1
+        -(t29 + t33 + 6.283185307179586*xp.ceil(-0.15915494309189535*(t30 + t33))),  # 1, 2
     ], (2, 3))
     valid = _stack(xp, [
-        t33 & xp.greater_equal(t6, -1e-12),  # 0
-        t33 & t8,  # 1
+        t34 & xp.greater_equal(t6, -1e-12),  # 0
+        t34 & xp.greater(t6, 1e-12),  # 1
     ], (2,))
     in_limits = _stack(xp, [
         xp.full(batch, True, dtype=xp.bool, device=device),  # 0

@@ -694,7 +694,7 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 77 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 85 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
@@ -703,45 +703,46 @@ def _ik_branches(mu):
     t2 = -t0 + mu0
     t3 = -t1 + mu1
     t4 = t2**2 + t3**2
-    t5 = 0.5*(2 - t4)
-    t6 = 1 - t5**2
-    t7 = mu2 + mu0 + mu1
-    t8 = (t6 > 1e-12)
-    t9 = casadi.if_else(t8, t5, casadi.if_else((t5 > 0), 1, -1))
-    t10 = casadi.if_else(t8, casadi.sqrt(t6), 0)
-    t11 = casadi.atan2(t10, t9)
-    t12 = 3.141592653589793 + t11
-    t13 = 3.141592653589793 - t11
-    t14 = 1 - t9
-    t15 = t10**2 + t14**2
-    t16 = t2*t14
-    t17 = t3*t10
-    t18 = -t17 + t16
-    t19 = t16 + t17
-    t20 = t3*t14
-    t21 = t2*t10
-    t22 = t20 + t21
-    t23 = t18**2 + t22**2
-    t24 = -t21 + t20
-    t25 = t19**2 + t24**2
-    t26 = 1e-24*t4*t15
-    t27 = casadi.if_else((t23 <= t26), 0, casadi.atan2(t22, t18))
-    t28 = -mu2
-    t29 = 3.141592653589793 + t28
-    t30 = t27 + t12
-    t31 = casadi.if_else((t25 <= t26), 0, casadi.atan2(t24, t19))
-    t32 = t31 + t13
-    t33 = (casadi.fabs(t7) < casadi.inf)
+    t5 = casadi.if_else((t4 > 0), casadi.sqrt(t4), 0)
+    t6 = 0.25*t5**2*(2 - t5)*(2 + t5)
+    t7 = 0.5*(2 - t4)
+    t8 = mu2 + mu0 + mu1
+    t9 = (t6 > 0)
+    t10 = casadi.if_else(t9, t7, casadi.if_else((t7 > 0), 1, -1))
+    t11 = casadi.if_else(t9, casadi.sqrt(t6), 0)
+    t12 = casadi.atan2(t11, t10)
+    t13 = 3.141592653589793 + t12
+    t14 = 3.141592653589793 - t12
+    t15 = 1 - t10
+    t16 = t11**2 + t15**2
+    t17 = t2*t15
+    t18 = t3*t11
+    t19 = -t18 + t17
+    t20 = t17 + t18
+    t21 = t3*t15
+    t22 = t2*t11
+    t23 = t21 + t22
+    t24 = t19**2 + t23**2
+    t25 = -t22 + t21
+    t26 = t20**2 + t25**2
+    t27 = 1e-40*t4*t16
+    t28 = casadi.if_else((t24 <= t27), 0, casadi.atan2(t23, t19))
+    t29 = -mu2
+    t30 = 3.141592653589793 + t29
+    t31 = t28 + t13
+    t32 = casadi.if_else((t26 <= t27), 0, casadi.atan2(t25, t20))
+    t33 = t32 + t14
+    t34 = (casadi.fabs(t8) < casadi.inf)
     q = casadi.SX(2, 3)
-    q[0, 0] = t27
-    q[0, 1] = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t12)) + t12
-    q[0, 2] = -(t28 + t30 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t29 + t30)))
-    q[1, 0] = t31
-    q[1, 1] = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t13)) + t13
-    q[1, 2] = -(t28 + t32 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t29 + t32)))
+    q[0, 0] = t28
+    q[0, 1] = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t13)) + t13
+    q[0, 2] = -(t29 + t31 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t30 + t31)))
+    q[1, 0] = t32
+    q[1, 1] = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t14)) + t14
+    q[1, 2] = -(t29 + t33 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t30 + t33)))
     valid = casadi.SX(2, 1)
-    valid[0, 0] = casadi.logic_and(t33, (t6 >= -1e-12))
-    valid[1, 0] = casadi.logic_and(t33, t8)
+    valid[0, 0] = casadi.logic_and(t34, (t6 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(t34, (t6 > 1e-12))
     in_limits = casadi.SX(2, 1)
     in_limits[0, 0] = True
     in_limits[1, 0] = True

@@ -99,7 +99,7 @@ int puma560_velocity_ik(const puma560_real q[PUMA560_DOF], const puma560_real mu
 puma560_real puma560_ik_numeric_step(const puma560_real target[16], const puma560_real q[PUMA560_DOF], puma560_real damping, puma560_real q_start[PUMA560_DOF], puma560_real q_next[PUMA560_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1344 operations. */
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1347 operations. */
 void puma560_ik_branches(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK_SOLUTIONS * PUMA560_DOF], int valid[PUMA560_MAX_IK_SOLUTIONS], int in_limits[PUMA560_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

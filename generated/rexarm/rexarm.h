@@ -97,7 +97,7 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
 rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], const rexarm_real q[REXARM_DOF], rexarm_real damping, rexarm_real q_start[REXARM_DOF], rexarm_real q_next[REXARM_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 4 row-major, element (r, c) at q[r * 4 + c]; valid[i], i < 8; in_limits[i], i < 8. 767 operations. */
+ * Result: q: 8 x 4 row-major, element (r, c) at q[r * 4 + c]; valid[i], i < 8; in_limits[i], i < 8. 800 operations. */
 void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK_SOLUTIONS * REXARM_DOF], int valid[REXARM_MAX_IK_SOLUTIONS], int in_limits[REXARM_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

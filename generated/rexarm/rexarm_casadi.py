@@ -1212,26 +1212,26 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 767 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 800 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
     mu3 = mu[3]
     t0 = casadi.sin(mu3)
-    t1 = 1 - t0**2
+    t1 = casadi.cos(mu3)**2
     t2 = casadi.atan2(mu0, -mu1)
     t3 = -1.5707963267948966 + t2
     t4 = mu3 + mu0 + mu1 + mu2
     t5 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t3)) + t3
     t6 = -6.283185307179586*casadi.floor(0.15915494309189535*(3.141592653589793 + t5)) + t5
-    t7 = (t1 > 1e-12)
+    t7 = (t1 > 0)
     t8 = casadi.if_else(t7, -t0, casadi.if_else((t0 < 0), 1, -1))
     t9 = casadi.if_else(t7, casadi.sqrt(t1), 0)
     t10 = casadi.atan2(t9, t8)
     t11 = mu0**2
     t12 = t11 + mu1**2
     t13 = t12 + mu2**2
-    t14 = 1e-24*t13
+    t14 = 1e-40*t13
     t15 = (t12 <= t14)
     t16 = casadi.if_else(t15, 1, 1/casadi.sqrt(t12))
     t17 = casadi.if_else(t15, 0, 1.5707963267948966 + t2)
@@ -1260,296 +1260,305 @@ def _ik_branches(mu):
     t40 = -0.12 + t39
     t41 = t30**2 + t38**2
     t42 = t41 + t34**2
-    t43 = 0.5*(0.02 - t42)
-    t44 = 1 - 10000*t43**2
-    t45 = (t44 > 1e-12)
-    t46 = casadi.if_else(t45, casadi.sqrt(t44), 0)
-    t47 = 100*t43
-    t48 = casadi.if_else(t45, t47, casadi.if_else((t47 > 0), 1, -1))
-    t49 = casadi.atan2(t46, t48)
-    t50 = 3.141592653589793 + t49
-    t51 = 3.141592653589793 - t49
-    t52 = 0.22 - 0.1*t48
-    t53 = -0.12 + t52
-    t54 = 0.01*t46**2 + t53**2
-    t55 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t50)) + t50
-    t56 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t55)) + t55
-    t57 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t51)) + t51
+    t43 = casadi.if_else((t42 > 0), casadi.sqrt(t42), 0)
+    t44 = 0.25*t43**2*(0.2 - t43)*(0.2 + t43)
+    t45 = 0.5*(0.02 - t42)
+    t46 = 10000*t44
+    t47 = (t46 > 0)
+    t48 = casadi.if_else(t47, casadi.sqrt(t46), 0)
+    t49 = 100*t45
+    t50 = casadi.if_else(t47, t49, casadi.if_else((t49 > 0), 1, -1))
+    t51 = casadi.atan2(t48, t50)
+    t52 = 3.141592653589793 + t51
+    t53 = 3.141592653589793 - t51
+    t54 = 0.22 - 0.1*t50
+    t55 = -0.12 + t54
+    t56 = 0.01*t48**2 + t55**2
+    t57 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t52)) + t52
     t58 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t57)) + t57
-    t59 = 0.1*t46
-    t60 = t59*t34
-    t61 = t38*t53
-    t62 = t60 + t61
-    t63 = -t60 + t61
-    t64 = t34*t53
-    t65 = t59*t38
-    t66 = -t65 + t64
-    t67 = t62**2 + t66**2
-    t68 = t64 + t65
-    t69 = t63**2 + t68**2
-    t70 = -t33
-    t71 = t70 + t29
-    t72 = t41 + t71**2
-    t73 = 0.5*(0.02 - t72)
-    t74 = 1 - 10000*t73**2
-    t75 = t70 + t31
-    t76 = (t74 > 1e-12)
-    t77 = casadi.if_else(t76, casadi.sqrt(t74), 0)
-    t78 = 100*t73
-    t79 = casadi.if_else(t76, t78, casadi.if_else((t78 > 0), 1, -1))
-    t80 = casadi.atan2(t77, t79)
-    t81 = 3.141592653589793 + t80
-    t82 = 3.141592653589793 - t80
-    t83 = 0.22 - 0.1*t79
-    t84 = -0.12 + t83
-    t85 = 0.01*t77**2 + t84**2
-    t86 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t81)) + t81
-    t87 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t86)) + t86
-    t88 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t82)) + t82
-    t89 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t88)) + t88
-    t90 = 0.1*t77
-    t91 = t90*t71
-    t92 = t38*t84
-    t93 = t91 + t92
-    t94 = -t91 + t92
-    t95 = t71*t84
-    t96 = t90*t38
-    t97 = -t96 + t95
-    t98 = t93**2 + t97**2
-    t99 = t95 + t96
-    t100 = t94**2 + t99**2
-    t101 = t32**2 + t40**2
-    t102 = t101 + t35**2
-    t103 = 0.5*(0.02 - t102)
-    t104 = 1 - 10000*t103**2
-    t105 = t101 + t75**2
-    t106 = 0.5*(0.02 - t105)
-    t107 = 1 - 10000*t106**2
-    t108 = (t104 > 1e-12)
-    t109 = casadi.if_else(t108, casadi.sqrt(t104), 0)
-    t110 = 100*t103
-    t111 = casadi.if_else(t108, t110, casadi.if_else((t110 > 0), 1, -1))
-    t112 = casadi.atan2(t109, t111)
-    t113 = 3.141592653589793 + t112
-    t114 = 3.141592653589793 - t112
-    t115 = 0.22 - 0.1*t111
-    t116 = -0.12 + t115
-    t117 = 0.01*t109**2 + t116**2
-    t118 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t113)) + t113
-    t119 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t118)) + t118
-    t120 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t114)) + t114
-    t121 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t120)) + t120
-    t122 = 0.1*t109
-    t123 = t122*t35
-    t124 = t40*t116
-    t125 = t123 + t124
-    t126 = -t123 + t124
-    t127 = t35*t116
-    t128 = t122*t40
-    t129 = -t128 + t127
-    t130 = t125**2 + t129**2
-    t131 = t127 + t128
-    t132 = t126**2 + t131**2
-    t133 = (t107 > 1e-12)
-    t134 = casadi.if_else(t133, casadi.sqrt(t107), 0)
-    t135 = 100*t106
-    t136 = casadi.if_else(t133, t135, casadi.if_else((t135 > 0), 1, -1))
-    t137 = casadi.atan2(t134, t136)
-    t138 = 3.141592653589793 + t137
-    t139 = 3.141592653589793 - t137
-    t140 = 0.22 - 0.1*t136
-    t141 = -0.12 + t140
-    t142 = 0.01*t134**2 + t141**2
-    t143 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t138)) + t138
-    t144 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t143)) + t143
-    t145 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t139)) + t139
-    t146 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t145)) + t145
-    t147 = 0.1*t134
-    t148 = t147*t75
-    t149 = t40*t141
-    t150 = t148 + t149
-    t151 = -t148 + t149
-    t152 = t75*t141
-    t153 = t147*t40
-    t154 = -t153 + t152
-    t155 = t150**2 + t154**2
-    t156 = t152 + t153
-    t157 = t151**2 + t156**2
-    t158 = 1e-24*t42*t54
-    t159 = casadi.if_else((t67 <= t158), 0, casadi.atan2(-t66, t62))
-    t160 = t159 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t159))
-    t161 = -t10
-    t162 = 3.141592653589793 + t161
-    t163 = t159 + t50
-    t164 = t161 + t163 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t162 + t163))
-    t165 = -t164
-    t166 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t165)) + t164
-    t167 = casadi.if_else((t69 <= t158), 0, casadi.atan2(-t68, t63))
-    t168 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t167)) + t167
-    t169 = t51 + t167
-    t170 = t161 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t162 + t169)) + t169
-    t171 = -t170
-    t172 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t171)) + t170
-    t173 = 1e-24*t72*t85
-    t174 = casadi.if_else((t98 <= t173), 0, casadi.atan2(-t97, t93))
-    t175 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t174)) + t174
-    t176 = 3.141592653589793 + t10
-    t177 = t81 + t174
-    t178 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t176 + t177)) + t10 + t177
+    t59 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t53)) + t53
+    t60 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t59)) + t59
+    t61 = 0.1*t48
+    t62 = t61*t34
+    t63 = t38*t55
+    t64 = t62 + t63
+    t65 = -t62 + t63
+    t66 = t34*t55
+    t67 = t61*t38
+    t68 = -t67 + t66
+    t69 = t64**2 + t68**2
+    t70 = t66 + t67
+    t71 = t65**2 + t70**2
+    t72 = -t33
+    t73 = t72 + t29
+    t74 = t41 + t73**2
+    t75 = casadi.if_else((t74 > 0), casadi.sqrt(t74), 0)
+    t76 = 0.25*t75**2*(0.2 - t75)*(0.2 + t75)
+    t77 = 0.5*(0.02 - t74)
+    t78 = t72 + t31
+    t79 = 10000*t76
+    t80 = (t79 > 0)
+    t81 = casadi.if_else(t80, casadi.sqrt(t79), 0)
+    t82 = 100*t77
+    t83 = casadi.if_else(t80, t82, casadi.if_else((t82 > 0), 1, -1))
+    t84 = casadi.atan2(t81, t83)
+    t85 = 3.141592653589793 + t84
+    t86 = 3.141592653589793 - t84
+    t87 = 0.22 - 0.1*t83
+    t88 = -0.12 + t87
+    t89 = 0.01*t81**2 + t88**2
+    t90 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t85)) + t85
+    t91 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t90)) + t90
+    t92 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t86)) + t86
+    t93 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t92)) + t92
+    t94 = 0.1*t81
+    t95 = t94*t73
+    t96 = t38*t88
+    t97 = t95 + t96
+    t98 = -t95 + t96
+    t99 = t73*t88
+    t100 = t94*t38
+    t101 = -t100 + t99
+    t102 = t97**2 + t101**2
+    t103 = t99 + t100
+    t104 = t98**2 + t103**2
+    t105 = t32**2 + t40**2
+    t106 = t105 + t35**2
+    t107 = casadi.if_else((t106 > 0), casadi.sqrt(t106), 0)
+    t108 = 0.25*t107**2*(0.2 - t107)*(0.2 + t107)
+    t109 = 0.5*(0.02 - t106)
+    t110 = t105 + t78**2
+    t111 = casadi.if_else((t110 > 0), casadi.sqrt(t110), 0)
+    t112 = 0.25*t111**2*(0.2 - t111)*(0.2 + t111)
+    t113 = 0.5*(0.02 - t110)
+    t114 = 10000*t108
+    t115 = (t114 > 0)
+    t116 = casadi.if_else(t115, casadi.sqrt(t114), 0)
+    t117 = 100*t109
+    t118 = casadi.if_else(t115, t117, casadi.if_else((t117 > 0), 1, -1))
+    t119 = casadi.atan2(t116, t118)
+    t120 = 3.141592653589793 + t119
+    t121 = 3.141592653589793 - t119
+    t122 = 0.22 - 0.1*t118
+    t123 = -0.12 + t122
+    t124 = 0.01*t116**2 + t123**2
+    t125 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t120)) + t120
+    t126 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t125)) + t125
+    t127 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t121)) + t121
+    t128 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t127)) + t127
+    t129 = 0.1*t116
+    t130 = t129*t35
+    t131 = t40*t123
+    t132 = t130 + t131
+    t133 = -t130 + t131
+    t134 = t35*t123
+    t135 = t129*t40
+    t136 = -t135 + t134
+    t137 = t132**2 + t136**2
+    t138 = t134 + t135
+    t139 = t133**2 + t138**2
+    t140 = 10000*t112
+    t141 = (t140 > 0)
+    t142 = casadi.if_else(t141, casadi.sqrt(t140), 0)
+    t143 = 100*t113
+    t144 = casadi.if_else(t141, t143, casadi.if_else((t143 > 0), 1, -1))
+    t145 = casadi.atan2(t142, t144)
+    t146 = 3.141592653589793 + t145
+    t147 = 3.141592653589793 - t145
+    t148 = 0.22 - 0.1*t144
+    t149 = -0.12 + t148
+    t150 = 0.01*t142**2 + t149**2
+    t151 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t146)) + t146
+    t152 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t151)) + t151
+    t153 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t147)) + t147
+    t154 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t153)) + t153
+    t155 = 0.1*t142
+    t156 = t155*t78
+    t157 = t40*t149
+    t158 = t156 + t157
+    t159 = -t156 + t157
+    t160 = t78*t149
+    t161 = t155*t40
+    t162 = -t161 + t160
+    t163 = t158**2 + t162**2
+    t164 = t160 + t161
+    t165 = t159**2 + t164**2
+    t166 = 1e-40*t42*t56
+    t167 = casadi.if_else((t69 <= t166), 0, casadi.atan2(-t68, t64))
+    t168 = t167 - 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t167))
+    t169 = -t10
+    t170 = 3.141592653589793 + t169
+    t171 = t167 + t52
+    t172 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t170 + t171)) + t169 + t171
+    t173 = -t172
+    t174 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t173)) + t172
+    t175 = casadi.if_else((t71 <= t166), 0, casadi.atan2(-t70, t65))
+    t176 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t175)) + t175
+    t177 = t53 + t175
+    t178 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t170 + t177)) + t169 + t177
     t179 = -t178
     t180 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t179)) + t178
-    t181 = casadi.if_else((t100 <= t173), 0, casadi.atan2(-t99, t94))
-    t182 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t181)) + t181
-    t183 = t82 + t181
-    t184 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t176 + t183)) + t10 + t183
-    t185 = -t184
-    t186 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t185)) + t184
-    t187 = 1e-24*t102*t117
-    t188 = casadi.if_else((t130 <= t187), 0, casadi.atan2(-t129, t125))
-    t189 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t188)) + t188
-    t190 = t113 + t188
-    t191 = t161 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t162 + t190)) + t190
-    t192 = -t191
-    t193 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t192)) + t191
-    t194 = casadi.if_else((t132 <= t187), 0, casadi.atan2(-t131, t126))
-    t195 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t194)) + t194
-    t196 = t114 + t194
-    t197 = t161 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(t162 + t196)) + t196
-    t198 = -t197
-    t199 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t198)) + t197
-    t200 = 1e-24*t105*t142
-    t201 = casadi.if_else((t155 <= t200), 0, casadi.atan2(-t154, t150))
-    t202 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t201)) + t201
-    t203 = t138 + t201
-    t204 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t176 + t203)) + t10 + t203
-    t205 = -t204
-    t206 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t205)) + t204
-    t207 = casadi.if_else((t157 <= t200), 0, casadi.atan2(-t156, t151))
-    t208 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t207)) + t207
-    t209 = t139 + t207
-    t210 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t176 + t209)) + t10 + t209
-    t211 = -t210
-    t212 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t211)) + t210
-    t213 = casadi.logic_and((t18 >= -3.141592653589793), (t18 <= 3.141592653589793))
-    t214 = (t19 <= 3.141592653589793)
-    t215 = casadi.if_else(casadi.logic_and(casadi.logic_not(t213), t214), t19, t18)
-    t216 = casadi.logic_and((t159 >= -2.0943951023931953), (t159 <= 2.0943951023931953))
-    t217 = (t160 <= 2.0943951023931953)
-    t218 = casadi.logic_and((t55 >= -2.0943951023931953), (t55 <= 2.0943951023931953))
-    t219 = (t56 <= 2.0943951023931953)
-    t220 = casadi.logic_and((t165 >= -2.0943951023931953), (t165 <= 2.0943951023931953))
-    t221 = -t166
-    t222 = (t221 <= 2.0943951023931953)
-    t223 = casadi.logic_and((t167 >= -2.0943951023931953), (t167 <= 2.0943951023931953))
-    t224 = (t168 <= 2.0943951023931953)
-    t225 = casadi.logic_and((t57 >= -2.0943951023931953), (t57 <= 2.0943951023931953))
-    t226 = (t58 <= 2.0943951023931953)
-    t227 = casadi.logic_and((t171 >= -2.0943951023931953), (t171 <= 2.0943951023931953))
-    t228 = -t172
-    t229 = (t228 <= 2.0943951023931953)
-    t230 = casadi.logic_and((t174 >= -2.0943951023931953), (t174 <= 2.0943951023931953))
-    t231 = (t175 <= 2.0943951023931953)
-    t232 = casadi.logic_and((t86 >= -2.0943951023931953), (t86 <= 2.0943951023931953))
-    t233 = (t87 <= 2.0943951023931953)
-    t234 = casadi.logic_and((t179 >= -2.0943951023931953), (t179 <= 2.0943951023931953))
-    t235 = -t180
-    t236 = (t235 <= 2.0943951023931953)
-    t237 = casadi.logic_and((t181 >= -2.0943951023931953), (t181 <= 2.0943951023931953))
-    t238 = (t182 <= 2.0943951023931953)
-    t239 = casadi.logic_and((t88 >= -2.0943951023931953), (t88 <= 2.0943951023931953))
-    t240 = (t89 <= 2.0943951023931953)
-    t241 = casadi.logic_and((t185 >= -2.0943951023931953), (t185 <= 2.0943951023931953))
-    t242 = -t186
-    t243 = (t242 <= 2.0943951023931953)
-    t244 = casadi.logic_and((t5 >= -3.141592653589793), (t5 <= 3.141592653589793))
-    t245 = (t6 <= 3.141592653589793)
-    t246 = casadi.if_else(casadi.logic_and(casadi.logic_not(t244), t245), t6, t5)
-    t247 = casadi.logic_and((t188 >= -2.0943951023931953), (t188 <= 2.0943951023931953))
-    t248 = (t189 <= 2.0943951023931953)
-    t249 = casadi.logic_and((t118 >= -2.0943951023931953), (t118 <= 2.0943951023931953))
-    t250 = (t119 <= 2.0943951023931953)
-    t251 = casadi.logic_and((t192 >= -2.0943951023931953), (t192 <= 2.0943951023931953))
-    t252 = -t193
-    t253 = (t252 <= 2.0943951023931953)
-    t254 = casadi.logic_and((t194 >= -2.0943951023931953), (t194 <= 2.0943951023931953))
-    t255 = (t195 <= 2.0943951023931953)
-    t256 = casadi.logic_and((t120 >= -2.0943951023931953), (t120 <= 2.0943951023931953))
-    t257 = (t121 <= 2.0943951023931953)
-    t258 = casadi.logic_and((t198 >= -2.0943951023931953), (t198 <= 2.0943951023931953))
-    t259 = -t199
-    t260 = (t259 <= 2.0943951023931953)
-    t261 = casadi.logic_and((t201 >= -2.0943951023931953), (t201 <= 2.0943951023931953))
-    t262 = (t202 <= 2.0943951023931953)
-    t263 = casadi.logic_and((t143 >= -2.0943951023931953), (t143 <= 2.0943951023931953))
-    t264 = (t144 <= 2.0943951023931953)
-    t265 = casadi.logic_and((t205 >= -2.0943951023931953), (t205 <= 2.0943951023931953))
-    t266 = -t206
-    t267 = (t266 <= 2.0943951023931953)
-    t268 = casadi.logic_and((t207 >= -2.0943951023931953), (t207 <= 2.0943951023931953))
-    t269 = (t208 <= 2.0943951023931953)
-    t270 = casadi.logic_and((t145 >= -2.0943951023931953), (t145 <= 2.0943951023931953))
-    t271 = (t146 <= 2.0943951023931953)
-    t272 = casadi.logic_and((t211 >= -2.0943951023931953), (t211 <= 2.0943951023931953))
-    t273 = -t212
-    t274 = (t273 <= 2.0943951023931953)
-    t275 = (casadi.fabs(t4) < casadi.inf)
-    t276 = (casadi.fabs(mu3) <= 1.5707963267948966)
-    t277 = (t12 > t14)
-    t278 = casadi.logic_or(casadi.logic_and(t15, (0 <= 1e-12*t13)), t277)
-    t279 = (t1 >= -1e-12)
-    t280 = casadi.logic_or(t213, t214)
-    t281 = casadi.logic_or(t244, t245)
+    t181 = 1e-40*t74*t89
+    t182 = casadi.if_else((t102 <= t181), 0, casadi.atan2(-t101, t97))
+    t183 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t182)) + t182
+    t184 = 3.141592653589793 + t10
+    t185 = t85 + t182
+    t186 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t184 + t185)) + t10 + t185
+    t187 = -t186
+    t188 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t187)) + t186
+    t189 = casadi.if_else((t104 <= t181), 0, casadi.atan2(-t103, t98))
+    t190 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t189)) + t189
+    t191 = t86 + t189
+    t192 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t184 + t191)) + t10 + t191
+    t193 = -t192
+    t194 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t193)) + t192
+    t195 = 1e-40*t106*t124
+    t196 = casadi.if_else((t137 <= t195), 0, casadi.atan2(-t136, t132))
+    t197 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t196)) + t196
+    t198 = t120 + t196
+    t199 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t170 + t198)) + t169 + t198
+    t200 = -t199
+    t201 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t200)) + t199
+    t202 = casadi.if_else((t139 <= t195), 0, casadi.atan2(-t138, t133))
+    t203 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t202)) + t202
+    t204 = t121 + t202
+    t205 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t170 + t204)) + t169 + t204
+    t206 = -t205
+    t207 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t206)) + t205
+    t208 = 1e-40*t110*t150
+    t209 = casadi.if_else((t163 <= t208), 0, casadi.atan2(-t162, t158))
+    t210 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t209)) + t209
+    t211 = t146 + t209
+    t212 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t184 + t211)) + t10 + t211
+    t213 = -t212
+    t214 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t213)) + t212
+    t215 = casadi.if_else((t165 <= t208), 0, casadi.atan2(-t164, t159))
+    t216 = -6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t215)) + t215
+    t217 = t147 + t215
+    t218 = 6.283185307179586*casadi.ceil(-0.15915494309189535*(t184 + t217)) + t10 + t217
+    t219 = -t218
+    t220 = 6.283185307179586*casadi.floor(0.15915494309189535*(2.0943951023931953 + t219)) + t218
+    t221 = casadi.logic_and((t18 >= -3.141592653589793), (t18 <= 3.141592653589793))
+    t222 = (t19 <= 3.141592653589793)
+    t223 = casadi.if_else(casadi.logic_and(casadi.logic_not(t221), t222), t19, t18)
+    t224 = casadi.logic_and((t167 >= -2.0943951023931953), (t167 <= 2.0943951023931953))
+    t225 = (t168 <= 2.0943951023931953)
+    t226 = casadi.logic_and((t57 >= -2.0943951023931953), (t57 <= 2.0943951023931953))
+    t227 = (t58 <= 2.0943951023931953)
+    t228 = casadi.logic_and((t173 >= -2.0943951023931953), (t173 <= 2.0943951023931953))
+    t229 = -t174
+    t230 = (t229 <= 2.0943951023931953)
+    t231 = casadi.logic_and((t175 >= -2.0943951023931953), (t175 <= 2.0943951023931953))
+    t232 = (t176 <= 2.0943951023931953)
+    t233 = casadi.logic_and((t59 >= -2.0943951023931953), (t59 <= 2.0943951023931953))
+    t234 = (t60 <= 2.0943951023931953)
+    t235 = casadi.logic_and((t179 >= -2.0943951023931953), (t179 <= 2.0943951023931953))
+    t236 = -t180
+    t237 = (t236 <= 2.0943951023931953)
+    t238 = casadi.logic_and((t182 >= -2.0943951023931953), (t182 <= 2.0943951023931953))
+    t239 = (t183 <= 2.0943951023931953)
+    t240 = casadi.logic_and((t90 >= -2.0943951023931953), (t90 <= 2.0943951023931953))
+    t241 = (t91 <= 2.0943951023931953)
+    t242 = casadi.logic_and((t187 >= -2.0943951023931953), (t187 <= 2.0943951023931953))
+    t243 = -t188
+    t244 = (t243 <= 2.0943951023931953)
+    t245 = casadi.logic_and((t189 >= -2.0943951023931953), (t189 <= 2.0943951023931953))
+    t246 = (t190 <= 2.0943951023931953)
+    t247 = casadi.logic_and((t92 >= -2.0943951023931953), (t92 <= 2.0943951023931953))
+    t248 = (t93 <= 2.0943951023931953)
+    t249 = casadi.logic_and((t193 >= -2.0943951023931953), (t193 <= 2.0943951023931953))
+    t250 = -t194
+    t251 = (t250 <= 2.0943951023931953)
+    t252 = casadi.logic_and((t5 >= -3.141592653589793), (t5 <= 3.141592653589793))
+    t253 = (t6 <= 3.141592653589793)
+    t254 = casadi.if_else(casadi.logic_and(casadi.logic_not(t252), t253), t6, t5)
+    t255 = casadi.logic_and((t196 >= -2.0943951023931953), (t196 <= 2.0943951023931953))
+    t256 = (t197 <= 2.0943951023931953)
+    t257 = casadi.logic_and((t125 >= -2.0943951023931953), (t125 <= 2.0943951023931953))
+    t258 = (t126 <= 2.0943951023931953)
+    t259 = casadi.logic_and((t200 >= -2.0943951023931953), (t200 <= 2.0943951023931953))
+    t260 = -t201
+    t261 = (t260 <= 2.0943951023931953)
+    t262 = casadi.logic_and((t202 >= -2.0943951023931953), (t202 <= 2.0943951023931953))
+    t263 = (t203 <= 2.0943951023931953)
+    t264 = casadi.logic_and((t127 >= -2.0943951023931953), (t127 <= 2.0943951023931953))
+    t265 = (t128 <= 2.0943951023931953)
+    t266 = casadi.logic_and((t206 >= -2.0943951023931953), (t206 <= 2.0943951023931953))
+    t267 = -t207
+    t268 = (t267 <= 2.0943951023931953)
+    t269 = casadi.logic_and((t209 >= -2.0943951023931953), (t209 <= 2.0943951023931953))
+    t270 = (t210 <= 2.0943951023931953)
+    t271 = casadi.logic_and((t151 >= -2.0943951023931953), (t151 <= 2.0943951023931953))
+    t272 = (t152 <= 2.0943951023931953)
+    t273 = casadi.logic_and((t213 >= -2.0943951023931953), (t213 <= 2.0943951023931953))
+    t274 = -t214
+    t275 = (t274 <= 2.0943951023931953)
+    t276 = casadi.logic_and((t215 >= -2.0943951023931953), (t215 <= 2.0943951023931953))
+    t277 = (t216 <= 2.0943951023931953)
+    t278 = casadi.logic_and((t153 >= -2.0943951023931953), (t153 <= 2.0943951023931953))
+    t279 = (t154 <= 2.0943951023931953)
+    t280 = casadi.logic_and((t219 >= -2.0943951023931953), (t219 <= 2.0943951023931953))
+    t281 = -t220
+    t282 = (t281 <= 2.0943951023931953)
+    t283 = (casadi.fabs(t4) < casadi.inf)
+    t284 = (casadi.fabs(mu3) <= 1.5707963267948966)
+    t285 = (t12 > t14)
+    t286 = casadi.logic_or(casadi.logic_and(t15, (0 <= 1e-12*t13)), t285)
+    t287 = (t1 >= -1e-12)
+    t288 = (t1 > 1e-12)
+    t289 = casadi.logic_or(t221, t222)
+    t290 = casadi.logic_or(t252, t253)
     q = casadi.SX(8, 4)
-    q[0, 0] = t215
-    q[0, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t216), t217), t160, t159)
-    q[0, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t218), t219), t56, t55)
-    q[0, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t220), t222), t221, t165)
-    q[1, 0] = t215
-    q[1, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t223), t224), t168, t167)
-    q[1, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t225), t226), t58, t57)
-    q[1, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t227), t229), t228, t171)
-    q[2, 0] = t215
-    q[2, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t230), t231), t175, t174)
-    q[2, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t232), t233), t87, t86)
-    q[2, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t234), t236), t235, t179)
-    q[3, 0] = t215
-    q[3, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t237), t238), t182, t181)
-    q[3, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t239), t240), t89, t88)
-    q[3, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t241), t243), t242, t185)
-    q[4, 0] = t246
-    q[4, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t247), t248), t189, t188)
-    q[4, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t249), t250), t119, t118)
-    q[4, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t251), t253), t252, t192)
-    q[5, 0] = t246
-    q[5, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t254), t255), t195, t194)
-    q[5, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t256), t257), t121, t120)
-    q[5, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t258), t260), t259, t198)
-    q[6, 0] = t246
-    q[6, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t261), t262), t202, t201)
-    q[6, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t263), t264), t144, t143)
-    q[6, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t265), t267), t266, t205)
-    q[7, 0] = t246
-    q[7, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t268), t269), t208, t207)
-    q[7, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t270), t271), t146, t145)
-    q[7, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t272), t274), t273, t211)
+    q[0, 0] = t223
+    q[0, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t224), t225), t168, t167)
+    q[0, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t226), t227), t58, t57)
+    q[0, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t228), t230), t229, t173)
+    q[1, 0] = t223
+    q[1, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t231), t232), t176, t175)
+    q[1, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t233), t234), t60, t59)
+    q[1, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t235), t237), t236, t179)
+    q[2, 0] = t223
+    q[2, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t238), t239), t183, t182)
+    q[2, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t240), t241), t91, t90)
+    q[2, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t242), t244), t243, t187)
+    q[3, 0] = t223
+    q[3, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t245), t246), t190, t189)
+    q[3, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t247), t248), t93, t92)
+    q[3, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t249), t251), t250, t193)
+    q[4, 0] = t254
+    q[4, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t255), t256), t197, t196)
+    q[4, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t257), t258), t126, t125)
+    q[4, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t259), t261), t260, t200)
+    q[5, 0] = t254
+    q[5, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t262), t263), t203, t202)
+    q[5, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t264), t265), t128, t127)
+    q[5, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t266), t268), t267, t206)
+    q[6, 0] = t254
+    q[6, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t269), t270), t210, t209)
+    q[6, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t271), t272), t152, t151)
+    q[6, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t273), t275), t274, t213)
+    q[7, 0] = t254
+    q[7, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t276), t277), t216, t215)
+    q[7, 2] = casadi.if_else(casadi.logic_and(casadi.logic_not(t278), t279), t154, t153)
+    q[7, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t280), t282), t281, t219)
     valid = casadi.SX(8, 1)
-    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t275, t276), t278), t279), (t44 >= -1e-12))
-    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t275, t276), t278), t279), t45)
-    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t275, t276), t278), t7), (t74 >= -1e-12))
-    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t275, t276), t278), t7), t76)
-    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t275, t276), t277), t279), (t104 >= -1e-12))
-    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t275, t276), t277), t279), t108)
-    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t275, t276), t277), t7), (t107 >= -1e-12))
-    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t275, t276), t277), t7), t133)
+    valid[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t283, t284), t286), t287), (t46 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t283, t284), t286), t287), (t46 > 1e-12))
+    valid[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t283, t284), t286), t288), (t79 >= -1e-12))
+    valid[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t283, t284), t286), t288), (t79 > 1e-12))
+    valid[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t283, t284), t285), t287), (t114 >= -1e-12))
+    valid[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t283, t284), t285), t287), (t114 > 1e-12))
+    valid[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t283, t284), t285), t288), (t140 >= -1e-12))
+    valid[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(t283, t284), t285), t288), (t140 > 1e-12))
     in_limits = casadi.SX(8, 1)
-    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t280, casadi.logic_or(t216, t217)), casadi.logic_or(t218, t219)), casadi.logic_or(t220, t222))
-    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t280, casadi.logic_or(t223, t224)), casadi.logic_or(t225, t226)), casadi.logic_or(t227, t229))
-    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t280, casadi.logic_or(t230, t231)), casadi.logic_or(t232, t233)), casadi.logic_or(t234, t236))
-    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t280, casadi.logic_or(t237, t238)), casadi.logic_or(t239, t240)), casadi.logic_or(t241, t243))
-    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t281, casadi.logic_or(t247, t248)), casadi.logic_or(t249, t250)), casadi.logic_or(t251, t253))
-    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t281, casadi.logic_or(t254, t255)), casadi.logic_or(t256, t257)), casadi.logic_or(t258, t260))
-    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t281, casadi.logic_or(t261, t262)), casadi.logic_or(t263, t264)), casadi.logic_or(t265, t267))
-    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t281, casadi.logic_or(t268, t269)), casadi.logic_or(t270, t271)), casadi.logic_or(t272, t274))
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t289, casadi.logic_or(t224, t225)), casadi.logic_or(t226, t227)), casadi.logic_or(t228, t230))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t289, casadi.logic_or(t231, t232)), casadi.logic_or(t233, t234)), casadi.logic_or(t235, t237))
+    in_limits[2, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t289, casadi.logic_or(t238, t239)), casadi.logic_or(t240, t241)), casadi.logic_or(t242, t244))
+    in_limits[3, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t289, casadi.logic_or(t245, t246)), casadi.logic_or(t247, t248)), casadi.logic_or(t249, t251))
+    in_limits[4, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, casadi.logic_or(t255, t256)), casadi.logic_or(t257, t258)), casadi.logic_or(t259, t261))
+    in_limits[5, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, casadi.logic_or(t262, t263)), casadi.logic_or(t264, t265)), casadi.logic_or(t266, t268))
+    in_limits[6, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, casadi.logic_or(t269, t270)), casadi.logic_or(t271, t272)), casadi.logic_or(t273, t275))
+    in_limits[7, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(t290, casadi.logic_or(t276, t277)), casadi.logic_or(t278, t279)), casadi.logic_or(t280, t282))
     return [q, valid, in_limits]
 
 

@@ -932,7 +932,7 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
 
 void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF], int valid[SCARA_MAX_IK_SOLUTIONS], int in_limits[SCARA_MAX_IK_SOLUTIONS])
 {
-    /* 171 operations */
+    /* 179 operations */
 
     /* Inputs */
     const scara_real mu0 = mu[0];
@@ -942,82 +942,83 @@ void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_M
 
     /* Intermediate terms */
     const scara_real t0 = 0.149769 + (mu0*mu0) + (mu1*mu1);
-    const scara_real t1 = 0.5*(0.331019 - t0);
-    const scara_real t2 = 1 - 125.18949581886645*(t1*t1);
-    const scara_real t3 = mu3 + mu0 + mu1 + mu2;
-    const int t4 = t2 > 1e-12;
-    const scara_real t5 = (t4 ? sqrt(t2) : 0);
-    const scara_real t6 = 11.188811188811188*t1;
-    const scara_real t7 = (t4 ? t6 : (t6 > 0 ? 1 : -1));
-    const scara_real t8 = atan2(t5, t7);
-    const scara_real t9 = 3.141592653589793 + t8;
-    const scara_real t10 = 3.141592653589793 - t8;
-    const scara_real t11 = 0.325 - 0.275*t7;
-    const scara_real t12 = 0.149769 + 0.075625*(t5*t5) + (t11*t11);
-    const scara_real t13 = -6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t9)) + t9;
-    const scara_real t14 = -6.283185307179586*floor(0.15915494309189535*(1.53588974175501 + t13)) + t13;
-    const scara_real t15 = -6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t10)) + t10;
-    const scara_real t16 = -6.283185307179586*floor(0.15915494309189535*(1.53588974175501 + t15)) + t15;
-    const scara_real t17 = 0.275*t5;
-    const scara_real t18 = t17*mu1;
-    const scara_real t19 = 0.149769 + mu0*t11;
-    const scara_real t20 = -t18 + t19;
-    const scara_real t21 = -0.149769 + t20;
-    const scara_real t22 = t18 + t19;
-    const scara_real t23 = -0.149769 + t22;
-    const scara_real t24 = mu1*t11;
-    const scara_real t25 = t17*mu0;
-    const scara_real t26 = t24 + t25;
-    const scara_real t27 = (t21*t21) + (t26*t26);
-    const scara_real t28 = -t25 + t24;
-    const scara_real t29 = (t23*t23) + (t28*t28);
-    const scara_real t30 = 1e-24*t0*t12;
-    const scara_real t31 = (t27 <= t30 ? 0 : atan2(t26, t21));
-    const scara_real t32 = t31 - 6.283185307179586*floor(0.15915494309189535*(0.8726646259971648 + t31));
-    const scara_real t33 = -mu3;
-    const scara_real t34 = -(t31 + t33 + t9);
-    const scara_real t35 = t34 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t34));
-    const scara_real t36 = -t35;
-    const scara_real t37 = 6.283185307179586*floor(0.15915494309189535*(6.283185307179586 + t36)) + t35;
-    const scara_real t38 = (t29 <= t30 ? 0 : atan2(t28, t23));
-    const scara_real t39 = t38 - 6.283185307179586*floor(0.15915494309189535*(0.8726646259971648 + t38));
-    const scara_real t40 = -(t33 + t38 + t10);
-    const scara_real t41 = t40 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t40));
-    const scara_real t42 = -t41;
-    const scara_real t43 = 6.283185307179586*floor(0.15915494309189535*(6.283185307179586 + t42)) + t41;
-    const int t44 = t31 >= -0.8726646259971648 && t31 <= 0.8726646259971648;
-    const int t45 = t32 <= 0.8726646259971648;
-    const int t46 = t13 >= -1.53588974175501 && t13 <= 1.53588974175501;
-    const int t47 = t14 <= 1.53588974175501;
-    const scara_real t48 = -0.387 + mu2;
-    const scara_real t49 = -t48;
-    const int t50 = t36 >= -6.283185307179586 && t36 <= 6.283185307179586;
-    const scara_real t51 = -t37;
-    const int t52 = t51 <= 6.283185307179586;
-    const int t53 = t38 >= -0.8726646259971648 && t38 <= 0.8726646259971648;
-    const int t54 = t39 <= 0.8726646259971648;
-    const int t55 = t15 >= -1.53588974175501 && t15 <= 1.53588974175501;
-    const int t56 = t16 <= 1.53588974175501;
-    const int t57 = t42 >= -6.283185307179586 && t42 <= 6.283185307179586;
-    const scara_real t58 = -t43;
-    const int t59 = t58 <= 6.283185307179586;
-    const int t60 = isfinite(t3);
-    const int t61 = t48 <= 0.0;
-    const int t62 = t49 <= 0.21;
+    const scara_real t1 = -0.149769 + t0;
+    const scara_real t2 = (t1 > 0 ? sqrt(t1) : 0);
+    const scara_real t3 = 0.25*(0.05 + t2)*(-0.05 + t2)*(0.6 - t2)*(0.6 + t2);
+    const scara_real t4 = 0.5*(0.331019 - t0);
+    const scara_real t5 = mu3 + mu0 + mu1 + mu2;
+    const scara_real t6 = 125.18949581886645*t3;
+    const int t7 = t6 > 0;
+    const scara_real t8 = (t7 ? sqrt(t6) : 0);
+    const scara_real t9 = 11.188811188811188*t4;
+    const scara_real t10 = (t7 ? t9 : (t9 > 0 ? 1 : -1));
+    const scara_real t11 = atan2(t8, t10);
+    const scara_real t12 = 3.141592653589793 + t11;
+    const scara_real t13 = 3.141592653589793 - t11;
+    const scara_real t14 = 0.325 - 0.275*t10;
+    const scara_real t15 = 0.149769 + 0.075625*(t8*t8) + (t14*t14);
+    const scara_real t16 = -6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t12)) + t12;
+    const scara_real t17 = -6.283185307179586*floor(0.15915494309189535*(1.53588974175501 + t16)) + t16;
+    const scara_real t18 = -6.283185307179586*ceil(0.15915494309189535*(-3.141592653589793 + t13)) + t13;
+    const scara_real t19 = -6.283185307179586*floor(0.15915494309189535*(1.53588974175501 + t18)) + t18;
+    const scara_real t20 = mu0*t14;
+    const scara_real t21 = 0.275*t8;
+    const scara_real t22 = t21*mu1;
+    const scara_real t23 = -t22 + t20;
+    const scara_real t24 = t20 + t22;
+    const scara_real t25 = mu1*t14;
+    const scara_real t26 = t21*mu0;
+    const scara_real t27 = t25 + t26;
+    const scara_real t28 = (t23*t23) + (t27*t27);
+    const scara_real t29 = -t26 + t25;
+    const scara_real t30 = (t24*t24) + (t29*t29);
+    const scara_real t31 = 1e-40*t0*t15;
+    const scara_real t32 = (t28 <= t31 ? 0 : atan2(t27, t23));
+    const scara_real t33 = t32 - 6.283185307179586*floor(0.15915494309189535*(0.8726646259971648 + t32));
+    const scara_real t34 = -mu3;
+    const scara_real t35 = -(t32 + t34 + t12);
+    const scara_real t36 = t35 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t35));
+    const scara_real t37 = -t36;
+    const scara_real t38 = 6.283185307179586*floor(0.15915494309189535*(6.283185307179586 + t37)) + t36;
+    const scara_real t39 = (t30 <= t31 ? 0 : atan2(t29, t24));
+    const scara_real t40 = t39 - 6.283185307179586*floor(0.15915494309189535*(0.8726646259971648 + t39));
+    const scara_real t41 = -(t34 + t39 + t13);
+    const scara_real t42 = t41 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t41));
+    const scara_real t43 = -t42;
+    const scara_real t44 = 6.283185307179586*floor(0.15915494309189535*(6.283185307179586 + t43)) + t42;
+    const int t45 = t32 >= -0.8726646259971648 && t32 <= 0.8726646259971648;
+    const int t46 = t33 <= 0.8726646259971648;
+    const int t47 = t16 >= -1.53588974175501 && t16 <= 1.53588974175501;
+    const int t48 = t17 <= 1.53588974175501;
+    const scara_real t49 = -0.387 + mu2;
+    const scara_real t50 = -t49;
+    const int t51 = t37 >= -6.283185307179586 && t37 <= 6.283185307179586;
+    const scara_real t52 = -t38;
+    const int t53 = t52 <= 6.283185307179586;
+    const int t54 = t39 >= -0.8726646259971648 && t39 <= 0.8726646259971648;
+    const int t55 = t40 <= 0.8726646259971648;
+    const int t56 = t18 >= -1.53588974175501 && t18 <= 1.53588974175501;
+    const int t57 = t19 <= 1.53588974175501;
+    const int t58 = t43 >= -6.283185307179586 && t43 <= 6.283185307179586;
+    const scara_real t59 = -t44;
+    const int t60 = t59 <= 6.283185307179586;
+    const int t61 = isfinite(t5);
+    const int t62 = t49 <= 0.0;
+    const int t63 = t50 <= 0.21;
 
     /* Outputs */
-    q[0] = (!t44 && t45 ? t32 : t31);
-    q[1] = (!t46 && t47 ? t14 : t13);
-    q[2] = t49;
-    q[3] = (!t50 && t52 ? t51 : t36);
-    q[4] = (!t53 && t54 ? t39 : t38);
-    q[5] = (!t55 && t56 ? t16 : t15);
-    q[6] = t49;
-    q[7] = (!t57 && t59 ? t58 : t42);
-    valid[0] = t60 && t2 >= -1e-12;
-    valid[1] = t60 && t4;
-    in_limits[0] = (t44 || t45) && (t46 || t47) && t61 && t62 && (t50 || t52);
-    in_limits[1] = (t53 || t54) && (t55 || t56) && t61 && t62 && (t57 || t59);
+    q[0] = (!t45 && t46 ? t33 : t32);
+    q[1] = (!t47 && t48 ? t17 : t16);
+    q[2] = t50;
+    q[3] = (!t51 && t53 ? t52 : t37);
+    q[4] = (!t54 && t55 ? t40 : t39);
+    q[5] = (!t56 && t57 ? t19 : t18);
+    q[6] = t50;
+    q[7] = (!t58 && t60 ? t59 : t43);
+    valid[0] = t61 && t6 >= -1e-12;
+    valid[1] = t61 && t6 > 1e-12;
+    in_limits[0] = (t45 || t46) && (t47 || t48) && t62 && t63 && (t51 || t53);
+    in_limits[1] = (t54 || t55) && (t56 || t57) && t62 && t63 && (t58 || t60);
 }
 
 int scara_ik_nearest(const scara_real mu[SCARA_TASK_DIM], const scara_real q_seed[SCARA_DOF], const scara_real weights[SCARA_DOF], scara_real q[SCARA_DOF])

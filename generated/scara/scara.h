@@ -97,7 +97,7 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
 scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const scara_real q[SCARA_DOF], scara_real damping, scara_real q_start[SCARA_DOF], scara_real q_next[SCARA_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 2 x 4 row-major, element (r, c) at q[r * 4 + c]; valid[i], i < 2; in_limits[i], i < 2. 171 operations. */
+ * Result: q: 2 x 4 row-major, element (r, c) at q[r * 4 + c]; valid[i], i < 2; in_limits[i], i < 2. 179 operations. */
 void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF], int valid[SCARA_MAX_IK_SOLUTIONS], int in_limits[SCARA_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

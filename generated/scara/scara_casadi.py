@@ -648,89 +648,90 @@ def _ik_numeric_step(target, q, damping):
 
 
 def _ik_branches(mu):
-    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 171 operations."""
+    """Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits: 179 operations."""
     mu0 = mu[0]
     mu1 = mu[1]
     mu2 = mu[2]
     mu3 = mu[3]
     t0 = 0.149769 + mu0**2 + mu1**2
-    t1 = 0.5*(0.331019 - t0)
-    t2 = 1 - 125.18949581886645*t1**2
-    t3 = mu3 + mu0 + mu1 + mu2
-    t4 = (t2 > 1e-12)
-    t5 = casadi.if_else(t4, casadi.sqrt(t2), 0)
-    t6 = 11.188811188811188*t1
-    t7 = casadi.if_else(t4, t6, casadi.if_else((t6 > 0), 1, -1))
-    t8 = casadi.atan2(t5, t7)
-    t9 = 3.141592653589793 + t8
-    t10 = 3.141592653589793 - t8
-    t11 = 0.325 - 0.275*t7
-    t12 = 0.149769 + 0.075625*t5**2 + t11**2
-    t13 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t9)) + t9
-    t14 = -6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t13)) + t13
-    t15 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t10)) + t10
-    t16 = -6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t15)) + t15
-    t17 = 0.275*t5
-    t18 = t17*mu1
-    t19 = 0.149769 + mu0*t11
-    t20 = -t18 + t19
-    t21 = -0.149769 + t20
-    t22 = t18 + t19
-    t23 = -0.149769 + t22
-    t24 = mu1*t11
-    t25 = t17*mu0
-    t26 = t24 + t25
-    t27 = t21**2 + t26**2
-    t28 = -t25 + t24
-    t29 = t23**2 + t28**2
-    t30 = 1e-24*t0*t12
-    t31 = casadi.if_else((t27 <= t30), 0, casadi.atan2(t26, t21))
-    t32 = t31 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t31))
-    t33 = -mu3
-    t34 = -(t31 + t33 + t9)
-    t35 = t34 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t34))
-    t36 = -t35
-    t37 = 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t36)) + t35
-    t38 = casadi.if_else((t29 <= t30), 0, casadi.atan2(t28, t23))
-    t39 = t38 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t38))
-    t40 = -(t33 + t38 + t10)
-    t41 = t40 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t40))
-    t42 = -t41
-    t43 = 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t42)) + t41
-    t44 = casadi.logic_and((t31 >= -0.8726646259971648), (t31 <= 0.8726646259971648))
-    t45 = (t32 <= 0.8726646259971648)
-    t46 = casadi.logic_and((t13 >= -1.53588974175501), (t13 <= 1.53588974175501))
-    t47 = (t14 <= 1.53588974175501)
-    t48 = -0.387 + mu2
-    t49 = -t48
-    t50 = casadi.logic_and((t36 >= -6.283185307179586), (t36 <= 6.283185307179586))
-    t51 = -t37
-    t52 = (t51 <= 6.283185307179586)
-    t53 = casadi.logic_and((t38 >= -0.8726646259971648), (t38 <= 0.8726646259971648))
-    t54 = (t39 <= 0.8726646259971648)
-    t55 = casadi.logic_and((t15 >= -1.53588974175501), (t15 <= 1.53588974175501))
-    t56 = (t16 <= 1.53588974175501)
-    t57 = casadi.logic_and((t42 >= -6.283185307179586), (t42 <= 6.283185307179586))
-    t58 = -t43
-    t59 = (t58 <= 6.283185307179586)
-    t60 = (casadi.fabs(t3) < casadi.inf)
-    t61 = (t48 <= 0.0)
-    t62 = (t49 <= 0.21)
+    t1 = -0.149769 + t0
+    t2 = casadi.if_else((t1 > 0), casadi.sqrt(t1), 0)
+    t3 = 0.25*(0.05 + t2)*(-0.05 + t2)*(0.6 - t2)*(0.6 + t2)
+    t4 = 0.5*(0.331019 - t0)
+    t5 = mu3 + mu0 + mu1 + mu2
+    t6 = 125.18949581886645*t3
+    t7 = (t6 > 0)
+    t8 = casadi.if_else(t7, casadi.sqrt(t6), 0)
+    t9 = 11.188811188811188*t4
+    t10 = casadi.if_else(t7, t9, casadi.if_else((t9 > 0), 1, -1))
+    t11 = casadi.atan2(t8, t10)
+    t12 = 3.141592653589793 + t11
+    t13 = 3.141592653589793 - t11
+    t14 = 0.325 - 0.275*t10
+    t15 = 0.149769 + 0.075625*t8**2 + t14**2
+    t16 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t12)) + t12
+    t17 = -6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t16)) + t16
+    t18 = -6.283185307179586*casadi.ceil(0.15915494309189535*(-3.141592653589793 + t13)) + t13
+    t19 = -6.283185307179586*casadi.floor(0.15915494309189535*(1.53588974175501 + t18)) + t18
+    t20 = mu0*t14
+    t21 = 0.275*t8
+    t22 = t21*mu1
+    t23 = -t22 + t20
+    t24 = t20 + t22
+    t25 = mu1*t14
+    t26 = t21*mu0
+    t27 = t25 + t26
+    t28 = t23**2 + t27**2
+    t29 = -t26 + t25
+    t30 = t24**2 + t29**2
+    t31 = 1e-40*t0*t15
+    t32 = casadi.if_else((t28 <= t31), 0, casadi.atan2(t27, t23))
+    t33 = t32 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t32))
+    t34 = -mu3
+    t35 = -(t32 + t34 + t12)
+    t36 = t35 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t35))
+    t37 = -t36
+    t38 = 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t37)) + t36
+    t39 = casadi.if_else((t30 <= t31), 0, casadi.atan2(t29, t24))
+    t40 = t39 - 6.283185307179586*casadi.floor(0.15915494309189535*(0.8726646259971648 + t39))
+    t41 = -(t34 + t39 + t13)
+    t42 = t41 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t41))
+    t43 = -t42
+    t44 = 6.283185307179586*casadi.floor(0.15915494309189535*(6.283185307179586 + t43)) + t42
+    t45 = casadi.logic_and((t32 >= -0.8726646259971648), (t32 <= 0.8726646259971648))
+    t46 = (t33 <= 0.8726646259971648)
+    t47 = casadi.logic_and((t16 >= -1.53588974175501), (t16 <= 1.53588974175501))
+    t48 = (t17 <= 1.53588974175501)
+    t49 = -0.387 + mu2
+    t50 = -t49
+    t51 = casadi.logic_and((t37 >= -6.283185307179586), (t37 <= 6.283185307179586))
+    t52 = -t38
+    t53 = (t52 <= 6.283185307179586)
+    t54 = casadi.logic_and((t39 >= -0.8726646259971648), (t39 <= 0.8726646259971648))
+    t55 = (t40 <= 0.8726646259971648)
+    t56 = casadi.logic_and((t18 >= -1.53588974175501), (t18 <= 1.53588974175501))
+    t57 = (t19 <= 1.53588974175501)
+    t58 = casadi.logic_and((t43 >= -6.283185307179586), (t43 <= 6.283185307179586))
+    t59 = -t44
+    t60 = (t59 <= 6.283185307179586)
+    t61 = (casadi.fabs(t5) < casadi.inf)
+    t62 = (t49 <= 0.0)
+    t63 = (t50 <= 0.21)
     q = casadi.SX(2, 4)
-    q[0, 0] = casadi.if_else(casadi.logic_and(casadi.logic_not(t44), t45), t32, t31)
-    q[0, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t46), t47), t14, t13)
-    q[0, 2] = t49
-    q[0, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t50), t52), t51, t36)
-    q[1, 0] = casadi.if_else(casadi.logic_and(casadi.logic_not(t53), t54), t39, t38)
-    q[1, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t55), t56), t16, t15)
-    q[1, 2] = t49
-    q[1, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t57), t59), t58, t42)
+    q[0, 0] = casadi.if_else(casadi.logic_and(casadi.logic_not(t45), t46), t33, t32)
+    q[0, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t47), t48), t17, t16)
+    q[0, 2] = t50
+    q[0, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t51), t53), t52, t37)
+    q[1, 0] = casadi.if_else(casadi.logic_and(casadi.logic_not(t54), t55), t40, t39)
+    q[1, 1] = casadi.if_else(casadi.logic_and(casadi.logic_not(t56), t57), t19, t18)
+    q[1, 2] = t50
+    q[1, 3] = casadi.if_else(casadi.logic_and(casadi.logic_not(t58), t60), t59, t43)
     valid = casadi.SX(2, 1)
-    valid[0, 0] = casadi.logic_and(t60, (t2 >= -1e-12))
-    valid[1, 0] = casadi.logic_and(t60, t4)
+    valid[0, 0] = casadi.logic_and(t61, (t6 >= -1e-12))
+    valid[1, 0] = casadi.logic_and(t61, (t6 > 1e-12))
     in_limits = casadi.SX(2, 1)
-    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_or(t44, t45), casadi.logic_or(t46, t47)), t61), t62), casadi.logic_or(t50, t52))
-    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_or(t53, t54), casadi.logic_or(t55, t56)), t61), t62), casadi.logic_or(t57, t59))
+    in_limits[0, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_or(t45, t46), casadi.logic_or(t47, t48)), t62), t63), casadi.logic_or(t51, t53))
+    in_limits[1, 0] = casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_and(casadi.logic_or(t54, t55), casadi.logic_or(t56, t57)), t62), t63), casadi.logic_or(t58, t60))
     return [q, valid, in_limits]
 
 

@@ -99,7 +99,7 @@ int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_rea
 stanford_real stanford_ik_numeric_step(const stanford_real target[16], const stanford_real q[STANFORD_DOF], stanford_real damping, stanford_real q_start[STANFORD_DOF], stanford_real q_next[STANFORD_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1055 operations. */
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1030 operations. */
 void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUTIONS * STANFORD_DOF], int valid[STANFORD_MAX_IK_SOLUTIONS], int in_limits[STANFORD_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

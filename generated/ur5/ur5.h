@@ -99,7 +99,7 @@ int ur5_velocity_ik(const ur5_real q[UR5_DOF], const ur5_real mu_dot[UR5_TASK_DI
 ur5_real ur5_ik_numeric_step(const ur5_real target[16], const ur5_real q[UR5_DOF], ur5_real damping, ur5_real q_start[UR5_DOF], ur5_real q_next[UR5_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
- * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1210 operations. */
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; in_limits[i], i < 8. 1264 operations. */
 void ur5_ik_branches(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5_DOF], int valid[UR5_MAX_IK_SOLUTIONS], int in_limits[UR5_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

@@ -22,7 +22,7 @@ from jacgen.model.structure import (E_Z, SOLVERS, Geometry, Nominal, SolverInfo,
                                     nearest_class, readable)
 from jacgen.solvers import general6r
 from jacgen.solvers.ik_limits import limited
-from jacgen.solvers.subproblems import Angle, Subproblems, relative, times, times_transposed
+from jacgen.solvers.subproblems import Angle, Root, Subproblems, relative, times, times_transposed
 
 Matrix = sympy.Matrix
 
@@ -284,7 +284,8 @@ def _yaw_pitch_branches(sp: Subproblems, k: dict, target, form: ClosedForm, dof:
     (elbow) and SP1 (shoulder). A pitch beyond +-pi/2 has no solution."""
     g, point = sp.graph, tuple(target[:3])
     pitch_valid = g.relation("<=", g.call("Abs", target[3]), g.value(sympy.pi / 2))
-    approaches = sp.sp4(sp.vector((0, 0, 1)), k["tool_x"], k["h2"], sp.name(-g.call("sin", target[3])))
+    approaches = sp.sp4(sp.vector((0, 0, 1)), k["tool_x"], k["h2"], sp.name(-g.call("sin", target[3])),
+                        across=sp.name(g.call("cos", target[3])**2))
     branches = []
     for base in sp.sp4(sp.sub(point, k["p1"]), k["h2"], k["h1"], k["reach"]):
         w = sp.add(k["p1"], sp.turn(k["h1"], base.angle, sp.sub(point, k["p1"]), back=True))
@@ -362,7 +363,7 @@ def _spherical_wrist_prismatic_branches(sp: Subproblems, k: dict, target, form: 
     disc = sp.name(half**2 - rest)
     scale = sp.name(sp.dot(e, e) + sp.dot(d, d))
     two = g.relation(">", disc, g.symbol(EPS) * scale)
-    root = sp.name(g.select(two, g.sqrt(disc), g.number(0)))
+    root = sp.name(g.select(g.relation(">", disc, g.number(0)), g.sqrt(disc), g.number(0)))
     branches = []
     for t3, valid in ((sp.name(-half + root), g.relation(">=", disc, -g.symbol(EPS) * scale)), (sp.name(-half - root), two)):
         reached = sp.add(e, sp.scaled(k["h3"], t3))
@@ -385,8 +386,14 @@ def _three_parallel_branches(sp: Subproblems, k: dict, target, form: ClosedForm,
         g = sp.turn(k["h1"], t1.angle, h)
         w = sp.add(k["p1"], sp.turn(k["h1"], t1.angle, sp.sub(wc, k["p1"]), back=True))
         t6 = total = None  # set by the first root of q5
-        for j, t5 in enumerate(sp.sp4(h, k["h6"], k["h5"], sp.dot(g, a))):
+        ga = sp.cross(g, a)
+        wrists = sp.sp4(h, k["h6"], k["h5"], sp.dot(g, a), across=sp.dot(ga, ga))
+        for j, t5 in enumerate(wrists):
             if j == 1 and form.flip:
+                # The flipped wrist is another configuration (q4 and q6 turned by pi, the elbow
+                # elsewhere) also where the two roots of q5 meet: valid with the first, or a pose
+                # whose q5 is within 1e-6 of 0 or pi could find only the flip it cannot reach.
+                t5 = Root(t5.angle, wrists[0].valid)
                 t6, total = t6.turned_half(), total.turned_half()
             else:
                 t6 = sp.sp1(times_transposed(sp, R, g), sp.turn(k["h5"], t5.angle, h, back=True), k["h6"])

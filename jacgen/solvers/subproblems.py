@@ -99,13 +99,22 @@ class Subproblems:
         c, s = self.name(c), self.name(s)
         return Angle(self.graph.call("atan2", s, c), c, s)
 
+    def perpendicular(self, p: Vector, k: Vector) -> Vector:
+        """The part of p perpendicular to the unit axis k. Angles about k are read from it,
+        never from p . q - (k . p)(k . q): near the axis that difference cancels to rounding
+        noise, where the parts themselves keep their digits."""
+        kp = self.dot(k, p)
+        return self.vector(p[i] - kp * k[i] for i in range(3))
+
     def sp1(self, p: Vector, q: Vector, k: Vector) -> Angle:
         """SP1: the angle turning p into q about the unit axis k (least squares when they
-        differ in length or height along k); 0 when p or q lies on the axis (any angle would do)."""
+        differ in length or height along k); 0 when p or q lies on the axis (any angle would do:
+        the product of their distances from it below sqrt(TINY) times |p| |q|)."""
         g = self.graph
         zero, one = g.number(0), g.number(1)
-        x = self.name(self.dot(p, q) - self.dot(k, p) * self.dot(k, q))
-        y = self.dot(k, self.cross(p, q))
+        p_perp, q_perp = self.perpendicular(p, k), self.perpendicular(q, k)
+        x = self.dot(p_perp, q_perp)
+        y = self.dot(k, self.cross(p_perp, q_perp))
         rr = self.name(x * x + y * y)
         pq = self.name(self.dot(p, p) * self.dot(q, q))
         self._margin(lambda: g.select(g.relation(">", pq, zero), g.sqrt(rr / pq), zero))
@@ -114,17 +123,29 @@ class Subproblems:
         return Angle(g.select(free, zero, g.call("atan2", y, x)), self.name(g.select(free, one, x * scale)),
                      self.name(g.select(free, zero, y * scale)))
 
-    def sp4(self, h: Vector, p: Vector, k: Vector, d: Node) -> tuple[Root, Root]:
-        """SP4: the angles t with h . rot(k, t) p = d, (phi + alpha, phi - alpha).
+    def sp4(self, h: Vector, p: Vector, k: Vector, d: Node, across: Node | None = None,
+            spread: Node | None = None) -> tuple[Root, Root]:
+        """SP4: the angles t with h . rot(k, t) p = d, (phi + alpha, phi - alpha), for unit h
+        and k.
 
-        h . rot(k, t) p = A cos t + B sin t + C. A double root (sin(alpha)^2 within EPS of 0)
-        is the first root only; when the left side does not depend on t, the first root is
-        0 if it equals d."""
+        h . rot(k, t) p = A cos t + B sin t + C. Two roots within sqrt(EPS) of each other
+        (sin(alpha)^2 within EPS of 0) are one double root: the first, phi + alpha, alpha kept
+        as it is (it is not rounded to 0: a wrist near its singularity needs it); when the left
+        side does not depend on t, the first root is 0 if it equals d.
+
+        `across`, when the caller knows it, is |h x x|^2 for a vector x with |x| = |p| and
+        h . x = d (the direction that the rotation about k and one about h carry p to). Then
+        sin(alpha)^2 = (|h x k|^2 across - (k . p - (h . k) d)^2) / (A^2 + B^2), which keeps
+        its digits where alpha is small and an error in it moves the pose to first order (a
+        wrist axis nearly parallel to h); 1 - cos(alpha)^2 would leave alpha only
+        sqrt(rounding) ~ 1e-8. `spread` is (A^2 + B^2) sin(alpha)^2 itself, where the caller
+        has a form without cancellation (`sp3`)."""
         g = self.graph
         zero, one = g.number(0), g.number(1)
         hk, kp = self.dot(h, k), self.dot(k, p)
-        a = self.name(self.dot(h, p) - hk * kp)
-        b = self.dot(h, self.cross(k, p))
+        h_perp, p_perp = self.perpendicular(h, k), self.perpendicular(p, k)
+        a = self.dot(h_perp, p_perp)
+        b = self.dot(h, self.cross(k, p_perp))
         rhs = self.name(d - hk * kp)
         r2 = self.name(a * a + b * b)
         scale = self.name(self.dot(h, h) * self.dot(p, p))
@@ -133,12 +154,15 @@ class Subproblems:
         inverse_r = self.name(g.select(constant, one, 1 / g.sqrt(r2)))
         cos_phi, sin_phi = self.name(a * inverse_r), self.name(b * inverse_r)
         cos_alpha = self.name(rhs * inverse_r)
-        disc = self.name(1 - cos_alpha**2)
+        if spread is None and across is not None:
+            hxk = self.cross(h, k)
+            spread = self.dot(hxk, hxk) * across - (kp - hk * d)**2
+        disc = self.name(1 - cos_alpha**2 if spread is None else spread * inverse_r**2)
         self._margin(lambda: g.call("Abs", disc))
-        two = g.relation(">", disc, self.eps)
-        # a double root: cos(alpha) = +-1, sin(alpha) = 0
-        cos_alpha = self.name(g.select(two, cos_alpha, g.select(g.relation(">", cos_alpha, zero), one, -one)))
-        sin_alpha = self.name(g.select(two, g.sqrt(disc), zero))
+        two, real = g.relation(">", disc, self.eps), g.relation(">", disc, zero)
+        # beyond a double root (cos(alpha) = +-1 to rounding): sin(alpha) = 0
+        cos_alpha = self.name(g.select(real, cos_alpha, g.select(g.relation(">", cos_alpha, zero), one, -one)))
+        sin_alpha = self.name(g.select(real, g.sqrt(disc), zero))
         phi, alpha = self.name(g.call("atan2", b, a)), self.name(g.call("atan2", sin_alpha, cos_alpha))
         plus = Angle(self.name(g.select(constant, zero, phi + alpha)),
                      self.name(g.select(constant, one, cos_phi * cos_alpha - sin_phi * sin_alpha)),
@@ -150,13 +174,25 @@ class Subproblems:
         return Root(plus, plus_valid), Root(minus, g.logic(AND, g.negation(constant), two))
 
     def sp3(self, p: Vector, q: Vector, k: Vector, dd: Node) -> tuple[Root, Root]:
-        """SP3: the angles t with |rot(k, t) p - q|^2 = dd (p, q relative to a point of the axis)."""
-        return self.sp4(q, p, k, self.name((self.dot(p, p) + self.dot(q, q) - dd) / 2))
+        """SP3: the angles t with |rot(k, t) p - q|^2 = dd (p, q relative to a point of the axis).
+
+        Across k, the distances |p_perp|, |q_perp| from the axis and c, the one asked between
+        the two points, are a triangle, and (A^2 + B^2) sin(alpha)^2 is 4 times its area squared
+        (Heron's product): it keeps its digits where c is small (a folded arm whose two links
+        are equal, a target near the base), where 1 - cos(alpha)^2 would lose them."""
+        g = self.graph
+        a = self.name(g.sqrt(self.dot(*[self.perpendicular(p, k)] * 2)))
+        b = self.name(g.sqrt(self.dot(*[self.perpendicular(q, k)] * 2)))
+        cc = self.name(dd - (self.dot(k, p) - self.dot(k, q))**2)
+        c = self.name(g.select(g.relation(">", cc, g.number(0)), g.sqrt(cc), g.number(0)))
+        spread = self.name((c - a + b) * (c + a - b) * (a + b - c) * (a + b + c) / 4)
+        return self.sp4(q, p, k, self.name((self.dot(p, p) + self.dot(q, q) - dd) / 2), spread=spread)
 
     def sp2(self, p: Vector, q: Vector, k1: Vector, k2: Vector) -> tuple[tuple[Angle, Angle, Node], ...]:
         """SP2: the angle pairs (t1, t2, valid) with rot(k1, t1) rot(k2, t2) p = q, for two axes
         through one point (p, q relative to it): rot(k2, t2) p = rot(k1, -t1) q = c,
-        c = alpha k1 + beta k2 +- gamma k1 x k2. One pair when gamma^2 is within EPS of 0."""
+        c = alpha k1 + beta k2 +- gamma k1 x k2. One pair when gamma^2 is within EPS |p|^2 of 0
+        (gamma kept as it is, as alpha in `sp4`)."""
         g = self.graph
         zero = g.number(0)
         k12 = self.dot(k1, k2)
@@ -164,10 +200,17 @@ class Subproblems:
         u, v = self.dot(k1, q), self.dot(k2, p)
         alpha, beta = self.name((u - k12 * v) / nn), self.name((v - k12 * u) / nn)
         pp = self.dot(p, p)
-        gg = self.name((pp - alpha**2 - beta**2 - 2 * alpha * beta * k12) / nn)
+        # nn gamma^2 = |c|^2 - |alpha k1 + beta k2|^2 = |k1 x q|^2 - nn beta^2 = |k2 x p|^2 - nn alpha^2
+        # (c turns into q about k1 and from p about k2). The smaller cross product is the form that
+        # keeps its digits where q nears k1 or p nears k2 (a wrist near its singularity, two axes
+        # lining up), where |p|^2 - u^2 - ... would leave gamma only sqrt(rounding) ~ 1e-8.
+        k1q, k2p = self.cross(k1, q), self.cross(k2, p)
+        q_across, p_across = self.dot(k1q, k1q), self.dot(k2p, k2p)
+        gg = self.name(g.select(g.relation("<", p_across, q_across), p_across - nn * alpha**2,
+                                q_across - nn * beta**2) / nn)
         self._margin(lambda: g.select(g.relation(">", pp, zero), g.call("Abs", gg) / pp, zero))
         two = g.relation(">", gg, self.eps * pp)
-        gamma = self.name(g.select(two, g.sqrt(gg), zero))
+        gamma = self.name(g.select(g.relation(">", gg, zero), g.sqrt(gg), zero))
         normal = self.cross(k1, k2)
         pairs = []
         for sign, valid in ((1, g.relation(">=", gg, -self.eps * pp)), (-1, two)):
