@@ -6,7 +6,8 @@ pi + 10^-k (k = 3 ... 15), for every shipped special class, in numpy (one batch)
 - Every pose has a solution.
 
 Closer to a singularity the split of a nearly free angle is not fixed by the pose to 1e-6, so
-only the pose error is asked there (the native module: tests/test_native.py).
+only the pose error is asked there. The native module prints the same graph; it is not run
+on these poses here.
 """
 
 import numpy as np

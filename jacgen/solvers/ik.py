@@ -363,7 +363,7 @@ def _spherical_wrist_prismatic_branches(sp: Subproblems, k: dict, target, form: 
     disc = sp.name(half**2 - rest)
     scale = sp.name(sp.dot(e, e) + sp.dot(d, d))
     two = g.relation(">", disc, g.symbol(EPS) * scale)
-    root = sp.name(g.select(g.relation(">", disc, g.number(0)), g.sqrt(disc), g.number(0)))
+    root = sp.name(sp.clamped_sqrt(disc))
     branches = []
     for t3, valid in ((sp.name(-half + root), g.relation(">=", disc, -g.symbol(EPS) * scale)), (sp.name(-half - root), two)):
         reached = sp.add(e, sp.scaled(k["h3"], t3))

@@ -99,6 +99,11 @@ class Subproblems:
         c, s = self.name(c), self.name(s)
         return Angle(self.graph.call("atan2", s, c), c, s)
 
+    def clamped_sqrt(self, value: Node) -> Node:
+        """sqrt(value), 0 where value is not positive (a root the target does not allow)."""
+        g = self.graph
+        return g.select(g.relation(">", value, g.number(0)), g.sqrt(value), g.number(0))
+
     def perpendicular(self, p: Vector, k: Vector) -> Vector:
         """The part of p perpendicular to the unit axis k. Angles about k are read from it,
         never from p . q - (k . p)(k . q): near the axis that difference cancels to rounding
@@ -162,7 +167,7 @@ class Subproblems:
         two, real = g.relation(">", disc, self.eps), g.relation(">", disc, zero)
         # beyond a double root (cos(alpha) = +-1 to rounding): sin(alpha) = 0
         cos_alpha = self.name(g.select(real, cos_alpha, g.select(g.relation(">", cos_alpha, zero), one, -one)))
-        sin_alpha = self.name(g.select(real, g.sqrt(disc), zero))
+        sin_alpha = self.name(self.clamped_sqrt(disc))
         phi, alpha = self.name(g.call("atan2", b, a)), self.name(g.call("atan2", sin_alpha, cos_alpha))
         plus = Angle(self.name(g.select(constant, zero, phi + alpha)),
                      self.name(g.select(constant, one, cos_phi * cos_alpha - sin_phi * sin_alpha)),
@@ -180,11 +185,10 @@ class Subproblems:
         the two points, are a triangle, and (A^2 + B^2) sin(alpha)^2 is 4 times its area squared
         (Heron's product): it keeps its digits where c is small (a folded arm whose two links
         are equal, a target near the base), where 1 - cos(alpha)^2 would lose them."""
-        g = self.graph
-        a = self.name(g.sqrt(self.dot(*[self.perpendicular(p, k)] * 2)))
-        b = self.name(g.sqrt(self.dot(*[self.perpendicular(q, k)] * 2)))
-        cc = self.name(dd - (self.dot(k, p) - self.dot(k, q))**2)
-        c = self.name(g.select(g.relation(">", cc, g.number(0)), g.sqrt(cc), g.number(0)))
+        p_perp, q_perp = self.perpendicular(p, k), self.perpendicular(q, k)
+        a = self.name(self.graph.sqrt(self.dot(p_perp, p_perp)))
+        b = self.name(self.graph.sqrt(self.dot(q_perp, q_perp)))
+        c = self.name(self.clamped_sqrt(self.name(dd - (self.dot(k, p) - self.dot(k, q))**2)))
         spread = self.name((c - a + b) * (c + a - b) * (a + b - c) * (a + b + c) / 4)
         return self.sp4(q, p, k, self.name((self.dot(p, p) + self.dot(q, q) - dd) / 2), spread=spread)
 
@@ -210,7 +214,7 @@ class Subproblems:
                                 q_across - nn * beta**2) / nn)
         self._margin(lambda: g.select(g.relation(">", pp, zero), g.call("Abs", gg) / pp, zero))
         two = g.relation(">", gg, self.eps * pp)
-        gamma = self.name(g.select(g.relation(">", gg, zero), g.sqrt(gg), zero))
+        gamma = self.name(self.clamped_sqrt(gg))
         normal = self.cross(k1, k2)
         pairs = []
         for sign, valid in ((1, g.relation(">=", gg, -self.eps * pp)), (-1, two)):
