@@ -97,7 +97,7 @@ def measure(robot, folder: Path, q: np.ndarray, sources: Path | None) -> dict[st
                 scalar_name(robot): getattr(reference, scalar_name(robot))(robot, q)[:, None]}
     figures = {}
     for name, value in expected.items():
-        found = emulator.evaluate(name, q)
+        found = np.hstack([np.reshape(part, (len(q), -1)) for part in emulator.results(name, q)])
         error = np.max(np.abs(found - value) / (1 + np.abs(value)))
         if not error <= VERIFIED["float"] * (1 + robot.reach):  # `jacgen verify`'s float tolerance
             raise SystemExit(f"{robot.name} {name} ({'casadi' if sources else 'jacgen'}): off by {error:.1e}")

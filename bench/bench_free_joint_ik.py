@@ -38,6 +38,7 @@ import common
 from common import kinematic_chain
 from jacgen.checking import reference
 from jacgen.checking.c_library import CLibrary
+from jacgen.emission.generator import Generator
 from jacgen.inputs.robot import parse_robot
 
 FREE_VALUE = {"panda": np.pi / 4, "iiwa": 0.3}
@@ -71,7 +72,8 @@ def run(robot, count: int, rounds: int, folder: Path) -> list[tuple[str, float, 
 
     code = common.generate(robot, folder, ("c", "python"))
     source = code / f"{robot.name}.c"
-    library = CLibrary(common.shared_library(source), robot, [], "double")
+    library = CLibrary(common.shared_library(source), robot,
+                       Generator(robot, selection=("ik", "ik_numeric")).signatures(), "double")
     module = common.load_module(code / f"{robot.name}.py")
     rows = []
 
@@ -85,7 +87,7 @@ def run(robot, count: int, rounds: int, folder: Path) -> list[tuple[str, float, 
         pose[...] = T
         return function(pose_address, angle, out_address)
     ctypes_micros = common.per_call(call, list(zip(targets, frees)), rounds) * 1e6
-    ours = [library.ik(T, 8, None, angle) for T, angle in zip(targets, frees)]
+    ours = [q[:count] for q, count in (library.call("ik", T, angle) for T, angle in zip(targets, frees))]
     measured = quality(robot, q, targets, ours)
     rows += [("C native", micros, measured), ("C via ctypes", ctypes_micros, measured)]
 
@@ -113,9 +115,9 @@ def run(robot, count: int, rounds: int, folder: Path) -> list[tuple[str, float, 
 
     if robot.name == "iiwa":
         starts = q + 0.1 * rng.choice([-1.0, 1.0], size=q.shape)
-        runs = [library.ik_numeric(T, start, 100, 1e-12) for T, start in zip(targets, starts)]
+        runs = [library.call("ik_numeric", T, start, 100, 1e-12) for T, start in zip(targets, starts)]
         found = [[x] if status == 0 else [] for x, status in runs]
-        rows.append(("ik_numeric", common.per_call(lambda T, start: library.ik_numeric(T, start, 100, 1e-12),
+        rows.append(("ik_numeric", common.per_call(lambda T, start: library.call("ik_numeric", T, start, 100, 1e-12),
                                                    list(zip(targets, starts)), rounds) * 1e6,
                      quality(robot, q, targets, found)))
     return rows

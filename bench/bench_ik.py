@@ -46,6 +46,7 @@ import common
 from common import kinematic_chain, without_limits
 from jacgen.checking import reference
 from jacgen.checking.c_library import CLibrary
+from jacgen.emission.generator import Generator
 from jacgen.solvers.ik import closed_form
 from jacgen.solvers.model import Model
 from jacgen.inputs.robot import load_robot
@@ -109,10 +110,10 @@ def _general_arm(name: str):
     return load_robot(path if path.exists() else common.ROOT / "tests" / "data" / "calibrated" / f"{name}.yaml")
 
 
-def valid_rows(library: CLibrary, T: np.ndarray, free: dict) -> np.ndarray:
+def valid_rows(library: CLibrary, T: np.ndarray, free: tuple) -> np.ndarray:
     """The solutions of NAME_ik_branches at T, inside the joint limits or not (as numpy's and
     ssik's are counted)."""
-    branches, valid, _ = library.ik_branches(T, 16, **free)
+    branches, valid, _ = library.call("ik_branches", T, *free)
     return branches[valid.astype(bool)]
 
 
@@ -125,13 +126,14 @@ def general_table(targets_count: int, rounds: int, folder: Path) -> None:
     for name in GENERAL:
         robot = _general_arm(name)
         code = common.generate(robot, folder, ("c", "python"))
-        library = CLibrary(common.shared_library(code / f"{name}.c"), robot, [], "double")
+        library = CLibrary(common.shared_library(code / f"{name}.c"), robot,
+                           Generator(robot, selection=("ik_branches",)).signatures(), "double")
         module = common.load_module(code / f"{name}.py")
         q = np.random.default_rng(5).uniform(-np.pi, np.pi, (targets_count, robot.dof))
         targets = reference.fk(robot, q)
         form = Model(robot).closed_form
         frees = None if form.free is None else q[:, form.free]  # a 7R arm: the free joint's angle
-        free = (lambda k: {}) if frees is None else (lambda k: {"q_free": frees[k]})
+        free = (lambda k: ()) if frees is None else (lambda k: (frees[k],))
         rows = {}
         micros, _ = common.native_ik(robot, code / f"{name}.c", targets, rounds, folder, frees)
         fast = form.fast_path
@@ -140,7 +142,8 @@ def general_table(targets_count: int, rounds: int, folder: Path) -> None:
         if fast:
             alone = replace(robot, name=f"{name}_eigen", nearest_class=False)
             source = common.generate(alone, folder) / f"{alone.name}.c"
-            alone_library = CLibrary(common.shared_library(source), alone, [], "double")
+            alone_library = CLibrary(common.shared_library(source), alone,
+                                     Generator(alone, selection=("ik_branches",)).signatures(), "double")
             micros, _ = common.native_ik(alone, source, targets, rounds, folder, frees)
             rows["C native, eigenproblem only"] = (micros, [valid_rows(alone_library, T, free(k))
                                                             for k, T in enumerate(targets)])

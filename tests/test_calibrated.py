@@ -96,10 +96,10 @@ def test_numpy_finds_what_the_eigenproblem_finds(name, generated):
 @pytest.mark.parametrize("name", ARMS)
 def test_c_finds_what_its_eigenproblem_finds(name, generated):
     arm = ARMS[name]
-    fast = generated(arm, ("c",), functions=("ik_branches",)).library()
-    general = generated(_eigenproblem_only(arm), ("c",), functions=("ik_branches",)).library()
+    fast = generated(arm, ("c",), functions=("ik_branches",)).library("ik_branches")
+    general = generated(_eigenproblem_only(arm), ("c",), functions=("ik_branches",)).library("ik_branches")
     poses = np.concatenate([_random_poses(arm, 1400, 3), _near_singular_poses(arm, 100, 4)])
-    ours, theirs = zip(*([fast.ik_branches(T, 16)[:2], general.ik_branches(T, 16)[:2]] for T in poses))
+    ours, theirs = zip(*([fast.call("ik_branches", T)[:2], general.call("ik_branches", T)[:2]] for T in poses))
     q, valid = map(np.array, zip(*ours))
     assert _differences(q, valid, *map(np.array, zip(*theirs))) == (0, 0)
     reached = np.abs(reference.fk(arm, q) - poses[:, None]).max(axis=(-2, -1))

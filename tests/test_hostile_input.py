@@ -149,7 +149,7 @@ def test_twelve_joints_fk_is_right(generated):
     expected = reference.fk(robot, q)
     assert np.abs(code.python.fk(q) - expected).max() < 1e-12
     assert np.abs(code.python.fk(q[0]) - expected[0]).max() < 1e-12
-    c = code.library(code.generator.functions()).evaluate("fk", q).reshape(expected.shape)
+    c = code.library("fk").evaluate("fk", q).reshape(expected.shape)
     assert np.abs(c - expected).max() < 1e-12
 
 
@@ -166,7 +166,7 @@ def test_parameter_only_entries_batch(generated):
     other = reference.fk(parse_robot(PARAMETER_ONLY.replace("0.14", "0.3").encode(), "arm.yaml"), q)
     assert np.abs(code.python.fk(q, L=0.3) - other).max() < 1e-14
     assert np.abs(code.python.fk(q, L=np.full(5, 0.3)) - other).max() < 1e-14
-    c = code.library(code.generator.functions()).evaluate("fk", q).reshape(expected.shape)
+    c = code.library("fk").evaluate("fk", q).reshape(expected.shape)
     assert np.abs(c - expected).max() < 1e-14
 
 
@@ -296,7 +296,7 @@ def test_fuzz_robot_files(tmp_path_factory, text):
     robot = load_robot(path)
     built = folder / "out" / robot.name
     library = compile_shared([built / f"{robot.name}.c"], folder / f"lib{robot.name}.so")
-    backends = GeneratedCode(robot, Generator(robot, selection=("fk", "jacobian")).functions(), folder / "out",
+    backends = GeneratedCode(robot, Generator(robot, selection=("fk", "jacobian")).signatures(), folder / "out",
                              {"double": library})
     ranges = np.array(robot.ranges)
     q = np.random.default_rng(0).uniform(ranges[:, 0], ranges[:, 1], (6, robot.dof))

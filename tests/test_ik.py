@@ -17,8 +17,10 @@ from ik_geo import Robot as IkGeoRobot
 
 from jacgen.checking import reference
 from jacgen.inputs.robot import parse_robot
+from jacgen.solvers.differential import IK_NUMERIC_DEFAULTS
 
 from conftest import random_configurations, robot
+from support.generated import c_ik
 from support.ik import kinematic_chain, regular, target_error, wrapped_distance
 
 WITH_IK = ["planar_2r", "planar_3r", "scara", "rexarm", "puma560", "kr5", "stanford", "ur5"]
@@ -204,7 +206,12 @@ RANDOM_CLASSES = ["planar_2r", "planar_3r", "scara", "yaw_pitch", "spherical_wri
 def _c_ik(generated, arm, real):
     """A function target -> solutions (k, n) calling the C NAME_ik of `arm` (ik and its
     callees, compiled with the contract's warning flags)."""
-    return functools.partial(generated(arm, ("c",), real, ("ik",)).library().ik, max_solutions=8)
+    return functools.partial(c_ik, generated(arm, ("c",), real, ("ik",)).library("ik"))
+
+
+def _c_ik_numeric(library, target, q0, max_iter=IK_NUMERIC_DEFAULTS["max_iter"], tol=IK_NUMERIC_DEFAULTS["tol"]):
+    """NAME_ik_numeric from q0: (q, status), with the generated Python's defaults."""
+    return library.call("ik_numeric", target, q0, max_iter, tol)
 
 
 def _reference_targets(arm):
@@ -272,9 +279,9 @@ def c_solvers(request, generated):
     for name in WITH_IK + FREE_JOINT:
         code = generated.committed(name) if real == "double" else generated(robot(name), ("c",), real,
                                                                             ("ik", "ik_numeric"))
-        library = code.library()
-        closed = functools.partial(library.ik, max_solutions=8) if name in WITH_IK else None  # see test_free_joint
-        solvers[name] = (closed, library.ik_numeric)
+        library = code.library(*(("ik", "ik_numeric") if name in WITH_IK else ("ik_numeric",)))
+        closed = functools.partial(c_ik, library) if name in WITH_IK else None  # see test_free_joint
+        solvers[name] = (closed, functools.partial(_c_ik_numeric, library))
     return real, solvers
 
 
@@ -346,7 +353,7 @@ def test_runtime_parameters(generated):
     text = open(robot("puma560").source).read().replace("name: puma560", "name: puma_runtime")
     text = text.replace("  d3: 0.15005 ", "  d3: {value: 0.15005, symbolic: true} ")
     code = generated(parse_robot(text.encode()), ("python", "c"))
-    arm, module, library = code.robot, code.python, code.library()
+    arm, module, library = code.robot, code.python, code.library("ik")
     q = random_configurations(robot("puma560"), 20, seed=18)
     for d3 in (0.15005, 0.3):
         for row in q:
@@ -354,5 +361,5 @@ def test_runtime_parameters(generated):
             assert len(module.ik(T, limits=False, d3=d3)) == 8
             found = module.ik(T, d3=d3)  # inside the limits, as the C returns them
             assert wrapped_distance(arm, found, row).min() < 1e-7
-            in_c = library.ik(T, 8, {"d3": d3})
+            in_c = c_ik(library, T, parameters={"d3": d3})
             assert in_c.shape == found.shape and np.abs(in_c - found).max() < 1e-9

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from jacgen.checking import reference
+from jacgen.solvers.differential import IK_NUMERIC_DEFAULTS
 
 from conftest import ROBOT_NAMES, random_configurations, robot
 from support.ik import reference_js, regular, target_error, without_limits, wrapped_distance
@@ -37,15 +38,15 @@ def backends(generated):
         module, calls = code.python, code.backends
 
         def solve(backend):
-            return lambda targets: calls.ik(backend, np.asarray(targets), None, module.MAX_IK_SOLUTIONS)[0]
+            return lambda targets: calls.ik(backend, np.asarray(targets), None)[0]
 
         def numeric(backend):
-            return lambda target, q0: tuple(v[0] for v in calls.ik_numeric(backend, np.asarray(target)[None],
-                                                                             np.asarray(q0)[None]))
+            return lambda target, q0: tuple(v[0] for v in calls.call(backend, "ik_numeric", np.asarray(target)[None],
+                                                                     np.asarray(q0)[None], *IK_NUMERIC_DEFAULTS.values()))
 
         def velocity(backend):
-            return lambda q, mu_dot, damping: tuple(v[0] for v in calls.velocity_ik(
-                backend, np.asarray(q)[None], np.asarray(mu_dot)[None], damping))
+            return lambda q, mu_dot, damping: tuple(v[0] for v in calls.call(
+                backend, "velocity_ik", np.asarray(q)[None], np.asarray(mu_dot)[None], damping))
 
         return arm, {
             "numpy": lambda targets: [module.ik(t) for t in targets],
@@ -259,7 +260,7 @@ def test_velocity_ik_of_every_shipped_robot(generated, name):
     forms with and without damping. Js here is made from the reference's geometric Jacobian
     alone (support.ik.reference_js), not taken from the reference's singularity_jacobian."""
     code = generated.committed(name)
-    arm, module, library = code.robot, code.python, code.library()
+    arm, module, library = code.robot, code.python, code.library("velocity_ik")
     assert (module.VELOCITY_IK_OK, module.VELOCITY_IK_SINGULAR, module.VELOCITY_IK_NOT_FINITE) == (0, 1, 2)
     q = random_configurations(arm, 20, seed=8)
     mu_dot = np.random.default_rng(1).normal(size=(20, len(arm.task)))
@@ -273,7 +274,7 @@ def test_velocity_ik_of_every_shipped_robot(generated, name):
         np.testing.assert_allclose(rates, np.linalg.pinv(js) @ target, atol=1e-9)
         np.testing.assert_allclose(damped_rates, _expected_rates(js, target, DAMPING), atol=1e-9)
         for damping in (0.0, DAMPING):
-            c_rates, c_status = library.velocity_ik(x, target, damping)
+            c_rates, c_status = library.call("velocity_ik", x, target, damping)
             assert c_status == 0
             np.testing.assert_allclose(c_rates, _expected_rates(js, target, damping), atol=1e-9)
 

@@ -53,8 +53,7 @@ def test_exact_up_to_the_singularity(generated, name, backend):
     free = getattr(code.python, "IK_FREE_JOINT", None)
     q, joints, exponents = near_singular(arm, free)
     targets = reference.ik_target(arm, q)
-    solutions, _ = code.backends.ik(backend, targets, None if free is None else q[:, free],
-                                    code.python.MAX_IK_SOLUTIONS)
+    solutions, _ = code.backends.ik(backend, targets, None if free is None else q[:, free])
     scale = 1 + arm.reach
     for row, found in enumerate(solutions):
         where = f"{name} {backend}: joint {joints[row] + 1} at {q[row, joints[row]]!r} (k = {exponents[row]})"
@@ -73,6 +72,6 @@ def test_the_ur5_pose_that_broke_the_wrist_rule(generated):
     q = np.array([-0.479485, -1.968904, -2.353171, -0.967762, 6.77e-7, 1.494600])
     target = reference.fk(arm, q)
     for backend in BACKENDS:
-        [found], _ = code.backends.ik(backend, target[None], None, code.python.MAX_IK_SOLUTIONS)
+        [found], _ = code.backends.ik(backend, target[None], None)
         assert target_error(arm, reference.fk(arm, found), target).max() <= TOLERANCE * (1 + arm.reach)
         assert wrapped_distance(arm, found, q).min() <= 1e-9, backend

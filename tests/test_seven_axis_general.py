@@ -65,11 +65,11 @@ def test_numpy_recovers_every_configuration(name):
 @pytest.mark.parametrize("name", ARMS)
 def test_c_recovers_every_configuration(name, generated):
     arm = robot(name)
-    library = generated.committed(name).library()
+    library = generated.committed(name).library("ik_branches")
     q = _configurations(300, 2)
     poses = reference.fk(arm, q)
     for k in range(len(q)):
-        branches, valid, _ = library.ik_branches(poses[k], 16, q_free=q[k, FREE])
+        branches, valid, _ = library.call("ik_branches", poses[k], q[k, FREE])
         found = branches[valid.astype(bool)]
         assert min(np.abs(wrapped(s - q[k])).max() for s in found) < 1e-8
         assert max(np.abs(reference.fk(arm, s) - poses[k]).max() for s in found) < 1e-9 * (1 + arm.reach)

@@ -16,10 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from jacgen.emission.catalogue import Function
+from jacgen.emission.catalogue import Signature
 from jacgen.errors import JacgenError
 from jacgen.inputs.robot import Robot
-from jacgen.solvers.differential import IK_NUMERIC_DEFAULTS
 
 # contract §3: the generated C compiles without a warning under these flags.
 WARNING_FLAGS = ("-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Wconversion", "-Wshadow",
@@ -82,14 +81,15 @@ def first_error(output: str) -> str:
 
 
 class CLibrary:
-    """One robot's compiled functions (`NAME_fk`, ...), called on numpy arrays."""
+    """One robot's compiled functions (`NAME_fk`, ...), called on numpy arrays: any function the
+    catalogue declares (`signatures`: the straight-line ones and the loops), the same way."""
 
-    def __init__(self, path: Path, robot: Robot, functions: list[Function], real: str):
+    def __init__(self, path: Path, robot: Robot, signatures: list[Signature], real: str):
         self.robot, self.real = robot, real
         self.dtype = NUMPY_TYPES[real]
         scalar = C_TYPES[real]
         self._library = ctypes.CDLL(str(path))
-        self._functions = {f.name: f for f in functions}
+        self._signatures = {f.name: f for f in signatures}
         self._parameters = None  # the ctypes struct NAME_params
         pointer = ctypes.POINTER(scalar)
         extra = []
@@ -97,11 +97,13 @@ class CLibrary:
             fields = [(p.name, scalar) for p in robot.symbolic_parameters]
             self._parameters = type(f"{robot.name}_params", (ctypes.Structure,), {"_fields_": fields})
             extra = [ctypes.POINTER(self._parameters)]
-        for function in functions:
+        for function in signatures:
             symbol = getattr(self._library, f"{robot.name}_{function.name}")
             returned = function.returned
-            outputs = [ctypes.POINTER(ctypes.c_int) if o.boolean else pointer for o in function.outputs if o is not returned]
-            symbol.argtypes = [scalar if a.scalar else pointer for a in function.arguments] + outputs + extra
+            outputs = [ctypes.POINTER(ctypes.c_int) if o.boolean or o.integer else pointer
+                       for o in function.outputs if o is not returned]
+            symbol.argtypes = [(ctypes.c_int if a.integer else scalar) if a.scalar else pointer
+                               for a in function.arguments] + outputs + extra
             symbol.restype = None if returned is None else ctypes.c_int if returned.integer or returned.boolean else scalar
 
     def evaluate(self, name: str, q: np.ndarray, *more: np.ndarray,
@@ -112,20 +114,30 @@ class CLibrary:
 
         Symbolic parameters take their nominal values unless given in `parameters`.
         """
-        function = self._functions[name]
-        symbol = getattr(self._library, f"{self.robot.name}_{name}")
-        extra = self._extra(parameters)
-        inputs = [np.ascontiguousarray(array, dtype=self.dtype) for array in (q, *more)]
-        starts = np.cumsum([0] + [output.size for output in function.outputs])
-        results = np.empty((len(inputs[0]), starts[-1]), dtype=self.dtype)
-        pointer = ctypes.POINTER(C_TYPES[self.real])
-        for k, out in enumerate(results):
-            arguments = [array[k].ctypes.data_as(pointer) for array in inputs]
-            if function.scalar:
-                out[0] = symbol(*arguments, *extra)
-            else:
-                symbol(*arguments, *(out[start:].ctypes.data_as(pointer) for start in starts[:-1]), *extra)
-        return results.astype(np.float64)
+        rows = [self.call(name, *arguments, parameters=parameters) for arguments in zip(q, *more)]
+        return np.array([np.concatenate([np.ravel(value) for value in row]) for row in rows],
+                        dtype=np.float64).reshape(len(q), -1)
+
+    def call(self, name: str, *arguments, parameters: dict[str, float] | None = None) -> tuple:
+        """One call of `NAME_name` with the function's arguments in order (arrays of any shape
+        holding their values, scalars as numbers): its results in the catalogue's order, each
+        in its numpy shape (a returned scalar as a number; truth values and statuses as ints).
+
+        Symbolic parameters take their nominal values unless given in `parameters`.
+        """
+        function = self._signatures[name]
+        real = C_TYPES[self.real]
+        given = [(ctypes.c_int if argument.integer else real)(value) if argument.scalar else
+                 np.ascontiguousarray(np.ravel(value), dtype=self.dtype)
+                 for argument, value in zip(function.arguments, arguments, strict=True)]
+        returned = function.returned
+        arrays = {output.name: np.zeros(output.size, dtype=np.intc if output.boolean or output.integer else self.dtype)
+                  for output in function.outputs if output is not returned}
+        value = getattr(self._library, f"{self.robot.name}_{name}")(
+            *(argument if isinstance(argument, ctypes._SimpleCData) else _pointer(argument) for argument in given),
+            *(_pointer(array) for array in arrays.values()), *self._extra(parameters))
+        return tuple(value if output is returned else _widened(arrays[output.name]).reshape(output.shape)
+                     for output in function.outputs)
 
     def _extra(self, parameters: dict[str, float] | None = None) -> list:
         """The trailing `const NAME_params *p` argument, if the robot has runtime parameters."""
@@ -134,67 +146,13 @@ class CLibrary:
         values = {p.name: p.value for p in self.robot.symbolic_parameters} | (parameters or {})
         return [ctypes.byref(self._parameters(*(values[p.name] for p in self.robot.symbolic_parameters)))]
 
-    def ik(self, target: np.ndarray, max_solutions: int, parameters: dict[str, float] | None = None,
-           q_free: float | None = None) -> np.ndarray:
-        """`NAME_ik` for one target (4x4 pose or task vector) and, with a free joint, its
-        angle: the solutions, (k, dof)."""
-        pointer = ctypes.POINTER(C_TYPES[self.real])
-        target = np.ascontiguousarray(np.ravel(target), dtype=self.dtype)
-        solutions = np.zeros(max_solutions * self.robot.dof, dtype=self.dtype)
-        free = [] if q_free is None else [C_TYPES[self.real](q_free)]
-        count = getattr(self._library, f"{self.robot.name}_ik")(target.ctypes.data_as(pointer), *free,
-                                                                 solutions.ctypes.data_as(pointer),
-                                                                 *self._extra(parameters))
-        return solutions[: count * self.robot.dof].reshape(count, self.robot.dof).astype(np.float64)
 
-    def ik_branches(self, target: np.ndarray, max_solutions: int,
-                    q_free: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """`NAME_ik_branches` for one target: every branch (max_solutions, dof), and whether
-        each is valid and inside the limits."""
-        pointer = ctypes.POINTER(C_TYPES[self.real])
-        target = np.ascontiguousarray(np.ravel(target), dtype=self.dtype)
-        q = np.zeros(max_solutions * self.robot.dof, dtype=self.dtype)
-        valid, in_limits = (np.zeros(max_solutions, dtype=np.intc) for _ in range(2))
-        free = [] if q_free is None else [C_TYPES[self.real](q_free)]
-        flags = ctypes.POINTER(ctypes.c_int)
-        getattr(self._library, f"{self.robot.name}_ik_branches")(
-            target.ctypes.data_as(pointer), *free, q.ctypes.data_as(pointer), valid.ctypes.data_as(flags),
-            in_limits.ctypes.data_as(flags), *self._extra())
-        return q.reshape(max_solutions, self.robot.dof).astype(np.float64), valid, in_limits
+def _pointer(array: np.ndarray):
+    """A C pointer to a numpy array's first element, of its type."""
+    kind = {np.dtype(np.intc): ctypes.c_int, np.dtype(np.float64): ctypes.c_double, np.dtype(np.float32): ctypes.c_float}
+    return array.ctypes.data_as(ctypes.POINTER(kind[array.dtype]))
 
-    def ik_nearest(self, target: np.ndarray, q_seed: np.ndarray, weights: np.ndarray,
-                   q_free: float | None = None) -> tuple[np.ndarray, int]:
-        """`NAME_ik_nearest`: (q, status)."""
-        pointer = ctypes.POINTER(C_TYPES[self.real])
-        target, q_seed, weights = (np.ascontiguousarray(np.ravel(a), dtype=self.dtype) for a in (target, q_seed, weights))
-        q = np.zeros(self.robot.dof, dtype=self.dtype)
-        free = [] if q_free is None else [C_TYPES[self.real](q_free)]
-        status = getattr(self._library, f"{self.robot.name}_ik_nearest")(
-            target.ctypes.data_as(pointer), q_seed.ctypes.data_as(pointer), *free, weights.ctypes.data_as(pointer),
-            q.ctypes.data_as(pointer), *self._extra())
-        return q.astype(np.float64), int(status)
 
-    def velocity_ik(self, q: np.ndarray, mu_dot: np.ndarray, damping: float) -> tuple[np.ndarray, int]:
-        """`NAME_velocity_ik`: (q_dot, status)."""
-        pointer = ctypes.POINTER(C_TYPES[self.real])
-        q = np.ascontiguousarray(q, dtype=self.dtype)
-        mu_dot = np.ascontiguousarray(mu_dot, dtype=self.dtype)
-        q_dot = np.zeros(self.robot.dof, dtype=self.dtype)
-        status = getattr(self._library, f"{self.robot.name}_velocity_ik")(
-            q.ctypes.data_as(pointer), mu_dot.ctypes.data_as(pointer), C_TYPES[self.real](damping),
-            q_dot.ctypes.data_as(pointer), *self._extra())
-        return q_dot.astype(np.float64), int(status)
-
-    def ik_numeric(self, target: np.ndarray, q0: np.ndarray, max_iter: int = IK_NUMERIC_DEFAULTS["max_iter"],
-                   tol: float = IK_NUMERIC_DEFAULTS["tol"]) -> tuple[np.ndarray, int]:
-        """`NAME_ik_numeric` from q0: (q, status); the defaults are the generated Python's."""
-        pointer = ctypes.POINTER(C_TYPES[self.real])
-        target = np.ascontiguousarray(np.ravel(target), dtype=self.dtype)
-        start = np.ascontiguousarray(q0, dtype=self.dtype)
-        q = np.zeros(self.robot.dof, dtype=self.dtype)
-        function = getattr(self._library, f"{self.robot.name}_ik_numeric")
-        function.argtypes = [pointer, pointer, ctypes.c_int, C_TYPES[self.real], pointer]
-        status = function(target.ctypes.data_as(pointer), start.ctypes.data_as(pointer), max_iter, tol,
-                          q.ctypes.data_as(pointer), *self._extra())
-        return q.astype(np.float64), status
-
+def _widened(array: np.ndarray) -> np.ndarray:
+    """Reals as float64, whatever the build's type; ints as they are."""
+    return array.astype(np.float64) if array.dtype.kind == "f" else array

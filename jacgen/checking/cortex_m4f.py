@@ -22,7 +22,6 @@ import numpy as np
 
 from jacgen.checking import reference
 from jacgen.checking.c_library import WARNING_FLAGS, first_error
-from jacgen.emission.catalogue import FUNCTION_NAMES
 from jacgen.emission.generator import Generator
 from jacgen.emission.render import environment, render_robot
 from jacgen.errors import JacgenError
@@ -99,26 +98,18 @@ def check_tools() -> None:
         raise TargetError(f"--target cortex-m4f needs {' and '.join(missing)} (Debian: {INSTALL})")
 
 
-def calls(robot: Robot, generator: Generator) -> list[Call]:
-    """Every function of the contract the robot has: the catalogue's, then ik and ik_numeric
-    (loops the C templates write). The general 6R solver's parts are measured through ik."""
+def calls(generator: Generator) -> list[Call]:
+    """Every function of the contract the robot has, as the catalogue declares it (the general 6R
+    solver's parts are measured through ik_branches)."""
     found = []
-    for function in generator.functions():
-        if function.name not in FUNCTION_NAMES:
+    for function in generator.signatures():
+        if function.declaration is None:
             continue
         returned = function.returned
         outputs = tuple((o.size, o.boolean or o.integer) for o in function.outputs if o is not returned)
         kind = None if returned is None else "int" if returned.boolean or returned.integer else "real"
-        found.append(Call(function.name, tuple((a.name, a.size, a.scalar, False) for a in function.arguments),
+        found.append(Call(function.name, tuple((a.name, a.size, a.scalar, a.integer) for a in function.arguments),
                           outputs, kind))
-    target = ("target", int(np.size(reference.ik_target(robot, np.zeros(robot.dof)))), False, False)
-    form = generator.closed_form
-    if form is not None and generator.generates("ik"):
-        free = (("q_free", 1, True, False),) if form.free is not None else ()
-        found.append(Call("ik", (target, *free), ((form.info.max_solutions * robot.dof, False),), "int"))
-    if generator.generates("ik_numeric"):
-        found.append(Call("ik_numeric", (target, ("q0", robot.dof, False, False), ("max_iter", 1, True, True),
-                                         ("tol", 1, True, False)), ((robot.dof, False),), "int"))
     return found
 
 
@@ -172,7 +163,8 @@ class Emulator:
     def __init__(self, robot: Robot, generator: Generator, folder: Path, sources: Path | None = None):
         check_tools()
         self.robot, self.folder = robot, folder
-        self.calls = {call.name: call for call in calls(robot, generator)}
+        self.signatures = {f.name: f for f in generator.signatures() if f.declaration is not None}
+        self.calls = {call.name: call for call in calls(generator)}
         self.index = {name: k for k, name in enumerate(self.calls)}
         code = folder / robot.name
         if sources is None:
@@ -240,7 +232,7 @@ class Emulator:
         self.measured[name] = batch
         return batch
 
-    def call(self, name: str, values: dict[str, np.ndarray]) -> Batch:
+    def call_with(self, name: str, values: dict[str, np.ndarray]) -> Batch:
         """`name` with each argument taken from `values` by its name (k rows each)."""
         return self.run(name, *(values[argument] for argument, _, _, _ in self.calls[name].inputs))
 
@@ -255,44 +247,18 @@ class Emulator:
                   "max_iter": np.full(len(q), IK_NUMERIC_DEFAULTS["max_iter"]), "tol": np.full(len(q), IK_NUMERIC_VERIFIED["float"]), "q_free": q[:, free] if free is not None else None}
         for name in self.calls:
             if name not in self.measured:
-                self.call(name, values)
+                self.call_with(name, values)
 
-    # -- the verify backend: the same methods as compile.CLibrary, one QEMU run each -----------
-    def evaluate(self, name: str, q: np.ndarray, *more: np.ndarray) -> np.ndarray:
-        """(k, size): the outputs side by side, or the returned scalar."""
-        batch = self.run(name, q, *more)
-        return batch.returned[:, None] if batch.returned is not None and not batch.outputs else np.hstack(batch.outputs)
-
-    def velocity_ik(self, q: np.ndarray, mu_dot: np.ndarray, damping: float) -> tuple[np.ndarray, np.ndarray]:
-        batch = self.run("velocity_ik", q, mu_dot, np.full(len(q), damping))
-        return batch.outputs[0], batch.returned
-
-    def ik(self, targets: np.ndarray, free: np.ndarray | None = None) -> tuple[list[np.ndarray], np.ndarray]:
-        """Every target's solutions (k_i, dof), and the target's own check of them: the largest
-        |fk(solution) - target| (angles of a task vector modulo 2 pi) per target."""
-        batch = self.run("ik", np.reshape(targets, (len(targets), -1)), *(() if free is None else (free,)))
-        solutions = batch.outputs[0].reshape(len(targets), -1, self.robot.dof)
-        return [found[:int(n)] for found, n in zip(solutions, batch.returned)], batch.ik_error
-
-    def ik_branches(self, targets: np.ndarray, free: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Every branch at each target (k, m, dof), and whether each is valid and inside the limits (k, m)."""
-        count = len(targets)
-        targets = np.reshape(targets, (count, -1))
-        batch = self.call("ik_branches", {"T": targets, "mu": targets, "q_free": free})
-        q, valid, in_limits = batch.outputs
-        return q.reshape(count, -1, self.robot.dof), valid.astype(bool), in_limits.astype(bool)
-
-    def ik_nearest(self, targets: np.ndarray, seeds: np.ndarray, weights: np.ndarray,
-                   free: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-        count = len(targets)
-        targets = np.reshape(targets, (count, -1))
-        batch = self.call("ik_nearest", {"T": targets, "mu": targets, "q_seed": seeds, "weights": weights, "q_free": free})
-        return batch.outputs[0], batch.returned
-
-    def ik_numeric(self, targets: np.ndarray, starts: np.ndarray, max_iter: int, tol: float) -> tuple[np.ndarray, np.ndarray]:
-        count = len(targets)
-        batch = self.run("ik_numeric", np.reshape(targets, (count, -1)), starts, np.full(count, max_iter), np.full(count, tol))
-        return batch.outputs[0], batch.returned
+    def results(self, name: str, *arguments) -> tuple[np.ndarray, ...]:
+        """`name` at k rows of its arguments (a scalar may be one number for all): its results in
+        the catalogue's order, each (k, *shape). `measured[name]` keeps the run, with ik's own
+        check on the target."""
+        signature = self.signatures[name]
+        count = next(len(value) for value in arguments if np.ndim(value))
+        batch = self.run(name, *(np.full(count, value) if np.ndim(value) == 0 else value for value in arguments))
+        arrays = iter(batch.outputs)
+        return tuple(batch.returned if output is signature.returned else next(arrays).reshape(count, *output.shape)
+                     for output in signature.outputs)
 
     # -- flash and stack, from the compiler --------------------------------------------------
     @cached_property

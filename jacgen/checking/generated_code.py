@@ -10,9 +10,8 @@ import numpy as np
 
 from jacgen.checking.c_library import CLibrary
 from jacgen.checking.cortex_m4f import Emulator
-from jacgen.emission.catalogue import Function
+from jacgen.emission.catalogue import Signature
 from jacgen.inputs.robot import Robot
-from jacgen.tolerances import IK_NUMERIC_VERIFIED
 
 HOST_BACKENDS = ("python", "casadi", "c double", "c float")  # what `jacgen verify` compares on the host
 # NAME_native as `verify --native` calls it: batches of float64 (the double C) and float32 (the
@@ -20,8 +19,6 @@ HOST_BACKENDS = ("python", "casadi", "c double", "c float")  # what `jacgen veri
 NATIVE_BACKENDS = ("native double", "native double scalar", "native double one", "native float",
                    "native float scalar")
 TARGET_BACKENDS = {"cortex-m4f": "cortex-m4f float"}  # `verify --target`: the target's float C alone
-# ik_numeric as verify runs it: up to this many steps, to this |error| by real type.
-IK_NUMERIC_STEPS = 200
 
 
 def import_module(path: Path, module_name: str):
@@ -32,15 +29,17 @@ def import_module(path: Path, module_name: str):
 
 
 class GeneratedCode:
-    """The generated code of one robot, each backend evaluating a function on a batch of q:
-    the host's (Python, CasADi, C double and float) or the emulated target's float C."""
+    """The generated code of one robot, each backend calling any function the catalogue declares
+    on a batch: the host's (Python, CasADi, C double and float) or the emulated target's float C."""
 
-    def __init__(self, robot: Robot, functions: list[Function], folder: Path, libraries: dict[str, Path],
+    def __init__(self, robot: Robot, signatures: list[Signature], folder: Path, libraries: dict[str, Path],
                  emulator: Emulator | None = None, native=None):
-        """folder: where `generate -o` wrote the double-precision Python and CasADi (folder/NAME/);
-        libraries: the compiled C by real type; emulator: the target instead of the host;
-        native: the built NAME_native module, to compare as well."""
+        """signatures: the robot's functions (`Generator.signatures`); folder: where `generate -o`
+        wrote the double-precision Python and CasADi (folder/NAME/); libraries: the compiled C by
+        real type; emulator: the target instead of the host; native: the built NAME_native
+        module, to compare as well."""
         self.robot, self.emulator = robot, emulator
+        self.signatures = {f.name: f for f in signatures}
         self.names = HOST_BACKENDS if emulator is None else (TARGET_BACKENDS["cortex-m4f"],)
         self.native = {}
         if native is not None:
@@ -52,124 +51,72 @@ class GeneratedCode:
             self.casadi = import_module(folder / robot.name / f"{robot.name}_casadi.py", f"_jacgen_{robot.name}_casadi")
             # CasADi's functions take the parameters as one trailing vector
             self.casadi_parameters = [list(self.casadi.PARAMETERS.values())] if self.nominal else []
-        self.c = {real: CLibrary(path, robot, functions, real) for real, path in libraries.items()}
+        self.c = {real: CLibrary(path, robot, signatures, real) for real, path in libraries.items()}
 
     def module(self, backend: str):
         """What answers NAME.py's calls for a backend: the numpy module, or NAME_native called one
         of its ways."""
         return self.python if backend == "python" else self.native[backend]
 
+    def has(self, backend: str, name: str) -> bool:
+        """Whether the backend has the function: CasADi lacks the loops it cannot run, and the
+        target runs the contract's functions only."""
+        if backend == "casadi":
+            return hasattr(self.casadi, name)
+        return name in (self.emulator.calls if self.emulator is not None else self.signatures)
+
+    def call(self, backend: str, name: str, *arguments) -> tuple[np.ndarray, ...]:
+        """`name` at k rows of its arguments, in the order the catalogue declares them (a scalar
+        argument may be one number for every row): its results, each (k, *shape), as the
+        Python module returns them. CasADi's functions take only the arguments they name (its
+        ik_numeric runs a fixed number of steps: no max_iter)."""
+        if backend == "python" or backend in self.native:
+            with np.errstate(divide="ignore", invalid="ignore"):  # NaN at Euler singularities
+                found = getattr(self.module(backend), name)(*arguments, **self.nominal)
+            return found if isinstance(found, tuple) else (found,)
+        if self.emulator is not None:
+            return self.emulator.results(name, *arguments)
+        signature = self.signatures[name]
+        count = next(len(value) for value in arguments if np.ndim(value))
+        if not count:
+            return tuple(np.zeros((0, *output.shape)) for output in signature.outputs)
+        rows = [[value if argument.scalar and np.ndim(value) == 0 else value[k]
+                 for argument, value in zip(signature.arguments, arguments, strict=True)] for k in range(count)]
+        shapes = {output.name: output.shape for output in signature.outputs}
+        if backend == "casadi":  # its results as it names them (its ik: every branch and its flags)
+            function = getattr(self.casadi, name)
+            position = {argument.name: k for k, argument in enumerate(signature.arguments)}
+            found = [[value.full() for value in function.call([_column(np.asarray(row[position[taken]], dtype=float))
+                                                               for taken in function.name_in() if taken in position]
+                                                              + self.casadi_parameters)] for row in rows]
+            names = function.name_out()
+        else:
+            library = self.c[backend.split()[1]]
+            found = [library.call(name, *row) for row in rows]
+            names = list(shapes)
+        return tuple(np.array(values).reshape(count, *shapes[taken]) if taken in shapes else np.array(values)
+                     for values, taken in zip(zip(*found), names))
+
     def evaluate(self, backend: str, name: str, q: np.ndarray, *more: np.ndarray) -> np.ndarray:
         """(k, size) results at the rows of q (and of q_dot, for the functions that take it),
         each output row-major, several outputs side by side, at the nominal parameter values."""
-        if backend == "python" or backend in self.native:
-            with np.errstate(divide="ignore", invalid="ignore"):  # NaN at Euler singularities
-                return _side_by_side(getattr(self.module(backend), name)(q, *more, **self.nominal), len(q))
-        if backend == "casadi":
-            function = getattr(self.casadi, name)
-            return np.vstack([_side_by_side(function(*rows, *self.casadi_parameters), 1) for rows in zip(q, *more)])
-        if self.emulator is not None:
-            return self.emulator.evaluate(name, q, *more)
-        return self.c[backend.split()[1]].evaluate(name, q, *more)
+        return np.hstack([np.reshape(part, (len(q), -1)) for part in self.call(backend, name, q, *more)])
 
-    def velocity_ik(self, backend: str, q: np.ndarray, mu_dot: np.ndarray,
-                    damping: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-        """velocity_ik at each row of q and mu_dot: (q_dot (k, dof), status (k,))."""
-        if not len(q):  # no regular configuration: the numpy module says what nothing looks like
-            return self.python.velocity_ik(q, mu_dot, damping, **self.nominal)
-        if backend == "python" or backend in self.native:
-            return self.module(backend).velocity_ik(q, mu_dot, damping, **self.nominal)
-        if backend == "casadi":
-            rows = [self.casadi.velocity_ik(x, rates, damping, *self.casadi_parameters) for x, rates in zip(q, mu_dot)]
-            return (np.array([q_dot.full().ravel() for q_dot, _ in rows]).reshape(len(q), -1),
-                    np.array([float(status) for _, status in rows]))
-        if self.emulator is not None:
-            return self.emulator.velocity_ik(q, mu_dot, damping)
-        rows = [self.c[backend.split()[1]].velocity_ik(x, rates, damping) for x, rates in zip(q, mu_dot)]
-        return np.array([q_dot for q_dot, _ in rows]).reshape(len(q), -1), np.array([status for _, status in rows])
-
-    def ik(self, backend: str, targets: np.ndarray, free: np.ndarray | None,
-           max_solutions: int) -> tuple[list[np.ndarray], np.ndarray | None]:
+    def ik(self, backend: str, targets: np.ndarray, free: np.ndarray | None) -> tuple[list[np.ndarray], np.ndarray | None]:
         """ik at each target (with the free joint's angle, if any): the solutions (k_i, dof) per
-        target, and the target's own check of them (None on the host)."""
-        if self.emulator is not None:
-            return self.emulator.ik(targets, free)
+        target, and the target's own check of them (None on the host). Its result is the one
+        whose layout differs by language: kept rows and a mask (Python), a count (C), every
+        branch with its flags (CasADi)."""
+        given = (targets,) if free is None else (targets, free)
+        if backend == "casadi":  # every branch, its validity and its limits: keep the solutions
+            q, valid, in_limits = self.call(backend, "ik", *given)
+            return [rows[mask.ravel() == 1] for rows, mask in zip(q, valid * in_limits)], None
         if backend == "python" or backend in self.native:  # one batched call
-            q, keep = self.module(backend).ik(targets, *(() if free is None else (free,)), **self.nominal)
+            q, keep = self.call(backend, "ik", *given)
             return [rows[mask] for rows, mask in zip(q, keep)], None
-
-        def solve(target: np.ndarray, *angle: float) -> np.ndarray:
-            if backend == "casadi":  # every branch, its validity and its limits: keep the solutions
-                q, valid, in_limits = self.casadi.ik(_column(target), *angle, *self.casadi_parameters)
-                return q.full()[(valid.full() * in_limits.full()).ravel() == 1]
-            return self.c[backend.split()[1]].ik(target, max_solutions, None, *angle)
-
-        return [np.reshape(solve(target, *angle), (-1, self.robot.dof)) for target, angle in _with_free(targets, free)], None
-
-    def ik_branches(self, backend: str, targets: np.ndarray, free: np.ndarray | None,
-                    max_solutions: int) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-        """ik_branches at each target: every branch (k, m, dof) and whether each is valid and
-        inside the limits (k, m); None where the backend has no ik_branches (general 6R: only C
-        and Python, as loops around the eigensolver)."""
-        if self.emulator is not None:
-            return self.emulator.ik_branches(targets, free) if "ik_branches" in self.emulator.calls else None
-        if backend == "python" or backend in self.native:
-            found = self.module(backend).ik_branches(targets, *(() if free is None else (free,)), **self.nominal)
-        elif backend == "casadi":
-            if not hasattr(self.casadi, "ik_branches"):
-                return None
-            rows = [[value.full() for value in self.casadi.ik_branches(_column(target), *angle, *self.casadi_parameters)]
-                    for target, angle in _with_free(targets, free)]
-            found = [np.array(values) for values in zip(*rows)]
-        else:
-            library = self.c[backend.split()[1]]
-            found = [np.array(values) for values in zip(*(library.ik_branches(target, max_solutions, *angle)
-                                                           for target, angle in _with_free(targets, free)))]
-        q, valid, in_limits = (np.asarray(value) for value in found)
-        count = len(targets)
-        return (q.reshape(count, -1, self.robot.dof), valid.reshape(count, -1).astype(bool),
-                in_limits.reshape(count, -1).astype(bool))
-
-    def ik_nearest(self, backend: str, targets: np.ndarray, seeds: np.ndarray, weights: np.ndarray,
-                   free: np.ndarray | None) -> tuple[np.ndarray, np.ndarray] | None:
-        """ik_nearest at each target from each seed: (q (k, dof), status (k,)); None where the
-        backend has none."""
-        if self.emulator is not None:
-            return self.emulator.ik_nearest(targets, seeds, weights, free) if "ik_nearest" in self.emulator.calls else None
-        if backend == "python" or backend in self.native:
-            return self.module(backend).ik_nearest(targets, seeds, *(() if free is None else (free,)), weights,
-                                                   **self.nominal)
-        if backend == "casadi":
-            if not hasattr(self.casadi, "ik_nearest"):
-                return None
-            rows = [self.casadi.ik_nearest(_column(target), seed, *angle, weight, *self.casadi_parameters)
-                    for (target, angle), seed, weight in zip(_with_free(targets, free), seeds, weights)]
-            return np.array([q.full().ravel() for q, _ in rows]), np.array([float(status) for _, status in rows])
-        library = self.c[backend.split()[1]]
-        rows = [library.ik_nearest(target, seed, weight, *angle)
-                for (target, angle), seed, weight in zip(_with_free(targets, free), seeds, weights)]
-        return np.array([q for q, _ in rows]), np.array([status for _, status in rows])
-
-    def ik_numeric(self, backend: str, targets: np.ndarray, starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """ik_numeric from each start: (q (k, dof), status (k,))."""
-        if self.emulator is not None:
-            return self.emulator.ik_numeric(targets, starts, IK_NUMERIC_STEPS, IK_NUMERIC_VERIFIED["float"])
-        if backend == "python" or backend in self.native:  # one batched call
-            real = "float" if "float" in backend else "double"
-            return self.module(backend).ik_numeric(targets, starts, IK_NUMERIC_STEPS, IK_NUMERIC_VERIFIED[real],
-                                                   **self.nominal)
-
-        def solve(target: np.ndarray, start: np.ndarray) -> tuple[np.ndarray, int]:
-            if backend == "casadi":  # a fixed number of steps
-                q, status = self.casadi.ik_numeric(_column(target), start, IK_NUMERIC_VERIFIED["double"],
-                                                   *self.casadi_parameters)
-                return q.full().ravel(), int(status)
-            real = backend.split()[1]
-            return self.c[real].ik_numeric(target, start, IK_NUMERIC_STEPS, IK_NUMERIC_VERIFIED[real])
-
-        found, status = zip(*(solve(target, start) for target, start in zip(targets, starts)))
-        return np.array(found), np.array(status)
-
+        q, count = self.call(backend, "ik", *given)
+        checked = self.emulator.measured["ik"].ik_error if self.emulator is not None else None
+        return [rows[:int(n)] for rows, n in zip(q, count)], checked
 
 class NativeCalls:
     """NAME_native's functions called as a native backend says: float32 arrays (the float C) or
@@ -205,17 +152,7 @@ class NativeCalls:
         return call
 
 
-def _side_by_side(results, count: int) -> np.ndarray:
-    """One result array, or a tuple of them (a fused function), as (count, size)."""
-    parts = results if isinstance(results, tuple) else (results,)
-    return np.hstack([np.reshape(np.asarray(part), (count, -1)) for part in parts])
+def _column(value: np.ndarray) -> np.ndarray:
+    """A value as CasADi takes it: a vector as a column, a matrix or a number as it is."""
+    return value[:, None] if value.ndim == 1 else value
 
-
-def _column(target: np.ndarray) -> np.ndarray:
-    """A target as CasADi takes it: a 4x4 pose as it is, a task vector as a column."""
-    return target if target.ndim == 2 else target[:, None]
-
-
-def _with_free(targets: np.ndarray, free: np.ndarray | None) -> list[tuple[np.ndarray, tuple]]:
-    """Each target with the free joint's angle as a trailing argument (none without a free joint)."""
-    return [(target, () if free is None else (free[k],)) for k, target in enumerate(targets)]

@@ -39,17 +39,15 @@ from jacgen.inputs.robot import EULER_ANGLES, Robot
 from jacgen.model import singularities
 from jacgen.parallel import for_each_robot
 from jacgen.solvers import ik
-from jacgen.tolerances import VERIFIED
+from jacgen.tolerances import IK_NUMERIC_VERIFIED, VERIFIED
 
 # Where cos(pitch) < this, roll and yaw and the Euler-angle rates are ill-conditioned (they
-# are undefined at pitch = +-90 deg): the angle rows of `task` and `task_jacobian` are not
+# are undefined at pitch = +-90 deg): the angle rows of the functions the catalogue declares
+# with `euler_rows`, and the functions of Js (`of_js`) where Js is the task Jacobian, are not
 # compared there (and may be NaN). Beyond 0.05 (|pitch| < 87 deg) rounding is amplified at
 # most 1/0.05^2 = 400-fold and the reference's central differences (step 1e-4) agree with
 # the exact rates to 3e-11; at 0.01 they were measured 4e-9 off (stanford).
 EULER_MARGIN = 0.05
-EULER_FUNCTIONS = ("task", "task_jacobian", "task_jacobian_dot")
-# Functions of Js: undefined where cos(pitch) = 0 when Js is the task Jacobian.
-JS_FUNCTIONS = ("manipulability", "jacobian_det")
 # Smallest / largest singular value of Js below which factors must vanish, and above which
 # velocity_ik is checked (there |q_dot| <~ 1e3 |mu_dot|, so the reference's finite-difference
 # error of 1e-11 in task_jacobian stays below the tolerance in the residual).
@@ -58,6 +56,8 @@ ZERO_JACOBIAN = 1e-12
 # ik_numeric iterates in Python per target: enough targets to cover the workspace, few
 # enough to keep verify quick.
 NUMERIC_IK_SAMPLES = 20
+# ik_numeric as verify runs it: up to this many steps, to IK_NUMERIC_VERIFIED by real type.
+IK_NUMERIC_STEPS = 200
 
 
 @dataclass(frozen=True)
@@ -99,9 +99,9 @@ def compare(robot: Robot, function: Function, value: np.ndarray, expected: np.nd
     of task_jacobian_dot reach |q_dot|^2 / cos(pitch)^2 near the margin.
     """
     elements = np.zeros(value.shape[1], dtype=bool)  # the entries undefined where cos(pitch) = 0
-    if function.name in EULER_FUNCTIONS:
+    if function.declaration.euler_rows:
         elements = np.repeat([name in EULER_ANGLES for name in robot.task], function.outputs[0].cols)
-    elif function.name in JS_FUNCTIONS and singularities.singularity_rows(robot) is None:
+    elif function.declaration.of_js and singularities.singularity_rows(robot) is None:
         elements[:] = True
     compared = np.ones(value.shape, dtype=bool)
     if elements.any():
@@ -152,14 +152,14 @@ def verify_robot(robot: Robot, backends: GeneratedCode, functions: list[Function
         note = (f"angle rows not compared at {skipped} of {len(q)} samples (cos(pitch) < {EULER_MARGIN})"
                 if skipped else "")
         results.append(Result(robot.name, function.name, errors,
-                              product_tolerances if function.name in JS_FUNCTIONS else tolerances, note))
+                              product_tolerances if function.declaration.of_js else tolerances, note))
     regular = ranks > REGULAR_RANK
     results += _ik_results(robot, backends, q[:random_count], tolerances, form)
     mu_dot = np.random.default_rng(0).normal(size=(int(regular.sum()), len(robot.task)))
     residuals, flagged = {}, {}
     for backend in names:
         residuals[backend], flagged[backend] = _velocity_ik_residual(
-            robot, backends.velocity_ik(backend, q[regular], mu_dot), q[regular], mu_dot,
+            robot, backends.call(backend, "velocity_ik", q[regular], mu_dot, 0.0), q[regular], mu_dot,
             allow_singular=_is_float(backend))
     results.append(Result(robot.name, "velocity_ik", residuals, tolerances,
                           ("|Js^T (Js q_dot - mu_dot)| / |Js| (|Js| |q_dot| + |mu_dot|)" if len(robot.task) > robot.dof
@@ -230,10 +230,10 @@ def _ik_results(robot: Robot, backends: GeneratedCode, q: np.ndarray, tolerances
         free = None if form.free is None else q[:, form.free]
         errors, checked = {}, {}
         for backend in backends.names:
-            if backend == "casadi" and form.solver == "general_6r":  # CasADi has no ik for it (an eigensolver loop)
+            if not backends.has(backend, "ik"):  # CasADi has no general 6R ik (an eigensolver loop)
                 errors[backend] = None
                 continue
-            found, checked[backend] = backends.ik(backend, targets, free, form.info.max_solutions)
+            found, checked[backend] = backends.ik(backend, targets, free)
             kept = free is None or all((solutions[:, form.free] == given).all() for solutions, given in zip(found, free))
             reached = np.repeat(targets, [len(solutions) for solutions in found], axis=0)
             errors[backend] = (math.inf if not kept or not all(len(solutions) for solutions in found)
@@ -250,7 +250,7 @@ def _ik_results(robot: Robot, backends: GeneratedCode, q: np.ndarray, tolerances
                               f"every solution of {len(targets)} targets fk(q) reaches the target"
                               + (f", with joint {form.free + 1} as given" if form.free is not None else "")
                               + "".join(f"; checked on the target too ({backend})" for backend in on_target)))
-        results += _branch_results(robot, backends, q, targets, free, ik_tolerances, form.info.max_solutions)
+        results += _branch_results(robot, backends, q, targets, free, ik_tolerances)
     starts = q + 0.1 * np.random.default_rng(1).choice([-1.0, 1.0], size=q.shape)
     limits = np.array(robot.ranges)
     starts = np.clip(starts, limits[:, 0], limits[:, 1])
@@ -258,7 +258,8 @@ def _ik_results(robot: Robot, backends: GeneratedCode, q: np.ndarray, tolerances
     count = len(q) if backends.emulator is not None else min(len(q), NUMERIC_IK_SAMPLES)
     errors, converged = {}, {}
     for backend in backends.names:
-        found, status = backends.ik_numeric(backend, targets[:count], starts[:count])
+        found, status = backends.call(backend, "ik_numeric", targets[:count], starts[:count], IK_NUMERIC_STEPS,
+                                      IK_NUMERIC_VERIFIED["float" if _is_float(backend) else "double"])
         # Status 0 promises |error| <= tol; a stall (a local minimum of the task error) is allowed.
         reached = np.asarray(status) == 0
         errors[backend] = _target_error(robot, np.asarray(found)[reached], targets[:count][reached])
@@ -270,7 +271,7 @@ def _ik_results(robot: Robot, backends: GeneratedCode, q: np.ndarray, tolerances
 
 
 def _branch_results(robot: Robot, backends: GeneratedCode, q: np.ndarray, targets: np.ndarray, free: np.ndarray | None,
-                    tolerances: dict, max_solutions: int) -> list[Result]:
+                    tolerances: dict) -> list[Result]:
     """ik_branches: every valid branch reaches its target, and at least one branch is valid
     (each target was reached at q); ik_nearest, seeded 0.05 away from q with random weights:
     status OK, a solution that reaches the target, and no valid branch inside the limits
@@ -280,17 +281,17 @@ def _branch_results(robot: Robot, backends: GeneratedCode, q: np.ndarray, target
     seeds = q + 0.05 * rng.choice([-1.0, 1.0], size=q.shape)
     weights = rng.uniform(0.5, 2.0, size=q.shape)
     branch_errors, nearest_errors, nearer = {}, {}, {}
+    given = () if free is None else (free,)
     for backend in backends.names:
-        branches = backends.ik_branches(backend, targets, free, max_solutions)
-        nearest = backends.ik_nearest(backend, targets, seeds, weights, free)
-        if branches is None or nearest is None:
+        if not backends.has(backend, "ik_nearest"):  # CasADi has no general 6R ik_branches: nor its ik_nearest
             branch_errors[backend] = nearest_errors[backend] = None
             continue
-        solutions, valid, in_limits = branches
+        solutions, valid, in_limits = backends.call(backend, "ik_branches", targets, *given)
+        valid, in_limits = valid.astype(bool), in_limits.astype(bool)
+        found, status = backends.call(backend, "ik_nearest", targets, seeds, *given, weights)
         reached = np.repeat(targets, valid.sum(axis=1), axis=0)
         branch_errors[backend] = (math.inf if not valid.any(axis=1).all()
                                   else _target_error(robot, solutions[valid], reached))
-        found, status = nearest
         ok = np.asarray(status) == 0
         nearest_errors[backend] = math.inf if not ok.all() else _target_error(robot, np.asarray(found), targets)
         distance = np.einsum("kj,kj->k", weights, (np.asarray(found) - seeds) ** 2)
@@ -362,7 +363,7 @@ def verify(robots: list[Robot], samples: int, seed: int,
             emulator = Emulator(robot, generator, folder / robot.name / target, sources)
             emulator.build()
             random, q = configurations(robot, generator.singularities, samples, seed)
-            results += verify_robot(robot, GeneratedCode(robot, generator.functions(), folder / robot.name / "double",
+            results += verify_robot(robot, GeneratedCode(robot, generator.signatures(), folder / robot.name / "double",
                                                          {}, emulator), generator.functions(), q, len(random),
                                     generator.closed_form)
             emulator.measure_remaining(random, generator.closed_form and generator.closed_form.free)
@@ -387,9 +388,8 @@ def verify_on_host(robot: Robot, samples: int, seed: int, folder: Path, native: 
         module = build_native(work / "native" / robot.name, robot.name) if native else None
         built = {real: build.result() for real, build in builds.items()}
     random, q = configurations(robot, generator.singularities, samples, seed)
-    functions = generator.functions()
-    return verify_robot(robot, GeneratedCode(robot, functions, work / "double", built, native=module),
-                        functions, q, len(random), generator.closed_form)
+    return verify_robot(robot, GeneratedCode(robot, generator.signatures(), work / "double", built, native=module),
+                        generator.functions(), q, len(random), generator.closed_form)
 
 
 def format_table(results: list[Result]) -> str:

@@ -9,17 +9,57 @@ from dataclasses import dataclass
 import sympy
 
 from jacgen.emission.lowering import Body
+from jacgen.solvers import differential, ik_limits
 
 SECOND_ORDER = ("fk_jacobian_dot", "jacobian_dot", "bias_acceleration", "task_jacobian_dot", "hessian")
 
-# Every function a robot can get, in the order the backends emit them (`ik` and `ik_numeric`
-# are loops the templates write around ik_branches and ik_numeric_step), and the functions each
-# one calls: `--functions` generates the named ones and their callees.
-FUNCTION_NAMES = ("fk", "jacobian", "fk_jacobian", "jacobian_tool", "task", "task_jacobian", "fk_jacobian_dot",
-                  "jacobian_dot", "bias_acceleration", "task_jacobian_dot", "hessian", "singularity_factors",
-                  "manipulability", "jacobian_det", "velocity_ik", "ik_numeric_step", "ik_numeric", "ik_branches",
-                  "ik_nearest", "ik")
-CALLEES = {"ik": ("ik_branches",), "ik_nearest": ("ik_branches",), "ik_numeric": ("ik_numeric_step",)}
+
+@dataclass(frozen=True)
+class Status:
+    """A value of a function's integer status, the same in every backend (`NAME_VELOCITY_IK_OK`)."""
+
+    name: str
+    value: int
+    meaning: str = ""
+
+
+@dataclass(frozen=True)
+class Declaration:
+    """What is fixed about a function whatever the robot: the functions it calls (`--functions`
+    generates them too), the values of its status, and the facts `verify` needs to compare it."""
+
+    name: str
+    callees: tuple[str, ...] = ()
+    statuses: tuple[Status, ...] = ()
+    euler_rows: bool = False  # rows of Euler angles or their rates: undefined where cos(pitch) = 0
+    of_js: bool = False  # a function of Js: undefined where cos(pitch) = 0 when Js is the task Jacobian
+
+
+def _statuses(*pairs) -> tuple[Status, ...]:
+    return tuple(Status(*pair) for pair in pairs)
+
+
+# Every function a robot can get, in the order the backends emit them. `ik`, `ik_numeric` and
+# the general 6R solver's `ik_branches` are loops (`Loop`), which each language's template
+# writes around the generated functions they call.
+CATALOGUE = (
+    Declaration("fk"), Declaration("jacobian"), Declaration("fk_jacobian"), Declaration("jacobian_tool"),
+    Declaration("task", euler_rows=True), Declaration("task_jacobian", euler_rows=True),
+    *(Declaration(name, euler_rows=name == "task_jacobian_dot") for name in SECOND_ORDER),
+    Declaration("singularity_factors"), Declaration("manipulability", of_js=True), Declaration("jacobian_det", of_js=True),
+    Declaration("velocity_ik", statuses=_statuses(("OK", differential.VELOCITY_IK_OK),
+                                                  ("SINGULAR", differential.VELOCITY_IK_SINGULAR),
+                                                  ("NOT_FINITE", differential.VELOCITY_IK_NOT_FINITE))),
+    Declaration("ik_numeric_step"),
+    Declaration("ik_numeric", ("ik_numeric_step",), _statuses(*differential.IK_NUMERIC_STATUSES)),
+    Declaration("ik_branches"),
+    Declaration("ik_nearest", ("ik_branches",), _statuses(("OK", ik_limits.IK_NEAREST_OK),
+                                                          ("NO_SOLUTION", ik_limits.IK_NEAREST_NO_SOLUTION),
+                                                          ("NOT_FINITE", ik_limits.IK_NEAREST_NOT_FINITE))),
+    Declaration("ik", ("ik_branches",)),
+)
+DECLARED = {declaration.name: declaration for declaration in CATALOGUE}
+FUNCTION_NAMES = tuple(DECLARED)
 
 
 # The contract's extent of every array, in named dimensions (C's `double J[6 * NAME_DOF]`), by
@@ -62,12 +102,17 @@ def extent_of(key: str, size: int) -> tuple[int | str, ...]:
     return EXTENTS.get(key, (16,) if size == 16 else ("TASK_DIM",) if key == "target" else (size,))
 
 
+def in_catalogue_order(functions) -> list:
+    """Functions (a loop's parts where the loop is) in the order the backends emit them."""
+    return sorted(functions, key=lambda function: FUNCTION_NAMES.index(function.part_of or function.name))
+
+
 def with_callees(names) -> frozenset[str]:
     """The functions named and those they call (ValueError for a name no robot has)."""
     unknown = [name for name in names if name not in FUNCTION_NAMES]
     if unknown:
         raise ValueError(f"unknown function {unknown[0]!r}; expected some of {', '.join(FUNCTION_NAMES)}")
-    return frozenset(names).union(*(CALLEES.get(name, ()) for name in names))
+    return frozenset(names).union(*(DECLARED[name].callees for name in names))
 
 
 @dataclass(frozen=True)
@@ -79,10 +124,16 @@ class Argument:
     vector: bool = True  # numpy shape (..., rows); else (..., rows, cols)
     scalar: bool = False  # one number: by value in C, shape (...) in numpy, its symbol named as the argument
     default: str | None = None  # a scalar's default in Python
+    integer: bool = False  # a count (ik_numeric's max_iter): an int in C
 
     @property
     def size(self) -> int:
         return len(self.symbols)
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """numpy shape of one call's value: () for a scalar, (rows,) for a vector."""
+        return () if self.scalar else (self.size,) if self.vector else self.symbols.shape
 
     @property
     def extent(self) -> tuple[int | str, ...]:
@@ -131,33 +182,24 @@ class Call:
 
 
 @dataclass(frozen=True)
-class Loop:
-    """A function a template writes around generated ones (the general 6R solver's ik_branches,
-    around an eigensolver): its name and outputs, as its callers read them."""
-
-    name: str
-    outputs: tuple[Output, ...]
-
-
-@dataclass(frozen=True)
-class Function:
-    """One generated function; its body's outputs are those of `outputs`, concatenated."""
+class Signature:
+    """How a generated function is called, in every language: its arguments, and its results
+    (the contract's C returns a scalar one by value and writes the others into arrays)."""
 
     name: str
     summary: str
     outputs: tuple[Output, ...]
-    body: Body
     arguments: tuple[Argument, ...]
-    calls: tuple[Call, ...] = ()
+    part_of: str = ""  # the loop whose template runs it, for a part of one (the general 6R solver's)
 
     @property
-    def inputs(self):
-        """(symbol, argument, row, col) of every input the body reads, in argument order, then
-        the results of its calls."""
-        for argument in (*self.arguments, *(result for call in self.calls for result in call.results)):
-            for k, symbol in enumerate(argument.symbols):
-                if symbol in self.body.read and not argument.scalar:
-                    yield (symbol, argument, *divmod(k, argument.symbols.cols))
+    def declaration(self) -> Declaration | None:
+        """Its entry in the catalogue; None for the parts of a loop that the contract does not name."""
+        return DECLARED.get(self.name)
+
+    @property
+    def statuses(self) -> tuple[Status, ...]:
+        return self.declaration.statuses if self.declaration else ()
 
     @property
     def scalar(self) -> bool:
@@ -168,6 +210,32 @@ class Function:
     def returned(self) -> Output | None:
         """The result C returns by value (a scalar), the others being arrays."""
         return next((output for output in self.outputs if output.scalar), None)
+
+
+@dataclass(frozen=True)
+class Loop(Signature):
+    """A function with control flow, which each language's template writes around the generated
+    functions it calls (`ik`, `ik_numeric`, the general 6R solver's `ik_branches`)."""
+
+    operations: int = 0  # a bound on the operations of one call (no Body counts them)
+    casadi: str | None = None  # "steps": CasADi runs a fixed number of steps and takes no integers; None: not there
+
+
+@dataclass(frozen=True)
+class Function(Signature):
+    """One generated straight-line function; its body's outputs are those of `outputs`, concatenated."""
+
+    body: Body = None
+    calls: tuple[Call, ...] = ()
+
+    @property
+    def inputs(self):
+        """(symbol, argument, row, col) of every input the body reads, in argument order, then
+        the results of its calls."""
+        for argument in (*self.arguments, *(result for call in self.calls for result in call.results)):
+            for k, symbol in enumerate(argument.symbols):
+                if symbol in self.body.read and not argument.scalar:
+                    yield (symbol, argument, *divmod(k, argument.symbols.cols))
 
     def parts(self, values: tuple[sympy.Expr, ...]):
         """The body's outputs split per output: (Output, its values row-major)."""

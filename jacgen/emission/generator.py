@@ -13,8 +13,8 @@ import numpy
 import sympy
 from sympy.core.parameters import distribute
 
-from jacgen.emission.catalogue import (CALLEES, EXTENTS, FUNCTION_NAMES, SECOND_ORDER, Argument, Call, Function, Loop,
-                                       Output, extent_of, with_callees)
+from jacgen.emission.catalogue import (EXTENTS, FUNCTION_NAMES, SECOND_ORDER, Argument, Call, Function, Loop,
+                                       Output, extent_of, in_catalogue_order, with_callees)
 from jacgen.emission.lowering import Lowering
 from jacgen.inputs.robot import EULER_ANGLES, Robot
 from jacgen.inputs.transforms import rot_z, twist
@@ -115,10 +115,7 @@ class Generator:
         form = self.closed_form
         if form is None or not (self.generates("ik_branches") or self.generates("ik_nearest")):
             return []
-        if form.target == "pose":
-            target = Argument("T", sympy.Matrix(4, 4, lambda r, c: generated_symbol("T", r, c, separator="")), vector=False)
-        else:
-            target = Argument("mu", sympy.Matrix([generated_symbol("mu", i) for i in range(len(self.robot.task))]))
+        target = self._closed_form_target()
         free, bindings, free_angle = (), {}, None
         if form.free is not None:  # the free joint's angle is an input; its cos and sin are the usual c_k, s_k
             free = (Argument("q_free", sympy.Matrix([sympy.Symbol("q_free", real=True)]), scalar=True),)
@@ -275,6 +272,12 @@ class Generator:
         return self.function("ik_numeric_step", summary, vector("q_start", self.q), vector("q_next", trial),
                              scalar("cost", cost), arguments=(target, given, damping), bindings=bindings)
 
+    def _closed_form_target(self) -> Argument:
+        """The closed form's target: T, the 4x4 pose, or mu, the task vector."""
+        if self.closed_form.target == "pose":
+            return Argument("T", sympy.Matrix(4, 4, lambda r, c: generated_symbol("T", r, c, separator="")), vector=False)
+        return Argument("mu", sympy.Matrix([generated_symbol("mu", i) for i in range(len(self.robot.task))]))
+
     def _ik_target(self) -> Argument:
         """ik_numeric's target: the 4x4 pose for a six-component task, else the task vector."""
         if len(self.robot.task) == 6:
@@ -426,35 +429,68 @@ class Generator:
                                   result.shape == "vector" or boolean, result.equals, boolean, result.shape == "status",
                                   result.layers, extent_of(key if key in EXTENTS else result.equals or name, size)))
             values += nodes
-        return Function(name, summary, tuple(outputs), self.lower(values, bindings or {}),
-                        arguments or (Argument("q", sympy.Matrix(self.q)),), calls)
+        return Function(name, summary, tuple(outputs), arguments or (Argument("q", sympy.Matrix(self.q)),),
+                        body=self.lower(values, bindings or {}), calls=calls, part_of=part_of or "")
 
     def functions(self) -> list[Function]:
-        """Every straight-line function, in the order the backends emit them."""
+        """Every straight-line function, in the catalogue's order (a loop's parts where the loop is)."""
         return list(self._functions)
 
-    def without_loops(self) -> list[Function]:
-        """The functions of a backend that cannot run the template loops (CasADi's SX graphs have
-        no eigensolver): without the general 6R solver's parts, and without ik_nearest, which
-        reads its ik_branches."""
-        skipped = {"ik_nearest"} | {f.name for f in self._functions if f.name.startswith("ik_general")}
-        return [f for f in self._functions if not (self.loops and f.name in skipped)]
+    def signatures(self) -> list[Function | Loop]:
+        """Every function a caller can call, in the catalogue's order: the straight-line ones
+        (a loop's parts too) and the loops."""
+        return in_catalogue_order((*self._functions, *self.loops))
 
-    @property
+    def without_loops(self) -> list[Function]:
+        """The functions of CasADi, whose SX graphs run no loop of unknown length: without the
+        parts of a loop it does not have, and without the functions that call such a loop (the
+        general 6R solver's ik_nearest reads its ik_branches)."""
+        absent = {loop.name for loop in self.loops if loop.casadi is None}
+        return [f for f in self._functions
+                if f.part_of not in absent and not any(call.function in absent for call in f.calls)]
+
+    @cached_property
     def loops(self) -> list[Loop]:
-        """The functions templates write around generated ones: the general 6R solver's ik_branches."""
-        form = self.closed_form
-        if form is None or form.solver != "general_6r" or not self.generates("ik_branches"):
-            return []
-        rows, extent = form.info.max_solutions, ("MAX_IK_SOLUTIONS",)
-        return [Loop("ik_branches", (Output("q", rows, self.robot.dof, extent=(*extent, "DOF")),
-                                     Output("valid", rows, 1, vector=True, boolean=True, extent=extent),
-                                     Output("in_limits", rows, 1, vector=True, boolean=True, extent=extent)))]
+        """The functions with control flow this robot gets, in the catalogue's order: ik_numeric
+        around ik_numeric_step, ik around ik_branches, and the general 6R solver's ik_branches
+        around the eigenproblem kernel of its language."""
+        form, n = self.closed_form, self.robot.dof
+        made = []
+        if self.generates("ik_numeric"):
+            defaults = differential.IK_NUMERIC_DEFAULTS
+            arguments = (self._ik_target(), Argument("q0", sympy.Matrix(sympy.symbols(f"q0_:{n}", real=True))),
+                         Argument("max_iter", sympy.Matrix([sympy.Symbol("max_iter")]), scalar=True,
+                                  default=repr(defaults["max_iter"]), integer=True),
+                         Argument("tol", sympy.Matrix([sympy.Symbol("tol")]), scalar=True, default=repr(defaults["tol"])))
+            made.append(Loop("ik_numeric", "iterative inverse kinematics from q0: damped least squares on the task "
+                             "error; (q, status)", (Output("q", n, 1, vector=True, extent=("DOF",)),
+                                                    Output("status", 1, 1, scalar=True, integer=True)), arguments,
+                             operations=differential.IK_NUMERIC_OPERATIONS, casadi="steps"))
+        if form is None:
+            return made
+        target = self._closed_form_target()
+        free = (Argument("q_free", sympy.Matrix([sympy.Symbol("q_free", real=True)]), scalar=True),) * (form.free is not None)
+        rows, solutions = form.info.max_solutions, ("MAX_IK_SOLUTIONS",)
+        general = form.solver == "general_6r"
+        if general and self.generates("ik_branches"):
+            made.append(Loop("ik_branches", "every branch of the general 6R ik, whether the target allows it and "
+                             "whether it is inside the joint limits",
+                             (Output("q", rows, n, extent=(*solutions, "DOF")),
+                              Output("valid", rows, 1, vector=True, boolean=True, extent=solutions),
+                              Output("in_limits", rows, 1, vector=True, boolean=True, extent=solutions)),
+                             (target, *free), operations=general6r.OPERATIONS))
+        if self.generates("ik"):
+            made.append(Loop("ik", "closed-form inverse kinematics: every joint solution that reaches the target, "
+                             "inside the joint limits unless `limits` is False: one target gives them as (k, DOF), a "
+                             "batch gives (q, keep), (..., MAX_IK_SOLUTIONS, DOF) and (..., MAX_IK_SOLUTIONS)",
+                             (Output("q", rows, n, extent=(*solutions, "DOF")),
+                              Output("count", 1, 1, scalar=True, integer=True)), (target, *free),
+                             operations=general6r.OPERATIONS if general else 0, casadi=None if general else "graph"))
+        return made
 
     def unavailable(self) -> list[str]:
         """The selected functions this robot does not have, each with why."""
         made = {f.name for f in (*self._functions, *self.loops)}
-        made |= {name for name, callees in CALLEES.items() if made.issuperset(callees)}
         why = {"ik": f"no closed form ({self.model.structure.reason})",
                "jacobian_det": f"Js is {len(self.robot.task)} x {self.robot.dof}, not square"}
         why["ik_branches"] = why["ik_nearest"] = why["ik"]
@@ -484,7 +520,7 @@ class Generator:
             self.ik_numeric_step_function(task_jacobian) if self.generates("ik_numeric_step") else None,
             *self.ik_functions(),
         )
-        return tuple(function for function in functions if function is not None)
+        return tuple(in_catalogue_order(function for function in functions if function is not None))
 
 
 def _rigid_inverse(transform: sympy.Matrix) -> sympy.Matrix:

@@ -34,6 +34,8 @@ IK_NUMERIC_STATUSES = (
 IK_NUMERIC_DEFAULTS = {"max_iter": 100, "tol": IK_NUMERIC_DEFAULT}
 # CasADi's ik_numeric takes this many steps (a fixed graph; the C and numpy stop when done).
 IK_NUMERIC_ITERATIONS = 100
+# A bound on the operations of one ik_numeric call of the default length (100 steps).
+IK_NUMERIC_OPERATIONS = 100 * 3 * 1_000
 # The Levenberg-Marquardt damping (added to the diagonal): start, least, most.
 IK_NUMERIC_DAMPING = {"start": 1e-6, "min": 1e-12, "max": 1e8}
 

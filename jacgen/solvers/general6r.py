@@ -343,6 +343,8 @@ Q_RANK = 1e-12
 # rounding splits into a complex pair (by about the square root of that rounding) still counts,
 # and the Newton steps and the tolerance above decide.
 IMAGINARY = {"double": 1e-5, "float": 1e-3}
+# A bound on the operations of one ik_branches call (what the native module splits batches by).
+OPERATIONS = 200_000
 
 
 def half_angle(s: np.ndarray) -> np.ndarray:

@@ -19,6 +19,7 @@ import pytest
 
 from jacgen.checking import generated_code
 from jacgen.checking.c_library import CLibrary, compile_shared
+from jacgen.emission.catalogue import with_callees
 from jacgen.emission.generator import Generator
 from jacgen.checking.generated_code import import_module
 from jacgen.files import write_files
@@ -60,15 +61,23 @@ class Code:
         self.build.mkdir(parents=True, exist_ok=True)
         return compile_shared([self._path(".c")], self.build / f"lib{self.robot.name}.so")
 
-    def library(self, functions=()) -> CLibrary:
-        """The compiled C called from Python (`functions`: those `CLibrary.evaluate` is to call)."""
-        return CLibrary(self.shared_library, self.robot, list(functions), self.real)
+    def signatures(self, names=None) -> list:
+        """The signatures of the functions named and their callees (every function: None), from
+        the code's Generator, or for committed code from one made for them."""
+        generator = self.generator or Generator(self.robot, selection=names)
+        wanted = None if names is None else with_callees(names)
+        return [f for f in generator.signatures() if wanted is None or (f.part_of or f.name) in wanted]
+
+    def library(self, *names: str) -> CLibrary:
+        """The compiled C called from Python: `CLibrary.call` and `evaluate` call the functions
+        named and their callees."""
+        return CLibrary(self.shared_library, self.robot, self.signatures(names) if names else [], self.real)
 
     @functools.cached_property
     def backends(self) -> generated_code.GeneratedCode:
         """Python, CasADi and this C, called on batches as `jacgen verify` calls them (backend
         names "python", "casadi", "c double" or "c float")."""
-        return generated_code.GeneratedCode(self.robot, [], self.folder, {self.real: self.shared_library})
+        return generated_code.GeneratedCode(self.robot, self.signatures(), self.folder, {self.real: self.shared_library})
 
 
 class GeneratedCode:
@@ -101,6 +110,12 @@ class GeneratedCode:
             self._code[key] = Code(load_robot(ROOT / "robots" / f"{name}.yaml"), GENERATED,
                                    self.folder / f"committed_{name}")
         return self._code[key]
+
+
+def c_ik(library: CLibrary, target, *free, parameters=None):
+    """NAME_ik's solutions (k, DOF) at one target (and the free joint's angle, if any)."""
+    q, count = library.call("ik", target, *free, parameters=parameters)
+    return q[:count]
 
 
 @pytest.fixture(scope="module")

@@ -5,12 +5,12 @@ from dataclasses import dataclass
 from typing import Callable
 
 
-from jacgen.emission.catalogue import Output
+from jacgen.emission.catalogue import DECLARED, Output
 from jacgen.emission.generator import Generator
 from jacgen.inputs.robot import Robot
 from jacgen.model import singularities
 from jacgen.model.nodes import RANK, TOLERANCES
-from jacgen.solvers import differential, general6r, ik, ik_limits
+from jacgen.solvers import differential, general6r, ik
 from jacgen.tolerances import REACHED
 
 
@@ -97,8 +97,7 @@ def ik_context(robot: Robot, generator: Generator, real: str, number: Callable, 
         "doc": ik.documentation(robot, form, solutions_macro),
         "inputs": ", ".join(inputs),
         "free_joint": form.free,
-        "nearest_statuses": [("OK", ik_limits.IK_NEAREST_OK), ("NO_SOLUTION", ik_limits.IK_NEAREST_NO_SOLUTION),
-                             ("NOT_FINITE", ik_limits.IK_NEAREST_NOT_FINITE)],
+        "nearest_statuses": [(status.name, status.value) for status in DECLARED["ik_nearest"].statuses],
         "signature": ", ".join(arguments),
         "wrapper": generator.generates("ik"),
         "nearest": generator.generates("ik_nearest"),
@@ -157,6 +156,5 @@ def velocity_ik_context(robot: Robot, real: str) -> dict:
         "mu_text": f"({names}): components of the tool's linear (v) and angular (w) velocity in the world frame"
         if rows is not None else f"the rate of the task vector ({', '.join(robot.task)})",
         "rank": repr(float(TOLERANCES[real][RANK])),
-        "statuses": [("OK", differential.VELOCITY_IK_OK), ("SINGULAR", differential.VELOCITY_IK_SINGULAR),
-                     ("NOT_FINITE", differential.VELOCITY_IK_NOT_FINITE)],
+        "statuses": [(status.name, status.value) for status in DECLARED["velocity_ik"].statuses],
     }

@@ -13,10 +13,10 @@ from math import prod
 
 from jacgen.emission.backends.c import CPrinter, c_context
 from jacgen.emission.backends.common import Backend
+from jacgen.emission.catalogue import Function
 from jacgen.emission.generator import Generator
 from jacgen.inputs import names
 from jacgen.inputs.robot import Robot
-from jacgen.solvers import differential
 from jacgen.version import __version__
 
 BUILDS = ("double", "float")
@@ -38,8 +38,6 @@ baseline (vectorised for the oldest x86-64) or scalar (no vector math library at
 VECTOR_MATH = ("sin", "cos", "tan", "asin", "acos", "atan", "atan2", "exp", "log", "pow")
 # A batch is split over threads when each gets at least this many operations (about 50 us).
 WORK_PER_THREAD = 100_000
-# Operations per row of the loops the C templates write (no Body counts them): a bound.
-LOOP_OPERATIONS = {"ik_branches": 200_000, "ik_numeric": 100 * 3 * 1_000}
 
 
 def build_name(robot: Robot, build: str) -> str:
@@ -93,61 +91,38 @@ def _entry(name: str, summary: str, inputs: list[dict], outputs: list[dict], ret
     }
 
 
-def entries(robot: Robot, generator: Generator, parameters: list[dict]) -> list[dict]:
-    """Every function of NAME.py with its operands, in the order of the C header."""
-    loops = {loop.name for loop in generator.loops}
+def entries(generator: Generator, parameters: list[dict]) -> list[dict]:
+    """Every function of NAME.py with its operands, in the catalogue's order, ik last: it runs
+    ik_branches' kernels and keeps the valid rows (its Python result is not its C one)."""
+    loops = {loop.name: loop for loop in generator.loops}
     made = []
-    for f in generator.functions():
-        inputs = [_operand(a.name, () if a.scalar else (a.size,) if a.vector else a.symbols.shape, "real", a.default)
-                  for a in f.arguments]
+    for f in (*generator.functions(), *(loop for loop in loops.values() if loop.name != "ik")):
+        inputs = [_operand(a.name, a.shape, "int" if a.integer else "real", a.default) for a in f.arguments]
         outputs = [_operand(o.name, o.shape, _kind(o)) for o in f.outputs]
         returned = next((k for k, o in enumerate(f.outputs) if o is f.returned), None)
-        simd = not any(call.function in loops for call in f.calls)
-        made.append(_entry(f.name, f.summary, inputs, outputs, returned, f.body.operation_count, simd, parameters))
-    form = generator.closed_form
-    target = (4, 4) if len(robot.task) == 6 else (len(robot.task),)
-    for loop in generator.loops:  # the general 6R solver: a pose, and a 7R arm's free joint
-        outputs = [_operand(o.name, o.shape, _kind(o)) for o in loop.outputs]
-        inputs = [_operand("T", (4, 4), "real")] + [_operand("q_free", (), "real")] * (form.free is not None)
-        made.append(_entry(loop.name, "every branch of the general 6R ik, whether the target allows it and whether "
-                           "it is inside the joint limits", inputs, outputs, None, LOOP_OPERATIONS[loop.name], False,
-                           parameters))
-    if generator.generates("ik_numeric"):
-        defaults = differential.IK_NUMERIC_DEFAULTS
-        inputs = [_operand("target", target, "real"), _operand("q0", (robot.dof,), "real"),
-                  _operand("max_iter", (), "int", repr(defaults["max_iter"])),
-                  _operand("tol", (), "real", repr(defaults["tol"]))]
-        made.append(_entry("ik_numeric", "iterative inverse kinematics from q0: damped least squares on the task "
-                           "error; (q, status)", inputs,
-                           [_operand("q", (robot.dof,), "real"), _operand("status", (), "int")], 1,
-                           LOOP_OPERATIONS["ik_numeric"], False, parameters))
-    if form is not None and generator.generates("ik"):
+        straight = isinstance(f, Function)
+        simd = straight and not any(call.function in loops for call in f.calls)
+        made.append(_entry(f.name, f.summary, inputs, outputs, returned,
+                           f.body.operation_count if straight else f.operations, simd, parameters))
+    if "ik" in loops:
         branches = next(e for e in made if e["name"] == "ik_branches")
-        ik = _entry("ik", "closed-form inverse kinematics: every joint solution that reaches the target, inside the "
-                    "joint limits unless `limits` is False: one target gives them as (k, DOF), a batch gives (q, "
-                    "keep), (..., MAX_IK_SOLUTIONS, DOF) and (..., MAX_IK_SOLUTIONS)",
-                    branches["operands"][:branches["positional"]], branches["operands"][branches["inputs"]:], None,
-                    branches["operations"], False, parameters)
+        ik = _entry("ik", loops["ik"].summary, branches["operands"][:branches["positional"]],
+                    branches["operands"][branches["inputs"]:], None, branches["operations"], False, parameters)
         made.append(ik | {"wraps": made.index(branches)})
     return made
 
 
-def constants(robot: Robot, c: dict) -> list[tuple[str, str]]:
+def constants(robot: Robot, generator: Generator, c: dict) -> list[tuple[str, str]]:
     """The module's constants, as NAME.py has them: (name, Python expression)."""
     made = [("DOF", str(robot.dof)), ("TASK", repr(tuple(robot.task)))]
     if robot.symbolic_parameters:
         made.append(("PARAMETERS", repr({p.name: p.value for p in robot.symbolic_parameters})))
-    ik = c["ik"]
-    if ik:
-        made.append(("MAX_IK_SOLUTIONS", str(ik["max_solutions"])))
-        if ik["free_joint"] is not None:
-            made.append(("IK_FREE_JOINT", str(ik["free_joint"])))
-        if ik["nearest"]:
-            made += [(f"IK_NEAREST_{status}", str(value)) for status, value in ik["nearest_statuses"]]
-    if c["ik_numeric"]:
-        made += [(f"IK_NUMERIC_{status}", str(value)) for status, value, _ in differential.IK_NUMERIC_STATUSES]
-    if c["velocity_ik"]:
-        made += [(f"VELOCITY_IK_{status}", str(value)) for status, value in c["velocity_ik"]["statuses"]]
+    if c["ik"]:
+        made.append(("MAX_IK_SOLUTIONS", str(c["ik"]["max_solutions"])))
+        if c["ik"]["free_joint"] is not None:
+            made.append(("IK_FREE_JOINT", str(c["ik"]["free_joint"])))
+    for f in sorted((*generator.functions(), *generator.loops), key=lambda f: f.name):
+        made += [(f"{f.name.upper()}_{status.name}", str(status.value)) for status in f.statuses]
     return made
 
 
@@ -155,7 +130,7 @@ def native_context(robot: Robot, generator: Generator, printer, real: str) -> di
     """The module and both builds of the C it wraps (`real` does not apply: it has both)."""
     builds = {build: c_context(replace(robot, name=build_name(robot, build)), generator, CPrinter(build), build)
               for build in BUILDS}
-    functions = entries(robot, generator, builds["double"]["parameters"])
+    functions = entries(generator, builds["double"]["parameters"])
     native = {
         "name": robot.name,
         "module": f"{robot.name}_native",
@@ -165,7 +140,7 @@ def native_context(robot: Robot, generator: Generator, printer, real: str) -> di
         # the functions with kernels of their own (and gufuncs): all but ik, which comes last and
         # uses ik_branches', so that an entry's index is its kernels' index
         "kernels": [e for e in functions if "wraps" not in e],
-        "constants": [(constant, c_string(value)) for constant, value in constants(robot, builds["double"])],
+        "constants": [(constant, c_string(value)) for constant, value in constants(robot, generator, builds["double"])],
         "module_doc": c_string(MODULE_DOC.format(name=robot.name)),
         "builds": [(build, build_name(robot, build)) for build in BUILDS],
         "vector_math": VECTOR_MATH,
