@@ -186,7 +186,7 @@ def test_reserved_parameter_names_cover_the_generated_code(robot_name):
         loose = sorted(name for name in names - parameters if not parameter_name_problem(name, robot.name))
         if loose:
             unreserved[path] = loose
-    assert not unreserved, f"names a parameter could take (add them to jacgen/names.py): {unreserved}"
+    assert not unreserved, f"names a parameter could take (add them to jacgen/inputs/names.py): {unreserved}"
 
 
 # -- free text ------------------------------------------------------------------------------------------

@@ -17,7 +17,7 @@ import sympy
 from jacgen.model import graph
 from jacgen.model.graph import TOLERANCE_VALUES, Node, evaluate
 from jacgen.emission.lowering import Body
-from jacgen.model.nodes import TOLERANCE_SYMBOLS
+from jacgen.model.tolerance_symbols import TOLERANCE_SYMBOLS
 
 # Integers up to this size print as integer literals (exact in float and double, and an `int`
 # in C); larger ones as floating literals, which cannot overflow an integer type.

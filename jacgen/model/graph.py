@@ -23,7 +23,7 @@ import numpy
 import sympy
 from sympy.logic.boolalg import Boolean
 
-from jacgen.model.nodes import TOLERANCE_SYMBOLS, TOLERANCES
+from jacgen.model.tolerance_symbols import TOLERANCE_SYMBOLS, TOLERANCES
 
 # The kinds of node. A number's value is an int, a Fraction (an exact rational, as sympy's
 # Rational), a Folded (a constant folded from sympy's floats and irrationals, see Folded) or, as

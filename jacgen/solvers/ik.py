@@ -17,7 +17,7 @@ import numpy
 import sympy
 
 from jacgen.model.graph import AND, Node
-from jacgen.model.nodes import EPS
+from jacgen.model.tolerance_symbols import EPS
 from jacgen.model.structure import (E_Z, SOLVERS, Geometry, Nominal, SolverInfo, Structure, classify, is_zero,
                                     nearest_class, readable)
 from jacgen.solvers import general6r

@@ -22,7 +22,7 @@ from typing import Callable
 import sympy
 
 from jacgen.model.graph import AND, CALL, NUMBER, OR, SELECT, Graph, Node
-from jacgen.model.nodes import EPS, TINY
+from jacgen.model.tolerance_symbols import EPS, TINY
 
 Vector = tuple[Node, Node, Node]
 

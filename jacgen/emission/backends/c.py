@@ -11,7 +11,7 @@ from jacgen.emission.generator import Generator
 from jacgen.emission.printers import AND, ATOM, MATH_FUNCTIONS, PRODUCT, RELATION, Printer
 from jacgen.inputs import names
 from jacgen.inputs.robot import Robot
-from jacgen.model.nodes import TOLERANCES
+from jacgen.model.tolerance_symbols import TOLERANCES
 
 _FLOAT_MAX = float(numpy.finfo(numpy.float32).max)
 

@@ -9,7 +9,7 @@ from jacgen.emission.catalogue import Output
 from jacgen.emission.generator import Generator
 from jacgen.inputs.robot import Robot
 from jacgen.model import singularities
-from jacgen.model.nodes import RANK, TOLERANCES
+from jacgen.model.tolerance_symbols import RANK, TOLERANCES
 from jacgen.solvers import differential, general6r, ik, ik_limits
 from jacgen.tolerances import REACHED
 
