@@ -7,7 +7,8 @@ import sympy
 from jacgen.inputs import numeric_chain
 from jacgen.inputs.robot import Robot
 from jacgen.model import structure
-from jacgen.model.singularities import READABLE_TERMS, Factor, Singularities, singularity_rows
+from jacgen.model.js_rank import singularity_rows
+from jacgen.model.singularities import READABLE_TERMS, Factor, Singularities
 from jacgen.model.structure import SOLVERS
 from jacgen.solvers import general6r
 from jacgen.solvers.model import Model

@@ -8,7 +8,7 @@ from typing import Callable
 from jacgen.emission.catalogue import Output
 from jacgen.emission.generator import Generator
 from jacgen.inputs.robot import Robot
-from jacgen.model import singularities
+from jacgen.model import js_rank
 from jacgen.model.tolerance_symbols import RANK, TOLERANCES
 from jacgen.solvers import differential, general6r, ik, ik_limits
 from jacgen.tolerances import REACHED
@@ -147,7 +147,7 @@ def ik_numeric_context(robot: Robot, number: Callable) -> dict:
 def velocity_ik_context(robot: Robot, real: str) -> dict:
     """What the documentation of velocity_ik says: Js, mu_dot, the system and its statuses."""
     m, n = len(robot.task), robot.dof
-    rows = singularities.singularity_rows(robot)
+    rows = js_rank.singularity_rows(robot)
     names = ", ".join(("vx", "vy", "vz", "wx", "wy", "wz")[r] for r in rows) if rows is not None else ""
     return {
         "system": min(m, n),
