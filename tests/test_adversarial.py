@@ -189,6 +189,17 @@ def test_reserved_parameter_names_cover_the_generated_code(robot_name):
     assert not unreserved, f"names a parameter could take (add them to jacgen/inputs/names.py): {unreserved}"
 
 
+def test_every_language_refuses_its_reserved_words():
+    """The languages are names.RESERVED's keys: each has its backend, and each word any of
+    them reserves is refused as a parameter name."""
+    from jacgen.emission.backends import LANGUAGES, backend
+    from jacgen.inputs.names import RESERVED
+
+    assert LANGUAGES == tuple(RESERVED) and all(backend(language).name == language for language in LANGUAGES)
+    words = set().union(*(words for reserved in RESERVED.values() for words in reserved.values()))
+    assert all(parameter_name_problem(word, "arm") for word in words)
+
+
 # -- free text ------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("text, problem", [
     ("ends */ here", "may not contain '*/'"), ("opens /* here", "may not contain '/*'"),

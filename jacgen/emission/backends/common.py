@@ -17,15 +17,14 @@ from jacgen.tolerances import REACHED
 @dataclass(frozen=True)
 class Backend:
     """One target language: its templates with the file each becomes, its expression printer
-    for a real type ("double", "float"; None: prints no expression), the builder of what its
-    templates receive, and the words it reserves (by reason)."""
+    for a real type ("double", "float"; None: prints no expression) and the builder of what its
+    templates receive. The words it reserves are `names.RESERVED[name]`."""
 
     name: str
     # (template, output file pattern with {name}[, the key of the context's part it renders])
     templates: tuple[tuple[str, ...], ...]
     printer: Callable[[str], object] | None
     context: Callable  # (robot, generator, printer, real) -> the templates' data
-    reserved: dict[str, frozenset[str]]
 
 
 def common_context(robot: Robot) -> dict:

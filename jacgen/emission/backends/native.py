@@ -14,7 +14,6 @@ from math import prod
 from jacgen.emission.backends.c import CPrinter, c_context
 from jacgen.emission.backends.common import Backend
 from jacgen.emission.generator import Generator
-from jacgen.inputs import names
 from jacgen.inputs.robot import Robot
 from jacgen.solvers import differential
 from jacgen.version import __version__
@@ -186,4 +185,4 @@ BACKEND = Backend(
      ("native/kernels.c.jinja", "{name}_native_float.c", "float"),
      ("native/native.h.jinja", "{name}_native.h"), ("native/module.c.jinja", "{name}_native.c"),
      ("native/setup.py.jinja", "setup.py"), ("native/pyproject.toml.jinja", "pyproject.toml")),
-    None, native_context, names.C_RESERVED)
+    None, native_context)
