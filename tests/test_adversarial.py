@@ -25,7 +25,7 @@ from click.testing import CliRunner
 from jacgen.cli import main
 from jacgen.inputs.names import PARAMETER_NAME_RULE, ROBOT_NAME_RULE, parameter_name_problem
 from jacgen.emission.render import DEFAULT_LANGUAGES, render_robot
-from jacgen.inputs.robot import parse_robot
+from jacgen.inputs.robot_file import parse_robot
 
 from conftest import ROOT
 

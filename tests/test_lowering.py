@@ -11,7 +11,7 @@ from jacgen.model.graph import AND, OR, Graph, Node, evaluate
 from jacgen.emission.cse import _reusing_temporaries, eliminate_common
 from jacgen.emission.lowering import Lowering
 from jacgen.emission.operation_count import operation_count
-from jacgen.inputs.robot import load_robot, parse_robot
+from jacgen.inputs.robot_file import load_robot, parse_robot
 from conftest import ROOT
 from support.graph_sympy import to_sympy
 from support.random_arms import random_arm_text
