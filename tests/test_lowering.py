@@ -7,7 +7,8 @@ import sympy
 from sympy.core.parameters import distribute
 
 from jacgen.emission.generator import Generator
-from jacgen.model.graph import AND, OR, Graph, Node, evaluate
+from jacgen.model.graph import Graph
+from jacgen.model.node import AND, OR, Node, evaluate
 from jacgen.emission.cse import _reusing_temporaries, eliminate_common
 from jacgen.emission.lowering import Lowering
 from jacgen.emission.operation_count import operation_count

@@ -9,7 +9,8 @@ from collections import Counter
 import sympy
 from sympy.simplify.cse_main import Unevaluated, match_common_args
 
-from jacgen.model.graph import ADD, CALL, MUL, NUMBER, POW, SELECT, Graph, Node, negative_coefficient
+from jacgen.model.graph import Graph
+from jacgen.model.node import ADD, CALL, MUL, NUMBER, POW, SELECT, Node, negative_coefficient
 
 
 def eliminate_common(graph: Graph, exprs: list[Node], symbols, negations: dict) -> tuple[list, list[Node]]:

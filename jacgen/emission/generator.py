@@ -19,7 +19,8 @@ from jacgen.inputs.robot import EULER_ANGLES, Robot
 from jacgen.model import kinematics
 from jacgen.model.joint_ring import joint_atoms
 from jacgen.model.js_rank import rank_determinant, singularity_jacobian
-from jacgen.model.graph import Node, elementwise
+from jacgen.model.graph import elementwise
+from jacgen.model.node import Node
 from jacgen.model.kinematics import generated_symbol
 from jacgen.model.singularities import Singularities
 from jacgen.solvers import differential, general6r_target, ik, ik_limits

@@ -17,7 +17,8 @@ import sympy
 from jacgen.emission.cse import eliminate_common
 from jacgen.emission.operation_count import operation_count
 from jacgen.inputs import names
-from jacgen.model.graph import ADD, MUL, SYMBOL, TOLERANCE_VALUES, Graph, Node, evaluate, negative_coefficient
+from jacgen.model.graph import Graph
+from jacgen.model.node import ADD, MUL, SYMBOL, TOLERANCE_VALUES, Node, evaluate, negative_coefficient
 
 
 @dataclass(frozen=True)

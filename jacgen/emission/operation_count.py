@@ -8,8 +8,8 @@ from fractions import Fraction
 
 import sympy
 
-from jacgen.model.graph import (ADD, AND, CALL, FINITE, MUL, NOT, NUMBER, OR, POW, RELATION, SELECT, TRUTH, Node,
-                                negative_coefficient)
+from jacgen.model.node import (ADD, AND, CALL, FINITE, MUL, NOT, NUMBER, OR, POW, RELATION, SELECT, TRUTH, Node,
+                               negative_coefficient)
 
 
 def operation_count(nodes) -> int:

@@ -15,7 +15,8 @@ from functools import lru_cache
 import sympy
 
 from jacgen.inputs.robot import EULER_ANGLES, TASK_COMPONENTS, Robot
-from jacgen.model.graph import Graph, Node, elementwise, is_zero
+from jacgen.model.graph import Graph, elementwise
+from jacgen.model.node import Node, is_zero
 
 # The maximal minors of Js (C(n, m) of them) the exact analysis seeks common factors of, and the
 # generated Gram determinant sums the squares of; past it, QR (`rank_determinant`).

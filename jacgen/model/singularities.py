@@ -29,7 +29,8 @@ from sympy.polys.rings import PolyElement
 
 from jacgen.inputs import numeric_chain
 from jacgen.inputs.robot import TASK_COMPONENTS, Robot
-from jacgen.model.graph import ADD, Graph, evaluate
+from jacgen.model.graph import Graph
+from jacgen.model.node import ADD, evaluate
 from jacgen.model.joint_ring import (READABLE_TERMS, JointRing, TooLarge, factorise, frames_about, geometric_columns,
                                      multiply, permutation_sign, term_count)
 from jacgen.model.js_rank import MINOR_LIMIT, maximal_minors, singularity_rows

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy
 import sympy
 
-from jacgen.model.graph import AND, Node
+from jacgen.model.node import AND, Node
 from jacgen.model.tolerance_symbols import EPS
 from jacgen.model.structure import (E_Z, SOLVERS, Geometry, Nominal, SolverInfo, Structure, classify, is_zero,
                                     nearest_class, readable)

@@ -5,7 +5,7 @@ from jacgen.emission.backends.common import Backend, common_context, ik_numeric_
 from jacgen.emission.backends.python import python_number
 from jacgen.emission.catalogue import Function
 from jacgen.emission.generator import Generator
-from jacgen.model.graph import is_zero
+from jacgen.model.node import is_zero
 from jacgen.emission.printers import MATH_FUNCTIONS, Printer
 from jacgen.inputs.robot import Robot
 

@@ -8,7 +8,7 @@ from jacgen.emission.backends.common import (Backend, common_context, dimensions
                                              velocity_ik_context)
 from jacgen.emission.catalogue import Function
 from jacgen.emission.generator import Generator
-from jacgen.model.graph import ADD, CALL, NUMBER, SELECT, SYMBOL
+from jacgen.model.node import ADD, CALL, NUMBER, SELECT, SYMBOL
 from jacgen.emission.printers import ATOM, MATH_FUNCTIONS, RELATION, Printer
 from jacgen.inputs.robot import Robot
 
