@@ -18,8 +18,8 @@ import sympy
 
 from jacgen.model.node import AND, Node
 from jacgen.model.tolerance_symbols import EPS
-from jacgen.model.structure import (E_Z, SOLVERS, Geometry, Nominal, SolverInfo, Structure, classify, is_zero,
-                                    nearest_class, readable)
+from jacgen.model.nearest_class import Nominal, nearest_class
+from jacgen.model.structure import E_Z, SOLVERS, Geometry, SolverInfo, Structure, classify, is_zero, readable
 from jacgen.solvers import general6r
 from jacgen.solvers.ik_limits import limited
 from jacgen.solvers.subproblems import Angle, Root, Subproblems, relative, times, times_transposed
