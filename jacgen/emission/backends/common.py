@@ -10,7 +10,8 @@ from jacgen.emission.generator import Generator
 from jacgen.inputs.robot import Robot
 from jacgen.model import js_rank
 from jacgen.model.tolerance_symbols import RANK, TOLERANCES
-from jacgen.solvers import differential, general6r, ik, ik_limits
+from jacgen.reports import ik_documentation
+from jacgen.solvers import differential, general6r, ik_limits
 from jacgen.tolerances import REACHED
 
 
@@ -93,7 +94,7 @@ def ik_context(robot: Robot, generator: Generator, real: str, number: Callable, 
     return {
         "solver": form.solver,
         "max_solutions": form.info.max_solutions,
-        "doc": ik.documentation(robot, form, solutions_macro),
+        "doc": ik_documentation.documentation(robot, form, solutions_macro),
         "inputs": ", ".join(inputs),
         "free_joint": form.free,
         "nearest_statuses": [("OK", ik_limits.IK_NEAREST_OK), ("NO_SOLUTION", ik_limits.IK_NEAREST_NO_SOLUTION),
