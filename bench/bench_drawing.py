@@ -25,7 +25,7 @@ import numpy as np
 import common
 from common import random_arm_text
 from jacgen.reports import drawing
-from jacgen.inputs.robot import parse_robot
+from jacgen.inputs.robot_file import parse_robot
 
 RTB_MODELS = {"puma560": "Puma560", "panda": "Panda", "ur5": "UR5", "stanford": "Stanford", "kr5": "KR5",
               "jaco": "Jaco"}

@@ -39,7 +39,7 @@ from common import kinematic_chain
 from jacgen.checking import reference
 from jacgen.checking.c_library import CLibrary
 from jacgen.emission.generator import Generator
-from jacgen.inputs.robot import parse_robot
+from jacgen.inputs.robot_file import parse_robot
 
 FREE_VALUE = {"panda": np.pi / 4, "iiwa": 0.3}
 

@@ -49,7 +49,7 @@ from jacgen.checking.c_library import CLibrary
 from jacgen.emission.generator import Generator
 from jacgen.solvers.ik import closed_form
 from jacgen.solvers.model import Model
-from jacgen.inputs.robot import load_robot
+from jacgen.inputs.robot_file import load_robot
 
 ROBOTS = {"ur5": IkGeoRobot.three_parallel_two_intersecting, "puma560": IkGeoRobot.spherical_two_parallel}
 GENERAL = ("jaco", "manocha_canny", "ur5_calibrated", "puma560_calibrated", "kr5_calibrated", "sawyer", "panda_calibrated")

@@ -28,7 +28,7 @@ from pathlib import Path
 import common
 from common import random_arm_text
 from jacgen.emission.generator import Generator, matrix
-from jacgen.inputs.robot import parse_robot
+from jacgen.inputs.robot_file import parse_robot
 
 ROBOTS = ("puma560", "ur5", "panda")
 VARIANTS = ("ours fk_jacobian", "ours fk_jacobian_dot", "pinocchio fk_jacobian", "pinocchio dot")

@@ -58,7 +58,7 @@ from jacgen.checking import reference  # noqa: E402
 from jacgen.checking.c_library import c_compiler, compile_shared  # noqa: E402
 from jacgen.files import write_files  # noqa: E402
 from jacgen.emission.render import render_robot  # noqa: E402
-from jacgen.inputs.robot import load_robot  # noqa: E402
+from jacgen.inputs.robot_file import load_robot  # noqa: E402
 
 # What benches take from tests/: {name: the module of tests/ that defines it}.
 FROM_TESTS = {"random_arm_text": "support.random_arms", "pinocchio_from_dh": "support.pinocchio_chain",
@@ -122,7 +122,7 @@ sys.path.insert(0, ".")
 try:  # the stage folders (issue 38), else the flat layout of earlier commits
     from jacgen.emission.generator import Generator
     from jacgen.emission.render import render_robot
-    from jacgen.inputs.robot import load_robot
+    from jacgen.inputs.robot_file import load_robot
 except ImportError:
     from jacgen.functions import Generator
     from jacgen.render import render_robot

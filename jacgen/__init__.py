@@ -16,7 +16,7 @@ from importlib import import_module
 from jacgen.version import __version__
 
 _HOMES = {"JacgenError": "errors", "RobotFileError": "errors", "Kinematics": "model.kinematics",
-          "render_robot": "emission.render", "Robot": "inputs.robot", "load_robot": "inputs.robot"}
+          "render_robot": "emission.render", "Robot": "inputs.robot", "load_robot": "inputs.robot_file"}
 
 __all__ = ["JacgenError", "Kinematics", "Robot", "RobotFileError", "load_robot", "render_robot", "__version__"]
 

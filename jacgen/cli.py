@@ -137,7 +137,7 @@ def generate(robot_files, output, languages, real, check, functions, budget_seco
     robots, files = [], {}
     if len(cached) < len(paths):
         from jacgen.emission.render import render_robots
-        from jacgen.inputs.robot import load_robot
+        from jacgen.inputs.robot_file import load_robot
 
         budget.set_seconds(budget_seconds)
         robots = [load_robot(path) for path in paths if path not in cached]  # validate all before writing any
@@ -175,7 +175,7 @@ def _remember(robots: list, files: dict[str, str], keys: dict[Path, str | None])
 @robot_files
 def validate(robot_files):
     """Check robot files only."""
-    from jacgen.inputs.robot import load_robot
+    from jacgen.inputs.robot_file import load_robot
 
     for path in robot_files:
         robot = load_robot(path)
@@ -211,7 +211,7 @@ def _configuration(ctx, param, value: str | None):
 def show(robot_file, plot_file, q, urdf_file, base, tip, tolerance):
     """Describe a robot in words (DH table, task, singularities, inverse kinematics), draw it,
     compare it with a URDF."""
-    from jacgen.inputs.robot import load_robot
+    from jacgen.inputs.robot_file import load_robot
     from jacgen.reports.description import describe
     from jacgen.solvers.model import Model
 
@@ -256,7 +256,7 @@ def verify(robot_files, samples, seed, target, sources, native, jobs):
     """Compare every generated function of every backend with the numpy reference."""
     from jacgen.checking.verify import format_table
     from jacgen.checking.verify import verify as verify_robots
-    from jacgen.inputs.robot import load_robot
+    from jacgen.inputs.robot_file import load_robot
 
     if sources and not target:
         raise click.UsageError("--sources needs --target")

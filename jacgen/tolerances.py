@@ -1,7 +1,7 @@
 """jacgen's tolerances, each named for what it decides. This module imports nothing, so the
 command line reads it before it loads a stage. The tolerances of one algorithm's inner
 working stay beside it: the structure stage's 1e-40 on 60-digit numbers, the generated code's
-EPS and TINY (`model/nodes.py`), the general 6R solver's convergence (`solvers/general6r.py`).
+EPS and TINY (`model/tolerance_symbols.py`), the general 6R solver's convergence (`solvers/general6r.py`).
 
 Most are 1e-9, in rad and in the robot's length unit (times 1 + reach where poses are
 compared): a few hundred roundings of double arithmetic on numbers of order 1 stay far below

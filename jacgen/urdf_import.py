@@ -19,8 +19,8 @@ from jacgen.checking import reference
 from jacgen.errors import JacgenError, RobotFileError
 from jacgen.inputs.dh_fit import Axis, exact_or_float, fit
 from jacgen.inputs.names import robot_name_problem
-from jacgen.inputs.robot import (FORBIDDEN_IN_TEXT, IDENTIFIER_PATTERN, NAME_PATTERN, TASK_COMPONENTS, Robot,
-                                 parse_robot, task_problem)
+from jacgen.inputs.robot import TASK_COMPONENTS, Robot
+from jacgen.inputs.robot_file import FORBIDDEN_IN_TEXT, IDENTIFIER_PATTERN, NAME_PATTERN, parse_robot, task_problem
 from jacgen.inputs.urdf import MOVABLE, LinkChain, Snapper, joint_axes, read_chain
 from jacgen.version import __version__
 from jacgen.tolerances import ANGLE_SNAP

@@ -25,7 +25,7 @@ from click.testing import CliRunner
 from jacgen.cli import main
 from jacgen.inputs.names import PARAMETER_NAME_RULE, ROBOT_NAME_RULE, parameter_name_problem
 from jacgen.emission.render import DEFAULT_LANGUAGES, render_robot
-from jacgen.inputs.robot import parse_robot
+from jacgen.inputs.robot_file import parse_robot
 
 from conftest import ROOT
 
@@ -186,7 +186,18 @@ def test_reserved_parameter_names_cover_the_generated_code(robot_name):
         loose = sorted(name for name in names - parameters if not parameter_name_problem(name, robot.name))
         if loose:
             unreserved[path] = loose
-    assert not unreserved, f"names a parameter could take (add them to jacgen/names.py): {unreserved}"
+    assert not unreserved, f"names a parameter could take (add them to jacgen/inputs/names.py): {unreserved}"
+
+
+def test_every_language_refuses_its_reserved_words():
+    """The languages are names.RESERVED's keys: each has its backend, and each word any of
+    them reserves is refused as a parameter name."""
+    from jacgen.emission.backends import LANGUAGES, backend
+    from jacgen.inputs.names import RESERVED
+
+    assert LANGUAGES == tuple(RESERVED) and all(backend(language).name == language for language in LANGUAGES)
+    words = set().union(*(words for reserved in RESERVED.values() for words in reserved.values()))
+    assert all(parameter_name_problem(word, "arm") for word in words)
 
 
 # -- free text ------------------------------------------------------------------------------------------

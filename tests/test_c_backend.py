@@ -19,7 +19,7 @@ from jacgen.emission.generator import Generator, matrix, scalar
 from jacgen.emission.backends.c import CPrinter
 from jacgen.files import write_files
 from jacgen.emission.render import render_robot
-from jacgen.inputs.robot import load_robot
+from jacgen.inputs.robot_file import load_robot
 
 from conftest import ROOT, random_configurations
 from support.graph_sympy import printed

@@ -13,7 +13,7 @@ import pytest
 from jacgen.checking import reference
 from jacgen.model import structure
 from jacgen.solvers.model import Model
-from jacgen.inputs.robot import load_robot
+from jacgen.inputs.robot_file import load_robot
 
 from conftest import GENERATED, robot
 from support.ik import wrapped

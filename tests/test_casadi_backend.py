@@ -9,8 +9,9 @@ from numpy.testing import assert_allclose
 
 from jacgen.checking import reference
 from jacgen.emission.backends.casadi import CasadiPrinter
-from jacgen.model.graph import AND, Graph
-from jacgen.inputs.robot import load_robot
+from jacgen.model.graph import Graph
+from jacgen.model.node import AND
+from jacgen.inputs.robot_file import load_robot
 from jacgen.checking.verify import compare
 
 from conftest import random_configurations, robot as shipped_robot

@@ -14,7 +14,7 @@ from jacgen.checking import reference
 from jacgen.checking.c_library import CLibrary, c_compiler, compile_shared
 from jacgen.emission.generator import Generator
 from jacgen.checking.generated_code import import_module
-from jacgen.inputs.robot import load_robot
+from jacgen.inputs.robot_file import load_robot
 
 ROOT = Path(__file__).resolve().parent.parent
 SHIPPED = sorted(path.stem for path in (ROOT / "robots").glob("*.yaml"))

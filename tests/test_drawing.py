@@ -15,7 +15,7 @@ from jacgen.checking import reference
 from jacgen.cli import main
 from jacgen.reports.urdf_comparison import compare_urdf, first_difference
 from jacgen.reports.drawing import BOUNDARY_CELLS, draw_arm, draw_workspace
-from jacgen.inputs.robot import parse_robot
+from jacgen.inputs.robot_file import parse_robot
 
 from conftest import ROBOT_NAMES, ROOT, random_configurations, robot
 from support.random_arms import random_arm_text
@@ -281,7 +281,7 @@ def test_q_must_be_finite_numbers(q, tmp_path):
 def test_the_dh_table_writes_exact_angles_in_degrees(tmp_path):
     """The report's DH table: an angle that is a rational number of degrees is written in
     degrees (the robot file's pi/2 and -14.5341 deg alike), one in plain radians as it is."""
-    from jacgen.inputs.robot import parse_robot
+    from jacgen.inputs.robot_file import parse_robot
     from jacgen.reports.description import dh_table
 
     text = """name: angles

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from jacgen.checking import reference
-from jacgen.inputs.robot import parse_robot
+from jacgen.inputs.robot_file import parse_robot
 
 from conftest import random_configurations, robot
 from support.generated import c_ik

@@ -29,7 +29,8 @@ from hypothesis import strategies as st
 from jacgen.inputs import values
 from jacgen.errors import RobotFileError
 from jacgen.inputs.values import ExpressionError, Value
-from jacgen.inputs.robot import TASK_COMPONENTS, Robot, parse_robot
+from jacgen.inputs.robot import TASK_COMPONENTS, Robot
+from jacgen.inputs.robot_file import parse_robot
 
 from conftest import ROBOT_FILES
 

@@ -14,7 +14,7 @@ from jacgen.solvers import general6r
 from jacgen.checking import reference
 from jacgen.checking.c_library import compile_shared
 from jacgen.solvers.model import Model
-from jacgen.inputs.robot import parse_robot
+from jacgen.inputs.robot_file import parse_robot
 
 from conftest import GENERATED, generated_module, robot
 from support.general6r_arms import multi_start

@@ -37,7 +37,7 @@ from jacgen.errors import JacgenError
 from jacgen.emission.generator import Generator
 from jacgen.checking.generated_code import GeneratedCode, import_module
 from jacgen.urdf_import import import_urdf
-from jacgen.inputs.robot import load_robot, parse_robot
+from jacgen.inputs.robot_file import load_robot, parse_robot
 
 from conftest import ROOT
 from support.graph_sympy import printed

@@ -16,7 +16,7 @@ from eaik.IK_HP import HPRobot
 from ik_geo import Robot as IkGeoRobot
 
 from jacgen.checking import reference
-from jacgen.inputs.robot import parse_robot
+from jacgen.inputs.robot_file import parse_robot
 from jacgen.solvers.differential import IK_NUMERIC_DEFAULTS
 
 from conftest import random_configurations, robot

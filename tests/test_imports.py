@@ -1,6 +1,7 @@
 """The stages of jacgen import one way (inputs, model, solvers, reports, emission, checking),
 and no module of jacgen/ reaches, directly or through others, back to itself. Lazy imports
-inside functions count too."""
+inside functions count too (stricter than module-level imports alone). No module is longer
+than one idea needs (LONGEST_MODULE)."""
 
 import ast
 from pathlib import Path
@@ -117,3 +118,12 @@ def test_every_package_is_installed():
     listed = set(tomllib.loads((PACKAGE.parent / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
     found = {module_name(path.parent / "__init__.py") for path in PACKAGE.rglob("__init__.py")}
     assert found <= listed, found - listed
+
+
+LONGEST_MODULE = 450  # lines: a module longer than this holds more than one idea
+
+
+def test_no_module_is_longer_than_one_idea():
+    long = {module_name(path): n for path in sorted(PACKAGE.rglob("*.py"))
+            if (n := len(path.read_text().splitlines())) > LONGEST_MODULE}
+    assert long == {}

@@ -8,7 +8,7 @@ from jacgen import Kinematics
 from jacgen.model import kinematics
 from jacgen.checking import reference
 from jacgen.emission.generator import Generator
-from jacgen.model.graph import evaluate
+from jacgen.model.node import evaluate
 
 from conftest import ROBOT_NAMES, random_configurations, robot
 

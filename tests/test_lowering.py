@@ -7,9 +7,12 @@ import sympy
 from sympy.core.parameters import distribute
 
 from jacgen.emission.generator import Generator
-from jacgen.model.graph import AND, OR, Graph, Node, evaluate
-from jacgen.emission.lowering import Lowering, _reusing_temporaries, eliminate_common, operation_count
-from jacgen.inputs.robot import load_robot, parse_robot
+from jacgen.model.graph import Graph
+from jacgen.model.node import AND, OR, Node, evaluate
+from jacgen.emission.cse import _reusing_temporaries, eliminate_common
+from jacgen.emission.lowering import Lowering
+from jacgen.emission.operation_count import operation_count
+from jacgen.inputs.robot_file import load_robot, parse_robot
 from conftest import ROOT
 from support.graph_sympy import to_sympy
 from support.random_arms import random_arm_text

@@ -26,7 +26,7 @@ from jacgen.emission.generator import Generator
 from jacgen.checking.generated_code import NATIVE_BACKENDS, import_module
 from jacgen.files import write_files
 from jacgen.emission.render import render_robot
-from jacgen.inputs.robot import load_robot, parse_robot
+from jacgen.inputs.robot_file import load_robot, parse_robot
 from jacgen.checking.verify import verify_on_host
 from support.random_arms import random_arm_text
 

@@ -6,7 +6,7 @@ import pytest
 
 from jacgen.inputs import numeric_chain
 from jacgen.checking import reference
-from jacgen.inputs.robot import parse_robot
+from jacgen.inputs.robot_file import parse_robot
 from support.random_arms import random_arm_text
 
 

@@ -16,7 +16,7 @@ from click.testing import CliRunner
 from jacgen.cli import main
 from jacgen.errors import RobotFileError
 from jacgen.inputs.values import ExpressionError, Value, parse
-from jacgen.inputs.robot import MAX_NESTING, parse_robot
+from jacgen.inputs.robot_file import MAX_NESTING, parse_robot
 
 from conftest import ROOT
 

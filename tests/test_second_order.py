@@ -9,7 +9,7 @@ import pytest
 from numpy.testing import assert_allclose
 
 from jacgen.checking import reference
-from jacgen.inputs.robot import parse_robot
+from jacgen.inputs.robot_file import parse_robot
 
 from conftest import ROBOT_NAMES, ROOT
 from support.pinocchio_chain import pinocchio_from_dh, robot_of, samples

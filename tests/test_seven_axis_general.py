@@ -17,7 +17,8 @@ from jacgen.inputs import numeric_chain
 from jacgen.checking import reference
 from jacgen.inputs.values import Value
 from jacgen.solvers.model import Model
-from jacgen.inputs.robot import Pose, parse_robot
+from jacgen.inputs.robot import Pose
+from jacgen.inputs.robot_file import parse_robot
 
 from conftest import generated_module, robot
 from support.general6r_arms import multi_start

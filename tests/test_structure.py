@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from jacgen.checking import reference
-from jacgen.inputs.robot import parse_robot
+from jacgen.inputs.robot_file import parse_robot
 from jacgen.model.structure import SOLVERS, Geometry, classify
 
 from conftest import ROBOT_NAMES, robot

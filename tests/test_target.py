@@ -12,7 +12,7 @@ import pytest
 from click.testing import CliRunner
 
 from jacgen.cli import main
-from jacgen.inputs.robot import load_robot
+from jacgen.inputs.robot_file import load_robot
 from jacgen.checking.cortex_m4f import INSTALL
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -15,7 +15,7 @@ from jacgen.checking import reference
 from jacgen.cli import main
 from jacgen.inputs.values import parse
 from jacgen.urdf_import import import_urdf, literal
-from jacgen.inputs.robot import load_robot, parse_robot
+from jacgen.inputs.robot_file import load_robot, parse_robot
 from jacgen.model.structure import classify
 
 from conftest import ROOT

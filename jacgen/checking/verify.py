@@ -36,7 +36,7 @@ from jacgen.emission.generator import Generator
 from jacgen.emission.render import render_robot
 from jacgen.files import write_files
 from jacgen.inputs.robot import EULER_ANGLES, Robot
-from jacgen.model import singularities
+from jacgen.model import js_rank
 from jacgen.parallel import for_each_robot
 from jacgen.solvers import ik
 from jacgen.tolerances import IK_NUMERIC_VERIFIED, VERIFIED
@@ -101,7 +101,7 @@ def compare(robot: Robot, function: Function, value: np.ndarray, expected: np.nd
     elements = np.zeros(value.shape[1], dtype=bool)  # the entries undefined where cos(pitch) = 0
     if function.declaration.euler_rows:
         elements = np.repeat([name in EULER_ANGLES for name in robot.task], function.outputs[0].cols)
-    elif function.declaration.of_js and singularities.singularity_rows(robot) is None:
+    elif function.declaration.of_js and js_rank.singularity_rows(robot) is None:
         elements[:] = True
     compared = np.ones(value.shape, dtype=bool)
     if elements.any():
@@ -189,7 +189,7 @@ def _rank_ratios(robot: Robot, q: np.ndarray) -> np.ndarray:
     columns = np.array([1.0 if joint.revolute else length for joint in robot.joints])
     for k, row in enumerate(q):
         rotation = reference.fk(robot, row)[:3, :3]
-        if singularities.singularity_rows(robot) is None and np.hypot(rotation[0, 0], rotation[1, 0]) < EULER_MARGIN:
+        if js_rank.singularity_rows(robot) is None and np.hypot(rotation[0, 0], rotation[1, 0]) < EULER_MARGIN:
             continue
         values = np.linalg.svd(reference.singularity_jacobian(robot, row) * columns / rows[:, None], compute_uv=False)
         # A Js that is zero to rounding (a 1 x 1 Js of a task the joint cannot move) is singular.

@@ -5,8 +5,7 @@ The kinematics are rebuilt over trig symbols (`c2 = cos(q2 + offset)`) that ever
 shares; adding a function touches the catalogue, this module and its algorithm.
 """
 
-import math
-from dataclasses import dataclass
+from dataclasses import replace
 from functools import cached_property
 
 import numpy
@@ -17,35 +16,28 @@ from jacgen.emission.catalogue import (EXTENTS, FUNCTION_NAMES, SECOND_ORDER, Ar
                                        Output, extent_of, in_catalogue_order, with_callees)
 from jacgen.emission.lowering import Lowering
 from jacgen.inputs.robot import EULER_ANGLES, Robot
-from jacgen.inputs.transforms import rot_z, twist
 from jacgen.model import kinematics
-from jacgen.model.joint_ring import joint_atoms, maximal_minors
-from jacgen.model.graph import Node, elementwise, is_zero
+from jacgen.model.joint_ring import joint_atoms
+from jacgen.model.js_rank import rank_determinant, singularity_jacobian
+from jacgen.model.graph import elementwise
+from jacgen.model.node import Node
 from jacgen.model.kinematics import generated_symbol
-from jacgen.model.singularities import MINOR_LIMIT, Singularities, singularity_jacobian
-from jacgen.solvers import differential, general6r, ik, ik_limits
+from jacgen.model.singularities import Singularities
+from jacgen.solvers import differential, general6r, general6r_target, ik, ik_limits
 from jacgen.solvers.model import Model
 from jacgen.solvers.subproblems import Subproblems, wrapped
 
 
-@dataclass(frozen=True)
-class Result:
-    """One named result of a generated function, as `matrix`, `vector`, `scalar` or `status` make it."""
-
-    name: str
-    values: list  # row by row: expressions, or truth values
-    rows: int
-    cols: int
-    shape: str  # "matrix", "vector" (numpy (rows,)), "scalar" or "status" (an integer scalar)
-    equals: str = ""  # in a function that fuses several: the function this result is
-    layers: int = 1  # > 1: a stack of that many matrices (the hessian)
+# A function's result as `matrix`, `vector`, `scalar` and `status` make it: its Output (what it
+# is truth values, and its extent, `Generator.function` adds) and its values, row by row.
+Result = tuple[Output, list]
 
 
 def matrix(name: str, value, equals: str = "", layers: int = 1) -> Result:
-    """A sympy Matrix, or a 2-D array of nodes."""
+    """A sympy Matrix, or a 2-D array of nodes (a stack of `layers` matrices: the hessian)."""
     rows, cols = value.shape
-    return Result(name, list(value.flat) if isinstance(value, numpy.ndarray) else list(value), rows, cols, "matrix",
-                  equals, layers)
+    return (Output(name, rows, cols, equals=equals, layers=layers),
+            list(value.flat) if isinstance(value, numpy.ndarray) else list(value))
 
 
 def _entry(value):
@@ -55,15 +47,15 @@ def _entry(value):
 
 def vector(name: str, values, equals: str = "") -> Result:
     values = [_entry(value) for value in values]
-    return Result(name, values, len(values), 1, "vector", equals)
+    return Output(name, len(values), 1, vector=True, equals=equals), values
 
 
 def scalar(name: str, value) -> Result:
-    return Result(name, [_entry(value)], 1, 1, "scalar")
+    return Output(name, 1, 1, scalar=True), [_entry(value)]
 
 
 def status(name: str, value) -> Result:
-    return Result(name, [_entry(value)], 1, 1, "status")
+    return Output(name, 1, 1, scalar=True, integer=True), [_entry(value)]
 
 
 class Generator:
@@ -154,57 +146,21 @@ class Generator:
 
     def general_6r_functions(self, target: Argument, free_input: tuple, bindings: dict,
                              sp: Subproblems) -> list[Function]:
-        """The generated parts of the general 6R solver (`general6r`), which ik_branches runs
-        around the eigenproblem kernel of its language: the equations at the target (P0, Ps, Pc
-        stacked 42 x 9, the hidden angle's shift applied; Q 14 x 8), the configuration of one
-        root's loop angles (the loop's free joint from the loop), the pose error and Jacobian of
-        a Newton step, ik's form of a configuration with its limits, and for a calibrated arm the
+        """The generated parts of the general 6R solver (`general6r`, `general6r_target`), which
+        ik_branches runs around the eigenproblem kernel of its language: the equations at the
+        target, the configuration of one root's loop angles, the pose error and Jacobian of a
+        Newton step, ik's form of a configuration with its limits, and for a calibrated arm the
         branches of its nominal arm's closed form, which start the fast path. A 7R arm's free
         joint (`free_input`, bound by `bindings`) is in the chain's head or tail."""
         form = self.closed_form
-        plan = form.elimination
-        equations, split = plan.equations, plan.equations.split
-        head, links, tail = general6r.chain_form(self.robot, form.free)
         six = form.joints  # the robot's joint of each of the chain's six
-        name = self.name
-        with distribute(False):
-            n = (_rigid_inverse(head) * target.symbols * _rigid_inverse(tail)).applyfunc(name)
-            v = _rigid_inverse(n).applyfunc(name) if split.target_inverted else n
-            values = {**{equations.rotation[k]: v[k // 3, k % 3] for k in range(9)},
-                      **{equations.translation[k]: v[k, 3] for k in range(3)}}
-            p0, ps, pc, q = (m.xreplace(values) for m in equations.matrices)
-            cos, sin = sympy.Float(math.cos(plan.shift), 17), sympy.Float(math.sin(plan.shift), 17)
-            ps, pc = cos * ps - sin * pc, sin * ps + cos * pc
-            stacked = sympy.Matrix.vstack(p0, ps, pc)
+        n, stacked, q = general6r_target.equations_at(self.robot, form, target.symbols, self.name)
         equations_function = self.function(
             "ik_general_equations", "the general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, "
             "P = [P0; Ps; Pc] (42 x 9)", matrix("P", stacked), matrix("Q", q), arguments=(target, *free_input), bindings=bindings,
             part_of="ik_branches")
         angles = Argument("angles", sympy.Matrix([generated_symbol("ga", k) for k in range(5)]))
-        loop = dict(zip((*split.triple, *split.pair), angles.symbols))
-        loop[split.hidden] = loop[split.hidden] + sympy.Float(plan.shift, 17)
-        theta = [None] * 6
-        for position, angle in loop.items():
-            theta[split.joint(position)] = -angle if split.backwards else angle
-        free = split.joint(split.free)
-        constants = [twist(link.d, link.a, link.alpha) for link in links]
-        # The loop angles' rotations, made before distribute(False): under it the -(g + shift) of a
-        # backwards split is not canonical, and cos's "could extract a minus sign" negates it back
-        # and forth forever.
-        turns = [None if i == free else rot_z(sympy.cos(theta[i]), sympy.sin(theta[i]))[:3, :3]
-                 for i in range(6)]
-        with distribute(False):
-            before, after = sympy.eye(3), constants[free][:3, :3] if free < 5 else sympy.eye(3)
-            for i, turn in enumerate(turns):
-                if i < free:
-                    before = (before * turn * constants[i][:3, :3]).applyfunc(name)
-                elif i > free:
-                    after = (after * turn * (constants[i][:3, :3] if i < 5 else sympy.eye(3))).applyfunc(name)
-            column = (before.T * n[:3, :3] * after.T[:, 0]).applyfunc(name)  # Z_free's first column
-            theta[free] = sympy.atan2(column[1], column[0])
-            q = list(self.q)  # the free joint of a 7R arm: its symbol, bound to q_free
-            for k, t in zip(six, theta):
-                q[k] = t - self.robot.joints[k].offset.exact
+        q = general6r_target.loop_configuration(self.robot, form, n, angles.symbols, self.q, self.name)
         start = self.function("ik_general_start", "the configuration of one root's loop angles (a - shift, b, c, "
                               "g, h; the loop's free joint from the loop)", vector("q", q),
                               arguments=(target, *free_input, angles), bindings=bindings, part_of="ik_branches")
@@ -225,13 +181,9 @@ class Generator:
                                scalar("in_limits", inside), arguments=(given,),
                                part_of="ik_branches")
         parts = [equations_function, start, step, limits]
-        if fast := form.fast_path:
-            sp.margins = []
+        if form.fast_path:
             free_angle = None if form.free is None else self.q[form.free]
-            q, valid, _ = ik.branches(fast.nominal.robot, fast.form, sp, target.symbols, free_angle)
-            margin = sp.margins[0]
-            for other in sp.margins[1:]:
-                margin = self.name_node(self.graph.select(self.graph.relation("<=", margin, other), margin, other))
+            q, valid, margin = general6r_target.nominal_branches(form, sp, target.symbols, free_angle)
             parts.append(self.function("ik_general_nominal", "the fast path's starting points: every branch of the "
                                        "nearest special class's closed form (the nominal arm's), whether its target "
                                        "allows it, and the least margin of its subproblems", matrix("q", q),
@@ -339,37 +291,6 @@ class Generator:
     def singularities(self) -> Singularities:
         return self.model.singularities
 
-    def rank_determinant(self, js: sympy.Matrix) -> Node:
-        """det(Js) for square Js, else the Gram determinant det(Js Js^T) or det(Js^T Js), by
-        Laplace expansion (memoised minors: division-free, at most 6 * 2^5 products per
-        determinant) over the named entries: a fixed cost on top of Js, whatever the arm.
-
-        The Gram determinant is the sum of the squared maximal minors of Js (Cauchy-Binet)
-        while there are at most MINOR_LIMIT of them; beyond, the product of the
-        squared diagonal of R in a QR factorisation of the tall one of Js, Js^T (modified
-        Gram-Schmidt, whose R is backward stable). Both stay accurate to rounding near a
-        singularity, where det(Js Js^T) formed from the product loses half the digits (its
-        square root, the manipulability, good only to sqrt(eps) * |Js|^m).
-        """
-        m, n = js.shape
-        g = self.graph
-        name = self.name_node
-        if m == n or math.comb(max(m, n), min(m, n)) <= MINOR_LIMIT:
-            named = [[0 if is_zero(entry) else entry for entry in row] for row in elementwise(name, g.values(js))]
-            minors = maximal_minors(named, g.number(0), g.number(1))
-            return minors[0] if m == n else sum(name(minor) ** 2 for minor in minors)
-        tall = js.T if m < n else js
-        columns = [list(column) for column in elementwise(name, g.values(tall)).T]
-        squared_diagonal = []
-        for k, column in enumerate(columns):
-            norm = name(sum(entry**2 for entry in column))
-            squared_diagonal.append(norm)
-            divisor = name(g.select(g.relation(">", norm, g.number(0)), norm, g.number(1)))
-            for j in range(k + 1, len(columns)):  # the part of column j orthogonal to column k
-                share = name(sum(a * b for a, b in zip(columns[j], column)) / divisor)
-                columns[j] = [name(entry - share * value) for entry, value in zip(columns[j], column)]
-        return g.mul(*squared_diagonal)
-
     def magnitude(self, value) -> Node:
         """|value|, of a named value."""
         return self.graph.call("Abs", self.name_node(value))
@@ -387,7 +308,7 @@ class Generator:
         for i, symbols in enumerate(joint_atoms(self.robot)):
             if len(symbols) == 2:
                 atoms.update(zip(symbols, self.cos_sin((i,))))
-        numeric = self.graph.number(0) if singular.everywhere else self.rank_determinant(js)
+        numeric = self.graph.number(0) if singular.everywhere else rank_determinant(js, self.graph, self.name_node)
         factors = [f.polynomial.xreplace(atoms) for f in singular.factors]
         if not singular.complete or singular.everywhere:
             factors.append(numeric)
@@ -421,13 +342,12 @@ class Generator:
         if not self.generates(part_of or name):
             return None
         outputs, values = [], []
-        for result in results:
-            nodes = [self.graph.value(value) for value in result.values]
+        for output, entries in results:
+            nodes = [self.graph.value(entry) for entry in entries]
             boolean = all(node.boolean for node in nodes)
-            key, size = f"{name}.{result.name}", result.rows * result.cols
-            outputs.append(Output(result.name, result.rows, result.cols, result.shape in ("scalar", "status"),
-                                  result.shape == "vector" or boolean, result.equals, boolean, result.shape == "status",
-                                  result.layers, extent_of(key if key in EXTENTS else result.equals or name, size)))
+            key = f"{name}.{output.name}"
+            outputs.append(replace(output, vector=output.vector or boolean, boolean=boolean,
+                                   extent=extent_of(key if key in EXTENTS else output.equals or name, output.size)))
             values += nodes
         return Function(name, summary, tuple(outputs), arguments or (Argument("q", sympy.Matrix(self.q)),),
                         body=self.lower(values, bindings or {}), calls=calls, part_of=part_of or "")
@@ -522,9 +442,3 @@ class Generator:
         )
         return tuple(in_catalogue_order(function for function in functions if function is not None))
 
-
-def _rigid_inverse(transform: sympy.Matrix) -> sympy.Matrix:
-    """[R p; 0 1]^-1 = [R^T -R^T p; 0 1]."""
-    rotation = transform[:3, :3].T
-    return sympy.Matrix.vstack(sympy.Matrix.hstack(rotation, -rotation * transform[:3, 3]),
-                               sympy.Matrix([[0, 0, 0, 1]]))

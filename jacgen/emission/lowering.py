@@ -3,23 +3,22 @@
 The algorithms (`kinematics`, `subproblems`, `ik`, `differential`) name every intermediate
 value with `Lowering.name`, so that no expression they build grows with the chain; a
 function's outputs are then lowered to a `Body` on the value graph (`graph.py`): the named
-values and trig symbols they read, common-subexpression elimination, temporaries numbered in
-a fixed order (the output does not depend on hashing). Every printer turns a Body into its
-language.
+values and trig symbols they read, common-subexpression elimination (`cse.py`), temporaries
+numbered in a fixed order (the output does not depend on hashing). Every printer turns a Body
+into its language; `operation_count.py` counts it.
 """
 
 import heapq
-from collections import Counter
-from fractions import Fraction
 from dataclasses import dataclass
 from functools import cached_property
 
 import sympy
-from sympy.simplify.cse_main import Unevaluated, match_common_args
 
-from jacgen.model.graph import (ADD, AND, FINITE, MUL, NOT, NUMBER, OR, POW, RELATION, SELECT, SYMBOL, TRUTH, CALL,
-                                   TOLERANCE_VALUES, Graph, Node, evaluate, negative_coefficient)
+from jacgen.emission.cse import eliminate_common
+from jacgen.emission.operation_count import operation_count
 from jacgen.inputs import names
+from jacgen.model.graph import Graph
+from jacgen.model.node import ADD, MUL, SYMBOL, TOLERANCE_VALUES, Node, evaluate, negative_coefficient
 
 
 @dataclass(frozen=True)
@@ -38,93 +37,6 @@ class Body:
     @cached_property
     def operation_count(self) -> int:
         return operation_count([e for _, e in self.definitions] + list(self.outputs))
-
-
-def operation_count(nodes) -> int:
-    """sympy's `count_ops` of `nodes`, the figure every report and bench shows, by its rules
-    (quirks included: a sum under a product's -1 adds no operations), counted once per node.
-
-    Its rules are one table in one function, in count_ops' order, so that a test can hold
-    the two equal rule by rule (tests/test_lowering.py)."""
-    counts: dict[Node, int] = {}
-
-    def count(node: Node) -> int:  # count_ops' walk of an expression
-        if node not in counts:
-            if node.kind == NUMBER:
-                counts[node] = _number_count(node.value)
-            elif node.kind == MUL:
-                counts[node] = 1 + unsigned(_negated(node)) if negative_coefficient(node) else unsigned(node.args)
-            elif node.kind == ADD:
-                terms = node.args
-                negatives = [negative_coefficient(term) for term in terms]
-                counts[node] = (len(terms) - 1 + all(negatives)
-                                + sum(negated_count(t) if n else count(t) for t, n in zip(terms, negatives)))
-            elif node.kind == POW and node.args[1].value == -1:
-                counts[node] = 1 + count(node.args[0])
-            else:
-                counts[node] = fallthrough(node)
-        return counts[node]
-
-    def negated_count(term: Node) -> int:  # count of -term, for a term with a negative number
-        if term.kind == NUMBER:
-            return _number_count(-term.value)
-        factors = _negated(term)
-        return count(factors[0]) if len(factors) == 1 else unsigned(factors)
-
-    def fallthrough(node: Node) -> int:
-        own = len(node.args) - 1 if node.kind in (MUL, AND, OR) else \
-            int(bool(node.args) and node.kind in (POW, CALL, SELECT, NOT, FINITE))
-        return own + sum(count(arg) for arg in node.args)
-
-    def unsigned(factors) -> int:  # a product without its sign, as numerator / denominator
-        numerator, denominator = [], []
-        for factor in factors:
-            if factor.kind == POW and factor.args[1].value < 0:
-                base, exponent = factor.args[0], factor.args[1].value
-                denominator.append(base if exponent == -1 else (base, -exponent))
-            else:
-                numerator.append(factor)
-        numerator = [f for f in numerator if not (f.kind == NUMBER and _is_integer(f.value) and f.value == 1)]
-        if all(f.kind == NUMBER and _is_integer(f.value) for f in numerator):  # 1/d, 2/d
-            return 1 + group(denominator)
-        if denominator:
-            integer = all(not isinstance(f, tuple) and f.kind == NUMBER and _is_integer(f.value) for f in denominator)
-            return (0 if integer else group(denominator)) + 1 + group(numerator)
-        return fallthrough(factors[0]) if len(factors) == 1 else len(factors) - 1 + sum(map(count, factors))
-
-    def group(factors) -> int:  # the product of `factors`
-        total = len(factors) - 1 if len(factors) > 1 else 0
-        for factor in factors:
-            if isinstance(factor, tuple):  # base ** positive exponent
-                base, exponent = factor
-                total += 1 + count(base) + _number_count(exponent)
-            else:
-                total += count(factor)
-        return total
-
-    def top(node: Node) -> int:  # count_ops of a truth value: one per function, whatever its arguments
-        if node.kind in (RELATION, AND, OR, NOT, FINITE):
-            return 1 + sum(top(arg) for arg in node.args)
-        return 0 if node.kind == TRUTH else count(node)
-
-    return sum(top(node) for node in nodes)
-
-
-def _is_integer(value) -> bool:
-    return isinstance(value, (int, sympy.Integer))
-
-
-def _number_count(value) -> int:
-    """count_ops of a number: a folded constant (sympy's Float) none, a rational its sign and its division."""
-    if isinstance(value, Fraction) or value == 1:
-        return 0
-    return int(bool(value < 0)) + (getattr(value, "q", 1) != 1)
-
-
-def _negated(product: Node) -> list[Node]:
-    """The factors of -product, for a product with a negative number (-1 dropped)."""
-    coefficient, *rest = product.args
-    return rest if coefficient.value == -1 else [Node(NUMBER, (), -coefficient.value), *rest]
 
 
 class Lowering:
@@ -303,189 +215,3 @@ def _in_dependency_order(definitions: list[tuple[sympy.Symbol, Node]]) -> list[t
             if waiting[reader] == 0:
                 heapq.heappush(ready, reader)
     return ordered
-
-
-def eliminate_common(graph: Graph, exprs: list[Node], symbols, negations: dict) -> tuple[list, list[Node]]:
-    """sympy's `cse(exprs, symbols, order="none")` (its opt_cse, then tree_cse) on the graph,
-    with the same temporaries: a sum or product with more negative terms is shared with its
-    negation, x**-n is 1/x**n, sums and products that share two or more terms share their
-    sum or product (sympy's own `match_common_args`, which reads nothing but `args`), and
-    every node reached twice becomes a temporary. The sign of a sum is decided from its
-    terms' numbers (sympy compares sort keys of whole expressions), what is rebuilt keeps its
-    order and is evaluated only where something in it can combine (`_rebuilt`), and
-    `negations` keeps each node's negation for the robot's other functions.
-
-    Returns [(temporary symbol, value)] and the expressions over them.
-
-    One function, longer than most, because it follows sympy's cse_main step by step (opt_cse's
-    passes, then tree_cse's walk): read side by side with it, a difference is a choice."""
-    rewritten: dict = {}  # node -> the form tree_cse walks (sympy's opt_subs)
-    adds, muls = {}, {}  # candidates for common arguments, in the order first met
-    seen = set()
-    power = lambda base, exponent: graph.node(POW, (base, exponent))  # noqa: E731
-    minus_one = graph.number(sympy.S.NegativeOne)
-
-    def find_rewrites(node):
-        if not node.args or node in seen:
-            return
-        seen.add(node)
-        for arg in node.args:
-            find_rewrites(arg)
-        if node.kind in (ADD, MUL):
-            if node not in negations:
-                negations[node] = _negation(graph, node)
-            negated = negations[node]
-            if negated is not None and negated.args:
-                rewritten[node] = Unevaluated(graph.mul, (graph.minus_one, negated))
-                seen.add(negated)
-                node = negated
-            if node.kind in (ADD, MUL) and len(node.args) > 1:
-                (adds if node.kind == ADD else muls)[node] = None
-        elif node.kind == POW and node.args[1].value < 0:
-            base, exponent = node.args[0], -node.args[1].value
-            rewritten[node] = Unevaluated(power, (base if exponent == 1 else power(base, graph.number(exponent)),
-                                                  minus_one))
-
-    for expr in exprs:
-        find_rewrites(expr)
-    match_common_args(graph.add, list(adds), rewritten)
-    match_common_args(graph.mul, list(muls), rewritten)
-
-    repeated, reached = set(), set()
-
-    def find_repeated(node):
-        if not isinstance(node, Unevaluated) and not node.args:
-            return
-        if node in reached:
-            repeated.add(node)
-            return
-        reached.add(node)
-        for arg in rewritten.get(node, node).args:
-            find_repeated(arg)
-
-    for expr in exprs:
-        find_repeated(expr)
-
-    replacements, named = [], {}
-
-    def rebuild(node):
-        if not isinstance(node, Unevaluated) and not node.args:
-            return node
-        if node in named:
-            return named[node]
-        form = rewritten.get(node, node)
-        args = [rebuild(arg) for arg in form.args]
-        if isinstance(form, Unevaluated):
-            new = form.func(*args)
-        elif all(new is old for new, old in zip(args, form.args)):
-            new = form
-        else:
-            new = _rebuilt(graph, form, args)
-        if node in repeated:
-            symbol = next(symbols)
-            named[node] = graph.symbol(symbol)
-            replacements.append((symbol, new))
-            return named[node]
-        return new
-
-    outputs = [rebuild(expr) for expr in exprs]
-    return _reusing_temporaries(graph, replacements, outputs)
-
-
-def _reusing_temporaries(graph: Graph, replacements: list, outputs: list[Node]) -> tuple[list, list[Node]]:
-    """Sums and products read the temporaries CSE made where that costs fewer operations:
-    `match_common_args` is greedy and leaves some (0.07*c2*s5*t2 beside t6 = c2*s5). A sum
-    holding all of a temporary's terms reads it, the largest first; a product is written out
-    to its factors (product temporaries without a number expanded: s2*s3*c5*t4, t4 = c3*c4)
-    and covered by the largest temporaries that fit (t12*c3*s3, t12 = s2*c4*c5), if that has
-    fewer factors. A product temporary reads only smaller ones, so none reads itself."""
-    values = {graph.symbol(symbol): value for symbol, value in replacements}
-    sums = {}  # a first term -> the sum temporaries starting with it: (symbol, terms)
-    written: dict[Node, Counter] = {}  # a product temporary without a number -> its factors written out
-    leaves: dict[Node, Counter] = {}  # any other factor -> itself (a power: its base, so many times)
-
-    def written_out(node: Node) -> Counter:
-        value = values.get(node)
-        if value is not None and value.kind == MUL and value.args[0].kind != NUMBER:
-            if node not in written:
-                written[node] = sum((written_out(factor) for factor in value.args), Counter())
-            return written[node]
-        if node not in leaves:
-            power = node.kind == POW and node.args[1].value.is_integer and node.args[1].value > 0
-            leaves[node] = Counter({node.args[0]: int(node.args[1].value)} if power else {node: 1})
-        return leaves[node]
-
-    for symbol, value in values.items():
-        if value.kind == ADD:
-            sums.setdefault(value.args[0], []).append((symbol, frozenset(value.args)))
-        elif value.kind == MUL and value.args[0].kind != NUMBER:
-            written_out(symbol)
-    products = {}  # a factor -> the product temporaries written out with it
-    for symbol, counter in written.items():
-        products.setdefault(min(counter, key=lambda n: n.index), []).append(symbol)
-    sizes = {t: sum(counter.values()) for t, counter in written.items()}
-    done: dict[Node, Node] = {}
-
-    def covered(node: Node, own: Node | None) -> Node:
-        number = node.args[:1] if node.args[0].kind == NUMBER else ()
-        left = Counter()
-        for factor in node.args[len(number):]:
-            left.update(written_out(factor))
-        candidates = {t for factor in left for t in products.get(factor, ())
-                      if t is not own and (own not in sizes or (sizes[t], t.index) < (sizes[own], own.index))}
-        if not candidates:
-            return node
-        used = []
-        for t in sorted(candidates, key=lambda t: (-sizes[t], t.index)):
-            while all(left[f] >= k for f, k in written[t].items()):
-                left -= written[t]
-                used.append(t)
-        factors = used + [base if k == 1 else graph.power(base, k) for base, k in left.items()]
-        cost = lambda fs: len(fs) + sum(f.kind == POW for f in fs)  # noqa: E731
-        return graph.mul(*number, *factors) if used and cost(factors) < cost(node.args[len(number):]) else node
-
-    def reusing(node: Node, own: Node | None = None) -> Node:
-        if not node.args:
-            return node
-        if own is None and node in done:
-            return done[node]
-        args = [reusing(arg) if arg.args else arg for arg in node.args]
-        new = node if all(a is b for a, b in zip(args, node.args)) else _rebuilt(graph, node, args)
-        if new.kind == MUL and products:
-            new = covered(new, own)
-        elif new.kind == ADD and sums:
-            terms, used = set(new.args), []
-            for symbol, parts in sorted({c for term in new.args for c in sums.get(term, ())},
-                                        key=lambda c: (-len(c[1]), c[0].index)):
-                if symbol is not own and parts < frozenset(new.args) and parts <= terms:
-                    terms -= parts
-                    used.append(symbol)
-            if used:
-                new = graph.add(*(term for term in new.args if term in terms), *used)
-        if own is None:
-            done[node] = new
-        return new
-
-    replacements = [(symbol, reusing(value, graph.symbol(symbol))) for symbol, value in replacements]
-    return replacements, [reusing(expr) for expr in outputs]
-
-
-def _negation(graph: Graph, node: Node) -> Node | None:
-    """-node when sympy's cse would share node with it (`could_extract_minus_sign`): a
-    product with a negative number or a sum with more such terms than others, else None.
-    (On a tie sympy compares the sort keys of the sum and its negation; without distribution
-    the negation is -1 times the sum, whose key is the larger: never.)"""
-    if node.kind == MUL:
-        return graph.negate(node) if negative_coefficient(node) else None
-    if 2 * sum(map(negative_coefficient, node.args)) <= len(node.args):
-        return None
-    return graph.node(ADD, tuple(graph.negate(term) for term in node.args))
-
-
-def _rebuilt(graph: Graph, form: Node, args: list[Node]) -> Node:
-    """form with new arguments: a call or select of temporaries as it is (one of numbers was
-    folded before); anything else as its kind evaluates (`Graph.rebuilt`), so that a sum whose
-    terms became the same temporary, x - x, is 0."""
-    if form.kind in (CALL, SELECT):
-        return graph.node(form.kind, tuple(args), form.value)
-    return graph.rebuilt(form, tuple(args))

@@ -14,10 +14,10 @@ as one literal: the shortest decimal that reads back as the same value of that t
 
 import sympy
 
-from jacgen.model import graph
-from jacgen.model.graph import TOLERANCE_VALUES, Node, evaluate
+from jacgen.model import node as kinds
+from jacgen.model.node import TOLERANCE_VALUES, Node, evaluate
 from jacgen.emission.lowering import Body
-from jacgen.model.nodes import TOLERANCE_SYMBOLS
+from jacgen.model.tolerance_symbols import TOLERANCE_SYMBOLS
 
 # Integers up to this size print as integer literals (exact in float and double, and an `int`
 # in C); larger ones as floating literals, which cannot overflow an integer type.
@@ -64,9 +64,9 @@ class Printer:
 
     def _node(self, node: Node) -> tuple[str, int]:
         kind = node.kind
-        if kind == graph.SYMBOL and node.value not in TOLERANCE_SYMBOLS:
+        if kind == kinds.SYMBOL and node.value not in TOLERANCE_SYMBOLS:
             return self._names.get(node.value, node.value.name), ATOM
-        if kind == graph.NUMBER and isinstance(node.value, int) and abs(node.value) <= EXACT_INTEGER:
+        if kind == kinds.NUMBER and isinstance(node.value, int) and abs(node.value) <= EXACT_INTEGER:
             return str(node.value), SUM if node.value < 0 else ATOM
         if node.boolean:
             if node.constant:
@@ -75,15 +75,15 @@ class Printer:
         if node.constant:
             text = self.literal(float(evaluate(node, self.tolerances)))
             return text, SUM if text.startswith("-") else ATOM
-        if kind == graph.ADD:
+        if kind == kinds.ADD:
             return self._sum(node.args), SUM
-        if kind == graph.MUL:
+        if kind == kinds.MUL:
             return self._product(node.args)
-        if kind == graph.POW:
+        if kind == kinds.POW:
             return self._power(node.args[0], node.args[1].value)
-        if kind == graph.SELECT:
+        if kind == kinds.SELECT:
             return self._select(list(zip(node.args[:-1:2], node.args[1:-1:2])), node.args[-1]), ATOM
-        if kind != graph.CALL or node.value not in self.functions:
+        if kind != kinds.CALL or node.value not in self.functions:
             raise ValueError(f"unsupported in {type(self).__name__}: {node.value}")
         return f"{self.functions[node.value]}({', '.join(self._print(arg)[0] for arg in node.args)})", ATOM
 
@@ -102,7 +102,7 @@ class Printer:
         exponent as the denominator."""
         sign, numerator, denominator = "", [], []
         for factor in sorted(factors, key=lambda factor: not factor.constant):  # numbers first
-            if factor.kind == graph.POW and factor.args[1].value < 0 and not factor.constant:
+            if factor.kind == kinds.POW and factor.args[1].value < 0 and not factor.constant:
                 denominator.append(self._power(factor.args[0], -factor.args[1].value))
                 continue
             number = factor.constant
@@ -134,18 +134,18 @@ class Printer:
         """Nested selects, one per condition."""
         (condition, value), *rest = pairs
         other = self._select(rest, otherwise) if rest else self.doprint(otherwise)
-        numbers = value.kind == graph.NUMBER and not rest and otherwise.kind == graph.NUMBER
+        numbers = value.kind == kinds.NUMBER and not rest and otherwise.kind == kinds.NUMBER
         return self.select(self.doprint(condition), self.doprint(value), other, numbers)
 
     def _boolean(self, node: Node) -> tuple[str, int]:
-        if node.kind in (graph.AND, graph.OR):
-            return self.logic("And" if node.kind == graph.AND else "Or", node.args), \
-                AND if node.kind == graph.AND else OR
-        if node.kind == graph.NOT:
+        if node.kind in (kinds.AND, kinds.OR):
+            return self.logic("And" if node.kind == kinds.AND else "Or", node.args), \
+                AND if node.kind == kinds.AND else OR
+        if node.kind == kinds.NOT:
             return self.negation(node.args[0]), ATOM
-        if node.kind == graph.FINITE:
+        if node.kind == kinds.FINITE:
             return self.finite(self.doprint(node.args[0])), ATOM
-        if node.kind == graph.RELATION:
+        if node.kind == kinds.RELATION:
             return self.relation(self.doprint(node.args[0]), node.value, self.doprint(node.args[1]))
         raise ValueError(f"unsupported in {type(self).__name__}: {node.kind}")
 

@@ -138,17 +138,19 @@ def robot_name_problem(name: str) -> str | None:
     return None
 
 
-# The words each language reserves, by the reason given; each backend names its table
-# (`backends.Backend.reserved`).
+# The words each language of the generated code reserves, by the reason given, keyed by the
+# language (its backend, `emission/backends/NAME.py`). The languages are this table's keys
+# (`backends.LANGUAGES`), so no language is generated without its reserved words refused.
 C_RESERVED = {"is a keyword": C_KEYWORDS | CPP_KEYWORDS, "is a <math.h> name": C_MATH_NAMES}
 PYTHON_RESERVED = {"is a keyword": PYTHON_KEYWORDS, "is a Python builtin": PYTHON_BUILTINS}
-RESERVED = (C_RESERVED, PYTHON_RESERVED)
+RESERVED = {"c": C_RESERVED, "python": PYTHON_RESERVED, "casadi": PYTHON_RESERVED, "report": {},
+            "native": C_RESERVED}  # report: Markdown, no identifiers
 
 
 def parameter_name_problem(name: str, robot_name: str) -> str | None:
     """Why `name` cannot name a parameter of robot `robot_name` (None when it can): a word a
     backend reserves, or one the generated code uses."""
-    for reserved in RESERVED:
+    for reserved in RESERVED.values():
         for reason, words in reserved.items():
             if name in words:
                 return reason

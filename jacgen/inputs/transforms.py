@@ -1,5 +1,5 @@
 """Exact homogeneous transforms (sympy 4 x 4 matrices): the elementary rotations and
-translations, and the poses of robot files and URDFs (translation xyz, then Rz(yaw) Ry(pitch)
+translations, a rigid transform's inverse, and the poses of robot files and URDFs (translation xyz, then Rz(yaw) Ry(pitch)
 Rx(roll))."""
 
 import sympy
@@ -25,6 +25,12 @@ def twist(d, a, alpha) -> Matrix:
     """Tz(d) Tx(a) Rx(alpha): a DH row's constant transform after its joint's rotation (the
     general 6R solver's C_i)."""
     return translation(0, 0, d) * translation(a, 0, 0) * rot_x(sympy.cos(alpha), sympy.sin(alpha))
+
+
+def rigid_inverse(transform: Matrix) -> Matrix:
+    """[R p; 0 1]^-1 = [R^T -R^T p; 0 1]."""
+    rotation = transform[:3, :3].T
+    return Matrix.vstack(Matrix.hstack(rotation, -rotation * transform[:3, 3]), Matrix([[0, 0, 0, 1]]))
 
 
 def exact_trig(angle) -> tuple[sympy.Expr, sympy.Expr]:

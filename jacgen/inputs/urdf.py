@@ -22,7 +22,7 @@ from sympy import Matrix
 
 from jacgen.errors import RobotFileError
 from jacgen.inputs import values
-from jacgen.inputs.robot import MAX_JOINTS
+from jacgen.inputs.robot_file import MAX_JOINTS
 from jacgen.inputs.transforms import xyz_rpy_transform
 from jacgen.inputs.values import ExpressionError
 from jacgen.tolerances import ANGLE_SNAP

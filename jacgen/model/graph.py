@@ -1,4 +1,5 @@
-"""The value graph: the generated code's expressions as interned nodes.
+"""The value graph: the generated code's expressions as interned nodes (`node.py`: what a
+node is, and its value in numbers).
 
 A node is built once per graph (one per robot): equal values are the same object, so a
 node's identity is its value, hashing is free and a shared subexpression is one node however
@@ -23,127 +24,15 @@ import numpy
 import sympy
 from sympy.logic.boolalg import Boolean
 
-from jacgen.model.nodes import TOLERANCE_SYMBOLS, TOLERANCES
-
-# The kinds of node. A number's value is an int, a Fraction (an exact rational, as sympy's
-# Rational), a Folded (a constant folded from sympy's floats and irrationals, see Folded) or, as
-# a power's exponent, a sympy Rational; a symbol's is its sympy Symbol; a call's the function's
-# name (sympy's class name: sin, atan2, Abs, Floor, ...); a relation's its operator (">=", ...).
-# Every number but a small integer prints as a literal of the build's real type.
-NUMBER, SYMBOL, TRUTH = "number", "symbol", "truth"
-ADD, MUL, POW, CALL, SELECT = "add", "mul", "pow", "call", "select"
-RELATION, AND, OR, NOT, FINITE = "relation", "and", "or", "not", "finite"
-FOLDED_DIGITS = 30
-BOOLEAN_KINDS = frozenset((TRUTH, RELATION, AND, OR, NOT, FINITE))
+from jacgen.model.node import (ADD, AND, CALL, FINITE, FOLDED_DIGITS, MUL, NOT, NUMBER, OR, POW, RELATION, RELATIONS,
+                               SELECT, SYMBOL, TOLERANCE_VALUES, TRUTH, Folded, Node, evaluate, negative_coefficient,
+                               number_of)
 
 REVERSED = {">=": "<=", ">": "<", "<=": ">=", "<": ">", "==": "==", "!=": "!="}
 NEGATED = {">=": "<", ">": "<=", "<=": ">", "<": ">=", "==": "!=", "!=": "=="}
-RELATIONS = {">=": operator.ge, ">": operator.gt, "<=": operator.le, "<": operator.lt, "==": operator.eq,
-             "!=": operator.ne}
-# The functions `evaluate` calls, by call name, and how it adds (in floats: fsum, rounded once).
-MATH = {"sin": math.sin, "cos": math.cos, "tan": math.tan, "asin": math.asin, "acos": math.acos, "atan": math.atan,
-        "atan2": math.atan2, "exp": math.exp, "log": math.log, "Abs": abs, "Floor": math.floor, "Ceiling": math.ceil,
-        ADD: math.fsum}
 # sympy's function of each call whose name is not sympy's own, to fold a call of numbers.
 SYMPY_CALLS = {"Floor": sympy.floor, "Ceiling": sympy.ceiling}
 BOOLEANS = {sympy.And: AND, sympy.Or: OR, sympy.Not: NOT}  # in sympy's values taken over
-
-
-class Folded(Fraction):
-    """A constant folded from sympy's floats and irrationals (2159/5000 * sqrt(2), pi / 4): its
-    value to FOLDED_DIGITS digits, held exactly, so that constants added or multiplied together
-    round once, when printed. Arithmetic with one stays folded, as with sympy's Float: 0.5 * 2
-    is 1.0, not the integer 1."""
-
-    __slots__ = ()
-
-
-def number_of(value, folded: bool):
-    """The result of arithmetic on numbers: Folded if an operand was, else exact (an integer as an int)."""
-    if folded:
-        return Folded(value)
-    return int(value) if isinstance(value, Fraction) and value.denominator == 1 else value
-
-
-class Node:
-    """One value of the graph; build it with `Graph.node` (or the constructors), never directly.
-    Arithmetic with another node or a number builds on the node's graph (`Graph.add`, `mul`,
-    `power`), so an algorithm written with + - * / ** runs on nodes as on sympy values."""
-
-    __slots__ = ("kind", "args", "value", "graph", "index", "_free")
-
-    def __init__(self, kind: str, args: tuple, value, graph: "Graph | None" = None, index: int = 0):
-        self.kind, self.args, self.value, self.graph, self.index, self._free = kind, args, value, graph, index, None
-
-    def __add__(self, other):
-        return self.graph.add(self, self.graph.value(other))
-
-    def __radd__(self, other):
-        return self.graph.add(self.graph.value(other), self)
-
-    def __sub__(self, other):
-        return self.graph.add(self, self.graph.negate(self.graph.value(other)))
-
-    def __rsub__(self, other):
-        return self.graph.add(self.graph.value(other), self.graph.negate(self))
-
-    def __mul__(self, other):
-        return self.graph.mul(self, self.graph.value(other))
-
-    def __rmul__(self, other):
-        return self.graph.mul(self.graph.value(other), self)
-
-    def __neg__(self):
-        return self.graph.negate(self)
-
-    def __truediv__(self, other):
-        return self.graph.mul(self, self.graph.power(self.graph.value(other), -1))
-
-    def __rtruediv__(self, other):
-        return self.graph.mul(self.graph.value(other), self.graph.power(self, -1))
-
-    def __pow__(self, exponent):
-        return self.graph.power(self, exponent)
-
-    @property
-    def free_symbols(self) -> frozenset:
-        """The sympy Symbols the value reads (the tolerances included)."""
-        if self._free is None:
-            if self.kind == SYMBOL:
-                self._free = frozenset((self.value,))
-            else:
-                self._free = frozenset().union(*(arg.free_symbols for arg in self.args))
-        return self._free
-
-    @property
-    def constant(self) -> bool:
-        """Whether the value reads nothing but numbers and the tolerances."""
-        return self.free_symbols <= TOLERANCE_SYMBOLS
-
-    @property
-    def boolean(self) -> bool:
-        """A truth value (an `int` in C, a bool array in numpy)."""
-        return self.kind in BOOLEAN_KINDS
-
-    def contains(self, kind: str, _seen: set | None = None) -> bool:
-        """Whether a node of `kind` is among this one and those it reads."""
-        seen = set() if _seen is None else _seen
-        seen.add(self)
-        return self.kind == kind or any(arg.contains(kind, seen) for arg in self.args if arg not in seen)
-
-    def __repr__(self):
-        return f"{self.kind}({self.value!r}, {len(self.args)} args)" if self.args else f"{self.kind}({self.value!r})"
-
-
-def is_zero(node: Node) -> bool:
-    """The exact number 0 (a structural zero of a matrix)."""
-    return node.kind == NUMBER and node.value == 0 and not isinstance(node.value, Folded)
-
-
-def negative_coefficient(node: Node) -> bool:
-    """A negative number, or a product whose number is negative."""
-    coefficient = node.args[0] if node.kind == MUL else node
-    return coefficient.kind == NUMBER and coefficient.value < 0
 
 
 class Graph:
@@ -459,48 +348,3 @@ def _flattened(kind: str, nodes) -> list[Node]:
         else:
             flat.append(node)
     return flat
-
-
-# -- numbers ----------------------------------------------------------------------------------------
-TOLERANCE_VALUES = {real: {symbol: float(value) for symbol, value in numbers.items()}
-                    for real, numbers in TOLERANCES.items()}
-
-
-def evaluate(node: Node, values: dict, functions: dict = MATH, _done: dict | None = None):
-    """The value of `node`, `values` giving each symbol's: in floats (truth values as bools),
-    or with `functions` of another library (numpy's, over arrays: arithmetic and calls only)."""
-    done = {} if _done is None else _done
-    if node in done:
-        return done[node]
-    kind, args = node.kind, node.args
-    if kind == NUMBER:
-        result = float(node.value)
-    elif kind == SYMBOL:
-        result = values[node.value]
-    elif kind == TRUTH:
-        result = node.value
-    else:
-        operands = [evaluate(arg, values, functions, done) for arg in args]
-        if kind == ADD:
-            result = functions[ADD](operands)
-        elif kind == MUL:
-            result = math.prod(operands)
-        elif kind == POW:
-            result = operands[0] ** operands[1]
-        elif kind == CALL:
-            result = functions[node.value](*operands)
-        elif kind == SELECT:
-            result = next((value for condition, value in zip(operands[:-1:2], operands[1:-1:2]) if condition),
-                          operands[-1])
-        elif kind == RELATION:
-            result = RELATIONS[node.value](*operands)
-        elif kind == AND:
-            result = all(operands)
-        elif kind == OR:
-            result = any(operands)
-        elif kind == NOT:
-            result = not operands[0]
-        else:  # FINITE
-            result = math.isfinite(operands[0])
-    done[node] = result
-    return result

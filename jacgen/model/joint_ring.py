@@ -1,13 +1,11 @@
 """Exact polynomials in a robot's joints: the ring over the joint atoms c_i, s_i (cos and sin
 of q_i + offset_i), the variables of prismatic joints and the symbolic parameters, where the
 singularity analysis (`singularities.py`) and the general 6R equations (`general6r.py`) multiply,
-expand determinants (maximal minors by memoised Laplace expansion) and factor, each product
-counted against one work limit.
+expand determinants (`js_rank.maximal_minors`, with this ring's products) and factor, each
+product counted against one work limit.
 """
 
-import itertools
 import math
-from functools import lru_cache
 
 import sympy
 from sympy.polys.orderings import lex
@@ -30,32 +28,6 @@ def joint_atoms(robot: Robot) -> tuple[tuple[sympy.Symbol, ...], ...]:
     q = kinematics.joint_symbols(robot)
     return tuple(kinematics.trig_symbols((i,), robot.dof) if joint.revolute else (q[i],)
                  for i, joint in enumerate(robot.joints))
-
-
-def maximal_minors(matrix, zero=0, one=1, times=lambda a, b: a * b) -> list:
-    """Every largest square minor of a matrix (list of rows), by Laplace expansion.
-
-    The minors of the lower rows are shared (memoised), so a 6 x 7 matrix costs about 450
-    products, and the result is division-free: exact in a ring, and straight-line code
-    that stays finite at singular configurations. Wide matrices give one minor per column
-    subset, tall ones per row subset, subsets in lexicographic order.
-    """
-    if len(matrix) > len(matrix[0]):
-        matrix = [list(column) for column in zip(*matrix)]
-    rows, cols = len(matrix), len(matrix[0])
-
-    @lru_cache(maxsize=None)
-    def minor(row: int, columns: tuple[int, ...]):
-        if row == rows:
-            return one
-        total = zero
-        for k, c in enumerate(columns):
-            if matrix[row][c] != 0:
-                term = times(matrix[row][c], minor(row + 1, columns[:k] + columns[k + 1:]))
-                total = total - term if k % 2 else total + term
-        return total
-
-    return [minor(0, subset) for subset in itertools.combinations(range(cols), rows)]
 
 
 # ---------------------------------------------------------------------------------------

@@ -1,9 +1,7 @@
-"""Singularity analysis (docs/contract.md §2): the singularity Jacobian Js, its polynomial and factors.
-
-Js is the task Jacobian, except that a task holding all of roll, pitch and yaw uses the
-geometric angular-velocity rows instead (so the Euler-angle singularity at pitch = ±90°
-is not mistaken for a kinematic one; it is reported separately). The robot is singular
-where det(Js) (m = n), det(Js Js^T) (m < n) or det(Js^T Js) (m > n) vanishes.
+"""Singularity analysis (docs/contract.md §2): the polynomial of the singularity Jacobian Js
+(`js_rank.py`) and its exact factors. The robot is singular where det(Js) (m = n),
+det(Js Js^T) (m < n) or det(Js^T Js) (m > n) vanishes; the Euler-angle singularity at
+pitch = ±90° is reported separately.
 
 The polynomial is computed exactly in a polynomial ring over the joint atoms c_i, s_i
 (cos and sin of q_i + offset_i), the variables of prismatic joints and the symbolic
@@ -30,10 +28,12 @@ import sympy
 from sympy.polys.rings import PolyElement
 
 from jacgen.inputs import numeric_chain
-from jacgen.inputs.robot import EULER_ANGLES, TASK_COMPONENTS, Robot
-from jacgen.model.graph import ADD, Graph, evaluate
+from jacgen.inputs.robot import TASK_COMPONENTS, Robot
+from jacgen.model.graph import Graph
+from jacgen.model.node import ADD, evaluate
 from jacgen.model.joint_ring import (READABLE_TERMS, JointRing, TooLarge, factorise, frames_about, geometric_columns,
-                                     maximal_minors, multiply, permutation_sign, term_count)
+                                     multiply, permutation_sign, term_count)
+from jacgen.model.js_rank import MINOR_LIMIT, maximal_minors, singularity_rows
 from jacgen.tolerances import PARALLEL, ROOT
 
 # What `evaluate` calls over numpy arrays (the zero sets of factors, on a grid of one joint).
@@ -41,26 +41,11 @@ NUMPY = {"sin": np.sin, "cos": np.cos, "tan": np.tan, "atan2": np.arctan2, "Abs"
 
 # The exact analysis is bounded by counts, never by a clock, so its outcome is the same on
 # every machine: the monomial products of all polynomial multiplications of one robot
-# (joint_ring.WORK_LIMIT); MINOR_LIMIT the maximal minors whose common factors are sought
-# (C(n, m) of them); FACTOR_TERM_LIMIT the size of a polynomial handed to sympy's factoring.
+# (joint_ring.WORK_LIMIT); the maximal minors whose common factors are sought
+# (js_rank.MINOR_LIMIT); FACTOR_TERM_LIMIT the size of a polynomial handed to sympy's factoring.
 # Past any of them the exact factors found so far stay, and the generated code computes the
 # rest of the rank condition numerically (det(Js), or det(Js Js^T) / det(Js^T Js)).
-MINOR_LIMIT = 64
 FACTOR_TERM_LIMIT = 400
-
-
-def singularity_rows(robot: Robot) -> tuple[int, ...] | None:
-    """Rows of the geometric Jacobian (vx vy vz wx wy wz) forming Js, in task order;
-    None when Js is the task Jacobian itself (a task with some but not all Euler angles)."""
-    if sum(component in EULER_ANGLES for component in robot.task) in (0, 3):
-        return tuple(TASK_COMPONENTS.index(component) for component in robot.task)
-    return None
-
-
-def singularity_jacobian(robot: Robot, jacobian: sympy.Matrix, task_jacobian: sympy.Matrix) -> sympy.Matrix:
-    """Js from the geometric and the task Jacobian of one chain."""
-    rows = singularity_rows(robot)
-    return task_jacobian if rows is None else jacobian.extract(list(rows), list(range(robot.dof)))
 
 
 def _analysed_matrix(ring: JointRing):

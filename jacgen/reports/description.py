@@ -6,8 +6,9 @@ import sympy
 
 from jacgen.inputs import numeric_chain
 from jacgen.inputs.robot import Robot
-from jacgen.model import structure
-from jacgen.model.singularities import READABLE_TERMS, Factor, Singularities, singularity_rows
+from jacgen.model.js_rank import singularity_rows
+from jacgen.model.nearest_class import NEAR_LENGTH, NEAR_TWIST
+from jacgen.model.singularities import READABLE_TERMS, Factor, Singularities
 from jacgen.model.structure import SOLVERS
 from jacgen.solvers import general6r
 from jacgen.solvers.model import Model
@@ -164,8 +165,8 @@ def _fast_path_line(model: Model) -> str:
     fast = model.closed_form.fast_path
     if fast is None:
         why = ("ik.nearest_class: false" if not model.robot.nearest_class else
-               f"no special class within {structure.NEAR_TWIST} rad of its twists and "
-               f"{structure.NEAR_LENGTH * 100:g} % of its reach of its lengths")
+               f"no special class within {NEAR_TWIST} rad of its twists and "
+               f"{NEAR_LENGTH * 100:g} % of its reach of its lengths")
         return f"path: every target to the eigenproblem ({why})"
     return (f"path: calibrated fast path. Nearest special class: {fast.form.solver}, with "
             f"{', '.join(fast.nominal.snapped)} (the arms differ by {fast.position:.3g} {model.robot.length_unit} "

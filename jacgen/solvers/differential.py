@@ -16,8 +16,9 @@ from typing import Callable
 import numpy
 import sympy
 
-from jacgen.model.graph import AND, OR, Graph, Node, elementwise
-from jacgen.model.nodes import RANK
+from jacgen.model.graph import Graph, elementwise
+from jacgen.model.node import AND, OR, Node
+from jacgen.model.tolerance_symbols import RANK
 from jacgen.tolerances import IK_NUMERIC_DEFAULT
 
 # Statuses of velocity_ik, the same in every backend.

@@ -321,7 +321,7 @@ MONOMIALS = np.array([np.outer(_HALF_ANGLE[b], _HALF_ANGLE[c]).ravel()
 ALONG_C = (0, 1, 3, 4, 6, 7, 9, 10)
 ALONG_B = tuple(range(9))
 NEWTON_STEPS = 6  # at most, on the pose, after the back-substitution (a near-double root needs more than 2)
-# The fast path of a calibrated arm (a structure.Nominal): the nominal arm's closed form, then up
+# The fast path of a calibrated arm (a nearest_class.Nominal): the nominal arm's closed form, then up
 # to FAST_STEPS Newton steps on the exact arm from each branch that the target allows or that
 # misses it by at most FAST_BAND times the arms' mismatch (the largest position and rotation error
 # between them at one configuration, over FAST_SAMPLES random ones). Each must reach T to

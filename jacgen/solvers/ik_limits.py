@@ -5,7 +5,7 @@ choice of the solution nearest a seed. On the value graph, like the solvers of `
 
 import sympy
 
-from jacgen.model.graph import AND, OR, Node
+from jacgen.model.node import AND, OR, Node
 from jacgen.solvers.subproblems import Subproblems, wrapped
 
 # ik_nearest's statuses

@@ -21,8 +21,9 @@ from typing import Callable
 
 import sympy
 
-from jacgen.model.graph import AND, CALL, NUMBER, OR, SELECT, Graph, Node
-from jacgen.model.nodes import EPS, TINY
+from jacgen.model.graph import Graph
+from jacgen.model.node import AND, CALL, NUMBER, OR, SELECT, Node
+from jacgen.model.tolerance_symbols import EPS, TINY
 
 Vector = tuple[Node, Node, Node]
 

@@ -11,7 +11,7 @@ import sympy
 
 from jacgen.solvers import general6r
 from jacgen.checking import reference
-from jacgen.inputs.robot import parse_robot
+from jacgen.inputs.robot_file import parse_robot
 
 from .ik import wrapped
 

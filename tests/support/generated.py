@@ -24,7 +24,8 @@ from jacgen.emission.generator import Generator
 from jacgen.checking.generated_code import import_module
 from jacgen.files import write_files
 from jacgen.emission.render import render_robot
-from jacgen.inputs.robot import Robot, load_robot
+from jacgen.inputs.robot import Robot
+from jacgen.inputs.robot_file import load_robot
 
 ROOT = Path(__file__).resolve().parents[2]
 GENERATED = ROOT / "generated"

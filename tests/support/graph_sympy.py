@@ -8,6 +8,7 @@ import sympy
 from sympy.logic.boolalg import BooleanFunction
 
 from jacgen.model import graph
+from jacgen.model import node as kinds
 
 
 class Select(sympy.Function):
@@ -22,34 +23,34 @@ CALLS = {"Floor": sympy.floor, "Ceiling": sympy.ceiling}
 RELATIONS = {">=": sympy.Ge, ">": sympy.Gt, "<=": sympy.Le, "<": sympy.Lt, "==": sympy.Eq, "!=": sympy.Ne}
 
 
-def to_sympy(node: graph.Node, _done: dict | None = None) -> sympy.Basic:
+def to_sympy(node: kinds.Node, _done: dict | None = None) -> sympy.Basic:
     done = {} if _done is None else _done
     if node in done:
         return done[node]
     kind, value = node.kind, node.value
     args = [to_sympy(arg, done) for arg in node.args]
-    if kind == graph.NUMBER:
+    if kind == kinds.NUMBER:
         result = sympy.Float(float(value)) if isinstance(value, Fraction) else sympy.sympify(value)
-    elif kind == graph.SYMBOL:
+    elif kind == kinds.SYMBOL:
         result = value
-    elif kind == graph.TRUTH:
+    elif kind == kinds.TRUTH:
         result = sympy.true if value else sympy.false
-    elif kind == graph.ADD:
+    elif kind == kinds.ADD:
         result = sympy.Add(*args, evaluate=False)
-    elif kind == graph.MUL:
+    elif kind == kinds.MUL:
         result = sympy.Mul(*args, evaluate=False)
-    elif kind == graph.POW:
+    elif kind == kinds.POW:
         result = sympy.Pow(*args, evaluate=False)
-    elif kind == graph.CALL:
+    elif kind == kinds.CALL:
         result = (CALLS[value] if value in CALLS else getattr(sympy, value))(*args, evaluate=False)
-    elif kind == graph.SELECT:
+    elif kind == kinds.SELECT:
         result = Select(*args, evaluate=False)
-    elif kind == graph.RELATION:
+    elif kind == kinds.RELATION:
         result = RELATIONS[value](*args, evaluate=False)
-    elif kind == graph.FINITE:
+    elif kind == kinds.FINITE:
         result = IsFinite(*args)
     else:
-        result = {graph.AND: sympy.And, graph.OR: sympy.Or, graph.NOT: sympy.Not}[kind](*args, evaluate=False)
+        result = {kinds.AND: sympy.And, kinds.OR: sympy.Or, kinds.NOT: sympy.Not}[kind](*args, evaluate=False)
     done[node] = result
     return result
 

@@ -8,7 +8,7 @@ import numpy as np
 
 from jacgen.checking import reference
 from jacgen.inputs.robot import EULER_ANGLES as EULER
-from jacgen.inputs.robot import parse_robot
+from jacgen.inputs.robot_file import parse_robot
 
 
 def wrapped(angles):

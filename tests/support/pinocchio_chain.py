@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from jacgen.inputs.robot import load_robot
+from jacgen.inputs.robot_file import load_robot
 
 ROBOTS = Path(__file__).resolve().parents[2] / "robots"
 SAMPLES = 200

@@ -2,16 +2,18 @@
 
 A language module (`c.py`, `python.py`, `casadi.py`, `report.py`) holds its expression printer
 (a subclass of `printers.Printer`: the literal policy, selects, comparisons, `isfinite`), the
-builder of what its templates receive, the list of its templates under `templates/` (with
-their runtime helpers), its comment syntax and its reserved words (`names.py`'s tables), in
-one `BACKEND` record (`common.Backend`). Every algorithm reaches every language as
-straight-line `Body`s (`lowering.py`): a backend only prints and lays out. Adding a language
-is one module, its templates, and its name in LANGUAGES.
+builder of what its templates receive and the list of its templates under `templates/` (with
+their runtime helpers), in one `BACKEND` record (`common.Backend`). Every algorithm reaches
+every language as straight-line `Body`s (`lowering.py`): a backend only prints and lays out.
+Adding a language is one module, its templates, and its name with its reserved words in
+`inputs/names.py`'s RESERVED, whose keys are LANGUAGES.
 """
 
 from importlib import import_module
 
-LANGUAGES = ("c", "python", "casadi", "report", "native")  # each the module of its name
+from jacgen.inputs.names import RESERVED
+
+LANGUAGES = tuple(RESERVED)  # each the module of its name
 # `generate` without --lang: native is asked for by name (it is a package to build, and writes
 # the C in both builds)
 DEFAULT_LANGUAGES = ("c", "python", "casadi", "report")

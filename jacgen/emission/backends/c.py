@@ -1,6 +1,6 @@
 """The C99 backend: its printer (double or float, no double promotion), the data of the header
 and source templates (`templates/c/`: the functions, the IK loops and the general 6R
-eigensolver's runtime), and its reserved words."""
+eigensolver's runtime), """
 
 import numpy
 
@@ -9,9 +9,8 @@ from jacgen.emission.backends.common import (Backend, common_context, ik_context
 from jacgen.emission.catalogue import Argument, Call, Function, Output
 from jacgen.emission.generator import Generator
 from jacgen.emission.printers import AND, ATOM, MATH_FUNCTIONS, PRODUCT, RELATION, Printer
-from jacgen.inputs import names
 from jacgen.inputs.robot import Robot
-from jacgen.model.nodes import TOLERANCES
+from jacgen.model.tolerance_symbols import TOLERANCES
 
 _FLOAT_MAX = float(numpy.finfo(numpy.float32).max)
 
@@ -181,5 +180,4 @@ def c_context(robot: Robot, generator: Generator, printer: CPrinter, real: str) 
     return dict(sorted(context.items()))
 
 
-BACKEND = Backend("c", (("c/robot.h.jinja", "{name}.h"), ("c/robot.c.jinja", "{name}.c")), CPrinter, c_context,
-                  names.C_RESERVED)
+BACKEND = Backend("c", (("c/robot.h.jinja", "{name}.h"), ("c/robot.c.jinja", "{name}.c")), CPrinter, c_context)

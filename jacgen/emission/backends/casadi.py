@@ -1,13 +1,12 @@
 """The CasADi backend: Python that builds each function as an SX graph (`templates/casadi/`),
-its printer, and its reserved words (Python's)."""
+and its printer."""
 
 from jacgen.emission.backends.common import Backend, common_context, ik_numeric_context, parameters_read, sentence
 from jacgen.emission.backends.python import python_number
 from jacgen.emission.catalogue import Function
 from jacgen.emission.generator import Generator
-from jacgen.model.graph import is_zero
+from jacgen.model.node import is_zero
 from jacgen.emission.printers import MATH_FUNCTIONS, Printer
-from jacgen.inputs import names
 from jacgen.inputs.robot import Robot
 
 
@@ -80,4 +79,4 @@ def casadi_context(robot: Robot, generator: Generator, printer: CasadiPrinter, r
 
 
 BACKEND = Backend("casadi", (("casadi/robot_casadi.py.jinja", "{name}_casadi.py"),),
-                  lambda real: CasadiPrinter(), casadi_context, names.PYTHON_RESERVED)
+                  lambda real: CasadiPrinter(), casadi_context)

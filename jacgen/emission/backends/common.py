@@ -8,24 +8,24 @@ from typing import Callable
 from jacgen.emission.catalogue import DECLARED, Output
 from jacgen.emission.generator import Generator
 from jacgen.inputs.robot import Robot
-from jacgen.model import singularities
-from jacgen.model.nodes import RANK, TOLERANCES
-from jacgen.solvers import differential, general6r, ik
+from jacgen.model import js_rank
+from jacgen.model.tolerance_symbols import RANK, TOLERANCES
+from jacgen.reports import ik_documentation
+from jacgen.solvers import differential, general6r
 from jacgen.tolerances import REACHED
 
 
 @dataclass(frozen=True)
 class Backend:
     """One target language: its templates with the file each becomes, its expression printer
-    for a real type ("double", "float"; None: prints no expression), the builder of what its
-    templates receive, and the words it reserves (by reason)."""
+    for a real type ("double", "float"; None: prints no expression) and the builder of what its
+    templates receive. The words it reserves are `names.RESERVED[name]`."""
 
     name: str
     # (template, output file pattern with {name}[, the key of the context's part it renders])
     templates: tuple[tuple[str, ...], ...]
     printer: Callable[[str], object] | None
     context: Callable  # (robot, generator, printer, real) -> the templates' data
-    reserved: dict[str, frozenset[str]]
 
 
 def common_context(robot: Robot) -> dict:
@@ -94,7 +94,7 @@ def ik_context(robot: Robot, generator: Generator, real: str, number: Callable, 
     return {
         "solver": form.solver,
         "max_solutions": form.info.max_solutions,
-        "doc": ik.documentation(robot, form, solutions_macro),
+        "doc": ik_documentation.documentation(robot, form, solutions_macro),
         "inputs": ", ".join(inputs),
         "free_joint": form.free,
         "nearest_statuses": [(status.name, status.value) for status in DECLARED["ik_nearest"].statuses],
@@ -146,7 +146,7 @@ def ik_numeric_context(robot: Robot, number: Callable) -> dict:
 def velocity_ik_context(robot: Robot, real: str) -> dict:
     """What the documentation of velocity_ik says: Js, mu_dot, the system and its statuses."""
     m, n = len(robot.task), robot.dof
-    rows = singularities.singularity_rows(robot)
+    rows = js_rank.singularity_rows(robot)
     names = ", ".join(("vx", "vy", "vz", "wx", "wy", "wz")[r] for r in rows) if rows is not None else ""
     return {
         "system": min(m, n),

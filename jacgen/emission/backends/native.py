@@ -15,7 +15,6 @@ from jacgen.emission.backends.c import CPrinter, c_context
 from jacgen.emission.backends.common import Backend
 from jacgen.emission.catalogue import Function
 from jacgen.emission.generator import Generator
-from jacgen.inputs import names
 from jacgen.inputs.robot import Robot
 from jacgen.version import __version__
 
@@ -161,4 +160,4 @@ BACKEND = Backend(
      ("native/kernels.c.jinja", "{name}_native_float.c", "float"),
      ("native/native.h.jinja", "{name}_native.h"), ("native/module.c.jinja", "{name}_native.c"),
      ("native/setup.py.jinja", "setup.py"), ("native/pyproject.toml.jinja", "pyproject.toml")),
-    None, native_context, names.C_RESERVED)
+    None, native_context)

@@ -1,5 +1,5 @@
 """The numpy backend (any array API namespace: numpy, JAX, PyTorch; batched): its printer, the
-data of `templates/python/`, and its reserved words."""
+data of `templates/python/`."""
 
 import numpy
 import sympy
@@ -8,9 +8,8 @@ from jacgen.emission.backends.common import (Backend, common_context, dimensions
                                              velocity_ik_context)
 from jacgen.emission.catalogue import Function
 from jacgen.emission.generator import Generator
-from jacgen.model.graph import ADD, CALL, NUMBER, SELECT, SYMBOL
+from jacgen.model.node import ADD, CALL, NUMBER, SELECT, SYMBOL
 from jacgen.emission.printers import ATOM, MATH_FUNCTIONS, RELATION, Printer
-from jacgen.inputs import names
 from jacgen.inputs.robot import Robot
 
 
@@ -140,4 +139,4 @@ def python_context(robot: Robot, generator: Generator, printer: PythonPrinter, r
 
 
 BACKEND = Backend("python", (("python/robot.py.jinja", "{name}.py"),),
-                  lambda real: PythonPrinter(), python_context, names.PYTHON_RESERVED)
+                  lambda real: PythonPrinter(), python_context)

@@ -32,4 +32,4 @@ def report_context(robot: Robot, generator: Generator, printer: None, real: str)
     return dict(sorted((common_context(robot) | _report_context(robot, generator)).items()))
 
 
-BACKEND = Backend("report", (("report/robot.md.jinja", "{name}.md"),), None, report_context, {})
+BACKEND = Backend("report", (("report/robot.md.jinja", "{name}.md"),), None, report_context)
