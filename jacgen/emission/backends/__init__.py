@@ -3,7 +3,7 @@
 A language module (`c.py`, `python.py`, `casadi.py`, `report.py`) holds its expression printer
 (a subclass of `printers.Printer`: the literal policy, selects, comparisons, `isfinite`), the
 builder of what its templates receive, the list of its templates under `templates/` (with
-their runtime helpers), its comment syntax and its reserved words (`names.py`'s tables), in
+their runtime helpers, fixed C under `templates/runtime/`), its comment syntax and its reserved words (`names.py`'s tables), in
 one `BACKEND` record (`common.Backend`). Every algorithm reaches every language as
 straight-line `Body`s (`lowering.py`): a backend only prints and lays out. Adding a language
 is one module, its templates, and its name in LANGUAGES.
