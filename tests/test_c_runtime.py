@@ -1,15 +1,13 @@
 """The C runtime helpers of the general 6R solver, compiled with the generated code's warning
-flags: templates/c/eigenvalues.c.jinja against matrices whose eigenvalues are known by
+flags: templates/runtime/eigenvalues.c against matrices whose eigenvalues are known by
 construction (similarity transforms of block-diagonal matrices, companion matrices of
 polynomials with given roots, repeated ones included) and against LAPACK;
-templates/c/general6r.c.jinja (the elimination from the equations at a target to the loop
+templates/runtime/general6r.c (the elimination from the equations at a target to the loop
 angles) through whole solutions: the configurations its roots complete to reach the pose on
-the numpy reference, the generating one among them, as many as numpy's eigensolver gives."""
+the numpy reference, the generating one among them, as many as numpy's eigensolver gives; its tables are those of jacgen/general6r.py."""
 
 import ctypes
 import math
-
-import jinja2
 
 import numpy as np
 import pytest
@@ -24,8 +22,10 @@ from support.ik import wrapped
 
 HARNESS = """
 #include <math.h>
-#include "eigenvalues.c.jinja"
+#include "eigenvalues.c"
 #include "general6r.c"
+void monomials(const double *c, double *out);
+void monomials(const double *c, double *out) { jacgen_g6_monomials(c, out); }
 int roots(const double *p, const double *q, double *angles);
 int roots(const double *p, const double *q, double *angles) {
     double pm[3][14][9], qm[14][8], out[JACGEN_G6_ROOTS][5];
@@ -47,18 +47,16 @@ int eigenvalues(int n, const double *matrix, double *re, double *im) {
 
 
 POINTER = ctypes.POINTER(ctypes.c_double)
+RUNTIME = ROOT / "templates" / "runtime"
 
 
 @pytest.fixture(scope="module")
 def library(tmp_path_factory):
     folder = tmp_path_factory.mktemp("runtime")
     (folder / "harness.c").write_text(HARNESS)
-    template = (ROOT / "templates" / "c" / "general6r.c.jinja").read_text()
-    (folder / "general6r.c").write_text(jinja2.Template(template).render(
-        monomials=general6r.MONOMIALS.astype(int).tolist(), along_b=general6r.ALONG_B, along_c=general6r.ALONG_C,
-        imaginary=general6r.IMAGINARY["double"], q_rank=general6r.Q_RANK))
-    library = ctypes.CDLL(str(compile_shared([folder / "harness.c"], folder / "libruntime.so",
-                                             ("-O2", f"-I{ROOT / 'templates' / 'c'}"))))
+    flags = ("-O2", f"-I{RUNTIME}", f"-DJACGEN_G6_IMAGINARY={general6r.IMAGINARY['double']}")
+    library = ctypes.CDLL(str(compile_shared([folder / "harness.c"], folder / "libruntime.so", flags)))
+    library.monomials.argtypes = [POINTER, POINTER]
     library.eigenvalues.argtypes = [ctypes.c_int, POINTER, POINTER, POINTER]
     library.roots.argtypes = [POINTER, POINTER, POINTER]
     return library
@@ -148,3 +146,14 @@ def test_general6r_roots_complete_to_every_solution(library, name):
         ours = arm.solve(pose, roots)
         assert min(np.abs(wrapped(s - q)).max() for s in ours) < 1e-8
         assert len(ours) == len(arm.solve(pose))
+
+
+def test_tables_are_those_of_the_numpy_solver(library):
+    """The C's MONOMIALS (written out) and ALONG_B, ALONG_C are jacgen/general6r.py's."""
+    for k in range(9):
+        unit, out = np.eye(9)[k], np.zeros(9)
+        library.monomials(unit.ctypes.data_as(POINTER), out.ctypes.data_as(POINTER))
+        assert list(out) == list(general6r.MONOMIALS[k])
+    text = (RUNTIME / "general6r.c").read_text()
+    for name, table in (("along_b", general6r.ALONG_B), ("along_c", general6r.ALONG_C)):
+        assert f"static const int {name}[{len(table)}] = {{{', '.join(map(str, table))}}};" in text

@@ -167,6 +167,7 @@ static int jacgen_eigenvalues(int n, double a[JACGEN_EIG_MAX][JACGEN_EIG_MAX], d
 }
 
 
+#define JACGEN_G6_IMAGINARY 1e-05
 /* Runtime helper of the general 6R solver (included by robot.c.jinja for its robots): from
  * Raghavan & Roth's 14 equations at one target, (P0 + s Ps + c Pc) v_bc = Q v_gh with the hidden
  * angle's shift already applied (jacgen/general6r.py), the loop angles (a, b, c, g, h) of every
@@ -176,7 +177,9 @@ static int jacgen_eigenvalues(int n, double a[JACGEN_EIG_MAX][JACGEN_EIG_MAX], d
  * x = +-i for every target (jacgen_g6_spurious); the other 16 are those of the companion matrix
  * with them deflated (jacgen_g6_deflated, jacgen_eigenvalues). Per real root, the null vector of
  * M(x) (inverse iteration) gives x_b and x_c, and R^-1 (Q^T P v_bc)[0..7] gives v_gh. Fixed size,
- * no allocation, no recursion. Returns the number of roots (0 when M2 or R is singular). */
+ * no allocation, no recursion. Returns the number of roots (0 when M2 or R is singular).
+ * Defined before it: JACGEN_G6_IMAGINARY, an eigenvalue being a root when |imaginary part| <= that
+ * (1 + |x|) (jacgen/general6r.py's IMAGINARY for the build's real type). */
 #define JACGEN_G6_ROOTS 16
 
 /* sum_k c[k] v_bc[k] times (1 + x_b^2) (1 + x_c^2) as a polynomial in x_b, x_c: its coefficient of
@@ -450,7 +453,7 @@ static int jacgen_general6r_roots(double p[3][14][9], double q_matrix[14][8],
     int found = 0;
     for (int k = 0; k < JACGEN_G6_ROOTS; k++) {
         double x = w->re[k], v[12];
-        if (!(fabs(w->im[k]) <= 1e-05 * (1.0 + fabs(x)))) continue;
+        if (!(fabs(w->im[k]) <= JACGEN_G6_IMAGINARY * (1.0 + fabs(x)))) continue;
         for (int i = 0; i < 12; i++)
             for (int j = 0; j < 12; j++) w->square[0][i][j] = w->m[0][i][j] + x * (w->m[1][i][j] + x * w->m[2][i][j]);
         jacgen_g6_null_vector(w->square[0], v);

@@ -2,7 +2,8 @@
 
 The robot's C is cross-compiled for a Cortex-M4F (single-precision FPU, hard float, newlib's
 libm) at -O2 with the contract's warning flags, linked with a harness rendered from the
-function catalogue (`templates/target/`) and run on QEMU's MPS2 AN386 board. Inputs and
+function catalogue (`templates/target/`) and the board's runtime
+(`templates/runtime/target_runtime.c`), and run on QEMU's MPS2 AN386 board. Inputs and
 results pass through files on the host by semihosting; one QEMU run evaluates a batch.
 
 Instruction counts: QEMU runs with `-icount shift=6`, so its virtual clock advances 64 ns per
@@ -28,6 +29,7 @@ from jacgen.errors import JacgenError
 from jacgen.files import write_files
 from jacgen.inputs.robot import Robot
 from jacgen.solvers.differential import IK_NUMERIC_DEFAULTS
+from jacgen.sources import template_folder
 from jacgen.tolerances import IK_NUMERIC_VERIFIED
 
 TARGETS = ("cortex-m4f",)
@@ -39,9 +41,9 @@ BUILD_FLAGS = ("-O2", "-ffunction-sections", "-fstack-usage", "-fcallgraph-info=
 QEMU = ("qemu-system-arm", "-M", "mps2-an386", "-nographic", "-monitor", "none",
         "-semihosting-config", "enable=on,target=native", "-icount", "shift=6", "-kernel")
 INSTRUCTIONS_PER_TICK = 40 / 64
-PAINTED_BYTES = 65536  # the stack painted below each call: a deeper call is reported as this
 RUN_SECONDS = 300  # a run that takes longer is stopped (it hangs)
-TEMPLATES = ("runtime.h", "runtime.c", "mps2_an386.ld", "harness.c")
+TEMPLATES = ("mps2_an386.ld", "harness.c")
+RUNTIME = ("target_runtime.h", "target_runtime.c")  # copied from templates/runtime/
 
 
 class TargetError(JacgenError):
@@ -142,7 +144,6 @@ def harness_context(robot: Robot, found: list[Call]) -> dict:
         "parameters": [f"{p.value!r}f" for p in robot.symbolic_parameters],
         "ik_check": target and {"function": "fk" if pose else "task", "size": target,
                                 "wrapped": [0] * 16 if pose else [int(name in ("roll", "pitch", "yaw")) for name in robot.task]},
-        "painted_bytes": PAINTED_BYTES,
     }
 
 
@@ -180,7 +181,9 @@ class Emulator:
         templates = environment()
         for name in TEMPLATES:
             (folder / name).write_text(templates.get_template(f"target/{name}.jinja").render(context))
-        self.sources = [code / f"{robot.name}.c", folder / "runtime.c", folder / "harness.c"]
+        for name in RUNTIME:
+            shutil.copyfile(template_folder() / "runtime" / name, folder / name)
+        self.sources = [code / f"{robot.name}.c", folder / "target_runtime.c", folder / "harness.c"]
         self.program = folder / f"{robot.name}.elf"
         self.measured: dict[str, Batch] = {}  # the last batch of each function run
 

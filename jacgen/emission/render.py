@@ -40,9 +40,18 @@ class CompiledTemplates(jinja2.FileSystemBytecodeCache):
 
 
 @functools.cache
+def runtime(name: str) -> str:
+    """The text of the runtime file `name` (`templates/runtime/`: fixed C, compiled and tested on
+    its own) without its last newline, for a template to copy in verbatim as `{{ runtime(name) }}`
+    on a line of its own; jinja never parses it."""
+    return (sources.template_folder() / "runtime" / name).read_text().removesuffix("\n")
+
+
+@functools.cache
 def environment() -> jinja2.Environment:
-    """The templates, compiled once per process (and, through the cache folder, per machine)."""
-    return jinja2.Environment(
+    """The templates, compiled once per process (and, through the cache folder, per machine),
+    with `runtime` as a global."""
+    templates = jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(sources.template_folder())),
         bytecode_cache=CompiledTemplates(str(cache.folder() / "templates")),
         undefined=jinja2.StrictUndefined,
@@ -51,6 +60,8 @@ def environment() -> jinja2.Environment:
         keep_trailing_newline=True,
         autoescape=False,
     )
+    templates.globals["runtime"] = runtime
+    return templates
 
 
 # The one-line comment of each kind of file, around the header.

@@ -336,9 +336,6 @@ FAST_BAND = 3.0
 FAST_MARGIN = 50.0
 FAST_SAMPLES = 1000
 CONVERGED = {"double": 1e-12, "float": 1e-5}
-# The C kernel's QR of Q: a diagonal entry of R below this times the largest is a column that
-# depends on the others (Q of rank below 8: v_gh cannot be read back, and the target has no root).
-Q_RANK = 1e-12
 # An eigenvalue is a root when |imaginary part| <= this (1 + |x|): a double root the target's
 # rounding splits into a complex pair (by about the square root of that rounding) still counts,
 # and the Newton steps and the tolerance above decide.

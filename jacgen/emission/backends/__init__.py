@@ -3,10 +3,11 @@
 A language module (`c.py`, `python.py`, `casadi.py`, `report.py`) holds its expression printer
 (a subclass of `printers.Printer`: the literal policy, selects, comparisons, `isfinite`), the
 builder of what its templates receive and the list of its templates under `templates/` (with
-their runtime helpers), in one `BACKEND` record (`common.Backend`). Every algorithm reaches
-every language as straight-line `Body`s (`lowering.py`): a backend only prints and lays out.
-Adding a language is one module, its templates, and its name with its reserved words in
-`inputs/names.py`'s RESERVED, whose keys are LANGUAGES.
+their runtime helpers, fixed C under `templates/runtime/`), in one `BACKEND` record
+(`common.Backend`). Every algorithm reaches every language as straight-line `Body`s
+(`lowering.py`): a backend only prints and lays out. Adding a language is one module, its
+templates, and its name with its reserved words in `inputs/names.py`'s RESERVED, whose keys
+are LANGUAGES.
 """
 
 from importlib import import_module

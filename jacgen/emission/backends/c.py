@@ -1,6 +1,6 @@
 """The C99 backend: its printer (double or float, no double promotion), the data of the header
-and source templates (`templates/c/`: the functions, the IK loops and the general 6R
-eigensolver's runtime), """
+and source templates (`templates/c/`: the functions and the IK loops; the general 6R
+eigensolver's runtime is C of its own, `templates/runtime/`)."""
 
 import numpy
 

@@ -104,7 +104,7 @@ def ik_context(robot: Robot, generator: Generator, real: str, number: Callable, 
         "general": form.solver == "general_6r" and {
             "monomials": general6r.MONOMIALS.astype(int).tolist(), "along_b": general6r.ALONG_B,
             "along_c": general6r.ALONG_C, "newton_steps": general6r.NEWTON_STEPS,
-            "tolerance": REACHED[real], "imaginary": general6r.IMAGINARY[real], "q_rank": general6r.Q_RANK,
+            "tolerance": REACHED[real], "imaginary": general6r.IMAGINARY[real],
             "squared": number(REACHED[real] ** 2),
             "converged_squared": number((general6r.CONVERGED[real] * (1 + robot.reach)) ** 2),
             "work_bytes": general6r.work_bytes(real),

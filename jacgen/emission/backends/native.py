@@ -5,7 +5,8 @@ that gcc vectorises and threads split, and every function as a numpy gufunc.
 It prints no expression. The C backend writes both builds (the float one named `NAME_float`,
 so that the two link into one module), and the templates under `templates/native/` lay out
 the glue: a table of every function's operands, one kernel per function and build that calls
-the C function on a block of rows, the module, and its `setup.py` and `pyproject.toml`.
+the C function on a block of rows, the module (around its fixed C,
+`templates/runtime/native_module.c`), and its `setup.py` and `pyproject.toml`.
 """
 
 from dataclasses import replace

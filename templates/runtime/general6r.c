@@ -7,15 +7,23 @@
  * x = +-i for every target (jacgen_g6_spurious); the other 16 are those of the companion matrix
  * with them deflated (jacgen_g6_deflated, jacgen_eigenvalues). Per real root, the null vector of
  * M(x) (inverse iteration) gives x_b and x_c, and R^-1 (Q^T P v_bc)[0..7] gives v_gh. Fixed size,
- * no allocation, no recursion. Returns the number of roots (0 when M2 or R is singular). */
+ * no allocation, no recursion. Returns the number of roots (0 when M2 or R is singular).
+ * Defined before it: JACGEN_G6_IMAGINARY, an eigenvalue being a root when |imaginary part| <= that
+ * (1 + |x|) (jacgen/general6r.py's IMAGINARY for the build's real type). */
 #define JACGEN_G6_ROOTS 16
 
 /* sum_k c[k] v_bc[k] times (1 + x_b^2) (1 + x_c^2) as a polynomial in x_b, x_c: its coefficient of
  * x_b^i x_c^j at 3 i + j (jacgen/general6r.py's MONOMIALS, written out without its zeros). */
 static void jacgen_g6_monomials(const double c[9], double out[9]) {
-{% for j in range(9) %}
-    out[{{ j }}] = {% for k in range(9) if monomials[k][j] %}{{ (" - " if monomials[k][j] < 0 else " + ") if not loop.first else ("-" if monomials[k][j] < 0 else "") }}{{ "%d.0 * " % (monomials[k][j] | abs) if (monomials[k][j] | abs) != 1 }}c[{{ k }}]{% endfor %};
-{% endfor %}
+    out[0] = c[3] + c[5] + c[7] + c[8];
+    out[1] = 2.0 * c[2] + 2.0 * c[6];
+    out[2] = -c[3] + c[5] - c[7] + c[8];
+    out[3] = 2.0 * c[1] + 2.0 * c[4];
+    out[4] = 4.0 * c[0];
+    out[5] = -2.0 * c[1] + 2.0 * c[4];
+    out[6] = -c[3] - c[5] + c[7] + c[8];
+    out[7] = -2.0 * c[2] + 2.0 * c[6];
+    out[8] = c[3] - c[5] - c[7] + c[8];
 }
 
 /* The Householder reflections of q (14 x 8) in place below the diagonal with their scales; r's
@@ -40,7 +48,7 @@ static int jacgen_g6_qr(double q[14][8], double beta[8], double rdiag[8]) {
     double largest = 0.0;
     for (int k = 0; k < 8; k++) largest = fmax(largest, fabs(rdiag[k]));
     for (int k = 0; k < 8; k++)
-        if (!(fabs(rdiag[k]) > {{ q_rank }} * largest)) return -1;
+        if (!(fabs(rdiag[k]) > 1e-12 * largest)) return -1;
     return 0;
 }
 
@@ -270,18 +278,18 @@ static int jacgen_general6r_roots(double p[3][14][9], double q_matrix[14][8],
     int order[12];
     if (jacgen_g6_spurious(w->m, w->square[0], w->square[1], w->u, w->v, order) != 0 || jacgen_g6_deflated(w, order) != 0
         || jacgen_eigenvalues(JACGEN_G6_ROOTS, w->deflated, w->re, w->im) != 0) return 0;
-    static const int along_c[{{ along_c | length }}] = { {{- along_c | join(", ") -}} };
-    static const int along_b[{{ along_b | length }}] = { {{- along_b | join(", ") -}} };
+    static const int along_c[8] = {0, 1, 3, 4, 6, 7, 9, 10};
+    static const int along_b[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
     int found = 0;
     for (int k = 0; k < JACGEN_G6_ROOTS; k++) {
         double x = w->re[k], v[12];
-        if (!(fabs(w->im[k]) <= {{ imaginary }} * (1.0 + fabs(x)))) continue;
+        if (!(fabs(w->im[k]) <= JACGEN_G6_IMAGINARY * (1.0 + fabs(x)))) continue;
         for (int i = 0; i < 12; i++)
             for (int j = 0; j < 12; j++) w->square[0][i][j] = w->m[0][i][j] + x * (w->m[1][i][j] + x * w->m[2][i][j]);
         jacgen_g6_null_vector(w->square[0], v);
         double a_angle = 2.0 * atan(x);
-        double b = jacgen_g6_half_angle(v, along_b, {{ along_b | length }}, 3);
-        double c = jacgen_g6_half_angle(v, along_c, {{ along_c | length }}, 1);
+        double b = jacgen_g6_half_angle(v, along_b, 9, 3);
+        double c = jacgen_g6_half_angle(v, along_c, 8, 1);
         double sa = sin(a_angle), ca = cos(a_angle), sb = sin(b), cb = cos(b), sc = sin(c), cc = cos(c);
         double v_bc[9] = {sb * sc, sb * cc, cb * sc, cb * cc, sb, cb, sc, cc, 1.0}, equations[14], v_gh[8];
         for (int i = 0; i < 14; i++) {

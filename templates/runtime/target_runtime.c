@@ -5,7 +5,7 @@
  * takes the stack and heap from what QEMU reports and calls main. */
 #include <stdint.h>
 
-#include "runtime.h"
+#include "target_runtime.h"
 
 #define CPACR (*(volatile uint32_t *)0xE000ED88u)
 #define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
