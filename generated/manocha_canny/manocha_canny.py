@@ -4134,6 +4134,7 @@ def ik_numeric(target, q0, max_iter=100, tol=1e-10):
         trial = xp.where(better[..., None], after, xp.where(worse[..., None], retry, trial))
     status = xp.where(xp.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
     q = xp.where((status == IK_NUMERIC_INVALID)[..., None], xp.asarray(q0, dtype=q.dtype), q)
+    status = xp.astype(status, xp.int32)
     return q, status[()] if status.ndim == 0 else status
 
 
