@@ -857,6 +857,12 @@ ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], [
 ik_nearest = casadi.Function("ik_nearest", [_mu, _q_seed, _weights], _ik_nearest(_mu, _q_seed, _weights), ["mu", "q_seed", "weights"], ["q", "status"])
 ik = ik_branches  # CasADi functions have fixed-size outputs: every branch, its validity and its limits
 
+# Statuses of ik_nearest: a solution found; no solution inside the limits (out of reach); the
+# target (its first three rows), q_seed or weights not finite. q = q_seed unless OK.
+IK_NEAREST_OK = 0
+IK_NEAREST_NO_SOLUTION = 1
+IK_NEAREST_NOT_FINITE = 2
+
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # max_iter steps tried, |error| still above tol
 IK_NUMERIC_STALLED = 2  # no step lowers |error|: out of reach, joint limit or local minimum

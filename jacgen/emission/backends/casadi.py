@@ -6,6 +6,7 @@ from jacgen.emission.backends.python import python_number
 from jacgen.emission.catalogue import Function
 from jacgen.emission.generator import Generator
 from jacgen.model.graph import is_zero
+from jacgen.solvers import ik_limits
 from jacgen.emission.printers import MATH_FUNCTIONS, Printer
 from jacgen.inputs import names
 from jacgen.inputs.robot import Robot
@@ -74,6 +75,7 @@ def casadi_context(robot: Robot, generator: Generator, printer: CasadiPrinter, r
     context["arguments"] = sorted({(a.name, a.symbols.rows, a.symbols.cols) for f in functions for a in f.arguments},
                                   key=lambda a: ("q", "q_dot", "mu_dot", "damping", "target", "T", "mu", "q_seed", "q_free", "weights").index(a[0]))
     context["ik"] = generator.closed_form is not None and not generator.loops and generator.generates("ik")
+    context["nearest_statuses"] = ik_limits.IK_NEAREST_STATUSES if any(f.name == "ik_nearest" for f in functions) else ()
     context["ik_numeric"] = generator.generates("ik_numeric") and (
         ik_numeric_context(robot, python_number) | {"casadi": LOOP_SYNTAX})
     return dict(sorted(context.items()))
