@@ -252,7 +252,9 @@ class _Numeric:
         """The values of joint `joint` where the one-joint factor f vanishes, in (-pi, pi] for a
         revolute joint: with t = tan(q/2), f(cos q, sin q) (1 + t^2)^deg is a polynomial in t
         of degree at most 2 deg, and q = pi is a root where f(-1, 0) = 0. Closed form up to
-        degree 2, numeric roots above, each checked against f."""
+        degree 2 with coefficients free of cos and sin (of an angle like 42.24 deg, whose
+        radicals sympy's roots took seconds over), numeric roots otherwise, each checked
+        against f."""
         expr, t = self.ring.expr(f).xreplace(self.nominal), sympy.Dummy("t", real=True)
         atoms = self.ring.atoms[joint]
         poly = sympy.Poly(expr, *atoms)
@@ -266,7 +268,7 @@ class _Numeric:
             at_pi = [sympy.pi] if abs(poly.eval((-1, 0))) <= ROOT * scale else []
         if in_t.is_zero:
             return ()
-        if in_t.degree() <= 2 and not in_t.has(sympy.Float):
+        if in_t.degree() <= 2 and not in_t.has(sympy.Float, sympy.cos, sympy.sin):
             values = [r for r in sympy.roots(in_t, multiple=True) if r.is_real]
         else:
             coefficients = [complex(c) for c in in_t.all_coeffs()]
