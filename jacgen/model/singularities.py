@@ -160,14 +160,15 @@ def _gram_factors(ring: JointRing, minors: list) -> tuple[PolyElement, list, boo
     from the factors common to every maximal minor, never from the sum itself."""
     common = minors[0]
     for minor in minors[1:]:
-        ring.times(common, minor)  # charged as a product: gcd costs about as much
+        ring.charge(len(common) * len(minor))  # as a product: gcd costs about as much
         common = common.gcd(minor)
     if len(common) > FACTOR_TERM_LIMIT:
         raise TooLarge(f"a common factor of {len(common)} terms")
     constant, factors = factorise(ring, common)
     # Where some minor is a constant multiple of the common factor, the rest of the sum of
-    # squares never vanishes: the common factors are the whole condition.
-    complete = any(minor and minor.exquo(common).is_ground for minor in minors)
+    # squares never vanishes: the common factors are the whole condition. A constant multiple
+    # has as many terms, so only those minors are divided (a division is not charged).
+    complete = any(minor and len(minor) == len(common) and minor.exquo(common).is_ground for minor in minors)
     note = "" if complete else (
         f"besides the factors common to all {len(minors)} maximal minors of Js, Js loses rank where the "
         f"Gram determinant {ring.robot.name}'s code computes numerically is 0")
