@@ -218,14 +218,18 @@ def show(robot_file, plot_file, q, urdf_file, base, tip, tolerance):
     robot = load_robot(robot_file)
     if q is not None and len(q) != robot.dof:
         raise JacgenError(f"--q: expected {robot.dof} values (one per joint of {robot.name}), got {len(q)}")
+    if plot_file:
+        from jacgen.reports.drawing import check_plot_format
+
+        plot_format = Path(plot_file).suffix[1:].lower() or "png"
+        check_plot_format(plot_format)  # before the text: a refused --plot prints one line only
     click.echo(describe(Model(robot)))
     if plot_file:
         import numpy as np
 
         from jacgen.reports.drawing import default_configurations, draw
 
-        drawing = draw(robot, [np.array(q)] if q is not None else default_configurations(robot),
-                       Path(plot_file).suffix[1:].lower() or "png")
+        drawing = draw(robot, [np.array(q)] if q is not None else default_configurations(robot), plot_format)
         write_files({Path(plot_file).name: drawing}, Path(plot_file).parent)
         click.echo(f"jacgen: wrote {plot_file}", err=True)
     if urdf_file:

@@ -19,9 +19,11 @@ from jacgen import load_robot
 from jacgen.checking import reference
 from jacgen.model.singularities import analyse
 from jacgen.cli import main
+from jacgen.inputs.robot import parse_robot
 
 from conftest import ROBOT_NAMES, generated_module, random_configurations, robot
 from support.ik import reference_js
+from support.random_arms import random_arm_text
 
 RANK_TOLERANCE = 1e-9  # smallest / largest singular value of Js at a singular configuration
 
@@ -240,3 +242,20 @@ def test_roots_of_a_one_joint_factor(polynomial):
     assert len(roots) == len(scanned), (roots, scanned)
     assert np.allclose(np.sort(np.round(roots, 3)), scanned, atol=2e-3)
     assert np.all(np.abs(value(np.cos(roots), np.sin(roots))) < 1e-9)
+
+
+def test_roots_with_the_cosine_of_an_angle_in_a_coefficient():
+    """A two-joint arm (random arm 4345, task x, roll, yaw) whose base turns by 42.2438, 105.238,
+    69.2617 deg: its one factor, of q1, has quadratic coefficients in cos and sin of those
+    angles, whose roots are found numerically (sympy's closed form took seconds); the factor
+    vanishes at each, and a dense scan over one turn finds no other."""
+    arm = parse_robot(random_arm_text(4345, 2).encode(), "arm4345.yaml")
+    [factor] = analyse(arm).factors
+    assert factor.joints == (0,) and len(factor.roots) == 2
+    value = sympy.lambdify(sympy.Symbol("q1"), factor.condition, "numpy")
+    roots = np.array([float(r) for r in factor.roots])
+    assert np.all(np.abs(value(roots)) < 1e-9)
+    grid = np.linspace(-np.pi, np.pi, 200001)
+    values = value(grid)
+    scanned = grid[1:][np.sign(values[:-1]) != np.sign(values[1:])]
+    assert np.allclose(np.sort(roots), scanned, atol=1e-4)

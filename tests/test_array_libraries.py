@@ -80,6 +80,10 @@ def test_every_function_matches_the_reference(lib, name):
     task = targets if len(arm.task) == 6 else reference.task(arm, q)
     start, step, cost = call("ik_numeric_step", task, q + 0.01, np.zeros(SAMPLES))
     assert (cost >= 0).all() and np.isfinite(step).all()
+    _, status = call("ik_numeric", task, q + 0.01)
+    assert status.dtype == np.int32 and (status == module.IK_NUMERIC_CONVERGED).all()
+    _, status = module.ik_numeric(to(task[0]), to(q[0] + 0.01))  # one target
+    assert str(status.dtype).split(".")[-1] == "int32" and int(status) == module.IK_NUMERIC_CONVERGED
 
     if hasattr(module, "ik_branches"):
         branches, valid, _ = call("ik_branches", task, *free_joint(module, q))

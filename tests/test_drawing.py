@@ -250,21 +250,24 @@ def test_show_plot_writes_a_picture(name, tmp_path):
 
 
 def test_plot_without_matplotlib_is_one_line(tmp_path, monkeypatch):
-    """Without matplotlib: `show` still describes, `--plot` is one line and exit 2."""
+    """Without matplotlib: `show` still describes; `--plot` is refused before the description,
+    one line and exit 2."""
     modules = __import__("sys").modules
     for name in [name for name in modules if name.split(".")[0] in ("matplotlib", "mpl_toolkits")] + ["matplotlib"]:
         monkeypatch.setitem(modules, name, None)  # as if never installed, submodules too
+    run = CliRunner().invoke(main, ["show", str(ROOT / "robots" / "ur5.yaml")])
+    assert run.exit_code == 0 and "ur5" in run.output
     run = CliRunner().invoke(main, ["show", str(ROOT / "robots" / "ur5.yaml"), "--plot", str(tmp_path / "a.png")])
     assert run.exit_code == 2
-    assert run.output.strip().splitlines()[-1] == "jacgen: error: --plot needs matplotlib: pip install 'jacgen[plot]'"
+    assert run.output.strip().splitlines() == ["jacgen: error: --plot needs matplotlib: pip install 'jacgen[plot]'"]
     assert not (tmp_path / "a.png").exists()
 
 
 def test_a_format_matplotlib_cannot_write_is_one_line(tmp_path):
     run = CliRunner().invoke(main, ["show", str(ROOT / "robots" / "planar_2r.yaml"), "--plot", str(tmp_path / "a.xyz")])
     assert run.exit_code == 2
-    assert run.output.strip().splitlines()[-1].startswith(
-        "jacgen: error: --plot: matplotlib writes no 'xyz' files; use one of ")
+    [line] = run.output.strip().splitlines()  # refused before the description
+    assert line.startswith("jacgen: error: --plot: matplotlib writes no 'xyz' files; use one of ")
     assert not (tmp_path / "a.xyz").exists()
 
 

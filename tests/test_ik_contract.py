@@ -314,3 +314,22 @@ def test_ik_numeric_cases(backends, name, backend):
     found, status = solve(far, q[1])
     low, high = np.array([j.limits or (-np.inf, np.inf) for j in arm.joints]).T
     assert status in (1, 2) and np.all(np.isfinite(found)) and np.all((found >= low) & (found <= high))
+
+
+@pytest.mark.parametrize("name", ["ur5", "puma560", "panda"])
+def test_ik_numeric_stalls_out_of_reach(generated, name):
+    """A target 100 m out of reach, where each step lowers the error less than the one before
+    without end: the damping rises and ik_numeric stalls within 200 steps (it ran to any
+    max_iter, 10^5 looked like a hang), numpy and C; q inside the limits, the tool nearer the
+    target than at q0."""
+    arm, code = robot(name), generated.committed(name)
+    q0 = np.full(arm.dof, 0.3)
+    far = reference.fk(arm, q0)
+    far[:3, 3] += 100.0
+    low, high = np.array([j.limits or (-np.inf, np.inf) for j in arm.joints]).T
+    for solve in (code.python.ik_numeric, code.library().ik_numeric):
+        found, status = solve(far, q0, 200)
+        assert status == code.python.IK_NUMERIC_STALLED
+        assert np.all((found >= low) & (found <= high))
+        distance = [np.linalg.norm(reference.fk(arm, q)[:3, 3] - far[:3, 3]) for q in (found, q0)]
+        assert distance[0] < distance[1]

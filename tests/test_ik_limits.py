@@ -88,17 +88,23 @@ def test_nearest_is_the_nearest(name):
                                                                   abs=1e-9)
 
 
-def test_nearest_statuses():
-    arm, module = robot("puma560"), generated_module("puma560")
+@pytest.mark.parametrize("suffix", ["", "_casadi"])
+def test_nearest_statuses(suffix):
+    """Each IK_NEAREST_* constant of the numpy and the CasADi module is what ik_nearest returns."""
+    arm, module = robot("puma560"), generated_module("puma560", suffix)
     seed = np.full(6, 0.2)
     target = reference.fk(arm, random_configurations(arm, 1, seed=44)[0])
     far = target.copy()
     far[:3, 3] += 10.0
-    for bad_target, bad_seed, status in [(far, seed, module.IK_NEAREST_NO_SOLUTION),
+    for bad_target, bad_seed, status in [(target, seed, module.IK_NEAREST_OK), (far, seed, module.IK_NEAREST_NO_SOLUTION),
                                          (np.full((4, 4), np.nan), seed, module.IK_NEAREST_NOT_FINITE),
                                          (target, np.r_[np.inf, seed[1:]], module.IK_NEAREST_NOT_FINITE)]:
-        found, got = module.ik_nearest(bad_target, bad_seed)
-        assert got == status and np.array_equal(found, bad_seed)
+        if suffix:
+            found, got = (np.asarray(v).ravel() for v in module.ik_nearest(bad_target, bad_seed, np.ones(6)))
+        else:
+            found, got = module.ik_nearest(bad_target, bad_seed)
+        assert got == status
+        assert status == module.IK_NEAREST_OK or np.array_equal(found, bad_seed)
 
 
 @pytest.mark.parametrize("name", ["puma560", "panda"])

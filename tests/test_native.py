@@ -116,6 +116,9 @@ def test_batch_rules_dtypes_and_errors(built):
     expected = numpy_ur5.velocity_ik(q, np.ones(6), 0.1)
     np.testing.assert_allclose(q_dot, expected[0], atol=1e-12)
     assert status.dtype == np.int32 and (status == expected[1]).all()
+    for module in (ur5, numpy_ur5):  # ik_numeric's status, one target and a batch
+        assert module.ik_numeric(T[0], q[0] + 0.01)[1].dtype == np.int32
+        assert module.ik_numeric(T, q + 0.01)[1].dtype == np.int32
     out = (np.empty((5, 4, 4)), np.empty((5, 6, 6)))
     returned = ur5.fk_jacobian(q, out=out)
     assert returned[0] is out[0] and np.allclose(out[1], J, atol=1e-14)

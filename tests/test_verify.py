@@ -9,6 +9,7 @@ from click.testing import CliRunner
 from jacgen.checking import reference, samples, verify
 from jacgen.cli import main
 from jacgen.checking.c_library import CompileError, compile_shared
+from jacgen.checking.generated_code import HOST_BACKENDS, TARGET_BACKENDS
 from jacgen.emission.generator import Generator, scalar
 
 from conftest import robot as shipped_robot
@@ -48,6 +49,16 @@ def test_a_wrong_result_fails(monkeypatch):
     rows = _rows(result.output)
     assert rows[("planar_2r", "jacobian_tool")][:8] == ["1.0e-03", "FAIL"] * 4
     assert result.output.splitlines()[-1].endswith(f"; 1 of {len(rows)} functions above tolerance")
+
+
+def test_the_summary_states_the_tolerances_of_the_builds_run():
+    """The host's table: double and float; --target cortex-m4f's: the float build alone."""
+    host = verify.Result("arm", "fk", dict.fromkeys(HOST_BACKENDS, 0.0), dict.fromkeys(HOST_BACKENDS, 1.0))
+    target = verify.Result("arm", "fk", {TARGET_BACKENDS["cortex-m4f"]: 0.0}, {TARGET_BACKENDS["cortex-m4f"]: 1.0})
+    assert verify.format_table([host]).splitlines()[-1] == (
+        "tolerance x (1 + reach): double 1e-09, float 1e-04; 0 of 1 functions above tolerance")
+    assert verify.format_table([target]).splitlines()[-1] == (
+        "tolerance x (1 + reach): float 1e-04; 0 of 1 functions above tolerance")
 
 
 def test_functions_without_reference_are_listed_not_compared(monkeypatch):

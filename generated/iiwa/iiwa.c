@@ -4021,7 +4021,7 @@ int iiwa_ik_numeric(const iiwa_real target[16], const iiwa_real q0[IIWA_DOF], in
         }
         lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
         trial_cost = iiwa_ik_numeric_step(target, trial, lighter, start, after);
-        if (trial_cost < cost) {
+        if (trial_cost < cost * 0.999999) {
             for (j = 0; j < IIWA_DOF; ++j) {
                 q[j] = trial[j];
                 trial[j] = after[j];

@@ -4634,7 +4634,7 @@ int jaco_ik_numeric(const jaco_real target[16], const jaco_real q0[JACO_DOF], in
         }
         lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
         trial_cost = jaco_ik_numeric_step(target, trial, lighter, start, after);
-        if (trial_cost < cost) {
+        if (trial_cost < cost * 0.999999) {
             for (j = 0; j < JACO_DOF; ++j) {
                 q[j] = trial[j];
                 trial[j] = after[j];

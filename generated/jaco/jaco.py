@@ -76,22 +76,18 @@ def _stack(xp, values, shape):
 def fk(q):
     """pose of the tool frame in the world frame (4x4 homogeneous): (4 x 4), 160 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.17453292519943295), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
     c2 = trig[..., 3]
-    s2 = -xp.cos(q2)
-    c3 = -xp.sin(q3)
+    s2 = -trig[..., 2]
+    c3 = -trig[..., 5]
     s3 = trig[..., 4]
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    c5 = -xp.cos(q5)
-    s5 = -xp.sin(q5)
-    c6 = -xp.sin(0.17453292519943295 + q6)
+    c5 = -trig[..., 8]
+    s5 = -trig[..., 9]
+    c6 = -trig[..., 11]
     s6 = trig[..., 10]
     t0 = c2*c3
     t1 = s2*s3
@@ -179,20 +175,17 @@ def fk(q):
 def jacobian(q):
     """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 163 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q5 = q[..., 4]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
     c2 = trig[..., 3]
-    s2 = -xp.cos(q2)
-    c3 = -xp.sin(q3)
+    s2 = -trig[..., 2]
+    c3 = -trig[..., 5]
     s3 = trig[..., 4]
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    c5 = -xp.cos(q5)
-    s5 = -xp.sin(q5)
+    c5 = -trig[..., 8]
+    s5 = -trig[..., 9]
     t0 = c2*c3
     t1 = s2*s3
     t2 = c1*t0 + c1*t1
@@ -282,22 +275,18 @@ def jacobian(q):
 def fk_jacobian(q):
     """fk and jacobian in one pass, sharing their terms: (4 x 4 and 6 x 6), 209 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.17453292519943295), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
     c2 = trig[..., 3]
-    s2 = -xp.cos(q2)
-    c3 = -xp.sin(q3)
+    s2 = -trig[..., 2]
+    c3 = -trig[..., 5]
     s3 = trig[..., 4]
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    c5 = -xp.cos(q5)
-    s5 = -xp.sin(q5)
-    c6 = -xp.sin(0.17453292519943295 + q6)
+    c5 = -trig[..., 8]
+    s5 = -trig[..., 9]
+    c6 = -trig[..., 11]
     s6 = trig[..., 10]
     t0 = c2*c3
     t1 = s2*s3
@@ -423,22 +412,18 @@ def fk_jacobian(q):
 def jacobian_tool(q):
     """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 6), 330 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.17453292519943295), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
     c2 = trig[..., 3]
-    s2 = -xp.cos(q2)
-    c3 = -xp.sin(q3)
+    s2 = -trig[..., 2]
+    c3 = -trig[..., 5]
     s3 = trig[..., 4]
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    c5 = -xp.cos(q5)
-    s5 = -xp.sin(q5)
-    c6 = -xp.sin(0.17453292519943295 + q6)
+    c5 = -trig[..., 8]
+    s5 = -trig[..., 9]
+    c6 = -trig[..., 11]
     s6 = trig[..., 10]
     t0 = c2*c3
     t1 = s2*s3
@@ -565,22 +550,18 @@ def jacobian_tool(q):
 def task(q):
     """task vector mu = (x, y, z, roll, pitch, yaw): (6 x 1), 161 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.17453292519943295), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
     c2 = trig[..., 3]
-    s2 = -xp.cos(q2)
-    c3 = -xp.sin(q3)
+    s2 = -trig[..., 2]
+    c3 = -trig[..., 5]
     s3 = trig[..., 4]
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    c5 = -xp.cos(q5)
-    s5 = -xp.sin(q5)
-    c6 = -xp.sin(0.17453292519943295 + q6)
+    c5 = -trig[..., 8]
+    s5 = -trig[..., 9]
+    c6 = -trig[..., 11]
     s6 = trig[..., 10]
     t0 = c2*c3
     t1 = s2*s3
@@ -652,22 +633,18 @@ def task(q):
 def task_jacobian(q):
     """analytic Jacobian d mu / d q (6 x DOF): (6 x 6), 242 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.17453292519943295), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
     c2 = trig[..., 3]
-    s2 = -xp.cos(q2)
-    c3 = -xp.sin(q3)
+    s2 = -trig[..., 2]
+    c3 = -trig[..., 5]
     s3 = trig[..., 4]
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    c5 = -xp.cos(q5)
-    s5 = -xp.sin(q5)
-    c6 = -xp.sin(0.17453292519943295 + q6)
+    c5 = -trig[..., 8]
+    s5 = -trig[..., 9]
+    c6 = -trig[..., 11]
     s6 = trig[..., 10]
     t0 = c2*c3
     t1 = s2*s3
@@ -779,10 +756,6 @@ def task_jacobian(q):
 def fk_jacobian_dot(q, q_dot):
     """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 6 and 6 x 1), 431 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
     qd3 = q_dot[..., 2]
@@ -793,14 +766,14 @@ def fk_jacobian_dot(q, q_dot):
     c1 = trig[..., 0]
     s1 = trig[..., 1]
     c2 = trig[..., 3]
-    s2 = -xp.cos(q2)
-    c3 = -xp.sin(q3)
+    s2 = -trig[..., 2]
+    c3 = -trig[..., 5]
     s3 = trig[..., 4]
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    c5 = -xp.cos(q5)
-    s5 = -xp.sin(q5)
-    c6 = -xp.sin(0.17453292519943295 + q6)
+    c5 = -trig[..., 8]
+    s5 = -trig[..., 9]
+    c6 = -trig[..., 11]
     s6 = trig[..., 10]
     t0 = c2*c3
     t1 = s2*s3
@@ -978,9 +951,6 @@ def fk_jacobian_dot(q, q_dot):
 def jacobian_dot(q, q_dot):
     """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 6), 316 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q5 = q[..., 4]
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
     qd3 = q_dot[..., 2]
@@ -991,13 +961,13 @@ def jacobian_dot(q, q_dot):
     c1 = trig[..., 0]
     s1 = trig[..., 1]
     c2 = trig[..., 3]
-    s2 = -xp.cos(q2)
-    c3 = -xp.sin(q3)
+    s2 = -trig[..., 2]
+    c3 = -trig[..., 5]
     s3 = trig[..., 4]
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    c5 = -xp.cos(q5)
-    s5 = -xp.sin(q5)
+    c5 = -trig[..., 8]
+    s5 = -trig[..., 9]
     t0 = c2*c3
     t1 = s2*s3
     t2 = c1*t0 + c1*t1
@@ -1130,9 +1100,6 @@ def jacobian_dot(q, q_dot):
 def bias_acceleration(q, q_dot):
     """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 371 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q5 = q[..., 4]
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
     qd3 = q_dot[..., 2]
@@ -1143,13 +1110,13 @@ def bias_acceleration(q, q_dot):
     c1 = trig[..., 0]
     s1 = trig[..., 1]
     c2 = trig[..., 3]
-    s2 = -xp.cos(q2)
-    c3 = -xp.sin(q3)
+    s2 = -trig[..., 2]
+    c3 = -trig[..., 5]
     s3 = trig[..., 4]
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    c5 = -xp.cos(q5)
-    s5 = -xp.sin(q5)
+    c5 = -trig[..., 8]
+    s5 = -trig[..., 9]
     t0 = c2*c3
     t1 = s2*s3
     t2 = c1*t0 + c1*t1
@@ -1252,10 +1219,6 @@ def bias_acceleration(q, q_dot):
 def task_jacobian_dot(q, q_dot):
     """time derivative of the analytic Jacobian along q_dot (6 x DOF): mu'' = J_a q'' + J_a' q': (6 x 6), 588 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (6,)), ("q_dot", q_dot, (6,)))
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
     qd3 = q_dot[..., 2]
@@ -1266,14 +1229,14 @@ def task_jacobian_dot(q, q_dot):
     c1 = trig[..., 0]
     s1 = trig[..., 1]
     c2 = trig[..., 3]
-    s2 = -xp.cos(q2)
-    c3 = -xp.sin(q3)
+    s2 = -trig[..., 2]
+    c3 = -trig[..., 5]
     s3 = trig[..., 4]
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    c5 = -xp.cos(q5)
-    s5 = -xp.sin(q5)
-    c6 = -xp.sin(0.17453292519943295 + q6)
+    c5 = -trig[..., 8]
+    s5 = -trig[..., 9]
+    c6 = -trig[..., 11]
     s6 = trig[..., 10]
     t0 = c2*c3
     t1 = s2*s3
@@ -1504,20 +1467,17 @@ def task_jacobian_dot(q, q_dot):
 def hessian(q):
     """partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): (6 x 6 x 6), 305 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q5 = q[..., 4]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
     c2 = trig[..., 3]
-    s2 = -xp.cos(q2)
-    c3 = -xp.sin(q3)
+    s2 = -trig[..., 2]
+    c3 = -trig[..., 5]
     s3 = trig[..., 4]
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    c5 = -xp.cos(q5)
-    s5 = -xp.sin(q5)
+    c5 = -trig[..., 8]
+    s5 = -trig[..., 9]
     t0 = c2*c3
     t1 = s2*s3
     t2 = c1*t0 + c1*t1
@@ -1847,18 +1807,15 @@ def hessian(q):
 def singularity_factors(q):
     """factors of det(Js): the robot is singular where one is 0: (1 x 1), 54 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q5 = q[..., 4]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c2 = trig[..., 3]
-    s2 = -xp.cos(q2)
-    c3 = -xp.sin(q3)
+    s2 = -trig[..., 2]
+    c3 = -trig[..., 5]
     s3 = trig[..., 4]
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    c5 = -xp.cos(q5)
-    s5 = -xp.sin(q5)
+    c5 = -trig[..., 8]
+    s5 = -trig[..., 9]
     t0 = c2*s4**2
     t1 = c2*s5
     t2 = s4*t1
@@ -1872,18 +1829,15 @@ def singularity_factors(q):
 def manipulability(q):
     """manipulability |det(Js)|: (1 x 1), 54 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q5 = q[..., 4]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c2 = trig[..., 3]
-    s2 = -xp.cos(q2)
-    c3 = -xp.sin(q3)
+    s2 = -trig[..., 2]
+    c3 = -trig[..., 5]
     s3 = trig[..., 4]
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    c5 = -xp.cos(q5)
-    s5 = -xp.sin(q5)
+    c5 = -trig[..., 8]
+    s5 = -trig[..., 9]
     t0 = c2*s5
     t1 = s4*t0
     t2 = c3*t0
@@ -1901,18 +1855,15 @@ def manipulability(q):
 def jacobian_det(q):
     """det(Js): (1 x 1), 53 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q5 = q[..., 4]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c2 = trig[..., 3]
-    s2 = -xp.cos(q2)
-    c3 = -xp.sin(q3)
+    s2 = -trig[..., 2]
+    c3 = -trig[..., 5]
     s3 = trig[..., 4]
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    c5 = -xp.cos(q5)
-    s5 = -xp.sin(q5)
+    c5 = -trig[..., 8]
+    s5 = -trig[..., 9]
     t0 = c2*s5
     t1 = s4*t0
     t2 = c3*t0
@@ -1946,13 +1897,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     c1 = trig[..., 0]
     s1 = trig[..., 1]
     c2 = trig[..., 3]
-    s2 = -xp.cos(q2)
-    c3 = -xp.sin(q3)
+    s2 = -trig[..., 2]
+    c3 = -trig[..., 5]
     s3 = trig[..., 4]
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    c5 = -xp.cos(q5)
-    s5 = -xp.sin(q5)
+    c5 = -trig[..., 8]
+    s5 = -trig[..., 9]
     t0 = c2*c3
     t1 = s2*s3
     t2 = c1*t0 + c1*t1
@@ -4190,7 +4141,7 @@ def ik(T, limits=True):
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # max_iter steps tried, |error| still above tol
-IK_NUMERIC_STALLED = 2  # no step lowers |error|: out of reach, joint limit or local minimum
+IK_NUMERIC_STALLED = 2  # no step lowers |error|^2 by a millionth: out of reach, joint limit or local minimum
 IK_NUMERIC_INVALID = 3  # target or q0 not finite, or max_iter < 0: q = q0
 _DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
 
@@ -4202,8 +4153,8 @@ def ik_numeric(target, q0, max_iter=100, tol=1e-10):
     target: the 4x4 tool pose in the world frame, or a batch of them with q0 (..., DOF).
     Each step is ik_numeric_step: q += J^T (J J^T + damping I)^-1 e, with e the task error
     (position error and rotation vector of R_target R^T, world frame) and J its Jacobian; joints are clamped to their limits.
-    The damping adapts (Levenberg-Marquardt): divided by 10 after a step that lowers |e|,
-    multiplied by 10 and the step discarded otherwise.
+    The damping adapts (Levenberg-Marquardt): divided by 10 after a step that lowers |e|^2
+    by more than a millionth, multiplied by 10 and the step discarded otherwise.
     Returns (q, status), status an IK_NUMERIC_* code per target; q is the best configuration
     found.
     """
@@ -4219,8 +4170,8 @@ def ik_numeric(target, q0, max_iter=100, tol=1e-10):
             break
         lighter = xp.maximum(damping * 0.1, least)
         _, after, trial_cost = ik_numeric_step(target, trial, lighter)
-        better = xp.logical_and(active, trial_cost < cost)
-        worse = xp.logical_and(active, trial_cost >= cost)
+        better = xp.logical_and(active, trial_cost < cost * 0.999999)
+        worse = xp.logical_and(active, trial_cost >= cost * 0.999999)
         q = xp.where(better[..., None], trial, q)
         cost = xp.where(better, trial_cost, cost)
         damping = xp.where(better, lighter, xp.where(worse, damping * 10.0, damping))
@@ -4229,6 +4180,7 @@ def ik_numeric(target, q0, max_iter=100, tol=1e-10):
         trial = xp.where(better[..., None], after, xp.where(worse[..., None], retry, trial))
     status = xp.where(xp.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
     q = xp.where((status == IK_NUMERIC_INVALID)[..., None], xp.asarray(q0, dtype=q.dtype), q)
+    status = xp.astype(status, xp.int32)
     return q, status[()] if status.ndim == 0 else status
 
 

@@ -3485,7 +3485,7 @@ int kr5_ik_numeric(const kr5_real target[16], const kr5_real q0[KR5_DOF], int ma
         }
         lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
         trial_cost = kr5_ik_numeric_step(target, trial, lighter, start, after);
-        if (trial_cost < cost) {
+        if (trial_cost < cost * 0.999999) {
             for (j = 0; j < KR5_DOF; ++j) {
                 q[j] = trial[j];
                 trial[j] = after[j];

@@ -3233,9 +3233,15 @@ ik_branches = casadi.Function("ik_branches", [_T], _ik_branches(_T), ["T"], ["q"
 ik_nearest = casadi.Function("ik_nearest", [_T, _q_seed, _weights], _ik_nearest(_T, _q_seed, _weights), ["T", "q_seed", "weights"], ["q", "status"])
 ik = ik_branches  # CasADi functions have fixed-size outputs: every branch, its validity and its limits
 
+# Statuses of ik_nearest: a solution found; no solution inside the limits (out of reach); the
+# target (its first three rows), q_seed or weights not finite. q = q_seed unless OK.
+IK_NEAREST_OK = 0
+IK_NEAREST_NO_SOLUTION = 1
+IK_NEAREST_NOT_FINITE = 2
+
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # max_iter steps tried, |error| still above tol
-IK_NUMERIC_STALLED = 2  # no step lowers |error|: out of reach, joint limit or local minimum
+IK_NUMERIC_STALLED = 2  # no step lowers |error|^2 by a millionth: out of reach, joint limit or local minimum
 IK_NUMERIC_INVALID = 3  # target or q0 not finite, or max_iter < 0: q = q0
 IK_NUMERIC_ITERATIONS = 100  # max_iter: the steps every call takes (a fixed graph)
 _DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
@@ -3253,8 +3259,8 @@ def _ik_numeric(target, q0, tol):
         active = status == IK_NUMERIC_ITERATION_LIMIT
         lighter = casadi.fmax(damping * 0.1, least)
         _, after, trial_cost = ik_numeric_step(target, trial, lighter)
-        better = casadi.logic_and(active, trial_cost < cost)
-        worse = casadi.logic_and(active, trial_cost >= cost)
+        better = casadi.logic_and(active, trial_cost < cost * 0.999999)
+        worse = casadi.logic_and(active, trial_cost >= cost * 0.999999)
         q = casadi.if_else(better, trial, q)
         cost = casadi.if_else(better, trial_cost, cost)
         damping = casadi.if_else(better, lighter, casadi.if_else(worse, damping * 10.0, damping))

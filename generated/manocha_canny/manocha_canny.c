@@ -4588,7 +4588,7 @@ int manocha_canny_ik_numeric(const manocha_canny_real target[16], const manocha_
         }
         lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
         trial_cost = manocha_canny_ik_numeric_step(target, trial, lighter, start, after);
-        if (trial_cost < cost) {
+        if (trial_cost < cost * 0.999999) {
             for (j = 0; j < MANOCHA_CANNY_DOF; ++j) {
                 q[j] = trial[j];
                 trial[j] = after[j];

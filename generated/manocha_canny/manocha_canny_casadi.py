@@ -2396,7 +2396,7 @@ ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _i
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # max_iter steps tried, |error| still above tol
-IK_NUMERIC_STALLED = 2  # no step lowers |error|: out of reach, joint limit or local minimum
+IK_NUMERIC_STALLED = 2  # no step lowers |error|^2 by a millionth: out of reach, joint limit or local minimum
 IK_NUMERIC_INVALID = 3  # target or q0 not finite, or max_iter < 0: q = q0
 IK_NUMERIC_ITERATIONS = 100  # max_iter: the steps every call takes (a fixed graph)
 _DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
@@ -2414,8 +2414,8 @@ def _ik_numeric(target, q0, tol):
         active = status == IK_NUMERIC_ITERATION_LIMIT
         lighter = casadi.fmax(damping * 0.1, least)
         _, after, trial_cost = ik_numeric_step(target, trial, lighter)
-        better = casadi.logic_and(active, trial_cost < cost)
-        worse = casadi.logic_and(active, trial_cost >= cost)
+        better = casadi.logic_and(active, trial_cost < cost * 0.999999)
+        worse = casadi.logic_and(active, trial_cost >= cost * 0.999999)
         q = casadi.if_else(better, trial, q)
         cost = casadi.if_else(better, trial_cost, cost)
         damping = casadi.if_else(better, lighter, casadi.if_else(worse, damping * 10.0, damping))

@@ -4634,7 +4634,7 @@ int mico_ik_numeric(const mico_real target[16], const mico_real q0[MICO_DOF], in
         }
         lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
         trial_cost = mico_ik_numeric_step(target, trial, lighter, start, after);
-        if (trial_cost < cost) {
+        if (trial_cost < cost * 0.999999) {
             for (j = 0; j < MICO_DOF; ++j) {
                 q[j] = trial[j];
                 trial[j] = after[j];

@@ -4284,7 +4284,7 @@ int panda_ik_numeric(const panda_real target[16], const panda_real q0[PANDA_DOF]
         }
         lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
         trial_cost = panda_ik_numeric_step(target, trial, lighter, start, after);
-        if (trial_cost < cost) {
+        if (trial_cost < cost * 0.999999) {
             for (j = 0; j < PANDA_DOF; ++j) {
                 q[j] = trial[j];
                 trial[j] = after[j];

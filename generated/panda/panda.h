@@ -147,7 +147,7 @@ int panda_ik(const panda_real T[16], panda_real q_free, panda_real q[PANDA_MAX_I
 /* ik_numeric status codes. */
 #define PANDA_IK_NUMERIC_CONVERGED 0       /* |error| <= tol */
 #define PANDA_IK_NUMERIC_ITERATION_LIMIT 1 /* max_iter steps tried, |error| still above tol */
-#define PANDA_IK_NUMERIC_STALLED 2         /* no step lowers |error|: out of reach, joint limit or local minimum */
+#define PANDA_IK_NUMERIC_STALLED 2         /* no step lowers |error|^2 by a millionth: out of reach, joint limit or local minimum */
 #define PANDA_IK_NUMERIC_INVALID 3         /* target or q0 not finite, or max_iter < 0: q = q0 */
 
 /* Iterative inverse kinematics from q0: damped least squares on the task error.
@@ -155,7 +155,8 @@ int panda_ik(const panda_real T[16], panda_real q_free, panda_real q[PANDA_MAX_I
  * Each step is q += J^T (J J^T + damping I)^-1 e, with e the task error
  * (position error and rotation vector of R_target R^T, world frame) and J the geometric Jacobian;
  * joints are clamped to their limits. The damping adapts (Levenberg-Marquardt): divided by 10
- * after a step that lowers |e|, multiplied by 10 and the step discarded otherwise. At most
+ * after a step that lowers |e|^2 by more than a millionth, multiplied by 10 and the step
+ * discarded otherwise. At most
  * max_iter steps; q receives the best configuration found. Returns a
  * PANDA_IK_NUMERIC_* status. No allocation, no recursion. */
 int panda_ik_numeric(const panda_real target[16], const panda_real q0[PANDA_DOF], int max_iter, panda_real tol, panda_real q[PANDA_DOF]);

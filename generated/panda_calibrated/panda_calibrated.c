@@ -7918,7 +7918,7 @@ int panda_calibrated_ik_numeric(const panda_calibrated_real target[16], const pa
         }
         lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
         trial_cost = panda_calibrated_ik_numeric_step(target, trial, lighter, start, after);
-        if (trial_cost < cost) {
+        if (trial_cost < cost * 0.999999) {
             for (j = 0; j < PANDA_CALIBRATED_DOF; ++j) {
                 q[j] = trial[j];
                 trial[j] = after[j];

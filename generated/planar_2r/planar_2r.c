@@ -742,7 +742,7 @@ int planar_2r_ik_numeric(const planar_2r_real target[PLANAR_2R_TASK_DIM], const 
         }
         lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
         trial_cost = planar_2r_ik_numeric_step(target, trial, lighter, start, after);
-        if (trial_cost < cost) {
+        if (trial_cost < cost * 0.999999) {
             for (j = 0; j < PLANAR_2R_DOF; ++j) {
                 q[j] = trial[j];
                 trial[j] = after[j];

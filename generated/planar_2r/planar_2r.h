@@ -139,7 +139,7 @@ int planar_2r_ik(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[P
 /* ik_numeric status codes. */
 #define PLANAR_2R_IK_NUMERIC_CONVERGED 0       /* |error| <= tol */
 #define PLANAR_2R_IK_NUMERIC_ITERATION_LIMIT 1 /* max_iter steps tried, |error| still above tol */
-#define PLANAR_2R_IK_NUMERIC_STALLED 2         /* no step lowers |error|: out of reach, joint limit or local minimum */
+#define PLANAR_2R_IK_NUMERIC_STALLED 2         /* no step lowers |error|^2 by a millionth: out of reach, joint limit or local minimum */
 #define PLANAR_2R_IK_NUMERIC_INVALID 3         /* target or q0 not finite, or max_iter < 0: q = q0 */
 
 /* Iterative inverse kinematics from q0: damped least squares on the task error.
@@ -147,7 +147,8 @@ int planar_2r_ik(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[P
  * Each step is q += J^T (J J^T + damping I)^-1 e, with e the task error
  * (target - mu(q), angles wrapped into (-pi, pi]) and J the task Jacobian;
  * joints are clamped to their limits. The damping adapts (Levenberg-Marquardt): divided by 10
- * after a step that lowers |e|, multiplied by 10 and the step discarded otherwise. At most
+ * after a step that lowers |e|^2 by more than a millionth, multiplied by 10 and the step
+ * discarded otherwise. At most
  * max_iter steps; q receives the best configuration found. Returns a
  * PLANAR_2R_IK_NUMERIC_* status. No allocation, no recursion. */
 int planar_2r_ik_numeric(const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real q0[PLANAR_2R_DOF], int max_iter, planar_2r_real tol, planar_2r_real q[PLANAR_2R_DOF]);

@@ -1039,7 +1039,7 @@ int planar_3r_ik_numeric(const planar_3r_real target[PLANAR_3R_TASK_DIM], const 
         }
         lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
         trial_cost = planar_3r_ik_numeric_step(target, trial, lighter, start, after);
-        if (trial_cost < cost) {
+        if (trial_cost < cost * 0.999999) {
             for (j = 0; j < PLANAR_3R_DOF; ++j) {
                 q[j] = trial[j];
                 trial[j] = after[j];

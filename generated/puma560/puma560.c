@@ -3316,7 +3316,7 @@ int puma560_ik_numeric(const puma560_real target[16], const puma560_real q0[PUMA
         }
         lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
         trial_cost = puma560_ik_numeric_step(target, trial, lighter, start, after);
-        if (trial_cost < cost) {
+        if (trial_cost < cost * 0.999999) {
             for (j = 0; j < PUMA560_DOF; ++j) {
                 q[j] = trial[j];
                 trial[j] = after[j];

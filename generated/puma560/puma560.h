@@ -145,7 +145,7 @@ int puma560_ik(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK_SOLUTIONS
 /* ik_numeric status codes. */
 #define PUMA560_IK_NUMERIC_CONVERGED 0       /* |error| <= tol */
 #define PUMA560_IK_NUMERIC_ITERATION_LIMIT 1 /* max_iter steps tried, |error| still above tol */
-#define PUMA560_IK_NUMERIC_STALLED 2         /* no step lowers |error|: out of reach, joint limit or local minimum */
+#define PUMA560_IK_NUMERIC_STALLED 2         /* no step lowers |error|^2 by a millionth: out of reach, joint limit or local minimum */
 #define PUMA560_IK_NUMERIC_INVALID 3         /* target or q0 not finite, or max_iter < 0: q = q0 */
 
 /* Iterative inverse kinematics from q0: damped least squares on the task error.
@@ -153,7 +153,8 @@ int puma560_ik(const puma560_real T[16], puma560_real q[PUMA560_MAX_IK_SOLUTIONS
  * Each step is q += J^T (J J^T + damping I)^-1 e, with e the task error
  * (position error and rotation vector of R_target R^T, world frame) and J the geometric Jacobian;
  * joints are clamped to their limits. The damping adapts (Levenberg-Marquardt): divided by 10
- * after a step that lowers |e|, multiplied by 10 and the step discarded otherwise. At most
+ * after a step that lowers |e|^2 by more than a millionth, multiplied by 10 and the step
+ * discarded otherwise. At most
  * max_iter steps; q receives the best configuration found. Returns a
  * PUMA560_IK_NUMERIC_* status. No allocation, no recursion. */
 int puma560_ik_numeric(const puma560_real target[16], const puma560_real q0[PUMA560_DOF], int max_iter, puma560_real tol, puma560_real q[PUMA560_DOF]);

@@ -2096,7 +2096,7 @@ int rexarm_ik_numeric(const rexarm_real target[REXARM_TASK_DIM], const rexarm_re
         }
         lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
         trial_cost = rexarm_ik_numeric_step(target, trial, lighter, start, after);
-        if (trial_cost < cost) {
+        if (trial_cost < cost * 0.999999) {
             for (j = 0; j < REXARM_DOF; ++j) {
                 q[j] = trial[j];
                 trial[j] = after[j];

@@ -145,7 +145,7 @@ int rexarm_ik(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK
 /* ik_numeric status codes. */
 #define REXARM_IK_NUMERIC_CONVERGED 0       /* |error| <= tol */
 #define REXARM_IK_NUMERIC_ITERATION_LIMIT 1 /* max_iter steps tried, |error| still above tol */
-#define REXARM_IK_NUMERIC_STALLED 2         /* no step lowers |error|: out of reach, joint limit or local minimum */
+#define REXARM_IK_NUMERIC_STALLED 2         /* no step lowers |error|^2 by a millionth: out of reach, joint limit or local minimum */
 #define REXARM_IK_NUMERIC_INVALID 3         /* target or q0 not finite, or max_iter < 0: q = q0 */
 
 /* Iterative inverse kinematics from q0: damped least squares on the task error.
@@ -153,7 +153,8 @@ int rexarm_ik(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK
  * Each step is q += J^T (J J^T + damping I)^-1 e, with e the task error
  * (target - mu(q), angles wrapped into (-pi, pi]) and J the task Jacobian;
  * joints are clamped to their limits. The damping adapts (Levenberg-Marquardt): divided by 10
- * after a step that lowers |e|, multiplied by 10 and the step discarded otherwise. At most
+ * after a step that lowers |e|^2 by more than a millionth, multiplied by 10 and the step
+ * discarded otherwise. At most
  * max_iter steps; q receives the best configuration found. Returns a
  * REXARM_IK_NUMERIC_* status. No allocation, no recursion. */
 int rexarm_ik_numeric(const rexarm_real target[REXARM_TASK_DIM], const rexarm_real q0[REXARM_DOF], int max_iter, rexarm_real tol, rexarm_real q[REXARM_DOF]);

@@ -76,11 +76,10 @@ def _stack(xp, values, shape):
 def fk(q):
     """pose of the tool frame in the world frame (4x4 homogeneous): (4 x 4), 46 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
-    q2 = q[..., 1]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
-    c2 = -xp.sin(q2)
+    c2 = -trig[..., 3]
     s2 = trig[..., 2]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
@@ -125,11 +124,10 @@ def fk(q):
 def jacobian(q):
     """geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 4), 64 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
-    q2 = q[..., 1]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
-    c2 = -xp.sin(q2)
+    c2 = -trig[..., 3]
     s2 = trig[..., 2]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
@@ -182,11 +180,10 @@ def jacobian(q):
 def fk_jacobian(q):
     """fk and jacobian in one pass, sharing their terms: (4 x 4 and 6 x 4), 72 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
-    q2 = q[..., 1]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
-    c2 = -xp.sin(q2)
+    c2 = -trig[..., 3]
     s2 = trig[..., 2]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
@@ -260,11 +257,10 @@ def fk_jacobian(q):
 def jacobian_tool(q):
     """geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz): (6 x 4), 96 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
-    q2 = q[..., 1]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
-    c2 = -xp.sin(q2)
+    c2 = -trig[..., 3]
     s2 = trig[..., 2]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
@@ -330,11 +326,10 @@ def jacobian_tool(q):
 def task(q):
     """task vector mu = (x, y, z, pitch): (4 x 1), 49 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
-    q2 = q[..., 1]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
-    c2 = -xp.sin(q2)
+    c2 = -trig[..., 3]
     s2 = trig[..., 2]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
@@ -366,11 +361,10 @@ def task(q):
 def task_jacobian(q):
     """analytic Jacobian d mu / d q (4 x DOF): (4 x 4), 73 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
-    q2 = q[..., 1]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
-    c2 = -xp.sin(q2)
+    c2 = -trig[..., 3]
     s2 = trig[..., 2]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
@@ -419,7 +413,6 @@ def task_jacobian(q):
 def fk_jacobian_dot(q, q_dot):
     """fk, jacobian and bias_acceleration in one pass, sharing their terms: (4 x 4 and 6 x 4 and 6 x 1), 180 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (4,)), ("q_dot", q_dot, (4,)))
-    q2 = q[..., 1]
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
     qd3 = q_dot[..., 2]
@@ -427,7 +420,7 @@ def fk_jacobian_dot(q, q_dot):
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
-    c2 = -xp.sin(q2)
+    c2 = -trig[..., 3]
     s2 = trig[..., 2]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
@@ -538,7 +531,6 @@ def fk_jacobian_dot(q, q_dot):
 def jacobian_dot(q, q_dot):
     """time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF): (6 x 4), 124 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (4,)), ("q_dot", q_dot, (4,)))
-    q2 = q[..., 1]
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
     qd3 = q_dot[..., 2]
@@ -546,7 +538,7 @@ def jacobian_dot(q, q_dot):
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
-    c2 = -xp.sin(q2)
+    c2 = -trig[..., 3]
     s2 = trig[..., 2]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
@@ -622,7 +614,6 @@ def jacobian_dot(q, q_dot):
 def bias_acceleration(q, q_dot):
     """J' q_dot: the tool's classical linear and angular acceleration at zero joint acceleration, world frame (6): (6 x 1), 160 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (4,)), ("q_dot", q_dot, (4,)))
-    q2 = q[..., 1]
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
     qd3 = q_dot[..., 2]
@@ -630,7 +621,7 @@ def bias_acceleration(q, q_dot):
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
-    c2 = -xp.sin(q2)
+    c2 = -trig[..., 3]
     s2 = trig[..., 2]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
@@ -688,7 +679,6 @@ def bias_acceleration(q, q_dot):
 def task_jacobian_dot(q, q_dot):
     """time derivative of the analytic Jacobian along q_dot (4 x DOF): mu'' = J_a q'' + J_a' q': (4 x 4), 167 operations."""
     xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (4,)), ("q_dot", q_dot, (4,)))
-    q2 = q[..., 1]
     qd1 = q_dot[..., 0]
     qd2 = q_dot[..., 1]
     qd3 = q_dot[..., 2]
@@ -696,7 +686,7 @@ def task_jacobian_dot(q, q_dot):
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
-    c2 = -xp.sin(q2)
+    c2 = -trig[..., 3]
     s2 = trig[..., 2]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
@@ -788,11 +778,10 @@ def task_jacobian_dot(q, q_dot):
 def hessian(q):
     """partial derivatives dJ/dq_k of the world geometric Jacobian (DOF x 6 x DOF, indexed [k, r, c]): (4 x 6 x 4), 82 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
-    q2 = q[..., 1]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
-    c2 = -xp.sin(q2)
+    c2 = -trig[..., 3]
     s2 = trig[..., 2]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
@@ -933,9 +922,8 @@ def hessian(q):
 def singularity_factors(q):
     """factors of det(Js): the robot is singular where one is 0: (2 x 1), 19 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
-    q2 = q[..., 1]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
-    c2 = -xp.sin(q2)
+    c2 = -trig[..., 3]
     s2 = trig[..., 2]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
@@ -953,11 +941,10 @@ def singularity_factors(q):
 def manipulability(q):
     """manipulability |det(Js)|: (1 x 1), 45 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
-    q2 = q[..., 1]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
-    c2 = -xp.sin(q2)
+    c2 = -trig[..., 3]
     s2 = trig[..., 2]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
@@ -978,11 +965,10 @@ def manipulability(q):
 def jacobian_det(q):
     """det(Js): (1 x 1), 44 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
-    q2 = q[..., 1]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
-    c2 = -xp.sin(q2)
+    c2 = -trig[..., 3]
     s2 = trig[..., 2]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
@@ -1014,7 +1000,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
-    c2 = -xp.sin(q2)
+    c2 = -trig[..., 3]
     s2 = trig[..., 2]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
@@ -2099,7 +2085,7 @@ def ik(mu, limits=True):
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # max_iter steps tried, |error| still above tol
-IK_NUMERIC_STALLED = 2  # no step lowers |error|: out of reach, joint limit or local minimum
+IK_NUMERIC_STALLED = 2  # no step lowers |error|^2 by a millionth: out of reach, joint limit or local minimum
 IK_NUMERIC_INVALID = 3  # target or q0 not finite, or max_iter < 0: q = q0
 _DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
 
@@ -2111,8 +2097,8 @@ def ik_numeric(target, q0, max_iter=100, tol=1e-10):
     target: the task vector (x, y, z, pitch), or a batch of them with q0 (..., DOF).
     Each step is ik_numeric_step: q += J^T (J J^T + damping I)^-1 e, with e the task error
     (target - mu(q), angles wrapped into (-pi, pi]) and J its Jacobian; joints are clamped to their limits.
-    The damping adapts (Levenberg-Marquardt): divided by 10 after a step that lowers |e|,
-    multiplied by 10 and the step discarded otherwise.
+    The damping adapts (Levenberg-Marquardt): divided by 10 after a step that lowers |e|^2
+    by more than a millionth, multiplied by 10 and the step discarded otherwise.
     Returns (q, status), status an IK_NUMERIC_* code per target; q is the best configuration
     found.
     """
@@ -2128,8 +2114,8 @@ def ik_numeric(target, q0, max_iter=100, tol=1e-10):
             break
         lighter = xp.maximum(damping * 0.1, least)
         _, after, trial_cost = ik_numeric_step(target, trial, lighter)
-        better = xp.logical_and(active, trial_cost < cost)
-        worse = xp.logical_and(active, trial_cost >= cost)
+        better = xp.logical_and(active, trial_cost < cost * 0.999999)
+        worse = xp.logical_and(active, trial_cost >= cost * 0.999999)
         q = xp.where(better[..., None], trial, q)
         cost = xp.where(better, trial_cost, cost)
         damping = xp.where(better, lighter, xp.where(worse, damping * 10.0, damping))
@@ -2138,6 +2124,7 @@ def ik_numeric(target, q0, max_iter=100, tol=1e-10):
         trial = xp.where(better[..., None], after, xp.where(worse[..., None], retry, trial))
     status = xp.where(xp.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
     q = xp.where((status == IK_NUMERIC_INVALID)[..., None], xp.asarray(q0, dtype=q.dtype), q)
+    status = xp.astype(status, xp.int32)
     return q, status[()] if status.ndim == 0 else status
 
 

@@ -5403,7 +5403,7 @@ int sawyer_ik_numeric(const sawyer_real target[16], const sawyer_real q0[SAWYER_
         }
         lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
         trial_cost = sawyer_ik_numeric_step(target, trial, lighter, start, after);
-        if (trial_cost < cost) {
+        if (trial_cost < cost * 0.999999) {
             for (j = 0; j < SAWYER_DOF; ++j) {
                 q[j] = trial[j];
                 trial[j] = after[j];

@@ -1159,7 +1159,7 @@ int scara_ik_numeric(const scara_real target[SCARA_TASK_DIM], const scara_real q
         }
         lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
         trial_cost = scara_ik_numeric_step(target, trial, lighter, start, after);
-        if (trial_cost < cost) {
+        if (trial_cost < cost * 0.999999) {
             for (j = 0; j < SCARA_DOF; ++j) {
                 q[j] = trial[j];
                 trial[j] = after[j];

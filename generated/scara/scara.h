@@ -142,7 +142,7 @@ int scara_ik(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLU
 /* ik_numeric status codes. */
 #define SCARA_IK_NUMERIC_CONVERGED 0       /* |error| <= tol */
 #define SCARA_IK_NUMERIC_ITERATION_LIMIT 1 /* max_iter steps tried, |error| still above tol */
-#define SCARA_IK_NUMERIC_STALLED 2         /* no step lowers |error|: out of reach, joint limit or local minimum */
+#define SCARA_IK_NUMERIC_STALLED 2         /* no step lowers |error|^2 by a millionth: out of reach, joint limit or local minimum */
 #define SCARA_IK_NUMERIC_INVALID 3         /* target or q0 not finite, or max_iter < 0: q = q0 */
 
 /* Iterative inverse kinematics from q0: damped least squares on the task error.
@@ -150,7 +150,8 @@ int scara_ik(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLU
  * Each step is q += J^T (J J^T + damping I)^-1 e, with e the task error
  * (target - mu(q), angles wrapped into (-pi, pi]) and J the task Jacobian;
  * joints are clamped to their limits. The damping adapts (Levenberg-Marquardt): divided by 10
- * after a step that lowers |e|, multiplied by 10 and the step discarded otherwise. At most
+ * after a step that lowers |e|^2 by more than a millionth, multiplied by 10 and the step
+ * discarded otherwise. At most
  * max_iter steps; q receives the best configuration found. Returns a
  * SCARA_IK_NUMERIC_* status. No allocation, no recursion. */
 int scara_ik_numeric(const scara_real target[SCARA_TASK_DIM], const scara_real q0[SCARA_DOF], int max_iter, scara_real tol, scara_real q[SCARA_DOF]);

@@ -2946,7 +2946,7 @@ int stanford_ik_numeric(const stanford_real target[16], const stanford_real q0[S
         }
         lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
         trial_cost = stanford_ik_numeric_step(target, trial, lighter, start, after);
-        if (trial_cost < cost) {
+        if (trial_cost < cost * 0.999999) {
             for (j = 0; j < STANFORD_DOF; ++j) {
                 q[j] = trial[j];
                 trial[j] = after[j];

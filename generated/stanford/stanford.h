@@ -146,7 +146,7 @@ int stanford_ik(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUT
 /* ik_numeric status codes. */
 #define STANFORD_IK_NUMERIC_CONVERGED 0       /* |error| <= tol */
 #define STANFORD_IK_NUMERIC_ITERATION_LIMIT 1 /* max_iter steps tried, |error| still above tol */
-#define STANFORD_IK_NUMERIC_STALLED 2         /* no step lowers |error|: out of reach, joint limit or local minimum */
+#define STANFORD_IK_NUMERIC_STALLED 2         /* no step lowers |error|^2 by a millionth: out of reach, joint limit or local minimum */
 #define STANFORD_IK_NUMERIC_INVALID 3         /* target or q0 not finite, or max_iter < 0: q = q0 */
 
 /* Iterative inverse kinematics from q0: damped least squares on the task error.
@@ -154,7 +154,8 @@ int stanford_ik(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUT
  * Each step is q += J^T (J J^T + damping I)^-1 e, with e the task error
  * (position error and rotation vector of R_target R^T, world frame) and J the geometric Jacobian;
  * joints are clamped to their limits. The damping adapts (Levenberg-Marquardt): divided by 10
- * after a step that lowers |e|, multiplied by 10 and the step discarded otherwise. At most
+ * after a step that lowers |e|^2 by more than a millionth, multiplied by 10 and the step
+ * discarded otherwise. At most
  * max_iter steps; q receives the best configuration found. Returns a
  * STANFORD_IK_NUMERIC_* status. No allocation, no recursion. */
 int stanford_ik_numeric(const stanford_real target[16], const stanford_real q0[STANFORD_DOF], int max_iter, stanford_real tol, stanford_real q[STANFORD_DOF]);

@@ -2932,7 +2932,7 @@ def ik(T, limits=True):
 
 IK_NUMERIC_CONVERGED = 0  # |error| <= tol
 IK_NUMERIC_ITERATION_LIMIT = 1  # max_iter steps tried, |error| still above tol
-IK_NUMERIC_STALLED = 2  # no step lowers |error|: out of reach, joint limit or local minimum
+IK_NUMERIC_STALLED = 2  # no step lowers |error|^2 by a millionth: out of reach, joint limit or local minimum
 IK_NUMERIC_INVALID = 3  # target or q0 not finite, or max_iter < 0: q = q0
 _DAMPING = (1e-06, 1e-12, 100000000.0)  # added to the diagonal: start, least, most
 
@@ -2944,8 +2944,8 @@ def ik_numeric(target, q0, max_iter=100, tol=1e-10):
     target: the 4x4 tool pose in the world frame, or a batch of them with q0 (..., DOF).
     Each step is ik_numeric_step: q += J^T (J J^T + damping I)^-1 e, with e the task error
     (position error and rotation vector of R_target R^T, world frame) and J its Jacobian; joints are clamped to their limits.
-    The damping adapts (Levenberg-Marquardt): divided by 10 after a step that lowers |e|,
-    multiplied by 10 and the step discarded otherwise.
+    The damping adapts (Levenberg-Marquardt): divided by 10 after a step that lowers |e|^2
+    by more than a millionth, multiplied by 10 and the step discarded otherwise.
     Returns (q, status), status an IK_NUMERIC_* code per target; q is the best configuration
     found.
     """
@@ -2961,8 +2961,8 @@ def ik_numeric(target, q0, max_iter=100, tol=1e-10):
             break
         lighter = xp.maximum(damping * 0.1, least)
         _, after, trial_cost = ik_numeric_step(target, trial, lighter)
-        better = xp.logical_and(active, trial_cost < cost)
-        worse = xp.logical_and(active, trial_cost >= cost)
+        better = xp.logical_and(active, trial_cost < cost * 0.999999)
+        worse = xp.logical_and(active, trial_cost >= cost * 0.999999)
         q = xp.where(better[..., None], trial, q)
         cost = xp.where(better, trial_cost, cost)
         damping = xp.where(better, lighter, xp.where(worse, damping * 10.0, damping))
@@ -2971,6 +2971,7 @@ def ik_numeric(target, q0, max_iter=100, tol=1e-10):
         trial = xp.where(better[..., None], after, xp.where(worse[..., None], retry, trial))
     status = xp.where(xp.logical_and(status == IK_NUMERIC_ITERATION_LIMIT, cost <= tol * tol), IK_NUMERIC_CONVERGED, status)
     q = xp.where((status == IK_NUMERIC_INVALID)[..., None], xp.asarray(q0, dtype=q.dtype), q)
+    status = xp.astype(status, xp.int32)
     return q, status[()] if status.ndim == 0 else status
 
 

@@ -3373,7 +3373,7 @@ int ur5_ik_numeric(const ur5_real target[16], const ur5_real q0[UR5_DOF], int ma
         }
         lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
         trial_cost = ur5_ik_numeric_step(target, trial, lighter, start, after);
-        if (trial_cost < cost) {
+        if (trial_cost < cost * 0.999999) {
             for (j = 0; j < UR5_DOF; ++j) {
                 q[j] = trial[j];
                 trial[j] = after[j];

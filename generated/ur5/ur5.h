@@ -146,7 +146,7 @@ int ur5_ik(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5_DOF]);
 /* ik_numeric status codes. */
 #define UR5_IK_NUMERIC_CONVERGED 0       /* |error| <= tol */
 #define UR5_IK_NUMERIC_ITERATION_LIMIT 1 /* max_iter steps tried, |error| still above tol */
-#define UR5_IK_NUMERIC_STALLED 2         /* no step lowers |error|: out of reach, joint limit or local minimum */
+#define UR5_IK_NUMERIC_STALLED 2         /* no step lowers |error|^2 by a millionth: out of reach, joint limit or local minimum */
 #define UR5_IK_NUMERIC_INVALID 3         /* target or q0 not finite, or max_iter < 0: q = q0 */
 
 /* Iterative inverse kinematics from q0: damped least squares on the task error.
@@ -154,7 +154,8 @@ int ur5_ik(const ur5_real T[16], ur5_real q[UR5_MAX_IK_SOLUTIONS * UR5_DOF]);
  * Each step is q += J^T (J J^T + damping I)^-1 e, with e the task error
  * (position error and rotation vector of R_target R^T, world frame) and J the geometric Jacobian;
  * joints are clamped to their limits. The damping adapts (Levenberg-Marquardt): divided by 10
- * after a step that lowers |e|, multiplied by 10 and the step discarded otherwise. At most
+ * after a step that lowers |e|^2 by more than a millionth, multiplied by 10 and the step
+ * discarded otherwise. At most
  * max_iter steps; q receives the best configuration found. Returns a
  * UR5_IK_NUMERIC_* status. No allocation, no recursion. */
 int ur5_ik_numeric(const ur5_real target[16], const ur5_real q0[UR5_DOF], int max_iter, ur5_real tol, ur5_real q[UR5_DOF]);

@@ -7251,7 +7251,7 @@ int ur5_calibrated_ik_numeric(const ur5_calibrated_real target[16], const ur5_ca
         }
         lighter = damping * 0.1 > 1e-12 ? damping * 0.1 : 1e-12;
         trial_cost = ur5_calibrated_ik_numeric_step(target, trial, lighter, start, after);
-        if (trial_cost < cost) {
+        if (trial_cost < cost * 0.999999) {
             for (j = 0; j < UR5_CALIBRATED_DOF; ++j) {
                 q[j] = trial[j];
                 trial[j] = after[j];

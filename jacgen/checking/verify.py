@@ -408,5 +408,7 @@ def format_table(results: list[Result]) -> str:
     widths = [max(len(row[c]) for row in rows) for c in range(len(header))]
     lines = ["  ".join(cell.ljust(width) for cell, width in zip(row, widths)).rstrip() for row in rows]
     failed = sum(result.failed for result in results)
-    lines.append(f"double tolerance {VERIFIED['double']:.0e} x (1 + reach); {failed} of {len(results)} functions above tolerance")
+    run = [real for real in VERIFIED if any(_is_float(backend) == (real == "float") for backend in names)]
+    tolerances = ", ".join(f"{real} {VERIFIED[real]:.0e}" for real in run)  # of the builds run
+    lines.append(f"tolerance x (1 + reach): {tolerances}; {failed} of {len(results)} functions above tolerance")
     return "\n".join(lines)

@@ -53,9 +53,7 @@ CATALOGUE = (
     Declaration("ik_numeric_step"),
     Declaration("ik_numeric", ("ik_numeric_step",), _statuses(*differential.IK_NUMERIC_STATUSES)),
     Declaration("ik_branches"),
-    Declaration("ik_nearest", ("ik_branches",), _statuses(("OK", ik_limits.IK_NEAREST_OK),
-                                                          ("NO_SOLUTION", ik_limits.IK_NEAREST_NO_SOLUTION),
-                                                          ("NOT_FINITE", ik_limits.IK_NEAREST_NOT_FINITE))),
+    Declaration("ik_nearest", ("ik_branches",), _statuses(*ik_limits.IK_NEAREST_STATUSES)),
     Declaration("ik", ("ik_branches",)),
 )
 DECLARED = {declaration.name: declaration for declaration in CATALOGUE}

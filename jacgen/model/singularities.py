@@ -145,14 +145,15 @@ def _gram_factors(ring: JointRing, minors: list) -> tuple[PolyElement, list, boo
     from the factors common to every maximal minor, never from the sum itself."""
     common = minors[0]
     for minor in minors[1:]:
-        ring.times(common, minor)  # charged as a product: gcd costs about as much
+        ring.charge(len(common) * len(minor))  # as a product: gcd costs about as much
         common = common.gcd(minor)
     if len(common) > FACTOR_TERM_LIMIT:
         raise TooLarge(f"a common factor of {len(common)} terms")
     constant, factors = factorise(ring, common)
     # Where some minor is a constant multiple of the common factor, the rest of the sum of
-    # squares never vanishes: the common factors are the whole condition.
-    complete = any(minor and minor.exquo(common).is_ground for minor in minors)
+    # squares never vanishes: the common factors are the whole condition. A constant multiple
+    # has as many terms, so only those minors are divided (a division is not charged).
+    complete = any(minor and len(minor) == len(common) and minor.exquo(common).is_ground for minor in minors)
     note = "" if complete else (
         f"besides the factors common to all {len(minors)} maximal minors of Js, Js loses rank where the "
         f"Gram determinant {ring.robot.name}'s code computes numerically is 0")
@@ -237,7 +238,9 @@ class _Numeric:
         """The values of joint `joint` where the one-joint factor f vanishes, in (-pi, pi] for a
         revolute joint: with t = tan(q/2), f(cos q, sin q) (1 + t^2)^deg is a polynomial in t
         of degree at most 2 deg, and q = pi is a root where f(-1, 0) = 0. Closed form up to
-        degree 2, numeric roots above, each checked against f."""
+        degree 2 with coefficients free of cos and sin (of an angle like 42.24 deg, whose
+        radicals sympy's roots took seconds over), numeric roots otherwise, each checked
+        against f."""
         expr, t = self.ring.expr(f).xreplace(self.nominal), sympy.Dummy("t", real=True)
         atoms = self.ring.atoms[joint]
         poly = sympy.Poly(expr, *atoms)
@@ -251,7 +254,7 @@ class _Numeric:
             at_pi = [sympy.pi] if abs(poly.eval((-1, 0))) <= ROOT * scale else []
         if in_t.is_zero:
             return ()
-        if in_t.degree() <= 2 and not in_t.has(sympy.Float):
+        if in_t.degree() <= 2 and not in_t.has(sympy.Float, sympy.cos, sympy.sin):
             values = [r for r in sympy.roots(in_t, multiple=True) if r.is_real]
         else:
             coefficients = [complex(c) for c in in_t.all_coeffs()]

@@ -52,15 +52,20 @@ def chain_points(robot: Robot, q: np.ndarray) -> np.ndarray:
     return np.array(points)
 
 
+def check_plot_format(file_format: str) -> None:
+    """One error line (JacgenError) without matplotlib, or for a format it does not write."""
+    formats = _figure().canvas.get_supported_filetypes()
+    if file_format not in formats:
+        raise JacgenError(f"--plot: matplotlib writes no '{file_format}' files; use one of {', '.join(sorted(formats))}")
+
+
 def draw(robot: Robot, configurations: list[np.ndarray], file_format: str = "png") -> bytes:
     """The drawing of `robot` at each configuration (and its planar map) as the bytes of a
     file in `file_format` (png, svg, pdf, ...: what matplotlib writes)."""
+    check_plot_format(file_format)
     planar = moves_in_plane(robot)
     panels = len(configurations) + planar
     figure = _figure(figsize=(5.5 * panels, 5.5), dpi=100)
-    formats = figure.canvas.get_supported_filetypes()
-    if file_format not in formats:
-        raise JacgenError(f"--plot: matplotlib writes no '{file_format}' files; use one of {', '.join(sorted(formats))}")
     figure.subplots_adjust(left=0.02, right=0.94, bottom=0.1, top=0.9, wspace=0.3)
     for k, q in enumerate(configurations):
         draw_arm(figure.add_subplot(1, panels, k + 1, projection="3d"), robot, q)

@@ -10,6 +10,8 @@ from jacgen.solvers.subproblems import Subproblems, wrapped
 
 # ik_nearest's statuses
 IK_NEAREST_OK, IK_NEAREST_NO_SOLUTION, IK_NEAREST_NOT_FINITE = 0, 1, 2
+IK_NEAREST_STATUSES = (("OK", IK_NEAREST_OK), ("NO_SOLUTION", IK_NEAREST_NO_SOLUTION),
+                       ("NOT_FINITE", IK_NEAREST_NOT_FINITE))  # as each backend names them, IK_NEAREST_OK ...
 TURN = 2 * sympy.pi
 
 

@@ -73,6 +73,8 @@ def casadi_context(robot: Robot, generator: Generator, printer: CasadiPrinter, r
     context["arguments"] = sorted({(a.name, a.symbols.rows, a.symbols.cols) for f in functions for a in f.arguments},
                                   key=lambda a: ("q", "q_dot", "mu_dot", "damping", "target", "T", "mu", "q_seed", "q_free", "weights").index(a[0]))
     context["ik"] = any(loop.name == "ik" and loop.casadi for loop in generator.loops)
+    context["nearest_statuses"] = [(status.name, status.value) for f in functions if f.name == "ik_nearest"
+                                   for status in f.statuses]
     context["ik_numeric"] = generator.generates("ik_numeric") and (
         ik_numeric_context(robot, python_number) | {"casadi": LOOP_SYNTAX})
     return dict(sorted(context.items()))

@@ -135,6 +135,7 @@ def ik_numeric_context(robot: Robot, number: Callable) -> dict:
         "step_text": "q += J^T (J J^T + damping I)^-1 e" if m <= n else "q += (J^T J + damping I)^-1 J^T e",
         "damping": {key: number(value) for key, value in differential.IK_NUMERIC_DAMPING.items()},
         "tenth": number(0.1),
+        "lowered": number(1 - differential.IK_NUMERIC_PROGRESS),  # the cost after a step that lowers it, at most
         "iterations": differential.IK_NUMERIC_ITERATIONS,
         "statuses": differential.IK_NUMERIC_STATUSES,
         "defaults": {key: repr(value) for key, value in differential.IK_NUMERIC_DEFAULTS.items()},

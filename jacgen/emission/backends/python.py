@@ -8,7 +8,7 @@ from jacgen.emission.backends.common import (Backend, common_context, dimensions
                                              velocity_ik_context)
 from jacgen.emission.catalogue import Function
 from jacgen.emission.generator import Generator
-from jacgen.model.node import ADD, CALL, NUMBER, SELECT, SYMBOL
+from jacgen.model.node import ADD, CALL, MUL, NUMBER, SELECT, SYMBOL
 from jacgen.emission.printers import ATOM, MATH_FUNCTIONS, RELATION, Printer
 from jacgen.inputs.robot import Robot
 
@@ -110,20 +110,25 @@ def _of_only(body, symbols: set) -> set:
 
 
 def _joint_trig(function: Function) -> tuple[dict, list]:
-    """The definitions cos(q_j + offset) and sin(q_j + offset) of the argument q, as entries of
-    `_cos_sin`'s array, and the offsets: ({symbol: code}, offset per joint)."""
+    """The definitions cos(q_j + offset) and sin(q_j + offset) of the argument q, and their
+    negations (an offset of a quarter turn swaps them), as entries of `_cos_sin`'s array, and
+    the offsets: ({symbol: code}, offset per joint). Read from the array, XLA computes them
+    once; a call of its own is computed again in every fused loop that reads it."""
     joints = {symbol: row for symbol, argument, row, _ in function.inputs if argument.name == "q"}
     if not joints:
         return {}, []
     offsets, trig = [0.0] * function.arguments[0].size, {}
     for symbol, value in function.body.definitions:
+        sign = ""
+        if value.kind == MUL and len(value.args) == 2 and value.args[0].kind == NUMBER and value.args[0].value == -1:
+            sign, value = "-", value.args[1]
         if value.kind == CALL and value.value in ("cos", "sin"):
             angle = value.args[0]
             offset, angle = angle.args if angle.kind == ADD and len(angle.args) == 2 else (None, angle)
             if angle.kind == SYMBOL and angle.value in joints and (offset is None or offset.kind == NUMBER):
                 row = joints[angle.value]
                 offsets[row] = float(offset.value) if offset else 0.0
-                trig[symbol] = f"trig[..., {2 * row + (value.value == 'sin')}]"
+                trig[symbol] = f"{sign}trig[..., {2 * row + (value.value == 'sin')}]"
     return trig, offsets
 
 
