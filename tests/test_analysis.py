@@ -19,7 +19,7 @@ from jacgen import load_robot
 from jacgen.checking import reference
 from jacgen.model.singularities import analyse
 from jacgen.cli import main
-from jacgen.inputs.robot import parse_robot
+from jacgen.inputs.robot_file import parse_robot
 
 from conftest import ROBOT_NAMES, generated_module, random_configurations, robot
 from support.ik import reference_js
