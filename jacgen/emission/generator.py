@@ -107,10 +107,10 @@ class Generator:
         form = self.closed_form
         if form is None or not (self.generates("ik_branches") or self.generates("ik_nearest")):
             return []
-        target = self._closed_form_target()
+        target = self._target(form.target == "pose")
         free, bindings, free_angle = (), {}, None
         if form.free is not None:  # the free joint's angle is an input; its cos and sin are the usual c_k, s_k
-            free = (Argument("q_free", sympy.Matrix([sympy.Symbol("q_free", real=True)]), scalar=True),)
+            free = (self._free_argument(),)
             free_angle = self.q[form.free]
             bindings = {free_angle: free[0].symbols[0]}
             self.cos_sin((form.free,))
@@ -224,18 +224,21 @@ class Generator:
         return self.function("ik_numeric_step", summary, vector("q_start", self.q), vector("q_next", trial),
                              scalar("cost", cost), arguments=(target, given, damping), bindings=bindings)
 
-    def _closed_form_target(self) -> Argument:
-        """The closed form's target: T, the 4x4 pose, or mu, the task vector."""
-        if self.closed_form.target == "pose":
-            return Argument("T", sympy.Matrix(4, 4, lambda r, c: generated_symbol("T", r, c, separator="")), vector=False)
-        return Argument("mu", sympy.Matrix([generated_symbol("mu", i) for i in range(len(self.robot.task))]))
+    def _target(self, pose: bool, name: str | None = None) -> Argument:
+        """An ik target: the 4x4 pose (named T unless `name`), or the task vector (mu)."""
+        if pose:
+            return Argument(name or "T", sympy.Matrix(4, 4, lambda r, c: generated_symbol("T", r, c, separator="")),
+                            vector=False)
+        return Argument(name or "mu", sympy.Matrix([generated_symbol("mu", i) for i in range(len(self.robot.task))]))
 
     def _ik_target(self) -> Argument:
         """ik_numeric's target: the 4x4 pose for a six-component task, else the task vector."""
-        if len(self.robot.task) == 6:
-            return Argument("target", sympy.Matrix(4, 4, lambda r, c: generated_symbol("T", r, c, separator="")),
-                            vector=False)
-        return Argument("target", sympy.Matrix([generated_symbol("mu", i) for i in range(len(self.robot.task))]))
+        return self._target(len(self.robot.task) == 6, "target")
+
+    @staticmethod
+    def _free_argument() -> Argument:
+        """A 7-axis arm's free joint angle, an input of its closed form."""
+        return Argument("q_free", sympy.Matrix([sympy.Symbol("q_free", real=True)]), scalar=True)
 
     def _task_error(self, target: Argument, task_jacobian: sympy.Matrix | None) -> tuple[list, sympy.Matrix]:
         """The error e that ik's iterations drive to 0, at the chain's q, and its Jacobian: for a
@@ -388,8 +391,8 @@ class Generator:
                              operations=differential.IK_NUMERIC_OPERATIONS, casadi="steps"))
         if form is None:
             return made
-        target = self._closed_form_target()
-        free = (Argument("q_free", sympy.Matrix([sympy.Symbol("q_free", real=True)]), scalar=True),) * (form.free is not None)
+        target = self._target(form.target == "pose")
+        free = (self._free_argument(),) * (form.free is not None)
         rows, solutions = form.info.max_solutions, ("MAX_IK_SOLUTIONS",)
         general = form.solver == "general_6r"
         if general and self.generates("ik_branches"):
