@@ -229,7 +229,8 @@ def show(robot_file, plot_file, q, urdf_file, base, tip, tolerance):
 
         from jacgen.reports.drawing import default_configurations, draw
 
-        drawing = draw(robot, [np.array(q)] if q is not None else default_configurations(robot), plot_format)
+        configurations = {"at --q": np.array(q)} if q is not None else default_configurations(robot)
+        drawing = draw(robot, configurations, plot_format)
         write_files({Path(plot_file).name: drawing}, Path(plot_file).parent)
         click.echo(f"jacgen: wrote {plot_file}", err=True)
     if urdf_file:
