@@ -220,6 +220,25 @@ def test_ur5_gets_two_different_configurations():
     assert [list(q) for q in default_configurations(puma).values()] == [[0.0] * 6, list(middle)]
 
 
+@pytest.mark.parametrize("name", ["ur5", "puma560", "panda"])
+def test_axis_numbers_do_not_overlap(name):
+    """The joints' numbers, as rendered, overlap no other number: the UR5's wrist axes 4, 5, 6
+    are about 0.1 m apart at q = 0, the Puma's 4 and 6 collinear at the middle of its limits."""
+    arm = robot(name)
+    canvas = FigureCanvasAgg(drawing_figure(arm, default_configurations(arm)))
+    canvas.draw()
+    for axes in canvas.figure.axes:
+        boxes = []
+        for i in range(arm.dof):  # each number's size as rendered, centred where its 3D point projects
+            number = _artist(axes, f"axis number {i + 1}")
+            size = number.get_window_extent(canvas.get_renderer()).size
+            centre = axes.transData.transform(_projected(axes, np.array([number.get_position_3d()]))[0])
+            boxes.append(np.array([centre - size / 2, centre + size / 2]))
+        overlapping = [(i + 1, j + 1) for i in range(arm.dof) for j in range(i)
+                       if np.all(boxes[i][0] < boxes[j][1]) and np.all(boxes[j][0] < boxes[i][1])]
+        assert not overlapping, (axes.get_title(), overlapping)
+
+
 @pytest.mark.parametrize("name, panels", [("ur5", 1), ("ur5", 2), ("planar_3r", 3), ("scara", 3)])
 def test_the_caption_fits_in_the_figure(name, panels):
     """The caption (wrapped) lies inside the figure, below every panel, and states the factor

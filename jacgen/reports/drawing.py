@@ -28,6 +28,7 @@ AXIS_STYLE = {True: {"color": "tab:orange", "linestyle": "-"},  # revolute
 TRIAD_COLOURS = ("tab:red", "tab:green", "tab:blue")  # x, y, z
 ELLIPSOID_COLOUR = "m"  # magenta: apart from the triads and from the map's viridis
 AXIS_LENGTH, TRIAD_LENGTH = 0.2, 0.12  # arrows and triads, as fractions of the drawing's size
+LABEL_GAP = 0.06  # an axis number from its arrow's tip, other numbers, arrows: this fraction of the size
 ELLIPSOID_SIZE = 0.3  # a 3D panel's largest drawn semi-axis, at most this fraction of the arm's extent
 ELLIPSE_GRID, ELLIPSE_SIZE = 3, 0.5  # the map's velocity ellipses: one per cell of a 3 x 3 grid over the
 # workspace, the largest drawn semi-axis at most half a cell
@@ -152,16 +153,17 @@ def draw_arm(axes, robot: Robot, q: np.ndarray, scale: float, label: str = "") -
     frames, tool = numeric_chain.axis_frames(robot, q)
     size = drawing_size(points)
     axes.plot(*points.T, color="0.25", linewidth=2, marker="o", markersize=3, gid="chain")
-    labelled = []
+    tips = []
     for i, (joint, frame) in enumerate(zip(robot.joints, frames)):
         origin, tip = frame[:3, 3], frame[:3, 3] + AXIS_LENGTH * size * frame[:3, 2]
         axes.quiver(*origin, *(tip - origin), arrow_length_ratio=0.2, linewidth=1.5, gid=f"axis {i + 1}",
                     **AXIS_STYLE[joint.revolute])
-        at = _label_position(tip, frame[:3, 2], labelled, size)
-        labelled.append(at)
+        tips.append(tip)
+    shafts = [(frame[:3, 3], tip) for frame, tip in zip(frames, tips)] + list(zip(points, points[1:]))
+    for i, (joint, at) in enumerate(zip(robot.joints, _label_positions(axes, tips, frames, shafts, size))):
         axes.text(*at, str(i + 1), fontsize=9, fontweight="bold", color=AXIS_STYLE[joint.revolute]["color"],
-                  ha="center", va="center", bbox={"boxstyle": "round,pad=0.1", "facecolor": "white",
-                                                  "edgecolor": "none", "alpha": 0.7})
+                  ha="center", va="center", zorder=100, gid=f"axis number {i + 1}",
+                  bbox={"boxstyle": "round,pad=0.1", "facecolor": "white", "edgecolor": "none", "alpha": 0.7})
     for name, pose in (("base", numeric_chain.fixed_pose(robot.base)), ("tool", tool)):
         for column, colour in enumerate(TRIAD_COLOURS):
             end = pose[:3, 3] + TRIAD_LENGTH * size * pose[:3, column]
@@ -178,16 +180,35 @@ def draw_arm(axes, robot: Robot, q: np.ndarray, scale: float, label: str = "") -
     axes.set_title(f"{' '.join(filter(None, [robot.name, label]))}\n{configuration_text(q)}", fontsize=9)
 
 
-def _label_position(tip: np.ndarray, along: np.ndarray, taken: list[np.ndarray], size: float) -> np.ndarray:
-    """Where a joint's number goes: just past its arrow's tip, moved further out along the axis
-    while it would sit within 0.08 of the drawing's size of a number already placed (the
-    numbers of close wrist axes would print over each other)."""
-    at = tip + 0.05 * size * along
-    for _ in range(4):
-        if all(np.linalg.norm(at - other) > 0.08 * size for other in taken):
-            break
-        at = at + 0.08 * size * along
-    return at
+def _label_positions(axes, tips, frames, shafts, size) -> list[np.ndarray]:
+    """Where the joints' numbers go: LABEL_GAP of the drawing's size from each arrow's tip, in
+    the screen plane (the view's right and up), in the first direction, starting from the
+    arrow's own as seen and turning by 45 deg steps, that keeps the number LABEL_GAP from the
+    numbers placed before and from every arrow and chain segment (the farthest, where none
+    does): the numbers of close or collinear axes (a wrist) do not print over each other."""
+    elev, azim = np.radians([axes.elev, axes.azim])
+    screen = np.array([[-np.sin(azim), np.cos(azim), 0.0],
+                       [-np.sin(elev) * np.cos(azim), -np.sin(elev) * np.sin(azim), np.cos(elev)]])
+    segments = [(screen @ start, screen @ end) for start, end in shafts]
+    gap, placed, positions = LABEL_GAP * size, [], []
+    for tip, frame in zip(tips, frames):
+        seen = screen @ frame[:3, 2]
+        start = np.arctan2(seen[1], seen[0]) if np.linalg.norm(seen) > 0.3 else np.pi / 2
+        candidates = [screen @ tip + gap * np.array([np.cos(start + turn), np.sin(start + turn)])
+                      for turn in np.radians([0, 45, -45, 90, -90, 135, -135, 180])]
+        clearances = [min([np.linalg.norm(c - other) for other in placed]
+                          + [_distance_to_segment(c, *segment) for segment in segments]) for c in candidates]
+        chosen = next((k for k, clear in enumerate(clearances) if clear >= gap), int(np.argmax(clearances)))
+        placed.append(candidates[chosen])
+        positions.append(tip + (candidates[chosen] - screen @ tip) @ screen)
+    return positions
+
+
+def _distance_to_segment(point: np.ndarray, start: np.ndarray, end: np.ndarray) -> float:
+    """The distance from point to the segment start-end."""
+    along = end - start
+    t = np.clip((point - start) @ along / max(along @ along, 1e-300), 0.0, 1.0)
+    return float(np.linalg.norm(point - start - t * along))
 
 
 def _draw_ellipsoid(axes, centre: np.ndarray, directions: np.ndarray, semi_axes: np.ndarray) -> np.ndarray:
