@@ -439,17 +439,48 @@ static PyObject *jacgen_many(const jacgen_function *f, int build, const jacgen_a
     return result;
 }
 
+/* A number given for an input that takes one for each component (`every`) becomes the list of
+ * them, held in `lists` for the caller to release. */
+static int jacgen_every(const jacgen_function *f, jacgen_arguments *a, PyObject **lists)
+{
+    int k;
+    Py_ssize_t i;
+    for (k = 0; k < f->inputs; k++) {
+        PyObject *value = a->value[k];
+        lists[k] = NULL;
+        if (!f->operand[k].every || value == NULL
+            || !(PyFloat_Check(value) || PyLong_Check(value) || PyArray_IsScalar(value, Generic)
+                 || (PyArray_Check(value) && PyArray_NDIM((PyArrayObject *)value) == 0))) {
+            continue;
+        }
+        if ((lists[k] = PyList_New(f->operand[k].size)) == NULL) {
+            return -1;
+        }
+        for (i = 0; i < f->operand[k].size; i++) {
+            PyList_SET_ITEM(lists[k], i, Py_NewRef(value));
+        }
+        a->value[k] = lists[k];
+    }
+    return 0;
+}
+
 static PyObject *jacgen_call(const jacgen_function *f, PyObject *const *args, Py_ssize_t nargs, PyObject *kwnames)
 {
     jacgen_arguments a;
-    PyObject *result;
-    int build;
+    PyObject *result = NULL, *lists[JACGEN_OPERANDS] = {NULL};
+    int build, k;
     if (jacgen_parse(f, args, nargs, kwnames, &a, 0) != 0) {
         return NULL;
     }
-    build = jacgen_build(f, &a);
-    result = jacgen_one(f, build, &a);
-    return result != NULL || PyErr_Occurred() ? result : jacgen_many(f, build, &a);
+    if (jacgen_every(f, &a, lists) == 0) {
+        build = jacgen_build(f, &a);
+        result = jacgen_one(f, build, &a);
+        result = result != NULL || PyErr_Occurred() ? result : jacgen_many(f, build, &a);
+    }
+    for (k = 0; k < f->inputs; k++) {
+        Py_XDECREF(lists[k]);
+    }
+    return result;
 }
 
 /* ik of one target: the valid (and in_limits) rows of ik_branches as (k, DOF), straight from
