@@ -2,6 +2,7 @@
 function's size. It prints no expression and reserves no word."""
 
 from jacgen.emission.backends.common import Backend, common_context, dimensions
+from jacgen.emission import jacobian_uses
 from jacgen.emission.generator import Generator
 from jacgen.inputs.robot import Robot
 from jacgen.reports import description as words
@@ -10,6 +11,9 @@ from jacgen.reports import description as words
 def _report_context(robot: Robot, generator: Generator) -> dict:
     """The Markdown report: the lines `jacgen show` prints, and each function's size."""
     singular = generator.singularities
+    operations = [{"name": f.name, "operations": f.body.operation_count,
+                   "shape": "scalar" if f.scalar else " and ".join(dimensions(o) for o in f.outputs)}
+                  for f in generator.functions()]
     return {
         "convention": robot.convention,
         "file_name": robot.file_name,
@@ -21,9 +25,8 @@ def _report_context(robot: Robot, generator: Generator) -> dict:
         "euler": words.euler_lines(robot, singular),
         "dexterity": words.dexterity_lines(generator.model),
         "ik": words.ik_lines(generator.model),
-        "operations": [{"name": f.name, "operations": f.body.operation_count,
-                        "shape": "scalar" if f.scalar else " and ".join(dimensions(o) for o in f.outputs)}
-                       for f in generator.functions()],
+        "operations": operations,
+        "uses": [f for f in operations if f["name"] in jacobian_uses.NAMES],
     }
 
 
