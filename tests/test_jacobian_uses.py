@@ -8,7 +8,7 @@ import pytest
 
 from jacgen.checking import reference
 from jacgen.inputs.robot_file import load_robot, parse_robot
-from conftest import ROOT
+from conftest import ROOT, generated_module
 
 USES = ("fk", "jacobian", "manipulability", "velocity_ik", "link_poses", "link_velocities", "velocity_ellipsoid",
         "condition_number", "manipulability_gradient", "velocity_ik_nullspace", "resolved_rate")
@@ -192,3 +192,50 @@ task: [x, y]
     assert kappa[:2] == pytest.approx(1.0, abs=1e-12)
     assert kappa[2] > 1.5
     assert code.python.condition_number([0.3, 0.0]) == np.inf  # stretched out: singular
+
+
+NEW = {"link_poses": lambda q, rng: (q,), "link_velocities": lambda q, rng: (q, rng.normal(size=q.shape)),
+       "velocity_ellipsoid": lambda q, rng: (q,), "condition_number": lambda q, rng: (q,),
+       "manipulability_gradient": lambda q, rng: (q,),
+       "velocity_ik_nullspace": lambda q, rng: (q, rng.normal(size=(len(q), 6)), rng.normal(size=q.shape)),
+       "resolved_rate": lambda q, rng: (q, np.tile(np.eye(4), (len(q), 1, 1)), rng.normal(size=(len(q), 6)),
+                                        np.full(6, 2.0), rng.normal(size=q.shape))}
+
+
+@pytest.mark.parametrize("lib", ["jax", "torch"])
+def test_jax_and_pytorch_give_numpy_numbers_and_gradients(lib):
+    """Each new function on JAX arrays (eager, jit, vmap) and PyTorch tensors gives NAME.py's numpy
+    numbers; autodiff of manipulability equals the generated manipulability_gradient, and of
+    condition_number central differences."""
+    module, rng = generated_module("panda"), np.random.default_rng(9)
+    q = rng.uniform(-1.5, 1.5, size=(8, 7))
+    if lib == "jax":
+        jax = pytest.importorskip("jax")
+        jax.config.update("jax_enable_x64", True)  # float64, as numpy
+        to, back, transforms = jax.numpy.asarray, np.asarray, (lambda f: f, jax.jit, jax.vmap)
+    else:
+        torch = pytest.importorskip("torch")
+        to, back, transforms = torch.from_numpy, lambda t: t.detach().numpy(), (lambda f: f,)
+    for function, arguments in NEW.items():
+        given = arguments(q, rng)
+        expected = getattr(module, function)(*given)
+        expected = expected if isinstance(expected, tuple) else (expected,)
+        for transform in transforms:
+            found = transform(getattr(module, function))(*map(to, given))
+            for a, b in zip(expected, found if isinstance(found, tuple) else (found,)):
+                np.testing.assert_allclose(back(b), a, atol=1e-9, rtol=1e-9, err_msg=function)
+    for row in q[:3]:
+        if lib == "jax":
+            gradient = np.asarray(jax.grad(module.manipulability)(jax.numpy.asarray(row)))
+            kappa = np.asarray(jax.grad(module.condition_number)(jax.numpy.asarray(row)))
+        else:
+            x = torch.tensor(row, requires_grad=True)
+            module.manipulability(x).backward()
+            gradient = x.grad.numpy()
+            y = torch.tensor(row, requires_grad=True)
+            module.condition_number(y).backward()
+            kappa = y.grad.numpy()
+        np.testing.assert_allclose(gradient, module.manipulability_gradient(row), atol=1e-10)
+        differences = np.array([(module.condition_number(row + 1e-6 * e) - module.condition_number(row - 1e-6 * e))
+                                / 2e-6 for e in np.eye(7)])
+        np.testing.assert_allclose(kappa, differences, rtol=1e-5, atol=1e-6)

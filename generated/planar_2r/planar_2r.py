@@ -571,7 +571,7 @@ def jacobian_det(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def manipulability_gradient(q):
-    """d manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): (2 x 1), 92 operations."""
+    """d manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): (2 x 1), 91 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (2,)))
     trig = _cos_sin(xp, q, (0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -593,33 +593,35 @@ def manipulability_gradient(q):
     t10 = t0 - t7*t9
     t11 = c12 + s12*t9
     t12 = 1 - t7**2*t8
-    t13 = xp.abs(t11)
-    t14 = t13*xp.where(xp.greater_equal(t11, 0), xp.asarray(1, dtype=dtype), -1)
-    t15 = t11 + t14
-    t16 = xp.where(xp.greater(t13, 0), 1/(t13*2*t13), 0)
-    t17 = 1 - t15**2*t16
-    t18 = t8*t17
-    t19 = t2*t18
-    t20 = -t19 + t17
-    t21 = s12*t7
-    t22 = t14*t12 + t10*t18*t21
-    t23 = t10*t20 + t8*t14*t21
-    t24 = 1e-12*t4
-    t25 = xp.where(xp.less_equal(t5, t24) | xp.less_equal(t13, t24), 0, xp.where(xp.less(t6, 0), 1, xp.where(xp.greater(t6, 0), xp.asarray(-1, dtype=dtype), 0))*xp.where(xp.less(t14, 0), 1, xp.where(xp.greater(t14, 0), xp.asarray(-1, dtype=dtype), 0)))
-    t26 = s12*t6
-    t27 = c12*t23 + t20*t26
-    t28 = t25*(t0*t22 + t1*t7*t18*t26 + t27)
-    t29 = t25*(c12*t22 + t27 + t6*t7*t19)
+    t13 = xp.where(xp.greater(t6, 0), xp.asarray(-1, dtype=dtype), 1)
+    t14 = xp.abs(t11)
+    t15 = t14*xp.where(xp.greater_equal(t11, 0), xp.asarray(1, dtype=dtype), -1)
+    t16 = t11 + t15
+    t17 = xp.where(xp.greater(t14, 0), 1/(t14*2*t14), 0)
+    t18 = 1 - t16**2*t17
+    t19 = xp.where(xp.greater(t15, 0), -t13, t13)
+    t20 = t8*t18
+    t21 = t2*t20
+    t22 = -t21 + t18
+    t23 = s12*t7
+    t24 = t15*t12 + t10*t20*t23
+    t25 = t10*t22 + t8*t15*t23
+    t26 = 1e-12*t4
+    t27 = xp.where(xp.less_equal(t5, t26) | xp.less_equal(t14, t26), 0, t19)
+    t28 = s12*t6
+    t29 = c12*t25 + t22*t28
+    t30 = t27*(t0*t24 + t1*t7*t20*t28 + t29)
+    t31 = t27*(c12*t24 + t29 + t6*t7*t21)
     dw = _stack(xp, [
-        t28,  # 0
-        t29,  # 1
+        t30,  # 0
+        t31,  # 1
     ], (2,))
     return dw
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ellipsoid(q):
-    """axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: (3 x 3 and 3 x 1 and 3 x 3 and 3 x 1), 304 operations."""
+    """axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: (3 x 3 and 3 x 1 and 3 x 3 and 3 x 1), 364 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (2,)))
     trig = _cos_sin(xp, q, (0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -645,140 +647,155 @@ def velocity_ellipsoid(q):
     t14 = t3*t7
     t15 = xp.not_equal(t14, 0)
     t16 = 0.5*(-t11 + t13)/xp.where(t15, -t14, 1)
-    t17 = xp.where(t15, xp.where(xp.greater_equal(t16, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t16) + xp.sqrt(1 + t16**2)), 0)
-    t18 = 1/xp.sqrt(1 + t17**2)
-    t19 = t14*t17
-    t20 = t19 + t11
-    t21 = -t19 + t13
-    t22 = t3*t18
-    t23 = t7*t18
-    t24 = t22 + t23*t17
-    t25 = t23 - t22*t17
-    t26 = t24*t25 + t12*t17*t18**2
-    t27 = xp.not_equal(t26, 0)
-    t28 = 0.5*(-t20 + t21)/xp.where(t27, -t26, 1)
-    t29 = xp.where(t27, xp.where(xp.greater_equal(t28, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t28) + xp.sqrt(1 + t28**2)), 0)
-    t30 = 1/xp.sqrt(1 + t29**2)
-    t31 = t26*t29
-    t32 = t31 + t20
-    t33 = -t31 + t21
-    t34 = t24*t30
-    t35 = t25*t30
-    t36 = t34 + t29*t35
-    t37 = t35 - t34*t29
-    t38 = t18*t30
-    t39 = t10*t38
-    t40 = t17*t39
-    t41 = t40 + t29*t39
-    t42 = -t39 + t29*t40
-    t43 = -t36*t37 + t41*t42
-    t44 = t17*t38
-    t45 = t38 - t29*t44
-    t46 = t44 + t29*t38
-    t47 = xp.not_equal(t43, 0)
-    t48 = 0.5*(-t32 + t33)/xp.where(t47, t43, 1)
-    t49 = xp.where(t47, xp.where(xp.greater_equal(t48, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t48) + xp.sqrt(1 + t48**2)), 0)
-    t50 = 1/xp.sqrt(1 + t49**2)
-    t51 = t43*t49
-    t52 = -t51 + t32
-    t53 = t33 + t51
-    t54 = t36*t50
-    t55 = t37*t50
-    t56 = t54 + t49*t55
-    t57 = t55 - t49*t54
-    t58 = t41*t50
-    t59 = t42*t50
-    t60 = t58 - t49*t59
-    t61 = t59 + t49*t58
-    t62 = -t56*t57 + t60*t61
-    t63 = t45*t50
-    t64 = t46*t50
-    t65 = t63 - t49*t64
-    t66 = t64 + t49*t63
-    t67 = xp.not_equal(t62, 0)
-    t68 = 0.5*(-t52 + t53)/xp.where(t67, t62, 1)
-    t69 = xp.where(t67, xp.where(xp.greater_equal(t68, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t68) + xp.sqrt(1 + t68**2)), 0)
-    t70 = 1/xp.sqrt(1 + t69**2)
-    t71 = t62*t69
-    t72 = -t71 + t52
-    t73 = t53 + t71
-    t74 = t56*t70
-    t75 = t57*t70
-    t76 = t74 + t69*t75
-    t77 = t75 - t69*t74
-    t78 = t60*t70
-    t79 = t61*t70
-    t80 = t78 - t69*t79
-    t81 = t79 + t69*t78
-    t82 = -t76*t77 + t80*t81
-    t83 = t65*t70
-    t84 = t66*t70
-    t85 = t83 - t69*t84
-    t86 = t84 + t69*t83
-    t87 = xp.not_equal(t82, 0)
-    t88 = 0.5*(-t72 + t73)/xp.where(t87, t82, 1)
-    t89 = xp.where(t87, xp.where(xp.greater_equal(t88, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t88) + xp.sqrt(1 + t88**2)), 0)
-    t90 = 1/xp.sqrt(1 + t89**2)
-    t91 = t76*t90
-    t92 = t77*t90
-    t93 = t91 + t89*t92
-    t94 = t92 - t89*t91
-    t95 = t80*t90
-    t96 = t81*t90
-    t97 = t95 - t89*t96
-    t98 = t96 + t89*t95
-    t99 = xp.sqrt(t93**2 + t97**2)
-    t100 = xp.sqrt(t94**2 + t98**2)
-    t101 = t85*t90
-    t102 = t86*t90
-    t103 = t101 - t89*t102
-    t104 = t102 + t89*t101
-    t105 = xp.less(t99, t100)
-    t106 = xp.where(t105, t100, t99)
-    t107 = xp.where(t105, t99, t100)
-    t108 = xp.where(t105, t104, t103)
-    t109 = xp.where(t105, t103, t104)
-    t110 = -t104
-    t111 = xp.where(t105, t103, t110)
-    t112 = xp.where(t105, t110, t103)
-    t113 = xp.less(t107, 0)
-    t114 = xp.where(t113, 0, t107)
-    t115 = xp.where(t113, t107, 0)
-    t116 = xp.where(t113, 0, t109)
-    t117 = xp.where(t113, 0, t112)
-    t118 = xp.where(t113, xp.asarray(1, dtype=dtype), 0)
-    t119 = xp.where(t113, t109, 0)
-    t120 = xp.where(t113, t112, 0)
-    t121 = xp.where(t113, xp.asarray(0, dtype=dtype), 1)
-    t122 = xp.less(t106, t114)
-    t123 = xp.where(t122, t114, t106)
-    t124 = xp.where(t122, t106, t114)
-    t125 = xp.where(t122, t116, t108)
-    t126 = xp.where(t122, t117, t111)
-    t127 = xp.where(t122, t118, 0)
-    t128 = xp.where(t122, t108, t116)
-    t129 = xp.where(t122, t111, t117)
-    t130 = xp.where(t122, 0, t118)
-    t131 = t125*(t121*t129 - t120*t130) - t126*(t121*t128 - t119*t130) + t127*(t120*t128 - t119*t129)
-    t132 = xp.where(xp.less(t131, 0), xp.asarray(-1, dtype=dtype), 1)
-    t133 = t119*t132
-    t134 = t120*t132
-    t135 = t121*t132
+    t17 = xp.abs(t16)
+    t18 = xp.greater_equal(t17, 1)
+    t19 = xp.abs(1/xp.where(t18, t16, 1))
+    t20 = xp.where(t15, xp.where(xp.greater_equal(t16, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t18, t19/(1 + xp.sqrt(1 + t19**2)), 1/(t17 + xp.sqrt(1 + t17**2))), 0)
+    t21 = 1/xp.sqrt(1 + t20**2)
+    t22 = t14*t20
+    t23 = t22 + t11
+    t24 = -t22 + t13
+    t25 = t3*t21
+    t26 = t7*t21
+    t27 = t25 + t26*t20
+    t28 = t26 - t25*t20
+    t29 = t27*t28 + t12*t20*t21**2
+    t30 = xp.not_equal(t29, 0)
+    t31 = 0.5*(-t23 + t24)/xp.where(t30, -t29, 1)
+    t32 = xp.abs(t31)
+    t33 = xp.greater_equal(t32, 1)
+    t34 = xp.abs(1/xp.where(t33, t31, 1))
+    t35 = xp.where(t30, xp.where(xp.greater_equal(t31, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t33, t34/(1 + xp.sqrt(1 + t34**2)), 1/(t32 + xp.sqrt(1 + t32**2))), 0)
+    t36 = 1/xp.sqrt(1 + t35**2)
+    t37 = t29*t35
+    t38 = t23 + t37
+    t39 = -t37 + t24
+    t40 = t27*t36
+    t41 = t28*t36
+    t42 = t40 + t35*t41
+    t43 = t41 - t35*t40
+    t44 = t21*t36
+    t45 = t10*t44
+    t46 = t20*t45
+    t47 = t46 + t35*t45
+    t48 = -t45 + t35*t46
+    t49 = -t42*t43 + t47*t48
+    t50 = t20*t44
+    t51 = t44 - t35*t50
+    t52 = t50 + t35*t44
+    t53 = xp.not_equal(t49, 0)
+    t54 = 0.5*(-t38 + t39)/xp.where(t53, t49, 1)
+    t55 = xp.abs(t54)
+    t56 = xp.greater_equal(t55, 1)
+    t57 = xp.abs(1/xp.where(t56, t54, 1))
+    t58 = xp.where(t53, xp.where(xp.greater_equal(t54, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t56, t57/(1 + xp.sqrt(1 + t57**2)), 1/(t55 + xp.sqrt(1 + t55**2))), 0)
+    t59 = 1/xp.sqrt(1 + t58**2)
+    t60 = t49*t58
+    t61 = -t60 + t38
+    t62 = t39 + t60
+    t63 = t42*t59
+    t64 = t43*t59
+    t65 = t63 + t58*t64
+    t66 = t64 - t58*t63
+    t67 = t47*t59
+    t68 = t48*t59
+    t69 = t67 - t58*t68
+    t70 = t68 + t58*t67
+    t71 = -t65*t66 + t69*t70
+    t72 = t51*t59
+    t73 = t52*t59
+    t74 = t72 - t58*t73
+    t75 = t73 + t58*t72
+    t76 = xp.not_equal(t71, 0)
+    t77 = 0.5*(-t61 + t62)/xp.where(t76, t71, 1)
+    t78 = xp.abs(t77)
+    t79 = xp.greater_equal(t78, 1)
+    t80 = xp.abs(1/xp.where(t79, t77, 1))
+    t81 = xp.where(t76, xp.where(xp.greater_equal(t77, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t79, t80/(1 + xp.sqrt(1 + t80**2)), 1/(t78 + xp.sqrt(1 + t78**2))), 0)
+    t82 = 1/xp.sqrt(1 + t81**2)
+    t83 = t71*t81
+    t84 = -t83 + t61
+    t85 = t62 + t83
+    t86 = t65*t82
+    t87 = t66*t82
+    t88 = t86 + t81*t87
+    t89 = t87 - t81*t86
+    t90 = t69*t82
+    t91 = t70*t82
+    t92 = t90 - t81*t91
+    t93 = t91 + t81*t90
+    t94 = -t88*t89 + t92*t93
+    t95 = t74*t82
+    t96 = t75*t82
+    t97 = t95 - t81*t96
+    t98 = t96 + t81*t95
+    t99 = xp.not_equal(t94, 0)
+    t100 = 0.5*(-t84 + t85)/xp.where(t99, t94, 1)
+    t101 = xp.abs(t100)
+    t102 = xp.greater_equal(t101, 1)
+    t103 = xp.abs(1/xp.where(t102, t100, 1))
+    t104 = xp.where(t99, xp.where(xp.greater_equal(t100, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t102, t103/(1 + xp.sqrt(1 + t103**2)), 1/(t101 + xp.sqrt(1 + t101**2))), 0)
+    t105 = 1/xp.sqrt(1 + t104**2)
+    t106 = t88*t105
+    t107 = t89*t105
+    t108 = t106 + t104*t107
+    t109 = t107 - t104*t106
+    t110 = t92*t105
+    t111 = t93*t105
+    t112 = t110 - t104*t111
+    t113 = t111 + t104*t110
+    t114 = xp.sqrt(t108**2 + t112**2)
+    t115 = xp.sqrt(t109**2 + t113**2)
+    t116 = t97*t105
+    t117 = t98*t105
+    t118 = t116 - t104*t117
+    t119 = t117 + t104*t116
+    t120 = xp.less(t114, t115)
+    t121 = xp.where(t120, t115, t114)
+    t122 = xp.where(t120, t114, t115)
+    t123 = xp.where(t120, t119, t118)
+    t124 = xp.where(t120, t118, t119)
+    t125 = -t119
+    t126 = xp.where(t120, t118, t125)
+    t127 = xp.where(t120, t125, t118)
+    t128 = xp.less(t122, 0)
+    t129 = xp.where(t128, 0, t122)
+    t130 = xp.where(t128, t122, 0)
+    t131 = xp.where(t128, 0, t124)
+    t132 = xp.where(t128, 0, t127)
+    t133 = xp.where(t128, xp.asarray(1, dtype=dtype), 0)
+    t134 = xp.where(t128, t124, 0)
+    t135 = xp.where(t128, t127, 0)
+    t136 = xp.where(t128, xp.asarray(0, dtype=dtype), 1)
+    t137 = xp.less(t121, t129)
+    t138 = xp.where(t137, t129, t121)
+    t139 = xp.where(t137, t121, t129)
+    t140 = xp.where(t137, t131, t123)
+    t141 = xp.where(t137, t132, t126)
+    t142 = xp.where(t137, t133, 0)
+    t143 = xp.where(t137, t123, t131)
+    t144 = xp.where(t137, t126, t132)
+    t145 = xp.where(t137, 0, t133)
+    t146 = t140*(t136*t144 - t135*t145) - t141*(t136*t143 - t134*t145) + t142*(t135*t143 - t134*t144)
+    t147 = xp.where(xp.less(t146, 0), xp.asarray(-1, dtype=dtype), 1)
+    t148 = t134*t147
+    t149 = t135*t147
+    t150 = t136*t147
     U_v = _stack(xp, [
-        t125,  # 0, 0
-        t128,  # 0, 1
-        t133,  # 0, 2
-        t126,  # 1, 0
-        t129,  # 1, 1
-        t134,  # 1, 2
-        t127,  # 2, 0
-        t130,  # 2, 1
-        t135,  # 2, 2
+        t140,  # 0, 0
+        t143,  # 0, 1
+        t148,  # 0, 2
+        t141,  # 1, 0
+        t144,  # 1, 1
+        t149,  # 1, 2
+        t142,  # 2, 0
+        t145,  # 2, 1
+        t150,  # 2, 2
     ], (3, 3))
     s_v = _stack(xp, [
-        t123,  # 0
-        t124,  # 1
-        t115,  # 2
+        t138,  # 0
+        t139,  # 1
+        t130,  # 2
     ], (3,))
     U_w = _stack(xp, [
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 0
@@ -801,7 +818,7 @@ def velocity_ellipsoid(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def condition_number(q):
-    """sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): (1 x 1), 87 operations."""
+    """sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): (1 x 1), 99 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (2,)))
     trig = _cos_sin(xp, q, (0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -827,19 +844,22 @@ def condition_number(q):
     t14 = t7*t10
     t15 = xp.not_equal(t14, 0)
     t16 = 0.5*(-t13 + t11)/xp.where(t15, -t14, 1)
-    t17 = xp.where(t15, xp.where(xp.greater_equal(t16, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t16) + xp.sqrt(1 + t16**2)), 0)
-    t18 = t17**2
-    t19 = 1/xp.sqrt(1 + t18)
-    t20 = t7*t19
-    t21 = t10*t19
-    t22 = t20 + t21*t17
-    t23 = -t21 + t20*t17
-    t24 = t12*t19**2
-    t25 = xp.sqrt(t24 + t22**2)
-    t26 = xp.sqrt(t23**2 + t18*t24)
-    t27 = xp.where(xp.greater(t26, t25), t26, t25)
-    t28 = xp.where(xp.less(t26, t25), t26, t25)
-    kappa = xp.broadcast_to(xp.where(xp.greater(t27, 0), t27, 1)/xp.where(xp.less_equal(t28, 1e-12*t27), 0, t28), batch)
+    t17 = xp.abs(t16)
+    t18 = xp.greater_equal(t17, 1)
+    t19 = xp.abs(1/xp.where(t18, t16, 1))
+    t20 = xp.where(t15, xp.where(xp.greater_equal(t16, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t18, t19/(1 + xp.sqrt(1 + t19**2)), 1/(t17 + xp.sqrt(1 + t17**2))), 0)
+    t21 = t20**2
+    t22 = 1/xp.sqrt(1 + t21)
+    t23 = t7*t22
+    t24 = t10*t22
+    t25 = t23 + t24*t20
+    t26 = -t24 + t23*t20
+    t27 = t12*t22**2
+    t28 = xp.sqrt(t27 + t25**2)
+    t29 = xp.sqrt(t26**2 + t21*t27)
+    t30 = xp.where(xp.greater(t29, t28), t29, t28)
+    t31 = xp.where(xp.less(t29, t28), t29, t28)
+    kappa = xp.broadcast_to(xp.where(xp.greater(t30, 0), t30, 1)/xp.where(xp.less_equal(t31, 1e-12*t30), 0, t31), batch)
     return kappa
 
 

@@ -389,7 +389,7 @@ def _jacobian_det(q):
 
 
 def _manipulability_gradient(q):
-    """D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): 92 operations."""
+    """D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): 91 operations."""
     q1 = q[0]
     q2 = q[1]
     c1 = casadi.cos(q1)
@@ -411,31 +411,33 @@ def _manipulability_gradient(q):
     t10 = t0 - t7*t9
     t11 = c12 + s12*t9
     t12 = 1 - t7**2*t8
-    t13 = casadi.fabs(t11)
-    t14 = t13*casadi.if_else((t11 >= 0), 1, -1)
-    t15 = t11 + t14
-    t16 = casadi.if_else((t13 > 0), 1/(t13*2*t13), 0)
-    t17 = 1 - t15**2*t16
-    t18 = t8*t17
-    t19 = t2*t18
-    t20 = -t19 + t17
-    t21 = s12*t7
-    t22 = t14*t12 + t10*t18*t21
-    t23 = t10*t20 + t8*t14*t21
-    t24 = 1e-12*t4
-    t25 = casadi.if_else(casadi.logic_or((t5 <= t24), (t13 <= t24)), 0, casadi.if_else((t6 < 0), 1, casadi.if_else((t6 > 0), -1, 0))*casadi.if_else((t14 < 0), 1, casadi.if_else((t14 > 0), -1, 0)))
-    t26 = s12*t6
-    t27 = c12*t23 + t20*t26
-    t28 = t25*(t0*t22 + t1*t7*t18*t26 + t27)
-    t29 = t25*(c12*t22 + t27 + t6*t7*t19)
+    t13 = casadi.if_else((t6 > 0), -1, 1)
+    t14 = casadi.fabs(t11)
+    t15 = t14*casadi.if_else((t11 >= 0), 1, -1)
+    t16 = t11 + t15
+    t17 = casadi.if_else((t14 > 0), 1/(t14*2*t14), 0)
+    t18 = 1 - t16**2*t17
+    t19 = casadi.if_else((t15 > 0), -t13, t13)
+    t20 = t8*t18
+    t21 = t2*t20
+    t22 = -t21 + t18
+    t23 = s12*t7
+    t24 = t15*t12 + t10*t20*t23
+    t25 = t10*t22 + t8*t15*t23
+    t26 = 1e-12*t4
+    t27 = casadi.if_else(casadi.logic_or((t5 <= t26), (t14 <= t26)), 0, t19)
+    t28 = s12*t6
+    t29 = c12*t25 + t22*t28
+    t30 = t27*(t0*t24 + t1*t7*t20*t28 + t29)
+    t31 = t27*(c12*t24 + t29 + t6*t7*t21)
     dw = casadi.SX(2, 1)
-    dw[0, 0] = t28
-    dw[1, 0] = t29
+    dw[0, 0] = t30
+    dw[1, 0] = t31
     return [dw]
 
 
 def _velocity_ellipsoid(q):
-    """Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: 304 operations."""
+    """Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: 364 operations."""
     q1 = q[0]
     q2 = q[1]
     c1 = casadi.cos(q1)
@@ -461,139 +463,154 @@ def _velocity_ellipsoid(q):
     t14 = t3*t7
     t15 = (t14 != 0)
     t16 = 0.5*(-t11 + t13)/casadi.if_else(t15, -t14, 1)
-    t17 = casadi.if_else(t15, casadi.if_else((t16 >= 0), 1, -1)/(casadi.fabs(t16) + casadi.sqrt(1 + t16**2)), 0)
-    t18 = 1/casadi.sqrt(1 + t17**2)
-    t19 = t14*t17
-    t20 = t19 + t11
-    t21 = -t19 + t13
-    t22 = t3*t18
-    t23 = t7*t18
-    t24 = t22 + t23*t17
-    t25 = t23 - t22*t17
-    t26 = t24*t25 + t12*t17*t18**2
-    t27 = (t26 != 0)
-    t28 = 0.5*(-t20 + t21)/casadi.if_else(t27, -t26, 1)
-    t29 = casadi.if_else(t27, casadi.if_else((t28 >= 0), 1, -1)/(casadi.fabs(t28) + casadi.sqrt(1 + t28**2)), 0)
-    t30 = 1/casadi.sqrt(1 + t29**2)
-    t31 = t26*t29
-    t32 = t31 + t20
-    t33 = -t31 + t21
-    t34 = t24*t30
-    t35 = t25*t30
-    t36 = t34 + t29*t35
-    t37 = t35 - t34*t29
-    t38 = t18*t30
-    t39 = t10*t38
-    t40 = t17*t39
-    t41 = t40 + t29*t39
-    t42 = -t39 + t29*t40
-    t43 = -t36*t37 + t41*t42
-    t44 = t17*t38
-    t45 = t38 - t29*t44
-    t46 = t44 + t29*t38
-    t47 = (t43 != 0)
-    t48 = 0.5*(-t32 + t33)/casadi.if_else(t47, t43, 1)
-    t49 = casadi.if_else(t47, casadi.if_else((t48 >= 0), 1, -1)/(casadi.fabs(t48) + casadi.sqrt(1 + t48**2)), 0)
-    t50 = 1/casadi.sqrt(1 + t49**2)
-    t51 = t43*t49
-    t52 = -t51 + t32
-    t53 = t33 + t51
-    t54 = t36*t50
-    t55 = t37*t50
-    t56 = t54 + t49*t55
-    t57 = t55 - t49*t54
-    t58 = t41*t50
-    t59 = t42*t50
-    t60 = t58 - t49*t59
-    t61 = t59 + t49*t58
-    t62 = -t56*t57 + t60*t61
-    t63 = t45*t50
-    t64 = t46*t50
-    t65 = t63 - t49*t64
-    t66 = t64 + t49*t63
-    t67 = (t62 != 0)
-    t68 = 0.5*(-t52 + t53)/casadi.if_else(t67, t62, 1)
-    t69 = casadi.if_else(t67, casadi.if_else((t68 >= 0), 1, -1)/(casadi.fabs(t68) + casadi.sqrt(1 + t68**2)), 0)
-    t70 = 1/casadi.sqrt(1 + t69**2)
-    t71 = t62*t69
-    t72 = -t71 + t52
-    t73 = t53 + t71
-    t74 = t56*t70
-    t75 = t57*t70
-    t76 = t74 + t69*t75
-    t77 = t75 - t69*t74
-    t78 = t60*t70
-    t79 = t61*t70
-    t80 = t78 - t69*t79
-    t81 = t79 + t69*t78
-    t82 = -t76*t77 + t80*t81
-    t83 = t65*t70
-    t84 = t66*t70
-    t85 = t83 - t69*t84
-    t86 = t84 + t69*t83
-    t87 = (t82 != 0)
-    t88 = 0.5*(-t72 + t73)/casadi.if_else(t87, t82, 1)
-    t89 = casadi.if_else(t87, casadi.if_else((t88 >= 0), 1, -1)/(casadi.fabs(t88) + casadi.sqrt(1 + t88**2)), 0)
-    t90 = 1/casadi.sqrt(1 + t89**2)
-    t91 = t76*t90
-    t92 = t77*t90
-    t93 = t91 + t89*t92
-    t94 = t92 - t89*t91
-    t95 = t80*t90
-    t96 = t81*t90
-    t97 = t95 - t89*t96
-    t98 = t96 + t89*t95
-    t99 = casadi.sqrt(t93**2 + t97**2)
-    t100 = casadi.sqrt(t94**2 + t98**2)
-    t101 = t85*t90
-    t102 = t86*t90
-    t103 = t101 - t89*t102
-    t104 = t102 + t89*t101
-    t105 = (t99 < t100)
-    t106 = casadi.if_else(t105, t100, t99)
-    t107 = casadi.if_else(t105, t99, t100)
-    t108 = casadi.if_else(t105, t104, t103)
-    t109 = casadi.if_else(t105, t103, t104)
-    t110 = -t104
-    t111 = casadi.if_else(t105, t103, t110)
-    t112 = casadi.if_else(t105, t110, t103)
-    t113 = (t107 < 0)
-    t114 = casadi.if_else(t113, 0, t107)
-    t115 = casadi.if_else(t113, t107, 0)
-    t116 = casadi.if_else(t113, 0, t109)
-    t117 = casadi.if_else(t113, 0, t112)
-    t118 = casadi.if_else(t113, 1, 0)
-    t119 = casadi.if_else(t113, t109, 0)
-    t120 = casadi.if_else(t113, t112, 0)
-    t121 = casadi.if_else(t113, 0, 1)
-    t122 = (t106 < t114)
-    t123 = casadi.if_else(t122, t114, t106)
-    t124 = casadi.if_else(t122, t106, t114)
-    t125 = casadi.if_else(t122, t116, t108)
-    t126 = casadi.if_else(t122, t117, t111)
-    t127 = casadi.if_else(t122, t118, 0)
-    t128 = casadi.if_else(t122, t108, t116)
-    t129 = casadi.if_else(t122, t111, t117)
-    t130 = casadi.if_else(t122, 0, t118)
-    t131 = t125*(t121*t129 - t120*t130) - t126*(t121*t128 - t119*t130) + t127*(t120*t128 - t119*t129)
-    t132 = casadi.if_else((t131 < 0), -1, 1)
-    t133 = t119*t132
-    t134 = t120*t132
-    t135 = t121*t132
+    t17 = casadi.fabs(t16)
+    t18 = (t17 >= 1)
+    t19 = casadi.fabs(1/casadi.if_else(t18, t16, 1))
+    t20 = casadi.if_else(t15, casadi.if_else((t16 >= 0), 1, -1)*casadi.if_else(t18, t19/(1 + casadi.sqrt(1 + t19**2)), 1/(t17 + casadi.sqrt(1 + t17**2))), 0)
+    t21 = 1/casadi.sqrt(1 + t20**2)
+    t22 = t14*t20
+    t23 = t22 + t11
+    t24 = -t22 + t13
+    t25 = t3*t21
+    t26 = t7*t21
+    t27 = t25 + t26*t20
+    t28 = t26 - t25*t20
+    t29 = t27*t28 + t12*t20*t21**2
+    t30 = (t29 != 0)
+    t31 = 0.5*(-t23 + t24)/casadi.if_else(t30, -t29, 1)
+    t32 = casadi.fabs(t31)
+    t33 = (t32 >= 1)
+    t34 = casadi.fabs(1/casadi.if_else(t33, t31, 1))
+    t35 = casadi.if_else(t30, casadi.if_else((t31 >= 0), 1, -1)*casadi.if_else(t33, t34/(1 + casadi.sqrt(1 + t34**2)), 1/(t32 + casadi.sqrt(1 + t32**2))), 0)
+    t36 = 1/casadi.sqrt(1 + t35**2)
+    t37 = t29*t35
+    t38 = t23 + t37
+    t39 = -t37 + t24
+    t40 = t27*t36
+    t41 = t28*t36
+    t42 = t40 + t35*t41
+    t43 = t41 - t35*t40
+    t44 = t21*t36
+    t45 = t10*t44
+    t46 = t20*t45
+    t47 = t46 + t35*t45
+    t48 = -t45 + t35*t46
+    t49 = -t42*t43 + t47*t48
+    t50 = t20*t44
+    t51 = t44 - t35*t50
+    t52 = t50 + t35*t44
+    t53 = (t49 != 0)
+    t54 = 0.5*(-t38 + t39)/casadi.if_else(t53, t49, 1)
+    t55 = casadi.fabs(t54)
+    t56 = (t55 >= 1)
+    t57 = casadi.fabs(1/casadi.if_else(t56, t54, 1))
+    t58 = casadi.if_else(t53, casadi.if_else((t54 >= 0), 1, -1)*casadi.if_else(t56, t57/(1 + casadi.sqrt(1 + t57**2)), 1/(t55 + casadi.sqrt(1 + t55**2))), 0)
+    t59 = 1/casadi.sqrt(1 + t58**2)
+    t60 = t49*t58
+    t61 = -t60 + t38
+    t62 = t39 + t60
+    t63 = t42*t59
+    t64 = t43*t59
+    t65 = t63 + t58*t64
+    t66 = t64 - t58*t63
+    t67 = t47*t59
+    t68 = t48*t59
+    t69 = t67 - t58*t68
+    t70 = t68 + t58*t67
+    t71 = -t65*t66 + t69*t70
+    t72 = t51*t59
+    t73 = t52*t59
+    t74 = t72 - t58*t73
+    t75 = t73 + t58*t72
+    t76 = (t71 != 0)
+    t77 = 0.5*(-t61 + t62)/casadi.if_else(t76, t71, 1)
+    t78 = casadi.fabs(t77)
+    t79 = (t78 >= 1)
+    t80 = casadi.fabs(1/casadi.if_else(t79, t77, 1))
+    t81 = casadi.if_else(t76, casadi.if_else((t77 >= 0), 1, -1)*casadi.if_else(t79, t80/(1 + casadi.sqrt(1 + t80**2)), 1/(t78 + casadi.sqrt(1 + t78**2))), 0)
+    t82 = 1/casadi.sqrt(1 + t81**2)
+    t83 = t71*t81
+    t84 = -t83 + t61
+    t85 = t62 + t83
+    t86 = t65*t82
+    t87 = t66*t82
+    t88 = t86 + t81*t87
+    t89 = t87 - t81*t86
+    t90 = t69*t82
+    t91 = t70*t82
+    t92 = t90 - t81*t91
+    t93 = t91 + t81*t90
+    t94 = -t88*t89 + t92*t93
+    t95 = t74*t82
+    t96 = t75*t82
+    t97 = t95 - t81*t96
+    t98 = t96 + t81*t95
+    t99 = (t94 != 0)
+    t100 = 0.5*(-t84 + t85)/casadi.if_else(t99, t94, 1)
+    t101 = casadi.fabs(t100)
+    t102 = (t101 >= 1)
+    t103 = casadi.fabs(1/casadi.if_else(t102, t100, 1))
+    t104 = casadi.if_else(t99, casadi.if_else((t100 >= 0), 1, -1)*casadi.if_else(t102, t103/(1 + casadi.sqrt(1 + t103**2)), 1/(t101 + casadi.sqrt(1 + t101**2))), 0)
+    t105 = 1/casadi.sqrt(1 + t104**2)
+    t106 = t88*t105
+    t107 = t89*t105
+    t108 = t106 + t104*t107
+    t109 = t107 - t104*t106
+    t110 = t92*t105
+    t111 = t93*t105
+    t112 = t110 - t104*t111
+    t113 = t111 + t104*t110
+    t114 = casadi.sqrt(t108**2 + t112**2)
+    t115 = casadi.sqrt(t109**2 + t113**2)
+    t116 = t97*t105
+    t117 = t98*t105
+    t118 = t116 - t104*t117
+    t119 = t117 + t104*t116
+    t120 = (t114 < t115)
+    t121 = casadi.if_else(t120, t115, t114)
+    t122 = casadi.if_else(t120, t114, t115)
+    t123 = casadi.if_else(t120, t119, t118)
+    t124 = casadi.if_else(t120, t118, t119)
+    t125 = -t119
+    t126 = casadi.if_else(t120, t118, t125)
+    t127 = casadi.if_else(t120, t125, t118)
+    t128 = (t122 < 0)
+    t129 = casadi.if_else(t128, 0, t122)
+    t130 = casadi.if_else(t128, t122, 0)
+    t131 = casadi.if_else(t128, 0, t124)
+    t132 = casadi.if_else(t128, 0, t127)
+    t133 = casadi.if_else(t128, 1, 0)
+    t134 = casadi.if_else(t128, t124, 0)
+    t135 = casadi.if_else(t128, t127, 0)
+    t136 = casadi.if_else(t128, 0, 1)
+    t137 = (t121 < t129)
+    t138 = casadi.if_else(t137, t129, t121)
+    t139 = casadi.if_else(t137, t121, t129)
+    t140 = casadi.if_else(t137, t131, t123)
+    t141 = casadi.if_else(t137, t132, t126)
+    t142 = casadi.if_else(t137, t133, 0)
+    t143 = casadi.if_else(t137, t123, t131)
+    t144 = casadi.if_else(t137, t126, t132)
+    t145 = casadi.if_else(t137, 0, t133)
+    t146 = t140*(t136*t144 - t135*t145) - t141*(t136*t143 - t134*t145) + t142*(t135*t143 - t134*t144)
+    t147 = casadi.if_else((t146 < 0), -1, 1)
+    t148 = t134*t147
+    t149 = t135*t147
+    t150 = t136*t147
     U_v = casadi.SX(3, 3)
-    U_v[0, 0] = t125
-    U_v[0, 1] = t128
-    U_v[0, 2] = t133
-    U_v[1, 0] = t126
-    U_v[1, 1] = t129
-    U_v[1, 2] = t134
-    U_v[2, 0] = t127
-    U_v[2, 1] = t130
-    U_v[2, 2] = t135
+    U_v[0, 0] = t140
+    U_v[0, 1] = t143
+    U_v[0, 2] = t148
+    U_v[1, 0] = t141
+    U_v[1, 1] = t144
+    U_v[1, 2] = t149
+    U_v[2, 0] = t142
+    U_v[2, 1] = t145
+    U_v[2, 2] = t150
     s_v = casadi.SX(3, 1)
-    s_v[0, 0] = t123
-    s_v[1, 0] = t124
-    s_v[2, 0] = t115
+    s_v[0, 0] = t138
+    s_v[1, 0] = t139
+    s_v[2, 0] = t130
     U_w = casadi.SX(3, 3)
     U_w[0, 1] = 1
     U_w[1, 2] = 1
@@ -604,7 +621,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 87 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 99 operations."""
     q1 = q[0]
     q2 = q[1]
     c1 = casadi.cos(q1)
@@ -630,20 +647,23 @@ def _condition_number(q):
     t14 = t7*t10
     t15 = (t14 != 0)
     t16 = 0.5*(-t13 + t11)/casadi.if_else(t15, -t14, 1)
-    t17 = casadi.if_else(t15, casadi.if_else((t16 >= 0), 1, -1)/(casadi.fabs(t16) + casadi.sqrt(1 + t16**2)), 0)
-    t18 = t17**2
-    t19 = 1/casadi.sqrt(1 + t18)
-    t20 = t7*t19
-    t21 = t10*t19
-    t22 = t20 + t21*t17
-    t23 = -t21 + t20*t17
-    t24 = t12*t19**2
-    t25 = casadi.sqrt(t24 + t22**2)
-    t26 = casadi.sqrt(t23**2 + t18*t24)
-    t27 = casadi.if_else((t26 > t25), t26, t25)
-    t28 = casadi.if_else((t26 < t25), t26, t25)
+    t17 = casadi.fabs(t16)
+    t18 = (t17 >= 1)
+    t19 = casadi.fabs(1/casadi.if_else(t18, t16, 1))
+    t20 = casadi.if_else(t15, casadi.if_else((t16 >= 0), 1, -1)*casadi.if_else(t18, t19/(1 + casadi.sqrt(1 + t19**2)), 1/(t17 + casadi.sqrt(1 + t17**2))), 0)
+    t21 = t20**2
+    t22 = 1/casadi.sqrt(1 + t21)
+    t23 = t7*t22
+    t24 = t10*t22
+    t25 = t23 + t24*t20
+    t26 = -t24 + t23*t20
+    t27 = t12*t22**2
+    t28 = casadi.sqrt(t27 + t25**2)
+    t29 = casadi.sqrt(t26**2 + t21*t27)
+    t30 = casadi.if_else((t29 > t28), t29, t28)
+    t31 = casadi.if_else((t29 < t28), t29, t28)
     kappa = casadi.SX(1, 1)
-    kappa[0, 0] = casadi.if_else((t27 > 0), t27, 1)/casadi.if_else((t28 <= 1e-12*t27), 0, t28)
+    kappa[0, 0] = casadi.if_else((t30 > 0), t30, 1)/casadi.if_else((t31 <= 1e-12*t30), 0, t31)
     return [kappa]
 
 

@@ -787,7 +787,7 @@ def jacobian_det(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def manipulability_gradient(q):
-    """d manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): (3 x 1), 209 operations."""
+    """d manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): (3 x 1), 207 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (3,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -819,63 +819,66 @@ def manipulability_gradient(q):
     t16 = 1 + t1*t14
     t17 = 1 + s123*t14
     t18 = 1 - t8**2*t9
-    t19 = t13**2
-    t20 = xp.sqrt(t19 + t12**2)
-    t21 = t20*xp.where(xp.greater_equal(t12, 0), xp.asarray(1, dtype=dtype), -1)
-    t22 = t12 + t21
-    t23 = xp.where(xp.greater(t20, 0), 1/(t20*(t20 + xp.abs(t12))), 0)
-    t24 = t23*(t16*t22 + t13*t17)
-    t25 = t16 - t22*t24
-    t26 = t17 - t13*t24
-    t27 = 1 - t22**2*t23
-    t28 = -(t11*t25 + t15*t21)
-    t29 = xp.abs(t26)
-    t30 = t29*xp.where(xp.greater_equal(t26, 0), xp.asarray(1, dtype=dtype), -1)
-    t31 = t26 + t30
-    t32 = xp.where(xp.greater(t29, 0), 1/(t29*2*t29), 0)
-    t33 = 1 - t31**2*t32
-    t34 = t23*t33
-    t35 = t33 - t19*t34
-    t36 = t13*t22
-    t37 = t23*t36
-    t38 = t9*(-t1*t27 + s123*t37)
-    t39 = t27 + t1*t38
-    t40 = -t37 + s123*t38
-    t41 = t34*t36
-    t42 = t9*(-s123*t35 + t1*t41)
-    t43 = -t41 + t1*t42
-    t44 = t35 + s123*t42
-    t45 = t21*t30
-    t46 = t8*t30*t38
-    t47 = t8*t42
-    t48 = t18*t45 - t11*t46 + t28*t47
-    t49 = t7*t25
-    t50 = t7*t46 + t47*t49
-    t51 = t8*t9*t45
-    t52 = t30*t39
-    t53 = -t43*t28 + t1*t51 + t11*t52
-    t54 = t7*t52 + t43*t49
-    t55 = t30*t40
-    t56 = -t44*t28 + s123*t51 + t11*t55
-    t57 = t7*t55 + t44*t49
-    t58 = 1e-12*t5
-    t59 = xp.where(xp.less_equal(t6, t58) | xp.less_equal(t20, t58) | xp.less_equal(t29, t58), 0, xp.where(xp.less(t7, 0), 1, xp.where(xp.greater(t7, 0), xp.asarray(-1, dtype=dtype), 0))*xp.where(xp.less(t21, 0), 1, xp.where(xp.greater(t21, 0), xp.asarray(-1, dtype=dtype), 0))*xp.where(xp.less(t30, 0), 1, xp.where(xp.greater(t30, 0), xp.asarray(-1, dtype=dtype), 0)))
-    t60 = c123*t56 + s123*t57
-    t61 = -t59*(c123*t48 + c123*t53 + s123*t54 + t60 - s123*t50)
-    t62 = t0*t53 + t1*t54 + t60
-    t63 = -t59*(t2*t48 + t62 - t3*t50)
-    t64 = -t59*(t0*t48 + t62 - t1*t50)
+    t19 = xp.where(xp.greater(t7, 0), xp.asarray(-1, dtype=dtype), 1)
+    t20 = t13**2
+    t21 = xp.sqrt(t20 + t12**2)
+    t22 = t21*xp.where(xp.greater_equal(t12, 0), xp.asarray(1, dtype=dtype), -1)
+    t23 = t12 + t22
+    t24 = xp.where(xp.greater(t21, 0), 1/(t21*(t21 + xp.abs(t12))), 0)
+    t25 = t24*(t16*t23 + t13*t17)
+    t26 = t16 - t23*t25
+    t27 = t17 - t13*t25
+    t28 = 1 - t23**2*t24
+    t29 = -(t11*t26 + t15*t22)
+    t30 = xp.where(xp.greater(t22, 0), -t19, t19)
+    t31 = xp.abs(t27)
+    t32 = t31*xp.where(xp.greater_equal(t27, 0), xp.asarray(1, dtype=dtype), -1)
+    t33 = t27 + t32
+    t34 = xp.where(xp.greater(t31, 0), 1/(t31*2*t31), 0)
+    t35 = 1 - t33**2*t34
+    t36 = xp.where(xp.greater(t32, 0), -t30, t30)
+    t37 = t24*t35
+    t38 = t35 - t20*t37
+    t39 = t13*t23
+    t40 = t24*t39
+    t41 = t9*(-t1*t28 + s123*t40)
+    t42 = t28 + t1*t41
+    t43 = -t40 + s123*t41
+    t44 = t37*t39
+    t45 = t9*(-s123*t38 + t1*t44)
+    t46 = -t44 + t1*t45
+    t47 = t38 + s123*t45
+    t48 = t22*t32
+    t49 = t8*t32*t41
+    t50 = t8*t45
+    t51 = t18*t48 - t11*t49 + t29*t50
+    t52 = t7*t26
+    t53 = t7*t49 + t50*t52
+    t54 = t8*t9*t48
+    t55 = t32*t42
+    t56 = -t46*t29 + t1*t54 + t11*t55
+    t57 = t7*t55 + t46*t52
+    t58 = t32*t43
+    t59 = -t47*t29 + s123*t54 + t11*t58
+    t60 = t7*t58 + t47*t52
+    t61 = 1e-12*t5
+    t62 = xp.where(xp.less_equal(t6, t61) | xp.less_equal(t21, t61) | xp.less_equal(t31, t61), 0, t36)
+    t63 = c123*t59 + s123*t60
+    t64 = -t62*(c123*t51 + c123*t56 + s123*t57 + t63 - s123*t53)
+    t65 = t0*t56 + t1*t57 + t63
+    t66 = -t62*(t2*t51 + t65 - t3*t53)
+    t67 = -t62*(t0*t51 + t65 - t1*t53)
     dw = _stack(xp, [
-        t63,  # 0
-        t64,  # 1
-        t61,  # 2
+        t66,  # 0
+        t67,  # 1
+        t64,  # 2
     ], (3,))
     return dw
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ellipsoid(q):
-    """axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: (3 x 3 and 3 x 1 and 3 x 3 and 3 x 1), 325 operations."""
+    """axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: (3 x 3 and 3 x 1 and 3 x 3 and 3 x 1), 385 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (3,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -908,140 +911,155 @@ def velocity_ellipsoid(q):
     t17 = t5*t9
     t18 = xp.not_equal(t17, 0)
     t19 = 0.5*(-t14 + t16)/xp.where(t18, -t17, 1)
-    t20 = xp.where(t18, xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t19) + xp.sqrt(1 + t19**2)), 0)
-    t21 = 1/xp.sqrt(1 + t20**2)
-    t22 = t17*t20
-    t23 = t22 + t14
-    t24 = -t22 + t16
-    t25 = t5*t21
-    t26 = t9*t21
-    t27 = t25 + t26*t20
-    t28 = t26 - t25*t20
-    t29 = t27*t28 + t15*t20*t21**2
-    t30 = xp.not_equal(t29, 0)
-    t31 = 0.5*(-t23 + t24)/xp.where(t30, -t29, 1)
-    t32 = xp.where(t30, xp.where(xp.greater_equal(t31, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t31) + xp.sqrt(1 + t31**2)), 0)
-    t33 = 1/xp.sqrt(1 + t32**2)
-    t34 = t29*t32
-    t35 = t34 + t23
-    t36 = -t34 + t24
-    t37 = t27*t33
-    t38 = t28*t33
-    t39 = t37 + t38*t32
-    t40 = t38 - t37*t32
-    t41 = t21*t33
-    t42 = t13*t41
-    t43 = t42*t20
-    t44 = t43 + t42*t32
-    t45 = -t42 + t43*t32
-    t46 = -t39*t40 + t44*t45
-    t47 = t41*t20
-    t48 = t41 - t47*t32
-    t49 = t47 + t41*t32
-    t50 = xp.not_equal(t46, 0)
-    t51 = 0.5*(-t35 + t36)/xp.where(t50, t46, 1)
-    t52 = xp.where(t50, xp.where(xp.greater_equal(t51, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t51) + xp.sqrt(1 + t51**2)), 0)
-    t53 = 1/xp.sqrt(1 + t52**2)
-    t54 = t46*t52
-    t55 = -t54 + t35
-    t56 = t54 + t36
-    t57 = t39*t53
-    t58 = t40*t53
-    t59 = t57 + t52*t58
-    t60 = t58 - t57*t52
-    t61 = t44*t53
-    t62 = t45*t53
-    t63 = t61 - t52*t62
-    t64 = t62 + t52*t61
-    t65 = -t59*t60 + t63*t64
-    t66 = t48*t53
-    t67 = t49*t53
-    t68 = t66 - t52*t67
-    t69 = t67 + t52*t66
-    t70 = xp.not_equal(t65, 0)
-    t71 = 0.5*(-t55 + t56)/xp.where(t70, t65, 1)
-    t72 = xp.where(t70, xp.where(xp.greater_equal(t71, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t71) + xp.sqrt(1 + t71**2)), 0)
-    t73 = 1/xp.sqrt(1 + t72**2)
-    t74 = t65*t72
-    t75 = -t74 + t55
-    t76 = t56 + t74
-    t77 = t59*t73
-    t78 = t60*t73
-    t79 = t77 + t72*t78
-    t80 = t78 - t72*t77
-    t81 = t63*t73
-    t82 = t64*t73
-    t83 = t81 - t72*t82
-    t84 = t82 + t72*t81
-    t85 = -t79*t80 + t83*t84
-    t86 = t68*t73
-    t87 = t69*t73
-    t88 = t86 - t72*t87
-    t89 = t87 + t72*t86
-    t90 = xp.not_equal(t85, 0)
-    t91 = 0.5*(-t75 + t76)/xp.where(t90, t85, 1)
-    t92 = xp.where(t90, xp.where(xp.greater_equal(t91, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t91) + xp.sqrt(1 + t91**2)), 0)
-    t93 = 1/xp.sqrt(1 + t92**2)
-    t94 = t79*t93
-    t95 = t80*t93
-    t96 = t94 + t92*t95
-    t97 = t95 - t92*t94
-    t98 = t83*t93
-    t99 = t84*t93
-    t100 = t98 - t92*t99
-    t101 = t99 + t92*t98
-    t102 = xp.sqrt(t96**2 + t100**2)
-    t103 = xp.sqrt(t97**2 + t101**2)
-    t104 = t88*t93
-    t105 = t89*t93
-    t106 = t104 - t92*t105
-    t107 = t105 + t92*t104
-    t108 = xp.less(t102, t103)
-    t109 = xp.where(t108, t103, t102)
-    t110 = xp.where(t108, t102, t103)
-    t111 = xp.where(t108, t107, t106)
-    t112 = xp.where(t108, t106, t107)
-    t113 = -t107
-    t114 = xp.where(t108, t106, t113)
-    t115 = xp.where(t108, t113, t106)
-    t116 = xp.less(t110, 0)
-    t117 = xp.where(t116, 0, t110)
-    t118 = xp.where(t116, t110, 0)
-    t119 = xp.where(t116, 0, t112)
-    t120 = xp.where(t116, 0, t115)
-    t121 = xp.where(t116, xp.asarray(1, dtype=dtype), 0)
-    t122 = xp.where(t116, t112, 0)
-    t123 = xp.where(t116, t115, 0)
-    t124 = xp.where(t116, xp.asarray(0, dtype=dtype), 1)
-    t125 = xp.less(t109, t117)
-    t126 = xp.where(t125, t117, t109)
-    t127 = xp.where(t125, t109, t117)
-    t128 = xp.where(t125, t119, t111)
-    t129 = xp.where(t125, t120, t114)
-    t130 = xp.where(t125, t121, 0)
-    t131 = xp.where(t125, t111, t119)
-    t132 = xp.where(t125, t114, t120)
-    t133 = xp.where(t125, 0, t121)
-    t134 = t128*(t124*t132 - t123*t133) - t129*(t124*t131 - t122*t133) + t130*(t123*t131 - t122*t132)
-    t135 = xp.where(xp.less(t134, 0), xp.asarray(-1, dtype=dtype), 1)
-    t136 = t122*t135
-    t137 = t123*t135
-    t138 = t124*t135
+    t20 = xp.abs(t19)
+    t21 = xp.greater_equal(t20, 1)
+    t22 = xp.abs(1/xp.where(t21, t19, 1))
+    t23 = xp.where(t18, xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t21, t22/(1 + xp.sqrt(1 + t22**2)), 1/(t20 + xp.sqrt(1 + t20**2))), 0)
+    t24 = 1/xp.sqrt(1 + t23**2)
+    t25 = t17*t23
+    t26 = t25 + t14
+    t27 = -t25 + t16
+    t28 = t5*t24
+    t29 = t9*t24
+    t30 = t28 + t29*t23
+    t31 = t29 - t28*t23
+    t32 = t30*t31 + t15*t23*t24**2
+    t33 = xp.not_equal(t32, 0)
+    t34 = 0.5*(-t26 + t27)/xp.where(t33, -t32, 1)
+    t35 = xp.abs(t34)
+    t36 = xp.greater_equal(t35, 1)
+    t37 = xp.abs(1/xp.where(t36, t34, 1))
+    t38 = xp.where(t33, xp.where(xp.greater_equal(t34, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t36, t37/(1 + xp.sqrt(1 + t37**2)), 1/(t35 + xp.sqrt(1 + t35**2))), 0)
+    t39 = 1/xp.sqrt(1 + t38**2)
+    t40 = t32*t38
+    t41 = t40 + t26
+    t42 = -t40 + t27
+    t43 = t30*t39
+    t44 = t31*t39
+    t45 = t43 + t44*t38
+    t46 = t44 - t43*t38
+    t47 = t24*t39
+    t48 = t13*t47
+    t49 = t48*t23
+    t50 = t49 + t48*t38
+    t51 = -t48 + t49*t38
+    t52 = -t45*t46 + t50*t51
+    t53 = t47*t23
+    t54 = t47 - t38*t53
+    t55 = t53 + t47*t38
+    t56 = xp.not_equal(t52, 0)
+    t57 = 0.5*(-t41 + t42)/xp.where(t56, t52, 1)
+    t58 = xp.abs(t57)
+    t59 = xp.greater_equal(t58, 1)
+    t60 = xp.abs(1/xp.where(t59, t57, 1))
+    t61 = xp.where(t56, xp.where(xp.greater_equal(t57, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t59, t60/(1 + xp.sqrt(1 + t60**2)), 1/(t58 + xp.sqrt(1 + t58**2))), 0)
+    t62 = 1/xp.sqrt(1 + t61**2)
+    t63 = t52*t61
+    t64 = -t63 + t41
+    t65 = t42 + t63
+    t66 = t45*t62
+    t67 = t46*t62
+    t68 = t66 + t61*t67
+    t69 = t67 - t61*t66
+    t70 = t50*t62
+    t71 = t51*t62
+    t72 = t70 - t61*t71
+    t73 = t71 + t61*t70
+    t74 = -t68*t69 + t72*t73
+    t75 = t54*t62
+    t76 = t55*t62
+    t77 = t75 - t61*t76
+    t78 = t76 + t61*t75
+    t79 = xp.not_equal(t74, 0)
+    t80 = 0.5*(-t64 + t65)/xp.where(t79, t74, 1)
+    t81 = xp.abs(t80)
+    t82 = xp.greater_equal(t81, 1)
+    t83 = xp.abs(1/xp.where(t82, t80, 1))
+    t84 = xp.where(t79, xp.where(xp.greater_equal(t80, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t82, t83/(1 + xp.sqrt(1 + t83**2)), 1/(t81 + xp.sqrt(1 + t81**2))), 0)
+    t85 = 1/xp.sqrt(1 + t84**2)
+    t86 = t74*t84
+    t87 = -t86 + t64
+    t88 = t65 + t86
+    t89 = t68*t85
+    t90 = t69*t85
+    t91 = t89 + t84*t90
+    t92 = t90 - t84*t89
+    t93 = t72*t85
+    t94 = t73*t85
+    t95 = t93 - t84*t94
+    t96 = t94 + t84*t93
+    t97 = -t91*t92 + t95*t96
+    t98 = t77*t85
+    t99 = t78*t85
+    t100 = t98 - t84*t99
+    t101 = t99 + t84*t98
+    t102 = xp.not_equal(t97, 0)
+    t103 = 0.5*(-t87 + t88)/xp.where(t102, t97, 1)
+    t104 = xp.abs(t103)
+    t105 = xp.greater_equal(t104, 1)
+    t106 = xp.abs(1/xp.where(t105, t103, 1))
+    t107 = xp.where(t102, xp.where(xp.greater_equal(t103, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t105, t106/(1 + xp.sqrt(1 + t106**2)), 1/(t104 + xp.sqrt(1 + t104**2))), 0)
+    t108 = 1/xp.sqrt(1 + t107**2)
+    t109 = t91*t108
+    t110 = t92*t108
+    t111 = t109 + t107*t110
+    t112 = t110 - t107*t109
+    t113 = t95*t108
+    t114 = t96*t108
+    t115 = t113 - t107*t114
+    t116 = t114 + t107*t113
+    t117 = xp.sqrt(t111**2 + t115**2)
+    t118 = xp.sqrt(t112**2 + t116**2)
+    t119 = t100*t108
+    t120 = t101*t108
+    t121 = t119 - t107*t120
+    t122 = t120 + t107*t119
+    t123 = xp.less(t117, t118)
+    t124 = xp.where(t123, t118, t117)
+    t125 = xp.where(t123, t117, t118)
+    t126 = xp.where(t123, t122, t121)
+    t127 = xp.where(t123, t121, t122)
+    t128 = -t122
+    t129 = xp.where(t123, t121, t128)
+    t130 = xp.where(t123, t128, t121)
+    t131 = xp.less(t125, 0)
+    t132 = xp.where(t131, 0, t125)
+    t133 = xp.where(t131, t125, 0)
+    t134 = xp.where(t131, 0, t127)
+    t135 = xp.where(t131, 0, t130)
+    t136 = xp.where(t131, xp.asarray(1, dtype=dtype), 0)
+    t137 = xp.where(t131, t127, 0)
+    t138 = xp.where(t131, t130, 0)
+    t139 = xp.where(t131, xp.asarray(0, dtype=dtype), 1)
+    t140 = xp.less(t124, t132)
+    t141 = xp.where(t140, t132, t124)
+    t142 = xp.where(t140, t124, t132)
+    t143 = xp.where(t140, t134, t126)
+    t144 = xp.where(t140, t135, t129)
+    t145 = xp.where(t140, t136, 0)
+    t146 = xp.where(t140, t126, t134)
+    t147 = xp.where(t140, t129, t135)
+    t148 = xp.where(t140, 0, t136)
+    t149 = t143*(t139*t147 - t138*t148) - t144*(t139*t146 - t137*t148) + t145*(t138*t146 - t137*t147)
+    t150 = xp.where(xp.less(t149, 0), xp.asarray(-1, dtype=dtype), 1)
+    t151 = t137*t150
+    t152 = t138*t150
+    t153 = t139*t150
     U_v = _stack(xp, [
-        t128,  # 0, 0
-        t131,  # 0, 1
-        t136,  # 0, 2
-        t129,  # 1, 0
-        t132,  # 1, 1
-        t137,  # 1, 2
-        t130,  # 2, 0
-        t133,  # 2, 1
-        t138,  # 2, 2
+        t143,  # 0, 0
+        t146,  # 0, 1
+        t151,  # 0, 2
+        t144,  # 1, 0
+        t147,  # 1, 1
+        t152,  # 1, 2
+        t145,  # 2, 0
+        t148,  # 2, 1
+        t153,  # 2, 2
     ], (3, 3))
     s_v = _stack(xp, [
-        t126,  # 0
-        t127,  # 1
-        t118,  # 2
+        t141,  # 0
+        t142,  # 1
+        t133,  # 2
     ], (3,))
     U_w = _stack(xp, [
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 0
@@ -1064,7 +1082,7 @@ def velocity_ellipsoid(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def condition_number(q):
-    """sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): (1 x 1), 810 operations."""
+    """sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): (1 x 1), 990 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (3,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -1113,300 +1131,345 @@ def condition_number(q):
     t33 = t32 + t11**2 + t17**2
     t34 = xp.not_equal(t31, 0)
     t35 = 0.5*(-t33 + t29)/xp.where(t34, t31, 1)
-    t36 = xp.where(t34, xp.where(xp.greater_equal(t35, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t35) + xp.sqrt(1 + t35**2)), 0)
-    t37 = 1/xp.sqrt(1 + t36**2)
-    t38 = t31*t36
-    t39 = -t38 + t33
-    t40 = t38 + t29
-    t41 = t11*t37
-    t42 = t21*t37
-    t43 = t41 + t42*t36
-    t44 = -t42 + t41*t36
-    t45 = t17*t37
-    t46 = t25*t37
-    t47 = t45 - t46*t36
-    t48 = t46 + t45*t36
-    t49 = t28*t47
-    t50 = xp.not_equal(t49, 0)
-    t51 = 0.5*(-t39 + t30)/xp.where(t50, -t49, 1)
-    t52 = xp.where(t50, xp.where(xp.greater_equal(t51, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t51) + xp.sqrt(1 + t51**2)), 0)
-    t53 = 1/xp.sqrt(1 + t52**2)
-    t54 = t49*t52
-    t55 = t54 + t39
-    t56 = -t54 + t30
-    t57 = t47*t53
-    t58 = t28*t53
-    t59 = t57 + t58*t52
-    t60 = -t58 + t57*t52
-    t61 = t52*t53
-    t62 = t43*t53
-    t63 = t62*t52
-    t64 = t48*t60 + t32*t61*t36*t37**2 + t63*t44
-    t65 = xp.not_equal(t64, 0)
-    t66 = 0.5*(-t40 + t56)/xp.where(t65, t64, 1)
-    t67 = xp.where(t65, xp.where(xp.greater_equal(t66, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t66) + xp.sqrt(1 + t66**2)), 0)
-    t68 = 1/xp.sqrt(1 + t67**2)
-    t69 = t64*t67
-    t70 = -t69 + t40
-    t71 = t69 + t56
-    t72 = t8*t37
-    t73 = t72*t68
-    t74 = t73*t36
-    t75 = t61*t73
-    t76 = -t74 + t75*t67
-    t77 = t75 + t74*t67
-    t78 = t44*t68
-    t79 = t63*t68
-    t80 = t78 - t79*t67
-    t81 = t79 + t78*t67
-    t82 = t48*t68
-    t83 = t60*t68
-    t84 = t82 - t83*t67
-    t85 = t83 + t82*t67
-    t86 = t72*t53
-    t87 = t59*t84 - t86*t76 + t62*t80
-    t88 = xp.not_equal(t87, 0)
-    t89 = 0.5*(-t55 + t70)/xp.where(t88, t87, 1)
-    t90 = xp.where(t88, xp.where(xp.greater_equal(t89, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t89) + xp.sqrt(1 + t89**2)), 0)
-    t91 = 1/xp.sqrt(1 + t90**2)
-    t92 = t87*t90
-    t93 = -t92 + t55
-    t94 = t92 + t70
-    t95 = t86*t91
-    t96 = t76*t91
-    t97 = t95 + t96*t90
-    t98 = t96 - t95*t90
-    t99 = t62*t91
-    t100 = t80*t91
-    t101 = t99 - t100*t90
-    t102 = t100 + t99*t90
-    t103 = t59*t91
-    t104 = t84*t91
-    t105 = t103 - t104*t90
-    t106 = t104 + t103*t90
-    t107 = t77*t97 + t81*t101 + t85*t105
-    t108 = xp.not_equal(t107, 0)
-    t109 = 0.5*(-t93 + t71)/xp.where(t108, t107, 1)
-    t110 = xp.where(t108, xp.where(xp.greater_equal(t109, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t109) + xp.sqrt(1 + t109**2)), 0)
-    t111 = 1/xp.sqrt(1 + t110**2)
-    t112 = t107*t110
-    t113 = -t112 + t93
-    t114 = t112 + t71
-    t115 = t97*t111
-    t116 = t77*t111
-    t117 = -t115 + t116*t110
-    t118 = t116 + t115*t110
-    t119 = t101*t111
-    t120 = t81*t111
-    t121 = t119 - t110*t120
-    t122 = t120 + t110*t119
-    t123 = t105*t111
-    t124 = t85*t111
-    t125 = t123 - t110*t124
-    t126 = t124 + t110*t123
-    t127 = -t98*t118 + t102*t122 + t106*t126
-    t128 = xp.not_equal(t127, 0)
-    t129 = 0.5*(-t94 + t114)/xp.where(t128, t127, 1)
-    t130 = xp.where(t128, xp.where(xp.greater_equal(t129, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t129) + xp.sqrt(1 + t129**2)), 0)
-    t131 = 1/xp.sqrt(1 + t130**2)
-    t132 = t127*t130
-    t133 = -t132 + t94
-    t134 = t114 + t132
-    t135 = t98*t131
-    t136 = t118*t131
-    t137 = t135 + t130*t136
-    t138 = -t136 + t130*t135
-    t139 = t102*t131
-    t140 = t122*t131
-    t141 = t139 - t130*t140
-    t142 = t140 + t130*t139
-    t143 = t106*t131
-    t144 = t126*t131
-    t145 = t143 - t130*t144
-    t146 = t144 + t130*t143
-    t147 = t117*t137 + t121*t141 + t125*t145
-    t148 = xp.not_equal(t147, 0)
-    t149 = 0.5*(-t113 + t133)/xp.where(t148, t147, 1)
-    t150 = xp.where(t148, xp.where(xp.greater_equal(t149, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t149) + xp.sqrt(1 + t149**2)), 0)
-    t151 = 1/xp.sqrt(1 + t150**2)
-    t152 = t147*t150
-    t153 = -t152 + t113
-    t154 = t133 + t152
-    t155 = t117*t151
-    t156 = t137*t151
-    t157 = t155 - t150*t156
-    t158 = t156 + t150*t155
-    t159 = t121*t151
-    t160 = t141*t151
-    t161 = t159 - t150*t160
-    t162 = t160 + t150*t159
-    t163 = t125*t151
-    t164 = t145*t151
-    t165 = t163 - t150*t164
-    t166 = t164 + t150*t163
-    t167 = t138*t157 + t142*t161 + t146*t165
-    t168 = xp.not_equal(t167, 0)
-    t169 = 0.5*(-t153 + t134)/xp.where(t168, t167, 1)
-    t170 = xp.where(t168, xp.where(xp.greater_equal(t169, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t169) + xp.sqrt(1 + t169**2)), 0)
-    t171 = 1/xp.sqrt(1 + t170**2)
-    t172 = t167*t170
-    t173 = -t172 + t153
-    t174 = t134 + t172
-    t175 = t157*t171
-    t176 = t138*t171
-    t177 = t175 - t170*t176
-    t178 = t176 + t170*t175
-    t179 = t161*t171
-    t180 = t142*t171
-    t181 = t179 - t170*t180
-    t182 = t180 + t170*t179
-    t183 = t165*t171
-    t184 = t146*t171
-    t185 = t183 - t170*t184
-    t186 = t184 + t170*t183
-    t187 = t158*t178 + t162*t182 + t166*t186
-    t188 = xp.not_equal(t187, 0)
-    t189 = 0.5*(-t154 + t174)/xp.where(t188, t187, 1)
-    t190 = xp.where(t188, xp.where(xp.greater_equal(t189, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t189) + xp.sqrt(1 + t189**2)), 0)
-    t191 = 1/xp.sqrt(1 + t190**2)
-    t192 = t187*t190
-    t193 = -t192 + t154
-    t194 = t174 + t192
-    t195 = t158*t191
-    t196 = t178*t191
-    t197 = t195 - t190*t196
-    t198 = t196 + t190*t195
-    t199 = t162*t191
-    t200 = t182*t191
-    t201 = t199 - t190*t200
-    t202 = t200 + t190*t199
-    t203 = t166*t191
-    t204 = t186*t191
-    t205 = t203 - t190*t204
-    t206 = t204 + t190*t203
-    t207 = t177*t197 + t181*t201 + t185*t205
-    t208 = xp.not_equal(t207, 0)
-    t209 = 0.5*(-t173 + t193)/xp.where(t208, t207, 1)
-    t210 = xp.where(t208, xp.where(xp.greater_equal(t209, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t209) + xp.sqrt(1 + t209**2)), 0)
-    t211 = 1/xp.sqrt(1 + t210**2)
-    t212 = t207*t210
-    t213 = -t212 + t173
-    t214 = t193 + t212
-    t215 = t177*t211
-    t216 = t197*t211
-    t217 = t215 - t210*t216
-    t218 = t216 + t210*t215
-    t219 = t181*t211
-    t220 = t201*t211
-    t221 = t219 - t210*t220
-    t222 = t220 + t210*t219
-    t223 = t185*t211
-    t224 = t205*t211
-    t225 = t223 - t210*t224
-    t226 = t224 + t210*t223
-    t227 = t198*t217 + t202*t221 + t206*t225
-    t228 = xp.not_equal(t227, 0)
-    t229 = 0.5*(-t213 + t194)/xp.where(t228, t227, 1)
-    t230 = xp.where(t228, xp.where(xp.greater_equal(t229, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t229) + xp.sqrt(1 + t229**2)), 0)
-    t231 = 1/xp.sqrt(1 + t230**2)
-    t232 = t227*t230
-    t233 = -t232 + t213
-    t234 = t194 + t232
-    t235 = t217*t231
-    t236 = t198*t231
-    t237 = t235 - t230*t236
-    t238 = t236 + t230*t235
-    t239 = t221*t231
-    t240 = t202*t231
-    t241 = t239 - t230*t240
-    t242 = t240 + t230*t239
-    t243 = t225*t231
-    t244 = t206*t231
-    t245 = t243 - t230*t244
-    t246 = t244 + t230*t243
-    t247 = t218*t238 + t222*t242 + t226*t246
-    t248 = xp.not_equal(t247, 0)
-    t249 = 0.5*(-t214 + t234)/xp.where(t248, t247, 1)
-    t250 = xp.where(t248, xp.where(xp.greater_equal(t249, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t249) + xp.sqrt(1 + t249**2)), 0)
-    t251 = 1/xp.sqrt(1 + t250**2)
-    t252 = t247*t250
-    t253 = -t252 + t214
-    t254 = t234 + t252
-    t255 = t218*t251
-    t256 = t238*t251
-    t257 = t255 - t250*t256
-    t258 = t256 + t250*t255
-    t259 = t222*t251
-    t260 = t242*t251
-    t261 = t259 - t250*t260
-    t262 = t260 + t250*t259
-    t263 = t226*t251
-    t264 = t246*t251
-    t265 = t263 - t250*t264
-    t266 = t264 + t250*t263
-    t267 = t237*t257 + t241*t261 + t245*t265
-    t268 = xp.not_equal(t267, 0)
-    t269 = 0.5*(-t233 + t253)/xp.where(t268, t267, 1)
-    t270 = xp.where(t268, xp.where(xp.greater_equal(t269, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t269) + xp.sqrt(1 + t269**2)), 0)
-    t271 = 1/xp.sqrt(1 + t270**2)
-    t272 = t267*t270
-    t273 = -t272 + t233
-    t274 = t253 + t272
-    t275 = t237*t271
-    t276 = t257*t271
-    t277 = t275 - t270*t276
-    t278 = t276 + t270*t275
-    t279 = t241*t271
-    t280 = t261*t271
-    t281 = t279 - t270*t280
-    t282 = t280 + t270*t279
-    t283 = t245*t271
-    t284 = t265*t271
-    t285 = t283 - t270*t284
-    t286 = t284 + t270*t283
-    t287 = t258*t277 + t262*t281 + t266*t285
-    t288 = xp.not_equal(t287, 0)
-    t289 = 0.5*(-t273 + t254)/xp.where(t288, t287, 1)
-    t290 = xp.where(t288, xp.where(xp.greater_equal(t289, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t289) + xp.sqrt(1 + t289**2)), 0)
-    t291 = 1/xp.sqrt(1 + t290**2)
-    t292 = t254 + t287*t290
-    t293 = t277*t291
-    t294 = t258*t291
-    t295 = t293 - t290*t294
-    t296 = t294 + t290*t293
-    t297 = t281*t291
-    t298 = t262*t291
-    t299 = t297 - t290*t298
-    t300 = t298 + t290*t297
-    t301 = t285*t291
-    t302 = t266*t291
-    t303 = t301 - t290*t302
-    t304 = t302 + t290*t301
-    t305 = t278*t296 + t282*t300 + t286*t304
-    t306 = xp.sqrt(t295**2 + t299**2 + t303**2)
-    t307 = xp.not_equal(t305, 0)
-    t308 = 0.5*(-t274 + t292)/xp.where(t307, t305, 1)
-    t309 = xp.where(t307, xp.where(xp.greater_equal(t308, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t308) + xp.sqrt(1 + t308**2)), 0)
+    t36 = xp.abs(t35)
+    t37 = xp.greater_equal(t36, 1)
+    t38 = xp.abs(1/xp.where(t37, t35, 1))
+    t39 = xp.where(t34, xp.where(xp.greater_equal(t35, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t37, t38/(1 + xp.sqrt(1 + t38**2)), 1/(t36 + xp.sqrt(1 + t36**2))), 0)
+    t40 = 1/xp.sqrt(1 + t39**2)
+    t41 = t31*t39
+    t42 = -t41 + t33
+    t43 = t41 + t29
+    t44 = t11*t40
+    t45 = t21*t40
+    t46 = t44 + t45*t39
+    t47 = -t45 + t44*t39
+    t48 = t17*t40
+    t49 = t25*t40
+    t50 = t48 - t49*t39
+    t51 = t49 + t48*t39
+    t52 = t28*t50
+    t53 = xp.not_equal(t52, 0)
+    t54 = 0.5*(-t42 + t30)/xp.where(t53, -t52, 1)
+    t55 = xp.abs(t54)
+    t56 = xp.greater_equal(t55, 1)
+    t57 = xp.abs(1/xp.where(t56, t54, 1))
+    t58 = xp.where(t53, xp.where(xp.greater_equal(t54, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t56, t57/(1 + xp.sqrt(1 + t57**2)), 1/(t55 + xp.sqrt(1 + t55**2))), 0)
+    t59 = 1/xp.sqrt(1 + t58**2)
+    t60 = t52*t58
+    t61 = t60 + t42
+    t62 = -t60 + t30
+    t63 = t50*t59
+    t64 = t28*t59
+    t65 = t63 + t64*t58
+    t66 = -t64 + t63*t58
+    t67 = t58*t59
+    t68 = t46*t59
+    t69 = t68*t58
+    t70 = t51*t66 + t32*t67*t39*t40**2 + t69*t47
+    t71 = xp.not_equal(t70, 0)
+    t72 = 0.5*(-t43 + t62)/xp.where(t71, t70, 1)
+    t73 = xp.abs(t72)
+    t74 = xp.greater_equal(t73, 1)
+    t75 = xp.abs(1/xp.where(t74, t72, 1))
+    t76 = xp.where(t71, xp.where(xp.greater_equal(t72, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t74, t75/(1 + xp.sqrt(1 + t75**2)), 1/(t73 + xp.sqrt(1 + t73**2))), 0)
+    t77 = 1/xp.sqrt(1 + t76**2)
+    t78 = t70*t76
+    t79 = -t78 + t43
+    t80 = t78 + t62
+    t81 = t8*t40
+    t82 = t81*t77
+    t83 = t82*t39
+    t84 = t67*t82
+    t85 = -t83 + t84*t76
+    t86 = t84 + t83*t76
+    t87 = t47*t77
+    t88 = t69*t77
+    t89 = t87 - t88*t76
+    t90 = t88 + t87*t76
+    t91 = t51*t77
+    t92 = t66*t77
+    t93 = t91 - t92*t76
+    t94 = t92 + t91*t76
+    t95 = t81*t59
+    t96 = t65*t93 - t95*t85 + t68*t89
+    t97 = xp.not_equal(t96, 0)
+    t98 = 0.5*(-t61 + t79)/xp.where(t97, t96, 1)
+    t99 = xp.abs(t98)
+    t100 = xp.greater_equal(t99, 1)
+    t101 = xp.abs(1/xp.where(t100, t98, 1))
+    t102 = xp.where(t97, xp.where(xp.greater_equal(t98, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t100, t101/(1 + xp.sqrt(1 + t101**2)), 1/(t99 + xp.sqrt(1 + t99**2))), 0)
+    t103 = 1/xp.sqrt(1 + t102**2)
+    t104 = t96*t102
+    t105 = -t104 + t61
+    t106 = t104 + t79
+    t107 = t95*t103
+    t108 = t85*t103
+    t109 = t107 + t108*t102
+    t110 = t108 - t107*t102
+    t111 = t68*t103
+    t112 = t89*t103
+    t113 = t111 - t112*t102
+    t114 = t112 + t111*t102
+    t115 = t65*t103
+    t116 = t93*t103
+    t117 = t115 - t116*t102
+    t118 = t116 + t115*t102
+    t119 = t86*t109 + t90*t113 + t94*t117
+    t120 = xp.not_equal(t119, 0)
+    t121 = 0.5*(-t105 + t80)/xp.where(t120, t119, 1)
+    t122 = xp.abs(t121)
+    t123 = xp.greater_equal(t122, 1)
+    t124 = xp.abs(1/xp.where(t123, t121, 1))
+    t125 = xp.where(t120, xp.where(xp.greater_equal(t121, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t123, t124/(1 + xp.sqrt(1 + t124**2)), 1/(t122 + xp.sqrt(1 + t122**2))), 0)
+    t126 = 1/xp.sqrt(1 + t125**2)
+    t127 = t119*t125
+    t128 = -t127 + t105
+    t129 = t127 + t80
+    t130 = t109*t126
+    t131 = t86*t126
+    t132 = -t130 + t131*t125
+    t133 = t131 + t130*t125
+    t134 = t113*t126
+    t135 = t90*t126
+    t136 = t134 - t125*t135
+    t137 = t135 + t125*t134
+    t138 = t117*t126
+    t139 = t94*t126
+    t140 = t138 - t125*t139
+    t141 = t139 + t125*t138
+    t142 = -t110*t133 + t114*t137 + t118*t141
+    t143 = xp.not_equal(t142, 0)
+    t144 = 0.5*(-t106 + t129)/xp.where(t143, t142, 1)
+    t145 = xp.abs(t144)
+    t146 = xp.greater_equal(t145, 1)
+    t147 = xp.abs(1/xp.where(t146, t144, 1))
+    t148 = xp.where(t143, xp.where(xp.greater_equal(t144, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t146, t147/(1 + xp.sqrt(1 + t147**2)), 1/(t145 + xp.sqrt(1 + t145**2))), 0)
+    t149 = 1/xp.sqrt(1 + t148**2)
+    t150 = t142*t148
+    t151 = -t150 + t106
+    t152 = t129 + t150
+    t153 = t110*t149
+    t154 = t133*t149
+    t155 = t153 + t148*t154
+    t156 = -t154 + t148*t153
+    t157 = t114*t149
+    t158 = t137*t149
+    t159 = t157 - t148*t158
+    t160 = t158 + t148*t157
+    t161 = t118*t149
+    t162 = t141*t149
+    t163 = t161 - t148*t162
+    t164 = t162 + t148*t161
+    t165 = t132*t155 + t136*t159 + t140*t163
+    t166 = xp.not_equal(t165, 0)
+    t167 = 0.5*(-t128 + t151)/xp.where(t166, t165, 1)
+    t168 = xp.abs(t167)
+    t169 = xp.greater_equal(t168, 1)
+    t170 = xp.abs(1/xp.where(t169, t167, 1))
+    t171 = xp.where(t166, xp.where(xp.greater_equal(t167, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t169, t170/(1 + xp.sqrt(1 + t170**2)), 1/(t168 + xp.sqrt(1 + t168**2))), 0)
+    t172 = 1/xp.sqrt(1 + t171**2)
+    t173 = t165*t171
+    t174 = -t173 + t128
+    t175 = t151 + t173
+    t176 = t132*t172
+    t177 = t155*t172
+    t178 = t176 - t171*t177
+    t179 = t177 + t171*t176
+    t180 = t136*t172
+    t181 = t159*t172
+    t182 = t180 - t171*t181
+    t183 = t181 + t171*t180
+    t184 = t140*t172
+    t185 = t163*t172
+    t186 = t184 - t171*t185
+    t187 = t185 + t171*t184
+    t188 = t156*t178 + t160*t182 + t164*t186
+    t189 = xp.not_equal(t188, 0)
+    t190 = 0.5*(-t174 + t152)/xp.where(t189, t188, 1)
+    t191 = xp.abs(t190)
+    t192 = xp.greater_equal(t191, 1)
+    t193 = xp.abs(1/xp.where(t192, t190, 1))
+    t194 = xp.where(t189, xp.where(xp.greater_equal(t190, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t192, t193/(1 + xp.sqrt(1 + t193**2)), 1/(t191 + xp.sqrt(1 + t191**2))), 0)
+    t195 = 1/xp.sqrt(1 + t194**2)
+    t196 = t188*t194
+    t197 = -t196 + t174
+    t198 = t152 + t196
+    t199 = t178*t195
+    t200 = t156*t195
+    t201 = t199 - t194*t200
+    t202 = t200 + t194*t199
+    t203 = t182*t195
+    t204 = t160*t195
+    t205 = t203 - t194*t204
+    t206 = t204 + t194*t203
+    t207 = t186*t195
+    t208 = t164*t195
+    t209 = t207 - t194*t208
+    t210 = t208 + t194*t207
+    t211 = t179*t202 + t183*t206 + t187*t210
+    t212 = xp.not_equal(t211, 0)
+    t213 = 0.5*(-t175 + t198)/xp.where(t212, t211, 1)
+    t214 = xp.abs(t213)
+    t215 = xp.greater_equal(t214, 1)
+    t216 = xp.abs(1/xp.where(t215, t213, 1))
+    t217 = xp.where(t212, xp.where(xp.greater_equal(t213, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t215, t216/(1 + xp.sqrt(1 + t216**2)), 1/(t214 + xp.sqrt(1 + t214**2))), 0)
+    t218 = 1/xp.sqrt(1 + t217**2)
+    t219 = t211*t217
+    t220 = -t219 + t175
+    t221 = t198 + t219
+    t222 = t179*t218
+    t223 = t202*t218
+    t224 = t222 - t217*t223
+    t225 = t223 + t217*t222
+    t226 = t183*t218
+    t227 = t206*t218
+    t228 = t226 - t217*t227
+    t229 = t227 + t217*t226
+    t230 = t187*t218
+    t231 = t210*t218
+    t232 = t230 - t217*t231
+    t233 = t231 + t217*t230
+    t234 = t201*t224 + t205*t228 + t209*t232
+    t235 = xp.not_equal(t234, 0)
+    t236 = 0.5*(-t197 + t220)/xp.where(t235, t234, 1)
+    t237 = xp.abs(t236)
+    t238 = xp.greater_equal(t237, 1)
+    t239 = xp.abs(1/xp.where(t238, t236, 1))
+    t240 = xp.where(t235, xp.where(xp.greater_equal(t236, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t238, t239/(1 + xp.sqrt(1 + t239**2)), 1/(t237 + xp.sqrt(1 + t237**2))), 0)
+    t241 = 1/xp.sqrt(1 + t240**2)
+    t242 = t234*t240
+    t243 = -t242 + t197
+    t244 = t220 + t242
+    t245 = t201*t241
+    t246 = t224*t241
+    t247 = t245 - t240*t246
+    t248 = t246 + t240*t245
+    t249 = t205*t241
+    t250 = t228*t241
+    t251 = t249 - t240*t250
+    t252 = t250 + t240*t249
+    t253 = t209*t241
+    t254 = t232*t241
+    t255 = t253 - t240*t254
+    t256 = t254 + t240*t253
+    t257 = t225*t247 + t229*t251 + t233*t255
+    t258 = xp.not_equal(t257, 0)
+    t259 = 0.5*(-t243 + t221)/xp.where(t258, t257, 1)
+    t260 = xp.abs(t259)
+    t261 = xp.greater_equal(t260, 1)
+    t262 = xp.abs(1/xp.where(t261, t259, 1))
+    t263 = xp.where(t258, xp.where(xp.greater_equal(t259, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t261, t262/(1 + xp.sqrt(1 + t262**2)), 1/(t260 + xp.sqrt(1 + t260**2))), 0)
+    t264 = 1/xp.sqrt(1 + t263**2)
+    t265 = t257*t263
+    t266 = -t265 + t243
+    t267 = t221 + t265
+    t268 = t247*t264
+    t269 = t225*t264
+    t270 = t268 - t263*t269
+    t271 = t269 + t263*t268
+    t272 = t251*t264
+    t273 = t229*t264
+    t274 = t272 - t263*t273
+    t275 = t273 + t263*t272
+    t276 = t255*t264
+    t277 = t233*t264
+    t278 = t276 - t263*t277
+    t279 = t277 + t263*t276
+    t280 = t248*t271 + t252*t275 + t256*t279
+    t281 = xp.not_equal(t280, 0)
+    t282 = 0.5*(-t244 + t267)/xp.where(t281, t280, 1)
+    t283 = xp.abs(t282)
+    t284 = xp.greater_equal(t283, 1)
+    t285 = xp.abs(1/xp.where(t284, t282, 1))
+    t286 = xp.where(t281, xp.where(xp.greater_equal(t282, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t284, t285/(1 + xp.sqrt(1 + t285**2)), 1/(t283 + xp.sqrt(1 + t283**2))), 0)
+    t287 = 1/xp.sqrt(1 + t286**2)
+    t288 = t280*t286
+    t289 = -t288 + t244
+    t290 = t267 + t288
+    t291 = t248*t287
+    t292 = t271*t287
+    t293 = t291 - t286*t292
+    t294 = t292 + t286*t291
+    t295 = t252*t287
+    t296 = t275*t287
+    t297 = t295 - t286*t296
+    t298 = t296 + t286*t295
+    t299 = t256*t287
+    t300 = t279*t287
+    t301 = t299 - t286*t300
+    t302 = t300 + t286*t299
+    t303 = t270*t293 + t274*t297 + t278*t301
+    t304 = xp.not_equal(t303, 0)
+    t305 = 0.5*(-t266 + t289)/xp.where(t304, t303, 1)
+    t306 = xp.abs(t305)
+    t307 = xp.greater_equal(t306, 1)
+    t308 = xp.abs(1/xp.where(t307, t305, 1))
+    t309 = xp.where(t304, xp.where(xp.greater_equal(t305, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t307, t308/(1 + xp.sqrt(1 + t308**2)), 1/(t306 + xp.sqrt(1 + t306**2))), 0)
     t310 = 1/xp.sqrt(1 + t309**2)
-    t311 = t278*t310
-    t312 = t296*t310
-    t313 = t311 - t309*t312
-    t314 = t312 + t309*t311
-    t315 = t282*t310
-    t316 = t300*t310
-    t317 = t315 - t309*t316
-    t318 = t316 + t309*t315
-    t319 = t286*t310
-    t320 = t304*t310
-    t321 = t319 - t309*t320
-    t322 = t320 + t309*t319
-    t323 = xp.sqrt(t313**2 + t317**2 + t321**2)
-    t324 = xp.sqrt(t314**2 + t318**2 + t322**2)
-    t325 = xp.where(xp.greater(t323, t306), t323, t306)
-    t326 = xp.where(xp.less(t323, t306), t323, t306)
-    t327 = xp.where(xp.greater(t324, t325), t324, t325)
-    t328 = xp.where(xp.less(t324, t326), t324, t326)
-    kappa = xp.broadcast_to(xp.where(xp.greater(t327, 0), t327, 1)/xp.where(xp.less_equal(t328, 1e-12*t327), 0, t328), batch)
+    t311 = t303*t309
+    t312 = -t311 + t266
+    t313 = t289 + t311
+    t314 = t270*t310
+    t315 = t293*t310
+    t316 = t314 - t309*t315
+    t317 = t315 + t309*t314
+    t318 = t274*t310
+    t319 = t297*t310
+    t320 = t318 - t309*t319
+    t321 = t319 + t309*t318
+    t322 = t278*t310
+    t323 = t301*t310
+    t324 = t322 - t309*t323
+    t325 = t323 + t309*t322
+    t326 = t294*t316 + t298*t320 + t302*t324
+    t327 = xp.not_equal(t326, 0)
+    t328 = 0.5*(-t312 + t290)/xp.where(t327, t326, 1)
+    t329 = xp.abs(t328)
+    t330 = xp.greater_equal(t329, 1)
+    t331 = xp.abs(1/xp.where(t330, t328, 1))
+    t332 = xp.where(t327, xp.where(xp.greater_equal(t328, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t330, t331/(1 + xp.sqrt(1 + t331**2)), 1/(t329 + xp.sqrt(1 + t329**2))), 0)
+    t333 = 1/xp.sqrt(1 + t332**2)
+    t334 = t290 + t326*t332
+    t335 = t316*t333
+    t336 = t294*t333
+    t337 = t335 - t332*t336
+    t338 = t336 + t332*t335
+    t339 = t320*t333
+    t340 = t298*t333
+    t341 = t339 - t332*t340
+    t342 = t340 + t332*t339
+    t343 = t324*t333
+    t344 = t302*t333
+    t345 = t343 - t332*t344
+    t346 = t344 + t332*t343
+    t347 = t317*t338 + t321*t342 + t325*t346
+    t348 = xp.sqrt(t337**2 + t341**2 + t345**2)
+    t349 = xp.not_equal(t347, 0)
+    t350 = 0.5*(-t313 + t334)/xp.where(t349, t347, 1)
+    t351 = xp.abs(t350)
+    t352 = xp.greater_equal(t351, 1)
+    t353 = xp.abs(1/xp.where(t352, t350, 1))
+    t354 = xp.where(t349, xp.where(xp.greater_equal(t350, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t352, t353/(1 + xp.sqrt(1 + t353**2)), 1/(t351 + xp.sqrt(1 + t351**2))), 0)
+    t355 = 1/xp.sqrt(1 + t354**2)
+    t356 = t317*t355
+    t357 = t338*t355
+    t358 = t356 - t354*t357
+    t359 = t357 + t354*t356
+    t360 = t321*t355
+    t361 = t342*t355
+    t362 = t360 - t354*t361
+    t363 = t361 + t354*t360
+    t364 = t325*t355
+    t365 = t346*t355
+    t366 = t364 - t354*t365
+    t367 = t365 + t354*t364
+    t368 = xp.sqrt(t358**2 + t362**2 + t366**2)
+    t369 = xp.sqrt(t359**2 + t363**2 + t367**2)
+    t370 = xp.where(xp.greater(t368, t348), t368, t348)
+    t371 = xp.where(xp.less(t368, t348), t368, t348)
+    t372 = xp.where(xp.greater(t369, t370), t369, t370)
+    t373 = xp.where(xp.less(t369, t371), t369, t371)
+    kappa = xp.broadcast_to(xp.where(xp.greater(t372, 0), t372, 1)/xp.where(xp.less_equal(t373, 1e-12*t372), 0, t373), batch)
     return kappa
 
 

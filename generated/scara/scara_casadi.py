@@ -524,7 +524,7 @@ def _jacobian_det(q):
 
 
 def _manipulability_gradient(q):
-    """D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): 101 operations."""
+    """D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): 100 operations."""
     q1 = q[0]
     q2 = q[1]
     c1 = casadi.cos(q1)
@@ -548,31 +548,33 @@ def _manipulability_gradient(q):
     t12 = t1 - t9*t11
     t13 = t0 + t2*t11
     t14 = 1 - t9**2*t10
-    t15 = casadi.fabs(t13)
-    t16 = t15*casadi.if_else((t13 >= 0), 1, -1)
-    t17 = t13 + t16
-    t18 = casadi.if_else((t15 > 0), 1/(t15*2*t15), 0)
-    t19 = 1 - t17**2*t18
-    t20 = t10*t19
-    t21 = t4*t20
-    t22 = -t21 + t19
-    t23 = t2*t9
-    t24 = t16*t14 + t20*t12*t23
-    t25 = t12*t22 + t10*t16*t23
-    t26 = 1e-12*t6
-    t27 = casadi.if_else(casadi.logic_or(casadi.logic_or((t7 <= t26), (t15 <= t26)), (1 <= t26)), 0, casadi.if_else((t8 < 0), 1, casadi.if_else((t8 > 0), -1, 0))*casadi.if_else((t16 < 0), 1, casadi.if_else((t16 > 0), -1, 0)))
-    t28 = t2*t8
-    t29 = t0*t25 + t22*t28
-    t30 = t27*(t1*t24 + t3*t20*t9*t28 + t29)
-    t31 = t27*(t29 + t0*t24 + t8*t9*t21)
+    t15 = casadi.if_else((t8 > 0), -1, 1)
+    t16 = casadi.fabs(t13)
+    t17 = t16*casadi.if_else((t13 >= 0), 1, -1)
+    t18 = t13 + t17
+    t19 = casadi.if_else((t16 > 0), 1/(t16*2*t16), 0)
+    t20 = 1 - t18**2*t19
+    t21 = casadi.if_else((t17 > 0), -t15, t15)
+    t22 = t10*t20
+    t23 = t4*t22
+    t24 = -t23 + t20
+    t25 = t2*t9
+    t26 = t17*t14 + t22*t12*t25
+    t27 = t12*t24 + t10*t17*t25
+    t28 = 1e-12*t6
+    t29 = casadi.if_else(casadi.logic_or(casadi.logic_or((t7 <= t28), (t16 <= t28)), (1 <= t28)), 0, t21)
+    t30 = t2*t8
+    t31 = t0*t27 + t24*t30
+    t32 = t29*(t1*t26 + t3*t22*t9*t30 + t31)
+    t33 = t29*(t31 + t0*t26 + t8*t9*t23)
     dw = casadi.SX(4, 1)
-    dw[0, 0] = t30
-    dw[1, 0] = t31
+    dw[0, 0] = t32
+    dw[1, 0] = t33
     return [dw]
 
 
 def _velocity_ellipsoid(q):
-    """Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: 310 operations."""
+    """Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: 370 operations."""
     q1 = q[0]
     q2 = q[1]
     c1 = casadi.cos(q1)
@@ -600,139 +602,154 @@ def _velocity_ellipsoid(q):
     t16 = t5*t9
     t17 = (t16 != 0)
     t18 = 0.5*(-t13 + t15)/casadi.if_else(t17, -t16, 1)
-    t19 = casadi.if_else(t17, casadi.if_else((t18 >= 0), 1, -1)/(casadi.fabs(t18) + casadi.sqrt(1 + t18**2)), 0)
-    t20 = 1/casadi.sqrt(1 + t19**2)
-    t21 = t16*t19
-    t22 = t21 + t13
-    t23 = -t21 + t15
-    t24 = t5*t20
-    t25 = t9*t20
-    t26 = t24 + t25*t19
-    t27 = t25 - t24*t19
-    t28 = t26*t27 + t14*t19*t20**2
-    t29 = (t28 != 0)
-    t30 = 0.5*(-t22 + t23)/casadi.if_else(t29, -t28, 1)
-    t31 = casadi.if_else(t29, casadi.if_else((t30 >= 0), 1, -1)/(casadi.fabs(t30) + casadi.sqrt(1 + t30**2)), 0)
-    t32 = 1/casadi.sqrt(1 + t31**2)
-    t33 = t28*t31
-    t34 = t33 + t22
-    t35 = -t33 + t23
-    t36 = t26*t32
-    t37 = t27*t32
-    t38 = t36 + t31*t37
-    t39 = t37 - t36*t31
-    t40 = t20*t32
-    t41 = t12*t40
-    t42 = t19*t41
-    t43 = t42 + t31*t41
-    t44 = -t41 + t31*t42
-    t45 = -t38*t39 + t43*t44
-    t46 = t19*t40
-    t47 = t40 - t31*t46
-    t48 = t46 + t31*t40
-    t49 = (t45 != 0)
-    t50 = 0.5*(-t34 + t35)/casadi.if_else(t49, t45, 1)
-    t51 = casadi.if_else(t49, casadi.if_else((t50 >= 0), 1, -1)/(casadi.fabs(t50) + casadi.sqrt(1 + t50**2)), 0)
-    t52 = 1/casadi.sqrt(1 + t51**2)
-    t53 = t45*t51
-    t54 = -t53 + t34
-    t55 = t35 + t53
-    t56 = t38*t52
-    t57 = t39*t52
-    t58 = t56 + t51*t57
-    t59 = t57 - t51*t56
-    t60 = t43*t52
-    t61 = t44*t52
-    t62 = t60 - t51*t61
-    t63 = t61 + t51*t60
-    t64 = -t58*t59 + t62*t63
-    t65 = t47*t52
-    t66 = t48*t52
-    t67 = t65 - t51*t66
-    t68 = t66 + t51*t65
-    t69 = (t64 != 0)
-    t70 = 0.5*(-t54 + t55)/casadi.if_else(t69, t64, 1)
-    t71 = casadi.if_else(t69, casadi.if_else((t70 >= 0), 1, -1)/(casadi.fabs(t70) + casadi.sqrt(1 + t70**2)), 0)
-    t72 = 1/casadi.sqrt(1 + t71**2)
-    t73 = t64*t71
-    t74 = -t73 + t54
-    t75 = t55 + t73
-    t76 = t58*t72
-    t77 = t59*t72
-    t78 = t76 + t71*t77
-    t79 = t77 - t71*t76
-    t80 = t62*t72
-    t81 = t63*t72
-    t82 = t80 - t71*t81
-    t83 = t81 + t71*t80
-    t84 = -t78*t79 + t82*t83
-    t85 = t67*t72
-    t86 = t68*t72
-    t87 = t85 - t71*t86
-    t88 = t86 + t71*t85
-    t89 = (t84 != 0)
-    t90 = 0.5*(-t74 + t75)/casadi.if_else(t89, t84, 1)
-    t91 = casadi.if_else(t89, casadi.if_else((t90 >= 0), 1, -1)/(casadi.fabs(t90) + casadi.sqrt(1 + t90**2)), 0)
-    t92 = 1/casadi.sqrt(1 + t91**2)
-    t93 = t78*t92
-    t94 = t79*t92
-    t95 = t93 + t91*t94
-    t96 = t94 - t91*t93
-    t97 = t82*t92
-    t98 = t83*t92
-    t99 = t97 - t91*t98
-    t100 = t98 + t91*t97
-    t101 = casadi.sqrt(t95**2 + t99**2)
-    t102 = casadi.sqrt(t96**2 + t100**2)
-    t103 = t87*t92
-    t104 = t88*t92
-    t105 = t103 - t91*t104
-    t106 = t104 + t91*t103
-    t107 = (t101 < t102)
-    t108 = casadi.if_else(t107, t102, t101)
-    t109 = casadi.if_else(t107, t101, t102)
-    t110 = casadi.if_else(t107, t106, t105)
-    t111 = casadi.if_else(t107, t105, t106)
-    t112 = -t106
-    t113 = casadi.if_else(t107, t105, t112)
-    t114 = casadi.if_else(t107, t112, t105)
-    t115 = (t109 < 1)
-    t116 = casadi.if_else(t115, 1, t109)
-    t117 = casadi.if_else(t115, t109, 1)
-    t118 = casadi.if_else(t115, 0, t111)
-    t119 = casadi.if_else(t115, 0, t114)
-    t120 = casadi.if_else(t115, 1, 0)
-    t121 = casadi.if_else(t115, t111, 0)
-    t122 = casadi.if_else(t115, t114, 0)
-    t123 = casadi.if_else(t115, 0, 1)
-    t124 = (t108 < t116)
-    t125 = casadi.if_else(t124, t116, t108)
-    t126 = casadi.if_else(t124, t108, t116)
-    t127 = casadi.if_else(t124, t118, t110)
-    t128 = casadi.if_else(t124, t119, t113)
-    t129 = casadi.if_else(t124, t120, 0)
-    t130 = casadi.if_else(t124, t110, t118)
-    t131 = casadi.if_else(t124, t113, t119)
-    t132 = casadi.if_else(t124, 0, t120)
-    t133 = t127*(t123*t131 - t122*t132) - t128*(t123*t130 - t121*t132) + t129*(t122*t130 - t121*t131)
-    t134 = casadi.if_else((t133 < 0), -1, 1)
-    t135 = t121*t134
-    t136 = t122*t134
-    t137 = t123*t134
+    t19 = casadi.fabs(t18)
+    t20 = (t19 >= 1)
+    t21 = casadi.fabs(1/casadi.if_else(t20, t18, 1))
+    t22 = casadi.if_else(t17, casadi.if_else((t18 >= 0), 1, -1)*casadi.if_else(t20, t21/(1 + casadi.sqrt(1 + t21**2)), 1/(t19 + casadi.sqrt(1 + t19**2))), 0)
+    t23 = 1/casadi.sqrt(1 + t22**2)
+    t24 = t16*t22
+    t25 = t24 + t13
+    t26 = -t24 + t15
+    t27 = t5*t23
+    t28 = t9*t23
+    t29 = t27 + t28*t22
+    t30 = t28 - t27*t22
+    t31 = t29*t30 + t14*t22*t23**2
+    t32 = (t31 != 0)
+    t33 = 0.5*(-t25 + t26)/casadi.if_else(t32, -t31, 1)
+    t34 = casadi.fabs(t33)
+    t35 = (t34 >= 1)
+    t36 = casadi.fabs(1/casadi.if_else(t35, t33, 1))
+    t37 = casadi.if_else(t32, casadi.if_else((t33 >= 0), 1, -1)*casadi.if_else(t35, t36/(1 + casadi.sqrt(1 + t36**2)), 1/(t34 + casadi.sqrt(1 + t34**2))), 0)
+    t38 = 1/casadi.sqrt(1 + t37**2)
+    t39 = t31*t37
+    t40 = t25 + t39
+    t41 = -t39 + t26
+    t42 = t29*t38
+    t43 = t30*t38
+    t44 = t42 + t37*t43
+    t45 = t43 - t37*t42
+    t46 = t23*t38
+    t47 = t12*t46
+    t48 = t22*t47
+    t49 = t48 + t37*t47
+    t50 = -t47 + t37*t48
+    t51 = -t44*t45 + t49*t50
+    t52 = t22*t46
+    t53 = t46 - t37*t52
+    t54 = t52 + t37*t46
+    t55 = (t51 != 0)
+    t56 = 0.5*(-t40 + t41)/casadi.if_else(t55, t51, 1)
+    t57 = casadi.fabs(t56)
+    t58 = (t57 >= 1)
+    t59 = casadi.fabs(1/casadi.if_else(t58, t56, 1))
+    t60 = casadi.if_else(t55, casadi.if_else((t56 >= 0), 1, -1)*casadi.if_else(t58, t59/(1 + casadi.sqrt(1 + t59**2)), 1/(t57 + casadi.sqrt(1 + t57**2))), 0)
+    t61 = 1/casadi.sqrt(1 + t60**2)
+    t62 = t51*t60
+    t63 = -t62 + t40
+    t64 = t41 + t62
+    t65 = t44*t61
+    t66 = t45*t61
+    t67 = t65 + t60*t66
+    t68 = t66 - t60*t65
+    t69 = t49*t61
+    t70 = t50*t61
+    t71 = t69 - t60*t70
+    t72 = t70 + t60*t69
+    t73 = -t67*t68 + t71*t72
+    t74 = t53*t61
+    t75 = t54*t61
+    t76 = t74 - t60*t75
+    t77 = t75 + t60*t74
+    t78 = (t73 != 0)
+    t79 = 0.5*(-t63 + t64)/casadi.if_else(t78, t73, 1)
+    t80 = casadi.fabs(t79)
+    t81 = (t80 >= 1)
+    t82 = casadi.fabs(1/casadi.if_else(t81, t79, 1))
+    t83 = casadi.if_else(t78, casadi.if_else((t79 >= 0), 1, -1)*casadi.if_else(t81, t82/(1 + casadi.sqrt(1 + t82**2)), 1/(t80 + casadi.sqrt(1 + t80**2))), 0)
+    t84 = 1/casadi.sqrt(1 + t83**2)
+    t85 = t73*t83
+    t86 = -t85 + t63
+    t87 = t64 + t85
+    t88 = t67*t84
+    t89 = t68*t84
+    t90 = t88 + t83*t89
+    t91 = t89 - t83*t88
+    t92 = t71*t84
+    t93 = t72*t84
+    t94 = t92 - t83*t93
+    t95 = t93 + t83*t92
+    t96 = -t90*t91 + t94*t95
+    t97 = t76*t84
+    t98 = t77*t84
+    t99 = t97 - t83*t98
+    t100 = t98 + t83*t97
+    t101 = (t96 != 0)
+    t102 = 0.5*(-t86 + t87)/casadi.if_else(t101, t96, 1)
+    t103 = casadi.fabs(t102)
+    t104 = (t103 >= 1)
+    t105 = casadi.fabs(1/casadi.if_else(t104, t102, 1))
+    t106 = casadi.if_else(t101, casadi.if_else((t102 >= 0), 1, -1)*casadi.if_else(t104, t105/(1 + casadi.sqrt(1 + t105**2)), 1/(t103 + casadi.sqrt(1 + t103**2))), 0)
+    t107 = 1/casadi.sqrt(1 + t106**2)
+    t108 = t90*t107
+    t109 = t91*t107
+    t110 = t108 + t106*t109
+    t111 = t109 - t106*t108
+    t112 = t94*t107
+    t113 = t95*t107
+    t114 = t112 - t106*t113
+    t115 = t113 + t106*t112
+    t116 = casadi.sqrt(t110**2 + t114**2)
+    t117 = casadi.sqrt(t111**2 + t115**2)
+    t118 = t99*t107
+    t119 = t100*t107
+    t120 = t118 - t106*t119
+    t121 = t119 + t106*t118
+    t122 = (t116 < t117)
+    t123 = casadi.if_else(t122, t117, t116)
+    t124 = casadi.if_else(t122, t116, t117)
+    t125 = casadi.if_else(t122, t121, t120)
+    t126 = casadi.if_else(t122, t120, t121)
+    t127 = -t121
+    t128 = casadi.if_else(t122, t120, t127)
+    t129 = casadi.if_else(t122, t127, t120)
+    t130 = (t124 < 1)
+    t131 = casadi.if_else(t130, 1, t124)
+    t132 = casadi.if_else(t130, t124, 1)
+    t133 = casadi.if_else(t130, 0, t126)
+    t134 = casadi.if_else(t130, 0, t129)
+    t135 = casadi.if_else(t130, 1, 0)
+    t136 = casadi.if_else(t130, t126, 0)
+    t137 = casadi.if_else(t130, t129, 0)
+    t138 = casadi.if_else(t130, 0, 1)
+    t139 = (t123 < t131)
+    t140 = casadi.if_else(t139, t131, t123)
+    t141 = casadi.if_else(t139, t123, t131)
+    t142 = casadi.if_else(t139, t133, t125)
+    t143 = casadi.if_else(t139, t134, t128)
+    t144 = casadi.if_else(t139, t135, 0)
+    t145 = casadi.if_else(t139, t125, t133)
+    t146 = casadi.if_else(t139, t128, t134)
+    t147 = casadi.if_else(t139, 0, t135)
+    t148 = t142*(t138*t146 - t137*t147) - t143*(t138*t145 - t136*t147) + t144*(t137*t145 - t136*t146)
+    t149 = casadi.if_else((t148 < 0), -1, 1)
+    t150 = t136*t149
+    t151 = t137*t149
+    t152 = t138*t149
     U_v = casadi.SX(3, 3)
-    U_v[0, 0] = t127
-    U_v[0, 1] = t130
-    U_v[0, 2] = t135
-    U_v[1, 0] = t128
-    U_v[1, 1] = t131
-    U_v[1, 2] = t136
-    U_v[2, 0] = t129
-    U_v[2, 1] = t132
-    U_v[2, 2] = t137
+    U_v[0, 0] = t142
+    U_v[0, 1] = t145
+    U_v[0, 2] = t150
+    U_v[1, 0] = t143
+    U_v[1, 1] = t146
+    U_v[1, 2] = t151
+    U_v[2, 0] = t144
+    U_v[2, 1] = t147
+    U_v[2, 2] = t152
     s_v = casadi.SX(3, 1)
-    s_v[0, 0] = t125
-    s_v[1, 0] = t126
-    s_v[2, 0] = t117
+    s_v[0, 0] = t140
+    s_v[1, 0] = t141
+    s_v[2, 0] = t132
     U_w = casadi.SX(3, 3)
     U_w[0, 1] = 1
     U_w[1, 2] = 1
@@ -743,7 +760,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 1048 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 1300 operations."""
     q1 = q[0]
     q2 = q[1]
     c1 = casadi.cos(q1)
@@ -779,420 +796,483 @@ def _condition_number(q):
     t24 = t23 + t10**2 + t14**2
     t25 = (t22 != 0)
     t26 = 0.5*(-t24 + t21)/casadi.if_else(t25, t22, 1)
-    t27 = casadi.if_else(t25, casadi.if_else((t26 >= 0), 1, -1)/(casadi.fabs(t26) + casadi.sqrt(1 + t26**2)), 0)
-    t28 = 1/casadi.sqrt(1 + t27**2)
-    t29 = t22*t27
-    t30 = -t29 + t24
-    t31 = t29 + t21
-    t32 = t10*t28
-    t33 = t17*t28
-    t34 = t32 + t33*t27
-    t35 = -t33 + t32*t27
-    t36 = t14*t28
-    t37 = t20*t28
-    t38 = t36 - t37*t27
-    t39 = t37 + t36*t27
-    t40 = (t38 != 0)
-    t41 = 0.5*(1.0 - t30)/casadi.if_else(t40, t38, 1)
-    t42 = casadi.if_else(t40, casadi.if_else((t41 >= 0), 1, -1)/(casadi.fabs(t41) + casadi.sqrt(1 + t41**2)), 0)
-    t43 = 1/casadi.sqrt(1 + t42**2)
-    t44 = t38*t42
-    t45 = -t44 + t30
-    t46 = 1.0 + t44
-    t47 = t43 + t44*t43
-    t48 = t42*t43
-    t49 = -t48 + t38*t43
-    t50 = t48*t34
-    t51 = t39*t47 + t23*t48*t27*t28**2 + t50*t35
-    t52 = (t51 != 0)
-    t53 = 0.5*(-t31 + t46)/casadi.if_else(t52, t51, 1)
-    t54 = casadi.if_else(t52, casadi.if_else((t53 >= 0), 1, -1)/(casadi.fabs(t53) + casadi.sqrt(1 + t53**2)), 0)
-    t55 = 1/casadi.sqrt(1 + t54**2)
-    t56 = t51*t54
-    t57 = -t56 + t31
-    t58 = t56 + t46
-    t59 = t6*t28
-    t60 = t59*t55
-    t61 = t60*t27
-    t62 = t48*t60
-    t63 = -t61 + t62*t54
-    t64 = t62 + t61*t54
-    t65 = t35*t55
-    t66 = t50*t55
-    t67 = t65 - t66*t54
-    t68 = t66 + t65*t54
-    t69 = t39*t55
-    t70 = t47*t55
-    t71 = t69 - t70*t54
-    t72 = t70 + t69*t54
-    t73 = t59*t43
-    t74 = t34*t43
-    t75 = t49*t71 - t73*t63 + t74*t67
-    t76 = (t75 != 0)
-    t77 = 0.5*(-t45 + t57)/casadi.if_else(t76, t75, 1)
-    t78 = casadi.if_else(t76, casadi.if_else((t77 >= 0), 1, -1)/(casadi.fabs(t77) + casadi.sqrt(1 + t77**2)), 0)
-    t79 = 1/casadi.sqrt(1 + t78**2)
-    t80 = t75*t78
-    t81 = -t80 + t45
-    t82 = t80 + t57
-    t83 = t73*t79
-    t84 = t63*t79
-    t85 = t83 + t84*t78
-    t86 = t84 - t83*t78
-    t87 = t74*t79
-    t88 = t67*t79
-    t89 = t87 - t88*t78
-    t90 = t88 + t87*t78
-    t91 = t49*t79
-    t92 = t71*t79
-    t93 = t91 - t92*t78
-    t94 = t92 + t91*t78
-    t95 = t64*t85 + t68*t89 + t72*t93
-    t96 = (t95 != 0)
-    t97 = 0.5*(-t81 + t58)/casadi.if_else(t96, t95, 1)
-    t98 = casadi.if_else(t96, casadi.if_else((t97 >= 0), 1, -1)/(casadi.fabs(t97) + casadi.sqrt(1 + t97**2)), 0)
-    t99 = 1/casadi.sqrt(1 + t98**2)
-    t100 = t95*t98
-    t101 = -t100 + t81
-    t102 = t100 + t58
-    t103 = t85*t99
-    t104 = t64*t99
-    t105 = -t103 + t104*t98
-    t106 = t104 + t103*t98
-    t107 = t89*t99
-    t108 = t68*t99
-    t109 = t107 - t108*t98
-    t110 = t108 + t107*t98
-    t111 = t93*t99
-    t112 = t72*t99
-    t113 = t111 - t112*t98
-    t114 = t112 + t111*t98
-    t115 = -t86*t106 + t90*t110 + t94*t114
-    t116 = (t115 != 0)
-    t117 = 0.5*(-t82 + t102)/casadi.if_else(t116, t115, 1)
-    t118 = casadi.if_else(t116, casadi.if_else((t117 >= 0), 1, -1)/(casadi.fabs(t117) + casadi.sqrt(1 + t117**2)), 0)
-    t119 = 1/casadi.sqrt(1 + t118**2)
-    t120 = t115*t118
-    t121 = -t120 + t82
-    t122 = t102 + t120
-    t123 = t86*t119
-    t124 = t106*t119
-    t125 = t123 + t118*t124
-    t126 = -t124 + t118*t123
-    t127 = t90*t119
-    t128 = t110*t119
-    t129 = t127 - t118*t128
-    t130 = t128 + t118*t127
-    t131 = t94*t119
-    t132 = t114*t119
-    t133 = t131 - t118*t132
-    t134 = t132 + t118*t131
-    t135 = t105*t125 + t109*t129 + t113*t133
-    t136 = (t135 != 0)
-    t137 = 0.5*(-t101 + t121)/casadi.if_else(t136, t135, 1)
-    t138 = casadi.if_else(t136, casadi.if_else((t137 >= 0), 1, -1)/(casadi.fabs(t137) + casadi.sqrt(1 + t137**2)), 0)
-    t139 = 1/casadi.sqrt(1 + t138**2)
-    t140 = t135*t138
-    t141 = -t140 + t101
-    t142 = t121 + t140
-    t143 = t105*t139
-    t144 = t125*t139
-    t145 = t143 - t138*t144
-    t146 = t144 + t138*t143
-    t147 = t109*t139
-    t148 = t129*t139
-    t149 = t147 - t138*t148
-    t150 = t148 + t138*t147
-    t151 = t113*t139
-    t152 = t133*t139
-    t153 = t151 - t138*t152
-    t154 = t152 + t138*t151
-    t155 = t126*t145 + t130*t149 + t134*t153
-    t156 = (t155 != 0)
-    t157 = 0.5*(-t141 + t122)/casadi.if_else(t156, t155, 1)
-    t158 = casadi.if_else(t156, casadi.if_else((t157 >= 0), 1, -1)/(casadi.fabs(t157) + casadi.sqrt(1 + t157**2)), 0)
-    t159 = 1/casadi.sqrt(1 + t158**2)
-    t160 = t155*t158
-    t161 = -t160 + t141
-    t162 = t122 + t160
-    t163 = t145*t159
-    t164 = t126*t159
-    t165 = t163 - t158*t164
-    t166 = t164 + t158*t163
-    t167 = t149*t159
-    t168 = t130*t159
-    t169 = t167 - t158*t168
-    t170 = t168 + t158*t167
-    t171 = t153*t159
-    t172 = t134*t159
-    t173 = t171 - t158*t172
-    t174 = t172 + t158*t171
-    t175 = t146*t166 + t150*t170 + t154*t174
-    t176 = (t175 != 0)
-    t177 = 0.5*(-t142 + t162)/casadi.if_else(t176, t175, 1)
-    t178 = casadi.if_else(t176, casadi.if_else((t177 >= 0), 1, -1)/(casadi.fabs(t177) + casadi.sqrt(1 + t177**2)), 0)
-    t179 = 1/casadi.sqrt(1 + t178**2)
-    t180 = t175*t178
-    t181 = -t180 + t142
-    t182 = t162 + t180
-    t183 = t146*t179
-    t184 = t166*t179
-    t185 = t183 - t178*t184
-    t186 = t184 + t178*t183
-    t187 = t150*t179
-    t188 = t170*t179
-    t189 = t187 - t178*t188
-    t190 = t188 + t178*t187
-    t191 = t154*t179
-    t192 = t174*t179
-    t193 = t191 - t178*t192
-    t194 = t192 + t178*t191
-    t195 = t165*t185 + t169*t189 + t173*t193
-    t196 = (t195 != 0)
-    t197 = 0.5*(-t161 + t181)/casadi.if_else(t196, t195, 1)
-    t198 = casadi.if_else(t196, casadi.if_else((t197 >= 0), 1, -1)/(casadi.fabs(t197) + casadi.sqrt(1 + t197**2)), 0)
-    t199 = 1/casadi.sqrt(1 + t198**2)
-    t200 = t195*t198
-    t201 = -t200 + t161
-    t202 = t181 + t200
-    t203 = t165*t199
-    t204 = t185*t199
-    t205 = t203 - t198*t204
-    t206 = t204 + t198*t203
-    t207 = t169*t199
-    t208 = t189*t199
-    t209 = t207 - t198*t208
-    t210 = t208 + t198*t207
-    t211 = t173*t199
-    t212 = t193*t199
-    t213 = t211 - t198*t212
-    t214 = t212 + t198*t211
-    t215 = t186*t205 + t190*t209 + t194*t213
-    t216 = (t215 != 0)
-    t217 = 0.5*(-t201 + t182)/casadi.if_else(t216, t215, 1)
-    t218 = casadi.if_else(t216, casadi.if_else((t217 >= 0), 1, -1)/(casadi.fabs(t217) + casadi.sqrt(1 + t217**2)), 0)
-    t219 = 1/casadi.sqrt(1 + t218**2)
-    t220 = t215*t218
-    t221 = -t220 + t201
-    t222 = t182 + t220
-    t223 = t205*t219
-    t224 = t186*t219
-    t225 = t223 - t218*t224
-    t226 = t224 + t218*t223
-    t227 = t209*t219
-    t228 = t190*t219
-    t229 = t227 - t218*t228
-    t230 = t228 + t218*t227
-    t231 = t213*t219
-    t232 = t194*t219
-    t233 = t231 - t218*t232
-    t234 = t232 + t218*t231
-    t235 = t206*t226 + t210*t230 + t214*t234
-    t236 = (t235 != 0)
-    t237 = 0.5*(-t202 + t222)/casadi.if_else(t236, t235, 1)
-    t238 = casadi.if_else(t236, casadi.if_else((t237 >= 0), 1, -1)/(casadi.fabs(t237) + casadi.sqrt(1 + t237**2)), 0)
-    t239 = 1/casadi.sqrt(1 + t238**2)
-    t240 = t235*t238
-    t241 = -t240 + t202
-    t242 = t222 + t240
-    t243 = t206*t239
-    t244 = t226*t239
-    t245 = t243 - t238*t244
-    t246 = t244 + t238*t243
-    t247 = t210*t239
-    t248 = t230*t239
-    t249 = t247 - t238*t248
-    t250 = t248 + t238*t247
-    t251 = t214*t239
-    t252 = t234*t239
-    t253 = t251 - t238*t252
-    t254 = t252 + t238*t251
-    t255 = t225*t245 + t229*t249 + t233*t253
-    t256 = (t255 != 0)
-    t257 = 0.5*(-t221 + t241)/casadi.if_else(t256, t255, 1)
-    t258 = casadi.if_else(t256, casadi.if_else((t257 >= 0), 1, -1)/(casadi.fabs(t257) + casadi.sqrt(1 + t257**2)), 0)
-    t259 = 1/casadi.sqrt(1 + t258**2)
-    t260 = t255*t258
-    t261 = -t260 + t221
-    t262 = t241 + t260
-    t263 = t225*t259
-    t264 = t245*t259
-    t265 = t263 - t258*t264
-    t266 = t264 + t258*t263
-    t267 = t229*t259
-    t268 = t249*t259
-    t269 = t267 - t258*t268
-    t270 = t268 + t258*t267
-    t271 = t233*t259
-    t272 = t253*t259
-    t273 = t271 - t258*t272
-    t274 = t272 + t258*t271
-    t275 = t246*t265 + t250*t269 + t254*t273
-    t276 = (t275 != 0)
-    t277 = 0.5*(-t261 + t242)/casadi.if_else(t276, t275, 1)
-    t278 = casadi.if_else(t276, casadi.if_else((t277 >= 0), 1, -1)/(casadi.fabs(t277) + casadi.sqrt(1 + t277**2)), 0)
-    t279 = 1/casadi.sqrt(1 + t278**2)
-    t280 = t275*t278
-    t281 = -t280 + t261
-    t282 = t242 + t280
-    t283 = t265*t279
-    t284 = t246*t279
-    t285 = t283 - t278*t284
-    t286 = t284 + t278*t283
-    t287 = t269*t279
-    t288 = t250*t279
-    t289 = t287 - t278*t288
-    t290 = t288 + t278*t287
-    t291 = t273*t279
-    t292 = t254*t279
-    t293 = t291 - t278*t292
-    t294 = t292 + t278*t291
-    t295 = t266*t286 + t270*t290 + t274*t294
-    t296 = (t295 != 0)
-    t297 = 0.5*(-t262 + t282)/casadi.if_else(t296, t295, 1)
-    t298 = casadi.if_else(t296, casadi.if_else((t297 >= 0), 1, -1)/(casadi.fabs(t297) + casadi.sqrt(1 + t297**2)), 0)
-    t299 = 1/casadi.sqrt(1 + t298**2)
-    t300 = t295*t298
-    t301 = -t300 + t262
-    t302 = t282 + t300
-    t303 = t266*t299
-    t304 = t286*t299
-    t305 = t303 - t298*t304
-    t306 = t304 + t298*t303
-    t307 = t270*t299
-    t308 = t290*t299
-    t309 = t307 - t298*t308
-    t310 = t308 + t298*t307
-    t311 = t274*t299
-    t312 = t294*t299
-    t313 = t311 - t298*t312
-    t314 = t312 + t298*t311
-    t315 = t285*t305 + t289*t309 + t293*t313
-    t316 = (t315 != 0)
-    t317 = 0.5*(-t281 + t301)/casadi.if_else(t316, t315, 1)
-    t318 = casadi.if_else(t316, casadi.if_else((t317 >= 0), 1, -1)/(casadi.fabs(t317) + casadi.sqrt(1 + t317**2)), 0)
-    t319 = 1/casadi.sqrt(1 + t318**2)
-    t320 = t315*t318
-    t321 = -t320 + t281
-    t322 = t301 + t320
-    t323 = t285*t319
-    t324 = t305*t319
-    t325 = t323 - t318*t324
-    t326 = t324 + t318*t323
-    t327 = t289*t319
-    t328 = t309*t319
-    t329 = t327 - t318*t328
-    t330 = t328 + t318*t327
-    t331 = t293*t319
-    t332 = t313*t319
-    t333 = t331 - t318*t332
-    t334 = t332 + t318*t331
-    t335 = t306*t325 + t310*t329 + t314*t333
-    t336 = (t335 != 0)
-    t337 = 0.5*(-t321 + t302)/casadi.if_else(t336, t335, 1)
-    t338 = casadi.if_else(t336, casadi.if_else((t337 >= 0), 1, -1)/(casadi.fabs(t337) + casadi.sqrt(1 + t337**2)), 0)
-    t339 = 1/casadi.sqrt(1 + t338**2)
-    t340 = t335*t338
-    t341 = -t340 + t321
-    t342 = t302 + t340
-    t343 = t325*t339
-    t344 = t306*t339
-    t345 = t343 - t338*t344
-    t346 = t344 + t338*t343
-    t347 = t329*t339
-    t348 = t310*t339
-    t349 = t347 - t338*t348
-    t350 = t348 + t338*t347
-    t351 = t333*t339
-    t352 = t314*t339
-    t353 = t351 - t338*t352
-    t354 = t352 + t338*t351
-    t355 = t326*t346 + t330*t350 + t334*t354
-    t356 = (t355 != 0)
-    t357 = 0.5*(-t322 + t342)/casadi.if_else(t356, t355, 1)
-    t358 = casadi.if_else(t356, casadi.if_else((t357 >= 0), 1, -1)/(casadi.fabs(t357) + casadi.sqrt(1 + t357**2)), 0)
-    t359 = 1/casadi.sqrt(1 + t358**2)
-    t360 = t355*t358
-    t361 = -t360 + t322
-    t362 = t342 + t360
-    t363 = t326*t359
-    t364 = t346*t359
-    t365 = t363 - t358*t364
-    t366 = t364 + t358*t363
-    t367 = t330*t359
-    t368 = t350*t359
-    t369 = t367 - t358*t368
-    t370 = t368 + t358*t367
-    t371 = t334*t359
-    t372 = t354*t359
-    t373 = t371 - t358*t372
-    t374 = t372 + t358*t371
-    t375 = t345*t365 + t349*t369 + t353*t373
-    t376 = (t375 != 0)
-    t377 = 0.5*(-t341 + t361)/casadi.if_else(t376, t375, 1)
-    t378 = casadi.if_else(t376, casadi.if_else((t377 >= 0), 1, -1)/(casadi.fabs(t377) + casadi.sqrt(1 + t377**2)), 0)
-    t379 = 1/casadi.sqrt(1 + t378**2)
-    t380 = t375*t378
-    t381 = -t380 + t341
-    t382 = t361 + t380
-    t383 = t345*t379
-    t384 = t365*t379
-    t385 = t383 - t378*t384
-    t386 = t384 + t378*t383
-    t387 = t349*t379
-    t388 = t369*t379
-    t389 = t387 - t378*t388
-    t390 = t388 + t378*t387
-    t391 = t353*t379
-    t392 = t373*t379
-    t393 = t391 - t378*t392
-    t394 = t392 + t378*t391
-    t395 = t366*t385 + t370*t389 + t374*t393
-    t396 = (t395 != 0)
-    t397 = 0.5*(-t381 + t362)/casadi.if_else(t396, t395, 1)
-    t398 = casadi.if_else(t396, casadi.if_else((t397 >= 0), 1, -1)/(casadi.fabs(t397) + casadi.sqrt(1 + t397**2)), 0)
-    t399 = 1/casadi.sqrt(1 + t398**2)
-    t400 = t362 + t395*t398
-    t401 = t385*t399
-    t402 = t366*t399
-    t403 = t401 - t398*t402
-    t404 = t402 + t398*t401
-    t405 = t389*t399
-    t406 = t370*t399
-    t407 = t405 - t398*t406
-    t408 = t406 + t398*t405
-    t409 = t393*t399
-    t410 = t374*t399
-    t411 = t409 - t398*t410
-    t412 = t410 + t398*t409
-    t413 = t386*t404 + t390*t408 + t394*t412
-    t414 = casadi.sqrt(t403**2 + t407**2 + t411**2)
-    t415 = (t413 != 0)
-    t416 = 0.5*(-t382 + t400)/casadi.if_else(t415, t413, 1)
-    t417 = casadi.if_else(t415, casadi.if_else((t416 >= 0), 1, -1)/(casadi.fabs(t416) + casadi.sqrt(1 + t416**2)), 0)
-    t418 = 1/casadi.sqrt(1 + t417**2)
-    t419 = t386*t418
-    t420 = t404*t418
-    t421 = t419 - t417*t420
-    t422 = t420 + t417*t419
-    t423 = t390*t418
-    t424 = t408*t418
-    t425 = t423 - t417*t424
-    t426 = t424 + t417*t423
-    t427 = t394*t418
-    t428 = t412*t418
-    t429 = t427 - t417*t428
-    t430 = t428 + t417*t427
-    t431 = casadi.sqrt(t421**2 + t425**2 + t429**2)
-    t432 = casadi.sqrt(t422**2 + t426**2 + t430**2)
-    t433 = casadi.if_else((t431 > t414), t431, t414)
-    t434 = casadi.if_else((t431 < t414), t431, t414)
-    t435 = casadi.if_else((1.8823529411764706 > t433), 1.8823529411764706, t433)
-    t436 = casadi.if_else((1.8823529411764706 < t434), 1.8823529411764706, t434)
-    t437 = casadi.if_else((t432 > t435), t432, t435)
-    t438 = casadi.if_else((t432 < t436), t432, t436)
+    t27 = casadi.fabs(t26)
+    t28 = (t27 >= 1)
+    t29 = casadi.fabs(1/casadi.if_else(t28, t26, 1))
+    t30 = casadi.if_else(t25, casadi.if_else((t26 >= 0), 1, -1)*casadi.if_else(t28, t29/(1 + casadi.sqrt(1 + t29**2)), 1/(t27 + casadi.sqrt(1 + t27**2))), 0)
+    t31 = 1/casadi.sqrt(1 + t30**2)
+    t32 = t22*t30
+    t33 = -t32 + t24
+    t34 = t32 + t21
+    t35 = t10*t31
+    t36 = t17*t31
+    t37 = t35 + t36*t30
+    t38 = -t36 + t35*t30
+    t39 = t14*t31
+    t40 = t20*t31
+    t41 = t39 - t40*t30
+    t42 = t40 + t39*t30
+    t43 = (t41 != 0)
+    t44 = 0.5*(1.0 - t33)/casadi.if_else(t43, t41, 1)
+    t45 = casadi.fabs(t44)
+    t46 = (t45 >= 1)
+    t47 = casadi.fabs(1/casadi.if_else(t46, t44, 1))
+    t48 = casadi.if_else(t43, casadi.if_else((t44 >= 0), 1, -1)*casadi.if_else(t46, t47/(1 + casadi.sqrt(1 + t47**2)), 1/(t45 + casadi.sqrt(1 + t45**2))), 0)
+    t49 = 1/casadi.sqrt(1 + t48**2)
+    t50 = t41*t48
+    t51 = -t50 + t33
+    t52 = 1.0 + t50
+    t53 = t49 + t50*t49
+    t54 = t48*t49
+    t55 = -t54 + t41*t49
+    t56 = t54*t37
+    t57 = t42*t53 + t23*t54*t30*t31**2 + t56*t38
+    t58 = (t57 != 0)
+    t59 = 0.5*(-t34 + t52)/casadi.if_else(t58, t57, 1)
+    t60 = casadi.fabs(t59)
+    t61 = (t60 >= 1)
+    t62 = casadi.fabs(1/casadi.if_else(t61, t59, 1))
+    t63 = casadi.if_else(t58, casadi.if_else((t59 >= 0), 1, -1)*casadi.if_else(t61, t62/(1 + casadi.sqrt(1 + t62**2)), 1/(t60 + casadi.sqrt(1 + t60**2))), 0)
+    t64 = 1/casadi.sqrt(1 + t63**2)
+    t65 = t57*t63
+    t66 = -t65 + t34
+    t67 = t65 + t52
+    t68 = t6*t31
+    t69 = t68*t64
+    t70 = t69*t30
+    t71 = t54*t69
+    t72 = -t70 + t71*t63
+    t73 = t71 + t70*t63
+    t74 = t38*t64
+    t75 = t56*t64
+    t76 = t74 - t75*t63
+    t77 = t75 + t74*t63
+    t78 = t42*t64
+    t79 = t53*t64
+    t80 = t78 - t79*t63
+    t81 = t79 + t78*t63
+    t82 = t68*t49
+    t83 = t37*t49
+    t84 = t55*t80 - t82*t72 + t83*t76
+    t85 = (t84 != 0)
+    t86 = 0.5*(-t51 + t66)/casadi.if_else(t85, t84, 1)
+    t87 = casadi.fabs(t86)
+    t88 = (t87 >= 1)
+    t89 = casadi.fabs(1/casadi.if_else(t88, t86, 1))
+    t90 = casadi.if_else(t85, casadi.if_else((t86 >= 0), 1, -1)*casadi.if_else(t88, t89/(1 + casadi.sqrt(1 + t89**2)), 1/(t87 + casadi.sqrt(1 + t87**2))), 0)
+    t91 = 1/casadi.sqrt(1 + t90**2)
+    t92 = t84*t90
+    t93 = -t92 + t51
+    t94 = t92 + t66
+    t95 = t82*t91
+    t96 = t72*t91
+    t97 = t95 + t96*t90
+    t98 = t96 - t95*t90
+    t99 = t83*t91
+    t100 = t76*t91
+    t101 = t99 - t100*t90
+    t102 = t100 + t99*t90
+    t103 = t55*t91
+    t104 = t80*t91
+    t105 = t103 - t104*t90
+    t106 = t104 + t103*t90
+    t107 = t73*t97 + t77*t101 + t81*t105
+    t108 = (t107 != 0)
+    t109 = 0.5*(-t93 + t67)/casadi.if_else(t108, t107, 1)
+    t110 = casadi.fabs(t109)
+    t111 = (t110 >= 1)
+    t112 = casadi.fabs(1/casadi.if_else(t111, t109, 1))
+    t113 = casadi.if_else(t108, casadi.if_else((t109 >= 0), 1, -1)*casadi.if_else(t111, t112/(1 + casadi.sqrt(1 + t112**2)), 1/(t110 + casadi.sqrt(1 + t110**2))), 0)
+    t114 = 1/casadi.sqrt(1 + t113**2)
+    t115 = t107*t113
+    t116 = -t115 + t93
+    t117 = t115 + t67
+    t118 = t97*t114
+    t119 = t73*t114
+    t120 = -t118 + t119*t113
+    t121 = t119 + t118*t113
+    t122 = t101*t114
+    t123 = t77*t114
+    t124 = t122 - t123*t113
+    t125 = t123 + t122*t113
+    t126 = t105*t114
+    t127 = t81*t114
+    t128 = t126 - t127*t113
+    t129 = t127 + t126*t113
+    t130 = -t98*t121 + t102*t125 + t106*t129
+    t131 = (t130 != 0)
+    t132 = 0.5*(-t94 + t117)/casadi.if_else(t131, t130, 1)
+    t133 = casadi.fabs(t132)
+    t134 = (t133 >= 1)
+    t135 = casadi.fabs(1/casadi.if_else(t134, t132, 1))
+    t136 = casadi.if_else(t131, casadi.if_else((t132 >= 0), 1, -1)*casadi.if_else(t134, t135/(1 + casadi.sqrt(1 + t135**2)), 1/(t133 + casadi.sqrt(1 + t133**2))), 0)
+    t137 = 1/casadi.sqrt(1 + t136**2)
+    t138 = t130*t136
+    t139 = -t138 + t94
+    t140 = t117 + t138
+    t141 = t98*t137
+    t142 = t121*t137
+    t143 = t141 + t136*t142
+    t144 = -t142 + t136*t141
+    t145 = t102*t137
+    t146 = t125*t137
+    t147 = t145 - t136*t146
+    t148 = t146 + t136*t145
+    t149 = t106*t137
+    t150 = t129*t137
+    t151 = t149 - t136*t150
+    t152 = t150 + t136*t149
+    t153 = t120*t143 + t124*t147 + t128*t151
+    t154 = (t153 != 0)
+    t155 = 0.5*(-t116 + t139)/casadi.if_else(t154, t153, 1)
+    t156 = casadi.fabs(t155)
+    t157 = (t156 >= 1)
+    t158 = casadi.fabs(1/casadi.if_else(t157, t155, 1))
+    t159 = casadi.if_else(t154, casadi.if_else((t155 >= 0), 1, -1)*casadi.if_else(t157, t158/(1 + casadi.sqrt(1 + t158**2)), 1/(t156 + casadi.sqrt(1 + t156**2))), 0)
+    t160 = 1/casadi.sqrt(1 + t159**2)
+    t161 = t153*t159
+    t162 = -t161 + t116
+    t163 = t139 + t161
+    t164 = t120*t160
+    t165 = t143*t160
+    t166 = t164 - t159*t165
+    t167 = t165 + t159*t164
+    t168 = t124*t160
+    t169 = t147*t160
+    t170 = t168 - t159*t169
+    t171 = t169 + t159*t168
+    t172 = t128*t160
+    t173 = t151*t160
+    t174 = t172 - t159*t173
+    t175 = t173 + t159*t172
+    t176 = t144*t166 + t148*t170 + t152*t174
+    t177 = (t176 != 0)
+    t178 = 0.5*(-t162 + t140)/casadi.if_else(t177, t176, 1)
+    t179 = casadi.fabs(t178)
+    t180 = (t179 >= 1)
+    t181 = casadi.fabs(1/casadi.if_else(t180, t178, 1))
+    t182 = casadi.if_else(t177, casadi.if_else((t178 >= 0), 1, -1)*casadi.if_else(t180, t181/(1 + casadi.sqrt(1 + t181**2)), 1/(t179 + casadi.sqrt(1 + t179**2))), 0)
+    t183 = 1/casadi.sqrt(1 + t182**2)
+    t184 = t176*t182
+    t185 = -t184 + t162
+    t186 = t140 + t184
+    t187 = t166*t183
+    t188 = t144*t183
+    t189 = t187 - t182*t188
+    t190 = t188 + t182*t187
+    t191 = t170*t183
+    t192 = t148*t183
+    t193 = t191 - t182*t192
+    t194 = t192 + t182*t191
+    t195 = t174*t183
+    t196 = t152*t183
+    t197 = t195 - t182*t196
+    t198 = t196 + t182*t195
+    t199 = t167*t190 + t171*t194 + t175*t198
+    t200 = (t199 != 0)
+    t201 = 0.5*(-t163 + t186)/casadi.if_else(t200, t199, 1)
+    t202 = casadi.fabs(t201)
+    t203 = (t202 >= 1)
+    t204 = casadi.fabs(1/casadi.if_else(t203, t201, 1))
+    t205 = casadi.if_else(t200, casadi.if_else((t201 >= 0), 1, -1)*casadi.if_else(t203, t204/(1 + casadi.sqrt(1 + t204**2)), 1/(t202 + casadi.sqrt(1 + t202**2))), 0)
+    t206 = 1/casadi.sqrt(1 + t205**2)
+    t207 = t199*t205
+    t208 = -t207 + t163
+    t209 = t186 + t207
+    t210 = t167*t206
+    t211 = t190*t206
+    t212 = t210 - t205*t211
+    t213 = t211 + t205*t210
+    t214 = t171*t206
+    t215 = t194*t206
+    t216 = t214 - t205*t215
+    t217 = t215 + t205*t214
+    t218 = t175*t206
+    t219 = t198*t206
+    t220 = t218 - t205*t219
+    t221 = t219 + t205*t218
+    t222 = t189*t212 + t193*t216 + t197*t220
+    t223 = (t222 != 0)
+    t224 = 0.5*(-t185 + t208)/casadi.if_else(t223, t222, 1)
+    t225 = casadi.fabs(t224)
+    t226 = (t225 >= 1)
+    t227 = casadi.fabs(1/casadi.if_else(t226, t224, 1))
+    t228 = casadi.if_else(t223, casadi.if_else((t224 >= 0), 1, -1)*casadi.if_else(t226, t227/(1 + casadi.sqrt(1 + t227**2)), 1/(t225 + casadi.sqrt(1 + t225**2))), 0)
+    t229 = 1/casadi.sqrt(1 + t228**2)
+    t230 = t222*t228
+    t231 = -t230 + t185
+    t232 = t208 + t230
+    t233 = t189*t229
+    t234 = t212*t229
+    t235 = t233 - t228*t234
+    t236 = t234 + t228*t233
+    t237 = t193*t229
+    t238 = t216*t229
+    t239 = t237 - t228*t238
+    t240 = t238 + t228*t237
+    t241 = t197*t229
+    t242 = t220*t229
+    t243 = t241 - t228*t242
+    t244 = t242 + t228*t241
+    t245 = t213*t235 + t217*t239 + t221*t243
+    t246 = (t245 != 0)
+    t247 = 0.5*(-t231 + t209)/casadi.if_else(t246, t245, 1)
+    t248 = casadi.fabs(t247)
+    t249 = (t248 >= 1)
+    t250 = casadi.fabs(1/casadi.if_else(t249, t247, 1))
+    t251 = casadi.if_else(t246, casadi.if_else((t247 >= 0), 1, -1)*casadi.if_else(t249, t250/(1 + casadi.sqrt(1 + t250**2)), 1/(t248 + casadi.sqrt(1 + t248**2))), 0)
+    t252 = 1/casadi.sqrt(1 + t251**2)
+    t253 = t245*t251
+    t254 = -t253 + t231
+    t255 = t209 + t253
+    t256 = t235*t252
+    t257 = t213*t252
+    t258 = t256 - t251*t257
+    t259 = t257 + t251*t256
+    t260 = t239*t252
+    t261 = t217*t252
+    t262 = t260 - t251*t261
+    t263 = t261 + t251*t260
+    t264 = t243*t252
+    t265 = t221*t252
+    t266 = t264 - t251*t265
+    t267 = t265 + t251*t264
+    t268 = t236*t259 + t240*t263 + t244*t267
+    t269 = (t268 != 0)
+    t270 = 0.5*(-t232 + t255)/casadi.if_else(t269, t268, 1)
+    t271 = casadi.fabs(t270)
+    t272 = (t271 >= 1)
+    t273 = casadi.fabs(1/casadi.if_else(t272, t270, 1))
+    t274 = casadi.if_else(t269, casadi.if_else((t270 >= 0), 1, -1)*casadi.if_else(t272, t273/(1 + casadi.sqrt(1 + t273**2)), 1/(t271 + casadi.sqrt(1 + t271**2))), 0)
+    t275 = 1/casadi.sqrt(1 + t274**2)
+    t276 = t268*t274
+    t277 = -t276 + t232
+    t278 = t255 + t276
+    t279 = t236*t275
+    t280 = t259*t275
+    t281 = t279 - t274*t280
+    t282 = t280 + t274*t279
+    t283 = t240*t275
+    t284 = t263*t275
+    t285 = t283 - t274*t284
+    t286 = t284 + t274*t283
+    t287 = t244*t275
+    t288 = t267*t275
+    t289 = t287 - t274*t288
+    t290 = t288 + t274*t287
+    t291 = t258*t281 + t262*t285 + t266*t289
+    t292 = (t291 != 0)
+    t293 = 0.5*(-t254 + t277)/casadi.if_else(t292, t291, 1)
+    t294 = casadi.fabs(t293)
+    t295 = (t294 >= 1)
+    t296 = casadi.fabs(1/casadi.if_else(t295, t293, 1))
+    t297 = casadi.if_else(t292, casadi.if_else((t293 >= 0), 1, -1)*casadi.if_else(t295, t296/(1 + casadi.sqrt(1 + t296**2)), 1/(t294 + casadi.sqrt(1 + t294**2))), 0)
+    t298 = 1/casadi.sqrt(1 + t297**2)
+    t299 = t291*t297
+    t300 = -t299 + t254
+    t301 = t277 + t299
+    t302 = t258*t298
+    t303 = t281*t298
+    t304 = t302 - t297*t303
+    t305 = t303 + t297*t302
+    t306 = t262*t298
+    t307 = t285*t298
+    t308 = t306 - t297*t307
+    t309 = t307 + t297*t306
+    t310 = t266*t298
+    t311 = t289*t298
+    t312 = t310 - t297*t311
+    t313 = t311 + t297*t310
+    t314 = t282*t304 + t286*t308 + t290*t312
+    t315 = (t314 != 0)
+    t316 = 0.5*(-t300 + t278)/casadi.if_else(t315, t314, 1)
+    t317 = casadi.fabs(t316)
+    t318 = (t317 >= 1)
+    t319 = casadi.fabs(1/casadi.if_else(t318, t316, 1))
+    t320 = casadi.if_else(t315, casadi.if_else((t316 >= 0), 1, -1)*casadi.if_else(t318, t319/(1 + casadi.sqrt(1 + t319**2)), 1/(t317 + casadi.sqrt(1 + t317**2))), 0)
+    t321 = 1/casadi.sqrt(1 + t320**2)
+    t322 = t314*t320
+    t323 = -t322 + t300
+    t324 = t278 + t322
+    t325 = t304*t321
+    t326 = t282*t321
+    t327 = t325 - t320*t326
+    t328 = t326 + t320*t325
+    t329 = t308*t321
+    t330 = t286*t321
+    t331 = t329 - t320*t330
+    t332 = t330 + t320*t329
+    t333 = t312*t321
+    t334 = t290*t321
+    t335 = t333 - t320*t334
+    t336 = t334 + t320*t333
+    t337 = t305*t328 + t309*t332 + t313*t336
+    t338 = (t337 != 0)
+    t339 = 0.5*(-t301 + t324)/casadi.if_else(t338, t337, 1)
+    t340 = casadi.fabs(t339)
+    t341 = (t340 >= 1)
+    t342 = casadi.fabs(1/casadi.if_else(t341, t339, 1))
+    t343 = casadi.if_else(t338, casadi.if_else((t339 >= 0), 1, -1)*casadi.if_else(t341, t342/(1 + casadi.sqrt(1 + t342**2)), 1/(t340 + casadi.sqrt(1 + t340**2))), 0)
+    t344 = 1/casadi.sqrt(1 + t343**2)
+    t345 = t337*t343
+    t346 = -t345 + t301
+    t347 = t324 + t345
+    t348 = t305*t344
+    t349 = t328*t344
+    t350 = t348 - t343*t349
+    t351 = t349 + t343*t348
+    t352 = t309*t344
+    t353 = t332*t344
+    t354 = t352 - t343*t353
+    t355 = t353 + t343*t352
+    t356 = t313*t344
+    t357 = t336*t344
+    t358 = t356 - t343*t357
+    t359 = t357 + t343*t356
+    t360 = t327*t350 + t331*t354 + t335*t358
+    t361 = (t360 != 0)
+    t362 = 0.5*(-t323 + t346)/casadi.if_else(t361, t360, 1)
+    t363 = casadi.fabs(t362)
+    t364 = (t363 >= 1)
+    t365 = casadi.fabs(1/casadi.if_else(t364, t362, 1))
+    t366 = casadi.if_else(t361, casadi.if_else((t362 >= 0), 1, -1)*casadi.if_else(t364, t365/(1 + casadi.sqrt(1 + t365**2)), 1/(t363 + casadi.sqrt(1 + t363**2))), 0)
+    t367 = 1/casadi.sqrt(1 + t366**2)
+    t368 = t360*t366
+    t369 = -t368 + t323
+    t370 = t346 + t368
+    t371 = t327*t367
+    t372 = t350*t367
+    t373 = t371 - t366*t372
+    t374 = t372 + t366*t371
+    t375 = t331*t367
+    t376 = t354*t367
+    t377 = t375 - t366*t376
+    t378 = t376 + t366*t375
+    t379 = t335*t367
+    t380 = t358*t367
+    t381 = t379 - t366*t380
+    t382 = t380 + t366*t379
+    t383 = t351*t373 + t355*t377 + t359*t381
+    t384 = (t383 != 0)
+    t385 = 0.5*(-t369 + t347)/casadi.if_else(t384, t383, 1)
+    t386 = casadi.fabs(t385)
+    t387 = (t386 >= 1)
+    t388 = casadi.fabs(1/casadi.if_else(t387, t385, 1))
+    t389 = casadi.if_else(t384, casadi.if_else((t385 >= 0), 1, -1)*casadi.if_else(t387, t388/(1 + casadi.sqrt(1 + t388**2)), 1/(t386 + casadi.sqrt(1 + t386**2))), 0)
+    t390 = 1/casadi.sqrt(1 + t389**2)
+    t391 = t383*t389
+    t392 = -t391 + t369
+    t393 = t347 + t391
+    t394 = t373*t390
+    t395 = t351*t390
+    t396 = t394 - t389*t395
+    t397 = t395 + t389*t394
+    t398 = t377*t390
+    t399 = t355*t390
+    t400 = t398 - t389*t399
+    t401 = t399 + t389*t398
+    t402 = t381*t390
+    t403 = t359*t390
+    t404 = t402 - t389*t403
+    t405 = t403 + t389*t402
+    t406 = t374*t397 + t378*t401 + t382*t405
+    t407 = (t406 != 0)
+    t408 = 0.5*(-t370 + t393)/casadi.if_else(t407, t406, 1)
+    t409 = casadi.fabs(t408)
+    t410 = (t409 >= 1)
+    t411 = casadi.fabs(1/casadi.if_else(t410, t408, 1))
+    t412 = casadi.if_else(t407, casadi.if_else((t408 >= 0), 1, -1)*casadi.if_else(t410, t411/(1 + casadi.sqrt(1 + t411**2)), 1/(t409 + casadi.sqrt(1 + t409**2))), 0)
+    t413 = 1/casadi.sqrt(1 + t412**2)
+    t414 = t406*t412
+    t415 = -t414 + t370
+    t416 = t393 + t414
+    t417 = t374*t413
+    t418 = t397*t413
+    t419 = t417 - t412*t418
+    t420 = t418 + t412*t417
+    t421 = t378*t413
+    t422 = t401*t413
+    t423 = t421 - t412*t422
+    t424 = t422 + t412*t421
+    t425 = t382*t413
+    t426 = t405*t413
+    t427 = t425 - t412*t426
+    t428 = t426 + t412*t425
+    t429 = t396*t419 + t400*t423 + t404*t427
+    t430 = (t429 != 0)
+    t431 = 0.5*(-t392 + t415)/casadi.if_else(t430, t429, 1)
+    t432 = casadi.fabs(t431)
+    t433 = (t432 >= 1)
+    t434 = casadi.fabs(1/casadi.if_else(t433, t431, 1))
+    t435 = casadi.if_else(t430, casadi.if_else((t431 >= 0), 1, -1)*casadi.if_else(t433, t434/(1 + casadi.sqrt(1 + t434**2)), 1/(t432 + casadi.sqrt(1 + t432**2))), 0)
+    t436 = 1/casadi.sqrt(1 + t435**2)
+    t437 = t429*t435
+    t438 = -t437 + t392
+    t439 = t415 + t437
+    t440 = t396*t436
+    t441 = t419*t436
+    t442 = t440 - t435*t441
+    t443 = t441 + t435*t440
+    t444 = t400*t436
+    t445 = t423*t436
+    t446 = t444 - t435*t445
+    t447 = t445 + t435*t444
+    t448 = t404*t436
+    t449 = t427*t436
+    t450 = t448 - t435*t449
+    t451 = t449 + t435*t448
+    t452 = t420*t442 + t424*t446 + t428*t450
+    t453 = (t452 != 0)
+    t454 = 0.5*(-t438 + t416)/casadi.if_else(t453, t452, 1)
+    t455 = casadi.fabs(t454)
+    t456 = (t455 >= 1)
+    t457 = casadi.fabs(1/casadi.if_else(t456, t454, 1))
+    t458 = casadi.if_else(t453, casadi.if_else((t454 >= 0), 1, -1)*casadi.if_else(t456, t457/(1 + casadi.sqrt(1 + t457**2)), 1/(t455 + casadi.sqrt(1 + t455**2))), 0)
+    t459 = 1/casadi.sqrt(1 + t458**2)
+    t460 = t416 + t452*t458
+    t461 = t442*t459
+    t462 = t420*t459
+    t463 = t461 - t458*t462
+    t464 = t462 + t458*t461
+    t465 = t446*t459
+    t466 = t424*t459
+    t467 = t465 - t458*t466
+    t468 = t466 + t458*t465
+    t469 = t450*t459
+    t470 = t428*t459
+    t471 = t469 - t458*t470
+    t472 = t470 + t458*t469
+    t473 = t443*t464 + t447*t468 + t451*t472
+    t474 = casadi.sqrt(t463**2 + t467**2 + t471**2)
+    t475 = (t473 != 0)
+    t476 = 0.5*(-t439 + t460)/casadi.if_else(t475, t473, 1)
+    t477 = casadi.fabs(t476)
+    t478 = (t477 >= 1)
+    t479 = casadi.fabs(1/casadi.if_else(t478, t476, 1))
+    t480 = casadi.if_else(t475, casadi.if_else((t476 >= 0), 1, -1)*casadi.if_else(t478, t479/(1 + casadi.sqrt(1 + t479**2)), 1/(t477 + casadi.sqrt(1 + t477**2))), 0)
+    t481 = 1/casadi.sqrt(1 + t480**2)
+    t482 = t443*t481
+    t483 = t464*t481
+    t484 = t482 - t480*t483
+    t485 = t483 + t480*t482
+    t486 = t447*t481
+    t487 = t468*t481
+    t488 = t486 - t480*t487
+    t489 = t487 + t480*t486
+    t490 = t451*t481
+    t491 = t472*t481
+    t492 = t490 - t480*t491
+    t493 = t491 + t480*t490
+    t494 = casadi.sqrt(t484**2 + t488**2 + t492**2)
+    t495 = casadi.sqrt(t485**2 + t489**2 + t493**2)
+    t496 = casadi.if_else((t494 > t474), t494, t474)
+    t497 = casadi.if_else((t494 < t474), t494, t474)
+    t498 = casadi.if_else((1.8823529411764706 > t496), 1.8823529411764706, t496)
+    t499 = casadi.if_else((1.8823529411764706 < t497), 1.8823529411764706, t497)
+    t500 = casadi.if_else((t495 > t498), t495, t498)
+    t501 = casadi.if_else((t495 < t499), t495, t499)
     kappa = casadi.SX(1, 1)
-    kappa[0, 0] = casadi.if_else((t437 > 0), t437, 1)/casadi.if_else((t438 <= 1e-12*t437), 0, t438)
+    kappa[0, 0] = casadi.if_else((t500 > 0), t500, 1)/casadi.if_else((t501 <= 1e-12*t500), 0, t501)
     return [kappa]
 
 

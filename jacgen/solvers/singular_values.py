@@ -40,8 +40,9 @@ def jacobi(R: list, g: Graph, name: Callable, vectors: bool) -> tuple[list[Node]
     R's rows (the columns of R^T, whose singular values are the same): that converges faster.
 
     A rotation of columns i, j with a = |w_i|^2, b = |w_j|^2, c = w_i . w_j: zeta = (b - a) /
-    2c, t = sign(zeta) / (|zeta| + sqrt(1 + zeta^2)) (the smaller angle), and none where c = 0
-    (a select of a divisor that stays finite, so that the gradients of JAX and PyTorch do too).
+    2c, t = sign(zeta) / (|zeta| + sqrt(1 + zeta^2)) (the smaller angle; for |zeta| >= 1 as
+    sign(zeta) |1/zeta| / (1 + sqrt(1 + 1/zeta^2)), which does not overflow), and none where
+    c = 0 (selects of divisors that stay finite, so that the gradients of JAX and PyTorch do too).
     It makes a and b a - t c and b + t c, which are kept rather than summed again."""
     k = len(R)
     zero, one = g.number(0), g.number(1)
@@ -56,7 +57,11 @@ def jacobi(R: list, g: Graph, name: Callable, vectors: bool) -> tuple[list[Node]
                 rotated = g.relation("!=", c, zero)
                 zeta = name((b - a) / (2 * g.select(rotated, c, one)))
                 sign = g.select(g.relation(">=", zeta, zero), one, -one)
-                t = name(g.select(rotated, sign / (g.call("Abs", zeta) + g.sqrt(1 + zeta**2)), zero))
+                large = g.relation(">=", g.call("Abs", zeta), one)
+                w = name(g.call("Abs", 1 / g.select(large, zeta, one)))  # |1 / zeta| where that is <= 1
+                small = g.call("Abs", zeta)
+                t = name(g.select(rotated, sign * g.select(large, w / (1 + g.sqrt(1 + w**2)),
+                                                           1 / (small + g.sqrt(1 + small**2))), zero))
                 cos = name(1 / g.sqrt(1 + t**2))
                 sin = name(cos * t)
                 squares[i], squares[j] = name(a - t * c), name(b + t * c)
@@ -155,9 +160,10 @@ def manipulability_gradient(js, layers: list, g: Graph, name: Callable) -> list[
             Q[c] = Q[c][:j] + [name(Q[c][i] - s * v[i - j]) for i in range(j, p)]
     adjugate = adjugate_triangular(R, g, name)
     weights = [[name(sum(Q[a][r] * adjugate[c][a] for a in range(k))) for c in range(k)] for r in range(p)]
-    signs = [g.select(g.relation(">", R[j][j], zero), one, g.select(g.relation("<", R[j][j], zero), -one, zero))
-             for j in range(k)]
-    sign = name(g.select(singular, zero, _product(signs, one)))
+    sign = one  # of det R: its diagonal's signs multiplied (no product of values, which may underflow)
+    for j in range(k):
+        sign = name(g.select(g.relation("<", R[j][j], zero), -sign, sign))
+    sign = name(g.select(singular, zero, sign))
     gradient = []
     for layer in layers:
         dA = layer if tall else layer.T
