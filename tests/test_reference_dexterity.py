@@ -37,6 +37,17 @@ joints:
 task: [x, y, z]
 """
 
+# A 4-joint arm with the task z and the three angles.
+WRIST_ARM = b"""name: wrist
+convention: standard
+joints:
+  - {type: prismatic, a: 0, alpha: 0, theta: 0, offset: 0.1, limits: [0, 0.5]}
+  - {type: revolute, a: 0, alpha: 1.5707963267948966, d: 0.2, offset: 0}
+  - {type: revolute, a: 0, alpha: -1.5707963267948966, d: 0, offset: 0}
+  - {type: revolute, a: 0, alpha: 0, d: 0.1, offset: 0}
+task: [z, roll, pitch, yaw]
+"""
+
 
 def rtb_model(name):
     with warnings.catch_warnings():
@@ -253,6 +264,14 @@ def test_task_error_of_a_pose_and_of_a_task_vector():
     q = samples("rexarm")[:20]
     target = reference.task(rexarm, q) + [0.01, -0.02, 0.0, 2 * math.pi + 0.1]  # pitch a turn and 0.1 away
     assert_allclose(reference.task_error(rexarm, q, target), np.tile([0.01, -0.02, 0.0, 0.1], (20, 1)), atol=1e-12)
+
+    wrist = parse_robot(WRIST_ARM)  # all three angles, Js's rows the angular velocity's: a rotation vector
+    q = np.random.default_rng(9).uniform(-2, 2, size=(20, 4))
+    moved = q + 0.05 * np.random.default_rng(10).normal(size=q.shape)
+    error = reference.task_error(wrist, q, reference.task(wrist, moved))
+    assert_allclose(error[:, 0], reference.fk(wrist, moved)[:, 2, 3] - reference.fk(wrist, q)[:, 2, 3], atol=1e-15)
+    turn = reference.fk(wrist, moved)[:, :3, :3] @ np.swapaxes(reference.fk(wrist, q)[:, :3, :3], 1, 2)
+    assert_allclose(error[:, 1:], Rotation.from_matrix(turn).as_rotvec(), atol=1e-12)
 
 
 # -- verify's checks, fed right and wrong answers ------------------------------------------------

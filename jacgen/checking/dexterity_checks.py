@@ -51,8 +51,9 @@ def dexterity_results(robot: Robot, backends: GeneratedCode, q: np.ndarray, defi
     if "condition_number" in generated:
         length = characteristic_length(robot)
         expected = 1 / reference.condition_number(robot, q[defined], length)
-        errors = _per_backend(backends, "condition_number", lambda backend: _largest(np.abs(
-            1 / np.reshape(backends.call(backend, "condition_number", q[defined])[0], -1) - expected)))
+        with np.errstate(divide="ignore"):  # a kappa of 0 (wrong) is an infinite error
+            errors = _per_backend(backends, "condition_number", lambda backend: _largest(np.abs(
+                1 / np.reshape(backends.call(backend, "condition_number", q[defined])[0], -1) - expected)))
         results.append(Result(robot.name, "condition_number", errors, tolerances,
                               f"|1/kappa - 1/kappa_ref| at {int(defined.sum())} samples, position rows / L = {length:.6g}"))
     if "manipulability_gradient" in generated:

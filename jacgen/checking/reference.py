@@ -37,12 +37,16 @@ def _translation(x, y, z):
     return _matrix([[1, 0, 0, x], [0, 1, 0, y], [0, 0, 1, z], [0, 0, 0, 1]])
 
 
-def _pose(pose):
-    """world<-frame transform of a base/tool Pose: Rz(yaw) Ry(pitch) Rx(roll) after xyz."""
-    roll, pitch, yaw = (v.approx for v in pose.rpy)
+def _rpy_rotation(roll, pitch, yaw):
+    """Rz(yaw) Ry(pitch) Rx(roll), 4x4."""
     cp, sp = np.cos(pitch), np.sin(pitch)
     rot_y = _matrix([[cp, 0, sp, 0], [0, 1, 0, 0], [-sp, 0, cp, 0], [0, 0, 0, 1]])
-    return _translation(*(v.approx for v in pose.xyz)) @ _rot_z(yaw) @ rot_y @ _rot_x(roll)
+    return _rot_z(yaw) @ rot_y @ _rot_x(roll)
+
+
+def _pose(pose):
+    """world<-frame transform of a base/tool Pose: Rz(yaw) Ry(pitch) Rx(roll) after xyz."""
+    return _translation(*(v.approx for v in pose.xyz)) @ _rpy_rotation(*(v.approx for v in pose.rpy))
 
 
 def _link(robot, joint, qi):
@@ -295,15 +299,24 @@ def rotation_vector(rotation):
 
 
 def task_error(robot, q, target):
-    """The error ik_numeric drives to 0 and resolved_rate feeds back: for a six-component task (a
-    4x4 target) the position error and the rotation vector of R_target R(q)^T, world frame; else
-    target - mu(q) with the Euler angles wrapped into (-pi, pi]."""
+    """The error resolved_rate feeds back, in the rows of Js: for a six-component task (a 4x4
+    target) ik_numeric's, the position error and the rotation vector of R_target R(q)^T, world
+    frame; for another task with all of roll, pitch and yaw (whose Js has angular-velocity rows)
+    the same from the target's angles, R_target = Rz(yaw) Ry(pitch) Rx(roll); else target - mu(q)
+    with the Euler angles wrapped into (-pi, pi]."""
     target = np.asarray(target, dtype=float)
+    pose = fk(robot, q)
     if len(robot.task) == 6:
-        pose = fk(robot, q)
-        turn = target[..., :3, :3] @ np.swapaxes(pose[..., :3, :3], -1, -2)
-        return np.concatenate([target[..., :3, 3] - pose[..., :3, 3], rotation_vector(turn)], -1)
-    difference = target - task(robot, q)
-    angular = [k for k, name in enumerate(robot.task) if name in ("roll", "pitch", "yaw")]
-    difference[..., angular] = np.pi - (np.pi - difference[..., angular]) % (2 * np.pi)
-    return difference
+        position, goal = target[..., :3, 3], target[..., :3, :3]
+    elif {"roll", "pitch", "yaw"} <= set(robot.task):
+        given = dict(zip(robot.task, np.moveaxis(target, -1, 0)))
+        position = np.stack([given.get(axis, pose[..., i, 3]) for i, axis in enumerate("xyz")], -1)
+        goal = _rpy_rotation(given["roll"], given["pitch"], given["yaw"])[..., :3, :3]
+    else:
+        difference = target - task(robot, q)
+        angular = [k for k, name in enumerate(robot.task) if name in ("roll", "pitch", "yaw")]
+        difference[..., angular] = np.pi - (np.pi - difference[..., angular]) % (2 * np.pi)
+        return difference
+    turn = rotation_vector(goal @ np.swapaxes(pose[..., :3, :3], -1, -2))
+    full = np.concatenate([position - pose[..., :3, 3], turn], -1)
+    return full[..., [TASK_COMPONENTS.index(name) for name in robot.task]]
