@@ -11,14 +11,11 @@ multiply back to det(Js) (or the Gram determinant) at random configurations.
 import numpy as np
 import pytest
 import sympy
-from click.testing import CliRunner
-from scipy.optimize import brentq, minimize, minimize_scalar
+from scipy.optimize import brentq, minimize
 
 from jacgen.model import kinematics
-from jacgen import load_robot
 from jacgen.checking import reference
 from jacgen.model.singularities import analyse
-from jacgen.cli import main
 from jacgen.inputs.robot_file import parse_robot
 
 from conftest import ROBOT_NAMES, generated_module, random_configurations, robot
@@ -195,32 +192,6 @@ def test_euler_singularity_of_a_pitch_task():
     value = sympy.lambdify([kinematics.joint_symbols(arm)], factor.condition, "numpy")
     q = solve_along(arm, lambda a, x: value(x), random_configurations(arm, 1, seed=4)[0], 3)
     assert abs(abs(reference.rpy(reference.fk(arm, q)[:3, :3])[1]) - np.pi / 2) < 1e-6
-
-
-def _planar_2r(tmp_path, a1, a2):
-    path = tmp_path / "two.yaml"
-    path.write_text(f"name: two\nconvention: standard\njoints:\n"
-                    f"  - {{type: revolute, a: {a1}, alpha: 0, d: 0}}\n"
-                    f"  - {{type: revolute, a: {a2}, alpha: 0, d: 0}}\ntask: [x, y]\n")
-    return path
-
-
-@pytest.mark.parametrize("a1, a2", [(1.0, 1.0), ("sqrt(2)", 1.0), (0.5, 0.8)])
-def test_isotropy_of_planar_2r(tmp_path, a1, a2):
-    """The reported best elbow angle is where the reference J is best conditioned."""
-    arm = load_robot(_planar_2r(tmp_path, a1, a2))
-    def condition(x):
-        return np.linalg.cond(reference.jacobian(arm, np.array([0.3, x]))[:2])
-
-    grid = np.linspace(0.01, np.pi - 0.01, 721)
-    start = grid[int(np.argmin([condition(x) for x in grid]))]
-    best = minimize_scalar(condition, bounds=(start - 0.01, start + 0.01), method="bounded",
-                           options={"xatol": 1e-10}).x
-    result = CliRunner().invoke(main, ["show", str(tmp_path / "two.yaml")])
-    assert result.exit_code == 0
-    line = next(line for line in result.output.splitlines() if "best conditioned" in line or "isotropic (" in line)
-    assert f"{np.degrees(best):.4g} deg" in line
-    assert ("isotropic (condition number 1)" in line) == (a1 == "sqrt(2)")
 
 
 @pytest.mark.parametrize("polynomial", ["c2**3 - 1/2", "4*c2**3 - 3*c2 - 1/5", "s2*c2 + s2 - 1/3", "c2 + 1"])

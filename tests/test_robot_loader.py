@@ -46,7 +46,7 @@ joints:
     limits: [-170, 170]
 task: [x, y, z]
 """
-TOP_KEYS = "name, description, convention, angle_unit, length_unit, parameters, joints, base, tool, task, ik"
+TOP_KEYS = "name, description, convention, angle_unit, length_unit, parameters, joints, base, tool, task, ik, characteristic_length"
 JOINT_KEYS = "name, type, a, alpha, d, theta, offset, limits"
 
 

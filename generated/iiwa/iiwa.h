@@ -35,6 +35,8 @@ typedef double iiwa_real;
 #define IIWA_NUM_SINGULARITY_FACTORS 2
 #define IIWA_MAX_IK_SOLUTIONS 8
 #define IIWA_IK_FREE_JOINT 2
+/* Characteristic length L (Angeles), m: divide the position rows of Js by it for a unit-free condition number; computed: the L whose best condition number over the joint ranges is least. */
+#define IIWA_CHARACTERISTIC_LENGTH 0.235399
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 119 operations. */

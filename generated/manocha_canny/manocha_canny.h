@@ -33,6 +33,8 @@ typedef double manocha_canny_real;
 #define MANOCHA_CANNY_TASK_DIM 6
 #define MANOCHA_CANNY_NUM_SINGULARITY_FACTORS 1
 #define MANOCHA_CANNY_MAX_IK_SOLUTIONS 16
+/* Characteristic length L (Angeles), m: divide the position rows of Js by it for a unit-free condition number; computed: the L whose best condition number over the joint ranges is least. */
+#define MANOCHA_CANNY_CHARACTERISTIC_LENGTH 0.804349
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 161 operations. */

@@ -35,6 +35,8 @@ typedef double panda_real;
 #define PANDA_NUM_SINGULARITY_FACTORS 1
 #define PANDA_MAX_IK_SOLUTIONS 8
 #define PANDA_IK_FREE_JOINT 6
+/* Characteristic length L (Angeles), m: divide the position rows of Js by it for a unit-free condition number; computed: the L whose best condition number over the joint ranges is least. */
+#define PANDA_CHARACTERISTIC_LENGTH 0.161889
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 152 operations. */

@@ -28,6 +28,8 @@ typedef double planar_2r_real;
 #define PLANAR_2R_TASK_DIM 2
 #define PLANAR_2R_NUM_SINGULARITY_FACTORS 1
 #define PLANAR_2R_MAX_IK_SOLUTIONS 2
+/* Characteristic length L (Angeles), m: divide the position rows of Js by it for a unit-free condition number; 1 (Js unchanged): the task has only positions, so L does not change the condition number. */
+#define PLANAR_2R_CHARACTERISTIC_LENGTH 1.0
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 13 operations. */

@@ -14,6 +14,8 @@ import casadi
 
 DOF = 2
 TASK = ("x", "y", )
+# Characteristic length L (Angeles), m: divide the position rows of Js by it for a unit-free condition number; 1 (Js unchanged): the task has only positions, so L does not change the condition number.
+CHARACTERISTIC_LENGTH = 1.0
 
 
 def _fk(q):

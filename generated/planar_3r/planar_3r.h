@@ -30,6 +30,8 @@ typedef double planar_3r_real;
 #define PLANAR_3R_TASK_DIM 3
 #define PLANAR_3R_NUM_SINGULARITY_FACTORS 1
 #define PLANAR_3R_MAX_IK_SOLUTIONS 2
+/* Characteristic length L (Angeles), m: divide the position rows of Js by it for a unit-free condition number; computed: the L whose best condition number over the joint ranges is least. */
+#define PLANAR_3R_CHARACTERISTIC_LENGTH 0.463158
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 23 operations. */

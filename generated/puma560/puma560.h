@@ -33,6 +33,8 @@ typedef double puma560_real;
 #define PUMA560_TASK_DIM 6
 #define PUMA560_NUM_SINGULARITY_FACTORS 3
 #define PUMA560_MAX_IK_SOLUTIONS 8
+/* Characteristic length L (Angeles), m: divide the position rows of Js by it for a unit-free condition number; computed: the L whose best condition number over the joint ranges is least. */
+#define PUMA560_CHARACTERISTIC_LENGTH 0.291411
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 96 operations. */

@@ -31,6 +31,8 @@ typedef double rexarm_real;
 #define REXARM_TASK_DIM 4
 #define REXARM_NUM_SINGULARITY_FACTORS 2
 #define REXARM_MAX_IK_SOLUTIONS 8
+/* Characteristic length L (Angeles), m: divide the position rows of Js by it for a unit-free condition number; computed: the L whose best condition number over the joint ranges is least. */
+#define REXARM_CHARACTERISTIC_LENGTH 0.0595879
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 46 operations. */

@@ -35,6 +35,8 @@ typedef double sawyer_real;
 #define SAWYER_NUM_SINGULARITY_FACTORS 1
 #define SAWYER_MAX_IK_SOLUTIONS 16
 #define SAWYER_IK_FREE_JOINT 6
+/* Characteristic length L (Angeles), m: divide the position rows of Js by it for a unit-free condition number; computed: the L whose best condition number over the joint ranges is least. */
+#define SAWYER_CHARACTERISTIC_LENGTH 0.220878
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 142 operations. */

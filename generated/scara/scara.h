@@ -31,6 +31,8 @@ typedef double scara_real;
 #define SCARA_TASK_DIM 4
 #define SCARA_NUM_SINGULARITY_FACTORS 1
 #define SCARA_MAX_IK_SOLUTIONS 2
+/* Characteristic length L (Angeles), m: divide the position rows of Js by it for a unit-free condition number; computed: the L whose best condition number over the joint ranges is least. */
+#define SCARA_CHARACTERISTIC_LENGTH 0.53125
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 27 operations. */

@@ -14,6 +14,8 @@ import casadi
 
 DOF = 4
 TASK = ("x", "y", "z", "yaw", )
+# Characteristic length L (Angeles), m: divide the position rows of Js by it for a unit-free condition number; computed: the L whose best condition number over the joint ranges is least.
+CHARACTERISTIC_LENGTH = 0.53125
 
 
 def _fk(q):

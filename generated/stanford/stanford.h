@@ -33,6 +33,8 @@ typedef double stanford_real;
 #define STANFORD_TASK_DIM 6
 #define STANFORD_NUM_SINGULARITY_FACTORS 3
 #define STANFORD_MAX_IK_SOLUTIONS 8
+/* Characteristic length L (Angeles), m: divide the position rows of Js by it for a unit-free condition number; computed: the L whose best condition number over the joint ranges is least. */
+#define STANFORD_CHARACTERISTIC_LENGTH 0.879319
 
 /* Pose of the tool frame in the world frame (4x4 homogeneous).
  * Result: T: 4 x 4 row-major, element (r, c) at T[r * 4 + c]. 73 operations. */

@@ -70,6 +70,7 @@ class Robot:
     digest: str  # sha256 of the file's bytes, first 16 hex digits
     free_joint: int | None = None  # `ik: {free_joint: k}`, 0-based: the joint the closed-form ik takes as input
     nearest_class: bool = True  # `ik: {nearest_class: false}` turns off the calibrated arms' fast path
+    characteristic_length: float | None = None  # Angeles' L from the file (model/dexterity.py); None: computed
 
     @property
     def dof(self) -> int:

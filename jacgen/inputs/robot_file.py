@@ -199,7 +199,7 @@ class _RobotReader:
         top = self.mapping(
             root, "",
             ("name", "description", "convention", "angle_unit", "length_unit", "parameters",
-             "joints", "base", "tool", "task", "ik"),
+             "joints", "base", "tool", "task", "ik", "characteristic_length"),
             ("name", "convention", "joints"),
         )
         name = self.string(top["name"], "name", pattern=NAME_PATTERN)
@@ -217,8 +217,9 @@ class _RobotReader:
         tool = self.pose(top["tool"], "tool") if "tool" in top else IDENTITY_POSE
         task = self.task(top.get("task"), root, len(joints))
         free_joint, nearest_class = self.ik_options(top["ik"], joints, task) if "ik" in top else (None, True)
+        length = self.characteristic_length(top["characteristic_length"]) if "characteristic_length" in top else None
         robot = Robot(name, description, convention, length_unit, parameters, joints, base, tool,
-                      task, self.path, hashlib.sha256(self.data).hexdigest()[:16], free_joint, nearest_class)
+                      task, self.path, hashlib.sha256(self.data).hexdigest()[:16], free_joint, nearest_class, length)
         self.check_sizes(robot, top["joints"])
         if "task" in top:
             self.check_euler_angles(robot, top["task"])
@@ -345,6 +346,17 @@ class _RobotReader:
             raise self.error(node, "task", problem)
         return tuple(names)
 
+
+    def characteristic_length(self, node) -> float:
+        """`characteristic_length`: a positive number (or expression) in the file's length unit,
+        fixed at generation time (it is printed into the generated constant)."""
+        value = self.value(node, "characteristic_length")
+        if value.symbolic:
+            raise self.error(node, "characteristic_length", f"may not hold a symbolic parameter (it is a constant "
+                             f"of the generated code), got {_shown(node.value)}")
+        if not value.approx > 0:
+            raise self.error(node, "characteristic_length", f"expected a positive length, got {_shown(node.value)}")
+        return value.approx
 
     def flag(self, node, key: str) -> bool:
         """A YAML boolean."""

@@ -1,11 +1,14 @@
-"""Words a person reads: DH table, task, singularities and IK of a robot (`jacgen show`,
-the generated NAME.md report)."""
+"""Words a person reads: DH table, task, singularities, dexterity and IK of a robot
+(`jacgen show`, the generated NAME.md report)."""
+
+import math
 
 import numpy as np
 import sympy
 
 from jacgen.inputs import numeric_chain
-from jacgen.inputs.robot import Robot
+from jacgen.inputs.robot import EULER_ANGLES, Robot
+from jacgen.model.dexterity import ISOTROPIC, NEUTRAL_LENGTH, Dexterity
 from jacgen.model.js_rank import singularity_rows
 from jacgen.model.nearest_class import NEAR_LENGTH, NEAR_TWIST
 from jacgen.model.singularities import READABLE_TERMS, Factor, Singularities
@@ -108,32 +111,42 @@ def moves_in_plane(robot: Robot) -> bool:
     return all(np.linalg.norm(np.cross(frame[:3, 2], [0.0, 0.0, 1.0])) < PARALLEL for frame in frames)
 
 
-def isotropy_lines(robot: Robot) -> list[str]:
-    """Planar 2R (task x, y): the best-conditioned elbow angle, isotropic when l1 = sqrt(2) l2.
+def dexterity_lines(model: Model) -> list[str]:
+    """Angeles' characteristic length L, the best condition number of Js with its position
+    rows divided by L, where it is reached, and whether the arm is isotropic there."""
+    robot, dexterity = model.robot, model.dexterity
+    unit = robot.length_unit
+    where = ", ".join(f"{np.degrees(value):.4g} deg" if joint.revolute else f"{value:.4g} {unit}"
+                      for joint, value in zip(robot.joints, dexterity.configuration))
+    lines = [f"characteristic length L = {dexterity.length!r} {unit}: {_length_origin(robot, dexterity)}"]
+    if not math.isfinite(dexterity.best_condition):
+        lines.append("best condition number: infinite (Js has less than full rank in every configuration)")
+    elif dexterity.isotropic:
+        lines.append(f"isotropic: condition number 1 (to {ISOTROPIC:g}) at q = ({where})")
+    else:
+        lines.append(f"not isotropic: best condition number {dexterity.best_condition:.4g} at q = ({where})")
+    if robot.symbolic_parameters:
+        lines.append("note: at the nominal values of the runtime parameters")
+    return lines
 
-    With link lengths l1, l2 and elbow angle phi, cond(J)^2 + 1/cond(J)^2 + 2 =
-    (l1^2 + 2 l2^2 + 2 l1 l2 cos(phi))^2 / (l1 l2 sin(phi))^2, least at
-    cos(phi) = -2 l1 l2 / (l1^2 + 2 l2^2), where cond(J) = 1 exactly when l1 = sqrt(2) l2.
-    """
-    if not (robot.dof == 2 and all(j.revolute for j in robot.joints) and robot.task == ("x", "y")
-            and moves_in_plane(robot)):
-        return []
-    frames, tool = numeric_chain.axis_frames(robot, np.zeros(2))
-    l1 = float(np.linalg.norm((frames[1][:3, 3] - frames[0][:3, 3])[:2]))
-    l2 = float(np.linalg.norm((tool[:3, 3] - frames[1][:3, 3])[:2]))
-    if l1 == 0 or l2 == 0:
-        return []
-    link1 = (frames[1][:3, 3] - frames[0][:3, 3])[:2]
-    link2 = (tool[:3, 3] - frames[1][:3, 3])[:2]
-    phi0 = np.arctan2(link1[0] * link2[1] - link1[1] * link2[0], np.dot(link1, link2))  # elbow angle at q2 = 0
-    phi = np.arccos(-2 * l1 * l2 / (l1**2 + 2 * l2**2))
-    angles = sorted(float((s * phi - phi0 + np.pi) % (2 * np.pi) - np.pi) for s in (1, -1))
-    condition = np.linalg.cond(numeric_chain.jacobian(robot, np.array([0.0, angles[0]]))[:2])
-    where = f"q2 in {{{', '.join(f'{np.degrees(a):.4g} deg' for a in angles)}}}"
-    if abs(condition - 1) < 1e-9:
-        return [f"isotropic (condition number 1) at {where}: l1 = sqrt(2) l2"]
-    return [f"no isotropic configuration (that needs l1 = sqrt(2) l2; here l1 = {l1:.6g}, l2 = {l2:.6g}); "
-            f"best conditioned at {where}, condition number {condition:.6g}"]
+
+def _length_origin(robot: Robot, dexterity: Dexterity) -> str:
+    """Where L comes from, and why it is 1 where it is not computed."""
+    origin = "from the robot file" if dexterity.given else f"{NEUTRAL_LENGTH:g} (Js unchanged)"
+    if not dexterity.length_matters:
+        kind = "positions" if any(c not in EULER_ANGLES for c in robot.task) else "angles"
+        return f"{origin}: the task has only {kind}, so L does not change the condition number"
+    if dexterity.given:
+        return origin
+    if not math.isfinite(dexterity.best_condition):
+        return f"{origin}: no L conditions Js, which has less than full rank everywhere"
+    return "computed: the L whose best condition number over the joint ranges is least"
+
+
+def characteristic_length_note(robot: Robot, dexterity: Dexterity) -> str:
+    """The one-line comment of the generated CHARACTERISTIC_LENGTH constant."""
+    return (f"Characteristic length L (Angeles), {robot.length_unit}: divide the position rows of Js by it for a "
+            f"unit-free condition number; {_length_origin(robot, dexterity)}")
 
 
 def ik_lines(model: Model) -> list[str]:
@@ -189,9 +202,7 @@ def describe(model: Model) -> str:
         lines.append("runtime parameters: " + ", ".join(f"{p.name} (nominal {p.value:g})" for p in symbolic))
     lines += ["", f"singularities ({singular.kind} = 0, Js = {js_text(robot)}):"]
     lines += [f"  {line}" for line in singularity_lines(robot, singular) + euler_lines(robot, singular)]
-    isotropy = isotropy_lines(robot)
-    if isotropy:
-        lines += ["", "isotropy:"] + [f"  {line}" for line in isotropy]
+    lines += ["", "dexterity:"] + [f"  {line}" for line in dexterity_lines(model)]
     lines += ["", "inverse kinematics:"] + [f"  {line}" for line in ik_lines(model)]
     return "\n".join(lines)
 

@@ -1,8 +1,8 @@
 """What jacgen derives from a robot file once, before any code exists: the end of the model
 and solver stages.
 
-The structure (and with it the closed-form solver and its exact constants) and the
-singularity analysis are computed at most once per robot and read by every backend, the
+The structure (and with it the closed-form solver and its exact constants), the singularity
+analysis and the dexterity are computed at most once per robot and read by every backend, the
 report and `jacgen show`/`verify`. Each is computed when first asked for.
 """
 
@@ -10,6 +10,7 @@ from functools import cached_property
 
 from jacgen import budget
 from jacgen.inputs.robot import Robot
+from jacgen.model.dexterity import Dexterity, dexterity
 from jacgen.model.singularities import Singularities, analyse, unanalysed
 from jacgen.model.structure import Geometry, Structure, classify
 from jacgen.solvers import ik
@@ -41,3 +42,8 @@ class Model:
         """The exact singularity analysis, under its work limits and the --budget safety net."""
         return budget.within_budget(lambda: analyse(self.robot), lambda: unanalysed(self.robot),
                                     f"the singularity analysis of {self.robot.name}")
+
+    @cached_property
+    def dexterity(self) -> Dexterity:
+        """Angeles' characteristic length, the best condition number of Js and where (numeric)."""
+        return dexterity(self.robot)

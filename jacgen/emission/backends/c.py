@@ -4,8 +4,8 @@ eigensolver's runtime is C of its own, `templates/runtime/`)."""
 
 import numpy
 
-from jacgen.emission.backends.common import (Backend, common_context, ik_context, ik_numeric_context, joint_lines,
-                                             parameters_read, sentence, task_lines, velocity_ik_context)
+from jacgen.emission.backends.common import (Backend, characteristic_length, common_context, ik_context, ik_numeric_context,
+                                             joint_lines, parameters_read, sentence, task_lines, velocity_ik_context)
 from jacgen.emission.catalogue import Argument, Call, Function, Output
 from jacgen.emission.generator import Generator
 from jacgen.emission.printers import AND, ATOM, MATH_FUNCTIONS, PRODUCT, RELATION, Printer
@@ -170,6 +170,7 @@ def c_context(robot: Robot, generator: Generator, printer: CPrinter, real: str) 
         "prefix": robot.name.upper(),
         "real": real,
         "macros": list(macros.items()),
+        "characteristic_length": characteristic_length(robot, generator, printer.number),
         "joint_lines": joint_lines(robot),
         "task_lines": task_lines(robot),
         "functions": [_c_function(f, robot, printer, macros, by_name) for f in functions],

@@ -1,7 +1,8 @@
 """The CasADi backend: Python that builds each function as an SX graph (`templates/casadi/`),
 and its printer."""
 
-from jacgen.emission.backends.common import Backend, common_context, ik_numeric_context, parameters_read, sentence
+from jacgen.emission.backends.common import (Backend, characteristic_length, common_context, ik_numeric_context,
+                                             parameters_read, sentence)
 from jacgen.emission.backends.python import python_number
 from jacgen.emission.catalogue import Function
 from jacgen.emission.generator import Generator
@@ -72,6 +73,7 @@ def casadi_context(robot: Robot, generator: Generator, printer: CasadiPrinter, r
     context["functions"] = [_casadi_function(f, robot, printer) for f in functions]
     context["arguments"] = sorted({(a.name, a.symbols.rows, a.symbols.cols) for f in functions for a in f.arguments},
                                   key=lambda a: ("q", "q_dot", "mu_dot", "damping", "target", "T", "mu", "q_seed", "q_free", "weights").index(a[0]))
+    context["characteristic_length"] = characteristic_length(robot, generator, python_number)
     context["ik"] = any(loop.name == "ik" and loop.casadi for loop in generator.loops)
     context["nearest_statuses"] = [(status.name, status.value) for f in functions if f.name == "ik_nearest"
                                    for status in f.statuses]

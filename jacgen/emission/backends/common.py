@@ -11,6 +11,7 @@ from jacgen.inputs.robot import Robot
 from jacgen.model import js_rank
 from jacgen.model.tolerance_symbols import RANK, TOLERANCES
 from jacgen.reports import ik_documentation
+from jacgen.reports.description import characteristic_length_note
 from jacgen.solvers import differential, general6r
 from jacgen.tolerances import REACHED
 
@@ -75,6 +76,13 @@ def task_lines(robot: Robot) -> list[str]:
     if angles:
         lines.append(f"{' '.join(angles)}: ZYX Euler angles of the tool, R = Rz(yaw) Ry(pitch) Rx(roll), rad")
     return lines
+
+
+def characteristic_length(robot: Robot, generator: Generator, number: Callable) -> dict:
+    """The CHARACTERISTIC_LENGTH constant (`model/dexterity.py`): its literal, printed by
+    `number`, and its one-line comment."""
+    dexterity = generator.model.dexterity
+    return {"value": number(dexterity.length), "note": characteristic_length_note(robot, dexterity)}
 
 
 def ik_context(robot: Robot, generator: Generator, real: str, number: Callable, solutions_macro: str) -> dict | None:

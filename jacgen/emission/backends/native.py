@@ -114,7 +114,8 @@ def entries(generator: Generator, parameters: list[dict]) -> list[dict]:
 
 def constants(robot: Robot, generator: Generator, c: dict) -> list[tuple[str, str]]:
     """The module's constants, as NAME.py has them: (name, Python expression)."""
-    made = [("DOF", str(robot.dof)), ("TASK", repr(tuple(robot.task)))]
+    made = [("DOF", str(robot.dof)), ("TASK", repr(tuple(robot.task))),
+            ("CHARACTERISTIC_LENGTH", c["characteristic_length"]["value"])]
     if robot.symbolic_parameters:
         made.append(("PARAMETERS", repr({p.name: p.value for p in robot.symbolic_parameters})))
     if c["ik"]:

@@ -4,8 +4,8 @@ data of `templates/python/`."""
 import numpy
 import sympy
 
-from jacgen.emission.backends.common import (Backend, common_context, dimensions, ik_context, ik_numeric_context,
-                                             velocity_ik_context)
+from jacgen.emission.backends.common import (Backend, characteristic_length, common_context, dimensions, ik_context,
+                                             ik_numeric_context, velocity_ik_context)
 from jacgen.emission.catalogue import Function
 from jacgen.emission.generator import Generator
 from jacgen.model.node import ADD, CALL, MUL, NUMBER, SELECT, SYMBOL
@@ -137,6 +137,7 @@ def python_context(robot: Robot, generator: Generator, printer: PythonPrinter, r
     context = common_context(robot)
     context["functions"] = [_python_function(f, printer, context["parameters"]) for f in generator.functions()]
     context["ik"] = ik_context(robot, generator, "double", python_number, "MAX_IK_SOLUTIONS")
+    context["characteristic_length"] = characteristic_length(robot, generator, python_number)
     context["ik_numeric"] = generator.generates("ik_numeric") and (
         ik_numeric_context(robot, python_number) | {"python": LOOP_SYNTAX})
     context["velocity_ik"] = generator.generates("velocity_ik") and velocity_ik_context(robot, "double")

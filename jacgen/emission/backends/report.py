@@ -19,7 +19,7 @@ def _report_context(robot: Robot, generator: Generator) -> dict:
         "js_text": words.js_text(robot),
         "singularities": words.singularity_lines(robot, singular),
         "euler": words.euler_lines(robot, singular),
-        "isotropy": words.isotropy_lines(robot),
+        "dexterity": words.dexterity_lines(generator.model),
         "ik": words.ik_lines(generator.model),
         "operations": [{"name": f.name, "operations": f.body.operation_count,
                         "shape": "scalar" if f.scalar else " and ".join(dimensions(o) for o in f.outputs)}
