@@ -30,9 +30,8 @@ TARGET_DISTANCE = 0.05
 
 
 def characteristic_length(robot: Robot) -> float:
-    """L, the length the position rows of Js are divided by in the condition number."""
-    if not hasattr(Model, "dexterity"):  # FALLBACK until jacgen/model/dexterity.py lands (issue 48): remove then
-        return robot.reach or 1.0
+    """L, the length the position rows of Js are divided by in the condition number (the
+    model's: Angeles' characteristic length, or the robot file's)."""
     return Model(robot).dexterity.length
 
 
