@@ -2,10 +2,10 @@
 the Robotics Toolbox's `robot.plot` on the same arms.
 
 1. Every shipped robot and the stress suite's arms (tests/test_drawing.py's: 30 seeded
-   random arms of 1 to 12 joints, one of 16 and one of 32): `jacgen.drawing.draw` into a PNG
-   at its default configurations (q = 0 and the middle of the limits; planar arms also
-   the workspace map). matplotlib's import is taken once, before (it is the same for
-   every drawing).
+   random arms of 1 to 12 joints, one of 16 and one of 32): `jacgen.reports.drawing.draw`
+   into a PNG at its default configurations (two panels with the velocity ellipsoid; planar
+   arms also the workspace map with its ellipses). matplotlib's import is taken once,
+   before (it is the same for every drawing).
 2. One configuration into a PNG, jacgen's `draw` with one panel against rtb's
    `robot.plot(q, backend="pyplot", jointaxes=True, eeframe=True)` then `savefig`, on the
    rtb DH models the shipped robot files come from (their tables equal rtb's to 1e-15).
@@ -73,8 +73,10 @@ def main():
             environment.fig.savefig(folder / f"rtb_{name}.png")
             plt.close("all")
 
-        measured = common.median_times({"jacgen": lambda: (folder / f"one_{name}.png").write_bytes(drawing.draw(arm, [q])),
-                                        "rtb": rtb_plot}, args.rounds)
+        def jacgen_plot():
+            (folder / f"one_{name}.png").write_bytes(drawing.draw(arm, {"at a random q": q}))
+
+        measured = common.median_times({"jacgen": jacgen_plot, "rtb": rtb_plot}, args.rounds)
         ours, peer = measured["jacgen"].seconds, measured["rtb"].seconds
         print(f"{name:<10}{ours:>9.3f}{peer:>9.3f}{ours / peer:>8.2f}")
 

@@ -197,11 +197,13 @@ def _configuration(ctx, param, value: str | None):
 @main.command()
 @click.argument("robot_file", type=click.Path(dir_okay=False))
 @click.option("--plot", "plot_file", type=click.Path(dir_okay=False), default=None, metavar="FILE.png",
-              help="Also draw the arm (3D, at q; planar arms: with the manipulability map and workspace "
-                   "boundary) into FILE (.png, .svg, .pdf); needs matplotlib.")
+              help="Also draw the arm (3D, at q, with the tool's velocity ellipsoid; planar arms: with the "
+                   "manipulability map, workspace boundary and velocity ellipses) into FILE (.png, .svg, .pdf); "
+                   "needs matplotlib.")
 @click.option("--q", "q", callback=_configuration, default=None, metavar="q1,q2,...",
               help="The configuration to draw (radians, and lengths for prismatic joints; default: q = 0 "
-                   "and the middle of the limits).")
+                   "and the middle of the limits, or where that is q = 0, each joint halfway to its upper limit, "
+                   "at most 45 deg).")
 @click.option("--compare-urdf", "urdf_file", type=click.Path(dir_okay=False), default=None, metavar="FILE.urdf",
               help="Compare the joint axes and tool pose with a URDF's chain; exit 1 where they differ.")
 @click.option("--base", default=None, metavar="LINK", help="--compare-urdf: first link (default: the root).")
@@ -229,7 +231,8 @@ def show(robot_file, plot_file, q, urdf_file, base, tip, tolerance):
 
         from jacgen.reports.drawing import default_configurations, draw
 
-        drawing = draw(robot, [np.array(q)] if q is not None else default_configurations(robot), plot_format)
+        configurations = {"at --q": np.array(q)} if q is not None else default_configurations(robot)
+        drawing = draw(robot, configurations, plot_format)
         write_files({Path(plot_file).name: drawing}, Path(plot_file).parent)
         click.echo(f"jacgen: wrote {plot_file}", err=True)
     if urdf_file:

@@ -14,7 +14,8 @@ from click.testing import CliRunner
 from jacgen.checking import reference
 from jacgen.cli import main
 from jacgen.reports.urdf_comparison import compare_urdf, first_difference
-from jacgen.reports.drawing import BOUNDARY_CELLS, draw_arm, draw_workspace
+from jacgen.reports.drawing import (BOUNDARY_CELLS, default_configurations, draw_arm, draw_workspace,
+                                    drawing_figure)
 from jacgen.inputs.robot_file import parse_robot
 
 from conftest import ROBOT_NAMES, ROOT, random_configurations, robot
@@ -24,6 +25,7 @@ from support.urdf import DATA, URDFS, imported
 matplotlib = pytest.importorskip("matplotlib")
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
 from mpl_toolkits.mplot3d import proj3d  # noqa: E402
 
 STRESS_SEEDS = 30  # tests/test_random_arms.py's arms, 1 to 12 joints, and two of 16 and 32
@@ -54,7 +56,7 @@ def test_drawing_is_the_reference_chain(name):
     axes_frames, tool = reference.frames(arm, q)
     figure = plt.figure()
     axes = figure.add_subplot(projection="3d")
-    draw_arm(axes, arm, q)
+    draw_arm(axes, arm, q, scale=0.2)
     figure.canvas.draw()
     chain = _artist(axes, "chain")
     vertices = np.transpose(chain.get_data_3d())
@@ -137,6 +139,121 @@ def test_workspace_boundary_with_limits():
     distance = np.min(np.linalg.norm(vertices[:, None] - curve[None], axis=-1), axis=1)
     assert distance.max() < 2 * 1.1 * (np.ptp(curve, axis=0).max()) / BOUNDARY_CELLS
     plt.close(figure)
+
+
+def _two_link_velocities(q1, q2, l1=1.0, l2=0.6):
+    """The planar 2R arm's tool position and its velocity ellipse by hand: J = [[-l1 s1 - l2 s12,
+    -l2 s12], [l1 c1 + l2 c12, l2 c12]]; the semi-axes sigma^2 = (T +- sqrt(T^2 - 4 D^2)) / 2 with
+    T = |J|_F^2 = l1^2 + 2 l2^2 + 2 l1 l2 c2 and D = det J = l1 l2 s2; the major axis at the angle
+    atan2(2 b, a - c) / 2 of J J^T = [[a, b], [b, c]]."""
+    s1, c1, s12, c12 = np.sin(q1), np.cos(q1), np.sin(q1 + q2), np.cos(q1 + q2)
+    jacobian = np.array([[-l1 * s1 - l2 * s12, -l2 * s12], [l1 * c1 + l2 * c12, l2 * c12]])
+    trace, determinant = l1**2 + 2 * l2**2 + 2 * l1 * l2 * np.cos(q2), l1 * l2 * np.sin(q2)
+    root = np.sqrt(trace**2 - 4 * determinant**2)
+    semi_axes = np.sqrt([(trace + root) / 2, (trace - root) / 2])
+    (a, b), (_, c) = jacobian @ jacobian.T
+    major = np.arctan2(2 * b, a - c) / 2
+    return np.array([l1 * c1 + l2 * c12, l1 * s1 + l2 * s12]), semi_axes, major
+
+
+def test_velocity_ellipsoid_of_a_2r_arm():
+    """At q = (0.4, 1.1) the 3D panel's ellipsoid sits on the tool; its principal semi-axes are
+    the 2R Jacobian's singular values (by hand) times the stated factor, along the axes of
+    J J^T, and flat across the plane (a 2-joint arm's tool cannot leave it)."""
+    arm = parse_robot(TWO_LINKS.encode(), "two_links.yaml")
+    tool, semi_axes, major = _two_link_velocities(0.4, 1.1)
+    figure = plt.figure()
+    axes = figure.add_subplot(projection="3d")
+    draw_arm(axes, arm, np.array([0.4, 1.1]), scale=0.2)
+    lines = [np.transpose(_artist(axes, f"velocity axis {k}").get_data_3d()) for k in (1, 2, 3)]
+    for (start, end), expected in zip(lines, [*semi_axes, 0.0]):
+        assert np.abs((start + end) / 2 - [*tool, 0]).max() < 1e-12
+        assert abs(np.linalg.norm(end - start) / 2 - 0.2 * expected) < 1e-12
+    start, end = lines[0]
+    along = (end - start) / np.linalg.norm(end - start)
+    assert abs(along[0] * np.sin(major) - along[1] * np.cos(major)) < 1e-9  # parallel to the major axis
+    assert abs(lines[1][1][2] - lines[1][0][2]) < 1e-12  # the minor axis in the plane too
+    plt.close(figure)
+
+
+def test_velocity_ellipses_on_the_map_of_a_2r_arm():
+    """Each ellipse on the planar map: semi-axes (width and height / 2) are the singular values
+    of the 2R Jacobian at its centre (they depend on the elbow angle only, cos q2 from the
+    centre's distance to the base) times the factor the title states; its angle is the major
+    axis of J J^T at one of the two elbows that reach the centre. A few, spread over the map."""
+    arm = parse_robot(TWO_LINKS.encode(), "two_links.yaml")
+    figure, axes = plt.subplots()
+    draw_workspace(figure, axes, arm)
+    scale = float(re.search(r"magenta, x([0-9.e+-]+)\)", axes.get_title()).group(1))
+    ellipses = [patch for patch in axes.patches if (patch.get_gid() or "").startswith("velocity ellipse")]
+    assert 5 <= len(ellipses) <= 9
+    assert np.ptp([e.center for e in ellipses], axis=0).min() > 1.6  # over the annulus, not in a corner of it
+    for ellipse in ellipses:
+        x, y = ellipse.center
+        q2 = np.arccos(np.clip((x * x + y * y - 1.0 - 0.36) / 1.2, -1, 1))
+        angles = []
+        for elbow in (q2, -q2):
+            q1 = np.arctan2(y, x) - np.arctan2(0.6 * np.sin(elbow), 1 + 0.6 * np.cos(elbow))
+            tool, semi_axes, major = _two_link_velocities(q1, elbow)
+            assert np.abs(tool - [x, y]).max() < 1e-9
+            angles.append(major)
+        assert np.abs(np.array([ellipse.width, ellipse.height]) / 2 - scale * semi_axes).max() < 1e-9
+        assert min(abs(np.sin(np.radians(ellipse.angle) - angle)) for angle in angles) < 1e-6
+    assert 0.2 * 1.6 / 3 <= max(e.width / 2 for e in ellipses) <= 0.5 * 3.2 / 3  # visible, within a grid cell
+    plt.close(figure)
+
+
+def test_ur5_gets_two_different_configurations():
+    """The UR5's limits are symmetric, so the middle of its limits is q = 0: the second panel
+    turns each joint halfway to its upper limit (at most 45 deg), and the titles say so."""
+    configurations = default_configurations(robot("ur5"))
+    assert len(configurations) == 2
+    zero, moved = configurations.values()
+    assert np.array_equal(zero, np.zeros(6)) and np.allclose(moved, np.radians(45))
+    figure = drawing_figure(robot("ur5"), configurations)
+    titles = [axes.get_title() for axes in figure.axes]
+    assert titles == ["ur5 at q = 0, the middle of its limits\nq = (0, 0, 0, 0, 0, 0)",
+                      "ur5 with each joint halfway to its upper limit (at most 45 deg)\n"
+                      "q = (0.785, 0.785, 0.785, 0.785, 0.785, 0.785)"]
+    puma = robot("puma560")
+    middle = np.mean(puma.ranges, axis=1)
+    assert [list(q) for q in default_configurations(puma).values()] == [[0.0] * 6, list(middle)]
+
+
+@pytest.mark.parametrize("name", ["ur5", "puma560", "panda"])
+def test_axis_numbers_do_not_overlap(name):
+    """The joints' numbers, as rendered, overlap no other number: the UR5's wrist axes 4, 5, 6
+    are about 0.1 m apart at q = 0, the Puma's 4 and 6 collinear at the middle of its limits."""
+    arm = robot(name)
+    canvas = FigureCanvasAgg(drawing_figure(arm, default_configurations(arm)))
+    canvas.draw()
+    for axes in canvas.figure.axes:
+        boxes = []
+        for i in range(arm.dof):  # each number's size as rendered, centred where its 3D point projects
+            number = _artist(axes, f"axis number {i + 1}")
+            size = number.get_window_extent(canvas.get_renderer()).size
+            centre = axes.transData.transform(_projected(axes, np.array([number.get_position_3d()]))[0])
+            boxes.append(np.array([centre - size / 2, centre + size / 2]))
+        overlapping = [(i + 1, j + 1) for i in range(arm.dof) for j in range(i)
+                       if np.all(boxes[i][0] < boxes[j][1]) and np.all(boxes[j][0] < boxes[i][1])]
+        assert not overlapping, (axes.get_title(), overlapping)
+
+
+@pytest.mark.parametrize("name, panels", [("ur5", 1), ("ur5", 2), ("planar_3r", 3), ("scara", 3)])
+def test_the_caption_fits_in_the_figure(name, panels):
+    """The caption (wrapped) lies inside the figure, below every panel, and states the factor
+    the ellipsoids are drawn at."""
+    arm = robot(name)
+    configurations = dict(list(default_configurations(arm).items())[:panels - (panels == 3)])
+    canvas = FigureCanvasAgg(drawing_figure(arm, configurations))
+    canvas.draw()
+    figure, renderer = canvas.figure, canvas.get_renderer()
+    caption = [text for text in figure.texts if text.get_gid() == "caption"][0]
+    box, frame = caption.get_window_extent(renderer), figure.bbox
+    assert frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1
+    assert all(box.y1 < axes.get_position().y0 * frame.height for axes in figure.axes)
+    text = caption.get_text().replace("\n", " ")
+    assert re.search(r"velocity ellipsoid for \|q_dot\| = 1 rad/s.*, x[0-9.]+ \(1 m/s drawn as [0-9.]+ m", text)
 
 
 # -- --compare-urdf ---------------------------------------------------------------------------

@@ -82,6 +82,14 @@ void iiwa_task_jacobian_dot(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[I
  * Result: H: 7 x 6 x 7 row-major, element (k, r, c) at H[k * 42 + r * 7 + c]. 381 operations. */
 void iiwa_hessian(const iiwa_real q[IIWA_DOF], iiwa_real H[IIWA_DOF * 6 * IIWA_DOF]);
 
+/* World pose of each link's DH frame, base A_1 ... A_i, without the tool (DOF x 4 x 4).
+ * Result: T: 7 x 4 x 4 row-major, element (k, r, c) at T[k * 16 + r * 4 + c]. 132 operations. */
+void iiwa_link_poses(const iiwa_real q[IIWA_DOF], iiwa_real T[IIWA_DOF * 4 * 4]);
+
+/* Linear and angular velocity [v; w] of each link frame's origin, world frame, propagated from the base (DOF x 6).
+ * Result: V: 7 x 6 row-major, element (r, c) at V[r * 6 + c]. 162 operations. */
+void iiwa_link_velocities(const iiwa_real q[IIWA_DOF], const iiwa_real q_dot[IIWA_DOF], iiwa_real V[IIWA_DOF * 6]);
+
 /* Factors of det(Js Js^T): the robot is singular where one is 0.
  * Result: f[i], i < 2. 696 operations. */
 void iiwa_singularity_factors(const iiwa_real q[IIWA_DOF], iiwa_real f[IIWA_NUM_SINGULARITY_FACTORS]);
@@ -90,9 +98,29 @@ void iiwa_singularity_factors(const iiwa_real q[IIWA_DOF], iiwa_real f[IIWA_NUM_
  * Result: returned as a scalar. 699 operations. */
 iiwa_real iiwa_manipulability(const iiwa_real q[IIWA_DOF]);
 
+/* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
+ * Result: dw[i], i < 7. 1731 operations. */
+void iiwa_manipulability_gradient(const iiwa_real q[IIWA_DOF], iiwa_real dw[IIWA_DOF]);
+
+/* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2316 operations. */
+void iiwa_velocity_ellipsoid(const iiwa_real q[IIWA_DOF], iiwa_real U_v[9], iiwa_real s_v[3], iiwa_real U_w[9], iiwa_real s_w[3]);
+
+/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
+ * Result: returned as a scalar. 7925 operations. */
+iiwa_real iiwa_condition_number(const iiwa_real q[IIWA_DOF]);
+
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
  * Result: q_dot[i], i < 7; returned as a scalar. 1034 operations. */
 int iiwa_velocity_ik(const iiwa_real q[IIWA_DOF], const iiwa_real mu_dot[IIWA_TASK_DIM], iiwa_real damping, iiwa_real q_dot[IIWA_DOF]);
+
+/* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 7; returned as a scalar. 1117 operations. */
+int iiwa_velocity_ik_nullspace(const iiwa_real q[IIWA_DOF], const iiwa_real mu_dot[IIWA_TASK_DIM], const iiwa_real z[IIWA_DOF], iiwa_real damping, iiwa_real q_dot[IIWA_DOF]);
+
+/* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 7; returned as a scalar. 1274 operations. */
+int iiwa_resolved_rate(const iiwa_real q[IIWA_DOF], const iiwa_real target[16], const iiwa_real target_rate[IIWA_TASK_DIM], const iiwa_real gain[IIWA_TASK_DIM], const iiwa_real z[IIWA_DOF], iiwa_real damping, iiwa_real q_dot[IIWA_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
  * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1109 operations. */

@@ -80,6 +80,14 @@ void jaco_task_jacobian_dot(const jaco_real q[JACO_DOF], const jaco_real q_dot[J
  * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 305 operations. */
 void jaco_hessian(const jaco_real q[JACO_DOF], jaco_real H[JACO_DOF * 6 * JACO_DOF]);
 
+/* World pose of each link's DH frame, base A_1 ... A_i, without the tool (DOF x 4 x 4).
+ * Result: T: 6 x 4 x 4 row-major, element (k, r, c) at T[k * 16 + r * 4 + c]. 176 operations. */
+void jaco_link_poses(const jaco_real q[JACO_DOF], jaco_real T[JACO_DOF * 4 * 4]);
+
+/* Linear and angular velocity [v; w] of each link frame's origin, world frame, propagated from the base (DOF x 6).
+ * Result: V: 6 x 6 row-major, element (r, c) at V[r * 6 + c]. 207 operations. */
+void jaco_link_velocities(const jaco_real q[JACO_DOF], const jaco_real q_dot[JACO_DOF], jaco_real V[JACO_DOF * 6]);
+
 /* Factors of det(Js): the robot is singular where one is 0.
  * Result: f[i], i < 1. 54 operations. */
 void jaco_singularity_factors(const jaco_real q[JACO_DOF], jaco_real f[JACO_NUM_SINGULARITY_FACTORS]);
@@ -92,9 +100,29 @@ jaco_real jaco_manipulability(const jaco_real q[JACO_DOF]);
  * Result: returned as a scalar. 53 operations. */
 jaco_real jaco_jacobian_det(const jaco_real q[JACO_DOF]);
 
+/* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
+ * Result: dw[i], i < 6. 1538 operations. */
+void jaco_manipulability_gradient(const jaco_real q[JACO_DOF], jaco_real dw[JACO_DOF]);
+
+/* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2314 operations. */
+void jaco_velocity_ellipsoid(const jaco_real q[JACO_DOF], jaco_real U_v[9], jaco_real s_v[3], jaco_real U_w[9], jaco_real s_w[3]);
+
+/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
+ * Result: returned as a scalar. 7939 operations. */
+jaco_real jaco_condition_number(const jaco_real q[JACO_DOF]);
+
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
  * Result: q_dot[i], i < 6; returned as a scalar. 1456 operations. */
 int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TASK_DIM], jaco_real damping, jaco_real q_dot[JACO_DOF]);
+
+/* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 6; returned as a scalar. 1462 operations. */
+int jaco_velocity_ik_nullspace(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TASK_DIM], const jaco_real z[JACO_DOF], jaco_real damping, jaco_real q_dot[JACO_DOF]);
+
+/* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 6; returned as a scalar. 1636 operations. */
+int jaco_resolved_rate(const jaco_real q[JACO_DOF], const jaco_real target[16], const jaco_real target_rate[JACO_TASK_DIM], const jaco_real gain[JACO_TASK_DIM], const jaco_real z[JACO_DOF], jaco_real damping, jaco_real q_dot[JACO_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
  * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1090 operations. */

@@ -80,6 +80,14 @@ void manocha_canny_task_jacobian_dot(const manocha_canny_real q[MANOCHA_CANNY_DO
  * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 268 operations. */
 void manocha_canny_hessian(const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real H[MANOCHA_CANNY_DOF * 6 * MANOCHA_CANNY_DOF]);
 
+/* World pose of each link's DH frame, base A_1 ... A_i, without the tool (DOF x 4 x 4).
+ * Result: T: 6 x 4 x 4 row-major, element (k, r, c) at T[k * 16 + r * 4 + c]. 185 operations. */
+void manocha_canny_link_poses(const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real T[MANOCHA_CANNY_DOF * 4 * 4]);
+
+/* Linear and angular velocity [v; w] of each link frame's origin, world frame, propagated from the base (DOF x 6).
+ * Result: V: 6 x 6 row-major, element (r, c) at V[r * 6 + c]. 188 operations. */
+void manocha_canny_link_velocities(const manocha_canny_real q[MANOCHA_CANNY_DOF], const manocha_canny_real q_dot[MANOCHA_CANNY_DOF], manocha_canny_real V[MANOCHA_CANNY_DOF * 6]);
+
 /* Factors of det(Js): the robot is singular where one is 0.
  * Result: f[i], i < 1. 89 operations. */
 void manocha_canny_singularity_factors(const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real f[MANOCHA_CANNY_NUM_SINGULARITY_FACTORS]);
@@ -92,9 +100,29 @@ manocha_canny_real manocha_canny_manipulability(const manocha_canny_real q[MANOC
  * Result: returned as a scalar. 89 operations. */
 manocha_canny_real manocha_canny_jacobian_det(const manocha_canny_real q[MANOCHA_CANNY_DOF]);
 
+/* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
+ * Result: dw[i], i < 6. 1141 operations. */
+void manocha_canny_manipulability_gradient(const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real dw[MANOCHA_CANNY_DOF]);
+
+/* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2266 operations. */
+void manocha_canny_velocity_ellipsoid(const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real U_v[9], manocha_canny_real s_v[3], manocha_canny_real U_w[9], manocha_canny_real s_w[3]);
+
+/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
+ * Result: returned as a scalar. 7803 operations. */
+manocha_canny_real manocha_canny_condition_number(const manocha_canny_real q[MANOCHA_CANNY_DOF]);
+
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
  * Result: q_dot[i], i < 6; returned as a scalar. 1373 operations. */
 int manocha_canny_velocity_ik(const manocha_canny_real q[MANOCHA_CANNY_DOF], const manocha_canny_real mu_dot[MANOCHA_CANNY_TASK_DIM], manocha_canny_real damping, manocha_canny_real q_dot[MANOCHA_CANNY_DOF]);
+
+/* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 6; returned as a scalar. 1379 operations. */
+int manocha_canny_velocity_ik_nullspace(const manocha_canny_real q[MANOCHA_CANNY_DOF], const manocha_canny_real mu_dot[MANOCHA_CANNY_TASK_DIM], const manocha_canny_real z[MANOCHA_CANNY_DOF], manocha_canny_real damping, manocha_canny_real q_dot[MANOCHA_CANNY_DOF]);
+
+/* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 6; returned as a scalar. 1552 operations. */
+int manocha_canny_resolved_rate(const manocha_canny_real q[MANOCHA_CANNY_DOF], const manocha_canny_real target[16], const manocha_canny_real target_rate[MANOCHA_CANNY_TASK_DIM], const manocha_canny_real gain[MANOCHA_CANNY_TASK_DIM], const manocha_canny_real z[MANOCHA_CANNY_DOF], manocha_canny_real damping, manocha_canny_real q_dot[MANOCHA_CANNY_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
  * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1026 operations. */

@@ -80,6 +80,14 @@ void mico_task_jacobian_dot(const mico_real q[MICO_DOF], const mico_real q_dot[M
  * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 305 operations. */
 void mico_hessian(const mico_real q[MICO_DOF], mico_real H[MICO_DOF * 6 * MICO_DOF]);
 
+/* World pose of each link's DH frame, base A_1 ... A_i, without the tool (DOF x 4 x 4).
+ * Result: T: 6 x 4 x 4 row-major, element (k, r, c) at T[k * 16 + r * 4 + c]. 176 operations. */
+void mico_link_poses(const mico_real q[MICO_DOF], mico_real T[MICO_DOF * 4 * 4]);
+
+/* Linear and angular velocity [v; w] of each link frame's origin, world frame, propagated from the base (DOF x 6).
+ * Result: V: 6 x 6 row-major, element (r, c) at V[r * 6 + c]. 207 operations. */
+void mico_link_velocities(const mico_real q[MICO_DOF], const mico_real q_dot[MICO_DOF], mico_real V[MICO_DOF * 6]);
+
 /* Factors of det(Js): the robot is singular where one is 0.
  * Result: f[i], i < 1. 54 operations. */
 void mico_singularity_factors(const mico_real q[MICO_DOF], mico_real f[MICO_NUM_SINGULARITY_FACTORS]);
@@ -92,9 +100,29 @@ mico_real mico_manipulability(const mico_real q[MICO_DOF]);
  * Result: returned as a scalar. 53 operations. */
 mico_real mico_jacobian_det(const mico_real q[MICO_DOF]);
 
+/* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
+ * Result: dw[i], i < 6. 1538 operations. */
+void mico_manipulability_gradient(const mico_real q[MICO_DOF], mico_real dw[MICO_DOF]);
+
+/* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2314 operations. */
+void mico_velocity_ellipsoid(const mico_real q[MICO_DOF], mico_real U_v[9], mico_real s_v[3], mico_real U_w[9], mico_real s_w[3]);
+
+/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
+ * Result: returned as a scalar. 7939 operations. */
+mico_real mico_condition_number(const mico_real q[MICO_DOF]);
+
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
  * Result: q_dot[i], i < 6; returned as a scalar. 1456 operations. */
 int mico_velocity_ik(const mico_real q[MICO_DOF], const mico_real mu_dot[MICO_TASK_DIM], mico_real damping, mico_real q_dot[MICO_DOF]);
+
+/* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 6; returned as a scalar. 1462 operations. */
+int mico_velocity_ik_nullspace(const mico_real q[MICO_DOF], const mico_real mu_dot[MICO_TASK_DIM], const mico_real z[MICO_DOF], mico_real damping, mico_real q_dot[MICO_DOF]);
+
+/* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 6; returned as a scalar. 1636 operations. */
+int mico_resolved_rate(const mico_real q[MICO_DOF], const mico_real target[16], const mico_real target_rate[MICO_TASK_DIM], const mico_real gain[MICO_TASK_DIM], const mico_real z[MICO_DOF], mico_real damping, mico_real q_dot[MICO_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
  * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1090 operations. */

@@ -82,6 +82,14 @@ void panda_task_jacobian_dot(const panda_real q[PANDA_DOF], const panda_real q_d
  * Result: H: 7 x 6 x 7 row-major, element (k, r, c) at H[k * 42 + r * 7 + c]. 407 operations. */
 void panda_hessian(const panda_real q[PANDA_DOF], panda_real H[PANDA_DOF * 6 * PANDA_DOF]);
 
+/* World pose of each link's DH frame, base A_1 ... A_i, without the tool (DOF x 4 x 4).
+ * Result: T: 7 x 4 x 4 row-major, element (k, r, c) at T[k * 16 + r * 4 + c]. 156 operations. */
+void panda_link_poses(const panda_real q[PANDA_DOF], panda_real T[PANDA_DOF * 4 * 4]);
+
+/* Linear and angular velocity [v; w] of each link frame's origin, world frame, propagated from the base (DOF x 6).
+ * Result: V: 7 x 6 row-major, element (r, c) at V[r * 6 + c]. 210 operations. */
+void panda_link_velocities(const panda_real q[PANDA_DOF], const panda_real q_dot[PANDA_DOF], panda_real V[PANDA_DOF * 6]);
+
 /* Factors of det(Js Js^T): the robot is singular where one is 0.
  * Result: f[i], i < 1. 730 operations. */
 void panda_singularity_factors(const panda_real q[PANDA_DOF], panda_real f[PANDA_NUM_SINGULARITY_FACTORS]);
@@ -90,9 +98,29 @@ void panda_singularity_factors(const panda_real q[PANDA_DOF], panda_real f[PANDA
  * Result: returned as a scalar. 733 operations. */
 panda_real panda_manipulability(const panda_real q[PANDA_DOF]);
 
+/* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
+ * Result: dw[i], i < 7. 1760 operations. */
+void panda_manipulability_gradient(const panda_real q[PANDA_DOF], panda_real dw[PANDA_DOF]);
+
+/* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2343 operations. */
+void panda_velocity_ellipsoid(const panda_real q[PANDA_DOF], panda_real U_v[9], panda_real s_v[3], panda_real U_w[9], panda_real s_w[3]);
+
+/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
+ * Result: returned as a scalar. 7953 operations. */
+panda_real panda_condition_number(const panda_real q[PANDA_DOF]);
+
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
  * Result: q_dot[i], i < 7; returned as a scalar. 1061 operations. */
 int panda_velocity_ik(const panda_real q[PANDA_DOF], const panda_real mu_dot[PANDA_TASK_DIM], panda_real damping, panda_real q_dot[PANDA_DOF]);
+
+/* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 7; returned as a scalar. 1143 operations. */
+int panda_velocity_ik_nullspace(const panda_real q[PANDA_DOF], const panda_real mu_dot[PANDA_TASK_DIM], const panda_real z[PANDA_DOF], panda_real damping, panda_real q_dot[PANDA_DOF]);
+
+/* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 7; returned as a scalar. 1304 operations. */
+int panda_resolved_rate(const panda_real q[PANDA_DOF], const panda_real target[16], const panda_real target_rate[PANDA_TASK_DIM], const panda_real gain[PANDA_TASK_DIM], const panda_real z[PANDA_DOF], panda_real damping, panda_real q_dot[PANDA_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
  * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1140 operations. */

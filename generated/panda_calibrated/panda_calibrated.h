@@ -82,6 +82,14 @@ void panda_calibrated_task_jacobian_dot(const panda_calibrated_real q[PANDA_CALI
  * Result: H: 7 x 6 x 7 row-major, element (k, r, c) at H[k * 42 + r * 7 + c]. 717 operations. */
 void panda_calibrated_hessian(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real H[PANDA_CALIBRATED_DOF * 6 * PANDA_CALIBRATED_DOF]);
 
+/* World pose of each link's DH frame, base A_1 ... A_i, without the tool (DOF x 4 x 4).
+ * Result: T: 7 x 4 x 4 row-major, element (k, r, c) at T[k * 16 + r * 4 + c]. 408 operations. */
+void panda_calibrated_link_poses(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real T[PANDA_CALIBRATED_DOF * 4 * 4]);
+
+/* Linear and angular velocity [v; w] of each link frame's origin, world frame, propagated from the base (DOF x 6).
+ * Result: V: 7 x 6 row-major, element (r, c) at V[r * 6 + c]. 433 operations. */
+void panda_calibrated_link_velocities(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF], panda_calibrated_real V[PANDA_CALIBRATED_DOF * 6]);
+
 /* Factors of det(Js Js^T): the robot is singular where one is 0.
  * Result: f[i], i < 1. 1049 operations. */
 void panda_calibrated_singularity_factors(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real f[PANDA_CALIBRATED_NUM_SINGULARITY_FACTORS]);
@@ -90,9 +98,29 @@ void panda_calibrated_singularity_factors(const panda_calibrated_real q[PANDA_CA
  * Result: returned as a scalar. 1052 operations. */
 panda_calibrated_real panda_calibrated_manipulability(const panda_calibrated_real q[PANDA_CALIBRATED_DOF]);
 
+/* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
+ * Result: dw[i], i < 7. 2358 operations. */
+void panda_calibrated_manipulability_gradient(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real dw[PANDA_CALIBRATED_DOF]);
+
+/* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2540 operations. */
+void panda_calibrated_velocity_ellipsoid(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real U_v[9], panda_calibrated_real s_v[3], panda_calibrated_real U_w[9], panda_calibrated_real s_w[3]);
+
+/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
+ * Result: returned as a scalar. 8178 operations. */
+panda_calibrated_real panda_calibrated_condition_number(const panda_calibrated_real q[PANDA_CALIBRATED_DOF]);
+
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
  * Result: q_dot[i], i < 7; returned as a scalar. 1305 operations. */
 int panda_calibrated_velocity_ik(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real mu_dot[PANDA_CALIBRATED_TASK_DIM], panda_calibrated_real damping, panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF]);
+
+/* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 7; returned as a scalar. 1401 operations. */
+int panda_calibrated_velocity_ik_nullspace(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real mu_dot[PANDA_CALIBRATED_TASK_DIM], const panda_calibrated_real z[PANDA_CALIBRATED_DOF], panda_calibrated_real damping, panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF]);
+
+/* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 7; returned as a scalar. 1576 operations. */
+int panda_calibrated_resolved_rate(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real target[16], const panda_calibrated_real target_rate[PANDA_CALIBRATED_TASK_DIM], const panda_calibrated_real gain[PANDA_CALIBRATED_TASK_DIM], const panda_calibrated_real z[PANDA_CALIBRATED_DOF], panda_calibrated_real damping, panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
  * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1393 operations. */

@@ -419,6 +419,99 @@ void planar_2r_hessian(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real H[P
     H[23] = 0;
 }
 
+void planar_2r_link_poses(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real T[PLANAR_2R_DOF * 4 * 4])
+{
+    /* 14 operations */
+
+    /* Inputs */
+    const planar_2r_real q1 = q[0];
+    const planar_2r_real q2 = q[1];
+
+    /* Intermediate terms */
+    const planar_2r_real c1 = cos(q1);
+    const planar_2r_real s1 = sin(q1);
+    const planar_2r_real c2 = cos(q2);
+    const planar_2r_real s2 = sin(q2);
+    const planar_2r_real t0 = c1*c2 - s1*s2;
+    const planar_2r_real t1 = c1 + t0;
+    const planar_2r_real t2 = c1*s2 + c2*s1;
+    const planar_2r_real t3 = s1 + t2;
+
+    /* Outputs */
+    T[0] = c1;
+    T[1] = -s1;
+    T[2] = 0;
+    T[3] = c1;
+    T[4] = s1;
+    T[5] = c1;
+    T[6] = 0;
+    T[7] = s1;
+    T[8] = 0;
+    T[9] = 0;
+    T[10] = 1;
+    T[11] = 0;
+    T[12] = 0;
+    T[13] = 0;
+    T[14] = 0;
+    T[15] = 1;
+    T[16] = t0;
+    T[17] = -t2;
+    T[18] = 0;
+    T[19] = t1;
+    T[20] = t2;
+    T[21] = t0;
+    T[22] = 0;
+    T[23] = t3;
+    T[24] = 0;
+    T[25] = 0;
+    T[26] = 1;
+    T[27] = 0;
+    T[28] = 0;
+    T[29] = 0;
+    T[30] = 0;
+    T[31] = 1;
+}
+
+void planar_2r_link_velocities(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real q_dot[PLANAR_2R_DOF], planar_2r_real V[PLANAR_2R_DOF * 6])
+{
+    /* 23 operations */
+
+    /* Inputs */
+    const planar_2r_real q1 = q[0];
+    const planar_2r_real q2 = q[1];
+    const planar_2r_real qd1 = q_dot[0];
+    const planar_2r_real qd2 = q_dot[1];
+
+    /* Intermediate terms */
+    const planar_2r_real c1 = cos(q1);
+    const planar_2r_real s1 = sin(q1);
+    const planar_2r_real c2 = cos(q2);
+    const planar_2r_real s2 = sin(q2);
+    const planar_2r_real t0 = qd1 + qd2;
+    const planar_2r_real t1 = c1 + c1*c2 - s1*s2;
+    const planar_2r_real t2 = s1 + c1*s2 + c2*s1;
+    const planar_2r_real t3 = -c1 + t1;
+    const planar_2r_real t4 = -s1 + t2;
+    const planar_2r_real t5 = s1*qd1;
+    const planar_2r_real t6 = t5 + t0*t4;
+    const planar_2r_real t7 = c1*qd1;
+    const planar_2r_real t8 = t7 + t0*t3;
+
+    /* Outputs */
+    V[0] = -t5;
+    V[1] = t7;
+    V[2] = 0;
+    V[3] = 0;
+    V[4] = 0;
+    V[5] = qd1;
+    V[6] = -t6;
+    V[7] = t8;
+    V[8] = 0;
+    V[9] = 0;
+    V[10] = 0;
+    V[11] = t0;
+}
+
 void planar_2r_singularity_factors(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real f[PLANAR_2R_NUM_SINGULARITY_FACTORS])
 {
     /* 1 operations */
@@ -461,6 +554,285 @@ planar_2r_real planar_2r_jacobian_det(const planar_2r_real q[PLANAR_2R_DOF])
     return s2;
 }
 
+void planar_2r_manipulability_gradient(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real dw[PLANAR_2R_DOF])
+{
+    /* 92 operations */
+
+    /* Inputs */
+    const planar_2r_real q1 = q[0];
+    const planar_2r_real q2 = q[1];
+
+    /* Intermediate terms */
+    const planar_2r_real c1 = cos(q1);
+    const planar_2r_real s1 = sin(q1);
+    const planar_2r_real c2 = cos(q2);
+    const planar_2r_real s2 = sin(q2);
+    const planar_2r_real c12 = c1*c2 - s1*s2;
+    const planar_2r_real s12 = c1*s2 + c2*s1;
+    const planar_2r_real t0 = c1 + c12;
+    const planar_2r_real t1 = s1 + s12;
+    const planar_2r_real t2 = (s12*s12);
+    const planar_2r_real t3 = (t1*t1) + t2;
+    const planar_2r_real t4 = sqrt((c12*c12) + (t0*t0) + t3);
+    const planar_2r_real t5 = sqrt(t3);
+    const planar_2r_real t6 = t5*(t1 <= 0 ? 1 : -1);
+    const planar_2r_real t7 = -t1 + t6;
+    const planar_2r_real t8 = (t5 > 0 ? 1/(t5*(t5 + fabs(t1))) : 0);
+    const planar_2r_real t9 = t8*(t0*t7 - c12*s12);
+    const planar_2r_real t10 = t0 - t7*t9;
+    const planar_2r_real t11 = c12 + s12*t9;
+    const planar_2r_real t12 = 1 - (t7*t7)*t8;
+    const planar_2r_real t13 = fabs(t11);
+    const planar_2r_real t14 = t13*(t11 >= 0 ? 1 : -1);
+    const planar_2r_real t15 = t11 + t14;
+    const planar_2r_real t16 = (t13 > 0 ? 1/(t13*2*t13) : 0);
+    const planar_2r_real t17 = 1 - (t15*t15)*t16;
+    const planar_2r_real t18 = t8*t17;
+    const planar_2r_real t19 = t2*t18;
+    const planar_2r_real t20 = -t19 + t17;
+    const planar_2r_real t21 = s12*t7;
+    const planar_2r_real t22 = t14*t12 + t10*t18*t21;
+    const planar_2r_real t23 = t10*t20 + t8*t14*t21;
+    const planar_2r_real t24 = 1e-12*t4;
+    const planar_2r_real t25 = ((t5 <= t24) || (t13 <= t24) ? 0 : (t6 < 0 ? 1 : (t6 > 0 ? -1 : 0))*(t14 < 0 ? 1 : (t14 > 0 ? -1 : 0)));
+    const planar_2r_real t26 = s12*t6;
+    const planar_2r_real t27 = c12*t23 + t20*t26;
+    const planar_2r_real t28 = t25*(t0*t22 + t1*t7*t18*t26 + t27);
+    const planar_2r_real t29 = t25*(c12*t22 + t27 + t6*t7*t19);
+
+    /* Outputs */
+    dw[0] = t28;
+    dw[1] = t29;
+}
+
+void planar_2r_velocity_ellipsoid(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real U_v[9], planar_2r_real s_v[3], planar_2r_real U_w[9], planar_2r_real s_w[3])
+{
+    /* 304 operations */
+
+    /* Inputs */
+    const planar_2r_real q1 = q[0];
+    const planar_2r_real q2 = q[1];
+
+    /* Intermediate terms */
+    const planar_2r_real c1 = cos(q1);
+    const planar_2r_real s1 = sin(q1);
+    const planar_2r_real c2 = cos(q2);
+    const planar_2r_real s2 = sin(q2);
+    const planar_2r_real c12 = c1*c2 - s1*s2;
+    const planar_2r_real s12 = c1*s2 + c2*s1;
+    const planar_2r_real t0 = c1 + c12;
+    const planar_2r_real t1 = s1 + s12;
+    const planar_2r_real t2 = sqrt((s12*s12) + (t1*t1));
+    const planar_2r_real t3 = t2*(t1 <= 0 ? 1 : -1);
+    const planar_2r_real t4 = -t1 + t3;
+    const planar_2r_real t5 = (t2 > 0 ? 1/(t2*(t2 + fabs(t1))) : 0);
+    const planar_2r_real t6 = t5*(t0*t4 - c12*s12);
+    const planar_2r_real t7 = t0 - t4*t6;
+    const planar_2r_real t8 = c12 + s12*t6;
+    const planar_2r_real t9 = fabs(t8);
+    const planar_2r_real t10 = t9*(t8 >= 0 ? 1 : -1);
+    const planar_2r_real t11 = (t3*t3);
+    const planar_2r_real t12 = (t10*t10);
+    const planar_2r_real t13 = t12 + (t7*t7);
+    const planar_2r_real t14 = t3*t7;
+    const int t15 = t14 != 0;
+    const planar_2r_real t16 = 0.5*(-t11 + t13)/(t15 ? -t14 : 1);
+    const planar_2r_real t17 = (t15 ? (t16 >= 0 ? 1 : -1)/(fabs(t16) + sqrt(1 + (t16*t16))) : 0);
+    const planar_2r_real t18 = 1.0/sqrt(1 + (t17*t17));
+    const planar_2r_real t19 = t14*t17;
+    const planar_2r_real t20 = t19 + t11;
+    const planar_2r_real t21 = -t19 + t13;
+    const planar_2r_real t22 = t3*t18;
+    const planar_2r_real t23 = t7*t18;
+    const planar_2r_real t24 = t22 + t23*t17;
+    const planar_2r_real t25 = t23 - t22*t17;
+    const planar_2r_real t26 = t24*t25 + t12*t17*(t18*t18);
+    const int t27 = t26 != 0;
+    const planar_2r_real t28 = 0.5*(-t20 + t21)/(t27 ? -t26 : 1);
+    const planar_2r_real t29 = (t27 ? (t28 >= 0 ? 1 : -1)/(fabs(t28) + sqrt(1 + (t28*t28))) : 0);
+    const planar_2r_real t30 = 1.0/sqrt(1 + (t29*t29));
+    const planar_2r_real t31 = t26*t29;
+    const planar_2r_real t32 = t31 + t20;
+    const planar_2r_real t33 = -t31 + t21;
+    const planar_2r_real t34 = t24*t30;
+    const planar_2r_real t35 = t25*t30;
+    const planar_2r_real t36 = t34 + t29*t35;
+    const planar_2r_real t37 = t35 - t34*t29;
+    const planar_2r_real t38 = t18*t30;
+    const planar_2r_real t39 = t10*t38;
+    const planar_2r_real t40 = t17*t39;
+    const planar_2r_real t41 = t40 + t29*t39;
+    const planar_2r_real t42 = -t39 + t29*t40;
+    const planar_2r_real t43 = -t36*t37 + t41*t42;
+    const planar_2r_real t44 = t17*t38;
+    const planar_2r_real t45 = t38 - t29*t44;
+    const planar_2r_real t46 = t44 + t29*t38;
+    const int t47 = t43 != 0;
+    const planar_2r_real t48 = 0.5*(-t32 + t33)/(t47 ? t43 : 1);
+    const planar_2r_real t49 = (t47 ? (t48 >= 0 ? 1 : -1)/(fabs(t48) + sqrt(1 + (t48*t48))) : 0);
+    const planar_2r_real t50 = 1.0/sqrt(1 + (t49*t49));
+    const planar_2r_real t51 = t43*t49;
+    const planar_2r_real t52 = -t51 + t32;
+    const planar_2r_real t53 = t33 + t51;
+    const planar_2r_real t54 = t36*t50;
+    const planar_2r_real t55 = t37*t50;
+    const planar_2r_real t56 = t54 + t49*t55;
+    const planar_2r_real t57 = t55 - t49*t54;
+    const planar_2r_real t58 = t41*t50;
+    const planar_2r_real t59 = t42*t50;
+    const planar_2r_real t60 = t58 - t49*t59;
+    const planar_2r_real t61 = t59 + t49*t58;
+    const planar_2r_real t62 = -t56*t57 + t60*t61;
+    const planar_2r_real t63 = t45*t50;
+    const planar_2r_real t64 = t46*t50;
+    const planar_2r_real t65 = t63 - t49*t64;
+    const planar_2r_real t66 = t64 + t49*t63;
+    const int t67 = t62 != 0;
+    const planar_2r_real t68 = 0.5*(-t52 + t53)/(t67 ? t62 : 1);
+    const planar_2r_real t69 = (t67 ? (t68 >= 0 ? 1 : -1)/(fabs(t68) + sqrt(1 + (t68*t68))) : 0);
+    const planar_2r_real t70 = 1.0/sqrt(1 + (t69*t69));
+    const planar_2r_real t71 = t62*t69;
+    const planar_2r_real t72 = -t71 + t52;
+    const planar_2r_real t73 = t53 + t71;
+    const planar_2r_real t74 = t56*t70;
+    const planar_2r_real t75 = t57*t70;
+    const planar_2r_real t76 = t74 + t69*t75;
+    const planar_2r_real t77 = t75 - t69*t74;
+    const planar_2r_real t78 = t60*t70;
+    const planar_2r_real t79 = t61*t70;
+    const planar_2r_real t80 = t78 - t69*t79;
+    const planar_2r_real t81 = t79 + t69*t78;
+    const planar_2r_real t82 = -t76*t77 + t80*t81;
+    const planar_2r_real t83 = t65*t70;
+    const planar_2r_real t84 = t66*t70;
+    const planar_2r_real t85 = t83 - t69*t84;
+    const planar_2r_real t86 = t84 + t69*t83;
+    const int t87 = t82 != 0;
+    const planar_2r_real t88 = 0.5*(-t72 + t73)/(t87 ? t82 : 1);
+    const planar_2r_real t89 = (t87 ? (t88 >= 0 ? 1 : -1)/(fabs(t88) + sqrt(1 + (t88*t88))) : 0);
+    const planar_2r_real t90 = 1.0/sqrt(1 + (t89*t89));
+    const planar_2r_real t91 = t76*t90;
+    const planar_2r_real t92 = t77*t90;
+    const planar_2r_real t93 = t91 + t89*t92;
+    const planar_2r_real t94 = t92 - t89*t91;
+    const planar_2r_real t95 = t80*t90;
+    const planar_2r_real t96 = t81*t90;
+    const planar_2r_real t97 = t95 - t89*t96;
+    const planar_2r_real t98 = t96 + t89*t95;
+    const planar_2r_real t99 = sqrt((t93*t93) + (t97*t97));
+    const planar_2r_real t100 = sqrt((t94*t94) + (t98*t98));
+    const planar_2r_real t101 = t85*t90;
+    const planar_2r_real t102 = t86*t90;
+    const planar_2r_real t103 = t101 - t89*t102;
+    const planar_2r_real t104 = t102 + t89*t101;
+    const int t105 = t99 < t100;
+    const planar_2r_real t106 = (t105 ? t100 : t99);
+    const planar_2r_real t107 = (t105 ? t99 : t100);
+    const planar_2r_real t108 = (t105 ? t104 : t103);
+    const planar_2r_real t109 = (t105 ? t103 : t104);
+    const planar_2r_real t110 = -t104;
+    const planar_2r_real t111 = (t105 ? t103 : t110);
+    const planar_2r_real t112 = (t105 ? t110 : t103);
+    const int t113 = t107 < 0;
+    const planar_2r_real t114 = (t113 ? 0 : t107);
+    const planar_2r_real t115 = (t113 ? t107 : 0);
+    const planar_2r_real t116 = (t113 ? 0 : t109);
+    const planar_2r_real t117 = (t113 ? 0 : t112);
+    const planar_2r_real t118 = (t113 ? 1 : 0);
+    const planar_2r_real t119 = (t113 ? t109 : 0);
+    const planar_2r_real t120 = (t113 ? t112 : 0);
+    const planar_2r_real t121 = (t113 ? 0 : 1);
+    const int t122 = t106 < t114;
+    const planar_2r_real t123 = (t122 ? t114 : t106);
+    const planar_2r_real t124 = (t122 ? t106 : t114);
+    const planar_2r_real t125 = (t122 ? t116 : t108);
+    const planar_2r_real t126 = (t122 ? t117 : t111);
+    const planar_2r_real t127 = (t122 ? t118 : 0);
+    const planar_2r_real t128 = (t122 ? t108 : t116);
+    const planar_2r_real t129 = (t122 ? t111 : t117);
+    const planar_2r_real t130 = (t122 ? 0 : t118);
+    const planar_2r_real t131 = t125*(t121*t129 - t120*t130) - t126*(t121*t128 - t119*t130) + t127*(t120*t128 - t119*t129);
+    const planar_2r_real t132 = (t131 < 0 ? -1 : 1);
+    const planar_2r_real t133 = t119*t132;
+    const planar_2r_real t134 = t120*t132;
+    const planar_2r_real t135 = t121*t132;
+
+    /* Outputs */
+    U_v[0] = t125;
+    U_v[1] = t128;
+    U_v[2] = t133;
+    U_v[3] = t126;
+    U_v[4] = t129;
+    U_v[5] = t134;
+    U_v[6] = t127;
+    U_v[7] = t130;
+    U_v[8] = t135;
+    s_v[0] = t123;
+    s_v[1] = t124;
+    s_v[2] = t115;
+    U_w[0] = 0;
+    U_w[1] = 1;
+    U_w[2] = 0;
+    U_w[3] = 0;
+    U_w[4] = 0;
+    U_w[5] = 1;
+    U_w[6] = 1;
+    U_w[7] = 0;
+    U_w[8] = 0;
+    s_w[0] = 1.4142135623730951;
+    s_w[1] = 0;
+    s_w[2] = 0;
+}
+
+planar_2r_real planar_2r_condition_number(const planar_2r_real q[PLANAR_2R_DOF])
+{
+    /* 87 operations */
+
+    /* Inputs */
+    const planar_2r_real q1 = q[0];
+    const planar_2r_real q2 = q[1];
+
+    /* Intermediate terms */
+    const planar_2r_real c1 = cos(q1);
+    const planar_2r_real s1 = sin(q1);
+    const planar_2r_real c2 = cos(q2);
+    const planar_2r_real s2 = sin(q2);
+    const planar_2r_real c12 = c1*c2 - s1*s2;
+    const planar_2r_real s12 = c1*s2 + c2*s1;
+    const planar_2r_real t0 = c1 + c12;
+    const planar_2r_real t1 = s1 + s12;
+    const planar_2r_real t2 = sqrt((s12*s12) + (t1*t1));
+    const planar_2r_real t3 = t2*(t1 <= 0 ? 1 : -1);
+    const planar_2r_real t4 = (t2 > 0 ? 1/(t2*(t2 + fabs(t1))) : 0);
+    const planar_2r_real t5 = t3 - 1.0*t1;
+    const planar_2r_real t6 = t4*(-c12*s12 + t0*t5);
+    const planar_2r_real t7 = t0 - t5*t6;
+    const planar_2r_real t8 = c12 + s12*t6;
+    const planar_2r_real t9 = fabs(t8);
+    const planar_2r_real t10 = t9*(t8 >= 0 ? 1 : -1);
+    const planar_2r_real t11 = (t10*t10);
+    const planar_2r_real t12 = (t3*t3);
+    const planar_2r_real t13 = t12 + (t7*t7);
+    const planar_2r_real t14 = t7*t10;
+    const int t15 = t14 != 0;
+    const planar_2r_real t16 = 0.5*(-t13 + t11)/(t15 ? -t14 : 1);
+    const planar_2r_real t17 = (t15 ? (t16 >= 0 ? 1 : -1)/(fabs(t16) + sqrt(1 + (t16*t16))) : 0);
+    const planar_2r_real t18 = (t17*t17);
+    const planar_2r_real t19 = 1.0/sqrt(1 + t18);
+    const planar_2r_real t20 = t7*t19;
+    const planar_2r_real t21 = t10*t19;
+    const planar_2r_real t22 = t20 + t21*t17;
+    const planar_2r_real t23 = -t21 + t20*t17;
+    const planar_2r_real t24 = t12*(t19*t19);
+    const planar_2r_real t25 = sqrt(t24 + (t22*t22));
+    const planar_2r_real t26 = sqrt((t23*t23) + t18*t24);
+    const planar_2r_real t27 = (t26 > t25 ? t26 : t25);
+    const planar_2r_real t28 = (t26 < t25 ? t26 : t25);
+
+    /* Outputs */
+    return (t27 > 0 ? t27 : 1)/(t28 <= 1e-12*t27 ? 0 : t28);
+}
+
 int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real mu_dot[PLANAR_2R_TASK_DIM], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF])
 {
     /* 173 operations */
@@ -480,13 +852,13 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const planar_2r_real s12 = c1*s2 + c2*s1;
     const planar_2r_real t0 = c1 + c12;
     const planar_2r_real t1 = s1 + s12;
-    const planar_2r_real t2 = t0*t1 + c12*s12;
+    const planar_2r_real t2 = c12*s12 + t0*t1;
     const planar_2r_real t3 = (t1*t1);
     const planar_2r_real t4 = (s12*s12) + t3;
     const planar_2r_real t5 = (t0*t0);
     const planar_2r_real t6 = sqrt(t3 + t5);
-    const planar_2r_real t7 = t6*(t1 <= 0 ? 1 : -1);
-    const planar_2r_real t8 = (t6 > 0 ? 1/(t6*(t6 + fabs(t1))) : 0);
+    const planar_2r_real t7 = (t1 <= 0 ? 1 : -1)*t6;
+    const planar_2r_real t8 = (t6 > 0 ? 1/(t6*(fabs(t1) + t6)) : 0);
     const planar_2r_real t9 = (c12*c12) + t5;
     const planar_2r_real t10 = sqrt(t4 + t9);
     const planar_2r_real t11 = (t2*t2);
@@ -495,18 +867,18 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const planar_2r_real t14 = (t13*t13);
     const planar_2r_real t15 = sqrt(t11 + t14);
     const planar_2r_real t16 = t15*(t13 >= 0 ? 1 : -1);
-    const planar_2r_real t17 = t16 + t13;
+    const planar_2r_real t17 = t13 + t16;
     const planar_2r_real t18 = (t15 > 0 ? 1/(t15*(t15 + fabs(t13))) : 0);
     const planar_2r_real t19 = t18*(mu_dot0*t17 - mu_dot1*t2);
     const planar_2r_real t20 = mu_dot0 - t17*t19;
     const planar_2r_real t21 = mu_dot1 + t2*t19;
     const planar_2r_real t22 = t9 + t12;
     const planar_2r_real t23 = sqrt(2*t11 + t14 + (t22*t22));
-    const planar_2r_real t24 = -t18*(t2*t17 + t2*t22);
+    const planar_2r_real t24 = -t18*(t2*t17 + t22*t2);
     const planar_2r_real t25 = t2 + t17*t24;
-    const planar_2r_real t26 = t2*t24 + t22;
+    const planar_2r_real t26 = t22 + t2*t24;
     const planar_2r_real t27 = fabs(t26);
-    const planar_2r_real t28 = (t26 >= 0 ? 1 : -1)*t27;
+    const planar_2r_real t28 = t27*(t26 >= 0 ? 1 : -1);
     const planar_2r_real t29 = t26 + t28;
     const planar_2r_real t30 = (t27 > 0 ? 1/(t27*2*t27) : 0);
     const planar_2r_real t31 = t21 - t21*(t29*t29)*t30;
@@ -515,16 +887,16 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const planar_2r_real t34 = -t1*t33 + t0*t32;
     const planar_2r_real t35 = -s12*t33 + c12*t32;
     const planar_2r_real t36 = -t1;
-    const planar_2r_real t37 = t7 + t36;
+    const planar_2r_real t37 = t36 + t7;
     const planar_2r_real t38 = t8*(c12*t0 - s12*t37);
     const planar_2r_real t39 = s12 + t37*t38;
     const planar_2r_real t40 = c12 - t0*t38;
     const planar_2r_real t41 = t8*(mu_dot0*t37 + t0*mu_dot1);
     const planar_2r_real t42 = mu_dot0 - t37*t41;
     const planar_2r_real t43 = mu_dot1 - t0*t41;
-    const planar_2r_real t44 = -s12 + q1 + q2 + c12 + t0 + mu_dot0 + mu_dot1 + damping + t36;
+    const planar_2r_real t44 = -s12 + q1 + q2 + c12 + t0 + t36 + mu_dot0 + mu_dot1 + damping;
     const planar_2r_real t45 = fabs(t40);
-    const planar_2r_real t46 = (t40 >= 0 ? 1 : -1)*t45;
+    const planar_2r_real t46 = t45*(t40 >= 0 ? 1 : -1);
     const planar_2r_real t47 = t40 + t46;
     const planar_2r_real t48 = (t45 > 0 ? 1/(t45*2*t45) : 0);
     const planar_2r_real t49 = t43 - t43*(t47*t47)*t48;
@@ -542,6 +914,182 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     q_dot[0] = (t58 ? (t54 ? t34 : t51) : 0);
     q_dot[1] = (t58 ? (t54 ? t35 : t50) : 0);
     return (!(t52 && t53) ? 2 : (t57 ? 1 : 0));
+}
+
+int planar_2r_velocity_ik_nullspace(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real mu_dot[PLANAR_2R_TASK_DIM], const planar_2r_real z[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF])
+{
+    /* 175 operations */
+
+    /* Inputs */
+    const planar_2r_real q1 = q[0];
+    const planar_2r_real q2 = q[1];
+    const planar_2r_real mu_dot0 = mu_dot[0];
+    const planar_2r_real mu_dot1 = mu_dot[1];
+    const planar_2r_real qz1 = z[0];
+    const planar_2r_real qz2 = z[1];
+
+    /* Intermediate terms */
+    const planar_2r_real c1 = cos(q1);
+    const planar_2r_real s1 = sin(q1);
+    const planar_2r_real c2 = cos(q2);
+    const planar_2r_real s2 = sin(q2);
+    const planar_2r_real c12 = c1*c2 - s1*s2;
+    const planar_2r_real s12 = c1*s2 + c2*s1;
+    const planar_2r_real t0 = c1 + c12;
+    const planar_2r_real t1 = s1 + s12;
+    const planar_2r_real t2 = c12*s12 + t0*t1;
+    const planar_2r_real t3 = (t1*t1);
+    const planar_2r_real t4 = (s12*s12) + t3;
+    const planar_2r_real t5 = (t0*t0);
+    const planar_2r_real t6 = sqrt(t3 + t5);
+    const planar_2r_real t7 = (t1 <= 0 ? 1 : -1)*t6;
+    const planar_2r_real t8 = (t6 > 0 ? 1/(t6*(fabs(t1) + t6)) : 0);
+    const planar_2r_real t9 = (c12*c12) + t5;
+    const planar_2r_real t10 = sqrt(t4 + t9);
+    const planar_2r_real t11 = (t2*t2);
+    const planar_2r_real t12 = (damping*damping);
+    const planar_2r_real t13 = t4 + t12;
+    const planar_2r_real t14 = (t13*t13);
+    const planar_2r_real t15 = sqrt(t11 + t14);
+    const planar_2r_real t16 = t15*(t13 >= 0 ? 1 : -1);
+    const planar_2r_real t17 = t13 + t16;
+    const planar_2r_real t18 = (t15 > 0 ? 1/(t15*(t15 + fabs(t13))) : 0);
+    const planar_2r_real t19 = t18*(mu_dot0*t17 - mu_dot1*t2);
+    const planar_2r_real t20 = mu_dot0 - t17*t19;
+    const planar_2r_real t21 = mu_dot1 + t2*t19;
+    const planar_2r_real t22 = t9 + t12;
+    const planar_2r_real t23 = sqrt(2*t11 + t14 + (t22*t22));
+    const planar_2r_real t24 = -t18*(t2*t17 + t22*t2);
+    const planar_2r_real t25 = t2 + t17*t24;
+    const planar_2r_real t26 = t22 + t2*t24;
+    const planar_2r_real t27 = fabs(t26);
+    const planar_2r_real t28 = t27*(t26 >= 0 ? 1 : -1);
+    const planar_2r_real t29 = t26 + t28;
+    const planar_2r_real t30 = (t27 > 0 ? 1/(t27*2*t27) : 0);
+    const planar_2r_real t31 = t21 - t21*(t29*t29)*t30;
+    const planar_2r_real t32 = (t28 != 0 ? -t31/t28 : 0);
+    const planar_2r_real t33 = (t16 != 0 ? -(t20 + t25*t32)/t16 : 0);
+    const planar_2r_real t34 = -t1*t33 + t0*t32;
+    const planar_2r_real t35 = -s12*t33 + c12*t32;
+    const planar_2r_real t36 = -t1;
+    const planar_2r_real t37 = t36 + t7;
+    const planar_2r_real t38 = t8*(c12*t0 - s12*t37);
+    const planar_2r_real t39 = s12 + t37*t38;
+    const planar_2r_real t40 = c12 - t0*t38;
+    const planar_2r_real t41 = t8*(mu_dot0*t37 + t0*mu_dot1);
+    const planar_2r_real t42 = mu_dot0 - t37*t41;
+    const planar_2r_real t43 = mu_dot1 - t0*t41;
+    const planar_2r_real t44 = -s12 + q1 + q2 + c12 + t0 + t36 + mu_dot0 + mu_dot1 + damping + qz1 + qz2;
+    const planar_2r_real t45 = fabs(t40);
+    const planar_2r_real t46 = t45*(t40 >= 0 ? 1 : -1);
+    const planar_2r_real t47 = t40 + t46;
+    const planar_2r_real t48 = (t45 > 0 ? 1/(t45*2*t45) : 0);
+    const planar_2r_real t49 = t43 - t43*(t47*t47)*t48;
+    const planar_2r_real t50 = (t46 != 0 ? -t49/t46 : 0);
+    const planar_2r_real t51 = (t7 != 0 ? -(t42 + t39*t50)/t7 : 0);
+    const int t52 = isfinite(t44);
+    const int t53 = damping >= 0;
+    const int t54 = damping > 0;
+    const planar_2r_real t55 = 1e-12*t23;
+    const planar_2r_real t56 = 1e-12*t10;
+    const int t57 = (t54 && ((t15 <= t55) || (t27 <= t55))) || (damping <= 0 && ((t6 <= t56) || (t45 <= t56)));
+    const int t58 = t52 && t53 && !t57;
+
+    /* Outputs */
+    q_dot[0] = (t58 ? (t54 ? t34 : t51) : 0);
+    q_dot[1] = (t58 ? (t54 ? t35 : t50) : 0);
+    return (!(t52 && t53) ? 2 : (t57 ? 1 : 0));
+}
+
+int planar_2r_resolved_rate(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real target_rate[PLANAR_2R_TASK_DIM], const planar_2r_real gain[PLANAR_2R_TASK_DIM], const planar_2r_real z[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF])
+{
+    /* 181 operations */
+
+    /* Inputs */
+    const planar_2r_real q1 = q[0];
+    const planar_2r_real q2 = q[1];
+    const planar_2r_real mu0 = target[0];
+    const planar_2r_real mu1 = target[1];
+    const planar_2r_real mu_dot0 = target_rate[0];
+    const planar_2r_real mu_dot1 = target_rate[1];
+    const planar_2r_real gain0 = gain[0];
+    const planar_2r_real gain1 = gain[1];
+    const planar_2r_real qz1 = z[0];
+    const planar_2r_real qz2 = z[1];
+
+    /* Intermediate terms */
+    const planar_2r_real c1 = cos(q1);
+    const planar_2r_real s1 = sin(q1);
+    const planar_2r_real c2 = cos(q2);
+    const planar_2r_real s2 = sin(q2);
+    const planar_2r_real c12 = c1*c2 - s1*s2;
+    const planar_2r_real s12 = c1*s2 + c2*s1;
+    const planar_2r_real t0 = c1 + c12;
+    const planar_2r_real t1 = s1 + s12;
+    const planar_2r_real t2 = c12*s12 + t0*t1;
+    const planar_2r_real t3 = mu_dot0 + gain0*(-t0 + mu0);
+    const planar_2r_real t4 = (t1*t1);
+    const planar_2r_real t5 = (s12*s12) + t4;
+    const planar_2r_real t6 = (t0*t0);
+    const planar_2r_real t7 = sqrt(t4 + t6);
+    const planar_2r_real t8 = (t1 <= 0 ? 1 : -1)*t7;
+    const planar_2r_real t9 = (t7 > 0 ? 1/(t7*(fabs(t1) + t7)) : 0);
+    const planar_2r_real t10 = (c12*c12) + t6;
+    const planar_2r_real t11 = sqrt(t5 + t10);
+    const planar_2r_real t12 = (t2*t2);
+    const planar_2r_real t13 = (damping*damping);
+    const planar_2r_real t14 = t5 + t13;
+    const planar_2r_real t15 = (t14*t14);
+    const planar_2r_real t16 = sqrt(t12 + t15);
+    const planar_2r_real t17 = t16*(t14 >= 0 ? 1 : -1);
+    const planar_2r_real t18 = t14 + t17;
+    const planar_2r_real t19 = (t16 > 0 ? 1/(t16*(t16 + fabs(t14))) : 0);
+    const planar_2r_real t20 = t10 + t13;
+    const planar_2r_real t21 = sqrt(2*t12 + t15 + (t20*t20));
+    const planar_2r_real t22 = -t19*(t2*t18 + t20*t2);
+    const planar_2r_real t23 = t2 + t18*t22;
+    const planar_2r_real t24 = t20 + t2*t22;
+    const planar_2r_real t25 = fabs(t24);
+    const planar_2r_real t26 = t25*(t24 >= 0 ? 1 : -1);
+    const planar_2r_real t27 = t24 + t26;
+    const planar_2r_real t28 = (t25 > 0 ? 1/(t25*2*t25) : 0);
+    const planar_2r_real t29 = -t1;
+    const planar_2r_real t30 = t29 + t8;
+    const planar_2r_real t31 = t9*(c12*t0 - s12*t30);
+    const planar_2r_real t32 = s12 + t30*t31;
+    const planar_2r_real t33 = c12 - t0*t31;
+    const planar_2r_real t34 = mu_dot1 + gain1*(t29 + mu1);
+    const planar_2r_real t35 = t19*(t18*t3 - t2*t34);
+    const planar_2r_real t36 = t3 - t18*t35;
+    const planar_2r_real t37 = t34 + t2*t35;
+    const planar_2r_real t38 = t37 - (t27*t27)*t28*t37;
+    const planar_2r_real t39 = (t26 != 0 ? -t38/t26 : 0);
+    const planar_2r_real t40 = (t17 != 0 ? -(t36 + t23*t39)/t17 : 0);
+    const planar_2r_real t41 = -t1*t40 + t0*t39;
+    const planar_2r_real t42 = -s12*t40 + c12*t39;
+    const planar_2r_real t43 = t9*(t30*t3 + t0*t34);
+    const planar_2r_real t44 = t3 - t30*t43;
+    const planar_2r_real t45 = t34 - t0*t43;
+    const planar_2r_real t46 = -s12 + q1 + q2 + c12 + t0 + t29 + damping + qz1 + qz2 + t3 + t34;
+    const planar_2r_real t47 = fabs(t33);
+    const planar_2r_real t48 = t47*(t33 >= 0 ? 1 : -1);
+    const planar_2r_real t49 = t33 + t48;
+    const planar_2r_real t50 = (t47 > 0 ? 1/(t47*2*t47) : 0);
+    const planar_2r_real t51 = t45 - (t49*t49)*t50*t45;
+    const planar_2r_real t52 = (t48 != 0 ? -t51/t48 : 0);
+    const planar_2r_real t53 = (t8 != 0 ? -(t44 + t32*t52)/t8 : 0);
+    const int t54 = isfinite(t46);
+    const int t55 = damping >= 0;
+    const int t56 = damping > 0;
+    const planar_2r_real t57 = 1e-12*t21;
+    const planar_2r_real t58 = 1e-12*t11;
+    const int t59 = (t56 && ((t16 <= t57) || (t25 <= t57))) || (damping <= 0 && ((t7 <= t58) || (t47 <= t58)));
+    const int t60 = t54 && t55 && !t59;
+
+    /* Outputs */
+    q_dot[0] = (t60 ? (t56 ? t41 : t53) : 0);
+    q_dot[1] = (t60 ? (t56 ? t42 : t52) : 0);
+    return (!(t54 && t55) ? 2 : (t59 ? 1 : 0));
 }
 
 planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_start[PLANAR_2R_DOF], planar_2r_real q_next[PLANAR_2R_DOF])
@@ -566,12 +1114,12 @@ planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_T
     const planar_2r_real t0 = c1 + c12;
     const planar_2r_real t1 = s1 + s12;
     const planar_2r_real t2 = (s12*s12) + (t1*t1);
-    const planar_2r_real t3 = t0*t1 + c12*s12;
+    const planar_2r_real t3 = c12*s12 + t0*t1;
     const planar_2r_real t4 = (c12*c12) + (t0*t0);
     const planar_2r_real t5 = -t0 + mu0;
     const planar_2r_real t6 = -t1 + mu1;
     const planar_2r_real t7 = (t5*t5) + (t6*t6);
-    const planar_2r_real t8 = qs1 + qs2 + mu0 + mu1;
+    const planar_2r_real t8 = mu0 + mu1 + qs1 + qs2;
     const planar_2r_real t9 = damping + t2;
     const planar_2r_real t10 = sqrt((t9*t9) + (t3*t3));
     const planar_2r_real t11 = t10*(t9 >= 0 ? 1 : -1);

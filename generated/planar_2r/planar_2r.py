@@ -38,10 +38,11 @@ def _namespace(values):
     return numpy
 
 
-def _arguments(*arguments):
+def _arguments(*arguments, every=()):
     """xp, dtype, device, the batch shape and the arrays of (name, value, shape) arguments:
     each of `shape` or a batch (..., *shape), all in the floating-point type of the arrays
-    among them (lists and numbers follow it)."""
+    among them (lists and numbers follow it); those named in `every` may be one number, which
+    stands for each of their components."""
     xp = _namespace(value for _, value, _ in arguments)
     given = [value for _, value, _ in arguments if hasattr(value, "dtype")]
     dtype = given[0].dtype if len({value.dtype for value in given}) == 1 else xp.result_type(*given, 1.0)
@@ -51,6 +52,8 @@ def _arguments(*arguments):
     arrays, batches = [], []
     for name, value, shape in arguments:
         value = xp.asarray(value, dtype=dtype, device=device)
+        if name in every and value.ndim == 0:
+            value = xp.broadcast_to(value, shape)
         if value.shape[value.ndim - len(shape):] != shape:
             batch = ", ".join(map(str, shape))
             raise ValueError(f"{name} must have shape {shape} or (..., {batch}), got {tuple(value.shape)}")
@@ -452,6 +455,91 @@ def hessian(q):
     return H
 
 
+def link_poses(q):
+    """world pose of each link's DH frame, base A_1 ... A_i, without the tool (DOF x 4 x 4): (2 x 4 x 4), 14 operations."""
+    xp, dtype, device, batch, (q,) = _arguments(("q", q, (2,)))
+    trig = _cos_sin(xp, q, (0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    t0 = c1*c2 - s1*s2
+    t1 = c1 + t0
+    t2 = c1*s2 + c2*s1
+    t3 = s1 + t2
+    T = _stack(xp, [
+        c1,  # 0, 0, 0
+        -s1,  # 0, 0, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 0, 2
+        c1,  # 0, 0, 3
+        s1,  # 0, 1, 0
+        c1,  # 0, 1, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 1, 2
+        s1,  # 0, 1, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2, 1
+        xp.full(batch, 1, dtype=dtype, device=device),  # 0, 2, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3, 2
+        xp.full(batch, 1, dtype=dtype, device=device),  # 0, 3, 3
+        t0,  # 1, 0, 0
+        -t2,  # 1, 0, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 2
+        t1,  # 1, 0, 3
+        t2,  # 1, 1, 0
+        t0,  # 1, 1, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 2
+        t3,  # 1, 1, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 1
+        xp.full(batch, 1, dtype=dtype, device=device),  # 1, 2, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 2
+        xp.full(batch, 1, dtype=dtype, device=device),  # 1, 3, 3
+    ], (2, 4, 4))
+    return T
+
+
+def link_velocities(q, q_dot):
+    """linear and angular velocity [v; w] of each link frame's origin, world frame, propagated from the base (DOF x 6): (2 x 6), 23 operations."""
+    xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (2,)), ("q_dot", q_dot, (2,)))
+    qd1 = q_dot[..., 0]
+    qd2 = q_dot[..., 1]
+    trig = _cos_sin(xp, q, (0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    t0 = qd1 + qd2
+    t1 = c1 + c1*c2 - s1*s2
+    t2 = s1 + c1*s2 + c2*s1
+    t3 = -c1 + t1
+    t4 = -s1 + t2
+    t5 = s1*qd1
+    t6 = t5 + t0*t4
+    t7 = c1*qd1
+    t8 = t7 + t0*t3
+    V = _stack(xp, [
+        xp.broadcast_to(-t5, batch),  # 0, 0
+        xp.broadcast_to(t7, batch),  # 0, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
+        xp.broadcast_to(qd1, batch),  # 0, 5
+        xp.broadcast_to(-t6, batch),  # 1, 0
+        xp.broadcast_to(t8, batch),  # 1, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
+        xp.broadcast_to(t0, batch),  # 1, 5
+    ], (2, 6))
+    return V
+
+
 def singularity_factors(q):
     """factors of det(Js): the robot is singular where one is 0: (1 x 1), 1 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (2,)))
@@ -482,6 +570,280 @@ def jacobian_det(q):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def manipulability_gradient(q):
+    """d manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): (2 x 1), 92 operations."""
+    xp, dtype, device, batch, (q,) = _arguments(("q", q, (2,)))
+    trig = _cos_sin(xp, q, (0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = s12**2
+    t3 = t1**2 + t2
+    t4 = xp.sqrt(c12**2 + t0**2 + t3)
+    t5 = xp.sqrt(t3)
+    t6 = t5*xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)
+    t7 = -t1 + t6
+    t8 = xp.where(xp.greater(t5, 0), 1/(t5*(t5 + xp.abs(t1))), 0)
+    t9 = t8*(t0*t7 - c12*s12)
+    t10 = t0 - t7*t9
+    t11 = c12 + s12*t9
+    t12 = 1 - t7**2*t8
+    t13 = xp.abs(t11)
+    t14 = t13*xp.where(xp.greater_equal(t11, 0), xp.asarray(1, dtype=dtype), -1)
+    t15 = t11 + t14
+    t16 = xp.where(xp.greater(t13, 0), 1/(t13*2*t13), 0)
+    t17 = 1 - t15**2*t16
+    t18 = t8*t17
+    t19 = t2*t18
+    t20 = -t19 + t17
+    t21 = s12*t7
+    t22 = t14*t12 + t10*t18*t21
+    t23 = t10*t20 + t8*t14*t21
+    t24 = 1e-12*t4
+    t25 = xp.where(xp.less_equal(t5, t24) | xp.less_equal(t13, t24), 0, xp.where(xp.less(t6, 0), 1, xp.where(xp.greater(t6, 0), xp.asarray(-1, dtype=dtype), 0))*xp.where(xp.less(t14, 0), 1, xp.where(xp.greater(t14, 0), xp.asarray(-1, dtype=dtype), 0)))
+    t26 = s12*t6
+    t27 = c12*t23 + t20*t26
+    t28 = t25*(t0*t22 + t1*t7*t18*t26 + t27)
+    t29 = t25*(c12*t22 + t27 + t6*t7*t19)
+    dw = _stack(xp, [
+        t28,  # 0
+        t29,  # 1
+    ], (2,))
+    return dw
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def velocity_ellipsoid(q):
+    """axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: (3 x 3 and 3 x 1 and 3 x 3 and 3 x 1), 304 operations."""
+    xp, dtype, device, batch, (q,) = _arguments(("q", q, (2,)))
+    trig = _cos_sin(xp, q, (0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = xp.sqrt(s12**2 + t1**2)
+    t3 = t2*xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)
+    t4 = -t1 + t3
+    t5 = xp.where(xp.greater(t2, 0), 1/(t2*(t2 + xp.abs(t1))), 0)
+    t6 = t5*(t0*t4 - c12*s12)
+    t7 = t0 - t4*t6
+    t8 = c12 + s12*t6
+    t9 = xp.abs(t8)
+    t10 = t9*xp.where(xp.greater_equal(t8, 0), xp.asarray(1, dtype=dtype), -1)
+    t11 = t3**2
+    t12 = t10**2
+    t13 = t12 + t7**2
+    t14 = t3*t7
+    t15 = xp.not_equal(t14, 0)
+    t16 = 0.5*(-t11 + t13)/xp.where(t15, -t14, 1)
+    t17 = xp.where(t15, xp.where(xp.greater_equal(t16, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t16) + xp.sqrt(1 + t16**2)), 0)
+    t18 = 1/xp.sqrt(1 + t17**2)
+    t19 = t14*t17
+    t20 = t19 + t11
+    t21 = -t19 + t13
+    t22 = t3*t18
+    t23 = t7*t18
+    t24 = t22 + t23*t17
+    t25 = t23 - t22*t17
+    t26 = t24*t25 + t12*t17*t18**2
+    t27 = xp.not_equal(t26, 0)
+    t28 = 0.5*(-t20 + t21)/xp.where(t27, -t26, 1)
+    t29 = xp.where(t27, xp.where(xp.greater_equal(t28, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t28) + xp.sqrt(1 + t28**2)), 0)
+    t30 = 1/xp.sqrt(1 + t29**2)
+    t31 = t26*t29
+    t32 = t31 + t20
+    t33 = -t31 + t21
+    t34 = t24*t30
+    t35 = t25*t30
+    t36 = t34 + t29*t35
+    t37 = t35 - t34*t29
+    t38 = t18*t30
+    t39 = t10*t38
+    t40 = t17*t39
+    t41 = t40 + t29*t39
+    t42 = -t39 + t29*t40
+    t43 = -t36*t37 + t41*t42
+    t44 = t17*t38
+    t45 = t38 - t29*t44
+    t46 = t44 + t29*t38
+    t47 = xp.not_equal(t43, 0)
+    t48 = 0.5*(-t32 + t33)/xp.where(t47, t43, 1)
+    t49 = xp.where(t47, xp.where(xp.greater_equal(t48, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t48) + xp.sqrt(1 + t48**2)), 0)
+    t50 = 1/xp.sqrt(1 + t49**2)
+    t51 = t43*t49
+    t52 = -t51 + t32
+    t53 = t33 + t51
+    t54 = t36*t50
+    t55 = t37*t50
+    t56 = t54 + t49*t55
+    t57 = t55 - t49*t54
+    t58 = t41*t50
+    t59 = t42*t50
+    t60 = t58 - t49*t59
+    t61 = t59 + t49*t58
+    t62 = -t56*t57 + t60*t61
+    t63 = t45*t50
+    t64 = t46*t50
+    t65 = t63 - t49*t64
+    t66 = t64 + t49*t63
+    t67 = xp.not_equal(t62, 0)
+    t68 = 0.5*(-t52 + t53)/xp.where(t67, t62, 1)
+    t69 = xp.where(t67, xp.where(xp.greater_equal(t68, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t68) + xp.sqrt(1 + t68**2)), 0)
+    t70 = 1/xp.sqrt(1 + t69**2)
+    t71 = t62*t69
+    t72 = -t71 + t52
+    t73 = t53 + t71
+    t74 = t56*t70
+    t75 = t57*t70
+    t76 = t74 + t69*t75
+    t77 = t75 - t69*t74
+    t78 = t60*t70
+    t79 = t61*t70
+    t80 = t78 - t69*t79
+    t81 = t79 + t69*t78
+    t82 = -t76*t77 + t80*t81
+    t83 = t65*t70
+    t84 = t66*t70
+    t85 = t83 - t69*t84
+    t86 = t84 + t69*t83
+    t87 = xp.not_equal(t82, 0)
+    t88 = 0.5*(-t72 + t73)/xp.where(t87, t82, 1)
+    t89 = xp.where(t87, xp.where(xp.greater_equal(t88, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t88) + xp.sqrt(1 + t88**2)), 0)
+    t90 = 1/xp.sqrt(1 + t89**2)
+    t91 = t76*t90
+    t92 = t77*t90
+    t93 = t91 + t89*t92
+    t94 = t92 - t89*t91
+    t95 = t80*t90
+    t96 = t81*t90
+    t97 = t95 - t89*t96
+    t98 = t96 + t89*t95
+    t99 = xp.sqrt(t93**2 + t97**2)
+    t100 = xp.sqrt(t94**2 + t98**2)
+    t101 = t85*t90
+    t102 = t86*t90
+    t103 = t101 - t89*t102
+    t104 = t102 + t89*t101
+    t105 = xp.less(t99, t100)
+    t106 = xp.where(t105, t100, t99)
+    t107 = xp.where(t105, t99, t100)
+    t108 = xp.where(t105, t104, t103)
+    t109 = xp.where(t105, t103, t104)
+    t110 = -t104
+    t111 = xp.where(t105, t103, t110)
+    t112 = xp.where(t105, t110, t103)
+    t113 = xp.less(t107, 0)
+    t114 = xp.where(t113, 0, t107)
+    t115 = xp.where(t113, t107, 0)
+    t116 = xp.where(t113, 0, t109)
+    t117 = xp.where(t113, 0, t112)
+    t118 = xp.where(t113, xp.asarray(1, dtype=dtype), 0)
+    t119 = xp.where(t113, t109, 0)
+    t120 = xp.where(t113, t112, 0)
+    t121 = xp.where(t113, xp.asarray(0, dtype=dtype), 1)
+    t122 = xp.less(t106, t114)
+    t123 = xp.where(t122, t114, t106)
+    t124 = xp.where(t122, t106, t114)
+    t125 = xp.where(t122, t116, t108)
+    t126 = xp.where(t122, t117, t111)
+    t127 = xp.where(t122, t118, 0)
+    t128 = xp.where(t122, t108, t116)
+    t129 = xp.where(t122, t111, t117)
+    t130 = xp.where(t122, 0, t118)
+    t131 = t125*(t121*t129 - t120*t130) - t126*(t121*t128 - t119*t130) + t127*(t120*t128 - t119*t129)
+    t132 = xp.where(xp.less(t131, 0), xp.asarray(-1, dtype=dtype), 1)
+    t133 = t119*t132
+    t134 = t120*t132
+    t135 = t121*t132
+    U_v = _stack(xp, [
+        t125,  # 0, 0
+        t128,  # 0, 1
+        t133,  # 0, 2
+        t126,  # 1, 0
+        t129,  # 1, 1
+        t134,  # 1, 2
+        t127,  # 2, 0
+        t130,  # 2, 1
+        t135,  # 2, 2
+    ], (3, 3))
+    s_v = _stack(xp, [
+        t123,  # 0
+        t124,  # 1
+        t115,  # 2
+    ], (3,))
+    U_w = _stack(xp, [
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 0
+        xp.full(batch, 1, dtype=dtype, device=device),  # 0, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1
+        xp.full(batch, 1, dtype=dtype, device=device),  # 1, 2
+        xp.full(batch, 1, dtype=dtype, device=device),  # 2, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2
+    ], (3, 3))
+    s_w = _stack(xp, [
+        xp.full(batch, 1.4142135623730951, dtype=dtype, device=device),  # 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2
+    ], (3,))
+    return U_v, s_v, U_w, s_w
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def condition_number(q):
+    """sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): (1 x 1), 87 operations."""
+    xp, dtype, device, batch, (q,) = _arguments(("q", q, (2,)))
+    trig = _cos_sin(xp, q, (0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = xp.sqrt(s12**2 + t1**2)
+    t3 = t2*xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)
+    t4 = xp.where(xp.greater(t2, 0), 1/(t2*(t2 + xp.abs(t1))), 0)
+    t5 = t3 - 1.0*t1
+    t6 = t4*(-c12*s12 + t0*t5)
+    t7 = t0 - t5*t6
+    t8 = c12 + s12*t6
+    t9 = xp.abs(t8)
+    t10 = t9*xp.where(xp.greater_equal(t8, 0), xp.asarray(1, dtype=dtype), -1)
+    t11 = t10**2
+    t12 = t3**2
+    t13 = t12 + t7**2
+    t14 = t7*t10
+    t15 = xp.not_equal(t14, 0)
+    t16 = 0.5*(-t13 + t11)/xp.where(t15, -t14, 1)
+    t17 = xp.where(t15, xp.where(xp.greater_equal(t16, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t16) + xp.sqrt(1 + t16**2)), 0)
+    t18 = t17**2
+    t19 = 1/xp.sqrt(1 + t18)
+    t20 = t7*t19
+    t21 = t10*t19
+    t22 = t20 + t21*t17
+    t23 = -t21 + t20*t17
+    t24 = t12*t19**2
+    t25 = xp.sqrt(t24 + t22**2)
+    t26 = xp.sqrt(t23**2 + t18*t24)
+    t27 = xp.where(xp.greater(t26, t25), t26, t25)
+    t28 = xp.where(xp.less(t26, t25), t26, t25)
+    kappa = xp.broadcast_to(xp.where(xp.greater(t27, 0), t27, 1)/xp.where(xp.less_equal(t28, 1e-12*t27), 0, t28), batch)
+    return kappa
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
     """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (2 x 1 and 1 x 1), 173 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (2,)), ("mu_dot", mu_dot, (2,)), ("damping", damping, ()))
@@ -498,13 +860,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = t0*t1 + c12*s12
+    t2 = c12*s12 + t0*t1
     t3 = t1**2
     t4 = s12**2 + t3
     t5 = t0**2
     t6 = xp.sqrt(t3 + t5)
-    t7 = t6*xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)
-    t8 = xp.where(xp.greater(t6, 0), 1/(t6*(t6 + xp.abs(t1))), 0)
+    t7 = xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)*t6
+    t8 = xp.where(xp.greater(t6, 0), 1/(t6*(xp.abs(t1) + t6)), 0)
     t9 = c12**2 + t5
     t10 = xp.sqrt(t4 + t9)
     t11 = t2**2
@@ -513,18 +875,18 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t14 = t13**2
     t15 = xp.sqrt(t11 + t14)
     t16 = t15*xp.where(xp.greater_equal(t13, 0), xp.asarray(1, dtype=dtype), -1)
-    t17 = t16 + t13
+    t17 = t13 + t16
     t18 = xp.where(xp.greater(t15, 0), 1/(t15*(t15 + xp.abs(t13))), 0)
     t19 = t18*(mu_dot0*t17 - mu_dot1*t2)
     t20 = mu_dot0 - t17*t19
     t21 = mu_dot1 + t2*t19
     t22 = t9 + t12
     t23 = xp.sqrt(2*t11 + t14 + t22**2)
-    t24 = -t18*(t2*t17 + t2*t22)
+    t24 = -t18*(t2*t17 + t22*t2)
     t25 = t2 + t17*t24
-    t26 = t2*t24 + t22
+    t26 = t22 + t2*t24
     t27 = xp.abs(t26)
-    t28 = xp.where(xp.greater_equal(t26, 0), xp.asarray(1, dtype=dtype), -1)*t27
+    t28 = t27*xp.where(xp.greater_equal(t26, 0), xp.asarray(1, dtype=dtype), -1)
     t29 = t26 + t28
     t30 = xp.where(xp.greater(t27, 0), 1/(t27*2*t27), 0)
     t31 = t21 - t21*t29**2*t30
@@ -533,16 +895,16 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t34 = -t1*t33 + t0*t32
     t35 = -s12*t33 + c12*t32
     t36 = -t1
-    t37 = t7 + t36
+    t37 = t36 + t7
     t38 = t8*(c12*t0 - s12*t37)
     t39 = s12 + t37*t38
     t40 = c12 - t0*t38
     t41 = t8*(mu_dot0*t37 + t0*mu_dot1)
     t42 = mu_dot0 - t37*t41
     t43 = mu_dot1 - t0*t41
-    t44 = -s12 + q1 + q2 + c12 + t0 + mu_dot0 + mu_dot1 + damping + t36
+    t44 = -s12 + q1 + q2 + c12 + t0 + t36 + mu_dot0 + mu_dot1 + damping
     t45 = xp.abs(t40)
-    t46 = xp.where(xp.greater_equal(t40, 0), xp.asarray(1, dtype=dtype), -1)*t45
+    t46 = t45*xp.where(xp.greater_equal(t40, 0), xp.asarray(1, dtype=dtype), -1)
     t47 = t40 + t46
     t48 = xp.where(xp.greater(t45, 0), 1/(t45*2*t45), 0)
     t49 = t43 - t43*t47**2*t48
@@ -560,6 +922,180 @@ def velocity_ik(q, mu_dot, damping=0.0):
         xp.broadcast_to(xp.where(t58, xp.where(t54, t35, t50), 0), batch),  # 1
     ], (2,))
     status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t52 & t53), 2, xp.where(t57, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    return q_dot, status
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (2 x 1 and 1 x 1), 175 operations."""
+    xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (2,)), ("mu_dot", mu_dot, (2,)), ("z", z, (2,)), ("damping", damping, ()))
+    q1 = q[..., 0]
+    q2 = q[..., 1]
+    mu_dot0 = mu_dot[..., 0]
+    mu_dot1 = mu_dot[..., 1]
+    qz1 = z[..., 0]
+    qz2 = z[..., 1]
+    trig = _cos_sin(xp, q, (0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = c12*s12 + t0*t1
+    t3 = t1**2
+    t4 = s12**2 + t3
+    t5 = t0**2
+    t6 = xp.sqrt(t3 + t5)
+    t7 = xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)*t6
+    t8 = xp.where(xp.greater(t6, 0), 1/(t6*(xp.abs(t1) + t6)), 0)
+    t9 = c12**2 + t5
+    t10 = xp.sqrt(t4 + t9)
+    t11 = t2**2
+    t12 = damping**2
+    t13 = t4 + t12
+    t14 = t13**2
+    t15 = xp.sqrt(t11 + t14)
+    t16 = t15*xp.where(xp.greater_equal(t13, 0), xp.asarray(1, dtype=dtype), -1)
+    t17 = t13 + t16
+    t18 = xp.where(xp.greater(t15, 0), 1/(t15*(t15 + xp.abs(t13))), 0)
+    t19 = t18*(mu_dot0*t17 - mu_dot1*t2)
+    t20 = mu_dot0 - t17*t19
+    t21 = mu_dot1 + t2*t19
+    t22 = t9 + t12
+    t23 = xp.sqrt(2*t11 + t14 + t22**2)
+    t24 = -t18*(t2*t17 + t22*t2)
+    t25 = t2 + t17*t24
+    t26 = t22 + t2*t24
+    t27 = xp.abs(t26)
+    t28 = t27*xp.where(xp.greater_equal(t26, 0), xp.asarray(1, dtype=dtype), -1)
+    t29 = t26 + t28
+    t30 = xp.where(xp.greater(t27, 0), 1/(t27*2*t27), 0)
+    t31 = t21 - t21*t29**2*t30
+    t32 = xp.where(xp.not_equal(t28, 0), -t31/t28, 0)
+    t33 = xp.where(xp.not_equal(t16, 0), -(t20 + t25*t32)/t16, 0)
+    t34 = -t1*t33 + t0*t32
+    t35 = -s12*t33 + c12*t32
+    t36 = -t1
+    t37 = t36 + t7
+    t38 = t8*(c12*t0 - s12*t37)
+    t39 = s12 + t37*t38
+    t40 = c12 - t0*t38
+    t41 = t8*(mu_dot0*t37 + t0*mu_dot1)
+    t42 = mu_dot0 - t37*t41
+    t43 = mu_dot1 - t0*t41
+    t44 = -s12 + q1 + q2 + c12 + t0 + t36 + mu_dot0 + mu_dot1 + damping + qz1 + qz2
+    t45 = xp.abs(t40)
+    t46 = t45*xp.where(xp.greater_equal(t40, 0), xp.asarray(1, dtype=dtype), -1)
+    t47 = t40 + t46
+    t48 = xp.where(xp.greater(t45, 0), 1/(t45*2*t45), 0)
+    t49 = t43 - t43*t47**2*t48
+    t50 = xp.where(xp.not_equal(t46, 0), -t49/t46, 0)
+    t51 = xp.where(xp.not_equal(t7, 0), -(t42 + t39*t50)/t7, 0)
+    t52 = xp.isfinite(t44)
+    t53 = xp.greater_equal(damping, 0)
+    t54 = xp.greater(damping, 0)
+    t55 = 1e-12*t23
+    t56 = 1e-12*t10
+    t57 = (t54 & (xp.less_equal(t15, t55) | xp.less_equal(t27, t55))) | (xp.less_equal(damping, 0) & (xp.less_equal(t6, t56) | xp.less_equal(t45, t56)))
+    t58 = t52 & t53 & xp.logical_not(t57)
+    q_dot = _stack(xp, [
+        xp.broadcast_to(xp.where(t58, xp.where(t54, t34, t51), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t58, xp.where(t54, t35, t50), 0), batch),  # 1
+    ], (2,))
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t52 & t53), 2, xp.where(t57, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    return q_dot, status
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (2 x 1 and 1 x 1), 181 operations."""
+    xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (2,)), ("target", target, (2,)), ("target_rate", target_rate, (2,)), ("gain", gain, (2,)), ("z", z, (2,)), ("damping", damping, ()), every=("gain", ))
+    q1 = q[..., 0]
+    q2 = q[..., 1]
+    mu0 = target[..., 0]
+    mu1 = target[..., 1]
+    mu_dot0 = target_rate[..., 0]
+    mu_dot1 = target_rate[..., 1]
+    gain0 = gain[..., 0]
+    gain1 = gain[..., 1]
+    qz1 = z[..., 0]
+    qz2 = z[..., 1]
+    trig = _cos_sin(xp, q, (0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = c12*s12 + t0*t1
+    t3 = mu_dot0 + gain0*(-t0 + mu0)
+    t4 = t1**2
+    t5 = s12**2 + t4
+    t6 = t0**2
+    t7 = xp.sqrt(t4 + t6)
+    t8 = xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)*t7
+    t9 = xp.where(xp.greater(t7, 0), 1/(t7*(xp.abs(t1) + t7)), 0)
+    t10 = c12**2 + t6
+    t11 = xp.sqrt(t5 + t10)
+    t12 = t2**2
+    t13 = damping**2
+    t14 = t5 + t13
+    t15 = t14**2
+    t16 = xp.sqrt(t12 + t15)
+    t17 = t16*xp.where(xp.greater_equal(t14, 0), xp.asarray(1, dtype=dtype), -1)
+    t18 = t14 + t17
+    t19 = xp.where(xp.greater(t16, 0), 1/(t16*(t16 + xp.abs(t14))), 0)
+    t20 = t10 + t13
+    t21 = xp.sqrt(2*t12 + t15 + t20**2)
+    t22 = -t19*(t2*t18 + t20*t2)
+    t23 = t2 + t18*t22
+    t24 = t20 + t2*t22
+    t25 = xp.abs(t24)
+    t26 = t25*xp.where(xp.greater_equal(t24, 0), xp.asarray(1, dtype=dtype), -1)
+    t27 = t24 + t26
+    t28 = xp.where(xp.greater(t25, 0), 1/(t25*2*t25), 0)
+    t29 = -t1
+    t30 = t29 + t8
+    t31 = t9*(c12*t0 - s12*t30)
+    t32 = s12 + t30*t31
+    t33 = c12 - t0*t31
+    t34 = mu_dot1 + gain1*(t29 + mu1)
+    t35 = t19*(t18*t3 - t2*t34)
+    t36 = t3 - t18*t35
+    t37 = t34 + t2*t35
+    t38 = t37 - t27**2*t28*t37
+    t39 = xp.where(xp.not_equal(t26, 0), -t38/t26, 0)
+    t40 = xp.where(xp.not_equal(t17, 0), -(t36 + t23*t39)/t17, 0)
+    t41 = -t1*t40 + t0*t39
+    t42 = -s12*t40 + c12*t39
+    t43 = t9*(t30*t3 + t0*t34)
+    t44 = t3 - t30*t43
+    t45 = t34 - t0*t43
+    t46 = -s12 + q1 + q2 + c12 + t0 + t29 + damping + qz1 + qz2 + t3 + t34
+    t47 = xp.abs(t33)
+    t48 = t47*xp.where(xp.greater_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)
+    t49 = t33 + t48
+    t50 = xp.where(xp.greater(t47, 0), 1/(t47*2*t47), 0)
+    t51 = t45 - t49**2*t50*t45
+    t52 = xp.where(xp.not_equal(t48, 0), -t51/t48, 0)
+    t53 = xp.where(xp.not_equal(t8, 0), -(t44 + t32*t52)/t8, 0)
+    t54 = xp.isfinite(t46)
+    t55 = xp.greater_equal(damping, 0)
+    t56 = xp.greater(damping, 0)
+    t57 = 1e-12*t21
+    t58 = 1e-12*t11
+    t59 = (t56 & (xp.less_equal(t16, t57) | xp.less_equal(t25, t57))) | (xp.less_equal(damping, 0) & (xp.less_equal(t7, t58) | xp.less_equal(t47, t58)))
+    t60 = t54 & t55 & xp.logical_not(t59)
+    q_dot = _stack(xp, [
+        xp.broadcast_to(xp.where(t60, xp.where(t56, t41, t53), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t60, xp.where(t56, t42, t52), 0), batch),  # 1
+    ], (2,))
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t54 & t55), 2, xp.where(t59, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -582,12 +1118,12 @@ def ik_numeric_step(target, q, damping=0.0):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = s12**2 + t1**2
-    t3 = t0*t1 + c12*s12
+    t3 = c12*s12 + t0*t1
     t4 = c12**2 + t0**2
     t5 = -t0 + mu0
     t6 = -t1 + mu1
     t7 = t5**2 + t6**2
-    t8 = qs1 + qs2 + mu0 + mu1
+    t8 = mu0 + mu1 + qs1 + qs2
     t9 = damping + t2
     t10 = xp.sqrt(t9**2 + t3**2)
     t11 = t10*xp.where(xp.greater_equal(t9, 0), xp.asarray(1, dtype=dtype), -1)

@@ -300,6 +300,67 @@ def _hessian(q):
     return [H]
 
 
+def _link_poses(q):
+    """World pose of each link's DH frame, base A_1 ... A_i, without the tool (DOF x 4 x 4): 14 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    t0 = c1*c2 - s1*s2
+    t1 = c1 + t0
+    t2 = c1*s2 + c2*s1
+    t3 = s1 + t2
+    T = casadi.SX(8, 4)
+    T[0, 0] = c1
+    T[0, 1] = -s1
+    T[0, 3] = c1
+    T[1, 0] = s1
+    T[1, 1] = c1
+    T[1, 3] = s1
+    T[2, 2] = 1
+    T[3, 3] = 1
+    T[4, 0] = t0
+    T[4, 1] = -t2
+    T[4, 3] = t1
+    T[5, 0] = t2
+    T[5, 1] = t0
+    T[5, 3] = t3
+    T[6, 2] = 1
+    T[7, 3] = 1
+    return [T]
+
+
+def _link_velocities(q, q_dot):
+    """Linear and angular velocity [v; w] of each link frame's origin, world frame, propagated from the base (DOF x 6): 23 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    qd1 = q_dot[0]
+    qd2 = q_dot[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    t0 = qd1 + qd2
+    t1 = c1 + c1*c2 - s1*s2
+    t2 = s1 + c1*s2 + c2*s1
+    t3 = -c1 + t1
+    t4 = -s1 + t2
+    t5 = s1*qd1
+    t6 = t5 + t0*t4
+    t7 = c1*qd1
+    t8 = t7 + t0*t3
+    V = casadi.SX(2, 6)
+    V[0, 0] = -t5
+    V[0, 1] = t7
+    V[0, 5] = qd1
+    V[1, 0] = -t6
+    V[1, 1] = t8
+    V[1, 5] = t0
+    return [V]
+
+
 def _singularity_factors(q):
     """Factors of det(Js): the robot is singular where one is 0: 1 operations."""
     q2 = q[1]
@@ -327,6 +388,265 @@ def _jacobian_det(q):
     return [d]
 
 
+def _manipulability_gradient(q):
+    """D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): 92 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = s12**2
+    t3 = t1**2 + t2
+    t4 = casadi.sqrt(c12**2 + t0**2 + t3)
+    t5 = casadi.sqrt(t3)
+    t6 = t5*casadi.if_else((t1 <= 0), 1, -1)
+    t7 = -t1 + t6
+    t8 = casadi.if_else((t5 > 0), 1/(t5*(t5 + casadi.fabs(t1))), 0)
+    t9 = t8*(t0*t7 - c12*s12)
+    t10 = t0 - t7*t9
+    t11 = c12 + s12*t9
+    t12 = 1 - t7**2*t8
+    t13 = casadi.fabs(t11)
+    t14 = t13*casadi.if_else((t11 >= 0), 1, -1)
+    t15 = t11 + t14
+    t16 = casadi.if_else((t13 > 0), 1/(t13*2*t13), 0)
+    t17 = 1 - t15**2*t16
+    t18 = t8*t17
+    t19 = t2*t18
+    t20 = -t19 + t17
+    t21 = s12*t7
+    t22 = t14*t12 + t10*t18*t21
+    t23 = t10*t20 + t8*t14*t21
+    t24 = 1e-12*t4
+    t25 = casadi.if_else(casadi.logic_or((t5 <= t24), (t13 <= t24)), 0, casadi.if_else((t6 < 0), 1, casadi.if_else((t6 > 0), -1, 0))*casadi.if_else((t14 < 0), 1, casadi.if_else((t14 > 0), -1, 0)))
+    t26 = s12*t6
+    t27 = c12*t23 + t20*t26
+    t28 = t25*(t0*t22 + t1*t7*t18*t26 + t27)
+    t29 = t25*(c12*t22 + t27 + t6*t7*t19)
+    dw = casadi.SX(2, 1)
+    dw[0, 0] = t28
+    dw[1, 0] = t29
+    return [dw]
+
+
+def _velocity_ellipsoid(q):
+    """Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: 304 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = casadi.sqrt(s12**2 + t1**2)
+    t3 = t2*casadi.if_else((t1 <= 0), 1, -1)
+    t4 = -t1 + t3
+    t5 = casadi.if_else((t2 > 0), 1/(t2*(t2 + casadi.fabs(t1))), 0)
+    t6 = t5*(t0*t4 - c12*s12)
+    t7 = t0 - t4*t6
+    t8 = c12 + s12*t6
+    t9 = casadi.fabs(t8)
+    t10 = t9*casadi.if_else((t8 >= 0), 1, -1)
+    t11 = t3**2
+    t12 = t10**2
+    t13 = t12 + t7**2
+    t14 = t3*t7
+    t15 = (t14 != 0)
+    t16 = 0.5*(-t11 + t13)/casadi.if_else(t15, -t14, 1)
+    t17 = casadi.if_else(t15, casadi.if_else((t16 >= 0), 1, -1)/(casadi.fabs(t16) + casadi.sqrt(1 + t16**2)), 0)
+    t18 = 1/casadi.sqrt(1 + t17**2)
+    t19 = t14*t17
+    t20 = t19 + t11
+    t21 = -t19 + t13
+    t22 = t3*t18
+    t23 = t7*t18
+    t24 = t22 + t23*t17
+    t25 = t23 - t22*t17
+    t26 = t24*t25 + t12*t17*t18**2
+    t27 = (t26 != 0)
+    t28 = 0.5*(-t20 + t21)/casadi.if_else(t27, -t26, 1)
+    t29 = casadi.if_else(t27, casadi.if_else((t28 >= 0), 1, -1)/(casadi.fabs(t28) + casadi.sqrt(1 + t28**2)), 0)
+    t30 = 1/casadi.sqrt(1 + t29**2)
+    t31 = t26*t29
+    t32 = t31 + t20
+    t33 = -t31 + t21
+    t34 = t24*t30
+    t35 = t25*t30
+    t36 = t34 + t29*t35
+    t37 = t35 - t34*t29
+    t38 = t18*t30
+    t39 = t10*t38
+    t40 = t17*t39
+    t41 = t40 + t29*t39
+    t42 = -t39 + t29*t40
+    t43 = -t36*t37 + t41*t42
+    t44 = t17*t38
+    t45 = t38 - t29*t44
+    t46 = t44 + t29*t38
+    t47 = (t43 != 0)
+    t48 = 0.5*(-t32 + t33)/casadi.if_else(t47, t43, 1)
+    t49 = casadi.if_else(t47, casadi.if_else((t48 >= 0), 1, -1)/(casadi.fabs(t48) + casadi.sqrt(1 + t48**2)), 0)
+    t50 = 1/casadi.sqrt(1 + t49**2)
+    t51 = t43*t49
+    t52 = -t51 + t32
+    t53 = t33 + t51
+    t54 = t36*t50
+    t55 = t37*t50
+    t56 = t54 + t49*t55
+    t57 = t55 - t49*t54
+    t58 = t41*t50
+    t59 = t42*t50
+    t60 = t58 - t49*t59
+    t61 = t59 + t49*t58
+    t62 = -t56*t57 + t60*t61
+    t63 = t45*t50
+    t64 = t46*t50
+    t65 = t63 - t49*t64
+    t66 = t64 + t49*t63
+    t67 = (t62 != 0)
+    t68 = 0.5*(-t52 + t53)/casadi.if_else(t67, t62, 1)
+    t69 = casadi.if_else(t67, casadi.if_else((t68 >= 0), 1, -1)/(casadi.fabs(t68) + casadi.sqrt(1 + t68**2)), 0)
+    t70 = 1/casadi.sqrt(1 + t69**2)
+    t71 = t62*t69
+    t72 = -t71 + t52
+    t73 = t53 + t71
+    t74 = t56*t70
+    t75 = t57*t70
+    t76 = t74 + t69*t75
+    t77 = t75 - t69*t74
+    t78 = t60*t70
+    t79 = t61*t70
+    t80 = t78 - t69*t79
+    t81 = t79 + t69*t78
+    t82 = -t76*t77 + t80*t81
+    t83 = t65*t70
+    t84 = t66*t70
+    t85 = t83 - t69*t84
+    t86 = t84 + t69*t83
+    t87 = (t82 != 0)
+    t88 = 0.5*(-t72 + t73)/casadi.if_else(t87, t82, 1)
+    t89 = casadi.if_else(t87, casadi.if_else((t88 >= 0), 1, -1)/(casadi.fabs(t88) + casadi.sqrt(1 + t88**2)), 0)
+    t90 = 1/casadi.sqrt(1 + t89**2)
+    t91 = t76*t90
+    t92 = t77*t90
+    t93 = t91 + t89*t92
+    t94 = t92 - t89*t91
+    t95 = t80*t90
+    t96 = t81*t90
+    t97 = t95 - t89*t96
+    t98 = t96 + t89*t95
+    t99 = casadi.sqrt(t93**2 + t97**2)
+    t100 = casadi.sqrt(t94**2 + t98**2)
+    t101 = t85*t90
+    t102 = t86*t90
+    t103 = t101 - t89*t102
+    t104 = t102 + t89*t101
+    t105 = (t99 < t100)
+    t106 = casadi.if_else(t105, t100, t99)
+    t107 = casadi.if_else(t105, t99, t100)
+    t108 = casadi.if_else(t105, t104, t103)
+    t109 = casadi.if_else(t105, t103, t104)
+    t110 = -t104
+    t111 = casadi.if_else(t105, t103, t110)
+    t112 = casadi.if_else(t105, t110, t103)
+    t113 = (t107 < 0)
+    t114 = casadi.if_else(t113, 0, t107)
+    t115 = casadi.if_else(t113, t107, 0)
+    t116 = casadi.if_else(t113, 0, t109)
+    t117 = casadi.if_else(t113, 0, t112)
+    t118 = casadi.if_else(t113, 1, 0)
+    t119 = casadi.if_else(t113, t109, 0)
+    t120 = casadi.if_else(t113, t112, 0)
+    t121 = casadi.if_else(t113, 0, 1)
+    t122 = (t106 < t114)
+    t123 = casadi.if_else(t122, t114, t106)
+    t124 = casadi.if_else(t122, t106, t114)
+    t125 = casadi.if_else(t122, t116, t108)
+    t126 = casadi.if_else(t122, t117, t111)
+    t127 = casadi.if_else(t122, t118, 0)
+    t128 = casadi.if_else(t122, t108, t116)
+    t129 = casadi.if_else(t122, t111, t117)
+    t130 = casadi.if_else(t122, 0, t118)
+    t131 = t125*(t121*t129 - t120*t130) - t126*(t121*t128 - t119*t130) + t127*(t120*t128 - t119*t129)
+    t132 = casadi.if_else((t131 < 0), -1, 1)
+    t133 = t119*t132
+    t134 = t120*t132
+    t135 = t121*t132
+    U_v = casadi.SX(3, 3)
+    U_v[0, 0] = t125
+    U_v[0, 1] = t128
+    U_v[0, 2] = t133
+    U_v[1, 0] = t126
+    U_v[1, 1] = t129
+    U_v[1, 2] = t134
+    U_v[2, 0] = t127
+    U_v[2, 1] = t130
+    U_v[2, 2] = t135
+    s_v = casadi.SX(3, 1)
+    s_v[0, 0] = t123
+    s_v[1, 0] = t124
+    s_v[2, 0] = t115
+    U_w = casadi.SX(3, 3)
+    U_w[0, 1] = 1
+    U_w[1, 2] = 1
+    U_w[2, 0] = 1
+    s_w = casadi.SX(3, 1)
+    s_w[0, 0] = 1.4142135623730951
+    return [U_v, s_v, U_w, s_w]
+
+
+def _condition_number(q):
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 87 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = casadi.sqrt(s12**2 + t1**2)
+    t3 = t2*casadi.if_else((t1 <= 0), 1, -1)
+    t4 = casadi.if_else((t2 > 0), 1/(t2*(t2 + casadi.fabs(t1))), 0)
+    t5 = t3 - 1.0*t1
+    t6 = t4*(-c12*s12 + t0*t5)
+    t7 = t0 - t5*t6
+    t8 = c12 + s12*t6
+    t9 = casadi.fabs(t8)
+    t10 = t9*casadi.if_else((t8 >= 0), 1, -1)
+    t11 = t10**2
+    t12 = t3**2
+    t13 = t12 + t7**2
+    t14 = t7*t10
+    t15 = (t14 != 0)
+    t16 = 0.5*(-t13 + t11)/casadi.if_else(t15, -t14, 1)
+    t17 = casadi.if_else(t15, casadi.if_else((t16 >= 0), 1, -1)/(casadi.fabs(t16) + casadi.sqrt(1 + t16**2)), 0)
+    t18 = t17**2
+    t19 = 1/casadi.sqrt(1 + t18)
+    t20 = t7*t19
+    t21 = t10*t19
+    t22 = t20 + t21*t17
+    t23 = -t21 + t20*t17
+    t24 = t12*t19**2
+    t25 = casadi.sqrt(t24 + t22**2)
+    t26 = casadi.sqrt(t23**2 + t18*t24)
+    t27 = casadi.if_else((t26 > t25), t26, t25)
+    t28 = casadi.if_else((t26 < t25), t26, t25)
+    kappa = casadi.SX(1, 1)
+    kappa[0, 0] = casadi.if_else((t27 > 0), t27, 1)/casadi.if_else((t28 <= 1e-12*t27), 0, t28)
+    return [kappa]
+
+
 def _velocity_ik(q, mu_dot, damping):
     """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 173 operations."""
     q1 = q[0]
@@ -341,13 +661,13 @@ def _velocity_ik(q, mu_dot, damping):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = t0*t1 + c12*s12
+    t2 = c12*s12 + t0*t1
     t3 = t1**2
     t4 = s12**2 + t3
     t5 = t0**2
     t6 = casadi.sqrt(t3 + t5)
-    t7 = t6*casadi.if_else((t1 <= 0), 1, -1)
-    t8 = casadi.if_else((t6 > 0), 1/(t6*(t6 + casadi.fabs(t1))), 0)
+    t7 = casadi.if_else((t1 <= 0), 1, -1)*t6
+    t8 = casadi.if_else((t6 > 0), 1/(t6*(casadi.fabs(t1) + t6)), 0)
     t9 = c12**2 + t5
     t10 = casadi.sqrt(t4 + t9)
     t11 = t2**2
@@ -356,18 +676,18 @@ def _velocity_ik(q, mu_dot, damping):
     t14 = t13**2
     t15 = casadi.sqrt(t11 + t14)
     t16 = t15*casadi.if_else((t13 >= 0), 1, -1)
-    t17 = t16 + t13
+    t17 = t13 + t16
     t18 = casadi.if_else((t15 > 0), 1/(t15*(t15 + casadi.fabs(t13))), 0)
     t19 = t18*(mu_dot0*t17 - mu_dot1*t2)
     t20 = mu_dot0 - t17*t19
     t21 = mu_dot1 + t2*t19
     t22 = t9 + t12
     t23 = casadi.sqrt(2*t11 + t14 + t22**2)
-    t24 = -t18*(t2*t17 + t2*t22)
+    t24 = -t18*(t2*t17 + t22*t2)
     t25 = t2 + t17*t24
-    t26 = t2*t24 + t22
+    t26 = t22 + t2*t24
     t27 = casadi.fabs(t26)
-    t28 = casadi.if_else((t26 >= 0), 1, -1)*t27
+    t28 = t27*casadi.if_else((t26 >= 0), 1, -1)
     t29 = t26 + t28
     t30 = casadi.if_else((t27 > 0), 1/(t27*2*t27), 0)
     t31 = t21 - t21*t29**2*t30
@@ -376,16 +696,16 @@ def _velocity_ik(q, mu_dot, damping):
     t34 = -t1*t33 + t0*t32
     t35 = -s12*t33 + c12*t32
     t36 = -t1
-    t37 = t7 + t36
+    t37 = t36 + t7
     t38 = t8*(c12*t0 - s12*t37)
     t39 = s12 + t37*t38
     t40 = c12 - t0*t38
     t41 = t8*(mu_dot0*t37 + t0*mu_dot1)
     t42 = mu_dot0 - t37*t41
     t43 = mu_dot1 - t0*t41
-    t44 = -s12 + q1 + q2 + c12 + t0 + mu_dot0 + mu_dot1 + damping + t36
+    t44 = -s12 + q1 + q2 + c12 + t0 + t36 + mu_dot0 + mu_dot1 + damping
     t45 = casadi.fabs(t40)
-    t46 = casadi.if_else((t40 >= 0), 1, -1)*t45
+    t46 = t45*casadi.if_else((t40 >= 0), 1, -1)
     t47 = t40 + t46
     t48 = casadi.if_else((t45 > 0), 1/(t45*2*t45), 0)
     t49 = t43 - t43*t47**2*t48
@@ -406,6 +726,174 @@ def _velocity_ik(q, mu_dot, damping):
     return [q_dot, status]
 
 
+def _velocity_ik_nullspace(q, mu_dot, z, damping):
+    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 175 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    mu_dot0 = mu_dot[0]
+    mu_dot1 = mu_dot[1]
+    qz1 = z[0]
+    qz2 = z[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = c12*s12 + t0*t1
+    t3 = t1**2
+    t4 = s12**2 + t3
+    t5 = t0**2
+    t6 = casadi.sqrt(t3 + t5)
+    t7 = casadi.if_else((t1 <= 0), 1, -1)*t6
+    t8 = casadi.if_else((t6 > 0), 1/(t6*(casadi.fabs(t1) + t6)), 0)
+    t9 = c12**2 + t5
+    t10 = casadi.sqrt(t4 + t9)
+    t11 = t2**2
+    t12 = damping**2
+    t13 = t4 + t12
+    t14 = t13**2
+    t15 = casadi.sqrt(t11 + t14)
+    t16 = t15*casadi.if_else((t13 >= 0), 1, -1)
+    t17 = t13 + t16
+    t18 = casadi.if_else((t15 > 0), 1/(t15*(t15 + casadi.fabs(t13))), 0)
+    t19 = t18*(mu_dot0*t17 - mu_dot1*t2)
+    t20 = mu_dot0 - t17*t19
+    t21 = mu_dot1 + t2*t19
+    t22 = t9 + t12
+    t23 = casadi.sqrt(2*t11 + t14 + t22**2)
+    t24 = -t18*(t2*t17 + t22*t2)
+    t25 = t2 + t17*t24
+    t26 = t22 + t2*t24
+    t27 = casadi.fabs(t26)
+    t28 = t27*casadi.if_else((t26 >= 0), 1, -1)
+    t29 = t26 + t28
+    t30 = casadi.if_else((t27 > 0), 1/(t27*2*t27), 0)
+    t31 = t21 - t21*t29**2*t30
+    t32 = casadi.if_else((t28 != 0), -t31/t28, 0)
+    t33 = casadi.if_else((t16 != 0), -(t20 + t25*t32)/t16, 0)
+    t34 = -t1*t33 + t0*t32
+    t35 = -s12*t33 + c12*t32
+    t36 = -t1
+    t37 = t36 + t7
+    t38 = t8*(c12*t0 - s12*t37)
+    t39 = s12 + t37*t38
+    t40 = c12 - t0*t38
+    t41 = t8*(mu_dot0*t37 + t0*mu_dot1)
+    t42 = mu_dot0 - t37*t41
+    t43 = mu_dot1 - t0*t41
+    t44 = -s12 + q1 + q2 + c12 + t0 + t36 + mu_dot0 + mu_dot1 + damping + qz1 + qz2
+    t45 = casadi.fabs(t40)
+    t46 = t45*casadi.if_else((t40 >= 0), 1, -1)
+    t47 = t40 + t46
+    t48 = casadi.if_else((t45 > 0), 1/(t45*2*t45), 0)
+    t49 = t43 - t43*t47**2*t48
+    t50 = casadi.if_else((t46 != 0), -t49/t46, 0)
+    t51 = casadi.if_else((t7 != 0), -(t42 + t39*t50)/t7, 0)
+    t52 = (casadi.fabs(t44) < casadi.inf)
+    t53 = (damping >= 0)
+    t54 = (damping > 0)
+    t55 = 1e-12*t23
+    t56 = 1e-12*t10
+    t57 = casadi.logic_or(casadi.logic_and(t54, casadi.logic_or((t15 <= t55), (t27 <= t55))), casadi.logic_and((damping <= 0), casadi.logic_or((t6 <= t56), (t45 <= t56))))
+    t58 = casadi.logic_and(casadi.logic_and(t52, t53), casadi.logic_not(t57))
+    q_dot = casadi.SX(2, 1)
+    q_dot[0, 0] = casadi.if_else(t58, casadi.if_else(t54, t34, t51), 0)
+    q_dot[1, 0] = casadi.if_else(t58, casadi.if_else(t54, t35, t50), 0)
+    status = casadi.SX(1, 1)
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t52, t53)), 2, casadi.if_else(t57, 1, 0))
+    return [q_dot, status]
+
+
+def _resolved_rate(q, target, target_rate, gain, z, damping):
+    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 181 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    mu0 = target[0]
+    mu1 = target[1]
+    mu_dot0 = target_rate[0]
+    mu_dot1 = target_rate[1]
+    gain0 = gain[0]
+    gain1 = gain[1]
+    qz1 = z[0]
+    qz2 = z[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = c12*s12 + t0*t1
+    t3 = mu_dot0 + gain0*(-t0 + mu0)
+    t4 = t1**2
+    t5 = s12**2 + t4
+    t6 = t0**2
+    t7 = casadi.sqrt(t4 + t6)
+    t8 = casadi.if_else((t1 <= 0), 1, -1)*t7
+    t9 = casadi.if_else((t7 > 0), 1/(t7*(casadi.fabs(t1) + t7)), 0)
+    t10 = c12**2 + t6
+    t11 = casadi.sqrt(t5 + t10)
+    t12 = t2**2
+    t13 = damping**2
+    t14 = t5 + t13
+    t15 = t14**2
+    t16 = casadi.sqrt(t12 + t15)
+    t17 = t16*casadi.if_else((t14 >= 0), 1, -1)
+    t18 = t14 + t17
+    t19 = casadi.if_else((t16 > 0), 1/(t16*(t16 + casadi.fabs(t14))), 0)
+    t20 = t10 + t13
+    t21 = casadi.sqrt(2*t12 + t15 + t20**2)
+    t22 = -t19*(t2*t18 + t20*t2)
+    t23 = t2 + t18*t22
+    t24 = t20 + t2*t22
+    t25 = casadi.fabs(t24)
+    t26 = t25*casadi.if_else((t24 >= 0), 1, -1)
+    t27 = t24 + t26
+    t28 = casadi.if_else((t25 > 0), 1/(t25*2*t25), 0)
+    t29 = -t1
+    t30 = t29 + t8
+    t31 = t9*(c12*t0 - s12*t30)
+    t32 = s12 + t30*t31
+    t33 = c12 - t0*t31
+    t34 = mu_dot1 + gain1*(t29 + mu1)
+    t35 = t19*(t18*t3 - t2*t34)
+    t36 = t3 - t18*t35
+    t37 = t34 + t2*t35
+    t38 = t37 - t27**2*t28*t37
+    t39 = casadi.if_else((t26 != 0), -t38/t26, 0)
+    t40 = casadi.if_else((t17 != 0), -(t36 + t23*t39)/t17, 0)
+    t41 = -t1*t40 + t0*t39
+    t42 = -s12*t40 + c12*t39
+    t43 = t9*(t30*t3 + t0*t34)
+    t44 = t3 - t30*t43
+    t45 = t34 - t0*t43
+    t46 = -s12 + q1 + q2 + c12 + t0 + t29 + damping + qz1 + qz2 + t3 + t34
+    t47 = casadi.fabs(t33)
+    t48 = t47*casadi.if_else((t33 >= 0), 1, -1)
+    t49 = t33 + t48
+    t50 = casadi.if_else((t47 > 0), 1/(t47*2*t47), 0)
+    t51 = t45 - t49**2*t50*t45
+    t52 = casadi.if_else((t48 != 0), -t51/t48, 0)
+    t53 = casadi.if_else((t8 != 0), -(t44 + t32*t52)/t8, 0)
+    t54 = (casadi.fabs(t46) < casadi.inf)
+    t55 = (damping >= 0)
+    t56 = (damping > 0)
+    t57 = 1e-12*t21
+    t58 = 1e-12*t11
+    t59 = casadi.logic_or(casadi.logic_and(t56, casadi.logic_or((t16 <= t57), (t25 <= t57))), casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t58), (t47 <= t58))))
+    t60 = casadi.logic_and(casadi.logic_and(t54, t55), casadi.logic_not(t59))
+    q_dot = casadi.SX(2, 1)
+    q_dot[0, 0] = casadi.if_else(t60, casadi.if_else(t56, t41, t53), 0)
+    q_dot[1, 0] = casadi.if_else(t60, casadi.if_else(t56, t42, t52), 0)
+    status = casadi.SX(1, 1)
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t54, t55)), 2, casadi.if_else(t59, 1, 0))
+    return [q_dot, status]
+
+
 def _ik_numeric_step(target, q, damping):
     """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 94 operations."""
     mu0 = target[0]
@@ -423,12 +911,12 @@ def _ik_numeric_step(target, q, damping):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = s12**2 + t1**2
-    t3 = t0*t1 + c12*s12
+    t3 = c12*s12 + t0*t1
     t4 = c12**2 + t0**2
     t5 = -t0 + mu0
     t6 = -t1 + mu1
     t7 = t5**2 + t6**2
-    t8 = qs1 + qs2 + mu0 + mu1
+    t8 = mu0 + mu1 + qs1 + qs2
     t9 = damping + t2
     t10 = casadi.sqrt(t9**2 + t3**2)
     t11 = t10*casadi.if_else((t9 >= 0), 1, -1)
@@ -557,6 +1045,9 @@ def _ik_nearest(mu, q_seed, weights):
 _q = casadi.SX.sym("q", 2, 1)
 _q_dot = casadi.SX.sym("q_dot", 2, 1)
 _mu_dot = casadi.SX.sym("mu_dot", 2, 1)
+_z = casadi.SX.sym("z", 2, 1)
+_target_rate = casadi.SX.sym("target_rate", 2, 1)
+_gain = casadi.SX.sym("gain", 2, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
 _target = casadi.SX.sym("target", 2, 1)
 _mu = casadi.SX.sym("mu", 2, 1)
@@ -573,10 +1064,17 @@ jacobian_dot = casadi.Function("jacobian_dot", [_q, _q_dot], _jacobian_dot(_q, _
 bias_acceleration = casadi.Function("bias_acceleration", [_q, _q_dot], _bias_acceleration(_q, _q_dot), ["q", "q_dot"], ["a"])
 task_jacobian_dot = casadi.Function("task_jacobian_dot", [_q, _q_dot], _task_jacobian_dot(_q, _q_dot), ["q", "q_dot"], ["Jd"])
 hessian = casadi.Function("hessian", [_q], _hessian(_q), ["q"], ["H"])
+link_poses = casadi.Function("link_poses", [_q], _link_poses(_q), ["q"], ["T"])
+link_velocities = casadi.Function("link_velocities", [_q, _q_dot], _link_velocities(_q, _q_dot), ["q", "q_dot"], ["V"])
 singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_factors(_q), ["q"], ["f"])
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
+manipulability_gradient = casadi.Function("manipulability_gradient", [_q], _manipulability_gradient(_q), ["q"], ["dw"])
+velocity_ellipsoid = casadi.Function("velocity_ellipsoid", [_q], _velocity_ellipsoid(_q), ["q"], ["U_v", "s_v", "U_w", "s_w"])
+condition_number = casadi.Function("condition_number", [_q], _condition_number(_q), ["q"], ["kappa"])
 velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
+velocity_ik_nullspace = casadi.Function("velocity_ik_nullspace", [_q, _mu_dot, _z, _damping], _velocity_ik_nullspace(_q, _mu_dot, _z, _damping), ["q", "mu_dot", "z", "damping"], ["q_dot", "status"])
+resolved_rate = casadi.Function("resolved_rate", [_q, _target, _target_rate, _gain, _z, _damping], _resolved_rate(_q, _target, _target_rate, _gain, _z, _damping), ["q", "target", "target_rate", "gain", "z", "damping"], ["q_dot", "status"])
 ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _ik_numeric_step(_target, _q, _damping), ["target", "q", "damping"], ["q_start", "q_next", "cost"])
 ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid", "in_limits"])
 ik_nearest = casadi.Function("ik_nearest", [_mu, _q_seed, _weights], _ik_nearest(_mu, _q_seed, _weights), ["mu", "q_seed", "weights"], ["q", "status"])
@@ -628,4 +1126,4 @@ ik_numeric = casadi.Function("ik_numeric", _inputs, _ik_numeric(*_inputs), ["tar
 
 def functions():
     """All functions by name (`ik` is `ik_branches`)."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches, "ik_nearest": ik_nearest, "ik": ik, "ik_numeric": ik_numeric}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "link_poses": link_poses, "link_velocities": link_velocities, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "manipulability_gradient": manipulability_gradient, "velocity_ellipsoid": velocity_ellipsoid, "condition_number": condition_number, "velocity_ik": velocity_ik, "velocity_ik_nullspace": velocity_ik_nullspace, "resolved_rate": resolved_rate, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches, "ik_nearest": ik_nearest, "ik": ik, "ik_numeric": ik_numeric}

@@ -38,10 +38,11 @@ def _namespace(values):
     return numpy
 
 
-def _arguments(*arguments):
+def _arguments(*arguments, every=()):
     """xp, dtype, device, the batch shape and the arrays of (name, value, shape) arguments:
     each of `shape` or a batch (..., *shape), all in the floating-point type of the arrays
-    among them (lists and numbers follow it)."""
+    among them (lists and numbers follow it); those named in `every` may be one number, which
+    stands for each of their components."""
     xp = _namespace(value for _, value, _ in arguments)
     given = [value for _, value, _ in arguments if hasattr(value, "dtype")]
     dtype = given[0].dtype if len({value.dtype for value in given}) == 1 else xp.result_type(*given, 1.0)
@@ -51,6 +52,8 @@ def _arguments(*arguments):
     arrays, batches = [], []
     for name, value, shape in arguments:
         value = xp.asarray(value, dtype=dtype, device=device)
+        if name in every and value.ndim == 0:
+            value = xp.broadcast_to(value, shape)
         if value.shape[value.ndim - len(shape):] != shape:
             batch = ", ".join(map(str, shape))
             raise ValueError(f"{name} must have shape {shape} or (..., {batch}), got {tuple(value.shape)}")
@@ -609,6 +612,131 @@ def hessian(q):
     return H
 
 
+def link_poses(q):
+    """world pose of each link's DH frame, base A_1 ... A_i, without the tool (DOF x 4 x 4): (3 x 4 x 4), 25 operations."""
+    xp, dtype, device, batch, (q,) = _arguments(("q", q, (3,)))
+    trig = _cos_sin(xp, q, (0.0, 0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c3 = trig[..., 4]
+    s3 = trig[..., 5]
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = c12*c3 - s12*s3
+    t3 = t0 + t2
+    t4 = c12*s3 + s12*c3
+    t5 = t1 + t4
+    T = _stack(xp, [
+        c1,  # 0, 0, 0
+        -s1,  # 0, 0, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 0, 2
+        c1,  # 0, 0, 3
+        s1,  # 0, 1, 0
+        c1,  # 0, 1, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 1, 2
+        s1,  # 0, 1, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2, 1
+        xp.full(batch, 1, dtype=dtype, device=device),  # 0, 2, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3, 2
+        xp.full(batch, 1, dtype=dtype, device=device),  # 0, 3, 3
+        c12,  # 1, 0, 0
+        -s12,  # 1, 0, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 2
+        t0,  # 1, 0, 3
+        s12,  # 1, 1, 0
+        c12,  # 1, 1, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 2
+        t1,  # 1, 1, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 1
+        xp.full(batch, 1, dtype=dtype, device=device),  # 1, 2, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 2
+        xp.full(batch, 1, dtype=dtype, device=device),  # 1, 3, 3
+        t2,  # 2, 0, 0
+        -t4,  # 2, 0, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0, 2
+        t3,  # 2, 0, 3
+        t4,  # 2, 1, 0
+        t2,  # 2, 1, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1, 2
+        t5,  # 2, 1, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2, 1
+        xp.full(batch, 1, dtype=dtype, device=device),  # 2, 2, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 2
+        xp.full(batch, 1, dtype=dtype, device=device),  # 2, 3, 3
+    ], (3, 4, 4))
+    return T
+
+
+def link_velocities(q, q_dot):
+    """linear and angular velocity [v; w] of each link frame's origin, world frame, propagated from the base (DOF x 6): (3 x 6), 41 operations."""
+    xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (3,)), ("q_dot", q_dot, (3,)))
+    qd1 = q_dot[..., 0]
+    qd2 = q_dot[..., 1]
+    qd3 = q_dot[..., 2]
+    trig = _cos_sin(xp, q, (0.0, 0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c3 = trig[..., 4]
+    s3 = trig[..., 5]
+    t0 = c1 + c12
+    t1 = s1 + s12
+    t2 = qd1 + qd2
+    t3 = qd3 + t2
+    t4 = t0 + c12*c3 - s12*s3
+    t5 = t1 + c12*s3 + s12*c3
+    t6 = -c1 + t0
+    t7 = -s1 + t1
+    t8 = -t0 + t4
+    t9 = -t1 + t5
+    t10 = s1*qd1
+    t11 = t10 + t2*t7
+    t12 = t11 + t3*t9
+    t13 = c1*qd1
+    t14 = t13 + t2*t6
+    t15 = t14 + t3*t8
+    V = _stack(xp, [
+        xp.broadcast_to(-t10, batch),  # 0, 0
+        xp.broadcast_to(t13, batch),  # 0, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
+        xp.broadcast_to(qd1, batch),  # 0, 5
+        xp.broadcast_to(-t11, batch),  # 1, 0
+        xp.broadcast_to(t14, batch),  # 1, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
+        xp.broadcast_to(t2, batch),  # 1, 5
+        xp.broadcast_to(-t12, batch),  # 2, 0
+        xp.broadcast_to(t15, batch),  # 2, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
+        xp.broadcast_to(t3, batch),  # 2, 5
+    ], (3, 6))
+    return V
+
+
 def singularity_factors(q):
     """factors of det(Js): the robot is singular where one is 0: (1 x 1), 1 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (3,)))
@@ -658,6 +786,631 @@ def jacobian_det(q):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def manipulability_gradient(q):
+    """d manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): (3 x 1), 209 operations."""
+    xp, dtype, device, batch, (q,) = _arguments(("q", q, (3,)))
+    trig = _cos_sin(xp, q, (0.0, 0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c3 = trig[..., 4]
+    s3 = trig[..., 5]
+    c123 = c12*c3 - s12*s3
+    s123 = c12*s3 + s12*c3
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
+    t4 = s123**2 + t1**2 + t3**2
+    t5 = xp.sqrt(3 + c123**2 + t0**2 + t2**2 + t4)
+    t6 = xp.sqrt(t4)
+    t7 = t6*xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)
+    t8 = -t3 + t7
+    t9 = xp.where(xp.greater(t6, 0), 1/(t6*(t6 + xp.abs(t3))), 0)
+    t10 = -t9*(-t2*t8 + t0*t1 + c123*s123)
+    t11 = t2 - t8*t10
+    t12 = t0 + t1*t10
+    t13 = c123 + s123*t10
+    t14 = -t9*(t1 + s123 - t8)
+    t15 = 1 - t8*t14
+    t16 = 1 + t1*t14
+    t17 = 1 + s123*t14
+    t18 = 1 - t8**2*t9
+    t19 = t13**2
+    t20 = xp.sqrt(t19 + t12**2)
+    t21 = t20*xp.where(xp.greater_equal(t12, 0), xp.asarray(1, dtype=dtype), -1)
+    t22 = t12 + t21
+    t23 = xp.where(xp.greater(t20, 0), 1/(t20*(t20 + xp.abs(t12))), 0)
+    t24 = t23*(t16*t22 + t13*t17)
+    t25 = t16 - t22*t24
+    t26 = t17 - t13*t24
+    t27 = 1 - t22**2*t23
+    t28 = -(t11*t25 + t15*t21)
+    t29 = xp.abs(t26)
+    t30 = t29*xp.where(xp.greater_equal(t26, 0), xp.asarray(1, dtype=dtype), -1)
+    t31 = t26 + t30
+    t32 = xp.where(xp.greater(t29, 0), 1/(t29*2*t29), 0)
+    t33 = 1 - t31**2*t32
+    t34 = t23*t33
+    t35 = t33 - t19*t34
+    t36 = t13*t22
+    t37 = t23*t36
+    t38 = t9*(-t1*t27 + s123*t37)
+    t39 = t27 + t1*t38
+    t40 = -t37 + s123*t38
+    t41 = t34*t36
+    t42 = t9*(-s123*t35 + t1*t41)
+    t43 = -t41 + t1*t42
+    t44 = t35 + s123*t42
+    t45 = t21*t30
+    t46 = t8*t30*t38
+    t47 = t8*t42
+    t48 = t18*t45 - t11*t46 + t28*t47
+    t49 = t7*t25
+    t50 = t7*t46 + t47*t49
+    t51 = t8*t9*t45
+    t52 = t30*t39
+    t53 = -t43*t28 + t1*t51 + t11*t52
+    t54 = t7*t52 + t43*t49
+    t55 = t30*t40
+    t56 = -t44*t28 + s123*t51 + t11*t55
+    t57 = t7*t55 + t44*t49
+    t58 = 1e-12*t5
+    t59 = xp.where(xp.less_equal(t6, t58) | xp.less_equal(t20, t58) | xp.less_equal(t29, t58), 0, xp.where(xp.less(t7, 0), 1, xp.where(xp.greater(t7, 0), xp.asarray(-1, dtype=dtype), 0))*xp.where(xp.less(t21, 0), 1, xp.where(xp.greater(t21, 0), xp.asarray(-1, dtype=dtype), 0))*xp.where(xp.less(t30, 0), 1, xp.where(xp.greater(t30, 0), xp.asarray(-1, dtype=dtype), 0)))
+    t60 = c123*t56 + s123*t57
+    t61 = -t59*(c123*t48 + c123*t53 + s123*t54 + t60 - s123*t50)
+    t62 = t0*t53 + t1*t54 + t60
+    t63 = -t59*(t2*t48 + t62 - t3*t50)
+    t64 = -t59*(t0*t48 + t62 - t1*t50)
+    dw = _stack(xp, [
+        t63,  # 0
+        t64,  # 1
+        t61,  # 2
+    ], (3,))
+    return dw
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def velocity_ellipsoid(q):
+    """axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: (3 x 3 and 3 x 1 and 3 x 3 and 3 x 1), 325 operations."""
+    xp, dtype, device, batch, (q,) = _arguments(("q", q, (3,)))
+    trig = _cos_sin(xp, q, (0.0, 0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c3 = trig[..., 4]
+    s3 = trig[..., 5]
+    c123 = c12*c3 - s12*s3
+    s123 = c12*s3 + s12*c3
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
+    t4 = xp.sqrt(s123**2 + t1**2 + t3**2)
+    t5 = t4*xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)
+    t6 = -t3 + t5
+    t7 = xp.where(xp.greater(t4, 0), 1/(t4*(t4 + xp.abs(t3))), 0)
+    t8 = -t7*(-t2*t6 + t0*t1 + c123*s123)
+    t9 = t2 - t6*t8
+    t10 = t0 + t1*t8
+    t11 = c123 + s123*t8
+    t12 = xp.sqrt(t10**2 + t11**2)
+    t13 = t12*xp.where(xp.greater_equal(t10, 0), xp.asarray(1, dtype=dtype), -1)
+    t14 = t5**2
+    t15 = t13**2
+    t16 = t15 + t9**2
+    t17 = t5*t9
+    t18 = xp.not_equal(t17, 0)
+    t19 = 0.5*(-t14 + t16)/xp.where(t18, -t17, 1)
+    t20 = xp.where(t18, xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t19) + xp.sqrt(1 + t19**2)), 0)
+    t21 = 1/xp.sqrt(1 + t20**2)
+    t22 = t17*t20
+    t23 = t22 + t14
+    t24 = -t22 + t16
+    t25 = t5*t21
+    t26 = t9*t21
+    t27 = t25 + t26*t20
+    t28 = t26 - t25*t20
+    t29 = t27*t28 + t15*t20*t21**2
+    t30 = xp.not_equal(t29, 0)
+    t31 = 0.5*(-t23 + t24)/xp.where(t30, -t29, 1)
+    t32 = xp.where(t30, xp.where(xp.greater_equal(t31, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t31) + xp.sqrt(1 + t31**2)), 0)
+    t33 = 1/xp.sqrt(1 + t32**2)
+    t34 = t29*t32
+    t35 = t34 + t23
+    t36 = -t34 + t24
+    t37 = t27*t33
+    t38 = t28*t33
+    t39 = t37 + t38*t32
+    t40 = t38 - t37*t32
+    t41 = t21*t33
+    t42 = t13*t41
+    t43 = t42*t20
+    t44 = t43 + t42*t32
+    t45 = -t42 + t43*t32
+    t46 = -t39*t40 + t44*t45
+    t47 = t41*t20
+    t48 = t41 - t47*t32
+    t49 = t47 + t41*t32
+    t50 = xp.not_equal(t46, 0)
+    t51 = 0.5*(-t35 + t36)/xp.where(t50, t46, 1)
+    t52 = xp.where(t50, xp.where(xp.greater_equal(t51, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t51) + xp.sqrt(1 + t51**2)), 0)
+    t53 = 1/xp.sqrt(1 + t52**2)
+    t54 = t46*t52
+    t55 = -t54 + t35
+    t56 = t54 + t36
+    t57 = t39*t53
+    t58 = t40*t53
+    t59 = t57 + t52*t58
+    t60 = t58 - t57*t52
+    t61 = t44*t53
+    t62 = t45*t53
+    t63 = t61 - t52*t62
+    t64 = t62 + t52*t61
+    t65 = -t59*t60 + t63*t64
+    t66 = t48*t53
+    t67 = t49*t53
+    t68 = t66 - t52*t67
+    t69 = t67 + t52*t66
+    t70 = xp.not_equal(t65, 0)
+    t71 = 0.5*(-t55 + t56)/xp.where(t70, t65, 1)
+    t72 = xp.where(t70, xp.where(xp.greater_equal(t71, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t71) + xp.sqrt(1 + t71**2)), 0)
+    t73 = 1/xp.sqrt(1 + t72**2)
+    t74 = t65*t72
+    t75 = -t74 + t55
+    t76 = t56 + t74
+    t77 = t59*t73
+    t78 = t60*t73
+    t79 = t77 + t72*t78
+    t80 = t78 - t72*t77
+    t81 = t63*t73
+    t82 = t64*t73
+    t83 = t81 - t72*t82
+    t84 = t82 + t72*t81
+    t85 = -t79*t80 + t83*t84
+    t86 = t68*t73
+    t87 = t69*t73
+    t88 = t86 - t72*t87
+    t89 = t87 + t72*t86
+    t90 = xp.not_equal(t85, 0)
+    t91 = 0.5*(-t75 + t76)/xp.where(t90, t85, 1)
+    t92 = xp.where(t90, xp.where(xp.greater_equal(t91, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t91) + xp.sqrt(1 + t91**2)), 0)
+    t93 = 1/xp.sqrt(1 + t92**2)
+    t94 = t79*t93
+    t95 = t80*t93
+    t96 = t94 + t92*t95
+    t97 = t95 - t92*t94
+    t98 = t83*t93
+    t99 = t84*t93
+    t100 = t98 - t92*t99
+    t101 = t99 + t92*t98
+    t102 = xp.sqrt(t96**2 + t100**2)
+    t103 = xp.sqrt(t97**2 + t101**2)
+    t104 = t88*t93
+    t105 = t89*t93
+    t106 = t104 - t92*t105
+    t107 = t105 + t92*t104
+    t108 = xp.less(t102, t103)
+    t109 = xp.where(t108, t103, t102)
+    t110 = xp.where(t108, t102, t103)
+    t111 = xp.where(t108, t107, t106)
+    t112 = xp.where(t108, t106, t107)
+    t113 = -t107
+    t114 = xp.where(t108, t106, t113)
+    t115 = xp.where(t108, t113, t106)
+    t116 = xp.less(t110, 0)
+    t117 = xp.where(t116, 0, t110)
+    t118 = xp.where(t116, t110, 0)
+    t119 = xp.where(t116, 0, t112)
+    t120 = xp.where(t116, 0, t115)
+    t121 = xp.where(t116, xp.asarray(1, dtype=dtype), 0)
+    t122 = xp.where(t116, t112, 0)
+    t123 = xp.where(t116, t115, 0)
+    t124 = xp.where(t116, xp.asarray(0, dtype=dtype), 1)
+    t125 = xp.less(t109, t117)
+    t126 = xp.where(t125, t117, t109)
+    t127 = xp.where(t125, t109, t117)
+    t128 = xp.where(t125, t119, t111)
+    t129 = xp.where(t125, t120, t114)
+    t130 = xp.where(t125, t121, 0)
+    t131 = xp.where(t125, t111, t119)
+    t132 = xp.where(t125, t114, t120)
+    t133 = xp.where(t125, 0, t121)
+    t134 = t128*(t124*t132 - t123*t133) - t129*(t124*t131 - t122*t133) + t130*(t123*t131 - t122*t132)
+    t135 = xp.where(xp.less(t134, 0), xp.asarray(-1, dtype=dtype), 1)
+    t136 = t122*t135
+    t137 = t123*t135
+    t138 = t124*t135
+    U_v = _stack(xp, [
+        t128,  # 0, 0
+        t131,  # 0, 1
+        t136,  # 0, 2
+        t129,  # 1, 0
+        t132,  # 1, 1
+        t137,  # 1, 2
+        t130,  # 2, 0
+        t133,  # 2, 1
+        t138,  # 2, 2
+    ], (3, 3))
+    s_v = _stack(xp, [
+        t126,  # 0
+        t127,  # 1
+        t118,  # 2
+    ], (3,))
+    U_w = _stack(xp, [
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 0
+        xp.full(batch, 1, dtype=dtype, device=device),  # 0, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1
+        xp.full(batch, 1, dtype=dtype, device=device),  # 1, 2
+        xp.full(batch, 1, dtype=dtype, device=device),  # 2, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2
+    ], (3, 3))
+    s_w = _stack(xp, [
+        xp.full(batch, 1.7320508075688772, dtype=dtype, device=device),  # 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2
+    ], (3,))
+    return U_v, s_v, U_w, s_w
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def condition_number(q):
+    """sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): (1 x 1), 810 operations."""
+    xp, dtype, device, batch, (q,) = _arguments(("q", q, (3,)))
+    trig = _cos_sin(xp, q, (0.0, 0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c3 = trig[..., 4]
+    s3 = trig[..., 5]
+    c123 = c12*c3 - s12*s3
+    s123 = c12*s3 + s12*c3
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
+    t4 = xp.sqrt(4.6616714347772055*t3**2 + 4.6616714347772055*t1**2 + 4.6616714347772055*s123**2)
+    t5 = 2.159090418388541*t3
+    t6 = xp.where(xp.greater(t4, 0), 1/(t4*(t4 + xp.abs(t5))), 0)
+    t7 = -t5
+    t8 = t4*xp.where(xp.greater_equal(t7, 0), xp.asarray(1, dtype=dtype), -1)
+    t9 = t7 + t8
+    t10 = -t6*(-2.159090418388541*t2*t9 + 4.6616714347772055*t0*t1 + 4.6616714347772055*c123*s123)
+    t11 = 2.159090418388541*t2 - t9*t10
+    t12 = 2.159090418388541*t1
+    t13 = 2.159090418388541*t0 + t12*t10
+    t14 = 2.159090418388541*s123
+    t15 = 2.159090418388541*c123 + t14*t10
+    t16 = -t6*(-t9 + t12 + t14)
+    t17 = 1 - t9*t16
+    t18 = 1 + t12*t16
+    t19 = 1 + t14*t16
+    t20 = xp.sqrt(t13**2 + t15**2)
+    t21 = t20*xp.where(xp.greater_equal(t13, 0), xp.asarray(1, dtype=dtype), -1)
+    t22 = t13 + t21
+    t23 = xp.where(xp.greater(t20, 0), 1/(t20*(t20 + xp.abs(t13))), 0)
+    t24 = t23*(t18*t22 + t15*t19)
+    t25 = t18 - t22*t24
+    t26 = t19 - t15*t24
+    t27 = xp.abs(t26)
+    t28 = t27*xp.where(xp.greater_equal(t26, 0), xp.asarray(1, dtype=dtype), -1)
+    t29 = t21**2 + t25**2
+    t30 = t28**2
+    t31 = -t11*t21 + t17*t25
+    t32 = t8**2
+    t33 = t32 + t11**2 + t17**2
+    t34 = xp.not_equal(t31, 0)
+    t35 = 0.5*(-t33 + t29)/xp.where(t34, t31, 1)
+    t36 = xp.where(t34, xp.where(xp.greater_equal(t35, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t35) + xp.sqrt(1 + t35**2)), 0)
+    t37 = 1/xp.sqrt(1 + t36**2)
+    t38 = t31*t36
+    t39 = -t38 + t33
+    t40 = t38 + t29
+    t41 = t11*t37
+    t42 = t21*t37
+    t43 = t41 + t42*t36
+    t44 = -t42 + t41*t36
+    t45 = t17*t37
+    t46 = t25*t37
+    t47 = t45 - t46*t36
+    t48 = t46 + t45*t36
+    t49 = t28*t47
+    t50 = xp.not_equal(t49, 0)
+    t51 = 0.5*(-t39 + t30)/xp.where(t50, -t49, 1)
+    t52 = xp.where(t50, xp.where(xp.greater_equal(t51, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t51) + xp.sqrt(1 + t51**2)), 0)
+    t53 = 1/xp.sqrt(1 + t52**2)
+    t54 = t49*t52
+    t55 = t54 + t39
+    t56 = -t54 + t30
+    t57 = t47*t53
+    t58 = t28*t53
+    t59 = t57 + t58*t52
+    t60 = -t58 + t57*t52
+    t61 = t52*t53
+    t62 = t43*t53
+    t63 = t62*t52
+    t64 = t48*t60 + t32*t61*t36*t37**2 + t63*t44
+    t65 = xp.not_equal(t64, 0)
+    t66 = 0.5*(-t40 + t56)/xp.where(t65, t64, 1)
+    t67 = xp.where(t65, xp.where(xp.greater_equal(t66, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t66) + xp.sqrt(1 + t66**2)), 0)
+    t68 = 1/xp.sqrt(1 + t67**2)
+    t69 = t64*t67
+    t70 = -t69 + t40
+    t71 = t69 + t56
+    t72 = t8*t37
+    t73 = t72*t68
+    t74 = t73*t36
+    t75 = t61*t73
+    t76 = -t74 + t75*t67
+    t77 = t75 + t74*t67
+    t78 = t44*t68
+    t79 = t63*t68
+    t80 = t78 - t79*t67
+    t81 = t79 + t78*t67
+    t82 = t48*t68
+    t83 = t60*t68
+    t84 = t82 - t83*t67
+    t85 = t83 + t82*t67
+    t86 = t72*t53
+    t87 = t59*t84 - t86*t76 + t62*t80
+    t88 = xp.not_equal(t87, 0)
+    t89 = 0.5*(-t55 + t70)/xp.where(t88, t87, 1)
+    t90 = xp.where(t88, xp.where(xp.greater_equal(t89, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t89) + xp.sqrt(1 + t89**2)), 0)
+    t91 = 1/xp.sqrt(1 + t90**2)
+    t92 = t87*t90
+    t93 = -t92 + t55
+    t94 = t92 + t70
+    t95 = t86*t91
+    t96 = t76*t91
+    t97 = t95 + t96*t90
+    t98 = t96 - t95*t90
+    t99 = t62*t91
+    t100 = t80*t91
+    t101 = t99 - t100*t90
+    t102 = t100 + t99*t90
+    t103 = t59*t91
+    t104 = t84*t91
+    t105 = t103 - t104*t90
+    t106 = t104 + t103*t90
+    t107 = t77*t97 + t81*t101 + t85*t105
+    t108 = xp.not_equal(t107, 0)
+    t109 = 0.5*(-t93 + t71)/xp.where(t108, t107, 1)
+    t110 = xp.where(t108, xp.where(xp.greater_equal(t109, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t109) + xp.sqrt(1 + t109**2)), 0)
+    t111 = 1/xp.sqrt(1 + t110**2)
+    t112 = t107*t110
+    t113 = -t112 + t93
+    t114 = t112 + t71
+    t115 = t97*t111
+    t116 = t77*t111
+    t117 = -t115 + t116*t110
+    t118 = t116 + t115*t110
+    t119 = t101*t111
+    t120 = t81*t111
+    t121 = t119 - t110*t120
+    t122 = t120 + t110*t119
+    t123 = t105*t111
+    t124 = t85*t111
+    t125 = t123 - t110*t124
+    t126 = t124 + t110*t123
+    t127 = -t98*t118 + t102*t122 + t106*t126
+    t128 = xp.not_equal(t127, 0)
+    t129 = 0.5*(-t94 + t114)/xp.where(t128, t127, 1)
+    t130 = xp.where(t128, xp.where(xp.greater_equal(t129, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t129) + xp.sqrt(1 + t129**2)), 0)
+    t131 = 1/xp.sqrt(1 + t130**2)
+    t132 = t127*t130
+    t133 = -t132 + t94
+    t134 = t114 + t132
+    t135 = t98*t131
+    t136 = t118*t131
+    t137 = t135 + t130*t136
+    t138 = -t136 + t130*t135
+    t139 = t102*t131
+    t140 = t122*t131
+    t141 = t139 - t130*t140
+    t142 = t140 + t130*t139
+    t143 = t106*t131
+    t144 = t126*t131
+    t145 = t143 - t130*t144
+    t146 = t144 + t130*t143
+    t147 = t117*t137 + t121*t141 + t125*t145
+    t148 = xp.not_equal(t147, 0)
+    t149 = 0.5*(-t113 + t133)/xp.where(t148, t147, 1)
+    t150 = xp.where(t148, xp.where(xp.greater_equal(t149, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t149) + xp.sqrt(1 + t149**2)), 0)
+    t151 = 1/xp.sqrt(1 + t150**2)
+    t152 = t147*t150
+    t153 = -t152 + t113
+    t154 = t133 + t152
+    t155 = t117*t151
+    t156 = t137*t151
+    t157 = t155 - t150*t156
+    t158 = t156 + t150*t155
+    t159 = t121*t151
+    t160 = t141*t151
+    t161 = t159 - t150*t160
+    t162 = t160 + t150*t159
+    t163 = t125*t151
+    t164 = t145*t151
+    t165 = t163 - t150*t164
+    t166 = t164 + t150*t163
+    t167 = t138*t157 + t142*t161 + t146*t165
+    t168 = xp.not_equal(t167, 0)
+    t169 = 0.5*(-t153 + t134)/xp.where(t168, t167, 1)
+    t170 = xp.where(t168, xp.where(xp.greater_equal(t169, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t169) + xp.sqrt(1 + t169**2)), 0)
+    t171 = 1/xp.sqrt(1 + t170**2)
+    t172 = t167*t170
+    t173 = -t172 + t153
+    t174 = t134 + t172
+    t175 = t157*t171
+    t176 = t138*t171
+    t177 = t175 - t170*t176
+    t178 = t176 + t170*t175
+    t179 = t161*t171
+    t180 = t142*t171
+    t181 = t179 - t170*t180
+    t182 = t180 + t170*t179
+    t183 = t165*t171
+    t184 = t146*t171
+    t185 = t183 - t170*t184
+    t186 = t184 + t170*t183
+    t187 = t158*t178 + t162*t182 + t166*t186
+    t188 = xp.not_equal(t187, 0)
+    t189 = 0.5*(-t154 + t174)/xp.where(t188, t187, 1)
+    t190 = xp.where(t188, xp.where(xp.greater_equal(t189, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t189) + xp.sqrt(1 + t189**2)), 0)
+    t191 = 1/xp.sqrt(1 + t190**2)
+    t192 = t187*t190
+    t193 = -t192 + t154
+    t194 = t174 + t192
+    t195 = t158*t191
+    t196 = t178*t191
+    t197 = t195 - t190*t196
+    t198 = t196 + t190*t195
+    t199 = t162*t191
+    t200 = t182*t191
+    t201 = t199 - t190*t200
+    t202 = t200 + t190*t199
+    t203 = t166*t191
+    t204 = t186*t191
+    t205 = t203 - t190*t204
+    t206 = t204 + t190*t203
+    t207 = t177*t197 + t181*t201 + t185*t205
+    t208 = xp.not_equal(t207, 0)
+    t209 = 0.5*(-t173 + t193)/xp.where(t208, t207, 1)
+    t210 = xp.where(t208, xp.where(xp.greater_equal(t209, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t209) + xp.sqrt(1 + t209**2)), 0)
+    t211 = 1/xp.sqrt(1 + t210**2)
+    t212 = t207*t210
+    t213 = -t212 + t173
+    t214 = t193 + t212
+    t215 = t177*t211
+    t216 = t197*t211
+    t217 = t215 - t210*t216
+    t218 = t216 + t210*t215
+    t219 = t181*t211
+    t220 = t201*t211
+    t221 = t219 - t210*t220
+    t222 = t220 + t210*t219
+    t223 = t185*t211
+    t224 = t205*t211
+    t225 = t223 - t210*t224
+    t226 = t224 + t210*t223
+    t227 = t198*t217 + t202*t221 + t206*t225
+    t228 = xp.not_equal(t227, 0)
+    t229 = 0.5*(-t213 + t194)/xp.where(t228, t227, 1)
+    t230 = xp.where(t228, xp.where(xp.greater_equal(t229, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t229) + xp.sqrt(1 + t229**2)), 0)
+    t231 = 1/xp.sqrt(1 + t230**2)
+    t232 = t227*t230
+    t233 = -t232 + t213
+    t234 = t194 + t232
+    t235 = t217*t231
+    t236 = t198*t231
+    t237 = t235 - t230*t236
+    t238 = t236 + t230*t235
+    t239 = t221*t231
+    t240 = t202*t231
+    t241 = t239 - t230*t240
+    t242 = t240 + t230*t239
+    t243 = t225*t231
+    t244 = t206*t231
+    t245 = t243 - t230*t244
+    t246 = t244 + t230*t243
+    t247 = t218*t238 + t222*t242 + t226*t246
+    t248 = xp.not_equal(t247, 0)
+    t249 = 0.5*(-t214 + t234)/xp.where(t248, t247, 1)
+    t250 = xp.where(t248, xp.where(xp.greater_equal(t249, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t249) + xp.sqrt(1 + t249**2)), 0)
+    t251 = 1/xp.sqrt(1 + t250**2)
+    t252 = t247*t250
+    t253 = -t252 + t214
+    t254 = t234 + t252
+    t255 = t218*t251
+    t256 = t238*t251
+    t257 = t255 - t250*t256
+    t258 = t256 + t250*t255
+    t259 = t222*t251
+    t260 = t242*t251
+    t261 = t259 - t250*t260
+    t262 = t260 + t250*t259
+    t263 = t226*t251
+    t264 = t246*t251
+    t265 = t263 - t250*t264
+    t266 = t264 + t250*t263
+    t267 = t237*t257 + t241*t261 + t245*t265
+    t268 = xp.not_equal(t267, 0)
+    t269 = 0.5*(-t233 + t253)/xp.where(t268, t267, 1)
+    t270 = xp.where(t268, xp.where(xp.greater_equal(t269, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t269) + xp.sqrt(1 + t269**2)), 0)
+    t271 = 1/xp.sqrt(1 + t270**2)
+    t272 = t267*t270
+    t273 = -t272 + t233
+    t274 = t253 + t272
+    t275 = t237*t271
+    t276 = t257*t271
+    t277 = t275 - t270*t276
+    t278 = t276 + t270*t275
+    t279 = t241*t271
+    t280 = t261*t271
+    t281 = t279 - t270*t280
+    t282 = t280 + t270*t279
+    t283 = t245*t271
+    t284 = t265*t271
+    t285 = t283 - t270*t284
+    t286 = t284 + t270*t283
+    t287 = t258*t277 + t262*t281 + t266*t285
+    t288 = xp.not_equal(t287, 0)
+    t289 = 0.5*(-t273 + t254)/xp.where(t288, t287, 1)
+    t290 = xp.where(t288, xp.where(xp.greater_equal(t289, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t289) + xp.sqrt(1 + t289**2)), 0)
+    t291 = 1/xp.sqrt(1 + t290**2)
+    t292 = t254 + t287*t290
+    t293 = t277*t291
+    t294 = t258*t291
+    t295 = t293 - t290*t294
+    t296 = t294 + t290*t293
+    t297 = t281*t291
+    t298 = t262*t291
+    t299 = t297 - t290*t298
+    t300 = t298 + t290*t297
+    t301 = t285*t291
+    t302 = t266*t291
+    t303 = t301 - t290*t302
+    t304 = t302 + t290*t301
+    t305 = t278*t296 + t282*t300 + t286*t304
+    t306 = xp.sqrt(t295**2 + t299**2 + t303**2)
+    t307 = xp.not_equal(t305, 0)
+    t308 = 0.5*(-t274 + t292)/xp.where(t307, t305, 1)
+    t309 = xp.where(t307, xp.where(xp.greater_equal(t308, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t308) + xp.sqrt(1 + t308**2)), 0)
+    t310 = 1/xp.sqrt(1 + t309**2)
+    t311 = t278*t310
+    t312 = t296*t310
+    t313 = t311 - t309*t312
+    t314 = t312 + t309*t311
+    t315 = t282*t310
+    t316 = t300*t310
+    t317 = t315 - t309*t316
+    t318 = t316 + t309*t315
+    t319 = t286*t310
+    t320 = t304*t310
+    t321 = t319 - t309*t320
+    t322 = t320 + t309*t319
+    t323 = xp.sqrt(t313**2 + t317**2 + t321**2)
+    t324 = xp.sqrt(t314**2 + t318**2 + t322**2)
+    t325 = xp.where(xp.greater(t323, t306), t323, t306)
+    t326 = xp.where(xp.less(t323, t306), t323, t306)
+    t327 = xp.where(xp.greater(t324, t325), t324, t325)
+    t328 = xp.where(xp.less(t324, t326), t324, t326)
+    kappa = xp.broadcast_to(xp.where(xp.greater(t327, 0), t327, 1)/xp.where(xp.less_equal(t328, 1e-12*t327), 0, t328), batch)
+    return kappa
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
     """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (3 x 1 and 1 x 1), 328 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (3,)), ("mu_dot", mu_dot, (3,)), ("damping", damping, ()))
@@ -682,14 +1435,14 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t1 = s12 + s123
     t2 = c1 + t0
     t3 = s1 + t1
-    t4 = t2*t3 + t0*t1 + c123*s123
+    t4 = t0*t1 + c123*s123 + t2*t3
     t5 = t3 + t1 + s123
     t6 = t3**2
     t7 = s123**2 + t1**2 + t6
     t8 = t2**2
     t9 = xp.sqrt(1 + t6 + t8)
-    t10 = t9*xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)
-    t11 = xp.where(xp.greater(t9, 0), 1/(t9*(t9 + xp.abs(t3))), 0)
+    t10 = xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)*t9
+    t11 = xp.where(xp.greater(t9, 0), 1/(t9*(xp.abs(t3) + t9)), 0)
     t12 = c123**2 + t0**2 + t8
     t13 = xp.sqrt(3 + t7 + t12)
     t14 = c123 + t0 + t2
@@ -700,17 +1453,17 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t19 = t18**2
     t20 = xp.sqrt(t15 + t16 + t19)
     t21 = t20*xp.where(xp.greater_equal(t18, 0), xp.asarray(1, dtype=dtype), -1)
-    t22 = t21 + t18
+    t22 = t18 + t21
     t23 = xp.where(xp.greater(t20, 0), 1/(t20*(t20 + xp.abs(t18))), 0)
     t24 = -t23*(-mu_dot0*t22 + mu_dot1*t4 + mu_dot2*t5)
     t25 = mu_dot0 - t22*t24
     t26 = mu_dot1 + t4*t24
     t27 = mu_dot2 + t5*t24
     t28 = t12 + t17
-    t29 = -t23*(t4*t22 + t4*t28 + t5*t14)
+    t29 = -t23*(t4*t22 + t28*t4 + t14*t5)
     t30 = t4 + t22*t29
-    t31 = t4*t29 + t28
-    t32 = t5*t29 + t14
+    t31 = t28 + t4*t29
+    t32 = t14 + t5*t29
     t33 = xp.sqrt(t31**2 + t32**2)
     t34 = t33*xp.where(xp.greater_equal(t31, 0), xp.asarray(1, dtype=dtype), -1)
     t35 = t31 + t34
@@ -720,15 +1473,15 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t39 = t27 - t32*t37
     t40 = 3 + t17
     t41 = xp.sqrt(2*t15 + 2*t16 + 2*t14**2 + t19 + t28**2 + t40**2)
-    t42 = -t23*(t5*t22 + t5*t40 + t4*t14)
+    t42 = -t23*(t5*t22 + t40*t5 + t14*t4)
     t43 = t5 + t22*t42
-    t44 = t4*t42 + t14
-    t45 = t5*t42 + t40
+    t44 = t14 + t4*t42
+    t45 = t40 + t5*t42
     t46 = t36*(t44*t35 + t32*t45)
     t47 = t44 - t35*t46
     t48 = t45 - t32*t46
     t49 = xp.abs(t48)
-    t50 = xp.where(xp.greater_equal(t48, 0), xp.asarray(1, dtype=dtype), -1)*t49
+    t50 = t49*xp.where(xp.greater_equal(t48, 0), xp.asarray(1, dtype=dtype), -1)
     t51 = t48 + t50
     t52 = xp.where(xp.greater(t49, 0), 1/(t49*2*t49), 0)
     t53 = t39 - t39*t51**2*t52
@@ -739,7 +1492,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t58 = t54 - t1*t56 + t0*t55
     t59 = t54 - s123*t56 + c123*t55
     t60 = -t3
-    t61 = t10 + t60
+    t61 = t60 + t10
     t62 = t11*(1 - t1*t61 + t0*t2)
     t63 = t1 + t61*t62
     t64 = t0 - t2*t62
@@ -762,9 +1515,9 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t81 = t77*(t72*t76 + t65*t73)
     t82 = t72 - t76*t81
     t83 = t73 - t65*t81
-    t84 = 3 - t1 - s123 + q1 + q2 + q3 + mu_dot0 + mu_dot1 + mu_dot2 + damping + t14 + t60
+    t84 = 3 - t1 - s123 + q1 + q2 + q3 + t14 + t60 + mu_dot0 + mu_dot1 + mu_dot2 + damping
     t85 = xp.abs(t80)
-    t86 = xp.where(xp.greater_equal(t80, 0), xp.asarray(1, dtype=dtype), -1)*t85
+    t86 = t85*xp.where(xp.greater_equal(t80, 0), xp.asarray(1, dtype=dtype), -1)
     t87 = t80 + t86
     t88 = xp.where(xp.greater(t85, 0), 1/(t85*2*t85), 0)
     t89 = t83 - t83*t87**2*t88
@@ -784,6 +1537,282 @@ def velocity_ik(q, mu_dot, damping=0.0):
         xp.broadcast_to(xp.where(t99, xp.where(t95, t59, t90), 0), batch),  # 2
     ], (3,))
     status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t93 & t94), 2, xp.where(t98, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    return q_dot, status
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (3 x 1 and 1 x 1), 331 operations."""
+    xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (3,)), ("mu_dot", mu_dot, (3,)), ("z", z, (3,)), ("damping", damping, ()))
+    q1 = q[..., 0]
+    q2 = q[..., 1]
+    q3 = q[..., 2]
+    mu_dot0 = mu_dot[..., 0]
+    mu_dot1 = mu_dot[..., 1]
+    mu_dot2 = mu_dot[..., 2]
+    qz1 = z[..., 0]
+    qz2 = z[..., 1]
+    qz3 = z[..., 2]
+    trig = _cos_sin(xp, q, (0.0, 0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c3 = trig[..., 4]
+    s3 = trig[..., 5]
+    c123 = c12*c3 - s12*s3
+    s123 = c12*s3 + s12*c3
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
+    t4 = t0*t1 + c123*s123 + t2*t3
+    t5 = t3 + t1 + s123
+    t6 = t3**2
+    t7 = s123**2 + t1**2 + t6
+    t8 = t2**2
+    t9 = xp.sqrt(1 + t6 + t8)
+    t10 = xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)*t9
+    t11 = xp.where(xp.greater(t9, 0), 1/(t9*(xp.abs(t3) + t9)), 0)
+    t12 = c123**2 + t0**2 + t8
+    t13 = xp.sqrt(3 + t7 + t12)
+    t14 = c123 + t0 + t2
+    t15 = t4**2
+    t16 = t5**2
+    t17 = damping**2
+    t18 = t7 + t17
+    t19 = t18**2
+    t20 = xp.sqrt(t15 + t16 + t19)
+    t21 = t20*xp.where(xp.greater_equal(t18, 0), xp.asarray(1, dtype=dtype), -1)
+    t22 = t18 + t21
+    t23 = xp.where(xp.greater(t20, 0), 1/(t20*(t20 + xp.abs(t18))), 0)
+    t24 = -t23*(-mu_dot0*t22 + mu_dot1*t4 + mu_dot2*t5)
+    t25 = mu_dot0 - t22*t24
+    t26 = mu_dot1 + t4*t24
+    t27 = mu_dot2 + t5*t24
+    t28 = t12 + t17
+    t29 = -t23*(t4*t22 + t28*t4 + t14*t5)
+    t30 = t4 + t22*t29
+    t31 = t28 + t4*t29
+    t32 = t14 + t5*t29
+    t33 = xp.sqrt(t31**2 + t32**2)
+    t34 = t33*xp.where(xp.greater_equal(t31, 0), xp.asarray(1, dtype=dtype), -1)
+    t35 = t31 + t34
+    t36 = xp.where(xp.greater(t33, 0), 1/(t33*(t33 + xp.abs(t31))), 0)
+    t37 = t36*(t26*t35 + t32*t27)
+    t38 = t26 - t35*t37
+    t39 = t27 - t32*t37
+    t40 = 3 + t17
+    t41 = xp.sqrt(2*t15 + 2*t16 + 2*t14**2 + t19 + t28**2 + t40**2)
+    t42 = -t23*(t5*t22 + t40*t5 + t14*t4)
+    t43 = t5 + t22*t42
+    t44 = t14 + t4*t42
+    t45 = t40 + t5*t42
+    t46 = t36*(t44*t35 + t32*t45)
+    t47 = t44 - t35*t46
+    t48 = t45 - t32*t46
+    t49 = xp.abs(t48)
+    t50 = t49*xp.where(xp.greater_equal(t48, 0), xp.asarray(1, dtype=dtype), -1)
+    t51 = t48 + t50
+    t52 = xp.where(xp.greater(t49, 0), 1/(t49*2*t49), 0)
+    t53 = t39 - t39*t51**2*t52
+    t54 = xp.where(xp.not_equal(t50, 0), -t53/t50, 0)
+    t55 = xp.where(xp.not_equal(t34, 0), -(t38 - t47*t54)/t34, 0)
+    t56 = xp.where(xp.not_equal(t21, 0), -(t25 + t30*t55 + t43*t54)/t21, 0)
+    t57 = t54 - t3*t56 + t2*t55
+    t58 = t54 - t1*t56 + t0*t55
+    t59 = t54 - s123*t56 + c123*t55
+    t60 = -t3
+    t61 = t60 + t10
+    t62 = t11*(1 - t1*t61 + t0*t2)
+    t63 = t1 + t61*t62
+    t64 = t0 - t2*t62
+    t65 = 1 - t62
+    t66 = t11*(1 + c123*t2 - s123*t61)
+    t67 = s123 + t61*t66
+    t68 = c123 - t2*t66
+    t69 = 1 - t66
+    t70 = t11*(mu_dot2 + mu_dot0*t61 + t2*mu_dot1)
+    t71 = mu_dot0 - t61*t70
+    t72 = mu_dot1 - t2*t70
+    t73 = -t70 + mu_dot2
+    t74 = xp.sqrt(t64**2 + t65**2)
+    t75 = t74*xp.where(xp.greater_equal(t64, 0), xp.asarray(1, dtype=dtype), -1)
+    t76 = t64 + t75
+    t77 = xp.where(xp.greater(t74, 0), 1/(t74*(t74 + xp.abs(t64))), 0)
+    t78 = t77*(t68*t76 + t65*t69)
+    t79 = t68 - t76*t78
+    t80 = t69 - t65*t78
+    t81 = t77*(t72*t76 + t65*t73)
+    t82 = t72 - t76*t81
+    t83 = t73 - t65*t81
+    t84 = 3 - t1 - s123 + q1 + q2 + q3 + t14 + t60 + mu_dot0 + mu_dot1 + mu_dot2 + damping + qz1 + qz2 + qz3
+    t85 = xp.abs(t80)
+    t86 = t85*xp.where(xp.greater_equal(t80, 0), xp.asarray(1, dtype=dtype), -1)
+    t87 = t80 + t86
+    t88 = xp.where(xp.greater(t85, 0), 1/(t85*2*t85), 0)
+    t89 = t83 - t83*t87**2*t88
+    t90 = xp.where(xp.not_equal(t86, 0), -t89/t86, 0)
+    t91 = xp.where(xp.not_equal(t75, 0), -(t82 - t79*t90)/t75, 0)
+    t92 = xp.where(xp.not_equal(t10, 0), -(t71 + t63*t91 + t67*t90)/t10, 0)
+    t93 = xp.isfinite(t84)
+    t94 = xp.greater_equal(damping, 0)
+    t95 = xp.greater(damping, 0)
+    t96 = 1e-12*t41
+    t97 = 1e-12*t13
+    t98 = (t95 & (xp.less_equal(t20, t96) | xp.less_equal(t33, t96) | xp.less_equal(t49, t96))) | (xp.less_equal(damping, 0) & (xp.less_equal(t9, t97) | xp.less_equal(t74, t97) | xp.less_equal(t85, t97)))
+    t99 = t93 & t94 & xp.logical_not(t98)
+    q_dot = _stack(xp, [
+        xp.broadcast_to(xp.where(t99, xp.where(t95, t57, t92), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t99, xp.where(t95, t58, t91), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t99, xp.where(t95, t59, t90), 0), batch),  # 2
+    ], (3,))
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t93 & t94), 2, xp.where(t98, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    return q_dot, status
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (3 x 1 and 1 x 1), 347 operations."""
+    xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (3,)), ("target", target, (3,)), ("target_rate", target_rate, (3,)), ("gain", gain, (3,)), ("z", z, (3,)), ("damping", damping, ()), every=("gain", ))
+    q1 = q[..., 0]
+    q2 = q[..., 1]
+    q3 = q[..., 2]
+    mu0 = target[..., 0]
+    mu1 = target[..., 1]
+    mu2 = target[..., 2]
+    mu_dot0 = target_rate[..., 0]
+    mu_dot1 = target_rate[..., 1]
+    mu_dot2 = target_rate[..., 2]
+    gain0 = gain[..., 0]
+    gain1 = gain[..., 1]
+    gain2 = gain[..., 2]
+    qz1 = z[..., 0]
+    qz2 = z[..., 1]
+    qz3 = z[..., 2]
+    trig = _cos_sin(xp, q, (0.0, 0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c3 = trig[..., 4]
+    s3 = trig[..., 5]
+    c123 = c12*c3 - s12*s3
+    s123 = c12*s3 + s12*c3
+    t0 = c12 + c123
+    t1 = s12 + s123
+    t2 = c1 + t0
+    t3 = s1 + t1
+    t4 = t0*t1 + c123*s123 + t2*t3
+    t5 = t3 + t1 + s123
+    t6 = mu_dot0 + gain0*(-t2 + mu0)
+    t7 = t3**2
+    t8 = s123**2 + t1**2 + t7
+    t9 = t2**2
+    t10 = xp.sqrt(1 + t7 + t9)
+    t11 = xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)*t10
+    t12 = xp.where(xp.greater(t10, 0), 1/(t10*(xp.abs(t3) + t10)), 0)
+    t13 = c123**2 + t0**2 + t9
+    t14 = xp.sqrt(3 + t8 + t13)
+    t15 = c123 + t0 + t2
+    t16 = t4**2
+    t17 = t5**2
+    t18 = damping**2
+    t19 = t8 + t18
+    t20 = t19**2
+    t21 = xp.sqrt(t16 + t17 + t20)
+    t22 = t21*xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)
+    t23 = t19 + t22
+    t24 = xp.where(xp.greater(t21, 0), 1/(t21*(t21 + xp.abs(t19))), 0)
+    t25 = t13 + t18
+    t26 = -t24*(t4*t23 + t25*t4 + t15*t5)
+    t27 = t4 + t23*t26
+    t28 = t25 + t4*t26
+    t29 = t15 + t5*t26
+    t30 = xp.sqrt(t28**2 + t29**2)
+    t31 = t30*xp.where(xp.greater_equal(t28, 0), xp.asarray(1, dtype=dtype), -1)
+    t32 = t28 + t31
+    t33 = xp.where(xp.greater(t30, 0), 1/(t30*(t30 + xp.abs(t28))), 0)
+    t34 = 3 + t18
+    t35 = xp.sqrt(2*t16 + 2*t17 + 2*t15**2 + t20 + t25**2 + t34**2)
+    t36 = -t24*(t5*t23 + t34*t5 + t15*t4)
+    t37 = t5 + t23*t36
+    t38 = t15 + t4*t36
+    t39 = t34 + t5*t36
+    t40 = t33*(t38*t32 + t29*t39)
+    t41 = t38 - t32*t40
+    t42 = t39 - t29*t40
+    t43 = xp.abs(t42)
+    t44 = t43*xp.where(xp.greater_equal(t42, 0), xp.asarray(1, dtype=dtype), -1)
+    t45 = t42 + t44
+    t46 = xp.where(xp.greater(t43, 0), 1/(t43*2*t43), 0)
+    t47 = -t3
+    t48 = t47 + t11
+    t49 = t12*(1 - t1*t48 + t0*t2)
+    t50 = t1 + t48*t49
+    t51 = t0 - t2*t49
+    t52 = 1 - t49
+    t53 = t12*(1 + c123*t2 - s123*t48)
+    t54 = s123 + t48*t53
+    t55 = c123 - t2*t53
+    t56 = 1 - t53
+    t57 = xp.sqrt(t51**2 + t52**2)
+    t58 = t57*xp.where(xp.greater_equal(t51, 0), xp.asarray(1, dtype=dtype), -1)
+    t59 = t51 + t58
+    t60 = xp.where(xp.greater(t57, 0), 1/(t57*(t57 + xp.abs(t51))), 0)
+    t61 = t60*(t55*t59 + t52*t56)
+    t62 = t55 - t59*t61
+    t63 = t56 - t52*t61
+    t64 = mu_dot1 + gain1*(t47 + mu1)
+    t65 = xp.abs(t63)
+    t66 = t65*xp.where(xp.greater_equal(t63, 0), xp.asarray(1, dtype=dtype), -1)
+    t67 = t63 + t66
+    t68 = xp.where(xp.greater(t65, 0), 1/(t65*2*t65), 0)
+    t69 = -mu2 + xp.atan2(s123, c123)
+    t70 = mu_dot2 - gain2*(t69 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t69)))
+    t71 = -t24*(-t23*t6 + t4*t64 + t5*t70)
+    t72 = t6 - t23*t71
+    t73 = t64 + t4*t71
+    t74 = t70 + t5*t71
+    t75 = t33*(t32*t73 + t29*t74)
+    t76 = t73 - t32*t75
+    t77 = t74 - t29*t75
+    t78 = t77 - t45**2*t46*t77
+    t79 = xp.where(xp.not_equal(t44, 0), -t78/t44, 0)
+    t80 = xp.where(xp.not_equal(t31, 0), -(t76 - t41*t79)/t31, 0)
+    t81 = xp.where(xp.not_equal(t22, 0), -(t72 + t27*t80 + t37*t79)/t22, 0)
+    t82 = t79 - t3*t81 + t2*t80
+    t83 = t79 - t1*t81 + t0*t80
+    t84 = t79 - s123*t81 + c123*t80
+    t85 = t12*(t70 + t48*t6 + t2*t64)
+    t86 = t6 - t48*t85
+    t87 = t64 - t2*t85
+    t88 = -t85 + t70
+    t89 = t60*(t59*t87 + t52*t88)
+    t90 = t87 - t59*t89
+    t91 = t88 - t52*t89
+    t92 = t91 - t67**2*t68*t91
+    t93 = xp.where(xp.not_equal(t66, 0), -t92/t66, 0)
+    t94 = xp.where(xp.not_equal(t58, 0), -(t90 - t62*t93)/t58, 0)
+    t95 = xp.where(xp.not_equal(t11, 0), -(t86 + t50*t94 + t54*t93)/t11, 0)
+    t96 = 3 - t1 - s123 + q1 + q2 + q3 + t15 + t47 + damping + qz1 + qz2 + qz3 + t6 + t64 + t70
+    t97 = xp.isfinite(t96)
+    t98 = xp.greater_equal(damping, 0)
+    t99 = xp.greater(damping, 0)
+    t100 = 1e-12*t35
+    t101 = 1e-12*t14
+    t102 = (t99 & (xp.less_equal(t21, t100) | xp.less_equal(t30, t100) | xp.less_equal(t43, t100))) | (xp.less_equal(damping, 0) & (xp.less_equal(t10, t101) | xp.less_equal(t57, t101) | xp.less_equal(t65, t101)))
+    t103 = t97 & t98 & xp.logical_not(t102)
+    q_dot = _stack(xp, [
+        xp.broadcast_to(xp.where(t103, xp.where(t99, t82, t95), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t103, xp.where(t99, t83, t94), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t103, xp.where(t99, t84, t93), 0), batch),  # 2
+    ], (3,))
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t97 & t98), 2, xp.where(t102, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -815,19 +1844,19 @@ def ik_numeric_step(target, q, damping=0.0):
     t2 = c1 + t0
     t3 = s1 + t1
     t4 = s123**2 + t1**2 + t3**2
-    t5 = t2*t3 + t0*t1 + c123*s123
+    t5 = t0*t1 + c123*s123 + t2*t3
     t6 = t3 + t1 + s123
     t7 = c123**2 + t0**2 + t2**2
     t8 = c123 + t0 + t2
     t9 = -t2 + mu0
     t10 = -t3 + mu1
-    t11 = qs1 + qs2 + qs3 + mu2 + mu0 + mu1
+    t11 = mu2 + mu0 + mu1 + qs1 + qs2 + qs3
     t12 = -mu2 + xp.atan2(s123, c123)
     t13 = t12 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t12))
     t14 = t9**2 + t10**2 + t13**2
     t15 = damping + t4
     t16 = xp.sqrt(t15**2 + t5**2 + t6**2)
-    t17 = t16*xp.where(xp.greater_equal(t15, 0), xp.asarray(1, dtype=dtype), -1)
+    t17 = xp.where(xp.greater_equal(t15, 0), xp.asarray(1, dtype=dtype), -1)*t16
     t18 = t15 + t17
     t19 = xp.where(xp.greater(t16, 0), 1/(t16*(t16 + xp.abs(t15))), 0)
     t20 = t19*(t9*t18 - t5*t10 + t6*t13)

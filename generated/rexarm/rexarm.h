@@ -78,6 +78,14 @@ void rexarm_task_jacobian_dot(const rexarm_real q[REXARM_DOF], const rexarm_real
  * Result: H: 4 x 6 x 4 row-major, element (k, r, c) at H[k * 24 + r * 4 + c]. 82 operations. */
 void rexarm_hessian(const rexarm_real q[REXARM_DOF], rexarm_real H[REXARM_DOF * 6 * REXARM_DOF]);
 
+/* World pose of each link's DH frame, base A_1 ... A_i, without the tool (DOF x 4 x 4).
+ * Result: T: 4 x 4 x 4 row-major, element (k, r, c) at T[k * 16 + r * 4 + c]. 71 operations. */
+void rexarm_link_poses(const rexarm_real q[REXARM_DOF], rexarm_real T[REXARM_DOF * 4 * 4]);
+
+/* Linear and angular velocity [v; w] of each link frame's origin, world frame, propagated from the base (DOF x 6).
+ * Result: V: 4 x 6 row-major, element (r, c) at V[r * 6 + c]. 101 operations. */
+void rexarm_link_velocities(const rexarm_real q[REXARM_DOF], const rexarm_real q_dot[REXARM_DOF], rexarm_real V[REXARM_DOF * 6]);
+
 /* Factors of det(Js): the robot is singular where one is 0.
  * Result: f[i], i < 2. 19 operations. */
 void rexarm_singularity_factors(const rexarm_real q[REXARM_DOF], rexarm_real f[REXARM_NUM_SINGULARITY_FACTORS]);
@@ -90,9 +98,29 @@ rexarm_real rexarm_manipulability(const rexarm_real q[REXARM_DOF]);
  * Result: returned as a scalar. 44 operations. */
 rexarm_real rexarm_jacobian_det(const rexarm_real q[REXARM_DOF]);
 
+/* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
+ * Result: dw[i], i < 4. 521 operations. */
+void rexarm_manipulability_gradient(const rexarm_real q[REXARM_DOF], rexarm_real dw[REXARM_DOF]);
+
+/* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2135 operations. */
+void rexarm_velocity_ellipsoid(const rexarm_real q[REXARM_DOF], rexarm_real U_v[9], rexarm_real s_v[3], rexarm_real U_w[9], rexarm_real s_w[3]);
+
+/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
+ * Result: returned as a scalar. 2509 operations. */
+rexarm_real rexarm_condition_number(const rexarm_real q[REXARM_DOF]);
+
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
  * Result: q_dot[i], i < 4; returned as a scalar. 599 operations. */
 int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], rexarm_real damping, rexarm_real q_dot[REXARM_DOF]);
+
+/* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 4; returned as a scalar. 603 operations. */
+int rexarm_velocity_ik_nullspace(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], const rexarm_real z[REXARM_DOF], rexarm_real damping, rexarm_real q_dot[REXARM_DOF]);
+
+/* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 4; returned as a scalar. 624 operations. */
+int rexarm_resolved_rate(const rexarm_real q[REXARM_DOF], const rexarm_real target[REXARM_TASK_DIM], const rexarm_real target_rate[REXARM_TASK_DIM], const rexarm_real gain[REXARM_TASK_DIM], const rexarm_real z[REXARM_DOF], rexarm_real damping, rexarm_real q_dot[REXARM_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
  * Result: q_start[i], i < 4; q_next[i], i < 4; returned as a scalar. 395 operations. */

@@ -78,6 +78,14 @@ void scara_task_jacobian_dot(const scara_real q[SCARA_DOF], const scara_real q_d
  * Result: H: 4 x 6 x 4 row-major, element (k, r, c) at H[k * 24 + r * 4 + c]. 20 operations. */
 void scara_hessian(const scara_real q[SCARA_DOF], scara_real H[SCARA_DOF * 6 * SCARA_DOF]);
 
+/* World pose of each link's DH frame, base A_1 ... A_i, without the tool (DOF x 4 x 4).
+ * Result: T: 4 x 4 x 4 row-major, element (k, r, c) at T[k * 16 + r * 4 + c]. 31 operations. */
+void scara_link_poses(const scara_real q[SCARA_DOF], scara_real T[SCARA_DOF * 4 * 4]);
+
+/* Linear and angular velocity [v; w] of each link frame's origin, world frame, propagated from the base (DOF x 6).
+ * Result: V: 4 x 6 row-major, element (r, c) at V[r * 6 + c]. 29 operations. */
+void scara_link_velocities(const scara_real q[SCARA_DOF], const scara_real q_dot[SCARA_DOF], scara_real V[SCARA_DOF * 6]);
+
 /* Factors of det(Js): the robot is singular where one is 0.
  * Result: f[i], i < 1. 1 operations. */
 void scara_singularity_factors(const scara_real q[SCARA_DOF], scara_real f[SCARA_NUM_SINGULARITY_FACTORS]);
@@ -90,9 +98,29 @@ scara_real scara_manipulability(const scara_real q[SCARA_DOF]);
  * Result: returned as a scalar. 19 operations. */
 scara_real scara_jacobian_det(const scara_real q[SCARA_DOF]);
 
+/* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
+ * Result: dw[i], i < 4. 101 operations. */
+void scara_manipulability_gradient(const scara_real q[SCARA_DOF], scara_real dw[SCARA_DOF]);
+
+/* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 310 operations. */
+void scara_velocity_ellipsoid(const scara_real q[SCARA_DOF], scara_real U_v[9], scara_real s_v[3], scara_real U_w[9], scara_real s_w[3]);
+
+/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
+ * Result: returned as a scalar. 1048 operations. */
+scara_real scara_condition_number(const scara_real q[SCARA_DOF]);
+
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
  * Result: q_dot[i], i < 4; returned as a scalar. 332 operations. */
 int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], scara_real damping, scara_real q_dot[SCARA_DOF]);
+
+/* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 4; returned as a scalar. 336 operations. */
+int scara_velocity_ik_nullspace(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], const scara_real z[SCARA_DOF], scara_real damping, scara_real q_dot[SCARA_DOF]);
+
+/* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 4; returned as a scalar. 364 operations. */
+int scara_resolved_rate(const scara_real q[SCARA_DOF], const scara_real target[SCARA_TASK_DIM], const scara_real target_rate[SCARA_TASK_DIM], const scara_real gain[SCARA_TASK_DIM], const scara_real z[SCARA_DOF], scara_real damping, scara_real q_dot[SCARA_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
  * Result: q_start[i], i < 4; q_next[i], i < 4; returned as a scalar. 219 operations. */

@@ -38,10 +38,11 @@ def _namespace(values):
     return numpy
 
 
-def _arguments(*arguments):
+def _arguments(*arguments, every=()):
     """xp, dtype, device, the batch shape and the arrays of (name, value, shape) arguments:
     each of `shape` or a batch (..., *shape), all in the floating-point type of the arrays
-    among them (lists and numbers follow it)."""
+    among them (lists and numbers follow it); those named in `every` may be one number, which
+    stands for each of their components."""
     xp = _namespace(value for _, value, _ in arguments)
     given = [value for _, value, _ in arguments if hasattr(value, "dtype")]
     dtype = given[0].dtype if len({value.dtype for value in given}) == 1 else xp.result_type(*given, 1.0)
@@ -51,6 +52,8 @@ def _arguments(*arguments):
     arrays, batches = [], []
     for name, value, shape in arguments:
         value = xp.asarray(value, dtype=dtype, device=device)
+        if name in every and value.ndim == 0:
+            value = xp.broadcast_to(value, shape)
         if value.shape[value.ndim - len(shape):] != shape:
             batch = ", ".join(map(str, shape))
             raise ValueError(f"{name} must have shape {shape} or (..., {batch}), got {tuple(value.shape)}")
@@ -654,6 +657,153 @@ def hessian(q):
     return H
 
 
+def link_poses(q):
+    """world pose of each link's DH frame, base A_1 ... A_i, without the tool (DOF x 4 x 4): (4 x 4 x 4), 31 operations."""
+    xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
+    q3 = q[..., 2]
+    trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c4 = trig[..., 6]
+    s4 = trig[..., 7]
+    t0 = 0.387 - q3
+    t1 = c12*c4 + s12*s4
+    t2 = s12*c4 - c12*s4
+    t3 = 0.325*c1
+    t4 = 0.275*c12 + t3
+    t5 = 0.325*s1
+    t6 = 0.275*s12 + t5
+    t7 = -c12
+    T = _stack(xp, [
+        c1,  # 0, 0, 0
+        -s1,  # 0, 0, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 0, 2
+        t3,  # 0, 0, 3
+        s1,  # 0, 1, 0
+        c1,  # 0, 1, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 1, 2
+        t5,  # 0, 1, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2, 1
+        xp.full(batch, 1, dtype=dtype, device=device),  # 0, 2, 2
+        xp.full(batch, 0.387, dtype=dtype, device=device),  # 0, 2, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3, 2
+        xp.full(batch, 1, dtype=dtype, device=device),  # 0, 3, 3
+        c12,  # 1, 0, 0
+        s12,  # 1, 0, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0, 2
+        t4,  # 1, 0, 3
+        s12,  # 1, 1, 0
+        t7,  # 1, 1, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1, 2
+        t6,  # 1, 1, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2, 1
+        xp.full(batch, -1, dtype=dtype, device=device),  # 1, 2, 2
+        xp.full(batch, 0.387, dtype=dtype, device=device),  # 1, 2, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3, 2
+        xp.full(batch, 1, dtype=dtype, device=device),  # 1, 3, 3
+        c12,  # 2, 0, 0
+        s12,  # 2, 0, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0, 2
+        t4,  # 2, 0, 3
+        s12,  # 2, 1, 0
+        t7,  # 2, 1, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1, 2
+        t6,  # 2, 1, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2, 1
+        xp.full(batch, -1, dtype=dtype, device=device),  # 2, 2, 2
+        t0,  # 2, 2, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3, 2
+        xp.full(batch, 1, dtype=dtype, device=device),  # 2, 3, 3
+        t1,  # 3, 0, 0
+        t2,  # 3, 0, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0, 2
+        t4,  # 3, 0, 3
+        t2,  # 3, 1, 0
+        -t1,  # 3, 1, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1, 2
+        t6,  # 3, 1, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2, 1
+        xp.full(batch, -1, dtype=dtype, device=device),  # 3, 2, 2
+        t0,  # 3, 2, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3, 2
+        xp.full(batch, 1, dtype=dtype, device=device),  # 3, 3, 3
+    ], (4, 4, 4))
+    return T
+
+
+def link_velocities(q, q_dot):
+    """linear and angular velocity [v; w] of each link frame's origin, world frame, propagated from the base (DOF x 6): (4 x 6), 29 operations."""
+    xp, dtype, device, batch, (q, q_dot,) = _arguments(("q", q, (4,)), ("q_dot", q_dot, (4,)))
+    qd1 = q_dot[..., 0]
+    qd2 = q_dot[..., 1]
+    qd3 = q_dot[..., 2]
+    qd4 = q_dot[..., 3]
+    trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = qd1 + qd2
+    t1 = -qd4 + t0
+    t2 = 0.325*c1
+    t3 = 0.275*c12 + t2
+    t4 = -t2 + t3
+    t5 = 0.325*s1
+    t6 = 0.275*s12 + t5
+    t7 = -t5 + t6
+    t8 = t5*qd1
+    t9 = t8 + t0*t7
+    t10 = t2*qd1
+    t11 = t10 + t0*t4
+    t12 = -t9
+    t13 = -qd3
+    V = _stack(xp, [
+        xp.broadcast_to(-t8, batch),  # 0, 0
+        xp.broadcast_to(t10, batch),  # 0, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
+        xp.broadcast_to(qd1, batch),  # 0, 5
+        xp.broadcast_to(t12, batch),  # 1, 0
+        xp.broadcast_to(t11, batch),  # 1, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
+        xp.broadcast_to(t0, batch),  # 1, 5
+        xp.broadcast_to(t12, batch),  # 2, 0
+        xp.broadcast_to(t11, batch),  # 2, 1
+        xp.broadcast_to(t13, batch),  # 2, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
+        xp.broadcast_to(t0, batch),  # 2, 5
+        xp.broadcast_to(t12, batch),  # 3, 0
+        xp.broadcast_to(t11, batch),  # 3, 1
+        xp.broadcast_to(t13, batch),  # 3, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4
+        xp.broadcast_to(t1, batch),  # 3, 5
+    ], (4, 6))
+    return V
+
+
 def singularity_factors(q):
     """factors of det(Js): the robot is singular where one is 0: (1 x 1), 1 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
@@ -703,6 +853,696 @@ def jacobian_det(q):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def manipulability_gradient(q):
+    """d manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): (4 x 1), 101 operations."""
+    xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
+    trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = 0.275*c12
+    t1 = 0.325*c1 + t0
+    t2 = 0.275*s12
+    t3 = 0.325*s1 + t2
+    t4 = 0.075625*s12**2
+    t5 = t3**2 + t4
+    t6 = xp.sqrt(4 + t1**2 + t5 + 0.075625*c12**2)
+    t7 = xp.sqrt(t5)
+    t8 = t7*xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)
+    t9 = -t3 + t8
+    t10 = xp.where(xp.greater(t7, 0), 1/(t7*(t7 + xp.abs(t3))), 0)
+    t11 = t10*(t1*t9 - 0.075625*c12*s12)
+    t12 = t1 - t9*t11
+    t13 = t0 + t2*t11
+    t14 = 1 - t9**2*t10
+    t15 = xp.abs(t13)
+    t16 = t15*xp.where(xp.greater_equal(t13, 0), xp.asarray(1, dtype=dtype), -1)
+    t17 = t13 + t16
+    t18 = xp.where(xp.greater(t15, 0), 1/(t15*2*t15), 0)
+    t19 = 1 - t17**2*t18
+    t20 = t10*t19
+    t21 = t4*t20
+    t22 = -t21 + t19
+    t23 = t2*t9
+    t24 = t16*t14 + t20*t12*t23
+    t25 = t12*t22 + t10*t16*t23
+    t26 = 1e-12*t6
+    t27 = xp.where(xp.less_equal(t7, t26) | xp.less_equal(t15, t26) | xp.less_equal(1, t26), 0, xp.where(xp.less(t8, 0), 1, xp.where(xp.greater(t8, 0), xp.asarray(-1, dtype=dtype), 0))*xp.where(xp.less(t16, 0), 1, xp.where(xp.greater(t16, 0), xp.asarray(-1, dtype=dtype), 0)))
+    t28 = t2*t8
+    t29 = t0*t25 + t22*t28
+    t30 = t27*(t1*t24 + t3*t20*t9*t28 + t29)
+    t31 = t27*(t29 + t0*t24 + t8*t9*t21)
+    dw = _stack(xp, [
+        t30,  # 0
+        t31,  # 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3
+    ], (4,))
+    return dw
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def velocity_ellipsoid(q):
+    """axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: (3 x 3 and 3 x 1 and 3 x 3 and 3 x 1), 310 operations."""
+    xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
+    trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = 0.275*c12
+    t1 = 0.325*c1 + t0
+    t2 = 0.275*s12
+    t3 = 0.325*s1 + t2
+    t4 = xp.sqrt(t3**2 + 0.075625*s12**2)
+    t5 = t4*xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)
+    t6 = -t3 + t5
+    t7 = xp.where(xp.greater(t4, 0), 1/(t4*(t4 + xp.abs(t3))), 0)
+    t8 = t7*(t1*t6 - 0.075625*c12*s12)
+    t9 = t1 - t6*t8
+    t10 = t0 + t2*t8
+    t11 = xp.abs(t10)
+    t12 = t11*xp.where(xp.greater_equal(t10, 0), xp.asarray(1, dtype=dtype), -1)
+    t13 = t5**2
+    t14 = t12**2
+    t15 = t14 + t9**2
+    t16 = t5*t9
+    t17 = xp.not_equal(t16, 0)
+    t18 = 0.5*(-t13 + t15)/xp.where(t17, -t16, 1)
+    t19 = xp.where(t17, xp.where(xp.greater_equal(t18, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t18) + xp.sqrt(1 + t18**2)), 0)
+    t20 = 1/xp.sqrt(1 + t19**2)
+    t21 = t16*t19
+    t22 = t21 + t13
+    t23 = -t21 + t15
+    t24 = t5*t20
+    t25 = t9*t20
+    t26 = t24 + t25*t19
+    t27 = t25 - t24*t19
+    t28 = t26*t27 + t14*t19*t20**2
+    t29 = xp.not_equal(t28, 0)
+    t30 = 0.5*(-t22 + t23)/xp.where(t29, -t28, 1)
+    t31 = xp.where(t29, xp.where(xp.greater_equal(t30, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t30) + xp.sqrt(1 + t30**2)), 0)
+    t32 = 1/xp.sqrt(1 + t31**2)
+    t33 = t28*t31
+    t34 = t33 + t22
+    t35 = -t33 + t23
+    t36 = t26*t32
+    t37 = t27*t32
+    t38 = t36 + t31*t37
+    t39 = t37 - t36*t31
+    t40 = t20*t32
+    t41 = t12*t40
+    t42 = t19*t41
+    t43 = t42 + t31*t41
+    t44 = -t41 + t31*t42
+    t45 = -t38*t39 + t43*t44
+    t46 = t19*t40
+    t47 = t40 - t31*t46
+    t48 = t46 + t31*t40
+    t49 = xp.not_equal(t45, 0)
+    t50 = 0.5*(-t34 + t35)/xp.where(t49, t45, 1)
+    t51 = xp.where(t49, xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t50) + xp.sqrt(1 + t50**2)), 0)
+    t52 = 1/xp.sqrt(1 + t51**2)
+    t53 = t45*t51
+    t54 = -t53 + t34
+    t55 = t35 + t53
+    t56 = t38*t52
+    t57 = t39*t52
+    t58 = t56 + t51*t57
+    t59 = t57 - t51*t56
+    t60 = t43*t52
+    t61 = t44*t52
+    t62 = t60 - t51*t61
+    t63 = t61 + t51*t60
+    t64 = -t58*t59 + t62*t63
+    t65 = t47*t52
+    t66 = t48*t52
+    t67 = t65 - t51*t66
+    t68 = t66 + t51*t65
+    t69 = xp.not_equal(t64, 0)
+    t70 = 0.5*(-t54 + t55)/xp.where(t69, t64, 1)
+    t71 = xp.where(t69, xp.where(xp.greater_equal(t70, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t70) + xp.sqrt(1 + t70**2)), 0)
+    t72 = 1/xp.sqrt(1 + t71**2)
+    t73 = t64*t71
+    t74 = -t73 + t54
+    t75 = t55 + t73
+    t76 = t58*t72
+    t77 = t59*t72
+    t78 = t76 + t71*t77
+    t79 = t77 - t71*t76
+    t80 = t62*t72
+    t81 = t63*t72
+    t82 = t80 - t71*t81
+    t83 = t81 + t71*t80
+    t84 = -t78*t79 + t82*t83
+    t85 = t67*t72
+    t86 = t68*t72
+    t87 = t85 - t71*t86
+    t88 = t86 + t71*t85
+    t89 = xp.not_equal(t84, 0)
+    t90 = 0.5*(-t74 + t75)/xp.where(t89, t84, 1)
+    t91 = xp.where(t89, xp.where(xp.greater_equal(t90, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t90) + xp.sqrt(1 + t90**2)), 0)
+    t92 = 1/xp.sqrt(1 + t91**2)
+    t93 = t78*t92
+    t94 = t79*t92
+    t95 = t93 + t91*t94
+    t96 = t94 - t91*t93
+    t97 = t82*t92
+    t98 = t83*t92
+    t99 = t97 - t91*t98
+    t100 = t98 + t91*t97
+    t101 = xp.sqrt(t95**2 + t99**2)
+    t102 = xp.sqrt(t96**2 + t100**2)
+    t103 = t87*t92
+    t104 = t88*t92
+    t105 = t103 - t91*t104
+    t106 = t104 + t91*t103
+    t107 = xp.less(t101, t102)
+    t108 = xp.where(t107, t102, t101)
+    t109 = xp.where(t107, t101, t102)
+    t110 = xp.where(t107, t106, t105)
+    t111 = xp.where(t107, t105, t106)
+    t112 = -t106
+    t113 = xp.where(t107, t105, t112)
+    t114 = xp.where(t107, t112, t105)
+    t115 = xp.less(t109, 1)
+    t116 = xp.where(t115, 1, t109)
+    t117 = xp.where(t115, t109, 1)
+    t118 = xp.where(t115, 0, t111)
+    t119 = xp.where(t115, 0, t114)
+    t120 = xp.where(t115, xp.asarray(1, dtype=dtype), 0)
+    t121 = xp.where(t115, t111, 0)
+    t122 = xp.where(t115, t114, 0)
+    t123 = xp.where(t115, xp.asarray(0, dtype=dtype), 1)
+    t124 = xp.less(t108, t116)
+    t125 = xp.where(t124, t116, t108)
+    t126 = xp.where(t124, t108, t116)
+    t127 = xp.where(t124, t118, t110)
+    t128 = xp.where(t124, t119, t113)
+    t129 = xp.where(t124, t120, 0)
+    t130 = xp.where(t124, t110, t118)
+    t131 = xp.where(t124, t113, t119)
+    t132 = xp.where(t124, 0, t120)
+    t133 = t127*(t123*t131 - t122*t132) - t128*(t123*t130 - t121*t132) + t129*(t122*t130 - t121*t131)
+    t134 = xp.where(xp.less(t133, 0), xp.asarray(-1, dtype=dtype), 1)
+    t135 = t121*t134
+    t136 = t122*t134
+    t137 = t123*t134
+    U_v = _stack(xp, [
+        t127,  # 0, 0
+        t130,  # 0, 1
+        t135,  # 0, 2
+        t128,  # 1, 0
+        t131,  # 1, 1
+        t136,  # 1, 2
+        t129,  # 2, 0
+        t132,  # 2, 1
+        t137,  # 2, 2
+    ], (3, 3))
+    s_v = _stack(xp, [
+        t125,  # 0
+        t126,  # 1
+        t117,  # 2
+    ], (3,))
+    U_w = _stack(xp, [
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 0
+        xp.full(batch, 1, dtype=dtype, device=device),  # 0, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1
+        xp.full(batch, 1, dtype=dtype, device=device),  # 1, 2
+        xp.full(batch, 1, dtype=dtype, device=device),  # 2, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2
+    ], (3, 3))
+    s_w = _stack(xp, [
+        xp.full(batch, 1.7320508075688772, dtype=dtype, device=device),  # 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2
+    ], (3,))
+    return U_v, s_v, U_w, s_w
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def condition_number(q):
+    """sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): (1 x 1), 1048 operations."""
+    xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
+    trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = 0.275*c12 + 0.325*c1
+    t1 = 0.275*s12 + 0.325*s1
+    t2 = xp.sqrt(3.5432525951557095*t1**2 + 0.26795847750865054*s12**2)
+    t3 = 1.8823529411764706*t1
+    t4 = xp.where(xp.greater(t2, 0), 1/(t2*(t2 + xp.abs(t3))), 0)
+    t5 = -t3
+    t6 = t2*xp.where(xp.greater_equal(t5, 0), xp.asarray(1, dtype=dtype), -1)
+    t7 = t5 + t6
+    t8 = 1.8823529411764706*t0
+    t9 = t4*(-0.26795847750865054*c12*s12 + t8*t7)
+    t10 = t8 - t7*t9
+    t11 = 0.5176470588235293*s12
+    t12 = 0.5176470588235293*c12 + t11*t9
+    t13 = t4*(-t11 + t7)
+    t14 = 1 - t7*t13
+    t15 = 1 + t11*t13
+    t16 = xp.abs(t12)
+    t17 = t16*xp.where(xp.greater_equal(t12, 0), xp.asarray(1, dtype=dtype), -1)
+    t18 = t12 + t17
+    t19 = xp.where(xp.greater(t16, 0), 1/(t16*2*t16), 0)
+    t20 = t15 - t15*t18**2*t19
+    t21 = t17**2 + t20**2
+    t22 = -t10*t17 + t14*t20
+    t23 = t6**2
+    t24 = t23 + t10**2 + t14**2
+    t25 = xp.not_equal(t22, 0)
+    t26 = 0.5*(-t24 + t21)/xp.where(t25, t22, 1)
+    t27 = xp.where(t25, xp.where(xp.greater_equal(t26, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t26) + xp.sqrt(1 + t26**2)), 0)
+    t28 = 1/xp.sqrt(1 + t27**2)
+    t29 = t22*t27
+    t30 = -t29 + t24
+    t31 = t29 + t21
+    t32 = t10*t28
+    t33 = t17*t28
+    t34 = t32 + t33*t27
+    t35 = -t33 + t32*t27
+    t36 = t14*t28
+    t37 = t20*t28
+    t38 = t36 - t37*t27
+    t39 = t37 + t36*t27
+    t40 = xp.not_equal(t38, 0)
+    t41 = 0.5*(1.0 - t30)/xp.where(t40, t38, 1)
+    t42 = xp.where(t40, xp.where(xp.greater_equal(t41, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t41) + xp.sqrt(1 + t41**2)), 0)
+    t43 = 1/xp.sqrt(1 + t42**2)
+    t44 = t38*t42
+    t45 = -t44 + t30
+    t46 = 1.0 + t44
+    t47 = t43 + t44*t43
+    t48 = t42*t43
+    t49 = -t48 + t38*t43
+    t50 = t48*t34
+    t51 = t39*t47 + t23*t48*t27*t28**2 + t50*t35
+    t52 = xp.not_equal(t51, 0)
+    t53 = 0.5*(-t31 + t46)/xp.where(t52, t51, 1)
+    t54 = xp.where(t52, xp.where(xp.greater_equal(t53, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t53) + xp.sqrt(1 + t53**2)), 0)
+    t55 = 1/xp.sqrt(1 + t54**2)
+    t56 = t51*t54
+    t57 = -t56 + t31
+    t58 = t56 + t46
+    t59 = t6*t28
+    t60 = t59*t55
+    t61 = t60*t27
+    t62 = t48*t60
+    t63 = -t61 + t62*t54
+    t64 = t62 + t61*t54
+    t65 = t35*t55
+    t66 = t50*t55
+    t67 = t65 - t66*t54
+    t68 = t66 + t65*t54
+    t69 = t39*t55
+    t70 = t47*t55
+    t71 = t69 - t70*t54
+    t72 = t70 + t69*t54
+    t73 = t59*t43
+    t74 = t34*t43
+    t75 = t49*t71 - t73*t63 + t74*t67
+    t76 = xp.not_equal(t75, 0)
+    t77 = 0.5*(-t45 + t57)/xp.where(t76, t75, 1)
+    t78 = xp.where(t76, xp.where(xp.greater_equal(t77, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t77) + xp.sqrt(1 + t77**2)), 0)
+    t79 = 1/xp.sqrt(1 + t78**2)
+    t80 = t75*t78
+    t81 = -t80 + t45
+    t82 = t80 + t57
+    t83 = t73*t79
+    t84 = t63*t79
+    t85 = t83 + t84*t78
+    t86 = t84 - t83*t78
+    t87 = t74*t79
+    t88 = t67*t79
+    t89 = t87 - t88*t78
+    t90 = t88 + t87*t78
+    t91 = t49*t79
+    t92 = t71*t79
+    t93 = t91 - t92*t78
+    t94 = t92 + t91*t78
+    t95 = t64*t85 + t68*t89 + t72*t93
+    t96 = xp.not_equal(t95, 0)
+    t97 = 0.5*(-t81 + t58)/xp.where(t96, t95, 1)
+    t98 = xp.where(t96, xp.where(xp.greater_equal(t97, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t97) + xp.sqrt(1 + t97**2)), 0)
+    t99 = 1/xp.sqrt(1 + t98**2)
+    t100 = t95*t98
+    t101 = -t100 + t81
+    t102 = t100 + t58
+    t103 = t85*t99
+    t104 = t64*t99
+    t105 = -t103 + t104*t98
+    t106 = t104 + t103*t98
+    t107 = t89*t99
+    t108 = t68*t99
+    t109 = t107 - t108*t98
+    t110 = t108 + t107*t98
+    t111 = t93*t99
+    t112 = t72*t99
+    t113 = t111 - t112*t98
+    t114 = t112 + t111*t98
+    t115 = -t86*t106 + t90*t110 + t94*t114
+    t116 = xp.not_equal(t115, 0)
+    t117 = 0.5*(-t82 + t102)/xp.where(t116, t115, 1)
+    t118 = xp.where(t116, xp.where(xp.greater_equal(t117, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t117) + xp.sqrt(1 + t117**2)), 0)
+    t119 = 1/xp.sqrt(1 + t118**2)
+    t120 = t115*t118
+    t121 = -t120 + t82
+    t122 = t102 + t120
+    t123 = t86*t119
+    t124 = t106*t119
+    t125 = t123 + t118*t124
+    t126 = -t124 + t118*t123
+    t127 = t90*t119
+    t128 = t110*t119
+    t129 = t127 - t118*t128
+    t130 = t128 + t118*t127
+    t131 = t94*t119
+    t132 = t114*t119
+    t133 = t131 - t118*t132
+    t134 = t132 + t118*t131
+    t135 = t105*t125 + t109*t129 + t113*t133
+    t136 = xp.not_equal(t135, 0)
+    t137 = 0.5*(-t101 + t121)/xp.where(t136, t135, 1)
+    t138 = xp.where(t136, xp.where(xp.greater_equal(t137, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t137) + xp.sqrt(1 + t137**2)), 0)
+    t139 = 1/xp.sqrt(1 + t138**2)
+    t140 = t135*t138
+    t141 = -t140 + t101
+    t142 = t121 + t140
+    t143 = t105*t139
+    t144 = t125*t139
+    t145 = t143 - t138*t144
+    t146 = t144 + t138*t143
+    t147 = t109*t139
+    t148 = t129*t139
+    t149 = t147 - t138*t148
+    t150 = t148 + t138*t147
+    t151 = t113*t139
+    t152 = t133*t139
+    t153 = t151 - t138*t152
+    t154 = t152 + t138*t151
+    t155 = t126*t145 + t130*t149 + t134*t153
+    t156 = xp.not_equal(t155, 0)
+    t157 = 0.5*(-t141 + t122)/xp.where(t156, t155, 1)
+    t158 = xp.where(t156, xp.where(xp.greater_equal(t157, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t157) + xp.sqrt(1 + t157**2)), 0)
+    t159 = 1/xp.sqrt(1 + t158**2)
+    t160 = t155*t158
+    t161 = -t160 + t141
+    t162 = t122 + t160
+    t163 = t145*t159
+    t164 = t126*t159
+    t165 = t163 - t158*t164
+    t166 = t164 + t158*t163
+    t167 = t149*t159
+    t168 = t130*t159
+    t169 = t167 - t158*t168
+    t170 = t168 + t158*t167
+    t171 = t153*t159
+    t172 = t134*t159
+    t173 = t171 - t158*t172
+    t174 = t172 + t158*t171
+    t175 = t146*t166 + t150*t170 + t154*t174
+    t176 = xp.not_equal(t175, 0)
+    t177 = 0.5*(-t142 + t162)/xp.where(t176, t175, 1)
+    t178 = xp.where(t176, xp.where(xp.greater_equal(t177, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t177) + xp.sqrt(1 + t177**2)), 0)
+    t179 = 1/xp.sqrt(1 + t178**2)
+    t180 = t175*t178
+    t181 = -t180 + t142
+    t182 = t162 + t180
+    t183 = t146*t179
+    t184 = t166*t179
+    t185 = t183 - t178*t184
+    t186 = t184 + t178*t183
+    t187 = t150*t179
+    t188 = t170*t179
+    t189 = t187 - t178*t188
+    t190 = t188 + t178*t187
+    t191 = t154*t179
+    t192 = t174*t179
+    t193 = t191 - t178*t192
+    t194 = t192 + t178*t191
+    t195 = t165*t185 + t169*t189 + t173*t193
+    t196 = xp.not_equal(t195, 0)
+    t197 = 0.5*(-t161 + t181)/xp.where(t196, t195, 1)
+    t198 = xp.where(t196, xp.where(xp.greater_equal(t197, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t197) + xp.sqrt(1 + t197**2)), 0)
+    t199 = 1/xp.sqrt(1 + t198**2)
+    t200 = t195*t198
+    t201 = -t200 + t161
+    t202 = t181 + t200
+    t203 = t165*t199
+    t204 = t185*t199
+    t205 = t203 - t198*t204
+    t206 = t204 + t198*t203
+    t207 = t169*t199
+    t208 = t189*t199
+    t209 = t207 - t198*t208
+    t210 = t208 + t198*t207
+    t211 = t173*t199
+    t212 = t193*t199
+    t213 = t211 - t198*t212
+    t214 = t212 + t198*t211
+    t215 = t186*t205 + t190*t209 + t194*t213
+    t216 = xp.not_equal(t215, 0)
+    t217 = 0.5*(-t201 + t182)/xp.where(t216, t215, 1)
+    t218 = xp.where(t216, xp.where(xp.greater_equal(t217, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t217) + xp.sqrt(1 + t217**2)), 0)
+    t219 = 1/xp.sqrt(1 + t218**2)
+    t220 = t215*t218
+    t221 = -t220 + t201
+    t222 = t182 + t220
+    t223 = t205*t219
+    t224 = t186*t219
+    t225 = t223 - t218*t224
+    t226 = t224 + t218*t223
+    t227 = t209*t219
+    t228 = t190*t219
+    t229 = t227 - t218*t228
+    t230 = t228 + t218*t227
+    t231 = t213*t219
+    t232 = t194*t219
+    t233 = t231 - t218*t232
+    t234 = t232 + t218*t231
+    t235 = t206*t226 + t210*t230 + t214*t234
+    t236 = xp.not_equal(t235, 0)
+    t237 = 0.5*(-t202 + t222)/xp.where(t236, t235, 1)
+    t238 = xp.where(t236, xp.where(xp.greater_equal(t237, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t237) + xp.sqrt(1 + t237**2)), 0)
+    t239 = 1/xp.sqrt(1 + t238**2)
+    t240 = t235*t238
+    t241 = -t240 + t202
+    t242 = t222 + t240
+    t243 = t206*t239
+    t244 = t226*t239
+    t245 = t243 - t238*t244
+    t246 = t244 + t238*t243
+    t247 = t210*t239
+    t248 = t230*t239
+    t249 = t247 - t238*t248
+    t250 = t248 + t238*t247
+    t251 = t214*t239
+    t252 = t234*t239
+    t253 = t251 - t238*t252
+    t254 = t252 + t238*t251
+    t255 = t225*t245 + t229*t249 + t233*t253
+    t256 = xp.not_equal(t255, 0)
+    t257 = 0.5*(-t221 + t241)/xp.where(t256, t255, 1)
+    t258 = xp.where(t256, xp.where(xp.greater_equal(t257, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t257) + xp.sqrt(1 + t257**2)), 0)
+    t259 = 1/xp.sqrt(1 + t258**2)
+    t260 = t255*t258
+    t261 = -t260 + t221
+    t262 = t241 + t260
+    t263 = t225*t259
+    t264 = t245*t259
+    t265 = t263 - t258*t264
+    t266 = t264 + t258*t263
+    t267 = t229*t259
+    t268 = t249*t259
+    t269 = t267 - t258*t268
+    t270 = t268 + t258*t267
+    t271 = t233*t259
+    t272 = t253*t259
+    t273 = t271 - t258*t272
+    t274 = t272 + t258*t271
+    t275 = t246*t265 + t250*t269 + t254*t273
+    t276 = xp.not_equal(t275, 0)
+    t277 = 0.5*(-t261 + t242)/xp.where(t276, t275, 1)
+    t278 = xp.where(t276, xp.where(xp.greater_equal(t277, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t277) + xp.sqrt(1 + t277**2)), 0)
+    t279 = 1/xp.sqrt(1 + t278**2)
+    t280 = t275*t278
+    t281 = -t280 + t261
+    t282 = t242 + t280
+    t283 = t265*t279
+    t284 = t246*t279
+    t285 = t283 - t278*t284
+    t286 = t284 + t278*t283
+    t287 = t269*t279
+    t288 = t250*t279
+    t289 = t287 - t278*t288
+    t290 = t288 + t278*t287
+    t291 = t273*t279
+    t292 = t254*t279
+    t293 = t291 - t278*t292
+    t294 = t292 + t278*t291
+    t295 = t266*t286 + t270*t290 + t274*t294
+    t296 = xp.not_equal(t295, 0)
+    t297 = 0.5*(-t262 + t282)/xp.where(t296, t295, 1)
+    t298 = xp.where(t296, xp.where(xp.greater_equal(t297, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t297) + xp.sqrt(1 + t297**2)), 0)
+    t299 = 1/xp.sqrt(1 + t298**2)
+    t300 = t295*t298
+    t301 = -t300 + t262
+    t302 = t282 + t300
+    t303 = t266*t299
+    t304 = t286*t299
+    t305 = t303 - t298*t304
+    t306 = t304 + t298*t303
+    t307 = t270*t299
+    t308 = t290*t299
+    t309 = t307 - t298*t308
+    t310 = t308 + t298*t307
+    t311 = t274*t299
+    t312 = t294*t299
+    t313 = t311 - t298*t312
+    t314 = t312 + t298*t311
+    t315 = t285*t305 + t289*t309 + t293*t313
+    t316 = xp.not_equal(t315, 0)
+    t317 = 0.5*(-t281 + t301)/xp.where(t316, t315, 1)
+    t318 = xp.where(t316, xp.where(xp.greater_equal(t317, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t317) + xp.sqrt(1 + t317**2)), 0)
+    t319 = 1/xp.sqrt(1 + t318**2)
+    t320 = t315*t318
+    t321 = -t320 + t281
+    t322 = t301 + t320
+    t323 = t285*t319
+    t324 = t305*t319
+    t325 = t323 - t318*t324
+    t326 = t324 + t318*t323
+    t327 = t289*t319
+    t328 = t309*t319
+    t329 = t327 - t318*t328
+    t330 = t328 + t318*t327
+    t331 = t293*t319
+    t332 = t313*t319
+    t333 = t331 - t318*t332
+    t334 = t332 + t318*t331
+    t335 = t306*t325 + t310*t329 + t314*t333
+    t336 = xp.not_equal(t335, 0)
+    t337 = 0.5*(-t321 + t302)/xp.where(t336, t335, 1)
+    t338 = xp.where(t336, xp.where(xp.greater_equal(t337, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t337) + xp.sqrt(1 + t337**2)), 0)
+    t339 = 1/xp.sqrt(1 + t338**2)
+    t340 = t335*t338
+    t341 = -t340 + t321
+    t342 = t302 + t340
+    t343 = t325*t339
+    t344 = t306*t339
+    t345 = t343 - t338*t344
+    t346 = t344 + t338*t343
+    t347 = t329*t339
+    t348 = t310*t339
+    t349 = t347 - t338*t348
+    t350 = t348 + t338*t347
+    t351 = t333*t339
+    t352 = t314*t339
+    t353 = t351 - t338*t352
+    t354 = t352 + t338*t351
+    t355 = t326*t346 + t330*t350 + t334*t354
+    t356 = xp.not_equal(t355, 0)
+    t357 = 0.5*(-t322 + t342)/xp.where(t356, t355, 1)
+    t358 = xp.where(t356, xp.where(xp.greater_equal(t357, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t357) + xp.sqrt(1 + t357**2)), 0)
+    t359 = 1/xp.sqrt(1 + t358**2)
+    t360 = t355*t358
+    t361 = -t360 + t322
+    t362 = t342 + t360
+    t363 = t326*t359
+    t364 = t346*t359
+    t365 = t363 - t358*t364
+    t366 = t364 + t358*t363
+    t367 = t330*t359
+    t368 = t350*t359
+    t369 = t367 - t358*t368
+    t370 = t368 + t358*t367
+    t371 = t334*t359
+    t372 = t354*t359
+    t373 = t371 - t358*t372
+    t374 = t372 + t358*t371
+    t375 = t345*t365 + t349*t369 + t353*t373
+    t376 = xp.not_equal(t375, 0)
+    t377 = 0.5*(-t341 + t361)/xp.where(t376, t375, 1)
+    t378 = xp.where(t376, xp.where(xp.greater_equal(t377, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t377) + xp.sqrt(1 + t377**2)), 0)
+    t379 = 1/xp.sqrt(1 + t378**2)
+    t380 = t375*t378
+    t381 = -t380 + t341
+    t382 = t361 + t380
+    t383 = t345*t379
+    t384 = t365*t379
+    t385 = t383 - t378*t384
+    t386 = t384 + t378*t383
+    t387 = t349*t379
+    t388 = t369*t379
+    t389 = t387 - t378*t388
+    t390 = t388 + t378*t387
+    t391 = t353*t379
+    t392 = t373*t379
+    t393 = t391 - t378*t392
+    t394 = t392 + t378*t391
+    t395 = t366*t385 + t370*t389 + t374*t393
+    t396 = xp.not_equal(t395, 0)
+    t397 = 0.5*(-t381 + t362)/xp.where(t396, t395, 1)
+    t398 = xp.where(t396, xp.where(xp.greater_equal(t397, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t397) + xp.sqrt(1 + t397**2)), 0)
+    t399 = 1/xp.sqrt(1 + t398**2)
+    t400 = t362 + t395*t398
+    t401 = t385*t399
+    t402 = t366*t399
+    t403 = t401 - t398*t402
+    t404 = t402 + t398*t401
+    t405 = t389*t399
+    t406 = t370*t399
+    t407 = t405 - t398*t406
+    t408 = t406 + t398*t405
+    t409 = t393*t399
+    t410 = t374*t399
+    t411 = t409 - t398*t410
+    t412 = t410 + t398*t409
+    t413 = t386*t404 + t390*t408 + t394*t412
+    t414 = xp.sqrt(t403**2 + t407**2 + t411**2)
+    t415 = xp.not_equal(t413, 0)
+    t416 = 0.5*(-t382 + t400)/xp.where(t415, t413, 1)
+    t417 = xp.where(t415, xp.where(xp.greater_equal(t416, 0), xp.asarray(1, dtype=dtype), -1)/(xp.abs(t416) + xp.sqrt(1 + t416**2)), 0)
+    t418 = 1/xp.sqrt(1 + t417**2)
+    t419 = t386*t418
+    t420 = t404*t418
+    t421 = t419 - t417*t420
+    t422 = t420 + t417*t419
+    t423 = t390*t418
+    t424 = t408*t418
+    t425 = t423 - t417*t424
+    t426 = t424 + t417*t423
+    t427 = t394*t418
+    t428 = t412*t418
+    t429 = t427 - t417*t428
+    t430 = t428 + t417*t427
+    t431 = xp.sqrt(t421**2 + t425**2 + t429**2)
+    t432 = xp.sqrt(t422**2 + t426**2 + t430**2)
+    t433 = xp.where(xp.greater(t431, t414), t431, t414)
+    t434 = xp.where(xp.less(t431, t414), t431, t414)
+    t435 = xp.where(xp.greater(1.8823529411764706, t433), 1.8823529411764706, t433)
+    t436 = xp.where(xp.less(1.8823529411764706, t434), 1.8823529411764706, t434)
+    t437 = xp.where(xp.greater(t432, t435), t432, t435)
+    t438 = xp.where(xp.less(t432, t436), t432, t436)
+    kappa = xp.broadcast_to(xp.where(xp.greater(t437, 0), t437, 1)/xp.where(xp.less_equal(t438, 1e-12*t437), 0, t438), batch)
+    return kappa
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
     """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 332 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (4,)), ("mu_dot", mu_dot, (4,)), ("damping", damping, ()))
@@ -725,16 +1565,16 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t1 = 0.325*c1 + t0
     t2 = 0.275*s12
     t3 = 0.325*s1 + t2
-    t4 = t1*t3 + 0.075625*c12*s12
+    t4 = 0.075625*c12*s12 + t1*t3
     t5 = t3 + t2
     t6 = t3**2
     t7 = t6 + 0.075625*s12**2
     t8 = t1**2
     t9 = xp.sqrt(1 + t6 + t8)
-    t10 = t9*xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)
-    t11 = xp.where(xp.greater(t9, 0), 1/(t9*(t9 + xp.abs(t3))), 0)
+    t10 = xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)*t9
+    t11 = xp.where(xp.greater(t9, 0), 1/(t9*(xp.abs(t3) + t9)), 0)
     t12 = -1 + t11
-    t13 = 0.075625*c12**2 + t8
+    t13 = t8 + 0.075625*c12**2
     t14 = xp.sqrt(4 + t7 + t13)
     t15 = t1 + t0
     t16 = t4**2
@@ -744,17 +1584,17 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t20 = t19**2
     t21 = xp.sqrt(t16 + t17 + t20)
     t22 = t21*xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)
-    t23 = t22 + t19
+    t23 = t19 + t22
     t24 = xp.where(xp.greater(t21, 0), 1/(t21*(t21 + xp.abs(t19))), 0)
     t25 = -t24*(-mu_dot0*t23 + mu_dot1*t4 + mu_dot3*t5)
     t26 = mu_dot0 - t23*t25
     t27 = mu_dot1 + t4*t25
     t28 = mu_dot3 + t5*t25
     t29 = t13 + t18
-    t30 = -t24*(t4*t23 + t4*t29 + t5*t15)
+    t30 = -t24*(t4*t23 + t29*t4 + t15*t5)
     t31 = t4 + t23*t30
-    t32 = t4*t30 + t29
-    t33 = t5*t30 + t15
+    t32 = t29 + t4*t30
+    t33 = t15 + t5*t30
     t34 = xp.sqrt(t32**2 + t33**2)
     t35 = t34*xp.where(xp.greater_equal(t32, 0), xp.asarray(1, dtype=dtype), -1)
     t36 = t32 + t35
@@ -765,21 +1605,21 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t41 = 1 + t18
     t42 = 3 + t18
     t43 = xp.sqrt(2*t16 + 2*t17 + 2*t15**2 + t20 + t29**2 + t41**2 + t42**2)
-    t44 = -t24*(t5*t23 + t5*t42 + t4*t15)
+    t44 = -t24*(t5*t23 + t42*t5 + t15*t4)
     t45 = t5 + t23*t44
-    t46 = t4*t44 + t15
-    t47 = t5*t44 + t42
+    t46 = t15 + t4*t44
+    t47 = t42 + t5*t44
     t48 = t37*(t46*t36 + t33*t47)
     t49 = t46 - t36*t48
     t50 = t47 - t33*t48
     t51 = xp.abs(t41)
     t52 = t51*xp.where(xp.greater_equal(t41, 0), xp.asarray(1, dtype=dtype), -1)
-    t53 = t52 + t41
+    t53 = t41 + t52
     t54 = xp.where(xp.greater(t51, 0), 1/(t51*2*t51), 0)
     t55 = mu_dot2 - mu_dot2*t53**2*t54
     t56 = xp.where(xp.not_equal(t52, 0), -t55/t52, 0)
     t57 = xp.abs(t50)
-    t58 = xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)*t57
+    t58 = t57*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
     t59 = t50 + t58
     t60 = xp.where(xp.greater(t57, 0), 1/(t57*2*t57), 0)
     t61 = t40 - t40*t59**2*t60
@@ -789,7 +1629,7 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t65 = t62 - t3*t64 + t1*t63
     t66 = t62 - t2*t64 + t0*t63
     t67 = -t3
-    t68 = t10 + t67
+    t68 = t67 + t10
     t69 = t11*(1 - t2*t68 + t1*t0)
     t70 = t2 + t68*t69
     t71 = t0 - t1*t69
@@ -805,13 +1645,13 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t81 = t80*(t75*t79 + t72*t76)
     t82 = t75 - t79*t81
     t83 = t76 - t72*t81
-    t84 = -t2 + q1 + q2 + q3 + q4 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + t15 + t67
+    t84 = -t2 + q1 + q2 + q3 + q4 + t15 + t67 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping
     t85 = t1*t11
-    t86 = t80*(t72*t12 + t79*t85)
-    t87 = -t79*t86 + t85
+    t86 = t80*(t72*t12 + t85*t79)
+    t87 = t85 - t79*t86
     t88 = t12 - t72*t86
     t89 = xp.abs(t88)
-    t90 = xp.where(xp.greater_equal(t88, 0), xp.asarray(1, dtype=dtype), -1)*t89
+    t90 = t89*xp.where(xp.greater_equal(t88, 0), xp.asarray(1, dtype=dtype), -1)
     t91 = t88 + t90
     t92 = xp.where(xp.greater(t89, 0), 1/(t89*2*t89), 0)
     t93 = t83 - t83*t91**2*t92
@@ -832,6 +1672,298 @@ def velocity_ik(q, mu_dot, damping=0.0):
         xp.broadcast_to(xp.where(t103, xp.where(t99, -t62, t94), 0), batch),  # 3
     ], (4,))
     status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t97 & t98), 2, xp.where(t102, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    return q_dot, status
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 336 operations."""
+    xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (4,)), ("mu_dot", mu_dot, (4,)), ("z", z, (4,)), ("damping", damping, ()))
+    q1 = q[..., 0]
+    q2 = q[..., 1]
+    q3 = q[..., 2]
+    q4 = q[..., 3]
+    mu_dot0 = mu_dot[..., 0]
+    mu_dot1 = mu_dot[..., 1]
+    mu_dot2 = mu_dot[..., 2]
+    mu_dot3 = mu_dot[..., 3]
+    qz1 = z[..., 0]
+    qz2 = z[..., 1]
+    qz3 = z[..., 2]
+    qz4 = z[..., 3]
+    trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = 0.275*c12
+    t1 = 0.325*c1 + t0
+    t2 = 0.275*s12
+    t3 = 0.325*s1 + t2
+    t4 = 0.075625*c12*s12 + t1*t3
+    t5 = t3 + t2
+    t6 = t3**2
+    t7 = t6 + 0.075625*s12**2
+    t8 = t1**2
+    t9 = xp.sqrt(1 + t6 + t8)
+    t10 = xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)*t9
+    t11 = xp.where(xp.greater(t9, 0), 1/(t9*(xp.abs(t3) + t9)), 0)
+    t12 = -1 + t11
+    t13 = t8 + 0.075625*c12**2
+    t14 = xp.sqrt(4 + t7 + t13)
+    t15 = t1 + t0
+    t16 = t4**2
+    t17 = t5**2
+    t18 = damping**2
+    t19 = t7 + t18
+    t20 = t19**2
+    t21 = xp.sqrt(t16 + t17 + t20)
+    t22 = t21*xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)
+    t23 = t19 + t22
+    t24 = xp.where(xp.greater(t21, 0), 1/(t21*(t21 + xp.abs(t19))), 0)
+    t25 = -t24*(-mu_dot0*t23 + mu_dot1*t4 + mu_dot3*t5)
+    t26 = mu_dot0 - t23*t25
+    t27 = mu_dot1 + t4*t25
+    t28 = mu_dot3 + t5*t25
+    t29 = t13 + t18
+    t30 = -t24*(t4*t23 + t29*t4 + t15*t5)
+    t31 = t4 + t23*t30
+    t32 = t29 + t4*t30
+    t33 = t15 + t5*t30
+    t34 = xp.sqrt(t32**2 + t33**2)
+    t35 = t34*xp.where(xp.greater_equal(t32, 0), xp.asarray(1, dtype=dtype), -1)
+    t36 = t32 + t35
+    t37 = xp.where(xp.greater(t34, 0), 1/(t34*(t34 + xp.abs(t32))), 0)
+    t38 = t37*(t27*t36 + t33*t28)
+    t39 = t27 - t36*t38
+    t40 = t28 - t33*t38
+    t41 = 1 + t18
+    t42 = 3 + t18
+    t43 = xp.sqrt(2*t16 + 2*t17 + 2*t15**2 + t20 + t29**2 + t41**2 + t42**2)
+    t44 = -t24*(t5*t23 + t42*t5 + t15*t4)
+    t45 = t5 + t23*t44
+    t46 = t15 + t4*t44
+    t47 = t42 + t5*t44
+    t48 = t37*(t46*t36 + t33*t47)
+    t49 = t46 - t36*t48
+    t50 = t47 - t33*t48
+    t51 = xp.abs(t41)
+    t52 = t51*xp.where(xp.greater_equal(t41, 0), xp.asarray(1, dtype=dtype), -1)
+    t53 = t41 + t52
+    t54 = xp.where(xp.greater(t51, 0), 1/(t51*2*t51), 0)
+    t55 = mu_dot2 - mu_dot2*t53**2*t54
+    t56 = xp.where(xp.not_equal(t52, 0), -t55/t52, 0)
+    t57 = xp.abs(t50)
+    t58 = t57*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
+    t59 = t50 + t58
+    t60 = xp.where(xp.greater(t57, 0), 1/(t57*2*t57), 0)
+    t61 = t40 - t40*t59**2*t60
+    t62 = xp.where(xp.not_equal(t58, 0), -t61/t58, 0)
+    t63 = xp.where(xp.not_equal(t35, 0), -(t39 - t49*t62)/t35, 0)
+    t64 = xp.where(xp.not_equal(t22, 0), -(t26 + t31*t63 + t45*t62)/t22, 0)
+    t65 = t62 - t3*t64 + t1*t63
+    t66 = t62 - t2*t64 + t0*t63
+    t67 = -t3
+    t68 = t67 + t10
+    t69 = t11*(1 - t2*t68 + t1*t0)
+    t70 = t2 + t68*t69
+    t71 = t0 - t1*t69
+    t72 = 1 - t69
+    t73 = t11*(mu_dot3 + mu_dot0*t68 + t1*mu_dot1)
+    t74 = mu_dot0 - t68*t73
+    t75 = mu_dot1 - t1*t73
+    t76 = -t73 + mu_dot3
+    t77 = xp.sqrt(t71**2 + t72**2)
+    t78 = t77*xp.where(xp.greater_equal(t71, 0), xp.asarray(1, dtype=dtype), -1)
+    t79 = t71 + t78
+    t80 = xp.where(xp.greater(t77, 0), 1/(t77*(t77 + xp.abs(t71))), 0)
+    t81 = t80*(t75*t79 + t72*t76)
+    t82 = t75 - t79*t81
+    t83 = t76 - t72*t81
+    t84 = -t2 + q1 + q2 + q3 + q4 + t15 + t67 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + qz1 + qz2 + qz3 + qz4
+    t85 = t1*t11
+    t86 = t80*(t72*t12 + t85*t79)
+    t87 = t85 - t79*t86
+    t88 = t12 - t72*t86
+    t89 = xp.abs(t88)
+    t90 = t89*xp.where(xp.greater_equal(t88, 0), xp.asarray(1, dtype=dtype), -1)
+    t91 = t88 + t90
+    t92 = xp.where(xp.greater(t89, 0), 1/(t89*2*t89), 0)
+    t93 = t83 - t83*t91**2*t92
+    t94 = xp.where(xp.not_equal(t90, 0), -t93/t90, 0)
+    t95 = xp.where(xp.not_equal(t78, 0), -(t82 - t87*t94)/t78, 0)
+    t96 = xp.where(xp.not_equal(t10, 0), -(-(-t70*t95 + t68*t11*t94) + t74)/t10, 0)
+    t97 = xp.isfinite(t84)
+    t98 = xp.greater_equal(damping, 0)
+    t99 = xp.greater(damping, 0)
+    t100 = 1e-12*t43
+    t101 = 1e-12*t14
+    t102 = (t99 & (xp.less_equal(t21, t100) | xp.less_equal(t34, t100) | xp.less_equal(t51, t100) | xp.less_equal(t57, t100))) | (xp.less_equal(damping, 0) & (xp.less_equal(t9, t101) | xp.less_equal(t77, t101) | xp.less_equal(1, t101) | xp.less_equal(t89, t101)))
+    t103 = t97 & t98 & xp.logical_not(t102)
+    q_dot = _stack(xp, [
+        xp.broadcast_to(xp.where(t103, xp.where(t99, t65, t96), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t103, xp.where(t99, t66, t95), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t103, xp.where(t99, -t56, -mu_dot2), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t103, xp.where(t99, -t62, t94), 0), batch),  # 3
+    ], (4,))
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t97 & t98), 2, xp.where(t102, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    return q_dot, status
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 364 operations."""
+    xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (4,)), ("target", target, (4,)), ("target_rate", target_rate, (4,)), ("gain", gain, (4,)), ("z", z, (4,)), ("damping", damping, ()), every=("gain", ))
+    q1 = q[..., 0]
+    q2 = q[..., 1]
+    q3 = q[..., 2]
+    q4 = q[..., 3]
+    mu0 = target[..., 0]
+    mu1 = target[..., 1]
+    mu2 = target[..., 2]
+    mu3 = target[..., 3]
+    mu_dot0 = target_rate[..., 0]
+    mu_dot1 = target_rate[..., 1]
+    mu_dot2 = target_rate[..., 2]
+    mu_dot3 = target_rate[..., 3]
+    gain0 = gain[..., 0]
+    gain1 = gain[..., 1]
+    gain2 = gain[..., 2]
+    gain3 = gain[..., 3]
+    qz1 = z[..., 0]
+    qz2 = z[..., 1]
+    qz3 = z[..., 2]
+    qz4 = z[..., 3]
+    trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
+    c1 = trig[..., 0]
+    s1 = trig[..., 1]
+    c2 = trig[..., 2]
+    s2 = trig[..., 3]
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c4 = trig[..., 6]
+    s4 = trig[..., 7]
+    t0 = 0.387 - q3
+    t1 = c12*c4 + s12*s4
+    t2 = s12*c4 - c12*s4
+    t3 = mu_dot2 + gain2*(-t0 + mu2)
+    t4 = 0.275*c12
+    t5 = 0.325*c1 + t4
+    t6 = mu_dot0 + gain0*(-t5 + mu0)
+    t7 = 0.275*s12
+    t8 = 0.325*s1 + t7
+    t9 = 0.075625*c12*s12 + t5*t8
+    t10 = t8 + t7
+    t11 = t8**2
+    t12 = t11 + 0.075625*s12**2
+    t13 = t5**2
+    t14 = xp.sqrt(1 + t11 + t13)
+    t15 = xp.where(xp.less_equal(t8, 0), xp.asarray(1, dtype=dtype), -1)*t14
+    t16 = xp.where(xp.greater(t14, 0), 1/(t14*(xp.abs(t8) + t14)), 0)
+    t17 = -1 + t16
+    t18 = t13 + 0.075625*c12**2
+    t19 = xp.sqrt(4 + t12 + t18)
+    t20 = t5 + t4
+    t21 = t9**2
+    t22 = t10**2
+    t23 = damping**2
+    t24 = t12 + t23
+    t25 = t24**2
+    t26 = xp.sqrt(t21 + t22 + t25)
+    t27 = t26*xp.where(xp.greater_equal(t24, 0), xp.asarray(1, dtype=dtype), -1)
+    t28 = t24 + t27
+    t29 = xp.where(xp.greater(t26, 0), 1/(t26*(t26 + xp.abs(t24))), 0)
+    t30 = t18 + t23
+    t31 = -t29*(t9*t28 + t30*t9 + t20*t10)
+    t32 = t9 + t28*t31
+    t33 = t30 + t9*t31
+    t34 = t20 + t10*t31
+    t35 = xp.sqrt(t33**2 + t34**2)
+    t36 = t35*xp.where(xp.greater_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)
+    t37 = t33 + t36
+    t38 = xp.where(xp.greater(t35, 0), 1/(t35*(t35 + xp.abs(t33))), 0)
+    t39 = 1 + t23
+    t40 = 3 + t23
+    t41 = xp.sqrt(2*t21 + 2*t22 + 2*t20**2 + t25 + t30**2 + t39**2 + t40**2)
+    t42 = -t29*(t10*t28 + t40*t10 + t20*t9)
+    t43 = t10 + t28*t42
+    t44 = t20 + t9*t42
+    t45 = t40 + t10*t42
+    t46 = t38*(t44*t37 + t34*t45)
+    t47 = t44 - t37*t46
+    t48 = t45 - t34*t46
+    t49 = xp.abs(t39)
+    t50 = t49*xp.where(xp.greater_equal(t39, 0), xp.asarray(1, dtype=dtype), -1)
+    t51 = t39 + t50
+    t52 = xp.where(xp.greater(t49, 0), 1/(t49*2*t49), 0)
+    t53 = t3 - t51**2*t52*t3
+    t54 = xp.where(xp.not_equal(t50, 0), -t53/t50, 0)
+    t55 = xp.abs(t48)
+    t56 = t55*xp.where(xp.greater_equal(t48, 0), xp.asarray(1, dtype=dtype), -1)
+    t57 = t48 + t56
+    t58 = xp.where(xp.greater(t55, 0), 1/(t55*2*t55), 0)
+    t59 = -t8
+    t60 = t59 + t15
+    t61 = t16*(1 - t7*t60 + t5*t4)
+    t62 = t7 + t60*t61
+    t63 = t4 - t5*t61
+    t64 = 1 - t61
+    t65 = xp.sqrt(t63**2 + t64**2)
+    t66 = t65*xp.where(xp.greater_equal(t63, 0), xp.asarray(1, dtype=dtype), -1)
+    t67 = t63 + t66
+    t68 = xp.where(xp.greater(t65, 0), 1/(t65*(t65 + xp.abs(t63))), 0)
+    t69 = mu_dot1 + gain1*(t59 + mu1)
+    t70 = t5*t16
+    t71 = t68*(t64*t17 + t70*t67)
+    t72 = t70 - t67*t71
+    t73 = t17 - t64*t71
+    t74 = xp.abs(t73)
+    t75 = t74*xp.where(xp.greater_equal(t73, 0), xp.asarray(1, dtype=dtype), -1)
+    t76 = t73 + t75
+    t77 = xp.where(xp.greater(t74, 0), 1/(t74*2*t74), 0)
+    t78 = -mu3 + xp.atan2(t2, t1)
+    t79 = mu_dot3 - gain3*(t78 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t78)))
+    t80 = -t29*(-t28*t6 + t9*t69 + t10*t79)
+    t81 = t6 - t28*t80
+    t82 = t69 + t9*t80
+    t83 = t79 + t10*t80
+    t84 = t38*(t37*t82 + t34*t83)
+    t85 = t82 - t37*t84
+    t86 = t83 - t34*t84
+    t87 = t86 - t57**2*t58*t86
+    t88 = xp.where(xp.not_equal(t56, 0), -t87/t56, 0)
+    t89 = xp.where(xp.not_equal(t36, 0), -(t85 - t47*t88)/t36, 0)
+    t90 = xp.where(xp.not_equal(t27, 0), -(t81 + t32*t89 + t43*t88)/t27, 0)
+    t91 = t88 - t8*t90 + t5*t89
+    t92 = t88 - t7*t90 + t4*t89
+    t93 = t16*(t79 + t60*t6 + t5*t69)
+    t94 = t6 - t60*t93
+    t95 = t69 - t5*t93
+    t96 = -t93 + t79
+    t97 = t68*(t67*t95 + t64*t96)
+    t98 = t95 - t67*t97
+    t99 = t96 - t64*t97
+    t100 = t99 - t76**2*t77*t99
+    t101 = xp.where(xp.not_equal(t75, 0), -t100/t75, 0)
+    t102 = xp.where(xp.not_equal(t66, 0), -(t98 - t72*t101)/t66, 0)
+    t103 = xp.where(xp.not_equal(t15, 0), -(-(-t62*t102 + t60*t16*t101) + t94)/t15, 0)
+    t104 = -t7 + q1 + q2 + q3 + q4 + t20 + t59 + damping + qz1 + qz2 + qz3 + qz4 + t6 + t69 + t3 + t79
+    t105 = xp.isfinite(t104)
+    t106 = xp.greater_equal(damping, 0)
+    t107 = xp.greater(damping, 0)
+    t108 = 1e-12*t41
+    t109 = 1e-12*t19
+    t110 = (t107 & (xp.less_equal(t26, t108) | xp.less_equal(t35, t108) | xp.less_equal(t49, t108) | xp.less_equal(t55, t108))) | (xp.less_equal(damping, 0) & (xp.less_equal(t14, t109) | xp.less_equal(t65, t109) | xp.less_equal(1, t109) | xp.less_equal(t74, t109)))
+    t111 = t105 & t106 & xp.logical_not(t110)
+    q_dot = _stack(xp, [
+        xp.broadcast_to(xp.where(t111, xp.where(t107, t91, t103), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t111, xp.where(t107, t92, t102), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t111, xp.where(t107, -t54, -t3), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t111, xp.where(t107, -t88, t101), 0), batch),  # 3
+    ], (4,))
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t105 & t106), 2, xp.where(t110, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -864,7 +1996,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t2 = s12*c4 - c12*s4
     t3 = -t0 + mu2
     t4 = 1 + damping
-    t5 = qs1 + qs2 + qs3 + qs4 + mu3 + mu0 + mu1 + mu2
+    t5 = mu3 + mu0 + mu1 + mu2 + qs1 + qs2 + qs3 + qs4
     t6 = 0.275*c12
     t7 = 0.325*c1 + t6
     t8 = t7**2 + 0.075625*c12**2
@@ -873,7 +2005,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t11 = 0.275*s12
     t12 = 0.325*s1 + t11
     t13 = t12**2 + 0.075625*s12**2
-    t14 = t7*t12 + 0.075625*c12*s12
+    t14 = 0.075625*c12*s12 + t7*t12
     t15 = t12 + t11
     t16 = -t12 + mu1
     t17 = -mu3 + xp.atan2(t2, t1)
@@ -889,7 +2021,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t27 = t16 + t14*t25
     t28 = -t18 + t15*t25
     t29 = damping + t8
-    t30 = -t24*(t15*t9 + t14*t23 + t14*t29)
+    t30 = -t24*(t15*t9 + t14*t23 + t29*t14)
     t31 = t14 + t23*t30
     t32 = t29 + t14*t30
     t33 = t9 + t15*t30
@@ -901,7 +2033,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t39 = t27 - t36*t38
     t40 = t28 - t33*t38
     t41 = 3 + damping
-    t42 = -t24*(t14*t9 + t15*t23 + t15*t41)
+    t42 = -t24*(t14*t9 + t15*t23 + t41*t15)
     t43 = t15 + t23*t42
     t44 = t9 + t14*t42
     t45 = t41 + t15*t42

@@ -367,6 +367,114 @@ def _hessian(q):
     return [H]
 
 
+def _link_poses(q):
+    """World pose of each link's DH frame, base A_1 ... A_i, without the tool (DOF x 4 x 4): 31 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    q3 = q[2]
+    q4 = q[3]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c4 = casadi.cos(q4)
+    s4 = casadi.sin(q4)
+    t0 = 0.387 - q3
+    t1 = c12*c4 + s12*s4
+    t2 = s12*c4 - c12*s4
+    t3 = 0.325*c1
+    t4 = 0.275*c12 + t3
+    t5 = 0.325*s1
+    t6 = 0.275*s12 + t5
+    t7 = -c12
+    T = casadi.SX(16, 4)
+    T[0, 0] = c1
+    T[0, 1] = -s1
+    T[0, 3] = t3
+    T[1, 0] = s1
+    T[1, 1] = c1
+    T[1, 3] = t5
+    T[2, 2] = 1
+    T[2, 3] = 0.387
+    T[3, 3] = 1
+    T[4, 0] = c12
+    T[4, 1] = s12
+    T[4, 3] = t4
+    T[5, 0] = s12
+    T[5, 1] = t7
+    T[5, 3] = t6
+    T[6, 2] = -1
+    T[6, 3] = 0.387
+    T[7, 3] = 1
+    T[8, 0] = c12
+    T[8, 1] = s12
+    T[8, 3] = t4
+    T[9, 0] = s12
+    T[9, 1] = t7
+    T[9, 3] = t6
+    T[10, 2] = -1
+    T[10, 3] = t0
+    T[11, 3] = 1
+    T[12, 0] = t1
+    T[12, 1] = t2
+    T[12, 3] = t4
+    T[13, 0] = t2
+    T[13, 1] = -t1
+    T[13, 3] = t6
+    T[14, 2] = -1
+    T[14, 3] = t0
+    T[15, 3] = 1
+    return [T]
+
+
+def _link_velocities(q, q_dot):
+    """Linear and angular velocity [v; w] of each link frame's origin, world frame, propagated from the base (DOF x 6): 29 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    qd1 = q_dot[0]
+    qd2 = q_dot[1]
+    qd3 = q_dot[2]
+    qd4 = q_dot[3]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = qd1 + qd2
+    t1 = -qd4 + t0
+    t2 = 0.325*c1
+    t3 = 0.275*c12 + t2
+    t4 = -t2 + t3
+    t5 = 0.325*s1
+    t6 = 0.275*s12 + t5
+    t7 = -t5 + t6
+    t8 = t5*qd1
+    t9 = t8 + t0*t7
+    t10 = t2*qd1
+    t11 = t10 + t0*t4
+    t12 = -t9
+    t13 = -qd3
+    V = casadi.SX(4, 6)
+    V[0, 0] = -t8
+    V[0, 1] = t10
+    V[0, 5] = qd1
+    V[1, 0] = t12
+    V[1, 1] = t11
+    V[1, 5] = t0
+    V[2, 0] = t12
+    V[2, 1] = t11
+    V[2, 2] = t13
+    V[2, 5] = t0
+    V[3, 0] = t12
+    V[3, 1] = t11
+    V[3, 2] = t13
+    V[3, 5] = t1
+    return [V]
+
+
 def _singularity_factors(q):
     """Factors of det(Js): the robot is singular where one is 0: 1 operations."""
     q2 = q[1]
@@ -415,6 +523,679 @@ def _jacobian_det(q):
     return [d]
 
 
+def _manipulability_gradient(q):
+    """D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): 101 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = 0.275*c12
+    t1 = 0.325*c1 + t0
+    t2 = 0.275*s12
+    t3 = 0.325*s1 + t2
+    t4 = 0.075625*s12**2
+    t5 = t3**2 + t4
+    t6 = casadi.sqrt(4 + t1**2 + t5 + 0.075625*c12**2)
+    t7 = casadi.sqrt(t5)
+    t8 = t7*casadi.if_else((t3 <= 0), 1, -1)
+    t9 = -t3 + t8
+    t10 = casadi.if_else((t7 > 0), 1/(t7*(t7 + casadi.fabs(t3))), 0)
+    t11 = t10*(t1*t9 - 0.075625*c12*s12)
+    t12 = t1 - t9*t11
+    t13 = t0 + t2*t11
+    t14 = 1 - t9**2*t10
+    t15 = casadi.fabs(t13)
+    t16 = t15*casadi.if_else((t13 >= 0), 1, -1)
+    t17 = t13 + t16
+    t18 = casadi.if_else((t15 > 0), 1/(t15*2*t15), 0)
+    t19 = 1 - t17**2*t18
+    t20 = t10*t19
+    t21 = t4*t20
+    t22 = -t21 + t19
+    t23 = t2*t9
+    t24 = t16*t14 + t20*t12*t23
+    t25 = t12*t22 + t10*t16*t23
+    t26 = 1e-12*t6
+    t27 = casadi.if_else(casadi.logic_or(casadi.logic_or((t7 <= t26), (t15 <= t26)), (1 <= t26)), 0, casadi.if_else((t8 < 0), 1, casadi.if_else((t8 > 0), -1, 0))*casadi.if_else((t16 < 0), 1, casadi.if_else((t16 > 0), -1, 0)))
+    t28 = t2*t8
+    t29 = t0*t25 + t22*t28
+    t30 = t27*(t1*t24 + t3*t20*t9*t28 + t29)
+    t31 = t27*(t29 + t0*t24 + t8*t9*t21)
+    dw = casadi.SX(4, 1)
+    dw[0, 0] = t30
+    dw[1, 0] = t31
+    return [dw]
+
+
+def _velocity_ellipsoid(q):
+    """Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: 310 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = 0.275*c12
+    t1 = 0.325*c1 + t0
+    t2 = 0.275*s12
+    t3 = 0.325*s1 + t2
+    t4 = casadi.sqrt(t3**2 + 0.075625*s12**2)
+    t5 = t4*casadi.if_else((t3 <= 0), 1, -1)
+    t6 = -t3 + t5
+    t7 = casadi.if_else((t4 > 0), 1/(t4*(t4 + casadi.fabs(t3))), 0)
+    t8 = t7*(t1*t6 - 0.075625*c12*s12)
+    t9 = t1 - t6*t8
+    t10 = t0 + t2*t8
+    t11 = casadi.fabs(t10)
+    t12 = t11*casadi.if_else((t10 >= 0), 1, -1)
+    t13 = t5**2
+    t14 = t12**2
+    t15 = t14 + t9**2
+    t16 = t5*t9
+    t17 = (t16 != 0)
+    t18 = 0.5*(-t13 + t15)/casadi.if_else(t17, -t16, 1)
+    t19 = casadi.if_else(t17, casadi.if_else((t18 >= 0), 1, -1)/(casadi.fabs(t18) + casadi.sqrt(1 + t18**2)), 0)
+    t20 = 1/casadi.sqrt(1 + t19**2)
+    t21 = t16*t19
+    t22 = t21 + t13
+    t23 = -t21 + t15
+    t24 = t5*t20
+    t25 = t9*t20
+    t26 = t24 + t25*t19
+    t27 = t25 - t24*t19
+    t28 = t26*t27 + t14*t19*t20**2
+    t29 = (t28 != 0)
+    t30 = 0.5*(-t22 + t23)/casadi.if_else(t29, -t28, 1)
+    t31 = casadi.if_else(t29, casadi.if_else((t30 >= 0), 1, -1)/(casadi.fabs(t30) + casadi.sqrt(1 + t30**2)), 0)
+    t32 = 1/casadi.sqrt(1 + t31**2)
+    t33 = t28*t31
+    t34 = t33 + t22
+    t35 = -t33 + t23
+    t36 = t26*t32
+    t37 = t27*t32
+    t38 = t36 + t31*t37
+    t39 = t37 - t36*t31
+    t40 = t20*t32
+    t41 = t12*t40
+    t42 = t19*t41
+    t43 = t42 + t31*t41
+    t44 = -t41 + t31*t42
+    t45 = -t38*t39 + t43*t44
+    t46 = t19*t40
+    t47 = t40 - t31*t46
+    t48 = t46 + t31*t40
+    t49 = (t45 != 0)
+    t50 = 0.5*(-t34 + t35)/casadi.if_else(t49, t45, 1)
+    t51 = casadi.if_else(t49, casadi.if_else((t50 >= 0), 1, -1)/(casadi.fabs(t50) + casadi.sqrt(1 + t50**2)), 0)
+    t52 = 1/casadi.sqrt(1 + t51**2)
+    t53 = t45*t51
+    t54 = -t53 + t34
+    t55 = t35 + t53
+    t56 = t38*t52
+    t57 = t39*t52
+    t58 = t56 + t51*t57
+    t59 = t57 - t51*t56
+    t60 = t43*t52
+    t61 = t44*t52
+    t62 = t60 - t51*t61
+    t63 = t61 + t51*t60
+    t64 = -t58*t59 + t62*t63
+    t65 = t47*t52
+    t66 = t48*t52
+    t67 = t65 - t51*t66
+    t68 = t66 + t51*t65
+    t69 = (t64 != 0)
+    t70 = 0.5*(-t54 + t55)/casadi.if_else(t69, t64, 1)
+    t71 = casadi.if_else(t69, casadi.if_else((t70 >= 0), 1, -1)/(casadi.fabs(t70) + casadi.sqrt(1 + t70**2)), 0)
+    t72 = 1/casadi.sqrt(1 + t71**2)
+    t73 = t64*t71
+    t74 = -t73 + t54
+    t75 = t55 + t73
+    t76 = t58*t72
+    t77 = t59*t72
+    t78 = t76 + t71*t77
+    t79 = t77 - t71*t76
+    t80 = t62*t72
+    t81 = t63*t72
+    t82 = t80 - t71*t81
+    t83 = t81 + t71*t80
+    t84 = -t78*t79 + t82*t83
+    t85 = t67*t72
+    t86 = t68*t72
+    t87 = t85 - t71*t86
+    t88 = t86 + t71*t85
+    t89 = (t84 != 0)
+    t90 = 0.5*(-t74 + t75)/casadi.if_else(t89, t84, 1)
+    t91 = casadi.if_else(t89, casadi.if_else((t90 >= 0), 1, -1)/(casadi.fabs(t90) + casadi.sqrt(1 + t90**2)), 0)
+    t92 = 1/casadi.sqrt(1 + t91**2)
+    t93 = t78*t92
+    t94 = t79*t92
+    t95 = t93 + t91*t94
+    t96 = t94 - t91*t93
+    t97 = t82*t92
+    t98 = t83*t92
+    t99 = t97 - t91*t98
+    t100 = t98 + t91*t97
+    t101 = casadi.sqrt(t95**2 + t99**2)
+    t102 = casadi.sqrt(t96**2 + t100**2)
+    t103 = t87*t92
+    t104 = t88*t92
+    t105 = t103 - t91*t104
+    t106 = t104 + t91*t103
+    t107 = (t101 < t102)
+    t108 = casadi.if_else(t107, t102, t101)
+    t109 = casadi.if_else(t107, t101, t102)
+    t110 = casadi.if_else(t107, t106, t105)
+    t111 = casadi.if_else(t107, t105, t106)
+    t112 = -t106
+    t113 = casadi.if_else(t107, t105, t112)
+    t114 = casadi.if_else(t107, t112, t105)
+    t115 = (t109 < 1)
+    t116 = casadi.if_else(t115, 1, t109)
+    t117 = casadi.if_else(t115, t109, 1)
+    t118 = casadi.if_else(t115, 0, t111)
+    t119 = casadi.if_else(t115, 0, t114)
+    t120 = casadi.if_else(t115, 1, 0)
+    t121 = casadi.if_else(t115, t111, 0)
+    t122 = casadi.if_else(t115, t114, 0)
+    t123 = casadi.if_else(t115, 0, 1)
+    t124 = (t108 < t116)
+    t125 = casadi.if_else(t124, t116, t108)
+    t126 = casadi.if_else(t124, t108, t116)
+    t127 = casadi.if_else(t124, t118, t110)
+    t128 = casadi.if_else(t124, t119, t113)
+    t129 = casadi.if_else(t124, t120, 0)
+    t130 = casadi.if_else(t124, t110, t118)
+    t131 = casadi.if_else(t124, t113, t119)
+    t132 = casadi.if_else(t124, 0, t120)
+    t133 = t127*(t123*t131 - t122*t132) - t128*(t123*t130 - t121*t132) + t129*(t122*t130 - t121*t131)
+    t134 = casadi.if_else((t133 < 0), -1, 1)
+    t135 = t121*t134
+    t136 = t122*t134
+    t137 = t123*t134
+    U_v = casadi.SX(3, 3)
+    U_v[0, 0] = t127
+    U_v[0, 1] = t130
+    U_v[0, 2] = t135
+    U_v[1, 0] = t128
+    U_v[1, 1] = t131
+    U_v[1, 2] = t136
+    U_v[2, 0] = t129
+    U_v[2, 1] = t132
+    U_v[2, 2] = t137
+    s_v = casadi.SX(3, 1)
+    s_v[0, 0] = t125
+    s_v[1, 0] = t126
+    s_v[2, 0] = t117
+    U_w = casadi.SX(3, 3)
+    U_w[0, 1] = 1
+    U_w[1, 2] = 1
+    U_w[2, 0] = 1
+    s_w = casadi.SX(3, 1)
+    s_w[0, 0] = 1.7320508075688772
+    return [U_v, s_v, U_w, s_w]
+
+
+def _condition_number(q):
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 1048 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = 0.275*c12 + 0.325*c1
+    t1 = 0.275*s12 + 0.325*s1
+    t2 = casadi.sqrt(3.5432525951557095*t1**2 + 0.26795847750865054*s12**2)
+    t3 = 1.8823529411764706*t1
+    t4 = casadi.if_else((t2 > 0), 1/(t2*(t2 + casadi.fabs(t3))), 0)
+    t5 = -t3
+    t6 = t2*casadi.if_else((t5 >= 0), 1, -1)
+    t7 = t5 + t6
+    t8 = 1.8823529411764706*t0
+    t9 = t4*(-0.26795847750865054*c12*s12 + t8*t7)
+    t10 = t8 - t7*t9
+    t11 = 0.5176470588235293*s12
+    t12 = 0.5176470588235293*c12 + t11*t9
+    t13 = t4*(-t11 + t7)
+    t14 = 1 - t7*t13
+    t15 = 1 + t11*t13
+    t16 = casadi.fabs(t12)
+    t17 = t16*casadi.if_else((t12 >= 0), 1, -1)
+    t18 = t12 + t17
+    t19 = casadi.if_else((t16 > 0), 1/(t16*2*t16), 0)
+    t20 = t15 - t15*t18**2*t19
+    t21 = t17**2 + t20**2
+    t22 = -t10*t17 + t14*t20
+    t23 = t6**2
+    t24 = t23 + t10**2 + t14**2
+    t25 = (t22 != 0)
+    t26 = 0.5*(-t24 + t21)/casadi.if_else(t25, t22, 1)
+    t27 = casadi.if_else(t25, casadi.if_else((t26 >= 0), 1, -1)/(casadi.fabs(t26) + casadi.sqrt(1 + t26**2)), 0)
+    t28 = 1/casadi.sqrt(1 + t27**2)
+    t29 = t22*t27
+    t30 = -t29 + t24
+    t31 = t29 + t21
+    t32 = t10*t28
+    t33 = t17*t28
+    t34 = t32 + t33*t27
+    t35 = -t33 + t32*t27
+    t36 = t14*t28
+    t37 = t20*t28
+    t38 = t36 - t37*t27
+    t39 = t37 + t36*t27
+    t40 = (t38 != 0)
+    t41 = 0.5*(1.0 - t30)/casadi.if_else(t40, t38, 1)
+    t42 = casadi.if_else(t40, casadi.if_else((t41 >= 0), 1, -1)/(casadi.fabs(t41) + casadi.sqrt(1 + t41**2)), 0)
+    t43 = 1/casadi.sqrt(1 + t42**2)
+    t44 = t38*t42
+    t45 = -t44 + t30
+    t46 = 1.0 + t44
+    t47 = t43 + t44*t43
+    t48 = t42*t43
+    t49 = -t48 + t38*t43
+    t50 = t48*t34
+    t51 = t39*t47 + t23*t48*t27*t28**2 + t50*t35
+    t52 = (t51 != 0)
+    t53 = 0.5*(-t31 + t46)/casadi.if_else(t52, t51, 1)
+    t54 = casadi.if_else(t52, casadi.if_else((t53 >= 0), 1, -1)/(casadi.fabs(t53) + casadi.sqrt(1 + t53**2)), 0)
+    t55 = 1/casadi.sqrt(1 + t54**2)
+    t56 = t51*t54
+    t57 = -t56 + t31
+    t58 = t56 + t46
+    t59 = t6*t28
+    t60 = t59*t55
+    t61 = t60*t27
+    t62 = t48*t60
+    t63 = -t61 + t62*t54
+    t64 = t62 + t61*t54
+    t65 = t35*t55
+    t66 = t50*t55
+    t67 = t65 - t66*t54
+    t68 = t66 + t65*t54
+    t69 = t39*t55
+    t70 = t47*t55
+    t71 = t69 - t70*t54
+    t72 = t70 + t69*t54
+    t73 = t59*t43
+    t74 = t34*t43
+    t75 = t49*t71 - t73*t63 + t74*t67
+    t76 = (t75 != 0)
+    t77 = 0.5*(-t45 + t57)/casadi.if_else(t76, t75, 1)
+    t78 = casadi.if_else(t76, casadi.if_else((t77 >= 0), 1, -1)/(casadi.fabs(t77) + casadi.sqrt(1 + t77**2)), 0)
+    t79 = 1/casadi.sqrt(1 + t78**2)
+    t80 = t75*t78
+    t81 = -t80 + t45
+    t82 = t80 + t57
+    t83 = t73*t79
+    t84 = t63*t79
+    t85 = t83 + t84*t78
+    t86 = t84 - t83*t78
+    t87 = t74*t79
+    t88 = t67*t79
+    t89 = t87 - t88*t78
+    t90 = t88 + t87*t78
+    t91 = t49*t79
+    t92 = t71*t79
+    t93 = t91 - t92*t78
+    t94 = t92 + t91*t78
+    t95 = t64*t85 + t68*t89 + t72*t93
+    t96 = (t95 != 0)
+    t97 = 0.5*(-t81 + t58)/casadi.if_else(t96, t95, 1)
+    t98 = casadi.if_else(t96, casadi.if_else((t97 >= 0), 1, -1)/(casadi.fabs(t97) + casadi.sqrt(1 + t97**2)), 0)
+    t99 = 1/casadi.sqrt(1 + t98**2)
+    t100 = t95*t98
+    t101 = -t100 + t81
+    t102 = t100 + t58
+    t103 = t85*t99
+    t104 = t64*t99
+    t105 = -t103 + t104*t98
+    t106 = t104 + t103*t98
+    t107 = t89*t99
+    t108 = t68*t99
+    t109 = t107 - t108*t98
+    t110 = t108 + t107*t98
+    t111 = t93*t99
+    t112 = t72*t99
+    t113 = t111 - t112*t98
+    t114 = t112 + t111*t98
+    t115 = -t86*t106 + t90*t110 + t94*t114
+    t116 = (t115 != 0)
+    t117 = 0.5*(-t82 + t102)/casadi.if_else(t116, t115, 1)
+    t118 = casadi.if_else(t116, casadi.if_else((t117 >= 0), 1, -1)/(casadi.fabs(t117) + casadi.sqrt(1 + t117**2)), 0)
+    t119 = 1/casadi.sqrt(1 + t118**2)
+    t120 = t115*t118
+    t121 = -t120 + t82
+    t122 = t102 + t120
+    t123 = t86*t119
+    t124 = t106*t119
+    t125 = t123 + t118*t124
+    t126 = -t124 + t118*t123
+    t127 = t90*t119
+    t128 = t110*t119
+    t129 = t127 - t118*t128
+    t130 = t128 + t118*t127
+    t131 = t94*t119
+    t132 = t114*t119
+    t133 = t131 - t118*t132
+    t134 = t132 + t118*t131
+    t135 = t105*t125 + t109*t129 + t113*t133
+    t136 = (t135 != 0)
+    t137 = 0.5*(-t101 + t121)/casadi.if_else(t136, t135, 1)
+    t138 = casadi.if_else(t136, casadi.if_else((t137 >= 0), 1, -1)/(casadi.fabs(t137) + casadi.sqrt(1 + t137**2)), 0)
+    t139 = 1/casadi.sqrt(1 + t138**2)
+    t140 = t135*t138
+    t141 = -t140 + t101
+    t142 = t121 + t140
+    t143 = t105*t139
+    t144 = t125*t139
+    t145 = t143 - t138*t144
+    t146 = t144 + t138*t143
+    t147 = t109*t139
+    t148 = t129*t139
+    t149 = t147 - t138*t148
+    t150 = t148 + t138*t147
+    t151 = t113*t139
+    t152 = t133*t139
+    t153 = t151 - t138*t152
+    t154 = t152 + t138*t151
+    t155 = t126*t145 + t130*t149 + t134*t153
+    t156 = (t155 != 0)
+    t157 = 0.5*(-t141 + t122)/casadi.if_else(t156, t155, 1)
+    t158 = casadi.if_else(t156, casadi.if_else((t157 >= 0), 1, -1)/(casadi.fabs(t157) + casadi.sqrt(1 + t157**2)), 0)
+    t159 = 1/casadi.sqrt(1 + t158**2)
+    t160 = t155*t158
+    t161 = -t160 + t141
+    t162 = t122 + t160
+    t163 = t145*t159
+    t164 = t126*t159
+    t165 = t163 - t158*t164
+    t166 = t164 + t158*t163
+    t167 = t149*t159
+    t168 = t130*t159
+    t169 = t167 - t158*t168
+    t170 = t168 + t158*t167
+    t171 = t153*t159
+    t172 = t134*t159
+    t173 = t171 - t158*t172
+    t174 = t172 + t158*t171
+    t175 = t146*t166 + t150*t170 + t154*t174
+    t176 = (t175 != 0)
+    t177 = 0.5*(-t142 + t162)/casadi.if_else(t176, t175, 1)
+    t178 = casadi.if_else(t176, casadi.if_else((t177 >= 0), 1, -1)/(casadi.fabs(t177) + casadi.sqrt(1 + t177**2)), 0)
+    t179 = 1/casadi.sqrt(1 + t178**2)
+    t180 = t175*t178
+    t181 = -t180 + t142
+    t182 = t162 + t180
+    t183 = t146*t179
+    t184 = t166*t179
+    t185 = t183 - t178*t184
+    t186 = t184 + t178*t183
+    t187 = t150*t179
+    t188 = t170*t179
+    t189 = t187 - t178*t188
+    t190 = t188 + t178*t187
+    t191 = t154*t179
+    t192 = t174*t179
+    t193 = t191 - t178*t192
+    t194 = t192 + t178*t191
+    t195 = t165*t185 + t169*t189 + t173*t193
+    t196 = (t195 != 0)
+    t197 = 0.5*(-t161 + t181)/casadi.if_else(t196, t195, 1)
+    t198 = casadi.if_else(t196, casadi.if_else((t197 >= 0), 1, -1)/(casadi.fabs(t197) + casadi.sqrt(1 + t197**2)), 0)
+    t199 = 1/casadi.sqrt(1 + t198**2)
+    t200 = t195*t198
+    t201 = -t200 + t161
+    t202 = t181 + t200
+    t203 = t165*t199
+    t204 = t185*t199
+    t205 = t203 - t198*t204
+    t206 = t204 + t198*t203
+    t207 = t169*t199
+    t208 = t189*t199
+    t209 = t207 - t198*t208
+    t210 = t208 + t198*t207
+    t211 = t173*t199
+    t212 = t193*t199
+    t213 = t211 - t198*t212
+    t214 = t212 + t198*t211
+    t215 = t186*t205 + t190*t209 + t194*t213
+    t216 = (t215 != 0)
+    t217 = 0.5*(-t201 + t182)/casadi.if_else(t216, t215, 1)
+    t218 = casadi.if_else(t216, casadi.if_else((t217 >= 0), 1, -1)/(casadi.fabs(t217) + casadi.sqrt(1 + t217**2)), 0)
+    t219 = 1/casadi.sqrt(1 + t218**2)
+    t220 = t215*t218
+    t221 = -t220 + t201
+    t222 = t182 + t220
+    t223 = t205*t219
+    t224 = t186*t219
+    t225 = t223 - t218*t224
+    t226 = t224 + t218*t223
+    t227 = t209*t219
+    t228 = t190*t219
+    t229 = t227 - t218*t228
+    t230 = t228 + t218*t227
+    t231 = t213*t219
+    t232 = t194*t219
+    t233 = t231 - t218*t232
+    t234 = t232 + t218*t231
+    t235 = t206*t226 + t210*t230 + t214*t234
+    t236 = (t235 != 0)
+    t237 = 0.5*(-t202 + t222)/casadi.if_else(t236, t235, 1)
+    t238 = casadi.if_else(t236, casadi.if_else((t237 >= 0), 1, -1)/(casadi.fabs(t237) + casadi.sqrt(1 + t237**2)), 0)
+    t239 = 1/casadi.sqrt(1 + t238**2)
+    t240 = t235*t238
+    t241 = -t240 + t202
+    t242 = t222 + t240
+    t243 = t206*t239
+    t244 = t226*t239
+    t245 = t243 - t238*t244
+    t246 = t244 + t238*t243
+    t247 = t210*t239
+    t248 = t230*t239
+    t249 = t247 - t238*t248
+    t250 = t248 + t238*t247
+    t251 = t214*t239
+    t252 = t234*t239
+    t253 = t251 - t238*t252
+    t254 = t252 + t238*t251
+    t255 = t225*t245 + t229*t249 + t233*t253
+    t256 = (t255 != 0)
+    t257 = 0.5*(-t221 + t241)/casadi.if_else(t256, t255, 1)
+    t258 = casadi.if_else(t256, casadi.if_else((t257 >= 0), 1, -1)/(casadi.fabs(t257) + casadi.sqrt(1 + t257**2)), 0)
+    t259 = 1/casadi.sqrt(1 + t258**2)
+    t260 = t255*t258
+    t261 = -t260 + t221
+    t262 = t241 + t260
+    t263 = t225*t259
+    t264 = t245*t259
+    t265 = t263 - t258*t264
+    t266 = t264 + t258*t263
+    t267 = t229*t259
+    t268 = t249*t259
+    t269 = t267 - t258*t268
+    t270 = t268 + t258*t267
+    t271 = t233*t259
+    t272 = t253*t259
+    t273 = t271 - t258*t272
+    t274 = t272 + t258*t271
+    t275 = t246*t265 + t250*t269 + t254*t273
+    t276 = (t275 != 0)
+    t277 = 0.5*(-t261 + t242)/casadi.if_else(t276, t275, 1)
+    t278 = casadi.if_else(t276, casadi.if_else((t277 >= 0), 1, -1)/(casadi.fabs(t277) + casadi.sqrt(1 + t277**2)), 0)
+    t279 = 1/casadi.sqrt(1 + t278**2)
+    t280 = t275*t278
+    t281 = -t280 + t261
+    t282 = t242 + t280
+    t283 = t265*t279
+    t284 = t246*t279
+    t285 = t283 - t278*t284
+    t286 = t284 + t278*t283
+    t287 = t269*t279
+    t288 = t250*t279
+    t289 = t287 - t278*t288
+    t290 = t288 + t278*t287
+    t291 = t273*t279
+    t292 = t254*t279
+    t293 = t291 - t278*t292
+    t294 = t292 + t278*t291
+    t295 = t266*t286 + t270*t290 + t274*t294
+    t296 = (t295 != 0)
+    t297 = 0.5*(-t262 + t282)/casadi.if_else(t296, t295, 1)
+    t298 = casadi.if_else(t296, casadi.if_else((t297 >= 0), 1, -1)/(casadi.fabs(t297) + casadi.sqrt(1 + t297**2)), 0)
+    t299 = 1/casadi.sqrt(1 + t298**2)
+    t300 = t295*t298
+    t301 = -t300 + t262
+    t302 = t282 + t300
+    t303 = t266*t299
+    t304 = t286*t299
+    t305 = t303 - t298*t304
+    t306 = t304 + t298*t303
+    t307 = t270*t299
+    t308 = t290*t299
+    t309 = t307 - t298*t308
+    t310 = t308 + t298*t307
+    t311 = t274*t299
+    t312 = t294*t299
+    t313 = t311 - t298*t312
+    t314 = t312 + t298*t311
+    t315 = t285*t305 + t289*t309 + t293*t313
+    t316 = (t315 != 0)
+    t317 = 0.5*(-t281 + t301)/casadi.if_else(t316, t315, 1)
+    t318 = casadi.if_else(t316, casadi.if_else((t317 >= 0), 1, -1)/(casadi.fabs(t317) + casadi.sqrt(1 + t317**2)), 0)
+    t319 = 1/casadi.sqrt(1 + t318**2)
+    t320 = t315*t318
+    t321 = -t320 + t281
+    t322 = t301 + t320
+    t323 = t285*t319
+    t324 = t305*t319
+    t325 = t323 - t318*t324
+    t326 = t324 + t318*t323
+    t327 = t289*t319
+    t328 = t309*t319
+    t329 = t327 - t318*t328
+    t330 = t328 + t318*t327
+    t331 = t293*t319
+    t332 = t313*t319
+    t333 = t331 - t318*t332
+    t334 = t332 + t318*t331
+    t335 = t306*t325 + t310*t329 + t314*t333
+    t336 = (t335 != 0)
+    t337 = 0.5*(-t321 + t302)/casadi.if_else(t336, t335, 1)
+    t338 = casadi.if_else(t336, casadi.if_else((t337 >= 0), 1, -1)/(casadi.fabs(t337) + casadi.sqrt(1 + t337**2)), 0)
+    t339 = 1/casadi.sqrt(1 + t338**2)
+    t340 = t335*t338
+    t341 = -t340 + t321
+    t342 = t302 + t340
+    t343 = t325*t339
+    t344 = t306*t339
+    t345 = t343 - t338*t344
+    t346 = t344 + t338*t343
+    t347 = t329*t339
+    t348 = t310*t339
+    t349 = t347 - t338*t348
+    t350 = t348 + t338*t347
+    t351 = t333*t339
+    t352 = t314*t339
+    t353 = t351 - t338*t352
+    t354 = t352 + t338*t351
+    t355 = t326*t346 + t330*t350 + t334*t354
+    t356 = (t355 != 0)
+    t357 = 0.5*(-t322 + t342)/casadi.if_else(t356, t355, 1)
+    t358 = casadi.if_else(t356, casadi.if_else((t357 >= 0), 1, -1)/(casadi.fabs(t357) + casadi.sqrt(1 + t357**2)), 0)
+    t359 = 1/casadi.sqrt(1 + t358**2)
+    t360 = t355*t358
+    t361 = -t360 + t322
+    t362 = t342 + t360
+    t363 = t326*t359
+    t364 = t346*t359
+    t365 = t363 - t358*t364
+    t366 = t364 + t358*t363
+    t367 = t330*t359
+    t368 = t350*t359
+    t369 = t367 - t358*t368
+    t370 = t368 + t358*t367
+    t371 = t334*t359
+    t372 = t354*t359
+    t373 = t371 - t358*t372
+    t374 = t372 + t358*t371
+    t375 = t345*t365 + t349*t369 + t353*t373
+    t376 = (t375 != 0)
+    t377 = 0.5*(-t341 + t361)/casadi.if_else(t376, t375, 1)
+    t378 = casadi.if_else(t376, casadi.if_else((t377 >= 0), 1, -1)/(casadi.fabs(t377) + casadi.sqrt(1 + t377**2)), 0)
+    t379 = 1/casadi.sqrt(1 + t378**2)
+    t380 = t375*t378
+    t381 = -t380 + t341
+    t382 = t361 + t380
+    t383 = t345*t379
+    t384 = t365*t379
+    t385 = t383 - t378*t384
+    t386 = t384 + t378*t383
+    t387 = t349*t379
+    t388 = t369*t379
+    t389 = t387 - t378*t388
+    t390 = t388 + t378*t387
+    t391 = t353*t379
+    t392 = t373*t379
+    t393 = t391 - t378*t392
+    t394 = t392 + t378*t391
+    t395 = t366*t385 + t370*t389 + t374*t393
+    t396 = (t395 != 0)
+    t397 = 0.5*(-t381 + t362)/casadi.if_else(t396, t395, 1)
+    t398 = casadi.if_else(t396, casadi.if_else((t397 >= 0), 1, -1)/(casadi.fabs(t397) + casadi.sqrt(1 + t397**2)), 0)
+    t399 = 1/casadi.sqrt(1 + t398**2)
+    t400 = t362 + t395*t398
+    t401 = t385*t399
+    t402 = t366*t399
+    t403 = t401 - t398*t402
+    t404 = t402 + t398*t401
+    t405 = t389*t399
+    t406 = t370*t399
+    t407 = t405 - t398*t406
+    t408 = t406 + t398*t405
+    t409 = t393*t399
+    t410 = t374*t399
+    t411 = t409 - t398*t410
+    t412 = t410 + t398*t409
+    t413 = t386*t404 + t390*t408 + t394*t412
+    t414 = casadi.sqrt(t403**2 + t407**2 + t411**2)
+    t415 = (t413 != 0)
+    t416 = 0.5*(-t382 + t400)/casadi.if_else(t415, t413, 1)
+    t417 = casadi.if_else(t415, casadi.if_else((t416 >= 0), 1, -1)/(casadi.fabs(t416) + casadi.sqrt(1 + t416**2)), 0)
+    t418 = 1/casadi.sqrt(1 + t417**2)
+    t419 = t386*t418
+    t420 = t404*t418
+    t421 = t419 - t417*t420
+    t422 = t420 + t417*t419
+    t423 = t390*t418
+    t424 = t408*t418
+    t425 = t423 - t417*t424
+    t426 = t424 + t417*t423
+    t427 = t394*t418
+    t428 = t412*t418
+    t429 = t427 - t417*t428
+    t430 = t428 + t417*t427
+    t431 = casadi.sqrt(t421**2 + t425**2 + t429**2)
+    t432 = casadi.sqrt(t422**2 + t426**2 + t430**2)
+    t433 = casadi.if_else((t431 > t414), t431, t414)
+    t434 = casadi.if_else((t431 < t414), t431, t414)
+    t435 = casadi.if_else((1.8823529411764706 > t433), 1.8823529411764706, t433)
+    t436 = casadi.if_else((1.8823529411764706 < t434), 1.8823529411764706, t434)
+    t437 = casadi.if_else((t432 > t435), t432, t435)
+    t438 = casadi.if_else((t432 < t436), t432, t436)
+    kappa = casadi.SX(1, 1)
+    kappa[0, 0] = casadi.if_else((t437 > 0), t437, 1)/casadi.if_else((t438 <= 1e-12*t437), 0, t438)
+    return [kappa]
+
+
 def _velocity_ik(q, mu_dot, damping):
     """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 332 operations."""
     q1 = q[0]
@@ -435,16 +1216,16 @@ def _velocity_ik(q, mu_dot, damping):
     t1 = 0.325*c1 + t0
     t2 = 0.275*s12
     t3 = 0.325*s1 + t2
-    t4 = t1*t3 + 0.075625*c12*s12
+    t4 = 0.075625*c12*s12 + t1*t3
     t5 = t3 + t2
     t6 = t3**2
     t7 = t6 + 0.075625*s12**2
     t8 = t1**2
     t9 = casadi.sqrt(1 + t6 + t8)
-    t10 = t9*casadi.if_else((t3 <= 0), 1, -1)
-    t11 = casadi.if_else((t9 > 0), 1/(t9*(t9 + casadi.fabs(t3))), 0)
+    t10 = casadi.if_else((t3 <= 0), 1, -1)*t9
+    t11 = casadi.if_else((t9 > 0), 1/(t9*(casadi.fabs(t3) + t9)), 0)
     t12 = -1 + t11
-    t13 = 0.075625*c12**2 + t8
+    t13 = t8 + 0.075625*c12**2
     t14 = casadi.sqrt(4 + t7 + t13)
     t15 = t1 + t0
     t16 = t4**2
@@ -454,17 +1235,17 @@ def _velocity_ik(q, mu_dot, damping):
     t20 = t19**2
     t21 = casadi.sqrt(t16 + t17 + t20)
     t22 = t21*casadi.if_else((t19 >= 0), 1, -1)
-    t23 = t22 + t19
+    t23 = t19 + t22
     t24 = casadi.if_else((t21 > 0), 1/(t21*(t21 + casadi.fabs(t19))), 0)
     t25 = -t24*(-mu_dot0*t23 + mu_dot1*t4 + mu_dot3*t5)
     t26 = mu_dot0 - t23*t25
     t27 = mu_dot1 + t4*t25
     t28 = mu_dot3 + t5*t25
     t29 = t13 + t18
-    t30 = -t24*(t4*t23 + t4*t29 + t5*t15)
+    t30 = -t24*(t4*t23 + t29*t4 + t15*t5)
     t31 = t4 + t23*t30
-    t32 = t4*t30 + t29
-    t33 = t5*t30 + t15
+    t32 = t29 + t4*t30
+    t33 = t15 + t5*t30
     t34 = casadi.sqrt(t32**2 + t33**2)
     t35 = t34*casadi.if_else((t32 >= 0), 1, -1)
     t36 = t32 + t35
@@ -475,21 +1256,21 @@ def _velocity_ik(q, mu_dot, damping):
     t41 = 1 + t18
     t42 = 3 + t18
     t43 = casadi.sqrt(2*t16 + 2*t17 + 2*t15**2 + t20 + t29**2 + t41**2 + t42**2)
-    t44 = -t24*(t5*t23 + t5*t42 + t4*t15)
+    t44 = -t24*(t5*t23 + t42*t5 + t15*t4)
     t45 = t5 + t23*t44
-    t46 = t4*t44 + t15
-    t47 = t5*t44 + t42
+    t46 = t15 + t4*t44
+    t47 = t42 + t5*t44
     t48 = t37*(t46*t36 + t33*t47)
     t49 = t46 - t36*t48
     t50 = t47 - t33*t48
     t51 = casadi.fabs(t41)
     t52 = t51*casadi.if_else((t41 >= 0), 1, -1)
-    t53 = t52 + t41
+    t53 = t41 + t52
     t54 = casadi.if_else((t51 > 0), 1/(t51*2*t51), 0)
     t55 = mu_dot2 - mu_dot2*t53**2*t54
     t56 = casadi.if_else((t52 != 0), -t55/t52, 0)
     t57 = casadi.fabs(t50)
-    t58 = casadi.if_else((t50 >= 0), 1, -1)*t57
+    t58 = t57*casadi.if_else((t50 >= 0), 1, -1)
     t59 = t50 + t58
     t60 = casadi.if_else((t57 > 0), 1/(t57*2*t57), 0)
     t61 = t40 - t40*t59**2*t60
@@ -499,7 +1280,7 @@ def _velocity_ik(q, mu_dot, damping):
     t65 = t62 - t3*t64 + t1*t63
     t66 = t62 - t2*t64 + t0*t63
     t67 = -t3
-    t68 = t10 + t67
+    t68 = t67 + t10
     t69 = t11*(1 - t2*t68 + t1*t0)
     t70 = t2 + t68*t69
     t71 = t0 - t1*t69
@@ -515,13 +1296,13 @@ def _velocity_ik(q, mu_dot, damping):
     t81 = t80*(t75*t79 + t72*t76)
     t82 = t75 - t79*t81
     t83 = t76 - t72*t81
-    t84 = -t2 + q1 + q2 + q3 + q4 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + t15 + t67
+    t84 = -t2 + q1 + q2 + q3 + q4 + t15 + t67 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping
     t85 = t1*t11
-    t86 = t80*(t72*t12 + t79*t85)
-    t87 = -t79*t86 + t85
+    t86 = t80*(t72*t12 + t85*t79)
+    t87 = t85 - t79*t86
     t88 = t12 - t72*t86
     t89 = casadi.fabs(t88)
-    t90 = casadi.if_else((t88 >= 0), 1, -1)*t89
+    t90 = t89*casadi.if_else((t88 >= 0), 1, -1)
     t91 = t88 + t90
     t92 = casadi.if_else((t89 > 0), 1/(t89*2*t89), 0)
     t93 = t83 - t83*t91**2*t92
@@ -542,6 +1323,292 @@ def _velocity_ik(q, mu_dot, damping):
     q_dot[3, 0] = casadi.if_else(t103, casadi.if_else(t99, -t62, t94), 0)
     status = casadi.SX(1, 1)
     status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t97, t98)), 2, casadi.if_else(t102, 1, 0))
+    return [q_dot, status]
+
+
+def _velocity_ik_nullspace(q, mu_dot, z, damping):
+    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 336 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    q3 = q[2]
+    q4 = q[3]
+    mu_dot0 = mu_dot[0]
+    mu_dot1 = mu_dot[1]
+    mu_dot2 = mu_dot[2]
+    mu_dot3 = mu_dot[3]
+    qz1 = z[0]
+    qz2 = z[1]
+    qz3 = z[2]
+    qz4 = z[3]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    t0 = 0.275*c12
+    t1 = 0.325*c1 + t0
+    t2 = 0.275*s12
+    t3 = 0.325*s1 + t2
+    t4 = 0.075625*c12*s12 + t1*t3
+    t5 = t3 + t2
+    t6 = t3**2
+    t7 = t6 + 0.075625*s12**2
+    t8 = t1**2
+    t9 = casadi.sqrt(1 + t6 + t8)
+    t10 = casadi.if_else((t3 <= 0), 1, -1)*t9
+    t11 = casadi.if_else((t9 > 0), 1/(t9*(casadi.fabs(t3) + t9)), 0)
+    t12 = -1 + t11
+    t13 = t8 + 0.075625*c12**2
+    t14 = casadi.sqrt(4 + t7 + t13)
+    t15 = t1 + t0
+    t16 = t4**2
+    t17 = t5**2
+    t18 = damping**2
+    t19 = t7 + t18
+    t20 = t19**2
+    t21 = casadi.sqrt(t16 + t17 + t20)
+    t22 = t21*casadi.if_else((t19 >= 0), 1, -1)
+    t23 = t19 + t22
+    t24 = casadi.if_else((t21 > 0), 1/(t21*(t21 + casadi.fabs(t19))), 0)
+    t25 = -t24*(-mu_dot0*t23 + mu_dot1*t4 + mu_dot3*t5)
+    t26 = mu_dot0 - t23*t25
+    t27 = mu_dot1 + t4*t25
+    t28 = mu_dot3 + t5*t25
+    t29 = t13 + t18
+    t30 = -t24*(t4*t23 + t29*t4 + t15*t5)
+    t31 = t4 + t23*t30
+    t32 = t29 + t4*t30
+    t33 = t15 + t5*t30
+    t34 = casadi.sqrt(t32**2 + t33**2)
+    t35 = t34*casadi.if_else((t32 >= 0), 1, -1)
+    t36 = t32 + t35
+    t37 = casadi.if_else((t34 > 0), 1/(t34*(t34 + casadi.fabs(t32))), 0)
+    t38 = t37*(t27*t36 + t33*t28)
+    t39 = t27 - t36*t38
+    t40 = t28 - t33*t38
+    t41 = 1 + t18
+    t42 = 3 + t18
+    t43 = casadi.sqrt(2*t16 + 2*t17 + 2*t15**2 + t20 + t29**2 + t41**2 + t42**2)
+    t44 = -t24*(t5*t23 + t42*t5 + t15*t4)
+    t45 = t5 + t23*t44
+    t46 = t15 + t4*t44
+    t47 = t42 + t5*t44
+    t48 = t37*(t46*t36 + t33*t47)
+    t49 = t46 - t36*t48
+    t50 = t47 - t33*t48
+    t51 = casadi.fabs(t41)
+    t52 = t51*casadi.if_else((t41 >= 0), 1, -1)
+    t53 = t41 + t52
+    t54 = casadi.if_else((t51 > 0), 1/(t51*2*t51), 0)
+    t55 = mu_dot2 - mu_dot2*t53**2*t54
+    t56 = casadi.if_else((t52 != 0), -t55/t52, 0)
+    t57 = casadi.fabs(t50)
+    t58 = t57*casadi.if_else((t50 >= 0), 1, -1)
+    t59 = t50 + t58
+    t60 = casadi.if_else((t57 > 0), 1/(t57*2*t57), 0)
+    t61 = t40 - t40*t59**2*t60
+    t62 = casadi.if_else((t58 != 0), -t61/t58, 0)
+    t63 = casadi.if_else((t35 != 0), -(t39 - t49*t62)/t35, 0)
+    t64 = casadi.if_else((t22 != 0), -(t26 + t31*t63 + t45*t62)/t22, 0)
+    t65 = t62 - t3*t64 + t1*t63
+    t66 = t62 - t2*t64 + t0*t63
+    t67 = -t3
+    t68 = t67 + t10
+    t69 = t11*(1 - t2*t68 + t1*t0)
+    t70 = t2 + t68*t69
+    t71 = t0 - t1*t69
+    t72 = 1 - t69
+    t73 = t11*(mu_dot3 + mu_dot0*t68 + t1*mu_dot1)
+    t74 = mu_dot0 - t68*t73
+    t75 = mu_dot1 - t1*t73
+    t76 = -t73 + mu_dot3
+    t77 = casadi.sqrt(t71**2 + t72**2)
+    t78 = t77*casadi.if_else((t71 >= 0), 1, -1)
+    t79 = t71 + t78
+    t80 = casadi.if_else((t77 > 0), 1/(t77*(t77 + casadi.fabs(t71))), 0)
+    t81 = t80*(t75*t79 + t72*t76)
+    t82 = t75 - t79*t81
+    t83 = t76 - t72*t81
+    t84 = -t2 + q1 + q2 + q3 + q4 + t15 + t67 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + qz1 + qz2 + qz3 + qz4
+    t85 = t1*t11
+    t86 = t80*(t72*t12 + t85*t79)
+    t87 = t85 - t79*t86
+    t88 = t12 - t72*t86
+    t89 = casadi.fabs(t88)
+    t90 = t89*casadi.if_else((t88 >= 0), 1, -1)
+    t91 = t88 + t90
+    t92 = casadi.if_else((t89 > 0), 1/(t89*2*t89), 0)
+    t93 = t83 - t83*t91**2*t92
+    t94 = casadi.if_else((t90 != 0), -t93/t90, 0)
+    t95 = casadi.if_else((t78 != 0), -(t82 - t87*t94)/t78, 0)
+    t96 = casadi.if_else((t10 != 0), -(-(-t70*t95 + t68*t11*t94) + t74)/t10, 0)
+    t97 = (casadi.fabs(t84) < casadi.inf)
+    t98 = (damping >= 0)
+    t99 = (damping > 0)
+    t100 = 1e-12*t43
+    t101 = 1e-12*t14
+    t102 = casadi.logic_or(casadi.logic_and(t99, casadi.logic_or(casadi.logic_or(casadi.logic_or((t21 <= t100), (t34 <= t100)), (t51 <= t100)), (t57 <= t100))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t9 <= t101), (t77 <= t101)), (1 <= t101)), (t89 <= t101))))
+    t103 = casadi.logic_and(casadi.logic_and(t97, t98), casadi.logic_not(t102))
+    q_dot = casadi.SX(4, 1)
+    q_dot[0, 0] = casadi.if_else(t103, casadi.if_else(t99, t65, t96), 0)
+    q_dot[1, 0] = casadi.if_else(t103, casadi.if_else(t99, t66, t95), 0)
+    q_dot[2, 0] = casadi.if_else(t103, casadi.if_else(t99, -t56, -mu_dot2), 0)
+    q_dot[3, 0] = casadi.if_else(t103, casadi.if_else(t99, -t62, t94), 0)
+    status = casadi.SX(1, 1)
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t97, t98)), 2, casadi.if_else(t102, 1, 0))
+    return [q_dot, status]
+
+
+def _resolved_rate(q, target, target_rate, gain, z, damping):
+    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 364 operations."""
+    q1 = q[0]
+    q2 = q[1]
+    q3 = q[2]
+    q4 = q[3]
+    mu0 = target[0]
+    mu1 = target[1]
+    mu2 = target[2]
+    mu3 = target[3]
+    mu_dot0 = target_rate[0]
+    mu_dot1 = target_rate[1]
+    mu_dot2 = target_rate[2]
+    mu_dot3 = target_rate[3]
+    gain0 = gain[0]
+    gain1 = gain[1]
+    gain2 = gain[2]
+    gain3 = gain[3]
+    qz1 = z[0]
+    qz2 = z[1]
+    qz3 = z[2]
+    qz4 = z[3]
+    c1 = casadi.cos(q1)
+    s1 = casadi.sin(q1)
+    c2 = casadi.cos(q2)
+    s2 = casadi.sin(q2)
+    c12 = c1*c2 - s1*s2
+    s12 = c1*s2 + c2*s1
+    c4 = casadi.cos(q4)
+    s4 = casadi.sin(q4)
+    t0 = 0.387 - q3
+    t1 = c12*c4 + s12*s4
+    t2 = s12*c4 - c12*s4
+    t3 = mu_dot2 + gain2*(-t0 + mu2)
+    t4 = 0.275*c12
+    t5 = 0.325*c1 + t4
+    t6 = mu_dot0 + gain0*(-t5 + mu0)
+    t7 = 0.275*s12
+    t8 = 0.325*s1 + t7
+    t9 = 0.075625*c12*s12 + t5*t8
+    t10 = t8 + t7
+    t11 = t8**2
+    t12 = t11 + 0.075625*s12**2
+    t13 = t5**2
+    t14 = casadi.sqrt(1 + t11 + t13)
+    t15 = casadi.if_else((t8 <= 0), 1, -1)*t14
+    t16 = casadi.if_else((t14 > 0), 1/(t14*(casadi.fabs(t8) + t14)), 0)
+    t17 = -1 + t16
+    t18 = t13 + 0.075625*c12**2
+    t19 = casadi.sqrt(4 + t12 + t18)
+    t20 = t5 + t4
+    t21 = t9**2
+    t22 = t10**2
+    t23 = damping**2
+    t24 = t12 + t23
+    t25 = t24**2
+    t26 = casadi.sqrt(t21 + t22 + t25)
+    t27 = t26*casadi.if_else((t24 >= 0), 1, -1)
+    t28 = t24 + t27
+    t29 = casadi.if_else((t26 > 0), 1/(t26*(t26 + casadi.fabs(t24))), 0)
+    t30 = t18 + t23
+    t31 = -t29*(t9*t28 + t30*t9 + t20*t10)
+    t32 = t9 + t28*t31
+    t33 = t30 + t9*t31
+    t34 = t20 + t10*t31
+    t35 = casadi.sqrt(t33**2 + t34**2)
+    t36 = t35*casadi.if_else((t33 >= 0), 1, -1)
+    t37 = t33 + t36
+    t38 = casadi.if_else((t35 > 0), 1/(t35*(t35 + casadi.fabs(t33))), 0)
+    t39 = 1 + t23
+    t40 = 3 + t23
+    t41 = casadi.sqrt(2*t21 + 2*t22 + 2*t20**2 + t25 + t30**2 + t39**2 + t40**2)
+    t42 = -t29*(t10*t28 + t40*t10 + t20*t9)
+    t43 = t10 + t28*t42
+    t44 = t20 + t9*t42
+    t45 = t40 + t10*t42
+    t46 = t38*(t44*t37 + t34*t45)
+    t47 = t44 - t37*t46
+    t48 = t45 - t34*t46
+    t49 = casadi.fabs(t39)
+    t50 = t49*casadi.if_else((t39 >= 0), 1, -1)
+    t51 = t39 + t50
+    t52 = casadi.if_else((t49 > 0), 1/(t49*2*t49), 0)
+    t53 = t3 - t51**2*t52*t3
+    t54 = casadi.if_else((t50 != 0), -t53/t50, 0)
+    t55 = casadi.fabs(t48)
+    t56 = t55*casadi.if_else((t48 >= 0), 1, -1)
+    t57 = t48 + t56
+    t58 = casadi.if_else((t55 > 0), 1/(t55*2*t55), 0)
+    t59 = -t8
+    t60 = t59 + t15
+    t61 = t16*(1 - t7*t60 + t5*t4)
+    t62 = t7 + t60*t61
+    t63 = t4 - t5*t61
+    t64 = 1 - t61
+    t65 = casadi.sqrt(t63**2 + t64**2)
+    t66 = t65*casadi.if_else((t63 >= 0), 1, -1)
+    t67 = t63 + t66
+    t68 = casadi.if_else((t65 > 0), 1/(t65*(t65 + casadi.fabs(t63))), 0)
+    t69 = mu_dot1 + gain1*(t59 + mu1)
+    t70 = t5*t16
+    t71 = t68*(t64*t17 + t70*t67)
+    t72 = t70 - t67*t71
+    t73 = t17 - t64*t71
+    t74 = casadi.fabs(t73)
+    t75 = t74*casadi.if_else((t73 >= 0), 1, -1)
+    t76 = t73 + t75
+    t77 = casadi.if_else((t74 > 0), 1/(t74*2*t74), 0)
+    t78 = -mu3 + casadi.atan2(t2, t1)
+    t79 = mu_dot3 - gain3*(t78 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t78)))
+    t80 = -t29*(-t28*t6 + t9*t69 + t10*t79)
+    t81 = t6 - t28*t80
+    t82 = t69 + t9*t80
+    t83 = t79 + t10*t80
+    t84 = t38*(t37*t82 + t34*t83)
+    t85 = t82 - t37*t84
+    t86 = t83 - t34*t84
+    t87 = t86 - t57**2*t58*t86
+    t88 = casadi.if_else((t56 != 0), -t87/t56, 0)
+    t89 = casadi.if_else((t36 != 0), -(t85 - t47*t88)/t36, 0)
+    t90 = casadi.if_else((t27 != 0), -(t81 + t32*t89 + t43*t88)/t27, 0)
+    t91 = t88 - t8*t90 + t5*t89
+    t92 = t88 - t7*t90 + t4*t89
+    t93 = t16*(t79 + t60*t6 + t5*t69)
+    t94 = t6 - t60*t93
+    t95 = t69 - t5*t93
+    t96 = -t93 + t79
+    t97 = t68*(t67*t95 + t64*t96)
+    t98 = t95 - t67*t97
+    t99 = t96 - t64*t97
+    t100 = t99 - t76**2*t77*t99
+    t101 = casadi.if_else((t75 != 0), -t100/t75, 0)
+    t102 = casadi.if_else((t66 != 0), -(t98 - t72*t101)/t66, 0)
+    t103 = casadi.if_else((t15 != 0), -(-(-t62*t102 + t60*t16*t101) + t94)/t15, 0)
+    t104 = -t7 + q1 + q2 + q3 + q4 + t20 + t59 + damping + qz1 + qz2 + qz3 + qz4 + t6 + t69 + t3 + t79
+    t105 = (casadi.fabs(t104) < casadi.inf)
+    t106 = (damping >= 0)
+    t107 = (damping > 0)
+    t108 = 1e-12*t41
+    t109 = 1e-12*t19
+    t110 = casadi.logic_or(casadi.logic_and(t107, casadi.logic_or(casadi.logic_or(casadi.logic_or((t26 <= t108), (t35 <= t108)), (t49 <= t108)), (t55 <= t108))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t14 <= t109), (t65 <= t109)), (1 <= t109)), (t74 <= t109))))
+    t111 = casadi.logic_and(casadi.logic_and(t105, t106), casadi.logic_not(t110))
+    q_dot = casadi.SX(4, 1)
+    q_dot[0, 0] = casadi.if_else(t111, casadi.if_else(t107, t91, t103), 0)
+    q_dot[1, 0] = casadi.if_else(t111, casadi.if_else(t107, t92, t102), 0)
+    q_dot[2, 0] = casadi.if_else(t111, casadi.if_else(t107, -t54, -t3), 0)
+    q_dot[3, 0] = casadi.if_else(t111, casadi.if_else(t107, -t88, t101), 0)
+    status = casadi.SX(1, 1)
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t105, t106)), 2, casadi.if_else(t110, 1, 0))
     return [q_dot, status]
 
 
@@ -572,7 +1639,7 @@ def _ik_numeric_step(target, q, damping):
     t2 = s12*c4 - c12*s4
     t3 = -t0 + mu2
     t4 = 1 + damping
-    t5 = qs1 + qs2 + qs3 + qs4 + mu3 + mu0 + mu1 + mu2
+    t5 = mu3 + mu0 + mu1 + mu2 + qs1 + qs2 + qs3 + qs4
     t6 = 0.275*c12
     t7 = 0.325*c1 + t6
     t8 = t7**2 + 0.075625*c12**2
@@ -581,7 +1648,7 @@ def _ik_numeric_step(target, q, damping):
     t11 = 0.275*s12
     t12 = 0.325*s1 + t11
     t13 = t12**2 + 0.075625*s12**2
-    t14 = t7*t12 + 0.075625*c12*s12
+    t14 = 0.075625*c12*s12 + t7*t12
     t15 = t12 + t11
     t16 = -t12 + mu1
     t17 = -mu3 + casadi.atan2(t2, t1)
@@ -597,7 +1664,7 @@ def _ik_numeric_step(target, q, damping):
     t27 = t16 + t14*t25
     t28 = -t18 + t15*t25
     t29 = damping + t8
-    t30 = -t24*(t15*t9 + t14*t23 + t14*t29)
+    t30 = -t24*(t15*t9 + t14*t23 + t29*t14)
     t31 = t14 + t23*t30
     t32 = t29 + t14*t30
     t33 = t9 + t15*t30
@@ -609,7 +1676,7 @@ def _ik_numeric_step(target, q, damping):
     t39 = t27 - t36*t38
     t40 = t28 - t33*t38
     t41 = 3 + damping
-    t42 = -t24*(t14*t9 + t15*t23 + t15*t41)
+    t42 = -t24*(t14*t9 + t15*t23 + t41*t15)
     t43 = t15 + t23*t42
     t44 = t9 + t14*t42
     t45 = t41 + t15*t42
@@ -834,6 +1901,9 @@ def _ik_nearest(mu, q_seed, weights):
 _q = casadi.SX.sym("q", 4, 1)
 _q_dot = casadi.SX.sym("q_dot", 4, 1)
 _mu_dot = casadi.SX.sym("mu_dot", 4, 1)
+_z = casadi.SX.sym("z", 4, 1)
+_target_rate = casadi.SX.sym("target_rate", 4, 1)
+_gain = casadi.SX.sym("gain", 4, 1)
 _damping = casadi.SX.sym("damping", 1, 1)
 _target = casadi.SX.sym("target", 4, 1)
 _mu = casadi.SX.sym("mu", 4, 1)
@@ -850,10 +1920,17 @@ jacobian_dot = casadi.Function("jacobian_dot", [_q, _q_dot], _jacobian_dot(_q, _
 bias_acceleration = casadi.Function("bias_acceleration", [_q, _q_dot], _bias_acceleration(_q, _q_dot), ["q", "q_dot"], ["a"])
 task_jacobian_dot = casadi.Function("task_jacobian_dot", [_q, _q_dot], _task_jacobian_dot(_q, _q_dot), ["q", "q_dot"], ["Jd"])
 hessian = casadi.Function("hessian", [_q], _hessian(_q), ["q"], ["H"])
+link_poses = casadi.Function("link_poses", [_q], _link_poses(_q), ["q"], ["T"])
+link_velocities = casadi.Function("link_velocities", [_q, _q_dot], _link_velocities(_q, _q_dot), ["q", "q_dot"], ["V"])
 singularity_factors = casadi.Function("singularity_factors", [_q], _singularity_factors(_q), ["q"], ["f"])
 manipulability = casadi.Function("manipulability", [_q], _manipulability(_q), ["q"], ["w"])
 jacobian_det = casadi.Function("jacobian_det", [_q], _jacobian_det(_q), ["q"], ["d"])
+manipulability_gradient = casadi.Function("manipulability_gradient", [_q], _manipulability_gradient(_q), ["q"], ["dw"])
+velocity_ellipsoid = casadi.Function("velocity_ellipsoid", [_q], _velocity_ellipsoid(_q), ["q"], ["U_v", "s_v", "U_w", "s_w"])
+condition_number = casadi.Function("condition_number", [_q], _condition_number(_q), ["q"], ["kappa"])
 velocity_ik = casadi.Function("velocity_ik", [_q, _mu_dot, _damping], _velocity_ik(_q, _mu_dot, _damping), ["q", "mu_dot", "damping"], ["q_dot", "status"])
+velocity_ik_nullspace = casadi.Function("velocity_ik_nullspace", [_q, _mu_dot, _z, _damping], _velocity_ik_nullspace(_q, _mu_dot, _z, _damping), ["q", "mu_dot", "z", "damping"], ["q_dot", "status"])
+resolved_rate = casadi.Function("resolved_rate", [_q, _target, _target_rate, _gain, _z, _damping], _resolved_rate(_q, _target, _target_rate, _gain, _z, _damping), ["q", "target", "target_rate", "gain", "z", "damping"], ["q_dot", "status"])
 ik_numeric_step = casadi.Function("ik_numeric_step", [_target, _q, _damping], _ik_numeric_step(_target, _q, _damping), ["target", "q", "damping"], ["q_start", "q_next", "cost"])
 ik_branches = casadi.Function("ik_branches", [_mu], _ik_branches(_mu), ["mu"], ["q", "valid", "in_limits"])
 ik_nearest = casadi.Function("ik_nearest", [_mu, _q_seed, _weights], _ik_nearest(_mu, _q_seed, _weights), ["mu", "q_seed", "weights"], ["q", "status"])
@@ -905,4 +1982,4 @@ ik_numeric = casadi.Function("ik_numeric", _inputs, _ik_numeric(*_inputs), ["tar
 
 def functions():
     """All functions by name (`ik` is `ik_branches`)."""
-    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "velocity_ik": velocity_ik, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches, "ik_nearest": ik_nearest, "ik": ik, "ik_numeric": ik_numeric}
+    return {"fk": fk, "jacobian": jacobian, "fk_jacobian": fk_jacobian, "jacobian_tool": jacobian_tool, "task": task, "task_jacobian": task_jacobian, "fk_jacobian_dot": fk_jacobian_dot, "jacobian_dot": jacobian_dot, "bias_acceleration": bias_acceleration, "task_jacobian_dot": task_jacobian_dot, "hessian": hessian, "link_poses": link_poses, "link_velocities": link_velocities, "singularity_factors": singularity_factors, "manipulability": manipulability, "jacobian_det": jacobian_det, "manipulability_gradient": manipulability_gradient, "velocity_ellipsoid": velocity_ellipsoid, "condition_number": condition_number, "velocity_ik": velocity_ik, "velocity_ik_nullspace": velocity_ik_nullspace, "resolved_rate": resolved_rate, "ik_numeric_step": ik_numeric_step, "ik_branches": ik_branches, "ik_nearest": ik_nearest, "ik": ik, "ik_numeric": ik_numeric}

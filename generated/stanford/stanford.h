@@ -80,6 +80,14 @@ void stanford_task_jacobian_dot(const stanford_real q[STANFORD_DOF], const stanf
  * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 109 operations. */
 void stanford_hessian(const stanford_real q[STANFORD_DOF], stanford_real H[STANFORD_DOF * 6 * STANFORD_DOF]);
 
+/* World pose of each link's DH frame, base A_1 ... A_i, without the tool (DOF x 4 x 4).
+ * Result: T: 6 x 4 x 4 row-major, element (k, r, c) at T[k * 16 + r * 4 + c]. 87 operations. */
+void stanford_link_poses(const stanford_real q[STANFORD_DOF], stanford_real T[STANFORD_DOF * 4 * 4]);
+
+/* Linear and angular velocity [v; w] of each link frame's origin, world frame, propagated from the base (DOF x 6).
+ * Result: V: 6 x 6 row-major, element (r, c) at V[r * 6 + c]. 91 operations. */
+void stanford_link_velocities(const stanford_real q[STANFORD_DOF], const stanford_real q_dot[STANFORD_DOF], stanford_real V[STANFORD_DOF * 6]);
+
 /* Factors of det(Js): the robot is singular where one is 0.
  * Result: f[i], i < 3. 2 operations. */
 void stanford_singularity_factors(const stanford_real q[STANFORD_DOF], stanford_real f[STANFORD_NUM_SINGULARITY_FACTORS]);
@@ -92,9 +100,29 @@ stanford_real stanford_manipulability(const stanford_real q[STANFORD_DOF]);
  * Result: returned as a scalar. 5 operations. */
 stanford_real stanford_jacobian_det(const stanford_real q[STANFORD_DOF]);
 
+/* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
+ * Result: dw[i], i < 6. 528 operations. */
+void stanford_manipulability_gradient(const stanford_real q[STANFORD_DOF], stanford_real dw[STANFORD_DOF]);
+
+/* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2133 operations. */
+void stanford_velocity_ellipsoid(const stanford_real q[STANFORD_DOF], stanford_real U_v[9], stanford_real s_v[3], stanford_real U_w[9], stanford_real s_w[3]);
+
+/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
+ * Result: returned as a scalar. 7643 operations. */
+stanford_real stanford_condition_number(const stanford_real q[STANFORD_DOF]);
+
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
  * Result: q_dot[i], i < 6; returned as a scalar. 1164 operations. */
 int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_real mu_dot[STANFORD_TASK_DIM], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
+
+/* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 6; returned as a scalar. 1170 operations. */
+int stanford_velocity_ik_nullspace(const stanford_real q[STANFORD_DOF], const stanford_real mu_dot[STANFORD_TASK_DIM], const stanford_real z[STANFORD_DOF], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
+
+/* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 6; returned as a scalar. 1331 operations. */
+int stanford_resolved_rate(const stanford_real q[STANFORD_DOF], const stanford_real target[16], const stanford_real target_rate[STANFORD_TASK_DIM], const stanford_real gain[STANFORD_TASK_DIM], const stanford_real z[STANFORD_DOF], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
  * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 853 operations. */

@@ -80,6 +80,14 @@ void ur5_task_jacobian_dot(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_D
  * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 149 operations. */
 void ur5_hessian(const ur5_real q[UR5_DOF], ur5_real H[UR5_DOF * 6 * UR5_DOF]);
 
+/* World pose of each link's DH frame, base A_1 ... A_i, without the tool (DOF x 4 x 4).
+ * Result: T: 6 x 4 x 4 row-major, element (k, r, c) at T[k * 16 + r * 4 + c]. 111 operations. */
+void ur5_link_poses(const ur5_real q[UR5_DOF], ur5_real T[UR5_DOF * 4 * 4]);
+
+/* Linear and angular velocity [v; w] of each link frame's origin, world frame, propagated from the base (DOF x 6).
+ * Result: V: 6 x 6 row-major, element (r, c) at V[r * 6 + c]. 159 operations. */
+void ur5_link_velocities(const ur5_real q[UR5_DOF], const ur5_real q_dot[UR5_DOF], ur5_real V[UR5_DOF * 6]);
+
 /* Factors of det(Js): the robot is singular where one is 0.
  * Result: f[i], i < 3. 25 operations. */
 void ur5_singularity_factors(const ur5_real q[UR5_DOF], ur5_real f[UR5_NUM_SINGULARITY_FACTORS]);
@@ -92,9 +100,29 @@ ur5_real ur5_manipulability(const ur5_real q[UR5_DOF]);
  * Result: returned as a scalar. 28 operations. */
 ur5_real ur5_jacobian_det(const ur5_real q[UR5_DOF]);
 
+/* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
+ * Result: dw[i], i < 6. 1141 operations. */
+void ur5_manipulability_gradient(const ur5_real q[UR5_DOF], ur5_real dw[UR5_DOF]);
+
+/* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2213 operations. */
+void ur5_velocity_ellipsoid(const ur5_real q[UR5_DOF], ur5_real U_v[9], ur5_real s_v[3], ur5_real U_w[9], ur5_real s_w[3]);
+
+/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
+ * Result: returned as a scalar. 7804 operations. */
+ur5_real ur5_condition_number(const ur5_real q[UR5_DOF]);
+
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
  * Result: q_dot[i], i < 6; returned as a scalar. 1301 operations. */
 int ur5_velocity_ik(const ur5_real q[UR5_DOF], const ur5_real mu_dot[UR5_TASK_DIM], ur5_real damping, ur5_real q_dot[UR5_DOF]);
+
+/* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 6; returned as a scalar. 1307 operations. */
+int ur5_velocity_ik_nullspace(const ur5_real q[UR5_DOF], const ur5_real mu_dot[UR5_TASK_DIM], const ur5_real z[UR5_DOF], ur5_real damping, ur5_real q_dot[UR5_DOF]);
+
+/* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 6; returned as a scalar. 1465 operations. */
+int ur5_resolved_rate(const ur5_real q[UR5_DOF], const ur5_real target[16], const ur5_real target_rate[UR5_TASK_DIM], const ur5_real gain[UR5_TASK_DIM], const ur5_real z[UR5_DOF], ur5_real damping, ur5_real q_dot[UR5_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
  * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 958 operations. */

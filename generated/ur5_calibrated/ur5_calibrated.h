@@ -80,6 +80,14 @@ void ur5_calibrated_task_jacobian_dot(const ur5_calibrated_real q[UR5_CALIBRATED
  * Result: H: 6 x 6 x 6 row-major, element (k, r, c) at H[k * 36 + r * 6 + c]. 524 operations. */
 void ur5_calibrated_hessian(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real H[UR5_CALIBRATED_DOF * 6 * UR5_CALIBRATED_DOF]);
 
+/* World pose of each link's DH frame, base A_1 ... A_i, without the tool (DOF x 4 x 4).
+ * Result: T: 6 x 4 x 4 row-major, element (k, r, c) at T[k * 16 + r * 4 + c]. 294 operations. */
+void ur5_calibrated_link_poses(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real T[UR5_CALIBRATED_DOF * 4 * 4]);
+
+/* Linear and angular velocity [v; w] of each link frame's origin, world frame, propagated from the base (DOF x 6).
+ * Result: V: 6 x 6 row-major, element (r, c) at V[r * 6 + c]. 354 operations. */
+void ur5_calibrated_link_velocities(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], const ur5_calibrated_real q_dot[UR5_CALIBRATED_DOF], ur5_calibrated_real V[UR5_CALIBRATED_DOF * 6]);
+
 /* Factors of det(Js): the robot is singular where one is 0.
  * Result: f[i], i < 1. 547 operations. */
 void ur5_calibrated_singularity_factors(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real f[UR5_CALIBRATED_NUM_SINGULARITY_FACTORS]);
@@ -92,9 +100,29 @@ ur5_calibrated_real ur5_calibrated_manipulability(const ur5_calibrated_real q[UR
  * Result: returned as a scalar. 547 operations. */
 ur5_calibrated_real ur5_calibrated_jacobian_det(const ur5_calibrated_real q[UR5_CALIBRATED_DOF]);
 
+/* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
+ * Result: dw[i], i < 6. 1797 operations. */
+void ur5_calibrated_manipulability_gradient(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real dw[UR5_CALIBRATED_DOF]);
+
+/* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2455 operations. */
+void ur5_calibrated_velocity_ellipsoid(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real U_v[9], ur5_calibrated_real s_v[3], ur5_calibrated_real U_w[9], ur5_calibrated_real s_w[3]);
+
+/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
+ * Result: returned as a scalar. 8060 operations. */
+ur5_calibrated_real ur5_calibrated_condition_number(const ur5_calibrated_real q[UR5_CALIBRATED_DOF]);
+
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
  * Result: q_dot[i], i < 6; returned as a scalar. 1621 operations. */
 int ur5_calibrated_velocity_ik(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], const ur5_calibrated_real mu_dot[UR5_CALIBRATED_TASK_DIM], ur5_calibrated_real damping, ur5_calibrated_real q_dot[UR5_CALIBRATED_DOF]);
+
+/* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 6; returned as a scalar. 1627 operations. */
+int ur5_calibrated_velocity_ik_nullspace(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], const ur5_calibrated_real mu_dot[UR5_CALIBRATED_TASK_DIM], const ur5_calibrated_real z[UR5_CALIBRATED_DOF], ur5_calibrated_real damping, ur5_calibrated_real q_dot[UR5_CALIBRATED_DOF]);
+
+/* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
+ * Result: q_dot[i], i < 6; returned as a scalar. 1789 operations. */
+int ur5_calibrated_resolved_rate(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], const ur5_calibrated_real target[16], const ur5_calibrated_real target_rate[UR5_CALIBRATED_TASK_DIM], const ur5_calibrated_real gain[UR5_CALIBRATED_TASK_DIM], const ur5_calibrated_real z[UR5_CALIBRATED_DOF], ur5_calibrated_real damping, ur5_calibrated_real q_dot[UR5_CALIBRATED_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
  * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1259 operations. */

@@ -6,9 +6,11 @@ the catalogue says.
 
 from dataclasses import dataclass
 
+import numpy
 import sympy
 
 from jacgen.emission.lowering import Body
+from jacgen.model.node import Node
 from jacgen.solvers import differential, ik_limits
 
 SECOND_ORDER = ("fk_jacobian_dot", "jacobian_dot", "bias_acceleration", "task_jacobian_dot", "hessian")
@@ -46,10 +48,14 @@ CATALOGUE = (
     Declaration("fk"), Declaration("jacobian"), Declaration("fk_jacobian"), Declaration("jacobian_tool"),
     Declaration("task", euler_rows=True), Declaration("task_jacobian", euler_rows=True),
     *(Declaration(name, euler_rows=name == "task_jacobian_dot") for name in SECOND_ORDER),
+    Declaration("link_poses"), Declaration("link_velocities"),
     Declaration("singularity_factors"), Declaration("manipulability", of_js=True), Declaration("jacobian_det", of_js=True),
+    Declaration("manipulability_gradient", of_js=True), Declaration("velocity_ellipsoid"),
+    Declaration("condition_number", of_js=True),
     Declaration("velocity_ik", statuses=_statuses(("OK", differential.VELOCITY_IK_OK),
                                                   ("SINGULAR", differential.VELOCITY_IK_SINGULAR),
                                                   ("NOT_FINITE", differential.VELOCITY_IK_NOT_FINITE))),
+    Declaration("velocity_ik_nullspace"), Declaration("resolved_rate"),
     Declaration("ik_numeric_step"),
     Declaration("ik_numeric", ("ik_numeric_step",), _statuses(*differential.IK_NUMERIC_STATUSES)),
     Declaration("ik_branches"),
@@ -75,6 +81,14 @@ EXTENTS = {
     "weights": ("DOF",),
     "mu_dot": ("TASK_DIM",),
     "velocity_ik.q_dot": ("DOF",),
+    "velocity_ik_nullspace.q_dot": ("DOF",),
+    "resolved_rate.q_dot": ("DOF",),
+    "z": ("DOF",),
+    "gain": ("TASK_DIM",),
+    "target_rate": ("TASK_DIM",),
+    "link_poses": ("DOF", 4, 4),
+    "link_velocities": ("DOF", 6),
+    "manipulability_gradient": ("DOF",),
     "ik_numeric_step.q_start": ("DOF",),
     "ik_numeric_step.q_next": ("DOF",),
     "ik_general_start.q": ("DOF",),
@@ -123,6 +137,7 @@ class Argument:
     scalar: bool = False  # one number: by value in C, shape (...) in numpy, its symbol named as the argument
     default: str | None = None  # a scalar's default in Python
     integer: bool = False  # a count (ik_numeric's max_iter): an int in C
+    every: bool = False  # a vector that Python also takes as one number for every component (a gain)
 
     @property
     def size(self) -> int:
@@ -241,3 +256,33 @@ class Function(Signature):
         for output in self.outputs:
             yield output, values[start:start + output.size]
             start += output.size
+
+
+# A function's result as `matrix`, `vector`, `scalar` and `status` make it: its Output (what it
+# is truth values, and its extent, `Generator.function` adds) and its values, row by row.
+Result = tuple[Output, list]
+
+
+def matrix(name: str, value, equals: str = "", layers: int = 1) -> Result:
+    """A sympy Matrix, or a 2-D array of nodes (a stack of `layers` matrices: the hessian)."""
+    rows, cols = value.shape
+    return (Output(name, rows, cols, equals=equals, layers=layers),
+            list(value.flat) if isinstance(value, numpy.ndarray) else list(value))
+
+
+def _entry(value):
+    """A node as it is; a number or sympy value as sympy's (the lowering takes both onto the graph)."""
+    return value if isinstance(value, Node) else sympy.sympify(value)
+
+
+def vector(name: str, values, equals: str = "") -> Result:
+    values = [_entry(value) for value in values]
+    return Output(name, len(values), 1, vector=True, equals=equals), values
+
+
+def scalar(name: str, value) -> Result:
+    return Output(name, 1, 1, scalar=True), [_entry(value)]
+
+
+def status(name: str, value) -> Result:
+    return Output(name, 1, 1, scalar=True, integer=True), [_entry(value)]

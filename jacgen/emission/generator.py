@@ -13,49 +13,21 @@ import sympy
 from sympy.core.parameters import distribute
 
 from jacgen.emission.catalogue import (EXTENTS, FUNCTION_NAMES, SECOND_ORDER, Argument, Call, Function, Loop,
-                                       Output, extent_of, in_catalogue_order, with_callees)
+                                       Output, Result, extent_of, in_catalogue_order, matrix, scalar, status,
+                                       vector, with_callees)
+from jacgen.emission import jacobian_uses
 from jacgen.emission.lowering import Lowering
 from jacgen.inputs.robot import EULER_ANGLES, Robot
 from jacgen.model import kinematics
 from jacgen.model.joint_ring import joint_atoms
 from jacgen.model.js_rank import rank_determinant, singularity_jacobian
 from jacgen.model.graph import elementwise
-from jacgen.model.node import Node
 from jacgen.model.kinematics import generated_symbol
+from jacgen.model.node import Node
 from jacgen.model.singularities import Singularities
 from jacgen.solvers import differential, general6r, general6r_target, ik, ik_limits
 from jacgen.solvers.model import Model
 from jacgen.solvers.subproblems import Subproblems, wrapped
-
-
-# A function's result as `matrix`, `vector`, `scalar` and `status` make it: its Output (what it
-# is truth values, and its extent, `Generator.function` adds) and its values, row by row.
-Result = tuple[Output, list]
-
-
-def matrix(name: str, value, equals: str = "", layers: int = 1) -> Result:
-    """A sympy Matrix, or a 2-D array of nodes (a stack of `layers` matrices: the hessian)."""
-    rows, cols = value.shape
-    return (Output(name, rows, cols, equals=equals, layers=layers),
-            list(value.flat) if isinstance(value, numpy.ndarray) else list(value))
-
-
-def _entry(value):
-    """A node as it is; a number or sympy value as sympy's (the lowering takes both onto the graph)."""
-    return value if isinstance(value, Node) else sympy.sympify(value)
-
-
-def vector(name: str, values, equals: str = "") -> Result:
-    values = [_entry(value) for value in values]
-    return Output(name, len(values), 1, vector=True, equals=equals), values
-
-
-def scalar(name: str, value) -> Result:
-    return Output(name, 1, 1, scalar=True), [_entry(value)]
-
-
-def status(name: str, value) -> Result:
-    return Output(name, 1, 1, scalar=True, integer=True), [_entry(value)]
 
 
 class Generator:
@@ -439,6 +411,7 @@ class Generator:
             self.function("task_jacobian", f"analytic Jacobian d mu / d q ({m} x DOF)", matrix("J", task_jacobian)),
             *self.second_order_functions(),
             *self.singularity_functions(js),
+            *jacobian_uses.functions(self, js, task_jacobian),
             self.velocity_ik_function(js) if self.generates("velocity_ik") else None,
             self.ik_numeric_step_function(task_jacobian) if self.generates("ik_numeric_step") else None,
             *self.ik_functions(),

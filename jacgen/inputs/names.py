@@ -87,6 +87,7 @@ GENERATED_PREFIXES = {
     "vb": "its valid flags vb0..", "lb": "its in-limits flags lb0..", "ga": "the general 6R angles ga0..",
     "qg": "a general 6R solution qg1..", "T": "the entries of an ik target T00..",
     "mu": "the entries of a task target mu0..", "mu_dot": "task rates mu_dot0..",
+    "qz": "null-space joint rates qz1..", "gain": "resolved_rate's gains gain0..",
     "c": "cos of a joint or a sum of joints c1.., c23..", "s": "sin of the same s1.., s23..",
     "t": "printed temporaries t0..",
 }

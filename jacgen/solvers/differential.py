@@ -45,55 +45,76 @@ IK_NUMERIC_DAMPING = {"start": 1e-6, "min": 1e-12, "max": 1e8}
 IK_NUMERIC_PROGRESS = 1e-6
 
 
-def householder_solve(A, b, g: Graph, name: Callable) -> tuple[list, Node]:
-    """x with A x = b (nodes), and whether A is numerically singular (see the module's rule)."""
-    k = len(A)
+def triangulate(A, g: Graph, name: Callable, right=()) -> tuple[list, list, list, list]:
+    """Householder QR of the p x k matrix A (rows of nodes, p >= k): R (k x k, upper triangular,
+    as rows), Q^T applied to each column of `right` (p long), the norms of the reflected
+    columns (|R_jj|), and the reflections (v, beta), H_j = I - beta v v^T acting on rows j..p-1,
+    A = H_0 ... H_{k-1} [R; 0]. alpha = R_jj takes the sign that avoids cancellation in v."""
+    p, k = len(A), len(A[0])
     zero, one = g.number(0), g.number(1)
-    scale = name(g.sqrt(sum(e**2 for row in A for e in row)))  # |A|_F, kept by the reflections
-    A, b = [list(row) for row in A], list(b)
-    norms = []
+    A, right = [list(row) for row in A], [list(column) for column in right]
+    norms, reflections = [], []
     for j in range(k):
-        column = [A[i][j] for i in range(j, k)]
+        column = [A[i][j] for i in range(j, p)]
         norm = name(g.sqrt(sum(c**2 for c in column)))
         alpha = name(-g.select(g.relation(">=", column[0], zero), one, -one) * norm)  # R[j][j]; the sign
         v = [name(column[0] - alpha)] + column[1:]  # avoids cancellation
         beta = name(g.select(g.relation(">", norm, zero), 1 / (norm * (norm + g.call("Abs", column[0]))), zero))
         for c in range(j + 1, k):  # beta = 2 / |v|^2
-            s = name(beta * sum(v[i - j] * A[i][c] for i in range(j, k)))
-            for i in range(j, k):
+            s = name(beta * sum(v[i - j] * A[i][c] for i in range(j, p)))
+            for i in range(j, p):
                 A[i][c] = name(A[i][c] - s * v[i - j])
-        s = name(beta * sum(v[i - j] * b[i] for i in range(j, k)))
-        for i in range(j, k):
-            b[i] = name(b[i] - s * v[i - j])
+        for b in right:
+            s = name(beta * sum(v[i - j] * b[i] for i in range(j, p)))
+            for i in range(j, p):
+                b[i] = name(b[i] - s * v[i - j])
         A[j][j] = alpha
         norms.append(norm)
+        reflections.append((v, beta))
+    return [[A[i][c] if c >= i else zero for c in range(k)] for i in range(k)], right, norms, reflections
+
+
+def householder_solve(A, b, g: Graph, name: Callable) -> tuple[list, Node]:
+    """x with A x = b (nodes), and whether A is numerically singular (see the module's rule)."""
+    k = len(A)
+    zero = g.number(0)
+    scale = name(g.sqrt(sum(e**2 for row in A for e in row)))  # |A|_F, kept by the reflections
+    R, (b,), norms, _ = triangulate(A, g, name, [b])
     x = [zero] * k
     for j in reversed(range(k)):
-        x[j] = name(g.select(g.relation("!=", A[j][j], zero),
-                             (b[j] - sum((A[j][c] * x[c] for c in range(j + 1, k)), zero)) / A[j][j], zero))
+        x[j] = name(g.select(g.relation("!=", R[j][j], zero),
+                             (b[j] - sum((R[j][c] * x[c] for c in range(j + 1, k)), zero)) / R[j][j], zero))
     return x, g.logic(OR, *(g.relation("<=", norm, g.symbol(RANK) * scale) for norm in norms))
 
 
 def velocity_ik(js: sympy.Matrix, q: list, mu_dot: list, damping: sympy.Symbol, g: Graph,
-                name: Callable) -> tuple[list, Node]:
-    """q_dot solving Js q_dot = mu_dot (Js at q) and the status.
+                name: Callable, z: list | None = None) -> tuple[list, Node]:
+    """q_dot solving Js q_dot = mu_dot (Js at q) and the status; with joint rates `z`, plus
+    their projection onto the null space of Js, (I - Js# Js) z.
 
     m = n: Js^-1 mu_dot for damping 0, else Js^T (Js Js^T + damping^2 I)^-1 mu_dot (both
     computed, one selected); m < n: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; m > n:
-    (Js^T Js + damping^2 I)^-1 Js^T mu_dot."""
+    (Js^T Js + damping^2 I)^-1 Js^T mu_dot. The null space of a square or tall Js is
+    {0}: there z changes nothing. For m < n, Js# mu_dot + (I - Js# Js) z is
+    Js# (mu_dot - Js z) + z: one solve of the same system."""
     m, n = js.shape
     js, q, mu_dot, damping = elementwise(name, g.values(js)), g.values(q), g.values(mu_dot), g.value(damping)
+    z = None if z is None else g.values(z)
     k = min(m, n)
     gram = elementwise(name, js @ js.T if m <= n else js.T @ js) + numpy.eye(k, dtype=int) * damping**2
-    rhs = list(mu_dot) if m <= n else list(elementwise(name, js.T @ mu_dot))
+    moved = z is not None and m < n  # the self-motion's task velocity, taken out of the solve
+    rhs = (list(elementwise(name, mu_dot - js @ z)) if moved else list(mu_dot)) if m <= n \
+        else list(elementwise(name, js.T @ mu_dot))
     x, singular = householder_solve(gram.tolist(), rhs, g, name)
     q_dot = list(elementwise(name, js.T @ numpy.array(x, dtype=object))) if m <= n else x
+    if moved:
+        q_dot = [name(rate + zi) for rate, zi in zip(q_dot, z)]
     if m == n:
         direct, direct_singular = householder_solve(js.tolist(), list(mu_dot), g, name)
         damped = g.relation(">", damping, g.number(0))
         q_dot = [g.select(damped, a, b) for a, b in zip(q_dot, direct)]
         singular = g.logic(OR, g.logic(AND, damped, singular), g.logic(AND, g.negation(damped), direct_singular))
-    inputs = [*q, *mu_dot, damping, *js.flat]
+    inputs = [*q, *mu_dot, damping, *js.flat, *(() if z is None else z)]
     finite = g.logic(AND, g.finite(name(sum(inputs))), g.relation(">=", damping, g.number(0)))
     status = g.select(g.negation(finite), g.number(VELOCITY_IK_NOT_FINITE),
                       g.select(singular, g.number(VELOCITY_IK_SINGULAR), g.number(VELOCITY_IK_OK)))

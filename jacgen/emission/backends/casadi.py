@@ -72,7 +72,8 @@ def casadi_context(robot: Robot, generator: Generator, printer: CasadiPrinter, r
     functions = generator.without_loops()
     context["functions"] = [_casadi_function(f, robot, printer) for f in functions]
     context["arguments"] = sorted({(a.name, a.symbols.rows, a.symbols.cols) for f in functions for a in f.arguments},
-                                  key=lambda a: ("q", "q_dot", "mu_dot", "damping", "target", "T", "mu", "q_seed", "q_free", "weights").index(a[0]))
+                                  key=lambda a: ("q", "q_dot", "mu_dot", "z", "target_rate", "gain", "damping", "target", "T", "mu", "q_seed",
+                                                 "q_free", "weights").index(a[0]))
     context["characteristic_length"] = characteristic_length(robot, generator, python_number)
     context["ik"] = any(loop.name == "ik" and loop.casadi for loop in generator.loops)
     context["nearest_statuses"] = [(status.name, status.value) for f in functions if f.name == "ik_nearest"
