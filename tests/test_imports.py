@@ -99,8 +99,8 @@ def test_a_circle_is_found():
 
 # The modules that check generated code or an imported file against the oracle; nothing that
 # generates may read it (its numbers come from `numeric_chain`, a separate implementation).
-CHECKERS = {"jacgen.checking.verify", "jacgen.checking.generated_code", "jacgen.checking.cortex_m4f",
-            "jacgen.urdf_import"}
+CHECKERS = {"jacgen.checking.verify", "jacgen.checking.dexterity_checks", "jacgen.checking.generated_code",
+            "jacgen.checking.cortex_m4f", "jacgen.urdf_import"}
 
 
 def test_only_the_checkers_import_the_reference():

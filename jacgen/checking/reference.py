@@ -37,12 +37,16 @@ def _translation(x, y, z):
     return _matrix([[1, 0, 0, x], [0, 1, 0, y], [0, 0, 1, z], [0, 0, 0, 1]])
 
 
-def _pose(pose):
-    """world<-frame transform of a base/tool Pose: Rz(yaw) Ry(pitch) Rx(roll) after xyz."""
-    roll, pitch, yaw = (v.approx for v in pose.rpy)
+def _rpy_rotation(roll, pitch, yaw):
+    """Rz(yaw) Ry(pitch) Rx(roll), 4x4."""
     cp, sp = np.cos(pitch), np.sin(pitch)
     rot_y = _matrix([[cp, 0, sp, 0], [0, 1, 0, 0], [-sp, 0, cp, 0], [0, 0, 0, 1]])
-    return _translation(*(v.approx for v in pose.xyz)) @ _rot_z(yaw) @ rot_y @ _rot_x(roll)
+    return _rot_z(yaw) @ rot_y @ _rot_x(roll)
+
+
+def _pose(pose):
+    """world<-frame transform of a base/tool Pose: Rz(yaw) Ry(pitch) Rx(roll) after xyz."""
+    return _translation(*(v.approx for v in pose.xyz)) @ _rpy_rotation(*(v.approx for v in pose.rpy))
 
 
 def _link(robot, joint, qi):
@@ -61,19 +65,24 @@ def frames(robot, q):
     Modified DH: joint i moves about z_i, the frame after the row's Rx Tx.
     Complex q is carried through (for complex-step derivatives).
     """
+    axes, links = _chain(robot, q)
+    return axes, links[-1] @ _pose(robot.tool)
+
+
+def _chain(robot, q):
+    """The joint axis frames (see `frames`) and the link frames base A_1 ... A_i, world poses."""
     q = np.asarray(q)
     q = q if np.iscomplexobj(q) else q.astype(float)
     current = _pose(robot.base)
-    axes = []
+    axes, links = [], []
     for i, joint in enumerate(robot.joints):
-        link = _link(robot, joint, q[..., i])
         if robot.convention == "standard":
             axes.append(current)
-            current = current @ link
         else:
             axes.append(current @ _rot_x(joint.alpha.approx) @ _translation(joint.a.approx, 0, 0))
-            current = current @ link
-    return axes, current @ _pose(robot.tool)
+        current = current @ _link(robot, joint, q[..., i])
+        links.append(current)
+    return axes, links
 
 
 def fk(robot, q):
@@ -195,3 +204,119 @@ def manipulability(robot, q):
 def jacobian_det(robot, q):
     """det(Js) of a square Js."""
     return np.linalg.det(singularity_jacobian(robot, q))
+
+
+# -- link frames and dexterity (issue 48) ------------------------------------------------------
+def link_poses(robot, q):
+    """World poses of the link frames base A_1 ... A_i, (..., n, 4, 4): the tool transform is not
+    applied, so link_poses(q)[-1] @ tool = fk(q)."""
+    return np.stack(np.broadcast_arrays(*_chain(robot, q)[1]), -3)
+
+
+def link_velocities(robot, q, q_dot):
+    """[v; w] of each link frame, (..., n, 6), world frame: v the rate of its origin, w the axial
+    vector of dR/dt R^T. dR/dt and dp/dt are complex-step derivatives of `link_poses` along q_dot,
+    so this shares nothing with a propagation of velocities from link to link."""
+    q, q_dot = np.asarray(q, dtype=float), np.asarray(q_dot, dtype=float)
+    poses = link_poses(robot, q + 1j * COMPLEX_STEP * q_dot)
+    rates = poses.imag / COMPLEX_STEP
+    spin = rates[..., :3, :3] @ np.swapaxes(poses.real[..., :3, :3], -1, -2)
+    return np.concatenate([rates[..., :3, 3], _axial(spin)], -1)
+
+
+def _axial(matrix):
+    """The axial vector of the skew-symmetric part of 3x3 matrices."""
+    skew = (matrix - np.swapaxes(matrix, -1, -2)) / 2
+    return np.stack([skew[..., 2, 1], skew[..., 0, 2], skew[..., 1, 0]], -1)
+
+
+def velocity_ellipsoid(robot, q):
+    """(U_v, s_v, U_w, s_w): left singular vectors (columns of a rotation) and singular values,
+    descending, of the linear rows J[:3] and the angular rows J[3:] of `jacobian`; for n < 3 the
+    trailing values are 0. By SVD, not by the eigenvalues of J J^T, whose square roots lose half
+    the digits of a small singular value (tests/test_reference_dexterity.py)."""
+    J = jacobian(robot, q)
+    return (*_left_singular(J[..., :3, :]), *_left_singular(J[..., 3:, :]))
+
+
+def _left_singular(block):
+    """U (a rotation: its last column's sign chosen so) and the 3 singular values of a 3 x n block."""
+    U, values, _ = np.linalg.svd(block)
+    values = np.concatenate([values, np.zeros((*values.shape[:-1], 3 - values.shape[-1]))], -1)
+    U[..., :, 2] *= np.sign(np.linalg.det(U))[..., None]
+    return U, values
+
+
+def condition_number(robot, q, length):
+    """sigma_max / sigma_min of Js with its position rows divided by `length` (the characteristic
+    length, so the value has no unit); +inf where sigma_min is 0."""
+    rows = np.array([1 / length if name in ("x", "y", "z") else 1.0 for name in robot.task])
+    values = np.linalg.svd(singularity_jacobian(robot, q) * rows[:, None], compute_uv=False)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(values[..., -1] > 0, values[..., 0] / values[..., -1], np.inf)
+
+
+def _js_and_derivatives(robot, q):
+    """Js at q and its partial derivatives d Js / d q_k, (..., n, m, n), each exact to rounding:
+    the geometric rows and `hessian`, or the Euler-rate form of the task Jacobian and
+    `task_jacobian_dot` along each joint."""
+    q = np.asarray(q, dtype=float)
+    if sum(name in ("roll", "pitch", "yaw") for name in robot.task) in (0, 3):
+        rows = [TASK_COMPONENTS.index(name) for name in robot.task]
+        return jacobian(robot, q)[..., rows, :], hessian(robot, q)[..., rows, :]
+    units = np.eye(q.shape[-1])
+    return _euler_rates_jacobian(robot, q), np.stack([task_jacobian_dot(robot, q, unit) for unit in units], -3)
+
+
+def manipulability_gradient(robot, q):
+    """d manipulability / d q_k, (..., n). With Js = sum_i s_i u_i v_i^T (thin SVD) the
+    manipulability is prod_i s_i and d s_i = u_i^T dJs v_i, so the derivative is
+    sum_i (prod_{j != i} s_j) u_i^T (d Js / d q_k) v_i, for a wide, square or tall Js alike.
+    Where the manipulability is exactly 0 (|s| has a kink there) it is 0, as in the generated code."""
+    js, derivatives = _js_and_derivatives(robot, q)
+    u, values, vt = np.linalg.svd(js, full_matrices=False)
+    others = np.stack([np.prod(np.delete(values, i, -1), -1) for i in range(values.shape[-1])], -1)
+    rates = np.einsum("...ai,...kab,...ib->...ki", u, derivatives, vt)
+    gradient = np.einsum("...ki,...i->...k", rates, others)
+    return np.where(np.prod(values, -1)[..., None] == 0, 0.0, gradient)
+
+
+def rotation_vector(rotation):
+    """The rotation vector (axis times angle in [0, pi]) of rotation matrices, the log map.
+
+    With v the axial vector of (R - R^T) / 2 (the axis times sin(angle)) and cos(angle) =
+    (trace - 1) / 2: below a quarter turn it is v angle / sin(angle) (angle / sin within [1,
+    pi / 2]); beyond, the axis is the eigenvector of (R + R^T) / 2 of eigenvalue 1 (the other two
+    are cos(angle) <= 0, a gap of at least 1), signed along v."""
+    v = _axial(rotation)
+    sin = np.linalg.norm(v, axis=-1)
+    cos = (np.trace(rotation, axis1=-2, axis2=-1) - 1) / 2
+    angle = np.arctan2(sin, cos)
+    axis = np.linalg.eigh((rotation + np.swapaxes(rotation, -1, -2)) / 2)[1][..., :, -1]
+    axis = axis * np.where(np.sum(axis * v, -1) < 0, -1.0, 1.0)[..., None]
+    ratio = np.where(sin > 0, angle / np.where(sin > 0, sin, 1.0), 1.0)
+    return np.where((cos > 0)[..., None], v * ratio[..., None], axis * angle[..., None])
+
+
+def task_error(robot, q, target):
+    """The error resolved_rate feeds back, in the rows of Js: for a six-component task (a 4x4
+    target) ik_numeric's, the position error and the rotation vector of R_target R(q)^T, world
+    frame; for another task with all of roll, pitch and yaw (whose Js has angular-velocity rows)
+    the same from the target's angles, R_target = Rz(yaw) Ry(pitch) Rx(roll); else target - mu(q)
+    with the Euler angles wrapped into (-pi, pi]."""
+    target = np.asarray(target, dtype=float)
+    pose = fk(robot, q)
+    if len(robot.task) == 6:
+        position, goal = target[..., :3, 3], target[..., :3, :3]
+    elif {"roll", "pitch", "yaw"} <= set(robot.task):
+        given = dict(zip(robot.task, np.moveaxis(target, -1, 0)))
+        position = np.stack([given.get(axis, pose[..., i, 3]) for i, axis in enumerate("xyz")], -1)
+        goal = _rpy_rotation(given["roll"], given["pitch"], given["yaw"])[..., :3, :3]
+    else:
+        difference = target - task(robot, q)
+        angular = [k for k, name in enumerate(robot.task) if name in ("roll", "pitch", "yaw")]
+        difference[..., angular] = np.pi - (np.pi - difference[..., angular]) % (2 * np.pi)
+        return difference
+    turn = rotation_vector(goal @ np.swapaxes(pose[..., :3, :3], -1, -2))
+    full = np.concatenate([position - pose[..., :3, 3], turn], -1)
+    return full[..., [TASK_COMPONENTS.index(name) for name in robot.task]]

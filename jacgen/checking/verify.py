@@ -10,7 +10,9 @@ reference does not have are listed as not compared).
 The random joint vectors are rounded to float32 first, so that the float build, which can
 only read float32 joint angles, is compared at exactly the configuration the reference
 sees, and its error is the error of its arithmetic alone. `ik` and `ik_numeric` are
-checked by round trip, `velocity_ik` by its backward error.
+checked by round trip, `velocity_ik` by its backward error, and the functions of velocity and
+dexterity whose results are not unique or not well conditioned (the velocity ellipsoid, the
+condition number, ...) by what characterises them (`dexterity_checks`).
 
 `--target cortex-m4f` checks the float C alone, run on an emulated Cortex-M4F
 (`jacgen.target`), with the same samples, comparisons and tolerances.
@@ -20,7 +22,6 @@ import inspect
 import math
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
@@ -29,7 +30,9 @@ import numpy as np
 from jacgen.checking import reference
 from jacgen.checking.c_library import build_native, c_compiler, compile_shared
 from jacgen.checking.cortex_m4f import Emulator, check_tools
+from jacgen.checking.dexterity_checks import CHECKED_HERE, dexterity_results, velocity_ik_residual
 from jacgen.checking.generated_code import HOST_BACKENDS, GeneratedCode
+from jacgen.checking.result import Result, is_float
 from jacgen.checking.samples import configurations
 from jacgen.emission.catalogue import Function
 from jacgen.emission.generator import Generator
@@ -58,22 +61,6 @@ ZERO_JACOBIAN = 1e-12
 NUMERIC_IK_SAMPLES = 20
 # ik_numeric as verify runs it: up to this many steps, to IK_NUMERIC_VERIFIED by real type.
 IK_NUMERIC_STEPS = 200
-
-
-@dataclass(frozen=True)
-class Result:
-    """The largest error of one function of one robot, per backend (None: not compared)."""
-
-    robot: str
-    function: str
-    errors: dict[str, float | None]
-    tolerances: dict[str, float]
-    note: str = ""
-
-    @property
-    def failed(self) -> bool:
-        return any(error is not None and not error <= self.tolerances[backend]
-                   for backend, error in self.errors.items())
 
 
 def _reference(robot: Robot, function: Function, q: np.ndarray, *more: np.ndarray) -> np.ndarray | None:
@@ -122,7 +109,7 @@ def verify_robot(robot: Robot, backends: GeneratedCode, functions: list[Function
                  random_count: int, form: ik.ClosedForm | None) -> list[Result]:
     """Every function at q, whose first `random_count` rows are random (not singular) samples."""
     names = backends.names
-    tolerances = {backend: VERIFIED["float" if _is_float(backend) else "double"] * (1 + robot.reach)
+    tolerances = {backend: VERIFIED["float" if is_float(backend) else "double"] * (1 + robot.reach)
                   for backend in names}
     # Js's determinant and manipulability are products of one entry per position row, each up to the reach
     positions = sum(component in ("x", "y", "z") for component in robot.task)
@@ -131,7 +118,8 @@ def verify_robot(robot: Robot, backends: GeneratedCode, functions: list[Function
     results = []
     ranks = _rank_ratios(robot, q)
     q_dot = np.random.default_rng(1).normal(size=q.shape)  # joint rates, for the second-order functions
-    compared = [f for f in functions if [a.name for a in f.arguments] in (["q"], ["q", "q_dot"])]  # the IK: below
+    compared = [f for f in functions if [a.name for a in f.arguments] in (["q"], ["q", "q_dot"])  # the IK: below
+                and f.name not in CHECKED_HERE]
     for function in compared:
         more = (q_dot,) if len(function.arguments) == 2 else ()
         if function.name == "singularity_factors":
@@ -158,25 +146,21 @@ def verify_robot(robot: Robot, backends: GeneratedCode, functions: list[Function
     mu_dot = np.random.default_rng(0).normal(size=(int(regular.sum()), len(robot.task)))
     residuals, flagged = {}, {}
     for backend in names:
-        residuals[backend], flagged[backend] = _velocity_ik_residual(
+        residuals[backend], flagged[backend] = velocity_ik_residual(
             robot, backends.call(backend, "velocity_ik", q[regular], mu_dot, 0.0), q[regular], mu_dot,
-            allow_singular=_is_float(backend))
+            allow_singular=is_float(backend))
     results.append(Result(robot.name, "velocity_ik", residuals, tolerances,
                           ("|Js^T (Js q_dot - mu_dot)| / |Js| (|Js| |q_dot| + |mu_dot|)" if len(robot.task) > robot.dof
                            else "|Js q_dot - mu_dot| / (|Js| |q_dot| + |mu_dot|)")
                           + f" at the {int(regular.sum())} samples where Js is regular"
                           + "".join(f"; {backend}: {flagged[backend]} reported singular (float's threshold)"
-                                    for backend in names if _is_float(backend) and flagged[backend])))
-    return results
+                                    for backend in names if is_float(backend) and flagged[backend])))
+    return results + dexterity_results(robot, backends, q, ~np.isnan(ranks), regular, tolerances, product_tolerances)
 
 
 def _wrapped(angles: np.ndarray) -> np.ndarray:
     """Differences of angles in [-pi, pi)."""
     return (angles + math.pi) % (2 * math.pi) - math.pi
-
-
-def _is_float(backend: str) -> bool:
-    return "float" in backend.split()
 
 
 def _rank_ratios(robot: Robot, q: np.ndarray) -> np.ndarray:
@@ -243,7 +227,7 @@ def _ik_results(robot: Robot, backends: GeneratedCode, q: np.ndarray, tolerances
         # The closed form divides by sines that vanish at singularities, so float rounding is
         # amplified there: measured up to 7.6e-4 on 2,000 ur5 targets, hence ten times the
         # tolerance of straight-line functions for the float builds.
-        ik_tolerances = {backend: 10 * tolerance if _is_float(backend) else tolerance
+        ik_tolerances = {backend: 10 * tolerance if is_float(backend) else tolerance
                          for backend, tolerance in tolerances.items()}
         on_target = [backend for backend, error in checked.items() if error is not None]
         results.append(Result(robot.name, "ik", errors, ik_tolerances,
@@ -259,7 +243,7 @@ def _ik_results(robot: Robot, backends: GeneratedCode, q: np.ndarray, tolerances
     errors, converged = {}, {}
     for backend in backends.names:
         found, status = backends.call(backend, "ik_numeric", targets[:count], starts[:count], IK_NUMERIC_STEPS,
-                                      IK_NUMERIC_VERIFIED["float" if _is_float(backend) else "double"])
+                                      IK_NUMERIC_VERIFIED["float" if is_float(backend) else "double"])
         # Status 0 promises |error| <= tol; a stall (a local minimum of the task error) is allowed.
         reached = np.asarray(status) == 0
         errors[backend] = _target_error(robot, np.asarray(found)[reached], targets[:count][reached])
@@ -305,32 +289,6 @@ def _branch_results(robot: Robot, backends: GeneratedCode, q: np.ndarray, target
             Result(robot.name, "ik_nearest", nearest_errors, tolerances,
                    "reaches the target, and no valid branch in the limits is nearer the seed"
                    + "".join(f"; {backend}: {n} not the nearest" for backend, n in nearer.items() if n))]
-
-
-def _velocity_ik_residual(robot: Robot, solved: tuple[np.ndarray, np.ndarray], q: np.ndarray,
-                          mu_dot: np.ndarray, allow_singular: bool = False) -> tuple[float, int]:
-    """Largest backward error of velocity_ik's (q_dot, status) at q for mu_dot, and how many
-    samples reported singular: the residual |Js q_dot - mu_dot| / (|Js| |q_dot| + |mu_dot|),
-    scaled by what rounding alone leaves so the bound does not depend on how well
-    conditioned Js is. A tall Js (m > n) has no exact solution: there the residual is that of
-    the normal equations, Js^T (Js q_dot - mu_dot). A status other than OK is an infinite
-    error, except that `allow_singular` lets a sample be reported singular: in float, a
-    system whose R has a diagonal ratio below 1e-5 is, and the Gram matrix of a Js sampled
-    here (condition number up to 1e3) reaches 1e6."""
-    q_dot, status = solved
-    singular = (status == 1) if allow_singular else np.zeros(len(q), dtype=bool)
-    if np.any((status != 0) & ~singular):
-        return math.inf, int(singular.sum())
-    q, q_dot, mu_dot = q[~singular], q_dot[~singular], mu_dot[~singular]
-    if not len(q):
-        return 0.0, int(singular.sum())
-    js = reference.singularity_jacobian(robot, q)
-    residual = np.einsum("kij,kj->ki", js, q_dot) - mu_dot
-    norm = np.linalg.norm(js, ord=2, axis=(1, 2))
-    scale = norm * np.linalg.norm(q_dot, axis=1) + np.linalg.norm(mu_dot, axis=1)
-    if len(robot.task) > robot.dof:
-        residual, scale = np.einsum("kij,ki->kj", js, residual), norm * scale
-    return float(np.max(np.linalg.norm(residual, axis=1) / scale, initial=0.0)), int(singular.sum())
 
 
 def verify(robots: list[Robot], samples: int, seed: int,
@@ -403,12 +361,12 @@ def format_table(results: list[Result]) -> str:
             error = result.errors[backend]
             mark = "" if error is None or error <= result.tolerances[backend] else " FAIL"
             cells.append("-" if error is None else f"{error:.1e}{mark}")
-        cells += [f"{max(result.tolerances[backend] for backend in names if _is_float(backend)):.1e}", result.note]
+        cells += [f"{max(result.tolerances[backend] for backend in names if is_float(backend)):.1e}", result.note]
         rows.append(cells)
     widths = [max(len(row[c]) for row in rows) for c in range(len(header))]
     lines = ["  ".join(cell.ljust(width) for cell, width in zip(row, widths)).rstrip() for row in rows]
     failed = sum(result.failed for result in results)
-    run = [real for real in VERIFIED if any(_is_float(backend) == (real == "float") for backend in names)]
+    run = [real for real in VERIFIED if any(is_float(backend) == (real == "float") for backend in names)]
     tolerances = ", ".join(f"{real} {VERIFIED[real]:.0e}" for real in run)  # of the builds run
     lines.append(f"tolerance x (1 + reach): {tolerances}; {failed} of {len(results)} functions above tolerance")
     return "\n".join(lines)

@@ -43,8 +43,9 @@ def pinocchio_from_dh(robot):
     standard  Rz(theta) Tz(d) Tx(a) Rx(alpha): before = 1,           after = Rz(t0) Tz(d0) Tx(a) Rx(alpha)
     modified  Rx(alpha) Tx(a) Rz(theta) Tz(d): before = Rx(alpha) Tx(a), after = Rz(t0) Tz(d0)
     with (t0, d0) = (offset, d) for a revolute and (theta, offset) for a prismatic joint. The
-    placement of joint i in joint i-1 is after_{i-1} * before_i (after_0 = the base), and the
-    tool frame sits at after_n * tool on the last joint.
+    placement of joint i in joint i-1 is after_{i-1} * before_i (after_0 = the base), the link
+    frame base A_1 ... A_i (frame `link_i`) sits at after_i on joint i, and the tool frame at
+    after_n * tool on the last joint.
     """
     model = pin.Model()
     parent, placement = 0, placement_of(robot.base)
@@ -60,6 +61,7 @@ def pinocchio_from_dh(robot):
         placement = rot_z(theta0) * translation(0, 0, d0)
         if robot.convention == "standard":
             placement = placement * translation(a, 0, 0) * rot_x(alpha)
+        model.addFrame(pin.Frame(f"link_{parent}", parent, placement, pin.FrameType.OP_FRAME))
     model.addFrame(pin.Frame("tool", parent, placement * placement_of(robot.tool), pin.FrameType.OP_FRAME))
     return model
 

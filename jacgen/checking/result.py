@@ -1,0 +1,24 @@
+"""One row of `jacgen verify`'s table, and which backends run in float: shared by `verify` and
+the checks it calls (`dexterity_checks`)."""
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Result:
+    """The largest error of one function of one robot, per backend (None: not compared)."""
+
+    robot: str
+    function: str
+    errors: dict[str, float | None]
+    tolerances: dict[str, float]
+    note: str = ""
+
+    @property
+    def failed(self) -> bool:
+        return any(error is not None and not error <= self.tolerances[backend]
+                   for backend, error in self.errors.items())
+
+
+def is_float(backend: str) -> bool:
+    return "float" in backend.split()
