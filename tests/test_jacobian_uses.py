@@ -199,7 +199,7 @@ NEW = {"link_poses": lambda q, rng: (q,), "link_velocities": lambda q, rng: (q, 
        "manipulability_gradient": lambda q, rng: (q,),
        "velocity_ik_nullspace": lambda q, rng: (q, rng.normal(size=(len(q), 6)), rng.normal(size=q.shape)),
        "resolved_rate": lambda q, rng: (q, np.tile(np.eye(4), (len(q), 1, 1)), rng.normal(size=(len(q), 6)),
-                                        np.full(6, 2.0), rng.normal(size=q.shape))}
+                                        np.full((len(q), 6), 2.0), rng.normal(size=q.shape))}
 
 
 @pytest.mark.parametrize("lib", ["jax", "torch"])
