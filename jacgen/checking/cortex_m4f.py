@@ -241,10 +241,13 @@ class Emulator:
 
     def measure_remaining(self, q: np.ndarray, free: int | None) -> None:
         """Run each function not run yet at q, so that every one has instruction and stack
-        figures: targets reached at q, seeds and starts 0.1 away, unit weights, damping 0.01."""
+        figures: targets reached at q, seeds and starts 0.1 away, unit weights, damping 0.01, random
+        rates and null-space motions, gains of 10."""
         rng = np.random.default_rng(2)
         target = reference.ik_target(self.robot, q)
-        values = {"q": q, "q_dot": rng.normal(size=q.shape), "mu_dot": rng.normal(size=(len(q), len(self.robot.task))),
+        rates = rng.normal(size=(len(q), len(self.robot.task)))
+        values = {"q": q, "q_dot": rng.normal(size=q.shape), "mu_dot": rates, "target_rate": rates,
+                  "z": rng.normal(size=q.shape), "gain": np.full_like(rates, 10.0),
                   "damping": np.full(len(q), 0.01), "target": target, "T": target, "mu": target,
                   "q_seed": q + 0.1, "q0": q + 0.1, "weights": np.ones_like(q),
                   "max_iter": np.full(len(q), IK_NUMERIC_DEFAULTS["max_iter"]), "tol": np.full(len(q), IK_NUMERIC_VERIFIED["float"]), "q_free": q[:, free] if free is not None else None}
