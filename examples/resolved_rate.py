@@ -1,5 +1,5 @@
-"""Resolved-rate control of a 7-axis arm, with and without null-space motion (README,
-"Resolved-rate control"): the Panda's tool follows a circle at 1 kHz through the generated
+"""Resolved-rate control of a 7-axis arm, with and without null-space motion (README §4,
+"Resolved-rate control with null-space motion"): the Panda's tool follows a circle at 1 kHz through the generated
 numpy module generated/panda/panda.py, as `jacgen generate robots/panda.yaml` writes it.
 
     python examples/resolved_rate.py [--seconds 4] [--plot docs/resolved_rate.png]
@@ -19,7 +19,9 @@ from pathlib import Path
 import numpy as np
 
 GENERATED = Path(__file__).resolve().parent.parent / "generated"
-START = np.array([0.5, -0.5, 1.5, -1.8, -0.5, 1.4, 0.785])  # rad: the elbow turned out, away from the best
+# rad, within the limits. Not a symmetric pose: where q1 = q3 = q5 = 0 the manipulability is
+# stationary along the self-motion, and z would do nothing.
+START = np.array([0.5, -0.5, 1.5, -1.8, -0.5, 1.4, 0.785])
 TICK = 1e-3  # s: the 1 kHz control loop
 RADIUS, PERIOD = 0.1, 4.0  # m, s: the circle, in the world x-y plane through the tool's start
 GAIN = 30.0  # 1/s: the task error decays as exp(-GAIN t)
