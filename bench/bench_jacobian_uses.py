@@ -134,13 +134,14 @@ def native_table(calls: int, rounds: int) -> None:
     peers = {"link_poses": PEERS[0], "link_velocities": PEERS[1], "velocity_ellipsoid": PEERS[2],
              "condition_number": PEERS[3]}
     names = [robot.name for robot in robots]
-    print(f"{'function':24} " + " ".join(f"{name:>9}" for name in names) + "   peer (same harness): "
+    width = max(map(len, PEERS))
+    print(f"{'function':36} " + " ".join(f"{name:>9}" for name in names) + f"   {'peer, same harness':{width}} "
           + " ".join(f"{name:>9}" for name in names))
     for function in OURS:
         ours = " ".join(f"{median[(name, f'ours {function}')]:9.1f}" for name in names)
         peer = peers.get(function)
         theirs = " ".join(f"{median[(name, peer)]:9.1f}" for name in names) if peer else ""
-        print(f"{function:24} {ours}   {peer or '':22} {theirs}")
+        print(f"{function:36} {ours}   {peer or '':{width}} {theirs}")
     for label, top, bottom in (("resolved_rate / velocity_ik", "resolved_rate", "velocity_ik"),
                                ("velocity_ik_nullspace / velocity_ik", "velocity_ik_nullspace", "velocity_ik"),
                                ("link_poses / fk", "link_poses", "fk")):
