@@ -3065,10 +3065,10 @@ def velocity_ellipsoid(q):
     t85 = t83**2
     t86 = t53*t59
     t87 = xp.not_equal(t86, 0)
-    t88 = 0.5*(-t56 + t84)/xp.where(t87, -t86, 1)
+    t88 = (-t56 + t84)/xp.where(t87, -2*t86, 1)
     t89 = xp.abs(t88)
     t90 = xp.greater_equal(t89, 1)
-    t91 = xp.abs(1/xp.where(t90, t88, 1))
+    t91 = 1/xp.abs(xp.where(t90, t88, 1))
     t92 = xp.where(t87, xp.where(xp.greater_equal(t88, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t90, t91/(1 + xp.sqrt(1 + t91**2)), 1/(t89 + xp.sqrt(1 + t89**2))), 0)
     t93 = 1/xp.sqrt(1 + t92**2)
     t94 = t86*t92
@@ -3084,10 +3084,10 @@ def velocity_ellipsoid(q):
     t104 = t103*t92
     t105 = t101*t99 - t104*t77
     t106 = xp.not_equal(t105, 0)
-    t107 = 0.5*(-t95 + t102)/xp.where(t106, t105, 1)
+    t107 = (-t95 + t102)/xp.where(t106, 2*t105, 1)
     t108 = xp.abs(t107)
     t109 = xp.greater_equal(t108, 1)
-    t110 = xp.abs(1/xp.where(t109, t107, 1))
+    t110 = 1/xp.abs(xp.where(t109, t107, 1))
     t111 = xp.where(t106, xp.where(xp.greater_equal(t107, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t109, t110/(1 + xp.sqrt(1 + t110**2)), 1/(t108 + xp.sqrt(1 + t108**2))), 0)
     t112 = 1/xp.sqrt(1 + t111**2)
     t113 = t105*t111
@@ -3103,10 +3103,10 @@ def velocity_ellipsoid(q):
     t123 = -t121 + t120*t111
     t124 = t100*t119 + t103*t123
     t125 = xp.not_equal(t124, 0)
-    t126 = 0.5*(-t96 + t115)/xp.where(t125, -t124, 1)
+    t126 = (-t96 + t115)/xp.where(t125, -2*t124, 1)
     t127 = xp.abs(t126)
     t128 = xp.greater_equal(t127, 1)
-    t129 = xp.abs(1/xp.where(t128, t126, 1))
+    t129 = 1/xp.abs(xp.where(t128, t126, 1))
     t130 = xp.where(t125, xp.where(xp.greater_equal(t126, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t128, t129/(1 + xp.sqrt(1 + t129**2)), 1/(t127 + xp.sqrt(1 + t127**2))), 0)
     t131 = 1/xp.sqrt(1 + t130**2)
     t132 = t124*t130
@@ -3132,10 +3132,10 @@ def velocity_ellipsoid(q):
     t152 = t130*t131
     t153 = t118*t137 - t122*t142 + t85*t146*t152*t112
     t154 = xp.not_equal(t153, 0)
-    t155 = 0.5*(-t114 + t133)/xp.where(t154, t153, 1)
+    t155 = (-t114 + t133)/xp.where(t154, 2*t153, 1)
     t156 = xp.abs(t155)
     t157 = xp.greater_equal(t156, 1)
-    t158 = xp.abs(1/xp.where(t157, t155, 1))
+    t158 = 1/xp.abs(xp.where(t157, t155, 1))
     t159 = xp.where(t154, xp.where(xp.greater_equal(t155, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t157, t158/(1 + xp.sqrt(1 + t158**2)), 1/(t156 + xp.sqrt(1 + t156**2))), 0)
     t160 = 1/xp.sqrt(1 + t159**2)
     t161 = t153*t159
@@ -3169,10 +3169,10 @@ def velocity_ellipsoid(q):
     t189 = t112*t131
     t190 = t138*t166 + t143*t170 - t189*t83*t179
     t191 = xp.not_equal(t190, 0)
-    t192 = 0.5*(-t162 + t134)/xp.where(t191, t190, 1)
+    t192 = (-t162 + t134)/xp.where(t191, 2*t190, 1)
     t193 = xp.abs(t192)
     t194 = xp.greater_equal(t193, 1)
-    t195 = xp.abs(1/xp.where(t194, t192, 1))
+    t195 = 1/xp.abs(xp.where(t194, t192, 1))
     t196 = xp.where(t191, xp.where(xp.greater_equal(t192, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t194, t195/(1 + xp.sqrt(1 + t195**2)), 1/(t193 + xp.sqrt(1 + t193**2))), 0)
     t197 = 1/xp.sqrt(1 + t196**2)
     t198 = t190*t196
@@ -3204,10 +3204,10 @@ def velocity_ellipsoid(q):
     t224 = t223 - t210*t196
     t225 = t210 + t223*t196
     t226 = xp.not_equal(t214, 0)
-    t227 = 0.5*(-t163 + t200)/xp.where(t226, t214, 1)
+    t227 = (-t163 + t200)/xp.where(t226, 2*t214, 1)
     t228 = xp.abs(t227)
     t229 = xp.greater_equal(t228, 1)
-    t230 = xp.abs(1/xp.where(t229, t227, 1))
+    t230 = 1/xp.abs(xp.where(t229, t227, 1))
     t231 = xp.where(t226, xp.where(xp.greater_equal(t227, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t229, t230/(1 + xp.sqrt(1 + t230**2)), 1/(t228 + xp.sqrt(1 + t228**2))), 0)
     t232 = 1/xp.sqrt(1 + t231**2)
     t233 = t214*t231
@@ -3239,10 +3239,10 @@ def velocity_ellipsoid(q):
     t259 = t257 + t258*t231
     t260 = t258 - t257*t231
     t261 = xp.not_equal(t248, 0)
-    t262 = 0.5*(-t199 + t234)/xp.where(t261, t248, 1)
+    t262 = (-t199 + t234)/xp.where(t261, 2*t248, 1)
     t263 = xp.abs(t262)
     t264 = xp.greater_equal(t263, 1)
-    t265 = xp.abs(1/xp.where(t264, t262, 1))
+    t265 = 1/xp.abs(xp.where(t264, t262, 1))
     t266 = xp.where(t261, xp.where(xp.greater_equal(t262, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t264, t265/(1 + xp.sqrt(1 + t265**2)), 1/(t263 + xp.sqrt(1 + t263**2))), 0)
     t267 = 1/xp.sqrt(1 + t266**2)
     t268 = t248*t266
@@ -3274,10 +3274,10 @@ def velocity_ellipsoid(q):
     t294 = t292 + t293*t266
     t295 = -t293 + t292*t266
     t296 = xp.not_equal(t283, 0)
-    t297 = 0.5*(-t269 + t235)/xp.where(t296, t283, 1)
+    t297 = (-t269 + t235)/xp.where(t296, 2*t283, 1)
     t298 = xp.abs(t297)
     t299 = xp.greater_equal(t298, 1)
-    t300 = xp.abs(1/xp.where(t299, t297, 1))
+    t300 = 1/xp.abs(xp.where(t299, t297, 1))
     t301 = xp.where(t296, xp.where(xp.greater_equal(t297, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t299, t300/(1 + xp.sqrt(1 + t300**2)), 1/(t298 + xp.sqrt(1 + t298**2))), 0)
     t302 = 1/xp.sqrt(1 + t301**2)
     t303 = t283*t301
@@ -3309,10 +3309,10 @@ def velocity_ellipsoid(q):
     t329 = t327 - t328*t301
     t330 = t328 + t327*t301
     t331 = xp.not_equal(t318, 0)
-    t332 = 0.5*(-t270 + t305)/xp.where(t331, t318, 1)
+    t332 = (-t270 + t305)/xp.where(t331, 2*t318, 1)
     t333 = xp.abs(t332)
     t334 = xp.greater_equal(t333, 1)
-    t335 = xp.abs(1/xp.where(t334, t332, 1))
+    t335 = 1/xp.abs(xp.where(t334, t332, 1))
     t336 = xp.where(t331, xp.where(xp.greater_equal(t332, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t334, t335/(1 + xp.sqrt(1 + t335**2)), 1/(t333 + xp.sqrt(1 + t333**2))), 0)
     t337 = 1/xp.sqrt(1 + t336**2)
     t338 = t318*t336
@@ -3344,10 +3344,10 @@ def velocity_ellipsoid(q):
     t364 = t362 - t336*t363
     t365 = t363 + t336*t362
     t366 = xp.not_equal(t353, 0)
-    t367 = 0.5*(-t304 + t339)/xp.where(t366, t353, 1)
+    t367 = (-t304 + t339)/xp.where(t366, 2*t353, 1)
     t368 = xp.abs(t367)
     t369 = xp.greater_equal(t368, 1)
-    t370 = xp.abs(1/xp.where(t369, t367, 1))
+    t370 = 1/xp.abs(xp.where(t369, t367, 1))
     t371 = xp.where(t366, xp.where(xp.greater_equal(t367, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t369, t370/(1 + xp.sqrt(1 + t370**2)), 1/(t368 + xp.sqrt(1 + t368**2))), 0)
     t372 = 1/xp.sqrt(1 + t371**2)
     t373 = t353*t371
@@ -3379,10 +3379,10 @@ def velocity_ellipsoid(q):
     t399 = t397 - t371*t398
     t400 = t398 + t371*t397
     t401 = xp.not_equal(t388, 0)
-    t402 = 0.5*(-t374 + t340)/xp.where(t401, t388, 1)
+    t402 = (-t374 + t340)/xp.where(t401, 2*t388, 1)
     t403 = xp.abs(t402)
     t404 = xp.greater_equal(t403, 1)
-    t405 = xp.abs(1/xp.where(t404, t402, 1))
+    t405 = 1/xp.abs(xp.where(t404, t402, 1))
     t406 = xp.where(t401, xp.where(xp.greater_equal(t402, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t404, t405/(1 + xp.sqrt(1 + t405**2)), 1/(t403 + xp.sqrt(1 + t403**2))), 0)
     t407 = 1/xp.sqrt(1 + t406**2)
     t408 = t388*t406
@@ -3414,10 +3414,10 @@ def velocity_ellipsoid(q):
     t434 = t432 - t406*t433
     t435 = t433 + t406*t432
     t436 = xp.not_equal(t423, 0)
-    t437 = 0.5*(-t375 + t410)/xp.where(t436, t423, 1)
+    t437 = (-t375 + t410)/xp.where(t436, 2*t423, 1)
     t438 = xp.abs(t437)
     t439 = xp.greater_equal(t438, 1)
-    t440 = xp.abs(1/xp.where(t439, t437, 1))
+    t440 = 1/xp.abs(xp.where(t439, t437, 1))
     t441 = xp.where(t436, xp.where(xp.greater_equal(t437, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t439, t440/(1 + xp.sqrt(1 + t440**2)), 1/(t438 + xp.sqrt(1 + t438**2))), 0)
     t442 = 1/xp.sqrt(1 + t441**2)
     t443 = t423*t441
@@ -3449,10 +3449,10 @@ def velocity_ellipsoid(q):
     t469 = t467 - t441*t468
     t470 = t468 + t441*t467
     t471 = xp.not_equal(t458, 0)
-    t472 = 0.5*(-t409 + t444)/xp.where(t471, t458, 1)
+    t472 = (-t409 + t444)/xp.where(t471, 2*t458, 1)
     t473 = xp.abs(t472)
     t474 = xp.greater_equal(t473, 1)
-    t475 = xp.abs(1/xp.where(t474, t472, 1))
+    t475 = 1/xp.abs(xp.where(t474, t472, 1))
     t476 = xp.where(t471, xp.where(xp.greater_equal(t472, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t474, t475/(1 + xp.sqrt(1 + t475**2)), 1/(t473 + xp.sqrt(1 + t473**2))), 0)
     t477 = 1/xp.sqrt(1 + t476**2)
     t478 = t458*t476
@@ -3484,10 +3484,10 @@ def velocity_ellipsoid(q):
     t504 = t502 - t476*t503
     t505 = t503 + t476*t502
     t506 = xp.not_equal(t493, 0)
-    t507 = 0.5*(-t479 + t445)/xp.where(t506, t493, 1)
+    t507 = (-t479 + t445)/xp.where(t506, 2*t493, 1)
     t508 = xp.abs(t507)
     t509 = xp.greater_equal(t508, 1)
-    t510 = xp.abs(1/xp.where(t509, t507, 1))
+    t510 = 1/xp.abs(xp.where(t509, t507, 1))
     t511 = xp.where(t506, xp.where(xp.greater_equal(t507, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t509, t510/(1 + xp.sqrt(1 + t510**2)), 1/(t508 + xp.sqrt(1 + t508**2))), 0)
     t512 = 1/xp.sqrt(1 + t511**2)
     t513 = t445 + t493*t511
@@ -3518,10 +3518,10 @@ def velocity_ellipsoid(q):
     t538 = t536 - t511*t537
     t539 = t537 + t511*t536
     t540 = xp.not_equal(t526, 0)
-    t541 = 0.5*(-t480 + t513)/xp.where(t540, t526, 1)
+    t541 = (-t480 + t513)/xp.where(t540, 2*t526, 1)
     t542 = xp.abs(t541)
     t543 = xp.greater_equal(t542, 1)
-    t544 = xp.abs(1/xp.where(t543, t541, 1))
+    t544 = 1/xp.abs(xp.where(t543, t541, 1))
     t545 = xp.where(t540, xp.where(xp.greater_equal(t541, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t543, t544/(1 + xp.sqrt(1 + t544**2)), 1/(t542 + xp.sqrt(1 + t542**2))), 0)
     t546 = 1/xp.sqrt(1 + t545**2)
     t547 = t484*t546
@@ -3620,10 +3620,10 @@ def velocity_ellipsoid(q):
     t640 = t639**2
     t641 = t618**2 + t632**2 + t640
     t642 = xp.not_equal(t629, 0)
-    t643 = 0.5*(-t608 + t628)/xp.where(t642, t629, 1)
+    t643 = (-t608 + t628)/xp.where(t642, 2*t629, 1)
     t644 = xp.abs(t643)
     t645 = xp.greater_equal(t644, 1)
-    t646 = xp.abs(1/xp.where(t645, t643, 1))
+    t646 = 1/xp.abs(xp.where(t645, t643, 1))
     t647 = xp.where(t642, xp.where(xp.greater_equal(t643, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t645, t646/(1 + xp.sqrt(1 + t646**2)), 1/(t644 + xp.sqrt(1 + t644**2))), 0)
     t648 = 1/xp.sqrt(1 + t647**2)
     t649 = t629*t647
@@ -3637,10 +3637,10 @@ def velocity_ellipsoid(q):
     t657 = t647*t656
     t658 = t618*t654 + t632*t657
     t659 = xp.not_equal(t658, 0)
-    t660 = 0.5*(-t650 + t641)/xp.where(t659, t658, 1)
+    t660 = (-t650 + t641)/xp.where(t659, 2*t658, 1)
     t661 = xp.abs(t660)
     t662 = xp.greater_equal(t661, 1)
-    t663 = xp.abs(1/xp.where(t662, t660, 1))
+    t663 = 1/xp.abs(xp.where(t662, t660, 1))
     t664 = xp.where(t659, xp.where(xp.greater_equal(t660, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t662, t663/(1 + xp.sqrt(1 + t663**2)), 1/(t661 + xp.sqrt(1 + t661**2))), 0)
     t665 = 1/xp.sqrt(1 + t664**2)
     t666 = t658*t664
@@ -3656,10 +3656,10 @@ def velocity_ellipsoid(q):
     t676 = t674 + t664*t673
     t677 = t655*t672 + t676*t656
     t678 = xp.not_equal(t677, 0)
-    t679 = 0.5*(-t651 + t668)/xp.where(t678, -t677, 1)
+    t679 = (-t651 + t668)/xp.where(t678, -2*t677, 1)
     t680 = xp.abs(t679)
     t681 = xp.greater_equal(t680, 1)
-    t682 = xp.abs(1/xp.where(t681, t679, 1))
+    t682 = 1/xp.abs(xp.where(t681, t679, 1))
     t683 = xp.where(t678, xp.where(xp.greater_equal(t679, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t681, t682/(1 + xp.sqrt(1 + t682**2)), 1/(t680 + xp.sqrt(1 + t680**2))), 0)
     t684 = 1/xp.sqrt(1 + t683**2)
     t685 = t677*t683
@@ -3685,10 +3685,10 @@ def velocity_ellipsoid(q):
     t705 = t683*t684
     t706 = t671*t690 + t675*t695 - t665*t640*t699*t705
     t707 = xp.not_equal(t706, 0)
-    t708 = 0.5*(-t667 + t686)/xp.where(t707, -t706, 1)
+    t708 = (-t667 + t686)/xp.where(t707, -2*t706, 1)
     t709 = xp.abs(t708)
     t710 = xp.greater_equal(t709, 1)
-    t711 = xp.abs(1/xp.where(t710, t708, 1))
+    t711 = 1/xp.abs(xp.where(t710, t708, 1))
     t712 = xp.where(t707, xp.where(xp.greater_equal(t708, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t710, t711/(1 + xp.sqrt(1 + t711**2)), 1/(t709 + xp.sqrt(1 + t709**2))), 0)
     t713 = 1/xp.sqrt(1 + t712**2)
     t714 = t706*t712
@@ -3722,10 +3722,10 @@ def velocity_ellipsoid(q):
     t742 = t665*t684
     t743 = t691*t719 + t696*t723 - t639*t732*t742
     t744 = xp.not_equal(t743, 0)
-    t745 = 0.5*(-t715 + t687)/xp.where(t744, t743, 1)
+    t745 = (-t715 + t687)/xp.where(t744, 2*t743, 1)
     t746 = xp.abs(t745)
     t747 = xp.greater_equal(t746, 1)
-    t748 = xp.abs(1/xp.where(t747, t745, 1))
+    t748 = 1/xp.abs(xp.where(t747, t745, 1))
     t749 = xp.where(t744, xp.where(xp.greater_equal(t745, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t747, t748/(1 + xp.sqrt(1 + t748**2)), 1/(t746 + xp.sqrt(1 + t746**2))), 0)
     t750 = 1/xp.sqrt(1 + t749**2)
     t751 = t743*t749
@@ -3757,10 +3757,10 @@ def velocity_ellipsoid(q):
     t777 = t776 - t749*t763
     t778 = t763 + t749*t776
     t779 = xp.not_equal(t767, 0)
-    t780 = 0.5*(-t716 + t753)/xp.where(t779, t767, 1)
+    t780 = (-t716 + t753)/xp.where(t779, 2*t767, 1)
     t781 = xp.abs(t780)
     t782 = xp.greater_equal(t781, 1)
-    t783 = xp.abs(1/xp.where(t782, t780, 1))
+    t783 = 1/xp.abs(xp.where(t782, t780, 1))
     t784 = xp.where(t779, xp.where(xp.greater_equal(t780, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t782, t783/(1 + xp.sqrt(1 + t783**2)), 1/(t781 + xp.sqrt(1 + t781**2))), 0)
     t785 = 1/xp.sqrt(1 + t784**2)
     t786 = t767*t784
@@ -3792,10 +3792,10 @@ def velocity_ellipsoid(q):
     t812 = t810 + t784*t811
     t813 = t811 - t784*t810
     t814 = xp.not_equal(t801, 0)
-    t815 = 0.5*(-t752 + t787)/xp.where(t814, t801, 1)
+    t815 = (-t752 + t787)/xp.where(t814, 2*t801, 1)
     t816 = xp.abs(t815)
     t817 = xp.greater_equal(t816, 1)
-    t818 = xp.abs(1/xp.where(t817, t815, 1))
+    t818 = 1/xp.abs(xp.where(t817, t815, 1))
     t819 = xp.where(t814, xp.where(xp.greater_equal(t815, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t817, t818/(1 + xp.sqrt(1 + t818**2)), 1/(t816 + xp.sqrt(1 + t816**2))), 0)
     t820 = 1/xp.sqrt(1 + t819**2)
     t821 = t801*t819
@@ -3827,10 +3827,10 @@ def velocity_ellipsoid(q):
     t847 = t845 + t819*t846
     t848 = -t846 + t819*t845
     t849 = xp.not_equal(t836, 0)
-    t850 = 0.5*(-t822 + t788)/xp.where(t849, t836, 1)
+    t850 = (-t822 + t788)/xp.where(t849, 2*t836, 1)
     t851 = xp.abs(t850)
     t852 = xp.greater_equal(t851, 1)
-    t853 = xp.abs(1/xp.where(t852, t850, 1))
+    t853 = 1/xp.abs(xp.where(t852, t850, 1))
     t854 = xp.where(t849, xp.where(xp.greater_equal(t850, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t852, t853/(1 + xp.sqrt(1 + t853**2)), 1/(t851 + xp.sqrt(1 + t851**2))), 0)
     t855 = 1/xp.sqrt(1 + t854**2)
     t856 = t836*t854
@@ -3862,10 +3862,10 @@ def velocity_ellipsoid(q):
     t882 = t880 - t854*t881
     t883 = t881 + t854*t880
     t884 = xp.not_equal(t871, 0)
-    t885 = 0.5*(-t823 + t858)/xp.where(t884, t871, 1)
+    t885 = (-t823 + t858)/xp.where(t884, 2*t871, 1)
     t886 = xp.abs(t885)
     t887 = xp.greater_equal(t886, 1)
-    t888 = xp.abs(1/xp.where(t887, t885, 1))
+    t888 = 1/xp.abs(xp.where(t887, t885, 1))
     t889 = xp.where(t884, xp.where(xp.greater_equal(t885, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t887, t888/(1 + xp.sqrt(1 + t888**2)), 1/(t886 + xp.sqrt(1 + t886**2))), 0)
     t890 = 1/xp.sqrt(1 + t889**2)
     t891 = t871*t889
@@ -3897,10 +3897,10 @@ def velocity_ellipsoid(q):
     t917 = t915 - t889*t916
     t918 = t916 + t889*t915
     t919 = xp.not_equal(t906, 0)
-    t920 = 0.5*(-t857 + t892)/xp.where(t919, t906, 1)
+    t920 = (-t857 + t892)/xp.where(t919, 2*t906, 1)
     t921 = xp.abs(t920)
     t922 = xp.greater_equal(t921, 1)
-    t923 = xp.abs(1/xp.where(t922, t920, 1))
+    t923 = 1/xp.abs(xp.where(t922, t920, 1))
     t924 = xp.where(t919, xp.where(xp.greater_equal(t920, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t922, t923/(1 + xp.sqrt(1 + t923**2)), 1/(t921 + xp.sqrt(1 + t921**2))), 0)
     t925 = 1/xp.sqrt(1 + t924**2)
     t926 = t906*t924
@@ -3932,10 +3932,10 @@ def velocity_ellipsoid(q):
     t952 = t950 - t924*t951
     t953 = t951 + t924*t950
     t954 = xp.not_equal(t941, 0)
-    t955 = 0.5*(-t927 + t893)/xp.where(t954, t941, 1)
+    t955 = (-t927 + t893)/xp.where(t954, 2*t941, 1)
     t956 = xp.abs(t955)
     t957 = xp.greater_equal(t956, 1)
-    t958 = xp.abs(1/xp.where(t957, t955, 1))
+    t958 = 1/xp.abs(xp.where(t957, t955, 1))
     t959 = xp.where(t954, xp.where(xp.greater_equal(t955, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t957, t958/(1 + xp.sqrt(1 + t958**2)), 1/(t956 + xp.sqrt(1 + t956**2))), 0)
     t960 = 1/xp.sqrt(1 + t959**2)
     t961 = t941*t959
@@ -3967,10 +3967,10 @@ def velocity_ellipsoid(q):
     t987 = t985 - t959*t986
     t988 = t986 + t959*t985
     t989 = xp.not_equal(t976, 0)
-    t990 = 0.5*(-t928 + t963)/xp.where(t989, t976, 1)
+    t990 = (-t928 + t963)/xp.where(t989, 2*t976, 1)
     t991 = xp.abs(t990)
     t992 = xp.greater_equal(t991, 1)
-    t993 = xp.abs(1/xp.where(t992, t990, 1))
+    t993 = 1/xp.abs(xp.where(t992, t990, 1))
     t994 = xp.where(t989, xp.where(xp.greater_equal(t990, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t992, t993/(1 + xp.sqrt(1 + t993**2)), 1/(t991 + xp.sqrt(1 + t991**2))), 0)
     t995 = 1/xp.sqrt(1 + t994**2)
     t996 = t976*t994
@@ -4002,10 +4002,10 @@ def velocity_ellipsoid(q):
     t1022 = t1020 - t994*t1021
     t1023 = t1021 + t994*t1020
     t1024 = xp.not_equal(t1011, 0)
-    t1025 = 0.5*(-t962 + t997)/xp.where(t1024, t1011, 1)
+    t1025 = (-t962 + t997)/xp.where(t1024, 2*t1011, 1)
     t1026 = xp.abs(t1025)
     t1027 = xp.greater_equal(t1026, 1)
-    t1028 = xp.abs(1/xp.where(t1027, t1025, 1))
+    t1028 = 1/xp.abs(xp.where(t1027, t1025, 1))
     t1029 = xp.where(t1024, xp.where(xp.greater_equal(t1025, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1027, t1028/(1 + xp.sqrt(1 + t1028**2)), 1/(t1026 + xp.sqrt(1 + t1026**2))), 0)
     t1030 = 1/xp.sqrt(1 + t1029**2)
     t1031 = t1011*t1029
@@ -4037,10 +4037,10 @@ def velocity_ellipsoid(q):
     t1057 = t1055 - t1029*t1056
     t1058 = t1056 + t1029*t1055
     t1059 = xp.not_equal(t1046, 0)
-    t1060 = 0.5*(-t1032 + t998)/xp.where(t1059, t1046, 1)
+    t1060 = (-t1032 + t998)/xp.where(t1059, 2*t1046, 1)
     t1061 = xp.abs(t1060)
     t1062 = xp.greater_equal(t1061, 1)
-    t1063 = xp.abs(1/xp.where(t1062, t1060, 1))
+    t1063 = 1/xp.abs(xp.where(t1062, t1060, 1))
     t1064 = xp.where(t1059, xp.where(xp.greater_equal(t1060, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1062, t1063/(1 + xp.sqrt(1 + t1063**2)), 1/(t1061 + xp.sqrt(1 + t1061**2))), 0)
     t1065 = 1/xp.sqrt(1 + t1064**2)
     t1066 = t998 + t1046*t1064
@@ -4071,10 +4071,10 @@ def velocity_ellipsoid(q):
     t1091 = t1089 - t1064*t1090
     t1092 = t1090 + t1064*t1089
     t1093 = xp.not_equal(t1079, 0)
-    t1094 = 0.5*(-t1033 + t1066)/xp.where(t1093, t1079, 1)
+    t1094 = (-t1033 + t1066)/xp.where(t1093, 2*t1079, 1)
     t1095 = xp.abs(t1094)
     t1096 = xp.greater_equal(t1095, 1)
-    t1097 = xp.abs(1/xp.where(t1096, t1094, 1))
+    t1097 = 1/xp.abs(xp.where(t1096, t1094, 1))
     t1098 = xp.where(t1093, xp.where(xp.greater_equal(t1094, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1096, t1097/(1 + xp.sqrt(1 + t1097**2)), 1/(t1095 + xp.sqrt(1 + t1095**2))), 0)
     t1099 = 1/xp.sqrt(1 + t1098**2)
     t1100 = t1037*t1099
@@ -4365,10 +4365,10 @@ def condition_number(q):
     t174 = t56*t71
     t175 = t65*t93 + t58*t143 + t172*t97 - t173*t103 + t174*t109
     t176 = xp.not_equal(t175, 0)
-    t177 = 0.5*(-t171 + t164)/xp.where(t176, -t175, 1)
+    t177 = (-t171 + t164)/xp.where(t176, -2*t175, 1)
     t178 = xp.abs(t177)
     t179 = xp.greater_equal(t178, 1)
-    t180 = xp.abs(1/xp.where(t179, t177, 1))
+    t180 = 1/xp.abs(xp.where(t179, t177, 1))
     t181 = xp.where(t176, xp.where(xp.greater_equal(t177, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t179, t180/(1 + xp.sqrt(1 + t180**2)), 1/(t178 + xp.sqrt(1 + t178**2))), 0)
     t182 = 1/xp.sqrt(1 + t181**2)
     t183 = t175*t181
@@ -4396,10 +4396,10 @@ def condition_number(q):
     t205 = -t203 + t202*t181
     t206 = t115*t192 + t119*t196 - t124*t200 + t149*t204
     t207 = xp.not_equal(t206, 0)
-    t208 = 0.5*(-t184 + t165)/xp.where(t207, t206, 1)
+    t208 = (-t184 + t165)/xp.where(t207, 2*t206, 1)
     t209 = xp.abs(t208)
     t210 = xp.greater_equal(t209, 1)
-    t211 = xp.abs(1/xp.where(t210, t208, 1))
+    t211 = 1/xp.abs(xp.where(t210, t208, 1))
     t212 = xp.where(t207, xp.where(xp.greater_equal(t208, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t210, t211/(1 + xp.sqrt(1 + t211**2)), 1/(t209 + xp.sqrt(1 + t209**2))), 0)
     t213 = 1/xp.sqrt(1 + t212**2)
     t214 = t206*t212
@@ -4423,10 +4423,10 @@ def condition_number(q):
     t232 = t230 + t229*t212
     t233 = t129*t223 + t154*t231 - t133*t227
     t234 = xp.not_equal(t233, 0)
-    t235 = 0.5*(-t215 + t166)/xp.where(t234, -t233, 1)
+    t235 = (-t215 + t166)/xp.where(t234, -2*t233, 1)
     t236 = xp.abs(t235)
     t237 = xp.greater_equal(t236, 1)
-    t238 = xp.abs(1/xp.where(t237, t235, 1))
+    t238 = 1/xp.abs(xp.where(t237, t235, 1))
     t239 = xp.where(t234, xp.where(xp.greater_equal(t235, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t237, t238/(1 + xp.sqrt(1 + t238**2)), 1/(t236 + xp.sqrt(1 + t236**2))), 0)
     t240 = 1/xp.sqrt(1 + t239**2)
     t241 = t233*t239
@@ -4446,10 +4446,10 @@ def condition_number(q):
     t255 = -t253 + t252*t239
     t256 = -t138*t250 + t159*t254
     t257 = xp.not_equal(t256, 0)
-    t258 = 0.5*(-t242 + t167)/xp.where(t257, t256, 1)
+    t258 = (-t242 + t167)/xp.where(t257, 2*t256, 1)
     t259 = xp.abs(t258)
     t260 = xp.greater_equal(t259, 1)
-    t261 = xp.abs(1/xp.where(t260, t258, 1))
+    t261 = 1/xp.abs(xp.where(t260, t258, 1))
     t262 = xp.where(t257, xp.where(xp.greater_equal(t258, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t260, t261/(1 + xp.sqrt(1 + t261**2)), 1/(t259 + xp.sqrt(1 + t259**2))), 0)
     t263 = 1/xp.sqrt(1 + t262**2)
     t264 = t256*t262
@@ -4465,10 +4465,10 @@ def condition_number(q):
     t274 = t272 + t271*t262
     t275 = t163*t273
     t276 = xp.not_equal(t275, 0)
-    t277 = 0.5*(-t265 + t168)/xp.where(t276, -t275, 1)
+    t277 = (-t265 + t168)/xp.where(t276, -2*t275, 1)
     t278 = xp.abs(t277)
     t279 = xp.greater_equal(t278, 1)
-    t280 = xp.abs(1/xp.where(t279, t277, 1))
+    t280 = 1/xp.abs(xp.where(t279, t277, 1))
     t281 = xp.where(t276, xp.where(xp.greater_equal(t277, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t279, t280/(1 + xp.sqrt(1 + t280**2)), 1/(t278 + xp.sqrt(1 + t278**2))), 0)
     t282 = 1/xp.sqrt(1 + t281**2)
     t283 = t275*t281
@@ -4482,10 +4482,10 @@ def condition_number(q):
     t291 = t290*t188
     t292 = -t193*t220 - t197*t224 + t201*t228 + t205*t232 + t169*t290*t181*t182**2 + t291*t189
     t293 = xp.not_equal(t292, 0)
-    t294 = 0.5*(-t185 + t216)/xp.where(t293, t292, 1)
+    t294 = (-t185 + t216)/xp.where(t293, 2*t292, 1)
     t295 = xp.abs(t294)
     t296 = xp.greater_equal(t295, 1)
-    t297 = xp.abs(1/xp.where(t296, t294, 1))
+    t297 = 1/xp.abs(xp.where(t296, t294, 1))
     t298 = xp.where(t293, xp.where(xp.greater_equal(t294, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t296, t297/(1 + xp.sqrt(1 + t297**2)), 1/(t295 + xp.sqrt(1 + t295**2))), 0)
     t299 = 1/xp.sqrt(1 + t298**2)
     t300 = t292*t298
@@ -4524,10 +4524,10 @@ def condition_number(q):
     t333 = t329*t219
     t334 = -t247*t319 - t251*t323 + t255*t327 - t331*t307 + t332*t311 + t333*t315
     t335 = xp.not_equal(t334, 0)
-    t336 = 0.5*(-t301 + t243)/xp.where(t335, t334, 1)
+    t336 = (-t301 + t243)/xp.where(t335, 2*t334, 1)
     t337 = xp.abs(t336)
     t338 = xp.greater_equal(t337, 1)
-    t339 = xp.abs(1/xp.where(t338, t336, 1))
+    t339 = 1/xp.abs(xp.where(t338, t336, 1))
     t340 = xp.where(t335, xp.where(xp.greater_equal(t336, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t338, t339/(1 + xp.sqrt(1 + t339**2)), 1/(t337 + xp.sqrt(1 + t337**2))), 0)
     t341 = 1/xp.sqrt(1 + t340**2)
     t342 = t334*t340
@@ -4570,10 +4570,10 @@ def condition_number(q):
     t379 = t378*t262
     t380 = t270*t363 + t274*t367 - t373*t347 + t375*t351 + t377*t355 - t379*t359
     t381 = xp.not_equal(t380, 0)
-    t382 = 0.5*(-t343 + t266)/xp.where(t381, t380, 1)
+    t382 = (-t343 + t266)/xp.where(t381, 2*t380, 1)
     t383 = xp.abs(t382)
     t384 = xp.greater_equal(t383, 1)
-    t385 = xp.abs(1/xp.where(t384, t382, 1))
+    t385 = 1/xp.abs(xp.where(t384, t382, 1))
     t386 = xp.where(t381, xp.where(xp.greater_equal(t382, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t384, t385/(1 + xp.sqrt(1 + t385**2)), 1/(t383 + xp.sqrt(1 + t383**2))), 0)
     t387 = 1/xp.sqrt(1 + t386**2)
     t388 = t380*t386
@@ -4615,10 +4615,10 @@ def condition_number(q):
     t424 = t423*t281
     t425 = t289*t413 - t416*t393 + t418*t397 + t420*t401 - t422*t405 + t424*t409
     t426 = xp.not_equal(t425, 0)
-    t427 = 0.5*(-t389 + t285)/xp.where(t426, t425, 1)
+    t427 = (-t389 + t285)/xp.where(t426, 2*t425, 1)
     t428 = xp.abs(t427)
     t429 = xp.greater_equal(t428, 1)
-    t430 = xp.abs(1/xp.where(t429, t427, 1))
+    t430 = 1/xp.abs(xp.where(t429, t427, 1))
     t431 = xp.where(t426, xp.where(xp.greater_equal(t427, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t429, t430/(1 + xp.sqrt(1 + t430**2)), 1/(t428 + xp.sqrt(1 + t428**2))), 0)
     t432 = 1/xp.sqrt(1 + t431**2)
     t433 = t425*t431
@@ -4650,10 +4650,10 @@ def condition_number(q):
     t459 = t457 + t456*t431
     t460 = t288*t458 - t415*t438 + t417*t442 + t419*t446 - t421*t450 + t423*t454
     t461 = xp.not_equal(t369, 0)
-    t462 = 0.5*(-t302 + t344)/xp.where(t461, t369, 1)
+    t462 = (-t302 + t344)/xp.where(t461, 2*t369, 1)
     t463 = xp.abs(t462)
     t464 = xp.greater_equal(t463, 1)
-    t465 = xp.abs(1/xp.where(t464, t462, 1))
+    t465 = 1/xp.abs(xp.where(t464, t462, 1))
     t466 = xp.where(t461, xp.where(xp.greater_equal(t462, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t464, t465/(1 + xp.sqrt(1 + t465**2)), 1/(t463 + xp.sqrt(1 + t463**2))), 0)
     t467 = 1/xp.sqrt(1 + t466**2)
     t468 = t369*t466
@@ -4685,10 +4685,10 @@ def condition_number(q):
     t494 = t492 + t491*t466
     t495 = -t394*t473 + t398*t477 + t402*t481 + t406*t485 + t410*t489 + t414*t493
     t496 = xp.not_equal(t495, 0)
-    t497 = 0.5*(-t469 + t390)/xp.where(t496, t495, 1)
+    t497 = (-t469 + t390)/xp.where(t496, 2*t495, 1)
     t498 = xp.abs(t497)
     t499 = xp.greater_equal(t498, 1)
-    t500 = xp.abs(1/xp.where(t499, t497, 1))
+    t500 = 1/xp.abs(xp.where(t499, t497, 1))
     t501 = xp.where(t496, xp.where(xp.greater_equal(t497, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t499, t500/(1 + xp.sqrt(1 + t500**2)), 1/(t498 + xp.sqrt(1 + t498**2))), 0)
     t502 = 1/xp.sqrt(1 + t501**2)
     t503 = t495*t501
@@ -4721,10 +4721,10 @@ def condition_number(q):
     t530 = -t439*t508 + t443*t512 + t447*t516 + t451*t520 + t455*t524 + t459*t528
     t531 = t474*t509 + t478*t513 + t482*t517 + t486*t521 + t490*t525 + t494*t529
     t532 = xp.not_equal(t530, 0)
-    t533 = 0.5*(-t504 + t435)/xp.where(t532, t530, 1)
+    t533 = (-t504 + t435)/xp.where(t532, 2*t530, 1)
     t534 = xp.abs(t533)
     t535 = xp.greater_equal(t534, 1)
-    t536 = xp.abs(1/xp.where(t535, t533, 1))
+    t536 = 1/xp.abs(xp.where(t535, t533, 1))
     t537 = xp.where(t532, xp.where(xp.greater_equal(t533, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t535, t536/(1 + xp.sqrt(1 + t536**2)), 1/(t534 + xp.sqrt(1 + t534**2))), 0)
     t538 = 1/xp.sqrt(1 + t537**2)
     t539 = t530*t537
@@ -4755,10 +4755,10 @@ def condition_number(q):
     t564 = t562 - t563*t537
     t565 = t563 + t562*t537
     t566 = xp.not_equal(t531, 0)
-    t567 = 0.5*(-t470 + t505)/xp.where(t566, t531, 1)
+    t567 = (-t470 + t505)/xp.where(t566, 2*t531, 1)
     t568 = xp.abs(t567)
     t569 = xp.greater_equal(t568, 1)
-    t570 = xp.abs(1/xp.where(t569, t567, 1))
+    t570 = 1/xp.abs(xp.where(t569, t567, 1))
     t571 = xp.where(t566, xp.where(xp.greater_equal(t567, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t569, t570/(1 + xp.sqrt(1 + t570**2)), 1/(t568 + xp.sqrt(1 + t568**2))), 0)
     t572 = 1/xp.sqrt(1 + t571**2)
     t573 = t531*t571
@@ -4790,10 +4790,10 @@ def condition_number(q):
     t599 = t597 + t596*t571
     t600 = t545*t578 + t549*t582 + t553*t586 + t557*t590 + t561*t594 + t565*t598
     t601 = xp.not_equal(t600, 0)
-    t602 = 0.5*(-t574 + t541)/xp.where(t601, t600, 1)
+    t602 = (-t574 + t541)/xp.where(t601, 2*t600, 1)
     t603 = xp.abs(t602)
     t604 = xp.greater_equal(t603, 1)
-    t605 = xp.abs(1/xp.where(t604, t602, 1))
+    t605 = 1/xp.abs(xp.where(t604, t602, 1))
     t606 = xp.where(t601, xp.where(xp.greater_equal(t602, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t604, t605/(1 + xp.sqrt(1 + t605**2)), 1/(t603 + xp.sqrt(1 + t603**2))), 0)
     t607 = 1/xp.sqrt(1 + t606**2)
     t608 = t600*t606
@@ -4825,10 +4825,10 @@ def condition_number(q):
     t634 = t632 + t631*t606
     t635 = t579*t614 + t583*t618 + t587*t622 + t591*t626 + t595*t630 + t599*t634
     t636 = xp.not_equal(t635, 0)
-    t637 = 0.5*(-t575 + t610)/xp.where(t636, t635, 1)
+    t637 = (-t575 + t610)/xp.where(t636, 2*t635, 1)
     t638 = xp.abs(t637)
     t639 = xp.greater_equal(t638, 1)
-    t640 = xp.abs(1/xp.where(t639, t637, 1))
+    t640 = 1/xp.abs(xp.where(t639, t637, 1))
     t641 = xp.where(t636, xp.where(xp.greater_equal(t637, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t639, t640/(1 + xp.sqrt(1 + t640**2)), 1/(t638 + xp.sqrt(1 + t638**2))), 0)
     t642 = 1/xp.sqrt(1 + t641**2)
     t643 = t635*t641
@@ -4859,10 +4859,10 @@ def condition_number(q):
     t668 = t666 - t667*t641
     t669 = t667 + t666*t641
     t670 = xp.not_equal(t460, 0)
-    t671 = 0.5*(-t284 + t434)/xp.where(t670, t460, 1)
+    t671 = (-t284 + t434)/xp.where(t670, 2*t460, 1)
     t672 = xp.abs(t671)
     t673 = xp.greater_equal(t672, 1)
-    t674 = xp.abs(1/xp.where(t673, t671, 1))
+    t674 = 1/xp.abs(xp.where(t673, t671, 1))
     t675 = xp.where(t670, xp.where(xp.greater_equal(t671, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t673, t674/(1 + xp.sqrt(1 + t674**2)), 1/(t672 + xp.sqrt(1 + t672**2))), 0)
     t676 = 1/xp.sqrt(1 + t675**2)
     t677 = t460*t675
@@ -4894,10 +4894,10 @@ def condition_number(q):
     t703 = t701 + t700*t675
     t704 = t544*t682 + t548*t686 + t552*t690 + t556*t694 + t560*t698 + t564*t702
     t705 = xp.not_equal(t704, 0)
-    t706 = 0.5*(-t678 + t540)/xp.where(t705, t704, 1)
+    t706 = (-t678 + t540)/xp.where(t705, 2*t704, 1)
     t707 = xp.abs(t706)
     t708 = xp.greater_equal(t707, 1)
-    t709 = xp.abs(1/xp.where(t708, t706, 1))
+    t709 = 1/xp.abs(xp.where(t708, t706, 1))
     t710 = xp.where(t705, xp.where(xp.greater_equal(t706, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t708, t709/(1 + xp.sqrt(1 + t709**2)), 1/(t707 + xp.sqrt(1 + t707**2))), 0)
     t711 = 1/xp.sqrt(1 + t710**2)
     t712 = t704*t710
@@ -4930,10 +4930,10 @@ def condition_number(q):
     t739 = t613*t717 + t617*t721 + t621*t725 + t625*t729 + t629*t733 + t633*t737
     t740 = -t683*t718 + t687*t722 + t691*t726 + t695*t730 + t699*t734 + t703*t738
     t741 = xp.not_equal(t739, 0)
-    t742 = 0.5*(-t713 + t609)/xp.where(t741, t739, 1)
+    t742 = (-t713 + t609)/xp.where(t741, 2*t739, 1)
     t743 = xp.abs(t742)
     t744 = xp.greater_equal(t743, 1)
-    t745 = xp.abs(1/xp.where(t744, t742, 1))
+    t745 = 1/xp.abs(xp.where(t744, t742, 1))
     t746 = xp.where(t741, xp.where(xp.greater_equal(t742, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t744, t745/(1 + xp.sqrt(1 + t745**2)), 1/(t743 + xp.sqrt(1 + t743**2))), 0)
     t747 = 1/xp.sqrt(1 + t746**2)
     t748 = t739*t746
@@ -4965,10 +4965,10 @@ def condition_number(q):
     t774 = t772 + t771*t746
     t775 = t648*t753 + t652*t757 + t656*t761 + t660*t765 + t664*t769 + t668*t773
     t776 = xp.not_equal(t775, 0)
-    t777 = 0.5*(-t749 + t644)/xp.where(t776, t775, 1)
+    t777 = (-t749 + t644)/xp.where(t776, 2*t775, 1)
     t778 = xp.abs(t777)
     t779 = xp.greater_equal(t778, 1)
-    t780 = xp.abs(1/xp.where(t779, t777, 1))
+    t780 = 1/xp.abs(xp.where(t779, t777, 1))
     t781 = xp.where(t776, xp.where(xp.greater_equal(t777, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t779, t780/(1 + xp.sqrt(1 + t780**2)), 1/(t778 + xp.sqrt(1 + t778**2))), 0)
     t782 = 1/xp.sqrt(1 + t781**2)
     t783 = t775*t781
@@ -5000,10 +5000,10 @@ def condition_number(q):
     t809 = t807 + t806*t781
     t810 = t649*t788 + t653*t792 + t657*t796 + t661*t800 + t665*t804 + t669*t808
     t811 = xp.not_equal(t810, 0)
-    t812 = 0.5*(-t784 + t645)/xp.where(t811, t810, 1)
+    t812 = (-t784 + t645)/xp.where(t811, 2*t810, 1)
     t813 = xp.abs(t812)
     t814 = xp.greater_equal(t813, 1)
-    t815 = xp.abs(1/xp.where(t814, t812, 1))
+    t815 = 1/xp.abs(xp.where(t814, t812, 1))
     t816 = xp.where(t811, xp.where(xp.greater_equal(t812, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t814, t815/(1 + xp.sqrt(1 + t815**2)), 1/(t813 + xp.sqrt(1 + t813**2))), 0)
     t817 = 1/xp.sqrt(1 + t816**2)
     t818 = t810*t816
@@ -5034,10 +5034,10 @@ def condition_number(q):
     t843 = t841 - t842*t816
     t844 = t842 + t841*t816
     t845 = xp.not_equal(t740, 0)
-    t846 = 0.5*(-t679 + t714)/xp.where(t845, t740, 1)
+    t846 = (-t679 + t714)/xp.where(t845, 2*t740, 1)
     t847 = xp.abs(t846)
     t848 = xp.greater_equal(t847, 1)
-    t849 = xp.abs(1/xp.where(t848, t846, 1))
+    t849 = 1/xp.abs(xp.where(t848, t846, 1))
     t850 = xp.where(t845, xp.where(xp.greater_equal(t846, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t848, t849/(1 + xp.sqrt(1 + t849**2)), 1/(t847 + xp.sqrt(1 + t847**2))), 0)
     t851 = 1/xp.sqrt(1 + t850**2)
     t852 = t740*t850
@@ -5069,10 +5069,10 @@ def condition_number(q):
     t878 = t876 + t875*t850
     t879 = t754*t857 + t758*t861 + t762*t865 + t766*t869 + t770*t873 + t774*t877
     t880 = xp.not_equal(t879, 0)
-    t881 = 0.5*(-t853 + t750)/xp.where(t880, t879, 1)
+    t881 = (-t853 + t750)/xp.where(t880, 2*t879, 1)
     t882 = xp.abs(t881)
     t883 = xp.greater_equal(t882, 1)
-    t884 = xp.abs(1/xp.where(t883, t881, 1))
+    t884 = 1/xp.abs(xp.where(t883, t881, 1))
     t885 = xp.where(t880, xp.where(xp.greater_equal(t881, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t883, t884/(1 + xp.sqrt(1 + t884**2)), 1/(t882 + xp.sqrt(1 + t882**2))), 0)
     t886 = 1/xp.sqrt(1 + t885**2)
     t887 = t879*t885
@@ -5105,10 +5105,10 @@ def condition_number(q):
     t914 = t789*t892 + t793*t896 + t797*t900 + t801*t904 + t805*t908 + t809*t912
     t915 = t858*t893 + t862*t897 + t866*t901 + t870*t905 + t874*t909 + t878*t913
     t916 = xp.not_equal(t914, 0)
-    t917 = 0.5*(-t888 + t785)/xp.where(t916, t914, 1)
+    t917 = (-t888 + t785)/xp.where(t916, 2*t914, 1)
     t918 = xp.abs(t917)
     t919 = xp.greater_equal(t918, 1)
-    t920 = xp.abs(1/xp.where(t919, t917, 1))
+    t920 = 1/xp.abs(xp.where(t919, t917, 1))
     t921 = xp.where(t916, xp.where(xp.greater_equal(t917, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t919, t920/(1 + xp.sqrt(1 + t920**2)), 1/(t918 + xp.sqrt(1 + t918**2))), 0)
     t922 = 1/xp.sqrt(1 + t921**2)
     t923 = t914*t921
@@ -5140,10 +5140,10 @@ def condition_number(q):
     t949 = t947 + t946*t921
     t950 = t824*t928 + t828*t932 + t832*t936 + t836*t940 + t840*t944 + t844*t948
     t951 = xp.not_equal(t950, 0)
-    t952 = 0.5*(-t924 + t820)/xp.where(t951, t950, 1)
+    t952 = (-t924 + t820)/xp.where(t951, 2*t950, 1)
     t953 = xp.abs(t952)
     t954 = xp.greater_equal(t953, 1)
-    t955 = xp.abs(1/xp.where(t954, t952, 1))
+    t955 = 1/xp.abs(xp.where(t954, t952, 1))
     t956 = xp.where(t951, xp.where(xp.greater_equal(t952, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t954, t955/(1 + xp.sqrt(1 + t955**2)), 1/(t953 + xp.sqrt(1 + t953**2))), 0)
     t957 = 1/xp.sqrt(1 + t956**2)
     t958 = t950*t956
@@ -5175,10 +5175,10 @@ def condition_number(q):
     t984 = t982 + t981*t956
     t985 = t823*t963 + t827*t967 + t831*t971 + t835*t975 + t839*t979 + t843*t983
     t986 = xp.not_equal(t915, 0)
-    t987 = 0.5*(-t854 + t889)/xp.where(t986, t915, 1)
+    t987 = (-t854 + t889)/xp.where(t986, 2*t915, 1)
     t988 = xp.abs(t987)
     t989 = xp.greater_equal(t988, 1)
-    t990 = xp.abs(1/xp.where(t989, t987, 1))
+    t990 = 1/xp.abs(xp.where(t989, t987, 1))
     t991 = xp.where(t986, xp.where(xp.greater_equal(t987, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t989, t990/(1 + xp.sqrt(1 + t990**2)), 1/(t988 + xp.sqrt(1 + t988**2))), 0)
     t992 = 1/xp.sqrt(1 + t991**2)
     t993 = t915*t991
@@ -5210,10 +5210,10 @@ def condition_number(q):
     t1019 = t1017 + t1016*t991
     t1020 = t929*t998 + t933*t1002 + t937*t1006 + t941*t1010 + t945*t1014 + t949*t1018
     t1021 = xp.not_equal(t1020, 0)
-    t1022 = 0.5*(-t994 + t925)/xp.where(t1021, t1020, 1)
+    t1022 = (-t994 + t925)/xp.where(t1021, 2*t1020, 1)
     t1023 = xp.abs(t1022)
     t1024 = xp.greater_equal(t1023, 1)
-    t1025 = xp.abs(1/xp.where(t1024, t1022, 1))
+    t1025 = 1/xp.abs(xp.where(t1024, t1022, 1))
     t1026 = xp.where(t1021, xp.where(xp.greater_equal(t1022, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1024, t1025/(1 + xp.sqrt(1 + t1025**2)), 1/(t1023 + xp.sqrt(1 + t1023**2))), 0)
     t1027 = 1/xp.sqrt(1 + t1026**2)
     t1028 = t1020*t1026
@@ -5246,10 +5246,10 @@ def condition_number(q):
     t1055 = t964*t1033 + t968*t1037 + t972*t1041 + t976*t1045 + t980*t1049 + t984*t1053
     t1056 = t999*t1034 + t1003*t1038 + t1007*t1042 + t1011*t1046 + t1015*t1050 + t1019*t1054
     t1057 = xp.not_equal(t1055, 0)
-    t1058 = 0.5*(-t1029 + t960)/xp.where(t1057, t1055, 1)
+    t1058 = (-t1029 + t960)/xp.where(t1057, 2*t1055, 1)
     t1059 = xp.abs(t1058)
     t1060 = xp.greater_equal(t1059, 1)
-    t1061 = xp.abs(1/xp.where(t1060, t1058, 1))
+    t1061 = 1/xp.abs(xp.where(t1060, t1058, 1))
     t1062 = xp.where(t1057, xp.where(xp.greater_equal(t1058, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1060, t1061/(1 + xp.sqrt(1 + t1061**2)), 1/(t1059 + xp.sqrt(1 + t1059**2))), 0)
     t1063 = 1/xp.sqrt(1 + t1062**2)
     t1064 = t1055*t1062
@@ -5280,10 +5280,10 @@ def condition_number(q):
     t1089 = t1087 - t1088*t1062
     t1090 = t1088 + t1087*t1062
     t1091 = xp.not_equal(t1056, 0)
-    t1092 = 0.5*(-t995 + t1030)/xp.where(t1091, t1056, 1)
+    t1092 = (-t995 + t1030)/xp.where(t1091, 2*t1056, 1)
     t1093 = xp.abs(t1092)
     t1094 = xp.greater_equal(t1093, 1)
-    t1095 = xp.abs(1/xp.where(t1094, t1092, 1))
+    t1095 = 1/xp.abs(xp.where(t1094, t1092, 1))
     t1096 = xp.where(t1091, xp.where(xp.greater_equal(t1092, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1094, t1095/(1 + xp.sqrt(1 + t1095**2)), 1/(t1093 + xp.sqrt(1 + t1093**2))), 0)
     t1097 = 1/xp.sqrt(1 + t1096**2)
     t1098 = t1056*t1096
@@ -5315,10 +5315,10 @@ def condition_number(q):
     t1124 = t1122 + t1121*t1096
     t1125 = t1070*t1103 + t1074*t1107 + t1078*t1111 + t1082*t1115 + t1086*t1119 + t1090*t1123
     t1126 = xp.not_equal(t1125, 0)
-    t1127 = 0.5*(-t1099 + t1066)/xp.where(t1126, t1125, 1)
+    t1127 = (-t1099 + t1066)/xp.where(t1126, 2*t1125, 1)
     t1128 = xp.abs(t1127)
     t1129 = xp.greater_equal(t1128, 1)
-    t1130 = xp.abs(1/xp.where(t1129, t1127, 1))
+    t1130 = 1/xp.abs(xp.where(t1129, t1127, 1))
     t1131 = xp.where(t1126, xp.where(xp.greater_equal(t1127, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1129, t1130/(1 + xp.sqrt(1 + t1130**2)), 1/(t1128 + xp.sqrt(1 + t1128**2))), 0)
     t1132 = 1/xp.sqrt(1 + t1131**2)
     t1133 = t1125*t1131
@@ -5350,10 +5350,10 @@ def condition_number(q):
     t1159 = t1157 + t1131*t1156
     t1160 = t1104*t1139 + t1108*t1143 + t1112*t1147 + t1116*t1151 + t1120*t1155 + t1124*t1159
     t1161 = xp.not_equal(t1160, 0)
-    t1162 = 0.5*(-t1100 + t1135)/xp.where(t1161, t1160, 1)
+    t1162 = (-t1100 + t1135)/xp.where(t1161, 2*t1160, 1)
     t1163 = xp.abs(t1162)
     t1164 = xp.greater_equal(t1163, 1)
-    t1165 = xp.abs(1/xp.where(t1164, t1162, 1))
+    t1165 = 1/xp.abs(xp.where(t1164, t1162, 1))
     t1166 = xp.where(t1161, xp.where(xp.greater_equal(t1162, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1164, t1165/(1 + xp.sqrt(1 + t1165**2)), 1/(t1163 + xp.sqrt(1 + t1163**2))), 0)
     t1167 = 1/xp.sqrt(1 + t1166**2)
     t1168 = t1160*t1166
@@ -5384,10 +5384,10 @@ def condition_number(q):
     t1193 = t1191 - t1166*t1192
     t1194 = t1192 + t1166*t1191
     t1195 = xp.not_equal(t985, 0)
-    t1196 = 0.5*(-t819 + t959)/xp.where(t1195, t985, 1)
+    t1196 = (-t819 + t959)/xp.where(t1195, 2*t985, 1)
     t1197 = xp.abs(t1196)
     t1198 = xp.greater_equal(t1197, 1)
-    t1199 = xp.abs(1/xp.where(t1198, t1196, 1))
+    t1199 = 1/xp.abs(xp.where(t1198, t1196, 1))
     t1200 = xp.where(t1195, xp.where(xp.greater_equal(t1196, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1198, t1199/(1 + xp.sqrt(1 + t1199**2)), 1/(t1197 + xp.sqrt(1 + t1197**2))), 0)
     t1201 = 1/xp.sqrt(1 + t1200**2)
     t1202 = t985*t1200
@@ -5419,10 +5419,10 @@ def condition_number(q):
     t1228 = t1226 + t1200*t1225
     t1229 = t1069*t1207 + t1073*t1211 + t1077*t1215 + t1081*t1219 + t1085*t1223 + t1089*t1227
     t1230 = xp.not_equal(t1229, 0)
-    t1231 = 0.5*(-t1203 + t1065)/xp.where(t1230, t1229, 1)
+    t1231 = (-t1203 + t1065)/xp.where(t1230, 2*t1229, 1)
     t1232 = xp.abs(t1231)
     t1233 = xp.greater_equal(t1232, 1)
-    t1234 = xp.abs(1/xp.where(t1233, t1231, 1))
+    t1234 = 1/xp.abs(xp.where(t1233, t1231, 1))
     t1235 = xp.where(t1230, xp.where(xp.greater_equal(t1231, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1233, t1234/(1 + xp.sqrt(1 + t1234**2)), 1/(t1232 + xp.sqrt(1 + t1232**2))), 0)
     t1236 = 1/xp.sqrt(1 + t1235**2)
     t1237 = t1229*t1235
@@ -5455,10 +5455,10 @@ def condition_number(q):
     t1264 = t1138*t1242 + t1142*t1246 + t1146*t1250 + t1150*t1254 + t1154*t1258 + t1158*t1262
     t1265 = t1208*t1243 + t1212*t1247 + t1216*t1251 + t1220*t1255 + t1224*t1259 + t1228*t1263
     t1266 = xp.not_equal(t1264, 0)
-    t1267 = 0.5*(-t1238 + t1134)/xp.where(t1266, t1264, 1)
+    t1267 = (-t1238 + t1134)/xp.where(t1266, 2*t1264, 1)
     t1268 = xp.abs(t1267)
     t1269 = xp.greater_equal(t1268, 1)
-    t1270 = xp.abs(1/xp.where(t1269, t1267, 1))
+    t1270 = 1/xp.abs(xp.where(t1269, t1267, 1))
     t1271 = xp.where(t1266, xp.where(xp.greater_equal(t1267, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1269, t1270/(1 + xp.sqrt(1 + t1270**2)), 1/(t1268 + xp.sqrt(1 + t1268**2))), 0)
     t1272 = 1/xp.sqrt(1 + t1271**2)
     t1273 = t1264*t1271
@@ -5490,10 +5490,10 @@ def condition_number(q):
     t1299 = t1297 + t1271*t1296
     t1300 = t1173*t1278 + t1177*t1282 + t1181*t1286 + t1185*t1290 + t1189*t1294 + t1193*t1298
     t1301 = xp.not_equal(t1300, 0)
-    t1302 = 0.5*(-t1274 + t1169)/xp.where(t1301, t1300, 1)
+    t1302 = (-t1274 + t1169)/xp.where(t1301, 2*t1300, 1)
     t1303 = xp.abs(t1302)
     t1304 = xp.greater_equal(t1303, 1)
-    t1305 = xp.abs(1/xp.where(t1304, t1302, 1))
+    t1305 = 1/xp.abs(xp.where(t1304, t1302, 1))
     t1306 = xp.where(t1301, xp.where(xp.greater_equal(t1302, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1304, t1305/(1 + xp.sqrt(1 + t1305**2)), 1/(t1303 + xp.sqrt(1 + t1303**2))), 0)
     t1307 = 1/xp.sqrt(1 + t1306**2)
     t1308 = t1300*t1306
@@ -5525,10 +5525,10 @@ def condition_number(q):
     t1334 = t1332 + t1306*t1331
     t1335 = t1174*t1313 + t1178*t1317 + t1182*t1321 + t1186*t1325 + t1190*t1329 + t1194*t1333
     t1336 = xp.not_equal(t1335, 0)
-    t1337 = 0.5*(-t1309 + t1170)/xp.where(t1336, t1335, 1)
+    t1337 = (-t1309 + t1170)/xp.where(t1336, 2*t1335, 1)
     t1338 = xp.abs(t1337)
     t1339 = xp.greater_equal(t1338, 1)
-    t1340 = xp.abs(1/xp.where(t1339, t1337, 1))
+    t1340 = 1/xp.abs(xp.where(t1339, t1337, 1))
     t1341 = xp.where(t1336, xp.where(xp.greater_equal(t1337, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1339, t1340/(1 + xp.sqrt(1 + t1340**2)), 1/(t1338 + xp.sqrt(1 + t1338**2))), 0)
     t1342 = 1/xp.sqrt(1 + t1341**2)
     t1343 = t1335*t1341
@@ -5559,10 +5559,10 @@ def condition_number(q):
     t1368 = t1366 - t1341*t1367
     t1369 = t1367 + t1341*t1366
     t1370 = xp.not_equal(t1265, 0)
-    t1371 = 0.5*(-t1204 + t1239)/xp.where(t1370, t1265, 1)
+    t1371 = (-t1204 + t1239)/xp.where(t1370, 2*t1265, 1)
     t1372 = xp.abs(t1371)
     t1373 = xp.greater_equal(t1372, 1)
-    t1374 = xp.abs(1/xp.where(t1373, t1371, 1))
+    t1374 = 1/xp.abs(xp.where(t1373, t1371, 1))
     t1375 = xp.where(t1370, xp.where(xp.greater_equal(t1371, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1373, t1374/(1 + xp.sqrt(1 + t1374**2)), 1/(t1372 + xp.sqrt(1 + t1372**2))), 0)
     t1376 = 1/xp.sqrt(1 + t1375**2)
     t1377 = t1265*t1375
@@ -5594,10 +5594,10 @@ def condition_number(q):
     t1403 = t1401 + t1375*t1400
     t1404 = t1279*t1382 + t1283*t1386 + t1287*t1390 + t1291*t1394 + t1295*t1398 + t1299*t1402
     t1405 = xp.not_equal(t1404, 0)
-    t1406 = 0.5*(-t1378 + t1275)/xp.where(t1405, t1404, 1)
+    t1406 = (-t1378 + t1275)/xp.where(t1405, 2*t1404, 1)
     t1407 = xp.abs(t1406)
     t1408 = xp.greater_equal(t1407, 1)
-    t1409 = xp.abs(1/xp.where(t1408, t1406, 1))
+    t1409 = 1/xp.abs(xp.where(t1408, t1406, 1))
     t1410 = xp.where(t1405, xp.where(xp.greater_equal(t1406, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1408, t1409/(1 + xp.sqrt(1 + t1409**2)), 1/(t1407 + xp.sqrt(1 + t1407**2))), 0)
     t1411 = 1/xp.sqrt(1 + t1410**2)
     t1412 = t1404*t1410
@@ -5630,10 +5630,10 @@ def condition_number(q):
     t1439 = t1314*t1417 + t1318*t1421 + t1322*t1425 + t1326*t1429 + t1330*t1433 + t1334*t1437
     t1440 = t1383*t1418 + t1387*t1422 + t1391*t1426 + t1395*t1430 + t1399*t1434 + t1403*t1438
     t1441 = xp.not_equal(t1439, 0)
-    t1442 = 0.5*(-t1413 + t1310)/xp.where(t1441, t1439, 1)
+    t1442 = (-t1413 + t1310)/xp.where(t1441, 2*t1439, 1)
     t1443 = xp.abs(t1442)
     t1444 = xp.greater_equal(t1443, 1)
-    t1445 = xp.abs(1/xp.where(t1444, t1442, 1))
+    t1445 = 1/xp.abs(xp.where(t1444, t1442, 1))
     t1446 = xp.where(t1441, xp.where(xp.greater_equal(t1442, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1444, t1445/(1 + xp.sqrt(1 + t1445**2)), 1/(t1443 + xp.sqrt(1 + t1443**2))), 0)
     t1447 = 1/xp.sqrt(1 + t1446**2)
     t1448 = t1439*t1446
@@ -5665,10 +5665,10 @@ def condition_number(q):
     t1474 = t1472 + t1446*t1471
     t1475 = t1349*t1453 + t1353*t1457 + t1357*t1461 + t1361*t1465 + t1365*t1469 + t1369*t1473
     t1476 = xp.not_equal(t1475, 0)
-    t1477 = 0.5*(-t1449 + t1345)/xp.where(t1476, t1475, 1)
+    t1477 = (-t1449 + t1345)/xp.where(t1476, 2*t1475, 1)
     t1478 = xp.abs(t1477)
     t1479 = xp.greater_equal(t1478, 1)
-    t1480 = xp.abs(1/xp.where(t1479, t1477, 1))
+    t1480 = 1/xp.abs(xp.where(t1479, t1477, 1))
     t1481 = xp.where(t1476, xp.where(xp.greater_equal(t1477, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1479, t1480/(1 + xp.sqrt(1 + t1480**2)), 1/(t1478 + xp.sqrt(1 + t1478**2))), 0)
     t1482 = 1/xp.sqrt(1 + t1481**2)
     t1483 = t1475*t1481
@@ -5700,10 +5700,10 @@ def condition_number(q):
     t1509 = t1507 + t1481*t1506
     t1510 = t1348*t1488 + t1352*t1492 + t1356*t1496 + t1360*t1500 + t1364*t1504 + t1368*t1508
     t1511 = xp.not_equal(t1440, 0)
-    t1512 = 0.5*(-t1379 + t1414)/xp.where(t1511, t1440, 1)
+    t1512 = (-t1379 + t1414)/xp.where(t1511, 2*t1440, 1)
     t1513 = xp.abs(t1512)
     t1514 = xp.greater_equal(t1513, 1)
-    t1515 = xp.abs(1/xp.where(t1514, t1512, 1))
+    t1515 = 1/xp.abs(xp.where(t1514, t1512, 1))
     t1516 = xp.where(t1511, xp.where(xp.greater_equal(t1512, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1514, t1515/(1 + xp.sqrt(1 + t1515**2)), 1/(t1513 + xp.sqrt(1 + t1513**2))), 0)
     t1517 = 1/xp.sqrt(1 + t1516**2)
     t1518 = t1440*t1516
@@ -5735,10 +5735,10 @@ def condition_number(q):
     t1544 = t1542 + t1516*t1541
     t1545 = t1454*t1523 + t1458*t1527 + t1462*t1531 + t1466*t1535 + t1470*t1539 + t1474*t1543
     t1546 = xp.not_equal(t1545, 0)
-    t1547 = 0.5*(-t1519 + t1450)/xp.where(t1546, t1545, 1)
+    t1547 = (-t1519 + t1450)/xp.where(t1546, 2*t1545, 1)
     t1548 = xp.abs(t1547)
     t1549 = xp.greater_equal(t1548, 1)
-    t1550 = xp.abs(1/xp.where(t1549, t1547, 1))
+    t1550 = 1/xp.abs(xp.where(t1549, t1547, 1))
     t1551 = xp.where(t1546, xp.where(xp.greater_equal(t1547, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1549, t1550/(1 + xp.sqrt(1 + t1550**2)), 1/(t1548 + xp.sqrt(1 + t1548**2))), 0)
     t1552 = 1/xp.sqrt(1 + t1551**2)
     t1553 = t1545*t1551
@@ -5771,10 +5771,10 @@ def condition_number(q):
     t1580 = t1489*t1558 + t1493*t1562 + t1497*t1566 + t1501*t1570 + t1505*t1574 + t1509*t1578
     t1581 = t1524*t1559 + t1528*t1563 + t1532*t1567 + t1536*t1571 + t1540*t1575 + t1544*t1579
     t1582 = xp.not_equal(t1580, 0)
-    t1583 = 0.5*(-t1554 + t1485)/xp.where(t1582, t1580, 1)
+    t1583 = (-t1554 + t1485)/xp.where(t1582, 2*t1580, 1)
     t1584 = xp.abs(t1583)
     t1585 = xp.greater_equal(t1584, 1)
-    t1586 = xp.abs(1/xp.where(t1585, t1583, 1))
+    t1586 = 1/xp.abs(xp.where(t1585, t1583, 1))
     t1587 = xp.where(t1582, xp.where(xp.greater_equal(t1583, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1585, t1586/(1 + xp.sqrt(1 + t1586**2)), 1/(t1584 + xp.sqrt(1 + t1584**2))), 0)
     t1588 = 1/xp.sqrt(1 + t1587**2)
     t1589 = t1580*t1587
@@ -5805,10 +5805,10 @@ def condition_number(q):
     t1614 = t1612 - t1587*t1613
     t1615 = t1613 + t1587*t1612
     t1616 = xp.not_equal(t1581, 0)
-    t1617 = 0.5*(-t1520 + t1555)/xp.where(t1616, t1581, 1)
+    t1617 = (-t1520 + t1555)/xp.where(t1616, 2*t1581, 1)
     t1618 = xp.abs(t1617)
     t1619 = xp.greater_equal(t1618, 1)
-    t1620 = xp.abs(1/xp.where(t1619, t1617, 1))
+    t1620 = 1/xp.abs(xp.where(t1619, t1617, 1))
     t1621 = xp.where(t1616, xp.where(xp.greater_equal(t1617, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1619, t1620/(1 + xp.sqrt(1 + t1620**2)), 1/(t1618 + xp.sqrt(1 + t1618**2))), 0)
     t1622 = 1/xp.sqrt(1 + t1621**2)
     t1623 = t1581*t1621
@@ -5840,10 +5840,10 @@ def condition_number(q):
     t1649 = t1647 + t1621*t1646
     t1650 = t1595*t1628 + t1599*t1632 + t1603*t1636 + t1607*t1640 + t1611*t1644 + t1615*t1648
     t1651 = xp.not_equal(t1650, 0)
-    t1652 = 0.5*(-t1624 + t1591)/xp.where(t1651, t1650, 1)
+    t1652 = (-t1624 + t1591)/xp.where(t1651, 2*t1650, 1)
     t1653 = xp.abs(t1652)
     t1654 = xp.greater_equal(t1653, 1)
-    t1655 = xp.abs(1/xp.where(t1654, t1652, 1))
+    t1655 = 1/xp.abs(xp.where(t1654, t1652, 1))
     t1656 = xp.where(t1651, xp.where(xp.greater_equal(t1652, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1654, t1655/(1 + xp.sqrt(1 + t1655**2)), 1/(t1653 + xp.sqrt(1 + t1653**2))), 0)
     t1657 = 1/xp.sqrt(1 + t1656**2)
     t1658 = t1650*t1656
@@ -5875,10 +5875,10 @@ def condition_number(q):
     t1684 = t1682 + t1656*t1681
     t1685 = t1629*t1664 + t1633*t1668 + t1637*t1672 + t1641*t1676 + t1645*t1680 + t1649*t1684
     t1686 = xp.not_equal(t1685, 0)
-    t1687 = 0.5*(-t1625 + t1660)/xp.where(t1686, t1685, 1)
+    t1687 = (-t1625 + t1660)/xp.where(t1686, 2*t1685, 1)
     t1688 = xp.abs(t1687)
     t1689 = xp.greater_equal(t1688, 1)
-    t1690 = xp.abs(1/xp.where(t1689, t1687, 1))
+    t1690 = 1/xp.abs(xp.where(t1689, t1687, 1))
     t1691 = xp.where(t1686, xp.where(xp.greater_equal(t1687, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1689, t1690/(1 + xp.sqrt(1 + t1690**2)), 1/(t1688 + xp.sqrt(1 + t1688**2))), 0)
     t1692 = 1/xp.sqrt(1 + t1691**2)
     t1693 = t1685*t1691
@@ -5909,10 +5909,10 @@ def condition_number(q):
     t1718 = t1716 - t1691*t1717
     t1719 = t1717 + t1691*t1716
     t1720 = xp.not_equal(t1510, 0)
-    t1721 = 0.5*(-t1344 + t1484)/xp.where(t1720, t1510, 1)
+    t1721 = (-t1344 + t1484)/xp.where(t1720, 2*t1510, 1)
     t1722 = xp.abs(t1721)
     t1723 = xp.greater_equal(t1722, 1)
-    t1724 = xp.abs(1/xp.where(t1723, t1721, 1))
+    t1724 = 1/xp.abs(xp.where(t1723, t1721, 1))
     t1725 = xp.where(t1720, xp.where(xp.greater_equal(t1721, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1723, t1724/(1 + xp.sqrt(1 + t1724**2)), 1/(t1722 + xp.sqrt(1 + t1722**2))), 0)
     t1726 = 1/xp.sqrt(1 + t1725**2)
     t1727 = t1510*t1725
@@ -5944,10 +5944,10 @@ def condition_number(q):
     t1753 = t1751 + t1725*t1750
     t1754 = t1594*t1732 + t1598*t1736 + t1602*t1740 + t1606*t1744 + t1610*t1748 + t1614*t1752
     t1755 = xp.not_equal(t1754, 0)
-    t1756 = 0.5*(-t1728 + t1590)/xp.where(t1755, t1754, 1)
+    t1756 = (-t1728 + t1590)/xp.where(t1755, 2*t1754, 1)
     t1757 = xp.abs(t1756)
     t1758 = xp.greater_equal(t1757, 1)
-    t1759 = xp.abs(1/xp.where(t1758, t1756, 1))
+    t1759 = 1/xp.abs(xp.where(t1758, t1756, 1))
     t1760 = xp.where(t1755, xp.where(xp.greater_equal(t1756, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1758, t1759/(1 + xp.sqrt(1 + t1759**2)), 1/(t1757 + xp.sqrt(1 + t1757**2))), 0)
     t1761 = 1/xp.sqrt(1 + t1760**2)
     t1762 = t1754*t1760
@@ -5980,10 +5980,10 @@ def condition_number(q):
     t1789 = t1663*t1767 + t1667*t1771 + t1671*t1775 + t1675*t1779 + t1679*t1783 + t1683*t1787
     t1790 = t1733*t1768 + t1737*t1772 + t1741*t1776 + t1745*t1780 + t1749*t1784 + t1753*t1788
     t1791 = xp.not_equal(t1789, 0)
-    t1792 = 0.5*(-t1763 + t1659)/xp.where(t1791, t1789, 1)
+    t1792 = (-t1763 + t1659)/xp.where(t1791, 2*t1789, 1)
     t1793 = xp.abs(t1792)
     t1794 = xp.greater_equal(t1793, 1)
-    t1795 = xp.abs(1/xp.where(t1794, t1792, 1))
+    t1795 = 1/xp.abs(xp.where(t1794, t1792, 1))
     t1796 = xp.where(t1791, xp.where(xp.greater_equal(t1792, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1794, t1795/(1 + xp.sqrt(1 + t1795**2)), 1/(t1793 + xp.sqrt(1 + t1793**2))), 0)
     t1797 = 1/xp.sqrt(1 + t1796**2)
     t1798 = t1789*t1796
@@ -6015,10 +6015,10 @@ def condition_number(q):
     t1824 = t1822 + t1796*t1821
     t1825 = t1698*t1803 + t1702*t1807 + t1706*t1811 + t1710*t1815 + t1714*t1819 + t1718*t1823
     t1826 = xp.not_equal(t1825, 0)
-    t1827 = 0.5*(-t1799 + t1694)/xp.where(t1826, t1825, 1)
+    t1827 = (-t1799 + t1694)/xp.where(t1826, 2*t1825, 1)
     t1828 = xp.abs(t1827)
     t1829 = xp.greater_equal(t1828, 1)
-    t1830 = xp.abs(1/xp.where(t1829, t1827, 1))
+    t1830 = 1/xp.abs(xp.where(t1829, t1827, 1))
     t1831 = xp.where(t1826, xp.where(xp.greater_equal(t1827, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1829, t1830/(1 + xp.sqrt(1 + t1830**2)), 1/(t1828 + xp.sqrt(1 + t1828**2))), 0)
     t1832 = 1/xp.sqrt(1 + t1831**2)
     t1833 = t1825*t1831
@@ -6050,10 +6050,10 @@ def condition_number(q):
     t1859 = t1857 + t1831*t1856
     t1860 = t1699*t1838 + t1703*t1842 + t1707*t1846 + t1711*t1850 + t1715*t1854 + t1719*t1858
     t1861 = xp.not_equal(t1860, 0)
-    t1862 = 0.5*(-t1834 + t1695)/xp.where(t1861, t1860, 1)
+    t1862 = (-t1834 + t1695)/xp.where(t1861, 2*t1860, 1)
     t1863 = xp.abs(t1862)
     t1864 = xp.greater_equal(t1863, 1)
-    t1865 = xp.abs(1/xp.where(t1864, t1862, 1))
+    t1865 = 1/xp.abs(xp.where(t1864, t1862, 1))
     t1866 = xp.where(t1861, xp.where(xp.greater_equal(t1862, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1864, t1865/(1 + xp.sqrt(1 + t1865**2)), 1/(t1863 + xp.sqrt(1 + t1863**2))), 0)
     t1867 = 1/xp.sqrt(1 + t1866**2)
     t1868 = t1860*t1866
@@ -6084,10 +6084,10 @@ def condition_number(q):
     t1893 = t1891 - t1866*t1892
     t1894 = t1892 + t1866*t1891
     t1895 = xp.not_equal(t1790, 0)
-    t1896 = 0.5*(-t1729 + t1764)/xp.where(t1895, t1790, 1)
+    t1896 = (-t1729 + t1764)/xp.where(t1895, 2*t1790, 1)
     t1897 = xp.abs(t1896)
     t1898 = xp.greater_equal(t1897, 1)
-    t1899 = xp.abs(1/xp.where(t1898, t1896, 1))
+    t1899 = 1/xp.abs(xp.where(t1898, t1896, 1))
     t1900 = xp.where(t1895, xp.where(xp.greater_equal(t1896, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1898, t1899/(1 + xp.sqrt(1 + t1899**2)), 1/(t1897 + xp.sqrt(1 + t1897**2))), 0)
     t1901 = 1/xp.sqrt(1 + t1900**2)
     t1902 = t1790*t1900
@@ -6119,10 +6119,10 @@ def condition_number(q):
     t1928 = t1926 + t1900*t1925
     t1929 = t1804*t1907 + t1808*t1911 + t1812*t1915 + t1816*t1919 + t1820*t1923 + t1824*t1927
     t1930 = xp.not_equal(t1929, 0)
-    t1931 = 0.5*(-t1903 + t1800)/xp.where(t1930, t1929, 1)
+    t1931 = (-t1903 + t1800)/xp.where(t1930, 2*t1929, 1)
     t1932 = xp.abs(t1931)
     t1933 = xp.greater_equal(t1932, 1)
-    t1934 = xp.abs(1/xp.where(t1933, t1931, 1))
+    t1934 = 1/xp.abs(xp.where(t1933, t1931, 1))
     t1935 = xp.where(t1930, xp.where(xp.greater_equal(t1931, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1933, t1934/(1 + xp.sqrt(1 + t1934**2)), 1/(t1932 + xp.sqrt(1 + t1932**2))), 0)
     t1936 = 1/xp.sqrt(1 + t1935**2)
     t1937 = t1929*t1935
@@ -6155,10 +6155,10 @@ def condition_number(q):
     t1964 = t1839*t1942 + t1843*t1946 + t1847*t1950 + t1851*t1954 + t1855*t1958 + t1859*t1962
     t1965 = t1908*t1943 + t1912*t1947 + t1916*t1951 + t1920*t1955 + t1924*t1959 + t1928*t1963
     t1966 = xp.not_equal(t1964, 0)
-    t1967 = 0.5*(-t1938 + t1835)/xp.where(t1966, t1964, 1)
+    t1967 = (-t1938 + t1835)/xp.where(t1966, 2*t1964, 1)
     t1968 = xp.abs(t1967)
     t1969 = xp.greater_equal(t1968, 1)
-    t1970 = xp.abs(1/xp.where(t1969, t1967, 1))
+    t1970 = 1/xp.abs(xp.where(t1969, t1967, 1))
     t1971 = xp.where(t1966, xp.where(xp.greater_equal(t1967, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1969, t1970/(1 + xp.sqrt(1 + t1970**2)), 1/(t1968 + xp.sqrt(1 + t1968**2))), 0)
     t1972 = 1/xp.sqrt(1 + t1971**2)
     t1973 = t1964*t1971
@@ -6190,10 +6190,10 @@ def condition_number(q):
     t1999 = t1997 + t1971*t1996
     t2000 = t1874*t1978 + t1878*t1982 + t1882*t1986 + t1886*t1990 + t1890*t1994 + t1894*t1998
     t2001 = xp.not_equal(t2000, 0)
-    t2002 = 0.5*(-t1974 + t1870)/xp.where(t2001, t2000, 1)
+    t2002 = (-t1974 + t1870)/xp.where(t2001, 2*t2000, 1)
     t2003 = xp.abs(t2002)
     t2004 = xp.greater_equal(t2003, 1)
-    t2005 = xp.abs(1/xp.where(t2004, t2002, 1))
+    t2005 = 1/xp.abs(xp.where(t2004, t2002, 1))
     t2006 = xp.where(t2001, xp.where(xp.greater_equal(t2002, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2004, t2005/(1 + xp.sqrt(1 + t2005**2)), 1/(t2003 + xp.sqrt(1 + t2003**2))), 0)
     t2007 = 1/xp.sqrt(1 + t2006**2)
     t2008 = t2000*t2006
@@ -6225,10 +6225,10 @@ def condition_number(q):
     t2034 = t2032 + t2006*t2031
     t2035 = t1873*t2013 + t1877*t2017 + t1881*t2021 + t1885*t2025 + t1889*t2029 + t1893*t2033
     t2036 = xp.not_equal(t1965, 0)
-    t2037 = 0.5*(-t1904 + t1939)/xp.where(t2036, t1965, 1)
+    t2037 = (-t1904 + t1939)/xp.where(t2036, 2*t1965, 1)
     t2038 = xp.abs(t2037)
     t2039 = xp.greater_equal(t2038, 1)
-    t2040 = xp.abs(1/xp.where(t2039, t2037, 1))
+    t2040 = 1/xp.abs(xp.where(t2039, t2037, 1))
     t2041 = xp.where(t2036, xp.where(xp.greater_equal(t2037, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2039, t2040/(1 + xp.sqrt(1 + t2040**2)), 1/(t2038 + xp.sqrt(1 + t2038**2))), 0)
     t2042 = 1/xp.sqrt(1 + t2041**2)
     t2043 = t1965*t2041
@@ -6260,10 +6260,10 @@ def condition_number(q):
     t2069 = t2067 + t2041*t2066
     t2070 = t1979*t2048 + t1983*t2052 + t1987*t2056 + t1991*t2060 + t1995*t2064 + t1999*t2068
     t2071 = xp.not_equal(t2070, 0)
-    t2072 = 0.5*(-t2044 + t1975)/xp.where(t2071, t2070, 1)
+    t2072 = (-t2044 + t1975)/xp.where(t2071, 2*t2070, 1)
     t2073 = xp.abs(t2072)
     t2074 = xp.greater_equal(t2073, 1)
-    t2075 = xp.abs(1/xp.where(t2074, t2072, 1))
+    t2075 = 1/xp.abs(xp.where(t2074, t2072, 1))
     t2076 = xp.where(t2071, xp.where(xp.greater_equal(t2072, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2074, t2075/(1 + xp.sqrt(1 + t2075**2)), 1/(t2073 + xp.sqrt(1 + t2073**2))), 0)
     t2077 = 1/xp.sqrt(1 + t2076**2)
     t2078 = t2070*t2076
@@ -6296,10 +6296,10 @@ def condition_number(q):
     t2105 = t2014*t2083 + t2018*t2087 + t2022*t2091 + t2026*t2095 + t2030*t2099 + t2034*t2103
     t2106 = t2049*t2084 + t2053*t2088 + t2057*t2092 + t2061*t2096 + t2065*t2100 + t2069*t2104
     t2107 = xp.not_equal(t2105, 0)
-    t2108 = 0.5*(-t2079 + t2010)/xp.where(t2107, t2105, 1)
+    t2108 = (-t2079 + t2010)/xp.where(t2107, 2*t2105, 1)
     t2109 = xp.abs(t2108)
     t2110 = xp.greater_equal(t2109, 1)
-    t2111 = xp.abs(1/xp.where(t2110, t2108, 1))
+    t2111 = 1/xp.abs(xp.where(t2110, t2108, 1))
     t2112 = xp.where(t2107, xp.where(xp.greater_equal(t2108, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2110, t2111/(1 + xp.sqrt(1 + t2111**2)), 1/(t2109 + xp.sqrt(1 + t2109**2))), 0)
     t2113 = 1/xp.sqrt(1 + t2112**2)
     t2114 = t2105*t2112
@@ -6330,10 +6330,10 @@ def condition_number(q):
     t2139 = t2137 - t2112*t2138
     t2140 = t2138 + t2112*t2137
     t2141 = xp.not_equal(t2106, 0)
-    t2142 = 0.5*(-t2045 + t2080)/xp.where(t2141, t2106, 1)
+    t2142 = (-t2045 + t2080)/xp.where(t2141, 2*t2106, 1)
     t2143 = xp.abs(t2142)
     t2144 = xp.greater_equal(t2143, 1)
-    t2145 = xp.abs(1/xp.where(t2144, t2142, 1))
+    t2145 = 1/xp.abs(xp.where(t2144, t2142, 1))
     t2146 = xp.where(t2141, xp.where(xp.greater_equal(t2142, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2144, t2145/(1 + xp.sqrt(1 + t2145**2)), 1/(t2143 + xp.sqrt(1 + t2143**2))), 0)
     t2147 = 1/xp.sqrt(1 + t2146**2)
     t2148 = t2106*t2146
@@ -6365,10 +6365,10 @@ def condition_number(q):
     t2174 = t2172 + t2146*t2171
     t2175 = t2120*t2153 + t2124*t2157 + t2128*t2161 + t2132*t2165 + t2136*t2169 + t2140*t2173
     t2176 = xp.not_equal(t2175, 0)
-    t2177 = 0.5*(-t2149 + t2116)/xp.where(t2176, t2175, 1)
+    t2177 = (-t2149 + t2116)/xp.where(t2176, 2*t2175, 1)
     t2178 = xp.abs(t2177)
     t2179 = xp.greater_equal(t2178, 1)
-    t2180 = xp.abs(1/xp.where(t2179, t2177, 1))
+    t2180 = 1/xp.abs(xp.where(t2179, t2177, 1))
     t2181 = xp.where(t2176, xp.where(xp.greater_equal(t2177, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2179, t2180/(1 + xp.sqrt(1 + t2180**2)), 1/(t2178 + xp.sqrt(1 + t2178**2))), 0)
     t2182 = 1/xp.sqrt(1 + t2181**2)
     t2183 = t2175*t2181
@@ -6400,10 +6400,10 @@ def condition_number(q):
     t2209 = t2207 + t2181*t2206
     t2210 = t2154*t2189 + t2158*t2193 + t2162*t2197 + t2166*t2201 + t2170*t2205 + t2174*t2209
     t2211 = xp.not_equal(t2210, 0)
-    t2212 = 0.5*(-t2150 + t2185)/xp.where(t2211, t2210, 1)
+    t2212 = (-t2150 + t2185)/xp.where(t2211, 2*t2210, 1)
     t2213 = xp.abs(t2212)
     t2214 = xp.greater_equal(t2213, 1)
-    t2215 = xp.abs(1/xp.where(t2214, t2212, 1))
+    t2215 = 1/xp.abs(xp.where(t2214, t2212, 1))
     t2216 = xp.where(t2211, xp.where(xp.greater_equal(t2212, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2214, t2215/(1 + xp.sqrt(1 + t2215**2)), 1/(t2213 + xp.sqrt(1 + t2213**2))), 0)
     t2217 = 1/xp.sqrt(1 + t2216**2)
     t2218 = t2210*t2216
@@ -6434,10 +6434,10 @@ def condition_number(q):
     t2243 = t2241 - t2216*t2242
     t2244 = t2242 + t2216*t2241
     t2245 = xp.not_equal(t2035, 0)
-    t2246 = 0.5*(-t1869 + t2009)/xp.where(t2245, t2035, 1)
+    t2246 = (-t1869 + t2009)/xp.where(t2245, 2*t2035, 1)
     t2247 = xp.abs(t2246)
     t2248 = xp.greater_equal(t2247, 1)
-    t2249 = xp.abs(1/xp.where(t2248, t2246, 1))
+    t2249 = 1/xp.abs(xp.where(t2248, t2246, 1))
     t2250 = xp.where(t2245, xp.where(xp.greater_equal(t2246, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2248, t2249/(1 + xp.sqrt(1 + t2249**2)), 1/(t2247 + xp.sqrt(1 + t2247**2))), 0)
     t2251 = 1/xp.sqrt(1 + t2250**2)
     t2252 = t2035*t2250
@@ -6469,10 +6469,10 @@ def condition_number(q):
     t2278 = t2276 + t2250*t2275
     t2279 = t2119*t2257 + t2123*t2261 + t2127*t2265 + t2131*t2269 + t2135*t2273 + t2139*t2277
     t2280 = xp.not_equal(t2279, 0)
-    t2281 = 0.5*(-t2253 + t2115)/xp.where(t2280, t2279, 1)
+    t2281 = (-t2253 + t2115)/xp.where(t2280, 2*t2279, 1)
     t2282 = xp.abs(t2281)
     t2283 = xp.greater_equal(t2282, 1)
-    t2284 = xp.abs(1/xp.where(t2283, t2281, 1))
+    t2284 = 1/xp.abs(xp.where(t2283, t2281, 1))
     t2285 = xp.where(t2280, xp.where(xp.greater_equal(t2281, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2283, t2284/(1 + xp.sqrt(1 + t2284**2)), 1/(t2282 + xp.sqrt(1 + t2282**2))), 0)
     t2286 = 1/xp.sqrt(1 + t2285**2)
     t2287 = t2279*t2285
@@ -6505,10 +6505,10 @@ def condition_number(q):
     t2314 = t2188*t2292 + t2192*t2296 + t2196*t2300 + t2200*t2304 + t2204*t2308 + t2208*t2312
     t2315 = t2258*t2293 + t2262*t2297 + t2266*t2301 + t2270*t2305 + t2274*t2309 + t2278*t2313
     t2316 = xp.not_equal(t2314, 0)
-    t2317 = 0.5*(-t2288 + t2184)/xp.where(t2316, t2314, 1)
+    t2317 = (-t2288 + t2184)/xp.where(t2316, 2*t2314, 1)
     t2318 = xp.abs(t2317)
     t2319 = xp.greater_equal(t2318, 1)
-    t2320 = xp.abs(1/xp.where(t2319, t2317, 1))
+    t2320 = 1/xp.abs(xp.where(t2319, t2317, 1))
     t2321 = xp.where(t2316, xp.where(xp.greater_equal(t2317, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2319, t2320/(1 + xp.sqrt(1 + t2320**2)), 1/(t2318 + xp.sqrt(1 + t2318**2))), 0)
     t2322 = 1/xp.sqrt(1 + t2321**2)
     t2323 = t2314*t2321
@@ -6540,10 +6540,10 @@ def condition_number(q):
     t2349 = t2347 + t2321*t2346
     t2350 = t2223*t2328 + t2227*t2332 + t2231*t2336 + t2235*t2340 + t2239*t2344 + t2243*t2348
     t2351 = xp.not_equal(t2350, 0)
-    t2352 = 0.5*(-t2324 + t2219)/xp.where(t2351, t2350, 1)
+    t2352 = (-t2324 + t2219)/xp.where(t2351, 2*t2350, 1)
     t2353 = xp.abs(t2352)
     t2354 = xp.greater_equal(t2353, 1)
-    t2355 = xp.abs(1/xp.where(t2354, t2352, 1))
+    t2355 = 1/xp.abs(xp.where(t2354, t2352, 1))
     t2356 = xp.where(t2351, xp.where(xp.greater_equal(t2352, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2354, t2355/(1 + xp.sqrt(1 + t2355**2)), 1/(t2353 + xp.sqrt(1 + t2353**2))), 0)
     t2357 = 1/xp.sqrt(1 + t2356**2)
     t2358 = t2350*t2356
@@ -6575,10 +6575,10 @@ def condition_number(q):
     t2384 = t2382 + t2356*t2381
     t2385 = t2224*t2363 + t2228*t2367 + t2232*t2371 + t2236*t2375 + t2240*t2379 + t2244*t2383
     t2386 = xp.not_equal(t2385, 0)
-    t2387 = 0.5*(-t2359 + t2220)/xp.where(t2386, t2385, 1)
+    t2387 = (-t2359 + t2220)/xp.where(t2386, 2*t2385, 1)
     t2388 = xp.abs(t2387)
     t2389 = xp.greater_equal(t2388, 1)
-    t2390 = xp.abs(1/xp.where(t2389, t2387, 1))
+    t2390 = 1/xp.abs(xp.where(t2389, t2387, 1))
     t2391 = xp.where(t2386, xp.where(xp.greater_equal(t2387, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2389, t2390/(1 + xp.sqrt(1 + t2390**2)), 1/(t2388 + xp.sqrt(1 + t2388**2))), 0)
     t2392 = 1/xp.sqrt(1 + t2391**2)
     t2393 = t2385*t2391
@@ -6609,10 +6609,10 @@ def condition_number(q):
     t2418 = t2416 - t2391*t2417
     t2419 = t2417 + t2391*t2416
     t2420 = xp.not_equal(t2315, 0)
-    t2421 = 0.5*(-t2254 + t2289)/xp.where(t2420, t2315, 1)
+    t2421 = (-t2254 + t2289)/xp.where(t2420, 2*t2315, 1)
     t2422 = xp.abs(t2421)
     t2423 = xp.greater_equal(t2422, 1)
-    t2424 = xp.abs(1/xp.where(t2423, t2421, 1))
+    t2424 = 1/xp.abs(xp.where(t2423, t2421, 1))
     t2425 = xp.where(t2420, xp.where(xp.greater_equal(t2421, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2423, t2424/(1 + xp.sqrt(1 + t2424**2)), 1/(t2422 + xp.sqrt(1 + t2422**2))), 0)
     t2426 = 1/xp.sqrt(1 + t2425**2)
     t2427 = t2315*t2425
@@ -6644,10 +6644,10 @@ def condition_number(q):
     t2453 = t2451 + t2425*t2450
     t2454 = t2329*t2432 + t2333*t2436 + t2337*t2440 + t2341*t2444 + t2345*t2448 + t2349*t2452
     t2455 = xp.not_equal(t2454, 0)
-    t2456 = 0.5*(-t2428 + t2325)/xp.where(t2455, t2454, 1)
+    t2456 = (-t2428 + t2325)/xp.where(t2455, 2*t2454, 1)
     t2457 = xp.abs(t2456)
     t2458 = xp.greater_equal(t2457, 1)
-    t2459 = xp.abs(1/xp.where(t2458, t2456, 1))
+    t2459 = 1/xp.abs(xp.where(t2458, t2456, 1))
     t2460 = xp.where(t2455, xp.where(xp.greater_equal(t2456, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2458, t2459/(1 + xp.sqrt(1 + t2459**2)), 1/(t2457 + xp.sqrt(1 + t2457**2))), 0)
     t2461 = 1/xp.sqrt(1 + t2460**2)
     t2462 = t2454*t2460
@@ -6680,10 +6680,10 @@ def condition_number(q):
     t2489 = t2364*t2467 + t2368*t2471 + t2372*t2475 + t2376*t2479 + t2380*t2483 + t2384*t2487
     t2490 = t2433*t2468 + t2437*t2472 + t2441*t2476 + t2445*t2480 + t2449*t2484 + t2453*t2488
     t2491 = xp.not_equal(t2489, 0)
-    t2492 = 0.5*(-t2463 + t2360)/xp.where(t2491, t2489, 1)
+    t2492 = (-t2463 + t2360)/xp.where(t2491, 2*t2489, 1)
     t2493 = xp.abs(t2492)
     t2494 = xp.greater_equal(t2493, 1)
-    t2495 = xp.abs(1/xp.where(t2494, t2492, 1))
+    t2495 = 1/xp.abs(xp.where(t2494, t2492, 1))
     t2496 = xp.where(t2491, xp.where(xp.greater_equal(t2492, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2494, t2495/(1 + xp.sqrt(1 + t2495**2)), 1/(t2493 + xp.sqrt(1 + t2493**2))), 0)
     t2497 = 1/xp.sqrt(1 + t2496**2)
     t2498 = t2489*t2496
@@ -6715,10 +6715,10 @@ def condition_number(q):
     t2524 = t2522 + t2496*t2521
     t2525 = t2399*t2503 + t2403*t2507 + t2407*t2511 + t2411*t2515 + t2415*t2519 + t2419*t2523
     t2526 = xp.not_equal(t2525, 0)
-    t2527 = 0.5*(-t2499 + t2395)/xp.where(t2526, t2525, 1)
+    t2527 = (-t2499 + t2395)/xp.where(t2526, 2*t2525, 1)
     t2528 = xp.abs(t2527)
     t2529 = xp.greater_equal(t2528, 1)
-    t2530 = xp.abs(1/xp.where(t2529, t2527, 1))
+    t2530 = 1/xp.abs(xp.where(t2529, t2527, 1))
     t2531 = xp.where(t2526, xp.where(xp.greater_equal(t2527, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2529, t2530/(1 + xp.sqrt(1 + t2530**2)), 1/(t2528 + xp.sqrt(1 + t2528**2))), 0)
     t2532 = 1/xp.sqrt(1 + t2531**2)
     t2533 = t2525*t2531
@@ -6750,10 +6750,10 @@ def condition_number(q):
     t2559 = t2557 + t2531*t2556
     t2560 = t2398*t2538 + t2402*t2542 + t2406*t2546 + t2410*t2550 + t2414*t2554 + t2418*t2558
     t2561 = xp.not_equal(t2490, 0)
-    t2562 = 0.5*(-t2429 + t2464)/xp.where(t2561, t2490, 1)
+    t2562 = (-t2429 + t2464)/xp.where(t2561, 2*t2490, 1)
     t2563 = xp.abs(t2562)
     t2564 = xp.greater_equal(t2563, 1)
-    t2565 = xp.abs(1/xp.where(t2564, t2562, 1))
+    t2565 = 1/xp.abs(xp.where(t2564, t2562, 1))
     t2566 = xp.where(t2561, xp.where(xp.greater_equal(t2562, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2564, t2565/(1 + xp.sqrt(1 + t2565**2)), 1/(t2563 + xp.sqrt(1 + t2563**2))), 0)
     t2567 = 1/xp.sqrt(1 + t2566**2)
     t2568 = t2490*t2566
@@ -6785,10 +6785,10 @@ def condition_number(q):
     t2594 = t2592 + t2566*t2591
     t2595 = t2504*t2573 + t2508*t2577 + t2512*t2581 + t2516*t2585 + t2520*t2589 + t2524*t2593
     t2596 = xp.not_equal(t2595, 0)
-    t2597 = 0.5*(-t2569 + t2500)/xp.where(t2596, t2595, 1)
+    t2597 = (-t2569 + t2500)/xp.where(t2596, 2*t2595, 1)
     t2598 = xp.abs(t2597)
     t2599 = xp.greater_equal(t2598, 1)
-    t2600 = xp.abs(1/xp.where(t2599, t2597, 1))
+    t2600 = 1/xp.abs(xp.where(t2599, t2597, 1))
     t2601 = xp.where(t2596, xp.where(xp.greater_equal(t2597, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2599, t2600/(1 + xp.sqrt(1 + t2600**2)), 1/(t2598 + xp.sqrt(1 + t2598**2))), 0)
     t2602 = 1/xp.sqrt(1 + t2601**2)
     t2603 = t2595*t2601
@@ -6821,10 +6821,10 @@ def condition_number(q):
     t2630 = t2539*t2608 + t2543*t2612 + t2547*t2616 + t2551*t2620 + t2555*t2624 + t2559*t2628
     t2631 = t2574*t2609 + t2578*t2613 + t2582*t2617 + t2586*t2621 + t2590*t2625 + t2594*t2629
     t2632 = xp.not_equal(t2630, 0)
-    t2633 = 0.5*(-t2604 + t2535)/xp.where(t2632, t2630, 1)
+    t2633 = (-t2604 + t2535)/xp.where(t2632, 2*t2630, 1)
     t2634 = xp.abs(t2633)
     t2635 = xp.greater_equal(t2634, 1)
-    t2636 = xp.abs(1/xp.where(t2635, t2633, 1))
+    t2636 = 1/xp.abs(xp.where(t2635, t2633, 1))
     t2637 = xp.where(t2632, xp.where(xp.greater_equal(t2633, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2635, t2636/(1 + xp.sqrt(1 + t2636**2)), 1/(t2634 + xp.sqrt(1 + t2634**2))), 0)
     t2638 = 1/xp.sqrt(1 + t2637**2)
     t2639 = t2630*t2637
@@ -6855,10 +6855,10 @@ def condition_number(q):
     t2664 = t2662 - t2637*t2663
     t2665 = t2663 + t2637*t2662
     t2666 = xp.not_equal(t2631, 0)
-    t2667 = 0.5*(-t2570 + t2605)/xp.where(t2666, t2631, 1)
+    t2667 = (-t2570 + t2605)/xp.where(t2666, 2*t2631, 1)
     t2668 = xp.abs(t2667)
     t2669 = xp.greater_equal(t2668, 1)
-    t2670 = xp.abs(1/xp.where(t2669, t2667, 1))
+    t2670 = 1/xp.abs(xp.where(t2669, t2667, 1))
     t2671 = xp.where(t2666, xp.where(xp.greater_equal(t2667, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2669, t2670/(1 + xp.sqrt(1 + t2670**2)), 1/(t2668 + xp.sqrt(1 + t2668**2))), 0)
     t2672 = 1/xp.sqrt(1 + t2671**2)
     t2673 = t2631*t2671
@@ -6890,10 +6890,10 @@ def condition_number(q):
     t2699 = t2697 + t2671*t2696
     t2700 = t2645*t2678 + t2649*t2682 + t2653*t2686 + t2657*t2690 + t2661*t2694 + t2665*t2698
     t2701 = xp.not_equal(t2700, 0)
-    t2702 = 0.5*(-t2674 + t2641)/xp.where(t2701, t2700, 1)
+    t2702 = (-t2674 + t2641)/xp.where(t2701, 2*t2700, 1)
     t2703 = xp.abs(t2702)
     t2704 = xp.greater_equal(t2703, 1)
-    t2705 = xp.abs(1/xp.where(t2704, t2702, 1))
+    t2705 = 1/xp.abs(xp.where(t2704, t2702, 1))
     t2706 = xp.where(t2701, xp.where(xp.greater_equal(t2702, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2704, t2705/(1 + xp.sqrt(1 + t2705**2)), 1/(t2703 + xp.sqrt(1 + t2703**2))), 0)
     t2707 = 1/xp.sqrt(1 + t2706**2)
     t2708 = t2700*t2706
@@ -6925,10 +6925,10 @@ def condition_number(q):
     t2734 = t2732 + t2706*t2731
     t2735 = t2679*t2714 + t2683*t2718 + t2687*t2722 + t2691*t2726 + t2695*t2730 + t2699*t2734
     t2736 = xp.not_equal(t2735, 0)
-    t2737 = 0.5*(-t2675 + t2710)/xp.where(t2736, t2735, 1)
+    t2737 = (-t2675 + t2710)/xp.where(t2736, 2*t2735, 1)
     t2738 = xp.abs(t2737)
     t2739 = xp.greater_equal(t2738, 1)
-    t2740 = xp.abs(1/xp.where(t2739, t2737, 1))
+    t2740 = 1/xp.abs(xp.where(t2739, t2737, 1))
     t2741 = xp.where(t2736, xp.where(xp.greater_equal(t2737, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2739, t2740/(1 + xp.sqrt(1 + t2740**2)), 1/(t2738 + xp.sqrt(1 + t2738**2))), 0)
     t2742 = 1/xp.sqrt(1 + t2741**2)
     t2743 = t2735*t2741
@@ -6959,10 +6959,10 @@ def condition_number(q):
     t2768 = t2766 - t2741*t2767
     t2769 = t2767 + t2741*t2766
     t2770 = xp.not_equal(t2560, 0)
-    t2771 = 0.5*(-t2394 + t2534)/xp.where(t2770, t2560, 1)
+    t2771 = (-t2394 + t2534)/xp.where(t2770, 2*t2560, 1)
     t2772 = xp.abs(t2771)
     t2773 = xp.greater_equal(t2772, 1)
-    t2774 = xp.abs(1/xp.where(t2773, t2771, 1))
+    t2774 = 1/xp.abs(xp.where(t2773, t2771, 1))
     t2775 = xp.where(t2770, xp.where(xp.greater_equal(t2771, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2773, t2774/(1 + xp.sqrt(1 + t2774**2)), 1/(t2772 + xp.sqrt(1 + t2772**2))), 0)
     t2776 = 1/xp.sqrt(1 + t2775**2)
     t2777 = t2560*t2775
@@ -6994,10 +6994,10 @@ def condition_number(q):
     t2803 = t2801 + t2775*t2800
     t2804 = t2644*t2782 + t2648*t2786 + t2652*t2790 + t2656*t2794 + t2660*t2798 + t2664*t2802
     t2805 = xp.not_equal(t2804, 0)
-    t2806 = 0.5*(-t2778 + t2640)/xp.where(t2805, t2804, 1)
+    t2806 = (-t2778 + t2640)/xp.where(t2805, 2*t2804, 1)
     t2807 = xp.abs(t2806)
     t2808 = xp.greater_equal(t2807, 1)
-    t2809 = xp.abs(1/xp.where(t2808, t2806, 1))
+    t2809 = 1/xp.abs(xp.where(t2808, t2806, 1))
     t2810 = xp.where(t2805, xp.where(xp.greater_equal(t2806, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2808, t2809/(1 + xp.sqrt(1 + t2809**2)), 1/(t2807 + xp.sqrt(1 + t2807**2))), 0)
     t2811 = 1/xp.sqrt(1 + t2810**2)
     t2812 = t2804*t2810
@@ -7030,10 +7030,10 @@ def condition_number(q):
     t2839 = t2713*t2817 + t2717*t2821 + t2721*t2825 + t2725*t2829 + t2729*t2833 + t2733*t2837
     t2840 = t2783*t2818 + t2787*t2822 + t2791*t2826 + t2795*t2830 + t2799*t2834 + t2803*t2838
     t2841 = xp.not_equal(t2839, 0)
-    t2842 = 0.5*(-t2813 + t2709)/xp.where(t2841, t2839, 1)
+    t2842 = (-t2813 + t2709)/xp.where(t2841, 2*t2839, 1)
     t2843 = xp.abs(t2842)
     t2844 = xp.greater_equal(t2843, 1)
-    t2845 = xp.abs(1/xp.where(t2844, t2842, 1))
+    t2845 = 1/xp.abs(xp.where(t2844, t2842, 1))
     t2846 = xp.where(t2841, xp.where(xp.greater_equal(t2842, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2844, t2845/(1 + xp.sqrt(1 + t2845**2)), 1/(t2843 + xp.sqrt(1 + t2843**2))), 0)
     t2847 = 1/xp.sqrt(1 + t2846**2)
     t2848 = t2839*t2846
@@ -7065,10 +7065,10 @@ def condition_number(q):
     t2874 = t2872 + t2846*t2871
     t2875 = t2748*t2853 + t2752*t2857 + t2756*t2861 + t2760*t2865 + t2764*t2869 + t2768*t2873
     t2876 = xp.not_equal(t2875, 0)
-    t2877 = 0.5*(-t2849 + t2744)/xp.where(t2876, t2875, 1)
+    t2877 = (-t2849 + t2744)/xp.where(t2876, 2*t2875, 1)
     t2878 = xp.abs(t2877)
     t2879 = xp.greater_equal(t2878, 1)
-    t2880 = xp.abs(1/xp.where(t2879, t2877, 1))
+    t2880 = 1/xp.abs(xp.where(t2879, t2877, 1))
     t2881 = xp.where(t2876, xp.where(xp.greater_equal(t2877, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2879, t2880/(1 + xp.sqrt(1 + t2880**2)), 1/(t2878 + xp.sqrt(1 + t2878**2))), 0)
     t2882 = 1/xp.sqrt(1 + t2881**2)
     t2883 = t2875*t2881
@@ -7100,10 +7100,10 @@ def condition_number(q):
     t2909 = t2907 + t2881*t2906
     t2910 = t2749*t2888 + t2753*t2892 + t2757*t2896 + t2761*t2900 + t2765*t2904 + t2769*t2908
     t2911 = xp.not_equal(t2910, 0)
-    t2912 = 0.5*(-t2884 + t2745)/xp.where(t2911, t2910, 1)
+    t2912 = (-t2884 + t2745)/xp.where(t2911, 2*t2910, 1)
     t2913 = xp.abs(t2912)
     t2914 = xp.greater_equal(t2913, 1)
-    t2915 = xp.abs(1/xp.where(t2914, t2912, 1))
+    t2915 = 1/xp.abs(xp.where(t2914, t2912, 1))
     t2916 = xp.where(t2911, xp.where(xp.greater_equal(t2912, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2914, t2915/(1 + xp.sqrt(1 + t2915**2)), 1/(t2913 + xp.sqrt(1 + t2913**2))), 0)
     t2917 = 1/xp.sqrt(1 + t2916**2)
     t2918 = t2910*t2916
@@ -7134,10 +7134,10 @@ def condition_number(q):
     t2943 = t2941 - t2916*t2942
     t2944 = t2942 + t2916*t2941
     t2945 = xp.not_equal(t2840, 0)
-    t2946 = 0.5*(-t2779 + t2814)/xp.where(t2945, t2840, 1)
+    t2946 = (-t2779 + t2814)/xp.where(t2945, 2*t2840, 1)
     t2947 = xp.abs(t2946)
     t2948 = xp.greater_equal(t2947, 1)
-    t2949 = xp.abs(1/xp.where(t2948, t2946, 1))
+    t2949 = 1/xp.abs(xp.where(t2948, t2946, 1))
     t2950 = xp.where(t2945, xp.where(xp.greater_equal(t2946, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2948, t2949/(1 + xp.sqrt(1 + t2949**2)), 1/(t2947 + xp.sqrt(1 + t2947**2))), 0)
     t2951 = 1/xp.sqrt(1 + t2950**2)
     t2952 = t2840*t2950
@@ -7169,10 +7169,10 @@ def condition_number(q):
     t2978 = t2976 + t2950*t2975
     t2979 = t2854*t2957 + t2858*t2961 + t2862*t2965 + t2866*t2969 + t2870*t2973 + t2874*t2977
     t2980 = xp.not_equal(t2979, 0)
-    t2981 = 0.5*(-t2953 + t2850)/xp.where(t2980, t2979, 1)
+    t2981 = (-t2953 + t2850)/xp.where(t2980, 2*t2979, 1)
     t2982 = xp.abs(t2981)
     t2983 = xp.greater_equal(t2982, 1)
-    t2984 = xp.abs(1/xp.where(t2983, t2981, 1))
+    t2984 = 1/xp.abs(xp.where(t2983, t2981, 1))
     t2985 = xp.where(t2980, xp.where(xp.greater_equal(t2981, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2983, t2984/(1 + xp.sqrt(1 + t2984**2)), 1/(t2982 + xp.sqrt(1 + t2982**2))), 0)
     t2986 = 1/xp.sqrt(1 + t2985**2)
     t2987 = t2979*t2985
@@ -7205,10 +7205,10 @@ def condition_number(q):
     t3014 = t2889*t2992 + t2893*t2996 + t2897*t3000 + t2901*t3004 + t2905*t3008 + t2909*t3012
     t3015 = t2958*t2993 + t2962*t2997 + t2966*t3001 + t2970*t3005 + t2974*t3009 + t2978*t3013
     t3016 = xp.not_equal(t3014, 0)
-    t3017 = 0.5*(-t2988 + t2885)/xp.where(t3016, t3014, 1)
+    t3017 = (-t2988 + t2885)/xp.where(t3016, 2*t3014, 1)
     t3018 = xp.abs(t3017)
     t3019 = xp.greater_equal(t3018, 1)
-    t3020 = xp.abs(1/xp.where(t3019, t3017, 1))
+    t3020 = 1/xp.abs(xp.where(t3019, t3017, 1))
     t3021 = xp.where(t3016, xp.where(xp.greater_equal(t3017, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3019, t3020/(1 + xp.sqrt(1 + t3020**2)), 1/(t3018 + xp.sqrt(1 + t3018**2))), 0)
     t3022 = 1/xp.sqrt(1 + t3021**2)
     t3023 = t3014*t3021
@@ -7240,10 +7240,10 @@ def condition_number(q):
     t3049 = t3047 + t3021*t3046
     t3050 = t2924*t3028 + t2928*t3032 + t2932*t3036 + t2936*t3040 + t2940*t3044 + t2944*t3048
     t3051 = xp.not_equal(t3050, 0)
-    t3052 = 0.5*(-t3024 + t2920)/xp.where(t3051, t3050, 1)
+    t3052 = (-t3024 + t2920)/xp.where(t3051, 2*t3050, 1)
     t3053 = xp.abs(t3052)
     t3054 = xp.greater_equal(t3053, 1)
-    t3055 = xp.abs(1/xp.where(t3054, t3052, 1))
+    t3055 = 1/xp.abs(xp.where(t3054, t3052, 1))
     t3056 = xp.where(t3051, xp.where(xp.greater_equal(t3052, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3054, t3055/(1 + xp.sqrt(1 + t3055**2)), 1/(t3053 + xp.sqrt(1 + t3053**2))), 0)
     t3057 = 1/xp.sqrt(1 + t3056**2)
     t3058 = t3050*t3056
@@ -7275,10 +7275,10 @@ def condition_number(q):
     t3084 = t3082 + t3056*t3081
     t3085 = t2923*t3063 + t2927*t3067 + t2931*t3071 + t2935*t3075 + t2939*t3079 + t2943*t3083
     t3086 = xp.not_equal(t3015, 0)
-    t3087 = 0.5*(-t2954 + t2989)/xp.where(t3086, t3015, 1)
+    t3087 = (-t2954 + t2989)/xp.where(t3086, 2*t3015, 1)
     t3088 = xp.abs(t3087)
     t3089 = xp.greater_equal(t3088, 1)
-    t3090 = xp.abs(1/xp.where(t3089, t3087, 1))
+    t3090 = 1/xp.abs(xp.where(t3089, t3087, 1))
     t3091 = xp.where(t3086, xp.where(xp.greater_equal(t3087, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3089, t3090/(1 + xp.sqrt(1 + t3090**2)), 1/(t3088 + xp.sqrt(1 + t3088**2))), 0)
     t3092 = 1/xp.sqrt(1 + t3091**2)
     t3093 = t3015*t3091
@@ -7310,10 +7310,10 @@ def condition_number(q):
     t3119 = t3117 + t3091*t3116
     t3120 = t3029*t3098 + t3033*t3102 + t3037*t3106 + t3041*t3110 + t3045*t3114 + t3049*t3118
     t3121 = xp.not_equal(t3120, 0)
-    t3122 = 0.5*(-t3094 + t3025)/xp.where(t3121, t3120, 1)
+    t3122 = (-t3094 + t3025)/xp.where(t3121, 2*t3120, 1)
     t3123 = xp.abs(t3122)
     t3124 = xp.greater_equal(t3123, 1)
-    t3125 = xp.abs(1/xp.where(t3124, t3122, 1))
+    t3125 = 1/xp.abs(xp.where(t3124, t3122, 1))
     t3126 = xp.where(t3121, xp.where(xp.greater_equal(t3122, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3124, t3125/(1 + xp.sqrt(1 + t3125**2)), 1/(t3123 + xp.sqrt(1 + t3123**2))), 0)
     t3127 = 1/xp.sqrt(1 + t3126**2)
     t3128 = t3120*t3126
@@ -7346,10 +7346,10 @@ def condition_number(q):
     t3155 = t3064*t3133 + t3068*t3137 + t3072*t3141 + t3076*t3145 + t3080*t3149 + t3084*t3153
     t3156 = t3099*t3134 + t3103*t3138 + t3107*t3142 + t3111*t3146 + t3115*t3150 + t3119*t3154
     t3157 = xp.not_equal(t3155, 0)
-    t3158 = 0.5*(-t3129 + t3060)/xp.where(t3157, t3155, 1)
+    t3158 = (-t3129 + t3060)/xp.where(t3157, 2*t3155, 1)
     t3159 = xp.abs(t3158)
     t3160 = xp.greater_equal(t3159, 1)
-    t3161 = xp.abs(1/xp.where(t3160, t3158, 1))
+    t3161 = 1/xp.abs(xp.where(t3160, t3158, 1))
     t3162 = xp.where(t3157, xp.where(xp.greater_equal(t3158, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3160, t3161/(1 + xp.sqrt(1 + t3161**2)), 1/(t3159 + xp.sqrt(1 + t3159**2))), 0)
     t3163 = 1/xp.sqrt(1 + t3162**2)
     t3164 = t3155*t3162
@@ -7380,10 +7380,10 @@ def condition_number(q):
     t3189 = t3187 - t3162*t3188
     t3190 = t3188 + t3162*t3187
     t3191 = xp.not_equal(t3156, 0)
-    t3192 = 0.5*(-t3095 + t3130)/xp.where(t3191, t3156, 1)
+    t3192 = (-t3095 + t3130)/xp.where(t3191, 2*t3156, 1)
     t3193 = xp.abs(t3192)
     t3194 = xp.greater_equal(t3193, 1)
-    t3195 = xp.abs(1/xp.where(t3194, t3192, 1))
+    t3195 = 1/xp.abs(xp.where(t3194, t3192, 1))
     t3196 = xp.where(t3191, xp.where(xp.greater_equal(t3192, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3194, t3195/(1 + xp.sqrt(1 + t3195**2)), 1/(t3193 + xp.sqrt(1 + t3193**2))), 0)
     t3197 = 1/xp.sqrt(1 + t3196**2)
     t3198 = t3156*t3196
@@ -7415,10 +7415,10 @@ def condition_number(q):
     t3224 = t3222 + t3196*t3221
     t3225 = t3170*t3203 + t3174*t3207 + t3178*t3211 + t3182*t3215 + t3186*t3219 + t3190*t3223
     t3226 = xp.not_equal(t3225, 0)
-    t3227 = 0.5*(-t3199 + t3166)/xp.where(t3226, t3225, 1)
+    t3227 = (-t3199 + t3166)/xp.where(t3226, 2*t3225, 1)
     t3228 = xp.abs(t3227)
     t3229 = xp.greater_equal(t3228, 1)
-    t3230 = xp.abs(1/xp.where(t3229, t3227, 1))
+    t3230 = 1/xp.abs(xp.where(t3229, t3227, 1))
     t3231 = xp.where(t3226, xp.where(xp.greater_equal(t3227, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3229, t3230/(1 + xp.sqrt(1 + t3230**2)), 1/(t3228 + xp.sqrt(1 + t3228**2))), 0)
     t3232 = 1/xp.sqrt(1 + t3231**2)
     t3233 = t3225*t3231
@@ -7450,10 +7450,10 @@ def condition_number(q):
     t3259 = t3257 + t3231*t3256
     t3260 = t3204*t3239 + t3208*t3243 + t3212*t3247 + t3216*t3251 + t3220*t3255 + t3224*t3259
     t3261 = xp.not_equal(t3260, 0)
-    t3262 = 0.5*(-t3200 + t3235)/xp.where(t3261, t3260, 1)
+    t3262 = (-t3200 + t3235)/xp.where(t3261, 2*t3260, 1)
     t3263 = xp.abs(t3262)
     t3264 = xp.greater_equal(t3263, 1)
-    t3265 = xp.abs(1/xp.where(t3264, t3262, 1))
+    t3265 = 1/xp.abs(xp.where(t3264, t3262, 1))
     t3266 = xp.where(t3261, xp.where(xp.greater_equal(t3262, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3264, t3265/(1 + xp.sqrt(1 + t3265**2)), 1/(t3263 + xp.sqrt(1 + t3263**2))), 0)
     t3267 = 1/xp.sqrt(1 + t3266**2)
     t3268 = t3260*t3266
@@ -7484,10 +7484,10 @@ def condition_number(q):
     t3293 = t3291 - t3266*t3292
     t3294 = t3292 + t3266*t3291
     t3295 = xp.not_equal(t3085, 0)
-    t3296 = 0.5*(-t2919 + t3059)/xp.where(t3295, t3085, 1)
+    t3296 = (-t2919 + t3059)/xp.where(t3295, 2*t3085, 1)
     t3297 = xp.abs(t3296)
     t3298 = xp.greater_equal(t3297, 1)
-    t3299 = xp.abs(1/xp.where(t3298, t3296, 1))
+    t3299 = 1/xp.abs(xp.where(t3298, t3296, 1))
     t3300 = xp.where(t3295, xp.where(xp.greater_equal(t3296, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3298, t3299/(1 + xp.sqrt(1 + t3299**2)), 1/(t3297 + xp.sqrt(1 + t3297**2))), 0)
     t3301 = 1/xp.sqrt(1 + t3300**2)
     t3302 = t3085*t3300
@@ -7519,10 +7519,10 @@ def condition_number(q):
     t3328 = t3326 + t3300*t3325
     t3329 = t3169*t3307 + t3173*t3311 + t3177*t3315 + t3181*t3319 + t3185*t3323 + t3189*t3327
     t3330 = xp.not_equal(t3329, 0)
-    t3331 = 0.5*(-t3303 + t3165)/xp.where(t3330, t3329, 1)
+    t3331 = (-t3303 + t3165)/xp.where(t3330, 2*t3329, 1)
     t3332 = xp.abs(t3331)
     t3333 = xp.greater_equal(t3332, 1)
-    t3334 = xp.abs(1/xp.where(t3333, t3331, 1))
+    t3334 = 1/xp.abs(xp.where(t3333, t3331, 1))
     t3335 = xp.where(t3330, xp.where(xp.greater_equal(t3331, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3333, t3334/(1 + xp.sqrt(1 + t3334**2)), 1/(t3332 + xp.sqrt(1 + t3332**2))), 0)
     t3336 = 1/xp.sqrt(1 + t3335**2)
     t3337 = t3329*t3335
@@ -7555,10 +7555,10 @@ def condition_number(q):
     t3364 = t3238*t3342 + t3242*t3346 + t3246*t3350 + t3250*t3354 + t3254*t3358 + t3258*t3362
     t3365 = t3308*t3343 + t3312*t3347 + t3316*t3351 + t3320*t3355 + t3324*t3359 + t3328*t3363
     t3366 = xp.not_equal(t3364, 0)
-    t3367 = 0.5*(-t3338 + t3234)/xp.where(t3366, t3364, 1)
+    t3367 = (-t3338 + t3234)/xp.where(t3366, 2*t3364, 1)
     t3368 = xp.abs(t3367)
     t3369 = xp.greater_equal(t3368, 1)
-    t3370 = xp.abs(1/xp.where(t3369, t3367, 1))
+    t3370 = 1/xp.abs(xp.where(t3369, t3367, 1))
     t3371 = xp.where(t3366, xp.where(xp.greater_equal(t3367, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3369, t3370/(1 + xp.sqrt(1 + t3370**2)), 1/(t3368 + xp.sqrt(1 + t3368**2))), 0)
     t3372 = 1/xp.sqrt(1 + t3371**2)
     t3373 = t3364*t3371
@@ -7590,10 +7590,10 @@ def condition_number(q):
     t3399 = t3397 + t3371*t3396
     t3400 = t3273*t3378 + t3277*t3382 + t3281*t3386 + t3285*t3390 + t3289*t3394 + t3293*t3398
     t3401 = xp.not_equal(t3400, 0)
-    t3402 = 0.5*(-t3374 + t3269)/xp.where(t3401, t3400, 1)
+    t3402 = (-t3374 + t3269)/xp.where(t3401, 2*t3400, 1)
     t3403 = xp.abs(t3402)
     t3404 = xp.greater_equal(t3403, 1)
-    t3405 = xp.abs(1/xp.where(t3404, t3402, 1))
+    t3405 = 1/xp.abs(xp.where(t3404, t3402, 1))
     t3406 = xp.where(t3401, xp.where(xp.greater_equal(t3402, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3404, t3405/(1 + xp.sqrt(1 + t3405**2)), 1/(t3403 + xp.sqrt(1 + t3403**2))), 0)
     t3407 = 1/xp.sqrt(1 + t3406**2)
     t3408 = t3400*t3406
@@ -7625,10 +7625,10 @@ def condition_number(q):
     t3434 = t3432 + t3406*t3431
     t3435 = t3274*t3413 + t3278*t3417 + t3282*t3421 + t3286*t3425 + t3290*t3429 + t3294*t3433
     t3436 = xp.not_equal(t3435, 0)
-    t3437 = 0.5*(-t3409 + t3270)/xp.where(t3436, t3435, 1)
+    t3437 = (-t3409 + t3270)/xp.where(t3436, 2*t3435, 1)
     t3438 = xp.abs(t3437)
     t3439 = xp.greater_equal(t3438, 1)
-    t3440 = xp.abs(1/xp.where(t3439, t3437, 1))
+    t3440 = 1/xp.abs(xp.where(t3439, t3437, 1))
     t3441 = xp.where(t3436, xp.where(xp.greater_equal(t3437, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3439, t3440/(1 + xp.sqrt(1 + t3440**2)), 1/(t3438 + xp.sqrt(1 + t3438**2))), 0)
     t3442 = 1/xp.sqrt(1 + t3441**2)
     t3443 = t3270 + t3435*t3441
@@ -7658,10 +7658,10 @@ def condition_number(q):
     t3467 = t3465 + t3441*t3464
     t3468 = xp.sqrt(t3446**2 + t3450**2 + t3454**2 + t3458**2 + t3462**2 + t3466**2)
     t3469 = xp.not_equal(t3365, 0)
-    t3470 = 0.5*(-t3304 + t3339)/xp.where(t3469, t3365, 1)
+    t3470 = (-t3304 + t3339)/xp.where(t3469, 2*t3365, 1)
     t3471 = xp.abs(t3470)
     t3472 = xp.greater_equal(t3471, 1)
-    t3473 = xp.abs(1/xp.where(t3472, t3470, 1))
+    t3473 = 1/xp.abs(xp.where(t3472, t3470, 1))
     t3474 = xp.where(t3469, xp.where(xp.greater_equal(t3470, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3472, t3473/(1 + xp.sqrt(1 + t3473**2)), 1/(t3471 + xp.sqrt(1 + t3471**2))), 0)
     t3475 = 1/xp.sqrt(1 + t3474**2)
     t3476 = t3365*t3474
@@ -7693,10 +7693,10 @@ def condition_number(q):
     t3502 = t3500 + t3474*t3499
     t3503 = t3379*t3481 + t3383*t3485 + t3387*t3489 + t3391*t3493 + t3395*t3497 + t3399*t3501
     t3504 = xp.not_equal(t3503, 0)
-    t3505 = 0.5*(-t3477 + t3375)/xp.where(t3504, t3503, 1)
+    t3505 = (-t3477 + t3375)/xp.where(t3504, 2*t3503, 1)
     t3506 = xp.abs(t3505)
     t3507 = xp.greater_equal(t3506, 1)
-    t3508 = xp.abs(1/xp.where(t3507, t3505, 1))
+    t3508 = 1/xp.abs(xp.where(t3507, t3505, 1))
     t3509 = xp.where(t3504, xp.where(xp.greater_equal(t3505, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3507, t3508/(1 + xp.sqrt(1 + t3508**2)), 1/(t3506 + xp.sqrt(1 + t3506**2))), 0)
     t3510 = 1/xp.sqrt(1 + t3509**2)
     t3511 = t3503*t3509
@@ -7729,10 +7729,10 @@ def condition_number(q):
     t3538 = t3414*t3516 + t3418*t3520 + t3422*t3524 + t3426*t3528 + t3430*t3532 + t3434*t3536
     t3539 = t3482*t3517 + t3486*t3521 + t3490*t3525 + t3494*t3529 + t3498*t3533 + t3502*t3537
     t3540 = xp.not_equal(t3538, 0)
-    t3541 = 0.5*(-t3512 + t3410)/xp.where(t3540, t3538, 1)
+    t3541 = (-t3512 + t3410)/xp.where(t3540, 2*t3538, 1)
     t3542 = xp.abs(t3541)
     t3543 = xp.greater_equal(t3542, 1)
-    t3544 = xp.abs(1/xp.where(t3543, t3541, 1))
+    t3544 = 1/xp.abs(xp.where(t3543, t3541, 1))
     t3545 = xp.where(t3540, xp.where(xp.greater_equal(t3541, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3543, t3544/(1 + xp.sqrt(1 + t3544**2)), 1/(t3542 + xp.sqrt(1 + t3542**2))), 0)
     t3546 = 1/xp.sqrt(1 + t3545**2)
     t3547 = t3538*t3545
@@ -7764,10 +7764,10 @@ def condition_number(q):
     t3573 = t3571 + t3545*t3570
     t3574 = t3447*t3552 + t3451*t3556 + t3455*t3560 + t3459*t3564 + t3463*t3568 + t3467*t3572
     t3575 = xp.not_equal(t3574, 0)
-    t3576 = 0.5*(-t3548 + t3443)/xp.where(t3575, t3574, 1)
+    t3576 = (-t3548 + t3443)/xp.where(t3575, 2*t3574, 1)
     t3577 = xp.abs(t3576)
     t3578 = xp.greater_equal(t3577, 1)
-    t3579 = xp.abs(1/xp.where(t3578, t3576, 1))
+    t3579 = 1/xp.abs(xp.where(t3578, t3576, 1))
     t3580 = xp.where(t3575, xp.where(xp.greater_equal(t3576, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3578, t3579/(1 + xp.sqrt(1 + t3579**2)), 1/(t3577 + xp.sqrt(1 + t3577**2))), 0)
     t3581 = 1/xp.sqrt(1 + t3580**2)
     t3582 = t3443 + t3574*t3580
@@ -7799,10 +7799,10 @@ def condition_number(q):
     t3608 = xp.where(xp.greater(t3607, t3468), t3607, t3468)
     t3609 = xp.where(xp.less(t3607, t3468), t3607, t3468)
     t3610 = xp.not_equal(t3539, 0)
-    t3611 = 0.5*(-t3478 + t3513)/xp.where(t3610, t3539, 1)
+    t3611 = (-t3478 + t3513)/xp.where(t3610, 2*t3539, 1)
     t3612 = xp.abs(t3611)
     t3613 = xp.greater_equal(t3612, 1)
-    t3614 = xp.abs(1/xp.where(t3613, t3611, 1))
+    t3614 = 1/xp.abs(xp.where(t3613, t3611, 1))
     t3615 = xp.where(t3610, xp.where(xp.greater_equal(t3611, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3613, t3614/(1 + xp.sqrt(1 + t3614**2)), 1/(t3612 + xp.sqrt(1 + t3612**2))), 0)
     t3616 = 1/xp.sqrt(1 + t3615**2)
     t3617 = t3539*t3615
@@ -7834,10 +7834,10 @@ def condition_number(q):
     t3643 = t3641 + t3615*t3640
     t3644 = t3553*t3622 + t3557*t3626 + t3561*t3630 + t3565*t3634 + t3569*t3638 + t3573*t3642
     t3645 = xp.not_equal(t3644, 0)
-    t3646 = 0.5*(-t3618 + t3549)/xp.where(t3645, t3644, 1)
+    t3646 = (-t3618 + t3549)/xp.where(t3645, 2*t3644, 1)
     t3647 = xp.abs(t3646)
     t3648 = xp.greater_equal(t3647, 1)
-    t3649 = xp.abs(1/xp.where(t3648, t3646, 1))
+    t3649 = 1/xp.abs(xp.where(t3648, t3646, 1))
     t3650 = xp.where(t3645, xp.where(xp.greater_equal(t3646, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3648, t3649/(1 + xp.sqrt(1 + t3649**2)), 1/(t3647 + xp.sqrt(1 + t3647**2))), 0)
     t3651 = 1/xp.sqrt(1 + t3650**2)
     t3652 = t3644*t3650
@@ -7870,10 +7870,10 @@ def condition_number(q):
     t3679 = t3586*t3657 + t3590*t3661 + t3594*t3665 + t3598*t3669 + t3602*t3673 + t3606*t3677
     t3680 = t3623*t3658 + t3627*t3662 + t3631*t3666 + t3635*t3670 + t3639*t3674 + t3643*t3678
     t3681 = xp.not_equal(t3679, 0)
-    t3682 = 0.5*(-t3653 + t3582)/xp.where(t3681, t3679, 1)
+    t3682 = (-t3653 + t3582)/xp.where(t3681, 2*t3679, 1)
     t3683 = xp.abs(t3682)
     t3684 = xp.greater_equal(t3683, 1)
-    t3685 = xp.abs(1/xp.where(t3684, t3682, 1))
+    t3685 = 1/xp.abs(xp.where(t3684, t3682, 1))
     t3686 = xp.where(t3681, xp.where(xp.greater_equal(t3682, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3684, t3685/(1 + xp.sqrt(1 + t3685**2)), 1/(t3683 + xp.sqrt(1 + t3683**2))), 0)
     t3687 = 1/xp.sqrt(1 + t3686**2)
     t3688 = t3582 + t3679*t3686
@@ -7905,10 +7905,10 @@ def condition_number(q):
     t3714 = xp.where(xp.greater(t3713, t3608), t3713, t3608)
     t3715 = xp.where(xp.less(t3713, t3609), t3713, t3609)
     t3716 = xp.not_equal(t3680, 0)
-    t3717 = 0.5*(-t3619 + t3654)/xp.where(t3716, t3680, 1)
+    t3717 = (-t3619 + t3654)/xp.where(t3716, 2*t3680, 1)
     t3718 = xp.abs(t3717)
     t3719 = xp.greater_equal(t3718, 1)
-    t3720 = xp.abs(1/xp.where(t3719, t3717, 1))
+    t3720 = 1/xp.abs(xp.where(t3719, t3717, 1))
     t3721 = xp.where(t3716, xp.where(xp.greater_equal(t3717, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3719, t3720/(1 + xp.sqrt(1 + t3720**2)), 1/(t3718 + xp.sqrt(1 + t3718**2))), 0)
     t3722 = 1/xp.sqrt(1 + t3721**2)
     t3723 = t3680*t3721
@@ -7940,10 +7940,10 @@ def condition_number(q):
     t3749 = t3747 + t3721*t3746
     t3750 = t3692*t3728 + t3696*t3732 + t3700*t3736 + t3704*t3740 + t3708*t3744 + t3712*t3748
     t3751 = xp.not_equal(t3750, 0)
-    t3752 = 0.5*(-t3724 + t3688)/xp.where(t3751, t3750, 1)
+    t3752 = (-t3724 + t3688)/xp.where(t3751, 2*t3750, 1)
     t3753 = xp.abs(t3752)
     t3754 = xp.greater_equal(t3753, 1)
-    t3755 = xp.abs(1/xp.where(t3754, t3752, 1))
+    t3755 = 1/xp.abs(xp.where(t3754, t3752, 1))
     t3756 = xp.where(t3751, xp.where(xp.greater_equal(t3752, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3754, t3755/(1 + xp.sqrt(1 + t3755**2)), 1/(t3753 + xp.sqrt(1 + t3753**2))), 0)
     t3757 = 1/xp.sqrt(1 + t3756**2)
     t3758 = t3688 + t3750*t3756
@@ -7976,10 +7976,10 @@ def condition_number(q):
     t3785 = xp.where(xp.greater(t3784, t3714), t3784, t3714)
     t3786 = xp.where(xp.less(t3784, t3715), t3784, t3715)
     t3787 = xp.not_equal(t3783, 0)
-    t3788 = 0.5*(-t3725 + t3758)/xp.where(t3787, t3783, 1)
+    t3788 = (-t3725 + t3758)/xp.where(t3787, 2*t3783, 1)
     t3789 = xp.abs(t3788)
     t3790 = xp.greater_equal(t3789, 1)
-    t3791 = xp.abs(1/xp.where(t3790, t3788, 1))
+    t3791 = 1/xp.abs(xp.where(t3790, t3788, 1))
     t3792 = xp.where(t3787, xp.where(xp.greater_equal(t3788, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3790, t3791/(1 + xp.sqrt(1 + t3791**2)), 1/(t3789 + xp.sqrt(1 + t3789**2))), 0)
     t3793 = 1/xp.sqrt(1 + t3792**2)
     t3794 = t3729*t3793
@@ -8012,7 +8012,9 @@ def condition_number(q):
     t3821 = xp.where(xp.less(t3818, t3786), t3818, t3786)
     t3822 = xp.where(xp.greater(t3819, t3820), t3819, t3820)
     t3823 = xp.where(xp.less(t3819, t3821), t3819, t3821)
-    kappa = xp.broadcast_to(xp.where(xp.greater(t3822, 0), t3822, 1)/xp.where(xp.less_equal(t3823, 1e-12*t3822), 0, t3823), batch)
+    t3824 = xp.where(xp.less_equal(t3823, 1e-12*t3822), 0, t3823)
+    t3825 = xp.where(xp.greater(t3822, 0), t3822, 1)
+    kappa = xp.broadcast_to(t3825/t3824, batch)
     return kappa
 
 

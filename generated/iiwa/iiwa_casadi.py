@@ -2829,10 +2829,10 @@ def _velocity_ellipsoid(q):
     t85 = t83**2
     t86 = t53*t59
     t87 = (t86 != 0)
-    t88 = 0.5*(-t56 + t84)/casadi.if_else(t87, -t86, 1)
+    t88 = (-t56 + t84)/casadi.if_else(t87, -2*t86, 1)
     t89 = casadi.fabs(t88)
     t90 = (t89 >= 1)
-    t91 = casadi.fabs(1/casadi.if_else(t90, t88, 1))
+    t91 = 1/casadi.fabs(casadi.if_else(t90, t88, 1))
     t92 = casadi.if_else(t87, casadi.if_else((t88 >= 0), 1, -1)*casadi.if_else(t90, t91/(1 + casadi.sqrt(1 + t91**2)), 1/(t89 + casadi.sqrt(1 + t89**2))), 0)
     t93 = 1/casadi.sqrt(1 + t92**2)
     t94 = t86*t92
@@ -2848,10 +2848,10 @@ def _velocity_ellipsoid(q):
     t104 = t103*t92
     t105 = t101*t99 - t104*t77
     t106 = (t105 != 0)
-    t107 = 0.5*(-t95 + t102)/casadi.if_else(t106, t105, 1)
+    t107 = (-t95 + t102)/casadi.if_else(t106, 2*t105, 1)
     t108 = casadi.fabs(t107)
     t109 = (t108 >= 1)
-    t110 = casadi.fabs(1/casadi.if_else(t109, t107, 1))
+    t110 = 1/casadi.fabs(casadi.if_else(t109, t107, 1))
     t111 = casadi.if_else(t106, casadi.if_else((t107 >= 0), 1, -1)*casadi.if_else(t109, t110/(1 + casadi.sqrt(1 + t110**2)), 1/(t108 + casadi.sqrt(1 + t108**2))), 0)
     t112 = 1/casadi.sqrt(1 + t111**2)
     t113 = t105*t111
@@ -2867,10 +2867,10 @@ def _velocity_ellipsoid(q):
     t123 = -t121 + t120*t111
     t124 = t100*t119 + t103*t123
     t125 = (t124 != 0)
-    t126 = 0.5*(-t96 + t115)/casadi.if_else(t125, -t124, 1)
+    t126 = (-t96 + t115)/casadi.if_else(t125, -2*t124, 1)
     t127 = casadi.fabs(t126)
     t128 = (t127 >= 1)
-    t129 = casadi.fabs(1/casadi.if_else(t128, t126, 1))
+    t129 = 1/casadi.fabs(casadi.if_else(t128, t126, 1))
     t130 = casadi.if_else(t125, casadi.if_else((t126 >= 0), 1, -1)*casadi.if_else(t128, t129/(1 + casadi.sqrt(1 + t129**2)), 1/(t127 + casadi.sqrt(1 + t127**2))), 0)
     t131 = 1/casadi.sqrt(1 + t130**2)
     t132 = t124*t130
@@ -2896,10 +2896,10 @@ def _velocity_ellipsoid(q):
     t152 = t130*t131
     t153 = t118*t137 - t122*t142 + t85*t146*t152*t112
     t154 = (t153 != 0)
-    t155 = 0.5*(-t114 + t133)/casadi.if_else(t154, t153, 1)
+    t155 = (-t114 + t133)/casadi.if_else(t154, 2*t153, 1)
     t156 = casadi.fabs(t155)
     t157 = (t156 >= 1)
-    t158 = casadi.fabs(1/casadi.if_else(t157, t155, 1))
+    t158 = 1/casadi.fabs(casadi.if_else(t157, t155, 1))
     t159 = casadi.if_else(t154, casadi.if_else((t155 >= 0), 1, -1)*casadi.if_else(t157, t158/(1 + casadi.sqrt(1 + t158**2)), 1/(t156 + casadi.sqrt(1 + t156**2))), 0)
     t160 = 1/casadi.sqrt(1 + t159**2)
     t161 = t153*t159
@@ -2933,10 +2933,10 @@ def _velocity_ellipsoid(q):
     t189 = t112*t131
     t190 = t138*t166 + t143*t170 - t189*t83*t179
     t191 = (t190 != 0)
-    t192 = 0.5*(-t162 + t134)/casadi.if_else(t191, t190, 1)
+    t192 = (-t162 + t134)/casadi.if_else(t191, 2*t190, 1)
     t193 = casadi.fabs(t192)
     t194 = (t193 >= 1)
-    t195 = casadi.fabs(1/casadi.if_else(t194, t192, 1))
+    t195 = 1/casadi.fabs(casadi.if_else(t194, t192, 1))
     t196 = casadi.if_else(t191, casadi.if_else((t192 >= 0), 1, -1)*casadi.if_else(t194, t195/(1 + casadi.sqrt(1 + t195**2)), 1/(t193 + casadi.sqrt(1 + t193**2))), 0)
     t197 = 1/casadi.sqrt(1 + t196**2)
     t198 = t190*t196
@@ -2968,10 +2968,10 @@ def _velocity_ellipsoid(q):
     t224 = t223 - t210*t196
     t225 = t210 + t223*t196
     t226 = (t214 != 0)
-    t227 = 0.5*(-t163 + t200)/casadi.if_else(t226, t214, 1)
+    t227 = (-t163 + t200)/casadi.if_else(t226, 2*t214, 1)
     t228 = casadi.fabs(t227)
     t229 = (t228 >= 1)
-    t230 = casadi.fabs(1/casadi.if_else(t229, t227, 1))
+    t230 = 1/casadi.fabs(casadi.if_else(t229, t227, 1))
     t231 = casadi.if_else(t226, casadi.if_else((t227 >= 0), 1, -1)*casadi.if_else(t229, t230/(1 + casadi.sqrt(1 + t230**2)), 1/(t228 + casadi.sqrt(1 + t228**2))), 0)
     t232 = 1/casadi.sqrt(1 + t231**2)
     t233 = t214*t231
@@ -3003,10 +3003,10 @@ def _velocity_ellipsoid(q):
     t259 = t257 + t258*t231
     t260 = t258 - t257*t231
     t261 = (t248 != 0)
-    t262 = 0.5*(-t199 + t234)/casadi.if_else(t261, t248, 1)
+    t262 = (-t199 + t234)/casadi.if_else(t261, 2*t248, 1)
     t263 = casadi.fabs(t262)
     t264 = (t263 >= 1)
-    t265 = casadi.fabs(1/casadi.if_else(t264, t262, 1))
+    t265 = 1/casadi.fabs(casadi.if_else(t264, t262, 1))
     t266 = casadi.if_else(t261, casadi.if_else((t262 >= 0), 1, -1)*casadi.if_else(t264, t265/(1 + casadi.sqrt(1 + t265**2)), 1/(t263 + casadi.sqrt(1 + t263**2))), 0)
     t267 = 1/casadi.sqrt(1 + t266**2)
     t268 = t248*t266
@@ -3038,10 +3038,10 @@ def _velocity_ellipsoid(q):
     t294 = t292 + t293*t266
     t295 = -t293 + t292*t266
     t296 = (t283 != 0)
-    t297 = 0.5*(-t269 + t235)/casadi.if_else(t296, t283, 1)
+    t297 = (-t269 + t235)/casadi.if_else(t296, 2*t283, 1)
     t298 = casadi.fabs(t297)
     t299 = (t298 >= 1)
-    t300 = casadi.fabs(1/casadi.if_else(t299, t297, 1))
+    t300 = 1/casadi.fabs(casadi.if_else(t299, t297, 1))
     t301 = casadi.if_else(t296, casadi.if_else((t297 >= 0), 1, -1)*casadi.if_else(t299, t300/(1 + casadi.sqrt(1 + t300**2)), 1/(t298 + casadi.sqrt(1 + t298**2))), 0)
     t302 = 1/casadi.sqrt(1 + t301**2)
     t303 = t283*t301
@@ -3073,10 +3073,10 @@ def _velocity_ellipsoid(q):
     t329 = t327 - t328*t301
     t330 = t328 + t327*t301
     t331 = (t318 != 0)
-    t332 = 0.5*(-t270 + t305)/casadi.if_else(t331, t318, 1)
+    t332 = (-t270 + t305)/casadi.if_else(t331, 2*t318, 1)
     t333 = casadi.fabs(t332)
     t334 = (t333 >= 1)
-    t335 = casadi.fabs(1/casadi.if_else(t334, t332, 1))
+    t335 = 1/casadi.fabs(casadi.if_else(t334, t332, 1))
     t336 = casadi.if_else(t331, casadi.if_else((t332 >= 0), 1, -1)*casadi.if_else(t334, t335/(1 + casadi.sqrt(1 + t335**2)), 1/(t333 + casadi.sqrt(1 + t333**2))), 0)
     t337 = 1/casadi.sqrt(1 + t336**2)
     t338 = t318*t336
@@ -3108,10 +3108,10 @@ def _velocity_ellipsoid(q):
     t364 = t362 - t336*t363
     t365 = t363 + t336*t362
     t366 = (t353 != 0)
-    t367 = 0.5*(-t304 + t339)/casadi.if_else(t366, t353, 1)
+    t367 = (-t304 + t339)/casadi.if_else(t366, 2*t353, 1)
     t368 = casadi.fabs(t367)
     t369 = (t368 >= 1)
-    t370 = casadi.fabs(1/casadi.if_else(t369, t367, 1))
+    t370 = 1/casadi.fabs(casadi.if_else(t369, t367, 1))
     t371 = casadi.if_else(t366, casadi.if_else((t367 >= 0), 1, -1)*casadi.if_else(t369, t370/(1 + casadi.sqrt(1 + t370**2)), 1/(t368 + casadi.sqrt(1 + t368**2))), 0)
     t372 = 1/casadi.sqrt(1 + t371**2)
     t373 = t353*t371
@@ -3143,10 +3143,10 @@ def _velocity_ellipsoid(q):
     t399 = t397 - t371*t398
     t400 = t398 + t371*t397
     t401 = (t388 != 0)
-    t402 = 0.5*(-t374 + t340)/casadi.if_else(t401, t388, 1)
+    t402 = (-t374 + t340)/casadi.if_else(t401, 2*t388, 1)
     t403 = casadi.fabs(t402)
     t404 = (t403 >= 1)
-    t405 = casadi.fabs(1/casadi.if_else(t404, t402, 1))
+    t405 = 1/casadi.fabs(casadi.if_else(t404, t402, 1))
     t406 = casadi.if_else(t401, casadi.if_else((t402 >= 0), 1, -1)*casadi.if_else(t404, t405/(1 + casadi.sqrt(1 + t405**2)), 1/(t403 + casadi.sqrt(1 + t403**2))), 0)
     t407 = 1/casadi.sqrt(1 + t406**2)
     t408 = t388*t406
@@ -3178,10 +3178,10 @@ def _velocity_ellipsoid(q):
     t434 = t432 - t406*t433
     t435 = t433 + t406*t432
     t436 = (t423 != 0)
-    t437 = 0.5*(-t375 + t410)/casadi.if_else(t436, t423, 1)
+    t437 = (-t375 + t410)/casadi.if_else(t436, 2*t423, 1)
     t438 = casadi.fabs(t437)
     t439 = (t438 >= 1)
-    t440 = casadi.fabs(1/casadi.if_else(t439, t437, 1))
+    t440 = 1/casadi.fabs(casadi.if_else(t439, t437, 1))
     t441 = casadi.if_else(t436, casadi.if_else((t437 >= 0), 1, -1)*casadi.if_else(t439, t440/(1 + casadi.sqrt(1 + t440**2)), 1/(t438 + casadi.sqrt(1 + t438**2))), 0)
     t442 = 1/casadi.sqrt(1 + t441**2)
     t443 = t423*t441
@@ -3213,10 +3213,10 @@ def _velocity_ellipsoid(q):
     t469 = t467 - t441*t468
     t470 = t468 + t441*t467
     t471 = (t458 != 0)
-    t472 = 0.5*(-t409 + t444)/casadi.if_else(t471, t458, 1)
+    t472 = (-t409 + t444)/casadi.if_else(t471, 2*t458, 1)
     t473 = casadi.fabs(t472)
     t474 = (t473 >= 1)
-    t475 = casadi.fabs(1/casadi.if_else(t474, t472, 1))
+    t475 = 1/casadi.fabs(casadi.if_else(t474, t472, 1))
     t476 = casadi.if_else(t471, casadi.if_else((t472 >= 0), 1, -1)*casadi.if_else(t474, t475/(1 + casadi.sqrt(1 + t475**2)), 1/(t473 + casadi.sqrt(1 + t473**2))), 0)
     t477 = 1/casadi.sqrt(1 + t476**2)
     t478 = t458*t476
@@ -3248,10 +3248,10 @@ def _velocity_ellipsoid(q):
     t504 = t502 - t476*t503
     t505 = t503 + t476*t502
     t506 = (t493 != 0)
-    t507 = 0.5*(-t479 + t445)/casadi.if_else(t506, t493, 1)
+    t507 = (-t479 + t445)/casadi.if_else(t506, 2*t493, 1)
     t508 = casadi.fabs(t507)
     t509 = (t508 >= 1)
-    t510 = casadi.fabs(1/casadi.if_else(t509, t507, 1))
+    t510 = 1/casadi.fabs(casadi.if_else(t509, t507, 1))
     t511 = casadi.if_else(t506, casadi.if_else((t507 >= 0), 1, -1)*casadi.if_else(t509, t510/(1 + casadi.sqrt(1 + t510**2)), 1/(t508 + casadi.sqrt(1 + t508**2))), 0)
     t512 = 1/casadi.sqrt(1 + t511**2)
     t513 = t445 + t493*t511
@@ -3282,10 +3282,10 @@ def _velocity_ellipsoid(q):
     t538 = t536 - t511*t537
     t539 = t537 + t511*t536
     t540 = (t526 != 0)
-    t541 = 0.5*(-t480 + t513)/casadi.if_else(t540, t526, 1)
+    t541 = (-t480 + t513)/casadi.if_else(t540, 2*t526, 1)
     t542 = casadi.fabs(t541)
     t543 = (t542 >= 1)
-    t544 = casadi.fabs(1/casadi.if_else(t543, t541, 1))
+    t544 = 1/casadi.fabs(casadi.if_else(t543, t541, 1))
     t545 = casadi.if_else(t540, casadi.if_else((t541 >= 0), 1, -1)*casadi.if_else(t543, t544/(1 + casadi.sqrt(1 + t544**2)), 1/(t542 + casadi.sqrt(1 + t542**2))), 0)
     t546 = 1/casadi.sqrt(1 + t545**2)
     t547 = t484*t546
@@ -3384,10 +3384,10 @@ def _velocity_ellipsoid(q):
     t640 = t639**2
     t641 = t618**2 + t632**2 + t640
     t642 = (t629 != 0)
-    t643 = 0.5*(-t608 + t628)/casadi.if_else(t642, t629, 1)
+    t643 = (-t608 + t628)/casadi.if_else(t642, 2*t629, 1)
     t644 = casadi.fabs(t643)
     t645 = (t644 >= 1)
-    t646 = casadi.fabs(1/casadi.if_else(t645, t643, 1))
+    t646 = 1/casadi.fabs(casadi.if_else(t645, t643, 1))
     t647 = casadi.if_else(t642, casadi.if_else((t643 >= 0), 1, -1)*casadi.if_else(t645, t646/(1 + casadi.sqrt(1 + t646**2)), 1/(t644 + casadi.sqrt(1 + t644**2))), 0)
     t648 = 1/casadi.sqrt(1 + t647**2)
     t649 = t629*t647
@@ -3401,10 +3401,10 @@ def _velocity_ellipsoid(q):
     t657 = t647*t656
     t658 = t618*t654 + t632*t657
     t659 = (t658 != 0)
-    t660 = 0.5*(-t650 + t641)/casadi.if_else(t659, t658, 1)
+    t660 = (-t650 + t641)/casadi.if_else(t659, 2*t658, 1)
     t661 = casadi.fabs(t660)
     t662 = (t661 >= 1)
-    t663 = casadi.fabs(1/casadi.if_else(t662, t660, 1))
+    t663 = 1/casadi.fabs(casadi.if_else(t662, t660, 1))
     t664 = casadi.if_else(t659, casadi.if_else((t660 >= 0), 1, -1)*casadi.if_else(t662, t663/(1 + casadi.sqrt(1 + t663**2)), 1/(t661 + casadi.sqrt(1 + t661**2))), 0)
     t665 = 1/casadi.sqrt(1 + t664**2)
     t666 = t658*t664
@@ -3420,10 +3420,10 @@ def _velocity_ellipsoid(q):
     t676 = t674 + t664*t673
     t677 = t655*t672 + t676*t656
     t678 = (t677 != 0)
-    t679 = 0.5*(-t651 + t668)/casadi.if_else(t678, -t677, 1)
+    t679 = (-t651 + t668)/casadi.if_else(t678, -2*t677, 1)
     t680 = casadi.fabs(t679)
     t681 = (t680 >= 1)
-    t682 = casadi.fabs(1/casadi.if_else(t681, t679, 1))
+    t682 = 1/casadi.fabs(casadi.if_else(t681, t679, 1))
     t683 = casadi.if_else(t678, casadi.if_else((t679 >= 0), 1, -1)*casadi.if_else(t681, t682/(1 + casadi.sqrt(1 + t682**2)), 1/(t680 + casadi.sqrt(1 + t680**2))), 0)
     t684 = 1/casadi.sqrt(1 + t683**2)
     t685 = t677*t683
@@ -3449,10 +3449,10 @@ def _velocity_ellipsoid(q):
     t705 = t683*t684
     t706 = t671*t690 + t675*t695 - t665*t640*t699*t705
     t707 = (t706 != 0)
-    t708 = 0.5*(-t667 + t686)/casadi.if_else(t707, -t706, 1)
+    t708 = (-t667 + t686)/casadi.if_else(t707, -2*t706, 1)
     t709 = casadi.fabs(t708)
     t710 = (t709 >= 1)
-    t711 = casadi.fabs(1/casadi.if_else(t710, t708, 1))
+    t711 = 1/casadi.fabs(casadi.if_else(t710, t708, 1))
     t712 = casadi.if_else(t707, casadi.if_else((t708 >= 0), 1, -1)*casadi.if_else(t710, t711/(1 + casadi.sqrt(1 + t711**2)), 1/(t709 + casadi.sqrt(1 + t709**2))), 0)
     t713 = 1/casadi.sqrt(1 + t712**2)
     t714 = t706*t712
@@ -3486,10 +3486,10 @@ def _velocity_ellipsoid(q):
     t742 = t665*t684
     t743 = t691*t719 + t696*t723 - t639*t732*t742
     t744 = (t743 != 0)
-    t745 = 0.5*(-t715 + t687)/casadi.if_else(t744, t743, 1)
+    t745 = (-t715 + t687)/casadi.if_else(t744, 2*t743, 1)
     t746 = casadi.fabs(t745)
     t747 = (t746 >= 1)
-    t748 = casadi.fabs(1/casadi.if_else(t747, t745, 1))
+    t748 = 1/casadi.fabs(casadi.if_else(t747, t745, 1))
     t749 = casadi.if_else(t744, casadi.if_else((t745 >= 0), 1, -1)*casadi.if_else(t747, t748/(1 + casadi.sqrt(1 + t748**2)), 1/(t746 + casadi.sqrt(1 + t746**2))), 0)
     t750 = 1/casadi.sqrt(1 + t749**2)
     t751 = t743*t749
@@ -3521,10 +3521,10 @@ def _velocity_ellipsoid(q):
     t777 = t776 - t749*t763
     t778 = t763 + t749*t776
     t779 = (t767 != 0)
-    t780 = 0.5*(-t716 + t753)/casadi.if_else(t779, t767, 1)
+    t780 = (-t716 + t753)/casadi.if_else(t779, 2*t767, 1)
     t781 = casadi.fabs(t780)
     t782 = (t781 >= 1)
-    t783 = casadi.fabs(1/casadi.if_else(t782, t780, 1))
+    t783 = 1/casadi.fabs(casadi.if_else(t782, t780, 1))
     t784 = casadi.if_else(t779, casadi.if_else((t780 >= 0), 1, -1)*casadi.if_else(t782, t783/(1 + casadi.sqrt(1 + t783**2)), 1/(t781 + casadi.sqrt(1 + t781**2))), 0)
     t785 = 1/casadi.sqrt(1 + t784**2)
     t786 = t767*t784
@@ -3556,10 +3556,10 @@ def _velocity_ellipsoid(q):
     t812 = t810 + t784*t811
     t813 = t811 - t784*t810
     t814 = (t801 != 0)
-    t815 = 0.5*(-t752 + t787)/casadi.if_else(t814, t801, 1)
+    t815 = (-t752 + t787)/casadi.if_else(t814, 2*t801, 1)
     t816 = casadi.fabs(t815)
     t817 = (t816 >= 1)
-    t818 = casadi.fabs(1/casadi.if_else(t817, t815, 1))
+    t818 = 1/casadi.fabs(casadi.if_else(t817, t815, 1))
     t819 = casadi.if_else(t814, casadi.if_else((t815 >= 0), 1, -1)*casadi.if_else(t817, t818/(1 + casadi.sqrt(1 + t818**2)), 1/(t816 + casadi.sqrt(1 + t816**2))), 0)
     t820 = 1/casadi.sqrt(1 + t819**2)
     t821 = t801*t819
@@ -3591,10 +3591,10 @@ def _velocity_ellipsoid(q):
     t847 = t845 + t819*t846
     t848 = -t846 + t819*t845
     t849 = (t836 != 0)
-    t850 = 0.5*(-t822 + t788)/casadi.if_else(t849, t836, 1)
+    t850 = (-t822 + t788)/casadi.if_else(t849, 2*t836, 1)
     t851 = casadi.fabs(t850)
     t852 = (t851 >= 1)
-    t853 = casadi.fabs(1/casadi.if_else(t852, t850, 1))
+    t853 = 1/casadi.fabs(casadi.if_else(t852, t850, 1))
     t854 = casadi.if_else(t849, casadi.if_else((t850 >= 0), 1, -1)*casadi.if_else(t852, t853/(1 + casadi.sqrt(1 + t853**2)), 1/(t851 + casadi.sqrt(1 + t851**2))), 0)
     t855 = 1/casadi.sqrt(1 + t854**2)
     t856 = t836*t854
@@ -3626,10 +3626,10 @@ def _velocity_ellipsoid(q):
     t882 = t880 - t854*t881
     t883 = t881 + t854*t880
     t884 = (t871 != 0)
-    t885 = 0.5*(-t823 + t858)/casadi.if_else(t884, t871, 1)
+    t885 = (-t823 + t858)/casadi.if_else(t884, 2*t871, 1)
     t886 = casadi.fabs(t885)
     t887 = (t886 >= 1)
-    t888 = casadi.fabs(1/casadi.if_else(t887, t885, 1))
+    t888 = 1/casadi.fabs(casadi.if_else(t887, t885, 1))
     t889 = casadi.if_else(t884, casadi.if_else((t885 >= 0), 1, -1)*casadi.if_else(t887, t888/(1 + casadi.sqrt(1 + t888**2)), 1/(t886 + casadi.sqrt(1 + t886**2))), 0)
     t890 = 1/casadi.sqrt(1 + t889**2)
     t891 = t871*t889
@@ -3661,10 +3661,10 @@ def _velocity_ellipsoid(q):
     t917 = t915 - t889*t916
     t918 = t916 + t889*t915
     t919 = (t906 != 0)
-    t920 = 0.5*(-t857 + t892)/casadi.if_else(t919, t906, 1)
+    t920 = (-t857 + t892)/casadi.if_else(t919, 2*t906, 1)
     t921 = casadi.fabs(t920)
     t922 = (t921 >= 1)
-    t923 = casadi.fabs(1/casadi.if_else(t922, t920, 1))
+    t923 = 1/casadi.fabs(casadi.if_else(t922, t920, 1))
     t924 = casadi.if_else(t919, casadi.if_else((t920 >= 0), 1, -1)*casadi.if_else(t922, t923/(1 + casadi.sqrt(1 + t923**2)), 1/(t921 + casadi.sqrt(1 + t921**2))), 0)
     t925 = 1/casadi.sqrt(1 + t924**2)
     t926 = t906*t924
@@ -3696,10 +3696,10 @@ def _velocity_ellipsoid(q):
     t952 = t950 - t924*t951
     t953 = t951 + t924*t950
     t954 = (t941 != 0)
-    t955 = 0.5*(-t927 + t893)/casadi.if_else(t954, t941, 1)
+    t955 = (-t927 + t893)/casadi.if_else(t954, 2*t941, 1)
     t956 = casadi.fabs(t955)
     t957 = (t956 >= 1)
-    t958 = casadi.fabs(1/casadi.if_else(t957, t955, 1))
+    t958 = 1/casadi.fabs(casadi.if_else(t957, t955, 1))
     t959 = casadi.if_else(t954, casadi.if_else((t955 >= 0), 1, -1)*casadi.if_else(t957, t958/(1 + casadi.sqrt(1 + t958**2)), 1/(t956 + casadi.sqrt(1 + t956**2))), 0)
     t960 = 1/casadi.sqrt(1 + t959**2)
     t961 = t941*t959
@@ -3731,10 +3731,10 @@ def _velocity_ellipsoid(q):
     t987 = t985 - t959*t986
     t988 = t986 + t959*t985
     t989 = (t976 != 0)
-    t990 = 0.5*(-t928 + t963)/casadi.if_else(t989, t976, 1)
+    t990 = (-t928 + t963)/casadi.if_else(t989, 2*t976, 1)
     t991 = casadi.fabs(t990)
     t992 = (t991 >= 1)
-    t993 = casadi.fabs(1/casadi.if_else(t992, t990, 1))
+    t993 = 1/casadi.fabs(casadi.if_else(t992, t990, 1))
     t994 = casadi.if_else(t989, casadi.if_else((t990 >= 0), 1, -1)*casadi.if_else(t992, t993/(1 + casadi.sqrt(1 + t993**2)), 1/(t991 + casadi.sqrt(1 + t991**2))), 0)
     t995 = 1/casadi.sqrt(1 + t994**2)
     t996 = t976*t994
@@ -3766,10 +3766,10 @@ def _velocity_ellipsoid(q):
     t1022 = t1020 - t994*t1021
     t1023 = t1021 + t994*t1020
     t1024 = (t1011 != 0)
-    t1025 = 0.5*(-t962 + t997)/casadi.if_else(t1024, t1011, 1)
+    t1025 = (-t962 + t997)/casadi.if_else(t1024, 2*t1011, 1)
     t1026 = casadi.fabs(t1025)
     t1027 = (t1026 >= 1)
-    t1028 = casadi.fabs(1/casadi.if_else(t1027, t1025, 1))
+    t1028 = 1/casadi.fabs(casadi.if_else(t1027, t1025, 1))
     t1029 = casadi.if_else(t1024, casadi.if_else((t1025 >= 0), 1, -1)*casadi.if_else(t1027, t1028/(1 + casadi.sqrt(1 + t1028**2)), 1/(t1026 + casadi.sqrt(1 + t1026**2))), 0)
     t1030 = 1/casadi.sqrt(1 + t1029**2)
     t1031 = t1011*t1029
@@ -3801,10 +3801,10 @@ def _velocity_ellipsoid(q):
     t1057 = t1055 - t1029*t1056
     t1058 = t1056 + t1029*t1055
     t1059 = (t1046 != 0)
-    t1060 = 0.5*(-t1032 + t998)/casadi.if_else(t1059, t1046, 1)
+    t1060 = (-t1032 + t998)/casadi.if_else(t1059, 2*t1046, 1)
     t1061 = casadi.fabs(t1060)
     t1062 = (t1061 >= 1)
-    t1063 = casadi.fabs(1/casadi.if_else(t1062, t1060, 1))
+    t1063 = 1/casadi.fabs(casadi.if_else(t1062, t1060, 1))
     t1064 = casadi.if_else(t1059, casadi.if_else((t1060 >= 0), 1, -1)*casadi.if_else(t1062, t1063/(1 + casadi.sqrt(1 + t1063**2)), 1/(t1061 + casadi.sqrt(1 + t1061**2))), 0)
     t1065 = 1/casadi.sqrt(1 + t1064**2)
     t1066 = t998 + t1046*t1064
@@ -3835,10 +3835,10 @@ def _velocity_ellipsoid(q):
     t1091 = t1089 - t1064*t1090
     t1092 = t1090 + t1064*t1089
     t1093 = (t1079 != 0)
-    t1094 = 0.5*(-t1033 + t1066)/casadi.if_else(t1093, t1079, 1)
+    t1094 = (-t1033 + t1066)/casadi.if_else(t1093, 2*t1079, 1)
     t1095 = casadi.fabs(t1094)
     t1096 = (t1095 >= 1)
-    t1097 = casadi.fabs(1/casadi.if_else(t1096, t1094, 1))
+    t1097 = 1/casadi.fabs(casadi.if_else(t1096, t1094, 1))
     t1098 = casadi.if_else(t1093, casadi.if_else((t1094 >= 0), 1, -1)*casadi.if_else(t1096, t1097/(1 + casadi.sqrt(1 + t1097**2)), 1/(t1095 + casadi.sqrt(1 + t1095**2))), 0)
     t1099 = 1/casadi.sqrt(1 + t1098**2)
     t1100 = t1037*t1099
@@ -4128,10 +4128,10 @@ def _condition_number(q):
     t174 = t56*t71
     t175 = t65*t93 + t58*t143 + t172*t97 - t173*t103 + t174*t109
     t176 = (t175 != 0)
-    t177 = 0.5*(-t171 + t164)/casadi.if_else(t176, -t175, 1)
+    t177 = (-t171 + t164)/casadi.if_else(t176, -2*t175, 1)
     t178 = casadi.fabs(t177)
     t179 = (t178 >= 1)
-    t180 = casadi.fabs(1/casadi.if_else(t179, t177, 1))
+    t180 = 1/casadi.fabs(casadi.if_else(t179, t177, 1))
     t181 = casadi.if_else(t176, casadi.if_else((t177 >= 0), 1, -1)*casadi.if_else(t179, t180/(1 + casadi.sqrt(1 + t180**2)), 1/(t178 + casadi.sqrt(1 + t178**2))), 0)
     t182 = 1/casadi.sqrt(1 + t181**2)
     t183 = t175*t181
@@ -4159,10 +4159,10 @@ def _condition_number(q):
     t205 = -t203 + t202*t181
     t206 = t115*t192 + t119*t196 - t124*t200 + t149*t204
     t207 = (t206 != 0)
-    t208 = 0.5*(-t184 + t165)/casadi.if_else(t207, t206, 1)
+    t208 = (-t184 + t165)/casadi.if_else(t207, 2*t206, 1)
     t209 = casadi.fabs(t208)
     t210 = (t209 >= 1)
-    t211 = casadi.fabs(1/casadi.if_else(t210, t208, 1))
+    t211 = 1/casadi.fabs(casadi.if_else(t210, t208, 1))
     t212 = casadi.if_else(t207, casadi.if_else((t208 >= 0), 1, -1)*casadi.if_else(t210, t211/(1 + casadi.sqrt(1 + t211**2)), 1/(t209 + casadi.sqrt(1 + t209**2))), 0)
     t213 = 1/casadi.sqrt(1 + t212**2)
     t214 = t206*t212
@@ -4186,10 +4186,10 @@ def _condition_number(q):
     t232 = t230 + t229*t212
     t233 = t129*t223 + t154*t231 - t133*t227
     t234 = (t233 != 0)
-    t235 = 0.5*(-t215 + t166)/casadi.if_else(t234, -t233, 1)
+    t235 = (-t215 + t166)/casadi.if_else(t234, -2*t233, 1)
     t236 = casadi.fabs(t235)
     t237 = (t236 >= 1)
-    t238 = casadi.fabs(1/casadi.if_else(t237, t235, 1))
+    t238 = 1/casadi.fabs(casadi.if_else(t237, t235, 1))
     t239 = casadi.if_else(t234, casadi.if_else((t235 >= 0), 1, -1)*casadi.if_else(t237, t238/(1 + casadi.sqrt(1 + t238**2)), 1/(t236 + casadi.sqrt(1 + t236**2))), 0)
     t240 = 1/casadi.sqrt(1 + t239**2)
     t241 = t233*t239
@@ -4209,10 +4209,10 @@ def _condition_number(q):
     t255 = -t253 + t252*t239
     t256 = -t138*t250 + t159*t254
     t257 = (t256 != 0)
-    t258 = 0.5*(-t242 + t167)/casadi.if_else(t257, t256, 1)
+    t258 = (-t242 + t167)/casadi.if_else(t257, 2*t256, 1)
     t259 = casadi.fabs(t258)
     t260 = (t259 >= 1)
-    t261 = casadi.fabs(1/casadi.if_else(t260, t258, 1))
+    t261 = 1/casadi.fabs(casadi.if_else(t260, t258, 1))
     t262 = casadi.if_else(t257, casadi.if_else((t258 >= 0), 1, -1)*casadi.if_else(t260, t261/(1 + casadi.sqrt(1 + t261**2)), 1/(t259 + casadi.sqrt(1 + t259**2))), 0)
     t263 = 1/casadi.sqrt(1 + t262**2)
     t264 = t256*t262
@@ -4228,10 +4228,10 @@ def _condition_number(q):
     t274 = t272 + t271*t262
     t275 = t163*t273
     t276 = (t275 != 0)
-    t277 = 0.5*(-t265 + t168)/casadi.if_else(t276, -t275, 1)
+    t277 = (-t265 + t168)/casadi.if_else(t276, -2*t275, 1)
     t278 = casadi.fabs(t277)
     t279 = (t278 >= 1)
-    t280 = casadi.fabs(1/casadi.if_else(t279, t277, 1))
+    t280 = 1/casadi.fabs(casadi.if_else(t279, t277, 1))
     t281 = casadi.if_else(t276, casadi.if_else((t277 >= 0), 1, -1)*casadi.if_else(t279, t280/(1 + casadi.sqrt(1 + t280**2)), 1/(t278 + casadi.sqrt(1 + t278**2))), 0)
     t282 = 1/casadi.sqrt(1 + t281**2)
     t283 = t275*t281
@@ -4245,10 +4245,10 @@ def _condition_number(q):
     t291 = t290*t188
     t292 = -t193*t220 - t197*t224 + t201*t228 + t205*t232 + t169*t290*t181*t182**2 + t291*t189
     t293 = (t292 != 0)
-    t294 = 0.5*(-t185 + t216)/casadi.if_else(t293, t292, 1)
+    t294 = (-t185 + t216)/casadi.if_else(t293, 2*t292, 1)
     t295 = casadi.fabs(t294)
     t296 = (t295 >= 1)
-    t297 = casadi.fabs(1/casadi.if_else(t296, t294, 1))
+    t297 = 1/casadi.fabs(casadi.if_else(t296, t294, 1))
     t298 = casadi.if_else(t293, casadi.if_else((t294 >= 0), 1, -1)*casadi.if_else(t296, t297/(1 + casadi.sqrt(1 + t297**2)), 1/(t295 + casadi.sqrt(1 + t295**2))), 0)
     t299 = 1/casadi.sqrt(1 + t298**2)
     t300 = t292*t298
@@ -4287,10 +4287,10 @@ def _condition_number(q):
     t333 = t329*t219
     t334 = -t247*t319 - t251*t323 + t255*t327 - t331*t307 + t332*t311 + t333*t315
     t335 = (t334 != 0)
-    t336 = 0.5*(-t301 + t243)/casadi.if_else(t335, t334, 1)
+    t336 = (-t301 + t243)/casadi.if_else(t335, 2*t334, 1)
     t337 = casadi.fabs(t336)
     t338 = (t337 >= 1)
-    t339 = casadi.fabs(1/casadi.if_else(t338, t336, 1))
+    t339 = 1/casadi.fabs(casadi.if_else(t338, t336, 1))
     t340 = casadi.if_else(t335, casadi.if_else((t336 >= 0), 1, -1)*casadi.if_else(t338, t339/(1 + casadi.sqrt(1 + t339**2)), 1/(t337 + casadi.sqrt(1 + t337**2))), 0)
     t341 = 1/casadi.sqrt(1 + t340**2)
     t342 = t334*t340
@@ -4333,10 +4333,10 @@ def _condition_number(q):
     t379 = t378*t262
     t380 = t270*t363 + t274*t367 - t373*t347 + t375*t351 + t377*t355 - t379*t359
     t381 = (t380 != 0)
-    t382 = 0.5*(-t343 + t266)/casadi.if_else(t381, t380, 1)
+    t382 = (-t343 + t266)/casadi.if_else(t381, 2*t380, 1)
     t383 = casadi.fabs(t382)
     t384 = (t383 >= 1)
-    t385 = casadi.fabs(1/casadi.if_else(t384, t382, 1))
+    t385 = 1/casadi.fabs(casadi.if_else(t384, t382, 1))
     t386 = casadi.if_else(t381, casadi.if_else((t382 >= 0), 1, -1)*casadi.if_else(t384, t385/(1 + casadi.sqrt(1 + t385**2)), 1/(t383 + casadi.sqrt(1 + t383**2))), 0)
     t387 = 1/casadi.sqrt(1 + t386**2)
     t388 = t380*t386
@@ -4378,10 +4378,10 @@ def _condition_number(q):
     t424 = t423*t281
     t425 = t289*t413 - t416*t393 + t418*t397 + t420*t401 - t422*t405 + t424*t409
     t426 = (t425 != 0)
-    t427 = 0.5*(-t389 + t285)/casadi.if_else(t426, t425, 1)
+    t427 = (-t389 + t285)/casadi.if_else(t426, 2*t425, 1)
     t428 = casadi.fabs(t427)
     t429 = (t428 >= 1)
-    t430 = casadi.fabs(1/casadi.if_else(t429, t427, 1))
+    t430 = 1/casadi.fabs(casadi.if_else(t429, t427, 1))
     t431 = casadi.if_else(t426, casadi.if_else((t427 >= 0), 1, -1)*casadi.if_else(t429, t430/(1 + casadi.sqrt(1 + t430**2)), 1/(t428 + casadi.sqrt(1 + t428**2))), 0)
     t432 = 1/casadi.sqrt(1 + t431**2)
     t433 = t425*t431
@@ -4413,10 +4413,10 @@ def _condition_number(q):
     t459 = t457 + t456*t431
     t460 = t288*t458 - t415*t438 + t417*t442 + t419*t446 - t421*t450 + t423*t454
     t461 = (t369 != 0)
-    t462 = 0.5*(-t302 + t344)/casadi.if_else(t461, t369, 1)
+    t462 = (-t302 + t344)/casadi.if_else(t461, 2*t369, 1)
     t463 = casadi.fabs(t462)
     t464 = (t463 >= 1)
-    t465 = casadi.fabs(1/casadi.if_else(t464, t462, 1))
+    t465 = 1/casadi.fabs(casadi.if_else(t464, t462, 1))
     t466 = casadi.if_else(t461, casadi.if_else((t462 >= 0), 1, -1)*casadi.if_else(t464, t465/(1 + casadi.sqrt(1 + t465**2)), 1/(t463 + casadi.sqrt(1 + t463**2))), 0)
     t467 = 1/casadi.sqrt(1 + t466**2)
     t468 = t369*t466
@@ -4448,10 +4448,10 @@ def _condition_number(q):
     t494 = t492 + t491*t466
     t495 = -t394*t473 + t398*t477 + t402*t481 + t406*t485 + t410*t489 + t414*t493
     t496 = (t495 != 0)
-    t497 = 0.5*(-t469 + t390)/casadi.if_else(t496, t495, 1)
+    t497 = (-t469 + t390)/casadi.if_else(t496, 2*t495, 1)
     t498 = casadi.fabs(t497)
     t499 = (t498 >= 1)
-    t500 = casadi.fabs(1/casadi.if_else(t499, t497, 1))
+    t500 = 1/casadi.fabs(casadi.if_else(t499, t497, 1))
     t501 = casadi.if_else(t496, casadi.if_else((t497 >= 0), 1, -1)*casadi.if_else(t499, t500/(1 + casadi.sqrt(1 + t500**2)), 1/(t498 + casadi.sqrt(1 + t498**2))), 0)
     t502 = 1/casadi.sqrt(1 + t501**2)
     t503 = t495*t501
@@ -4484,10 +4484,10 @@ def _condition_number(q):
     t530 = -t439*t508 + t443*t512 + t447*t516 + t451*t520 + t455*t524 + t459*t528
     t531 = t474*t509 + t478*t513 + t482*t517 + t486*t521 + t490*t525 + t494*t529
     t532 = (t530 != 0)
-    t533 = 0.5*(-t504 + t435)/casadi.if_else(t532, t530, 1)
+    t533 = (-t504 + t435)/casadi.if_else(t532, 2*t530, 1)
     t534 = casadi.fabs(t533)
     t535 = (t534 >= 1)
-    t536 = casadi.fabs(1/casadi.if_else(t535, t533, 1))
+    t536 = 1/casadi.fabs(casadi.if_else(t535, t533, 1))
     t537 = casadi.if_else(t532, casadi.if_else((t533 >= 0), 1, -1)*casadi.if_else(t535, t536/(1 + casadi.sqrt(1 + t536**2)), 1/(t534 + casadi.sqrt(1 + t534**2))), 0)
     t538 = 1/casadi.sqrt(1 + t537**2)
     t539 = t530*t537
@@ -4518,10 +4518,10 @@ def _condition_number(q):
     t564 = t562 - t563*t537
     t565 = t563 + t562*t537
     t566 = (t531 != 0)
-    t567 = 0.5*(-t470 + t505)/casadi.if_else(t566, t531, 1)
+    t567 = (-t470 + t505)/casadi.if_else(t566, 2*t531, 1)
     t568 = casadi.fabs(t567)
     t569 = (t568 >= 1)
-    t570 = casadi.fabs(1/casadi.if_else(t569, t567, 1))
+    t570 = 1/casadi.fabs(casadi.if_else(t569, t567, 1))
     t571 = casadi.if_else(t566, casadi.if_else((t567 >= 0), 1, -1)*casadi.if_else(t569, t570/(1 + casadi.sqrt(1 + t570**2)), 1/(t568 + casadi.sqrt(1 + t568**2))), 0)
     t572 = 1/casadi.sqrt(1 + t571**2)
     t573 = t531*t571
@@ -4553,10 +4553,10 @@ def _condition_number(q):
     t599 = t597 + t596*t571
     t600 = t545*t578 + t549*t582 + t553*t586 + t557*t590 + t561*t594 + t565*t598
     t601 = (t600 != 0)
-    t602 = 0.5*(-t574 + t541)/casadi.if_else(t601, t600, 1)
+    t602 = (-t574 + t541)/casadi.if_else(t601, 2*t600, 1)
     t603 = casadi.fabs(t602)
     t604 = (t603 >= 1)
-    t605 = casadi.fabs(1/casadi.if_else(t604, t602, 1))
+    t605 = 1/casadi.fabs(casadi.if_else(t604, t602, 1))
     t606 = casadi.if_else(t601, casadi.if_else((t602 >= 0), 1, -1)*casadi.if_else(t604, t605/(1 + casadi.sqrt(1 + t605**2)), 1/(t603 + casadi.sqrt(1 + t603**2))), 0)
     t607 = 1/casadi.sqrt(1 + t606**2)
     t608 = t600*t606
@@ -4588,10 +4588,10 @@ def _condition_number(q):
     t634 = t632 + t631*t606
     t635 = t579*t614 + t583*t618 + t587*t622 + t591*t626 + t595*t630 + t599*t634
     t636 = (t635 != 0)
-    t637 = 0.5*(-t575 + t610)/casadi.if_else(t636, t635, 1)
+    t637 = (-t575 + t610)/casadi.if_else(t636, 2*t635, 1)
     t638 = casadi.fabs(t637)
     t639 = (t638 >= 1)
-    t640 = casadi.fabs(1/casadi.if_else(t639, t637, 1))
+    t640 = 1/casadi.fabs(casadi.if_else(t639, t637, 1))
     t641 = casadi.if_else(t636, casadi.if_else((t637 >= 0), 1, -1)*casadi.if_else(t639, t640/(1 + casadi.sqrt(1 + t640**2)), 1/(t638 + casadi.sqrt(1 + t638**2))), 0)
     t642 = 1/casadi.sqrt(1 + t641**2)
     t643 = t635*t641
@@ -4622,10 +4622,10 @@ def _condition_number(q):
     t668 = t666 - t667*t641
     t669 = t667 + t666*t641
     t670 = (t460 != 0)
-    t671 = 0.5*(-t284 + t434)/casadi.if_else(t670, t460, 1)
+    t671 = (-t284 + t434)/casadi.if_else(t670, 2*t460, 1)
     t672 = casadi.fabs(t671)
     t673 = (t672 >= 1)
-    t674 = casadi.fabs(1/casadi.if_else(t673, t671, 1))
+    t674 = 1/casadi.fabs(casadi.if_else(t673, t671, 1))
     t675 = casadi.if_else(t670, casadi.if_else((t671 >= 0), 1, -1)*casadi.if_else(t673, t674/(1 + casadi.sqrt(1 + t674**2)), 1/(t672 + casadi.sqrt(1 + t672**2))), 0)
     t676 = 1/casadi.sqrt(1 + t675**2)
     t677 = t460*t675
@@ -4657,10 +4657,10 @@ def _condition_number(q):
     t703 = t701 + t700*t675
     t704 = t544*t682 + t548*t686 + t552*t690 + t556*t694 + t560*t698 + t564*t702
     t705 = (t704 != 0)
-    t706 = 0.5*(-t678 + t540)/casadi.if_else(t705, t704, 1)
+    t706 = (-t678 + t540)/casadi.if_else(t705, 2*t704, 1)
     t707 = casadi.fabs(t706)
     t708 = (t707 >= 1)
-    t709 = casadi.fabs(1/casadi.if_else(t708, t706, 1))
+    t709 = 1/casadi.fabs(casadi.if_else(t708, t706, 1))
     t710 = casadi.if_else(t705, casadi.if_else((t706 >= 0), 1, -1)*casadi.if_else(t708, t709/(1 + casadi.sqrt(1 + t709**2)), 1/(t707 + casadi.sqrt(1 + t707**2))), 0)
     t711 = 1/casadi.sqrt(1 + t710**2)
     t712 = t704*t710
@@ -4693,10 +4693,10 @@ def _condition_number(q):
     t739 = t613*t717 + t617*t721 + t621*t725 + t625*t729 + t629*t733 + t633*t737
     t740 = -t683*t718 + t687*t722 + t691*t726 + t695*t730 + t699*t734 + t703*t738
     t741 = (t739 != 0)
-    t742 = 0.5*(-t713 + t609)/casadi.if_else(t741, t739, 1)
+    t742 = (-t713 + t609)/casadi.if_else(t741, 2*t739, 1)
     t743 = casadi.fabs(t742)
     t744 = (t743 >= 1)
-    t745 = casadi.fabs(1/casadi.if_else(t744, t742, 1))
+    t745 = 1/casadi.fabs(casadi.if_else(t744, t742, 1))
     t746 = casadi.if_else(t741, casadi.if_else((t742 >= 0), 1, -1)*casadi.if_else(t744, t745/(1 + casadi.sqrt(1 + t745**2)), 1/(t743 + casadi.sqrt(1 + t743**2))), 0)
     t747 = 1/casadi.sqrt(1 + t746**2)
     t748 = t739*t746
@@ -4728,10 +4728,10 @@ def _condition_number(q):
     t774 = t772 + t771*t746
     t775 = t648*t753 + t652*t757 + t656*t761 + t660*t765 + t664*t769 + t668*t773
     t776 = (t775 != 0)
-    t777 = 0.5*(-t749 + t644)/casadi.if_else(t776, t775, 1)
+    t777 = (-t749 + t644)/casadi.if_else(t776, 2*t775, 1)
     t778 = casadi.fabs(t777)
     t779 = (t778 >= 1)
-    t780 = casadi.fabs(1/casadi.if_else(t779, t777, 1))
+    t780 = 1/casadi.fabs(casadi.if_else(t779, t777, 1))
     t781 = casadi.if_else(t776, casadi.if_else((t777 >= 0), 1, -1)*casadi.if_else(t779, t780/(1 + casadi.sqrt(1 + t780**2)), 1/(t778 + casadi.sqrt(1 + t778**2))), 0)
     t782 = 1/casadi.sqrt(1 + t781**2)
     t783 = t775*t781
@@ -4763,10 +4763,10 @@ def _condition_number(q):
     t809 = t807 + t806*t781
     t810 = t649*t788 + t653*t792 + t657*t796 + t661*t800 + t665*t804 + t669*t808
     t811 = (t810 != 0)
-    t812 = 0.5*(-t784 + t645)/casadi.if_else(t811, t810, 1)
+    t812 = (-t784 + t645)/casadi.if_else(t811, 2*t810, 1)
     t813 = casadi.fabs(t812)
     t814 = (t813 >= 1)
-    t815 = casadi.fabs(1/casadi.if_else(t814, t812, 1))
+    t815 = 1/casadi.fabs(casadi.if_else(t814, t812, 1))
     t816 = casadi.if_else(t811, casadi.if_else((t812 >= 0), 1, -1)*casadi.if_else(t814, t815/(1 + casadi.sqrt(1 + t815**2)), 1/(t813 + casadi.sqrt(1 + t813**2))), 0)
     t817 = 1/casadi.sqrt(1 + t816**2)
     t818 = t810*t816
@@ -4797,10 +4797,10 @@ def _condition_number(q):
     t843 = t841 - t842*t816
     t844 = t842 + t841*t816
     t845 = (t740 != 0)
-    t846 = 0.5*(-t679 + t714)/casadi.if_else(t845, t740, 1)
+    t846 = (-t679 + t714)/casadi.if_else(t845, 2*t740, 1)
     t847 = casadi.fabs(t846)
     t848 = (t847 >= 1)
-    t849 = casadi.fabs(1/casadi.if_else(t848, t846, 1))
+    t849 = 1/casadi.fabs(casadi.if_else(t848, t846, 1))
     t850 = casadi.if_else(t845, casadi.if_else((t846 >= 0), 1, -1)*casadi.if_else(t848, t849/(1 + casadi.sqrt(1 + t849**2)), 1/(t847 + casadi.sqrt(1 + t847**2))), 0)
     t851 = 1/casadi.sqrt(1 + t850**2)
     t852 = t740*t850
@@ -4832,10 +4832,10 @@ def _condition_number(q):
     t878 = t876 + t875*t850
     t879 = t754*t857 + t758*t861 + t762*t865 + t766*t869 + t770*t873 + t774*t877
     t880 = (t879 != 0)
-    t881 = 0.5*(-t853 + t750)/casadi.if_else(t880, t879, 1)
+    t881 = (-t853 + t750)/casadi.if_else(t880, 2*t879, 1)
     t882 = casadi.fabs(t881)
     t883 = (t882 >= 1)
-    t884 = casadi.fabs(1/casadi.if_else(t883, t881, 1))
+    t884 = 1/casadi.fabs(casadi.if_else(t883, t881, 1))
     t885 = casadi.if_else(t880, casadi.if_else((t881 >= 0), 1, -1)*casadi.if_else(t883, t884/(1 + casadi.sqrt(1 + t884**2)), 1/(t882 + casadi.sqrt(1 + t882**2))), 0)
     t886 = 1/casadi.sqrt(1 + t885**2)
     t887 = t879*t885
@@ -4868,10 +4868,10 @@ def _condition_number(q):
     t914 = t789*t892 + t793*t896 + t797*t900 + t801*t904 + t805*t908 + t809*t912
     t915 = t858*t893 + t862*t897 + t866*t901 + t870*t905 + t874*t909 + t878*t913
     t916 = (t914 != 0)
-    t917 = 0.5*(-t888 + t785)/casadi.if_else(t916, t914, 1)
+    t917 = (-t888 + t785)/casadi.if_else(t916, 2*t914, 1)
     t918 = casadi.fabs(t917)
     t919 = (t918 >= 1)
-    t920 = casadi.fabs(1/casadi.if_else(t919, t917, 1))
+    t920 = 1/casadi.fabs(casadi.if_else(t919, t917, 1))
     t921 = casadi.if_else(t916, casadi.if_else((t917 >= 0), 1, -1)*casadi.if_else(t919, t920/(1 + casadi.sqrt(1 + t920**2)), 1/(t918 + casadi.sqrt(1 + t918**2))), 0)
     t922 = 1/casadi.sqrt(1 + t921**2)
     t923 = t914*t921
@@ -4903,10 +4903,10 @@ def _condition_number(q):
     t949 = t947 + t946*t921
     t950 = t824*t928 + t828*t932 + t832*t936 + t836*t940 + t840*t944 + t844*t948
     t951 = (t950 != 0)
-    t952 = 0.5*(-t924 + t820)/casadi.if_else(t951, t950, 1)
+    t952 = (-t924 + t820)/casadi.if_else(t951, 2*t950, 1)
     t953 = casadi.fabs(t952)
     t954 = (t953 >= 1)
-    t955 = casadi.fabs(1/casadi.if_else(t954, t952, 1))
+    t955 = 1/casadi.fabs(casadi.if_else(t954, t952, 1))
     t956 = casadi.if_else(t951, casadi.if_else((t952 >= 0), 1, -1)*casadi.if_else(t954, t955/(1 + casadi.sqrt(1 + t955**2)), 1/(t953 + casadi.sqrt(1 + t953**2))), 0)
     t957 = 1/casadi.sqrt(1 + t956**2)
     t958 = t950*t956
@@ -4938,10 +4938,10 @@ def _condition_number(q):
     t984 = t982 + t981*t956
     t985 = t823*t963 + t827*t967 + t831*t971 + t835*t975 + t839*t979 + t843*t983
     t986 = (t915 != 0)
-    t987 = 0.5*(-t854 + t889)/casadi.if_else(t986, t915, 1)
+    t987 = (-t854 + t889)/casadi.if_else(t986, 2*t915, 1)
     t988 = casadi.fabs(t987)
     t989 = (t988 >= 1)
-    t990 = casadi.fabs(1/casadi.if_else(t989, t987, 1))
+    t990 = 1/casadi.fabs(casadi.if_else(t989, t987, 1))
     t991 = casadi.if_else(t986, casadi.if_else((t987 >= 0), 1, -1)*casadi.if_else(t989, t990/(1 + casadi.sqrt(1 + t990**2)), 1/(t988 + casadi.sqrt(1 + t988**2))), 0)
     t992 = 1/casadi.sqrt(1 + t991**2)
     t993 = t915*t991
@@ -4973,10 +4973,10 @@ def _condition_number(q):
     t1019 = t1017 + t1016*t991
     t1020 = t929*t998 + t933*t1002 + t937*t1006 + t941*t1010 + t945*t1014 + t949*t1018
     t1021 = (t1020 != 0)
-    t1022 = 0.5*(-t994 + t925)/casadi.if_else(t1021, t1020, 1)
+    t1022 = (-t994 + t925)/casadi.if_else(t1021, 2*t1020, 1)
     t1023 = casadi.fabs(t1022)
     t1024 = (t1023 >= 1)
-    t1025 = casadi.fabs(1/casadi.if_else(t1024, t1022, 1))
+    t1025 = 1/casadi.fabs(casadi.if_else(t1024, t1022, 1))
     t1026 = casadi.if_else(t1021, casadi.if_else((t1022 >= 0), 1, -1)*casadi.if_else(t1024, t1025/(1 + casadi.sqrt(1 + t1025**2)), 1/(t1023 + casadi.sqrt(1 + t1023**2))), 0)
     t1027 = 1/casadi.sqrt(1 + t1026**2)
     t1028 = t1020*t1026
@@ -5009,10 +5009,10 @@ def _condition_number(q):
     t1055 = t964*t1033 + t968*t1037 + t972*t1041 + t976*t1045 + t980*t1049 + t984*t1053
     t1056 = t999*t1034 + t1003*t1038 + t1007*t1042 + t1011*t1046 + t1015*t1050 + t1019*t1054
     t1057 = (t1055 != 0)
-    t1058 = 0.5*(-t1029 + t960)/casadi.if_else(t1057, t1055, 1)
+    t1058 = (-t1029 + t960)/casadi.if_else(t1057, 2*t1055, 1)
     t1059 = casadi.fabs(t1058)
     t1060 = (t1059 >= 1)
-    t1061 = casadi.fabs(1/casadi.if_else(t1060, t1058, 1))
+    t1061 = 1/casadi.fabs(casadi.if_else(t1060, t1058, 1))
     t1062 = casadi.if_else(t1057, casadi.if_else((t1058 >= 0), 1, -1)*casadi.if_else(t1060, t1061/(1 + casadi.sqrt(1 + t1061**2)), 1/(t1059 + casadi.sqrt(1 + t1059**2))), 0)
     t1063 = 1/casadi.sqrt(1 + t1062**2)
     t1064 = t1055*t1062
@@ -5043,10 +5043,10 @@ def _condition_number(q):
     t1089 = t1087 - t1088*t1062
     t1090 = t1088 + t1087*t1062
     t1091 = (t1056 != 0)
-    t1092 = 0.5*(-t995 + t1030)/casadi.if_else(t1091, t1056, 1)
+    t1092 = (-t995 + t1030)/casadi.if_else(t1091, 2*t1056, 1)
     t1093 = casadi.fabs(t1092)
     t1094 = (t1093 >= 1)
-    t1095 = casadi.fabs(1/casadi.if_else(t1094, t1092, 1))
+    t1095 = 1/casadi.fabs(casadi.if_else(t1094, t1092, 1))
     t1096 = casadi.if_else(t1091, casadi.if_else((t1092 >= 0), 1, -1)*casadi.if_else(t1094, t1095/(1 + casadi.sqrt(1 + t1095**2)), 1/(t1093 + casadi.sqrt(1 + t1093**2))), 0)
     t1097 = 1/casadi.sqrt(1 + t1096**2)
     t1098 = t1056*t1096
@@ -5078,10 +5078,10 @@ def _condition_number(q):
     t1124 = t1122 + t1121*t1096
     t1125 = t1070*t1103 + t1074*t1107 + t1078*t1111 + t1082*t1115 + t1086*t1119 + t1090*t1123
     t1126 = (t1125 != 0)
-    t1127 = 0.5*(-t1099 + t1066)/casadi.if_else(t1126, t1125, 1)
+    t1127 = (-t1099 + t1066)/casadi.if_else(t1126, 2*t1125, 1)
     t1128 = casadi.fabs(t1127)
     t1129 = (t1128 >= 1)
-    t1130 = casadi.fabs(1/casadi.if_else(t1129, t1127, 1))
+    t1130 = 1/casadi.fabs(casadi.if_else(t1129, t1127, 1))
     t1131 = casadi.if_else(t1126, casadi.if_else((t1127 >= 0), 1, -1)*casadi.if_else(t1129, t1130/(1 + casadi.sqrt(1 + t1130**2)), 1/(t1128 + casadi.sqrt(1 + t1128**2))), 0)
     t1132 = 1/casadi.sqrt(1 + t1131**2)
     t1133 = t1125*t1131
@@ -5113,10 +5113,10 @@ def _condition_number(q):
     t1159 = t1157 + t1131*t1156
     t1160 = t1104*t1139 + t1108*t1143 + t1112*t1147 + t1116*t1151 + t1120*t1155 + t1124*t1159
     t1161 = (t1160 != 0)
-    t1162 = 0.5*(-t1100 + t1135)/casadi.if_else(t1161, t1160, 1)
+    t1162 = (-t1100 + t1135)/casadi.if_else(t1161, 2*t1160, 1)
     t1163 = casadi.fabs(t1162)
     t1164 = (t1163 >= 1)
-    t1165 = casadi.fabs(1/casadi.if_else(t1164, t1162, 1))
+    t1165 = 1/casadi.fabs(casadi.if_else(t1164, t1162, 1))
     t1166 = casadi.if_else(t1161, casadi.if_else((t1162 >= 0), 1, -1)*casadi.if_else(t1164, t1165/(1 + casadi.sqrt(1 + t1165**2)), 1/(t1163 + casadi.sqrt(1 + t1163**2))), 0)
     t1167 = 1/casadi.sqrt(1 + t1166**2)
     t1168 = t1160*t1166
@@ -5147,10 +5147,10 @@ def _condition_number(q):
     t1193 = t1191 - t1166*t1192
     t1194 = t1192 + t1166*t1191
     t1195 = (t985 != 0)
-    t1196 = 0.5*(-t819 + t959)/casadi.if_else(t1195, t985, 1)
+    t1196 = (-t819 + t959)/casadi.if_else(t1195, 2*t985, 1)
     t1197 = casadi.fabs(t1196)
     t1198 = (t1197 >= 1)
-    t1199 = casadi.fabs(1/casadi.if_else(t1198, t1196, 1))
+    t1199 = 1/casadi.fabs(casadi.if_else(t1198, t1196, 1))
     t1200 = casadi.if_else(t1195, casadi.if_else((t1196 >= 0), 1, -1)*casadi.if_else(t1198, t1199/(1 + casadi.sqrt(1 + t1199**2)), 1/(t1197 + casadi.sqrt(1 + t1197**2))), 0)
     t1201 = 1/casadi.sqrt(1 + t1200**2)
     t1202 = t985*t1200
@@ -5182,10 +5182,10 @@ def _condition_number(q):
     t1228 = t1226 + t1200*t1225
     t1229 = t1069*t1207 + t1073*t1211 + t1077*t1215 + t1081*t1219 + t1085*t1223 + t1089*t1227
     t1230 = (t1229 != 0)
-    t1231 = 0.5*(-t1203 + t1065)/casadi.if_else(t1230, t1229, 1)
+    t1231 = (-t1203 + t1065)/casadi.if_else(t1230, 2*t1229, 1)
     t1232 = casadi.fabs(t1231)
     t1233 = (t1232 >= 1)
-    t1234 = casadi.fabs(1/casadi.if_else(t1233, t1231, 1))
+    t1234 = 1/casadi.fabs(casadi.if_else(t1233, t1231, 1))
     t1235 = casadi.if_else(t1230, casadi.if_else((t1231 >= 0), 1, -1)*casadi.if_else(t1233, t1234/(1 + casadi.sqrt(1 + t1234**2)), 1/(t1232 + casadi.sqrt(1 + t1232**2))), 0)
     t1236 = 1/casadi.sqrt(1 + t1235**2)
     t1237 = t1229*t1235
@@ -5218,10 +5218,10 @@ def _condition_number(q):
     t1264 = t1138*t1242 + t1142*t1246 + t1146*t1250 + t1150*t1254 + t1154*t1258 + t1158*t1262
     t1265 = t1208*t1243 + t1212*t1247 + t1216*t1251 + t1220*t1255 + t1224*t1259 + t1228*t1263
     t1266 = (t1264 != 0)
-    t1267 = 0.5*(-t1238 + t1134)/casadi.if_else(t1266, t1264, 1)
+    t1267 = (-t1238 + t1134)/casadi.if_else(t1266, 2*t1264, 1)
     t1268 = casadi.fabs(t1267)
     t1269 = (t1268 >= 1)
-    t1270 = casadi.fabs(1/casadi.if_else(t1269, t1267, 1))
+    t1270 = 1/casadi.fabs(casadi.if_else(t1269, t1267, 1))
     t1271 = casadi.if_else(t1266, casadi.if_else((t1267 >= 0), 1, -1)*casadi.if_else(t1269, t1270/(1 + casadi.sqrt(1 + t1270**2)), 1/(t1268 + casadi.sqrt(1 + t1268**2))), 0)
     t1272 = 1/casadi.sqrt(1 + t1271**2)
     t1273 = t1264*t1271
@@ -5253,10 +5253,10 @@ def _condition_number(q):
     t1299 = t1297 + t1271*t1296
     t1300 = t1173*t1278 + t1177*t1282 + t1181*t1286 + t1185*t1290 + t1189*t1294 + t1193*t1298
     t1301 = (t1300 != 0)
-    t1302 = 0.5*(-t1274 + t1169)/casadi.if_else(t1301, t1300, 1)
+    t1302 = (-t1274 + t1169)/casadi.if_else(t1301, 2*t1300, 1)
     t1303 = casadi.fabs(t1302)
     t1304 = (t1303 >= 1)
-    t1305 = casadi.fabs(1/casadi.if_else(t1304, t1302, 1))
+    t1305 = 1/casadi.fabs(casadi.if_else(t1304, t1302, 1))
     t1306 = casadi.if_else(t1301, casadi.if_else((t1302 >= 0), 1, -1)*casadi.if_else(t1304, t1305/(1 + casadi.sqrt(1 + t1305**2)), 1/(t1303 + casadi.sqrt(1 + t1303**2))), 0)
     t1307 = 1/casadi.sqrt(1 + t1306**2)
     t1308 = t1300*t1306
@@ -5288,10 +5288,10 @@ def _condition_number(q):
     t1334 = t1332 + t1306*t1331
     t1335 = t1174*t1313 + t1178*t1317 + t1182*t1321 + t1186*t1325 + t1190*t1329 + t1194*t1333
     t1336 = (t1335 != 0)
-    t1337 = 0.5*(-t1309 + t1170)/casadi.if_else(t1336, t1335, 1)
+    t1337 = (-t1309 + t1170)/casadi.if_else(t1336, 2*t1335, 1)
     t1338 = casadi.fabs(t1337)
     t1339 = (t1338 >= 1)
-    t1340 = casadi.fabs(1/casadi.if_else(t1339, t1337, 1))
+    t1340 = 1/casadi.fabs(casadi.if_else(t1339, t1337, 1))
     t1341 = casadi.if_else(t1336, casadi.if_else((t1337 >= 0), 1, -1)*casadi.if_else(t1339, t1340/(1 + casadi.sqrt(1 + t1340**2)), 1/(t1338 + casadi.sqrt(1 + t1338**2))), 0)
     t1342 = 1/casadi.sqrt(1 + t1341**2)
     t1343 = t1335*t1341
@@ -5322,10 +5322,10 @@ def _condition_number(q):
     t1368 = t1366 - t1341*t1367
     t1369 = t1367 + t1341*t1366
     t1370 = (t1265 != 0)
-    t1371 = 0.5*(-t1204 + t1239)/casadi.if_else(t1370, t1265, 1)
+    t1371 = (-t1204 + t1239)/casadi.if_else(t1370, 2*t1265, 1)
     t1372 = casadi.fabs(t1371)
     t1373 = (t1372 >= 1)
-    t1374 = casadi.fabs(1/casadi.if_else(t1373, t1371, 1))
+    t1374 = 1/casadi.fabs(casadi.if_else(t1373, t1371, 1))
     t1375 = casadi.if_else(t1370, casadi.if_else((t1371 >= 0), 1, -1)*casadi.if_else(t1373, t1374/(1 + casadi.sqrt(1 + t1374**2)), 1/(t1372 + casadi.sqrt(1 + t1372**2))), 0)
     t1376 = 1/casadi.sqrt(1 + t1375**2)
     t1377 = t1265*t1375
@@ -5357,10 +5357,10 @@ def _condition_number(q):
     t1403 = t1401 + t1375*t1400
     t1404 = t1279*t1382 + t1283*t1386 + t1287*t1390 + t1291*t1394 + t1295*t1398 + t1299*t1402
     t1405 = (t1404 != 0)
-    t1406 = 0.5*(-t1378 + t1275)/casadi.if_else(t1405, t1404, 1)
+    t1406 = (-t1378 + t1275)/casadi.if_else(t1405, 2*t1404, 1)
     t1407 = casadi.fabs(t1406)
     t1408 = (t1407 >= 1)
-    t1409 = casadi.fabs(1/casadi.if_else(t1408, t1406, 1))
+    t1409 = 1/casadi.fabs(casadi.if_else(t1408, t1406, 1))
     t1410 = casadi.if_else(t1405, casadi.if_else((t1406 >= 0), 1, -1)*casadi.if_else(t1408, t1409/(1 + casadi.sqrt(1 + t1409**2)), 1/(t1407 + casadi.sqrt(1 + t1407**2))), 0)
     t1411 = 1/casadi.sqrt(1 + t1410**2)
     t1412 = t1404*t1410
@@ -5393,10 +5393,10 @@ def _condition_number(q):
     t1439 = t1314*t1417 + t1318*t1421 + t1322*t1425 + t1326*t1429 + t1330*t1433 + t1334*t1437
     t1440 = t1383*t1418 + t1387*t1422 + t1391*t1426 + t1395*t1430 + t1399*t1434 + t1403*t1438
     t1441 = (t1439 != 0)
-    t1442 = 0.5*(-t1413 + t1310)/casadi.if_else(t1441, t1439, 1)
+    t1442 = (-t1413 + t1310)/casadi.if_else(t1441, 2*t1439, 1)
     t1443 = casadi.fabs(t1442)
     t1444 = (t1443 >= 1)
-    t1445 = casadi.fabs(1/casadi.if_else(t1444, t1442, 1))
+    t1445 = 1/casadi.fabs(casadi.if_else(t1444, t1442, 1))
     t1446 = casadi.if_else(t1441, casadi.if_else((t1442 >= 0), 1, -1)*casadi.if_else(t1444, t1445/(1 + casadi.sqrt(1 + t1445**2)), 1/(t1443 + casadi.sqrt(1 + t1443**2))), 0)
     t1447 = 1/casadi.sqrt(1 + t1446**2)
     t1448 = t1439*t1446
@@ -5428,10 +5428,10 @@ def _condition_number(q):
     t1474 = t1472 + t1446*t1471
     t1475 = t1349*t1453 + t1353*t1457 + t1357*t1461 + t1361*t1465 + t1365*t1469 + t1369*t1473
     t1476 = (t1475 != 0)
-    t1477 = 0.5*(-t1449 + t1345)/casadi.if_else(t1476, t1475, 1)
+    t1477 = (-t1449 + t1345)/casadi.if_else(t1476, 2*t1475, 1)
     t1478 = casadi.fabs(t1477)
     t1479 = (t1478 >= 1)
-    t1480 = casadi.fabs(1/casadi.if_else(t1479, t1477, 1))
+    t1480 = 1/casadi.fabs(casadi.if_else(t1479, t1477, 1))
     t1481 = casadi.if_else(t1476, casadi.if_else((t1477 >= 0), 1, -1)*casadi.if_else(t1479, t1480/(1 + casadi.sqrt(1 + t1480**2)), 1/(t1478 + casadi.sqrt(1 + t1478**2))), 0)
     t1482 = 1/casadi.sqrt(1 + t1481**2)
     t1483 = t1475*t1481
@@ -5463,10 +5463,10 @@ def _condition_number(q):
     t1509 = t1507 + t1481*t1506
     t1510 = t1348*t1488 + t1352*t1492 + t1356*t1496 + t1360*t1500 + t1364*t1504 + t1368*t1508
     t1511 = (t1440 != 0)
-    t1512 = 0.5*(-t1379 + t1414)/casadi.if_else(t1511, t1440, 1)
+    t1512 = (-t1379 + t1414)/casadi.if_else(t1511, 2*t1440, 1)
     t1513 = casadi.fabs(t1512)
     t1514 = (t1513 >= 1)
-    t1515 = casadi.fabs(1/casadi.if_else(t1514, t1512, 1))
+    t1515 = 1/casadi.fabs(casadi.if_else(t1514, t1512, 1))
     t1516 = casadi.if_else(t1511, casadi.if_else((t1512 >= 0), 1, -1)*casadi.if_else(t1514, t1515/(1 + casadi.sqrt(1 + t1515**2)), 1/(t1513 + casadi.sqrt(1 + t1513**2))), 0)
     t1517 = 1/casadi.sqrt(1 + t1516**2)
     t1518 = t1440*t1516
@@ -5498,10 +5498,10 @@ def _condition_number(q):
     t1544 = t1542 + t1516*t1541
     t1545 = t1454*t1523 + t1458*t1527 + t1462*t1531 + t1466*t1535 + t1470*t1539 + t1474*t1543
     t1546 = (t1545 != 0)
-    t1547 = 0.5*(-t1519 + t1450)/casadi.if_else(t1546, t1545, 1)
+    t1547 = (-t1519 + t1450)/casadi.if_else(t1546, 2*t1545, 1)
     t1548 = casadi.fabs(t1547)
     t1549 = (t1548 >= 1)
-    t1550 = casadi.fabs(1/casadi.if_else(t1549, t1547, 1))
+    t1550 = 1/casadi.fabs(casadi.if_else(t1549, t1547, 1))
     t1551 = casadi.if_else(t1546, casadi.if_else((t1547 >= 0), 1, -1)*casadi.if_else(t1549, t1550/(1 + casadi.sqrt(1 + t1550**2)), 1/(t1548 + casadi.sqrt(1 + t1548**2))), 0)
     t1552 = 1/casadi.sqrt(1 + t1551**2)
     t1553 = t1545*t1551
@@ -5534,10 +5534,10 @@ def _condition_number(q):
     t1580 = t1489*t1558 + t1493*t1562 + t1497*t1566 + t1501*t1570 + t1505*t1574 + t1509*t1578
     t1581 = t1524*t1559 + t1528*t1563 + t1532*t1567 + t1536*t1571 + t1540*t1575 + t1544*t1579
     t1582 = (t1580 != 0)
-    t1583 = 0.5*(-t1554 + t1485)/casadi.if_else(t1582, t1580, 1)
+    t1583 = (-t1554 + t1485)/casadi.if_else(t1582, 2*t1580, 1)
     t1584 = casadi.fabs(t1583)
     t1585 = (t1584 >= 1)
-    t1586 = casadi.fabs(1/casadi.if_else(t1585, t1583, 1))
+    t1586 = 1/casadi.fabs(casadi.if_else(t1585, t1583, 1))
     t1587 = casadi.if_else(t1582, casadi.if_else((t1583 >= 0), 1, -1)*casadi.if_else(t1585, t1586/(1 + casadi.sqrt(1 + t1586**2)), 1/(t1584 + casadi.sqrt(1 + t1584**2))), 0)
     t1588 = 1/casadi.sqrt(1 + t1587**2)
     t1589 = t1580*t1587
@@ -5568,10 +5568,10 @@ def _condition_number(q):
     t1614 = t1612 - t1587*t1613
     t1615 = t1613 + t1587*t1612
     t1616 = (t1581 != 0)
-    t1617 = 0.5*(-t1520 + t1555)/casadi.if_else(t1616, t1581, 1)
+    t1617 = (-t1520 + t1555)/casadi.if_else(t1616, 2*t1581, 1)
     t1618 = casadi.fabs(t1617)
     t1619 = (t1618 >= 1)
-    t1620 = casadi.fabs(1/casadi.if_else(t1619, t1617, 1))
+    t1620 = 1/casadi.fabs(casadi.if_else(t1619, t1617, 1))
     t1621 = casadi.if_else(t1616, casadi.if_else((t1617 >= 0), 1, -1)*casadi.if_else(t1619, t1620/(1 + casadi.sqrt(1 + t1620**2)), 1/(t1618 + casadi.sqrt(1 + t1618**2))), 0)
     t1622 = 1/casadi.sqrt(1 + t1621**2)
     t1623 = t1581*t1621
@@ -5603,10 +5603,10 @@ def _condition_number(q):
     t1649 = t1647 + t1621*t1646
     t1650 = t1595*t1628 + t1599*t1632 + t1603*t1636 + t1607*t1640 + t1611*t1644 + t1615*t1648
     t1651 = (t1650 != 0)
-    t1652 = 0.5*(-t1624 + t1591)/casadi.if_else(t1651, t1650, 1)
+    t1652 = (-t1624 + t1591)/casadi.if_else(t1651, 2*t1650, 1)
     t1653 = casadi.fabs(t1652)
     t1654 = (t1653 >= 1)
-    t1655 = casadi.fabs(1/casadi.if_else(t1654, t1652, 1))
+    t1655 = 1/casadi.fabs(casadi.if_else(t1654, t1652, 1))
     t1656 = casadi.if_else(t1651, casadi.if_else((t1652 >= 0), 1, -1)*casadi.if_else(t1654, t1655/(1 + casadi.sqrt(1 + t1655**2)), 1/(t1653 + casadi.sqrt(1 + t1653**2))), 0)
     t1657 = 1/casadi.sqrt(1 + t1656**2)
     t1658 = t1650*t1656
@@ -5638,10 +5638,10 @@ def _condition_number(q):
     t1684 = t1682 + t1656*t1681
     t1685 = t1629*t1664 + t1633*t1668 + t1637*t1672 + t1641*t1676 + t1645*t1680 + t1649*t1684
     t1686 = (t1685 != 0)
-    t1687 = 0.5*(-t1625 + t1660)/casadi.if_else(t1686, t1685, 1)
+    t1687 = (-t1625 + t1660)/casadi.if_else(t1686, 2*t1685, 1)
     t1688 = casadi.fabs(t1687)
     t1689 = (t1688 >= 1)
-    t1690 = casadi.fabs(1/casadi.if_else(t1689, t1687, 1))
+    t1690 = 1/casadi.fabs(casadi.if_else(t1689, t1687, 1))
     t1691 = casadi.if_else(t1686, casadi.if_else((t1687 >= 0), 1, -1)*casadi.if_else(t1689, t1690/(1 + casadi.sqrt(1 + t1690**2)), 1/(t1688 + casadi.sqrt(1 + t1688**2))), 0)
     t1692 = 1/casadi.sqrt(1 + t1691**2)
     t1693 = t1685*t1691
@@ -5672,10 +5672,10 @@ def _condition_number(q):
     t1718 = t1716 - t1691*t1717
     t1719 = t1717 + t1691*t1716
     t1720 = (t1510 != 0)
-    t1721 = 0.5*(-t1344 + t1484)/casadi.if_else(t1720, t1510, 1)
+    t1721 = (-t1344 + t1484)/casadi.if_else(t1720, 2*t1510, 1)
     t1722 = casadi.fabs(t1721)
     t1723 = (t1722 >= 1)
-    t1724 = casadi.fabs(1/casadi.if_else(t1723, t1721, 1))
+    t1724 = 1/casadi.fabs(casadi.if_else(t1723, t1721, 1))
     t1725 = casadi.if_else(t1720, casadi.if_else((t1721 >= 0), 1, -1)*casadi.if_else(t1723, t1724/(1 + casadi.sqrt(1 + t1724**2)), 1/(t1722 + casadi.sqrt(1 + t1722**2))), 0)
     t1726 = 1/casadi.sqrt(1 + t1725**2)
     t1727 = t1510*t1725
@@ -5707,10 +5707,10 @@ def _condition_number(q):
     t1753 = t1751 + t1725*t1750
     t1754 = t1594*t1732 + t1598*t1736 + t1602*t1740 + t1606*t1744 + t1610*t1748 + t1614*t1752
     t1755 = (t1754 != 0)
-    t1756 = 0.5*(-t1728 + t1590)/casadi.if_else(t1755, t1754, 1)
+    t1756 = (-t1728 + t1590)/casadi.if_else(t1755, 2*t1754, 1)
     t1757 = casadi.fabs(t1756)
     t1758 = (t1757 >= 1)
-    t1759 = casadi.fabs(1/casadi.if_else(t1758, t1756, 1))
+    t1759 = 1/casadi.fabs(casadi.if_else(t1758, t1756, 1))
     t1760 = casadi.if_else(t1755, casadi.if_else((t1756 >= 0), 1, -1)*casadi.if_else(t1758, t1759/(1 + casadi.sqrt(1 + t1759**2)), 1/(t1757 + casadi.sqrt(1 + t1757**2))), 0)
     t1761 = 1/casadi.sqrt(1 + t1760**2)
     t1762 = t1754*t1760
@@ -5743,10 +5743,10 @@ def _condition_number(q):
     t1789 = t1663*t1767 + t1667*t1771 + t1671*t1775 + t1675*t1779 + t1679*t1783 + t1683*t1787
     t1790 = t1733*t1768 + t1737*t1772 + t1741*t1776 + t1745*t1780 + t1749*t1784 + t1753*t1788
     t1791 = (t1789 != 0)
-    t1792 = 0.5*(-t1763 + t1659)/casadi.if_else(t1791, t1789, 1)
+    t1792 = (-t1763 + t1659)/casadi.if_else(t1791, 2*t1789, 1)
     t1793 = casadi.fabs(t1792)
     t1794 = (t1793 >= 1)
-    t1795 = casadi.fabs(1/casadi.if_else(t1794, t1792, 1))
+    t1795 = 1/casadi.fabs(casadi.if_else(t1794, t1792, 1))
     t1796 = casadi.if_else(t1791, casadi.if_else((t1792 >= 0), 1, -1)*casadi.if_else(t1794, t1795/(1 + casadi.sqrt(1 + t1795**2)), 1/(t1793 + casadi.sqrt(1 + t1793**2))), 0)
     t1797 = 1/casadi.sqrt(1 + t1796**2)
     t1798 = t1789*t1796
@@ -5778,10 +5778,10 @@ def _condition_number(q):
     t1824 = t1822 + t1796*t1821
     t1825 = t1698*t1803 + t1702*t1807 + t1706*t1811 + t1710*t1815 + t1714*t1819 + t1718*t1823
     t1826 = (t1825 != 0)
-    t1827 = 0.5*(-t1799 + t1694)/casadi.if_else(t1826, t1825, 1)
+    t1827 = (-t1799 + t1694)/casadi.if_else(t1826, 2*t1825, 1)
     t1828 = casadi.fabs(t1827)
     t1829 = (t1828 >= 1)
-    t1830 = casadi.fabs(1/casadi.if_else(t1829, t1827, 1))
+    t1830 = 1/casadi.fabs(casadi.if_else(t1829, t1827, 1))
     t1831 = casadi.if_else(t1826, casadi.if_else((t1827 >= 0), 1, -1)*casadi.if_else(t1829, t1830/(1 + casadi.sqrt(1 + t1830**2)), 1/(t1828 + casadi.sqrt(1 + t1828**2))), 0)
     t1832 = 1/casadi.sqrt(1 + t1831**2)
     t1833 = t1825*t1831
@@ -5813,10 +5813,10 @@ def _condition_number(q):
     t1859 = t1857 + t1831*t1856
     t1860 = t1699*t1838 + t1703*t1842 + t1707*t1846 + t1711*t1850 + t1715*t1854 + t1719*t1858
     t1861 = (t1860 != 0)
-    t1862 = 0.5*(-t1834 + t1695)/casadi.if_else(t1861, t1860, 1)
+    t1862 = (-t1834 + t1695)/casadi.if_else(t1861, 2*t1860, 1)
     t1863 = casadi.fabs(t1862)
     t1864 = (t1863 >= 1)
-    t1865 = casadi.fabs(1/casadi.if_else(t1864, t1862, 1))
+    t1865 = 1/casadi.fabs(casadi.if_else(t1864, t1862, 1))
     t1866 = casadi.if_else(t1861, casadi.if_else((t1862 >= 0), 1, -1)*casadi.if_else(t1864, t1865/(1 + casadi.sqrt(1 + t1865**2)), 1/(t1863 + casadi.sqrt(1 + t1863**2))), 0)
     t1867 = 1/casadi.sqrt(1 + t1866**2)
     t1868 = t1860*t1866
@@ -5847,10 +5847,10 @@ def _condition_number(q):
     t1893 = t1891 - t1866*t1892
     t1894 = t1892 + t1866*t1891
     t1895 = (t1790 != 0)
-    t1896 = 0.5*(-t1729 + t1764)/casadi.if_else(t1895, t1790, 1)
+    t1896 = (-t1729 + t1764)/casadi.if_else(t1895, 2*t1790, 1)
     t1897 = casadi.fabs(t1896)
     t1898 = (t1897 >= 1)
-    t1899 = casadi.fabs(1/casadi.if_else(t1898, t1896, 1))
+    t1899 = 1/casadi.fabs(casadi.if_else(t1898, t1896, 1))
     t1900 = casadi.if_else(t1895, casadi.if_else((t1896 >= 0), 1, -1)*casadi.if_else(t1898, t1899/(1 + casadi.sqrt(1 + t1899**2)), 1/(t1897 + casadi.sqrt(1 + t1897**2))), 0)
     t1901 = 1/casadi.sqrt(1 + t1900**2)
     t1902 = t1790*t1900
@@ -5882,10 +5882,10 @@ def _condition_number(q):
     t1928 = t1926 + t1900*t1925
     t1929 = t1804*t1907 + t1808*t1911 + t1812*t1915 + t1816*t1919 + t1820*t1923 + t1824*t1927
     t1930 = (t1929 != 0)
-    t1931 = 0.5*(-t1903 + t1800)/casadi.if_else(t1930, t1929, 1)
+    t1931 = (-t1903 + t1800)/casadi.if_else(t1930, 2*t1929, 1)
     t1932 = casadi.fabs(t1931)
     t1933 = (t1932 >= 1)
-    t1934 = casadi.fabs(1/casadi.if_else(t1933, t1931, 1))
+    t1934 = 1/casadi.fabs(casadi.if_else(t1933, t1931, 1))
     t1935 = casadi.if_else(t1930, casadi.if_else((t1931 >= 0), 1, -1)*casadi.if_else(t1933, t1934/(1 + casadi.sqrt(1 + t1934**2)), 1/(t1932 + casadi.sqrt(1 + t1932**2))), 0)
     t1936 = 1/casadi.sqrt(1 + t1935**2)
     t1937 = t1929*t1935
@@ -5918,10 +5918,10 @@ def _condition_number(q):
     t1964 = t1839*t1942 + t1843*t1946 + t1847*t1950 + t1851*t1954 + t1855*t1958 + t1859*t1962
     t1965 = t1908*t1943 + t1912*t1947 + t1916*t1951 + t1920*t1955 + t1924*t1959 + t1928*t1963
     t1966 = (t1964 != 0)
-    t1967 = 0.5*(-t1938 + t1835)/casadi.if_else(t1966, t1964, 1)
+    t1967 = (-t1938 + t1835)/casadi.if_else(t1966, 2*t1964, 1)
     t1968 = casadi.fabs(t1967)
     t1969 = (t1968 >= 1)
-    t1970 = casadi.fabs(1/casadi.if_else(t1969, t1967, 1))
+    t1970 = 1/casadi.fabs(casadi.if_else(t1969, t1967, 1))
     t1971 = casadi.if_else(t1966, casadi.if_else((t1967 >= 0), 1, -1)*casadi.if_else(t1969, t1970/(1 + casadi.sqrt(1 + t1970**2)), 1/(t1968 + casadi.sqrt(1 + t1968**2))), 0)
     t1972 = 1/casadi.sqrt(1 + t1971**2)
     t1973 = t1964*t1971
@@ -5953,10 +5953,10 @@ def _condition_number(q):
     t1999 = t1997 + t1971*t1996
     t2000 = t1874*t1978 + t1878*t1982 + t1882*t1986 + t1886*t1990 + t1890*t1994 + t1894*t1998
     t2001 = (t2000 != 0)
-    t2002 = 0.5*(-t1974 + t1870)/casadi.if_else(t2001, t2000, 1)
+    t2002 = (-t1974 + t1870)/casadi.if_else(t2001, 2*t2000, 1)
     t2003 = casadi.fabs(t2002)
     t2004 = (t2003 >= 1)
-    t2005 = casadi.fabs(1/casadi.if_else(t2004, t2002, 1))
+    t2005 = 1/casadi.fabs(casadi.if_else(t2004, t2002, 1))
     t2006 = casadi.if_else(t2001, casadi.if_else((t2002 >= 0), 1, -1)*casadi.if_else(t2004, t2005/(1 + casadi.sqrt(1 + t2005**2)), 1/(t2003 + casadi.sqrt(1 + t2003**2))), 0)
     t2007 = 1/casadi.sqrt(1 + t2006**2)
     t2008 = t2000*t2006
@@ -5988,10 +5988,10 @@ def _condition_number(q):
     t2034 = t2032 + t2006*t2031
     t2035 = t1873*t2013 + t1877*t2017 + t1881*t2021 + t1885*t2025 + t1889*t2029 + t1893*t2033
     t2036 = (t1965 != 0)
-    t2037 = 0.5*(-t1904 + t1939)/casadi.if_else(t2036, t1965, 1)
+    t2037 = (-t1904 + t1939)/casadi.if_else(t2036, 2*t1965, 1)
     t2038 = casadi.fabs(t2037)
     t2039 = (t2038 >= 1)
-    t2040 = casadi.fabs(1/casadi.if_else(t2039, t2037, 1))
+    t2040 = 1/casadi.fabs(casadi.if_else(t2039, t2037, 1))
     t2041 = casadi.if_else(t2036, casadi.if_else((t2037 >= 0), 1, -1)*casadi.if_else(t2039, t2040/(1 + casadi.sqrt(1 + t2040**2)), 1/(t2038 + casadi.sqrt(1 + t2038**2))), 0)
     t2042 = 1/casadi.sqrt(1 + t2041**2)
     t2043 = t1965*t2041
@@ -6023,10 +6023,10 @@ def _condition_number(q):
     t2069 = t2067 + t2041*t2066
     t2070 = t1979*t2048 + t1983*t2052 + t1987*t2056 + t1991*t2060 + t1995*t2064 + t1999*t2068
     t2071 = (t2070 != 0)
-    t2072 = 0.5*(-t2044 + t1975)/casadi.if_else(t2071, t2070, 1)
+    t2072 = (-t2044 + t1975)/casadi.if_else(t2071, 2*t2070, 1)
     t2073 = casadi.fabs(t2072)
     t2074 = (t2073 >= 1)
-    t2075 = casadi.fabs(1/casadi.if_else(t2074, t2072, 1))
+    t2075 = 1/casadi.fabs(casadi.if_else(t2074, t2072, 1))
     t2076 = casadi.if_else(t2071, casadi.if_else((t2072 >= 0), 1, -1)*casadi.if_else(t2074, t2075/(1 + casadi.sqrt(1 + t2075**2)), 1/(t2073 + casadi.sqrt(1 + t2073**2))), 0)
     t2077 = 1/casadi.sqrt(1 + t2076**2)
     t2078 = t2070*t2076
@@ -6059,10 +6059,10 @@ def _condition_number(q):
     t2105 = t2014*t2083 + t2018*t2087 + t2022*t2091 + t2026*t2095 + t2030*t2099 + t2034*t2103
     t2106 = t2049*t2084 + t2053*t2088 + t2057*t2092 + t2061*t2096 + t2065*t2100 + t2069*t2104
     t2107 = (t2105 != 0)
-    t2108 = 0.5*(-t2079 + t2010)/casadi.if_else(t2107, t2105, 1)
+    t2108 = (-t2079 + t2010)/casadi.if_else(t2107, 2*t2105, 1)
     t2109 = casadi.fabs(t2108)
     t2110 = (t2109 >= 1)
-    t2111 = casadi.fabs(1/casadi.if_else(t2110, t2108, 1))
+    t2111 = 1/casadi.fabs(casadi.if_else(t2110, t2108, 1))
     t2112 = casadi.if_else(t2107, casadi.if_else((t2108 >= 0), 1, -1)*casadi.if_else(t2110, t2111/(1 + casadi.sqrt(1 + t2111**2)), 1/(t2109 + casadi.sqrt(1 + t2109**2))), 0)
     t2113 = 1/casadi.sqrt(1 + t2112**2)
     t2114 = t2105*t2112
@@ -6093,10 +6093,10 @@ def _condition_number(q):
     t2139 = t2137 - t2112*t2138
     t2140 = t2138 + t2112*t2137
     t2141 = (t2106 != 0)
-    t2142 = 0.5*(-t2045 + t2080)/casadi.if_else(t2141, t2106, 1)
+    t2142 = (-t2045 + t2080)/casadi.if_else(t2141, 2*t2106, 1)
     t2143 = casadi.fabs(t2142)
     t2144 = (t2143 >= 1)
-    t2145 = casadi.fabs(1/casadi.if_else(t2144, t2142, 1))
+    t2145 = 1/casadi.fabs(casadi.if_else(t2144, t2142, 1))
     t2146 = casadi.if_else(t2141, casadi.if_else((t2142 >= 0), 1, -1)*casadi.if_else(t2144, t2145/(1 + casadi.sqrt(1 + t2145**2)), 1/(t2143 + casadi.sqrt(1 + t2143**2))), 0)
     t2147 = 1/casadi.sqrt(1 + t2146**2)
     t2148 = t2106*t2146
@@ -6128,10 +6128,10 @@ def _condition_number(q):
     t2174 = t2172 + t2146*t2171
     t2175 = t2120*t2153 + t2124*t2157 + t2128*t2161 + t2132*t2165 + t2136*t2169 + t2140*t2173
     t2176 = (t2175 != 0)
-    t2177 = 0.5*(-t2149 + t2116)/casadi.if_else(t2176, t2175, 1)
+    t2177 = (-t2149 + t2116)/casadi.if_else(t2176, 2*t2175, 1)
     t2178 = casadi.fabs(t2177)
     t2179 = (t2178 >= 1)
-    t2180 = casadi.fabs(1/casadi.if_else(t2179, t2177, 1))
+    t2180 = 1/casadi.fabs(casadi.if_else(t2179, t2177, 1))
     t2181 = casadi.if_else(t2176, casadi.if_else((t2177 >= 0), 1, -1)*casadi.if_else(t2179, t2180/(1 + casadi.sqrt(1 + t2180**2)), 1/(t2178 + casadi.sqrt(1 + t2178**2))), 0)
     t2182 = 1/casadi.sqrt(1 + t2181**2)
     t2183 = t2175*t2181
@@ -6163,10 +6163,10 @@ def _condition_number(q):
     t2209 = t2207 + t2181*t2206
     t2210 = t2154*t2189 + t2158*t2193 + t2162*t2197 + t2166*t2201 + t2170*t2205 + t2174*t2209
     t2211 = (t2210 != 0)
-    t2212 = 0.5*(-t2150 + t2185)/casadi.if_else(t2211, t2210, 1)
+    t2212 = (-t2150 + t2185)/casadi.if_else(t2211, 2*t2210, 1)
     t2213 = casadi.fabs(t2212)
     t2214 = (t2213 >= 1)
-    t2215 = casadi.fabs(1/casadi.if_else(t2214, t2212, 1))
+    t2215 = 1/casadi.fabs(casadi.if_else(t2214, t2212, 1))
     t2216 = casadi.if_else(t2211, casadi.if_else((t2212 >= 0), 1, -1)*casadi.if_else(t2214, t2215/(1 + casadi.sqrt(1 + t2215**2)), 1/(t2213 + casadi.sqrt(1 + t2213**2))), 0)
     t2217 = 1/casadi.sqrt(1 + t2216**2)
     t2218 = t2210*t2216
@@ -6197,10 +6197,10 @@ def _condition_number(q):
     t2243 = t2241 - t2216*t2242
     t2244 = t2242 + t2216*t2241
     t2245 = (t2035 != 0)
-    t2246 = 0.5*(-t1869 + t2009)/casadi.if_else(t2245, t2035, 1)
+    t2246 = (-t1869 + t2009)/casadi.if_else(t2245, 2*t2035, 1)
     t2247 = casadi.fabs(t2246)
     t2248 = (t2247 >= 1)
-    t2249 = casadi.fabs(1/casadi.if_else(t2248, t2246, 1))
+    t2249 = 1/casadi.fabs(casadi.if_else(t2248, t2246, 1))
     t2250 = casadi.if_else(t2245, casadi.if_else((t2246 >= 0), 1, -1)*casadi.if_else(t2248, t2249/(1 + casadi.sqrt(1 + t2249**2)), 1/(t2247 + casadi.sqrt(1 + t2247**2))), 0)
     t2251 = 1/casadi.sqrt(1 + t2250**2)
     t2252 = t2035*t2250
@@ -6232,10 +6232,10 @@ def _condition_number(q):
     t2278 = t2276 + t2250*t2275
     t2279 = t2119*t2257 + t2123*t2261 + t2127*t2265 + t2131*t2269 + t2135*t2273 + t2139*t2277
     t2280 = (t2279 != 0)
-    t2281 = 0.5*(-t2253 + t2115)/casadi.if_else(t2280, t2279, 1)
+    t2281 = (-t2253 + t2115)/casadi.if_else(t2280, 2*t2279, 1)
     t2282 = casadi.fabs(t2281)
     t2283 = (t2282 >= 1)
-    t2284 = casadi.fabs(1/casadi.if_else(t2283, t2281, 1))
+    t2284 = 1/casadi.fabs(casadi.if_else(t2283, t2281, 1))
     t2285 = casadi.if_else(t2280, casadi.if_else((t2281 >= 0), 1, -1)*casadi.if_else(t2283, t2284/(1 + casadi.sqrt(1 + t2284**2)), 1/(t2282 + casadi.sqrt(1 + t2282**2))), 0)
     t2286 = 1/casadi.sqrt(1 + t2285**2)
     t2287 = t2279*t2285
@@ -6268,10 +6268,10 @@ def _condition_number(q):
     t2314 = t2188*t2292 + t2192*t2296 + t2196*t2300 + t2200*t2304 + t2204*t2308 + t2208*t2312
     t2315 = t2258*t2293 + t2262*t2297 + t2266*t2301 + t2270*t2305 + t2274*t2309 + t2278*t2313
     t2316 = (t2314 != 0)
-    t2317 = 0.5*(-t2288 + t2184)/casadi.if_else(t2316, t2314, 1)
+    t2317 = (-t2288 + t2184)/casadi.if_else(t2316, 2*t2314, 1)
     t2318 = casadi.fabs(t2317)
     t2319 = (t2318 >= 1)
-    t2320 = casadi.fabs(1/casadi.if_else(t2319, t2317, 1))
+    t2320 = 1/casadi.fabs(casadi.if_else(t2319, t2317, 1))
     t2321 = casadi.if_else(t2316, casadi.if_else((t2317 >= 0), 1, -1)*casadi.if_else(t2319, t2320/(1 + casadi.sqrt(1 + t2320**2)), 1/(t2318 + casadi.sqrt(1 + t2318**2))), 0)
     t2322 = 1/casadi.sqrt(1 + t2321**2)
     t2323 = t2314*t2321
@@ -6303,10 +6303,10 @@ def _condition_number(q):
     t2349 = t2347 + t2321*t2346
     t2350 = t2223*t2328 + t2227*t2332 + t2231*t2336 + t2235*t2340 + t2239*t2344 + t2243*t2348
     t2351 = (t2350 != 0)
-    t2352 = 0.5*(-t2324 + t2219)/casadi.if_else(t2351, t2350, 1)
+    t2352 = (-t2324 + t2219)/casadi.if_else(t2351, 2*t2350, 1)
     t2353 = casadi.fabs(t2352)
     t2354 = (t2353 >= 1)
-    t2355 = casadi.fabs(1/casadi.if_else(t2354, t2352, 1))
+    t2355 = 1/casadi.fabs(casadi.if_else(t2354, t2352, 1))
     t2356 = casadi.if_else(t2351, casadi.if_else((t2352 >= 0), 1, -1)*casadi.if_else(t2354, t2355/(1 + casadi.sqrt(1 + t2355**2)), 1/(t2353 + casadi.sqrt(1 + t2353**2))), 0)
     t2357 = 1/casadi.sqrt(1 + t2356**2)
     t2358 = t2350*t2356
@@ -6338,10 +6338,10 @@ def _condition_number(q):
     t2384 = t2382 + t2356*t2381
     t2385 = t2224*t2363 + t2228*t2367 + t2232*t2371 + t2236*t2375 + t2240*t2379 + t2244*t2383
     t2386 = (t2385 != 0)
-    t2387 = 0.5*(-t2359 + t2220)/casadi.if_else(t2386, t2385, 1)
+    t2387 = (-t2359 + t2220)/casadi.if_else(t2386, 2*t2385, 1)
     t2388 = casadi.fabs(t2387)
     t2389 = (t2388 >= 1)
-    t2390 = casadi.fabs(1/casadi.if_else(t2389, t2387, 1))
+    t2390 = 1/casadi.fabs(casadi.if_else(t2389, t2387, 1))
     t2391 = casadi.if_else(t2386, casadi.if_else((t2387 >= 0), 1, -1)*casadi.if_else(t2389, t2390/(1 + casadi.sqrt(1 + t2390**2)), 1/(t2388 + casadi.sqrt(1 + t2388**2))), 0)
     t2392 = 1/casadi.sqrt(1 + t2391**2)
     t2393 = t2385*t2391
@@ -6372,10 +6372,10 @@ def _condition_number(q):
     t2418 = t2416 - t2391*t2417
     t2419 = t2417 + t2391*t2416
     t2420 = (t2315 != 0)
-    t2421 = 0.5*(-t2254 + t2289)/casadi.if_else(t2420, t2315, 1)
+    t2421 = (-t2254 + t2289)/casadi.if_else(t2420, 2*t2315, 1)
     t2422 = casadi.fabs(t2421)
     t2423 = (t2422 >= 1)
-    t2424 = casadi.fabs(1/casadi.if_else(t2423, t2421, 1))
+    t2424 = 1/casadi.fabs(casadi.if_else(t2423, t2421, 1))
     t2425 = casadi.if_else(t2420, casadi.if_else((t2421 >= 0), 1, -1)*casadi.if_else(t2423, t2424/(1 + casadi.sqrt(1 + t2424**2)), 1/(t2422 + casadi.sqrt(1 + t2422**2))), 0)
     t2426 = 1/casadi.sqrt(1 + t2425**2)
     t2427 = t2315*t2425
@@ -6407,10 +6407,10 @@ def _condition_number(q):
     t2453 = t2451 + t2425*t2450
     t2454 = t2329*t2432 + t2333*t2436 + t2337*t2440 + t2341*t2444 + t2345*t2448 + t2349*t2452
     t2455 = (t2454 != 0)
-    t2456 = 0.5*(-t2428 + t2325)/casadi.if_else(t2455, t2454, 1)
+    t2456 = (-t2428 + t2325)/casadi.if_else(t2455, 2*t2454, 1)
     t2457 = casadi.fabs(t2456)
     t2458 = (t2457 >= 1)
-    t2459 = casadi.fabs(1/casadi.if_else(t2458, t2456, 1))
+    t2459 = 1/casadi.fabs(casadi.if_else(t2458, t2456, 1))
     t2460 = casadi.if_else(t2455, casadi.if_else((t2456 >= 0), 1, -1)*casadi.if_else(t2458, t2459/(1 + casadi.sqrt(1 + t2459**2)), 1/(t2457 + casadi.sqrt(1 + t2457**2))), 0)
     t2461 = 1/casadi.sqrt(1 + t2460**2)
     t2462 = t2454*t2460
@@ -6443,10 +6443,10 @@ def _condition_number(q):
     t2489 = t2364*t2467 + t2368*t2471 + t2372*t2475 + t2376*t2479 + t2380*t2483 + t2384*t2487
     t2490 = t2433*t2468 + t2437*t2472 + t2441*t2476 + t2445*t2480 + t2449*t2484 + t2453*t2488
     t2491 = (t2489 != 0)
-    t2492 = 0.5*(-t2463 + t2360)/casadi.if_else(t2491, t2489, 1)
+    t2492 = (-t2463 + t2360)/casadi.if_else(t2491, 2*t2489, 1)
     t2493 = casadi.fabs(t2492)
     t2494 = (t2493 >= 1)
-    t2495 = casadi.fabs(1/casadi.if_else(t2494, t2492, 1))
+    t2495 = 1/casadi.fabs(casadi.if_else(t2494, t2492, 1))
     t2496 = casadi.if_else(t2491, casadi.if_else((t2492 >= 0), 1, -1)*casadi.if_else(t2494, t2495/(1 + casadi.sqrt(1 + t2495**2)), 1/(t2493 + casadi.sqrt(1 + t2493**2))), 0)
     t2497 = 1/casadi.sqrt(1 + t2496**2)
     t2498 = t2489*t2496
@@ -6478,10 +6478,10 @@ def _condition_number(q):
     t2524 = t2522 + t2496*t2521
     t2525 = t2399*t2503 + t2403*t2507 + t2407*t2511 + t2411*t2515 + t2415*t2519 + t2419*t2523
     t2526 = (t2525 != 0)
-    t2527 = 0.5*(-t2499 + t2395)/casadi.if_else(t2526, t2525, 1)
+    t2527 = (-t2499 + t2395)/casadi.if_else(t2526, 2*t2525, 1)
     t2528 = casadi.fabs(t2527)
     t2529 = (t2528 >= 1)
-    t2530 = casadi.fabs(1/casadi.if_else(t2529, t2527, 1))
+    t2530 = 1/casadi.fabs(casadi.if_else(t2529, t2527, 1))
     t2531 = casadi.if_else(t2526, casadi.if_else((t2527 >= 0), 1, -1)*casadi.if_else(t2529, t2530/(1 + casadi.sqrt(1 + t2530**2)), 1/(t2528 + casadi.sqrt(1 + t2528**2))), 0)
     t2532 = 1/casadi.sqrt(1 + t2531**2)
     t2533 = t2525*t2531
@@ -6513,10 +6513,10 @@ def _condition_number(q):
     t2559 = t2557 + t2531*t2556
     t2560 = t2398*t2538 + t2402*t2542 + t2406*t2546 + t2410*t2550 + t2414*t2554 + t2418*t2558
     t2561 = (t2490 != 0)
-    t2562 = 0.5*(-t2429 + t2464)/casadi.if_else(t2561, t2490, 1)
+    t2562 = (-t2429 + t2464)/casadi.if_else(t2561, 2*t2490, 1)
     t2563 = casadi.fabs(t2562)
     t2564 = (t2563 >= 1)
-    t2565 = casadi.fabs(1/casadi.if_else(t2564, t2562, 1))
+    t2565 = 1/casadi.fabs(casadi.if_else(t2564, t2562, 1))
     t2566 = casadi.if_else(t2561, casadi.if_else((t2562 >= 0), 1, -1)*casadi.if_else(t2564, t2565/(1 + casadi.sqrt(1 + t2565**2)), 1/(t2563 + casadi.sqrt(1 + t2563**2))), 0)
     t2567 = 1/casadi.sqrt(1 + t2566**2)
     t2568 = t2490*t2566
@@ -6548,10 +6548,10 @@ def _condition_number(q):
     t2594 = t2592 + t2566*t2591
     t2595 = t2504*t2573 + t2508*t2577 + t2512*t2581 + t2516*t2585 + t2520*t2589 + t2524*t2593
     t2596 = (t2595 != 0)
-    t2597 = 0.5*(-t2569 + t2500)/casadi.if_else(t2596, t2595, 1)
+    t2597 = (-t2569 + t2500)/casadi.if_else(t2596, 2*t2595, 1)
     t2598 = casadi.fabs(t2597)
     t2599 = (t2598 >= 1)
-    t2600 = casadi.fabs(1/casadi.if_else(t2599, t2597, 1))
+    t2600 = 1/casadi.fabs(casadi.if_else(t2599, t2597, 1))
     t2601 = casadi.if_else(t2596, casadi.if_else((t2597 >= 0), 1, -1)*casadi.if_else(t2599, t2600/(1 + casadi.sqrt(1 + t2600**2)), 1/(t2598 + casadi.sqrt(1 + t2598**2))), 0)
     t2602 = 1/casadi.sqrt(1 + t2601**2)
     t2603 = t2595*t2601
@@ -6584,10 +6584,10 @@ def _condition_number(q):
     t2630 = t2539*t2608 + t2543*t2612 + t2547*t2616 + t2551*t2620 + t2555*t2624 + t2559*t2628
     t2631 = t2574*t2609 + t2578*t2613 + t2582*t2617 + t2586*t2621 + t2590*t2625 + t2594*t2629
     t2632 = (t2630 != 0)
-    t2633 = 0.5*(-t2604 + t2535)/casadi.if_else(t2632, t2630, 1)
+    t2633 = (-t2604 + t2535)/casadi.if_else(t2632, 2*t2630, 1)
     t2634 = casadi.fabs(t2633)
     t2635 = (t2634 >= 1)
-    t2636 = casadi.fabs(1/casadi.if_else(t2635, t2633, 1))
+    t2636 = 1/casadi.fabs(casadi.if_else(t2635, t2633, 1))
     t2637 = casadi.if_else(t2632, casadi.if_else((t2633 >= 0), 1, -1)*casadi.if_else(t2635, t2636/(1 + casadi.sqrt(1 + t2636**2)), 1/(t2634 + casadi.sqrt(1 + t2634**2))), 0)
     t2638 = 1/casadi.sqrt(1 + t2637**2)
     t2639 = t2630*t2637
@@ -6618,10 +6618,10 @@ def _condition_number(q):
     t2664 = t2662 - t2637*t2663
     t2665 = t2663 + t2637*t2662
     t2666 = (t2631 != 0)
-    t2667 = 0.5*(-t2570 + t2605)/casadi.if_else(t2666, t2631, 1)
+    t2667 = (-t2570 + t2605)/casadi.if_else(t2666, 2*t2631, 1)
     t2668 = casadi.fabs(t2667)
     t2669 = (t2668 >= 1)
-    t2670 = casadi.fabs(1/casadi.if_else(t2669, t2667, 1))
+    t2670 = 1/casadi.fabs(casadi.if_else(t2669, t2667, 1))
     t2671 = casadi.if_else(t2666, casadi.if_else((t2667 >= 0), 1, -1)*casadi.if_else(t2669, t2670/(1 + casadi.sqrt(1 + t2670**2)), 1/(t2668 + casadi.sqrt(1 + t2668**2))), 0)
     t2672 = 1/casadi.sqrt(1 + t2671**2)
     t2673 = t2631*t2671
@@ -6653,10 +6653,10 @@ def _condition_number(q):
     t2699 = t2697 + t2671*t2696
     t2700 = t2645*t2678 + t2649*t2682 + t2653*t2686 + t2657*t2690 + t2661*t2694 + t2665*t2698
     t2701 = (t2700 != 0)
-    t2702 = 0.5*(-t2674 + t2641)/casadi.if_else(t2701, t2700, 1)
+    t2702 = (-t2674 + t2641)/casadi.if_else(t2701, 2*t2700, 1)
     t2703 = casadi.fabs(t2702)
     t2704 = (t2703 >= 1)
-    t2705 = casadi.fabs(1/casadi.if_else(t2704, t2702, 1))
+    t2705 = 1/casadi.fabs(casadi.if_else(t2704, t2702, 1))
     t2706 = casadi.if_else(t2701, casadi.if_else((t2702 >= 0), 1, -1)*casadi.if_else(t2704, t2705/(1 + casadi.sqrt(1 + t2705**2)), 1/(t2703 + casadi.sqrt(1 + t2703**2))), 0)
     t2707 = 1/casadi.sqrt(1 + t2706**2)
     t2708 = t2700*t2706
@@ -6688,10 +6688,10 @@ def _condition_number(q):
     t2734 = t2732 + t2706*t2731
     t2735 = t2679*t2714 + t2683*t2718 + t2687*t2722 + t2691*t2726 + t2695*t2730 + t2699*t2734
     t2736 = (t2735 != 0)
-    t2737 = 0.5*(-t2675 + t2710)/casadi.if_else(t2736, t2735, 1)
+    t2737 = (-t2675 + t2710)/casadi.if_else(t2736, 2*t2735, 1)
     t2738 = casadi.fabs(t2737)
     t2739 = (t2738 >= 1)
-    t2740 = casadi.fabs(1/casadi.if_else(t2739, t2737, 1))
+    t2740 = 1/casadi.fabs(casadi.if_else(t2739, t2737, 1))
     t2741 = casadi.if_else(t2736, casadi.if_else((t2737 >= 0), 1, -1)*casadi.if_else(t2739, t2740/(1 + casadi.sqrt(1 + t2740**2)), 1/(t2738 + casadi.sqrt(1 + t2738**2))), 0)
     t2742 = 1/casadi.sqrt(1 + t2741**2)
     t2743 = t2735*t2741
@@ -6722,10 +6722,10 @@ def _condition_number(q):
     t2768 = t2766 - t2741*t2767
     t2769 = t2767 + t2741*t2766
     t2770 = (t2560 != 0)
-    t2771 = 0.5*(-t2394 + t2534)/casadi.if_else(t2770, t2560, 1)
+    t2771 = (-t2394 + t2534)/casadi.if_else(t2770, 2*t2560, 1)
     t2772 = casadi.fabs(t2771)
     t2773 = (t2772 >= 1)
-    t2774 = casadi.fabs(1/casadi.if_else(t2773, t2771, 1))
+    t2774 = 1/casadi.fabs(casadi.if_else(t2773, t2771, 1))
     t2775 = casadi.if_else(t2770, casadi.if_else((t2771 >= 0), 1, -1)*casadi.if_else(t2773, t2774/(1 + casadi.sqrt(1 + t2774**2)), 1/(t2772 + casadi.sqrt(1 + t2772**2))), 0)
     t2776 = 1/casadi.sqrt(1 + t2775**2)
     t2777 = t2560*t2775
@@ -6757,10 +6757,10 @@ def _condition_number(q):
     t2803 = t2801 + t2775*t2800
     t2804 = t2644*t2782 + t2648*t2786 + t2652*t2790 + t2656*t2794 + t2660*t2798 + t2664*t2802
     t2805 = (t2804 != 0)
-    t2806 = 0.5*(-t2778 + t2640)/casadi.if_else(t2805, t2804, 1)
+    t2806 = (-t2778 + t2640)/casadi.if_else(t2805, 2*t2804, 1)
     t2807 = casadi.fabs(t2806)
     t2808 = (t2807 >= 1)
-    t2809 = casadi.fabs(1/casadi.if_else(t2808, t2806, 1))
+    t2809 = 1/casadi.fabs(casadi.if_else(t2808, t2806, 1))
     t2810 = casadi.if_else(t2805, casadi.if_else((t2806 >= 0), 1, -1)*casadi.if_else(t2808, t2809/(1 + casadi.sqrt(1 + t2809**2)), 1/(t2807 + casadi.sqrt(1 + t2807**2))), 0)
     t2811 = 1/casadi.sqrt(1 + t2810**2)
     t2812 = t2804*t2810
@@ -6793,10 +6793,10 @@ def _condition_number(q):
     t2839 = t2713*t2817 + t2717*t2821 + t2721*t2825 + t2725*t2829 + t2729*t2833 + t2733*t2837
     t2840 = t2783*t2818 + t2787*t2822 + t2791*t2826 + t2795*t2830 + t2799*t2834 + t2803*t2838
     t2841 = (t2839 != 0)
-    t2842 = 0.5*(-t2813 + t2709)/casadi.if_else(t2841, t2839, 1)
+    t2842 = (-t2813 + t2709)/casadi.if_else(t2841, 2*t2839, 1)
     t2843 = casadi.fabs(t2842)
     t2844 = (t2843 >= 1)
-    t2845 = casadi.fabs(1/casadi.if_else(t2844, t2842, 1))
+    t2845 = 1/casadi.fabs(casadi.if_else(t2844, t2842, 1))
     t2846 = casadi.if_else(t2841, casadi.if_else((t2842 >= 0), 1, -1)*casadi.if_else(t2844, t2845/(1 + casadi.sqrt(1 + t2845**2)), 1/(t2843 + casadi.sqrt(1 + t2843**2))), 0)
     t2847 = 1/casadi.sqrt(1 + t2846**2)
     t2848 = t2839*t2846
@@ -6828,10 +6828,10 @@ def _condition_number(q):
     t2874 = t2872 + t2846*t2871
     t2875 = t2748*t2853 + t2752*t2857 + t2756*t2861 + t2760*t2865 + t2764*t2869 + t2768*t2873
     t2876 = (t2875 != 0)
-    t2877 = 0.5*(-t2849 + t2744)/casadi.if_else(t2876, t2875, 1)
+    t2877 = (-t2849 + t2744)/casadi.if_else(t2876, 2*t2875, 1)
     t2878 = casadi.fabs(t2877)
     t2879 = (t2878 >= 1)
-    t2880 = casadi.fabs(1/casadi.if_else(t2879, t2877, 1))
+    t2880 = 1/casadi.fabs(casadi.if_else(t2879, t2877, 1))
     t2881 = casadi.if_else(t2876, casadi.if_else((t2877 >= 0), 1, -1)*casadi.if_else(t2879, t2880/(1 + casadi.sqrt(1 + t2880**2)), 1/(t2878 + casadi.sqrt(1 + t2878**2))), 0)
     t2882 = 1/casadi.sqrt(1 + t2881**2)
     t2883 = t2875*t2881
@@ -6863,10 +6863,10 @@ def _condition_number(q):
     t2909 = t2907 + t2881*t2906
     t2910 = t2749*t2888 + t2753*t2892 + t2757*t2896 + t2761*t2900 + t2765*t2904 + t2769*t2908
     t2911 = (t2910 != 0)
-    t2912 = 0.5*(-t2884 + t2745)/casadi.if_else(t2911, t2910, 1)
+    t2912 = (-t2884 + t2745)/casadi.if_else(t2911, 2*t2910, 1)
     t2913 = casadi.fabs(t2912)
     t2914 = (t2913 >= 1)
-    t2915 = casadi.fabs(1/casadi.if_else(t2914, t2912, 1))
+    t2915 = 1/casadi.fabs(casadi.if_else(t2914, t2912, 1))
     t2916 = casadi.if_else(t2911, casadi.if_else((t2912 >= 0), 1, -1)*casadi.if_else(t2914, t2915/(1 + casadi.sqrt(1 + t2915**2)), 1/(t2913 + casadi.sqrt(1 + t2913**2))), 0)
     t2917 = 1/casadi.sqrt(1 + t2916**2)
     t2918 = t2910*t2916
@@ -6897,10 +6897,10 @@ def _condition_number(q):
     t2943 = t2941 - t2916*t2942
     t2944 = t2942 + t2916*t2941
     t2945 = (t2840 != 0)
-    t2946 = 0.5*(-t2779 + t2814)/casadi.if_else(t2945, t2840, 1)
+    t2946 = (-t2779 + t2814)/casadi.if_else(t2945, 2*t2840, 1)
     t2947 = casadi.fabs(t2946)
     t2948 = (t2947 >= 1)
-    t2949 = casadi.fabs(1/casadi.if_else(t2948, t2946, 1))
+    t2949 = 1/casadi.fabs(casadi.if_else(t2948, t2946, 1))
     t2950 = casadi.if_else(t2945, casadi.if_else((t2946 >= 0), 1, -1)*casadi.if_else(t2948, t2949/(1 + casadi.sqrt(1 + t2949**2)), 1/(t2947 + casadi.sqrt(1 + t2947**2))), 0)
     t2951 = 1/casadi.sqrt(1 + t2950**2)
     t2952 = t2840*t2950
@@ -6932,10 +6932,10 @@ def _condition_number(q):
     t2978 = t2976 + t2950*t2975
     t2979 = t2854*t2957 + t2858*t2961 + t2862*t2965 + t2866*t2969 + t2870*t2973 + t2874*t2977
     t2980 = (t2979 != 0)
-    t2981 = 0.5*(-t2953 + t2850)/casadi.if_else(t2980, t2979, 1)
+    t2981 = (-t2953 + t2850)/casadi.if_else(t2980, 2*t2979, 1)
     t2982 = casadi.fabs(t2981)
     t2983 = (t2982 >= 1)
-    t2984 = casadi.fabs(1/casadi.if_else(t2983, t2981, 1))
+    t2984 = 1/casadi.fabs(casadi.if_else(t2983, t2981, 1))
     t2985 = casadi.if_else(t2980, casadi.if_else((t2981 >= 0), 1, -1)*casadi.if_else(t2983, t2984/(1 + casadi.sqrt(1 + t2984**2)), 1/(t2982 + casadi.sqrt(1 + t2982**2))), 0)
     t2986 = 1/casadi.sqrt(1 + t2985**2)
     t2987 = t2979*t2985
@@ -6968,10 +6968,10 @@ def _condition_number(q):
     t3014 = t2889*t2992 + t2893*t2996 + t2897*t3000 + t2901*t3004 + t2905*t3008 + t2909*t3012
     t3015 = t2958*t2993 + t2962*t2997 + t2966*t3001 + t2970*t3005 + t2974*t3009 + t2978*t3013
     t3016 = (t3014 != 0)
-    t3017 = 0.5*(-t2988 + t2885)/casadi.if_else(t3016, t3014, 1)
+    t3017 = (-t2988 + t2885)/casadi.if_else(t3016, 2*t3014, 1)
     t3018 = casadi.fabs(t3017)
     t3019 = (t3018 >= 1)
-    t3020 = casadi.fabs(1/casadi.if_else(t3019, t3017, 1))
+    t3020 = 1/casadi.fabs(casadi.if_else(t3019, t3017, 1))
     t3021 = casadi.if_else(t3016, casadi.if_else((t3017 >= 0), 1, -1)*casadi.if_else(t3019, t3020/(1 + casadi.sqrt(1 + t3020**2)), 1/(t3018 + casadi.sqrt(1 + t3018**2))), 0)
     t3022 = 1/casadi.sqrt(1 + t3021**2)
     t3023 = t3014*t3021
@@ -7003,10 +7003,10 @@ def _condition_number(q):
     t3049 = t3047 + t3021*t3046
     t3050 = t2924*t3028 + t2928*t3032 + t2932*t3036 + t2936*t3040 + t2940*t3044 + t2944*t3048
     t3051 = (t3050 != 0)
-    t3052 = 0.5*(-t3024 + t2920)/casadi.if_else(t3051, t3050, 1)
+    t3052 = (-t3024 + t2920)/casadi.if_else(t3051, 2*t3050, 1)
     t3053 = casadi.fabs(t3052)
     t3054 = (t3053 >= 1)
-    t3055 = casadi.fabs(1/casadi.if_else(t3054, t3052, 1))
+    t3055 = 1/casadi.fabs(casadi.if_else(t3054, t3052, 1))
     t3056 = casadi.if_else(t3051, casadi.if_else((t3052 >= 0), 1, -1)*casadi.if_else(t3054, t3055/(1 + casadi.sqrt(1 + t3055**2)), 1/(t3053 + casadi.sqrt(1 + t3053**2))), 0)
     t3057 = 1/casadi.sqrt(1 + t3056**2)
     t3058 = t3050*t3056
@@ -7038,10 +7038,10 @@ def _condition_number(q):
     t3084 = t3082 + t3056*t3081
     t3085 = t2923*t3063 + t2927*t3067 + t2931*t3071 + t2935*t3075 + t2939*t3079 + t2943*t3083
     t3086 = (t3015 != 0)
-    t3087 = 0.5*(-t2954 + t2989)/casadi.if_else(t3086, t3015, 1)
+    t3087 = (-t2954 + t2989)/casadi.if_else(t3086, 2*t3015, 1)
     t3088 = casadi.fabs(t3087)
     t3089 = (t3088 >= 1)
-    t3090 = casadi.fabs(1/casadi.if_else(t3089, t3087, 1))
+    t3090 = 1/casadi.fabs(casadi.if_else(t3089, t3087, 1))
     t3091 = casadi.if_else(t3086, casadi.if_else((t3087 >= 0), 1, -1)*casadi.if_else(t3089, t3090/(1 + casadi.sqrt(1 + t3090**2)), 1/(t3088 + casadi.sqrt(1 + t3088**2))), 0)
     t3092 = 1/casadi.sqrt(1 + t3091**2)
     t3093 = t3015*t3091
@@ -7073,10 +7073,10 @@ def _condition_number(q):
     t3119 = t3117 + t3091*t3116
     t3120 = t3029*t3098 + t3033*t3102 + t3037*t3106 + t3041*t3110 + t3045*t3114 + t3049*t3118
     t3121 = (t3120 != 0)
-    t3122 = 0.5*(-t3094 + t3025)/casadi.if_else(t3121, t3120, 1)
+    t3122 = (-t3094 + t3025)/casadi.if_else(t3121, 2*t3120, 1)
     t3123 = casadi.fabs(t3122)
     t3124 = (t3123 >= 1)
-    t3125 = casadi.fabs(1/casadi.if_else(t3124, t3122, 1))
+    t3125 = 1/casadi.fabs(casadi.if_else(t3124, t3122, 1))
     t3126 = casadi.if_else(t3121, casadi.if_else((t3122 >= 0), 1, -1)*casadi.if_else(t3124, t3125/(1 + casadi.sqrt(1 + t3125**2)), 1/(t3123 + casadi.sqrt(1 + t3123**2))), 0)
     t3127 = 1/casadi.sqrt(1 + t3126**2)
     t3128 = t3120*t3126
@@ -7109,10 +7109,10 @@ def _condition_number(q):
     t3155 = t3064*t3133 + t3068*t3137 + t3072*t3141 + t3076*t3145 + t3080*t3149 + t3084*t3153
     t3156 = t3099*t3134 + t3103*t3138 + t3107*t3142 + t3111*t3146 + t3115*t3150 + t3119*t3154
     t3157 = (t3155 != 0)
-    t3158 = 0.5*(-t3129 + t3060)/casadi.if_else(t3157, t3155, 1)
+    t3158 = (-t3129 + t3060)/casadi.if_else(t3157, 2*t3155, 1)
     t3159 = casadi.fabs(t3158)
     t3160 = (t3159 >= 1)
-    t3161 = casadi.fabs(1/casadi.if_else(t3160, t3158, 1))
+    t3161 = 1/casadi.fabs(casadi.if_else(t3160, t3158, 1))
     t3162 = casadi.if_else(t3157, casadi.if_else((t3158 >= 0), 1, -1)*casadi.if_else(t3160, t3161/(1 + casadi.sqrt(1 + t3161**2)), 1/(t3159 + casadi.sqrt(1 + t3159**2))), 0)
     t3163 = 1/casadi.sqrt(1 + t3162**2)
     t3164 = t3155*t3162
@@ -7143,10 +7143,10 @@ def _condition_number(q):
     t3189 = t3187 - t3162*t3188
     t3190 = t3188 + t3162*t3187
     t3191 = (t3156 != 0)
-    t3192 = 0.5*(-t3095 + t3130)/casadi.if_else(t3191, t3156, 1)
+    t3192 = (-t3095 + t3130)/casadi.if_else(t3191, 2*t3156, 1)
     t3193 = casadi.fabs(t3192)
     t3194 = (t3193 >= 1)
-    t3195 = casadi.fabs(1/casadi.if_else(t3194, t3192, 1))
+    t3195 = 1/casadi.fabs(casadi.if_else(t3194, t3192, 1))
     t3196 = casadi.if_else(t3191, casadi.if_else((t3192 >= 0), 1, -1)*casadi.if_else(t3194, t3195/(1 + casadi.sqrt(1 + t3195**2)), 1/(t3193 + casadi.sqrt(1 + t3193**2))), 0)
     t3197 = 1/casadi.sqrt(1 + t3196**2)
     t3198 = t3156*t3196
@@ -7178,10 +7178,10 @@ def _condition_number(q):
     t3224 = t3222 + t3196*t3221
     t3225 = t3170*t3203 + t3174*t3207 + t3178*t3211 + t3182*t3215 + t3186*t3219 + t3190*t3223
     t3226 = (t3225 != 0)
-    t3227 = 0.5*(-t3199 + t3166)/casadi.if_else(t3226, t3225, 1)
+    t3227 = (-t3199 + t3166)/casadi.if_else(t3226, 2*t3225, 1)
     t3228 = casadi.fabs(t3227)
     t3229 = (t3228 >= 1)
-    t3230 = casadi.fabs(1/casadi.if_else(t3229, t3227, 1))
+    t3230 = 1/casadi.fabs(casadi.if_else(t3229, t3227, 1))
     t3231 = casadi.if_else(t3226, casadi.if_else((t3227 >= 0), 1, -1)*casadi.if_else(t3229, t3230/(1 + casadi.sqrt(1 + t3230**2)), 1/(t3228 + casadi.sqrt(1 + t3228**2))), 0)
     t3232 = 1/casadi.sqrt(1 + t3231**2)
     t3233 = t3225*t3231
@@ -7213,10 +7213,10 @@ def _condition_number(q):
     t3259 = t3257 + t3231*t3256
     t3260 = t3204*t3239 + t3208*t3243 + t3212*t3247 + t3216*t3251 + t3220*t3255 + t3224*t3259
     t3261 = (t3260 != 0)
-    t3262 = 0.5*(-t3200 + t3235)/casadi.if_else(t3261, t3260, 1)
+    t3262 = (-t3200 + t3235)/casadi.if_else(t3261, 2*t3260, 1)
     t3263 = casadi.fabs(t3262)
     t3264 = (t3263 >= 1)
-    t3265 = casadi.fabs(1/casadi.if_else(t3264, t3262, 1))
+    t3265 = 1/casadi.fabs(casadi.if_else(t3264, t3262, 1))
     t3266 = casadi.if_else(t3261, casadi.if_else((t3262 >= 0), 1, -1)*casadi.if_else(t3264, t3265/(1 + casadi.sqrt(1 + t3265**2)), 1/(t3263 + casadi.sqrt(1 + t3263**2))), 0)
     t3267 = 1/casadi.sqrt(1 + t3266**2)
     t3268 = t3260*t3266
@@ -7247,10 +7247,10 @@ def _condition_number(q):
     t3293 = t3291 - t3266*t3292
     t3294 = t3292 + t3266*t3291
     t3295 = (t3085 != 0)
-    t3296 = 0.5*(-t2919 + t3059)/casadi.if_else(t3295, t3085, 1)
+    t3296 = (-t2919 + t3059)/casadi.if_else(t3295, 2*t3085, 1)
     t3297 = casadi.fabs(t3296)
     t3298 = (t3297 >= 1)
-    t3299 = casadi.fabs(1/casadi.if_else(t3298, t3296, 1))
+    t3299 = 1/casadi.fabs(casadi.if_else(t3298, t3296, 1))
     t3300 = casadi.if_else(t3295, casadi.if_else((t3296 >= 0), 1, -1)*casadi.if_else(t3298, t3299/(1 + casadi.sqrt(1 + t3299**2)), 1/(t3297 + casadi.sqrt(1 + t3297**2))), 0)
     t3301 = 1/casadi.sqrt(1 + t3300**2)
     t3302 = t3085*t3300
@@ -7282,10 +7282,10 @@ def _condition_number(q):
     t3328 = t3326 + t3300*t3325
     t3329 = t3169*t3307 + t3173*t3311 + t3177*t3315 + t3181*t3319 + t3185*t3323 + t3189*t3327
     t3330 = (t3329 != 0)
-    t3331 = 0.5*(-t3303 + t3165)/casadi.if_else(t3330, t3329, 1)
+    t3331 = (-t3303 + t3165)/casadi.if_else(t3330, 2*t3329, 1)
     t3332 = casadi.fabs(t3331)
     t3333 = (t3332 >= 1)
-    t3334 = casadi.fabs(1/casadi.if_else(t3333, t3331, 1))
+    t3334 = 1/casadi.fabs(casadi.if_else(t3333, t3331, 1))
     t3335 = casadi.if_else(t3330, casadi.if_else((t3331 >= 0), 1, -1)*casadi.if_else(t3333, t3334/(1 + casadi.sqrt(1 + t3334**2)), 1/(t3332 + casadi.sqrt(1 + t3332**2))), 0)
     t3336 = 1/casadi.sqrt(1 + t3335**2)
     t3337 = t3329*t3335
@@ -7318,10 +7318,10 @@ def _condition_number(q):
     t3364 = t3238*t3342 + t3242*t3346 + t3246*t3350 + t3250*t3354 + t3254*t3358 + t3258*t3362
     t3365 = t3308*t3343 + t3312*t3347 + t3316*t3351 + t3320*t3355 + t3324*t3359 + t3328*t3363
     t3366 = (t3364 != 0)
-    t3367 = 0.5*(-t3338 + t3234)/casadi.if_else(t3366, t3364, 1)
+    t3367 = (-t3338 + t3234)/casadi.if_else(t3366, 2*t3364, 1)
     t3368 = casadi.fabs(t3367)
     t3369 = (t3368 >= 1)
-    t3370 = casadi.fabs(1/casadi.if_else(t3369, t3367, 1))
+    t3370 = 1/casadi.fabs(casadi.if_else(t3369, t3367, 1))
     t3371 = casadi.if_else(t3366, casadi.if_else((t3367 >= 0), 1, -1)*casadi.if_else(t3369, t3370/(1 + casadi.sqrt(1 + t3370**2)), 1/(t3368 + casadi.sqrt(1 + t3368**2))), 0)
     t3372 = 1/casadi.sqrt(1 + t3371**2)
     t3373 = t3364*t3371
@@ -7353,10 +7353,10 @@ def _condition_number(q):
     t3399 = t3397 + t3371*t3396
     t3400 = t3273*t3378 + t3277*t3382 + t3281*t3386 + t3285*t3390 + t3289*t3394 + t3293*t3398
     t3401 = (t3400 != 0)
-    t3402 = 0.5*(-t3374 + t3269)/casadi.if_else(t3401, t3400, 1)
+    t3402 = (-t3374 + t3269)/casadi.if_else(t3401, 2*t3400, 1)
     t3403 = casadi.fabs(t3402)
     t3404 = (t3403 >= 1)
-    t3405 = casadi.fabs(1/casadi.if_else(t3404, t3402, 1))
+    t3405 = 1/casadi.fabs(casadi.if_else(t3404, t3402, 1))
     t3406 = casadi.if_else(t3401, casadi.if_else((t3402 >= 0), 1, -1)*casadi.if_else(t3404, t3405/(1 + casadi.sqrt(1 + t3405**2)), 1/(t3403 + casadi.sqrt(1 + t3403**2))), 0)
     t3407 = 1/casadi.sqrt(1 + t3406**2)
     t3408 = t3400*t3406
@@ -7388,10 +7388,10 @@ def _condition_number(q):
     t3434 = t3432 + t3406*t3431
     t3435 = t3274*t3413 + t3278*t3417 + t3282*t3421 + t3286*t3425 + t3290*t3429 + t3294*t3433
     t3436 = (t3435 != 0)
-    t3437 = 0.5*(-t3409 + t3270)/casadi.if_else(t3436, t3435, 1)
+    t3437 = (-t3409 + t3270)/casadi.if_else(t3436, 2*t3435, 1)
     t3438 = casadi.fabs(t3437)
     t3439 = (t3438 >= 1)
-    t3440 = casadi.fabs(1/casadi.if_else(t3439, t3437, 1))
+    t3440 = 1/casadi.fabs(casadi.if_else(t3439, t3437, 1))
     t3441 = casadi.if_else(t3436, casadi.if_else((t3437 >= 0), 1, -1)*casadi.if_else(t3439, t3440/(1 + casadi.sqrt(1 + t3440**2)), 1/(t3438 + casadi.sqrt(1 + t3438**2))), 0)
     t3442 = 1/casadi.sqrt(1 + t3441**2)
     t3443 = t3270 + t3435*t3441
@@ -7421,10 +7421,10 @@ def _condition_number(q):
     t3467 = t3465 + t3441*t3464
     t3468 = casadi.sqrt(t3446**2 + t3450**2 + t3454**2 + t3458**2 + t3462**2 + t3466**2)
     t3469 = (t3365 != 0)
-    t3470 = 0.5*(-t3304 + t3339)/casadi.if_else(t3469, t3365, 1)
+    t3470 = (-t3304 + t3339)/casadi.if_else(t3469, 2*t3365, 1)
     t3471 = casadi.fabs(t3470)
     t3472 = (t3471 >= 1)
-    t3473 = casadi.fabs(1/casadi.if_else(t3472, t3470, 1))
+    t3473 = 1/casadi.fabs(casadi.if_else(t3472, t3470, 1))
     t3474 = casadi.if_else(t3469, casadi.if_else((t3470 >= 0), 1, -1)*casadi.if_else(t3472, t3473/(1 + casadi.sqrt(1 + t3473**2)), 1/(t3471 + casadi.sqrt(1 + t3471**2))), 0)
     t3475 = 1/casadi.sqrt(1 + t3474**2)
     t3476 = t3365*t3474
@@ -7456,10 +7456,10 @@ def _condition_number(q):
     t3502 = t3500 + t3474*t3499
     t3503 = t3379*t3481 + t3383*t3485 + t3387*t3489 + t3391*t3493 + t3395*t3497 + t3399*t3501
     t3504 = (t3503 != 0)
-    t3505 = 0.5*(-t3477 + t3375)/casadi.if_else(t3504, t3503, 1)
+    t3505 = (-t3477 + t3375)/casadi.if_else(t3504, 2*t3503, 1)
     t3506 = casadi.fabs(t3505)
     t3507 = (t3506 >= 1)
-    t3508 = casadi.fabs(1/casadi.if_else(t3507, t3505, 1))
+    t3508 = 1/casadi.fabs(casadi.if_else(t3507, t3505, 1))
     t3509 = casadi.if_else(t3504, casadi.if_else((t3505 >= 0), 1, -1)*casadi.if_else(t3507, t3508/(1 + casadi.sqrt(1 + t3508**2)), 1/(t3506 + casadi.sqrt(1 + t3506**2))), 0)
     t3510 = 1/casadi.sqrt(1 + t3509**2)
     t3511 = t3503*t3509
@@ -7492,10 +7492,10 @@ def _condition_number(q):
     t3538 = t3414*t3516 + t3418*t3520 + t3422*t3524 + t3426*t3528 + t3430*t3532 + t3434*t3536
     t3539 = t3482*t3517 + t3486*t3521 + t3490*t3525 + t3494*t3529 + t3498*t3533 + t3502*t3537
     t3540 = (t3538 != 0)
-    t3541 = 0.5*(-t3512 + t3410)/casadi.if_else(t3540, t3538, 1)
+    t3541 = (-t3512 + t3410)/casadi.if_else(t3540, 2*t3538, 1)
     t3542 = casadi.fabs(t3541)
     t3543 = (t3542 >= 1)
-    t3544 = casadi.fabs(1/casadi.if_else(t3543, t3541, 1))
+    t3544 = 1/casadi.fabs(casadi.if_else(t3543, t3541, 1))
     t3545 = casadi.if_else(t3540, casadi.if_else((t3541 >= 0), 1, -1)*casadi.if_else(t3543, t3544/(1 + casadi.sqrt(1 + t3544**2)), 1/(t3542 + casadi.sqrt(1 + t3542**2))), 0)
     t3546 = 1/casadi.sqrt(1 + t3545**2)
     t3547 = t3538*t3545
@@ -7527,10 +7527,10 @@ def _condition_number(q):
     t3573 = t3571 + t3545*t3570
     t3574 = t3447*t3552 + t3451*t3556 + t3455*t3560 + t3459*t3564 + t3463*t3568 + t3467*t3572
     t3575 = (t3574 != 0)
-    t3576 = 0.5*(-t3548 + t3443)/casadi.if_else(t3575, t3574, 1)
+    t3576 = (-t3548 + t3443)/casadi.if_else(t3575, 2*t3574, 1)
     t3577 = casadi.fabs(t3576)
     t3578 = (t3577 >= 1)
-    t3579 = casadi.fabs(1/casadi.if_else(t3578, t3576, 1))
+    t3579 = 1/casadi.fabs(casadi.if_else(t3578, t3576, 1))
     t3580 = casadi.if_else(t3575, casadi.if_else((t3576 >= 0), 1, -1)*casadi.if_else(t3578, t3579/(1 + casadi.sqrt(1 + t3579**2)), 1/(t3577 + casadi.sqrt(1 + t3577**2))), 0)
     t3581 = 1/casadi.sqrt(1 + t3580**2)
     t3582 = t3443 + t3574*t3580
@@ -7562,10 +7562,10 @@ def _condition_number(q):
     t3608 = casadi.if_else((t3607 > t3468), t3607, t3468)
     t3609 = casadi.if_else((t3607 < t3468), t3607, t3468)
     t3610 = (t3539 != 0)
-    t3611 = 0.5*(-t3478 + t3513)/casadi.if_else(t3610, t3539, 1)
+    t3611 = (-t3478 + t3513)/casadi.if_else(t3610, 2*t3539, 1)
     t3612 = casadi.fabs(t3611)
     t3613 = (t3612 >= 1)
-    t3614 = casadi.fabs(1/casadi.if_else(t3613, t3611, 1))
+    t3614 = 1/casadi.fabs(casadi.if_else(t3613, t3611, 1))
     t3615 = casadi.if_else(t3610, casadi.if_else((t3611 >= 0), 1, -1)*casadi.if_else(t3613, t3614/(1 + casadi.sqrt(1 + t3614**2)), 1/(t3612 + casadi.sqrt(1 + t3612**2))), 0)
     t3616 = 1/casadi.sqrt(1 + t3615**2)
     t3617 = t3539*t3615
@@ -7597,10 +7597,10 @@ def _condition_number(q):
     t3643 = t3641 + t3615*t3640
     t3644 = t3553*t3622 + t3557*t3626 + t3561*t3630 + t3565*t3634 + t3569*t3638 + t3573*t3642
     t3645 = (t3644 != 0)
-    t3646 = 0.5*(-t3618 + t3549)/casadi.if_else(t3645, t3644, 1)
+    t3646 = (-t3618 + t3549)/casadi.if_else(t3645, 2*t3644, 1)
     t3647 = casadi.fabs(t3646)
     t3648 = (t3647 >= 1)
-    t3649 = casadi.fabs(1/casadi.if_else(t3648, t3646, 1))
+    t3649 = 1/casadi.fabs(casadi.if_else(t3648, t3646, 1))
     t3650 = casadi.if_else(t3645, casadi.if_else((t3646 >= 0), 1, -1)*casadi.if_else(t3648, t3649/(1 + casadi.sqrt(1 + t3649**2)), 1/(t3647 + casadi.sqrt(1 + t3647**2))), 0)
     t3651 = 1/casadi.sqrt(1 + t3650**2)
     t3652 = t3644*t3650
@@ -7633,10 +7633,10 @@ def _condition_number(q):
     t3679 = t3586*t3657 + t3590*t3661 + t3594*t3665 + t3598*t3669 + t3602*t3673 + t3606*t3677
     t3680 = t3623*t3658 + t3627*t3662 + t3631*t3666 + t3635*t3670 + t3639*t3674 + t3643*t3678
     t3681 = (t3679 != 0)
-    t3682 = 0.5*(-t3653 + t3582)/casadi.if_else(t3681, t3679, 1)
+    t3682 = (-t3653 + t3582)/casadi.if_else(t3681, 2*t3679, 1)
     t3683 = casadi.fabs(t3682)
     t3684 = (t3683 >= 1)
-    t3685 = casadi.fabs(1/casadi.if_else(t3684, t3682, 1))
+    t3685 = 1/casadi.fabs(casadi.if_else(t3684, t3682, 1))
     t3686 = casadi.if_else(t3681, casadi.if_else((t3682 >= 0), 1, -1)*casadi.if_else(t3684, t3685/(1 + casadi.sqrt(1 + t3685**2)), 1/(t3683 + casadi.sqrt(1 + t3683**2))), 0)
     t3687 = 1/casadi.sqrt(1 + t3686**2)
     t3688 = t3582 + t3679*t3686
@@ -7668,10 +7668,10 @@ def _condition_number(q):
     t3714 = casadi.if_else((t3713 > t3608), t3713, t3608)
     t3715 = casadi.if_else((t3713 < t3609), t3713, t3609)
     t3716 = (t3680 != 0)
-    t3717 = 0.5*(-t3619 + t3654)/casadi.if_else(t3716, t3680, 1)
+    t3717 = (-t3619 + t3654)/casadi.if_else(t3716, 2*t3680, 1)
     t3718 = casadi.fabs(t3717)
     t3719 = (t3718 >= 1)
-    t3720 = casadi.fabs(1/casadi.if_else(t3719, t3717, 1))
+    t3720 = 1/casadi.fabs(casadi.if_else(t3719, t3717, 1))
     t3721 = casadi.if_else(t3716, casadi.if_else((t3717 >= 0), 1, -1)*casadi.if_else(t3719, t3720/(1 + casadi.sqrt(1 + t3720**2)), 1/(t3718 + casadi.sqrt(1 + t3718**2))), 0)
     t3722 = 1/casadi.sqrt(1 + t3721**2)
     t3723 = t3680*t3721
@@ -7703,10 +7703,10 @@ def _condition_number(q):
     t3749 = t3747 + t3721*t3746
     t3750 = t3692*t3728 + t3696*t3732 + t3700*t3736 + t3704*t3740 + t3708*t3744 + t3712*t3748
     t3751 = (t3750 != 0)
-    t3752 = 0.5*(-t3724 + t3688)/casadi.if_else(t3751, t3750, 1)
+    t3752 = (-t3724 + t3688)/casadi.if_else(t3751, 2*t3750, 1)
     t3753 = casadi.fabs(t3752)
     t3754 = (t3753 >= 1)
-    t3755 = casadi.fabs(1/casadi.if_else(t3754, t3752, 1))
+    t3755 = 1/casadi.fabs(casadi.if_else(t3754, t3752, 1))
     t3756 = casadi.if_else(t3751, casadi.if_else((t3752 >= 0), 1, -1)*casadi.if_else(t3754, t3755/(1 + casadi.sqrt(1 + t3755**2)), 1/(t3753 + casadi.sqrt(1 + t3753**2))), 0)
     t3757 = 1/casadi.sqrt(1 + t3756**2)
     t3758 = t3688 + t3750*t3756
@@ -7739,10 +7739,10 @@ def _condition_number(q):
     t3785 = casadi.if_else((t3784 > t3714), t3784, t3714)
     t3786 = casadi.if_else((t3784 < t3715), t3784, t3715)
     t3787 = (t3783 != 0)
-    t3788 = 0.5*(-t3725 + t3758)/casadi.if_else(t3787, t3783, 1)
+    t3788 = (-t3725 + t3758)/casadi.if_else(t3787, 2*t3783, 1)
     t3789 = casadi.fabs(t3788)
     t3790 = (t3789 >= 1)
-    t3791 = casadi.fabs(1/casadi.if_else(t3790, t3788, 1))
+    t3791 = 1/casadi.fabs(casadi.if_else(t3790, t3788, 1))
     t3792 = casadi.if_else(t3787, casadi.if_else((t3788 >= 0), 1, -1)*casadi.if_else(t3790, t3791/(1 + casadi.sqrt(1 + t3791**2)), 1/(t3789 + casadi.sqrt(1 + t3789**2))), 0)
     t3793 = 1/casadi.sqrt(1 + t3792**2)
     t3794 = t3729*t3793
@@ -7775,8 +7775,10 @@ def _condition_number(q):
     t3821 = casadi.if_else((t3818 < t3786), t3818, t3786)
     t3822 = casadi.if_else((t3819 > t3820), t3819, t3820)
     t3823 = casadi.if_else((t3819 < t3821), t3819, t3821)
+    t3824 = casadi.if_else((t3823 <= 1e-12*t3822), 0, t3823)
+    t3825 = casadi.if_else((t3822 > 0), t3822, 1)
     kappa = casadi.SX(1, 1)
-    kappa[0, 0] = casadi.if_else((t3822 > 0), t3822, 1)/casadi.if_else((t3823 <= 1e-12*t3822), 0, t3823)
+    kappa[0, 0] = t3825/t3824
     return [kappa]
 
 

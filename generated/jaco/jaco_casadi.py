@@ -2618,10 +2618,10 @@ def _velocity_ellipsoid(q):
     t95 = t94**2
     t96 = t61*t67
     t97 = (t96 != 0)
-    t98 = 0.5*(-t64 + t78)/casadi.if_else(t97, t96, 1)
+    t98 = (-t64 + t78)/casadi.if_else(t97, 2*t96, 1)
     t99 = casadi.fabs(t98)
     t100 = (t99 >= 1)
-    t101 = casadi.fabs(1/casadi.if_else(t100, t98, 1))
+    t101 = 1/casadi.fabs(casadi.if_else(t100, t98, 1))
     t102 = casadi.if_else(t97, casadi.if_else((t98 >= 0), 1, -1)*casadi.if_else(t100, t101/(1 + casadi.sqrt(1 + t101**2)), 1/(t99 + casadi.sqrt(1 + t99**2))), 0)
     t103 = 1/casadi.sqrt(1 + t102**2)
     t104 = t96*t102
@@ -2637,10 +2637,10 @@ def _velocity_ellipsoid(q):
     t114 = t113*t102
     t115 = -t111*t109 + t114*t88
     t116 = (t115 != 0)
-    t117 = 0.5*(-t105 + t112)/casadi.if_else(t116, t115, 1)
+    t117 = (-t105 + t112)/casadi.if_else(t116, 2*t115, 1)
     t118 = casadi.fabs(t117)
     t119 = (t118 >= 1)
-    t120 = casadi.fabs(1/casadi.if_else(t119, t117, 1))
+    t120 = 1/casadi.fabs(casadi.if_else(t119, t117, 1))
     t121 = casadi.if_else(t116, casadi.if_else((t117 >= 0), 1, -1)*casadi.if_else(t119, t120/(1 + casadi.sqrt(1 + t120**2)), 1/(t118 + casadi.sqrt(1 + t118**2))), 0)
     t122 = 1/casadi.sqrt(1 + t121**2)
     t123 = t115*t121
@@ -2656,10 +2656,10 @@ def _velocity_ellipsoid(q):
     t133 = t131 + t130*t121
     t134 = t110*t129 + t113*t133
     t135 = (t134 != 0)
-    t136 = 0.5*(-t106 + t125)/casadi.if_else(t135, -t134, 1)
+    t136 = (-t106 + t125)/casadi.if_else(t135, -2*t134, 1)
     t137 = casadi.fabs(t136)
     t138 = (t137 >= 1)
-    t139 = casadi.fabs(1/casadi.if_else(t138, t136, 1))
+    t139 = 1/casadi.fabs(casadi.if_else(t138, t136, 1))
     t140 = casadi.if_else(t135, casadi.if_else((t136 >= 0), 1, -1)*casadi.if_else(t138, t139/(1 + casadi.sqrt(1 + t139**2)), 1/(t137 + casadi.sqrt(1 + t137**2))), 0)
     t141 = 1/casadi.sqrt(1 + t140**2)
     t142 = t134*t140
@@ -2685,10 +2685,10 @@ def _velocity_ellipsoid(q):
     t162 = t140*t141
     t163 = t128*t147 + t132*t152 - t95*t156*t162*t122
     t164 = (t163 != 0)
-    t165 = 0.5*(-t124 + t143)/casadi.if_else(t164, -t163, 1)
+    t165 = (-t124 + t143)/casadi.if_else(t164, -2*t163, 1)
     t166 = casadi.fabs(t165)
     t167 = (t166 >= 1)
-    t168 = casadi.fabs(1/casadi.if_else(t167, t165, 1))
+    t168 = 1/casadi.fabs(casadi.if_else(t167, t165, 1))
     t169 = casadi.if_else(t164, casadi.if_else((t165 >= 0), 1, -1)*casadi.if_else(t167, t168/(1 + casadi.sqrt(1 + t168**2)), 1/(t166 + casadi.sqrt(1 + t166**2))), 0)
     t170 = 1/casadi.sqrt(1 + t169**2)
     t171 = t163*t169
@@ -2722,10 +2722,10 @@ def _velocity_ellipsoid(q):
     t199 = t122*t141
     t200 = t148*t176 + t153*t180 - t199*t94*t189
     t201 = (t200 != 0)
-    t202 = 0.5*(-t172 + t144)/casadi.if_else(t201, t200, 1)
+    t202 = (-t172 + t144)/casadi.if_else(t201, 2*t200, 1)
     t203 = casadi.fabs(t202)
     t204 = (t203 >= 1)
-    t205 = casadi.fabs(1/casadi.if_else(t204, t202, 1))
+    t205 = 1/casadi.fabs(casadi.if_else(t204, t202, 1))
     t206 = casadi.if_else(t201, casadi.if_else((t202 >= 0), 1, -1)*casadi.if_else(t204, t205/(1 + casadi.sqrt(1 + t205**2)), 1/(t203 + casadi.sqrt(1 + t203**2))), 0)
     t207 = 1/casadi.sqrt(1 + t206**2)
     t208 = t200*t206
@@ -2757,10 +2757,10 @@ def _velocity_ellipsoid(q):
     t234 = t233 - t220*t206
     t235 = t220 + t233*t206
     t236 = (t224 != 0)
-    t237 = 0.5*(-t173 + t210)/casadi.if_else(t236, t224, 1)
+    t237 = (-t173 + t210)/casadi.if_else(t236, 2*t224, 1)
     t238 = casadi.fabs(t237)
     t239 = (t238 >= 1)
-    t240 = casadi.fabs(1/casadi.if_else(t239, t237, 1))
+    t240 = 1/casadi.fabs(casadi.if_else(t239, t237, 1))
     t241 = casadi.if_else(t236, casadi.if_else((t237 >= 0), 1, -1)*casadi.if_else(t239, t240/(1 + casadi.sqrt(1 + t240**2)), 1/(t238 + casadi.sqrt(1 + t238**2))), 0)
     t242 = 1/casadi.sqrt(1 + t241**2)
     t243 = t224*t241
@@ -2792,10 +2792,10 @@ def _velocity_ellipsoid(q):
     t269 = t267 + t268*t241
     t270 = t268 - t267*t241
     t271 = (t258 != 0)
-    t272 = 0.5*(-t209 + t244)/casadi.if_else(t271, t258, 1)
+    t272 = (-t209 + t244)/casadi.if_else(t271, 2*t258, 1)
     t273 = casadi.fabs(t272)
     t274 = (t273 >= 1)
-    t275 = casadi.fabs(1/casadi.if_else(t274, t272, 1))
+    t275 = 1/casadi.fabs(casadi.if_else(t274, t272, 1))
     t276 = casadi.if_else(t271, casadi.if_else((t272 >= 0), 1, -1)*casadi.if_else(t274, t275/(1 + casadi.sqrt(1 + t275**2)), 1/(t273 + casadi.sqrt(1 + t273**2))), 0)
     t277 = 1/casadi.sqrt(1 + t276**2)
     t278 = t258*t276
@@ -2827,10 +2827,10 @@ def _velocity_ellipsoid(q):
     t304 = t302 + t303*t276
     t305 = -t303 + t302*t276
     t306 = (t293 != 0)
-    t307 = 0.5*(-t279 + t245)/casadi.if_else(t306, t293, 1)
+    t307 = (-t279 + t245)/casadi.if_else(t306, 2*t293, 1)
     t308 = casadi.fabs(t307)
     t309 = (t308 >= 1)
-    t310 = casadi.fabs(1/casadi.if_else(t309, t307, 1))
+    t310 = 1/casadi.fabs(casadi.if_else(t309, t307, 1))
     t311 = casadi.if_else(t306, casadi.if_else((t307 >= 0), 1, -1)*casadi.if_else(t309, t310/(1 + casadi.sqrt(1 + t310**2)), 1/(t308 + casadi.sqrt(1 + t308**2))), 0)
     t312 = 1/casadi.sqrt(1 + t311**2)
     t313 = t293*t311
@@ -2862,10 +2862,10 @@ def _velocity_ellipsoid(q):
     t339 = t337 - t338*t311
     t340 = t338 + t337*t311
     t341 = (t328 != 0)
-    t342 = 0.5*(-t280 + t315)/casadi.if_else(t341, t328, 1)
+    t342 = (-t280 + t315)/casadi.if_else(t341, 2*t328, 1)
     t343 = casadi.fabs(t342)
     t344 = (t343 >= 1)
-    t345 = casadi.fabs(1/casadi.if_else(t344, t342, 1))
+    t345 = 1/casadi.fabs(casadi.if_else(t344, t342, 1))
     t346 = casadi.if_else(t341, casadi.if_else((t342 >= 0), 1, -1)*casadi.if_else(t344, t345/(1 + casadi.sqrt(1 + t345**2)), 1/(t343 + casadi.sqrt(1 + t343**2))), 0)
     t347 = 1/casadi.sqrt(1 + t346**2)
     t348 = t328*t346
@@ -2897,10 +2897,10 @@ def _velocity_ellipsoid(q):
     t374 = t372 - t373*t346
     t375 = t373 + t372*t346
     t376 = (t363 != 0)
-    t377 = 0.5*(-t314 + t349)/casadi.if_else(t376, t363, 1)
+    t377 = (-t314 + t349)/casadi.if_else(t376, 2*t363, 1)
     t378 = casadi.fabs(t377)
     t379 = (t378 >= 1)
-    t380 = casadi.fabs(1/casadi.if_else(t379, t377, 1))
+    t380 = 1/casadi.fabs(casadi.if_else(t379, t377, 1))
     t381 = casadi.if_else(t376, casadi.if_else((t377 >= 0), 1, -1)*casadi.if_else(t379, t380/(1 + casadi.sqrt(1 + t380**2)), 1/(t378 + casadi.sqrt(1 + t378**2))), 0)
     t382 = 1/casadi.sqrt(1 + t381**2)
     t383 = t363*t381
@@ -2932,10 +2932,10 @@ def _velocity_ellipsoid(q):
     t409 = t407 - t408*t381
     t410 = t408 + t407*t381
     t411 = (t398 != 0)
-    t412 = 0.5*(-t384 + t350)/casadi.if_else(t411, t398, 1)
+    t412 = (-t384 + t350)/casadi.if_else(t411, 2*t398, 1)
     t413 = casadi.fabs(t412)
     t414 = (t413 >= 1)
-    t415 = casadi.fabs(1/casadi.if_else(t414, t412, 1))
+    t415 = 1/casadi.fabs(casadi.if_else(t414, t412, 1))
     t416 = casadi.if_else(t411, casadi.if_else((t412 >= 0), 1, -1)*casadi.if_else(t414, t415/(1 + casadi.sqrt(1 + t415**2)), 1/(t413 + casadi.sqrt(1 + t413**2))), 0)
     t417 = 1/casadi.sqrt(1 + t416**2)
     t418 = t398*t416
@@ -2967,10 +2967,10 @@ def _velocity_ellipsoid(q):
     t444 = t442 - t416*t443
     t445 = t443 + t416*t442
     t446 = (t433 != 0)
-    t447 = 0.5*(-t385 + t420)/casadi.if_else(t446, t433, 1)
+    t447 = (-t385 + t420)/casadi.if_else(t446, 2*t433, 1)
     t448 = casadi.fabs(t447)
     t449 = (t448 >= 1)
-    t450 = casadi.fabs(1/casadi.if_else(t449, t447, 1))
+    t450 = 1/casadi.fabs(casadi.if_else(t449, t447, 1))
     t451 = casadi.if_else(t446, casadi.if_else((t447 >= 0), 1, -1)*casadi.if_else(t449, t450/(1 + casadi.sqrt(1 + t450**2)), 1/(t448 + casadi.sqrt(1 + t448**2))), 0)
     t452 = 1/casadi.sqrt(1 + t451**2)
     t453 = t433*t451
@@ -3002,10 +3002,10 @@ def _velocity_ellipsoid(q):
     t479 = t477 - t451*t478
     t480 = t478 + t451*t477
     t481 = (t468 != 0)
-    t482 = 0.5*(-t419 + t454)/casadi.if_else(t481, t468, 1)
+    t482 = (-t419 + t454)/casadi.if_else(t481, 2*t468, 1)
     t483 = casadi.fabs(t482)
     t484 = (t483 >= 1)
-    t485 = casadi.fabs(1/casadi.if_else(t484, t482, 1))
+    t485 = 1/casadi.fabs(casadi.if_else(t484, t482, 1))
     t486 = casadi.if_else(t481, casadi.if_else((t482 >= 0), 1, -1)*casadi.if_else(t484, t485/(1 + casadi.sqrt(1 + t485**2)), 1/(t483 + casadi.sqrt(1 + t483**2))), 0)
     t487 = 1/casadi.sqrt(1 + t486**2)
     t488 = t468*t486
@@ -3037,10 +3037,10 @@ def _velocity_ellipsoid(q):
     t514 = t512 - t486*t513
     t515 = t513 + t486*t512
     t516 = (t503 != 0)
-    t517 = 0.5*(-t489 + t455)/casadi.if_else(t516, t503, 1)
+    t517 = (-t489 + t455)/casadi.if_else(t516, 2*t503, 1)
     t518 = casadi.fabs(t517)
     t519 = (t518 >= 1)
-    t520 = casadi.fabs(1/casadi.if_else(t519, t517, 1))
+    t520 = 1/casadi.fabs(casadi.if_else(t519, t517, 1))
     t521 = casadi.if_else(t516, casadi.if_else((t517 >= 0), 1, -1)*casadi.if_else(t519, t520/(1 + casadi.sqrt(1 + t520**2)), 1/(t518 + casadi.sqrt(1 + t518**2))), 0)
     t522 = 1/casadi.sqrt(1 + t521**2)
     t523 = t455 + t503*t521
@@ -3071,10 +3071,10 @@ def _velocity_ellipsoid(q):
     t548 = t546 - t521*t547
     t549 = t547 + t521*t546
     t550 = (t536 != 0)
-    t551 = 0.5*(-t490 + t523)/casadi.if_else(t550, t536, 1)
+    t551 = (-t490 + t523)/casadi.if_else(t550, 2*t536, 1)
     t552 = casadi.fabs(t551)
     t553 = (t552 >= 1)
-    t554 = casadi.fabs(1/casadi.if_else(t553, t551, 1))
+    t554 = 1/casadi.fabs(casadi.if_else(t553, t551, 1))
     t555 = casadi.if_else(t550, casadi.if_else((t551 >= 0), 1, -1)*casadi.if_else(t553, t554/(1 + casadi.sqrt(1 + t554**2)), 1/(t552 + casadi.sqrt(1 + t552**2))), 0)
     t556 = 1/casadi.sqrt(1 + t555**2)
     t557 = t494*t556
@@ -3166,10 +3166,10 @@ def _velocity_ellipsoid(q):
     t643 = t642**2
     t644 = t624**2 + t636**2 + t643
     t645 = (t633 != 0)
-    t646 = 0.5*(-t616 + t632)/casadi.if_else(t645, t633, 1)
+    t646 = (-t616 + t632)/casadi.if_else(t645, 2*t633, 1)
     t647 = casadi.fabs(t646)
     t648 = (t647 >= 1)
-    t649 = casadi.fabs(1/casadi.if_else(t648, t646, 1))
+    t649 = 1/casadi.fabs(casadi.if_else(t648, t646, 1))
     t650 = casadi.if_else(t645, casadi.if_else((t646 >= 0), 1, -1)*casadi.if_else(t648, t649/(1 + casadi.sqrt(1 + t649**2)), 1/(t647 + casadi.sqrt(1 + t647**2))), 0)
     t651 = 1/casadi.sqrt(1 + t650**2)
     t652 = t633*t650
@@ -3183,10 +3183,10 @@ def _velocity_ellipsoid(q):
     t660 = t650*t659
     t661 = -t624*t657 + t636*t660
     t662 = (t661 != 0)
-    t663 = 0.5*(-t653 + t644)/casadi.if_else(t662, t661, 1)
+    t663 = (-t653 + t644)/casadi.if_else(t662, 2*t661, 1)
     t664 = casadi.fabs(t663)
     t665 = (t664 >= 1)
-    t666 = casadi.fabs(1/casadi.if_else(t665, t663, 1))
+    t666 = 1/casadi.fabs(casadi.if_else(t665, t663, 1))
     t667 = casadi.if_else(t662, casadi.if_else((t663 >= 0), 1, -1)*casadi.if_else(t665, t666/(1 + casadi.sqrt(1 + t666**2)), 1/(t664 + casadi.sqrt(1 + t664**2))), 0)
     t668 = 1/casadi.sqrt(1 + t667**2)
     t669 = t661*t667
@@ -3202,10 +3202,10 @@ def _velocity_ellipsoid(q):
     t679 = t677 + t667*t676
     t680 = t658*t675 + t679*t659
     t681 = (t680 != 0)
-    t682 = 0.5*(-t654 + t671)/casadi.if_else(t681, -t680, 1)
+    t682 = (-t654 + t671)/casadi.if_else(t681, -2*t680, 1)
     t683 = casadi.fabs(t682)
     t684 = (t683 >= 1)
-    t685 = casadi.fabs(1/casadi.if_else(t684, t682, 1))
+    t685 = 1/casadi.fabs(casadi.if_else(t684, t682, 1))
     t686 = casadi.if_else(t681, casadi.if_else((t682 >= 0), 1, -1)*casadi.if_else(t684, t685/(1 + casadi.sqrt(1 + t685**2)), 1/(t683 + casadi.sqrt(1 + t683**2))), 0)
     t687 = 1/casadi.sqrt(1 + t686**2)
     t688 = t680*t686
@@ -3231,10 +3231,10 @@ def _velocity_ellipsoid(q):
     t708 = t686*t687
     t709 = t674*t693 + t678*t698 - t668*t643*t702*t708
     t710 = (t709 != 0)
-    t711 = 0.5*(-t670 + t689)/casadi.if_else(t710, -t709, 1)
+    t711 = (-t670 + t689)/casadi.if_else(t710, -2*t709, 1)
     t712 = casadi.fabs(t711)
     t713 = (t712 >= 1)
-    t714 = casadi.fabs(1/casadi.if_else(t713, t711, 1))
+    t714 = 1/casadi.fabs(casadi.if_else(t713, t711, 1))
     t715 = casadi.if_else(t710, casadi.if_else((t711 >= 0), 1, -1)*casadi.if_else(t713, t714/(1 + casadi.sqrt(1 + t714**2)), 1/(t712 + casadi.sqrt(1 + t712**2))), 0)
     t716 = 1/casadi.sqrt(1 + t715**2)
     t717 = t709*t715
@@ -3268,10 +3268,10 @@ def _velocity_ellipsoid(q):
     t745 = t668*t687
     t746 = t694*t722 + t699*t726 - t642*t735*t745
     t747 = (t746 != 0)
-    t748 = 0.5*(-t718 + t690)/casadi.if_else(t747, t746, 1)
+    t748 = (-t718 + t690)/casadi.if_else(t747, 2*t746, 1)
     t749 = casadi.fabs(t748)
     t750 = (t749 >= 1)
-    t751 = casadi.fabs(1/casadi.if_else(t750, t748, 1))
+    t751 = 1/casadi.fabs(casadi.if_else(t750, t748, 1))
     t752 = casadi.if_else(t747, casadi.if_else((t748 >= 0), 1, -1)*casadi.if_else(t750, t751/(1 + casadi.sqrt(1 + t751**2)), 1/(t749 + casadi.sqrt(1 + t749**2))), 0)
     t753 = 1/casadi.sqrt(1 + t752**2)
     t754 = t746*t752
@@ -3303,10 +3303,10 @@ def _velocity_ellipsoid(q):
     t780 = t779 - t752*t766
     t781 = t766 + t752*t779
     t782 = (t770 != 0)
-    t783 = 0.5*(-t719 + t756)/casadi.if_else(t782, t770, 1)
+    t783 = (-t719 + t756)/casadi.if_else(t782, 2*t770, 1)
     t784 = casadi.fabs(t783)
     t785 = (t784 >= 1)
-    t786 = casadi.fabs(1/casadi.if_else(t785, t783, 1))
+    t786 = 1/casadi.fabs(casadi.if_else(t785, t783, 1))
     t787 = casadi.if_else(t782, casadi.if_else((t783 >= 0), 1, -1)*casadi.if_else(t785, t786/(1 + casadi.sqrt(1 + t786**2)), 1/(t784 + casadi.sqrt(1 + t784**2))), 0)
     t788 = 1/casadi.sqrt(1 + t787**2)
     t789 = t770*t787
@@ -3338,10 +3338,10 @@ def _velocity_ellipsoid(q):
     t815 = t813 + t787*t814
     t816 = t814 - t787*t813
     t817 = (t804 != 0)
-    t818 = 0.5*(-t755 + t790)/casadi.if_else(t817, t804, 1)
+    t818 = (-t755 + t790)/casadi.if_else(t817, 2*t804, 1)
     t819 = casadi.fabs(t818)
     t820 = (t819 >= 1)
-    t821 = casadi.fabs(1/casadi.if_else(t820, t818, 1))
+    t821 = 1/casadi.fabs(casadi.if_else(t820, t818, 1))
     t822 = casadi.if_else(t817, casadi.if_else((t818 >= 0), 1, -1)*casadi.if_else(t820, t821/(1 + casadi.sqrt(1 + t821**2)), 1/(t819 + casadi.sqrt(1 + t819**2))), 0)
     t823 = 1/casadi.sqrt(1 + t822**2)
     t824 = t804*t822
@@ -3373,10 +3373,10 @@ def _velocity_ellipsoid(q):
     t850 = t848 + t822*t849
     t851 = -t849 + t822*t848
     t852 = (t839 != 0)
-    t853 = 0.5*(-t825 + t791)/casadi.if_else(t852, t839, 1)
+    t853 = (-t825 + t791)/casadi.if_else(t852, 2*t839, 1)
     t854 = casadi.fabs(t853)
     t855 = (t854 >= 1)
-    t856 = casadi.fabs(1/casadi.if_else(t855, t853, 1))
+    t856 = 1/casadi.fabs(casadi.if_else(t855, t853, 1))
     t857 = casadi.if_else(t852, casadi.if_else((t853 >= 0), 1, -1)*casadi.if_else(t855, t856/(1 + casadi.sqrt(1 + t856**2)), 1/(t854 + casadi.sqrt(1 + t854**2))), 0)
     t858 = 1/casadi.sqrt(1 + t857**2)
     t859 = t839*t857
@@ -3408,10 +3408,10 @@ def _velocity_ellipsoid(q):
     t885 = t883 - t857*t884
     t886 = t884 + t857*t883
     t887 = (t874 != 0)
-    t888 = 0.5*(-t826 + t861)/casadi.if_else(t887, t874, 1)
+    t888 = (-t826 + t861)/casadi.if_else(t887, 2*t874, 1)
     t889 = casadi.fabs(t888)
     t890 = (t889 >= 1)
-    t891 = casadi.fabs(1/casadi.if_else(t890, t888, 1))
+    t891 = 1/casadi.fabs(casadi.if_else(t890, t888, 1))
     t892 = casadi.if_else(t887, casadi.if_else((t888 >= 0), 1, -1)*casadi.if_else(t890, t891/(1 + casadi.sqrt(1 + t891**2)), 1/(t889 + casadi.sqrt(1 + t889**2))), 0)
     t893 = 1/casadi.sqrt(1 + t892**2)
     t894 = t874*t892
@@ -3443,10 +3443,10 @@ def _velocity_ellipsoid(q):
     t920 = t918 - t892*t919
     t921 = t919 + t892*t918
     t922 = (t909 != 0)
-    t923 = 0.5*(-t860 + t895)/casadi.if_else(t922, t909, 1)
+    t923 = (-t860 + t895)/casadi.if_else(t922, 2*t909, 1)
     t924 = casadi.fabs(t923)
     t925 = (t924 >= 1)
-    t926 = casadi.fabs(1/casadi.if_else(t925, t923, 1))
+    t926 = 1/casadi.fabs(casadi.if_else(t925, t923, 1))
     t927 = casadi.if_else(t922, casadi.if_else((t923 >= 0), 1, -1)*casadi.if_else(t925, t926/(1 + casadi.sqrt(1 + t926**2)), 1/(t924 + casadi.sqrt(1 + t924**2))), 0)
     t928 = 1/casadi.sqrt(1 + t927**2)
     t929 = t909*t927
@@ -3478,10 +3478,10 @@ def _velocity_ellipsoid(q):
     t955 = t953 - t927*t954
     t956 = t954 + t927*t953
     t957 = (t944 != 0)
-    t958 = 0.5*(-t930 + t896)/casadi.if_else(t957, t944, 1)
+    t958 = (-t930 + t896)/casadi.if_else(t957, 2*t944, 1)
     t959 = casadi.fabs(t958)
     t960 = (t959 >= 1)
-    t961 = casadi.fabs(1/casadi.if_else(t960, t958, 1))
+    t961 = 1/casadi.fabs(casadi.if_else(t960, t958, 1))
     t962 = casadi.if_else(t957, casadi.if_else((t958 >= 0), 1, -1)*casadi.if_else(t960, t961/(1 + casadi.sqrt(1 + t961**2)), 1/(t959 + casadi.sqrt(1 + t959**2))), 0)
     t963 = 1/casadi.sqrt(1 + t962**2)
     t964 = t944*t962
@@ -3513,10 +3513,10 @@ def _velocity_ellipsoid(q):
     t990 = t988 - t962*t989
     t991 = t989 + t962*t988
     t992 = (t979 != 0)
-    t993 = 0.5*(-t931 + t966)/casadi.if_else(t992, t979, 1)
+    t993 = (-t931 + t966)/casadi.if_else(t992, 2*t979, 1)
     t994 = casadi.fabs(t993)
     t995 = (t994 >= 1)
-    t996 = casadi.fabs(1/casadi.if_else(t995, t993, 1))
+    t996 = 1/casadi.fabs(casadi.if_else(t995, t993, 1))
     t997 = casadi.if_else(t992, casadi.if_else((t993 >= 0), 1, -1)*casadi.if_else(t995, t996/(1 + casadi.sqrt(1 + t996**2)), 1/(t994 + casadi.sqrt(1 + t994**2))), 0)
     t998 = 1/casadi.sqrt(1 + t997**2)
     t999 = t979*t997
@@ -3548,10 +3548,10 @@ def _velocity_ellipsoid(q):
     t1025 = t1023 - t997*t1024
     t1026 = t1024 + t997*t1023
     t1027 = (t1014 != 0)
-    t1028 = 0.5*(-t965 + t1000)/casadi.if_else(t1027, t1014, 1)
+    t1028 = (-t965 + t1000)/casadi.if_else(t1027, 2*t1014, 1)
     t1029 = casadi.fabs(t1028)
     t1030 = (t1029 >= 1)
-    t1031 = casadi.fabs(1/casadi.if_else(t1030, t1028, 1))
+    t1031 = 1/casadi.fabs(casadi.if_else(t1030, t1028, 1))
     t1032 = casadi.if_else(t1027, casadi.if_else((t1028 >= 0), 1, -1)*casadi.if_else(t1030, t1031/(1 + casadi.sqrt(1 + t1031**2)), 1/(t1029 + casadi.sqrt(1 + t1029**2))), 0)
     t1033 = 1/casadi.sqrt(1 + t1032**2)
     t1034 = t1014*t1032
@@ -3583,10 +3583,10 @@ def _velocity_ellipsoid(q):
     t1060 = t1058 - t1032*t1059
     t1061 = t1059 + t1032*t1058
     t1062 = (t1049 != 0)
-    t1063 = 0.5*(-t1035 + t1001)/casadi.if_else(t1062, t1049, 1)
+    t1063 = (-t1035 + t1001)/casadi.if_else(t1062, 2*t1049, 1)
     t1064 = casadi.fabs(t1063)
     t1065 = (t1064 >= 1)
-    t1066 = casadi.fabs(1/casadi.if_else(t1065, t1063, 1))
+    t1066 = 1/casadi.fabs(casadi.if_else(t1065, t1063, 1))
     t1067 = casadi.if_else(t1062, casadi.if_else((t1063 >= 0), 1, -1)*casadi.if_else(t1065, t1066/(1 + casadi.sqrt(1 + t1066**2)), 1/(t1064 + casadi.sqrt(1 + t1064**2))), 0)
     t1068 = 1/casadi.sqrt(1 + t1067**2)
     t1069 = t1001 + t1049*t1067
@@ -3617,10 +3617,10 @@ def _velocity_ellipsoid(q):
     t1094 = t1092 - t1067*t1093
     t1095 = t1093 + t1067*t1092
     t1096 = (t1082 != 0)
-    t1097 = 0.5*(-t1036 + t1069)/casadi.if_else(t1096, t1082, 1)
+    t1097 = (-t1036 + t1069)/casadi.if_else(t1096, 2*t1082, 1)
     t1098 = casadi.fabs(t1097)
     t1099 = (t1098 >= 1)
-    t1100 = casadi.fabs(1/casadi.if_else(t1099, t1097, 1))
+    t1100 = 1/casadi.fabs(casadi.if_else(t1099, t1097, 1))
     t1101 = casadi.if_else(t1096, casadi.if_else((t1097 >= 0), 1, -1)*casadi.if_else(t1099, t1100/(1 + casadi.sqrt(1 + t1100**2)), 1/(t1098 + casadi.sqrt(1 + t1098**2))), 0)
     t1102 = 1/casadi.sqrt(1 + t1101**2)
     t1103 = t1040*t1102
@@ -3915,10 +3915,10 @@ def _condition_number(q):
     t182 = t63*t69
     t183 = t74*t153 - t81*t91 + t180*t107 + t181*t113 + t182*t119
     t184 = (t183 != 0)
-    t185 = 0.5*(-t179 + t172)/casadi.if_else(t184, -t183, 1)
+    t185 = (-t179 + t172)/casadi.if_else(t184, -2*t183, 1)
     t186 = casadi.fabs(t185)
     t187 = (t186 >= 1)
-    t188 = casadi.fabs(1/casadi.if_else(t187, t185, 1))
+    t188 = 1/casadi.fabs(casadi.if_else(t187, t185, 1))
     t189 = casadi.if_else(t184, casadi.if_else((t185 >= 0), 1, -1)*casadi.if_else(t187, t188/(1 + casadi.sqrt(1 + t188**2)), 1/(t186 + casadi.sqrt(1 + t186**2))), 0)
     t190 = 1/casadi.sqrt(1 + t189**2)
     t191 = t183*t189
@@ -3946,10 +3946,10 @@ def _condition_number(q):
     t213 = t211 - t210*t189
     t214 = t129*t204 + t134*t208 + t159*t212 - t125*t200
     t215 = (t214 != 0)
-    t216 = 0.5*(-t192 + t173)/casadi.if_else(t215, -t214, 1)
+    t216 = (-t192 + t173)/casadi.if_else(t215, -2*t214, 1)
     t217 = casadi.fabs(t216)
     t218 = (t217 >= 1)
-    t219 = casadi.fabs(1/casadi.if_else(t218, t216, 1))
+    t219 = 1/casadi.fabs(casadi.if_else(t218, t216, 1))
     t220 = casadi.if_else(t215, casadi.if_else((t216 >= 0), 1, -1)*casadi.if_else(t218, t219/(1 + casadi.sqrt(1 + t219**2)), 1/(t217 + casadi.sqrt(1 + t217**2))), 0)
     t221 = 1/casadi.sqrt(1 + t220**2)
     t222 = t214*t220
@@ -3973,10 +3973,10 @@ def _condition_number(q):
     t240 = t238 - t237*t220
     t241 = t139*t231 + t143*t235 - t164*t239
     t242 = (t241 != 0)
-    t243 = 0.5*(-t223 + t174)/casadi.if_else(t242, t241, 1)
+    t243 = (-t223 + t174)/casadi.if_else(t242, 2*t241, 1)
     t244 = casadi.fabs(t243)
     t245 = (t244 >= 1)
-    t246 = casadi.fabs(1/casadi.if_else(t245, t243, 1))
+    t246 = 1/casadi.fabs(casadi.if_else(t245, t243, 1))
     t247 = casadi.if_else(t242, casadi.if_else((t243 >= 0), 1, -1)*casadi.if_else(t245, t246/(1 + casadi.sqrt(1 + t246**2)), 1/(t244 + casadi.sqrt(1 + t244**2))), 0)
     t248 = 1/casadi.sqrt(1 + t247**2)
     t249 = t241*t247
@@ -3996,10 +3996,10 @@ def _condition_number(q):
     t263 = t261 - t260*t247
     t264 = t147*t258 + t168*t262
     t265 = (t264 != 0)
-    t266 = 0.5*(-t250 + t175)/casadi.if_else(t265, -t264, 1)
+    t266 = (-t250 + t175)/casadi.if_else(t265, -2*t264, 1)
     t267 = casadi.fabs(t266)
     t268 = (t267 >= 1)
-    t269 = casadi.fabs(1/casadi.if_else(t268, t266, 1))
+    t269 = 1/casadi.fabs(casadi.if_else(t268, t266, 1))
     t270 = casadi.if_else(t265, casadi.if_else((t266 >= 0), 1, -1)*casadi.if_else(t268, t269/(1 + casadi.sqrt(1 + t269**2)), 1/(t267 + casadi.sqrt(1 + t267**2))), 0)
     t271 = 1/casadi.sqrt(1 + t270**2)
     t272 = t264*t270
@@ -4015,10 +4015,10 @@ def _condition_number(q):
     t282 = t280 - t279*t270
     t283 = t171*t281
     t284 = (t283 != 0)
-    t285 = 0.5*(-t273 + t176)/casadi.if_else(t284, t283, 1)
+    t285 = (-t273 + t176)/casadi.if_else(t284, 2*t283, 1)
     t286 = casadi.fabs(t285)
     t287 = (t286 >= 1)
-    t288 = casadi.fabs(1/casadi.if_else(t287, t285, 1))
+    t288 = 1/casadi.fabs(casadi.if_else(t287, t285, 1))
     t289 = casadi.if_else(t284, casadi.if_else((t285 >= 0), 1, -1)*casadi.if_else(t287, t288/(1 + casadi.sqrt(1 + t288**2)), 1/(t286 + casadi.sqrt(1 + t286**2))), 0)
     t290 = 1/casadi.sqrt(1 + t289**2)
     t291 = t283*t289
@@ -4032,10 +4032,10 @@ def _condition_number(q):
     t299 = t298*t196
     t300 = -t201*t228 + t205*t232 + t209*t236 + t213*t240 + t177*t298*t189*t190**2 - t299*t197
     t301 = (t300 != 0)
-    t302 = 0.5*(-t193 + t224)/casadi.if_else(t301, t300, 1)
+    t302 = (-t193 + t224)/casadi.if_else(t301, 2*t300, 1)
     t303 = casadi.fabs(t302)
     t304 = (t303 >= 1)
-    t305 = casadi.fabs(1/casadi.if_else(t304, t302, 1))
+    t305 = 1/casadi.fabs(casadi.if_else(t304, t302, 1))
     t306 = casadi.if_else(t301, casadi.if_else((t302 >= 0), 1, -1)*casadi.if_else(t304, t305/(1 + casadi.sqrt(1 + t305**2)), 1/(t303 + casadi.sqrt(1 + t303**2))), 0)
     t307 = 1/casadi.sqrt(1 + t306**2)
     t308 = t300*t306
@@ -4074,10 +4074,10 @@ def _condition_number(q):
     t341 = t337*t227
     t342 = t255*t327 + t259*t331 - t263*t335 + t339*t315 + t340*t319 - t341*t323
     t343 = (t342 != 0)
-    t344 = 0.5*(-t309 + t251)/casadi.if_else(t343, -t342, 1)
+    t344 = (-t309 + t251)/casadi.if_else(t343, -2*t342, 1)
     t345 = casadi.fabs(t344)
     t346 = (t345 >= 1)
-    t347 = casadi.fabs(1/casadi.if_else(t346, t344, 1))
+    t347 = 1/casadi.fabs(casadi.if_else(t346, t344, 1))
     t348 = casadi.if_else(t343, casadi.if_else((t344 >= 0), 1, -1)*casadi.if_else(t346, t347/(1 + casadi.sqrt(1 + t347**2)), 1/(t345 + casadi.sqrt(1 + t345**2))), 0)
     t349 = 1/casadi.sqrt(1 + t348**2)
     t350 = t342*t348
@@ -4120,10 +4120,10 @@ def _condition_number(q):
     t387 = t386*t270
     t388 = t278*t371 + t282*t375 - t381*t355 - t383*t359 + t385*t363 + t387*t367
     t389 = (t388 != 0)
-    t390 = 0.5*(-t351 + t274)/casadi.if_else(t389, t388, 1)
+    t390 = (-t351 + t274)/casadi.if_else(t389, 2*t388, 1)
     t391 = casadi.fabs(t390)
     t392 = (t391 >= 1)
-    t393 = casadi.fabs(1/casadi.if_else(t392, t390, 1))
+    t393 = 1/casadi.fabs(casadi.if_else(t392, t390, 1))
     t394 = casadi.if_else(t389, casadi.if_else((t390 >= 0), 1, -1)*casadi.if_else(t392, t393/(1 + casadi.sqrt(1 + t393**2)), 1/(t391 + casadi.sqrt(1 + t391**2))), 0)
     t395 = 1/casadi.sqrt(1 + t394**2)
     t396 = t388*t394
@@ -4165,10 +4165,10 @@ def _condition_number(q):
     t432 = t431*t289
     t433 = -t297*t421 - t424*t401 - t426*t405 + t428*t409 + t430*t413 + t432*t417
     t434 = (t433 != 0)
-    t435 = 0.5*(-t397 + t293)/casadi.if_else(t434, t433, 1)
+    t435 = (-t397 + t293)/casadi.if_else(t434, 2*t433, 1)
     t436 = casadi.fabs(t435)
     t437 = (t436 >= 1)
-    t438 = casadi.fabs(1/casadi.if_else(t437, t435, 1))
+    t438 = 1/casadi.fabs(casadi.if_else(t437, t435, 1))
     t439 = casadi.if_else(t434, casadi.if_else((t435 >= 0), 1, -1)*casadi.if_else(t437, t438/(1 + casadi.sqrt(1 + t438**2)), 1/(t436 + casadi.sqrt(1 + t436**2))), 0)
     t440 = 1/casadi.sqrt(1 + t439**2)
     t441 = t433*t439
@@ -4200,10 +4200,10 @@ def _condition_number(q):
     t467 = -t465 + t464*t439
     t468 = t296*t466 - t423*t446 - t425*t450 + t427*t454 + t429*t458 + t431*t462
     t469 = (t377 != 0)
-    t470 = 0.5*(-t310 + t352)/casadi.if_else(t469, t377, 1)
+    t470 = (-t310 + t352)/casadi.if_else(t469, 2*t377, 1)
     t471 = casadi.fabs(t470)
     t472 = (t471 >= 1)
-    t473 = casadi.fabs(1/casadi.if_else(t472, t470, 1))
+    t473 = 1/casadi.fabs(casadi.if_else(t472, t470, 1))
     t474 = casadi.if_else(t469, casadi.if_else((t470 >= 0), 1, -1)*casadi.if_else(t472, t473/(1 + casadi.sqrt(1 + t473**2)), 1/(t471 + casadi.sqrt(1 + t471**2))), 0)
     t475 = 1/casadi.sqrt(1 + t474**2)
     t476 = t377*t474
@@ -4235,10 +4235,10 @@ def _condition_number(q):
     t502 = t500 + t499*t474
     t503 = -t402*t481 + t406*t485 + t410*t489 + t414*t493 + t418*t497 + t422*t501
     t504 = (t503 != 0)
-    t505 = 0.5*(-t477 + t398)/casadi.if_else(t504, t503, 1)
+    t505 = (-t477 + t398)/casadi.if_else(t504, 2*t503, 1)
     t506 = casadi.fabs(t505)
     t507 = (t506 >= 1)
-    t508 = casadi.fabs(1/casadi.if_else(t507, t505, 1))
+    t508 = 1/casadi.fabs(casadi.if_else(t507, t505, 1))
     t509 = casadi.if_else(t504, casadi.if_else((t505 >= 0), 1, -1)*casadi.if_else(t507, t508/(1 + casadi.sqrt(1 + t508**2)), 1/(t506 + casadi.sqrt(1 + t506**2))), 0)
     t510 = 1/casadi.sqrt(1 + t509**2)
     t511 = t503*t509
@@ -4271,10 +4271,10 @@ def _condition_number(q):
     t538 = -t447*t516 + t451*t520 + t455*t524 + t459*t528 + t463*t532 + t467*t536
     t539 = t482*t517 + t486*t521 + t490*t525 + t494*t529 + t498*t533 + t502*t537
     t540 = (t538 != 0)
-    t541 = 0.5*(-t512 + t443)/casadi.if_else(t540, t538, 1)
+    t541 = (-t512 + t443)/casadi.if_else(t540, 2*t538, 1)
     t542 = casadi.fabs(t541)
     t543 = (t542 >= 1)
-    t544 = casadi.fabs(1/casadi.if_else(t543, t541, 1))
+    t544 = 1/casadi.fabs(casadi.if_else(t543, t541, 1))
     t545 = casadi.if_else(t540, casadi.if_else((t541 >= 0), 1, -1)*casadi.if_else(t543, t544/(1 + casadi.sqrt(1 + t544**2)), 1/(t542 + casadi.sqrt(1 + t542**2))), 0)
     t546 = 1/casadi.sqrt(1 + t545**2)
     t547 = t538*t545
@@ -4305,10 +4305,10 @@ def _condition_number(q):
     t572 = t570 - t571*t545
     t573 = t571 + t570*t545
     t574 = (t539 != 0)
-    t575 = 0.5*(-t478 + t513)/casadi.if_else(t574, t539, 1)
+    t575 = (-t478 + t513)/casadi.if_else(t574, 2*t539, 1)
     t576 = casadi.fabs(t575)
     t577 = (t576 >= 1)
-    t578 = casadi.fabs(1/casadi.if_else(t577, t575, 1))
+    t578 = 1/casadi.fabs(casadi.if_else(t577, t575, 1))
     t579 = casadi.if_else(t574, casadi.if_else((t575 >= 0), 1, -1)*casadi.if_else(t577, t578/(1 + casadi.sqrt(1 + t578**2)), 1/(t576 + casadi.sqrt(1 + t576**2))), 0)
     t580 = 1/casadi.sqrt(1 + t579**2)
     t581 = t539*t579
@@ -4340,10 +4340,10 @@ def _condition_number(q):
     t607 = t605 + t604*t579
     t608 = t553*t586 + t557*t590 + t561*t594 + t565*t598 + t569*t602 + t573*t606
     t609 = (t608 != 0)
-    t610 = 0.5*(-t582 + t549)/casadi.if_else(t609, t608, 1)
+    t610 = (-t582 + t549)/casadi.if_else(t609, 2*t608, 1)
     t611 = casadi.fabs(t610)
     t612 = (t611 >= 1)
-    t613 = casadi.fabs(1/casadi.if_else(t612, t610, 1))
+    t613 = 1/casadi.fabs(casadi.if_else(t612, t610, 1))
     t614 = casadi.if_else(t609, casadi.if_else((t610 >= 0), 1, -1)*casadi.if_else(t612, t613/(1 + casadi.sqrt(1 + t613**2)), 1/(t611 + casadi.sqrt(1 + t611**2))), 0)
     t615 = 1/casadi.sqrt(1 + t614**2)
     t616 = t608*t614
@@ -4375,10 +4375,10 @@ def _condition_number(q):
     t642 = t640 + t639*t614
     t643 = t587*t622 + t591*t626 + t595*t630 + t599*t634 + t603*t638 + t607*t642
     t644 = (t643 != 0)
-    t645 = 0.5*(-t583 + t618)/casadi.if_else(t644, t643, 1)
+    t645 = (-t583 + t618)/casadi.if_else(t644, 2*t643, 1)
     t646 = casadi.fabs(t645)
     t647 = (t646 >= 1)
-    t648 = casadi.fabs(1/casadi.if_else(t647, t645, 1))
+    t648 = 1/casadi.fabs(casadi.if_else(t647, t645, 1))
     t649 = casadi.if_else(t644, casadi.if_else((t645 >= 0), 1, -1)*casadi.if_else(t647, t648/(1 + casadi.sqrt(1 + t648**2)), 1/(t646 + casadi.sqrt(1 + t646**2))), 0)
     t650 = 1/casadi.sqrt(1 + t649**2)
     t651 = t643*t649
@@ -4409,10 +4409,10 @@ def _condition_number(q):
     t676 = t674 - t675*t649
     t677 = t675 + t674*t649
     t678 = (t468 != 0)
-    t679 = 0.5*(-t292 + t442)/casadi.if_else(t678, t468, 1)
+    t679 = (-t292 + t442)/casadi.if_else(t678, 2*t468, 1)
     t680 = casadi.fabs(t679)
     t681 = (t680 >= 1)
-    t682 = casadi.fabs(1/casadi.if_else(t681, t679, 1))
+    t682 = 1/casadi.fabs(casadi.if_else(t681, t679, 1))
     t683 = casadi.if_else(t678, casadi.if_else((t679 >= 0), 1, -1)*casadi.if_else(t681, t682/(1 + casadi.sqrt(1 + t682**2)), 1/(t680 + casadi.sqrt(1 + t680**2))), 0)
     t684 = 1/casadi.sqrt(1 + t683**2)
     t685 = t468*t683
@@ -4444,10 +4444,10 @@ def _condition_number(q):
     t711 = t709 + t708*t683
     t712 = t552*t690 + t556*t694 + t560*t698 + t564*t702 + t568*t706 + t572*t710
     t713 = (t712 != 0)
-    t714 = 0.5*(-t686 + t548)/casadi.if_else(t713, t712, 1)
+    t714 = (-t686 + t548)/casadi.if_else(t713, 2*t712, 1)
     t715 = casadi.fabs(t714)
     t716 = (t715 >= 1)
-    t717 = casadi.fabs(1/casadi.if_else(t716, t714, 1))
+    t717 = 1/casadi.fabs(casadi.if_else(t716, t714, 1))
     t718 = casadi.if_else(t713, casadi.if_else((t714 >= 0), 1, -1)*casadi.if_else(t716, t717/(1 + casadi.sqrt(1 + t717**2)), 1/(t715 + casadi.sqrt(1 + t715**2))), 0)
     t719 = 1/casadi.sqrt(1 + t718**2)
     t720 = t712*t718
@@ -4480,10 +4480,10 @@ def _condition_number(q):
     t747 = t621*t725 + t625*t729 + t629*t733 + t633*t737 + t637*t741 + t641*t745
     t748 = -t691*t726 + t695*t730 + t699*t734 + t703*t738 + t707*t742 + t711*t746
     t749 = (t747 != 0)
-    t750 = 0.5*(-t721 + t617)/casadi.if_else(t749, t747, 1)
+    t750 = (-t721 + t617)/casadi.if_else(t749, 2*t747, 1)
     t751 = casadi.fabs(t750)
     t752 = (t751 >= 1)
-    t753 = casadi.fabs(1/casadi.if_else(t752, t750, 1))
+    t753 = 1/casadi.fabs(casadi.if_else(t752, t750, 1))
     t754 = casadi.if_else(t749, casadi.if_else((t750 >= 0), 1, -1)*casadi.if_else(t752, t753/(1 + casadi.sqrt(1 + t753**2)), 1/(t751 + casadi.sqrt(1 + t751**2))), 0)
     t755 = 1/casadi.sqrt(1 + t754**2)
     t756 = t747*t754
@@ -4515,10 +4515,10 @@ def _condition_number(q):
     t782 = t780 + t779*t754
     t783 = t656*t761 + t660*t765 + t664*t769 + t668*t773 + t672*t777 + t676*t781
     t784 = (t783 != 0)
-    t785 = 0.5*(-t757 + t652)/casadi.if_else(t784, t783, 1)
+    t785 = (-t757 + t652)/casadi.if_else(t784, 2*t783, 1)
     t786 = casadi.fabs(t785)
     t787 = (t786 >= 1)
-    t788 = casadi.fabs(1/casadi.if_else(t787, t785, 1))
+    t788 = 1/casadi.fabs(casadi.if_else(t787, t785, 1))
     t789 = casadi.if_else(t784, casadi.if_else((t785 >= 0), 1, -1)*casadi.if_else(t787, t788/(1 + casadi.sqrt(1 + t788**2)), 1/(t786 + casadi.sqrt(1 + t786**2))), 0)
     t790 = 1/casadi.sqrt(1 + t789**2)
     t791 = t783*t789
@@ -4550,10 +4550,10 @@ def _condition_number(q):
     t817 = t815 + t814*t789
     t818 = t657*t796 + t661*t800 + t665*t804 + t669*t808 + t673*t812 + t677*t816
     t819 = (t818 != 0)
-    t820 = 0.5*(-t792 + t653)/casadi.if_else(t819, t818, 1)
+    t820 = (-t792 + t653)/casadi.if_else(t819, 2*t818, 1)
     t821 = casadi.fabs(t820)
     t822 = (t821 >= 1)
-    t823 = casadi.fabs(1/casadi.if_else(t822, t820, 1))
+    t823 = 1/casadi.fabs(casadi.if_else(t822, t820, 1))
     t824 = casadi.if_else(t819, casadi.if_else((t820 >= 0), 1, -1)*casadi.if_else(t822, t823/(1 + casadi.sqrt(1 + t823**2)), 1/(t821 + casadi.sqrt(1 + t821**2))), 0)
     t825 = 1/casadi.sqrt(1 + t824**2)
     t826 = t818*t824
@@ -4584,10 +4584,10 @@ def _condition_number(q):
     t851 = t849 - t850*t824
     t852 = t850 + t849*t824
     t853 = (t748 != 0)
-    t854 = 0.5*(-t687 + t722)/casadi.if_else(t853, t748, 1)
+    t854 = (-t687 + t722)/casadi.if_else(t853, 2*t748, 1)
     t855 = casadi.fabs(t854)
     t856 = (t855 >= 1)
-    t857 = casadi.fabs(1/casadi.if_else(t856, t854, 1))
+    t857 = 1/casadi.fabs(casadi.if_else(t856, t854, 1))
     t858 = casadi.if_else(t853, casadi.if_else((t854 >= 0), 1, -1)*casadi.if_else(t856, t857/(1 + casadi.sqrt(1 + t857**2)), 1/(t855 + casadi.sqrt(1 + t855**2))), 0)
     t859 = 1/casadi.sqrt(1 + t858**2)
     t860 = t748*t858
@@ -4619,10 +4619,10 @@ def _condition_number(q):
     t886 = t884 + t883*t858
     t887 = t762*t865 + t766*t869 + t770*t873 + t774*t877 + t778*t881 + t782*t885
     t888 = (t887 != 0)
-    t889 = 0.5*(-t861 + t758)/casadi.if_else(t888, t887, 1)
+    t889 = (-t861 + t758)/casadi.if_else(t888, 2*t887, 1)
     t890 = casadi.fabs(t889)
     t891 = (t890 >= 1)
-    t892 = casadi.fabs(1/casadi.if_else(t891, t889, 1))
+    t892 = 1/casadi.fabs(casadi.if_else(t891, t889, 1))
     t893 = casadi.if_else(t888, casadi.if_else((t889 >= 0), 1, -1)*casadi.if_else(t891, t892/(1 + casadi.sqrt(1 + t892**2)), 1/(t890 + casadi.sqrt(1 + t890**2))), 0)
     t894 = 1/casadi.sqrt(1 + t893**2)
     t895 = t887*t893
@@ -4655,10 +4655,10 @@ def _condition_number(q):
     t922 = t797*t900 + t801*t904 + t805*t908 + t809*t912 + t813*t916 + t817*t920
     t923 = t866*t901 + t870*t905 + t874*t909 + t878*t913 + t882*t917 + t886*t921
     t924 = (t922 != 0)
-    t925 = 0.5*(-t896 + t793)/casadi.if_else(t924, t922, 1)
+    t925 = (-t896 + t793)/casadi.if_else(t924, 2*t922, 1)
     t926 = casadi.fabs(t925)
     t927 = (t926 >= 1)
-    t928 = casadi.fabs(1/casadi.if_else(t927, t925, 1))
+    t928 = 1/casadi.fabs(casadi.if_else(t927, t925, 1))
     t929 = casadi.if_else(t924, casadi.if_else((t925 >= 0), 1, -1)*casadi.if_else(t927, t928/(1 + casadi.sqrt(1 + t928**2)), 1/(t926 + casadi.sqrt(1 + t926**2))), 0)
     t930 = 1/casadi.sqrt(1 + t929**2)
     t931 = t922*t929
@@ -4690,10 +4690,10 @@ def _condition_number(q):
     t957 = t955 + t954*t929
     t958 = t832*t936 + t836*t940 + t840*t944 + t844*t948 + t848*t952 + t852*t956
     t959 = (t958 != 0)
-    t960 = 0.5*(-t932 + t828)/casadi.if_else(t959, t958, 1)
+    t960 = (-t932 + t828)/casadi.if_else(t959, 2*t958, 1)
     t961 = casadi.fabs(t960)
     t962 = (t961 >= 1)
-    t963 = casadi.fabs(1/casadi.if_else(t962, t960, 1))
+    t963 = 1/casadi.fabs(casadi.if_else(t962, t960, 1))
     t964 = casadi.if_else(t959, casadi.if_else((t960 >= 0), 1, -1)*casadi.if_else(t962, t963/(1 + casadi.sqrt(1 + t963**2)), 1/(t961 + casadi.sqrt(1 + t961**2))), 0)
     t965 = 1/casadi.sqrt(1 + t964**2)
     t966 = t958*t964
@@ -4725,10 +4725,10 @@ def _condition_number(q):
     t992 = t990 + t989*t964
     t993 = t831*t971 + t835*t975 + t839*t979 + t843*t983 + t847*t987 + t851*t991
     t994 = (t923 != 0)
-    t995 = 0.5*(-t862 + t897)/casadi.if_else(t994, t923, 1)
+    t995 = (-t862 + t897)/casadi.if_else(t994, 2*t923, 1)
     t996 = casadi.fabs(t995)
     t997 = (t996 >= 1)
-    t998 = casadi.fabs(1/casadi.if_else(t997, t995, 1))
+    t998 = 1/casadi.fabs(casadi.if_else(t997, t995, 1))
     t999 = casadi.if_else(t994, casadi.if_else((t995 >= 0), 1, -1)*casadi.if_else(t997, t998/(1 + casadi.sqrt(1 + t998**2)), 1/(t996 + casadi.sqrt(1 + t996**2))), 0)
     t1000 = 1/casadi.sqrt(1 + t999**2)
     t1001 = t923*t999
@@ -4760,10 +4760,10 @@ def _condition_number(q):
     t1027 = t1025 + t1024*t999
     t1028 = t937*t1006 + t941*t1010 + t945*t1014 + t949*t1018 + t953*t1022 + t957*t1026
     t1029 = (t1028 != 0)
-    t1030 = 0.5*(-t1002 + t933)/casadi.if_else(t1029, t1028, 1)
+    t1030 = (-t1002 + t933)/casadi.if_else(t1029, 2*t1028, 1)
     t1031 = casadi.fabs(t1030)
     t1032 = (t1031 >= 1)
-    t1033 = casadi.fabs(1/casadi.if_else(t1032, t1030, 1))
+    t1033 = 1/casadi.fabs(casadi.if_else(t1032, t1030, 1))
     t1034 = casadi.if_else(t1029, casadi.if_else((t1030 >= 0), 1, -1)*casadi.if_else(t1032, t1033/(1 + casadi.sqrt(1 + t1033**2)), 1/(t1031 + casadi.sqrt(1 + t1031**2))), 0)
     t1035 = 1/casadi.sqrt(1 + t1034**2)
     t1036 = t1028*t1034
@@ -4796,10 +4796,10 @@ def _condition_number(q):
     t1063 = t972*t1041 + t976*t1045 + t980*t1049 + t984*t1053 + t988*t1057 + t992*t1061
     t1064 = t1007*t1042 + t1011*t1046 + t1015*t1050 + t1019*t1054 + t1023*t1058 + t1027*t1062
     t1065 = (t1063 != 0)
-    t1066 = 0.5*(-t1037 + t968)/casadi.if_else(t1065, t1063, 1)
+    t1066 = (-t1037 + t968)/casadi.if_else(t1065, 2*t1063, 1)
     t1067 = casadi.fabs(t1066)
     t1068 = (t1067 >= 1)
-    t1069 = casadi.fabs(1/casadi.if_else(t1068, t1066, 1))
+    t1069 = 1/casadi.fabs(casadi.if_else(t1068, t1066, 1))
     t1070 = casadi.if_else(t1065, casadi.if_else((t1066 >= 0), 1, -1)*casadi.if_else(t1068, t1069/(1 + casadi.sqrt(1 + t1069**2)), 1/(t1067 + casadi.sqrt(1 + t1067**2))), 0)
     t1071 = 1/casadi.sqrt(1 + t1070**2)
     t1072 = t1063*t1070
@@ -4830,10 +4830,10 @@ def _condition_number(q):
     t1097 = t1095 - t1096*t1070
     t1098 = t1096 + t1095*t1070
     t1099 = (t1064 != 0)
-    t1100 = 0.5*(-t1003 + t1038)/casadi.if_else(t1099, t1064, 1)
+    t1100 = (-t1003 + t1038)/casadi.if_else(t1099, 2*t1064, 1)
     t1101 = casadi.fabs(t1100)
     t1102 = (t1101 >= 1)
-    t1103 = casadi.fabs(1/casadi.if_else(t1102, t1100, 1))
+    t1103 = 1/casadi.fabs(casadi.if_else(t1102, t1100, 1))
     t1104 = casadi.if_else(t1099, casadi.if_else((t1100 >= 0), 1, -1)*casadi.if_else(t1102, t1103/(1 + casadi.sqrt(1 + t1103**2)), 1/(t1101 + casadi.sqrt(1 + t1101**2))), 0)
     t1105 = 1/casadi.sqrt(1 + t1104**2)
     t1106 = t1064*t1104
@@ -4865,10 +4865,10 @@ def _condition_number(q):
     t1132 = t1130 + t1129*t1104
     t1133 = t1078*t1111 + t1082*t1115 + t1086*t1119 + t1090*t1123 + t1094*t1127 + t1098*t1131
     t1134 = (t1133 != 0)
-    t1135 = 0.5*(-t1107 + t1074)/casadi.if_else(t1134, t1133, 1)
+    t1135 = (-t1107 + t1074)/casadi.if_else(t1134, 2*t1133, 1)
     t1136 = casadi.fabs(t1135)
     t1137 = (t1136 >= 1)
-    t1138 = casadi.fabs(1/casadi.if_else(t1137, t1135, 1))
+    t1138 = 1/casadi.fabs(casadi.if_else(t1137, t1135, 1))
     t1139 = casadi.if_else(t1134, casadi.if_else((t1135 >= 0), 1, -1)*casadi.if_else(t1137, t1138/(1 + casadi.sqrt(1 + t1138**2)), 1/(t1136 + casadi.sqrt(1 + t1136**2))), 0)
     t1140 = 1/casadi.sqrt(1 + t1139**2)
     t1141 = t1133*t1139
@@ -4900,10 +4900,10 @@ def _condition_number(q):
     t1167 = t1165 + t1139*t1164
     t1168 = t1112*t1147 + t1116*t1151 + t1120*t1155 + t1124*t1159 + t1128*t1163 + t1132*t1167
     t1169 = (t1168 != 0)
-    t1170 = 0.5*(-t1108 + t1143)/casadi.if_else(t1169, t1168, 1)
+    t1170 = (-t1108 + t1143)/casadi.if_else(t1169, 2*t1168, 1)
     t1171 = casadi.fabs(t1170)
     t1172 = (t1171 >= 1)
-    t1173 = casadi.fabs(1/casadi.if_else(t1172, t1170, 1))
+    t1173 = 1/casadi.fabs(casadi.if_else(t1172, t1170, 1))
     t1174 = casadi.if_else(t1169, casadi.if_else((t1170 >= 0), 1, -1)*casadi.if_else(t1172, t1173/(1 + casadi.sqrt(1 + t1173**2)), 1/(t1171 + casadi.sqrt(1 + t1171**2))), 0)
     t1175 = 1/casadi.sqrt(1 + t1174**2)
     t1176 = t1168*t1174
@@ -4934,10 +4934,10 @@ def _condition_number(q):
     t1201 = t1199 - t1174*t1200
     t1202 = t1200 + t1174*t1199
     t1203 = (t993 != 0)
-    t1204 = 0.5*(-t827 + t967)/casadi.if_else(t1203, t993, 1)
+    t1204 = (-t827 + t967)/casadi.if_else(t1203, 2*t993, 1)
     t1205 = casadi.fabs(t1204)
     t1206 = (t1205 >= 1)
-    t1207 = casadi.fabs(1/casadi.if_else(t1206, t1204, 1))
+    t1207 = 1/casadi.fabs(casadi.if_else(t1206, t1204, 1))
     t1208 = casadi.if_else(t1203, casadi.if_else((t1204 >= 0), 1, -1)*casadi.if_else(t1206, t1207/(1 + casadi.sqrt(1 + t1207**2)), 1/(t1205 + casadi.sqrt(1 + t1205**2))), 0)
     t1209 = 1/casadi.sqrt(1 + t1208**2)
     t1210 = t993*t1208
@@ -4969,10 +4969,10 @@ def _condition_number(q):
     t1236 = t1234 + t1208*t1233
     t1237 = t1077*t1215 + t1081*t1219 + t1085*t1223 + t1089*t1227 + t1093*t1231 + t1097*t1235
     t1238 = (t1237 != 0)
-    t1239 = 0.5*(-t1211 + t1073)/casadi.if_else(t1238, t1237, 1)
+    t1239 = (-t1211 + t1073)/casadi.if_else(t1238, 2*t1237, 1)
     t1240 = casadi.fabs(t1239)
     t1241 = (t1240 >= 1)
-    t1242 = casadi.fabs(1/casadi.if_else(t1241, t1239, 1))
+    t1242 = 1/casadi.fabs(casadi.if_else(t1241, t1239, 1))
     t1243 = casadi.if_else(t1238, casadi.if_else((t1239 >= 0), 1, -1)*casadi.if_else(t1241, t1242/(1 + casadi.sqrt(1 + t1242**2)), 1/(t1240 + casadi.sqrt(1 + t1240**2))), 0)
     t1244 = 1/casadi.sqrt(1 + t1243**2)
     t1245 = t1237*t1243
@@ -5005,10 +5005,10 @@ def _condition_number(q):
     t1272 = t1146*t1250 + t1150*t1254 + t1154*t1258 + t1158*t1262 + t1162*t1266 + t1166*t1270
     t1273 = t1216*t1251 + t1220*t1255 + t1224*t1259 + t1228*t1263 + t1232*t1267 + t1236*t1271
     t1274 = (t1272 != 0)
-    t1275 = 0.5*(-t1246 + t1142)/casadi.if_else(t1274, t1272, 1)
+    t1275 = (-t1246 + t1142)/casadi.if_else(t1274, 2*t1272, 1)
     t1276 = casadi.fabs(t1275)
     t1277 = (t1276 >= 1)
-    t1278 = casadi.fabs(1/casadi.if_else(t1277, t1275, 1))
+    t1278 = 1/casadi.fabs(casadi.if_else(t1277, t1275, 1))
     t1279 = casadi.if_else(t1274, casadi.if_else((t1275 >= 0), 1, -1)*casadi.if_else(t1277, t1278/(1 + casadi.sqrt(1 + t1278**2)), 1/(t1276 + casadi.sqrt(1 + t1276**2))), 0)
     t1280 = 1/casadi.sqrt(1 + t1279**2)
     t1281 = t1272*t1279
@@ -5040,10 +5040,10 @@ def _condition_number(q):
     t1307 = t1305 + t1279*t1304
     t1308 = t1181*t1286 + t1185*t1290 + t1189*t1294 + t1193*t1298 + t1197*t1302 + t1201*t1306
     t1309 = (t1308 != 0)
-    t1310 = 0.5*(-t1282 + t1177)/casadi.if_else(t1309, t1308, 1)
+    t1310 = (-t1282 + t1177)/casadi.if_else(t1309, 2*t1308, 1)
     t1311 = casadi.fabs(t1310)
     t1312 = (t1311 >= 1)
-    t1313 = casadi.fabs(1/casadi.if_else(t1312, t1310, 1))
+    t1313 = 1/casadi.fabs(casadi.if_else(t1312, t1310, 1))
     t1314 = casadi.if_else(t1309, casadi.if_else((t1310 >= 0), 1, -1)*casadi.if_else(t1312, t1313/(1 + casadi.sqrt(1 + t1313**2)), 1/(t1311 + casadi.sqrt(1 + t1311**2))), 0)
     t1315 = 1/casadi.sqrt(1 + t1314**2)
     t1316 = t1308*t1314
@@ -5075,10 +5075,10 @@ def _condition_number(q):
     t1342 = t1340 + t1314*t1339
     t1343 = t1182*t1321 + t1186*t1325 + t1190*t1329 + t1194*t1333 + t1198*t1337 + t1202*t1341
     t1344 = (t1343 != 0)
-    t1345 = 0.5*(-t1317 + t1178)/casadi.if_else(t1344, t1343, 1)
+    t1345 = (-t1317 + t1178)/casadi.if_else(t1344, 2*t1343, 1)
     t1346 = casadi.fabs(t1345)
     t1347 = (t1346 >= 1)
-    t1348 = casadi.fabs(1/casadi.if_else(t1347, t1345, 1))
+    t1348 = 1/casadi.fabs(casadi.if_else(t1347, t1345, 1))
     t1349 = casadi.if_else(t1344, casadi.if_else((t1345 >= 0), 1, -1)*casadi.if_else(t1347, t1348/(1 + casadi.sqrt(1 + t1348**2)), 1/(t1346 + casadi.sqrt(1 + t1346**2))), 0)
     t1350 = 1/casadi.sqrt(1 + t1349**2)
     t1351 = t1343*t1349
@@ -5109,10 +5109,10 @@ def _condition_number(q):
     t1376 = t1374 - t1349*t1375
     t1377 = t1375 + t1349*t1374
     t1378 = (t1273 != 0)
-    t1379 = 0.5*(-t1212 + t1247)/casadi.if_else(t1378, t1273, 1)
+    t1379 = (-t1212 + t1247)/casadi.if_else(t1378, 2*t1273, 1)
     t1380 = casadi.fabs(t1379)
     t1381 = (t1380 >= 1)
-    t1382 = casadi.fabs(1/casadi.if_else(t1381, t1379, 1))
+    t1382 = 1/casadi.fabs(casadi.if_else(t1381, t1379, 1))
     t1383 = casadi.if_else(t1378, casadi.if_else((t1379 >= 0), 1, -1)*casadi.if_else(t1381, t1382/(1 + casadi.sqrt(1 + t1382**2)), 1/(t1380 + casadi.sqrt(1 + t1380**2))), 0)
     t1384 = 1/casadi.sqrt(1 + t1383**2)
     t1385 = t1273*t1383
@@ -5144,10 +5144,10 @@ def _condition_number(q):
     t1411 = t1409 + t1383*t1408
     t1412 = t1287*t1390 + t1291*t1394 + t1295*t1398 + t1299*t1402 + t1303*t1406 + t1307*t1410
     t1413 = (t1412 != 0)
-    t1414 = 0.5*(-t1386 + t1283)/casadi.if_else(t1413, t1412, 1)
+    t1414 = (-t1386 + t1283)/casadi.if_else(t1413, 2*t1412, 1)
     t1415 = casadi.fabs(t1414)
     t1416 = (t1415 >= 1)
-    t1417 = casadi.fabs(1/casadi.if_else(t1416, t1414, 1))
+    t1417 = 1/casadi.fabs(casadi.if_else(t1416, t1414, 1))
     t1418 = casadi.if_else(t1413, casadi.if_else((t1414 >= 0), 1, -1)*casadi.if_else(t1416, t1417/(1 + casadi.sqrt(1 + t1417**2)), 1/(t1415 + casadi.sqrt(1 + t1415**2))), 0)
     t1419 = 1/casadi.sqrt(1 + t1418**2)
     t1420 = t1412*t1418
@@ -5180,10 +5180,10 @@ def _condition_number(q):
     t1447 = t1322*t1425 + t1326*t1429 + t1330*t1433 + t1334*t1437 + t1338*t1441 + t1342*t1445
     t1448 = t1391*t1426 + t1395*t1430 + t1399*t1434 + t1403*t1438 + t1407*t1442 + t1411*t1446
     t1449 = (t1447 != 0)
-    t1450 = 0.5*(-t1421 + t1318)/casadi.if_else(t1449, t1447, 1)
+    t1450 = (-t1421 + t1318)/casadi.if_else(t1449, 2*t1447, 1)
     t1451 = casadi.fabs(t1450)
     t1452 = (t1451 >= 1)
-    t1453 = casadi.fabs(1/casadi.if_else(t1452, t1450, 1))
+    t1453 = 1/casadi.fabs(casadi.if_else(t1452, t1450, 1))
     t1454 = casadi.if_else(t1449, casadi.if_else((t1450 >= 0), 1, -1)*casadi.if_else(t1452, t1453/(1 + casadi.sqrt(1 + t1453**2)), 1/(t1451 + casadi.sqrt(1 + t1451**2))), 0)
     t1455 = 1/casadi.sqrt(1 + t1454**2)
     t1456 = t1447*t1454
@@ -5215,10 +5215,10 @@ def _condition_number(q):
     t1482 = t1480 + t1454*t1479
     t1483 = t1357*t1461 + t1361*t1465 + t1365*t1469 + t1369*t1473 + t1373*t1477 + t1377*t1481
     t1484 = (t1483 != 0)
-    t1485 = 0.5*(-t1457 + t1353)/casadi.if_else(t1484, t1483, 1)
+    t1485 = (-t1457 + t1353)/casadi.if_else(t1484, 2*t1483, 1)
     t1486 = casadi.fabs(t1485)
     t1487 = (t1486 >= 1)
-    t1488 = casadi.fabs(1/casadi.if_else(t1487, t1485, 1))
+    t1488 = 1/casadi.fabs(casadi.if_else(t1487, t1485, 1))
     t1489 = casadi.if_else(t1484, casadi.if_else((t1485 >= 0), 1, -1)*casadi.if_else(t1487, t1488/(1 + casadi.sqrt(1 + t1488**2)), 1/(t1486 + casadi.sqrt(1 + t1486**2))), 0)
     t1490 = 1/casadi.sqrt(1 + t1489**2)
     t1491 = t1483*t1489
@@ -5250,10 +5250,10 @@ def _condition_number(q):
     t1517 = t1515 + t1489*t1514
     t1518 = t1356*t1496 + t1360*t1500 + t1364*t1504 + t1368*t1508 + t1372*t1512 + t1376*t1516
     t1519 = (t1448 != 0)
-    t1520 = 0.5*(-t1387 + t1422)/casadi.if_else(t1519, t1448, 1)
+    t1520 = (-t1387 + t1422)/casadi.if_else(t1519, 2*t1448, 1)
     t1521 = casadi.fabs(t1520)
     t1522 = (t1521 >= 1)
-    t1523 = casadi.fabs(1/casadi.if_else(t1522, t1520, 1))
+    t1523 = 1/casadi.fabs(casadi.if_else(t1522, t1520, 1))
     t1524 = casadi.if_else(t1519, casadi.if_else((t1520 >= 0), 1, -1)*casadi.if_else(t1522, t1523/(1 + casadi.sqrt(1 + t1523**2)), 1/(t1521 + casadi.sqrt(1 + t1521**2))), 0)
     t1525 = 1/casadi.sqrt(1 + t1524**2)
     t1526 = t1448*t1524
@@ -5285,10 +5285,10 @@ def _condition_number(q):
     t1552 = t1550 + t1524*t1549
     t1553 = t1462*t1531 + t1466*t1535 + t1470*t1539 + t1474*t1543 + t1478*t1547 + t1482*t1551
     t1554 = (t1553 != 0)
-    t1555 = 0.5*(-t1527 + t1458)/casadi.if_else(t1554, t1553, 1)
+    t1555 = (-t1527 + t1458)/casadi.if_else(t1554, 2*t1553, 1)
     t1556 = casadi.fabs(t1555)
     t1557 = (t1556 >= 1)
-    t1558 = casadi.fabs(1/casadi.if_else(t1557, t1555, 1))
+    t1558 = 1/casadi.fabs(casadi.if_else(t1557, t1555, 1))
     t1559 = casadi.if_else(t1554, casadi.if_else((t1555 >= 0), 1, -1)*casadi.if_else(t1557, t1558/(1 + casadi.sqrt(1 + t1558**2)), 1/(t1556 + casadi.sqrt(1 + t1556**2))), 0)
     t1560 = 1/casadi.sqrt(1 + t1559**2)
     t1561 = t1553*t1559
@@ -5321,10 +5321,10 @@ def _condition_number(q):
     t1588 = t1497*t1566 + t1501*t1570 + t1505*t1574 + t1509*t1578 + t1513*t1582 + t1517*t1586
     t1589 = t1532*t1567 + t1536*t1571 + t1540*t1575 + t1544*t1579 + t1548*t1583 + t1552*t1587
     t1590 = (t1588 != 0)
-    t1591 = 0.5*(-t1562 + t1493)/casadi.if_else(t1590, t1588, 1)
+    t1591 = (-t1562 + t1493)/casadi.if_else(t1590, 2*t1588, 1)
     t1592 = casadi.fabs(t1591)
     t1593 = (t1592 >= 1)
-    t1594 = casadi.fabs(1/casadi.if_else(t1593, t1591, 1))
+    t1594 = 1/casadi.fabs(casadi.if_else(t1593, t1591, 1))
     t1595 = casadi.if_else(t1590, casadi.if_else((t1591 >= 0), 1, -1)*casadi.if_else(t1593, t1594/(1 + casadi.sqrt(1 + t1594**2)), 1/(t1592 + casadi.sqrt(1 + t1592**2))), 0)
     t1596 = 1/casadi.sqrt(1 + t1595**2)
     t1597 = t1588*t1595
@@ -5355,10 +5355,10 @@ def _condition_number(q):
     t1622 = t1620 - t1595*t1621
     t1623 = t1621 + t1595*t1620
     t1624 = (t1589 != 0)
-    t1625 = 0.5*(-t1528 + t1563)/casadi.if_else(t1624, t1589, 1)
+    t1625 = (-t1528 + t1563)/casadi.if_else(t1624, 2*t1589, 1)
     t1626 = casadi.fabs(t1625)
     t1627 = (t1626 >= 1)
-    t1628 = casadi.fabs(1/casadi.if_else(t1627, t1625, 1))
+    t1628 = 1/casadi.fabs(casadi.if_else(t1627, t1625, 1))
     t1629 = casadi.if_else(t1624, casadi.if_else((t1625 >= 0), 1, -1)*casadi.if_else(t1627, t1628/(1 + casadi.sqrt(1 + t1628**2)), 1/(t1626 + casadi.sqrt(1 + t1626**2))), 0)
     t1630 = 1/casadi.sqrt(1 + t1629**2)
     t1631 = t1589*t1629
@@ -5390,10 +5390,10 @@ def _condition_number(q):
     t1657 = t1655 + t1629*t1654
     t1658 = t1603*t1636 + t1607*t1640 + t1611*t1644 + t1615*t1648 + t1619*t1652 + t1623*t1656
     t1659 = (t1658 != 0)
-    t1660 = 0.5*(-t1632 + t1599)/casadi.if_else(t1659, t1658, 1)
+    t1660 = (-t1632 + t1599)/casadi.if_else(t1659, 2*t1658, 1)
     t1661 = casadi.fabs(t1660)
     t1662 = (t1661 >= 1)
-    t1663 = casadi.fabs(1/casadi.if_else(t1662, t1660, 1))
+    t1663 = 1/casadi.fabs(casadi.if_else(t1662, t1660, 1))
     t1664 = casadi.if_else(t1659, casadi.if_else((t1660 >= 0), 1, -1)*casadi.if_else(t1662, t1663/(1 + casadi.sqrt(1 + t1663**2)), 1/(t1661 + casadi.sqrt(1 + t1661**2))), 0)
     t1665 = 1/casadi.sqrt(1 + t1664**2)
     t1666 = t1658*t1664
@@ -5425,10 +5425,10 @@ def _condition_number(q):
     t1692 = t1690 + t1664*t1689
     t1693 = t1637*t1672 + t1641*t1676 + t1645*t1680 + t1649*t1684 + t1653*t1688 + t1657*t1692
     t1694 = (t1693 != 0)
-    t1695 = 0.5*(-t1633 + t1668)/casadi.if_else(t1694, t1693, 1)
+    t1695 = (-t1633 + t1668)/casadi.if_else(t1694, 2*t1693, 1)
     t1696 = casadi.fabs(t1695)
     t1697 = (t1696 >= 1)
-    t1698 = casadi.fabs(1/casadi.if_else(t1697, t1695, 1))
+    t1698 = 1/casadi.fabs(casadi.if_else(t1697, t1695, 1))
     t1699 = casadi.if_else(t1694, casadi.if_else((t1695 >= 0), 1, -1)*casadi.if_else(t1697, t1698/(1 + casadi.sqrt(1 + t1698**2)), 1/(t1696 + casadi.sqrt(1 + t1696**2))), 0)
     t1700 = 1/casadi.sqrt(1 + t1699**2)
     t1701 = t1693*t1699
@@ -5459,10 +5459,10 @@ def _condition_number(q):
     t1726 = t1724 - t1699*t1725
     t1727 = t1725 + t1699*t1724
     t1728 = (t1518 != 0)
-    t1729 = 0.5*(-t1352 + t1492)/casadi.if_else(t1728, t1518, 1)
+    t1729 = (-t1352 + t1492)/casadi.if_else(t1728, 2*t1518, 1)
     t1730 = casadi.fabs(t1729)
     t1731 = (t1730 >= 1)
-    t1732 = casadi.fabs(1/casadi.if_else(t1731, t1729, 1))
+    t1732 = 1/casadi.fabs(casadi.if_else(t1731, t1729, 1))
     t1733 = casadi.if_else(t1728, casadi.if_else((t1729 >= 0), 1, -1)*casadi.if_else(t1731, t1732/(1 + casadi.sqrt(1 + t1732**2)), 1/(t1730 + casadi.sqrt(1 + t1730**2))), 0)
     t1734 = 1/casadi.sqrt(1 + t1733**2)
     t1735 = t1518*t1733
@@ -5494,10 +5494,10 @@ def _condition_number(q):
     t1761 = t1759 + t1733*t1758
     t1762 = t1602*t1740 + t1606*t1744 + t1610*t1748 + t1614*t1752 + t1618*t1756 + t1622*t1760
     t1763 = (t1762 != 0)
-    t1764 = 0.5*(-t1736 + t1598)/casadi.if_else(t1763, t1762, 1)
+    t1764 = (-t1736 + t1598)/casadi.if_else(t1763, 2*t1762, 1)
     t1765 = casadi.fabs(t1764)
     t1766 = (t1765 >= 1)
-    t1767 = casadi.fabs(1/casadi.if_else(t1766, t1764, 1))
+    t1767 = 1/casadi.fabs(casadi.if_else(t1766, t1764, 1))
     t1768 = casadi.if_else(t1763, casadi.if_else((t1764 >= 0), 1, -1)*casadi.if_else(t1766, t1767/(1 + casadi.sqrt(1 + t1767**2)), 1/(t1765 + casadi.sqrt(1 + t1765**2))), 0)
     t1769 = 1/casadi.sqrt(1 + t1768**2)
     t1770 = t1762*t1768
@@ -5530,10 +5530,10 @@ def _condition_number(q):
     t1797 = t1671*t1775 + t1675*t1779 + t1679*t1783 + t1683*t1787 + t1687*t1791 + t1691*t1795
     t1798 = t1741*t1776 + t1745*t1780 + t1749*t1784 + t1753*t1788 + t1757*t1792 + t1761*t1796
     t1799 = (t1797 != 0)
-    t1800 = 0.5*(-t1771 + t1667)/casadi.if_else(t1799, t1797, 1)
+    t1800 = (-t1771 + t1667)/casadi.if_else(t1799, 2*t1797, 1)
     t1801 = casadi.fabs(t1800)
     t1802 = (t1801 >= 1)
-    t1803 = casadi.fabs(1/casadi.if_else(t1802, t1800, 1))
+    t1803 = 1/casadi.fabs(casadi.if_else(t1802, t1800, 1))
     t1804 = casadi.if_else(t1799, casadi.if_else((t1800 >= 0), 1, -1)*casadi.if_else(t1802, t1803/(1 + casadi.sqrt(1 + t1803**2)), 1/(t1801 + casadi.sqrt(1 + t1801**2))), 0)
     t1805 = 1/casadi.sqrt(1 + t1804**2)
     t1806 = t1797*t1804
@@ -5565,10 +5565,10 @@ def _condition_number(q):
     t1832 = t1830 + t1804*t1829
     t1833 = t1706*t1811 + t1710*t1815 + t1714*t1819 + t1718*t1823 + t1722*t1827 + t1726*t1831
     t1834 = (t1833 != 0)
-    t1835 = 0.5*(-t1807 + t1702)/casadi.if_else(t1834, t1833, 1)
+    t1835 = (-t1807 + t1702)/casadi.if_else(t1834, 2*t1833, 1)
     t1836 = casadi.fabs(t1835)
     t1837 = (t1836 >= 1)
-    t1838 = casadi.fabs(1/casadi.if_else(t1837, t1835, 1))
+    t1838 = 1/casadi.fabs(casadi.if_else(t1837, t1835, 1))
     t1839 = casadi.if_else(t1834, casadi.if_else((t1835 >= 0), 1, -1)*casadi.if_else(t1837, t1838/(1 + casadi.sqrt(1 + t1838**2)), 1/(t1836 + casadi.sqrt(1 + t1836**2))), 0)
     t1840 = 1/casadi.sqrt(1 + t1839**2)
     t1841 = t1833*t1839
@@ -5600,10 +5600,10 @@ def _condition_number(q):
     t1867 = t1865 + t1839*t1864
     t1868 = t1707*t1846 + t1711*t1850 + t1715*t1854 + t1719*t1858 + t1723*t1862 + t1727*t1866
     t1869 = (t1868 != 0)
-    t1870 = 0.5*(-t1842 + t1703)/casadi.if_else(t1869, t1868, 1)
+    t1870 = (-t1842 + t1703)/casadi.if_else(t1869, 2*t1868, 1)
     t1871 = casadi.fabs(t1870)
     t1872 = (t1871 >= 1)
-    t1873 = casadi.fabs(1/casadi.if_else(t1872, t1870, 1))
+    t1873 = 1/casadi.fabs(casadi.if_else(t1872, t1870, 1))
     t1874 = casadi.if_else(t1869, casadi.if_else((t1870 >= 0), 1, -1)*casadi.if_else(t1872, t1873/(1 + casadi.sqrt(1 + t1873**2)), 1/(t1871 + casadi.sqrt(1 + t1871**2))), 0)
     t1875 = 1/casadi.sqrt(1 + t1874**2)
     t1876 = t1868*t1874
@@ -5634,10 +5634,10 @@ def _condition_number(q):
     t1901 = t1899 - t1874*t1900
     t1902 = t1900 + t1874*t1899
     t1903 = (t1798 != 0)
-    t1904 = 0.5*(-t1737 + t1772)/casadi.if_else(t1903, t1798, 1)
+    t1904 = (-t1737 + t1772)/casadi.if_else(t1903, 2*t1798, 1)
     t1905 = casadi.fabs(t1904)
     t1906 = (t1905 >= 1)
-    t1907 = casadi.fabs(1/casadi.if_else(t1906, t1904, 1))
+    t1907 = 1/casadi.fabs(casadi.if_else(t1906, t1904, 1))
     t1908 = casadi.if_else(t1903, casadi.if_else((t1904 >= 0), 1, -1)*casadi.if_else(t1906, t1907/(1 + casadi.sqrt(1 + t1907**2)), 1/(t1905 + casadi.sqrt(1 + t1905**2))), 0)
     t1909 = 1/casadi.sqrt(1 + t1908**2)
     t1910 = t1798*t1908
@@ -5669,10 +5669,10 @@ def _condition_number(q):
     t1936 = t1934 + t1908*t1933
     t1937 = t1812*t1915 + t1816*t1919 + t1820*t1923 + t1824*t1927 + t1828*t1931 + t1832*t1935
     t1938 = (t1937 != 0)
-    t1939 = 0.5*(-t1911 + t1808)/casadi.if_else(t1938, t1937, 1)
+    t1939 = (-t1911 + t1808)/casadi.if_else(t1938, 2*t1937, 1)
     t1940 = casadi.fabs(t1939)
     t1941 = (t1940 >= 1)
-    t1942 = casadi.fabs(1/casadi.if_else(t1941, t1939, 1))
+    t1942 = 1/casadi.fabs(casadi.if_else(t1941, t1939, 1))
     t1943 = casadi.if_else(t1938, casadi.if_else((t1939 >= 0), 1, -1)*casadi.if_else(t1941, t1942/(1 + casadi.sqrt(1 + t1942**2)), 1/(t1940 + casadi.sqrt(1 + t1940**2))), 0)
     t1944 = 1/casadi.sqrt(1 + t1943**2)
     t1945 = t1937*t1943
@@ -5705,10 +5705,10 @@ def _condition_number(q):
     t1972 = t1847*t1950 + t1851*t1954 + t1855*t1958 + t1859*t1962 + t1863*t1966 + t1867*t1970
     t1973 = t1916*t1951 + t1920*t1955 + t1924*t1959 + t1928*t1963 + t1932*t1967 + t1936*t1971
     t1974 = (t1972 != 0)
-    t1975 = 0.5*(-t1946 + t1843)/casadi.if_else(t1974, t1972, 1)
+    t1975 = (-t1946 + t1843)/casadi.if_else(t1974, 2*t1972, 1)
     t1976 = casadi.fabs(t1975)
     t1977 = (t1976 >= 1)
-    t1978 = casadi.fabs(1/casadi.if_else(t1977, t1975, 1))
+    t1978 = 1/casadi.fabs(casadi.if_else(t1977, t1975, 1))
     t1979 = casadi.if_else(t1974, casadi.if_else((t1975 >= 0), 1, -1)*casadi.if_else(t1977, t1978/(1 + casadi.sqrt(1 + t1978**2)), 1/(t1976 + casadi.sqrt(1 + t1976**2))), 0)
     t1980 = 1/casadi.sqrt(1 + t1979**2)
     t1981 = t1972*t1979
@@ -5740,10 +5740,10 @@ def _condition_number(q):
     t2007 = t2005 + t1979*t2004
     t2008 = t1882*t1986 + t1886*t1990 + t1890*t1994 + t1894*t1998 + t1898*t2002 + t1902*t2006
     t2009 = (t2008 != 0)
-    t2010 = 0.5*(-t1982 + t1878)/casadi.if_else(t2009, t2008, 1)
+    t2010 = (-t1982 + t1878)/casadi.if_else(t2009, 2*t2008, 1)
     t2011 = casadi.fabs(t2010)
     t2012 = (t2011 >= 1)
-    t2013 = casadi.fabs(1/casadi.if_else(t2012, t2010, 1))
+    t2013 = 1/casadi.fabs(casadi.if_else(t2012, t2010, 1))
     t2014 = casadi.if_else(t2009, casadi.if_else((t2010 >= 0), 1, -1)*casadi.if_else(t2012, t2013/(1 + casadi.sqrt(1 + t2013**2)), 1/(t2011 + casadi.sqrt(1 + t2011**2))), 0)
     t2015 = 1/casadi.sqrt(1 + t2014**2)
     t2016 = t2008*t2014
@@ -5775,10 +5775,10 @@ def _condition_number(q):
     t2042 = t2040 + t2014*t2039
     t2043 = t1881*t2021 + t1885*t2025 + t1889*t2029 + t1893*t2033 + t1897*t2037 + t1901*t2041
     t2044 = (t1973 != 0)
-    t2045 = 0.5*(-t1912 + t1947)/casadi.if_else(t2044, t1973, 1)
+    t2045 = (-t1912 + t1947)/casadi.if_else(t2044, 2*t1973, 1)
     t2046 = casadi.fabs(t2045)
     t2047 = (t2046 >= 1)
-    t2048 = casadi.fabs(1/casadi.if_else(t2047, t2045, 1))
+    t2048 = 1/casadi.fabs(casadi.if_else(t2047, t2045, 1))
     t2049 = casadi.if_else(t2044, casadi.if_else((t2045 >= 0), 1, -1)*casadi.if_else(t2047, t2048/(1 + casadi.sqrt(1 + t2048**2)), 1/(t2046 + casadi.sqrt(1 + t2046**2))), 0)
     t2050 = 1/casadi.sqrt(1 + t2049**2)
     t2051 = t1973*t2049
@@ -5810,10 +5810,10 @@ def _condition_number(q):
     t2077 = t2075 + t2049*t2074
     t2078 = t1987*t2056 + t1991*t2060 + t1995*t2064 + t1999*t2068 + t2003*t2072 + t2007*t2076
     t2079 = (t2078 != 0)
-    t2080 = 0.5*(-t2052 + t1983)/casadi.if_else(t2079, t2078, 1)
+    t2080 = (-t2052 + t1983)/casadi.if_else(t2079, 2*t2078, 1)
     t2081 = casadi.fabs(t2080)
     t2082 = (t2081 >= 1)
-    t2083 = casadi.fabs(1/casadi.if_else(t2082, t2080, 1))
+    t2083 = 1/casadi.fabs(casadi.if_else(t2082, t2080, 1))
     t2084 = casadi.if_else(t2079, casadi.if_else((t2080 >= 0), 1, -1)*casadi.if_else(t2082, t2083/(1 + casadi.sqrt(1 + t2083**2)), 1/(t2081 + casadi.sqrt(1 + t2081**2))), 0)
     t2085 = 1/casadi.sqrt(1 + t2084**2)
     t2086 = t2078*t2084
@@ -5846,10 +5846,10 @@ def _condition_number(q):
     t2113 = t2022*t2091 + t2026*t2095 + t2030*t2099 + t2034*t2103 + t2038*t2107 + t2042*t2111
     t2114 = t2057*t2092 + t2061*t2096 + t2065*t2100 + t2069*t2104 + t2073*t2108 + t2077*t2112
     t2115 = (t2113 != 0)
-    t2116 = 0.5*(-t2087 + t2018)/casadi.if_else(t2115, t2113, 1)
+    t2116 = (-t2087 + t2018)/casadi.if_else(t2115, 2*t2113, 1)
     t2117 = casadi.fabs(t2116)
     t2118 = (t2117 >= 1)
-    t2119 = casadi.fabs(1/casadi.if_else(t2118, t2116, 1))
+    t2119 = 1/casadi.fabs(casadi.if_else(t2118, t2116, 1))
     t2120 = casadi.if_else(t2115, casadi.if_else((t2116 >= 0), 1, -1)*casadi.if_else(t2118, t2119/(1 + casadi.sqrt(1 + t2119**2)), 1/(t2117 + casadi.sqrt(1 + t2117**2))), 0)
     t2121 = 1/casadi.sqrt(1 + t2120**2)
     t2122 = t2113*t2120
@@ -5880,10 +5880,10 @@ def _condition_number(q):
     t2147 = t2145 - t2120*t2146
     t2148 = t2146 + t2120*t2145
     t2149 = (t2114 != 0)
-    t2150 = 0.5*(-t2053 + t2088)/casadi.if_else(t2149, t2114, 1)
+    t2150 = (-t2053 + t2088)/casadi.if_else(t2149, 2*t2114, 1)
     t2151 = casadi.fabs(t2150)
     t2152 = (t2151 >= 1)
-    t2153 = casadi.fabs(1/casadi.if_else(t2152, t2150, 1))
+    t2153 = 1/casadi.fabs(casadi.if_else(t2152, t2150, 1))
     t2154 = casadi.if_else(t2149, casadi.if_else((t2150 >= 0), 1, -1)*casadi.if_else(t2152, t2153/(1 + casadi.sqrt(1 + t2153**2)), 1/(t2151 + casadi.sqrt(1 + t2151**2))), 0)
     t2155 = 1/casadi.sqrt(1 + t2154**2)
     t2156 = t2114*t2154
@@ -5915,10 +5915,10 @@ def _condition_number(q):
     t2182 = t2180 + t2154*t2179
     t2183 = t2128*t2161 + t2132*t2165 + t2136*t2169 + t2140*t2173 + t2144*t2177 + t2148*t2181
     t2184 = (t2183 != 0)
-    t2185 = 0.5*(-t2157 + t2124)/casadi.if_else(t2184, t2183, 1)
+    t2185 = (-t2157 + t2124)/casadi.if_else(t2184, 2*t2183, 1)
     t2186 = casadi.fabs(t2185)
     t2187 = (t2186 >= 1)
-    t2188 = casadi.fabs(1/casadi.if_else(t2187, t2185, 1))
+    t2188 = 1/casadi.fabs(casadi.if_else(t2187, t2185, 1))
     t2189 = casadi.if_else(t2184, casadi.if_else((t2185 >= 0), 1, -1)*casadi.if_else(t2187, t2188/(1 + casadi.sqrt(1 + t2188**2)), 1/(t2186 + casadi.sqrt(1 + t2186**2))), 0)
     t2190 = 1/casadi.sqrt(1 + t2189**2)
     t2191 = t2183*t2189
@@ -5950,10 +5950,10 @@ def _condition_number(q):
     t2217 = t2215 + t2189*t2214
     t2218 = t2162*t2197 + t2166*t2201 + t2170*t2205 + t2174*t2209 + t2178*t2213 + t2182*t2217
     t2219 = (t2218 != 0)
-    t2220 = 0.5*(-t2158 + t2193)/casadi.if_else(t2219, t2218, 1)
+    t2220 = (-t2158 + t2193)/casadi.if_else(t2219, 2*t2218, 1)
     t2221 = casadi.fabs(t2220)
     t2222 = (t2221 >= 1)
-    t2223 = casadi.fabs(1/casadi.if_else(t2222, t2220, 1))
+    t2223 = 1/casadi.fabs(casadi.if_else(t2222, t2220, 1))
     t2224 = casadi.if_else(t2219, casadi.if_else((t2220 >= 0), 1, -1)*casadi.if_else(t2222, t2223/(1 + casadi.sqrt(1 + t2223**2)), 1/(t2221 + casadi.sqrt(1 + t2221**2))), 0)
     t2225 = 1/casadi.sqrt(1 + t2224**2)
     t2226 = t2218*t2224
@@ -5984,10 +5984,10 @@ def _condition_number(q):
     t2251 = t2249 - t2224*t2250
     t2252 = t2250 + t2224*t2249
     t2253 = (t2043 != 0)
-    t2254 = 0.5*(-t1877 + t2017)/casadi.if_else(t2253, t2043, 1)
+    t2254 = (-t1877 + t2017)/casadi.if_else(t2253, 2*t2043, 1)
     t2255 = casadi.fabs(t2254)
     t2256 = (t2255 >= 1)
-    t2257 = casadi.fabs(1/casadi.if_else(t2256, t2254, 1))
+    t2257 = 1/casadi.fabs(casadi.if_else(t2256, t2254, 1))
     t2258 = casadi.if_else(t2253, casadi.if_else((t2254 >= 0), 1, -1)*casadi.if_else(t2256, t2257/(1 + casadi.sqrt(1 + t2257**2)), 1/(t2255 + casadi.sqrt(1 + t2255**2))), 0)
     t2259 = 1/casadi.sqrt(1 + t2258**2)
     t2260 = t2043*t2258
@@ -6019,10 +6019,10 @@ def _condition_number(q):
     t2286 = t2284 + t2258*t2283
     t2287 = t2127*t2265 + t2131*t2269 + t2135*t2273 + t2139*t2277 + t2143*t2281 + t2147*t2285
     t2288 = (t2287 != 0)
-    t2289 = 0.5*(-t2261 + t2123)/casadi.if_else(t2288, t2287, 1)
+    t2289 = (-t2261 + t2123)/casadi.if_else(t2288, 2*t2287, 1)
     t2290 = casadi.fabs(t2289)
     t2291 = (t2290 >= 1)
-    t2292 = casadi.fabs(1/casadi.if_else(t2291, t2289, 1))
+    t2292 = 1/casadi.fabs(casadi.if_else(t2291, t2289, 1))
     t2293 = casadi.if_else(t2288, casadi.if_else((t2289 >= 0), 1, -1)*casadi.if_else(t2291, t2292/(1 + casadi.sqrt(1 + t2292**2)), 1/(t2290 + casadi.sqrt(1 + t2290**2))), 0)
     t2294 = 1/casadi.sqrt(1 + t2293**2)
     t2295 = t2287*t2293
@@ -6055,10 +6055,10 @@ def _condition_number(q):
     t2322 = t2196*t2300 + t2200*t2304 + t2204*t2308 + t2208*t2312 + t2212*t2316 + t2216*t2320
     t2323 = t2266*t2301 + t2270*t2305 + t2274*t2309 + t2278*t2313 + t2282*t2317 + t2286*t2321
     t2324 = (t2322 != 0)
-    t2325 = 0.5*(-t2296 + t2192)/casadi.if_else(t2324, t2322, 1)
+    t2325 = (-t2296 + t2192)/casadi.if_else(t2324, 2*t2322, 1)
     t2326 = casadi.fabs(t2325)
     t2327 = (t2326 >= 1)
-    t2328 = casadi.fabs(1/casadi.if_else(t2327, t2325, 1))
+    t2328 = 1/casadi.fabs(casadi.if_else(t2327, t2325, 1))
     t2329 = casadi.if_else(t2324, casadi.if_else((t2325 >= 0), 1, -1)*casadi.if_else(t2327, t2328/(1 + casadi.sqrt(1 + t2328**2)), 1/(t2326 + casadi.sqrt(1 + t2326**2))), 0)
     t2330 = 1/casadi.sqrt(1 + t2329**2)
     t2331 = t2322*t2329
@@ -6090,10 +6090,10 @@ def _condition_number(q):
     t2357 = t2355 + t2329*t2354
     t2358 = t2231*t2336 + t2235*t2340 + t2239*t2344 + t2243*t2348 + t2247*t2352 + t2251*t2356
     t2359 = (t2358 != 0)
-    t2360 = 0.5*(-t2332 + t2227)/casadi.if_else(t2359, t2358, 1)
+    t2360 = (-t2332 + t2227)/casadi.if_else(t2359, 2*t2358, 1)
     t2361 = casadi.fabs(t2360)
     t2362 = (t2361 >= 1)
-    t2363 = casadi.fabs(1/casadi.if_else(t2362, t2360, 1))
+    t2363 = 1/casadi.fabs(casadi.if_else(t2362, t2360, 1))
     t2364 = casadi.if_else(t2359, casadi.if_else((t2360 >= 0), 1, -1)*casadi.if_else(t2362, t2363/(1 + casadi.sqrt(1 + t2363**2)), 1/(t2361 + casadi.sqrt(1 + t2361**2))), 0)
     t2365 = 1/casadi.sqrt(1 + t2364**2)
     t2366 = t2358*t2364
@@ -6125,10 +6125,10 @@ def _condition_number(q):
     t2392 = t2390 + t2364*t2389
     t2393 = t2232*t2371 + t2236*t2375 + t2240*t2379 + t2244*t2383 + t2248*t2387 + t2252*t2391
     t2394 = (t2393 != 0)
-    t2395 = 0.5*(-t2367 + t2228)/casadi.if_else(t2394, t2393, 1)
+    t2395 = (-t2367 + t2228)/casadi.if_else(t2394, 2*t2393, 1)
     t2396 = casadi.fabs(t2395)
     t2397 = (t2396 >= 1)
-    t2398 = casadi.fabs(1/casadi.if_else(t2397, t2395, 1))
+    t2398 = 1/casadi.fabs(casadi.if_else(t2397, t2395, 1))
     t2399 = casadi.if_else(t2394, casadi.if_else((t2395 >= 0), 1, -1)*casadi.if_else(t2397, t2398/(1 + casadi.sqrt(1 + t2398**2)), 1/(t2396 + casadi.sqrt(1 + t2396**2))), 0)
     t2400 = 1/casadi.sqrt(1 + t2399**2)
     t2401 = t2393*t2399
@@ -6159,10 +6159,10 @@ def _condition_number(q):
     t2426 = t2424 - t2399*t2425
     t2427 = t2425 + t2399*t2424
     t2428 = (t2323 != 0)
-    t2429 = 0.5*(-t2262 + t2297)/casadi.if_else(t2428, t2323, 1)
+    t2429 = (-t2262 + t2297)/casadi.if_else(t2428, 2*t2323, 1)
     t2430 = casadi.fabs(t2429)
     t2431 = (t2430 >= 1)
-    t2432 = casadi.fabs(1/casadi.if_else(t2431, t2429, 1))
+    t2432 = 1/casadi.fabs(casadi.if_else(t2431, t2429, 1))
     t2433 = casadi.if_else(t2428, casadi.if_else((t2429 >= 0), 1, -1)*casadi.if_else(t2431, t2432/(1 + casadi.sqrt(1 + t2432**2)), 1/(t2430 + casadi.sqrt(1 + t2430**2))), 0)
     t2434 = 1/casadi.sqrt(1 + t2433**2)
     t2435 = t2323*t2433
@@ -6194,10 +6194,10 @@ def _condition_number(q):
     t2461 = t2459 + t2433*t2458
     t2462 = t2337*t2440 + t2341*t2444 + t2345*t2448 + t2349*t2452 + t2353*t2456 + t2357*t2460
     t2463 = (t2462 != 0)
-    t2464 = 0.5*(-t2436 + t2333)/casadi.if_else(t2463, t2462, 1)
+    t2464 = (-t2436 + t2333)/casadi.if_else(t2463, 2*t2462, 1)
     t2465 = casadi.fabs(t2464)
     t2466 = (t2465 >= 1)
-    t2467 = casadi.fabs(1/casadi.if_else(t2466, t2464, 1))
+    t2467 = 1/casadi.fabs(casadi.if_else(t2466, t2464, 1))
     t2468 = casadi.if_else(t2463, casadi.if_else((t2464 >= 0), 1, -1)*casadi.if_else(t2466, t2467/(1 + casadi.sqrt(1 + t2467**2)), 1/(t2465 + casadi.sqrt(1 + t2465**2))), 0)
     t2469 = 1/casadi.sqrt(1 + t2468**2)
     t2470 = t2462*t2468
@@ -6230,10 +6230,10 @@ def _condition_number(q):
     t2497 = t2372*t2475 + t2376*t2479 + t2380*t2483 + t2384*t2487 + t2388*t2491 + t2392*t2495
     t2498 = t2441*t2476 + t2445*t2480 + t2449*t2484 + t2453*t2488 + t2457*t2492 + t2461*t2496
     t2499 = (t2497 != 0)
-    t2500 = 0.5*(-t2471 + t2368)/casadi.if_else(t2499, t2497, 1)
+    t2500 = (-t2471 + t2368)/casadi.if_else(t2499, 2*t2497, 1)
     t2501 = casadi.fabs(t2500)
     t2502 = (t2501 >= 1)
-    t2503 = casadi.fabs(1/casadi.if_else(t2502, t2500, 1))
+    t2503 = 1/casadi.fabs(casadi.if_else(t2502, t2500, 1))
     t2504 = casadi.if_else(t2499, casadi.if_else((t2500 >= 0), 1, -1)*casadi.if_else(t2502, t2503/(1 + casadi.sqrt(1 + t2503**2)), 1/(t2501 + casadi.sqrt(1 + t2501**2))), 0)
     t2505 = 1/casadi.sqrt(1 + t2504**2)
     t2506 = t2497*t2504
@@ -6265,10 +6265,10 @@ def _condition_number(q):
     t2532 = t2530 + t2504*t2529
     t2533 = t2407*t2511 + t2411*t2515 + t2415*t2519 + t2419*t2523 + t2423*t2527 + t2427*t2531
     t2534 = (t2533 != 0)
-    t2535 = 0.5*(-t2507 + t2403)/casadi.if_else(t2534, t2533, 1)
+    t2535 = (-t2507 + t2403)/casadi.if_else(t2534, 2*t2533, 1)
     t2536 = casadi.fabs(t2535)
     t2537 = (t2536 >= 1)
-    t2538 = casadi.fabs(1/casadi.if_else(t2537, t2535, 1))
+    t2538 = 1/casadi.fabs(casadi.if_else(t2537, t2535, 1))
     t2539 = casadi.if_else(t2534, casadi.if_else((t2535 >= 0), 1, -1)*casadi.if_else(t2537, t2538/(1 + casadi.sqrt(1 + t2538**2)), 1/(t2536 + casadi.sqrt(1 + t2536**2))), 0)
     t2540 = 1/casadi.sqrt(1 + t2539**2)
     t2541 = t2533*t2539
@@ -6300,10 +6300,10 @@ def _condition_number(q):
     t2567 = t2565 + t2539*t2564
     t2568 = t2406*t2546 + t2410*t2550 + t2414*t2554 + t2418*t2558 + t2422*t2562 + t2426*t2566
     t2569 = (t2498 != 0)
-    t2570 = 0.5*(-t2437 + t2472)/casadi.if_else(t2569, t2498, 1)
+    t2570 = (-t2437 + t2472)/casadi.if_else(t2569, 2*t2498, 1)
     t2571 = casadi.fabs(t2570)
     t2572 = (t2571 >= 1)
-    t2573 = casadi.fabs(1/casadi.if_else(t2572, t2570, 1))
+    t2573 = 1/casadi.fabs(casadi.if_else(t2572, t2570, 1))
     t2574 = casadi.if_else(t2569, casadi.if_else((t2570 >= 0), 1, -1)*casadi.if_else(t2572, t2573/(1 + casadi.sqrt(1 + t2573**2)), 1/(t2571 + casadi.sqrt(1 + t2571**2))), 0)
     t2575 = 1/casadi.sqrt(1 + t2574**2)
     t2576 = t2498*t2574
@@ -6335,10 +6335,10 @@ def _condition_number(q):
     t2602 = t2600 + t2574*t2599
     t2603 = t2512*t2581 + t2516*t2585 + t2520*t2589 + t2524*t2593 + t2528*t2597 + t2532*t2601
     t2604 = (t2603 != 0)
-    t2605 = 0.5*(-t2577 + t2508)/casadi.if_else(t2604, t2603, 1)
+    t2605 = (-t2577 + t2508)/casadi.if_else(t2604, 2*t2603, 1)
     t2606 = casadi.fabs(t2605)
     t2607 = (t2606 >= 1)
-    t2608 = casadi.fabs(1/casadi.if_else(t2607, t2605, 1))
+    t2608 = 1/casadi.fabs(casadi.if_else(t2607, t2605, 1))
     t2609 = casadi.if_else(t2604, casadi.if_else((t2605 >= 0), 1, -1)*casadi.if_else(t2607, t2608/(1 + casadi.sqrt(1 + t2608**2)), 1/(t2606 + casadi.sqrt(1 + t2606**2))), 0)
     t2610 = 1/casadi.sqrt(1 + t2609**2)
     t2611 = t2603*t2609
@@ -6371,10 +6371,10 @@ def _condition_number(q):
     t2638 = t2547*t2616 + t2551*t2620 + t2555*t2624 + t2559*t2628 + t2563*t2632 + t2567*t2636
     t2639 = t2582*t2617 + t2586*t2621 + t2590*t2625 + t2594*t2629 + t2598*t2633 + t2602*t2637
     t2640 = (t2638 != 0)
-    t2641 = 0.5*(-t2612 + t2543)/casadi.if_else(t2640, t2638, 1)
+    t2641 = (-t2612 + t2543)/casadi.if_else(t2640, 2*t2638, 1)
     t2642 = casadi.fabs(t2641)
     t2643 = (t2642 >= 1)
-    t2644 = casadi.fabs(1/casadi.if_else(t2643, t2641, 1))
+    t2644 = 1/casadi.fabs(casadi.if_else(t2643, t2641, 1))
     t2645 = casadi.if_else(t2640, casadi.if_else((t2641 >= 0), 1, -1)*casadi.if_else(t2643, t2644/(1 + casadi.sqrt(1 + t2644**2)), 1/(t2642 + casadi.sqrt(1 + t2642**2))), 0)
     t2646 = 1/casadi.sqrt(1 + t2645**2)
     t2647 = t2638*t2645
@@ -6405,10 +6405,10 @@ def _condition_number(q):
     t2672 = t2670 - t2645*t2671
     t2673 = t2671 + t2645*t2670
     t2674 = (t2639 != 0)
-    t2675 = 0.5*(-t2578 + t2613)/casadi.if_else(t2674, t2639, 1)
+    t2675 = (-t2578 + t2613)/casadi.if_else(t2674, 2*t2639, 1)
     t2676 = casadi.fabs(t2675)
     t2677 = (t2676 >= 1)
-    t2678 = casadi.fabs(1/casadi.if_else(t2677, t2675, 1))
+    t2678 = 1/casadi.fabs(casadi.if_else(t2677, t2675, 1))
     t2679 = casadi.if_else(t2674, casadi.if_else((t2675 >= 0), 1, -1)*casadi.if_else(t2677, t2678/(1 + casadi.sqrt(1 + t2678**2)), 1/(t2676 + casadi.sqrt(1 + t2676**2))), 0)
     t2680 = 1/casadi.sqrt(1 + t2679**2)
     t2681 = t2639*t2679
@@ -6440,10 +6440,10 @@ def _condition_number(q):
     t2707 = t2705 + t2679*t2704
     t2708 = t2653*t2686 + t2657*t2690 + t2661*t2694 + t2665*t2698 + t2669*t2702 + t2673*t2706
     t2709 = (t2708 != 0)
-    t2710 = 0.5*(-t2682 + t2649)/casadi.if_else(t2709, t2708, 1)
+    t2710 = (-t2682 + t2649)/casadi.if_else(t2709, 2*t2708, 1)
     t2711 = casadi.fabs(t2710)
     t2712 = (t2711 >= 1)
-    t2713 = casadi.fabs(1/casadi.if_else(t2712, t2710, 1))
+    t2713 = 1/casadi.fabs(casadi.if_else(t2712, t2710, 1))
     t2714 = casadi.if_else(t2709, casadi.if_else((t2710 >= 0), 1, -1)*casadi.if_else(t2712, t2713/(1 + casadi.sqrt(1 + t2713**2)), 1/(t2711 + casadi.sqrt(1 + t2711**2))), 0)
     t2715 = 1/casadi.sqrt(1 + t2714**2)
     t2716 = t2708*t2714
@@ -6475,10 +6475,10 @@ def _condition_number(q):
     t2742 = t2740 + t2714*t2739
     t2743 = t2687*t2722 + t2691*t2726 + t2695*t2730 + t2699*t2734 + t2703*t2738 + t2707*t2742
     t2744 = (t2743 != 0)
-    t2745 = 0.5*(-t2683 + t2718)/casadi.if_else(t2744, t2743, 1)
+    t2745 = (-t2683 + t2718)/casadi.if_else(t2744, 2*t2743, 1)
     t2746 = casadi.fabs(t2745)
     t2747 = (t2746 >= 1)
-    t2748 = casadi.fabs(1/casadi.if_else(t2747, t2745, 1))
+    t2748 = 1/casadi.fabs(casadi.if_else(t2747, t2745, 1))
     t2749 = casadi.if_else(t2744, casadi.if_else((t2745 >= 0), 1, -1)*casadi.if_else(t2747, t2748/(1 + casadi.sqrt(1 + t2748**2)), 1/(t2746 + casadi.sqrt(1 + t2746**2))), 0)
     t2750 = 1/casadi.sqrt(1 + t2749**2)
     t2751 = t2743*t2749
@@ -6509,10 +6509,10 @@ def _condition_number(q):
     t2776 = t2774 - t2749*t2775
     t2777 = t2775 + t2749*t2774
     t2778 = (t2568 != 0)
-    t2779 = 0.5*(-t2402 + t2542)/casadi.if_else(t2778, t2568, 1)
+    t2779 = (-t2402 + t2542)/casadi.if_else(t2778, 2*t2568, 1)
     t2780 = casadi.fabs(t2779)
     t2781 = (t2780 >= 1)
-    t2782 = casadi.fabs(1/casadi.if_else(t2781, t2779, 1))
+    t2782 = 1/casadi.fabs(casadi.if_else(t2781, t2779, 1))
     t2783 = casadi.if_else(t2778, casadi.if_else((t2779 >= 0), 1, -1)*casadi.if_else(t2781, t2782/(1 + casadi.sqrt(1 + t2782**2)), 1/(t2780 + casadi.sqrt(1 + t2780**2))), 0)
     t2784 = 1/casadi.sqrt(1 + t2783**2)
     t2785 = t2568*t2783
@@ -6544,10 +6544,10 @@ def _condition_number(q):
     t2811 = t2809 + t2783*t2808
     t2812 = t2652*t2790 + t2656*t2794 + t2660*t2798 + t2664*t2802 + t2668*t2806 + t2672*t2810
     t2813 = (t2812 != 0)
-    t2814 = 0.5*(-t2786 + t2648)/casadi.if_else(t2813, t2812, 1)
+    t2814 = (-t2786 + t2648)/casadi.if_else(t2813, 2*t2812, 1)
     t2815 = casadi.fabs(t2814)
     t2816 = (t2815 >= 1)
-    t2817 = casadi.fabs(1/casadi.if_else(t2816, t2814, 1))
+    t2817 = 1/casadi.fabs(casadi.if_else(t2816, t2814, 1))
     t2818 = casadi.if_else(t2813, casadi.if_else((t2814 >= 0), 1, -1)*casadi.if_else(t2816, t2817/(1 + casadi.sqrt(1 + t2817**2)), 1/(t2815 + casadi.sqrt(1 + t2815**2))), 0)
     t2819 = 1/casadi.sqrt(1 + t2818**2)
     t2820 = t2812*t2818
@@ -6580,10 +6580,10 @@ def _condition_number(q):
     t2847 = t2721*t2825 + t2725*t2829 + t2729*t2833 + t2733*t2837 + t2737*t2841 + t2741*t2845
     t2848 = t2791*t2826 + t2795*t2830 + t2799*t2834 + t2803*t2838 + t2807*t2842 + t2811*t2846
     t2849 = (t2847 != 0)
-    t2850 = 0.5*(-t2821 + t2717)/casadi.if_else(t2849, t2847, 1)
+    t2850 = (-t2821 + t2717)/casadi.if_else(t2849, 2*t2847, 1)
     t2851 = casadi.fabs(t2850)
     t2852 = (t2851 >= 1)
-    t2853 = casadi.fabs(1/casadi.if_else(t2852, t2850, 1))
+    t2853 = 1/casadi.fabs(casadi.if_else(t2852, t2850, 1))
     t2854 = casadi.if_else(t2849, casadi.if_else((t2850 >= 0), 1, -1)*casadi.if_else(t2852, t2853/(1 + casadi.sqrt(1 + t2853**2)), 1/(t2851 + casadi.sqrt(1 + t2851**2))), 0)
     t2855 = 1/casadi.sqrt(1 + t2854**2)
     t2856 = t2847*t2854
@@ -6615,10 +6615,10 @@ def _condition_number(q):
     t2882 = t2880 + t2854*t2879
     t2883 = t2756*t2861 + t2760*t2865 + t2764*t2869 + t2768*t2873 + t2772*t2877 + t2776*t2881
     t2884 = (t2883 != 0)
-    t2885 = 0.5*(-t2857 + t2752)/casadi.if_else(t2884, t2883, 1)
+    t2885 = (-t2857 + t2752)/casadi.if_else(t2884, 2*t2883, 1)
     t2886 = casadi.fabs(t2885)
     t2887 = (t2886 >= 1)
-    t2888 = casadi.fabs(1/casadi.if_else(t2887, t2885, 1))
+    t2888 = 1/casadi.fabs(casadi.if_else(t2887, t2885, 1))
     t2889 = casadi.if_else(t2884, casadi.if_else((t2885 >= 0), 1, -1)*casadi.if_else(t2887, t2888/(1 + casadi.sqrt(1 + t2888**2)), 1/(t2886 + casadi.sqrt(1 + t2886**2))), 0)
     t2890 = 1/casadi.sqrt(1 + t2889**2)
     t2891 = t2883*t2889
@@ -6650,10 +6650,10 @@ def _condition_number(q):
     t2917 = t2915 + t2889*t2914
     t2918 = t2757*t2896 + t2761*t2900 + t2765*t2904 + t2769*t2908 + t2773*t2912 + t2777*t2916
     t2919 = (t2918 != 0)
-    t2920 = 0.5*(-t2892 + t2753)/casadi.if_else(t2919, t2918, 1)
+    t2920 = (-t2892 + t2753)/casadi.if_else(t2919, 2*t2918, 1)
     t2921 = casadi.fabs(t2920)
     t2922 = (t2921 >= 1)
-    t2923 = casadi.fabs(1/casadi.if_else(t2922, t2920, 1))
+    t2923 = 1/casadi.fabs(casadi.if_else(t2922, t2920, 1))
     t2924 = casadi.if_else(t2919, casadi.if_else((t2920 >= 0), 1, -1)*casadi.if_else(t2922, t2923/(1 + casadi.sqrt(1 + t2923**2)), 1/(t2921 + casadi.sqrt(1 + t2921**2))), 0)
     t2925 = 1/casadi.sqrt(1 + t2924**2)
     t2926 = t2918*t2924
@@ -6684,10 +6684,10 @@ def _condition_number(q):
     t2951 = t2949 - t2924*t2950
     t2952 = t2950 + t2924*t2949
     t2953 = (t2848 != 0)
-    t2954 = 0.5*(-t2787 + t2822)/casadi.if_else(t2953, t2848, 1)
+    t2954 = (-t2787 + t2822)/casadi.if_else(t2953, 2*t2848, 1)
     t2955 = casadi.fabs(t2954)
     t2956 = (t2955 >= 1)
-    t2957 = casadi.fabs(1/casadi.if_else(t2956, t2954, 1))
+    t2957 = 1/casadi.fabs(casadi.if_else(t2956, t2954, 1))
     t2958 = casadi.if_else(t2953, casadi.if_else((t2954 >= 0), 1, -1)*casadi.if_else(t2956, t2957/(1 + casadi.sqrt(1 + t2957**2)), 1/(t2955 + casadi.sqrt(1 + t2955**2))), 0)
     t2959 = 1/casadi.sqrt(1 + t2958**2)
     t2960 = t2848*t2958
@@ -6719,10 +6719,10 @@ def _condition_number(q):
     t2986 = t2984 + t2958*t2983
     t2987 = t2862*t2965 + t2866*t2969 + t2870*t2973 + t2874*t2977 + t2878*t2981 + t2882*t2985
     t2988 = (t2987 != 0)
-    t2989 = 0.5*(-t2961 + t2858)/casadi.if_else(t2988, t2987, 1)
+    t2989 = (-t2961 + t2858)/casadi.if_else(t2988, 2*t2987, 1)
     t2990 = casadi.fabs(t2989)
     t2991 = (t2990 >= 1)
-    t2992 = casadi.fabs(1/casadi.if_else(t2991, t2989, 1))
+    t2992 = 1/casadi.fabs(casadi.if_else(t2991, t2989, 1))
     t2993 = casadi.if_else(t2988, casadi.if_else((t2989 >= 0), 1, -1)*casadi.if_else(t2991, t2992/(1 + casadi.sqrt(1 + t2992**2)), 1/(t2990 + casadi.sqrt(1 + t2990**2))), 0)
     t2994 = 1/casadi.sqrt(1 + t2993**2)
     t2995 = t2987*t2993
@@ -6755,10 +6755,10 @@ def _condition_number(q):
     t3022 = t2897*t3000 + t2901*t3004 + t2905*t3008 + t2909*t3012 + t2913*t3016 + t2917*t3020
     t3023 = t2966*t3001 + t2970*t3005 + t2974*t3009 + t2978*t3013 + t2982*t3017 + t2986*t3021
     t3024 = (t3022 != 0)
-    t3025 = 0.5*(-t2996 + t2893)/casadi.if_else(t3024, t3022, 1)
+    t3025 = (-t2996 + t2893)/casadi.if_else(t3024, 2*t3022, 1)
     t3026 = casadi.fabs(t3025)
     t3027 = (t3026 >= 1)
-    t3028 = casadi.fabs(1/casadi.if_else(t3027, t3025, 1))
+    t3028 = 1/casadi.fabs(casadi.if_else(t3027, t3025, 1))
     t3029 = casadi.if_else(t3024, casadi.if_else((t3025 >= 0), 1, -1)*casadi.if_else(t3027, t3028/(1 + casadi.sqrt(1 + t3028**2)), 1/(t3026 + casadi.sqrt(1 + t3026**2))), 0)
     t3030 = 1/casadi.sqrt(1 + t3029**2)
     t3031 = t3022*t3029
@@ -6790,10 +6790,10 @@ def _condition_number(q):
     t3057 = t3055 + t3029*t3054
     t3058 = t2932*t3036 + t2936*t3040 + t2940*t3044 + t2944*t3048 + t2948*t3052 + t2952*t3056
     t3059 = (t3058 != 0)
-    t3060 = 0.5*(-t3032 + t2928)/casadi.if_else(t3059, t3058, 1)
+    t3060 = (-t3032 + t2928)/casadi.if_else(t3059, 2*t3058, 1)
     t3061 = casadi.fabs(t3060)
     t3062 = (t3061 >= 1)
-    t3063 = casadi.fabs(1/casadi.if_else(t3062, t3060, 1))
+    t3063 = 1/casadi.fabs(casadi.if_else(t3062, t3060, 1))
     t3064 = casadi.if_else(t3059, casadi.if_else((t3060 >= 0), 1, -1)*casadi.if_else(t3062, t3063/(1 + casadi.sqrt(1 + t3063**2)), 1/(t3061 + casadi.sqrt(1 + t3061**2))), 0)
     t3065 = 1/casadi.sqrt(1 + t3064**2)
     t3066 = t3058*t3064
@@ -6825,10 +6825,10 @@ def _condition_number(q):
     t3092 = t3090 + t3064*t3089
     t3093 = t2931*t3071 + t2935*t3075 + t2939*t3079 + t2943*t3083 + t2947*t3087 + t2951*t3091
     t3094 = (t3023 != 0)
-    t3095 = 0.5*(-t2962 + t2997)/casadi.if_else(t3094, t3023, 1)
+    t3095 = (-t2962 + t2997)/casadi.if_else(t3094, 2*t3023, 1)
     t3096 = casadi.fabs(t3095)
     t3097 = (t3096 >= 1)
-    t3098 = casadi.fabs(1/casadi.if_else(t3097, t3095, 1))
+    t3098 = 1/casadi.fabs(casadi.if_else(t3097, t3095, 1))
     t3099 = casadi.if_else(t3094, casadi.if_else((t3095 >= 0), 1, -1)*casadi.if_else(t3097, t3098/(1 + casadi.sqrt(1 + t3098**2)), 1/(t3096 + casadi.sqrt(1 + t3096**2))), 0)
     t3100 = 1/casadi.sqrt(1 + t3099**2)
     t3101 = t3023*t3099
@@ -6860,10 +6860,10 @@ def _condition_number(q):
     t3127 = t3125 + t3099*t3124
     t3128 = t3037*t3106 + t3041*t3110 + t3045*t3114 + t3049*t3118 + t3053*t3122 + t3057*t3126
     t3129 = (t3128 != 0)
-    t3130 = 0.5*(-t3102 + t3033)/casadi.if_else(t3129, t3128, 1)
+    t3130 = (-t3102 + t3033)/casadi.if_else(t3129, 2*t3128, 1)
     t3131 = casadi.fabs(t3130)
     t3132 = (t3131 >= 1)
-    t3133 = casadi.fabs(1/casadi.if_else(t3132, t3130, 1))
+    t3133 = 1/casadi.fabs(casadi.if_else(t3132, t3130, 1))
     t3134 = casadi.if_else(t3129, casadi.if_else((t3130 >= 0), 1, -1)*casadi.if_else(t3132, t3133/(1 + casadi.sqrt(1 + t3133**2)), 1/(t3131 + casadi.sqrt(1 + t3131**2))), 0)
     t3135 = 1/casadi.sqrt(1 + t3134**2)
     t3136 = t3128*t3134
@@ -6896,10 +6896,10 @@ def _condition_number(q):
     t3163 = t3072*t3141 + t3076*t3145 + t3080*t3149 + t3084*t3153 + t3088*t3157 + t3092*t3161
     t3164 = t3107*t3142 + t3111*t3146 + t3115*t3150 + t3119*t3154 + t3123*t3158 + t3127*t3162
     t3165 = (t3163 != 0)
-    t3166 = 0.5*(-t3137 + t3068)/casadi.if_else(t3165, t3163, 1)
+    t3166 = (-t3137 + t3068)/casadi.if_else(t3165, 2*t3163, 1)
     t3167 = casadi.fabs(t3166)
     t3168 = (t3167 >= 1)
-    t3169 = casadi.fabs(1/casadi.if_else(t3168, t3166, 1))
+    t3169 = 1/casadi.fabs(casadi.if_else(t3168, t3166, 1))
     t3170 = casadi.if_else(t3165, casadi.if_else((t3166 >= 0), 1, -1)*casadi.if_else(t3168, t3169/(1 + casadi.sqrt(1 + t3169**2)), 1/(t3167 + casadi.sqrt(1 + t3167**2))), 0)
     t3171 = 1/casadi.sqrt(1 + t3170**2)
     t3172 = t3163*t3170
@@ -6930,10 +6930,10 @@ def _condition_number(q):
     t3197 = t3195 - t3170*t3196
     t3198 = t3196 + t3170*t3195
     t3199 = (t3164 != 0)
-    t3200 = 0.5*(-t3103 + t3138)/casadi.if_else(t3199, t3164, 1)
+    t3200 = (-t3103 + t3138)/casadi.if_else(t3199, 2*t3164, 1)
     t3201 = casadi.fabs(t3200)
     t3202 = (t3201 >= 1)
-    t3203 = casadi.fabs(1/casadi.if_else(t3202, t3200, 1))
+    t3203 = 1/casadi.fabs(casadi.if_else(t3202, t3200, 1))
     t3204 = casadi.if_else(t3199, casadi.if_else((t3200 >= 0), 1, -1)*casadi.if_else(t3202, t3203/(1 + casadi.sqrt(1 + t3203**2)), 1/(t3201 + casadi.sqrt(1 + t3201**2))), 0)
     t3205 = 1/casadi.sqrt(1 + t3204**2)
     t3206 = t3164*t3204
@@ -6965,10 +6965,10 @@ def _condition_number(q):
     t3232 = t3230 + t3204*t3229
     t3233 = t3178*t3211 + t3182*t3215 + t3186*t3219 + t3190*t3223 + t3194*t3227 + t3198*t3231
     t3234 = (t3233 != 0)
-    t3235 = 0.5*(-t3207 + t3174)/casadi.if_else(t3234, t3233, 1)
+    t3235 = (-t3207 + t3174)/casadi.if_else(t3234, 2*t3233, 1)
     t3236 = casadi.fabs(t3235)
     t3237 = (t3236 >= 1)
-    t3238 = casadi.fabs(1/casadi.if_else(t3237, t3235, 1))
+    t3238 = 1/casadi.fabs(casadi.if_else(t3237, t3235, 1))
     t3239 = casadi.if_else(t3234, casadi.if_else((t3235 >= 0), 1, -1)*casadi.if_else(t3237, t3238/(1 + casadi.sqrt(1 + t3238**2)), 1/(t3236 + casadi.sqrt(1 + t3236**2))), 0)
     t3240 = 1/casadi.sqrt(1 + t3239**2)
     t3241 = t3233*t3239
@@ -7000,10 +7000,10 @@ def _condition_number(q):
     t3267 = t3265 + t3239*t3264
     t3268 = t3212*t3247 + t3216*t3251 + t3220*t3255 + t3224*t3259 + t3228*t3263 + t3232*t3267
     t3269 = (t3268 != 0)
-    t3270 = 0.5*(-t3208 + t3243)/casadi.if_else(t3269, t3268, 1)
+    t3270 = (-t3208 + t3243)/casadi.if_else(t3269, 2*t3268, 1)
     t3271 = casadi.fabs(t3270)
     t3272 = (t3271 >= 1)
-    t3273 = casadi.fabs(1/casadi.if_else(t3272, t3270, 1))
+    t3273 = 1/casadi.fabs(casadi.if_else(t3272, t3270, 1))
     t3274 = casadi.if_else(t3269, casadi.if_else((t3270 >= 0), 1, -1)*casadi.if_else(t3272, t3273/(1 + casadi.sqrt(1 + t3273**2)), 1/(t3271 + casadi.sqrt(1 + t3271**2))), 0)
     t3275 = 1/casadi.sqrt(1 + t3274**2)
     t3276 = t3268*t3274
@@ -7034,10 +7034,10 @@ def _condition_number(q):
     t3301 = t3299 - t3274*t3300
     t3302 = t3300 + t3274*t3299
     t3303 = (t3093 != 0)
-    t3304 = 0.5*(-t2927 + t3067)/casadi.if_else(t3303, t3093, 1)
+    t3304 = (-t2927 + t3067)/casadi.if_else(t3303, 2*t3093, 1)
     t3305 = casadi.fabs(t3304)
     t3306 = (t3305 >= 1)
-    t3307 = casadi.fabs(1/casadi.if_else(t3306, t3304, 1))
+    t3307 = 1/casadi.fabs(casadi.if_else(t3306, t3304, 1))
     t3308 = casadi.if_else(t3303, casadi.if_else((t3304 >= 0), 1, -1)*casadi.if_else(t3306, t3307/(1 + casadi.sqrt(1 + t3307**2)), 1/(t3305 + casadi.sqrt(1 + t3305**2))), 0)
     t3309 = 1/casadi.sqrt(1 + t3308**2)
     t3310 = t3093*t3308
@@ -7069,10 +7069,10 @@ def _condition_number(q):
     t3336 = t3334 + t3308*t3333
     t3337 = t3177*t3315 + t3181*t3319 + t3185*t3323 + t3189*t3327 + t3193*t3331 + t3197*t3335
     t3338 = (t3337 != 0)
-    t3339 = 0.5*(-t3311 + t3173)/casadi.if_else(t3338, t3337, 1)
+    t3339 = (-t3311 + t3173)/casadi.if_else(t3338, 2*t3337, 1)
     t3340 = casadi.fabs(t3339)
     t3341 = (t3340 >= 1)
-    t3342 = casadi.fabs(1/casadi.if_else(t3341, t3339, 1))
+    t3342 = 1/casadi.fabs(casadi.if_else(t3341, t3339, 1))
     t3343 = casadi.if_else(t3338, casadi.if_else((t3339 >= 0), 1, -1)*casadi.if_else(t3341, t3342/(1 + casadi.sqrt(1 + t3342**2)), 1/(t3340 + casadi.sqrt(1 + t3340**2))), 0)
     t3344 = 1/casadi.sqrt(1 + t3343**2)
     t3345 = t3337*t3343
@@ -7105,10 +7105,10 @@ def _condition_number(q):
     t3372 = t3246*t3350 + t3250*t3354 + t3254*t3358 + t3258*t3362 + t3262*t3366 + t3266*t3370
     t3373 = t3316*t3351 + t3320*t3355 + t3324*t3359 + t3328*t3363 + t3332*t3367 + t3336*t3371
     t3374 = (t3372 != 0)
-    t3375 = 0.5*(-t3346 + t3242)/casadi.if_else(t3374, t3372, 1)
+    t3375 = (-t3346 + t3242)/casadi.if_else(t3374, 2*t3372, 1)
     t3376 = casadi.fabs(t3375)
     t3377 = (t3376 >= 1)
-    t3378 = casadi.fabs(1/casadi.if_else(t3377, t3375, 1))
+    t3378 = 1/casadi.fabs(casadi.if_else(t3377, t3375, 1))
     t3379 = casadi.if_else(t3374, casadi.if_else((t3375 >= 0), 1, -1)*casadi.if_else(t3377, t3378/(1 + casadi.sqrt(1 + t3378**2)), 1/(t3376 + casadi.sqrt(1 + t3376**2))), 0)
     t3380 = 1/casadi.sqrt(1 + t3379**2)
     t3381 = t3372*t3379
@@ -7140,10 +7140,10 @@ def _condition_number(q):
     t3407 = t3405 + t3379*t3404
     t3408 = t3281*t3386 + t3285*t3390 + t3289*t3394 + t3293*t3398 + t3297*t3402 + t3301*t3406
     t3409 = (t3408 != 0)
-    t3410 = 0.5*(-t3382 + t3277)/casadi.if_else(t3409, t3408, 1)
+    t3410 = (-t3382 + t3277)/casadi.if_else(t3409, 2*t3408, 1)
     t3411 = casadi.fabs(t3410)
     t3412 = (t3411 >= 1)
-    t3413 = casadi.fabs(1/casadi.if_else(t3412, t3410, 1))
+    t3413 = 1/casadi.fabs(casadi.if_else(t3412, t3410, 1))
     t3414 = casadi.if_else(t3409, casadi.if_else((t3410 >= 0), 1, -1)*casadi.if_else(t3412, t3413/(1 + casadi.sqrt(1 + t3413**2)), 1/(t3411 + casadi.sqrt(1 + t3411**2))), 0)
     t3415 = 1/casadi.sqrt(1 + t3414**2)
     t3416 = t3408*t3414
@@ -7175,10 +7175,10 @@ def _condition_number(q):
     t3442 = t3440 + t3414*t3439
     t3443 = t3282*t3421 + t3286*t3425 + t3290*t3429 + t3294*t3433 + t3298*t3437 + t3302*t3441
     t3444 = (t3443 != 0)
-    t3445 = 0.5*(-t3417 + t3278)/casadi.if_else(t3444, t3443, 1)
+    t3445 = (-t3417 + t3278)/casadi.if_else(t3444, 2*t3443, 1)
     t3446 = casadi.fabs(t3445)
     t3447 = (t3446 >= 1)
-    t3448 = casadi.fabs(1/casadi.if_else(t3447, t3445, 1))
+    t3448 = 1/casadi.fabs(casadi.if_else(t3447, t3445, 1))
     t3449 = casadi.if_else(t3444, casadi.if_else((t3445 >= 0), 1, -1)*casadi.if_else(t3447, t3448/(1 + casadi.sqrt(1 + t3448**2)), 1/(t3446 + casadi.sqrt(1 + t3446**2))), 0)
     t3450 = 1/casadi.sqrt(1 + t3449**2)
     t3451 = t3278 + t3443*t3449
@@ -7208,10 +7208,10 @@ def _condition_number(q):
     t3475 = t3473 + t3449*t3472
     t3476 = casadi.sqrt(t3454**2 + t3458**2 + t3462**2 + t3466**2 + t3470**2 + t3474**2)
     t3477 = (t3373 != 0)
-    t3478 = 0.5*(-t3312 + t3347)/casadi.if_else(t3477, t3373, 1)
+    t3478 = (-t3312 + t3347)/casadi.if_else(t3477, 2*t3373, 1)
     t3479 = casadi.fabs(t3478)
     t3480 = (t3479 >= 1)
-    t3481 = casadi.fabs(1/casadi.if_else(t3480, t3478, 1))
+    t3481 = 1/casadi.fabs(casadi.if_else(t3480, t3478, 1))
     t3482 = casadi.if_else(t3477, casadi.if_else((t3478 >= 0), 1, -1)*casadi.if_else(t3480, t3481/(1 + casadi.sqrt(1 + t3481**2)), 1/(t3479 + casadi.sqrt(1 + t3479**2))), 0)
     t3483 = 1/casadi.sqrt(1 + t3482**2)
     t3484 = t3373*t3482
@@ -7243,10 +7243,10 @@ def _condition_number(q):
     t3510 = t3508 + t3482*t3507
     t3511 = t3387*t3489 + t3391*t3493 + t3395*t3497 + t3399*t3501 + t3403*t3505 + t3407*t3509
     t3512 = (t3511 != 0)
-    t3513 = 0.5*(-t3485 + t3383)/casadi.if_else(t3512, t3511, 1)
+    t3513 = (-t3485 + t3383)/casadi.if_else(t3512, 2*t3511, 1)
     t3514 = casadi.fabs(t3513)
     t3515 = (t3514 >= 1)
-    t3516 = casadi.fabs(1/casadi.if_else(t3515, t3513, 1))
+    t3516 = 1/casadi.fabs(casadi.if_else(t3515, t3513, 1))
     t3517 = casadi.if_else(t3512, casadi.if_else((t3513 >= 0), 1, -1)*casadi.if_else(t3515, t3516/(1 + casadi.sqrt(1 + t3516**2)), 1/(t3514 + casadi.sqrt(1 + t3514**2))), 0)
     t3518 = 1/casadi.sqrt(1 + t3517**2)
     t3519 = t3511*t3517
@@ -7279,10 +7279,10 @@ def _condition_number(q):
     t3546 = t3422*t3524 + t3426*t3528 + t3430*t3532 + t3434*t3536 + t3438*t3540 + t3442*t3544
     t3547 = t3490*t3525 + t3494*t3529 + t3498*t3533 + t3502*t3537 + t3506*t3541 + t3510*t3545
     t3548 = (t3546 != 0)
-    t3549 = 0.5*(-t3520 + t3418)/casadi.if_else(t3548, t3546, 1)
+    t3549 = (-t3520 + t3418)/casadi.if_else(t3548, 2*t3546, 1)
     t3550 = casadi.fabs(t3549)
     t3551 = (t3550 >= 1)
-    t3552 = casadi.fabs(1/casadi.if_else(t3551, t3549, 1))
+    t3552 = 1/casadi.fabs(casadi.if_else(t3551, t3549, 1))
     t3553 = casadi.if_else(t3548, casadi.if_else((t3549 >= 0), 1, -1)*casadi.if_else(t3551, t3552/(1 + casadi.sqrt(1 + t3552**2)), 1/(t3550 + casadi.sqrt(1 + t3550**2))), 0)
     t3554 = 1/casadi.sqrt(1 + t3553**2)
     t3555 = t3546*t3553
@@ -7314,10 +7314,10 @@ def _condition_number(q):
     t3581 = t3579 + t3553*t3578
     t3582 = t3455*t3560 + t3459*t3564 + t3463*t3568 + t3467*t3572 + t3471*t3576 + t3475*t3580
     t3583 = (t3582 != 0)
-    t3584 = 0.5*(-t3556 + t3451)/casadi.if_else(t3583, t3582, 1)
+    t3584 = (-t3556 + t3451)/casadi.if_else(t3583, 2*t3582, 1)
     t3585 = casadi.fabs(t3584)
     t3586 = (t3585 >= 1)
-    t3587 = casadi.fabs(1/casadi.if_else(t3586, t3584, 1))
+    t3587 = 1/casadi.fabs(casadi.if_else(t3586, t3584, 1))
     t3588 = casadi.if_else(t3583, casadi.if_else((t3584 >= 0), 1, -1)*casadi.if_else(t3586, t3587/(1 + casadi.sqrt(1 + t3587**2)), 1/(t3585 + casadi.sqrt(1 + t3585**2))), 0)
     t3589 = 1/casadi.sqrt(1 + t3588**2)
     t3590 = t3451 + t3582*t3588
@@ -7349,10 +7349,10 @@ def _condition_number(q):
     t3616 = casadi.if_else((t3615 > t3476), t3615, t3476)
     t3617 = casadi.if_else((t3615 < t3476), t3615, t3476)
     t3618 = (t3547 != 0)
-    t3619 = 0.5*(-t3486 + t3521)/casadi.if_else(t3618, t3547, 1)
+    t3619 = (-t3486 + t3521)/casadi.if_else(t3618, 2*t3547, 1)
     t3620 = casadi.fabs(t3619)
     t3621 = (t3620 >= 1)
-    t3622 = casadi.fabs(1/casadi.if_else(t3621, t3619, 1))
+    t3622 = 1/casadi.fabs(casadi.if_else(t3621, t3619, 1))
     t3623 = casadi.if_else(t3618, casadi.if_else((t3619 >= 0), 1, -1)*casadi.if_else(t3621, t3622/(1 + casadi.sqrt(1 + t3622**2)), 1/(t3620 + casadi.sqrt(1 + t3620**2))), 0)
     t3624 = 1/casadi.sqrt(1 + t3623**2)
     t3625 = t3547*t3623
@@ -7384,10 +7384,10 @@ def _condition_number(q):
     t3651 = t3649 + t3623*t3648
     t3652 = t3561*t3630 + t3565*t3634 + t3569*t3638 + t3573*t3642 + t3577*t3646 + t3581*t3650
     t3653 = (t3652 != 0)
-    t3654 = 0.5*(-t3626 + t3557)/casadi.if_else(t3653, t3652, 1)
+    t3654 = (-t3626 + t3557)/casadi.if_else(t3653, 2*t3652, 1)
     t3655 = casadi.fabs(t3654)
     t3656 = (t3655 >= 1)
-    t3657 = casadi.fabs(1/casadi.if_else(t3656, t3654, 1))
+    t3657 = 1/casadi.fabs(casadi.if_else(t3656, t3654, 1))
     t3658 = casadi.if_else(t3653, casadi.if_else((t3654 >= 0), 1, -1)*casadi.if_else(t3656, t3657/(1 + casadi.sqrt(1 + t3657**2)), 1/(t3655 + casadi.sqrt(1 + t3655**2))), 0)
     t3659 = 1/casadi.sqrt(1 + t3658**2)
     t3660 = t3652*t3658
@@ -7420,10 +7420,10 @@ def _condition_number(q):
     t3687 = t3594*t3665 + t3598*t3669 + t3602*t3673 + t3606*t3677 + t3610*t3681 + t3614*t3685
     t3688 = t3631*t3666 + t3635*t3670 + t3639*t3674 + t3643*t3678 + t3647*t3682 + t3651*t3686
     t3689 = (t3687 != 0)
-    t3690 = 0.5*(-t3661 + t3590)/casadi.if_else(t3689, t3687, 1)
+    t3690 = (-t3661 + t3590)/casadi.if_else(t3689, 2*t3687, 1)
     t3691 = casadi.fabs(t3690)
     t3692 = (t3691 >= 1)
-    t3693 = casadi.fabs(1/casadi.if_else(t3692, t3690, 1))
+    t3693 = 1/casadi.fabs(casadi.if_else(t3692, t3690, 1))
     t3694 = casadi.if_else(t3689, casadi.if_else((t3690 >= 0), 1, -1)*casadi.if_else(t3692, t3693/(1 + casadi.sqrt(1 + t3693**2)), 1/(t3691 + casadi.sqrt(1 + t3691**2))), 0)
     t3695 = 1/casadi.sqrt(1 + t3694**2)
     t3696 = t3590 + t3687*t3694
@@ -7455,10 +7455,10 @@ def _condition_number(q):
     t3722 = casadi.if_else((t3721 > t3616), t3721, t3616)
     t3723 = casadi.if_else((t3721 < t3617), t3721, t3617)
     t3724 = (t3688 != 0)
-    t3725 = 0.5*(-t3627 + t3662)/casadi.if_else(t3724, t3688, 1)
+    t3725 = (-t3627 + t3662)/casadi.if_else(t3724, 2*t3688, 1)
     t3726 = casadi.fabs(t3725)
     t3727 = (t3726 >= 1)
-    t3728 = casadi.fabs(1/casadi.if_else(t3727, t3725, 1))
+    t3728 = 1/casadi.fabs(casadi.if_else(t3727, t3725, 1))
     t3729 = casadi.if_else(t3724, casadi.if_else((t3725 >= 0), 1, -1)*casadi.if_else(t3727, t3728/(1 + casadi.sqrt(1 + t3728**2)), 1/(t3726 + casadi.sqrt(1 + t3726**2))), 0)
     t3730 = 1/casadi.sqrt(1 + t3729**2)
     t3731 = t3688*t3729
@@ -7490,10 +7490,10 @@ def _condition_number(q):
     t3757 = t3755 + t3729*t3754
     t3758 = t3700*t3736 + t3704*t3740 + t3708*t3744 + t3712*t3748 + t3716*t3752 + t3720*t3756
     t3759 = (t3758 != 0)
-    t3760 = 0.5*(-t3732 + t3696)/casadi.if_else(t3759, t3758, 1)
+    t3760 = (-t3732 + t3696)/casadi.if_else(t3759, 2*t3758, 1)
     t3761 = casadi.fabs(t3760)
     t3762 = (t3761 >= 1)
-    t3763 = casadi.fabs(1/casadi.if_else(t3762, t3760, 1))
+    t3763 = 1/casadi.fabs(casadi.if_else(t3762, t3760, 1))
     t3764 = casadi.if_else(t3759, casadi.if_else((t3760 >= 0), 1, -1)*casadi.if_else(t3762, t3763/(1 + casadi.sqrt(1 + t3763**2)), 1/(t3761 + casadi.sqrt(1 + t3761**2))), 0)
     t3765 = 1/casadi.sqrt(1 + t3764**2)
     t3766 = t3696 + t3758*t3764
@@ -7526,10 +7526,10 @@ def _condition_number(q):
     t3793 = casadi.if_else((t3792 > t3722), t3792, t3722)
     t3794 = casadi.if_else((t3792 < t3723), t3792, t3723)
     t3795 = (t3791 != 0)
-    t3796 = 0.5*(-t3733 + t3766)/casadi.if_else(t3795, t3791, 1)
+    t3796 = (-t3733 + t3766)/casadi.if_else(t3795, 2*t3791, 1)
     t3797 = casadi.fabs(t3796)
     t3798 = (t3797 >= 1)
-    t3799 = casadi.fabs(1/casadi.if_else(t3798, t3796, 1))
+    t3799 = 1/casadi.fabs(casadi.if_else(t3798, t3796, 1))
     t3800 = casadi.if_else(t3795, casadi.if_else((t3796 >= 0), 1, -1)*casadi.if_else(t3798, t3799/(1 + casadi.sqrt(1 + t3799**2)), 1/(t3797 + casadi.sqrt(1 + t3797**2))), 0)
     t3801 = 1/casadi.sqrt(1 + t3800**2)
     t3802 = t3737*t3801
@@ -7562,8 +7562,10 @@ def _condition_number(q):
     t3829 = casadi.if_else((t3826 < t3794), t3826, t3794)
     t3830 = casadi.if_else((t3827 > t3828), t3827, t3828)
     t3831 = casadi.if_else((t3827 < t3829), t3827, t3829)
+    t3832 = casadi.if_else((t3831 <= 1e-12*t3830), 0, t3831)
+    t3833 = casadi.if_else((t3830 > 0), t3830, 1)
     kappa = casadi.SX(1, 1)
-    kappa[0, 0] = casadi.if_else((t3830 > 0), t3830, 1)/casadi.if_else((t3831 <= 1e-12*t3830), 0, t3831)
+    kappa[0, 0] = t3833/t3832
     return [kappa]
 
 

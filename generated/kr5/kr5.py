@@ -2403,10 +2403,10 @@ def velocity_ellipsoid(q):
     t73 = t72**2
     t74 = t42*t48
     t75 = xp.not_equal(t74, 0)
-    t76 = 0.5*(-t45 + t58)/xp.where(t75, -t74, 1)
+    t76 = (-t45 + t58)/xp.where(t75, -2*t74, 1)
     t77 = xp.abs(t76)
     t78 = xp.greater_equal(t77, 1)
-    t79 = xp.abs(1/xp.where(t78, t76, 1))
+    t79 = 1/xp.abs(xp.where(t78, t76, 1))
     t80 = xp.where(t75, xp.where(xp.greater_equal(t76, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t78, t79/(1 + xp.sqrt(1 + t79**2)), 1/(t77 + xp.sqrt(1 + t77**2))), 0)
     t81 = 1/xp.sqrt(1 + t80**2)
     t82 = t74*t80
@@ -2422,10 +2422,10 @@ def velocity_ellipsoid(q):
     t92 = t91*t80
     t93 = t89*t87 - t92*t67
     t94 = xp.not_equal(t93, 0)
-    t95 = 0.5*(-t83 + t90)/xp.where(t94, t93, 1)
+    t95 = (-t83 + t90)/xp.where(t94, 2*t93, 1)
     t96 = xp.abs(t95)
     t97 = xp.greater_equal(t96, 1)
-    t98 = xp.abs(1/xp.where(t97, t95, 1))
+    t98 = 1/xp.abs(xp.where(t97, t95, 1))
     t99 = xp.where(t94, xp.where(xp.greater_equal(t95, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t97, t98/(1 + xp.sqrt(1 + t98**2)), 1/(t96 + xp.sqrt(1 + t96**2))), 0)
     t100 = 1/xp.sqrt(1 + t99**2)
     t101 = t93*t99
@@ -2441,10 +2441,10 @@ def velocity_ellipsoid(q):
     t111 = -t109 + t108*t99
     t112 = t88*t107 + t91*t111
     t113 = xp.not_equal(t112, 0)
-    t114 = 0.5*(-t84 + t103)/xp.where(t113, -t112, 1)
+    t114 = (-t84 + t103)/xp.where(t113, -2*t112, 1)
     t115 = xp.abs(t114)
     t116 = xp.greater_equal(t115, 1)
-    t117 = xp.abs(1/xp.where(t116, t114, 1))
+    t117 = 1/xp.abs(xp.where(t116, t114, 1))
     t118 = xp.where(t113, xp.where(xp.greater_equal(t114, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t116, t117/(1 + xp.sqrt(1 + t117**2)), 1/(t115 + xp.sqrt(1 + t115**2))), 0)
     t119 = 1/xp.sqrt(1 + t118**2)
     t120 = t112*t118
@@ -2470,10 +2470,10 @@ def velocity_ellipsoid(q):
     t140 = t118*t119
     t141 = t106*t125 - t110*t130 + t73*t134*t140*t100
     t142 = xp.not_equal(t141, 0)
-    t143 = 0.5*(-t102 + t121)/xp.where(t142, t141, 1)
+    t143 = (-t102 + t121)/xp.where(t142, 2*t141, 1)
     t144 = xp.abs(t143)
     t145 = xp.greater_equal(t144, 1)
-    t146 = xp.abs(1/xp.where(t145, t143, 1))
+    t146 = 1/xp.abs(xp.where(t145, t143, 1))
     t147 = xp.where(t142, xp.where(xp.greater_equal(t143, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t145, t146/(1 + xp.sqrt(1 + t146**2)), 1/(t144 + xp.sqrt(1 + t144**2))), 0)
     t148 = 1/xp.sqrt(1 + t147**2)
     t149 = t141*t147
@@ -2507,10 +2507,10 @@ def velocity_ellipsoid(q):
     t177 = t100*t119
     t178 = t126*t154 + t131*t158 - t72*t177*t167
     t179 = xp.not_equal(t178, 0)
-    t180 = 0.5*(-t150 + t122)/xp.where(t179, t178, 1)
+    t180 = (-t150 + t122)/xp.where(t179, 2*t178, 1)
     t181 = xp.abs(t180)
     t182 = xp.greater_equal(t181, 1)
-    t183 = xp.abs(1/xp.where(t182, t180, 1))
+    t183 = 1/xp.abs(xp.where(t182, t180, 1))
     t184 = xp.where(t179, xp.where(xp.greater_equal(t180, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t182, t183/(1 + xp.sqrt(1 + t183**2)), 1/(t181 + xp.sqrt(1 + t181**2))), 0)
     t185 = 1/xp.sqrt(1 + t184**2)
     t186 = t178*t184
@@ -2542,10 +2542,10 @@ def velocity_ellipsoid(q):
     t212 = t211 - t198*t184
     t213 = t198 + t211*t184
     t214 = xp.not_equal(t202, 0)
-    t215 = 0.5*(-t151 + t188)/xp.where(t214, t202, 1)
+    t215 = (-t151 + t188)/xp.where(t214, 2*t202, 1)
     t216 = xp.abs(t215)
     t217 = xp.greater_equal(t216, 1)
-    t218 = xp.abs(1/xp.where(t217, t215, 1))
+    t218 = 1/xp.abs(xp.where(t217, t215, 1))
     t219 = xp.where(t214, xp.where(xp.greater_equal(t215, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t217, t218/(1 + xp.sqrt(1 + t218**2)), 1/(t216 + xp.sqrt(1 + t216**2))), 0)
     t220 = 1/xp.sqrt(1 + t219**2)
     t221 = t202*t219
@@ -2577,10 +2577,10 @@ def velocity_ellipsoid(q):
     t247 = t245 + t246*t219
     t248 = t246 - t245*t219
     t249 = xp.not_equal(t236, 0)
-    t250 = 0.5*(-t187 + t222)/xp.where(t249, t236, 1)
+    t250 = (-t187 + t222)/xp.where(t249, 2*t236, 1)
     t251 = xp.abs(t250)
     t252 = xp.greater_equal(t251, 1)
-    t253 = xp.abs(1/xp.where(t252, t250, 1))
+    t253 = 1/xp.abs(xp.where(t252, t250, 1))
     t254 = xp.where(t249, xp.where(xp.greater_equal(t250, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t252, t253/(1 + xp.sqrt(1 + t253**2)), 1/(t251 + xp.sqrt(1 + t251**2))), 0)
     t255 = 1/xp.sqrt(1 + t254**2)
     t256 = t236*t254
@@ -2612,10 +2612,10 @@ def velocity_ellipsoid(q):
     t282 = t280 + t281*t254
     t283 = -t281 + t280*t254
     t284 = xp.not_equal(t271, 0)
-    t285 = 0.5*(-t257 + t223)/xp.where(t284, t271, 1)
+    t285 = (-t257 + t223)/xp.where(t284, 2*t271, 1)
     t286 = xp.abs(t285)
     t287 = xp.greater_equal(t286, 1)
-    t288 = xp.abs(1/xp.where(t287, t285, 1))
+    t288 = 1/xp.abs(xp.where(t287, t285, 1))
     t289 = xp.where(t284, xp.where(xp.greater_equal(t285, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t287, t288/(1 + xp.sqrt(1 + t288**2)), 1/(t286 + xp.sqrt(1 + t286**2))), 0)
     t290 = 1/xp.sqrt(1 + t289**2)
     t291 = t271*t289
@@ -2647,10 +2647,10 @@ def velocity_ellipsoid(q):
     t317 = t315 - t289*t316
     t318 = t316 + t289*t315
     t319 = xp.not_equal(t306, 0)
-    t320 = 0.5*(-t258 + t293)/xp.where(t319, t306, 1)
+    t320 = (-t258 + t293)/xp.where(t319, 2*t306, 1)
     t321 = xp.abs(t320)
     t322 = xp.greater_equal(t321, 1)
-    t323 = xp.abs(1/xp.where(t322, t320, 1))
+    t323 = 1/xp.abs(xp.where(t322, t320, 1))
     t324 = xp.where(t319, xp.where(xp.greater_equal(t320, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t322, t323/(1 + xp.sqrt(1 + t323**2)), 1/(t321 + xp.sqrt(1 + t321**2))), 0)
     t325 = 1/xp.sqrt(1 + t324**2)
     t326 = t306*t324
@@ -2682,10 +2682,10 @@ def velocity_ellipsoid(q):
     t352 = t350 - t324*t351
     t353 = t351 + t324*t350
     t354 = xp.not_equal(t341, 0)
-    t355 = 0.5*(-t292 + t327)/xp.where(t354, t341, 1)
+    t355 = (-t292 + t327)/xp.where(t354, 2*t341, 1)
     t356 = xp.abs(t355)
     t357 = xp.greater_equal(t356, 1)
-    t358 = xp.abs(1/xp.where(t357, t355, 1))
+    t358 = 1/xp.abs(xp.where(t357, t355, 1))
     t359 = xp.where(t354, xp.where(xp.greater_equal(t355, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t357, t358/(1 + xp.sqrt(1 + t358**2)), 1/(t356 + xp.sqrt(1 + t356**2))), 0)
     t360 = 1/xp.sqrt(1 + t359**2)
     t361 = t341*t359
@@ -2717,10 +2717,10 @@ def velocity_ellipsoid(q):
     t387 = t385 - t359*t386
     t388 = t386 + t359*t385
     t389 = xp.not_equal(t376, 0)
-    t390 = 0.5*(-t362 + t328)/xp.where(t389, t376, 1)
+    t390 = (-t362 + t328)/xp.where(t389, 2*t376, 1)
     t391 = xp.abs(t390)
     t392 = xp.greater_equal(t391, 1)
-    t393 = xp.abs(1/xp.where(t392, t390, 1))
+    t393 = 1/xp.abs(xp.where(t392, t390, 1))
     t394 = xp.where(t389, xp.where(xp.greater_equal(t390, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t392, t393/(1 + xp.sqrt(1 + t393**2)), 1/(t391 + xp.sqrt(1 + t391**2))), 0)
     t395 = 1/xp.sqrt(1 + t394**2)
     t396 = t376*t394
@@ -2752,10 +2752,10 @@ def velocity_ellipsoid(q):
     t422 = t420 - t394*t421
     t423 = t421 + t394*t420
     t424 = xp.not_equal(t411, 0)
-    t425 = 0.5*(-t363 + t398)/xp.where(t424, t411, 1)
+    t425 = (-t363 + t398)/xp.where(t424, 2*t411, 1)
     t426 = xp.abs(t425)
     t427 = xp.greater_equal(t426, 1)
-    t428 = xp.abs(1/xp.where(t427, t425, 1))
+    t428 = 1/xp.abs(xp.where(t427, t425, 1))
     t429 = xp.where(t424, xp.where(xp.greater_equal(t425, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t427, t428/(1 + xp.sqrt(1 + t428**2)), 1/(t426 + xp.sqrt(1 + t426**2))), 0)
     t430 = 1/xp.sqrt(1 + t429**2)
     t431 = t411*t429
@@ -2787,10 +2787,10 @@ def velocity_ellipsoid(q):
     t457 = t455 - t429*t456
     t458 = t456 + t429*t455
     t459 = xp.not_equal(t446, 0)
-    t460 = 0.5*(-t397 + t432)/xp.where(t459, t446, 1)
+    t460 = (-t397 + t432)/xp.where(t459, 2*t446, 1)
     t461 = xp.abs(t460)
     t462 = xp.greater_equal(t461, 1)
-    t463 = xp.abs(1/xp.where(t462, t460, 1))
+    t463 = 1/xp.abs(xp.where(t462, t460, 1))
     t464 = xp.where(t459, xp.where(xp.greater_equal(t460, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t462, t463/(1 + xp.sqrt(1 + t463**2)), 1/(t461 + xp.sqrt(1 + t461**2))), 0)
     t465 = 1/xp.sqrt(1 + t464**2)
     t466 = t446*t464
@@ -2822,10 +2822,10 @@ def velocity_ellipsoid(q):
     t492 = t490 - t464*t491
     t493 = t491 + t464*t490
     t494 = xp.not_equal(t481, 0)
-    t495 = 0.5*(-t467 + t433)/xp.where(t494, t481, 1)
+    t495 = (-t467 + t433)/xp.where(t494, 2*t481, 1)
     t496 = xp.abs(t495)
     t497 = xp.greater_equal(t496, 1)
-    t498 = xp.abs(1/xp.where(t497, t495, 1))
+    t498 = 1/xp.abs(xp.where(t497, t495, 1))
     t499 = xp.where(t494, xp.where(xp.greater_equal(t495, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t497, t498/(1 + xp.sqrt(1 + t498**2)), 1/(t496 + xp.sqrt(1 + t496**2))), 0)
     t500 = 1/xp.sqrt(1 + t499**2)
     t501 = t433 + t481*t499
@@ -2856,10 +2856,10 @@ def velocity_ellipsoid(q):
     t526 = t524 - t499*t525
     t527 = t525 + t499*t524
     t528 = xp.not_equal(t514, 0)
-    t529 = 0.5*(-t468 + t501)/xp.where(t528, t514, 1)
+    t529 = (-t468 + t501)/xp.where(t528, 2*t514, 1)
     t530 = xp.abs(t529)
     t531 = xp.greater_equal(t530, 1)
-    t532 = xp.abs(1/xp.where(t531, t529, 1))
+    t532 = 1/xp.abs(xp.where(t531, t529, 1))
     t533 = xp.where(t528, xp.where(xp.greater_equal(t529, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t531, t532/(1 + xp.sqrt(1 + t532**2)), 1/(t530 + xp.sqrt(1 + t530**2))), 0)
     t534 = 1/xp.sqrt(1 + t533**2)
     t535 = t472*t534
@@ -2953,10 +2953,10 @@ def velocity_ellipsoid(q):
     t623 = t622**2
     t624 = t604**2 + t616**2 + t623
     t625 = xp.not_equal(t613, 0)
-    t626 = 0.5*(-t596 + t612)/xp.where(t625, t613, 1)
+    t626 = (-t596 + t612)/xp.where(t625, 2*t613, 1)
     t627 = xp.abs(t626)
     t628 = xp.greater_equal(t627, 1)
-    t629 = xp.abs(1/xp.where(t628, t626, 1))
+    t629 = 1/xp.abs(xp.where(t628, t626, 1))
     t630 = xp.where(t625, xp.where(xp.greater_equal(t626, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t628, t629/(1 + xp.sqrt(1 + t629**2)), 1/(t627 + xp.sqrt(1 + t627**2))), 0)
     t631 = 1/xp.sqrt(1 + t630**2)
     t632 = t613*t630
@@ -2970,10 +2970,10 @@ def velocity_ellipsoid(q):
     t640 = t630*t639
     t641 = t604*t637 + t616*t640
     t642 = xp.not_equal(t641, 0)
-    t643 = 0.5*(-t633 + t624)/xp.where(t642, t641, 1)
+    t643 = (-t633 + t624)/xp.where(t642, 2*t641, 1)
     t644 = xp.abs(t643)
     t645 = xp.greater_equal(t644, 1)
-    t646 = xp.abs(1/xp.where(t645, t643, 1))
+    t646 = 1/xp.abs(xp.where(t645, t643, 1))
     t647 = xp.where(t642, xp.where(xp.greater_equal(t643, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t645, t646/(1 + xp.sqrt(1 + t646**2)), 1/(t644 + xp.sqrt(1 + t644**2))), 0)
     t648 = 1/xp.sqrt(1 + t647**2)
     t649 = t641*t647
@@ -2989,10 +2989,10 @@ def velocity_ellipsoid(q):
     t659 = t657 + t647*t656
     t660 = t638*t655 + t659*t639
     t661 = xp.not_equal(t660, 0)
-    t662 = 0.5*(-t634 + t651)/xp.where(t661, -t660, 1)
+    t662 = (-t634 + t651)/xp.where(t661, -2*t660, 1)
     t663 = xp.abs(t662)
     t664 = xp.greater_equal(t663, 1)
-    t665 = xp.abs(1/xp.where(t664, t662, 1))
+    t665 = 1/xp.abs(xp.where(t664, t662, 1))
     t666 = xp.where(t661, xp.where(xp.greater_equal(t662, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t664, t665/(1 + xp.sqrt(1 + t665**2)), 1/(t663 + xp.sqrt(1 + t663**2))), 0)
     t667 = 1/xp.sqrt(1 + t666**2)
     t668 = t660*t666
@@ -3018,10 +3018,10 @@ def velocity_ellipsoid(q):
     t688 = t666*t667
     t689 = t654*t673 + t658*t678 - t648*t623*t682*t688
     t690 = xp.not_equal(t689, 0)
-    t691 = 0.5*(-t650 + t669)/xp.where(t690, -t689, 1)
+    t691 = (-t650 + t669)/xp.where(t690, -2*t689, 1)
     t692 = xp.abs(t691)
     t693 = xp.greater_equal(t692, 1)
-    t694 = xp.abs(1/xp.where(t693, t691, 1))
+    t694 = 1/xp.abs(xp.where(t693, t691, 1))
     t695 = xp.where(t690, xp.where(xp.greater_equal(t691, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t693, t694/(1 + xp.sqrt(1 + t694**2)), 1/(t692 + xp.sqrt(1 + t692**2))), 0)
     t696 = 1/xp.sqrt(1 + t695**2)
     t697 = t689*t695
@@ -3055,10 +3055,10 @@ def velocity_ellipsoid(q):
     t725 = t648*t667
     t726 = t674*t702 + t679*t706 - t622*t715*t725
     t727 = xp.not_equal(t726, 0)
-    t728 = 0.5*(-t698 + t670)/xp.where(t727, t726, 1)
+    t728 = (-t698 + t670)/xp.where(t727, 2*t726, 1)
     t729 = xp.abs(t728)
     t730 = xp.greater_equal(t729, 1)
-    t731 = xp.abs(1/xp.where(t730, t728, 1))
+    t731 = 1/xp.abs(xp.where(t730, t728, 1))
     t732 = xp.where(t727, xp.where(xp.greater_equal(t728, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t730, t731/(1 + xp.sqrt(1 + t731**2)), 1/(t729 + xp.sqrt(1 + t729**2))), 0)
     t733 = 1/xp.sqrt(1 + t732**2)
     t734 = t726*t732
@@ -3090,10 +3090,10 @@ def velocity_ellipsoid(q):
     t760 = t759 - t732*t746
     t761 = t746 + t732*t759
     t762 = xp.not_equal(t750, 0)
-    t763 = 0.5*(-t699 + t736)/xp.where(t762, t750, 1)
+    t763 = (-t699 + t736)/xp.where(t762, 2*t750, 1)
     t764 = xp.abs(t763)
     t765 = xp.greater_equal(t764, 1)
-    t766 = xp.abs(1/xp.where(t765, t763, 1))
+    t766 = 1/xp.abs(xp.where(t765, t763, 1))
     t767 = xp.where(t762, xp.where(xp.greater_equal(t763, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t765, t766/(1 + xp.sqrt(1 + t766**2)), 1/(t764 + xp.sqrt(1 + t764**2))), 0)
     t768 = 1/xp.sqrt(1 + t767**2)
     t769 = t750*t767
@@ -3125,10 +3125,10 @@ def velocity_ellipsoid(q):
     t795 = t793 + t767*t794
     t796 = t794 - t767*t793
     t797 = xp.not_equal(t784, 0)
-    t798 = 0.5*(-t735 + t770)/xp.where(t797, t784, 1)
+    t798 = (-t735 + t770)/xp.where(t797, 2*t784, 1)
     t799 = xp.abs(t798)
     t800 = xp.greater_equal(t799, 1)
-    t801 = xp.abs(1/xp.where(t800, t798, 1))
+    t801 = 1/xp.abs(xp.where(t800, t798, 1))
     t802 = xp.where(t797, xp.where(xp.greater_equal(t798, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t800, t801/(1 + xp.sqrt(1 + t801**2)), 1/(t799 + xp.sqrt(1 + t799**2))), 0)
     t803 = 1/xp.sqrt(1 + t802**2)
     t804 = t784*t802
@@ -3160,10 +3160,10 @@ def velocity_ellipsoid(q):
     t830 = t828 + t802*t829
     t831 = -t829 + t802*t828
     t832 = xp.not_equal(t819, 0)
-    t833 = 0.5*(-t805 + t771)/xp.where(t832, t819, 1)
+    t833 = (-t805 + t771)/xp.where(t832, 2*t819, 1)
     t834 = xp.abs(t833)
     t835 = xp.greater_equal(t834, 1)
-    t836 = xp.abs(1/xp.where(t835, t833, 1))
+    t836 = 1/xp.abs(xp.where(t835, t833, 1))
     t837 = xp.where(t832, xp.where(xp.greater_equal(t833, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t835, t836/(1 + xp.sqrt(1 + t836**2)), 1/(t834 + xp.sqrt(1 + t834**2))), 0)
     t838 = 1/xp.sqrt(1 + t837**2)
     t839 = t819*t837
@@ -3195,10 +3195,10 @@ def velocity_ellipsoid(q):
     t865 = t863 - t837*t864
     t866 = t864 + t837*t863
     t867 = xp.not_equal(t854, 0)
-    t868 = 0.5*(-t806 + t841)/xp.where(t867, t854, 1)
+    t868 = (-t806 + t841)/xp.where(t867, 2*t854, 1)
     t869 = xp.abs(t868)
     t870 = xp.greater_equal(t869, 1)
-    t871 = xp.abs(1/xp.where(t870, t868, 1))
+    t871 = 1/xp.abs(xp.where(t870, t868, 1))
     t872 = xp.where(t867, xp.where(xp.greater_equal(t868, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t870, t871/(1 + xp.sqrt(1 + t871**2)), 1/(t869 + xp.sqrt(1 + t869**2))), 0)
     t873 = 1/xp.sqrt(1 + t872**2)
     t874 = t854*t872
@@ -3230,10 +3230,10 @@ def velocity_ellipsoid(q):
     t900 = t898 - t872*t899
     t901 = t899 + t872*t898
     t902 = xp.not_equal(t889, 0)
-    t903 = 0.5*(-t840 + t875)/xp.where(t902, t889, 1)
+    t903 = (-t840 + t875)/xp.where(t902, 2*t889, 1)
     t904 = xp.abs(t903)
     t905 = xp.greater_equal(t904, 1)
-    t906 = xp.abs(1/xp.where(t905, t903, 1))
+    t906 = 1/xp.abs(xp.where(t905, t903, 1))
     t907 = xp.where(t902, xp.where(xp.greater_equal(t903, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t905, t906/(1 + xp.sqrt(1 + t906**2)), 1/(t904 + xp.sqrt(1 + t904**2))), 0)
     t908 = 1/xp.sqrt(1 + t907**2)
     t909 = t889*t907
@@ -3265,10 +3265,10 @@ def velocity_ellipsoid(q):
     t935 = t933 - t907*t934
     t936 = t934 + t907*t933
     t937 = xp.not_equal(t924, 0)
-    t938 = 0.5*(-t910 + t876)/xp.where(t937, t924, 1)
+    t938 = (-t910 + t876)/xp.where(t937, 2*t924, 1)
     t939 = xp.abs(t938)
     t940 = xp.greater_equal(t939, 1)
-    t941 = xp.abs(1/xp.where(t940, t938, 1))
+    t941 = 1/xp.abs(xp.where(t940, t938, 1))
     t942 = xp.where(t937, xp.where(xp.greater_equal(t938, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t940, t941/(1 + xp.sqrt(1 + t941**2)), 1/(t939 + xp.sqrt(1 + t939**2))), 0)
     t943 = 1/xp.sqrt(1 + t942**2)
     t944 = t924*t942
@@ -3300,10 +3300,10 @@ def velocity_ellipsoid(q):
     t970 = t968 - t942*t969
     t971 = t969 + t942*t968
     t972 = xp.not_equal(t959, 0)
-    t973 = 0.5*(-t911 + t946)/xp.where(t972, t959, 1)
+    t973 = (-t911 + t946)/xp.where(t972, 2*t959, 1)
     t974 = xp.abs(t973)
     t975 = xp.greater_equal(t974, 1)
-    t976 = xp.abs(1/xp.where(t975, t973, 1))
+    t976 = 1/xp.abs(xp.where(t975, t973, 1))
     t977 = xp.where(t972, xp.where(xp.greater_equal(t973, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t975, t976/(1 + xp.sqrt(1 + t976**2)), 1/(t974 + xp.sqrt(1 + t974**2))), 0)
     t978 = 1/xp.sqrt(1 + t977**2)
     t979 = t959*t977
@@ -3335,10 +3335,10 @@ def velocity_ellipsoid(q):
     t1005 = t1003 - t977*t1004
     t1006 = t1004 + t977*t1003
     t1007 = xp.not_equal(t994, 0)
-    t1008 = 0.5*(-t945 + t980)/xp.where(t1007, t994, 1)
+    t1008 = (-t945 + t980)/xp.where(t1007, 2*t994, 1)
     t1009 = xp.abs(t1008)
     t1010 = xp.greater_equal(t1009, 1)
-    t1011 = xp.abs(1/xp.where(t1010, t1008, 1))
+    t1011 = 1/xp.abs(xp.where(t1010, t1008, 1))
     t1012 = xp.where(t1007, xp.where(xp.greater_equal(t1008, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1010, t1011/(1 + xp.sqrt(1 + t1011**2)), 1/(t1009 + xp.sqrt(1 + t1009**2))), 0)
     t1013 = 1/xp.sqrt(1 + t1012**2)
     t1014 = t994*t1012
@@ -3370,10 +3370,10 @@ def velocity_ellipsoid(q):
     t1040 = t1038 - t1012*t1039
     t1041 = t1039 + t1012*t1038
     t1042 = xp.not_equal(t1029, 0)
-    t1043 = 0.5*(-t1015 + t981)/xp.where(t1042, t1029, 1)
+    t1043 = (-t1015 + t981)/xp.where(t1042, 2*t1029, 1)
     t1044 = xp.abs(t1043)
     t1045 = xp.greater_equal(t1044, 1)
-    t1046 = xp.abs(1/xp.where(t1045, t1043, 1))
+    t1046 = 1/xp.abs(xp.where(t1045, t1043, 1))
     t1047 = xp.where(t1042, xp.where(xp.greater_equal(t1043, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1045, t1046/(1 + xp.sqrt(1 + t1046**2)), 1/(t1044 + xp.sqrt(1 + t1044**2))), 0)
     t1048 = 1/xp.sqrt(1 + t1047**2)
     t1049 = t981 + t1029*t1047
@@ -3404,10 +3404,10 @@ def velocity_ellipsoid(q):
     t1074 = t1072 - t1047*t1073
     t1075 = t1073 + t1047*t1072
     t1076 = xp.not_equal(t1062, 0)
-    t1077 = 0.5*(-t1016 + t1049)/xp.where(t1076, t1062, 1)
+    t1077 = (-t1016 + t1049)/xp.where(t1076, 2*t1062, 1)
     t1078 = xp.abs(t1077)
     t1079 = xp.greater_equal(t1078, 1)
-    t1080 = xp.abs(1/xp.where(t1079, t1077, 1))
+    t1080 = 1/xp.abs(xp.where(t1079, t1077, 1))
     t1081 = xp.where(t1076, xp.where(xp.greater_equal(t1077, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1079, t1080/(1 + xp.sqrt(1 + t1080**2)), 1/(t1078 + xp.sqrt(1 + t1078**2))), 0)
     t1082 = 1/xp.sqrt(1 + t1081**2)
     t1083 = t1020*t1082
@@ -3680,10 +3680,10 @@ def condition_number(q):
     t156 = t47*t104
     t157 = t55*t69 + t49*t129 + t154*t82 - t155*t87 + t156*t110
     t158 = xp.not_equal(t157, 0)
-    t159 = 0.5*(-t153 + t146)/xp.where(t158, -t157, 1)
+    t159 = (-t153 + t146)/xp.where(t158, -2*t157, 1)
     t160 = xp.abs(t159)
     t161 = xp.greater_equal(t160, 1)
-    t162 = xp.abs(1/xp.where(t161, t159, 1))
+    t162 = 1/xp.abs(xp.where(t161, t159, 1))
     t163 = xp.where(t158, xp.where(xp.greater_equal(t159, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t161, t162/(1 + xp.sqrt(1 + t162**2)), 1/(t160 + xp.sqrt(1 + t160**2))), 0)
     t164 = 1/xp.sqrt(1 + t163**2)
     t165 = t157*t163
@@ -3711,10 +3711,10 @@ def condition_number(q):
     t187 = -t185 + t184*t163
     t188 = t96*t178 + t115*t182 + t134*t186 - t92*t174
     t189 = xp.not_equal(t188, 0)
-    t190 = 0.5*(-t166 + t147)/xp.where(t189, -t188, 1)
+    t190 = (-t166 + t147)/xp.where(t189, -2*t188, 1)
     t191 = xp.abs(t190)
     t192 = xp.greater_equal(t191, 1)
-    t193 = xp.abs(1/xp.where(t192, t190, 1))
+    t193 = 1/xp.abs(xp.where(t192, t190, 1))
     t194 = xp.where(t189, xp.where(xp.greater_equal(t190, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t192, t193/(1 + xp.sqrt(1 + t193**2)), 1/(t191 + xp.sqrt(1 + t191**2))), 0)
     t195 = 1/xp.sqrt(1 + t194**2)
     t196 = t188*t194
@@ -3738,10 +3738,10 @@ def condition_number(q):
     t214 = -t212 + t211*t194
     t215 = t100*t205 + t119*t209 - t138*t213
     t216 = xp.not_equal(t215, 0)
-    t217 = 0.5*(-t197 + t148)/xp.where(t216, -t215, 1)
+    t217 = (-t197 + t148)/xp.where(t216, -2*t215, 1)
     t218 = xp.abs(t217)
     t219 = xp.greater_equal(t218, 1)
-    t220 = xp.abs(1/xp.where(t219, t217, 1))
+    t220 = 1/xp.abs(xp.where(t219, t217, 1))
     t221 = xp.where(t216, xp.where(xp.greater_equal(t217, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t219, t220/(1 + xp.sqrt(1 + t220**2)), 1/(t218 + xp.sqrt(1 + t218**2))), 0)
     t222 = 1/xp.sqrt(1 + t221**2)
     t223 = t215*t221
@@ -3761,10 +3761,10 @@ def condition_number(q):
     t237 = t235 + t234*t221
     t238 = t123*t232 + t142*t236
     t239 = xp.not_equal(t238, 0)
-    t240 = 0.5*(-t224 + t149)/xp.where(t239, t238, 1)
+    t240 = (-t224 + t149)/xp.where(t239, 2*t238, 1)
     t241 = xp.abs(t240)
     t242 = xp.greater_equal(t241, 1)
-    t243 = xp.abs(1/xp.where(t242, t240, 1))
+    t243 = 1/xp.abs(xp.where(t242, t240, 1))
     t244 = xp.where(t239, xp.where(xp.greater_equal(t240, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t242, t243/(1 + xp.sqrt(1 + t243**2)), 1/(t241 + xp.sqrt(1 + t241**2))), 0)
     t245 = 1/xp.sqrt(1 + t244**2)
     t246 = t238*t244
@@ -3780,10 +3780,10 @@ def condition_number(q):
     t256 = t254 + t253*t244
     t257 = t145*t255
     t258 = xp.not_equal(t257, 0)
-    t259 = 0.5*(-t247 + t150)/xp.where(t258, -t257, 1)
+    t259 = (-t247 + t150)/xp.where(t258, -2*t257, 1)
     t260 = xp.abs(t259)
     t261 = xp.greater_equal(t260, 1)
-    t262 = xp.abs(1/xp.where(t261, t259, 1))
+    t262 = 1/xp.abs(xp.where(t261, t259, 1))
     t263 = xp.where(t258, xp.where(xp.greater_equal(t259, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t261, t262/(1 + xp.sqrt(1 + t262**2)), 1/(t260 + xp.sqrt(1 + t260**2))), 0)
     t264 = 1/xp.sqrt(1 + t263**2)
     t265 = t257*t263
@@ -3797,10 +3797,10 @@ def condition_number(q):
     t273 = t272*t170
     t274 = -t175*t202 - t179*t206 + t183*t210 + t187*t214 + t151*t272*t163*t164**2 + t273*t171
     t275 = xp.not_equal(t274, 0)
-    t276 = 0.5*(-t167 + t198)/xp.where(t275, t274, 1)
+    t276 = (-t167 + t198)/xp.where(t275, 2*t274, 1)
     t277 = xp.abs(t276)
     t278 = xp.greater_equal(t277, 1)
-    t279 = xp.abs(1/xp.where(t278, t276, 1))
+    t279 = 1/xp.abs(xp.where(t278, t276, 1))
     t280 = xp.where(t275, xp.where(xp.greater_equal(t276, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t278, t279/(1 + xp.sqrt(1 + t279**2)), 1/(t277 + xp.sqrt(1 + t277**2))), 0)
     t281 = 1/xp.sqrt(1 + t280**2)
     t282 = t274*t280
@@ -3839,10 +3839,10 @@ def condition_number(q):
     t315 = t311*t201
     t316 = -t229*t301 + t233*t305 + t237*t309 - t313*t289 + t314*t293 + t315*t297
     t317 = xp.not_equal(t316, 0)
-    t318 = 0.5*(-t283 + t225)/xp.where(t317, t316, 1)
+    t318 = (-t283 + t225)/xp.where(t317, 2*t316, 1)
     t319 = xp.abs(t318)
     t320 = xp.greater_equal(t319, 1)
-    t321 = xp.abs(1/xp.where(t320, t318, 1))
+    t321 = 1/xp.abs(xp.where(t320, t318, 1))
     t322 = xp.where(t317, xp.where(xp.greater_equal(t318, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t320, t321/(1 + xp.sqrt(1 + t321**2)), 1/(t319 + xp.sqrt(1 + t319**2))), 0)
     t323 = 1/xp.sqrt(1 + t322**2)
     t324 = t316*t322
@@ -3885,10 +3885,10 @@ def condition_number(q):
     t361 = t360*t244
     t362 = -t252*t345 + t256*t349 - t355*t329 + t357*t333 + t359*t337 - t361*t341
     t363 = xp.not_equal(t362, 0)
-    t364 = 0.5*(-t325 + t248)/xp.where(t363, t362, 1)
+    t364 = (-t325 + t248)/xp.where(t363, 2*t362, 1)
     t365 = xp.abs(t364)
     t366 = xp.greater_equal(t365, 1)
-    t367 = xp.abs(1/xp.where(t366, t364, 1))
+    t367 = 1/xp.abs(xp.where(t366, t364, 1))
     t368 = xp.where(t363, xp.where(xp.greater_equal(t364, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t366, t367/(1 + xp.sqrt(1 + t367**2)), 1/(t365 + xp.sqrt(1 + t365**2))), 0)
     t369 = 1/xp.sqrt(1 + t368**2)
     t370 = t362*t368
@@ -3930,10 +3930,10 @@ def condition_number(q):
     t406 = t405*t263
     t407 = t271*t395 - t398*t375 + t400*t379 + t402*t383 - t404*t387 + t406*t391
     t408 = xp.not_equal(t407, 0)
-    t409 = 0.5*(-t371 + t267)/xp.where(t408, t407, 1)
+    t409 = (-t371 + t267)/xp.where(t408, 2*t407, 1)
     t410 = xp.abs(t409)
     t411 = xp.greater_equal(t410, 1)
-    t412 = xp.abs(1/xp.where(t411, t409, 1))
+    t412 = 1/xp.abs(xp.where(t411, t409, 1))
     t413 = xp.where(t408, xp.where(xp.greater_equal(t409, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t411, t412/(1 + xp.sqrt(1 + t412**2)), 1/(t410 + xp.sqrt(1 + t410**2))), 0)
     t414 = 1/xp.sqrt(1 + t413**2)
     t415 = t407*t413
@@ -3965,10 +3965,10 @@ def condition_number(q):
     t441 = t439 + t438*t413
     t442 = t270*t440 - t397*t420 + t399*t424 + t401*t428 - t403*t432 + t405*t436
     t443 = xp.not_equal(t351, 0)
-    t444 = 0.5*(-t284 + t326)/xp.where(t443, t351, 1)
+    t444 = (-t284 + t326)/xp.where(t443, 2*t351, 1)
     t445 = xp.abs(t444)
     t446 = xp.greater_equal(t445, 1)
-    t447 = xp.abs(1/xp.where(t446, t444, 1))
+    t447 = 1/xp.abs(xp.where(t446, t444, 1))
     t448 = xp.where(t443, xp.where(xp.greater_equal(t444, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t446, t447/(1 + xp.sqrt(1 + t447**2)), 1/(t445 + xp.sqrt(1 + t445**2))), 0)
     t449 = 1/xp.sqrt(1 + t448**2)
     t450 = t351*t448
@@ -4000,10 +4000,10 @@ def condition_number(q):
     t476 = t474 + t473*t448
     t477 = -t376*t455 + t380*t459 + t384*t463 + t388*t467 + t392*t471 + t396*t475
     t478 = xp.not_equal(t477, 0)
-    t479 = 0.5*(-t451 + t372)/xp.where(t478, t477, 1)
+    t479 = (-t451 + t372)/xp.where(t478, 2*t477, 1)
     t480 = xp.abs(t479)
     t481 = xp.greater_equal(t480, 1)
-    t482 = xp.abs(1/xp.where(t481, t479, 1))
+    t482 = 1/xp.abs(xp.where(t481, t479, 1))
     t483 = xp.where(t478, xp.where(xp.greater_equal(t479, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t481, t482/(1 + xp.sqrt(1 + t482**2)), 1/(t480 + xp.sqrt(1 + t480**2))), 0)
     t484 = 1/xp.sqrt(1 + t483**2)
     t485 = t477*t483
@@ -4036,10 +4036,10 @@ def condition_number(q):
     t512 = -t421*t490 + t425*t494 + t429*t498 + t433*t502 + t437*t506 + t441*t510
     t513 = t456*t491 + t460*t495 + t464*t499 + t468*t503 + t472*t507 + t476*t511
     t514 = xp.not_equal(t512, 0)
-    t515 = 0.5*(-t486 + t417)/xp.where(t514, t512, 1)
+    t515 = (-t486 + t417)/xp.where(t514, 2*t512, 1)
     t516 = xp.abs(t515)
     t517 = xp.greater_equal(t516, 1)
-    t518 = xp.abs(1/xp.where(t517, t515, 1))
+    t518 = 1/xp.abs(xp.where(t517, t515, 1))
     t519 = xp.where(t514, xp.where(xp.greater_equal(t515, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t517, t518/(1 + xp.sqrt(1 + t518**2)), 1/(t516 + xp.sqrt(1 + t516**2))), 0)
     t520 = 1/xp.sqrt(1 + t519**2)
     t521 = t512*t519
@@ -4070,10 +4070,10 @@ def condition_number(q):
     t546 = t544 - t545*t519
     t547 = t545 + t544*t519
     t548 = xp.not_equal(t513, 0)
-    t549 = 0.5*(-t452 + t487)/xp.where(t548, t513, 1)
+    t549 = (-t452 + t487)/xp.where(t548, 2*t513, 1)
     t550 = xp.abs(t549)
     t551 = xp.greater_equal(t550, 1)
-    t552 = xp.abs(1/xp.where(t551, t549, 1))
+    t552 = 1/xp.abs(xp.where(t551, t549, 1))
     t553 = xp.where(t548, xp.where(xp.greater_equal(t549, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t551, t552/(1 + xp.sqrt(1 + t552**2)), 1/(t550 + xp.sqrt(1 + t550**2))), 0)
     t554 = 1/xp.sqrt(1 + t553**2)
     t555 = t513*t553
@@ -4105,10 +4105,10 @@ def condition_number(q):
     t581 = t579 + t578*t553
     t582 = t527*t560 + t531*t564 + t535*t568 + t539*t572 + t543*t576 + t547*t580
     t583 = xp.not_equal(t582, 0)
-    t584 = 0.5*(-t556 + t523)/xp.where(t583, t582, 1)
+    t584 = (-t556 + t523)/xp.where(t583, 2*t582, 1)
     t585 = xp.abs(t584)
     t586 = xp.greater_equal(t585, 1)
-    t587 = xp.abs(1/xp.where(t586, t584, 1))
+    t587 = 1/xp.abs(xp.where(t586, t584, 1))
     t588 = xp.where(t583, xp.where(xp.greater_equal(t584, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t586, t587/(1 + xp.sqrt(1 + t587**2)), 1/(t585 + xp.sqrt(1 + t585**2))), 0)
     t589 = 1/xp.sqrt(1 + t588**2)
     t590 = t582*t588
@@ -4140,10 +4140,10 @@ def condition_number(q):
     t616 = t614 + t613*t588
     t617 = t561*t596 + t565*t600 + t569*t604 + t573*t608 + t577*t612 + t581*t616
     t618 = xp.not_equal(t617, 0)
-    t619 = 0.5*(-t557 + t592)/xp.where(t618, t617, 1)
+    t619 = (-t557 + t592)/xp.where(t618, 2*t617, 1)
     t620 = xp.abs(t619)
     t621 = xp.greater_equal(t620, 1)
-    t622 = xp.abs(1/xp.where(t621, t619, 1))
+    t622 = 1/xp.abs(xp.where(t621, t619, 1))
     t623 = xp.where(t618, xp.where(xp.greater_equal(t619, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t621, t622/(1 + xp.sqrt(1 + t622**2)), 1/(t620 + xp.sqrt(1 + t620**2))), 0)
     t624 = 1/xp.sqrt(1 + t623**2)
     t625 = t617*t623
@@ -4174,10 +4174,10 @@ def condition_number(q):
     t650 = t648 - t649*t623
     t651 = t649 + t648*t623
     t652 = xp.not_equal(t442, 0)
-    t653 = 0.5*(-t266 + t416)/xp.where(t652, t442, 1)
+    t653 = (-t266 + t416)/xp.where(t652, 2*t442, 1)
     t654 = xp.abs(t653)
     t655 = xp.greater_equal(t654, 1)
-    t656 = xp.abs(1/xp.where(t655, t653, 1))
+    t656 = 1/xp.abs(xp.where(t655, t653, 1))
     t657 = xp.where(t652, xp.where(xp.greater_equal(t653, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t655, t656/(1 + xp.sqrt(1 + t656**2)), 1/(t654 + xp.sqrt(1 + t654**2))), 0)
     t658 = 1/xp.sqrt(1 + t657**2)
     t659 = t442*t657
@@ -4209,10 +4209,10 @@ def condition_number(q):
     t685 = t683 + t682*t657
     t686 = t526*t664 + t530*t668 + t534*t672 + t538*t676 + t542*t680 + t546*t684
     t687 = xp.not_equal(t686, 0)
-    t688 = 0.5*(-t660 + t522)/xp.where(t687, t686, 1)
+    t688 = (-t660 + t522)/xp.where(t687, 2*t686, 1)
     t689 = xp.abs(t688)
     t690 = xp.greater_equal(t689, 1)
-    t691 = xp.abs(1/xp.where(t690, t688, 1))
+    t691 = 1/xp.abs(xp.where(t690, t688, 1))
     t692 = xp.where(t687, xp.where(xp.greater_equal(t688, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t690, t691/(1 + xp.sqrt(1 + t691**2)), 1/(t689 + xp.sqrt(1 + t689**2))), 0)
     t693 = 1/xp.sqrt(1 + t692**2)
     t694 = t686*t692
@@ -4245,10 +4245,10 @@ def condition_number(q):
     t721 = t595*t699 + t599*t703 + t603*t707 + t607*t711 + t611*t715 + t615*t719
     t722 = -t665*t700 + t669*t704 + t673*t708 + t677*t712 + t681*t716 + t685*t720
     t723 = xp.not_equal(t721, 0)
-    t724 = 0.5*(-t695 + t591)/xp.where(t723, t721, 1)
+    t724 = (-t695 + t591)/xp.where(t723, 2*t721, 1)
     t725 = xp.abs(t724)
     t726 = xp.greater_equal(t725, 1)
-    t727 = xp.abs(1/xp.where(t726, t724, 1))
+    t727 = 1/xp.abs(xp.where(t726, t724, 1))
     t728 = xp.where(t723, xp.where(xp.greater_equal(t724, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t726, t727/(1 + xp.sqrt(1 + t727**2)), 1/(t725 + xp.sqrt(1 + t725**2))), 0)
     t729 = 1/xp.sqrt(1 + t728**2)
     t730 = t721*t728
@@ -4280,10 +4280,10 @@ def condition_number(q):
     t756 = t754 + t753*t728
     t757 = t630*t735 + t634*t739 + t638*t743 + t642*t747 + t646*t751 + t650*t755
     t758 = xp.not_equal(t757, 0)
-    t759 = 0.5*(-t731 + t626)/xp.where(t758, t757, 1)
+    t759 = (-t731 + t626)/xp.where(t758, 2*t757, 1)
     t760 = xp.abs(t759)
     t761 = xp.greater_equal(t760, 1)
-    t762 = xp.abs(1/xp.where(t761, t759, 1))
+    t762 = 1/xp.abs(xp.where(t761, t759, 1))
     t763 = xp.where(t758, xp.where(xp.greater_equal(t759, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t761, t762/(1 + xp.sqrt(1 + t762**2)), 1/(t760 + xp.sqrt(1 + t760**2))), 0)
     t764 = 1/xp.sqrt(1 + t763**2)
     t765 = t757*t763
@@ -4315,10 +4315,10 @@ def condition_number(q):
     t791 = t789 + t788*t763
     t792 = t631*t770 + t635*t774 + t639*t778 + t643*t782 + t647*t786 + t651*t790
     t793 = xp.not_equal(t792, 0)
-    t794 = 0.5*(-t766 + t627)/xp.where(t793, t792, 1)
+    t794 = (-t766 + t627)/xp.where(t793, 2*t792, 1)
     t795 = xp.abs(t794)
     t796 = xp.greater_equal(t795, 1)
-    t797 = xp.abs(1/xp.where(t796, t794, 1))
+    t797 = 1/xp.abs(xp.where(t796, t794, 1))
     t798 = xp.where(t793, xp.where(xp.greater_equal(t794, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t796, t797/(1 + xp.sqrt(1 + t797**2)), 1/(t795 + xp.sqrt(1 + t795**2))), 0)
     t799 = 1/xp.sqrt(1 + t798**2)
     t800 = t792*t798
@@ -4349,10 +4349,10 @@ def condition_number(q):
     t825 = t823 - t824*t798
     t826 = t824 + t823*t798
     t827 = xp.not_equal(t722, 0)
-    t828 = 0.5*(-t661 + t696)/xp.where(t827, t722, 1)
+    t828 = (-t661 + t696)/xp.where(t827, 2*t722, 1)
     t829 = xp.abs(t828)
     t830 = xp.greater_equal(t829, 1)
-    t831 = xp.abs(1/xp.where(t830, t828, 1))
+    t831 = 1/xp.abs(xp.where(t830, t828, 1))
     t832 = xp.where(t827, xp.where(xp.greater_equal(t828, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t830, t831/(1 + xp.sqrt(1 + t831**2)), 1/(t829 + xp.sqrt(1 + t829**2))), 0)
     t833 = 1/xp.sqrt(1 + t832**2)
     t834 = t722*t832
@@ -4384,10 +4384,10 @@ def condition_number(q):
     t860 = t858 + t857*t832
     t861 = t736*t839 + t740*t843 + t744*t847 + t748*t851 + t752*t855 + t756*t859
     t862 = xp.not_equal(t861, 0)
-    t863 = 0.5*(-t835 + t732)/xp.where(t862, t861, 1)
+    t863 = (-t835 + t732)/xp.where(t862, 2*t861, 1)
     t864 = xp.abs(t863)
     t865 = xp.greater_equal(t864, 1)
-    t866 = xp.abs(1/xp.where(t865, t863, 1))
+    t866 = 1/xp.abs(xp.where(t865, t863, 1))
     t867 = xp.where(t862, xp.where(xp.greater_equal(t863, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t865, t866/(1 + xp.sqrt(1 + t866**2)), 1/(t864 + xp.sqrt(1 + t864**2))), 0)
     t868 = 1/xp.sqrt(1 + t867**2)
     t869 = t861*t867
@@ -4420,10 +4420,10 @@ def condition_number(q):
     t896 = t771*t874 + t775*t878 + t779*t882 + t783*t886 + t787*t890 + t791*t894
     t897 = t840*t875 + t844*t879 + t848*t883 + t852*t887 + t856*t891 + t860*t895
     t898 = xp.not_equal(t896, 0)
-    t899 = 0.5*(-t870 + t767)/xp.where(t898, t896, 1)
+    t899 = (-t870 + t767)/xp.where(t898, 2*t896, 1)
     t900 = xp.abs(t899)
     t901 = xp.greater_equal(t900, 1)
-    t902 = xp.abs(1/xp.where(t901, t899, 1))
+    t902 = 1/xp.abs(xp.where(t901, t899, 1))
     t903 = xp.where(t898, xp.where(xp.greater_equal(t899, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t901, t902/(1 + xp.sqrt(1 + t902**2)), 1/(t900 + xp.sqrt(1 + t900**2))), 0)
     t904 = 1/xp.sqrt(1 + t903**2)
     t905 = t896*t903
@@ -4455,10 +4455,10 @@ def condition_number(q):
     t931 = t929 + t928*t903
     t932 = t806*t910 + t810*t914 + t814*t918 + t818*t922 + t822*t926 + t826*t930
     t933 = xp.not_equal(t932, 0)
-    t934 = 0.5*(-t906 + t802)/xp.where(t933, t932, 1)
+    t934 = (-t906 + t802)/xp.where(t933, 2*t932, 1)
     t935 = xp.abs(t934)
     t936 = xp.greater_equal(t935, 1)
-    t937 = xp.abs(1/xp.where(t936, t934, 1))
+    t937 = 1/xp.abs(xp.where(t936, t934, 1))
     t938 = xp.where(t933, xp.where(xp.greater_equal(t934, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t936, t937/(1 + xp.sqrt(1 + t937**2)), 1/(t935 + xp.sqrt(1 + t935**2))), 0)
     t939 = 1/xp.sqrt(1 + t938**2)
     t940 = t932*t938
@@ -4490,10 +4490,10 @@ def condition_number(q):
     t966 = t964 + t963*t938
     t967 = t805*t945 + t809*t949 + t813*t953 + t817*t957 + t821*t961 + t825*t965
     t968 = xp.not_equal(t897, 0)
-    t969 = 0.5*(-t836 + t871)/xp.where(t968, t897, 1)
+    t969 = (-t836 + t871)/xp.where(t968, 2*t897, 1)
     t970 = xp.abs(t969)
     t971 = xp.greater_equal(t970, 1)
-    t972 = xp.abs(1/xp.where(t971, t969, 1))
+    t972 = 1/xp.abs(xp.where(t971, t969, 1))
     t973 = xp.where(t968, xp.where(xp.greater_equal(t969, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t971, t972/(1 + xp.sqrt(1 + t972**2)), 1/(t970 + xp.sqrt(1 + t970**2))), 0)
     t974 = 1/xp.sqrt(1 + t973**2)
     t975 = t897*t973
@@ -4525,10 +4525,10 @@ def condition_number(q):
     t1001 = t999 + t998*t973
     t1002 = t911*t980 + t915*t984 + t919*t988 + t923*t992 + t927*t996 + t931*t1000
     t1003 = xp.not_equal(t1002, 0)
-    t1004 = 0.5*(-t976 + t907)/xp.where(t1003, t1002, 1)
+    t1004 = (-t976 + t907)/xp.where(t1003, 2*t1002, 1)
     t1005 = xp.abs(t1004)
     t1006 = xp.greater_equal(t1005, 1)
-    t1007 = xp.abs(1/xp.where(t1006, t1004, 1))
+    t1007 = 1/xp.abs(xp.where(t1006, t1004, 1))
     t1008 = xp.where(t1003, xp.where(xp.greater_equal(t1004, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1006, t1007/(1 + xp.sqrt(1 + t1007**2)), 1/(t1005 + xp.sqrt(1 + t1005**2))), 0)
     t1009 = 1/xp.sqrt(1 + t1008**2)
     t1010 = t1002*t1008
@@ -4561,10 +4561,10 @@ def condition_number(q):
     t1037 = t946*t1015 + t950*t1019 + t954*t1023 + t958*t1027 + t962*t1031 + t966*t1035
     t1038 = t981*t1016 + t985*t1020 + t989*t1024 + t993*t1028 + t997*t1032 + t1001*t1036
     t1039 = xp.not_equal(t1037, 0)
-    t1040 = 0.5*(-t1011 + t942)/xp.where(t1039, t1037, 1)
+    t1040 = (-t1011 + t942)/xp.where(t1039, 2*t1037, 1)
     t1041 = xp.abs(t1040)
     t1042 = xp.greater_equal(t1041, 1)
-    t1043 = xp.abs(1/xp.where(t1042, t1040, 1))
+    t1043 = 1/xp.abs(xp.where(t1042, t1040, 1))
     t1044 = xp.where(t1039, xp.where(xp.greater_equal(t1040, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1042, t1043/(1 + xp.sqrt(1 + t1043**2)), 1/(t1041 + xp.sqrt(1 + t1041**2))), 0)
     t1045 = 1/xp.sqrt(1 + t1044**2)
     t1046 = t1037*t1044
@@ -4595,10 +4595,10 @@ def condition_number(q):
     t1071 = t1069 - t1070*t1044
     t1072 = t1070 + t1069*t1044
     t1073 = xp.not_equal(t1038, 0)
-    t1074 = 0.5*(-t977 + t1012)/xp.where(t1073, t1038, 1)
+    t1074 = (-t977 + t1012)/xp.where(t1073, 2*t1038, 1)
     t1075 = xp.abs(t1074)
     t1076 = xp.greater_equal(t1075, 1)
-    t1077 = xp.abs(1/xp.where(t1076, t1074, 1))
+    t1077 = 1/xp.abs(xp.where(t1076, t1074, 1))
     t1078 = xp.where(t1073, xp.where(xp.greater_equal(t1074, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1076, t1077/(1 + xp.sqrt(1 + t1077**2)), 1/(t1075 + xp.sqrt(1 + t1075**2))), 0)
     t1079 = 1/xp.sqrt(1 + t1078**2)
     t1080 = t1038*t1078
@@ -4630,10 +4630,10 @@ def condition_number(q):
     t1106 = t1104 + t1078*t1103
     t1107 = t1052*t1085 + t1056*t1089 + t1060*t1093 + t1064*t1097 + t1068*t1101 + t1072*t1105
     t1108 = xp.not_equal(t1107, 0)
-    t1109 = 0.5*(-t1081 + t1048)/xp.where(t1108, t1107, 1)
+    t1109 = (-t1081 + t1048)/xp.where(t1108, 2*t1107, 1)
     t1110 = xp.abs(t1109)
     t1111 = xp.greater_equal(t1110, 1)
-    t1112 = xp.abs(1/xp.where(t1111, t1109, 1))
+    t1112 = 1/xp.abs(xp.where(t1111, t1109, 1))
     t1113 = xp.where(t1108, xp.where(xp.greater_equal(t1109, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1111, t1112/(1 + xp.sqrt(1 + t1112**2)), 1/(t1110 + xp.sqrt(1 + t1110**2))), 0)
     t1114 = 1/xp.sqrt(1 + t1113**2)
     t1115 = t1107*t1113
@@ -4665,10 +4665,10 @@ def condition_number(q):
     t1141 = t1139 + t1113*t1138
     t1142 = t1086*t1121 + t1090*t1125 + t1094*t1129 + t1098*t1133 + t1102*t1137 + t1106*t1141
     t1143 = xp.not_equal(t1142, 0)
-    t1144 = 0.5*(-t1082 + t1117)/xp.where(t1143, t1142, 1)
+    t1144 = (-t1082 + t1117)/xp.where(t1143, 2*t1142, 1)
     t1145 = xp.abs(t1144)
     t1146 = xp.greater_equal(t1145, 1)
-    t1147 = xp.abs(1/xp.where(t1146, t1144, 1))
+    t1147 = 1/xp.abs(xp.where(t1146, t1144, 1))
     t1148 = xp.where(t1143, xp.where(xp.greater_equal(t1144, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1146, t1147/(1 + xp.sqrt(1 + t1147**2)), 1/(t1145 + xp.sqrt(1 + t1145**2))), 0)
     t1149 = 1/xp.sqrt(1 + t1148**2)
     t1150 = t1142*t1148
@@ -4699,10 +4699,10 @@ def condition_number(q):
     t1175 = t1173 - t1148*t1174
     t1176 = t1174 + t1148*t1173
     t1177 = xp.not_equal(t967, 0)
-    t1178 = 0.5*(-t801 + t941)/xp.where(t1177, t967, 1)
+    t1178 = (-t801 + t941)/xp.where(t1177, 2*t967, 1)
     t1179 = xp.abs(t1178)
     t1180 = xp.greater_equal(t1179, 1)
-    t1181 = xp.abs(1/xp.where(t1180, t1178, 1))
+    t1181 = 1/xp.abs(xp.where(t1180, t1178, 1))
     t1182 = xp.where(t1177, xp.where(xp.greater_equal(t1178, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1180, t1181/(1 + xp.sqrt(1 + t1181**2)), 1/(t1179 + xp.sqrt(1 + t1179**2))), 0)
     t1183 = 1/xp.sqrt(1 + t1182**2)
     t1184 = t967*t1182
@@ -4734,10 +4734,10 @@ def condition_number(q):
     t1210 = t1208 + t1182*t1207
     t1211 = t1051*t1189 + t1055*t1193 + t1059*t1197 + t1063*t1201 + t1067*t1205 + t1071*t1209
     t1212 = xp.not_equal(t1211, 0)
-    t1213 = 0.5*(-t1185 + t1047)/xp.where(t1212, t1211, 1)
+    t1213 = (-t1185 + t1047)/xp.where(t1212, 2*t1211, 1)
     t1214 = xp.abs(t1213)
     t1215 = xp.greater_equal(t1214, 1)
-    t1216 = xp.abs(1/xp.where(t1215, t1213, 1))
+    t1216 = 1/xp.abs(xp.where(t1215, t1213, 1))
     t1217 = xp.where(t1212, xp.where(xp.greater_equal(t1213, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1215, t1216/(1 + xp.sqrt(1 + t1216**2)), 1/(t1214 + xp.sqrt(1 + t1214**2))), 0)
     t1218 = 1/xp.sqrt(1 + t1217**2)
     t1219 = t1211*t1217
@@ -4770,10 +4770,10 @@ def condition_number(q):
     t1246 = t1120*t1224 + t1124*t1228 + t1128*t1232 + t1132*t1236 + t1136*t1240 + t1140*t1244
     t1247 = t1190*t1225 + t1194*t1229 + t1198*t1233 + t1202*t1237 + t1206*t1241 + t1210*t1245
     t1248 = xp.not_equal(t1246, 0)
-    t1249 = 0.5*(-t1220 + t1116)/xp.where(t1248, t1246, 1)
+    t1249 = (-t1220 + t1116)/xp.where(t1248, 2*t1246, 1)
     t1250 = xp.abs(t1249)
     t1251 = xp.greater_equal(t1250, 1)
-    t1252 = xp.abs(1/xp.where(t1251, t1249, 1))
+    t1252 = 1/xp.abs(xp.where(t1251, t1249, 1))
     t1253 = xp.where(t1248, xp.where(xp.greater_equal(t1249, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1251, t1252/(1 + xp.sqrt(1 + t1252**2)), 1/(t1250 + xp.sqrt(1 + t1250**2))), 0)
     t1254 = 1/xp.sqrt(1 + t1253**2)
     t1255 = t1246*t1253
@@ -4805,10 +4805,10 @@ def condition_number(q):
     t1281 = t1279 + t1253*t1278
     t1282 = t1155*t1260 + t1159*t1264 + t1163*t1268 + t1167*t1272 + t1171*t1276 + t1175*t1280
     t1283 = xp.not_equal(t1282, 0)
-    t1284 = 0.5*(-t1256 + t1151)/xp.where(t1283, t1282, 1)
+    t1284 = (-t1256 + t1151)/xp.where(t1283, 2*t1282, 1)
     t1285 = xp.abs(t1284)
     t1286 = xp.greater_equal(t1285, 1)
-    t1287 = xp.abs(1/xp.where(t1286, t1284, 1))
+    t1287 = 1/xp.abs(xp.where(t1286, t1284, 1))
     t1288 = xp.where(t1283, xp.where(xp.greater_equal(t1284, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1286, t1287/(1 + xp.sqrt(1 + t1287**2)), 1/(t1285 + xp.sqrt(1 + t1285**2))), 0)
     t1289 = 1/xp.sqrt(1 + t1288**2)
     t1290 = t1282*t1288
@@ -4840,10 +4840,10 @@ def condition_number(q):
     t1316 = t1314 + t1288*t1313
     t1317 = t1156*t1295 + t1160*t1299 + t1164*t1303 + t1168*t1307 + t1172*t1311 + t1176*t1315
     t1318 = xp.not_equal(t1317, 0)
-    t1319 = 0.5*(-t1291 + t1152)/xp.where(t1318, t1317, 1)
+    t1319 = (-t1291 + t1152)/xp.where(t1318, 2*t1317, 1)
     t1320 = xp.abs(t1319)
     t1321 = xp.greater_equal(t1320, 1)
-    t1322 = xp.abs(1/xp.where(t1321, t1319, 1))
+    t1322 = 1/xp.abs(xp.where(t1321, t1319, 1))
     t1323 = xp.where(t1318, xp.where(xp.greater_equal(t1319, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1321, t1322/(1 + xp.sqrt(1 + t1322**2)), 1/(t1320 + xp.sqrt(1 + t1320**2))), 0)
     t1324 = 1/xp.sqrt(1 + t1323**2)
     t1325 = t1317*t1323
@@ -4874,10 +4874,10 @@ def condition_number(q):
     t1350 = t1348 - t1323*t1349
     t1351 = t1349 + t1323*t1348
     t1352 = xp.not_equal(t1247, 0)
-    t1353 = 0.5*(-t1186 + t1221)/xp.where(t1352, t1247, 1)
+    t1353 = (-t1186 + t1221)/xp.where(t1352, 2*t1247, 1)
     t1354 = xp.abs(t1353)
     t1355 = xp.greater_equal(t1354, 1)
-    t1356 = xp.abs(1/xp.where(t1355, t1353, 1))
+    t1356 = 1/xp.abs(xp.where(t1355, t1353, 1))
     t1357 = xp.where(t1352, xp.where(xp.greater_equal(t1353, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1355, t1356/(1 + xp.sqrt(1 + t1356**2)), 1/(t1354 + xp.sqrt(1 + t1354**2))), 0)
     t1358 = 1/xp.sqrt(1 + t1357**2)
     t1359 = t1247*t1357
@@ -4909,10 +4909,10 @@ def condition_number(q):
     t1385 = t1383 + t1357*t1382
     t1386 = t1261*t1364 + t1265*t1368 + t1269*t1372 + t1273*t1376 + t1277*t1380 + t1281*t1384
     t1387 = xp.not_equal(t1386, 0)
-    t1388 = 0.5*(-t1360 + t1257)/xp.where(t1387, t1386, 1)
+    t1388 = (-t1360 + t1257)/xp.where(t1387, 2*t1386, 1)
     t1389 = xp.abs(t1388)
     t1390 = xp.greater_equal(t1389, 1)
-    t1391 = xp.abs(1/xp.where(t1390, t1388, 1))
+    t1391 = 1/xp.abs(xp.where(t1390, t1388, 1))
     t1392 = xp.where(t1387, xp.where(xp.greater_equal(t1388, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1390, t1391/(1 + xp.sqrt(1 + t1391**2)), 1/(t1389 + xp.sqrt(1 + t1389**2))), 0)
     t1393 = 1/xp.sqrt(1 + t1392**2)
     t1394 = t1386*t1392
@@ -4945,10 +4945,10 @@ def condition_number(q):
     t1421 = t1296*t1399 + t1300*t1403 + t1304*t1407 + t1308*t1411 + t1312*t1415 + t1316*t1419
     t1422 = t1365*t1400 + t1369*t1404 + t1373*t1408 + t1377*t1412 + t1381*t1416 + t1385*t1420
     t1423 = xp.not_equal(t1421, 0)
-    t1424 = 0.5*(-t1395 + t1292)/xp.where(t1423, t1421, 1)
+    t1424 = (-t1395 + t1292)/xp.where(t1423, 2*t1421, 1)
     t1425 = xp.abs(t1424)
     t1426 = xp.greater_equal(t1425, 1)
-    t1427 = xp.abs(1/xp.where(t1426, t1424, 1))
+    t1427 = 1/xp.abs(xp.where(t1426, t1424, 1))
     t1428 = xp.where(t1423, xp.where(xp.greater_equal(t1424, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1426, t1427/(1 + xp.sqrt(1 + t1427**2)), 1/(t1425 + xp.sqrt(1 + t1425**2))), 0)
     t1429 = 1/xp.sqrt(1 + t1428**2)
     t1430 = t1421*t1428
@@ -4980,10 +4980,10 @@ def condition_number(q):
     t1456 = t1454 + t1428*t1453
     t1457 = t1331*t1435 + t1335*t1439 + t1339*t1443 + t1343*t1447 + t1347*t1451 + t1351*t1455
     t1458 = xp.not_equal(t1457, 0)
-    t1459 = 0.5*(-t1431 + t1327)/xp.where(t1458, t1457, 1)
+    t1459 = (-t1431 + t1327)/xp.where(t1458, 2*t1457, 1)
     t1460 = xp.abs(t1459)
     t1461 = xp.greater_equal(t1460, 1)
-    t1462 = xp.abs(1/xp.where(t1461, t1459, 1))
+    t1462 = 1/xp.abs(xp.where(t1461, t1459, 1))
     t1463 = xp.where(t1458, xp.where(xp.greater_equal(t1459, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1461, t1462/(1 + xp.sqrt(1 + t1462**2)), 1/(t1460 + xp.sqrt(1 + t1460**2))), 0)
     t1464 = 1/xp.sqrt(1 + t1463**2)
     t1465 = t1457*t1463
@@ -5015,10 +5015,10 @@ def condition_number(q):
     t1491 = t1489 + t1463*t1488
     t1492 = t1330*t1470 + t1334*t1474 + t1338*t1478 + t1342*t1482 + t1346*t1486 + t1350*t1490
     t1493 = xp.not_equal(t1422, 0)
-    t1494 = 0.5*(-t1361 + t1396)/xp.where(t1493, t1422, 1)
+    t1494 = (-t1361 + t1396)/xp.where(t1493, 2*t1422, 1)
     t1495 = xp.abs(t1494)
     t1496 = xp.greater_equal(t1495, 1)
-    t1497 = xp.abs(1/xp.where(t1496, t1494, 1))
+    t1497 = 1/xp.abs(xp.where(t1496, t1494, 1))
     t1498 = xp.where(t1493, xp.where(xp.greater_equal(t1494, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1496, t1497/(1 + xp.sqrt(1 + t1497**2)), 1/(t1495 + xp.sqrt(1 + t1495**2))), 0)
     t1499 = 1/xp.sqrt(1 + t1498**2)
     t1500 = t1422*t1498
@@ -5050,10 +5050,10 @@ def condition_number(q):
     t1526 = t1524 + t1498*t1523
     t1527 = t1436*t1505 + t1440*t1509 + t1444*t1513 + t1448*t1517 + t1452*t1521 + t1456*t1525
     t1528 = xp.not_equal(t1527, 0)
-    t1529 = 0.5*(-t1501 + t1432)/xp.where(t1528, t1527, 1)
+    t1529 = (-t1501 + t1432)/xp.where(t1528, 2*t1527, 1)
     t1530 = xp.abs(t1529)
     t1531 = xp.greater_equal(t1530, 1)
-    t1532 = xp.abs(1/xp.where(t1531, t1529, 1))
+    t1532 = 1/xp.abs(xp.where(t1531, t1529, 1))
     t1533 = xp.where(t1528, xp.where(xp.greater_equal(t1529, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1531, t1532/(1 + xp.sqrt(1 + t1532**2)), 1/(t1530 + xp.sqrt(1 + t1530**2))), 0)
     t1534 = 1/xp.sqrt(1 + t1533**2)
     t1535 = t1527*t1533
@@ -5086,10 +5086,10 @@ def condition_number(q):
     t1562 = t1471*t1540 + t1475*t1544 + t1479*t1548 + t1483*t1552 + t1487*t1556 + t1491*t1560
     t1563 = t1506*t1541 + t1510*t1545 + t1514*t1549 + t1518*t1553 + t1522*t1557 + t1526*t1561
     t1564 = xp.not_equal(t1562, 0)
-    t1565 = 0.5*(-t1536 + t1467)/xp.where(t1564, t1562, 1)
+    t1565 = (-t1536 + t1467)/xp.where(t1564, 2*t1562, 1)
     t1566 = xp.abs(t1565)
     t1567 = xp.greater_equal(t1566, 1)
-    t1568 = xp.abs(1/xp.where(t1567, t1565, 1))
+    t1568 = 1/xp.abs(xp.where(t1567, t1565, 1))
     t1569 = xp.where(t1564, xp.where(xp.greater_equal(t1565, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1567, t1568/(1 + xp.sqrt(1 + t1568**2)), 1/(t1566 + xp.sqrt(1 + t1566**2))), 0)
     t1570 = 1/xp.sqrt(1 + t1569**2)
     t1571 = t1562*t1569
@@ -5120,10 +5120,10 @@ def condition_number(q):
     t1596 = t1594 - t1569*t1595
     t1597 = t1595 + t1569*t1594
     t1598 = xp.not_equal(t1563, 0)
-    t1599 = 0.5*(-t1502 + t1537)/xp.where(t1598, t1563, 1)
+    t1599 = (-t1502 + t1537)/xp.where(t1598, 2*t1563, 1)
     t1600 = xp.abs(t1599)
     t1601 = xp.greater_equal(t1600, 1)
-    t1602 = xp.abs(1/xp.where(t1601, t1599, 1))
+    t1602 = 1/xp.abs(xp.where(t1601, t1599, 1))
     t1603 = xp.where(t1598, xp.where(xp.greater_equal(t1599, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1601, t1602/(1 + xp.sqrt(1 + t1602**2)), 1/(t1600 + xp.sqrt(1 + t1600**2))), 0)
     t1604 = 1/xp.sqrt(1 + t1603**2)
     t1605 = t1563*t1603
@@ -5155,10 +5155,10 @@ def condition_number(q):
     t1631 = t1629 + t1603*t1628
     t1632 = t1577*t1610 + t1581*t1614 + t1585*t1618 + t1589*t1622 + t1593*t1626 + t1597*t1630
     t1633 = xp.not_equal(t1632, 0)
-    t1634 = 0.5*(-t1606 + t1573)/xp.where(t1633, t1632, 1)
+    t1634 = (-t1606 + t1573)/xp.where(t1633, 2*t1632, 1)
     t1635 = xp.abs(t1634)
     t1636 = xp.greater_equal(t1635, 1)
-    t1637 = xp.abs(1/xp.where(t1636, t1634, 1))
+    t1637 = 1/xp.abs(xp.where(t1636, t1634, 1))
     t1638 = xp.where(t1633, xp.where(xp.greater_equal(t1634, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1636, t1637/(1 + xp.sqrt(1 + t1637**2)), 1/(t1635 + xp.sqrt(1 + t1635**2))), 0)
     t1639 = 1/xp.sqrt(1 + t1638**2)
     t1640 = t1632*t1638
@@ -5190,10 +5190,10 @@ def condition_number(q):
     t1666 = t1664 + t1638*t1663
     t1667 = t1611*t1646 + t1615*t1650 + t1619*t1654 + t1623*t1658 + t1627*t1662 + t1631*t1666
     t1668 = xp.not_equal(t1667, 0)
-    t1669 = 0.5*(-t1607 + t1642)/xp.where(t1668, t1667, 1)
+    t1669 = (-t1607 + t1642)/xp.where(t1668, 2*t1667, 1)
     t1670 = xp.abs(t1669)
     t1671 = xp.greater_equal(t1670, 1)
-    t1672 = xp.abs(1/xp.where(t1671, t1669, 1))
+    t1672 = 1/xp.abs(xp.where(t1671, t1669, 1))
     t1673 = xp.where(t1668, xp.where(xp.greater_equal(t1669, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1671, t1672/(1 + xp.sqrt(1 + t1672**2)), 1/(t1670 + xp.sqrt(1 + t1670**2))), 0)
     t1674 = 1/xp.sqrt(1 + t1673**2)
     t1675 = t1667*t1673
@@ -5224,10 +5224,10 @@ def condition_number(q):
     t1700 = t1698 - t1673*t1699
     t1701 = t1699 + t1673*t1698
     t1702 = xp.not_equal(t1492, 0)
-    t1703 = 0.5*(-t1326 + t1466)/xp.where(t1702, t1492, 1)
+    t1703 = (-t1326 + t1466)/xp.where(t1702, 2*t1492, 1)
     t1704 = xp.abs(t1703)
     t1705 = xp.greater_equal(t1704, 1)
-    t1706 = xp.abs(1/xp.where(t1705, t1703, 1))
+    t1706 = 1/xp.abs(xp.where(t1705, t1703, 1))
     t1707 = xp.where(t1702, xp.where(xp.greater_equal(t1703, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1705, t1706/(1 + xp.sqrt(1 + t1706**2)), 1/(t1704 + xp.sqrt(1 + t1704**2))), 0)
     t1708 = 1/xp.sqrt(1 + t1707**2)
     t1709 = t1492*t1707
@@ -5259,10 +5259,10 @@ def condition_number(q):
     t1735 = t1733 + t1707*t1732
     t1736 = t1576*t1714 + t1580*t1718 + t1584*t1722 + t1588*t1726 + t1592*t1730 + t1596*t1734
     t1737 = xp.not_equal(t1736, 0)
-    t1738 = 0.5*(-t1710 + t1572)/xp.where(t1737, t1736, 1)
+    t1738 = (-t1710 + t1572)/xp.where(t1737, 2*t1736, 1)
     t1739 = xp.abs(t1738)
     t1740 = xp.greater_equal(t1739, 1)
-    t1741 = xp.abs(1/xp.where(t1740, t1738, 1))
+    t1741 = 1/xp.abs(xp.where(t1740, t1738, 1))
     t1742 = xp.where(t1737, xp.where(xp.greater_equal(t1738, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1740, t1741/(1 + xp.sqrt(1 + t1741**2)), 1/(t1739 + xp.sqrt(1 + t1739**2))), 0)
     t1743 = 1/xp.sqrt(1 + t1742**2)
     t1744 = t1736*t1742
@@ -5295,10 +5295,10 @@ def condition_number(q):
     t1771 = t1645*t1749 + t1649*t1753 + t1653*t1757 + t1657*t1761 + t1661*t1765 + t1665*t1769
     t1772 = t1715*t1750 + t1719*t1754 + t1723*t1758 + t1727*t1762 + t1731*t1766 + t1735*t1770
     t1773 = xp.not_equal(t1771, 0)
-    t1774 = 0.5*(-t1745 + t1641)/xp.where(t1773, t1771, 1)
+    t1774 = (-t1745 + t1641)/xp.where(t1773, 2*t1771, 1)
     t1775 = xp.abs(t1774)
     t1776 = xp.greater_equal(t1775, 1)
-    t1777 = xp.abs(1/xp.where(t1776, t1774, 1))
+    t1777 = 1/xp.abs(xp.where(t1776, t1774, 1))
     t1778 = xp.where(t1773, xp.where(xp.greater_equal(t1774, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1776, t1777/(1 + xp.sqrt(1 + t1777**2)), 1/(t1775 + xp.sqrt(1 + t1775**2))), 0)
     t1779 = 1/xp.sqrt(1 + t1778**2)
     t1780 = t1771*t1778
@@ -5330,10 +5330,10 @@ def condition_number(q):
     t1806 = t1804 + t1778*t1803
     t1807 = t1680*t1785 + t1684*t1789 + t1688*t1793 + t1692*t1797 + t1696*t1801 + t1700*t1805
     t1808 = xp.not_equal(t1807, 0)
-    t1809 = 0.5*(-t1781 + t1676)/xp.where(t1808, t1807, 1)
+    t1809 = (-t1781 + t1676)/xp.where(t1808, 2*t1807, 1)
     t1810 = xp.abs(t1809)
     t1811 = xp.greater_equal(t1810, 1)
-    t1812 = xp.abs(1/xp.where(t1811, t1809, 1))
+    t1812 = 1/xp.abs(xp.where(t1811, t1809, 1))
     t1813 = xp.where(t1808, xp.where(xp.greater_equal(t1809, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1811, t1812/(1 + xp.sqrt(1 + t1812**2)), 1/(t1810 + xp.sqrt(1 + t1810**2))), 0)
     t1814 = 1/xp.sqrt(1 + t1813**2)
     t1815 = t1807*t1813
@@ -5365,10 +5365,10 @@ def condition_number(q):
     t1841 = t1839 + t1813*t1838
     t1842 = t1681*t1820 + t1685*t1824 + t1689*t1828 + t1693*t1832 + t1697*t1836 + t1701*t1840
     t1843 = xp.not_equal(t1842, 0)
-    t1844 = 0.5*(-t1816 + t1677)/xp.where(t1843, t1842, 1)
+    t1844 = (-t1816 + t1677)/xp.where(t1843, 2*t1842, 1)
     t1845 = xp.abs(t1844)
     t1846 = xp.greater_equal(t1845, 1)
-    t1847 = xp.abs(1/xp.where(t1846, t1844, 1))
+    t1847 = 1/xp.abs(xp.where(t1846, t1844, 1))
     t1848 = xp.where(t1843, xp.where(xp.greater_equal(t1844, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1846, t1847/(1 + xp.sqrt(1 + t1847**2)), 1/(t1845 + xp.sqrt(1 + t1845**2))), 0)
     t1849 = 1/xp.sqrt(1 + t1848**2)
     t1850 = t1842*t1848
@@ -5399,10 +5399,10 @@ def condition_number(q):
     t1875 = t1873 - t1848*t1874
     t1876 = t1874 + t1848*t1873
     t1877 = xp.not_equal(t1772, 0)
-    t1878 = 0.5*(-t1711 + t1746)/xp.where(t1877, t1772, 1)
+    t1878 = (-t1711 + t1746)/xp.where(t1877, 2*t1772, 1)
     t1879 = xp.abs(t1878)
     t1880 = xp.greater_equal(t1879, 1)
-    t1881 = xp.abs(1/xp.where(t1880, t1878, 1))
+    t1881 = 1/xp.abs(xp.where(t1880, t1878, 1))
     t1882 = xp.where(t1877, xp.where(xp.greater_equal(t1878, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1880, t1881/(1 + xp.sqrt(1 + t1881**2)), 1/(t1879 + xp.sqrt(1 + t1879**2))), 0)
     t1883 = 1/xp.sqrt(1 + t1882**2)
     t1884 = t1772*t1882
@@ -5434,10 +5434,10 @@ def condition_number(q):
     t1910 = t1908 + t1882*t1907
     t1911 = t1786*t1889 + t1790*t1893 + t1794*t1897 + t1798*t1901 + t1802*t1905 + t1806*t1909
     t1912 = xp.not_equal(t1911, 0)
-    t1913 = 0.5*(-t1885 + t1782)/xp.where(t1912, t1911, 1)
+    t1913 = (-t1885 + t1782)/xp.where(t1912, 2*t1911, 1)
     t1914 = xp.abs(t1913)
     t1915 = xp.greater_equal(t1914, 1)
-    t1916 = xp.abs(1/xp.where(t1915, t1913, 1))
+    t1916 = 1/xp.abs(xp.where(t1915, t1913, 1))
     t1917 = xp.where(t1912, xp.where(xp.greater_equal(t1913, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1915, t1916/(1 + xp.sqrt(1 + t1916**2)), 1/(t1914 + xp.sqrt(1 + t1914**2))), 0)
     t1918 = 1/xp.sqrt(1 + t1917**2)
     t1919 = t1911*t1917
@@ -5470,10 +5470,10 @@ def condition_number(q):
     t1946 = t1821*t1924 + t1825*t1928 + t1829*t1932 + t1833*t1936 + t1837*t1940 + t1841*t1944
     t1947 = t1890*t1925 + t1894*t1929 + t1898*t1933 + t1902*t1937 + t1906*t1941 + t1910*t1945
     t1948 = xp.not_equal(t1946, 0)
-    t1949 = 0.5*(-t1920 + t1817)/xp.where(t1948, t1946, 1)
+    t1949 = (-t1920 + t1817)/xp.where(t1948, 2*t1946, 1)
     t1950 = xp.abs(t1949)
     t1951 = xp.greater_equal(t1950, 1)
-    t1952 = xp.abs(1/xp.where(t1951, t1949, 1))
+    t1952 = 1/xp.abs(xp.where(t1951, t1949, 1))
     t1953 = xp.where(t1948, xp.where(xp.greater_equal(t1949, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1951, t1952/(1 + xp.sqrt(1 + t1952**2)), 1/(t1950 + xp.sqrt(1 + t1950**2))), 0)
     t1954 = 1/xp.sqrt(1 + t1953**2)
     t1955 = t1946*t1953
@@ -5505,10 +5505,10 @@ def condition_number(q):
     t1981 = t1979 + t1953*t1978
     t1982 = t1856*t1960 + t1860*t1964 + t1864*t1968 + t1868*t1972 + t1872*t1976 + t1876*t1980
     t1983 = xp.not_equal(t1982, 0)
-    t1984 = 0.5*(-t1956 + t1852)/xp.where(t1983, t1982, 1)
+    t1984 = (-t1956 + t1852)/xp.where(t1983, 2*t1982, 1)
     t1985 = xp.abs(t1984)
     t1986 = xp.greater_equal(t1985, 1)
-    t1987 = xp.abs(1/xp.where(t1986, t1984, 1))
+    t1987 = 1/xp.abs(xp.where(t1986, t1984, 1))
     t1988 = xp.where(t1983, xp.where(xp.greater_equal(t1984, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1986, t1987/(1 + xp.sqrt(1 + t1987**2)), 1/(t1985 + xp.sqrt(1 + t1985**2))), 0)
     t1989 = 1/xp.sqrt(1 + t1988**2)
     t1990 = t1982*t1988
@@ -5540,10 +5540,10 @@ def condition_number(q):
     t2016 = t2014 + t1988*t2013
     t2017 = t1855*t1995 + t1859*t1999 + t1863*t2003 + t1867*t2007 + t1871*t2011 + t1875*t2015
     t2018 = xp.not_equal(t1947, 0)
-    t2019 = 0.5*(-t1886 + t1921)/xp.where(t2018, t1947, 1)
+    t2019 = (-t1886 + t1921)/xp.where(t2018, 2*t1947, 1)
     t2020 = xp.abs(t2019)
     t2021 = xp.greater_equal(t2020, 1)
-    t2022 = xp.abs(1/xp.where(t2021, t2019, 1))
+    t2022 = 1/xp.abs(xp.where(t2021, t2019, 1))
     t2023 = xp.where(t2018, xp.where(xp.greater_equal(t2019, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2021, t2022/(1 + xp.sqrt(1 + t2022**2)), 1/(t2020 + xp.sqrt(1 + t2020**2))), 0)
     t2024 = 1/xp.sqrt(1 + t2023**2)
     t2025 = t1947*t2023
@@ -5575,10 +5575,10 @@ def condition_number(q):
     t2051 = t2049 + t2023*t2048
     t2052 = t1961*t2030 + t1965*t2034 + t1969*t2038 + t1973*t2042 + t1977*t2046 + t1981*t2050
     t2053 = xp.not_equal(t2052, 0)
-    t2054 = 0.5*(-t2026 + t1957)/xp.where(t2053, t2052, 1)
+    t2054 = (-t2026 + t1957)/xp.where(t2053, 2*t2052, 1)
     t2055 = xp.abs(t2054)
     t2056 = xp.greater_equal(t2055, 1)
-    t2057 = xp.abs(1/xp.where(t2056, t2054, 1))
+    t2057 = 1/xp.abs(xp.where(t2056, t2054, 1))
     t2058 = xp.where(t2053, xp.where(xp.greater_equal(t2054, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2056, t2057/(1 + xp.sqrt(1 + t2057**2)), 1/(t2055 + xp.sqrt(1 + t2055**2))), 0)
     t2059 = 1/xp.sqrt(1 + t2058**2)
     t2060 = t2052*t2058
@@ -5611,10 +5611,10 @@ def condition_number(q):
     t2087 = t1996*t2065 + t2000*t2069 + t2004*t2073 + t2008*t2077 + t2012*t2081 + t2016*t2085
     t2088 = t2031*t2066 + t2035*t2070 + t2039*t2074 + t2043*t2078 + t2047*t2082 + t2051*t2086
     t2089 = xp.not_equal(t2087, 0)
-    t2090 = 0.5*(-t2061 + t1992)/xp.where(t2089, t2087, 1)
+    t2090 = (-t2061 + t1992)/xp.where(t2089, 2*t2087, 1)
     t2091 = xp.abs(t2090)
     t2092 = xp.greater_equal(t2091, 1)
-    t2093 = xp.abs(1/xp.where(t2092, t2090, 1))
+    t2093 = 1/xp.abs(xp.where(t2092, t2090, 1))
     t2094 = xp.where(t2089, xp.where(xp.greater_equal(t2090, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2092, t2093/(1 + xp.sqrt(1 + t2093**2)), 1/(t2091 + xp.sqrt(1 + t2091**2))), 0)
     t2095 = 1/xp.sqrt(1 + t2094**2)
     t2096 = t2087*t2094
@@ -5645,10 +5645,10 @@ def condition_number(q):
     t2121 = t2119 - t2094*t2120
     t2122 = t2120 + t2094*t2119
     t2123 = xp.not_equal(t2088, 0)
-    t2124 = 0.5*(-t2027 + t2062)/xp.where(t2123, t2088, 1)
+    t2124 = (-t2027 + t2062)/xp.where(t2123, 2*t2088, 1)
     t2125 = xp.abs(t2124)
     t2126 = xp.greater_equal(t2125, 1)
-    t2127 = xp.abs(1/xp.where(t2126, t2124, 1))
+    t2127 = 1/xp.abs(xp.where(t2126, t2124, 1))
     t2128 = xp.where(t2123, xp.where(xp.greater_equal(t2124, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2126, t2127/(1 + xp.sqrt(1 + t2127**2)), 1/(t2125 + xp.sqrt(1 + t2125**2))), 0)
     t2129 = 1/xp.sqrt(1 + t2128**2)
     t2130 = t2088*t2128
@@ -5680,10 +5680,10 @@ def condition_number(q):
     t2156 = t2154 + t2128*t2153
     t2157 = t2102*t2135 + t2106*t2139 + t2110*t2143 + t2114*t2147 + t2118*t2151 + t2122*t2155
     t2158 = xp.not_equal(t2157, 0)
-    t2159 = 0.5*(-t2131 + t2098)/xp.where(t2158, t2157, 1)
+    t2159 = (-t2131 + t2098)/xp.where(t2158, 2*t2157, 1)
     t2160 = xp.abs(t2159)
     t2161 = xp.greater_equal(t2160, 1)
-    t2162 = xp.abs(1/xp.where(t2161, t2159, 1))
+    t2162 = 1/xp.abs(xp.where(t2161, t2159, 1))
     t2163 = xp.where(t2158, xp.where(xp.greater_equal(t2159, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2161, t2162/(1 + xp.sqrt(1 + t2162**2)), 1/(t2160 + xp.sqrt(1 + t2160**2))), 0)
     t2164 = 1/xp.sqrt(1 + t2163**2)
     t2165 = t2157*t2163
@@ -5715,10 +5715,10 @@ def condition_number(q):
     t2191 = t2189 + t2163*t2188
     t2192 = t2136*t2171 + t2140*t2175 + t2144*t2179 + t2148*t2183 + t2152*t2187 + t2156*t2191
     t2193 = xp.not_equal(t2192, 0)
-    t2194 = 0.5*(-t2132 + t2167)/xp.where(t2193, t2192, 1)
+    t2194 = (-t2132 + t2167)/xp.where(t2193, 2*t2192, 1)
     t2195 = xp.abs(t2194)
     t2196 = xp.greater_equal(t2195, 1)
-    t2197 = xp.abs(1/xp.where(t2196, t2194, 1))
+    t2197 = 1/xp.abs(xp.where(t2196, t2194, 1))
     t2198 = xp.where(t2193, xp.where(xp.greater_equal(t2194, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2196, t2197/(1 + xp.sqrt(1 + t2197**2)), 1/(t2195 + xp.sqrt(1 + t2195**2))), 0)
     t2199 = 1/xp.sqrt(1 + t2198**2)
     t2200 = t2192*t2198
@@ -5749,10 +5749,10 @@ def condition_number(q):
     t2225 = t2223 - t2198*t2224
     t2226 = t2224 + t2198*t2223
     t2227 = xp.not_equal(t2017, 0)
-    t2228 = 0.5*(-t1851 + t1991)/xp.where(t2227, t2017, 1)
+    t2228 = (-t1851 + t1991)/xp.where(t2227, 2*t2017, 1)
     t2229 = xp.abs(t2228)
     t2230 = xp.greater_equal(t2229, 1)
-    t2231 = xp.abs(1/xp.where(t2230, t2228, 1))
+    t2231 = 1/xp.abs(xp.where(t2230, t2228, 1))
     t2232 = xp.where(t2227, xp.where(xp.greater_equal(t2228, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2230, t2231/(1 + xp.sqrt(1 + t2231**2)), 1/(t2229 + xp.sqrt(1 + t2229**2))), 0)
     t2233 = 1/xp.sqrt(1 + t2232**2)
     t2234 = t2017*t2232
@@ -5784,10 +5784,10 @@ def condition_number(q):
     t2260 = t2258 + t2232*t2257
     t2261 = t2101*t2239 + t2105*t2243 + t2109*t2247 + t2113*t2251 + t2117*t2255 + t2121*t2259
     t2262 = xp.not_equal(t2261, 0)
-    t2263 = 0.5*(-t2235 + t2097)/xp.where(t2262, t2261, 1)
+    t2263 = (-t2235 + t2097)/xp.where(t2262, 2*t2261, 1)
     t2264 = xp.abs(t2263)
     t2265 = xp.greater_equal(t2264, 1)
-    t2266 = xp.abs(1/xp.where(t2265, t2263, 1))
+    t2266 = 1/xp.abs(xp.where(t2265, t2263, 1))
     t2267 = xp.where(t2262, xp.where(xp.greater_equal(t2263, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2265, t2266/(1 + xp.sqrt(1 + t2266**2)), 1/(t2264 + xp.sqrt(1 + t2264**2))), 0)
     t2268 = 1/xp.sqrt(1 + t2267**2)
     t2269 = t2261*t2267
@@ -5820,10 +5820,10 @@ def condition_number(q):
     t2296 = t2170*t2274 + t2174*t2278 + t2178*t2282 + t2182*t2286 + t2186*t2290 + t2190*t2294
     t2297 = t2240*t2275 + t2244*t2279 + t2248*t2283 + t2252*t2287 + t2256*t2291 + t2260*t2295
     t2298 = xp.not_equal(t2296, 0)
-    t2299 = 0.5*(-t2270 + t2166)/xp.where(t2298, t2296, 1)
+    t2299 = (-t2270 + t2166)/xp.where(t2298, 2*t2296, 1)
     t2300 = xp.abs(t2299)
     t2301 = xp.greater_equal(t2300, 1)
-    t2302 = xp.abs(1/xp.where(t2301, t2299, 1))
+    t2302 = 1/xp.abs(xp.where(t2301, t2299, 1))
     t2303 = xp.where(t2298, xp.where(xp.greater_equal(t2299, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2301, t2302/(1 + xp.sqrt(1 + t2302**2)), 1/(t2300 + xp.sqrt(1 + t2300**2))), 0)
     t2304 = 1/xp.sqrt(1 + t2303**2)
     t2305 = t2296*t2303
@@ -5855,10 +5855,10 @@ def condition_number(q):
     t2331 = t2329 + t2303*t2328
     t2332 = t2205*t2310 + t2209*t2314 + t2213*t2318 + t2217*t2322 + t2221*t2326 + t2225*t2330
     t2333 = xp.not_equal(t2332, 0)
-    t2334 = 0.5*(-t2306 + t2201)/xp.where(t2333, t2332, 1)
+    t2334 = (-t2306 + t2201)/xp.where(t2333, 2*t2332, 1)
     t2335 = xp.abs(t2334)
     t2336 = xp.greater_equal(t2335, 1)
-    t2337 = xp.abs(1/xp.where(t2336, t2334, 1))
+    t2337 = 1/xp.abs(xp.where(t2336, t2334, 1))
     t2338 = xp.where(t2333, xp.where(xp.greater_equal(t2334, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2336, t2337/(1 + xp.sqrt(1 + t2337**2)), 1/(t2335 + xp.sqrt(1 + t2335**2))), 0)
     t2339 = 1/xp.sqrt(1 + t2338**2)
     t2340 = t2332*t2338
@@ -5890,10 +5890,10 @@ def condition_number(q):
     t2366 = t2364 + t2338*t2363
     t2367 = t2206*t2345 + t2210*t2349 + t2214*t2353 + t2218*t2357 + t2222*t2361 + t2226*t2365
     t2368 = xp.not_equal(t2367, 0)
-    t2369 = 0.5*(-t2341 + t2202)/xp.where(t2368, t2367, 1)
+    t2369 = (-t2341 + t2202)/xp.where(t2368, 2*t2367, 1)
     t2370 = xp.abs(t2369)
     t2371 = xp.greater_equal(t2370, 1)
-    t2372 = xp.abs(1/xp.where(t2371, t2369, 1))
+    t2372 = 1/xp.abs(xp.where(t2371, t2369, 1))
     t2373 = xp.where(t2368, xp.where(xp.greater_equal(t2369, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2371, t2372/(1 + xp.sqrt(1 + t2372**2)), 1/(t2370 + xp.sqrt(1 + t2370**2))), 0)
     t2374 = 1/xp.sqrt(1 + t2373**2)
     t2375 = t2367*t2373
@@ -5924,10 +5924,10 @@ def condition_number(q):
     t2400 = t2398 - t2373*t2399
     t2401 = t2399 + t2373*t2398
     t2402 = xp.not_equal(t2297, 0)
-    t2403 = 0.5*(-t2236 + t2271)/xp.where(t2402, t2297, 1)
+    t2403 = (-t2236 + t2271)/xp.where(t2402, 2*t2297, 1)
     t2404 = xp.abs(t2403)
     t2405 = xp.greater_equal(t2404, 1)
-    t2406 = xp.abs(1/xp.where(t2405, t2403, 1))
+    t2406 = 1/xp.abs(xp.where(t2405, t2403, 1))
     t2407 = xp.where(t2402, xp.where(xp.greater_equal(t2403, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2405, t2406/(1 + xp.sqrt(1 + t2406**2)), 1/(t2404 + xp.sqrt(1 + t2404**2))), 0)
     t2408 = 1/xp.sqrt(1 + t2407**2)
     t2409 = t2297*t2407
@@ -5959,10 +5959,10 @@ def condition_number(q):
     t2435 = t2433 + t2407*t2432
     t2436 = t2311*t2414 + t2315*t2418 + t2319*t2422 + t2323*t2426 + t2327*t2430 + t2331*t2434
     t2437 = xp.not_equal(t2436, 0)
-    t2438 = 0.5*(-t2410 + t2307)/xp.where(t2437, t2436, 1)
+    t2438 = (-t2410 + t2307)/xp.where(t2437, 2*t2436, 1)
     t2439 = xp.abs(t2438)
     t2440 = xp.greater_equal(t2439, 1)
-    t2441 = xp.abs(1/xp.where(t2440, t2438, 1))
+    t2441 = 1/xp.abs(xp.where(t2440, t2438, 1))
     t2442 = xp.where(t2437, xp.where(xp.greater_equal(t2438, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2440, t2441/(1 + xp.sqrt(1 + t2441**2)), 1/(t2439 + xp.sqrt(1 + t2439**2))), 0)
     t2443 = 1/xp.sqrt(1 + t2442**2)
     t2444 = t2436*t2442
@@ -5995,10 +5995,10 @@ def condition_number(q):
     t2471 = t2346*t2449 + t2350*t2453 + t2354*t2457 + t2358*t2461 + t2362*t2465 + t2366*t2469
     t2472 = t2415*t2450 + t2419*t2454 + t2423*t2458 + t2427*t2462 + t2431*t2466 + t2435*t2470
     t2473 = xp.not_equal(t2471, 0)
-    t2474 = 0.5*(-t2445 + t2342)/xp.where(t2473, t2471, 1)
+    t2474 = (-t2445 + t2342)/xp.where(t2473, 2*t2471, 1)
     t2475 = xp.abs(t2474)
     t2476 = xp.greater_equal(t2475, 1)
-    t2477 = xp.abs(1/xp.where(t2476, t2474, 1))
+    t2477 = 1/xp.abs(xp.where(t2476, t2474, 1))
     t2478 = xp.where(t2473, xp.where(xp.greater_equal(t2474, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2476, t2477/(1 + xp.sqrt(1 + t2477**2)), 1/(t2475 + xp.sqrt(1 + t2475**2))), 0)
     t2479 = 1/xp.sqrt(1 + t2478**2)
     t2480 = t2471*t2478
@@ -6030,10 +6030,10 @@ def condition_number(q):
     t2506 = t2504 + t2478*t2503
     t2507 = t2381*t2485 + t2385*t2489 + t2389*t2493 + t2393*t2497 + t2397*t2501 + t2401*t2505
     t2508 = xp.not_equal(t2507, 0)
-    t2509 = 0.5*(-t2481 + t2377)/xp.where(t2508, t2507, 1)
+    t2509 = (-t2481 + t2377)/xp.where(t2508, 2*t2507, 1)
     t2510 = xp.abs(t2509)
     t2511 = xp.greater_equal(t2510, 1)
-    t2512 = xp.abs(1/xp.where(t2511, t2509, 1))
+    t2512 = 1/xp.abs(xp.where(t2511, t2509, 1))
     t2513 = xp.where(t2508, xp.where(xp.greater_equal(t2509, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2511, t2512/(1 + xp.sqrt(1 + t2512**2)), 1/(t2510 + xp.sqrt(1 + t2510**2))), 0)
     t2514 = 1/xp.sqrt(1 + t2513**2)
     t2515 = t2507*t2513
@@ -6065,10 +6065,10 @@ def condition_number(q):
     t2541 = t2539 + t2513*t2538
     t2542 = t2380*t2520 + t2384*t2524 + t2388*t2528 + t2392*t2532 + t2396*t2536 + t2400*t2540
     t2543 = xp.not_equal(t2472, 0)
-    t2544 = 0.5*(-t2411 + t2446)/xp.where(t2543, t2472, 1)
+    t2544 = (-t2411 + t2446)/xp.where(t2543, 2*t2472, 1)
     t2545 = xp.abs(t2544)
     t2546 = xp.greater_equal(t2545, 1)
-    t2547 = xp.abs(1/xp.where(t2546, t2544, 1))
+    t2547 = 1/xp.abs(xp.where(t2546, t2544, 1))
     t2548 = xp.where(t2543, xp.where(xp.greater_equal(t2544, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2546, t2547/(1 + xp.sqrt(1 + t2547**2)), 1/(t2545 + xp.sqrt(1 + t2545**2))), 0)
     t2549 = 1/xp.sqrt(1 + t2548**2)
     t2550 = t2472*t2548
@@ -6100,10 +6100,10 @@ def condition_number(q):
     t2576 = t2574 + t2548*t2573
     t2577 = t2486*t2555 + t2490*t2559 + t2494*t2563 + t2498*t2567 + t2502*t2571 + t2506*t2575
     t2578 = xp.not_equal(t2577, 0)
-    t2579 = 0.5*(-t2551 + t2482)/xp.where(t2578, t2577, 1)
+    t2579 = (-t2551 + t2482)/xp.where(t2578, 2*t2577, 1)
     t2580 = xp.abs(t2579)
     t2581 = xp.greater_equal(t2580, 1)
-    t2582 = xp.abs(1/xp.where(t2581, t2579, 1))
+    t2582 = 1/xp.abs(xp.where(t2581, t2579, 1))
     t2583 = xp.where(t2578, xp.where(xp.greater_equal(t2579, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2581, t2582/(1 + xp.sqrt(1 + t2582**2)), 1/(t2580 + xp.sqrt(1 + t2580**2))), 0)
     t2584 = 1/xp.sqrt(1 + t2583**2)
     t2585 = t2577*t2583
@@ -6136,10 +6136,10 @@ def condition_number(q):
     t2612 = t2521*t2590 + t2525*t2594 + t2529*t2598 + t2533*t2602 + t2537*t2606 + t2541*t2610
     t2613 = t2556*t2591 + t2560*t2595 + t2564*t2599 + t2568*t2603 + t2572*t2607 + t2576*t2611
     t2614 = xp.not_equal(t2612, 0)
-    t2615 = 0.5*(-t2586 + t2517)/xp.where(t2614, t2612, 1)
+    t2615 = (-t2586 + t2517)/xp.where(t2614, 2*t2612, 1)
     t2616 = xp.abs(t2615)
     t2617 = xp.greater_equal(t2616, 1)
-    t2618 = xp.abs(1/xp.where(t2617, t2615, 1))
+    t2618 = 1/xp.abs(xp.where(t2617, t2615, 1))
     t2619 = xp.where(t2614, xp.where(xp.greater_equal(t2615, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2617, t2618/(1 + xp.sqrt(1 + t2618**2)), 1/(t2616 + xp.sqrt(1 + t2616**2))), 0)
     t2620 = 1/xp.sqrt(1 + t2619**2)
     t2621 = t2612*t2619
@@ -6170,10 +6170,10 @@ def condition_number(q):
     t2646 = t2644 - t2619*t2645
     t2647 = t2645 + t2619*t2644
     t2648 = xp.not_equal(t2613, 0)
-    t2649 = 0.5*(-t2552 + t2587)/xp.where(t2648, t2613, 1)
+    t2649 = (-t2552 + t2587)/xp.where(t2648, 2*t2613, 1)
     t2650 = xp.abs(t2649)
     t2651 = xp.greater_equal(t2650, 1)
-    t2652 = xp.abs(1/xp.where(t2651, t2649, 1))
+    t2652 = 1/xp.abs(xp.where(t2651, t2649, 1))
     t2653 = xp.where(t2648, xp.where(xp.greater_equal(t2649, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2651, t2652/(1 + xp.sqrt(1 + t2652**2)), 1/(t2650 + xp.sqrt(1 + t2650**2))), 0)
     t2654 = 1/xp.sqrt(1 + t2653**2)
     t2655 = t2613*t2653
@@ -6205,10 +6205,10 @@ def condition_number(q):
     t2681 = t2679 + t2653*t2678
     t2682 = t2627*t2660 + t2631*t2664 + t2635*t2668 + t2639*t2672 + t2643*t2676 + t2647*t2680
     t2683 = xp.not_equal(t2682, 0)
-    t2684 = 0.5*(-t2656 + t2623)/xp.where(t2683, t2682, 1)
+    t2684 = (-t2656 + t2623)/xp.where(t2683, 2*t2682, 1)
     t2685 = xp.abs(t2684)
     t2686 = xp.greater_equal(t2685, 1)
-    t2687 = xp.abs(1/xp.where(t2686, t2684, 1))
+    t2687 = 1/xp.abs(xp.where(t2686, t2684, 1))
     t2688 = xp.where(t2683, xp.where(xp.greater_equal(t2684, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2686, t2687/(1 + xp.sqrt(1 + t2687**2)), 1/(t2685 + xp.sqrt(1 + t2685**2))), 0)
     t2689 = 1/xp.sqrt(1 + t2688**2)
     t2690 = t2682*t2688
@@ -6240,10 +6240,10 @@ def condition_number(q):
     t2716 = t2714 + t2688*t2713
     t2717 = t2661*t2696 + t2665*t2700 + t2669*t2704 + t2673*t2708 + t2677*t2712 + t2681*t2716
     t2718 = xp.not_equal(t2717, 0)
-    t2719 = 0.5*(-t2657 + t2692)/xp.where(t2718, t2717, 1)
+    t2719 = (-t2657 + t2692)/xp.where(t2718, 2*t2717, 1)
     t2720 = xp.abs(t2719)
     t2721 = xp.greater_equal(t2720, 1)
-    t2722 = xp.abs(1/xp.where(t2721, t2719, 1))
+    t2722 = 1/xp.abs(xp.where(t2721, t2719, 1))
     t2723 = xp.where(t2718, xp.where(xp.greater_equal(t2719, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2721, t2722/(1 + xp.sqrt(1 + t2722**2)), 1/(t2720 + xp.sqrt(1 + t2720**2))), 0)
     t2724 = 1/xp.sqrt(1 + t2723**2)
     t2725 = t2717*t2723
@@ -6274,10 +6274,10 @@ def condition_number(q):
     t2750 = t2748 - t2723*t2749
     t2751 = t2749 + t2723*t2748
     t2752 = xp.not_equal(t2542, 0)
-    t2753 = 0.5*(-t2376 + t2516)/xp.where(t2752, t2542, 1)
+    t2753 = (-t2376 + t2516)/xp.where(t2752, 2*t2542, 1)
     t2754 = xp.abs(t2753)
     t2755 = xp.greater_equal(t2754, 1)
-    t2756 = xp.abs(1/xp.where(t2755, t2753, 1))
+    t2756 = 1/xp.abs(xp.where(t2755, t2753, 1))
     t2757 = xp.where(t2752, xp.where(xp.greater_equal(t2753, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2755, t2756/(1 + xp.sqrt(1 + t2756**2)), 1/(t2754 + xp.sqrt(1 + t2754**2))), 0)
     t2758 = 1/xp.sqrt(1 + t2757**2)
     t2759 = t2542*t2757
@@ -6309,10 +6309,10 @@ def condition_number(q):
     t2785 = t2783 + t2757*t2782
     t2786 = t2626*t2764 + t2630*t2768 + t2634*t2772 + t2638*t2776 + t2642*t2780 + t2646*t2784
     t2787 = xp.not_equal(t2786, 0)
-    t2788 = 0.5*(-t2760 + t2622)/xp.where(t2787, t2786, 1)
+    t2788 = (-t2760 + t2622)/xp.where(t2787, 2*t2786, 1)
     t2789 = xp.abs(t2788)
     t2790 = xp.greater_equal(t2789, 1)
-    t2791 = xp.abs(1/xp.where(t2790, t2788, 1))
+    t2791 = 1/xp.abs(xp.where(t2790, t2788, 1))
     t2792 = xp.where(t2787, xp.where(xp.greater_equal(t2788, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2790, t2791/(1 + xp.sqrt(1 + t2791**2)), 1/(t2789 + xp.sqrt(1 + t2789**2))), 0)
     t2793 = 1/xp.sqrt(1 + t2792**2)
     t2794 = t2786*t2792
@@ -6345,10 +6345,10 @@ def condition_number(q):
     t2821 = t2695*t2799 + t2699*t2803 + t2703*t2807 + t2707*t2811 + t2711*t2815 + t2715*t2819
     t2822 = t2765*t2800 + t2769*t2804 + t2773*t2808 + t2777*t2812 + t2781*t2816 + t2785*t2820
     t2823 = xp.not_equal(t2821, 0)
-    t2824 = 0.5*(-t2795 + t2691)/xp.where(t2823, t2821, 1)
+    t2824 = (-t2795 + t2691)/xp.where(t2823, 2*t2821, 1)
     t2825 = xp.abs(t2824)
     t2826 = xp.greater_equal(t2825, 1)
-    t2827 = xp.abs(1/xp.where(t2826, t2824, 1))
+    t2827 = 1/xp.abs(xp.where(t2826, t2824, 1))
     t2828 = xp.where(t2823, xp.where(xp.greater_equal(t2824, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2826, t2827/(1 + xp.sqrt(1 + t2827**2)), 1/(t2825 + xp.sqrt(1 + t2825**2))), 0)
     t2829 = 1/xp.sqrt(1 + t2828**2)
     t2830 = t2821*t2828
@@ -6380,10 +6380,10 @@ def condition_number(q):
     t2856 = t2854 + t2828*t2853
     t2857 = t2730*t2835 + t2734*t2839 + t2738*t2843 + t2742*t2847 + t2746*t2851 + t2750*t2855
     t2858 = xp.not_equal(t2857, 0)
-    t2859 = 0.5*(-t2831 + t2726)/xp.where(t2858, t2857, 1)
+    t2859 = (-t2831 + t2726)/xp.where(t2858, 2*t2857, 1)
     t2860 = xp.abs(t2859)
     t2861 = xp.greater_equal(t2860, 1)
-    t2862 = xp.abs(1/xp.where(t2861, t2859, 1))
+    t2862 = 1/xp.abs(xp.where(t2861, t2859, 1))
     t2863 = xp.where(t2858, xp.where(xp.greater_equal(t2859, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2861, t2862/(1 + xp.sqrt(1 + t2862**2)), 1/(t2860 + xp.sqrt(1 + t2860**2))), 0)
     t2864 = 1/xp.sqrt(1 + t2863**2)
     t2865 = t2857*t2863
@@ -6415,10 +6415,10 @@ def condition_number(q):
     t2891 = t2889 + t2863*t2888
     t2892 = t2731*t2870 + t2735*t2874 + t2739*t2878 + t2743*t2882 + t2747*t2886 + t2751*t2890
     t2893 = xp.not_equal(t2892, 0)
-    t2894 = 0.5*(-t2866 + t2727)/xp.where(t2893, t2892, 1)
+    t2894 = (-t2866 + t2727)/xp.where(t2893, 2*t2892, 1)
     t2895 = xp.abs(t2894)
     t2896 = xp.greater_equal(t2895, 1)
-    t2897 = xp.abs(1/xp.where(t2896, t2894, 1))
+    t2897 = 1/xp.abs(xp.where(t2896, t2894, 1))
     t2898 = xp.where(t2893, xp.where(xp.greater_equal(t2894, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2896, t2897/(1 + xp.sqrt(1 + t2897**2)), 1/(t2895 + xp.sqrt(1 + t2895**2))), 0)
     t2899 = 1/xp.sqrt(1 + t2898**2)
     t2900 = t2892*t2898
@@ -6449,10 +6449,10 @@ def condition_number(q):
     t2925 = t2923 - t2898*t2924
     t2926 = t2924 + t2898*t2923
     t2927 = xp.not_equal(t2822, 0)
-    t2928 = 0.5*(-t2761 + t2796)/xp.where(t2927, t2822, 1)
+    t2928 = (-t2761 + t2796)/xp.where(t2927, 2*t2822, 1)
     t2929 = xp.abs(t2928)
     t2930 = xp.greater_equal(t2929, 1)
-    t2931 = xp.abs(1/xp.where(t2930, t2928, 1))
+    t2931 = 1/xp.abs(xp.where(t2930, t2928, 1))
     t2932 = xp.where(t2927, xp.where(xp.greater_equal(t2928, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2930, t2931/(1 + xp.sqrt(1 + t2931**2)), 1/(t2929 + xp.sqrt(1 + t2929**2))), 0)
     t2933 = 1/xp.sqrt(1 + t2932**2)
     t2934 = t2822*t2932
@@ -6484,10 +6484,10 @@ def condition_number(q):
     t2960 = t2958 + t2932*t2957
     t2961 = t2836*t2939 + t2840*t2943 + t2844*t2947 + t2848*t2951 + t2852*t2955 + t2856*t2959
     t2962 = xp.not_equal(t2961, 0)
-    t2963 = 0.5*(-t2935 + t2832)/xp.where(t2962, t2961, 1)
+    t2963 = (-t2935 + t2832)/xp.where(t2962, 2*t2961, 1)
     t2964 = xp.abs(t2963)
     t2965 = xp.greater_equal(t2964, 1)
-    t2966 = xp.abs(1/xp.where(t2965, t2963, 1))
+    t2966 = 1/xp.abs(xp.where(t2965, t2963, 1))
     t2967 = xp.where(t2962, xp.where(xp.greater_equal(t2963, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2965, t2966/(1 + xp.sqrt(1 + t2966**2)), 1/(t2964 + xp.sqrt(1 + t2964**2))), 0)
     t2968 = 1/xp.sqrt(1 + t2967**2)
     t2969 = t2961*t2967
@@ -6520,10 +6520,10 @@ def condition_number(q):
     t2996 = t2871*t2974 + t2875*t2978 + t2879*t2982 + t2883*t2986 + t2887*t2990 + t2891*t2994
     t2997 = t2940*t2975 + t2944*t2979 + t2948*t2983 + t2952*t2987 + t2956*t2991 + t2960*t2995
     t2998 = xp.not_equal(t2996, 0)
-    t2999 = 0.5*(-t2970 + t2867)/xp.where(t2998, t2996, 1)
+    t2999 = (-t2970 + t2867)/xp.where(t2998, 2*t2996, 1)
     t3000 = xp.abs(t2999)
     t3001 = xp.greater_equal(t3000, 1)
-    t3002 = xp.abs(1/xp.where(t3001, t2999, 1))
+    t3002 = 1/xp.abs(xp.where(t3001, t2999, 1))
     t3003 = xp.where(t2998, xp.where(xp.greater_equal(t2999, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3001, t3002/(1 + xp.sqrt(1 + t3002**2)), 1/(t3000 + xp.sqrt(1 + t3000**2))), 0)
     t3004 = 1/xp.sqrt(1 + t3003**2)
     t3005 = t2996*t3003
@@ -6555,10 +6555,10 @@ def condition_number(q):
     t3031 = t3029 + t3003*t3028
     t3032 = t2906*t3010 + t2910*t3014 + t2914*t3018 + t2918*t3022 + t2922*t3026 + t2926*t3030
     t3033 = xp.not_equal(t3032, 0)
-    t3034 = 0.5*(-t3006 + t2902)/xp.where(t3033, t3032, 1)
+    t3034 = (-t3006 + t2902)/xp.where(t3033, 2*t3032, 1)
     t3035 = xp.abs(t3034)
     t3036 = xp.greater_equal(t3035, 1)
-    t3037 = xp.abs(1/xp.where(t3036, t3034, 1))
+    t3037 = 1/xp.abs(xp.where(t3036, t3034, 1))
     t3038 = xp.where(t3033, xp.where(xp.greater_equal(t3034, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3036, t3037/(1 + xp.sqrt(1 + t3037**2)), 1/(t3035 + xp.sqrt(1 + t3035**2))), 0)
     t3039 = 1/xp.sqrt(1 + t3038**2)
     t3040 = t3032*t3038
@@ -6590,10 +6590,10 @@ def condition_number(q):
     t3066 = t3064 + t3038*t3063
     t3067 = t2905*t3045 + t2909*t3049 + t2913*t3053 + t2917*t3057 + t2921*t3061 + t2925*t3065
     t3068 = xp.not_equal(t2997, 0)
-    t3069 = 0.5*(-t2936 + t2971)/xp.where(t3068, t2997, 1)
+    t3069 = (-t2936 + t2971)/xp.where(t3068, 2*t2997, 1)
     t3070 = xp.abs(t3069)
     t3071 = xp.greater_equal(t3070, 1)
-    t3072 = xp.abs(1/xp.where(t3071, t3069, 1))
+    t3072 = 1/xp.abs(xp.where(t3071, t3069, 1))
     t3073 = xp.where(t3068, xp.where(xp.greater_equal(t3069, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3071, t3072/(1 + xp.sqrt(1 + t3072**2)), 1/(t3070 + xp.sqrt(1 + t3070**2))), 0)
     t3074 = 1/xp.sqrt(1 + t3073**2)
     t3075 = t2997*t3073
@@ -6625,10 +6625,10 @@ def condition_number(q):
     t3101 = t3099 + t3073*t3098
     t3102 = t3011*t3080 + t3015*t3084 + t3019*t3088 + t3023*t3092 + t3027*t3096 + t3031*t3100
     t3103 = xp.not_equal(t3102, 0)
-    t3104 = 0.5*(-t3076 + t3007)/xp.where(t3103, t3102, 1)
+    t3104 = (-t3076 + t3007)/xp.where(t3103, 2*t3102, 1)
     t3105 = xp.abs(t3104)
     t3106 = xp.greater_equal(t3105, 1)
-    t3107 = xp.abs(1/xp.where(t3106, t3104, 1))
+    t3107 = 1/xp.abs(xp.where(t3106, t3104, 1))
     t3108 = xp.where(t3103, xp.where(xp.greater_equal(t3104, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3106, t3107/(1 + xp.sqrt(1 + t3107**2)), 1/(t3105 + xp.sqrt(1 + t3105**2))), 0)
     t3109 = 1/xp.sqrt(1 + t3108**2)
     t3110 = t3102*t3108
@@ -6661,10 +6661,10 @@ def condition_number(q):
     t3137 = t3046*t3115 + t3050*t3119 + t3054*t3123 + t3058*t3127 + t3062*t3131 + t3066*t3135
     t3138 = t3081*t3116 + t3085*t3120 + t3089*t3124 + t3093*t3128 + t3097*t3132 + t3101*t3136
     t3139 = xp.not_equal(t3137, 0)
-    t3140 = 0.5*(-t3111 + t3042)/xp.where(t3139, t3137, 1)
+    t3140 = (-t3111 + t3042)/xp.where(t3139, 2*t3137, 1)
     t3141 = xp.abs(t3140)
     t3142 = xp.greater_equal(t3141, 1)
-    t3143 = xp.abs(1/xp.where(t3142, t3140, 1))
+    t3143 = 1/xp.abs(xp.where(t3142, t3140, 1))
     t3144 = xp.where(t3139, xp.where(xp.greater_equal(t3140, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3142, t3143/(1 + xp.sqrt(1 + t3143**2)), 1/(t3141 + xp.sqrt(1 + t3141**2))), 0)
     t3145 = 1/xp.sqrt(1 + t3144**2)
     t3146 = t3137*t3144
@@ -6695,10 +6695,10 @@ def condition_number(q):
     t3171 = t3169 - t3144*t3170
     t3172 = t3170 + t3144*t3169
     t3173 = xp.not_equal(t3138, 0)
-    t3174 = 0.5*(-t3077 + t3112)/xp.where(t3173, t3138, 1)
+    t3174 = (-t3077 + t3112)/xp.where(t3173, 2*t3138, 1)
     t3175 = xp.abs(t3174)
     t3176 = xp.greater_equal(t3175, 1)
-    t3177 = xp.abs(1/xp.where(t3176, t3174, 1))
+    t3177 = 1/xp.abs(xp.where(t3176, t3174, 1))
     t3178 = xp.where(t3173, xp.where(xp.greater_equal(t3174, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3176, t3177/(1 + xp.sqrt(1 + t3177**2)), 1/(t3175 + xp.sqrt(1 + t3175**2))), 0)
     t3179 = 1/xp.sqrt(1 + t3178**2)
     t3180 = t3138*t3178
@@ -6730,10 +6730,10 @@ def condition_number(q):
     t3206 = t3204 + t3178*t3203
     t3207 = t3152*t3185 + t3156*t3189 + t3160*t3193 + t3164*t3197 + t3168*t3201 + t3172*t3205
     t3208 = xp.not_equal(t3207, 0)
-    t3209 = 0.5*(-t3181 + t3148)/xp.where(t3208, t3207, 1)
+    t3209 = (-t3181 + t3148)/xp.where(t3208, 2*t3207, 1)
     t3210 = xp.abs(t3209)
     t3211 = xp.greater_equal(t3210, 1)
-    t3212 = xp.abs(1/xp.where(t3211, t3209, 1))
+    t3212 = 1/xp.abs(xp.where(t3211, t3209, 1))
     t3213 = xp.where(t3208, xp.where(xp.greater_equal(t3209, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3211, t3212/(1 + xp.sqrt(1 + t3212**2)), 1/(t3210 + xp.sqrt(1 + t3210**2))), 0)
     t3214 = 1/xp.sqrt(1 + t3213**2)
     t3215 = t3207*t3213
@@ -6765,10 +6765,10 @@ def condition_number(q):
     t3241 = t3239 + t3213*t3238
     t3242 = t3186*t3221 + t3190*t3225 + t3194*t3229 + t3198*t3233 + t3202*t3237 + t3206*t3241
     t3243 = xp.not_equal(t3242, 0)
-    t3244 = 0.5*(-t3182 + t3217)/xp.where(t3243, t3242, 1)
+    t3244 = (-t3182 + t3217)/xp.where(t3243, 2*t3242, 1)
     t3245 = xp.abs(t3244)
     t3246 = xp.greater_equal(t3245, 1)
-    t3247 = xp.abs(1/xp.where(t3246, t3244, 1))
+    t3247 = 1/xp.abs(xp.where(t3246, t3244, 1))
     t3248 = xp.where(t3243, xp.where(xp.greater_equal(t3244, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3246, t3247/(1 + xp.sqrt(1 + t3247**2)), 1/(t3245 + xp.sqrt(1 + t3245**2))), 0)
     t3249 = 1/xp.sqrt(1 + t3248**2)
     t3250 = t3242*t3248
@@ -6799,10 +6799,10 @@ def condition_number(q):
     t3275 = t3273 - t3248*t3274
     t3276 = t3274 + t3248*t3273
     t3277 = xp.not_equal(t3067, 0)
-    t3278 = 0.5*(-t2901 + t3041)/xp.where(t3277, t3067, 1)
+    t3278 = (-t2901 + t3041)/xp.where(t3277, 2*t3067, 1)
     t3279 = xp.abs(t3278)
     t3280 = xp.greater_equal(t3279, 1)
-    t3281 = xp.abs(1/xp.where(t3280, t3278, 1))
+    t3281 = 1/xp.abs(xp.where(t3280, t3278, 1))
     t3282 = xp.where(t3277, xp.where(xp.greater_equal(t3278, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3280, t3281/(1 + xp.sqrt(1 + t3281**2)), 1/(t3279 + xp.sqrt(1 + t3279**2))), 0)
     t3283 = 1/xp.sqrt(1 + t3282**2)
     t3284 = t3067*t3282
@@ -6834,10 +6834,10 @@ def condition_number(q):
     t3310 = t3308 + t3282*t3307
     t3311 = t3151*t3289 + t3155*t3293 + t3159*t3297 + t3163*t3301 + t3167*t3305 + t3171*t3309
     t3312 = xp.not_equal(t3311, 0)
-    t3313 = 0.5*(-t3285 + t3147)/xp.where(t3312, t3311, 1)
+    t3313 = (-t3285 + t3147)/xp.where(t3312, 2*t3311, 1)
     t3314 = xp.abs(t3313)
     t3315 = xp.greater_equal(t3314, 1)
-    t3316 = xp.abs(1/xp.where(t3315, t3313, 1))
+    t3316 = 1/xp.abs(xp.where(t3315, t3313, 1))
     t3317 = xp.where(t3312, xp.where(xp.greater_equal(t3313, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3315, t3316/(1 + xp.sqrt(1 + t3316**2)), 1/(t3314 + xp.sqrt(1 + t3314**2))), 0)
     t3318 = 1/xp.sqrt(1 + t3317**2)
     t3319 = t3311*t3317
@@ -6870,10 +6870,10 @@ def condition_number(q):
     t3346 = t3220*t3324 + t3224*t3328 + t3228*t3332 + t3232*t3336 + t3236*t3340 + t3240*t3344
     t3347 = t3290*t3325 + t3294*t3329 + t3298*t3333 + t3302*t3337 + t3306*t3341 + t3310*t3345
     t3348 = xp.not_equal(t3346, 0)
-    t3349 = 0.5*(-t3320 + t3216)/xp.where(t3348, t3346, 1)
+    t3349 = (-t3320 + t3216)/xp.where(t3348, 2*t3346, 1)
     t3350 = xp.abs(t3349)
     t3351 = xp.greater_equal(t3350, 1)
-    t3352 = xp.abs(1/xp.where(t3351, t3349, 1))
+    t3352 = 1/xp.abs(xp.where(t3351, t3349, 1))
     t3353 = xp.where(t3348, xp.where(xp.greater_equal(t3349, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3351, t3352/(1 + xp.sqrt(1 + t3352**2)), 1/(t3350 + xp.sqrt(1 + t3350**2))), 0)
     t3354 = 1/xp.sqrt(1 + t3353**2)
     t3355 = t3346*t3353
@@ -6905,10 +6905,10 @@ def condition_number(q):
     t3381 = t3379 + t3353*t3378
     t3382 = t3255*t3360 + t3259*t3364 + t3263*t3368 + t3267*t3372 + t3271*t3376 + t3275*t3380
     t3383 = xp.not_equal(t3382, 0)
-    t3384 = 0.5*(-t3356 + t3251)/xp.where(t3383, t3382, 1)
+    t3384 = (-t3356 + t3251)/xp.where(t3383, 2*t3382, 1)
     t3385 = xp.abs(t3384)
     t3386 = xp.greater_equal(t3385, 1)
-    t3387 = xp.abs(1/xp.where(t3386, t3384, 1))
+    t3387 = 1/xp.abs(xp.where(t3386, t3384, 1))
     t3388 = xp.where(t3383, xp.where(xp.greater_equal(t3384, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3386, t3387/(1 + xp.sqrt(1 + t3387**2)), 1/(t3385 + xp.sqrt(1 + t3385**2))), 0)
     t3389 = 1/xp.sqrt(1 + t3388**2)
     t3390 = t3382*t3388
@@ -6940,10 +6940,10 @@ def condition_number(q):
     t3416 = t3414 + t3388*t3413
     t3417 = t3256*t3395 + t3260*t3399 + t3264*t3403 + t3268*t3407 + t3272*t3411 + t3276*t3415
     t3418 = xp.not_equal(t3417, 0)
-    t3419 = 0.5*(-t3391 + t3252)/xp.where(t3418, t3417, 1)
+    t3419 = (-t3391 + t3252)/xp.where(t3418, 2*t3417, 1)
     t3420 = xp.abs(t3419)
     t3421 = xp.greater_equal(t3420, 1)
-    t3422 = xp.abs(1/xp.where(t3421, t3419, 1))
+    t3422 = 1/xp.abs(xp.where(t3421, t3419, 1))
     t3423 = xp.where(t3418, xp.where(xp.greater_equal(t3419, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3421, t3422/(1 + xp.sqrt(1 + t3422**2)), 1/(t3420 + xp.sqrt(1 + t3420**2))), 0)
     t3424 = 1/xp.sqrt(1 + t3423**2)
     t3425 = t3252 + t3417*t3423
@@ -6973,10 +6973,10 @@ def condition_number(q):
     t3449 = t3447 + t3423*t3446
     t3450 = xp.sqrt(t3428**2 + t3432**2 + t3436**2 + t3440**2 + t3444**2 + t3448**2)
     t3451 = xp.not_equal(t3347, 0)
-    t3452 = 0.5*(-t3286 + t3321)/xp.where(t3451, t3347, 1)
+    t3452 = (-t3286 + t3321)/xp.where(t3451, 2*t3347, 1)
     t3453 = xp.abs(t3452)
     t3454 = xp.greater_equal(t3453, 1)
-    t3455 = xp.abs(1/xp.where(t3454, t3452, 1))
+    t3455 = 1/xp.abs(xp.where(t3454, t3452, 1))
     t3456 = xp.where(t3451, xp.where(xp.greater_equal(t3452, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3454, t3455/(1 + xp.sqrt(1 + t3455**2)), 1/(t3453 + xp.sqrt(1 + t3453**2))), 0)
     t3457 = 1/xp.sqrt(1 + t3456**2)
     t3458 = t3347*t3456
@@ -7008,10 +7008,10 @@ def condition_number(q):
     t3484 = t3482 + t3456*t3481
     t3485 = t3361*t3463 + t3365*t3467 + t3369*t3471 + t3373*t3475 + t3377*t3479 + t3381*t3483
     t3486 = xp.not_equal(t3485, 0)
-    t3487 = 0.5*(-t3459 + t3357)/xp.where(t3486, t3485, 1)
+    t3487 = (-t3459 + t3357)/xp.where(t3486, 2*t3485, 1)
     t3488 = xp.abs(t3487)
     t3489 = xp.greater_equal(t3488, 1)
-    t3490 = xp.abs(1/xp.where(t3489, t3487, 1))
+    t3490 = 1/xp.abs(xp.where(t3489, t3487, 1))
     t3491 = xp.where(t3486, xp.where(xp.greater_equal(t3487, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3489, t3490/(1 + xp.sqrt(1 + t3490**2)), 1/(t3488 + xp.sqrt(1 + t3488**2))), 0)
     t3492 = 1/xp.sqrt(1 + t3491**2)
     t3493 = t3485*t3491
@@ -7044,10 +7044,10 @@ def condition_number(q):
     t3520 = t3396*t3498 + t3400*t3502 + t3404*t3506 + t3408*t3510 + t3412*t3514 + t3416*t3518
     t3521 = t3464*t3499 + t3468*t3503 + t3472*t3507 + t3476*t3511 + t3480*t3515 + t3484*t3519
     t3522 = xp.not_equal(t3520, 0)
-    t3523 = 0.5*(-t3494 + t3392)/xp.where(t3522, t3520, 1)
+    t3523 = (-t3494 + t3392)/xp.where(t3522, 2*t3520, 1)
     t3524 = xp.abs(t3523)
     t3525 = xp.greater_equal(t3524, 1)
-    t3526 = xp.abs(1/xp.where(t3525, t3523, 1))
+    t3526 = 1/xp.abs(xp.where(t3525, t3523, 1))
     t3527 = xp.where(t3522, xp.where(xp.greater_equal(t3523, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3525, t3526/(1 + xp.sqrt(1 + t3526**2)), 1/(t3524 + xp.sqrt(1 + t3524**2))), 0)
     t3528 = 1/xp.sqrt(1 + t3527**2)
     t3529 = t3520*t3527
@@ -7079,10 +7079,10 @@ def condition_number(q):
     t3555 = t3553 + t3527*t3552
     t3556 = t3429*t3534 + t3433*t3538 + t3437*t3542 + t3441*t3546 + t3445*t3550 + t3449*t3554
     t3557 = xp.not_equal(t3556, 0)
-    t3558 = 0.5*(-t3530 + t3425)/xp.where(t3557, t3556, 1)
+    t3558 = (-t3530 + t3425)/xp.where(t3557, 2*t3556, 1)
     t3559 = xp.abs(t3558)
     t3560 = xp.greater_equal(t3559, 1)
-    t3561 = xp.abs(1/xp.where(t3560, t3558, 1))
+    t3561 = 1/xp.abs(xp.where(t3560, t3558, 1))
     t3562 = xp.where(t3557, xp.where(xp.greater_equal(t3558, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3560, t3561/(1 + xp.sqrt(1 + t3561**2)), 1/(t3559 + xp.sqrt(1 + t3559**2))), 0)
     t3563 = 1/xp.sqrt(1 + t3562**2)
     t3564 = t3425 + t3556*t3562
@@ -7114,10 +7114,10 @@ def condition_number(q):
     t3590 = xp.where(xp.greater(t3589, t3450), t3589, t3450)
     t3591 = xp.where(xp.less(t3589, t3450), t3589, t3450)
     t3592 = xp.not_equal(t3521, 0)
-    t3593 = 0.5*(-t3460 + t3495)/xp.where(t3592, t3521, 1)
+    t3593 = (-t3460 + t3495)/xp.where(t3592, 2*t3521, 1)
     t3594 = xp.abs(t3593)
     t3595 = xp.greater_equal(t3594, 1)
-    t3596 = xp.abs(1/xp.where(t3595, t3593, 1))
+    t3596 = 1/xp.abs(xp.where(t3595, t3593, 1))
     t3597 = xp.where(t3592, xp.where(xp.greater_equal(t3593, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3595, t3596/(1 + xp.sqrt(1 + t3596**2)), 1/(t3594 + xp.sqrt(1 + t3594**2))), 0)
     t3598 = 1/xp.sqrt(1 + t3597**2)
     t3599 = t3521*t3597
@@ -7149,10 +7149,10 @@ def condition_number(q):
     t3625 = t3623 + t3597*t3622
     t3626 = t3535*t3604 + t3539*t3608 + t3543*t3612 + t3547*t3616 + t3551*t3620 + t3555*t3624
     t3627 = xp.not_equal(t3626, 0)
-    t3628 = 0.5*(-t3600 + t3531)/xp.where(t3627, t3626, 1)
+    t3628 = (-t3600 + t3531)/xp.where(t3627, 2*t3626, 1)
     t3629 = xp.abs(t3628)
     t3630 = xp.greater_equal(t3629, 1)
-    t3631 = xp.abs(1/xp.where(t3630, t3628, 1))
+    t3631 = 1/xp.abs(xp.where(t3630, t3628, 1))
     t3632 = xp.where(t3627, xp.where(xp.greater_equal(t3628, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3630, t3631/(1 + xp.sqrt(1 + t3631**2)), 1/(t3629 + xp.sqrt(1 + t3629**2))), 0)
     t3633 = 1/xp.sqrt(1 + t3632**2)
     t3634 = t3626*t3632
@@ -7185,10 +7185,10 @@ def condition_number(q):
     t3661 = t3568*t3639 + t3572*t3643 + t3576*t3647 + t3580*t3651 + t3584*t3655 + t3588*t3659
     t3662 = t3605*t3640 + t3609*t3644 + t3613*t3648 + t3617*t3652 + t3621*t3656 + t3625*t3660
     t3663 = xp.not_equal(t3661, 0)
-    t3664 = 0.5*(-t3635 + t3564)/xp.where(t3663, t3661, 1)
+    t3664 = (-t3635 + t3564)/xp.where(t3663, 2*t3661, 1)
     t3665 = xp.abs(t3664)
     t3666 = xp.greater_equal(t3665, 1)
-    t3667 = xp.abs(1/xp.where(t3666, t3664, 1))
+    t3667 = 1/xp.abs(xp.where(t3666, t3664, 1))
     t3668 = xp.where(t3663, xp.where(xp.greater_equal(t3664, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3666, t3667/(1 + xp.sqrt(1 + t3667**2)), 1/(t3665 + xp.sqrt(1 + t3665**2))), 0)
     t3669 = 1/xp.sqrt(1 + t3668**2)
     t3670 = t3564 + t3661*t3668
@@ -7220,10 +7220,10 @@ def condition_number(q):
     t3696 = xp.where(xp.greater(t3695, t3590), t3695, t3590)
     t3697 = xp.where(xp.less(t3695, t3591), t3695, t3591)
     t3698 = xp.not_equal(t3662, 0)
-    t3699 = 0.5*(-t3601 + t3636)/xp.where(t3698, t3662, 1)
+    t3699 = (-t3601 + t3636)/xp.where(t3698, 2*t3662, 1)
     t3700 = xp.abs(t3699)
     t3701 = xp.greater_equal(t3700, 1)
-    t3702 = xp.abs(1/xp.where(t3701, t3699, 1))
+    t3702 = 1/xp.abs(xp.where(t3701, t3699, 1))
     t3703 = xp.where(t3698, xp.where(xp.greater_equal(t3699, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3701, t3702/(1 + xp.sqrt(1 + t3702**2)), 1/(t3700 + xp.sqrt(1 + t3700**2))), 0)
     t3704 = 1/xp.sqrt(1 + t3703**2)
     t3705 = t3662*t3703
@@ -7255,10 +7255,10 @@ def condition_number(q):
     t3731 = t3729 + t3703*t3728
     t3732 = t3674*t3710 + t3678*t3714 + t3682*t3718 + t3686*t3722 + t3690*t3726 + t3694*t3730
     t3733 = xp.not_equal(t3732, 0)
-    t3734 = 0.5*(-t3706 + t3670)/xp.where(t3733, t3732, 1)
+    t3734 = (-t3706 + t3670)/xp.where(t3733, 2*t3732, 1)
     t3735 = xp.abs(t3734)
     t3736 = xp.greater_equal(t3735, 1)
-    t3737 = xp.abs(1/xp.where(t3736, t3734, 1))
+    t3737 = 1/xp.abs(xp.where(t3736, t3734, 1))
     t3738 = xp.where(t3733, xp.where(xp.greater_equal(t3734, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3736, t3737/(1 + xp.sqrt(1 + t3737**2)), 1/(t3735 + xp.sqrt(1 + t3735**2))), 0)
     t3739 = 1/xp.sqrt(1 + t3738**2)
     t3740 = t3670 + t3732*t3738
@@ -7291,10 +7291,10 @@ def condition_number(q):
     t3767 = xp.where(xp.greater(t3766, t3696), t3766, t3696)
     t3768 = xp.where(xp.less(t3766, t3697), t3766, t3697)
     t3769 = xp.not_equal(t3765, 0)
-    t3770 = 0.5*(-t3707 + t3740)/xp.where(t3769, t3765, 1)
+    t3770 = (-t3707 + t3740)/xp.where(t3769, 2*t3765, 1)
     t3771 = xp.abs(t3770)
     t3772 = xp.greater_equal(t3771, 1)
-    t3773 = xp.abs(1/xp.where(t3772, t3770, 1))
+    t3773 = 1/xp.abs(xp.where(t3772, t3770, 1))
     t3774 = xp.where(t3769, xp.where(xp.greater_equal(t3770, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3772, t3773/(1 + xp.sqrt(1 + t3773**2)), 1/(t3771 + xp.sqrt(1 + t3771**2))), 0)
     t3775 = 1/xp.sqrt(1 + t3774**2)
     t3776 = t3711*t3775
@@ -7327,7 +7327,9 @@ def condition_number(q):
     t3803 = xp.where(xp.less(t3800, t3768), t3800, t3768)
     t3804 = xp.where(xp.greater(t3801, t3802), t3801, t3802)
     t3805 = xp.where(xp.less(t3801, t3803), t3801, t3803)
-    kappa = xp.broadcast_to(xp.where(xp.greater(t3804, 0), t3804, 1)/xp.where(xp.less_equal(t3805, 1e-12*t3804), 0, t3805), batch)
+    t3806 = xp.where(xp.less_equal(t3805, 1e-12*t3804), 0, t3805)
+    t3807 = xp.where(xp.greater(t3804, 0), t3804, 1)
+    kappa = xp.broadcast_to(t3807/t3806, batch)
     return kappa
 
 

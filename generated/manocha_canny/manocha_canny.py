@@ -2640,10 +2640,10 @@ def velocity_ellipsoid(q):
     t86 = t84**2
     t87 = t60*t66
     t88 = xp.not_equal(t87, 0)
-    t89 = 0.5*(-t63 + t85)/xp.where(t88, -t87, 1)
+    t89 = (-t63 + t85)/xp.where(t88, -2*t87, 1)
     t90 = xp.abs(t89)
     t91 = xp.greater_equal(t90, 1)
-    t92 = xp.abs(1/xp.where(t91, t89, 1))
+    t92 = 1/xp.abs(xp.where(t91, t89, 1))
     t93 = xp.where(t88, xp.where(xp.greater_equal(t89, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t91, t92/(1 + xp.sqrt(1 + t92**2)), 1/(t90 + xp.sqrt(1 + t90**2))), 0)
     t94 = 1/xp.sqrt(1 + t93**2)
     t95 = t87*t93
@@ -2659,10 +2659,10 @@ def velocity_ellipsoid(q):
     t105 = t104*t93
     t106 = t102*t100 + t105*t80
     t107 = xp.not_equal(t106, 0)
-    t108 = 0.5*(-t96 + t103)/xp.where(t107, t106, 1)
+    t108 = (-t96 + t103)/xp.where(t107, 2*t106, 1)
     t109 = xp.abs(t108)
     t110 = xp.greater_equal(t109, 1)
-    t111 = xp.abs(1/xp.where(t110, t108, 1))
+    t111 = 1/xp.abs(xp.where(t110, t108, 1))
     t112 = xp.where(t107, xp.where(xp.greater_equal(t108, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t110, t111/(1 + xp.sqrt(1 + t111**2)), 1/(t109 + xp.sqrt(1 + t109**2))), 0)
     t113 = 1/xp.sqrt(1 + t112**2)
     t114 = t106*t112
@@ -2678,10 +2678,10 @@ def velocity_ellipsoid(q):
     t124 = t122 + t121*t112
     t125 = t101*t120 + t104*t124
     t126 = xp.not_equal(t125, 0)
-    t127 = 0.5*(-t97 + t116)/xp.where(t126, -t125, 1)
+    t127 = (-t97 + t116)/xp.where(t126, -2*t125, 1)
     t128 = xp.abs(t127)
     t129 = xp.greater_equal(t128, 1)
-    t130 = xp.abs(1/xp.where(t129, t127, 1))
+    t130 = 1/xp.abs(xp.where(t129, t127, 1))
     t131 = xp.where(t126, xp.where(xp.greater_equal(t127, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t129, t130/(1 + xp.sqrt(1 + t130**2)), 1/(t128 + xp.sqrt(1 + t128**2))), 0)
     t132 = 1/xp.sqrt(1 + t131**2)
     t133 = t125*t131
@@ -2707,10 +2707,10 @@ def velocity_ellipsoid(q):
     t153 = t131*t132
     t154 = t119*t138 - t123*t143 + t86*t147*t153*t113
     t155 = xp.not_equal(t154, 0)
-    t156 = 0.5*(-t115 + t134)/xp.where(t155, t154, 1)
+    t156 = (-t115 + t134)/xp.where(t155, 2*t154, 1)
     t157 = xp.abs(t156)
     t158 = xp.greater_equal(t157, 1)
-    t159 = xp.abs(1/xp.where(t158, t156, 1))
+    t159 = 1/xp.abs(xp.where(t158, t156, 1))
     t160 = xp.where(t155, xp.where(xp.greater_equal(t156, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t158, t159/(1 + xp.sqrt(1 + t159**2)), 1/(t157 + xp.sqrt(1 + t157**2))), 0)
     t161 = 1/xp.sqrt(1 + t160**2)
     t162 = t154*t160
@@ -2744,10 +2744,10 @@ def velocity_ellipsoid(q):
     t190 = t113*t132
     t191 = t139*t167 + t144*t171 - t84*t190*t180
     t192 = xp.not_equal(t191, 0)
-    t193 = 0.5*(-t163 + t135)/xp.where(t192, t191, 1)
+    t193 = (-t163 + t135)/xp.where(t192, 2*t191, 1)
     t194 = xp.abs(t193)
     t195 = xp.greater_equal(t194, 1)
-    t196 = xp.abs(1/xp.where(t195, t193, 1))
+    t196 = 1/xp.abs(xp.where(t195, t193, 1))
     t197 = xp.where(t192, xp.where(xp.greater_equal(t193, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t195, t196/(1 + xp.sqrt(1 + t196**2)), 1/(t194 + xp.sqrt(1 + t194**2))), 0)
     t198 = 1/xp.sqrt(1 + t197**2)
     t199 = t191*t197
@@ -2779,10 +2779,10 @@ def velocity_ellipsoid(q):
     t225 = t224 - t211*t197
     t226 = t211 + t224*t197
     t227 = xp.not_equal(t215, 0)
-    t228 = 0.5*(-t164 + t201)/xp.where(t227, t215, 1)
+    t228 = (-t164 + t201)/xp.where(t227, 2*t215, 1)
     t229 = xp.abs(t228)
     t230 = xp.greater_equal(t229, 1)
-    t231 = xp.abs(1/xp.where(t230, t228, 1))
+    t231 = 1/xp.abs(xp.where(t230, t228, 1))
     t232 = xp.where(t227, xp.where(xp.greater_equal(t228, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t230, t231/(1 + xp.sqrt(1 + t231**2)), 1/(t229 + xp.sqrt(1 + t229**2))), 0)
     t233 = 1/xp.sqrt(1 + t232**2)
     t234 = t215*t232
@@ -2814,10 +2814,10 @@ def velocity_ellipsoid(q):
     t260 = t258 + t259*t232
     t261 = t259 - t258*t232
     t262 = xp.not_equal(t249, 0)
-    t263 = 0.5*(-t200 + t235)/xp.where(t262, t249, 1)
+    t263 = (-t200 + t235)/xp.where(t262, 2*t249, 1)
     t264 = xp.abs(t263)
     t265 = xp.greater_equal(t264, 1)
-    t266 = xp.abs(1/xp.where(t265, t263, 1))
+    t266 = 1/xp.abs(xp.where(t265, t263, 1))
     t267 = xp.where(t262, xp.where(xp.greater_equal(t263, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t265, t266/(1 + xp.sqrt(1 + t266**2)), 1/(t264 + xp.sqrt(1 + t264**2))), 0)
     t268 = 1/xp.sqrt(1 + t267**2)
     t269 = t249*t267
@@ -2849,10 +2849,10 @@ def velocity_ellipsoid(q):
     t295 = t293 + t267*t294
     t296 = -t294 + t267*t293
     t297 = xp.not_equal(t284, 0)
-    t298 = 0.5*(-t270 + t236)/xp.where(t297, t284, 1)
+    t298 = (-t270 + t236)/xp.where(t297, 2*t284, 1)
     t299 = xp.abs(t298)
     t300 = xp.greater_equal(t299, 1)
-    t301 = xp.abs(1/xp.where(t300, t298, 1))
+    t301 = 1/xp.abs(xp.where(t300, t298, 1))
     t302 = xp.where(t297, xp.where(xp.greater_equal(t298, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t300, t301/(1 + xp.sqrt(1 + t301**2)), 1/(t299 + xp.sqrt(1 + t299**2))), 0)
     t303 = 1/xp.sqrt(1 + t302**2)
     t304 = t284*t302
@@ -2884,10 +2884,10 @@ def velocity_ellipsoid(q):
     t330 = t328 - t302*t329
     t331 = t329 + t302*t328
     t332 = xp.not_equal(t319, 0)
-    t333 = 0.5*(-t271 + t306)/xp.where(t332, t319, 1)
+    t333 = (-t271 + t306)/xp.where(t332, 2*t319, 1)
     t334 = xp.abs(t333)
     t335 = xp.greater_equal(t334, 1)
-    t336 = xp.abs(1/xp.where(t335, t333, 1))
+    t336 = 1/xp.abs(xp.where(t335, t333, 1))
     t337 = xp.where(t332, xp.where(xp.greater_equal(t333, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t335, t336/(1 + xp.sqrt(1 + t336**2)), 1/(t334 + xp.sqrt(1 + t334**2))), 0)
     t338 = 1/xp.sqrt(1 + t337**2)
     t339 = t319*t337
@@ -2919,10 +2919,10 @@ def velocity_ellipsoid(q):
     t365 = t363 - t337*t364
     t366 = t364 + t337*t363
     t367 = xp.not_equal(t354, 0)
-    t368 = 0.5*(-t305 + t340)/xp.where(t367, t354, 1)
+    t368 = (-t305 + t340)/xp.where(t367, 2*t354, 1)
     t369 = xp.abs(t368)
     t370 = xp.greater_equal(t369, 1)
-    t371 = xp.abs(1/xp.where(t370, t368, 1))
+    t371 = 1/xp.abs(xp.where(t370, t368, 1))
     t372 = xp.where(t367, xp.where(xp.greater_equal(t368, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t370, t371/(1 + xp.sqrt(1 + t371**2)), 1/(t369 + xp.sqrt(1 + t369**2))), 0)
     t373 = 1/xp.sqrt(1 + t372**2)
     t374 = t354*t372
@@ -2954,10 +2954,10 @@ def velocity_ellipsoid(q):
     t400 = t398 - t372*t399
     t401 = t399 + t372*t398
     t402 = xp.not_equal(t389, 0)
-    t403 = 0.5*(-t375 + t341)/xp.where(t402, t389, 1)
+    t403 = (-t375 + t341)/xp.where(t402, 2*t389, 1)
     t404 = xp.abs(t403)
     t405 = xp.greater_equal(t404, 1)
-    t406 = xp.abs(1/xp.where(t405, t403, 1))
+    t406 = 1/xp.abs(xp.where(t405, t403, 1))
     t407 = xp.where(t402, xp.where(xp.greater_equal(t403, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t405, t406/(1 + xp.sqrt(1 + t406**2)), 1/(t404 + xp.sqrt(1 + t404**2))), 0)
     t408 = 1/xp.sqrt(1 + t407**2)
     t409 = t389*t407
@@ -2989,10 +2989,10 @@ def velocity_ellipsoid(q):
     t435 = t433 - t407*t434
     t436 = t434 + t407*t433
     t437 = xp.not_equal(t424, 0)
-    t438 = 0.5*(-t376 + t411)/xp.where(t437, t424, 1)
+    t438 = (-t376 + t411)/xp.where(t437, 2*t424, 1)
     t439 = xp.abs(t438)
     t440 = xp.greater_equal(t439, 1)
-    t441 = xp.abs(1/xp.where(t440, t438, 1))
+    t441 = 1/xp.abs(xp.where(t440, t438, 1))
     t442 = xp.where(t437, xp.where(xp.greater_equal(t438, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t440, t441/(1 + xp.sqrt(1 + t441**2)), 1/(t439 + xp.sqrt(1 + t439**2))), 0)
     t443 = 1/xp.sqrt(1 + t442**2)
     t444 = t424*t442
@@ -3024,10 +3024,10 @@ def velocity_ellipsoid(q):
     t470 = t468 - t442*t469
     t471 = t469 + t442*t468
     t472 = xp.not_equal(t459, 0)
-    t473 = 0.5*(-t410 + t445)/xp.where(t472, t459, 1)
+    t473 = (-t410 + t445)/xp.where(t472, 2*t459, 1)
     t474 = xp.abs(t473)
     t475 = xp.greater_equal(t474, 1)
-    t476 = xp.abs(1/xp.where(t475, t473, 1))
+    t476 = 1/xp.abs(xp.where(t475, t473, 1))
     t477 = xp.where(t472, xp.where(xp.greater_equal(t473, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t475, t476/(1 + xp.sqrt(1 + t476**2)), 1/(t474 + xp.sqrt(1 + t474**2))), 0)
     t478 = 1/xp.sqrt(1 + t477**2)
     t479 = t459*t477
@@ -3059,10 +3059,10 @@ def velocity_ellipsoid(q):
     t505 = t503 - t477*t504
     t506 = t504 + t477*t503
     t507 = xp.not_equal(t494, 0)
-    t508 = 0.5*(-t480 + t446)/xp.where(t507, t494, 1)
+    t508 = (-t480 + t446)/xp.where(t507, 2*t494, 1)
     t509 = xp.abs(t508)
     t510 = xp.greater_equal(t509, 1)
-    t511 = xp.abs(1/xp.where(t510, t508, 1))
+    t511 = 1/xp.abs(xp.where(t510, t508, 1))
     t512 = xp.where(t507, xp.where(xp.greater_equal(t508, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t510, t511/(1 + xp.sqrt(1 + t511**2)), 1/(t509 + xp.sqrt(1 + t509**2))), 0)
     t513 = 1/xp.sqrt(1 + t512**2)
     t514 = t446 + t494*t512
@@ -3093,10 +3093,10 @@ def velocity_ellipsoid(q):
     t539 = t537 - t512*t538
     t540 = t538 + t512*t537
     t541 = xp.not_equal(t527, 0)
-    t542 = 0.5*(-t481 + t514)/xp.where(t541, t527, 1)
+    t542 = (-t481 + t514)/xp.where(t541, 2*t527, 1)
     t543 = xp.abs(t542)
     t544 = xp.greater_equal(t543, 1)
-    t545 = xp.abs(1/xp.where(t544, t542, 1))
+    t545 = 1/xp.abs(xp.where(t544, t542, 1))
     t546 = xp.where(t541, xp.where(xp.greater_equal(t542, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t544, t545/(1 + xp.sqrt(1 + t545**2)), 1/(t543 + xp.sqrt(1 + t543**2))), 0)
     t547 = 1/xp.sqrt(1 + t546**2)
     t548 = t485*t547
@@ -3190,10 +3190,10 @@ def velocity_ellipsoid(q):
     t636 = t635**2
     t637 = t616**2 + t629**2 + t636
     t638 = xp.not_equal(t626, 0)
-    t639 = 0.5*(-t607 + t625)/xp.where(t638, t626, 1)
+    t639 = (-t607 + t625)/xp.where(t638, 2*t626, 1)
     t640 = xp.abs(t639)
     t641 = xp.greater_equal(t640, 1)
-    t642 = xp.abs(1/xp.where(t641, t639, 1))
+    t642 = 1/xp.abs(xp.where(t641, t639, 1))
     t643 = xp.where(t638, xp.where(xp.greater_equal(t639, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t641, t642/(1 + xp.sqrt(1 + t642**2)), 1/(t640 + xp.sqrt(1 + t640**2))), 0)
     t644 = 1/xp.sqrt(1 + t643**2)
     t645 = t626*t643
@@ -3207,10 +3207,10 @@ def velocity_ellipsoid(q):
     t653 = t643*t652
     t654 = t616*t650 - t629*t653
     t655 = xp.not_equal(t654, 0)
-    t656 = 0.5*(-t646 + t637)/xp.where(t655, t654, 1)
+    t656 = (-t646 + t637)/xp.where(t655, 2*t654, 1)
     t657 = xp.abs(t656)
     t658 = xp.greater_equal(t657, 1)
-    t659 = xp.abs(1/xp.where(t658, t656, 1))
+    t659 = 1/xp.abs(xp.where(t658, t656, 1))
     t660 = xp.where(t655, xp.where(xp.greater_equal(t656, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t658, t659/(1 + xp.sqrt(1 + t659**2)), 1/(t657 + xp.sqrt(1 + t657**2))), 0)
     t661 = 1/xp.sqrt(1 + t660**2)
     t662 = t654*t660
@@ -3226,10 +3226,10 @@ def velocity_ellipsoid(q):
     t672 = -t670 + t660*t669
     t673 = t651*t668 + t672*t652
     t674 = xp.not_equal(t673, 0)
-    t675 = 0.5*(-t647 + t664)/xp.where(t674, -t673, 1)
+    t675 = (-t647 + t664)/xp.where(t674, -2*t673, 1)
     t676 = xp.abs(t675)
     t677 = xp.greater_equal(t676, 1)
-    t678 = xp.abs(1/xp.where(t677, t675, 1))
+    t678 = 1/xp.abs(xp.where(t677, t675, 1))
     t679 = xp.where(t674, xp.where(xp.greater_equal(t675, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t677, t678/(1 + xp.sqrt(1 + t678**2)), 1/(t676 + xp.sqrt(1 + t676**2))), 0)
     t680 = 1/xp.sqrt(1 + t679**2)
     t681 = t673*t679
@@ -3255,10 +3255,10 @@ def velocity_ellipsoid(q):
     t701 = t679*t680
     t702 = t667*t686 + t671*t691 - t661*t636*t695*t701
     t703 = xp.not_equal(t702, 0)
-    t704 = 0.5*(-t663 + t682)/xp.where(t703, -t702, 1)
+    t704 = (-t663 + t682)/xp.where(t703, -2*t702, 1)
     t705 = xp.abs(t704)
     t706 = xp.greater_equal(t705, 1)
-    t707 = xp.abs(1/xp.where(t706, t704, 1))
+    t707 = 1/xp.abs(xp.where(t706, t704, 1))
     t708 = xp.where(t703, xp.where(xp.greater_equal(t704, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t706, t707/(1 + xp.sqrt(1 + t707**2)), 1/(t705 + xp.sqrt(1 + t705**2))), 0)
     t709 = 1/xp.sqrt(1 + t708**2)
     t710 = t702*t708
@@ -3292,10 +3292,10 @@ def velocity_ellipsoid(q):
     t738 = t661*t680
     t739 = t687*t715 + t692*t719 - t635*t728*t738
     t740 = xp.not_equal(t739, 0)
-    t741 = 0.5*(-t711 + t683)/xp.where(t740, t739, 1)
+    t741 = (-t711 + t683)/xp.where(t740, 2*t739, 1)
     t742 = xp.abs(t741)
     t743 = xp.greater_equal(t742, 1)
-    t744 = xp.abs(1/xp.where(t743, t741, 1))
+    t744 = 1/xp.abs(xp.where(t743, t741, 1))
     t745 = xp.where(t740, xp.where(xp.greater_equal(t741, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t743, t744/(1 + xp.sqrt(1 + t744**2)), 1/(t742 + xp.sqrt(1 + t742**2))), 0)
     t746 = 1/xp.sqrt(1 + t745**2)
     t747 = t739*t745
@@ -3327,10 +3327,10 @@ def velocity_ellipsoid(q):
     t773 = t772 - t745*t759
     t774 = t759 + t745*t772
     t775 = xp.not_equal(t763, 0)
-    t776 = 0.5*(-t712 + t749)/xp.where(t775, t763, 1)
+    t776 = (-t712 + t749)/xp.where(t775, 2*t763, 1)
     t777 = xp.abs(t776)
     t778 = xp.greater_equal(t777, 1)
-    t779 = xp.abs(1/xp.where(t778, t776, 1))
+    t779 = 1/xp.abs(xp.where(t778, t776, 1))
     t780 = xp.where(t775, xp.where(xp.greater_equal(t776, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t778, t779/(1 + xp.sqrt(1 + t779**2)), 1/(t777 + xp.sqrt(1 + t777**2))), 0)
     t781 = 1/xp.sqrt(1 + t780**2)
     t782 = t763*t780
@@ -3362,10 +3362,10 @@ def velocity_ellipsoid(q):
     t808 = t806 + t780*t807
     t809 = t807 - t780*t806
     t810 = xp.not_equal(t797, 0)
-    t811 = 0.5*(-t748 + t783)/xp.where(t810, t797, 1)
+    t811 = (-t748 + t783)/xp.where(t810, 2*t797, 1)
     t812 = xp.abs(t811)
     t813 = xp.greater_equal(t812, 1)
-    t814 = xp.abs(1/xp.where(t813, t811, 1))
+    t814 = 1/xp.abs(xp.where(t813, t811, 1))
     t815 = xp.where(t810, xp.where(xp.greater_equal(t811, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t813, t814/(1 + xp.sqrt(1 + t814**2)), 1/(t812 + xp.sqrt(1 + t812**2))), 0)
     t816 = 1/xp.sqrt(1 + t815**2)
     t817 = t797*t815
@@ -3397,10 +3397,10 @@ def velocity_ellipsoid(q):
     t843 = t841 + t815*t842
     t844 = -t842 + t815*t841
     t845 = xp.not_equal(t832, 0)
-    t846 = 0.5*(-t818 + t784)/xp.where(t845, t832, 1)
+    t846 = (-t818 + t784)/xp.where(t845, 2*t832, 1)
     t847 = xp.abs(t846)
     t848 = xp.greater_equal(t847, 1)
-    t849 = xp.abs(1/xp.where(t848, t846, 1))
+    t849 = 1/xp.abs(xp.where(t848, t846, 1))
     t850 = xp.where(t845, xp.where(xp.greater_equal(t846, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t848, t849/(1 + xp.sqrt(1 + t849**2)), 1/(t847 + xp.sqrt(1 + t847**2))), 0)
     t851 = 1/xp.sqrt(1 + t850**2)
     t852 = t832*t850
@@ -3432,10 +3432,10 @@ def velocity_ellipsoid(q):
     t878 = t876 - t850*t877
     t879 = t877 + t850*t876
     t880 = xp.not_equal(t867, 0)
-    t881 = 0.5*(-t819 + t854)/xp.where(t880, t867, 1)
+    t881 = (-t819 + t854)/xp.where(t880, 2*t867, 1)
     t882 = xp.abs(t881)
     t883 = xp.greater_equal(t882, 1)
-    t884 = xp.abs(1/xp.where(t883, t881, 1))
+    t884 = 1/xp.abs(xp.where(t883, t881, 1))
     t885 = xp.where(t880, xp.where(xp.greater_equal(t881, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t883, t884/(1 + xp.sqrt(1 + t884**2)), 1/(t882 + xp.sqrt(1 + t882**2))), 0)
     t886 = 1/xp.sqrt(1 + t885**2)
     t887 = t867*t885
@@ -3467,10 +3467,10 @@ def velocity_ellipsoid(q):
     t913 = t911 - t885*t912
     t914 = t912 + t885*t911
     t915 = xp.not_equal(t902, 0)
-    t916 = 0.5*(-t853 + t888)/xp.where(t915, t902, 1)
+    t916 = (-t853 + t888)/xp.where(t915, 2*t902, 1)
     t917 = xp.abs(t916)
     t918 = xp.greater_equal(t917, 1)
-    t919 = xp.abs(1/xp.where(t918, t916, 1))
+    t919 = 1/xp.abs(xp.where(t918, t916, 1))
     t920 = xp.where(t915, xp.where(xp.greater_equal(t916, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t918, t919/(1 + xp.sqrt(1 + t919**2)), 1/(t917 + xp.sqrt(1 + t917**2))), 0)
     t921 = 1/xp.sqrt(1 + t920**2)
     t922 = t902*t920
@@ -3502,10 +3502,10 @@ def velocity_ellipsoid(q):
     t948 = t946 - t920*t947
     t949 = t947 + t920*t946
     t950 = xp.not_equal(t937, 0)
-    t951 = 0.5*(-t923 + t889)/xp.where(t950, t937, 1)
+    t951 = (-t923 + t889)/xp.where(t950, 2*t937, 1)
     t952 = xp.abs(t951)
     t953 = xp.greater_equal(t952, 1)
-    t954 = xp.abs(1/xp.where(t953, t951, 1))
+    t954 = 1/xp.abs(xp.where(t953, t951, 1))
     t955 = xp.where(t950, xp.where(xp.greater_equal(t951, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t953, t954/(1 + xp.sqrt(1 + t954**2)), 1/(t952 + xp.sqrt(1 + t952**2))), 0)
     t956 = 1/xp.sqrt(1 + t955**2)
     t957 = t937*t955
@@ -3537,10 +3537,10 @@ def velocity_ellipsoid(q):
     t983 = t981 - t955*t982
     t984 = t982 + t955*t981
     t985 = xp.not_equal(t972, 0)
-    t986 = 0.5*(-t924 + t959)/xp.where(t985, t972, 1)
+    t986 = (-t924 + t959)/xp.where(t985, 2*t972, 1)
     t987 = xp.abs(t986)
     t988 = xp.greater_equal(t987, 1)
-    t989 = xp.abs(1/xp.where(t988, t986, 1))
+    t989 = 1/xp.abs(xp.where(t988, t986, 1))
     t990 = xp.where(t985, xp.where(xp.greater_equal(t986, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t988, t989/(1 + xp.sqrt(1 + t989**2)), 1/(t987 + xp.sqrt(1 + t987**2))), 0)
     t991 = 1/xp.sqrt(1 + t990**2)
     t992 = t972*t990
@@ -3572,10 +3572,10 @@ def velocity_ellipsoid(q):
     t1018 = t1016 - t990*t1017
     t1019 = t1017 + t990*t1016
     t1020 = xp.not_equal(t1007, 0)
-    t1021 = 0.5*(-t958 + t993)/xp.where(t1020, t1007, 1)
+    t1021 = (-t958 + t993)/xp.where(t1020, 2*t1007, 1)
     t1022 = xp.abs(t1021)
     t1023 = xp.greater_equal(t1022, 1)
-    t1024 = xp.abs(1/xp.where(t1023, t1021, 1))
+    t1024 = 1/xp.abs(xp.where(t1023, t1021, 1))
     t1025 = xp.where(t1020, xp.where(xp.greater_equal(t1021, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1023, t1024/(1 + xp.sqrt(1 + t1024**2)), 1/(t1022 + xp.sqrt(1 + t1022**2))), 0)
     t1026 = 1/xp.sqrt(1 + t1025**2)
     t1027 = t1007*t1025
@@ -3607,10 +3607,10 @@ def velocity_ellipsoid(q):
     t1053 = t1051 - t1025*t1052
     t1054 = t1052 + t1025*t1051
     t1055 = xp.not_equal(t1042, 0)
-    t1056 = 0.5*(-t1028 + t994)/xp.where(t1055, t1042, 1)
+    t1056 = (-t1028 + t994)/xp.where(t1055, 2*t1042, 1)
     t1057 = xp.abs(t1056)
     t1058 = xp.greater_equal(t1057, 1)
-    t1059 = xp.abs(1/xp.where(t1058, t1056, 1))
+    t1059 = 1/xp.abs(xp.where(t1058, t1056, 1))
     t1060 = xp.where(t1055, xp.where(xp.greater_equal(t1056, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1058, t1059/(1 + xp.sqrt(1 + t1059**2)), 1/(t1057 + xp.sqrt(1 + t1057**2))), 0)
     t1061 = 1/xp.sqrt(1 + t1060**2)
     t1062 = t994 + t1042*t1060
@@ -3641,10 +3641,10 @@ def velocity_ellipsoid(q):
     t1087 = t1085 - t1060*t1086
     t1088 = t1086 + t1060*t1085
     t1089 = xp.not_equal(t1075, 0)
-    t1090 = 0.5*(-t1029 + t1062)/xp.where(t1089, t1075, 1)
+    t1090 = (-t1029 + t1062)/xp.where(t1089, 2*t1075, 1)
     t1091 = xp.abs(t1090)
     t1092 = xp.greater_equal(t1091, 1)
-    t1093 = xp.abs(1/xp.where(t1092, t1090, 1))
+    t1093 = 1/xp.abs(xp.where(t1092, t1090, 1))
     t1094 = xp.where(t1089, xp.where(xp.greater_equal(t1090, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1092, t1093/(1 + xp.sqrt(1 + t1093**2)), 1/(t1091 + xp.sqrt(1 + t1091**2))), 0)
     t1095 = 1/xp.sqrt(1 + t1094**2)
     t1096 = t1033*t1095
@@ -3913,10 +3913,10 @@ def condition_number(q):
     t154 = t64*t75
     t155 = t71*t91 - t66*t107 + t152*t95 + t153*t99 + t154*t103
     t156 = xp.not_equal(t155, 0)
-    t157 = 0.5*(-t151 + t144)/xp.where(t156, -t155, 1)
+    t157 = (-t151 + t144)/xp.where(t156, -2*t155, 1)
     t158 = xp.abs(t157)
     t159 = xp.greater_equal(t158, 1)
-    t160 = xp.abs(1/xp.where(t159, t157, 1))
+    t160 = 1/xp.abs(xp.where(t159, t157, 1))
     t161 = xp.where(t156, xp.where(xp.greater_equal(t157, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t159, t160/(1 + xp.sqrt(1 + t160**2)), 1/(t158 + xp.sqrt(1 + t158**2))), 0)
     t162 = 1/xp.sqrt(1 + t161**2)
     t163 = t155*t161
@@ -3944,10 +3944,10 @@ def condition_number(q):
     t185 = t183 + t182*t161
     t186 = t115*t176 + t118*t180 + t121*t184 - t111*t172
     t187 = xp.not_equal(t186, 0)
-    t188 = 0.5*(-t164 + t145)/xp.where(t187, -t186, 1)
+    t188 = (-t164 + t145)/xp.where(t187, -2*t186, 1)
     t189 = xp.abs(t188)
     t190 = xp.greater_equal(t189, 1)
-    t191 = xp.abs(1/xp.where(t190, t188, 1))
+    t191 = 1/xp.abs(xp.where(t190, t188, 1))
     t192 = xp.where(t187, xp.where(xp.greater_equal(t188, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t190, t191/(1 + xp.sqrt(1 + t191**2)), 1/(t189 + xp.sqrt(1 + t189**2))), 0)
     t193 = 1/xp.sqrt(1 + t192**2)
     t194 = t186*t192
@@ -3971,10 +3971,10 @@ def condition_number(q):
     t212 = -t210 + t209*t192
     t213 = t124*t203 + t128*t207 - t132*t211
     t214 = xp.not_equal(t213, 0)
-    t215 = 0.5*(-t195 + t146)/xp.where(t214, t213, 1)
+    t215 = (-t195 + t146)/xp.where(t214, 2*t213, 1)
     t216 = xp.abs(t215)
     t217 = xp.greater_equal(t216, 1)
-    t218 = xp.abs(1/xp.where(t217, t215, 1))
+    t218 = 1/xp.abs(xp.where(t217, t215, 1))
     t219 = xp.where(t214, xp.where(xp.greater_equal(t215, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t217, t218/(1 + xp.sqrt(1 + t218**2)), 1/(t216 + xp.sqrt(1 + t216**2))), 0)
     t220 = 1/xp.sqrt(1 + t219**2)
     t221 = t213*t219
@@ -3994,10 +3994,10 @@ def condition_number(q):
     t235 = -t233 + t232*t219
     t236 = -t136*t230 + t140*t234
     t237 = xp.not_equal(t236, 0)
-    t238 = 0.5*(-t222 + t147)/xp.where(t237, t236, 1)
+    t238 = (-t222 + t147)/xp.where(t237, 2*t236, 1)
     t239 = xp.abs(t238)
     t240 = xp.greater_equal(t239, 1)
-    t241 = xp.abs(1/xp.where(t240, t238, 1))
+    t241 = 1/xp.abs(xp.where(t240, t238, 1))
     t242 = xp.where(t237, xp.where(xp.greater_equal(t238, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t240, t241/(1 + xp.sqrt(1 + t241**2)), 1/(t239 + xp.sqrt(1 + t239**2))), 0)
     t243 = 1/xp.sqrt(1 + t242**2)
     t244 = t236*t242
@@ -4013,10 +4013,10 @@ def condition_number(q):
     t254 = t252 + t251*t242
     t255 = t143*t253
     t256 = xp.not_equal(t255, 0)
-    t257 = 0.5*(-t245 + t148)/xp.where(t256, -t255, 1)
+    t257 = (-t245 + t148)/xp.where(t256, -2*t255, 1)
     t258 = xp.abs(t257)
     t259 = xp.greater_equal(t258, 1)
-    t260 = xp.abs(1/xp.where(t259, t257, 1))
+    t260 = 1/xp.abs(xp.where(t259, t257, 1))
     t261 = xp.where(t256, xp.where(xp.greater_equal(t257, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t259, t260/(1 + xp.sqrt(1 + t260**2)), 1/(t258 + xp.sqrt(1 + t258**2))), 0)
     t262 = 1/xp.sqrt(1 + t261**2)
     t263 = t255*t261
@@ -4030,10 +4030,10 @@ def condition_number(q):
     t271 = t270*t168
     t272 = -t173*t200 + t177*t204 + t181*t208 + t185*t212 + t149*t270*t161*t162**2 + t271*t169
     t273 = xp.not_equal(t272, 0)
-    t274 = 0.5*(-t165 + t196)/xp.where(t273, t272, 1)
+    t274 = (-t165 + t196)/xp.where(t273, 2*t272, 1)
     t275 = xp.abs(t274)
     t276 = xp.greater_equal(t275, 1)
-    t277 = xp.abs(1/xp.where(t276, t274, 1))
+    t277 = 1/xp.abs(xp.where(t276, t274, 1))
     t278 = xp.where(t273, xp.where(xp.greater_equal(t274, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t276, t277/(1 + xp.sqrt(1 + t277**2)), 1/(t275 + xp.sqrt(1 + t275**2))), 0)
     t279 = 1/xp.sqrt(1 + t278**2)
     t280 = t272*t278
@@ -4072,10 +4072,10 @@ def condition_number(q):
     t313 = t309*t199
     t314 = -t227*t299 - t231*t303 + t235*t307 - t311*t287 + t312*t291 + t313*t295
     t315 = xp.not_equal(t314, 0)
-    t316 = 0.5*(-t281 + t223)/xp.where(t315, t314, 1)
+    t316 = (-t281 + t223)/xp.where(t315, 2*t314, 1)
     t317 = xp.abs(t316)
     t318 = xp.greater_equal(t317, 1)
-    t319 = xp.abs(1/xp.where(t318, t316, 1))
+    t319 = 1/xp.abs(xp.where(t318, t316, 1))
     t320 = xp.where(t315, xp.where(xp.greater_equal(t316, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t318, t319/(1 + xp.sqrt(1 + t319**2)), 1/(t317 + xp.sqrt(1 + t317**2))), 0)
     t321 = 1/xp.sqrt(1 + t320**2)
     t322 = t314*t320
@@ -4118,10 +4118,10 @@ def condition_number(q):
     t359 = t358*t242
     t360 = t250*t343 + t254*t347 - t353*t327 + t355*t331 + t357*t335 + t359*t339
     t361 = xp.not_equal(t360, 0)
-    t362 = 0.5*(-t323 + t246)/xp.where(t361, t360, 1)
+    t362 = (-t323 + t246)/xp.where(t361, 2*t360, 1)
     t363 = xp.abs(t362)
     t364 = xp.greater_equal(t363, 1)
-    t365 = xp.abs(1/xp.where(t364, t362, 1))
+    t365 = 1/xp.abs(xp.where(t364, t362, 1))
     t366 = xp.where(t361, xp.where(xp.greater_equal(t362, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t364, t365/(1 + xp.sqrt(1 + t365**2)), 1/(t363 + xp.sqrt(1 + t363**2))), 0)
     t367 = 1/xp.sqrt(1 + t366**2)
     t368 = t360*t366
@@ -4163,10 +4163,10 @@ def condition_number(q):
     t404 = t403*t261
     t405 = t269*t393 - t396*t373 + t398*t377 + t400*t381 + t402*t385 + t404*t389
     t406 = xp.not_equal(t405, 0)
-    t407 = 0.5*(-t369 + t265)/xp.where(t406, t405, 1)
+    t407 = (-t369 + t265)/xp.where(t406, 2*t405, 1)
     t408 = xp.abs(t407)
     t409 = xp.greater_equal(t408, 1)
-    t410 = xp.abs(1/xp.where(t409, t407, 1))
+    t410 = 1/xp.abs(xp.where(t409, t407, 1))
     t411 = xp.where(t406, xp.where(xp.greater_equal(t407, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t409, t410/(1 + xp.sqrt(1 + t410**2)), 1/(t408 + xp.sqrt(1 + t408**2))), 0)
     t412 = 1/xp.sqrt(1 + t411**2)
     t413 = t405*t411
@@ -4198,10 +4198,10 @@ def condition_number(q):
     t439 = t437 + t436*t411
     t440 = t268*t438 - t395*t418 + t397*t422 + t399*t426 + t401*t430 + t403*t434
     t441 = xp.not_equal(t349, 0)
-    t442 = 0.5*(-t282 + t324)/xp.where(t441, t349, 1)
+    t442 = (-t282 + t324)/xp.where(t441, 2*t349, 1)
     t443 = xp.abs(t442)
     t444 = xp.greater_equal(t443, 1)
-    t445 = xp.abs(1/xp.where(t444, t442, 1))
+    t445 = 1/xp.abs(xp.where(t444, t442, 1))
     t446 = xp.where(t441, xp.where(xp.greater_equal(t442, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t444, t445/(1 + xp.sqrt(1 + t445**2)), 1/(t443 + xp.sqrt(1 + t443**2))), 0)
     t447 = 1/xp.sqrt(1 + t446**2)
     t448 = t349*t446
@@ -4233,10 +4233,10 @@ def condition_number(q):
     t474 = t472 + t471*t446
     t475 = -t374*t453 + t378*t457 + t382*t461 + t386*t465 + t390*t469 + t394*t473
     t476 = xp.not_equal(t475, 0)
-    t477 = 0.5*(-t449 + t370)/xp.where(t476, t475, 1)
+    t477 = (-t449 + t370)/xp.where(t476, 2*t475, 1)
     t478 = xp.abs(t477)
     t479 = xp.greater_equal(t478, 1)
-    t480 = xp.abs(1/xp.where(t479, t477, 1))
+    t480 = 1/xp.abs(xp.where(t479, t477, 1))
     t481 = xp.where(t476, xp.where(xp.greater_equal(t477, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t479, t480/(1 + xp.sqrt(1 + t480**2)), 1/(t478 + xp.sqrt(1 + t478**2))), 0)
     t482 = 1/xp.sqrt(1 + t481**2)
     t483 = t475*t481
@@ -4269,10 +4269,10 @@ def condition_number(q):
     t510 = -t419*t488 + t423*t492 + t427*t496 + t431*t500 + t435*t504 + t439*t508
     t511 = t454*t489 + t458*t493 + t462*t497 + t466*t501 + t470*t505 + t474*t509
     t512 = xp.not_equal(t510, 0)
-    t513 = 0.5*(-t484 + t415)/xp.where(t512, t510, 1)
+    t513 = (-t484 + t415)/xp.where(t512, 2*t510, 1)
     t514 = xp.abs(t513)
     t515 = xp.greater_equal(t514, 1)
-    t516 = xp.abs(1/xp.where(t515, t513, 1))
+    t516 = 1/xp.abs(xp.where(t515, t513, 1))
     t517 = xp.where(t512, xp.where(xp.greater_equal(t513, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t515, t516/(1 + xp.sqrt(1 + t516**2)), 1/(t514 + xp.sqrt(1 + t514**2))), 0)
     t518 = 1/xp.sqrt(1 + t517**2)
     t519 = t510*t517
@@ -4303,10 +4303,10 @@ def condition_number(q):
     t544 = t542 - t543*t517
     t545 = t543 + t542*t517
     t546 = xp.not_equal(t511, 0)
-    t547 = 0.5*(-t450 + t485)/xp.where(t546, t511, 1)
+    t547 = (-t450 + t485)/xp.where(t546, 2*t511, 1)
     t548 = xp.abs(t547)
     t549 = xp.greater_equal(t548, 1)
-    t550 = xp.abs(1/xp.where(t549, t547, 1))
+    t550 = 1/xp.abs(xp.where(t549, t547, 1))
     t551 = xp.where(t546, xp.where(xp.greater_equal(t547, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t549, t550/(1 + xp.sqrt(1 + t550**2)), 1/(t548 + xp.sqrt(1 + t548**2))), 0)
     t552 = 1/xp.sqrt(1 + t551**2)
     t553 = t511*t551
@@ -4338,10 +4338,10 @@ def condition_number(q):
     t579 = t577 + t576*t551
     t580 = t525*t558 + t529*t562 + t533*t566 + t537*t570 + t541*t574 + t545*t578
     t581 = xp.not_equal(t580, 0)
-    t582 = 0.5*(-t554 + t521)/xp.where(t581, t580, 1)
+    t582 = (-t554 + t521)/xp.where(t581, 2*t580, 1)
     t583 = xp.abs(t582)
     t584 = xp.greater_equal(t583, 1)
-    t585 = xp.abs(1/xp.where(t584, t582, 1))
+    t585 = 1/xp.abs(xp.where(t584, t582, 1))
     t586 = xp.where(t581, xp.where(xp.greater_equal(t582, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t584, t585/(1 + xp.sqrt(1 + t585**2)), 1/(t583 + xp.sqrt(1 + t583**2))), 0)
     t587 = 1/xp.sqrt(1 + t586**2)
     t588 = t580*t586
@@ -4373,10 +4373,10 @@ def condition_number(q):
     t614 = t612 + t611*t586
     t615 = t559*t594 + t563*t598 + t567*t602 + t571*t606 + t575*t610 + t579*t614
     t616 = xp.not_equal(t615, 0)
-    t617 = 0.5*(-t555 + t590)/xp.where(t616, t615, 1)
+    t617 = (-t555 + t590)/xp.where(t616, 2*t615, 1)
     t618 = xp.abs(t617)
     t619 = xp.greater_equal(t618, 1)
-    t620 = xp.abs(1/xp.where(t619, t617, 1))
+    t620 = 1/xp.abs(xp.where(t619, t617, 1))
     t621 = xp.where(t616, xp.where(xp.greater_equal(t617, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t619, t620/(1 + xp.sqrt(1 + t620**2)), 1/(t618 + xp.sqrt(1 + t618**2))), 0)
     t622 = 1/xp.sqrt(1 + t621**2)
     t623 = t615*t621
@@ -4407,10 +4407,10 @@ def condition_number(q):
     t648 = t646 - t647*t621
     t649 = t647 + t646*t621
     t650 = xp.not_equal(t440, 0)
-    t651 = 0.5*(-t264 + t414)/xp.where(t650, t440, 1)
+    t651 = (-t264 + t414)/xp.where(t650, 2*t440, 1)
     t652 = xp.abs(t651)
     t653 = xp.greater_equal(t652, 1)
-    t654 = xp.abs(1/xp.where(t653, t651, 1))
+    t654 = 1/xp.abs(xp.where(t653, t651, 1))
     t655 = xp.where(t650, xp.where(xp.greater_equal(t651, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t653, t654/(1 + xp.sqrt(1 + t654**2)), 1/(t652 + xp.sqrt(1 + t652**2))), 0)
     t656 = 1/xp.sqrt(1 + t655**2)
     t657 = t440*t655
@@ -4442,10 +4442,10 @@ def condition_number(q):
     t683 = t681 + t680*t655
     t684 = t524*t662 + t528*t666 + t532*t670 + t536*t674 + t540*t678 + t544*t682
     t685 = xp.not_equal(t684, 0)
-    t686 = 0.5*(-t658 + t520)/xp.where(t685, t684, 1)
+    t686 = (-t658 + t520)/xp.where(t685, 2*t684, 1)
     t687 = xp.abs(t686)
     t688 = xp.greater_equal(t687, 1)
-    t689 = xp.abs(1/xp.where(t688, t686, 1))
+    t689 = 1/xp.abs(xp.where(t688, t686, 1))
     t690 = xp.where(t685, xp.where(xp.greater_equal(t686, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t688, t689/(1 + xp.sqrt(1 + t689**2)), 1/(t687 + xp.sqrt(1 + t687**2))), 0)
     t691 = 1/xp.sqrt(1 + t690**2)
     t692 = t684*t690
@@ -4478,10 +4478,10 @@ def condition_number(q):
     t719 = t593*t697 + t597*t701 + t601*t705 + t605*t709 + t609*t713 + t613*t717
     t720 = -t663*t698 + t667*t702 + t671*t706 + t675*t710 + t679*t714 + t683*t718
     t721 = xp.not_equal(t719, 0)
-    t722 = 0.5*(-t693 + t589)/xp.where(t721, t719, 1)
+    t722 = (-t693 + t589)/xp.where(t721, 2*t719, 1)
     t723 = xp.abs(t722)
     t724 = xp.greater_equal(t723, 1)
-    t725 = xp.abs(1/xp.where(t724, t722, 1))
+    t725 = 1/xp.abs(xp.where(t724, t722, 1))
     t726 = xp.where(t721, xp.where(xp.greater_equal(t722, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t724, t725/(1 + xp.sqrt(1 + t725**2)), 1/(t723 + xp.sqrt(1 + t723**2))), 0)
     t727 = 1/xp.sqrt(1 + t726**2)
     t728 = t719*t726
@@ -4513,10 +4513,10 @@ def condition_number(q):
     t754 = t752 + t751*t726
     t755 = t628*t733 + t632*t737 + t636*t741 + t640*t745 + t644*t749 + t648*t753
     t756 = xp.not_equal(t755, 0)
-    t757 = 0.5*(-t729 + t624)/xp.where(t756, t755, 1)
+    t757 = (-t729 + t624)/xp.where(t756, 2*t755, 1)
     t758 = xp.abs(t757)
     t759 = xp.greater_equal(t758, 1)
-    t760 = xp.abs(1/xp.where(t759, t757, 1))
+    t760 = 1/xp.abs(xp.where(t759, t757, 1))
     t761 = xp.where(t756, xp.where(xp.greater_equal(t757, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t759, t760/(1 + xp.sqrt(1 + t760**2)), 1/(t758 + xp.sqrt(1 + t758**2))), 0)
     t762 = 1/xp.sqrt(1 + t761**2)
     t763 = t755*t761
@@ -4548,10 +4548,10 @@ def condition_number(q):
     t789 = t787 + t786*t761
     t790 = t629*t768 + t633*t772 + t637*t776 + t641*t780 + t645*t784 + t649*t788
     t791 = xp.not_equal(t790, 0)
-    t792 = 0.5*(-t764 + t625)/xp.where(t791, t790, 1)
+    t792 = (-t764 + t625)/xp.where(t791, 2*t790, 1)
     t793 = xp.abs(t792)
     t794 = xp.greater_equal(t793, 1)
-    t795 = xp.abs(1/xp.where(t794, t792, 1))
+    t795 = 1/xp.abs(xp.where(t794, t792, 1))
     t796 = xp.where(t791, xp.where(xp.greater_equal(t792, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t794, t795/(1 + xp.sqrt(1 + t795**2)), 1/(t793 + xp.sqrt(1 + t793**2))), 0)
     t797 = 1/xp.sqrt(1 + t796**2)
     t798 = t790*t796
@@ -4582,10 +4582,10 @@ def condition_number(q):
     t823 = t821 - t822*t796
     t824 = t822 + t821*t796
     t825 = xp.not_equal(t720, 0)
-    t826 = 0.5*(-t659 + t694)/xp.where(t825, t720, 1)
+    t826 = (-t659 + t694)/xp.where(t825, 2*t720, 1)
     t827 = xp.abs(t826)
     t828 = xp.greater_equal(t827, 1)
-    t829 = xp.abs(1/xp.where(t828, t826, 1))
+    t829 = 1/xp.abs(xp.where(t828, t826, 1))
     t830 = xp.where(t825, xp.where(xp.greater_equal(t826, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t828, t829/(1 + xp.sqrt(1 + t829**2)), 1/(t827 + xp.sqrt(1 + t827**2))), 0)
     t831 = 1/xp.sqrt(1 + t830**2)
     t832 = t720*t830
@@ -4617,10 +4617,10 @@ def condition_number(q):
     t858 = t856 + t855*t830
     t859 = t734*t837 + t738*t841 + t742*t845 + t746*t849 + t750*t853 + t754*t857
     t860 = xp.not_equal(t859, 0)
-    t861 = 0.5*(-t833 + t730)/xp.where(t860, t859, 1)
+    t861 = (-t833 + t730)/xp.where(t860, 2*t859, 1)
     t862 = xp.abs(t861)
     t863 = xp.greater_equal(t862, 1)
-    t864 = xp.abs(1/xp.where(t863, t861, 1))
+    t864 = 1/xp.abs(xp.where(t863, t861, 1))
     t865 = xp.where(t860, xp.where(xp.greater_equal(t861, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t863, t864/(1 + xp.sqrt(1 + t864**2)), 1/(t862 + xp.sqrt(1 + t862**2))), 0)
     t866 = 1/xp.sqrt(1 + t865**2)
     t867 = t859*t865
@@ -4653,10 +4653,10 @@ def condition_number(q):
     t894 = t769*t872 + t773*t876 + t777*t880 + t781*t884 + t785*t888 + t789*t892
     t895 = t838*t873 + t842*t877 + t846*t881 + t850*t885 + t854*t889 + t858*t893
     t896 = xp.not_equal(t894, 0)
-    t897 = 0.5*(-t868 + t765)/xp.where(t896, t894, 1)
+    t897 = (-t868 + t765)/xp.where(t896, 2*t894, 1)
     t898 = xp.abs(t897)
     t899 = xp.greater_equal(t898, 1)
-    t900 = xp.abs(1/xp.where(t899, t897, 1))
+    t900 = 1/xp.abs(xp.where(t899, t897, 1))
     t901 = xp.where(t896, xp.where(xp.greater_equal(t897, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t899, t900/(1 + xp.sqrt(1 + t900**2)), 1/(t898 + xp.sqrt(1 + t898**2))), 0)
     t902 = 1/xp.sqrt(1 + t901**2)
     t903 = t894*t901
@@ -4688,10 +4688,10 @@ def condition_number(q):
     t929 = t927 + t926*t901
     t930 = t804*t908 + t808*t912 + t812*t916 + t816*t920 + t820*t924 + t824*t928
     t931 = xp.not_equal(t930, 0)
-    t932 = 0.5*(-t904 + t800)/xp.where(t931, t930, 1)
+    t932 = (-t904 + t800)/xp.where(t931, 2*t930, 1)
     t933 = xp.abs(t932)
     t934 = xp.greater_equal(t933, 1)
-    t935 = xp.abs(1/xp.where(t934, t932, 1))
+    t935 = 1/xp.abs(xp.where(t934, t932, 1))
     t936 = xp.where(t931, xp.where(xp.greater_equal(t932, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t934, t935/(1 + xp.sqrt(1 + t935**2)), 1/(t933 + xp.sqrt(1 + t933**2))), 0)
     t937 = 1/xp.sqrt(1 + t936**2)
     t938 = t930*t936
@@ -4723,10 +4723,10 @@ def condition_number(q):
     t964 = t962 + t961*t936
     t965 = t803*t943 + t807*t947 + t811*t951 + t815*t955 + t819*t959 + t823*t963
     t966 = xp.not_equal(t895, 0)
-    t967 = 0.5*(-t834 + t869)/xp.where(t966, t895, 1)
+    t967 = (-t834 + t869)/xp.where(t966, 2*t895, 1)
     t968 = xp.abs(t967)
     t969 = xp.greater_equal(t968, 1)
-    t970 = xp.abs(1/xp.where(t969, t967, 1))
+    t970 = 1/xp.abs(xp.where(t969, t967, 1))
     t971 = xp.where(t966, xp.where(xp.greater_equal(t967, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t969, t970/(1 + xp.sqrt(1 + t970**2)), 1/(t968 + xp.sqrt(1 + t968**2))), 0)
     t972 = 1/xp.sqrt(1 + t971**2)
     t973 = t895*t971
@@ -4758,10 +4758,10 @@ def condition_number(q):
     t999 = t997 + t996*t971
     t1000 = t909*t978 + t913*t982 + t917*t986 + t921*t990 + t925*t994 + t929*t998
     t1001 = xp.not_equal(t1000, 0)
-    t1002 = 0.5*(-t974 + t905)/xp.where(t1001, t1000, 1)
+    t1002 = (-t974 + t905)/xp.where(t1001, 2*t1000, 1)
     t1003 = xp.abs(t1002)
     t1004 = xp.greater_equal(t1003, 1)
-    t1005 = xp.abs(1/xp.where(t1004, t1002, 1))
+    t1005 = 1/xp.abs(xp.where(t1004, t1002, 1))
     t1006 = xp.where(t1001, xp.where(xp.greater_equal(t1002, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1004, t1005/(1 + xp.sqrt(1 + t1005**2)), 1/(t1003 + xp.sqrt(1 + t1003**2))), 0)
     t1007 = 1/xp.sqrt(1 + t1006**2)
     t1008 = t1000*t1006
@@ -4794,10 +4794,10 @@ def condition_number(q):
     t1035 = t944*t1013 + t948*t1017 + t952*t1021 + t956*t1025 + t960*t1029 + t964*t1033
     t1036 = t979*t1014 + t983*t1018 + t987*t1022 + t991*t1026 + t995*t1030 + t999*t1034
     t1037 = xp.not_equal(t1035, 0)
-    t1038 = 0.5*(-t1009 + t940)/xp.where(t1037, t1035, 1)
+    t1038 = (-t1009 + t940)/xp.where(t1037, 2*t1035, 1)
     t1039 = xp.abs(t1038)
     t1040 = xp.greater_equal(t1039, 1)
-    t1041 = xp.abs(1/xp.where(t1040, t1038, 1))
+    t1041 = 1/xp.abs(xp.where(t1040, t1038, 1))
     t1042 = xp.where(t1037, xp.where(xp.greater_equal(t1038, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1040, t1041/(1 + xp.sqrt(1 + t1041**2)), 1/(t1039 + xp.sqrt(1 + t1039**2))), 0)
     t1043 = 1/xp.sqrt(1 + t1042**2)
     t1044 = t1035*t1042
@@ -4828,10 +4828,10 @@ def condition_number(q):
     t1069 = t1067 - t1068*t1042
     t1070 = t1068 + t1067*t1042
     t1071 = xp.not_equal(t1036, 0)
-    t1072 = 0.5*(-t975 + t1010)/xp.where(t1071, t1036, 1)
+    t1072 = (-t975 + t1010)/xp.where(t1071, 2*t1036, 1)
     t1073 = xp.abs(t1072)
     t1074 = xp.greater_equal(t1073, 1)
-    t1075 = xp.abs(1/xp.where(t1074, t1072, 1))
+    t1075 = 1/xp.abs(xp.where(t1074, t1072, 1))
     t1076 = xp.where(t1071, xp.where(xp.greater_equal(t1072, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1074, t1075/(1 + xp.sqrt(1 + t1075**2)), 1/(t1073 + xp.sqrt(1 + t1073**2))), 0)
     t1077 = 1/xp.sqrt(1 + t1076**2)
     t1078 = t1036*t1076
@@ -4863,10 +4863,10 @@ def condition_number(q):
     t1104 = t1102 + t1101*t1076
     t1105 = t1050*t1083 + t1054*t1087 + t1058*t1091 + t1062*t1095 + t1066*t1099 + t1070*t1103
     t1106 = xp.not_equal(t1105, 0)
-    t1107 = 0.5*(-t1079 + t1046)/xp.where(t1106, t1105, 1)
+    t1107 = (-t1079 + t1046)/xp.where(t1106, 2*t1105, 1)
     t1108 = xp.abs(t1107)
     t1109 = xp.greater_equal(t1108, 1)
-    t1110 = xp.abs(1/xp.where(t1109, t1107, 1))
+    t1110 = 1/xp.abs(xp.where(t1109, t1107, 1))
     t1111 = xp.where(t1106, xp.where(xp.greater_equal(t1107, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1109, t1110/(1 + xp.sqrt(1 + t1110**2)), 1/(t1108 + xp.sqrt(1 + t1108**2))), 0)
     t1112 = 1/xp.sqrt(1 + t1111**2)
     t1113 = t1105*t1111
@@ -4898,10 +4898,10 @@ def condition_number(q):
     t1139 = t1137 + t1111*t1136
     t1140 = t1084*t1119 + t1088*t1123 + t1092*t1127 + t1096*t1131 + t1100*t1135 + t1104*t1139
     t1141 = xp.not_equal(t1140, 0)
-    t1142 = 0.5*(-t1080 + t1115)/xp.where(t1141, t1140, 1)
+    t1142 = (-t1080 + t1115)/xp.where(t1141, 2*t1140, 1)
     t1143 = xp.abs(t1142)
     t1144 = xp.greater_equal(t1143, 1)
-    t1145 = xp.abs(1/xp.where(t1144, t1142, 1))
+    t1145 = 1/xp.abs(xp.where(t1144, t1142, 1))
     t1146 = xp.where(t1141, xp.where(xp.greater_equal(t1142, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1144, t1145/(1 + xp.sqrt(1 + t1145**2)), 1/(t1143 + xp.sqrt(1 + t1143**2))), 0)
     t1147 = 1/xp.sqrt(1 + t1146**2)
     t1148 = t1140*t1146
@@ -4932,10 +4932,10 @@ def condition_number(q):
     t1173 = t1171 - t1146*t1172
     t1174 = t1172 + t1146*t1171
     t1175 = xp.not_equal(t965, 0)
-    t1176 = 0.5*(-t799 + t939)/xp.where(t1175, t965, 1)
+    t1176 = (-t799 + t939)/xp.where(t1175, 2*t965, 1)
     t1177 = xp.abs(t1176)
     t1178 = xp.greater_equal(t1177, 1)
-    t1179 = xp.abs(1/xp.where(t1178, t1176, 1))
+    t1179 = 1/xp.abs(xp.where(t1178, t1176, 1))
     t1180 = xp.where(t1175, xp.where(xp.greater_equal(t1176, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1178, t1179/(1 + xp.sqrt(1 + t1179**2)), 1/(t1177 + xp.sqrt(1 + t1177**2))), 0)
     t1181 = 1/xp.sqrt(1 + t1180**2)
     t1182 = t965*t1180
@@ -4967,10 +4967,10 @@ def condition_number(q):
     t1208 = t1206 + t1180*t1205
     t1209 = t1049*t1187 + t1053*t1191 + t1057*t1195 + t1061*t1199 + t1065*t1203 + t1069*t1207
     t1210 = xp.not_equal(t1209, 0)
-    t1211 = 0.5*(-t1183 + t1045)/xp.where(t1210, t1209, 1)
+    t1211 = (-t1183 + t1045)/xp.where(t1210, 2*t1209, 1)
     t1212 = xp.abs(t1211)
     t1213 = xp.greater_equal(t1212, 1)
-    t1214 = xp.abs(1/xp.where(t1213, t1211, 1))
+    t1214 = 1/xp.abs(xp.where(t1213, t1211, 1))
     t1215 = xp.where(t1210, xp.where(xp.greater_equal(t1211, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1213, t1214/(1 + xp.sqrt(1 + t1214**2)), 1/(t1212 + xp.sqrt(1 + t1212**2))), 0)
     t1216 = 1/xp.sqrt(1 + t1215**2)
     t1217 = t1209*t1215
@@ -5003,10 +5003,10 @@ def condition_number(q):
     t1244 = t1118*t1222 + t1122*t1226 + t1126*t1230 + t1130*t1234 + t1134*t1238 + t1138*t1242
     t1245 = t1188*t1223 + t1192*t1227 + t1196*t1231 + t1200*t1235 + t1204*t1239 + t1208*t1243
     t1246 = xp.not_equal(t1244, 0)
-    t1247 = 0.5*(-t1218 + t1114)/xp.where(t1246, t1244, 1)
+    t1247 = (-t1218 + t1114)/xp.where(t1246, 2*t1244, 1)
     t1248 = xp.abs(t1247)
     t1249 = xp.greater_equal(t1248, 1)
-    t1250 = xp.abs(1/xp.where(t1249, t1247, 1))
+    t1250 = 1/xp.abs(xp.where(t1249, t1247, 1))
     t1251 = xp.where(t1246, xp.where(xp.greater_equal(t1247, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1249, t1250/(1 + xp.sqrt(1 + t1250**2)), 1/(t1248 + xp.sqrt(1 + t1248**2))), 0)
     t1252 = 1/xp.sqrt(1 + t1251**2)
     t1253 = t1244*t1251
@@ -5038,10 +5038,10 @@ def condition_number(q):
     t1279 = t1277 + t1251*t1276
     t1280 = t1153*t1258 + t1157*t1262 + t1161*t1266 + t1165*t1270 + t1169*t1274 + t1173*t1278
     t1281 = xp.not_equal(t1280, 0)
-    t1282 = 0.5*(-t1254 + t1149)/xp.where(t1281, t1280, 1)
+    t1282 = (-t1254 + t1149)/xp.where(t1281, 2*t1280, 1)
     t1283 = xp.abs(t1282)
     t1284 = xp.greater_equal(t1283, 1)
-    t1285 = xp.abs(1/xp.where(t1284, t1282, 1))
+    t1285 = 1/xp.abs(xp.where(t1284, t1282, 1))
     t1286 = xp.where(t1281, xp.where(xp.greater_equal(t1282, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1284, t1285/(1 + xp.sqrt(1 + t1285**2)), 1/(t1283 + xp.sqrt(1 + t1283**2))), 0)
     t1287 = 1/xp.sqrt(1 + t1286**2)
     t1288 = t1280*t1286
@@ -5073,10 +5073,10 @@ def condition_number(q):
     t1314 = t1312 + t1286*t1311
     t1315 = t1154*t1293 + t1158*t1297 + t1162*t1301 + t1166*t1305 + t1170*t1309 + t1174*t1313
     t1316 = xp.not_equal(t1315, 0)
-    t1317 = 0.5*(-t1289 + t1150)/xp.where(t1316, t1315, 1)
+    t1317 = (-t1289 + t1150)/xp.where(t1316, 2*t1315, 1)
     t1318 = xp.abs(t1317)
     t1319 = xp.greater_equal(t1318, 1)
-    t1320 = xp.abs(1/xp.where(t1319, t1317, 1))
+    t1320 = 1/xp.abs(xp.where(t1319, t1317, 1))
     t1321 = xp.where(t1316, xp.where(xp.greater_equal(t1317, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1319, t1320/(1 + xp.sqrt(1 + t1320**2)), 1/(t1318 + xp.sqrt(1 + t1318**2))), 0)
     t1322 = 1/xp.sqrt(1 + t1321**2)
     t1323 = t1315*t1321
@@ -5107,10 +5107,10 @@ def condition_number(q):
     t1348 = t1346 - t1321*t1347
     t1349 = t1347 + t1321*t1346
     t1350 = xp.not_equal(t1245, 0)
-    t1351 = 0.5*(-t1184 + t1219)/xp.where(t1350, t1245, 1)
+    t1351 = (-t1184 + t1219)/xp.where(t1350, 2*t1245, 1)
     t1352 = xp.abs(t1351)
     t1353 = xp.greater_equal(t1352, 1)
-    t1354 = xp.abs(1/xp.where(t1353, t1351, 1))
+    t1354 = 1/xp.abs(xp.where(t1353, t1351, 1))
     t1355 = xp.where(t1350, xp.where(xp.greater_equal(t1351, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1353, t1354/(1 + xp.sqrt(1 + t1354**2)), 1/(t1352 + xp.sqrt(1 + t1352**2))), 0)
     t1356 = 1/xp.sqrt(1 + t1355**2)
     t1357 = t1245*t1355
@@ -5142,10 +5142,10 @@ def condition_number(q):
     t1383 = t1381 + t1355*t1380
     t1384 = t1259*t1362 + t1263*t1366 + t1267*t1370 + t1271*t1374 + t1275*t1378 + t1279*t1382
     t1385 = xp.not_equal(t1384, 0)
-    t1386 = 0.5*(-t1358 + t1255)/xp.where(t1385, t1384, 1)
+    t1386 = (-t1358 + t1255)/xp.where(t1385, 2*t1384, 1)
     t1387 = xp.abs(t1386)
     t1388 = xp.greater_equal(t1387, 1)
-    t1389 = xp.abs(1/xp.where(t1388, t1386, 1))
+    t1389 = 1/xp.abs(xp.where(t1388, t1386, 1))
     t1390 = xp.where(t1385, xp.where(xp.greater_equal(t1386, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1388, t1389/(1 + xp.sqrt(1 + t1389**2)), 1/(t1387 + xp.sqrt(1 + t1387**2))), 0)
     t1391 = 1/xp.sqrt(1 + t1390**2)
     t1392 = t1384*t1390
@@ -5178,10 +5178,10 @@ def condition_number(q):
     t1419 = t1294*t1397 + t1298*t1401 + t1302*t1405 + t1306*t1409 + t1310*t1413 + t1314*t1417
     t1420 = t1363*t1398 + t1367*t1402 + t1371*t1406 + t1375*t1410 + t1379*t1414 + t1383*t1418
     t1421 = xp.not_equal(t1419, 0)
-    t1422 = 0.5*(-t1393 + t1290)/xp.where(t1421, t1419, 1)
+    t1422 = (-t1393 + t1290)/xp.where(t1421, 2*t1419, 1)
     t1423 = xp.abs(t1422)
     t1424 = xp.greater_equal(t1423, 1)
-    t1425 = xp.abs(1/xp.where(t1424, t1422, 1))
+    t1425 = 1/xp.abs(xp.where(t1424, t1422, 1))
     t1426 = xp.where(t1421, xp.where(xp.greater_equal(t1422, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1424, t1425/(1 + xp.sqrt(1 + t1425**2)), 1/(t1423 + xp.sqrt(1 + t1423**2))), 0)
     t1427 = 1/xp.sqrt(1 + t1426**2)
     t1428 = t1419*t1426
@@ -5213,10 +5213,10 @@ def condition_number(q):
     t1454 = t1452 + t1426*t1451
     t1455 = t1329*t1433 + t1333*t1437 + t1337*t1441 + t1341*t1445 + t1345*t1449 + t1349*t1453
     t1456 = xp.not_equal(t1455, 0)
-    t1457 = 0.5*(-t1429 + t1325)/xp.where(t1456, t1455, 1)
+    t1457 = (-t1429 + t1325)/xp.where(t1456, 2*t1455, 1)
     t1458 = xp.abs(t1457)
     t1459 = xp.greater_equal(t1458, 1)
-    t1460 = xp.abs(1/xp.where(t1459, t1457, 1))
+    t1460 = 1/xp.abs(xp.where(t1459, t1457, 1))
     t1461 = xp.where(t1456, xp.where(xp.greater_equal(t1457, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1459, t1460/(1 + xp.sqrt(1 + t1460**2)), 1/(t1458 + xp.sqrt(1 + t1458**2))), 0)
     t1462 = 1/xp.sqrt(1 + t1461**2)
     t1463 = t1455*t1461
@@ -5248,10 +5248,10 @@ def condition_number(q):
     t1489 = t1487 + t1461*t1486
     t1490 = t1328*t1468 + t1332*t1472 + t1336*t1476 + t1340*t1480 + t1344*t1484 + t1348*t1488
     t1491 = xp.not_equal(t1420, 0)
-    t1492 = 0.5*(-t1359 + t1394)/xp.where(t1491, t1420, 1)
+    t1492 = (-t1359 + t1394)/xp.where(t1491, 2*t1420, 1)
     t1493 = xp.abs(t1492)
     t1494 = xp.greater_equal(t1493, 1)
-    t1495 = xp.abs(1/xp.where(t1494, t1492, 1))
+    t1495 = 1/xp.abs(xp.where(t1494, t1492, 1))
     t1496 = xp.where(t1491, xp.where(xp.greater_equal(t1492, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1494, t1495/(1 + xp.sqrt(1 + t1495**2)), 1/(t1493 + xp.sqrt(1 + t1493**2))), 0)
     t1497 = 1/xp.sqrt(1 + t1496**2)
     t1498 = t1420*t1496
@@ -5283,10 +5283,10 @@ def condition_number(q):
     t1524 = t1522 + t1496*t1521
     t1525 = t1434*t1503 + t1438*t1507 + t1442*t1511 + t1446*t1515 + t1450*t1519 + t1454*t1523
     t1526 = xp.not_equal(t1525, 0)
-    t1527 = 0.5*(-t1499 + t1430)/xp.where(t1526, t1525, 1)
+    t1527 = (-t1499 + t1430)/xp.where(t1526, 2*t1525, 1)
     t1528 = xp.abs(t1527)
     t1529 = xp.greater_equal(t1528, 1)
-    t1530 = xp.abs(1/xp.where(t1529, t1527, 1))
+    t1530 = 1/xp.abs(xp.where(t1529, t1527, 1))
     t1531 = xp.where(t1526, xp.where(xp.greater_equal(t1527, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1529, t1530/(1 + xp.sqrt(1 + t1530**2)), 1/(t1528 + xp.sqrt(1 + t1528**2))), 0)
     t1532 = 1/xp.sqrt(1 + t1531**2)
     t1533 = t1525*t1531
@@ -5319,10 +5319,10 @@ def condition_number(q):
     t1560 = t1469*t1538 + t1473*t1542 + t1477*t1546 + t1481*t1550 + t1485*t1554 + t1489*t1558
     t1561 = t1504*t1539 + t1508*t1543 + t1512*t1547 + t1516*t1551 + t1520*t1555 + t1524*t1559
     t1562 = xp.not_equal(t1560, 0)
-    t1563 = 0.5*(-t1534 + t1465)/xp.where(t1562, t1560, 1)
+    t1563 = (-t1534 + t1465)/xp.where(t1562, 2*t1560, 1)
     t1564 = xp.abs(t1563)
     t1565 = xp.greater_equal(t1564, 1)
-    t1566 = xp.abs(1/xp.where(t1565, t1563, 1))
+    t1566 = 1/xp.abs(xp.where(t1565, t1563, 1))
     t1567 = xp.where(t1562, xp.where(xp.greater_equal(t1563, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1565, t1566/(1 + xp.sqrt(1 + t1566**2)), 1/(t1564 + xp.sqrt(1 + t1564**2))), 0)
     t1568 = 1/xp.sqrt(1 + t1567**2)
     t1569 = t1560*t1567
@@ -5353,10 +5353,10 @@ def condition_number(q):
     t1594 = t1592 - t1567*t1593
     t1595 = t1593 + t1567*t1592
     t1596 = xp.not_equal(t1561, 0)
-    t1597 = 0.5*(-t1500 + t1535)/xp.where(t1596, t1561, 1)
+    t1597 = (-t1500 + t1535)/xp.where(t1596, 2*t1561, 1)
     t1598 = xp.abs(t1597)
     t1599 = xp.greater_equal(t1598, 1)
-    t1600 = xp.abs(1/xp.where(t1599, t1597, 1))
+    t1600 = 1/xp.abs(xp.where(t1599, t1597, 1))
     t1601 = xp.where(t1596, xp.where(xp.greater_equal(t1597, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1599, t1600/(1 + xp.sqrt(1 + t1600**2)), 1/(t1598 + xp.sqrt(1 + t1598**2))), 0)
     t1602 = 1/xp.sqrt(1 + t1601**2)
     t1603 = t1561*t1601
@@ -5388,10 +5388,10 @@ def condition_number(q):
     t1629 = t1627 + t1601*t1626
     t1630 = t1575*t1608 + t1579*t1612 + t1583*t1616 + t1587*t1620 + t1591*t1624 + t1595*t1628
     t1631 = xp.not_equal(t1630, 0)
-    t1632 = 0.5*(-t1604 + t1571)/xp.where(t1631, t1630, 1)
+    t1632 = (-t1604 + t1571)/xp.where(t1631, 2*t1630, 1)
     t1633 = xp.abs(t1632)
     t1634 = xp.greater_equal(t1633, 1)
-    t1635 = xp.abs(1/xp.where(t1634, t1632, 1))
+    t1635 = 1/xp.abs(xp.where(t1634, t1632, 1))
     t1636 = xp.where(t1631, xp.where(xp.greater_equal(t1632, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1634, t1635/(1 + xp.sqrt(1 + t1635**2)), 1/(t1633 + xp.sqrt(1 + t1633**2))), 0)
     t1637 = 1/xp.sqrt(1 + t1636**2)
     t1638 = t1630*t1636
@@ -5423,10 +5423,10 @@ def condition_number(q):
     t1664 = t1662 + t1636*t1661
     t1665 = t1609*t1644 + t1613*t1648 + t1617*t1652 + t1621*t1656 + t1625*t1660 + t1629*t1664
     t1666 = xp.not_equal(t1665, 0)
-    t1667 = 0.5*(-t1605 + t1640)/xp.where(t1666, t1665, 1)
+    t1667 = (-t1605 + t1640)/xp.where(t1666, 2*t1665, 1)
     t1668 = xp.abs(t1667)
     t1669 = xp.greater_equal(t1668, 1)
-    t1670 = xp.abs(1/xp.where(t1669, t1667, 1))
+    t1670 = 1/xp.abs(xp.where(t1669, t1667, 1))
     t1671 = xp.where(t1666, xp.where(xp.greater_equal(t1667, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1669, t1670/(1 + xp.sqrt(1 + t1670**2)), 1/(t1668 + xp.sqrt(1 + t1668**2))), 0)
     t1672 = 1/xp.sqrt(1 + t1671**2)
     t1673 = t1665*t1671
@@ -5457,10 +5457,10 @@ def condition_number(q):
     t1698 = t1696 - t1671*t1697
     t1699 = t1697 + t1671*t1696
     t1700 = xp.not_equal(t1490, 0)
-    t1701 = 0.5*(-t1324 + t1464)/xp.where(t1700, t1490, 1)
+    t1701 = (-t1324 + t1464)/xp.where(t1700, 2*t1490, 1)
     t1702 = xp.abs(t1701)
     t1703 = xp.greater_equal(t1702, 1)
-    t1704 = xp.abs(1/xp.where(t1703, t1701, 1))
+    t1704 = 1/xp.abs(xp.where(t1703, t1701, 1))
     t1705 = xp.where(t1700, xp.where(xp.greater_equal(t1701, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1703, t1704/(1 + xp.sqrt(1 + t1704**2)), 1/(t1702 + xp.sqrt(1 + t1702**2))), 0)
     t1706 = 1/xp.sqrt(1 + t1705**2)
     t1707 = t1490*t1705
@@ -5492,10 +5492,10 @@ def condition_number(q):
     t1733 = t1731 + t1705*t1730
     t1734 = t1574*t1712 + t1578*t1716 + t1582*t1720 + t1586*t1724 + t1590*t1728 + t1594*t1732
     t1735 = xp.not_equal(t1734, 0)
-    t1736 = 0.5*(-t1708 + t1570)/xp.where(t1735, t1734, 1)
+    t1736 = (-t1708 + t1570)/xp.where(t1735, 2*t1734, 1)
     t1737 = xp.abs(t1736)
     t1738 = xp.greater_equal(t1737, 1)
-    t1739 = xp.abs(1/xp.where(t1738, t1736, 1))
+    t1739 = 1/xp.abs(xp.where(t1738, t1736, 1))
     t1740 = xp.where(t1735, xp.where(xp.greater_equal(t1736, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1738, t1739/(1 + xp.sqrt(1 + t1739**2)), 1/(t1737 + xp.sqrt(1 + t1737**2))), 0)
     t1741 = 1/xp.sqrt(1 + t1740**2)
     t1742 = t1734*t1740
@@ -5528,10 +5528,10 @@ def condition_number(q):
     t1769 = t1643*t1747 + t1647*t1751 + t1651*t1755 + t1655*t1759 + t1659*t1763 + t1663*t1767
     t1770 = t1713*t1748 + t1717*t1752 + t1721*t1756 + t1725*t1760 + t1729*t1764 + t1733*t1768
     t1771 = xp.not_equal(t1769, 0)
-    t1772 = 0.5*(-t1743 + t1639)/xp.where(t1771, t1769, 1)
+    t1772 = (-t1743 + t1639)/xp.where(t1771, 2*t1769, 1)
     t1773 = xp.abs(t1772)
     t1774 = xp.greater_equal(t1773, 1)
-    t1775 = xp.abs(1/xp.where(t1774, t1772, 1))
+    t1775 = 1/xp.abs(xp.where(t1774, t1772, 1))
     t1776 = xp.where(t1771, xp.where(xp.greater_equal(t1772, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1774, t1775/(1 + xp.sqrt(1 + t1775**2)), 1/(t1773 + xp.sqrt(1 + t1773**2))), 0)
     t1777 = 1/xp.sqrt(1 + t1776**2)
     t1778 = t1769*t1776
@@ -5563,10 +5563,10 @@ def condition_number(q):
     t1804 = t1802 + t1776*t1801
     t1805 = t1678*t1783 + t1682*t1787 + t1686*t1791 + t1690*t1795 + t1694*t1799 + t1698*t1803
     t1806 = xp.not_equal(t1805, 0)
-    t1807 = 0.5*(-t1779 + t1674)/xp.where(t1806, t1805, 1)
+    t1807 = (-t1779 + t1674)/xp.where(t1806, 2*t1805, 1)
     t1808 = xp.abs(t1807)
     t1809 = xp.greater_equal(t1808, 1)
-    t1810 = xp.abs(1/xp.where(t1809, t1807, 1))
+    t1810 = 1/xp.abs(xp.where(t1809, t1807, 1))
     t1811 = xp.where(t1806, xp.where(xp.greater_equal(t1807, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1809, t1810/(1 + xp.sqrt(1 + t1810**2)), 1/(t1808 + xp.sqrt(1 + t1808**2))), 0)
     t1812 = 1/xp.sqrt(1 + t1811**2)
     t1813 = t1805*t1811
@@ -5598,10 +5598,10 @@ def condition_number(q):
     t1839 = t1837 + t1811*t1836
     t1840 = t1679*t1818 + t1683*t1822 + t1687*t1826 + t1691*t1830 + t1695*t1834 + t1699*t1838
     t1841 = xp.not_equal(t1840, 0)
-    t1842 = 0.5*(-t1814 + t1675)/xp.where(t1841, t1840, 1)
+    t1842 = (-t1814 + t1675)/xp.where(t1841, 2*t1840, 1)
     t1843 = xp.abs(t1842)
     t1844 = xp.greater_equal(t1843, 1)
-    t1845 = xp.abs(1/xp.where(t1844, t1842, 1))
+    t1845 = 1/xp.abs(xp.where(t1844, t1842, 1))
     t1846 = xp.where(t1841, xp.where(xp.greater_equal(t1842, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1844, t1845/(1 + xp.sqrt(1 + t1845**2)), 1/(t1843 + xp.sqrt(1 + t1843**2))), 0)
     t1847 = 1/xp.sqrt(1 + t1846**2)
     t1848 = t1840*t1846
@@ -5632,10 +5632,10 @@ def condition_number(q):
     t1873 = t1871 - t1846*t1872
     t1874 = t1872 + t1846*t1871
     t1875 = xp.not_equal(t1770, 0)
-    t1876 = 0.5*(-t1709 + t1744)/xp.where(t1875, t1770, 1)
+    t1876 = (-t1709 + t1744)/xp.where(t1875, 2*t1770, 1)
     t1877 = xp.abs(t1876)
     t1878 = xp.greater_equal(t1877, 1)
-    t1879 = xp.abs(1/xp.where(t1878, t1876, 1))
+    t1879 = 1/xp.abs(xp.where(t1878, t1876, 1))
     t1880 = xp.where(t1875, xp.where(xp.greater_equal(t1876, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1878, t1879/(1 + xp.sqrt(1 + t1879**2)), 1/(t1877 + xp.sqrt(1 + t1877**2))), 0)
     t1881 = 1/xp.sqrt(1 + t1880**2)
     t1882 = t1770*t1880
@@ -5667,10 +5667,10 @@ def condition_number(q):
     t1908 = t1906 + t1880*t1905
     t1909 = t1784*t1887 + t1788*t1891 + t1792*t1895 + t1796*t1899 + t1800*t1903 + t1804*t1907
     t1910 = xp.not_equal(t1909, 0)
-    t1911 = 0.5*(-t1883 + t1780)/xp.where(t1910, t1909, 1)
+    t1911 = (-t1883 + t1780)/xp.where(t1910, 2*t1909, 1)
     t1912 = xp.abs(t1911)
     t1913 = xp.greater_equal(t1912, 1)
-    t1914 = xp.abs(1/xp.where(t1913, t1911, 1))
+    t1914 = 1/xp.abs(xp.where(t1913, t1911, 1))
     t1915 = xp.where(t1910, xp.where(xp.greater_equal(t1911, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1913, t1914/(1 + xp.sqrt(1 + t1914**2)), 1/(t1912 + xp.sqrt(1 + t1912**2))), 0)
     t1916 = 1/xp.sqrt(1 + t1915**2)
     t1917 = t1909*t1915
@@ -5703,10 +5703,10 @@ def condition_number(q):
     t1944 = t1819*t1922 + t1823*t1926 + t1827*t1930 + t1831*t1934 + t1835*t1938 + t1839*t1942
     t1945 = t1888*t1923 + t1892*t1927 + t1896*t1931 + t1900*t1935 + t1904*t1939 + t1908*t1943
     t1946 = xp.not_equal(t1944, 0)
-    t1947 = 0.5*(-t1918 + t1815)/xp.where(t1946, t1944, 1)
+    t1947 = (-t1918 + t1815)/xp.where(t1946, 2*t1944, 1)
     t1948 = xp.abs(t1947)
     t1949 = xp.greater_equal(t1948, 1)
-    t1950 = xp.abs(1/xp.where(t1949, t1947, 1))
+    t1950 = 1/xp.abs(xp.where(t1949, t1947, 1))
     t1951 = xp.where(t1946, xp.where(xp.greater_equal(t1947, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1949, t1950/(1 + xp.sqrt(1 + t1950**2)), 1/(t1948 + xp.sqrt(1 + t1948**2))), 0)
     t1952 = 1/xp.sqrt(1 + t1951**2)
     t1953 = t1944*t1951
@@ -5738,10 +5738,10 @@ def condition_number(q):
     t1979 = t1977 + t1951*t1976
     t1980 = t1854*t1958 + t1858*t1962 + t1862*t1966 + t1866*t1970 + t1870*t1974 + t1874*t1978
     t1981 = xp.not_equal(t1980, 0)
-    t1982 = 0.5*(-t1954 + t1850)/xp.where(t1981, t1980, 1)
+    t1982 = (-t1954 + t1850)/xp.where(t1981, 2*t1980, 1)
     t1983 = xp.abs(t1982)
     t1984 = xp.greater_equal(t1983, 1)
-    t1985 = xp.abs(1/xp.where(t1984, t1982, 1))
+    t1985 = 1/xp.abs(xp.where(t1984, t1982, 1))
     t1986 = xp.where(t1981, xp.where(xp.greater_equal(t1982, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1984, t1985/(1 + xp.sqrt(1 + t1985**2)), 1/(t1983 + xp.sqrt(1 + t1983**2))), 0)
     t1987 = 1/xp.sqrt(1 + t1986**2)
     t1988 = t1980*t1986
@@ -5773,10 +5773,10 @@ def condition_number(q):
     t2014 = t2012 + t1986*t2011
     t2015 = t1853*t1993 + t1857*t1997 + t1861*t2001 + t1865*t2005 + t1869*t2009 + t1873*t2013
     t2016 = xp.not_equal(t1945, 0)
-    t2017 = 0.5*(-t1884 + t1919)/xp.where(t2016, t1945, 1)
+    t2017 = (-t1884 + t1919)/xp.where(t2016, 2*t1945, 1)
     t2018 = xp.abs(t2017)
     t2019 = xp.greater_equal(t2018, 1)
-    t2020 = xp.abs(1/xp.where(t2019, t2017, 1))
+    t2020 = 1/xp.abs(xp.where(t2019, t2017, 1))
     t2021 = xp.where(t2016, xp.where(xp.greater_equal(t2017, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2019, t2020/(1 + xp.sqrt(1 + t2020**2)), 1/(t2018 + xp.sqrt(1 + t2018**2))), 0)
     t2022 = 1/xp.sqrt(1 + t2021**2)
     t2023 = t1945*t2021
@@ -5808,10 +5808,10 @@ def condition_number(q):
     t2049 = t2047 + t2021*t2046
     t2050 = t1959*t2028 + t1963*t2032 + t1967*t2036 + t1971*t2040 + t1975*t2044 + t1979*t2048
     t2051 = xp.not_equal(t2050, 0)
-    t2052 = 0.5*(-t2024 + t1955)/xp.where(t2051, t2050, 1)
+    t2052 = (-t2024 + t1955)/xp.where(t2051, 2*t2050, 1)
     t2053 = xp.abs(t2052)
     t2054 = xp.greater_equal(t2053, 1)
-    t2055 = xp.abs(1/xp.where(t2054, t2052, 1))
+    t2055 = 1/xp.abs(xp.where(t2054, t2052, 1))
     t2056 = xp.where(t2051, xp.where(xp.greater_equal(t2052, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2054, t2055/(1 + xp.sqrt(1 + t2055**2)), 1/(t2053 + xp.sqrt(1 + t2053**2))), 0)
     t2057 = 1/xp.sqrt(1 + t2056**2)
     t2058 = t2050*t2056
@@ -5844,10 +5844,10 @@ def condition_number(q):
     t2085 = t1994*t2063 + t1998*t2067 + t2002*t2071 + t2006*t2075 + t2010*t2079 + t2014*t2083
     t2086 = t2029*t2064 + t2033*t2068 + t2037*t2072 + t2041*t2076 + t2045*t2080 + t2049*t2084
     t2087 = xp.not_equal(t2085, 0)
-    t2088 = 0.5*(-t2059 + t1990)/xp.where(t2087, t2085, 1)
+    t2088 = (-t2059 + t1990)/xp.where(t2087, 2*t2085, 1)
     t2089 = xp.abs(t2088)
     t2090 = xp.greater_equal(t2089, 1)
-    t2091 = xp.abs(1/xp.where(t2090, t2088, 1))
+    t2091 = 1/xp.abs(xp.where(t2090, t2088, 1))
     t2092 = xp.where(t2087, xp.where(xp.greater_equal(t2088, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2090, t2091/(1 + xp.sqrt(1 + t2091**2)), 1/(t2089 + xp.sqrt(1 + t2089**2))), 0)
     t2093 = 1/xp.sqrt(1 + t2092**2)
     t2094 = t2085*t2092
@@ -5878,10 +5878,10 @@ def condition_number(q):
     t2119 = t2117 - t2092*t2118
     t2120 = t2118 + t2092*t2117
     t2121 = xp.not_equal(t2086, 0)
-    t2122 = 0.5*(-t2025 + t2060)/xp.where(t2121, t2086, 1)
+    t2122 = (-t2025 + t2060)/xp.where(t2121, 2*t2086, 1)
     t2123 = xp.abs(t2122)
     t2124 = xp.greater_equal(t2123, 1)
-    t2125 = xp.abs(1/xp.where(t2124, t2122, 1))
+    t2125 = 1/xp.abs(xp.where(t2124, t2122, 1))
     t2126 = xp.where(t2121, xp.where(xp.greater_equal(t2122, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2124, t2125/(1 + xp.sqrt(1 + t2125**2)), 1/(t2123 + xp.sqrt(1 + t2123**2))), 0)
     t2127 = 1/xp.sqrt(1 + t2126**2)
     t2128 = t2086*t2126
@@ -5913,10 +5913,10 @@ def condition_number(q):
     t2154 = t2152 + t2126*t2151
     t2155 = t2100*t2133 + t2104*t2137 + t2108*t2141 + t2112*t2145 + t2116*t2149 + t2120*t2153
     t2156 = xp.not_equal(t2155, 0)
-    t2157 = 0.5*(-t2129 + t2096)/xp.where(t2156, t2155, 1)
+    t2157 = (-t2129 + t2096)/xp.where(t2156, 2*t2155, 1)
     t2158 = xp.abs(t2157)
     t2159 = xp.greater_equal(t2158, 1)
-    t2160 = xp.abs(1/xp.where(t2159, t2157, 1))
+    t2160 = 1/xp.abs(xp.where(t2159, t2157, 1))
     t2161 = xp.where(t2156, xp.where(xp.greater_equal(t2157, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2159, t2160/(1 + xp.sqrt(1 + t2160**2)), 1/(t2158 + xp.sqrt(1 + t2158**2))), 0)
     t2162 = 1/xp.sqrt(1 + t2161**2)
     t2163 = t2155*t2161
@@ -5948,10 +5948,10 @@ def condition_number(q):
     t2189 = t2187 + t2161*t2186
     t2190 = t2134*t2169 + t2138*t2173 + t2142*t2177 + t2146*t2181 + t2150*t2185 + t2154*t2189
     t2191 = xp.not_equal(t2190, 0)
-    t2192 = 0.5*(-t2130 + t2165)/xp.where(t2191, t2190, 1)
+    t2192 = (-t2130 + t2165)/xp.where(t2191, 2*t2190, 1)
     t2193 = xp.abs(t2192)
     t2194 = xp.greater_equal(t2193, 1)
-    t2195 = xp.abs(1/xp.where(t2194, t2192, 1))
+    t2195 = 1/xp.abs(xp.where(t2194, t2192, 1))
     t2196 = xp.where(t2191, xp.where(xp.greater_equal(t2192, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2194, t2195/(1 + xp.sqrt(1 + t2195**2)), 1/(t2193 + xp.sqrt(1 + t2193**2))), 0)
     t2197 = 1/xp.sqrt(1 + t2196**2)
     t2198 = t2190*t2196
@@ -5982,10 +5982,10 @@ def condition_number(q):
     t2223 = t2221 - t2196*t2222
     t2224 = t2222 + t2196*t2221
     t2225 = xp.not_equal(t2015, 0)
-    t2226 = 0.5*(-t1849 + t1989)/xp.where(t2225, t2015, 1)
+    t2226 = (-t1849 + t1989)/xp.where(t2225, 2*t2015, 1)
     t2227 = xp.abs(t2226)
     t2228 = xp.greater_equal(t2227, 1)
-    t2229 = xp.abs(1/xp.where(t2228, t2226, 1))
+    t2229 = 1/xp.abs(xp.where(t2228, t2226, 1))
     t2230 = xp.where(t2225, xp.where(xp.greater_equal(t2226, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2228, t2229/(1 + xp.sqrt(1 + t2229**2)), 1/(t2227 + xp.sqrt(1 + t2227**2))), 0)
     t2231 = 1/xp.sqrt(1 + t2230**2)
     t2232 = t2015*t2230
@@ -6017,10 +6017,10 @@ def condition_number(q):
     t2258 = t2256 + t2230*t2255
     t2259 = t2099*t2237 + t2103*t2241 + t2107*t2245 + t2111*t2249 + t2115*t2253 + t2119*t2257
     t2260 = xp.not_equal(t2259, 0)
-    t2261 = 0.5*(-t2233 + t2095)/xp.where(t2260, t2259, 1)
+    t2261 = (-t2233 + t2095)/xp.where(t2260, 2*t2259, 1)
     t2262 = xp.abs(t2261)
     t2263 = xp.greater_equal(t2262, 1)
-    t2264 = xp.abs(1/xp.where(t2263, t2261, 1))
+    t2264 = 1/xp.abs(xp.where(t2263, t2261, 1))
     t2265 = xp.where(t2260, xp.where(xp.greater_equal(t2261, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2263, t2264/(1 + xp.sqrt(1 + t2264**2)), 1/(t2262 + xp.sqrt(1 + t2262**2))), 0)
     t2266 = 1/xp.sqrt(1 + t2265**2)
     t2267 = t2259*t2265
@@ -6053,10 +6053,10 @@ def condition_number(q):
     t2294 = t2168*t2272 + t2172*t2276 + t2176*t2280 + t2180*t2284 + t2184*t2288 + t2188*t2292
     t2295 = t2238*t2273 + t2242*t2277 + t2246*t2281 + t2250*t2285 + t2254*t2289 + t2258*t2293
     t2296 = xp.not_equal(t2294, 0)
-    t2297 = 0.5*(-t2268 + t2164)/xp.where(t2296, t2294, 1)
+    t2297 = (-t2268 + t2164)/xp.where(t2296, 2*t2294, 1)
     t2298 = xp.abs(t2297)
     t2299 = xp.greater_equal(t2298, 1)
-    t2300 = xp.abs(1/xp.where(t2299, t2297, 1))
+    t2300 = 1/xp.abs(xp.where(t2299, t2297, 1))
     t2301 = xp.where(t2296, xp.where(xp.greater_equal(t2297, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2299, t2300/(1 + xp.sqrt(1 + t2300**2)), 1/(t2298 + xp.sqrt(1 + t2298**2))), 0)
     t2302 = 1/xp.sqrt(1 + t2301**2)
     t2303 = t2294*t2301
@@ -6088,10 +6088,10 @@ def condition_number(q):
     t2329 = t2327 + t2301*t2326
     t2330 = t2203*t2308 + t2207*t2312 + t2211*t2316 + t2215*t2320 + t2219*t2324 + t2223*t2328
     t2331 = xp.not_equal(t2330, 0)
-    t2332 = 0.5*(-t2304 + t2199)/xp.where(t2331, t2330, 1)
+    t2332 = (-t2304 + t2199)/xp.where(t2331, 2*t2330, 1)
     t2333 = xp.abs(t2332)
     t2334 = xp.greater_equal(t2333, 1)
-    t2335 = xp.abs(1/xp.where(t2334, t2332, 1))
+    t2335 = 1/xp.abs(xp.where(t2334, t2332, 1))
     t2336 = xp.where(t2331, xp.where(xp.greater_equal(t2332, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2334, t2335/(1 + xp.sqrt(1 + t2335**2)), 1/(t2333 + xp.sqrt(1 + t2333**2))), 0)
     t2337 = 1/xp.sqrt(1 + t2336**2)
     t2338 = t2330*t2336
@@ -6123,10 +6123,10 @@ def condition_number(q):
     t2364 = t2362 + t2336*t2361
     t2365 = t2204*t2343 + t2208*t2347 + t2212*t2351 + t2216*t2355 + t2220*t2359 + t2224*t2363
     t2366 = xp.not_equal(t2365, 0)
-    t2367 = 0.5*(-t2339 + t2200)/xp.where(t2366, t2365, 1)
+    t2367 = (-t2339 + t2200)/xp.where(t2366, 2*t2365, 1)
     t2368 = xp.abs(t2367)
     t2369 = xp.greater_equal(t2368, 1)
-    t2370 = xp.abs(1/xp.where(t2369, t2367, 1))
+    t2370 = 1/xp.abs(xp.where(t2369, t2367, 1))
     t2371 = xp.where(t2366, xp.where(xp.greater_equal(t2367, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2369, t2370/(1 + xp.sqrt(1 + t2370**2)), 1/(t2368 + xp.sqrt(1 + t2368**2))), 0)
     t2372 = 1/xp.sqrt(1 + t2371**2)
     t2373 = t2365*t2371
@@ -6157,10 +6157,10 @@ def condition_number(q):
     t2398 = t2396 - t2371*t2397
     t2399 = t2397 + t2371*t2396
     t2400 = xp.not_equal(t2295, 0)
-    t2401 = 0.5*(-t2234 + t2269)/xp.where(t2400, t2295, 1)
+    t2401 = (-t2234 + t2269)/xp.where(t2400, 2*t2295, 1)
     t2402 = xp.abs(t2401)
     t2403 = xp.greater_equal(t2402, 1)
-    t2404 = xp.abs(1/xp.where(t2403, t2401, 1))
+    t2404 = 1/xp.abs(xp.where(t2403, t2401, 1))
     t2405 = xp.where(t2400, xp.where(xp.greater_equal(t2401, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2403, t2404/(1 + xp.sqrt(1 + t2404**2)), 1/(t2402 + xp.sqrt(1 + t2402**2))), 0)
     t2406 = 1/xp.sqrt(1 + t2405**2)
     t2407 = t2295*t2405
@@ -6192,10 +6192,10 @@ def condition_number(q):
     t2433 = t2431 + t2405*t2430
     t2434 = t2309*t2412 + t2313*t2416 + t2317*t2420 + t2321*t2424 + t2325*t2428 + t2329*t2432
     t2435 = xp.not_equal(t2434, 0)
-    t2436 = 0.5*(-t2408 + t2305)/xp.where(t2435, t2434, 1)
+    t2436 = (-t2408 + t2305)/xp.where(t2435, 2*t2434, 1)
     t2437 = xp.abs(t2436)
     t2438 = xp.greater_equal(t2437, 1)
-    t2439 = xp.abs(1/xp.where(t2438, t2436, 1))
+    t2439 = 1/xp.abs(xp.where(t2438, t2436, 1))
     t2440 = xp.where(t2435, xp.where(xp.greater_equal(t2436, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2438, t2439/(1 + xp.sqrt(1 + t2439**2)), 1/(t2437 + xp.sqrt(1 + t2437**2))), 0)
     t2441 = 1/xp.sqrt(1 + t2440**2)
     t2442 = t2434*t2440
@@ -6228,10 +6228,10 @@ def condition_number(q):
     t2469 = t2344*t2447 + t2348*t2451 + t2352*t2455 + t2356*t2459 + t2360*t2463 + t2364*t2467
     t2470 = t2413*t2448 + t2417*t2452 + t2421*t2456 + t2425*t2460 + t2429*t2464 + t2433*t2468
     t2471 = xp.not_equal(t2469, 0)
-    t2472 = 0.5*(-t2443 + t2340)/xp.where(t2471, t2469, 1)
+    t2472 = (-t2443 + t2340)/xp.where(t2471, 2*t2469, 1)
     t2473 = xp.abs(t2472)
     t2474 = xp.greater_equal(t2473, 1)
-    t2475 = xp.abs(1/xp.where(t2474, t2472, 1))
+    t2475 = 1/xp.abs(xp.where(t2474, t2472, 1))
     t2476 = xp.where(t2471, xp.where(xp.greater_equal(t2472, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2474, t2475/(1 + xp.sqrt(1 + t2475**2)), 1/(t2473 + xp.sqrt(1 + t2473**2))), 0)
     t2477 = 1/xp.sqrt(1 + t2476**2)
     t2478 = t2469*t2476
@@ -6263,10 +6263,10 @@ def condition_number(q):
     t2504 = t2502 + t2476*t2501
     t2505 = t2379*t2483 + t2383*t2487 + t2387*t2491 + t2391*t2495 + t2395*t2499 + t2399*t2503
     t2506 = xp.not_equal(t2505, 0)
-    t2507 = 0.5*(-t2479 + t2375)/xp.where(t2506, t2505, 1)
+    t2507 = (-t2479 + t2375)/xp.where(t2506, 2*t2505, 1)
     t2508 = xp.abs(t2507)
     t2509 = xp.greater_equal(t2508, 1)
-    t2510 = xp.abs(1/xp.where(t2509, t2507, 1))
+    t2510 = 1/xp.abs(xp.where(t2509, t2507, 1))
     t2511 = xp.where(t2506, xp.where(xp.greater_equal(t2507, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2509, t2510/(1 + xp.sqrt(1 + t2510**2)), 1/(t2508 + xp.sqrt(1 + t2508**2))), 0)
     t2512 = 1/xp.sqrt(1 + t2511**2)
     t2513 = t2505*t2511
@@ -6298,10 +6298,10 @@ def condition_number(q):
     t2539 = t2537 + t2511*t2536
     t2540 = t2378*t2518 + t2382*t2522 + t2386*t2526 + t2390*t2530 + t2394*t2534 + t2398*t2538
     t2541 = xp.not_equal(t2470, 0)
-    t2542 = 0.5*(-t2409 + t2444)/xp.where(t2541, t2470, 1)
+    t2542 = (-t2409 + t2444)/xp.where(t2541, 2*t2470, 1)
     t2543 = xp.abs(t2542)
     t2544 = xp.greater_equal(t2543, 1)
-    t2545 = xp.abs(1/xp.where(t2544, t2542, 1))
+    t2545 = 1/xp.abs(xp.where(t2544, t2542, 1))
     t2546 = xp.where(t2541, xp.where(xp.greater_equal(t2542, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2544, t2545/(1 + xp.sqrt(1 + t2545**2)), 1/(t2543 + xp.sqrt(1 + t2543**2))), 0)
     t2547 = 1/xp.sqrt(1 + t2546**2)
     t2548 = t2470*t2546
@@ -6333,10 +6333,10 @@ def condition_number(q):
     t2574 = t2572 + t2546*t2571
     t2575 = t2484*t2553 + t2488*t2557 + t2492*t2561 + t2496*t2565 + t2500*t2569 + t2504*t2573
     t2576 = xp.not_equal(t2575, 0)
-    t2577 = 0.5*(-t2549 + t2480)/xp.where(t2576, t2575, 1)
+    t2577 = (-t2549 + t2480)/xp.where(t2576, 2*t2575, 1)
     t2578 = xp.abs(t2577)
     t2579 = xp.greater_equal(t2578, 1)
-    t2580 = xp.abs(1/xp.where(t2579, t2577, 1))
+    t2580 = 1/xp.abs(xp.where(t2579, t2577, 1))
     t2581 = xp.where(t2576, xp.where(xp.greater_equal(t2577, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2579, t2580/(1 + xp.sqrt(1 + t2580**2)), 1/(t2578 + xp.sqrt(1 + t2578**2))), 0)
     t2582 = 1/xp.sqrt(1 + t2581**2)
     t2583 = t2575*t2581
@@ -6369,10 +6369,10 @@ def condition_number(q):
     t2610 = t2519*t2588 + t2523*t2592 + t2527*t2596 + t2531*t2600 + t2535*t2604 + t2539*t2608
     t2611 = t2554*t2589 + t2558*t2593 + t2562*t2597 + t2566*t2601 + t2570*t2605 + t2574*t2609
     t2612 = xp.not_equal(t2610, 0)
-    t2613 = 0.5*(-t2584 + t2515)/xp.where(t2612, t2610, 1)
+    t2613 = (-t2584 + t2515)/xp.where(t2612, 2*t2610, 1)
     t2614 = xp.abs(t2613)
     t2615 = xp.greater_equal(t2614, 1)
-    t2616 = xp.abs(1/xp.where(t2615, t2613, 1))
+    t2616 = 1/xp.abs(xp.where(t2615, t2613, 1))
     t2617 = xp.where(t2612, xp.where(xp.greater_equal(t2613, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2615, t2616/(1 + xp.sqrt(1 + t2616**2)), 1/(t2614 + xp.sqrt(1 + t2614**2))), 0)
     t2618 = 1/xp.sqrt(1 + t2617**2)
     t2619 = t2610*t2617
@@ -6403,10 +6403,10 @@ def condition_number(q):
     t2644 = t2642 - t2617*t2643
     t2645 = t2643 + t2617*t2642
     t2646 = xp.not_equal(t2611, 0)
-    t2647 = 0.5*(-t2550 + t2585)/xp.where(t2646, t2611, 1)
+    t2647 = (-t2550 + t2585)/xp.where(t2646, 2*t2611, 1)
     t2648 = xp.abs(t2647)
     t2649 = xp.greater_equal(t2648, 1)
-    t2650 = xp.abs(1/xp.where(t2649, t2647, 1))
+    t2650 = 1/xp.abs(xp.where(t2649, t2647, 1))
     t2651 = xp.where(t2646, xp.where(xp.greater_equal(t2647, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2649, t2650/(1 + xp.sqrt(1 + t2650**2)), 1/(t2648 + xp.sqrt(1 + t2648**2))), 0)
     t2652 = 1/xp.sqrt(1 + t2651**2)
     t2653 = t2611*t2651
@@ -6438,10 +6438,10 @@ def condition_number(q):
     t2679 = t2677 + t2651*t2676
     t2680 = t2625*t2658 + t2629*t2662 + t2633*t2666 + t2637*t2670 + t2641*t2674 + t2645*t2678
     t2681 = xp.not_equal(t2680, 0)
-    t2682 = 0.5*(-t2654 + t2621)/xp.where(t2681, t2680, 1)
+    t2682 = (-t2654 + t2621)/xp.where(t2681, 2*t2680, 1)
     t2683 = xp.abs(t2682)
     t2684 = xp.greater_equal(t2683, 1)
-    t2685 = xp.abs(1/xp.where(t2684, t2682, 1))
+    t2685 = 1/xp.abs(xp.where(t2684, t2682, 1))
     t2686 = xp.where(t2681, xp.where(xp.greater_equal(t2682, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2684, t2685/(1 + xp.sqrt(1 + t2685**2)), 1/(t2683 + xp.sqrt(1 + t2683**2))), 0)
     t2687 = 1/xp.sqrt(1 + t2686**2)
     t2688 = t2680*t2686
@@ -6473,10 +6473,10 @@ def condition_number(q):
     t2714 = t2712 + t2686*t2711
     t2715 = t2659*t2694 + t2663*t2698 + t2667*t2702 + t2671*t2706 + t2675*t2710 + t2679*t2714
     t2716 = xp.not_equal(t2715, 0)
-    t2717 = 0.5*(-t2655 + t2690)/xp.where(t2716, t2715, 1)
+    t2717 = (-t2655 + t2690)/xp.where(t2716, 2*t2715, 1)
     t2718 = xp.abs(t2717)
     t2719 = xp.greater_equal(t2718, 1)
-    t2720 = xp.abs(1/xp.where(t2719, t2717, 1))
+    t2720 = 1/xp.abs(xp.where(t2719, t2717, 1))
     t2721 = xp.where(t2716, xp.where(xp.greater_equal(t2717, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2719, t2720/(1 + xp.sqrt(1 + t2720**2)), 1/(t2718 + xp.sqrt(1 + t2718**2))), 0)
     t2722 = 1/xp.sqrt(1 + t2721**2)
     t2723 = t2715*t2721
@@ -6507,10 +6507,10 @@ def condition_number(q):
     t2748 = t2746 - t2721*t2747
     t2749 = t2747 + t2721*t2746
     t2750 = xp.not_equal(t2540, 0)
-    t2751 = 0.5*(-t2374 + t2514)/xp.where(t2750, t2540, 1)
+    t2751 = (-t2374 + t2514)/xp.where(t2750, 2*t2540, 1)
     t2752 = xp.abs(t2751)
     t2753 = xp.greater_equal(t2752, 1)
-    t2754 = xp.abs(1/xp.where(t2753, t2751, 1))
+    t2754 = 1/xp.abs(xp.where(t2753, t2751, 1))
     t2755 = xp.where(t2750, xp.where(xp.greater_equal(t2751, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2753, t2754/(1 + xp.sqrt(1 + t2754**2)), 1/(t2752 + xp.sqrt(1 + t2752**2))), 0)
     t2756 = 1/xp.sqrt(1 + t2755**2)
     t2757 = t2540*t2755
@@ -6542,10 +6542,10 @@ def condition_number(q):
     t2783 = t2781 + t2755*t2780
     t2784 = t2624*t2762 + t2628*t2766 + t2632*t2770 + t2636*t2774 + t2640*t2778 + t2644*t2782
     t2785 = xp.not_equal(t2784, 0)
-    t2786 = 0.5*(-t2758 + t2620)/xp.where(t2785, t2784, 1)
+    t2786 = (-t2758 + t2620)/xp.where(t2785, 2*t2784, 1)
     t2787 = xp.abs(t2786)
     t2788 = xp.greater_equal(t2787, 1)
-    t2789 = xp.abs(1/xp.where(t2788, t2786, 1))
+    t2789 = 1/xp.abs(xp.where(t2788, t2786, 1))
     t2790 = xp.where(t2785, xp.where(xp.greater_equal(t2786, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2788, t2789/(1 + xp.sqrt(1 + t2789**2)), 1/(t2787 + xp.sqrt(1 + t2787**2))), 0)
     t2791 = 1/xp.sqrt(1 + t2790**2)
     t2792 = t2784*t2790
@@ -6578,10 +6578,10 @@ def condition_number(q):
     t2819 = t2693*t2797 + t2697*t2801 + t2701*t2805 + t2705*t2809 + t2709*t2813 + t2713*t2817
     t2820 = t2763*t2798 + t2767*t2802 + t2771*t2806 + t2775*t2810 + t2779*t2814 + t2783*t2818
     t2821 = xp.not_equal(t2819, 0)
-    t2822 = 0.5*(-t2793 + t2689)/xp.where(t2821, t2819, 1)
+    t2822 = (-t2793 + t2689)/xp.where(t2821, 2*t2819, 1)
     t2823 = xp.abs(t2822)
     t2824 = xp.greater_equal(t2823, 1)
-    t2825 = xp.abs(1/xp.where(t2824, t2822, 1))
+    t2825 = 1/xp.abs(xp.where(t2824, t2822, 1))
     t2826 = xp.where(t2821, xp.where(xp.greater_equal(t2822, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2824, t2825/(1 + xp.sqrt(1 + t2825**2)), 1/(t2823 + xp.sqrt(1 + t2823**2))), 0)
     t2827 = 1/xp.sqrt(1 + t2826**2)
     t2828 = t2819*t2826
@@ -6613,10 +6613,10 @@ def condition_number(q):
     t2854 = t2852 + t2826*t2851
     t2855 = t2728*t2833 + t2732*t2837 + t2736*t2841 + t2740*t2845 + t2744*t2849 + t2748*t2853
     t2856 = xp.not_equal(t2855, 0)
-    t2857 = 0.5*(-t2829 + t2724)/xp.where(t2856, t2855, 1)
+    t2857 = (-t2829 + t2724)/xp.where(t2856, 2*t2855, 1)
     t2858 = xp.abs(t2857)
     t2859 = xp.greater_equal(t2858, 1)
-    t2860 = xp.abs(1/xp.where(t2859, t2857, 1))
+    t2860 = 1/xp.abs(xp.where(t2859, t2857, 1))
     t2861 = xp.where(t2856, xp.where(xp.greater_equal(t2857, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2859, t2860/(1 + xp.sqrt(1 + t2860**2)), 1/(t2858 + xp.sqrt(1 + t2858**2))), 0)
     t2862 = 1/xp.sqrt(1 + t2861**2)
     t2863 = t2855*t2861
@@ -6648,10 +6648,10 @@ def condition_number(q):
     t2889 = t2887 + t2861*t2886
     t2890 = t2729*t2868 + t2733*t2872 + t2737*t2876 + t2741*t2880 + t2745*t2884 + t2749*t2888
     t2891 = xp.not_equal(t2890, 0)
-    t2892 = 0.5*(-t2864 + t2725)/xp.where(t2891, t2890, 1)
+    t2892 = (-t2864 + t2725)/xp.where(t2891, 2*t2890, 1)
     t2893 = xp.abs(t2892)
     t2894 = xp.greater_equal(t2893, 1)
-    t2895 = xp.abs(1/xp.where(t2894, t2892, 1))
+    t2895 = 1/xp.abs(xp.where(t2894, t2892, 1))
     t2896 = xp.where(t2891, xp.where(xp.greater_equal(t2892, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2894, t2895/(1 + xp.sqrt(1 + t2895**2)), 1/(t2893 + xp.sqrt(1 + t2893**2))), 0)
     t2897 = 1/xp.sqrt(1 + t2896**2)
     t2898 = t2890*t2896
@@ -6682,10 +6682,10 @@ def condition_number(q):
     t2923 = t2921 - t2896*t2922
     t2924 = t2922 + t2896*t2921
     t2925 = xp.not_equal(t2820, 0)
-    t2926 = 0.5*(-t2759 + t2794)/xp.where(t2925, t2820, 1)
+    t2926 = (-t2759 + t2794)/xp.where(t2925, 2*t2820, 1)
     t2927 = xp.abs(t2926)
     t2928 = xp.greater_equal(t2927, 1)
-    t2929 = xp.abs(1/xp.where(t2928, t2926, 1))
+    t2929 = 1/xp.abs(xp.where(t2928, t2926, 1))
     t2930 = xp.where(t2925, xp.where(xp.greater_equal(t2926, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2928, t2929/(1 + xp.sqrt(1 + t2929**2)), 1/(t2927 + xp.sqrt(1 + t2927**2))), 0)
     t2931 = 1/xp.sqrt(1 + t2930**2)
     t2932 = t2820*t2930
@@ -6717,10 +6717,10 @@ def condition_number(q):
     t2958 = t2956 + t2930*t2955
     t2959 = t2834*t2937 + t2838*t2941 + t2842*t2945 + t2846*t2949 + t2850*t2953 + t2854*t2957
     t2960 = xp.not_equal(t2959, 0)
-    t2961 = 0.5*(-t2933 + t2830)/xp.where(t2960, t2959, 1)
+    t2961 = (-t2933 + t2830)/xp.where(t2960, 2*t2959, 1)
     t2962 = xp.abs(t2961)
     t2963 = xp.greater_equal(t2962, 1)
-    t2964 = xp.abs(1/xp.where(t2963, t2961, 1))
+    t2964 = 1/xp.abs(xp.where(t2963, t2961, 1))
     t2965 = xp.where(t2960, xp.where(xp.greater_equal(t2961, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2963, t2964/(1 + xp.sqrt(1 + t2964**2)), 1/(t2962 + xp.sqrt(1 + t2962**2))), 0)
     t2966 = 1/xp.sqrt(1 + t2965**2)
     t2967 = t2959*t2965
@@ -6753,10 +6753,10 @@ def condition_number(q):
     t2994 = t2869*t2972 + t2873*t2976 + t2877*t2980 + t2881*t2984 + t2885*t2988 + t2889*t2992
     t2995 = t2938*t2973 + t2942*t2977 + t2946*t2981 + t2950*t2985 + t2954*t2989 + t2958*t2993
     t2996 = xp.not_equal(t2994, 0)
-    t2997 = 0.5*(-t2968 + t2865)/xp.where(t2996, t2994, 1)
+    t2997 = (-t2968 + t2865)/xp.where(t2996, 2*t2994, 1)
     t2998 = xp.abs(t2997)
     t2999 = xp.greater_equal(t2998, 1)
-    t3000 = xp.abs(1/xp.where(t2999, t2997, 1))
+    t3000 = 1/xp.abs(xp.where(t2999, t2997, 1))
     t3001 = xp.where(t2996, xp.where(xp.greater_equal(t2997, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2999, t3000/(1 + xp.sqrt(1 + t3000**2)), 1/(t2998 + xp.sqrt(1 + t2998**2))), 0)
     t3002 = 1/xp.sqrt(1 + t3001**2)
     t3003 = t2994*t3001
@@ -6788,10 +6788,10 @@ def condition_number(q):
     t3029 = t3027 + t3001*t3026
     t3030 = t2904*t3008 + t2908*t3012 + t2912*t3016 + t2916*t3020 + t2920*t3024 + t2924*t3028
     t3031 = xp.not_equal(t3030, 0)
-    t3032 = 0.5*(-t3004 + t2900)/xp.where(t3031, t3030, 1)
+    t3032 = (-t3004 + t2900)/xp.where(t3031, 2*t3030, 1)
     t3033 = xp.abs(t3032)
     t3034 = xp.greater_equal(t3033, 1)
-    t3035 = xp.abs(1/xp.where(t3034, t3032, 1))
+    t3035 = 1/xp.abs(xp.where(t3034, t3032, 1))
     t3036 = xp.where(t3031, xp.where(xp.greater_equal(t3032, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3034, t3035/(1 + xp.sqrt(1 + t3035**2)), 1/(t3033 + xp.sqrt(1 + t3033**2))), 0)
     t3037 = 1/xp.sqrt(1 + t3036**2)
     t3038 = t3030*t3036
@@ -6823,10 +6823,10 @@ def condition_number(q):
     t3064 = t3062 + t3036*t3061
     t3065 = t2903*t3043 + t2907*t3047 + t2911*t3051 + t2915*t3055 + t2919*t3059 + t2923*t3063
     t3066 = xp.not_equal(t2995, 0)
-    t3067 = 0.5*(-t2934 + t2969)/xp.where(t3066, t2995, 1)
+    t3067 = (-t2934 + t2969)/xp.where(t3066, 2*t2995, 1)
     t3068 = xp.abs(t3067)
     t3069 = xp.greater_equal(t3068, 1)
-    t3070 = xp.abs(1/xp.where(t3069, t3067, 1))
+    t3070 = 1/xp.abs(xp.where(t3069, t3067, 1))
     t3071 = xp.where(t3066, xp.where(xp.greater_equal(t3067, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3069, t3070/(1 + xp.sqrt(1 + t3070**2)), 1/(t3068 + xp.sqrt(1 + t3068**2))), 0)
     t3072 = 1/xp.sqrt(1 + t3071**2)
     t3073 = t2995*t3071
@@ -6858,10 +6858,10 @@ def condition_number(q):
     t3099 = t3097 + t3071*t3096
     t3100 = t3009*t3078 + t3013*t3082 + t3017*t3086 + t3021*t3090 + t3025*t3094 + t3029*t3098
     t3101 = xp.not_equal(t3100, 0)
-    t3102 = 0.5*(-t3074 + t3005)/xp.where(t3101, t3100, 1)
+    t3102 = (-t3074 + t3005)/xp.where(t3101, 2*t3100, 1)
     t3103 = xp.abs(t3102)
     t3104 = xp.greater_equal(t3103, 1)
-    t3105 = xp.abs(1/xp.where(t3104, t3102, 1))
+    t3105 = 1/xp.abs(xp.where(t3104, t3102, 1))
     t3106 = xp.where(t3101, xp.where(xp.greater_equal(t3102, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3104, t3105/(1 + xp.sqrt(1 + t3105**2)), 1/(t3103 + xp.sqrt(1 + t3103**2))), 0)
     t3107 = 1/xp.sqrt(1 + t3106**2)
     t3108 = t3100*t3106
@@ -6894,10 +6894,10 @@ def condition_number(q):
     t3135 = t3044*t3113 + t3048*t3117 + t3052*t3121 + t3056*t3125 + t3060*t3129 + t3064*t3133
     t3136 = t3079*t3114 + t3083*t3118 + t3087*t3122 + t3091*t3126 + t3095*t3130 + t3099*t3134
     t3137 = xp.not_equal(t3135, 0)
-    t3138 = 0.5*(-t3109 + t3040)/xp.where(t3137, t3135, 1)
+    t3138 = (-t3109 + t3040)/xp.where(t3137, 2*t3135, 1)
     t3139 = xp.abs(t3138)
     t3140 = xp.greater_equal(t3139, 1)
-    t3141 = xp.abs(1/xp.where(t3140, t3138, 1))
+    t3141 = 1/xp.abs(xp.where(t3140, t3138, 1))
     t3142 = xp.where(t3137, xp.where(xp.greater_equal(t3138, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3140, t3141/(1 + xp.sqrt(1 + t3141**2)), 1/(t3139 + xp.sqrt(1 + t3139**2))), 0)
     t3143 = 1/xp.sqrt(1 + t3142**2)
     t3144 = t3135*t3142
@@ -6928,10 +6928,10 @@ def condition_number(q):
     t3169 = t3167 - t3142*t3168
     t3170 = t3168 + t3142*t3167
     t3171 = xp.not_equal(t3136, 0)
-    t3172 = 0.5*(-t3075 + t3110)/xp.where(t3171, t3136, 1)
+    t3172 = (-t3075 + t3110)/xp.where(t3171, 2*t3136, 1)
     t3173 = xp.abs(t3172)
     t3174 = xp.greater_equal(t3173, 1)
-    t3175 = xp.abs(1/xp.where(t3174, t3172, 1))
+    t3175 = 1/xp.abs(xp.where(t3174, t3172, 1))
     t3176 = xp.where(t3171, xp.where(xp.greater_equal(t3172, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3174, t3175/(1 + xp.sqrt(1 + t3175**2)), 1/(t3173 + xp.sqrt(1 + t3173**2))), 0)
     t3177 = 1/xp.sqrt(1 + t3176**2)
     t3178 = t3136*t3176
@@ -6963,10 +6963,10 @@ def condition_number(q):
     t3204 = t3202 + t3176*t3201
     t3205 = t3150*t3183 + t3154*t3187 + t3158*t3191 + t3162*t3195 + t3166*t3199 + t3170*t3203
     t3206 = xp.not_equal(t3205, 0)
-    t3207 = 0.5*(-t3179 + t3146)/xp.where(t3206, t3205, 1)
+    t3207 = (-t3179 + t3146)/xp.where(t3206, 2*t3205, 1)
     t3208 = xp.abs(t3207)
     t3209 = xp.greater_equal(t3208, 1)
-    t3210 = xp.abs(1/xp.where(t3209, t3207, 1))
+    t3210 = 1/xp.abs(xp.where(t3209, t3207, 1))
     t3211 = xp.where(t3206, xp.where(xp.greater_equal(t3207, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3209, t3210/(1 + xp.sqrt(1 + t3210**2)), 1/(t3208 + xp.sqrt(1 + t3208**2))), 0)
     t3212 = 1/xp.sqrt(1 + t3211**2)
     t3213 = t3205*t3211
@@ -6998,10 +6998,10 @@ def condition_number(q):
     t3239 = t3237 + t3211*t3236
     t3240 = t3184*t3219 + t3188*t3223 + t3192*t3227 + t3196*t3231 + t3200*t3235 + t3204*t3239
     t3241 = xp.not_equal(t3240, 0)
-    t3242 = 0.5*(-t3180 + t3215)/xp.where(t3241, t3240, 1)
+    t3242 = (-t3180 + t3215)/xp.where(t3241, 2*t3240, 1)
     t3243 = xp.abs(t3242)
     t3244 = xp.greater_equal(t3243, 1)
-    t3245 = xp.abs(1/xp.where(t3244, t3242, 1))
+    t3245 = 1/xp.abs(xp.where(t3244, t3242, 1))
     t3246 = xp.where(t3241, xp.where(xp.greater_equal(t3242, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3244, t3245/(1 + xp.sqrt(1 + t3245**2)), 1/(t3243 + xp.sqrt(1 + t3243**2))), 0)
     t3247 = 1/xp.sqrt(1 + t3246**2)
     t3248 = t3240*t3246
@@ -7032,10 +7032,10 @@ def condition_number(q):
     t3273 = t3271 - t3246*t3272
     t3274 = t3272 + t3246*t3271
     t3275 = xp.not_equal(t3065, 0)
-    t3276 = 0.5*(-t2899 + t3039)/xp.where(t3275, t3065, 1)
+    t3276 = (-t2899 + t3039)/xp.where(t3275, 2*t3065, 1)
     t3277 = xp.abs(t3276)
     t3278 = xp.greater_equal(t3277, 1)
-    t3279 = xp.abs(1/xp.where(t3278, t3276, 1))
+    t3279 = 1/xp.abs(xp.where(t3278, t3276, 1))
     t3280 = xp.where(t3275, xp.where(xp.greater_equal(t3276, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3278, t3279/(1 + xp.sqrt(1 + t3279**2)), 1/(t3277 + xp.sqrt(1 + t3277**2))), 0)
     t3281 = 1/xp.sqrt(1 + t3280**2)
     t3282 = t3065*t3280
@@ -7067,10 +7067,10 @@ def condition_number(q):
     t3308 = t3306 + t3280*t3305
     t3309 = t3149*t3287 + t3153*t3291 + t3157*t3295 + t3161*t3299 + t3165*t3303 + t3169*t3307
     t3310 = xp.not_equal(t3309, 0)
-    t3311 = 0.5*(-t3283 + t3145)/xp.where(t3310, t3309, 1)
+    t3311 = (-t3283 + t3145)/xp.where(t3310, 2*t3309, 1)
     t3312 = xp.abs(t3311)
     t3313 = xp.greater_equal(t3312, 1)
-    t3314 = xp.abs(1/xp.where(t3313, t3311, 1))
+    t3314 = 1/xp.abs(xp.where(t3313, t3311, 1))
     t3315 = xp.where(t3310, xp.where(xp.greater_equal(t3311, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3313, t3314/(1 + xp.sqrt(1 + t3314**2)), 1/(t3312 + xp.sqrt(1 + t3312**2))), 0)
     t3316 = 1/xp.sqrt(1 + t3315**2)
     t3317 = t3309*t3315
@@ -7103,10 +7103,10 @@ def condition_number(q):
     t3344 = t3218*t3322 + t3222*t3326 + t3226*t3330 + t3230*t3334 + t3234*t3338 + t3238*t3342
     t3345 = t3288*t3323 + t3292*t3327 + t3296*t3331 + t3300*t3335 + t3304*t3339 + t3308*t3343
     t3346 = xp.not_equal(t3344, 0)
-    t3347 = 0.5*(-t3318 + t3214)/xp.where(t3346, t3344, 1)
+    t3347 = (-t3318 + t3214)/xp.where(t3346, 2*t3344, 1)
     t3348 = xp.abs(t3347)
     t3349 = xp.greater_equal(t3348, 1)
-    t3350 = xp.abs(1/xp.where(t3349, t3347, 1))
+    t3350 = 1/xp.abs(xp.where(t3349, t3347, 1))
     t3351 = xp.where(t3346, xp.where(xp.greater_equal(t3347, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3349, t3350/(1 + xp.sqrt(1 + t3350**2)), 1/(t3348 + xp.sqrt(1 + t3348**2))), 0)
     t3352 = 1/xp.sqrt(1 + t3351**2)
     t3353 = t3344*t3351
@@ -7138,10 +7138,10 @@ def condition_number(q):
     t3379 = t3377 + t3351*t3376
     t3380 = t3253*t3358 + t3257*t3362 + t3261*t3366 + t3265*t3370 + t3269*t3374 + t3273*t3378
     t3381 = xp.not_equal(t3380, 0)
-    t3382 = 0.5*(-t3354 + t3249)/xp.where(t3381, t3380, 1)
+    t3382 = (-t3354 + t3249)/xp.where(t3381, 2*t3380, 1)
     t3383 = xp.abs(t3382)
     t3384 = xp.greater_equal(t3383, 1)
-    t3385 = xp.abs(1/xp.where(t3384, t3382, 1))
+    t3385 = 1/xp.abs(xp.where(t3384, t3382, 1))
     t3386 = xp.where(t3381, xp.where(xp.greater_equal(t3382, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3384, t3385/(1 + xp.sqrt(1 + t3385**2)), 1/(t3383 + xp.sqrt(1 + t3383**2))), 0)
     t3387 = 1/xp.sqrt(1 + t3386**2)
     t3388 = t3380*t3386
@@ -7173,10 +7173,10 @@ def condition_number(q):
     t3414 = t3412 + t3386*t3411
     t3415 = t3254*t3393 + t3258*t3397 + t3262*t3401 + t3266*t3405 + t3270*t3409 + t3274*t3413
     t3416 = xp.not_equal(t3415, 0)
-    t3417 = 0.5*(-t3389 + t3250)/xp.where(t3416, t3415, 1)
+    t3417 = (-t3389 + t3250)/xp.where(t3416, 2*t3415, 1)
     t3418 = xp.abs(t3417)
     t3419 = xp.greater_equal(t3418, 1)
-    t3420 = xp.abs(1/xp.where(t3419, t3417, 1))
+    t3420 = 1/xp.abs(xp.where(t3419, t3417, 1))
     t3421 = xp.where(t3416, xp.where(xp.greater_equal(t3417, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3419, t3420/(1 + xp.sqrt(1 + t3420**2)), 1/(t3418 + xp.sqrt(1 + t3418**2))), 0)
     t3422 = 1/xp.sqrt(1 + t3421**2)
     t3423 = t3250 + t3415*t3421
@@ -7206,10 +7206,10 @@ def condition_number(q):
     t3447 = t3445 + t3421*t3444
     t3448 = xp.sqrt(t3426**2 + t3430**2 + t3434**2 + t3438**2 + t3442**2 + t3446**2)
     t3449 = xp.not_equal(t3345, 0)
-    t3450 = 0.5*(-t3284 + t3319)/xp.where(t3449, t3345, 1)
+    t3450 = (-t3284 + t3319)/xp.where(t3449, 2*t3345, 1)
     t3451 = xp.abs(t3450)
     t3452 = xp.greater_equal(t3451, 1)
-    t3453 = xp.abs(1/xp.where(t3452, t3450, 1))
+    t3453 = 1/xp.abs(xp.where(t3452, t3450, 1))
     t3454 = xp.where(t3449, xp.where(xp.greater_equal(t3450, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3452, t3453/(1 + xp.sqrt(1 + t3453**2)), 1/(t3451 + xp.sqrt(1 + t3451**2))), 0)
     t3455 = 1/xp.sqrt(1 + t3454**2)
     t3456 = t3345*t3454
@@ -7241,10 +7241,10 @@ def condition_number(q):
     t3482 = t3480 + t3454*t3479
     t3483 = t3359*t3461 + t3363*t3465 + t3367*t3469 + t3371*t3473 + t3375*t3477 + t3379*t3481
     t3484 = xp.not_equal(t3483, 0)
-    t3485 = 0.5*(-t3457 + t3355)/xp.where(t3484, t3483, 1)
+    t3485 = (-t3457 + t3355)/xp.where(t3484, 2*t3483, 1)
     t3486 = xp.abs(t3485)
     t3487 = xp.greater_equal(t3486, 1)
-    t3488 = xp.abs(1/xp.where(t3487, t3485, 1))
+    t3488 = 1/xp.abs(xp.where(t3487, t3485, 1))
     t3489 = xp.where(t3484, xp.where(xp.greater_equal(t3485, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3487, t3488/(1 + xp.sqrt(1 + t3488**2)), 1/(t3486 + xp.sqrt(1 + t3486**2))), 0)
     t3490 = 1/xp.sqrt(1 + t3489**2)
     t3491 = t3483*t3489
@@ -7277,10 +7277,10 @@ def condition_number(q):
     t3518 = t3394*t3496 + t3398*t3500 + t3402*t3504 + t3406*t3508 + t3410*t3512 + t3414*t3516
     t3519 = t3462*t3497 + t3466*t3501 + t3470*t3505 + t3474*t3509 + t3478*t3513 + t3482*t3517
     t3520 = xp.not_equal(t3518, 0)
-    t3521 = 0.5*(-t3492 + t3390)/xp.where(t3520, t3518, 1)
+    t3521 = (-t3492 + t3390)/xp.where(t3520, 2*t3518, 1)
     t3522 = xp.abs(t3521)
     t3523 = xp.greater_equal(t3522, 1)
-    t3524 = xp.abs(1/xp.where(t3523, t3521, 1))
+    t3524 = 1/xp.abs(xp.where(t3523, t3521, 1))
     t3525 = xp.where(t3520, xp.where(xp.greater_equal(t3521, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3523, t3524/(1 + xp.sqrt(1 + t3524**2)), 1/(t3522 + xp.sqrt(1 + t3522**2))), 0)
     t3526 = 1/xp.sqrt(1 + t3525**2)
     t3527 = t3518*t3525
@@ -7312,10 +7312,10 @@ def condition_number(q):
     t3553 = t3551 + t3525*t3550
     t3554 = t3427*t3532 + t3431*t3536 + t3435*t3540 + t3439*t3544 + t3443*t3548 + t3447*t3552
     t3555 = xp.not_equal(t3554, 0)
-    t3556 = 0.5*(-t3528 + t3423)/xp.where(t3555, t3554, 1)
+    t3556 = (-t3528 + t3423)/xp.where(t3555, 2*t3554, 1)
     t3557 = xp.abs(t3556)
     t3558 = xp.greater_equal(t3557, 1)
-    t3559 = xp.abs(1/xp.where(t3558, t3556, 1))
+    t3559 = 1/xp.abs(xp.where(t3558, t3556, 1))
     t3560 = xp.where(t3555, xp.where(xp.greater_equal(t3556, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3558, t3559/(1 + xp.sqrt(1 + t3559**2)), 1/(t3557 + xp.sqrt(1 + t3557**2))), 0)
     t3561 = 1/xp.sqrt(1 + t3560**2)
     t3562 = t3423 + t3554*t3560
@@ -7347,10 +7347,10 @@ def condition_number(q):
     t3588 = xp.where(xp.greater(t3587, t3448), t3587, t3448)
     t3589 = xp.where(xp.less(t3587, t3448), t3587, t3448)
     t3590 = xp.not_equal(t3519, 0)
-    t3591 = 0.5*(-t3458 + t3493)/xp.where(t3590, t3519, 1)
+    t3591 = (-t3458 + t3493)/xp.where(t3590, 2*t3519, 1)
     t3592 = xp.abs(t3591)
     t3593 = xp.greater_equal(t3592, 1)
-    t3594 = xp.abs(1/xp.where(t3593, t3591, 1))
+    t3594 = 1/xp.abs(xp.where(t3593, t3591, 1))
     t3595 = xp.where(t3590, xp.where(xp.greater_equal(t3591, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3593, t3594/(1 + xp.sqrt(1 + t3594**2)), 1/(t3592 + xp.sqrt(1 + t3592**2))), 0)
     t3596 = 1/xp.sqrt(1 + t3595**2)
     t3597 = t3519*t3595
@@ -7382,10 +7382,10 @@ def condition_number(q):
     t3623 = t3621 + t3595*t3620
     t3624 = t3533*t3602 + t3537*t3606 + t3541*t3610 + t3545*t3614 + t3549*t3618 + t3553*t3622
     t3625 = xp.not_equal(t3624, 0)
-    t3626 = 0.5*(-t3598 + t3529)/xp.where(t3625, t3624, 1)
+    t3626 = (-t3598 + t3529)/xp.where(t3625, 2*t3624, 1)
     t3627 = xp.abs(t3626)
     t3628 = xp.greater_equal(t3627, 1)
-    t3629 = xp.abs(1/xp.where(t3628, t3626, 1))
+    t3629 = 1/xp.abs(xp.where(t3628, t3626, 1))
     t3630 = xp.where(t3625, xp.where(xp.greater_equal(t3626, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3628, t3629/(1 + xp.sqrt(1 + t3629**2)), 1/(t3627 + xp.sqrt(1 + t3627**2))), 0)
     t3631 = 1/xp.sqrt(1 + t3630**2)
     t3632 = t3624*t3630
@@ -7418,10 +7418,10 @@ def condition_number(q):
     t3659 = t3566*t3637 + t3570*t3641 + t3574*t3645 + t3578*t3649 + t3582*t3653 + t3586*t3657
     t3660 = t3603*t3638 + t3607*t3642 + t3611*t3646 + t3615*t3650 + t3619*t3654 + t3623*t3658
     t3661 = xp.not_equal(t3659, 0)
-    t3662 = 0.5*(-t3633 + t3562)/xp.where(t3661, t3659, 1)
+    t3662 = (-t3633 + t3562)/xp.where(t3661, 2*t3659, 1)
     t3663 = xp.abs(t3662)
     t3664 = xp.greater_equal(t3663, 1)
-    t3665 = xp.abs(1/xp.where(t3664, t3662, 1))
+    t3665 = 1/xp.abs(xp.where(t3664, t3662, 1))
     t3666 = xp.where(t3661, xp.where(xp.greater_equal(t3662, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3664, t3665/(1 + xp.sqrt(1 + t3665**2)), 1/(t3663 + xp.sqrt(1 + t3663**2))), 0)
     t3667 = 1/xp.sqrt(1 + t3666**2)
     t3668 = t3562 + t3659*t3666
@@ -7453,10 +7453,10 @@ def condition_number(q):
     t3694 = xp.where(xp.greater(t3693, t3588), t3693, t3588)
     t3695 = xp.where(xp.less(t3693, t3589), t3693, t3589)
     t3696 = xp.not_equal(t3660, 0)
-    t3697 = 0.5*(-t3599 + t3634)/xp.where(t3696, t3660, 1)
+    t3697 = (-t3599 + t3634)/xp.where(t3696, 2*t3660, 1)
     t3698 = xp.abs(t3697)
     t3699 = xp.greater_equal(t3698, 1)
-    t3700 = xp.abs(1/xp.where(t3699, t3697, 1))
+    t3700 = 1/xp.abs(xp.where(t3699, t3697, 1))
     t3701 = xp.where(t3696, xp.where(xp.greater_equal(t3697, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3699, t3700/(1 + xp.sqrt(1 + t3700**2)), 1/(t3698 + xp.sqrt(1 + t3698**2))), 0)
     t3702 = 1/xp.sqrt(1 + t3701**2)
     t3703 = t3660*t3701
@@ -7488,10 +7488,10 @@ def condition_number(q):
     t3729 = t3727 + t3701*t3726
     t3730 = t3672*t3708 + t3676*t3712 + t3680*t3716 + t3684*t3720 + t3688*t3724 + t3692*t3728
     t3731 = xp.not_equal(t3730, 0)
-    t3732 = 0.5*(-t3704 + t3668)/xp.where(t3731, t3730, 1)
+    t3732 = (-t3704 + t3668)/xp.where(t3731, 2*t3730, 1)
     t3733 = xp.abs(t3732)
     t3734 = xp.greater_equal(t3733, 1)
-    t3735 = xp.abs(1/xp.where(t3734, t3732, 1))
+    t3735 = 1/xp.abs(xp.where(t3734, t3732, 1))
     t3736 = xp.where(t3731, xp.where(xp.greater_equal(t3732, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3734, t3735/(1 + xp.sqrt(1 + t3735**2)), 1/(t3733 + xp.sqrt(1 + t3733**2))), 0)
     t3737 = 1/xp.sqrt(1 + t3736**2)
     t3738 = t3668 + t3730*t3736
@@ -7524,10 +7524,10 @@ def condition_number(q):
     t3765 = xp.where(xp.greater(t3764, t3694), t3764, t3694)
     t3766 = xp.where(xp.less(t3764, t3695), t3764, t3695)
     t3767 = xp.not_equal(t3763, 0)
-    t3768 = 0.5*(-t3705 + t3738)/xp.where(t3767, t3763, 1)
+    t3768 = (-t3705 + t3738)/xp.where(t3767, 2*t3763, 1)
     t3769 = xp.abs(t3768)
     t3770 = xp.greater_equal(t3769, 1)
-    t3771 = xp.abs(1/xp.where(t3770, t3768, 1))
+    t3771 = 1/xp.abs(xp.where(t3770, t3768, 1))
     t3772 = xp.where(t3767, xp.where(xp.greater_equal(t3768, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3770, t3771/(1 + xp.sqrt(1 + t3771**2)), 1/(t3769 + xp.sqrt(1 + t3769**2))), 0)
     t3773 = 1/xp.sqrt(1 + t3772**2)
     t3774 = t3709*t3773
@@ -7560,7 +7560,9 @@ def condition_number(q):
     t3801 = xp.where(xp.less(t3798, t3766), t3798, t3766)
     t3802 = xp.where(xp.greater(t3799, t3800), t3799, t3800)
     t3803 = xp.where(xp.less(t3799, t3801), t3799, t3801)
-    kappa = xp.broadcast_to(xp.where(xp.greater(t3802, 0), t3802, 1)/xp.where(xp.less_equal(t3803, 1e-12*t3802), 0, t3803), batch)
+    t3804 = xp.where(xp.less_equal(t3803, 1e-12*t3802), 0, t3803)
+    t3805 = xp.where(xp.greater(t3802, 0), t3802, 1)
+    kappa = xp.broadcast_to(t3805/t3804, batch)
     return kappa
 
 

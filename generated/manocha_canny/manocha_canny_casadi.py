@@ -2384,10 +2384,10 @@ def _velocity_ellipsoid(q):
     t86 = t84**2
     t87 = t60*t66
     t88 = (t87 != 0)
-    t89 = 0.5*(-t63 + t85)/casadi.if_else(t88, -t87, 1)
+    t89 = (-t63 + t85)/casadi.if_else(t88, -2*t87, 1)
     t90 = casadi.fabs(t89)
     t91 = (t90 >= 1)
-    t92 = casadi.fabs(1/casadi.if_else(t91, t89, 1))
+    t92 = 1/casadi.fabs(casadi.if_else(t91, t89, 1))
     t93 = casadi.if_else(t88, casadi.if_else((t89 >= 0), 1, -1)*casadi.if_else(t91, t92/(1 + casadi.sqrt(1 + t92**2)), 1/(t90 + casadi.sqrt(1 + t90**2))), 0)
     t94 = 1/casadi.sqrt(1 + t93**2)
     t95 = t87*t93
@@ -2403,10 +2403,10 @@ def _velocity_ellipsoid(q):
     t105 = t104*t93
     t106 = t102*t100 + t105*t80
     t107 = (t106 != 0)
-    t108 = 0.5*(-t96 + t103)/casadi.if_else(t107, t106, 1)
+    t108 = (-t96 + t103)/casadi.if_else(t107, 2*t106, 1)
     t109 = casadi.fabs(t108)
     t110 = (t109 >= 1)
-    t111 = casadi.fabs(1/casadi.if_else(t110, t108, 1))
+    t111 = 1/casadi.fabs(casadi.if_else(t110, t108, 1))
     t112 = casadi.if_else(t107, casadi.if_else((t108 >= 0), 1, -1)*casadi.if_else(t110, t111/(1 + casadi.sqrt(1 + t111**2)), 1/(t109 + casadi.sqrt(1 + t109**2))), 0)
     t113 = 1/casadi.sqrt(1 + t112**2)
     t114 = t106*t112
@@ -2422,10 +2422,10 @@ def _velocity_ellipsoid(q):
     t124 = t122 + t121*t112
     t125 = t101*t120 + t104*t124
     t126 = (t125 != 0)
-    t127 = 0.5*(-t97 + t116)/casadi.if_else(t126, -t125, 1)
+    t127 = (-t97 + t116)/casadi.if_else(t126, -2*t125, 1)
     t128 = casadi.fabs(t127)
     t129 = (t128 >= 1)
-    t130 = casadi.fabs(1/casadi.if_else(t129, t127, 1))
+    t130 = 1/casadi.fabs(casadi.if_else(t129, t127, 1))
     t131 = casadi.if_else(t126, casadi.if_else((t127 >= 0), 1, -1)*casadi.if_else(t129, t130/(1 + casadi.sqrt(1 + t130**2)), 1/(t128 + casadi.sqrt(1 + t128**2))), 0)
     t132 = 1/casadi.sqrt(1 + t131**2)
     t133 = t125*t131
@@ -2451,10 +2451,10 @@ def _velocity_ellipsoid(q):
     t153 = t131*t132
     t154 = t119*t138 - t123*t143 + t86*t147*t153*t113
     t155 = (t154 != 0)
-    t156 = 0.5*(-t115 + t134)/casadi.if_else(t155, t154, 1)
+    t156 = (-t115 + t134)/casadi.if_else(t155, 2*t154, 1)
     t157 = casadi.fabs(t156)
     t158 = (t157 >= 1)
-    t159 = casadi.fabs(1/casadi.if_else(t158, t156, 1))
+    t159 = 1/casadi.fabs(casadi.if_else(t158, t156, 1))
     t160 = casadi.if_else(t155, casadi.if_else((t156 >= 0), 1, -1)*casadi.if_else(t158, t159/(1 + casadi.sqrt(1 + t159**2)), 1/(t157 + casadi.sqrt(1 + t157**2))), 0)
     t161 = 1/casadi.sqrt(1 + t160**2)
     t162 = t154*t160
@@ -2488,10 +2488,10 @@ def _velocity_ellipsoid(q):
     t190 = t113*t132
     t191 = t139*t167 + t144*t171 - t84*t190*t180
     t192 = (t191 != 0)
-    t193 = 0.5*(-t163 + t135)/casadi.if_else(t192, t191, 1)
+    t193 = (-t163 + t135)/casadi.if_else(t192, 2*t191, 1)
     t194 = casadi.fabs(t193)
     t195 = (t194 >= 1)
-    t196 = casadi.fabs(1/casadi.if_else(t195, t193, 1))
+    t196 = 1/casadi.fabs(casadi.if_else(t195, t193, 1))
     t197 = casadi.if_else(t192, casadi.if_else((t193 >= 0), 1, -1)*casadi.if_else(t195, t196/(1 + casadi.sqrt(1 + t196**2)), 1/(t194 + casadi.sqrt(1 + t194**2))), 0)
     t198 = 1/casadi.sqrt(1 + t197**2)
     t199 = t191*t197
@@ -2523,10 +2523,10 @@ def _velocity_ellipsoid(q):
     t225 = t224 - t211*t197
     t226 = t211 + t224*t197
     t227 = (t215 != 0)
-    t228 = 0.5*(-t164 + t201)/casadi.if_else(t227, t215, 1)
+    t228 = (-t164 + t201)/casadi.if_else(t227, 2*t215, 1)
     t229 = casadi.fabs(t228)
     t230 = (t229 >= 1)
-    t231 = casadi.fabs(1/casadi.if_else(t230, t228, 1))
+    t231 = 1/casadi.fabs(casadi.if_else(t230, t228, 1))
     t232 = casadi.if_else(t227, casadi.if_else((t228 >= 0), 1, -1)*casadi.if_else(t230, t231/(1 + casadi.sqrt(1 + t231**2)), 1/(t229 + casadi.sqrt(1 + t229**2))), 0)
     t233 = 1/casadi.sqrt(1 + t232**2)
     t234 = t215*t232
@@ -2558,10 +2558,10 @@ def _velocity_ellipsoid(q):
     t260 = t258 + t259*t232
     t261 = t259 - t258*t232
     t262 = (t249 != 0)
-    t263 = 0.5*(-t200 + t235)/casadi.if_else(t262, t249, 1)
+    t263 = (-t200 + t235)/casadi.if_else(t262, 2*t249, 1)
     t264 = casadi.fabs(t263)
     t265 = (t264 >= 1)
-    t266 = casadi.fabs(1/casadi.if_else(t265, t263, 1))
+    t266 = 1/casadi.fabs(casadi.if_else(t265, t263, 1))
     t267 = casadi.if_else(t262, casadi.if_else((t263 >= 0), 1, -1)*casadi.if_else(t265, t266/(1 + casadi.sqrt(1 + t266**2)), 1/(t264 + casadi.sqrt(1 + t264**2))), 0)
     t268 = 1/casadi.sqrt(1 + t267**2)
     t269 = t249*t267
@@ -2593,10 +2593,10 @@ def _velocity_ellipsoid(q):
     t295 = t293 + t267*t294
     t296 = -t294 + t267*t293
     t297 = (t284 != 0)
-    t298 = 0.5*(-t270 + t236)/casadi.if_else(t297, t284, 1)
+    t298 = (-t270 + t236)/casadi.if_else(t297, 2*t284, 1)
     t299 = casadi.fabs(t298)
     t300 = (t299 >= 1)
-    t301 = casadi.fabs(1/casadi.if_else(t300, t298, 1))
+    t301 = 1/casadi.fabs(casadi.if_else(t300, t298, 1))
     t302 = casadi.if_else(t297, casadi.if_else((t298 >= 0), 1, -1)*casadi.if_else(t300, t301/(1 + casadi.sqrt(1 + t301**2)), 1/(t299 + casadi.sqrt(1 + t299**2))), 0)
     t303 = 1/casadi.sqrt(1 + t302**2)
     t304 = t284*t302
@@ -2628,10 +2628,10 @@ def _velocity_ellipsoid(q):
     t330 = t328 - t302*t329
     t331 = t329 + t302*t328
     t332 = (t319 != 0)
-    t333 = 0.5*(-t271 + t306)/casadi.if_else(t332, t319, 1)
+    t333 = (-t271 + t306)/casadi.if_else(t332, 2*t319, 1)
     t334 = casadi.fabs(t333)
     t335 = (t334 >= 1)
-    t336 = casadi.fabs(1/casadi.if_else(t335, t333, 1))
+    t336 = 1/casadi.fabs(casadi.if_else(t335, t333, 1))
     t337 = casadi.if_else(t332, casadi.if_else((t333 >= 0), 1, -1)*casadi.if_else(t335, t336/(1 + casadi.sqrt(1 + t336**2)), 1/(t334 + casadi.sqrt(1 + t334**2))), 0)
     t338 = 1/casadi.sqrt(1 + t337**2)
     t339 = t319*t337
@@ -2663,10 +2663,10 @@ def _velocity_ellipsoid(q):
     t365 = t363 - t337*t364
     t366 = t364 + t337*t363
     t367 = (t354 != 0)
-    t368 = 0.5*(-t305 + t340)/casadi.if_else(t367, t354, 1)
+    t368 = (-t305 + t340)/casadi.if_else(t367, 2*t354, 1)
     t369 = casadi.fabs(t368)
     t370 = (t369 >= 1)
-    t371 = casadi.fabs(1/casadi.if_else(t370, t368, 1))
+    t371 = 1/casadi.fabs(casadi.if_else(t370, t368, 1))
     t372 = casadi.if_else(t367, casadi.if_else((t368 >= 0), 1, -1)*casadi.if_else(t370, t371/(1 + casadi.sqrt(1 + t371**2)), 1/(t369 + casadi.sqrt(1 + t369**2))), 0)
     t373 = 1/casadi.sqrt(1 + t372**2)
     t374 = t354*t372
@@ -2698,10 +2698,10 @@ def _velocity_ellipsoid(q):
     t400 = t398 - t372*t399
     t401 = t399 + t372*t398
     t402 = (t389 != 0)
-    t403 = 0.5*(-t375 + t341)/casadi.if_else(t402, t389, 1)
+    t403 = (-t375 + t341)/casadi.if_else(t402, 2*t389, 1)
     t404 = casadi.fabs(t403)
     t405 = (t404 >= 1)
-    t406 = casadi.fabs(1/casadi.if_else(t405, t403, 1))
+    t406 = 1/casadi.fabs(casadi.if_else(t405, t403, 1))
     t407 = casadi.if_else(t402, casadi.if_else((t403 >= 0), 1, -1)*casadi.if_else(t405, t406/(1 + casadi.sqrt(1 + t406**2)), 1/(t404 + casadi.sqrt(1 + t404**2))), 0)
     t408 = 1/casadi.sqrt(1 + t407**2)
     t409 = t389*t407
@@ -2733,10 +2733,10 @@ def _velocity_ellipsoid(q):
     t435 = t433 - t407*t434
     t436 = t434 + t407*t433
     t437 = (t424 != 0)
-    t438 = 0.5*(-t376 + t411)/casadi.if_else(t437, t424, 1)
+    t438 = (-t376 + t411)/casadi.if_else(t437, 2*t424, 1)
     t439 = casadi.fabs(t438)
     t440 = (t439 >= 1)
-    t441 = casadi.fabs(1/casadi.if_else(t440, t438, 1))
+    t441 = 1/casadi.fabs(casadi.if_else(t440, t438, 1))
     t442 = casadi.if_else(t437, casadi.if_else((t438 >= 0), 1, -1)*casadi.if_else(t440, t441/(1 + casadi.sqrt(1 + t441**2)), 1/(t439 + casadi.sqrt(1 + t439**2))), 0)
     t443 = 1/casadi.sqrt(1 + t442**2)
     t444 = t424*t442
@@ -2768,10 +2768,10 @@ def _velocity_ellipsoid(q):
     t470 = t468 - t442*t469
     t471 = t469 + t442*t468
     t472 = (t459 != 0)
-    t473 = 0.5*(-t410 + t445)/casadi.if_else(t472, t459, 1)
+    t473 = (-t410 + t445)/casadi.if_else(t472, 2*t459, 1)
     t474 = casadi.fabs(t473)
     t475 = (t474 >= 1)
-    t476 = casadi.fabs(1/casadi.if_else(t475, t473, 1))
+    t476 = 1/casadi.fabs(casadi.if_else(t475, t473, 1))
     t477 = casadi.if_else(t472, casadi.if_else((t473 >= 0), 1, -1)*casadi.if_else(t475, t476/(1 + casadi.sqrt(1 + t476**2)), 1/(t474 + casadi.sqrt(1 + t474**2))), 0)
     t478 = 1/casadi.sqrt(1 + t477**2)
     t479 = t459*t477
@@ -2803,10 +2803,10 @@ def _velocity_ellipsoid(q):
     t505 = t503 - t477*t504
     t506 = t504 + t477*t503
     t507 = (t494 != 0)
-    t508 = 0.5*(-t480 + t446)/casadi.if_else(t507, t494, 1)
+    t508 = (-t480 + t446)/casadi.if_else(t507, 2*t494, 1)
     t509 = casadi.fabs(t508)
     t510 = (t509 >= 1)
-    t511 = casadi.fabs(1/casadi.if_else(t510, t508, 1))
+    t511 = 1/casadi.fabs(casadi.if_else(t510, t508, 1))
     t512 = casadi.if_else(t507, casadi.if_else((t508 >= 0), 1, -1)*casadi.if_else(t510, t511/(1 + casadi.sqrt(1 + t511**2)), 1/(t509 + casadi.sqrt(1 + t509**2))), 0)
     t513 = 1/casadi.sqrt(1 + t512**2)
     t514 = t446 + t494*t512
@@ -2837,10 +2837,10 @@ def _velocity_ellipsoid(q):
     t539 = t537 - t512*t538
     t540 = t538 + t512*t537
     t541 = (t527 != 0)
-    t542 = 0.5*(-t481 + t514)/casadi.if_else(t541, t527, 1)
+    t542 = (-t481 + t514)/casadi.if_else(t541, 2*t527, 1)
     t543 = casadi.fabs(t542)
     t544 = (t543 >= 1)
-    t545 = casadi.fabs(1/casadi.if_else(t544, t542, 1))
+    t545 = 1/casadi.fabs(casadi.if_else(t544, t542, 1))
     t546 = casadi.if_else(t541, casadi.if_else((t542 >= 0), 1, -1)*casadi.if_else(t544, t545/(1 + casadi.sqrt(1 + t545**2)), 1/(t543 + casadi.sqrt(1 + t543**2))), 0)
     t547 = 1/casadi.sqrt(1 + t546**2)
     t548 = t485*t547
@@ -2934,10 +2934,10 @@ def _velocity_ellipsoid(q):
     t636 = t635**2
     t637 = t616**2 + t629**2 + t636
     t638 = (t626 != 0)
-    t639 = 0.5*(-t607 + t625)/casadi.if_else(t638, t626, 1)
+    t639 = (-t607 + t625)/casadi.if_else(t638, 2*t626, 1)
     t640 = casadi.fabs(t639)
     t641 = (t640 >= 1)
-    t642 = casadi.fabs(1/casadi.if_else(t641, t639, 1))
+    t642 = 1/casadi.fabs(casadi.if_else(t641, t639, 1))
     t643 = casadi.if_else(t638, casadi.if_else((t639 >= 0), 1, -1)*casadi.if_else(t641, t642/(1 + casadi.sqrt(1 + t642**2)), 1/(t640 + casadi.sqrt(1 + t640**2))), 0)
     t644 = 1/casadi.sqrt(1 + t643**2)
     t645 = t626*t643
@@ -2951,10 +2951,10 @@ def _velocity_ellipsoid(q):
     t653 = t643*t652
     t654 = t616*t650 - t629*t653
     t655 = (t654 != 0)
-    t656 = 0.5*(-t646 + t637)/casadi.if_else(t655, t654, 1)
+    t656 = (-t646 + t637)/casadi.if_else(t655, 2*t654, 1)
     t657 = casadi.fabs(t656)
     t658 = (t657 >= 1)
-    t659 = casadi.fabs(1/casadi.if_else(t658, t656, 1))
+    t659 = 1/casadi.fabs(casadi.if_else(t658, t656, 1))
     t660 = casadi.if_else(t655, casadi.if_else((t656 >= 0), 1, -1)*casadi.if_else(t658, t659/(1 + casadi.sqrt(1 + t659**2)), 1/(t657 + casadi.sqrt(1 + t657**2))), 0)
     t661 = 1/casadi.sqrt(1 + t660**2)
     t662 = t654*t660
@@ -2970,10 +2970,10 @@ def _velocity_ellipsoid(q):
     t672 = -t670 + t660*t669
     t673 = t651*t668 + t672*t652
     t674 = (t673 != 0)
-    t675 = 0.5*(-t647 + t664)/casadi.if_else(t674, -t673, 1)
+    t675 = (-t647 + t664)/casadi.if_else(t674, -2*t673, 1)
     t676 = casadi.fabs(t675)
     t677 = (t676 >= 1)
-    t678 = casadi.fabs(1/casadi.if_else(t677, t675, 1))
+    t678 = 1/casadi.fabs(casadi.if_else(t677, t675, 1))
     t679 = casadi.if_else(t674, casadi.if_else((t675 >= 0), 1, -1)*casadi.if_else(t677, t678/(1 + casadi.sqrt(1 + t678**2)), 1/(t676 + casadi.sqrt(1 + t676**2))), 0)
     t680 = 1/casadi.sqrt(1 + t679**2)
     t681 = t673*t679
@@ -2999,10 +2999,10 @@ def _velocity_ellipsoid(q):
     t701 = t679*t680
     t702 = t667*t686 + t671*t691 - t661*t636*t695*t701
     t703 = (t702 != 0)
-    t704 = 0.5*(-t663 + t682)/casadi.if_else(t703, -t702, 1)
+    t704 = (-t663 + t682)/casadi.if_else(t703, -2*t702, 1)
     t705 = casadi.fabs(t704)
     t706 = (t705 >= 1)
-    t707 = casadi.fabs(1/casadi.if_else(t706, t704, 1))
+    t707 = 1/casadi.fabs(casadi.if_else(t706, t704, 1))
     t708 = casadi.if_else(t703, casadi.if_else((t704 >= 0), 1, -1)*casadi.if_else(t706, t707/(1 + casadi.sqrt(1 + t707**2)), 1/(t705 + casadi.sqrt(1 + t705**2))), 0)
     t709 = 1/casadi.sqrt(1 + t708**2)
     t710 = t702*t708
@@ -3036,10 +3036,10 @@ def _velocity_ellipsoid(q):
     t738 = t661*t680
     t739 = t687*t715 + t692*t719 - t635*t728*t738
     t740 = (t739 != 0)
-    t741 = 0.5*(-t711 + t683)/casadi.if_else(t740, t739, 1)
+    t741 = (-t711 + t683)/casadi.if_else(t740, 2*t739, 1)
     t742 = casadi.fabs(t741)
     t743 = (t742 >= 1)
-    t744 = casadi.fabs(1/casadi.if_else(t743, t741, 1))
+    t744 = 1/casadi.fabs(casadi.if_else(t743, t741, 1))
     t745 = casadi.if_else(t740, casadi.if_else((t741 >= 0), 1, -1)*casadi.if_else(t743, t744/(1 + casadi.sqrt(1 + t744**2)), 1/(t742 + casadi.sqrt(1 + t742**2))), 0)
     t746 = 1/casadi.sqrt(1 + t745**2)
     t747 = t739*t745
@@ -3071,10 +3071,10 @@ def _velocity_ellipsoid(q):
     t773 = t772 - t745*t759
     t774 = t759 + t745*t772
     t775 = (t763 != 0)
-    t776 = 0.5*(-t712 + t749)/casadi.if_else(t775, t763, 1)
+    t776 = (-t712 + t749)/casadi.if_else(t775, 2*t763, 1)
     t777 = casadi.fabs(t776)
     t778 = (t777 >= 1)
-    t779 = casadi.fabs(1/casadi.if_else(t778, t776, 1))
+    t779 = 1/casadi.fabs(casadi.if_else(t778, t776, 1))
     t780 = casadi.if_else(t775, casadi.if_else((t776 >= 0), 1, -1)*casadi.if_else(t778, t779/(1 + casadi.sqrt(1 + t779**2)), 1/(t777 + casadi.sqrt(1 + t777**2))), 0)
     t781 = 1/casadi.sqrt(1 + t780**2)
     t782 = t763*t780
@@ -3106,10 +3106,10 @@ def _velocity_ellipsoid(q):
     t808 = t806 + t780*t807
     t809 = t807 - t780*t806
     t810 = (t797 != 0)
-    t811 = 0.5*(-t748 + t783)/casadi.if_else(t810, t797, 1)
+    t811 = (-t748 + t783)/casadi.if_else(t810, 2*t797, 1)
     t812 = casadi.fabs(t811)
     t813 = (t812 >= 1)
-    t814 = casadi.fabs(1/casadi.if_else(t813, t811, 1))
+    t814 = 1/casadi.fabs(casadi.if_else(t813, t811, 1))
     t815 = casadi.if_else(t810, casadi.if_else((t811 >= 0), 1, -1)*casadi.if_else(t813, t814/(1 + casadi.sqrt(1 + t814**2)), 1/(t812 + casadi.sqrt(1 + t812**2))), 0)
     t816 = 1/casadi.sqrt(1 + t815**2)
     t817 = t797*t815
@@ -3141,10 +3141,10 @@ def _velocity_ellipsoid(q):
     t843 = t841 + t815*t842
     t844 = -t842 + t815*t841
     t845 = (t832 != 0)
-    t846 = 0.5*(-t818 + t784)/casadi.if_else(t845, t832, 1)
+    t846 = (-t818 + t784)/casadi.if_else(t845, 2*t832, 1)
     t847 = casadi.fabs(t846)
     t848 = (t847 >= 1)
-    t849 = casadi.fabs(1/casadi.if_else(t848, t846, 1))
+    t849 = 1/casadi.fabs(casadi.if_else(t848, t846, 1))
     t850 = casadi.if_else(t845, casadi.if_else((t846 >= 0), 1, -1)*casadi.if_else(t848, t849/(1 + casadi.sqrt(1 + t849**2)), 1/(t847 + casadi.sqrt(1 + t847**2))), 0)
     t851 = 1/casadi.sqrt(1 + t850**2)
     t852 = t832*t850
@@ -3176,10 +3176,10 @@ def _velocity_ellipsoid(q):
     t878 = t876 - t850*t877
     t879 = t877 + t850*t876
     t880 = (t867 != 0)
-    t881 = 0.5*(-t819 + t854)/casadi.if_else(t880, t867, 1)
+    t881 = (-t819 + t854)/casadi.if_else(t880, 2*t867, 1)
     t882 = casadi.fabs(t881)
     t883 = (t882 >= 1)
-    t884 = casadi.fabs(1/casadi.if_else(t883, t881, 1))
+    t884 = 1/casadi.fabs(casadi.if_else(t883, t881, 1))
     t885 = casadi.if_else(t880, casadi.if_else((t881 >= 0), 1, -1)*casadi.if_else(t883, t884/(1 + casadi.sqrt(1 + t884**2)), 1/(t882 + casadi.sqrt(1 + t882**2))), 0)
     t886 = 1/casadi.sqrt(1 + t885**2)
     t887 = t867*t885
@@ -3211,10 +3211,10 @@ def _velocity_ellipsoid(q):
     t913 = t911 - t885*t912
     t914 = t912 + t885*t911
     t915 = (t902 != 0)
-    t916 = 0.5*(-t853 + t888)/casadi.if_else(t915, t902, 1)
+    t916 = (-t853 + t888)/casadi.if_else(t915, 2*t902, 1)
     t917 = casadi.fabs(t916)
     t918 = (t917 >= 1)
-    t919 = casadi.fabs(1/casadi.if_else(t918, t916, 1))
+    t919 = 1/casadi.fabs(casadi.if_else(t918, t916, 1))
     t920 = casadi.if_else(t915, casadi.if_else((t916 >= 0), 1, -1)*casadi.if_else(t918, t919/(1 + casadi.sqrt(1 + t919**2)), 1/(t917 + casadi.sqrt(1 + t917**2))), 0)
     t921 = 1/casadi.sqrt(1 + t920**2)
     t922 = t902*t920
@@ -3246,10 +3246,10 @@ def _velocity_ellipsoid(q):
     t948 = t946 - t920*t947
     t949 = t947 + t920*t946
     t950 = (t937 != 0)
-    t951 = 0.5*(-t923 + t889)/casadi.if_else(t950, t937, 1)
+    t951 = (-t923 + t889)/casadi.if_else(t950, 2*t937, 1)
     t952 = casadi.fabs(t951)
     t953 = (t952 >= 1)
-    t954 = casadi.fabs(1/casadi.if_else(t953, t951, 1))
+    t954 = 1/casadi.fabs(casadi.if_else(t953, t951, 1))
     t955 = casadi.if_else(t950, casadi.if_else((t951 >= 0), 1, -1)*casadi.if_else(t953, t954/(1 + casadi.sqrt(1 + t954**2)), 1/(t952 + casadi.sqrt(1 + t952**2))), 0)
     t956 = 1/casadi.sqrt(1 + t955**2)
     t957 = t937*t955
@@ -3281,10 +3281,10 @@ def _velocity_ellipsoid(q):
     t983 = t981 - t955*t982
     t984 = t982 + t955*t981
     t985 = (t972 != 0)
-    t986 = 0.5*(-t924 + t959)/casadi.if_else(t985, t972, 1)
+    t986 = (-t924 + t959)/casadi.if_else(t985, 2*t972, 1)
     t987 = casadi.fabs(t986)
     t988 = (t987 >= 1)
-    t989 = casadi.fabs(1/casadi.if_else(t988, t986, 1))
+    t989 = 1/casadi.fabs(casadi.if_else(t988, t986, 1))
     t990 = casadi.if_else(t985, casadi.if_else((t986 >= 0), 1, -1)*casadi.if_else(t988, t989/(1 + casadi.sqrt(1 + t989**2)), 1/(t987 + casadi.sqrt(1 + t987**2))), 0)
     t991 = 1/casadi.sqrt(1 + t990**2)
     t992 = t972*t990
@@ -3316,10 +3316,10 @@ def _velocity_ellipsoid(q):
     t1018 = t1016 - t990*t1017
     t1019 = t1017 + t990*t1016
     t1020 = (t1007 != 0)
-    t1021 = 0.5*(-t958 + t993)/casadi.if_else(t1020, t1007, 1)
+    t1021 = (-t958 + t993)/casadi.if_else(t1020, 2*t1007, 1)
     t1022 = casadi.fabs(t1021)
     t1023 = (t1022 >= 1)
-    t1024 = casadi.fabs(1/casadi.if_else(t1023, t1021, 1))
+    t1024 = 1/casadi.fabs(casadi.if_else(t1023, t1021, 1))
     t1025 = casadi.if_else(t1020, casadi.if_else((t1021 >= 0), 1, -1)*casadi.if_else(t1023, t1024/(1 + casadi.sqrt(1 + t1024**2)), 1/(t1022 + casadi.sqrt(1 + t1022**2))), 0)
     t1026 = 1/casadi.sqrt(1 + t1025**2)
     t1027 = t1007*t1025
@@ -3351,10 +3351,10 @@ def _velocity_ellipsoid(q):
     t1053 = t1051 - t1025*t1052
     t1054 = t1052 + t1025*t1051
     t1055 = (t1042 != 0)
-    t1056 = 0.5*(-t1028 + t994)/casadi.if_else(t1055, t1042, 1)
+    t1056 = (-t1028 + t994)/casadi.if_else(t1055, 2*t1042, 1)
     t1057 = casadi.fabs(t1056)
     t1058 = (t1057 >= 1)
-    t1059 = casadi.fabs(1/casadi.if_else(t1058, t1056, 1))
+    t1059 = 1/casadi.fabs(casadi.if_else(t1058, t1056, 1))
     t1060 = casadi.if_else(t1055, casadi.if_else((t1056 >= 0), 1, -1)*casadi.if_else(t1058, t1059/(1 + casadi.sqrt(1 + t1059**2)), 1/(t1057 + casadi.sqrt(1 + t1057**2))), 0)
     t1061 = 1/casadi.sqrt(1 + t1060**2)
     t1062 = t994 + t1042*t1060
@@ -3385,10 +3385,10 @@ def _velocity_ellipsoid(q):
     t1087 = t1085 - t1060*t1086
     t1088 = t1086 + t1060*t1085
     t1089 = (t1075 != 0)
-    t1090 = 0.5*(-t1029 + t1062)/casadi.if_else(t1089, t1075, 1)
+    t1090 = (-t1029 + t1062)/casadi.if_else(t1089, 2*t1075, 1)
     t1091 = casadi.fabs(t1090)
     t1092 = (t1091 >= 1)
-    t1093 = casadi.fabs(1/casadi.if_else(t1092, t1090, 1))
+    t1093 = 1/casadi.fabs(casadi.if_else(t1092, t1090, 1))
     t1094 = casadi.if_else(t1089, casadi.if_else((t1090 >= 0), 1, -1)*casadi.if_else(t1092, t1093/(1 + casadi.sqrt(1 + t1093**2)), 1/(t1091 + casadi.sqrt(1 + t1091**2))), 0)
     t1095 = 1/casadi.sqrt(1 + t1094**2)
     t1096 = t1033*t1095
@@ -3655,10 +3655,10 @@ def _condition_number(q):
     t154 = t64*t75
     t155 = t71*t91 - t66*t107 + t152*t95 + t153*t99 + t154*t103
     t156 = (t155 != 0)
-    t157 = 0.5*(-t151 + t144)/casadi.if_else(t156, -t155, 1)
+    t157 = (-t151 + t144)/casadi.if_else(t156, -2*t155, 1)
     t158 = casadi.fabs(t157)
     t159 = (t158 >= 1)
-    t160 = casadi.fabs(1/casadi.if_else(t159, t157, 1))
+    t160 = 1/casadi.fabs(casadi.if_else(t159, t157, 1))
     t161 = casadi.if_else(t156, casadi.if_else((t157 >= 0), 1, -1)*casadi.if_else(t159, t160/(1 + casadi.sqrt(1 + t160**2)), 1/(t158 + casadi.sqrt(1 + t158**2))), 0)
     t162 = 1/casadi.sqrt(1 + t161**2)
     t163 = t155*t161
@@ -3686,10 +3686,10 @@ def _condition_number(q):
     t185 = t183 + t182*t161
     t186 = t115*t176 + t118*t180 + t121*t184 - t111*t172
     t187 = (t186 != 0)
-    t188 = 0.5*(-t164 + t145)/casadi.if_else(t187, -t186, 1)
+    t188 = (-t164 + t145)/casadi.if_else(t187, -2*t186, 1)
     t189 = casadi.fabs(t188)
     t190 = (t189 >= 1)
-    t191 = casadi.fabs(1/casadi.if_else(t190, t188, 1))
+    t191 = 1/casadi.fabs(casadi.if_else(t190, t188, 1))
     t192 = casadi.if_else(t187, casadi.if_else((t188 >= 0), 1, -1)*casadi.if_else(t190, t191/(1 + casadi.sqrt(1 + t191**2)), 1/(t189 + casadi.sqrt(1 + t189**2))), 0)
     t193 = 1/casadi.sqrt(1 + t192**2)
     t194 = t186*t192
@@ -3713,10 +3713,10 @@ def _condition_number(q):
     t212 = -t210 + t209*t192
     t213 = t124*t203 + t128*t207 - t132*t211
     t214 = (t213 != 0)
-    t215 = 0.5*(-t195 + t146)/casadi.if_else(t214, t213, 1)
+    t215 = (-t195 + t146)/casadi.if_else(t214, 2*t213, 1)
     t216 = casadi.fabs(t215)
     t217 = (t216 >= 1)
-    t218 = casadi.fabs(1/casadi.if_else(t217, t215, 1))
+    t218 = 1/casadi.fabs(casadi.if_else(t217, t215, 1))
     t219 = casadi.if_else(t214, casadi.if_else((t215 >= 0), 1, -1)*casadi.if_else(t217, t218/(1 + casadi.sqrt(1 + t218**2)), 1/(t216 + casadi.sqrt(1 + t216**2))), 0)
     t220 = 1/casadi.sqrt(1 + t219**2)
     t221 = t213*t219
@@ -3736,10 +3736,10 @@ def _condition_number(q):
     t235 = -t233 + t232*t219
     t236 = -t136*t230 + t140*t234
     t237 = (t236 != 0)
-    t238 = 0.5*(-t222 + t147)/casadi.if_else(t237, t236, 1)
+    t238 = (-t222 + t147)/casadi.if_else(t237, 2*t236, 1)
     t239 = casadi.fabs(t238)
     t240 = (t239 >= 1)
-    t241 = casadi.fabs(1/casadi.if_else(t240, t238, 1))
+    t241 = 1/casadi.fabs(casadi.if_else(t240, t238, 1))
     t242 = casadi.if_else(t237, casadi.if_else((t238 >= 0), 1, -1)*casadi.if_else(t240, t241/(1 + casadi.sqrt(1 + t241**2)), 1/(t239 + casadi.sqrt(1 + t239**2))), 0)
     t243 = 1/casadi.sqrt(1 + t242**2)
     t244 = t236*t242
@@ -3755,10 +3755,10 @@ def _condition_number(q):
     t254 = t252 + t251*t242
     t255 = t143*t253
     t256 = (t255 != 0)
-    t257 = 0.5*(-t245 + t148)/casadi.if_else(t256, -t255, 1)
+    t257 = (-t245 + t148)/casadi.if_else(t256, -2*t255, 1)
     t258 = casadi.fabs(t257)
     t259 = (t258 >= 1)
-    t260 = casadi.fabs(1/casadi.if_else(t259, t257, 1))
+    t260 = 1/casadi.fabs(casadi.if_else(t259, t257, 1))
     t261 = casadi.if_else(t256, casadi.if_else((t257 >= 0), 1, -1)*casadi.if_else(t259, t260/(1 + casadi.sqrt(1 + t260**2)), 1/(t258 + casadi.sqrt(1 + t258**2))), 0)
     t262 = 1/casadi.sqrt(1 + t261**2)
     t263 = t255*t261
@@ -3772,10 +3772,10 @@ def _condition_number(q):
     t271 = t270*t168
     t272 = -t173*t200 + t177*t204 + t181*t208 + t185*t212 + t149*t270*t161*t162**2 + t271*t169
     t273 = (t272 != 0)
-    t274 = 0.5*(-t165 + t196)/casadi.if_else(t273, t272, 1)
+    t274 = (-t165 + t196)/casadi.if_else(t273, 2*t272, 1)
     t275 = casadi.fabs(t274)
     t276 = (t275 >= 1)
-    t277 = casadi.fabs(1/casadi.if_else(t276, t274, 1))
+    t277 = 1/casadi.fabs(casadi.if_else(t276, t274, 1))
     t278 = casadi.if_else(t273, casadi.if_else((t274 >= 0), 1, -1)*casadi.if_else(t276, t277/(1 + casadi.sqrt(1 + t277**2)), 1/(t275 + casadi.sqrt(1 + t275**2))), 0)
     t279 = 1/casadi.sqrt(1 + t278**2)
     t280 = t272*t278
@@ -3814,10 +3814,10 @@ def _condition_number(q):
     t313 = t309*t199
     t314 = -t227*t299 - t231*t303 + t235*t307 - t311*t287 + t312*t291 + t313*t295
     t315 = (t314 != 0)
-    t316 = 0.5*(-t281 + t223)/casadi.if_else(t315, t314, 1)
+    t316 = (-t281 + t223)/casadi.if_else(t315, 2*t314, 1)
     t317 = casadi.fabs(t316)
     t318 = (t317 >= 1)
-    t319 = casadi.fabs(1/casadi.if_else(t318, t316, 1))
+    t319 = 1/casadi.fabs(casadi.if_else(t318, t316, 1))
     t320 = casadi.if_else(t315, casadi.if_else((t316 >= 0), 1, -1)*casadi.if_else(t318, t319/(1 + casadi.sqrt(1 + t319**2)), 1/(t317 + casadi.sqrt(1 + t317**2))), 0)
     t321 = 1/casadi.sqrt(1 + t320**2)
     t322 = t314*t320
@@ -3860,10 +3860,10 @@ def _condition_number(q):
     t359 = t358*t242
     t360 = t250*t343 + t254*t347 - t353*t327 + t355*t331 + t357*t335 + t359*t339
     t361 = (t360 != 0)
-    t362 = 0.5*(-t323 + t246)/casadi.if_else(t361, t360, 1)
+    t362 = (-t323 + t246)/casadi.if_else(t361, 2*t360, 1)
     t363 = casadi.fabs(t362)
     t364 = (t363 >= 1)
-    t365 = casadi.fabs(1/casadi.if_else(t364, t362, 1))
+    t365 = 1/casadi.fabs(casadi.if_else(t364, t362, 1))
     t366 = casadi.if_else(t361, casadi.if_else((t362 >= 0), 1, -1)*casadi.if_else(t364, t365/(1 + casadi.sqrt(1 + t365**2)), 1/(t363 + casadi.sqrt(1 + t363**2))), 0)
     t367 = 1/casadi.sqrt(1 + t366**2)
     t368 = t360*t366
@@ -3905,10 +3905,10 @@ def _condition_number(q):
     t404 = t403*t261
     t405 = t269*t393 - t396*t373 + t398*t377 + t400*t381 + t402*t385 + t404*t389
     t406 = (t405 != 0)
-    t407 = 0.5*(-t369 + t265)/casadi.if_else(t406, t405, 1)
+    t407 = (-t369 + t265)/casadi.if_else(t406, 2*t405, 1)
     t408 = casadi.fabs(t407)
     t409 = (t408 >= 1)
-    t410 = casadi.fabs(1/casadi.if_else(t409, t407, 1))
+    t410 = 1/casadi.fabs(casadi.if_else(t409, t407, 1))
     t411 = casadi.if_else(t406, casadi.if_else((t407 >= 0), 1, -1)*casadi.if_else(t409, t410/(1 + casadi.sqrt(1 + t410**2)), 1/(t408 + casadi.sqrt(1 + t408**2))), 0)
     t412 = 1/casadi.sqrt(1 + t411**2)
     t413 = t405*t411
@@ -3940,10 +3940,10 @@ def _condition_number(q):
     t439 = t437 + t436*t411
     t440 = t268*t438 - t395*t418 + t397*t422 + t399*t426 + t401*t430 + t403*t434
     t441 = (t349 != 0)
-    t442 = 0.5*(-t282 + t324)/casadi.if_else(t441, t349, 1)
+    t442 = (-t282 + t324)/casadi.if_else(t441, 2*t349, 1)
     t443 = casadi.fabs(t442)
     t444 = (t443 >= 1)
-    t445 = casadi.fabs(1/casadi.if_else(t444, t442, 1))
+    t445 = 1/casadi.fabs(casadi.if_else(t444, t442, 1))
     t446 = casadi.if_else(t441, casadi.if_else((t442 >= 0), 1, -1)*casadi.if_else(t444, t445/(1 + casadi.sqrt(1 + t445**2)), 1/(t443 + casadi.sqrt(1 + t443**2))), 0)
     t447 = 1/casadi.sqrt(1 + t446**2)
     t448 = t349*t446
@@ -3975,10 +3975,10 @@ def _condition_number(q):
     t474 = t472 + t471*t446
     t475 = -t374*t453 + t378*t457 + t382*t461 + t386*t465 + t390*t469 + t394*t473
     t476 = (t475 != 0)
-    t477 = 0.5*(-t449 + t370)/casadi.if_else(t476, t475, 1)
+    t477 = (-t449 + t370)/casadi.if_else(t476, 2*t475, 1)
     t478 = casadi.fabs(t477)
     t479 = (t478 >= 1)
-    t480 = casadi.fabs(1/casadi.if_else(t479, t477, 1))
+    t480 = 1/casadi.fabs(casadi.if_else(t479, t477, 1))
     t481 = casadi.if_else(t476, casadi.if_else((t477 >= 0), 1, -1)*casadi.if_else(t479, t480/(1 + casadi.sqrt(1 + t480**2)), 1/(t478 + casadi.sqrt(1 + t478**2))), 0)
     t482 = 1/casadi.sqrt(1 + t481**2)
     t483 = t475*t481
@@ -4011,10 +4011,10 @@ def _condition_number(q):
     t510 = -t419*t488 + t423*t492 + t427*t496 + t431*t500 + t435*t504 + t439*t508
     t511 = t454*t489 + t458*t493 + t462*t497 + t466*t501 + t470*t505 + t474*t509
     t512 = (t510 != 0)
-    t513 = 0.5*(-t484 + t415)/casadi.if_else(t512, t510, 1)
+    t513 = (-t484 + t415)/casadi.if_else(t512, 2*t510, 1)
     t514 = casadi.fabs(t513)
     t515 = (t514 >= 1)
-    t516 = casadi.fabs(1/casadi.if_else(t515, t513, 1))
+    t516 = 1/casadi.fabs(casadi.if_else(t515, t513, 1))
     t517 = casadi.if_else(t512, casadi.if_else((t513 >= 0), 1, -1)*casadi.if_else(t515, t516/(1 + casadi.sqrt(1 + t516**2)), 1/(t514 + casadi.sqrt(1 + t514**2))), 0)
     t518 = 1/casadi.sqrt(1 + t517**2)
     t519 = t510*t517
@@ -4045,10 +4045,10 @@ def _condition_number(q):
     t544 = t542 - t543*t517
     t545 = t543 + t542*t517
     t546 = (t511 != 0)
-    t547 = 0.5*(-t450 + t485)/casadi.if_else(t546, t511, 1)
+    t547 = (-t450 + t485)/casadi.if_else(t546, 2*t511, 1)
     t548 = casadi.fabs(t547)
     t549 = (t548 >= 1)
-    t550 = casadi.fabs(1/casadi.if_else(t549, t547, 1))
+    t550 = 1/casadi.fabs(casadi.if_else(t549, t547, 1))
     t551 = casadi.if_else(t546, casadi.if_else((t547 >= 0), 1, -1)*casadi.if_else(t549, t550/(1 + casadi.sqrt(1 + t550**2)), 1/(t548 + casadi.sqrt(1 + t548**2))), 0)
     t552 = 1/casadi.sqrt(1 + t551**2)
     t553 = t511*t551
@@ -4080,10 +4080,10 @@ def _condition_number(q):
     t579 = t577 + t576*t551
     t580 = t525*t558 + t529*t562 + t533*t566 + t537*t570 + t541*t574 + t545*t578
     t581 = (t580 != 0)
-    t582 = 0.5*(-t554 + t521)/casadi.if_else(t581, t580, 1)
+    t582 = (-t554 + t521)/casadi.if_else(t581, 2*t580, 1)
     t583 = casadi.fabs(t582)
     t584 = (t583 >= 1)
-    t585 = casadi.fabs(1/casadi.if_else(t584, t582, 1))
+    t585 = 1/casadi.fabs(casadi.if_else(t584, t582, 1))
     t586 = casadi.if_else(t581, casadi.if_else((t582 >= 0), 1, -1)*casadi.if_else(t584, t585/(1 + casadi.sqrt(1 + t585**2)), 1/(t583 + casadi.sqrt(1 + t583**2))), 0)
     t587 = 1/casadi.sqrt(1 + t586**2)
     t588 = t580*t586
@@ -4115,10 +4115,10 @@ def _condition_number(q):
     t614 = t612 + t611*t586
     t615 = t559*t594 + t563*t598 + t567*t602 + t571*t606 + t575*t610 + t579*t614
     t616 = (t615 != 0)
-    t617 = 0.5*(-t555 + t590)/casadi.if_else(t616, t615, 1)
+    t617 = (-t555 + t590)/casadi.if_else(t616, 2*t615, 1)
     t618 = casadi.fabs(t617)
     t619 = (t618 >= 1)
-    t620 = casadi.fabs(1/casadi.if_else(t619, t617, 1))
+    t620 = 1/casadi.fabs(casadi.if_else(t619, t617, 1))
     t621 = casadi.if_else(t616, casadi.if_else((t617 >= 0), 1, -1)*casadi.if_else(t619, t620/(1 + casadi.sqrt(1 + t620**2)), 1/(t618 + casadi.sqrt(1 + t618**2))), 0)
     t622 = 1/casadi.sqrt(1 + t621**2)
     t623 = t615*t621
@@ -4149,10 +4149,10 @@ def _condition_number(q):
     t648 = t646 - t647*t621
     t649 = t647 + t646*t621
     t650 = (t440 != 0)
-    t651 = 0.5*(-t264 + t414)/casadi.if_else(t650, t440, 1)
+    t651 = (-t264 + t414)/casadi.if_else(t650, 2*t440, 1)
     t652 = casadi.fabs(t651)
     t653 = (t652 >= 1)
-    t654 = casadi.fabs(1/casadi.if_else(t653, t651, 1))
+    t654 = 1/casadi.fabs(casadi.if_else(t653, t651, 1))
     t655 = casadi.if_else(t650, casadi.if_else((t651 >= 0), 1, -1)*casadi.if_else(t653, t654/(1 + casadi.sqrt(1 + t654**2)), 1/(t652 + casadi.sqrt(1 + t652**2))), 0)
     t656 = 1/casadi.sqrt(1 + t655**2)
     t657 = t440*t655
@@ -4184,10 +4184,10 @@ def _condition_number(q):
     t683 = t681 + t680*t655
     t684 = t524*t662 + t528*t666 + t532*t670 + t536*t674 + t540*t678 + t544*t682
     t685 = (t684 != 0)
-    t686 = 0.5*(-t658 + t520)/casadi.if_else(t685, t684, 1)
+    t686 = (-t658 + t520)/casadi.if_else(t685, 2*t684, 1)
     t687 = casadi.fabs(t686)
     t688 = (t687 >= 1)
-    t689 = casadi.fabs(1/casadi.if_else(t688, t686, 1))
+    t689 = 1/casadi.fabs(casadi.if_else(t688, t686, 1))
     t690 = casadi.if_else(t685, casadi.if_else((t686 >= 0), 1, -1)*casadi.if_else(t688, t689/(1 + casadi.sqrt(1 + t689**2)), 1/(t687 + casadi.sqrt(1 + t687**2))), 0)
     t691 = 1/casadi.sqrt(1 + t690**2)
     t692 = t684*t690
@@ -4220,10 +4220,10 @@ def _condition_number(q):
     t719 = t593*t697 + t597*t701 + t601*t705 + t605*t709 + t609*t713 + t613*t717
     t720 = -t663*t698 + t667*t702 + t671*t706 + t675*t710 + t679*t714 + t683*t718
     t721 = (t719 != 0)
-    t722 = 0.5*(-t693 + t589)/casadi.if_else(t721, t719, 1)
+    t722 = (-t693 + t589)/casadi.if_else(t721, 2*t719, 1)
     t723 = casadi.fabs(t722)
     t724 = (t723 >= 1)
-    t725 = casadi.fabs(1/casadi.if_else(t724, t722, 1))
+    t725 = 1/casadi.fabs(casadi.if_else(t724, t722, 1))
     t726 = casadi.if_else(t721, casadi.if_else((t722 >= 0), 1, -1)*casadi.if_else(t724, t725/(1 + casadi.sqrt(1 + t725**2)), 1/(t723 + casadi.sqrt(1 + t723**2))), 0)
     t727 = 1/casadi.sqrt(1 + t726**2)
     t728 = t719*t726
@@ -4255,10 +4255,10 @@ def _condition_number(q):
     t754 = t752 + t751*t726
     t755 = t628*t733 + t632*t737 + t636*t741 + t640*t745 + t644*t749 + t648*t753
     t756 = (t755 != 0)
-    t757 = 0.5*(-t729 + t624)/casadi.if_else(t756, t755, 1)
+    t757 = (-t729 + t624)/casadi.if_else(t756, 2*t755, 1)
     t758 = casadi.fabs(t757)
     t759 = (t758 >= 1)
-    t760 = casadi.fabs(1/casadi.if_else(t759, t757, 1))
+    t760 = 1/casadi.fabs(casadi.if_else(t759, t757, 1))
     t761 = casadi.if_else(t756, casadi.if_else((t757 >= 0), 1, -1)*casadi.if_else(t759, t760/(1 + casadi.sqrt(1 + t760**2)), 1/(t758 + casadi.sqrt(1 + t758**2))), 0)
     t762 = 1/casadi.sqrt(1 + t761**2)
     t763 = t755*t761
@@ -4290,10 +4290,10 @@ def _condition_number(q):
     t789 = t787 + t786*t761
     t790 = t629*t768 + t633*t772 + t637*t776 + t641*t780 + t645*t784 + t649*t788
     t791 = (t790 != 0)
-    t792 = 0.5*(-t764 + t625)/casadi.if_else(t791, t790, 1)
+    t792 = (-t764 + t625)/casadi.if_else(t791, 2*t790, 1)
     t793 = casadi.fabs(t792)
     t794 = (t793 >= 1)
-    t795 = casadi.fabs(1/casadi.if_else(t794, t792, 1))
+    t795 = 1/casadi.fabs(casadi.if_else(t794, t792, 1))
     t796 = casadi.if_else(t791, casadi.if_else((t792 >= 0), 1, -1)*casadi.if_else(t794, t795/(1 + casadi.sqrt(1 + t795**2)), 1/(t793 + casadi.sqrt(1 + t793**2))), 0)
     t797 = 1/casadi.sqrt(1 + t796**2)
     t798 = t790*t796
@@ -4324,10 +4324,10 @@ def _condition_number(q):
     t823 = t821 - t822*t796
     t824 = t822 + t821*t796
     t825 = (t720 != 0)
-    t826 = 0.5*(-t659 + t694)/casadi.if_else(t825, t720, 1)
+    t826 = (-t659 + t694)/casadi.if_else(t825, 2*t720, 1)
     t827 = casadi.fabs(t826)
     t828 = (t827 >= 1)
-    t829 = casadi.fabs(1/casadi.if_else(t828, t826, 1))
+    t829 = 1/casadi.fabs(casadi.if_else(t828, t826, 1))
     t830 = casadi.if_else(t825, casadi.if_else((t826 >= 0), 1, -1)*casadi.if_else(t828, t829/(1 + casadi.sqrt(1 + t829**2)), 1/(t827 + casadi.sqrt(1 + t827**2))), 0)
     t831 = 1/casadi.sqrt(1 + t830**2)
     t832 = t720*t830
@@ -4359,10 +4359,10 @@ def _condition_number(q):
     t858 = t856 + t855*t830
     t859 = t734*t837 + t738*t841 + t742*t845 + t746*t849 + t750*t853 + t754*t857
     t860 = (t859 != 0)
-    t861 = 0.5*(-t833 + t730)/casadi.if_else(t860, t859, 1)
+    t861 = (-t833 + t730)/casadi.if_else(t860, 2*t859, 1)
     t862 = casadi.fabs(t861)
     t863 = (t862 >= 1)
-    t864 = casadi.fabs(1/casadi.if_else(t863, t861, 1))
+    t864 = 1/casadi.fabs(casadi.if_else(t863, t861, 1))
     t865 = casadi.if_else(t860, casadi.if_else((t861 >= 0), 1, -1)*casadi.if_else(t863, t864/(1 + casadi.sqrt(1 + t864**2)), 1/(t862 + casadi.sqrt(1 + t862**2))), 0)
     t866 = 1/casadi.sqrt(1 + t865**2)
     t867 = t859*t865
@@ -4395,10 +4395,10 @@ def _condition_number(q):
     t894 = t769*t872 + t773*t876 + t777*t880 + t781*t884 + t785*t888 + t789*t892
     t895 = t838*t873 + t842*t877 + t846*t881 + t850*t885 + t854*t889 + t858*t893
     t896 = (t894 != 0)
-    t897 = 0.5*(-t868 + t765)/casadi.if_else(t896, t894, 1)
+    t897 = (-t868 + t765)/casadi.if_else(t896, 2*t894, 1)
     t898 = casadi.fabs(t897)
     t899 = (t898 >= 1)
-    t900 = casadi.fabs(1/casadi.if_else(t899, t897, 1))
+    t900 = 1/casadi.fabs(casadi.if_else(t899, t897, 1))
     t901 = casadi.if_else(t896, casadi.if_else((t897 >= 0), 1, -1)*casadi.if_else(t899, t900/(1 + casadi.sqrt(1 + t900**2)), 1/(t898 + casadi.sqrt(1 + t898**2))), 0)
     t902 = 1/casadi.sqrt(1 + t901**2)
     t903 = t894*t901
@@ -4430,10 +4430,10 @@ def _condition_number(q):
     t929 = t927 + t926*t901
     t930 = t804*t908 + t808*t912 + t812*t916 + t816*t920 + t820*t924 + t824*t928
     t931 = (t930 != 0)
-    t932 = 0.5*(-t904 + t800)/casadi.if_else(t931, t930, 1)
+    t932 = (-t904 + t800)/casadi.if_else(t931, 2*t930, 1)
     t933 = casadi.fabs(t932)
     t934 = (t933 >= 1)
-    t935 = casadi.fabs(1/casadi.if_else(t934, t932, 1))
+    t935 = 1/casadi.fabs(casadi.if_else(t934, t932, 1))
     t936 = casadi.if_else(t931, casadi.if_else((t932 >= 0), 1, -1)*casadi.if_else(t934, t935/(1 + casadi.sqrt(1 + t935**2)), 1/(t933 + casadi.sqrt(1 + t933**2))), 0)
     t937 = 1/casadi.sqrt(1 + t936**2)
     t938 = t930*t936
@@ -4465,10 +4465,10 @@ def _condition_number(q):
     t964 = t962 + t961*t936
     t965 = t803*t943 + t807*t947 + t811*t951 + t815*t955 + t819*t959 + t823*t963
     t966 = (t895 != 0)
-    t967 = 0.5*(-t834 + t869)/casadi.if_else(t966, t895, 1)
+    t967 = (-t834 + t869)/casadi.if_else(t966, 2*t895, 1)
     t968 = casadi.fabs(t967)
     t969 = (t968 >= 1)
-    t970 = casadi.fabs(1/casadi.if_else(t969, t967, 1))
+    t970 = 1/casadi.fabs(casadi.if_else(t969, t967, 1))
     t971 = casadi.if_else(t966, casadi.if_else((t967 >= 0), 1, -1)*casadi.if_else(t969, t970/(1 + casadi.sqrt(1 + t970**2)), 1/(t968 + casadi.sqrt(1 + t968**2))), 0)
     t972 = 1/casadi.sqrt(1 + t971**2)
     t973 = t895*t971
@@ -4500,10 +4500,10 @@ def _condition_number(q):
     t999 = t997 + t996*t971
     t1000 = t909*t978 + t913*t982 + t917*t986 + t921*t990 + t925*t994 + t929*t998
     t1001 = (t1000 != 0)
-    t1002 = 0.5*(-t974 + t905)/casadi.if_else(t1001, t1000, 1)
+    t1002 = (-t974 + t905)/casadi.if_else(t1001, 2*t1000, 1)
     t1003 = casadi.fabs(t1002)
     t1004 = (t1003 >= 1)
-    t1005 = casadi.fabs(1/casadi.if_else(t1004, t1002, 1))
+    t1005 = 1/casadi.fabs(casadi.if_else(t1004, t1002, 1))
     t1006 = casadi.if_else(t1001, casadi.if_else((t1002 >= 0), 1, -1)*casadi.if_else(t1004, t1005/(1 + casadi.sqrt(1 + t1005**2)), 1/(t1003 + casadi.sqrt(1 + t1003**2))), 0)
     t1007 = 1/casadi.sqrt(1 + t1006**2)
     t1008 = t1000*t1006
@@ -4536,10 +4536,10 @@ def _condition_number(q):
     t1035 = t944*t1013 + t948*t1017 + t952*t1021 + t956*t1025 + t960*t1029 + t964*t1033
     t1036 = t979*t1014 + t983*t1018 + t987*t1022 + t991*t1026 + t995*t1030 + t999*t1034
     t1037 = (t1035 != 0)
-    t1038 = 0.5*(-t1009 + t940)/casadi.if_else(t1037, t1035, 1)
+    t1038 = (-t1009 + t940)/casadi.if_else(t1037, 2*t1035, 1)
     t1039 = casadi.fabs(t1038)
     t1040 = (t1039 >= 1)
-    t1041 = casadi.fabs(1/casadi.if_else(t1040, t1038, 1))
+    t1041 = 1/casadi.fabs(casadi.if_else(t1040, t1038, 1))
     t1042 = casadi.if_else(t1037, casadi.if_else((t1038 >= 0), 1, -1)*casadi.if_else(t1040, t1041/(1 + casadi.sqrt(1 + t1041**2)), 1/(t1039 + casadi.sqrt(1 + t1039**2))), 0)
     t1043 = 1/casadi.sqrt(1 + t1042**2)
     t1044 = t1035*t1042
@@ -4570,10 +4570,10 @@ def _condition_number(q):
     t1069 = t1067 - t1068*t1042
     t1070 = t1068 + t1067*t1042
     t1071 = (t1036 != 0)
-    t1072 = 0.5*(-t975 + t1010)/casadi.if_else(t1071, t1036, 1)
+    t1072 = (-t975 + t1010)/casadi.if_else(t1071, 2*t1036, 1)
     t1073 = casadi.fabs(t1072)
     t1074 = (t1073 >= 1)
-    t1075 = casadi.fabs(1/casadi.if_else(t1074, t1072, 1))
+    t1075 = 1/casadi.fabs(casadi.if_else(t1074, t1072, 1))
     t1076 = casadi.if_else(t1071, casadi.if_else((t1072 >= 0), 1, -1)*casadi.if_else(t1074, t1075/(1 + casadi.sqrt(1 + t1075**2)), 1/(t1073 + casadi.sqrt(1 + t1073**2))), 0)
     t1077 = 1/casadi.sqrt(1 + t1076**2)
     t1078 = t1036*t1076
@@ -4605,10 +4605,10 @@ def _condition_number(q):
     t1104 = t1102 + t1101*t1076
     t1105 = t1050*t1083 + t1054*t1087 + t1058*t1091 + t1062*t1095 + t1066*t1099 + t1070*t1103
     t1106 = (t1105 != 0)
-    t1107 = 0.5*(-t1079 + t1046)/casadi.if_else(t1106, t1105, 1)
+    t1107 = (-t1079 + t1046)/casadi.if_else(t1106, 2*t1105, 1)
     t1108 = casadi.fabs(t1107)
     t1109 = (t1108 >= 1)
-    t1110 = casadi.fabs(1/casadi.if_else(t1109, t1107, 1))
+    t1110 = 1/casadi.fabs(casadi.if_else(t1109, t1107, 1))
     t1111 = casadi.if_else(t1106, casadi.if_else((t1107 >= 0), 1, -1)*casadi.if_else(t1109, t1110/(1 + casadi.sqrt(1 + t1110**2)), 1/(t1108 + casadi.sqrt(1 + t1108**2))), 0)
     t1112 = 1/casadi.sqrt(1 + t1111**2)
     t1113 = t1105*t1111
@@ -4640,10 +4640,10 @@ def _condition_number(q):
     t1139 = t1137 + t1111*t1136
     t1140 = t1084*t1119 + t1088*t1123 + t1092*t1127 + t1096*t1131 + t1100*t1135 + t1104*t1139
     t1141 = (t1140 != 0)
-    t1142 = 0.5*(-t1080 + t1115)/casadi.if_else(t1141, t1140, 1)
+    t1142 = (-t1080 + t1115)/casadi.if_else(t1141, 2*t1140, 1)
     t1143 = casadi.fabs(t1142)
     t1144 = (t1143 >= 1)
-    t1145 = casadi.fabs(1/casadi.if_else(t1144, t1142, 1))
+    t1145 = 1/casadi.fabs(casadi.if_else(t1144, t1142, 1))
     t1146 = casadi.if_else(t1141, casadi.if_else((t1142 >= 0), 1, -1)*casadi.if_else(t1144, t1145/(1 + casadi.sqrt(1 + t1145**2)), 1/(t1143 + casadi.sqrt(1 + t1143**2))), 0)
     t1147 = 1/casadi.sqrt(1 + t1146**2)
     t1148 = t1140*t1146
@@ -4674,10 +4674,10 @@ def _condition_number(q):
     t1173 = t1171 - t1146*t1172
     t1174 = t1172 + t1146*t1171
     t1175 = (t965 != 0)
-    t1176 = 0.5*(-t799 + t939)/casadi.if_else(t1175, t965, 1)
+    t1176 = (-t799 + t939)/casadi.if_else(t1175, 2*t965, 1)
     t1177 = casadi.fabs(t1176)
     t1178 = (t1177 >= 1)
-    t1179 = casadi.fabs(1/casadi.if_else(t1178, t1176, 1))
+    t1179 = 1/casadi.fabs(casadi.if_else(t1178, t1176, 1))
     t1180 = casadi.if_else(t1175, casadi.if_else((t1176 >= 0), 1, -1)*casadi.if_else(t1178, t1179/(1 + casadi.sqrt(1 + t1179**2)), 1/(t1177 + casadi.sqrt(1 + t1177**2))), 0)
     t1181 = 1/casadi.sqrt(1 + t1180**2)
     t1182 = t965*t1180
@@ -4709,10 +4709,10 @@ def _condition_number(q):
     t1208 = t1206 + t1180*t1205
     t1209 = t1049*t1187 + t1053*t1191 + t1057*t1195 + t1061*t1199 + t1065*t1203 + t1069*t1207
     t1210 = (t1209 != 0)
-    t1211 = 0.5*(-t1183 + t1045)/casadi.if_else(t1210, t1209, 1)
+    t1211 = (-t1183 + t1045)/casadi.if_else(t1210, 2*t1209, 1)
     t1212 = casadi.fabs(t1211)
     t1213 = (t1212 >= 1)
-    t1214 = casadi.fabs(1/casadi.if_else(t1213, t1211, 1))
+    t1214 = 1/casadi.fabs(casadi.if_else(t1213, t1211, 1))
     t1215 = casadi.if_else(t1210, casadi.if_else((t1211 >= 0), 1, -1)*casadi.if_else(t1213, t1214/(1 + casadi.sqrt(1 + t1214**2)), 1/(t1212 + casadi.sqrt(1 + t1212**2))), 0)
     t1216 = 1/casadi.sqrt(1 + t1215**2)
     t1217 = t1209*t1215
@@ -4745,10 +4745,10 @@ def _condition_number(q):
     t1244 = t1118*t1222 + t1122*t1226 + t1126*t1230 + t1130*t1234 + t1134*t1238 + t1138*t1242
     t1245 = t1188*t1223 + t1192*t1227 + t1196*t1231 + t1200*t1235 + t1204*t1239 + t1208*t1243
     t1246 = (t1244 != 0)
-    t1247 = 0.5*(-t1218 + t1114)/casadi.if_else(t1246, t1244, 1)
+    t1247 = (-t1218 + t1114)/casadi.if_else(t1246, 2*t1244, 1)
     t1248 = casadi.fabs(t1247)
     t1249 = (t1248 >= 1)
-    t1250 = casadi.fabs(1/casadi.if_else(t1249, t1247, 1))
+    t1250 = 1/casadi.fabs(casadi.if_else(t1249, t1247, 1))
     t1251 = casadi.if_else(t1246, casadi.if_else((t1247 >= 0), 1, -1)*casadi.if_else(t1249, t1250/(1 + casadi.sqrt(1 + t1250**2)), 1/(t1248 + casadi.sqrt(1 + t1248**2))), 0)
     t1252 = 1/casadi.sqrt(1 + t1251**2)
     t1253 = t1244*t1251
@@ -4780,10 +4780,10 @@ def _condition_number(q):
     t1279 = t1277 + t1251*t1276
     t1280 = t1153*t1258 + t1157*t1262 + t1161*t1266 + t1165*t1270 + t1169*t1274 + t1173*t1278
     t1281 = (t1280 != 0)
-    t1282 = 0.5*(-t1254 + t1149)/casadi.if_else(t1281, t1280, 1)
+    t1282 = (-t1254 + t1149)/casadi.if_else(t1281, 2*t1280, 1)
     t1283 = casadi.fabs(t1282)
     t1284 = (t1283 >= 1)
-    t1285 = casadi.fabs(1/casadi.if_else(t1284, t1282, 1))
+    t1285 = 1/casadi.fabs(casadi.if_else(t1284, t1282, 1))
     t1286 = casadi.if_else(t1281, casadi.if_else((t1282 >= 0), 1, -1)*casadi.if_else(t1284, t1285/(1 + casadi.sqrt(1 + t1285**2)), 1/(t1283 + casadi.sqrt(1 + t1283**2))), 0)
     t1287 = 1/casadi.sqrt(1 + t1286**2)
     t1288 = t1280*t1286
@@ -4815,10 +4815,10 @@ def _condition_number(q):
     t1314 = t1312 + t1286*t1311
     t1315 = t1154*t1293 + t1158*t1297 + t1162*t1301 + t1166*t1305 + t1170*t1309 + t1174*t1313
     t1316 = (t1315 != 0)
-    t1317 = 0.5*(-t1289 + t1150)/casadi.if_else(t1316, t1315, 1)
+    t1317 = (-t1289 + t1150)/casadi.if_else(t1316, 2*t1315, 1)
     t1318 = casadi.fabs(t1317)
     t1319 = (t1318 >= 1)
-    t1320 = casadi.fabs(1/casadi.if_else(t1319, t1317, 1))
+    t1320 = 1/casadi.fabs(casadi.if_else(t1319, t1317, 1))
     t1321 = casadi.if_else(t1316, casadi.if_else((t1317 >= 0), 1, -1)*casadi.if_else(t1319, t1320/(1 + casadi.sqrt(1 + t1320**2)), 1/(t1318 + casadi.sqrt(1 + t1318**2))), 0)
     t1322 = 1/casadi.sqrt(1 + t1321**2)
     t1323 = t1315*t1321
@@ -4849,10 +4849,10 @@ def _condition_number(q):
     t1348 = t1346 - t1321*t1347
     t1349 = t1347 + t1321*t1346
     t1350 = (t1245 != 0)
-    t1351 = 0.5*(-t1184 + t1219)/casadi.if_else(t1350, t1245, 1)
+    t1351 = (-t1184 + t1219)/casadi.if_else(t1350, 2*t1245, 1)
     t1352 = casadi.fabs(t1351)
     t1353 = (t1352 >= 1)
-    t1354 = casadi.fabs(1/casadi.if_else(t1353, t1351, 1))
+    t1354 = 1/casadi.fabs(casadi.if_else(t1353, t1351, 1))
     t1355 = casadi.if_else(t1350, casadi.if_else((t1351 >= 0), 1, -1)*casadi.if_else(t1353, t1354/(1 + casadi.sqrt(1 + t1354**2)), 1/(t1352 + casadi.sqrt(1 + t1352**2))), 0)
     t1356 = 1/casadi.sqrt(1 + t1355**2)
     t1357 = t1245*t1355
@@ -4884,10 +4884,10 @@ def _condition_number(q):
     t1383 = t1381 + t1355*t1380
     t1384 = t1259*t1362 + t1263*t1366 + t1267*t1370 + t1271*t1374 + t1275*t1378 + t1279*t1382
     t1385 = (t1384 != 0)
-    t1386 = 0.5*(-t1358 + t1255)/casadi.if_else(t1385, t1384, 1)
+    t1386 = (-t1358 + t1255)/casadi.if_else(t1385, 2*t1384, 1)
     t1387 = casadi.fabs(t1386)
     t1388 = (t1387 >= 1)
-    t1389 = casadi.fabs(1/casadi.if_else(t1388, t1386, 1))
+    t1389 = 1/casadi.fabs(casadi.if_else(t1388, t1386, 1))
     t1390 = casadi.if_else(t1385, casadi.if_else((t1386 >= 0), 1, -1)*casadi.if_else(t1388, t1389/(1 + casadi.sqrt(1 + t1389**2)), 1/(t1387 + casadi.sqrt(1 + t1387**2))), 0)
     t1391 = 1/casadi.sqrt(1 + t1390**2)
     t1392 = t1384*t1390
@@ -4920,10 +4920,10 @@ def _condition_number(q):
     t1419 = t1294*t1397 + t1298*t1401 + t1302*t1405 + t1306*t1409 + t1310*t1413 + t1314*t1417
     t1420 = t1363*t1398 + t1367*t1402 + t1371*t1406 + t1375*t1410 + t1379*t1414 + t1383*t1418
     t1421 = (t1419 != 0)
-    t1422 = 0.5*(-t1393 + t1290)/casadi.if_else(t1421, t1419, 1)
+    t1422 = (-t1393 + t1290)/casadi.if_else(t1421, 2*t1419, 1)
     t1423 = casadi.fabs(t1422)
     t1424 = (t1423 >= 1)
-    t1425 = casadi.fabs(1/casadi.if_else(t1424, t1422, 1))
+    t1425 = 1/casadi.fabs(casadi.if_else(t1424, t1422, 1))
     t1426 = casadi.if_else(t1421, casadi.if_else((t1422 >= 0), 1, -1)*casadi.if_else(t1424, t1425/(1 + casadi.sqrt(1 + t1425**2)), 1/(t1423 + casadi.sqrt(1 + t1423**2))), 0)
     t1427 = 1/casadi.sqrt(1 + t1426**2)
     t1428 = t1419*t1426
@@ -4955,10 +4955,10 @@ def _condition_number(q):
     t1454 = t1452 + t1426*t1451
     t1455 = t1329*t1433 + t1333*t1437 + t1337*t1441 + t1341*t1445 + t1345*t1449 + t1349*t1453
     t1456 = (t1455 != 0)
-    t1457 = 0.5*(-t1429 + t1325)/casadi.if_else(t1456, t1455, 1)
+    t1457 = (-t1429 + t1325)/casadi.if_else(t1456, 2*t1455, 1)
     t1458 = casadi.fabs(t1457)
     t1459 = (t1458 >= 1)
-    t1460 = casadi.fabs(1/casadi.if_else(t1459, t1457, 1))
+    t1460 = 1/casadi.fabs(casadi.if_else(t1459, t1457, 1))
     t1461 = casadi.if_else(t1456, casadi.if_else((t1457 >= 0), 1, -1)*casadi.if_else(t1459, t1460/(1 + casadi.sqrt(1 + t1460**2)), 1/(t1458 + casadi.sqrt(1 + t1458**2))), 0)
     t1462 = 1/casadi.sqrt(1 + t1461**2)
     t1463 = t1455*t1461
@@ -4990,10 +4990,10 @@ def _condition_number(q):
     t1489 = t1487 + t1461*t1486
     t1490 = t1328*t1468 + t1332*t1472 + t1336*t1476 + t1340*t1480 + t1344*t1484 + t1348*t1488
     t1491 = (t1420 != 0)
-    t1492 = 0.5*(-t1359 + t1394)/casadi.if_else(t1491, t1420, 1)
+    t1492 = (-t1359 + t1394)/casadi.if_else(t1491, 2*t1420, 1)
     t1493 = casadi.fabs(t1492)
     t1494 = (t1493 >= 1)
-    t1495 = casadi.fabs(1/casadi.if_else(t1494, t1492, 1))
+    t1495 = 1/casadi.fabs(casadi.if_else(t1494, t1492, 1))
     t1496 = casadi.if_else(t1491, casadi.if_else((t1492 >= 0), 1, -1)*casadi.if_else(t1494, t1495/(1 + casadi.sqrt(1 + t1495**2)), 1/(t1493 + casadi.sqrt(1 + t1493**2))), 0)
     t1497 = 1/casadi.sqrt(1 + t1496**2)
     t1498 = t1420*t1496
@@ -5025,10 +5025,10 @@ def _condition_number(q):
     t1524 = t1522 + t1496*t1521
     t1525 = t1434*t1503 + t1438*t1507 + t1442*t1511 + t1446*t1515 + t1450*t1519 + t1454*t1523
     t1526 = (t1525 != 0)
-    t1527 = 0.5*(-t1499 + t1430)/casadi.if_else(t1526, t1525, 1)
+    t1527 = (-t1499 + t1430)/casadi.if_else(t1526, 2*t1525, 1)
     t1528 = casadi.fabs(t1527)
     t1529 = (t1528 >= 1)
-    t1530 = casadi.fabs(1/casadi.if_else(t1529, t1527, 1))
+    t1530 = 1/casadi.fabs(casadi.if_else(t1529, t1527, 1))
     t1531 = casadi.if_else(t1526, casadi.if_else((t1527 >= 0), 1, -1)*casadi.if_else(t1529, t1530/(1 + casadi.sqrt(1 + t1530**2)), 1/(t1528 + casadi.sqrt(1 + t1528**2))), 0)
     t1532 = 1/casadi.sqrt(1 + t1531**2)
     t1533 = t1525*t1531
@@ -5061,10 +5061,10 @@ def _condition_number(q):
     t1560 = t1469*t1538 + t1473*t1542 + t1477*t1546 + t1481*t1550 + t1485*t1554 + t1489*t1558
     t1561 = t1504*t1539 + t1508*t1543 + t1512*t1547 + t1516*t1551 + t1520*t1555 + t1524*t1559
     t1562 = (t1560 != 0)
-    t1563 = 0.5*(-t1534 + t1465)/casadi.if_else(t1562, t1560, 1)
+    t1563 = (-t1534 + t1465)/casadi.if_else(t1562, 2*t1560, 1)
     t1564 = casadi.fabs(t1563)
     t1565 = (t1564 >= 1)
-    t1566 = casadi.fabs(1/casadi.if_else(t1565, t1563, 1))
+    t1566 = 1/casadi.fabs(casadi.if_else(t1565, t1563, 1))
     t1567 = casadi.if_else(t1562, casadi.if_else((t1563 >= 0), 1, -1)*casadi.if_else(t1565, t1566/(1 + casadi.sqrt(1 + t1566**2)), 1/(t1564 + casadi.sqrt(1 + t1564**2))), 0)
     t1568 = 1/casadi.sqrt(1 + t1567**2)
     t1569 = t1560*t1567
@@ -5095,10 +5095,10 @@ def _condition_number(q):
     t1594 = t1592 - t1567*t1593
     t1595 = t1593 + t1567*t1592
     t1596 = (t1561 != 0)
-    t1597 = 0.5*(-t1500 + t1535)/casadi.if_else(t1596, t1561, 1)
+    t1597 = (-t1500 + t1535)/casadi.if_else(t1596, 2*t1561, 1)
     t1598 = casadi.fabs(t1597)
     t1599 = (t1598 >= 1)
-    t1600 = casadi.fabs(1/casadi.if_else(t1599, t1597, 1))
+    t1600 = 1/casadi.fabs(casadi.if_else(t1599, t1597, 1))
     t1601 = casadi.if_else(t1596, casadi.if_else((t1597 >= 0), 1, -1)*casadi.if_else(t1599, t1600/(1 + casadi.sqrt(1 + t1600**2)), 1/(t1598 + casadi.sqrt(1 + t1598**2))), 0)
     t1602 = 1/casadi.sqrt(1 + t1601**2)
     t1603 = t1561*t1601
@@ -5130,10 +5130,10 @@ def _condition_number(q):
     t1629 = t1627 + t1601*t1626
     t1630 = t1575*t1608 + t1579*t1612 + t1583*t1616 + t1587*t1620 + t1591*t1624 + t1595*t1628
     t1631 = (t1630 != 0)
-    t1632 = 0.5*(-t1604 + t1571)/casadi.if_else(t1631, t1630, 1)
+    t1632 = (-t1604 + t1571)/casadi.if_else(t1631, 2*t1630, 1)
     t1633 = casadi.fabs(t1632)
     t1634 = (t1633 >= 1)
-    t1635 = casadi.fabs(1/casadi.if_else(t1634, t1632, 1))
+    t1635 = 1/casadi.fabs(casadi.if_else(t1634, t1632, 1))
     t1636 = casadi.if_else(t1631, casadi.if_else((t1632 >= 0), 1, -1)*casadi.if_else(t1634, t1635/(1 + casadi.sqrt(1 + t1635**2)), 1/(t1633 + casadi.sqrt(1 + t1633**2))), 0)
     t1637 = 1/casadi.sqrt(1 + t1636**2)
     t1638 = t1630*t1636
@@ -5165,10 +5165,10 @@ def _condition_number(q):
     t1664 = t1662 + t1636*t1661
     t1665 = t1609*t1644 + t1613*t1648 + t1617*t1652 + t1621*t1656 + t1625*t1660 + t1629*t1664
     t1666 = (t1665 != 0)
-    t1667 = 0.5*(-t1605 + t1640)/casadi.if_else(t1666, t1665, 1)
+    t1667 = (-t1605 + t1640)/casadi.if_else(t1666, 2*t1665, 1)
     t1668 = casadi.fabs(t1667)
     t1669 = (t1668 >= 1)
-    t1670 = casadi.fabs(1/casadi.if_else(t1669, t1667, 1))
+    t1670 = 1/casadi.fabs(casadi.if_else(t1669, t1667, 1))
     t1671 = casadi.if_else(t1666, casadi.if_else((t1667 >= 0), 1, -1)*casadi.if_else(t1669, t1670/(1 + casadi.sqrt(1 + t1670**2)), 1/(t1668 + casadi.sqrt(1 + t1668**2))), 0)
     t1672 = 1/casadi.sqrt(1 + t1671**2)
     t1673 = t1665*t1671
@@ -5199,10 +5199,10 @@ def _condition_number(q):
     t1698 = t1696 - t1671*t1697
     t1699 = t1697 + t1671*t1696
     t1700 = (t1490 != 0)
-    t1701 = 0.5*(-t1324 + t1464)/casadi.if_else(t1700, t1490, 1)
+    t1701 = (-t1324 + t1464)/casadi.if_else(t1700, 2*t1490, 1)
     t1702 = casadi.fabs(t1701)
     t1703 = (t1702 >= 1)
-    t1704 = casadi.fabs(1/casadi.if_else(t1703, t1701, 1))
+    t1704 = 1/casadi.fabs(casadi.if_else(t1703, t1701, 1))
     t1705 = casadi.if_else(t1700, casadi.if_else((t1701 >= 0), 1, -1)*casadi.if_else(t1703, t1704/(1 + casadi.sqrt(1 + t1704**2)), 1/(t1702 + casadi.sqrt(1 + t1702**2))), 0)
     t1706 = 1/casadi.sqrt(1 + t1705**2)
     t1707 = t1490*t1705
@@ -5234,10 +5234,10 @@ def _condition_number(q):
     t1733 = t1731 + t1705*t1730
     t1734 = t1574*t1712 + t1578*t1716 + t1582*t1720 + t1586*t1724 + t1590*t1728 + t1594*t1732
     t1735 = (t1734 != 0)
-    t1736 = 0.5*(-t1708 + t1570)/casadi.if_else(t1735, t1734, 1)
+    t1736 = (-t1708 + t1570)/casadi.if_else(t1735, 2*t1734, 1)
     t1737 = casadi.fabs(t1736)
     t1738 = (t1737 >= 1)
-    t1739 = casadi.fabs(1/casadi.if_else(t1738, t1736, 1))
+    t1739 = 1/casadi.fabs(casadi.if_else(t1738, t1736, 1))
     t1740 = casadi.if_else(t1735, casadi.if_else((t1736 >= 0), 1, -1)*casadi.if_else(t1738, t1739/(1 + casadi.sqrt(1 + t1739**2)), 1/(t1737 + casadi.sqrt(1 + t1737**2))), 0)
     t1741 = 1/casadi.sqrt(1 + t1740**2)
     t1742 = t1734*t1740
@@ -5270,10 +5270,10 @@ def _condition_number(q):
     t1769 = t1643*t1747 + t1647*t1751 + t1651*t1755 + t1655*t1759 + t1659*t1763 + t1663*t1767
     t1770 = t1713*t1748 + t1717*t1752 + t1721*t1756 + t1725*t1760 + t1729*t1764 + t1733*t1768
     t1771 = (t1769 != 0)
-    t1772 = 0.5*(-t1743 + t1639)/casadi.if_else(t1771, t1769, 1)
+    t1772 = (-t1743 + t1639)/casadi.if_else(t1771, 2*t1769, 1)
     t1773 = casadi.fabs(t1772)
     t1774 = (t1773 >= 1)
-    t1775 = casadi.fabs(1/casadi.if_else(t1774, t1772, 1))
+    t1775 = 1/casadi.fabs(casadi.if_else(t1774, t1772, 1))
     t1776 = casadi.if_else(t1771, casadi.if_else((t1772 >= 0), 1, -1)*casadi.if_else(t1774, t1775/(1 + casadi.sqrt(1 + t1775**2)), 1/(t1773 + casadi.sqrt(1 + t1773**2))), 0)
     t1777 = 1/casadi.sqrt(1 + t1776**2)
     t1778 = t1769*t1776
@@ -5305,10 +5305,10 @@ def _condition_number(q):
     t1804 = t1802 + t1776*t1801
     t1805 = t1678*t1783 + t1682*t1787 + t1686*t1791 + t1690*t1795 + t1694*t1799 + t1698*t1803
     t1806 = (t1805 != 0)
-    t1807 = 0.5*(-t1779 + t1674)/casadi.if_else(t1806, t1805, 1)
+    t1807 = (-t1779 + t1674)/casadi.if_else(t1806, 2*t1805, 1)
     t1808 = casadi.fabs(t1807)
     t1809 = (t1808 >= 1)
-    t1810 = casadi.fabs(1/casadi.if_else(t1809, t1807, 1))
+    t1810 = 1/casadi.fabs(casadi.if_else(t1809, t1807, 1))
     t1811 = casadi.if_else(t1806, casadi.if_else((t1807 >= 0), 1, -1)*casadi.if_else(t1809, t1810/(1 + casadi.sqrt(1 + t1810**2)), 1/(t1808 + casadi.sqrt(1 + t1808**2))), 0)
     t1812 = 1/casadi.sqrt(1 + t1811**2)
     t1813 = t1805*t1811
@@ -5340,10 +5340,10 @@ def _condition_number(q):
     t1839 = t1837 + t1811*t1836
     t1840 = t1679*t1818 + t1683*t1822 + t1687*t1826 + t1691*t1830 + t1695*t1834 + t1699*t1838
     t1841 = (t1840 != 0)
-    t1842 = 0.5*(-t1814 + t1675)/casadi.if_else(t1841, t1840, 1)
+    t1842 = (-t1814 + t1675)/casadi.if_else(t1841, 2*t1840, 1)
     t1843 = casadi.fabs(t1842)
     t1844 = (t1843 >= 1)
-    t1845 = casadi.fabs(1/casadi.if_else(t1844, t1842, 1))
+    t1845 = 1/casadi.fabs(casadi.if_else(t1844, t1842, 1))
     t1846 = casadi.if_else(t1841, casadi.if_else((t1842 >= 0), 1, -1)*casadi.if_else(t1844, t1845/(1 + casadi.sqrt(1 + t1845**2)), 1/(t1843 + casadi.sqrt(1 + t1843**2))), 0)
     t1847 = 1/casadi.sqrt(1 + t1846**2)
     t1848 = t1840*t1846
@@ -5374,10 +5374,10 @@ def _condition_number(q):
     t1873 = t1871 - t1846*t1872
     t1874 = t1872 + t1846*t1871
     t1875 = (t1770 != 0)
-    t1876 = 0.5*(-t1709 + t1744)/casadi.if_else(t1875, t1770, 1)
+    t1876 = (-t1709 + t1744)/casadi.if_else(t1875, 2*t1770, 1)
     t1877 = casadi.fabs(t1876)
     t1878 = (t1877 >= 1)
-    t1879 = casadi.fabs(1/casadi.if_else(t1878, t1876, 1))
+    t1879 = 1/casadi.fabs(casadi.if_else(t1878, t1876, 1))
     t1880 = casadi.if_else(t1875, casadi.if_else((t1876 >= 0), 1, -1)*casadi.if_else(t1878, t1879/(1 + casadi.sqrt(1 + t1879**2)), 1/(t1877 + casadi.sqrt(1 + t1877**2))), 0)
     t1881 = 1/casadi.sqrt(1 + t1880**2)
     t1882 = t1770*t1880
@@ -5409,10 +5409,10 @@ def _condition_number(q):
     t1908 = t1906 + t1880*t1905
     t1909 = t1784*t1887 + t1788*t1891 + t1792*t1895 + t1796*t1899 + t1800*t1903 + t1804*t1907
     t1910 = (t1909 != 0)
-    t1911 = 0.5*(-t1883 + t1780)/casadi.if_else(t1910, t1909, 1)
+    t1911 = (-t1883 + t1780)/casadi.if_else(t1910, 2*t1909, 1)
     t1912 = casadi.fabs(t1911)
     t1913 = (t1912 >= 1)
-    t1914 = casadi.fabs(1/casadi.if_else(t1913, t1911, 1))
+    t1914 = 1/casadi.fabs(casadi.if_else(t1913, t1911, 1))
     t1915 = casadi.if_else(t1910, casadi.if_else((t1911 >= 0), 1, -1)*casadi.if_else(t1913, t1914/(1 + casadi.sqrt(1 + t1914**2)), 1/(t1912 + casadi.sqrt(1 + t1912**2))), 0)
     t1916 = 1/casadi.sqrt(1 + t1915**2)
     t1917 = t1909*t1915
@@ -5445,10 +5445,10 @@ def _condition_number(q):
     t1944 = t1819*t1922 + t1823*t1926 + t1827*t1930 + t1831*t1934 + t1835*t1938 + t1839*t1942
     t1945 = t1888*t1923 + t1892*t1927 + t1896*t1931 + t1900*t1935 + t1904*t1939 + t1908*t1943
     t1946 = (t1944 != 0)
-    t1947 = 0.5*(-t1918 + t1815)/casadi.if_else(t1946, t1944, 1)
+    t1947 = (-t1918 + t1815)/casadi.if_else(t1946, 2*t1944, 1)
     t1948 = casadi.fabs(t1947)
     t1949 = (t1948 >= 1)
-    t1950 = casadi.fabs(1/casadi.if_else(t1949, t1947, 1))
+    t1950 = 1/casadi.fabs(casadi.if_else(t1949, t1947, 1))
     t1951 = casadi.if_else(t1946, casadi.if_else((t1947 >= 0), 1, -1)*casadi.if_else(t1949, t1950/(1 + casadi.sqrt(1 + t1950**2)), 1/(t1948 + casadi.sqrt(1 + t1948**2))), 0)
     t1952 = 1/casadi.sqrt(1 + t1951**2)
     t1953 = t1944*t1951
@@ -5480,10 +5480,10 @@ def _condition_number(q):
     t1979 = t1977 + t1951*t1976
     t1980 = t1854*t1958 + t1858*t1962 + t1862*t1966 + t1866*t1970 + t1870*t1974 + t1874*t1978
     t1981 = (t1980 != 0)
-    t1982 = 0.5*(-t1954 + t1850)/casadi.if_else(t1981, t1980, 1)
+    t1982 = (-t1954 + t1850)/casadi.if_else(t1981, 2*t1980, 1)
     t1983 = casadi.fabs(t1982)
     t1984 = (t1983 >= 1)
-    t1985 = casadi.fabs(1/casadi.if_else(t1984, t1982, 1))
+    t1985 = 1/casadi.fabs(casadi.if_else(t1984, t1982, 1))
     t1986 = casadi.if_else(t1981, casadi.if_else((t1982 >= 0), 1, -1)*casadi.if_else(t1984, t1985/(1 + casadi.sqrt(1 + t1985**2)), 1/(t1983 + casadi.sqrt(1 + t1983**2))), 0)
     t1987 = 1/casadi.sqrt(1 + t1986**2)
     t1988 = t1980*t1986
@@ -5515,10 +5515,10 @@ def _condition_number(q):
     t2014 = t2012 + t1986*t2011
     t2015 = t1853*t1993 + t1857*t1997 + t1861*t2001 + t1865*t2005 + t1869*t2009 + t1873*t2013
     t2016 = (t1945 != 0)
-    t2017 = 0.5*(-t1884 + t1919)/casadi.if_else(t2016, t1945, 1)
+    t2017 = (-t1884 + t1919)/casadi.if_else(t2016, 2*t1945, 1)
     t2018 = casadi.fabs(t2017)
     t2019 = (t2018 >= 1)
-    t2020 = casadi.fabs(1/casadi.if_else(t2019, t2017, 1))
+    t2020 = 1/casadi.fabs(casadi.if_else(t2019, t2017, 1))
     t2021 = casadi.if_else(t2016, casadi.if_else((t2017 >= 0), 1, -1)*casadi.if_else(t2019, t2020/(1 + casadi.sqrt(1 + t2020**2)), 1/(t2018 + casadi.sqrt(1 + t2018**2))), 0)
     t2022 = 1/casadi.sqrt(1 + t2021**2)
     t2023 = t1945*t2021
@@ -5550,10 +5550,10 @@ def _condition_number(q):
     t2049 = t2047 + t2021*t2046
     t2050 = t1959*t2028 + t1963*t2032 + t1967*t2036 + t1971*t2040 + t1975*t2044 + t1979*t2048
     t2051 = (t2050 != 0)
-    t2052 = 0.5*(-t2024 + t1955)/casadi.if_else(t2051, t2050, 1)
+    t2052 = (-t2024 + t1955)/casadi.if_else(t2051, 2*t2050, 1)
     t2053 = casadi.fabs(t2052)
     t2054 = (t2053 >= 1)
-    t2055 = casadi.fabs(1/casadi.if_else(t2054, t2052, 1))
+    t2055 = 1/casadi.fabs(casadi.if_else(t2054, t2052, 1))
     t2056 = casadi.if_else(t2051, casadi.if_else((t2052 >= 0), 1, -1)*casadi.if_else(t2054, t2055/(1 + casadi.sqrt(1 + t2055**2)), 1/(t2053 + casadi.sqrt(1 + t2053**2))), 0)
     t2057 = 1/casadi.sqrt(1 + t2056**2)
     t2058 = t2050*t2056
@@ -5586,10 +5586,10 @@ def _condition_number(q):
     t2085 = t1994*t2063 + t1998*t2067 + t2002*t2071 + t2006*t2075 + t2010*t2079 + t2014*t2083
     t2086 = t2029*t2064 + t2033*t2068 + t2037*t2072 + t2041*t2076 + t2045*t2080 + t2049*t2084
     t2087 = (t2085 != 0)
-    t2088 = 0.5*(-t2059 + t1990)/casadi.if_else(t2087, t2085, 1)
+    t2088 = (-t2059 + t1990)/casadi.if_else(t2087, 2*t2085, 1)
     t2089 = casadi.fabs(t2088)
     t2090 = (t2089 >= 1)
-    t2091 = casadi.fabs(1/casadi.if_else(t2090, t2088, 1))
+    t2091 = 1/casadi.fabs(casadi.if_else(t2090, t2088, 1))
     t2092 = casadi.if_else(t2087, casadi.if_else((t2088 >= 0), 1, -1)*casadi.if_else(t2090, t2091/(1 + casadi.sqrt(1 + t2091**2)), 1/(t2089 + casadi.sqrt(1 + t2089**2))), 0)
     t2093 = 1/casadi.sqrt(1 + t2092**2)
     t2094 = t2085*t2092
@@ -5620,10 +5620,10 @@ def _condition_number(q):
     t2119 = t2117 - t2092*t2118
     t2120 = t2118 + t2092*t2117
     t2121 = (t2086 != 0)
-    t2122 = 0.5*(-t2025 + t2060)/casadi.if_else(t2121, t2086, 1)
+    t2122 = (-t2025 + t2060)/casadi.if_else(t2121, 2*t2086, 1)
     t2123 = casadi.fabs(t2122)
     t2124 = (t2123 >= 1)
-    t2125 = casadi.fabs(1/casadi.if_else(t2124, t2122, 1))
+    t2125 = 1/casadi.fabs(casadi.if_else(t2124, t2122, 1))
     t2126 = casadi.if_else(t2121, casadi.if_else((t2122 >= 0), 1, -1)*casadi.if_else(t2124, t2125/(1 + casadi.sqrt(1 + t2125**2)), 1/(t2123 + casadi.sqrt(1 + t2123**2))), 0)
     t2127 = 1/casadi.sqrt(1 + t2126**2)
     t2128 = t2086*t2126
@@ -5655,10 +5655,10 @@ def _condition_number(q):
     t2154 = t2152 + t2126*t2151
     t2155 = t2100*t2133 + t2104*t2137 + t2108*t2141 + t2112*t2145 + t2116*t2149 + t2120*t2153
     t2156 = (t2155 != 0)
-    t2157 = 0.5*(-t2129 + t2096)/casadi.if_else(t2156, t2155, 1)
+    t2157 = (-t2129 + t2096)/casadi.if_else(t2156, 2*t2155, 1)
     t2158 = casadi.fabs(t2157)
     t2159 = (t2158 >= 1)
-    t2160 = casadi.fabs(1/casadi.if_else(t2159, t2157, 1))
+    t2160 = 1/casadi.fabs(casadi.if_else(t2159, t2157, 1))
     t2161 = casadi.if_else(t2156, casadi.if_else((t2157 >= 0), 1, -1)*casadi.if_else(t2159, t2160/(1 + casadi.sqrt(1 + t2160**2)), 1/(t2158 + casadi.sqrt(1 + t2158**2))), 0)
     t2162 = 1/casadi.sqrt(1 + t2161**2)
     t2163 = t2155*t2161
@@ -5690,10 +5690,10 @@ def _condition_number(q):
     t2189 = t2187 + t2161*t2186
     t2190 = t2134*t2169 + t2138*t2173 + t2142*t2177 + t2146*t2181 + t2150*t2185 + t2154*t2189
     t2191 = (t2190 != 0)
-    t2192 = 0.5*(-t2130 + t2165)/casadi.if_else(t2191, t2190, 1)
+    t2192 = (-t2130 + t2165)/casadi.if_else(t2191, 2*t2190, 1)
     t2193 = casadi.fabs(t2192)
     t2194 = (t2193 >= 1)
-    t2195 = casadi.fabs(1/casadi.if_else(t2194, t2192, 1))
+    t2195 = 1/casadi.fabs(casadi.if_else(t2194, t2192, 1))
     t2196 = casadi.if_else(t2191, casadi.if_else((t2192 >= 0), 1, -1)*casadi.if_else(t2194, t2195/(1 + casadi.sqrt(1 + t2195**2)), 1/(t2193 + casadi.sqrt(1 + t2193**2))), 0)
     t2197 = 1/casadi.sqrt(1 + t2196**2)
     t2198 = t2190*t2196
@@ -5724,10 +5724,10 @@ def _condition_number(q):
     t2223 = t2221 - t2196*t2222
     t2224 = t2222 + t2196*t2221
     t2225 = (t2015 != 0)
-    t2226 = 0.5*(-t1849 + t1989)/casadi.if_else(t2225, t2015, 1)
+    t2226 = (-t1849 + t1989)/casadi.if_else(t2225, 2*t2015, 1)
     t2227 = casadi.fabs(t2226)
     t2228 = (t2227 >= 1)
-    t2229 = casadi.fabs(1/casadi.if_else(t2228, t2226, 1))
+    t2229 = 1/casadi.fabs(casadi.if_else(t2228, t2226, 1))
     t2230 = casadi.if_else(t2225, casadi.if_else((t2226 >= 0), 1, -1)*casadi.if_else(t2228, t2229/(1 + casadi.sqrt(1 + t2229**2)), 1/(t2227 + casadi.sqrt(1 + t2227**2))), 0)
     t2231 = 1/casadi.sqrt(1 + t2230**2)
     t2232 = t2015*t2230
@@ -5759,10 +5759,10 @@ def _condition_number(q):
     t2258 = t2256 + t2230*t2255
     t2259 = t2099*t2237 + t2103*t2241 + t2107*t2245 + t2111*t2249 + t2115*t2253 + t2119*t2257
     t2260 = (t2259 != 0)
-    t2261 = 0.5*(-t2233 + t2095)/casadi.if_else(t2260, t2259, 1)
+    t2261 = (-t2233 + t2095)/casadi.if_else(t2260, 2*t2259, 1)
     t2262 = casadi.fabs(t2261)
     t2263 = (t2262 >= 1)
-    t2264 = casadi.fabs(1/casadi.if_else(t2263, t2261, 1))
+    t2264 = 1/casadi.fabs(casadi.if_else(t2263, t2261, 1))
     t2265 = casadi.if_else(t2260, casadi.if_else((t2261 >= 0), 1, -1)*casadi.if_else(t2263, t2264/(1 + casadi.sqrt(1 + t2264**2)), 1/(t2262 + casadi.sqrt(1 + t2262**2))), 0)
     t2266 = 1/casadi.sqrt(1 + t2265**2)
     t2267 = t2259*t2265
@@ -5795,10 +5795,10 @@ def _condition_number(q):
     t2294 = t2168*t2272 + t2172*t2276 + t2176*t2280 + t2180*t2284 + t2184*t2288 + t2188*t2292
     t2295 = t2238*t2273 + t2242*t2277 + t2246*t2281 + t2250*t2285 + t2254*t2289 + t2258*t2293
     t2296 = (t2294 != 0)
-    t2297 = 0.5*(-t2268 + t2164)/casadi.if_else(t2296, t2294, 1)
+    t2297 = (-t2268 + t2164)/casadi.if_else(t2296, 2*t2294, 1)
     t2298 = casadi.fabs(t2297)
     t2299 = (t2298 >= 1)
-    t2300 = casadi.fabs(1/casadi.if_else(t2299, t2297, 1))
+    t2300 = 1/casadi.fabs(casadi.if_else(t2299, t2297, 1))
     t2301 = casadi.if_else(t2296, casadi.if_else((t2297 >= 0), 1, -1)*casadi.if_else(t2299, t2300/(1 + casadi.sqrt(1 + t2300**2)), 1/(t2298 + casadi.sqrt(1 + t2298**2))), 0)
     t2302 = 1/casadi.sqrt(1 + t2301**2)
     t2303 = t2294*t2301
@@ -5830,10 +5830,10 @@ def _condition_number(q):
     t2329 = t2327 + t2301*t2326
     t2330 = t2203*t2308 + t2207*t2312 + t2211*t2316 + t2215*t2320 + t2219*t2324 + t2223*t2328
     t2331 = (t2330 != 0)
-    t2332 = 0.5*(-t2304 + t2199)/casadi.if_else(t2331, t2330, 1)
+    t2332 = (-t2304 + t2199)/casadi.if_else(t2331, 2*t2330, 1)
     t2333 = casadi.fabs(t2332)
     t2334 = (t2333 >= 1)
-    t2335 = casadi.fabs(1/casadi.if_else(t2334, t2332, 1))
+    t2335 = 1/casadi.fabs(casadi.if_else(t2334, t2332, 1))
     t2336 = casadi.if_else(t2331, casadi.if_else((t2332 >= 0), 1, -1)*casadi.if_else(t2334, t2335/(1 + casadi.sqrt(1 + t2335**2)), 1/(t2333 + casadi.sqrt(1 + t2333**2))), 0)
     t2337 = 1/casadi.sqrt(1 + t2336**2)
     t2338 = t2330*t2336
@@ -5865,10 +5865,10 @@ def _condition_number(q):
     t2364 = t2362 + t2336*t2361
     t2365 = t2204*t2343 + t2208*t2347 + t2212*t2351 + t2216*t2355 + t2220*t2359 + t2224*t2363
     t2366 = (t2365 != 0)
-    t2367 = 0.5*(-t2339 + t2200)/casadi.if_else(t2366, t2365, 1)
+    t2367 = (-t2339 + t2200)/casadi.if_else(t2366, 2*t2365, 1)
     t2368 = casadi.fabs(t2367)
     t2369 = (t2368 >= 1)
-    t2370 = casadi.fabs(1/casadi.if_else(t2369, t2367, 1))
+    t2370 = 1/casadi.fabs(casadi.if_else(t2369, t2367, 1))
     t2371 = casadi.if_else(t2366, casadi.if_else((t2367 >= 0), 1, -1)*casadi.if_else(t2369, t2370/(1 + casadi.sqrt(1 + t2370**2)), 1/(t2368 + casadi.sqrt(1 + t2368**2))), 0)
     t2372 = 1/casadi.sqrt(1 + t2371**2)
     t2373 = t2365*t2371
@@ -5899,10 +5899,10 @@ def _condition_number(q):
     t2398 = t2396 - t2371*t2397
     t2399 = t2397 + t2371*t2396
     t2400 = (t2295 != 0)
-    t2401 = 0.5*(-t2234 + t2269)/casadi.if_else(t2400, t2295, 1)
+    t2401 = (-t2234 + t2269)/casadi.if_else(t2400, 2*t2295, 1)
     t2402 = casadi.fabs(t2401)
     t2403 = (t2402 >= 1)
-    t2404 = casadi.fabs(1/casadi.if_else(t2403, t2401, 1))
+    t2404 = 1/casadi.fabs(casadi.if_else(t2403, t2401, 1))
     t2405 = casadi.if_else(t2400, casadi.if_else((t2401 >= 0), 1, -1)*casadi.if_else(t2403, t2404/(1 + casadi.sqrt(1 + t2404**2)), 1/(t2402 + casadi.sqrt(1 + t2402**2))), 0)
     t2406 = 1/casadi.sqrt(1 + t2405**2)
     t2407 = t2295*t2405
@@ -5934,10 +5934,10 @@ def _condition_number(q):
     t2433 = t2431 + t2405*t2430
     t2434 = t2309*t2412 + t2313*t2416 + t2317*t2420 + t2321*t2424 + t2325*t2428 + t2329*t2432
     t2435 = (t2434 != 0)
-    t2436 = 0.5*(-t2408 + t2305)/casadi.if_else(t2435, t2434, 1)
+    t2436 = (-t2408 + t2305)/casadi.if_else(t2435, 2*t2434, 1)
     t2437 = casadi.fabs(t2436)
     t2438 = (t2437 >= 1)
-    t2439 = casadi.fabs(1/casadi.if_else(t2438, t2436, 1))
+    t2439 = 1/casadi.fabs(casadi.if_else(t2438, t2436, 1))
     t2440 = casadi.if_else(t2435, casadi.if_else((t2436 >= 0), 1, -1)*casadi.if_else(t2438, t2439/(1 + casadi.sqrt(1 + t2439**2)), 1/(t2437 + casadi.sqrt(1 + t2437**2))), 0)
     t2441 = 1/casadi.sqrt(1 + t2440**2)
     t2442 = t2434*t2440
@@ -5970,10 +5970,10 @@ def _condition_number(q):
     t2469 = t2344*t2447 + t2348*t2451 + t2352*t2455 + t2356*t2459 + t2360*t2463 + t2364*t2467
     t2470 = t2413*t2448 + t2417*t2452 + t2421*t2456 + t2425*t2460 + t2429*t2464 + t2433*t2468
     t2471 = (t2469 != 0)
-    t2472 = 0.5*(-t2443 + t2340)/casadi.if_else(t2471, t2469, 1)
+    t2472 = (-t2443 + t2340)/casadi.if_else(t2471, 2*t2469, 1)
     t2473 = casadi.fabs(t2472)
     t2474 = (t2473 >= 1)
-    t2475 = casadi.fabs(1/casadi.if_else(t2474, t2472, 1))
+    t2475 = 1/casadi.fabs(casadi.if_else(t2474, t2472, 1))
     t2476 = casadi.if_else(t2471, casadi.if_else((t2472 >= 0), 1, -1)*casadi.if_else(t2474, t2475/(1 + casadi.sqrt(1 + t2475**2)), 1/(t2473 + casadi.sqrt(1 + t2473**2))), 0)
     t2477 = 1/casadi.sqrt(1 + t2476**2)
     t2478 = t2469*t2476
@@ -6005,10 +6005,10 @@ def _condition_number(q):
     t2504 = t2502 + t2476*t2501
     t2505 = t2379*t2483 + t2383*t2487 + t2387*t2491 + t2391*t2495 + t2395*t2499 + t2399*t2503
     t2506 = (t2505 != 0)
-    t2507 = 0.5*(-t2479 + t2375)/casadi.if_else(t2506, t2505, 1)
+    t2507 = (-t2479 + t2375)/casadi.if_else(t2506, 2*t2505, 1)
     t2508 = casadi.fabs(t2507)
     t2509 = (t2508 >= 1)
-    t2510 = casadi.fabs(1/casadi.if_else(t2509, t2507, 1))
+    t2510 = 1/casadi.fabs(casadi.if_else(t2509, t2507, 1))
     t2511 = casadi.if_else(t2506, casadi.if_else((t2507 >= 0), 1, -1)*casadi.if_else(t2509, t2510/(1 + casadi.sqrt(1 + t2510**2)), 1/(t2508 + casadi.sqrt(1 + t2508**2))), 0)
     t2512 = 1/casadi.sqrt(1 + t2511**2)
     t2513 = t2505*t2511
@@ -6040,10 +6040,10 @@ def _condition_number(q):
     t2539 = t2537 + t2511*t2536
     t2540 = t2378*t2518 + t2382*t2522 + t2386*t2526 + t2390*t2530 + t2394*t2534 + t2398*t2538
     t2541 = (t2470 != 0)
-    t2542 = 0.5*(-t2409 + t2444)/casadi.if_else(t2541, t2470, 1)
+    t2542 = (-t2409 + t2444)/casadi.if_else(t2541, 2*t2470, 1)
     t2543 = casadi.fabs(t2542)
     t2544 = (t2543 >= 1)
-    t2545 = casadi.fabs(1/casadi.if_else(t2544, t2542, 1))
+    t2545 = 1/casadi.fabs(casadi.if_else(t2544, t2542, 1))
     t2546 = casadi.if_else(t2541, casadi.if_else((t2542 >= 0), 1, -1)*casadi.if_else(t2544, t2545/(1 + casadi.sqrt(1 + t2545**2)), 1/(t2543 + casadi.sqrt(1 + t2543**2))), 0)
     t2547 = 1/casadi.sqrt(1 + t2546**2)
     t2548 = t2470*t2546
@@ -6075,10 +6075,10 @@ def _condition_number(q):
     t2574 = t2572 + t2546*t2571
     t2575 = t2484*t2553 + t2488*t2557 + t2492*t2561 + t2496*t2565 + t2500*t2569 + t2504*t2573
     t2576 = (t2575 != 0)
-    t2577 = 0.5*(-t2549 + t2480)/casadi.if_else(t2576, t2575, 1)
+    t2577 = (-t2549 + t2480)/casadi.if_else(t2576, 2*t2575, 1)
     t2578 = casadi.fabs(t2577)
     t2579 = (t2578 >= 1)
-    t2580 = casadi.fabs(1/casadi.if_else(t2579, t2577, 1))
+    t2580 = 1/casadi.fabs(casadi.if_else(t2579, t2577, 1))
     t2581 = casadi.if_else(t2576, casadi.if_else((t2577 >= 0), 1, -1)*casadi.if_else(t2579, t2580/(1 + casadi.sqrt(1 + t2580**2)), 1/(t2578 + casadi.sqrt(1 + t2578**2))), 0)
     t2582 = 1/casadi.sqrt(1 + t2581**2)
     t2583 = t2575*t2581
@@ -6111,10 +6111,10 @@ def _condition_number(q):
     t2610 = t2519*t2588 + t2523*t2592 + t2527*t2596 + t2531*t2600 + t2535*t2604 + t2539*t2608
     t2611 = t2554*t2589 + t2558*t2593 + t2562*t2597 + t2566*t2601 + t2570*t2605 + t2574*t2609
     t2612 = (t2610 != 0)
-    t2613 = 0.5*(-t2584 + t2515)/casadi.if_else(t2612, t2610, 1)
+    t2613 = (-t2584 + t2515)/casadi.if_else(t2612, 2*t2610, 1)
     t2614 = casadi.fabs(t2613)
     t2615 = (t2614 >= 1)
-    t2616 = casadi.fabs(1/casadi.if_else(t2615, t2613, 1))
+    t2616 = 1/casadi.fabs(casadi.if_else(t2615, t2613, 1))
     t2617 = casadi.if_else(t2612, casadi.if_else((t2613 >= 0), 1, -1)*casadi.if_else(t2615, t2616/(1 + casadi.sqrt(1 + t2616**2)), 1/(t2614 + casadi.sqrt(1 + t2614**2))), 0)
     t2618 = 1/casadi.sqrt(1 + t2617**2)
     t2619 = t2610*t2617
@@ -6145,10 +6145,10 @@ def _condition_number(q):
     t2644 = t2642 - t2617*t2643
     t2645 = t2643 + t2617*t2642
     t2646 = (t2611 != 0)
-    t2647 = 0.5*(-t2550 + t2585)/casadi.if_else(t2646, t2611, 1)
+    t2647 = (-t2550 + t2585)/casadi.if_else(t2646, 2*t2611, 1)
     t2648 = casadi.fabs(t2647)
     t2649 = (t2648 >= 1)
-    t2650 = casadi.fabs(1/casadi.if_else(t2649, t2647, 1))
+    t2650 = 1/casadi.fabs(casadi.if_else(t2649, t2647, 1))
     t2651 = casadi.if_else(t2646, casadi.if_else((t2647 >= 0), 1, -1)*casadi.if_else(t2649, t2650/(1 + casadi.sqrt(1 + t2650**2)), 1/(t2648 + casadi.sqrt(1 + t2648**2))), 0)
     t2652 = 1/casadi.sqrt(1 + t2651**2)
     t2653 = t2611*t2651
@@ -6180,10 +6180,10 @@ def _condition_number(q):
     t2679 = t2677 + t2651*t2676
     t2680 = t2625*t2658 + t2629*t2662 + t2633*t2666 + t2637*t2670 + t2641*t2674 + t2645*t2678
     t2681 = (t2680 != 0)
-    t2682 = 0.5*(-t2654 + t2621)/casadi.if_else(t2681, t2680, 1)
+    t2682 = (-t2654 + t2621)/casadi.if_else(t2681, 2*t2680, 1)
     t2683 = casadi.fabs(t2682)
     t2684 = (t2683 >= 1)
-    t2685 = casadi.fabs(1/casadi.if_else(t2684, t2682, 1))
+    t2685 = 1/casadi.fabs(casadi.if_else(t2684, t2682, 1))
     t2686 = casadi.if_else(t2681, casadi.if_else((t2682 >= 0), 1, -1)*casadi.if_else(t2684, t2685/(1 + casadi.sqrt(1 + t2685**2)), 1/(t2683 + casadi.sqrt(1 + t2683**2))), 0)
     t2687 = 1/casadi.sqrt(1 + t2686**2)
     t2688 = t2680*t2686
@@ -6215,10 +6215,10 @@ def _condition_number(q):
     t2714 = t2712 + t2686*t2711
     t2715 = t2659*t2694 + t2663*t2698 + t2667*t2702 + t2671*t2706 + t2675*t2710 + t2679*t2714
     t2716 = (t2715 != 0)
-    t2717 = 0.5*(-t2655 + t2690)/casadi.if_else(t2716, t2715, 1)
+    t2717 = (-t2655 + t2690)/casadi.if_else(t2716, 2*t2715, 1)
     t2718 = casadi.fabs(t2717)
     t2719 = (t2718 >= 1)
-    t2720 = casadi.fabs(1/casadi.if_else(t2719, t2717, 1))
+    t2720 = 1/casadi.fabs(casadi.if_else(t2719, t2717, 1))
     t2721 = casadi.if_else(t2716, casadi.if_else((t2717 >= 0), 1, -1)*casadi.if_else(t2719, t2720/(1 + casadi.sqrt(1 + t2720**2)), 1/(t2718 + casadi.sqrt(1 + t2718**2))), 0)
     t2722 = 1/casadi.sqrt(1 + t2721**2)
     t2723 = t2715*t2721
@@ -6249,10 +6249,10 @@ def _condition_number(q):
     t2748 = t2746 - t2721*t2747
     t2749 = t2747 + t2721*t2746
     t2750 = (t2540 != 0)
-    t2751 = 0.5*(-t2374 + t2514)/casadi.if_else(t2750, t2540, 1)
+    t2751 = (-t2374 + t2514)/casadi.if_else(t2750, 2*t2540, 1)
     t2752 = casadi.fabs(t2751)
     t2753 = (t2752 >= 1)
-    t2754 = casadi.fabs(1/casadi.if_else(t2753, t2751, 1))
+    t2754 = 1/casadi.fabs(casadi.if_else(t2753, t2751, 1))
     t2755 = casadi.if_else(t2750, casadi.if_else((t2751 >= 0), 1, -1)*casadi.if_else(t2753, t2754/(1 + casadi.sqrt(1 + t2754**2)), 1/(t2752 + casadi.sqrt(1 + t2752**2))), 0)
     t2756 = 1/casadi.sqrt(1 + t2755**2)
     t2757 = t2540*t2755
@@ -6284,10 +6284,10 @@ def _condition_number(q):
     t2783 = t2781 + t2755*t2780
     t2784 = t2624*t2762 + t2628*t2766 + t2632*t2770 + t2636*t2774 + t2640*t2778 + t2644*t2782
     t2785 = (t2784 != 0)
-    t2786 = 0.5*(-t2758 + t2620)/casadi.if_else(t2785, t2784, 1)
+    t2786 = (-t2758 + t2620)/casadi.if_else(t2785, 2*t2784, 1)
     t2787 = casadi.fabs(t2786)
     t2788 = (t2787 >= 1)
-    t2789 = casadi.fabs(1/casadi.if_else(t2788, t2786, 1))
+    t2789 = 1/casadi.fabs(casadi.if_else(t2788, t2786, 1))
     t2790 = casadi.if_else(t2785, casadi.if_else((t2786 >= 0), 1, -1)*casadi.if_else(t2788, t2789/(1 + casadi.sqrt(1 + t2789**2)), 1/(t2787 + casadi.sqrt(1 + t2787**2))), 0)
     t2791 = 1/casadi.sqrt(1 + t2790**2)
     t2792 = t2784*t2790
@@ -6320,10 +6320,10 @@ def _condition_number(q):
     t2819 = t2693*t2797 + t2697*t2801 + t2701*t2805 + t2705*t2809 + t2709*t2813 + t2713*t2817
     t2820 = t2763*t2798 + t2767*t2802 + t2771*t2806 + t2775*t2810 + t2779*t2814 + t2783*t2818
     t2821 = (t2819 != 0)
-    t2822 = 0.5*(-t2793 + t2689)/casadi.if_else(t2821, t2819, 1)
+    t2822 = (-t2793 + t2689)/casadi.if_else(t2821, 2*t2819, 1)
     t2823 = casadi.fabs(t2822)
     t2824 = (t2823 >= 1)
-    t2825 = casadi.fabs(1/casadi.if_else(t2824, t2822, 1))
+    t2825 = 1/casadi.fabs(casadi.if_else(t2824, t2822, 1))
     t2826 = casadi.if_else(t2821, casadi.if_else((t2822 >= 0), 1, -1)*casadi.if_else(t2824, t2825/(1 + casadi.sqrt(1 + t2825**2)), 1/(t2823 + casadi.sqrt(1 + t2823**2))), 0)
     t2827 = 1/casadi.sqrt(1 + t2826**2)
     t2828 = t2819*t2826
@@ -6355,10 +6355,10 @@ def _condition_number(q):
     t2854 = t2852 + t2826*t2851
     t2855 = t2728*t2833 + t2732*t2837 + t2736*t2841 + t2740*t2845 + t2744*t2849 + t2748*t2853
     t2856 = (t2855 != 0)
-    t2857 = 0.5*(-t2829 + t2724)/casadi.if_else(t2856, t2855, 1)
+    t2857 = (-t2829 + t2724)/casadi.if_else(t2856, 2*t2855, 1)
     t2858 = casadi.fabs(t2857)
     t2859 = (t2858 >= 1)
-    t2860 = casadi.fabs(1/casadi.if_else(t2859, t2857, 1))
+    t2860 = 1/casadi.fabs(casadi.if_else(t2859, t2857, 1))
     t2861 = casadi.if_else(t2856, casadi.if_else((t2857 >= 0), 1, -1)*casadi.if_else(t2859, t2860/(1 + casadi.sqrt(1 + t2860**2)), 1/(t2858 + casadi.sqrt(1 + t2858**2))), 0)
     t2862 = 1/casadi.sqrt(1 + t2861**2)
     t2863 = t2855*t2861
@@ -6390,10 +6390,10 @@ def _condition_number(q):
     t2889 = t2887 + t2861*t2886
     t2890 = t2729*t2868 + t2733*t2872 + t2737*t2876 + t2741*t2880 + t2745*t2884 + t2749*t2888
     t2891 = (t2890 != 0)
-    t2892 = 0.5*(-t2864 + t2725)/casadi.if_else(t2891, t2890, 1)
+    t2892 = (-t2864 + t2725)/casadi.if_else(t2891, 2*t2890, 1)
     t2893 = casadi.fabs(t2892)
     t2894 = (t2893 >= 1)
-    t2895 = casadi.fabs(1/casadi.if_else(t2894, t2892, 1))
+    t2895 = 1/casadi.fabs(casadi.if_else(t2894, t2892, 1))
     t2896 = casadi.if_else(t2891, casadi.if_else((t2892 >= 0), 1, -1)*casadi.if_else(t2894, t2895/(1 + casadi.sqrt(1 + t2895**2)), 1/(t2893 + casadi.sqrt(1 + t2893**2))), 0)
     t2897 = 1/casadi.sqrt(1 + t2896**2)
     t2898 = t2890*t2896
@@ -6424,10 +6424,10 @@ def _condition_number(q):
     t2923 = t2921 - t2896*t2922
     t2924 = t2922 + t2896*t2921
     t2925 = (t2820 != 0)
-    t2926 = 0.5*(-t2759 + t2794)/casadi.if_else(t2925, t2820, 1)
+    t2926 = (-t2759 + t2794)/casadi.if_else(t2925, 2*t2820, 1)
     t2927 = casadi.fabs(t2926)
     t2928 = (t2927 >= 1)
-    t2929 = casadi.fabs(1/casadi.if_else(t2928, t2926, 1))
+    t2929 = 1/casadi.fabs(casadi.if_else(t2928, t2926, 1))
     t2930 = casadi.if_else(t2925, casadi.if_else((t2926 >= 0), 1, -1)*casadi.if_else(t2928, t2929/(1 + casadi.sqrt(1 + t2929**2)), 1/(t2927 + casadi.sqrt(1 + t2927**2))), 0)
     t2931 = 1/casadi.sqrt(1 + t2930**2)
     t2932 = t2820*t2930
@@ -6459,10 +6459,10 @@ def _condition_number(q):
     t2958 = t2956 + t2930*t2955
     t2959 = t2834*t2937 + t2838*t2941 + t2842*t2945 + t2846*t2949 + t2850*t2953 + t2854*t2957
     t2960 = (t2959 != 0)
-    t2961 = 0.5*(-t2933 + t2830)/casadi.if_else(t2960, t2959, 1)
+    t2961 = (-t2933 + t2830)/casadi.if_else(t2960, 2*t2959, 1)
     t2962 = casadi.fabs(t2961)
     t2963 = (t2962 >= 1)
-    t2964 = casadi.fabs(1/casadi.if_else(t2963, t2961, 1))
+    t2964 = 1/casadi.fabs(casadi.if_else(t2963, t2961, 1))
     t2965 = casadi.if_else(t2960, casadi.if_else((t2961 >= 0), 1, -1)*casadi.if_else(t2963, t2964/(1 + casadi.sqrt(1 + t2964**2)), 1/(t2962 + casadi.sqrt(1 + t2962**2))), 0)
     t2966 = 1/casadi.sqrt(1 + t2965**2)
     t2967 = t2959*t2965
@@ -6495,10 +6495,10 @@ def _condition_number(q):
     t2994 = t2869*t2972 + t2873*t2976 + t2877*t2980 + t2881*t2984 + t2885*t2988 + t2889*t2992
     t2995 = t2938*t2973 + t2942*t2977 + t2946*t2981 + t2950*t2985 + t2954*t2989 + t2958*t2993
     t2996 = (t2994 != 0)
-    t2997 = 0.5*(-t2968 + t2865)/casadi.if_else(t2996, t2994, 1)
+    t2997 = (-t2968 + t2865)/casadi.if_else(t2996, 2*t2994, 1)
     t2998 = casadi.fabs(t2997)
     t2999 = (t2998 >= 1)
-    t3000 = casadi.fabs(1/casadi.if_else(t2999, t2997, 1))
+    t3000 = 1/casadi.fabs(casadi.if_else(t2999, t2997, 1))
     t3001 = casadi.if_else(t2996, casadi.if_else((t2997 >= 0), 1, -1)*casadi.if_else(t2999, t3000/(1 + casadi.sqrt(1 + t3000**2)), 1/(t2998 + casadi.sqrt(1 + t2998**2))), 0)
     t3002 = 1/casadi.sqrt(1 + t3001**2)
     t3003 = t2994*t3001
@@ -6530,10 +6530,10 @@ def _condition_number(q):
     t3029 = t3027 + t3001*t3026
     t3030 = t2904*t3008 + t2908*t3012 + t2912*t3016 + t2916*t3020 + t2920*t3024 + t2924*t3028
     t3031 = (t3030 != 0)
-    t3032 = 0.5*(-t3004 + t2900)/casadi.if_else(t3031, t3030, 1)
+    t3032 = (-t3004 + t2900)/casadi.if_else(t3031, 2*t3030, 1)
     t3033 = casadi.fabs(t3032)
     t3034 = (t3033 >= 1)
-    t3035 = casadi.fabs(1/casadi.if_else(t3034, t3032, 1))
+    t3035 = 1/casadi.fabs(casadi.if_else(t3034, t3032, 1))
     t3036 = casadi.if_else(t3031, casadi.if_else((t3032 >= 0), 1, -1)*casadi.if_else(t3034, t3035/(1 + casadi.sqrt(1 + t3035**2)), 1/(t3033 + casadi.sqrt(1 + t3033**2))), 0)
     t3037 = 1/casadi.sqrt(1 + t3036**2)
     t3038 = t3030*t3036
@@ -6565,10 +6565,10 @@ def _condition_number(q):
     t3064 = t3062 + t3036*t3061
     t3065 = t2903*t3043 + t2907*t3047 + t2911*t3051 + t2915*t3055 + t2919*t3059 + t2923*t3063
     t3066 = (t2995 != 0)
-    t3067 = 0.5*(-t2934 + t2969)/casadi.if_else(t3066, t2995, 1)
+    t3067 = (-t2934 + t2969)/casadi.if_else(t3066, 2*t2995, 1)
     t3068 = casadi.fabs(t3067)
     t3069 = (t3068 >= 1)
-    t3070 = casadi.fabs(1/casadi.if_else(t3069, t3067, 1))
+    t3070 = 1/casadi.fabs(casadi.if_else(t3069, t3067, 1))
     t3071 = casadi.if_else(t3066, casadi.if_else((t3067 >= 0), 1, -1)*casadi.if_else(t3069, t3070/(1 + casadi.sqrt(1 + t3070**2)), 1/(t3068 + casadi.sqrt(1 + t3068**2))), 0)
     t3072 = 1/casadi.sqrt(1 + t3071**2)
     t3073 = t2995*t3071
@@ -6600,10 +6600,10 @@ def _condition_number(q):
     t3099 = t3097 + t3071*t3096
     t3100 = t3009*t3078 + t3013*t3082 + t3017*t3086 + t3021*t3090 + t3025*t3094 + t3029*t3098
     t3101 = (t3100 != 0)
-    t3102 = 0.5*(-t3074 + t3005)/casadi.if_else(t3101, t3100, 1)
+    t3102 = (-t3074 + t3005)/casadi.if_else(t3101, 2*t3100, 1)
     t3103 = casadi.fabs(t3102)
     t3104 = (t3103 >= 1)
-    t3105 = casadi.fabs(1/casadi.if_else(t3104, t3102, 1))
+    t3105 = 1/casadi.fabs(casadi.if_else(t3104, t3102, 1))
     t3106 = casadi.if_else(t3101, casadi.if_else((t3102 >= 0), 1, -1)*casadi.if_else(t3104, t3105/(1 + casadi.sqrt(1 + t3105**2)), 1/(t3103 + casadi.sqrt(1 + t3103**2))), 0)
     t3107 = 1/casadi.sqrt(1 + t3106**2)
     t3108 = t3100*t3106
@@ -6636,10 +6636,10 @@ def _condition_number(q):
     t3135 = t3044*t3113 + t3048*t3117 + t3052*t3121 + t3056*t3125 + t3060*t3129 + t3064*t3133
     t3136 = t3079*t3114 + t3083*t3118 + t3087*t3122 + t3091*t3126 + t3095*t3130 + t3099*t3134
     t3137 = (t3135 != 0)
-    t3138 = 0.5*(-t3109 + t3040)/casadi.if_else(t3137, t3135, 1)
+    t3138 = (-t3109 + t3040)/casadi.if_else(t3137, 2*t3135, 1)
     t3139 = casadi.fabs(t3138)
     t3140 = (t3139 >= 1)
-    t3141 = casadi.fabs(1/casadi.if_else(t3140, t3138, 1))
+    t3141 = 1/casadi.fabs(casadi.if_else(t3140, t3138, 1))
     t3142 = casadi.if_else(t3137, casadi.if_else((t3138 >= 0), 1, -1)*casadi.if_else(t3140, t3141/(1 + casadi.sqrt(1 + t3141**2)), 1/(t3139 + casadi.sqrt(1 + t3139**2))), 0)
     t3143 = 1/casadi.sqrt(1 + t3142**2)
     t3144 = t3135*t3142
@@ -6670,10 +6670,10 @@ def _condition_number(q):
     t3169 = t3167 - t3142*t3168
     t3170 = t3168 + t3142*t3167
     t3171 = (t3136 != 0)
-    t3172 = 0.5*(-t3075 + t3110)/casadi.if_else(t3171, t3136, 1)
+    t3172 = (-t3075 + t3110)/casadi.if_else(t3171, 2*t3136, 1)
     t3173 = casadi.fabs(t3172)
     t3174 = (t3173 >= 1)
-    t3175 = casadi.fabs(1/casadi.if_else(t3174, t3172, 1))
+    t3175 = 1/casadi.fabs(casadi.if_else(t3174, t3172, 1))
     t3176 = casadi.if_else(t3171, casadi.if_else((t3172 >= 0), 1, -1)*casadi.if_else(t3174, t3175/(1 + casadi.sqrt(1 + t3175**2)), 1/(t3173 + casadi.sqrt(1 + t3173**2))), 0)
     t3177 = 1/casadi.sqrt(1 + t3176**2)
     t3178 = t3136*t3176
@@ -6705,10 +6705,10 @@ def _condition_number(q):
     t3204 = t3202 + t3176*t3201
     t3205 = t3150*t3183 + t3154*t3187 + t3158*t3191 + t3162*t3195 + t3166*t3199 + t3170*t3203
     t3206 = (t3205 != 0)
-    t3207 = 0.5*(-t3179 + t3146)/casadi.if_else(t3206, t3205, 1)
+    t3207 = (-t3179 + t3146)/casadi.if_else(t3206, 2*t3205, 1)
     t3208 = casadi.fabs(t3207)
     t3209 = (t3208 >= 1)
-    t3210 = casadi.fabs(1/casadi.if_else(t3209, t3207, 1))
+    t3210 = 1/casadi.fabs(casadi.if_else(t3209, t3207, 1))
     t3211 = casadi.if_else(t3206, casadi.if_else((t3207 >= 0), 1, -1)*casadi.if_else(t3209, t3210/(1 + casadi.sqrt(1 + t3210**2)), 1/(t3208 + casadi.sqrt(1 + t3208**2))), 0)
     t3212 = 1/casadi.sqrt(1 + t3211**2)
     t3213 = t3205*t3211
@@ -6740,10 +6740,10 @@ def _condition_number(q):
     t3239 = t3237 + t3211*t3236
     t3240 = t3184*t3219 + t3188*t3223 + t3192*t3227 + t3196*t3231 + t3200*t3235 + t3204*t3239
     t3241 = (t3240 != 0)
-    t3242 = 0.5*(-t3180 + t3215)/casadi.if_else(t3241, t3240, 1)
+    t3242 = (-t3180 + t3215)/casadi.if_else(t3241, 2*t3240, 1)
     t3243 = casadi.fabs(t3242)
     t3244 = (t3243 >= 1)
-    t3245 = casadi.fabs(1/casadi.if_else(t3244, t3242, 1))
+    t3245 = 1/casadi.fabs(casadi.if_else(t3244, t3242, 1))
     t3246 = casadi.if_else(t3241, casadi.if_else((t3242 >= 0), 1, -1)*casadi.if_else(t3244, t3245/(1 + casadi.sqrt(1 + t3245**2)), 1/(t3243 + casadi.sqrt(1 + t3243**2))), 0)
     t3247 = 1/casadi.sqrt(1 + t3246**2)
     t3248 = t3240*t3246
@@ -6774,10 +6774,10 @@ def _condition_number(q):
     t3273 = t3271 - t3246*t3272
     t3274 = t3272 + t3246*t3271
     t3275 = (t3065 != 0)
-    t3276 = 0.5*(-t2899 + t3039)/casadi.if_else(t3275, t3065, 1)
+    t3276 = (-t2899 + t3039)/casadi.if_else(t3275, 2*t3065, 1)
     t3277 = casadi.fabs(t3276)
     t3278 = (t3277 >= 1)
-    t3279 = casadi.fabs(1/casadi.if_else(t3278, t3276, 1))
+    t3279 = 1/casadi.fabs(casadi.if_else(t3278, t3276, 1))
     t3280 = casadi.if_else(t3275, casadi.if_else((t3276 >= 0), 1, -1)*casadi.if_else(t3278, t3279/(1 + casadi.sqrt(1 + t3279**2)), 1/(t3277 + casadi.sqrt(1 + t3277**2))), 0)
     t3281 = 1/casadi.sqrt(1 + t3280**2)
     t3282 = t3065*t3280
@@ -6809,10 +6809,10 @@ def _condition_number(q):
     t3308 = t3306 + t3280*t3305
     t3309 = t3149*t3287 + t3153*t3291 + t3157*t3295 + t3161*t3299 + t3165*t3303 + t3169*t3307
     t3310 = (t3309 != 0)
-    t3311 = 0.5*(-t3283 + t3145)/casadi.if_else(t3310, t3309, 1)
+    t3311 = (-t3283 + t3145)/casadi.if_else(t3310, 2*t3309, 1)
     t3312 = casadi.fabs(t3311)
     t3313 = (t3312 >= 1)
-    t3314 = casadi.fabs(1/casadi.if_else(t3313, t3311, 1))
+    t3314 = 1/casadi.fabs(casadi.if_else(t3313, t3311, 1))
     t3315 = casadi.if_else(t3310, casadi.if_else((t3311 >= 0), 1, -1)*casadi.if_else(t3313, t3314/(1 + casadi.sqrt(1 + t3314**2)), 1/(t3312 + casadi.sqrt(1 + t3312**2))), 0)
     t3316 = 1/casadi.sqrt(1 + t3315**2)
     t3317 = t3309*t3315
@@ -6845,10 +6845,10 @@ def _condition_number(q):
     t3344 = t3218*t3322 + t3222*t3326 + t3226*t3330 + t3230*t3334 + t3234*t3338 + t3238*t3342
     t3345 = t3288*t3323 + t3292*t3327 + t3296*t3331 + t3300*t3335 + t3304*t3339 + t3308*t3343
     t3346 = (t3344 != 0)
-    t3347 = 0.5*(-t3318 + t3214)/casadi.if_else(t3346, t3344, 1)
+    t3347 = (-t3318 + t3214)/casadi.if_else(t3346, 2*t3344, 1)
     t3348 = casadi.fabs(t3347)
     t3349 = (t3348 >= 1)
-    t3350 = casadi.fabs(1/casadi.if_else(t3349, t3347, 1))
+    t3350 = 1/casadi.fabs(casadi.if_else(t3349, t3347, 1))
     t3351 = casadi.if_else(t3346, casadi.if_else((t3347 >= 0), 1, -1)*casadi.if_else(t3349, t3350/(1 + casadi.sqrt(1 + t3350**2)), 1/(t3348 + casadi.sqrt(1 + t3348**2))), 0)
     t3352 = 1/casadi.sqrt(1 + t3351**2)
     t3353 = t3344*t3351
@@ -6880,10 +6880,10 @@ def _condition_number(q):
     t3379 = t3377 + t3351*t3376
     t3380 = t3253*t3358 + t3257*t3362 + t3261*t3366 + t3265*t3370 + t3269*t3374 + t3273*t3378
     t3381 = (t3380 != 0)
-    t3382 = 0.5*(-t3354 + t3249)/casadi.if_else(t3381, t3380, 1)
+    t3382 = (-t3354 + t3249)/casadi.if_else(t3381, 2*t3380, 1)
     t3383 = casadi.fabs(t3382)
     t3384 = (t3383 >= 1)
-    t3385 = casadi.fabs(1/casadi.if_else(t3384, t3382, 1))
+    t3385 = 1/casadi.fabs(casadi.if_else(t3384, t3382, 1))
     t3386 = casadi.if_else(t3381, casadi.if_else((t3382 >= 0), 1, -1)*casadi.if_else(t3384, t3385/(1 + casadi.sqrt(1 + t3385**2)), 1/(t3383 + casadi.sqrt(1 + t3383**2))), 0)
     t3387 = 1/casadi.sqrt(1 + t3386**2)
     t3388 = t3380*t3386
@@ -6915,10 +6915,10 @@ def _condition_number(q):
     t3414 = t3412 + t3386*t3411
     t3415 = t3254*t3393 + t3258*t3397 + t3262*t3401 + t3266*t3405 + t3270*t3409 + t3274*t3413
     t3416 = (t3415 != 0)
-    t3417 = 0.5*(-t3389 + t3250)/casadi.if_else(t3416, t3415, 1)
+    t3417 = (-t3389 + t3250)/casadi.if_else(t3416, 2*t3415, 1)
     t3418 = casadi.fabs(t3417)
     t3419 = (t3418 >= 1)
-    t3420 = casadi.fabs(1/casadi.if_else(t3419, t3417, 1))
+    t3420 = 1/casadi.fabs(casadi.if_else(t3419, t3417, 1))
     t3421 = casadi.if_else(t3416, casadi.if_else((t3417 >= 0), 1, -1)*casadi.if_else(t3419, t3420/(1 + casadi.sqrt(1 + t3420**2)), 1/(t3418 + casadi.sqrt(1 + t3418**2))), 0)
     t3422 = 1/casadi.sqrt(1 + t3421**2)
     t3423 = t3250 + t3415*t3421
@@ -6948,10 +6948,10 @@ def _condition_number(q):
     t3447 = t3445 + t3421*t3444
     t3448 = casadi.sqrt(t3426**2 + t3430**2 + t3434**2 + t3438**2 + t3442**2 + t3446**2)
     t3449 = (t3345 != 0)
-    t3450 = 0.5*(-t3284 + t3319)/casadi.if_else(t3449, t3345, 1)
+    t3450 = (-t3284 + t3319)/casadi.if_else(t3449, 2*t3345, 1)
     t3451 = casadi.fabs(t3450)
     t3452 = (t3451 >= 1)
-    t3453 = casadi.fabs(1/casadi.if_else(t3452, t3450, 1))
+    t3453 = 1/casadi.fabs(casadi.if_else(t3452, t3450, 1))
     t3454 = casadi.if_else(t3449, casadi.if_else((t3450 >= 0), 1, -1)*casadi.if_else(t3452, t3453/(1 + casadi.sqrt(1 + t3453**2)), 1/(t3451 + casadi.sqrt(1 + t3451**2))), 0)
     t3455 = 1/casadi.sqrt(1 + t3454**2)
     t3456 = t3345*t3454
@@ -6983,10 +6983,10 @@ def _condition_number(q):
     t3482 = t3480 + t3454*t3479
     t3483 = t3359*t3461 + t3363*t3465 + t3367*t3469 + t3371*t3473 + t3375*t3477 + t3379*t3481
     t3484 = (t3483 != 0)
-    t3485 = 0.5*(-t3457 + t3355)/casadi.if_else(t3484, t3483, 1)
+    t3485 = (-t3457 + t3355)/casadi.if_else(t3484, 2*t3483, 1)
     t3486 = casadi.fabs(t3485)
     t3487 = (t3486 >= 1)
-    t3488 = casadi.fabs(1/casadi.if_else(t3487, t3485, 1))
+    t3488 = 1/casadi.fabs(casadi.if_else(t3487, t3485, 1))
     t3489 = casadi.if_else(t3484, casadi.if_else((t3485 >= 0), 1, -1)*casadi.if_else(t3487, t3488/(1 + casadi.sqrt(1 + t3488**2)), 1/(t3486 + casadi.sqrt(1 + t3486**2))), 0)
     t3490 = 1/casadi.sqrt(1 + t3489**2)
     t3491 = t3483*t3489
@@ -7019,10 +7019,10 @@ def _condition_number(q):
     t3518 = t3394*t3496 + t3398*t3500 + t3402*t3504 + t3406*t3508 + t3410*t3512 + t3414*t3516
     t3519 = t3462*t3497 + t3466*t3501 + t3470*t3505 + t3474*t3509 + t3478*t3513 + t3482*t3517
     t3520 = (t3518 != 0)
-    t3521 = 0.5*(-t3492 + t3390)/casadi.if_else(t3520, t3518, 1)
+    t3521 = (-t3492 + t3390)/casadi.if_else(t3520, 2*t3518, 1)
     t3522 = casadi.fabs(t3521)
     t3523 = (t3522 >= 1)
-    t3524 = casadi.fabs(1/casadi.if_else(t3523, t3521, 1))
+    t3524 = 1/casadi.fabs(casadi.if_else(t3523, t3521, 1))
     t3525 = casadi.if_else(t3520, casadi.if_else((t3521 >= 0), 1, -1)*casadi.if_else(t3523, t3524/(1 + casadi.sqrt(1 + t3524**2)), 1/(t3522 + casadi.sqrt(1 + t3522**2))), 0)
     t3526 = 1/casadi.sqrt(1 + t3525**2)
     t3527 = t3518*t3525
@@ -7054,10 +7054,10 @@ def _condition_number(q):
     t3553 = t3551 + t3525*t3550
     t3554 = t3427*t3532 + t3431*t3536 + t3435*t3540 + t3439*t3544 + t3443*t3548 + t3447*t3552
     t3555 = (t3554 != 0)
-    t3556 = 0.5*(-t3528 + t3423)/casadi.if_else(t3555, t3554, 1)
+    t3556 = (-t3528 + t3423)/casadi.if_else(t3555, 2*t3554, 1)
     t3557 = casadi.fabs(t3556)
     t3558 = (t3557 >= 1)
-    t3559 = casadi.fabs(1/casadi.if_else(t3558, t3556, 1))
+    t3559 = 1/casadi.fabs(casadi.if_else(t3558, t3556, 1))
     t3560 = casadi.if_else(t3555, casadi.if_else((t3556 >= 0), 1, -1)*casadi.if_else(t3558, t3559/(1 + casadi.sqrt(1 + t3559**2)), 1/(t3557 + casadi.sqrt(1 + t3557**2))), 0)
     t3561 = 1/casadi.sqrt(1 + t3560**2)
     t3562 = t3423 + t3554*t3560
@@ -7089,10 +7089,10 @@ def _condition_number(q):
     t3588 = casadi.if_else((t3587 > t3448), t3587, t3448)
     t3589 = casadi.if_else((t3587 < t3448), t3587, t3448)
     t3590 = (t3519 != 0)
-    t3591 = 0.5*(-t3458 + t3493)/casadi.if_else(t3590, t3519, 1)
+    t3591 = (-t3458 + t3493)/casadi.if_else(t3590, 2*t3519, 1)
     t3592 = casadi.fabs(t3591)
     t3593 = (t3592 >= 1)
-    t3594 = casadi.fabs(1/casadi.if_else(t3593, t3591, 1))
+    t3594 = 1/casadi.fabs(casadi.if_else(t3593, t3591, 1))
     t3595 = casadi.if_else(t3590, casadi.if_else((t3591 >= 0), 1, -1)*casadi.if_else(t3593, t3594/(1 + casadi.sqrt(1 + t3594**2)), 1/(t3592 + casadi.sqrt(1 + t3592**2))), 0)
     t3596 = 1/casadi.sqrt(1 + t3595**2)
     t3597 = t3519*t3595
@@ -7124,10 +7124,10 @@ def _condition_number(q):
     t3623 = t3621 + t3595*t3620
     t3624 = t3533*t3602 + t3537*t3606 + t3541*t3610 + t3545*t3614 + t3549*t3618 + t3553*t3622
     t3625 = (t3624 != 0)
-    t3626 = 0.5*(-t3598 + t3529)/casadi.if_else(t3625, t3624, 1)
+    t3626 = (-t3598 + t3529)/casadi.if_else(t3625, 2*t3624, 1)
     t3627 = casadi.fabs(t3626)
     t3628 = (t3627 >= 1)
-    t3629 = casadi.fabs(1/casadi.if_else(t3628, t3626, 1))
+    t3629 = 1/casadi.fabs(casadi.if_else(t3628, t3626, 1))
     t3630 = casadi.if_else(t3625, casadi.if_else((t3626 >= 0), 1, -1)*casadi.if_else(t3628, t3629/(1 + casadi.sqrt(1 + t3629**2)), 1/(t3627 + casadi.sqrt(1 + t3627**2))), 0)
     t3631 = 1/casadi.sqrt(1 + t3630**2)
     t3632 = t3624*t3630
@@ -7160,10 +7160,10 @@ def _condition_number(q):
     t3659 = t3566*t3637 + t3570*t3641 + t3574*t3645 + t3578*t3649 + t3582*t3653 + t3586*t3657
     t3660 = t3603*t3638 + t3607*t3642 + t3611*t3646 + t3615*t3650 + t3619*t3654 + t3623*t3658
     t3661 = (t3659 != 0)
-    t3662 = 0.5*(-t3633 + t3562)/casadi.if_else(t3661, t3659, 1)
+    t3662 = (-t3633 + t3562)/casadi.if_else(t3661, 2*t3659, 1)
     t3663 = casadi.fabs(t3662)
     t3664 = (t3663 >= 1)
-    t3665 = casadi.fabs(1/casadi.if_else(t3664, t3662, 1))
+    t3665 = 1/casadi.fabs(casadi.if_else(t3664, t3662, 1))
     t3666 = casadi.if_else(t3661, casadi.if_else((t3662 >= 0), 1, -1)*casadi.if_else(t3664, t3665/(1 + casadi.sqrt(1 + t3665**2)), 1/(t3663 + casadi.sqrt(1 + t3663**2))), 0)
     t3667 = 1/casadi.sqrt(1 + t3666**2)
     t3668 = t3562 + t3659*t3666
@@ -7195,10 +7195,10 @@ def _condition_number(q):
     t3694 = casadi.if_else((t3693 > t3588), t3693, t3588)
     t3695 = casadi.if_else((t3693 < t3589), t3693, t3589)
     t3696 = (t3660 != 0)
-    t3697 = 0.5*(-t3599 + t3634)/casadi.if_else(t3696, t3660, 1)
+    t3697 = (-t3599 + t3634)/casadi.if_else(t3696, 2*t3660, 1)
     t3698 = casadi.fabs(t3697)
     t3699 = (t3698 >= 1)
-    t3700 = casadi.fabs(1/casadi.if_else(t3699, t3697, 1))
+    t3700 = 1/casadi.fabs(casadi.if_else(t3699, t3697, 1))
     t3701 = casadi.if_else(t3696, casadi.if_else((t3697 >= 0), 1, -1)*casadi.if_else(t3699, t3700/(1 + casadi.sqrt(1 + t3700**2)), 1/(t3698 + casadi.sqrt(1 + t3698**2))), 0)
     t3702 = 1/casadi.sqrt(1 + t3701**2)
     t3703 = t3660*t3701
@@ -7230,10 +7230,10 @@ def _condition_number(q):
     t3729 = t3727 + t3701*t3726
     t3730 = t3672*t3708 + t3676*t3712 + t3680*t3716 + t3684*t3720 + t3688*t3724 + t3692*t3728
     t3731 = (t3730 != 0)
-    t3732 = 0.5*(-t3704 + t3668)/casadi.if_else(t3731, t3730, 1)
+    t3732 = (-t3704 + t3668)/casadi.if_else(t3731, 2*t3730, 1)
     t3733 = casadi.fabs(t3732)
     t3734 = (t3733 >= 1)
-    t3735 = casadi.fabs(1/casadi.if_else(t3734, t3732, 1))
+    t3735 = 1/casadi.fabs(casadi.if_else(t3734, t3732, 1))
     t3736 = casadi.if_else(t3731, casadi.if_else((t3732 >= 0), 1, -1)*casadi.if_else(t3734, t3735/(1 + casadi.sqrt(1 + t3735**2)), 1/(t3733 + casadi.sqrt(1 + t3733**2))), 0)
     t3737 = 1/casadi.sqrt(1 + t3736**2)
     t3738 = t3668 + t3730*t3736
@@ -7266,10 +7266,10 @@ def _condition_number(q):
     t3765 = casadi.if_else((t3764 > t3694), t3764, t3694)
     t3766 = casadi.if_else((t3764 < t3695), t3764, t3695)
     t3767 = (t3763 != 0)
-    t3768 = 0.5*(-t3705 + t3738)/casadi.if_else(t3767, t3763, 1)
+    t3768 = (-t3705 + t3738)/casadi.if_else(t3767, 2*t3763, 1)
     t3769 = casadi.fabs(t3768)
     t3770 = (t3769 >= 1)
-    t3771 = casadi.fabs(1/casadi.if_else(t3770, t3768, 1))
+    t3771 = 1/casadi.fabs(casadi.if_else(t3770, t3768, 1))
     t3772 = casadi.if_else(t3767, casadi.if_else((t3768 >= 0), 1, -1)*casadi.if_else(t3770, t3771/(1 + casadi.sqrt(1 + t3771**2)), 1/(t3769 + casadi.sqrt(1 + t3769**2))), 0)
     t3773 = 1/casadi.sqrt(1 + t3772**2)
     t3774 = t3709*t3773
@@ -7302,8 +7302,10 @@ def _condition_number(q):
     t3801 = casadi.if_else((t3798 < t3766), t3798, t3766)
     t3802 = casadi.if_else((t3799 > t3800), t3799, t3800)
     t3803 = casadi.if_else((t3799 < t3801), t3799, t3801)
+    t3804 = casadi.if_else((t3803 <= 1e-12*t3802), 0, t3803)
+    t3805 = casadi.if_else((t3802 > 0), t3802, 1)
     kappa = casadi.SX(1, 1)
-    kappa[0, 0] = casadi.if_else((t3802 > 0), t3802, 1)/casadi.if_else((t3803 <= 1e-12*t3802), 0, t3803)
+    kappa[0, 0] = t3805/t3804
     return [kappa]
 
 

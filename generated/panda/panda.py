@@ -3298,10 +3298,10 @@ def velocity_ellipsoid(q):
     t94 = t92**2
     t95 = t62*t68
     t96 = xp.not_equal(t95, 0)
-    t97 = 0.5*(-t65 + t93)/xp.where(t96, -t95, 1)
+    t97 = (-t65 + t93)/xp.where(t96, -2*t95, 1)
     t98 = xp.abs(t97)
     t99 = xp.greater_equal(t98, 1)
-    t100 = xp.abs(1/xp.where(t99, t97, 1))
+    t100 = 1/xp.abs(xp.where(t99, t97, 1))
     t101 = xp.where(t96, xp.where(xp.greater_equal(t97, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t99, t100/(1 + xp.sqrt(1 + t100**2)), 1/(t98 + xp.sqrt(1 + t98**2))), 0)
     t102 = 1/xp.sqrt(1 + t101**2)
     t103 = t95*t101
@@ -3317,10 +3317,10 @@ def velocity_ellipsoid(q):
     t113 = t112*t101
     t114 = t110*t108 - t113*t86
     t115 = xp.not_equal(t114, 0)
-    t116 = 0.5*(-t104 + t111)/xp.where(t115, t114, 1)
+    t116 = (-t104 + t111)/xp.where(t115, 2*t114, 1)
     t117 = xp.abs(t116)
     t118 = xp.greater_equal(t117, 1)
-    t119 = xp.abs(1/xp.where(t118, t116, 1))
+    t119 = 1/xp.abs(xp.where(t118, t116, 1))
     t120 = xp.where(t115, xp.where(xp.greater_equal(t116, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t118, t119/(1 + xp.sqrt(1 + t119**2)), 1/(t117 + xp.sqrt(1 + t117**2))), 0)
     t121 = 1/xp.sqrt(1 + t120**2)
     t122 = t114*t120
@@ -3336,10 +3336,10 @@ def velocity_ellipsoid(q):
     t132 = -t130 + t129*t120
     t133 = t109*t128 + t112*t132
     t134 = xp.not_equal(t133, 0)
-    t135 = 0.5*(-t105 + t124)/xp.where(t134, -t133, 1)
+    t135 = (-t105 + t124)/xp.where(t134, -2*t133, 1)
     t136 = xp.abs(t135)
     t137 = xp.greater_equal(t136, 1)
-    t138 = xp.abs(1/xp.where(t137, t135, 1))
+    t138 = 1/xp.abs(xp.where(t137, t135, 1))
     t139 = xp.where(t134, xp.where(xp.greater_equal(t135, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t137, t138/(1 + xp.sqrt(1 + t138**2)), 1/(t136 + xp.sqrt(1 + t136**2))), 0)
     t140 = 1/xp.sqrt(1 + t139**2)
     t141 = t133*t139
@@ -3365,10 +3365,10 @@ def velocity_ellipsoid(q):
     t161 = t139*t140
     t162 = t127*t146 - t131*t151 + t94*t155*t161*t121
     t163 = xp.not_equal(t162, 0)
-    t164 = 0.5*(-t123 + t142)/xp.where(t163, t162, 1)
+    t164 = (-t123 + t142)/xp.where(t163, 2*t162, 1)
     t165 = xp.abs(t164)
     t166 = xp.greater_equal(t165, 1)
-    t167 = xp.abs(1/xp.where(t166, t164, 1))
+    t167 = 1/xp.abs(xp.where(t166, t164, 1))
     t168 = xp.where(t163, xp.where(xp.greater_equal(t164, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t166, t167/(1 + xp.sqrt(1 + t167**2)), 1/(t165 + xp.sqrt(1 + t165**2))), 0)
     t169 = 1/xp.sqrt(1 + t168**2)
     t170 = t162*t168
@@ -3402,10 +3402,10 @@ def velocity_ellipsoid(q):
     t198 = t121*t140
     t199 = t147*t175 + t152*t179 - t198*t92*t188
     t200 = xp.not_equal(t199, 0)
-    t201 = 0.5*(-t171 + t143)/xp.where(t200, t199, 1)
+    t201 = (-t171 + t143)/xp.where(t200, 2*t199, 1)
     t202 = xp.abs(t201)
     t203 = xp.greater_equal(t202, 1)
-    t204 = xp.abs(1/xp.where(t203, t201, 1))
+    t204 = 1/xp.abs(xp.where(t203, t201, 1))
     t205 = xp.where(t200, xp.where(xp.greater_equal(t201, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t203, t204/(1 + xp.sqrt(1 + t204**2)), 1/(t202 + xp.sqrt(1 + t202**2))), 0)
     t206 = 1/xp.sqrt(1 + t205**2)
     t207 = t199*t205
@@ -3437,10 +3437,10 @@ def velocity_ellipsoid(q):
     t233 = t232 - t219*t205
     t234 = t219 + t232*t205
     t235 = xp.not_equal(t223, 0)
-    t236 = 0.5*(-t172 + t209)/xp.where(t235, t223, 1)
+    t236 = (-t172 + t209)/xp.where(t235, 2*t223, 1)
     t237 = xp.abs(t236)
     t238 = xp.greater_equal(t237, 1)
-    t239 = xp.abs(1/xp.where(t238, t236, 1))
+    t239 = 1/xp.abs(xp.where(t238, t236, 1))
     t240 = xp.where(t235, xp.where(xp.greater_equal(t236, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t238, t239/(1 + xp.sqrt(1 + t239**2)), 1/(t237 + xp.sqrt(1 + t237**2))), 0)
     t241 = 1/xp.sqrt(1 + t240**2)
     t242 = t223*t240
@@ -3472,10 +3472,10 @@ def velocity_ellipsoid(q):
     t268 = t266 + t267*t240
     t269 = t267 - t266*t240
     t270 = xp.not_equal(t257, 0)
-    t271 = 0.5*(-t208 + t243)/xp.where(t270, t257, 1)
+    t271 = (-t208 + t243)/xp.where(t270, 2*t257, 1)
     t272 = xp.abs(t271)
     t273 = xp.greater_equal(t272, 1)
-    t274 = xp.abs(1/xp.where(t273, t271, 1))
+    t274 = 1/xp.abs(xp.where(t273, t271, 1))
     t275 = xp.where(t270, xp.where(xp.greater_equal(t271, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t273, t274/(1 + xp.sqrt(1 + t274**2)), 1/(t272 + xp.sqrt(1 + t272**2))), 0)
     t276 = 1/xp.sqrt(1 + t275**2)
     t277 = t257*t275
@@ -3507,10 +3507,10 @@ def velocity_ellipsoid(q):
     t303 = t301 + t302*t275
     t304 = -t302 + t301*t275
     t305 = xp.not_equal(t292, 0)
-    t306 = 0.5*(-t278 + t244)/xp.where(t305, t292, 1)
+    t306 = (-t278 + t244)/xp.where(t305, 2*t292, 1)
     t307 = xp.abs(t306)
     t308 = xp.greater_equal(t307, 1)
-    t309 = xp.abs(1/xp.where(t308, t306, 1))
+    t309 = 1/xp.abs(xp.where(t308, t306, 1))
     t310 = xp.where(t305, xp.where(xp.greater_equal(t306, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t308, t309/(1 + xp.sqrt(1 + t309**2)), 1/(t307 + xp.sqrt(1 + t307**2))), 0)
     t311 = 1/xp.sqrt(1 + t310**2)
     t312 = t292*t310
@@ -3542,10 +3542,10 @@ def velocity_ellipsoid(q):
     t338 = t336 - t337*t310
     t339 = t337 + t336*t310
     t340 = xp.not_equal(t327, 0)
-    t341 = 0.5*(-t279 + t314)/xp.where(t340, t327, 1)
+    t341 = (-t279 + t314)/xp.where(t340, 2*t327, 1)
     t342 = xp.abs(t341)
     t343 = xp.greater_equal(t342, 1)
-    t344 = xp.abs(1/xp.where(t343, t341, 1))
+    t344 = 1/xp.abs(xp.where(t343, t341, 1))
     t345 = xp.where(t340, xp.where(xp.greater_equal(t341, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t343, t344/(1 + xp.sqrt(1 + t344**2)), 1/(t342 + xp.sqrt(1 + t342**2))), 0)
     t346 = 1/xp.sqrt(1 + t345**2)
     t347 = t327*t345
@@ -3577,10 +3577,10 @@ def velocity_ellipsoid(q):
     t373 = t371 - t345*t372
     t374 = t372 + t345*t371
     t375 = xp.not_equal(t362, 0)
-    t376 = 0.5*(-t313 + t348)/xp.where(t375, t362, 1)
+    t376 = (-t313 + t348)/xp.where(t375, 2*t362, 1)
     t377 = xp.abs(t376)
     t378 = xp.greater_equal(t377, 1)
-    t379 = xp.abs(1/xp.where(t378, t376, 1))
+    t379 = 1/xp.abs(xp.where(t378, t376, 1))
     t380 = xp.where(t375, xp.where(xp.greater_equal(t376, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t378, t379/(1 + xp.sqrt(1 + t379**2)), 1/(t377 + xp.sqrt(1 + t377**2))), 0)
     t381 = 1/xp.sqrt(1 + t380**2)
     t382 = t362*t380
@@ -3612,10 +3612,10 @@ def velocity_ellipsoid(q):
     t408 = t406 - t380*t407
     t409 = t407 + t380*t406
     t410 = xp.not_equal(t397, 0)
-    t411 = 0.5*(-t383 + t349)/xp.where(t410, t397, 1)
+    t411 = (-t383 + t349)/xp.where(t410, 2*t397, 1)
     t412 = xp.abs(t411)
     t413 = xp.greater_equal(t412, 1)
-    t414 = xp.abs(1/xp.where(t413, t411, 1))
+    t414 = 1/xp.abs(xp.where(t413, t411, 1))
     t415 = xp.where(t410, xp.where(xp.greater_equal(t411, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t413, t414/(1 + xp.sqrt(1 + t414**2)), 1/(t412 + xp.sqrt(1 + t412**2))), 0)
     t416 = 1/xp.sqrt(1 + t415**2)
     t417 = t397*t415
@@ -3647,10 +3647,10 @@ def velocity_ellipsoid(q):
     t443 = t441 - t415*t442
     t444 = t442 + t415*t441
     t445 = xp.not_equal(t432, 0)
-    t446 = 0.5*(-t384 + t419)/xp.where(t445, t432, 1)
+    t446 = (-t384 + t419)/xp.where(t445, 2*t432, 1)
     t447 = xp.abs(t446)
     t448 = xp.greater_equal(t447, 1)
-    t449 = xp.abs(1/xp.where(t448, t446, 1))
+    t449 = 1/xp.abs(xp.where(t448, t446, 1))
     t450 = xp.where(t445, xp.where(xp.greater_equal(t446, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t448, t449/(1 + xp.sqrt(1 + t449**2)), 1/(t447 + xp.sqrt(1 + t447**2))), 0)
     t451 = 1/xp.sqrt(1 + t450**2)
     t452 = t432*t450
@@ -3682,10 +3682,10 @@ def velocity_ellipsoid(q):
     t478 = t476 - t450*t477
     t479 = t477 + t450*t476
     t480 = xp.not_equal(t467, 0)
-    t481 = 0.5*(-t418 + t453)/xp.where(t480, t467, 1)
+    t481 = (-t418 + t453)/xp.where(t480, 2*t467, 1)
     t482 = xp.abs(t481)
     t483 = xp.greater_equal(t482, 1)
-    t484 = xp.abs(1/xp.where(t483, t481, 1))
+    t484 = 1/xp.abs(xp.where(t483, t481, 1))
     t485 = xp.where(t480, xp.where(xp.greater_equal(t481, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t483, t484/(1 + xp.sqrt(1 + t484**2)), 1/(t482 + xp.sqrt(1 + t482**2))), 0)
     t486 = 1/xp.sqrt(1 + t485**2)
     t487 = t467*t485
@@ -3717,10 +3717,10 @@ def velocity_ellipsoid(q):
     t513 = t511 - t485*t512
     t514 = t512 + t485*t511
     t515 = xp.not_equal(t502, 0)
-    t516 = 0.5*(-t488 + t454)/xp.where(t515, t502, 1)
+    t516 = (-t488 + t454)/xp.where(t515, 2*t502, 1)
     t517 = xp.abs(t516)
     t518 = xp.greater_equal(t517, 1)
-    t519 = xp.abs(1/xp.where(t518, t516, 1))
+    t519 = 1/xp.abs(xp.where(t518, t516, 1))
     t520 = xp.where(t515, xp.where(xp.greater_equal(t516, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t518, t519/(1 + xp.sqrt(1 + t519**2)), 1/(t517 + xp.sqrt(1 + t517**2))), 0)
     t521 = 1/xp.sqrt(1 + t520**2)
     t522 = t454 + t502*t520
@@ -3751,10 +3751,10 @@ def velocity_ellipsoid(q):
     t547 = t545 - t520*t546
     t548 = t546 + t520*t545
     t549 = xp.not_equal(t535, 0)
-    t550 = 0.5*(-t489 + t522)/xp.where(t549, t535, 1)
+    t550 = (-t489 + t522)/xp.where(t549, 2*t535, 1)
     t551 = xp.abs(t550)
     t552 = xp.greater_equal(t551, 1)
-    t553 = xp.abs(1/xp.where(t552, t550, 1))
+    t553 = 1/xp.abs(xp.where(t552, t550, 1))
     t554 = xp.where(t549, xp.where(xp.greater_equal(t550, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t552, t553/(1 + xp.sqrt(1 + t553**2)), 1/(t551 + xp.sqrt(1 + t551**2))), 0)
     t555 = 1/xp.sqrt(1 + t554**2)
     t556 = t493*t555
@@ -3853,10 +3853,10 @@ def velocity_ellipsoid(q):
     t649 = t648**2
     t650 = t627**2 + t641**2 + t649
     t651 = xp.not_equal(t638, 0)
-    t652 = 0.5*(-t617 + t637)/xp.where(t651, t638, 1)
+    t652 = (-t617 + t637)/xp.where(t651, 2*t638, 1)
     t653 = xp.abs(t652)
     t654 = xp.greater_equal(t653, 1)
-    t655 = xp.abs(1/xp.where(t654, t652, 1))
+    t655 = 1/xp.abs(xp.where(t654, t652, 1))
     t656 = xp.where(t651, xp.where(xp.greater_equal(t652, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t654, t655/(1 + xp.sqrt(1 + t655**2)), 1/(t653 + xp.sqrt(1 + t653**2))), 0)
     t657 = 1/xp.sqrt(1 + t656**2)
     t658 = t638*t656
@@ -3870,10 +3870,10 @@ def velocity_ellipsoid(q):
     t666 = t656*t665
     t667 = t627*t663 + t641*t666
     t668 = xp.not_equal(t667, 0)
-    t669 = 0.5*(-t659 + t650)/xp.where(t668, t667, 1)
+    t669 = (-t659 + t650)/xp.where(t668, 2*t667, 1)
     t670 = xp.abs(t669)
     t671 = xp.greater_equal(t670, 1)
-    t672 = xp.abs(1/xp.where(t671, t669, 1))
+    t672 = 1/xp.abs(xp.where(t671, t669, 1))
     t673 = xp.where(t668, xp.where(xp.greater_equal(t669, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t671, t672/(1 + xp.sqrt(1 + t672**2)), 1/(t670 + xp.sqrt(1 + t670**2))), 0)
     t674 = 1/xp.sqrt(1 + t673**2)
     t675 = t667*t673
@@ -3889,10 +3889,10 @@ def velocity_ellipsoid(q):
     t685 = t683 + t673*t682
     t686 = t664*t681 + t685*t665
     t687 = xp.not_equal(t686, 0)
-    t688 = 0.5*(-t660 + t677)/xp.where(t687, -t686, 1)
+    t688 = (-t660 + t677)/xp.where(t687, -2*t686, 1)
     t689 = xp.abs(t688)
     t690 = xp.greater_equal(t689, 1)
-    t691 = xp.abs(1/xp.where(t690, t688, 1))
+    t691 = 1/xp.abs(xp.where(t690, t688, 1))
     t692 = xp.where(t687, xp.where(xp.greater_equal(t688, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t690, t691/(1 + xp.sqrt(1 + t691**2)), 1/(t689 + xp.sqrt(1 + t689**2))), 0)
     t693 = 1/xp.sqrt(1 + t692**2)
     t694 = t686*t692
@@ -3918,10 +3918,10 @@ def velocity_ellipsoid(q):
     t714 = t692*t693
     t715 = t680*t699 + t684*t704 - t674*t649*t708*t714
     t716 = xp.not_equal(t715, 0)
-    t717 = 0.5*(-t676 + t695)/xp.where(t716, -t715, 1)
+    t717 = (-t676 + t695)/xp.where(t716, -2*t715, 1)
     t718 = xp.abs(t717)
     t719 = xp.greater_equal(t718, 1)
-    t720 = xp.abs(1/xp.where(t719, t717, 1))
+    t720 = 1/xp.abs(xp.where(t719, t717, 1))
     t721 = xp.where(t716, xp.where(xp.greater_equal(t717, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t719, t720/(1 + xp.sqrt(1 + t720**2)), 1/(t718 + xp.sqrt(1 + t718**2))), 0)
     t722 = 1/xp.sqrt(1 + t721**2)
     t723 = t715*t721
@@ -3955,10 +3955,10 @@ def velocity_ellipsoid(q):
     t751 = t674*t693
     t752 = t700*t728 + t705*t732 - t648*t741*t751
     t753 = xp.not_equal(t752, 0)
-    t754 = 0.5*(-t724 + t696)/xp.where(t753, t752, 1)
+    t754 = (-t724 + t696)/xp.where(t753, 2*t752, 1)
     t755 = xp.abs(t754)
     t756 = xp.greater_equal(t755, 1)
-    t757 = xp.abs(1/xp.where(t756, t754, 1))
+    t757 = 1/xp.abs(xp.where(t756, t754, 1))
     t758 = xp.where(t753, xp.where(xp.greater_equal(t754, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t756, t757/(1 + xp.sqrt(1 + t757**2)), 1/(t755 + xp.sqrt(1 + t755**2))), 0)
     t759 = 1/xp.sqrt(1 + t758**2)
     t760 = t752*t758
@@ -3990,10 +3990,10 @@ def velocity_ellipsoid(q):
     t786 = t785 - t758*t772
     t787 = t772 + t758*t785
     t788 = xp.not_equal(t776, 0)
-    t789 = 0.5*(-t725 + t762)/xp.where(t788, t776, 1)
+    t789 = (-t725 + t762)/xp.where(t788, 2*t776, 1)
     t790 = xp.abs(t789)
     t791 = xp.greater_equal(t790, 1)
-    t792 = xp.abs(1/xp.where(t791, t789, 1))
+    t792 = 1/xp.abs(xp.where(t791, t789, 1))
     t793 = xp.where(t788, xp.where(xp.greater_equal(t789, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t791, t792/(1 + xp.sqrt(1 + t792**2)), 1/(t790 + xp.sqrt(1 + t790**2))), 0)
     t794 = 1/xp.sqrt(1 + t793**2)
     t795 = t776*t793
@@ -4025,10 +4025,10 @@ def velocity_ellipsoid(q):
     t821 = t819 + t793*t820
     t822 = t820 - t793*t819
     t823 = xp.not_equal(t810, 0)
-    t824 = 0.5*(-t761 + t796)/xp.where(t823, t810, 1)
+    t824 = (-t761 + t796)/xp.where(t823, 2*t810, 1)
     t825 = xp.abs(t824)
     t826 = xp.greater_equal(t825, 1)
-    t827 = xp.abs(1/xp.where(t826, t824, 1))
+    t827 = 1/xp.abs(xp.where(t826, t824, 1))
     t828 = xp.where(t823, xp.where(xp.greater_equal(t824, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t826, t827/(1 + xp.sqrt(1 + t827**2)), 1/(t825 + xp.sqrt(1 + t825**2))), 0)
     t829 = 1/xp.sqrt(1 + t828**2)
     t830 = t810*t828
@@ -4060,10 +4060,10 @@ def velocity_ellipsoid(q):
     t856 = t854 + t828*t855
     t857 = -t855 + t828*t854
     t858 = xp.not_equal(t845, 0)
-    t859 = 0.5*(-t831 + t797)/xp.where(t858, t845, 1)
+    t859 = (-t831 + t797)/xp.where(t858, 2*t845, 1)
     t860 = xp.abs(t859)
     t861 = xp.greater_equal(t860, 1)
-    t862 = xp.abs(1/xp.where(t861, t859, 1))
+    t862 = 1/xp.abs(xp.where(t861, t859, 1))
     t863 = xp.where(t858, xp.where(xp.greater_equal(t859, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t861, t862/(1 + xp.sqrt(1 + t862**2)), 1/(t860 + xp.sqrt(1 + t860**2))), 0)
     t864 = 1/xp.sqrt(1 + t863**2)
     t865 = t845*t863
@@ -4095,10 +4095,10 @@ def velocity_ellipsoid(q):
     t891 = t889 - t863*t890
     t892 = t890 + t863*t889
     t893 = xp.not_equal(t880, 0)
-    t894 = 0.5*(-t832 + t867)/xp.where(t893, t880, 1)
+    t894 = (-t832 + t867)/xp.where(t893, 2*t880, 1)
     t895 = xp.abs(t894)
     t896 = xp.greater_equal(t895, 1)
-    t897 = xp.abs(1/xp.where(t896, t894, 1))
+    t897 = 1/xp.abs(xp.where(t896, t894, 1))
     t898 = xp.where(t893, xp.where(xp.greater_equal(t894, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t896, t897/(1 + xp.sqrt(1 + t897**2)), 1/(t895 + xp.sqrt(1 + t895**2))), 0)
     t899 = 1/xp.sqrt(1 + t898**2)
     t900 = t880*t898
@@ -4130,10 +4130,10 @@ def velocity_ellipsoid(q):
     t926 = t924 - t898*t925
     t927 = t925 + t898*t924
     t928 = xp.not_equal(t915, 0)
-    t929 = 0.5*(-t866 + t901)/xp.where(t928, t915, 1)
+    t929 = (-t866 + t901)/xp.where(t928, 2*t915, 1)
     t930 = xp.abs(t929)
     t931 = xp.greater_equal(t930, 1)
-    t932 = xp.abs(1/xp.where(t931, t929, 1))
+    t932 = 1/xp.abs(xp.where(t931, t929, 1))
     t933 = xp.where(t928, xp.where(xp.greater_equal(t929, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t931, t932/(1 + xp.sqrt(1 + t932**2)), 1/(t930 + xp.sqrt(1 + t930**2))), 0)
     t934 = 1/xp.sqrt(1 + t933**2)
     t935 = t915*t933
@@ -4165,10 +4165,10 @@ def velocity_ellipsoid(q):
     t961 = t959 - t933*t960
     t962 = t960 + t933*t959
     t963 = xp.not_equal(t950, 0)
-    t964 = 0.5*(-t936 + t902)/xp.where(t963, t950, 1)
+    t964 = (-t936 + t902)/xp.where(t963, 2*t950, 1)
     t965 = xp.abs(t964)
     t966 = xp.greater_equal(t965, 1)
-    t967 = xp.abs(1/xp.where(t966, t964, 1))
+    t967 = 1/xp.abs(xp.where(t966, t964, 1))
     t968 = xp.where(t963, xp.where(xp.greater_equal(t964, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t966, t967/(1 + xp.sqrt(1 + t967**2)), 1/(t965 + xp.sqrt(1 + t965**2))), 0)
     t969 = 1/xp.sqrt(1 + t968**2)
     t970 = t950*t968
@@ -4200,10 +4200,10 @@ def velocity_ellipsoid(q):
     t996 = t994 - t968*t995
     t997 = t995 + t968*t994
     t998 = xp.not_equal(t985, 0)
-    t999 = 0.5*(-t937 + t972)/xp.where(t998, t985, 1)
+    t999 = (-t937 + t972)/xp.where(t998, 2*t985, 1)
     t1000 = xp.abs(t999)
     t1001 = xp.greater_equal(t1000, 1)
-    t1002 = xp.abs(1/xp.where(t1001, t999, 1))
+    t1002 = 1/xp.abs(xp.where(t1001, t999, 1))
     t1003 = xp.where(t998, xp.where(xp.greater_equal(t999, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1001, t1002/(1 + xp.sqrt(1 + t1002**2)), 1/(t1000 + xp.sqrt(1 + t1000**2))), 0)
     t1004 = 1/xp.sqrt(1 + t1003**2)
     t1005 = t985*t1003
@@ -4235,10 +4235,10 @@ def velocity_ellipsoid(q):
     t1031 = t1029 - t1003*t1030
     t1032 = t1030 + t1003*t1029
     t1033 = xp.not_equal(t1020, 0)
-    t1034 = 0.5*(-t971 + t1006)/xp.where(t1033, t1020, 1)
+    t1034 = (-t971 + t1006)/xp.where(t1033, 2*t1020, 1)
     t1035 = xp.abs(t1034)
     t1036 = xp.greater_equal(t1035, 1)
-    t1037 = xp.abs(1/xp.where(t1036, t1034, 1))
+    t1037 = 1/xp.abs(xp.where(t1036, t1034, 1))
     t1038 = xp.where(t1033, xp.where(xp.greater_equal(t1034, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1036, t1037/(1 + xp.sqrt(1 + t1037**2)), 1/(t1035 + xp.sqrt(1 + t1035**2))), 0)
     t1039 = 1/xp.sqrt(1 + t1038**2)
     t1040 = t1020*t1038
@@ -4270,10 +4270,10 @@ def velocity_ellipsoid(q):
     t1066 = t1064 - t1038*t1065
     t1067 = t1065 + t1038*t1064
     t1068 = xp.not_equal(t1055, 0)
-    t1069 = 0.5*(-t1041 + t1007)/xp.where(t1068, t1055, 1)
+    t1069 = (-t1041 + t1007)/xp.where(t1068, 2*t1055, 1)
     t1070 = xp.abs(t1069)
     t1071 = xp.greater_equal(t1070, 1)
-    t1072 = xp.abs(1/xp.where(t1071, t1069, 1))
+    t1072 = 1/xp.abs(xp.where(t1071, t1069, 1))
     t1073 = xp.where(t1068, xp.where(xp.greater_equal(t1069, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1071, t1072/(1 + xp.sqrt(1 + t1072**2)), 1/(t1070 + xp.sqrt(1 + t1070**2))), 0)
     t1074 = 1/xp.sqrt(1 + t1073**2)
     t1075 = t1007 + t1055*t1073
@@ -4304,10 +4304,10 @@ def velocity_ellipsoid(q):
     t1100 = t1098 - t1073*t1099
     t1101 = t1099 + t1073*t1098
     t1102 = xp.not_equal(t1088, 0)
-    t1103 = 0.5*(-t1042 + t1075)/xp.where(t1102, t1088, 1)
+    t1103 = (-t1042 + t1075)/xp.where(t1102, 2*t1088, 1)
     t1104 = xp.abs(t1103)
     t1105 = xp.greater_equal(t1104, 1)
-    t1106 = xp.abs(1/xp.where(t1105, t1103, 1))
+    t1106 = 1/xp.abs(xp.where(t1105, t1103, 1))
     t1107 = xp.where(t1102, xp.where(xp.greater_equal(t1103, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1105, t1106/(1 + xp.sqrt(1 + t1106**2)), 1/(t1104 + xp.sqrt(1 + t1104**2))), 0)
     t1108 = 1/xp.sqrt(1 + t1107**2)
     t1109 = t1046*t1108
@@ -4607,10 +4607,10 @@ def condition_number(q):
     t183 = t65*t80
     t184 = t74*t102 + t67*t152 + t181*t106 - t182*t112 + t183*t118
     t185 = xp.not_equal(t184, 0)
-    t186 = 0.5*(-t180 + t173)/xp.where(t185, -t184, 1)
+    t186 = (-t180 + t173)/xp.where(t185, -2*t184, 1)
     t187 = xp.abs(t186)
     t188 = xp.greater_equal(t187, 1)
-    t189 = xp.abs(1/xp.where(t188, t186, 1))
+    t189 = 1/xp.abs(xp.where(t188, t186, 1))
     t190 = xp.where(t185, xp.where(xp.greater_equal(t186, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t188, t189/(1 + xp.sqrt(1 + t189**2)), 1/(t187 + xp.sqrt(1 + t187**2))), 0)
     t191 = 1/xp.sqrt(1 + t190**2)
     t192 = t184*t190
@@ -4638,10 +4638,10 @@ def condition_number(q):
     t214 = -t212 + t211*t190
     t215 = t124*t201 + t128*t205 - t133*t209 + t158*t213
     t216 = xp.not_equal(t215, 0)
-    t217 = 0.5*(-t193 + t174)/xp.where(t216, t215, 1)
+    t217 = (-t193 + t174)/xp.where(t216, 2*t215, 1)
     t218 = xp.abs(t217)
     t219 = xp.greater_equal(t218, 1)
-    t220 = xp.abs(1/xp.where(t219, t217, 1))
+    t220 = 1/xp.abs(xp.where(t219, t217, 1))
     t221 = xp.where(t216, xp.where(xp.greater_equal(t217, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t219, t220/(1 + xp.sqrt(1 + t220**2)), 1/(t218 + xp.sqrt(1 + t218**2))), 0)
     t222 = 1/xp.sqrt(1 + t221**2)
     t223 = t215*t221
@@ -4665,10 +4665,10 @@ def condition_number(q):
     t241 = t239 + t238*t221
     t242 = t138*t232 + t163*t240 - t142*t236
     t243 = xp.not_equal(t242, 0)
-    t244 = 0.5*(-t224 + t175)/xp.where(t243, -t242, 1)
+    t244 = (-t224 + t175)/xp.where(t243, -2*t242, 1)
     t245 = xp.abs(t244)
     t246 = xp.greater_equal(t245, 1)
-    t247 = xp.abs(1/xp.where(t246, t244, 1))
+    t247 = 1/xp.abs(xp.where(t246, t244, 1))
     t248 = xp.where(t243, xp.where(xp.greater_equal(t244, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t246, t247/(1 + xp.sqrt(1 + t247**2)), 1/(t245 + xp.sqrt(1 + t245**2))), 0)
     t249 = 1/xp.sqrt(1 + t248**2)
     t250 = t242*t248
@@ -4688,10 +4688,10 @@ def condition_number(q):
     t264 = -t262 + t261*t248
     t265 = -t147*t259 + t168*t263
     t266 = xp.not_equal(t265, 0)
-    t267 = 0.5*(-t251 + t176)/xp.where(t266, t265, 1)
+    t267 = (-t251 + t176)/xp.where(t266, 2*t265, 1)
     t268 = xp.abs(t267)
     t269 = xp.greater_equal(t268, 1)
-    t270 = xp.abs(1/xp.where(t269, t267, 1))
+    t270 = 1/xp.abs(xp.where(t269, t267, 1))
     t271 = xp.where(t266, xp.where(xp.greater_equal(t267, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t269, t270/(1 + xp.sqrt(1 + t270**2)), 1/(t268 + xp.sqrt(1 + t268**2))), 0)
     t272 = 1/xp.sqrt(1 + t271**2)
     t273 = t265*t271
@@ -4707,10 +4707,10 @@ def condition_number(q):
     t283 = t281 + t280*t271
     t284 = t172*t282
     t285 = xp.not_equal(t284, 0)
-    t286 = 0.5*(-t274 + t177)/xp.where(t285, -t284, 1)
+    t286 = (-t274 + t177)/xp.where(t285, -2*t284, 1)
     t287 = xp.abs(t286)
     t288 = xp.greater_equal(t287, 1)
-    t289 = xp.abs(1/xp.where(t288, t286, 1))
+    t289 = 1/xp.abs(xp.where(t288, t286, 1))
     t290 = xp.where(t285, xp.where(xp.greater_equal(t286, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t288, t289/(1 + xp.sqrt(1 + t289**2)), 1/(t287 + xp.sqrt(1 + t287**2))), 0)
     t291 = 1/xp.sqrt(1 + t290**2)
     t292 = t284*t290
@@ -4724,10 +4724,10 @@ def condition_number(q):
     t300 = t299*t197
     t301 = -t202*t229 - t206*t233 + t210*t237 + t214*t241 + t178*t299*t190*t191**2 + t300*t198
     t302 = xp.not_equal(t301, 0)
-    t303 = 0.5*(-t194 + t225)/xp.where(t302, t301, 1)
+    t303 = (-t194 + t225)/xp.where(t302, 2*t301, 1)
     t304 = xp.abs(t303)
     t305 = xp.greater_equal(t304, 1)
-    t306 = xp.abs(1/xp.where(t305, t303, 1))
+    t306 = 1/xp.abs(xp.where(t305, t303, 1))
     t307 = xp.where(t302, xp.where(xp.greater_equal(t303, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t305, t306/(1 + xp.sqrt(1 + t306**2)), 1/(t304 + xp.sqrt(1 + t304**2))), 0)
     t308 = 1/xp.sqrt(1 + t307**2)
     t309 = t301*t307
@@ -4766,10 +4766,10 @@ def condition_number(q):
     t342 = t338*t228
     t343 = -t256*t328 - t260*t332 + t264*t336 - t340*t316 + t341*t320 + t342*t324
     t344 = xp.not_equal(t343, 0)
-    t345 = 0.5*(-t310 + t252)/xp.where(t344, t343, 1)
+    t345 = (-t310 + t252)/xp.where(t344, 2*t343, 1)
     t346 = xp.abs(t345)
     t347 = xp.greater_equal(t346, 1)
-    t348 = xp.abs(1/xp.where(t347, t345, 1))
+    t348 = 1/xp.abs(xp.where(t347, t345, 1))
     t349 = xp.where(t344, xp.where(xp.greater_equal(t345, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t347, t348/(1 + xp.sqrt(1 + t348**2)), 1/(t346 + xp.sqrt(1 + t346**2))), 0)
     t350 = 1/xp.sqrt(1 + t349**2)
     t351 = t343*t349
@@ -4812,10 +4812,10 @@ def condition_number(q):
     t388 = t387*t271
     t389 = t279*t372 + t283*t376 - t382*t356 + t384*t360 + t386*t364 - t388*t368
     t390 = xp.not_equal(t389, 0)
-    t391 = 0.5*(-t352 + t275)/xp.where(t390, t389, 1)
+    t391 = (-t352 + t275)/xp.where(t390, 2*t389, 1)
     t392 = xp.abs(t391)
     t393 = xp.greater_equal(t392, 1)
-    t394 = xp.abs(1/xp.where(t393, t391, 1))
+    t394 = 1/xp.abs(xp.where(t393, t391, 1))
     t395 = xp.where(t390, xp.where(xp.greater_equal(t391, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t393, t394/(1 + xp.sqrt(1 + t394**2)), 1/(t392 + xp.sqrt(1 + t392**2))), 0)
     t396 = 1/xp.sqrt(1 + t395**2)
     t397 = t389*t395
@@ -4857,10 +4857,10 @@ def condition_number(q):
     t433 = t432*t290
     t434 = t298*t422 - t425*t402 + t427*t406 + t429*t410 - t431*t414 + t433*t418
     t435 = xp.not_equal(t434, 0)
-    t436 = 0.5*(-t398 + t294)/xp.where(t435, t434, 1)
+    t436 = (-t398 + t294)/xp.where(t435, 2*t434, 1)
     t437 = xp.abs(t436)
     t438 = xp.greater_equal(t437, 1)
-    t439 = xp.abs(1/xp.where(t438, t436, 1))
+    t439 = 1/xp.abs(xp.where(t438, t436, 1))
     t440 = xp.where(t435, xp.where(xp.greater_equal(t436, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t438, t439/(1 + xp.sqrt(1 + t439**2)), 1/(t437 + xp.sqrt(1 + t437**2))), 0)
     t441 = 1/xp.sqrt(1 + t440**2)
     t442 = t434*t440
@@ -4892,10 +4892,10 @@ def condition_number(q):
     t468 = t466 + t465*t440
     t469 = t297*t467 - t424*t447 + t426*t451 + t428*t455 - t430*t459 + t432*t463
     t470 = xp.not_equal(t378, 0)
-    t471 = 0.5*(-t311 + t353)/xp.where(t470, t378, 1)
+    t471 = (-t311 + t353)/xp.where(t470, 2*t378, 1)
     t472 = xp.abs(t471)
     t473 = xp.greater_equal(t472, 1)
-    t474 = xp.abs(1/xp.where(t473, t471, 1))
+    t474 = 1/xp.abs(xp.where(t473, t471, 1))
     t475 = xp.where(t470, xp.where(xp.greater_equal(t471, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t473, t474/(1 + xp.sqrt(1 + t474**2)), 1/(t472 + xp.sqrt(1 + t472**2))), 0)
     t476 = 1/xp.sqrt(1 + t475**2)
     t477 = t378*t475
@@ -4927,10 +4927,10 @@ def condition_number(q):
     t503 = t501 + t500*t475
     t504 = -t403*t482 + t407*t486 + t411*t490 + t415*t494 + t419*t498 + t423*t502
     t505 = xp.not_equal(t504, 0)
-    t506 = 0.5*(-t478 + t399)/xp.where(t505, t504, 1)
+    t506 = (-t478 + t399)/xp.where(t505, 2*t504, 1)
     t507 = xp.abs(t506)
     t508 = xp.greater_equal(t507, 1)
-    t509 = xp.abs(1/xp.where(t508, t506, 1))
+    t509 = 1/xp.abs(xp.where(t508, t506, 1))
     t510 = xp.where(t505, xp.where(xp.greater_equal(t506, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t508, t509/(1 + xp.sqrt(1 + t509**2)), 1/(t507 + xp.sqrt(1 + t507**2))), 0)
     t511 = 1/xp.sqrt(1 + t510**2)
     t512 = t504*t510
@@ -4963,10 +4963,10 @@ def condition_number(q):
     t539 = -t448*t517 + t452*t521 + t456*t525 + t460*t529 + t464*t533 + t468*t537
     t540 = t483*t518 + t487*t522 + t491*t526 + t495*t530 + t499*t534 + t503*t538
     t541 = xp.not_equal(t539, 0)
-    t542 = 0.5*(-t513 + t444)/xp.where(t541, t539, 1)
+    t542 = (-t513 + t444)/xp.where(t541, 2*t539, 1)
     t543 = xp.abs(t542)
     t544 = xp.greater_equal(t543, 1)
-    t545 = xp.abs(1/xp.where(t544, t542, 1))
+    t545 = 1/xp.abs(xp.where(t544, t542, 1))
     t546 = xp.where(t541, xp.where(xp.greater_equal(t542, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t544, t545/(1 + xp.sqrt(1 + t545**2)), 1/(t543 + xp.sqrt(1 + t543**2))), 0)
     t547 = 1/xp.sqrt(1 + t546**2)
     t548 = t539*t546
@@ -4997,10 +4997,10 @@ def condition_number(q):
     t573 = t571 - t572*t546
     t574 = t572 + t571*t546
     t575 = xp.not_equal(t540, 0)
-    t576 = 0.5*(-t479 + t514)/xp.where(t575, t540, 1)
+    t576 = (-t479 + t514)/xp.where(t575, 2*t540, 1)
     t577 = xp.abs(t576)
     t578 = xp.greater_equal(t577, 1)
-    t579 = xp.abs(1/xp.where(t578, t576, 1))
+    t579 = 1/xp.abs(xp.where(t578, t576, 1))
     t580 = xp.where(t575, xp.where(xp.greater_equal(t576, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t578, t579/(1 + xp.sqrt(1 + t579**2)), 1/(t577 + xp.sqrt(1 + t577**2))), 0)
     t581 = 1/xp.sqrt(1 + t580**2)
     t582 = t540*t580
@@ -5032,10 +5032,10 @@ def condition_number(q):
     t608 = t606 + t605*t580
     t609 = t554*t587 + t558*t591 + t562*t595 + t566*t599 + t570*t603 + t574*t607
     t610 = xp.not_equal(t609, 0)
-    t611 = 0.5*(-t583 + t550)/xp.where(t610, t609, 1)
+    t611 = (-t583 + t550)/xp.where(t610, 2*t609, 1)
     t612 = xp.abs(t611)
     t613 = xp.greater_equal(t612, 1)
-    t614 = xp.abs(1/xp.where(t613, t611, 1))
+    t614 = 1/xp.abs(xp.where(t613, t611, 1))
     t615 = xp.where(t610, xp.where(xp.greater_equal(t611, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t613, t614/(1 + xp.sqrt(1 + t614**2)), 1/(t612 + xp.sqrt(1 + t612**2))), 0)
     t616 = 1/xp.sqrt(1 + t615**2)
     t617 = t609*t615
@@ -5067,10 +5067,10 @@ def condition_number(q):
     t643 = t641 + t640*t615
     t644 = t588*t623 + t592*t627 + t596*t631 + t600*t635 + t604*t639 + t608*t643
     t645 = xp.not_equal(t644, 0)
-    t646 = 0.5*(-t584 + t619)/xp.where(t645, t644, 1)
+    t646 = (-t584 + t619)/xp.where(t645, 2*t644, 1)
     t647 = xp.abs(t646)
     t648 = xp.greater_equal(t647, 1)
-    t649 = xp.abs(1/xp.where(t648, t646, 1))
+    t649 = 1/xp.abs(xp.where(t648, t646, 1))
     t650 = xp.where(t645, xp.where(xp.greater_equal(t646, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t648, t649/(1 + xp.sqrt(1 + t649**2)), 1/(t647 + xp.sqrt(1 + t647**2))), 0)
     t651 = 1/xp.sqrt(1 + t650**2)
     t652 = t644*t650
@@ -5101,10 +5101,10 @@ def condition_number(q):
     t677 = t675 - t676*t650
     t678 = t676 + t675*t650
     t679 = xp.not_equal(t469, 0)
-    t680 = 0.5*(-t293 + t443)/xp.where(t679, t469, 1)
+    t680 = (-t293 + t443)/xp.where(t679, 2*t469, 1)
     t681 = xp.abs(t680)
     t682 = xp.greater_equal(t681, 1)
-    t683 = xp.abs(1/xp.where(t682, t680, 1))
+    t683 = 1/xp.abs(xp.where(t682, t680, 1))
     t684 = xp.where(t679, xp.where(xp.greater_equal(t680, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t682, t683/(1 + xp.sqrt(1 + t683**2)), 1/(t681 + xp.sqrt(1 + t681**2))), 0)
     t685 = 1/xp.sqrt(1 + t684**2)
     t686 = t469*t684
@@ -5136,10 +5136,10 @@ def condition_number(q):
     t712 = t710 + t709*t684
     t713 = t553*t691 + t557*t695 + t561*t699 + t565*t703 + t569*t707 + t573*t711
     t714 = xp.not_equal(t713, 0)
-    t715 = 0.5*(-t687 + t549)/xp.where(t714, t713, 1)
+    t715 = (-t687 + t549)/xp.where(t714, 2*t713, 1)
     t716 = xp.abs(t715)
     t717 = xp.greater_equal(t716, 1)
-    t718 = xp.abs(1/xp.where(t717, t715, 1))
+    t718 = 1/xp.abs(xp.where(t717, t715, 1))
     t719 = xp.where(t714, xp.where(xp.greater_equal(t715, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t717, t718/(1 + xp.sqrt(1 + t718**2)), 1/(t716 + xp.sqrt(1 + t716**2))), 0)
     t720 = 1/xp.sqrt(1 + t719**2)
     t721 = t713*t719
@@ -5172,10 +5172,10 @@ def condition_number(q):
     t748 = t622*t726 + t626*t730 + t630*t734 + t634*t738 + t638*t742 + t642*t746
     t749 = -t692*t727 + t696*t731 + t700*t735 + t704*t739 + t708*t743 + t712*t747
     t750 = xp.not_equal(t748, 0)
-    t751 = 0.5*(-t722 + t618)/xp.where(t750, t748, 1)
+    t751 = (-t722 + t618)/xp.where(t750, 2*t748, 1)
     t752 = xp.abs(t751)
     t753 = xp.greater_equal(t752, 1)
-    t754 = xp.abs(1/xp.where(t753, t751, 1))
+    t754 = 1/xp.abs(xp.where(t753, t751, 1))
     t755 = xp.where(t750, xp.where(xp.greater_equal(t751, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t753, t754/(1 + xp.sqrt(1 + t754**2)), 1/(t752 + xp.sqrt(1 + t752**2))), 0)
     t756 = 1/xp.sqrt(1 + t755**2)
     t757 = t748*t755
@@ -5207,10 +5207,10 @@ def condition_number(q):
     t783 = t781 + t780*t755
     t784 = t657*t762 + t661*t766 + t665*t770 + t669*t774 + t673*t778 + t677*t782
     t785 = xp.not_equal(t784, 0)
-    t786 = 0.5*(-t758 + t653)/xp.where(t785, t784, 1)
+    t786 = (-t758 + t653)/xp.where(t785, 2*t784, 1)
     t787 = xp.abs(t786)
     t788 = xp.greater_equal(t787, 1)
-    t789 = xp.abs(1/xp.where(t788, t786, 1))
+    t789 = 1/xp.abs(xp.where(t788, t786, 1))
     t790 = xp.where(t785, xp.where(xp.greater_equal(t786, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t788, t789/(1 + xp.sqrt(1 + t789**2)), 1/(t787 + xp.sqrt(1 + t787**2))), 0)
     t791 = 1/xp.sqrt(1 + t790**2)
     t792 = t784*t790
@@ -5242,10 +5242,10 @@ def condition_number(q):
     t818 = t816 + t815*t790
     t819 = t658*t797 + t662*t801 + t666*t805 + t670*t809 + t674*t813 + t678*t817
     t820 = xp.not_equal(t819, 0)
-    t821 = 0.5*(-t793 + t654)/xp.where(t820, t819, 1)
+    t821 = (-t793 + t654)/xp.where(t820, 2*t819, 1)
     t822 = xp.abs(t821)
     t823 = xp.greater_equal(t822, 1)
-    t824 = xp.abs(1/xp.where(t823, t821, 1))
+    t824 = 1/xp.abs(xp.where(t823, t821, 1))
     t825 = xp.where(t820, xp.where(xp.greater_equal(t821, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t823, t824/(1 + xp.sqrt(1 + t824**2)), 1/(t822 + xp.sqrt(1 + t822**2))), 0)
     t826 = 1/xp.sqrt(1 + t825**2)
     t827 = t819*t825
@@ -5276,10 +5276,10 @@ def condition_number(q):
     t852 = t850 - t851*t825
     t853 = t851 + t850*t825
     t854 = xp.not_equal(t749, 0)
-    t855 = 0.5*(-t688 + t723)/xp.where(t854, t749, 1)
+    t855 = (-t688 + t723)/xp.where(t854, 2*t749, 1)
     t856 = xp.abs(t855)
     t857 = xp.greater_equal(t856, 1)
-    t858 = xp.abs(1/xp.where(t857, t855, 1))
+    t858 = 1/xp.abs(xp.where(t857, t855, 1))
     t859 = xp.where(t854, xp.where(xp.greater_equal(t855, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t857, t858/(1 + xp.sqrt(1 + t858**2)), 1/(t856 + xp.sqrt(1 + t856**2))), 0)
     t860 = 1/xp.sqrt(1 + t859**2)
     t861 = t749*t859
@@ -5311,10 +5311,10 @@ def condition_number(q):
     t887 = t885 + t884*t859
     t888 = t763*t866 + t767*t870 + t771*t874 + t775*t878 + t779*t882 + t783*t886
     t889 = xp.not_equal(t888, 0)
-    t890 = 0.5*(-t862 + t759)/xp.where(t889, t888, 1)
+    t890 = (-t862 + t759)/xp.where(t889, 2*t888, 1)
     t891 = xp.abs(t890)
     t892 = xp.greater_equal(t891, 1)
-    t893 = xp.abs(1/xp.where(t892, t890, 1))
+    t893 = 1/xp.abs(xp.where(t892, t890, 1))
     t894 = xp.where(t889, xp.where(xp.greater_equal(t890, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t892, t893/(1 + xp.sqrt(1 + t893**2)), 1/(t891 + xp.sqrt(1 + t891**2))), 0)
     t895 = 1/xp.sqrt(1 + t894**2)
     t896 = t888*t894
@@ -5347,10 +5347,10 @@ def condition_number(q):
     t923 = t798*t901 + t802*t905 + t806*t909 + t810*t913 + t814*t917 + t818*t921
     t924 = t867*t902 + t871*t906 + t875*t910 + t879*t914 + t883*t918 + t887*t922
     t925 = xp.not_equal(t923, 0)
-    t926 = 0.5*(-t897 + t794)/xp.where(t925, t923, 1)
+    t926 = (-t897 + t794)/xp.where(t925, 2*t923, 1)
     t927 = xp.abs(t926)
     t928 = xp.greater_equal(t927, 1)
-    t929 = xp.abs(1/xp.where(t928, t926, 1))
+    t929 = 1/xp.abs(xp.where(t928, t926, 1))
     t930 = xp.where(t925, xp.where(xp.greater_equal(t926, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t928, t929/(1 + xp.sqrt(1 + t929**2)), 1/(t927 + xp.sqrt(1 + t927**2))), 0)
     t931 = 1/xp.sqrt(1 + t930**2)
     t932 = t923*t930
@@ -5382,10 +5382,10 @@ def condition_number(q):
     t958 = t956 + t955*t930
     t959 = t833*t937 + t837*t941 + t841*t945 + t845*t949 + t849*t953 + t853*t957
     t960 = xp.not_equal(t959, 0)
-    t961 = 0.5*(-t933 + t829)/xp.where(t960, t959, 1)
+    t961 = (-t933 + t829)/xp.where(t960, 2*t959, 1)
     t962 = xp.abs(t961)
     t963 = xp.greater_equal(t962, 1)
-    t964 = xp.abs(1/xp.where(t963, t961, 1))
+    t964 = 1/xp.abs(xp.where(t963, t961, 1))
     t965 = xp.where(t960, xp.where(xp.greater_equal(t961, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t963, t964/(1 + xp.sqrt(1 + t964**2)), 1/(t962 + xp.sqrt(1 + t962**2))), 0)
     t966 = 1/xp.sqrt(1 + t965**2)
     t967 = t959*t965
@@ -5417,10 +5417,10 @@ def condition_number(q):
     t993 = t991 + t990*t965
     t994 = t832*t972 + t836*t976 + t840*t980 + t844*t984 + t848*t988 + t852*t992
     t995 = xp.not_equal(t924, 0)
-    t996 = 0.5*(-t863 + t898)/xp.where(t995, t924, 1)
+    t996 = (-t863 + t898)/xp.where(t995, 2*t924, 1)
     t997 = xp.abs(t996)
     t998 = xp.greater_equal(t997, 1)
-    t999 = xp.abs(1/xp.where(t998, t996, 1))
+    t999 = 1/xp.abs(xp.where(t998, t996, 1))
     t1000 = xp.where(t995, xp.where(xp.greater_equal(t996, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t998, t999/(1 + xp.sqrt(1 + t999**2)), 1/(t997 + xp.sqrt(1 + t997**2))), 0)
     t1001 = 1/xp.sqrt(1 + t1000**2)
     t1002 = t924*t1000
@@ -5452,10 +5452,10 @@ def condition_number(q):
     t1028 = t1026 + t1025*t1000
     t1029 = t938*t1007 + t942*t1011 + t946*t1015 + t950*t1019 + t954*t1023 + t958*t1027
     t1030 = xp.not_equal(t1029, 0)
-    t1031 = 0.5*(-t1003 + t934)/xp.where(t1030, t1029, 1)
+    t1031 = (-t1003 + t934)/xp.where(t1030, 2*t1029, 1)
     t1032 = xp.abs(t1031)
     t1033 = xp.greater_equal(t1032, 1)
-    t1034 = xp.abs(1/xp.where(t1033, t1031, 1))
+    t1034 = 1/xp.abs(xp.where(t1033, t1031, 1))
     t1035 = xp.where(t1030, xp.where(xp.greater_equal(t1031, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1033, t1034/(1 + xp.sqrt(1 + t1034**2)), 1/(t1032 + xp.sqrt(1 + t1032**2))), 0)
     t1036 = 1/xp.sqrt(1 + t1035**2)
     t1037 = t1029*t1035
@@ -5488,10 +5488,10 @@ def condition_number(q):
     t1064 = t973*t1042 + t977*t1046 + t981*t1050 + t985*t1054 + t989*t1058 + t993*t1062
     t1065 = t1008*t1043 + t1012*t1047 + t1016*t1051 + t1020*t1055 + t1024*t1059 + t1028*t1063
     t1066 = xp.not_equal(t1064, 0)
-    t1067 = 0.5*(-t1038 + t969)/xp.where(t1066, t1064, 1)
+    t1067 = (-t1038 + t969)/xp.where(t1066, 2*t1064, 1)
     t1068 = xp.abs(t1067)
     t1069 = xp.greater_equal(t1068, 1)
-    t1070 = xp.abs(1/xp.where(t1069, t1067, 1))
+    t1070 = 1/xp.abs(xp.where(t1069, t1067, 1))
     t1071 = xp.where(t1066, xp.where(xp.greater_equal(t1067, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1069, t1070/(1 + xp.sqrt(1 + t1070**2)), 1/(t1068 + xp.sqrt(1 + t1068**2))), 0)
     t1072 = 1/xp.sqrt(1 + t1071**2)
     t1073 = t1064*t1071
@@ -5522,10 +5522,10 @@ def condition_number(q):
     t1098 = t1096 - t1097*t1071
     t1099 = t1097 + t1096*t1071
     t1100 = xp.not_equal(t1065, 0)
-    t1101 = 0.5*(-t1004 + t1039)/xp.where(t1100, t1065, 1)
+    t1101 = (-t1004 + t1039)/xp.where(t1100, 2*t1065, 1)
     t1102 = xp.abs(t1101)
     t1103 = xp.greater_equal(t1102, 1)
-    t1104 = xp.abs(1/xp.where(t1103, t1101, 1))
+    t1104 = 1/xp.abs(xp.where(t1103, t1101, 1))
     t1105 = xp.where(t1100, xp.where(xp.greater_equal(t1101, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1103, t1104/(1 + xp.sqrt(1 + t1104**2)), 1/(t1102 + xp.sqrt(1 + t1102**2))), 0)
     t1106 = 1/xp.sqrt(1 + t1105**2)
     t1107 = t1065*t1105
@@ -5557,10 +5557,10 @@ def condition_number(q):
     t1133 = t1131 + t1130*t1105
     t1134 = t1079*t1112 + t1083*t1116 + t1087*t1120 + t1091*t1124 + t1095*t1128 + t1099*t1132
     t1135 = xp.not_equal(t1134, 0)
-    t1136 = 0.5*(-t1108 + t1075)/xp.where(t1135, t1134, 1)
+    t1136 = (-t1108 + t1075)/xp.where(t1135, 2*t1134, 1)
     t1137 = xp.abs(t1136)
     t1138 = xp.greater_equal(t1137, 1)
-    t1139 = xp.abs(1/xp.where(t1138, t1136, 1))
+    t1139 = 1/xp.abs(xp.where(t1138, t1136, 1))
     t1140 = xp.where(t1135, xp.where(xp.greater_equal(t1136, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1138, t1139/(1 + xp.sqrt(1 + t1139**2)), 1/(t1137 + xp.sqrt(1 + t1137**2))), 0)
     t1141 = 1/xp.sqrt(1 + t1140**2)
     t1142 = t1134*t1140
@@ -5592,10 +5592,10 @@ def condition_number(q):
     t1168 = t1166 + t1140*t1165
     t1169 = t1113*t1148 + t1117*t1152 + t1121*t1156 + t1125*t1160 + t1129*t1164 + t1133*t1168
     t1170 = xp.not_equal(t1169, 0)
-    t1171 = 0.5*(-t1109 + t1144)/xp.where(t1170, t1169, 1)
+    t1171 = (-t1109 + t1144)/xp.where(t1170, 2*t1169, 1)
     t1172 = xp.abs(t1171)
     t1173 = xp.greater_equal(t1172, 1)
-    t1174 = xp.abs(1/xp.where(t1173, t1171, 1))
+    t1174 = 1/xp.abs(xp.where(t1173, t1171, 1))
     t1175 = xp.where(t1170, xp.where(xp.greater_equal(t1171, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1173, t1174/(1 + xp.sqrt(1 + t1174**2)), 1/(t1172 + xp.sqrt(1 + t1172**2))), 0)
     t1176 = 1/xp.sqrt(1 + t1175**2)
     t1177 = t1169*t1175
@@ -5626,10 +5626,10 @@ def condition_number(q):
     t1202 = t1200 - t1175*t1201
     t1203 = t1201 + t1175*t1200
     t1204 = xp.not_equal(t994, 0)
-    t1205 = 0.5*(-t828 + t968)/xp.where(t1204, t994, 1)
+    t1205 = (-t828 + t968)/xp.where(t1204, 2*t994, 1)
     t1206 = xp.abs(t1205)
     t1207 = xp.greater_equal(t1206, 1)
-    t1208 = xp.abs(1/xp.where(t1207, t1205, 1))
+    t1208 = 1/xp.abs(xp.where(t1207, t1205, 1))
     t1209 = xp.where(t1204, xp.where(xp.greater_equal(t1205, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1207, t1208/(1 + xp.sqrt(1 + t1208**2)), 1/(t1206 + xp.sqrt(1 + t1206**2))), 0)
     t1210 = 1/xp.sqrt(1 + t1209**2)
     t1211 = t994*t1209
@@ -5661,10 +5661,10 @@ def condition_number(q):
     t1237 = t1235 + t1209*t1234
     t1238 = t1078*t1216 + t1082*t1220 + t1086*t1224 + t1090*t1228 + t1094*t1232 + t1098*t1236
     t1239 = xp.not_equal(t1238, 0)
-    t1240 = 0.5*(-t1212 + t1074)/xp.where(t1239, t1238, 1)
+    t1240 = (-t1212 + t1074)/xp.where(t1239, 2*t1238, 1)
     t1241 = xp.abs(t1240)
     t1242 = xp.greater_equal(t1241, 1)
-    t1243 = xp.abs(1/xp.where(t1242, t1240, 1))
+    t1243 = 1/xp.abs(xp.where(t1242, t1240, 1))
     t1244 = xp.where(t1239, xp.where(xp.greater_equal(t1240, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1242, t1243/(1 + xp.sqrt(1 + t1243**2)), 1/(t1241 + xp.sqrt(1 + t1241**2))), 0)
     t1245 = 1/xp.sqrt(1 + t1244**2)
     t1246 = t1238*t1244
@@ -5697,10 +5697,10 @@ def condition_number(q):
     t1273 = t1147*t1251 + t1151*t1255 + t1155*t1259 + t1159*t1263 + t1163*t1267 + t1167*t1271
     t1274 = t1217*t1252 + t1221*t1256 + t1225*t1260 + t1229*t1264 + t1233*t1268 + t1237*t1272
     t1275 = xp.not_equal(t1273, 0)
-    t1276 = 0.5*(-t1247 + t1143)/xp.where(t1275, t1273, 1)
+    t1276 = (-t1247 + t1143)/xp.where(t1275, 2*t1273, 1)
     t1277 = xp.abs(t1276)
     t1278 = xp.greater_equal(t1277, 1)
-    t1279 = xp.abs(1/xp.where(t1278, t1276, 1))
+    t1279 = 1/xp.abs(xp.where(t1278, t1276, 1))
     t1280 = xp.where(t1275, xp.where(xp.greater_equal(t1276, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1278, t1279/(1 + xp.sqrt(1 + t1279**2)), 1/(t1277 + xp.sqrt(1 + t1277**2))), 0)
     t1281 = 1/xp.sqrt(1 + t1280**2)
     t1282 = t1273*t1280
@@ -5732,10 +5732,10 @@ def condition_number(q):
     t1308 = t1306 + t1280*t1305
     t1309 = t1182*t1287 + t1186*t1291 + t1190*t1295 + t1194*t1299 + t1198*t1303 + t1202*t1307
     t1310 = xp.not_equal(t1309, 0)
-    t1311 = 0.5*(-t1283 + t1178)/xp.where(t1310, t1309, 1)
+    t1311 = (-t1283 + t1178)/xp.where(t1310, 2*t1309, 1)
     t1312 = xp.abs(t1311)
     t1313 = xp.greater_equal(t1312, 1)
-    t1314 = xp.abs(1/xp.where(t1313, t1311, 1))
+    t1314 = 1/xp.abs(xp.where(t1313, t1311, 1))
     t1315 = xp.where(t1310, xp.where(xp.greater_equal(t1311, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1313, t1314/(1 + xp.sqrt(1 + t1314**2)), 1/(t1312 + xp.sqrt(1 + t1312**2))), 0)
     t1316 = 1/xp.sqrt(1 + t1315**2)
     t1317 = t1309*t1315
@@ -5767,10 +5767,10 @@ def condition_number(q):
     t1343 = t1341 + t1315*t1340
     t1344 = t1183*t1322 + t1187*t1326 + t1191*t1330 + t1195*t1334 + t1199*t1338 + t1203*t1342
     t1345 = xp.not_equal(t1344, 0)
-    t1346 = 0.5*(-t1318 + t1179)/xp.where(t1345, t1344, 1)
+    t1346 = (-t1318 + t1179)/xp.where(t1345, 2*t1344, 1)
     t1347 = xp.abs(t1346)
     t1348 = xp.greater_equal(t1347, 1)
-    t1349 = xp.abs(1/xp.where(t1348, t1346, 1))
+    t1349 = 1/xp.abs(xp.where(t1348, t1346, 1))
     t1350 = xp.where(t1345, xp.where(xp.greater_equal(t1346, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1348, t1349/(1 + xp.sqrt(1 + t1349**2)), 1/(t1347 + xp.sqrt(1 + t1347**2))), 0)
     t1351 = 1/xp.sqrt(1 + t1350**2)
     t1352 = t1344*t1350
@@ -5801,10 +5801,10 @@ def condition_number(q):
     t1377 = t1375 - t1350*t1376
     t1378 = t1376 + t1350*t1375
     t1379 = xp.not_equal(t1274, 0)
-    t1380 = 0.5*(-t1213 + t1248)/xp.where(t1379, t1274, 1)
+    t1380 = (-t1213 + t1248)/xp.where(t1379, 2*t1274, 1)
     t1381 = xp.abs(t1380)
     t1382 = xp.greater_equal(t1381, 1)
-    t1383 = xp.abs(1/xp.where(t1382, t1380, 1))
+    t1383 = 1/xp.abs(xp.where(t1382, t1380, 1))
     t1384 = xp.where(t1379, xp.where(xp.greater_equal(t1380, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1382, t1383/(1 + xp.sqrt(1 + t1383**2)), 1/(t1381 + xp.sqrt(1 + t1381**2))), 0)
     t1385 = 1/xp.sqrt(1 + t1384**2)
     t1386 = t1274*t1384
@@ -5836,10 +5836,10 @@ def condition_number(q):
     t1412 = t1410 + t1384*t1409
     t1413 = t1288*t1391 + t1292*t1395 + t1296*t1399 + t1300*t1403 + t1304*t1407 + t1308*t1411
     t1414 = xp.not_equal(t1413, 0)
-    t1415 = 0.5*(-t1387 + t1284)/xp.where(t1414, t1413, 1)
+    t1415 = (-t1387 + t1284)/xp.where(t1414, 2*t1413, 1)
     t1416 = xp.abs(t1415)
     t1417 = xp.greater_equal(t1416, 1)
-    t1418 = xp.abs(1/xp.where(t1417, t1415, 1))
+    t1418 = 1/xp.abs(xp.where(t1417, t1415, 1))
     t1419 = xp.where(t1414, xp.where(xp.greater_equal(t1415, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1417, t1418/(1 + xp.sqrt(1 + t1418**2)), 1/(t1416 + xp.sqrt(1 + t1416**2))), 0)
     t1420 = 1/xp.sqrt(1 + t1419**2)
     t1421 = t1413*t1419
@@ -5872,10 +5872,10 @@ def condition_number(q):
     t1448 = t1323*t1426 + t1327*t1430 + t1331*t1434 + t1335*t1438 + t1339*t1442 + t1343*t1446
     t1449 = t1392*t1427 + t1396*t1431 + t1400*t1435 + t1404*t1439 + t1408*t1443 + t1412*t1447
     t1450 = xp.not_equal(t1448, 0)
-    t1451 = 0.5*(-t1422 + t1319)/xp.where(t1450, t1448, 1)
+    t1451 = (-t1422 + t1319)/xp.where(t1450, 2*t1448, 1)
     t1452 = xp.abs(t1451)
     t1453 = xp.greater_equal(t1452, 1)
-    t1454 = xp.abs(1/xp.where(t1453, t1451, 1))
+    t1454 = 1/xp.abs(xp.where(t1453, t1451, 1))
     t1455 = xp.where(t1450, xp.where(xp.greater_equal(t1451, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1453, t1454/(1 + xp.sqrt(1 + t1454**2)), 1/(t1452 + xp.sqrt(1 + t1452**2))), 0)
     t1456 = 1/xp.sqrt(1 + t1455**2)
     t1457 = t1448*t1455
@@ -5907,10 +5907,10 @@ def condition_number(q):
     t1483 = t1481 + t1455*t1480
     t1484 = t1358*t1462 + t1362*t1466 + t1366*t1470 + t1370*t1474 + t1374*t1478 + t1378*t1482
     t1485 = xp.not_equal(t1484, 0)
-    t1486 = 0.5*(-t1458 + t1354)/xp.where(t1485, t1484, 1)
+    t1486 = (-t1458 + t1354)/xp.where(t1485, 2*t1484, 1)
     t1487 = xp.abs(t1486)
     t1488 = xp.greater_equal(t1487, 1)
-    t1489 = xp.abs(1/xp.where(t1488, t1486, 1))
+    t1489 = 1/xp.abs(xp.where(t1488, t1486, 1))
     t1490 = xp.where(t1485, xp.where(xp.greater_equal(t1486, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1488, t1489/(1 + xp.sqrt(1 + t1489**2)), 1/(t1487 + xp.sqrt(1 + t1487**2))), 0)
     t1491 = 1/xp.sqrt(1 + t1490**2)
     t1492 = t1484*t1490
@@ -5942,10 +5942,10 @@ def condition_number(q):
     t1518 = t1516 + t1490*t1515
     t1519 = t1357*t1497 + t1361*t1501 + t1365*t1505 + t1369*t1509 + t1373*t1513 + t1377*t1517
     t1520 = xp.not_equal(t1449, 0)
-    t1521 = 0.5*(-t1388 + t1423)/xp.where(t1520, t1449, 1)
+    t1521 = (-t1388 + t1423)/xp.where(t1520, 2*t1449, 1)
     t1522 = xp.abs(t1521)
     t1523 = xp.greater_equal(t1522, 1)
-    t1524 = xp.abs(1/xp.where(t1523, t1521, 1))
+    t1524 = 1/xp.abs(xp.where(t1523, t1521, 1))
     t1525 = xp.where(t1520, xp.where(xp.greater_equal(t1521, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1523, t1524/(1 + xp.sqrt(1 + t1524**2)), 1/(t1522 + xp.sqrt(1 + t1522**2))), 0)
     t1526 = 1/xp.sqrt(1 + t1525**2)
     t1527 = t1449*t1525
@@ -5977,10 +5977,10 @@ def condition_number(q):
     t1553 = t1551 + t1525*t1550
     t1554 = t1463*t1532 + t1467*t1536 + t1471*t1540 + t1475*t1544 + t1479*t1548 + t1483*t1552
     t1555 = xp.not_equal(t1554, 0)
-    t1556 = 0.5*(-t1528 + t1459)/xp.where(t1555, t1554, 1)
+    t1556 = (-t1528 + t1459)/xp.where(t1555, 2*t1554, 1)
     t1557 = xp.abs(t1556)
     t1558 = xp.greater_equal(t1557, 1)
-    t1559 = xp.abs(1/xp.where(t1558, t1556, 1))
+    t1559 = 1/xp.abs(xp.where(t1558, t1556, 1))
     t1560 = xp.where(t1555, xp.where(xp.greater_equal(t1556, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1558, t1559/(1 + xp.sqrt(1 + t1559**2)), 1/(t1557 + xp.sqrt(1 + t1557**2))), 0)
     t1561 = 1/xp.sqrt(1 + t1560**2)
     t1562 = t1554*t1560
@@ -6013,10 +6013,10 @@ def condition_number(q):
     t1589 = t1498*t1567 + t1502*t1571 + t1506*t1575 + t1510*t1579 + t1514*t1583 + t1518*t1587
     t1590 = t1533*t1568 + t1537*t1572 + t1541*t1576 + t1545*t1580 + t1549*t1584 + t1553*t1588
     t1591 = xp.not_equal(t1589, 0)
-    t1592 = 0.5*(-t1563 + t1494)/xp.where(t1591, t1589, 1)
+    t1592 = (-t1563 + t1494)/xp.where(t1591, 2*t1589, 1)
     t1593 = xp.abs(t1592)
     t1594 = xp.greater_equal(t1593, 1)
-    t1595 = xp.abs(1/xp.where(t1594, t1592, 1))
+    t1595 = 1/xp.abs(xp.where(t1594, t1592, 1))
     t1596 = xp.where(t1591, xp.where(xp.greater_equal(t1592, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1594, t1595/(1 + xp.sqrt(1 + t1595**2)), 1/(t1593 + xp.sqrt(1 + t1593**2))), 0)
     t1597 = 1/xp.sqrt(1 + t1596**2)
     t1598 = t1589*t1596
@@ -6047,10 +6047,10 @@ def condition_number(q):
     t1623 = t1621 - t1596*t1622
     t1624 = t1622 + t1596*t1621
     t1625 = xp.not_equal(t1590, 0)
-    t1626 = 0.5*(-t1529 + t1564)/xp.where(t1625, t1590, 1)
+    t1626 = (-t1529 + t1564)/xp.where(t1625, 2*t1590, 1)
     t1627 = xp.abs(t1626)
     t1628 = xp.greater_equal(t1627, 1)
-    t1629 = xp.abs(1/xp.where(t1628, t1626, 1))
+    t1629 = 1/xp.abs(xp.where(t1628, t1626, 1))
     t1630 = xp.where(t1625, xp.where(xp.greater_equal(t1626, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1628, t1629/(1 + xp.sqrt(1 + t1629**2)), 1/(t1627 + xp.sqrt(1 + t1627**2))), 0)
     t1631 = 1/xp.sqrt(1 + t1630**2)
     t1632 = t1590*t1630
@@ -6082,10 +6082,10 @@ def condition_number(q):
     t1658 = t1656 + t1630*t1655
     t1659 = t1604*t1637 + t1608*t1641 + t1612*t1645 + t1616*t1649 + t1620*t1653 + t1624*t1657
     t1660 = xp.not_equal(t1659, 0)
-    t1661 = 0.5*(-t1633 + t1600)/xp.where(t1660, t1659, 1)
+    t1661 = (-t1633 + t1600)/xp.where(t1660, 2*t1659, 1)
     t1662 = xp.abs(t1661)
     t1663 = xp.greater_equal(t1662, 1)
-    t1664 = xp.abs(1/xp.where(t1663, t1661, 1))
+    t1664 = 1/xp.abs(xp.where(t1663, t1661, 1))
     t1665 = xp.where(t1660, xp.where(xp.greater_equal(t1661, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1663, t1664/(1 + xp.sqrt(1 + t1664**2)), 1/(t1662 + xp.sqrt(1 + t1662**2))), 0)
     t1666 = 1/xp.sqrt(1 + t1665**2)
     t1667 = t1659*t1665
@@ -6117,10 +6117,10 @@ def condition_number(q):
     t1693 = t1691 + t1665*t1690
     t1694 = t1638*t1673 + t1642*t1677 + t1646*t1681 + t1650*t1685 + t1654*t1689 + t1658*t1693
     t1695 = xp.not_equal(t1694, 0)
-    t1696 = 0.5*(-t1634 + t1669)/xp.where(t1695, t1694, 1)
+    t1696 = (-t1634 + t1669)/xp.where(t1695, 2*t1694, 1)
     t1697 = xp.abs(t1696)
     t1698 = xp.greater_equal(t1697, 1)
-    t1699 = xp.abs(1/xp.where(t1698, t1696, 1))
+    t1699 = 1/xp.abs(xp.where(t1698, t1696, 1))
     t1700 = xp.where(t1695, xp.where(xp.greater_equal(t1696, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1698, t1699/(1 + xp.sqrt(1 + t1699**2)), 1/(t1697 + xp.sqrt(1 + t1697**2))), 0)
     t1701 = 1/xp.sqrt(1 + t1700**2)
     t1702 = t1694*t1700
@@ -6151,10 +6151,10 @@ def condition_number(q):
     t1727 = t1725 - t1700*t1726
     t1728 = t1726 + t1700*t1725
     t1729 = xp.not_equal(t1519, 0)
-    t1730 = 0.5*(-t1353 + t1493)/xp.where(t1729, t1519, 1)
+    t1730 = (-t1353 + t1493)/xp.where(t1729, 2*t1519, 1)
     t1731 = xp.abs(t1730)
     t1732 = xp.greater_equal(t1731, 1)
-    t1733 = xp.abs(1/xp.where(t1732, t1730, 1))
+    t1733 = 1/xp.abs(xp.where(t1732, t1730, 1))
     t1734 = xp.where(t1729, xp.where(xp.greater_equal(t1730, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1732, t1733/(1 + xp.sqrt(1 + t1733**2)), 1/(t1731 + xp.sqrt(1 + t1731**2))), 0)
     t1735 = 1/xp.sqrt(1 + t1734**2)
     t1736 = t1519*t1734
@@ -6186,10 +6186,10 @@ def condition_number(q):
     t1762 = t1760 + t1734*t1759
     t1763 = t1603*t1741 + t1607*t1745 + t1611*t1749 + t1615*t1753 + t1619*t1757 + t1623*t1761
     t1764 = xp.not_equal(t1763, 0)
-    t1765 = 0.5*(-t1737 + t1599)/xp.where(t1764, t1763, 1)
+    t1765 = (-t1737 + t1599)/xp.where(t1764, 2*t1763, 1)
     t1766 = xp.abs(t1765)
     t1767 = xp.greater_equal(t1766, 1)
-    t1768 = xp.abs(1/xp.where(t1767, t1765, 1))
+    t1768 = 1/xp.abs(xp.where(t1767, t1765, 1))
     t1769 = xp.where(t1764, xp.where(xp.greater_equal(t1765, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1767, t1768/(1 + xp.sqrt(1 + t1768**2)), 1/(t1766 + xp.sqrt(1 + t1766**2))), 0)
     t1770 = 1/xp.sqrt(1 + t1769**2)
     t1771 = t1763*t1769
@@ -6222,10 +6222,10 @@ def condition_number(q):
     t1798 = t1672*t1776 + t1676*t1780 + t1680*t1784 + t1684*t1788 + t1688*t1792 + t1692*t1796
     t1799 = t1742*t1777 + t1746*t1781 + t1750*t1785 + t1754*t1789 + t1758*t1793 + t1762*t1797
     t1800 = xp.not_equal(t1798, 0)
-    t1801 = 0.5*(-t1772 + t1668)/xp.where(t1800, t1798, 1)
+    t1801 = (-t1772 + t1668)/xp.where(t1800, 2*t1798, 1)
     t1802 = xp.abs(t1801)
     t1803 = xp.greater_equal(t1802, 1)
-    t1804 = xp.abs(1/xp.where(t1803, t1801, 1))
+    t1804 = 1/xp.abs(xp.where(t1803, t1801, 1))
     t1805 = xp.where(t1800, xp.where(xp.greater_equal(t1801, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1803, t1804/(1 + xp.sqrt(1 + t1804**2)), 1/(t1802 + xp.sqrt(1 + t1802**2))), 0)
     t1806 = 1/xp.sqrt(1 + t1805**2)
     t1807 = t1798*t1805
@@ -6257,10 +6257,10 @@ def condition_number(q):
     t1833 = t1831 + t1805*t1830
     t1834 = t1707*t1812 + t1711*t1816 + t1715*t1820 + t1719*t1824 + t1723*t1828 + t1727*t1832
     t1835 = xp.not_equal(t1834, 0)
-    t1836 = 0.5*(-t1808 + t1703)/xp.where(t1835, t1834, 1)
+    t1836 = (-t1808 + t1703)/xp.where(t1835, 2*t1834, 1)
     t1837 = xp.abs(t1836)
     t1838 = xp.greater_equal(t1837, 1)
-    t1839 = xp.abs(1/xp.where(t1838, t1836, 1))
+    t1839 = 1/xp.abs(xp.where(t1838, t1836, 1))
     t1840 = xp.where(t1835, xp.where(xp.greater_equal(t1836, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1838, t1839/(1 + xp.sqrt(1 + t1839**2)), 1/(t1837 + xp.sqrt(1 + t1837**2))), 0)
     t1841 = 1/xp.sqrt(1 + t1840**2)
     t1842 = t1834*t1840
@@ -6292,10 +6292,10 @@ def condition_number(q):
     t1868 = t1866 + t1840*t1865
     t1869 = t1708*t1847 + t1712*t1851 + t1716*t1855 + t1720*t1859 + t1724*t1863 + t1728*t1867
     t1870 = xp.not_equal(t1869, 0)
-    t1871 = 0.5*(-t1843 + t1704)/xp.where(t1870, t1869, 1)
+    t1871 = (-t1843 + t1704)/xp.where(t1870, 2*t1869, 1)
     t1872 = xp.abs(t1871)
     t1873 = xp.greater_equal(t1872, 1)
-    t1874 = xp.abs(1/xp.where(t1873, t1871, 1))
+    t1874 = 1/xp.abs(xp.where(t1873, t1871, 1))
     t1875 = xp.where(t1870, xp.where(xp.greater_equal(t1871, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1873, t1874/(1 + xp.sqrt(1 + t1874**2)), 1/(t1872 + xp.sqrt(1 + t1872**2))), 0)
     t1876 = 1/xp.sqrt(1 + t1875**2)
     t1877 = t1869*t1875
@@ -6326,10 +6326,10 @@ def condition_number(q):
     t1902 = t1900 - t1875*t1901
     t1903 = t1901 + t1875*t1900
     t1904 = xp.not_equal(t1799, 0)
-    t1905 = 0.5*(-t1738 + t1773)/xp.where(t1904, t1799, 1)
+    t1905 = (-t1738 + t1773)/xp.where(t1904, 2*t1799, 1)
     t1906 = xp.abs(t1905)
     t1907 = xp.greater_equal(t1906, 1)
-    t1908 = xp.abs(1/xp.where(t1907, t1905, 1))
+    t1908 = 1/xp.abs(xp.where(t1907, t1905, 1))
     t1909 = xp.where(t1904, xp.where(xp.greater_equal(t1905, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1907, t1908/(1 + xp.sqrt(1 + t1908**2)), 1/(t1906 + xp.sqrt(1 + t1906**2))), 0)
     t1910 = 1/xp.sqrt(1 + t1909**2)
     t1911 = t1799*t1909
@@ -6361,10 +6361,10 @@ def condition_number(q):
     t1937 = t1935 + t1909*t1934
     t1938 = t1813*t1916 + t1817*t1920 + t1821*t1924 + t1825*t1928 + t1829*t1932 + t1833*t1936
     t1939 = xp.not_equal(t1938, 0)
-    t1940 = 0.5*(-t1912 + t1809)/xp.where(t1939, t1938, 1)
+    t1940 = (-t1912 + t1809)/xp.where(t1939, 2*t1938, 1)
     t1941 = xp.abs(t1940)
     t1942 = xp.greater_equal(t1941, 1)
-    t1943 = xp.abs(1/xp.where(t1942, t1940, 1))
+    t1943 = 1/xp.abs(xp.where(t1942, t1940, 1))
     t1944 = xp.where(t1939, xp.where(xp.greater_equal(t1940, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1942, t1943/(1 + xp.sqrt(1 + t1943**2)), 1/(t1941 + xp.sqrt(1 + t1941**2))), 0)
     t1945 = 1/xp.sqrt(1 + t1944**2)
     t1946 = t1938*t1944
@@ -6397,10 +6397,10 @@ def condition_number(q):
     t1973 = t1848*t1951 + t1852*t1955 + t1856*t1959 + t1860*t1963 + t1864*t1967 + t1868*t1971
     t1974 = t1917*t1952 + t1921*t1956 + t1925*t1960 + t1929*t1964 + t1933*t1968 + t1937*t1972
     t1975 = xp.not_equal(t1973, 0)
-    t1976 = 0.5*(-t1947 + t1844)/xp.where(t1975, t1973, 1)
+    t1976 = (-t1947 + t1844)/xp.where(t1975, 2*t1973, 1)
     t1977 = xp.abs(t1976)
     t1978 = xp.greater_equal(t1977, 1)
-    t1979 = xp.abs(1/xp.where(t1978, t1976, 1))
+    t1979 = 1/xp.abs(xp.where(t1978, t1976, 1))
     t1980 = xp.where(t1975, xp.where(xp.greater_equal(t1976, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1978, t1979/(1 + xp.sqrt(1 + t1979**2)), 1/(t1977 + xp.sqrt(1 + t1977**2))), 0)
     t1981 = 1/xp.sqrt(1 + t1980**2)
     t1982 = t1973*t1980
@@ -6432,10 +6432,10 @@ def condition_number(q):
     t2008 = t2006 + t1980*t2005
     t2009 = t1883*t1987 + t1887*t1991 + t1891*t1995 + t1895*t1999 + t1899*t2003 + t1903*t2007
     t2010 = xp.not_equal(t2009, 0)
-    t2011 = 0.5*(-t1983 + t1879)/xp.where(t2010, t2009, 1)
+    t2011 = (-t1983 + t1879)/xp.where(t2010, 2*t2009, 1)
     t2012 = xp.abs(t2011)
     t2013 = xp.greater_equal(t2012, 1)
-    t2014 = xp.abs(1/xp.where(t2013, t2011, 1))
+    t2014 = 1/xp.abs(xp.where(t2013, t2011, 1))
     t2015 = xp.where(t2010, xp.where(xp.greater_equal(t2011, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2013, t2014/(1 + xp.sqrt(1 + t2014**2)), 1/(t2012 + xp.sqrt(1 + t2012**2))), 0)
     t2016 = 1/xp.sqrt(1 + t2015**2)
     t2017 = t2009*t2015
@@ -6467,10 +6467,10 @@ def condition_number(q):
     t2043 = t2041 + t2015*t2040
     t2044 = t1882*t2022 + t1886*t2026 + t1890*t2030 + t1894*t2034 + t1898*t2038 + t1902*t2042
     t2045 = xp.not_equal(t1974, 0)
-    t2046 = 0.5*(-t1913 + t1948)/xp.where(t2045, t1974, 1)
+    t2046 = (-t1913 + t1948)/xp.where(t2045, 2*t1974, 1)
     t2047 = xp.abs(t2046)
     t2048 = xp.greater_equal(t2047, 1)
-    t2049 = xp.abs(1/xp.where(t2048, t2046, 1))
+    t2049 = 1/xp.abs(xp.where(t2048, t2046, 1))
     t2050 = xp.where(t2045, xp.where(xp.greater_equal(t2046, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2048, t2049/(1 + xp.sqrt(1 + t2049**2)), 1/(t2047 + xp.sqrt(1 + t2047**2))), 0)
     t2051 = 1/xp.sqrt(1 + t2050**2)
     t2052 = t1974*t2050
@@ -6502,10 +6502,10 @@ def condition_number(q):
     t2078 = t2076 + t2050*t2075
     t2079 = t1988*t2057 + t1992*t2061 + t1996*t2065 + t2000*t2069 + t2004*t2073 + t2008*t2077
     t2080 = xp.not_equal(t2079, 0)
-    t2081 = 0.5*(-t2053 + t1984)/xp.where(t2080, t2079, 1)
+    t2081 = (-t2053 + t1984)/xp.where(t2080, 2*t2079, 1)
     t2082 = xp.abs(t2081)
     t2083 = xp.greater_equal(t2082, 1)
-    t2084 = xp.abs(1/xp.where(t2083, t2081, 1))
+    t2084 = 1/xp.abs(xp.where(t2083, t2081, 1))
     t2085 = xp.where(t2080, xp.where(xp.greater_equal(t2081, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2083, t2084/(1 + xp.sqrt(1 + t2084**2)), 1/(t2082 + xp.sqrt(1 + t2082**2))), 0)
     t2086 = 1/xp.sqrt(1 + t2085**2)
     t2087 = t2079*t2085
@@ -6538,10 +6538,10 @@ def condition_number(q):
     t2114 = t2023*t2092 + t2027*t2096 + t2031*t2100 + t2035*t2104 + t2039*t2108 + t2043*t2112
     t2115 = t2058*t2093 + t2062*t2097 + t2066*t2101 + t2070*t2105 + t2074*t2109 + t2078*t2113
     t2116 = xp.not_equal(t2114, 0)
-    t2117 = 0.5*(-t2088 + t2019)/xp.where(t2116, t2114, 1)
+    t2117 = (-t2088 + t2019)/xp.where(t2116, 2*t2114, 1)
     t2118 = xp.abs(t2117)
     t2119 = xp.greater_equal(t2118, 1)
-    t2120 = xp.abs(1/xp.where(t2119, t2117, 1))
+    t2120 = 1/xp.abs(xp.where(t2119, t2117, 1))
     t2121 = xp.where(t2116, xp.where(xp.greater_equal(t2117, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2119, t2120/(1 + xp.sqrt(1 + t2120**2)), 1/(t2118 + xp.sqrt(1 + t2118**2))), 0)
     t2122 = 1/xp.sqrt(1 + t2121**2)
     t2123 = t2114*t2121
@@ -6572,10 +6572,10 @@ def condition_number(q):
     t2148 = t2146 - t2121*t2147
     t2149 = t2147 + t2121*t2146
     t2150 = xp.not_equal(t2115, 0)
-    t2151 = 0.5*(-t2054 + t2089)/xp.where(t2150, t2115, 1)
+    t2151 = (-t2054 + t2089)/xp.where(t2150, 2*t2115, 1)
     t2152 = xp.abs(t2151)
     t2153 = xp.greater_equal(t2152, 1)
-    t2154 = xp.abs(1/xp.where(t2153, t2151, 1))
+    t2154 = 1/xp.abs(xp.where(t2153, t2151, 1))
     t2155 = xp.where(t2150, xp.where(xp.greater_equal(t2151, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2153, t2154/(1 + xp.sqrt(1 + t2154**2)), 1/(t2152 + xp.sqrt(1 + t2152**2))), 0)
     t2156 = 1/xp.sqrt(1 + t2155**2)
     t2157 = t2115*t2155
@@ -6607,10 +6607,10 @@ def condition_number(q):
     t2183 = t2181 + t2155*t2180
     t2184 = t2129*t2162 + t2133*t2166 + t2137*t2170 + t2141*t2174 + t2145*t2178 + t2149*t2182
     t2185 = xp.not_equal(t2184, 0)
-    t2186 = 0.5*(-t2158 + t2125)/xp.where(t2185, t2184, 1)
+    t2186 = (-t2158 + t2125)/xp.where(t2185, 2*t2184, 1)
     t2187 = xp.abs(t2186)
     t2188 = xp.greater_equal(t2187, 1)
-    t2189 = xp.abs(1/xp.where(t2188, t2186, 1))
+    t2189 = 1/xp.abs(xp.where(t2188, t2186, 1))
     t2190 = xp.where(t2185, xp.where(xp.greater_equal(t2186, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2188, t2189/(1 + xp.sqrt(1 + t2189**2)), 1/(t2187 + xp.sqrt(1 + t2187**2))), 0)
     t2191 = 1/xp.sqrt(1 + t2190**2)
     t2192 = t2184*t2190
@@ -6642,10 +6642,10 @@ def condition_number(q):
     t2218 = t2216 + t2190*t2215
     t2219 = t2163*t2198 + t2167*t2202 + t2171*t2206 + t2175*t2210 + t2179*t2214 + t2183*t2218
     t2220 = xp.not_equal(t2219, 0)
-    t2221 = 0.5*(-t2159 + t2194)/xp.where(t2220, t2219, 1)
+    t2221 = (-t2159 + t2194)/xp.where(t2220, 2*t2219, 1)
     t2222 = xp.abs(t2221)
     t2223 = xp.greater_equal(t2222, 1)
-    t2224 = xp.abs(1/xp.where(t2223, t2221, 1))
+    t2224 = 1/xp.abs(xp.where(t2223, t2221, 1))
     t2225 = xp.where(t2220, xp.where(xp.greater_equal(t2221, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2223, t2224/(1 + xp.sqrt(1 + t2224**2)), 1/(t2222 + xp.sqrt(1 + t2222**2))), 0)
     t2226 = 1/xp.sqrt(1 + t2225**2)
     t2227 = t2219*t2225
@@ -6676,10 +6676,10 @@ def condition_number(q):
     t2252 = t2250 - t2225*t2251
     t2253 = t2251 + t2225*t2250
     t2254 = xp.not_equal(t2044, 0)
-    t2255 = 0.5*(-t1878 + t2018)/xp.where(t2254, t2044, 1)
+    t2255 = (-t1878 + t2018)/xp.where(t2254, 2*t2044, 1)
     t2256 = xp.abs(t2255)
     t2257 = xp.greater_equal(t2256, 1)
-    t2258 = xp.abs(1/xp.where(t2257, t2255, 1))
+    t2258 = 1/xp.abs(xp.where(t2257, t2255, 1))
     t2259 = xp.where(t2254, xp.where(xp.greater_equal(t2255, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2257, t2258/(1 + xp.sqrt(1 + t2258**2)), 1/(t2256 + xp.sqrt(1 + t2256**2))), 0)
     t2260 = 1/xp.sqrt(1 + t2259**2)
     t2261 = t2044*t2259
@@ -6711,10 +6711,10 @@ def condition_number(q):
     t2287 = t2285 + t2259*t2284
     t2288 = t2128*t2266 + t2132*t2270 + t2136*t2274 + t2140*t2278 + t2144*t2282 + t2148*t2286
     t2289 = xp.not_equal(t2288, 0)
-    t2290 = 0.5*(-t2262 + t2124)/xp.where(t2289, t2288, 1)
+    t2290 = (-t2262 + t2124)/xp.where(t2289, 2*t2288, 1)
     t2291 = xp.abs(t2290)
     t2292 = xp.greater_equal(t2291, 1)
-    t2293 = xp.abs(1/xp.where(t2292, t2290, 1))
+    t2293 = 1/xp.abs(xp.where(t2292, t2290, 1))
     t2294 = xp.where(t2289, xp.where(xp.greater_equal(t2290, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2292, t2293/(1 + xp.sqrt(1 + t2293**2)), 1/(t2291 + xp.sqrt(1 + t2291**2))), 0)
     t2295 = 1/xp.sqrt(1 + t2294**2)
     t2296 = t2288*t2294
@@ -6747,10 +6747,10 @@ def condition_number(q):
     t2323 = t2197*t2301 + t2201*t2305 + t2205*t2309 + t2209*t2313 + t2213*t2317 + t2217*t2321
     t2324 = t2267*t2302 + t2271*t2306 + t2275*t2310 + t2279*t2314 + t2283*t2318 + t2287*t2322
     t2325 = xp.not_equal(t2323, 0)
-    t2326 = 0.5*(-t2297 + t2193)/xp.where(t2325, t2323, 1)
+    t2326 = (-t2297 + t2193)/xp.where(t2325, 2*t2323, 1)
     t2327 = xp.abs(t2326)
     t2328 = xp.greater_equal(t2327, 1)
-    t2329 = xp.abs(1/xp.where(t2328, t2326, 1))
+    t2329 = 1/xp.abs(xp.where(t2328, t2326, 1))
     t2330 = xp.where(t2325, xp.where(xp.greater_equal(t2326, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2328, t2329/(1 + xp.sqrt(1 + t2329**2)), 1/(t2327 + xp.sqrt(1 + t2327**2))), 0)
     t2331 = 1/xp.sqrt(1 + t2330**2)
     t2332 = t2323*t2330
@@ -6782,10 +6782,10 @@ def condition_number(q):
     t2358 = t2356 + t2330*t2355
     t2359 = t2232*t2337 + t2236*t2341 + t2240*t2345 + t2244*t2349 + t2248*t2353 + t2252*t2357
     t2360 = xp.not_equal(t2359, 0)
-    t2361 = 0.5*(-t2333 + t2228)/xp.where(t2360, t2359, 1)
+    t2361 = (-t2333 + t2228)/xp.where(t2360, 2*t2359, 1)
     t2362 = xp.abs(t2361)
     t2363 = xp.greater_equal(t2362, 1)
-    t2364 = xp.abs(1/xp.where(t2363, t2361, 1))
+    t2364 = 1/xp.abs(xp.where(t2363, t2361, 1))
     t2365 = xp.where(t2360, xp.where(xp.greater_equal(t2361, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2363, t2364/(1 + xp.sqrt(1 + t2364**2)), 1/(t2362 + xp.sqrt(1 + t2362**2))), 0)
     t2366 = 1/xp.sqrt(1 + t2365**2)
     t2367 = t2359*t2365
@@ -6817,10 +6817,10 @@ def condition_number(q):
     t2393 = t2391 + t2365*t2390
     t2394 = t2233*t2372 + t2237*t2376 + t2241*t2380 + t2245*t2384 + t2249*t2388 + t2253*t2392
     t2395 = xp.not_equal(t2394, 0)
-    t2396 = 0.5*(-t2368 + t2229)/xp.where(t2395, t2394, 1)
+    t2396 = (-t2368 + t2229)/xp.where(t2395, 2*t2394, 1)
     t2397 = xp.abs(t2396)
     t2398 = xp.greater_equal(t2397, 1)
-    t2399 = xp.abs(1/xp.where(t2398, t2396, 1))
+    t2399 = 1/xp.abs(xp.where(t2398, t2396, 1))
     t2400 = xp.where(t2395, xp.where(xp.greater_equal(t2396, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2398, t2399/(1 + xp.sqrt(1 + t2399**2)), 1/(t2397 + xp.sqrt(1 + t2397**2))), 0)
     t2401 = 1/xp.sqrt(1 + t2400**2)
     t2402 = t2394*t2400
@@ -6851,10 +6851,10 @@ def condition_number(q):
     t2427 = t2425 - t2400*t2426
     t2428 = t2426 + t2400*t2425
     t2429 = xp.not_equal(t2324, 0)
-    t2430 = 0.5*(-t2263 + t2298)/xp.where(t2429, t2324, 1)
+    t2430 = (-t2263 + t2298)/xp.where(t2429, 2*t2324, 1)
     t2431 = xp.abs(t2430)
     t2432 = xp.greater_equal(t2431, 1)
-    t2433 = xp.abs(1/xp.where(t2432, t2430, 1))
+    t2433 = 1/xp.abs(xp.where(t2432, t2430, 1))
     t2434 = xp.where(t2429, xp.where(xp.greater_equal(t2430, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2432, t2433/(1 + xp.sqrt(1 + t2433**2)), 1/(t2431 + xp.sqrt(1 + t2431**2))), 0)
     t2435 = 1/xp.sqrt(1 + t2434**2)
     t2436 = t2324*t2434
@@ -6886,10 +6886,10 @@ def condition_number(q):
     t2462 = t2460 + t2434*t2459
     t2463 = t2338*t2441 + t2342*t2445 + t2346*t2449 + t2350*t2453 + t2354*t2457 + t2358*t2461
     t2464 = xp.not_equal(t2463, 0)
-    t2465 = 0.5*(-t2437 + t2334)/xp.where(t2464, t2463, 1)
+    t2465 = (-t2437 + t2334)/xp.where(t2464, 2*t2463, 1)
     t2466 = xp.abs(t2465)
     t2467 = xp.greater_equal(t2466, 1)
-    t2468 = xp.abs(1/xp.where(t2467, t2465, 1))
+    t2468 = 1/xp.abs(xp.where(t2467, t2465, 1))
     t2469 = xp.where(t2464, xp.where(xp.greater_equal(t2465, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2467, t2468/(1 + xp.sqrt(1 + t2468**2)), 1/(t2466 + xp.sqrt(1 + t2466**2))), 0)
     t2470 = 1/xp.sqrt(1 + t2469**2)
     t2471 = t2463*t2469
@@ -6922,10 +6922,10 @@ def condition_number(q):
     t2498 = t2373*t2476 + t2377*t2480 + t2381*t2484 + t2385*t2488 + t2389*t2492 + t2393*t2496
     t2499 = t2442*t2477 + t2446*t2481 + t2450*t2485 + t2454*t2489 + t2458*t2493 + t2462*t2497
     t2500 = xp.not_equal(t2498, 0)
-    t2501 = 0.5*(-t2472 + t2369)/xp.where(t2500, t2498, 1)
+    t2501 = (-t2472 + t2369)/xp.where(t2500, 2*t2498, 1)
     t2502 = xp.abs(t2501)
     t2503 = xp.greater_equal(t2502, 1)
-    t2504 = xp.abs(1/xp.where(t2503, t2501, 1))
+    t2504 = 1/xp.abs(xp.where(t2503, t2501, 1))
     t2505 = xp.where(t2500, xp.where(xp.greater_equal(t2501, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2503, t2504/(1 + xp.sqrt(1 + t2504**2)), 1/(t2502 + xp.sqrt(1 + t2502**2))), 0)
     t2506 = 1/xp.sqrt(1 + t2505**2)
     t2507 = t2498*t2505
@@ -6957,10 +6957,10 @@ def condition_number(q):
     t2533 = t2531 + t2505*t2530
     t2534 = t2408*t2512 + t2412*t2516 + t2416*t2520 + t2420*t2524 + t2424*t2528 + t2428*t2532
     t2535 = xp.not_equal(t2534, 0)
-    t2536 = 0.5*(-t2508 + t2404)/xp.where(t2535, t2534, 1)
+    t2536 = (-t2508 + t2404)/xp.where(t2535, 2*t2534, 1)
     t2537 = xp.abs(t2536)
     t2538 = xp.greater_equal(t2537, 1)
-    t2539 = xp.abs(1/xp.where(t2538, t2536, 1))
+    t2539 = 1/xp.abs(xp.where(t2538, t2536, 1))
     t2540 = xp.where(t2535, xp.where(xp.greater_equal(t2536, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2538, t2539/(1 + xp.sqrt(1 + t2539**2)), 1/(t2537 + xp.sqrt(1 + t2537**2))), 0)
     t2541 = 1/xp.sqrt(1 + t2540**2)
     t2542 = t2534*t2540
@@ -6992,10 +6992,10 @@ def condition_number(q):
     t2568 = t2566 + t2540*t2565
     t2569 = t2407*t2547 + t2411*t2551 + t2415*t2555 + t2419*t2559 + t2423*t2563 + t2427*t2567
     t2570 = xp.not_equal(t2499, 0)
-    t2571 = 0.5*(-t2438 + t2473)/xp.where(t2570, t2499, 1)
+    t2571 = (-t2438 + t2473)/xp.where(t2570, 2*t2499, 1)
     t2572 = xp.abs(t2571)
     t2573 = xp.greater_equal(t2572, 1)
-    t2574 = xp.abs(1/xp.where(t2573, t2571, 1))
+    t2574 = 1/xp.abs(xp.where(t2573, t2571, 1))
     t2575 = xp.where(t2570, xp.where(xp.greater_equal(t2571, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2573, t2574/(1 + xp.sqrt(1 + t2574**2)), 1/(t2572 + xp.sqrt(1 + t2572**2))), 0)
     t2576 = 1/xp.sqrt(1 + t2575**2)
     t2577 = t2499*t2575
@@ -7027,10 +7027,10 @@ def condition_number(q):
     t2603 = t2601 + t2575*t2600
     t2604 = t2513*t2582 + t2517*t2586 + t2521*t2590 + t2525*t2594 + t2529*t2598 + t2533*t2602
     t2605 = xp.not_equal(t2604, 0)
-    t2606 = 0.5*(-t2578 + t2509)/xp.where(t2605, t2604, 1)
+    t2606 = (-t2578 + t2509)/xp.where(t2605, 2*t2604, 1)
     t2607 = xp.abs(t2606)
     t2608 = xp.greater_equal(t2607, 1)
-    t2609 = xp.abs(1/xp.where(t2608, t2606, 1))
+    t2609 = 1/xp.abs(xp.where(t2608, t2606, 1))
     t2610 = xp.where(t2605, xp.where(xp.greater_equal(t2606, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2608, t2609/(1 + xp.sqrt(1 + t2609**2)), 1/(t2607 + xp.sqrt(1 + t2607**2))), 0)
     t2611 = 1/xp.sqrt(1 + t2610**2)
     t2612 = t2604*t2610
@@ -7063,10 +7063,10 @@ def condition_number(q):
     t2639 = t2548*t2617 + t2552*t2621 + t2556*t2625 + t2560*t2629 + t2564*t2633 + t2568*t2637
     t2640 = t2583*t2618 + t2587*t2622 + t2591*t2626 + t2595*t2630 + t2599*t2634 + t2603*t2638
     t2641 = xp.not_equal(t2639, 0)
-    t2642 = 0.5*(-t2613 + t2544)/xp.where(t2641, t2639, 1)
+    t2642 = (-t2613 + t2544)/xp.where(t2641, 2*t2639, 1)
     t2643 = xp.abs(t2642)
     t2644 = xp.greater_equal(t2643, 1)
-    t2645 = xp.abs(1/xp.where(t2644, t2642, 1))
+    t2645 = 1/xp.abs(xp.where(t2644, t2642, 1))
     t2646 = xp.where(t2641, xp.where(xp.greater_equal(t2642, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2644, t2645/(1 + xp.sqrt(1 + t2645**2)), 1/(t2643 + xp.sqrt(1 + t2643**2))), 0)
     t2647 = 1/xp.sqrt(1 + t2646**2)
     t2648 = t2639*t2646
@@ -7097,10 +7097,10 @@ def condition_number(q):
     t2673 = t2671 - t2646*t2672
     t2674 = t2672 + t2646*t2671
     t2675 = xp.not_equal(t2640, 0)
-    t2676 = 0.5*(-t2579 + t2614)/xp.where(t2675, t2640, 1)
+    t2676 = (-t2579 + t2614)/xp.where(t2675, 2*t2640, 1)
     t2677 = xp.abs(t2676)
     t2678 = xp.greater_equal(t2677, 1)
-    t2679 = xp.abs(1/xp.where(t2678, t2676, 1))
+    t2679 = 1/xp.abs(xp.where(t2678, t2676, 1))
     t2680 = xp.where(t2675, xp.where(xp.greater_equal(t2676, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2678, t2679/(1 + xp.sqrt(1 + t2679**2)), 1/(t2677 + xp.sqrt(1 + t2677**2))), 0)
     t2681 = 1/xp.sqrt(1 + t2680**2)
     t2682 = t2640*t2680
@@ -7132,10 +7132,10 @@ def condition_number(q):
     t2708 = t2706 + t2680*t2705
     t2709 = t2654*t2687 + t2658*t2691 + t2662*t2695 + t2666*t2699 + t2670*t2703 + t2674*t2707
     t2710 = xp.not_equal(t2709, 0)
-    t2711 = 0.5*(-t2683 + t2650)/xp.where(t2710, t2709, 1)
+    t2711 = (-t2683 + t2650)/xp.where(t2710, 2*t2709, 1)
     t2712 = xp.abs(t2711)
     t2713 = xp.greater_equal(t2712, 1)
-    t2714 = xp.abs(1/xp.where(t2713, t2711, 1))
+    t2714 = 1/xp.abs(xp.where(t2713, t2711, 1))
     t2715 = xp.where(t2710, xp.where(xp.greater_equal(t2711, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2713, t2714/(1 + xp.sqrt(1 + t2714**2)), 1/(t2712 + xp.sqrt(1 + t2712**2))), 0)
     t2716 = 1/xp.sqrt(1 + t2715**2)
     t2717 = t2709*t2715
@@ -7167,10 +7167,10 @@ def condition_number(q):
     t2743 = t2741 + t2715*t2740
     t2744 = t2688*t2723 + t2692*t2727 + t2696*t2731 + t2700*t2735 + t2704*t2739 + t2708*t2743
     t2745 = xp.not_equal(t2744, 0)
-    t2746 = 0.5*(-t2684 + t2719)/xp.where(t2745, t2744, 1)
+    t2746 = (-t2684 + t2719)/xp.where(t2745, 2*t2744, 1)
     t2747 = xp.abs(t2746)
     t2748 = xp.greater_equal(t2747, 1)
-    t2749 = xp.abs(1/xp.where(t2748, t2746, 1))
+    t2749 = 1/xp.abs(xp.where(t2748, t2746, 1))
     t2750 = xp.where(t2745, xp.where(xp.greater_equal(t2746, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2748, t2749/(1 + xp.sqrt(1 + t2749**2)), 1/(t2747 + xp.sqrt(1 + t2747**2))), 0)
     t2751 = 1/xp.sqrt(1 + t2750**2)
     t2752 = t2744*t2750
@@ -7201,10 +7201,10 @@ def condition_number(q):
     t2777 = t2775 - t2750*t2776
     t2778 = t2776 + t2750*t2775
     t2779 = xp.not_equal(t2569, 0)
-    t2780 = 0.5*(-t2403 + t2543)/xp.where(t2779, t2569, 1)
+    t2780 = (-t2403 + t2543)/xp.where(t2779, 2*t2569, 1)
     t2781 = xp.abs(t2780)
     t2782 = xp.greater_equal(t2781, 1)
-    t2783 = xp.abs(1/xp.where(t2782, t2780, 1))
+    t2783 = 1/xp.abs(xp.where(t2782, t2780, 1))
     t2784 = xp.where(t2779, xp.where(xp.greater_equal(t2780, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2782, t2783/(1 + xp.sqrt(1 + t2783**2)), 1/(t2781 + xp.sqrt(1 + t2781**2))), 0)
     t2785 = 1/xp.sqrt(1 + t2784**2)
     t2786 = t2569*t2784
@@ -7236,10 +7236,10 @@ def condition_number(q):
     t2812 = t2810 + t2784*t2809
     t2813 = t2653*t2791 + t2657*t2795 + t2661*t2799 + t2665*t2803 + t2669*t2807 + t2673*t2811
     t2814 = xp.not_equal(t2813, 0)
-    t2815 = 0.5*(-t2787 + t2649)/xp.where(t2814, t2813, 1)
+    t2815 = (-t2787 + t2649)/xp.where(t2814, 2*t2813, 1)
     t2816 = xp.abs(t2815)
     t2817 = xp.greater_equal(t2816, 1)
-    t2818 = xp.abs(1/xp.where(t2817, t2815, 1))
+    t2818 = 1/xp.abs(xp.where(t2817, t2815, 1))
     t2819 = xp.where(t2814, xp.where(xp.greater_equal(t2815, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2817, t2818/(1 + xp.sqrt(1 + t2818**2)), 1/(t2816 + xp.sqrt(1 + t2816**2))), 0)
     t2820 = 1/xp.sqrt(1 + t2819**2)
     t2821 = t2813*t2819
@@ -7272,10 +7272,10 @@ def condition_number(q):
     t2848 = t2722*t2826 + t2726*t2830 + t2730*t2834 + t2734*t2838 + t2738*t2842 + t2742*t2846
     t2849 = t2792*t2827 + t2796*t2831 + t2800*t2835 + t2804*t2839 + t2808*t2843 + t2812*t2847
     t2850 = xp.not_equal(t2848, 0)
-    t2851 = 0.5*(-t2822 + t2718)/xp.where(t2850, t2848, 1)
+    t2851 = (-t2822 + t2718)/xp.where(t2850, 2*t2848, 1)
     t2852 = xp.abs(t2851)
     t2853 = xp.greater_equal(t2852, 1)
-    t2854 = xp.abs(1/xp.where(t2853, t2851, 1))
+    t2854 = 1/xp.abs(xp.where(t2853, t2851, 1))
     t2855 = xp.where(t2850, xp.where(xp.greater_equal(t2851, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2853, t2854/(1 + xp.sqrt(1 + t2854**2)), 1/(t2852 + xp.sqrt(1 + t2852**2))), 0)
     t2856 = 1/xp.sqrt(1 + t2855**2)
     t2857 = t2848*t2855
@@ -7307,10 +7307,10 @@ def condition_number(q):
     t2883 = t2881 + t2855*t2880
     t2884 = t2757*t2862 + t2761*t2866 + t2765*t2870 + t2769*t2874 + t2773*t2878 + t2777*t2882
     t2885 = xp.not_equal(t2884, 0)
-    t2886 = 0.5*(-t2858 + t2753)/xp.where(t2885, t2884, 1)
+    t2886 = (-t2858 + t2753)/xp.where(t2885, 2*t2884, 1)
     t2887 = xp.abs(t2886)
     t2888 = xp.greater_equal(t2887, 1)
-    t2889 = xp.abs(1/xp.where(t2888, t2886, 1))
+    t2889 = 1/xp.abs(xp.where(t2888, t2886, 1))
     t2890 = xp.where(t2885, xp.where(xp.greater_equal(t2886, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2888, t2889/(1 + xp.sqrt(1 + t2889**2)), 1/(t2887 + xp.sqrt(1 + t2887**2))), 0)
     t2891 = 1/xp.sqrt(1 + t2890**2)
     t2892 = t2884*t2890
@@ -7342,10 +7342,10 @@ def condition_number(q):
     t2918 = t2916 + t2890*t2915
     t2919 = t2758*t2897 + t2762*t2901 + t2766*t2905 + t2770*t2909 + t2774*t2913 + t2778*t2917
     t2920 = xp.not_equal(t2919, 0)
-    t2921 = 0.5*(-t2893 + t2754)/xp.where(t2920, t2919, 1)
+    t2921 = (-t2893 + t2754)/xp.where(t2920, 2*t2919, 1)
     t2922 = xp.abs(t2921)
     t2923 = xp.greater_equal(t2922, 1)
-    t2924 = xp.abs(1/xp.where(t2923, t2921, 1))
+    t2924 = 1/xp.abs(xp.where(t2923, t2921, 1))
     t2925 = xp.where(t2920, xp.where(xp.greater_equal(t2921, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2923, t2924/(1 + xp.sqrt(1 + t2924**2)), 1/(t2922 + xp.sqrt(1 + t2922**2))), 0)
     t2926 = 1/xp.sqrt(1 + t2925**2)
     t2927 = t2919*t2925
@@ -7376,10 +7376,10 @@ def condition_number(q):
     t2952 = t2950 - t2925*t2951
     t2953 = t2951 + t2925*t2950
     t2954 = xp.not_equal(t2849, 0)
-    t2955 = 0.5*(-t2788 + t2823)/xp.where(t2954, t2849, 1)
+    t2955 = (-t2788 + t2823)/xp.where(t2954, 2*t2849, 1)
     t2956 = xp.abs(t2955)
     t2957 = xp.greater_equal(t2956, 1)
-    t2958 = xp.abs(1/xp.where(t2957, t2955, 1))
+    t2958 = 1/xp.abs(xp.where(t2957, t2955, 1))
     t2959 = xp.where(t2954, xp.where(xp.greater_equal(t2955, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2957, t2958/(1 + xp.sqrt(1 + t2958**2)), 1/(t2956 + xp.sqrt(1 + t2956**2))), 0)
     t2960 = 1/xp.sqrt(1 + t2959**2)
     t2961 = t2849*t2959
@@ -7411,10 +7411,10 @@ def condition_number(q):
     t2987 = t2985 + t2959*t2984
     t2988 = t2863*t2966 + t2867*t2970 + t2871*t2974 + t2875*t2978 + t2879*t2982 + t2883*t2986
     t2989 = xp.not_equal(t2988, 0)
-    t2990 = 0.5*(-t2962 + t2859)/xp.where(t2989, t2988, 1)
+    t2990 = (-t2962 + t2859)/xp.where(t2989, 2*t2988, 1)
     t2991 = xp.abs(t2990)
     t2992 = xp.greater_equal(t2991, 1)
-    t2993 = xp.abs(1/xp.where(t2992, t2990, 1))
+    t2993 = 1/xp.abs(xp.where(t2992, t2990, 1))
     t2994 = xp.where(t2989, xp.where(xp.greater_equal(t2990, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2992, t2993/(1 + xp.sqrt(1 + t2993**2)), 1/(t2991 + xp.sqrt(1 + t2991**2))), 0)
     t2995 = 1/xp.sqrt(1 + t2994**2)
     t2996 = t2988*t2994
@@ -7447,10 +7447,10 @@ def condition_number(q):
     t3023 = t2898*t3001 + t2902*t3005 + t2906*t3009 + t2910*t3013 + t2914*t3017 + t2918*t3021
     t3024 = t2967*t3002 + t2971*t3006 + t2975*t3010 + t2979*t3014 + t2983*t3018 + t2987*t3022
     t3025 = xp.not_equal(t3023, 0)
-    t3026 = 0.5*(-t2997 + t2894)/xp.where(t3025, t3023, 1)
+    t3026 = (-t2997 + t2894)/xp.where(t3025, 2*t3023, 1)
     t3027 = xp.abs(t3026)
     t3028 = xp.greater_equal(t3027, 1)
-    t3029 = xp.abs(1/xp.where(t3028, t3026, 1))
+    t3029 = 1/xp.abs(xp.where(t3028, t3026, 1))
     t3030 = xp.where(t3025, xp.where(xp.greater_equal(t3026, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3028, t3029/(1 + xp.sqrt(1 + t3029**2)), 1/(t3027 + xp.sqrt(1 + t3027**2))), 0)
     t3031 = 1/xp.sqrt(1 + t3030**2)
     t3032 = t3023*t3030
@@ -7482,10 +7482,10 @@ def condition_number(q):
     t3058 = t3056 + t3030*t3055
     t3059 = t2933*t3037 + t2937*t3041 + t2941*t3045 + t2945*t3049 + t2949*t3053 + t2953*t3057
     t3060 = xp.not_equal(t3059, 0)
-    t3061 = 0.5*(-t3033 + t2929)/xp.where(t3060, t3059, 1)
+    t3061 = (-t3033 + t2929)/xp.where(t3060, 2*t3059, 1)
     t3062 = xp.abs(t3061)
     t3063 = xp.greater_equal(t3062, 1)
-    t3064 = xp.abs(1/xp.where(t3063, t3061, 1))
+    t3064 = 1/xp.abs(xp.where(t3063, t3061, 1))
     t3065 = xp.where(t3060, xp.where(xp.greater_equal(t3061, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3063, t3064/(1 + xp.sqrt(1 + t3064**2)), 1/(t3062 + xp.sqrt(1 + t3062**2))), 0)
     t3066 = 1/xp.sqrt(1 + t3065**2)
     t3067 = t3059*t3065
@@ -7517,10 +7517,10 @@ def condition_number(q):
     t3093 = t3091 + t3065*t3090
     t3094 = t2932*t3072 + t2936*t3076 + t2940*t3080 + t2944*t3084 + t2948*t3088 + t2952*t3092
     t3095 = xp.not_equal(t3024, 0)
-    t3096 = 0.5*(-t2963 + t2998)/xp.where(t3095, t3024, 1)
+    t3096 = (-t2963 + t2998)/xp.where(t3095, 2*t3024, 1)
     t3097 = xp.abs(t3096)
     t3098 = xp.greater_equal(t3097, 1)
-    t3099 = xp.abs(1/xp.where(t3098, t3096, 1))
+    t3099 = 1/xp.abs(xp.where(t3098, t3096, 1))
     t3100 = xp.where(t3095, xp.where(xp.greater_equal(t3096, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3098, t3099/(1 + xp.sqrt(1 + t3099**2)), 1/(t3097 + xp.sqrt(1 + t3097**2))), 0)
     t3101 = 1/xp.sqrt(1 + t3100**2)
     t3102 = t3024*t3100
@@ -7552,10 +7552,10 @@ def condition_number(q):
     t3128 = t3126 + t3100*t3125
     t3129 = t3038*t3107 + t3042*t3111 + t3046*t3115 + t3050*t3119 + t3054*t3123 + t3058*t3127
     t3130 = xp.not_equal(t3129, 0)
-    t3131 = 0.5*(-t3103 + t3034)/xp.where(t3130, t3129, 1)
+    t3131 = (-t3103 + t3034)/xp.where(t3130, 2*t3129, 1)
     t3132 = xp.abs(t3131)
     t3133 = xp.greater_equal(t3132, 1)
-    t3134 = xp.abs(1/xp.where(t3133, t3131, 1))
+    t3134 = 1/xp.abs(xp.where(t3133, t3131, 1))
     t3135 = xp.where(t3130, xp.where(xp.greater_equal(t3131, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3133, t3134/(1 + xp.sqrt(1 + t3134**2)), 1/(t3132 + xp.sqrt(1 + t3132**2))), 0)
     t3136 = 1/xp.sqrt(1 + t3135**2)
     t3137 = t3129*t3135
@@ -7588,10 +7588,10 @@ def condition_number(q):
     t3164 = t3073*t3142 + t3077*t3146 + t3081*t3150 + t3085*t3154 + t3089*t3158 + t3093*t3162
     t3165 = t3108*t3143 + t3112*t3147 + t3116*t3151 + t3120*t3155 + t3124*t3159 + t3128*t3163
     t3166 = xp.not_equal(t3164, 0)
-    t3167 = 0.5*(-t3138 + t3069)/xp.where(t3166, t3164, 1)
+    t3167 = (-t3138 + t3069)/xp.where(t3166, 2*t3164, 1)
     t3168 = xp.abs(t3167)
     t3169 = xp.greater_equal(t3168, 1)
-    t3170 = xp.abs(1/xp.where(t3169, t3167, 1))
+    t3170 = 1/xp.abs(xp.where(t3169, t3167, 1))
     t3171 = xp.where(t3166, xp.where(xp.greater_equal(t3167, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3169, t3170/(1 + xp.sqrt(1 + t3170**2)), 1/(t3168 + xp.sqrt(1 + t3168**2))), 0)
     t3172 = 1/xp.sqrt(1 + t3171**2)
     t3173 = t3164*t3171
@@ -7622,10 +7622,10 @@ def condition_number(q):
     t3198 = t3196 - t3171*t3197
     t3199 = t3197 + t3171*t3196
     t3200 = xp.not_equal(t3165, 0)
-    t3201 = 0.5*(-t3104 + t3139)/xp.where(t3200, t3165, 1)
+    t3201 = (-t3104 + t3139)/xp.where(t3200, 2*t3165, 1)
     t3202 = xp.abs(t3201)
     t3203 = xp.greater_equal(t3202, 1)
-    t3204 = xp.abs(1/xp.where(t3203, t3201, 1))
+    t3204 = 1/xp.abs(xp.where(t3203, t3201, 1))
     t3205 = xp.where(t3200, xp.where(xp.greater_equal(t3201, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3203, t3204/(1 + xp.sqrt(1 + t3204**2)), 1/(t3202 + xp.sqrt(1 + t3202**2))), 0)
     t3206 = 1/xp.sqrt(1 + t3205**2)
     t3207 = t3165*t3205
@@ -7657,10 +7657,10 @@ def condition_number(q):
     t3233 = t3231 + t3205*t3230
     t3234 = t3179*t3212 + t3183*t3216 + t3187*t3220 + t3191*t3224 + t3195*t3228 + t3199*t3232
     t3235 = xp.not_equal(t3234, 0)
-    t3236 = 0.5*(-t3208 + t3175)/xp.where(t3235, t3234, 1)
+    t3236 = (-t3208 + t3175)/xp.where(t3235, 2*t3234, 1)
     t3237 = xp.abs(t3236)
     t3238 = xp.greater_equal(t3237, 1)
-    t3239 = xp.abs(1/xp.where(t3238, t3236, 1))
+    t3239 = 1/xp.abs(xp.where(t3238, t3236, 1))
     t3240 = xp.where(t3235, xp.where(xp.greater_equal(t3236, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3238, t3239/(1 + xp.sqrt(1 + t3239**2)), 1/(t3237 + xp.sqrt(1 + t3237**2))), 0)
     t3241 = 1/xp.sqrt(1 + t3240**2)
     t3242 = t3234*t3240
@@ -7692,10 +7692,10 @@ def condition_number(q):
     t3268 = t3266 + t3240*t3265
     t3269 = t3213*t3248 + t3217*t3252 + t3221*t3256 + t3225*t3260 + t3229*t3264 + t3233*t3268
     t3270 = xp.not_equal(t3269, 0)
-    t3271 = 0.5*(-t3209 + t3244)/xp.where(t3270, t3269, 1)
+    t3271 = (-t3209 + t3244)/xp.where(t3270, 2*t3269, 1)
     t3272 = xp.abs(t3271)
     t3273 = xp.greater_equal(t3272, 1)
-    t3274 = xp.abs(1/xp.where(t3273, t3271, 1))
+    t3274 = 1/xp.abs(xp.where(t3273, t3271, 1))
     t3275 = xp.where(t3270, xp.where(xp.greater_equal(t3271, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3273, t3274/(1 + xp.sqrt(1 + t3274**2)), 1/(t3272 + xp.sqrt(1 + t3272**2))), 0)
     t3276 = 1/xp.sqrt(1 + t3275**2)
     t3277 = t3269*t3275
@@ -7726,10 +7726,10 @@ def condition_number(q):
     t3302 = t3300 - t3275*t3301
     t3303 = t3301 + t3275*t3300
     t3304 = xp.not_equal(t3094, 0)
-    t3305 = 0.5*(-t2928 + t3068)/xp.where(t3304, t3094, 1)
+    t3305 = (-t2928 + t3068)/xp.where(t3304, 2*t3094, 1)
     t3306 = xp.abs(t3305)
     t3307 = xp.greater_equal(t3306, 1)
-    t3308 = xp.abs(1/xp.where(t3307, t3305, 1))
+    t3308 = 1/xp.abs(xp.where(t3307, t3305, 1))
     t3309 = xp.where(t3304, xp.where(xp.greater_equal(t3305, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3307, t3308/(1 + xp.sqrt(1 + t3308**2)), 1/(t3306 + xp.sqrt(1 + t3306**2))), 0)
     t3310 = 1/xp.sqrt(1 + t3309**2)
     t3311 = t3094*t3309
@@ -7761,10 +7761,10 @@ def condition_number(q):
     t3337 = t3335 + t3309*t3334
     t3338 = t3178*t3316 + t3182*t3320 + t3186*t3324 + t3190*t3328 + t3194*t3332 + t3198*t3336
     t3339 = xp.not_equal(t3338, 0)
-    t3340 = 0.5*(-t3312 + t3174)/xp.where(t3339, t3338, 1)
+    t3340 = (-t3312 + t3174)/xp.where(t3339, 2*t3338, 1)
     t3341 = xp.abs(t3340)
     t3342 = xp.greater_equal(t3341, 1)
-    t3343 = xp.abs(1/xp.where(t3342, t3340, 1))
+    t3343 = 1/xp.abs(xp.where(t3342, t3340, 1))
     t3344 = xp.where(t3339, xp.where(xp.greater_equal(t3340, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3342, t3343/(1 + xp.sqrt(1 + t3343**2)), 1/(t3341 + xp.sqrt(1 + t3341**2))), 0)
     t3345 = 1/xp.sqrt(1 + t3344**2)
     t3346 = t3338*t3344
@@ -7797,10 +7797,10 @@ def condition_number(q):
     t3373 = t3247*t3351 + t3251*t3355 + t3255*t3359 + t3259*t3363 + t3263*t3367 + t3267*t3371
     t3374 = t3317*t3352 + t3321*t3356 + t3325*t3360 + t3329*t3364 + t3333*t3368 + t3337*t3372
     t3375 = xp.not_equal(t3373, 0)
-    t3376 = 0.5*(-t3347 + t3243)/xp.where(t3375, t3373, 1)
+    t3376 = (-t3347 + t3243)/xp.where(t3375, 2*t3373, 1)
     t3377 = xp.abs(t3376)
     t3378 = xp.greater_equal(t3377, 1)
-    t3379 = xp.abs(1/xp.where(t3378, t3376, 1))
+    t3379 = 1/xp.abs(xp.where(t3378, t3376, 1))
     t3380 = xp.where(t3375, xp.where(xp.greater_equal(t3376, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3378, t3379/(1 + xp.sqrt(1 + t3379**2)), 1/(t3377 + xp.sqrt(1 + t3377**2))), 0)
     t3381 = 1/xp.sqrt(1 + t3380**2)
     t3382 = t3373*t3380
@@ -7832,10 +7832,10 @@ def condition_number(q):
     t3408 = t3406 + t3380*t3405
     t3409 = t3282*t3387 + t3286*t3391 + t3290*t3395 + t3294*t3399 + t3298*t3403 + t3302*t3407
     t3410 = xp.not_equal(t3409, 0)
-    t3411 = 0.5*(-t3383 + t3278)/xp.where(t3410, t3409, 1)
+    t3411 = (-t3383 + t3278)/xp.where(t3410, 2*t3409, 1)
     t3412 = xp.abs(t3411)
     t3413 = xp.greater_equal(t3412, 1)
-    t3414 = xp.abs(1/xp.where(t3413, t3411, 1))
+    t3414 = 1/xp.abs(xp.where(t3413, t3411, 1))
     t3415 = xp.where(t3410, xp.where(xp.greater_equal(t3411, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3413, t3414/(1 + xp.sqrt(1 + t3414**2)), 1/(t3412 + xp.sqrt(1 + t3412**2))), 0)
     t3416 = 1/xp.sqrt(1 + t3415**2)
     t3417 = t3409*t3415
@@ -7867,10 +7867,10 @@ def condition_number(q):
     t3443 = t3441 + t3415*t3440
     t3444 = t3283*t3422 + t3287*t3426 + t3291*t3430 + t3295*t3434 + t3299*t3438 + t3303*t3442
     t3445 = xp.not_equal(t3444, 0)
-    t3446 = 0.5*(-t3418 + t3279)/xp.where(t3445, t3444, 1)
+    t3446 = (-t3418 + t3279)/xp.where(t3445, 2*t3444, 1)
     t3447 = xp.abs(t3446)
     t3448 = xp.greater_equal(t3447, 1)
-    t3449 = xp.abs(1/xp.where(t3448, t3446, 1))
+    t3449 = 1/xp.abs(xp.where(t3448, t3446, 1))
     t3450 = xp.where(t3445, xp.where(xp.greater_equal(t3446, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3448, t3449/(1 + xp.sqrt(1 + t3449**2)), 1/(t3447 + xp.sqrt(1 + t3447**2))), 0)
     t3451 = 1/xp.sqrt(1 + t3450**2)
     t3452 = t3279 + t3444*t3450
@@ -7900,10 +7900,10 @@ def condition_number(q):
     t3476 = t3474 + t3450*t3473
     t3477 = xp.sqrt(t3455**2 + t3459**2 + t3463**2 + t3467**2 + t3471**2 + t3475**2)
     t3478 = xp.not_equal(t3374, 0)
-    t3479 = 0.5*(-t3313 + t3348)/xp.where(t3478, t3374, 1)
+    t3479 = (-t3313 + t3348)/xp.where(t3478, 2*t3374, 1)
     t3480 = xp.abs(t3479)
     t3481 = xp.greater_equal(t3480, 1)
-    t3482 = xp.abs(1/xp.where(t3481, t3479, 1))
+    t3482 = 1/xp.abs(xp.where(t3481, t3479, 1))
     t3483 = xp.where(t3478, xp.where(xp.greater_equal(t3479, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3481, t3482/(1 + xp.sqrt(1 + t3482**2)), 1/(t3480 + xp.sqrt(1 + t3480**2))), 0)
     t3484 = 1/xp.sqrt(1 + t3483**2)
     t3485 = t3374*t3483
@@ -7935,10 +7935,10 @@ def condition_number(q):
     t3511 = t3509 + t3483*t3508
     t3512 = t3388*t3490 + t3392*t3494 + t3396*t3498 + t3400*t3502 + t3404*t3506 + t3408*t3510
     t3513 = xp.not_equal(t3512, 0)
-    t3514 = 0.5*(-t3486 + t3384)/xp.where(t3513, t3512, 1)
+    t3514 = (-t3486 + t3384)/xp.where(t3513, 2*t3512, 1)
     t3515 = xp.abs(t3514)
     t3516 = xp.greater_equal(t3515, 1)
-    t3517 = xp.abs(1/xp.where(t3516, t3514, 1))
+    t3517 = 1/xp.abs(xp.where(t3516, t3514, 1))
     t3518 = xp.where(t3513, xp.where(xp.greater_equal(t3514, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3516, t3517/(1 + xp.sqrt(1 + t3517**2)), 1/(t3515 + xp.sqrt(1 + t3515**2))), 0)
     t3519 = 1/xp.sqrt(1 + t3518**2)
     t3520 = t3512*t3518
@@ -7971,10 +7971,10 @@ def condition_number(q):
     t3547 = t3423*t3525 + t3427*t3529 + t3431*t3533 + t3435*t3537 + t3439*t3541 + t3443*t3545
     t3548 = t3491*t3526 + t3495*t3530 + t3499*t3534 + t3503*t3538 + t3507*t3542 + t3511*t3546
     t3549 = xp.not_equal(t3547, 0)
-    t3550 = 0.5*(-t3521 + t3419)/xp.where(t3549, t3547, 1)
+    t3550 = (-t3521 + t3419)/xp.where(t3549, 2*t3547, 1)
     t3551 = xp.abs(t3550)
     t3552 = xp.greater_equal(t3551, 1)
-    t3553 = xp.abs(1/xp.where(t3552, t3550, 1))
+    t3553 = 1/xp.abs(xp.where(t3552, t3550, 1))
     t3554 = xp.where(t3549, xp.where(xp.greater_equal(t3550, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3552, t3553/(1 + xp.sqrt(1 + t3553**2)), 1/(t3551 + xp.sqrt(1 + t3551**2))), 0)
     t3555 = 1/xp.sqrt(1 + t3554**2)
     t3556 = t3547*t3554
@@ -8006,10 +8006,10 @@ def condition_number(q):
     t3582 = t3580 + t3554*t3579
     t3583 = t3456*t3561 + t3460*t3565 + t3464*t3569 + t3468*t3573 + t3472*t3577 + t3476*t3581
     t3584 = xp.not_equal(t3583, 0)
-    t3585 = 0.5*(-t3557 + t3452)/xp.where(t3584, t3583, 1)
+    t3585 = (-t3557 + t3452)/xp.where(t3584, 2*t3583, 1)
     t3586 = xp.abs(t3585)
     t3587 = xp.greater_equal(t3586, 1)
-    t3588 = xp.abs(1/xp.where(t3587, t3585, 1))
+    t3588 = 1/xp.abs(xp.where(t3587, t3585, 1))
     t3589 = xp.where(t3584, xp.where(xp.greater_equal(t3585, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3587, t3588/(1 + xp.sqrt(1 + t3588**2)), 1/(t3586 + xp.sqrt(1 + t3586**2))), 0)
     t3590 = 1/xp.sqrt(1 + t3589**2)
     t3591 = t3452 + t3583*t3589
@@ -8041,10 +8041,10 @@ def condition_number(q):
     t3617 = xp.where(xp.greater(t3616, t3477), t3616, t3477)
     t3618 = xp.where(xp.less(t3616, t3477), t3616, t3477)
     t3619 = xp.not_equal(t3548, 0)
-    t3620 = 0.5*(-t3487 + t3522)/xp.where(t3619, t3548, 1)
+    t3620 = (-t3487 + t3522)/xp.where(t3619, 2*t3548, 1)
     t3621 = xp.abs(t3620)
     t3622 = xp.greater_equal(t3621, 1)
-    t3623 = xp.abs(1/xp.where(t3622, t3620, 1))
+    t3623 = 1/xp.abs(xp.where(t3622, t3620, 1))
     t3624 = xp.where(t3619, xp.where(xp.greater_equal(t3620, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3622, t3623/(1 + xp.sqrt(1 + t3623**2)), 1/(t3621 + xp.sqrt(1 + t3621**2))), 0)
     t3625 = 1/xp.sqrt(1 + t3624**2)
     t3626 = t3548*t3624
@@ -8076,10 +8076,10 @@ def condition_number(q):
     t3652 = t3650 + t3624*t3649
     t3653 = t3562*t3631 + t3566*t3635 + t3570*t3639 + t3574*t3643 + t3578*t3647 + t3582*t3651
     t3654 = xp.not_equal(t3653, 0)
-    t3655 = 0.5*(-t3627 + t3558)/xp.where(t3654, t3653, 1)
+    t3655 = (-t3627 + t3558)/xp.where(t3654, 2*t3653, 1)
     t3656 = xp.abs(t3655)
     t3657 = xp.greater_equal(t3656, 1)
-    t3658 = xp.abs(1/xp.where(t3657, t3655, 1))
+    t3658 = 1/xp.abs(xp.where(t3657, t3655, 1))
     t3659 = xp.where(t3654, xp.where(xp.greater_equal(t3655, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3657, t3658/(1 + xp.sqrt(1 + t3658**2)), 1/(t3656 + xp.sqrt(1 + t3656**2))), 0)
     t3660 = 1/xp.sqrt(1 + t3659**2)
     t3661 = t3653*t3659
@@ -8112,10 +8112,10 @@ def condition_number(q):
     t3688 = t3595*t3666 + t3599*t3670 + t3603*t3674 + t3607*t3678 + t3611*t3682 + t3615*t3686
     t3689 = t3632*t3667 + t3636*t3671 + t3640*t3675 + t3644*t3679 + t3648*t3683 + t3652*t3687
     t3690 = xp.not_equal(t3688, 0)
-    t3691 = 0.5*(-t3662 + t3591)/xp.where(t3690, t3688, 1)
+    t3691 = (-t3662 + t3591)/xp.where(t3690, 2*t3688, 1)
     t3692 = xp.abs(t3691)
     t3693 = xp.greater_equal(t3692, 1)
-    t3694 = xp.abs(1/xp.where(t3693, t3691, 1))
+    t3694 = 1/xp.abs(xp.where(t3693, t3691, 1))
     t3695 = xp.where(t3690, xp.where(xp.greater_equal(t3691, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3693, t3694/(1 + xp.sqrt(1 + t3694**2)), 1/(t3692 + xp.sqrt(1 + t3692**2))), 0)
     t3696 = 1/xp.sqrt(1 + t3695**2)
     t3697 = t3591 + t3688*t3695
@@ -8147,10 +8147,10 @@ def condition_number(q):
     t3723 = xp.where(xp.greater(t3722, t3617), t3722, t3617)
     t3724 = xp.where(xp.less(t3722, t3618), t3722, t3618)
     t3725 = xp.not_equal(t3689, 0)
-    t3726 = 0.5*(-t3628 + t3663)/xp.where(t3725, t3689, 1)
+    t3726 = (-t3628 + t3663)/xp.where(t3725, 2*t3689, 1)
     t3727 = xp.abs(t3726)
     t3728 = xp.greater_equal(t3727, 1)
-    t3729 = xp.abs(1/xp.where(t3728, t3726, 1))
+    t3729 = 1/xp.abs(xp.where(t3728, t3726, 1))
     t3730 = xp.where(t3725, xp.where(xp.greater_equal(t3726, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3728, t3729/(1 + xp.sqrt(1 + t3729**2)), 1/(t3727 + xp.sqrt(1 + t3727**2))), 0)
     t3731 = 1/xp.sqrt(1 + t3730**2)
     t3732 = t3689*t3730
@@ -8182,10 +8182,10 @@ def condition_number(q):
     t3758 = t3756 + t3730*t3755
     t3759 = t3701*t3737 + t3705*t3741 + t3709*t3745 + t3713*t3749 + t3717*t3753 + t3721*t3757
     t3760 = xp.not_equal(t3759, 0)
-    t3761 = 0.5*(-t3733 + t3697)/xp.where(t3760, t3759, 1)
+    t3761 = (-t3733 + t3697)/xp.where(t3760, 2*t3759, 1)
     t3762 = xp.abs(t3761)
     t3763 = xp.greater_equal(t3762, 1)
-    t3764 = xp.abs(1/xp.where(t3763, t3761, 1))
+    t3764 = 1/xp.abs(xp.where(t3763, t3761, 1))
     t3765 = xp.where(t3760, xp.where(xp.greater_equal(t3761, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3763, t3764/(1 + xp.sqrt(1 + t3764**2)), 1/(t3762 + xp.sqrt(1 + t3762**2))), 0)
     t3766 = 1/xp.sqrt(1 + t3765**2)
     t3767 = t3697 + t3759*t3765
@@ -8218,10 +8218,10 @@ def condition_number(q):
     t3794 = xp.where(xp.greater(t3793, t3723), t3793, t3723)
     t3795 = xp.where(xp.less(t3793, t3724), t3793, t3724)
     t3796 = xp.not_equal(t3792, 0)
-    t3797 = 0.5*(-t3734 + t3767)/xp.where(t3796, t3792, 1)
+    t3797 = (-t3734 + t3767)/xp.where(t3796, 2*t3792, 1)
     t3798 = xp.abs(t3797)
     t3799 = xp.greater_equal(t3798, 1)
-    t3800 = xp.abs(1/xp.where(t3799, t3797, 1))
+    t3800 = 1/xp.abs(xp.where(t3799, t3797, 1))
     t3801 = xp.where(t3796, xp.where(xp.greater_equal(t3797, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3799, t3800/(1 + xp.sqrt(1 + t3800**2)), 1/(t3798 + xp.sqrt(1 + t3798**2))), 0)
     t3802 = 1/xp.sqrt(1 + t3801**2)
     t3803 = t3738*t3802
@@ -8254,7 +8254,9 @@ def condition_number(q):
     t3830 = xp.where(xp.less(t3827, t3795), t3827, t3795)
     t3831 = xp.where(xp.greater(t3828, t3829), t3828, t3829)
     t3832 = xp.where(xp.less(t3828, t3830), t3828, t3830)
-    kappa = xp.broadcast_to(xp.where(xp.greater(t3831, 0), t3831, 1)/xp.where(xp.less_equal(t3832, 1e-12*t3831), 0, t3832), batch)
+    t3833 = xp.where(xp.less_equal(t3832, 1e-12*t3831), 0, t3832)
+    t3834 = xp.where(xp.greater(t3831, 0), t3831, 1)
+    kappa = xp.broadcast_to(t3834/t3833, batch)
     return kappa
 
 

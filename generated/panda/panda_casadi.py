@@ -3062,10 +3062,10 @@ def _velocity_ellipsoid(q):
     t94 = t92**2
     t95 = t62*t68
     t96 = (t95 != 0)
-    t97 = 0.5*(-t65 + t93)/casadi.if_else(t96, -t95, 1)
+    t97 = (-t65 + t93)/casadi.if_else(t96, -2*t95, 1)
     t98 = casadi.fabs(t97)
     t99 = (t98 >= 1)
-    t100 = casadi.fabs(1/casadi.if_else(t99, t97, 1))
+    t100 = 1/casadi.fabs(casadi.if_else(t99, t97, 1))
     t101 = casadi.if_else(t96, casadi.if_else((t97 >= 0), 1, -1)*casadi.if_else(t99, t100/(1 + casadi.sqrt(1 + t100**2)), 1/(t98 + casadi.sqrt(1 + t98**2))), 0)
     t102 = 1/casadi.sqrt(1 + t101**2)
     t103 = t95*t101
@@ -3081,10 +3081,10 @@ def _velocity_ellipsoid(q):
     t113 = t112*t101
     t114 = t110*t108 - t113*t86
     t115 = (t114 != 0)
-    t116 = 0.5*(-t104 + t111)/casadi.if_else(t115, t114, 1)
+    t116 = (-t104 + t111)/casadi.if_else(t115, 2*t114, 1)
     t117 = casadi.fabs(t116)
     t118 = (t117 >= 1)
-    t119 = casadi.fabs(1/casadi.if_else(t118, t116, 1))
+    t119 = 1/casadi.fabs(casadi.if_else(t118, t116, 1))
     t120 = casadi.if_else(t115, casadi.if_else((t116 >= 0), 1, -1)*casadi.if_else(t118, t119/(1 + casadi.sqrt(1 + t119**2)), 1/(t117 + casadi.sqrt(1 + t117**2))), 0)
     t121 = 1/casadi.sqrt(1 + t120**2)
     t122 = t114*t120
@@ -3100,10 +3100,10 @@ def _velocity_ellipsoid(q):
     t132 = -t130 + t129*t120
     t133 = t109*t128 + t112*t132
     t134 = (t133 != 0)
-    t135 = 0.5*(-t105 + t124)/casadi.if_else(t134, -t133, 1)
+    t135 = (-t105 + t124)/casadi.if_else(t134, -2*t133, 1)
     t136 = casadi.fabs(t135)
     t137 = (t136 >= 1)
-    t138 = casadi.fabs(1/casadi.if_else(t137, t135, 1))
+    t138 = 1/casadi.fabs(casadi.if_else(t137, t135, 1))
     t139 = casadi.if_else(t134, casadi.if_else((t135 >= 0), 1, -1)*casadi.if_else(t137, t138/(1 + casadi.sqrt(1 + t138**2)), 1/(t136 + casadi.sqrt(1 + t136**2))), 0)
     t140 = 1/casadi.sqrt(1 + t139**2)
     t141 = t133*t139
@@ -3129,10 +3129,10 @@ def _velocity_ellipsoid(q):
     t161 = t139*t140
     t162 = t127*t146 - t131*t151 + t94*t155*t161*t121
     t163 = (t162 != 0)
-    t164 = 0.5*(-t123 + t142)/casadi.if_else(t163, t162, 1)
+    t164 = (-t123 + t142)/casadi.if_else(t163, 2*t162, 1)
     t165 = casadi.fabs(t164)
     t166 = (t165 >= 1)
-    t167 = casadi.fabs(1/casadi.if_else(t166, t164, 1))
+    t167 = 1/casadi.fabs(casadi.if_else(t166, t164, 1))
     t168 = casadi.if_else(t163, casadi.if_else((t164 >= 0), 1, -1)*casadi.if_else(t166, t167/(1 + casadi.sqrt(1 + t167**2)), 1/(t165 + casadi.sqrt(1 + t165**2))), 0)
     t169 = 1/casadi.sqrt(1 + t168**2)
     t170 = t162*t168
@@ -3166,10 +3166,10 @@ def _velocity_ellipsoid(q):
     t198 = t121*t140
     t199 = t147*t175 + t152*t179 - t198*t92*t188
     t200 = (t199 != 0)
-    t201 = 0.5*(-t171 + t143)/casadi.if_else(t200, t199, 1)
+    t201 = (-t171 + t143)/casadi.if_else(t200, 2*t199, 1)
     t202 = casadi.fabs(t201)
     t203 = (t202 >= 1)
-    t204 = casadi.fabs(1/casadi.if_else(t203, t201, 1))
+    t204 = 1/casadi.fabs(casadi.if_else(t203, t201, 1))
     t205 = casadi.if_else(t200, casadi.if_else((t201 >= 0), 1, -1)*casadi.if_else(t203, t204/(1 + casadi.sqrt(1 + t204**2)), 1/(t202 + casadi.sqrt(1 + t202**2))), 0)
     t206 = 1/casadi.sqrt(1 + t205**2)
     t207 = t199*t205
@@ -3201,10 +3201,10 @@ def _velocity_ellipsoid(q):
     t233 = t232 - t219*t205
     t234 = t219 + t232*t205
     t235 = (t223 != 0)
-    t236 = 0.5*(-t172 + t209)/casadi.if_else(t235, t223, 1)
+    t236 = (-t172 + t209)/casadi.if_else(t235, 2*t223, 1)
     t237 = casadi.fabs(t236)
     t238 = (t237 >= 1)
-    t239 = casadi.fabs(1/casadi.if_else(t238, t236, 1))
+    t239 = 1/casadi.fabs(casadi.if_else(t238, t236, 1))
     t240 = casadi.if_else(t235, casadi.if_else((t236 >= 0), 1, -1)*casadi.if_else(t238, t239/(1 + casadi.sqrt(1 + t239**2)), 1/(t237 + casadi.sqrt(1 + t237**2))), 0)
     t241 = 1/casadi.sqrt(1 + t240**2)
     t242 = t223*t240
@@ -3236,10 +3236,10 @@ def _velocity_ellipsoid(q):
     t268 = t266 + t267*t240
     t269 = t267 - t266*t240
     t270 = (t257 != 0)
-    t271 = 0.5*(-t208 + t243)/casadi.if_else(t270, t257, 1)
+    t271 = (-t208 + t243)/casadi.if_else(t270, 2*t257, 1)
     t272 = casadi.fabs(t271)
     t273 = (t272 >= 1)
-    t274 = casadi.fabs(1/casadi.if_else(t273, t271, 1))
+    t274 = 1/casadi.fabs(casadi.if_else(t273, t271, 1))
     t275 = casadi.if_else(t270, casadi.if_else((t271 >= 0), 1, -1)*casadi.if_else(t273, t274/(1 + casadi.sqrt(1 + t274**2)), 1/(t272 + casadi.sqrt(1 + t272**2))), 0)
     t276 = 1/casadi.sqrt(1 + t275**2)
     t277 = t257*t275
@@ -3271,10 +3271,10 @@ def _velocity_ellipsoid(q):
     t303 = t301 + t302*t275
     t304 = -t302 + t301*t275
     t305 = (t292 != 0)
-    t306 = 0.5*(-t278 + t244)/casadi.if_else(t305, t292, 1)
+    t306 = (-t278 + t244)/casadi.if_else(t305, 2*t292, 1)
     t307 = casadi.fabs(t306)
     t308 = (t307 >= 1)
-    t309 = casadi.fabs(1/casadi.if_else(t308, t306, 1))
+    t309 = 1/casadi.fabs(casadi.if_else(t308, t306, 1))
     t310 = casadi.if_else(t305, casadi.if_else((t306 >= 0), 1, -1)*casadi.if_else(t308, t309/(1 + casadi.sqrt(1 + t309**2)), 1/(t307 + casadi.sqrt(1 + t307**2))), 0)
     t311 = 1/casadi.sqrt(1 + t310**2)
     t312 = t292*t310
@@ -3306,10 +3306,10 @@ def _velocity_ellipsoid(q):
     t338 = t336 - t337*t310
     t339 = t337 + t336*t310
     t340 = (t327 != 0)
-    t341 = 0.5*(-t279 + t314)/casadi.if_else(t340, t327, 1)
+    t341 = (-t279 + t314)/casadi.if_else(t340, 2*t327, 1)
     t342 = casadi.fabs(t341)
     t343 = (t342 >= 1)
-    t344 = casadi.fabs(1/casadi.if_else(t343, t341, 1))
+    t344 = 1/casadi.fabs(casadi.if_else(t343, t341, 1))
     t345 = casadi.if_else(t340, casadi.if_else((t341 >= 0), 1, -1)*casadi.if_else(t343, t344/(1 + casadi.sqrt(1 + t344**2)), 1/(t342 + casadi.sqrt(1 + t342**2))), 0)
     t346 = 1/casadi.sqrt(1 + t345**2)
     t347 = t327*t345
@@ -3341,10 +3341,10 @@ def _velocity_ellipsoid(q):
     t373 = t371 - t345*t372
     t374 = t372 + t345*t371
     t375 = (t362 != 0)
-    t376 = 0.5*(-t313 + t348)/casadi.if_else(t375, t362, 1)
+    t376 = (-t313 + t348)/casadi.if_else(t375, 2*t362, 1)
     t377 = casadi.fabs(t376)
     t378 = (t377 >= 1)
-    t379 = casadi.fabs(1/casadi.if_else(t378, t376, 1))
+    t379 = 1/casadi.fabs(casadi.if_else(t378, t376, 1))
     t380 = casadi.if_else(t375, casadi.if_else((t376 >= 0), 1, -1)*casadi.if_else(t378, t379/(1 + casadi.sqrt(1 + t379**2)), 1/(t377 + casadi.sqrt(1 + t377**2))), 0)
     t381 = 1/casadi.sqrt(1 + t380**2)
     t382 = t362*t380
@@ -3376,10 +3376,10 @@ def _velocity_ellipsoid(q):
     t408 = t406 - t380*t407
     t409 = t407 + t380*t406
     t410 = (t397 != 0)
-    t411 = 0.5*(-t383 + t349)/casadi.if_else(t410, t397, 1)
+    t411 = (-t383 + t349)/casadi.if_else(t410, 2*t397, 1)
     t412 = casadi.fabs(t411)
     t413 = (t412 >= 1)
-    t414 = casadi.fabs(1/casadi.if_else(t413, t411, 1))
+    t414 = 1/casadi.fabs(casadi.if_else(t413, t411, 1))
     t415 = casadi.if_else(t410, casadi.if_else((t411 >= 0), 1, -1)*casadi.if_else(t413, t414/(1 + casadi.sqrt(1 + t414**2)), 1/(t412 + casadi.sqrt(1 + t412**2))), 0)
     t416 = 1/casadi.sqrt(1 + t415**2)
     t417 = t397*t415
@@ -3411,10 +3411,10 @@ def _velocity_ellipsoid(q):
     t443 = t441 - t415*t442
     t444 = t442 + t415*t441
     t445 = (t432 != 0)
-    t446 = 0.5*(-t384 + t419)/casadi.if_else(t445, t432, 1)
+    t446 = (-t384 + t419)/casadi.if_else(t445, 2*t432, 1)
     t447 = casadi.fabs(t446)
     t448 = (t447 >= 1)
-    t449 = casadi.fabs(1/casadi.if_else(t448, t446, 1))
+    t449 = 1/casadi.fabs(casadi.if_else(t448, t446, 1))
     t450 = casadi.if_else(t445, casadi.if_else((t446 >= 0), 1, -1)*casadi.if_else(t448, t449/(1 + casadi.sqrt(1 + t449**2)), 1/(t447 + casadi.sqrt(1 + t447**2))), 0)
     t451 = 1/casadi.sqrt(1 + t450**2)
     t452 = t432*t450
@@ -3446,10 +3446,10 @@ def _velocity_ellipsoid(q):
     t478 = t476 - t450*t477
     t479 = t477 + t450*t476
     t480 = (t467 != 0)
-    t481 = 0.5*(-t418 + t453)/casadi.if_else(t480, t467, 1)
+    t481 = (-t418 + t453)/casadi.if_else(t480, 2*t467, 1)
     t482 = casadi.fabs(t481)
     t483 = (t482 >= 1)
-    t484 = casadi.fabs(1/casadi.if_else(t483, t481, 1))
+    t484 = 1/casadi.fabs(casadi.if_else(t483, t481, 1))
     t485 = casadi.if_else(t480, casadi.if_else((t481 >= 0), 1, -1)*casadi.if_else(t483, t484/(1 + casadi.sqrt(1 + t484**2)), 1/(t482 + casadi.sqrt(1 + t482**2))), 0)
     t486 = 1/casadi.sqrt(1 + t485**2)
     t487 = t467*t485
@@ -3481,10 +3481,10 @@ def _velocity_ellipsoid(q):
     t513 = t511 - t485*t512
     t514 = t512 + t485*t511
     t515 = (t502 != 0)
-    t516 = 0.5*(-t488 + t454)/casadi.if_else(t515, t502, 1)
+    t516 = (-t488 + t454)/casadi.if_else(t515, 2*t502, 1)
     t517 = casadi.fabs(t516)
     t518 = (t517 >= 1)
-    t519 = casadi.fabs(1/casadi.if_else(t518, t516, 1))
+    t519 = 1/casadi.fabs(casadi.if_else(t518, t516, 1))
     t520 = casadi.if_else(t515, casadi.if_else((t516 >= 0), 1, -1)*casadi.if_else(t518, t519/(1 + casadi.sqrt(1 + t519**2)), 1/(t517 + casadi.sqrt(1 + t517**2))), 0)
     t521 = 1/casadi.sqrt(1 + t520**2)
     t522 = t454 + t502*t520
@@ -3515,10 +3515,10 @@ def _velocity_ellipsoid(q):
     t547 = t545 - t520*t546
     t548 = t546 + t520*t545
     t549 = (t535 != 0)
-    t550 = 0.5*(-t489 + t522)/casadi.if_else(t549, t535, 1)
+    t550 = (-t489 + t522)/casadi.if_else(t549, 2*t535, 1)
     t551 = casadi.fabs(t550)
     t552 = (t551 >= 1)
-    t553 = casadi.fabs(1/casadi.if_else(t552, t550, 1))
+    t553 = 1/casadi.fabs(casadi.if_else(t552, t550, 1))
     t554 = casadi.if_else(t549, casadi.if_else((t550 >= 0), 1, -1)*casadi.if_else(t552, t553/(1 + casadi.sqrt(1 + t553**2)), 1/(t551 + casadi.sqrt(1 + t551**2))), 0)
     t555 = 1/casadi.sqrt(1 + t554**2)
     t556 = t493*t555
@@ -3617,10 +3617,10 @@ def _velocity_ellipsoid(q):
     t649 = t648**2
     t650 = t627**2 + t641**2 + t649
     t651 = (t638 != 0)
-    t652 = 0.5*(-t617 + t637)/casadi.if_else(t651, t638, 1)
+    t652 = (-t617 + t637)/casadi.if_else(t651, 2*t638, 1)
     t653 = casadi.fabs(t652)
     t654 = (t653 >= 1)
-    t655 = casadi.fabs(1/casadi.if_else(t654, t652, 1))
+    t655 = 1/casadi.fabs(casadi.if_else(t654, t652, 1))
     t656 = casadi.if_else(t651, casadi.if_else((t652 >= 0), 1, -1)*casadi.if_else(t654, t655/(1 + casadi.sqrt(1 + t655**2)), 1/(t653 + casadi.sqrt(1 + t653**2))), 0)
     t657 = 1/casadi.sqrt(1 + t656**2)
     t658 = t638*t656
@@ -3634,10 +3634,10 @@ def _velocity_ellipsoid(q):
     t666 = t656*t665
     t667 = t627*t663 + t641*t666
     t668 = (t667 != 0)
-    t669 = 0.5*(-t659 + t650)/casadi.if_else(t668, t667, 1)
+    t669 = (-t659 + t650)/casadi.if_else(t668, 2*t667, 1)
     t670 = casadi.fabs(t669)
     t671 = (t670 >= 1)
-    t672 = casadi.fabs(1/casadi.if_else(t671, t669, 1))
+    t672 = 1/casadi.fabs(casadi.if_else(t671, t669, 1))
     t673 = casadi.if_else(t668, casadi.if_else((t669 >= 0), 1, -1)*casadi.if_else(t671, t672/(1 + casadi.sqrt(1 + t672**2)), 1/(t670 + casadi.sqrt(1 + t670**2))), 0)
     t674 = 1/casadi.sqrt(1 + t673**2)
     t675 = t667*t673
@@ -3653,10 +3653,10 @@ def _velocity_ellipsoid(q):
     t685 = t683 + t673*t682
     t686 = t664*t681 + t685*t665
     t687 = (t686 != 0)
-    t688 = 0.5*(-t660 + t677)/casadi.if_else(t687, -t686, 1)
+    t688 = (-t660 + t677)/casadi.if_else(t687, -2*t686, 1)
     t689 = casadi.fabs(t688)
     t690 = (t689 >= 1)
-    t691 = casadi.fabs(1/casadi.if_else(t690, t688, 1))
+    t691 = 1/casadi.fabs(casadi.if_else(t690, t688, 1))
     t692 = casadi.if_else(t687, casadi.if_else((t688 >= 0), 1, -1)*casadi.if_else(t690, t691/(1 + casadi.sqrt(1 + t691**2)), 1/(t689 + casadi.sqrt(1 + t689**2))), 0)
     t693 = 1/casadi.sqrt(1 + t692**2)
     t694 = t686*t692
@@ -3682,10 +3682,10 @@ def _velocity_ellipsoid(q):
     t714 = t692*t693
     t715 = t680*t699 + t684*t704 - t674*t649*t708*t714
     t716 = (t715 != 0)
-    t717 = 0.5*(-t676 + t695)/casadi.if_else(t716, -t715, 1)
+    t717 = (-t676 + t695)/casadi.if_else(t716, -2*t715, 1)
     t718 = casadi.fabs(t717)
     t719 = (t718 >= 1)
-    t720 = casadi.fabs(1/casadi.if_else(t719, t717, 1))
+    t720 = 1/casadi.fabs(casadi.if_else(t719, t717, 1))
     t721 = casadi.if_else(t716, casadi.if_else((t717 >= 0), 1, -1)*casadi.if_else(t719, t720/(1 + casadi.sqrt(1 + t720**2)), 1/(t718 + casadi.sqrt(1 + t718**2))), 0)
     t722 = 1/casadi.sqrt(1 + t721**2)
     t723 = t715*t721
@@ -3719,10 +3719,10 @@ def _velocity_ellipsoid(q):
     t751 = t674*t693
     t752 = t700*t728 + t705*t732 - t648*t741*t751
     t753 = (t752 != 0)
-    t754 = 0.5*(-t724 + t696)/casadi.if_else(t753, t752, 1)
+    t754 = (-t724 + t696)/casadi.if_else(t753, 2*t752, 1)
     t755 = casadi.fabs(t754)
     t756 = (t755 >= 1)
-    t757 = casadi.fabs(1/casadi.if_else(t756, t754, 1))
+    t757 = 1/casadi.fabs(casadi.if_else(t756, t754, 1))
     t758 = casadi.if_else(t753, casadi.if_else((t754 >= 0), 1, -1)*casadi.if_else(t756, t757/(1 + casadi.sqrt(1 + t757**2)), 1/(t755 + casadi.sqrt(1 + t755**2))), 0)
     t759 = 1/casadi.sqrt(1 + t758**2)
     t760 = t752*t758
@@ -3754,10 +3754,10 @@ def _velocity_ellipsoid(q):
     t786 = t785 - t758*t772
     t787 = t772 + t758*t785
     t788 = (t776 != 0)
-    t789 = 0.5*(-t725 + t762)/casadi.if_else(t788, t776, 1)
+    t789 = (-t725 + t762)/casadi.if_else(t788, 2*t776, 1)
     t790 = casadi.fabs(t789)
     t791 = (t790 >= 1)
-    t792 = casadi.fabs(1/casadi.if_else(t791, t789, 1))
+    t792 = 1/casadi.fabs(casadi.if_else(t791, t789, 1))
     t793 = casadi.if_else(t788, casadi.if_else((t789 >= 0), 1, -1)*casadi.if_else(t791, t792/(1 + casadi.sqrt(1 + t792**2)), 1/(t790 + casadi.sqrt(1 + t790**2))), 0)
     t794 = 1/casadi.sqrt(1 + t793**2)
     t795 = t776*t793
@@ -3789,10 +3789,10 @@ def _velocity_ellipsoid(q):
     t821 = t819 + t793*t820
     t822 = t820 - t793*t819
     t823 = (t810 != 0)
-    t824 = 0.5*(-t761 + t796)/casadi.if_else(t823, t810, 1)
+    t824 = (-t761 + t796)/casadi.if_else(t823, 2*t810, 1)
     t825 = casadi.fabs(t824)
     t826 = (t825 >= 1)
-    t827 = casadi.fabs(1/casadi.if_else(t826, t824, 1))
+    t827 = 1/casadi.fabs(casadi.if_else(t826, t824, 1))
     t828 = casadi.if_else(t823, casadi.if_else((t824 >= 0), 1, -1)*casadi.if_else(t826, t827/(1 + casadi.sqrt(1 + t827**2)), 1/(t825 + casadi.sqrt(1 + t825**2))), 0)
     t829 = 1/casadi.sqrt(1 + t828**2)
     t830 = t810*t828
@@ -3824,10 +3824,10 @@ def _velocity_ellipsoid(q):
     t856 = t854 + t828*t855
     t857 = -t855 + t828*t854
     t858 = (t845 != 0)
-    t859 = 0.5*(-t831 + t797)/casadi.if_else(t858, t845, 1)
+    t859 = (-t831 + t797)/casadi.if_else(t858, 2*t845, 1)
     t860 = casadi.fabs(t859)
     t861 = (t860 >= 1)
-    t862 = casadi.fabs(1/casadi.if_else(t861, t859, 1))
+    t862 = 1/casadi.fabs(casadi.if_else(t861, t859, 1))
     t863 = casadi.if_else(t858, casadi.if_else((t859 >= 0), 1, -1)*casadi.if_else(t861, t862/(1 + casadi.sqrt(1 + t862**2)), 1/(t860 + casadi.sqrt(1 + t860**2))), 0)
     t864 = 1/casadi.sqrt(1 + t863**2)
     t865 = t845*t863
@@ -3859,10 +3859,10 @@ def _velocity_ellipsoid(q):
     t891 = t889 - t863*t890
     t892 = t890 + t863*t889
     t893 = (t880 != 0)
-    t894 = 0.5*(-t832 + t867)/casadi.if_else(t893, t880, 1)
+    t894 = (-t832 + t867)/casadi.if_else(t893, 2*t880, 1)
     t895 = casadi.fabs(t894)
     t896 = (t895 >= 1)
-    t897 = casadi.fabs(1/casadi.if_else(t896, t894, 1))
+    t897 = 1/casadi.fabs(casadi.if_else(t896, t894, 1))
     t898 = casadi.if_else(t893, casadi.if_else((t894 >= 0), 1, -1)*casadi.if_else(t896, t897/(1 + casadi.sqrt(1 + t897**2)), 1/(t895 + casadi.sqrt(1 + t895**2))), 0)
     t899 = 1/casadi.sqrt(1 + t898**2)
     t900 = t880*t898
@@ -3894,10 +3894,10 @@ def _velocity_ellipsoid(q):
     t926 = t924 - t898*t925
     t927 = t925 + t898*t924
     t928 = (t915 != 0)
-    t929 = 0.5*(-t866 + t901)/casadi.if_else(t928, t915, 1)
+    t929 = (-t866 + t901)/casadi.if_else(t928, 2*t915, 1)
     t930 = casadi.fabs(t929)
     t931 = (t930 >= 1)
-    t932 = casadi.fabs(1/casadi.if_else(t931, t929, 1))
+    t932 = 1/casadi.fabs(casadi.if_else(t931, t929, 1))
     t933 = casadi.if_else(t928, casadi.if_else((t929 >= 0), 1, -1)*casadi.if_else(t931, t932/(1 + casadi.sqrt(1 + t932**2)), 1/(t930 + casadi.sqrt(1 + t930**2))), 0)
     t934 = 1/casadi.sqrt(1 + t933**2)
     t935 = t915*t933
@@ -3929,10 +3929,10 @@ def _velocity_ellipsoid(q):
     t961 = t959 - t933*t960
     t962 = t960 + t933*t959
     t963 = (t950 != 0)
-    t964 = 0.5*(-t936 + t902)/casadi.if_else(t963, t950, 1)
+    t964 = (-t936 + t902)/casadi.if_else(t963, 2*t950, 1)
     t965 = casadi.fabs(t964)
     t966 = (t965 >= 1)
-    t967 = casadi.fabs(1/casadi.if_else(t966, t964, 1))
+    t967 = 1/casadi.fabs(casadi.if_else(t966, t964, 1))
     t968 = casadi.if_else(t963, casadi.if_else((t964 >= 0), 1, -1)*casadi.if_else(t966, t967/(1 + casadi.sqrt(1 + t967**2)), 1/(t965 + casadi.sqrt(1 + t965**2))), 0)
     t969 = 1/casadi.sqrt(1 + t968**2)
     t970 = t950*t968
@@ -3964,10 +3964,10 @@ def _velocity_ellipsoid(q):
     t996 = t994 - t968*t995
     t997 = t995 + t968*t994
     t998 = (t985 != 0)
-    t999 = 0.5*(-t937 + t972)/casadi.if_else(t998, t985, 1)
+    t999 = (-t937 + t972)/casadi.if_else(t998, 2*t985, 1)
     t1000 = casadi.fabs(t999)
     t1001 = (t1000 >= 1)
-    t1002 = casadi.fabs(1/casadi.if_else(t1001, t999, 1))
+    t1002 = 1/casadi.fabs(casadi.if_else(t1001, t999, 1))
     t1003 = casadi.if_else(t998, casadi.if_else((t999 >= 0), 1, -1)*casadi.if_else(t1001, t1002/(1 + casadi.sqrt(1 + t1002**2)), 1/(t1000 + casadi.sqrt(1 + t1000**2))), 0)
     t1004 = 1/casadi.sqrt(1 + t1003**2)
     t1005 = t985*t1003
@@ -3999,10 +3999,10 @@ def _velocity_ellipsoid(q):
     t1031 = t1029 - t1003*t1030
     t1032 = t1030 + t1003*t1029
     t1033 = (t1020 != 0)
-    t1034 = 0.5*(-t971 + t1006)/casadi.if_else(t1033, t1020, 1)
+    t1034 = (-t971 + t1006)/casadi.if_else(t1033, 2*t1020, 1)
     t1035 = casadi.fabs(t1034)
     t1036 = (t1035 >= 1)
-    t1037 = casadi.fabs(1/casadi.if_else(t1036, t1034, 1))
+    t1037 = 1/casadi.fabs(casadi.if_else(t1036, t1034, 1))
     t1038 = casadi.if_else(t1033, casadi.if_else((t1034 >= 0), 1, -1)*casadi.if_else(t1036, t1037/(1 + casadi.sqrt(1 + t1037**2)), 1/(t1035 + casadi.sqrt(1 + t1035**2))), 0)
     t1039 = 1/casadi.sqrt(1 + t1038**2)
     t1040 = t1020*t1038
@@ -4034,10 +4034,10 @@ def _velocity_ellipsoid(q):
     t1066 = t1064 - t1038*t1065
     t1067 = t1065 + t1038*t1064
     t1068 = (t1055 != 0)
-    t1069 = 0.5*(-t1041 + t1007)/casadi.if_else(t1068, t1055, 1)
+    t1069 = (-t1041 + t1007)/casadi.if_else(t1068, 2*t1055, 1)
     t1070 = casadi.fabs(t1069)
     t1071 = (t1070 >= 1)
-    t1072 = casadi.fabs(1/casadi.if_else(t1071, t1069, 1))
+    t1072 = 1/casadi.fabs(casadi.if_else(t1071, t1069, 1))
     t1073 = casadi.if_else(t1068, casadi.if_else((t1069 >= 0), 1, -1)*casadi.if_else(t1071, t1072/(1 + casadi.sqrt(1 + t1072**2)), 1/(t1070 + casadi.sqrt(1 + t1070**2))), 0)
     t1074 = 1/casadi.sqrt(1 + t1073**2)
     t1075 = t1007 + t1055*t1073
@@ -4068,10 +4068,10 @@ def _velocity_ellipsoid(q):
     t1100 = t1098 - t1073*t1099
     t1101 = t1099 + t1073*t1098
     t1102 = (t1088 != 0)
-    t1103 = 0.5*(-t1042 + t1075)/casadi.if_else(t1102, t1088, 1)
+    t1103 = (-t1042 + t1075)/casadi.if_else(t1102, 2*t1088, 1)
     t1104 = casadi.fabs(t1103)
     t1105 = (t1104 >= 1)
-    t1106 = casadi.fabs(1/casadi.if_else(t1105, t1103, 1))
+    t1106 = 1/casadi.fabs(casadi.if_else(t1105, t1103, 1))
     t1107 = casadi.if_else(t1102, casadi.if_else((t1103 >= 0), 1, -1)*casadi.if_else(t1105, t1106/(1 + casadi.sqrt(1 + t1106**2)), 1/(t1104 + casadi.sqrt(1 + t1104**2))), 0)
     t1108 = 1/casadi.sqrt(1 + t1107**2)
     t1109 = t1046*t1108
@@ -4370,10 +4370,10 @@ def _condition_number(q):
     t183 = t65*t80
     t184 = t74*t102 + t67*t152 + t181*t106 - t182*t112 + t183*t118
     t185 = (t184 != 0)
-    t186 = 0.5*(-t180 + t173)/casadi.if_else(t185, -t184, 1)
+    t186 = (-t180 + t173)/casadi.if_else(t185, -2*t184, 1)
     t187 = casadi.fabs(t186)
     t188 = (t187 >= 1)
-    t189 = casadi.fabs(1/casadi.if_else(t188, t186, 1))
+    t189 = 1/casadi.fabs(casadi.if_else(t188, t186, 1))
     t190 = casadi.if_else(t185, casadi.if_else((t186 >= 0), 1, -1)*casadi.if_else(t188, t189/(1 + casadi.sqrt(1 + t189**2)), 1/(t187 + casadi.sqrt(1 + t187**2))), 0)
     t191 = 1/casadi.sqrt(1 + t190**2)
     t192 = t184*t190
@@ -4401,10 +4401,10 @@ def _condition_number(q):
     t214 = -t212 + t211*t190
     t215 = t124*t201 + t128*t205 - t133*t209 + t158*t213
     t216 = (t215 != 0)
-    t217 = 0.5*(-t193 + t174)/casadi.if_else(t216, t215, 1)
+    t217 = (-t193 + t174)/casadi.if_else(t216, 2*t215, 1)
     t218 = casadi.fabs(t217)
     t219 = (t218 >= 1)
-    t220 = casadi.fabs(1/casadi.if_else(t219, t217, 1))
+    t220 = 1/casadi.fabs(casadi.if_else(t219, t217, 1))
     t221 = casadi.if_else(t216, casadi.if_else((t217 >= 0), 1, -1)*casadi.if_else(t219, t220/(1 + casadi.sqrt(1 + t220**2)), 1/(t218 + casadi.sqrt(1 + t218**2))), 0)
     t222 = 1/casadi.sqrt(1 + t221**2)
     t223 = t215*t221
@@ -4428,10 +4428,10 @@ def _condition_number(q):
     t241 = t239 + t238*t221
     t242 = t138*t232 + t163*t240 - t142*t236
     t243 = (t242 != 0)
-    t244 = 0.5*(-t224 + t175)/casadi.if_else(t243, -t242, 1)
+    t244 = (-t224 + t175)/casadi.if_else(t243, -2*t242, 1)
     t245 = casadi.fabs(t244)
     t246 = (t245 >= 1)
-    t247 = casadi.fabs(1/casadi.if_else(t246, t244, 1))
+    t247 = 1/casadi.fabs(casadi.if_else(t246, t244, 1))
     t248 = casadi.if_else(t243, casadi.if_else((t244 >= 0), 1, -1)*casadi.if_else(t246, t247/(1 + casadi.sqrt(1 + t247**2)), 1/(t245 + casadi.sqrt(1 + t245**2))), 0)
     t249 = 1/casadi.sqrt(1 + t248**2)
     t250 = t242*t248
@@ -4451,10 +4451,10 @@ def _condition_number(q):
     t264 = -t262 + t261*t248
     t265 = -t147*t259 + t168*t263
     t266 = (t265 != 0)
-    t267 = 0.5*(-t251 + t176)/casadi.if_else(t266, t265, 1)
+    t267 = (-t251 + t176)/casadi.if_else(t266, 2*t265, 1)
     t268 = casadi.fabs(t267)
     t269 = (t268 >= 1)
-    t270 = casadi.fabs(1/casadi.if_else(t269, t267, 1))
+    t270 = 1/casadi.fabs(casadi.if_else(t269, t267, 1))
     t271 = casadi.if_else(t266, casadi.if_else((t267 >= 0), 1, -1)*casadi.if_else(t269, t270/(1 + casadi.sqrt(1 + t270**2)), 1/(t268 + casadi.sqrt(1 + t268**2))), 0)
     t272 = 1/casadi.sqrt(1 + t271**2)
     t273 = t265*t271
@@ -4470,10 +4470,10 @@ def _condition_number(q):
     t283 = t281 + t280*t271
     t284 = t172*t282
     t285 = (t284 != 0)
-    t286 = 0.5*(-t274 + t177)/casadi.if_else(t285, -t284, 1)
+    t286 = (-t274 + t177)/casadi.if_else(t285, -2*t284, 1)
     t287 = casadi.fabs(t286)
     t288 = (t287 >= 1)
-    t289 = casadi.fabs(1/casadi.if_else(t288, t286, 1))
+    t289 = 1/casadi.fabs(casadi.if_else(t288, t286, 1))
     t290 = casadi.if_else(t285, casadi.if_else((t286 >= 0), 1, -1)*casadi.if_else(t288, t289/(1 + casadi.sqrt(1 + t289**2)), 1/(t287 + casadi.sqrt(1 + t287**2))), 0)
     t291 = 1/casadi.sqrt(1 + t290**2)
     t292 = t284*t290
@@ -4487,10 +4487,10 @@ def _condition_number(q):
     t300 = t299*t197
     t301 = -t202*t229 - t206*t233 + t210*t237 + t214*t241 + t178*t299*t190*t191**2 + t300*t198
     t302 = (t301 != 0)
-    t303 = 0.5*(-t194 + t225)/casadi.if_else(t302, t301, 1)
+    t303 = (-t194 + t225)/casadi.if_else(t302, 2*t301, 1)
     t304 = casadi.fabs(t303)
     t305 = (t304 >= 1)
-    t306 = casadi.fabs(1/casadi.if_else(t305, t303, 1))
+    t306 = 1/casadi.fabs(casadi.if_else(t305, t303, 1))
     t307 = casadi.if_else(t302, casadi.if_else((t303 >= 0), 1, -1)*casadi.if_else(t305, t306/(1 + casadi.sqrt(1 + t306**2)), 1/(t304 + casadi.sqrt(1 + t304**2))), 0)
     t308 = 1/casadi.sqrt(1 + t307**2)
     t309 = t301*t307
@@ -4529,10 +4529,10 @@ def _condition_number(q):
     t342 = t338*t228
     t343 = -t256*t328 - t260*t332 + t264*t336 - t340*t316 + t341*t320 + t342*t324
     t344 = (t343 != 0)
-    t345 = 0.5*(-t310 + t252)/casadi.if_else(t344, t343, 1)
+    t345 = (-t310 + t252)/casadi.if_else(t344, 2*t343, 1)
     t346 = casadi.fabs(t345)
     t347 = (t346 >= 1)
-    t348 = casadi.fabs(1/casadi.if_else(t347, t345, 1))
+    t348 = 1/casadi.fabs(casadi.if_else(t347, t345, 1))
     t349 = casadi.if_else(t344, casadi.if_else((t345 >= 0), 1, -1)*casadi.if_else(t347, t348/(1 + casadi.sqrt(1 + t348**2)), 1/(t346 + casadi.sqrt(1 + t346**2))), 0)
     t350 = 1/casadi.sqrt(1 + t349**2)
     t351 = t343*t349
@@ -4575,10 +4575,10 @@ def _condition_number(q):
     t388 = t387*t271
     t389 = t279*t372 + t283*t376 - t382*t356 + t384*t360 + t386*t364 - t388*t368
     t390 = (t389 != 0)
-    t391 = 0.5*(-t352 + t275)/casadi.if_else(t390, t389, 1)
+    t391 = (-t352 + t275)/casadi.if_else(t390, 2*t389, 1)
     t392 = casadi.fabs(t391)
     t393 = (t392 >= 1)
-    t394 = casadi.fabs(1/casadi.if_else(t393, t391, 1))
+    t394 = 1/casadi.fabs(casadi.if_else(t393, t391, 1))
     t395 = casadi.if_else(t390, casadi.if_else((t391 >= 0), 1, -1)*casadi.if_else(t393, t394/(1 + casadi.sqrt(1 + t394**2)), 1/(t392 + casadi.sqrt(1 + t392**2))), 0)
     t396 = 1/casadi.sqrt(1 + t395**2)
     t397 = t389*t395
@@ -4620,10 +4620,10 @@ def _condition_number(q):
     t433 = t432*t290
     t434 = t298*t422 - t425*t402 + t427*t406 + t429*t410 - t431*t414 + t433*t418
     t435 = (t434 != 0)
-    t436 = 0.5*(-t398 + t294)/casadi.if_else(t435, t434, 1)
+    t436 = (-t398 + t294)/casadi.if_else(t435, 2*t434, 1)
     t437 = casadi.fabs(t436)
     t438 = (t437 >= 1)
-    t439 = casadi.fabs(1/casadi.if_else(t438, t436, 1))
+    t439 = 1/casadi.fabs(casadi.if_else(t438, t436, 1))
     t440 = casadi.if_else(t435, casadi.if_else((t436 >= 0), 1, -1)*casadi.if_else(t438, t439/(1 + casadi.sqrt(1 + t439**2)), 1/(t437 + casadi.sqrt(1 + t437**2))), 0)
     t441 = 1/casadi.sqrt(1 + t440**2)
     t442 = t434*t440
@@ -4655,10 +4655,10 @@ def _condition_number(q):
     t468 = t466 + t465*t440
     t469 = t297*t467 - t424*t447 + t426*t451 + t428*t455 - t430*t459 + t432*t463
     t470 = (t378 != 0)
-    t471 = 0.5*(-t311 + t353)/casadi.if_else(t470, t378, 1)
+    t471 = (-t311 + t353)/casadi.if_else(t470, 2*t378, 1)
     t472 = casadi.fabs(t471)
     t473 = (t472 >= 1)
-    t474 = casadi.fabs(1/casadi.if_else(t473, t471, 1))
+    t474 = 1/casadi.fabs(casadi.if_else(t473, t471, 1))
     t475 = casadi.if_else(t470, casadi.if_else((t471 >= 0), 1, -1)*casadi.if_else(t473, t474/(1 + casadi.sqrt(1 + t474**2)), 1/(t472 + casadi.sqrt(1 + t472**2))), 0)
     t476 = 1/casadi.sqrt(1 + t475**2)
     t477 = t378*t475
@@ -4690,10 +4690,10 @@ def _condition_number(q):
     t503 = t501 + t500*t475
     t504 = -t403*t482 + t407*t486 + t411*t490 + t415*t494 + t419*t498 + t423*t502
     t505 = (t504 != 0)
-    t506 = 0.5*(-t478 + t399)/casadi.if_else(t505, t504, 1)
+    t506 = (-t478 + t399)/casadi.if_else(t505, 2*t504, 1)
     t507 = casadi.fabs(t506)
     t508 = (t507 >= 1)
-    t509 = casadi.fabs(1/casadi.if_else(t508, t506, 1))
+    t509 = 1/casadi.fabs(casadi.if_else(t508, t506, 1))
     t510 = casadi.if_else(t505, casadi.if_else((t506 >= 0), 1, -1)*casadi.if_else(t508, t509/(1 + casadi.sqrt(1 + t509**2)), 1/(t507 + casadi.sqrt(1 + t507**2))), 0)
     t511 = 1/casadi.sqrt(1 + t510**2)
     t512 = t504*t510
@@ -4726,10 +4726,10 @@ def _condition_number(q):
     t539 = -t448*t517 + t452*t521 + t456*t525 + t460*t529 + t464*t533 + t468*t537
     t540 = t483*t518 + t487*t522 + t491*t526 + t495*t530 + t499*t534 + t503*t538
     t541 = (t539 != 0)
-    t542 = 0.5*(-t513 + t444)/casadi.if_else(t541, t539, 1)
+    t542 = (-t513 + t444)/casadi.if_else(t541, 2*t539, 1)
     t543 = casadi.fabs(t542)
     t544 = (t543 >= 1)
-    t545 = casadi.fabs(1/casadi.if_else(t544, t542, 1))
+    t545 = 1/casadi.fabs(casadi.if_else(t544, t542, 1))
     t546 = casadi.if_else(t541, casadi.if_else((t542 >= 0), 1, -1)*casadi.if_else(t544, t545/(1 + casadi.sqrt(1 + t545**2)), 1/(t543 + casadi.sqrt(1 + t543**2))), 0)
     t547 = 1/casadi.sqrt(1 + t546**2)
     t548 = t539*t546
@@ -4760,10 +4760,10 @@ def _condition_number(q):
     t573 = t571 - t572*t546
     t574 = t572 + t571*t546
     t575 = (t540 != 0)
-    t576 = 0.5*(-t479 + t514)/casadi.if_else(t575, t540, 1)
+    t576 = (-t479 + t514)/casadi.if_else(t575, 2*t540, 1)
     t577 = casadi.fabs(t576)
     t578 = (t577 >= 1)
-    t579 = casadi.fabs(1/casadi.if_else(t578, t576, 1))
+    t579 = 1/casadi.fabs(casadi.if_else(t578, t576, 1))
     t580 = casadi.if_else(t575, casadi.if_else((t576 >= 0), 1, -1)*casadi.if_else(t578, t579/(1 + casadi.sqrt(1 + t579**2)), 1/(t577 + casadi.sqrt(1 + t577**2))), 0)
     t581 = 1/casadi.sqrt(1 + t580**2)
     t582 = t540*t580
@@ -4795,10 +4795,10 @@ def _condition_number(q):
     t608 = t606 + t605*t580
     t609 = t554*t587 + t558*t591 + t562*t595 + t566*t599 + t570*t603 + t574*t607
     t610 = (t609 != 0)
-    t611 = 0.5*(-t583 + t550)/casadi.if_else(t610, t609, 1)
+    t611 = (-t583 + t550)/casadi.if_else(t610, 2*t609, 1)
     t612 = casadi.fabs(t611)
     t613 = (t612 >= 1)
-    t614 = casadi.fabs(1/casadi.if_else(t613, t611, 1))
+    t614 = 1/casadi.fabs(casadi.if_else(t613, t611, 1))
     t615 = casadi.if_else(t610, casadi.if_else((t611 >= 0), 1, -1)*casadi.if_else(t613, t614/(1 + casadi.sqrt(1 + t614**2)), 1/(t612 + casadi.sqrt(1 + t612**2))), 0)
     t616 = 1/casadi.sqrt(1 + t615**2)
     t617 = t609*t615
@@ -4830,10 +4830,10 @@ def _condition_number(q):
     t643 = t641 + t640*t615
     t644 = t588*t623 + t592*t627 + t596*t631 + t600*t635 + t604*t639 + t608*t643
     t645 = (t644 != 0)
-    t646 = 0.5*(-t584 + t619)/casadi.if_else(t645, t644, 1)
+    t646 = (-t584 + t619)/casadi.if_else(t645, 2*t644, 1)
     t647 = casadi.fabs(t646)
     t648 = (t647 >= 1)
-    t649 = casadi.fabs(1/casadi.if_else(t648, t646, 1))
+    t649 = 1/casadi.fabs(casadi.if_else(t648, t646, 1))
     t650 = casadi.if_else(t645, casadi.if_else((t646 >= 0), 1, -1)*casadi.if_else(t648, t649/(1 + casadi.sqrt(1 + t649**2)), 1/(t647 + casadi.sqrt(1 + t647**2))), 0)
     t651 = 1/casadi.sqrt(1 + t650**2)
     t652 = t644*t650
@@ -4864,10 +4864,10 @@ def _condition_number(q):
     t677 = t675 - t676*t650
     t678 = t676 + t675*t650
     t679 = (t469 != 0)
-    t680 = 0.5*(-t293 + t443)/casadi.if_else(t679, t469, 1)
+    t680 = (-t293 + t443)/casadi.if_else(t679, 2*t469, 1)
     t681 = casadi.fabs(t680)
     t682 = (t681 >= 1)
-    t683 = casadi.fabs(1/casadi.if_else(t682, t680, 1))
+    t683 = 1/casadi.fabs(casadi.if_else(t682, t680, 1))
     t684 = casadi.if_else(t679, casadi.if_else((t680 >= 0), 1, -1)*casadi.if_else(t682, t683/(1 + casadi.sqrt(1 + t683**2)), 1/(t681 + casadi.sqrt(1 + t681**2))), 0)
     t685 = 1/casadi.sqrt(1 + t684**2)
     t686 = t469*t684
@@ -4899,10 +4899,10 @@ def _condition_number(q):
     t712 = t710 + t709*t684
     t713 = t553*t691 + t557*t695 + t561*t699 + t565*t703 + t569*t707 + t573*t711
     t714 = (t713 != 0)
-    t715 = 0.5*(-t687 + t549)/casadi.if_else(t714, t713, 1)
+    t715 = (-t687 + t549)/casadi.if_else(t714, 2*t713, 1)
     t716 = casadi.fabs(t715)
     t717 = (t716 >= 1)
-    t718 = casadi.fabs(1/casadi.if_else(t717, t715, 1))
+    t718 = 1/casadi.fabs(casadi.if_else(t717, t715, 1))
     t719 = casadi.if_else(t714, casadi.if_else((t715 >= 0), 1, -1)*casadi.if_else(t717, t718/(1 + casadi.sqrt(1 + t718**2)), 1/(t716 + casadi.sqrt(1 + t716**2))), 0)
     t720 = 1/casadi.sqrt(1 + t719**2)
     t721 = t713*t719
@@ -4935,10 +4935,10 @@ def _condition_number(q):
     t748 = t622*t726 + t626*t730 + t630*t734 + t634*t738 + t638*t742 + t642*t746
     t749 = -t692*t727 + t696*t731 + t700*t735 + t704*t739 + t708*t743 + t712*t747
     t750 = (t748 != 0)
-    t751 = 0.5*(-t722 + t618)/casadi.if_else(t750, t748, 1)
+    t751 = (-t722 + t618)/casadi.if_else(t750, 2*t748, 1)
     t752 = casadi.fabs(t751)
     t753 = (t752 >= 1)
-    t754 = casadi.fabs(1/casadi.if_else(t753, t751, 1))
+    t754 = 1/casadi.fabs(casadi.if_else(t753, t751, 1))
     t755 = casadi.if_else(t750, casadi.if_else((t751 >= 0), 1, -1)*casadi.if_else(t753, t754/(1 + casadi.sqrt(1 + t754**2)), 1/(t752 + casadi.sqrt(1 + t752**2))), 0)
     t756 = 1/casadi.sqrt(1 + t755**2)
     t757 = t748*t755
@@ -4970,10 +4970,10 @@ def _condition_number(q):
     t783 = t781 + t780*t755
     t784 = t657*t762 + t661*t766 + t665*t770 + t669*t774 + t673*t778 + t677*t782
     t785 = (t784 != 0)
-    t786 = 0.5*(-t758 + t653)/casadi.if_else(t785, t784, 1)
+    t786 = (-t758 + t653)/casadi.if_else(t785, 2*t784, 1)
     t787 = casadi.fabs(t786)
     t788 = (t787 >= 1)
-    t789 = casadi.fabs(1/casadi.if_else(t788, t786, 1))
+    t789 = 1/casadi.fabs(casadi.if_else(t788, t786, 1))
     t790 = casadi.if_else(t785, casadi.if_else((t786 >= 0), 1, -1)*casadi.if_else(t788, t789/(1 + casadi.sqrt(1 + t789**2)), 1/(t787 + casadi.sqrt(1 + t787**2))), 0)
     t791 = 1/casadi.sqrt(1 + t790**2)
     t792 = t784*t790
@@ -5005,10 +5005,10 @@ def _condition_number(q):
     t818 = t816 + t815*t790
     t819 = t658*t797 + t662*t801 + t666*t805 + t670*t809 + t674*t813 + t678*t817
     t820 = (t819 != 0)
-    t821 = 0.5*(-t793 + t654)/casadi.if_else(t820, t819, 1)
+    t821 = (-t793 + t654)/casadi.if_else(t820, 2*t819, 1)
     t822 = casadi.fabs(t821)
     t823 = (t822 >= 1)
-    t824 = casadi.fabs(1/casadi.if_else(t823, t821, 1))
+    t824 = 1/casadi.fabs(casadi.if_else(t823, t821, 1))
     t825 = casadi.if_else(t820, casadi.if_else((t821 >= 0), 1, -1)*casadi.if_else(t823, t824/(1 + casadi.sqrt(1 + t824**2)), 1/(t822 + casadi.sqrt(1 + t822**2))), 0)
     t826 = 1/casadi.sqrt(1 + t825**2)
     t827 = t819*t825
@@ -5039,10 +5039,10 @@ def _condition_number(q):
     t852 = t850 - t851*t825
     t853 = t851 + t850*t825
     t854 = (t749 != 0)
-    t855 = 0.5*(-t688 + t723)/casadi.if_else(t854, t749, 1)
+    t855 = (-t688 + t723)/casadi.if_else(t854, 2*t749, 1)
     t856 = casadi.fabs(t855)
     t857 = (t856 >= 1)
-    t858 = casadi.fabs(1/casadi.if_else(t857, t855, 1))
+    t858 = 1/casadi.fabs(casadi.if_else(t857, t855, 1))
     t859 = casadi.if_else(t854, casadi.if_else((t855 >= 0), 1, -1)*casadi.if_else(t857, t858/(1 + casadi.sqrt(1 + t858**2)), 1/(t856 + casadi.sqrt(1 + t856**2))), 0)
     t860 = 1/casadi.sqrt(1 + t859**2)
     t861 = t749*t859
@@ -5074,10 +5074,10 @@ def _condition_number(q):
     t887 = t885 + t884*t859
     t888 = t763*t866 + t767*t870 + t771*t874 + t775*t878 + t779*t882 + t783*t886
     t889 = (t888 != 0)
-    t890 = 0.5*(-t862 + t759)/casadi.if_else(t889, t888, 1)
+    t890 = (-t862 + t759)/casadi.if_else(t889, 2*t888, 1)
     t891 = casadi.fabs(t890)
     t892 = (t891 >= 1)
-    t893 = casadi.fabs(1/casadi.if_else(t892, t890, 1))
+    t893 = 1/casadi.fabs(casadi.if_else(t892, t890, 1))
     t894 = casadi.if_else(t889, casadi.if_else((t890 >= 0), 1, -1)*casadi.if_else(t892, t893/(1 + casadi.sqrt(1 + t893**2)), 1/(t891 + casadi.sqrt(1 + t891**2))), 0)
     t895 = 1/casadi.sqrt(1 + t894**2)
     t896 = t888*t894
@@ -5110,10 +5110,10 @@ def _condition_number(q):
     t923 = t798*t901 + t802*t905 + t806*t909 + t810*t913 + t814*t917 + t818*t921
     t924 = t867*t902 + t871*t906 + t875*t910 + t879*t914 + t883*t918 + t887*t922
     t925 = (t923 != 0)
-    t926 = 0.5*(-t897 + t794)/casadi.if_else(t925, t923, 1)
+    t926 = (-t897 + t794)/casadi.if_else(t925, 2*t923, 1)
     t927 = casadi.fabs(t926)
     t928 = (t927 >= 1)
-    t929 = casadi.fabs(1/casadi.if_else(t928, t926, 1))
+    t929 = 1/casadi.fabs(casadi.if_else(t928, t926, 1))
     t930 = casadi.if_else(t925, casadi.if_else((t926 >= 0), 1, -1)*casadi.if_else(t928, t929/(1 + casadi.sqrt(1 + t929**2)), 1/(t927 + casadi.sqrt(1 + t927**2))), 0)
     t931 = 1/casadi.sqrt(1 + t930**2)
     t932 = t923*t930
@@ -5145,10 +5145,10 @@ def _condition_number(q):
     t958 = t956 + t955*t930
     t959 = t833*t937 + t837*t941 + t841*t945 + t845*t949 + t849*t953 + t853*t957
     t960 = (t959 != 0)
-    t961 = 0.5*(-t933 + t829)/casadi.if_else(t960, t959, 1)
+    t961 = (-t933 + t829)/casadi.if_else(t960, 2*t959, 1)
     t962 = casadi.fabs(t961)
     t963 = (t962 >= 1)
-    t964 = casadi.fabs(1/casadi.if_else(t963, t961, 1))
+    t964 = 1/casadi.fabs(casadi.if_else(t963, t961, 1))
     t965 = casadi.if_else(t960, casadi.if_else((t961 >= 0), 1, -1)*casadi.if_else(t963, t964/(1 + casadi.sqrt(1 + t964**2)), 1/(t962 + casadi.sqrt(1 + t962**2))), 0)
     t966 = 1/casadi.sqrt(1 + t965**2)
     t967 = t959*t965
@@ -5180,10 +5180,10 @@ def _condition_number(q):
     t993 = t991 + t990*t965
     t994 = t832*t972 + t836*t976 + t840*t980 + t844*t984 + t848*t988 + t852*t992
     t995 = (t924 != 0)
-    t996 = 0.5*(-t863 + t898)/casadi.if_else(t995, t924, 1)
+    t996 = (-t863 + t898)/casadi.if_else(t995, 2*t924, 1)
     t997 = casadi.fabs(t996)
     t998 = (t997 >= 1)
-    t999 = casadi.fabs(1/casadi.if_else(t998, t996, 1))
+    t999 = 1/casadi.fabs(casadi.if_else(t998, t996, 1))
     t1000 = casadi.if_else(t995, casadi.if_else((t996 >= 0), 1, -1)*casadi.if_else(t998, t999/(1 + casadi.sqrt(1 + t999**2)), 1/(t997 + casadi.sqrt(1 + t997**2))), 0)
     t1001 = 1/casadi.sqrt(1 + t1000**2)
     t1002 = t924*t1000
@@ -5215,10 +5215,10 @@ def _condition_number(q):
     t1028 = t1026 + t1025*t1000
     t1029 = t938*t1007 + t942*t1011 + t946*t1015 + t950*t1019 + t954*t1023 + t958*t1027
     t1030 = (t1029 != 0)
-    t1031 = 0.5*(-t1003 + t934)/casadi.if_else(t1030, t1029, 1)
+    t1031 = (-t1003 + t934)/casadi.if_else(t1030, 2*t1029, 1)
     t1032 = casadi.fabs(t1031)
     t1033 = (t1032 >= 1)
-    t1034 = casadi.fabs(1/casadi.if_else(t1033, t1031, 1))
+    t1034 = 1/casadi.fabs(casadi.if_else(t1033, t1031, 1))
     t1035 = casadi.if_else(t1030, casadi.if_else((t1031 >= 0), 1, -1)*casadi.if_else(t1033, t1034/(1 + casadi.sqrt(1 + t1034**2)), 1/(t1032 + casadi.sqrt(1 + t1032**2))), 0)
     t1036 = 1/casadi.sqrt(1 + t1035**2)
     t1037 = t1029*t1035
@@ -5251,10 +5251,10 @@ def _condition_number(q):
     t1064 = t973*t1042 + t977*t1046 + t981*t1050 + t985*t1054 + t989*t1058 + t993*t1062
     t1065 = t1008*t1043 + t1012*t1047 + t1016*t1051 + t1020*t1055 + t1024*t1059 + t1028*t1063
     t1066 = (t1064 != 0)
-    t1067 = 0.5*(-t1038 + t969)/casadi.if_else(t1066, t1064, 1)
+    t1067 = (-t1038 + t969)/casadi.if_else(t1066, 2*t1064, 1)
     t1068 = casadi.fabs(t1067)
     t1069 = (t1068 >= 1)
-    t1070 = casadi.fabs(1/casadi.if_else(t1069, t1067, 1))
+    t1070 = 1/casadi.fabs(casadi.if_else(t1069, t1067, 1))
     t1071 = casadi.if_else(t1066, casadi.if_else((t1067 >= 0), 1, -1)*casadi.if_else(t1069, t1070/(1 + casadi.sqrt(1 + t1070**2)), 1/(t1068 + casadi.sqrt(1 + t1068**2))), 0)
     t1072 = 1/casadi.sqrt(1 + t1071**2)
     t1073 = t1064*t1071
@@ -5285,10 +5285,10 @@ def _condition_number(q):
     t1098 = t1096 - t1097*t1071
     t1099 = t1097 + t1096*t1071
     t1100 = (t1065 != 0)
-    t1101 = 0.5*(-t1004 + t1039)/casadi.if_else(t1100, t1065, 1)
+    t1101 = (-t1004 + t1039)/casadi.if_else(t1100, 2*t1065, 1)
     t1102 = casadi.fabs(t1101)
     t1103 = (t1102 >= 1)
-    t1104 = casadi.fabs(1/casadi.if_else(t1103, t1101, 1))
+    t1104 = 1/casadi.fabs(casadi.if_else(t1103, t1101, 1))
     t1105 = casadi.if_else(t1100, casadi.if_else((t1101 >= 0), 1, -1)*casadi.if_else(t1103, t1104/(1 + casadi.sqrt(1 + t1104**2)), 1/(t1102 + casadi.sqrt(1 + t1102**2))), 0)
     t1106 = 1/casadi.sqrt(1 + t1105**2)
     t1107 = t1065*t1105
@@ -5320,10 +5320,10 @@ def _condition_number(q):
     t1133 = t1131 + t1130*t1105
     t1134 = t1079*t1112 + t1083*t1116 + t1087*t1120 + t1091*t1124 + t1095*t1128 + t1099*t1132
     t1135 = (t1134 != 0)
-    t1136 = 0.5*(-t1108 + t1075)/casadi.if_else(t1135, t1134, 1)
+    t1136 = (-t1108 + t1075)/casadi.if_else(t1135, 2*t1134, 1)
     t1137 = casadi.fabs(t1136)
     t1138 = (t1137 >= 1)
-    t1139 = casadi.fabs(1/casadi.if_else(t1138, t1136, 1))
+    t1139 = 1/casadi.fabs(casadi.if_else(t1138, t1136, 1))
     t1140 = casadi.if_else(t1135, casadi.if_else((t1136 >= 0), 1, -1)*casadi.if_else(t1138, t1139/(1 + casadi.sqrt(1 + t1139**2)), 1/(t1137 + casadi.sqrt(1 + t1137**2))), 0)
     t1141 = 1/casadi.sqrt(1 + t1140**2)
     t1142 = t1134*t1140
@@ -5355,10 +5355,10 @@ def _condition_number(q):
     t1168 = t1166 + t1140*t1165
     t1169 = t1113*t1148 + t1117*t1152 + t1121*t1156 + t1125*t1160 + t1129*t1164 + t1133*t1168
     t1170 = (t1169 != 0)
-    t1171 = 0.5*(-t1109 + t1144)/casadi.if_else(t1170, t1169, 1)
+    t1171 = (-t1109 + t1144)/casadi.if_else(t1170, 2*t1169, 1)
     t1172 = casadi.fabs(t1171)
     t1173 = (t1172 >= 1)
-    t1174 = casadi.fabs(1/casadi.if_else(t1173, t1171, 1))
+    t1174 = 1/casadi.fabs(casadi.if_else(t1173, t1171, 1))
     t1175 = casadi.if_else(t1170, casadi.if_else((t1171 >= 0), 1, -1)*casadi.if_else(t1173, t1174/(1 + casadi.sqrt(1 + t1174**2)), 1/(t1172 + casadi.sqrt(1 + t1172**2))), 0)
     t1176 = 1/casadi.sqrt(1 + t1175**2)
     t1177 = t1169*t1175
@@ -5389,10 +5389,10 @@ def _condition_number(q):
     t1202 = t1200 - t1175*t1201
     t1203 = t1201 + t1175*t1200
     t1204 = (t994 != 0)
-    t1205 = 0.5*(-t828 + t968)/casadi.if_else(t1204, t994, 1)
+    t1205 = (-t828 + t968)/casadi.if_else(t1204, 2*t994, 1)
     t1206 = casadi.fabs(t1205)
     t1207 = (t1206 >= 1)
-    t1208 = casadi.fabs(1/casadi.if_else(t1207, t1205, 1))
+    t1208 = 1/casadi.fabs(casadi.if_else(t1207, t1205, 1))
     t1209 = casadi.if_else(t1204, casadi.if_else((t1205 >= 0), 1, -1)*casadi.if_else(t1207, t1208/(1 + casadi.sqrt(1 + t1208**2)), 1/(t1206 + casadi.sqrt(1 + t1206**2))), 0)
     t1210 = 1/casadi.sqrt(1 + t1209**2)
     t1211 = t994*t1209
@@ -5424,10 +5424,10 @@ def _condition_number(q):
     t1237 = t1235 + t1209*t1234
     t1238 = t1078*t1216 + t1082*t1220 + t1086*t1224 + t1090*t1228 + t1094*t1232 + t1098*t1236
     t1239 = (t1238 != 0)
-    t1240 = 0.5*(-t1212 + t1074)/casadi.if_else(t1239, t1238, 1)
+    t1240 = (-t1212 + t1074)/casadi.if_else(t1239, 2*t1238, 1)
     t1241 = casadi.fabs(t1240)
     t1242 = (t1241 >= 1)
-    t1243 = casadi.fabs(1/casadi.if_else(t1242, t1240, 1))
+    t1243 = 1/casadi.fabs(casadi.if_else(t1242, t1240, 1))
     t1244 = casadi.if_else(t1239, casadi.if_else((t1240 >= 0), 1, -1)*casadi.if_else(t1242, t1243/(1 + casadi.sqrt(1 + t1243**2)), 1/(t1241 + casadi.sqrt(1 + t1241**2))), 0)
     t1245 = 1/casadi.sqrt(1 + t1244**2)
     t1246 = t1238*t1244
@@ -5460,10 +5460,10 @@ def _condition_number(q):
     t1273 = t1147*t1251 + t1151*t1255 + t1155*t1259 + t1159*t1263 + t1163*t1267 + t1167*t1271
     t1274 = t1217*t1252 + t1221*t1256 + t1225*t1260 + t1229*t1264 + t1233*t1268 + t1237*t1272
     t1275 = (t1273 != 0)
-    t1276 = 0.5*(-t1247 + t1143)/casadi.if_else(t1275, t1273, 1)
+    t1276 = (-t1247 + t1143)/casadi.if_else(t1275, 2*t1273, 1)
     t1277 = casadi.fabs(t1276)
     t1278 = (t1277 >= 1)
-    t1279 = casadi.fabs(1/casadi.if_else(t1278, t1276, 1))
+    t1279 = 1/casadi.fabs(casadi.if_else(t1278, t1276, 1))
     t1280 = casadi.if_else(t1275, casadi.if_else((t1276 >= 0), 1, -1)*casadi.if_else(t1278, t1279/(1 + casadi.sqrt(1 + t1279**2)), 1/(t1277 + casadi.sqrt(1 + t1277**2))), 0)
     t1281 = 1/casadi.sqrt(1 + t1280**2)
     t1282 = t1273*t1280
@@ -5495,10 +5495,10 @@ def _condition_number(q):
     t1308 = t1306 + t1280*t1305
     t1309 = t1182*t1287 + t1186*t1291 + t1190*t1295 + t1194*t1299 + t1198*t1303 + t1202*t1307
     t1310 = (t1309 != 0)
-    t1311 = 0.5*(-t1283 + t1178)/casadi.if_else(t1310, t1309, 1)
+    t1311 = (-t1283 + t1178)/casadi.if_else(t1310, 2*t1309, 1)
     t1312 = casadi.fabs(t1311)
     t1313 = (t1312 >= 1)
-    t1314 = casadi.fabs(1/casadi.if_else(t1313, t1311, 1))
+    t1314 = 1/casadi.fabs(casadi.if_else(t1313, t1311, 1))
     t1315 = casadi.if_else(t1310, casadi.if_else((t1311 >= 0), 1, -1)*casadi.if_else(t1313, t1314/(1 + casadi.sqrt(1 + t1314**2)), 1/(t1312 + casadi.sqrt(1 + t1312**2))), 0)
     t1316 = 1/casadi.sqrt(1 + t1315**2)
     t1317 = t1309*t1315
@@ -5530,10 +5530,10 @@ def _condition_number(q):
     t1343 = t1341 + t1315*t1340
     t1344 = t1183*t1322 + t1187*t1326 + t1191*t1330 + t1195*t1334 + t1199*t1338 + t1203*t1342
     t1345 = (t1344 != 0)
-    t1346 = 0.5*(-t1318 + t1179)/casadi.if_else(t1345, t1344, 1)
+    t1346 = (-t1318 + t1179)/casadi.if_else(t1345, 2*t1344, 1)
     t1347 = casadi.fabs(t1346)
     t1348 = (t1347 >= 1)
-    t1349 = casadi.fabs(1/casadi.if_else(t1348, t1346, 1))
+    t1349 = 1/casadi.fabs(casadi.if_else(t1348, t1346, 1))
     t1350 = casadi.if_else(t1345, casadi.if_else((t1346 >= 0), 1, -1)*casadi.if_else(t1348, t1349/(1 + casadi.sqrt(1 + t1349**2)), 1/(t1347 + casadi.sqrt(1 + t1347**2))), 0)
     t1351 = 1/casadi.sqrt(1 + t1350**2)
     t1352 = t1344*t1350
@@ -5564,10 +5564,10 @@ def _condition_number(q):
     t1377 = t1375 - t1350*t1376
     t1378 = t1376 + t1350*t1375
     t1379 = (t1274 != 0)
-    t1380 = 0.5*(-t1213 + t1248)/casadi.if_else(t1379, t1274, 1)
+    t1380 = (-t1213 + t1248)/casadi.if_else(t1379, 2*t1274, 1)
     t1381 = casadi.fabs(t1380)
     t1382 = (t1381 >= 1)
-    t1383 = casadi.fabs(1/casadi.if_else(t1382, t1380, 1))
+    t1383 = 1/casadi.fabs(casadi.if_else(t1382, t1380, 1))
     t1384 = casadi.if_else(t1379, casadi.if_else((t1380 >= 0), 1, -1)*casadi.if_else(t1382, t1383/(1 + casadi.sqrt(1 + t1383**2)), 1/(t1381 + casadi.sqrt(1 + t1381**2))), 0)
     t1385 = 1/casadi.sqrt(1 + t1384**2)
     t1386 = t1274*t1384
@@ -5599,10 +5599,10 @@ def _condition_number(q):
     t1412 = t1410 + t1384*t1409
     t1413 = t1288*t1391 + t1292*t1395 + t1296*t1399 + t1300*t1403 + t1304*t1407 + t1308*t1411
     t1414 = (t1413 != 0)
-    t1415 = 0.5*(-t1387 + t1284)/casadi.if_else(t1414, t1413, 1)
+    t1415 = (-t1387 + t1284)/casadi.if_else(t1414, 2*t1413, 1)
     t1416 = casadi.fabs(t1415)
     t1417 = (t1416 >= 1)
-    t1418 = casadi.fabs(1/casadi.if_else(t1417, t1415, 1))
+    t1418 = 1/casadi.fabs(casadi.if_else(t1417, t1415, 1))
     t1419 = casadi.if_else(t1414, casadi.if_else((t1415 >= 0), 1, -1)*casadi.if_else(t1417, t1418/(1 + casadi.sqrt(1 + t1418**2)), 1/(t1416 + casadi.sqrt(1 + t1416**2))), 0)
     t1420 = 1/casadi.sqrt(1 + t1419**2)
     t1421 = t1413*t1419
@@ -5635,10 +5635,10 @@ def _condition_number(q):
     t1448 = t1323*t1426 + t1327*t1430 + t1331*t1434 + t1335*t1438 + t1339*t1442 + t1343*t1446
     t1449 = t1392*t1427 + t1396*t1431 + t1400*t1435 + t1404*t1439 + t1408*t1443 + t1412*t1447
     t1450 = (t1448 != 0)
-    t1451 = 0.5*(-t1422 + t1319)/casadi.if_else(t1450, t1448, 1)
+    t1451 = (-t1422 + t1319)/casadi.if_else(t1450, 2*t1448, 1)
     t1452 = casadi.fabs(t1451)
     t1453 = (t1452 >= 1)
-    t1454 = casadi.fabs(1/casadi.if_else(t1453, t1451, 1))
+    t1454 = 1/casadi.fabs(casadi.if_else(t1453, t1451, 1))
     t1455 = casadi.if_else(t1450, casadi.if_else((t1451 >= 0), 1, -1)*casadi.if_else(t1453, t1454/(1 + casadi.sqrt(1 + t1454**2)), 1/(t1452 + casadi.sqrt(1 + t1452**2))), 0)
     t1456 = 1/casadi.sqrt(1 + t1455**2)
     t1457 = t1448*t1455
@@ -5670,10 +5670,10 @@ def _condition_number(q):
     t1483 = t1481 + t1455*t1480
     t1484 = t1358*t1462 + t1362*t1466 + t1366*t1470 + t1370*t1474 + t1374*t1478 + t1378*t1482
     t1485 = (t1484 != 0)
-    t1486 = 0.5*(-t1458 + t1354)/casadi.if_else(t1485, t1484, 1)
+    t1486 = (-t1458 + t1354)/casadi.if_else(t1485, 2*t1484, 1)
     t1487 = casadi.fabs(t1486)
     t1488 = (t1487 >= 1)
-    t1489 = casadi.fabs(1/casadi.if_else(t1488, t1486, 1))
+    t1489 = 1/casadi.fabs(casadi.if_else(t1488, t1486, 1))
     t1490 = casadi.if_else(t1485, casadi.if_else((t1486 >= 0), 1, -1)*casadi.if_else(t1488, t1489/(1 + casadi.sqrt(1 + t1489**2)), 1/(t1487 + casadi.sqrt(1 + t1487**2))), 0)
     t1491 = 1/casadi.sqrt(1 + t1490**2)
     t1492 = t1484*t1490
@@ -5705,10 +5705,10 @@ def _condition_number(q):
     t1518 = t1516 + t1490*t1515
     t1519 = t1357*t1497 + t1361*t1501 + t1365*t1505 + t1369*t1509 + t1373*t1513 + t1377*t1517
     t1520 = (t1449 != 0)
-    t1521 = 0.5*(-t1388 + t1423)/casadi.if_else(t1520, t1449, 1)
+    t1521 = (-t1388 + t1423)/casadi.if_else(t1520, 2*t1449, 1)
     t1522 = casadi.fabs(t1521)
     t1523 = (t1522 >= 1)
-    t1524 = casadi.fabs(1/casadi.if_else(t1523, t1521, 1))
+    t1524 = 1/casadi.fabs(casadi.if_else(t1523, t1521, 1))
     t1525 = casadi.if_else(t1520, casadi.if_else((t1521 >= 0), 1, -1)*casadi.if_else(t1523, t1524/(1 + casadi.sqrt(1 + t1524**2)), 1/(t1522 + casadi.sqrt(1 + t1522**2))), 0)
     t1526 = 1/casadi.sqrt(1 + t1525**2)
     t1527 = t1449*t1525
@@ -5740,10 +5740,10 @@ def _condition_number(q):
     t1553 = t1551 + t1525*t1550
     t1554 = t1463*t1532 + t1467*t1536 + t1471*t1540 + t1475*t1544 + t1479*t1548 + t1483*t1552
     t1555 = (t1554 != 0)
-    t1556 = 0.5*(-t1528 + t1459)/casadi.if_else(t1555, t1554, 1)
+    t1556 = (-t1528 + t1459)/casadi.if_else(t1555, 2*t1554, 1)
     t1557 = casadi.fabs(t1556)
     t1558 = (t1557 >= 1)
-    t1559 = casadi.fabs(1/casadi.if_else(t1558, t1556, 1))
+    t1559 = 1/casadi.fabs(casadi.if_else(t1558, t1556, 1))
     t1560 = casadi.if_else(t1555, casadi.if_else((t1556 >= 0), 1, -1)*casadi.if_else(t1558, t1559/(1 + casadi.sqrt(1 + t1559**2)), 1/(t1557 + casadi.sqrt(1 + t1557**2))), 0)
     t1561 = 1/casadi.sqrt(1 + t1560**2)
     t1562 = t1554*t1560
@@ -5776,10 +5776,10 @@ def _condition_number(q):
     t1589 = t1498*t1567 + t1502*t1571 + t1506*t1575 + t1510*t1579 + t1514*t1583 + t1518*t1587
     t1590 = t1533*t1568 + t1537*t1572 + t1541*t1576 + t1545*t1580 + t1549*t1584 + t1553*t1588
     t1591 = (t1589 != 0)
-    t1592 = 0.5*(-t1563 + t1494)/casadi.if_else(t1591, t1589, 1)
+    t1592 = (-t1563 + t1494)/casadi.if_else(t1591, 2*t1589, 1)
     t1593 = casadi.fabs(t1592)
     t1594 = (t1593 >= 1)
-    t1595 = casadi.fabs(1/casadi.if_else(t1594, t1592, 1))
+    t1595 = 1/casadi.fabs(casadi.if_else(t1594, t1592, 1))
     t1596 = casadi.if_else(t1591, casadi.if_else((t1592 >= 0), 1, -1)*casadi.if_else(t1594, t1595/(1 + casadi.sqrt(1 + t1595**2)), 1/(t1593 + casadi.sqrt(1 + t1593**2))), 0)
     t1597 = 1/casadi.sqrt(1 + t1596**2)
     t1598 = t1589*t1596
@@ -5810,10 +5810,10 @@ def _condition_number(q):
     t1623 = t1621 - t1596*t1622
     t1624 = t1622 + t1596*t1621
     t1625 = (t1590 != 0)
-    t1626 = 0.5*(-t1529 + t1564)/casadi.if_else(t1625, t1590, 1)
+    t1626 = (-t1529 + t1564)/casadi.if_else(t1625, 2*t1590, 1)
     t1627 = casadi.fabs(t1626)
     t1628 = (t1627 >= 1)
-    t1629 = casadi.fabs(1/casadi.if_else(t1628, t1626, 1))
+    t1629 = 1/casadi.fabs(casadi.if_else(t1628, t1626, 1))
     t1630 = casadi.if_else(t1625, casadi.if_else((t1626 >= 0), 1, -1)*casadi.if_else(t1628, t1629/(1 + casadi.sqrt(1 + t1629**2)), 1/(t1627 + casadi.sqrt(1 + t1627**2))), 0)
     t1631 = 1/casadi.sqrt(1 + t1630**2)
     t1632 = t1590*t1630
@@ -5845,10 +5845,10 @@ def _condition_number(q):
     t1658 = t1656 + t1630*t1655
     t1659 = t1604*t1637 + t1608*t1641 + t1612*t1645 + t1616*t1649 + t1620*t1653 + t1624*t1657
     t1660 = (t1659 != 0)
-    t1661 = 0.5*(-t1633 + t1600)/casadi.if_else(t1660, t1659, 1)
+    t1661 = (-t1633 + t1600)/casadi.if_else(t1660, 2*t1659, 1)
     t1662 = casadi.fabs(t1661)
     t1663 = (t1662 >= 1)
-    t1664 = casadi.fabs(1/casadi.if_else(t1663, t1661, 1))
+    t1664 = 1/casadi.fabs(casadi.if_else(t1663, t1661, 1))
     t1665 = casadi.if_else(t1660, casadi.if_else((t1661 >= 0), 1, -1)*casadi.if_else(t1663, t1664/(1 + casadi.sqrt(1 + t1664**2)), 1/(t1662 + casadi.sqrt(1 + t1662**2))), 0)
     t1666 = 1/casadi.sqrt(1 + t1665**2)
     t1667 = t1659*t1665
@@ -5880,10 +5880,10 @@ def _condition_number(q):
     t1693 = t1691 + t1665*t1690
     t1694 = t1638*t1673 + t1642*t1677 + t1646*t1681 + t1650*t1685 + t1654*t1689 + t1658*t1693
     t1695 = (t1694 != 0)
-    t1696 = 0.5*(-t1634 + t1669)/casadi.if_else(t1695, t1694, 1)
+    t1696 = (-t1634 + t1669)/casadi.if_else(t1695, 2*t1694, 1)
     t1697 = casadi.fabs(t1696)
     t1698 = (t1697 >= 1)
-    t1699 = casadi.fabs(1/casadi.if_else(t1698, t1696, 1))
+    t1699 = 1/casadi.fabs(casadi.if_else(t1698, t1696, 1))
     t1700 = casadi.if_else(t1695, casadi.if_else((t1696 >= 0), 1, -1)*casadi.if_else(t1698, t1699/(1 + casadi.sqrt(1 + t1699**2)), 1/(t1697 + casadi.sqrt(1 + t1697**2))), 0)
     t1701 = 1/casadi.sqrt(1 + t1700**2)
     t1702 = t1694*t1700
@@ -5914,10 +5914,10 @@ def _condition_number(q):
     t1727 = t1725 - t1700*t1726
     t1728 = t1726 + t1700*t1725
     t1729 = (t1519 != 0)
-    t1730 = 0.5*(-t1353 + t1493)/casadi.if_else(t1729, t1519, 1)
+    t1730 = (-t1353 + t1493)/casadi.if_else(t1729, 2*t1519, 1)
     t1731 = casadi.fabs(t1730)
     t1732 = (t1731 >= 1)
-    t1733 = casadi.fabs(1/casadi.if_else(t1732, t1730, 1))
+    t1733 = 1/casadi.fabs(casadi.if_else(t1732, t1730, 1))
     t1734 = casadi.if_else(t1729, casadi.if_else((t1730 >= 0), 1, -1)*casadi.if_else(t1732, t1733/(1 + casadi.sqrt(1 + t1733**2)), 1/(t1731 + casadi.sqrt(1 + t1731**2))), 0)
     t1735 = 1/casadi.sqrt(1 + t1734**2)
     t1736 = t1519*t1734
@@ -5949,10 +5949,10 @@ def _condition_number(q):
     t1762 = t1760 + t1734*t1759
     t1763 = t1603*t1741 + t1607*t1745 + t1611*t1749 + t1615*t1753 + t1619*t1757 + t1623*t1761
     t1764 = (t1763 != 0)
-    t1765 = 0.5*(-t1737 + t1599)/casadi.if_else(t1764, t1763, 1)
+    t1765 = (-t1737 + t1599)/casadi.if_else(t1764, 2*t1763, 1)
     t1766 = casadi.fabs(t1765)
     t1767 = (t1766 >= 1)
-    t1768 = casadi.fabs(1/casadi.if_else(t1767, t1765, 1))
+    t1768 = 1/casadi.fabs(casadi.if_else(t1767, t1765, 1))
     t1769 = casadi.if_else(t1764, casadi.if_else((t1765 >= 0), 1, -1)*casadi.if_else(t1767, t1768/(1 + casadi.sqrt(1 + t1768**2)), 1/(t1766 + casadi.sqrt(1 + t1766**2))), 0)
     t1770 = 1/casadi.sqrt(1 + t1769**2)
     t1771 = t1763*t1769
@@ -5985,10 +5985,10 @@ def _condition_number(q):
     t1798 = t1672*t1776 + t1676*t1780 + t1680*t1784 + t1684*t1788 + t1688*t1792 + t1692*t1796
     t1799 = t1742*t1777 + t1746*t1781 + t1750*t1785 + t1754*t1789 + t1758*t1793 + t1762*t1797
     t1800 = (t1798 != 0)
-    t1801 = 0.5*(-t1772 + t1668)/casadi.if_else(t1800, t1798, 1)
+    t1801 = (-t1772 + t1668)/casadi.if_else(t1800, 2*t1798, 1)
     t1802 = casadi.fabs(t1801)
     t1803 = (t1802 >= 1)
-    t1804 = casadi.fabs(1/casadi.if_else(t1803, t1801, 1))
+    t1804 = 1/casadi.fabs(casadi.if_else(t1803, t1801, 1))
     t1805 = casadi.if_else(t1800, casadi.if_else((t1801 >= 0), 1, -1)*casadi.if_else(t1803, t1804/(1 + casadi.sqrt(1 + t1804**2)), 1/(t1802 + casadi.sqrt(1 + t1802**2))), 0)
     t1806 = 1/casadi.sqrt(1 + t1805**2)
     t1807 = t1798*t1805
@@ -6020,10 +6020,10 @@ def _condition_number(q):
     t1833 = t1831 + t1805*t1830
     t1834 = t1707*t1812 + t1711*t1816 + t1715*t1820 + t1719*t1824 + t1723*t1828 + t1727*t1832
     t1835 = (t1834 != 0)
-    t1836 = 0.5*(-t1808 + t1703)/casadi.if_else(t1835, t1834, 1)
+    t1836 = (-t1808 + t1703)/casadi.if_else(t1835, 2*t1834, 1)
     t1837 = casadi.fabs(t1836)
     t1838 = (t1837 >= 1)
-    t1839 = casadi.fabs(1/casadi.if_else(t1838, t1836, 1))
+    t1839 = 1/casadi.fabs(casadi.if_else(t1838, t1836, 1))
     t1840 = casadi.if_else(t1835, casadi.if_else((t1836 >= 0), 1, -1)*casadi.if_else(t1838, t1839/(1 + casadi.sqrt(1 + t1839**2)), 1/(t1837 + casadi.sqrt(1 + t1837**2))), 0)
     t1841 = 1/casadi.sqrt(1 + t1840**2)
     t1842 = t1834*t1840
@@ -6055,10 +6055,10 @@ def _condition_number(q):
     t1868 = t1866 + t1840*t1865
     t1869 = t1708*t1847 + t1712*t1851 + t1716*t1855 + t1720*t1859 + t1724*t1863 + t1728*t1867
     t1870 = (t1869 != 0)
-    t1871 = 0.5*(-t1843 + t1704)/casadi.if_else(t1870, t1869, 1)
+    t1871 = (-t1843 + t1704)/casadi.if_else(t1870, 2*t1869, 1)
     t1872 = casadi.fabs(t1871)
     t1873 = (t1872 >= 1)
-    t1874 = casadi.fabs(1/casadi.if_else(t1873, t1871, 1))
+    t1874 = 1/casadi.fabs(casadi.if_else(t1873, t1871, 1))
     t1875 = casadi.if_else(t1870, casadi.if_else((t1871 >= 0), 1, -1)*casadi.if_else(t1873, t1874/(1 + casadi.sqrt(1 + t1874**2)), 1/(t1872 + casadi.sqrt(1 + t1872**2))), 0)
     t1876 = 1/casadi.sqrt(1 + t1875**2)
     t1877 = t1869*t1875
@@ -6089,10 +6089,10 @@ def _condition_number(q):
     t1902 = t1900 - t1875*t1901
     t1903 = t1901 + t1875*t1900
     t1904 = (t1799 != 0)
-    t1905 = 0.5*(-t1738 + t1773)/casadi.if_else(t1904, t1799, 1)
+    t1905 = (-t1738 + t1773)/casadi.if_else(t1904, 2*t1799, 1)
     t1906 = casadi.fabs(t1905)
     t1907 = (t1906 >= 1)
-    t1908 = casadi.fabs(1/casadi.if_else(t1907, t1905, 1))
+    t1908 = 1/casadi.fabs(casadi.if_else(t1907, t1905, 1))
     t1909 = casadi.if_else(t1904, casadi.if_else((t1905 >= 0), 1, -1)*casadi.if_else(t1907, t1908/(1 + casadi.sqrt(1 + t1908**2)), 1/(t1906 + casadi.sqrt(1 + t1906**2))), 0)
     t1910 = 1/casadi.sqrt(1 + t1909**2)
     t1911 = t1799*t1909
@@ -6124,10 +6124,10 @@ def _condition_number(q):
     t1937 = t1935 + t1909*t1934
     t1938 = t1813*t1916 + t1817*t1920 + t1821*t1924 + t1825*t1928 + t1829*t1932 + t1833*t1936
     t1939 = (t1938 != 0)
-    t1940 = 0.5*(-t1912 + t1809)/casadi.if_else(t1939, t1938, 1)
+    t1940 = (-t1912 + t1809)/casadi.if_else(t1939, 2*t1938, 1)
     t1941 = casadi.fabs(t1940)
     t1942 = (t1941 >= 1)
-    t1943 = casadi.fabs(1/casadi.if_else(t1942, t1940, 1))
+    t1943 = 1/casadi.fabs(casadi.if_else(t1942, t1940, 1))
     t1944 = casadi.if_else(t1939, casadi.if_else((t1940 >= 0), 1, -1)*casadi.if_else(t1942, t1943/(1 + casadi.sqrt(1 + t1943**2)), 1/(t1941 + casadi.sqrt(1 + t1941**2))), 0)
     t1945 = 1/casadi.sqrt(1 + t1944**2)
     t1946 = t1938*t1944
@@ -6160,10 +6160,10 @@ def _condition_number(q):
     t1973 = t1848*t1951 + t1852*t1955 + t1856*t1959 + t1860*t1963 + t1864*t1967 + t1868*t1971
     t1974 = t1917*t1952 + t1921*t1956 + t1925*t1960 + t1929*t1964 + t1933*t1968 + t1937*t1972
     t1975 = (t1973 != 0)
-    t1976 = 0.5*(-t1947 + t1844)/casadi.if_else(t1975, t1973, 1)
+    t1976 = (-t1947 + t1844)/casadi.if_else(t1975, 2*t1973, 1)
     t1977 = casadi.fabs(t1976)
     t1978 = (t1977 >= 1)
-    t1979 = casadi.fabs(1/casadi.if_else(t1978, t1976, 1))
+    t1979 = 1/casadi.fabs(casadi.if_else(t1978, t1976, 1))
     t1980 = casadi.if_else(t1975, casadi.if_else((t1976 >= 0), 1, -1)*casadi.if_else(t1978, t1979/(1 + casadi.sqrt(1 + t1979**2)), 1/(t1977 + casadi.sqrt(1 + t1977**2))), 0)
     t1981 = 1/casadi.sqrt(1 + t1980**2)
     t1982 = t1973*t1980
@@ -6195,10 +6195,10 @@ def _condition_number(q):
     t2008 = t2006 + t1980*t2005
     t2009 = t1883*t1987 + t1887*t1991 + t1891*t1995 + t1895*t1999 + t1899*t2003 + t1903*t2007
     t2010 = (t2009 != 0)
-    t2011 = 0.5*(-t1983 + t1879)/casadi.if_else(t2010, t2009, 1)
+    t2011 = (-t1983 + t1879)/casadi.if_else(t2010, 2*t2009, 1)
     t2012 = casadi.fabs(t2011)
     t2013 = (t2012 >= 1)
-    t2014 = casadi.fabs(1/casadi.if_else(t2013, t2011, 1))
+    t2014 = 1/casadi.fabs(casadi.if_else(t2013, t2011, 1))
     t2015 = casadi.if_else(t2010, casadi.if_else((t2011 >= 0), 1, -1)*casadi.if_else(t2013, t2014/(1 + casadi.sqrt(1 + t2014**2)), 1/(t2012 + casadi.sqrt(1 + t2012**2))), 0)
     t2016 = 1/casadi.sqrt(1 + t2015**2)
     t2017 = t2009*t2015
@@ -6230,10 +6230,10 @@ def _condition_number(q):
     t2043 = t2041 + t2015*t2040
     t2044 = t1882*t2022 + t1886*t2026 + t1890*t2030 + t1894*t2034 + t1898*t2038 + t1902*t2042
     t2045 = (t1974 != 0)
-    t2046 = 0.5*(-t1913 + t1948)/casadi.if_else(t2045, t1974, 1)
+    t2046 = (-t1913 + t1948)/casadi.if_else(t2045, 2*t1974, 1)
     t2047 = casadi.fabs(t2046)
     t2048 = (t2047 >= 1)
-    t2049 = casadi.fabs(1/casadi.if_else(t2048, t2046, 1))
+    t2049 = 1/casadi.fabs(casadi.if_else(t2048, t2046, 1))
     t2050 = casadi.if_else(t2045, casadi.if_else((t2046 >= 0), 1, -1)*casadi.if_else(t2048, t2049/(1 + casadi.sqrt(1 + t2049**2)), 1/(t2047 + casadi.sqrt(1 + t2047**2))), 0)
     t2051 = 1/casadi.sqrt(1 + t2050**2)
     t2052 = t1974*t2050
@@ -6265,10 +6265,10 @@ def _condition_number(q):
     t2078 = t2076 + t2050*t2075
     t2079 = t1988*t2057 + t1992*t2061 + t1996*t2065 + t2000*t2069 + t2004*t2073 + t2008*t2077
     t2080 = (t2079 != 0)
-    t2081 = 0.5*(-t2053 + t1984)/casadi.if_else(t2080, t2079, 1)
+    t2081 = (-t2053 + t1984)/casadi.if_else(t2080, 2*t2079, 1)
     t2082 = casadi.fabs(t2081)
     t2083 = (t2082 >= 1)
-    t2084 = casadi.fabs(1/casadi.if_else(t2083, t2081, 1))
+    t2084 = 1/casadi.fabs(casadi.if_else(t2083, t2081, 1))
     t2085 = casadi.if_else(t2080, casadi.if_else((t2081 >= 0), 1, -1)*casadi.if_else(t2083, t2084/(1 + casadi.sqrt(1 + t2084**2)), 1/(t2082 + casadi.sqrt(1 + t2082**2))), 0)
     t2086 = 1/casadi.sqrt(1 + t2085**2)
     t2087 = t2079*t2085
@@ -6301,10 +6301,10 @@ def _condition_number(q):
     t2114 = t2023*t2092 + t2027*t2096 + t2031*t2100 + t2035*t2104 + t2039*t2108 + t2043*t2112
     t2115 = t2058*t2093 + t2062*t2097 + t2066*t2101 + t2070*t2105 + t2074*t2109 + t2078*t2113
     t2116 = (t2114 != 0)
-    t2117 = 0.5*(-t2088 + t2019)/casadi.if_else(t2116, t2114, 1)
+    t2117 = (-t2088 + t2019)/casadi.if_else(t2116, 2*t2114, 1)
     t2118 = casadi.fabs(t2117)
     t2119 = (t2118 >= 1)
-    t2120 = casadi.fabs(1/casadi.if_else(t2119, t2117, 1))
+    t2120 = 1/casadi.fabs(casadi.if_else(t2119, t2117, 1))
     t2121 = casadi.if_else(t2116, casadi.if_else((t2117 >= 0), 1, -1)*casadi.if_else(t2119, t2120/(1 + casadi.sqrt(1 + t2120**2)), 1/(t2118 + casadi.sqrt(1 + t2118**2))), 0)
     t2122 = 1/casadi.sqrt(1 + t2121**2)
     t2123 = t2114*t2121
@@ -6335,10 +6335,10 @@ def _condition_number(q):
     t2148 = t2146 - t2121*t2147
     t2149 = t2147 + t2121*t2146
     t2150 = (t2115 != 0)
-    t2151 = 0.5*(-t2054 + t2089)/casadi.if_else(t2150, t2115, 1)
+    t2151 = (-t2054 + t2089)/casadi.if_else(t2150, 2*t2115, 1)
     t2152 = casadi.fabs(t2151)
     t2153 = (t2152 >= 1)
-    t2154 = casadi.fabs(1/casadi.if_else(t2153, t2151, 1))
+    t2154 = 1/casadi.fabs(casadi.if_else(t2153, t2151, 1))
     t2155 = casadi.if_else(t2150, casadi.if_else((t2151 >= 0), 1, -1)*casadi.if_else(t2153, t2154/(1 + casadi.sqrt(1 + t2154**2)), 1/(t2152 + casadi.sqrt(1 + t2152**2))), 0)
     t2156 = 1/casadi.sqrt(1 + t2155**2)
     t2157 = t2115*t2155
@@ -6370,10 +6370,10 @@ def _condition_number(q):
     t2183 = t2181 + t2155*t2180
     t2184 = t2129*t2162 + t2133*t2166 + t2137*t2170 + t2141*t2174 + t2145*t2178 + t2149*t2182
     t2185 = (t2184 != 0)
-    t2186 = 0.5*(-t2158 + t2125)/casadi.if_else(t2185, t2184, 1)
+    t2186 = (-t2158 + t2125)/casadi.if_else(t2185, 2*t2184, 1)
     t2187 = casadi.fabs(t2186)
     t2188 = (t2187 >= 1)
-    t2189 = casadi.fabs(1/casadi.if_else(t2188, t2186, 1))
+    t2189 = 1/casadi.fabs(casadi.if_else(t2188, t2186, 1))
     t2190 = casadi.if_else(t2185, casadi.if_else((t2186 >= 0), 1, -1)*casadi.if_else(t2188, t2189/(1 + casadi.sqrt(1 + t2189**2)), 1/(t2187 + casadi.sqrt(1 + t2187**2))), 0)
     t2191 = 1/casadi.sqrt(1 + t2190**2)
     t2192 = t2184*t2190
@@ -6405,10 +6405,10 @@ def _condition_number(q):
     t2218 = t2216 + t2190*t2215
     t2219 = t2163*t2198 + t2167*t2202 + t2171*t2206 + t2175*t2210 + t2179*t2214 + t2183*t2218
     t2220 = (t2219 != 0)
-    t2221 = 0.5*(-t2159 + t2194)/casadi.if_else(t2220, t2219, 1)
+    t2221 = (-t2159 + t2194)/casadi.if_else(t2220, 2*t2219, 1)
     t2222 = casadi.fabs(t2221)
     t2223 = (t2222 >= 1)
-    t2224 = casadi.fabs(1/casadi.if_else(t2223, t2221, 1))
+    t2224 = 1/casadi.fabs(casadi.if_else(t2223, t2221, 1))
     t2225 = casadi.if_else(t2220, casadi.if_else((t2221 >= 0), 1, -1)*casadi.if_else(t2223, t2224/(1 + casadi.sqrt(1 + t2224**2)), 1/(t2222 + casadi.sqrt(1 + t2222**2))), 0)
     t2226 = 1/casadi.sqrt(1 + t2225**2)
     t2227 = t2219*t2225
@@ -6439,10 +6439,10 @@ def _condition_number(q):
     t2252 = t2250 - t2225*t2251
     t2253 = t2251 + t2225*t2250
     t2254 = (t2044 != 0)
-    t2255 = 0.5*(-t1878 + t2018)/casadi.if_else(t2254, t2044, 1)
+    t2255 = (-t1878 + t2018)/casadi.if_else(t2254, 2*t2044, 1)
     t2256 = casadi.fabs(t2255)
     t2257 = (t2256 >= 1)
-    t2258 = casadi.fabs(1/casadi.if_else(t2257, t2255, 1))
+    t2258 = 1/casadi.fabs(casadi.if_else(t2257, t2255, 1))
     t2259 = casadi.if_else(t2254, casadi.if_else((t2255 >= 0), 1, -1)*casadi.if_else(t2257, t2258/(1 + casadi.sqrt(1 + t2258**2)), 1/(t2256 + casadi.sqrt(1 + t2256**2))), 0)
     t2260 = 1/casadi.sqrt(1 + t2259**2)
     t2261 = t2044*t2259
@@ -6474,10 +6474,10 @@ def _condition_number(q):
     t2287 = t2285 + t2259*t2284
     t2288 = t2128*t2266 + t2132*t2270 + t2136*t2274 + t2140*t2278 + t2144*t2282 + t2148*t2286
     t2289 = (t2288 != 0)
-    t2290 = 0.5*(-t2262 + t2124)/casadi.if_else(t2289, t2288, 1)
+    t2290 = (-t2262 + t2124)/casadi.if_else(t2289, 2*t2288, 1)
     t2291 = casadi.fabs(t2290)
     t2292 = (t2291 >= 1)
-    t2293 = casadi.fabs(1/casadi.if_else(t2292, t2290, 1))
+    t2293 = 1/casadi.fabs(casadi.if_else(t2292, t2290, 1))
     t2294 = casadi.if_else(t2289, casadi.if_else((t2290 >= 0), 1, -1)*casadi.if_else(t2292, t2293/(1 + casadi.sqrt(1 + t2293**2)), 1/(t2291 + casadi.sqrt(1 + t2291**2))), 0)
     t2295 = 1/casadi.sqrt(1 + t2294**2)
     t2296 = t2288*t2294
@@ -6510,10 +6510,10 @@ def _condition_number(q):
     t2323 = t2197*t2301 + t2201*t2305 + t2205*t2309 + t2209*t2313 + t2213*t2317 + t2217*t2321
     t2324 = t2267*t2302 + t2271*t2306 + t2275*t2310 + t2279*t2314 + t2283*t2318 + t2287*t2322
     t2325 = (t2323 != 0)
-    t2326 = 0.5*(-t2297 + t2193)/casadi.if_else(t2325, t2323, 1)
+    t2326 = (-t2297 + t2193)/casadi.if_else(t2325, 2*t2323, 1)
     t2327 = casadi.fabs(t2326)
     t2328 = (t2327 >= 1)
-    t2329 = casadi.fabs(1/casadi.if_else(t2328, t2326, 1))
+    t2329 = 1/casadi.fabs(casadi.if_else(t2328, t2326, 1))
     t2330 = casadi.if_else(t2325, casadi.if_else((t2326 >= 0), 1, -1)*casadi.if_else(t2328, t2329/(1 + casadi.sqrt(1 + t2329**2)), 1/(t2327 + casadi.sqrt(1 + t2327**2))), 0)
     t2331 = 1/casadi.sqrt(1 + t2330**2)
     t2332 = t2323*t2330
@@ -6545,10 +6545,10 @@ def _condition_number(q):
     t2358 = t2356 + t2330*t2355
     t2359 = t2232*t2337 + t2236*t2341 + t2240*t2345 + t2244*t2349 + t2248*t2353 + t2252*t2357
     t2360 = (t2359 != 0)
-    t2361 = 0.5*(-t2333 + t2228)/casadi.if_else(t2360, t2359, 1)
+    t2361 = (-t2333 + t2228)/casadi.if_else(t2360, 2*t2359, 1)
     t2362 = casadi.fabs(t2361)
     t2363 = (t2362 >= 1)
-    t2364 = casadi.fabs(1/casadi.if_else(t2363, t2361, 1))
+    t2364 = 1/casadi.fabs(casadi.if_else(t2363, t2361, 1))
     t2365 = casadi.if_else(t2360, casadi.if_else((t2361 >= 0), 1, -1)*casadi.if_else(t2363, t2364/(1 + casadi.sqrt(1 + t2364**2)), 1/(t2362 + casadi.sqrt(1 + t2362**2))), 0)
     t2366 = 1/casadi.sqrt(1 + t2365**2)
     t2367 = t2359*t2365
@@ -6580,10 +6580,10 @@ def _condition_number(q):
     t2393 = t2391 + t2365*t2390
     t2394 = t2233*t2372 + t2237*t2376 + t2241*t2380 + t2245*t2384 + t2249*t2388 + t2253*t2392
     t2395 = (t2394 != 0)
-    t2396 = 0.5*(-t2368 + t2229)/casadi.if_else(t2395, t2394, 1)
+    t2396 = (-t2368 + t2229)/casadi.if_else(t2395, 2*t2394, 1)
     t2397 = casadi.fabs(t2396)
     t2398 = (t2397 >= 1)
-    t2399 = casadi.fabs(1/casadi.if_else(t2398, t2396, 1))
+    t2399 = 1/casadi.fabs(casadi.if_else(t2398, t2396, 1))
     t2400 = casadi.if_else(t2395, casadi.if_else((t2396 >= 0), 1, -1)*casadi.if_else(t2398, t2399/(1 + casadi.sqrt(1 + t2399**2)), 1/(t2397 + casadi.sqrt(1 + t2397**2))), 0)
     t2401 = 1/casadi.sqrt(1 + t2400**2)
     t2402 = t2394*t2400
@@ -6614,10 +6614,10 @@ def _condition_number(q):
     t2427 = t2425 - t2400*t2426
     t2428 = t2426 + t2400*t2425
     t2429 = (t2324 != 0)
-    t2430 = 0.5*(-t2263 + t2298)/casadi.if_else(t2429, t2324, 1)
+    t2430 = (-t2263 + t2298)/casadi.if_else(t2429, 2*t2324, 1)
     t2431 = casadi.fabs(t2430)
     t2432 = (t2431 >= 1)
-    t2433 = casadi.fabs(1/casadi.if_else(t2432, t2430, 1))
+    t2433 = 1/casadi.fabs(casadi.if_else(t2432, t2430, 1))
     t2434 = casadi.if_else(t2429, casadi.if_else((t2430 >= 0), 1, -1)*casadi.if_else(t2432, t2433/(1 + casadi.sqrt(1 + t2433**2)), 1/(t2431 + casadi.sqrt(1 + t2431**2))), 0)
     t2435 = 1/casadi.sqrt(1 + t2434**2)
     t2436 = t2324*t2434
@@ -6649,10 +6649,10 @@ def _condition_number(q):
     t2462 = t2460 + t2434*t2459
     t2463 = t2338*t2441 + t2342*t2445 + t2346*t2449 + t2350*t2453 + t2354*t2457 + t2358*t2461
     t2464 = (t2463 != 0)
-    t2465 = 0.5*(-t2437 + t2334)/casadi.if_else(t2464, t2463, 1)
+    t2465 = (-t2437 + t2334)/casadi.if_else(t2464, 2*t2463, 1)
     t2466 = casadi.fabs(t2465)
     t2467 = (t2466 >= 1)
-    t2468 = casadi.fabs(1/casadi.if_else(t2467, t2465, 1))
+    t2468 = 1/casadi.fabs(casadi.if_else(t2467, t2465, 1))
     t2469 = casadi.if_else(t2464, casadi.if_else((t2465 >= 0), 1, -1)*casadi.if_else(t2467, t2468/(1 + casadi.sqrt(1 + t2468**2)), 1/(t2466 + casadi.sqrt(1 + t2466**2))), 0)
     t2470 = 1/casadi.sqrt(1 + t2469**2)
     t2471 = t2463*t2469
@@ -6685,10 +6685,10 @@ def _condition_number(q):
     t2498 = t2373*t2476 + t2377*t2480 + t2381*t2484 + t2385*t2488 + t2389*t2492 + t2393*t2496
     t2499 = t2442*t2477 + t2446*t2481 + t2450*t2485 + t2454*t2489 + t2458*t2493 + t2462*t2497
     t2500 = (t2498 != 0)
-    t2501 = 0.5*(-t2472 + t2369)/casadi.if_else(t2500, t2498, 1)
+    t2501 = (-t2472 + t2369)/casadi.if_else(t2500, 2*t2498, 1)
     t2502 = casadi.fabs(t2501)
     t2503 = (t2502 >= 1)
-    t2504 = casadi.fabs(1/casadi.if_else(t2503, t2501, 1))
+    t2504 = 1/casadi.fabs(casadi.if_else(t2503, t2501, 1))
     t2505 = casadi.if_else(t2500, casadi.if_else((t2501 >= 0), 1, -1)*casadi.if_else(t2503, t2504/(1 + casadi.sqrt(1 + t2504**2)), 1/(t2502 + casadi.sqrt(1 + t2502**2))), 0)
     t2506 = 1/casadi.sqrt(1 + t2505**2)
     t2507 = t2498*t2505
@@ -6720,10 +6720,10 @@ def _condition_number(q):
     t2533 = t2531 + t2505*t2530
     t2534 = t2408*t2512 + t2412*t2516 + t2416*t2520 + t2420*t2524 + t2424*t2528 + t2428*t2532
     t2535 = (t2534 != 0)
-    t2536 = 0.5*(-t2508 + t2404)/casadi.if_else(t2535, t2534, 1)
+    t2536 = (-t2508 + t2404)/casadi.if_else(t2535, 2*t2534, 1)
     t2537 = casadi.fabs(t2536)
     t2538 = (t2537 >= 1)
-    t2539 = casadi.fabs(1/casadi.if_else(t2538, t2536, 1))
+    t2539 = 1/casadi.fabs(casadi.if_else(t2538, t2536, 1))
     t2540 = casadi.if_else(t2535, casadi.if_else((t2536 >= 0), 1, -1)*casadi.if_else(t2538, t2539/(1 + casadi.sqrt(1 + t2539**2)), 1/(t2537 + casadi.sqrt(1 + t2537**2))), 0)
     t2541 = 1/casadi.sqrt(1 + t2540**2)
     t2542 = t2534*t2540
@@ -6755,10 +6755,10 @@ def _condition_number(q):
     t2568 = t2566 + t2540*t2565
     t2569 = t2407*t2547 + t2411*t2551 + t2415*t2555 + t2419*t2559 + t2423*t2563 + t2427*t2567
     t2570 = (t2499 != 0)
-    t2571 = 0.5*(-t2438 + t2473)/casadi.if_else(t2570, t2499, 1)
+    t2571 = (-t2438 + t2473)/casadi.if_else(t2570, 2*t2499, 1)
     t2572 = casadi.fabs(t2571)
     t2573 = (t2572 >= 1)
-    t2574 = casadi.fabs(1/casadi.if_else(t2573, t2571, 1))
+    t2574 = 1/casadi.fabs(casadi.if_else(t2573, t2571, 1))
     t2575 = casadi.if_else(t2570, casadi.if_else((t2571 >= 0), 1, -1)*casadi.if_else(t2573, t2574/(1 + casadi.sqrt(1 + t2574**2)), 1/(t2572 + casadi.sqrt(1 + t2572**2))), 0)
     t2576 = 1/casadi.sqrt(1 + t2575**2)
     t2577 = t2499*t2575
@@ -6790,10 +6790,10 @@ def _condition_number(q):
     t2603 = t2601 + t2575*t2600
     t2604 = t2513*t2582 + t2517*t2586 + t2521*t2590 + t2525*t2594 + t2529*t2598 + t2533*t2602
     t2605 = (t2604 != 0)
-    t2606 = 0.5*(-t2578 + t2509)/casadi.if_else(t2605, t2604, 1)
+    t2606 = (-t2578 + t2509)/casadi.if_else(t2605, 2*t2604, 1)
     t2607 = casadi.fabs(t2606)
     t2608 = (t2607 >= 1)
-    t2609 = casadi.fabs(1/casadi.if_else(t2608, t2606, 1))
+    t2609 = 1/casadi.fabs(casadi.if_else(t2608, t2606, 1))
     t2610 = casadi.if_else(t2605, casadi.if_else((t2606 >= 0), 1, -1)*casadi.if_else(t2608, t2609/(1 + casadi.sqrt(1 + t2609**2)), 1/(t2607 + casadi.sqrt(1 + t2607**2))), 0)
     t2611 = 1/casadi.sqrt(1 + t2610**2)
     t2612 = t2604*t2610
@@ -6826,10 +6826,10 @@ def _condition_number(q):
     t2639 = t2548*t2617 + t2552*t2621 + t2556*t2625 + t2560*t2629 + t2564*t2633 + t2568*t2637
     t2640 = t2583*t2618 + t2587*t2622 + t2591*t2626 + t2595*t2630 + t2599*t2634 + t2603*t2638
     t2641 = (t2639 != 0)
-    t2642 = 0.5*(-t2613 + t2544)/casadi.if_else(t2641, t2639, 1)
+    t2642 = (-t2613 + t2544)/casadi.if_else(t2641, 2*t2639, 1)
     t2643 = casadi.fabs(t2642)
     t2644 = (t2643 >= 1)
-    t2645 = casadi.fabs(1/casadi.if_else(t2644, t2642, 1))
+    t2645 = 1/casadi.fabs(casadi.if_else(t2644, t2642, 1))
     t2646 = casadi.if_else(t2641, casadi.if_else((t2642 >= 0), 1, -1)*casadi.if_else(t2644, t2645/(1 + casadi.sqrt(1 + t2645**2)), 1/(t2643 + casadi.sqrt(1 + t2643**2))), 0)
     t2647 = 1/casadi.sqrt(1 + t2646**2)
     t2648 = t2639*t2646
@@ -6860,10 +6860,10 @@ def _condition_number(q):
     t2673 = t2671 - t2646*t2672
     t2674 = t2672 + t2646*t2671
     t2675 = (t2640 != 0)
-    t2676 = 0.5*(-t2579 + t2614)/casadi.if_else(t2675, t2640, 1)
+    t2676 = (-t2579 + t2614)/casadi.if_else(t2675, 2*t2640, 1)
     t2677 = casadi.fabs(t2676)
     t2678 = (t2677 >= 1)
-    t2679 = casadi.fabs(1/casadi.if_else(t2678, t2676, 1))
+    t2679 = 1/casadi.fabs(casadi.if_else(t2678, t2676, 1))
     t2680 = casadi.if_else(t2675, casadi.if_else((t2676 >= 0), 1, -1)*casadi.if_else(t2678, t2679/(1 + casadi.sqrt(1 + t2679**2)), 1/(t2677 + casadi.sqrt(1 + t2677**2))), 0)
     t2681 = 1/casadi.sqrt(1 + t2680**2)
     t2682 = t2640*t2680
@@ -6895,10 +6895,10 @@ def _condition_number(q):
     t2708 = t2706 + t2680*t2705
     t2709 = t2654*t2687 + t2658*t2691 + t2662*t2695 + t2666*t2699 + t2670*t2703 + t2674*t2707
     t2710 = (t2709 != 0)
-    t2711 = 0.5*(-t2683 + t2650)/casadi.if_else(t2710, t2709, 1)
+    t2711 = (-t2683 + t2650)/casadi.if_else(t2710, 2*t2709, 1)
     t2712 = casadi.fabs(t2711)
     t2713 = (t2712 >= 1)
-    t2714 = casadi.fabs(1/casadi.if_else(t2713, t2711, 1))
+    t2714 = 1/casadi.fabs(casadi.if_else(t2713, t2711, 1))
     t2715 = casadi.if_else(t2710, casadi.if_else((t2711 >= 0), 1, -1)*casadi.if_else(t2713, t2714/(1 + casadi.sqrt(1 + t2714**2)), 1/(t2712 + casadi.sqrt(1 + t2712**2))), 0)
     t2716 = 1/casadi.sqrt(1 + t2715**2)
     t2717 = t2709*t2715
@@ -6930,10 +6930,10 @@ def _condition_number(q):
     t2743 = t2741 + t2715*t2740
     t2744 = t2688*t2723 + t2692*t2727 + t2696*t2731 + t2700*t2735 + t2704*t2739 + t2708*t2743
     t2745 = (t2744 != 0)
-    t2746 = 0.5*(-t2684 + t2719)/casadi.if_else(t2745, t2744, 1)
+    t2746 = (-t2684 + t2719)/casadi.if_else(t2745, 2*t2744, 1)
     t2747 = casadi.fabs(t2746)
     t2748 = (t2747 >= 1)
-    t2749 = casadi.fabs(1/casadi.if_else(t2748, t2746, 1))
+    t2749 = 1/casadi.fabs(casadi.if_else(t2748, t2746, 1))
     t2750 = casadi.if_else(t2745, casadi.if_else((t2746 >= 0), 1, -1)*casadi.if_else(t2748, t2749/(1 + casadi.sqrt(1 + t2749**2)), 1/(t2747 + casadi.sqrt(1 + t2747**2))), 0)
     t2751 = 1/casadi.sqrt(1 + t2750**2)
     t2752 = t2744*t2750
@@ -6964,10 +6964,10 @@ def _condition_number(q):
     t2777 = t2775 - t2750*t2776
     t2778 = t2776 + t2750*t2775
     t2779 = (t2569 != 0)
-    t2780 = 0.5*(-t2403 + t2543)/casadi.if_else(t2779, t2569, 1)
+    t2780 = (-t2403 + t2543)/casadi.if_else(t2779, 2*t2569, 1)
     t2781 = casadi.fabs(t2780)
     t2782 = (t2781 >= 1)
-    t2783 = casadi.fabs(1/casadi.if_else(t2782, t2780, 1))
+    t2783 = 1/casadi.fabs(casadi.if_else(t2782, t2780, 1))
     t2784 = casadi.if_else(t2779, casadi.if_else((t2780 >= 0), 1, -1)*casadi.if_else(t2782, t2783/(1 + casadi.sqrt(1 + t2783**2)), 1/(t2781 + casadi.sqrt(1 + t2781**2))), 0)
     t2785 = 1/casadi.sqrt(1 + t2784**2)
     t2786 = t2569*t2784
@@ -6999,10 +6999,10 @@ def _condition_number(q):
     t2812 = t2810 + t2784*t2809
     t2813 = t2653*t2791 + t2657*t2795 + t2661*t2799 + t2665*t2803 + t2669*t2807 + t2673*t2811
     t2814 = (t2813 != 0)
-    t2815 = 0.5*(-t2787 + t2649)/casadi.if_else(t2814, t2813, 1)
+    t2815 = (-t2787 + t2649)/casadi.if_else(t2814, 2*t2813, 1)
     t2816 = casadi.fabs(t2815)
     t2817 = (t2816 >= 1)
-    t2818 = casadi.fabs(1/casadi.if_else(t2817, t2815, 1))
+    t2818 = 1/casadi.fabs(casadi.if_else(t2817, t2815, 1))
     t2819 = casadi.if_else(t2814, casadi.if_else((t2815 >= 0), 1, -1)*casadi.if_else(t2817, t2818/(1 + casadi.sqrt(1 + t2818**2)), 1/(t2816 + casadi.sqrt(1 + t2816**2))), 0)
     t2820 = 1/casadi.sqrt(1 + t2819**2)
     t2821 = t2813*t2819
@@ -7035,10 +7035,10 @@ def _condition_number(q):
     t2848 = t2722*t2826 + t2726*t2830 + t2730*t2834 + t2734*t2838 + t2738*t2842 + t2742*t2846
     t2849 = t2792*t2827 + t2796*t2831 + t2800*t2835 + t2804*t2839 + t2808*t2843 + t2812*t2847
     t2850 = (t2848 != 0)
-    t2851 = 0.5*(-t2822 + t2718)/casadi.if_else(t2850, t2848, 1)
+    t2851 = (-t2822 + t2718)/casadi.if_else(t2850, 2*t2848, 1)
     t2852 = casadi.fabs(t2851)
     t2853 = (t2852 >= 1)
-    t2854 = casadi.fabs(1/casadi.if_else(t2853, t2851, 1))
+    t2854 = 1/casadi.fabs(casadi.if_else(t2853, t2851, 1))
     t2855 = casadi.if_else(t2850, casadi.if_else((t2851 >= 0), 1, -1)*casadi.if_else(t2853, t2854/(1 + casadi.sqrt(1 + t2854**2)), 1/(t2852 + casadi.sqrt(1 + t2852**2))), 0)
     t2856 = 1/casadi.sqrt(1 + t2855**2)
     t2857 = t2848*t2855
@@ -7070,10 +7070,10 @@ def _condition_number(q):
     t2883 = t2881 + t2855*t2880
     t2884 = t2757*t2862 + t2761*t2866 + t2765*t2870 + t2769*t2874 + t2773*t2878 + t2777*t2882
     t2885 = (t2884 != 0)
-    t2886 = 0.5*(-t2858 + t2753)/casadi.if_else(t2885, t2884, 1)
+    t2886 = (-t2858 + t2753)/casadi.if_else(t2885, 2*t2884, 1)
     t2887 = casadi.fabs(t2886)
     t2888 = (t2887 >= 1)
-    t2889 = casadi.fabs(1/casadi.if_else(t2888, t2886, 1))
+    t2889 = 1/casadi.fabs(casadi.if_else(t2888, t2886, 1))
     t2890 = casadi.if_else(t2885, casadi.if_else((t2886 >= 0), 1, -1)*casadi.if_else(t2888, t2889/(1 + casadi.sqrt(1 + t2889**2)), 1/(t2887 + casadi.sqrt(1 + t2887**2))), 0)
     t2891 = 1/casadi.sqrt(1 + t2890**2)
     t2892 = t2884*t2890
@@ -7105,10 +7105,10 @@ def _condition_number(q):
     t2918 = t2916 + t2890*t2915
     t2919 = t2758*t2897 + t2762*t2901 + t2766*t2905 + t2770*t2909 + t2774*t2913 + t2778*t2917
     t2920 = (t2919 != 0)
-    t2921 = 0.5*(-t2893 + t2754)/casadi.if_else(t2920, t2919, 1)
+    t2921 = (-t2893 + t2754)/casadi.if_else(t2920, 2*t2919, 1)
     t2922 = casadi.fabs(t2921)
     t2923 = (t2922 >= 1)
-    t2924 = casadi.fabs(1/casadi.if_else(t2923, t2921, 1))
+    t2924 = 1/casadi.fabs(casadi.if_else(t2923, t2921, 1))
     t2925 = casadi.if_else(t2920, casadi.if_else((t2921 >= 0), 1, -1)*casadi.if_else(t2923, t2924/(1 + casadi.sqrt(1 + t2924**2)), 1/(t2922 + casadi.sqrt(1 + t2922**2))), 0)
     t2926 = 1/casadi.sqrt(1 + t2925**2)
     t2927 = t2919*t2925
@@ -7139,10 +7139,10 @@ def _condition_number(q):
     t2952 = t2950 - t2925*t2951
     t2953 = t2951 + t2925*t2950
     t2954 = (t2849 != 0)
-    t2955 = 0.5*(-t2788 + t2823)/casadi.if_else(t2954, t2849, 1)
+    t2955 = (-t2788 + t2823)/casadi.if_else(t2954, 2*t2849, 1)
     t2956 = casadi.fabs(t2955)
     t2957 = (t2956 >= 1)
-    t2958 = casadi.fabs(1/casadi.if_else(t2957, t2955, 1))
+    t2958 = 1/casadi.fabs(casadi.if_else(t2957, t2955, 1))
     t2959 = casadi.if_else(t2954, casadi.if_else((t2955 >= 0), 1, -1)*casadi.if_else(t2957, t2958/(1 + casadi.sqrt(1 + t2958**2)), 1/(t2956 + casadi.sqrt(1 + t2956**2))), 0)
     t2960 = 1/casadi.sqrt(1 + t2959**2)
     t2961 = t2849*t2959
@@ -7174,10 +7174,10 @@ def _condition_number(q):
     t2987 = t2985 + t2959*t2984
     t2988 = t2863*t2966 + t2867*t2970 + t2871*t2974 + t2875*t2978 + t2879*t2982 + t2883*t2986
     t2989 = (t2988 != 0)
-    t2990 = 0.5*(-t2962 + t2859)/casadi.if_else(t2989, t2988, 1)
+    t2990 = (-t2962 + t2859)/casadi.if_else(t2989, 2*t2988, 1)
     t2991 = casadi.fabs(t2990)
     t2992 = (t2991 >= 1)
-    t2993 = casadi.fabs(1/casadi.if_else(t2992, t2990, 1))
+    t2993 = 1/casadi.fabs(casadi.if_else(t2992, t2990, 1))
     t2994 = casadi.if_else(t2989, casadi.if_else((t2990 >= 0), 1, -1)*casadi.if_else(t2992, t2993/(1 + casadi.sqrt(1 + t2993**2)), 1/(t2991 + casadi.sqrt(1 + t2991**2))), 0)
     t2995 = 1/casadi.sqrt(1 + t2994**2)
     t2996 = t2988*t2994
@@ -7210,10 +7210,10 @@ def _condition_number(q):
     t3023 = t2898*t3001 + t2902*t3005 + t2906*t3009 + t2910*t3013 + t2914*t3017 + t2918*t3021
     t3024 = t2967*t3002 + t2971*t3006 + t2975*t3010 + t2979*t3014 + t2983*t3018 + t2987*t3022
     t3025 = (t3023 != 0)
-    t3026 = 0.5*(-t2997 + t2894)/casadi.if_else(t3025, t3023, 1)
+    t3026 = (-t2997 + t2894)/casadi.if_else(t3025, 2*t3023, 1)
     t3027 = casadi.fabs(t3026)
     t3028 = (t3027 >= 1)
-    t3029 = casadi.fabs(1/casadi.if_else(t3028, t3026, 1))
+    t3029 = 1/casadi.fabs(casadi.if_else(t3028, t3026, 1))
     t3030 = casadi.if_else(t3025, casadi.if_else((t3026 >= 0), 1, -1)*casadi.if_else(t3028, t3029/(1 + casadi.sqrt(1 + t3029**2)), 1/(t3027 + casadi.sqrt(1 + t3027**2))), 0)
     t3031 = 1/casadi.sqrt(1 + t3030**2)
     t3032 = t3023*t3030
@@ -7245,10 +7245,10 @@ def _condition_number(q):
     t3058 = t3056 + t3030*t3055
     t3059 = t2933*t3037 + t2937*t3041 + t2941*t3045 + t2945*t3049 + t2949*t3053 + t2953*t3057
     t3060 = (t3059 != 0)
-    t3061 = 0.5*(-t3033 + t2929)/casadi.if_else(t3060, t3059, 1)
+    t3061 = (-t3033 + t2929)/casadi.if_else(t3060, 2*t3059, 1)
     t3062 = casadi.fabs(t3061)
     t3063 = (t3062 >= 1)
-    t3064 = casadi.fabs(1/casadi.if_else(t3063, t3061, 1))
+    t3064 = 1/casadi.fabs(casadi.if_else(t3063, t3061, 1))
     t3065 = casadi.if_else(t3060, casadi.if_else((t3061 >= 0), 1, -1)*casadi.if_else(t3063, t3064/(1 + casadi.sqrt(1 + t3064**2)), 1/(t3062 + casadi.sqrt(1 + t3062**2))), 0)
     t3066 = 1/casadi.sqrt(1 + t3065**2)
     t3067 = t3059*t3065
@@ -7280,10 +7280,10 @@ def _condition_number(q):
     t3093 = t3091 + t3065*t3090
     t3094 = t2932*t3072 + t2936*t3076 + t2940*t3080 + t2944*t3084 + t2948*t3088 + t2952*t3092
     t3095 = (t3024 != 0)
-    t3096 = 0.5*(-t2963 + t2998)/casadi.if_else(t3095, t3024, 1)
+    t3096 = (-t2963 + t2998)/casadi.if_else(t3095, 2*t3024, 1)
     t3097 = casadi.fabs(t3096)
     t3098 = (t3097 >= 1)
-    t3099 = casadi.fabs(1/casadi.if_else(t3098, t3096, 1))
+    t3099 = 1/casadi.fabs(casadi.if_else(t3098, t3096, 1))
     t3100 = casadi.if_else(t3095, casadi.if_else((t3096 >= 0), 1, -1)*casadi.if_else(t3098, t3099/(1 + casadi.sqrt(1 + t3099**2)), 1/(t3097 + casadi.sqrt(1 + t3097**2))), 0)
     t3101 = 1/casadi.sqrt(1 + t3100**2)
     t3102 = t3024*t3100
@@ -7315,10 +7315,10 @@ def _condition_number(q):
     t3128 = t3126 + t3100*t3125
     t3129 = t3038*t3107 + t3042*t3111 + t3046*t3115 + t3050*t3119 + t3054*t3123 + t3058*t3127
     t3130 = (t3129 != 0)
-    t3131 = 0.5*(-t3103 + t3034)/casadi.if_else(t3130, t3129, 1)
+    t3131 = (-t3103 + t3034)/casadi.if_else(t3130, 2*t3129, 1)
     t3132 = casadi.fabs(t3131)
     t3133 = (t3132 >= 1)
-    t3134 = casadi.fabs(1/casadi.if_else(t3133, t3131, 1))
+    t3134 = 1/casadi.fabs(casadi.if_else(t3133, t3131, 1))
     t3135 = casadi.if_else(t3130, casadi.if_else((t3131 >= 0), 1, -1)*casadi.if_else(t3133, t3134/(1 + casadi.sqrt(1 + t3134**2)), 1/(t3132 + casadi.sqrt(1 + t3132**2))), 0)
     t3136 = 1/casadi.sqrt(1 + t3135**2)
     t3137 = t3129*t3135
@@ -7351,10 +7351,10 @@ def _condition_number(q):
     t3164 = t3073*t3142 + t3077*t3146 + t3081*t3150 + t3085*t3154 + t3089*t3158 + t3093*t3162
     t3165 = t3108*t3143 + t3112*t3147 + t3116*t3151 + t3120*t3155 + t3124*t3159 + t3128*t3163
     t3166 = (t3164 != 0)
-    t3167 = 0.5*(-t3138 + t3069)/casadi.if_else(t3166, t3164, 1)
+    t3167 = (-t3138 + t3069)/casadi.if_else(t3166, 2*t3164, 1)
     t3168 = casadi.fabs(t3167)
     t3169 = (t3168 >= 1)
-    t3170 = casadi.fabs(1/casadi.if_else(t3169, t3167, 1))
+    t3170 = 1/casadi.fabs(casadi.if_else(t3169, t3167, 1))
     t3171 = casadi.if_else(t3166, casadi.if_else((t3167 >= 0), 1, -1)*casadi.if_else(t3169, t3170/(1 + casadi.sqrt(1 + t3170**2)), 1/(t3168 + casadi.sqrt(1 + t3168**2))), 0)
     t3172 = 1/casadi.sqrt(1 + t3171**2)
     t3173 = t3164*t3171
@@ -7385,10 +7385,10 @@ def _condition_number(q):
     t3198 = t3196 - t3171*t3197
     t3199 = t3197 + t3171*t3196
     t3200 = (t3165 != 0)
-    t3201 = 0.5*(-t3104 + t3139)/casadi.if_else(t3200, t3165, 1)
+    t3201 = (-t3104 + t3139)/casadi.if_else(t3200, 2*t3165, 1)
     t3202 = casadi.fabs(t3201)
     t3203 = (t3202 >= 1)
-    t3204 = casadi.fabs(1/casadi.if_else(t3203, t3201, 1))
+    t3204 = 1/casadi.fabs(casadi.if_else(t3203, t3201, 1))
     t3205 = casadi.if_else(t3200, casadi.if_else((t3201 >= 0), 1, -1)*casadi.if_else(t3203, t3204/(1 + casadi.sqrt(1 + t3204**2)), 1/(t3202 + casadi.sqrt(1 + t3202**2))), 0)
     t3206 = 1/casadi.sqrt(1 + t3205**2)
     t3207 = t3165*t3205
@@ -7420,10 +7420,10 @@ def _condition_number(q):
     t3233 = t3231 + t3205*t3230
     t3234 = t3179*t3212 + t3183*t3216 + t3187*t3220 + t3191*t3224 + t3195*t3228 + t3199*t3232
     t3235 = (t3234 != 0)
-    t3236 = 0.5*(-t3208 + t3175)/casadi.if_else(t3235, t3234, 1)
+    t3236 = (-t3208 + t3175)/casadi.if_else(t3235, 2*t3234, 1)
     t3237 = casadi.fabs(t3236)
     t3238 = (t3237 >= 1)
-    t3239 = casadi.fabs(1/casadi.if_else(t3238, t3236, 1))
+    t3239 = 1/casadi.fabs(casadi.if_else(t3238, t3236, 1))
     t3240 = casadi.if_else(t3235, casadi.if_else((t3236 >= 0), 1, -1)*casadi.if_else(t3238, t3239/(1 + casadi.sqrt(1 + t3239**2)), 1/(t3237 + casadi.sqrt(1 + t3237**2))), 0)
     t3241 = 1/casadi.sqrt(1 + t3240**2)
     t3242 = t3234*t3240
@@ -7455,10 +7455,10 @@ def _condition_number(q):
     t3268 = t3266 + t3240*t3265
     t3269 = t3213*t3248 + t3217*t3252 + t3221*t3256 + t3225*t3260 + t3229*t3264 + t3233*t3268
     t3270 = (t3269 != 0)
-    t3271 = 0.5*(-t3209 + t3244)/casadi.if_else(t3270, t3269, 1)
+    t3271 = (-t3209 + t3244)/casadi.if_else(t3270, 2*t3269, 1)
     t3272 = casadi.fabs(t3271)
     t3273 = (t3272 >= 1)
-    t3274 = casadi.fabs(1/casadi.if_else(t3273, t3271, 1))
+    t3274 = 1/casadi.fabs(casadi.if_else(t3273, t3271, 1))
     t3275 = casadi.if_else(t3270, casadi.if_else((t3271 >= 0), 1, -1)*casadi.if_else(t3273, t3274/(1 + casadi.sqrt(1 + t3274**2)), 1/(t3272 + casadi.sqrt(1 + t3272**2))), 0)
     t3276 = 1/casadi.sqrt(1 + t3275**2)
     t3277 = t3269*t3275
@@ -7489,10 +7489,10 @@ def _condition_number(q):
     t3302 = t3300 - t3275*t3301
     t3303 = t3301 + t3275*t3300
     t3304 = (t3094 != 0)
-    t3305 = 0.5*(-t2928 + t3068)/casadi.if_else(t3304, t3094, 1)
+    t3305 = (-t2928 + t3068)/casadi.if_else(t3304, 2*t3094, 1)
     t3306 = casadi.fabs(t3305)
     t3307 = (t3306 >= 1)
-    t3308 = casadi.fabs(1/casadi.if_else(t3307, t3305, 1))
+    t3308 = 1/casadi.fabs(casadi.if_else(t3307, t3305, 1))
     t3309 = casadi.if_else(t3304, casadi.if_else((t3305 >= 0), 1, -1)*casadi.if_else(t3307, t3308/(1 + casadi.sqrt(1 + t3308**2)), 1/(t3306 + casadi.sqrt(1 + t3306**2))), 0)
     t3310 = 1/casadi.sqrt(1 + t3309**2)
     t3311 = t3094*t3309
@@ -7524,10 +7524,10 @@ def _condition_number(q):
     t3337 = t3335 + t3309*t3334
     t3338 = t3178*t3316 + t3182*t3320 + t3186*t3324 + t3190*t3328 + t3194*t3332 + t3198*t3336
     t3339 = (t3338 != 0)
-    t3340 = 0.5*(-t3312 + t3174)/casadi.if_else(t3339, t3338, 1)
+    t3340 = (-t3312 + t3174)/casadi.if_else(t3339, 2*t3338, 1)
     t3341 = casadi.fabs(t3340)
     t3342 = (t3341 >= 1)
-    t3343 = casadi.fabs(1/casadi.if_else(t3342, t3340, 1))
+    t3343 = 1/casadi.fabs(casadi.if_else(t3342, t3340, 1))
     t3344 = casadi.if_else(t3339, casadi.if_else((t3340 >= 0), 1, -1)*casadi.if_else(t3342, t3343/(1 + casadi.sqrt(1 + t3343**2)), 1/(t3341 + casadi.sqrt(1 + t3341**2))), 0)
     t3345 = 1/casadi.sqrt(1 + t3344**2)
     t3346 = t3338*t3344
@@ -7560,10 +7560,10 @@ def _condition_number(q):
     t3373 = t3247*t3351 + t3251*t3355 + t3255*t3359 + t3259*t3363 + t3263*t3367 + t3267*t3371
     t3374 = t3317*t3352 + t3321*t3356 + t3325*t3360 + t3329*t3364 + t3333*t3368 + t3337*t3372
     t3375 = (t3373 != 0)
-    t3376 = 0.5*(-t3347 + t3243)/casadi.if_else(t3375, t3373, 1)
+    t3376 = (-t3347 + t3243)/casadi.if_else(t3375, 2*t3373, 1)
     t3377 = casadi.fabs(t3376)
     t3378 = (t3377 >= 1)
-    t3379 = casadi.fabs(1/casadi.if_else(t3378, t3376, 1))
+    t3379 = 1/casadi.fabs(casadi.if_else(t3378, t3376, 1))
     t3380 = casadi.if_else(t3375, casadi.if_else((t3376 >= 0), 1, -1)*casadi.if_else(t3378, t3379/(1 + casadi.sqrt(1 + t3379**2)), 1/(t3377 + casadi.sqrt(1 + t3377**2))), 0)
     t3381 = 1/casadi.sqrt(1 + t3380**2)
     t3382 = t3373*t3380
@@ -7595,10 +7595,10 @@ def _condition_number(q):
     t3408 = t3406 + t3380*t3405
     t3409 = t3282*t3387 + t3286*t3391 + t3290*t3395 + t3294*t3399 + t3298*t3403 + t3302*t3407
     t3410 = (t3409 != 0)
-    t3411 = 0.5*(-t3383 + t3278)/casadi.if_else(t3410, t3409, 1)
+    t3411 = (-t3383 + t3278)/casadi.if_else(t3410, 2*t3409, 1)
     t3412 = casadi.fabs(t3411)
     t3413 = (t3412 >= 1)
-    t3414 = casadi.fabs(1/casadi.if_else(t3413, t3411, 1))
+    t3414 = 1/casadi.fabs(casadi.if_else(t3413, t3411, 1))
     t3415 = casadi.if_else(t3410, casadi.if_else((t3411 >= 0), 1, -1)*casadi.if_else(t3413, t3414/(1 + casadi.sqrt(1 + t3414**2)), 1/(t3412 + casadi.sqrt(1 + t3412**2))), 0)
     t3416 = 1/casadi.sqrt(1 + t3415**2)
     t3417 = t3409*t3415
@@ -7630,10 +7630,10 @@ def _condition_number(q):
     t3443 = t3441 + t3415*t3440
     t3444 = t3283*t3422 + t3287*t3426 + t3291*t3430 + t3295*t3434 + t3299*t3438 + t3303*t3442
     t3445 = (t3444 != 0)
-    t3446 = 0.5*(-t3418 + t3279)/casadi.if_else(t3445, t3444, 1)
+    t3446 = (-t3418 + t3279)/casadi.if_else(t3445, 2*t3444, 1)
     t3447 = casadi.fabs(t3446)
     t3448 = (t3447 >= 1)
-    t3449 = casadi.fabs(1/casadi.if_else(t3448, t3446, 1))
+    t3449 = 1/casadi.fabs(casadi.if_else(t3448, t3446, 1))
     t3450 = casadi.if_else(t3445, casadi.if_else((t3446 >= 0), 1, -1)*casadi.if_else(t3448, t3449/(1 + casadi.sqrt(1 + t3449**2)), 1/(t3447 + casadi.sqrt(1 + t3447**2))), 0)
     t3451 = 1/casadi.sqrt(1 + t3450**2)
     t3452 = t3279 + t3444*t3450
@@ -7663,10 +7663,10 @@ def _condition_number(q):
     t3476 = t3474 + t3450*t3473
     t3477 = casadi.sqrt(t3455**2 + t3459**2 + t3463**2 + t3467**2 + t3471**2 + t3475**2)
     t3478 = (t3374 != 0)
-    t3479 = 0.5*(-t3313 + t3348)/casadi.if_else(t3478, t3374, 1)
+    t3479 = (-t3313 + t3348)/casadi.if_else(t3478, 2*t3374, 1)
     t3480 = casadi.fabs(t3479)
     t3481 = (t3480 >= 1)
-    t3482 = casadi.fabs(1/casadi.if_else(t3481, t3479, 1))
+    t3482 = 1/casadi.fabs(casadi.if_else(t3481, t3479, 1))
     t3483 = casadi.if_else(t3478, casadi.if_else((t3479 >= 0), 1, -1)*casadi.if_else(t3481, t3482/(1 + casadi.sqrt(1 + t3482**2)), 1/(t3480 + casadi.sqrt(1 + t3480**2))), 0)
     t3484 = 1/casadi.sqrt(1 + t3483**2)
     t3485 = t3374*t3483
@@ -7698,10 +7698,10 @@ def _condition_number(q):
     t3511 = t3509 + t3483*t3508
     t3512 = t3388*t3490 + t3392*t3494 + t3396*t3498 + t3400*t3502 + t3404*t3506 + t3408*t3510
     t3513 = (t3512 != 0)
-    t3514 = 0.5*(-t3486 + t3384)/casadi.if_else(t3513, t3512, 1)
+    t3514 = (-t3486 + t3384)/casadi.if_else(t3513, 2*t3512, 1)
     t3515 = casadi.fabs(t3514)
     t3516 = (t3515 >= 1)
-    t3517 = casadi.fabs(1/casadi.if_else(t3516, t3514, 1))
+    t3517 = 1/casadi.fabs(casadi.if_else(t3516, t3514, 1))
     t3518 = casadi.if_else(t3513, casadi.if_else((t3514 >= 0), 1, -1)*casadi.if_else(t3516, t3517/(1 + casadi.sqrt(1 + t3517**2)), 1/(t3515 + casadi.sqrt(1 + t3515**2))), 0)
     t3519 = 1/casadi.sqrt(1 + t3518**2)
     t3520 = t3512*t3518
@@ -7734,10 +7734,10 @@ def _condition_number(q):
     t3547 = t3423*t3525 + t3427*t3529 + t3431*t3533 + t3435*t3537 + t3439*t3541 + t3443*t3545
     t3548 = t3491*t3526 + t3495*t3530 + t3499*t3534 + t3503*t3538 + t3507*t3542 + t3511*t3546
     t3549 = (t3547 != 0)
-    t3550 = 0.5*(-t3521 + t3419)/casadi.if_else(t3549, t3547, 1)
+    t3550 = (-t3521 + t3419)/casadi.if_else(t3549, 2*t3547, 1)
     t3551 = casadi.fabs(t3550)
     t3552 = (t3551 >= 1)
-    t3553 = casadi.fabs(1/casadi.if_else(t3552, t3550, 1))
+    t3553 = 1/casadi.fabs(casadi.if_else(t3552, t3550, 1))
     t3554 = casadi.if_else(t3549, casadi.if_else((t3550 >= 0), 1, -1)*casadi.if_else(t3552, t3553/(1 + casadi.sqrt(1 + t3553**2)), 1/(t3551 + casadi.sqrt(1 + t3551**2))), 0)
     t3555 = 1/casadi.sqrt(1 + t3554**2)
     t3556 = t3547*t3554
@@ -7769,10 +7769,10 @@ def _condition_number(q):
     t3582 = t3580 + t3554*t3579
     t3583 = t3456*t3561 + t3460*t3565 + t3464*t3569 + t3468*t3573 + t3472*t3577 + t3476*t3581
     t3584 = (t3583 != 0)
-    t3585 = 0.5*(-t3557 + t3452)/casadi.if_else(t3584, t3583, 1)
+    t3585 = (-t3557 + t3452)/casadi.if_else(t3584, 2*t3583, 1)
     t3586 = casadi.fabs(t3585)
     t3587 = (t3586 >= 1)
-    t3588 = casadi.fabs(1/casadi.if_else(t3587, t3585, 1))
+    t3588 = 1/casadi.fabs(casadi.if_else(t3587, t3585, 1))
     t3589 = casadi.if_else(t3584, casadi.if_else((t3585 >= 0), 1, -1)*casadi.if_else(t3587, t3588/(1 + casadi.sqrt(1 + t3588**2)), 1/(t3586 + casadi.sqrt(1 + t3586**2))), 0)
     t3590 = 1/casadi.sqrt(1 + t3589**2)
     t3591 = t3452 + t3583*t3589
@@ -7804,10 +7804,10 @@ def _condition_number(q):
     t3617 = casadi.if_else((t3616 > t3477), t3616, t3477)
     t3618 = casadi.if_else((t3616 < t3477), t3616, t3477)
     t3619 = (t3548 != 0)
-    t3620 = 0.5*(-t3487 + t3522)/casadi.if_else(t3619, t3548, 1)
+    t3620 = (-t3487 + t3522)/casadi.if_else(t3619, 2*t3548, 1)
     t3621 = casadi.fabs(t3620)
     t3622 = (t3621 >= 1)
-    t3623 = casadi.fabs(1/casadi.if_else(t3622, t3620, 1))
+    t3623 = 1/casadi.fabs(casadi.if_else(t3622, t3620, 1))
     t3624 = casadi.if_else(t3619, casadi.if_else((t3620 >= 0), 1, -1)*casadi.if_else(t3622, t3623/(1 + casadi.sqrt(1 + t3623**2)), 1/(t3621 + casadi.sqrt(1 + t3621**2))), 0)
     t3625 = 1/casadi.sqrt(1 + t3624**2)
     t3626 = t3548*t3624
@@ -7839,10 +7839,10 @@ def _condition_number(q):
     t3652 = t3650 + t3624*t3649
     t3653 = t3562*t3631 + t3566*t3635 + t3570*t3639 + t3574*t3643 + t3578*t3647 + t3582*t3651
     t3654 = (t3653 != 0)
-    t3655 = 0.5*(-t3627 + t3558)/casadi.if_else(t3654, t3653, 1)
+    t3655 = (-t3627 + t3558)/casadi.if_else(t3654, 2*t3653, 1)
     t3656 = casadi.fabs(t3655)
     t3657 = (t3656 >= 1)
-    t3658 = casadi.fabs(1/casadi.if_else(t3657, t3655, 1))
+    t3658 = 1/casadi.fabs(casadi.if_else(t3657, t3655, 1))
     t3659 = casadi.if_else(t3654, casadi.if_else((t3655 >= 0), 1, -1)*casadi.if_else(t3657, t3658/(1 + casadi.sqrt(1 + t3658**2)), 1/(t3656 + casadi.sqrt(1 + t3656**2))), 0)
     t3660 = 1/casadi.sqrt(1 + t3659**2)
     t3661 = t3653*t3659
@@ -7875,10 +7875,10 @@ def _condition_number(q):
     t3688 = t3595*t3666 + t3599*t3670 + t3603*t3674 + t3607*t3678 + t3611*t3682 + t3615*t3686
     t3689 = t3632*t3667 + t3636*t3671 + t3640*t3675 + t3644*t3679 + t3648*t3683 + t3652*t3687
     t3690 = (t3688 != 0)
-    t3691 = 0.5*(-t3662 + t3591)/casadi.if_else(t3690, t3688, 1)
+    t3691 = (-t3662 + t3591)/casadi.if_else(t3690, 2*t3688, 1)
     t3692 = casadi.fabs(t3691)
     t3693 = (t3692 >= 1)
-    t3694 = casadi.fabs(1/casadi.if_else(t3693, t3691, 1))
+    t3694 = 1/casadi.fabs(casadi.if_else(t3693, t3691, 1))
     t3695 = casadi.if_else(t3690, casadi.if_else((t3691 >= 0), 1, -1)*casadi.if_else(t3693, t3694/(1 + casadi.sqrt(1 + t3694**2)), 1/(t3692 + casadi.sqrt(1 + t3692**2))), 0)
     t3696 = 1/casadi.sqrt(1 + t3695**2)
     t3697 = t3591 + t3688*t3695
@@ -7910,10 +7910,10 @@ def _condition_number(q):
     t3723 = casadi.if_else((t3722 > t3617), t3722, t3617)
     t3724 = casadi.if_else((t3722 < t3618), t3722, t3618)
     t3725 = (t3689 != 0)
-    t3726 = 0.5*(-t3628 + t3663)/casadi.if_else(t3725, t3689, 1)
+    t3726 = (-t3628 + t3663)/casadi.if_else(t3725, 2*t3689, 1)
     t3727 = casadi.fabs(t3726)
     t3728 = (t3727 >= 1)
-    t3729 = casadi.fabs(1/casadi.if_else(t3728, t3726, 1))
+    t3729 = 1/casadi.fabs(casadi.if_else(t3728, t3726, 1))
     t3730 = casadi.if_else(t3725, casadi.if_else((t3726 >= 0), 1, -1)*casadi.if_else(t3728, t3729/(1 + casadi.sqrt(1 + t3729**2)), 1/(t3727 + casadi.sqrt(1 + t3727**2))), 0)
     t3731 = 1/casadi.sqrt(1 + t3730**2)
     t3732 = t3689*t3730
@@ -7945,10 +7945,10 @@ def _condition_number(q):
     t3758 = t3756 + t3730*t3755
     t3759 = t3701*t3737 + t3705*t3741 + t3709*t3745 + t3713*t3749 + t3717*t3753 + t3721*t3757
     t3760 = (t3759 != 0)
-    t3761 = 0.5*(-t3733 + t3697)/casadi.if_else(t3760, t3759, 1)
+    t3761 = (-t3733 + t3697)/casadi.if_else(t3760, 2*t3759, 1)
     t3762 = casadi.fabs(t3761)
     t3763 = (t3762 >= 1)
-    t3764 = casadi.fabs(1/casadi.if_else(t3763, t3761, 1))
+    t3764 = 1/casadi.fabs(casadi.if_else(t3763, t3761, 1))
     t3765 = casadi.if_else(t3760, casadi.if_else((t3761 >= 0), 1, -1)*casadi.if_else(t3763, t3764/(1 + casadi.sqrt(1 + t3764**2)), 1/(t3762 + casadi.sqrt(1 + t3762**2))), 0)
     t3766 = 1/casadi.sqrt(1 + t3765**2)
     t3767 = t3697 + t3759*t3765
@@ -7981,10 +7981,10 @@ def _condition_number(q):
     t3794 = casadi.if_else((t3793 > t3723), t3793, t3723)
     t3795 = casadi.if_else((t3793 < t3724), t3793, t3724)
     t3796 = (t3792 != 0)
-    t3797 = 0.5*(-t3734 + t3767)/casadi.if_else(t3796, t3792, 1)
+    t3797 = (-t3734 + t3767)/casadi.if_else(t3796, 2*t3792, 1)
     t3798 = casadi.fabs(t3797)
     t3799 = (t3798 >= 1)
-    t3800 = casadi.fabs(1/casadi.if_else(t3799, t3797, 1))
+    t3800 = 1/casadi.fabs(casadi.if_else(t3799, t3797, 1))
     t3801 = casadi.if_else(t3796, casadi.if_else((t3797 >= 0), 1, -1)*casadi.if_else(t3799, t3800/(1 + casadi.sqrt(1 + t3800**2)), 1/(t3798 + casadi.sqrt(1 + t3798**2))), 0)
     t3802 = 1/casadi.sqrt(1 + t3801**2)
     t3803 = t3738*t3802
@@ -8017,8 +8017,10 @@ def _condition_number(q):
     t3830 = casadi.if_else((t3827 < t3795), t3827, t3795)
     t3831 = casadi.if_else((t3828 > t3829), t3828, t3829)
     t3832 = casadi.if_else((t3828 < t3830), t3828, t3830)
+    t3833 = casadi.if_else((t3832 <= 1e-12*t3831), 0, t3832)
+    t3834 = casadi.if_else((t3831 > 0), t3831, 1)
     kappa = casadi.SX(1, 1)
-    kappa[0, 0] = casadi.if_else((t3831 > 0), t3831, 1)/casadi.if_else((t3832 <= 1e-12*t3831), 0, t3832)
+    kappa[0, 0] = t3834/t3833
     return [kappa]
 
 

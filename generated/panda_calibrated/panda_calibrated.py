@@ -4588,10 +4588,10 @@ def velocity_ellipsoid(q):
     t163 = t162 + t146**2 + t154**2
     t164 = t126*t132
     t165 = xp.not_equal(t164, 0)
-    t166 = 0.5*(-t129 + t143)/xp.where(t165, -t164, 1)
+    t166 = (-t129 + t143)/xp.where(t165, -2*t164, 1)
     t167 = xp.abs(t166)
     t168 = xp.greater_equal(t167, 1)
-    t169 = xp.abs(1/xp.where(t168, t166, 1))
+    t169 = 1/xp.abs(xp.where(t168, t166, 1))
     t170 = xp.where(t165, xp.where(xp.greater_equal(t166, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t168, t169/(1 + xp.sqrt(1 + t169**2)), 1/(t167 + xp.sqrt(1 + t167**2))), 0)
     t171 = 1/xp.sqrt(1 + t170**2)
     t172 = t164*t170
@@ -4605,10 +4605,10 @@ def velocity_ellipsoid(q):
     t180 = t179*t170
     t181 = t146*t177 + t180*t154
     t182 = xp.not_equal(t181, 0)
-    t183 = 0.5*(-t173 + t163)/xp.where(t182, -t181, 1)
+    t183 = (-t173 + t163)/xp.where(t182, -2*t181, 1)
     t184 = xp.abs(t183)
     t185 = xp.greater_equal(t184, 1)
-    t186 = xp.abs(1/xp.where(t185, t183, 1))
+    t186 = 1/xp.abs(xp.where(t185, t183, 1))
     t187 = xp.where(t182, xp.where(xp.greater_equal(t183, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t185, t186/(1 + xp.sqrt(1 + t186**2)), 1/(t184 + xp.sqrt(1 + t184**2))), 0)
     t188 = 1/xp.sqrt(1 + t187**2)
     t189 = t181*t187
@@ -4624,10 +4624,10 @@ def velocity_ellipsoid(q):
     t199 = -t197 + t196*t187
     t200 = t178*t195 - t179*t199
     t201 = xp.not_equal(t200, 0)
-    t202 = 0.5*(-t174 + t191)/xp.where(t201, t200, 1)
+    t202 = (-t174 + t191)/xp.where(t201, 2*t200, 1)
     t203 = xp.abs(t202)
     t204 = xp.greater_equal(t203, 1)
-    t205 = xp.abs(1/xp.where(t204, t202, 1))
+    t205 = 1/xp.abs(xp.where(t204, t202, 1))
     t206 = xp.where(t201, xp.where(xp.greater_equal(t202, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t204, t205/(1 + xp.sqrt(1 + t205**2)), 1/(t203 + xp.sqrt(1 + t203**2))), 0)
     t207 = 1/xp.sqrt(1 + t206**2)
     t208 = t200*t206
@@ -4653,10 +4653,10 @@ def velocity_ellipsoid(q):
     t228 = t206*t207
     t229 = t194*t213 + t198*t218 - t162*t222*t228*t188
     t230 = xp.not_equal(t229, 0)
-    t231 = 0.5*(-t190 + t209)/xp.where(t230, -t229, 1)
+    t231 = (-t190 + t209)/xp.where(t230, -2*t229, 1)
     t232 = xp.abs(t231)
     t233 = xp.greater_equal(t232, 1)
-    t234 = xp.abs(1/xp.where(t233, t231, 1))
+    t234 = 1/xp.abs(xp.where(t233, t231, 1))
     t235 = xp.where(t230, xp.where(xp.greater_equal(t231, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t233, t234/(1 + xp.sqrt(1 + t234**2)), 1/(t232 + xp.sqrt(1 + t232**2))), 0)
     t236 = 1/xp.sqrt(1 + t235**2)
     t237 = t229*t235
@@ -4690,10 +4690,10 @@ def velocity_ellipsoid(q):
     t265 = t188*t207
     t266 = t214*t242 - t219*t246 + t265*t161*t255
     t267 = xp.not_equal(t266, 0)
-    t268 = 0.5*(-t238 + t210)/xp.where(t267, -t266, 1)
+    t268 = (-t238 + t210)/xp.where(t267, -2*t266, 1)
     t269 = xp.abs(t268)
     t270 = xp.greater_equal(t269, 1)
-    t271 = xp.abs(1/xp.where(t270, t268, 1))
+    t271 = 1/xp.abs(xp.where(t270, t268, 1))
     t272 = xp.where(t267, xp.where(xp.greater_equal(t268, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t270, t271/(1 + xp.sqrt(1 + t271**2)), 1/(t269 + xp.sqrt(1 + t269**2))), 0)
     t273 = 1/xp.sqrt(1 + t272**2)
     t274 = t266*t272
@@ -4725,10 +4725,10 @@ def velocity_ellipsoid(q):
     t300 = t299 - t286*t272
     t301 = t286 + t299*t272
     t302 = xp.not_equal(t290, 0)
-    t303 = 0.5*(-t239 + t276)/xp.where(t302, t290, 1)
+    t303 = (-t239 + t276)/xp.where(t302, 2*t290, 1)
     t304 = xp.abs(t303)
     t305 = xp.greater_equal(t304, 1)
-    t306 = xp.abs(1/xp.where(t305, t303, 1))
+    t306 = 1/xp.abs(xp.where(t305, t303, 1))
     t307 = xp.where(t302, xp.where(xp.greater_equal(t303, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t305, t306/(1 + xp.sqrt(1 + t306**2)), 1/(t304 + xp.sqrt(1 + t304**2))), 0)
     t308 = 1/xp.sqrt(1 + t307**2)
     t309 = t290*t307
@@ -4760,10 +4760,10 @@ def velocity_ellipsoid(q):
     t335 = t333 + t334*t307
     t336 = t334 - t333*t307
     t337 = xp.not_equal(t324, 0)
-    t338 = 0.5*(-t275 + t310)/xp.where(t337, t324, 1)
+    t338 = (-t275 + t310)/xp.where(t337, 2*t324, 1)
     t339 = xp.abs(t338)
     t340 = xp.greater_equal(t339, 1)
-    t341 = xp.abs(1/xp.where(t340, t338, 1))
+    t341 = 1/xp.abs(xp.where(t340, t338, 1))
     t342 = xp.where(t337, xp.where(xp.greater_equal(t338, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t340, t341/(1 + xp.sqrt(1 + t341**2)), 1/(t339 + xp.sqrt(1 + t339**2))), 0)
     t343 = 1/xp.sqrt(1 + t342**2)
     t344 = t324*t342
@@ -4795,10 +4795,10 @@ def velocity_ellipsoid(q):
     t370 = t368 + t369*t342
     t371 = -t369 + t368*t342
     t372 = xp.not_equal(t359, 0)
-    t373 = 0.5*(-t345 + t311)/xp.where(t372, t359, 1)
+    t373 = (-t345 + t311)/xp.where(t372, 2*t359, 1)
     t374 = xp.abs(t373)
     t375 = xp.greater_equal(t374, 1)
-    t376 = xp.abs(1/xp.where(t375, t373, 1))
+    t376 = 1/xp.abs(xp.where(t375, t373, 1))
     t377 = xp.where(t372, xp.where(xp.greater_equal(t373, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t375, t376/(1 + xp.sqrt(1 + t376**2)), 1/(t374 + xp.sqrt(1 + t374**2))), 0)
     t378 = 1/xp.sqrt(1 + t377**2)
     t379 = t359*t377
@@ -4830,10 +4830,10 @@ def velocity_ellipsoid(q):
     t405 = t403 - t404*t377
     t406 = t404 + t403*t377
     t407 = xp.not_equal(t394, 0)
-    t408 = 0.5*(-t346 + t381)/xp.where(t407, t394, 1)
+    t408 = (-t346 + t381)/xp.where(t407, 2*t394, 1)
     t409 = xp.abs(t408)
     t410 = xp.greater_equal(t409, 1)
-    t411 = xp.abs(1/xp.where(t410, t408, 1))
+    t411 = 1/xp.abs(xp.where(t410, t408, 1))
     t412 = xp.where(t407, xp.where(xp.greater_equal(t408, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t410, t411/(1 + xp.sqrt(1 + t411**2)), 1/(t409 + xp.sqrt(1 + t409**2))), 0)
     t413 = 1/xp.sqrt(1 + t412**2)
     t414 = t394*t412
@@ -4865,10 +4865,10 @@ def velocity_ellipsoid(q):
     t440 = t438 - t439*t412
     t441 = t439 + t438*t412
     t442 = xp.not_equal(t429, 0)
-    t443 = 0.5*(-t380 + t415)/xp.where(t442, t429, 1)
+    t443 = (-t380 + t415)/xp.where(t442, 2*t429, 1)
     t444 = xp.abs(t443)
     t445 = xp.greater_equal(t444, 1)
-    t446 = xp.abs(1/xp.where(t445, t443, 1))
+    t446 = 1/xp.abs(xp.where(t445, t443, 1))
     t447 = xp.where(t442, xp.where(xp.greater_equal(t443, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t445, t446/(1 + xp.sqrt(1 + t446**2)), 1/(t444 + xp.sqrt(1 + t444**2))), 0)
     t448 = 1/xp.sqrt(1 + t447**2)
     t449 = t429*t447
@@ -4900,10 +4900,10 @@ def velocity_ellipsoid(q):
     t475 = t473 - t474*t447
     t476 = t474 + t473*t447
     t477 = xp.not_equal(t464, 0)
-    t478 = 0.5*(-t450 + t416)/xp.where(t477, t464, 1)
+    t478 = (-t450 + t416)/xp.where(t477, 2*t464, 1)
     t479 = xp.abs(t478)
     t480 = xp.greater_equal(t479, 1)
-    t481 = xp.abs(1/xp.where(t480, t478, 1))
+    t481 = 1/xp.abs(xp.where(t480, t478, 1))
     t482 = xp.where(t477, xp.where(xp.greater_equal(t478, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t480, t481/(1 + xp.sqrt(1 + t481**2)), 1/(t479 + xp.sqrt(1 + t479**2))), 0)
     t483 = 1/xp.sqrt(1 + t482**2)
     t484 = t464*t482
@@ -4935,10 +4935,10 @@ def velocity_ellipsoid(q):
     t510 = t508 - t509*t482
     t511 = t509 + t508*t482
     t512 = xp.not_equal(t499, 0)
-    t513 = 0.5*(-t451 + t486)/xp.where(t512, t499, 1)
+    t513 = (-t451 + t486)/xp.where(t512, 2*t499, 1)
     t514 = xp.abs(t513)
     t515 = xp.greater_equal(t514, 1)
-    t516 = xp.abs(1/xp.where(t515, t513, 1))
+    t516 = 1/xp.abs(xp.where(t515, t513, 1))
     t517 = xp.where(t512, xp.where(xp.greater_equal(t513, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t515, t516/(1 + xp.sqrt(1 + t516**2)), 1/(t514 + xp.sqrt(1 + t514**2))), 0)
     t518 = 1/xp.sqrt(1 + t517**2)
     t519 = t499*t517
@@ -4970,10 +4970,10 @@ def velocity_ellipsoid(q):
     t545 = t543 - t517*t544
     t546 = t544 + t517*t543
     t547 = xp.not_equal(t534, 0)
-    t548 = 0.5*(-t485 + t520)/xp.where(t547, t534, 1)
+    t548 = (-t485 + t520)/xp.where(t547, 2*t534, 1)
     t549 = xp.abs(t548)
     t550 = xp.greater_equal(t549, 1)
-    t551 = xp.abs(1/xp.where(t550, t548, 1))
+    t551 = 1/xp.abs(xp.where(t550, t548, 1))
     t552 = xp.where(t547, xp.where(xp.greater_equal(t548, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t550, t551/(1 + xp.sqrt(1 + t551**2)), 1/(t549 + xp.sqrt(1 + t549**2))), 0)
     t553 = 1/xp.sqrt(1 + t552**2)
     t554 = t534*t552
@@ -5005,10 +5005,10 @@ def velocity_ellipsoid(q):
     t580 = t578 - t552*t579
     t581 = t579 + t552*t578
     t582 = xp.not_equal(t569, 0)
-    t583 = 0.5*(-t555 + t521)/xp.where(t582, t569, 1)
+    t583 = (-t555 + t521)/xp.where(t582, 2*t569, 1)
     t584 = xp.abs(t583)
     t585 = xp.greater_equal(t584, 1)
-    t586 = xp.abs(1/xp.where(t585, t583, 1))
+    t586 = 1/xp.abs(xp.where(t585, t583, 1))
     t587 = xp.where(t582, xp.where(xp.greater_equal(t583, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t585, t586/(1 + xp.sqrt(1 + t586**2)), 1/(t584 + xp.sqrt(1 + t584**2))), 0)
     t588 = 1/xp.sqrt(1 + t587**2)
     t589 = t521 + t569*t587
@@ -5039,10 +5039,10 @@ def velocity_ellipsoid(q):
     t614 = t612 - t587*t613
     t615 = t613 + t587*t612
     t616 = xp.not_equal(t602, 0)
-    t617 = 0.5*(-t556 + t589)/xp.where(t616, t602, 1)
+    t617 = (-t556 + t589)/xp.where(t616, 2*t602, 1)
     t618 = xp.abs(t617)
     t619 = xp.greater_equal(t618, 1)
-    t620 = xp.abs(1/xp.where(t619, t617, 1))
+    t620 = 1/xp.abs(xp.where(t619, t617, 1))
     t621 = xp.where(t616, xp.where(xp.greater_equal(t617, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t619, t620/(1 + xp.sqrt(1 + t620**2)), 1/(t618 + xp.sqrt(1 + t618**2))), 0)
     t622 = 1/xp.sqrt(1 + t621**2)
     t623 = t560*t622
@@ -5140,10 +5140,10 @@ def velocity_ellipsoid(q):
     t715 = t693**2 + t705**2 + t714
     t716 = t89*t685
     t717 = xp.not_equal(t716, 0)
-    t718 = 0.5*(-t682 + t713)/xp.where(t717, t716, 1)
+    t718 = (-t682 + t713)/xp.where(t717, 2*t716, 1)
     t719 = xp.abs(t718)
     t720 = xp.greater_equal(t719, 1)
-    t721 = xp.abs(1/xp.where(t720, t718, 1))
+    t721 = 1/xp.abs(xp.where(t720, t718, 1))
     t722 = xp.where(t717, xp.where(xp.greater_equal(t718, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t720, t721/(1 + xp.sqrt(1 + t721**2)), 1/(t719 + xp.sqrt(1 + t719**2))), 0)
     t723 = 1/xp.sqrt(1 + t722**2)
     t724 = t722*t716
@@ -5157,10 +5157,10 @@ def velocity_ellipsoid(q):
     t732 = t722*t731
     t733 = t693*t729 + t705*t732
     t734 = xp.not_equal(t733, 0)
-    t735 = 0.5*(-t725 + t715)/xp.where(t734, t733, 1)
+    t735 = (-t725 + t715)/xp.where(t734, 2*t733, 1)
     t736 = xp.abs(t735)
     t737 = xp.greater_equal(t736, 1)
-    t738 = xp.abs(1/xp.where(t737, t735, 1))
+    t738 = 1/xp.abs(xp.where(t737, t735, 1))
     t739 = xp.where(t734, xp.where(xp.greater_equal(t735, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t737, t738/(1 + xp.sqrt(1 + t738**2)), 1/(t736 + xp.sqrt(1 + t736**2))), 0)
     t740 = 1/xp.sqrt(1 + t739**2)
     t741 = t733*t739
@@ -5176,10 +5176,10 @@ def velocity_ellipsoid(q):
     t751 = t749 + t739*t748
     t752 = t730*t747 + t751*t731
     t753 = xp.not_equal(t752, 0)
-    t754 = 0.5*(-t726 + t743)/xp.where(t753, -t752, 1)
+    t754 = (-t726 + t743)/xp.where(t753, -2*t752, 1)
     t755 = xp.abs(t754)
     t756 = xp.greater_equal(t755, 1)
-    t757 = xp.abs(1/xp.where(t756, t754, 1))
+    t757 = 1/xp.abs(xp.where(t756, t754, 1))
     t758 = xp.where(t753, xp.where(xp.greater_equal(t754, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t756, t757/(1 + xp.sqrt(1 + t757**2)), 1/(t755 + xp.sqrt(1 + t755**2))), 0)
     t759 = 1/xp.sqrt(1 + t758**2)
     t760 = t752*t758
@@ -5205,10 +5205,10 @@ def velocity_ellipsoid(q):
     t780 = t758*t759
     t781 = t746*t765 + t750*t770 - t740*t714*t774*t780
     t782 = xp.not_equal(t781, 0)
-    t783 = 0.5*(-t742 + t761)/xp.where(t782, -t781, 1)
+    t783 = (-t742 + t761)/xp.where(t782, -2*t781, 1)
     t784 = xp.abs(t783)
     t785 = xp.greater_equal(t784, 1)
-    t786 = xp.abs(1/xp.where(t785, t783, 1))
+    t786 = 1/xp.abs(xp.where(t785, t783, 1))
     t787 = xp.where(t782, xp.where(xp.greater_equal(t783, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t785, t786/(1 + xp.sqrt(1 + t786**2)), 1/(t784 + xp.sqrt(1 + t784**2))), 0)
     t788 = 1/xp.sqrt(1 + t787**2)
     t789 = t781*t787
@@ -5242,10 +5242,10 @@ def velocity_ellipsoid(q):
     t817 = t740*t759
     t818 = t766*t794 + t771*t798 - t712*t807*t817
     t819 = xp.not_equal(t818, 0)
-    t820 = 0.5*(-t790 + t762)/xp.where(t819, t818, 1)
+    t820 = (-t790 + t762)/xp.where(t819, 2*t818, 1)
     t821 = xp.abs(t820)
     t822 = xp.greater_equal(t821, 1)
-    t823 = xp.abs(1/xp.where(t822, t820, 1))
+    t823 = 1/xp.abs(xp.where(t822, t820, 1))
     t824 = xp.where(t819, xp.where(xp.greater_equal(t820, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t822, t823/(1 + xp.sqrt(1 + t823**2)), 1/(t821 + xp.sqrt(1 + t821**2))), 0)
     t825 = 1/xp.sqrt(1 + t824**2)
     t826 = t818*t824
@@ -5277,10 +5277,10 @@ def velocity_ellipsoid(q):
     t852 = t851 - t824*t838
     t853 = t838 + t824*t851
     t854 = xp.not_equal(t842, 0)
-    t855 = 0.5*(-t791 + t828)/xp.where(t854, t842, 1)
+    t855 = (-t791 + t828)/xp.where(t854, 2*t842, 1)
     t856 = xp.abs(t855)
     t857 = xp.greater_equal(t856, 1)
-    t858 = xp.abs(1/xp.where(t857, t855, 1))
+    t858 = 1/xp.abs(xp.where(t857, t855, 1))
     t859 = xp.where(t854, xp.where(xp.greater_equal(t855, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t857, t858/(1 + xp.sqrt(1 + t858**2)), 1/(t856 + xp.sqrt(1 + t856**2))), 0)
     t860 = 1/xp.sqrt(1 + t859**2)
     t861 = t842*t859
@@ -5312,10 +5312,10 @@ def velocity_ellipsoid(q):
     t887 = t885 + t859*t886
     t888 = t886 - t859*t885
     t889 = xp.not_equal(t876, 0)
-    t890 = 0.5*(-t827 + t862)/xp.where(t889, t876, 1)
+    t890 = (-t827 + t862)/xp.where(t889, 2*t876, 1)
     t891 = xp.abs(t890)
     t892 = xp.greater_equal(t891, 1)
-    t893 = xp.abs(1/xp.where(t892, t890, 1))
+    t893 = 1/xp.abs(xp.where(t892, t890, 1))
     t894 = xp.where(t889, xp.where(xp.greater_equal(t890, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t892, t893/(1 + xp.sqrt(1 + t893**2)), 1/(t891 + xp.sqrt(1 + t891**2))), 0)
     t895 = 1/xp.sqrt(1 + t894**2)
     t896 = t876*t894
@@ -5347,10 +5347,10 @@ def velocity_ellipsoid(q):
     t922 = t920 + t894*t921
     t923 = -t921 + t894*t920
     t924 = xp.not_equal(t911, 0)
-    t925 = 0.5*(-t897 + t863)/xp.where(t924, t911, 1)
+    t925 = (-t897 + t863)/xp.where(t924, 2*t911, 1)
     t926 = xp.abs(t925)
     t927 = xp.greater_equal(t926, 1)
-    t928 = xp.abs(1/xp.where(t927, t925, 1))
+    t928 = 1/xp.abs(xp.where(t927, t925, 1))
     t929 = xp.where(t924, xp.where(xp.greater_equal(t925, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t927, t928/(1 + xp.sqrt(1 + t928**2)), 1/(t926 + xp.sqrt(1 + t926**2))), 0)
     t930 = 1/xp.sqrt(1 + t929**2)
     t931 = t911*t929
@@ -5382,10 +5382,10 @@ def velocity_ellipsoid(q):
     t957 = t955 - t929*t956
     t958 = t956 + t929*t955
     t959 = xp.not_equal(t946, 0)
-    t960 = 0.5*(-t898 + t933)/xp.where(t959, t946, 1)
+    t960 = (-t898 + t933)/xp.where(t959, 2*t946, 1)
     t961 = xp.abs(t960)
     t962 = xp.greater_equal(t961, 1)
-    t963 = xp.abs(1/xp.where(t962, t960, 1))
+    t963 = 1/xp.abs(xp.where(t962, t960, 1))
     t964 = xp.where(t959, xp.where(xp.greater_equal(t960, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t962, t963/(1 + xp.sqrt(1 + t963**2)), 1/(t961 + xp.sqrt(1 + t961**2))), 0)
     t965 = 1/xp.sqrt(1 + t964**2)
     t966 = t946*t964
@@ -5417,10 +5417,10 @@ def velocity_ellipsoid(q):
     t992 = t990 - t964*t991
     t993 = t991 + t964*t990
     t994 = xp.not_equal(t981, 0)
-    t995 = 0.5*(-t932 + t967)/xp.where(t994, t981, 1)
+    t995 = (-t932 + t967)/xp.where(t994, 2*t981, 1)
     t996 = xp.abs(t995)
     t997 = xp.greater_equal(t996, 1)
-    t998 = xp.abs(1/xp.where(t997, t995, 1))
+    t998 = 1/xp.abs(xp.where(t997, t995, 1))
     t999 = xp.where(t994, xp.where(xp.greater_equal(t995, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t997, t998/(1 + xp.sqrt(1 + t998**2)), 1/(t996 + xp.sqrt(1 + t996**2))), 0)
     t1000 = 1/xp.sqrt(1 + t999**2)
     t1001 = t981*t999
@@ -5452,10 +5452,10 @@ def velocity_ellipsoid(q):
     t1027 = t1025 - t999*t1026
     t1028 = t1026 + t999*t1025
     t1029 = xp.not_equal(t1016, 0)
-    t1030 = 0.5*(-t1002 + t968)/xp.where(t1029, t1016, 1)
+    t1030 = (-t1002 + t968)/xp.where(t1029, 2*t1016, 1)
     t1031 = xp.abs(t1030)
     t1032 = xp.greater_equal(t1031, 1)
-    t1033 = xp.abs(1/xp.where(t1032, t1030, 1))
+    t1033 = 1/xp.abs(xp.where(t1032, t1030, 1))
     t1034 = xp.where(t1029, xp.where(xp.greater_equal(t1030, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1032, t1033/(1 + xp.sqrt(1 + t1033**2)), 1/(t1031 + xp.sqrt(1 + t1031**2))), 0)
     t1035 = 1/xp.sqrt(1 + t1034**2)
     t1036 = t1016*t1034
@@ -5487,10 +5487,10 @@ def velocity_ellipsoid(q):
     t1062 = t1060 - t1034*t1061
     t1063 = t1061 + t1034*t1060
     t1064 = xp.not_equal(t1051, 0)
-    t1065 = 0.5*(-t1003 + t1038)/xp.where(t1064, t1051, 1)
+    t1065 = (-t1003 + t1038)/xp.where(t1064, 2*t1051, 1)
     t1066 = xp.abs(t1065)
     t1067 = xp.greater_equal(t1066, 1)
-    t1068 = xp.abs(1/xp.where(t1067, t1065, 1))
+    t1068 = 1/xp.abs(xp.where(t1067, t1065, 1))
     t1069 = xp.where(t1064, xp.where(xp.greater_equal(t1065, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1067, t1068/(1 + xp.sqrt(1 + t1068**2)), 1/(t1066 + xp.sqrt(1 + t1066**2))), 0)
     t1070 = 1/xp.sqrt(1 + t1069**2)
     t1071 = t1051*t1069
@@ -5522,10 +5522,10 @@ def velocity_ellipsoid(q):
     t1097 = t1095 - t1069*t1096
     t1098 = t1096 + t1069*t1095
     t1099 = xp.not_equal(t1086, 0)
-    t1100 = 0.5*(-t1037 + t1072)/xp.where(t1099, t1086, 1)
+    t1100 = (-t1037 + t1072)/xp.where(t1099, 2*t1086, 1)
     t1101 = xp.abs(t1100)
     t1102 = xp.greater_equal(t1101, 1)
-    t1103 = xp.abs(1/xp.where(t1102, t1100, 1))
+    t1103 = 1/xp.abs(xp.where(t1102, t1100, 1))
     t1104 = xp.where(t1099, xp.where(xp.greater_equal(t1100, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1102, t1103/(1 + xp.sqrt(1 + t1103**2)), 1/(t1101 + xp.sqrt(1 + t1101**2))), 0)
     t1105 = 1/xp.sqrt(1 + t1104**2)
     t1106 = t1086*t1104
@@ -5557,10 +5557,10 @@ def velocity_ellipsoid(q):
     t1132 = t1130 - t1104*t1131
     t1133 = t1131 + t1104*t1130
     t1134 = xp.not_equal(t1121, 0)
-    t1135 = 0.5*(-t1107 + t1073)/xp.where(t1134, t1121, 1)
+    t1135 = (-t1107 + t1073)/xp.where(t1134, 2*t1121, 1)
     t1136 = xp.abs(t1135)
     t1137 = xp.greater_equal(t1136, 1)
-    t1138 = xp.abs(1/xp.where(t1137, t1135, 1))
+    t1138 = 1/xp.abs(xp.where(t1137, t1135, 1))
     t1139 = xp.where(t1134, xp.where(xp.greater_equal(t1135, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1137, t1138/(1 + xp.sqrt(1 + t1138**2)), 1/(t1136 + xp.sqrt(1 + t1136**2))), 0)
     t1140 = 1/xp.sqrt(1 + t1139**2)
     t1141 = t1073 + t1121*t1139
@@ -5591,10 +5591,10 @@ def velocity_ellipsoid(q):
     t1166 = t1164 - t1139*t1165
     t1167 = t1165 + t1139*t1164
     t1168 = xp.not_equal(t1154, 0)
-    t1169 = 0.5*(-t1108 + t1141)/xp.where(t1168, t1154, 1)
+    t1169 = (-t1108 + t1141)/xp.where(t1168, 2*t1154, 1)
     t1170 = xp.abs(t1169)
     t1171 = xp.greater_equal(t1170, 1)
-    t1172 = xp.abs(1/xp.where(t1171, t1169, 1))
+    t1172 = 1/xp.abs(xp.where(t1171, t1169, 1))
     t1173 = xp.where(t1168, xp.where(xp.greater_equal(t1169, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1171, t1172/(1 + xp.sqrt(1 + t1172**2)), 1/(t1170 + xp.sqrt(1 + t1170**2))), 0)
     t1174 = 1/xp.sqrt(1 + t1173**2)
     t1175 = t1112*t1174
@@ -5965,10 +5965,10 @@ def condition_number(q):
     t254 = t252 + t253**2 + t153**2 + t187**2 + t136**2 + t144**2
     t255 = -t153*t161 + t187*t195 - t136*t172 + t144*t179 + t253*t165
     t256 = xp.not_equal(t255, 0)
-    t257 = 0.5*(-t254 + t247)/xp.where(t256, t255, 1)
+    t257 = (-t254 + t247)/xp.where(t256, 2*t255, 1)
     t258 = xp.abs(t257)
     t259 = xp.greater_equal(t258, 1)
-    t260 = xp.abs(1/xp.where(t259, t257, 1))
+    t260 = 1/xp.abs(xp.where(t259, t257, 1))
     t261 = xp.where(t256, xp.where(xp.greater_equal(t257, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t259, t260/(1 + xp.sqrt(1 + t260**2)), 1/(t258 + xp.sqrt(1 + t258**2))), 0)
     t262 = 1/xp.sqrt(1 + t261**2)
     t263 = t255*t261
@@ -5996,10 +5996,10 @@ def condition_number(q):
     t285 = t283 + t282*t261
     t286 = -t202*t272 + t206*t276 - t212*t280 + t218*t284
     t287 = xp.not_equal(t286, 0)
-    t288 = 0.5*(-t264 + t248)/xp.where(t287, t286, 1)
+    t288 = (-t264 + t248)/xp.where(t287, 2*t286, 1)
     t289 = xp.abs(t288)
     t290 = xp.greater_equal(t289, 1)
-    t291 = xp.abs(1/xp.where(t290, t288, 1))
+    t291 = 1/xp.abs(xp.where(t290, t288, 1))
     t292 = xp.where(t287, xp.where(xp.greater_equal(t288, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t290, t291/(1 + xp.sqrt(1 + t291**2)), 1/(t289 + xp.sqrt(1 + t289**2))), 0)
     t293 = 1/xp.sqrt(1 + t292**2)
     t294 = t286*t292
@@ -6023,10 +6023,10 @@ def condition_number(q):
     t312 = t310 + t309*t292
     t313 = t224*t303 + t228*t307 - t233*t311
     t314 = xp.not_equal(t313, 0)
-    t315 = 0.5*(-t295 + t249)/xp.where(t314, -t313, 1)
+    t315 = (-t295 + t249)/xp.where(t314, -2*t313, 1)
     t316 = xp.abs(t315)
     t317 = xp.greater_equal(t316, 1)
-    t318 = xp.abs(1/xp.where(t317, t315, 1))
+    t318 = 1/xp.abs(xp.where(t317, t315, 1))
     t319 = xp.where(t314, xp.where(xp.greater_equal(t315, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t317, t318/(1 + xp.sqrt(1 + t318**2)), 1/(t316 + xp.sqrt(1 + t316**2))), 0)
     t320 = 1/xp.sqrt(1 + t319**2)
     t321 = t313*t319
@@ -6046,10 +6046,10 @@ def condition_number(q):
     t335 = t333 + t332*t319
     t336 = t238*t330 + t242*t334
     t337 = xp.not_equal(t336, 0)
-    t338 = 0.5*(-t322 + t250)/xp.where(t337, t336, 1)
+    t338 = (-t322 + t250)/xp.where(t337, 2*t336, 1)
     t339 = xp.abs(t338)
     t340 = xp.greater_equal(t339, 1)
-    t341 = xp.abs(1/xp.where(t340, t338, 1))
+    t341 = 1/xp.abs(xp.where(t340, t338, 1))
     t342 = xp.where(t337, xp.where(xp.greater_equal(t338, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t340, t341/(1 + xp.sqrt(1 + t341**2)), 1/(t339 + xp.sqrt(1 + t339**2))), 0)
     t343 = 1/xp.sqrt(1 + t342**2)
     t344 = t336*t342
@@ -6065,10 +6065,10 @@ def condition_number(q):
     t354 = t352 + t351*t342
     t355 = t246*t353
     t356 = xp.not_equal(t355, 0)
-    t357 = 0.5*(-t345 + t251)/xp.where(t356, -t355, 1)
+    t357 = (-t345 + t251)/xp.where(t356, -2*t355, 1)
     t358 = xp.abs(t357)
     t359 = xp.greater_equal(t358, 1)
-    t360 = xp.abs(1/xp.where(t359, t357, 1))
+    t360 = 1/xp.abs(xp.where(t359, t357, 1))
     t361 = xp.where(t356, xp.where(xp.greater_equal(t357, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t359, t360/(1 + xp.sqrt(1 + t360**2)), 1/(t358 + xp.sqrt(1 + t358**2))), 0)
     t362 = 1/xp.sqrt(1 + t361**2)
     t363 = t355*t361
@@ -6082,10 +6082,10 @@ def condition_number(q):
     t371 = t370*t268
     t372 = t273*t300 - t277*t304 + t281*t308 + t285*t312 + t252*t370*t261*t262**2 + t371*t269
     t373 = xp.not_equal(t372, 0)
-    t374 = 0.5*(-t265 + t296)/xp.where(t373, t372, 1)
+    t374 = (-t265 + t296)/xp.where(t373, 2*t372, 1)
     t375 = xp.abs(t374)
     t376 = xp.greater_equal(t375, 1)
-    t377 = xp.abs(1/xp.where(t376, t374, 1))
+    t377 = 1/xp.abs(xp.where(t376, t374, 1))
     t378 = xp.where(t373, xp.where(xp.greater_equal(t374, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t376, t377/(1 + xp.sqrt(1 + t377**2)), 1/(t375 + xp.sqrt(1 + t375**2))), 0)
     t379 = 1/xp.sqrt(1 + t378**2)
     t380 = t372*t378
@@ -6124,10 +6124,10 @@ def condition_number(q):
     t413 = t409*t299
     t414 = -t327*t399 + t331*t403 + t335*t407 - t411*t387 + t412*t391 + t413*t395
     t415 = xp.not_equal(t414, 0)
-    t416 = 0.5*(-t381 + t323)/xp.where(t415, t414, 1)
+    t416 = (-t381 + t323)/xp.where(t415, 2*t414, 1)
     t417 = xp.abs(t416)
     t418 = xp.greater_equal(t417, 1)
-    t419 = xp.abs(1/xp.where(t418, t416, 1))
+    t419 = 1/xp.abs(xp.where(t418, t416, 1))
     t420 = xp.where(t415, xp.where(xp.greater_equal(t416, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t418, t419/(1 + xp.sqrt(1 + t419**2)), 1/(t417 + xp.sqrt(1 + t417**2))), 0)
     t421 = 1/xp.sqrt(1 + t420**2)
     t422 = t414*t420
@@ -6170,10 +6170,10 @@ def condition_number(q):
     t459 = t458*t342
     t460 = -t350*t443 + t354*t447 - t453*t427 + t455*t431 + t457*t435 - t459*t439
     t461 = xp.not_equal(t460, 0)
-    t462 = 0.5*(-t423 + t346)/xp.where(t461, t460, 1)
+    t462 = (-t423 + t346)/xp.where(t461, 2*t460, 1)
     t463 = xp.abs(t462)
     t464 = xp.greater_equal(t463, 1)
-    t465 = xp.abs(1/xp.where(t464, t462, 1))
+    t465 = 1/xp.abs(xp.where(t464, t462, 1))
     t466 = xp.where(t461, xp.where(xp.greater_equal(t462, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t464, t465/(1 + xp.sqrt(1 + t465**2)), 1/(t463 + xp.sqrt(1 + t463**2))), 0)
     t467 = 1/xp.sqrt(1 + t466**2)
     t468 = t460*t466
@@ -6215,10 +6215,10 @@ def condition_number(q):
     t504 = t503*t361
     t505 = t369*t493 - t496*t473 + t498*t477 + t500*t481 - t502*t485 + t504*t489
     t506 = xp.not_equal(t505, 0)
-    t507 = 0.5*(-t469 + t365)/xp.where(t506, t505, 1)
+    t507 = (-t469 + t365)/xp.where(t506, 2*t505, 1)
     t508 = xp.abs(t507)
     t509 = xp.greater_equal(t508, 1)
-    t510 = xp.abs(1/xp.where(t509, t507, 1))
+    t510 = 1/xp.abs(xp.where(t509, t507, 1))
     t511 = xp.where(t506, xp.where(xp.greater_equal(t507, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t509, t510/(1 + xp.sqrt(1 + t510**2)), 1/(t508 + xp.sqrt(1 + t508**2))), 0)
     t512 = 1/xp.sqrt(1 + t511**2)
     t513 = t505*t511
@@ -6250,10 +6250,10 @@ def condition_number(q):
     t539 = t537 + t536*t511
     t540 = t368*t538 - t495*t518 + t497*t522 + t499*t526 - t501*t530 + t503*t534
     t541 = xp.not_equal(t449, 0)
-    t542 = 0.5*(-t382 + t424)/xp.where(t541, t449, 1)
+    t542 = (-t382 + t424)/xp.where(t541, 2*t449, 1)
     t543 = xp.abs(t542)
     t544 = xp.greater_equal(t543, 1)
-    t545 = xp.abs(1/xp.where(t544, t542, 1))
+    t545 = 1/xp.abs(xp.where(t544, t542, 1))
     t546 = xp.where(t541, xp.where(xp.greater_equal(t542, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t544, t545/(1 + xp.sqrt(1 + t545**2)), 1/(t543 + xp.sqrt(1 + t543**2))), 0)
     t547 = 1/xp.sqrt(1 + t546**2)
     t548 = t449*t546
@@ -6285,10 +6285,10 @@ def condition_number(q):
     t574 = t572 + t571*t546
     t575 = -t474*t553 + t478*t557 + t482*t561 + t486*t565 + t490*t569 + t494*t573
     t576 = xp.not_equal(t575, 0)
-    t577 = 0.5*(-t549 + t470)/xp.where(t576, t575, 1)
+    t577 = (-t549 + t470)/xp.where(t576, 2*t575, 1)
     t578 = xp.abs(t577)
     t579 = xp.greater_equal(t578, 1)
-    t580 = xp.abs(1/xp.where(t579, t577, 1))
+    t580 = 1/xp.abs(xp.where(t579, t577, 1))
     t581 = xp.where(t576, xp.where(xp.greater_equal(t577, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t579, t580/(1 + xp.sqrt(1 + t580**2)), 1/(t578 + xp.sqrt(1 + t578**2))), 0)
     t582 = 1/xp.sqrt(1 + t581**2)
     t583 = t575*t581
@@ -6321,10 +6321,10 @@ def condition_number(q):
     t610 = -t519*t588 + t523*t592 + t527*t596 + t531*t600 + t535*t604 + t539*t608
     t611 = t554*t589 + t558*t593 + t562*t597 + t566*t601 + t570*t605 + t574*t609
     t612 = xp.not_equal(t610, 0)
-    t613 = 0.5*(-t584 + t515)/xp.where(t612, t610, 1)
+    t613 = (-t584 + t515)/xp.where(t612, 2*t610, 1)
     t614 = xp.abs(t613)
     t615 = xp.greater_equal(t614, 1)
-    t616 = xp.abs(1/xp.where(t615, t613, 1))
+    t616 = 1/xp.abs(xp.where(t615, t613, 1))
     t617 = xp.where(t612, xp.where(xp.greater_equal(t613, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t615, t616/(1 + xp.sqrt(1 + t616**2)), 1/(t614 + xp.sqrt(1 + t614**2))), 0)
     t618 = 1/xp.sqrt(1 + t617**2)
     t619 = t610*t617
@@ -6355,10 +6355,10 @@ def condition_number(q):
     t644 = t642 - t643*t617
     t645 = t643 + t642*t617
     t646 = xp.not_equal(t611, 0)
-    t647 = 0.5*(-t550 + t585)/xp.where(t646, t611, 1)
+    t647 = (-t550 + t585)/xp.where(t646, 2*t611, 1)
     t648 = xp.abs(t647)
     t649 = xp.greater_equal(t648, 1)
-    t650 = xp.abs(1/xp.where(t649, t647, 1))
+    t650 = 1/xp.abs(xp.where(t649, t647, 1))
     t651 = xp.where(t646, xp.where(xp.greater_equal(t647, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t649, t650/(1 + xp.sqrt(1 + t650**2)), 1/(t648 + xp.sqrt(1 + t648**2))), 0)
     t652 = 1/xp.sqrt(1 + t651**2)
     t653 = t611*t651
@@ -6390,10 +6390,10 @@ def condition_number(q):
     t679 = t677 + t676*t651
     t680 = t625*t658 + t629*t662 + t633*t666 + t637*t670 + t641*t674 + t645*t678
     t681 = xp.not_equal(t680, 0)
-    t682 = 0.5*(-t654 + t621)/xp.where(t681, t680, 1)
+    t682 = (-t654 + t621)/xp.where(t681, 2*t680, 1)
     t683 = xp.abs(t682)
     t684 = xp.greater_equal(t683, 1)
-    t685 = xp.abs(1/xp.where(t684, t682, 1))
+    t685 = 1/xp.abs(xp.where(t684, t682, 1))
     t686 = xp.where(t681, xp.where(xp.greater_equal(t682, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t684, t685/(1 + xp.sqrt(1 + t685**2)), 1/(t683 + xp.sqrt(1 + t683**2))), 0)
     t687 = 1/xp.sqrt(1 + t686**2)
     t688 = t680*t686
@@ -6425,10 +6425,10 @@ def condition_number(q):
     t714 = t712 + t711*t686
     t715 = t659*t694 + t663*t698 + t667*t702 + t671*t706 + t675*t710 + t679*t714
     t716 = xp.not_equal(t715, 0)
-    t717 = 0.5*(-t655 + t690)/xp.where(t716, t715, 1)
+    t717 = (-t655 + t690)/xp.where(t716, 2*t715, 1)
     t718 = xp.abs(t717)
     t719 = xp.greater_equal(t718, 1)
-    t720 = xp.abs(1/xp.where(t719, t717, 1))
+    t720 = 1/xp.abs(xp.where(t719, t717, 1))
     t721 = xp.where(t716, xp.where(xp.greater_equal(t717, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t719, t720/(1 + xp.sqrt(1 + t720**2)), 1/(t718 + xp.sqrt(1 + t718**2))), 0)
     t722 = 1/xp.sqrt(1 + t721**2)
     t723 = t715*t721
@@ -6459,10 +6459,10 @@ def condition_number(q):
     t748 = t746 - t747*t721
     t749 = t747 + t746*t721
     t750 = xp.not_equal(t540, 0)
-    t751 = 0.5*(-t364 + t514)/xp.where(t750, t540, 1)
+    t751 = (-t364 + t514)/xp.where(t750, 2*t540, 1)
     t752 = xp.abs(t751)
     t753 = xp.greater_equal(t752, 1)
-    t754 = xp.abs(1/xp.where(t753, t751, 1))
+    t754 = 1/xp.abs(xp.where(t753, t751, 1))
     t755 = xp.where(t750, xp.where(xp.greater_equal(t751, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t753, t754/(1 + xp.sqrt(1 + t754**2)), 1/(t752 + xp.sqrt(1 + t752**2))), 0)
     t756 = 1/xp.sqrt(1 + t755**2)
     t757 = t540*t755
@@ -6494,10 +6494,10 @@ def condition_number(q):
     t783 = t781 + t780*t755
     t784 = t624*t762 + t628*t766 + t632*t770 + t636*t774 + t640*t778 + t644*t782
     t785 = xp.not_equal(t784, 0)
-    t786 = 0.5*(-t758 + t620)/xp.where(t785, t784, 1)
+    t786 = (-t758 + t620)/xp.where(t785, 2*t784, 1)
     t787 = xp.abs(t786)
     t788 = xp.greater_equal(t787, 1)
-    t789 = xp.abs(1/xp.where(t788, t786, 1))
+    t789 = 1/xp.abs(xp.where(t788, t786, 1))
     t790 = xp.where(t785, xp.where(xp.greater_equal(t786, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t788, t789/(1 + xp.sqrt(1 + t789**2)), 1/(t787 + xp.sqrt(1 + t787**2))), 0)
     t791 = 1/xp.sqrt(1 + t790**2)
     t792 = t784*t790
@@ -6530,10 +6530,10 @@ def condition_number(q):
     t819 = t693*t797 + t697*t801 + t701*t805 + t705*t809 + t709*t813 + t713*t817
     t820 = -t763*t798 + t767*t802 + t771*t806 + t775*t810 + t779*t814 + t783*t818
     t821 = xp.not_equal(t819, 0)
-    t822 = 0.5*(-t793 + t689)/xp.where(t821, t819, 1)
+    t822 = (-t793 + t689)/xp.where(t821, 2*t819, 1)
     t823 = xp.abs(t822)
     t824 = xp.greater_equal(t823, 1)
-    t825 = xp.abs(1/xp.where(t824, t822, 1))
+    t825 = 1/xp.abs(xp.where(t824, t822, 1))
     t826 = xp.where(t821, xp.where(xp.greater_equal(t822, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t824, t825/(1 + xp.sqrt(1 + t825**2)), 1/(t823 + xp.sqrt(1 + t823**2))), 0)
     t827 = 1/xp.sqrt(1 + t826**2)
     t828 = t819*t826
@@ -6565,10 +6565,10 @@ def condition_number(q):
     t854 = t852 + t851*t826
     t855 = t728*t833 + t732*t837 + t736*t841 + t740*t845 + t744*t849 + t748*t853
     t856 = xp.not_equal(t855, 0)
-    t857 = 0.5*(-t829 + t724)/xp.where(t856, t855, 1)
+    t857 = (-t829 + t724)/xp.where(t856, 2*t855, 1)
     t858 = xp.abs(t857)
     t859 = xp.greater_equal(t858, 1)
-    t860 = xp.abs(1/xp.where(t859, t857, 1))
+    t860 = 1/xp.abs(xp.where(t859, t857, 1))
     t861 = xp.where(t856, xp.where(xp.greater_equal(t857, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t859, t860/(1 + xp.sqrt(1 + t860**2)), 1/(t858 + xp.sqrt(1 + t858**2))), 0)
     t862 = 1/xp.sqrt(1 + t861**2)
     t863 = t855*t861
@@ -6600,10 +6600,10 @@ def condition_number(q):
     t889 = t887 + t886*t861
     t890 = t729*t868 + t733*t872 + t737*t876 + t741*t880 + t745*t884 + t749*t888
     t891 = xp.not_equal(t890, 0)
-    t892 = 0.5*(-t864 + t725)/xp.where(t891, t890, 1)
+    t892 = (-t864 + t725)/xp.where(t891, 2*t890, 1)
     t893 = xp.abs(t892)
     t894 = xp.greater_equal(t893, 1)
-    t895 = xp.abs(1/xp.where(t894, t892, 1))
+    t895 = 1/xp.abs(xp.where(t894, t892, 1))
     t896 = xp.where(t891, xp.where(xp.greater_equal(t892, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t894, t895/(1 + xp.sqrt(1 + t895**2)), 1/(t893 + xp.sqrt(1 + t893**2))), 0)
     t897 = 1/xp.sqrt(1 + t896**2)
     t898 = t890*t896
@@ -6634,10 +6634,10 @@ def condition_number(q):
     t923 = t921 - t922*t896
     t924 = t922 + t921*t896
     t925 = xp.not_equal(t820, 0)
-    t926 = 0.5*(-t759 + t794)/xp.where(t925, t820, 1)
+    t926 = (-t759 + t794)/xp.where(t925, 2*t820, 1)
     t927 = xp.abs(t926)
     t928 = xp.greater_equal(t927, 1)
-    t929 = xp.abs(1/xp.where(t928, t926, 1))
+    t929 = 1/xp.abs(xp.where(t928, t926, 1))
     t930 = xp.where(t925, xp.where(xp.greater_equal(t926, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t928, t929/(1 + xp.sqrt(1 + t929**2)), 1/(t927 + xp.sqrt(1 + t927**2))), 0)
     t931 = 1/xp.sqrt(1 + t930**2)
     t932 = t820*t930
@@ -6669,10 +6669,10 @@ def condition_number(q):
     t958 = t956 + t955*t930
     t959 = t834*t937 + t838*t941 + t842*t945 + t846*t949 + t850*t953 + t854*t957
     t960 = xp.not_equal(t959, 0)
-    t961 = 0.5*(-t933 + t830)/xp.where(t960, t959, 1)
+    t961 = (-t933 + t830)/xp.where(t960, 2*t959, 1)
     t962 = xp.abs(t961)
     t963 = xp.greater_equal(t962, 1)
-    t964 = xp.abs(1/xp.where(t963, t961, 1))
+    t964 = 1/xp.abs(xp.where(t963, t961, 1))
     t965 = xp.where(t960, xp.where(xp.greater_equal(t961, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t963, t964/(1 + xp.sqrt(1 + t964**2)), 1/(t962 + xp.sqrt(1 + t962**2))), 0)
     t966 = 1/xp.sqrt(1 + t965**2)
     t967 = t959*t965
@@ -6705,10 +6705,10 @@ def condition_number(q):
     t994 = t869*t972 + t873*t976 + t877*t980 + t881*t984 + t885*t988 + t889*t992
     t995 = t938*t973 + t942*t977 + t946*t981 + t950*t985 + t954*t989 + t958*t993
     t996 = xp.not_equal(t994, 0)
-    t997 = 0.5*(-t968 + t865)/xp.where(t996, t994, 1)
+    t997 = (-t968 + t865)/xp.where(t996, 2*t994, 1)
     t998 = xp.abs(t997)
     t999 = xp.greater_equal(t998, 1)
-    t1000 = xp.abs(1/xp.where(t999, t997, 1))
+    t1000 = 1/xp.abs(xp.where(t999, t997, 1))
     t1001 = xp.where(t996, xp.where(xp.greater_equal(t997, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t999, t1000/(1 + xp.sqrt(1 + t1000**2)), 1/(t998 + xp.sqrt(1 + t998**2))), 0)
     t1002 = 1/xp.sqrt(1 + t1001**2)
     t1003 = t994*t1001
@@ -6740,10 +6740,10 @@ def condition_number(q):
     t1029 = t1027 + t1026*t1001
     t1030 = t904*t1008 + t908*t1012 + t912*t1016 + t916*t1020 + t920*t1024 + t924*t1028
     t1031 = xp.not_equal(t1030, 0)
-    t1032 = 0.5*(-t1004 + t900)/xp.where(t1031, t1030, 1)
+    t1032 = (-t1004 + t900)/xp.where(t1031, 2*t1030, 1)
     t1033 = xp.abs(t1032)
     t1034 = xp.greater_equal(t1033, 1)
-    t1035 = xp.abs(1/xp.where(t1034, t1032, 1))
+    t1035 = 1/xp.abs(xp.where(t1034, t1032, 1))
     t1036 = xp.where(t1031, xp.where(xp.greater_equal(t1032, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1034, t1035/(1 + xp.sqrt(1 + t1035**2)), 1/(t1033 + xp.sqrt(1 + t1033**2))), 0)
     t1037 = 1/xp.sqrt(1 + t1036**2)
     t1038 = t1030*t1036
@@ -6775,10 +6775,10 @@ def condition_number(q):
     t1064 = t1062 + t1061*t1036
     t1065 = t903*t1043 + t907*t1047 + t911*t1051 + t915*t1055 + t919*t1059 + t923*t1063
     t1066 = xp.not_equal(t995, 0)
-    t1067 = 0.5*(-t934 + t969)/xp.where(t1066, t995, 1)
+    t1067 = (-t934 + t969)/xp.where(t1066, 2*t995, 1)
     t1068 = xp.abs(t1067)
     t1069 = xp.greater_equal(t1068, 1)
-    t1070 = xp.abs(1/xp.where(t1069, t1067, 1))
+    t1070 = 1/xp.abs(xp.where(t1069, t1067, 1))
     t1071 = xp.where(t1066, xp.where(xp.greater_equal(t1067, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1069, t1070/(1 + xp.sqrt(1 + t1070**2)), 1/(t1068 + xp.sqrt(1 + t1068**2))), 0)
     t1072 = 1/xp.sqrt(1 + t1071**2)
     t1073 = t995*t1071
@@ -6810,10 +6810,10 @@ def condition_number(q):
     t1099 = t1097 + t1096*t1071
     t1100 = t1009*t1078 + t1013*t1082 + t1017*t1086 + t1021*t1090 + t1025*t1094 + t1029*t1098
     t1101 = xp.not_equal(t1100, 0)
-    t1102 = 0.5*(-t1074 + t1005)/xp.where(t1101, t1100, 1)
+    t1102 = (-t1074 + t1005)/xp.where(t1101, 2*t1100, 1)
     t1103 = xp.abs(t1102)
     t1104 = xp.greater_equal(t1103, 1)
-    t1105 = xp.abs(1/xp.where(t1104, t1102, 1))
+    t1105 = 1/xp.abs(xp.where(t1104, t1102, 1))
     t1106 = xp.where(t1101, xp.where(xp.greater_equal(t1102, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1104, t1105/(1 + xp.sqrt(1 + t1105**2)), 1/(t1103 + xp.sqrt(1 + t1103**2))), 0)
     t1107 = 1/xp.sqrt(1 + t1106**2)
     t1108 = t1100*t1106
@@ -6846,10 +6846,10 @@ def condition_number(q):
     t1135 = t1044*t1113 + t1048*t1117 + t1052*t1121 + t1056*t1125 + t1060*t1129 + t1064*t1133
     t1136 = t1079*t1114 + t1083*t1118 + t1087*t1122 + t1091*t1126 + t1095*t1130 + t1099*t1134
     t1137 = xp.not_equal(t1135, 0)
-    t1138 = 0.5*(-t1109 + t1040)/xp.where(t1137, t1135, 1)
+    t1138 = (-t1109 + t1040)/xp.where(t1137, 2*t1135, 1)
     t1139 = xp.abs(t1138)
     t1140 = xp.greater_equal(t1139, 1)
-    t1141 = xp.abs(1/xp.where(t1140, t1138, 1))
+    t1141 = 1/xp.abs(xp.where(t1140, t1138, 1))
     t1142 = xp.where(t1137, xp.where(xp.greater_equal(t1138, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1140, t1141/(1 + xp.sqrt(1 + t1141**2)), 1/(t1139 + xp.sqrt(1 + t1139**2))), 0)
     t1143 = 1/xp.sqrt(1 + t1142**2)
     t1144 = t1135*t1142
@@ -6880,10 +6880,10 @@ def condition_number(q):
     t1169 = t1167 - t1168*t1142
     t1170 = t1168 + t1167*t1142
     t1171 = xp.not_equal(t1136, 0)
-    t1172 = 0.5*(-t1075 + t1110)/xp.where(t1171, t1136, 1)
+    t1172 = (-t1075 + t1110)/xp.where(t1171, 2*t1136, 1)
     t1173 = xp.abs(t1172)
     t1174 = xp.greater_equal(t1173, 1)
-    t1175 = xp.abs(1/xp.where(t1174, t1172, 1))
+    t1175 = 1/xp.abs(xp.where(t1174, t1172, 1))
     t1176 = xp.where(t1171, xp.where(xp.greater_equal(t1172, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1174, t1175/(1 + xp.sqrt(1 + t1175**2)), 1/(t1173 + xp.sqrt(1 + t1173**2))), 0)
     t1177 = 1/xp.sqrt(1 + t1176**2)
     t1178 = t1136*t1176
@@ -6915,10 +6915,10 @@ def condition_number(q):
     t1204 = t1202 + t1201*t1176
     t1205 = t1150*t1183 + t1154*t1187 + t1158*t1191 + t1162*t1195 + t1166*t1199 + t1170*t1203
     t1206 = xp.not_equal(t1205, 0)
-    t1207 = 0.5*(-t1179 + t1146)/xp.where(t1206, t1205, 1)
+    t1207 = (-t1179 + t1146)/xp.where(t1206, 2*t1205, 1)
     t1208 = xp.abs(t1207)
     t1209 = xp.greater_equal(t1208, 1)
-    t1210 = xp.abs(1/xp.where(t1209, t1207, 1))
+    t1210 = 1/xp.abs(xp.where(t1209, t1207, 1))
     t1211 = xp.where(t1206, xp.where(xp.greater_equal(t1207, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1209, t1210/(1 + xp.sqrt(1 + t1210**2)), 1/(t1208 + xp.sqrt(1 + t1208**2))), 0)
     t1212 = 1/xp.sqrt(1 + t1211**2)
     t1213 = t1205*t1211
@@ -6950,10 +6950,10 @@ def condition_number(q):
     t1239 = t1237 + t1211*t1236
     t1240 = t1184*t1219 + t1188*t1223 + t1192*t1227 + t1196*t1231 + t1200*t1235 + t1204*t1239
     t1241 = xp.not_equal(t1240, 0)
-    t1242 = 0.5*(-t1180 + t1215)/xp.where(t1241, t1240, 1)
+    t1242 = (-t1180 + t1215)/xp.where(t1241, 2*t1240, 1)
     t1243 = xp.abs(t1242)
     t1244 = xp.greater_equal(t1243, 1)
-    t1245 = xp.abs(1/xp.where(t1244, t1242, 1))
+    t1245 = 1/xp.abs(xp.where(t1244, t1242, 1))
     t1246 = xp.where(t1241, xp.where(xp.greater_equal(t1242, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1244, t1245/(1 + xp.sqrt(1 + t1245**2)), 1/(t1243 + xp.sqrt(1 + t1243**2))), 0)
     t1247 = 1/xp.sqrt(1 + t1246**2)
     t1248 = t1240*t1246
@@ -6984,10 +6984,10 @@ def condition_number(q):
     t1273 = t1271 - t1246*t1272
     t1274 = t1272 + t1246*t1271
     t1275 = xp.not_equal(t1065, 0)
-    t1276 = 0.5*(-t899 + t1039)/xp.where(t1275, t1065, 1)
+    t1276 = (-t899 + t1039)/xp.where(t1275, 2*t1065, 1)
     t1277 = xp.abs(t1276)
     t1278 = xp.greater_equal(t1277, 1)
-    t1279 = xp.abs(1/xp.where(t1278, t1276, 1))
+    t1279 = 1/xp.abs(xp.where(t1278, t1276, 1))
     t1280 = xp.where(t1275, xp.where(xp.greater_equal(t1276, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1278, t1279/(1 + xp.sqrt(1 + t1279**2)), 1/(t1277 + xp.sqrt(1 + t1277**2))), 0)
     t1281 = 1/xp.sqrt(1 + t1280**2)
     t1282 = t1065*t1280
@@ -7019,10 +7019,10 @@ def condition_number(q):
     t1308 = t1306 + t1280*t1305
     t1309 = t1149*t1287 + t1153*t1291 + t1157*t1295 + t1161*t1299 + t1165*t1303 + t1169*t1307
     t1310 = xp.not_equal(t1309, 0)
-    t1311 = 0.5*(-t1283 + t1145)/xp.where(t1310, t1309, 1)
+    t1311 = (-t1283 + t1145)/xp.where(t1310, 2*t1309, 1)
     t1312 = xp.abs(t1311)
     t1313 = xp.greater_equal(t1312, 1)
-    t1314 = xp.abs(1/xp.where(t1313, t1311, 1))
+    t1314 = 1/xp.abs(xp.where(t1313, t1311, 1))
     t1315 = xp.where(t1310, xp.where(xp.greater_equal(t1311, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1313, t1314/(1 + xp.sqrt(1 + t1314**2)), 1/(t1312 + xp.sqrt(1 + t1312**2))), 0)
     t1316 = 1/xp.sqrt(1 + t1315**2)
     t1317 = t1309*t1315
@@ -7055,10 +7055,10 @@ def condition_number(q):
     t1344 = t1218*t1322 + t1222*t1326 + t1226*t1330 + t1230*t1334 + t1234*t1338 + t1238*t1342
     t1345 = t1288*t1323 + t1292*t1327 + t1296*t1331 + t1300*t1335 + t1304*t1339 + t1308*t1343
     t1346 = xp.not_equal(t1344, 0)
-    t1347 = 0.5*(-t1318 + t1214)/xp.where(t1346, t1344, 1)
+    t1347 = (-t1318 + t1214)/xp.where(t1346, 2*t1344, 1)
     t1348 = xp.abs(t1347)
     t1349 = xp.greater_equal(t1348, 1)
-    t1350 = xp.abs(1/xp.where(t1349, t1347, 1))
+    t1350 = 1/xp.abs(xp.where(t1349, t1347, 1))
     t1351 = xp.where(t1346, xp.where(xp.greater_equal(t1347, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1349, t1350/(1 + xp.sqrt(1 + t1350**2)), 1/(t1348 + xp.sqrt(1 + t1348**2))), 0)
     t1352 = 1/xp.sqrt(1 + t1351**2)
     t1353 = t1344*t1351
@@ -7090,10 +7090,10 @@ def condition_number(q):
     t1379 = t1377 + t1351*t1376
     t1380 = t1253*t1358 + t1257*t1362 + t1261*t1366 + t1265*t1370 + t1269*t1374 + t1273*t1378
     t1381 = xp.not_equal(t1380, 0)
-    t1382 = 0.5*(-t1354 + t1249)/xp.where(t1381, t1380, 1)
+    t1382 = (-t1354 + t1249)/xp.where(t1381, 2*t1380, 1)
     t1383 = xp.abs(t1382)
     t1384 = xp.greater_equal(t1383, 1)
-    t1385 = xp.abs(1/xp.where(t1384, t1382, 1))
+    t1385 = 1/xp.abs(xp.where(t1384, t1382, 1))
     t1386 = xp.where(t1381, xp.where(xp.greater_equal(t1382, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1384, t1385/(1 + xp.sqrt(1 + t1385**2)), 1/(t1383 + xp.sqrt(1 + t1383**2))), 0)
     t1387 = 1/xp.sqrt(1 + t1386**2)
     t1388 = t1380*t1386
@@ -7125,10 +7125,10 @@ def condition_number(q):
     t1414 = t1412 + t1386*t1411
     t1415 = t1254*t1393 + t1258*t1397 + t1262*t1401 + t1266*t1405 + t1270*t1409 + t1274*t1413
     t1416 = xp.not_equal(t1415, 0)
-    t1417 = 0.5*(-t1389 + t1250)/xp.where(t1416, t1415, 1)
+    t1417 = (-t1389 + t1250)/xp.where(t1416, 2*t1415, 1)
     t1418 = xp.abs(t1417)
     t1419 = xp.greater_equal(t1418, 1)
-    t1420 = xp.abs(1/xp.where(t1419, t1417, 1))
+    t1420 = 1/xp.abs(xp.where(t1419, t1417, 1))
     t1421 = xp.where(t1416, xp.where(xp.greater_equal(t1417, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1419, t1420/(1 + xp.sqrt(1 + t1420**2)), 1/(t1418 + xp.sqrt(1 + t1418**2))), 0)
     t1422 = 1/xp.sqrt(1 + t1421**2)
     t1423 = t1415*t1421
@@ -7159,10 +7159,10 @@ def condition_number(q):
     t1448 = t1446 - t1421*t1447
     t1449 = t1447 + t1421*t1446
     t1450 = xp.not_equal(t1345, 0)
-    t1451 = 0.5*(-t1284 + t1319)/xp.where(t1450, t1345, 1)
+    t1451 = (-t1284 + t1319)/xp.where(t1450, 2*t1345, 1)
     t1452 = xp.abs(t1451)
     t1453 = xp.greater_equal(t1452, 1)
-    t1454 = xp.abs(1/xp.where(t1453, t1451, 1))
+    t1454 = 1/xp.abs(xp.where(t1453, t1451, 1))
     t1455 = xp.where(t1450, xp.where(xp.greater_equal(t1451, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1453, t1454/(1 + xp.sqrt(1 + t1454**2)), 1/(t1452 + xp.sqrt(1 + t1452**2))), 0)
     t1456 = 1/xp.sqrt(1 + t1455**2)
     t1457 = t1345*t1455
@@ -7194,10 +7194,10 @@ def condition_number(q):
     t1483 = t1481 + t1455*t1480
     t1484 = t1359*t1462 + t1363*t1466 + t1367*t1470 + t1371*t1474 + t1375*t1478 + t1379*t1482
     t1485 = xp.not_equal(t1484, 0)
-    t1486 = 0.5*(-t1458 + t1355)/xp.where(t1485, t1484, 1)
+    t1486 = (-t1458 + t1355)/xp.where(t1485, 2*t1484, 1)
     t1487 = xp.abs(t1486)
     t1488 = xp.greater_equal(t1487, 1)
-    t1489 = xp.abs(1/xp.where(t1488, t1486, 1))
+    t1489 = 1/xp.abs(xp.where(t1488, t1486, 1))
     t1490 = xp.where(t1485, xp.where(xp.greater_equal(t1486, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1488, t1489/(1 + xp.sqrt(1 + t1489**2)), 1/(t1487 + xp.sqrt(1 + t1487**2))), 0)
     t1491 = 1/xp.sqrt(1 + t1490**2)
     t1492 = t1484*t1490
@@ -7230,10 +7230,10 @@ def condition_number(q):
     t1519 = t1394*t1497 + t1398*t1501 + t1402*t1505 + t1406*t1509 + t1410*t1513 + t1414*t1517
     t1520 = t1463*t1498 + t1467*t1502 + t1471*t1506 + t1475*t1510 + t1479*t1514 + t1483*t1518
     t1521 = xp.not_equal(t1519, 0)
-    t1522 = 0.5*(-t1493 + t1390)/xp.where(t1521, t1519, 1)
+    t1522 = (-t1493 + t1390)/xp.where(t1521, 2*t1519, 1)
     t1523 = xp.abs(t1522)
     t1524 = xp.greater_equal(t1523, 1)
-    t1525 = xp.abs(1/xp.where(t1524, t1522, 1))
+    t1525 = 1/xp.abs(xp.where(t1524, t1522, 1))
     t1526 = xp.where(t1521, xp.where(xp.greater_equal(t1522, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1524, t1525/(1 + xp.sqrt(1 + t1525**2)), 1/(t1523 + xp.sqrt(1 + t1523**2))), 0)
     t1527 = 1/xp.sqrt(1 + t1526**2)
     t1528 = t1519*t1526
@@ -7265,10 +7265,10 @@ def condition_number(q):
     t1554 = t1552 + t1526*t1551
     t1555 = t1429*t1533 + t1433*t1537 + t1437*t1541 + t1441*t1545 + t1445*t1549 + t1449*t1553
     t1556 = xp.not_equal(t1555, 0)
-    t1557 = 0.5*(-t1529 + t1425)/xp.where(t1556, t1555, 1)
+    t1557 = (-t1529 + t1425)/xp.where(t1556, 2*t1555, 1)
     t1558 = xp.abs(t1557)
     t1559 = xp.greater_equal(t1558, 1)
-    t1560 = xp.abs(1/xp.where(t1559, t1557, 1))
+    t1560 = 1/xp.abs(xp.where(t1559, t1557, 1))
     t1561 = xp.where(t1556, xp.where(xp.greater_equal(t1557, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1559, t1560/(1 + xp.sqrt(1 + t1560**2)), 1/(t1558 + xp.sqrt(1 + t1558**2))), 0)
     t1562 = 1/xp.sqrt(1 + t1561**2)
     t1563 = t1555*t1561
@@ -7300,10 +7300,10 @@ def condition_number(q):
     t1589 = t1587 + t1561*t1586
     t1590 = t1428*t1568 + t1432*t1572 + t1436*t1576 + t1440*t1580 + t1444*t1584 + t1448*t1588
     t1591 = xp.not_equal(t1520, 0)
-    t1592 = 0.5*(-t1459 + t1494)/xp.where(t1591, t1520, 1)
+    t1592 = (-t1459 + t1494)/xp.where(t1591, 2*t1520, 1)
     t1593 = xp.abs(t1592)
     t1594 = xp.greater_equal(t1593, 1)
-    t1595 = xp.abs(1/xp.where(t1594, t1592, 1))
+    t1595 = 1/xp.abs(xp.where(t1594, t1592, 1))
     t1596 = xp.where(t1591, xp.where(xp.greater_equal(t1592, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1594, t1595/(1 + xp.sqrt(1 + t1595**2)), 1/(t1593 + xp.sqrt(1 + t1593**2))), 0)
     t1597 = 1/xp.sqrt(1 + t1596**2)
     t1598 = t1520*t1596
@@ -7335,10 +7335,10 @@ def condition_number(q):
     t1624 = t1622 + t1596*t1621
     t1625 = t1534*t1603 + t1538*t1607 + t1542*t1611 + t1546*t1615 + t1550*t1619 + t1554*t1623
     t1626 = xp.not_equal(t1625, 0)
-    t1627 = 0.5*(-t1599 + t1530)/xp.where(t1626, t1625, 1)
+    t1627 = (-t1599 + t1530)/xp.where(t1626, 2*t1625, 1)
     t1628 = xp.abs(t1627)
     t1629 = xp.greater_equal(t1628, 1)
-    t1630 = xp.abs(1/xp.where(t1629, t1627, 1))
+    t1630 = 1/xp.abs(xp.where(t1629, t1627, 1))
     t1631 = xp.where(t1626, xp.where(xp.greater_equal(t1627, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1629, t1630/(1 + xp.sqrt(1 + t1630**2)), 1/(t1628 + xp.sqrt(1 + t1628**2))), 0)
     t1632 = 1/xp.sqrt(1 + t1631**2)
     t1633 = t1625*t1631
@@ -7371,10 +7371,10 @@ def condition_number(q):
     t1660 = t1569*t1638 + t1573*t1642 + t1577*t1646 + t1581*t1650 + t1585*t1654 + t1589*t1658
     t1661 = t1604*t1639 + t1608*t1643 + t1612*t1647 + t1616*t1651 + t1620*t1655 + t1624*t1659
     t1662 = xp.not_equal(t1660, 0)
-    t1663 = 0.5*(-t1634 + t1565)/xp.where(t1662, t1660, 1)
+    t1663 = (-t1634 + t1565)/xp.where(t1662, 2*t1660, 1)
     t1664 = xp.abs(t1663)
     t1665 = xp.greater_equal(t1664, 1)
-    t1666 = xp.abs(1/xp.where(t1665, t1663, 1))
+    t1666 = 1/xp.abs(xp.where(t1665, t1663, 1))
     t1667 = xp.where(t1662, xp.where(xp.greater_equal(t1663, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1665, t1666/(1 + xp.sqrt(1 + t1666**2)), 1/(t1664 + xp.sqrt(1 + t1664**2))), 0)
     t1668 = 1/xp.sqrt(1 + t1667**2)
     t1669 = t1660*t1667
@@ -7405,10 +7405,10 @@ def condition_number(q):
     t1694 = t1692 - t1667*t1693
     t1695 = t1693 + t1667*t1692
     t1696 = xp.not_equal(t1661, 0)
-    t1697 = 0.5*(-t1600 + t1635)/xp.where(t1696, t1661, 1)
+    t1697 = (-t1600 + t1635)/xp.where(t1696, 2*t1661, 1)
     t1698 = xp.abs(t1697)
     t1699 = xp.greater_equal(t1698, 1)
-    t1700 = xp.abs(1/xp.where(t1699, t1697, 1))
+    t1700 = 1/xp.abs(xp.where(t1699, t1697, 1))
     t1701 = xp.where(t1696, xp.where(xp.greater_equal(t1697, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1699, t1700/(1 + xp.sqrt(1 + t1700**2)), 1/(t1698 + xp.sqrt(1 + t1698**2))), 0)
     t1702 = 1/xp.sqrt(1 + t1701**2)
     t1703 = t1661*t1701
@@ -7440,10 +7440,10 @@ def condition_number(q):
     t1729 = t1727 + t1701*t1726
     t1730 = t1675*t1708 + t1679*t1712 + t1683*t1716 + t1687*t1720 + t1691*t1724 + t1695*t1728
     t1731 = xp.not_equal(t1730, 0)
-    t1732 = 0.5*(-t1704 + t1671)/xp.where(t1731, t1730, 1)
+    t1732 = (-t1704 + t1671)/xp.where(t1731, 2*t1730, 1)
     t1733 = xp.abs(t1732)
     t1734 = xp.greater_equal(t1733, 1)
-    t1735 = xp.abs(1/xp.where(t1734, t1732, 1))
+    t1735 = 1/xp.abs(xp.where(t1734, t1732, 1))
     t1736 = xp.where(t1731, xp.where(xp.greater_equal(t1732, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1734, t1735/(1 + xp.sqrt(1 + t1735**2)), 1/(t1733 + xp.sqrt(1 + t1733**2))), 0)
     t1737 = 1/xp.sqrt(1 + t1736**2)
     t1738 = t1730*t1736
@@ -7475,10 +7475,10 @@ def condition_number(q):
     t1764 = t1762 + t1736*t1761
     t1765 = t1709*t1744 + t1713*t1748 + t1717*t1752 + t1721*t1756 + t1725*t1760 + t1729*t1764
     t1766 = xp.not_equal(t1765, 0)
-    t1767 = 0.5*(-t1705 + t1740)/xp.where(t1766, t1765, 1)
+    t1767 = (-t1705 + t1740)/xp.where(t1766, 2*t1765, 1)
     t1768 = xp.abs(t1767)
     t1769 = xp.greater_equal(t1768, 1)
-    t1770 = xp.abs(1/xp.where(t1769, t1767, 1))
+    t1770 = 1/xp.abs(xp.where(t1769, t1767, 1))
     t1771 = xp.where(t1766, xp.where(xp.greater_equal(t1767, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1769, t1770/(1 + xp.sqrt(1 + t1770**2)), 1/(t1768 + xp.sqrt(1 + t1768**2))), 0)
     t1772 = 1/xp.sqrt(1 + t1771**2)
     t1773 = t1765*t1771
@@ -7509,10 +7509,10 @@ def condition_number(q):
     t1798 = t1796 - t1771*t1797
     t1799 = t1797 + t1771*t1796
     t1800 = xp.not_equal(t1590, 0)
-    t1801 = 0.5*(-t1424 + t1564)/xp.where(t1800, t1590, 1)
+    t1801 = (-t1424 + t1564)/xp.where(t1800, 2*t1590, 1)
     t1802 = xp.abs(t1801)
     t1803 = xp.greater_equal(t1802, 1)
-    t1804 = xp.abs(1/xp.where(t1803, t1801, 1))
+    t1804 = 1/xp.abs(xp.where(t1803, t1801, 1))
     t1805 = xp.where(t1800, xp.where(xp.greater_equal(t1801, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1803, t1804/(1 + xp.sqrt(1 + t1804**2)), 1/(t1802 + xp.sqrt(1 + t1802**2))), 0)
     t1806 = 1/xp.sqrt(1 + t1805**2)
     t1807 = t1590*t1805
@@ -7544,10 +7544,10 @@ def condition_number(q):
     t1833 = t1831 + t1805*t1830
     t1834 = t1674*t1812 + t1678*t1816 + t1682*t1820 + t1686*t1824 + t1690*t1828 + t1694*t1832
     t1835 = xp.not_equal(t1834, 0)
-    t1836 = 0.5*(-t1808 + t1670)/xp.where(t1835, t1834, 1)
+    t1836 = (-t1808 + t1670)/xp.where(t1835, 2*t1834, 1)
     t1837 = xp.abs(t1836)
     t1838 = xp.greater_equal(t1837, 1)
-    t1839 = xp.abs(1/xp.where(t1838, t1836, 1))
+    t1839 = 1/xp.abs(xp.where(t1838, t1836, 1))
     t1840 = xp.where(t1835, xp.where(xp.greater_equal(t1836, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1838, t1839/(1 + xp.sqrt(1 + t1839**2)), 1/(t1837 + xp.sqrt(1 + t1837**2))), 0)
     t1841 = 1/xp.sqrt(1 + t1840**2)
     t1842 = t1834*t1840
@@ -7580,10 +7580,10 @@ def condition_number(q):
     t1869 = t1743*t1847 + t1747*t1851 + t1751*t1855 + t1755*t1859 + t1759*t1863 + t1763*t1867
     t1870 = t1813*t1848 + t1817*t1852 + t1821*t1856 + t1825*t1860 + t1829*t1864 + t1833*t1868
     t1871 = xp.not_equal(t1869, 0)
-    t1872 = 0.5*(-t1843 + t1739)/xp.where(t1871, t1869, 1)
+    t1872 = (-t1843 + t1739)/xp.where(t1871, 2*t1869, 1)
     t1873 = xp.abs(t1872)
     t1874 = xp.greater_equal(t1873, 1)
-    t1875 = xp.abs(1/xp.where(t1874, t1872, 1))
+    t1875 = 1/xp.abs(xp.where(t1874, t1872, 1))
     t1876 = xp.where(t1871, xp.where(xp.greater_equal(t1872, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1874, t1875/(1 + xp.sqrt(1 + t1875**2)), 1/(t1873 + xp.sqrt(1 + t1873**2))), 0)
     t1877 = 1/xp.sqrt(1 + t1876**2)
     t1878 = t1869*t1876
@@ -7615,10 +7615,10 @@ def condition_number(q):
     t1904 = t1902 + t1876*t1901
     t1905 = t1778*t1883 + t1782*t1887 + t1786*t1891 + t1790*t1895 + t1794*t1899 + t1798*t1903
     t1906 = xp.not_equal(t1905, 0)
-    t1907 = 0.5*(-t1879 + t1774)/xp.where(t1906, t1905, 1)
+    t1907 = (-t1879 + t1774)/xp.where(t1906, 2*t1905, 1)
     t1908 = xp.abs(t1907)
     t1909 = xp.greater_equal(t1908, 1)
-    t1910 = xp.abs(1/xp.where(t1909, t1907, 1))
+    t1910 = 1/xp.abs(xp.where(t1909, t1907, 1))
     t1911 = xp.where(t1906, xp.where(xp.greater_equal(t1907, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1909, t1910/(1 + xp.sqrt(1 + t1910**2)), 1/(t1908 + xp.sqrt(1 + t1908**2))), 0)
     t1912 = 1/xp.sqrt(1 + t1911**2)
     t1913 = t1905*t1911
@@ -7650,10 +7650,10 @@ def condition_number(q):
     t1939 = t1937 + t1911*t1936
     t1940 = t1779*t1918 + t1783*t1922 + t1787*t1926 + t1791*t1930 + t1795*t1934 + t1799*t1938
     t1941 = xp.not_equal(t1940, 0)
-    t1942 = 0.5*(-t1914 + t1775)/xp.where(t1941, t1940, 1)
+    t1942 = (-t1914 + t1775)/xp.where(t1941, 2*t1940, 1)
     t1943 = xp.abs(t1942)
     t1944 = xp.greater_equal(t1943, 1)
-    t1945 = xp.abs(1/xp.where(t1944, t1942, 1))
+    t1945 = 1/xp.abs(xp.where(t1944, t1942, 1))
     t1946 = xp.where(t1941, xp.where(xp.greater_equal(t1942, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1944, t1945/(1 + xp.sqrt(1 + t1945**2)), 1/(t1943 + xp.sqrt(1 + t1943**2))), 0)
     t1947 = 1/xp.sqrt(1 + t1946**2)
     t1948 = t1940*t1946
@@ -7684,10 +7684,10 @@ def condition_number(q):
     t1973 = t1971 - t1946*t1972
     t1974 = t1972 + t1946*t1971
     t1975 = xp.not_equal(t1870, 0)
-    t1976 = 0.5*(-t1809 + t1844)/xp.where(t1975, t1870, 1)
+    t1976 = (-t1809 + t1844)/xp.where(t1975, 2*t1870, 1)
     t1977 = xp.abs(t1976)
     t1978 = xp.greater_equal(t1977, 1)
-    t1979 = xp.abs(1/xp.where(t1978, t1976, 1))
+    t1979 = 1/xp.abs(xp.where(t1978, t1976, 1))
     t1980 = xp.where(t1975, xp.where(xp.greater_equal(t1976, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1978, t1979/(1 + xp.sqrt(1 + t1979**2)), 1/(t1977 + xp.sqrt(1 + t1977**2))), 0)
     t1981 = 1/xp.sqrt(1 + t1980**2)
     t1982 = t1870*t1980
@@ -7719,10 +7719,10 @@ def condition_number(q):
     t2008 = t2006 + t1980*t2005
     t2009 = t1884*t1987 + t1888*t1991 + t1892*t1995 + t1896*t1999 + t1900*t2003 + t1904*t2007
     t2010 = xp.not_equal(t2009, 0)
-    t2011 = 0.5*(-t1983 + t1880)/xp.where(t2010, t2009, 1)
+    t2011 = (-t1983 + t1880)/xp.where(t2010, 2*t2009, 1)
     t2012 = xp.abs(t2011)
     t2013 = xp.greater_equal(t2012, 1)
-    t2014 = xp.abs(1/xp.where(t2013, t2011, 1))
+    t2014 = 1/xp.abs(xp.where(t2013, t2011, 1))
     t2015 = xp.where(t2010, xp.where(xp.greater_equal(t2011, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2013, t2014/(1 + xp.sqrt(1 + t2014**2)), 1/(t2012 + xp.sqrt(1 + t2012**2))), 0)
     t2016 = 1/xp.sqrt(1 + t2015**2)
     t2017 = t2009*t2015
@@ -7755,10 +7755,10 @@ def condition_number(q):
     t2044 = t1919*t2022 + t1923*t2026 + t1927*t2030 + t1931*t2034 + t1935*t2038 + t1939*t2042
     t2045 = t1988*t2023 + t1992*t2027 + t1996*t2031 + t2000*t2035 + t2004*t2039 + t2008*t2043
     t2046 = xp.not_equal(t2044, 0)
-    t2047 = 0.5*(-t2018 + t1915)/xp.where(t2046, t2044, 1)
+    t2047 = (-t2018 + t1915)/xp.where(t2046, 2*t2044, 1)
     t2048 = xp.abs(t2047)
     t2049 = xp.greater_equal(t2048, 1)
-    t2050 = xp.abs(1/xp.where(t2049, t2047, 1))
+    t2050 = 1/xp.abs(xp.where(t2049, t2047, 1))
     t2051 = xp.where(t2046, xp.where(xp.greater_equal(t2047, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2049, t2050/(1 + xp.sqrt(1 + t2050**2)), 1/(t2048 + xp.sqrt(1 + t2048**2))), 0)
     t2052 = 1/xp.sqrt(1 + t2051**2)
     t2053 = t2044*t2051
@@ -7790,10 +7790,10 @@ def condition_number(q):
     t2079 = t2077 + t2051*t2076
     t2080 = t1954*t2058 + t1958*t2062 + t1962*t2066 + t1966*t2070 + t1970*t2074 + t1974*t2078
     t2081 = xp.not_equal(t2080, 0)
-    t2082 = 0.5*(-t2054 + t1950)/xp.where(t2081, t2080, 1)
+    t2082 = (-t2054 + t1950)/xp.where(t2081, 2*t2080, 1)
     t2083 = xp.abs(t2082)
     t2084 = xp.greater_equal(t2083, 1)
-    t2085 = xp.abs(1/xp.where(t2084, t2082, 1))
+    t2085 = 1/xp.abs(xp.where(t2084, t2082, 1))
     t2086 = xp.where(t2081, xp.where(xp.greater_equal(t2082, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2084, t2085/(1 + xp.sqrt(1 + t2085**2)), 1/(t2083 + xp.sqrt(1 + t2083**2))), 0)
     t2087 = 1/xp.sqrt(1 + t2086**2)
     t2088 = t2080*t2086
@@ -7825,10 +7825,10 @@ def condition_number(q):
     t2114 = t2112 + t2086*t2111
     t2115 = t1953*t2093 + t1957*t2097 + t1961*t2101 + t1965*t2105 + t1969*t2109 + t1973*t2113
     t2116 = xp.not_equal(t2045, 0)
-    t2117 = 0.5*(-t1984 + t2019)/xp.where(t2116, t2045, 1)
+    t2117 = (-t1984 + t2019)/xp.where(t2116, 2*t2045, 1)
     t2118 = xp.abs(t2117)
     t2119 = xp.greater_equal(t2118, 1)
-    t2120 = xp.abs(1/xp.where(t2119, t2117, 1))
+    t2120 = 1/xp.abs(xp.where(t2119, t2117, 1))
     t2121 = xp.where(t2116, xp.where(xp.greater_equal(t2117, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2119, t2120/(1 + xp.sqrt(1 + t2120**2)), 1/(t2118 + xp.sqrt(1 + t2118**2))), 0)
     t2122 = 1/xp.sqrt(1 + t2121**2)
     t2123 = t2045*t2121
@@ -7860,10 +7860,10 @@ def condition_number(q):
     t2149 = t2147 + t2121*t2146
     t2150 = t2059*t2128 + t2063*t2132 + t2067*t2136 + t2071*t2140 + t2075*t2144 + t2079*t2148
     t2151 = xp.not_equal(t2150, 0)
-    t2152 = 0.5*(-t2124 + t2055)/xp.where(t2151, t2150, 1)
+    t2152 = (-t2124 + t2055)/xp.where(t2151, 2*t2150, 1)
     t2153 = xp.abs(t2152)
     t2154 = xp.greater_equal(t2153, 1)
-    t2155 = xp.abs(1/xp.where(t2154, t2152, 1))
+    t2155 = 1/xp.abs(xp.where(t2154, t2152, 1))
     t2156 = xp.where(t2151, xp.where(xp.greater_equal(t2152, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2154, t2155/(1 + xp.sqrt(1 + t2155**2)), 1/(t2153 + xp.sqrt(1 + t2153**2))), 0)
     t2157 = 1/xp.sqrt(1 + t2156**2)
     t2158 = t2150*t2156
@@ -7896,10 +7896,10 @@ def condition_number(q):
     t2185 = t2094*t2163 + t2098*t2167 + t2102*t2171 + t2106*t2175 + t2110*t2179 + t2114*t2183
     t2186 = t2129*t2164 + t2133*t2168 + t2137*t2172 + t2141*t2176 + t2145*t2180 + t2149*t2184
     t2187 = xp.not_equal(t2185, 0)
-    t2188 = 0.5*(-t2159 + t2090)/xp.where(t2187, t2185, 1)
+    t2188 = (-t2159 + t2090)/xp.where(t2187, 2*t2185, 1)
     t2189 = xp.abs(t2188)
     t2190 = xp.greater_equal(t2189, 1)
-    t2191 = xp.abs(1/xp.where(t2190, t2188, 1))
+    t2191 = 1/xp.abs(xp.where(t2190, t2188, 1))
     t2192 = xp.where(t2187, xp.where(xp.greater_equal(t2188, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2190, t2191/(1 + xp.sqrt(1 + t2191**2)), 1/(t2189 + xp.sqrt(1 + t2189**2))), 0)
     t2193 = 1/xp.sqrt(1 + t2192**2)
     t2194 = t2185*t2192
@@ -7930,10 +7930,10 @@ def condition_number(q):
     t2219 = t2217 - t2192*t2218
     t2220 = t2218 + t2192*t2217
     t2221 = xp.not_equal(t2186, 0)
-    t2222 = 0.5*(-t2125 + t2160)/xp.where(t2221, t2186, 1)
+    t2222 = (-t2125 + t2160)/xp.where(t2221, 2*t2186, 1)
     t2223 = xp.abs(t2222)
     t2224 = xp.greater_equal(t2223, 1)
-    t2225 = xp.abs(1/xp.where(t2224, t2222, 1))
+    t2225 = 1/xp.abs(xp.where(t2224, t2222, 1))
     t2226 = xp.where(t2221, xp.where(xp.greater_equal(t2222, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2224, t2225/(1 + xp.sqrt(1 + t2225**2)), 1/(t2223 + xp.sqrt(1 + t2223**2))), 0)
     t2227 = 1/xp.sqrt(1 + t2226**2)
     t2228 = t2186*t2226
@@ -7965,10 +7965,10 @@ def condition_number(q):
     t2254 = t2252 + t2226*t2251
     t2255 = t2200*t2233 + t2204*t2237 + t2208*t2241 + t2212*t2245 + t2216*t2249 + t2220*t2253
     t2256 = xp.not_equal(t2255, 0)
-    t2257 = 0.5*(-t2229 + t2196)/xp.where(t2256, t2255, 1)
+    t2257 = (-t2229 + t2196)/xp.where(t2256, 2*t2255, 1)
     t2258 = xp.abs(t2257)
     t2259 = xp.greater_equal(t2258, 1)
-    t2260 = xp.abs(1/xp.where(t2259, t2257, 1))
+    t2260 = 1/xp.abs(xp.where(t2259, t2257, 1))
     t2261 = xp.where(t2256, xp.where(xp.greater_equal(t2257, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2259, t2260/(1 + xp.sqrt(1 + t2260**2)), 1/(t2258 + xp.sqrt(1 + t2258**2))), 0)
     t2262 = 1/xp.sqrt(1 + t2261**2)
     t2263 = t2255*t2261
@@ -8000,10 +8000,10 @@ def condition_number(q):
     t2289 = t2287 + t2261*t2286
     t2290 = t2234*t2269 + t2238*t2273 + t2242*t2277 + t2246*t2281 + t2250*t2285 + t2254*t2289
     t2291 = xp.not_equal(t2290, 0)
-    t2292 = 0.5*(-t2230 + t2265)/xp.where(t2291, t2290, 1)
+    t2292 = (-t2230 + t2265)/xp.where(t2291, 2*t2290, 1)
     t2293 = xp.abs(t2292)
     t2294 = xp.greater_equal(t2293, 1)
-    t2295 = xp.abs(1/xp.where(t2294, t2292, 1))
+    t2295 = 1/xp.abs(xp.where(t2294, t2292, 1))
     t2296 = xp.where(t2291, xp.where(xp.greater_equal(t2292, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2294, t2295/(1 + xp.sqrt(1 + t2295**2)), 1/(t2293 + xp.sqrt(1 + t2293**2))), 0)
     t2297 = 1/xp.sqrt(1 + t2296**2)
     t2298 = t2290*t2296
@@ -8034,10 +8034,10 @@ def condition_number(q):
     t2323 = t2321 - t2296*t2322
     t2324 = t2322 + t2296*t2321
     t2325 = xp.not_equal(t2115, 0)
-    t2326 = 0.5*(-t1949 + t2089)/xp.where(t2325, t2115, 1)
+    t2326 = (-t1949 + t2089)/xp.where(t2325, 2*t2115, 1)
     t2327 = xp.abs(t2326)
     t2328 = xp.greater_equal(t2327, 1)
-    t2329 = xp.abs(1/xp.where(t2328, t2326, 1))
+    t2329 = 1/xp.abs(xp.where(t2328, t2326, 1))
     t2330 = xp.where(t2325, xp.where(xp.greater_equal(t2326, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2328, t2329/(1 + xp.sqrt(1 + t2329**2)), 1/(t2327 + xp.sqrt(1 + t2327**2))), 0)
     t2331 = 1/xp.sqrt(1 + t2330**2)
     t2332 = t2115*t2330
@@ -8069,10 +8069,10 @@ def condition_number(q):
     t2358 = t2356 + t2330*t2355
     t2359 = t2199*t2337 + t2203*t2341 + t2207*t2345 + t2211*t2349 + t2215*t2353 + t2219*t2357
     t2360 = xp.not_equal(t2359, 0)
-    t2361 = 0.5*(-t2333 + t2195)/xp.where(t2360, t2359, 1)
+    t2361 = (-t2333 + t2195)/xp.where(t2360, 2*t2359, 1)
     t2362 = xp.abs(t2361)
     t2363 = xp.greater_equal(t2362, 1)
-    t2364 = xp.abs(1/xp.where(t2363, t2361, 1))
+    t2364 = 1/xp.abs(xp.where(t2363, t2361, 1))
     t2365 = xp.where(t2360, xp.where(xp.greater_equal(t2361, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2363, t2364/(1 + xp.sqrt(1 + t2364**2)), 1/(t2362 + xp.sqrt(1 + t2362**2))), 0)
     t2366 = 1/xp.sqrt(1 + t2365**2)
     t2367 = t2359*t2365
@@ -8105,10 +8105,10 @@ def condition_number(q):
     t2394 = t2268*t2372 + t2272*t2376 + t2276*t2380 + t2280*t2384 + t2284*t2388 + t2288*t2392
     t2395 = t2338*t2373 + t2342*t2377 + t2346*t2381 + t2350*t2385 + t2354*t2389 + t2358*t2393
     t2396 = xp.not_equal(t2394, 0)
-    t2397 = 0.5*(-t2368 + t2264)/xp.where(t2396, t2394, 1)
+    t2397 = (-t2368 + t2264)/xp.where(t2396, 2*t2394, 1)
     t2398 = xp.abs(t2397)
     t2399 = xp.greater_equal(t2398, 1)
-    t2400 = xp.abs(1/xp.where(t2399, t2397, 1))
+    t2400 = 1/xp.abs(xp.where(t2399, t2397, 1))
     t2401 = xp.where(t2396, xp.where(xp.greater_equal(t2397, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2399, t2400/(1 + xp.sqrt(1 + t2400**2)), 1/(t2398 + xp.sqrt(1 + t2398**2))), 0)
     t2402 = 1/xp.sqrt(1 + t2401**2)
     t2403 = t2394*t2401
@@ -8140,10 +8140,10 @@ def condition_number(q):
     t2429 = t2427 + t2401*t2426
     t2430 = t2303*t2408 + t2307*t2412 + t2311*t2416 + t2315*t2420 + t2319*t2424 + t2323*t2428
     t2431 = xp.not_equal(t2430, 0)
-    t2432 = 0.5*(-t2404 + t2299)/xp.where(t2431, t2430, 1)
+    t2432 = (-t2404 + t2299)/xp.where(t2431, 2*t2430, 1)
     t2433 = xp.abs(t2432)
     t2434 = xp.greater_equal(t2433, 1)
-    t2435 = xp.abs(1/xp.where(t2434, t2432, 1))
+    t2435 = 1/xp.abs(xp.where(t2434, t2432, 1))
     t2436 = xp.where(t2431, xp.where(xp.greater_equal(t2432, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2434, t2435/(1 + xp.sqrt(1 + t2435**2)), 1/(t2433 + xp.sqrt(1 + t2433**2))), 0)
     t2437 = 1/xp.sqrt(1 + t2436**2)
     t2438 = t2430*t2436
@@ -8175,10 +8175,10 @@ def condition_number(q):
     t2464 = t2462 + t2436*t2461
     t2465 = t2304*t2443 + t2308*t2447 + t2312*t2451 + t2316*t2455 + t2320*t2459 + t2324*t2463
     t2466 = xp.not_equal(t2465, 0)
-    t2467 = 0.5*(-t2439 + t2300)/xp.where(t2466, t2465, 1)
+    t2467 = (-t2439 + t2300)/xp.where(t2466, 2*t2465, 1)
     t2468 = xp.abs(t2467)
     t2469 = xp.greater_equal(t2468, 1)
-    t2470 = xp.abs(1/xp.where(t2469, t2467, 1))
+    t2470 = 1/xp.abs(xp.where(t2469, t2467, 1))
     t2471 = xp.where(t2466, xp.where(xp.greater_equal(t2467, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2469, t2470/(1 + xp.sqrt(1 + t2470**2)), 1/(t2468 + xp.sqrt(1 + t2468**2))), 0)
     t2472 = 1/xp.sqrt(1 + t2471**2)
     t2473 = t2465*t2471
@@ -8209,10 +8209,10 @@ def condition_number(q):
     t2498 = t2496 - t2471*t2497
     t2499 = t2497 + t2471*t2496
     t2500 = xp.not_equal(t2395, 0)
-    t2501 = 0.5*(-t2334 + t2369)/xp.where(t2500, t2395, 1)
+    t2501 = (-t2334 + t2369)/xp.where(t2500, 2*t2395, 1)
     t2502 = xp.abs(t2501)
     t2503 = xp.greater_equal(t2502, 1)
-    t2504 = xp.abs(1/xp.where(t2503, t2501, 1))
+    t2504 = 1/xp.abs(xp.where(t2503, t2501, 1))
     t2505 = xp.where(t2500, xp.where(xp.greater_equal(t2501, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2503, t2504/(1 + xp.sqrt(1 + t2504**2)), 1/(t2502 + xp.sqrt(1 + t2502**2))), 0)
     t2506 = 1/xp.sqrt(1 + t2505**2)
     t2507 = t2395*t2505
@@ -8244,10 +8244,10 @@ def condition_number(q):
     t2533 = t2531 + t2505*t2530
     t2534 = t2409*t2512 + t2413*t2516 + t2417*t2520 + t2421*t2524 + t2425*t2528 + t2429*t2532
     t2535 = xp.not_equal(t2534, 0)
-    t2536 = 0.5*(-t2508 + t2405)/xp.where(t2535, t2534, 1)
+    t2536 = (-t2508 + t2405)/xp.where(t2535, 2*t2534, 1)
     t2537 = xp.abs(t2536)
     t2538 = xp.greater_equal(t2537, 1)
-    t2539 = xp.abs(1/xp.where(t2538, t2536, 1))
+    t2539 = 1/xp.abs(xp.where(t2538, t2536, 1))
     t2540 = xp.where(t2535, xp.where(xp.greater_equal(t2536, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2538, t2539/(1 + xp.sqrt(1 + t2539**2)), 1/(t2537 + xp.sqrt(1 + t2537**2))), 0)
     t2541 = 1/xp.sqrt(1 + t2540**2)
     t2542 = t2534*t2540
@@ -8280,10 +8280,10 @@ def condition_number(q):
     t2569 = t2444*t2547 + t2448*t2551 + t2452*t2555 + t2456*t2559 + t2460*t2563 + t2464*t2567
     t2570 = t2513*t2548 + t2517*t2552 + t2521*t2556 + t2525*t2560 + t2529*t2564 + t2533*t2568
     t2571 = xp.not_equal(t2569, 0)
-    t2572 = 0.5*(-t2543 + t2440)/xp.where(t2571, t2569, 1)
+    t2572 = (-t2543 + t2440)/xp.where(t2571, 2*t2569, 1)
     t2573 = xp.abs(t2572)
     t2574 = xp.greater_equal(t2573, 1)
-    t2575 = xp.abs(1/xp.where(t2574, t2572, 1))
+    t2575 = 1/xp.abs(xp.where(t2574, t2572, 1))
     t2576 = xp.where(t2571, xp.where(xp.greater_equal(t2572, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2574, t2575/(1 + xp.sqrt(1 + t2575**2)), 1/(t2573 + xp.sqrt(1 + t2573**2))), 0)
     t2577 = 1/xp.sqrt(1 + t2576**2)
     t2578 = t2569*t2576
@@ -8315,10 +8315,10 @@ def condition_number(q):
     t2604 = t2602 + t2576*t2601
     t2605 = t2479*t2583 + t2483*t2587 + t2487*t2591 + t2491*t2595 + t2495*t2599 + t2499*t2603
     t2606 = xp.not_equal(t2605, 0)
-    t2607 = 0.5*(-t2579 + t2475)/xp.where(t2606, t2605, 1)
+    t2607 = (-t2579 + t2475)/xp.where(t2606, 2*t2605, 1)
     t2608 = xp.abs(t2607)
     t2609 = xp.greater_equal(t2608, 1)
-    t2610 = xp.abs(1/xp.where(t2609, t2607, 1))
+    t2610 = 1/xp.abs(xp.where(t2609, t2607, 1))
     t2611 = xp.where(t2606, xp.where(xp.greater_equal(t2607, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2609, t2610/(1 + xp.sqrt(1 + t2610**2)), 1/(t2608 + xp.sqrt(1 + t2608**2))), 0)
     t2612 = 1/xp.sqrt(1 + t2611**2)
     t2613 = t2605*t2611
@@ -8350,10 +8350,10 @@ def condition_number(q):
     t2639 = t2637 + t2611*t2636
     t2640 = t2478*t2618 + t2482*t2622 + t2486*t2626 + t2490*t2630 + t2494*t2634 + t2498*t2638
     t2641 = xp.not_equal(t2570, 0)
-    t2642 = 0.5*(-t2509 + t2544)/xp.where(t2641, t2570, 1)
+    t2642 = (-t2509 + t2544)/xp.where(t2641, 2*t2570, 1)
     t2643 = xp.abs(t2642)
     t2644 = xp.greater_equal(t2643, 1)
-    t2645 = xp.abs(1/xp.where(t2644, t2642, 1))
+    t2645 = 1/xp.abs(xp.where(t2644, t2642, 1))
     t2646 = xp.where(t2641, xp.where(xp.greater_equal(t2642, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2644, t2645/(1 + xp.sqrt(1 + t2645**2)), 1/(t2643 + xp.sqrt(1 + t2643**2))), 0)
     t2647 = 1/xp.sqrt(1 + t2646**2)
     t2648 = t2570*t2646
@@ -8385,10 +8385,10 @@ def condition_number(q):
     t2674 = t2672 + t2646*t2671
     t2675 = t2584*t2653 + t2588*t2657 + t2592*t2661 + t2596*t2665 + t2600*t2669 + t2604*t2673
     t2676 = xp.not_equal(t2675, 0)
-    t2677 = 0.5*(-t2649 + t2580)/xp.where(t2676, t2675, 1)
+    t2677 = (-t2649 + t2580)/xp.where(t2676, 2*t2675, 1)
     t2678 = xp.abs(t2677)
     t2679 = xp.greater_equal(t2678, 1)
-    t2680 = xp.abs(1/xp.where(t2679, t2677, 1))
+    t2680 = 1/xp.abs(xp.where(t2679, t2677, 1))
     t2681 = xp.where(t2676, xp.where(xp.greater_equal(t2677, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2679, t2680/(1 + xp.sqrt(1 + t2680**2)), 1/(t2678 + xp.sqrt(1 + t2678**2))), 0)
     t2682 = 1/xp.sqrt(1 + t2681**2)
     t2683 = t2675*t2681
@@ -8421,10 +8421,10 @@ def condition_number(q):
     t2710 = t2619*t2688 + t2623*t2692 + t2627*t2696 + t2631*t2700 + t2635*t2704 + t2639*t2708
     t2711 = t2654*t2689 + t2658*t2693 + t2662*t2697 + t2666*t2701 + t2670*t2705 + t2674*t2709
     t2712 = xp.not_equal(t2710, 0)
-    t2713 = 0.5*(-t2684 + t2615)/xp.where(t2712, t2710, 1)
+    t2713 = (-t2684 + t2615)/xp.where(t2712, 2*t2710, 1)
     t2714 = xp.abs(t2713)
     t2715 = xp.greater_equal(t2714, 1)
-    t2716 = xp.abs(1/xp.where(t2715, t2713, 1))
+    t2716 = 1/xp.abs(xp.where(t2715, t2713, 1))
     t2717 = xp.where(t2712, xp.where(xp.greater_equal(t2713, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2715, t2716/(1 + xp.sqrt(1 + t2716**2)), 1/(t2714 + xp.sqrt(1 + t2714**2))), 0)
     t2718 = 1/xp.sqrt(1 + t2717**2)
     t2719 = t2710*t2717
@@ -8455,10 +8455,10 @@ def condition_number(q):
     t2744 = t2742 - t2717*t2743
     t2745 = t2743 + t2717*t2742
     t2746 = xp.not_equal(t2711, 0)
-    t2747 = 0.5*(-t2650 + t2685)/xp.where(t2746, t2711, 1)
+    t2747 = (-t2650 + t2685)/xp.where(t2746, 2*t2711, 1)
     t2748 = xp.abs(t2747)
     t2749 = xp.greater_equal(t2748, 1)
-    t2750 = xp.abs(1/xp.where(t2749, t2747, 1))
+    t2750 = 1/xp.abs(xp.where(t2749, t2747, 1))
     t2751 = xp.where(t2746, xp.where(xp.greater_equal(t2747, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2749, t2750/(1 + xp.sqrt(1 + t2750**2)), 1/(t2748 + xp.sqrt(1 + t2748**2))), 0)
     t2752 = 1/xp.sqrt(1 + t2751**2)
     t2753 = t2711*t2751
@@ -8490,10 +8490,10 @@ def condition_number(q):
     t2779 = t2777 + t2751*t2776
     t2780 = t2725*t2758 + t2729*t2762 + t2733*t2766 + t2737*t2770 + t2741*t2774 + t2745*t2778
     t2781 = xp.not_equal(t2780, 0)
-    t2782 = 0.5*(-t2754 + t2721)/xp.where(t2781, t2780, 1)
+    t2782 = (-t2754 + t2721)/xp.where(t2781, 2*t2780, 1)
     t2783 = xp.abs(t2782)
     t2784 = xp.greater_equal(t2783, 1)
-    t2785 = xp.abs(1/xp.where(t2784, t2782, 1))
+    t2785 = 1/xp.abs(xp.where(t2784, t2782, 1))
     t2786 = xp.where(t2781, xp.where(xp.greater_equal(t2782, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2784, t2785/(1 + xp.sqrt(1 + t2785**2)), 1/(t2783 + xp.sqrt(1 + t2783**2))), 0)
     t2787 = 1/xp.sqrt(1 + t2786**2)
     t2788 = t2780*t2786
@@ -8525,10 +8525,10 @@ def condition_number(q):
     t2814 = t2812 + t2786*t2811
     t2815 = t2759*t2794 + t2763*t2798 + t2767*t2802 + t2771*t2806 + t2775*t2810 + t2779*t2814
     t2816 = xp.not_equal(t2815, 0)
-    t2817 = 0.5*(-t2755 + t2790)/xp.where(t2816, t2815, 1)
+    t2817 = (-t2755 + t2790)/xp.where(t2816, 2*t2815, 1)
     t2818 = xp.abs(t2817)
     t2819 = xp.greater_equal(t2818, 1)
-    t2820 = xp.abs(1/xp.where(t2819, t2817, 1))
+    t2820 = 1/xp.abs(xp.where(t2819, t2817, 1))
     t2821 = xp.where(t2816, xp.where(xp.greater_equal(t2817, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2819, t2820/(1 + xp.sqrt(1 + t2820**2)), 1/(t2818 + xp.sqrt(1 + t2818**2))), 0)
     t2822 = 1/xp.sqrt(1 + t2821**2)
     t2823 = t2815*t2821
@@ -8559,10 +8559,10 @@ def condition_number(q):
     t2848 = t2846 - t2821*t2847
     t2849 = t2847 + t2821*t2846
     t2850 = xp.not_equal(t2640, 0)
-    t2851 = 0.5*(-t2474 + t2614)/xp.where(t2850, t2640, 1)
+    t2851 = (-t2474 + t2614)/xp.where(t2850, 2*t2640, 1)
     t2852 = xp.abs(t2851)
     t2853 = xp.greater_equal(t2852, 1)
-    t2854 = xp.abs(1/xp.where(t2853, t2851, 1))
+    t2854 = 1/xp.abs(xp.where(t2853, t2851, 1))
     t2855 = xp.where(t2850, xp.where(xp.greater_equal(t2851, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2853, t2854/(1 + xp.sqrt(1 + t2854**2)), 1/(t2852 + xp.sqrt(1 + t2852**2))), 0)
     t2856 = 1/xp.sqrt(1 + t2855**2)
     t2857 = t2640*t2855
@@ -8594,10 +8594,10 @@ def condition_number(q):
     t2883 = t2881 + t2855*t2880
     t2884 = t2724*t2862 + t2728*t2866 + t2732*t2870 + t2736*t2874 + t2740*t2878 + t2744*t2882
     t2885 = xp.not_equal(t2884, 0)
-    t2886 = 0.5*(-t2858 + t2720)/xp.where(t2885, t2884, 1)
+    t2886 = (-t2858 + t2720)/xp.where(t2885, 2*t2884, 1)
     t2887 = xp.abs(t2886)
     t2888 = xp.greater_equal(t2887, 1)
-    t2889 = xp.abs(1/xp.where(t2888, t2886, 1))
+    t2889 = 1/xp.abs(xp.where(t2888, t2886, 1))
     t2890 = xp.where(t2885, xp.where(xp.greater_equal(t2886, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2888, t2889/(1 + xp.sqrt(1 + t2889**2)), 1/(t2887 + xp.sqrt(1 + t2887**2))), 0)
     t2891 = 1/xp.sqrt(1 + t2890**2)
     t2892 = t2884*t2890
@@ -8630,10 +8630,10 @@ def condition_number(q):
     t2919 = t2793*t2897 + t2797*t2901 + t2801*t2905 + t2805*t2909 + t2809*t2913 + t2813*t2917
     t2920 = t2863*t2898 + t2867*t2902 + t2871*t2906 + t2875*t2910 + t2879*t2914 + t2883*t2918
     t2921 = xp.not_equal(t2919, 0)
-    t2922 = 0.5*(-t2893 + t2789)/xp.where(t2921, t2919, 1)
+    t2922 = (-t2893 + t2789)/xp.where(t2921, 2*t2919, 1)
     t2923 = xp.abs(t2922)
     t2924 = xp.greater_equal(t2923, 1)
-    t2925 = xp.abs(1/xp.where(t2924, t2922, 1))
+    t2925 = 1/xp.abs(xp.where(t2924, t2922, 1))
     t2926 = xp.where(t2921, xp.where(xp.greater_equal(t2922, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2924, t2925/(1 + xp.sqrt(1 + t2925**2)), 1/(t2923 + xp.sqrt(1 + t2923**2))), 0)
     t2927 = 1/xp.sqrt(1 + t2926**2)
     t2928 = t2919*t2926
@@ -8665,10 +8665,10 @@ def condition_number(q):
     t2954 = t2952 + t2926*t2951
     t2955 = t2828*t2933 + t2832*t2937 + t2836*t2941 + t2840*t2945 + t2844*t2949 + t2848*t2953
     t2956 = xp.not_equal(t2955, 0)
-    t2957 = 0.5*(-t2929 + t2824)/xp.where(t2956, t2955, 1)
+    t2957 = (-t2929 + t2824)/xp.where(t2956, 2*t2955, 1)
     t2958 = xp.abs(t2957)
     t2959 = xp.greater_equal(t2958, 1)
-    t2960 = xp.abs(1/xp.where(t2959, t2957, 1))
+    t2960 = 1/xp.abs(xp.where(t2959, t2957, 1))
     t2961 = xp.where(t2956, xp.where(xp.greater_equal(t2957, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2959, t2960/(1 + xp.sqrt(1 + t2960**2)), 1/(t2958 + xp.sqrt(1 + t2958**2))), 0)
     t2962 = 1/xp.sqrt(1 + t2961**2)
     t2963 = t2955*t2961
@@ -8700,10 +8700,10 @@ def condition_number(q):
     t2989 = t2987 + t2961*t2986
     t2990 = t2829*t2968 + t2833*t2972 + t2837*t2976 + t2841*t2980 + t2845*t2984 + t2849*t2988
     t2991 = xp.not_equal(t2990, 0)
-    t2992 = 0.5*(-t2964 + t2825)/xp.where(t2991, t2990, 1)
+    t2992 = (-t2964 + t2825)/xp.where(t2991, 2*t2990, 1)
     t2993 = xp.abs(t2992)
     t2994 = xp.greater_equal(t2993, 1)
-    t2995 = xp.abs(1/xp.where(t2994, t2992, 1))
+    t2995 = 1/xp.abs(xp.where(t2994, t2992, 1))
     t2996 = xp.where(t2991, xp.where(xp.greater_equal(t2992, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2994, t2995/(1 + xp.sqrt(1 + t2995**2)), 1/(t2993 + xp.sqrt(1 + t2993**2))), 0)
     t2997 = 1/xp.sqrt(1 + t2996**2)
     t2998 = t2990*t2996
@@ -8734,10 +8734,10 @@ def condition_number(q):
     t3023 = t3021 - t2996*t3022
     t3024 = t3022 + t2996*t3021
     t3025 = xp.not_equal(t2920, 0)
-    t3026 = 0.5*(-t2859 + t2894)/xp.where(t3025, t2920, 1)
+    t3026 = (-t2859 + t2894)/xp.where(t3025, 2*t2920, 1)
     t3027 = xp.abs(t3026)
     t3028 = xp.greater_equal(t3027, 1)
-    t3029 = xp.abs(1/xp.where(t3028, t3026, 1))
+    t3029 = 1/xp.abs(xp.where(t3028, t3026, 1))
     t3030 = xp.where(t3025, xp.where(xp.greater_equal(t3026, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3028, t3029/(1 + xp.sqrt(1 + t3029**2)), 1/(t3027 + xp.sqrt(1 + t3027**2))), 0)
     t3031 = 1/xp.sqrt(1 + t3030**2)
     t3032 = t2920*t3030
@@ -8769,10 +8769,10 @@ def condition_number(q):
     t3058 = t3056 + t3030*t3055
     t3059 = t2934*t3037 + t2938*t3041 + t2942*t3045 + t2946*t3049 + t2950*t3053 + t2954*t3057
     t3060 = xp.not_equal(t3059, 0)
-    t3061 = 0.5*(-t3033 + t2930)/xp.where(t3060, t3059, 1)
+    t3061 = (-t3033 + t2930)/xp.where(t3060, 2*t3059, 1)
     t3062 = xp.abs(t3061)
     t3063 = xp.greater_equal(t3062, 1)
-    t3064 = xp.abs(1/xp.where(t3063, t3061, 1))
+    t3064 = 1/xp.abs(xp.where(t3063, t3061, 1))
     t3065 = xp.where(t3060, xp.where(xp.greater_equal(t3061, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3063, t3064/(1 + xp.sqrt(1 + t3064**2)), 1/(t3062 + xp.sqrt(1 + t3062**2))), 0)
     t3066 = 1/xp.sqrt(1 + t3065**2)
     t3067 = t3059*t3065
@@ -8805,10 +8805,10 @@ def condition_number(q):
     t3094 = t2969*t3072 + t2973*t3076 + t2977*t3080 + t2981*t3084 + t2985*t3088 + t2989*t3092
     t3095 = t3038*t3073 + t3042*t3077 + t3046*t3081 + t3050*t3085 + t3054*t3089 + t3058*t3093
     t3096 = xp.not_equal(t3094, 0)
-    t3097 = 0.5*(-t3068 + t2965)/xp.where(t3096, t3094, 1)
+    t3097 = (-t3068 + t2965)/xp.where(t3096, 2*t3094, 1)
     t3098 = xp.abs(t3097)
     t3099 = xp.greater_equal(t3098, 1)
-    t3100 = xp.abs(1/xp.where(t3099, t3097, 1))
+    t3100 = 1/xp.abs(xp.where(t3099, t3097, 1))
     t3101 = xp.where(t3096, xp.where(xp.greater_equal(t3097, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3099, t3100/(1 + xp.sqrt(1 + t3100**2)), 1/(t3098 + xp.sqrt(1 + t3098**2))), 0)
     t3102 = 1/xp.sqrt(1 + t3101**2)
     t3103 = t3094*t3101
@@ -8840,10 +8840,10 @@ def condition_number(q):
     t3129 = t3127 + t3101*t3126
     t3130 = t3004*t3108 + t3008*t3112 + t3012*t3116 + t3016*t3120 + t3020*t3124 + t3024*t3128
     t3131 = xp.not_equal(t3130, 0)
-    t3132 = 0.5*(-t3104 + t3000)/xp.where(t3131, t3130, 1)
+    t3132 = (-t3104 + t3000)/xp.where(t3131, 2*t3130, 1)
     t3133 = xp.abs(t3132)
     t3134 = xp.greater_equal(t3133, 1)
-    t3135 = xp.abs(1/xp.where(t3134, t3132, 1))
+    t3135 = 1/xp.abs(xp.where(t3134, t3132, 1))
     t3136 = xp.where(t3131, xp.where(xp.greater_equal(t3132, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3134, t3135/(1 + xp.sqrt(1 + t3135**2)), 1/(t3133 + xp.sqrt(1 + t3133**2))), 0)
     t3137 = 1/xp.sqrt(1 + t3136**2)
     t3138 = t3130*t3136
@@ -8875,10 +8875,10 @@ def condition_number(q):
     t3164 = t3162 + t3136*t3161
     t3165 = t3003*t3143 + t3007*t3147 + t3011*t3151 + t3015*t3155 + t3019*t3159 + t3023*t3163
     t3166 = xp.not_equal(t3095, 0)
-    t3167 = 0.5*(-t3034 + t3069)/xp.where(t3166, t3095, 1)
+    t3167 = (-t3034 + t3069)/xp.where(t3166, 2*t3095, 1)
     t3168 = xp.abs(t3167)
     t3169 = xp.greater_equal(t3168, 1)
-    t3170 = xp.abs(1/xp.where(t3169, t3167, 1))
+    t3170 = 1/xp.abs(xp.where(t3169, t3167, 1))
     t3171 = xp.where(t3166, xp.where(xp.greater_equal(t3167, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3169, t3170/(1 + xp.sqrt(1 + t3170**2)), 1/(t3168 + xp.sqrt(1 + t3168**2))), 0)
     t3172 = 1/xp.sqrt(1 + t3171**2)
     t3173 = t3095*t3171
@@ -8910,10 +8910,10 @@ def condition_number(q):
     t3199 = t3197 + t3171*t3196
     t3200 = t3109*t3178 + t3113*t3182 + t3117*t3186 + t3121*t3190 + t3125*t3194 + t3129*t3198
     t3201 = xp.not_equal(t3200, 0)
-    t3202 = 0.5*(-t3174 + t3105)/xp.where(t3201, t3200, 1)
+    t3202 = (-t3174 + t3105)/xp.where(t3201, 2*t3200, 1)
     t3203 = xp.abs(t3202)
     t3204 = xp.greater_equal(t3203, 1)
-    t3205 = xp.abs(1/xp.where(t3204, t3202, 1))
+    t3205 = 1/xp.abs(xp.where(t3204, t3202, 1))
     t3206 = xp.where(t3201, xp.where(xp.greater_equal(t3202, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3204, t3205/(1 + xp.sqrt(1 + t3205**2)), 1/(t3203 + xp.sqrt(1 + t3203**2))), 0)
     t3207 = 1/xp.sqrt(1 + t3206**2)
     t3208 = t3200*t3206
@@ -8946,10 +8946,10 @@ def condition_number(q):
     t3235 = t3144*t3213 + t3148*t3217 + t3152*t3221 + t3156*t3225 + t3160*t3229 + t3164*t3233
     t3236 = t3179*t3214 + t3183*t3218 + t3187*t3222 + t3191*t3226 + t3195*t3230 + t3199*t3234
     t3237 = xp.not_equal(t3235, 0)
-    t3238 = 0.5*(-t3209 + t3140)/xp.where(t3237, t3235, 1)
+    t3238 = (-t3209 + t3140)/xp.where(t3237, 2*t3235, 1)
     t3239 = xp.abs(t3238)
     t3240 = xp.greater_equal(t3239, 1)
-    t3241 = xp.abs(1/xp.where(t3240, t3238, 1))
+    t3241 = 1/xp.abs(xp.where(t3240, t3238, 1))
     t3242 = xp.where(t3237, xp.where(xp.greater_equal(t3238, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3240, t3241/(1 + xp.sqrt(1 + t3241**2)), 1/(t3239 + xp.sqrt(1 + t3239**2))), 0)
     t3243 = 1/xp.sqrt(1 + t3242**2)
     t3244 = t3235*t3242
@@ -8980,10 +8980,10 @@ def condition_number(q):
     t3269 = t3267 - t3242*t3268
     t3270 = t3268 + t3242*t3267
     t3271 = xp.not_equal(t3236, 0)
-    t3272 = 0.5*(-t3175 + t3210)/xp.where(t3271, t3236, 1)
+    t3272 = (-t3175 + t3210)/xp.where(t3271, 2*t3236, 1)
     t3273 = xp.abs(t3272)
     t3274 = xp.greater_equal(t3273, 1)
-    t3275 = xp.abs(1/xp.where(t3274, t3272, 1))
+    t3275 = 1/xp.abs(xp.where(t3274, t3272, 1))
     t3276 = xp.where(t3271, xp.where(xp.greater_equal(t3272, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3274, t3275/(1 + xp.sqrt(1 + t3275**2)), 1/(t3273 + xp.sqrt(1 + t3273**2))), 0)
     t3277 = 1/xp.sqrt(1 + t3276**2)
     t3278 = t3236*t3276
@@ -9015,10 +9015,10 @@ def condition_number(q):
     t3304 = t3302 + t3276*t3301
     t3305 = t3250*t3283 + t3254*t3287 + t3258*t3291 + t3262*t3295 + t3266*t3299 + t3270*t3303
     t3306 = xp.not_equal(t3305, 0)
-    t3307 = 0.5*(-t3279 + t3246)/xp.where(t3306, t3305, 1)
+    t3307 = (-t3279 + t3246)/xp.where(t3306, 2*t3305, 1)
     t3308 = xp.abs(t3307)
     t3309 = xp.greater_equal(t3308, 1)
-    t3310 = xp.abs(1/xp.where(t3309, t3307, 1))
+    t3310 = 1/xp.abs(xp.where(t3309, t3307, 1))
     t3311 = xp.where(t3306, xp.where(xp.greater_equal(t3307, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3309, t3310/(1 + xp.sqrt(1 + t3310**2)), 1/(t3308 + xp.sqrt(1 + t3308**2))), 0)
     t3312 = 1/xp.sqrt(1 + t3311**2)
     t3313 = t3305*t3311
@@ -9050,10 +9050,10 @@ def condition_number(q):
     t3339 = t3337 + t3311*t3336
     t3340 = t3284*t3319 + t3288*t3323 + t3292*t3327 + t3296*t3331 + t3300*t3335 + t3304*t3339
     t3341 = xp.not_equal(t3340, 0)
-    t3342 = 0.5*(-t3280 + t3315)/xp.where(t3341, t3340, 1)
+    t3342 = (-t3280 + t3315)/xp.where(t3341, 2*t3340, 1)
     t3343 = xp.abs(t3342)
     t3344 = xp.greater_equal(t3343, 1)
-    t3345 = xp.abs(1/xp.where(t3344, t3342, 1))
+    t3345 = 1/xp.abs(xp.where(t3344, t3342, 1))
     t3346 = xp.where(t3341, xp.where(xp.greater_equal(t3342, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3344, t3345/(1 + xp.sqrt(1 + t3345**2)), 1/(t3343 + xp.sqrt(1 + t3343**2))), 0)
     t3347 = 1/xp.sqrt(1 + t3346**2)
     t3348 = t3340*t3346
@@ -9084,10 +9084,10 @@ def condition_number(q):
     t3373 = t3371 - t3346*t3372
     t3374 = t3372 + t3346*t3371
     t3375 = xp.not_equal(t3165, 0)
-    t3376 = 0.5*(-t2999 + t3139)/xp.where(t3375, t3165, 1)
+    t3376 = (-t2999 + t3139)/xp.where(t3375, 2*t3165, 1)
     t3377 = xp.abs(t3376)
     t3378 = xp.greater_equal(t3377, 1)
-    t3379 = xp.abs(1/xp.where(t3378, t3376, 1))
+    t3379 = 1/xp.abs(xp.where(t3378, t3376, 1))
     t3380 = xp.where(t3375, xp.where(xp.greater_equal(t3376, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3378, t3379/(1 + xp.sqrt(1 + t3379**2)), 1/(t3377 + xp.sqrt(1 + t3377**2))), 0)
     t3381 = 1/xp.sqrt(1 + t3380**2)
     t3382 = t3165*t3380
@@ -9119,10 +9119,10 @@ def condition_number(q):
     t3408 = t3406 + t3380*t3405
     t3409 = t3249*t3387 + t3253*t3391 + t3257*t3395 + t3261*t3399 + t3265*t3403 + t3269*t3407
     t3410 = xp.not_equal(t3409, 0)
-    t3411 = 0.5*(-t3383 + t3245)/xp.where(t3410, t3409, 1)
+    t3411 = (-t3383 + t3245)/xp.where(t3410, 2*t3409, 1)
     t3412 = xp.abs(t3411)
     t3413 = xp.greater_equal(t3412, 1)
-    t3414 = xp.abs(1/xp.where(t3413, t3411, 1))
+    t3414 = 1/xp.abs(xp.where(t3413, t3411, 1))
     t3415 = xp.where(t3410, xp.where(xp.greater_equal(t3411, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3413, t3414/(1 + xp.sqrt(1 + t3414**2)), 1/(t3412 + xp.sqrt(1 + t3412**2))), 0)
     t3416 = 1/xp.sqrt(1 + t3415**2)
     t3417 = t3409*t3415
@@ -9155,10 +9155,10 @@ def condition_number(q):
     t3444 = t3318*t3422 + t3322*t3426 + t3326*t3430 + t3330*t3434 + t3334*t3438 + t3338*t3442
     t3445 = t3388*t3423 + t3392*t3427 + t3396*t3431 + t3400*t3435 + t3404*t3439 + t3408*t3443
     t3446 = xp.not_equal(t3444, 0)
-    t3447 = 0.5*(-t3418 + t3314)/xp.where(t3446, t3444, 1)
+    t3447 = (-t3418 + t3314)/xp.where(t3446, 2*t3444, 1)
     t3448 = xp.abs(t3447)
     t3449 = xp.greater_equal(t3448, 1)
-    t3450 = xp.abs(1/xp.where(t3449, t3447, 1))
+    t3450 = 1/xp.abs(xp.where(t3449, t3447, 1))
     t3451 = xp.where(t3446, xp.where(xp.greater_equal(t3447, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3449, t3450/(1 + xp.sqrt(1 + t3450**2)), 1/(t3448 + xp.sqrt(1 + t3448**2))), 0)
     t3452 = 1/xp.sqrt(1 + t3451**2)
     t3453 = t3444*t3451
@@ -9190,10 +9190,10 @@ def condition_number(q):
     t3479 = t3477 + t3451*t3476
     t3480 = t3353*t3458 + t3357*t3462 + t3361*t3466 + t3365*t3470 + t3369*t3474 + t3373*t3478
     t3481 = xp.not_equal(t3480, 0)
-    t3482 = 0.5*(-t3454 + t3349)/xp.where(t3481, t3480, 1)
+    t3482 = (-t3454 + t3349)/xp.where(t3481, 2*t3480, 1)
     t3483 = xp.abs(t3482)
     t3484 = xp.greater_equal(t3483, 1)
-    t3485 = xp.abs(1/xp.where(t3484, t3482, 1))
+    t3485 = 1/xp.abs(xp.where(t3484, t3482, 1))
     t3486 = xp.where(t3481, xp.where(xp.greater_equal(t3482, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3484, t3485/(1 + xp.sqrt(1 + t3485**2)), 1/(t3483 + xp.sqrt(1 + t3483**2))), 0)
     t3487 = 1/xp.sqrt(1 + t3486**2)
     t3488 = t3480*t3486
@@ -9225,10 +9225,10 @@ def condition_number(q):
     t3514 = t3512 + t3486*t3511
     t3515 = t3354*t3493 + t3358*t3497 + t3362*t3501 + t3366*t3505 + t3370*t3509 + t3374*t3513
     t3516 = xp.not_equal(t3515, 0)
-    t3517 = 0.5*(-t3489 + t3350)/xp.where(t3516, t3515, 1)
+    t3517 = (-t3489 + t3350)/xp.where(t3516, 2*t3515, 1)
     t3518 = xp.abs(t3517)
     t3519 = xp.greater_equal(t3518, 1)
-    t3520 = xp.abs(1/xp.where(t3519, t3517, 1))
+    t3520 = 1/xp.abs(xp.where(t3519, t3517, 1))
     t3521 = xp.where(t3516, xp.where(xp.greater_equal(t3517, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3519, t3520/(1 + xp.sqrt(1 + t3520**2)), 1/(t3518 + xp.sqrt(1 + t3518**2))), 0)
     t3522 = 1/xp.sqrt(1 + t3521**2)
     t3523 = t3350 + t3515*t3521
@@ -9258,10 +9258,10 @@ def condition_number(q):
     t3547 = t3545 + t3521*t3544
     t3548 = xp.sqrt(t3526**2 + t3530**2 + t3534**2 + t3538**2 + t3542**2 + t3546**2)
     t3549 = xp.not_equal(t3445, 0)
-    t3550 = 0.5*(-t3384 + t3419)/xp.where(t3549, t3445, 1)
+    t3550 = (-t3384 + t3419)/xp.where(t3549, 2*t3445, 1)
     t3551 = xp.abs(t3550)
     t3552 = xp.greater_equal(t3551, 1)
-    t3553 = xp.abs(1/xp.where(t3552, t3550, 1))
+    t3553 = 1/xp.abs(xp.where(t3552, t3550, 1))
     t3554 = xp.where(t3549, xp.where(xp.greater_equal(t3550, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3552, t3553/(1 + xp.sqrt(1 + t3553**2)), 1/(t3551 + xp.sqrt(1 + t3551**2))), 0)
     t3555 = 1/xp.sqrt(1 + t3554**2)
     t3556 = t3445*t3554
@@ -9293,10 +9293,10 @@ def condition_number(q):
     t3582 = t3580 + t3554*t3579
     t3583 = t3459*t3561 + t3463*t3565 + t3467*t3569 + t3471*t3573 + t3475*t3577 + t3479*t3581
     t3584 = xp.not_equal(t3583, 0)
-    t3585 = 0.5*(-t3557 + t3455)/xp.where(t3584, t3583, 1)
+    t3585 = (-t3557 + t3455)/xp.where(t3584, 2*t3583, 1)
     t3586 = xp.abs(t3585)
     t3587 = xp.greater_equal(t3586, 1)
-    t3588 = xp.abs(1/xp.where(t3587, t3585, 1))
+    t3588 = 1/xp.abs(xp.where(t3587, t3585, 1))
     t3589 = xp.where(t3584, xp.where(xp.greater_equal(t3585, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3587, t3588/(1 + xp.sqrt(1 + t3588**2)), 1/(t3586 + xp.sqrt(1 + t3586**2))), 0)
     t3590 = 1/xp.sqrt(1 + t3589**2)
     t3591 = t3583*t3589
@@ -9329,10 +9329,10 @@ def condition_number(q):
     t3618 = t3494*t3596 + t3498*t3600 + t3502*t3604 + t3506*t3608 + t3510*t3612 + t3514*t3616
     t3619 = t3562*t3597 + t3566*t3601 + t3570*t3605 + t3574*t3609 + t3578*t3613 + t3582*t3617
     t3620 = xp.not_equal(t3618, 0)
-    t3621 = 0.5*(-t3592 + t3490)/xp.where(t3620, t3618, 1)
+    t3621 = (-t3592 + t3490)/xp.where(t3620, 2*t3618, 1)
     t3622 = xp.abs(t3621)
     t3623 = xp.greater_equal(t3622, 1)
-    t3624 = xp.abs(1/xp.where(t3623, t3621, 1))
+    t3624 = 1/xp.abs(xp.where(t3623, t3621, 1))
     t3625 = xp.where(t3620, xp.where(xp.greater_equal(t3621, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3623, t3624/(1 + xp.sqrt(1 + t3624**2)), 1/(t3622 + xp.sqrt(1 + t3622**2))), 0)
     t3626 = 1/xp.sqrt(1 + t3625**2)
     t3627 = t3618*t3625
@@ -9364,10 +9364,10 @@ def condition_number(q):
     t3653 = t3651 + t3625*t3650
     t3654 = t3527*t3632 + t3531*t3636 + t3535*t3640 + t3539*t3644 + t3543*t3648 + t3547*t3652
     t3655 = xp.not_equal(t3654, 0)
-    t3656 = 0.5*(-t3628 + t3523)/xp.where(t3655, t3654, 1)
+    t3656 = (-t3628 + t3523)/xp.where(t3655, 2*t3654, 1)
     t3657 = xp.abs(t3656)
     t3658 = xp.greater_equal(t3657, 1)
-    t3659 = xp.abs(1/xp.where(t3658, t3656, 1))
+    t3659 = 1/xp.abs(xp.where(t3658, t3656, 1))
     t3660 = xp.where(t3655, xp.where(xp.greater_equal(t3656, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3658, t3659/(1 + xp.sqrt(1 + t3659**2)), 1/(t3657 + xp.sqrt(1 + t3657**2))), 0)
     t3661 = 1/xp.sqrt(1 + t3660**2)
     t3662 = t3523 + t3654*t3660
@@ -9399,10 +9399,10 @@ def condition_number(q):
     t3688 = xp.where(xp.greater(t3687, t3548), t3687, t3548)
     t3689 = xp.where(xp.less(t3687, t3548), t3687, t3548)
     t3690 = xp.not_equal(t3619, 0)
-    t3691 = 0.5*(-t3558 + t3593)/xp.where(t3690, t3619, 1)
+    t3691 = (-t3558 + t3593)/xp.where(t3690, 2*t3619, 1)
     t3692 = xp.abs(t3691)
     t3693 = xp.greater_equal(t3692, 1)
-    t3694 = xp.abs(1/xp.where(t3693, t3691, 1))
+    t3694 = 1/xp.abs(xp.where(t3693, t3691, 1))
     t3695 = xp.where(t3690, xp.where(xp.greater_equal(t3691, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3693, t3694/(1 + xp.sqrt(1 + t3694**2)), 1/(t3692 + xp.sqrt(1 + t3692**2))), 0)
     t3696 = 1/xp.sqrt(1 + t3695**2)
     t3697 = t3619*t3695
@@ -9434,10 +9434,10 @@ def condition_number(q):
     t3723 = t3721 + t3695*t3720
     t3724 = t3633*t3702 + t3637*t3706 + t3641*t3710 + t3645*t3714 + t3649*t3718 + t3653*t3722
     t3725 = xp.not_equal(t3724, 0)
-    t3726 = 0.5*(-t3698 + t3629)/xp.where(t3725, t3724, 1)
+    t3726 = (-t3698 + t3629)/xp.where(t3725, 2*t3724, 1)
     t3727 = xp.abs(t3726)
     t3728 = xp.greater_equal(t3727, 1)
-    t3729 = xp.abs(1/xp.where(t3728, t3726, 1))
+    t3729 = 1/xp.abs(xp.where(t3728, t3726, 1))
     t3730 = xp.where(t3725, xp.where(xp.greater_equal(t3726, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3728, t3729/(1 + xp.sqrt(1 + t3729**2)), 1/(t3727 + xp.sqrt(1 + t3727**2))), 0)
     t3731 = 1/xp.sqrt(1 + t3730**2)
     t3732 = t3724*t3730
@@ -9470,10 +9470,10 @@ def condition_number(q):
     t3759 = t3666*t3737 + t3670*t3741 + t3674*t3745 + t3678*t3749 + t3682*t3753 + t3686*t3757
     t3760 = t3703*t3738 + t3707*t3742 + t3711*t3746 + t3715*t3750 + t3719*t3754 + t3723*t3758
     t3761 = xp.not_equal(t3759, 0)
-    t3762 = 0.5*(-t3733 + t3662)/xp.where(t3761, t3759, 1)
+    t3762 = (-t3733 + t3662)/xp.where(t3761, 2*t3759, 1)
     t3763 = xp.abs(t3762)
     t3764 = xp.greater_equal(t3763, 1)
-    t3765 = xp.abs(1/xp.where(t3764, t3762, 1))
+    t3765 = 1/xp.abs(xp.where(t3764, t3762, 1))
     t3766 = xp.where(t3761, xp.where(xp.greater_equal(t3762, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3764, t3765/(1 + xp.sqrt(1 + t3765**2)), 1/(t3763 + xp.sqrt(1 + t3763**2))), 0)
     t3767 = 1/xp.sqrt(1 + t3766**2)
     t3768 = t3662 + t3759*t3766
@@ -9505,10 +9505,10 @@ def condition_number(q):
     t3794 = xp.where(xp.greater(t3793, t3688), t3793, t3688)
     t3795 = xp.where(xp.less(t3793, t3689), t3793, t3689)
     t3796 = xp.not_equal(t3760, 0)
-    t3797 = 0.5*(-t3699 + t3734)/xp.where(t3796, t3760, 1)
+    t3797 = (-t3699 + t3734)/xp.where(t3796, 2*t3760, 1)
     t3798 = xp.abs(t3797)
     t3799 = xp.greater_equal(t3798, 1)
-    t3800 = xp.abs(1/xp.where(t3799, t3797, 1))
+    t3800 = 1/xp.abs(xp.where(t3799, t3797, 1))
     t3801 = xp.where(t3796, xp.where(xp.greater_equal(t3797, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3799, t3800/(1 + xp.sqrt(1 + t3800**2)), 1/(t3798 + xp.sqrt(1 + t3798**2))), 0)
     t3802 = 1/xp.sqrt(1 + t3801**2)
     t3803 = t3760*t3801
@@ -9540,10 +9540,10 @@ def condition_number(q):
     t3829 = t3827 + t3801*t3826
     t3830 = t3772*t3808 + t3776*t3812 + t3780*t3816 + t3784*t3820 + t3788*t3824 + t3792*t3828
     t3831 = xp.not_equal(t3830, 0)
-    t3832 = 0.5*(-t3804 + t3768)/xp.where(t3831, t3830, 1)
+    t3832 = (-t3804 + t3768)/xp.where(t3831, 2*t3830, 1)
     t3833 = xp.abs(t3832)
     t3834 = xp.greater_equal(t3833, 1)
-    t3835 = xp.abs(1/xp.where(t3834, t3832, 1))
+    t3835 = 1/xp.abs(xp.where(t3834, t3832, 1))
     t3836 = xp.where(t3831, xp.where(xp.greater_equal(t3832, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3834, t3835/(1 + xp.sqrt(1 + t3835**2)), 1/(t3833 + xp.sqrt(1 + t3833**2))), 0)
     t3837 = 1/xp.sqrt(1 + t3836**2)
     t3838 = t3768 + t3830*t3836
@@ -9576,10 +9576,10 @@ def condition_number(q):
     t3865 = xp.where(xp.greater(t3864, t3794), t3864, t3794)
     t3866 = xp.where(xp.less(t3864, t3795), t3864, t3795)
     t3867 = xp.not_equal(t3863, 0)
-    t3868 = 0.5*(-t3805 + t3838)/xp.where(t3867, t3863, 1)
+    t3868 = (-t3805 + t3838)/xp.where(t3867, 2*t3863, 1)
     t3869 = xp.abs(t3868)
     t3870 = xp.greater_equal(t3869, 1)
-    t3871 = xp.abs(1/xp.where(t3870, t3868, 1))
+    t3871 = 1/xp.abs(xp.where(t3870, t3868, 1))
     t3872 = xp.where(t3867, xp.where(xp.greater_equal(t3868, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3870, t3871/(1 + xp.sqrt(1 + t3871**2)), 1/(t3869 + xp.sqrt(1 + t3869**2))), 0)
     t3873 = 1/xp.sqrt(1 + t3872**2)
     t3874 = t3809*t3873
@@ -9612,7 +9612,9 @@ def condition_number(q):
     t3901 = xp.where(xp.less(t3898, t3866), t3898, t3866)
     t3902 = xp.where(xp.greater(t3899, t3900), t3899, t3900)
     t3903 = xp.where(xp.less(t3899, t3901), t3899, t3901)
-    kappa = xp.broadcast_to(xp.where(xp.greater(t3902, 0), t3902, 1)/xp.where(xp.less_equal(t3903, 1e-12*t3902), 0, t3903), batch)
+    t3904 = xp.where(xp.less_equal(t3903, 1e-12*t3902), 0, t3903)
+    t3905 = xp.where(xp.greater(t3902, 0), t3902, 1)
+    kappa = xp.broadcast_to(t3905/t3904, batch)
     return kappa
 
 

@@ -638,10 +638,10 @@ void planar_2r_velocity_ellipsoid(const planar_2r_real q[PLANAR_2R_DOF], planar_
     const planar_2r_real t13 = t12 + (t7*t7);
     const planar_2r_real t14 = t3*t7;
     const int t15 = t14 != 0;
-    const planar_2r_real t16 = 0.5*(-t11 + t13)/(t15 ? -t14 : 1);
+    const planar_2r_real t16 = (-t11 + t13)/(t15 ? -2*t14 : 1);
     const planar_2r_real t17 = fabs(t16);
     const int t18 = t17 >= 1;
-    const planar_2r_real t19 = fabs(1.0/(t18 ? t16 : 1));
+    const planar_2r_real t19 = 1.0/fabs((t18 ? t16 : 1));
     const planar_2r_real t20 = (t15 ? (t16 >= 0 ? 1 : -1)*(t18 ? t19/(1 + sqrt(1 + (t19*t19))) : 1.0/(t17 + sqrt(1 + (t17*t17)))) : 0);
     const planar_2r_real t21 = 1.0/sqrt(1 + (t20*t20));
     const planar_2r_real t22 = t14*t20;
@@ -653,10 +653,10 @@ void planar_2r_velocity_ellipsoid(const planar_2r_real q[PLANAR_2R_DOF], planar_
     const planar_2r_real t28 = t26 - t25*t20;
     const planar_2r_real t29 = t27*t28 + t12*t20*(t21*t21);
     const int t30 = t29 != 0;
-    const planar_2r_real t31 = 0.5*(-t23 + t24)/(t30 ? -t29 : 1);
+    const planar_2r_real t31 = (-t23 + t24)/(t30 ? -2*t29 : 1);
     const planar_2r_real t32 = fabs(t31);
     const int t33 = t32 >= 1;
-    const planar_2r_real t34 = fabs(1.0/(t33 ? t31 : 1));
+    const planar_2r_real t34 = 1.0/fabs((t33 ? t31 : 1));
     const planar_2r_real t35 = (t30 ? (t31 >= 0 ? 1 : -1)*(t33 ? t34/(1 + sqrt(1 + (t34*t34))) : 1.0/(t32 + sqrt(1 + (t32*t32)))) : 0);
     const planar_2r_real t36 = 1.0/sqrt(1 + (t35*t35));
     const planar_2r_real t37 = t29*t35;
@@ -676,10 +676,10 @@ void planar_2r_velocity_ellipsoid(const planar_2r_real q[PLANAR_2R_DOF], planar_
     const planar_2r_real t51 = t44 - t35*t50;
     const planar_2r_real t52 = t50 + t35*t44;
     const int t53 = t49 != 0;
-    const planar_2r_real t54 = 0.5*(-t38 + t39)/(t53 ? t49 : 1);
+    const planar_2r_real t54 = (-t38 + t39)/(t53 ? 2*t49 : 1);
     const planar_2r_real t55 = fabs(t54);
     const int t56 = t55 >= 1;
-    const planar_2r_real t57 = fabs(1.0/(t56 ? t54 : 1));
+    const planar_2r_real t57 = 1.0/fabs((t56 ? t54 : 1));
     const planar_2r_real t58 = (t53 ? (t54 >= 0 ? 1 : -1)*(t56 ? t57/(1 + sqrt(1 + (t57*t57))) : 1.0/(t55 + sqrt(1 + (t55*t55)))) : 0);
     const planar_2r_real t59 = 1.0/sqrt(1 + (t58*t58));
     const planar_2r_real t60 = t49*t58;
@@ -699,10 +699,10 @@ void planar_2r_velocity_ellipsoid(const planar_2r_real q[PLANAR_2R_DOF], planar_
     const planar_2r_real t74 = t72 - t58*t73;
     const planar_2r_real t75 = t73 + t58*t72;
     const int t76 = t71 != 0;
-    const planar_2r_real t77 = 0.5*(-t61 + t62)/(t76 ? t71 : 1);
+    const planar_2r_real t77 = (-t61 + t62)/(t76 ? 2*t71 : 1);
     const planar_2r_real t78 = fabs(t77);
     const int t79 = t78 >= 1;
-    const planar_2r_real t80 = fabs(1.0/(t79 ? t77 : 1));
+    const planar_2r_real t80 = 1.0/fabs((t79 ? t77 : 1));
     const planar_2r_real t81 = (t76 ? (t77 >= 0 ? 1 : -1)*(t79 ? t80/(1 + sqrt(1 + (t80*t80))) : 1.0/(t78 + sqrt(1 + (t78*t78)))) : 0);
     const planar_2r_real t82 = 1.0/sqrt(1 + (t81*t81));
     const planar_2r_real t83 = t71*t81;
@@ -722,10 +722,10 @@ void planar_2r_velocity_ellipsoid(const planar_2r_real q[PLANAR_2R_DOF], planar_
     const planar_2r_real t97 = t95 - t81*t96;
     const planar_2r_real t98 = t96 + t81*t95;
     const int t99 = t94 != 0;
-    const planar_2r_real t100 = 0.5*(-t84 + t85)/(t99 ? t94 : 1);
+    const planar_2r_real t100 = (-t84 + t85)/(t99 ? 2*t94 : 1);
     const planar_2r_real t101 = fabs(t100);
     const int t102 = t101 >= 1;
-    const planar_2r_real t103 = fabs(1.0/(t102 ? t100 : 1));
+    const planar_2r_real t103 = 1.0/fabs((t102 ? t100 : 1));
     const planar_2r_real t104 = (t99 ? (t100 >= 0 ? 1 : -1)*(t102 ? t103/(1 + sqrt(1 + (t103*t103))) : 1.0/(t101 + sqrt(1 + (t101*t101)))) : 0);
     const planar_2r_real t105 = 1.0/sqrt(1 + (t104*t104));
     const planar_2r_real t106 = t88*t105;
@@ -820,10 +820,10 @@ planar_2r_real planar_2r_condition_number(const planar_2r_real q[PLANAR_2R_DOF])
     const planar_2r_real t1 = s1 + s12;
     const planar_2r_real t2 = sqrt((s12*s12) + (t1*t1));
     const planar_2r_real t3 = t2*(t1 <= 0 ? 1 : -1);
-    const planar_2r_real t4 = (t2 > 0 ? 1/(t2*(t2 + fabs(t1))) : 0);
-    const planar_2r_real t5 = t3 - 1.0*t1;
-    const planar_2r_real t6 = t4*(-c12*s12 + t0*t5);
-    const planar_2r_real t7 = t0 - t5*t6;
+    const planar_2r_real t4 = -t1 + t3;
+    const planar_2r_real t5 = (t2 > 0 ? 1/(t2*(t2 + fabs(t1))) : 0);
+    const planar_2r_real t6 = t5*(t0*t4 - c12*s12);
+    const planar_2r_real t7 = t0 - t4*t6;
     const planar_2r_real t8 = c12 + s12*t6;
     const planar_2r_real t9 = fabs(t8);
     const planar_2r_real t10 = t9*(t8 >= 0 ? 1 : -1);
@@ -832,10 +832,10 @@ planar_2r_real planar_2r_condition_number(const planar_2r_real q[PLANAR_2R_DOF])
     const planar_2r_real t13 = t12 + (t7*t7);
     const planar_2r_real t14 = t7*t10;
     const int t15 = t14 != 0;
-    const planar_2r_real t16 = 0.5*(-t13 + t11)/(t15 ? -t14 : 1);
+    const planar_2r_real t16 = (-t13 + t11)/(t15 ? -2*t14 : 1);
     const planar_2r_real t17 = fabs(t16);
     const int t18 = t17 >= 1;
-    const planar_2r_real t19 = fabs(1.0/(t18 ? t16 : 1));
+    const planar_2r_real t19 = 1.0/fabs((t18 ? t16 : 1));
     const planar_2r_real t20 = (t15 ? (t16 >= 0 ? 1 : -1)*(t18 ? t19/(1 + sqrt(1 + (t19*t19))) : 1.0/(t17 + sqrt(1 + (t17*t17)))) : 0);
     const planar_2r_real t21 = (t20*t20);
     const planar_2r_real t22 = 1.0/sqrt(1 + t21);
@@ -848,9 +848,11 @@ planar_2r_real planar_2r_condition_number(const planar_2r_real q[PLANAR_2R_DOF])
     const planar_2r_real t29 = sqrt((t26*t26) + t21*t27);
     const planar_2r_real t30 = (t29 > t28 ? t29 : t28);
     const planar_2r_real t31 = (t29 < t28 ? t29 : t28);
+    const planar_2r_real t32 = (t31 <= 1e-12*t30 ? 0 : t31);
+    const planar_2r_real t33 = (t30 > 0 ? t30 : 1);
 
     /* Outputs */
-    return (t30 > 0 ? t30 : 1)/(t31 <= 1e-12*t30 ? 0 : t31);
+    return t33/t32;
 }
 
 int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real mu_dot[PLANAR_2R_TASK_DIM], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF])

@@ -646,10 +646,10 @@ def velocity_ellipsoid(q):
     t13 = t12 + t7**2
     t14 = t3*t7
     t15 = xp.not_equal(t14, 0)
-    t16 = 0.5*(-t11 + t13)/xp.where(t15, -t14, 1)
+    t16 = (-t11 + t13)/xp.where(t15, -2*t14, 1)
     t17 = xp.abs(t16)
     t18 = xp.greater_equal(t17, 1)
-    t19 = xp.abs(1/xp.where(t18, t16, 1))
+    t19 = 1/xp.abs(xp.where(t18, t16, 1))
     t20 = xp.where(t15, xp.where(xp.greater_equal(t16, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t18, t19/(1 + xp.sqrt(1 + t19**2)), 1/(t17 + xp.sqrt(1 + t17**2))), 0)
     t21 = 1/xp.sqrt(1 + t20**2)
     t22 = t14*t20
@@ -661,10 +661,10 @@ def velocity_ellipsoid(q):
     t28 = t26 - t25*t20
     t29 = t27*t28 + t12*t20*t21**2
     t30 = xp.not_equal(t29, 0)
-    t31 = 0.5*(-t23 + t24)/xp.where(t30, -t29, 1)
+    t31 = (-t23 + t24)/xp.where(t30, -2*t29, 1)
     t32 = xp.abs(t31)
     t33 = xp.greater_equal(t32, 1)
-    t34 = xp.abs(1/xp.where(t33, t31, 1))
+    t34 = 1/xp.abs(xp.where(t33, t31, 1))
     t35 = xp.where(t30, xp.where(xp.greater_equal(t31, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t33, t34/(1 + xp.sqrt(1 + t34**2)), 1/(t32 + xp.sqrt(1 + t32**2))), 0)
     t36 = 1/xp.sqrt(1 + t35**2)
     t37 = t29*t35
@@ -684,10 +684,10 @@ def velocity_ellipsoid(q):
     t51 = t44 - t35*t50
     t52 = t50 + t35*t44
     t53 = xp.not_equal(t49, 0)
-    t54 = 0.5*(-t38 + t39)/xp.where(t53, t49, 1)
+    t54 = (-t38 + t39)/xp.where(t53, 2*t49, 1)
     t55 = xp.abs(t54)
     t56 = xp.greater_equal(t55, 1)
-    t57 = xp.abs(1/xp.where(t56, t54, 1))
+    t57 = 1/xp.abs(xp.where(t56, t54, 1))
     t58 = xp.where(t53, xp.where(xp.greater_equal(t54, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t56, t57/(1 + xp.sqrt(1 + t57**2)), 1/(t55 + xp.sqrt(1 + t55**2))), 0)
     t59 = 1/xp.sqrt(1 + t58**2)
     t60 = t49*t58
@@ -707,10 +707,10 @@ def velocity_ellipsoid(q):
     t74 = t72 - t58*t73
     t75 = t73 + t58*t72
     t76 = xp.not_equal(t71, 0)
-    t77 = 0.5*(-t61 + t62)/xp.where(t76, t71, 1)
+    t77 = (-t61 + t62)/xp.where(t76, 2*t71, 1)
     t78 = xp.abs(t77)
     t79 = xp.greater_equal(t78, 1)
-    t80 = xp.abs(1/xp.where(t79, t77, 1))
+    t80 = 1/xp.abs(xp.where(t79, t77, 1))
     t81 = xp.where(t76, xp.where(xp.greater_equal(t77, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t79, t80/(1 + xp.sqrt(1 + t80**2)), 1/(t78 + xp.sqrt(1 + t78**2))), 0)
     t82 = 1/xp.sqrt(1 + t81**2)
     t83 = t71*t81
@@ -730,10 +730,10 @@ def velocity_ellipsoid(q):
     t97 = t95 - t81*t96
     t98 = t96 + t81*t95
     t99 = xp.not_equal(t94, 0)
-    t100 = 0.5*(-t84 + t85)/xp.where(t99, t94, 1)
+    t100 = (-t84 + t85)/xp.where(t99, 2*t94, 1)
     t101 = xp.abs(t100)
     t102 = xp.greater_equal(t101, 1)
-    t103 = xp.abs(1/xp.where(t102, t100, 1))
+    t103 = 1/xp.abs(xp.where(t102, t100, 1))
     t104 = xp.where(t99, xp.where(xp.greater_equal(t100, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t102, t103/(1 + xp.sqrt(1 + t103**2)), 1/(t101 + xp.sqrt(1 + t101**2))), 0)
     t105 = 1/xp.sqrt(1 + t104**2)
     t106 = t88*t105
@@ -831,10 +831,10 @@ def condition_number(q):
     t1 = s1 + s12
     t2 = xp.sqrt(s12**2 + t1**2)
     t3 = t2*xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)
-    t4 = xp.where(xp.greater(t2, 0), 1/(t2*(t2 + xp.abs(t1))), 0)
-    t5 = t3 - 1.0*t1
-    t6 = t4*(-c12*s12 + t0*t5)
-    t7 = t0 - t5*t6
+    t4 = -t1 + t3
+    t5 = xp.where(xp.greater(t2, 0), 1/(t2*(t2 + xp.abs(t1))), 0)
+    t6 = t5*(t0*t4 - c12*s12)
+    t7 = t0 - t4*t6
     t8 = c12 + s12*t6
     t9 = xp.abs(t8)
     t10 = t9*xp.where(xp.greater_equal(t8, 0), xp.asarray(1, dtype=dtype), -1)
@@ -843,10 +843,10 @@ def condition_number(q):
     t13 = t12 + t7**2
     t14 = t7*t10
     t15 = xp.not_equal(t14, 0)
-    t16 = 0.5*(-t13 + t11)/xp.where(t15, -t14, 1)
+    t16 = (-t13 + t11)/xp.where(t15, -2*t14, 1)
     t17 = xp.abs(t16)
     t18 = xp.greater_equal(t17, 1)
-    t19 = xp.abs(1/xp.where(t18, t16, 1))
+    t19 = 1/xp.abs(xp.where(t18, t16, 1))
     t20 = xp.where(t15, xp.where(xp.greater_equal(t16, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t18, t19/(1 + xp.sqrt(1 + t19**2)), 1/(t17 + xp.sqrt(1 + t17**2))), 0)
     t21 = t20**2
     t22 = 1/xp.sqrt(1 + t21)
@@ -859,7 +859,9 @@ def condition_number(q):
     t29 = xp.sqrt(t26**2 + t21*t27)
     t30 = xp.where(xp.greater(t29, t28), t29, t28)
     t31 = xp.where(xp.less(t29, t28), t29, t28)
-    kappa = xp.broadcast_to(xp.where(xp.greater(t30, 0), t30, 1)/xp.where(xp.less_equal(t31, 1e-12*t30), 0, t31), batch)
+    t32 = xp.where(xp.less_equal(t31, 1e-12*t30), 0, t31)
+    t33 = xp.where(xp.greater(t30, 0), t30, 1)
+    kappa = xp.broadcast_to(t33/t32, batch)
     return kappa
 
 

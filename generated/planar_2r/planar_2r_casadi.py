@@ -462,10 +462,10 @@ def _velocity_ellipsoid(q):
     t13 = t12 + t7**2
     t14 = t3*t7
     t15 = (t14 != 0)
-    t16 = 0.5*(-t11 + t13)/casadi.if_else(t15, -t14, 1)
+    t16 = (-t11 + t13)/casadi.if_else(t15, -2*t14, 1)
     t17 = casadi.fabs(t16)
     t18 = (t17 >= 1)
-    t19 = casadi.fabs(1/casadi.if_else(t18, t16, 1))
+    t19 = 1/casadi.fabs(casadi.if_else(t18, t16, 1))
     t20 = casadi.if_else(t15, casadi.if_else((t16 >= 0), 1, -1)*casadi.if_else(t18, t19/(1 + casadi.sqrt(1 + t19**2)), 1/(t17 + casadi.sqrt(1 + t17**2))), 0)
     t21 = 1/casadi.sqrt(1 + t20**2)
     t22 = t14*t20
@@ -477,10 +477,10 @@ def _velocity_ellipsoid(q):
     t28 = t26 - t25*t20
     t29 = t27*t28 + t12*t20*t21**2
     t30 = (t29 != 0)
-    t31 = 0.5*(-t23 + t24)/casadi.if_else(t30, -t29, 1)
+    t31 = (-t23 + t24)/casadi.if_else(t30, -2*t29, 1)
     t32 = casadi.fabs(t31)
     t33 = (t32 >= 1)
-    t34 = casadi.fabs(1/casadi.if_else(t33, t31, 1))
+    t34 = 1/casadi.fabs(casadi.if_else(t33, t31, 1))
     t35 = casadi.if_else(t30, casadi.if_else((t31 >= 0), 1, -1)*casadi.if_else(t33, t34/(1 + casadi.sqrt(1 + t34**2)), 1/(t32 + casadi.sqrt(1 + t32**2))), 0)
     t36 = 1/casadi.sqrt(1 + t35**2)
     t37 = t29*t35
@@ -500,10 +500,10 @@ def _velocity_ellipsoid(q):
     t51 = t44 - t35*t50
     t52 = t50 + t35*t44
     t53 = (t49 != 0)
-    t54 = 0.5*(-t38 + t39)/casadi.if_else(t53, t49, 1)
+    t54 = (-t38 + t39)/casadi.if_else(t53, 2*t49, 1)
     t55 = casadi.fabs(t54)
     t56 = (t55 >= 1)
-    t57 = casadi.fabs(1/casadi.if_else(t56, t54, 1))
+    t57 = 1/casadi.fabs(casadi.if_else(t56, t54, 1))
     t58 = casadi.if_else(t53, casadi.if_else((t54 >= 0), 1, -1)*casadi.if_else(t56, t57/(1 + casadi.sqrt(1 + t57**2)), 1/(t55 + casadi.sqrt(1 + t55**2))), 0)
     t59 = 1/casadi.sqrt(1 + t58**2)
     t60 = t49*t58
@@ -523,10 +523,10 @@ def _velocity_ellipsoid(q):
     t74 = t72 - t58*t73
     t75 = t73 + t58*t72
     t76 = (t71 != 0)
-    t77 = 0.5*(-t61 + t62)/casadi.if_else(t76, t71, 1)
+    t77 = (-t61 + t62)/casadi.if_else(t76, 2*t71, 1)
     t78 = casadi.fabs(t77)
     t79 = (t78 >= 1)
-    t80 = casadi.fabs(1/casadi.if_else(t79, t77, 1))
+    t80 = 1/casadi.fabs(casadi.if_else(t79, t77, 1))
     t81 = casadi.if_else(t76, casadi.if_else((t77 >= 0), 1, -1)*casadi.if_else(t79, t80/(1 + casadi.sqrt(1 + t80**2)), 1/(t78 + casadi.sqrt(1 + t78**2))), 0)
     t82 = 1/casadi.sqrt(1 + t81**2)
     t83 = t71*t81
@@ -546,10 +546,10 @@ def _velocity_ellipsoid(q):
     t97 = t95 - t81*t96
     t98 = t96 + t81*t95
     t99 = (t94 != 0)
-    t100 = 0.5*(-t84 + t85)/casadi.if_else(t99, t94, 1)
+    t100 = (-t84 + t85)/casadi.if_else(t99, 2*t94, 1)
     t101 = casadi.fabs(t100)
     t102 = (t101 >= 1)
-    t103 = casadi.fabs(1/casadi.if_else(t102, t100, 1))
+    t103 = 1/casadi.fabs(casadi.if_else(t102, t100, 1))
     t104 = casadi.if_else(t99, casadi.if_else((t100 >= 0), 1, -1)*casadi.if_else(t102, t103/(1 + casadi.sqrt(1 + t103**2)), 1/(t101 + casadi.sqrt(1 + t101**2))), 0)
     t105 = 1/casadi.sqrt(1 + t104**2)
     t106 = t88*t105
@@ -634,10 +634,10 @@ def _condition_number(q):
     t1 = s1 + s12
     t2 = casadi.sqrt(s12**2 + t1**2)
     t3 = t2*casadi.if_else((t1 <= 0), 1, -1)
-    t4 = casadi.if_else((t2 > 0), 1/(t2*(t2 + casadi.fabs(t1))), 0)
-    t5 = t3 - 1.0*t1
-    t6 = t4*(-c12*s12 + t0*t5)
-    t7 = t0 - t5*t6
+    t4 = -t1 + t3
+    t5 = casadi.if_else((t2 > 0), 1/(t2*(t2 + casadi.fabs(t1))), 0)
+    t6 = t5*(t0*t4 - c12*s12)
+    t7 = t0 - t4*t6
     t8 = c12 + s12*t6
     t9 = casadi.fabs(t8)
     t10 = t9*casadi.if_else((t8 >= 0), 1, -1)
@@ -646,10 +646,10 @@ def _condition_number(q):
     t13 = t12 + t7**2
     t14 = t7*t10
     t15 = (t14 != 0)
-    t16 = 0.5*(-t13 + t11)/casadi.if_else(t15, -t14, 1)
+    t16 = (-t13 + t11)/casadi.if_else(t15, -2*t14, 1)
     t17 = casadi.fabs(t16)
     t18 = (t17 >= 1)
-    t19 = casadi.fabs(1/casadi.if_else(t18, t16, 1))
+    t19 = 1/casadi.fabs(casadi.if_else(t18, t16, 1))
     t20 = casadi.if_else(t15, casadi.if_else((t16 >= 0), 1, -1)*casadi.if_else(t18, t19/(1 + casadi.sqrt(1 + t19**2)), 1/(t17 + casadi.sqrt(1 + t17**2))), 0)
     t21 = t20**2
     t22 = 1/casadi.sqrt(1 + t21)
@@ -662,8 +662,10 @@ def _condition_number(q):
     t29 = casadi.sqrt(t26**2 + t21*t27)
     t30 = casadi.if_else((t29 > t28), t29, t28)
     t31 = casadi.if_else((t29 < t28), t29, t28)
+    t32 = casadi.if_else((t31 <= 1e-12*t30), 0, t31)
+    t33 = casadi.if_else((t30 > 0), t30, 1)
     kappa = casadi.SX(1, 1)
-    kappa[0, 0] = casadi.if_else((t30 > 0), t30, 1)/casadi.if_else((t31 <= 1e-12*t30), 0, t31)
+    kappa[0, 0] = t33/t32
     return [kappa]
 
 

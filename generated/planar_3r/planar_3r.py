@@ -910,10 +910,10 @@ def velocity_ellipsoid(q):
     t16 = t15 + t9**2
     t17 = t5*t9
     t18 = xp.not_equal(t17, 0)
-    t19 = 0.5*(-t14 + t16)/xp.where(t18, -t17, 1)
+    t19 = (-t14 + t16)/xp.where(t18, -2*t17, 1)
     t20 = xp.abs(t19)
     t21 = xp.greater_equal(t20, 1)
-    t22 = xp.abs(1/xp.where(t21, t19, 1))
+    t22 = 1/xp.abs(xp.where(t21, t19, 1))
     t23 = xp.where(t18, xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t21, t22/(1 + xp.sqrt(1 + t22**2)), 1/(t20 + xp.sqrt(1 + t20**2))), 0)
     t24 = 1/xp.sqrt(1 + t23**2)
     t25 = t17*t23
@@ -925,10 +925,10 @@ def velocity_ellipsoid(q):
     t31 = t29 - t28*t23
     t32 = t30*t31 + t15*t23*t24**2
     t33 = xp.not_equal(t32, 0)
-    t34 = 0.5*(-t26 + t27)/xp.where(t33, -t32, 1)
+    t34 = (-t26 + t27)/xp.where(t33, -2*t32, 1)
     t35 = xp.abs(t34)
     t36 = xp.greater_equal(t35, 1)
-    t37 = xp.abs(1/xp.where(t36, t34, 1))
+    t37 = 1/xp.abs(xp.where(t36, t34, 1))
     t38 = xp.where(t33, xp.where(xp.greater_equal(t34, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t36, t37/(1 + xp.sqrt(1 + t37**2)), 1/(t35 + xp.sqrt(1 + t35**2))), 0)
     t39 = 1/xp.sqrt(1 + t38**2)
     t40 = t32*t38
@@ -948,10 +948,10 @@ def velocity_ellipsoid(q):
     t54 = t47 - t38*t53
     t55 = t53 + t47*t38
     t56 = xp.not_equal(t52, 0)
-    t57 = 0.5*(-t41 + t42)/xp.where(t56, t52, 1)
+    t57 = (-t41 + t42)/xp.where(t56, 2*t52, 1)
     t58 = xp.abs(t57)
     t59 = xp.greater_equal(t58, 1)
-    t60 = xp.abs(1/xp.where(t59, t57, 1))
+    t60 = 1/xp.abs(xp.where(t59, t57, 1))
     t61 = xp.where(t56, xp.where(xp.greater_equal(t57, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t59, t60/(1 + xp.sqrt(1 + t60**2)), 1/(t58 + xp.sqrt(1 + t58**2))), 0)
     t62 = 1/xp.sqrt(1 + t61**2)
     t63 = t52*t61
@@ -971,10 +971,10 @@ def velocity_ellipsoid(q):
     t77 = t75 - t61*t76
     t78 = t76 + t61*t75
     t79 = xp.not_equal(t74, 0)
-    t80 = 0.5*(-t64 + t65)/xp.where(t79, t74, 1)
+    t80 = (-t64 + t65)/xp.where(t79, 2*t74, 1)
     t81 = xp.abs(t80)
     t82 = xp.greater_equal(t81, 1)
-    t83 = xp.abs(1/xp.where(t82, t80, 1))
+    t83 = 1/xp.abs(xp.where(t82, t80, 1))
     t84 = xp.where(t79, xp.where(xp.greater_equal(t80, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t82, t83/(1 + xp.sqrt(1 + t83**2)), 1/(t81 + xp.sqrt(1 + t81**2))), 0)
     t85 = 1/xp.sqrt(1 + t84**2)
     t86 = t74*t84
@@ -994,10 +994,10 @@ def velocity_ellipsoid(q):
     t100 = t98 - t84*t99
     t101 = t99 + t84*t98
     t102 = xp.not_equal(t97, 0)
-    t103 = 0.5*(-t87 + t88)/xp.where(t102, t97, 1)
+    t103 = (-t87 + t88)/xp.where(t102, 2*t97, 1)
     t104 = xp.abs(t103)
     t105 = xp.greater_equal(t104, 1)
-    t106 = xp.abs(1/xp.where(t105, t103, 1))
+    t106 = 1/xp.abs(xp.where(t105, t103, 1))
     t107 = xp.where(t102, xp.where(xp.greater_equal(t103, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t105, t106/(1 + xp.sqrt(1 + t106**2)), 1/(t104 + xp.sqrt(1 + t104**2))), 0)
     t108 = 1/xp.sqrt(1 + t107**2)
     t109 = t91*t108
@@ -1130,10 +1130,10 @@ def condition_number(q):
     t32 = t8**2
     t33 = t32 + t11**2 + t17**2
     t34 = xp.not_equal(t31, 0)
-    t35 = 0.5*(-t33 + t29)/xp.where(t34, t31, 1)
+    t35 = (-t33 + t29)/xp.where(t34, 2*t31, 1)
     t36 = xp.abs(t35)
     t37 = xp.greater_equal(t36, 1)
-    t38 = xp.abs(1/xp.where(t37, t35, 1))
+    t38 = 1/xp.abs(xp.where(t37, t35, 1))
     t39 = xp.where(t34, xp.where(xp.greater_equal(t35, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t37, t38/(1 + xp.sqrt(1 + t38**2)), 1/(t36 + xp.sqrt(1 + t36**2))), 0)
     t40 = 1/xp.sqrt(1 + t39**2)
     t41 = t31*t39
@@ -1149,10 +1149,10 @@ def condition_number(q):
     t51 = t49 + t48*t39
     t52 = t28*t50
     t53 = xp.not_equal(t52, 0)
-    t54 = 0.5*(-t42 + t30)/xp.where(t53, -t52, 1)
+    t54 = (-t42 + t30)/xp.where(t53, -2*t52, 1)
     t55 = xp.abs(t54)
     t56 = xp.greater_equal(t55, 1)
-    t57 = xp.abs(1/xp.where(t56, t54, 1))
+    t57 = 1/xp.abs(xp.where(t56, t54, 1))
     t58 = xp.where(t53, xp.where(xp.greater_equal(t54, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t56, t57/(1 + xp.sqrt(1 + t57**2)), 1/(t55 + xp.sqrt(1 + t55**2))), 0)
     t59 = 1/xp.sqrt(1 + t58**2)
     t60 = t52*t58
@@ -1167,10 +1167,10 @@ def condition_number(q):
     t69 = t68*t58
     t70 = t51*t66 + t32*t67*t39*t40**2 + t69*t47
     t71 = xp.not_equal(t70, 0)
-    t72 = 0.5*(-t43 + t62)/xp.where(t71, t70, 1)
+    t72 = (-t43 + t62)/xp.where(t71, 2*t70, 1)
     t73 = xp.abs(t72)
     t74 = xp.greater_equal(t73, 1)
-    t75 = xp.abs(1/xp.where(t74, t72, 1))
+    t75 = 1/xp.abs(xp.where(t74, t72, 1))
     t76 = xp.where(t71, xp.where(xp.greater_equal(t72, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t74, t75/(1 + xp.sqrt(1 + t75**2)), 1/(t73 + xp.sqrt(1 + t73**2))), 0)
     t77 = 1/xp.sqrt(1 + t76**2)
     t78 = t70*t76
@@ -1193,10 +1193,10 @@ def condition_number(q):
     t95 = t81*t59
     t96 = t65*t93 - t95*t85 + t68*t89
     t97 = xp.not_equal(t96, 0)
-    t98 = 0.5*(-t61 + t79)/xp.where(t97, t96, 1)
+    t98 = (-t61 + t79)/xp.where(t97, 2*t96, 1)
     t99 = xp.abs(t98)
     t100 = xp.greater_equal(t99, 1)
-    t101 = xp.abs(1/xp.where(t100, t98, 1))
+    t101 = 1/xp.abs(xp.where(t100, t98, 1))
     t102 = xp.where(t97, xp.where(xp.greater_equal(t98, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t100, t101/(1 + xp.sqrt(1 + t101**2)), 1/(t99 + xp.sqrt(1 + t99**2))), 0)
     t103 = 1/xp.sqrt(1 + t102**2)
     t104 = t96*t102
@@ -1216,10 +1216,10 @@ def condition_number(q):
     t118 = t116 + t115*t102
     t119 = t86*t109 + t90*t113 + t94*t117
     t120 = xp.not_equal(t119, 0)
-    t121 = 0.5*(-t105 + t80)/xp.where(t120, t119, 1)
+    t121 = (-t105 + t80)/xp.where(t120, 2*t119, 1)
     t122 = xp.abs(t121)
     t123 = xp.greater_equal(t122, 1)
-    t124 = xp.abs(1/xp.where(t123, t121, 1))
+    t124 = 1/xp.abs(xp.where(t123, t121, 1))
     t125 = xp.where(t120, xp.where(xp.greater_equal(t121, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t123, t124/(1 + xp.sqrt(1 + t124**2)), 1/(t122 + xp.sqrt(1 + t122**2))), 0)
     t126 = 1/xp.sqrt(1 + t125**2)
     t127 = t119*t125
@@ -1239,10 +1239,10 @@ def condition_number(q):
     t141 = t139 + t125*t138
     t142 = -t110*t133 + t114*t137 + t118*t141
     t143 = xp.not_equal(t142, 0)
-    t144 = 0.5*(-t106 + t129)/xp.where(t143, t142, 1)
+    t144 = (-t106 + t129)/xp.where(t143, 2*t142, 1)
     t145 = xp.abs(t144)
     t146 = xp.greater_equal(t145, 1)
-    t147 = xp.abs(1/xp.where(t146, t144, 1))
+    t147 = 1/xp.abs(xp.where(t146, t144, 1))
     t148 = xp.where(t143, xp.where(xp.greater_equal(t144, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t146, t147/(1 + xp.sqrt(1 + t147**2)), 1/(t145 + xp.sqrt(1 + t145**2))), 0)
     t149 = 1/xp.sqrt(1 + t148**2)
     t150 = t142*t148
@@ -1262,10 +1262,10 @@ def condition_number(q):
     t164 = t162 + t148*t161
     t165 = t132*t155 + t136*t159 + t140*t163
     t166 = xp.not_equal(t165, 0)
-    t167 = 0.5*(-t128 + t151)/xp.where(t166, t165, 1)
+    t167 = (-t128 + t151)/xp.where(t166, 2*t165, 1)
     t168 = xp.abs(t167)
     t169 = xp.greater_equal(t168, 1)
-    t170 = xp.abs(1/xp.where(t169, t167, 1))
+    t170 = 1/xp.abs(xp.where(t169, t167, 1))
     t171 = xp.where(t166, xp.where(xp.greater_equal(t167, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t169, t170/(1 + xp.sqrt(1 + t170**2)), 1/(t168 + xp.sqrt(1 + t168**2))), 0)
     t172 = 1/xp.sqrt(1 + t171**2)
     t173 = t165*t171
@@ -1285,10 +1285,10 @@ def condition_number(q):
     t187 = t185 + t171*t184
     t188 = t156*t178 + t160*t182 + t164*t186
     t189 = xp.not_equal(t188, 0)
-    t190 = 0.5*(-t174 + t152)/xp.where(t189, t188, 1)
+    t190 = (-t174 + t152)/xp.where(t189, 2*t188, 1)
     t191 = xp.abs(t190)
     t192 = xp.greater_equal(t191, 1)
-    t193 = xp.abs(1/xp.where(t192, t190, 1))
+    t193 = 1/xp.abs(xp.where(t192, t190, 1))
     t194 = xp.where(t189, xp.where(xp.greater_equal(t190, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t192, t193/(1 + xp.sqrt(1 + t193**2)), 1/(t191 + xp.sqrt(1 + t191**2))), 0)
     t195 = 1/xp.sqrt(1 + t194**2)
     t196 = t188*t194
@@ -1308,10 +1308,10 @@ def condition_number(q):
     t210 = t208 + t194*t207
     t211 = t179*t202 + t183*t206 + t187*t210
     t212 = xp.not_equal(t211, 0)
-    t213 = 0.5*(-t175 + t198)/xp.where(t212, t211, 1)
+    t213 = (-t175 + t198)/xp.where(t212, 2*t211, 1)
     t214 = xp.abs(t213)
     t215 = xp.greater_equal(t214, 1)
-    t216 = xp.abs(1/xp.where(t215, t213, 1))
+    t216 = 1/xp.abs(xp.where(t215, t213, 1))
     t217 = xp.where(t212, xp.where(xp.greater_equal(t213, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t215, t216/(1 + xp.sqrt(1 + t216**2)), 1/(t214 + xp.sqrt(1 + t214**2))), 0)
     t218 = 1/xp.sqrt(1 + t217**2)
     t219 = t211*t217
@@ -1331,10 +1331,10 @@ def condition_number(q):
     t233 = t231 + t217*t230
     t234 = t201*t224 + t205*t228 + t209*t232
     t235 = xp.not_equal(t234, 0)
-    t236 = 0.5*(-t197 + t220)/xp.where(t235, t234, 1)
+    t236 = (-t197 + t220)/xp.where(t235, 2*t234, 1)
     t237 = xp.abs(t236)
     t238 = xp.greater_equal(t237, 1)
-    t239 = xp.abs(1/xp.where(t238, t236, 1))
+    t239 = 1/xp.abs(xp.where(t238, t236, 1))
     t240 = xp.where(t235, xp.where(xp.greater_equal(t236, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t238, t239/(1 + xp.sqrt(1 + t239**2)), 1/(t237 + xp.sqrt(1 + t237**2))), 0)
     t241 = 1/xp.sqrt(1 + t240**2)
     t242 = t234*t240
@@ -1354,10 +1354,10 @@ def condition_number(q):
     t256 = t254 + t240*t253
     t257 = t225*t247 + t229*t251 + t233*t255
     t258 = xp.not_equal(t257, 0)
-    t259 = 0.5*(-t243 + t221)/xp.where(t258, t257, 1)
+    t259 = (-t243 + t221)/xp.where(t258, 2*t257, 1)
     t260 = xp.abs(t259)
     t261 = xp.greater_equal(t260, 1)
-    t262 = xp.abs(1/xp.where(t261, t259, 1))
+    t262 = 1/xp.abs(xp.where(t261, t259, 1))
     t263 = xp.where(t258, xp.where(xp.greater_equal(t259, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t261, t262/(1 + xp.sqrt(1 + t262**2)), 1/(t260 + xp.sqrt(1 + t260**2))), 0)
     t264 = 1/xp.sqrt(1 + t263**2)
     t265 = t257*t263
@@ -1377,10 +1377,10 @@ def condition_number(q):
     t279 = t277 + t263*t276
     t280 = t248*t271 + t252*t275 + t256*t279
     t281 = xp.not_equal(t280, 0)
-    t282 = 0.5*(-t244 + t267)/xp.where(t281, t280, 1)
+    t282 = (-t244 + t267)/xp.where(t281, 2*t280, 1)
     t283 = xp.abs(t282)
     t284 = xp.greater_equal(t283, 1)
-    t285 = xp.abs(1/xp.where(t284, t282, 1))
+    t285 = 1/xp.abs(xp.where(t284, t282, 1))
     t286 = xp.where(t281, xp.where(xp.greater_equal(t282, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t284, t285/(1 + xp.sqrt(1 + t285**2)), 1/(t283 + xp.sqrt(1 + t283**2))), 0)
     t287 = 1/xp.sqrt(1 + t286**2)
     t288 = t280*t286
@@ -1400,10 +1400,10 @@ def condition_number(q):
     t302 = t300 + t286*t299
     t303 = t270*t293 + t274*t297 + t278*t301
     t304 = xp.not_equal(t303, 0)
-    t305 = 0.5*(-t266 + t289)/xp.where(t304, t303, 1)
+    t305 = (-t266 + t289)/xp.where(t304, 2*t303, 1)
     t306 = xp.abs(t305)
     t307 = xp.greater_equal(t306, 1)
-    t308 = xp.abs(1/xp.where(t307, t305, 1))
+    t308 = 1/xp.abs(xp.where(t307, t305, 1))
     t309 = xp.where(t304, xp.where(xp.greater_equal(t305, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t307, t308/(1 + xp.sqrt(1 + t308**2)), 1/(t306 + xp.sqrt(1 + t306**2))), 0)
     t310 = 1/xp.sqrt(1 + t309**2)
     t311 = t303*t309
@@ -1423,10 +1423,10 @@ def condition_number(q):
     t325 = t323 + t309*t322
     t326 = t294*t316 + t298*t320 + t302*t324
     t327 = xp.not_equal(t326, 0)
-    t328 = 0.5*(-t312 + t290)/xp.where(t327, t326, 1)
+    t328 = (-t312 + t290)/xp.where(t327, 2*t326, 1)
     t329 = xp.abs(t328)
     t330 = xp.greater_equal(t329, 1)
-    t331 = xp.abs(1/xp.where(t330, t328, 1))
+    t331 = 1/xp.abs(xp.where(t330, t328, 1))
     t332 = xp.where(t327, xp.where(xp.greater_equal(t328, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t330, t331/(1 + xp.sqrt(1 + t331**2)), 1/(t329 + xp.sqrt(1 + t329**2))), 0)
     t333 = 1/xp.sqrt(1 + t332**2)
     t334 = t290 + t326*t332
@@ -1445,10 +1445,10 @@ def condition_number(q):
     t347 = t317*t338 + t321*t342 + t325*t346
     t348 = xp.sqrt(t337**2 + t341**2 + t345**2)
     t349 = xp.not_equal(t347, 0)
-    t350 = 0.5*(-t313 + t334)/xp.where(t349, t347, 1)
+    t350 = (-t313 + t334)/xp.where(t349, 2*t347, 1)
     t351 = xp.abs(t350)
     t352 = xp.greater_equal(t351, 1)
-    t353 = xp.abs(1/xp.where(t352, t350, 1))
+    t353 = 1/xp.abs(xp.where(t352, t350, 1))
     t354 = xp.where(t349, xp.where(xp.greater_equal(t350, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t352, t353/(1 + xp.sqrt(1 + t353**2)), 1/(t351 + xp.sqrt(1 + t351**2))), 0)
     t355 = 1/xp.sqrt(1 + t354**2)
     t356 = t317*t355
@@ -1469,7 +1469,9 @@ def condition_number(q):
     t371 = xp.where(xp.less(t368, t348), t368, t348)
     t372 = xp.where(xp.greater(t369, t370), t369, t370)
     t373 = xp.where(xp.less(t369, t371), t369, t371)
-    kappa = xp.broadcast_to(xp.where(xp.greater(t372, 0), t372, 1)/xp.where(xp.less_equal(t373, 1e-12*t372), 0, t373), batch)
+    t374 = xp.where(xp.less_equal(t373, 1e-12*t372), 0, t373)
+    t375 = xp.where(xp.greater(t372, 0), t372, 1)
+    kappa = xp.broadcast_to(t375/t374, batch)
     return kappa
 
 

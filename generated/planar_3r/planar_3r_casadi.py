@@ -695,10 +695,10 @@ def _velocity_ellipsoid(q):
     t16 = t15 + t9**2
     t17 = t5*t9
     t18 = (t17 != 0)
-    t19 = 0.5*(-t14 + t16)/casadi.if_else(t18, -t17, 1)
+    t19 = (-t14 + t16)/casadi.if_else(t18, -2*t17, 1)
     t20 = casadi.fabs(t19)
     t21 = (t20 >= 1)
-    t22 = casadi.fabs(1/casadi.if_else(t21, t19, 1))
+    t22 = 1/casadi.fabs(casadi.if_else(t21, t19, 1))
     t23 = casadi.if_else(t18, casadi.if_else((t19 >= 0), 1, -1)*casadi.if_else(t21, t22/(1 + casadi.sqrt(1 + t22**2)), 1/(t20 + casadi.sqrt(1 + t20**2))), 0)
     t24 = 1/casadi.sqrt(1 + t23**2)
     t25 = t17*t23
@@ -710,10 +710,10 @@ def _velocity_ellipsoid(q):
     t31 = t29 - t28*t23
     t32 = t30*t31 + t15*t23*t24**2
     t33 = (t32 != 0)
-    t34 = 0.5*(-t26 + t27)/casadi.if_else(t33, -t32, 1)
+    t34 = (-t26 + t27)/casadi.if_else(t33, -2*t32, 1)
     t35 = casadi.fabs(t34)
     t36 = (t35 >= 1)
-    t37 = casadi.fabs(1/casadi.if_else(t36, t34, 1))
+    t37 = 1/casadi.fabs(casadi.if_else(t36, t34, 1))
     t38 = casadi.if_else(t33, casadi.if_else((t34 >= 0), 1, -1)*casadi.if_else(t36, t37/(1 + casadi.sqrt(1 + t37**2)), 1/(t35 + casadi.sqrt(1 + t35**2))), 0)
     t39 = 1/casadi.sqrt(1 + t38**2)
     t40 = t32*t38
@@ -733,10 +733,10 @@ def _velocity_ellipsoid(q):
     t54 = t47 - t38*t53
     t55 = t53 + t47*t38
     t56 = (t52 != 0)
-    t57 = 0.5*(-t41 + t42)/casadi.if_else(t56, t52, 1)
+    t57 = (-t41 + t42)/casadi.if_else(t56, 2*t52, 1)
     t58 = casadi.fabs(t57)
     t59 = (t58 >= 1)
-    t60 = casadi.fabs(1/casadi.if_else(t59, t57, 1))
+    t60 = 1/casadi.fabs(casadi.if_else(t59, t57, 1))
     t61 = casadi.if_else(t56, casadi.if_else((t57 >= 0), 1, -1)*casadi.if_else(t59, t60/(1 + casadi.sqrt(1 + t60**2)), 1/(t58 + casadi.sqrt(1 + t58**2))), 0)
     t62 = 1/casadi.sqrt(1 + t61**2)
     t63 = t52*t61
@@ -756,10 +756,10 @@ def _velocity_ellipsoid(q):
     t77 = t75 - t61*t76
     t78 = t76 + t61*t75
     t79 = (t74 != 0)
-    t80 = 0.5*(-t64 + t65)/casadi.if_else(t79, t74, 1)
+    t80 = (-t64 + t65)/casadi.if_else(t79, 2*t74, 1)
     t81 = casadi.fabs(t80)
     t82 = (t81 >= 1)
-    t83 = casadi.fabs(1/casadi.if_else(t82, t80, 1))
+    t83 = 1/casadi.fabs(casadi.if_else(t82, t80, 1))
     t84 = casadi.if_else(t79, casadi.if_else((t80 >= 0), 1, -1)*casadi.if_else(t82, t83/(1 + casadi.sqrt(1 + t83**2)), 1/(t81 + casadi.sqrt(1 + t81**2))), 0)
     t85 = 1/casadi.sqrt(1 + t84**2)
     t86 = t74*t84
@@ -779,10 +779,10 @@ def _velocity_ellipsoid(q):
     t100 = t98 - t84*t99
     t101 = t99 + t84*t98
     t102 = (t97 != 0)
-    t103 = 0.5*(-t87 + t88)/casadi.if_else(t102, t97, 1)
+    t103 = (-t87 + t88)/casadi.if_else(t102, 2*t97, 1)
     t104 = casadi.fabs(t103)
     t105 = (t104 >= 1)
-    t106 = casadi.fabs(1/casadi.if_else(t105, t103, 1))
+    t106 = 1/casadi.fabs(casadi.if_else(t105, t103, 1))
     t107 = casadi.if_else(t102, casadi.if_else((t103 >= 0), 1, -1)*casadi.if_else(t105, t106/(1 + casadi.sqrt(1 + t106**2)), 1/(t104 + casadi.sqrt(1 + t104**2))), 0)
     t108 = 1/casadi.sqrt(1 + t107**2)
     t109 = t91*t108
@@ -903,10 +903,10 @@ def _condition_number(q):
     t32 = t8**2
     t33 = t32 + t11**2 + t17**2
     t34 = (t31 != 0)
-    t35 = 0.5*(-t33 + t29)/casadi.if_else(t34, t31, 1)
+    t35 = (-t33 + t29)/casadi.if_else(t34, 2*t31, 1)
     t36 = casadi.fabs(t35)
     t37 = (t36 >= 1)
-    t38 = casadi.fabs(1/casadi.if_else(t37, t35, 1))
+    t38 = 1/casadi.fabs(casadi.if_else(t37, t35, 1))
     t39 = casadi.if_else(t34, casadi.if_else((t35 >= 0), 1, -1)*casadi.if_else(t37, t38/(1 + casadi.sqrt(1 + t38**2)), 1/(t36 + casadi.sqrt(1 + t36**2))), 0)
     t40 = 1/casadi.sqrt(1 + t39**2)
     t41 = t31*t39
@@ -922,10 +922,10 @@ def _condition_number(q):
     t51 = t49 + t48*t39
     t52 = t28*t50
     t53 = (t52 != 0)
-    t54 = 0.5*(-t42 + t30)/casadi.if_else(t53, -t52, 1)
+    t54 = (-t42 + t30)/casadi.if_else(t53, -2*t52, 1)
     t55 = casadi.fabs(t54)
     t56 = (t55 >= 1)
-    t57 = casadi.fabs(1/casadi.if_else(t56, t54, 1))
+    t57 = 1/casadi.fabs(casadi.if_else(t56, t54, 1))
     t58 = casadi.if_else(t53, casadi.if_else((t54 >= 0), 1, -1)*casadi.if_else(t56, t57/(1 + casadi.sqrt(1 + t57**2)), 1/(t55 + casadi.sqrt(1 + t55**2))), 0)
     t59 = 1/casadi.sqrt(1 + t58**2)
     t60 = t52*t58
@@ -940,10 +940,10 @@ def _condition_number(q):
     t69 = t68*t58
     t70 = t51*t66 + t32*t67*t39*t40**2 + t69*t47
     t71 = (t70 != 0)
-    t72 = 0.5*(-t43 + t62)/casadi.if_else(t71, t70, 1)
+    t72 = (-t43 + t62)/casadi.if_else(t71, 2*t70, 1)
     t73 = casadi.fabs(t72)
     t74 = (t73 >= 1)
-    t75 = casadi.fabs(1/casadi.if_else(t74, t72, 1))
+    t75 = 1/casadi.fabs(casadi.if_else(t74, t72, 1))
     t76 = casadi.if_else(t71, casadi.if_else((t72 >= 0), 1, -1)*casadi.if_else(t74, t75/(1 + casadi.sqrt(1 + t75**2)), 1/(t73 + casadi.sqrt(1 + t73**2))), 0)
     t77 = 1/casadi.sqrt(1 + t76**2)
     t78 = t70*t76
@@ -966,10 +966,10 @@ def _condition_number(q):
     t95 = t81*t59
     t96 = t65*t93 - t95*t85 + t68*t89
     t97 = (t96 != 0)
-    t98 = 0.5*(-t61 + t79)/casadi.if_else(t97, t96, 1)
+    t98 = (-t61 + t79)/casadi.if_else(t97, 2*t96, 1)
     t99 = casadi.fabs(t98)
     t100 = (t99 >= 1)
-    t101 = casadi.fabs(1/casadi.if_else(t100, t98, 1))
+    t101 = 1/casadi.fabs(casadi.if_else(t100, t98, 1))
     t102 = casadi.if_else(t97, casadi.if_else((t98 >= 0), 1, -1)*casadi.if_else(t100, t101/(1 + casadi.sqrt(1 + t101**2)), 1/(t99 + casadi.sqrt(1 + t99**2))), 0)
     t103 = 1/casadi.sqrt(1 + t102**2)
     t104 = t96*t102
@@ -989,10 +989,10 @@ def _condition_number(q):
     t118 = t116 + t115*t102
     t119 = t86*t109 + t90*t113 + t94*t117
     t120 = (t119 != 0)
-    t121 = 0.5*(-t105 + t80)/casadi.if_else(t120, t119, 1)
+    t121 = (-t105 + t80)/casadi.if_else(t120, 2*t119, 1)
     t122 = casadi.fabs(t121)
     t123 = (t122 >= 1)
-    t124 = casadi.fabs(1/casadi.if_else(t123, t121, 1))
+    t124 = 1/casadi.fabs(casadi.if_else(t123, t121, 1))
     t125 = casadi.if_else(t120, casadi.if_else((t121 >= 0), 1, -1)*casadi.if_else(t123, t124/(1 + casadi.sqrt(1 + t124**2)), 1/(t122 + casadi.sqrt(1 + t122**2))), 0)
     t126 = 1/casadi.sqrt(1 + t125**2)
     t127 = t119*t125
@@ -1012,10 +1012,10 @@ def _condition_number(q):
     t141 = t139 + t125*t138
     t142 = -t110*t133 + t114*t137 + t118*t141
     t143 = (t142 != 0)
-    t144 = 0.5*(-t106 + t129)/casadi.if_else(t143, t142, 1)
+    t144 = (-t106 + t129)/casadi.if_else(t143, 2*t142, 1)
     t145 = casadi.fabs(t144)
     t146 = (t145 >= 1)
-    t147 = casadi.fabs(1/casadi.if_else(t146, t144, 1))
+    t147 = 1/casadi.fabs(casadi.if_else(t146, t144, 1))
     t148 = casadi.if_else(t143, casadi.if_else((t144 >= 0), 1, -1)*casadi.if_else(t146, t147/(1 + casadi.sqrt(1 + t147**2)), 1/(t145 + casadi.sqrt(1 + t145**2))), 0)
     t149 = 1/casadi.sqrt(1 + t148**2)
     t150 = t142*t148
@@ -1035,10 +1035,10 @@ def _condition_number(q):
     t164 = t162 + t148*t161
     t165 = t132*t155 + t136*t159 + t140*t163
     t166 = (t165 != 0)
-    t167 = 0.5*(-t128 + t151)/casadi.if_else(t166, t165, 1)
+    t167 = (-t128 + t151)/casadi.if_else(t166, 2*t165, 1)
     t168 = casadi.fabs(t167)
     t169 = (t168 >= 1)
-    t170 = casadi.fabs(1/casadi.if_else(t169, t167, 1))
+    t170 = 1/casadi.fabs(casadi.if_else(t169, t167, 1))
     t171 = casadi.if_else(t166, casadi.if_else((t167 >= 0), 1, -1)*casadi.if_else(t169, t170/(1 + casadi.sqrt(1 + t170**2)), 1/(t168 + casadi.sqrt(1 + t168**2))), 0)
     t172 = 1/casadi.sqrt(1 + t171**2)
     t173 = t165*t171
@@ -1058,10 +1058,10 @@ def _condition_number(q):
     t187 = t185 + t171*t184
     t188 = t156*t178 + t160*t182 + t164*t186
     t189 = (t188 != 0)
-    t190 = 0.5*(-t174 + t152)/casadi.if_else(t189, t188, 1)
+    t190 = (-t174 + t152)/casadi.if_else(t189, 2*t188, 1)
     t191 = casadi.fabs(t190)
     t192 = (t191 >= 1)
-    t193 = casadi.fabs(1/casadi.if_else(t192, t190, 1))
+    t193 = 1/casadi.fabs(casadi.if_else(t192, t190, 1))
     t194 = casadi.if_else(t189, casadi.if_else((t190 >= 0), 1, -1)*casadi.if_else(t192, t193/(1 + casadi.sqrt(1 + t193**2)), 1/(t191 + casadi.sqrt(1 + t191**2))), 0)
     t195 = 1/casadi.sqrt(1 + t194**2)
     t196 = t188*t194
@@ -1081,10 +1081,10 @@ def _condition_number(q):
     t210 = t208 + t194*t207
     t211 = t179*t202 + t183*t206 + t187*t210
     t212 = (t211 != 0)
-    t213 = 0.5*(-t175 + t198)/casadi.if_else(t212, t211, 1)
+    t213 = (-t175 + t198)/casadi.if_else(t212, 2*t211, 1)
     t214 = casadi.fabs(t213)
     t215 = (t214 >= 1)
-    t216 = casadi.fabs(1/casadi.if_else(t215, t213, 1))
+    t216 = 1/casadi.fabs(casadi.if_else(t215, t213, 1))
     t217 = casadi.if_else(t212, casadi.if_else((t213 >= 0), 1, -1)*casadi.if_else(t215, t216/(1 + casadi.sqrt(1 + t216**2)), 1/(t214 + casadi.sqrt(1 + t214**2))), 0)
     t218 = 1/casadi.sqrt(1 + t217**2)
     t219 = t211*t217
@@ -1104,10 +1104,10 @@ def _condition_number(q):
     t233 = t231 + t217*t230
     t234 = t201*t224 + t205*t228 + t209*t232
     t235 = (t234 != 0)
-    t236 = 0.5*(-t197 + t220)/casadi.if_else(t235, t234, 1)
+    t236 = (-t197 + t220)/casadi.if_else(t235, 2*t234, 1)
     t237 = casadi.fabs(t236)
     t238 = (t237 >= 1)
-    t239 = casadi.fabs(1/casadi.if_else(t238, t236, 1))
+    t239 = 1/casadi.fabs(casadi.if_else(t238, t236, 1))
     t240 = casadi.if_else(t235, casadi.if_else((t236 >= 0), 1, -1)*casadi.if_else(t238, t239/(1 + casadi.sqrt(1 + t239**2)), 1/(t237 + casadi.sqrt(1 + t237**2))), 0)
     t241 = 1/casadi.sqrt(1 + t240**2)
     t242 = t234*t240
@@ -1127,10 +1127,10 @@ def _condition_number(q):
     t256 = t254 + t240*t253
     t257 = t225*t247 + t229*t251 + t233*t255
     t258 = (t257 != 0)
-    t259 = 0.5*(-t243 + t221)/casadi.if_else(t258, t257, 1)
+    t259 = (-t243 + t221)/casadi.if_else(t258, 2*t257, 1)
     t260 = casadi.fabs(t259)
     t261 = (t260 >= 1)
-    t262 = casadi.fabs(1/casadi.if_else(t261, t259, 1))
+    t262 = 1/casadi.fabs(casadi.if_else(t261, t259, 1))
     t263 = casadi.if_else(t258, casadi.if_else((t259 >= 0), 1, -1)*casadi.if_else(t261, t262/(1 + casadi.sqrt(1 + t262**2)), 1/(t260 + casadi.sqrt(1 + t260**2))), 0)
     t264 = 1/casadi.sqrt(1 + t263**2)
     t265 = t257*t263
@@ -1150,10 +1150,10 @@ def _condition_number(q):
     t279 = t277 + t263*t276
     t280 = t248*t271 + t252*t275 + t256*t279
     t281 = (t280 != 0)
-    t282 = 0.5*(-t244 + t267)/casadi.if_else(t281, t280, 1)
+    t282 = (-t244 + t267)/casadi.if_else(t281, 2*t280, 1)
     t283 = casadi.fabs(t282)
     t284 = (t283 >= 1)
-    t285 = casadi.fabs(1/casadi.if_else(t284, t282, 1))
+    t285 = 1/casadi.fabs(casadi.if_else(t284, t282, 1))
     t286 = casadi.if_else(t281, casadi.if_else((t282 >= 0), 1, -1)*casadi.if_else(t284, t285/(1 + casadi.sqrt(1 + t285**2)), 1/(t283 + casadi.sqrt(1 + t283**2))), 0)
     t287 = 1/casadi.sqrt(1 + t286**2)
     t288 = t280*t286
@@ -1173,10 +1173,10 @@ def _condition_number(q):
     t302 = t300 + t286*t299
     t303 = t270*t293 + t274*t297 + t278*t301
     t304 = (t303 != 0)
-    t305 = 0.5*(-t266 + t289)/casadi.if_else(t304, t303, 1)
+    t305 = (-t266 + t289)/casadi.if_else(t304, 2*t303, 1)
     t306 = casadi.fabs(t305)
     t307 = (t306 >= 1)
-    t308 = casadi.fabs(1/casadi.if_else(t307, t305, 1))
+    t308 = 1/casadi.fabs(casadi.if_else(t307, t305, 1))
     t309 = casadi.if_else(t304, casadi.if_else((t305 >= 0), 1, -1)*casadi.if_else(t307, t308/(1 + casadi.sqrt(1 + t308**2)), 1/(t306 + casadi.sqrt(1 + t306**2))), 0)
     t310 = 1/casadi.sqrt(1 + t309**2)
     t311 = t303*t309
@@ -1196,10 +1196,10 @@ def _condition_number(q):
     t325 = t323 + t309*t322
     t326 = t294*t316 + t298*t320 + t302*t324
     t327 = (t326 != 0)
-    t328 = 0.5*(-t312 + t290)/casadi.if_else(t327, t326, 1)
+    t328 = (-t312 + t290)/casadi.if_else(t327, 2*t326, 1)
     t329 = casadi.fabs(t328)
     t330 = (t329 >= 1)
-    t331 = casadi.fabs(1/casadi.if_else(t330, t328, 1))
+    t331 = 1/casadi.fabs(casadi.if_else(t330, t328, 1))
     t332 = casadi.if_else(t327, casadi.if_else((t328 >= 0), 1, -1)*casadi.if_else(t330, t331/(1 + casadi.sqrt(1 + t331**2)), 1/(t329 + casadi.sqrt(1 + t329**2))), 0)
     t333 = 1/casadi.sqrt(1 + t332**2)
     t334 = t290 + t326*t332
@@ -1218,10 +1218,10 @@ def _condition_number(q):
     t347 = t317*t338 + t321*t342 + t325*t346
     t348 = casadi.sqrt(t337**2 + t341**2 + t345**2)
     t349 = (t347 != 0)
-    t350 = 0.5*(-t313 + t334)/casadi.if_else(t349, t347, 1)
+    t350 = (-t313 + t334)/casadi.if_else(t349, 2*t347, 1)
     t351 = casadi.fabs(t350)
     t352 = (t351 >= 1)
-    t353 = casadi.fabs(1/casadi.if_else(t352, t350, 1))
+    t353 = 1/casadi.fabs(casadi.if_else(t352, t350, 1))
     t354 = casadi.if_else(t349, casadi.if_else((t350 >= 0), 1, -1)*casadi.if_else(t352, t353/(1 + casadi.sqrt(1 + t353**2)), 1/(t351 + casadi.sqrt(1 + t351**2))), 0)
     t355 = 1/casadi.sqrt(1 + t354**2)
     t356 = t317*t355
@@ -1242,8 +1242,10 @@ def _condition_number(q):
     t371 = casadi.if_else((t368 < t348), t368, t348)
     t372 = casadi.if_else((t369 > t370), t369, t370)
     t373 = casadi.if_else((t369 < t371), t369, t371)
+    t374 = casadi.if_else((t373 <= 1e-12*t372), 0, t373)
+    t375 = casadi.if_else((t372 > 0), t372, 1)
     kappa = casadi.SX(1, 1)
-    kappa[0, 0] = casadi.if_else((t372 > 0), t372, 1)/casadi.if_else((t373 <= 1e-12*t372), 0, t373)
+    kappa[0, 0] = t375/t374
     return [kappa]
 
 

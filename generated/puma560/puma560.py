@@ -2045,10 +2045,10 @@ def velocity_ellipsoid(q):
     t54 = t53**2
     t55 = t29*t35
     t56 = xp.not_equal(t55, 0)
-    t57 = 0.5*(-t32 + t43)/xp.where(t56, -t55, 1)
+    t57 = (-t32 + t43)/xp.where(t56, -2*t55, 1)
     t58 = xp.abs(t57)
     t59 = xp.greater_equal(t58, 1)
-    t60 = xp.abs(1/xp.where(t59, t57, 1))
+    t60 = 1/xp.abs(xp.where(t59, t57, 1))
     t61 = xp.where(t56, xp.where(xp.greater_equal(t57, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t59, t60/(1 + xp.sqrt(1 + t60**2)), 1/(t58 + xp.sqrt(1 + t58**2))), 0)
     t62 = 1/xp.sqrt(1 + t61**2)
     t63 = t55*t61
@@ -2064,10 +2064,10 @@ def velocity_ellipsoid(q):
     t73 = t72*t61
     t74 = t70*t68 + t73*t50
     t75 = xp.not_equal(t74, 0)
-    t76 = 0.5*(-t64 + t71)/xp.where(t75, t74, 1)
+    t76 = (-t64 + t71)/xp.where(t75, 2*t74, 1)
     t77 = xp.abs(t76)
     t78 = xp.greater_equal(t77, 1)
-    t79 = xp.abs(1/xp.where(t78, t76, 1))
+    t79 = 1/xp.abs(xp.where(t78, t76, 1))
     t80 = xp.where(t75, xp.where(xp.greater_equal(t76, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t78, t79/(1 + xp.sqrt(1 + t79**2)), 1/(t77 + xp.sqrt(1 + t77**2))), 0)
     t81 = 1/xp.sqrt(1 + t80**2)
     t82 = t74*t80
@@ -2083,10 +2083,10 @@ def velocity_ellipsoid(q):
     t92 = t90 + t89*t80
     t93 = t69*t88 + t72*t92
     t94 = xp.not_equal(t93, 0)
-    t95 = 0.5*(-t65 + t84)/xp.where(t94, -t93, 1)
+    t95 = (-t65 + t84)/xp.where(t94, -2*t93, 1)
     t96 = xp.abs(t95)
     t97 = xp.greater_equal(t96, 1)
-    t98 = xp.abs(1/xp.where(t97, t95, 1))
+    t98 = 1/xp.abs(xp.where(t97, t95, 1))
     t99 = xp.where(t94, xp.where(xp.greater_equal(t95, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t97, t98/(1 + xp.sqrt(1 + t98**2)), 1/(t96 + xp.sqrt(1 + t96**2))), 0)
     t100 = 1/xp.sqrt(1 + t99**2)
     t101 = t93*t99
@@ -2112,10 +2112,10 @@ def velocity_ellipsoid(q):
     t121 = t99*t100
     t122 = t87*t106 - t91*t111 + t54*t115*t121*t81
     t123 = xp.not_equal(t122, 0)
-    t124 = 0.5*(-t83 + t102)/xp.where(t123, t122, 1)
+    t124 = (-t83 + t102)/xp.where(t123, 2*t122, 1)
     t125 = xp.abs(t124)
     t126 = xp.greater_equal(t125, 1)
-    t127 = xp.abs(1/xp.where(t126, t124, 1))
+    t127 = 1/xp.abs(xp.where(t126, t124, 1))
     t128 = xp.where(t123, xp.where(xp.greater_equal(t124, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t126, t127/(1 + xp.sqrt(1 + t127**2)), 1/(t125 + xp.sqrt(1 + t125**2))), 0)
     t129 = 1/xp.sqrt(1 + t128**2)
     t130 = t122*t128
@@ -2149,10 +2149,10 @@ def velocity_ellipsoid(q):
     t158 = t81*t100
     t159 = t107*t135 + t112*t139 - t53*t158*t148
     t160 = xp.not_equal(t159, 0)
-    t161 = 0.5*(-t131 + t103)/xp.where(t160, t159, 1)
+    t161 = (-t131 + t103)/xp.where(t160, 2*t159, 1)
     t162 = xp.abs(t161)
     t163 = xp.greater_equal(t162, 1)
-    t164 = xp.abs(1/xp.where(t163, t161, 1))
+    t164 = 1/xp.abs(xp.where(t163, t161, 1))
     t165 = xp.where(t160, xp.where(xp.greater_equal(t161, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t163, t164/(1 + xp.sqrt(1 + t164**2)), 1/(t162 + xp.sqrt(1 + t162**2))), 0)
     t166 = 1/xp.sqrt(1 + t165**2)
     t167 = t159*t165
@@ -2184,10 +2184,10 @@ def velocity_ellipsoid(q):
     t193 = t192 - t165*t179
     t194 = t179 + t165*t192
     t195 = xp.not_equal(t183, 0)
-    t196 = 0.5*(-t132 + t169)/xp.where(t195, t183, 1)
+    t196 = (-t132 + t169)/xp.where(t195, 2*t183, 1)
     t197 = xp.abs(t196)
     t198 = xp.greater_equal(t197, 1)
-    t199 = xp.abs(1/xp.where(t198, t196, 1))
+    t199 = 1/xp.abs(xp.where(t198, t196, 1))
     t200 = xp.where(t195, xp.where(xp.greater_equal(t196, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t198, t199/(1 + xp.sqrt(1 + t199**2)), 1/(t197 + xp.sqrt(1 + t197**2))), 0)
     t201 = 1/xp.sqrt(1 + t200**2)
     t202 = t183*t200
@@ -2219,10 +2219,10 @@ def velocity_ellipsoid(q):
     t228 = t226 + t200*t227
     t229 = t227 - t200*t226
     t230 = xp.not_equal(t217, 0)
-    t231 = 0.5*(-t168 + t203)/xp.where(t230, t217, 1)
+    t231 = (-t168 + t203)/xp.where(t230, 2*t217, 1)
     t232 = xp.abs(t231)
     t233 = xp.greater_equal(t232, 1)
-    t234 = xp.abs(1/xp.where(t233, t231, 1))
+    t234 = 1/xp.abs(xp.where(t233, t231, 1))
     t235 = xp.where(t230, xp.where(xp.greater_equal(t231, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t233, t234/(1 + xp.sqrt(1 + t234**2)), 1/(t232 + xp.sqrt(1 + t232**2))), 0)
     t236 = 1/xp.sqrt(1 + t235**2)
     t237 = t217*t235
@@ -2254,10 +2254,10 @@ def velocity_ellipsoid(q):
     t263 = t261 + t235*t262
     t264 = -t262 + t235*t261
     t265 = xp.not_equal(t252, 0)
-    t266 = 0.5*(-t238 + t204)/xp.where(t265, t252, 1)
+    t266 = (-t238 + t204)/xp.where(t265, 2*t252, 1)
     t267 = xp.abs(t266)
     t268 = xp.greater_equal(t267, 1)
-    t269 = xp.abs(1/xp.where(t268, t266, 1))
+    t269 = 1/xp.abs(xp.where(t268, t266, 1))
     t270 = xp.where(t265, xp.where(xp.greater_equal(t266, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t268, t269/(1 + xp.sqrt(1 + t269**2)), 1/(t267 + xp.sqrt(1 + t267**2))), 0)
     t271 = 1/xp.sqrt(1 + t270**2)
     t272 = t252*t270
@@ -2289,10 +2289,10 @@ def velocity_ellipsoid(q):
     t298 = t296 - t270*t297
     t299 = t297 + t270*t296
     t300 = xp.not_equal(t287, 0)
-    t301 = 0.5*(-t239 + t274)/xp.where(t300, t287, 1)
+    t301 = (-t239 + t274)/xp.where(t300, 2*t287, 1)
     t302 = xp.abs(t301)
     t303 = xp.greater_equal(t302, 1)
-    t304 = xp.abs(1/xp.where(t303, t301, 1))
+    t304 = 1/xp.abs(xp.where(t303, t301, 1))
     t305 = xp.where(t300, xp.where(xp.greater_equal(t301, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t303, t304/(1 + xp.sqrt(1 + t304**2)), 1/(t302 + xp.sqrt(1 + t302**2))), 0)
     t306 = 1/xp.sqrt(1 + t305**2)
     t307 = t287*t305
@@ -2324,10 +2324,10 @@ def velocity_ellipsoid(q):
     t333 = t331 - t305*t332
     t334 = t332 + t305*t331
     t335 = xp.not_equal(t322, 0)
-    t336 = 0.5*(-t273 + t308)/xp.where(t335, t322, 1)
+    t336 = (-t273 + t308)/xp.where(t335, 2*t322, 1)
     t337 = xp.abs(t336)
     t338 = xp.greater_equal(t337, 1)
-    t339 = xp.abs(1/xp.where(t338, t336, 1))
+    t339 = 1/xp.abs(xp.where(t338, t336, 1))
     t340 = xp.where(t335, xp.where(xp.greater_equal(t336, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t338, t339/(1 + xp.sqrt(1 + t339**2)), 1/(t337 + xp.sqrt(1 + t337**2))), 0)
     t341 = 1/xp.sqrt(1 + t340**2)
     t342 = t322*t340
@@ -2359,10 +2359,10 @@ def velocity_ellipsoid(q):
     t368 = t366 - t340*t367
     t369 = t367 + t340*t366
     t370 = xp.not_equal(t357, 0)
-    t371 = 0.5*(-t343 + t309)/xp.where(t370, t357, 1)
+    t371 = (-t343 + t309)/xp.where(t370, 2*t357, 1)
     t372 = xp.abs(t371)
     t373 = xp.greater_equal(t372, 1)
-    t374 = xp.abs(1/xp.where(t373, t371, 1))
+    t374 = 1/xp.abs(xp.where(t373, t371, 1))
     t375 = xp.where(t370, xp.where(xp.greater_equal(t371, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t373, t374/(1 + xp.sqrt(1 + t374**2)), 1/(t372 + xp.sqrt(1 + t372**2))), 0)
     t376 = 1/xp.sqrt(1 + t375**2)
     t377 = t357*t375
@@ -2394,10 +2394,10 @@ def velocity_ellipsoid(q):
     t403 = t401 - t375*t402
     t404 = t402 + t375*t401
     t405 = xp.not_equal(t392, 0)
-    t406 = 0.5*(-t344 + t379)/xp.where(t405, t392, 1)
+    t406 = (-t344 + t379)/xp.where(t405, 2*t392, 1)
     t407 = xp.abs(t406)
     t408 = xp.greater_equal(t407, 1)
-    t409 = xp.abs(1/xp.where(t408, t406, 1))
+    t409 = 1/xp.abs(xp.where(t408, t406, 1))
     t410 = xp.where(t405, xp.where(xp.greater_equal(t406, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t408, t409/(1 + xp.sqrt(1 + t409**2)), 1/(t407 + xp.sqrt(1 + t407**2))), 0)
     t411 = 1/xp.sqrt(1 + t410**2)
     t412 = t392*t410
@@ -2429,10 +2429,10 @@ def velocity_ellipsoid(q):
     t438 = t436 - t410*t437
     t439 = t437 + t410*t436
     t440 = xp.not_equal(t427, 0)
-    t441 = 0.5*(-t378 + t413)/xp.where(t440, t427, 1)
+    t441 = (-t378 + t413)/xp.where(t440, 2*t427, 1)
     t442 = xp.abs(t441)
     t443 = xp.greater_equal(t442, 1)
-    t444 = xp.abs(1/xp.where(t443, t441, 1))
+    t444 = 1/xp.abs(xp.where(t443, t441, 1))
     t445 = xp.where(t440, xp.where(xp.greater_equal(t441, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t443, t444/(1 + xp.sqrt(1 + t444**2)), 1/(t442 + xp.sqrt(1 + t442**2))), 0)
     t446 = 1/xp.sqrt(1 + t445**2)
     t447 = t427*t445
@@ -2464,10 +2464,10 @@ def velocity_ellipsoid(q):
     t473 = t471 - t445*t472
     t474 = t472 + t445*t471
     t475 = xp.not_equal(t462, 0)
-    t476 = 0.5*(-t448 + t414)/xp.where(t475, t462, 1)
+    t476 = (-t448 + t414)/xp.where(t475, 2*t462, 1)
     t477 = xp.abs(t476)
     t478 = xp.greater_equal(t477, 1)
-    t479 = xp.abs(1/xp.where(t478, t476, 1))
+    t479 = 1/xp.abs(xp.where(t478, t476, 1))
     t480 = xp.where(t475, xp.where(xp.greater_equal(t476, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t478, t479/(1 + xp.sqrt(1 + t479**2)), 1/(t477 + xp.sqrt(1 + t477**2))), 0)
     t481 = 1/xp.sqrt(1 + t480**2)
     t482 = t414 + t462*t480
@@ -2498,10 +2498,10 @@ def velocity_ellipsoid(q):
     t507 = t505 - t480*t506
     t508 = t506 + t480*t505
     t509 = xp.not_equal(t495, 0)
-    t510 = 0.5*(-t449 + t482)/xp.where(t509, t495, 1)
+    t510 = (-t449 + t482)/xp.where(t509, 2*t495, 1)
     t511 = xp.abs(t510)
     t512 = xp.greater_equal(t511, 1)
-    t513 = xp.abs(1/xp.where(t512, t510, 1))
+    t513 = 1/xp.abs(xp.where(t512, t510, 1))
     t514 = xp.where(t509, xp.where(xp.greater_equal(t510, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t512, t513/(1 + xp.sqrt(1 + t513**2)), 1/(t511 + xp.sqrt(1 + t511**2))), 0)
     t515 = 1/xp.sqrt(1 + t514**2)
     t516 = t453*t515
@@ -2596,10 +2596,10 @@ def velocity_ellipsoid(q):
     t605 = t604**2
     t606 = t592**2 + t598**2 + t605
     t607 = xp.not_equal(t589, 0)
-    t608 = 0.5*(-t577 + t588)/xp.where(t607, t589, 1)
+    t608 = (-t577 + t588)/xp.where(t607, 2*t589, 1)
     t609 = xp.abs(t608)
     t610 = xp.greater_equal(t609, 1)
-    t611 = xp.abs(1/xp.where(t610, t608, 1))
+    t611 = 1/xp.abs(xp.where(t610, t608, 1))
     t612 = xp.where(t607, xp.where(xp.greater_equal(t608, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t610, t611/(1 + xp.sqrt(1 + t611**2)), 1/(t609 + xp.sqrt(1 + t609**2))), 0)
     t613 = 1/xp.sqrt(1 + t612**2)
     t614 = t589*t612
@@ -2613,10 +2613,10 @@ def velocity_ellipsoid(q):
     t622 = t612*t621
     t623 = t592*t619 - t598*t622
     t624 = xp.not_equal(t623, 0)
-    t625 = 0.5*(-t615 + t606)/xp.where(t624, t623, 1)
+    t625 = (-t615 + t606)/xp.where(t624, 2*t623, 1)
     t626 = xp.abs(t625)
     t627 = xp.greater_equal(t626, 1)
-    t628 = xp.abs(1/xp.where(t627, t625, 1))
+    t628 = 1/xp.abs(xp.where(t627, t625, 1))
     t629 = xp.where(t624, xp.where(xp.greater_equal(t625, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t627, t628/(1 + xp.sqrt(1 + t628**2)), 1/(t626 + xp.sqrt(1 + t626**2))), 0)
     t630 = 1/xp.sqrt(1 + t629**2)
     t631 = t623*t629
@@ -2632,10 +2632,10 @@ def velocity_ellipsoid(q):
     t641 = -t639 + t629*t638
     t642 = t620*t637 + t641*t621
     t643 = xp.not_equal(t642, 0)
-    t644 = 0.5*(-t616 + t633)/xp.where(t643, -t642, 1)
+    t644 = (-t616 + t633)/xp.where(t643, -2*t642, 1)
     t645 = xp.abs(t644)
     t646 = xp.greater_equal(t645, 1)
-    t647 = xp.abs(1/xp.where(t646, t644, 1))
+    t647 = 1/xp.abs(xp.where(t646, t644, 1))
     t648 = xp.where(t643, xp.where(xp.greater_equal(t644, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t646, t647/(1 + xp.sqrt(1 + t647**2)), 1/(t645 + xp.sqrt(1 + t645**2))), 0)
     t649 = 1/xp.sqrt(1 + t648**2)
     t650 = t642*t648
@@ -2661,10 +2661,10 @@ def velocity_ellipsoid(q):
     t670 = t648*t649
     t671 = t636*t655 + t640*t660 - t630*t605*t664*t670
     t672 = xp.not_equal(t671, 0)
-    t673 = 0.5*(-t632 + t651)/xp.where(t672, -t671, 1)
+    t673 = (-t632 + t651)/xp.where(t672, -2*t671, 1)
     t674 = xp.abs(t673)
     t675 = xp.greater_equal(t674, 1)
-    t676 = xp.abs(1/xp.where(t675, t673, 1))
+    t676 = 1/xp.abs(xp.where(t675, t673, 1))
     t677 = xp.where(t672, xp.where(xp.greater_equal(t673, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t675, t676/(1 + xp.sqrt(1 + t676**2)), 1/(t674 + xp.sqrt(1 + t674**2))), 0)
     t678 = 1/xp.sqrt(1 + t677**2)
     t679 = t671*t677
@@ -2698,10 +2698,10 @@ def velocity_ellipsoid(q):
     t707 = t630*t649
     t708 = t656*t684 + t661*t688 - t604*t697*t707
     t709 = xp.not_equal(t708, 0)
-    t710 = 0.5*(-t680 + t652)/xp.where(t709, t708, 1)
+    t710 = (-t680 + t652)/xp.where(t709, 2*t708, 1)
     t711 = xp.abs(t710)
     t712 = xp.greater_equal(t711, 1)
-    t713 = xp.abs(1/xp.where(t712, t710, 1))
+    t713 = 1/xp.abs(xp.where(t712, t710, 1))
     t714 = xp.where(t709, xp.where(xp.greater_equal(t710, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t712, t713/(1 + xp.sqrt(1 + t713**2)), 1/(t711 + xp.sqrt(1 + t711**2))), 0)
     t715 = 1/xp.sqrt(1 + t714**2)
     t716 = t708*t714
@@ -2733,10 +2733,10 @@ def velocity_ellipsoid(q):
     t742 = t741 - t714*t728
     t743 = t728 + t714*t741
     t744 = xp.not_equal(t732, 0)
-    t745 = 0.5*(-t681 + t718)/xp.where(t744, t732, 1)
+    t745 = (-t681 + t718)/xp.where(t744, 2*t732, 1)
     t746 = xp.abs(t745)
     t747 = xp.greater_equal(t746, 1)
-    t748 = xp.abs(1/xp.where(t747, t745, 1))
+    t748 = 1/xp.abs(xp.where(t747, t745, 1))
     t749 = xp.where(t744, xp.where(xp.greater_equal(t745, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t747, t748/(1 + xp.sqrt(1 + t748**2)), 1/(t746 + xp.sqrt(1 + t746**2))), 0)
     t750 = 1/xp.sqrt(1 + t749**2)
     t751 = t732*t749
@@ -2768,10 +2768,10 @@ def velocity_ellipsoid(q):
     t777 = t775 + t749*t776
     t778 = t776 - t749*t775
     t779 = xp.not_equal(t766, 0)
-    t780 = 0.5*(-t717 + t752)/xp.where(t779, t766, 1)
+    t780 = (-t717 + t752)/xp.where(t779, 2*t766, 1)
     t781 = xp.abs(t780)
     t782 = xp.greater_equal(t781, 1)
-    t783 = xp.abs(1/xp.where(t782, t780, 1))
+    t783 = 1/xp.abs(xp.where(t782, t780, 1))
     t784 = xp.where(t779, xp.where(xp.greater_equal(t780, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t782, t783/(1 + xp.sqrt(1 + t783**2)), 1/(t781 + xp.sqrt(1 + t781**2))), 0)
     t785 = 1/xp.sqrt(1 + t784**2)
     t786 = t766*t784
@@ -2803,10 +2803,10 @@ def velocity_ellipsoid(q):
     t812 = t810 + t784*t811
     t813 = -t811 + t784*t810
     t814 = xp.not_equal(t801, 0)
-    t815 = 0.5*(-t787 + t753)/xp.where(t814, t801, 1)
+    t815 = (-t787 + t753)/xp.where(t814, 2*t801, 1)
     t816 = xp.abs(t815)
     t817 = xp.greater_equal(t816, 1)
-    t818 = xp.abs(1/xp.where(t817, t815, 1))
+    t818 = 1/xp.abs(xp.where(t817, t815, 1))
     t819 = xp.where(t814, xp.where(xp.greater_equal(t815, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t817, t818/(1 + xp.sqrt(1 + t818**2)), 1/(t816 + xp.sqrt(1 + t816**2))), 0)
     t820 = 1/xp.sqrt(1 + t819**2)
     t821 = t801*t819
@@ -2838,10 +2838,10 @@ def velocity_ellipsoid(q):
     t847 = t845 - t819*t846
     t848 = t846 + t819*t845
     t849 = xp.not_equal(t836, 0)
-    t850 = 0.5*(-t788 + t823)/xp.where(t849, t836, 1)
+    t850 = (-t788 + t823)/xp.where(t849, 2*t836, 1)
     t851 = xp.abs(t850)
     t852 = xp.greater_equal(t851, 1)
-    t853 = xp.abs(1/xp.where(t852, t850, 1))
+    t853 = 1/xp.abs(xp.where(t852, t850, 1))
     t854 = xp.where(t849, xp.where(xp.greater_equal(t850, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t852, t853/(1 + xp.sqrt(1 + t853**2)), 1/(t851 + xp.sqrt(1 + t851**2))), 0)
     t855 = 1/xp.sqrt(1 + t854**2)
     t856 = t836*t854
@@ -2873,10 +2873,10 @@ def velocity_ellipsoid(q):
     t882 = t880 - t854*t881
     t883 = t881 + t854*t880
     t884 = xp.not_equal(t871, 0)
-    t885 = 0.5*(-t822 + t857)/xp.where(t884, t871, 1)
+    t885 = (-t822 + t857)/xp.where(t884, 2*t871, 1)
     t886 = xp.abs(t885)
     t887 = xp.greater_equal(t886, 1)
-    t888 = xp.abs(1/xp.where(t887, t885, 1))
+    t888 = 1/xp.abs(xp.where(t887, t885, 1))
     t889 = xp.where(t884, xp.where(xp.greater_equal(t885, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t887, t888/(1 + xp.sqrt(1 + t888**2)), 1/(t886 + xp.sqrt(1 + t886**2))), 0)
     t890 = 1/xp.sqrt(1 + t889**2)
     t891 = t871*t889
@@ -2908,10 +2908,10 @@ def velocity_ellipsoid(q):
     t917 = t915 - t889*t916
     t918 = t916 + t889*t915
     t919 = xp.not_equal(t906, 0)
-    t920 = 0.5*(-t892 + t858)/xp.where(t919, t906, 1)
+    t920 = (-t892 + t858)/xp.where(t919, 2*t906, 1)
     t921 = xp.abs(t920)
     t922 = xp.greater_equal(t921, 1)
-    t923 = xp.abs(1/xp.where(t922, t920, 1))
+    t923 = 1/xp.abs(xp.where(t922, t920, 1))
     t924 = xp.where(t919, xp.where(xp.greater_equal(t920, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t922, t923/(1 + xp.sqrt(1 + t923**2)), 1/(t921 + xp.sqrt(1 + t921**2))), 0)
     t925 = 1/xp.sqrt(1 + t924**2)
     t926 = t906*t924
@@ -2943,10 +2943,10 @@ def velocity_ellipsoid(q):
     t952 = t950 - t924*t951
     t953 = t951 + t924*t950
     t954 = xp.not_equal(t941, 0)
-    t955 = 0.5*(-t893 + t928)/xp.where(t954, t941, 1)
+    t955 = (-t893 + t928)/xp.where(t954, 2*t941, 1)
     t956 = xp.abs(t955)
     t957 = xp.greater_equal(t956, 1)
-    t958 = xp.abs(1/xp.where(t957, t955, 1))
+    t958 = 1/xp.abs(xp.where(t957, t955, 1))
     t959 = xp.where(t954, xp.where(xp.greater_equal(t955, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t957, t958/(1 + xp.sqrt(1 + t958**2)), 1/(t956 + xp.sqrt(1 + t956**2))), 0)
     t960 = 1/xp.sqrt(1 + t959**2)
     t961 = t941*t959
@@ -2978,10 +2978,10 @@ def velocity_ellipsoid(q):
     t987 = t985 - t959*t986
     t988 = t986 + t959*t985
     t989 = xp.not_equal(t976, 0)
-    t990 = 0.5*(-t927 + t962)/xp.where(t989, t976, 1)
+    t990 = (-t927 + t962)/xp.where(t989, 2*t976, 1)
     t991 = xp.abs(t990)
     t992 = xp.greater_equal(t991, 1)
-    t993 = xp.abs(1/xp.where(t992, t990, 1))
+    t993 = 1/xp.abs(xp.where(t992, t990, 1))
     t994 = xp.where(t989, xp.where(xp.greater_equal(t990, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t992, t993/(1 + xp.sqrt(1 + t993**2)), 1/(t991 + xp.sqrt(1 + t991**2))), 0)
     t995 = 1/xp.sqrt(1 + t994**2)
     t996 = t976*t994
@@ -3013,10 +3013,10 @@ def velocity_ellipsoid(q):
     t1022 = t1020 - t994*t1021
     t1023 = t1021 + t994*t1020
     t1024 = xp.not_equal(t1011, 0)
-    t1025 = 0.5*(-t997 + t963)/xp.where(t1024, t1011, 1)
+    t1025 = (-t997 + t963)/xp.where(t1024, 2*t1011, 1)
     t1026 = xp.abs(t1025)
     t1027 = xp.greater_equal(t1026, 1)
-    t1028 = xp.abs(1/xp.where(t1027, t1025, 1))
+    t1028 = 1/xp.abs(xp.where(t1027, t1025, 1))
     t1029 = xp.where(t1024, xp.where(xp.greater_equal(t1025, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1027, t1028/(1 + xp.sqrt(1 + t1028**2)), 1/(t1026 + xp.sqrt(1 + t1026**2))), 0)
     t1030 = 1/xp.sqrt(1 + t1029**2)
     t1031 = t963 + t1011*t1029
@@ -3047,10 +3047,10 @@ def velocity_ellipsoid(q):
     t1056 = t1054 - t1029*t1055
     t1057 = t1055 + t1029*t1054
     t1058 = xp.not_equal(t1044, 0)
-    t1059 = 0.5*(-t998 + t1031)/xp.where(t1058, t1044, 1)
+    t1059 = (-t998 + t1031)/xp.where(t1058, 2*t1044, 1)
     t1060 = xp.abs(t1059)
     t1061 = xp.greater_equal(t1060, 1)
-    t1062 = xp.abs(1/xp.where(t1061, t1059, 1))
+    t1062 = 1/xp.abs(xp.where(t1061, t1059, 1))
     t1063 = xp.where(t1058, xp.where(xp.greater_equal(t1059, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1061, t1062/(1 + xp.sqrt(1 + t1062**2)), 1/(t1060 + xp.sqrt(1 + t1060**2))), 0)
     t1064 = 1/xp.sqrt(1 + t1063**2)
     t1065 = t1002*t1064
@@ -3286,10 +3286,10 @@ def condition_number(q):
     t119 = t59*t90
     t120 = t63*t73 - t98*t103 + t117*t84 + t118*t87 + t119*t95
     t121 = xp.not_equal(t120, 0)
-    t122 = 0.5*(-t116 + t105)/xp.where(t121, -t120, 1)
+    t122 = (-t116 + t105)/xp.where(t121, -2*t120, 1)
     t123 = xp.abs(t122)
     t124 = xp.greater_equal(t123, 1)
-    t125 = xp.abs(1/xp.where(t124, t122, 1))
+    t125 = 1/xp.abs(xp.where(t124, t122, 1))
     t126 = xp.where(t121, xp.where(xp.greater_equal(t122, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t124, t125/(1 + xp.sqrt(1 + t125**2)), 1/(t123 + xp.sqrt(1 + t123**2))), 0)
     t127 = 1/xp.sqrt(1 + t126**2)
     t128 = t120*t126
@@ -3317,10 +3317,10 @@ def condition_number(q):
     t150 = t148 + t147*t126
     t151 = t107*t137 - t111*t141 - t112*t145 + t113*t149
     t152 = xp.not_equal(t151, 0)
-    t153 = 0.5*(-t129 + t114)/xp.where(t152, t151, 1)
+    t153 = (-t129 + t114)/xp.where(t152, 2*t151, 1)
     t154 = xp.abs(t153)
     t155 = xp.greater_equal(t154, 1)
-    t156 = xp.abs(1/xp.where(t155, t153, 1))
+    t156 = 1/xp.abs(xp.where(t155, t153, 1))
     t157 = xp.where(t152, xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t155, t156/(1 + xp.sqrt(1 + t156**2)), 1/(t154 + xp.sqrt(1 + t154**2))), 0)
     t158 = 1/xp.sqrt(1 + t157**2)
     t159 = t151*t157
@@ -3344,10 +3344,10 @@ def condition_number(q):
     t177 = t175 + t174*t157
     t178 = t27*t168 + t31*t172 + t40*t176
     t179 = xp.not_equal(t178, 0)
-    t180 = 0.5*(-t160 + t48)/xp.where(t179, t178, 1)
+    t180 = (-t160 + t48)/xp.where(t179, 2*t178, 1)
     t181 = xp.abs(t180)
     t182 = xp.greater_equal(t181, 1)
-    t183 = xp.abs(1/xp.where(t182, t180, 1))
+    t183 = 1/xp.abs(xp.where(t182, t180, 1))
     t184 = xp.where(t179, xp.where(xp.greater_equal(t180, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t182, t183/(1 + xp.sqrt(1 + t183**2)), 1/(t181 + xp.sqrt(1 + t181**2))), 0)
     t185 = 1/xp.sqrt(1 + t184**2)
     t186 = t178*t184
@@ -3367,10 +3367,10 @@ def condition_number(q):
     t200 = t198 + t197*t184
     t201 = -t35*t195 + t44*t199
     t202 = xp.not_equal(t201, 0)
-    t203 = 0.5*(-t187 + t49)/xp.where(t202, t201, 1)
+    t203 = (-t187 + t49)/xp.where(t202, 2*t201, 1)
     t204 = xp.abs(t203)
     t205 = xp.greater_equal(t204, 1)
-    t206 = xp.abs(1/xp.where(t205, t203, 1))
+    t206 = 1/xp.abs(xp.where(t205, t203, 1))
     t207 = xp.where(t202, xp.where(xp.greater_equal(t203, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t205, t206/(1 + xp.sqrt(1 + t206**2)), 1/(t204 + xp.sqrt(1 + t204**2))), 0)
     t208 = 1/xp.sqrt(1 + t207**2)
     t209 = t201*t207
@@ -3386,10 +3386,10 @@ def condition_number(q):
     t219 = t217 + t216*t207
     t220 = t47*t218
     t221 = xp.not_equal(t220, 0)
-    t222 = 0.5*(-t210 + t50)/xp.where(t221, -t220, 1)
+    t222 = (-t210 + t50)/xp.where(t221, -2*t220, 1)
     t223 = xp.abs(t222)
     t224 = xp.greater_equal(t223, 1)
-    t225 = xp.abs(1/xp.where(t224, t222, 1))
+    t225 = 1/xp.abs(xp.where(t224, t222, 1))
     t226 = xp.where(t221, xp.where(xp.greater_equal(t222, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t224, t225/(1 + xp.sqrt(1 + t225**2)), 1/(t223 + xp.sqrt(1 + t223**2))), 0)
     t227 = 1/xp.sqrt(1 + t226**2)
     t228 = t220*t226
@@ -3403,10 +3403,10 @@ def condition_number(q):
     t236 = t235*t133
     t237 = -t138*t165 + t142*t169 + t146*t173 + t150*t177 + t115*t235*t126*t127**2 + t236*t134
     t238 = xp.not_equal(t237, 0)
-    t239 = 0.5*(-t130 + t161)/xp.where(t238, t237, 1)
+    t239 = (-t130 + t161)/xp.where(t238, 2*t237, 1)
     t240 = xp.abs(t239)
     t241 = xp.greater_equal(t240, 1)
-    t242 = xp.abs(1/xp.where(t241, t239, 1))
+    t242 = 1/xp.abs(xp.where(t241, t239, 1))
     t243 = xp.where(t238, xp.where(xp.greater_equal(t239, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t241, t242/(1 + xp.sqrt(1 + t242**2)), 1/(t240 + xp.sqrt(1 + t240**2))), 0)
     t244 = 1/xp.sqrt(1 + t243**2)
     t245 = t237*t243
@@ -3445,10 +3445,10 @@ def condition_number(q):
     t278 = t274*t164
     t279 = -t192*t264 - t196*t268 + t200*t272 - t276*t252 + t277*t256 + t278*t260
     t280 = xp.not_equal(t279, 0)
-    t281 = 0.5*(-t246 + t188)/xp.where(t280, t279, 1)
+    t281 = (-t246 + t188)/xp.where(t280, 2*t279, 1)
     t282 = xp.abs(t281)
     t283 = xp.greater_equal(t282, 1)
-    t284 = xp.abs(1/xp.where(t283, t281, 1))
+    t284 = 1/xp.abs(xp.where(t283, t281, 1))
     t285 = xp.where(t280, xp.where(xp.greater_equal(t281, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t283, t284/(1 + xp.sqrt(1 + t284**2)), 1/(t282 + xp.sqrt(1 + t282**2))), 0)
     t286 = 1/xp.sqrt(1 + t285**2)
     t287 = t279*t285
@@ -3491,10 +3491,10 @@ def condition_number(q):
     t324 = t323*t207
     t325 = t215*t308 + t219*t312 - t318*t292 + t320*t296 + t322*t300 + t324*t304
     t326 = xp.not_equal(t325, 0)
-    t327 = 0.5*(-t288 + t211)/xp.where(t326, t325, 1)
+    t327 = (-t288 + t211)/xp.where(t326, 2*t325, 1)
     t328 = xp.abs(t327)
     t329 = xp.greater_equal(t328, 1)
-    t330 = xp.abs(1/xp.where(t329, t327, 1))
+    t330 = 1/xp.abs(xp.where(t329, t327, 1))
     t331 = xp.where(t326, xp.where(xp.greater_equal(t327, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t329, t330/(1 + xp.sqrt(1 + t330**2)), 1/(t328 + xp.sqrt(1 + t328**2))), 0)
     t332 = 1/xp.sqrt(1 + t331**2)
     t333 = t325*t331
@@ -3536,10 +3536,10 @@ def condition_number(q):
     t369 = t368*t226
     t370 = t234*t358 - t361*t338 + t363*t342 + t365*t346 + t367*t350 + t369*t354
     t371 = xp.not_equal(t370, 0)
-    t372 = 0.5*(-t334 + t230)/xp.where(t371, t370, 1)
+    t372 = (-t334 + t230)/xp.where(t371, 2*t370, 1)
     t373 = xp.abs(t372)
     t374 = xp.greater_equal(t373, 1)
-    t375 = xp.abs(1/xp.where(t374, t372, 1))
+    t375 = 1/xp.abs(xp.where(t374, t372, 1))
     t376 = xp.where(t371, xp.where(xp.greater_equal(t372, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t374, t375/(1 + xp.sqrt(1 + t375**2)), 1/(t373 + xp.sqrt(1 + t373**2))), 0)
     t377 = 1/xp.sqrt(1 + t376**2)
     t378 = t370*t376
@@ -3571,10 +3571,10 @@ def condition_number(q):
     t404 = t402 + t401*t376
     t405 = t233*t403 - t360*t383 + t362*t387 + t364*t391 + t366*t395 + t368*t399
     t406 = xp.not_equal(t314, 0)
-    t407 = 0.5*(-t247 + t289)/xp.where(t406, t314, 1)
+    t407 = (-t247 + t289)/xp.where(t406, 2*t314, 1)
     t408 = xp.abs(t407)
     t409 = xp.greater_equal(t408, 1)
-    t410 = xp.abs(1/xp.where(t409, t407, 1))
+    t410 = 1/xp.abs(xp.where(t409, t407, 1))
     t411 = xp.where(t406, xp.where(xp.greater_equal(t407, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t409, t410/(1 + xp.sqrt(1 + t410**2)), 1/(t408 + xp.sqrt(1 + t408**2))), 0)
     t412 = 1/xp.sqrt(1 + t411**2)
     t413 = t314*t411
@@ -3606,10 +3606,10 @@ def condition_number(q):
     t439 = t437 + t436*t411
     t440 = -t339*t418 + t343*t422 + t347*t426 + t351*t430 + t355*t434 + t359*t438
     t441 = xp.not_equal(t440, 0)
-    t442 = 0.5*(-t414 + t335)/xp.where(t441, t440, 1)
+    t442 = (-t414 + t335)/xp.where(t441, 2*t440, 1)
     t443 = xp.abs(t442)
     t444 = xp.greater_equal(t443, 1)
-    t445 = xp.abs(1/xp.where(t444, t442, 1))
+    t445 = 1/xp.abs(xp.where(t444, t442, 1))
     t446 = xp.where(t441, xp.where(xp.greater_equal(t442, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t444, t445/(1 + xp.sqrt(1 + t445**2)), 1/(t443 + xp.sqrt(1 + t443**2))), 0)
     t447 = 1/xp.sqrt(1 + t446**2)
     t448 = t440*t446
@@ -3642,10 +3642,10 @@ def condition_number(q):
     t475 = -t384*t453 + t388*t457 + t392*t461 + t396*t465 + t400*t469 + t404*t473
     t476 = t419*t454 + t423*t458 + t427*t462 + t431*t466 + t435*t470 + t439*t474
     t477 = xp.not_equal(t475, 0)
-    t478 = 0.5*(-t449 + t380)/xp.where(t477, t475, 1)
+    t478 = (-t449 + t380)/xp.where(t477, 2*t475, 1)
     t479 = xp.abs(t478)
     t480 = xp.greater_equal(t479, 1)
-    t481 = xp.abs(1/xp.where(t480, t478, 1))
+    t481 = 1/xp.abs(xp.where(t480, t478, 1))
     t482 = xp.where(t477, xp.where(xp.greater_equal(t478, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t480, t481/(1 + xp.sqrt(1 + t481**2)), 1/(t479 + xp.sqrt(1 + t479**2))), 0)
     t483 = 1/xp.sqrt(1 + t482**2)
     t484 = t475*t482
@@ -3676,10 +3676,10 @@ def condition_number(q):
     t509 = t507 - t508*t482
     t510 = t508 + t507*t482
     t511 = xp.not_equal(t476, 0)
-    t512 = 0.5*(-t415 + t450)/xp.where(t511, t476, 1)
+    t512 = (-t415 + t450)/xp.where(t511, 2*t476, 1)
     t513 = xp.abs(t512)
     t514 = xp.greater_equal(t513, 1)
-    t515 = xp.abs(1/xp.where(t514, t512, 1))
+    t515 = 1/xp.abs(xp.where(t514, t512, 1))
     t516 = xp.where(t511, xp.where(xp.greater_equal(t512, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t514, t515/(1 + xp.sqrt(1 + t515**2)), 1/(t513 + xp.sqrt(1 + t513**2))), 0)
     t517 = 1/xp.sqrt(1 + t516**2)
     t518 = t476*t516
@@ -3711,10 +3711,10 @@ def condition_number(q):
     t544 = t542 + t541*t516
     t545 = t490*t523 + t494*t527 + t498*t531 + t502*t535 + t506*t539 + t510*t543
     t546 = xp.not_equal(t545, 0)
-    t547 = 0.5*(-t519 + t486)/xp.where(t546, t545, 1)
+    t547 = (-t519 + t486)/xp.where(t546, 2*t545, 1)
     t548 = xp.abs(t547)
     t549 = xp.greater_equal(t548, 1)
-    t550 = xp.abs(1/xp.where(t549, t547, 1))
+    t550 = 1/xp.abs(xp.where(t549, t547, 1))
     t551 = xp.where(t546, xp.where(xp.greater_equal(t547, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t549, t550/(1 + xp.sqrt(1 + t550**2)), 1/(t548 + xp.sqrt(1 + t548**2))), 0)
     t552 = 1/xp.sqrt(1 + t551**2)
     t553 = t545*t551
@@ -3746,10 +3746,10 @@ def condition_number(q):
     t579 = t577 + t576*t551
     t580 = t524*t559 + t528*t563 + t532*t567 + t536*t571 + t540*t575 + t544*t579
     t581 = xp.not_equal(t580, 0)
-    t582 = 0.5*(-t520 + t555)/xp.where(t581, t580, 1)
+    t582 = (-t520 + t555)/xp.where(t581, 2*t580, 1)
     t583 = xp.abs(t582)
     t584 = xp.greater_equal(t583, 1)
-    t585 = xp.abs(1/xp.where(t584, t582, 1))
+    t585 = 1/xp.abs(xp.where(t584, t582, 1))
     t586 = xp.where(t581, xp.where(xp.greater_equal(t582, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t584, t585/(1 + xp.sqrt(1 + t585**2)), 1/(t583 + xp.sqrt(1 + t583**2))), 0)
     t587 = 1/xp.sqrt(1 + t586**2)
     t588 = t580*t586
@@ -3780,10 +3780,10 @@ def condition_number(q):
     t613 = t611 - t612*t586
     t614 = t612 + t611*t586
     t615 = xp.not_equal(t405, 0)
-    t616 = 0.5*(-t229 + t379)/xp.where(t615, t405, 1)
+    t616 = (-t229 + t379)/xp.where(t615, 2*t405, 1)
     t617 = xp.abs(t616)
     t618 = xp.greater_equal(t617, 1)
-    t619 = xp.abs(1/xp.where(t618, t616, 1))
+    t619 = 1/xp.abs(xp.where(t618, t616, 1))
     t620 = xp.where(t615, xp.where(xp.greater_equal(t616, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t618, t619/(1 + xp.sqrt(1 + t619**2)), 1/(t617 + xp.sqrt(1 + t617**2))), 0)
     t621 = 1/xp.sqrt(1 + t620**2)
     t622 = t405*t620
@@ -3815,10 +3815,10 @@ def condition_number(q):
     t648 = t646 + t645*t620
     t649 = t489*t627 + t493*t631 + t497*t635 + t501*t639 + t505*t643 + t509*t647
     t650 = xp.not_equal(t649, 0)
-    t651 = 0.5*(-t623 + t485)/xp.where(t650, t649, 1)
+    t651 = (-t623 + t485)/xp.where(t650, 2*t649, 1)
     t652 = xp.abs(t651)
     t653 = xp.greater_equal(t652, 1)
-    t654 = xp.abs(1/xp.where(t653, t651, 1))
+    t654 = 1/xp.abs(xp.where(t653, t651, 1))
     t655 = xp.where(t650, xp.where(xp.greater_equal(t651, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t653, t654/(1 + xp.sqrt(1 + t654**2)), 1/(t652 + xp.sqrt(1 + t652**2))), 0)
     t656 = 1/xp.sqrt(1 + t655**2)
     t657 = t649*t655
@@ -3851,10 +3851,10 @@ def condition_number(q):
     t684 = t558*t662 + t562*t666 + t566*t670 + t570*t674 + t574*t678 + t578*t682
     t685 = -t628*t663 + t632*t667 + t636*t671 + t640*t675 + t644*t679 + t648*t683
     t686 = xp.not_equal(t684, 0)
-    t687 = 0.5*(-t658 + t554)/xp.where(t686, t684, 1)
+    t687 = (-t658 + t554)/xp.where(t686, 2*t684, 1)
     t688 = xp.abs(t687)
     t689 = xp.greater_equal(t688, 1)
-    t690 = xp.abs(1/xp.where(t689, t687, 1))
+    t690 = 1/xp.abs(xp.where(t689, t687, 1))
     t691 = xp.where(t686, xp.where(xp.greater_equal(t687, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t689, t690/(1 + xp.sqrt(1 + t690**2)), 1/(t688 + xp.sqrt(1 + t688**2))), 0)
     t692 = 1/xp.sqrt(1 + t691**2)
     t693 = t684*t691
@@ -3886,10 +3886,10 @@ def condition_number(q):
     t719 = t717 + t716*t691
     t720 = t593*t698 + t597*t702 + t601*t706 + t605*t710 + t609*t714 + t613*t718
     t721 = xp.not_equal(t720, 0)
-    t722 = 0.5*(-t694 + t589)/xp.where(t721, t720, 1)
+    t722 = (-t694 + t589)/xp.where(t721, 2*t720, 1)
     t723 = xp.abs(t722)
     t724 = xp.greater_equal(t723, 1)
-    t725 = xp.abs(1/xp.where(t724, t722, 1))
+    t725 = 1/xp.abs(xp.where(t724, t722, 1))
     t726 = xp.where(t721, xp.where(xp.greater_equal(t722, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t724, t725/(1 + xp.sqrt(1 + t725**2)), 1/(t723 + xp.sqrt(1 + t723**2))), 0)
     t727 = 1/xp.sqrt(1 + t726**2)
     t728 = t720*t726
@@ -3921,10 +3921,10 @@ def condition_number(q):
     t754 = t752 + t751*t726
     t755 = t594*t733 + t598*t737 + t602*t741 + t606*t745 + t610*t749 + t614*t753
     t756 = xp.not_equal(t755, 0)
-    t757 = 0.5*(-t729 + t590)/xp.where(t756, t755, 1)
+    t757 = (-t729 + t590)/xp.where(t756, 2*t755, 1)
     t758 = xp.abs(t757)
     t759 = xp.greater_equal(t758, 1)
-    t760 = xp.abs(1/xp.where(t759, t757, 1))
+    t760 = 1/xp.abs(xp.where(t759, t757, 1))
     t761 = xp.where(t756, xp.where(xp.greater_equal(t757, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t759, t760/(1 + xp.sqrt(1 + t760**2)), 1/(t758 + xp.sqrt(1 + t758**2))), 0)
     t762 = 1/xp.sqrt(1 + t761**2)
     t763 = t755*t761
@@ -3955,10 +3955,10 @@ def condition_number(q):
     t788 = t786 - t787*t761
     t789 = t787 + t786*t761
     t790 = xp.not_equal(t685, 0)
-    t791 = 0.5*(-t624 + t659)/xp.where(t790, t685, 1)
+    t791 = (-t624 + t659)/xp.where(t790, 2*t685, 1)
     t792 = xp.abs(t791)
     t793 = xp.greater_equal(t792, 1)
-    t794 = xp.abs(1/xp.where(t793, t791, 1))
+    t794 = 1/xp.abs(xp.where(t793, t791, 1))
     t795 = xp.where(t790, xp.where(xp.greater_equal(t791, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t793, t794/(1 + xp.sqrt(1 + t794**2)), 1/(t792 + xp.sqrt(1 + t792**2))), 0)
     t796 = 1/xp.sqrt(1 + t795**2)
     t797 = t685*t795
@@ -3990,10 +3990,10 @@ def condition_number(q):
     t823 = t821 + t820*t795
     t824 = t699*t802 + t703*t806 + t707*t810 + t711*t814 + t715*t818 + t719*t822
     t825 = xp.not_equal(t824, 0)
-    t826 = 0.5*(-t798 + t695)/xp.where(t825, t824, 1)
+    t826 = (-t798 + t695)/xp.where(t825, 2*t824, 1)
     t827 = xp.abs(t826)
     t828 = xp.greater_equal(t827, 1)
-    t829 = xp.abs(1/xp.where(t828, t826, 1))
+    t829 = 1/xp.abs(xp.where(t828, t826, 1))
     t830 = xp.where(t825, xp.where(xp.greater_equal(t826, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t828, t829/(1 + xp.sqrt(1 + t829**2)), 1/(t827 + xp.sqrt(1 + t827**2))), 0)
     t831 = 1/xp.sqrt(1 + t830**2)
     t832 = t824*t830
@@ -4026,10 +4026,10 @@ def condition_number(q):
     t859 = t734*t837 + t738*t841 + t742*t845 + t746*t849 + t750*t853 + t754*t857
     t860 = t803*t838 + t807*t842 + t811*t846 + t815*t850 + t819*t854 + t823*t858
     t861 = xp.not_equal(t859, 0)
-    t862 = 0.5*(-t833 + t730)/xp.where(t861, t859, 1)
+    t862 = (-t833 + t730)/xp.where(t861, 2*t859, 1)
     t863 = xp.abs(t862)
     t864 = xp.greater_equal(t863, 1)
-    t865 = xp.abs(1/xp.where(t864, t862, 1))
+    t865 = 1/xp.abs(xp.where(t864, t862, 1))
     t866 = xp.where(t861, xp.where(xp.greater_equal(t862, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t864, t865/(1 + xp.sqrt(1 + t865**2)), 1/(t863 + xp.sqrt(1 + t863**2))), 0)
     t867 = 1/xp.sqrt(1 + t866**2)
     t868 = t859*t866
@@ -4061,10 +4061,10 @@ def condition_number(q):
     t894 = t892 + t891*t866
     t895 = t769*t873 + t773*t877 + t777*t881 + t781*t885 + t785*t889 + t789*t893
     t896 = xp.not_equal(t895, 0)
-    t897 = 0.5*(-t869 + t765)/xp.where(t896, t895, 1)
+    t897 = (-t869 + t765)/xp.where(t896, 2*t895, 1)
     t898 = xp.abs(t897)
     t899 = xp.greater_equal(t898, 1)
-    t900 = xp.abs(1/xp.where(t899, t897, 1))
+    t900 = 1/xp.abs(xp.where(t899, t897, 1))
     t901 = xp.where(t896, xp.where(xp.greater_equal(t897, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t899, t900/(1 + xp.sqrt(1 + t900**2)), 1/(t898 + xp.sqrt(1 + t898**2))), 0)
     t902 = 1/xp.sqrt(1 + t901**2)
     t903 = t895*t901
@@ -4096,10 +4096,10 @@ def condition_number(q):
     t929 = t927 + t926*t901
     t930 = t768*t908 + t772*t912 + t776*t916 + t780*t920 + t784*t924 + t788*t928
     t931 = xp.not_equal(t860, 0)
-    t932 = 0.5*(-t799 + t834)/xp.where(t931, t860, 1)
+    t932 = (-t799 + t834)/xp.where(t931, 2*t860, 1)
     t933 = xp.abs(t932)
     t934 = xp.greater_equal(t933, 1)
-    t935 = xp.abs(1/xp.where(t934, t932, 1))
+    t935 = 1/xp.abs(xp.where(t934, t932, 1))
     t936 = xp.where(t931, xp.where(xp.greater_equal(t932, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t934, t935/(1 + xp.sqrt(1 + t935**2)), 1/(t933 + xp.sqrt(1 + t933**2))), 0)
     t937 = 1/xp.sqrt(1 + t936**2)
     t938 = t860*t936
@@ -4131,10 +4131,10 @@ def condition_number(q):
     t964 = t962 + t961*t936
     t965 = t874*t943 + t878*t947 + t882*t951 + t886*t955 + t890*t959 + t894*t963
     t966 = xp.not_equal(t965, 0)
-    t967 = 0.5*(-t939 + t870)/xp.where(t966, t965, 1)
+    t967 = (-t939 + t870)/xp.where(t966, 2*t965, 1)
     t968 = xp.abs(t967)
     t969 = xp.greater_equal(t968, 1)
-    t970 = xp.abs(1/xp.where(t969, t967, 1))
+    t970 = 1/xp.abs(xp.where(t969, t967, 1))
     t971 = xp.where(t966, xp.where(xp.greater_equal(t967, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t969, t970/(1 + xp.sqrt(1 + t970**2)), 1/(t968 + xp.sqrt(1 + t968**2))), 0)
     t972 = 1/xp.sqrt(1 + t971**2)
     t973 = t965*t971
@@ -4167,10 +4167,10 @@ def condition_number(q):
     t1000 = t909*t978 + t913*t982 + t917*t986 + t921*t990 + t925*t994 + t929*t998
     t1001 = t944*t979 + t948*t983 + t952*t987 + t956*t991 + t960*t995 + t964*t999
     t1002 = xp.not_equal(t1000, 0)
-    t1003 = 0.5*(-t974 + t905)/xp.where(t1002, t1000, 1)
+    t1003 = (-t974 + t905)/xp.where(t1002, 2*t1000, 1)
     t1004 = xp.abs(t1003)
     t1005 = xp.greater_equal(t1004, 1)
-    t1006 = xp.abs(1/xp.where(t1005, t1003, 1))
+    t1006 = 1/xp.abs(xp.where(t1005, t1003, 1))
     t1007 = xp.where(t1002, xp.where(xp.greater_equal(t1003, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1005, t1006/(1 + xp.sqrt(1 + t1006**2)), 1/(t1004 + xp.sqrt(1 + t1004**2))), 0)
     t1008 = 1/xp.sqrt(1 + t1007**2)
     t1009 = t1000*t1007
@@ -4201,10 +4201,10 @@ def condition_number(q):
     t1034 = t1032 - t1033*t1007
     t1035 = t1033 + t1032*t1007
     t1036 = xp.not_equal(t1001, 0)
-    t1037 = 0.5*(-t940 + t975)/xp.where(t1036, t1001, 1)
+    t1037 = (-t940 + t975)/xp.where(t1036, 2*t1001, 1)
     t1038 = xp.abs(t1037)
     t1039 = xp.greater_equal(t1038, 1)
-    t1040 = xp.abs(1/xp.where(t1039, t1037, 1))
+    t1040 = 1/xp.abs(xp.where(t1039, t1037, 1))
     t1041 = xp.where(t1036, xp.where(xp.greater_equal(t1037, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1039, t1040/(1 + xp.sqrt(1 + t1040**2)), 1/(t1038 + xp.sqrt(1 + t1038**2))), 0)
     t1042 = 1/xp.sqrt(1 + t1041**2)
     t1043 = t1001*t1041
@@ -4236,10 +4236,10 @@ def condition_number(q):
     t1069 = t1067 + t1041*t1066
     t1070 = t1015*t1048 + t1019*t1052 + t1023*t1056 + t1027*t1060 + t1031*t1064 + t1035*t1068
     t1071 = xp.not_equal(t1070, 0)
-    t1072 = 0.5*(-t1044 + t1011)/xp.where(t1071, t1070, 1)
+    t1072 = (-t1044 + t1011)/xp.where(t1071, 2*t1070, 1)
     t1073 = xp.abs(t1072)
     t1074 = xp.greater_equal(t1073, 1)
-    t1075 = xp.abs(1/xp.where(t1074, t1072, 1))
+    t1075 = 1/xp.abs(xp.where(t1074, t1072, 1))
     t1076 = xp.where(t1071, xp.where(xp.greater_equal(t1072, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1074, t1075/(1 + xp.sqrt(1 + t1075**2)), 1/(t1073 + xp.sqrt(1 + t1073**2))), 0)
     t1077 = 1/xp.sqrt(1 + t1076**2)
     t1078 = t1070*t1076
@@ -4271,10 +4271,10 @@ def condition_number(q):
     t1104 = t1102 + t1076*t1101
     t1105 = t1049*t1084 + t1053*t1088 + t1057*t1092 + t1061*t1096 + t1065*t1100 + t1069*t1104
     t1106 = xp.not_equal(t1105, 0)
-    t1107 = 0.5*(-t1045 + t1080)/xp.where(t1106, t1105, 1)
+    t1107 = (-t1045 + t1080)/xp.where(t1106, 2*t1105, 1)
     t1108 = xp.abs(t1107)
     t1109 = xp.greater_equal(t1108, 1)
-    t1110 = xp.abs(1/xp.where(t1109, t1107, 1))
+    t1110 = 1/xp.abs(xp.where(t1109, t1107, 1))
     t1111 = xp.where(t1106, xp.where(xp.greater_equal(t1107, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1109, t1110/(1 + xp.sqrt(1 + t1110**2)), 1/(t1108 + xp.sqrt(1 + t1108**2))), 0)
     t1112 = 1/xp.sqrt(1 + t1111**2)
     t1113 = t1105*t1111
@@ -4305,10 +4305,10 @@ def condition_number(q):
     t1138 = t1136 - t1111*t1137
     t1139 = t1137 + t1111*t1136
     t1140 = xp.not_equal(t930, 0)
-    t1141 = 0.5*(-t764 + t904)/xp.where(t1140, t930, 1)
+    t1141 = (-t764 + t904)/xp.where(t1140, 2*t930, 1)
     t1142 = xp.abs(t1141)
     t1143 = xp.greater_equal(t1142, 1)
-    t1144 = xp.abs(1/xp.where(t1143, t1141, 1))
+    t1144 = 1/xp.abs(xp.where(t1143, t1141, 1))
     t1145 = xp.where(t1140, xp.where(xp.greater_equal(t1141, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1143, t1144/(1 + xp.sqrt(1 + t1144**2)), 1/(t1142 + xp.sqrt(1 + t1142**2))), 0)
     t1146 = 1/xp.sqrt(1 + t1145**2)
     t1147 = t930*t1145
@@ -4340,10 +4340,10 @@ def condition_number(q):
     t1173 = t1171 + t1145*t1170
     t1174 = t1014*t1152 + t1018*t1156 + t1022*t1160 + t1026*t1164 + t1030*t1168 + t1034*t1172
     t1175 = xp.not_equal(t1174, 0)
-    t1176 = 0.5*(-t1148 + t1010)/xp.where(t1175, t1174, 1)
+    t1176 = (-t1148 + t1010)/xp.where(t1175, 2*t1174, 1)
     t1177 = xp.abs(t1176)
     t1178 = xp.greater_equal(t1177, 1)
-    t1179 = xp.abs(1/xp.where(t1178, t1176, 1))
+    t1179 = 1/xp.abs(xp.where(t1178, t1176, 1))
     t1180 = xp.where(t1175, xp.where(xp.greater_equal(t1176, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1178, t1179/(1 + xp.sqrt(1 + t1179**2)), 1/(t1177 + xp.sqrt(1 + t1177**2))), 0)
     t1181 = 1/xp.sqrt(1 + t1180**2)
     t1182 = t1174*t1180
@@ -4376,10 +4376,10 @@ def condition_number(q):
     t1209 = t1083*t1187 + t1087*t1191 + t1091*t1195 + t1095*t1199 + t1099*t1203 + t1103*t1207
     t1210 = t1153*t1188 + t1157*t1192 + t1161*t1196 + t1165*t1200 + t1169*t1204 + t1173*t1208
     t1211 = xp.not_equal(t1209, 0)
-    t1212 = 0.5*(-t1183 + t1079)/xp.where(t1211, t1209, 1)
+    t1212 = (-t1183 + t1079)/xp.where(t1211, 2*t1209, 1)
     t1213 = xp.abs(t1212)
     t1214 = xp.greater_equal(t1213, 1)
-    t1215 = xp.abs(1/xp.where(t1214, t1212, 1))
+    t1215 = 1/xp.abs(xp.where(t1214, t1212, 1))
     t1216 = xp.where(t1211, xp.where(xp.greater_equal(t1212, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1214, t1215/(1 + xp.sqrt(1 + t1215**2)), 1/(t1213 + xp.sqrt(1 + t1213**2))), 0)
     t1217 = 1/xp.sqrt(1 + t1216**2)
     t1218 = t1209*t1216
@@ -4411,10 +4411,10 @@ def condition_number(q):
     t1244 = t1242 + t1216*t1241
     t1245 = t1118*t1223 + t1122*t1227 + t1126*t1231 + t1130*t1235 + t1134*t1239 + t1138*t1243
     t1246 = xp.not_equal(t1245, 0)
-    t1247 = 0.5*(-t1219 + t1114)/xp.where(t1246, t1245, 1)
+    t1247 = (-t1219 + t1114)/xp.where(t1246, 2*t1245, 1)
     t1248 = xp.abs(t1247)
     t1249 = xp.greater_equal(t1248, 1)
-    t1250 = xp.abs(1/xp.where(t1249, t1247, 1))
+    t1250 = 1/xp.abs(xp.where(t1249, t1247, 1))
     t1251 = xp.where(t1246, xp.where(xp.greater_equal(t1247, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1249, t1250/(1 + xp.sqrt(1 + t1250**2)), 1/(t1248 + xp.sqrt(1 + t1248**2))), 0)
     t1252 = 1/xp.sqrt(1 + t1251**2)
     t1253 = t1245*t1251
@@ -4446,10 +4446,10 @@ def condition_number(q):
     t1279 = t1277 + t1251*t1276
     t1280 = t1119*t1258 + t1123*t1262 + t1127*t1266 + t1131*t1270 + t1135*t1274 + t1139*t1278
     t1281 = xp.not_equal(t1280, 0)
-    t1282 = 0.5*(-t1254 + t1115)/xp.where(t1281, t1280, 1)
+    t1282 = (-t1254 + t1115)/xp.where(t1281, 2*t1280, 1)
     t1283 = xp.abs(t1282)
     t1284 = xp.greater_equal(t1283, 1)
-    t1285 = xp.abs(1/xp.where(t1284, t1282, 1))
+    t1285 = 1/xp.abs(xp.where(t1284, t1282, 1))
     t1286 = xp.where(t1281, xp.where(xp.greater_equal(t1282, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1284, t1285/(1 + xp.sqrt(1 + t1285**2)), 1/(t1283 + xp.sqrt(1 + t1283**2))), 0)
     t1287 = 1/xp.sqrt(1 + t1286**2)
     t1288 = t1280*t1286
@@ -4480,10 +4480,10 @@ def condition_number(q):
     t1313 = t1311 - t1286*t1312
     t1314 = t1312 + t1286*t1311
     t1315 = xp.not_equal(t1210, 0)
-    t1316 = 0.5*(-t1149 + t1184)/xp.where(t1315, t1210, 1)
+    t1316 = (-t1149 + t1184)/xp.where(t1315, 2*t1210, 1)
     t1317 = xp.abs(t1316)
     t1318 = xp.greater_equal(t1317, 1)
-    t1319 = xp.abs(1/xp.where(t1318, t1316, 1))
+    t1319 = 1/xp.abs(xp.where(t1318, t1316, 1))
     t1320 = xp.where(t1315, xp.where(xp.greater_equal(t1316, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1318, t1319/(1 + xp.sqrt(1 + t1319**2)), 1/(t1317 + xp.sqrt(1 + t1317**2))), 0)
     t1321 = 1/xp.sqrt(1 + t1320**2)
     t1322 = t1210*t1320
@@ -4515,10 +4515,10 @@ def condition_number(q):
     t1348 = t1346 + t1320*t1345
     t1349 = t1224*t1327 + t1228*t1331 + t1232*t1335 + t1236*t1339 + t1240*t1343 + t1244*t1347
     t1350 = xp.not_equal(t1349, 0)
-    t1351 = 0.5*(-t1323 + t1220)/xp.where(t1350, t1349, 1)
+    t1351 = (-t1323 + t1220)/xp.where(t1350, 2*t1349, 1)
     t1352 = xp.abs(t1351)
     t1353 = xp.greater_equal(t1352, 1)
-    t1354 = xp.abs(1/xp.where(t1353, t1351, 1))
+    t1354 = 1/xp.abs(xp.where(t1353, t1351, 1))
     t1355 = xp.where(t1350, xp.where(xp.greater_equal(t1351, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1353, t1354/(1 + xp.sqrt(1 + t1354**2)), 1/(t1352 + xp.sqrt(1 + t1352**2))), 0)
     t1356 = 1/xp.sqrt(1 + t1355**2)
     t1357 = t1349*t1355
@@ -4551,10 +4551,10 @@ def condition_number(q):
     t1384 = t1259*t1362 + t1263*t1366 + t1267*t1370 + t1271*t1374 + t1275*t1378 + t1279*t1382
     t1385 = t1328*t1363 + t1332*t1367 + t1336*t1371 + t1340*t1375 + t1344*t1379 + t1348*t1383
     t1386 = xp.not_equal(t1384, 0)
-    t1387 = 0.5*(-t1358 + t1255)/xp.where(t1386, t1384, 1)
+    t1387 = (-t1358 + t1255)/xp.where(t1386, 2*t1384, 1)
     t1388 = xp.abs(t1387)
     t1389 = xp.greater_equal(t1388, 1)
-    t1390 = xp.abs(1/xp.where(t1389, t1387, 1))
+    t1390 = 1/xp.abs(xp.where(t1389, t1387, 1))
     t1391 = xp.where(t1386, xp.where(xp.greater_equal(t1387, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1389, t1390/(1 + xp.sqrt(1 + t1390**2)), 1/(t1388 + xp.sqrt(1 + t1388**2))), 0)
     t1392 = 1/xp.sqrt(1 + t1391**2)
     t1393 = t1384*t1391
@@ -4586,10 +4586,10 @@ def condition_number(q):
     t1419 = t1417 + t1391*t1416
     t1420 = t1294*t1398 + t1298*t1402 + t1302*t1406 + t1306*t1410 + t1310*t1414 + t1314*t1418
     t1421 = xp.not_equal(t1420, 0)
-    t1422 = 0.5*(-t1394 + t1290)/xp.where(t1421, t1420, 1)
+    t1422 = (-t1394 + t1290)/xp.where(t1421, 2*t1420, 1)
     t1423 = xp.abs(t1422)
     t1424 = xp.greater_equal(t1423, 1)
-    t1425 = xp.abs(1/xp.where(t1424, t1422, 1))
+    t1425 = 1/xp.abs(xp.where(t1424, t1422, 1))
     t1426 = xp.where(t1421, xp.where(xp.greater_equal(t1422, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1424, t1425/(1 + xp.sqrt(1 + t1425**2)), 1/(t1423 + xp.sqrt(1 + t1423**2))), 0)
     t1427 = 1/xp.sqrt(1 + t1426**2)
     t1428 = t1420*t1426
@@ -4621,10 +4621,10 @@ def condition_number(q):
     t1454 = t1452 + t1426*t1451
     t1455 = t1293*t1433 + t1297*t1437 + t1301*t1441 + t1305*t1445 + t1309*t1449 + t1313*t1453
     t1456 = xp.not_equal(t1385, 0)
-    t1457 = 0.5*(-t1324 + t1359)/xp.where(t1456, t1385, 1)
+    t1457 = (-t1324 + t1359)/xp.where(t1456, 2*t1385, 1)
     t1458 = xp.abs(t1457)
     t1459 = xp.greater_equal(t1458, 1)
-    t1460 = xp.abs(1/xp.where(t1459, t1457, 1))
+    t1460 = 1/xp.abs(xp.where(t1459, t1457, 1))
     t1461 = xp.where(t1456, xp.where(xp.greater_equal(t1457, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1459, t1460/(1 + xp.sqrt(1 + t1460**2)), 1/(t1458 + xp.sqrt(1 + t1458**2))), 0)
     t1462 = 1/xp.sqrt(1 + t1461**2)
     t1463 = t1385*t1461
@@ -4656,10 +4656,10 @@ def condition_number(q):
     t1489 = t1487 + t1461*t1486
     t1490 = t1399*t1468 + t1403*t1472 + t1407*t1476 + t1411*t1480 + t1415*t1484 + t1419*t1488
     t1491 = xp.not_equal(t1490, 0)
-    t1492 = 0.5*(-t1464 + t1395)/xp.where(t1491, t1490, 1)
+    t1492 = (-t1464 + t1395)/xp.where(t1491, 2*t1490, 1)
     t1493 = xp.abs(t1492)
     t1494 = xp.greater_equal(t1493, 1)
-    t1495 = xp.abs(1/xp.where(t1494, t1492, 1))
+    t1495 = 1/xp.abs(xp.where(t1494, t1492, 1))
     t1496 = xp.where(t1491, xp.where(xp.greater_equal(t1492, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1494, t1495/(1 + xp.sqrt(1 + t1495**2)), 1/(t1493 + xp.sqrt(1 + t1493**2))), 0)
     t1497 = 1/xp.sqrt(1 + t1496**2)
     t1498 = t1490*t1496
@@ -4692,10 +4692,10 @@ def condition_number(q):
     t1525 = t1434*t1503 + t1438*t1507 + t1442*t1511 + t1446*t1515 + t1450*t1519 + t1454*t1523
     t1526 = t1469*t1504 + t1473*t1508 + t1477*t1512 + t1481*t1516 + t1485*t1520 + t1489*t1524
     t1527 = xp.not_equal(t1525, 0)
-    t1528 = 0.5*(-t1499 + t1430)/xp.where(t1527, t1525, 1)
+    t1528 = (-t1499 + t1430)/xp.where(t1527, 2*t1525, 1)
     t1529 = xp.abs(t1528)
     t1530 = xp.greater_equal(t1529, 1)
-    t1531 = xp.abs(1/xp.where(t1530, t1528, 1))
+    t1531 = 1/xp.abs(xp.where(t1530, t1528, 1))
     t1532 = xp.where(t1527, xp.where(xp.greater_equal(t1528, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1530, t1531/(1 + xp.sqrt(1 + t1531**2)), 1/(t1529 + xp.sqrt(1 + t1529**2))), 0)
     t1533 = 1/xp.sqrt(1 + t1532**2)
     t1534 = t1525*t1532
@@ -4726,10 +4726,10 @@ def condition_number(q):
     t1559 = t1557 - t1532*t1558
     t1560 = t1558 + t1532*t1557
     t1561 = xp.not_equal(t1526, 0)
-    t1562 = 0.5*(-t1465 + t1500)/xp.where(t1561, t1526, 1)
+    t1562 = (-t1465 + t1500)/xp.where(t1561, 2*t1526, 1)
     t1563 = xp.abs(t1562)
     t1564 = xp.greater_equal(t1563, 1)
-    t1565 = xp.abs(1/xp.where(t1564, t1562, 1))
+    t1565 = 1/xp.abs(xp.where(t1564, t1562, 1))
     t1566 = xp.where(t1561, xp.where(xp.greater_equal(t1562, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1564, t1565/(1 + xp.sqrt(1 + t1565**2)), 1/(t1563 + xp.sqrt(1 + t1563**2))), 0)
     t1567 = 1/xp.sqrt(1 + t1566**2)
     t1568 = t1526*t1566
@@ -4761,10 +4761,10 @@ def condition_number(q):
     t1594 = t1592 + t1566*t1591
     t1595 = t1540*t1573 + t1544*t1577 + t1548*t1581 + t1552*t1585 + t1556*t1589 + t1560*t1593
     t1596 = xp.not_equal(t1595, 0)
-    t1597 = 0.5*(-t1569 + t1536)/xp.where(t1596, t1595, 1)
+    t1597 = (-t1569 + t1536)/xp.where(t1596, 2*t1595, 1)
     t1598 = xp.abs(t1597)
     t1599 = xp.greater_equal(t1598, 1)
-    t1600 = xp.abs(1/xp.where(t1599, t1597, 1))
+    t1600 = 1/xp.abs(xp.where(t1599, t1597, 1))
     t1601 = xp.where(t1596, xp.where(xp.greater_equal(t1597, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1599, t1600/(1 + xp.sqrt(1 + t1600**2)), 1/(t1598 + xp.sqrt(1 + t1598**2))), 0)
     t1602 = 1/xp.sqrt(1 + t1601**2)
     t1603 = t1595*t1601
@@ -4796,10 +4796,10 @@ def condition_number(q):
     t1629 = t1627 + t1601*t1626
     t1630 = t1574*t1609 + t1578*t1613 + t1582*t1617 + t1586*t1621 + t1590*t1625 + t1594*t1629
     t1631 = xp.not_equal(t1630, 0)
-    t1632 = 0.5*(-t1570 + t1605)/xp.where(t1631, t1630, 1)
+    t1632 = (-t1570 + t1605)/xp.where(t1631, 2*t1630, 1)
     t1633 = xp.abs(t1632)
     t1634 = xp.greater_equal(t1633, 1)
-    t1635 = xp.abs(1/xp.where(t1634, t1632, 1))
+    t1635 = 1/xp.abs(xp.where(t1634, t1632, 1))
     t1636 = xp.where(t1631, xp.where(xp.greater_equal(t1632, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1634, t1635/(1 + xp.sqrt(1 + t1635**2)), 1/(t1633 + xp.sqrt(1 + t1633**2))), 0)
     t1637 = 1/xp.sqrt(1 + t1636**2)
     t1638 = t1630*t1636
@@ -4830,10 +4830,10 @@ def condition_number(q):
     t1663 = t1661 - t1636*t1662
     t1664 = t1662 + t1636*t1661
     t1665 = xp.not_equal(t1455, 0)
-    t1666 = 0.5*(-t1289 + t1429)/xp.where(t1665, t1455, 1)
+    t1666 = (-t1289 + t1429)/xp.where(t1665, 2*t1455, 1)
     t1667 = xp.abs(t1666)
     t1668 = xp.greater_equal(t1667, 1)
-    t1669 = xp.abs(1/xp.where(t1668, t1666, 1))
+    t1669 = 1/xp.abs(xp.where(t1668, t1666, 1))
     t1670 = xp.where(t1665, xp.where(xp.greater_equal(t1666, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1668, t1669/(1 + xp.sqrt(1 + t1669**2)), 1/(t1667 + xp.sqrt(1 + t1667**2))), 0)
     t1671 = 1/xp.sqrt(1 + t1670**2)
     t1672 = t1455*t1670
@@ -4865,10 +4865,10 @@ def condition_number(q):
     t1698 = t1696 + t1670*t1695
     t1699 = t1539*t1677 + t1543*t1681 + t1547*t1685 + t1551*t1689 + t1555*t1693 + t1559*t1697
     t1700 = xp.not_equal(t1699, 0)
-    t1701 = 0.5*(-t1673 + t1535)/xp.where(t1700, t1699, 1)
+    t1701 = (-t1673 + t1535)/xp.where(t1700, 2*t1699, 1)
     t1702 = xp.abs(t1701)
     t1703 = xp.greater_equal(t1702, 1)
-    t1704 = xp.abs(1/xp.where(t1703, t1701, 1))
+    t1704 = 1/xp.abs(xp.where(t1703, t1701, 1))
     t1705 = xp.where(t1700, xp.where(xp.greater_equal(t1701, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1703, t1704/(1 + xp.sqrt(1 + t1704**2)), 1/(t1702 + xp.sqrt(1 + t1702**2))), 0)
     t1706 = 1/xp.sqrt(1 + t1705**2)
     t1707 = t1699*t1705
@@ -4901,10 +4901,10 @@ def condition_number(q):
     t1734 = t1608*t1712 + t1612*t1716 + t1616*t1720 + t1620*t1724 + t1624*t1728 + t1628*t1732
     t1735 = t1678*t1713 + t1682*t1717 + t1686*t1721 + t1690*t1725 + t1694*t1729 + t1698*t1733
     t1736 = xp.not_equal(t1734, 0)
-    t1737 = 0.5*(-t1708 + t1604)/xp.where(t1736, t1734, 1)
+    t1737 = (-t1708 + t1604)/xp.where(t1736, 2*t1734, 1)
     t1738 = xp.abs(t1737)
     t1739 = xp.greater_equal(t1738, 1)
-    t1740 = xp.abs(1/xp.where(t1739, t1737, 1))
+    t1740 = 1/xp.abs(xp.where(t1739, t1737, 1))
     t1741 = xp.where(t1736, xp.where(xp.greater_equal(t1737, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1739, t1740/(1 + xp.sqrt(1 + t1740**2)), 1/(t1738 + xp.sqrt(1 + t1738**2))), 0)
     t1742 = 1/xp.sqrt(1 + t1741**2)
     t1743 = t1734*t1741
@@ -4936,10 +4936,10 @@ def condition_number(q):
     t1769 = t1767 + t1741*t1766
     t1770 = t1643*t1748 + t1647*t1752 + t1651*t1756 + t1655*t1760 + t1659*t1764 + t1663*t1768
     t1771 = xp.not_equal(t1770, 0)
-    t1772 = 0.5*(-t1744 + t1639)/xp.where(t1771, t1770, 1)
+    t1772 = (-t1744 + t1639)/xp.where(t1771, 2*t1770, 1)
     t1773 = xp.abs(t1772)
     t1774 = xp.greater_equal(t1773, 1)
-    t1775 = xp.abs(1/xp.where(t1774, t1772, 1))
+    t1775 = 1/xp.abs(xp.where(t1774, t1772, 1))
     t1776 = xp.where(t1771, xp.where(xp.greater_equal(t1772, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1774, t1775/(1 + xp.sqrt(1 + t1775**2)), 1/(t1773 + xp.sqrt(1 + t1773**2))), 0)
     t1777 = 1/xp.sqrt(1 + t1776**2)
     t1778 = t1770*t1776
@@ -4971,10 +4971,10 @@ def condition_number(q):
     t1804 = t1802 + t1776*t1801
     t1805 = t1644*t1783 + t1648*t1787 + t1652*t1791 + t1656*t1795 + t1660*t1799 + t1664*t1803
     t1806 = xp.not_equal(t1805, 0)
-    t1807 = 0.5*(-t1779 + t1640)/xp.where(t1806, t1805, 1)
+    t1807 = (-t1779 + t1640)/xp.where(t1806, 2*t1805, 1)
     t1808 = xp.abs(t1807)
     t1809 = xp.greater_equal(t1808, 1)
-    t1810 = xp.abs(1/xp.where(t1809, t1807, 1))
+    t1810 = 1/xp.abs(xp.where(t1809, t1807, 1))
     t1811 = xp.where(t1806, xp.where(xp.greater_equal(t1807, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1809, t1810/(1 + xp.sqrt(1 + t1810**2)), 1/(t1808 + xp.sqrt(1 + t1808**2))), 0)
     t1812 = 1/xp.sqrt(1 + t1811**2)
     t1813 = t1805*t1811
@@ -5005,10 +5005,10 @@ def condition_number(q):
     t1838 = t1836 - t1811*t1837
     t1839 = t1837 + t1811*t1836
     t1840 = xp.not_equal(t1735, 0)
-    t1841 = 0.5*(-t1674 + t1709)/xp.where(t1840, t1735, 1)
+    t1841 = (-t1674 + t1709)/xp.where(t1840, 2*t1735, 1)
     t1842 = xp.abs(t1841)
     t1843 = xp.greater_equal(t1842, 1)
-    t1844 = xp.abs(1/xp.where(t1843, t1841, 1))
+    t1844 = 1/xp.abs(xp.where(t1843, t1841, 1))
     t1845 = xp.where(t1840, xp.where(xp.greater_equal(t1841, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1843, t1844/(1 + xp.sqrt(1 + t1844**2)), 1/(t1842 + xp.sqrt(1 + t1842**2))), 0)
     t1846 = 1/xp.sqrt(1 + t1845**2)
     t1847 = t1735*t1845
@@ -5040,10 +5040,10 @@ def condition_number(q):
     t1873 = t1871 + t1845*t1870
     t1874 = t1749*t1852 + t1753*t1856 + t1757*t1860 + t1761*t1864 + t1765*t1868 + t1769*t1872
     t1875 = xp.not_equal(t1874, 0)
-    t1876 = 0.5*(-t1848 + t1745)/xp.where(t1875, t1874, 1)
+    t1876 = (-t1848 + t1745)/xp.where(t1875, 2*t1874, 1)
     t1877 = xp.abs(t1876)
     t1878 = xp.greater_equal(t1877, 1)
-    t1879 = xp.abs(1/xp.where(t1878, t1876, 1))
+    t1879 = 1/xp.abs(xp.where(t1878, t1876, 1))
     t1880 = xp.where(t1875, xp.where(xp.greater_equal(t1876, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1878, t1879/(1 + xp.sqrt(1 + t1879**2)), 1/(t1877 + xp.sqrt(1 + t1877**2))), 0)
     t1881 = 1/xp.sqrt(1 + t1880**2)
     t1882 = t1874*t1880
@@ -5076,10 +5076,10 @@ def condition_number(q):
     t1909 = t1784*t1887 + t1788*t1891 + t1792*t1895 + t1796*t1899 + t1800*t1903 + t1804*t1907
     t1910 = t1853*t1888 + t1857*t1892 + t1861*t1896 + t1865*t1900 + t1869*t1904 + t1873*t1908
     t1911 = xp.not_equal(t1909, 0)
-    t1912 = 0.5*(-t1883 + t1780)/xp.where(t1911, t1909, 1)
+    t1912 = (-t1883 + t1780)/xp.where(t1911, 2*t1909, 1)
     t1913 = xp.abs(t1912)
     t1914 = xp.greater_equal(t1913, 1)
-    t1915 = xp.abs(1/xp.where(t1914, t1912, 1))
+    t1915 = 1/xp.abs(xp.where(t1914, t1912, 1))
     t1916 = xp.where(t1911, xp.where(xp.greater_equal(t1912, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1914, t1915/(1 + xp.sqrt(1 + t1915**2)), 1/(t1913 + xp.sqrt(1 + t1913**2))), 0)
     t1917 = 1/xp.sqrt(1 + t1916**2)
     t1918 = t1909*t1916
@@ -5111,10 +5111,10 @@ def condition_number(q):
     t1944 = t1942 + t1916*t1941
     t1945 = t1819*t1923 + t1823*t1927 + t1827*t1931 + t1831*t1935 + t1835*t1939 + t1839*t1943
     t1946 = xp.not_equal(t1945, 0)
-    t1947 = 0.5*(-t1919 + t1815)/xp.where(t1946, t1945, 1)
+    t1947 = (-t1919 + t1815)/xp.where(t1946, 2*t1945, 1)
     t1948 = xp.abs(t1947)
     t1949 = xp.greater_equal(t1948, 1)
-    t1950 = xp.abs(1/xp.where(t1949, t1947, 1))
+    t1950 = 1/xp.abs(xp.where(t1949, t1947, 1))
     t1951 = xp.where(t1946, xp.where(xp.greater_equal(t1947, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1949, t1950/(1 + xp.sqrt(1 + t1950**2)), 1/(t1948 + xp.sqrt(1 + t1948**2))), 0)
     t1952 = 1/xp.sqrt(1 + t1951**2)
     t1953 = t1945*t1951
@@ -5146,10 +5146,10 @@ def condition_number(q):
     t1979 = t1977 + t1951*t1976
     t1980 = t1818*t1958 + t1822*t1962 + t1826*t1966 + t1830*t1970 + t1834*t1974 + t1838*t1978
     t1981 = xp.not_equal(t1910, 0)
-    t1982 = 0.5*(-t1849 + t1884)/xp.where(t1981, t1910, 1)
+    t1982 = (-t1849 + t1884)/xp.where(t1981, 2*t1910, 1)
     t1983 = xp.abs(t1982)
     t1984 = xp.greater_equal(t1983, 1)
-    t1985 = xp.abs(1/xp.where(t1984, t1982, 1))
+    t1985 = 1/xp.abs(xp.where(t1984, t1982, 1))
     t1986 = xp.where(t1981, xp.where(xp.greater_equal(t1982, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1984, t1985/(1 + xp.sqrt(1 + t1985**2)), 1/(t1983 + xp.sqrt(1 + t1983**2))), 0)
     t1987 = 1/xp.sqrt(1 + t1986**2)
     t1988 = t1910*t1986
@@ -5181,10 +5181,10 @@ def condition_number(q):
     t2014 = t2012 + t1986*t2011
     t2015 = t1924*t1993 + t1928*t1997 + t1932*t2001 + t1936*t2005 + t1940*t2009 + t1944*t2013
     t2016 = xp.not_equal(t2015, 0)
-    t2017 = 0.5*(-t1989 + t1920)/xp.where(t2016, t2015, 1)
+    t2017 = (-t1989 + t1920)/xp.where(t2016, 2*t2015, 1)
     t2018 = xp.abs(t2017)
     t2019 = xp.greater_equal(t2018, 1)
-    t2020 = xp.abs(1/xp.where(t2019, t2017, 1))
+    t2020 = 1/xp.abs(xp.where(t2019, t2017, 1))
     t2021 = xp.where(t2016, xp.where(xp.greater_equal(t2017, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2019, t2020/(1 + xp.sqrt(1 + t2020**2)), 1/(t2018 + xp.sqrt(1 + t2018**2))), 0)
     t2022 = 1/xp.sqrt(1 + t2021**2)
     t2023 = t2015*t2021
@@ -5217,10 +5217,10 @@ def condition_number(q):
     t2050 = t1959*t2028 + t1963*t2032 + t1967*t2036 + t1971*t2040 + t1975*t2044 + t1979*t2048
     t2051 = t1994*t2029 + t1998*t2033 + t2002*t2037 + t2006*t2041 + t2010*t2045 + t2014*t2049
     t2052 = xp.not_equal(t2050, 0)
-    t2053 = 0.5*(-t2024 + t1955)/xp.where(t2052, t2050, 1)
+    t2053 = (-t2024 + t1955)/xp.where(t2052, 2*t2050, 1)
     t2054 = xp.abs(t2053)
     t2055 = xp.greater_equal(t2054, 1)
-    t2056 = xp.abs(1/xp.where(t2055, t2053, 1))
+    t2056 = 1/xp.abs(xp.where(t2055, t2053, 1))
     t2057 = xp.where(t2052, xp.where(xp.greater_equal(t2053, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2055, t2056/(1 + xp.sqrt(1 + t2056**2)), 1/(t2054 + xp.sqrt(1 + t2054**2))), 0)
     t2058 = 1/xp.sqrt(1 + t2057**2)
     t2059 = t2050*t2057
@@ -5251,10 +5251,10 @@ def condition_number(q):
     t2084 = t2082 - t2057*t2083
     t2085 = t2083 + t2057*t2082
     t2086 = xp.not_equal(t2051, 0)
-    t2087 = 0.5*(-t1990 + t2025)/xp.where(t2086, t2051, 1)
+    t2087 = (-t1990 + t2025)/xp.where(t2086, 2*t2051, 1)
     t2088 = xp.abs(t2087)
     t2089 = xp.greater_equal(t2088, 1)
-    t2090 = xp.abs(1/xp.where(t2089, t2087, 1))
+    t2090 = 1/xp.abs(xp.where(t2089, t2087, 1))
     t2091 = xp.where(t2086, xp.where(xp.greater_equal(t2087, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2089, t2090/(1 + xp.sqrt(1 + t2090**2)), 1/(t2088 + xp.sqrt(1 + t2088**2))), 0)
     t2092 = 1/xp.sqrt(1 + t2091**2)
     t2093 = t2051*t2091
@@ -5286,10 +5286,10 @@ def condition_number(q):
     t2119 = t2117 + t2091*t2116
     t2120 = t2065*t2098 + t2069*t2102 + t2073*t2106 + t2077*t2110 + t2081*t2114 + t2085*t2118
     t2121 = xp.not_equal(t2120, 0)
-    t2122 = 0.5*(-t2094 + t2061)/xp.where(t2121, t2120, 1)
+    t2122 = (-t2094 + t2061)/xp.where(t2121, 2*t2120, 1)
     t2123 = xp.abs(t2122)
     t2124 = xp.greater_equal(t2123, 1)
-    t2125 = xp.abs(1/xp.where(t2124, t2122, 1))
+    t2125 = 1/xp.abs(xp.where(t2124, t2122, 1))
     t2126 = xp.where(t2121, xp.where(xp.greater_equal(t2122, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2124, t2125/(1 + xp.sqrt(1 + t2125**2)), 1/(t2123 + xp.sqrt(1 + t2123**2))), 0)
     t2127 = 1/xp.sqrt(1 + t2126**2)
     t2128 = t2120*t2126
@@ -5321,10 +5321,10 @@ def condition_number(q):
     t2154 = t2152 + t2126*t2151
     t2155 = t2099*t2134 + t2103*t2138 + t2107*t2142 + t2111*t2146 + t2115*t2150 + t2119*t2154
     t2156 = xp.not_equal(t2155, 0)
-    t2157 = 0.5*(-t2095 + t2130)/xp.where(t2156, t2155, 1)
+    t2157 = (-t2095 + t2130)/xp.where(t2156, 2*t2155, 1)
     t2158 = xp.abs(t2157)
     t2159 = xp.greater_equal(t2158, 1)
-    t2160 = xp.abs(1/xp.where(t2159, t2157, 1))
+    t2160 = 1/xp.abs(xp.where(t2159, t2157, 1))
     t2161 = xp.where(t2156, xp.where(xp.greater_equal(t2157, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2159, t2160/(1 + xp.sqrt(1 + t2160**2)), 1/(t2158 + xp.sqrt(1 + t2158**2))), 0)
     t2162 = 1/xp.sqrt(1 + t2161**2)
     t2163 = t2155*t2161
@@ -5355,10 +5355,10 @@ def condition_number(q):
     t2188 = t2186 - t2161*t2187
     t2189 = t2187 + t2161*t2186
     t2190 = xp.not_equal(t1980, 0)
-    t2191 = 0.5*(-t1814 + t1954)/xp.where(t2190, t1980, 1)
+    t2191 = (-t1814 + t1954)/xp.where(t2190, 2*t1980, 1)
     t2192 = xp.abs(t2191)
     t2193 = xp.greater_equal(t2192, 1)
-    t2194 = xp.abs(1/xp.where(t2193, t2191, 1))
+    t2194 = 1/xp.abs(xp.where(t2193, t2191, 1))
     t2195 = xp.where(t2190, xp.where(xp.greater_equal(t2191, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2193, t2194/(1 + xp.sqrt(1 + t2194**2)), 1/(t2192 + xp.sqrt(1 + t2192**2))), 0)
     t2196 = 1/xp.sqrt(1 + t2195**2)
     t2197 = t1980*t2195
@@ -5390,10 +5390,10 @@ def condition_number(q):
     t2223 = t2221 + t2195*t2220
     t2224 = t2064*t2202 + t2068*t2206 + t2072*t2210 + t2076*t2214 + t2080*t2218 + t2084*t2222
     t2225 = xp.not_equal(t2224, 0)
-    t2226 = 0.5*(-t2198 + t2060)/xp.where(t2225, t2224, 1)
+    t2226 = (-t2198 + t2060)/xp.where(t2225, 2*t2224, 1)
     t2227 = xp.abs(t2226)
     t2228 = xp.greater_equal(t2227, 1)
-    t2229 = xp.abs(1/xp.where(t2228, t2226, 1))
+    t2229 = 1/xp.abs(xp.where(t2228, t2226, 1))
     t2230 = xp.where(t2225, xp.where(xp.greater_equal(t2226, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2228, t2229/(1 + xp.sqrt(1 + t2229**2)), 1/(t2227 + xp.sqrt(1 + t2227**2))), 0)
     t2231 = 1/xp.sqrt(1 + t2230**2)
     t2232 = t2224*t2230
@@ -5426,10 +5426,10 @@ def condition_number(q):
     t2259 = t2133*t2237 + t2137*t2241 + t2141*t2245 + t2145*t2249 + t2149*t2253 + t2153*t2257
     t2260 = t2203*t2238 + t2207*t2242 + t2211*t2246 + t2215*t2250 + t2219*t2254 + t2223*t2258
     t2261 = xp.not_equal(t2259, 0)
-    t2262 = 0.5*(-t2233 + t2129)/xp.where(t2261, t2259, 1)
+    t2262 = (-t2233 + t2129)/xp.where(t2261, 2*t2259, 1)
     t2263 = xp.abs(t2262)
     t2264 = xp.greater_equal(t2263, 1)
-    t2265 = xp.abs(1/xp.where(t2264, t2262, 1))
+    t2265 = 1/xp.abs(xp.where(t2264, t2262, 1))
     t2266 = xp.where(t2261, xp.where(xp.greater_equal(t2262, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2264, t2265/(1 + xp.sqrt(1 + t2265**2)), 1/(t2263 + xp.sqrt(1 + t2263**2))), 0)
     t2267 = 1/xp.sqrt(1 + t2266**2)
     t2268 = t2259*t2266
@@ -5461,10 +5461,10 @@ def condition_number(q):
     t2294 = t2292 + t2266*t2291
     t2295 = t2168*t2273 + t2172*t2277 + t2176*t2281 + t2180*t2285 + t2184*t2289 + t2188*t2293
     t2296 = xp.not_equal(t2295, 0)
-    t2297 = 0.5*(-t2269 + t2164)/xp.where(t2296, t2295, 1)
+    t2297 = (-t2269 + t2164)/xp.where(t2296, 2*t2295, 1)
     t2298 = xp.abs(t2297)
     t2299 = xp.greater_equal(t2298, 1)
-    t2300 = xp.abs(1/xp.where(t2299, t2297, 1))
+    t2300 = 1/xp.abs(xp.where(t2299, t2297, 1))
     t2301 = xp.where(t2296, xp.where(xp.greater_equal(t2297, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2299, t2300/(1 + xp.sqrt(1 + t2300**2)), 1/(t2298 + xp.sqrt(1 + t2298**2))), 0)
     t2302 = 1/xp.sqrt(1 + t2301**2)
     t2303 = t2295*t2301
@@ -5496,10 +5496,10 @@ def condition_number(q):
     t2329 = t2327 + t2301*t2326
     t2330 = t2169*t2308 + t2173*t2312 + t2177*t2316 + t2181*t2320 + t2185*t2324 + t2189*t2328
     t2331 = xp.not_equal(t2330, 0)
-    t2332 = 0.5*(-t2304 + t2165)/xp.where(t2331, t2330, 1)
+    t2332 = (-t2304 + t2165)/xp.where(t2331, 2*t2330, 1)
     t2333 = xp.abs(t2332)
     t2334 = xp.greater_equal(t2333, 1)
-    t2335 = xp.abs(1/xp.where(t2334, t2332, 1))
+    t2335 = 1/xp.abs(xp.where(t2334, t2332, 1))
     t2336 = xp.where(t2331, xp.where(xp.greater_equal(t2332, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2334, t2335/(1 + xp.sqrt(1 + t2335**2)), 1/(t2333 + xp.sqrt(1 + t2333**2))), 0)
     t2337 = 1/xp.sqrt(1 + t2336**2)
     t2338 = t2330*t2336
@@ -5530,10 +5530,10 @@ def condition_number(q):
     t2363 = t2361 - t2336*t2362
     t2364 = t2362 + t2336*t2361
     t2365 = xp.not_equal(t2260, 0)
-    t2366 = 0.5*(-t2199 + t2234)/xp.where(t2365, t2260, 1)
+    t2366 = (-t2199 + t2234)/xp.where(t2365, 2*t2260, 1)
     t2367 = xp.abs(t2366)
     t2368 = xp.greater_equal(t2367, 1)
-    t2369 = xp.abs(1/xp.where(t2368, t2366, 1))
+    t2369 = 1/xp.abs(xp.where(t2368, t2366, 1))
     t2370 = xp.where(t2365, xp.where(xp.greater_equal(t2366, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2368, t2369/(1 + xp.sqrt(1 + t2369**2)), 1/(t2367 + xp.sqrt(1 + t2367**2))), 0)
     t2371 = 1/xp.sqrt(1 + t2370**2)
     t2372 = t2260*t2370
@@ -5565,10 +5565,10 @@ def condition_number(q):
     t2398 = t2396 + t2370*t2395
     t2399 = t2274*t2377 + t2278*t2381 + t2282*t2385 + t2286*t2389 + t2290*t2393 + t2294*t2397
     t2400 = xp.not_equal(t2399, 0)
-    t2401 = 0.5*(-t2373 + t2270)/xp.where(t2400, t2399, 1)
+    t2401 = (-t2373 + t2270)/xp.where(t2400, 2*t2399, 1)
     t2402 = xp.abs(t2401)
     t2403 = xp.greater_equal(t2402, 1)
-    t2404 = xp.abs(1/xp.where(t2403, t2401, 1))
+    t2404 = 1/xp.abs(xp.where(t2403, t2401, 1))
     t2405 = xp.where(t2400, xp.where(xp.greater_equal(t2401, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2403, t2404/(1 + xp.sqrt(1 + t2404**2)), 1/(t2402 + xp.sqrt(1 + t2402**2))), 0)
     t2406 = 1/xp.sqrt(1 + t2405**2)
     t2407 = t2399*t2405
@@ -5601,10 +5601,10 @@ def condition_number(q):
     t2434 = t2309*t2412 + t2313*t2416 + t2317*t2420 + t2321*t2424 + t2325*t2428 + t2329*t2432
     t2435 = t2378*t2413 + t2382*t2417 + t2386*t2421 + t2390*t2425 + t2394*t2429 + t2398*t2433
     t2436 = xp.not_equal(t2434, 0)
-    t2437 = 0.5*(-t2408 + t2305)/xp.where(t2436, t2434, 1)
+    t2437 = (-t2408 + t2305)/xp.where(t2436, 2*t2434, 1)
     t2438 = xp.abs(t2437)
     t2439 = xp.greater_equal(t2438, 1)
-    t2440 = xp.abs(1/xp.where(t2439, t2437, 1))
+    t2440 = 1/xp.abs(xp.where(t2439, t2437, 1))
     t2441 = xp.where(t2436, xp.where(xp.greater_equal(t2437, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2439, t2440/(1 + xp.sqrt(1 + t2440**2)), 1/(t2438 + xp.sqrt(1 + t2438**2))), 0)
     t2442 = 1/xp.sqrt(1 + t2441**2)
     t2443 = t2434*t2441
@@ -5636,10 +5636,10 @@ def condition_number(q):
     t2469 = t2467 + t2441*t2466
     t2470 = t2344*t2448 + t2348*t2452 + t2352*t2456 + t2356*t2460 + t2360*t2464 + t2364*t2468
     t2471 = xp.not_equal(t2470, 0)
-    t2472 = 0.5*(-t2444 + t2340)/xp.where(t2471, t2470, 1)
+    t2472 = (-t2444 + t2340)/xp.where(t2471, 2*t2470, 1)
     t2473 = xp.abs(t2472)
     t2474 = xp.greater_equal(t2473, 1)
-    t2475 = xp.abs(1/xp.where(t2474, t2472, 1))
+    t2475 = 1/xp.abs(xp.where(t2474, t2472, 1))
     t2476 = xp.where(t2471, xp.where(xp.greater_equal(t2472, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2474, t2475/(1 + xp.sqrt(1 + t2475**2)), 1/(t2473 + xp.sqrt(1 + t2473**2))), 0)
     t2477 = 1/xp.sqrt(1 + t2476**2)
     t2478 = t2470*t2476
@@ -5671,10 +5671,10 @@ def condition_number(q):
     t2504 = t2502 + t2476*t2501
     t2505 = t2343*t2483 + t2347*t2487 + t2351*t2491 + t2355*t2495 + t2359*t2499 + t2363*t2503
     t2506 = xp.not_equal(t2435, 0)
-    t2507 = 0.5*(-t2374 + t2409)/xp.where(t2506, t2435, 1)
+    t2507 = (-t2374 + t2409)/xp.where(t2506, 2*t2435, 1)
     t2508 = xp.abs(t2507)
     t2509 = xp.greater_equal(t2508, 1)
-    t2510 = xp.abs(1/xp.where(t2509, t2507, 1))
+    t2510 = 1/xp.abs(xp.where(t2509, t2507, 1))
     t2511 = xp.where(t2506, xp.where(xp.greater_equal(t2507, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2509, t2510/(1 + xp.sqrt(1 + t2510**2)), 1/(t2508 + xp.sqrt(1 + t2508**2))), 0)
     t2512 = 1/xp.sqrt(1 + t2511**2)
     t2513 = t2435*t2511
@@ -5706,10 +5706,10 @@ def condition_number(q):
     t2539 = t2537 + t2511*t2536
     t2540 = t2449*t2518 + t2453*t2522 + t2457*t2526 + t2461*t2530 + t2465*t2534 + t2469*t2538
     t2541 = xp.not_equal(t2540, 0)
-    t2542 = 0.5*(-t2514 + t2445)/xp.where(t2541, t2540, 1)
+    t2542 = (-t2514 + t2445)/xp.where(t2541, 2*t2540, 1)
     t2543 = xp.abs(t2542)
     t2544 = xp.greater_equal(t2543, 1)
-    t2545 = xp.abs(1/xp.where(t2544, t2542, 1))
+    t2545 = 1/xp.abs(xp.where(t2544, t2542, 1))
     t2546 = xp.where(t2541, xp.where(xp.greater_equal(t2542, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2544, t2545/(1 + xp.sqrt(1 + t2545**2)), 1/(t2543 + xp.sqrt(1 + t2543**2))), 0)
     t2547 = 1/xp.sqrt(1 + t2546**2)
     t2548 = t2540*t2546
@@ -5742,10 +5742,10 @@ def condition_number(q):
     t2575 = t2484*t2553 + t2488*t2557 + t2492*t2561 + t2496*t2565 + t2500*t2569 + t2504*t2573
     t2576 = t2519*t2554 + t2523*t2558 + t2527*t2562 + t2531*t2566 + t2535*t2570 + t2539*t2574
     t2577 = xp.not_equal(t2575, 0)
-    t2578 = 0.5*(-t2549 + t2480)/xp.where(t2577, t2575, 1)
+    t2578 = (-t2549 + t2480)/xp.where(t2577, 2*t2575, 1)
     t2579 = xp.abs(t2578)
     t2580 = xp.greater_equal(t2579, 1)
-    t2581 = xp.abs(1/xp.where(t2580, t2578, 1))
+    t2581 = 1/xp.abs(xp.where(t2580, t2578, 1))
     t2582 = xp.where(t2577, xp.where(xp.greater_equal(t2578, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2580, t2581/(1 + xp.sqrt(1 + t2581**2)), 1/(t2579 + xp.sqrt(1 + t2579**2))), 0)
     t2583 = 1/xp.sqrt(1 + t2582**2)
     t2584 = t2575*t2582
@@ -5776,10 +5776,10 @@ def condition_number(q):
     t2609 = t2607 - t2582*t2608
     t2610 = t2608 + t2582*t2607
     t2611 = xp.not_equal(t2576, 0)
-    t2612 = 0.5*(-t2515 + t2550)/xp.where(t2611, t2576, 1)
+    t2612 = (-t2515 + t2550)/xp.where(t2611, 2*t2576, 1)
     t2613 = xp.abs(t2612)
     t2614 = xp.greater_equal(t2613, 1)
-    t2615 = xp.abs(1/xp.where(t2614, t2612, 1))
+    t2615 = 1/xp.abs(xp.where(t2614, t2612, 1))
     t2616 = xp.where(t2611, xp.where(xp.greater_equal(t2612, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2614, t2615/(1 + xp.sqrt(1 + t2615**2)), 1/(t2613 + xp.sqrt(1 + t2613**2))), 0)
     t2617 = 1/xp.sqrt(1 + t2616**2)
     t2618 = t2576*t2616
@@ -5811,10 +5811,10 @@ def condition_number(q):
     t2644 = t2642 + t2616*t2641
     t2645 = t2590*t2623 + t2594*t2627 + t2598*t2631 + t2602*t2635 + t2606*t2639 + t2610*t2643
     t2646 = xp.not_equal(t2645, 0)
-    t2647 = 0.5*(-t2619 + t2586)/xp.where(t2646, t2645, 1)
+    t2647 = (-t2619 + t2586)/xp.where(t2646, 2*t2645, 1)
     t2648 = xp.abs(t2647)
     t2649 = xp.greater_equal(t2648, 1)
-    t2650 = xp.abs(1/xp.where(t2649, t2647, 1))
+    t2650 = 1/xp.abs(xp.where(t2649, t2647, 1))
     t2651 = xp.where(t2646, xp.where(xp.greater_equal(t2647, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2649, t2650/(1 + xp.sqrt(1 + t2650**2)), 1/(t2648 + xp.sqrt(1 + t2648**2))), 0)
     t2652 = 1/xp.sqrt(1 + t2651**2)
     t2653 = t2645*t2651
@@ -5846,10 +5846,10 @@ def condition_number(q):
     t2679 = t2677 + t2651*t2676
     t2680 = t2624*t2659 + t2628*t2663 + t2632*t2667 + t2636*t2671 + t2640*t2675 + t2644*t2679
     t2681 = xp.not_equal(t2680, 0)
-    t2682 = 0.5*(-t2620 + t2655)/xp.where(t2681, t2680, 1)
+    t2682 = (-t2620 + t2655)/xp.where(t2681, 2*t2680, 1)
     t2683 = xp.abs(t2682)
     t2684 = xp.greater_equal(t2683, 1)
-    t2685 = xp.abs(1/xp.where(t2684, t2682, 1))
+    t2685 = 1/xp.abs(xp.where(t2684, t2682, 1))
     t2686 = xp.where(t2681, xp.where(xp.greater_equal(t2682, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2684, t2685/(1 + xp.sqrt(1 + t2685**2)), 1/(t2683 + xp.sqrt(1 + t2683**2))), 0)
     t2687 = 1/xp.sqrt(1 + t2686**2)
     t2688 = t2680*t2686
@@ -5880,10 +5880,10 @@ def condition_number(q):
     t2713 = t2711 - t2686*t2712
     t2714 = t2712 + t2686*t2711
     t2715 = xp.not_equal(t2505, 0)
-    t2716 = 0.5*(-t2339 + t2479)/xp.where(t2715, t2505, 1)
+    t2716 = (-t2339 + t2479)/xp.where(t2715, 2*t2505, 1)
     t2717 = xp.abs(t2716)
     t2718 = xp.greater_equal(t2717, 1)
-    t2719 = xp.abs(1/xp.where(t2718, t2716, 1))
+    t2719 = 1/xp.abs(xp.where(t2718, t2716, 1))
     t2720 = xp.where(t2715, xp.where(xp.greater_equal(t2716, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2718, t2719/(1 + xp.sqrt(1 + t2719**2)), 1/(t2717 + xp.sqrt(1 + t2717**2))), 0)
     t2721 = 1/xp.sqrt(1 + t2720**2)
     t2722 = t2505*t2720
@@ -5915,10 +5915,10 @@ def condition_number(q):
     t2748 = t2746 + t2720*t2745
     t2749 = t2589*t2727 + t2593*t2731 + t2597*t2735 + t2601*t2739 + t2605*t2743 + t2609*t2747
     t2750 = xp.not_equal(t2749, 0)
-    t2751 = 0.5*(-t2723 + t2585)/xp.where(t2750, t2749, 1)
+    t2751 = (-t2723 + t2585)/xp.where(t2750, 2*t2749, 1)
     t2752 = xp.abs(t2751)
     t2753 = xp.greater_equal(t2752, 1)
-    t2754 = xp.abs(1/xp.where(t2753, t2751, 1))
+    t2754 = 1/xp.abs(xp.where(t2753, t2751, 1))
     t2755 = xp.where(t2750, xp.where(xp.greater_equal(t2751, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2753, t2754/(1 + xp.sqrt(1 + t2754**2)), 1/(t2752 + xp.sqrt(1 + t2752**2))), 0)
     t2756 = 1/xp.sqrt(1 + t2755**2)
     t2757 = t2749*t2755
@@ -5951,10 +5951,10 @@ def condition_number(q):
     t2784 = t2658*t2762 + t2662*t2766 + t2666*t2770 + t2670*t2774 + t2674*t2778 + t2678*t2782
     t2785 = t2728*t2763 + t2732*t2767 + t2736*t2771 + t2740*t2775 + t2744*t2779 + t2748*t2783
     t2786 = xp.not_equal(t2784, 0)
-    t2787 = 0.5*(-t2758 + t2654)/xp.where(t2786, t2784, 1)
+    t2787 = (-t2758 + t2654)/xp.where(t2786, 2*t2784, 1)
     t2788 = xp.abs(t2787)
     t2789 = xp.greater_equal(t2788, 1)
-    t2790 = xp.abs(1/xp.where(t2789, t2787, 1))
+    t2790 = 1/xp.abs(xp.where(t2789, t2787, 1))
     t2791 = xp.where(t2786, xp.where(xp.greater_equal(t2787, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2789, t2790/(1 + xp.sqrt(1 + t2790**2)), 1/(t2788 + xp.sqrt(1 + t2788**2))), 0)
     t2792 = 1/xp.sqrt(1 + t2791**2)
     t2793 = t2784*t2791
@@ -5986,10 +5986,10 @@ def condition_number(q):
     t2819 = t2817 + t2791*t2816
     t2820 = t2693*t2798 + t2697*t2802 + t2701*t2806 + t2705*t2810 + t2709*t2814 + t2713*t2818
     t2821 = xp.not_equal(t2820, 0)
-    t2822 = 0.5*(-t2794 + t2689)/xp.where(t2821, t2820, 1)
+    t2822 = (-t2794 + t2689)/xp.where(t2821, 2*t2820, 1)
     t2823 = xp.abs(t2822)
     t2824 = xp.greater_equal(t2823, 1)
-    t2825 = xp.abs(1/xp.where(t2824, t2822, 1))
+    t2825 = 1/xp.abs(xp.where(t2824, t2822, 1))
     t2826 = xp.where(t2821, xp.where(xp.greater_equal(t2822, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2824, t2825/(1 + xp.sqrt(1 + t2825**2)), 1/(t2823 + xp.sqrt(1 + t2823**2))), 0)
     t2827 = 1/xp.sqrt(1 + t2826**2)
     t2828 = t2820*t2826
@@ -6021,10 +6021,10 @@ def condition_number(q):
     t2854 = t2852 + t2826*t2851
     t2855 = t2694*t2833 + t2698*t2837 + t2702*t2841 + t2706*t2845 + t2710*t2849 + t2714*t2853
     t2856 = xp.not_equal(t2855, 0)
-    t2857 = 0.5*(-t2829 + t2690)/xp.where(t2856, t2855, 1)
+    t2857 = (-t2829 + t2690)/xp.where(t2856, 2*t2855, 1)
     t2858 = xp.abs(t2857)
     t2859 = xp.greater_equal(t2858, 1)
-    t2860 = xp.abs(1/xp.where(t2859, t2857, 1))
+    t2860 = 1/xp.abs(xp.where(t2859, t2857, 1))
     t2861 = xp.where(t2856, xp.where(xp.greater_equal(t2857, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2859, t2860/(1 + xp.sqrt(1 + t2860**2)), 1/(t2858 + xp.sqrt(1 + t2858**2))), 0)
     t2862 = 1/xp.sqrt(1 + t2861**2)
     t2863 = t2855*t2861
@@ -6055,10 +6055,10 @@ def condition_number(q):
     t2888 = t2886 - t2861*t2887
     t2889 = t2887 + t2861*t2886
     t2890 = xp.not_equal(t2785, 0)
-    t2891 = 0.5*(-t2724 + t2759)/xp.where(t2890, t2785, 1)
+    t2891 = (-t2724 + t2759)/xp.where(t2890, 2*t2785, 1)
     t2892 = xp.abs(t2891)
     t2893 = xp.greater_equal(t2892, 1)
-    t2894 = xp.abs(1/xp.where(t2893, t2891, 1))
+    t2894 = 1/xp.abs(xp.where(t2893, t2891, 1))
     t2895 = xp.where(t2890, xp.where(xp.greater_equal(t2891, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2893, t2894/(1 + xp.sqrt(1 + t2894**2)), 1/(t2892 + xp.sqrt(1 + t2892**2))), 0)
     t2896 = 1/xp.sqrt(1 + t2895**2)
     t2897 = t2785*t2895
@@ -6090,10 +6090,10 @@ def condition_number(q):
     t2923 = t2921 + t2895*t2920
     t2924 = t2799*t2902 + t2803*t2906 + t2807*t2910 + t2811*t2914 + t2815*t2918 + t2819*t2922
     t2925 = xp.not_equal(t2924, 0)
-    t2926 = 0.5*(-t2898 + t2795)/xp.where(t2925, t2924, 1)
+    t2926 = (-t2898 + t2795)/xp.where(t2925, 2*t2924, 1)
     t2927 = xp.abs(t2926)
     t2928 = xp.greater_equal(t2927, 1)
-    t2929 = xp.abs(1/xp.where(t2928, t2926, 1))
+    t2929 = 1/xp.abs(xp.where(t2928, t2926, 1))
     t2930 = xp.where(t2925, xp.where(xp.greater_equal(t2926, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2928, t2929/(1 + xp.sqrt(1 + t2929**2)), 1/(t2927 + xp.sqrt(1 + t2927**2))), 0)
     t2931 = 1/xp.sqrt(1 + t2930**2)
     t2932 = t2924*t2930
@@ -6126,10 +6126,10 @@ def condition_number(q):
     t2959 = t2834*t2937 + t2838*t2941 + t2842*t2945 + t2846*t2949 + t2850*t2953 + t2854*t2957
     t2960 = t2903*t2938 + t2907*t2942 + t2911*t2946 + t2915*t2950 + t2919*t2954 + t2923*t2958
     t2961 = xp.not_equal(t2959, 0)
-    t2962 = 0.5*(-t2933 + t2830)/xp.where(t2961, t2959, 1)
+    t2962 = (-t2933 + t2830)/xp.where(t2961, 2*t2959, 1)
     t2963 = xp.abs(t2962)
     t2964 = xp.greater_equal(t2963, 1)
-    t2965 = xp.abs(1/xp.where(t2964, t2962, 1))
+    t2965 = 1/xp.abs(xp.where(t2964, t2962, 1))
     t2966 = xp.where(t2961, xp.where(xp.greater_equal(t2962, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2964, t2965/(1 + xp.sqrt(1 + t2965**2)), 1/(t2963 + xp.sqrt(1 + t2963**2))), 0)
     t2967 = 1/xp.sqrt(1 + t2966**2)
     t2968 = t2959*t2966
@@ -6161,10 +6161,10 @@ def condition_number(q):
     t2994 = t2992 + t2966*t2991
     t2995 = t2869*t2973 + t2873*t2977 + t2877*t2981 + t2881*t2985 + t2885*t2989 + t2889*t2993
     t2996 = xp.not_equal(t2995, 0)
-    t2997 = 0.5*(-t2969 + t2865)/xp.where(t2996, t2995, 1)
+    t2997 = (-t2969 + t2865)/xp.where(t2996, 2*t2995, 1)
     t2998 = xp.abs(t2997)
     t2999 = xp.greater_equal(t2998, 1)
-    t3000 = xp.abs(1/xp.where(t2999, t2997, 1))
+    t3000 = 1/xp.abs(xp.where(t2999, t2997, 1))
     t3001 = xp.where(t2996, xp.where(xp.greater_equal(t2997, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2999, t3000/(1 + xp.sqrt(1 + t3000**2)), 1/(t2998 + xp.sqrt(1 + t2998**2))), 0)
     t3002 = 1/xp.sqrt(1 + t3001**2)
     t3003 = t2995*t3001
@@ -6196,10 +6196,10 @@ def condition_number(q):
     t3029 = t3027 + t3001*t3026
     t3030 = t2868*t3008 + t2872*t3012 + t2876*t3016 + t2880*t3020 + t2884*t3024 + t2888*t3028
     t3031 = xp.not_equal(t2960, 0)
-    t3032 = 0.5*(-t2899 + t2934)/xp.where(t3031, t2960, 1)
+    t3032 = (-t2899 + t2934)/xp.where(t3031, 2*t2960, 1)
     t3033 = xp.abs(t3032)
     t3034 = xp.greater_equal(t3033, 1)
-    t3035 = xp.abs(1/xp.where(t3034, t3032, 1))
+    t3035 = 1/xp.abs(xp.where(t3034, t3032, 1))
     t3036 = xp.where(t3031, xp.where(xp.greater_equal(t3032, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3034, t3035/(1 + xp.sqrt(1 + t3035**2)), 1/(t3033 + xp.sqrt(1 + t3033**2))), 0)
     t3037 = 1/xp.sqrt(1 + t3036**2)
     t3038 = t2960*t3036
@@ -6231,10 +6231,10 @@ def condition_number(q):
     t3064 = t3062 + t3036*t3061
     t3065 = t2974*t3043 + t2978*t3047 + t2982*t3051 + t2986*t3055 + t2990*t3059 + t2994*t3063
     t3066 = xp.not_equal(t3065, 0)
-    t3067 = 0.5*(-t3039 + t2970)/xp.where(t3066, t3065, 1)
+    t3067 = (-t3039 + t2970)/xp.where(t3066, 2*t3065, 1)
     t3068 = xp.abs(t3067)
     t3069 = xp.greater_equal(t3068, 1)
-    t3070 = xp.abs(1/xp.where(t3069, t3067, 1))
+    t3070 = 1/xp.abs(xp.where(t3069, t3067, 1))
     t3071 = xp.where(t3066, xp.where(xp.greater_equal(t3067, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3069, t3070/(1 + xp.sqrt(1 + t3070**2)), 1/(t3068 + xp.sqrt(1 + t3068**2))), 0)
     t3072 = 1/xp.sqrt(1 + t3071**2)
     t3073 = t3065*t3071
@@ -6267,10 +6267,10 @@ def condition_number(q):
     t3100 = t3009*t3078 + t3013*t3082 + t3017*t3086 + t3021*t3090 + t3025*t3094 + t3029*t3098
     t3101 = t3044*t3079 + t3048*t3083 + t3052*t3087 + t3056*t3091 + t3060*t3095 + t3064*t3099
     t3102 = xp.not_equal(t3100, 0)
-    t3103 = 0.5*(-t3074 + t3005)/xp.where(t3102, t3100, 1)
+    t3103 = (-t3074 + t3005)/xp.where(t3102, 2*t3100, 1)
     t3104 = xp.abs(t3103)
     t3105 = xp.greater_equal(t3104, 1)
-    t3106 = xp.abs(1/xp.where(t3105, t3103, 1))
+    t3106 = 1/xp.abs(xp.where(t3105, t3103, 1))
     t3107 = xp.where(t3102, xp.where(xp.greater_equal(t3103, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3105, t3106/(1 + xp.sqrt(1 + t3106**2)), 1/(t3104 + xp.sqrt(1 + t3104**2))), 0)
     t3108 = 1/xp.sqrt(1 + t3107**2)
     t3109 = t3100*t3107
@@ -6301,10 +6301,10 @@ def condition_number(q):
     t3134 = t3132 - t3107*t3133
     t3135 = t3133 + t3107*t3132
     t3136 = xp.not_equal(t3101, 0)
-    t3137 = 0.5*(-t3040 + t3075)/xp.where(t3136, t3101, 1)
+    t3137 = (-t3040 + t3075)/xp.where(t3136, 2*t3101, 1)
     t3138 = xp.abs(t3137)
     t3139 = xp.greater_equal(t3138, 1)
-    t3140 = xp.abs(1/xp.where(t3139, t3137, 1))
+    t3140 = 1/xp.abs(xp.where(t3139, t3137, 1))
     t3141 = xp.where(t3136, xp.where(xp.greater_equal(t3137, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3139, t3140/(1 + xp.sqrt(1 + t3140**2)), 1/(t3138 + xp.sqrt(1 + t3138**2))), 0)
     t3142 = 1/xp.sqrt(1 + t3141**2)
     t3143 = t3101*t3141
@@ -6336,10 +6336,10 @@ def condition_number(q):
     t3169 = t3167 + t3141*t3166
     t3170 = t3115*t3148 + t3119*t3152 + t3123*t3156 + t3127*t3160 + t3131*t3164 + t3135*t3168
     t3171 = xp.not_equal(t3170, 0)
-    t3172 = 0.5*(-t3144 + t3111)/xp.where(t3171, t3170, 1)
+    t3172 = (-t3144 + t3111)/xp.where(t3171, 2*t3170, 1)
     t3173 = xp.abs(t3172)
     t3174 = xp.greater_equal(t3173, 1)
-    t3175 = xp.abs(1/xp.where(t3174, t3172, 1))
+    t3175 = 1/xp.abs(xp.where(t3174, t3172, 1))
     t3176 = xp.where(t3171, xp.where(xp.greater_equal(t3172, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3174, t3175/(1 + xp.sqrt(1 + t3175**2)), 1/(t3173 + xp.sqrt(1 + t3173**2))), 0)
     t3177 = 1/xp.sqrt(1 + t3176**2)
     t3178 = t3170*t3176
@@ -6371,10 +6371,10 @@ def condition_number(q):
     t3204 = t3202 + t3176*t3201
     t3205 = t3149*t3184 + t3153*t3188 + t3157*t3192 + t3161*t3196 + t3165*t3200 + t3169*t3204
     t3206 = xp.not_equal(t3205, 0)
-    t3207 = 0.5*(-t3145 + t3180)/xp.where(t3206, t3205, 1)
+    t3207 = (-t3145 + t3180)/xp.where(t3206, 2*t3205, 1)
     t3208 = xp.abs(t3207)
     t3209 = xp.greater_equal(t3208, 1)
-    t3210 = xp.abs(1/xp.where(t3209, t3207, 1))
+    t3210 = 1/xp.abs(xp.where(t3209, t3207, 1))
     t3211 = xp.where(t3206, xp.where(xp.greater_equal(t3207, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3209, t3210/(1 + xp.sqrt(1 + t3210**2)), 1/(t3208 + xp.sqrt(1 + t3208**2))), 0)
     t3212 = 1/xp.sqrt(1 + t3211**2)
     t3213 = t3205*t3211
@@ -6405,10 +6405,10 @@ def condition_number(q):
     t3238 = t3236 - t3211*t3237
     t3239 = t3237 + t3211*t3236
     t3240 = xp.not_equal(t3030, 0)
-    t3241 = 0.5*(-t2864 + t3004)/xp.where(t3240, t3030, 1)
+    t3241 = (-t2864 + t3004)/xp.where(t3240, 2*t3030, 1)
     t3242 = xp.abs(t3241)
     t3243 = xp.greater_equal(t3242, 1)
-    t3244 = xp.abs(1/xp.where(t3243, t3241, 1))
+    t3244 = 1/xp.abs(xp.where(t3243, t3241, 1))
     t3245 = xp.where(t3240, xp.where(xp.greater_equal(t3241, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3243, t3244/(1 + xp.sqrt(1 + t3244**2)), 1/(t3242 + xp.sqrt(1 + t3242**2))), 0)
     t3246 = 1/xp.sqrt(1 + t3245**2)
     t3247 = t3030*t3245
@@ -6440,10 +6440,10 @@ def condition_number(q):
     t3273 = t3271 + t3245*t3270
     t3274 = t3114*t3252 + t3118*t3256 + t3122*t3260 + t3126*t3264 + t3130*t3268 + t3134*t3272
     t3275 = xp.not_equal(t3274, 0)
-    t3276 = 0.5*(-t3248 + t3110)/xp.where(t3275, t3274, 1)
+    t3276 = (-t3248 + t3110)/xp.where(t3275, 2*t3274, 1)
     t3277 = xp.abs(t3276)
     t3278 = xp.greater_equal(t3277, 1)
-    t3279 = xp.abs(1/xp.where(t3278, t3276, 1))
+    t3279 = 1/xp.abs(xp.where(t3278, t3276, 1))
     t3280 = xp.where(t3275, xp.where(xp.greater_equal(t3276, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3278, t3279/(1 + xp.sqrt(1 + t3279**2)), 1/(t3277 + xp.sqrt(1 + t3277**2))), 0)
     t3281 = 1/xp.sqrt(1 + t3280**2)
     t3282 = t3274*t3280
@@ -6476,10 +6476,10 @@ def condition_number(q):
     t3309 = t3183*t3287 + t3187*t3291 + t3191*t3295 + t3195*t3299 + t3199*t3303 + t3203*t3307
     t3310 = t3253*t3288 + t3257*t3292 + t3261*t3296 + t3265*t3300 + t3269*t3304 + t3273*t3308
     t3311 = xp.not_equal(t3309, 0)
-    t3312 = 0.5*(-t3283 + t3179)/xp.where(t3311, t3309, 1)
+    t3312 = (-t3283 + t3179)/xp.where(t3311, 2*t3309, 1)
     t3313 = xp.abs(t3312)
     t3314 = xp.greater_equal(t3313, 1)
-    t3315 = xp.abs(1/xp.where(t3314, t3312, 1))
+    t3315 = 1/xp.abs(xp.where(t3314, t3312, 1))
     t3316 = xp.where(t3311, xp.where(xp.greater_equal(t3312, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3314, t3315/(1 + xp.sqrt(1 + t3315**2)), 1/(t3313 + xp.sqrt(1 + t3313**2))), 0)
     t3317 = 1/xp.sqrt(1 + t3316**2)
     t3318 = t3309*t3316
@@ -6511,10 +6511,10 @@ def condition_number(q):
     t3344 = t3342 + t3316*t3341
     t3345 = t3218*t3323 + t3222*t3327 + t3226*t3331 + t3230*t3335 + t3234*t3339 + t3238*t3343
     t3346 = xp.not_equal(t3345, 0)
-    t3347 = 0.5*(-t3319 + t3214)/xp.where(t3346, t3345, 1)
+    t3347 = (-t3319 + t3214)/xp.where(t3346, 2*t3345, 1)
     t3348 = xp.abs(t3347)
     t3349 = xp.greater_equal(t3348, 1)
-    t3350 = xp.abs(1/xp.where(t3349, t3347, 1))
+    t3350 = 1/xp.abs(xp.where(t3349, t3347, 1))
     t3351 = xp.where(t3346, xp.where(xp.greater_equal(t3347, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3349, t3350/(1 + xp.sqrt(1 + t3350**2)), 1/(t3348 + xp.sqrt(1 + t3348**2))), 0)
     t3352 = 1/xp.sqrt(1 + t3351**2)
     t3353 = t3345*t3351
@@ -6546,10 +6546,10 @@ def condition_number(q):
     t3379 = t3377 + t3351*t3376
     t3380 = t3219*t3358 + t3223*t3362 + t3227*t3366 + t3231*t3370 + t3235*t3374 + t3239*t3378
     t3381 = xp.not_equal(t3380, 0)
-    t3382 = 0.5*(-t3354 + t3215)/xp.where(t3381, t3380, 1)
+    t3382 = (-t3354 + t3215)/xp.where(t3381, 2*t3380, 1)
     t3383 = xp.abs(t3382)
     t3384 = xp.greater_equal(t3383, 1)
-    t3385 = xp.abs(1/xp.where(t3384, t3382, 1))
+    t3385 = 1/xp.abs(xp.where(t3384, t3382, 1))
     t3386 = xp.where(t3381, xp.where(xp.greater_equal(t3382, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3384, t3385/(1 + xp.sqrt(1 + t3385**2)), 1/(t3383 + xp.sqrt(1 + t3383**2))), 0)
     t3387 = 1/xp.sqrt(1 + t3386**2)
     t3388 = t3215 + t3380*t3386
@@ -6579,10 +6579,10 @@ def condition_number(q):
     t3412 = t3410 + t3386*t3409
     t3413 = xp.sqrt(t3391**2 + t3395**2 + t3399**2 + t3403**2 + t3407**2 + t3411**2)
     t3414 = xp.not_equal(t3310, 0)
-    t3415 = 0.5*(-t3249 + t3284)/xp.where(t3414, t3310, 1)
+    t3415 = (-t3249 + t3284)/xp.where(t3414, 2*t3310, 1)
     t3416 = xp.abs(t3415)
     t3417 = xp.greater_equal(t3416, 1)
-    t3418 = xp.abs(1/xp.where(t3417, t3415, 1))
+    t3418 = 1/xp.abs(xp.where(t3417, t3415, 1))
     t3419 = xp.where(t3414, xp.where(xp.greater_equal(t3415, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3417, t3418/(1 + xp.sqrt(1 + t3418**2)), 1/(t3416 + xp.sqrt(1 + t3416**2))), 0)
     t3420 = 1/xp.sqrt(1 + t3419**2)
     t3421 = t3310*t3419
@@ -6614,10 +6614,10 @@ def condition_number(q):
     t3447 = t3445 + t3419*t3444
     t3448 = t3324*t3426 + t3328*t3430 + t3332*t3434 + t3336*t3438 + t3340*t3442 + t3344*t3446
     t3449 = xp.not_equal(t3448, 0)
-    t3450 = 0.5*(-t3422 + t3320)/xp.where(t3449, t3448, 1)
+    t3450 = (-t3422 + t3320)/xp.where(t3449, 2*t3448, 1)
     t3451 = xp.abs(t3450)
     t3452 = xp.greater_equal(t3451, 1)
-    t3453 = xp.abs(1/xp.where(t3452, t3450, 1))
+    t3453 = 1/xp.abs(xp.where(t3452, t3450, 1))
     t3454 = xp.where(t3449, xp.where(xp.greater_equal(t3450, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3452, t3453/(1 + xp.sqrt(1 + t3453**2)), 1/(t3451 + xp.sqrt(1 + t3451**2))), 0)
     t3455 = 1/xp.sqrt(1 + t3454**2)
     t3456 = t3448*t3454
@@ -6650,10 +6650,10 @@ def condition_number(q):
     t3483 = t3359*t3461 + t3363*t3465 + t3367*t3469 + t3371*t3473 + t3375*t3477 + t3379*t3481
     t3484 = t3427*t3462 + t3431*t3466 + t3435*t3470 + t3439*t3474 + t3443*t3478 + t3447*t3482
     t3485 = xp.not_equal(t3483, 0)
-    t3486 = 0.5*(-t3457 + t3355)/xp.where(t3485, t3483, 1)
+    t3486 = (-t3457 + t3355)/xp.where(t3485, 2*t3483, 1)
     t3487 = xp.abs(t3486)
     t3488 = xp.greater_equal(t3487, 1)
-    t3489 = xp.abs(1/xp.where(t3488, t3486, 1))
+    t3489 = 1/xp.abs(xp.where(t3488, t3486, 1))
     t3490 = xp.where(t3485, xp.where(xp.greater_equal(t3486, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3488, t3489/(1 + xp.sqrt(1 + t3489**2)), 1/(t3487 + xp.sqrt(1 + t3487**2))), 0)
     t3491 = 1/xp.sqrt(1 + t3490**2)
     t3492 = t3483*t3490
@@ -6685,10 +6685,10 @@ def condition_number(q):
     t3518 = t3516 + t3490*t3515
     t3519 = t3392*t3497 + t3396*t3501 + t3400*t3505 + t3404*t3509 + t3408*t3513 + t3412*t3517
     t3520 = xp.not_equal(t3519, 0)
-    t3521 = 0.5*(-t3493 + t3388)/xp.where(t3520, t3519, 1)
+    t3521 = (-t3493 + t3388)/xp.where(t3520, 2*t3519, 1)
     t3522 = xp.abs(t3521)
     t3523 = xp.greater_equal(t3522, 1)
-    t3524 = xp.abs(1/xp.where(t3523, t3521, 1))
+    t3524 = 1/xp.abs(xp.where(t3523, t3521, 1))
     t3525 = xp.where(t3520, xp.where(xp.greater_equal(t3521, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3523, t3524/(1 + xp.sqrt(1 + t3524**2)), 1/(t3522 + xp.sqrt(1 + t3522**2))), 0)
     t3526 = 1/xp.sqrt(1 + t3525**2)
     t3527 = t3388 + t3519*t3525
@@ -6720,10 +6720,10 @@ def condition_number(q):
     t3553 = xp.where(xp.greater(t3552, t3413), t3552, t3413)
     t3554 = xp.where(xp.less(t3552, t3413), t3552, t3413)
     t3555 = xp.not_equal(t3484, 0)
-    t3556 = 0.5*(-t3423 + t3458)/xp.where(t3555, t3484, 1)
+    t3556 = (-t3423 + t3458)/xp.where(t3555, 2*t3484, 1)
     t3557 = xp.abs(t3556)
     t3558 = xp.greater_equal(t3557, 1)
-    t3559 = xp.abs(1/xp.where(t3558, t3556, 1))
+    t3559 = 1/xp.abs(xp.where(t3558, t3556, 1))
     t3560 = xp.where(t3555, xp.where(xp.greater_equal(t3556, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3558, t3559/(1 + xp.sqrt(1 + t3559**2)), 1/(t3557 + xp.sqrt(1 + t3557**2))), 0)
     t3561 = 1/xp.sqrt(1 + t3560**2)
     t3562 = t3484*t3560
@@ -6755,10 +6755,10 @@ def condition_number(q):
     t3588 = t3586 + t3560*t3585
     t3589 = t3498*t3567 + t3502*t3571 + t3506*t3575 + t3510*t3579 + t3514*t3583 + t3518*t3587
     t3590 = xp.not_equal(t3589, 0)
-    t3591 = 0.5*(-t3563 + t3494)/xp.where(t3590, t3589, 1)
+    t3591 = (-t3563 + t3494)/xp.where(t3590, 2*t3589, 1)
     t3592 = xp.abs(t3591)
     t3593 = xp.greater_equal(t3592, 1)
-    t3594 = xp.abs(1/xp.where(t3593, t3591, 1))
+    t3594 = 1/xp.abs(xp.where(t3593, t3591, 1))
     t3595 = xp.where(t3590, xp.where(xp.greater_equal(t3591, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3593, t3594/(1 + xp.sqrt(1 + t3594**2)), 1/(t3592 + xp.sqrt(1 + t3592**2))), 0)
     t3596 = 1/xp.sqrt(1 + t3595**2)
     t3597 = t3589*t3595
@@ -6791,10 +6791,10 @@ def condition_number(q):
     t3624 = t3531*t3602 + t3535*t3606 + t3539*t3610 + t3543*t3614 + t3547*t3618 + t3551*t3622
     t3625 = t3568*t3603 + t3572*t3607 + t3576*t3611 + t3580*t3615 + t3584*t3619 + t3588*t3623
     t3626 = xp.not_equal(t3624, 0)
-    t3627 = 0.5*(-t3598 + t3527)/xp.where(t3626, t3624, 1)
+    t3627 = (-t3598 + t3527)/xp.where(t3626, 2*t3624, 1)
     t3628 = xp.abs(t3627)
     t3629 = xp.greater_equal(t3628, 1)
-    t3630 = xp.abs(1/xp.where(t3629, t3627, 1))
+    t3630 = 1/xp.abs(xp.where(t3629, t3627, 1))
     t3631 = xp.where(t3626, xp.where(xp.greater_equal(t3627, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3629, t3630/(1 + xp.sqrt(1 + t3630**2)), 1/(t3628 + xp.sqrt(1 + t3628**2))), 0)
     t3632 = 1/xp.sqrt(1 + t3631**2)
     t3633 = t3527 + t3624*t3631
@@ -6826,10 +6826,10 @@ def condition_number(q):
     t3659 = xp.where(xp.greater(t3658, t3553), t3658, t3553)
     t3660 = xp.where(xp.less(t3658, t3554), t3658, t3554)
     t3661 = xp.not_equal(t3625, 0)
-    t3662 = 0.5*(-t3564 + t3599)/xp.where(t3661, t3625, 1)
+    t3662 = (-t3564 + t3599)/xp.where(t3661, 2*t3625, 1)
     t3663 = xp.abs(t3662)
     t3664 = xp.greater_equal(t3663, 1)
-    t3665 = xp.abs(1/xp.where(t3664, t3662, 1))
+    t3665 = 1/xp.abs(xp.where(t3664, t3662, 1))
     t3666 = xp.where(t3661, xp.where(xp.greater_equal(t3662, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3664, t3665/(1 + xp.sqrt(1 + t3665**2)), 1/(t3663 + xp.sqrt(1 + t3663**2))), 0)
     t3667 = 1/xp.sqrt(1 + t3666**2)
     t3668 = t3625*t3666
@@ -6861,10 +6861,10 @@ def condition_number(q):
     t3694 = t3692 + t3666*t3691
     t3695 = t3637*t3673 + t3641*t3677 + t3645*t3681 + t3649*t3685 + t3653*t3689 + t3657*t3693
     t3696 = xp.not_equal(t3695, 0)
-    t3697 = 0.5*(-t3669 + t3633)/xp.where(t3696, t3695, 1)
+    t3697 = (-t3669 + t3633)/xp.where(t3696, 2*t3695, 1)
     t3698 = xp.abs(t3697)
     t3699 = xp.greater_equal(t3698, 1)
-    t3700 = xp.abs(1/xp.where(t3699, t3697, 1))
+    t3700 = 1/xp.abs(xp.where(t3699, t3697, 1))
     t3701 = xp.where(t3696, xp.where(xp.greater_equal(t3697, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3699, t3700/(1 + xp.sqrt(1 + t3700**2)), 1/(t3698 + xp.sqrt(1 + t3698**2))), 0)
     t3702 = 1/xp.sqrt(1 + t3701**2)
     t3703 = t3633 + t3695*t3701
@@ -6897,10 +6897,10 @@ def condition_number(q):
     t3730 = xp.where(xp.greater(t3729, t3659), t3729, t3659)
     t3731 = xp.where(xp.less(t3729, t3660), t3729, t3660)
     t3732 = xp.not_equal(t3728, 0)
-    t3733 = 0.5*(-t3670 + t3703)/xp.where(t3732, t3728, 1)
+    t3733 = (-t3670 + t3703)/xp.where(t3732, 2*t3728, 1)
     t3734 = xp.abs(t3733)
     t3735 = xp.greater_equal(t3734, 1)
-    t3736 = xp.abs(1/xp.where(t3735, t3733, 1))
+    t3736 = 1/xp.abs(xp.where(t3735, t3733, 1))
     t3737 = xp.where(t3732, xp.where(xp.greater_equal(t3733, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3735, t3736/(1 + xp.sqrt(1 + t3736**2)), 1/(t3734 + xp.sqrt(1 + t3734**2))), 0)
     t3738 = 1/xp.sqrt(1 + t3737**2)
     t3739 = t3674*t3738
@@ -6933,7 +6933,9 @@ def condition_number(q):
     t3766 = xp.where(xp.less(t3763, t3731), t3763, t3731)
     t3767 = xp.where(xp.greater(t3764, t3765), t3764, t3765)
     t3768 = xp.where(xp.less(t3764, t3766), t3764, t3766)
-    kappa = xp.broadcast_to(xp.where(xp.greater(t3767, 0), t3767, 1)/xp.where(xp.less_equal(t3768, 1e-12*t3767), 0, t3768), batch)
+    t3769 = xp.where(xp.less_equal(t3768, 1e-12*t3767), 0, t3768)
+    t3770 = xp.where(xp.greater(t3767, 0), t3767, 1)
+    kappa = xp.broadcast_to(t3770/t3769, batch)
     return kappa
 
 

@@ -1734,10 +1734,10 @@ def _velocity_ellipsoid(q):
     t54 = t53**2
     t55 = t29*t35
     t56 = (t55 != 0)
-    t57 = 0.5*(-t32 + t43)/casadi.if_else(t56, -t55, 1)
+    t57 = (-t32 + t43)/casadi.if_else(t56, -2*t55, 1)
     t58 = casadi.fabs(t57)
     t59 = (t58 >= 1)
-    t60 = casadi.fabs(1/casadi.if_else(t59, t57, 1))
+    t60 = 1/casadi.fabs(casadi.if_else(t59, t57, 1))
     t61 = casadi.if_else(t56, casadi.if_else((t57 >= 0), 1, -1)*casadi.if_else(t59, t60/(1 + casadi.sqrt(1 + t60**2)), 1/(t58 + casadi.sqrt(1 + t58**2))), 0)
     t62 = 1/casadi.sqrt(1 + t61**2)
     t63 = t55*t61
@@ -1753,10 +1753,10 @@ def _velocity_ellipsoid(q):
     t73 = t72*t61
     t74 = t70*t68 + t73*t50
     t75 = (t74 != 0)
-    t76 = 0.5*(-t64 + t71)/casadi.if_else(t75, t74, 1)
+    t76 = (-t64 + t71)/casadi.if_else(t75, 2*t74, 1)
     t77 = casadi.fabs(t76)
     t78 = (t77 >= 1)
-    t79 = casadi.fabs(1/casadi.if_else(t78, t76, 1))
+    t79 = 1/casadi.fabs(casadi.if_else(t78, t76, 1))
     t80 = casadi.if_else(t75, casadi.if_else((t76 >= 0), 1, -1)*casadi.if_else(t78, t79/(1 + casadi.sqrt(1 + t79**2)), 1/(t77 + casadi.sqrt(1 + t77**2))), 0)
     t81 = 1/casadi.sqrt(1 + t80**2)
     t82 = t74*t80
@@ -1772,10 +1772,10 @@ def _velocity_ellipsoid(q):
     t92 = t90 + t89*t80
     t93 = t69*t88 + t72*t92
     t94 = (t93 != 0)
-    t95 = 0.5*(-t65 + t84)/casadi.if_else(t94, -t93, 1)
+    t95 = (-t65 + t84)/casadi.if_else(t94, -2*t93, 1)
     t96 = casadi.fabs(t95)
     t97 = (t96 >= 1)
-    t98 = casadi.fabs(1/casadi.if_else(t97, t95, 1))
+    t98 = 1/casadi.fabs(casadi.if_else(t97, t95, 1))
     t99 = casadi.if_else(t94, casadi.if_else((t95 >= 0), 1, -1)*casadi.if_else(t97, t98/(1 + casadi.sqrt(1 + t98**2)), 1/(t96 + casadi.sqrt(1 + t96**2))), 0)
     t100 = 1/casadi.sqrt(1 + t99**2)
     t101 = t93*t99
@@ -1801,10 +1801,10 @@ def _velocity_ellipsoid(q):
     t121 = t99*t100
     t122 = t87*t106 - t91*t111 + t54*t115*t121*t81
     t123 = (t122 != 0)
-    t124 = 0.5*(-t83 + t102)/casadi.if_else(t123, t122, 1)
+    t124 = (-t83 + t102)/casadi.if_else(t123, 2*t122, 1)
     t125 = casadi.fabs(t124)
     t126 = (t125 >= 1)
-    t127 = casadi.fabs(1/casadi.if_else(t126, t124, 1))
+    t127 = 1/casadi.fabs(casadi.if_else(t126, t124, 1))
     t128 = casadi.if_else(t123, casadi.if_else((t124 >= 0), 1, -1)*casadi.if_else(t126, t127/(1 + casadi.sqrt(1 + t127**2)), 1/(t125 + casadi.sqrt(1 + t125**2))), 0)
     t129 = 1/casadi.sqrt(1 + t128**2)
     t130 = t122*t128
@@ -1838,10 +1838,10 @@ def _velocity_ellipsoid(q):
     t158 = t81*t100
     t159 = t107*t135 + t112*t139 - t53*t158*t148
     t160 = (t159 != 0)
-    t161 = 0.5*(-t131 + t103)/casadi.if_else(t160, t159, 1)
+    t161 = (-t131 + t103)/casadi.if_else(t160, 2*t159, 1)
     t162 = casadi.fabs(t161)
     t163 = (t162 >= 1)
-    t164 = casadi.fabs(1/casadi.if_else(t163, t161, 1))
+    t164 = 1/casadi.fabs(casadi.if_else(t163, t161, 1))
     t165 = casadi.if_else(t160, casadi.if_else((t161 >= 0), 1, -1)*casadi.if_else(t163, t164/(1 + casadi.sqrt(1 + t164**2)), 1/(t162 + casadi.sqrt(1 + t162**2))), 0)
     t166 = 1/casadi.sqrt(1 + t165**2)
     t167 = t159*t165
@@ -1873,10 +1873,10 @@ def _velocity_ellipsoid(q):
     t193 = t192 - t165*t179
     t194 = t179 + t165*t192
     t195 = (t183 != 0)
-    t196 = 0.5*(-t132 + t169)/casadi.if_else(t195, t183, 1)
+    t196 = (-t132 + t169)/casadi.if_else(t195, 2*t183, 1)
     t197 = casadi.fabs(t196)
     t198 = (t197 >= 1)
-    t199 = casadi.fabs(1/casadi.if_else(t198, t196, 1))
+    t199 = 1/casadi.fabs(casadi.if_else(t198, t196, 1))
     t200 = casadi.if_else(t195, casadi.if_else((t196 >= 0), 1, -1)*casadi.if_else(t198, t199/(1 + casadi.sqrt(1 + t199**2)), 1/(t197 + casadi.sqrt(1 + t197**2))), 0)
     t201 = 1/casadi.sqrt(1 + t200**2)
     t202 = t183*t200
@@ -1908,10 +1908,10 @@ def _velocity_ellipsoid(q):
     t228 = t226 + t200*t227
     t229 = t227 - t200*t226
     t230 = (t217 != 0)
-    t231 = 0.5*(-t168 + t203)/casadi.if_else(t230, t217, 1)
+    t231 = (-t168 + t203)/casadi.if_else(t230, 2*t217, 1)
     t232 = casadi.fabs(t231)
     t233 = (t232 >= 1)
-    t234 = casadi.fabs(1/casadi.if_else(t233, t231, 1))
+    t234 = 1/casadi.fabs(casadi.if_else(t233, t231, 1))
     t235 = casadi.if_else(t230, casadi.if_else((t231 >= 0), 1, -1)*casadi.if_else(t233, t234/(1 + casadi.sqrt(1 + t234**2)), 1/(t232 + casadi.sqrt(1 + t232**2))), 0)
     t236 = 1/casadi.sqrt(1 + t235**2)
     t237 = t217*t235
@@ -1943,10 +1943,10 @@ def _velocity_ellipsoid(q):
     t263 = t261 + t235*t262
     t264 = -t262 + t235*t261
     t265 = (t252 != 0)
-    t266 = 0.5*(-t238 + t204)/casadi.if_else(t265, t252, 1)
+    t266 = (-t238 + t204)/casadi.if_else(t265, 2*t252, 1)
     t267 = casadi.fabs(t266)
     t268 = (t267 >= 1)
-    t269 = casadi.fabs(1/casadi.if_else(t268, t266, 1))
+    t269 = 1/casadi.fabs(casadi.if_else(t268, t266, 1))
     t270 = casadi.if_else(t265, casadi.if_else((t266 >= 0), 1, -1)*casadi.if_else(t268, t269/(1 + casadi.sqrt(1 + t269**2)), 1/(t267 + casadi.sqrt(1 + t267**2))), 0)
     t271 = 1/casadi.sqrt(1 + t270**2)
     t272 = t252*t270
@@ -1978,10 +1978,10 @@ def _velocity_ellipsoid(q):
     t298 = t296 - t270*t297
     t299 = t297 + t270*t296
     t300 = (t287 != 0)
-    t301 = 0.5*(-t239 + t274)/casadi.if_else(t300, t287, 1)
+    t301 = (-t239 + t274)/casadi.if_else(t300, 2*t287, 1)
     t302 = casadi.fabs(t301)
     t303 = (t302 >= 1)
-    t304 = casadi.fabs(1/casadi.if_else(t303, t301, 1))
+    t304 = 1/casadi.fabs(casadi.if_else(t303, t301, 1))
     t305 = casadi.if_else(t300, casadi.if_else((t301 >= 0), 1, -1)*casadi.if_else(t303, t304/(1 + casadi.sqrt(1 + t304**2)), 1/(t302 + casadi.sqrt(1 + t302**2))), 0)
     t306 = 1/casadi.sqrt(1 + t305**2)
     t307 = t287*t305
@@ -2013,10 +2013,10 @@ def _velocity_ellipsoid(q):
     t333 = t331 - t305*t332
     t334 = t332 + t305*t331
     t335 = (t322 != 0)
-    t336 = 0.5*(-t273 + t308)/casadi.if_else(t335, t322, 1)
+    t336 = (-t273 + t308)/casadi.if_else(t335, 2*t322, 1)
     t337 = casadi.fabs(t336)
     t338 = (t337 >= 1)
-    t339 = casadi.fabs(1/casadi.if_else(t338, t336, 1))
+    t339 = 1/casadi.fabs(casadi.if_else(t338, t336, 1))
     t340 = casadi.if_else(t335, casadi.if_else((t336 >= 0), 1, -1)*casadi.if_else(t338, t339/(1 + casadi.sqrt(1 + t339**2)), 1/(t337 + casadi.sqrt(1 + t337**2))), 0)
     t341 = 1/casadi.sqrt(1 + t340**2)
     t342 = t322*t340
@@ -2048,10 +2048,10 @@ def _velocity_ellipsoid(q):
     t368 = t366 - t340*t367
     t369 = t367 + t340*t366
     t370 = (t357 != 0)
-    t371 = 0.5*(-t343 + t309)/casadi.if_else(t370, t357, 1)
+    t371 = (-t343 + t309)/casadi.if_else(t370, 2*t357, 1)
     t372 = casadi.fabs(t371)
     t373 = (t372 >= 1)
-    t374 = casadi.fabs(1/casadi.if_else(t373, t371, 1))
+    t374 = 1/casadi.fabs(casadi.if_else(t373, t371, 1))
     t375 = casadi.if_else(t370, casadi.if_else((t371 >= 0), 1, -1)*casadi.if_else(t373, t374/(1 + casadi.sqrt(1 + t374**2)), 1/(t372 + casadi.sqrt(1 + t372**2))), 0)
     t376 = 1/casadi.sqrt(1 + t375**2)
     t377 = t357*t375
@@ -2083,10 +2083,10 @@ def _velocity_ellipsoid(q):
     t403 = t401 - t375*t402
     t404 = t402 + t375*t401
     t405 = (t392 != 0)
-    t406 = 0.5*(-t344 + t379)/casadi.if_else(t405, t392, 1)
+    t406 = (-t344 + t379)/casadi.if_else(t405, 2*t392, 1)
     t407 = casadi.fabs(t406)
     t408 = (t407 >= 1)
-    t409 = casadi.fabs(1/casadi.if_else(t408, t406, 1))
+    t409 = 1/casadi.fabs(casadi.if_else(t408, t406, 1))
     t410 = casadi.if_else(t405, casadi.if_else((t406 >= 0), 1, -1)*casadi.if_else(t408, t409/(1 + casadi.sqrt(1 + t409**2)), 1/(t407 + casadi.sqrt(1 + t407**2))), 0)
     t411 = 1/casadi.sqrt(1 + t410**2)
     t412 = t392*t410
@@ -2118,10 +2118,10 @@ def _velocity_ellipsoid(q):
     t438 = t436 - t410*t437
     t439 = t437 + t410*t436
     t440 = (t427 != 0)
-    t441 = 0.5*(-t378 + t413)/casadi.if_else(t440, t427, 1)
+    t441 = (-t378 + t413)/casadi.if_else(t440, 2*t427, 1)
     t442 = casadi.fabs(t441)
     t443 = (t442 >= 1)
-    t444 = casadi.fabs(1/casadi.if_else(t443, t441, 1))
+    t444 = 1/casadi.fabs(casadi.if_else(t443, t441, 1))
     t445 = casadi.if_else(t440, casadi.if_else((t441 >= 0), 1, -1)*casadi.if_else(t443, t444/(1 + casadi.sqrt(1 + t444**2)), 1/(t442 + casadi.sqrt(1 + t442**2))), 0)
     t446 = 1/casadi.sqrt(1 + t445**2)
     t447 = t427*t445
@@ -2153,10 +2153,10 @@ def _velocity_ellipsoid(q):
     t473 = t471 - t445*t472
     t474 = t472 + t445*t471
     t475 = (t462 != 0)
-    t476 = 0.5*(-t448 + t414)/casadi.if_else(t475, t462, 1)
+    t476 = (-t448 + t414)/casadi.if_else(t475, 2*t462, 1)
     t477 = casadi.fabs(t476)
     t478 = (t477 >= 1)
-    t479 = casadi.fabs(1/casadi.if_else(t478, t476, 1))
+    t479 = 1/casadi.fabs(casadi.if_else(t478, t476, 1))
     t480 = casadi.if_else(t475, casadi.if_else((t476 >= 0), 1, -1)*casadi.if_else(t478, t479/(1 + casadi.sqrt(1 + t479**2)), 1/(t477 + casadi.sqrt(1 + t477**2))), 0)
     t481 = 1/casadi.sqrt(1 + t480**2)
     t482 = t414 + t462*t480
@@ -2187,10 +2187,10 @@ def _velocity_ellipsoid(q):
     t507 = t505 - t480*t506
     t508 = t506 + t480*t505
     t509 = (t495 != 0)
-    t510 = 0.5*(-t449 + t482)/casadi.if_else(t509, t495, 1)
+    t510 = (-t449 + t482)/casadi.if_else(t509, 2*t495, 1)
     t511 = casadi.fabs(t510)
     t512 = (t511 >= 1)
-    t513 = casadi.fabs(1/casadi.if_else(t512, t510, 1))
+    t513 = 1/casadi.fabs(casadi.if_else(t512, t510, 1))
     t514 = casadi.if_else(t509, casadi.if_else((t510 >= 0), 1, -1)*casadi.if_else(t512, t513/(1 + casadi.sqrt(1 + t513**2)), 1/(t511 + casadi.sqrt(1 + t511**2))), 0)
     t515 = 1/casadi.sqrt(1 + t514**2)
     t516 = t453*t515
@@ -2285,10 +2285,10 @@ def _velocity_ellipsoid(q):
     t605 = t604**2
     t606 = t592**2 + t598**2 + t605
     t607 = (t589 != 0)
-    t608 = 0.5*(-t577 + t588)/casadi.if_else(t607, t589, 1)
+    t608 = (-t577 + t588)/casadi.if_else(t607, 2*t589, 1)
     t609 = casadi.fabs(t608)
     t610 = (t609 >= 1)
-    t611 = casadi.fabs(1/casadi.if_else(t610, t608, 1))
+    t611 = 1/casadi.fabs(casadi.if_else(t610, t608, 1))
     t612 = casadi.if_else(t607, casadi.if_else((t608 >= 0), 1, -1)*casadi.if_else(t610, t611/(1 + casadi.sqrt(1 + t611**2)), 1/(t609 + casadi.sqrt(1 + t609**2))), 0)
     t613 = 1/casadi.sqrt(1 + t612**2)
     t614 = t589*t612
@@ -2302,10 +2302,10 @@ def _velocity_ellipsoid(q):
     t622 = t612*t621
     t623 = t592*t619 - t598*t622
     t624 = (t623 != 0)
-    t625 = 0.5*(-t615 + t606)/casadi.if_else(t624, t623, 1)
+    t625 = (-t615 + t606)/casadi.if_else(t624, 2*t623, 1)
     t626 = casadi.fabs(t625)
     t627 = (t626 >= 1)
-    t628 = casadi.fabs(1/casadi.if_else(t627, t625, 1))
+    t628 = 1/casadi.fabs(casadi.if_else(t627, t625, 1))
     t629 = casadi.if_else(t624, casadi.if_else((t625 >= 0), 1, -1)*casadi.if_else(t627, t628/(1 + casadi.sqrt(1 + t628**2)), 1/(t626 + casadi.sqrt(1 + t626**2))), 0)
     t630 = 1/casadi.sqrt(1 + t629**2)
     t631 = t623*t629
@@ -2321,10 +2321,10 @@ def _velocity_ellipsoid(q):
     t641 = -t639 + t629*t638
     t642 = t620*t637 + t641*t621
     t643 = (t642 != 0)
-    t644 = 0.5*(-t616 + t633)/casadi.if_else(t643, -t642, 1)
+    t644 = (-t616 + t633)/casadi.if_else(t643, -2*t642, 1)
     t645 = casadi.fabs(t644)
     t646 = (t645 >= 1)
-    t647 = casadi.fabs(1/casadi.if_else(t646, t644, 1))
+    t647 = 1/casadi.fabs(casadi.if_else(t646, t644, 1))
     t648 = casadi.if_else(t643, casadi.if_else((t644 >= 0), 1, -1)*casadi.if_else(t646, t647/(1 + casadi.sqrt(1 + t647**2)), 1/(t645 + casadi.sqrt(1 + t645**2))), 0)
     t649 = 1/casadi.sqrt(1 + t648**2)
     t650 = t642*t648
@@ -2350,10 +2350,10 @@ def _velocity_ellipsoid(q):
     t670 = t648*t649
     t671 = t636*t655 + t640*t660 - t630*t605*t664*t670
     t672 = (t671 != 0)
-    t673 = 0.5*(-t632 + t651)/casadi.if_else(t672, -t671, 1)
+    t673 = (-t632 + t651)/casadi.if_else(t672, -2*t671, 1)
     t674 = casadi.fabs(t673)
     t675 = (t674 >= 1)
-    t676 = casadi.fabs(1/casadi.if_else(t675, t673, 1))
+    t676 = 1/casadi.fabs(casadi.if_else(t675, t673, 1))
     t677 = casadi.if_else(t672, casadi.if_else((t673 >= 0), 1, -1)*casadi.if_else(t675, t676/(1 + casadi.sqrt(1 + t676**2)), 1/(t674 + casadi.sqrt(1 + t674**2))), 0)
     t678 = 1/casadi.sqrt(1 + t677**2)
     t679 = t671*t677
@@ -2387,10 +2387,10 @@ def _velocity_ellipsoid(q):
     t707 = t630*t649
     t708 = t656*t684 + t661*t688 - t604*t697*t707
     t709 = (t708 != 0)
-    t710 = 0.5*(-t680 + t652)/casadi.if_else(t709, t708, 1)
+    t710 = (-t680 + t652)/casadi.if_else(t709, 2*t708, 1)
     t711 = casadi.fabs(t710)
     t712 = (t711 >= 1)
-    t713 = casadi.fabs(1/casadi.if_else(t712, t710, 1))
+    t713 = 1/casadi.fabs(casadi.if_else(t712, t710, 1))
     t714 = casadi.if_else(t709, casadi.if_else((t710 >= 0), 1, -1)*casadi.if_else(t712, t713/(1 + casadi.sqrt(1 + t713**2)), 1/(t711 + casadi.sqrt(1 + t711**2))), 0)
     t715 = 1/casadi.sqrt(1 + t714**2)
     t716 = t708*t714
@@ -2422,10 +2422,10 @@ def _velocity_ellipsoid(q):
     t742 = t741 - t714*t728
     t743 = t728 + t714*t741
     t744 = (t732 != 0)
-    t745 = 0.5*(-t681 + t718)/casadi.if_else(t744, t732, 1)
+    t745 = (-t681 + t718)/casadi.if_else(t744, 2*t732, 1)
     t746 = casadi.fabs(t745)
     t747 = (t746 >= 1)
-    t748 = casadi.fabs(1/casadi.if_else(t747, t745, 1))
+    t748 = 1/casadi.fabs(casadi.if_else(t747, t745, 1))
     t749 = casadi.if_else(t744, casadi.if_else((t745 >= 0), 1, -1)*casadi.if_else(t747, t748/(1 + casadi.sqrt(1 + t748**2)), 1/(t746 + casadi.sqrt(1 + t746**2))), 0)
     t750 = 1/casadi.sqrt(1 + t749**2)
     t751 = t732*t749
@@ -2457,10 +2457,10 @@ def _velocity_ellipsoid(q):
     t777 = t775 + t749*t776
     t778 = t776 - t749*t775
     t779 = (t766 != 0)
-    t780 = 0.5*(-t717 + t752)/casadi.if_else(t779, t766, 1)
+    t780 = (-t717 + t752)/casadi.if_else(t779, 2*t766, 1)
     t781 = casadi.fabs(t780)
     t782 = (t781 >= 1)
-    t783 = casadi.fabs(1/casadi.if_else(t782, t780, 1))
+    t783 = 1/casadi.fabs(casadi.if_else(t782, t780, 1))
     t784 = casadi.if_else(t779, casadi.if_else((t780 >= 0), 1, -1)*casadi.if_else(t782, t783/(1 + casadi.sqrt(1 + t783**2)), 1/(t781 + casadi.sqrt(1 + t781**2))), 0)
     t785 = 1/casadi.sqrt(1 + t784**2)
     t786 = t766*t784
@@ -2492,10 +2492,10 @@ def _velocity_ellipsoid(q):
     t812 = t810 + t784*t811
     t813 = -t811 + t784*t810
     t814 = (t801 != 0)
-    t815 = 0.5*(-t787 + t753)/casadi.if_else(t814, t801, 1)
+    t815 = (-t787 + t753)/casadi.if_else(t814, 2*t801, 1)
     t816 = casadi.fabs(t815)
     t817 = (t816 >= 1)
-    t818 = casadi.fabs(1/casadi.if_else(t817, t815, 1))
+    t818 = 1/casadi.fabs(casadi.if_else(t817, t815, 1))
     t819 = casadi.if_else(t814, casadi.if_else((t815 >= 0), 1, -1)*casadi.if_else(t817, t818/(1 + casadi.sqrt(1 + t818**2)), 1/(t816 + casadi.sqrt(1 + t816**2))), 0)
     t820 = 1/casadi.sqrt(1 + t819**2)
     t821 = t801*t819
@@ -2527,10 +2527,10 @@ def _velocity_ellipsoid(q):
     t847 = t845 - t819*t846
     t848 = t846 + t819*t845
     t849 = (t836 != 0)
-    t850 = 0.5*(-t788 + t823)/casadi.if_else(t849, t836, 1)
+    t850 = (-t788 + t823)/casadi.if_else(t849, 2*t836, 1)
     t851 = casadi.fabs(t850)
     t852 = (t851 >= 1)
-    t853 = casadi.fabs(1/casadi.if_else(t852, t850, 1))
+    t853 = 1/casadi.fabs(casadi.if_else(t852, t850, 1))
     t854 = casadi.if_else(t849, casadi.if_else((t850 >= 0), 1, -1)*casadi.if_else(t852, t853/(1 + casadi.sqrt(1 + t853**2)), 1/(t851 + casadi.sqrt(1 + t851**2))), 0)
     t855 = 1/casadi.sqrt(1 + t854**2)
     t856 = t836*t854
@@ -2562,10 +2562,10 @@ def _velocity_ellipsoid(q):
     t882 = t880 - t854*t881
     t883 = t881 + t854*t880
     t884 = (t871 != 0)
-    t885 = 0.5*(-t822 + t857)/casadi.if_else(t884, t871, 1)
+    t885 = (-t822 + t857)/casadi.if_else(t884, 2*t871, 1)
     t886 = casadi.fabs(t885)
     t887 = (t886 >= 1)
-    t888 = casadi.fabs(1/casadi.if_else(t887, t885, 1))
+    t888 = 1/casadi.fabs(casadi.if_else(t887, t885, 1))
     t889 = casadi.if_else(t884, casadi.if_else((t885 >= 0), 1, -1)*casadi.if_else(t887, t888/(1 + casadi.sqrt(1 + t888**2)), 1/(t886 + casadi.sqrt(1 + t886**2))), 0)
     t890 = 1/casadi.sqrt(1 + t889**2)
     t891 = t871*t889
@@ -2597,10 +2597,10 @@ def _velocity_ellipsoid(q):
     t917 = t915 - t889*t916
     t918 = t916 + t889*t915
     t919 = (t906 != 0)
-    t920 = 0.5*(-t892 + t858)/casadi.if_else(t919, t906, 1)
+    t920 = (-t892 + t858)/casadi.if_else(t919, 2*t906, 1)
     t921 = casadi.fabs(t920)
     t922 = (t921 >= 1)
-    t923 = casadi.fabs(1/casadi.if_else(t922, t920, 1))
+    t923 = 1/casadi.fabs(casadi.if_else(t922, t920, 1))
     t924 = casadi.if_else(t919, casadi.if_else((t920 >= 0), 1, -1)*casadi.if_else(t922, t923/(1 + casadi.sqrt(1 + t923**2)), 1/(t921 + casadi.sqrt(1 + t921**2))), 0)
     t925 = 1/casadi.sqrt(1 + t924**2)
     t926 = t906*t924
@@ -2632,10 +2632,10 @@ def _velocity_ellipsoid(q):
     t952 = t950 - t924*t951
     t953 = t951 + t924*t950
     t954 = (t941 != 0)
-    t955 = 0.5*(-t893 + t928)/casadi.if_else(t954, t941, 1)
+    t955 = (-t893 + t928)/casadi.if_else(t954, 2*t941, 1)
     t956 = casadi.fabs(t955)
     t957 = (t956 >= 1)
-    t958 = casadi.fabs(1/casadi.if_else(t957, t955, 1))
+    t958 = 1/casadi.fabs(casadi.if_else(t957, t955, 1))
     t959 = casadi.if_else(t954, casadi.if_else((t955 >= 0), 1, -1)*casadi.if_else(t957, t958/(1 + casadi.sqrt(1 + t958**2)), 1/(t956 + casadi.sqrt(1 + t956**2))), 0)
     t960 = 1/casadi.sqrt(1 + t959**2)
     t961 = t941*t959
@@ -2667,10 +2667,10 @@ def _velocity_ellipsoid(q):
     t987 = t985 - t959*t986
     t988 = t986 + t959*t985
     t989 = (t976 != 0)
-    t990 = 0.5*(-t927 + t962)/casadi.if_else(t989, t976, 1)
+    t990 = (-t927 + t962)/casadi.if_else(t989, 2*t976, 1)
     t991 = casadi.fabs(t990)
     t992 = (t991 >= 1)
-    t993 = casadi.fabs(1/casadi.if_else(t992, t990, 1))
+    t993 = 1/casadi.fabs(casadi.if_else(t992, t990, 1))
     t994 = casadi.if_else(t989, casadi.if_else((t990 >= 0), 1, -1)*casadi.if_else(t992, t993/(1 + casadi.sqrt(1 + t993**2)), 1/(t991 + casadi.sqrt(1 + t991**2))), 0)
     t995 = 1/casadi.sqrt(1 + t994**2)
     t996 = t976*t994
@@ -2702,10 +2702,10 @@ def _velocity_ellipsoid(q):
     t1022 = t1020 - t994*t1021
     t1023 = t1021 + t994*t1020
     t1024 = (t1011 != 0)
-    t1025 = 0.5*(-t997 + t963)/casadi.if_else(t1024, t1011, 1)
+    t1025 = (-t997 + t963)/casadi.if_else(t1024, 2*t1011, 1)
     t1026 = casadi.fabs(t1025)
     t1027 = (t1026 >= 1)
-    t1028 = casadi.fabs(1/casadi.if_else(t1027, t1025, 1))
+    t1028 = 1/casadi.fabs(casadi.if_else(t1027, t1025, 1))
     t1029 = casadi.if_else(t1024, casadi.if_else((t1025 >= 0), 1, -1)*casadi.if_else(t1027, t1028/(1 + casadi.sqrt(1 + t1028**2)), 1/(t1026 + casadi.sqrt(1 + t1026**2))), 0)
     t1030 = 1/casadi.sqrt(1 + t1029**2)
     t1031 = t963 + t1011*t1029
@@ -2736,10 +2736,10 @@ def _velocity_ellipsoid(q):
     t1056 = t1054 - t1029*t1055
     t1057 = t1055 + t1029*t1054
     t1058 = (t1044 != 0)
-    t1059 = 0.5*(-t998 + t1031)/casadi.if_else(t1058, t1044, 1)
+    t1059 = (-t998 + t1031)/casadi.if_else(t1058, 2*t1044, 1)
     t1060 = casadi.fabs(t1059)
     t1061 = (t1060 >= 1)
-    t1062 = casadi.fabs(1/casadi.if_else(t1061, t1059, 1))
+    t1062 = 1/casadi.fabs(casadi.if_else(t1061, t1059, 1))
     t1063 = casadi.if_else(t1058, casadi.if_else((t1059 >= 0), 1, -1)*casadi.if_else(t1061, t1062/(1 + casadi.sqrt(1 + t1062**2)), 1/(t1060 + casadi.sqrt(1 + t1060**2))), 0)
     t1064 = 1/casadi.sqrt(1 + t1063**2)
     t1065 = t1002*t1064
@@ -2973,10 +2973,10 @@ def _condition_number(q):
     t119 = t59*t90
     t120 = t63*t73 - t98*t103 + t117*t84 + t118*t87 + t119*t95
     t121 = (t120 != 0)
-    t122 = 0.5*(-t116 + t105)/casadi.if_else(t121, -t120, 1)
+    t122 = (-t116 + t105)/casadi.if_else(t121, -2*t120, 1)
     t123 = casadi.fabs(t122)
     t124 = (t123 >= 1)
-    t125 = casadi.fabs(1/casadi.if_else(t124, t122, 1))
+    t125 = 1/casadi.fabs(casadi.if_else(t124, t122, 1))
     t126 = casadi.if_else(t121, casadi.if_else((t122 >= 0), 1, -1)*casadi.if_else(t124, t125/(1 + casadi.sqrt(1 + t125**2)), 1/(t123 + casadi.sqrt(1 + t123**2))), 0)
     t127 = 1/casadi.sqrt(1 + t126**2)
     t128 = t120*t126
@@ -3004,10 +3004,10 @@ def _condition_number(q):
     t150 = t148 + t147*t126
     t151 = t107*t137 - t111*t141 - t112*t145 + t113*t149
     t152 = (t151 != 0)
-    t153 = 0.5*(-t129 + t114)/casadi.if_else(t152, t151, 1)
+    t153 = (-t129 + t114)/casadi.if_else(t152, 2*t151, 1)
     t154 = casadi.fabs(t153)
     t155 = (t154 >= 1)
-    t156 = casadi.fabs(1/casadi.if_else(t155, t153, 1))
+    t156 = 1/casadi.fabs(casadi.if_else(t155, t153, 1))
     t157 = casadi.if_else(t152, casadi.if_else((t153 >= 0), 1, -1)*casadi.if_else(t155, t156/(1 + casadi.sqrt(1 + t156**2)), 1/(t154 + casadi.sqrt(1 + t154**2))), 0)
     t158 = 1/casadi.sqrt(1 + t157**2)
     t159 = t151*t157
@@ -3031,10 +3031,10 @@ def _condition_number(q):
     t177 = t175 + t174*t157
     t178 = t27*t168 + t31*t172 + t40*t176
     t179 = (t178 != 0)
-    t180 = 0.5*(-t160 + t48)/casadi.if_else(t179, t178, 1)
+    t180 = (-t160 + t48)/casadi.if_else(t179, 2*t178, 1)
     t181 = casadi.fabs(t180)
     t182 = (t181 >= 1)
-    t183 = casadi.fabs(1/casadi.if_else(t182, t180, 1))
+    t183 = 1/casadi.fabs(casadi.if_else(t182, t180, 1))
     t184 = casadi.if_else(t179, casadi.if_else((t180 >= 0), 1, -1)*casadi.if_else(t182, t183/(1 + casadi.sqrt(1 + t183**2)), 1/(t181 + casadi.sqrt(1 + t181**2))), 0)
     t185 = 1/casadi.sqrt(1 + t184**2)
     t186 = t178*t184
@@ -3054,10 +3054,10 @@ def _condition_number(q):
     t200 = t198 + t197*t184
     t201 = -t35*t195 + t44*t199
     t202 = (t201 != 0)
-    t203 = 0.5*(-t187 + t49)/casadi.if_else(t202, t201, 1)
+    t203 = (-t187 + t49)/casadi.if_else(t202, 2*t201, 1)
     t204 = casadi.fabs(t203)
     t205 = (t204 >= 1)
-    t206 = casadi.fabs(1/casadi.if_else(t205, t203, 1))
+    t206 = 1/casadi.fabs(casadi.if_else(t205, t203, 1))
     t207 = casadi.if_else(t202, casadi.if_else((t203 >= 0), 1, -1)*casadi.if_else(t205, t206/(1 + casadi.sqrt(1 + t206**2)), 1/(t204 + casadi.sqrt(1 + t204**2))), 0)
     t208 = 1/casadi.sqrt(1 + t207**2)
     t209 = t201*t207
@@ -3073,10 +3073,10 @@ def _condition_number(q):
     t219 = t217 + t216*t207
     t220 = t47*t218
     t221 = (t220 != 0)
-    t222 = 0.5*(-t210 + t50)/casadi.if_else(t221, -t220, 1)
+    t222 = (-t210 + t50)/casadi.if_else(t221, -2*t220, 1)
     t223 = casadi.fabs(t222)
     t224 = (t223 >= 1)
-    t225 = casadi.fabs(1/casadi.if_else(t224, t222, 1))
+    t225 = 1/casadi.fabs(casadi.if_else(t224, t222, 1))
     t226 = casadi.if_else(t221, casadi.if_else((t222 >= 0), 1, -1)*casadi.if_else(t224, t225/(1 + casadi.sqrt(1 + t225**2)), 1/(t223 + casadi.sqrt(1 + t223**2))), 0)
     t227 = 1/casadi.sqrt(1 + t226**2)
     t228 = t220*t226
@@ -3090,10 +3090,10 @@ def _condition_number(q):
     t236 = t235*t133
     t237 = -t138*t165 + t142*t169 + t146*t173 + t150*t177 + t115*t235*t126*t127**2 + t236*t134
     t238 = (t237 != 0)
-    t239 = 0.5*(-t130 + t161)/casadi.if_else(t238, t237, 1)
+    t239 = (-t130 + t161)/casadi.if_else(t238, 2*t237, 1)
     t240 = casadi.fabs(t239)
     t241 = (t240 >= 1)
-    t242 = casadi.fabs(1/casadi.if_else(t241, t239, 1))
+    t242 = 1/casadi.fabs(casadi.if_else(t241, t239, 1))
     t243 = casadi.if_else(t238, casadi.if_else((t239 >= 0), 1, -1)*casadi.if_else(t241, t242/(1 + casadi.sqrt(1 + t242**2)), 1/(t240 + casadi.sqrt(1 + t240**2))), 0)
     t244 = 1/casadi.sqrt(1 + t243**2)
     t245 = t237*t243
@@ -3132,10 +3132,10 @@ def _condition_number(q):
     t278 = t274*t164
     t279 = -t192*t264 - t196*t268 + t200*t272 - t276*t252 + t277*t256 + t278*t260
     t280 = (t279 != 0)
-    t281 = 0.5*(-t246 + t188)/casadi.if_else(t280, t279, 1)
+    t281 = (-t246 + t188)/casadi.if_else(t280, 2*t279, 1)
     t282 = casadi.fabs(t281)
     t283 = (t282 >= 1)
-    t284 = casadi.fabs(1/casadi.if_else(t283, t281, 1))
+    t284 = 1/casadi.fabs(casadi.if_else(t283, t281, 1))
     t285 = casadi.if_else(t280, casadi.if_else((t281 >= 0), 1, -1)*casadi.if_else(t283, t284/(1 + casadi.sqrt(1 + t284**2)), 1/(t282 + casadi.sqrt(1 + t282**2))), 0)
     t286 = 1/casadi.sqrt(1 + t285**2)
     t287 = t279*t285
@@ -3178,10 +3178,10 @@ def _condition_number(q):
     t324 = t323*t207
     t325 = t215*t308 + t219*t312 - t318*t292 + t320*t296 + t322*t300 + t324*t304
     t326 = (t325 != 0)
-    t327 = 0.5*(-t288 + t211)/casadi.if_else(t326, t325, 1)
+    t327 = (-t288 + t211)/casadi.if_else(t326, 2*t325, 1)
     t328 = casadi.fabs(t327)
     t329 = (t328 >= 1)
-    t330 = casadi.fabs(1/casadi.if_else(t329, t327, 1))
+    t330 = 1/casadi.fabs(casadi.if_else(t329, t327, 1))
     t331 = casadi.if_else(t326, casadi.if_else((t327 >= 0), 1, -1)*casadi.if_else(t329, t330/(1 + casadi.sqrt(1 + t330**2)), 1/(t328 + casadi.sqrt(1 + t328**2))), 0)
     t332 = 1/casadi.sqrt(1 + t331**2)
     t333 = t325*t331
@@ -3223,10 +3223,10 @@ def _condition_number(q):
     t369 = t368*t226
     t370 = t234*t358 - t361*t338 + t363*t342 + t365*t346 + t367*t350 + t369*t354
     t371 = (t370 != 0)
-    t372 = 0.5*(-t334 + t230)/casadi.if_else(t371, t370, 1)
+    t372 = (-t334 + t230)/casadi.if_else(t371, 2*t370, 1)
     t373 = casadi.fabs(t372)
     t374 = (t373 >= 1)
-    t375 = casadi.fabs(1/casadi.if_else(t374, t372, 1))
+    t375 = 1/casadi.fabs(casadi.if_else(t374, t372, 1))
     t376 = casadi.if_else(t371, casadi.if_else((t372 >= 0), 1, -1)*casadi.if_else(t374, t375/(1 + casadi.sqrt(1 + t375**2)), 1/(t373 + casadi.sqrt(1 + t373**2))), 0)
     t377 = 1/casadi.sqrt(1 + t376**2)
     t378 = t370*t376
@@ -3258,10 +3258,10 @@ def _condition_number(q):
     t404 = t402 + t401*t376
     t405 = t233*t403 - t360*t383 + t362*t387 + t364*t391 + t366*t395 + t368*t399
     t406 = (t314 != 0)
-    t407 = 0.5*(-t247 + t289)/casadi.if_else(t406, t314, 1)
+    t407 = (-t247 + t289)/casadi.if_else(t406, 2*t314, 1)
     t408 = casadi.fabs(t407)
     t409 = (t408 >= 1)
-    t410 = casadi.fabs(1/casadi.if_else(t409, t407, 1))
+    t410 = 1/casadi.fabs(casadi.if_else(t409, t407, 1))
     t411 = casadi.if_else(t406, casadi.if_else((t407 >= 0), 1, -1)*casadi.if_else(t409, t410/(1 + casadi.sqrt(1 + t410**2)), 1/(t408 + casadi.sqrt(1 + t408**2))), 0)
     t412 = 1/casadi.sqrt(1 + t411**2)
     t413 = t314*t411
@@ -3293,10 +3293,10 @@ def _condition_number(q):
     t439 = t437 + t436*t411
     t440 = -t339*t418 + t343*t422 + t347*t426 + t351*t430 + t355*t434 + t359*t438
     t441 = (t440 != 0)
-    t442 = 0.5*(-t414 + t335)/casadi.if_else(t441, t440, 1)
+    t442 = (-t414 + t335)/casadi.if_else(t441, 2*t440, 1)
     t443 = casadi.fabs(t442)
     t444 = (t443 >= 1)
-    t445 = casadi.fabs(1/casadi.if_else(t444, t442, 1))
+    t445 = 1/casadi.fabs(casadi.if_else(t444, t442, 1))
     t446 = casadi.if_else(t441, casadi.if_else((t442 >= 0), 1, -1)*casadi.if_else(t444, t445/(1 + casadi.sqrt(1 + t445**2)), 1/(t443 + casadi.sqrt(1 + t443**2))), 0)
     t447 = 1/casadi.sqrt(1 + t446**2)
     t448 = t440*t446
@@ -3329,10 +3329,10 @@ def _condition_number(q):
     t475 = -t384*t453 + t388*t457 + t392*t461 + t396*t465 + t400*t469 + t404*t473
     t476 = t419*t454 + t423*t458 + t427*t462 + t431*t466 + t435*t470 + t439*t474
     t477 = (t475 != 0)
-    t478 = 0.5*(-t449 + t380)/casadi.if_else(t477, t475, 1)
+    t478 = (-t449 + t380)/casadi.if_else(t477, 2*t475, 1)
     t479 = casadi.fabs(t478)
     t480 = (t479 >= 1)
-    t481 = casadi.fabs(1/casadi.if_else(t480, t478, 1))
+    t481 = 1/casadi.fabs(casadi.if_else(t480, t478, 1))
     t482 = casadi.if_else(t477, casadi.if_else((t478 >= 0), 1, -1)*casadi.if_else(t480, t481/(1 + casadi.sqrt(1 + t481**2)), 1/(t479 + casadi.sqrt(1 + t479**2))), 0)
     t483 = 1/casadi.sqrt(1 + t482**2)
     t484 = t475*t482
@@ -3363,10 +3363,10 @@ def _condition_number(q):
     t509 = t507 - t508*t482
     t510 = t508 + t507*t482
     t511 = (t476 != 0)
-    t512 = 0.5*(-t415 + t450)/casadi.if_else(t511, t476, 1)
+    t512 = (-t415 + t450)/casadi.if_else(t511, 2*t476, 1)
     t513 = casadi.fabs(t512)
     t514 = (t513 >= 1)
-    t515 = casadi.fabs(1/casadi.if_else(t514, t512, 1))
+    t515 = 1/casadi.fabs(casadi.if_else(t514, t512, 1))
     t516 = casadi.if_else(t511, casadi.if_else((t512 >= 0), 1, -1)*casadi.if_else(t514, t515/(1 + casadi.sqrt(1 + t515**2)), 1/(t513 + casadi.sqrt(1 + t513**2))), 0)
     t517 = 1/casadi.sqrt(1 + t516**2)
     t518 = t476*t516
@@ -3398,10 +3398,10 @@ def _condition_number(q):
     t544 = t542 + t541*t516
     t545 = t490*t523 + t494*t527 + t498*t531 + t502*t535 + t506*t539 + t510*t543
     t546 = (t545 != 0)
-    t547 = 0.5*(-t519 + t486)/casadi.if_else(t546, t545, 1)
+    t547 = (-t519 + t486)/casadi.if_else(t546, 2*t545, 1)
     t548 = casadi.fabs(t547)
     t549 = (t548 >= 1)
-    t550 = casadi.fabs(1/casadi.if_else(t549, t547, 1))
+    t550 = 1/casadi.fabs(casadi.if_else(t549, t547, 1))
     t551 = casadi.if_else(t546, casadi.if_else((t547 >= 0), 1, -1)*casadi.if_else(t549, t550/(1 + casadi.sqrt(1 + t550**2)), 1/(t548 + casadi.sqrt(1 + t548**2))), 0)
     t552 = 1/casadi.sqrt(1 + t551**2)
     t553 = t545*t551
@@ -3433,10 +3433,10 @@ def _condition_number(q):
     t579 = t577 + t576*t551
     t580 = t524*t559 + t528*t563 + t532*t567 + t536*t571 + t540*t575 + t544*t579
     t581 = (t580 != 0)
-    t582 = 0.5*(-t520 + t555)/casadi.if_else(t581, t580, 1)
+    t582 = (-t520 + t555)/casadi.if_else(t581, 2*t580, 1)
     t583 = casadi.fabs(t582)
     t584 = (t583 >= 1)
-    t585 = casadi.fabs(1/casadi.if_else(t584, t582, 1))
+    t585 = 1/casadi.fabs(casadi.if_else(t584, t582, 1))
     t586 = casadi.if_else(t581, casadi.if_else((t582 >= 0), 1, -1)*casadi.if_else(t584, t585/(1 + casadi.sqrt(1 + t585**2)), 1/(t583 + casadi.sqrt(1 + t583**2))), 0)
     t587 = 1/casadi.sqrt(1 + t586**2)
     t588 = t580*t586
@@ -3467,10 +3467,10 @@ def _condition_number(q):
     t613 = t611 - t612*t586
     t614 = t612 + t611*t586
     t615 = (t405 != 0)
-    t616 = 0.5*(-t229 + t379)/casadi.if_else(t615, t405, 1)
+    t616 = (-t229 + t379)/casadi.if_else(t615, 2*t405, 1)
     t617 = casadi.fabs(t616)
     t618 = (t617 >= 1)
-    t619 = casadi.fabs(1/casadi.if_else(t618, t616, 1))
+    t619 = 1/casadi.fabs(casadi.if_else(t618, t616, 1))
     t620 = casadi.if_else(t615, casadi.if_else((t616 >= 0), 1, -1)*casadi.if_else(t618, t619/(1 + casadi.sqrt(1 + t619**2)), 1/(t617 + casadi.sqrt(1 + t617**2))), 0)
     t621 = 1/casadi.sqrt(1 + t620**2)
     t622 = t405*t620
@@ -3502,10 +3502,10 @@ def _condition_number(q):
     t648 = t646 + t645*t620
     t649 = t489*t627 + t493*t631 + t497*t635 + t501*t639 + t505*t643 + t509*t647
     t650 = (t649 != 0)
-    t651 = 0.5*(-t623 + t485)/casadi.if_else(t650, t649, 1)
+    t651 = (-t623 + t485)/casadi.if_else(t650, 2*t649, 1)
     t652 = casadi.fabs(t651)
     t653 = (t652 >= 1)
-    t654 = casadi.fabs(1/casadi.if_else(t653, t651, 1))
+    t654 = 1/casadi.fabs(casadi.if_else(t653, t651, 1))
     t655 = casadi.if_else(t650, casadi.if_else((t651 >= 0), 1, -1)*casadi.if_else(t653, t654/(1 + casadi.sqrt(1 + t654**2)), 1/(t652 + casadi.sqrt(1 + t652**2))), 0)
     t656 = 1/casadi.sqrt(1 + t655**2)
     t657 = t649*t655
@@ -3538,10 +3538,10 @@ def _condition_number(q):
     t684 = t558*t662 + t562*t666 + t566*t670 + t570*t674 + t574*t678 + t578*t682
     t685 = -t628*t663 + t632*t667 + t636*t671 + t640*t675 + t644*t679 + t648*t683
     t686 = (t684 != 0)
-    t687 = 0.5*(-t658 + t554)/casadi.if_else(t686, t684, 1)
+    t687 = (-t658 + t554)/casadi.if_else(t686, 2*t684, 1)
     t688 = casadi.fabs(t687)
     t689 = (t688 >= 1)
-    t690 = casadi.fabs(1/casadi.if_else(t689, t687, 1))
+    t690 = 1/casadi.fabs(casadi.if_else(t689, t687, 1))
     t691 = casadi.if_else(t686, casadi.if_else((t687 >= 0), 1, -1)*casadi.if_else(t689, t690/(1 + casadi.sqrt(1 + t690**2)), 1/(t688 + casadi.sqrt(1 + t688**2))), 0)
     t692 = 1/casadi.sqrt(1 + t691**2)
     t693 = t684*t691
@@ -3573,10 +3573,10 @@ def _condition_number(q):
     t719 = t717 + t716*t691
     t720 = t593*t698 + t597*t702 + t601*t706 + t605*t710 + t609*t714 + t613*t718
     t721 = (t720 != 0)
-    t722 = 0.5*(-t694 + t589)/casadi.if_else(t721, t720, 1)
+    t722 = (-t694 + t589)/casadi.if_else(t721, 2*t720, 1)
     t723 = casadi.fabs(t722)
     t724 = (t723 >= 1)
-    t725 = casadi.fabs(1/casadi.if_else(t724, t722, 1))
+    t725 = 1/casadi.fabs(casadi.if_else(t724, t722, 1))
     t726 = casadi.if_else(t721, casadi.if_else((t722 >= 0), 1, -1)*casadi.if_else(t724, t725/(1 + casadi.sqrt(1 + t725**2)), 1/(t723 + casadi.sqrt(1 + t723**2))), 0)
     t727 = 1/casadi.sqrt(1 + t726**2)
     t728 = t720*t726
@@ -3608,10 +3608,10 @@ def _condition_number(q):
     t754 = t752 + t751*t726
     t755 = t594*t733 + t598*t737 + t602*t741 + t606*t745 + t610*t749 + t614*t753
     t756 = (t755 != 0)
-    t757 = 0.5*(-t729 + t590)/casadi.if_else(t756, t755, 1)
+    t757 = (-t729 + t590)/casadi.if_else(t756, 2*t755, 1)
     t758 = casadi.fabs(t757)
     t759 = (t758 >= 1)
-    t760 = casadi.fabs(1/casadi.if_else(t759, t757, 1))
+    t760 = 1/casadi.fabs(casadi.if_else(t759, t757, 1))
     t761 = casadi.if_else(t756, casadi.if_else((t757 >= 0), 1, -1)*casadi.if_else(t759, t760/(1 + casadi.sqrt(1 + t760**2)), 1/(t758 + casadi.sqrt(1 + t758**2))), 0)
     t762 = 1/casadi.sqrt(1 + t761**2)
     t763 = t755*t761
@@ -3642,10 +3642,10 @@ def _condition_number(q):
     t788 = t786 - t787*t761
     t789 = t787 + t786*t761
     t790 = (t685 != 0)
-    t791 = 0.5*(-t624 + t659)/casadi.if_else(t790, t685, 1)
+    t791 = (-t624 + t659)/casadi.if_else(t790, 2*t685, 1)
     t792 = casadi.fabs(t791)
     t793 = (t792 >= 1)
-    t794 = casadi.fabs(1/casadi.if_else(t793, t791, 1))
+    t794 = 1/casadi.fabs(casadi.if_else(t793, t791, 1))
     t795 = casadi.if_else(t790, casadi.if_else((t791 >= 0), 1, -1)*casadi.if_else(t793, t794/(1 + casadi.sqrt(1 + t794**2)), 1/(t792 + casadi.sqrt(1 + t792**2))), 0)
     t796 = 1/casadi.sqrt(1 + t795**2)
     t797 = t685*t795
@@ -3677,10 +3677,10 @@ def _condition_number(q):
     t823 = t821 + t820*t795
     t824 = t699*t802 + t703*t806 + t707*t810 + t711*t814 + t715*t818 + t719*t822
     t825 = (t824 != 0)
-    t826 = 0.5*(-t798 + t695)/casadi.if_else(t825, t824, 1)
+    t826 = (-t798 + t695)/casadi.if_else(t825, 2*t824, 1)
     t827 = casadi.fabs(t826)
     t828 = (t827 >= 1)
-    t829 = casadi.fabs(1/casadi.if_else(t828, t826, 1))
+    t829 = 1/casadi.fabs(casadi.if_else(t828, t826, 1))
     t830 = casadi.if_else(t825, casadi.if_else((t826 >= 0), 1, -1)*casadi.if_else(t828, t829/(1 + casadi.sqrt(1 + t829**2)), 1/(t827 + casadi.sqrt(1 + t827**2))), 0)
     t831 = 1/casadi.sqrt(1 + t830**2)
     t832 = t824*t830
@@ -3713,10 +3713,10 @@ def _condition_number(q):
     t859 = t734*t837 + t738*t841 + t742*t845 + t746*t849 + t750*t853 + t754*t857
     t860 = t803*t838 + t807*t842 + t811*t846 + t815*t850 + t819*t854 + t823*t858
     t861 = (t859 != 0)
-    t862 = 0.5*(-t833 + t730)/casadi.if_else(t861, t859, 1)
+    t862 = (-t833 + t730)/casadi.if_else(t861, 2*t859, 1)
     t863 = casadi.fabs(t862)
     t864 = (t863 >= 1)
-    t865 = casadi.fabs(1/casadi.if_else(t864, t862, 1))
+    t865 = 1/casadi.fabs(casadi.if_else(t864, t862, 1))
     t866 = casadi.if_else(t861, casadi.if_else((t862 >= 0), 1, -1)*casadi.if_else(t864, t865/(1 + casadi.sqrt(1 + t865**2)), 1/(t863 + casadi.sqrt(1 + t863**2))), 0)
     t867 = 1/casadi.sqrt(1 + t866**2)
     t868 = t859*t866
@@ -3748,10 +3748,10 @@ def _condition_number(q):
     t894 = t892 + t891*t866
     t895 = t769*t873 + t773*t877 + t777*t881 + t781*t885 + t785*t889 + t789*t893
     t896 = (t895 != 0)
-    t897 = 0.5*(-t869 + t765)/casadi.if_else(t896, t895, 1)
+    t897 = (-t869 + t765)/casadi.if_else(t896, 2*t895, 1)
     t898 = casadi.fabs(t897)
     t899 = (t898 >= 1)
-    t900 = casadi.fabs(1/casadi.if_else(t899, t897, 1))
+    t900 = 1/casadi.fabs(casadi.if_else(t899, t897, 1))
     t901 = casadi.if_else(t896, casadi.if_else((t897 >= 0), 1, -1)*casadi.if_else(t899, t900/(1 + casadi.sqrt(1 + t900**2)), 1/(t898 + casadi.sqrt(1 + t898**2))), 0)
     t902 = 1/casadi.sqrt(1 + t901**2)
     t903 = t895*t901
@@ -3783,10 +3783,10 @@ def _condition_number(q):
     t929 = t927 + t926*t901
     t930 = t768*t908 + t772*t912 + t776*t916 + t780*t920 + t784*t924 + t788*t928
     t931 = (t860 != 0)
-    t932 = 0.5*(-t799 + t834)/casadi.if_else(t931, t860, 1)
+    t932 = (-t799 + t834)/casadi.if_else(t931, 2*t860, 1)
     t933 = casadi.fabs(t932)
     t934 = (t933 >= 1)
-    t935 = casadi.fabs(1/casadi.if_else(t934, t932, 1))
+    t935 = 1/casadi.fabs(casadi.if_else(t934, t932, 1))
     t936 = casadi.if_else(t931, casadi.if_else((t932 >= 0), 1, -1)*casadi.if_else(t934, t935/(1 + casadi.sqrt(1 + t935**2)), 1/(t933 + casadi.sqrt(1 + t933**2))), 0)
     t937 = 1/casadi.sqrt(1 + t936**2)
     t938 = t860*t936
@@ -3818,10 +3818,10 @@ def _condition_number(q):
     t964 = t962 + t961*t936
     t965 = t874*t943 + t878*t947 + t882*t951 + t886*t955 + t890*t959 + t894*t963
     t966 = (t965 != 0)
-    t967 = 0.5*(-t939 + t870)/casadi.if_else(t966, t965, 1)
+    t967 = (-t939 + t870)/casadi.if_else(t966, 2*t965, 1)
     t968 = casadi.fabs(t967)
     t969 = (t968 >= 1)
-    t970 = casadi.fabs(1/casadi.if_else(t969, t967, 1))
+    t970 = 1/casadi.fabs(casadi.if_else(t969, t967, 1))
     t971 = casadi.if_else(t966, casadi.if_else((t967 >= 0), 1, -1)*casadi.if_else(t969, t970/(1 + casadi.sqrt(1 + t970**2)), 1/(t968 + casadi.sqrt(1 + t968**2))), 0)
     t972 = 1/casadi.sqrt(1 + t971**2)
     t973 = t965*t971
@@ -3854,10 +3854,10 @@ def _condition_number(q):
     t1000 = t909*t978 + t913*t982 + t917*t986 + t921*t990 + t925*t994 + t929*t998
     t1001 = t944*t979 + t948*t983 + t952*t987 + t956*t991 + t960*t995 + t964*t999
     t1002 = (t1000 != 0)
-    t1003 = 0.5*(-t974 + t905)/casadi.if_else(t1002, t1000, 1)
+    t1003 = (-t974 + t905)/casadi.if_else(t1002, 2*t1000, 1)
     t1004 = casadi.fabs(t1003)
     t1005 = (t1004 >= 1)
-    t1006 = casadi.fabs(1/casadi.if_else(t1005, t1003, 1))
+    t1006 = 1/casadi.fabs(casadi.if_else(t1005, t1003, 1))
     t1007 = casadi.if_else(t1002, casadi.if_else((t1003 >= 0), 1, -1)*casadi.if_else(t1005, t1006/(1 + casadi.sqrt(1 + t1006**2)), 1/(t1004 + casadi.sqrt(1 + t1004**2))), 0)
     t1008 = 1/casadi.sqrt(1 + t1007**2)
     t1009 = t1000*t1007
@@ -3888,10 +3888,10 @@ def _condition_number(q):
     t1034 = t1032 - t1033*t1007
     t1035 = t1033 + t1032*t1007
     t1036 = (t1001 != 0)
-    t1037 = 0.5*(-t940 + t975)/casadi.if_else(t1036, t1001, 1)
+    t1037 = (-t940 + t975)/casadi.if_else(t1036, 2*t1001, 1)
     t1038 = casadi.fabs(t1037)
     t1039 = (t1038 >= 1)
-    t1040 = casadi.fabs(1/casadi.if_else(t1039, t1037, 1))
+    t1040 = 1/casadi.fabs(casadi.if_else(t1039, t1037, 1))
     t1041 = casadi.if_else(t1036, casadi.if_else((t1037 >= 0), 1, -1)*casadi.if_else(t1039, t1040/(1 + casadi.sqrt(1 + t1040**2)), 1/(t1038 + casadi.sqrt(1 + t1038**2))), 0)
     t1042 = 1/casadi.sqrt(1 + t1041**2)
     t1043 = t1001*t1041
@@ -3923,10 +3923,10 @@ def _condition_number(q):
     t1069 = t1067 + t1041*t1066
     t1070 = t1015*t1048 + t1019*t1052 + t1023*t1056 + t1027*t1060 + t1031*t1064 + t1035*t1068
     t1071 = (t1070 != 0)
-    t1072 = 0.5*(-t1044 + t1011)/casadi.if_else(t1071, t1070, 1)
+    t1072 = (-t1044 + t1011)/casadi.if_else(t1071, 2*t1070, 1)
     t1073 = casadi.fabs(t1072)
     t1074 = (t1073 >= 1)
-    t1075 = casadi.fabs(1/casadi.if_else(t1074, t1072, 1))
+    t1075 = 1/casadi.fabs(casadi.if_else(t1074, t1072, 1))
     t1076 = casadi.if_else(t1071, casadi.if_else((t1072 >= 0), 1, -1)*casadi.if_else(t1074, t1075/(1 + casadi.sqrt(1 + t1075**2)), 1/(t1073 + casadi.sqrt(1 + t1073**2))), 0)
     t1077 = 1/casadi.sqrt(1 + t1076**2)
     t1078 = t1070*t1076
@@ -3958,10 +3958,10 @@ def _condition_number(q):
     t1104 = t1102 + t1076*t1101
     t1105 = t1049*t1084 + t1053*t1088 + t1057*t1092 + t1061*t1096 + t1065*t1100 + t1069*t1104
     t1106 = (t1105 != 0)
-    t1107 = 0.5*(-t1045 + t1080)/casadi.if_else(t1106, t1105, 1)
+    t1107 = (-t1045 + t1080)/casadi.if_else(t1106, 2*t1105, 1)
     t1108 = casadi.fabs(t1107)
     t1109 = (t1108 >= 1)
-    t1110 = casadi.fabs(1/casadi.if_else(t1109, t1107, 1))
+    t1110 = 1/casadi.fabs(casadi.if_else(t1109, t1107, 1))
     t1111 = casadi.if_else(t1106, casadi.if_else((t1107 >= 0), 1, -1)*casadi.if_else(t1109, t1110/(1 + casadi.sqrt(1 + t1110**2)), 1/(t1108 + casadi.sqrt(1 + t1108**2))), 0)
     t1112 = 1/casadi.sqrt(1 + t1111**2)
     t1113 = t1105*t1111
@@ -3992,10 +3992,10 @@ def _condition_number(q):
     t1138 = t1136 - t1111*t1137
     t1139 = t1137 + t1111*t1136
     t1140 = (t930 != 0)
-    t1141 = 0.5*(-t764 + t904)/casadi.if_else(t1140, t930, 1)
+    t1141 = (-t764 + t904)/casadi.if_else(t1140, 2*t930, 1)
     t1142 = casadi.fabs(t1141)
     t1143 = (t1142 >= 1)
-    t1144 = casadi.fabs(1/casadi.if_else(t1143, t1141, 1))
+    t1144 = 1/casadi.fabs(casadi.if_else(t1143, t1141, 1))
     t1145 = casadi.if_else(t1140, casadi.if_else((t1141 >= 0), 1, -1)*casadi.if_else(t1143, t1144/(1 + casadi.sqrt(1 + t1144**2)), 1/(t1142 + casadi.sqrt(1 + t1142**2))), 0)
     t1146 = 1/casadi.sqrt(1 + t1145**2)
     t1147 = t930*t1145
@@ -4027,10 +4027,10 @@ def _condition_number(q):
     t1173 = t1171 + t1145*t1170
     t1174 = t1014*t1152 + t1018*t1156 + t1022*t1160 + t1026*t1164 + t1030*t1168 + t1034*t1172
     t1175 = (t1174 != 0)
-    t1176 = 0.5*(-t1148 + t1010)/casadi.if_else(t1175, t1174, 1)
+    t1176 = (-t1148 + t1010)/casadi.if_else(t1175, 2*t1174, 1)
     t1177 = casadi.fabs(t1176)
     t1178 = (t1177 >= 1)
-    t1179 = casadi.fabs(1/casadi.if_else(t1178, t1176, 1))
+    t1179 = 1/casadi.fabs(casadi.if_else(t1178, t1176, 1))
     t1180 = casadi.if_else(t1175, casadi.if_else((t1176 >= 0), 1, -1)*casadi.if_else(t1178, t1179/(1 + casadi.sqrt(1 + t1179**2)), 1/(t1177 + casadi.sqrt(1 + t1177**2))), 0)
     t1181 = 1/casadi.sqrt(1 + t1180**2)
     t1182 = t1174*t1180
@@ -4063,10 +4063,10 @@ def _condition_number(q):
     t1209 = t1083*t1187 + t1087*t1191 + t1091*t1195 + t1095*t1199 + t1099*t1203 + t1103*t1207
     t1210 = t1153*t1188 + t1157*t1192 + t1161*t1196 + t1165*t1200 + t1169*t1204 + t1173*t1208
     t1211 = (t1209 != 0)
-    t1212 = 0.5*(-t1183 + t1079)/casadi.if_else(t1211, t1209, 1)
+    t1212 = (-t1183 + t1079)/casadi.if_else(t1211, 2*t1209, 1)
     t1213 = casadi.fabs(t1212)
     t1214 = (t1213 >= 1)
-    t1215 = casadi.fabs(1/casadi.if_else(t1214, t1212, 1))
+    t1215 = 1/casadi.fabs(casadi.if_else(t1214, t1212, 1))
     t1216 = casadi.if_else(t1211, casadi.if_else((t1212 >= 0), 1, -1)*casadi.if_else(t1214, t1215/(1 + casadi.sqrt(1 + t1215**2)), 1/(t1213 + casadi.sqrt(1 + t1213**2))), 0)
     t1217 = 1/casadi.sqrt(1 + t1216**2)
     t1218 = t1209*t1216
@@ -4098,10 +4098,10 @@ def _condition_number(q):
     t1244 = t1242 + t1216*t1241
     t1245 = t1118*t1223 + t1122*t1227 + t1126*t1231 + t1130*t1235 + t1134*t1239 + t1138*t1243
     t1246 = (t1245 != 0)
-    t1247 = 0.5*(-t1219 + t1114)/casadi.if_else(t1246, t1245, 1)
+    t1247 = (-t1219 + t1114)/casadi.if_else(t1246, 2*t1245, 1)
     t1248 = casadi.fabs(t1247)
     t1249 = (t1248 >= 1)
-    t1250 = casadi.fabs(1/casadi.if_else(t1249, t1247, 1))
+    t1250 = 1/casadi.fabs(casadi.if_else(t1249, t1247, 1))
     t1251 = casadi.if_else(t1246, casadi.if_else((t1247 >= 0), 1, -1)*casadi.if_else(t1249, t1250/(1 + casadi.sqrt(1 + t1250**2)), 1/(t1248 + casadi.sqrt(1 + t1248**2))), 0)
     t1252 = 1/casadi.sqrt(1 + t1251**2)
     t1253 = t1245*t1251
@@ -4133,10 +4133,10 @@ def _condition_number(q):
     t1279 = t1277 + t1251*t1276
     t1280 = t1119*t1258 + t1123*t1262 + t1127*t1266 + t1131*t1270 + t1135*t1274 + t1139*t1278
     t1281 = (t1280 != 0)
-    t1282 = 0.5*(-t1254 + t1115)/casadi.if_else(t1281, t1280, 1)
+    t1282 = (-t1254 + t1115)/casadi.if_else(t1281, 2*t1280, 1)
     t1283 = casadi.fabs(t1282)
     t1284 = (t1283 >= 1)
-    t1285 = casadi.fabs(1/casadi.if_else(t1284, t1282, 1))
+    t1285 = 1/casadi.fabs(casadi.if_else(t1284, t1282, 1))
     t1286 = casadi.if_else(t1281, casadi.if_else((t1282 >= 0), 1, -1)*casadi.if_else(t1284, t1285/(1 + casadi.sqrt(1 + t1285**2)), 1/(t1283 + casadi.sqrt(1 + t1283**2))), 0)
     t1287 = 1/casadi.sqrt(1 + t1286**2)
     t1288 = t1280*t1286
@@ -4167,10 +4167,10 @@ def _condition_number(q):
     t1313 = t1311 - t1286*t1312
     t1314 = t1312 + t1286*t1311
     t1315 = (t1210 != 0)
-    t1316 = 0.5*(-t1149 + t1184)/casadi.if_else(t1315, t1210, 1)
+    t1316 = (-t1149 + t1184)/casadi.if_else(t1315, 2*t1210, 1)
     t1317 = casadi.fabs(t1316)
     t1318 = (t1317 >= 1)
-    t1319 = casadi.fabs(1/casadi.if_else(t1318, t1316, 1))
+    t1319 = 1/casadi.fabs(casadi.if_else(t1318, t1316, 1))
     t1320 = casadi.if_else(t1315, casadi.if_else((t1316 >= 0), 1, -1)*casadi.if_else(t1318, t1319/(1 + casadi.sqrt(1 + t1319**2)), 1/(t1317 + casadi.sqrt(1 + t1317**2))), 0)
     t1321 = 1/casadi.sqrt(1 + t1320**2)
     t1322 = t1210*t1320
@@ -4202,10 +4202,10 @@ def _condition_number(q):
     t1348 = t1346 + t1320*t1345
     t1349 = t1224*t1327 + t1228*t1331 + t1232*t1335 + t1236*t1339 + t1240*t1343 + t1244*t1347
     t1350 = (t1349 != 0)
-    t1351 = 0.5*(-t1323 + t1220)/casadi.if_else(t1350, t1349, 1)
+    t1351 = (-t1323 + t1220)/casadi.if_else(t1350, 2*t1349, 1)
     t1352 = casadi.fabs(t1351)
     t1353 = (t1352 >= 1)
-    t1354 = casadi.fabs(1/casadi.if_else(t1353, t1351, 1))
+    t1354 = 1/casadi.fabs(casadi.if_else(t1353, t1351, 1))
     t1355 = casadi.if_else(t1350, casadi.if_else((t1351 >= 0), 1, -1)*casadi.if_else(t1353, t1354/(1 + casadi.sqrt(1 + t1354**2)), 1/(t1352 + casadi.sqrt(1 + t1352**2))), 0)
     t1356 = 1/casadi.sqrt(1 + t1355**2)
     t1357 = t1349*t1355
@@ -4238,10 +4238,10 @@ def _condition_number(q):
     t1384 = t1259*t1362 + t1263*t1366 + t1267*t1370 + t1271*t1374 + t1275*t1378 + t1279*t1382
     t1385 = t1328*t1363 + t1332*t1367 + t1336*t1371 + t1340*t1375 + t1344*t1379 + t1348*t1383
     t1386 = (t1384 != 0)
-    t1387 = 0.5*(-t1358 + t1255)/casadi.if_else(t1386, t1384, 1)
+    t1387 = (-t1358 + t1255)/casadi.if_else(t1386, 2*t1384, 1)
     t1388 = casadi.fabs(t1387)
     t1389 = (t1388 >= 1)
-    t1390 = casadi.fabs(1/casadi.if_else(t1389, t1387, 1))
+    t1390 = 1/casadi.fabs(casadi.if_else(t1389, t1387, 1))
     t1391 = casadi.if_else(t1386, casadi.if_else((t1387 >= 0), 1, -1)*casadi.if_else(t1389, t1390/(1 + casadi.sqrt(1 + t1390**2)), 1/(t1388 + casadi.sqrt(1 + t1388**2))), 0)
     t1392 = 1/casadi.sqrt(1 + t1391**2)
     t1393 = t1384*t1391
@@ -4273,10 +4273,10 @@ def _condition_number(q):
     t1419 = t1417 + t1391*t1416
     t1420 = t1294*t1398 + t1298*t1402 + t1302*t1406 + t1306*t1410 + t1310*t1414 + t1314*t1418
     t1421 = (t1420 != 0)
-    t1422 = 0.5*(-t1394 + t1290)/casadi.if_else(t1421, t1420, 1)
+    t1422 = (-t1394 + t1290)/casadi.if_else(t1421, 2*t1420, 1)
     t1423 = casadi.fabs(t1422)
     t1424 = (t1423 >= 1)
-    t1425 = casadi.fabs(1/casadi.if_else(t1424, t1422, 1))
+    t1425 = 1/casadi.fabs(casadi.if_else(t1424, t1422, 1))
     t1426 = casadi.if_else(t1421, casadi.if_else((t1422 >= 0), 1, -1)*casadi.if_else(t1424, t1425/(1 + casadi.sqrt(1 + t1425**2)), 1/(t1423 + casadi.sqrt(1 + t1423**2))), 0)
     t1427 = 1/casadi.sqrt(1 + t1426**2)
     t1428 = t1420*t1426
@@ -4308,10 +4308,10 @@ def _condition_number(q):
     t1454 = t1452 + t1426*t1451
     t1455 = t1293*t1433 + t1297*t1437 + t1301*t1441 + t1305*t1445 + t1309*t1449 + t1313*t1453
     t1456 = (t1385 != 0)
-    t1457 = 0.5*(-t1324 + t1359)/casadi.if_else(t1456, t1385, 1)
+    t1457 = (-t1324 + t1359)/casadi.if_else(t1456, 2*t1385, 1)
     t1458 = casadi.fabs(t1457)
     t1459 = (t1458 >= 1)
-    t1460 = casadi.fabs(1/casadi.if_else(t1459, t1457, 1))
+    t1460 = 1/casadi.fabs(casadi.if_else(t1459, t1457, 1))
     t1461 = casadi.if_else(t1456, casadi.if_else((t1457 >= 0), 1, -1)*casadi.if_else(t1459, t1460/(1 + casadi.sqrt(1 + t1460**2)), 1/(t1458 + casadi.sqrt(1 + t1458**2))), 0)
     t1462 = 1/casadi.sqrt(1 + t1461**2)
     t1463 = t1385*t1461
@@ -4343,10 +4343,10 @@ def _condition_number(q):
     t1489 = t1487 + t1461*t1486
     t1490 = t1399*t1468 + t1403*t1472 + t1407*t1476 + t1411*t1480 + t1415*t1484 + t1419*t1488
     t1491 = (t1490 != 0)
-    t1492 = 0.5*(-t1464 + t1395)/casadi.if_else(t1491, t1490, 1)
+    t1492 = (-t1464 + t1395)/casadi.if_else(t1491, 2*t1490, 1)
     t1493 = casadi.fabs(t1492)
     t1494 = (t1493 >= 1)
-    t1495 = casadi.fabs(1/casadi.if_else(t1494, t1492, 1))
+    t1495 = 1/casadi.fabs(casadi.if_else(t1494, t1492, 1))
     t1496 = casadi.if_else(t1491, casadi.if_else((t1492 >= 0), 1, -1)*casadi.if_else(t1494, t1495/(1 + casadi.sqrt(1 + t1495**2)), 1/(t1493 + casadi.sqrt(1 + t1493**2))), 0)
     t1497 = 1/casadi.sqrt(1 + t1496**2)
     t1498 = t1490*t1496
@@ -4379,10 +4379,10 @@ def _condition_number(q):
     t1525 = t1434*t1503 + t1438*t1507 + t1442*t1511 + t1446*t1515 + t1450*t1519 + t1454*t1523
     t1526 = t1469*t1504 + t1473*t1508 + t1477*t1512 + t1481*t1516 + t1485*t1520 + t1489*t1524
     t1527 = (t1525 != 0)
-    t1528 = 0.5*(-t1499 + t1430)/casadi.if_else(t1527, t1525, 1)
+    t1528 = (-t1499 + t1430)/casadi.if_else(t1527, 2*t1525, 1)
     t1529 = casadi.fabs(t1528)
     t1530 = (t1529 >= 1)
-    t1531 = casadi.fabs(1/casadi.if_else(t1530, t1528, 1))
+    t1531 = 1/casadi.fabs(casadi.if_else(t1530, t1528, 1))
     t1532 = casadi.if_else(t1527, casadi.if_else((t1528 >= 0), 1, -1)*casadi.if_else(t1530, t1531/(1 + casadi.sqrt(1 + t1531**2)), 1/(t1529 + casadi.sqrt(1 + t1529**2))), 0)
     t1533 = 1/casadi.sqrt(1 + t1532**2)
     t1534 = t1525*t1532
@@ -4413,10 +4413,10 @@ def _condition_number(q):
     t1559 = t1557 - t1532*t1558
     t1560 = t1558 + t1532*t1557
     t1561 = (t1526 != 0)
-    t1562 = 0.5*(-t1465 + t1500)/casadi.if_else(t1561, t1526, 1)
+    t1562 = (-t1465 + t1500)/casadi.if_else(t1561, 2*t1526, 1)
     t1563 = casadi.fabs(t1562)
     t1564 = (t1563 >= 1)
-    t1565 = casadi.fabs(1/casadi.if_else(t1564, t1562, 1))
+    t1565 = 1/casadi.fabs(casadi.if_else(t1564, t1562, 1))
     t1566 = casadi.if_else(t1561, casadi.if_else((t1562 >= 0), 1, -1)*casadi.if_else(t1564, t1565/(1 + casadi.sqrt(1 + t1565**2)), 1/(t1563 + casadi.sqrt(1 + t1563**2))), 0)
     t1567 = 1/casadi.sqrt(1 + t1566**2)
     t1568 = t1526*t1566
@@ -4448,10 +4448,10 @@ def _condition_number(q):
     t1594 = t1592 + t1566*t1591
     t1595 = t1540*t1573 + t1544*t1577 + t1548*t1581 + t1552*t1585 + t1556*t1589 + t1560*t1593
     t1596 = (t1595 != 0)
-    t1597 = 0.5*(-t1569 + t1536)/casadi.if_else(t1596, t1595, 1)
+    t1597 = (-t1569 + t1536)/casadi.if_else(t1596, 2*t1595, 1)
     t1598 = casadi.fabs(t1597)
     t1599 = (t1598 >= 1)
-    t1600 = casadi.fabs(1/casadi.if_else(t1599, t1597, 1))
+    t1600 = 1/casadi.fabs(casadi.if_else(t1599, t1597, 1))
     t1601 = casadi.if_else(t1596, casadi.if_else((t1597 >= 0), 1, -1)*casadi.if_else(t1599, t1600/(1 + casadi.sqrt(1 + t1600**2)), 1/(t1598 + casadi.sqrt(1 + t1598**2))), 0)
     t1602 = 1/casadi.sqrt(1 + t1601**2)
     t1603 = t1595*t1601
@@ -4483,10 +4483,10 @@ def _condition_number(q):
     t1629 = t1627 + t1601*t1626
     t1630 = t1574*t1609 + t1578*t1613 + t1582*t1617 + t1586*t1621 + t1590*t1625 + t1594*t1629
     t1631 = (t1630 != 0)
-    t1632 = 0.5*(-t1570 + t1605)/casadi.if_else(t1631, t1630, 1)
+    t1632 = (-t1570 + t1605)/casadi.if_else(t1631, 2*t1630, 1)
     t1633 = casadi.fabs(t1632)
     t1634 = (t1633 >= 1)
-    t1635 = casadi.fabs(1/casadi.if_else(t1634, t1632, 1))
+    t1635 = 1/casadi.fabs(casadi.if_else(t1634, t1632, 1))
     t1636 = casadi.if_else(t1631, casadi.if_else((t1632 >= 0), 1, -1)*casadi.if_else(t1634, t1635/(1 + casadi.sqrt(1 + t1635**2)), 1/(t1633 + casadi.sqrt(1 + t1633**2))), 0)
     t1637 = 1/casadi.sqrt(1 + t1636**2)
     t1638 = t1630*t1636
@@ -4517,10 +4517,10 @@ def _condition_number(q):
     t1663 = t1661 - t1636*t1662
     t1664 = t1662 + t1636*t1661
     t1665 = (t1455 != 0)
-    t1666 = 0.5*(-t1289 + t1429)/casadi.if_else(t1665, t1455, 1)
+    t1666 = (-t1289 + t1429)/casadi.if_else(t1665, 2*t1455, 1)
     t1667 = casadi.fabs(t1666)
     t1668 = (t1667 >= 1)
-    t1669 = casadi.fabs(1/casadi.if_else(t1668, t1666, 1))
+    t1669 = 1/casadi.fabs(casadi.if_else(t1668, t1666, 1))
     t1670 = casadi.if_else(t1665, casadi.if_else((t1666 >= 0), 1, -1)*casadi.if_else(t1668, t1669/(1 + casadi.sqrt(1 + t1669**2)), 1/(t1667 + casadi.sqrt(1 + t1667**2))), 0)
     t1671 = 1/casadi.sqrt(1 + t1670**2)
     t1672 = t1455*t1670
@@ -4552,10 +4552,10 @@ def _condition_number(q):
     t1698 = t1696 + t1670*t1695
     t1699 = t1539*t1677 + t1543*t1681 + t1547*t1685 + t1551*t1689 + t1555*t1693 + t1559*t1697
     t1700 = (t1699 != 0)
-    t1701 = 0.5*(-t1673 + t1535)/casadi.if_else(t1700, t1699, 1)
+    t1701 = (-t1673 + t1535)/casadi.if_else(t1700, 2*t1699, 1)
     t1702 = casadi.fabs(t1701)
     t1703 = (t1702 >= 1)
-    t1704 = casadi.fabs(1/casadi.if_else(t1703, t1701, 1))
+    t1704 = 1/casadi.fabs(casadi.if_else(t1703, t1701, 1))
     t1705 = casadi.if_else(t1700, casadi.if_else((t1701 >= 0), 1, -1)*casadi.if_else(t1703, t1704/(1 + casadi.sqrt(1 + t1704**2)), 1/(t1702 + casadi.sqrt(1 + t1702**2))), 0)
     t1706 = 1/casadi.sqrt(1 + t1705**2)
     t1707 = t1699*t1705
@@ -4588,10 +4588,10 @@ def _condition_number(q):
     t1734 = t1608*t1712 + t1612*t1716 + t1616*t1720 + t1620*t1724 + t1624*t1728 + t1628*t1732
     t1735 = t1678*t1713 + t1682*t1717 + t1686*t1721 + t1690*t1725 + t1694*t1729 + t1698*t1733
     t1736 = (t1734 != 0)
-    t1737 = 0.5*(-t1708 + t1604)/casadi.if_else(t1736, t1734, 1)
+    t1737 = (-t1708 + t1604)/casadi.if_else(t1736, 2*t1734, 1)
     t1738 = casadi.fabs(t1737)
     t1739 = (t1738 >= 1)
-    t1740 = casadi.fabs(1/casadi.if_else(t1739, t1737, 1))
+    t1740 = 1/casadi.fabs(casadi.if_else(t1739, t1737, 1))
     t1741 = casadi.if_else(t1736, casadi.if_else((t1737 >= 0), 1, -1)*casadi.if_else(t1739, t1740/(1 + casadi.sqrt(1 + t1740**2)), 1/(t1738 + casadi.sqrt(1 + t1738**2))), 0)
     t1742 = 1/casadi.sqrt(1 + t1741**2)
     t1743 = t1734*t1741
@@ -4623,10 +4623,10 @@ def _condition_number(q):
     t1769 = t1767 + t1741*t1766
     t1770 = t1643*t1748 + t1647*t1752 + t1651*t1756 + t1655*t1760 + t1659*t1764 + t1663*t1768
     t1771 = (t1770 != 0)
-    t1772 = 0.5*(-t1744 + t1639)/casadi.if_else(t1771, t1770, 1)
+    t1772 = (-t1744 + t1639)/casadi.if_else(t1771, 2*t1770, 1)
     t1773 = casadi.fabs(t1772)
     t1774 = (t1773 >= 1)
-    t1775 = casadi.fabs(1/casadi.if_else(t1774, t1772, 1))
+    t1775 = 1/casadi.fabs(casadi.if_else(t1774, t1772, 1))
     t1776 = casadi.if_else(t1771, casadi.if_else((t1772 >= 0), 1, -1)*casadi.if_else(t1774, t1775/(1 + casadi.sqrt(1 + t1775**2)), 1/(t1773 + casadi.sqrt(1 + t1773**2))), 0)
     t1777 = 1/casadi.sqrt(1 + t1776**2)
     t1778 = t1770*t1776
@@ -4658,10 +4658,10 @@ def _condition_number(q):
     t1804 = t1802 + t1776*t1801
     t1805 = t1644*t1783 + t1648*t1787 + t1652*t1791 + t1656*t1795 + t1660*t1799 + t1664*t1803
     t1806 = (t1805 != 0)
-    t1807 = 0.5*(-t1779 + t1640)/casadi.if_else(t1806, t1805, 1)
+    t1807 = (-t1779 + t1640)/casadi.if_else(t1806, 2*t1805, 1)
     t1808 = casadi.fabs(t1807)
     t1809 = (t1808 >= 1)
-    t1810 = casadi.fabs(1/casadi.if_else(t1809, t1807, 1))
+    t1810 = 1/casadi.fabs(casadi.if_else(t1809, t1807, 1))
     t1811 = casadi.if_else(t1806, casadi.if_else((t1807 >= 0), 1, -1)*casadi.if_else(t1809, t1810/(1 + casadi.sqrt(1 + t1810**2)), 1/(t1808 + casadi.sqrt(1 + t1808**2))), 0)
     t1812 = 1/casadi.sqrt(1 + t1811**2)
     t1813 = t1805*t1811
@@ -4692,10 +4692,10 @@ def _condition_number(q):
     t1838 = t1836 - t1811*t1837
     t1839 = t1837 + t1811*t1836
     t1840 = (t1735 != 0)
-    t1841 = 0.5*(-t1674 + t1709)/casadi.if_else(t1840, t1735, 1)
+    t1841 = (-t1674 + t1709)/casadi.if_else(t1840, 2*t1735, 1)
     t1842 = casadi.fabs(t1841)
     t1843 = (t1842 >= 1)
-    t1844 = casadi.fabs(1/casadi.if_else(t1843, t1841, 1))
+    t1844 = 1/casadi.fabs(casadi.if_else(t1843, t1841, 1))
     t1845 = casadi.if_else(t1840, casadi.if_else((t1841 >= 0), 1, -1)*casadi.if_else(t1843, t1844/(1 + casadi.sqrt(1 + t1844**2)), 1/(t1842 + casadi.sqrt(1 + t1842**2))), 0)
     t1846 = 1/casadi.sqrt(1 + t1845**2)
     t1847 = t1735*t1845
@@ -4727,10 +4727,10 @@ def _condition_number(q):
     t1873 = t1871 + t1845*t1870
     t1874 = t1749*t1852 + t1753*t1856 + t1757*t1860 + t1761*t1864 + t1765*t1868 + t1769*t1872
     t1875 = (t1874 != 0)
-    t1876 = 0.5*(-t1848 + t1745)/casadi.if_else(t1875, t1874, 1)
+    t1876 = (-t1848 + t1745)/casadi.if_else(t1875, 2*t1874, 1)
     t1877 = casadi.fabs(t1876)
     t1878 = (t1877 >= 1)
-    t1879 = casadi.fabs(1/casadi.if_else(t1878, t1876, 1))
+    t1879 = 1/casadi.fabs(casadi.if_else(t1878, t1876, 1))
     t1880 = casadi.if_else(t1875, casadi.if_else((t1876 >= 0), 1, -1)*casadi.if_else(t1878, t1879/(1 + casadi.sqrt(1 + t1879**2)), 1/(t1877 + casadi.sqrt(1 + t1877**2))), 0)
     t1881 = 1/casadi.sqrt(1 + t1880**2)
     t1882 = t1874*t1880
@@ -4763,10 +4763,10 @@ def _condition_number(q):
     t1909 = t1784*t1887 + t1788*t1891 + t1792*t1895 + t1796*t1899 + t1800*t1903 + t1804*t1907
     t1910 = t1853*t1888 + t1857*t1892 + t1861*t1896 + t1865*t1900 + t1869*t1904 + t1873*t1908
     t1911 = (t1909 != 0)
-    t1912 = 0.5*(-t1883 + t1780)/casadi.if_else(t1911, t1909, 1)
+    t1912 = (-t1883 + t1780)/casadi.if_else(t1911, 2*t1909, 1)
     t1913 = casadi.fabs(t1912)
     t1914 = (t1913 >= 1)
-    t1915 = casadi.fabs(1/casadi.if_else(t1914, t1912, 1))
+    t1915 = 1/casadi.fabs(casadi.if_else(t1914, t1912, 1))
     t1916 = casadi.if_else(t1911, casadi.if_else((t1912 >= 0), 1, -1)*casadi.if_else(t1914, t1915/(1 + casadi.sqrt(1 + t1915**2)), 1/(t1913 + casadi.sqrt(1 + t1913**2))), 0)
     t1917 = 1/casadi.sqrt(1 + t1916**2)
     t1918 = t1909*t1916
@@ -4798,10 +4798,10 @@ def _condition_number(q):
     t1944 = t1942 + t1916*t1941
     t1945 = t1819*t1923 + t1823*t1927 + t1827*t1931 + t1831*t1935 + t1835*t1939 + t1839*t1943
     t1946 = (t1945 != 0)
-    t1947 = 0.5*(-t1919 + t1815)/casadi.if_else(t1946, t1945, 1)
+    t1947 = (-t1919 + t1815)/casadi.if_else(t1946, 2*t1945, 1)
     t1948 = casadi.fabs(t1947)
     t1949 = (t1948 >= 1)
-    t1950 = casadi.fabs(1/casadi.if_else(t1949, t1947, 1))
+    t1950 = 1/casadi.fabs(casadi.if_else(t1949, t1947, 1))
     t1951 = casadi.if_else(t1946, casadi.if_else((t1947 >= 0), 1, -1)*casadi.if_else(t1949, t1950/(1 + casadi.sqrt(1 + t1950**2)), 1/(t1948 + casadi.sqrt(1 + t1948**2))), 0)
     t1952 = 1/casadi.sqrt(1 + t1951**2)
     t1953 = t1945*t1951
@@ -4833,10 +4833,10 @@ def _condition_number(q):
     t1979 = t1977 + t1951*t1976
     t1980 = t1818*t1958 + t1822*t1962 + t1826*t1966 + t1830*t1970 + t1834*t1974 + t1838*t1978
     t1981 = (t1910 != 0)
-    t1982 = 0.5*(-t1849 + t1884)/casadi.if_else(t1981, t1910, 1)
+    t1982 = (-t1849 + t1884)/casadi.if_else(t1981, 2*t1910, 1)
     t1983 = casadi.fabs(t1982)
     t1984 = (t1983 >= 1)
-    t1985 = casadi.fabs(1/casadi.if_else(t1984, t1982, 1))
+    t1985 = 1/casadi.fabs(casadi.if_else(t1984, t1982, 1))
     t1986 = casadi.if_else(t1981, casadi.if_else((t1982 >= 0), 1, -1)*casadi.if_else(t1984, t1985/(1 + casadi.sqrt(1 + t1985**2)), 1/(t1983 + casadi.sqrt(1 + t1983**2))), 0)
     t1987 = 1/casadi.sqrt(1 + t1986**2)
     t1988 = t1910*t1986
@@ -4868,10 +4868,10 @@ def _condition_number(q):
     t2014 = t2012 + t1986*t2011
     t2015 = t1924*t1993 + t1928*t1997 + t1932*t2001 + t1936*t2005 + t1940*t2009 + t1944*t2013
     t2016 = (t2015 != 0)
-    t2017 = 0.5*(-t1989 + t1920)/casadi.if_else(t2016, t2015, 1)
+    t2017 = (-t1989 + t1920)/casadi.if_else(t2016, 2*t2015, 1)
     t2018 = casadi.fabs(t2017)
     t2019 = (t2018 >= 1)
-    t2020 = casadi.fabs(1/casadi.if_else(t2019, t2017, 1))
+    t2020 = 1/casadi.fabs(casadi.if_else(t2019, t2017, 1))
     t2021 = casadi.if_else(t2016, casadi.if_else((t2017 >= 0), 1, -1)*casadi.if_else(t2019, t2020/(1 + casadi.sqrt(1 + t2020**2)), 1/(t2018 + casadi.sqrt(1 + t2018**2))), 0)
     t2022 = 1/casadi.sqrt(1 + t2021**2)
     t2023 = t2015*t2021
@@ -4904,10 +4904,10 @@ def _condition_number(q):
     t2050 = t1959*t2028 + t1963*t2032 + t1967*t2036 + t1971*t2040 + t1975*t2044 + t1979*t2048
     t2051 = t1994*t2029 + t1998*t2033 + t2002*t2037 + t2006*t2041 + t2010*t2045 + t2014*t2049
     t2052 = (t2050 != 0)
-    t2053 = 0.5*(-t2024 + t1955)/casadi.if_else(t2052, t2050, 1)
+    t2053 = (-t2024 + t1955)/casadi.if_else(t2052, 2*t2050, 1)
     t2054 = casadi.fabs(t2053)
     t2055 = (t2054 >= 1)
-    t2056 = casadi.fabs(1/casadi.if_else(t2055, t2053, 1))
+    t2056 = 1/casadi.fabs(casadi.if_else(t2055, t2053, 1))
     t2057 = casadi.if_else(t2052, casadi.if_else((t2053 >= 0), 1, -1)*casadi.if_else(t2055, t2056/(1 + casadi.sqrt(1 + t2056**2)), 1/(t2054 + casadi.sqrt(1 + t2054**2))), 0)
     t2058 = 1/casadi.sqrt(1 + t2057**2)
     t2059 = t2050*t2057
@@ -4938,10 +4938,10 @@ def _condition_number(q):
     t2084 = t2082 - t2057*t2083
     t2085 = t2083 + t2057*t2082
     t2086 = (t2051 != 0)
-    t2087 = 0.5*(-t1990 + t2025)/casadi.if_else(t2086, t2051, 1)
+    t2087 = (-t1990 + t2025)/casadi.if_else(t2086, 2*t2051, 1)
     t2088 = casadi.fabs(t2087)
     t2089 = (t2088 >= 1)
-    t2090 = casadi.fabs(1/casadi.if_else(t2089, t2087, 1))
+    t2090 = 1/casadi.fabs(casadi.if_else(t2089, t2087, 1))
     t2091 = casadi.if_else(t2086, casadi.if_else((t2087 >= 0), 1, -1)*casadi.if_else(t2089, t2090/(1 + casadi.sqrt(1 + t2090**2)), 1/(t2088 + casadi.sqrt(1 + t2088**2))), 0)
     t2092 = 1/casadi.sqrt(1 + t2091**2)
     t2093 = t2051*t2091
@@ -4973,10 +4973,10 @@ def _condition_number(q):
     t2119 = t2117 + t2091*t2116
     t2120 = t2065*t2098 + t2069*t2102 + t2073*t2106 + t2077*t2110 + t2081*t2114 + t2085*t2118
     t2121 = (t2120 != 0)
-    t2122 = 0.5*(-t2094 + t2061)/casadi.if_else(t2121, t2120, 1)
+    t2122 = (-t2094 + t2061)/casadi.if_else(t2121, 2*t2120, 1)
     t2123 = casadi.fabs(t2122)
     t2124 = (t2123 >= 1)
-    t2125 = casadi.fabs(1/casadi.if_else(t2124, t2122, 1))
+    t2125 = 1/casadi.fabs(casadi.if_else(t2124, t2122, 1))
     t2126 = casadi.if_else(t2121, casadi.if_else((t2122 >= 0), 1, -1)*casadi.if_else(t2124, t2125/(1 + casadi.sqrt(1 + t2125**2)), 1/(t2123 + casadi.sqrt(1 + t2123**2))), 0)
     t2127 = 1/casadi.sqrt(1 + t2126**2)
     t2128 = t2120*t2126
@@ -5008,10 +5008,10 @@ def _condition_number(q):
     t2154 = t2152 + t2126*t2151
     t2155 = t2099*t2134 + t2103*t2138 + t2107*t2142 + t2111*t2146 + t2115*t2150 + t2119*t2154
     t2156 = (t2155 != 0)
-    t2157 = 0.5*(-t2095 + t2130)/casadi.if_else(t2156, t2155, 1)
+    t2157 = (-t2095 + t2130)/casadi.if_else(t2156, 2*t2155, 1)
     t2158 = casadi.fabs(t2157)
     t2159 = (t2158 >= 1)
-    t2160 = casadi.fabs(1/casadi.if_else(t2159, t2157, 1))
+    t2160 = 1/casadi.fabs(casadi.if_else(t2159, t2157, 1))
     t2161 = casadi.if_else(t2156, casadi.if_else((t2157 >= 0), 1, -1)*casadi.if_else(t2159, t2160/(1 + casadi.sqrt(1 + t2160**2)), 1/(t2158 + casadi.sqrt(1 + t2158**2))), 0)
     t2162 = 1/casadi.sqrt(1 + t2161**2)
     t2163 = t2155*t2161
@@ -5042,10 +5042,10 @@ def _condition_number(q):
     t2188 = t2186 - t2161*t2187
     t2189 = t2187 + t2161*t2186
     t2190 = (t1980 != 0)
-    t2191 = 0.5*(-t1814 + t1954)/casadi.if_else(t2190, t1980, 1)
+    t2191 = (-t1814 + t1954)/casadi.if_else(t2190, 2*t1980, 1)
     t2192 = casadi.fabs(t2191)
     t2193 = (t2192 >= 1)
-    t2194 = casadi.fabs(1/casadi.if_else(t2193, t2191, 1))
+    t2194 = 1/casadi.fabs(casadi.if_else(t2193, t2191, 1))
     t2195 = casadi.if_else(t2190, casadi.if_else((t2191 >= 0), 1, -1)*casadi.if_else(t2193, t2194/(1 + casadi.sqrt(1 + t2194**2)), 1/(t2192 + casadi.sqrt(1 + t2192**2))), 0)
     t2196 = 1/casadi.sqrt(1 + t2195**2)
     t2197 = t1980*t2195
@@ -5077,10 +5077,10 @@ def _condition_number(q):
     t2223 = t2221 + t2195*t2220
     t2224 = t2064*t2202 + t2068*t2206 + t2072*t2210 + t2076*t2214 + t2080*t2218 + t2084*t2222
     t2225 = (t2224 != 0)
-    t2226 = 0.5*(-t2198 + t2060)/casadi.if_else(t2225, t2224, 1)
+    t2226 = (-t2198 + t2060)/casadi.if_else(t2225, 2*t2224, 1)
     t2227 = casadi.fabs(t2226)
     t2228 = (t2227 >= 1)
-    t2229 = casadi.fabs(1/casadi.if_else(t2228, t2226, 1))
+    t2229 = 1/casadi.fabs(casadi.if_else(t2228, t2226, 1))
     t2230 = casadi.if_else(t2225, casadi.if_else((t2226 >= 0), 1, -1)*casadi.if_else(t2228, t2229/(1 + casadi.sqrt(1 + t2229**2)), 1/(t2227 + casadi.sqrt(1 + t2227**2))), 0)
     t2231 = 1/casadi.sqrt(1 + t2230**2)
     t2232 = t2224*t2230
@@ -5113,10 +5113,10 @@ def _condition_number(q):
     t2259 = t2133*t2237 + t2137*t2241 + t2141*t2245 + t2145*t2249 + t2149*t2253 + t2153*t2257
     t2260 = t2203*t2238 + t2207*t2242 + t2211*t2246 + t2215*t2250 + t2219*t2254 + t2223*t2258
     t2261 = (t2259 != 0)
-    t2262 = 0.5*(-t2233 + t2129)/casadi.if_else(t2261, t2259, 1)
+    t2262 = (-t2233 + t2129)/casadi.if_else(t2261, 2*t2259, 1)
     t2263 = casadi.fabs(t2262)
     t2264 = (t2263 >= 1)
-    t2265 = casadi.fabs(1/casadi.if_else(t2264, t2262, 1))
+    t2265 = 1/casadi.fabs(casadi.if_else(t2264, t2262, 1))
     t2266 = casadi.if_else(t2261, casadi.if_else((t2262 >= 0), 1, -1)*casadi.if_else(t2264, t2265/(1 + casadi.sqrt(1 + t2265**2)), 1/(t2263 + casadi.sqrt(1 + t2263**2))), 0)
     t2267 = 1/casadi.sqrt(1 + t2266**2)
     t2268 = t2259*t2266
@@ -5148,10 +5148,10 @@ def _condition_number(q):
     t2294 = t2292 + t2266*t2291
     t2295 = t2168*t2273 + t2172*t2277 + t2176*t2281 + t2180*t2285 + t2184*t2289 + t2188*t2293
     t2296 = (t2295 != 0)
-    t2297 = 0.5*(-t2269 + t2164)/casadi.if_else(t2296, t2295, 1)
+    t2297 = (-t2269 + t2164)/casadi.if_else(t2296, 2*t2295, 1)
     t2298 = casadi.fabs(t2297)
     t2299 = (t2298 >= 1)
-    t2300 = casadi.fabs(1/casadi.if_else(t2299, t2297, 1))
+    t2300 = 1/casadi.fabs(casadi.if_else(t2299, t2297, 1))
     t2301 = casadi.if_else(t2296, casadi.if_else((t2297 >= 0), 1, -1)*casadi.if_else(t2299, t2300/(1 + casadi.sqrt(1 + t2300**2)), 1/(t2298 + casadi.sqrt(1 + t2298**2))), 0)
     t2302 = 1/casadi.sqrt(1 + t2301**2)
     t2303 = t2295*t2301
@@ -5183,10 +5183,10 @@ def _condition_number(q):
     t2329 = t2327 + t2301*t2326
     t2330 = t2169*t2308 + t2173*t2312 + t2177*t2316 + t2181*t2320 + t2185*t2324 + t2189*t2328
     t2331 = (t2330 != 0)
-    t2332 = 0.5*(-t2304 + t2165)/casadi.if_else(t2331, t2330, 1)
+    t2332 = (-t2304 + t2165)/casadi.if_else(t2331, 2*t2330, 1)
     t2333 = casadi.fabs(t2332)
     t2334 = (t2333 >= 1)
-    t2335 = casadi.fabs(1/casadi.if_else(t2334, t2332, 1))
+    t2335 = 1/casadi.fabs(casadi.if_else(t2334, t2332, 1))
     t2336 = casadi.if_else(t2331, casadi.if_else((t2332 >= 0), 1, -1)*casadi.if_else(t2334, t2335/(1 + casadi.sqrt(1 + t2335**2)), 1/(t2333 + casadi.sqrt(1 + t2333**2))), 0)
     t2337 = 1/casadi.sqrt(1 + t2336**2)
     t2338 = t2330*t2336
@@ -5217,10 +5217,10 @@ def _condition_number(q):
     t2363 = t2361 - t2336*t2362
     t2364 = t2362 + t2336*t2361
     t2365 = (t2260 != 0)
-    t2366 = 0.5*(-t2199 + t2234)/casadi.if_else(t2365, t2260, 1)
+    t2366 = (-t2199 + t2234)/casadi.if_else(t2365, 2*t2260, 1)
     t2367 = casadi.fabs(t2366)
     t2368 = (t2367 >= 1)
-    t2369 = casadi.fabs(1/casadi.if_else(t2368, t2366, 1))
+    t2369 = 1/casadi.fabs(casadi.if_else(t2368, t2366, 1))
     t2370 = casadi.if_else(t2365, casadi.if_else((t2366 >= 0), 1, -1)*casadi.if_else(t2368, t2369/(1 + casadi.sqrt(1 + t2369**2)), 1/(t2367 + casadi.sqrt(1 + t2367**2))), 0)
     t2371 = 1/casadi.sqrt(1 + t2370**2)
     t2372 = t2260*t2370
@@ -5252,10 +5252,10 @@ def _condition_number(q):
     t2398 = t2396 + t2370*t2395
     t2399 = t2274*t2377 + t2278*t2381 + t2282*t2385 + t2286*t2389 + t2290*t2393 + t2294*t2397
     t2400 = (t2399 != 0)
-    t2401 = 0.5*(-t2373 + t2270)/casadi.if_else(t2400, t2399, 1)
+    t2401 = (-t2373 + t2270)/casadi.if_else(t2400, 2*t2399, 1)
     t2402 = casadi.fabs(t2401)
     t2403 = (t2402 >= 1)
-    t2404 = casadi.fabs(1/casadi.if_else(t2403, t2401, 1))
+    t2404 = 1/casadi.fabs(casadi.if_else(t2403, t2401, 1))
     t2405 = casadi.if_else(t2400, casadi.if_else((t2401 >= 0), 1, -1)*casadi.if_else(t2403, t2404/(1 + casadi.sqrt(1 + t2404**2)), 1/(t2402 + casadi.sqrt(1 + t2402**2))), 0)
     t2406 = 1/casadi.sqrt(1 + t2405**2)
     t2407 = t2399*t2405
@@ -5288,10 +5288,10 @@ def _condition_number(q):
     t2434 = t2309*t2412 + t2313*t2416 + t2317*t2420 + t2321*t2424 + t2325*t2428 + t2329*t2432
     t2435 = t2378*t2413 + t2382*t2417 + t2386*t2421 + t2390*t2425 + t2394*t2429 + t2398*t2433
     t2436 = (t2434 != 0)
-    t2437 = 0.5*(-t2408 + t2305)/casadi.if_else(t2436, t2434, 1)
+    t2437 = (-t2408 + t2305)/casadi.if_else(t2436, 2*t2434, 1)
     t2438 = casadi.fabs(t2437)
     t2439 = (t2438 >= 1)
-    t2440 = casadi.fabs(1/casadi.if_else(t2439, t2437, 1))
+    t2440 = 1/casadi.fabs(casadi.if_else(t2439, t2437, 1))
     t2441 = casadi.if_else(t2436, casadi.if_else((t2437 >= 0), 1, -1)*casadi.if_else(t2439, t2440/(1 + casadi.sqrt(1 + t2440**2)), 1/(t2438 + casadi.sqrt(1 + t2438**2))), 0)
     t2442 = 1/casadi.sqrt(1 + t2441**2)
     t2443 = t2434*t2441
@@ -5323,10 +5323,10 @@ def _condition_number(q):
     t2469 = t2467 + t2441*t2466
     t2470 = t2344*t2448 + t2348*t2452 + t2352*t2456 + t2356*t2460 + t2360*t2464 + t2364*t2468
     t2471 = (t2470 != 0)
-    t2472 = 0.5*(-t2444 + t2340)/casadi.if_else(t2471, t2470, 1)
+    t2472 = (-t2444 + t2340)/casadi.if_else(t2471, 2*t2470, 1)
     t2473 = casadi.fabs(t2472)
     t2474 = (t2473 >= 1)
-    t2475 = casadi.fabs(1/casadi.if_else(t2474, t2472, 1))
+    t2475 = 1/casadi.fabs(casadi.if_else(t2474, t2472, 1))
     t2476 = casadi.if_else(t2471, casadi.if_else((t2472 >= 0), 1, -1)*casadi.if_else(t2474, t2475/(1 + casadi.sqrt(1 + t2475**2)), 1/(t2473 + casadi.sqrt(1 + t2473**2))), 0)
     t2477 = 1/casadi.sqrt(1 + t2476**2)
     t2478 = t2470*t2476
@@ -5358,10 +5358,10 @@ def _condition_number(q):
     t2504 = t2502 + t2476*t2501
     t2505 = t2343*t2483 + t2347*t2487 + t2351*t2491 + t2355*t2495 + t2359*t2499 + t2363*t2503
     t2506 = (t2435 != 0)
-    t2507 = 0.5*(-t2374 + t2409)/casadi.if_else(t2506, t2435, 1)
+    t2507 = (-t2374 + t2409)/casadi.if_else(t2506, 2*t2435, 1)
     t2508 = casadi.fabs(t2507)
     t2509 = (t2508 >= 1)
-    t2510 = casadi.fabs(1/casadi.if_else(t2509, t2507, 1))
+    t2510 = 1/casadi.fabs(casadi.if_else(t2509, t2507, 1))
     t2511 = casadi.if_else(t2506, casadi.if_else((t2507 >= 0), 1, -1)*casadi.if_else(t2509, t2510/(1 + casadi.sqrt(1 + t2510**2)), 1/(t2508 + casadi.sqrt(1 + t2508**2))), 0)
     t2512 = 1/casadi.sqrt(1 + t2511**2)
     t2513 = t2435*t2511
@@ -5393,10 +5393,10 @@ def _condition_number(q):
     t2539 = t2537 + t2511*t2536
     t2540 = t2449*t2518 + t2453*t2522 + t2457*t2526 + t2461*t2530 + t2465*t2534 + t2469*t2538
     t2541 = (t2540 != 0)
-    t2542 = 0.5*(-t2514 + t2445)/casadi.if_else(t2541, t2540, 1)
+    t2542 = (-t2514 + t2445)/casadi.if_else(t2541, 2*t2540, 1)
     t2543 = casadi.fabs(t2542)
     t2544 = (t2543 >= 1)
-    t2545 = casadi.fabs(1/casadi.if_else(t2544, t2542, 1))
+    t2545 = 1/casadi.fabs(casadi.if_else(t2544, t2542, 1))
     t2546 = casadi.if_else(t2541, casadi.if_else((t2542 >= 0), 1, -1)*casadi.if_else(t2544, t2545/(1 + casadi.sqrt(1 + t2545**2)), 1/(t2543 + casadi.sqrt(1 + t2543**2))), 0)
     t2547 = 1/casadi.sqrt(1 + t2546**2)
     t2548 = t2540*t2546
@@ -5429,10 +5429,10 @@ def _condition_number(q):
     t2575 = t2484*t2553 + t2488*t2557 + t2492*t2561 + t2496*t2565 + t2500*t2569 + t2504*t2573
     t2576 = t2519*t2554 + t2523*t2558 + t2527*t2562 + t2531*t2566 + t2535*t2570 + t2539*t2574
     t2577 = (t2575 != 0)
-    t2578 = 0.5*(-t2549 + t2480)/casadi.if_else(t2577, t2575, 1)
+    t2578 = (-t2549 + t2480)/casadi.if_else(t2577, 2*t2575, 1)
     t2579 = casadi.fabs(t2578)
     t2580 = (t2579 >= 1)
-    t2581 = casadi.fabs(1/casadi.if_else(t2580, t2578, 1))
+    t2581 = 1/casadi.fabs(casadi.if_else(t2580, t2578, 1))
     t2582 = casadi.if_else(t2577, casadi.if_else((t2578 >= 0), 1, -1)*casadi.if_else(t2580, t2581/(1 + casadi.sqrt(1 + t2581**2)), 1/(t2579 + casadi.sqrt(1 + t2579**2))), 0)
     t2583 = 1/casadi.sqrt(1 + t2582**2)
     t2584 = t2575*t2582
@@ -5463,10 +5463,10 @@ def _condition_number(q):
     t2609 = t2607 - t2582*t2608
     t2610 = t2608 + t2582*t2607
     t2611 = (t2576 != 0)
-    t2612 = 0.5*(-t2515 + t2550)/casadi.if_else(t2611, t2576, 1)
+    t2612 = (-t2515 + t2550)/casadi.if_else(t2611, 2*t2576, 1)
     t2613 = casadi.fabs(t2612)
     t2614 = (t2613 >= 1)
-    t2615 = casadi.fabs(1/casadi.if_else(t2614, t2612, 1))
+    t2615 = 1/casadi.fabs(casadi.if_else(t2614, t2612, 1))
     t2616 = casadi.if_else(t2611, casadi.if_else((t2612 >= 0), 1, -1)*casadi.if_else(t2614, t2615/(1 + casadi.sqrt(1 + t2615**2)), 1/(t2613 + casadi.sqrt(1 + t2613**2))), 0)
     t2617 = 1/casadi.sqrt(1 + t2616**2)
     t2618 = t2576*t2616
@@ -5498,10 +5498,10 @@ def _condition_number(q):
     t2644 = t2642 + t2616*t2641
     t2645 = t2590*t2623 + t2594*t2627 + t2598*t2631 + t2602*t2635 + t2606*t2639 + t2610*t2643
     t2646 = (t2645 != 0)
-    t2647 = 0.5*(-t2619 + t2586)/casadi.if_else(t2646, t2645, 1)
+    t2647 = (-t2619 + t2586)/casadi.if_else(t2646, 2*t2645, 1)
     t2648 = casadi.fabs(t2647)
     t2649 = (t2648 >= 1)
-    t2650 = casadi.fabs(1/casadi.if_else(t2649, t2647, 1))
+    t2650 = 1/casadi.fabs(casadi.if_else(t2649, t2647, 1))
     t2651 = casadi.if_else(t2646, casadi.if_else((t2647 >= 0), 1, -1)*casadi.if_else(t2649, t2650/(1 + casadi.sqrt(1 + t2650**2)), 1/(t2648 + casadi.sqrt(1 + t2648**2))), 0)
     t2652 = 1/casadi.sqrt(1 + t2651**2)
     t2653 = t2645*t2651
@@ -5533,10 +5533,10 @@ def _condition_number(q):
     t2679 = t2677 + t2651*t2676
     t2680 = t2624*t2659 + t2628*t2663 + t2632*t2667 + t2636*t2671 + t2640*t2675 + t2644*t2679
     t2681 = (t2680 != 0)
-    t2682 = 0.5*(-t2620 + t2655)/casadi.if_else(t2681, t2680, 1)
+    t2682 = (-t2620 + t2655)/casadi.if_else(t2681, 2*t2680, 1)
     t2683 = casadi.fabs(t2682)
     t2684 = (t2683 >= 1)
-    t2685 = casadi.fabs(1/casadi.if_else(t2684, t2682, 1))
+    t2685 = 1/casadi.fabs(casadi.if_else(t2684, t2682, 1))
     t2686 = casadi.if_else(t2681, casadi.if_else((t2682 >= 0), 1, -1)*casadi.if_else(t2684, t2685/(1 + casadi.sqrt(1 + t2685**2)), 1/(t2683 + casadi.sqrt(1 + t2683**2))), 0)
     t2687 = 1/casadi.sqrt(1 + t2686**2)
     t2688 = t2680*t2686
@@ -5567,10 +5567,10 @@ def _condition_number(q):
     t2713 = t2711 - t2686*t2712
     t2714 = t2712 + t2686*t2711
     t2715 = (t2505 != 0)
-    t2716 = 0.5*(-t2339 + t2479)/casadi.if_else(t2715, t2505, 1)
+    t2716 = (-t2339 + t2479)/casadi.if_else(t2715, 2*t2505, 1)
     t2717 = casadi.fabs(t2716)
     t2718 = (t2717 >= 1)
-    t2719 = casadi.fabs(1/casadi.if_else(t2718, t2716, 1))
+    t2719 = 1/casadi.fabs(casadi.if_else(t2718, t2716, 1))
     t2720 = casadi.if_else(t2715, casadi.if_else((t2716 >= 0), 1, -1)*casadi.if_else(t2718, t2719/(1 + casadi.sqrt(1 + t2719**2)), 1/(t2717 + casadi.sqrt(1 + t2717**2))), 0)
     t2721 = 1/casadi.sqrt(1 + t2720**2)
     t2722 = t2505*t2720
@@ -5602,10 +5602,10 @@ def _condition_number(q):
     t2748 = t2746 + t2720*t2745
     t2749 = t2589*t2727 + t2593*t2731 + t2597*t2735 + t2601*t2739 + t2605*t2743 + t2609*t2747
     t2750 = (t2749 != 0)
-    t2751 = 0.5*(-t2723 + t2585)/casadi.if_else(t2750, t2749, 1)
+    t2751 = (-t2723 + t2585)/casadi.if_else(t2750, 2*t2749, 1)
     t2752 = casadi.fabs(t2751)
     t2753 = (t2752 >= 1)
-    t2754 = casadi.fabs(1/casadi.if_else(t2753, t2751, 1))
+    t2754 = 1/casadi.fabs(casadi.if_else(t2753, t2751, 1))
     t2755 = casadi.if_else(t2750, casadi.if_else((t2751 >= 0), 1, -1)*casadi.if_else(t2753, t2754/(1 + casadi.sqrt(1 + t2754**2)), 1/(t2752 + casadi.sqrt(1 + t2752**2))), 0)
     t2756 = 1/casadi.sqrt(1 + t2755**2)
     t2757 = t2749*t2755
@@ -5638,10 +5638,10 @@ def _condition_number(q):
     t2784 = t2658*t2762 + t2662*t2766 + t2666*t2770 + t2670*t2774 + t2674*t2778 + t2678*t2782
     t2785 = t2728*t2763 + t2732*t2767 + t2736*t2771 + t2740*t2775 + t2744*t2779 + t2748*t2783
     t2786 = (t2784 != 0)
-    t2787 = 0.5*(-t2758 + t2654)/casadi.if_else(t2786, t2784, 1)
+    t2787 = (-t2758 + t2654)/casadi.if_else(t2786, 2*t2784, 1)
     t2788 = casadi.fabs(t2787)
     t2789 = (t2788 >= 1)
-    t2790 = casadi.fabs(1/casadi.if_else(t2789, t2787, 1))
+    t2790 = 1/casadi.fabs(casadi.if_else(t2789, t2787, 1))
     t2791 = casadi.if_else(t2786, casadi.if_else((t2787 >= 0), 1, -1)*casadi.if_else(t2789, t2790/(1 + casadi.sqrt(1 + t2790**2)), 1/(t2788 + casadi.sqrt(1 + t2788**2))), 0)
     t2792 = 1/casadi.sqrt(1 + t2791**2)
     t2793 = t2784*t2791
@@ -5673,10 +5673,10 @@ def _condition_number(q):
     t2819 = t2817 + t2791*t2816
     t2820 = t2693*t2798 + t2697*t2802 + t2701*t2806 + t2705*t2810 + t2709*t2814 + t2713*t2818
     t2821 = (t2820 != 0)
-    t2822 = 0.5*(-t2794 + t2689)/casadi.if_else(t2821, t2820, 1)
+    t2822 = (-t2794 + t2689)/casadi.if_else(t2821, 2*t2820, 1)
     t2823 = casadi.fabs(t2822)
     t2824 = (t2823 >= 1)
-    t2825 = casadi.fabs(1/casadi.if_else(t2824, t2822, 1))
+    t2825 = 1/casadi.fabs(casadi.if_else(t2824, t2822, 1))
     t2826 = casadi.if_else(t2821, casadi.if_else((t2822 >= 0), 1, -1)*casadi.if_else(t2824, t2825/(1 + casadi.sqrt(1 + t2825**2)), 1/(t2823 + casadi.sqrt(1 + t2823**2))), 0)
     t2827 = 1/casadi.sqrt(1 + t2826**2)
     t2828 = t2820*t2826
@@ -5708,10 +5708,10 @@ def _condition_number(q):
     t2854 = t2852 + t2826*t2851
     t2855 = t2694*t2833 + t2698*t2837 + t2702*t2841 + t2706*t2845 + t2710*t2849 + t2714*t2853
     t2856 = (t2855 != 0)
-    t2857 = 0.5*(-t2829 + t2690)/casadi.if_else(t2856, t2855, 1)
+    t2857 = (-t2829 + t2690)/casadi.if_else(t2856, 2*t2855, 1)
     t2858 = casadi.fabs(t2857)
     t2859 = (t2858 >= 1)
-    t2860 = casadi.fabs(1/casadi.if_else(t2859, t2857, 1))
+    t2860 = 1/casadi.fabs(casadi.if_else(t2859, t2857, 1))
     t2861 = casadi.if_else(t2856, casadi.if_else((t2857 >= 0), 1, -1)*casadi.if_else(t2859, t2860/(1 + casadi.sqrt(1 + t2860**2)), 1/(t2858 + casadi.sqrt(1 + t2858**2))), 0)
     t2862 = 1/casadi.sqrt(1 + t2861**2)
     t2863 = t2855*t2861
@@ -5742,10 +5742,10 @@ def _condition_number(q):
     t2888 = t2886 - t2861*t2887
     t2889 = t2887 + t2861*t2886
     t2890 = (t2785 != 0)
-    t2891 = 0.5*(-t2724 + t2759)/casadi.if_else(t2890, t2785, 1)
+    t2891 = (-t2724 + t2759)/casadi.if_else(t2890, 2*t2785, 1)
     t2892 = casadi.fabs(t2891)
     t2893 = (t2892 >= 1)
-    t2894 = casadi.fabs(1/casadi.if_else(t2893, t2891, 1))
+    t2894 = 1/casadi.fabs(casadi.if_else(t2893, t2891, 1))
     t2895 = casadi.if_else(t2890, casadi.if_else((t2891 >= 0), 1, -1)*casadi.if_else(t2893, t2894/(1 + casadi.sqrt(1 + t2894**2)), 1/(t2892 + casadi.sqrt(1 + t2892**2))), 0)
     t2896 = 1/casadi.sqrt(1 + t2895**2)
     t2897 = t2785*t2895
@@ -5777,10 +5777,10 @@ def _condition_number(q):
     t2923 = t2921 + t2895*t2920
     t2924 = t2799*t2902 + t2803*t2906 + t2807*t2910 + t2811*t2914 + t2815*t2918 + t2819*t2922
     t2925 = (t2924 != 0)
-    t2926 = 0.5*(-t2898 + t2795)/casadi.if_else(t2925, t2924, 1)
+    t2926 = (-t2898 + t2795)/casadi.if_else(t2925, 2*t2924, 1)
     t2927 = casadi.fabs(t2926)
     t2928 = (t2927 >= 1)
-    t2929 = casadi.fabs(1/casadi.if_else(t2928, t2926, 1))
+    t2929 = 1/casadi.fabs(casadi.if_else(t2928, t2926, 1))
     t2930 = casadi.if_else(t2925, casadi.if_else((t2926 >= 0), 1, -1)*casadi.if_else(t2928, t2929/(1 + casadi.sqrt(1 + t2929**2)), 1/(t2927 + casadi.sqrt(1 + t2927**2))), 0)
     t2931 = 1/casadi.sqrt(1 + t2930**2)
     t2932 = t2924*t2930
@@ -5813,10 +5813,10 @@ def _condition_number(q):
     t2959 = t2834*t2937 + t2838*t2941 + t2842*t2945 + t2846*t2949 + t2850*t2953 + t2854*t2957
     t2960 = t2903*t2938 + t2907*t2942 + t2911*t2946 + t2915*t2950 + t2919*t2954 + t2923*t2958
     t2961 = (t2959 != 0)
-    t2962 = 0.5*(-t2933 + t2830)/casadi.if_else(t2961, t2959, 1)
+    t2962 = (-t2933 + t2830)/casadi.if_else(t2961, 2*t2959, 1)
     t2963 = casadi.fabs(t2962)
     t2964 = (t2963 >= 1)
-    t2965 = casadi.fabs(1/casadi.if_else(t2964, t2962, 1))
+    t2965 = 1/casadi.fabs(casadi.if_else(t2964, t2962, 1))
     t2966 = casadi.if_else(t2961, casadi.if_else((t2962 >= 0), 1, -1)*casadi.if_else(t2964, t2965/(1 + casadi.sqrt(1 + t2965**2)), 1/(t2963 + casadi.sqrt(1 + t2963**2))), 0)
     t2967 = 1/casadi.sqrt(1 + t2966**2)
     t2968 = t2959*t2966
@@ -5848,10 +5848,10 @@ def _condition_number(q):
     t2994 = t2992 + t2966*t2991
     t2995 = t2869*t2973 + t2873*t2977 + t2877*t2981 + t2881*t2985 + t2885*t2989 + t2889*t2993
     t2996 = (t2995 != 0)
-    t2997 = 0.5*(-t2969 + t2865)/casadi.if_else(t2996, t2995, 1)
+    t2997 = (-t2969 + t2865)/casadi.if_else(t2996, 2*t2995, 1)
     t2998 = casadi.fabs(t2997)
     t2999 = (t2998 >= 1)
-    t3000 = casadi.fabs(1/casadi.if_else(t2999, t2997, 1))
+    t3000 = 1/casadi.fabs(casadi.if_else(t2999, t2997, 1))
     t3001 = casadi.if_else(t2996, casadi.if_else((t2997 >= 0), 1, -1)*casadi.if_else(t2999, t3000/(1 + casadi.sqrt(1 + t3000**2)), 1/(t2998 + casadi.sqrt(1 + t2998**2))), 0)
     t3002 = 1/casadi.sqrt(1 + t3001**2)
     t3003 = t2995*t3001
@@ -5883,10 +5883,10 @@ def _condition_number(q):
     t3029 = t3027 + t3001*t3026
     t3030 = t2868*t3008 + t2872*t3012 + t2876*t3016 + t2880*t3020 + t2884*t3024 + t2888*t3028
     t3031 = (t2960 != 0)
-    t3032 = 0.5*(-t2899 + t2934)/casadi.if_else(t3031, t2960, 1)
+    t3032 = (-t2899 + t2934)/casadi.if_else(t3031, 2*t2960, 1)
     t3033 = casadi.fabs(t3032)
     t3034 = (t3033 >= 1)
-    t3035 = casadi.fabs(1/casadi.if_else(t3034, t3032, 1))
+    t3035 = 1/casadi.fabs(casadi.if_else(t3034, t3032, 1))
     t3036 = casadi.if_else(t3031, casadi.if_else((t3032 >= 0), 1, -1)*casadi.if_else(t3034, t3035/(1 + casadi.sqrt(1 + t3035**2)), 1/(t3033 + casadi.sqrt(1 + t3033**2))), 0)
     t3037 = 1/casadi.sqrt(1 + t3036**2)
     t3038 = t2960*t3036
@@ -5918,10 +5918,10 @@ def _condition_number(q):
     t3064 = t3062 + t3036*t3061
     t3065 = t2974*t3043 + t2978*t3047 + t2982*t3051 + t2986*t3055 + t2990*t3059 + t2994*t3063
     t3066 = (t3065 != 0)
-    t3067 = 0.5*(-t3039 + t2970)/casadi.if_else(t3066, t3065, 1)
+    t3067 = (-t3039 + t2970)/casadi.if_else(t3066, 2*t3065, 1)
     t3068 = casadi.fabs(t3067)
     t3069 = (t3068 >= 1)
-    t3070 = casadi.fabs(1/casadi.if_else(t3069, t3067, 1))
+    t3070 = 1/casadi.fabs(casadi.if_else(t3069, t3067, 1))
     t3071 = casadi.if_else(t3066, casadi.if_else((t3067 >= 0), 1, -1)*casadi.if_else(t3069, t3070/(1 + casadi.sqrt(1 + t3070**2)), 1/(t3068 + casadi.sqrt(1 + t3068**2))), 0)
     t3072 = 1/casadi.sqrt(1 + t3071**2)
     t3073 = t3065*t3071
@@ -5954,10 +5954,10 @@ def _condition_number(q):
     t3100 = t3009*t3078 + t3013*t3082 + t3017*t3086 + t3021*t3090 + t3025*t3094 + t3029*t3098
     t3101 = t3044*t3079 + t3048*t3083 + t3052*t3087 + t3056*t3091 + t3060*t3095 + t3064*t3099
     t3102 = (t3100 != 0)
-    t3103 = 0.5*(-t3074 + t3005)/casadi.if_else(t3102, t3100, 1)
+    t3103 = (-t3074 + t3005)/casadi.if_else(t3102, 2*t3100, 1)
     t3104 = casadi.fabs(t3103)
     t3105 = (t3104 >= 1)
-    t3106 = casadi.fabs(1/casadi.if_else(t3105, t3103, 1))
+    t3106 = 1/casadi.fabs(casadi.if_else(t3105, t3103, 1))
     t3107 = casadi.if_else(t3102, casadi.if_else((t3103 >= 0), 1, -1)*casadi.if_else(t3105, t3106/(1 + casadi.sqrt(1 + t3106**2)), 1/(t3104 + casadi.sqrt(1 + t3104**2))), 0)
     t3108 = 1/casadi.sqrt(1 + t3107**2)
     t3109 = t3100*t3107
@@ -5988,10 +5988,10 @@ def _condition_number(q):
     t3134 = t3132 - t3107*t3133
     t3135 = t3133 + t3107*t3132
     t3136 = (t3101 != 0)
-    t3137 = 0.5*(-t3040 + t3075)/casadi.if_else(t3136, t3101, 1)
+    t3137 = (-t3040 + t3075)/casadi.if_else(t3136, 2*t3101, 1)
     t3138 = casadi.fabs(t3137)
     t3139 = (t3138 >= 1)
-    t3140 = casadi.fabs(1/casadi.if_else(t3139, t3137, 1))
+    t3140 = 1/casadi.fabs(casadi.if_else(t3139, t3137, 1))
     t3141 = casadi.if_else(t3136, casadi.if_else((t3137 >= 0), 1, -1)*casadi.if_else(t3139, t3140/(1 + casadi.sqrt(1 + t3140**2)), 1/(t3138 + casadi.sqrt(1 + t3138**2))), 0)
     t3142 = 1/casadi.sqrt(1 + t3141**2)
     t3143 = t3101*t3141
@@ -6023,10 +6023,10 @@ def _condition_number(q):
     t3169 = t3167 + t3141*t3166
     t3170 = t3115*t3148 + t3119*t3152 + t3123*t3156 + t3127*t3160 + t3131*t3164 + t3135*t3168
     t3171 = (t3170 != 0)
-    t3172 = 0.5*(-t3144 + t3111)/casadi.if_else(t3171, t3170, 1)
+    t3172 = (-t3144 + t3111)/casadi.if_else(t3171, 2*t3170, 1)
     t3173 = casadi.fabs(t3172)
     t3174 = (t3173 >= 1)
-    t3175 = casadi.fabs(1/casadi.if_else(t3174, t3172, 1))
+    t3175 = 1/casadi.fabs(casadi.if_else(t3174, t3172, 1))
     t3176 = casadi.if_else(t3171, casadi.if_else((t3172 >= 0), 1, -1)*casadi.if_else(t3174, t3175/(1 + casadi.sqrt(1 + t3175**2)), 1/(t3173 + casadi.sqrt(1 + t3173**2))), 0)
     t3177 = 1/casadi.sqrt(1 + t3176**2)
     t3178 = t3170*t3176
@@ -6058,10 +6058,10 @@ def _condition_number(q):
     t3204 = t3202 + t3176*t3201
     t3205 = t3149*t3184 + t3153*t3188 + t3157*t3192 + t3161*t3196 + t3165*t3200 + t3169*t3204
     t3206 = (t3205 != 0)
-    t3207 = 0.5*(-t3145 + t3180)/casadi.if_else(t3206, t3205, 1)
+    t3207 = (-t3145 + t3180)/casadi.if_else(t3206, 2*t3205, 1)
     t3208 = casadi.fabs(t3207)
     t3209 = (t3208 >= 1)
-    t3210 = casadi.fabs(1/casadi.if_else(t3209, t3207, 1))
+    t3210 = 1/casadi.fabs(casadi.if_else(t3209, t3207, 1))
     t3211 = casadi.if_else(t3206, casadi.if_else((t3207 >= 0), 1, -1)*casadi.if_else(t3209, t3210/(1 + casadi.sqrt(1 + t3210**2)), 1/(t3208 + casadi.sqrt(1 + t3208**2))), 0)
     t3212 = 1/casadi.sqrt(1 + t3211**2)
     t3213 = t3205*t3211
@@ -6092,10 +6092,10 @@ def _condition_number(q):
     t3238 = t3236 - t3211*t3237
     t3239 = t3237 + t3211*t3236
     t3240 = (t3030 != 0)
-    t3241 = 0.5*(-t2864 + t3004)/casadi.if_else(t3240, t3030, 1)
+    t3241 = (-t2864 + t3004)/casadi.if_else(t3240, 2*t3030, 1)
     t3242 = casadi.fabs(t3241)
     t3243 = (t3242 >= 1)
-    t3244 = casadi.fabs(1/casadi.if_else(t3243, t3241, 1))
+    t3244 = 1/casadi.fabs(casadi.if_else(t3243, t3241, 1))
     t3245 = casadi.if_else(t3240, casadi.if_else((t3241 >= 0), 1, -1)*casadi.if_else(t3243, t3244/(1 + casadi.sqrt(1 + t3244**2)), 1/(t3242 + casadi.sqrt(1 + t3242**2))), 0)
     t3246 = 1/casadi.sqrt(1 + t3245**2)
     t3247 = t3030*t3245
@@ -6127,10 +6127,10 @@ def _condition_number(q):
     t3273 = t3271 + t3245*t3270
     t3274 = t3114*t3252 + t3118*t3256 + t3122*t3260 + t3126*t3264 + t3130*t3268 + t3134*t3272
     t3275 = (t3274 != 0)
-    t3276 = 0.5*(-t3248 + t3110)/casadi.if_else(t3275, t3274, 1)
+    t3276 = (-t3248 + t3110)/casadi.if_else(t3275, 2*t3274, 1)
     t3277 = casadi.fabs(t3276)
     t3278 = (t3277 >= 1)
-    t3279 = casadi.fabs(1/casadi.if_else(t3278, t3276, 1))
+    t3279 = 1/casadi.fabs(casadi.if_else(t3278, t3276, 1))
     t3280 = casadi.if_else(t3275, casadi.if_else((t3276 >= 0), 1, -1)*casadi.if_else(t3278, t3279/(1 + casadi.sqrt(1 + t3279**2)), 1/(t3277 + casadi.sqrt(1 + t3277**2))), 0)
     t3281 = 1/casadi.sqrt(1 + t3280**2)
     t3282 = t3274*t3280
@@ -6163,10 +6163,10 @@ def _condition_number(q):
     t3309 = t3183*t3287 + t3187*t3291 + t3191*t3295 + t3195*t3299 + t3199*t3303 + t3203*t3307
     t3310 = t3253*t3288 + t3257*t3292 + t3261*t3296 + t3265*t3300 + t3269*t3304 + t3273*t3308
     t3311 = (t3309 != 0)
-    t3312 = 0.5*(-t3283 + t3179)/casadi.if_else(t3311, t3309, 1)
+    t3312 = (-t3283 + t3179)/casadi.if_else(t3311, 2*t3309, 1)
     t3313 = casadi.fabs(t3312)
     t3314 = (t3313 >= 1)
-    t3315 = casadi.fabs(1/casadi.if_else(t3314, t3312, 1))
+    t3315 = 1/casadi.fabs(casadi.if_else(t3314, t3312, 1))
     t3316 = casadi.if_else(t3311, casadi.if_else((t3312 >= 0), 1, -1)*casadi.if_else(t3314, t3315/(1 + casadi.sqrt(1 + t3315**2)), 1/(t3313 + casadi.sqrt(1 + t3313**2))), 0)
     t3317 = 1/casadi.sqrt(1 + t3316**2)
     t3318 = t3309*t3316
@@ -6198,10 +6198,10 @@ def _condition_number(q):
     t3344 = t3342 + t3316*t3341
     t3345 = t3218*t3323 + t3222*t3327 + t3226*t3331 + t3230*t3335 + t3234*t3339 + t3238*t3343
     t3346 = (t3345 != 0)
-    t3347 = 0.5*(-t3319 + t3214)/casadi.if_else(t3346, t3345, 1)
+    t3347 = (-t3319 + t3214)/casadi.if_else(t3346, 2*t3345, 1)
     t3348 = casadi.fabs(t3347)
     t3349 = (t3348 >= 1)
-    t3350 = casadi.fabs(1/casadi.if_else(t3349, t3347, 1))
+    t3350 = 1/casadi.fabs(casadi.if_else(t3349, t3347, 1))
     t3351 = casadi.if_else(t3346, casadi.if_else((t3347 >= 0), 1, -1)*casadi.if_else(t3349, t3350/(1 + casadi.sqrt(1 + t3350**2)), 1/(t3348 + casadi.sqrt(1 + t3348**2))), 0)
     t3352 = 1/casadi.sqrt(1 + t3351**2)
     t3353 = t3345*t3351
@@ -6233,10 +6233,10 @@ def _condition_number(q):
     t3379 = t3377 + t3351*t3376
     t3380 = t3219*t3358 + t3223*t3362 + t3227*t3366 + t3231*t3370 + t3235*t3374 + t3239*t3378
     t3381 = (t3380 != 0)
-    t3382 = 0.5*(-t3354 + t3215)/casadi.if_else(t3381, t3380, 1)
+    t3382 = (-t3354 + t3215)/casadi.if_else(t3381, 2*t3380, 1)
     t3383 = casadi.fabs(t3382)
     t3384 = (t3383 >= 1)
-    t3385 = casadi.fabs(1/casadi.if_else(t3384, t3382, 1))
+    t3385 = 1/casadi.fabs(casadi.if_else(t3384, t3382, 1))
     t3386 = casadi.if_else(t3381, casadi.if_else((t3382 >= 0), 1, -1)*casadi.if_else(t3384, t3385/(1 + casadi.sqrt(1 + t3385**2)), 1/(t3383 + casadi.sqrt(1 + t3383**2))), 0)
     t3387 = 1/casadi.sqrt(1 + t3386**2)
     t3388 = t3215 + t3380*t3386
@@ -6266,10 +6266,10 @@ def _condition_number(q):
     t3412 = t3410 + t3386*t3409
     t3413 = casadi.sqrt(t3391**2 + t3395**2 + t3399**2 + t3403**2 + t3407**2 + t3411**2)
     t3414 = (t3310 != 0)
-    t3415 = 0.5*(-t3249 + t3284)/casadi.if_else(t3414, t3310, 1)
+    t3415 = (-t3249 + t3284)/casadi.if_else(t3414, 2*t3310, 1)
     t3416 = casadi.fabs(t3415)
     t3417 = (t3416 >= 1)
-    t3418 = casadi.fabs(1/casadi.if_else(t3417, t3415, 1))
+    t3418 = 1/casadi.fabs(casadi.if_else(t3417, t3415, 1))
     t3419 = casadi.if_else(t3414, casadi.if_else((t3415 >= 0), 1, -1)*casadi.if_else(t3417, t3418/(1 + casadi.sqrt(1 + t3418**2)), 1/(t3416 + casadi.sqrt(1 + t3416**2))), 0)
     t3420 = 1/casadi.sqrt(1 + t3419**2)
     t3421 = t3310*t3419
@@ -6301,10 +6301,10 @@ def _condition_number(q):
     t3447 = t3445 + t3419*t3444
     t3448 = t3324*t3426 + t3328*t3430 + t3332*t3434 + t3336*t3438 + t3340*t3442 + t3344*t3446
     t3449 = (t3448 != 0)
-    t3450 = 0.5*(-t3422 + t3320)/casadi.if_else(t3449, t3448, 1)
+    t3450 = (-t3422 + t3320)/casadi.if_else(t3449, 2*t3448, 1)
     t3451 = casadi.fabs(t3450)
     t3452 = (t3451 >= 1)
-    t3453 = casadi.fabs(1/casadi.if_else(t3452, t3450, 1))
+    t3453 = 1/casadi.fabs(casadi.if_else(t3452, t3450, 1))
     t3454 = casadi.if_else(t3449, casadi.if_else((t3450 >= 0), 1, -1)*casadi.if_else(t3452, t3453/(1 + casadi.sqrt(1 + t3453**2)), 1/(t3451 + casadi.sqrt(1 + t3451**2))), 0)
     t3455 = 1/casadi.sqrt(1 + t3454**2)
     t3456 = t3448*t3454
@@ -6337,10 +6337,10 @@ def _condition_number(q):
     t3483 = t3359*t3461 + t3363*t3465 + t3367*t3469 + t3371*t3473 + t3375*t3477 + t3379*t3481
     t3484 = t3427*t3462 + t3431*t3466 + t3435*t3470 + t3439*t3474 + t3443*t3478 + t3447*t3482
     t3485 = (t3483 != 0)
-    t3486 = 0.5*(-t3457 + t3355)/casadi.if_else(t3485, t3483, 1)
+    t3486 = (-t3457 + t3355)/casadi.if_else(t3485, 2*t3483, 1)
     t3487 = casadi.fabs(t3486)
     t3488 = (t3487 >= 1)
-    t3489 = casadi.fabs(1/casadi.if_else(t3488, t3486, 1))
+    t3489 = 1/casadi.fabs(casadi.if_else(t3488, t3486, 1))
     t3490 = casadi.if_else(t3485, casadi.if_else((t3486 >= 0), 1, -1)*casadi.if_else(t3488, t3489/(1 + casadi.sqrt(1 + t3489**2)), 1/(t3487 + casadi.sqrt(1 + t3487**2))), 0)
     t3491 = 1/casadi.sqrt(1 + t3490**2)
     t3492 = t3483*t3490
@@ -6372,10 +6372,10 @@ def _condition_number(q):
     t3518 = t3516 + t3490*t3515
     t3519 = t3392*t3497 + t3396*t3501 + t3400*t3505 + t3404*t3509 + t3408*t3513 + t3412*t3517
     t3520 = (t3519 != 0)
-    t3521 = 0.5*(-t3493 + t3388)/casadi.if_else(t3520, t3519, 1)
+    t3521 = (-t3493 + t3388)/casadi.if_else(t3520, 2*t3519, 1)
     t3522 = casadi.fabs(t3521)
     t3523 = (t3522 >= 1)
-    t3524 = casadi.fabs(1/casadi.if_else(t3523, t3521, 1))
+    t3524 = 1/casadi.fabs(casadi.if_else(t3523, t3521, 1))
     t3525 = casadi.if_else(t3520, casadi.if_else((t3521 >= 0), 1, -1)*casadi.if_else(t3523, t3524/(1 + casadi.sqrt(1 + t3524**2)), 1/(t3522 + casadi.sqrt(1 + t3522**2))), 0)
     t3526 = 1/casadi.sqrt(1 + t3525**2)
     t3527 = t3388 + t3519*t3525
@@ -6407,10 +6407,10 @@ def _condition_number(q):
     t3553 = casadi.if_else((t3552 > t3413), t3552, t3413)
     t3554 = casadi.if_else((t3552 < t3413), t3552, t3413)
     t3555 = (t3484 != 0)
-    t3556 = 0.5*(-t3423 + t3458)/casadi.if_else(t3555, t3484, 1)
+    t3556 = (-t3423 + t3458)/casadi.if_else(t3555, 2*t3484, 1)
     t3557 = casadi.fabs(t3556)
     t3558 = (t3557 >= 1)
-    t3559 = casadi.fabs(1/casadi.if_else(t3558, t3556, 1))
+    t3559 = 1/casadi.fabs(casadi.if_else(t3558, t3556, 1))
     t3560 = casadi.if_else(t3555, casadi.if_else((t3556 >= 0), 1, -1)*casadi.if_else(t3558, t3559/(1 + casadi.sqrt(1 + t3559**2)), 1/(t3557 + casadi.sqrt(1 + t3557**2))), 0)
     t3561 = 1/casadi.sqrt(1 + t3560**2)
     t3562 = t3484*t3560
@@ -6442,10 +6442,10 @@ def _condition_number(q):
     t3588 = t3586 + t3560*t3585
     t3589 = t3498*t3567 + t3502*t3571 + t3506*t3575 + t3510*t3579 + t3514*t3583 + t3518*t3587
     t3590 = (t3589 != 0)
-    t3591 = 0.5*(-t3563 + t3494)/casadi.if_else(t3590, t3589, 1)
+    t3591 = (-t3563 + t3494)/casadi.if_else(t3590, 2*t3589, 1)
     t3592 = casadi.fabs(t3591)
     t3593 = (t3592 >= 1)
-    t3594 = casadi.fabs(1/casadi.if_else(t3593, t3591, 1))
+    t3594 = 1/casadi.fabs(casadi.if_else(t3593, t3591, 1))
     t3595 = casadi.if_else(t3590, casadi.if_else((t3591 >= 0), 1, -1)*casadi.if_else(t3593, t3594/(1 + casadi.sqrt(1 + t3594**2)), 1/(t3592 + casadi.sqrt(1 + t3592**2))), 0)
     t3596 = 1/casadi.sqrt(1 + t3595**2)
     t3597 = t3589*t3595
@@ -6478,10 +6478,10 @@ def _condition_number(q):
     t3624 = t3531*t3602 + t3535*t3606 + t3539*t3610 + t3543*t3614 + t3547*t3618 + t3551*t3622
     t3625 = t3568*t3603 + t3572*t3607 + t3576*t3611 + t3580*t3615 + t3584*t3619 + t3588*t3623
     t3626 = (t3624 != 0)
-    t3627 = 0.5*(-t3598 + t3527)/casadi.if_else(t3626, t3624, 1)
+    t3627 = (-t3598 + t3527)/casadi.if_else(t3626, 2*t3624, 1)
     t3628 = casadi.fabs(t3627)
     t3629 = (t3628 >= 1)
-    t3630 = casadi.fabs(1/casadi.if_else(t3629, t3627, 1))
+    t3630 = 1/casadi.fabs(casadi.if_else(t3629, t3627, 1))
     t3631 = casadi.if_else(t3626, casadi.if_else((t3627 >= 0), 1, -1)*casadi.if_else(t3629, t3630/(1 + casadi.sqrt(1 + t3630**2)), 1/(t3628 + casadi.sqrt(1 + t3628**2))), 0)
     t3632 = 1/casadi.sqrt(1 + t3631**2)
     t3633 = t3527 + t3624*t3631
@@ -6513,10 +6513,10 @@ def _condition_number(q):
     t3659 = casadi.if_else((t3658 > t3553), t3658, t3553)
     t3660 = casadi.if_else((t3658 < t3554), t3658, t3554)
     t3661 = (t3625 != 0)
-    t3662 = 0.5*(-t3564 + t3599)/casadi.if_else(t3661, t3625, 1)
+    t3662 = (-t3564 + t3599)/casadi.if_else(t3661, 2*t3625, 1)
     t3663 = casadi.fabs(t3662)
     t3664 = (t3663 >= 1)
-    t3665 = casadi.fabs(1/casadi.if_else(t3664, t3662, 1))
+    t3665 = 1/casadi.fabs(casadi.if_else(t3664, t3662, 1))
     t3666 = casadi.if_else(t3661, casadi.if_else((t3662 >= 0), 1, -1)*casadi.if_else(t3664, t3665/(1 + casadi.sqrt(1 + t3665**2)), 1/(t3663 + casadi.sqrt(1 + t3663**2))), 0)
     t3667 = 1/casadi.sqrt(1 + t3666**2)
     t3668 = t3625*t3666
@@ -6548,10 +6548,10 @@ def _condition_number(q):
     t3694 = t3692 + t3666*t3691
     t3695 = t3637*t3673 + t3641*t3677 + t3645*t3681 + t3649*t3685 + t3653*t3689 + t3657*t3693
     t3696 = (t3695 != 0)
-    t3697 = 0.5*(-t3669 + t3633)/casadi.if_else(t3696, t3695, 1)
+    t3697 = (-t3669 + t3633)/casadi.if_else(t3696, 2*t3695, 1)
     t3698 = casadi.fabs(t3697)
     t3699 = (t3698 >= 1)
-    t3700 = casadi.fabs(1/casadi.if_else(t3699, t3697, 1))
+    t3700 = 1/casadi.fabs(casadi.if_else(t3699, t3697, 1))
     t3701 = casadi.if_else(t3696, casadi.if_else((t3697 >= 0), 1, -1)*casadi.if_else(t3699, t3700/(1 + casadi.sqrt(1 + t3700**2)), 1/(t3698 + casadi.sqrt(1 + t3698**2))), 0)
     t3702 = 1/casadi.sqrt(1 + t3701**2)
     t3703 = t3633 + t3695*t3701
@@ -6584,10 +6584,10 @@ def _condition_number(q):
     t3730 = casadi.if_else((t3729 > t3659), t3729, t3659)
     t3731 = casadi.if_else((t3729 < t3660), t3729, t3660)
     t3732 = (t3728 != 0)
-    t3733 = 0.5*(-t3670 + t3703)/casadi.if_else(t3732, t3728, 1)
+    t3733 = (-t3670 + t3703)/casadi.if_else(t3732, 2*t3728, 1)
     t3734 = casadi.fabs(t3733)
     t3735 = (t3734 >= 1)
-    t3736 = casadi.fabs(1/casadi.if_else(t3735, t3733, 1))
+    t3736 = 1/casadi.fabs(casadi.if_else(t3735, t3733, 1))
     t3737 = casadi.if_else(t3732, casadi.if_else((t3733 >= 0), 1, -1)*casadi.if_else(t3735, t3736/(1 + casadi.sqrt(1 + t3736**2)), 1/(t3734 + casadi.sqrt(1 + t3734**2))), 0)
     t3738 = 1/casadi.sqrt(1 + t3737**2)
     t3739 = t3674*t3738
@@ -6620,8 +6620,10 @@ def _condition_number(q):
     t3766 = casadi.if_else((t3763 < t3731), t3763, t3731)
     t3767 = casadi.if_else((t3764 > t3765), t3764, t3765)
     t3768 = casadi.if_else((t3764 < t3766), t3764, t3766)
+    t3769 = casadi.if_else((t3768 <= 1e-12*t3767), 0, t3768)
+    t3770 = casadi.if_else((t3767 > 0), t3767, 1)
     kappa = casadi.SX(1, 1)
-    kappa[0, 0] = casadi.if_else((t3767 > 0), t3767, 1)/casadi.if_else((t3768 <= 1e-12*t3767), 0, t3768)
+    kappa[0, 0] = t3770/t3769
     return [kappa]
 
 

@@ -1450,10 +1450,10 @@ def velocity_ellipsoid(q):
     t48 = t47**2
     t49 = t19*t25
     t50 = xp.not_equal(t49, 0)
-    t51 = 0.5*(-t22 + t34)/xp.where(t50, -t49, 1)
+    t51 = (-t22 + t34)/xp.where(t50, -2*t49, 1)
     t52 = xp.abs(t51)
     t53 = xp.greater_equal(t52, 1)
-    t54 = xp.abs(1/xp.where(t53, t51, 1))
+    t54 = 1/xp.abs(xp.where(t53, t51, 1))
     t55 = xp.where(t50, xp.where(xp.greater_equal(t51, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t53, t54/(1 + xp.sqrt(1 + t54**2)), 1/(t52 + xp.sqrt(1 + t52**2))), 0)
     t56 = 1/xp.sqrt(1 + t55**2)
     t57 = t49*t55
@@ -1469,10 +1469,10 @@ def velocity_ellipsoid(q):
     t67 = t66*t55
     t68 = t64*t62 + t67*t43
     t69 = xp.not_equal(t68, 0)
-    t70 = 0.5*(-t58 + t65)/xp.where(t69, t68, 1)
+    t70 = (-t58 + t65)/xp.where(t69, 2*t68, 1)
     t71 = xp.abs(t70)
     t72 = xp.greater_equal(t71, 1)
-    t73 = xp.abs(1/xp.where(t72, t70, 1))
+    t73 = 1/xp.abs(xp.where(t72, t70, 1))
     t74 = xp.where(t69, xp.where(xp.greater_equal(t70, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t72, t73/(1 + xp.sqrt(1 + t73**2)), 1/(t71 + xp.sqrt(1 + t71**2))), 0)
     t75 = 1/xp.sqrt(1 + t74**2)
     t76 = t68*t74
@@ -1488,10 +1488,10 @@ def velocity_ellipsoid(q):
     t86 = t84 + t83*t74
     t87 = t63*t82 + t66*t86
     t88 = xp.not_equal(t87, 0)
-    t89 = 0.5*(-t59 + t78)/xp.where(t88, -t87, 1)
+    t89 = (-t59 + t78)/xp.where(t88, -2*t87, 1)
     t90 = xp.abs(t89)
     t91 = xp.greater_equal(t90, 1)
-    t92 = xp.abs(1/xp.where(t91, t89, 1))
+    t92 = 1/xp.abs(xp.where(t91, t89, 1))
     t93 = xp.where(t88, xp.where(xp.greater_equal(t89, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t91, t92/(1 + xp.sqrt(1 + t92**2)), 1/(t90 + xp.sqrt(1 + t90**2))), 0)
     t94 = 1/xp.sqrt(1 + t93**2)
     t95 = t87*t93
@@ -1517,10 +1517,10 @@ def velocity_ellipsoid(q):
     t115 = t93*t94
     t116 = t81*t100 - t85*t105 + t48*t109*t115*t75
     t117 = xp.not_equal(t116, 0)
-    t118 = 0.5*(-t77 + t96)/xp.where(t117, t116, 1)
+    t118 = (-t77 + t96)/xp.where(t117, 2*t116, 1)
     t119 = xp.abs(t118)
     t120 = xp.greater_equal(t119, 1)
-    t121 = xp.abs(1/xp.where(t120, t118, 1))
+    t121 = 1/xp.abs(xp.where(t120, t118, 1))
     t122 = xp.where(t117, xp.where(xp.greater_equal(t118, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t120, t121/(1 + xp.sqrt(1 + t121**2)), 1/(t119 + xp.sqrt(1 + t119**2))), 0)
     t123 = 1/xp.sqrt(1 + t122**2)
     t124 = t116*t122
@@ -1554,10 +1554,10 @@ def velocity_ellipsoid(q):
     t152 = t75*t94
     t153 = t101*t129 + t106*t133 - t47*t152*t142
     t154 = xp.not_equal(t153, 0)
-    t155 = 0.5*(-t125 + t97)/xp.where(t154, t153, 1)
+    t155 = (-t125 + t97)/xp.where(t154, 2*t153, 1)
     t156 = xp.abs(t155)
     t157 = xp.greater_equal(t156, 1)
-    t158 = xp.abs(1/xp.where(t157, t155, 1))
+    t158 = 1/xp.abs(xp.where(t157, t155, 1))
     t159 = xp.where(t154, xp.where(xp.greater_equal(t155, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t157, t158/(1 + xp.sqrt(1 + t158**2)), 1/(t156 + xp.sqrt(1 + t156**2))), 0)
     t160 = 1/xp.sqrt(1 + t159**2)
     t161 = t153*t159
@@ -1589,10 +1589,10 @@ def velocity_ellipsoid(q):
     t187 = t186 - t159*t173
     t188 = t173 + t159*t186
     t189 = xp.not_equal(t177, 0)
-    t190 = 0.5*(-t126 + t163)/xp.where(t189, t177, 1)
+    t190 = (-t126 + t163)/xp.where(t189, 2*t177, 1)
     t191 = xp.abs(t190)
     t192 = xp.greater_equal(t191, 1)
-    t193 = xp.abs(1/xp.where(t192, t190, 1))
+    t193 = 1/xp.abs(xp.where(t192, t190, 1))
     t194 = xp.where(t189, xp.where(xp.greater_equal(t190, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t192, t193/(1 + xp.sqrt(1 + t193**2)), 1/(t191 + xp.sqrt(1 + t191**2))), 0)
     t195 = 1/xp.sqrt(1 + t194**2)
     t196 = t177*t194
@@ -1624,10 +1624,10 @@ def velocity_ellipsoid(q):
     t222 = t220 + t194*t221
     t223 = t221 - t194*t220
     t224 = xp.not_equal(t211, 0)
-    t225 = 0.5*(-t162 + t197)/xp.where(t224, t211, 1)
+    t225 = (-t162 + t197)/xp.where(t224, 2*t211, 1)
     t226 = xp.abs(t225)
     t227 = xp.greater_equal(t226, 1)
-    t228 = xp.abs(1/xp.where(t227, t225, 1))
+    t228 = 1/xp.abs(xp.where(t227, t225, 1))
     t229 = xp.where(t224, xp.where(xp.greater_equal(t225, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t227, t228/(1 + xp.sqrt(1 + t228**2)), 1/(t226 + xp.sqrt(1 + t226**2))), 0)
     t230 = 1/xp.sqrt(1 + t229**2)
     t231 = t211*t229
@@ -1659,10 +1659,10 @@ def velocity_ellipsoid(q):
     t257 = t255 + t229*t256
     t258 = -t256 + t229*t255
     t259 = xp.not_equal(t246, 0)
-    t260 = 0.5*(-t232 + t198)/xp.where(t259, t246, 1)
+    t260 = (-t232 + t198)/xp.where(t259, 2*t246, 1)
     t261 = xp.abs(t260)
     t262 = xp.greater_equal(t261, 1)
-    t263 = xp.abs(1/xp.where(t262, t260, 1))
+    t263 = 1/xp.abs(xp.where(t262, t260, 1))
     t264 = xp.where(t259, xp.where(xp.greater_equal(t260, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t262, t263/(1 + xp.sqrt(1 + t263**2)), 1/(t261 + xp.sqrt(1 + t261**2))), 0)
     t265 = 1/xp.sqrt(1 + t264**2)
     t266 = t246*t264
@@ -1694,10 +1694,10 @@ def velocity_ellipsoid(q):
     t292 = t290 - t264*t291
     t293 = t291 + t264*t290
     t294 = xp.not_equal(t281, 0)
-    t295 = 0.5*(-t233 + t268)/xp.where(t294, t281, 1)
+    t295 = (-t233 + t268)/xp.where(t294, 2*t281, 1)
     t296 = xp.abs(t295)
     t297 = xp.greater_equal(t296, 1)
-    t298 = xp.abs(1/xp.where(t297, t295, 1))
+    t298 = 1/xp.abs(xp.where(t297, t295, 1))
     t299 = xp.where(t294, xp.where(xp.greater_equal(t295, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t297, t298/(1 + xp.sqrt(1 + t298**2)), 1/(t296 + xp.sqrt(1 + t296**2))), 0)
     t300 = 1/xp.sqrt(1 + t299**2)
     t301 = t281*t299
@@ -1729,10 +1729,10 @@ def velocity_ellipsoid(q):
     t327 = t325 - t299*t326
     t328 = t326 + t299*t325
     t329 = xp.not_equal(t316, 0)
-    t330 = 0.5*(-t267 + t302)/xp.where(t329, t316, 1)
+    t330 = (-t267 + t302)/xp.where(t329, 2*t316, 1)
     t331 = xp.abs(t330)
     t332 = xp.greater_equal(t331, 1)
-    t333 = xp.abs(1/xp.where(t332, t330, 1))
+    t333 = 1/xp.abs(xp.where(t332, t330, 1))
     t334 = xp.where(t329, xp.where(xp.greater_equal(t330, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t332, t333/(1 + xp.sqrt(1 + t333**2)), 1/(t331 + xp.sqrt(1 + t331**2))), 0)
     t335 = 1/xp.sqrt(1 + t334**2)
     t336 = t316*t334
@@ -1764,10 +1764,10 @@ def velocity_ellipsoid(q):
     t362 = t360 - t334*t361
     t363 = t361 + t334*t360
     t364 = xp.not_equal(t351, 0)
-    t365 = 0.5*(-t337 + t303)/xp.where(t364, t351, 1)
+    t365 = (-t337 + t303)/xp.where(t364, 2*t351, 1)
     t366 = xp.abs(t365)
     t367 = xp.greater_equal(t366, 1)
-    t368 = xp.abs(1/xp.where(t367, t365, 1))
+    t368 = 1/xp.abs(xp.where(t367, t365, 1))
     t369 = xp.where(t364, xp.where(xp.greater_equal(t365, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t367, t368/(1 + xp.sqrt(1 + t368**2)), 1/(t366 + xp.sqrt(1 + t366**2))), 0)
     t370 = 1/xp.sqrt(1 + t369**2)
     t371 = t351*t369
@@ -1799,10 +1799,10 @@ def velocity_ellipsoid(q):
     t397 = t395 - t369*t396
     t398 = t396 + t369*t395
     t399 = xp.not_equal(t386, 0)
-    t400 = 0.5*(-t338 + t373)/xp.where(t399, t386, 1)
+    t400 = (-t338 + t373)/xp.where(t399, 2*t386, 1)
     t401 = xp.abs(t400)
     t402 = xp.greater_equal(t401, 1)
-    t403 = xp.abs(1/xp.where(t402, t400, 1))
+    t403 = 1/xp.abs(xp.where(t402, t400, 1))
     t404 = xp.where(t399, xp.where(xp.greater_equal(t400, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t402, t403/(1 + xp.sqrt(1 + t403**2)), 1/(t401 + xp.sqrt(1 + t401**2))), 0)
     t405 = 1/xp.sqrt(1 + t404**2)
     t406 = t386*t404
@@ -1834,10 +1834,10 @@ def velocity_ellipsoid(q):
     t432 = t430 - t404*t431
     t433 = t431 + t404*t430
     t434 = xp.not_equal(t421, 0)
-    t435 = 0.5*(-t372 + t407)/xp.where(t434, t421, 1)
+    t435 = (-t372 + t407)/xp.where(t434, 2*t421, 1)
     t436 = xp.abs(t435)
     t437 = xp.greater_equal(t436, 1)
-    t438 = xp.abs(1/xp.where(t437, t435, 1))
+    t438 = 1/xp.abs(xp.where(t437, t435, 1))
     t439 = xp.where(t434, xp.where(xp.greater_equal(t435, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t437, t438/(1 + xp.sqrt(1 + t438**2)), 1/(t436 + xp.sqrt(1 + t436**2))), 0)
     t440 = 1/xp.sqrt(1 + t439**2)
     t441 = t421*t439
@@ -1869,10 +1869,10 @@ def velocity_ellipsoid(q):
     t467 = t465 - t439*t466
     t468 = t466 + t439*t465
     t469 = xp.not_equal(t456, 0)
-    t470 = 0.5*(-t442 + t408)/xp.where(t469, t456, 1)
+    t470 = (-t442 + t408)/xp.where(t469, 2*t456, 1)
     t471 = xp.abs(t470)
     t472 = xp.greater_equal(t471, 1)
-    t473 = xp.abs(1/xp.where(t472, t470, 1))
+    t473 = 1/xp.abs(xp.where(t472, t470, 1))
     t474 = xp.where(t469, xp.where(xp.greater_equal(t470, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t472, t473/(1 + xp.sqrt(1 + t473**2)), 1/(t471 + xp.sqrt(1 + t471**2))), 0)
     t475 = 1/xp.sqrt(1 + t474**2)
     t476 = t408 + t456*t474
@@ -1903,10 +1903,10 @@ def velocity_ellipsoid(q):
     t501 = t499 - t474*t500
     t502 = t500 + t474*t499
     t503 = xp.not_equal(t489, 0)
-    t504 = 0.5*(-t443 + t476)/xp.where(t503, t489, 1)
+    t504 = (-t443 + t476)/xp.where(t503, 2*t489, 1)
     t505 = xp.abs(t504)
     t506 = xp.greater_equal(t505, 1)
-    t507 = xp.abs(1/xp.where(t506, t504, 1))
+    t507 = 1/xp.abs(xp.where(t506, t504, 1))
     t508 = xp.where(t503, xp.where(xp.greater_equal(t504, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t506, t507/(1 + xp.sqrt(1 + t507**2)), 1/(t505 + xp.sqrt(1 + t505**2))), 0)
     t509 = 1/xp.sqrt(1 + t508**2)
     t510 = t447*t509
@@ -1991,10 +1991,10 @@ def velocity_ellipsoid(q):
     t589 = 3*t23
     t590 = t578*t589
     t591 = xp.not_equal(t590, 0)
-    t592 = 0.5*(-t571 + t580)/xp.where(t591, -t590, 1)
+    t592 = (-t571 + t580)/xp.where(t591, -2*t590, 1)
     t593 = xp.abs(t592)
     t594 = xp.greater_equal(t593, 1)
-    t595 = xp.abs(1/xp.where(t594, t592, 1))
+    t595 = 1/xp.abs(xp.where(t594, t592, 1))
     t596 = xp.where(t591, xp.where(xp.greater_equal(t592, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t594, t595/(1 + xp.sqrt(1 + t595**2)), 1/(t593 + xp.sqrt(1 + t593**2))), 0)
     t597 = 1/xp.sqrt(1 + t596**2)
     t598 = t590*t596
@@ -2009,10 +2009,10 @@ def velocity_ellipsoid(q):
     t607 = t596*t606
     t608 = t579*t604 + t583*t607
     t609 = xp.not_equal(t608, 0)
-    t610 = 0.5*(-t599 + t588)/xp.where(t609, -t608, 1)
+    t610 = (-t599 + t588)/xp.where(t609, -2*t608, 1)
     t611 = xp.abs(t610)
     t612 = xp.greater_equal(t611, 1)
-    t613 = xp.abs(1/xp.where(t612, t610, 1))
+    t613 = 1/xp.abs(xp.where(t612, t610, 1))
     t614 = xp.where(t609, xp.where(xp.greater_equal(t610, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t612, t613/(1 + xp.sqrt(1 + t613**2)), 1/(t611 + xp.sqrt(1 + t611**2))), 0)
     t615 = 1/xp.sqrt(1 + t614**2)
     t616 = t608*t614
@@ -2028,10 +2028,10 @@ def velocity_ellipsoid(q):
     t626 = -t624 + t614*t623
     t627 = t605*t622 - t626*t606
     t628 = xp.not_equal(t627, 0)
-    t629 = 0.5*(-t600 + t618)/xp.where(t628, t627, 1)
+    t629 = (-t600 + t618)/xp.where(t628, 2*t627, 1)
     t630 = xp.abs(t629)
     t631 = xp.greater_equal(t630, 1)
-    t632 = xp.abs(1/xp.where(t631, t629, 1))
+    t632 = 1/xp.abs(xp.where(t631, t629, 1))
     t633 = xp.where(t628, xp.where(xp.greater_equal(t629, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t631, t632/(1 + xp.sqrt(1 + t632**2)), 1/(t630 + xp.sqrt(1 + t630**2))), 0)
     t634 = 1/xp.sqrt(1 + t633**2)
     t635 = t627*t633
@@ -2057,10 +2057,10 @@ def velocity_ellipsoid(q):
     t655 = t633*t634
     t656 = t621*t640 + t625*t645 - t615*t587*t649*t655
     t657 = xp.not_equal(t656, 0)
-    t658 = 0.5*(-t617 + t636)/xp.where(t657, -t656, 1)
+    t658 = (-t617 + t636)/xp.where(t657, -2*t656, 1)
     t659 = xp.abs(t658)
     t660 = xp.greater_equal(t659, 1)
-    t661 = xp.abs(1/xp.where(t660, t658, 1))
+    t661 = 1/xp.abs(xp.where(t660, t658, 1))
     t662 = xp.where(t657, xp.where(xp.greater_equal(t658, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t660, t661/(1 + xp.sqrt(1 + t661**2)), 1/(t659 + xp.sqrt(1 + t659**2))), 0)
     t663 = 1/xp.sqrt(1 + t662**2)
     t664 = t656*t662
@@ -2094,10 +2094,10 @@ def velocity_ellipsoid(q):
     t692 = t615*t634
     t693 = t641*t669 - t646*t673 + t586*t682*t692
     t694 = xp.not_equal(t693, 0)
-    t695 = 0.5*(-t665 + t637)/xp.where(t694, -t693, 1)
+    t695 = (-t665 + t637)/xp.where(t694, -2*t693, 1)
     t696 = xp.abs(t695)
     t697 = xp.greater_equal(t696, 1)
-    t698 = xp.abs(1/xp.where(t697, t695, 1))
+    t698 = 1/xp.abs(xp.where(t697, t695, 1))
     t699 = xp.where(t694, xp.where(xp.greater_equal(t695, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t697, t698/(1 + xp.sqrt(1 + t698**2)), 1/(t696 + xp.sqrt(1 + t696**2))), 0)
     t700 = 1/xp.sqrt(1 + t699**2)
     t701 = t693*t699
@@ -2129,10 +2129,10 @@ def velocity_ellipsoid(q):
     t727 = t726 - t699*t713
     t728 = t713 + t699*t726
     t729 = xp.not_equal(t717, 0)
-    t730 = 0.5*(-t666 + t703)/xp.where(t729, t717, 1)
+    t730 = (-t666 + t703)/xp.where(t729, 2*t717, 1)
     t731 = xp.abs(t730)
     t732 = xp.greater_equal(t731, 1)
-    t733 = xp.abs(1/xp.where(t732, t730, 1))
+    t733 = 1/xp.abs(xp.where(t732, t730, 1))
     t734 = xp.where(t729, xp.where(xp.greater_equal(t730, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t732, t733/(1 + xp.sqrt(1 + t733**2)), 1/(t731 + xp.sqrt(1 + t731**2))), 0)
     t735 = 1/xp.sqrt(1 + t734**2)
     t736 = t717*t734
@@ -2164,10 +2164,10 @@ def velocity_ellipsoid(q):
     t762 = t760 + t734*t761
     t763 = t761 - t734*t760
     t764 = xp.not_equal(t751, 0)
-    t765 = 0.5*(-t702 + t737)/xp.where(t764, t751, 1)
+    t765 = (-t702 + t737)/xp.where(t764, 2*t751, 1)
     t766 = xp.abs(t765)
     t767 = xp.greater_equal(t766, 1)
-    t768 = xp.abs(1/xp.where(t767, t765, 1))
+    t768 = 1/xp.abs(xp.where(t767, t765, 1))
     t769 = xp.where(t764, xp.where(xp.greater_equal(t765, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t767, t768/(1 + xp.sqrt(1 + t768**2)), 1/(t766 + xp.sqrt(1 + t766**2))), 0)
     t770 = 1/xp.sqrt(1 + t769**2)
     t771 = t751*t769
@@ -2199,10 +2199,10 @@ def velocity_ellipsoid(q):
     t797 = t795 + t769*t796
     t798 = -t796 + t769*t795
     t799 = xp.not_equal(t786, 0)
-    t800 = 0.5*(-t772 + t738)/xp.where(t799, t786, 1)
+    t800 = (-t772 + t738)/xp.where(t799, 2*t786, 1)
     t801 = xp.abs(t800)
     t802 = xp.greater_equal(t801, 1)
-    t803 = xp.abs(1/xp.where(t802, t800, 1))
+    t803 = 1/xp.abs(xp.where(t802, t800, 1))
     t804 = xp.where(t799, xp.where(xp.greater_equal(t800, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t802, t803/(1 + xp.sqrt(1 + t803**2)), 1/(t801 + xp.sqrt(1 + t801**2))), 0)
     t805 = 1/xp.sqrt(1 + t804**2)
     t806 = t786*t804
@@ -2234,10 +2234,10 @@ def velocity_ellipsoid(q):
     t832 = t830 - t804*t831
     t833 = t831 + t804*t830
     t834 = xp.not_equal(t821, 0)
-    t835 = 0.5*(-t773 + t808)/xp.where(t834, t821, 1)
+    t835 = (-t773 + t808)/xp.where(t834, 2*t821, 1)
     t836 = xp.abs(t835)
     t837 = xp.greater_equal(t836, 1)
-    t838 = xp.abs(1/xp.where(t837, t835, 1))
+    t838 = 1/xp.abs(xp.where(t837, t835, 1))
     t839 = xp.where(t834, xp.where(xp.greater_equal(t835, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t837, t838/(1 + xp.sqrt(1 + t838**2)), 1/(t836 + xp.sqrt(1 + t836**2))), 0)
     t840 = 1/xp.sqrt(1 + t839**2)
     t841 = t821*t839
@@ -2269,10 +2269,10 @@ def velocity_ellipsoid(q):
     t867 = t865 - t839*t866
     t868 = t866 + t839*t865
     t869 = xp.not_equal(t856, 0)
-    t870 = 0.5*(-t807 + t842)/xp.where(t869, t856, 1)
+    t870 = (-t807 + t842)/xp.where(t869, 2*t856, 1)
     t871 = xp.abs(t870)
     t872 = xp.greater_equal(t871, 1)
-    t873 = xp.abs(1/xp.where(t872, t870, 1))
+    t873 = 1/xp.abs(xp.where(t872, t870, 1))
     t874 = xp.where(t869, xp.where(xp.greater_equal(t870, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t872, t873/(1 + xp.sqrt(1 + t873**2)), 1/(t871 + xp.sqrt(1 + t871**2))), 0)
     t875 = 1/xp.sqrt(1 + t874**2)
     t876 = t856*t874
@@ -2304,10 +2304,10 @@ def velocity_ellipsoid(q):
     t902 = t900 - t874*t901
     t903 = t901 + t874*t900
     t904 = xp.not_equal(t891, 0)
-    t905 = 0.5*(-t877 + t843)/xp.where(t904, t891, 1)
+    t905 = (-t877 + t843)/xp.where(t904, 2*t891, 1)
     t906 = xp.abs(t905)
     t907 = xp.greater_equal(t906, 1)
-    t908 = xp.abs(1/xp.where(t907, t905, 1))
+    t908 = 1/xp.abs(xp.where(t907, t905, 1))
     t909 = xp.where(t904, xp.where(xp.greater_equal(t905, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t907, t908/(1 + xp.sqrt(1 + t908**2)), 1/(t906 + xp.sqrt(1 + t906**2))), 0)
     t910 = 1/xp.sqrt(1 + t909**2)
     t911 = t891*t909
@@ -2339,10 +2339,10 @@ def velocity_ellipsoid(q):
     t937 = t935 - t909*t936
     t938 = t936 + t909*t935
     t939 = xp.not_equal(t926, 0)
-    t940 = 0.5*(-t878 + t913)/xp.where(t939, t926, 1)
+    t940 = (-t878 + t913)/xp.where(t939, 2*t926, 1)
     t941 = xp.abs(t940)
     t942 = xp.greater_equal(t941, 1)
-    t943 = xp.abs(1/xp.where(t942, t940, 1))
+    t943 = 1/xp.abs(xp.where(t942, t940, 1))
     t944 = xp.where(t939, xp.where(xp.greater_equal(t940, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t942, t943/(1 + xp.sqrt(1 + t943**2)), 1/(t941 + xp.sqrt(1 + t941**2))), 0)
     t945 = 1/xp.sqrt(1 + t944**2)
     t946 = t926*t944
@@ -2374,10 +2374,10 @@ def velocity_ellipsoid(q):
     t972 = t970 - t944*t971
     t973 = t971 + t944*t970
     t974 = xp.not_equal(t961, 0)
-    t975 = 0.5*(-t912 + t947)/xp.where(t974, t961, 1)
+    t975 = (-t912 + t947)/xp.where(t974, 2*t961, 1)
     t976 = xp.abs(t975)
     t977 = xp.greater_equal(t976, 1)
-    t978 = xp.abs(1/xp.where(t977, t975, 1))
+    t978 = 1/xp.abs(xp.where(t977, t975, 1))
     t979 = xp.where(t974, xp.where(xp.greater_equal(t975, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t977, t978/(1 + xp.sqrt(1 + t978**2)), 1/(t976 + xp.sqrt(1 + t976**2))), 0)
     t980 = 1/xp.sqrt(1 + t979**2)
     t981 = t961*t979
@@ -2409,10 +2409,10 @@ def velocity_ellipsoid(q):
     t1007 = t1005 - t979*t1006
     t1008 = t1006 + t979*t1005
     t1009 = xp.not_equal(t996, 0)
-    t1010 = 0.5*(-t982 + t948)/xp.where(t1009, t996, 1)
+    t1010 = (-t982 + t948)/xp.where(t1009, 2*t996, 1)
     t1011 = xp.abs(t1010)
     t1012 = xp.greater_equal(t1011, 1)
-    t1013 = xp.abs(1/xp.where(t1012, t1010, 1))
+    t1013 = 1/xp.abs(xp.where(t1012, t1010, 1))
     t1014 = xp.where(t1009, xp.where(xp.greater_equal(t1010, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1012, t1013/(1 + xp.sqrt(1 + t1013**2)), 1/(t1011 + xp.sqrt(1 + t1011**2))), 0)
     t1015 = 1/xp.sqrt(1 + t1014**2)
     t1016 = t948 + t996*t1014
@@ -2443,10 +2443,10 @@ def velocity_ellipsoid(q):
     t1041 = t1039 - t1014*t1040
     t1042 = t1040 + t1014*t1039
     t1043 = xp.not_equal(t1029, 0)
-    t1044 = 0.5*(-t983 + t1016)/xp.where(t1043, t1029, 1)
+    t1044 = (-t983 + t1016)/xp.where(t1043, 2*t1029, 1)
     t1045 = xp.abs(t1044)
     t1046 = xp.greater_equal(t1045, 1)
-    t1047 = xp.abs(1/xp.where(t1046, t1044, 1))
+    t1047 = 1/xp.abs(xp.where(t1046, t1044, 1))
     t1048 = xp.where(t1043, xp.where(xp.greater_equal(t1044, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1046, t1047/(1 + xp.sqrt(1 + t1047**2)), 1/(t1045 + xp.sqrt(1 + t1045**2))), 0)
     t1049 = 1/xp.sqrt(1 + t1048**2)
     t1050 = t987*t1049
@@ -2642,10 +2642,10 @@ def condition_number(q):
     t79 = t26*t51
     t80 = t31*t40 + t78*t56 + t79*t60
     t81 = xp.not_equal(t80, 0)
-    t82 = 0.5*(-t77 + t72)/xp.where(t81, -t80, 1)
+    t82 = (-t77 + t72)/xp.where(t81, -2*t80, 1)
     t83 = xp.abs(t82)
     t84 = xp.greater_equal(t83, 1)
-    t85 = xp.abs(1/xp.where(t84, t82, 1))
+    t85 = 1/xp.abs(xp.where(t84, t82, 1))
     t86 = xp.where(t81, xp.where(xp.greater_equal(t82, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t84, t85/(1 + xp.sqrt(1 + t85**2)), 1/(t83 + xp.sqrt(1 + t83**2))), 0)
     t87 = 1/xp.sqrt(1 + t86**2)
     t88 = t80*t86
@@ -2665,10 +2665,10 @@ def condition_number(q):
     t102 = t100 - t99*t86
     t103 = t64*t97 - t68*t101
     t104 = xp.not_equal(t103, 0)
-    t105 = 0.5*(-t89 + t73)/xp.where(t104, t103, 1)
+    t105 = (-t89 + t73)/xp.where(t104, 2*t103, 1)
     t106 = xp.abs(t105)
     t107 = xp.greater_equal(t106, 1)
-    t108 = xp.abs(1/xp.where(t107, t105, 1))
+    t108 = 1/xp.abs(xp.where(t107, t105, 1))
     t109 = xp.where(t104, xp.where(xp.greater_equal(t105, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t107, t108/(1 + xp.sqrt(1 + t108**2)), 1/(t106 + xp.sqrt(1 + t106**2))), 0)
     t110 = 1/xp.sqrt(1 + t109**2)
     t111 = t103*t109
@@ -2684,10 +2684,10 @@ def condition_number(q):
     t121 = t119 - t118*t109
     t122 = t71*t120
     t123 = xp.not_equal(t122, 0)
-    t124 = 0.5*(-t112 + t74)/xp.where(t123, t122, 1)
+    t124 = (-t112 + t74)/xp.where(t123, 2*t122, 1)
     t125 = xp.abs(t124)
     t126 = xp.greater_equal(t125, 1)
-    t127 = xp.abs(1/xp.where(t126, t124, 1))
+    t127 = 1/xp.abs(xp.where(t126, t124, 1))
     t128 = xp.where(t123, xp.where(xp.greater_equal(t124, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t126, t127/(1 + xp.sqrt(1 + t127**2)), 1/(t125 + xp.sqrt(1 + t125**2))), 0)
     t129 = 1/xp.sqrt(1 + t128**2)
     t130 = t122*t128
@@ -2702,10 +2702,10 @@ def condition_number(q):
     t139 = t138*t109
     t140 = -t98*t117 + t102*t121 + t75*t137*t86*t87**2 + t139*t94
     t141 = xp.not_equal(t140, 0)
-    t142 = 0.5*(-t90 + t113)/xp.where(t141, t140, 1)
+    t142 = (-t90 + t113)/xp.where(t141, 2*t140, 1)
     t143 = xp.abs(t142)
     t144 = xp.greater_equal(t143, 1)
-    t145 = xp.abs(1/xp.where(t144, t142, 1))
+    t145 = 1/xp.abs(xp.where(t144, t142, 1))
     t146 = xp.where(t141, xp.where(xp.greater_equal(t142, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t144, t145/(1 + xp.sqrt(1 + t145**2)), 1/(t143 + xp.sqrt(1 + t143**2))), 0)
     t147 = 1/xp.sqrt(1 + t146**2)
     t148 = t140*t146
@@ -2737,10 +2737,10 @@ def condition_number(q):
     t174 = t173*t128
     t175 = -t136*t167 - t170*t155 + t172*t159 + t174*t163
     t176 = xp.not_equal(t175, 0)
-    t177 = 0.5*(-t149 + t132)/xp.where(t176, t175, 1)
+    t177 = (-t149 + t132)/xp.where(t176, 2*t175, 1)
     t178 = xp.abs(t177)
     t179 = xp.greater_equal(t178, 1)
-    t180 = xp.abs(1/xp.where(t179, t177, 1))
+    t180 = 1/xp.abs(xp.where(t179, t177, 1))
     t181 = xp.where(t176, xp.where(xp.greater_equal(t177, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t179, t180/(1 + xp.sqrt(1 + t180**2)), 1/(t178 + xp.sqrt(1 + t178**2))), 0)
     t182 = 1/xp.sqrt(1 + t181**2)
     t183 = t175*t181
@@ -2765,10 +2765,10 @@ def condition_number(q):
     t202 = -t156*t189 + t160*t193 + t164*t197 + t168*t201
     t203 = t135*t200 - t169*t188 + t171*t192 + t173*t196
     t204 = xp.not_equal(t202, 0)
-    t205 = 0.5*(-t150 + t185)/xp.where(t204, t202, 1)
+    t205 = (-t150 + t185)/xp.where(t204, 2*t202, 1)
     t206 = xp.abs(t205)
     t207 = xp.greater_equal(t206, 1)
-    t208 = xp.abs(1/xp.where(t207, t205, 1))
+    t208 = 1/xp.abs(xp.where(t207, t205, 1))
     t209 = xp.where(t204, xp.where(xp.greater_equal(t205, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t207, t208/(1 + xp.sqrt(1 + t208**2)), 1/(t206 + xp.sqrt(1 + t206**2))), 0)
     t210 = 1/xp.sqrt(1 + t209**2)
     t211 = t202*t209
@@ -2791,10 +2791,10 @@ def condition_number(q):
     t228 = t226 - t227*t209
     t229 = t227 + t226*t209
     t230 = xp.not_equal(t203, 0)
-    t231 = 0.5*(-t131 + t184)/xp.where(t230, t203, 1)
+    t231 = (-t131 + t184)/xp.where(t230, 2*t203, 1)
     t232 = xp.abs(t231)
     t233 = xp.greater_equal(t232, 1)
-    t234 = xp.abs(1/xp.where(t233, t231, 1))
+    t234 = 1/xp.abs(xp.where(t233, t231, 1))
     t235 = xp.where(t230, xp.where(xp.greater_equal(t231, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t233, t234/(1 + xp.sqrt(1 + t234**2)), 1/(t232 + xp.sqrt(1 + t232**2))), 0)
     t236 = 1/xp.sqrt(1 + t235**2)
     t237 = t203*t235
@@ -2818,10 +2818,10 @@ def condition_number(q):
     t255 = t253 + t252*t235
     t256 = t216*t242 + t220*t246 + t224*t250 + t228*t254
     t257 = xp.not_equal(t256, 0)
-    t258 = 0.5*(-t238 + t212)/xp.where(t257, t256, 1)
+    t258 = (-t238 + t212)/xp.where(t257, 2*t256, 1)
     t259 = xp.abs(t258)
     t260 = xp.greater_equal(t259, 1)
-    t261 = xp.abs(1/xp.where(t260, t258, 1))
+    t261 = 1/xp.abs(xp.where(t260, t258, 1))
     t262 = xp.where(t257, xp.where(xp.greater_equal(t258, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t260, t261/(1 + xp.sqrt(1 + t261**2)), 1/(t259 + xp.sqrt(1 + t259**2))), 0)
     t263 = 1/xp.sqrt(1 + t262**2)
     t264 = t256*t262
@@ -2846,10 +2846,10 @@ def condition_number(q):
     t283 = t217*t269 + t221*t273 + t225*t277 + t229*t281
     t284 = -t243*t270 + t247*t274 + t251*t278 + t255*t282
     t285 = xp.not_equal(t283, 0)
-    t286 = 0.5*(-t265 + t213)/xp.where(t285, t283, 1)
+    t286 = (-t265 + t213)/xp.where(t285, 2*t283, 1)
     t287 = xp.abs(t286)
     t288 = xp.greater_equal(t287, 1)
-    t289 = xp.abs(1/xp.where(t288, t286, 1))
+    t289 = 1/xp.abs(xp.where(t288, t286, 1))
     t290 = xp.where(t285, xp.where(xp.greater_equal(t286, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t288, t289/(1 + xp.sqrt(1 + t289**2)), 1/(t287 + xp.sqrt(1 + t287**2))), 0)
     t291 = 1/xp.sqrt(1 + t290**2)
     t292 = t283*t290
@@ -2872,10 +2872,10 @@ def condition_number(q):
     t309 = t307 - t308*t290
     t310 = t308 + t307*t290
     t311 = xp.not_equal(t284, 0)
-    t312 = 0.5*(-t239 + t266)/xp.where(t311, t284, 1)
+    t312 = (-t239 + t266)/xp.where(t311, 2*t284, 1)
     t313 = xp.abs(t312)
     t314 = xp.greater_equal(t313, 1)
-    t315 = xp.abs(1/xp.where(t314, t312, 1))
+    t315 = 1/xp.abs(xp.where(t314, t312, 1))
     t316 = xp.where(t311, xp.where(xp.greater_equal(t312, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t314, t315/(1 + xp.sqrt(1 + t315**2)), 1/(t313 + xp.sqrt(1 + t313**2))), 0)
     t317 = 1/xp.sqrt(1 + t316**2)
     t318 = t284*t316
@@ -2899,10 +2899,10 @@ def condition_number(q):
     t336 = t334 + t333*t316
     t337 = t298*t323 + t302*t327 + t306*t331 + t310*t335
     t338 = xp.not_equal(t337, 0)
-    t339 = 0.5*(-t319 + t294)/xp.where(t338, t337, 1)
+    t339 = (-t319 + t294)/xp.where(t338, 2*t337, 1)
     t340 = xp.abs(t339)
     t341 = xp.greater_equal(t340, 1)
-    t342 = xp.abs(1/xp.where(t341, t339, 1))
+    t342 = 1/xp.abs(xp.where(t341, t339, 1))
     t343 = xp.where(t338, xp.where(xp.greater_equal(t339, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t341, t342/(1 + xp.sqrt(1 + t342**2)), 1/(t340 + xp.sqrt(1 + t340**2))), 0)
     t344 = 1/xp.sqrt(1 + t343**2)
     t345 = t337*t343
@@ -2927,10 +2927,10 @@ def condition_number(q):
     t364 = t324*t351 + t328*t355 + t332*t359 + t336*t363
     t365 = t297*t350 + t301*t354 + t305*t358 + t309*t362
     t366 = xp.not_equal(t364, 0)
-    t367 = 0.5*(-t320 + t347)/xp.where(t366, t364, 1)
+    t367 = (-t320 + t347)/xp.where(t366, 2*t364, 1)
     t368 = xp.abs(t367)
     t369 = xp.greater_equal(t368, 1)
-    t370 = xp.abs(1/xp.where(t369, t367, 1))
+    t370 = 1/xp.abs(xp.where(t369, t367, 1))
     t371 = xp.where(t366, xp.where(xp.greater_equal(t367, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t369, t370/(1 + xp.sqrt(1 + t370**2)), 1/(t368 + xp.sqrt(1 + t368**2))), 0)
     t372 = 1/xp.sqrt(1 + t371**2)
     t373 = t364*t371
@@ -2953,10 +2953,10 @@ def condition_number(q):
     t390 = t388 - t389*t371
     t391 = t389 + t388*t371
     t392 = xp.not_equal(t365, 0)
-    t393 = 0.5*(-t293 + t346)/xp.where(t392, t365, 1)
+    t393 = (-t293 + t346)/xp.where(t392, 2*t365, 1)
     t394 = xp.abs(t393)
     t395 = xp.greater_equal(t394, 1)
-    t396 = xp.abs(1/xp.where(t395, t393, 1))
+    t396 = 1/xp.abs(xp.where(t395, t393, 1))
     t397 = xp.where(t392, xp.where(xp.greater_equal(t393, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t395, t396/(1 + xp.sqrt(1 + t396**2)), 1/(t394 + xp.sqrt(1 + t394**2))), 0)
     t398 = 1/xp.sqrt(1 + t397**2)
     t399 = t365*t397
@@ -2980,10 +2980,10 @@ def condition_number(q):
     t417 = t415 + t414*t397
     t418 = t378*t404 + t382*t408 + t386*t412 + t390*t416
     t419 = xp.not_equal(t418, 0)
-    t420 = 0.5*(-t400 + t374)/xp.where(t419, t418, 1)
+    t420 = (-t400 + t374)/xp.where(t419, 2*t418, 1)
     t421 = xp.abs(t420)
     t422 = xp.greater_equal(t421, 1)
-    t423 = xp.abs(1/xp.where(t422, t420, 1))
+    t423 = 1/xp.abs(xp.where(t422, t420, 1))
     t424 = xp.where(t419, xp.where(xp.greater_equal(t420, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t422, t423/(1 + xp.sqrt(1 + t423**2)), 1/(t421 + xp.sqrt(1 + t421**2))), 0)
     t425 = 1/xp.sqrt(1 + t424**2)
     t426 = t418*t424
@@ -3008,10 +3008,10 @@ def condition_number(q):
     t445 = t379*t431 + t383*t435 + t387*t439 + t391*t443
     t446 = t405*t432 + t409*t436 + t413*t440 + t417*t444
     t447 = xp.not_equal(t445, 0)
-    t448 = 0.5*(-t427 + t375)/xp.where(t447, t445, 1)
+    t448 = (-t427 + t375)/xp.where(t447, 2*t445, 1)
     t449 = xp.abs(t448)
     t450 = xp.greater_equal(t449, 1)
-    t451 = xp.abs(1/xp.where(t450, t448, 1))
+    t451 = 1/xp.abs(xp.where(t450, t448, 1))
     t452 = xp.where(t447, xp.where(xp.greater_equal(t448, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t450, t451/(1 + xp.sqrt(1 + t451**2)), 1/(t449 + xp.sqrt(1 + t449**2))), 0)
     t453 = 1/xp.sqrt(1 + t452**2)
     t454 = t445*t452
@@ -3034,10 +3034,10 @@ def condition_number(q):
     t471 = t469 - t470*t452
     t472 = t470 + t469*t452
     t473 = xp.not_equal(t446, 0)
-    t474 = 0.5*(-t401 + t428)/xp.where(t473, t446, 1)
+    t474 = (-t401 + t428)/xp.where(t473, 2*t446, 1)
     t475 = xp.abs(t474)
     t476 = xp.greater_equal(t475, 1)
-    t477 = xp.abs(1/xp.where(t476, t474, 1))
+    t477 = 1/xp.abs(xp.where(t476, t474, 1))
     t478 = xp.where(t473, xp.where(xp.greater_equal(t474, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t476, t477/(1 + xp.sqrt(1 + t477**2)), 1/(t475 + xp.sqrt(1 + t475**2))), 0)
     t479 = 1/xp.sqrt(1 + t478**2)
     t480 = t446*t478
@@ -3061,10 +3061,10 @@ def condition_number(q):
     t498 = t496 + t495*t478
     t499 = t460*t485 + t464*t489 + t468*t493 + t472*t497
     t500 = xp.not_equal(t499, 0)
-    t501 = 0.5*(-t481 + t456)/xp.where(t500, t499, 1)
+    t501 = (-t481 + t456)/xp.where(t500, 2*t499, 1)
     t502 = xp.abs(t501)
     t503 = xp.greater_equal(t502, 1)
-    t504 = xp.abs(1/xp.where(t503, t501, 1))
+    t504 = 1/xp.abs(xp.where(t503, t501, 1))
     t505 = xp.where(t500, xp.where(xp.greater_equal(t501, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t503, t504/(1 + xp.sqrt(1 + t504**2)), 1/(t502 + xp.sqrt(1 + t502**2))), 0)
     t506 = 1/xp.sqrt(1 + t505**2)
     t507 = t499*t505
@@ -3089,10 +3089,10 @@ def condition_number(q):
     t526 = t486*t513 + t490*t517 + t494*t521 + t498*t525
     t527 = t459*t512 + t463*t516 + t467*t520 + t471*t524
     t528 = xp.not_equal(t526, 0)
-    t529 = 0.5*(-t482 + t509)/xp.where(t528, t526, 1)
+    t529 = (-t482 + t509)/xp.where(t528, 2*t526, 1)
     t530 = xp.abs(t529)
     t531 = xp.greater_equal(t530, 1)
-    t532 = xp.abs(1/xp.where(t531, t529, 1))
+    t532 = 1/xp.abs(xp.where(t531, t529, 1))
     t533 = xp.where(t528, xp.where(xp.greater_equal(t529, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t531, t532/(1 + xp.sqrt(1 + t532**2)), 1/(t530 + xp.sqrt(1 + t530**2))), 0)
     t534 = 1/xp.sqrt(1 + t533**2)
     t535 = t526*t533
@@ -3115,10 +3115,10 @@ def condition_number(q):
     t552 = t550 - t551*t533
     t553 = t551 + t550*t533
     t554 = xp.not_equal(t527, 0)
-    t555 = 0.5*(-t455 + t508)/xp.where(t554, t527, 1)
+    t555 = (-t455 + t508)/xp.where(t554, 2*t527, 1)
     t556 = xp.abs(t555)
     t557 = xp.greater_equal(t556, 1)
-    t558 = xp.abs(1/xp.where(t557, t555, 1))
+    t558 = 1/xp.abs(xp.where(t557, t555, 1))
     t559 = xp.where(t554, xp.where(xp.greater_equal(t555, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t557, t558/(1 + xp.sqrt(1 + t558**2)), 1/(t556 + xp.sqrt(1 + t556**2))), 0)
     t560 = 1/xp.sqrt(1 + t559**2)
     t561 = t527*t559
@@ -3142,10 +3142,10 @@ def condition_number(q):
     t579 = t577 + t576*t559
     t580 = t540*t566 + t544*t570 + t548*t574 + t552*t578
     t581 = xp.not_equal(t580, 0)
-    t582 = 0.5*(-t562 + t536)/xp.where(t581, t580, 1)
+    t582 = (-t562 + t536)/xp.where(t581, 2*t580, 1)
     t583 = xp.abs(t582)
     t584 = xp.greater_equal(t583, 1)
-    t585 = xp.abs(1/xp.where(t584, t582, 1))
+    t585 = 1/xp.abs(xp.where(t584, t582, 1))
     t586 = xp.where(t581, xp.where(xp.greater_equal(t582, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t584, t585/(1 + xp.sqrt(1 + t585**2)), 1/(t583 + xp.sqrt(1 + t583**2))), 0)
     t587 = 1/xp.sqrt(1 + t586**2)
     t588 = t580*t586
@@ -3170,10 +3170,10 @@ def condition_number(q):
     t607 = t541*t593 + t545*t597 + t549*t601 + t553*t605
     t608 = t567*t594 + t571*t598 + t575*t602 + t579*t606
     t609 = xp.not_equal(t607, 0)
-    t610 = 0.5*(-t589 + t537)/xp.where(t609, t607, 1)
+    t610 = (-t589 + t537)/xp.where(t609, 2*t607, 1)
     t611 = xp.abs(t610)
     t612 = xp.greater_equal(t611, 1)
-    t613 = xp.abs(1/xp.where(t612, t610, 1))
+    t613 = 1/xp.abs(xp.where(t612, t610, 1))
     t614 = xp.where(t609, xp.where(xp.greater_equal(t610, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t612, t613/(1 + xp.sqrt(1 + t613**2)), 1/(t611 + xp.sqrt(1 + t611**2))), 0)
     t615 = 1/xp.sqrt(1 + t614**2)
     t616 = t607*t614
@@ -3196,10 +3196,10 @@ def condition_number(q):
     t633 = t631 - t632*t614
     t634 = t632 + t631*t614
     t635 = xp.not_equal(t608, 0)
-    t636 = 0.5*(-t563 + t590)/xp.where(t635, t608, 1)
+    t636 = (-t563 + t590)/xp.where(t635, 2*t608, 1)
     t637 = xp.abs(t636)
     t638 = xp.greater_equal(t637, 1)
-    t639 = xp.abs(1/xp.where(t638, t636, 1))
+    t639 = 1/xp.abs(xp.where(t638, t636, 1))
     t640 = xp.where(t635, xp.where(xp.greater_equal(t636, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t638, t639/(1 + xp.sqrt(1 + t639**2)), 1/(t637 + xp.sqrt(1 + t637**2))), 0)
     t641 = 1/xp.sqrt(1 + t640**2)
     t642 = t608*t640
@@ -3223,10 +3223,10 @@ def condition_number(q):
     t660 = t658 + t657*t640
     t661 = t622*t647 + t626*t651 + t630*t655 + t634*t659
     t662 = xp.not_equal(t661, 0)
-    t663 = 0.5*(-t643 + t618)/xp.where(t662, t661, 1)
+    t663 = (-t643 + t618)/xp.where(t662, 2*t661, 1)
     t664 = xp.abs(t663)
     t665 = xp.greater_equal(t664, 1)
-    t666 = xp.abs(1/xp.where(t665, t663, 1))
+    t666 = 1/xp.abs(xp.where(t665, t663, 1))
     t667 = xp.where(t662, xp.where(xp.greater_equal(t663, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t665, t666/(1 + xp.sqrt(1 + t666**2)), 1/(t664 + xp.sqrt(1 + t664**2))), 0)
     t668 = 1/xp.sqrt(1 + t667**2)
     t669 = t661*t667
@@ -3251,10 +3251,10 @@ def condition_number(q):
     t688 = t648*t675 + t652*t679 + t656*t683 + t660*t687
     t689 = t621*t674 + t625*t678 + t629*t682 + t633*t686
     t690 = xp.not_equal(t688, 0)
-    t691 = 0.5*(-t644 + t671)/xp.where(t690, t688, 1)
+    t691 = (-t644 + t671)/xp.where(t690, 2*t688, 1)
     t692 = xp.abs(t691)
     t693 = xp.greater_equal(t692, 1)
-    t694 = xp.abs(1/xp.where(t693, t691, 1))
+    t694 = 1/xp.abs(xp.where(t693, t691, 1))
     t695 = xp.where(t690, xp.where(xp.greater_equal(t691, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t693, t694/(1 + xp.sqrt(1 + t694**2)), 1/(t692 + xp.sqrt(1 + t692**2))), 0)
     t696 = 1/xp.sqrt(1 + t695**2)
     t697 = t688*t695
@@ -3277,10 +3277,10 @@ def condition_number(q):
     t714 = t712 - t713*t695
     t715 = t713 + t712*t695
     t716 = xp.not_equal(t689, 0)
-    t717 = 0.5*(-t617 + t670)/xp.where(t716, t689, 1)
+    t717 = (-t617 + t670)/xp.where(t716, 2*t689, 1)
     t718 = xp.abs(t717)
     t719 = xp.greater_equal(t718, 1)
-    t720 = xp.abs(1/xp.where(t719, t717, 1))
+    t720 = 1/xp.abs(xp.where(t719, t717, 1))
     t721 = xp.where(t716, xp.where(xp.greater_equal(t717, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t719, t720/(1 + xp.sqrt(1 + t720**2)), 1/(t718 + xp.sqrt(1 + t718**2))), 0)
     t722 = 1/xp.sqrt(1 + t721**2)
     t723 = t689*t721
@@ -3304,10 +3304,10 @@ def condition_number(q):
     t741 = t739 + t738*t721
     t742 = t702*t728 + t706*t732 + t710*t736 + t714*t740
     t743 = xp.not_equal(t742, 0)
-    t744 = 0.5*(-t724 + t698)/xp.where(t743, t742, 1)
+    t744 = (-t724 + t698)/xp.where(t743, 2*t742, 1)
     t745 = xp.abs(t744)
     t746 = xp.greater_equal(t745, 1)
-    t747 = xp.abs(1/xp.where(t746, t744, 1))
+    t747 = 1/xp.abs(xp.where(t746, t744, 1))
     t748 = xp.where(t743, xp.where(xp.greater_equal(t744, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t746, t747/(1 + xp.sqrt(1 + t747**2)), 1/(t745 + xp.sqrt(1 + t745**2))), 0)
     t749 = 1/xp.sqrt(1 + t748**2)
     t750 = t742*t748
@@ -3332,10 +3332,10 @@ def condition_number(q):
     t769 = t703*t755 + t707*t759 + t711*t763 + t715*t767
     t770 = t729*t756 + t733*t760 + t737*t764 + t741*t768
     t771 = xp.not_equal(t769, 0)
-    t772 = 0.5*(-t751 + t699)/xp.where(t771, t769, 1)
+    t772 = (-t751 + t699)/xp.where(t771, 2*t769, 1)
     t773 = xp.abs(t772)
     t774 = xp.greater_equal(t773, 1)
-    t775 = xp.abs(1/xp.where(t774, t772, 1))
+    t775 = 1/xp.abs(xp.where(t774, t772, 1))
     t776 = xp.where(t771, xp.where(xp.greater_equal(t772, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t774, t775/(1 + xp.sqrt(1 + t775**2)), 1/(t773 + xp.sqrt(1 + t773**2))), 0)
     t777 = 1/xp.sqrt(1 + t776**2)
     t778 = t769*t776
@@ -3358,10 +3358,10 @@ def condition_number(q):
     t795 = t793 - t794*t776
     t796 = t794 + t793*t776
     t797 = xp.not_equal(t770, 0)
-    t798 = 0.5*(-t725 + t752)/xp.where(t797, t770, 1)
+    t798 = (-t725 + t752)/xp.where(t797, 2*t770, 1)
     t799 = xp.abs(t798)
     t800 = xp.greater_equal(t799, 1)
-    t801 = xp.abs(1/xp.where(t800, t798, 1))
+    t801 = 1/xp.abs(xp.where(t800, t798, 1))
     t802 = xp.where(t797, xp.where(xp.greater_equal(t798, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t800, t801/(1 + xp.sqrt(1 + t801**2)), 1/(t799 + xp.sqrt(1 + t799**2))), 0)
     t803 = 1/xp.sqrt(1 + t802**2)
     t804 = t770*t802
@@ -3385,10 +3385,10 @@ def condition_number(q):
     t822 = t820 + t819*t802
     t823 = t784*t809 + t788*t813 + t792*t817 + t796*t821
     t824 = xp.not_equal(t823, 0)
-    t825 = 0.5*(-t805 + t780)/xp.where(t824, t823, 1)
+    t825 = (-t805 + t780)/xp.where(t824, 2*t823, 1)
     t826 = xp.abs(t825)
     t827 = xp.greater_equal(t826, 1)
-    t828 = xp.abs(1/xp.where(t827, t825, 1))
+    t828 = 1/xp.abs(xp.where(t827, t825, 1))
     t829 = xp.where(t824, xp.where(xp.greater_equal(t825, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t827, t828/(1 + xp.sqrt(1 + t828**2)), 1/(t826 + xp.sqrt(1 + t826**2))), 0)
     t830 = 1/xp.sqrt(1 + t829**2)
     t831 = t823*t829
@@ -3413,10 +3413,10 @@ def condition_number(q):
     t850 = t810*t837 + t814*t841 + t818*t845 + t822*t849
     t851 = t783*t836 + t787*t840 + t791*t844 + t795*t848
     t852 = xp.not_equal(t850, 0)
-    t853 = 0.5*(-t806 + t833)/xp.where(t852, t850, 1)
+    t853 = (-t806 + t833)/xp.where(t852, 2*t850, 1)
     t854 = xp.abs(t853)
     t855 = xp.greater_equal(t854, 1)
-    t856 = xp.abs(1/xp.where(t855, t853, 1))
+    t856 = 1/xp.abs(xp.where(t855, t853, 1))
     t857 = xp.where(t852, xp.where(xp.greater_equal(t853, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t855, t856/(1 + xp.sqrt(1 + t856**2)), 1/(t854 + xp.sqrt(1 + t854**2))), 0)
     t858 = 1/xp.sqrt(1 + t857**2)
     t859 = t850*t857
@@ -3439,10 +3439,10 @@ def condition_number(q):
     t876 = t874 - t875*t857
     t877 = t875 + t874*t857
     t878 = xp.not_equal(t851, 0)
-    t879 = 0.5*(-t779 + t832)/xp.where(t878, t851, 1)
+    t879 = (-t779 + t832)/xp.where(t878, 2*t851, 1)
     t880 = xp.abs(t879)
     t881 = xp.greater_equal(t880, 1)
-    t882 = xp.abs(1/xp.where(t881, t879, 1))
+    t882 = 1/xp.abs(xp.where(t881, t879, 1))
     t883 = xp.where(t878, xp.where(xp.greater_equal(t879, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t881, t882/(1 + xp.sqrt(1 + t882**2)), 1/(t880 + xp.sqrt(1 + t880**2))), 0)
     t884 = 1/xp.sqrt(1 + t883**2)
     t885 = t851*t883
@@ -3466,10 +3466,10 @@ def condition_number(q):
     t903 = t901 + t900*t883
     t904 = t864*t890 + t868*t894 + t872*t898 + t876*t902
     t905 = xp.not_equal(t904, 0)
-    t906 = 0.5*(-t886 + t860)/xp.where(t905, t904, 1)
+    t906 = (-t886 + t860)/xp.where(t905, 2*t904, 1)
     t907 = xp.abs(t906)
     t908 = xp.greater_equal(t907, 1)
-    t909 = xp.abs(1/xp.where(t908, t906, 1))
+    t909 = 1/xp.abs(xp.where(t908, t906, 1))
     t910 = xp.where(t905, xp.where(xp.greater_equal(t906, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t908, t909/(1 + xp.sqrt(1 + t909**2)), 1/(t907 + xp.sqrt(1 + t907**2))), 0)
     t911 = 1/xp.sqrt(1 + t910**2)
     t912 = t904*t910
@@ -3494,10 +3494,10 @@ def condition_number(q):
     t931 = t865*t917 + t869*t921 + t873*t925 + t877*t929
     t932 = t891*t918 + t895*t922 + t899*t926 + t903*t930
     t933 = xp.not_equal(t931, 0)
-    t934 = 0.5*(-t913 + t861)/xp.where(t933, t931, 1)
+    t934 = (-t913 + t861)/xp.where(t933, 2*t931, 1)
     t935 = xp.abs(t934)
     t936 = xp.greater_equal(t935, 1)
-    t937 = xp.abs(1/xp.where(t936, t934, 1))
+    t937 = 1/xp.abs(xp.where(t936, t934, 1))
     t938 = xp.where(t933, xp.where(xp.greater_equal(t934, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t936, t937/(1 + xp.sqrt(1 + t937**2)), 1/(t935 + xp.sqrt(1 + t935**2))), 0)
     t939 = 1/xp.sqrt(1 + t938**2)
     t940 = t931*t938
@@ -3520,10 +3520,10 @@ def condition_number(q):
     t957 = t955 - t956*t938
     t958 = t956 + t955*t938
     t959 = xp.not_equal(t932, 0)
-    t960 = 0.5*(-t887 + t914)/xp.where(t959, t932, 1)
+    t960 = (-t887 + t914)/xp.where(t959, 2*t932, 1)
     t961 = xp.abs(t960)
     t962 = xp.greater_equal(t961, 1)
-    t963 = xp.abs(1/xp.where(t962, t960, 1))
+    t963 = 1/xp.abs(xp.where(t962, t960, 1))
     t964 = xp.where(t959, xp.where(xp.greater_equal(t960, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t962, t963/(1 + xp.sqrt(1 + t963**2)), 1/(t961 + xp.sqrt(1 + t961**2))), 0)
     t965 = 1/xp.sqrt(1 + t964**2)
     t966 = t932*t964
@@ -3547,10 +3547,10 @@ def condition_number(q):
     t984 = t982 + t981*t964
     t985 = t946*t971 + t950*t975 + t954*t979 + t958*t983
     t986 = xp.not_equal(t985, 0)
-    t987 = 0.5*(-t967 + t942)/xp.where(t986, t985, 1)
+    t987 = (-t967 + t942)/xp.where(t986, 2*t985, 1)
     t988 = xp.abs(t987)
     t989 = xp.greater_equal(t988, 1)
-    t990 = xp.abs(1/xp.where(t989, t987, 1))
+    t990 = 1/xp.abs(xp.where(t989, t987, 1))
     t991 = xp.where(t986, xp.where(xp.greater_equal(t987, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t989, t990/(1 + xp.sqrt(1 + t990**2)), 1/(t988 + xp.sqrt(1 + t988**2))), 0)
     t992 = 1/xp.sqrt(1 + t991**2)
     t993 = t985*t991
@@ -3575,10 +3575,10 @@ def condition_number(q):
     t1012 = t972*t999 + t976*t1003 + t980*t1007 + t984*t1011
     t1013 = t945*t998 + t949*t1002 + t953*t1006 + t957*t1010
     t1014 = xp.not_equal(t1012, 0)
-    t1015 = 0.5*(-t968 + t995)/xp.where(t1014, t1012, 1)
+    t1015 = (-t968 + t995)/xp.where(t1014, 2*t1012, 1)
     t1016 = xp.abs(t1015)
     t1017 = xp.greater_equal(t1016, 1)
-    t1018 = xp.abs(1/xp.where(t1017, t1015, 1))
+    t1018 = 1/xp.abs(xp.where(t1017, t1015, 1))
     t1019 = xp.where(t1014, xp.where(xp.greater_equal(t1015, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1017, t1018/(1 + xp.sqrt(1 + t1018**2)), 1/(t1016 + xp.sqrt(1 + t1016**2))), 0)
     t1020 = 1/xp.sqrt(1 + t1019**2)
     t1021 = t1012*t1019
@@ -3601,10 +3601,10 @@ def condition_number(q):
     t1038 = t1036 - t1037*t1019
     t1039 = t1037 + t1036*t1019
     t1040 = xp.not_equal(t1013, 0)
-    t1041 = 0.5*(-t941 + t994)/xp.where(t1040, t1013, 1)
+    t1041 = (-t941 + t994)/xp.where(t1040, 2*t1013, 1)
     t1042 = xp.abs(t1041)
     t1043 = xp.greater_equal(t1042, 1)
-    t1044 = xp.abs(1/xp.where(t1043, t1041, 1))
+    t1044 = 1/xp.abs(xp.where(t1043, t1041, 1))
     t1045 = xp.where(t1040, xp.where(xp.greater_equal(t1041, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1043, t1044/(1 + xp.sqrt(1 + t1044**2)), 1/(t1042 + xp.sqrt(1 + t1042**2))), 0)
     t1046 = 1/xp.sqrt(1 + t1045**2)
     t1047 = t1013*t1045
@@ -3628,10 +3628,10 @@ def condition_number(q):
     t1065 = t1063 + t1062*t1045
     t1066 = t1026*t1052 + t1030*t1056 + t1034*t1060 + t1038*t1064
     t1067 = xp.not_equal(t1066, 0)
-    t1068 = 0.5*(-t1048 + t1022)/xp.where(t1067, t1066, 1)
+    t1068 = (-t1048 + t1022)/xp.where(t1067, 2*t1066, 1)
     t1069 = xp.abs(t1068)
     t1070 = xp.greater_equal(t1069, 1)
-    t1071 = xp.abs(1/xp.where(t1070, t1068, 1))
+    t1071 = 1/xp.abs(xp.where(t1070, t1068, 1))
     t1072 = xp.where(t1067, xp.where(xp.greater_equal(t1068, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1070, t1071/(1 + xp.sqrt(1 + t1071**2)), 1/(t1069 + xp.sqrt(1 + t1069**2))), 0)
     t1073 = 1/xp.sqrt(1 + t1072**2)
     t1074 = t1066*t1072
@@ -3656,10 +3656,10 @@ def condition_number(q):
     t1093 = t1027*t1079 + t1031*t1083 + t1035*t1087 + t1039*t1091
     t1094 = t1053*t1080 + t1057*t1084 + t1061*t1088 + t1065*t1092
     t1095 = xp.not_equal(t1093, 0)
-    t1096 = 0.5*(-t1075 + t1023)/xp.where(t1095, t1093, 1)
+    t1096 = (-t1075 + t1023)/xp.where(t1095, 2*t1093, 1)
     t1097 = xp.abs(t1096)
     t1098 = xp.greater_equal(t1097, 1)
-    t1099 = xp.abs(1/xp.where(t1098, t1096, 1))
+    t1099 = 1/xp.abs(xp.where(t1098, t1096, 1))
     t1100 = xp.where(t1095, xp.where(xp.greater_equal(t1096, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1098, t1099/(1 + xp.sqrt(1 + t1099**2)), 1/(t1097 + xp.sqrt(1 + t1097**2))), 0)
     t1101 = 1/xp.sqrt(1 + t1100**2)
     t1102 = t1023 + t1093*t1100
@@ -3681,10 +3681,10 @@ def condition_number(q):
     t1118 = t1116 + t1100*t1115
     t1119 = xp.sqrt(t1105**2 + t1109**2 + t1113**2 + t1117**2)
     t1120 = xp.not_equal(t1094, 0)
-    t1121 = 0.5*(-t1049 + t1076)/xp.where(t1120, t1094, 1)
+    t1121 = (-t1049 + t1076)/xp.where(t1120, 2*t1094, 1)
     t1122 = xp.abs(t1121)
     t1123 = xp.greater_equal(t1122, 1)
-    t1124 = xp.abs(1/xp.where(t1123, t1121, 1))
+    t1124 = 1/xp.abs(xp.where(t1123, t1121, 1))
     t1125 = xp.where(t1120, xp.where(xp.greater_equal(t1121, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1123, t1124/(1 + xp.sqrt(1 + t1124**2)), 1/(t1122 + xp.sqrt(1 + t1122**2))), 0)
     t1126 = 1/xp.sqrt(1 + t1125**2)
     t1127 = t1094*t1125
@@ -3708,10 +3708,10 @@ def condition_number(q):
     t1145 = t1143 + t1125*t1142
     t1146 = t1106*t1132 + t1110*t1136 + t1114*t1140 + t1118*t1144
     t1147 = xp.not_equal(t1146, 0)
-    t1148 = 0.5*(-t1128 + t1102)/xp.where(t1147, t1146, 1)
+    t1148 = (-t1128 + t1102)/xp.where(t1147, 2*t1146, 1)
     t1149 = xp.abs(t1148)
     t1150 = xp.greater_equal(t1149, 1)
-    t1151 = xp.abs(1/xp.where(t1150, t1148, 1))
+    t1151 = 1/xp.abs(xp.where(t1150, t1148, 1))
     t1152 = xp.where(t1147, xp.where(xp.greater_equal(t1148, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1150, t1151/(1 + xp.sqrt(1 + t1151**2)), 1/(t1149 + xp.sqrt(1 + t1149**2))), 0)
     t1153 = 1/xp.sqrt(1 + t1152**2)
     t1154 = t1102 + t1146*t1152
@@ -3736,10 +3736,10 @@ def condition_number(q):
     t1173 = xp.where(xp.greater(t1172, t1119), t1172, t1119)
     t1174 = xp.where(xp.less(t1172, t1119), t1172, t1119)
     t1175 = xp.not_equal(t1171, 0)
-    t1176 = 0.5*(-t1129 + t1154)/xp.where(t1175, t1171, 1)
+    t1176 = (-t1129 + t1154)/xp.where(t1175, 2*t1171, 1)
     t1177 = xp.abs(t1176)
     t1178 = xp.greater_equal(t1177, 1)
-    t1179 = xp.abs(1/xp.where(t1178, t1176, 1))
+    t1179 = 1/xp.abs(xp.where(t1178, t1176, 1))
     t1180 = xp.where(t1175, xp.where(xp.greater_equal(t1176, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1178, t1179/(1 + xp.sqrt(1 + t1179**2)), 1/(t1177 + xp.sqrt(1 + t1177**2))), 0)
     t1181 = 1/xp.sqrt(1 + t1180**2)
     t1182 = t1133*t1181
@@ -3764,7 +3764,9 @@ def condition_number(q):
     t1201 = xp.where(xp.less(t1198, t1174), t1198, t1174)
     t1202 = xp.where(xp.greater(t1199, t1200), t1199, t1200)
     t1203 = xp.where(xp.less(t1199, t1201), t1199, t1201)
-    kappa = xp.broadcast_to(xp.where(xp.greater(t1202, 0), t1202, 1)/xp.where(xp.less_equal(t1203, 1e-12*t1202), 0, t1203), batch)
+    t1204 = xp.where(xp.less_equal(t1203, 1e-12*t1202), 0, t1203)
+    t1205 = xp.where(xp.greater(t1202, 0), t1202, 1)
+    kappa = xp.broadcast_to(t1205/t1204, batch)
     return kappa
 
 

@@ -1282,10 +1282,10 @@ def _velocity_ellipsoid(q):
     t48 = t47**2
     t49 = t19*t25
     t50 = (t49 != 0)
-    t51 = 0.5*(-t22 + t34)/casadi.if_else(t50, -t49, 1)
+    t51 = (-t22 + t34)/casadi.if_else(t50, -2*t49, 1)
     t52 = casadi.fabs(t51)
     t53 = (t52 >= 1)
-    t54 = casadi.fabs(1/casadi.if_else(t53, t51, 1))
+    t54 = 1/casadi.fabs(casadi.if_else(t53, t51, 1))
     t55 = casadi.if_else(t50, casadi.if_else((t51 >= 0), 1, -1)*casadi.if_else(t53, t54/(1 + casadi.sqrt(1 + t54**2)), 1/(t52 + casadi.sqrt(1 + t52**2))), 0)
     t56 = 1/casadi.sqrt(1 + t55**2)
     t57 = t49*t55
@@ -1301,10 +1301,10 @@ def _velocity_ellipsoid(q):
     t67 = t66*t55
     t68 = t64*t62 + t67*t43
     t69 = (t68 != 0)
-    t70 = 0.5*(-t58 + t65)/casadi.if_else(t69, t68, 1)
+    t70 = (-t58 + t65)/casadi.if_else(t69, 2*t68, 1)
     t71 = casadi.fabs(t70)
     t72 = (t71 >= 1)
-    t73 = casadi.fabs(1/casadi.if_else(t72, t70, 1))
+    t73 = 1/casadi.fabs(casadi.if_else(t72, t70, 1))
     t74 = casadi.if_else(t69, casadi.if_else((t70 >= 0), 1, -1)*casadi.if_else(t72, t73/(1 + casadi.sqrt(1 + t73**2)), 1/(t71 + casadi.sqrt(1 + t71**2))), 0)
     t75 = 1/casadi.sqrt(1 + t74**2)
     t76 = t68*t74
@@ -1320,10 +1320,10 @@ def _velocity_ellipsoid(q):
     t86 = t84 + t83*t74
     t87 = t63*t82 + t66*t86
     t88 = (t87 != 0)
-    t89 = 0.5*(-t59 + t78)/casadi.if_else(t88, -t87, 1)
+    t89 = (-t59 + t78)/casadi.if_else(t88, -2*t87, 1)
     t90 = casadi.fabs(t89)
     t91 = (t90 >= 1)
-    t92 = casadi.fabs(1/casadi.if_else(t91, t89, 1))
+    t92 = 1/casadi.fabs(casadi.if_else(t91, t89, 1))
     t93 = casadi.if_else(t88, casadi.if_else((t89 >= 0), 1, -1)*casadi.if_else(t91, t92/(1 + casadi.sqrt(1 + t92**2)), 1/(t90 + casadi.sqrt(1 + t90**2))), 0)
     t94 = 1/casadi.sqrt(1 + t93**2)
     t95 = t87*t93
@@ -1349,10 +1349,10 @@ def _velocity_ellipsoid(q):
     t115 = t93*t94
     t116 = t81*t100 - t85*t105 + t48*t109*t115*t75
     t117 = (t116 != 0)
-    t118 = 0.5*(-t77 + t96)/casadi.if_else(t117, t116, 1)
+    t118 = (-t77 + t96)/casadi.if_else(t117, 2*t116, 1)
     t119 = casadi.fabs(t118)
     t120 = (t119 >= 1)
-    t121 = casadi.fabs(1/casadi.if_else(t120, t118, 1))
+    t121 = 1/casadi.fabs(casadi.if_else(t120, t118, 1))
     t122 = casadi.if_else(t117, casadi.if_else((t118 >= 0), 1, -1)*casadi.if_else(t120, t121/(1 + casadi.sqrt(1 + t121**2)), 1/(t119 + casadi.sqrt(1 + t119**2))), 0)
     t123 = 1/casadi.sqrt(1 + t122**2)
     t124 = t116*t122
@@ -1386,10 +1386,10 @@ def _velocity_ellipsoid(q):
     t152 = t75*t94
     t153 = t101*t129 + t106*t133 - t47*t152*t142
     t154 = (t153 != 0)
-    t155 = 0.5*(-t125 + t97)/casadi.if_else(t154, t153, 1)
+    t155 = (-t125 + t97)/casadi.if_else(t154, 2*t153, 1)
     t156 = casadi.fabs(t155)
     t157 = (t156 >= 1)
-    t158 = casadi.fabs(1/casadi.if_else(t157, t155, 1))
+    t158 = 1/casadi.fabs(casadi.if_else(t157, t155, 1))
     t159 = casadi.if_else(t154, casadi.if_else((t155 >= 0), 1, -1)*casadi.if_else(t157, t158/(1 + casadi.sqrt(1 + t158**2)), 1/(t156 + casadi.sqrt(1 + t156**2))), 0)
     t160 = 1/casadi.sqrt(1 + t159**2)
     t161 = t153*t159
@@ -1421,10 +1421,10 @@ def _velocity_ellipsoid(q):
     t187 = t186 - t159*t173
     t188 = t173 + t159*t186
     t189 = (t177 != 0)
-    t190 = 0.5*(-t126 + t163)/casadi.if_else(t189, t177, 1)
+    t190 = (-t126 + t163)/casadi.if_else(t189, 2*t177, 1)
     t191 = casadi.fabs(t190)
     t192 = (t191 >= 1)
-    t193 = casadi.fabs(1/casadi.if_else(t192, t190, 1))
+    t193 = 1/casadi.fabs(casadi.if_else(t192, t190, 1))
     t194 = casadi.if_else(t189, casadi.if_else((t190 >= 0), 1, -1)*casadi.if_else(t192, t193/(1 + casadi.sqrt(1 + t193**2)), 1/(t191 + casadi.sqrt(1 + t191**2))), 0)
     t195 = 1/casadi.sqrt(1 + t194**2)
     t196 = t177*t194
@@ -1456,10 +1456,10 @@ def _velocity_ellipsoid(q):
     t222 = t220 + t194*t221
     t223 = t221 - t194*t220
     t224 = (t211 != 0)
-    t225 = 0.5*(-t162 + t197)/casadi.if_else(t224, t211, 1)
+    t225 = (-t162 + t197)/casadi.if_else(t224, 2*t211, 1)
     t226 = casadi.fabs(t225)
     t227 = (t226 >= 1)
-    t228 = casadi.fabs(1/casadi.if_else(t227, t225, 1))
+    t228 = 1/casadi.fabs(casadi.if_else(t227, t225, 1))
     t229 = casadi.if_else(t224, casadi.if_else((t225 >= 0), 1, -1)*casadi.if_else(t227, t228/(1 + casadi.sqrt(1 + t228**2)), 1/(t226 + casadi.sqrt(1 + t226**2))), 0)
     t230 = 1/casadi.sqrt(1 + t229**2)
     t231 = t211*t229
@@ -1491,10 +1491,10 @@ def _velocity_ellipsoid(q):
     t257 = t255 + t229*t256
     t258 = -t256 + t229*t255
     t259 = (t246 != 0)
-    t260 = 0.5*(-t232 + t198)/casadi.if_else(t259, t246, 1)
+    t260 = (-t232 + t198)/casadi.if_else(t259, 2*t246, 1)
     t261 = casadi.fabs(t260)
     t262 = (t261 >= 1)
-    t263 = casadi.fabs(1/casadi.if_else(t262, t260, 1))
+    t263 = 1/casadi.fabs(casadi.if_else(t262, t260, 1))
     t264 = casadi.if_else(t259, casadi.if_else((t260 >= 0), 1, -1)*casadi.if_else(t262, t263/(1 + casadi.sqrt(1 + t263**2)), 1/(t261 + casadi.sqrt(1 + t261**2))), 0)
     t265 = 1/casadi.sqrt(1 + t264**2)
     t266 = t246*t264
@@ -1526,10 +1526,10 @@ def _velocity_ellipsoid(q):
     t292 = t290 - t264*t291
     t293 = t291 + t264*t290
     t294 = (t281 != 0)
-    t295 = 0.5*(-t233 + t268)/casadi.if_else(t294, t281, 1)
+    t295 = (-t233 + t268)/casadi.if_else(t294, 2*t281, 1)
     t296 = casadi.fabs(t295)
     t297 = (t296 >= 1)
-    t298 = casadi.fabs(1/casadi.if_else(t297, t295, 1))
+    t298 = 1/casadi.fabs(casadi.if_else(t297, t295, 1))
     t299 = casadi.if_else(t294, casadi.if_else((t295 >= 0), 1, -1)*casadi.if_else(t297, t298/(1 + casadi.sqrt(1 + t298**2)), 1/(t296 + casadi.sqrt(1 + t296**2))), 0)
     t300 = 1/casadi.sqrt(1 + t299**2)
     t301 = t281*t299
@@ -1561,10 +1561,10 @@ def _velocity_ellipsoid(q):
     t327 = t325 - t299*t326
     t328 = t326 + t299*t325
     t329 = (t316 != 0)
-    t330 = 0.5*(-t267 + t302)/casadi.if_else(t329, t316, 1)
+    t330 = (-t267 + t302)/casadi.if_else(t329, 2*t316, 1)
     t331 = casadi.fabs(t330)
     t332 = (t331 >= 1)
-    t333 = casadi.fabs(1/casadi.if_else(t332, t330, 1))
+    t333 = 1/casadi.fabs(casadi.if_else(t332, t330, 1))
     t334 = casadi.if_else(t329, casadi.if_else((t330 >= 0), 1, -1)*casadi.if_else(t332, t333/(1 + casadi.sqrt(1 + t333**2)), 1/(t331 + casadi.sqrt(1 + t331**2))), 0)
     t335 = 1/casadi.sqrt(1 + t334**2)
     t336 = t316*t334
@@ -1596,10 +1596,10 @@ def _velocity_ellipsoid(q):
     t362 = t360 - t334*t361
     t363 = t361 + t334*t360
     t364 = (t351 != 0)
-    t365 = 0.5*(-t337 + t303)/casadi.if_else(t364, t351, 1)
+    t365 = (-t337 + t303)/casadi.if_else(t364, 2*t351, 1)
     t366 = casadi.fabs(t365)
     t367 = (t366 >= 1)
-    t368 = casadi.fabs(1/casadi.if_else(t367, t365, 1))
+    t368 = 1/casadi.fabs(casadi.if_else(t367, t365, 1))
     t369 = casadi.if_else(t364, casadi.if_else((t365 >= 0), 1, -1)*casadi.if_else(t367, t368/(1 + casadi.sqrt(1 + t368**2)), 1/(t366 + casadi.sqrt(1 + t366**2))), 0)
     t370 = 1/casadi.sqrt(1 + t369**2)
     t371 = t351*t369
@@ -1631,10 +1631,10 @@ def _velocity_ellipsoid(q):
     t397 = t395 - t369*t396
     t398 = t396 + t369*t395
     t399 = (t386 != 0)
-    t400 = 0.5*(-t338 + t373)/casadi.if_else(t399, t386, 1)
+    t400 = (-t338 + t373)/casadi.if_else(t399, 2*t386, 1)
     t401 = casadi.fabs(t400)
     t402 = (t401 >= 1)
-    t403 = casadi.fabs(1/casadi.if_else(t402, t400, 1))
+    t403 = 1/casadi.fabs(casadi.if_else(t402, t400, 1))
     t404 = casadi.if_else(t399, casadi.if_else((t400 >= 0), 1, -1)*casadi.if_else(t402, t403/(1 + casadi.sqrt(1 + t403**2)), 1/(t401 + casadi.sqrt(1 + t401**2))), 0)
     t405 = 1/casadi.sqrt(1 + t404**2)
     t406 = t386*t404
@@ -1666,10 +1666,10 @@ def _velocity_ellipsoid(q):
     t432 = t430 - t404*t431
     t433 = t431 + t404*t430
     t434 = (t421 != 0)
-    t435 = 0.5*(-t372 + t407)/casadi.if_else(t434, t421, 1)
+    t435 = (-t372 + t407)/casadi.if_else(t434, 2*t421, 1)
     t436 = casadi.fabs(t435)
     t437 = (t436 >= 1)
-    t438 = casadi.fabs(1/casadi.if_else(t437, t435, 1))
+    t438 = 1/casadi.fabs(casadi.if_else(t437, t435, 1))
     t439 = casadi.if_else(t434, casadi.if_else((t435 >= 0), 1, -1)*casadi.if_else(t437, t438/(1 + casadi.sqrt(1 + t438**2)), 1/(t436 + casadi.sqrt(1 + t436**2))), 0)
     t440 = 1/casadi.sqrt(1 + t439**2)
     t441 = t421*t439
@@ -1701,10 +1701,10 @@ def _velocity_ellipsoid(q):
     t467 = t465 - t439*t466
     t468 = t466 + t439*t465
     t469 = (t456 != 0)
-    t470 = 0.5*(-t442 + t408)/casadi.if_else(t469, t456, 1)
+    t470 = (-t442 + t408)/casadi.if_else(t469, 2*t456, 1)
     t471 = casadi.fabs(t470)
     t472 = (t471 >= 1)
-    t473 = casadi.fabs(1/casadi.if_else(t472, t470, 1))
+    t473 = 1/casadi.fabs(casadi.if_else(t472, t470, 1))
     t474 = casadi.if_else(t469, casadi.if_else((t470 >= 0), 1, -1)*casadi.if_else(t472, t473/(1 + casadi.sqrt(1 + t473**2)), 1/(t471 + casadi.sqrt(1 + t471**2))), 0)
     t475 = 1/casadi.sqrt(1 + t474**2)
     t476 = t408 + t456*t474
@@ -1735,10 +1735,10 @@ def _velocity_ellipsoid(q):
     t501 = t499 - t474*t500
     t502 = t500 + t474*t499
     t503 = (t489 != 0)
-    t504 = 0.5*(-t443 + t476)/casadi.if_else(t503, t489, 1)
+    t504 = (-t443 + t476)/casadi.if_else(t503, 2*t489, 1)
     t505 = casadi.fabs(t504)
     t506 = (t505 >= 1)
-    t507 = casadi.fabs(1/casadi.if_else(t506, t504, 1))
+    t507 = 1/casadi.fabs(casadi.if_else(t506, t504, 1))
     t508 = casadi.if_else(t503, casadi.if_else((t504 >= 0), 1, -1)*casadi.if_else(t506, t507/(1 + casadi.sqrt(1 + t507**2)), 1/(t505 + casadi.sqrt(1 + t505**2))), 0)
     t509 = 1/casadi.sqrt(1 + t508**2)
     t510 = t447*t509
@@ -1823,10 +1823,10 @@ def _velocity_ellipsoid(q):
     t589 = 3*t23
     t590 = t578*t589
     t591 = (t590 != 0)
-    t592 = 0.5*(-t571 + t580)/casadi.if_else(t591, -t590, 1)
+    t592 = (-t571 + t580)/casadi.if_else(t591, -2*t590, 1)
     t593 = casadi.fabs(t592)
     t594 = (t593 >= 1)
-    t595 = casadi.fabs(1/casadi.if_else(t594, t592, 1))
+    t595 = 1/casadi.fabs(casadi.if_else(t594, t592, 1))
     t596 = casadi.if_else(t591, casadi.if_else((t592 >= 0), 1, -1)*casadi.if_else(t594, t595/(1 + casadi.sqrt(1 + t595**2)), 1/(t593 + casadi.sqrt(1 + t593**2))), 0)
     t597 = 1/casadi.sqrt(1 + t596**2)
     t598 = t590*t596
@@ -1841,10 +1841,10 @@ def _velocity_ellipsoid(q):
     t607 = t596*t606
     t608 = t579*t604 + t583*t607
     t609 = (t608 != 0)
-    t610 = 0.5*(-t599 + t588)/casadi.if_else(t609, -t608, 1)
+    t610 = (-t599 + t588)/casadi.if_else(t609, -2*t608, 1)
     t611 = casadi.fabs(t610)
     t612 = (t611 >= 1)
-    t613 = casadi.fabs(1/casadi.if_else(t612, t610, 1))
+    t613 = 1/casadi.fabs(casadi.if_else(t612, t610, 1))
     t614 = casadi.if_else(t609, casadi.if_else((t610 >= 0), 1, -1)*casadi.if_else(t612, t613/(1 + casadi.sqrt(1 + t613**2)), 1/(t611 + casadi.sqrt(1 + t611**2))), 0)
     t615 = 1/casadi.sqrt(1 + t614**2)
     t616 = t608*t614
@@ -1860,10 +1860,10 @@ def _velocity_ellipsoid(q):
     t626 = -t624 + t614*t623
     t627 = t605*t622 - t626*t606
     t628 = (t627 != 0)
-    t629 = 0.5*(-t600 + t618)/casadi.if_else(t628, t627, 1)
+    t629 = (-t600 + t618)/casadi.if_else(t628, 2*t627, 1)
     t630 = casadi.fabs(t629)
     t631 = (t630 >= 1)
-    t632 = casadi.fabs(1/casadi.if_else(t631, t629, 1))
+    t632 = 1/casadi.fabs(casadi.if_else(t631, t629, 1))
     t633 = casadi.if_else(t628, casadi.if_else((t629 >= 0), 1, -1)*casadi.if_else(t631, t632/(1 + casadi.sqrt(1 + t632**2)), 1/(t630 + casadi.sqrt(1 + t630**2))), 0)
     t634 = 1/casadi.sqrt(1 + t633**2)
     t635 = t627*t633
@@ -1889,10 +1889,10 @@ def _velocity_ellipsoid(q):
     t655 = t633*t634
     t656 = t621*t640 + t625*t645 - t615*t587*t649*t655
     t657 = (t656 != 0)
-    t658 = 0.5*(-t617 + t636)/casadi.if_else(t657, -t656, 1)
+    t658 = (-t617 + t636)/casadi.if_else(t657, -2*t656, 1)
     t659 = casadi.fabs(t658)
     t660 = (t659 >= 1)
-    t661 = casadi.fabs(1/casadi.if_else(t660, t658, 1))
+    t661 = 1/casadi.fabs(casadi.if_else(t660, t658, 1))
     t662 = casadi.if_else(t657, casadi.if_else((t658 >= 0), 1, -1)*casadi.if_else(t660, t661/(1 + casadi.sqrt(1 + t661**2)), 1/(t659 + casadi.sqrt(1 + t659**2))), 0)
     t663 = 1/casadi.sqrt(1 + t662**2)
     t664 = t656*t662
@@ -1926,10 +1926,10 @@ def _velocity_ellipsoid(q):
     t692 = t615*t634
     t693 = t641*t669 - t646*t673 + t586*t682*t692
     t694 = (t693 != 0)
-    t695 = 0.5*(-t665 + t637)/casadi.if_else(t694, -t693, 1)
+    t695 = (-t665 + t637)/casadi.if_else(t694, -2*t693, 1)
     t696 = casadi.fabs(t695)
     t697 = (t696 >= 1)
-    t698 = casadi.fabs(1/casadi.if_else(t697, t695, 1))
+    t698 = 1/casadi.fabs(casadi.if_else(t697, t695, 1))
     t699 = casadi.if_else(t694, casadi.if_else((t695 >= 0), 1, -1)*casadi.if_else(t697, t698/(1 + casadi.sqrt(1 + t698**2)), 1/(t696 + casadi.sqrt(1 + t696**2))), 0)
     t700 = 1/casadi.sqrt(1 + t699**2)
     t701 = t693*t699
@@ -1961,10 +1961,10 @@ def _velocity_ellipsoid(q):
     t727 = t726 - t699*t713
     t728 = t713 + t699*t726
     t729 = (t717 != 0)
-    t730 = 0.5*(-t666 + t703)/casadi.if_else(t729, t717, 1)
+    t730 = (-t666 + t703)/casadi.if_else(t729, 2*t717, 1)
     t731 = casadi.fabs(t730)
     t732 = (t731 >= 1)
-    t733 = casadi.fabs(1/casadi.if_else(t732, t730, 1))
+    t733 = 1/casadi.fabs(casadi.if_else(t732, t730, 1))
     t734 = casadi.if_else(t729, casadi.if_else((t730 >= 0), 1, -1)*casadi.if_else(t732, t733/(1 + casadi.sqrt(1 + t733**2)), 1/(t731 + casadi.sqrt(1 + t731**2))), 0)
     t735 = 1/casadi.sqrt(1 + t734**2)
     t736 = t717*t734
@@ -1996,10 +1996,10 @@ def _velocity_ellipsoid(q):
     t762 = t760 + t734*t761
     t763 = t761 - t734*t760
     t764 = (t751 != 0)
-    t765 = 0.5*(-t702 + t737)/casadi.if_else(t764, t751, 1)
+    t765 = (-t702 + t737)/casadi.if_else(t764, 2*t751, 1)
     t766 = casadi.fabs(t765)
     t767 = (t766 >= 1)
-    t768 = casadi.fabs(1/casadi.if_else(t767, t765, 1))
+    t768 = 1/casadi.fabs(casadi.if_else(t767, t765, 1))
     t769 = casadi.if_else(t764, casadi.if_else((t765 >= 0), 1, -1)*casadi.if_else(t767, t768/(1 + casadi.sqrt(1 + t768**2)), 1/(t766 + casadi.sqrt(1 + t766**2))), 0)
     t770 = 1/casadi.sqrt(1 + t769**2)
     t771 = t751*t769
@@ -2031,10 +2031,10 @@ def _velocity_ellipsoid(q):
     t797 = t795 + t769*t796
     t798 = -t796 + t769*t795
     t799 = (t786 != 0)
-    t800 = 0.5*(-t772 + t738)/casadi.if_else(t799, t786, 1)
+    t800 = (-t772 + t738)/casadi.if_else(t799, 2*t786, 1)
     t801 = casadi.fabs(t800)
     t802 = (t801 >= 1)
-    t803 = casadi.fabs(1/casadi.if_else(t802, t800, 1))
+    t803 = 1/casadi.fabs(casadi.if_else(t802, t800, 1))
     t804 = casadi.if_else(t799, casadi.if_else((t800 >= 0), 1, -1)*casadi.if_else(t802, t803/(1 + casadi.sqrt(1 + t803**2)), 1/(t801 + casadi.sqrt(1 + t801**2))), 0)
     t805 = 1/casadi.sqrt(1 + t804**2)
     t806 = t786*t804
@@ -2066,10 +2066,10 @@ def _velocity_ellipsoid(q):
     t832 = t830 - t804*t831
     t833 = t831 + t804*t830
     t834 = (t821 != 0)
-    t835 = 0.5*(-t773 + t808)/casadi.if_else(t834, t821, 1)
+    t835 = (-t773 + t808)/casadi.if_else(t834, 2*t821, 1)
     t836 = casadi.fabs(t835)
     t837 = (t836 >= 1)
-    t838 = casadi.fabs(1/casadi.if_else(t837, t835, 1))
+    t838 = 1/casadi.fabs(casadi.if_else(t837, t835, 1))
     t839 = casadi.if_else(t834, casadi.if_else((t835 >= 0), 1, -1)*casadi.if_else(t837, t838/(1 + casadi.sqrt(1 + t838**2)), 1/(t836 + casadi.sqrt(1 + t836**2))), 0)
     t840 = 1/casadi.sqrt(1 + t839**2)
     t841 = t821*t839
@@ -2101,10 +2101,10 @@ def _velocity_ellipsoid(q):
     t867 = t865 - t839*t866
     t868 = t866 + t839*t865
     t869 = (t856 != 0)
-    t870 = 0.5*(-t807 + t842)/casadi.if_else(t869, t856, 1)
+    t870 = (-t807 + t842)/casadi.if_else(t869, 2*t856, 1)
     t871 = casadi.fabs(t870)
     t872 = (t871 >= 1)
-    t873 = casadi.fabs(1/casadi.if_else(t872, t870, 1))
+    t873 = 1/casadi.fabs(casadi.if_else(t872, t870, 1))
     t874 = casadi.if_else(t869, casadi.if_else((t870 >= 0), 1, -1)*casadi.if_else(t872, t873/(1 + casadi.sqrt(1 + t873**2)), 1/(t871 + casadi.sqrt(1 + t871**2))), 0)
     t875 = 1/casadi.sqrt(1 + t874**2)
     t876 = t856*t874
@@ -2136,10 +2136,10 @@ def _velocity_ellipsoid(q):
     t902 = t900 - t874*t901
     t903 = t901 + t874*t900
     t904 = (t891 != 0)
-    t905 = 0.5*(-t877 + t843)/casadi.if_else(t904, t891, 1)
+    t905 = (-t877 + t843)/casadi.if_else(t904, 2*t891, 1)
     t906 = casadi.fabs(t905)
     t907 = (t906 >= 1)
-    t908 = casadi.fabs(1/casadi.if_else(t907, t905, 1))
+    t908 = 1/casadi.fabs(casadi.if_else(t907, t905, 1))
     t909 = casadi.if_else(t904, casadi.if_else((t905 >= 0), 1, -1)*casadi.if_else(t907, t908/(1 + casadi.sqrt(1 + t908**2)), 1/(t906 + casadi.sqrt(1 + t906**2))), 0)
     t910 = 1/casadi.sqrt(1 + t909**2)
     t911 = t891*t909
@@ -2171,10 +2171,10 @@ def _velocity_ellipsoid(q):
     t937 = t935 - t909*t936
     t938 = t936 + t909*t935
     t939 = (t926 != 0)
-    t940 = 0.5*(-t878 + t913)/casadi.if_else(t939, t926, 1)
+    t940 = (-t878 + t913)/casadi.if_else(t939, 2*t926, 1)
     t941 = casadi.fabs(t940)
     t942 = (t941 >= 1)
-    t943 = casadi.fabs(1/casadi.if_else(t942, t940, 1))
+    t943 = 1/casadi.fabs(casadi.if_else(t942, t940, 1))
     t944 = casadi.if_else(t939, casadi.if_else((t940 >= 0), 1, -1)*casadi.if_else(t942, t943/(1 + casadi.sqrt(1 + t943**2)), 1/(t941 + casadi.sqrt(1 + t941**2))), 0)
     t945 = 1/casadi.sqrt(1 + t944**2)
     t946 = t926*t944
@@ -2206,10 +2206,10 @@ def _velocity_ellipsoid(q):
     t972 = t970 - t944*t971
     t973 = t971 + t944*t970
     t974 = (t961 != 0)
-    t975 = 0.5*(-t912 + t947)/casadi.if_else(t974, t961, 1)
+    t975 = (-t912 + t947)/casadi.if_else(t974, 2*t961, 1)
     t976 = casadi.fabs(t975)
     t977 = (t976 >= 1)
-    t978 = casadi.fabs(1/casadi.if_else(t977, t975, 1))
+    t978 = 1/casadi.fabs(casadi.if_else(t977, t975, 1))
     t979 = casadi.if_else(t974, casadi.if_else((t975 >= 0), 1, -1)*casadi.if_else(t977, t978/(1 + casadi.sqrt(1 + t978**2)), 1/(t976 + casadi.sqrt(1 + t976**2))), 0)
     t980 = 1/casadi.sqrt(1 + t979**2)
     t981 = t961*t979
@@ -2241,10 +2241,10 @@ def _velocity_ellipsoid(q):
     t1007 = t1005 - t979*t1006
     t1008 = t1006 + t979*t1005
     t1009 = (t996 != 0)
-    t1010 = 0.5*(-t982 + t948)/casadi.if_else(t1009, t996, 1)
+    t1010 = (-t982 + t948)/casadi.if_else(t1009, 2*t996, 1)
     t1011 = casadi.fabs(t1010)
     t1012 = (t1011 >= 1)
-    t1013 = casadi.fabs(1/casadi.if_else(t1012, t1010, 1))
+    t1013 = 1/casadi.fabs(casadi.if_else(t1012, t1010, 1))
     t1014 = casadi.if_else(t1009, casadi.if_else((t1010 >= 0), 1, -1)*casadi.if_else(t1012, t1013/(1 + casadi.sqrt(1 + t1013**2)), 1/(t1011 + casadi.sqrt(1 + t1011**2))), 0)
     t1015 = 1/casadi.sqrt(1 + t1014**2)
     t1016 = t948 + t996*t1014
@@ -2275,10 +2275,10 @@ def _velocity_ellipsoid(q):
     t1041 = t1039 - t1014*t1040
     t1042 = t1040 + t1014*t1039
     t1043 = (t1029 != 0)
-    t1044 = 0.5*(-t983 + t1016)/casadi.if_else(t1043, t1029, 1)
+    t1044 = (-t983 + t1016)/casadi.if_else(t1043, 2*t1029, 1)
     t1045 = casadi.fabs(t1044)
     t1046 = (t1045 >= 1)
-    t1047 = casadi.fabs(1/casadi.if_else(t1046, t1044, 1))
+    t1047 = 1/casadi.fabs(casadi.if_else(t1046, t1044, 1))
     t1048 = casadi.if_else(t1043, casadi.if_else((t1044 >= 0), 1, -1)*casadi.if_else(t1046, t1047/(1 + casadi.sqrt(1 + t1047**2)), 1/(t1045 + casadi.sqrt(1 + t1045**2))), 0)
     t1049 = 1/casadi.sqrt(1 + t1048**2)
     t1050 = t987*t1049
@@ -2471,10 +2471,10 @@ def _condition_number(q):
     t79 = t26*t51
     t80 = t31*t40 + t78*t56 + t79*t60
     t81 = (t80 != 0)
-    t82 = 0.5*(-t77 + t72)/casadi.if_else(t81, -t80, 1)
+    t82 = (-t77 + t72)/casadi.if_else(t81, -2*t80, 1)
     t83 = casadi.fabs(t82)
     t84 = (t83 >= 1)
-    t85 = casadi.fabs(1/casadi.if_else(t84, t82, 1))
+    t85 = 1/casadi.fabs(casadi.if_else(t84, t82, 1))
     t86 = casadi.if_else(t81, casadi.if_else((t82 >= 0), 1, -1)*casadi.if_else(t84, t85/(1 + casadi.sqrt(1 + t85**2)), 1/(t83 + casadi.sqrt(1 + t83**2))), 0)
     t87 = 1/casadi.sqrt(1 + t86**2)
     t88 = t80*t86
@@ -2494,10 +2494,10 @@ def _condition_number(q):
     t102 = t100 - t99*t86
     t103 = t64*t97 - t68*t101
     t104 = (t103 != 0)
-    t105 = 0.5*(-t89 + t73)/casadi.if_else(t104, t103, 1)
+    t105 = (-t89 + t73)/casadi.if_else(t104, 2*t103, 1)
     t106 = casadi.fabs(t105)
     t107 = (t106 >= 1)
-    t108 = casadi.fabs(1/casadi.if_else(t107, t105, 1))
+    t108 = 1/casadi.fabs(casadi.if_else(t107, t105, 1))
     t109 = casadi.if_else(t104, casadi.if_else((t105 >= 0), 1, -1)*casadi.if_else(t107, t108/(1 + casadi.sqrt(1 + t108**2)), 1/(t106 + casadi.sqrt(1 + t106**2))), 0)
     t110 = 1/casadi.sqrt(1 + t109**2)
     t111 = t103*t109
@@ -2513,10 +2513,10 @@ def _condition_number(q):
     t121 = t119 - t118*t109
     t122 = t71*t120
     t123 = (t122 != 0)
-    t124 = 0.5*(-t112 + t74)/casadi.if_else(t123, t122, 1)
+    t124 = (-t112 + t74)/casadi.if_else(t123, 2*t122, 1)
     t125 = casadi.fabs(t124)
     t126 = (t125 >= 1)
-    t127 = casadi.fabs(1/casadi.if_else(t126, t124, 1))
+    t127 = 1/casadi.fabs(casadi.if_else(t126, t124, 1))
     t128 = casadi.if_else(t123, casadi.if_else((t124 >= 0), 1, -1)*casadi.if_else(t126, t127/(1 + casadi.sqrt(1 + t127**2)), 1/(t125 + casadi.sqrt(1 + t125**2))), 0)
     t129 = 1/casadi.sqrt(1 + t128**2)
     t130 = t122*t128
@@ -2531,10 +2531,10 @@ def _condition_number(q):
     t139 = t138*t109
     t140 = -t98*t117 + t102*t121 + t75*t137*t86*t87**2 + t139*t94
     t141 = (t140 != 0)
-    t142 = 0.5*(-t90 + t113)/casadi.if_else(t141, t140, 1)
+    t142 = (-t90 + t113)/casadi.if_else(t141, 2*t140, 1)
     t143 = casadi.fabs(t142)
     t144 = (t143 >= 1)
-    t145 = casadi.fabs(1/casadi.if_else(t144, t142, 1))
+    t145 = 1/casadi.fabs(casadi.if_else(t144, t142, 1))
     t146 = casadi.if_else(t141, casadi.if_else((t142 >= 0), 1, -1)*casadi.if_else(t144, t145/(1 + casadi.sqrt(1 + t145**2)), 1/(t143 + casadi.sqrt(1 + t143**2))), 0)
     t147 = 1/casadi.sqrt(1 + t146**2)
     t148 = t140*t146
@@ -2566,10 +2566,10 @@ def _condition_number(q):
     t174 = t173*t128
     t175 = -t136*t167 - t170*t155 + t172*t159 + t174*t163
     t176 = (t175 != 0)
-    t177 = 0.5*(-t149 + t132)/casadi.if_else(t176, t175, 1)
+    t177 = (-t149 + t132)/casadi.if_else(t176, 2*t175, 1)
     t178 = casadi.fabs(t177)
     t179 = (t178 >= 1)
-    t180 = casadi.fabs(1/casadi.if_else(t179, t177, 1))
+    t180 = 1/casadi.fabs(casadi.if_else(t179, t177, 1))
     t181 = casadi.if_else(t176, casadi.if_else((t177 >= 0), 1, -1)*casadi.if_else(t179, t180/(1 + casadi.sqrt(1 + t180**2)), 1/(t178 + casadi.sqrt(1 + t178**2))), 0)
     t182 = 1/casadi.sqrt(1 + t181**2)
     t183 = t175*t181
@@ -2594,10 +2594,10 @@ def _condition_number(q):
     t202 = -t156*t189 + t160*t193 + t164*t197 + t168*t201
     t203 = t135*t200 - t169*t188 + t171*t192 + t173*t196
     t204 = (t202 != 0)
-    t205 = 0.5*(-t150 + t185)/casadi.if_else(t204, t202, 1)
+    t205 = (-t150 + t185)/casadi.if_else(t204, 2*t202, 1)
     t206 = casadi.fabs(t205)
     t207 = (t206 >= 1)
-    t208 = casadi.fabs(1/casadi.if_else(t207, t205, 1))
+    t208 = 1/casadi.fabs(casadi.if_else(t207, t205, 1))
     t209 = casadi.if_else(t204, casadi.if_else((t205 >= 0), 1, -1)*casadi.if_else(t207, t208/(1 + casadi.sqrt(1 + t208**2)), 1/(t206 + casadi.sqrt(1 + t206**2))), 0)
     t210 = 1/casadi.sqrt(1 + t209**2)
     t211 = t202*t209
@@ -2620,10 +2620,10 @@ def _condition_number(q):
     t228 = t226 - t227*t209
     t229 = t227 + t226*t209
     t230 = (t203 != 0)
-    t231 = 0.5*(-t131 + t184)/casadi.if_else(t230, t203, 1)
+    t231 = (-t131 + t184)/casadi.if_else(t230, 2*t203, 1)
     t232 = casadi.fabs(t231)
     t233 = (t232 >= 1)
-    t234 = casadi.fabs(1/casadi.if_else(t233, t231, 1))
+    t234 = 1/casadi.fabs(casadi.if_else(t233, t231, 1))
     t235 = casadi.if_else(t230, casadi.if_else((t231 >= 0), 1, -1)*casadi.if_else(t233, t234/(1 + casadi.sqrt(1 + t234**2)), 1/(t232 + casadi.sqrt(1 + t232**2))), 0)
     t236 = 1/casadi.sqrt(1 + t235**2)
     t237 = t203*t235
@@ -2647,10 +2647,10 @@ def _condition_number(q):
     t255 = t253 + t252*t235
     t256 = t216*t242 + t220*t246 + t224*t250 + t228*t254
     t257 = (t256 != 0)
-    t258 = 0.5*(-t238 + t212)/casadi.if_else(t257, t256, 1)
+    t258 = (-t238 + t212)/casadi.if_else(t257, 2*t256, 1)
     t259 = casadi.fabs(t258)
     t260 = (t259 >= 1)
-    t261 = casadi.fabs(1/casadi.if_else(t260, t258, 1))
+    t261 = 1/casadi.fabs(casadi.if_else(t260, t258, 1))
     t262 = casadi.if_else(t257, casadi.if_else((t258 >= 0), 1, -1)*casadi.if_else(t260, t261/(1 + casadi.sqrt(1 + t261**2)), 1/(t259 + casadi.sqrt(1 + t259**2))), 0)
     t263 = 1/casadi.sqrt(1 + t262**2)
     t264 = t256*t262
@@ -2675,10 +2675,10 @@ def _condition_number(q):
     t283 = t217*t269 + t221*t273 + t225*t277 + t229*t281
     t284 = -t243*t270 + t247*t274 + t251*t278 + t255*t282
     t285 = (t283 != 0)
-    t286 = 0.5*(-t265 + t213)/casadi.if_else(t285, t283, 1)
+    t286 = (-t265 + t213)/casadi.if_else(t285, 2*t283, 1)
     t287 = casadi.fabs(t286)
     t288 = (t287 >= 1)
-    t289 = casadi.fabs(1/casadi.if_else(t288, t286, 1))
+    t289 = 1/casadi.fabs(casadi.if_else(t288, t286, 1))
     t290 = casadi.if_else(t285, casadi.if_else((t286 >= 0), 1, -1)*casadi.if_else(t288, t289/(1 + casadi.sqrt(1 + t289**2)), 1/(t287 + casadi.sqrt(1 + t287**2))), 0)
     t291 = 1/casadi.sqrt(1 + t290**2)
     t292 = t283*t290
@@ -2701,10 +2701,10 @@ def _condition_number(q):
     t309 = t307 - t308*t290
     t310 = t308 + t307*t290
     t311 = (t284 != 0)
-    t312 = 0.5*(-t239 + t266)/casadi.if_else(t311, t284, 1)
+    t312 = (-t239 + t266)/casadi.if_else(t311, 2*t284, 1)
     t313 = casadi.fabs(t312)
     t314 = (t313 >= 1)
-    t315 = casadi.fabs(1/casadi.if_else(t314, t312, 1))
+    t315 = 1/casadi.fabs(casadi.if_else(t314, t312, 1))
     t316 = casadi.if_else(t311, casadi.if_else((t312 >= 0), 1, -1)*casadi.if_else(t314, t315/(1 + casadi.sqrt(1 + t315**2)), 1/(t313 + casadi.sqrt(1 + t313**2))), 0)
     t317 = 1/casadi.sqrt(1 + t316**2)
     t318 = t284*t316
@@ -2728,10 +2728,10 @@ def _condition_number(q):
     t336 = t334 + t333*t316
     t337 = t298*t323 + t302*t327 + t306*t331 + t310*t335
     t338 = (t337 != 0)
-    t339 = 0.5*(-t319 + t294)/casadi.if_else(t338, t337, 1)
+    t339 = (-t319 + t294)/casadi.if_else(t338, 2*t337, 1)
     t340 = casadi.fabs(t339)
     t341 = (t340 >= 1)
-    t342 = casadi.fabs(1/casadi.if_else(t341, t339, 1))
+    t342 = 1/casadi.fabs(casadi.if_else(t341, t339, 1))
     t343 = casadi.if_else(t338, casadi.if_else((t339 >= 0), 1, -1)*casadi.if_else(t341, t342/(1 + casadi.sqrt(1 + t342**2)), 1/(t340 + casadi.sqrt(1 + t340**2))), 0)
     t344 = 1/casadi.sqrt(1 + t343**2)
     t345 = t337*t343
@@ -2756,10 +2756,10 @@ def _condition_number(q):
     t364 = t324*t351 + t328*t355 + t332*t359 + t336*t363
     t365 = t297*t350 + t301*t354 + t305*t358 + t309*t362
     t366 = (t364 != 0)
-    t367 = 0.5*(-t320 + t347)/casadi.if_else(t366, t364, 1)
+    t367 = (-t320 + t347)/casadi.if_else(t366, 2*t364, 1)
     t368 = casadi.fabs(t367)
     t369 = (t368 >= 1)
-    t370 = casadi.fabs(1/casadi.if_else(t369, t367, 1))
+    t370 = 1/casadi.fabs(casadi.if_else(t369, t367, 1))
     t371 = casadi.if_else(t366, casadi.if_else((t367 >= 0), 1, -1)*casadi.if_else(t369, t370/(1 + casadi.sqrt(1 + t370**2)), 1/(t368 + casadi.sqrt(1 + t368**2))), 0)
     t372 = 1/casadi.sqrt(1 + t371**2)
     t373 = t364*t371
@@ -2782,10 +2782,10 @@ def _condition_number(q):
     t390 = t388 - t389*t371
     t391 = t389 + t388*t371
     t392 = (t365 != 0)
-    t393 = 0.5*(-t293 + t346)/casadi.if_else(t392, t365, 1)
+    t393 = (-t293 + t346)/casadi.if_else(t392, 2*t365, 1)
     t394 = casadi.fabs(t393)
     t395 = (t394 >= 1)
-    t396 = casadi.fabs(1/casadi.if_else(t395, t393, 1))
+    t396 = 1/casadi.fabs(casadi.if_else(t395, t393, 1))
     t397 = casadi.if_else(t392, casadi.if_else((t393 >= 0), 1, -1)*casadi.if_else(t395, t396/(1 + casadi.sqrt(1 + t396**2)), 1/(t394 + casadi.sqrt(1 + t394**2))), 0)
     t398 = 1/casadi.sqrt(1 + t397**2)
     t399 = t365*t397
@@ -2809,10 +2809,10 @@ def _condition_number(q):
     t417 = t415 + t414*t397
     t418 = t378*t404 + t382*t408 + t386*t412 + t390*t416
     t419 = (t418 != 0)
-    t420 = 0.5*(-t400 + t374)/casadi.if_else(t419, t418, 1)
+    t420 = (-t400 + t374)/casadi.if_else(t419, 2*t418, 1)
     t421 = casadi.fabs(t420)
     t422 = (t421 >= 1)
-    t423 = casadi.fabs(1/casadi.if_else(t422, t420, 1))
+    t423 = 1/casadi.fabs(casadi.if_else(t422, t420, 1))
     t424 = casadi.if_else(t419, casadi.if_else((t420 >= 0), 1, -1)*casadi.if_else(t422, t423/(1 + casadi.sqrt(1 + t423**2)), 1/(t421 + casadi.sqrt(1 + t421**2))), 0)
     t425 = 1/casadi.sqrt(1 + t424**2)
     t426 = t418*t424
@@ -2837,10 +2837,10 @@ def _condition_number(q):
     t445 = t379*t431 + t383*t435 + t387*t439 + t391*t443
     t446 = t405*t432 + t409*t436 + t413*t440 + t417*t444
     t447 = (t445 != 0)
-    t448 = 0.5*(-t427 + t375)/casadi.if_else(t447, t445, 1)
+    t448 = (-t427 + t375)/casadi.if_else(t447, 2*t445, 1)
     t449 = casadi.fabs(t448)
     t450 = (t449 >= 1)
-    t451 = casadi.fabs(1/casadi.if_else(t450, t448, 1))
+    t451 = 1/casadi.fabs(casadi.if_else(t450, t448, 1))
     t452 = casadi.if_else(t447, casadi.if_else((t448 >= 0), 1, -1)*casadi.if_else(t450, t451/(1 + casadi.sqrt(1 + t451**2)), 1/(t449 + casadi.sqrt(1 + t449**2))), 0)
     t453 = 1/casadi.sqrt(1 + t452**2)
     t454 = t445*t452
@@ -2863,10 +2863,10 @@ def _condition_number(q):
     t471 = t469 - t470*t452
     t472 = t470 + t469*t452
     t473 = (t446 != 0)
-    t474 = 0.5*(-t401 + t428)/casadi.if_else(t473, t446, 1)
+    t474 = (-t401 + t428)/casadi.if_else(t473, 2*t446, 1)
     t475 = casadi.fabs(t474)
     t476 = (t475 >= 1)
-    t477 = casadi.fabs(1/casadi.if_else(t476, t474, 1))
+    t477 = 1/casadi.fabs(casadi.if_else(t476, t474, 1))
     t478 = casadi.if_else(t473, casadi.if_else((t474 >= 0), 1, -1)*casadi.if_else(t476, t477/(1 + casadi.sqrt(1 + t477**2)), 1/(t475 + casadi.sqrt(1 + t475**2))), 0)
     t479 = 1/casadi.sqrt(1 + t478**2)
     t480 = t446*t478
@@ -2890,10 +2890,10 @@ def _condition_number(q):
     t498 = t496 + t495*t478
     t499 = t460*t485 + t464*t489 + t468*t493 + t472*t497
     t500 = (t499 != 0)
-    t501 = 0.5*(-t481 + t456)/casadi.if_else(t500, t499, 1)
+    t501 = (-t481 + t456)/casadi.if_else(t500, 2*t499, 1)
     t502 = casadi.fabs(t501)
     t503 = (t502 >= 1)
-    t504 = casadi.fabs(1/casadi.if_else(t503, t501, 1))
+    t504 = 1/casadi.fabs(casadi.if_else(t503, t501, 1))
     t505 = casadi.if_else(t500, casadi.if_else((t501 >= 0), 1, -1)*casadi.if_else(t503, t504/(1 + casadi.sqrt(1 + t504**2)), 1/(t502 + casadi.sqrt(1 + t502**2))), 0)
     t506 = 1/casadi.sqrt(1 + t505**2)
     t507 = t499*t505
@@ -2918,10 +2918,10 @@ def _condition_number(q):
     t526 = t486*t513 + t490*t517 + t494*t521 + t498*t525
     t527 = t459*t512 + t463*t516 + t467*t520 + t471*t524
     t528 = (t526 != 0)
-    t529 = 0.5*(-t482 + t509)/casadi.if_else(t528, t526, 1)
+    t529 = (-t482 + t509)/casadi.if_else(t528, 2*t526, 1)
     t530 = casadi.fabs(t529)
     t531 = (t530 >= 1)
-    t532 = casadi.fabs(1/casadi.if_else(t531, t529, 1))
+    t532 = 1/casadi.fabs(casadi.if_else(t531, t529, 1))
     t533 = casadi.if_else(t528, casadi.if_else((t529 >= 0), 1, -1)*casadi.if_else(t531, t532/(1 + casadi.sqrt(1 + t532**2)), 1/(t530 + casadi.sqrt(1 + t530**2))), 0)
     t534 = 1/casadi.sqrt(1 + t533**2)
     t535 = t526*t533
@@ -2944,10 +2944,10 @@ def _condition_number(q):
     t552 = t550 - t551*t533
     t553 = t551 + t550*t533
     t554 = (t527 != 0)
-    t555 = 0.5*(-t455 + t508)/casadi.if_else(t554, t527, 1)
+    t555 = (-t455 + t508)/casadi.if_else(t554, 2*t527, 1)
     t556 = casadi.fabs(t555)
     t557 = (t556 >= 1)
-    t558 = casadi.fabs(1/casadi.if_else(t557, t555, 1))
+    t558 = 1/casadi.fabs(casadi.if_else(t557, t555, 1))
     t559 = casadi.if_else(t554, casadi.if_else((t555 >= 0), 1, -1)*casadi.if_else(t557, t558/(1 + casadi.sqrt(1 + t558**2)), 1/(t556 + casadi.sqrt(1 + t556**2))), 0)
     t560 = 1/casadi.sqrt(1 + t559**2)
     t561 = t527*t559
@@ -2971,10 +2971,10 @@ def _condition_number(q):
     t579 = t577 + t576*t559
     t580 = t540*t566 + t544*t570 + t548*t574 + t552*t578
     t581 = (t580 != 0)
-    t582 = 0.5*(-t562 + t536)/casadi.if_else(t581, t580, 1)
+    t582 = (-t562 + t536)/casadi.if_else(t581, 2*t580, 1)
     t583 = casadi.fabs(t582)
     t584 = (t583 >= 1)
-    t585 = casadi.fabs(1/casadi.if_else(t584, t582, 1))
+    t585 = 1/casadi.fabs(casadi.if_else(t584, t582, 1))
     t586 = casadi.if_else(t581, casadi.if_else((t582 >= 0), 1, -1)*casadi.if_else(t584, t585/(1 + casadi.sqrt(1 + t585**2)), 1/(t583 + casadi.sqrt(1 + t583**2))), 0)
     t587 = 1/casadi.sqrt(1 + t586**2)
     t588 = t580*t586
@@ -2999,10 +2999,10 @@ def _condition_number(q):
     t607 = t541*t593 + t545*t597 + t549*t601 + t553*t605
     t608 = t567*t594 + t571*t598 + t575*t602 + t579*t606
     t609 = (t607 != 0)
-    t610 = 0.5*(-t589 + t537)/casadi.if_else(t609, t607, 1)
+    t610 = (-t589 + t537)/casadi.if_else(t609, 2*t607, 1)
     t611 = casadi.fabs(t610)
     t612 = (t611 >= 1)
-    t613 = casadi.fabs(1/casadi.if_else(t612, t610, 1))
+    t613 = 1/casadi.fabs(casadi.if_else(t612, t610, 1))
     t614 = casadi.if_else(t609, casadi.if_else((t610 >= 0), 1, -1)*casadi.if_else(t612, t613/(1 + casadi.sqrt(1 + t613**2)), 1/(t611 + casadi.sqrt(1 + t611**2))), 0)
     t615 = 1/casadi.sqrt(1 + t614**2)
     t616 = t607*t614
@@ -3025,10 +3025,10 @@ def _condition_number(q):
     t633 = t631 - t632*t614
     t634 = t632 + t631*t614
     t635 = (t608 != 0)
-    t636 = 0.5*(-t563 + t590)/casadi.if_else(t635, t608, 1)
+    t636 = (-t563 + t590)/casadi.if_else(t635, 2*t608, 1)
     t637 = casadi.fabs(t636)
     t638 = (t637 >= 1)
-    t639 = casadi.fabs(1/casadi.if_else(t638, t636, 1))
+    t639 = 1/casadi.fabs(casadi.if_else(t638, t636, 1))
     t640 = casadi.if_else(t635, casadi.if_else((t636 >= 0), 1, -1)*casadi.if_else(t638, t639/(1 + casadi.sqrt(1 + t639**2)), 1/(t637 + casadi.sqrt(1 + t637**2))), 0)
     t641 = 1/casadi.sqrt(1 + t640**2)
     t642 = t608*t640
@@ -3052,10 +3052,10 @@ def _condition_number(q):
     t660 = t658 + t657*t640
     t661 = t622*t647 + t626*t651 + t630*t655 + t634*t659
     t662 = (t661 != 0)
-    t663 = 0.5*(-t643 + t618)/casadi.if_else(t662, t661, 1)
+    t663 = (-t643 + t618)/casadi.if_else(t662, 2*t661, 1)
     t664 = casadi.fabs(t663)
     t665 = (t664 >= 1)
-    t666 = casadi.fabs(1/casadi.if_else(t665, t663, 1))
+    t666 = 1/casadi.fabs(casadi.if_else(t665, t663, 1))
     t667 = casadi.if_else(t662, casadi.if_else((t663 >= 0), 1, -1)*casadi.if_else(t665, t666/(1 + casadi.sqrt(1 + t666**2)), 1/(t664 + casadi.sqrt(1 + t664**2))), 0)
     t668 = 1/casadi.sqrt(1 + t667**2)
     t669 = t661*t667
@@ -3080,10 +3080,10 @@ def _condition_number(q):
     t688 = t648*t675 + t652*t679 + t656*t683 + t660*t687
     t689 = t621*t674 + t625*t678 + t629*t682 + t633*t686
     t690 = (t688 != 0)
-    t691 = 0.5*(-t644 + t671)/casadi.if_else(t690, t688, 1)
+    t691 = (-t644 + t671)/casadi.if_else(t690, 2*t688, 1)
     t692 = casadi.fabs(t691)
     t693 = (t692 >= 1)
-    t694 = casadi.fabs(1/casadi.if_else(t693, t691, 1))
+    t694 = 1/casadi.fabs(casadi.if_else(t693, t691, 1))
     t695 = casadi.if_else(t690, casadi.if_else((t691 >= 0), 1, -1)*casadi.if_else(t693, t694/(1 + casadi.sqrt(1 + t694**2)), 1/(t692 + casadi.sqrt(1 + t692**2))), 0)
     t696 = 1/casadi.sqrt(1 + t695**2)
     t697 = t688*t695
@@ -3106,10 +3106,10 @@ def _condition_number(q):
     t714 = t712 - t713*t695
     t715 = t713 + t712*t695
     t716 = (t689 != 0)
-    t717 = 0.5*(-t617 + t670)/casadi.if_else(t716, t689, 1)
+    t717 = (-t617 + t670)/casadi.if_else(t716, 2*t689, 1)
     t718 = casadi.fabs(t717)
     t719 = (t718 >= 1)
-    t720 = casadi.fabs(1/casadi.if_else(t719, t717, 1))
+    t720 = 1/casadi.fabs(casadi.if_else(t719, t717, 1))
     t721 = casadi.if_else(t716, casadi.if_else((t717 >= 0), 1, -1)*casadi.if_else(t719, t720/(1 + casadi.sqrt(1 + t720**2)), 1/(t718 + casadi.sqrt(1 + t718**2))), 0)
     t722 = 1/casadi.sqrt(1 + t721**2)
     t723 = t689*t721
@@ -3133,10 +3133,10 @@ def _condition_number(q):
     t741 = t739 + t738*t721
     t742 = t702*t728 + t706*t732 + t710*t736 + t714*t740
     t743 = (t742 != 0)
-    t744 = 0.5*(-t724 + t698)/casadi.if_else(t743, t742, 1)
+    t744 = (-t724 + t698)/casadi.if_else(t743, 2*t742, 1)
     t745 = casadi.fabs(t744)
     t746 = (t745 >= 1)
-    t747 = casadi.fabs(1/casadi.if_else(t746, t744, 1))
+    t747 = 1/casadi.fabs(casadi.if_else(t746, t744, 1))
     t748 = casadi.if_else(t743, casadi.if_else((t744 >= 0), 1, -1)*casadi.if_else(t746, t747/(1 + casadi.sqrt(1 + t747**2)), 1/(t745 + casadi.sqrt(1 + t745**2))), 0)
     t749 = 1/casadi.sqrt(1 + t748**2)
     t750 = t742*t748
@@ -3161,10 +3161,10 @@ def _condition_number(q):
     t769 = t703*t755 + t707*t759 + t711*t763 + t715*t767
     t770 = t729*t756 + t733*t760 + t737*t764 + t741*t768
     t771 = (t769 != 0)
-    t772 = 0.5*(-t751 + t699)/casadi.if_else(t771, t769, 1)
+    t772 = (-t751 + t699)/casadi.if_else(t771, 2*t769, 1)
     t773 = casadi.fabs(t772)
     t774 = (t773 >= 1)
-    t775 = casadi.fabs(1/casadi.if_else(t774, t772, 1))
+    t775 = 1/casadi.fabs(casadi.if_else(t774, t772, 1))
     t776 = casadi.if_else(t771, casadi.if_else((t772 >= 0), 1, -1)*casadi.if_else(t774, t775/(1 + casadi.sqrt(1 + t775**2)), 1/(t773 + casadi.sqrt(1 + t773**2))), 0)
     t777 = 1/casadi.sqrt(1 + t776**2)
     t778 = t769*t776
@@ -3187,10 +3187,10 @@ def _condition_number(q):
     t795 = t793 - t794*t776
     t796 = t794 + t793*t776
     t797 = (t770 != 0)
-    t798 = 0.5*(-t725 + t752)/casadi.if_else(t797, t770, 1)
+    t798 = (-t725 + t752)/casadi.if_else(t797, 2*t770, 1)
     t799 = casadi.fabs(t798)
     t800 = (t799 >= 1)
-    t801 = casadi.fabs(1/casadi.if_else(t800, t798, 1))
+    t801 = 1/casadi.fabs(casadi.if_else(t800, t798, 1))
     t802 = casadi.if_else(t797, casadi.if_else((t798 >= 0), 1, -1)*casadi.if_else(t800, t801/(1 + casadi.sqrt(1 + t801**2)), 1/(t799 + casadi.sqrt(1 + t799**2))), 0)
     t803 = 1/casadi.sqrt(1 + t802**2)
     t804 = t770*t802
@@ -3214,10 +3214,10 @@ def _condition_number(q):
     t822 = t820 + t819*t802
     t823 = t784*t809 + t788*t813 + t792*t817 + t796*t821
     t824 = (t823 != 0)
-    t825 = 0.5*(-t805 + t780)/casadi.if_else(t824, t823, 1)
+    t825 = (-t805 + t780)/casadi.if_else(t824, 2*t823, 1)
     t826 = casadi.fabs(t825)
     t827 = (t826 >= 1)
-    t828 = casadi.fabs(1/casadi.if_else(t827, t825, 1))
+    t828 = 1/casadi.fabs(casadi.if_else(t827, t825, 1))
     t829 = casadi.if_else(t824, casadi.if_else((t825 >= 0), 1, -1)*casadi.if_else(t827, t828/(1 + casadi.sqrt(1 + t828**2)), 1/(t826 + casadi.sqrt(1 + t826**2))), 0)
     t830 = 1/casadi.sqrt(1 + t829**2)
     t831 = t823*t829
@@ -3242,10 +3242,10 @@ def _condition_number(q):
     t850 = t810*t837 + t814*t841 + t818*t845 + t822*t849
     t851 = t783*t836 + t787*t840 + t791*t844 + t795*t848
     t852 = (t850 != 0)
-    t853 = 0.5*(-t806 + t833)/casadi.if_else(t852, t850, 1)
+    t853 = (-t806 + t833)/casadi.if_else(t852, 2*t850, 1)
     t854 = casadi.fabs(t853)
     t855 = (t854 >= 1)
-    t856 = casadi.fabs(1/casadi.if_else(t855, t853, 1))
+    t856 = 1/casadi.fabs(casadi.if_else(t855, t853, 1))
     t857 = casadi.if_else(t852, casadi.if_else((t853 >= 0), 1, -1)*casadi.if_else(t855, t856/(1 + casadi.sqrt(1 + t856**2)), 1/(t854 + casadi.sqrt(1 + t854**2))), 0)
     t858 = 1/casadi.sqrt(1 + t857**2)
     t859 = t850*t857
@@ -3268,10 +3268,10 @@ def _condition_number(q):
     t876 = t874 - t875*t857
     t877 = t875 + t874*t857
     t878 = (t851 != 0)
-    t879 = 0.5*(-t779 + t832)/casadi.if_else(t878, t851, 1)
+    t879 = (-t779 + t832)/casadi.if_else(t878, 2*t851, 1)
     t880 = casadi.fabs(t879)
     t881 = (t880 >= 1)
-    t882 = casadi.fabs(1/casadi.if_else(t881, t879, 1))
+    t882 = 1/casadi.fabs(casadi.if_else(t881, t879, 1))
     t883 = casadi.if_else(t878, casadi.if_else((t879 >= 0), 1, -1)*casadi.if_else(t881, t882/(1 + casadi.sqrt(1 + t882**2)), 1/(t880 + casadi.sqrt(1 + t880**2))), 0)
     t884 = 1/casadi.sqrt(1 + t883**2)
     t885 = t851*t883
@@ -3295,10 +3295,10 @@ def _condition_number(q):
     t903 = t901 + t900*t883
     t904 = t864*t890 + t868*t894 + t872*t898 + t876*t902
     t905 = (t904 != 0)
-    t906 = 0.5*(-t886 + t860)/casadi.if_else(t905, t904, 1)
+    t906 = (-t886 + t860)/casadi.if_else(t905, 2*t904, 1)
     t907 = casadi.fabs(t906)
     t908 = (t907 >= 1)
-    t909 = casadi.fabs(1/casadi.if_else(t908, t906, 1))
+    t909 = 1/casadi.fabs(casadi.if_else(t908, t906, 1))
     t910 = casadi.if_else(t905, casadi.if_else((t906 >= 0), 1, -1)*casadi.if_else(t908, t909/(1 + casadi.sqrt(1 + t909**2)), 1/(t907 + casadi.sqrt(1 + t907**2))), 0)
     t911 = 1/casadi.sqrt(1 + t910**2)
     t912 = t904*t910
@@ -3323,10 +3323,10 @@ def _condition_number(q):
     t931 = t865*t917 + t869*t921 + t873*t925 + t877*t929
     t932 = t891*t918 + t895*t922 + t899*t926 + t903*t930
     t933 = (t931 != 0)
-    t934 = 0.5*(-t913 + t861)/casadi.if_else(t933, t931, 1)
+    t934 = (-t913 + t861)/casadi.if_else(t933, 2*t931, 1)
     t935 = casadi.fabs(t934)
     t936 = (t935 >= 1)
-    t937 = casadi.fabs(1/casadi.if_else(t936, t934, 1))
+    t937 = 1/casadi.fabs(casadi.if_else(t936, t934, 1))
     t938 = casadi.if_else(t933, casadi.if_else((t934 >= 0), 1, -1)*casadi.if_else(t936, t937/(1 + casadi.sqrt(1 + t937**2)), 1/(t935 + casadi.sqrt(1 + t935**2))), 0)
     t939 = 1/casadi.sqrt(1 + t938**2)
     t940 = t931*t938
@@ -3349,10 +3349,10 @@ def _condition_number(q):
     t957 = t955 - t956*t938
     t958 = t956 + t955*t938
     t959 = (t932 != 0)
-    t960 = 0.5*(-t887 + t914)/casadi.if_else(t959, t932, 1)
+    t960 = (-t887 + t914)/casadi.if_else(t959, 2*t932, 1)
     t961 = casadi.fabs(t960)
     t962 = (t961 >= 1)
-    t963 = casadi.fabs(1/casadi.if_else(t962, t960, 1))
+    t963 = 1/casadi.fabs(casadi.if_else(t962, t960, 1))
     t964 = casadi.if_else(t959, casadi.if_else((t960 >= 0), 1, -1)*casadi.if_else(t962, t963/(1 + casadi.sqrt(1 + t963**2)), 1/(t961 + casadi.sqrt(1 + t961**2))), 0)
     t965 = 1/casadi.sqrt(1 + t964**2)
     t966 = t932*t964
@@ -3376,10 +3376,10 @@ def _condition_number(q):
     t984 = t982 + t981*t964
     t985 = t946*t971 + t950*t975 + t954*t979 + t958*t983
     t986 = (t985 != 0)
-    t987 = 0.5*(-t967 + t942)/casadi.if_else(t986, t985, 1)
+    t987 = (-t967 + t942)/casadi.if_else(t986, 2*t985, 1)
     t988 = casadi.fabs(t987)
     t989 = (t988 >= 1)
-    t990 = casadi.fabs(1/casadi.if_else(t989, t987, 1))
+    t990 = 1/casadi.fabs(casadi.if_else(t989, t987, 1))
     t991 = casadi.if_else(t986, casadi.if_else((t987 >= 0), 1, -1)*casadi.if_else(t989, t990/(1 + casadi.sqrt(1 + t990**2)), 1/(t988 + casadi.sqrt(1 + t988**2))), 0)
     t992 = 1/casadi.sqrt(1 + t991**2)
     t993 = t985*t991
@@ -3404,10 +3404,10 @@ def _condition_number(q):
     t1012 = t972*t999 + t976*t1003 + t980*t1007 + t984*t1011
     t1013 = t945*t998 + t949*t1002 + t953*t1006 + t957*t1010
     t1014 = (t1012 != 0)
-    t1015 = 0.5*(-t968 + t995)/casadi.if_else(t1014, t1012, 1)
+    t1015 = (-t968 + t995)/casadi.if_else(t1014, 2*t1012, 1)
     t1016 = casadi.fabs(t1015)
     t1017 = (t1016 >= 1)
-    t1018 = casadi.fabs(1/casadi.if_else(t1017, t1015, 1))
+    t1018 = 1/casadi.fabs(casadi.if_else(t1017, t1015, 1))
     t1019 = casadi.if_else(t1014, casadi.if_else((t1015 >= 0), 1, -1)*casadi.if_else(t1017, t1018/(1 + casadi.sqrt(1 + t1018**2)), 1/(t1016 + casadi.sqrt(1 + t1016**2))), 0)
     t1020 = 1/casadi.sqrt(1 + t1019**2)
     t1021 = t1012*t1019
@@ -3430,10 +3430,10 @@ def _condition_number(q):
     t1038 = t1036 - t1037*t1019
     t1039 = t1037 + t1036*t1019
     t1040 = (t1013 != 0)
-    t1041 = 0.5*(-t941 + t994)/casadi.if_else(t1040, t1013, 1)
+    t1041 = (-t941 + t994)/casadi.if_else(t1040, 2*t1013, 1)
     t1042 = casadi.fabs(t1041)
     t1043 = (t1042 >= 1)
-    t1044 = casadi.fabs(1/casadi.if_else(t1043, t1041, 1))
+    t1044 = 1/casadi.fabs(casadi.if_else(t1043, t1041, 1))
     t1045 = casadi.if_else(t1040, casadi.if_else((t1041 >= 0), 1, -1)*casadi.if_else(t1043, t1044/(1 + casadi.sqrt(1 + t1044**2)), 1/(t1042 + casadi.sqrt(1 + t1042**2))), 0)
     t1046 = 1/casadi.sqrt(1 + t1045**2)
     t1047 = t1013*t1045
@@ -3457,10 +3457,10 @@ def _condition_number(q):
     t1065 = t1063 + t1062*t1045
     t1066 = t1026*t1052 + t1030*t1056 + t1034*t1060 + t1038*t1064
     t1067 = (t1066 != 0)
-    t1068 = 0.5*(-t1048 + t1022)/casadi.if_else(t1067, t1066, 1)
+    t1068 = (-t1048 + t1022)/casadi.if_else(t1067, 2*t1066, 1)
     t1069 = casadi.fabs(t1068)
     t1070 = (t1069 >= 1)
-    t1071 = casadi.fabs(1/casadi.if_else(t1070, t1068, 1))
+    t1071 = 1/casadi.fabs(casadi.if_else(t1070, t1068, 1))
     t1072 = casadi.if_else(t1067, casadi.if_else((t1068 >= 0), 1, -1)*casadi.if_else(t1070, t1071/(1 + casadi.sqrt(1 + t1071**2)), 1/(t1069 + casadi.sqrt(1 + t1069**2))), 0)
     t1073 = 1/casadi.sqrt(1 + t1072**2)
     t1074 = t1066*t1072
@@ -3485,10 +3485,10 @@ def _condition_number(q):
     t1093 = t1027*t1079 + t1031*t1083 + t1035*t1087 + t1039*t1091
     t1094 = t1053*t1080 + t1057*t1084 + t1061*t1088 + t1065*t1092
     t1095 = (t1093 != 0)
-    t1096 = 0.5*(-t1075 + t1023)/casadi.if_else(t1095, t1093, 1)
+    t1096 = (-t1075 + t1023)/casadi.if_else(t1095, 2*t1093, 1)
     t1097 = casadi.fabs(t1096)
     t1098 = (t1097 >= 1)
-    t1099 = casadi.fabs(1/casadi.if_else(t1098, t1096, 1))
+    t1099 = 1/casadi.fabs(casadi.if_else(t1098, t1096, 1))
     t1100 = casadi.if_else(t1095, casadi.if_else((t1096 >= 0), 1, -1)*casadi.if_else(t1098, t1099/(1 + casadi.sqrt(1 + t1099**2)), 1/(t1097 + casadi.sqrt(1 + t1097**2))), 0)
     t1101 = 1/casadi.sqrt(1 + t1100**2)
     t1102 = t1023 + t1093*t1100
@@ -3510,10 +3510,10 @@ def _condition_number(q):
     t1118 = t1116 + t1100*t1115
     t1119 = casadi.sqrt(t1105**2 + t1109**2 + t1113**2 + t1117**2)
     t1120 = (t1094 != 0)
-    t1121 = 0.5*(-t1049 + t1076)/casadi.if_else(t1120, t1094, 1)
+    t1121 = (-t1049 + t1076)/casadi.if_else(t1120, 2*t1094, 1)
     t1122 = casadi.fabs(t1121)
     t1123 = (t1122 >= 1)
-    t1124 = casadi.fabs(1/casadi.if_else(t1123, t1121, 1))
+    t1124 = 1/casadi.fabs(casadi.if_else(t1123, t1121, 1))
     t1125 = casadi.if_else(t1120, casadi.if_else((t1121 >= 0), 1, -1)*casadi.if_else(t1123, t1124/(1 + casadi.sqrt(1 + t1124**2)), 1/(t1122 + casadi.sqrt(1 + t1122**2))), 0)
     t1126 = 1/casadi.sqrt(1 + t1125**2)
     t1127 = t1094*t1125
@@ -3537,10 +3537,10 @@ def _condition_number(q):
     t1145 = t1143 + t1125*t1142
     t1146 = t1106*t1132 + t1110*t1136 + t1114*t1140 + t1118*t1144
     t1147 = (t1146 != 0)
-    t1148 = 0.5*(-t1128 + t1102)/casadi.if_else(t1147, t1146, 1)
+    t1148 = (-t1128 + t1102)/casadi.if_else(t1147, 2*t1146, 1)
     t1149 = casadi.fabs(t1148)
     t1150 = (t1149 >= 1)
-    t1151 = casadi.fabs(1/casadi.if_else(t1150, t1148, 1))
+    t1151 = 1/casadi.fabs(casadi.if_else(t1150, t1148, 1))
     t1152 = casadi.if_else(t1147, casadi.if_else((t1148 >= 0), 1, -1)*casadi.if_else(t1150, t1151/(1 + casadi.sqrt(1 + t1151**2)), 1/(t1149 + casadi.sqrt(1 + t1149**2))), 0)
     t1153 = 1/casadi.sqrt(1 + t1152**2)
     t1154 = t1102 + t1146*t1152
@@ -3565,10 +3565,10 @@ def _condition_number(q):
     t1173 = casadi.if_else((t1172 > t1119), t1172, t1119)
     t1174 = casadi.if_else((t1172 < t1119), t1172, t1119)
     t1175 = (t1171 != 0)
-    t1176 = 0.5*(-t1129 + t1154)/casadi.if_else(t1175, t1171, 1)
+    t1176 = (-t1129 + t1154)/casadi.if_else(t1175, 2*t1171, 1)
     t1177 = casadi.fabs(t1176)
     t1178 = (t1177 >= 1)
-    t1179 = casadi.fabs(1/casadi.if_else(t1178, t1176, 1))
+    t1179 = 1/casadi.fabs(casadi.if_else(t1178, t1176, 1))
     t1180 = casadi.if_else(t1175, casadi.if_else((t1176 >= 0), 1, -1)*casadi.if_else(t1178, t1179/(1 + casadi.sqrt(1 + t1179**2)), 1/(t1177 + casadi.sqrt(1 + t1177**2))), 0)
     t1181 = 1/casadi.sqrt(1 + t1180**2)
     t1182 = t1133*t1181
@@ -3593,8 +3593,10 @@ def _condition_number(q):
     t1201 = casadi.if_else((t1198 < t1174), t1198, t1174)
     t1202 = casadi.if_else((t1199 > t1200), t1199, t1200)
     t1203 = casadi.if_else((t1199 < t1201), t1199, t1201)
+    t1204 = casadi.if_else((t1203 <= 1e-12*t1202), 0, t1203)
+    t1205 = casadi.if_else((t1202 > 0), t1202, 1)
     kappa = casadi.SX(1, 1)
-    kappa[0, 0] = casadi.if_else((t1202 > 0), t1202, 1)/casadi.if_else((t1203 <= 1e-12*t1202), 0, t1203)
+    kappa[0, 0] = t1205/t1204
     return [kappa]
 
 

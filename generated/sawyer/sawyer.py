@@ -3227,10 +3227,10 @@ def velocity_ellipsoid(q):
     t92 = t90**2
     t93 = t60*t66
     t94 = xp.not_equal(t93, 0)
-    t95 = 0.5*(-t63 + t91)/xp.where(t94, -t93, 1)
+    t95 = (-t63 + t91)/xp.where(t94, -2*t93, 1)
     t96 = xp.abs(t95)
     t97 = xp.greater_equal(t96, 1)
-    t98 = xp.abs(1/xp.where(t97, t95, 1))
+    t98 = 1/xp.abs(xp.where(t97, t95, 1))
     t99 = xp.where(t94, xp.where(xp.greater_equal(t95, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t97, t98/(1 + xp.sqrt(1 + t98**2)), 1/(t96 + xp.sqrt(1 + t96**2))), 0)
     t100 = 1/xp.sqrt(1 + t99**2)
     t101 = t93*t99
@@ -3246,10 +3246,10 @@ def velocity_ellipsoid(q):
     t111 = t110*t99
     t112 = t108*t106 - t111*t84
     t113 = xp.not_equal(t112, 0)
-    t114 = 0.5*(-t102 + t109)/xp.where(t113, t112, 1)
+    t114 = (-t102 + t109)/xp.where(t113, 2*t112, 1)
     t115 = xp.abs(t114)
     t116 = xp.greater_equal(t115, 1)
-    t117 = xp.abs(1/xp.where(t116, t114, 1))
+    t117 = 1/xp.abs(xp.where(t116, t114, 1))
     t118 = xp.where(t113, xp.where(xp.greater_equal(t114, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t116, t117/(1 + xp.sqrt(1 + t117**2)), 1/(t115 + xp.sqrt(1 + t115**2))), 0)
     t119 = 1/xp.sqrt(1 + t118**2)
     t120 = t112*t118
@@ -3265,10 +3265,10 @@ def velocity_ellipsoid(q):
     t130 = -t128 + t127*t118
     t131 = t107*t126 + t110*t130
     t132 = xp.not_equal(t131, 0)
-    t133 = 0.5*(-t103 + t122)/xp.where(t132, -t131, 1)
+    t133 = (-t103 + t122)/xp.where(t132, -2*t131, 1)
     t134 = xp.abs(t133)
     t135 = xp.greater_equal(t134, 1)
-    t136 = xp.abs(1/xp.where(t135, t133, 1))
+    t136 = 1/xp.abs(xp.where(t135, t133, 1))
     t137 = xp.where(t132, xp.where(xp.greater_equal(t133, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t135, t136/(1 + xp.sqrt(1 + t136**2)), 1/(t134 + xp.sqrt(1 + t134**2))), 0)
     t138 = 1/xp.sqrt(1 + t137**2)
     t139 = t131*t137
@@ -3294,10 +3294,10 @@ def velocity_ellipsoid(q):
     t159 = t137*t138
     t160 = t125*t144 - t129*t149 + t92*t153*t159*t119
     t161 = xp.not_equal(t160, 0)
-    t162 = 0.5*(-t121 + t140)/xp.where(t161, t160, 1)
+    t162 = (-t121 + t140)/xp.where(t161, 2*t160, 1)
     t163 = xp.abs(t162)
     t164 = xp.greater_equal(t163, 1)
-    t165 = xp.abs(1/xp.where(t164, t162, 1))
+    t165 = 1/xp.abs(xp.where(t164, t162, 1))
     t166 = xp.where(t161, xp.where(xp.greater_equal(t162, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t164, t165/(1 + xp.sqrt(1 + t165**2)), 1/(t163 + xp.sqrt(1 + t163**2))), 0)
     t167 = 1/xp.sqrt(1 + t166**2)
     t168 = t160*t166
@@ -3331,10 +3331,10 @@ def velocity_ellipsoid(q):
     t196 = t119*t138
     t197 = t145*t173 + t150*t177 - t196*t90*t186
     t198 = xp.not_equal(t197, 0)
-    t199 = 0.5*(-t169 + t141)/xp.where(t198, t197, 1)
+    t199 = (-t169 + t141)/xp.where(t198, 2*t197, 1)
     t200 = xp.abs(t199)
     t201 = xp.greater_equal(t200, 1)
-    t202 = xp.abs(1/xp.where(t201, t199, 1))
+    t202 = 1/xp.abs(xp.where(t201, t199, 1))
     t203 = xp.where(t198, xp.where(xp.greater_equal(t199, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t201, t202/(1 + xp.sqrt(1 + t202**2)), 1/(t200 + xp.sqrt(1 + t200**2))), 0)
     t204 = 1/xp.sqrt(1 + t203**2)
     t205 = t197*t203
@@ -3366,10 +3366,10 @@ def velocity_ellipsoid(q):
     t231 = t230 - t217*t203
     t232 = t217 + t230*t203
     t233 = xp.not_equal(t221, 0)
-    t234 = 0.5*(-t170 + t207)/xp.where(t233, t221, 1)
+    t234 = (-t170 + t207)/xp.where(t233, 2*t221, 1)
     t235 = xp.abs(t234)
     t236 = xp.greater_equal(t235, 1)
-    t237 = xp.abs(1/xp.where(t236, t234, 1))
+    t237 = 1/xp.abs(xp.where(t236, t234, 1))
     t238 = xp.where(t233, xp.where(xp.greater_equal(t234, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t236, t237/(1 + xp.sqrt(1 + t237**2)), 1/(t235 + xp.sqrt(1 + t235**2))), 0)
     t239 = 1/xp.sqrt(1 + t238**2)
     t240 = t221*t238
@@ -3401,10 +3401,10 @@ def velocity_ellipsoid(q):
     t266 = t264 + t265*t238
     t267 = t265 - t264*t238
     t268 = xp.not_equal(t255, 0)
-    t269 = 0.5*(-t206 + t241)/xp.where(t268, t255, 1)
+    t269 = (-t206 + t241)/xp.where(t268, 2*t255, 1)
     t270 = xp.abs(t269)
     t271 = xp.greater_equal(t270, 1)
-    t272 = xp.abs(1/xp.where(t271, t269, 1))
+    t272 = 1/xp.abs(xp.where(t271, t269, 1))
     t273 = xp.where(t268, xp.where(xp.greater_equal(t269, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t271, t272/(1 + xp.sqrt(1 + t272**2)), 1/(t270 + xp.sqrt(1 + t270**2))), 0)
     t274 = 1/xp.sqrt(1 + t273**2)
     t275 = t255*t273
@@ -3436,10 +3436,10 @@ def velocity_ellipsoid(q):
     t301 = t299 + t300*t273
     t302 = -t300 + t299*t273
     t303 = xp.not_equal(t290, 0)
-    t304 = 0.5*(-t276 + t242)/xp.where(t303, t290, 1)
+    t304 = (-t276 + t242)/xp.where(t303, 2*t290, 1)
     t305 = xp.abs(t304)
     t306 = xp.greater_equal(t305, 1)
-    t307 = xp.abs(1/xp.where(t306, t304, 1))
+    t307 = 1/xp.abs(xp.where(t306, t304, 1))
     t308 = xp.where(t303, xp.where(xp.greater_equal(t304, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t306, t307/(1 + xp.sqrt(1 + t307**2)), 1/(t305 + xp.sqrt(1 + t305**2))), 0)
     t309 = 1/xp.sqrt(1 + t308**2)
     t310 = t290*t308
@@ -3471,10 +3471,10 @@ def velocity_ellipsoid(q):
     t336 = t334 - t335*t308
     t337 = t335 + t334*t308
     t338 = xp.not_equal(t325, 0)
-    t339 = 0.5*(-t277 + t312)/xp.where(t338, t325, 1)
+    t339 = (-t277 + t312)/xp.where(t338, 2*t325, 1)
     t340 = xp.abs(t339)
     t341 = xp.greater_equal(t340, 1)
-    t342 = xp.abs(1/xp.where(t341, t339, 1))
+    t342 = 1/xp.abs(xp.where(t341, t339, 1))
     t343 = xp.where(t338, xp.where(xp.greater_equal(t339, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t341, t342/(1 + xp.sqrt(1 + t342**2)), 1/(t340 + xp.sqrt(1 + t340**2))), 0)
     t344 = 1/xp.sqrt(1 + t343**2)
     t345 = t325*t343
@@ -3506,10 +3506,10 @@ def velocity_ellipsoid(q):
     t371 = t369 - t343*t370
     t372 = t370 + t343*t369
     t373 = xp.not_equal(t360, 0)
-    t374 = 0.5*(-t311 + t346)/xp.where(t373, t360, 1)
+    t374 = (-t311 + t346)/xp.where(t373, 2*t360, 1)
     t375 = xp.abs(t374)
     t376 = xp.greater_equal(t375, 1)
-    t377 = xp.abs(1/xp.where(t376, t374, 1))
+    t377 = 1/xp.abs(xp.where(t376, t374, 1))
     t378 = xp.where(t373, xp.where(xp.greater_equal(t374, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t376, t377/(1 + xp.sqrt(1 + t377**2)), 1/(t375 + xp.sqrt(1 + t375**2))), 0)
     t379 = 1/xp.sqrt(1 + t378**2)
     t380 = t360*t378
@@ -3541,10 +3541,10 @@ def velocity_ellipsoid(q):
     t406 = t404 - t378*t405
     t407 = t405 + t378*t404
     t408 = xp.not_equal(t395, 0)
-    t409 = 0.5*(-t381 + t347)/xp.where(t408, t395, 1)
+    t409 = (-t381 + t347)/xp.where(t408, 2*t395, 1)
     t410 = xp.abs(t409)
     t411 = xp.greater_equal(t410, 1)
-    t412 = xp.abs(1/xp.where(t411, t409, 1))
+    t412 = 1/xp.abs(xp.where(t411, t409, 1))
     t413 = xp.where(t408, xp.where(xp.greater_equal(t409, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t411, t412/(1 + xp.sqrt(1 + t412**2)), 1/(t410 + xp.sqrt(1 + t410**2))), 0)
     t414 = 1/xp.sqrt(1 + t413**2)
     t415 = t395*t413
@@ -3576,10 +3576,10 @@ def velocity_ellipsoid(q):
     t441 = t439 - t413*t440
     t442 = t440 + t413*t439
     t443 = xp.not_equal(t430, 0)
-    t444 = 0.5*(-t382 + t417)/xp.where(t443, t430, 1)
+    t444 = (-t382 + t417)/xp.where(t443, 2*t430, 1)
     t445 = xp.abs(t444)
     t446 = xp.greater_equal(t445, 1)
-    t447 = xp.abs(1/xp.where(t446, t444, 1))
+    t447 = 1/xp.abs(xp.where(t446, t444, 1))
     t448 = xp.where(t443, xp.where(xp.greater_equal(t444, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t446, t447/(1 + xp.sqrt(1 + t447**2)), 1/(t445 + xp.sqrt(1 + t445**2))), 0)
     t449 = 1/xp.sqrt(1 + t448**2)
     t450 = t430*t448
@@ -3611,10 +3611,10 @@ def velocity_ellipsoid(q):
     t476 = t474 - t448*t475
     t477 = t475 + t448*t474
     t478 = xp.not_equal(t465, 0)
-    t479 = 0.5*(-t416 + t451)/xp.where(t478, t465, 1)
+    t479 = (-t416 + t451)/xp.where(t478, 2*t465, 1)
     t480 = xp.abs(t479)
     t481 = xp.greater_equal(t480, 1)
-    t482 = xp.abs(1/xp.where(t481, t479, 1))
+    t482 = 1/xp.abs(xp.where(t481, t479, 1))
     t483 = xp.where(t478, xp.where(xp.greater_equal(t479, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t481, t482/(1 + xp.sqrt(1 + t482**2)), 1/(t480 + xp.sqrt(1 + t480**2))), 0)
     t484 = 1/xp.sqrt(1 + t483**2)
     t485 = t465*t483
@@ -3646,10 +3646,10 @@ def velocity_ellipsoid(q):
     t511 = t509 - t483*t510
     t512 = t510 + t483*t509
     t513 = xp.not_equal(t500, 0)
-    t514 = 0.5*(-t486 + t452)/xp.where(t513, t500, 1)
+    t514 = (-t486 + t452)/xp.where(t513, 2*t500, 1)
     t515 = xp.abs(t514)
     t516 = xp.greater_equal(t515, 1)
-    t517 = xp.abs(1/xp.where(t516, t514, 1))
+    t517 = 1/xp.abs(xp.where(t516, t514, 1))
     t518 = xp.where(t513, xp.where(xp.greater_equal(t514, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t516, t517/(1 + xp.sqrt(1 + t517**2)), 1/(t515 + xp.sqrt(1 + t515**2))), 0)
     t519 = 1/xp.sqrt(1 + t518**2)
     t520 = t452 + t500*t518
@@ -3680,10 +3680,10 @@ def velocity_ellipsoid(q):
     t545 = t543 - t518*t544
     t546 = t544 + t518*t543
     t547 = xp.not_equal(t533, 0)
-    t548 = 0.5*(-t487 + t520)/xp.where(t547, t533, 1)
+    t548 = (-t487 + t520)/xp.where(t547, 2*t533, 1)
     t549 = xp.abs(t548)
     t550 = xp.greater_equal(t549, 1)
-    t551 = xp.abs(1/xp.where(t550, t548, 1))
+    t551 = 1/xp.abs(xp.where(t550, t548, 1))
     t552 = xp.where(t547, xp.where(xp.greater_equal(t548, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t550, t551/(1 + xp.sqrt(1 + t551**2)), 1/(t549 + xp.sqrt(1 + t549**2))), 0)
     t553 = 1/xp.sqrt(1 + t552**2)
     t554 = t491*t553
@@ -3782,10 +3782,10 @@ def velocity_ellipsoid(q):
     t647 = t646**2
     t648 = t625**2 + t639**2 + t647
     t649 = xp.not_equal(t636, 0)
-    t650 = 0.5*(-t615 + t635)/xp.where(t649, t636, 1)
+    t650 = (-t615 + t635)/xp.where(t649, 2*t636, 1)
     t651 = xp.abs(t650)
     t652 = xp.greater_equal(t651, 1)
-    t653 = xp.abs(1/xp.where(t652, t650, 1))
+    t653 = 1/xp.abs(xp.where(t652, t650, 1))
     t654 = xp.where(t649, xp.where(xp.greater_equal(t650, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t652, t653/(1 + xp.sqrt(1 + t653**2)), 1/(t651 + xp.sqrt(1 + t651**2))), 0)
     t655 = 1/xp.sqrt(1 + t654**2)
     t656 = t636*t654
@@ -3799,10 +3799,10 @@ def velocity_ellipsoid(q):
     t664 = t654*t663
     t665 = t625*t661 + t639*t664
     t666 = xp.not_equal(t665, 0)
-    t667 = 0.5*(-t657 + t648)/xp.where(t666, t665, 1)
+    t667 = (-t657 + t648)/xp.where(t666, 2*t665, 1)
     t668 = xp.abs(t667)
     t669 = xp.greater_equal(t668, 1)
-    t670 = xp.abs(1/xp.where(t669, t667, 1))
+    t670 = 1/xp.abs(xp.where(t669, t667, 1))
     t671 = xp.where(t666, xp.where(xp.greater_equal(t667, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t669, t670/(1 + xp.sqrt(1 + t670**2)), 1/(t668 + xp.sqrt(1 + t668**2))), 0)
     t672 = 1/xp.sqrt(1 + t671**2)
     t673 = t665*t671
@@ -3818,10 +3818,10 @@ def velocity_ellipsoid(q):
     t683 = t681 + t671*t680
     t684 = t662*t679 + t683*t663
     t685 = xp.not_equal(t684, 0)
-    t686 = 0.5*(-t658 + t675)/xp.where(t685, -t684, 1)
+    t686 = (-t658 + t675)/xp.where(t685, -2*t684, 1)
     t687 = xp.abs(t686)
     t688 = xp.greater_equal(t687, 1)
-    t689 = xp.abs(1/xp.where(t688, t686, 1))
+    t689 = 1/xp.abs(xp.where(t688, t686, 1))
     t690 = xp.where(t685, xp.where(xp.greater_equal(t686, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t688, t689/(1 + xp.sqrt(1 + t689**2)), 1/(t687 + xp.sqrt(1 + t687**2))), 0)
     t691 = 1/xp.sqrt(1 + t690**2)
     t692 = t684*t690
@@ -3847,10 +3847,10 @@ def velocity_ellipsoid(q):
     t712 = t690*t691
     t713 = t678*t697 + t682*t702 - t672*t647*t706*t712
     t714 = xp.not_equal(t713, 0)
-    t715 = 0.5*(-t674 + t693)/xp.where(t714, -t713, 1)
+    t715 = (-t674 + t693)/xp.where(t714, -2*t713, 1)
     t716 = xp.abs(t715)
     t717 = xp.greater_equal(t716, 1)
-    t718 = xp.abs(1/xp.where(t717, t715, 1))
+    t718 = 1/xp.abs(xp.where(t717, t715, 1))
     t719 = xp.where(t714, xp.where(xp.greater_equal(t715, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t717, t718/(1 + xp.sqrt(1 + t718**2)), 1/(t716 + xp.sqrt(1 + t716**2))), 0)
     t720 = 1/xp.sqrt(1 + t719**2)
     t721 = t713*t719
@@ -3884,10 +3884,10 @@ def velocity_ellipsoid(q):
     t749 = t672*t691
     t750 = t698*t726 + t703*t730 - t646*t739*t749
     t751 = xp.not_equal(t750, 0)
-    t752 = 0.5*(-t722 + t694)/xp.where(t751, t750, 1)
+    t752 = (-t722 + t694)/xp.where(t751, 2*t750, 1)
     t753 = xp.abs(t752)
     t754 = xp.greater_equal(t753, 1)
-    t755 = xp.abs(1/xp.where(t754, t752, 1))
+    t755 = 1/xp.abs(xp.where(t754, t752, 1))
     t756 = xp.where(t751, xp.where(xp.greater_equal(t752, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t754, t755/(1 + xp.sqrt(1 + t755**2)), 1/(t753 + xp.sqrt(1 + t753**2))), 0)
     t757 = 1/xp.sqrt(1 + t756**2)
     t758 = t750*t756
@@ -3919,10 +3919,10 @@ def velocity_ellipsoid(q):
     t784 = t783 - t756*t770
     t785 = t770 + t756*t783
     t786 = xp.not_equal(t774, 0)
-    t787 = 0.5*(-t723 + t760)/xp.where(t786, t774, 1)
+    t787 = (-t723 + t760)/xp.where(t786, 2*t774, 1)
     t788 = xp.abs(t787)
     t789 = xp.greater_equal(t788, 1)
-    t790 = xp.abs(1/xp.where(t789, t787, 1))
+    t790 = 1/xp.abs(xp.where(t789, t787, 1))
     t791 = xp.where(t786, xp.where(xp.greater_equal(t787, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t789, t790/(1 + xp.sqrt(1 + t790**2)), 1/(t788 + xp.sqrt(1 + t788**2))), 0)
     t792 = 1/xp.sqrt(1 + t791**2)
     t793 = t774*t791
@@ -3954,10 +3954,10 @@ def velocity_ellipsoid(q):
     t819 = t817 + t791*t818
     t820 = t818 - t791*t817
     t821 = xp.not_equal(t808, 0)
-    t822 = 0.5*(-t759 + t794)/xp.where(t821, t808, 1)
+    t822 = (-t759 + t794)/xp.where(t821, 2*t808, 1)
     t823 = xp.abs(t822)
     t824 = xp.greater_equal(t823, 1)
-    t825 = xp.abs(1/xp.where(t824, t822, 1))
+    t825 = 1/xp.abs(xp.where(t824, t822, 1))
     t826 = xp.where(t821, xp.where(xp.greater_equal(t822, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t824, t825/(1 + xp.sqrt(1 + t825**2)), 1/(t823 + xp.sqrt(1 + t823**2))), 0)
     t827 = 1/xp.sqrt(1 + t826**2)
     t828 = t808*t826
@@ -3989,10 +3989,10 @@ def velocity_ellipsoid(q):
     t854 = t852 + t826*t853
     t855 = -t853 + t826*t852
     t856 = xp.not_equal(t843, 0)
-    t857 = 0.5*(-t829 + t795)/xp.where(t856, t843, 1)
+    t857 = (-t829 + t795)/xp.where(t856, 2*t843, 1)
     t858 = xp.abs(t857)
     t859 = xp.greater_equal(t858, 1)
-    t860 = xp.abs(1/xp.where(t859, t857, 1))
+    t860 = 1/xp.abs(xp.where(t859, t857, 1))
     t861 = xp.where(t856, xp.where(xp.greater_equal(t857, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t859, t860/(1 + xp.sqrt(1 + t860**2)), 1/(t858 + xp.sqrt(1 + t858**2))), 0)
     t862 = 1/xp.sqrt(1 + t861**2)
     t863 = t843*t861
@@ -4024,10 +4024,10 @@ def velocity_ellipsoid(q):
     t889 = t887 - t861*t888
     t890 = t888 + t861*t887
     t891 = xp.not_equal(t878, 0)
-    t892 = 0.5*(-t830 + t865)/xp.where(t891, t878, 1)
+    t892 = (-t830 + t865)/xp.where(t891, 2*t878, 1)
     t893 = xp.abs(t892)
     t894 = xp.greater_equal(t893, 1)
-    t895 = xp.abs(1/xp.where(t894, t892, 1))
+    t895 = 1/xp.abs(xp.where(t894, t892, 1))
     t896 = xp.where(t891, xp.where(xp.greater_equal(t892, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t894, t895/(1 + xp.sqrt(1 + t895**2)), 1/(t893 + xp.sqrt(1 + t893**2))), 0)
     t897 = 1/xp.sqrt(1 + t896**2)
     t898 = t878*t896
@@ -4059,10 +4059,10 @@ def velocity_ellipsoid(q):
     t924 = t922 - t896*t923
     t925 = t923 + t896*t922
     t926 = xp.not_equal(t913, 0)
-    t927 = 0.5*(-t864 + t899)/xp.where(t926, t913, 1)
+    t927 = (-t864 + t899)/xp.where(t926, 2*t913, 1)
     t928 = xp.abs(t927)
     t929 = xp.greater_equal(t928, 1)
-    t930 = xp.abs(1/xp.where(t929, t927, 1))
+    t930 = 1/xp.abs(xp.where(t929, t927, 1))
     t931 = xp.where(t926, xp.where(xp.greater_equal(t927, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t929, t930/(1 + xp.sqrt(1 + t930**2)), 1/(t928 + xp.sqrt(1 + t928**2))), 0)
     t932 = 1/xp.sqrt(1 + t931**2)
     t933 = t913*t931
@@ -4094,10 +4094,10 @@ def velocity_ellipsoid(q):
     t959 = t957 - t931*t958
     t960 = t958 + t931*t957
     t961 = xp.not_equal(t948, 0)
-    t962 = 0.5*(-t934 + t900)/xp.where(t961, t948, 1)
+    t962 = (-t934 + t900)/xp.where(t961, 2*t948, 1)
     t963 = xp.abs(t962)
     t964 = xp.greater_equal(t963, 1)
-    t965 = xp.abs(1/xp.where(t964, t962, 1))
+    t965 = 1/xp.abs(xp.where(t964, t962, 1))
     t966 = xp.where(t961, xp.where(xp.greater_equal(t962, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t964, t965/(1 + xp.sqrt(1 + t965**2)), 1/(t963 + xp.sqrt(1 + t963**2))), 0)
     t967 = 1/xp.sqrt(1 + t966**2)
     t968 = t948*t966
@@ -4129,10 +4129,10 @@ def velocity_ellipsoid(q):
     t994 = t992 - t966*t993
     t995 = t993 + t966*t992
     t996 = xp.not_equal(t983, 0)
-    t997 = 0.5*(-t935 + t970)/xp.where(t996, t983, 1)
+    t997 = (-t935 + t970)/xp.where(t996, 2*t983, 1)
     t998 = xp.abs(t997)
     t999 = xp.greater_equal(t998, 1)
-    t1000 = xp.abs(1/xp.where(t999, t997, 1))
+    t1000 = 1/xp.abs(xp.where(t999, t997, 1))
     t1001 = xp.where(t996, xp.where(xp.greater_equal(t997, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t999, t1000/(1 + xp.sqrt(1 + t1000**2)), 1/(t998 + xp.sqrt(1 + t998**2))), 0)
     t1002 = 1/xp.sqrt(1 + t1001**2)
     t1003 = t983*t1001
@@ -4164,10 +4164,10 @@ def velocity_ellipsoid(q):
     t1029 = t1027 - t1001*t1028
     t1030 = t1028 + t1001*t1027
     t1031 = xp.not_equal(t1018, 0)
-    t1032 = 0.5*(-t969 + t1004)/xp.where(t1031, t1018, 1)
+    t1032 = (-t969 + t1004)/xp.where(t1031, 2*t1018, 1)
     t1033 = xp.abs(t1032)
     t1034 = xp.greater_equal(t1033, 1)
-    t1035 = xp.abs(1/xp.where(t1034, t1032, 1))
+    t1035 = 1/xp.abs(xp.where(t1034, t1032, 1))
     t1036 = xp.where(t1031, xp.where(xp.greater_equal(t1032, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1034, t1035/(1 + xp.sqrt(1 + t1035**2)), 1/(t1033 + xp.sqrt(1 + t1033**2))), 0)
     t1037 = 1/xp.sqrt(1 + t1036**2)
     t1038 = t1018*t1036
@@ -4199,10 +4199,10 @@ def velocity_ellipsoid(q):
     t1064 = t1062 - t1036*t1063
     t1065 = t1063 + t1036*t1062
     t1066 = xp.not_equal(t1053, 0)
-    t1067 = 0.5*(-t1039 + t1005)/xp.where(t1066, t1053, 1)
+    t1067 = (-t1039 + t1005)/xp.where(t1066, 2*t1053, 1)
     t1068 = xp.abs(t1067)
     t1069 = xp.greater_equal(t1068, 1)
-    t1070 = xp.abs(1/xp.where(t1069, t1067, 1))
+    t1070 = 1/xp.abs(xp.where(t1069, t1067, 1))
     t1071 = xp.where(t1066, xp.where(xp.greater_equal(t1067, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1069, t1070/(1 + xp.sqrt(1 + t1070**2)), 1/(t1068 + xp.sqrt(1 + t1068**2))), 0)
     t1072 = 1/xp.sqrt(1 + t1071**2)
     t1073 = t1005 + t1053*t1071
@@ -4233,10 +4233,10 @@ def velocity_ellipsoid(q):
     t1098 = t1096 - t1071*t1097
     t1099 = t1097 + t1071*t1096
     t1100 = xp.not_equal(t1086, 0)
-    t1101 = 0.5*(-t1040 + t1073)/xp.where(t1100, t1086, 1)
+    t1101 = (-t1040 + t1073)/xp.where(t1100, 2*t1086, 1)
     t1102 = xp.abs(t1101)
     t1103 = xp.greater_equal(t1102, 1)
-    t1104 = xp.abs(1/xp.where(t1103, t1101, 1))
+    t1104 = 1/xp.abs(xp.where(t1103, t1101, 1))
     t1105 = xp.where(t1100, xp.where(xp.greater_equal(t1101, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1103, t1104/(1 + xp.sqrt(1 + t1104**2)), 1/(t1102 + xp.sqrt(1 + t1102**2))), 0)
     t1106 = 1/xp.sqrt(1 + t1105**2)
     t1107 = t1044*t1106
@@ -4534,10 +4534,10 @@ def condition_number(q):
     t181 = t63*t78
     t182 = t72*t100 + t65*t150 + t179*t104 - t180*t110 + t181*t116
     t183 = xp.not_equal(t182, 0)
-    t184 = 0.5*(-t178 + t171)/xp.where(t183, -t182, 1)
+    t184 = (-t178 + t171)/xp.where(t183, -2*t182, 1)
     t185 = xp.abs(t184)
     t186 = xp.greater_equal(t185, 1)
-    t187 = xp.abs(1/xp.where(t186, t184, 1))
+    t187 = 1/xp.abs(xp.where(t186, t184, 1))
     t188 = xp.where(t183, xp.where(xp.greater_equal(t184, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t186, t187/(1 + xp.sqrt(1 + t187**2)), 1/(t185 + xp.sqrt(1 + t185**2))), 0)
     t189 = 1/xp.sqrt(1 + t188**2)
     t190 = t182*t188
@@ -4565,10 +4565,10 @@ def condition_number(q):
     t212 = -t210 + t209*t188
     t213 = t122*t199 - t126*t203 + t131*t207 - t156*t211
     t214 = xp.not_equal(t213, 0)
-    t215 = 0.5*(-t191 + t172)/xp.where(t214, t213, 1)
+    t215 = (-t191 + t172)/xp.where(t214, 2*t213, 1)
     t216 = xp.abs(t215)
     t217 = xp.greater_equal(t216, 1)
-    t218 = xp.abs(1/xp.where(t217, t215, 1))
+    t218 = 1/xp.abs(xp.where(t217, t215, 1))
     t219 = xp.where(t214, xp.where(xp.greater_equal(t215, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t217, t218/(1 + xp.sqrt(1 + t218**2)), 1/(t216 + xp.sqrt(1 + t216**2))), 0)
     t220 = 1/xp.sqrt(1 + t219**2)
     t221 = t213*t219
@@ -4592,10 +4592,10 @@ def condition_number(q):
     t239 = -t237 + t236*t219
     t240 = t136*t230 + t140*t234 - t161*t238
     t241 = xp.not_equal(t240, 0)
-    t242 = 0.5*(-t222 + t173)/xp.where(t241, -t240, 1)
+    t242 = (-t222 + t173)/xp.where(t241, -2*t240, 1)
     t243 = xp.abs(t242)
     t244 = xp.greater_equal(t243, 1)
-    t245 = xp.abs(1/xp.where(t244, t242, 1))
+    t245 = 1/xp.abs(xp.where(t244, t242, 1))
     t246 = xp.where(t241, xp.where(xp.greater_equal(t242, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t244, t245/(1 + xp.sqrt(1 + t245**2)), 1/(t243 + xp.sqrt(1 + t243**2))), 0)
     t247 = 1/xp.sqrt(1 + t246**2)
     t248 = t240*t246
@@ -4615,10 +4615,10 @@ def condition_number(q):
     t262 = t260 + t259*t246
     t263 = -t145*t257 + t166*t261
     t264 = xp.not_equal(t263, 0)
-    t265 = 0.5*(-t249 + t174)/xp.where(t264, t263, 1)
+    t265 = (-t249 + t174)/xp.where(t264, 2*t263, 1)
     t266 = xp.abs(t265)
     t267 = xp.greater_equal(t266, 1)
-    t268 = xp.abs(1/xp.where(t267, t265, 1))
+    t268 = 1/xp.abs(xp.where(t267, t265, 1))
     t269 = xp.where(t264, xp.where(xp.greater_equal(t265, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t267, t268/(1 + xp.sqrt(1 + t268**2)), 1/(t266 + xp.sqrt(1 + t266**2))), 0)
     t270 = 1/xp.sqrt(1 + t269**2)
     t271 = t263*t269
@@ -4634,10 +4634,10 @@ def condition_number(q):
     t281 = t279 + t278*t269
     t282 = t170*t280
     t283 = xp.not_equal(t282, 0)
-    t284 = 0.5*(-t272 + t175)/xp.where(t283, -t282, 1)
+    t284 = (-t272 + t175)/xp.where(t283, -2*t282, 1)
     t285 = xp.abs(t284)
     t286 = xp.greater_equal(t285, 1)
-    t287 = xp.abs(1/xp.where(t286, t284, 1))
+    t287 = 1/xp.abs(xp.where(t286, t284, 1))
     t288 = xp.where(t283, xp.where(xp.greater_equal(t284, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t286, t287/(1 + xp.sqrt(1 + t287**2)), 1/(t285 + xp.sqrt(1 + t285**2))), 0)
     t289 = 1/xp.sqrt(1 + t288**2)
     t290 = t282*t288
@@ -4651,10 +4651,10 @@ def condition_number(q):
     t298 = t297*t195
     t299 = -t200*t227 - t204*t231 - t208*t235 + t212*t239 + t176*t297*t188*t189**2 + t298*t196
     t300 = xp.not_equal(t299, 0)
-    t301 = 0.5*(-t192 + t223)/xp.where(t300, t299, 1)
+    t301 = (-t192 + t223)/xp.where(t300, 2*t299, 1)
     t302 = xp.abs(t301)
     t303 = xp.greater_equal(t302, 1)
-    t304 = xp.abs(1/xp.where(t303, t301, 1))
+    t304 = 1/xp.abs(xp.where(t303, t301, 1))
     t305 = xp.where(t300, xp.where(xp.greater_equal(t301, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t303, t304/(1 + xp.sqrt(1 + t304**2)), 1/(t302 + xp.sqrt(1 + t302**2))), 0)
     t306 = 1/xp.sqrt(1 + t305**2)
     t307 = t299*t305
@@ -4693,10 +4693,10 @@ def condition_number(q):
     t340 = t336*t226
     t341 = -t254*t326 + t258*t330 + t262*t334 - t338*t314 + t339*t318 + t340*t322
     t342 = xp.not_equal(t341, 0)
-    t343 = 0.5*(-t308 + t250)/xp.where(t342, t341, 1)
+    t343 = (-t308 + t250)/xp.where(t342, 2*t341, 1)
     t344 = xp.abs(t343)
     t345 = xp.greater_equal(t344, 1)
-    t346 = xp.abs(1/xp.where(t345, t343, 1))
+    t346 = 1/xp.abs(xp.where(t345, t343, 1))
     t347 = xp.where(t342, xp.where(xp.greater_equal(t343, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t345, t346/(1 + xp.sqrt(1 + t346**2)), 1/(t344 + xp.sqrt(1 + t344**2))), 0)
     t348 = 1/xp.sqrt(1 + t347**2)
     t349 = t341*t347
@@ -4739,10 +4739,10 @@ def condition_number(q):
     t386 = t385*t269
     t387 = t277*t370 + t281*t374 - t380*t354 + t382*t358 + t384*t362 - t386*t366
     t388 = xp.not_equal(t387, 0)
-    t389 = 0.5*(-t350 + t273)/xp.where(t388, t387, 1)
+    t389 = (-t350 + t273)/xp.where(t388, 2*t387, 1)
     t390 = xp.abs(t389)
     t391 = xp.greater_equal(t390, 1)
-    t392 = xp.abs(1/xp.where(t391, t389, 1))
+    t392 = 1/xp.abs(xp.where(t391, t389, 1))
     t393 = xp.where(t388, xp.where(xp.greater_equal(t389, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t391, t392/(1 + xp.sqrt(1 + t392**2)), 1/(t390 + xp.sqrt(1 + t390**2))), 0)
     t394 = 1/xp.sqrt(1 + t393**2)
     t395 = t387*t393
@@ -4784,10 +4784,10 @@ def condition_number(q):
     t431 = t430*t288
     t432 = t296*t420 - t423*t400 + t425*t404 + t427*t408 - t429*t412 + t431*t416
     t433 = xp.not_equal(t432, 0)
-    t434 = 0.5*(-t396 + t292)/xp.where(t433, t432, 1)
+    t434 = (-t396 + t292)/xp.where(t433, 2*t432, 1)
     t435 = xp.abs(t434)
     t436 = xp.greater_equal(t435, 1)
-    t437 = xp.abs(1/xp.where(t436, t434, 1))
+    t437 = 1/xp.abs(xp.where(t436, t434, 1))
     t438 = xp.where(t433, xp.where(xp.greater_equal(t434, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t436, t437/(1 + xp.sqrt(1 + t437**2)), 1/(t435 + xp.sqrt(1 + t435**2))), 0)
     t439 = 1/xp.sqrt(1 + t438**2)
     t440 = t432*t438
@@ -4819,10 +4819,10 @@ def condition_number(q):
     t466 = t464 + t463*t438
     t467 = t295*t465 - t422*t445 + t424*t449 + t426*t453 - t428*t457 + t430*t461
     t468 = xp.not_equal(t376, 0)
-    t469 = 0.5*(-t309 + t351)/xp.where(t468, t376, 1)
+    t469 = (-t309 + t351)/xp.where(t468, 2*t376, 1)
     t470 = xp.abs(t469)
     t471 = xp.greater_equal(t470, 1)
-    t472 = xp.abs(1/xp.where(t471, t469, 1))
+    t472 = 1/xp.abs(xp.where(t471, t469, 1))
     t473 = xp.where(t468, xp.where(xp.greater_equal(t469, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t471, t472/(1 + xp.sqrt(1 + t472**2)), 1/(t470 + xp.sqrt(1 + t470**2))), 0)
     t474 = 1/xp.sqrt(1 + t473**2)
     t475 = t376*t473
@@ -4854,10 +4854,10 @@ def condition_number(q):
     t501 = t499 + t498*t473
     t502 = -t401*t480 + t405*t484 + t409*t488 + t413*t492 + t417*t496 + t421*t500
     t503 = xp.not_equal(t502, 0)
-    t504 = 0.5*(-t476 + t397)/xp.where(t503, t502, 1)
+    t504 = (-t476 + t397)/xp.where(t503, 2*t502, 1)
     t505 = xp.abs(t504)
     t506 = xp.greater_equal(t505, 1)
-    t507 = xp.abs(1/xp.where(t506, t504, 1))
+    t507 = 1/xp.abs(xp.where(t506, t504, 1))
     t508 = xp.where(t503, xp.where(xp.greater_equal(t504, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t506, t507/(1 + xp.sqrt(1 + t507**2)), 1/(t505 + xp.sqrt(1 + t505**2))), 0)
     t509 = 1/xp.sqrt(1 + t508**2)
     t510 = t502*t508
@@ -4890,10 +4890,10 @@ def condition_number(q):
     t537 = -t446*t515 + t450*t519 + t454*t523 + t458*t527 + t462*t531 + t466*t535
     t538 = t481*t516 + t485*t520 + t489*t524 + t493*t528 + t497*t532 + t501*t536
     t539 = xp.not_equal(t537, 0)
-    t540 = 0.5*(-t511 + t442)/xp.where(t539, t537, 1)
+    t540 = (-t511 + t442)/xp.where(t539, 2*t537, 1)
     t541 = xp.abs(t540)
     t542 = xp.greater_equal(t541, 1)
-    t543 = xp.abs(1/xp.where(t542, t540, 1))
+    t543 = 1/xp.abs(xp.where(t542, t540, 1))
     t544 = xp.where(t539, xp.where(xp.greater_equal(t540, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t542, t543/(1 + xp.sqrt(1 + t543**2)), 1/(t541 + xp.sqrt(1 + t541**2))), 0)
     t545 = 1/xp.sqrt(1 + t544**2)
     t546 = t537*t544
@@ -4924,10 +4924,10 @@ def condition_number(q):
     t571 = t569 - t570*t544
     t572 = t570 + t569*t544
     t573 = xp.not_equal(t538, 0)
-    t574 = 0.5*(-t477 + t512)/xp.where(t573, t538, 1)
+    t574 = (-t477 + t512)/xp.where(t573, 2*t538, 1)
     t575 = xp.abs(t574)
     t576 = xp.greater_equal(t575, 1)
-    t577 = xp.abs(1/xp.where(t576, t574, 1))
+    t577 = 1/xp.abs(xp.where(t576, t574, 1))
     t578 = xp.where(t573, xp.where(xp.greater_equal(t574, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t576, t577/(1 + xp.sqrt(1 + t577**2)), 1/(t575 + xp.sqrt(1 + t575**2))), 0)
     t579 = 1/xp.sqrt(1 + t578**2)
     t580 = t538*t578
@@ -4959,10 +4959,10 @@ def condition_number(q):
     t606 = t604 + t603*t578
     t607 = t552*t585 + t556*t589 + t560*t593 + t564*t597 + t568*t601 + t572*t605
     t608 = xp.not_equal(t607, 0)
-    t609 = 0.5*(-t581 + t548)/xp.where(t608, t607, 1)
+    t609 = (-t581 + t548)/xp.where(t608, 2*t607, 1)
     t610 = xp.abs(t609)
     t611 = xp.greater_equal(t610, 1)
-    t612 = xp.abs(1/xp.where(t611, t609, 1))
+    t612 = 1/xp.abs(xp.where(t611, t609, 1))
     t613 = xp.where(t608, xp.where(xp.greater_equal(t609, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t611, t612/(1 + xp.sqrt(1 + t612**2)), 1/(t610 + xp.sqrt(1 + t610**2))), 0)
     t614 = 1/xp.sqrt(1 + t613**2)
     t615 = t607*t613
@@ -4994,10 +4994,10 @@ def condition_number(q):
     t641 = t639 + t638*t613
     t642 = t586*t621 + t590*t625 + t594*t629 + t598*t633 + t602*t637 + t606*t641
     t643 = xp.not_equal(t642, 0)
-    t644 = 0.5*(-t582 + t617)/xp.where(t643, t642, 1)
+    t644 = (-t582 + t617)/xp.where(t643, 2*t642, 1)
     t645 = xp.abs(t644)
     t646 = xp.greater_equal(t645, 1)
-    t647 = xp.abs(1/xp.where(t646, t644, 1))
+    t647 = 1/xp.abs(xp.where(t646, t644, 1))
     t648 = xp.where(t643, xp.where(xp.greater_equal(t644, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t646, t647/(1 + xp.sqrt(1 + t647**2)), 1/(t645 + xp.sqrt(1 + t645**2))), 0)
     t649 = 1/xp.sqrt(1 + t648**2)
     t650 = t642*t648
@@ -5028,10 +5028,10 @@ def condition_number(q):
     t675 = t673 - t674*t648
     t676 = t674 + t673*t648
     t677 = xp.not_equal(t467, 0)
-    t678 = 0.5*(-t291 + t441)/xp.where(t677, t467, 1)
+    t678 = (-t291 + t441)/xp.where(t677, 2*t467, 1)
     t679 = xp.abs(t678)
     t680 = xp.greater_equal(t679, 1)
-    t681 = xp.abs(1/xp.where(t680, t678, 1))
+    t681 = 1/xp.abs(xp.where(t680, t678, 1))
     t682 = xp.where(t677, xp.where(xp.greater_equal(t678, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t680, t681/(1 + xp.sqrt(1 + t681**2)), 1/(t679 + xp.sqrt(1 + t679**2))), 0)
     t683 = 1/xp.sqrt(1 + t682**2)
     t684 = t467*t682
@@ -5063,10 +5063,10 @@ def condition_number(q):
     t710 = t708 + t707*t682
     t711 = t551*t689 + t555*t693 + t559*t697 + t563*t701 + t567*t705 + t571*t709
     t712 = xp.not_equal(t711, 0)
-    t713 = 0.5*(-t685 + t547)/xp.where(t712, t711, 1)
+    t713 = (-t685 + t547)/xp.where(t712, 2*t711, 1)
     t714 = xp.abs(t713)
     t715 = xp.greater_equal(t714, 1)
-    t716 = xp.abs(1/xp.where(t715, t713, 1))
+    t716 = 1/xp.abs(xp.where(t715, t713, 1))
     t717 = xp.where(t712, xp.where(xp.greater_equal(t713, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t715, t716/(1 + xp.sqrt(1 + t716**2)), 1/(t714 + xp.sqrt(1 + t714**2))), 0)
     t718 = 1/xp.sqrt(1 + t717**2)
     t719 = t711*t717
@@ -5099,10 +5099,10 @@ def condition_number(q):
     t746 = t620*t724 + t624*t728 + t628*t732 + t632*t736 + t636*t740 + t640*t744
     t747 = -t690*t725 + t694*t729 + t698*t733 + t702*t737 + t706*t741 + t710*t745
     t748 = xp.not_equal(t746, 0)
-    t749 = 0.5*(-t720 + t616)/xp.where(t748, t746, 1)
+    t749 = (-t720 + t616)/xp.where(t748, 2*t746, 1)
     t750 = xp.abs(t749)
     t751 = xp.greater_equal(t750, 1)
-    t752 = xp.abs(1/xp.where(t751, t749, 1))
+    t752 = 1/xp.abs(xp.where(t751, t749, 1))
     t753 = xp.where(t748, xp.where(xp.greater_equal(t749, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t751, t752/(1 + xp.sqrt(1 + t752**2)), 1/(t750 + xp.sqrt(1 + t750**2))), 0)
     t754 = 1/xp.sqrt(1 + t753**2)
     t755 = t746*t753
@@ -5134,10 +5134,10 @@ def condition_number(q):
     t781 = t779 + t778*t753
     t782 = t655*t760 + t659*t764 + t663*t768 + t667*t772 + t671*t776 + t675*t780
     t783 = xp.not_equal(t782, 0)
-    t784 = 0.5*(-t756 + t651)/xp.where(t783, t782, 1)
+    t784 = (-t756 + t651)/xp.where(t783, 2*t782, 1)
     t785 = xp.abs(t784)
     t786 = xp.greater_equal(t785, 1)
-    t787 = xp.abs(1/xp.where(t786, t784, 1))
+    t787 = 1/xp.abs(xp.where(t786, t784, 1))
     t788 = xp.where(t783, xp.where(xp.greater_equal(t784, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t786, t787/(1 + xp.sqrt(1 + t787**2)), 1/(t785 + xp.sqrt(1 + t785**2))), 0)
     t789 = 1/xp.sqrt(1 + t788**2)
     t790 = t782*t788
@@ -5169,10 +5169,10 @@ def condition_number(q):
     t816 = t814 + t813*t788
     t817 = t656*t795 + t660*t799 + t664*t803 + t668*t807 + t672*t811 + t676*t815
     t818 = xp.not_equal(t817, 0)
-    t819 = 0.5*(-t791 + t652)/xp.where(t818, t817, 1)
+    t819 = (-t791 + t652)/xp.where(t818, 2*t817, 1)
     t820 = xp.abs(t819)
     t821 = xp.greater_equal(t820, 1)
-    t822 = xp.abs(1/xp.where(t821, t819, 1))
+    t822 = 1/xp.abs(xp.where(t821, t819, 1))
     t823 = xp.where(t818, xp.where(xp.greater_equal(t819, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t821, t822/(1 + xp.sqrt(1 + t822**2)), 1/(t820 + xp.sqrt(1 + t820**2))), 0)
     t824 = 1/xp.sqrt(1 + t823**2)
     t825 = t817*t823
@@ -5203,10 +5203,10 @@ def condition_number(q):
     t850 = t848 - t849*t823
     t851 = t849 + t848*t823
     t852 = xp.not_equal(t747, 0)
-    t853 = 0.5*(-t686 + t721)/xp.where(t852, t747, 1)
+    t853 = (-t686 + t721)/xp.where(t852, 2*t747, 1)
     t854 = xp.abs(t853)
     t855 = xp.greater_equal(t854, 1)
-    t856 = xp.abs(1/xp.where(t855, t853, 1))
+    t856 = 1/xp.abs(xp.where(t855, t853, 1))
     t857 = xp.where(t852, xp.where(xp.greater_equal(t853, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t855, t856/(1 + xp.sqrt(1 + t856**2)), 1/(t854 + xp.sqrt(1 + t854**2))), 0)
     t858 = 1/xp.sqrt(1 + t857**2)
     t859 = t747*t857
@@ -5238,10 +5238,10 @@ def condition_number(q):
     t885 = t883 + t882*t857
     t886 = t761*t864 + t765*t868 + t769*t872 + t773*t876 + t777*t880 + t781*t884
     t887 = xp.not_equal(t886, 0)
-    t888 = 0.5*(-t860 + t757)/xp.where(t887, t886, 1)
+    t888 = (-t860 + t757)/xp.where(t887, 2*t886, 1)
     t889 = xp.abs(t888)
     t890 = xp.greater_equal(t889, 1)
-    t891 = xp.abs(1/xp.where(t890, t888, 1))
+    t891 = 1/xp.abs(xp.where(t890, t888, 1))
     t892 = xp.where(t887, xp.where(xp.greater_equal(t888, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t890, t891/(1 + xp.sqrt(1 + t891**2)), 1/(t889 + xp.sqrt(1 + t889**2))), 0)
     t893 = 1/xp.sqrt(1 + t892**2)
     t894 = t886*t892
@@ -5274,10 +5274,10 @@ def condition_number(q):
     t921 = t796*t899 + t800*t903 + t804*t907 + t808*t911 + t812*t915 + t816*t919
     t922 = t865*t900 + t869*t904 + t873*t908 + t877*t912 + t881*t916 + t885*t920
     t923 = xp.not_equal(t921, 0)
-    t924 = 0.5*(-t895 + t792)/xp.where(t923, t921, 1)
+    t924 = (-t895 + t792)/xp.where(t923, 2*t921, 1)
     t925 = xp.abs(t924)
     t926 = xp.greater_equal(t925, 1)
-    t927 = xp.abs(1/xp.where(t926, t924, 1))
+    t927 = 1/xp.abs(xp.where(t926, t924, 1))
     t928 = xp.where(t923, xp.where(xp.greater_equal(t924, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t926, t927/(1 + xp.sqrt(1 + t927**2)), 1/(t925 + xp.sqrt(1 + t925**2))), 0)
     t929 = 1/xp.sqrt(1 + t928**2)
     t930 = t921*t928
@@ -5309,10 +5309,10 @@ def condition_number(q):
     t956 = t954 + t953*t928
     t957 = t831*t935 + t835*t939 + t839*t943 + t843*t947 + t847*t951 + t851*t955
     t958 = xp.not_equal(t957, 0)
-    t959 = 0.5*(-t931 + t827)/xp.where(t958, t957, 1)
+    t959 = (-t931 + t827)/xp.where(t958, 2*t957, 1)
     t960 = xp.abs(t959)
     t961 = xp.greater_equal(t960, 1)
-    t962 = xp.abs(1/xp.where(t961, t959, 1))
+    t962 = 1/xp.abs(xp.where(t961, t959, 1))
     t963 = xp.where(t958, xp.where(xp.greater_equal(t959, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t961, t962/(1 + xp.sqrt(1 + t962**2)), 1/(t960 + xp.sqrt(1 + t960**2))), 0)
     t964 = 1/xp.sqrt(1 + t963**2)
     t965 = t957*t963
@@ -5344,10 +5344,10 @@ def condition_number(q):
     t991 = t989 + t988*t963
     t992 = t830*t970 + t834*t974 + t838*t978 + t842*t982 + t846*t986 + t850*t990
     t993 = xp.not_equal(t922, 0)
-    t994 = 0.5*(-t861 + t896)/xp.where(t993, t922, 1)
+    t994 = (-t861 + t896)/xp.where(t993, 2*t922, 1)
     t995 = xp.abs(t994)
     t996 = xp.greater_equal(t995, 1)
-    t997 = xp.abs(1/xp.where(t996, t994, 1))
+    t997 = 1/xp.abs(xp.where(t996, t994, 1))
     t998 = xp.where(t993, xp.where(xp.greater_equal(t994, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t996, t997/(1 + xp.sqrt(1 + t997**2)), 1/(t995 + xp.sqrt(1 + t995**2))), 0)
     t999 = 1/xp.sqrt(1 + t998**2)
     t1000 = t922*t998
@@ -5379,10 +5379,10 @@ def condition_number(q):
     t1026 = t1024 + t1023*t998
     t1027 = t936*t1005 + t940*t1009 + t944*t1013 + t948*t1017 + t952*t1021 + t956*t1025
     t1028 = xp.not_equal(t1027, 0)
-    t1029 = 0.5*(-t1001 + t932)/xp.where(t1028, t1027, 1)
+    t1029 = (-t1001 + t932)/xp.where(t1028, 2*t1027, 1)
     t1030 = xp.abs(t1029)
     t1031 = xp.greater_equal(t1030, 1)
-    t1032 = xp.abs(1/xp.where(t1031, t1029, 1))
+    t1032 = 1/xp.abs(xp.where(t1031, t1029, 1))
     t1033 = xp.where(t1028, xp.where(xp.greater_equal(t1029, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1031, t1032/(1 + xp.sqrt(1 + t1032**2)), 1/(t1030 + xp.sqrt(1 + t1030**2))), 0)
     t1034 = 1/xp.sqrt(1 + t1033**2)
     t1035 = t1027*t1033
@@ -5415,10 +5415,10 @@ def condition_number(q):
     t1062 = t971*t1040 + t975*t1044 + t979*t1048 + t983*t1052 + t987*t1056 + t991*t1060
     t1063 = t1006*t1041 + t1010*t1045 + t1014*t1049 + t1018*t1053 + t1022*t1057 + t1026*t1061
     t1064 = xp.not_equal(t1062, 0)
-    t1065 = 0.5*(-t1036 + t967)/xp.where(t1064, t1062, 1)
+    t1065 = (-t1036 + t967)/xp.where(t1064, 2*t1062, 1)
     t1066 = xp.abs(t1065)
     t1067 = xp.greater_equal(t1066, 1)
-    t1068 = xp.abs(1/xp.where(t1067, t1065, 1))
+    t1068 = 1/xp.abs(xp.where(t1067, t1065, 1))
     t1069 = xp.where(t1064, xp.where(xp.greater_equal(t1065, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1067, t1068/(1 + xp.sqrt(1 + t1068**2)), 1/(t1066 + xp.sqrt(1 + t1066**2))), 0)
     t1070 = 1/xp.sqrt(1 + t1069**2)
     t1071 = t1062*t1069
@@ -5449,10 +5449,10 @@ def condition_number(q):
     t1096 = t1094 - t1095*t1069
     t1097 = t1095 + t1094*t1069
     t1098 = xp.not_equal(t1063, 0)
-    t1099 = 0.5*(-t1002 + t1037)/xp.where(t1098, t1063, 1)
+    t1099 = (-t1002 + t1037)/xp.where(t1098, 2*t1063, 1)
     t1100 = xp.abs(t1099)
     t1101 = xp.greater_equal(t1100, 1)
-    t1102 = xp.abs(1/xp.where(t1101, t1099, 1))
+    t1102 = 1/xp.abs(xp.where(t1101, t1099, 1))
     t1103 = xp.where(t1098, xp.where(xp.greater_equal(t1099, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1101, t1102/(1 + xp.sqrt(1 + t1102**2)), 1/(t1100 + xp.sqrt(1 + t1100**2))), 0)
     t1104 = 1/xp.sqrt(1 + t1103**2)
     t1105 = t1063*t1103
@@ -5484,10 +5484,10 @@ def condition_number(q):
     t1131 = t1129 + t1128*t1103
     t1132 = t1077*t1110 + t1081*t1114 + t1085*t1118 + t1089*t1122 + t1093*t1126 + t1097*t1130
     t1133 = xp.not_equal(t1132, 0)
-    t1134 = 0.5*(-t1106 + t1073)/xp.where(t1133, t1132, 1)
+    t1134 = (-t1106 + t1073)/xp.where(t1133, 2*t1132, 1)
     t1135 = xp.abs(t1134)
     t1136 = xp.greater_equal(t1135, 1)
-    t1137 = xp.abs(1/xp.where(t1136, t1134, 1))
+    t1137 = 1/xp.abs(xp.where(t1136, t1134, 1))
     t1138 = xp.where(t1133, xp.where(xp.greater_equal(t1134, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1136, t1137/(1 + xp.sqrt(1 + t1137**2)), 1/(t1135 + xp.sqrt(1 + t1135**2))), 0)
     t1139 = 1/xp.sqrt(1 + t1138**2)
     t1140 = t1132*t1138
@@ -5519,10 +5519,10 @@ def condition_number(q):
     t1166 = t1164 + t1138*t1163
     t1167 = t1111*t1146 + t1115*t1150 + t1119*t1154 + t1123*t1158 + t1127*t1162 + t1131*t1166
     t1168 = xp.not_equal(t1167, 0)
-    t1169 = 0.5*(-t1107 + t1142)/xp.where(t1168, t1167, 1)
+    t1169 = (-t1107 + t1142)/xp.where(t1168, 2*t1167, 1)
     t1170 = xp.abs(t1169)
     t1171 = xp.greater_equal(t1170, 1)
-    t1172 = xp.abs(1/xp.where(t1171, t1169, 1))
+    t1172 = 1/xp.abs(xp.where(t1171, t1169, 1))
     t1173 = xp.where(t1168, xp.where(xp.greater_equal(t1169, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1171, t1172/(1 + xp.sqrt(1 + t1172**2)), 1/(t1170 + xp.sqrt(1 + t1170**2))), 0)
     t1174 = 1/xp.sqrt(1 + t1173**2)
     t1175 = t1167*t1173
@@ -5553,10 +5553,10 @@ def condition_number(q):
     t1200 = t1198 - t1173*t1199
     t1201 = t1199 + t1173*t1198
     t1202 = xp.not_equal(t992, 0)
-    t1203 = 0.5*(-t826 + t966)/xp.where(t1202, t992, 1)
+    t1203 = (-t826 + t966)/xp.where(t1202, 2*t992, 1)
     t1204 = xp.abs(t1203)
     t1205 = xp.greater_equal(t1204, 1)
-    t1206 = xp.abs(1/xp.where(t1205, t1203, 1))
+    t1206 = 1/xp.abs(xp.where(t1205, t1203, 1))
     t1207 = xp.where(t1202, xp.where(xp.greater_equal(t1203, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1205, t1206/(1 + xp.sqrt(1 + t1206**2)), 1/(t1204 + xp.sqrt(1 + t1204**2))), 0)
     t1208 = 1/xp.sqrt(1 + t1207**2)
     t1209 = t992*t1207
@@ -5588,10 +5588,10 @@ def condition_number(q):
     t1235 = t1233 + t1207*t1232
     t1236 = t1076*t1214 + t1080*t1218 + t1084*t1222 + t1088*t1226 + t1092*t1230 + t1096*t1234
     t1237 = xp.not_equal(t1236, 0)
-    t1238 = 0.5*(-t1210 + t1072)/xp.where(t1237, t1236, 1)
+    t1238 = (-t1210 + t1072)/xp.where(t1237, 2*t1236, 1)
     t1239 = xp.abs(t1238)
     t1240 = xp.greater_equal(t1239, 1)
-    t1241 = xp.abs(1/xp.where(t1240, t1238, 1))
+    t1241 = 1/xp.abs(xp.where(t1240, t1238, 1))
     t1242 = xp.where(t1237, xp.where(xp.greater_equal(t1238, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1240, t1241/(1 + xp.sqrt(1 + t1241**2)), 1/(t1239 + xp.sqrt(1 + t1239**2))), 0)
     t1243 = 1/xp.sqrt(1 + t1242**2)
     t1244 = t1236*t1242
@@ -5624,10 +5624,10 @@ def condition_number(q):
     t1271 = t1145*t1249 + t1149*t1253 + t1153*t1257 + t1157*t1261 + t1161*t1265 + t1165*t1269
     t1272 = t1215*t1250 + t1219*t1254 + t1223*t1258 + t1227*t1262 + t1231*t1266 + t1235*t1270
     t1273 = xp.not_equal(t1271, 0)
-    t1274 = 0.5*(-t1245 + t1141)/xp.where(t1273, t1271, 1)
+    t1274 = (-t1245 + t1141)/xp.where(t1273, 2*t1271, 1)
     t1275 = xp.abs(t1274)
     t1276 = xp.greater_equal(t1275, 1)
-    t1277 = xp.abs(1/xp.where(t1276, t1274, 1))
+    t1277 = 1/xp.abs(xp.where(t1276, t1274, 1))
     t1278 = xp.where(t1273, xp.where(xp.greater_equal(t1274, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1276, t1277/(1 + xp.sqrt(1 + t1277**2)), 1/(t1275 + xp.sqrt(1 + t1275**2))), 0)
     t1279 = 1/xp.sqrt(1 + t1278**2)
     t1280 = t1271*t1278
@@ -5659,10 +5659,10 @@ def condition_number(q):
     t1306 = t1304 + t1278*t1303
     t1307 = t1180*t1285 + t1184*t1289 + t1188*t1293 + t1192*t1297 + t1196*t1301 + t1200*t1305
     t1308 = xp.not_equal(t1307, 0)
-    t1309 = 0.5*(-t1281 + t1176)/xp.where(t1308, t1307, 1)
+    t1309 = (-t1281 + t1176)/xp.where(t1308, 2*t1307, 1)
     t1310 = xp.abs(t1309)
     t1311 = xp.greater_equal(t1310, 1)
-    t1312 = xp.abs(1/xp.where(t1311, t1309, 1))
+    t1312 = 1/xp.abs(xp.where(t1311, t1309, 1))
     t1313 = xp.where(t1308, xp.where(xp.greater_equal(t1309, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1311, t1312/(1 + xp.sqrt(1 + t1312**2)), 1/(t1310 + xp.sqrt(1 + t1310**2))), 0)
     t1314 = 1/xp.sqrt(1 + t1313**2)
     t1315 = t1307*t1313
@@ -5694,10 +5694,10 @@ def condition_number(q):
     t1341 = t1339 + t1313*t1338
     t1342 = t1181*t1320 + t1185*t1324 + t1189*t1328 + t1193*t1332 + t1197*t1336 + t1201*t1340
     t1343 = xp.not_equal(t1342, 0)
-    t1344 = 0.5*(-t1316 + t1177)/xp.where(t1343, t1342, 1)
+    t1344 = (-t1316 + t1177)/xp.where(t1343, 2*t1342, 1)
     t1345 = xp.abs(t1344)
     t1346 = xp.greater_equal(t1345, 1)
-    t1347 = xp.abs(1/xp.where(t1346, t1344, 1))
+    t1347 = 1/xp.abs(xp.where(t1346, t1344, 1))
     t1348 = xp.where(t1343, xp.where(xp.greater_equal(t1344, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1346, t1347/(1 + xp.sqrt(1 + t1347**2)), 1/(t1345 + xp.sqrt(1 + t1345**2))), 0)
     t1349 = 1/xp.sqrt(1 + t1348**2)
     t1350 = t1342*t1348
@@ -5728,10 +5728,10 @@ def condition_number(q):
     t1375 = t1373 - t1348*t1374
     t1376 = t1374 + t1348*t1373
     t1377 = xp.not_equal(t1272, 0)
-    t1378 = 0.5*(-t1211 + t1246)/xp.where(t1377, t1272, 1)
+    t1378 = (-t1211 + t1246)/xp.where(t1377, 2*t1272, 1)
     t1379 = xp.abs(t1378)
     t1380 = xp.greater_equal(t1379, 1)
-    t1381 = xp.abs(1/xp.where(t1380, t1378, 1))
+    t1381 = 1/xp.abs(xp.where(t1380, t1378, 1))
     t1382 = xp.where(t1377, xp.where(xp.greater_equal(t1378, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1380, t1381/(1 + xp.sqrt(1 + t1381**2)), 1/(t1379 + xp.sqrt(1 + t1379**2))), 0)
     t1383 = 1/xp.sqrt(1 + t1382**2)
     t1384 = t1272*t1382
@@ -5763,10 +5763,10 @@ def condition_number(q):
     t1410 = t1408 + t1382*t1407
     t1411 = t1286*t1389 + t1290*t1393 + t1294*t1397 + t1298*t1401 + t1302*t1405 + t1306*t1409
     t1412 = xp.not_equal(t1411, 0)
-    t1413 = 0.5*(-t1385 + t1282)/xp.where(t1412, t1411, 1)
+    t1413 = (-t1385 + t1282)/xp.where(t1412, 2*t1411, 1)
     t1414 = xp.abs(t1413)
     t1415 = xp.greater_equal(t1414, 1)
-    t1416 = xp.abs(1/xp.where(t1415, t1413, 1))
+    t1416 = 1/xp.abs(xp.where(t1415, t1413, 1))
     t1417 = xp.where(t1412, xp.where(xp.greater_equal(t1413, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1415, t1416/(1 + xp.sqrt(1 + t1416**2)), 1/(t1414 + xp.sqrt(1 + t1414**2))), 0)
     t1418 = 1/xp.sqrt(1 + t1417**2)
     t1419 = t1411*t1417
@@ -5799,10 +5799,10 @@ def condition_number(q):
     t1446 = t1321*t1424 + t1325*t1428 + t1329*t1432 + t1333*t1436 + t1337*t1440 + t1341*t1444
     t1447 = t1390*t1425 + t1394*t1429 + t1398*t1433 + t1402*t1437 + t1406*t1441 + t1410*t1445
     t1448 = xp.not_equal(t1446, 0)
-    t1449 = 0.5*(-t1420 + t1317)/xp.where(t1448, t1446, 1)
+    t1449 = (-t1420 + t1317)/xp.where(t1448, 2*t1446, 1)
     t1450 = xp.abs(t1449)
     t1451 = xp.greater_equal(t1450, 1)
-    t1452 = xp.abs(1/xp.where(t1451, t1449, 1))
+    t1452 = 1/xp.abs(xp.where(t1451, t1449, 1))
     t1453 = xp.where(t1448, xp.where(xp.greater_equal(t1449, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1451, t1452/(1 + xp.sqrt(1 + t1452**2)), 1/(t1450 + xp.sqrt(1 + t1450**2))), 0)
     t1454 = 1/xp.sqrt(1 + t1453**2)
     t1455 = t1446*t1453
@@ -5834,10 +5834,10 @@ def condition_number(q):
     t1481 = t1479 + t1453*t1478
     t1482 = t1356*t1460 + t1360*t1464 + t1364*t1468 + t1368*t1472 + t1372*t1476 + t1376*t1480
     t1483 = xp.not_equal(t1482, 0)
-    t1484 = 0.5*(-t1456 + t1352)/xp.where(t1483, t1482, 1)
+    t1484 = (-t1456 + t1352)/xp.where(t1483, 2*t1482, 1)
     t1485 = xp.abs(t1484)
     t1486 = xp.greater_equal(t1485, 1)
-    t1487 = xp.abs(1/xp.where(t1486, t1484, 1))
+    t1487 = 1/xp.abs(xp.where(t1486, t1484, 1))
     t1488 = xp.where(t1483, xp.where(xp.greater_equal(t1484, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1486, t1487/(1 + xp.sqrt(1 + t1487**2)), 1/(t1485 + xp.sqrt(1 + t1485**2))), 0)
     t1489 = 1/xp.sqrt(1 + t1488**2)
     t1490 = t1482*t1488
@@ -5869,10 +5869,10 @@ def condition_number(q):
     t1516 = t1514 + t1488*t1513
     t1517 = t1355*t1495 + t1359*t1499 + t1363*t1503 + t1367*t1507 + t1371*t1511 + t1375*t1515
     t1518 = xp.not_equal(t1447, 0)
-    t1519 = 0.5*(-t1386 + t1421)/xp.where(t1518, t1447, 1)
+    t1519 = (-t1386 + t1421)/xp.where(t1518, 2*t1447, 1)
     t1520 = xp.abs(t1519)
     t1521 = xp.greater_equal(t1520, 1)
-    t1522 = xp.abs(1/xp.where(t1521, t1519, 1))
+    t1522 = 1/xp.abs(xp.where(t1521, t1519, 1))
     t1523 = xp.where(t1518, xp.where(xp.greater_equal(t1519, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1521, t1522/(1 + xp.sqrt(1 + t1522**2)), 1/(t1520 + xp.sqrt(1 + t1520**2))), 0)
     t1524 = 1/xp.sqrt(1 + t1523**2)
     t1525 = t1447*t1523
@@ -5904,10 +5904,10 @@ def condition_number(q):
     t1551 = t1549 + t1523*t1548
     t1552 = t1461*t1530 + t1465*t1534 + t1469*t1538 + t1473*t1542 + t1477*t1546 + t1481*t1550
     t1553 = xp.not_equal(t1552, 0)
-    t1554 = 0.5*(-t1526 + t1457)/xp.where(t1553, t1552, 1)
+    t1554 = (-t1526 + t1457)/xp.where(t1553, 2*t1552, 1)
     t1555 = xp.abs(t1554)
     t1556 = xp.greater_equal(t1555, 1)
-    t1557 = xp.abs(1/xp.where(t1556, t1554, 1))
+    t1557 = 1/xp.abs(xp.where(t1556, t1554, 1))
     t1558 = xp.where(t1553, xp.where(xp.greater_equal(t1554, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1556, t1557/(1 + xp.sqrt(1 + t1557**2)), 1/(t1555 + xp.sqrt(1 + t1555**2))), 0)
     t1559 = 1/xp.sqrt(1 + t1558**2)
     t1560 = t1552*t1558
@@ -5940,10 +5940,10 @@ def condition_number(q):
     t1587 = t1496*t1565 + t1500*t1569 + t1504*t1573 + t1508*t1577 + t1512*t1581 + t1516*t1585
     t1588 = t1531*t1566 + t1535*t1570 + t1539*t1574 + t1543*t1578 + t1547*t1582 + t1551*t1586
     t1589 = xp.not_equal(t1587, 0)
-    t1590 = 0.5*(-t1561 + t1492)/xp.where(t1589, t1587, 1)
+    t1590 = (-t1561 + t1492)/xp.where(t1589, 2*t1587, 1)
     t1591 = xp.abs(t1590)
     t1592 = xp.greater_equal(t1591, 1)
-    t1593 = xp.abs(1/xp.where(t1592, t1590, 1))
+    t1593 = 1/xp.abs(xp.where(t1592, t1590, 1))
     t1594 = xp.where(t1589, xp.where(xp.greater_equal(t1590, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1592, t1593/(1 + xp.sqrt(1 + t1593**2)), 1/(t1591 + xp.sqrt(1 + t1591**2))), 0)
     t1595 = 1/xp.sqrt(1 + t1594**2)
     t1596 = t1587*t1594
@@ -5974,10 +5974,10 @@ def condition_number(q):
     t1621 = t1619 - t1594*t1620
     t1622 = t1620 + t1594*t1619
     t1623 = xp.not_equal(t1588, 0)
-    t1624 = 0.5*(-t1527 + t1562)/xp.where(t1623, t1588, 1)
+    t1624 = (-t1527 + t1562)/xp.where(t1623, 2*t1588, 1)
     t1625 = xp.abs(t1624)
     t1626 = xp.greater_equal(t1625, 1)
-    t1627 = xp.abs(1/xp.where(t1626, t1624, 1))
+    t1627 = 1/xp.abs(xp.where(t1626, t1624, 1))
     t1628 = xp.where(t1623, xp.where(xp.greater_equal(t1624, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1626, t1627/(1 + xp.sqrt(1 + t1627**2)), 1/(t1625 + xp.sqrt(1 + t1625**2))), 0)
     t1629 = 1/xp.sqrt(1 + t1628**2)
     t1630 = t1588*t1628
@@ -6009,10 +6009,10 @@ def condition_number(q):
     t1656 = t1654 + t1628*t1653
     t1657 = t1602*t1635 + t1606*t1639 + t1610*t1643 + t1614*t1647 + t1618*t1651 + t1622*t1655
     t1658 = xp.not_equal(t1657, 0)
-    t1659 = 0.5*(-t1631 + t1598)/xp.where(t1658, t1657, 1)
+    t1659 = (-t1631 + t1598)/xp.where(t1658, 2*t1657, 1)
     t1660 = xp.abs(t1659)
     t1661 = xp.greater_equal(t1660, 1)
-    t1662 = xp.abs(1/xp.where(t1661, t1659, 1))
+    t1662 = 1/xp.abs(xp.where(t1661, t1659, 1))
     t1663 = xp.where(t1658, xp.where(xp.greater_equal(t1659, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1661, t1662/(1 + xp.sqrt(1 + t1662**2)), 1/(t1660 + xp.sqrt(1 + t1660**2))), 0)
     t1664 = 1/xp.sqrt(1 + t1663**2)
     t1665 = t1657*t1663
@@ -6044,10 +6044,10 @@ def condition_number(q):
     t1691 = t1689 + t1663*t1688
     t1692 = t1636*t1671 + t1640*t1675 + t1644*t1679 + t1648*t1683 + t1652*t1687 + t1656*t1691
     t1693 = xp.not_equal(t1692, 0)
-    t1694 = 0.5*(-t1632 + t1667)/xp.where(t1693, t1692, 1)
+    t1694 = (-t1632 + t1667)/xp.where(t1693, 2*t1692, 1)
     t1695 = xp.abs(t1694)
     t1696 = xp.greater_equal(t1695, 1)
-    t1697 = xp.abs(1/xp.where(t1696, t1694, 1))
+    t1697 = 1/xp.abs(xp.where(t1696, t1694, 1))
     t1698 = xp.where(t1693, xp.where(xp.greater_equal(t1694, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1696, t1697/(1 + xp.sqrt(1 + t1697**2)), 1/(t1695 + xp.sqrt(1 + t1695**2))), 0)
     t1699 = 1/xp.sqrt(1 + t1698**2)
     t1700 = t1692*t1698
@@ -6078,10 +6078,10 @@ def condition_number(q):
     t1725 = t1723 - t1698*t1724
     t1726 = t1724 + t1698*t1723
     t1727 = xp.not_equal(t1517, 0)
-    t1728 = 0.5*(-t1351 + t1491)/xp.where(t1727, t1517, 1)
+    t1728 = (-t1351 + t1491)/xp.where(t1727, 2*t1517, 1)
     t1729 = xp.abs(t1728)
     t1730 = xp.greater_equal(t1729, 1)
-    t1731 = xp.abs(1/xp.where(t1730, t1728, 1))
+    t1731 = 1/xp.abs(xp.where(t1730, t1728, 1))
     t1732 = xp.where(t1727, xp.where(xp.greater_equal(t1728, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1730, t1731/(1 + xp.sqrt(1 + t1731**2)), 1/(t1729 + xp.sqrt(1 + t1729**2))), 0)
     t1733 = 1/xp.sqrt(1 + t1732**2)
     t1734 = t1517*t1732
@@ -6113,10 +6113,10 @@ def condition_number(q):
     t1760 = t1758 + t1732*t1757
     t1761 = t1601*t1739 + t1605*t1743 + t1609*t1747 + t1613*t1751 + t1617*t1755 + t1621*t1759
     t1762 = xp.not_equal(t1761, 0)
-    t1763 = 0.5*(-t1735 + t1597)/xp.where(t1762, t1761, 1)
+    t1763 = (-t1735 + t1597)/xp.where(t1762, 2*t1761, 1)
     t1764 = xp.abs(t1763)
     t1765 = xp.greater_equal(t1764, 1)
-    t1766 = xp.abs(1/xp.where(t1765, t1763, 1))
+    t1766 = 1/xp.abs(xp.where(t1765, t1763, 1))
     t1767 = xp.where(t1762, xp.where(xp.greater_equal(t1763, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1765, t1766/(1 + xp.sqrt(1 + t1766**2)), 1/(t1764 + xp.sqrt(1 + t1764**2))), 0)
     t1768 = 1/xp.sqrt(1 + t1767**2)
     t1769 = t1761*t1767
@@ -6149,10 +6149,10 @@ def condition_number(q):
     t1796 = t1670*t1774 + t1674*t1778 + t1678*t1782 + t1682*t1786 + t1686*t1790 + t1690*t1794
     t1797 = t1740*t1775 + t1744*t1779 + t1748*t1783 + t1752*t1787 + t1756*t1791 + t1760*t1795
     t1798 = xp.not_equal(t1796, 0)
-    t1799 = 0.5*(-t1770 + t1666)/xp.where(t1798, t1796, 1)
+    t1799 = (-t1770 + t1666)/xp.where(t1798, 2*t1796, 1)
     t1800 = xp.abs(t1799)
     t1801 = xp.greater_equal(t1800, 1)
-    t1802 = xp.abs(1/xp.where(t1801, t1799, 1))
+    t1802 = 1/xp.abs(xp.where(t1801, t1799, 1))
     t1803 = xp.where(t1798, xp.where(xp.greater_equal(t1799, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1801, t1802/(1 + xp.sqrt(1 + t1802**2)), 1/(t1800 + xp.sqrt(1 + t1800**2))), 0)
     t1804 = 1/xp.sqrt(1 + t1803**2)
     t1805 = t1796*t1803
@@ -6184,10 +6184,10 @@ def condition_number(q):
     t1831 = t1829 + t1803*t1828
     t1832 = t1705*t1810 + t1709*t1814 + t1713*t1818 + t1717*t1822 + t1721*t1826 + t1725*t1830
     t1833 = xp.not_equal(t1832, 0)
-    t1834 = 0.5*(-t1806 + t1701)/xp.where(t1833, t1832, 1)
+    t1834 = (-t1806 + t1701)/xp.where(t1833, 2*t1832, 1)
     t1835 = xp.abs(t1834)
     t1836 = xp.greater_equal(t1835, 1)
-    t1837 = xp.abs(1/xp.where(t1836, t1834, 1))
+    t1837 = 1/xp.abs(xp.where(t1836, t1834, 1))
     t1838 = xp.where(t1833, xp.where(xp.greater_equal(t1834, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1836, t1837/(1 + xp.sqrt(1 + t1837**2)), 1/(t1835 + xp.sqrt(1 + t1835**2))), 0)
     t1839 = 1/xp.sqrt(1 + t1838**2)
     t1840 = t1832*t1838
@@ -6219,10 +6219,10 @@ def condition_number(q):
     t1866 = t1864 + t1838*t1863
     t1867 = t1706*t1845 + t1710*t1849 + t1714*t1853 + t1718*t1857 + t1722*t1861 + t1726*t1865
     t1868 = xp.not_equal(t1867, 0)
-    t1869 = 0.5*(-t1841 + t1702)/xp.where(t1868, t1867, 1)
+    t1869 = (-t1841 + t1702)/xp.where(t1868, 2*t1867, 1)
     t1870 = xp.abs(t1869)
     t1871 = xp.greater_equal(t1870, 1)
-    t1872 = xp.abs(1/xp.where(t1871, t1869, 1))
+    t1872 = 1/xp.abs(xp.where(t1871, t1869, 1))
     t1873 = xp.where(t1868, xp.where(xp.greater_equal(t1869, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1871, t1872/(1 + xp.sqrt(1 + t1872**2)), 1/(t1870 + xp.sqrt(1 + t1870**2))), 0)
     t1874 = 1/xp.sqrt(1 + t1873**2)
     t1875 = t1867*t1873
@@ -6253,10 +6253,10 @@ def condition_number(q):
     t1900 = t1898 - t1873*t1899
     t1901 = t1899 + t1873*t1898
     t1902 = xp.not_equal(t1797, 0)
-    t1903 = 0.5*(-t1736 + t1771)/xp.where(t1902, t1797, 1)
+    t1903 = (-t1736 + t1771)/xp.where(t1902, 2*t1797, 1)
     t1904 = xp.abs(t1903)
     t1905 = xp.greater_equal(t1904, 1)
-    t1906 = xp.abs(1/xp.where(t1905, t1903, 1))
+    t1906 = 1/xp.abs(xp.where(t1905, t1903, 1))
     t1907 = xp.where(t1902, xp.where(xp.greater_equal(t1903, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1905, t1906/(1 + xp.sqrt(1 + t1906**2)), 1/(t1904 + xp.sqrt(1 + t1904**2))), 0)
     t1908 = 1/xp.sqrt(1 + t1907**2)
     t1909 = t1797*t1907
@@ -6288,10 +6288,10 @@ def condition_number(q):
     t1935 = t1933 + t1907*t1932
     t1936 = t1811*t1914 + t1815*t1918 + t1819*t1922 + t1823*t1926 + t1827*t1930 + t1831*t1934
     t1937 = xp.not_equal(t1936, 0)
-    t1938 = 0.5*(-t1910 + t1807)/xp.where(t1937, t1936, 1)
+    t1938 = (-t1910 + t1807)/xp.where(t1937, 2*t1936, 1)
     t1939 = xp.abs(t1938)
     t1940 = xp.greater_equal(t1939, 1)
-    t1941 = xp.abs(1/xp.where(t1940, t1938, 1))
+    t1941 = 1/xp.abs(xp.where(t1940, t1938, 1))
     t1942 = xp.where(t1937, xp.where(xp.greater_equal(t1938, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1940, t1941/(1 + xp.sqrt(1 + t1941**2)), 1/(t1939 + xp.sqrt(1 + t1939**2))), 0)
     t1943 = 1/xp.sqrt(1 + t1942**2)
     t1944 = t1936*t1942
@@ -6324,10 +6324,10 @@ def condition_number(q):
     t1971 = t1846*t1949 + t1850*t1953 + t1854*t1957 + t1858*t1961 + t1862*t1965 + t1866*t1969
     t1972 = t1915*t1950 + t1919*t1954 + t1923*t1958 + t1927*t1962 + t1931*t1966 + t1935*t1970
     t1973 = xp.not_equal(t1971, 0)
-    t1974 = 0.5*(-t1945 + t1842)/xp.where(t1973, t1971, 1)
+    t1974 = (-t1945 + t1842)/xp.where(t1973, 2*t1971, 1)
     t1975 = xp.abs(t1974)
     t1976 = xp.greater_equal(t1975, 1)
-    t1977 = xp.abs(1/xp.where(t1976, t1974, 1))
+    t1977 = 1/xp.abs(xp.where(t1976, t1974, 1))
     t1978 = xp.where(t1973, xp.where(xp.greater_equal(t1974, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1976, t1977/(1 + xp.sqrt(1 + t1977**2)), 1/(t1975 + xp.sqrt(1 + t1975**2))), 0)
     t1979 = 1/xp.sqrt(1 + t1978**2)
     t1980 = t1971*t1978
@@ -6359,10 +6359,10 @@ def condition_number(q):
     t2006 = t2004 + t1978*t2003
     t2007 = t1881*t1985 + t1885*t1989 + t1889*t1993 + t1893*t1997 + t1897*t2001 + t1901*t2005
     t2008 = xp.not_equal(t2007, 0)
-    t2009 = 0.5*(-t1981 + t1877)/xp.where(t2008, t2007, 1)
+    t2009 = (-t1981 + t1877)/xp.where(t2008, 2*t2007, 1)
     t2010 = xp.abs(t2009)
     t2011 = xp.greater_equal(t2010, 1)
-    t2012 = xp.abs(1/xp.where(t2011, t2009, 1))
+    t2012 = 1/xp.abs(xp.where(t2011, t2009, 1))
     t2013 = xp.where(t2008, xp.where(xp.greater_equal(t2009, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2011, t2012/(1 + xp.sqrt(1 + t2012**2)), 1/(t2010 + xp.sqrt(1 + t2010**2))), 0)
     t2014 = 1/xp.sqrt(1 + t2013**2)
     t2015 = t2007*t2013
@@ -6394,10 +6394,10 @@ def condition_number(q):
     t2041 = t2039 + t2013*t2038
     t2042 = t1880*t2020 + t1884*t2024 + t1888*t2028 + t1892*t2032 + t1896*t2036 + t1900*t2040
     t2043 = xp.not_equal(t1972, 0)
-    t2044 = 0.5*(-t1911 + t1946)/xp.where(t2043, t1972, 1)
+    t2044 = (-t1911 + t1946)/xp.where(t2043, 2*t1972, 1)
     t2045 = xp.abs(t2044)
     t2046 = xp.greater_equal(t2045, 1)
-    t2047 = xp.abs(1/xp.where(t2046, t2044, 1))
+    t2047 = 1/xp.abs(xp.where(t2046, t2044, 1))
     t2048 = xp.where(t2043, xp.where(xp.greater_equal(t2044, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2046, t2047/(1 + xp.sqrt(1 + t2047**2)), 1/(t2045 + xp.sqrt(1 + t2045**2))), 0)
     t2049 = 1/xp.sqrt(1 + t2048**2)
     t2050 = t1972*t2048
@@ -6429,10 +6429,10 @@ def condition_number(q):
     t2076 = t2074 + t2048*t2073
     t2077 = t1986*t2055 + t1990*t2059 + t1994*t2063 + t1998*t2067 + t2002*t2071 + t2006*t2075
     t2078 = xp.not_equal(t2077, 0)
-    t2079 = 0.5*(-t2051 + t1982)/xp.where(t2078, t2077, 1)
+    t2079 = (-t2051 + t1982)/xp.where(t2078, 2*t2077, 1)
     t2080 = xp.abs(t2079)
     t2081 = xp.greater_equal(t2080, 1)
-    t2082 = xp.abs(1/xp.where(t2081, t2079, 1))
+    t2082 = 1/xp.abs(xp.where(t2081, t2079, 1))
     t2083 = xp.where(t2078, xp.where(xp.greater_equal(t2079, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2081, t2082/(1 + xp.sqrt(1 + t2082**2)), 1/(t2080 + xp.sqrt(1 + t2080**2))), 0)
     t2084 = 1/xp.sqrt(1 + t2083**2)
     t2085 = t2077*t2083
@@ -6465,10 +6465,10 @@ def condition_number(q):
     t2112 = t2021*t2090 + t2025*t2094 + t2029*t2098 + t2033*t2102 + t2037*t2106 + t2041*t2110
     t2113 = t2056*t2091 + t2060*t2095 + t2064*t2099 + t2068*t2103 + t2072*t2107 + t2076*t2111
     t2114 = xp.not_equal(t2112, 0)
-    t2115 = 0.5*(-t2086 + t2017)/xp.where(t2114, t2112, 1)
+    t2115 = (-t2086 + t2017)/xp.where(t2114, 2*t2112, 1)
     t2116 = xp.abs(t2115)
     t2117 = xp.greater_equal(t2116, 1)
-    t2118 = xp.abs(1/xp.where(t2117, t2115, 1))
+    t2118 = 1/xp.abs(xp.where(t2117, t2115, 1))
     t2119 = xp.where(t2114, xp.where(xp.greater_equal(t2115, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2117, t2118/(1 + xp.sqrt(1 + t2118**2)), 1/(t2116 + xp.sqrt(1 + t2116**2))), 0)
     t2120 = 1/xp.sqrt(1 + t2119**2)
     t2121 = t2112*t2119
@@ -6499,10 +6499,10 @@ def condition_number(q):
     t2146 = t2144 - t2119*t2145
     t2147 = t2145 + t2119*t2144
     t2148 = xp.not_equal(t2113, 0)
-    t2149 = 0.5*(-t2052 + t2087)/xp.where(t2148, t2113, 1)
+    t2149 = (-t2052 + t2087)/xp.where(t2148, 2*t2113, 1)
     t2150 = xp.abs(t2149)
     t2151 = xp.greater_equal(t2150, 1)
-    t2152 = xp.abs(1/xp.where(t2151, t2149, 1))
+    t2152 = 1/xp.abs(xp.where(t2151, t2149, 1))
     t2153 = xp.where(t2148, xp.where(xp.greater_equal(t2149, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2151, t2152/(1 + xp.sqrt(1 + t2152**2)), 1/(t2150 + xp.sqrt(1 + t2150**2))), 0)
     t2154 = 1/xp.sqrt(1 + t2153**2)
     t2155 = t2113*t2153
@@ -6534,10 +6534,10 @@ def condition_number(q):
     t2181 = t2179 + t2153*t2178
     t2182 = t2127*t2160 + t2131*t2164 + t2135*t2168 + t2139*t2172 + t2143*t2176 + t2147*t2180
     t2183 = xp.not_equal(t2182, 0)
-    t2184 = 0.5*(-t2156 + t2123)/xp.where(t2183, t2182, 1)
+    t2184 = (-t2156 + t2123)/xp.where(t2183, 2*t2182, 1)
     t2185 = xp.abs(t2184)
     t2186 = xp.greater_equal(t2185, 1)
-    t2187 = xp.abs(1/xp.where(t2186, t2184, 1))
+    t2187 = 1/xp.abs(xp.where(t2186, t2184, 1))
     t2188 = xp.where(t2183, xp.where(xp.greater_equal(t2184, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2186, t2187/(1 + xp.sqrt(1 + t2187**2)), 1/(t2185 + xp.sqrt(1 + t2185**2))), 0)
     t2189 = 1/xp.sqrt(1 + t2188**2)
     t2190 = t2182*t2188
@@ -6569,10 +6569,10 @@ def condition_number(q):
     t2216 = t2214 + t2188*t2213
     t2217 = t2161*t2196 + t2165*t2200 + t2169*t2204 + t2173*t2208 + t2177*t2212 + t2181*t2216
     t2218 = xp.not_equal(t2217, 0)
-    t2219 = 0.5*(-t2157 + t2192)/xp.where(t2218, t2217, 1)
+    t2219 = (-t2157 + t2192)/xp.where(t2218, 2*t2217, 1)
     t2220 = xp.abs(t2219)
     t2221 = xp.greater_equal(t2220, 1)
-    t2222 = xp.abs(1/xp.where(t2221, t2219, 1))
+    t2222 = 1/xp.abs(xp.where(t2221, t2219, 1))
     t2223 = xp.where(t2218, xp.where(xp.greater_equal(t2219, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2221, t2222/(1 + xp.sqrt(1 + t2222**2)), 1/(t2220 + xp.sqrt(1 + t2220**2))), 0)
     t2224 = 1/xp.sqrt(1 + t2223**2)
     t2225 = t2217*t2223
@@ -6603,10 +6603,10 @@ def condition_number(q):
     t2250 = t2248 - t2223*t2249
     t2251 = t2249 + t2223*t2248
     t2252 = xp.not_equal(t2042, 0)
-    t2253 = 0.5*(-t1876 + t2016)/xp.where(t2252, t2042, 1)
+    t2253 = (-t1876 + t2016)/xp.where(t2252, 2*t2042, 1)
     t2254 = xp.abs(t2253)
     t2255 = xp.greater_equal(t2254, 1)
-    t2256 = xp.abs(1/xp.where(t2255, t2253, 1))
+    t2256 = 1/xp.abs(xp.where(t2255, t2253, 1))
     t2257 = xp.where(t2252, xp.where(xp.greater_equal(t2253, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2255, t2256/(1 + xp.sqrt(1 + t2256**2)), 1/(t2254 + xp.sqrt(1 + t2254**2))), 0)
     t2258 = 1/xp.sqrt(1 + t2257**2)
     t2259 = t2042*t2257
@@ -6638,10 +6638,10 @@ def condition_number(q):
     t2285 = t2283 + t2257*t2282
     t2286 = t2126*t2264 + t2130*t2268 + t2134*t2272 + t2138*t2276 + t2142*t2280 + t2146*t2284
     t2287 = xp.not_equal(t2286, 0)
-    t2288 = 0.5*(-t2260 + t2122)/xp.where(t2287, t2286, 1)
+    t2288 = (-t2260 + t2122)/xp.where(t2287, 2*t2286, 1)
     t2289 = xp.abs(t2288)
     t2290 = xp.greater_equal(t2289, 1)
-    t2291 = xp.abs(1/xp.where(t2290, t2288, 1))
+    t2291 = 1/xp.abs(xp.where(t2290, t2288, 1))
     t2292 = xp.where(t2287, xp.where(xp.greater_equal(t2288, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2290, t2291/(1 + xp.sqrt(1 + t2291**2)), 1/(t2289 + xp.sqrt(1 + t2289**2))), 0)
     t2293 = 1/xp.sqrt(1 + t2292**2)
     t2294 = t2286*t2292
@@ -6674,10 +6674,10 @@ def condition_number(q):
     t2321 = t2195*t2299 + t2199*t2303 + t2203*t2307 + t2207*t2311 + t2211*t2315 + t2215*t2319
     t2322 = t2265*t2300 + t2269*t2304 + t2273*t2308 + t2277*t2312 + t2281*t2316 + t2285*t2320
     t2323 = xp.not_equal(t2321, 0)
-    t2324 = 0.5*(-t2295 + t2191)/xp.where(t2323, t2321, 1)
+    t2324 = (-t2295 + t2191)/xp.where(t2323, 2*t2321, 1)
     t2325 = xp.abs(t2324)
     t2326 = xp.greater_equal(t2325, 1)
-    t2327 = xp.abs(1/xp.where(t2326, t2324, 1))
+    t2327 = 1/xp.abs(xp.where(t2326, t2324, 1))
     t2328 = xp.where(t2323, xp.where(xp.greater_equal(t2324, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2326, t2327/(1 + xp.sqrt(1 + t2327**2)), 1/(t2325 + xp.sqrt(1 + t2325**2))), 0)
     t2329 = 1/xp.sqrt(1 + t2328**2)
     t2330 = t2321*t2328
@@ -6709,10 +6709,10 @@ def condition_number(q):
     t2356 = t2354 + t2328*t2353
     t2357 = t2230*t2335 + t2234*t2339 + t2238*t2343 + t2242*t2347 + t2246*t2351 + t2250*t2355
     t2358 = xp.not_equal(t2357, 0)
-    t2359 = 0.5*(-t2331 + t2226)/xp.where(t2358, t2357, 1)
+    t2359 = (-t2331 + t2226)/xp.where(t2358, 2*t2357, 1)
     t2360 = xp.abs(t2359)
     t2361 = xp.greater_equal(t2360, 1)
-    t2362 = xp.abs(1/xp.where(t2361, t2359, 1))
+    t2362 = 1/xp.abs(xp.where(t2361, t2359, 1))
     t2363 = xp.where(t2358, xp.where(xp.greater_equal(t2359, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2361, t2362/(1 + xp.sqrt(1 + t2362**2)), 1/(t2360 + xp.sqrt(1 + t2360**2))), 0)
     t2364 = 1/xp.sqrt(1 + t2363**2)
     t2365 = t2357*t2363
@@ -6744,10 +6744,10 @@ def condition_number(q):
     t2391 = t2389 + t2363*t2388
     t2392 = t2231*t2370 + t2235*t2374 + t2239*t2378 + t2243*t2382 + t2247*t2386 + t2251*t2390
     t2393 = xp.not_equal(t2392, 0)
-    t2394 = 0.5*(-t2366 + t2227)/xp.where(t2393, t2392, 1)
+    t2394 = (-t2366 + t2227)/xp.where(t2393, 2*t2392, 1)
     t2395 = xp.abs(t2394)
     t2396 = xp.greater_equal(t2395, 1)
-    t2397 = xp.abs(1/xp.where(t2396, t2394, 1))
+    t2397 = 1/xp.abs(xp.where(t2396, t2394, 1))
     t2398 = xp.where(t2393, xp.where(xp.greater_equal(t2394, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2396, t2397/(1 + xp.sqrt(1 + t2397**2)), 1/(t2395 + xp.sqrt(1 + t2395**2))), 0)
     t2399 = 1/xp.sqrt(1 + t2398**2)
     t2400 = t2392*t2398
@@ -6778,10 +6778,10 @@ def condition_number(q):
     t2425 = t2423 - t2398*t2424
     t2426 = t2424 + t2398*t2423
     t2427 = xp.not_equal(t2322, 0)
-    t2428 = 0.5*(-t2261 + t2296)/xp.where(t2427, t2322, 1)
+    t2428 = (-t2261 + t2296)/xp.where(t2427, 2*t2322, 1)
     t2429 = xp.abs(t2428)
     t2430 = xp.greater_equal(t2429, 1)
-    t2431 = xp.abs(1/xp.where(t2430, t2428, 1))
+    t2431 = 1/xp.abs(xp.where(t2430, t2428, 1))
     t2432 = xp.where(t2427, xp.where(xp.greater_equal(t2428, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2430, t2431/(1 + xp.sqrt(1 + t2431**2)), 1/(t2429 + xp.sqrt(1 + t2429**2))), 0)
     t2433 = 1/xp.sqrt(1 + t2432**2)
     t2434 = t2322*t2432
@@ -6813,10 +6813,10 @@ def condition_number(q):
     t2460 = t2458 + t2432*t2457
     t2461 = t2336*t2439 + t2340*t2443 + t2344*t2447 + t2348*t2451 + t2352*t2455 + t2356*t2459
     t2462 = xp.not_equal(t2461, 0)
-    t2463 = 0.5*(-t2435 + t2332)/xp.where(t2462, t2461, 1)
+    t2463 = (-t2435 + t2332)/xp.where(t2462, 2*t2461, 1)
     t2464 = xp.abs(t2463)
     t2465 = xp.greater_equal(t2464, 1)
-    t2466 = xp.abs(1/xp.where(t2465, t2463, 1))
+    t2466 = 1/xp.abs(xp.where(t2465, t2463, 1))
     t2467 = xp.where(t2462, xp.where(xp.greater_equal(t2463, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2465, t2466/(1 + xp.sqrt(1 + t2466**2)), 1/(t2464 + xp.sqrt(1 + t2464**2))), 0)
     t2468 = 1/xp.sqrt(1 + t2467**2)
     t2469 = t2461*t2467
@@ -6849,10 +6849,10 @@ def condition_number(q):
     t2496 = t2371*t2474 + t2375*t2478 + t2379*t2482 + t2383*t2486 + t2387*t2490 + t2391*t2494
     t2497 = t2440*t2475 + t2444*t2479 + t2448*t2483 + t2452*t2487 + t2456*t2491 + t2460*t2495
     t2498 = xp.not_equal(t2496, 0)
-    t2499 = 0.5*(-t2470 + t2367)/xp.where(t2498, t2496, 1)
+    t2499 = (-t2470 + t2367)/xp.where(t2498, 2*t2496, 1)
     t2500 = xp.abs(t2499)
     t2501 = xp.greater_equal(t2500, 1)
-    t2502 = xp.abs(1/xp.where(t2501, t2499, 1))
+    t2502 = 1/xp.abs(xp.where(t2501, t2499, 1))
     t2503 = xp.where(t2498, xp.where(xp.greater_equal(t2499, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2501, t2502/(1 + xp.sqrt(1 + t2502**2)), 1/(t2500 + xp.sqrt(1 + t2500**2))), 0)
     t2504 = 1/xp.sqrt(1 + t2503**2)
     t2505 = t2496*t2503
@@ -6884,10 +6884,10 @@ def condition_number(q):
     t2531 = t2529 + t2503*t2528
     t2532 = t2406*t2510 + t2410*t2514 + t2414*t2518 + t2418*t2522 + t2422*t2526 + t2426*t2530
     t2533 = xp.not_equal(t2532, 0)
-    t2534 = 0.5*(-t2506 + t2402)/xp.where(t2533, t2532, 1)
+    t2534 = (-t2506 + t2402)/xp.where(t2533, 2*t2532, 1)
     t2535 = xp.abs(t2534)
     t2536 = xp.greater_equal(t2535, 1)
-    t2537 = xp.abs(1/xp.where(t2536, t2534, 1))
+    t2537 = 1/xp.abs(xp.where(t2536, t2534, 1))
     t2538 = xp.where(t2533, xp.where(xp.greater_equal(t2534, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2536, t2537/(1 + xp.sqrt(1 + t2537**2)), 1/(t2535 + xp.sqrt(1 + t2535**2))), 0)
     t2539 = 1/xp.sqrt(1 + t2538**2)
     t2540 = t2532*t2538
@@ -6919,10 +6919,10 @@ def condition_number(q):
     t2566 = t2564 + t2538*t2563
     t2567 = t2405*t2545 + t2409*t2549 + t2413*t2553 + t2417*t2557 + t2421*t2561 + t2425*t2565
     t2568 = xp.not_equal(t2497, 0)
-    t2569 = 0.5*(-t2436 + t2471)/xp.where(t2568, t2497, 1)
+    t2569 = (-t2436 + t2471)/xp.where(t2568, 2*t2497, 1)
     t2570 = xp.abs(t2569)
     t2571 = xp.greater_equal(t2570, 1)
-    t2572 = xp.abs(1/xp.where(t2571, t2569, 1))
+    t2572 = 1/xp.abs(xp.where(t2571, t2569, 1))
     t2573 = xp.where(t2568, xp.where(xp.greater_equal(t2569, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2571, t2572/(1 + xp.sqrt(1 + t2572**2)), 1/(t2570 + xp.sqrt(1 + t2570**2))), 0)
     t2574 = 1/xp.sqrt(1 + t2573**2)
     t2575 = t2497*t2573
@@ -6954,10 +6954,10 @@ def condition_number(q):
     t2601 = t2599 + t2573*t2598
     t2602 = t2511*t2580 + t2515*t2584 + t2519*t2588 + t2523*t2592 + t2527*t2596 + t2531*t2600
     t2603 = xp.not_equal(t2602, 0)
-    t2604 = 0.5*(-t2576 + t2507)/xp.where(t2603, t2602, 1)
+    t2604 = (-t2576 + t2507)/xp.where(t2603, 2*t2602, 1)
     t2605 = xp.abs(t2604)
     t2606 = xp.greater_equal(t2605, 1)
-    t2607 = xp.abs(1/xp.where(t2606, t2604, 1))
+    t2607 = 1/xp.abs(xp.where(t2606, t2604, 1))
     t2608 = xp.where(t2603, xp.where(xp.greater_equal(t2604, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2606, t2607/(1 + xp.sqrt(1 + t2607**2)), 1/(t2605 + xp.sqrt(1 + t2605**2))), 0)
     t2609 = 1/xp.sqrt(1 + t2608**2)
     t2610 = t2602*t2608
@@ -6990,10 +6990,10 @@ def condition_number(q):
     t2637 = t2546*t2615 + t2550*t2619 + t2554*t2623 + t2558*t2627 + t2562*t2631 + t2566*t2635
     t2638 = t2581*t2616 + t2585*t2620 + t2589*t2624 + t2593*t2628 + t2597*t2632 + t2601*t2636
     t2639 = xp.not_equal(t2637, 0)
-    t2640 = 0.5*(-t2611 + t2542)/xp.where(t2639, t2637, 1)
+    t2640 = (-t2611 + t2542)/xp.where(t2639, 2*t2637, 1)
     t2641 = xp.abs(t2640)
     t2642 = xp.greater_equal(t2641, 1)
-    t2643 = xp.abs(1/xp.where(t2642, t2640, 1))
+    t2643 = 1/xp.abs(xp.where(t2642, t2640, 1))
     t2644 = xp.where(t2639, xp.where(xp.greater_equal(t2640, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2642, t2643/(1 + xp.sqrt(1 + t2643**2)), 1/(t2641 + xp.sqrt(1 + t2641**2))), 0)
     t2645 = 1/xp.sqrt(1 + t2644**2)
     t2646 = t2637*t2644
@@ -7024,10 +7024,10 @@ def condition_number(q):
     t2671 = t2669 - t2644*t2670
     t2672 = t2670 + t2644*t2669
     t2673 = xp.not_equal(t2638, 0)
-    t2674 = 0.5*(-t2577 + t2612)/xp.where(t2673, t2638, 1)
+    t2674 = (-t2577 + t2612)/xp.where(t2673, 2*t2638, 1)
     t2675 = xp.abs(t2674)
     t2676 = xp.greater_equal(t2675, 1)
-    t2677 = xp.abs(1/xp.where(t2676, t2674, 1))
+    t2677 = 1/xp.abs(xp.where(t2676, t2674, 1))
     t2678 = xp.where(t2673, xp.where(xp.greater_equal(t2674, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2676, t2677/(1 + xp.sqrt(1 + t2677**2)), 1/(t2675 + xp.sqrt(1 + t2675**2))), 0)
     t2679 = 1/xp.sqrt(1 + t2678**2)
     t2680 = t2638*t2678
@@ -7059,10 +7059,10 @@ def condition_number(q):
     t2706 = t2704 + t2678*t2703
     t2707 = t2652*t2685 + t2656*t2689 + t2660*t2693 + t2664*t2697 + t2668*t2701 + t2672*t2705
     t2708 = xp.not_equal(t2707, 0)
-    t2709 = 0.5*(-t2681 + t2648)/xp.where(t2708, t2707, 1)
+    t2709 = (-t2681 + t2648)/xp.where(t2708, 2*t2707, 1)
     t2710 = xp.abs(t2709)
     t2711 = xp.greater_equal(t2710, 1)
-    t2712 = xp.abs(1/xp.where(t2711, t2709, 1))
+    t2712 = 1/xp.abs(xp.where(t2711, t2709, 1))
     t2713 = xp.where(t2708, xp.where(xp.greater_equal(t2709, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2711, t2712/(1 + xp.sqrt(1 + t2712**2)), 1/(t2710 + xp.sqrt(1 + t2710**2))), 0)
     t2714 = 1/xp.sqrt(1 + t2713**2)
     t2715 = t2707*t2713
@@ -7094,10 +7094,10 @@ def condition_number(q):
     t2741 = t2739 + t2713*t2738
     t2742 = t2686*t2721 + t2690*t2725 + t2694*t2729 + t2698*t2733 + t2702*t2737 + t2706*t2741
     t2743 = xp.not_equal(t2742, 0)
-    t2744 = 0.5*(-t2682 + t2717)/xp.where(t2743, t2742, 1)
+    t2744 = (-t2682 + t2717)/xp.where(t2743, 2*t2742, 1)
     t2745 = xp.abs(t2744)
     t2746 = xp.greater_equal(t2745, 1)
-    t2747 = xp.abs(1/xp.where(t2746, t2744, 1))
+    t2747 = 1/xp.abs(xp.where(t2746, t2744, 1))
     t2748 = xp.where(t2743, xp.where(xp.greater_equal(t2744, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2746, t2747/(1 + xp.sqrt(1 + t2747**2)), 1/(t2745 + xp.sqrt(1 + t2745**2))), 0)
     t2749 = 1/xp.sqrt(1 + t2748**2)
     t2750 = t2742*t2748
@@ -7128,10 +7128,10 @@ def condition_number(q):
     t2775 = t2773 - t2748*t2774
     t2776 = t2774 + t2748*t2773
     t2777 = xp.not_equal(t2567, 0)
-    t2778 = 0.5*(-t2401 + t2541)/xp.where(t2777, t2567, 1)
+    t2778 = (-t2401 + t2541)/xp.where(t2777, 2*t2567, 1)
     t2779 = xp.abs(t2778)
     t2780 = xp.greater_equal(t2779, 1)
-    t2781 = xp.abs(1/xp.where(t2780, t2778, 1))
+    t2781 = 1/xp.abs(xp.where(t2780, t2778, 1))
     t2782 = xp.where(t2777, xp.where(xp.greater_equal(t2778, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2780, t2781/(1 + xp.sqrt(1 + t2781**2)), 1/(t2779 + xp.sqrt(1 + t2779**2))), 0)
     t2783 = 1/xp.sqrt(1 + t2782**2)
     t2784 = t2567*t2782
@@ -7163,10 +7163,10 @@ def condition_number(q):
     t2810 = t2808 + t2782*t2807
     t2811 = t2651*t2789 + t2655*t2793 + t2659*t2797 + t2663*t2801 + t2667*t2805 + t2671*t2809
     t2812 = xp.not_equal(t2811, 0)
-    t2813 = 0.5*(-t2785 + t2647)/xp.where(t2812, t2811, 1)
+    t2813 = (-t2785 + t2647)/xp.where(t2812, 2*t2811, 1)
     t2814 = xp.abs(t2813)
     t2815 = xp.greater_equal(t2814, 1)
-    t2816 = xp.abs(1/xp.where(t2815, t2813, 1))
+    t2816 = 1/xp.abs(xp.where(t2815, t2813, 1))
     t2817 = xp.where(t2812, xp.where(xp.greater_equal(t2813, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2815, t2816/(1 + xp.sqrt(1 + t2816**2)), 1/(t2814 + xp.sqrt(1 + t2814**2))), 0)
     t2818 = 1/xp.sqrt(1 + t2817**2)
     t2819 = t2811*t2817
@@ -7199,10 +7199,10 @@ def condition_number(q):
     t2846 = t2720*t2824 + t2724*t2828 + t2728*t2832 + t2732*t2836 + t2736*t2840 + t2740*t2844
     t2847 = t2790*t2825 + t2794*t2829 + t2798*t2833 + t2802*t2837 + t2806*t2841 + t2810*t2845
     t2848 = xp.not_equal(t2846, 0)
-    t2849 = 0.5*(-t2820 + t2716)/xp.where(t2848, t2846, 1)
+    t2849 = (-t2820 + t2716)/xp.where(t2848, 2*t2846, 1)
     t2850 = xp.abs(t2849)
     t2851 = xp.greater_equal(t2850, 1)
-    t2852 = xp.abs(1/xp.where(t2851, t2849, 1))
+    t2852 = 1/xp.abs(xp.where(t2851, t2849, 1))
     t2853 = xp.where(t2848, xp.where(xp.greater_equal(t2849, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2851, t2852/(1 + xp.sqrt(1 + t2852**2)), 1/(t2850 + xp.sqrt(1 + t2850**2))), 0)
     t2854 = 1/xp.sqrt(1 + t2853**2)
     t2855 = t2846*t2853
@@ -7234,10 +7234,10 @@ def condition_number(q):
     t2881 = t2879 + t2853*t2878
     t2882 = t2755*t2860 + t2759*t2864 + t2763*t2868 + t2767*t2872 + t2771*t2876 + t2775*t2880
     t2883 = xp.not_equal(t2882, 0)
-    t2884 = 0.5*(-t2856 + t2751)/xp.where(t2883, t2882, 1)
+    t2884 = (-t2856 + t2751)/xp.where(t2883, 2*t2882, 1)
     t2885 = xp.abs(t2884)
     t2886 = xp.greater_equal(t2885, 1)
-    t2887 = xp.abs(1/xp.where(t2886, t2884, 1))
+    t2887 = 1/xp.abs(xp.where(t2886, t2884, 1))
     t2888 = xp.where(t2883, xp.where(xp.greater_equal(t2884, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2886, t2887/(1 + xp.sqrt(1 + t2887**2)), 1/(t2885 + xp.sqrt(1 + t2885**2))), 0)
     t2889 = 1/xp.sqrt(1 + t2888**2)
     t2890 = t2882*t2888
@@ -7269,10 +7269,10 @@ def condition_number(q):
     t2916 = t2914 + t2888*t2913
     t2917 = t2756*t2895 + t2760*t2899 + t2764*t2903 + t2768*t2907 + t2772*t2911 + t2776*t2915
     t2918 = xp.not_equal(t2917, 0)
-    t2919 = 0.5*(-t2891 + t2752)/xp.where(t2918, t2917, 1)
+    t2919 = (-t2891 + t2752)/xp.where(t2918, 2*t2917, 1)
     t2920 = xp.abs(t2919)
     t2921 = xp.greater_equal(t2920, 1)
-    t2922 = xp.abs(1/xp.where(t2921, t2919, 1))
+    t2922 = 1/xp.abs(xp.where(t2921, t2919, 1))
     t2923 = xp.where(t2918, xp.where(xp.greater_equal(t2919, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2921, t2922/(1 + xp.sqrt(1 + t2922**2)), 1/(t2920 + xp.sqrt(1 + t2920**2))), 0)
     t2924 = 1/xp.sqrt(1 + t2923**2)
     t2925 = t2917*t2923
@@ -7303,10 +7303,10 @@ def condition_number(q):
     t2950 = t2948 - t2923*t2949
     t2951 = t2949 + t2923*t2948
     t2952 = xp.not_equal(t2847, 0)
-    t2953 = 0.5*(-t2786 + t2821)/xp.where(t2952, t2847, 1)
+    t2953 = (-t2786 + t2821)/xp.where(t2952, 2*t2847, 1)
     t2954 = xp.abs(t2953)
     t2955 = xp.greater_equal(t2954, 1)
-    t2956 = xp.abs(1/xp.where(t2955, t2953, 1))
+    t2956 = 1/xp.abs(xp.where(t2955, t2953, 1))
     t2957 = xp.where(t2952, xp.where(xp.greater_equal(t2953, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2955, t2956/(1 + xp.sqrt(1 + t2956**2)), 1/(t2954 + xp.sqrt(1 + t2954**2))), 0)
     t2958 = 1/xp.sqrt(1 + t2957**2)
     t2959 = t2847*t2957
@@ -7338,10 +7338,10 @@ def condition_number(q):
     t2985 = t2983 + t2957*t2982
     t2986 = t2861*t2964 + t2865*t2968 + t2869*t2972 + t2873*t2976 + t2877*t2980 + t2881*t2984
     t2987 = xp.not_equal(t2986, 0)
-    t2988 = 0.5*(-t2960 + t2857)/xp.where(t2987, t2986, 1)
+    t2988 = (-t2960 + t2857)/xp.where(t2987, 2*t2986, 1)
     t2989 = xp.abs(t2988)
     t2990 = xp.greater_equal(t2989, 1)
-    t2991 = xp.abs(1/xp.where(t2990, t2988, 1))
+    t2991 = 1/xp.abs(xp.where(t2990, t2988, 1))
     t2992 = xp.where(t2987, xp.where(xp.greater_equal(t2988, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2990, t2991/(1 + xp.sqrt(1 + t2991**2)), 1/(t2989 + xp.sqrt(1 + t2989**2))), 0)
     t2993 = 1/xp.sqrt(1 + t2992**2)
     t2994 = t2986*t2992
@@ -7374,10 +7374,10 @@ def condition_number(q):
     t3021 = t2896*t2999 + t2900*t3003 + t2904*t3007 + t2908*t3011 + t2912*t3015 + t2916*t3019
     t3022 = t2965*t3000 + t2969*t3004 + t2973*t3008 + t2977*t3012 + t2981*t3016 + t2985*t3020
     t3023 = xp.not_equal(t3021, 0)
-    t3024 = 0.5*(-t2995 + t2892)/xp.where(t3023, t3021, 1)
+    t3024 = (-t2995 + t2892)/xp.where(t3023, 2*t3021, 1)
     t3025 = xp.abs(t3024)
     t3026 = xp.greater_equal(t3025, 1)
-    t3027 = xp.abs(1/xp.where(t3026, t3024, 1))
+    t3027 = 1/xp.abs(xp.where(t3026, t3024, 1))
     t3028 = xp.where(t3023, xp.where(xp.greater_equal(t3024, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3026, t3027/(1 + xp.sqrt(1 + t3027**2)), 1/(t3025 + xp.sqrt(1 + t3025**2))), 0)
     t3029 = 1/xp.sqrt(1 + t3028**2)
     t3030 = t3021*t3028
@@ -7409,10 +7409,10 @@ def condition_number(q):
     t3056 = t3054 + t3028*t3053
     t3057 = t2931*t3035 + t2935*t3039 + t2939*t3043 + t2943*t3047 + t2947*t3051 + t2951*t3055
     t3058 = xp.not_equal(t3057, 0)
-    t3059 = 0.5*(-t3031 + t2927)/xp.where(t3058, t3057, 1)
+    t3059 = (-t3031 + t2927)/xp.where(t3058, 2*t3057, 1)
     t3060 = xp.abs(t3059)
     t3061 = xp.greater_equal(t3060, 1)
-    t3062 = xp.abs(1/xp.where(t3061, t3059, 1))
+    t3062 = 1/xp.abs(xp.where(t3061, t3059, 1))
     t3063 = xp.where(t3058, xp.where(xp.greater_equal(t3059, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3061, t3062/(1 + xp.sqrt(1 + t3062**2)), 1/(t3060 + xp.sqrt(1 + t3060**2))), 0)
     t3064 = 1/xp.sqrt(1 + t3063**2)
     t3065 = t3057*t3063
@@ -7444,10 +7444,10 @@ def condition_number(q):
     t3091 = t3089 + t3063*t3088
     t3092 = t2930*t3070 + t2934*t3074 + t2938*t3078 + t2942*t3082 + t2946*t3086 + t2950*t3090
     t3093 = xp.not_equal(t3022, 0)
-    t3094 = 0.5*(-t2961 + t2996)/xp.where(t3093, t3022, 1)
+    t3094 = (-t2961 + t2996)/xp.where(t3093, 2*t3022, 1)
     t3095 = xp.abs(t3094)
     t3096 = xp.greater_equal(t3095, 1)
-    t3097 = xp.abs(1/xp.where(t3096, t3094, 1))
+    t3097 = 1/xp.abs(xp.where(t3096, t3094, 1))
     t3098 = xp.where(t3093, xp.where(xp.greater_equal(t3094, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3096, t3097/(1 + xp.sqrt(1 + t3097**2)), 1/(t3095 + xp.sqrt(1 + t3095**2))), 0)
     t3099 = 1/xp.sqrt(1 + t3098**2)
     t3100 = t3022*t3098
@@ -7479,10 +7479,10 @@ def condition_number(q):
     t3126 = t3124 + t3098*t3123
     t3127 = t3036*t3105 + t3040*t3109 + t3044*t3113 + t3048*t3117 + t3052*t3121 + t3056*t3125
     t3128 = xp.not_equal(t3127, 0)
-    t3129 = 0.5*(-t3101 + t3032)/xp.where(t3128, t3127, 1)
+    t3129 = (-t3101 + t3032)/xp.where(t3128, 2*t3127, 1)
     t3130 = xp.abs(t3129)
     t3131 = xp.greater_equal(t3130, 1)
-    t3132 = xp.abs(1/xp.where(t3131, t3129, 1))
+    t3132 = 1/xp.abs(xp.where(t3131, t3129, 1))
     t3133 = xp.where(t3128, xp.where(xp.greater_equal(t3129, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3131, t3132/(1 + xp.sqrt(1 + t3132**2)), 1/(t3130 + xp.sqrt(1 + t3130**2))), 0)
     t3134 = 1/xp.sqrt(1 + t3133**2)
     t3135 = t3127*t3133
@@ -7515,10 +7515,10 @@ def condition_number(q):
     t3162 = t3071*t3140 + t3075*t3144 + t3079*t3148 + t3083*t3152 + t3087*t3156 + t3091*t3160
     t3163 = t3106*t3141 + t3110*t3145 + t3114*t3149 + t3118*t3153 + t3122*t3157 + t3126*t3161
     t3164 = xp.not_equal(t3162, 0)
-    t3165 = 0.5*(-t3136 + t3067)/xp.where(t3164, t3162, 1)
+    t3165 = (-t3136 + t3067)/xp.where(t3164, 2*t3162, 1)
     t3166 = xp.abs(t3165)
     t3167 = xp.greater_equal(t3166, 1)
-    t3168 = xp.abs(1/xp.where(t3167, t3165, 1))
+    t3168 = 1/xp.abs(xp.where(t3167, t3165, 1))
     t3169 = xp.where(t3164, xp.where(xp.greater_equal(t3165, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3167, t3168/(1 + xp.sqrt(1 + t3168**2)), 1/(t3166 + xp.sqrt(1 + t3166**2))), 0)
     t3170 = 1/xp.sqrt(1 + t3169**2)
     t3171 = t3162*t3169
@@ -7549,10 +7549,10 @@ def condition_number(q):
     t3196 = t3194 - t3169*t3195
     t3197 = t3195 + t3169*t3194
     t3198 = xp.not_equal(t3163, 0)
-    t3199 = 0.5*(-t3102 + t3137)/xp.where(t3198, t3163, 1)
+    t3199 = (-t3102 + t3137)/xp.where(t3198, 2*t3163, 1)
     t3200 = xp.abs(t3199)
     t3201 = xp.greater_equal(t3200, 1)
-    t3202 = xp.abs(1/xp.where(t3201, t3199, 1))
+    t3202 = 1/xp.abs(xp.where(t3201, t3199, 1))
     t3203 = xp.where(t3198, xp.where(xp.greater_equal(t3199, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3201, t3202/(1 + xp.sqrt(1 + t3202**2)), 1/(t3200 + xp.sqrt(1 + t3200**2))), 0)
     t3204 = 1/xp.sqrt(1 + t3203**2)
     t3205 = t3163*t3203
@@ -7584,10 +7584,10 @@ def condition_number(q):
     t3231 = t3229 + t3203*t3228
     t3232 = t3177*t3210 + t3181*t3214 + t3185*t3218 + t3189*t3222 + t3193*t3226 + t3197*t3230
     t3233 = xp.not_equal(t3232, 0)
-    t3234 = 0.5*(-t3206 + t3173)/xp.where(t3233, t3232, 1)
+    t3234 = (-t3206 + t3173)/xp.where(t3233, 2*t3232, 1)
     t3235 = xp.abs(t3234)
     t3236 = xp.greater_equal(t3235, 1)
-    t3237 = xp.abs(1/xp.where(t3236, t3234, 1))
+    t3237 = 1/xp.abs(xp.where(t3236, t3234, 1))
     t3238 = xp.where(t3233, xp.where(xp.greater_equal(t3234, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3236, t3237/(1 + xp.sqrt(1 + t3237**2)), 1/(t3235 + xp.sqrt(1 + t3235**2))), 0)
     t3239 = 1/xp.sqrt(1 + t3238**2)
     t3240 = t3232*t3238
@@ -7619,10 +7619,10 @@ def condition_number(q):
     t3266 = t3264 + t3238*t3263
     t3267 = t3211*t3246 + t3215*t3250 + t3219*t3254 + t3223*t3258 + t3227*t3262 + t3231*t3266
     t3268 = xp.not_equal(t3267, 0)
-    t3269 = 0.5*(-t3207 + t3242)/xp.where(t3268, t3267, 1)
+    t3269 = (-t3207 + t3242)/xp.where(t3268, 2*t3267, 1)
     t3270 = xp.abs(t3269)
     t3271 = xp.greater_equal(t3270, 1)
-    t3272 = xp.abs(1/xp.where(t3271, t3269, 1))
+    t3272 = 1/xp.abs(xp.where(t3271, t3269, 1))
     t3273 = xp.where(t3268, xp.where(xp.greater_equal(t3269, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3271, t3272/(1 + xp.sqrt(1 + t3272**2)), 1/(t3270 + xp.sqrt(1 + t3270**2))), 0)
     t3274 = 1/xp.sqrt(1 + t3273**2)
     t3275 = t3267*t3273
@@ -7653,10 +7653,10 @@ def condition_number(q):
     t3300 = t3298 - t3273*t3299
     t3301 = t3299 + t3273*t3298
     t3302 = xp.not_equal(t3092, 0)
-    t3303 = 0.5*(-t2926 + t3066)/xp.where(t3302, t3092, 1)
+    t3303 = (-t2926 + t3066)/xp.where(t3302, 2*t3092, 1)
     t3304 = xp.abs(t3303)
     t3305 = xp.greater_equal(t3304, 1)
-    t3306 = xp.abs(1/xp.where(t3305, t3303, 1))
+    t3306 = 1/xp.abs(xp.where(t3305, t3303, 1))
     t3307 = xp.where(t3302, xp.where(xp.greater_equal(t3303, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3305, t3306/(1 + xp.sqrt(1 + t3306**2)), 1/(t3304 + xp.sqrt(1 + t3304**2))), 0)
     t3308 = 1/xp.sqrt(1 + t3307**2)
     t3309 = t3092*t3307
@@ -7688,10 +7688,10 @@ def condition_number(q):
     t3335 = t3333 + t3307*t3332
     t3336 = t3176*t3314 + t3180*t3318 + t3184*t3322 + t3188*t3326 + t3192*t3330 + t3196*t3334
     t3337 = xp.not_equal(t3336, 0)
-    t3338 = 0.5*(-t3310 + t3172)/xp.where(t3337, t3336, 1)
+    t3338 = (-t3310 + t3172)/xp.where(t3337, 2*t3336, 1)
     t3339 = xp.abs(t3338)
     t3340 = xp.greater_equal(t3339, 1)
-    t3341 = xp.abs(1/xp.where(t3340, t3338, 1))
+    t3341 = 1/xp.abs(xp.where(t3340, t3338, 1))
     t3342 = xp.where(t3337, xp.where(xp.greater_equal(t3338, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3340, t3341/(1 + xp.sqrt(1 + t3341**2)), 1/(t3339 + xp.sqrt(1 + t3339**2))), 0)
     t3343 = 1/xp.sqrt(1 + t3342**2)
     t3344 = t3336*t3342
@@ -7724,10 +7724,10 @@ def condition_number(q):
     t3371 = t3245*t3349 + t3249*t3353 + t3253*t3357 + t3257*t3361 + t3261*t3365 + t3265*t3369
     t3372 = t3315*t3350 + t3319*t3354 + t3323*t3358 + t3327*t3362 + t3331*t3366 + t3335*t3370
     t3373 = xp.not_equal(t3371, 0)
-    t3374 = 0.5*(-t3345 + t3241)/xp.where(t3373, t3371, 1)
+    t3374 = (-t3345 + t3241)/xp.where(t3373, 2*t3371, 1)
     t3375 = xp.abs(t3374)
     t3376 = xp.greater_equal(t3375, 1)
-    t3377 = xp.abs(1/xp.where(t3376, t3374, 1))
+    t3377 = 1/xp.abs(xp.where(t3376, t3374, 1))
     t3378 = xp.where(t3373, xp.where(xp.greater_equal(t3374, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3376, t3377/(1 + xp.sqrt(1 + t3377**2)), 1/(t3375 + xp.sqrt(1 + t3375**2))), 0)
     t3379 = 1/xp.sqrt(1 + t3378**2)
     t3380 = t3371*t3378
@@ -7759,10 +7759,10 @@ def condition_number(q):
     t3406 = t3404 + t3378*t3403
     t3407 = t3280*t3385 + t3284*t3389 + t3288*t3393 + t3292*t3397 + t3296*t3401 + t3300*t3405
     t3408 = xp.not_equal(t3407, 0)
-    t3409 = 0.5*(-t3381 + t3276)/xp.where(t3408, t3407, 1)
+    t3409 = (-t3381 + t3276)/xp.where(t3408, 2*t3407, 1)
     t3410 = xp.abs(t3409)
     t3411 = xp.greater_equal(t3410, 1)
-    t3412 = xp.abs(1/xp.where(t3411, t3409, 1))
+    t3412 = 1/xp.abs(xp.where(t3411, t3409, 1))
     t3413 = xp.where(t3408, xp.where(xp.greater_equal(t3409, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3411, t3412/(1 + xp.sqrt(1 + t3412**2)), 1/(t3410 + xp.sqrt(1 + t3410**2))), 0)
     t3414 = 1/xp.sqrt(1 + t3413**2)
     t3415 = t3407*t3413
@@ -7794,10 +7794,10 @@ def condition_number(q):
     t3441 = t3439 + t3413*t3438
     t3442 = t3281*t3420 + t3285*t3424 + t3289*t3428 + t3293*t3432 + t3297*t3436 + t3301*t3440
     t3443 = xp.not_equal(t3442, 0)
-    t3444 = 0.5*(-t3416 + t3277)/xp.where(t3443, t3442, 1)
+    t3444 = (-t3416 + t3277)/xp.where(t3443, 2*t3442, 1)
     t3445 = xp.abs(t3444)
     t3446 = xp.greater_equal(t3445, 1)
-    t3447 = xp.abs(1/xp.where(t3446, t3444, 1))
+    t3447 = 1/xp.abs(xp.where(t3446, t3444, 1))
     t3448 = xp.where(t3443, xp.where(xp.greater_equal(t3444, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3446, t3447/(1 + xp.sqrt(1 + t3447**2)), 1/(t3445 + xp.sqrt(1 + t3445**2))), 0)
     t3449 = 1/xp.sqrt(1 + t3448**2)
     t3450 = t3277 + t3442*t3448
@@ -7827,10 +7827,10 @@ def condition_number(q):
     t3474 = t3472 + t3448*t3471
     t3475 = xp.sqrt(t3453**2 + t3457**2 + t3461**2 + t3465**2 + t3469**2 + t3473**2)
     t3476 = xp.not_equal(t3372, 0)
-    t3477 = 0.5*(-t3311 + t3346)/xp.where(t3476, t3372, 1)
+    t3477 = (-t3311 + t3346)/xp.where(t3476, 2*t3372, 1)
     t3478 = xp.abs(t3477)
     t3479 = xp.greater_equal(t3478, 1)
-    t3480 = xp.abs(1/xp.where(t3479, t3477, 1))
+    t3480 = 1/xp.abs(xp.where(t3479, t3477, 1))
     t3481 = xp.where(t3476, xp.where(xp.greater_equal(t3477, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3479, t3480/(1 + xp.sqrt(1 + t3480**2)), 1/(t3478 + xp.sqrt(1 + t3478**2))), 0)
     t3482 = 1/xp.sqrt(1 + t3481**2)
     t3483 = t3372*t3481
@@ -7862,10 +7862,10 @@ def condition_number(q):
     t3509 = t3507 + t3481*t3506
     t3510 = t3386*t3488 + t3390*t3492 + t3394*t3496 + t3398*t3500 + t3402*t3504 + t3406*t3508
     t3511 = xp.not_equal(t3510, 0)
-    t3512 = 0.5*(-t3484 + t3382)/xp.where(t3511, t3510, 1)
+    t3512 = (-t3484 + t3382)/xp.where(t3511, 2*t3510, 1)
     t3513 = xp.abs(t3512)
     t3514 = xp.greater_equal(t3513, 1)
-    t3515 = xp.abs(1/xp.where(t3514, t3512, 1))
+    t3515 = 1/xp.abs(xp.where(t3514, t3512, 1))
     t3516 = xp.where(t3511, xp.where(xp.greater_equal(t3512, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3514, t3515/(1 + xp.sqrt(1 + t3515**2)), 1/(t3513 + xp.sqrt(1 + t3513**2))), 0)
     t3517 = 1/xp.sqrt(1 + t3516**2)
     t3518 = t3510*t3516
@@ -7898,10 +7898,10 @@ def condition_number(q):
     t3545 = t3421*t3523 + t3425*t3527 + t3429*t3531 + t3433*t3535 + t3437*t3539 + t3441*t3543
     t3546 = t3489*t3524 + t3493*t3528 + t3497*t3532 + t3501*t3536 + t3505*t3540 + t3509*t3544
     t3547 = xp.not_equal(t3545, 0)
-    t3548 = 0.5*(-t3519 + t3417)/xp.where(t3547, t3545, 1)
+    t3548 = (-t3519 + t3417)/xp.where(t3547, 2*t3545, 1)
     t3549 = xp.abs(t3548)
     t3550 = xp.greater_equal(t3549, 1)
-    t3551 = xp.abs(1/xp.where(t3550, t3548, 1))
+    t3551 = 1/xp.abs(xp.where(t3550, t3548, 1))
     t3552 = xp.where(t3547, xp.where(xp.greater_equal(t3548, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3550, t3551/(1 + xp.sqrt(1 + t3551**2)), 1/(t3549 + xp.sqrt(1 + t3549**2))), 0)
     t3553 = 1/xp.sqrt(1 + t3552**2)
     t3554 = t3545*t3552
@@ -7933,10 +7933,10 @@ def condition_number(q):
     t3580 = t3578 + t3552*t3577
     t3581 = t3454*t3559 + t3458*t3563 + t3462*t3567 + t3466*t3571 + t3470*t3575 + t3474*t3579
     t3582 = xp.not_equal(t3581, 0)
-    t3583 = 0.5*(-t3555 + t3450)/xp.where(t3582, t3581, 1)
+    t3583 = (-t3555 + t3450)/xp.where(t3582, 2*t3581, 1)
     t3584 = xp.abs(t3583)
     t3585 = xp.greater_equal(t3584, 1)
-    t3586 = xp.abs(1/xp.where(t3585, t3583, 1))
+    t3586 = 1/xp.abs(xp.where(t3585, t3583, 1))
     t3587 = xp.where(t3582, xp.where(xp.greater_equal(t3583, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3585, t3586/(1 + xp.sqrt(1 + t3586**2)), 1/(t3584 + xp.sqrt(1 + t3584**2))), 0)
     t3588 = 1/xp.sqrt(1 + t3587**2)
     t3589 = t3450 + t3581*t3587
@@ -7968,10 +7968,10 @@ def condition_number(q):
     t3615 = xp.where(xp.greater(t3614, t3475), t3614, t3475)
     t3616 = xp.where(xp.less(t3614, t3475), t3614, t3475)
     t3617 = xp.not_equal(t3546, 0)
-    t3618 = 0.5*(-t3485 + t3520)/xp.where(t3617, t3546, 1)
+    t3618 = (-t3485 + t3520)/xp.where(t3617, 2*t3546, 1)
     t3619 = xp.abs(t3618)
     t3620 = xp.greater_equal(t3619, 1)
-    t3621 = xp.abs(1/xp.where(t3620, t3618, 1))
+    t3621 = 1/xp.abs(xp.where(t3620, t3618, 1))
     t3622 = xp.where(t3617, xp.where(xp.greater_equal(t3618, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3620, t3621/(1 + xp.sqrt(1 + t3621**2)), 1/(t3619 + xp.sqrt(1 + t3619**2))), 0)
     t3623 = 1/xp.sqrt(1 + t3622**2)
     t3624 = t3546*t3622
@@ -8003,10 +8003,10 @@ def condition_number(q):
     t3650 = t3648 + t3622*t3647
     t3651 = t3560*t3629 + t3564*t3633 + t3568*t3637 + t3572*t3641 + t3576*t3645 + t3580*t3649
     t3652 = xp.not_equal(t3651, 0)
-    t3653 = 0.5*(-t3625 + t3556)/xp.where(t3652, t3651, 1)
+    t3653 = (-t3625 + t3556)/xp.where(t3652, 2*t3651, 1)
     t3654 = xp.abs(t3653)
     t3655 = xp.greater_equal(t3654, 1)
-    t3656 = xp.abs(1/xp.where(t3655, t3653, 1))
+    t3656 = 1/xp.abs(xp.where(t3655, t3653, 1))
     t3657 = xp.where(t3652, xp.where(xp.greater_equal(t3653, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3655, t3656/(1 + xp.sqrt(1 + t3656**2)), 1/(t3654 + xp.sqrt(1 + t3654**2))), 0)
     t3658 = 1/xp.sqrt(1 + t3657**2)
     t3659 = t3651*t3657
@@ -8039,10 +8039,10 @@ def condition_number(q):
     t3686 = t3593*t3664 + t3597*t3668 + t3601*t3672 + t3605*t3676 + t3609*t3680 + t3613*t3684
     t3687 = t3630*t3665 + t3634*t3669 + t3638*t3673 + t3642*t3677 + t3646*t3681 + t3650*t3685
     t3688 = xp.not_equal(t3686, 0)
-    t3689 = 0.5*(-t3660 + t3589)/xp.where(t3688, t3686, 1)
+    t3689 = (-t3660 + t3589)/xp.where(t3688, 2*t3686, 1)
     t3690 = xp.abs(t3689)
     t3691 = xp.greater_equal(t3690, 1)
-    t3692 = xp.abs(1/xp.where(t3691, t3689, 1))
+    t3692 = 1/xp.abs(xp.where(t3691, t3689, 1))
     t3693 = xp.where(t3688, xp.where(xp.greater_equal(t3689, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3691, t3692/(1 + xp.sqrt(1 + t3692**2)), 1/(t3690 + xp.sqrt(1 + t3690**2))), 0)
     t3694 = 1/xp.sqrt(1 + t3693**2)
     t3695 = t3589 + t3686*t3693
@@ -8074,10 +8074,10 @@ def condition_number(q):
     t3721 = xp.where(xp.greater(t3720, t3615), t3720, t3615)
     t3722 = xp.where(xp.less(t3720, t3616), t3720, t3616)
     t3723 = xp.not_equal(t3687, 0)
-    t3724 = 0.5*(-t3626 + t3661)/xp.where(t3723, t3687, 1)
+    t3724 = (-t3626 + t3661)/xp.where(t3723, 2*t3687, 1)
     t3725 = xp.abs(t3724)
     t3726 = xp.greater_equal(t3725, 1)
-    t3727 = xp.abs(1/xp.where(t3726, t3724, 1))
+    t3727 = 1/xp.abs(xp.where(t3726, t3724, 1))
     t3728 = xp.where(t3723, xp.where(xp.greater_equal(t3724, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3726, t3727/(1 + xp.sqrt(1 + t3727**2)), 1/(t3725 + xp.sqrt(1 + t3725**2))), 0)
     t3729 = 1/xp.sqrt(1 + t3728**2)
     t3730 = t3687*t3728
@@ -8109,10 +8109,10 @@ def condition_number(q):
     t3756 = t3754 + t3728*t3753
     t3757 = t3699*t3735 + t3703*t3739 + t3707*t3743 + t3711*t3747 + t3715*t3751 + t3719*t3755
     t3758 = xp.not_equal(t3757, 0)
-    t3759 = 0.5*(-t3731 + t3695)/xp.where(t3758, t3757, 1)
+    t3759 = (-t3731 + t3695)/xp.where(t3758, 2*t3757, 1)
     t3760 = xp.abs(t3759)
     t3761 = xp.greater_equal(t3760, 1)
-    t3762 = xp.abs(1/xp.where(t3761, t3759, 1))
+    t3762 = 1/xp.abs(xp.where(t3761, t3759, 1))
     t3763 = xp.where(t3758, xp.where(xp.greater_equal(t3759, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3761, t3762/(1 + xp.sqrt(1 + t3762**2)), 1/(t3760 + xp.sqrt(1 + t3760**2))), 0)
     t3764 = 1/xp.sqrt(1 + t3763**2)
     t3765 = t3695 + t3757*t3763
@@ -8145,10 +8145,10 @@ def condition_number(q):
     t3792 = xp.where(xp.greater(t3791, t3721), t3791, t3721)
     t3793 = xp.where(xp.less(t3791, t3722), t3791, t3722)
     t3794 = xp.not_equal(t3790, 0)
-    t3795 = 0.5*(-t3732 + t3765)/xp.where(t3794, t3790, 1)
+    t3795 = (-t3732 + t3765)/xp.where(t3794, 2*t3790, 1)
     t3796 = xp.abs(t3795)
     t3797 = xp.greater_equal(t3796, 1)
-    t3798 = xp.abs(1/xp.where(t3797, t3795, 1))
+    t3798 = 1/xp.abs(xp.where(t3797, t3795, 1))
     t3799 = xp.where(t3794, xp.where(xp.greater_equal(t3795, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3797, t3798/(1 + xp.sqrt(1 + t3798**2)), 1/(t3796 + xp.sqrt(1 + t3796**2))), 0)
     t3800 = 1/xp.sqrt(1 + t3799**2)
     t3801 = t3736*t3800
@@ -8181,7 +8181,9 @@ def condition_number(q):
     t3828 = xp.where(xp.less(t3825, t3793), t3825, t3793)
     t3829 = xp.where(xp.greater(t3826, t3827), t3826, t3827)
     t3830 = xp.where(xp.less(t3826, t3828), t3826, t3828)
-    kappa = xp.broadcast_to(xp.where(xp.greater(t3829, 0), t3829, 1)/xp.where(xp.less_equal(t3830, 1e-12*t3829), 0, t3830), batch)
+    t3831 = xp.where(xp.less_equal(t3830, 1e-12*t3829), 0, t3830)
+    t3832 = xp.where(xp.greater(t3829, 0), t3829, 1)
+    kappa = xp.broadcast_to(t3832/t3831, batch)
     return kappa
 
 

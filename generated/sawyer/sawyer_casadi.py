@@ -3000,10 +3000,10 @@ def _velocity_ellipsoid(q):
     t92 = t90**2
     t93 = t60*t66
     t94 = (t93 != 0)
-    t95 = 0.5*(-t63 + t91)/casadi.if_else(t94, -t93, 1)
+    t95 = (-t63 + t91)/casadi.if_else(t94, -2*t93, 1)
     t96 = casadi.fabs(t95)
     t97 = (t96 >= 1)
-    t98 = casadi.fabs(1/casadi.if_else(t97, t95, 1))
+    t98 = 1/casadi.fabs(casadi.if_else(t97, t95, 1))
     t99 = casadi.if_else(t94, casadi.if_else((t95 >= 0), 1, -1)*casadi.if_else(t97, t98/(1 + casadi.sqrt(1 + t98**2)), 1/(t96 + casadi.sqrt(1 + t96**2))), 0)
     t100 = 1/casadi.sqrt(1 + t99**2)
     t101 = t93*t99
@@ -3019,10 +3019,10 @@ def _velocity_ellipsoid(q):
     t111 = t110*t99
     t112 = t108*t106 - t111*t84
     t113 = (t112 != 0)
-    t114 = 0.5*(-t102 + t109)/casadi.if_else(t113, t112, 1)
+    t114 = (-t102 + t109)/casadi.if_else(t113, 2*t112, 1)
     t115 = casadi.fabs(t114)
     t116 = (t115 >= 1)
-    t117 = casadi.fabs(1/casadi.if_else(t116, t114, 1))
+    t117 = 1/casadi.fabs(casadi.if_else(t116, t114, 1))
     t118 = casadi.if_else(t113, casadi.if_else((t114 >= 0), 1, -1)*casadi.if_else(t116, t117/(1 + casadi.sqrt(1 + t117**2)), 1/(t115 + casadi.sqrt(1 + t115**2))), 0)
     t119 = 1/casadi.sqrt(1 + t118**2)
     t120 = t112*t118
@@ -3038,10 +3038,10 @@ def _velocity_ellipsoid(q):
     t130 = -t128 + t127*t118
     t131 = t107*t126 + t110*t130
     t132 = (t131 != 0)
-    t133 = 0.5*(-t103 + t122)/casadi.if_else(t132, -t131, 1)
+    t133 = (-t103 + t122)/casadi.if_else(t132, -2*t131, 1)
     t134 = casadi.fabs(t133)
     t135 = (t134 >= 1)
-    t136 = casadi.fabs(1/casadi.if_else(t135, t133, 1))
+    t136 = 1/casadi.fabs(casadi.if_else(t135, t133, 1))
     t137 = casadi.if_else(t132, casadi.if_else((t133 >= 0), 1, -1)*casadi.if_else(t135, t136/(1 + casadi.sqrt(1 + t136**2)), 1/(t134 + casadi.sqrt(1 + t134**2))), 0)
     t138 = 1/casadi.sqrt(1 + t137**2)
     t139 = t131*t137
@@ -3067,10 +3067,10 @@ def _velocity_ellipsoid(q):
     t159 = t137*t138
     t160 = t125*t144 - t129*t149 + t92*t153*t159*t119
     t161 = (t160 != 0)
-    t162 = 0.5*(-t121 + t140)/casadi.if_else(t161, t160, 1)
+    t162 = (-t121 + t140)/casadi.if_else(t161, 2*t160, 1)
     t163 = casadi.fabs(t162)
     t164 = (t163 >= 1)
-    t165 = casadi.fabs(1/casadi.if_else(t164, t162, 1))
+    t165 = 1/casadi.fabs(casadi.if_else(t164, t162, 1))
     t166 = casadi.if_else(t161, casadi.if_else((t162 >= 0), 1, -1)*casadi.if_else(t164, t165/(1 + casadi.sqrt(1 + t165**2)), 1/(t163 + casadi.sqrt(1 + t163**2))), 0)
     t167 = 1/casadi.sqrt(1 + t166**2)
     t168 = t160*t166
@@ -3104,10 +3104,10 @@ def _velocity_ellipsoid(q):
     t196 = t119*t138
     t197 = t145*t173 + t150*t177 - t196*t90*t186
     t198 = (t197 != 0)
-    t199 = 0.5*(-t169 + t141)/casadi.if_else(t198, t197, 1)
+    t199 = (-t169 + t141)/casadi.if_else(t198, 2*t197, 1)
     t200 = casadi.fabs(t199)
     t201 = (t200 >= 1)
-    t202 = casadi.fabs(1/casadi.if_else(t201, t199, 1))
+    t202 = 1/casadi.fabs(casadi.if_else(t201, t199, 1))
     t203 = casadi.if_else(t198, casadi.if_else((t199 >= 0), 1, -1)*casadi.if_else(t201, t202/(1 + casadi.sqrt(1 + t202**2)), 1/(t200 + casadi.sqrt(1 + t200**2))), 0)
     t204 = 1/casadi.sqrt(1 + t203**2)
     t205 = t197*t203
@@ -3139,10 +3139,10 @@ def _velocity_ellipsoid(q):
     t231 = t230 - t217*t203
     t232 = t217 + t230*t203
     t233 = (t221 != 0)
-    t234 = 0.5*(-t170 + t207)/casadi.if_else(t233, t221, 1)
+    t234 = (-t170 + t207)/casadi.if_else(t233, 2*t221, 1)
     t235 = casadi.fabs(t234)
     t236 = (t235 >= 1)
-    t237 = casadi.fabs(1/casadi.if_else(t236, t234, 1))
+    t237 = 1/casadi.fabs(casadi.if_else(t236, t234, 1))
     t238 = casadi.if_else(t233, casadi.if_else((t234 >= 0), 1, -1)*casadi.if_else(t236, t237/(1 + casadi.sqrt(1 + t237**2)), 1/(t235 + casadi.sqrt(1 + t235**2))), 0)
     t239 = 1/casadi.sqrt(1 + t238**2)
     t240 = t221*t238
@@ -3174,10 +3174,10 @@ def _velocity_ellipsoid(q):
     t266 = t264 + t265*t238
     t267 = t265 - t264*t238
     t268 = (t255 != 0)
-    t269 = 0.5*(-t206 + t241)/casadi.if_else(t268, t255, 1)
+    t269 = (-t206 + t241)/casadi.if_else(t268, 2*t255, 1)
     t270 = casadi.fabs(t269)
     t271 = (t270 >= 1)
-    t272 = casadi.fabs(1/casadi.if_else(t271, t269, 1))
+    t272 = 1/casadi.fabs(casadi.if_else(t271, t269, 1))
     t273 = casadi.if_else(t268, casadi.if_else((t269 >= 0), 1, -1)*casadi.if_else(t271, t272/(1 + casadi.sqrt(1 + t272**2)), 1/(t270 + casadi.sqrt(1 + t270**2))), 0)
     t274 = 1/casadi.sqrt(1 + t273**2)
     t275 = t255*t273
@@ -3209,10 +3209,10 @@ def _velocity_ellipsoid(q):
     t301 = t299 + t300*t273
     t302 = -t300 + t299*t273
     t303 = (t290 != 0)
-    t304 = 0.5*(-t276 + t242)/casadi.if_else(t303, t290, 1)
+    t304 = (-t276 + t242)/casadi.if_else(t303, 2*t290, 1)
     t305 = casadi.fabs(t304)
     t306 = (t305 >= 1)
-    t307 = casadi.fabs(1/casadi.if_else(t306, t304, 1))
+    t307 = 1/casadi.fabs(casadi.if_else(t306, t304, 1))
     t308 = casadi.if_else(t303, casadi.if_else((t304 >= 0), 1, -1)*casadi.if_else(t306, t307/(1 + casadi.sqrt(1 + t307**2)), 1/(t305 + casadi.sqrt(1 + t305**2))), 0)
     t309 = 1/casadi.sqrt(1 + t308**2)
     t310 = t290*t308
@@ -3244,10 +3244,10 @@ def _velocity_ellipsoid(q):
     t336 = t334 - t335*t308
     t337 = t335 + t334*t308
     t338 = (t325 != 0)
-    t339 = 0.5*(-t277 + t312)/casadi.if_else(t338, t325, 1)
+    t339 = (-t277 + t312)/casadi.if_else(t338, 2*t325, 1)
     t340 = casadi.fabs(t339)
     t341 = (t340 >= 1)
-    t342 = casadi.fabs(1/casadi.if_else(t341, t339, 1))
+    t342 = 1/casadi.fabs(casadi.if_else(t341, t339, 1))
     t343 = casadi.if_else(t338, casadi.if_else((t339 >= 0), 1, -1)*casadi.if_else(t341, t342/(1 + casadi.sqrt(1 + t342**2)), 1/(t340 + casadi.sqrt(1 + t340**2))), 0)
     t344 = 1/casadi.sqrt(1 + t343**2)
     t345 = t325*t343
@@ -3279,10 +3279,10 @@ def _velocity_ellipsoid(q):
     t371 = t369 - t343*t370
     t372 = t370 + t343*t369
     t373 = (t360 != 0)
-    t374 = 0.5*(-t311 + t346)/casadi.if_else(t373, t360, 1)
+    t374 = (-t311 + t346)/casadi.if_else(t373, 2*t360, 1)
     t375 = casadi.fabs(t374)
     t376 = (t375 >= 1)
-    t377 = casadi.fabs(1/casadi.if_else(t376, t374, 1))
+    t377 = 1/casadi.fabs(casadi.if_else(t376, t374, 1))
     t378 = casadi.if_else(t373, casadi.if_else((t374 >= 0), 1, -1)*casadi.if_else(t376, t377/(1 + casadi.sqrt(1 + t377**2)), 1/(t375 + casadi.sqrt(1 + t375**2))), 0)
     t379 = 1/casadi.sqrt(1 + t378**2)
     t380 = t360*t378
@@ -3314,10 +3314,10 @@ def _velocity_ellipsoid(q):
     t406 = t404 - t378*t405
     t407 = t405 + t378*t404
     t408 = (t395 != 0)
-    t409 = 0.5*(-t381 + t347)/casadi.if_else(t408, t395, 1)
+    t409 = (-t381 + t347)/casadi.if_else(t408, 2*t395, 1)
     t410 = casadi.fabs(t409)
     t411 = (t410 >= 1)
-    t412 = casadi.fabs(1/casadi.if_else(t411, t409, 1))
+    t412 = 1/casadi.fabs(casadi.if_else(t411, t409, 1))
     t413 = casadi.if_else(t408, casadi.if_else((t409 >= 0), 1, -1)*casadi.if_else(t411, t412/(1 + casadi.sqrt(1 + t412**2)), 1/(t410 + casadi.sqrt(1 + t410**2))), 0)
     t414 = 1/casadi.sqrt(1 + t413**2)
     t415 = t395*t413
@@ -3349,10 +3349,10 @@ def _velocity_ellipsoid(q):
     t441 = t439 - t413*t440
     t442 = t440 + t413*t439
     t443 = (t430 != 0)
-    t444 = 0.5*(-t382 + t417)/casadi.if_else(t443, t430, 1)
+    t444 = (-t382 + t417)/casadi.if_else(t443, 2*t430, 1)
     t445 = casadi.fabs(t444)
     t446 = (t445 >= 1)
-    t447 = casadi.fabs(1/casadi.if_else(t446, t444, 1))
+    t447 = 1/casadi.fabs(casadi.if_else(t446, t444, 1))
     t448 = casadi.if_else(t443, casadi.if_else((t444 >= 0), 1, -1)*casadi.if_else(t446, t447/(1 + casadi.sqrt(1 + t447**2)), 1/(t445 + casadi.sqrt(1 + t445**2))), 0)
     t449 = 1/casadi.sqrt(1 + t448**2)
     t450 = t430*t448
@@ -3384,10 +3384,10 @@ def _velocity_ellipsoid(q):
     t476 = t474 - t448*t475
     t477 = t475 + t448*t474
     t478 = (t465 != 0)
-    t479 = 0.5*(-t416 + t451)/casadi.if_else(t478, t465, 1)
+    t479 = (-t416 + t451)/casadi.if_else(t478, 2*t465, 1)
     t480 = casadi.fabs(t479)
     t481 = (t480 >= 1)
-    t482 = casadi.fabs(1/casadi.if_else(t481, t479, 1))
+    t482 = 1/casadi.fabs(casadi.if_else(t481, t479, 1))
     t483 = casadi.if_else(t478, casadi.if_else((t479 >= 0), 1, -1)*casadi.if_else(t481, t482/(1 + casadi.sqrt(1 + t482**2)), 1/(t480 + casadi.sqrt(1 + t480**2))), 0)
     t484 = 1/casadi.sqrt(1 + t483**2)
     t485 = t465*t483
@@ -3419,10 +3419,10 @@ def _velocity_ellipsoid(q):
     t511 = t509 - t483*t510
     t512 = t510 + t483*t509
     t513 = (t500 != 0)
-    t514 = 0.5*(-t486 + t452)/casadi.if_else(t513, t500, 1)
+    t514 = (-t486 + t452)/casadi.if_else(t513, 2*t500, 1)
     t515 = casadi.fabs(t514)
     t516 = (t515 >= 1)
-    t517 = casadi.fabs(1/casadi.if_else(t516, t514, 1))
+    t517 = 1/casadi.fabs(casadi.if_else(t516, t514, 1))
     t518 = casadi.if_else(t513, casadi.if_else((t514 >= 0), 1, -1)*casadi.if_else(t516, t517/(1 + casadi.sqrt(1 + t517**2)), 1/(t515 + casadi.sqrt(1 + t515**2))), 0)
     t519 = 1/casadi.sqrt(1 + t518**2)
     t520 = t452 + t500*t518
@@ -3453,10 +3453,10 @@ def _velocity_ellipsoid(q):
     t545 = t543 - t518*t544
     t546 = t544 + t518*t543
     t547 = (t533 != 0)
-    t548 = 0.5*(-t487 + t520)/casadi.if_else(t547, t533, 1)
+    t548 = (-t487 + t520)/casadi.if_else(t547, 2*t533, 1)
     t549 = casadi.fabs(t548)
     t550 = (t549 >= 1)
-    t551 = casadi.fabs(1/casadi.if_else(t550, t548, 1))
+    t551 = 1/casadi.fabs(casadi.if_else(t550, t548, 1))
     t552 = casadi.if_else(t547, casadi.if_else((t548 >= 0), 1, -1)*casadi.if_else(t550, t551/(1 + casadi.sqrt(1 + t551**2)), 1/(t549 + casadi.sqrt(1 + t549**2))), 0)
     t553 = 1/casadi.sqrt(1 + t552**2)
     t554 = t491*t553
@@ -3555,10 +3555,10 @@ def _velocity_ellipsoid(q):
     t647 = t646**2
     t648 = t625**2 + t639**2 + t647
     t649 = (t636 != 0)
-    t650 = 0.5*(-t615 + t635)/casadi.if_else(t649, t636, 1)
+    t650 = (-t615 + t635)/casadi.if_else(t649, 2*t636, 1)
     t651 = casadi.fabs(t650)
     t652 = (t651 >= 1)
-    t653 = casadi.fabs(1/casadi.if_else(t652, t650, 1))
+    t653 = 1/casadi.fabs(casadi.if_else(t652, t650, 1))
     t654 = casadi.if_else(t649, casadi.if_else((t650 >= 0), 1, -1)*casadi.if_else(t652, t653/(1 + casadi.sqrt(1 + t653**2)), 1/(t651 + casadi.sqrt(1 + t651**2))), 0)
     t655 = 1/casadi.sqrt(1 + t654**2)
     t656 = t636*t654
@@ -3572,10 +3572,10 @@ def _velocity_ellipsoid(q):
     t664 = t654*t663
     t665 = t625*t661 + t639*t664
     t666 = (t665 != 0)
-    t667 = 0.5*(-t657 + t648)/casadi.if_else(t666, t665, 1)
+    t667 = (-t657 + t648)/casadi.if_else(t666, 2*t665, 1)
     t668 = casadi.fabs(t667)
     t669 = (t668 >= 1)
-    t670 = casadi.fabs(1/casadi.if_else(t669, t667, 1))
+    t670 = 1/casadi.fabs(casadi.if_else(t669, t667, 1))
     t671 = casadi.if_else(t666, casadi.if_else((t667 >= 0), 1, -1)*casadi.if_else(t669, t670/(1 + casadi.sqrt(1 + t670**2)), 1/(t668 + casadi.sqrt(1 + t668**2))), 0)
     t672 = 1/casadi.sqrt(1 + t671**2)
     t673 = t665*t671
@@ -3591,10 +3591,10 @@ def _velocity_ellipsoid(q):
     t683 = t681 + t671*t680
     t684 = t662*t679 + t683*t663
     t685 = (t684 != 0)
-    t686 = 0.5*(-t658 + t675)/casadi.if_else(t685, -t684, 1)
+    t686 = (-t658 + t675)/casadi.if_else(t685, -2*t684, 1)
     t687 = casadi.fabs(t686)
     t688 = (t687 >= 1)
-    t689 = casadi.fabs(1/casadi.if_else(t688, t686, 1))
+    t689 = 1/casadi.fabs(casadi.if_else(t688, t686, 1))
     t690 = casadi.if_else(t685, casadi.if_else((t686 >= 0), 1, -1)*casadi.if_else(t688, t689/(1 + casadi.sqrt(1 + t689**2)), 1/(t687 + casadi.sqrt(1 + t687**2))), 0)
     t691 = 1/casadi.sqrt(1 + t690**2)
     t692 = t684*t690
@@ -3620,10 +3620,10 @@ def _velocity_ellipsoid(q):
     t712 = t690*t691
     t713 = t678*t697 + t682*t702 - t672*t647*t706*t712
     t714 = (t713 != 0)
-    t715 = 0.5*(-t674 + t693)/casadi.if_else(t714, -t713, 1)
+    t715 = (-t674 + t693)/casadi.if_else(t714, -2*t713, 1)
     t716 = casadi.fabs(t715)
     t717 = (t716 >= 1)
-    t718 = casadi.fabs(1/casadi.if_else(t717, t715, 1))
+    t718 = 1/casadi.fabs(casadi.if_else(t717, t715, 1))
     t719 = casadi.if_else(t714, casadi.if_else((t715 >= 0), 1, -1)*casadi.if_else(t717, t718/(1 + casadi.sqrt(1 + t718**2)), 1/(t716 + casadi.sqrt(1 + t716**2))), 0)
     t720 = 1/casadi.sqrt(1 + t719**2)
     t721 = t713*t719
@@ -3657,10 +3657,10 @@ def _velocity_ellipsoid(q):
     t749 = t672*t691
     t750 = t698*t726 + t703*t730 - t646*t739*t749
     t751 = (t750 != 0)
-    t752 = 0.5*(-t722 + t694)/casadi.if_else(t751, t750, 1)
+    t752 = (-t722 + t694)/casadi.if_else(t751, 2*t750, 1)
     t753 = casadi.fabs(t752)
     t754 = (t753 >= 1)
-    t755 = casadi.fabs(1/casadi.if_else(t754, t752, 1))
+    t755 = 1/casadi.fabs(casadi.if_else(t754, t752, 1))
     t756 = casadi.if_else(t751, casadi.if_else((t752 >= 0), 1, -1)*casadi.if_else(t754, t755/(1 + casadi.sqrt(1 + t755**2)), 1/(t753 + casadi.sqrt(1 + t753**2))), 0)
     t757 = 1/casadi.sqrt(1 + t756**2)
     t758 = t750*t756
@@ -3692,10 +3692,10 @@ def _velocity_ellipsoid(q):
     t784 = t783 - t756*t770
     t785 = t770 + t756*t783
     t786 = (t774 != 0)
-    t787 = 0.5*(-t723 + t760)/casadi.if_else(t786, t774, 1)
+    t787 = (-t723 + t760)/casadi.if_else(t786, 2*t774, 1)
     t788 = casadi.fabs(t787)
     t789 = (t788 >= 1)
-    t790 = casadi.fabs(1/casadi.if_else(t789, t787, 1))
+    t790 = 1/casadi.fabs(casadi.if_else(t789, t787, 1))
     t791 = casadi.if_else(t786, casadi.if_else((t787 >= 0), 1, -1)*casadi.if_else(t789, t790/(1 + casadi.sqrt(1 + t790**2)), 1/(t788 + casadi.sqrt(1 + t788**2))), 0)
     t792 = 1/casadi.sqrt(1 + t791**2)
     t793 = t774*t791
@@ -3727,10 +3727,10 @@ def _velocity_ellipsoid(q):
     t819 = t817 + t791*t818
     t820 = t818 - t791*t817
     t821 = (t808 != 0)
-    t822 = 0.5*(-t759 + t794)/casadi.if_else(t821, t808, 1)
+    t822 = (-t759 + t794)/casadi.if_else(t821, 2*t808, 1)
     t823 = casadi.fabs(t822)
     t824 = (t823 >= 1)
-    t825 = casadi.fabs(1/casadi.if_else(t824, t822, 1))
+    t825 = 1/casadi.fabs(casadi.if_else(t824, t822, 1))
     t826 = casadi.if_else(t821, casadi.if_else((t822 >= 0), 1, -1)*casadi.if_else(t824, t825/(1 + casadi.sqrt(1 + t825**2)), 1/(t823 + casadi.sqrt(1 + t823**2))), 0)
     t827 = 1/casadi.sqrt(1 + t826**2)
     t828 = t808*t826
@@ -3762,10 +3762,10 @@ def _velocity_ellipsoid(q):
     t854 = t852 + t826*t853
     t855 = -t853 + t826*t852
     t856 = (t843 != 0)
-    t857 = 0.5*(-t829 + t795)/casadi.if_else(t856, t843, 1)
+    t857 = (-t829 + t795)/casadi.if_else(t856, 2*t843, 1)
     t858 = casadi.fabs(t857)
     t859 = (t858 >= 1)
-    t860 = casadi.fabs(1/casadi.if_else(t859, t857, 1))
+    t860 = 1/casadi.fabs(casadi.if_else(t859, t857, 1))
     t861 = casadi.if_else(t856, casadi.if_else((t857 >= 0), 1, -1)*casadi.if_else(t859, t860/(1 + casadi.sqrt(1 + t860**2)), 1/(t858 + casadi.sqrt(1 + t858**2))), 0)
     t862 = 1/casadi.sqrt(1 + t861**2)
     t863 = t843*t861
@@ -3797,10 +3797,10 @@ def _velocity_ellipsoid(q):
     t889 = t887 - t861*t888
     t890 = t888 + t861*t887
     t891 = (t878 != 0)
-    t892 = 0.5*(-t830 + t865)/casadi.if_else(t891, t878, 1)
+    t892 = (-t830 + t865)/casadi.if_else(t891, 2*t878, 1)
     t893 = casadi.fabs(t892)
     t894 = (t893 >= 1)
-    t895 = casadi.fabs(1/casadi.if_else(t894, t892, 1))
+    t895 = 1/casadi.fabs(casadi.if_else(t894, t892, 1))
     t896 = casadi.if_else(t891, casadi.if_else((t892 >= 0), 1, -1)*casadi.if_else(t894, t895/(1 + casadi.sqrt(1 + t895**2)), 1/(t893 + casadi.sqrt(1 + t893**2))), 0)
     t897 = 1/casadi.sqrt(1 + t896**2)
     t898 = t878*t896
@@ -3832,10 +3832,10 @@ def _velocity_ellipsoid(q):
     t924 = t922 - t896*t923
     t925 = t923 + t896*t922
     t926 = (t913 != 0)
-    t927 = 0.5*(-t864 + t899)/casadi.if_else(t926, t913, 1)
+    t927 = (-t864 + t899)/casadi.if_else(t926, 2*t913, 1)
     t928 = casadi.fabs(t927)
     t929 = (t928 >= 1)
-    t930 = casadi.fabs(1/casadi.if_else(t929, t927, 1))
+    t930 = 1/casadi.fabs(casadi.if_else(t929, t927, 1))
     t931 = casadi.if_else(t926, casadi.if_else((t927 >= 0), 1, -1)*casadi.if_else(t929, t930/(1 + casadi.sqrt(1 + t930**2)), 1/(t928 + casadi.sqrt(1 + t928**2))), 0)
     t932 = 1/casadi.sqrt(1 + t931**2)
     t933 = t913*t931
@@ -3867,10 +3867,10 @@ def _velocity_ellipsoid(q):
     t959 = t957 - t931*t958
     t960 = t958 + t931*t957
     t961 = (t948 != 0)
-    t962 = 0.5*(-t934 + t900)/casadi.if_else(t961, t948, 1)
+    t962 = (-t934 + t900)/casadi.if_else(t961, 2*t948, 1)
     t963 = casadi.fabs(t962)
     t964 = (t963 >= 1)
-    t965 = casadi.fabs(1/casadi.if_else(t964, t962, 1))
+    t965 = 1/casadi.fabs(casadi.if_else(t964, t962, 1))
     t966 = casadi.if_else(t961, casadi.if_else((t962 >= 0), 1, -1)*casadi.if_else(t964, t965/(1 + casadi.sqrt(1 + t965**2)), 1/(t963 + casadi.sqrt(1 + t963**2))), 0)
     t967 = 1/casadi.sqrt(1 + t966**2)
     t968 = t948*t966
@@ -3902,10 +3902,10 @@ def _velocity_ellipsoid(q):
     t994 = t992 - t966*t993
     t995 = t993 + t966*t992
     t996 = (t983 != 0)
-    t997 = 0.5*(-t935 + t970)/casadi.if_else(t996, t983, 1)
+    t997 = (-t935 + t970)/casadi.if_else(t996, 2*t983, 1)
     t998 = casadi.fabs(t997)
     t999 = (t998 >= 1)
-    t1000 = casadi.fabs(1/casadi.if_else(t999, t997, 1))
+    t1000 = 1/casadi.fabs(casadi.if_else(t999, t997, 1))
     t1001 = casadi.if_else(t996, casadi.if_else((t997 >= 0), 1, -1)*casadi.if_else(t999, t1000/(1 + casadi.sqrt(1 + t1000**2)), 1/(t998 + casadi.sqrt(1 + t998**2))), 0)
     t1002 = 1/casadi.sqrt(1 + t1001**2)
     t1003 = t983*t1001
@@ -3937,10 +3937,10 @@ def _velocity_ellipsoid(q):
     t1029 = t1027 - t1001*t1028
     t1030 = t1028 + t1001*t1027
     t1031 = (t1018 != 0)
-    t1032 = 0.5*(-t969 + t1004)/casadi.if_else(t1031, t1018, 1)
+    t1032 = (-t969 + t1004)/casadi.if_else(t1031, 2*t1018, 1)
     t1033 = casadi.fabs(t1032)
     t1034 = (t1033 >= 1)
-    t1035 = casadi.fabs(1/casadi.if_else(t1034, t1032, 1))
+    t1035 = 1/casadi.fabs(casadi.if_else(t1034, t1032, 1))
     t1036 = casadi.if_else(t1031, casadi.if_else((t1032 >= 0), 1, -1)*casadi.if_else(t1034, t1035/(1 + casadi.sqrt(1 + t1035**2)), 1/(t1033 + casadi.sqrt(1 + t1033**2))), 0)
     t1037 = 1/casadi.sqrt(1 + t1036**2)
     t1038 = t1018*t1036
@@ -3972,10 +3972,10 @@ def _velocity_ellipsoid(q):
     t1064 = t1062 - t1036*t1063
     t1065 = t1063 + t1036*t1062
     t1066 = (t1053 != 0)
-    t1067 = 0.5*(-t1039 + t1005)/casadi.if_else(t1066, t1053, 1)
+    t1067 = (-t1039 + t1005)/casadi.if_else(t1066, 2*t1053, 1)
     t1068 = casadi.fabs(t1067)
     t1069 = (t1068 >= 1)
-    t1070 = casadi.fabs(1/casadi.if_else(t1069, t1067, 1))
+    t1070 = 1/casadi.fabs(casadi.if_else(t1069, t1067, 1))
     t1071 = casadi.if_else(t1066, casadi.if_else((t1067 >= 0), 1, -1)*casadi.if_else(t1069, t1070/(1 + casadi.sqrt(1 + t1070**2)), 1/(t1068 + casadi.sqrt(1 + t1068**2))), 0)
     t1072 = 1/casadi.sqrt(1 + t1071**2)
     t1073 = t1005 + t1053*t1071
@@ -4006,10 +4006,10 @@ def _velocity_ellipsoid(q):
     t1098 = t1096 - t1071*t1097
     t1099 = t1097 + t1071*t1096
     t1100 = (t1086 != 0)
-    t1101 = 0.5*(-t1040 + t1073)/casadi.if_else(t1100, t1086, 1)
+    t1101 = (-t1040 + t1073)/casadi.if_else(t1100, 2*t1086, 1)
     t1102 = casadi.fabs(t1101)
     t1103 = (t1102 >= 1)
-    t1104 = casadi.fabs(1/casadi.if_else(t1103, t1101, 1))
+    t1104 = 1/casadi.fabs(casadi.if_else(t1103, t1101, 1))
     t1105 = casadi.if_else(t1100, casadi.if_else((t1101 >= 0), 1, -1)*casadi.if_else(t1103, t1104/(1 + casadi.sqrt(1 + t1104**2)), 1/(t1102 + casadi.sqrt(1 + t1102**2))), 0)
     t1106 = 1/casadi.sqrt(1 + t1105**2)
     t1107 = t1044*t1106
@@ -4306,10 +4306,10 @@ def _condition_number(q):
     t181 = t63*t78
     t182 = t72*t100 + t65*t150 + t179*t104 - t180*t110 + t181*t116
     t183 = (t182 != 0)
-    t184 = 0.5*(-t178 + t171)/casadi.if_else(t183, -t182, 1)
+    t184 = (-t178 + t171)/casadi.if_else(t183, -2*t182, 1)
     t185 = casadi.fabs(t184)
     t186 = (t185 >= 1)
-    t187 = casadi.fabs(1/casadi.if_else(t186, t184, 1))
+    t187 = 1/casadi.fabs(casadi.if_else(t186, t184, 1))
     t188 = casadi.if_else(t183, casadi.if_else((t184 >= 0), 1, -1)*casadi.if_else(t186, t187/(1 + casadi.sqrt(1 + t187**2)), 1/(t185 + casadi.sqrt(1 + t185**2))), 0)
     t189 = 1/casadi.sqrt(1 + t188**2)
     t190 = t182*t188
@@ -4337,10 +4337,10 @@ def _condition_number(q):
     t212 = -t210 + t209*t188
     t213 = t122*t199 - t126*t203 + t131*t207 - t156*t211
     t214 = (t213 != 0)
-    t215 = 0.5*(-t191 + t172)/casadi.if_else(t214, t213, 1)
+    t215 = (-t191 + t172)/casadi.if_else(t214, 2*t213, 1)
     t216 = casadi.fabs(t215)
     t217 = (t216 >= 1)
-    t218 = casadi.fabs(1/casadi.if_else(t217, t215, 1))
+    t218 = 1/casadi.fabs(casadi.if_else(t217, t215, 1))
     t219 = casadi.if_else(t214, casadi.if_else((t215 >= 0), 1, -1)*casadi.if_else(t217, t218/(1 + casadi.sqrt(1 + t218**2)), 1/(t216 + casadi.sqrt(1 + t216**2))), 0)
     t220 = 1/casadi.sqrt(1 + t219**2)
     t221 = t213*t219
@@ -4364,10 +4364,10 @@ def _condition_number(q):
     t239 = -t237 + t236*t219
     t240 = t136*t230 + t140*t234 - t161*t238
     t241 = (t240 != 0)
-    t242 = 0.5*(-t222 + t173)/casadi.if_else(t241, -t240, 1)
+    t242 = (-t222 + t173)/casadi.if_else(t241, -2*t240, 1)
     t243 = casadi.fabs(t242)
     t244 = (t243 >= 1)
-    t245 = casadi.fabs(1/casadi.if_else(t244, t242, 1))
+    t245 = 1/casadi.fabs(casadi.if_else(t244, t242, 1))
     t246 = casadi.if_else(t241, casadi.if_else((t242 >= 0), 1, -1)*casadi.if_else(t244, t245/(1 + casadi.sqrt(1 + t245**2)), 1/(t243 + casadi.sqrt(1 + t243**2))), 0)
     t247 = 1/casadi.sqrt(1 + t246**2)
     t248 = t240*t246
@@ -4387,10 +4387,10 @@ def _condition_number(q):
     t262 = t260 + t259*t246
     t263 = -t145*t257 + t166*t261
     t264 = (t263 != 0)
-    t265 = 0.5*(-t249 + t174)/casadi.if_else(t264, t263, 1)
+    t265 = (-t249 + t174)/casadi.if_else(t264, 2*t263, 1)
     t266 = casadi.fabs(t265)
     t267 = (t266 >= 1)
-    t268 = casadi.fabs(1/casadi.if_else(t267, t265, 1))
+    t268 = 1/casadi.fabs(casadi.if_else(t267, t265, 1))
     t269 = casadi.if_else(t264, casadi.if_else((t265 >= 0), 1, -1)*casadi.if_else(t267, t268/(1 + casadi.sqrt(1 + t268**2)), 1/(t266 + casadi.sqrt(1 + t266**2))), 0)
     t270 = 1/casadi.sqrt(1 + t269**2)
     t271 = t263*t269
@@ -4406,10 +4406,10 @@ def _condition_number(q):
     t281 = t279 + t278*t269
     t282 = t170*t280
     t283 = (t282 != 0)
-    t284 = 0.5*(-t272 + t175)/casadi.if_else(t283, -t282, 1)
+    t284 = (-t272 + t175)/casadi.if_else(t283, -2*t282, 1)
     t285 = casadi.fabs(t284)
     t286 = (t285 >= 1)
-    t287 = casadi.fabs(1/casadi.if_else(t286, t284, 1))
+    t287 = 1/casadi.fabs(casadi.if_else(t286, t284, 1))
     t288 = casadi.if_else(t283, casadi.if_else((t284 >= 0), 1, -1)*casadi.if_else(t286, t287/(1 + casadi.sqrt(1 + t287**2)), 1/(t285 + casadi.sqrt(1 + t285**2))), 0)
     t289 = 1/casadi.sqrt(1 + t288**2)
     t290 = t282*t288
@@ -4423,10 +4423,10 @@ def _condition_number(q):
     t298 = t297*t195
     t299 = -t200*t227 - t204*t231 - t208*t235 + t212*t239 + t176*t297*t188*t189**2 + t298*t196
     t300 = (t299 != 0)
-    t301 = 0.5*(-t192 + t223)/casadi.if_else(t300, t299, 1)
+    t301 = (-t192 + t223)/casadi.if_else(t300, 2*t299, 1)
     t302 = casadi.fabs(t301)
     t303 = (t302 >= 1)
-    t304 = casadi.fabs(1/casadi.if_else(t303, t301, 1))
+    t304 = 1/casadi.fabs(casadi.if_else(t303, t301, 1))
     t305 = casadi.if_else(t300, casadi.if_else((t301 >= 0), 1, -1)*casadi.if_else(t303, t304/(1 + casadi.sqrt(1 + t304**2)), 1/(t302 + casadi.sqrt(1 + t302**2))), 0)
     t306 = 1/casadi.sqrt(1 + t305**2)
     t307 = t299*t305
@@ -4465,10 +4465,10 @@ def _condition_number(q):
     t340 = t336*t226
     t341 = -t254*t326 + t258*t330 + t262*t334 - t338*t314 + t339*t318 + t340*t322
     t342 = (t341 != 0)
-    t343 = 0.5*(-t308 + t250)/casadi.if_else(t342, t341, 1)
+    t343 = (-t308 + t250)/casadi.if_else(t342, 2*t341, 1)
     t344 = casadi.fabs(t343)
     t345 = (t344 >= 1)
-    t346 = casadi.fabs(1/casadi.if_else(t345, t343, 1))
+    t346 = 1/casadi.fabs(casadi.if_else(t345, t343, 1))
     t347 = casadi.if_else(t342, casadi.if_else((t343 >= 0), 1, -1)*casadi.if_else(t345, t346/(1 + casadi.sqrt(1 + t346**2)), 1/(t344 + casadi.sqrt(1 + t344**2))), 0)
     t348 = 1/casadi.sqrt(1 + t347**2)
     t349 = t341*t347
@@ -4511,10 +4511,10 @@ def _condition_number(q):
     t386 = t385*t269
     t387 = t277*t370 + t281*t374 - t380*t354 + t382*t358 + t384*t362 - t386*t366
     t388 = (t387 != 0)
-    t389 = 0.5*(-t350 + t273)/casadi.if_else(t388, t387, 1)
+    t389 = (-t350 + t273)/casadi.if_else(t388, 2*t387, 1)
     t390 = casadi.fabs(t389)
     t391 = (t390 >= 1)
-    t392 = casadi.fabs(1/casadi.if_else(t391, t389, 1))
+    t392 = 1/casadi.fabs(casadi.if_else(t391, t389, 1))
     t393 = casadi.if_else(t388, casadi.if_else((t389 >= 0), 1, -1)*casadi.if_else(t391, t392/(1 + casadi.sqrt(1 + t392**2)), 1/(t390 + casadi.sqrt(1 + t390**2))), 0)
     t394 = 1/casadi.sqrt(1 + t393**2)
     t395 = t387*t393
@@ -4556,10 +4556,10 @@ def _condition_number(q):
     t431 = t430*t288
     t432 = t296*t420 - t423*t400 + t425*t404 + t427*t408 - t429*t412 + t431*t416
     t433 = (t432 != 0)
-    t434 = 0.5*(-t396 + t292)/casadi.if_else(t433, t432, 1)
+    t434 = (-t396 + t292)/casadi.if_else(t433, 2*t432, 1)
     t435 = casadi.fabs(t434)
     t436 = (t435 >= 1)
-    t437 = casadi.fabs(1/casadi.if_else(t436, t434, 1))
+    t437 = 1/casadi.fabs(casadi.if_else(t436, t434, 1))
     t438 = casadi.if_else(t433, casadi.if_else((t434 >= 0), 1, -1)*casadi.if_else(t436, t437/(1 + casadi.sqrt(1 + t437**2)), 1/(t435 + casadi.sqrt(1 + t435**2))), 0)
     t439 = 1/casadi.sqrt(1 + t438**2)
     t440 = t432*t438
@@ -4591,10 +4591,10 @@ def _condition_number(q):
     t466 = t464 + t463*t438
     t467 = t295*t465 - t422*t445 + t424*t449 + t426*t453 - t428*t457 + t430*t461
     t468 = (t376 != 0)
-    t469 = 0.5*(-t309 + t351)/casadi.if_else(t468, t376, 1)
+    t469 = (-t309 + t351)/casadi.if_else(t468, 2*t376, 1)
     t470 = casadi.fabs(t469)
     t471 = (t470 >= 1)
-    t472 = casadi.fabs(1/casadi.if_else(t471, t469, 1))
+    t472 = 1/casadi.fabs(casadi.if_else(t471, t469, 1))
     t473 = casadi.if_else(t468, casadi.if_else((t469 >= 0), 1, -1)*casadi.if_else(t471, t472/(1 + casadi.sqrt(1 + t472**2)), 1/(t470 + casadi.sqrt(1 + t470**2))), 0)
     t474 = 1/casadi.sqrt(1 + t473**2)
     t475 = t376*t473
@@ -4626,10 +4626,10 @@ def _condition_number(q):
     t501 = t499 + t498*t473
     t502 = -t401*t480 + t405*t484 + t409*t488 + t413*t492 + t417*t496 + t421*t500
     t503 = (t502 != 0)
-    t504 = 0.5*(-t476 + t397)/casadi.if_else(t503, t502, 1)
+    t504 = (-t476 + t397)/casadi.if_else(t503, 2*t502, 1)
     t505 = casadi.fabs(t504)
     t506 = (t505 >= 1)
-    t507 = casadi.fabs(1/casadi.if_else(t506, t504, 1))
+    t507 = 1/casadi.fabs(casadi.if_else(t506, t504, 1))
     t508 = casadi.if_else(t503, casadi.if_else((t504 >= 0), 1, -1)*casadi.if_else(t506, t507/(1 + casadi.sqrt(1 + t507**2)), 1/(t505 + casadi.sqrt(1 + t505**2))), 0)
     t509 = 1/casadi.sqrt(1 + t508**2)
     t510 = t502*t508
@@ -4662,10 +4662,10 @@ def _condition_number(q):
     t537 = -t446*t515 + t450*t519 + t454*t523 + t458*t527 + t462*t531 + t466*t535
     t538 = t481*t516 + t485*t520 + t489*t524 + t493*t528 + t497*t532 + t501*t536
     t539 = (t537 != 0)
-    t540 = 0.5*(-t511 + t442)/casadi.if_else(t539, t537, 1)
+    t540 = (-t511 + t442)/casadi.if_else(t539, 2*t537, 1)
     t541 = casadi.fabs(t540)
     t542 = (t541 >= 1)
-    t543 = casadi.fabs(1/casadi.if_else(t542, t540, 1))
+    t543 = 1/casadi.fabs(casadi.if_else(t542, t540, 1))
     t544 = casadi.if_else(t539, casadi.if_else((t540 >= 0), 1, -1)*casadi.if_else(t542, t543/(1 + casadi.sqrt(1 + t543**2)), 1/(t541 + casadi.sqrt(1 + t541**2))), 0)
     t545 = 1/casadi.sqrt(1 + t544**2)
     t546 = t537*t544
@@ -4696,10 +4696,10 @@ def _condition_number(q):
     t571 = t569 - t570*t544
     t572 = t570 + t569*t544
     t573 = (t538 != 0)
-    t574 = 0.5*(-t477 + t512)/casadi.if_else(t573, t538, 1)
+    t574 = (-t477 + t512)/casadi.if_else(t573, 2*t538, 1)
     t575 = casadi.fabs(t574)
     t576 = (t575 >= 1)
-    t577 = casadi.fabs(1/casadi.if_else(t576, t574, 1))
+    t577 = 1/casadi.fabs(casadi.if_else(t576, t574, 1))
     t578 = casadi.if_else(t573, casadi.if_else((t574 >= 0), 1, -1)*casadi.if_else(t576, t577/(1 + casadi.sqrt(1 + t577**2)), 1/(t575 + casadi.sqrt(1 + t575**2))), 0)
     t579 = 1/casadi.sqrt(1 + t578**2)
     t580 = t538*t578
@@ -4731,10 +4731,10 @@ def _condition_number(q):
     t606 = t604 + t603*t578
     t607 = t552*t585 + t556*t589 + t560*t593 + t564*t597 + t568*t601 + t572*t605
     t608 = (t607 != 0)
-    t609 = 0.5*(-t581 + t548)/casadi.if_else(t608, t607, 1)
+    t609 = (-t581 + t548)/casadi.if_else(t608, 2*t607, 1)
     t610 = casadi.fabs(t609)
     t611 = (t610 >= 1)
-    t612 = casadi.fabs(1/casadi.if_else(t611, t609, 1))
+    t612 = 1/casadi.fabs(casadi.if_else(t611, t609, 1))
     t613 = casadi.if_else(t608, casadi.if_else((t609 >= 0), 1, -1)*casadi.if_else(t611, t612/(1 + casadi.sqrt(1 + t612**2)), 1/(t610 + casadi.sqrt(1 + t610**2))), 0)
     t614 = 1/casadi.sqrt(1 + t613**2)
     t615 = t607*t613
@@ -4766,10 +4766,10 @@ def _condition_number(q):
     t641 = t639 + t638*t613
     t642 = t586*t621 + t590*t625 + t594*t629 + t598*t633 + t602*t637 + t606*t641
     t643 = (t642 != 0)
-    t644 = 0.5*(-t582 + t617)/casadi.if_else(t643, t642, 1)
+    t644 = (-t582 + t617)/casadi.if_else(t643, 2*t642, 1)
     t645 = casadi.fabs(t644)
     t646 = (t645 >= 1)
-    t647 = casadi.fabs(1/casadi.if_else(t646, t644, 1))
+    t647 = 1/casadi.fabs(casadi.if_else(t646, t644, 1))
     t648 = casadi.if_else(t643, casadi.if_else((t644 >= 0), 1, -1)*casadi.if_else(t646, t647/(1 + casadi.sqrt(1 + t647**2)), 1/(t645 + casadi.sqrt(1 + t645**2))), 0)
     t649 = 1/casadi.sqrt(1 + t648**2)
     t650 = t642*t648
@@ -4800,10 +4800,10 @@ def _condition_number(q):
     t675 = t673 - t674*t648
     t676 = t674 + t673*t648
     t677 = (t467 != 0)
-    t678 = 0.5*(-t291 + t441)/casadi.if_else(t677, t467, 1)
+    t678 = (-t291 + t441)/casadi.if_else(t677, 2*t467, 1)
     t679 = casadi.fabs(t678)
     t680 = (t679 >= 1)
-    t681 = casadi.fabs(1/casadi.if_else(t680, t678, 1))
+    t681 = 1/casadi.fabs(casadi.if_else(t680, t678, 1))
     t682 = casadi.if_else(t677, casadi.if_else((t678 >= 0), 1, -1)*casadi.if_else(t680, t681/(1 + casadi.sqrt(1 + t681**2)), 1/(t679 + casadi.sqrt(1 + t679**2))), 0)
     t683 = 1/casadi.sqrt(1 + t682**2)
     t684 = t467*t682
@@ -4835,10 +4835,10 @@ def _condition_number(q):
     t710 = t708 + t707*t682
     t711 = t551*t689 + t555*t693 + t559*t697 + t563*t701 + t567*t705 + t571*t709
     t712 = (t711 != 0)
-    t713 = 0.5*(-t685 + t547)/casadi.if_else(t712, t711, 1)
+    t713 = (-t685 + t547)/casadi.if_else(t712, 2*t711, 1)
     t714 = casadi.fabs(t713)
     t715 = (t714 >= 1)
-    t716 = casadi.fabs(1/casadi.if_else(t715, t713, 1))
+    t716 = 1/casadi.fabs(casadi.if_else(t715, t713, 1))
     t717 = casadi.if_else(t712, casadi.if_else((t713 >= 0), 1, -1)*casadi.if_else(t715, t716/(1 + casadi.sqrt(1 + t716**2)), 1/(t714 + casadi.sqrt(1 + t714**2))), 0)
     t718 = 1/casadi.sqrt(1 + t717**2)
     t719 = t711*t717
@@ -4871,10 +4871,10 @@ def _condition_number(q):
     t746 = t620*t724 + t624*t728 + t628*t732 + t632*t736 + t636*t740 + t640*t744
     t747 = -t690*t725 + t694*t729 + t698*t733 + t702*t737 + t706*t741 + t710*t745
     t748 = (t746 != 0)
-    t749 = 0.5*(-t720 + t616)/casadi.if_else(t748, t746, 1)
+    t749 = (-t720 + t616)/casadi.if_else(t748, 2*t746, 1)
     t750 = casadi.fabs(t749)
     t751 = (t750 >= 1)
-    t752 = casadi.fabs(1/casadi.if_else(t751, t749, 1))
+    t752 = 1/casadi.fabs(casadi.if_else(t751, t749, 1))
     t753 = casadi.if_else(t748, casadi.if_else((t749 >= 0), 1, -1)*casadi.if_else(t751, t752/(1 + casadi.sqrt(1 + t752**2)), 1/(t750 + casadi.sqrt(1 + t750**2))), 0)
     t754 = 1/casadi.sqrt(1 + t753**2)
     t755 = t746*t753
@@ -4906,10 +4906,10 @@ def _condition_number(q):
     t781 = t779 + t778*t753
     t782 = t655*t760 + t659*t764 + t663*t768 + t667*t772 + t671*t776 + t675*t780
     t783 = (t782 != 0)
-    t784 = 0.5*(-t756 + t651)/casadi.if_else(t783, t782, 1)
+    t784 = (-t756 + t651)/casadi.if_else(t783, 2*t782, 1)
     t785 = casadi.fabs(t784)
     t786 = (t785 >= 1)
-    t787 = casadi.fabs(1/casadi.if_else(t786, t784, 1))
+    t787 = 1/casadi.fabs(casadi.if_else(t786, t784, 1))
     t788 = casadi.if_else(t783, casadi.if_else((t784 >= 0), 1, -1)*casadi.if_else(t786, t787/(1 + casadi.sqrt(1 + t787**2)), 1/(t785 + casadi.sqrt(1 + t785**2))), 0)
     t789 = 1/casadi.sqrt(1 + t788**2)
     t790 = t782*t788
@@ -4941,10 +4941,10 @@ def _condition_number(q):
     t816 = t814 + t813*t788
     t817 = t656*t795 + t660*t799 + t664*t803 + t668*t807 + t672*t811 + t676*t815
     t818 = (t817 != 0)
-    t819 = 0.5*(-t791 + t652)/casadi.if_else(t818, t817, 1)
+    t819 = (-t791 + t652)/casadi.if_else(t818, 2*t817, 1)
     t820 = casadi.fabs(t819)
     t821 = (t820 >= 1)
-    t822 = casadi.fabs(1/casadi.if_else(t821, t819, 1))
+    t822 = 1/casadi.fabs(casadi.if_else(t821, t819, 1))
     t823 = casadi.if_else(t818, casadi.if_else((t819 >= 0), 1, -1)*casadi.if_else(t821, t822/(1 + casadi.sqrt(1 + t822**2)), 1/(t820 + casadi.sqrt(1 + t820**2))), 0)
     t824 = 1/casadi.sqrt(1 + t823**2)
     t825 = t817*t823
@@ -4975,10 +4975,10 @@ def _condition_number(q):
     t850 = t848 - t849*t823
     t851 = t849 + t848*t823
     t852 = (t747 != 0)
-    t853 = 0.5*(-t686 + t721)/casadi.if_else(t852, t747, 1)
+    t853 = (-t686 + t721)/casadi.if_else(t852, 2*t747, 1)
     t854 = casadi.fabs(t853)
     t855 = (t854 >= 1)
-    t856 = casadi.fabs(1/casadi.if_else(t855, t853, 1))
+    t856 = 1/casadi.fabs(casadi.if_else(t855, t853, 1))
     t857 = casadi.if_else(t852, casadi.if_else((t853 >= 0), 1, -1)*casadi.if_else(t855, t856/(1 + casadi.sqrt(1 + t856**2)), 1/(t854 + casadi.sqrt(1 + t854**2))), 0)
     t858 = 1/casadi.sqrt(1 + t857**2)
     t859 = t747*t857
@@ -5010,10 +5010,10 @@ def _condition_number(q):
     t885 = t883 + t882*t857
     t886 = t761*t864 + t765*t868 + t769*t872 + t773*t876 + t777*t880 + t781*t884
     t887 = (t886 != 0)
-    t888 = 0.5*(-t860 + t757)/casadi.if_else(t887, t886, 1)
+    t888 = (-t860 + t757)/casadi.if_else(t887, 2*t886, 1)
     t889 = casadi.fabs(t888)
     t890 = (t889 >= 1)
-    t891 = casadi.fabs(1/casadi.if_else(t890, t888, 1))
+    t891 = 1/casadi.fabs(casadi.if_else(t890, t888, 1))
     t892 = casadi.if_else(t887, casadi.if_else((t888 >= 0), 1, -1)*casadi.if_else(t890, t891/(1 + casadi.sqrt(1 + t891**2)), 1/(t889 + casadi.sqrt(1 + t889**2))), 0)
     t893 = 1/casadi.sqrt(1 + t892**2)
     t894 = t886*t892
@@ -5046,10 +5046,10 @@ def _condition_number(q):
     t921 = t796*t899 + t800*t903 + t804*t907 + t808*t911 + t812*t915 + t816*t919
     t922 = t865*t900 + t869*t904 + t873*t908 + t877*t912 + t881*t916 + t885*t920
     t923 = (t921 != 0)
-    t924 = 0.5*(-t895 + t792)/casadi.if_else(t923, t921, 1)
+    t924 = (-t895 + t792)/casadi.if_else(t923, 2*t921, 1)
     t925 = casadi.fabs(t924)
     t926 = (t925 >= 1)
-    t927 = casadi.fabs(1/casadi.if_else(t926, t924, 1))
+    t927 = 1/casadi.fabs(casadi.if_else(t926, t924, 1))
     t928 = casadi.if_else(t923, casadi.if_else((t924 >= 0), 1, -1)*casadi.if_else(t926, t927/(1 + casadi.sqrt(1 + t927**2)), 1/(t925 + casadi.sqrt(1 + t925**2))), 0)
     t929 = 1/casadi.sqrt(1 + t928**2)
     t930 = t921*t928
@@ -5081,10 +5081,10 @@ def _condition_number(q):
     t956 = t954 + t953*t928
     t957 = t831*t935 + t835*t939 + t839*t943 + t843*t947 + t847*t951 + t851*t955
     t958 = (t957 != 0)
-    t959 = 0.5*(-t931 + t827)/casadi.if_else(t958, t957, 1)
+    t959 = (-t931 + t827)/casadi.if_else(t958, 2*t957, 1)
     t960 = casadi.fabs(t959)
     t961 = (t960 >= 1)
-    t962 = casadi.fabs(1/casadi.if_else(t961, t959, 1))
+    t962 = 1/casadi.fabs(casadi.if_else(t961, t959, 1))
     t963 = casadi.if_else(t958, casadi.if_else((t959 >= 0), 1, -1)*casadi.if_else(t961, t962/(1 + casadi.sqrt(1 + t962**2)), 1/(t960 + casadi.sqrt(1 + t960**2))), 0)
     t964 = 1/casadi.sqrt(1 + t963**2)
     t965 = t957*t963
@@ -5116,10 +5116,10 @@ def _condition_number(q):
     t991 = t989 + t988*t963
     t992 = t830*t970 + t834*t974 + t838*t978 + t842*t982 + t846*t986 + t850*t990
     t993 = (t922 != 0)
-    t994 = 0.5*(-t861 + t896)/casadi.if_else(t993, t922, 1)
+    t994 = (-t861 + t896)/casadi.if_else(t993, 2*t922, 1)
     t995 = casadi.fabs(t994)
     t996 = (t995 >= 1)
-    t997 = casadi.fabs(1/casadi.if_else(t996, t994, 1))
+    t997 = 1/casadi.fabs(casadi.if_else(t996, t994, 1))
     t998 = casadi.if_else(t993, casadi.if_else((t994 >= 0), 1, -1)*casadi.if_else(t996, t997/(1 + casadi.sqrt(1 + t997**2)), 1/(t995 + casadi.sqrt(1 + t995**2))), 0)
     t999 = 1/casadi.sqrt(1 + t998**2)
     t1000 = t922*t998
@@ -5151,10 +5151,10 @@ def _condition_number(q):
     t1026 = t1024 + t1023*t998
     t1027 = t936*t1005 + t940*t1009 + t944*t1013 + t948*t1017 + t952*t1021 + t956*t1025
     t1028 = (t1027 != 0)
-    t1029 = 0.5*(-t1001 + t932)/casadi.if_else(t1028, t1027, 1)
+    t1029 = (-t1001 + t932)/casadi.if_else(t1028, 2*t1027, 1)
     t1030 = casadi.fabs(t1029)
     t1031 = (t1030 >= 1)
-    t1032 = casadi.fabs(1/casadi.if_else(t1031, t1029, 1))
+    t1032 = 1/casadi.fabs(casadi.if_else(t1031, t1029, 1))
     t1033 = casadi.if_else(t1028, casadi.if_else((t1029 >= 0), 1, -1)*casadi.if_else(t1031, t1032/(1 + casadi.sqrt(1 + t1032**2)), 1/(t1030 + casadi.sqrt(1 + t1030**2))), 0)
     t1034 = 1/casadi.sqrt(1 + t1033**2)
     t1035 = t1027*t1033
@@ -5187,10 +5187,10 @@ def _condition_number(q):
     t1062 = t971*t1040 + t975*t1044 + t979*t1048 + t983*t1052 + t987*t1056 + t991*t1060
     t1063 = t1006*t1041 + t1010*t1045 + t1014*t1049 + t1018*t1053 + t1022*t1057 + t1026*t1061
     t1064 = (t1062 != 0)
-    t1065 = 0.5*(-t1036 + t967)/casadi.if_else(t1064, t1062, 1)
+    t1065 = (-t1036 + t967)/casadi.if_else(t1064, 2*t1062, 1)
     t1066 = casadi.fabs(t1065)
     t1067 = (t1066 >= 1)
-    t1068 = casadi.fabs(1/casadi.if_else(t1067, t1065, 1))
+    t1068 = 1/casadi.fabs(casadi.if_else(t1067, t1065, 1))
     t1069 = casadi.if_else(t1064, casadi.if_else((t1065 >= 0), 1, -1)*casadi.if_else(t1067, t1068/(1 + casadi.sqrt(1 + t1068**2)), 1/(t1066 + casadi.sqrt(1 + t1066**2))), 0)
     t1070 = 1/casadi.sqrt(1 + t1069**2)
     t1071 = t1062*t1069
@@ -5221,10 +5221,10 @@ def _condition_number(q):
     t1096 = t1094 - t1095*t1069
     t1097 = t1095 + t1094*t1069
     t1098 = (t1063 != 0)
-    t1099 = 0.5*(-t1002 + t1037)/casadi.if_else(t1098, t1063, 1)
+    t1099 = (-t1002 + t1037)/casadi.if_else(t1098, 2*t1063, 1)
     t1100 = casadi.fabs(t1099)
     t1101 = (t1100 >= 1)
-    t1102 = casadi.fabs(1/casadi.if_else(t1101, t1099, 1))
+    t1102 = 1/casadi.fabs(casadi.if_else(t1101, t1099, 1))
     t1103 = casadi.if_else(t1098, casadi.if_else((t1099 >= 0), 1, -1)*casadi.if_else(t1101, t1102/(1 + casadi.sqrt(1 + t1102**2)), 1/(t1100 + casadi.sqrt(1 + t1100**2))), 0)
     t1104 = 1/casadi.sqrt(1 + t1103**2)
     t1105 = t1063*t1103
@@ -5256,10 +5256,10 @@ def _condition_number(q):
     t1131 = t1129 + t1128*t1103
     t1132 = t1077*t1110 + t1081*t1114 + t1085*t1118 + t1089*t1122 + t1093*t1126 + t1097*t1130
     t1133 = (t1132 != 0)
-    t1134 = 0.5*(-t1106 + t1073)/casadi.if_else(t1133, t1132, 1)
+    t1134 = (-t1106 + t1073)/casadi.if_else(t1133, 2*t1132, 1)
     t1135 = casadi.fabs(t1134)
     t1136 = (t1135 >= 1)
-    t1137 = casadi.fabs(1/casadi.if_else(t1136, t1134, 1))
+    t1137 = 1/casadi.fabs(casadi.if_else(t1136, t1134, 1))
     t1138 = casadi.if_else(t1133, casadi.if_else((t1134 >= 0), 1, -1)*casadi.if_else(t1136, t1137/(1 + casadi.sqrt(1 + t1137**2)), 1/(t1135 + casadi.sqrt(1 + t1135**2))), 0)
     t1139 = 1/casadi.sqrt(1 + t1138**2)
     t1140 = t1132*t1138
@@ -5291,10 +5291,10 @@ def _condition_number(q):
     t1166 = t1164 + t1138*t1163
     t1167 = t1111*t1146 + t1115*t1150 + t1119*t1154 + t1123*t1158 + t1127*t1162 + t1131*t1166
     t1168 = (t1167 != 0)
-    t1169 = 0.5*(-t1107 + t1142)/casadi.if_else(t1168, t1167, 1)
+    t1169 = (-t1107 + t1142)/casadi.if_else(t1168, 2*t1167, 1)
     t1170 = casadi.fabs(t1169)
     t1171 = (t1170 >= 1)
-    t1172 = casadi.fabs(1/casadi.if_else(t1171, t1169, 1))
+    t1172 = 1/casadi.fabs(casadi.if_else(t1171, t1169, 1))
     t1173 = casadi.if_else(t1168, casadi.if_else((t1169 >= 0), 1, -1)*casadi.if_else(t1171, t1172/(1 + casadi.sqrt(1 + t1172**2)), 1/(t1170 + casadi.sqrt(1 + t1170**2))), 0)
     t1174 = 1/casadi.sqrt(1 + t1173**2)
     t1175 = t1167*t1173
@@ -5325,10 +5325,10 @@ def _condition_number(q):
     t1200 = t1198 - t1173*t1199
     t1201 = t1199 + t1173*t1198
     t1202 = (t992 != 0)
-    t1203 = 0.5*(-t826 + t966)/casadi.if_else(t1202, t992, 1)
+    t1203 = (-t826 + t966)/casadi.if_else(t1202, 2*t992, 1)
     t1204 = casadi.fabs(t1203)
     t1205 = (t1204 >= 1)
-    t1206 = casadi.fabs(1/casadi.if_else(t1205, t1203, 1))
+    t1206 = 1/casadi.fabs(casadi.if_else(t1205, t1203, 1))
     t1207 = casadi.if_else(t1202, casadi.if_else((t1203 >= 0), 1, -1)*casadi.if_else(t1205, t1206/(1 + casadi.sqrt(1 + t1206**2)), 1/(t1204 + casadi.sqrt(1 + t1204**2))), 0)
     t1208 = 1/casadi.sqrt(1 + t1207**2)
     t1209 = t992*t1207
@@ -5360,10 +5360,10 @@ def _condition_number(q):
     t1235 = t1233 + t1207*t1232
     t1236 = t1076*t1214 + t1080*t1218 + t1084*t1222 + t1088*t1226 + t1092*t1230 + t1096*t1234
     t1237 = (t1236 != 0)
-    t1238 = 0.5*(-t1210 + t1072)/casadi.if_else(t1237, t1236, 1)
+    t1238 = (-t1210 + t1072)/casadi.if_else(t1237, 2*t1236, 1)
     t1239 = casadi.fabs(t1238)
     t1240 = (t1239 >= 1)
-    t1241 = casadi.fabs(1/casadi.if_else(t1240, t1238, 1))
+    t1241 = 1/casadi.fabs(casadi.if_else(t1240, t1238, 1))
     t1242 = casadi.if_else(t1237, casadi.if_else((t1238 >= 0), 1, -1)*casadi.if_else(t1240, t1241/(1 + casadi.sqrt(1 + t1241**2)), 1/(t1239 + casadi.sqrt(1 + t1239**2))), 0)
     t1243 = 1/casadi.sqrt(1 + t1242**2)
     t1244 = t1236*t1242
@@ -5396,10 +5396,10 @@ def _condition_number(q):
     t1271 = t1145*t1249 + t1149*t1253 + t1153*t1257 + t1157*t1261 + t1161*t1265 + t1165*t1269
     t1272 = t1215*t1250 + t1219*t1254 + t1223*t1258 + t1227*t1262 + t1231*t1266 + t1235*t1270
     t1273 = (t1271 != 0)
-    t1274 = 0.5*(-t1245 + t1141)/casadi.if_else(t1273, t1271, 1)
+    t1274 = (-t1245 + t1141)/casadi.if_else(t1273, 2*t1271, 1)
     t1275 = casadi.fabs(t1274)
     t1276 = (t1275 >= 1)
-    t1277 = casadi.fabs(1/casadi.if_else(t1276, t1274, 1))
+    t1277 = 1/casadi.fabs(casadi.if_else(t1276, t1274, 1))
     t1278 = casadi.if_else(t1273, casadi.if_else((t1274 >= 0), 1, -1)*casadi.if_else(t1276, t1277/(1 + casadi.sqrt(1 + t1277**2)), 1/(t1275 + casadi.sqrt(1 + t1275**2))), 0)
     t1279 = 1/casadi.sqrt(1 + t1278**2)
     t1280 = t1271*t1278
@@ -5431,10 +5431,10 @@ def _condition_number(q):
     t1306 = t1304 + t1278*t1303
     t1307 = t1180*t1285 + t1184*t1289 + t1188*t1293 + t1192*t1297 + t1196*t1301 + t1200*t1305
     t1308 = (t1307 != 0)
-    t1309 = 0.5*(-t1281 + t1176)/casadi.if_else(t1308, t1307, 1)
+    t1309 = (-t1281 + t1176)/casadi.if_else(t1308, 2*t1307, 1)
     t1310 = casadi.fabs(t1309)
     t1311 = (t1310 >= 1)
-    t1312 = casadi.fabs(1/casadi.if_else(t1311, t1309, 1))
+    t1312 = 1/casadi.fabs(casadi.if_else(t1311, t1309, 1))
     t1313 = casadi.if_else(t1308, casadi.if_else((t1309 >= 0), 1, -1)*casadi.if_else(t1311, t1312/(1 + casadi.sqrt(1 + t1312**2)), 1/(t1310 + casadi.sqrt(1 + t1310**2))), 0)
     t1314 = 1/casadi.sqrt(1 + t1313**2)
     t1315 = t1307*t1313
@@ -5466,10 +5466,10 @@ def _condition_number(q):
     t1341 = t1339 + t1313*t1338
     t1342 = t1181*t1320 + t1185*t1324 + t1189*t1328 + t1193*t1332 + t1197*t1336 + t1201*t1340
     t1343 = (t1342 != 0)
-    t1344 = 0.5*(-t1316 + t1177)/casadi.if_else(t1343, t1342, 1)
+    t1344 = (-t1316 + t1177)/casadi.if_else(t1343, 2*t1342, 1)
     t1345 = casadi.fabs(t1344)
     t1346 = (t1345 >= 1)
-    t1347 = casadi.fabs(1/casadi.if_else(t1346, t1344, 1))
+    t1347 = 1/casadi.fabs(casadi.if_else(t1346, t1344, 1))
     t1348 = casadi.if_else(t1343, casadi.if_else((t1344 >= 0), 1, -1)*casadi.if_else(t1346, t1347/(1 + casadi.sqrt(1 + t1347**2)), 1/(t1345 + casadi.sqrt(1 + t1345**2))), 0)
     t1349 = 1/casadi.sqrt(1 + t1348**2)
     t1350 = t1342*t1348
@@ -5500,10 +5500,10 @@ def _condition_number(q):
     t1375 = t1373 - t1348*t1374
     t1376 = t1374 + t1348*t1373
     t1377 = (t1272 != 0)
-    t1378 = 0.5*(-t1211 + t1246)/casadi.if_else(t1377, t1272, 1)
+    t1378 = (-t1211 + t1246)/casadi.if_else(t1377, 2*t1272, 1)
     t1379 = casadi.fabs(t1378)
     t1380 = (t1379 >= 1)
-    t1381 = casadi.fabs(1/casadi.if_else(t1380, t1378, 1))
+    t1381 = 1/casadi.fabs(casadi.if_else(t1380, t1378, 1))
     t1382 = casadi.if_else(t1377, casadi.if_else((t1378 >= 0), 1, -1)*casadi.if_else(t1380, t1381/(1 + casadi.sqrt(1 + t1381**2)), 1/(t1379 + casadi.sqrt(1 + t1379**2))), 0)
     t1383 = 1/casadi.sqrt(1 + t1382**2)
     t1384 = t1272*t1382
@@ -5535,10 +5535,10 @@ def _condition_number(q):
     t1410 = t1408 + t1382*t1407
     t1411 = t1286*t1389 + t1290*t1393 + t1294*t1397 + t1298*t1401 + t1302*t1405 + t1306*t1409
     t1412 = (t1411 != 0)
-    t1413 = 0.5*(-t1385 + t1282)/casadi.if_else(t1412, t1411, 1)
+    t1413 = (-t1385 + t1282)/casadi.if_else(t1412, 2*t1411, 1)
     t1414 = casadi.fabs(t1413)
     t1415 = (t1414 >= 1)
-    t1416 = casadi.fabs(1/casadi.if_else(t1415, t1413, 1))
+    t1416 = 1/casadi.fabs(casadi.if_else(t1415, t1413, 1))
     t1417 = casadi.if_else(t1412, casadi.if_else((t1413 >= 0), 1, -1)*casadi.if_else(t1415, t1416/(1 + casadi.sqrt(1 + t1416**2)), 1/(t1414 + casadi.sqrt(1 + t1414**2))), 0)
     t1418 = 1/casadi.sqrt(1 + t1417**2)
     t1419 = t1411*t1417
@@ -5571,10 +5571,10 @@ def _condition_number(q):
     t1446 = t1321*t1424 + t1325*t1428 + t1329*t1432 + t1333*t1436 + t1337*t1440 + t1341*t1444
     t1447 = t1390*t1425 + t1394*t1429 + t1398*t1433 + t1402*t1437 + t1406*t1441 + t1410*t1445
     t1448 = (t1446 != 0)
-    t1449 = 0.5*(-t1420 + t1317)/casadi.if_else(t1448, t1446, 1)
+    t1449 = (-t1420 + t1317)/casadi.if_else(t1448, 2*t1446, 1)
     t1450 = casadi.fabs(t1449)
     t1451 = (t1450 >= 1)
-    t1452 = casadi.fabs(1/casadi.if_else(t1451, t1449, 1))
+    t1452 = 1/casadi.fabs(casadi.if_else(t1451, t1449, 1))
     t1453 = casadi.if_else(t1448, casadi.if_else((t1449 >= 0), 1, -1)*casadi.if_else(t1451, t1452/(1 + casadi.sqrt(1 + t1452**2)), 1/(t1450 + casadi.sqrt(1 + t1450**2))), 0)
     t1454 = 1/casadi.sqrt(1 + t1453**2)
     t1455 = t1446*t1453
@@ -5606,10 +5606,10 @@ def _condition_number(q):
     t1481 = t1479 + t1453*t1478
     t1482 = t1356*t1460 + t1360*t1464 + t1364*t1468 + t1368*t1472 + t1372*t1476 + t1376*t1480
     t1483 = (t1482 != 0)
-    t1484 = 0.5*(-t1456 + t1352)/casadi.if_else(t1483, t1482, 1)
+    t1484 = (-t1456 + t1352)/casadi.if_else(t1483, 2*t1482, 1)
     t1485 = casadi.fabs(t1484)
     t1486 = (t1485 >= 1)
-    t1487 = casadi.fabs(1/casadi.if_else(t1486, t1484, 1))
+    t1487 = 1/casadi.fabs(casadi.if_else(t1486, t1484, 1))
     t1488 = casadi.if_else(t1483, casadi.if_else((t1484 >= 0), 1, -1)*casadi.if_else(t1486, t1487/(1 + casadi.sqrt(1 + t1487**2)), 1/(t1485 + casadi.sqrt(1 + t1485**2))), 0)
     t1489 = 1/casadi.sqrt(1 + t1488**2)
     t1490 = t1482*t1488
@@ -5641,10 +5641,10 @@ def _condition_number(q):
     t1516 = t1514 + t1488*t1513
     t1517 = t1355*t1495 + t1359*t1499 + t1363*t1503 + t1367*t1507 + t1371*t1511 + t1375*t1515
     t1518 = (t1447 != 0)
-    t1519 = 0.5*(-t1386 + t1421)/casadi.if_else(t1518, t1447, 1)
+    t1519 = (-t1386 + t1421)/casadi.if_else(t1518, 2*t1447, 1)
     t1520 = casadi.fabs(t1519)
     t1521 = (t1520 >= 1)
-    t1522 = casadi.fabs(1/casadi.if_else(t1521, t1519, 1))
+    t1522 = 1/casadi.fabs(casadi.if_else(t1521, t1519, 1))
     t1523 = casadi.if_else(t1518, casadi.if_else((t1519 >= 0), 1, -1)*casadi.if_else(t1521, t1522/(1 + casadi.sqrt(1 + t1522**2)), 1/(t1520 + casadi.sqrt(1 + t1520**2))), 0)
     t1524 = 1/casadi.sqrt(1 + t1523**2)
     t1525 = t1447*t1523
@@ -5676,10 +5676,10 @@ def _condition_number(q):
     t1551 = t1549 + t1523*t1548
     t1552 = t1461*t1530 + t1465*t1534 + t1469*t1538 + t1473*t1542 + t1477*t1546 + t1481*t1550
     t1553 = (t1552 != 0)
-    t1554 = 0.5*(-t1526 + t1457)/casadi.if_else(t1553, t1552, 1)
+    t1554 = (-t1526 + t1457)/casadi.if_else(t1553, 2*t1552, 1)
     t1555 = casadi.fabs(t1554)
     t1556 = (t1555 >= 1)
-    t1557 = casadi.fabs(1/casadi.if_else(t1556, t1554, 1))
+    t1557 = 1/casadi.fabs(casadi.if_else(t1556, t1554, 1))
     t1558 = casadi.if_else(t1553, casadi.if_else((t1554 >= 0), 1, -1)*casadi.if_else(t1556, t1557/(1 + casadi.sqrt(1 + t1557**2)), 1/(t1555 + casadi.sqrt(1 + t1555**2))), 0)
     t1559 = 1/casadi.sqrt(1 + t1558**2)
     t1560 = t1552*t1558
@@ -5712,10 +5712,10 @@ def _condition_number(q):
     t1587 = t1496*t1565 + t1500*t1569 + t1504*t1573 + t1508*t1577 + t1512*t1581 + t1516*t1585
     t1588 = t1531*t1566 + t1535*t1570 + t1539*t1574 + t1543*t1578 + t1547*t1582 + t1551*t1586
     t1589 = (t1587 != 0)
-    t1590 = 0.5*(-t1561 + t1492)/casadi.if_else(t1589, t1587, 1)
+    t1590 = (-t1561 + t1492)/casadi.if_else(t1589, 2*t1587, 1)
     t1591 = casadi.fabs(t1590)
     t1592 = (t1591 >= 1)
-    t1593 = casadi.fabs(1/casadi.if_else(t1592, t1590, 1))
+    t1593 = 1/casadi.fabs(casadi.if_else(t1592, t1590, 1))
     t1594 = casadi.if_else(t1589, casadi.if_else((t1590 >= 0), 1, -1)*casadi.if_else(t1592, t1593/(1 + casadi.sqrt(1 + t1593**2)), 1/(t1591 + casadi.sqrt(1 + t1591**2))), 0)
     t1595 = 1/casadi.sqrt(1 + t1594**2)
     t1596 = t1587*t1594
@@ -5746,10 +5746,10 @@ def _condition_number(q):
     t1621 = t1619 - t1594*t1620
     t1622 = t1620 + t1594*t1619
     t1623 = (t1588 != 0)
-    t1624 = 0.5*(-t1527 + t1562)/casadi.if_else(t1623, t1588, 1)
+    t1624 = (-t1527 + t1562)/casadi.if_else(t1623, 2*t1588, 1)
     t1625 = casadi.fabs(t1624)
     t1626 = (t1625 >= 1)
-    t1627 = casadi.fabs(1/casadi.if_else(t1626, t1624, 1))
+    t1627 = 1/casadi.fabs(casadi.if_else(t1626, t1624, 1))
     t1628 = casadi.if_else(t1623, casadi.if_else((t1624 >= 0), 1, -1)*casadi.if_else(t1626, t1627/(1 + casadi.sqrt(1 + t1627**2)), 1/(t1625 + casadi.sqrt(1 + t1625**2))), 0)
     t1629 = 1/casadi.sqrt(1 + t1628**2)
     t1630 = t1588*t1628
@@ -5781,10 +5781,10 @@ def _condition_number(q):
     t1656 = t1654 + t1628*t1653
     t1657 = t1602*t1635 + t1606*t1639 + t1610*t1643 + t1614*t1647 + t1618*t1651 + t1622*t1655
     t1658 = (t1657 != 0)
-    t1659 = 0.5*(-t1631 + t1598)/casadi.if_else(t1658, t1657, 1)
+    t1659 = (-t1631 + t1598)/casadi.if_else(t1658, 2*t1657, 1)
     t1660 = casadi.fabs(t1659)
     t1661 = (t1660 >= 1)
-    t1662 = casadi.fabs(1/casadi.if_else(t1661, t1659, 1))
+    t1662 = 1/casadi.fabs(casadi.if_else(t1661, t1659, 1))
     t1663 = casadi.if_else(t1658, casadi.if_else((t1659 >= 0), 1, -1)*casadi.if_else(t1661, t1662/(1 + casadi.sqrt(1 + t1662**2)), 1/(t1660 + casadi.sqrt(1 + t1660**2))), 0)
     t1664 = 1/casadi.sqrt(1 + t1663**2)
     t1665 = t1657*t1663
@@ -5816,10 +5816,10 @@ def _condition_number(q):
     t1691 = t1689 + t1663*t1688
     t1692 = t1636*t1671 + t1640*t1675 + t1644*t1679 + t1648*t1683 + t1652*t1687 + t1656*t1691
     t1693 = (t1692 != 0)
-    t1694 = 0.5*(-t1632 + t1667)/casadi.if_else(t1693, t1692, 1)
+    t1694 = (-t1632 + t1667)/casadi.if_else(t1693, 2*t1692, 1)
     t1695 = casadi.fabs(t1694)
     t1696 = (t1695 >= 1)
-    t1697 = casadi.fabs(1/casadi.if_else(t1696, t1694, 1))
+    t1697 = 1/casadi.fabs(casadi.if_else(t1696, t1694, 1))
     t1698 = casadi.if_else(t1693, casadi.if_else((t1694 >= 0), 1, -1)*casadi.if_else(t1696, t1697/(1 + casadi.sqrt(1 + t1697**2)), 1/(t1695 + casadi.sqrt(1 + t1695**2))), 0)
     t1699 = 1/casadi.sqrt(1 + t1698**2)
     t1700 = t1692*t1698
@@ -5850,10 +5850,10 @@ def _condition_number(q):
     t1725 = t1723 - t1698*t1724
     t1726 = t1724 + t1698*t1723
     t1727 = (t1517 != 0)
-    t1728 = 0.5*(-t1351 + t1491)/casadi.if_else(t1727, t1517, 1)
+    t1728 = (-t1351 + t1491)/casadi.if_else(t1727, 2*t1517, 1)
     t1729 = casadi.fabs(t1728)
     t1730 = (t1729 >= 1)
-    t1731 = casadi.fabs(1/casadi.if_else(t1730, t1728, 1))
+    t1731 = 1/casadi.fabs(casadi.if_else(t1730, t1728, 1))
     t1732 = casadi.if_else(t1727, casadi.if_else((t1728 >= 0), 1, -1)*casadi.if_else(t1730, t1731/(1 + casadi.sqrt(1 + t1731**2)), 1/(t1729 + casadi.sqrt(1 + t1729**2))), 0)
     t1733 = 1/casadi.sqrt(1 + t1732**2)
     t1734 = t1517*t1732
@@ -5885,10 +5885,10 @@ def _condition_number(q):
     t1760 = t1758 + t1732*t1757
     t1761 = t1601*t1739 + t1605*t1743 + t1609*t1747 + t1613*t1751 + t1617*t1755 + t1621*t1759
     t1762 = (t1761 != 0)
-    t1763 = 0.5*(-t1735 + t1597)/casadi.if_else(t1762, t1761, 1)
+    t1763 = (-t1735 + t1597)/casadi.if_else(t1762, 2*t1761, 1)
     t1764 = casadi.fabs(t1763)
     t1765 = (t1764 >= 1)
-    t1766 = casadi.fabs(1/casadi.if_else(t1765, t1763, 1))
+    t1766 = 1/casadi.fabs(casadi.if_else(t1765, t1763, 1))
     t1767 = casadi.if_else(t1762, casadi.if_else((t1763 >= 0), 1, -1)*casadi.if_else(t1765, t1766/(1 + casadi.sqrt(1 + t1766**2)), 1/(t1764 + casadi.sqrt(1 + t1764**2))), 0)
     t1768 = 1/casadi.sqrt(1 + t1767**2)
     t1769 = t1761*t1767
@@ -5921,10 +5921,10 @@ def _condition_number(q):
     t1796 = t1670*t1774 + t1674*t1778 + t1678*t1782 + t1682*t1786 + t1686*t1790 + t1690*t1794
     t1797 = t1740*t1775 + t1744*t1779 + t1748*t1783 + t1752*t1787 + t1756*t1791 + t1760*t1795
     t1798 = (t1796 != 0)
-    t1799 = 0.5*(-t1770 + t1666)/casadi.if_else(t1798, t1796, 1)
+    t1799 = (-t1770 + t1666)/casadi.if_else(t1798, 2*t1796, 1)
     t1800 = casadi.fabs(t1799)
     t1801 = (t1800 >= 1)
-    t1802 = casadi.fabs(1/casadi.if_else(t1801, t1799, 1))
+    t1802 = 1/casadi.fabs(casadi.if_else(t1801, t1799, 1))
     t1803 = casadi.if_else(t1798, casadi.if_else((t1799 >= 0), 1, -1)*casadi.if_else(t1801, t1802/(1 + casadi.sqrt(1 + t1802**2)), 1/(t1800 + casadi.sqrt(1 + t1800**2))), 0)
     t1804 = 1/casadi.sqrt(1 + t1803**2)
     t1805 = t1796*t1803
@@ -5956,10 +5956,10 @@ def _condition_number(q):
     t1831 = t1829 + t1803*t1828
     t1832 = t1705*t1810 + t1709*t1814 + t1713*t1818 + t1717*t1822 + t1721*t1826 + t1725*t1830
     t1833 = (t1832 != 0)
-    t1834 = 0.5*(-t1806 + t1701)/casadi.if_else(t1833, t1832, 1)
+    t1834 = (-t1806 + t1701)/casadi.if_else(t1833, 2*t1832, 1)
     t1835 = casadi.fabs(t1834)
     t1836 = (t1835 >= 1)
-    t1837 = casadi.fabs(1/casadi.if_else(t1836, t1834, 1))
+    t1837 = 1/casadi.fabs(casadi.if_else(t1836, t1834, 1))
     t1838 = casadi.if_else(t1833, casadi.if_else((t1834 >= 0), 1, -1)*casadi.if_else(t1836, t1837/(1 + casadi.sqrt(1 + t1837**2)), 1/(t1835 + casadi.sqrt(1 + t1835**2))), 0)
     t1839 = 1/casadi.sqrt(1 + t1838**2)
     t1840 = t1832*t1838
@@ -5991,10 +5991,10 @@ def _condition_number(q):
     t1866 = t1864 + t1838*t1863
     t1867 = t1706*t1845 + t1710*t1849 + t1714*t1853 + t1718*t1857 + t1722*t1861 + t1726*t1865
     t1868 = (t1867 != 0)
-    t1869 = 0.5*(-t1841 + t1702)/casadi.if_else(t1868, t1867, 1)
+    t1869 = (-t1841 + t1702)/casadi.if_else(t1868, 2*t1867, 1)
     t1870 = casadi.fabs(t1869)
     t1871 = (t1870 >= 1)
-    t1872 = casadi.fabs(1/casadi.if_else(t1871, t1869, 1))
+    t1872 = 1/casadi.fabs(casadi.if_else(t1871, t1869, 1))
     t1873 = casadi.if_else(t1868, casadi.if_else((t1869 >= 0), 1, -1)*casadi.if_else(t1871, t1872/(1 + casadi.sqrt(1 + t1872**2)), 1/(t1870 + casadi.sqrt(1 + t1870**2))), 0)
     t1874 = 1/casadi.sqrt(1 + t1873**2)
     t1875 = t1867*t1873
@@ -6025,10 +6025,10 @@ def _condition_number(q):
     t1900 = t1898 - t1873*t1899
     t1901 = t1899 + t1873*t1898
     t1902 = (t1797 != 0)
-    t1903 = 0.5*(-t1736 + t1771)/casadi.if_else(t1902, t1797, 1)
+    t1903 = (-t1736 + t1771)/casadi.if_else(t1902, 2*t1797, 1)
     t1904 = casadi.fabs(t1903)
     t1905 = (t1904 >= 1)
-    t1906 = casadi.fabs(1/casadi.if_else(t1905, t1903, 1))
+    t1906 = 1/casadi.fabs(casadi.if_else(t1905, t1903, 1))
     t1907 = casadi.if_else(t1902, casadi.if_else((t1903 >= 0), 1, -1)*casadi.if_else(t1905, t1906/(1 + casadi.sqrt(1 + t1906**2)), 1/(t1904 + casadi.sqrt(1 + t1904**2))), 0)
     t1908 = 1/casadi.sqrt(1 + t1907**2)
     t1909 = t1797*t1907
@@ -6060,10 +6060,10 @@ def _condition_number(q):
     t1935 = t1933 + t1907*t1932
     t1936 = t1811*t1914 + t1815*t1918 + t1819*t1922 + t1823*t1926 + t1827*t1930 + t1831*t1934
     t1937 = (t1936 != 0)
-    t1938 = 0.5*(-t1910 + t1807)/casadi.if_else(t1937, t1936, 1)
+    t1938 = (-t1910 + t1807)/casadi.if_else(t1937, 2*t1936, 1)
     t1939 = casadi.fabs(t1938)
     t1940 = (t1939 >= 1)
-    t1941 = casadi.fabs(1/casadi.if_else(t1940, t1938, 1))
+    t1941 = 1/casadi.fabs(casadi.if_else(t1940, t1938, 1))
     t1942 = casadi.if_else(t1937, casadi.if_else((t1938 >= 0), 1, -1)*casadi.if_else(t1940, t1941/(1 + casadi.sqrt(1 + t1941**2)), 1/(t1939 + casadi.sqrt(1 + t1939**2))), 0)
     t1943 = 1/casadi.sqrt(1 + t1942**2)
     t1944 = t1936*t1942
@@ -6096,10 +6096,10 @@ def _condition_number(q):
     t1971 = t1846*t1949 + t1850*t1953 + t1854*t1957 + t1858*t1961 + t1862*t1965 + t1866*t1969
     t1972 = t1915*t1950 + t1919*t1954 + t1923*t1958 + t1927*t1962 + t1931*t1966 + t1935*t1970
     t1973 = (t1971 != 0)
-    t1974 = 0.5*(-t1945 + t1842)/casadi.if_else(t1973, t1971, 1)
+    t1974 = (-t1945 + t1842)/casadi.if_else(t1973, 2*t1971, 1)
     t1975 = casadi.fabs(t1974)
     t1976 = (t1975 >= 1)
-    t1977 = casadi.fabs(1/casadi.if_else(t1976, t1974, 1))
+    t1977 = 1/casadi.fabs(casadi.if_else(t1976, t1974, 1))
     t1978 = casadi.if_else(t1973, casadi.if_else((t1974 >= 0), 1, -1)*casadi.if_else(t1976, t1977/(1 + casadi.sqrt(1 + t1977**2)), 1/(t1975 + casadi.sqrt(1 + t1975**2))), 0)
     t1979 = 1/casadi.sqrt(1 + t1978**2)
     t1980 = t1971*t1978
@@ -6131,10 +6131,10 @@ def _condition_number(q):
     t2006 = t2004 + t1978*t2003
     t2007 = t1881*t1985 + t1885*t1989 + t1889*t1993 + t1893*t1997 + t1897*t2001 + t1901*t2005
     t2008 = (t2007 != 0)
-    t2009 = 0.5*(-t1981 + t1877)/casadi.if_else(t2008, t2007, 1)
+    t2009 = (-t1981 + t1877)/casadi.if_else(t2008, 2*t2007, 1)
     t2010 = casadi.fabs(t2009)
     t2011 = (t2010 >= 1)
-    t2012 = casadi.fabs(1/casadi.if_else(t2011, t2009, 1))
+    t2012 = 1/casadi.fabs(casadi.if_else(t2011, t2009, 1))
     t2013 = casadi.if_else(t2008, casadi.if_else((t2009 >= 0), 1, -1)*casadi.if_else(t2011, t2012/(1 + casadi.sqrt(1 + t2012**2)), 1/(t2010 + casadi.sqrt(1 + t2010**2))), 0)
     t2014 = 1/casadi.sqrt(1 + t2013**2)
     t2015 = t2007*t2013
@@ -6166,10 +6166,10 @@ def _condition_number(q):
     t2041 = t2039 + t2013*t2038
     t2042 = t1880*t2020 + t1884*t2024 + t1888*t2028 + t1892*t2032 + t1896*t2036 + t1900*t2040
     t2043 = (t1972 != 0)
-    t2044 = 0.5*(-t1911 + t1946)/casadi.if_else(t2043, t1972, 1)
+    t2044 = (-t1911 + t1946)/casadi.if_else(t2043, 2*t1972, 1)
     t2045 = casadi.fabs(t2044)
     t2046 = (t2045 >= 1)
-    t2047 = casadi.fabs(1/casadi.if_else(t2046, t2044, 1))
+    t2047 = 1/casadi.fabs(casadi.if_else(t2046, t2044, 1))
     t2048 = casadi.if_else(t2043, casadi.if_else((t2044 >= 0), 1, -1)*casadi.if_else(t2046, t2047/(1 + casadi.sqrt(1 + t2047**2)), 1/(t2045 + casadi.sqrt(1 + t2045**2))), 0)
     t2049 = 1/casadi.sqrt(1 + t2048**2)
     t2050 = t1972*t2048
@@ -6201,10 +6201,10 @@ def _condition_number(q):
     t2076 = t2074 + t2048*t2073
     t2077 = t1986*t2055 + t1990*t2059 + t1994*t2063 + t1998*t2067 + t2002*t2071 + t2006*t2075
     t2078 = (t2077 != 0)
-    t2079 = 0.5*(-t2051 + t1982)/casadi.if_else(t2078, t2077, 1)
+    t2079 = (-t2051 + t1982)/casadi.if_else(t2078, 2*t2077, 1)
     t2080 = casadi.fabs(t2079)
     t2081 = (t2080 >= 1)
-    t2082 = casadi.fabs(1/casadi.if_else(t2081, t2079, 1))
+    t2082 = 1/casadi.fabs(casadi.if_else(t2081, t2079, 1))
     t2083 = casadi.if_else(t2078, casadi.if_else((t2079 >= 0), 1, -1)*casadi.if_else(t2081, t2082/(1 + casadi.sqrt(1 + t2082**2)), 1/(t2080 + casadi.sqrt(1 + t2080**2))), 0)
     t2084 = 1/casadi.sqrt(1 + t2083**2)
     t2085 = t2077*t2083
@@ -6237,10 +6237,10 @@ def _condition_number(q):
     t2112 = t2021*t2090 + t2025*t2094 + t2029*t2098 + t2033*t2102 + t2037*t2106 + t2041*t2110
     t2113 = t2056*t2091 + t2060*t2095 + t2064*t2099 + t2068*t2103 + t2072*t2107 + t2076*t2111
     t2114 = (t2112 != 0)
-    t2115 = 0.5*(-t2086 + t2017)/casadi.if_else(t2114, t2112, 1)
+    t2115 = (-t2086 + t2017)/casadi.if_else(t2114, 2*t2112, 1)
     t2116 = casadi.fabs(t2115)
     t2117 = (t2116 >= 1)
-    t2118 = casadi.fabs(1/casadi.if_else(t2117, t2115, 1))
+    t2118 = 1/casadi.fabs(casadi.if_else(t2117, t2115, 1))
     t2119 = casadi.if_else(t2114, casadi.if_else((t2115 >= 0), 1, -1)*casadi.if_else(t2117, t2118/(1 + casadi.sqrt(1 + t2118**2)), 1/(t2116 + casadi.sqrt(1 + t2116**2))), 0)
     t2120 = 1/casadi.sqrt(1 + t2119**2)
     t2121 = t2112*t2119
@@ -6271,10 +6271,10 @@ def _condition_number(q):
     t2146 = t2144 - t2119*t2145
     t2147 = t2145 + t2119*t2144
     t2148 = (t2113 != 0)
-    t2149 = 0.5*(-t2052 + t2087)/casadi.if_else(t2148, t2113, 1)
+    t2149 = (-t2052 + t2087)/casadi.if_else(t2148, 2*t2113, 1)
     t2150 = casadi.fabs(t2149)
     t2151 = (t2150 >= 1)
-    t2152 = casadi.fabs(1/casadi.if_else(t2151, t2149, 1))
+    t2152 = 1/casadi.fabs(casadi.if_else(t2151, t2149, 1))
     t2153 = casadi.if_else(t2148, casadi.if_else((t2149 >= 0), 1, -1)*casadi.if_else(t2151, t2152/(1 + casadi.sqrt(1 + t2152**2)), 1/(t2150 + casadi.sqrt(1 + t2150**2))), 0)
     t2154 = 1/casadi.sqrt(1 + t2153**2)
     t2155 = t2113*t2153
@@ -6306,10 +6306,10 @@ def _condition_number(q):
     t2181 = t2179 + t2153*t2178
     t2182 = t2127*t2160 + t2131*t2164 + t2135*t2168 + t2139*t2172 + t2143*t2176 + t2147*t2180
     t2183 = (t2182 != 0)
-    t2184 = 0.5*(-t2156 + t2123)/casadi.if_else(t2183, t2182, 1)
+    t2184 = (-t2156 + t2123)/casadi.if_else(t2183, 2*t2182, 1)
     t2185 = casadi.fabs(t2184)
     t2186 = (t2185 >= 1)
-    t2187 = casadi.fabs(1/casadi.if_else(t2186, t2184, 1))
+    t2187 = 1/casadi.fabs(casadi.if_else(t2186, t2184, 1))
     t2188 = casadi.if_else(t2183, casadi.if_else((t2184 >= 0), 1, -1)*casadi.if_else(t2186, t2187/(1 + casadi.sqrt(1 + t2187**2)), 1/(t2185 + casadi.sqrt(1 + t2185**2))), 0)
     t2189 = 1/casadi.sqrt(1 + t2188**2)
     t2190 = t2182*t2188
@@ -6341,10 +6341,10 @@ def _condition_number(q):
     t2216 = t2214 + t2188*t2213
     t2217 = t2161*t2196 + t2165*t2200 + t2169*t2204 + t2173*t2208 + t2177*t2212 + t2181*t2216
     t2218 = (t2217 != 0)
-    t2219 = 0.5*(-t2157 + t2192)/casadi.if_else(t2218, t2217, 1)
+    t2219 = (-t2157 + t2192)/casadi.if_else(t2218, 2*t2217, 1)
     t2220 = casadi.fabs(t2219)
     t2221 = (t2220 >= 1)
-    t2222 = casadi.fabs(1/casadi.if_else(t2221, t2219, 1))
+    t2222 = 1/casadi.fabs(casadi.if_else(t2221, t2219, 1))
     t2223 = casadi.if_else(t2218, casadi.if_else((t2219 >= 0), 1, -1)*casadi.if_else(t2221, t2222/(1 + casadi.sqrt(1 + t2222**2)), 1/(t2220 + casadi.sqrt(1 + t2220**2))), 0)
     t2224 = 1/casadi.sqrt(1 + t2223**2)
     t2225 = t2217*t2223
@@ -6375,10 +6375,10 @@ def _condition_number(q):
     t2250 = t2248 - t2223*t2249
     t2251 = t2249 + t2223*t2248
     t2252 = (t2042 != 0)
-    t2253 = 0.5*(-t1876 + t2016)/casadi.if_else(t2252, t2042, 1)
+    t2253 = (-t1876 + t2016)/casadi.if_else(t2252, 2*t2042, 1)
     t2254 = casadi.fabs(t2253)
     t2255 = (t2254 >= 1)
-    t2256 = casadi.fabs(1/casadi.if_else(t2255, t2253, 1))
+    t2256 = 1/casadi.fabs(casadi.if_else(t2255, t2253, 1))
     t2257 = casadi.if_else(t2252, casadi.if_else((t2253 >= 0), 1, -1)*casadi.if_else(t2255, t2256/(1 + casadi.sqrt(1 + t2256**2)), 1/(t2254 + casadi.sqrt(1 + t2254**2))), 0)
     t2258 = 1/casadi.sqrt(1 + t2257**2)
     t2259 = t2042*t2257
@@ -6410,10 +6410,10 @@ def _condition_number(q):
     t2285 = t2283 + t2257*t2282
     t2286 = t2126*t2264 + t2130*t2268 + t2134*t2272 + t2138*t2276 + t2142*t2280 + t2146*t2284
     t2287 = (t2286 != 0)
-    t2288 = 0.5*(-t2260 + t2122)/casadi.if_else(t2287, t2286, 1)
+    t2288 = (-t2260 + t2122)/casadi.if_else(t2287, 2*t2286, 1)
     t2289 = casadi.fabs(t2288)
     t2290 = (t2289 >= 1)
-    t2291 = casadi.fabs(1/casadi.if_else(t2290, t2288, 1))
+    t2291 = 1/casadi.fabs(casadi.if_else(t2290, t2288, 1))
     t2292 = casadi.if_else(t2287, casadi.if_else((t2288 >= 0), 1, -1)*casadi.if_else(t2290, t2291/(1 + casadi.sqrt(1 + t2291**2)), 1/(t2289 + casadi.sqrt(1 + t2289**2))), 0)
     t2293 = 1/casadi.sqrt(1 + t2292**2)
     t2294 = t2286*t2292
@@ -6446,10 +6446,10 @@ def _condition_number(q):
     t2321 = t2195*t2299 + t2199*t2303 + t2203*t2307 + t2207*t2311 + t2211*t2315 + t2215*t2319
     t2322 = t2265*t2300 + t2269*t2304 + t2273*t2308 + t2277*t2312 + t2281*t2316 + t2285*t2320
     t2323 = (t2321 != 0)
-    t2324 = 0.5*(-t2295 + t2191)/casadi.if_else(t2323, t2321, 1)
+    t2324 = (-t2295 + t2191)/casadi.if_else(t2323, 2*t2321, 1)
     t2325 = casadi.fabs(t2324)
     t2326 = (t2325 >= 1)
-    t2327 = casadi.fabs(1/casadi.if_else(t2326, t2324, 1))
+    t2327 = 1/casadi.fabs(casadi.if_else(t2326, t2324, 1))
     t2328 = casadi.if_else(t2323, casadi.if_else((t2324 >= 0), 1, -1)*casadi.if_else(t2326, t2327/(1 + casadi.sqrt(1 + t2327**2)), 1/(t2325 + casadi.sqrt(1 + t2325**2))), 0)
     t2329 = 1/casadi.sqrt(1 + t2328**2)
     t2330 = t2321*t2328
@@ -6481,10 +6481,10 @@ def _condition_number(q):
     t2356 = t2354 + t2328*t2353
     t2357 = t2230*t2335 + t2234*t2339 + t2238*t2343 + t2242*t2347 + t2246*t2351 + t2250*t2355
     t2358 = (t2357 != 0)
-    t2359 = 0.5*(-t2331 + t2226)/casadi.if_else(t2358, t2357, 1)
+    t2359 = (-t2331 + t2226)/casadi.if_else(t2358, 2*t2357, 1)
     t2360 = casadi.fabs(t2359)
     t2361 = (t2360 >= 1)
-    t2362 = casadi.fabs(1/casadi.if_else(t2361, t2359, 1))
+    t2362 = 1/casadi.fabs(casadi.if_else(t2361, t2359, 1))
     t2363 = casadi.if_else(t2358, casadi.if_else((t2359 >= 0), 1, -1)*casadi.if_else(t2361, t2362/(1 + casadi.sqrt(1 + t2362**2)), 1/(t2360 + casadi.sqrt(1 + t2360**2))), 0)
     t2364 = 1/casadi.sqrt(1 + t2363**2)
     t2365 = t2357*t2363
@@ -6516,10 +6516,10 @@ def _condition_number(q):
     t2391 = t2389 + t2363*t2388
     t2392 = t2231*t2370 + t2235*t2374 + t2239*t2378 + t2243*t2382 + t2247*t2386 + t2251*t2390
     t2393 = (t2392 != 0)
-    t2394 = 0.5*(-t2366 + t2227)/casadi.if_else(t2393, t2392, 1)
+    t2394 = (-t2366 + t2227)/casadi.if_else(t2393, 2*t2392, 1)
     t2395 = casadi.fabs(t2394)
     t2396 = (t2395 >= 1)
-    t2397 = casadi.fabs(1/casadi.if_else(t2396, t2394, 1))
+    t2397 = 1/casadi.fabs(casadi.if_else(t2396, t2394, 1))
     t2398 = casadi.if_else(t2393, casadi.if_else((t2394 >= 0), 1, -1)*casadi.if_else(t2396, t2397/(1 + casadi.sqrt(1 + t2397**2)), 1/(t2395 + casadi.sqrt(1 + t2395**2))), 0)
     t2399 = 1/casadi.sqrt(1 + t2398**2)
     t2400 = t2392*t2398
@@ -6550,10 +6550,10 @@ def _condition_number(q):
     t2425 = t2423 - t2398*t2424
     t2426 = t2424 + t2398*t2423
     t2427 = (t2322 != 0)
-    t2428 = 0.5*(-t2261 + t2296)/casadi.if_else(t2427, t2322, 1)
+    t2428 = (-t2261 + t2296)/casadi.if_else(t2427, 2*t2322, 1)
     t2429 = casadi.fabs(t2428)
     t2430 = (t2429 >= 1)
-    t2431 = casadi.fabs(1/casadi.if_else(t2430, t2428, 1))
+    t2431 = 1/casadi.fabs(casadi.if_else(t2430, t2428, 1))
     t2432 = casadi.if_else(t2427, casadi.if_else((t2428 >= 0), 1, -1)*casadi.if_else(t2430, t2431/(1 + casadi.sqrt(1 + t2431**2)), 1/(t2429 + casadi.sqrt(1 + t2429**2))), 0)
     t2433 = 1/casadi.sqrt(1 + t2432**2)
     t2434 = t2322*t2432
@@ -6585,10 +6585,10 @@ def _condition_number(q):
     t2460 = t2458 + t2432*t2457
     t2461 = t2336*t2439 + t2340*t2443 + t2344*t2447 + t2348*t2451 + t2352*t2455 + t2356*t2459
     t2462 = (t2461 != 0)
-    t2463 = 0.5*(-t2435 + t2332)/casadi.if_else(t2462, t2461, 1)
+    t2463 = (-t2435 + t2332)/casadi.if_else(t2462, 2*t2461, 1)
     t2464 = casadi.fabs(t2463)
     t2465 = (t2464 >= 1)
-    t2466 = casadi.fabs(1/casadi.if_else(t2465, t2463, 1))
+    t2466 = 1/casadi.fabs(casadi.if_else(t2465, t2463, 1))
     t2467 = casadi.if_else(t2462, casadi.if_else((t2463 >= 0), 1, -1)*casadi.if_else(t2465, t2466/(1 + casadi.sqrt(1 + t2466**2)), 1/(t2464 + casadi.sqrt(1 + t2464**2))), 0)
     t2468 = 1/casadi.sqrt(1 + t2467**2)
     t2469 = t2461*t2467
@@ -6621,10 +6621,10 @@ def _condition_number(q):
     t2496 = t2371*t2474 + t2375*t2478 + t2379*t2482 + t2383*t2486 + t2387*t2490 + t2391*t2494
     t2497 = t2440*t2475 + t2444*t2479 + t2448*t2483 + t2452*t2487 + t2456*t2491 + t2460*t2495
     t2498 = (t2496 != 0)
-    t2499 = 0.5*(-t2470 + t2367)/casadi.if_else(t2498, t2496, 1)
+    t2499 = (-t2470 + t2367)/casadi.if_else(t2498, 2*t2496, 1)
     t2500 = casadi.fabs(t2499)
     t2501 = (t2500 >= 1)
-    t2502 = casadi.fabs(1/casadi.if_else(t2501, t2499, 1))
+    t2502 = 1/casadi.fabs(casadi.if_else(t2501, t2499, 1))
     t2503 = casadi.if_else(t2498, casadi.if_else((t2499 >= 0), 1, -1)*casadi.if_else(t2501, t2502/(1 + casadi.sqrt(1 + t2502**2)), 1/(t2500 + casadi.sqrt(1 + t2500**2))), 0)
     t2504 = 1/casadi.sqrt(1 + t2503**2)
     t2505 = t2496*t2503
@@ -6656,10 +6656,10 @@ def _condition_number(q):
     t2531 = t2529 + t2503*t2528
     t2532 = t2406*t2510 + t2410*t2514 + t2414*t2518 + t2418*t2522 + t2422*t2526 + t2426*t2530
     t2533 = (t2532 != 0)
-    t2534 = 0.5*(-t2506 + t2402)/casadi.if_else(t2533, t2532, 1)
+    t2534 = (-t2506 + t2402)/casadi.if_else(t2533, 2*t2532, 1)
     t2535 = casadi.fabs(t2534)
     t2536 = (t2535 >= 1)
-    t2537 = casadi.fabs(1/casadi.if_else(t2536, t2534, 1))
+    t2537 = 1/casadi.fabs(casadi.if_else(t2536, t2534, 1))
     t2538 = casadi.if_else(t2533, casadi.if_else((t2534 >= 0), 1, -1)*casadi.if_else(t2536, t2537/(1 + casadi.sqrt(1 + t2537**2)), 1/(t2535 + casadi.sqrt(1 + t2535**2))), 0)
     t2539 = 1/casadi.sqrt(1 + t2538**2)
     t2540 = t2532*t2538
@@ -6691,10 +6691,10 @@ def _condition_number(q):
     t2566 = t2564 + t2538*t2563
     t2567 = t2405*t2545 + t2409*t2549 + t2413*t2553 + t2417*t2557 + t2421*t2561 + t2425*t2565
     t2568 = (t2497 != 0)
-    t2569 = 0.5*(-t2436 + t2471)/casadi.if_else(t2568, t2497, 1)
+    t2569 = (-t2436 + t2471)/casadi.if_else(t2568, 2*t2497, 1)
     t2570 = casadi.fabs(t2569)
     t2571 = (t2570 >= 1)
-    t2572 = casadi.fabs(1/casadi.if_else(t2571, t2569, 1))
+    t2572 = 1/casadi.fabs(casadi.if_else(t2571, t2569, 1))
     t2573 = casadi.if_else(t2568, casadi.if_else((t2569 >= 0), 1, -1)*casadi.if_else(t2571, t2572/(1 + casadi.sqrt(1 + t2572**2)), 1/(t2570 + casadi.sqrt(1 + t2570**2))), 0)
     t2574 = 1/casadi.sqrt(1 + t2573**2)
     t2575 = t2497*t2573
@@ -6726,10 +6726,10 @@ def _condition_number(q):
     t2601 = t2599 + t2573*t2598
     t2602 = t2511*t2580 + t2515*t2584 + t2519*t2588 + t2523*t2592 + t2527*t2596 + t2531*t2600
     t2603 = (t2602 != 0)
-    t2604 = 0.5*(-t2576 + t2507)/casadi.if_else(t2603, t2602, 1)
+    t2604 = (-t2576 + t2507)/casadi.if_else(t2603, 2*t2602, 1)
     t2605 = casadi.fabs(t2604)
     t2606 = (t2605 >= 1)
-    t2607 = casadi.fabs(1/casadi.if_else(t2606, t2604, 1))
+    t2607 = 1/casadi.fabs(casadi.if_else(t2606, t2604, 1))
     t2608 = casadi.if_else(t2603, casadi.if_else((t2604 >= 0), 1, -1)*casadi.if_else(t2606, t2607/(1 + casadi.sqrt(1 + t2607**2)), 1/(t2605 + casadi.sqrt(1 + t2605**2))), 0)
     t2609 = 1/casadi.sqrt(1 + t2608**2)
     t2610 = t2602*t2608
@@ -6762,10 +6762,10 @@ def _condition_number(q):
     t2637 = t2546*t2615 + t2550*t2619 + t2554*t2623 + t2558*t2627 + t2562*t2631 + t2566*t2635
     t2638 = t2581*t2616 + t2585*t2620 + t2589*t2624 + t2593*t2628 + t2597*t2632 + t2601*t2636
     t2639 = (t2637 != 0)
-    t2640 = 0.5*(-t2611 + t2542)/casadi.if_else(t2639, t2637, 1)
+    t2640 = (-t2611 + t2542)/casadi.if_else(t2639, 2*t2637, 1)
     t2641 = casadi.fabs(t2640)
     t2642 = (t2641 >= 1)
-    t2643 = casadi.fabs(1/casadi.if_else(t2642, t2640, 1))
+    t2643 = 1/casadi.fabs(casadi.if_else(t2642, t2640, 1))
     t2644 = casadi.if_else(t2639, casadi.if_else((t2640 >= 0), 1, -1)*casadi.if_else(t2642, t2643/(1 + casadi.sqrt(1 + t2643**2)), 1/(t2641 + casadi.sqrt(1 + t2641**2))), 0)
     t2645 = 1/casadi.sqrt(1 + t2644**2)
     t2646 = t2637*t2644
@@ -6796,10 +6796,10 @@ def _condition_number(q):
     t2671 = t2669 - t2644*t2670
     t2672 = t2670 + t2644*t2669
     t2673 = (t2638 != 0)
-    t2674 = 0.5*(-t2577 + t2612)/casadi.if_else(t2673, t2638, 1)
+    t2674 = (-t2577 + t2612)/casadi.if_else(t2673, 2*t2638, 1)
     t2675 = casadi.fabs(t2674)
     t2676 = (t2675 >= 1)
-    t2677 = casadi.fabs(1/casadi.if_else(t2676, t2674, 1))
+    t2677 = 1/casadi.fabs(casadi.if_else(t2676, t2674, 1))
     t2678 = casadi.if_else(t2673, casadi.if_else((t2674 >= 0), 1, -1)*casadi.if_else(t2676, t2677/(1 + casadi.sqrt(1 + t2677**2)), 1/(t2675 + casadi.sqrt(1 + t2675**2))), 0)
     t2679 = 1/casadi.sqrt(1 + t2678**2)
     t2680 = t2638*t2678
@@ -6831,10 +6831,10 @@ def _condition_number(q):
     t2706 = t2704 + t2678*t2703
     t2707 = t2652*t2685 + t2656*t2689 + t2660*t2693 + t2664*t2697 + t2668*t2701 + t2672*t2705
     t2708 = (t2707 != 0)
-    t2709 = 0.5*(-t2681 + t2648)/casadi.if_else(t2708, t2707, 1)
+    t2709 = (-t2681 + t2648)/casadi.if_else(t2708, 2*t2707, 1)
     t2710 = casadi.fabs(t2709)
     t2711 = (t2710 >= 1)
-    t2712 = casadi.fabs(1/casadi.if_else(t2711, t2709, 1))
+    t2712 = 1/casadi.fabs(casadi.if_else(t2711, t2709, 1))
     t2713 = casadi.if_else(t2708, casadi.if_else((t2709 >= 0), 1, -1)*casadi.if_else(t2711, t2712/(1 + casadi.sqrt(1 + t2712**2)), 1/(t2710 + casadi.sqrt(1 + t2710**2))), 0)
     t2714 = 1/casadi.sqrt(1 + t2713**2)
     t2715 = t2707*t2713
@@ -6866,10 +6866,10 @@ def _condition_number(q):
     t2741 = t2739 + t2713*t2738
     t2742 = t2686*t2721 + t2690*t2725 + t2694*t2729 + t2698*t2733 + t2702*t2737 + t2706*t2741
     t2743 = (t2742 != 0)
-    t2744 = 0.5*(-t2682 + t2717)/casadi.if_else(t2743, t2742, 1)
+    t2744 = (-t2682 + t2717)/casadi.if_else(t2743, 2*t2742, 1)
     t2745 = casadi.fabs(t2744)
     t2746 = (t2745 >= 1)
-    t2747 = casadi.fabs(1/casadi.if_else(t2746, t2744, 1))
+    t2747 = 1/casadi.fabs(casadi.if_else(t2746, t2744, 1))
     t2748 = casadi.if_else(t2743, casadi.if_else((t2744 >= 0), 1, -1)*casadi.if_else(t2746, t2747/(1 + casadi.sqrt(1 + t2747**2)), 1/(t2745 + casadi.sqrt(1 + t2745**2))), 0)
     t2749 = 1/casadi.sqrt(1 + t2748**2)
     t2750 = t2742*t2748
@@ -6900,10 +6900,10 @@ def _condition_number(q):
     t2775 = t2773 - t2748*t2774
     t2776 = t2774 + t2748*t2773
     t2777 = (t2567 != 0)
-    t2778 = 0.5*(-t2401 + t2541)/casadi.if_else(t2777, t2567, 1)
+    t2778 = (-t2401 + t2541)/casadi.if_else(t2777, 2*t2567, 1)
     t2779 = casadi.fabs(t2778)
     t2780 = (t2779 >= 1)
-    t2781 = casadi.fabs(1/casadi.if_else(t2780, t2778, 1))
+    t2781 = 1/casadi.fabs(casadi.if_else(t2780, t2778, 1))
     t2782 = casadi.if_else(t2777, casadi.if_else((t2778 >= 0), 1, -1)*casadi.if_else(t2780, t2781/(1 + casadi.sqrt(1 + t2781**2)), 1/(t2779 + casadi.sqrt(1 + t2779**2))), 0)
     t2783 = 1/casadi.sqrt(1 + t2782**2)
     t2784 = t2567*t2782
@@ -6935,10 +6935,10 @@ def _condition_number(q):
     t2810 = t2808 + t2782*t2807
     t2811 = t2651*t2789 + t2655*t2793 + t2659*t2797 + t2663*t2801 + t2667*t2805 + t2671*t2809
     t2812 = (t2811 != 0)
-    t2813 = 0.5*(-t2785 + t2647)/casadi.if_else(t2812, t2811, 1)
+    t2813 = (-t2785 + t2647)/casadi.if_else(t2812, 2*t2811, 1)
     t2814 = casadi.fabs(t2813)
     t2815 = (t2814 >= 1)
-    t2816 = casadi.fabs(1/casadi.if_else(t2815, t2813, 1))
+    t2816 = 1/casadi.fabs(casadi.if_else(t2815, t2813, 1))
     t2817 = casadi.if_else(t2812, casadi.if_else((t2813 >= 0), 1, -1)*casadi.if_else(t2815, t2816/(1 + casadi.sqrt(1 + t2816**2)), 1/(t2814 + casadi.sqrt(1 + t2814**2))), 0)
     t2818 = 1/casadi.sqrt(1 + t2817**2)
     t2819 = t2811*t2817
@@ -6971,10 +6971,10 @@ def _condition_number(q):
     t2846 = t2720*t2824 + t2724*t2828 + t2728*t2832 + t2732*t2836 + t2736*t2840 + t2740*t2844
     t2847 = t2790*t2825 + t2794*t2829 + t2798*t2833 + t2802*t2837 + t2806*t2841 + t2810*t2845
     t2848 = (t2846 != 0)
-    t2849 = 0.5*(-t2820 + t2716)/casadi.if_else(t2848, t2846, 1)
+    t2849 = (-t2820 + t2716)/casadi.if_else(t2848, 2*t2846, 1)
     t2850 = casadi.fabs(t2849)
     t2851 = (t2850 >= 1)
-    t2852 = casadi.fabs(1/casadi.if_else(t2851, t2849, 1))
+    t2852 = 1/casadi.fabs(casadi.if_else(t2851, t2849, 1))
     t2853 = casadi.if_else(t2848, casadi.if_else((t2849 >= 0), 1, -1)*casadi.if_else(t2851, t2852/(1 + casadi.sqrt(1 + t2852**2)), 1/(t2850 + casadi.sqrt(1 + t2850**2))), 0)
     t2854 = 1/casadi.sqrt(1 + t2853**2)
     t2855 = t2846*t2853
@@ -7006,10 +7006,10 @@ def _condition_number(q):
     t2881 = t2879 + t2853*t2878
     t2882 = t2755*t2860 + t2759*t2864 + t2763*t2868 + t2767*t2872 + t2771*t2876 + t2775*t2880
     t2883 = (t2882 != 0)
-    t2884 = 0.5*(-t2856 + t2751)/casadi.if_else(t2883, t2882, 1)
+    t2884 = (-t2856 + t2751)/casadi.if_else(t2883, 2*t2882, 1)
     t2885 = casadi.fabs(t2884)
     t2886 = (t2885 >= 1)
-    t2887 = casadi.fabs(1/casadi.if_else(t2886, t2884, 1))
+    t2887 = 1/casadi.fabs(casadi.if_else(t2886, t2884, 1))
     t2888 = casadi.if_else(t2883, casadi.if_else((t2884 >= 0), 1, -1)*casadi.if_else(t2886, t2887/(1 + casadi.sqrt(1 + t2887**2)), 1/(t2885 + casadi.sqrt(1 + t2885**2))), 0)
     t2889 = 1/casadi.sqrt(1 + t2888**2)
     t2890 = t2882*t2888
@@ -7041,10 +7041,10 @@ def _condition_number(q):
     t2916 = t2914 + t2888*t2913
     t2917 = t2756*t2895 + t2760*t2899 + t2764*t2903 + t2768*t2907 + t2772*t2911 + t2776*t2915
     t2918 = (t2917 != 0)
-    t2919 = 0.5*(-t2891 + t2752)/casadi.if_else(t2918, t2917, 1)
+    t2919 = (-t2891 + t2752)/casadi.if_else(t2918, 2*t2917, 1)
     t2920 = casadi.fabs(t2919)
     t2921 = (t2920 >= 1)
-    t2922 = casadi.fabs(1/casadi.if_else(t2921, t2919, 1))
+    t2922 = 1/casadi.fabs(casadi.if_else(t2921, t2919, 1))
     t2923 = casadi.if_else(t2918, casadi.if_else((t2919 >= 0), 1, -1)*casadi.if_else(t2921, t2922/(1 + casadi.sqrt(1 + t2922**2)), 1/(t2920 + casadi.sqrt(1 + t2920**2))), 0)
     t2924 = 1/casadi.sqrt(1 + t2923**2)
     t2925 = t2917*t2923
@@ -7075,10 +7075,10 @@ def _condition_number(q):
     t2950 = t2948 - t2923*t2949
     t2951 = t2949 + t2923*t2948
     t2952 = (t2847 != 0)
-    t2953 = 0.5*(-t2786 + t2821)/casadi.if_else(t2952, t2847, 1)
+    t2953 = (-t2786 + t2821)/casadi.if_else(t2952, 2*t2847, 1)
     t2954 = casadi.fabs(t2953)
     t2955 = (t2954 >= 1)
-    t2956 = casadi.fabs(1/casadi.if_else(t2955, t2953, 1))
+    t2956 = 1/casadi.fabs(casadi.if_else(t2955, t2953, 1))
     t2957 = casadi.if_else(t2952, casadi.if_else((t2953 >= 0), 1, -1)*casadi.if_else(t2955, t2956/(1 + casadi.sqrt(1 + t2956**2)), 1/(t2954 + casadi.sqrt(1 + t2954**2))), 0)
     t2958 = 1/casadi.sqrt(1 + t2957**2)
     t2959 = t2847*t2957
@@ -7110,10 +7110,10 @@ def _condition_number(q):
     t2985 = t2983 + t2957*t2982
     t2986 = t2861*t2964 + t2865*t2968 + t2869*t2972 + t2873*t2976 + t2877*t2980 + t2881*t2984
     t2987 = (t2986 != 0)
-    t2988 = 0.5*(-t2960 + t2857)/casadi.if_else(t2987, t2986, 1)
+    t2988 = (-t2960 + t2857)/casadi.if_else(t2987, 2*t2986, 1)
     t2989 = casadi.fabs(t2988)
     t2990 = (t2989 >= 1)
-    t2991 = casadi.fabs(1/casadi.if_else(t2990, t2988, 1))
+    t2991 = 1/casadi.fabs(casadi.if_else(t2990, t2988, 1))
     t2992 = casadi.if_else(t2987, casadi.if_else((t2988 >= 0), 1, -1)*casadi.if_else(t2990, t2991/(1 + casadi.sqrt(1 + t2991**2)), 1/(t2989 + casadi.sqrt(1 + t2989**2))), 0)
     t2993 = 1/casadi.sqrt(1 + t2992**2)
     t2994 = t2986*t2992
@@ -7146,10 +7146,10 @@ def _condition_number(q):
     t3021 = t2896*t2999 + t2900*t3003 + t2904*t3007 + t2908*t3011 + t2912*t3015 + t2916*t3019
     t3022 = t2965*t3000 + t2969*t3004 + t2973*t3008 + t2977*t3012 + t2981*t3016 + t2985*t3020
     t3023 = (t3021 != 0)
-    t3024 = 0.5*(-t2995 + t2892)/casadi.if_else(t3023, t3021, 1)
+    t3024 = (-t2995 + t2892)/casadi.if_else(t3023, 2*t3021, 1)
     t3025 = casadi.fabs(t3024)
     t3026 = (t3025 >= 1)
-    t3027 = casadi.fabs(1/casadi.if_else(t3026, t3024, 1))
+    t3027 = 1/casadi.fabs(casadi.if_else(t3026, t3024, 1))
     t3028 = casadi.if_else(t3023, casadi.if_else((t3024 >= 0), 1, -1)*casadi.if_else(t3026, t3027/(1 + casadi.sqrt(1 + t3027**2)), 1/(t3025 + casadi.sqrt(1 + t3025**2))), 0)
     t3029 = 1/casadi.sqrt(1 + t3028**2)
     t3030 = t3021*t3028
@@ -7181,10 +7181,10 @@ def _condition_number(q):
     t3056 = t3054 + t3028*t3053
     t3057 = t2931*t3035 + t2935*t3039 + t2939*t3043 + t2943*t3047 + t2947*t3051 + t2951*t3055
     t3058 = (t3057 != 0)
-    t3059 = 0.5*(-t3031 + t2927)/casadi.if_else(t3058, t3057, 1)
+    t3059 = (-t3031 + t2927)/casadi.if_else(t3058, 2*t3057, 1)
     t3060 = casadi.fabs(t3059)
     t3061 = (t3060 >= 1)
-    t3062 = casadi.fabs(1/casadi.if_else(t3061, t3059, 1))
+    t3062 = 1/casadi.fabs(casadi.if_else(t3061, t3059, 1))
     t3063 = casadi.if_else(t3058, casadi.if_else((t3059 >= 0), 1, -1)*casadi.if_else(t3061, t3062/(1 + casadi.sqrt(1 + t3062**2)), 1/(t3060 + casadi.sqrt(1 + t3060**2))), 0)
     t3064 = 1/casadi.sqrt(1 + t3063**2)
     t3065 = t3057*t3063
@@ -7216,10 +7216,10 @@ def _condition_number(q):
     t3091 = t3089 + t3063*t3088
     t3092 = t2930*t3070 + t2934*t3074 + t2938*t3078 + t2942*t3082 + t2946*t3086 + t2950*t3090
     t3093 = (t3022 != 0)
-    t3094 = 0.5*(-t2961 + t2996)/casadi.if_else(t3093, t3022, 1)
+    t3094 = (-t2961 + t2996)/casadi.if_else(t3093, 2*t3022, 1)
     t3095 = casadi.fabs(t3094)
     t3096 = (t3095 >= 1)
-    t3097 = casadi.fabs(1/casadi.if_else(t3096, t3094, 1))
+    t3097 = 1/casadi.fabs(casadi.if_else(t3096, t3094, 1))
     t3098 = casadi.if_else(t3093, casadi.if_else((t3094 >= 0), 1, -1)*casadi.if_else(t3096, t3097/(1 + casadi.sqrt(1 + t3097**2)), 1/(t3095 + casadi.sqrt(1 + t3095**2))), 0)
     t3099 = 1/casadi.sqrt(1 + t3098**2)
     t3100 = t3022*t3098
@@ -7251,10 +7251,10 @@ def _condition_number(q):
     t3126 = t3124 + t3098*t3123
     t3127 = t3036*t3105 + t3040*t3109 + t3044*t3113 + t3048*t3117 + t3052*t3121 + t3056*t3125
     t3128 = (t3127 != 0)
-    t3129 = 0.5*(-t3101 + t3032)/casadi.if_else(t3128, t3127, 1)
+    t3129 = (-t3101 + t3032)/casadi.if_else(t3128, 2*t3127, 1)
     t3130 = casadi.fabs(t3129)
     t3131 = (t3130 >= 1)
-    t3132 = casadi.fabs(1/casadi.if_else(t3131, t3129, 1))
+    t3132 = 1/casadi.fabs(casadi.if_else(t3131, t3129, 1))
     t3133 = casadi.if_else(t3128, casadi.if_else((t3129 >= 0), 1, -1)*casadi.if_else(t3131, t3132/(1 + casadi.sqrt(1 + t3132**2)), 1/(t3130 + casadi.sqrt(1 + t3130**2))), 0)
     t3134 = 1/casadi.sqrt(1 + t3133**2)
     t3135 = t3127*t3133
@@ -7287,10 +7287,10 @@ def _condition_number(q):
     t3162 = t3071*t3140 + t3075*t3144 + t3079*t3148 + t3083*t3152 + t3087*t3156 + t3091*t3160
     t3163 = t3106*t3141 + t3110*t3145 + t3114*t3149 + t3118*t3153 + t3122*t3157 + t3126*t3161
     t3164 = (t3162 != 0)
-    t3165 = 0.5*(-t3136 + t3067)/casadi.if_else(t3164, t3162, 1)
+    t3165 = (-t3136 + t3067)/casadi.if_else(t3164, 2*t3162, 1)
     t3166 = casadi.fabs(t3165)
     t3167 = (t3166 >= 1)
-    t3168 = casadi.fabs(1/casadi.if_else(t3167, t3165, 1))
+    t3168 = 1/casadi.fabs(casadi.if_else(t3167, t3165, 1))
     t3169 = casadi.if_else(t3164, casadi.if_else((t3165 >= 0), 1, -1)*casadi.if_else(t3167, t3168/(1 + casadi.sqrt(1 + t3168**2)), 1/(t3166 + casadi.sqrt(1 + t3166**2))), 0)
     t3170 = 1/casadi.sqrt(1 + t3169**2)
     t3171 = t3162*t3169
@@ -7321,10 +7321,10 @@ def _condition_number(q):
     t3196 = t3194 - t3169*t3195
     t3197 = t3195 + t3169*t3194
     t3198 = (t3163 != 0)
-    t3199 = 0.5*(-t3102 + t3137)/casadi.if_else(t3198, t3163, 1)
+    t3199 = (-t3102 + t3137)/casadi.if_else(t3198, 2*t3163, 1)
     t3200 = casadi.fabs(t3199)
     t3201 = (t3200 >= 1)
-    t3202 = casadi.fabs(1/casadi.if_else(t3201, t3199, 1))
+    t3202 = 1/casadi.fabs(casadi.if_else(t3201, t3199, 1))
     t3203 = casadi.if_else(t3198, casadi.if_else((t3199 >= 0), 1, -1)*casadi.if_else(t3201, t3202/(1 + casadi.sqrt(1 + t3202**2)), 1/(t3200 + casadi.sqrt(1 + t3200**2))), 0)
     t3204 = 1/casadi.sqrt(1 + t3203**2)
     t3205 = t3163*t3203
@@ -7356,10 +7356,10 @@ def _condition_number(q):
     t3231 = t3229 + t3203*t3228
     t3232 = t3177*t3210 + t3181*t3214 + t3185*t3218 + t3189*t3222 + t3193*t3226 + t3197*t3230
     t3233 = (t3232 != 0)
-    t3234 = 0.5*(-t3206 + t3173)/casadi.if_else(t3233, t3232, 1)
+    t3234 = (-t3206 + t3173)/casadi.if_else(t3233, 2*t3232, 1)
     t3235 = casadi.fabs(t3234)
     t3236 = (t3235 >= 1)
-    t3237 = casadi.fabs(1/casadi.if_else(t3236, t3234, 1))
+    t3237 = 1/casadi.fabs(casadi.if_else(t3236, t3234, 1))
     t3238 = casadi.if_else(t3233, casadi.if_else((t3234 >= 0), 1, -1)*casadi.if_else(t3236, t3237/(1 + casadi.sqrt(1 + t3237**2)), 1/(t3235 + casadi.sqrt(1 + t3235**2))), 0)
     t3239 = 1/casadi.sqrt(1 + t3238**2)
     t3240 = t3232*t3238
@@ -7391,10 +7391,10 @@ def _condition_number(q):
     t3266 = t3264 + t3238*t3263
     t3267 = t3211*t3246 + t3215*t3250 + t3219*t3254 + t3223*t3258 + t3227*t3262 + t3231*t3266
     t3268 = (t3267 != 0)
-    t3269 = 0.5*(-t3207 + t3242)/casadi.if_else(t3268, t3267, 1)
+    t3269 = (-t3207 + t3242)/casadi.if_else(t3268, 2*t3267, 1)
     t3270 = casadi.fabs(t3269)
     t3271 = (t3270 >= 1)
-    t3272 = casadi.fabs(1/casadi.if_else(t3271, t3269, 1))
+    t3272 = 1/casadi.fabs(casadi.if_else(t3271, t3269, 1))
     t3273 = casadi.if_else(t3268, casadi.if_else((t3269 >= 0), 1, -1)*casadi.if_else(t3271, t3272/(1 + casadi.sqrt(1 + t3272**2)), 1/(t3270 + casadi.sqrt(1 + t3270**2))), 0)
     t3274 = 1/casadi.sqrt(1 + t3273**2)
     t3275 = t3267*t3273
@@ -7425,10 +7425,10 @@ def _condition_number(q):
     t3300 = t3298 - t3273*t3299
     t3301 = t3299 + t3273*t3298
     t3302 = (t3092 != 0)
-    t3303 = 0.5*(-t2926 + t3066)/casadi.if_else(t3302, t3092, 1)
+    t3303 = (-t2926 + t3066)/casadi.if_else(t3302, 2*t3092, 1)
     t3304 = casadi.fabs(t3303)
     t3305 = (t3304 >= 1)
-    t3306 = casadi.fabs(1/casadi.if_else(t3305, t3303, 1))
+    t3306 = 1/casadi.fabs(casadi.if_else(t3305, t3303, 1))
     t3307 = casadi.if_else(t3302, casadi.if_else((t3303 >= 0), 1, -1)*casadi.if_else(t3305, t3306/(1 + casadi.sqrt(1 + t3306**2)), 1/(t3304 + casadi.sqrt(1 + t3304**2))), 0)
     t3308 = 1/casadi.sqrt(1 + t3307**2)
     t3309 = t3092*t3307
@@ -7460,10 +7460,10 @@ def _condition_number(q):
     t3335 = t3333 + t3307*t3332
     t3336 = t3176*t3314 + t3180*t3318 + t3184*t3322 + t3188*t3326 + t3192*t3330 + t3196*t3334
     t3337 = (t3336 != 0)
-    t3338 = 0.5*(-t3310 + t3172)/casadi.if_else(t3337, t3336, 1)
+    t3338 = (-t3310 + t3172)/casadi.if_else(t3337, 2*t3336, 1)
     t3339 = casadi.fabs(t3338)
     t3340 = (t3339 >= 1)
-    t3341 = casadi.fabs(1/casadi.if_else(t3340, t3338, 1))
+    t3341 = 1/casadi.fabs(casadi.if_else(t3340, t3338, 1))
     t3342 = casadi.if_else(t3337, casadi.if_else((t3338 >= 0), 1, -1)*casadi.if_else(t3340, t3341/(1 + casadi.sqrt(1 + t3341**2)), 1/(t3339 + casadi.sqrt(1 + t3339**2))), 0)
     t3343 = 1/casadi.sqrt(1 + t3342**2)
     t3344 = t3336*t3342
@@ -7496,10 +7496,10 @@ def _condition_number(q):
     t3371 = t3245*t3349 + t3249*t3353 + t3253*t3357 + t3257*t3361 + t3261*t3365 + t3265*t3369
     t3372 = t3315*t3350 + t3319*t3354 + t3323*t3358 + t3327*t3362 + t3331*t3366 + t3335*t3370
     t3373 = (t3371 != 0)
-    t3374 = 0.5*(-t3345 + t3241)/casadi.if_else(t3373, t3371, 1)
+    t3374 = (-t3345 + t3241)/casadi.if_else(t3373, 2*t3371, 1)
     t3375 = casadi.fabs(t3374)
     t3376 = (t3375 >= 1)
-    t3377 = casadi.fabs(1/casadi.if_else(t3376, t3374, 1))
+    t3377 = 1/casadi.fabs(casadi.if_else(t3376, t3374, 1))
     t3378 = casadi.if_else(t3373, casadi.if_else((t3374 >= 0), 1, -1)*casadi.if_else(t3376, t3377/(1 + casadi.sqrt(1 + t3377**2)), 1/(t3375 + casadi.sqrt(1 + t3375**2))), 0)
     t3379 = 1/casadi.sqrt(1 + t3378**2)
     t3380 = t3371*t3378
@@ -7531,10 +7531,10 @@ def _condition_number(q):
     t3406 = t3404 + t3378*t3403
     t3407 = t3280*t3385 + t3284*t3389 + t3288*t3393 + t3292*t3397 + t3296*t3401 + t3300*t3405
     t3408 = (t3407 != 0)
-    t3409 = 0.5*(-t3381 + t3276)/casadi.if_else(t3408, t3407, 1)
+    t3409 = (-t3381 + t3276)/casadi.if_else(t3408, 2*t3407, 1)
     t3410 = casadi.fabs(t3409)
     t3411 = (t3410 >= 1)
-    t3412 = casadi.fabs(1/casadi.if_else(t3411, t3409, 1))
+    t3412 = 1/casadi.fabs(casadi.if_else(t3411, t3409, 1))
     t3413 = casadi.if_else(t3408, casadi.if_else((t3409 >= 0), 1, -1)*casadi.if_else(t3411, t3412/(1 + casadi.sqrt(1 + t3412**2)), 1/(t3410 + casadi.sqrt(1 + t3410**2))), 0)
     t3414 = 1/casadi.sqrt(1 + t3413**2)
     t3415 = t3407*t3413
@@ -7566,10 +7566,10 @@ def _condition_number(q):
     t3441 = t3439 + t3413*t3438
     t3442 = t3281*t3420 + t3285*t3424 + t3289*t3428 + t3293*t3432 + t3297*t3436 + t3301*t3440
     t3443 = (t3442 != 0)
-    t3444 = 0.5*(-t3416 + t3277)/casadi.if_else(t3443, t3442, 1)
+    t3444 = (-t3416 + t3277)/casadi.if_else(t3443, 2*t3442, 1)
     t3445 = casadi.fabs(t3444)
     t3446 = (t3445 >= 1)
-    t3447 = casadi.fabs(1/casadi.if_else(t3446, t3444, 1))
+    t3447 = 1/casadi.fabs(casadi.if_else(t3446, t3444, 1))
     t3448 = casadi.if_else(t3443, casadi.if_else((t3444 >= 0), 1, -1)*casadi.if_else(t3446, t3447/(1 + casadi.sqrt(1 + t3447**2)), 1/(t3445 + casadi.sqrt(1 + t3445**2))), 0)
     t3449 = 1/casadi.sqrt(1 + t3448**2)
     t3450 = t3277 + t3442*t3448
@@ -7599,10 +7599,10 @@ def _condition_number(q):
     t3474 = t3472 + t3448*t3471
     t3475 = casadi.sqrt(t3453**2 + t3457**2 + t3461**2 + t3465**2 + t3469**2 + t3473**2)
     t3476 = (t3372 != 0)
-    t3477 = 0.5*(-t3311 + t3346)/casadi.if_else(t3476, t3372, 1)
+    t3477 = (-t3311 + t3346)/casadi.if_else(t3476, 2*t3372, 1)
     t3478 = casadi.fabs(t3477)
     t3479 = (t3478 >= 1)
-    t3480 = casadi.fabs(1/casadi.if_else(t3479, t3477, 1))
+    t3480 = 1/casadi.fabs(casadi.if_else(t3479, t3477, 1))
     t3481 = casadi.if_else(t3476, casadi.if_else((t3477 >= 0), 1, -1)*casadi.if_else(t3479, t3480/(1 + casadi.sqrt(1 + t3480**2)), 1/(t3478 + casadi.sqrt(1 + t3478**2))), 0)
     t3482 = 1/casadi.sqrt(1 + t3481**2)
     t3483 = t3372*t3481
@@ -7634,10 +7634,10 @@ def _condition_number(q):
     t3509 = t3507 + t3481*t3506
     t3510 = t3386*t3488 + t3390*t3492 + t3394*t3496 + t3398*t3500 + t3402*t3504 + t3406*t3508
     t3511 = (t3510 != 0)
-    t3512 = 0.5*(-t3484 + t3382)/casadi.if_else(t3511, t3510, 1)
+    t3512 = (-t3484 + t3382)/casadi.if_else(t3511, 2*t3510, 1)
     t3513 = casadi.fabs(t3512)
     t3514 = (t3513 >= 1)
-    t3515 = casadi.fabs(1/casadi.if_else(t3514, t3512, 1))
+    t3515 = 1/casadi.fabs(casadi.if_else(t3514, t3512, 1))
     t3516 = casadi.if_else(t3511, casadi.if_else((t3512 >= 0), 1, -1)*casadi.if_else(t3514, t3515/(1 + casadi.sqrt(1 + t3515**2)), 1/(t3513 + casadi.sqrt(1 + t3513**2))), 0)
     t3517 = 1/casadi.sqrt(1 + t3516**2)
     t3518 = t3510*t3516
@@ -7670,10 +7670,10 @@ def _condition_number(q):
     t3545 = t3421*t3523 + t3425*t3527 + t3429*t3531 + t3433*t3535 + t3437*t3539 + t3441*t3543
     t3546 = t3489*t3524 + t3493*t3528 + t3497*t3532 + t3501*t3536 + t3505*t3540 + t3509*t3544
     t3547 = (t3545 != 0)
-    t3548 = 0.5*(-t3519 + t3417)/casadi.if_else(t3547, t3545, 1)
+    t3548 = (-t3519 + t3417)/casadi.if_else(t3547, 2*t3545, 1)
     t3549 = casadi.fabs(t3548)
     t3550 = (t3549 >= 1)
-    t3551 = casadi.fabs(1/casadi.if_else(t3550, t3548, 1))
+    t3551 = 1/casadi.fabs(casadi.if_else(t3550, t3548, 1))
     t3552 = casadi.if_else(t3547, casadi.if_else((t3548 >= 0), 1, -1)*casadi.if_else(t3550, t3551/(1 + casadi.sqrt(1 + t3551**2)), 1/(t3549 + casadi.sqrt(1 + t3549**2))), 0)
     t3553 = 1/casadi.sqrt(1 + t3552**2)
     t3554 = t3545*t3552
@@ -7705,10 +7705,10 @@ def _condition_number(q):
     t3580 = t3578 + t3552*t3577
     t3581 = t3454*t3559 + t3458*t3563 + t3462*t3567 + t3466*t3571 + t3470*t3575 + t3474*t3579
     t3582 = (t3581 != 0)
-    t3583 = 0.5*(-t3555 + t3450)/casadi.if_else(t3582, t3581, 1)
+    t3583 = (-t3555 + t3450)/casadi.if_else(t3582, 2*t3581, 1)
     t3584 = casadi.fabs(t3583)
     t3585 = (t3584 >= 1)
-    t3586 = casadi.fabs(1/casadi.if_else(t3585, t3583, 1))
+    t3586 = 1/casadi.fabs(casadi.if_else(t3585, t3583, 1))
     t3587 = casadi.if_else(t3582, casadi.if_else((t3583 >= 0), 1, -1)*casadi.if_else(t3585, t3586/(1 + casadi.sqrt(1 + t3586**2)), 1/(t3584 + casadi.sqrt(1 + t3584**2))), 0)
     t3588 = 1/casadi.sqrt(1 + t3587**2)
     t3589 = t3450 + t3581*t3587
@@ -7740,10 +7740,10 @@ def _condition_number(q):
     t3615 = casadi.if_else((t3614 > t3475), t3614, t3475)
     t3616 = casadi.if_else((t3614 < t3475), t3614, t3475)
     t3617 = (t3546 != 0)
-    t3618 = 0.5*(-t3485 + t3520)/casadi.if_else(t3617, t3546, 1)
+    t3618 = (-t3485 + t3520)/casadi.if_else(t3617, 2*t3546, 1)
     t3619 = casadi.fabs(t3618)
     t3620 = (t3619 >= 1)
-    t3621 = casadi.fabs(1/casadi.if_else(t3620, t3618, 1))
+    t3621 = 1/casadi.fabs(casadi.if_else(t3620, t3618, 1))
     t3622 = casadi.if_else(t3617, casadi.if_else((t3618 >= 0), 1, -1)*casadi.if_else(t3620, t3621/(1 + casadi.sqrt(1 + t3621**2)), 1/(t3619 + casadi.sqrt(1 + t3619**2))), 0)
     t3623 = 1/casadi.sqrt(1 + t3622**2)
     t3624 = t3546*t3622
@@ -7775,10 +7775,10 @@ def _condition_number(q):
     t3650 = t3648 + t3622*t3647
     t3651 = t3560*t3629 + t3564*t3633 + t3568*t3637 + t3572*t3641 + t3576*t3645 + t3580*t3649
     t3652 = (t3651 != 0)
-    t3653 = 0.5*(-t3625 + t3556)/casadi.if_else(t3652, t3651, 1)
+    t3653 = (-t3625 + t3556)/casadi.if_else(t3652, 2*t3651, 1)
     t3654 = casadi.fabs(t3653)
     t3655 = (t3654 >= 1)
-    t3656 = casadi.fabs(1/casadi.if_else(t3655, t3653, 1))
+    t3656 = 1/casadi.fabs(casadi.if_else(t3655, t3653, 1))
     t3657 = casadi.if_else(t3652, casadi.if_else((t3653 >= 0), 1, -1)*casadi.if_else(t3655, t3656/(1 + casadi.sqrt(1 + t3656**2)), 1/(t3654 + casadi.sqrt(1 + t3654**2))), 0)
     t3658 = 1/casadi.sqrt(1 + t3657**2)
     t3659 = t3651*t3657
@@ -7811,10 +7811,10 @@ def _condition_number(q):
     t3686 = t3593*t3664 + t3597*t3668 + t3601*t3672 + t3605*t3676 + t3609*t3680 + t3613*t3684
     t3687 = t3630*t3665 + t3634*t3669 + t3638*t3673 + t3642*t3677 + t3646*t3681 + t3650*t3685
     t3688 = (t3686 != 0)
-    t3689 = 0.5*(-t3660 + t3589)/casadi.if_else(t3688, t3686, 1)
+    t3689 = (-t3660 + t3589)/casadi.if_else(t3688, 2*t3686, 1)
     t3690 = casadi.fabs(t3689)
     t3691 = (t3690 >= 1)
-    t3692 = casadi.fabs(1/casadi.if_else(t3691, t3689, 1))
+    t3692 = 1/casadi.fabs(casadi.if_else(t3691, t3689, 1))
     t3693 = casadi.if_else(t3688, casadi.if_else((t3689 >= 0), 1, -1)*casadi.if_else(t3691, t3692/(1 + casadi.sqrt(1 + t3692**2)), 1/(t3690 + casadi.sqrt(1 + t3690**2))), 0)
     t3694 = 1/casadi.sqrt(1 + t3693**2)
     t3695 = t3589 + t3686*t3693
@@ -7846,10 +7846,10 @@ def _condition_number(q):
     t3721 = casadi.if_else((t3720 > t3615), t3720, t3615)
     t3722 = casadi.if_else((t3720 < t3616), t3720, t3616)
     t3723 = (t3687 != 0)
-    t3724 = 0.5*(-t3626 + t3661)/casadi.if_else(t3723, t3687, 1)
+    t3724 = (-t3626 + t3661)/casadi.if_else(t3723, 2*t3687, 1)
     t3725 = casadi.fabs(t3724)
     t3726 = (t3725 >= 1)
-    t3727 = casadi.fabs(1/casadi.if_else(t3726, t3724, 1))
+    t3727 = 1/casadi.fabs(casadi.if_else(t3726, t3724, 1))
     t3728 = casadi.if_else(t3723, casadi.if_else((t3724 >= 0), 1, -1)*casadi.if_else(t3726, t3727/(1 + casadi.sqrt(1 + t3727**2)), 1/(t3725 + casadi.sqrt(1 + t3725**2))), 0)
     t3729 = 1/casadi.sqrt(1 + t3728**2)
     t3730 = t3687*t3728
@@ -7881,10 +7881,10 @@ def _condition_number(q):
     t3756 = t3754 + t3728*t3753
     t3757 = t3699*t3735 + t3703*t3739 + t3707*t3743 + t3711*t3747 + t3715*t3751 + t3719*t3755
     t3758 = (t3757 != 0)
-    t3759 = 0.5*(-t3731 + t3695)/casadi.if_else(t3758, t3757, 1)
+    t3759 = (-t3731 + t3695)/casadi.if_else(t3758, 2*t3757, 1)
     t3760 = casadi.fabs(t3759)
     t3761 = (t3760 >= 1)
-    t3762 = casadi.fabs(1/casadi.if_else(t3761, t3759, 1))
+    t3762 = 1/casadi.fabs(casadi.if_else(t3761, t3759, 1))
     t3763 = casadi.if_else(t3758, casadi.if_else((t3759 >= 0), 1, -1)*casadi.if_else(t3761, t3762/(1 + casadi.sqrt(1 + t3762**2)), 1/(t3760 + casadi.sqrt(1 + t3760**2))), 0)
     t3764 = 1/casadi.sqrt(1 + t3763**2)
     t3765 = t3695 + t3757*t3763
@@ -7917,10 +7917,10 @@ def _condition_number(q):
     t3792 = casadi.if_else((t3791 > t3721), t3791, t3721)
     t3793 = casadi.if_else((t3791 < t3722), t3791, t3722)
     t3794 = (t3790 != 0)
-    t3795 = 0.5*(-t3732 + t3765)/casadi.if_else(t3794, t3790, 1)
+    t3795 = (-t3732 + t3765)/casadi.if_else(t3794, 2*t3790, 1)
     t3796 = casadi.fabs(t3795)
     t3797 = (t3796 >= 1)
-    t3798 = casadi.fabs(1/casadi.if_else(t3797, t3795, 1))
+    t3798 = 1/casadi.fabs(casadi.if_else(t3797, t3795, 1))
     t3799 = casadi.if_else(t3794, casadi.if_else((t3795 >= 0), 1, -1)*casadi.if_else(t3797, t3798/(1 + casadi.sqrt(1 + t3798**2)), 1/(t3796 + casadi.sqrt(1 + t3796**2))), 0)
     t3800 = 1/casadi.sqrt(1 + t3799**2)
     t3801 = t3736*t3800
@@ -7953,8 +7953,10 @@ def _condition_number(q):
     t3828 = casadi.if_else((t3825 < t3793), t3825, t3793)
     t3829 = casadi.if_else((t3826 > t3827), t3826, t3827)
     t3830 = casadi.if_else((t3826 < t3828), t3826, t3828)
+    t3831 = casadi.if_else((t3830 <= 1e-12*t3829), 0, t3830)
+    t3832 = casadi.if_else((t3829 > 0), t3829, 1)
     kappa = casadi.SX(1, 1)
-    kappa[0, 0] = casadi.if_else((t3829 > 0), t3829, 1)/casadi.if_else((t3830 <= 1e-12*t3829), 0, t3830)
+    kappa[0, 0] = t3832/t3831
     return [kappa]
 
 

@@ -935,10 +935,10 @@ def velocity_ellipsoid(q):
     t15 = t14 + t9**2
     t16 = t5*t9
     t17 = xp.not_equal(t16, 0)
-    t18 = 0.5*(-t13 + t15)/xp.where(t17, -t16, 1)
+    t18 = (-t13 + t15)/xp.where(t17, -2*t16, 1)
     t19 = xp.abs(t18)
     t20 = xp.greater_equal(t19, 1)
-    t21 = xp.abs(1/xp.where(t20, t18, 1))
+    t21 = 1/xp.abs(xp.where(t20, t18, 1))
     t22 = xp.where(t17, xp.where(xp.greater_equal(t18, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t20, t21/(1 + xp.sqrt(1 + t21**2)), 1/(t19 + xp.sqrt(1 + t19**2))), 0)
     t23 = 1/xp.sqrt(1 + t22**2)
     t24 = t16*t22
@@ -950,10 +950,10 @@ def velocity_ellipsoid(q):
     t30 = t28 - t27*t22
     t31 = t29*t30 + t14*t22*t23**2
     t32 = xp.not_equal(t31, 0)
-    t33 = 0.5*(-t25 + t26)/xp.where(t32, -t31, 1)
+    t33 = (-t25 + t26)/xp.where(t32, -2*t31, 1)
     t34 = xp.abs(t33)
     t35 = xp.greater_equal(t34, 1)
-    t36 = xp.abs(1/xp.where(t35, t33, 1))
+    t36 = 1/xp.abs(xp.where(t35, t33, 1))
     t37 = xp.where(t32, xp.where(xp.greater_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t35, t36/(1 + xp.sqrt(1 + t36**2)), 1/(t34 + xp.sqrt(1 + t34**2))), 0)
     t38 = 1/xp.sqrt(1 + t37**2)
     t39 = t31*t37
@@ -973,10 +973,10 @@ def velocity_ellipsoid(q):
     t53 = t46 - t37*t52
     t54 = t52 + t37*t46
     t55 = xp.not_equal(t51, 0)
-    t56 = 0.5*(-t40 + t41)/xp.where(t55, t51, 1)
+    t56 = (-t40 + t41)/xp.where(t55, 2*t51, 1)
     t57 = xp.abs(t56)
     t58 = xp.greater_equal(t57, 1)
-    t59 = xp.abs(1/xp.where(t58, t56, 1))
+    t59 = 1/xp.abs(xp.where(t58, t56, 1))
     t60 = xp.where(t55, xp.where(xp.greater_equal(t56, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t58, t59/(1 + xp.sqrt(1 + t59**2)), 1/(t57 + xp.sqrt(1 + t57**2))), 0)
     t61 = 1/xp.sqrt(1 + t60**2)
     t62 = t51*t60
@@ -996,10 +996,10 @@ def velocity_ellipsoid(q):
     t76 = t74 - t60*t75
     t77 = t75 + t60*t74
     t78 = xp.not_equal(t73, 0)
-    t79 = 0.5*(-t63 + t64)/xp.where(t78, t73, 1)
+    t79 = (-t63 + t64)/xp.where(t78, 2*t73, 1)
     t80 = xp.abs(t79)
     t81 = xp.greater_equal(t80, 1)
-    t82 = xp.abs(1/xp.where(t81, t79, 1))
+    t82 = 1/xp.abs(xp.where(t81, t79, 1))
     t83 = xp.where(t78, xp.where(xp.greater_equal(t79, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t81, t82/(1 + xp.sqrt(1 + t82**2)), 1/(t80 + xp.sqrt(1 + t80**2))), 0)
     t84 = 1/xp.sqrt(1 + t83**2)
     t85 = t73*t83
@@ -1019,10 +1019,10 @@ def velocity_ellipsoid(q):
     t99 = t97 - t83*t98
     t100 = t98 + t83*t97
     t101 = xp.not_equal(t96, 0)
-    t102 = 0.5*(-t86 + t87)/xp.where(t101, t96, 1)
+    t102 = (-t86 + t87)/xp.where(t101, 2*t96, 1)
     t103 = xp.abs(t102)
     t104 = xp.greater_equal(t103, 1)
-    t105 = xp.abs(1/xp.where(t104, t102, 1))
+    t105 = 1/xp.abs(xp.where(t104, t102, 1))
     t106 = xp.where(t101, xp.where(xp.greater_equal(t102, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t104, t105/(1 + xp.sqrt(1 + t105**2)), 1/(t103 + xp.sqrt(1 + t103**2))), 0)
     t107 = 1/xp.sqrt(1 + t106**2)
     t108 = t90*t107
@@ -1142,10 +1142,10 @@ def condition_number(q):
     t23 = t6**2
     t24 = t23 + t10**2 + t14**2
     t25 = xp.not_equal(t22, 0)
-    t26 = 0.5*(-t24 + t21)/xp.where(t25, t22, 1)
+    t26 = (-t24 + t21)/xp.where(t25, 2*t22, 1)
     t27 = xp.abs(t26)
     t28 = xp.greater_equal(t27, 1)
-    t29 = xp.abs(1/xp.where(t28, t26, 1))
+    t29 = 1/xp.abs(xp.where(t28, t26, 1))
     t30 = xp.where(t25, xp.where(xp.greater_equal(t26, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t28, t29/(1 + xp.sqrt(1 + t29**2)), 1/(t27 + xp.sqrt(1 + t27**2))), 0)
     t31 = 1/xp.sqrt(1 + t30**2)
     t32 = t22*t30
@@ -1160,10 +1160,10 @@ def condition_number(q):
     t41 = t39 - t40*t30
     t42 = t40 + t39*t30
     t43 = xp.not_equal(t41, 0)
-    t44 = 0.5*(1.0 - t33)/xp.where(t43, t41, 1)
+    t44 = (1.0 - t33)/xp.where(t43, 2*t41, 1)
     t45 = xp.abs(t44)
     t46 = xp.greater_equal(t45, 1)
-    t47 = xp.abs(1/xp.where(t46, t44, 1))
+    t47 = 1/xp.abs(xp.where(t46, t44, 1))
     t48 = xp.where(t43, xp.where(xp.greater_equal(t44, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t46, t47/(1 + xp.sqrt(1 + t47**2)), 1/(t45 + xp.sqrt(1 + t45**2))), 0)
     t49 = 1/xp.sqrt(1 + t48**2)
     t50 = t41*t48
@@ -1175,10 +1175,10 @@ def condition_number(q):
     t56 = t54*t37
     t57 = t42*t53 + t23*t54*t30*t31**2 + t56*t38
     t58 = xp.not_equal(t57, 0)
-    t59 = 0.5*(-t34 + t52)/xp.where(t58, t57, 1)
+    t59 = (-t34 + t52)/xp.where(t58, 2*t57, 1)
     t60 = xp.abs(t59)
     t61 = xp.greater_equal(t60, 1)
-    t62 = xp.abs(1/xp.where(t61, t59, 1))
+    t62 = 1/xp.abs(xp.where(t61, t59, 1))
     t63 = xp.where(t58, xp.where(xp.greater_equal(t59, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t61, t62/(1 + xp.sqrt(1 + t62**2)), 1/(t60 + xp.sqrt(1 + t60**2))), 0)
     t64 = 1/xp.sqrt(1 + t63**2)
     t65 = t57*t63
@@ -1202,10 +1202,10 @@ def condition_number(q):
     t83 = t37*t49
     t84 = t55*t80 - t82*t72 + t83*t76
     t85 = xp.not_equal(t84, 0)
-    t86 = 0.5*(-t51 + t66)/xp.where(t85, t84, 1)
+    t86 = (-t51 + t66)/xp.where(t85, 2*t84, 1)
     t87 = xp.abs(t86)
     t88 = xp.greater_equal(t87, 1)
-    t89 = xp.abs(1/xp.where(t88, t86, 1))
+    t89 = 1/xp.abs(xp.where(t88, t86, 1))
     t90 = xp.where(t85, xp.where(xp.greater_equal(t86, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t88, t89/(1 + xp.sqrt(1 + t89**2)), 1/(t87 + xp.sqrt(1 + t87**2))), 0)
     t91 = 1/xp.sqrt(1 + t90**2)
     t92 = t84*t90
@@ -1225,10 +1225,10 @@ def condition_number(q):
     t106 = t104 + t103*t90
     t107 = t73*t97 + t77*t101 + t81*t105
     t108 = xp.not_equal(t107, 0)
-    t109 = 0.5*(-t93 + t67)/xp.where(t108, t107, 1)
+    t109 = (-t93 + t67)/xp.where(t108, 2*t107, 1)
     t110 = xp.abs(t109)
     t111 = xp.greater_equal(t110, 1)
-    t112 = xp.abs(1/xp.where(t111, t109, 1))
+    t112 = 1/xp.abs(xp.where(t111, t109, 1))
     t113 = xp.where(t108, xp.where(xp.greater_equal(t109, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t111, t112/(1 + xp.sqrt(1 + t112**2)), 1/(t110 + xp.sqrt(1 + t110**2))), 0)
     t114 = 1/xp.sqrt(1 + t113**2)
     t115 = t107*t113
@@ -1248,10 +1248,10 @@ def condition_number(q):
     t129 = t127 + t126*t113
     t130 = -t98*t121 + t102*t125 + t106*t129
     t131 = xp.not_equal(t130, 0)
-    t132 = 0.5*(-t94 + t117)/xp.where(t131, t130, 1)
+    t132 = (-t94 + t117)/xp.where(t131, 2*t130, 1)
     t133 = xp.abs(t132)
     t134 = xp.greater_equal(t133, 1)
-    t135 = xp.abs(1/xp.where(t134, t132, 1))
+    t135 = 1/xp.abs(xp.where(t134, t132, 1))
     t136 = xp.where(t131, xp.where(xp.greater_equal(t132, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t134, t135/(1 + xp.sqrt(1 + t135**2)), 1/(t133 + xp.sqrt(1 + t133**2))), 0)
     t137 = 1/xp.sqrt(1 + t136**2)
     t138 = t130*t136
@@ -1271,10 +1271,10 @@ def condition_number(q):
     t152 = t150 + t136*t149
     t153 = t120*t143 + t124*t147 + t128*t151
     t154 = xp.not_equal(t153, 0)
-    t155 = 0.5*(-t116 + t139)/xp.where(t154, t153, 1)
+    t155 = (-t116 + t139)/xp.where(t154, 2*t153, 1)
     t156 = xp.abs(t155)
     t157 = xp.greater_equal(t156, 1)
-    t158 = xp.abs(1/xp.where(t157, t155, 1))
+    t158 = 1/xp.abs(xp.where(t157, t155, 1))
     t159 = xp.where(t154, xp.where(xp.greater_equal(t155, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t157, t158/(1 + xp.sqrt(1 + t158**2)), 1/(t156 + xp.sqrt(1 + t156**2))), 0)
     t160 = 1/xp.sqrt(1 + t159**2)
     t161 = t153*t159
@@ -1294,10 +1294,10 @@ def condition_number(q):
     t175 = t173 + t159*t172
     t176 = t144*t166 + t148*t170 + t152*t174
     t177 = xp.not_equal(t176, 0)
-    t178 = 0.5*(-t162 + t140)/xp.where(t177, t176, 1)
+    t178 = (-t162 + t140)/xp.where(t177, 2*t176, 1)
     t179 = xp.abs(t178)
     t180 = xp.greater_equal(t179, 1)
-    t181 = xp.abs(1/xp.where(t180, t178, 1))
+    t181 = 1/xp.abs(xp.where(t180, t178, 1))
     t182 = xp.where(t177, xp.where(xp.greater_equal(t178, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t180, t181/(1 + xp.sqrt(1 + t181**2)), 1/(t179 + xp.sqrt(1 + t179**2))), 0)
     t183 = 1/xp.sqrt(1 + t182**2)
     t184 = t176*t182
@@ -1317,10 +1317,10 @@ def condition_number(q):
     t198 = t196 + t182*t195
     t199 = t167*t190 + t171*t194 + t175*t198
     t200 = xp.not_equal(t199, 0)
-    t201 = 0.5*(-t163 + t186)/xp.where(t200, t199, 1)
+    t201 = (-t163 + t186)/xp.where(t200, 2*t199, 1)
     t202 = xp.abs(t201)
     t203 = xp.greater_equal(t202, 1)
-    t204 = xp.abs(1/xp.where(t203, t201, 1))
+    t204 = 1/xp.abs(xp.where(t203, t201, 1))
     t205 = xp.where(t200, xp.where(xp.greater_equal(t201, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t203, t204/(1 + xp.sqrt(1 + t204**2)), 1/(t202 + xp.sqrt(1 + t202**2))), 0)
     t206 = 1/xp.sqrt(1 + t205**2)
     t207 = t199*t205
@@ -1340,10 +1340,10 @@ def condition_number(q):
     t221 = t219 + t205*t218
     t222 = t189*t212 + t193*t216 + t197*t220
     t223 = xp.not_equal(t222, 0)
-    t224 = 0.5*(-t185 + t208)/xp.where(t223, t222, 1)
+    t224 = (-t185 + t208)/xp.where(t223, 2*t222, 1)
     t225 = xp.abs(t224)
     t226 = xp.greater_equal(t225, 1)
-    t227 = xp.abs(1/xp.where(t226, t224, 1))
+    t227 = 1/xp.abs(xp.where(t226, t224, 1))
     t228 = xp.where(t223, xp.where(xp.greater_equal(t224, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t226, t227/(1 + xp.sqrt(1 + t227**2)), 1/(t225 + xp.sqrt(1 + t225**2))), 0)
     t229 = 1/xp.sqrt(1 + t228**2)
     t230 = t222*t228
@@ -1363,10 +1363,10 @@ def condition_number(q):
     t244 = t242 + t228*t241
     t245 = t213*t235 + t217*t239 + t221*t243
     t246 = xp.not_equal(t245, 0)
-    t247 = 0.5*(-t231 + t209)/xp.where(t246, t245, 1)
+    t247 = (-t231 + t209)/xp.where(t246, 2*t245, 1)
     t248 = xp.abs(t247)
     t249 = xp.greater_equal(t248, 1)
-    t250 = xp.abs(1/xp.where(t249, t247, 1))
+    t250 = 1/xp.abs(xp.where(t249, t247, 1))
     t251 = xp.where(t246, xp.where(xp.greater_equal(t247, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t249, t250/(1 + xp.sqrt(1 + t250**2)), 1/(t248 + xp.sqrt(1 + t248**2))), 0)
     t252 = 1/xp.sqrt(1 + t251**2)
     t253 = t245*t251
@@ -1386,10 +1386,10 @@ def condition_number(q):
     t267 = t265 + t251*t264
     t268 = t236*t259 + t240*t263 + t244*t267
     t269 = xp.not_equal(t268, 0)
-    t270 = 0.5*(-t232 + t255)/xp.where(t269, t268, 1)
+    t270 = (-t232 + t255)/xp.where(t269, 2*t268, 1)
     t271 = xp.abs(t270)
     t272 = xp.greater_equal(t271, 1)
-    t273 = xp.abs(1/xp.where(t272, t270, 1))
+    t273 = 1/xp.abs(xp.where(t272, t270, 1))
     t274 = xp.where(t269, xp.where(xp.greater_equal(t270, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t272, t273/(1 + xp.sqrt(1 + t273**2)), 1/(t271 + xp.sqrt(1 + t271**2))), 0)
     t275 = 1/xp.sqrt(1 + t274**2)
     t276 = t268*t274
@@ -1409,10 +1409,10 @@ def condition_number(q):
     t290 = t288 + t274*t287
     t291 = t258*t281 + t262*t285 + t266*t289
     t292 = xp.not_equal(t291, 0)
-    t293 = 0.5*(-t254 + t277)/xp.where(t292, t291, 1)
+    t293 = (-t254 + t277)/xp.where(t292, 2*t291, 1)
     t294 = xp.abs(t293)
     t295 = xp.greater_equal(t294, 1)
-    t296 = xp.abs(1/xp.where(t295, t293, 1))
+    t296 = 1/xp.abs(xp.where(t295, t293, 1))
     t297 = xp.where(t292, xp.where(xp.greater_equal(t293, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t295, t296/(1 + xp.sqrt(1 + t296**2)), 1/(t294 + xp.sqrt(1 + t294**2))), 0)
     t298 = 1/xp.sqrt(1 + t297**2)
     t299 = t291*t297
@@ -1432,10 +1432,10 @@ def condition_number(q):
     t313 = t311 + t297*t310
     t314 = t282*t304 + t286*t308 + t290*t312
     t315 = xp.not_equal(t314, 0)
-    t316 = 0.5*(-t300 + t278)/xp.where(t315, t314, 1)
+    t316 = (-t300 + t278)/xp.where(t315, 2*t314, 1)
     t317 = xp.abs(t316)
     t318 = xp.greater_equal(t317, 1)
-    t319 = xp.abs(1/xp.where(t318, t316, 1))
+    t319 = 1/xp.abs(xp.where(t318, t316, 1))
     t320 = xp.where(t315, xp.where(xp.greater_equal(t316, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t318, t319/(1 + xp.sqrt(1 + t319**2)), 1/(t317 + xp.sqrt(1 + t317**2))), 0)
     t321 = 1/xp.sqrt(1 + t320**2)
     t322 = t314*t320
@@ -1455,10 +1455,10 @@ def condition_number(q):
     t336 = t334 + t320*t333
     t337 = t305*t328 + t309*t332 + t313*t336
     t338 = xp.not_equal(t337, 0)
-    t339 = 0.5*(-t301 + t324)/xp.where(t338, t337, 1)
+    t339 = (-t301 + t324)/xp.where(t338, 2*t337, 1)
     t340 = xp.abs(t339)
     t341 = xp.greater_equal(t340, 1)
-    t342 = xp.abs(1/xp.where(t341, t339, 1))
+    t342 = 1/xp.abs(xp.where(t341, t339, 1))
     t343 = xp.where(t338, xp.where(xp.greater_equal(t339, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t341, t342/(1 + xp.sqrt(1 + t342**2)), 1/(t340 + xp.sqrt(1 + t340**2))), 0)
     t344 = 1/xp.sqrt(1 + t343**2)
     t345 = t337*t343
@@ -1478,10 +1478,10 @@ def condition_number(q):
     t359 = t357 + t343*t356
     t360 = t327*t350 + t331*t354 + t335*t358
     t361 = xp.not_equal(t360, 0)
-    t362 = 0.5*(-t323 + t346)/xp.where(t361, t360, 1)
+    t362 = (-t323 + t346)/xp.where(t361, 2*t360, 1)
     t363 = xp.abs(t362)
     t364 = xp.greater_equal(t363, 1)
-    t365 = xp.abs(1/xp.where(t364, t362, 1))
+    t365 = 1/xp.abs(xp.where(t364, t362, 1))
     t366 = xp.where(t361, xp.where(xp.greater_equal(t362, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t364, t365/(1 + xp.sqrt(1 + t365**2)), 1/(t363 + xp.sqrt(1 + t363**2))), 0)
     t367 = 1/xp.sqrt(1 + t366**2)
     t368 = t360*t366
@@ -1501,10 +1501,10 @@ def condition_number(q):
     t382 = t380 + t366*t379
     t383 = t351*t373 + t355*t377 + t359*t381
     t384 = xp.not_equal(t383, 0)
-    t385 = 0.5*(-t369 + t347)/xp.where(t384, t383, 1)
+    t385 = (-t369 + t347)/xp.where(t384, 2*t383, 1)
     t386 = xp.abs(t385)
     t387 = xp.greater_equal(t386, 1)
-    t388 = xp.abs(1/xp.where(t387, t385, 1))
+    t388 = 1/xp.abs(xp.where(t387, t385, 1))
     t389 = xp.where(t384, xp.where(xp.greater_equal(t385, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t387, t388/(1 + xp.sqrt(1 + t388**2)), 1/(t386 + xp.sqrt(1 + t386**2))), 0)
     t390 = 1/xp.sqrt(1 + t389**2)
     t391 = t383*t389
@@ -1524,10 +1524,10 @@ def condition_number(q):
     t405 = t403 + t389*t402
     t406 = t374*t397 + t378*t401 + t382*t405
     t407 = xp.not_equal(t406, 0)
-    t408 = 0.5*(-t370 + t393)/xp.where(t407, t406, 1)
+    t408 = (-t370 + t393)/xp.where(t407, 2*t406, 1)
     t409 = xp.abs(t408)
     t410 = xp.greater_equal(t409, 1)
-    t411 = xp.abs(1/xp.where(t410, t408, 1))
+    t411 = 1/xp.abs(xp.where(t410, t408, 1))
     t412 = xp.where(t407, xp.where(xp.greater_equal(t408, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t410, t411/(1 + xp.sqrt(1 + t411**2)), 1/(t409 + xp.sqrt(1 + t409**2))), 0)
     t413 = 1/xp.sqrt(1 + t412**2)
     t414 = t406*t412
@@ -1547,10 +1547,10 @@ def condition_number(q):
     t428 = t426 + t412*t425
     t429 = t396*t419 + t400*t423 + t404*t427
     t430 = xp.not_equal(t429, 0)
-    t431 = 0.5*(-t392 + t415)/xp.where(t430, t429, 1)
+    t431 = (-t392 + t415)/xp.where(t430, 2*t429, 1)
     t432 = xp.abs(t431)
     t433 = xp.greater_equal(t432, 1)
-    t434 = xp.abs(1/xp.where(t433, t431, 1))
+    t434 = 1/xp.abs(xp.where(t433, t431, 1))
     t435 = xp.where(t430, xp.where(xp.greater_equal(t431, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t433, t434/(1 + xp.sqrt(1 + t434**2)), 1/(t432 + xp.sqrt(1 + t432**2))), 0)
     t436 = 1/xp.sqrt(1 + t435**2)
     t437 = t429*t435
@@ -1570,10 +1570,10 @@ def condition_number(q):
     t451 = t449 + t435*t448
     t452 = t420*t442 + t424*t446 + t428*t450
     t453 = xp.not_equal(t452, 0)
-    t454 = 0.5*(-t438 + t416)/xp.where(t453, t452, 1)
+    t454 = (-t438 + t416)/xp.where(t453, 2*t452, 1)
     t455 = xp.abs(t454)
     t456 = xp.greater_equal(t455, 1)
-    t457 = xp.abs(1/xp.where(t456, t454, 1))
+    t457 = 1/xp.abs(xp.where(t456, t454, 1))
     t458 = xp.where(t453, xp.where(xp.greater_equal(t454, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t456, t457/(1 + xp.sqrt(1 + t457**2)), 1/(t455 + xp.sqrt(1 + t455**2))), 0)
     t459 = 1/xp.sqrt(1 + t458**2)
     t460 = t416 + t452*t458
@@ -1592,10 +1592,10 @@ def condition_number(q):
     t473 = t443*t464 + t447*t468 + t451*t472
     t474 = xp.sqrt(t463**2 + t467**2 + t471**2)
     t475 = xp.not_equal(t473, 0)
-    t476 = 0.5*(-t439 + t460)/xp.where(t475, t473, 1)
+    t476 = (-t439 + t460)/xp.where(t475, 2*t473, 1)
     t477 = xp.abs(t476)
     t478 = xp.greater_equal(t477, 1)
-    t479 = xp.abs(1/xp.where(t478, t476, 1))
+    t479 = 1/xp.abs(xp.where(t478, t476, 1))
     t480 = xp.where(t475, xp.where(xp.greater_equal(t476, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t478, t479/(1 + xp.sqrt(1 + t479**2)), 1/(t477 + xp.sqrt(1 + t477**2))), 0)
     t481 = 1/xp.sqrt(1 + t480**2)
     t482 = t443*t481
@@ -1618,7 +1618,9 @@ def condition_number(q):
     t499 = xp.where(xp.less(1.8823529411764706, t497), 1.8823529411764706, t497)
     t500 = xp.where(xp.greater(t495, t498), t495, t498)
     t501 = xp.where(xp.less(t495, t499), t495, t499)
-    kappa = xp.broadcast_to(xp.where(xp.greater(t500, 0), t500, 1)/xp.where(xp.less_equal(t501, 1e-12*t500), 0, t501), batch)
+    t502 = xp.where(xp.less_equal(t501, 1e-12*t500), 0, t501)
+    t503 = xp.where(xp.greater(t500, 0), t500, 1)
+    kappa = xp.broadcast_to(t503/t502, batch)
     return kappa
 
 

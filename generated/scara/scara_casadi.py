@@ -601,10 +601,10 @@ def _velocity_ellipsoid(q):
     t15 = t14 + t9**2
     t16 = t5*t9
     t17 = (t16 != 0)
-    t18 = 0.5*(-t13 + t15)/casadi.if_else(t17, -t16, 1)
+    t18 = (-t13 + t15)/casadi.if_else(t17, -2*t16, 1)
     t19 = casadi.fabs(t18)
     t20 = (t19 >= 1)
-    t21 = casadi.fabs(1/casadi.if_else(t20, t18, 1))
+    t21 = 1/casadi.fabs(casadi.if_else(t20, t18, 1))
     t22 = casadi.if_else(t17, casadi.if_else((t18 >= 0), 1, -1)*casadi.if_else(t20, t21/(1 + casadi.sqrt(1 + t21**2)), 1/(t19 + casadi.sqrt(1 + t19**2))), 0)
     t23 = 1/casadi.sqrt(1 + t22**2)
     t24 = t16*t22
@@ -616,10 +616,10 @@ def _velocity_ellipsoid(q):
     t30 = t28 - t27*t22
     t31 = t29*t30 + t14*t22*t23**2
     t32 = (t31 != 0)
-    t33 = 0.5*(-t25 + t26)/casadi.if_else(t32, -t31, 1)
+    t33 = (-t25 + t26)/casadi.if_else(t32, -2*t31, 1)
     t34 = casadi.fabs(t33)
     t35 = (t34 >= 1)
-    t36 = casadi.fabs(1/casadi.if_else(t35, t33, 1))
+    t36 = 1/casadi.fabs(casadi.if_else(t35, t33, 1))
     t37 = casadi.if_else(t32, casadi.if_else((t33 >= 0), 1, -1)*casadi.if_else(t35, t36/(1 + casadi.sqrt(1 + t36**2)), 1/(t34 + casadi.sqrt(1 + t34**2))), 0)
     t38 = 1/casadi.sqrt(1 + t37**2)
     t39 = t31*t37
@@ -639,10 +639,10 @@ def _velocity_ellipsoid(q):
     t53 = t46 - t37*t52
     t54 = t52 + t37*t46
     t55 = (t51 != 0)
-    t56 = 0.5*(-t40 + t41)/casadi.if_else(t55, t51, 1)
+    t56 = (-t40 + t41)/casadi.if_else(t55, 2*t51, 1)
     t57 = casadi.fabs(t56)
     t58 = (t57 >= 1)
-    t59 = casadi.fabs(1/casadi.if_else(t58, t56, 1))
+    t59 = 1/casadi.fabs(casadi.if_else(t58, t56, 1))
     t60 = casadi.if_else(t55, casadi.if_else((t56 >= 0), 1, -1)*casadi.if_else(t58, t59/(1 + casadi.sqrt(1 + t59**2)), 1/(t57 + casadi.sqrt(1 + t57**2))), 0)
     t61 = 1/casadi.sqrt(1 + t60**2)
     t62 = t51*t60
@@ -662,10 +662,10 @@ def _velocity_ellipsoid(q):
     t76 = t74 - t60*t75
     t77 = t75 + t60*t74
     t78 = (t73 != 0)
-    t79 = 0.5*(-t63 + t64)/casadi.if_else(t78, t73, 1)
+    t79 = (-t63 + t64)/casadi.if_else(t78, 2*t73, 1)
     t80 = casadi.fabs(t79)
     t81 = (t80 >= 1)
-    t82 = casadi.fabs(1/casadi.if_else(t81, t79, 1))
+    t82 = 1/casadi.fabs(casadi.if_else(t81, t79, 1))
     t83 = casadi.if_else(t78, casadi.if_else((t79 >= 0), 1, -1)*casadi.if_else(t81, t82/(1 + casadi.sqrt(1 + t82**2)), 1/(t80 + casadi.sqrt(1 + t80**2))), 0)
     t84 = 1/casadi.sqrt(1 + t83**2)
     t85 = t73*t83
@@ -685,10 +685,10 @@ def _velocity_ellipsoid(q):
     t99 = t97 - t83*t98
     t100 = t98 + t83*t97
     t101 = (t96 != 0)
-    t102 = 0.5*(-t86 + t87)/casadi.if_else(t101, t96, 1)
+    t102 = (-t86 + t87)/casadi.if_else(t101, 2*t96, 1)
     t103 = casadi.fabs(t102)
     t104 = (t103 >= 1)
-    t105 = casadi.fabs(1/casadi.if_else(t104, t102, 1))
+    t105 = 1/casadi.fabs(casadi.if_else(t104, t102, 1))
     t106 = casadi.if_else(t101, casadi.if_else((t102 >= 0), 1, -1)*casadi.if_else(t104, t105/(1 + casadi.sqrt(1 + t105**2)), 1/(t103 + casadi.sqrt(1 + t103**2))), 0)
     t107 = 1/casadi.sqrt(1 + t106**2)
     t108 = t90*t107
@@ -795,10 +795,10 @@ def _condition_number(q):
     t23 = t6**2
     t24 = t23 + t10**2 + t14**2
     t25 = (t22 != 0)
-    t26 = 0.5*(-t24 + t21)/casadi.if_else(t25, t22, 1)
+    t26 = (-t24 + t21)/casadi.if_else(t25, 2*t22, 1)
     t27 = casadi.fabs(t26)
     t28 = (t27 >= 1)
-    t29 = casadi.fabs(1/casadi.if_else(t28, t26, 1))
+    t29 = 1/casadi.fabs(casadi.if_else(t28, t26, 1))
     t30 = casadi.if_else(t25, casadi.if_else((t26 >= 0), 1, -1)*casadi.if_else(t28, t29/(1 + casadi.sqrt(1 + t29**2)), 1/(t27 + casadi.sqrt(1 + t27**2))), 0)
     t31 = 1/casadi.sqrt(1 + t30**2)
     t32 = t22*t30
@@ -813,10 +813,10 @@ def _condition_number(q):
     t41 = t39 - t40*t30
     t42 = t40 + t39*t30
     t43 = (t41 != 0)
-    t44 = 0.5*(1.0 - t33)/casadi.if_else(t43, t41, 1)
+    t44 = (1.0 - t33)/casadi.if_else(t43, 2*t41, 1)
     t45 = casadi.fabs(t44)
     t46 = (t45 >= 1)
-    t47 = casadi.fabs(1/casadi.if_else(t46, t44, 1))
+    t47 = 1/casadi.fabs(casadi.if_else(t46, t44, 1))
     t48 = casadi.if_else(t43, casadi.if_else((t44 >= 0), 1, -1)*casadi.if_else(t46, t47/(1 + casadi.sqrt(1 + t47**2)), 1/(t45 + casadi.sqrt(1 + t45**2))), 0)
     t49 = 1/casadi.sqrt(1 + t48**2)
     t50 = t41*t48
@@ -828,10 +828,10 @@ def _condition_number(q):
     t56 = t54*t37
     t57 = t42*t53 + t23*t54*t30*t31**2 + t56*t38
     t58 = (t57 != 0)
-    t59 = 0.5*(-t34 + t52)/casadi.if_else(t58, t57, 1)
+    t59 = (-t34 + t52)/casadi.if_else(t58, 2*t57, 1)
     t60 = casadi.fabs(t59)
     t61 = (t60 >= 1)
-    t62 = casadi.fabs(1/casadi.if_else(t61, t59, 1))
+    t62 = 1/casadi.fabs(casadi.if_else(t61, t59, 1))
     t63 = casadi.if_else(t58, casadi.if_else((t59 >= 0), 1, -1)*casadi.if_else(t61, t62/(1 + casadi.sqrt(1 + t62**2)), 1/(t60 + casadi.sqrt(1 + t60**2))), 0)
     t64 = 1/casadi.sqrt(1 + t63**2)
     t65 = t57*t63
@@ -855,10 +855,10 @@ def _condition_number(q):
     t83 = t37*t49
     t84 = t55*t80 - t82*t72 + t83*t76
     t85 = (t84 != 0)
-    t86 = 0.5*(-t51 + t66)/casadi.if_else(t85, t84, 1)
+    t86 = (-t51 + t66)/casadi.if_else(t85, 2*t84, 1)
     t87 = casadi.fabs(t86)
     t88 = (t87 >= 1)
-    t89 = casadi.fabs(1/casadi.if_else(t88, t86, 1))
+    t89 = 1/casadi.fabs(casadi.if_else(t88, t86, 1))
     t90 = casadi.if_else(t85, casadi.if_else((t86 >= 0), 1, -1)*casadi.if_else(t88, t89/(1 + casadi.sqrt(1 + t89**2)), 1/(t87 + casadi.sqrt(1 + t87**2))), 0)
     t91 = 1/casadi.sqrt(1 + t90**2)
     t92 = t84*t90
@@ -878,10 +878,10 @@ def _condition_number(q):
     t106 = t104 + t103*t90
     t107 = t73*t97 + t77*t101 + t81*t105
     t108 = (t107 != 0)
-    t109 = 0.5*(-t93 + t67)/casadi.if_else(t108, t107, 1)
+    t109 = (-t93 + t67)/casadi.if_else(t108, 2*t107, 1)
     t110 = casadi.fabs(t109)
     t111 = (t110 >= 1)
-    t112 = casadi.fabs(1/casadi.if_else(t111, t109, 1))
+    t112 = 1/casadi.fabs(casadi.if_else(t111, t109, 1))
     t113 = casadi.if_else(t108, casadi.if_else((t109 >= 0), 1, -1)*casadi.if_else(t111, t112/(1 + casadi.sqrt(1 + t112**2)), 1/(t110 + casadi.sqrt(1 + t110**2))), 0)
     t114 = 1/casadi.sqrt(1 + t113**2)
     t115 = t107*t113
@@ -901,10 +901,10 @@ def _condition_number(q):
     t129 = t127 + t126*t113
     t130 = -t98*t121 + t102*t125 + t106*t129
     t131 = (t130 != 0)
-    t132 = 0.5*(-t94 + t117)/casadi.if_else(t131, t130, 1)
+    t132 = (-t94 + t117)/casadi.if_else(t131, 2*t130, 1)
     t133 = casadi.fabs(t132)
     t134 = (t133 >= 1)
-    t135 = casadi.fabs(1/casadi.if_else(t134, t132, 1))
+    t135 = 1/casadi.fabs(casadi.if_else(t134, t132, 1))
     t136 = casadi.if_else(t131, casadi.if_else((t132 >= 0), 1, -1)*casadi.if_else(t134, t135/(1 + casadi.sqrt(1 + t135**2)), 1/(t133 + casadi.sqrt(1 + t133**2))), 0)
     t137 = 1/casadi.sqrt(1 + t136**2)
     t138 = t130*t136
@@ -924,10 +924,10 @@ def _condition_number(q):
     t152 = t150 + t136*t149
     t153 = t120*t143 + t124*t147 + t128*t151
     t154 = (t153 != 0)
-    t155 = 0.5*(-t116 + t139)/casadi.if_else(t154, t153, 1)
+    t155 = (-t116 + t139)/casadi.if_else(t154, 2*t153, 1)
     t156 = casadi.fabs(t155)
     t157 = (t156 >= 1)
-    t158 = casadi.fabs(1/casadi.if_else(t157, t155, 1))
+    t158 = 1/casadi.fabs(casadi.if_else(t157, t155, 1))
     t159 = casadi.if_else(t154, casadi.if_else((t155 >= 0), 1, -1)*casadi.if_else(t157, t158/(1 + casadi.sqrt(1 + t158**2)), 1/(t156 + casadi.sqrt(1 + t156**2))), 0)
     t160 = 1/casadi.sqrt(1 + t159**2)
     t161 = t153*t159
@@ -947,10 +947,10 @@ def _condition_number(q):
     t175 = t173 + t159*t172
     t176 = t144*t166 + t148*t170 + t152*t174
     t177 = (t176 != 0)
-    t178 = 0.5*(-t162 + t140)/casadi.if_else(t177, t176, 1)
+    t178 = (-t162 + t140)/casadi.if_else(t177, 2*t176, 1)
     t179 = casadi.fabs(t178)
     t180 = (t179 >= 1)
-    t181 = casadi.fabs(1/casadi.if_else(t180, t178, 1))
+    t181 = 1/casadi.fabs(casadi.if_else(t180, t178, 1))
     t182 = casadi.if_else(t177, casadi.if_else((t178 >= 0), 1, -1)*casadi.if_else(t180, t181/(1 + casadi.sqrt(1 + t181**2)), 1/(t179 + casadi.sqrt(1 + t179**2))), 0)
     t183 = 1/casadi.sqrt(1 + t182**2)
     t184 = t176*t182
@@ -970,10 +970,10 @@ def _condition_number(q):
     t198 = t196 + t182*t195
     t199 = t167*t190 + t171*t194 + t175*t198
     t200 = (t199 != 0)
-    t201 = 0.5*(-t163 + t186)/casadi.if_else(t200, t199, 1)
+    t201 = (-t163 + t186)/casadi.if_else(t200, 2*t199, 1)
     t202 = casadi.fabs(t201)
     t203 = (t202 >= 1)
-    t204 = casadi.fabs(1/casadi.if_else(t203, t201, 1))
+    t204 = 1/casadi.fabs(casadi.if_else(t203, t201, 1))
     t205 = casadi.if_else(t200, casadi.if_else((t201 >= 0), 1, -1)*casadi.if_else(t203, t204/(1 + casadi.sqrt(1 + t204**2)), 1/(t202 + casadi.sqrt(1 + t202**2))), 0)
     t206 = 1/casadi.sqrt(1 + t205**2)
     t207 = t199*t205
@@ -993,10 +993,10 @@ def _condition_number(q):
     t221 = t219 + t205*t218
     t222 = t189*t212 + t193*t216 + t197*t220
     t223 = (t222 != 0)
-    t224 = 0.5*(-t185 + t208)/casadi.if_else(t223, t222, 1)
+    t224 = (-t185 + t208)/casadi.if_else(t223, 2*t222, 1)
     t225 = casadi.fabs(t224)
     t226 = (t225 >= 1)
-    t227 = casadi.fabs(1/casadi.if_else(t226, t224, 1))
+    t227 = 1/casadi.fabs(casadi.if_else(t226, t224, 1))
     t228 = casadi.if_else(t223, casadi.if_else((t224 >= 0), 1, -1)*casadi.if_else(t226, t227/(1 + casadi.sqrt(1 + t227**2)), 1/(t225 + casadi.sqrt(1 + t225**2))), 0)
     t229 = 1/casadi.sqrt(1 + t228**2)
     t230 = t222*t228
@@ -1016,10 +1016,10 @@ def _condition_number(q):
     t244 = t242 + t228*t241
     t245 = t213*t235 + t217*t239 + t221*t243
     t246 = (t245 != 0)
-    t247 = 0.5*(-t231 + t209)/casadi.if_else(t246, t245, 1)
+    t247 = (-t231 + t209)/casadi.if_else(t246, 2*t245, 1)
     t248 = casadi.fabs(t247)
     t249 = (t248 >= 1)
-    t250 = casadi.fabs(1/casadi.if_else(t249, t247, 1))
+    t250 = 1/casadi.fabs(casadi.if_else(t249, t247, 1))
     t251 = casadi.if_else(t246, casadi.if_else((t247 >= 0), 1, -1)*casadi.if_else(t249, t250/(1 + casadi.sqrt(1 + t250**2)), 1/(t248 + casadi.sqrt(1 + t248**2))), 0)
     t252 = 1/casadi.sqrt(1 + t251**2)
     t253 = t245*t251
@@ -1039,10 +1039,10 @@ def _condition_number(q):
     t267 = t265 + t251*t264
     t268 = t236*t259 + t240*t263 + t244*t267
     t269 = (t268 != 0)
-    t270 = 0.5*(-t232 + t255)/casadi.if_else(t269, t268, 1)
+    t270 = (-t232 + t255)/casadi.if_else(t269, 2*t268, 1)
     t271 = casadi.fabs(t270)
     t272 = (t271 >= 1)
-    t273 = casadi.fabs(1/casadi.if_else(t272, t270, 1))
+    t273 = 1/casadi.fabs(casadi.if_else(t272, t270, 1))
     t274 = casadi.if_else(t269, casadi.if_else((t270 >= 0), 1, -1)*casadi.if_else(t272, t273/(1 + casadi.sqrt(1 + t273**2)), 1/(t271 + casadi.sqrt(1 + t271**2))), 0)
     t275 = 1/casadi.sqrt(1 + t274**2)
     t276 = t268*t274
@@ -1062,10 +1062,10 @@ def _condition_number(q):
     t290 = t288 + t274*t287
     t291 = t258*t281 + t262*t285 + t266*t289
     t292 = (t291 != 0)
-    t293 = 0.5*(-t254 + t277)/casadi.if_else(t292, t291, 1)
+    t293 = (-t254 + t277)/casadi.if_else(t292, 2*t291, 1)
     t294 = casadi.fabs(t293)
     t295 = (t294 >= 1)
-    t296 = casadi.fabs(1/casadi.if_else(t295, t293, 1))
+    t296 = 1/casadi.fabs(casadi.if_else(t295, t293, 1))
     t297 = casadi.if_else(t292, casadi.if_else((t293 >= 0), 1, -1)*casadi.if_else(t295, t296/(1 + casadi.sqrt(1 + t296**2)), 1/(t294 + casadi.sqrt(1 + t294**2))), 0)
     t298 = 1/casadi.sqrt(1 + t297**2)
     t299 = t291*t297
@@ -1085,10 +1085,10 @@ def _condition_number(q):
     t313 = t311 + t297*t310
     t314 = t282*t304 + t286*t308 + t290*t312
     t315 = (t314 != 0)
-    t316 = 0.5*(-t300 + t278)/casadi.if_else(t315, t314, 1)
+    t316 = (-t300 + t278)/casadi.if_else(t315, 2*t314, 1)
     t317 = casadi.fabs(t316)
     t318 = (t317 >= 1)
-    t319 = casadi.fabs(1/casadi.if_else(t318, t316, 1))
+    t319 = 1/casadi.fabs(casadi.if_else(t318, t316, 1))
     t320 = casadi.if_else(t315, casadi.if_else((t316 >= 0), 1, -1)*casadi.if_else(t318, t319/(1 + casadi.sqrt(1 + t319**2)), 1/(t317 + casadi.sqrt(1 + t317**2))), 0)
     t321 = 1/casadi.sqrt(1 + t320**2)
     t322 = t314*t320
@@ -1108,10 +1108,10 @@ def _condition_number(q):
     t336 = t334 + t320*t333
     t337 = t305*t328 + t309*t332 + t313*t336
     t338 = (t337 != 0)
-    t339 = 0.5*(-t301 + t324)/casadi.if_else(t338, t337, 1)
+    t339 = (-t301 + t324)/casadi.if_else(t338, 2*t337, 1)
     t340 = casadi.fabs(t339)
     t341 = (t340 >= 1)
-    t342 = casadi.fabs(1/casadi.if_else(t341, t339, 1))
+    t342 = 1/casadi.fabs(casadi.if_else(t341, t339, 1))
     t343 = casadi.if_else(t338, casadi.if_else((t339 >= 0), 1, -1)*casadi.if_else(t341, t342/(1 + casadi.sqrt(1 + t342**2)), 1/(t340 + casadi.sqrt(1 + t340**2))), 0)
     t344 = 1/casadi.sqrt(1 + t343**2)
     t345 = t337*t343
@@ -1131,10 +1131,10 @@ def _condition_number(q):
     t359 = t357 + t343*t356
     t360 = t327*t350 + t331*t354 + t335*t358
     t361 = (t360 != 0)
-    t362 = 0.5*(-t323 + t346)/casadi.if_else(t361, t360, 1)
+    t362 = (-t323 + t346)/casadi.if_else(t361, 2*t360, 1)
     t363 = casadi.fabs(t362)
     t364 = (t363 >= 1)
-    t365 = casadi.fabs(1/casadi.if_else(t364, t362, 1))
+    t365 = 1/casadi.fabs(casadi.if_else(t364, t362, 1))
     t366 = casadi.if_else(t361, casadi.if_else((t362 >= 0), 1, -1)*casadi.if_else(t364, t365/(1 + casadi.sqrt(1 + t365**2)), 1/(t363 + casadi.sqrt(1 + t363**2))), 0)
     t367 = 1/casadi.sqrt(1 + t366**2)
     t368 = t360*t366
@@ -1154,10 +1154,10 @@ def _condition_number(q):
     t382 = t380 + t366*t379
     t383 = t351*t373 + t355*t377 + t359*t381
     t384 = (t383 != 0)
-    t385 = 0.5*(-t369 + t347)/casadi.if_else(t384, t383, 1)
+    t385 = (-t369 + t347)/casadi.if_else(t384, 2*t383, 1)
     t386 = casadi.fabs(t385)
     t387 = (t386 >= 1)
-    t388 = casadi.fabs(1/casadi.if_else(t387, t385, 1))
+    t388 = 1/casadi.fabs(casadi.if_else(t387, t385, 1))
     t389 = casadi.if_else(t384, casadi.if_else((t385 >= 0), 1, -1)*casadi.if_else(t387, t388/(1 + casadi.sqrt(1 + t388**2)), 1/(t386 + casadi.sqrt(1 + t386**2))), 0)
     t390 = 1/casadi.sqrt(1 + t389**2)
     t391 = t383*t389
@@ -1177,10 +1177,10 @@ def _condition_number(q):
     t405 = t403 + t389*t402
     t406 = t374*t397 + t378*t401 + t382*t405
     t407 = (t406 != 0)
-    t408 = 0.5*(-t370 + t393)/casadi.if_else(t407, t406, 1)
+    t408 = (-t370 + t393)/casadi.if_else(t407, 2*t406, 1)
     t409 = casadi.fabs(t408)
     t410 = (t409 >= 1)
-    t411 = casadi.fabs(1/casadi.if_else(t410, t408, 1))
+    t411 = 1/casadi.fabs(casadi.if_else(t410, t408, 1))
     t412 = casadi.if_else(t407, casadi.if_else((t408 >= 0), 1, -1)*casadi.if_else(t410, t411/(1 + casadi.sqrt(1 + t411**2)), 1/(t409 + casadi.sqrt(1 + t409**2))), 0)
     t413 = 1/casadi.sqrt(1 + t412**2)
     t414 = t406*t412
@@ -1200,10 +1200,10 @@ def _condition_number(q):
     t428 = t426 + t412*t425
     t429 = t396*t419 + t400*t423 + t404*t427
     t430 = (t429 != 0)
-    t431 = 0.5*(-t392 + t415)/casadi.if_else(t430, t429, 1)
+    t431 = (-t392 + t415)/casadi.if_else(t430, 2*t429, 1)
     t432 = casadi.fabs(t431)
     t433 = (t432 >= 1)
-    t434 = casadi.fabs(1/casadi.if_else(t433, t431, 1))
+    t434 = 1/casadi.fabs(casadi.if_else(t433, t431, 1))
     t435 = casadi.if_else(t430, casadi.if_else((t431 >= 0), 1, -1)*casadi.if_else(t433, t434/(1 + casadi.sqrt(1 + t434**2)), 1/(t432 + casadi.sqrt(1 + t432**2))), 0)
     t436 = 1/casadi.sqrt(1 + t435**2)
     t437 = t429*t435
@@ -1223,10 +1223,10 @@ def _condition_number(q):
     t451 = t449 + t435*t448
     t452 = t420*t442 + t424*t446 + t428*t450
     t453 = (t452 != 0)
-    t454 = 0.5*(-t438 + t416)/casadi.if_else(t453, t452, 1)
+    t454 = (-t438 + t416)/casadi.if_else(t453, 2*t452, 1)
     t455 = casadi.fabs(t454)
     t456 = (t455 >= 1)
-    t457 = casadi.fabs(1/casadi.if_else(t456, t454, 1))
+    t457 = 1/casadi.fabs(casadi.if_else(t456, t454, 1))
     t458 = casadi.if_else(t453, casadi.if_else((t454 >= 0), 1, -1)*casadi.if_else(t456, t457/(1 + casadi.sqrt(1 + t457**2)), 1/(t455 + casadi.sqrt(1 + t455**2))), 0)
     t459 = 1/casadi.sqrt(1 + t458**2)
     t460 = t416 + t452*t458
@@ -1245,10 +1245,10 @@ def _condition_number(q):
     t473 = t443*t464 + t447*t468 + t451*t472
     t474 = casadi.sqrt(t463**2 + t467**2 + t471**2)
     t475 = (t473 != 0)
-    t476 = 0.5*(-t439 + t460)/casadi.if_else(t475, t473, 1)
+    t476 = (-t439 + t460)/casadi.if_else(t475, 2*t473, 1)
     t477 = casadi.fabs(t476)
     t478 = (t477 >= 1)
-    t479 = casadi.fabs(1/casadi.if_else(t478, t476, 1))
+    t479 = 1/casadi.fabs(casadi.if_else(t478, t476, 1))
     t480 = casadi.if_else(t475, casadi.if_else((t476 >= 0), 1, -1)*casadi.if_else(t478, t479/(1 + casadi.sqrt(1 + t479**2)), 1/(t477 + casadi.sqrt(1 + t477**2))), 0)
     t481 = 1/casadi.sqrt(1 + t480**2)
     t482 = t443*t481
@@ -1271,8 +1271,10 @@ def _condition_number(q):
     t499 = casadi.if_else((1.8823529411764706 < t497), 1.8823529411764706, t497)
     t500 = casadi.if_else((t495 > t498), t495, t498)
     t501 = casadi.if_else((t495 < t499), t495, t499)
+    t502 = casadi.if_else((t501 <= 1e-12*t500), 0, t501)
+    t503 = casadi.if_else((t500 > 0), t500, 1)
     kappa = casadi.SX(1, 1)
-    kappa[0, 0] = casadi.if_else((t500 > 0), t500, 1)/casadi.if_else((t501 <= 1e-12*t500), 0, t501)
+    kappa[0, 0] = t503/t502
     return [kappa]
 
 

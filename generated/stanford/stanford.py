@@ -1817,10 +1817,10 @@ def velocity_ellipsoid(q):
     t48 = t47**2
     t49 = t25*t29
     t50 = xp.not_equal(t49, 0)
-    t51 = 0.5*(-t31 + t38)/xp.where(t50, -t49, 1)
+    t51 = (-t31 + t38)/xp.where(t50, -2*t49, 1)
     t52 = xp.abs(t51)
     t53 = xp.greater_equal(t52, 1)
-    t54 = xp.abs(1/xp.where(t53, t51, 1))
+    t54 = 1/xp.abs(xp.where(t53, t51, 1))
     t55 = xp.where(t50, xp.where(xp.greater_equal(t51, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t53, t54/(1 + xp.sqrt(1 + t54**2)), 1/(t52 + xp.sqrt(1 + t52**2))), 0)
     t56 = 1/xp.sqrt(1 + t55**2)
     t57 = t49*t55
@@ -1836,10 +1836,10 @@ def velocity_ellipsoid(q):
     t67 = t66*t55
     t68 = t64*t62 - t67*t44
     t69 = xp.not_equal(t68, 0)
-    t70 = 0.5*(-t58 + t65)/xp.where(t69, t68, 1)
+    t70 = (-t58 + t65)/xp.where(t69, 2*t68, 1)
     t71 = xp.abs(t70)
     t72 = xp.greater_equal(t71, 1)
-    t73 = xp.abs(1/xp.where(t72, t70, 1))
+    t73 = 1/xp.abs(xp.where(t72, t70, 1))
     t74 = xp.where(t69, xp.where(xp.greater_equal(t70, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t72, t73/(1 + xp.sqrt(1 + t73**2)), 1/(t71 + xp.sqrt(1 + t71**2))), 0)
     t75 = 1/xp.sqrt(1 + t74**2)
     t76 = t68*t74
@@ -1855,10 +1855,10 @@ def velocity_ellipsoid(q):
     t86 = -t84 + t83*t74
     t87 = t63*t82 + t66*t86
     t88 = xp.not_equal(t87, 0)
-    t89 = 0.5*(-t59 + t78)/xp.where(t88, -t87, 1)
+    t89 = (-t59 + t78)/xp.where(t88, -2*t87, 1)
     t90 = xp.abs(t89)
     t91 = xp.greater_equal(t90, 1)
-    t92 = xp.abs(1/xp.where(t91, t89, 1))
+    t92 = 1/xp.abs(xp.where(t91, t89, 1))
     t93 = xp.where(t88, xp.where(xp.greater_equal(t89, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t91, t92/(1 + xp.sqrt(1 + t92**2)), 1/(t90 + xp.sqrt(1 + t90**2))), 0)
     t94 = 1/xp.sqrt(1 + t93**2)
     t95 = t87*t93
@@ -1884,10 +1884,10 @@ def velocity_ellipsoid(q):
     t115 = t93*t94
     t116 = t81*t100 - t85*t105 + t48*t109*t115*t75
     t117 = xp.not_equal(t116, 0)
-    t118 = 0.5*(-t77 + t96)/xp.where(t117, t116, 1)
+    t118 = (-t77 + t96)/xp.where(t117, 2*t116, 1)
     t119 = xp.abs(t118)
     t120 = xp.greater_equal(t119, 1)
-    t121 = xp.abs(1/xp.where(t120, t118, 1))
+    t121 = 1/xp.abs(xp.where(t120, t118, 1))
     t122 = xp.where(t117, xp.where(xp.greater_equal(t118, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t120, t121/(1 + xp.sqrt(1 + t121**2)), 1/(t119 + xp.sqrt(1 + t119**2))), 0)
     t123 = 1/xp.sqrt(1 + t122**2)
     t124 = t116*t122
@@ -1921,10 +1921,10 @@ def velocity_ellipsoid(q):
     t152 = t75*t94
     t153 = t101*t129 + t106*t133 - t47*t152*t142
     t154 = xp.not_equal(t153, 0)
-    t155 = 0.5*(-t125 + t97)/xp.where(t154, t153, 1)
+    t155 = (-t125 + t97)/xp.where(t154, 2*t153, 1)
     t156 = xp.abs(t155)
     t157 = xp.greater_equal(t156, 1)
-    t158 = xp.abs(1/xp.where(t157, t155, 1))
+    t158 = 1/xp.abs(xp.where(t157, t155, 1))
     t159 = xp.where(t154, xp.where(xp.greater_equal(t155, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t157, t158/(1 + xp.sqrt(1 + t158**2)), 1/(t156 + xp.sqrt(1 + t156**2))), 0)
     t160 = 1/xp.sqrt(1 + t159**2)
     t161 = t153*t159
@@ -1956,10 +1956,10 @@ def velocity_ellipsoid(q):
     t187 = t186 - t159*t173
     t188 = t173 + t159*t186
     t189 = xp.not_equal(t177, 0)
-    t190 = 0.5*(-t126 + t163)/xp.where(t189, t177, 1)
+    t190 = (-t126 + t163)/xp.where(t189, 2*t177, 1)
     t191 = xp.abs(t190)
     t192 = xp.greater_equal(t191, 1)
-    t193 = xp.abs(1/xp.where(t192, t190, 1))
+    t193 = 1/xp.abs(xp.where(t192, t190, 1))
     t194 = xp.where(t189, xp.where(xp.greater_equal(t190, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t192, t193/(1 + xp.sqrt(1 + t193**2)), 1/(t191 + xp.sqrt(1 + t191**2))), 0)
     t195 = 1/xp.sqrt(1 + t194**2)
     t196 = t177*t194
@@ -1991,10 +1991,10 @@ def velocity_ellipsoid(q):
     t222 = t220 + t194*t221
     t223 = t221 - t194*t220
     t224 = xp.not_equal(t211, 0)
-    t225 = 0.5*(-t162 + t197)/xp.where(t224, t211, 1)
+    t225 = (-t162 + t197)/xp.where(t224, 2*t211, 1)
     t226 = xp.abs(t225)
     t227 = xp.greater_equal(t226, 1)
-    t228 = xp.abs(1/xp.where(t227, t225, 1))
+    t228 = 1/xp.abs(xp.where(t227, t225, 1))
     t229 = xp.where(t224, xp.where(xp.greater_equal(t225, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t227, t228/(1 + xp.sqrt(1 + t228**2)), 1/(t226 + xp.sqrt(1 + t226**2))), 0)
     t230 = 1/xp.sqrt(1 + t229**2)
     t231 = t211*t229
@@ -2026,10 +2026,10 @@ def velocity_ellipsoid(q):
     t257 = t255 + t229*t256
     t258 = -t256 + t229*t255
     t259 = xp.not_equal(t246, 0)
-    t260 = 0.5*(-t232 + t198)/xp.where(t259, t246, 1)
+    t260 = (-t232 + t198)/xp.where(t259, 2*t246, 1)
     t261 = xp.abs(t260)
     t262 = xp.greater_equal(t261, 1)
-    t263 = xp.abs(1/xp.where(t262, t260, 1))
+    t263 = 1/xp.abs(xp.where(t262, t260, 1))
     t264 = xp.where(t259, xp.where(xp.greater_equal(t260, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t262, t263/(1 + xp.sqrt(1 + t263**2)), 1/(t261 + xp.sqrt(1 + t261**2))), 0)
     t265 = 1/xp.sqrt(1 + t264**2)
     t266 = t246*t264
@@ -2061,10 +2061,10 @@ def velocity_ellipsoid(q):
     t292 = t290 - t264*t291
     t293 = t291 + t264*t290
     t294 = xp.not_equal(t281, 0)
-    t295 = 0.5*(-t233 + t268)/xp.where(t294, t281, 1)
+    t295 = (-t233 + t268)/xp.where(t294, 2*t281, 1)
     t296 = xp.abs(t295)
     t297 = xp.greater_equal(t296, 1)
-    t298 = xp.abs(1/xp.where(t297, t295, 1))
+    t298 = 1/xp.abs(xp.where(t297, t295, 1))
     t299 = xp.where(t294, xp.where(xp.greater_equal(t295, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t297, t298/(1 + xp.sqrt(1 + t298**2)), 1/(t296 + xp.sqrt(1 + t296**2))), 0)
     t300 = 1/xp.sqrt(1 + t299**2)
     t301 = t281*t299
@@ -2096,10 +2096,10 @@ def velocity_ellipsoid(q):
     t327 = t325 - t299*t326
     t328 = t326 + t299*t325
     t329 = xp.not_equal(t316, 0)
-    t330 = 0.5*(-t267 + t302)/xp.where(t329, t316, 1)
+    t330 = (-t267 + t302)/xp.where(t329, 2*t316, 1)
     t331 = xp.abs(t330)
     t332 = xp.greater_equal(t331, 1)
-    t333 = xp.abs(1/xp.where(t332, t330, 1))
+    t333 = 1/xp.abs(xp.where(t332, t330, 1))
     t334 = xp.where(t329, xp.where(xp.greater_equal(t330, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t332, t333/(1 + xp.sqrt(1 + t333**2)), 1/(t331 + xp.sqrt(1 + t331**2))), 0)
     t335 = 1/xp.sqrt(1 + t334**2)
     t336 = t316*t334
@@ -2131,10 +2131,10 @@ def velocity_ellipsoid(q):
     t362 = t360 - t334*t361
     t363 = t361 + t334*t360
     t364 = xp.not_equal(t351, 0)
-    t365 = 0.5*(-t337 + t303)/xp.where(t364, t351, 1)
+    t365 = (-t337 + t303)/xp.where(t364, 2*t351, 1)
     t366 = xp.abs(t365)
     t367 = xp.greater_equal(t366, 1)
-    t368 = xp.abs(1/xp.where(t367, t365, 1))
+    t368 = 1/xp.abs(xp.where(t367, t365, 1))
     t369 = xp.where(t364, xp.where(xp.greater_equal(t365, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t367, t368/(1 + xp.sqrt(1 + t368**2)), 1/(t366 + xp.sqrt(1 + t366**2))), 0)
     t370 = 1/xp.sqrt(1 + t369**2)
     t371 = t351*t369
@@ -2166,10 +2166,10 @@ def velocity_ellipsoid(q):
     t397 = t395 - t369*t396
     t398 = t396 + t369*t395
     t399 = xp.not_equal(t386, 0)
-    t400 = 0.5*(-t338 + t373)/xp.where(t399, t386, 1)
+    t400 = (-t338 + t373)/xp.where(t399, 2*t386, 1)
     t401 = xp.abs(t400)
     t402 = xp.greater_equal(t401, 1)
-    t403 = xp.abs(1/xp.where(t402, t400, 1))
+    t403 = 1/xp.abs(xp.where(t402, t400, 1))
     t404 = xp.where(t399, xp.where(xp.greater_equal(t400, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t402, t403/(1 + xp.sqrt(1 + t403**2)), 1/(t401 + xp.sqrt(1 + t401**2))), 0)
     t405 = 1/xp.sqrt(1 + t404**2)
     t406 = t386*t404
@@ -2201,10 +2201,10 @@ def velocity_ellipsoid(q):
     t432 = t430 - t404*t431
     t433 = t431 + t404*t430
     t434 = xp.not_equal(t421, 0)
-    t435 = 0.5*(-t372 + t407)/xp.where(t434, t421, 1)
+    t435 = (-t372 + t407)/xp.where(t434, 2*t421, 1)
     t436 = xp.abs(t435)
     t437 = xp.greater_equal(t436, 1)
-    t438 = xp.abs(1/xp.where(t437, t435, 1))
+    t438 = 1/xp.abs(xp.where(t437, t435, 1))
     t439 = xp.where(t434, xp.where(xp.greater_equal(t435, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t437, t438/(1 + xp.sqrt(1 + t438**2)), 1/(t436 + xp.sqrt(1 + t436**2))), 0)
     t440 = 1/xp.sqrt(1 + t439**2)
     t441 = t421*t439
@@ -2236,10 +2236,10 @@ def velocity_ellipsoid(q):
     t467 = t465 - t439*t466
     t468 = t466 + t439*t465
     t469 = xp.not_equal(t456, 0)
-    t470 = 0.5*(-t442 + t408)/xp.where(t469, t456, 1)
+    t470 = (-t442 + t408)/xp.where(t469, 2*t456, 1)
     t471 = xp.abs(t470)
     t472 = xp.greater_equal(t471, 1)
-    t473 = xp.abs(1/xp.where(t472, t470, 1))
+    t473 = 1/xp.abs(xp.where(t472, t470, 1))
     t474 = xp.where(t469, xp.where(xp.greater_equal(t470, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t472, t473/(1 + xp.sqrt(1 + t473**2)), 1/(t471 + xp.sqrt(1 + t471**2))), 0)
     t475 = 1/xp.sqrt(1 + t474**2)
     t476 = t408 + t456*t474
@@ -2270,10 +2270,10 @@ def velocity_ellipsoid(q):
     t501 = t499 - t474*t500
     t502 = t500 + t474*t499
     t503 = xp.not_equal(t489, 0)
-    t504 = 0.5*(-t443 + t476)/xp.where(t503, t489, 1)
+    t504 = (-t443 + t476)/xp.where(t503, 2*t489, 1)
     t505 = xp.abs(t504)
     t506 = xp.greater_equal(t505, 1)
-    t507 = xp.abs(1/xp.where(t506, t504, 1))
+    t507 = 1/xp.abs(xp.where(t506, t504, 1))
     t508 = xp.where(t503, xp.where(xp.greater_equal(t504, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t506, t507/(1 + xp.sqrt(1 + t507**2)), 1/(t505 + xp.sqrt(1 + t505**2))), 0)
     t509 = 1/xp.sqrt(1 + t508**2)
     t510 = t447*t509
@@ -2364,10 +2364,10 @@ def velocity_ellipsoid(q):
     t595 = t594**2
     t596 = t584**2 + t590**2 + t595
     t597 = xp.not_equal(t581, 0)
-    t598 = 0.5*(-t569 + t580)/xp.where(t597, t581, 1)
+    t598 = (-t569 + t580)/xp.where(t597, 2*t581, 1)
     t599 = xp.abs(t598)
     t600 = xp.greater_equal(t599, 1)
-    t601 = xp.abs(1/xp.where(t600, t598, 1))
+    t601 = 1/xp.abs(xp.where(t600, t598, 1))
     t602 = xp.where(t597, xp.where(xp.greater_equal(t598, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t600, t601/(1 + xp.sqrt(1 + t601**2)), 1/(t599 + xp.sqrt(1 + t599**2))), 0)
     t603 = 1/xp.sqrt(1 + t602**2)
     t604 = t581*t602
@@ -2381,10 +2381,10 @@ def velocity_ellipsoid(q):
     t612 = t602*t611
     t613 = t584*t609 + t590*t612
     t614 = xp.not_equal(t613, 0)
-    t615 = 0.5*(-t605 + t596)/xp.where(t614, t613, 1)
+    t615 = (-t605 + t596)/xp.where(t614, 2*t613, 1)
     t616 = xp.abs(t615)
     t617 = xp.greater_equal(t616, 1)
-    t618 = xp.abs(1/xp.where(t617, t615, 1))
+    t618 = 1/xp.abs(xp.where(t617, t615, 1))
     t619 = xp.where(t614, xp.where(xp.greater_equal(t615, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t617, t618/(1 + xp.sqrt(1 + t618**2)), 1/(t616 + xp.sqrt(1 + t616**2))), 0)
     t620 = 1/xp.sqrt(1 + t619**2)
     t621 = t613*t619
@@ -2400,10 +2400,10 @@ def velocity_ellipsoid(q):
     t631 = t629 + t619*t628
     t632 = t610*t627 + t631*t611
     t633 = xp.not_equal(t632, 0)
-    t634 = 0.5*(-t606 + t623)/xp.where(t633, -t632, 1)
+    t634 = (-t606 + t623)/xp.where(t633, -2*t632, 1)
     t635 = xp.abs(t634)
     t636 = xp.greater_equal(t635, 1)
-    t637 = xp.abs(1/xp.where(t636, t634, 1))
+    t637 = 1/xp.abs(xp.where(t636, t634, 1))
     t638 = xp.where(t633, xp.where(xp.greater_equal(t634, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t636, t637/(1 + xp.sqrt(1 + t637**2)), 1/(t635 + xp.sqrt(1 + t635**2))), 0)
     t639 = 1/xp.sqrt(1 + t638**2)
     t640 = t632*t638
@@ -2429,10 +2429,10 @@ def velocity_ellipsoid(q):
     t660 = t638*t639
     t661 = t626*t645 + t630*t650 - t620*t595*t654*t660
     t662 = xp.not_equal(t661, 0)
-    t663 = 0.5*(-t622 + t641)/xp.where(t662, -t661, 1)
+    t663 = (-t622 + t641)/xp.where(t662, -2*t661, 1)
     t664 = xp.abs(t663)
     t665 = xp.greater_equal(t664, 1)
-    t666 = xp.abs(1/xp.where(t665, t663, 1))
+    t666 = 1/xp.abs(xp.where(t665, t663, 1))
     t667 = xp.where(t662, xp.where(xp.greater_equal(t663, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t665, t666/(1 + xp.sqrt(1 + t666**2)), 1/(t664 + xp.sqrt(1 + t664**2))), 0)
     t668 = 1/xp.sqrt(1 + t667**2)
     t669 = t661*t667
@@ -2466,10 +2466,10 @@ def velocity_ellipsoid(q):
     t697 = t620*t639
     t698 = t646*t674 + t651*t678 - t594*t687*t697
     t699 = xp.not_equal(t698, 0)
-    t700 = 0.5*(-t670 + t642)/xp.where(t699, t698, 1)
+    t700 = (-t670 + t642)/xp.where(t699, 2*t698, 1)
     t701 = xp.abs(t700)
     t702 = xp.greater_equal(t701, 1)
-    t703 = xp.abs(1/xp.where(t702, t700, 1))
+    t703 = 1/xp.abs(xp.where(t702, t700, 1))
     t704 = xp.where(t699, xp.where(xp.greater_equal(t700, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t702, t703/(1 + xp.sqrt(1 + t703**2)), 1/(t701 + xp.sqrt(1 + t701**2))), 0)
     t705 = 1/xp.sqrt(1 + t704**2)
     t706 = t698*t704
@@ -2501,10 +2501,10 @@ def velocity_ellipsoid(q):
     t732 = t731 - t704*t718
     t733 = t718 + t704*t731
     t734 = xp.not_equal(t722, 0)
-    t735 = 0.5*(-t671 + t708)/xp.where(t734, t722, 1)
+    t735 = (-t671 + t708)/xp.where(t734, 2*t722, 1)
     t736 = xp.abs(t735)
     t737 = xp.greater_equal(t736, 1)
-    t738 = xp.abs(1/xp.where(t737, t735, 1))
+    t738 = 1/xp.abs(xp.where(t737, t735, 1))
     t739 = xp.where(t734, xp.where(xp.greater_equal(t735, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t737, t738/(1 + xp.sqrt(1 + t738**2)), 1/(t736 + xp.sqrt(1 + t736**2))), 0)
     t740 = 1/xp.sqrt(1 + t739**2)
     t741 = t722*t739
@@ -2536,10 +2536,10 @@ def velocity_ellipsoid(q):
     t767 = t765 + t739*t766
     t768 = t766 - t739*t765
     t769 = xp.not_equal(t756, 0)
-    t770 = 0.5*(-t707 + t742)/xp.where(t769, t756, 1)
+    t770 = (-t707 + t742)/xp.where(t769, 2*t756, 1)
     t771 = xp.abs(t770)
     t772 = xp.greater_equal(t771, 1)
-    t773 = xp.abs(1/xp.where(t772, t770, 1))
+    t773 = 1/xp.abs(xp.where(t772, t770, 1))
     t774 = xp.where(t769, xp.where(xp.greater_equal(t770, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t772, t773/(1 + xp.sqrt(1 + t773**2)), 1/(t771 + xp.sqrt(1 + t771**2))), 0)
     t775 = 1/xp.sqrt(1 + t774**2)
     t776 = t756*t774
@@ -2571,10 +2571,10 @@ def velocity_ellipsoid(q):
     t802 = t800 + t774*t801
     t803 = -t801 + t774*t800
     t804 = xp.not_equal(t791, 0)
-    t805 = 0.5*(-t777 + t743)/xp.where(t804, t791, 1)
+    t805 = (-t777 + t743)/xp.where(t804, 2*t791, 1)
     t806 = xp.abs(t805)
     t807 = xp.greater_equal(t806, 1)
-    t808 = xp.abs(1/xp.where(t807, t805, 1))
+    t808 = 1/xp.abs(xp.where(t807, t805, 1))
     t809 = xp.where(t804, xp.where(xp.greater_equal(t805, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t807, t808/(1 + xp.sqrt(1 + t808**2)), 1/(t806 + xp.sqrt(1 + t806**2))), 0)
     t810 = 1/xp.sqrt(1 + t809**2)
     t811 = t791*t809
@@ -2606,10 +2606,10 @@ def velocity_ellipsoid(q):
     t837 = t835 - t809*t836
     t838 = t836 + t809*t835
     t839 = xp.not_equal(t826, 0)
-    t840 = 0.5*(-t778 + t813)/xp.where(t839, t826, 1)
+    t840 = (-t778 + t813)/xp.where(t839, 2*t826, 1)
     t841 = xp.abs(t840)
     t842 = xp.greater_equal(t841, 1)
-    t843 = xp.abs(1/xp.where(t842, t840, 1))
+    t843 = 1/xp.abs(xp.where(t842, t840, 1))
     t844 = xp.where(t839, xp.where(xp.greater_equal(t840, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t842, t843/(1 + xp.sqrt(1 + t843**2)), 1/(t841 + xp.sqrt(1 + t841**2))), 0)
     t845 = 1/xp.sqrt(1 + t844**2)
     t846 = t826*t844
@@ -2641,10 +2641,10 @@ def velocity_ellipsoid(q):
     t872 = t870 - t844*t871
     t873 = t871 + t844*t870
     t874 = xp.not_equal(t861, 0)
-    t875 = 0.5*(-t812 + t847)/xp.where(t874, t861, 1)
+    t875 = (-t812 + t847)/xp.where(t874, 2*t861, 1)
     t876 = xp.abs(t875)
     t877 = xp.greater_equal(t876, 1)
-    t878 = xp.abs(1/xp.where(t877, t875, 1))
+    t878 = 1/xp.abs(xp.where(t877, t875, 1))
     t879 = xp.where(t874, xp.where(xp.greater_equal(t875, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t877, t878/(1 + xp.sqrt(1 + t878**2)), 1/(t876 + xp.sqrt(1 + t876**2))), 0)
     t880 = 1/xp.sqrt(1 + t879**2)
     t881 = t861*t879
@@ -2676,10 +2676,10 @@ def velocity_ellipsoid(q):
     t907 = t905 - t879*t906
     t908 = t906 + t879*t905
     t909 = xp.not_equal(t896, 0)
-    t910 = 0.5*(-t882 + t848)/xp.where(t909, t896, 1)
+    t910 = (-t882 + t848)/xp.where(t909, 2*t896, 1)
     t911 = xp.abs(t910)
     t912 = xp.greater_equal(t911, 1)
-    t913 = xp.abs(1/xp.where(t912, t910, 1))
+    t913 = 1/xp.abs(xp.where(t912, t910, 1))
     t914 = xp.where(t909, xp.where(xp.greater_equal(t910, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t912, t913/(1 + xp.sqrt(1 + t913**2)), 1/(t911 + xp.sqrt(1 + t911**2))), 0)
     t915 = 1/xp.sqrt(1 + t914**2)
     t916 = t896*t914
@@ -2711,10 +2711,10 @@ def velocity_ellipsoid(q):
     t942 = t940 - t914*t941
     t943 = t941 + t914*t940
     t944 = xp.not_equal(t931, 0)
-    t945 = 0.5*(-t883 + t918)/xp.where(t944, t931, 1)
+    t945 = (-t883 + t918)/xp.where(t944, 2*t931, 1)
     t946 = xp.abs(t945)
     t947 = xp.greater_equal(t946, 1)
-    t948 = xp.abs(1/xp.where(t947, t945, 1))
+    t948 = 1/xp.abs(xp.where(t947, t945, 1))
     t949 = xp.where(t944, xp.where(xp.greater_equal(t945, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t947, t948/(1 + xp.sqrt(1 + t948**2)), 1/(t946 + xp.sqrt(1 + t946**2))), 0)
     t950 = 1/xp.sqrt(1 + t949**2)
     t951 = t931*t949
@@ -2746,10 +2746,10 @@ def velocity_ellipsoid(q):
     t977 = t975 - t949*t976
     t978 = t976 + t949*t975
     t979 = xp.not_equal(t966, 0)
-    t980 = 0.5*(-t917 + t952)/xp.where(t979, t966, 1)
+    t980 = (-t917 + t952)/xp.where(t979, 2*t966, 1)
     t981 = xp.abs(t980)
     t982 = xp.greater_equal(t981, 1)
-    t983 = xp.abs(1/xp.where(t982, t980, 1))
+    t983 = 1/xp.abs(xp.where(t982, t980, 1))
     t984 = xp.where(t979, xp.where(xp.greater_equal(t980, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t982, t983/(1 + xp.sqrt(1 + t983**2)), 1/(t981 + xp.sqrt(1 + t981**2))), 0)
     t985 = 1/xp.sqrt(1 + t984**2)
     t986 = t966*t984
@@ -2781,10 +2781,10 @@ def velocity_ellipsoid(q):
     t1012 = t1010 - t984*t1011
     t1013 = t1011 + t984*t1010
     t1014 = xp.not_equal(t1001, 0)
-    t1015 = 0.5*(-t987 + t953)/xp.where(t1014, t1001, 1)
+    t1015 = (-t987 + t953)/xp.where(t1014, 2*t1001, 1)
     t1016 = xp.abs(t1015)
     t1017 = xp.greater_equal(t1016, 1)
-    t1018 = xp.abs(1/xp.where(t1017, t1015, 1))
+    t1018 = 1/xp.abs(xp.where(t1017, t1015, 1))
     t1019 = xp.where(t1014, xp.where(xp.greater_equal(t1015, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1017, t1018/(1 + xp.sqrt(1 + t1018**2)), 1/(t1016 + xp.sqrt(1 + t1016**2))), 0)
     t1020 = 1/xp.sqrt(1 + t1019**2)
     t1021 = t953 + t1001*t1019
@@ -2815,10 +2815,10 @@ def velocity_ellipsoid(q):
     t1046 = t1044 - t1019*t1045
     t1047 = t1045 + t1019*t1044
     t1048 = xp.not_equal(t1034, 0)
-    t1049 = 0.5*(-t988 + t1021)/xp.where(t1048, t1034, 1)
+    t1049 = (-t988 + t1021)/xp.where(t1048, 2*t1034, 1)
     t1050 = xp.abs(t1049)
     t1051 = xp.greater_equal(t1050, 1)
-    t1052 = xp.abs(1/xp.where(t1051, t1049, 1))
+    t1052 = 1/xp.abs(xp.where(t1051, t1049, 1))
     t1053 = xp.where(t1048, xp.where(xp.greater_equal(t1049, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1051, t1052/(1 + xp.sqrt(1 + t1052**2)), 1/(t1050 + xp.sqrt(1 + t1050**2))), 0)
     t1054 = 1/xp.sqrt(1 + t1053**2)
     t1055 = t992*t1054
@@ -3041,10 +3041,10 @@ def condition_number(q):
     t109 = t55*t81
     t110 = t60*t71 + t84*t93 + t107*t75 - t108*t78 + t109*t87
     t111 = xp.not_equal(t110, 0)
-    t112 = 0.5*(-t106 + t95)/xp.where(t111, -t110, 1)
+    t112 = (-t106 + t95)/xp.where(t111, -2*t110, 1)
     t113 = xp.abs(t112)
     t114 = xp.greater_equal(t113, 1)
-    t115 = xp.abs(1/xp.where(t114, t112, 1))
+    t115 = 1/xp.abs(xp.where(t114, t112, 1))
     t116 = xp.where(t111, xp.where(xp.greater_equal(t112, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t114, t115/(1 + xp.sqrt(1 + t115**2)), 1/(t113 + xp.sqrt(1 + t113**2))), 0)
     t117 = 1/xp.sqrt(1 + t116**2)
     t118 = t110*t116
@@ -3072,10 +3072,10 @@ def condition_number(q):
     t140 = -t138 + t137*t116
     t141 = t97*t127 + t101*t131 - t102*t135 + t103*t139
     t142 = xp.not_equal(t141, 0)
-    t143 = 0.5*(-t119 + t104)/xp.where(t142, t141, 1)
+    t143 = (-t119 + t104)/xp.where(t142, 2*t141, 1)
     t144 = xp.abs(t143)
     t145 = xp.greater_equal(t144, 1)
-    t146 = xp.abs(1/xp.where(t145, t143, 1))
+    t146 = 1/xp.abs(xp.where(t145, t143, 1))
     t147 = xp.where(t142, xp.where(xp.greater_equal(t143, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t145, t146/(1 + xp.sqrt(1 + t146**2)), 1/(t144 + xp.sqrt(1 + t144**2))), 0)
     t148 = 1/xp.sqrt(1 + t147**2)
     t149 = t141*t147
@@ -3099,10 +3099,10 @@ def condition_number(q):
     t167 = t165 + t164*t147
     t168 = t21*t158 + t25*t162 - t34*t166
     t169 = xp.not_equal(t168, 0)
-    t170 = 0.5*(-t150 + t42)/xp.where(t169, -t168, 1)
+    t170 = (-t150 + t42)/xp.where(t169, -2*t168, 1)
     t171 = xp.abs(t170)
     t172 = xp.greater_equal(t171, 1)
-    t173 = xp.abs(1/xp.where(t172, t170, 1))
+    t173 = 1/xp.abs(xp.where(t172, t170, 1))
     t174 = xp.where(t169, xp.where(xp.greater_equal(t170, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t172, t173/(1 + xp.sqrt(1 + t173**2)), 1/(t171 + xp.sqrt(1 + t171**2))), 0)
     t175 = 1/xp.sqrt(1 + t174**2)
     t176 = t168*t174
@@ -3122,10 +3122,10 @@ def condition_number(q):
     t190 = t188 + t187*t174
     t191 = t29*t185 - t38*t189
     t192 = xp.not_equal(t191, 0)
-    t193 = 0.5*(-t177 + t43)/xp.where(t192, t191, 1)
+    t193 = (-t177 + t43)/xp.where(t192, 2*t191, 1)
     t194 = xp.abs(t193)
     t195 = xp.greater_equal(t194, 1)
-    t196 = xp.abs(1/xp.where(t195, t193, 1))
+    t196 = 1/xp.abs(xp.where(t195, t193, 1))
     t197 = xp.where(t192, xp.where(xp.greater_equal(t193, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t195, t196/(1 + xp.sqrt(1 + t196**2)), 1/(t194 + xp.sqrt(1 + t194**2))), 0)
     t198 = 1/xp.sqrt(1 + t197**2)
     t199 = t191*t197
@@ -3141,10 +3141,10 @@ def condition_number(q):
     t209 = -t207 + t206*t197
     t210 = t41*t208
     t211 = xp.not_equal(t210, 0)
-    t212 = 0.5*(-t200 + t44)/xp.where(t211, -t210, 1)
+    t212 = (-t200 + t44)/xp.where(t211, -2*t210, 1)
     t213 = xp.abs(t212)
     t214 = xp.greater_equal(t213, 1)
-    t215 = xp.abs(1/xp.where(t214, t212, 1))
+    t215 = 1/xp.abs(xp.where(t214, t212, 1))
     t216 = xp.where(t211, xp.where(xp.greater_equal(t212, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t214, t215/(1 + xp.sqrt(1 + t215**2)), 1/(t213 + xp.sqrt(1 + t213**2))), 0)
     t217 = 1/xp.sqrt(1 + t216**2)
     t218 = t210*t216
@@ -3158,10 +3158,10 @@ def condition_number(q):
     t226 = t225*t123
     t227 = -t128*t155 + t132*t159 + t136*t163 + t140*t167 + t105*t225*t116*t117**2 + t226*t124
     t228 = xp.not_equal(t227, 0)
-    t229 = 0.5*(-t120 + t151)/xp.where(t228, t227, 1)
+    t229 = (-t120 + t151)/xp.where(t228, 2*t227, 1)
     t230 = xp.abs(t229)
     t231 = xp.greater_equal(t230, 1)
-    t232 = xp.abs(1/xp.where(t231, t229, 1))
+    t232 = 1/xp.abs(xp.where(t231, t229, 1))
     t233 = xp.where(t228, xp.where(xp.greater_equal(t229, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t231, t232/(1 + xp.sqrt(1 + t232**2)), 1/(t230 + xp.sqrt(1 + t230**2))), 0)
     t234 = 1/xp.sqrt(1 + t233**2)
     t235 = t227*t233
@@ -3200,10 +3200,10 @@ def condition_number(q):
     t268 = t264*t154
     t269 = t182*t254 + t186*t258 + t190*t262 - t266*t242 + t267*t246 + t268*t250
     t270 = xp.not_equal(t269, 0)
-    t271 = 0.5*(-t236 + t178)/xp.where(t270, t269, 1)
+    t271 = (-t236 + t178)/xp.where(t270, 2*t269, 1)
     t272 = xp.abs(t271)
     t273 = xp.greater_equal(t272, 1)
-    t274 = xp.abs(1/xp.where(t273, t271, 1))
+    t274 = 1/xp.abs(xp.where(t273, t271, 1))
     t275 = xp.where(t270, xp.where(xp.greater_equal(t271, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t273, t274/(1 + xp.sqrt(1 + t274**2)), 1/(t272 + xp.sqrt(1 + t272**2))), 0)
     t276 = 1/xp.sqrt(1 + t275**2)
     t277 = t269*t275
@@ -3246,10 +3246,10 @@ def condition_number(q):
     t314 = t313*t197
     t315 = -t205*t298 + t209*t302 - t308*t282 + t310*t286 + t312*t290 + t314*t294
     t316 = xp.not_equal(t315, 0)
-    t317 = 0.5*(-t278 + t201)/xp.where(t316, t315, 1)
+    t317 = (-t278 + t201)/xp.where(t316, 2*t315, 1)
     t318 = xp.abs(t317)
     t319 = xp.greater_equal(t318, 1)
-    t320 = xp.abs(1/xp.where(t319, t317, 1))
+    t320 = 1/xp.abs(xp.where(t319, t317, 1))
     t321 = xp.where(t316, xp.where(xp.greater_equal(t317, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t319, t320/(1 + xp.sqrt(1 + t320**2)), 1/(t318 + xp.sqrt(1 + t318**2))), 0)
     t322 = 1/xp.sqrt(1 + t321**2)
     t323 = t315*t321
@@ -3291,10 +3291,10 @@ def condition_number(q):
     t359 = t358*t216
     t360 = t224*t348 - t351*t328 + t353*t332 + t355*t336 + t357*t340 + t359*t344
     t361 = xp.not_equal(t360, 0)
-    t362 = 0.5*(-t324 + t220)/xp.where(t361, t360, 1)
+    t362 = (-t324 + t220)/xp.where(t361, 2*t360, 1)
     t363 = xp.abs(t362)
     t364 = xp.greater_equal(t363, 1)
-    t365 = xp.abs(1/xp.where(t364, t362, 1))
+    t365 = 1/xp.abs(xp.where(t364, t362, 1))
     t366 = xp.where(t361, xp.where(xp.greater_equal(t362, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t364, t365/(1 + xp.sqrt(1 + t365**2)), 1/(t363 + xp.sqrt(1 + t363**2))), 0)
     t367 = 1/xp.sqrt(1 + t366**2)
     t368 = t360*t366
@@ -3326,10 +3326,10 @@ def condition_number(q):
     t394 = t392 + t391*t366
     t395 = t223*t393 - t350*t373 + t352*t377 + t354*t381 + t356*t385 + t358*t389
     t396 = xp.not_equal(t304, 0)
-    t397 = 0.5*(-t237 + t279)/xp.where(t396, t304, 1)
+    t397 = (-t237 + t279)/xp.where(t396, 2*t304, 1)
     t398 = xp.abs(t397)
     t399 = xp.greater_equal(t398, 1)
-    t400 = xp.abs(1/xp.where(t399, t397, 1))
+    t400 = 1/xp.abs(xp.where(t399, t397, 1))
     t401 = xp.where(t396, xp.where(xp.greater_equal(t397, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t399, t400/(1 + xp.sqrt(1 + t400**2)), 1/(t398 + xp.sqrt(1 + t398**2))), 0)
     t402 = 1/xp.sqrt(1 + t401**2)
     t403 = t304*t401
@@ -3361,10 +3361,10 @@ def condition_number(q):
     t429 = t427 + t426*t401
     t430 = -t329*t408 + t333*t412 + t337*t416 + t341*t420 + t345*t424 + t349*t428
     t431 = xp.not_equal(t430, 0)
-    t432 = 0.5*(-t404 + t325)/xp.where(t431, t430, 1)
+    t432 = (-t404 + t325)/xp.where(t431, 2*t430, 1)
     t433 = xp.abs(t432)
     t434 = xp.greater_equal(t433, 1)
-    t435 = xp.abs(1/xp.where(t434, t432, 1))
+    t435 = 1/xp.abs(xp.where(t434, t432, 1))
     t436 = xp.where(t431, xp.where(xp.greater_equal(t432, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t434, t435/(1 + xp.sqrt(1 + t435**2)), 1/(t433 + xp.sqrt(1 + t433**2))), 0)
     t437 = 1/xp.sqrt(1 + t436**2)
     t438 = t430*t436
@@ -3397,10 +3397,10 @@ def condition_number(q):
     t465 = -t374*t443 + t378*t447 + t382*t451 + t386*t455 + t390*t459 + t394*t463
     t466 = t409*t444 + t413*t448 + t417*t452 + t421*t456 + t425*t460 + t429*t464
     t467 = xp.not_equal(t465, 0)
-    t468 = 0.5*(-t439 + t370)/xp.where(t467, t465, 1)
+    t468 = (-t439 + t370)/xp.where(t467, 2*t465, 1)
     t469 = xp.abs(t468)
     t470 = xp.greater_equal(t469, 1)
-    t471 = xp.abs(1/xp.where(t470, t468, 1))
+    t471 = 1/xp.abs(xp.where(t470, t468, 1))
     t472 = xp.where(t467, xp.where(xp.greater_equal(t468, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t470, t471/(1 + xp.sqrt(1 + t471**2)), 1/(t469 + xp.sqrt(1 + t469**2))), 0)
     t473 = 1/xp.sqrt(1 + t472**2)
     t474 = t465*t472
@@ -3431,10 +3431,10 @@ def condition_number(q):
     t499 = t497 - t498*t472
     t500 = t498 + t497*t472
     t501 = xp.not_equal(t466, 0)
-    t502 = 0.5*(-t405 + t440)/xp.where(t501, t466, 1)
+    t502 = (-t405 + t440)/xp.where(t501, 2*t466, 1)
     t503 = xp.abs(t502)
     t504 = xp.greater_equal(t503, 1)
-    t505 = xp.abs(1/xp.where(t504, t502, 1))
+    t505 = 1/xp.abs(xp.where(t504, t502, 1))
     t506 = xp.where(t501, xp.where(xp.greater_equal(t502, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t504, t505/(1 + xp.sqrt(1 + t505**2)), 1/(t503 + xp.sqrt(1 + t503**2))), 0)
     t507 = 1/xp.sqrt(1 + t506**2)
     t508 = t466*t506
@@ -3466,10 +3466,10 @@ def condition_number(q):
     t534 = t532 + t531*t506
     t535 = t480*t513 + t484*t517 + t488*t521 + t492*t525 + t496*t529 + t500*t533
     t536 = xp.not_equal(t535, 0)
-    t537 = 0.5*(-t509 + t476)/xp.where(t536, t535, 1)
+    t537 = (-t509 + t476)/xp.where(t536, 2*t535, 1)
     t538 = xp.abs(t537)
     t539 = xp.greater_equal(t538, 1)
-    t540 = xp.abs(1/xp.where(t539, t537, 1))
+    t540 = 1/xp.abs(xp.where(t539, t537, 1))
     t541 = xp.where(t536, xp.where(xp.greater_equal(t537, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t539, t540/(1 + xp.sqrt(1 + t540**2)), 1/(t538 + xp.sqrt(1 + t538**2))), 0)
     t542 = 1/xp.sqrt(1 + t541**2)
     t543 = t535*t541
@@ -3501,10 +3501,10 @@ def condition_number(q):
     t569 = t567 + t566*t541
     t570 = t514*t549 + t518*t553 + t522*t557 + t526*t561 + t530*t565 + t534*t569
     t571 = xp.not_equal(t570, 0)
-    t572 = 0.5*(-t510 + t545)/xp.where(t571, t570, 1)
+    t572 = (-t510 + t545)/xp.where(t571, 2*t570, 1)
     t573 = xp.abs(t572)
     t574 = xp.greater_equal(t573, 1)
-    t575 = xp.abs(1/xp.where(t574, t572, 1))
+    t575 = 1/xp.abs(xp.where(t574, t572, 1))
     t576 = xp.where(t571, xp.where(xp.greater_equal(t572, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t574, t575/(1 + xp.sqrt(1 + t575**2)), 1/(t573 + xp.sqrt(1 + t573**2))), 0)
     t577 = 1/xp.sqrt(1 + t576**2)
     t578 = t570*t576
@@ -3535,10 +3535,10 @@ def condition_number(q):
     t603 = t601 - t602*t576
     t604 = t602 + t601*t576
     t605 = xp.not_equal(t395, 0)
-    t606 = 0.5*(-t219 + t369)/xp.where(t605, t395, 1)
+    t606 = (-t219 + t369)/xp.where(t605, 2*t395, 1)
     t607 = xp.abs(t606)
     t608 = xp.greater_equal(t607, 1)
-    t609 = xp.abs(1/xp.where(t608, t606, 1))
+    t609 = 1/xp.abs(xp.where(t608, t606, 1))
     t610 = xp.where(t605, xp.where(xp.greater_equal(t606, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t608, t609/(1 + xp.sqrt(1 + t609**2)), 1/(t607 + xp.sqrt(1 + t607**2))), 0)
     t611 = 1/xp.sqrt(1 + t610**2)
     t612 = t395*t610
@@ -3570,10 +3570,10 @@ def condition_number(q):
     t638 = t636 + t635*t610
     t639 = t479*t617 + t483*t621 + t487*t625 + t491*t629 + t495*t633 + t499*t637
     t640 = xp.not_equal(t639, 0)
-    t641 = 0.5*(-t613 + t475)/xp.where(t640, t639, 1)
+    t641 = (-t613 + t475)/xp.where(t640, 2*t639, 1)
     t642 = xp.abs(t641)
     t643 = xp.greater_equal(t642, 1)
-    t644 = xp.abs(1/xp.where(t643, t641, 1))
+    t644 = 1/xp.abs(xp.where(t643, t641, 1))
     t645 = xp.where(t640, xp.where(xp.greater_equal(t641, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t643, t644/(1 + xp.sqrt(1 + t644**2)), 1/(t642 + xp.sqrt(1 + t642**2))), 0)
     t646 = 1/xp.sqrt(1 + t645**2)
     t647 = t639*t645
@@ -3606,10 +3606,10 @@ def condition_number(q):
     t674 = t548*t652 + t552*t656 + t556*t660 + t560*t664 + t564*t668 + t568*t672
     t675 = -t618*t653 + t622*t657 + t626*t661 + t630*t665 + t634*t669 + t638*t673
     t676 = xp.not_equal(t674, 0)
-    t677 = 0.5*(-t648 + t544)/xp.where(t676, t674, 1)
+    t677 = (-t648 + t544)/xp.where(t676, 2*t674, 1)
     t678 = xp.abs(t677)
     t679 = xp.greater_equal(t678, 1)
-    t680 = xp.abs(1/xp.where(t679, t677, 1))
+    t680 = 1/xp.abs(xp.where(t679, t677, 1))
     t681 = xp.where(t676, xp.where(xp.greater_equal(t677, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t679, t680/(1 + xp.sqrt(1 + t680**2)), 1/(t678 + xp.sqrt(1 + t678**2))), 0)
     t682 = 1/xp.sqrt(1 + t681**2)
     t683 = t674*t681
@@ -3641,10 +3641,10 @@ def condition_number(q):
     t709 = t707 + t706*t681
     t710 = t583*t688 + t587*t692 + t591*t696 + t595*t700 + t599*t704 + t603*t708
     t711 = xp.not_equal(t710, 0)
-    t712 = 0.5*(-t684 + t579)/xp.where(t711, t710, 1)
+    t712 = (-t684 + t579)/xp.where(t711, 2*t710, 1)
     t713 = xp.abs(t712)
     t714 = xp.greater_equal(t713, 1)
-    t715 = xp.abs(1/xp.where(t714, t712, 1))
+    t715 = 1/xp.abs(xp.where(t714, t712, 1))
     t716 = xp.where(t711, xp.where(xp.greater_equal(t712, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t714, t715/(1 + xp.sqrt(1 + t715**2)), 1/(t713 + xp.sqrt(1 + t713**2))), 0)
     t717 = 1/xp.sqrt(1 + t716**2)
     t718 = t710*t716
@@ -3676,10 +3676,10 @@ def condition_number(q):
     t744 = t742 + t741*t716
     t745 = t584*t723 + t588*t727 + t592*t731 + t596*t735 + t600*t739 + t604*t743
     t746 = xp.not_equal(t745, 0)
-    t747 = 0.5*(-t719 + t580)/xp.where(t746, t745, 1)
+    t747 = (-t719 + t580)/xp.where(t746, 2*t745, 1)
     t748 = xp.abs(t747)
     t749 = xp.greater_equal(t748, 1)
-    t750 = xp.abs(1/xp.where(t749, t747, 1))
+    t750 = 1/xp.abs(xp.where(t749, t747, 1))
     t751 = xp.where(t746, xp.where(xp.greater_equal(t747, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t749, t750/(1 + xp.sqrt(1 + t750**2)), 1/(t748 + xp.sqrt(1 + t748**2))), 0)
     t752 = 1/xp.sqrt(1 + t751**2)
     t753 = t745*t751
@@ -3710,10 +3710,10 @@ def condition_number(q):
     t778 = t776 - t777*t751
     t779 = t777 + t776*t751
     t780 = xp.not_equal(t675, 0)
-    t781 = 0.5*(-t614 + t649)/xp.where(t780, t675, 1)
+    t781 = (-t614 + t649)/xp.where(t780, 2*t675, 1)
     t782 = xp.abs(t781)
     t783 = xp.greater_equal(t782, 1)
-    t784 = xp.abs(1/xp.where(t783, t781, 1))
+    t784 = 1/xp.abs(xp.where(t783, t781, 1))
     t785 = xp.where(t780, xp.where(xp.greater_equal(t781, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t783, t784/(1 + xp.sqrt(1 + t784**2)), 1/(t782 + xp.sqrt(1 + t782**2))), 0)
     t786 = 1/xp.sqrt(1 + t785**2)
     t787 = t675*t785
@@ -3745,10 +3745,10 @@ def condition_number(q):
     t813 = t811 + t810*t785
     t814 = t689*t792 + t693*t796 + t697*t800 + t701*t804 + t705*t808 + t709*t812
     t815 = xp.not_equal(t814, 0)
-    t816 = 0.5*(-t788 + t685)/xp.where(t815, t814, 1)
+    t816 = (-t788 + t685)/xp.where(t815, 2*t814, 1)
     t817 = xp.abs(t816)
     t818 = xp.greater_equal(t817, 1)
-    t819 = xp.abs(1/xp.where(t818, t816, 1))
+    t819 = 1/xp.abs(xp.where(t818, t816, 1))
     t820 = xp.where(t815, xp.where(xp.greater_equal(t816, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t818, t819/(1 + xp.sqrt(1 + t819**2)), 1/(t817 + xp.sqrt(1 + t817**2))), 0)
     t821 = 1/xp.sqrt(1 + t820**2)
     t822 = t814*t820
@@ -3781,10 +3781,10 @@ def condition_number(q):
     t849 = t724*t827 + t728*t831 + t732*t835 + t736*t839 + t740*t843 + t744*t847
     t850 = t793*t828 + t797*t832 + t801*t836 + t805*t840 + t809*t844 + t813*t848
     t851 = xp.not_equal(t849, 0)
-    t852 = 0.5*(-t823 + t720)/xp.where(t851, t849, 1)
+    t852 = (-t823 + t720)/xp.where(t851, 2*t849, 1)
     t853 = xp.abs(t852)
     t854 = xp.greater_equal(t853, 1)
-    t855 = xp.abs(1/xp.where(t854, t852, 1))
+    t855 = 1/xp.abs(xp.where(t854, t852, 1))
     t856 = xp.where(t851, xp.where(xp.greater_equal(t852, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t854, t855/(1 + xp.sqrt(1 + t855**2)), 1/(t853 + xp.sqrt(1 + t853**2))), 0)
     t857 = 1/xp.sqrt(1 + t856**2)
     t858 = t849*t856
@@ -3816,10 +3816,10 @@ def condition_number(q):
     t884 = t882 + t881*t856
     t885 = t759*t863 + t763*t867 + t767*t871 + t771*t875 + t775*t879 + t779*t883
     t886 = xp.not_equal(t885, 0)
-    t887 = 0.5*(-t859 + t755)/xp.where(t886, t885, 1)
+    t887 = (-t859 + t755)/xp.where(t886, 2*t885, 1)
     t888 = xp.abs(t887)
     t889 = xp.greater_equal(t888, 1)
-    t890 = xp.abs(1/xp.where(t889, t887, 1))
+    t890 = 1/xp.abs(xp.where(t889, t887, 1))
     t891 = xp.where(t886, xp.where(xp.greater_equal(t887, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t889, t890/(1 + xp.sqrt(1 + t890**2)), 1/(t888 + xp.sqrt(1 + t888**2))), 0)
     t892 = 1/xp.sqrt(1 + t891**2)
     t893 = t885*t891
@@ -3851,10 +3851,10 @@ def condition_number(q):
     t919 = t917 + t916*t891
     t920 = t758*t898 + t762*t902 + t766*t906 + t770*t910 + t774*t914 + t778*t918
     t921 = xp.not_equal(t850, 0)
-    t922 = 0.5*(-t789 + t824)/xp.where(t921, t850, 1)
+    t922 = (-t789 + t824)/xp.where(t921, 2*t850, 1)
     t923 = xp.abs(t922)
     t924 = xp.greater_equal(t923, 1)
-    t925 = xp.abs(1/xp.where(t924, t922, 1))
+    t925 = 1/xp.abs(xp.where(t924, t922, 1))
     t926 = xp.where(t921, xp.where(xp.greater_equal(t922, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t924, t925/(1 + xp.sqrt(1 + t925**2)), 1/(t923 + xp.sqrt(1 + t923**2))), 0)
     t927 = 1/xp.sqrt(1 + t926**2)
     t928 = t850*t926
@@ -3886,10 +3886,10 @@ def condition_number(q):
     t954 = t952 + t951*t926
     t955 = t864*t933 + t868*t937 + t872*t941 + t876*t945 + t880*t949 + t884*t953
     t956 = xp.not_equal(t955, 0)
-    t957 = 0.5*(-t929 + t860)/xp.where(t956, t955, 1)
+    t957 = (-t929 + t860)/xp.where(t956, 2*t955, 1)
     t958 = xp.abs(t957)
     t959 = xp.greater_equal(t958, 1)
-    t960 = xp.abs(1/xp.where(t959, t957, 1))
+    t960 = 1/xp.abs(xp.where(t959, t957, 1))
     t961 = xp.where(t956, xp.where(xp.greater_equal(t957, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t959, t960/(1 + xp.sqrt(1 + t960**2)), 1/(t958 + xp.sqrt(1 + t958**2))), 0)
     t962 = 1/xp.sqrt(1 + t961**2)
     t963 = t955*t961
@@ -3922,10 +3922,10 @@ def condition_number(q):
     t990 = t899*t968 + t903*t972 + t907*t976 + t911*t980 + t915*t984 + t919*t988
     t991 = t934*t969 + t938*t973 + t942*t977 + t946*t981 + t950*t985 + t954*t989
     t992 = xp.not_equal(t990, 0)
-    t993 = 0.5*(-t964 + t895)/xp.where(t992, t990, 1)
+    t993 = (-t964 + t895)/xp.where(t992, 2*t990, 1)
     t994 = xp.abs(t993)
     t995 = xp.greater_equal(t994, 1)
-    t996 = xp.abs(1/xp.where(t995, t993, 1))
+    t996 = 1/xp.abs(xp.where(t995, t993, 1))
     t997 = xp.where(t992, xp.where(xp.greater_equal(t993, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t995, t996/(1 + xp.sqrt(1 + t996**2)), 1/(t994 + xp.sqrt(1 + t994**2))), 0)
     t998 = 1/xp.sqrt(1 + t997**2)
     t999 = t990*t997
@@ -3956,10 +3956,10 @@ def condition_number(q):
     t1024 = t1022 - t1023*t997
     t1025 = t1023 + t1022*t997
     t1026 = xp.not_equal(t991, 0)
-    t1027 = 0.5*(-t930 + t965)/xp.where(t1026, t991, 1)
+    t1027 = (-t930 + t965)/xp.where(t1026, 2*t991, 1)
     t1028 = xp.abs(t1027)
     t1029 = xp.greater_equal(t1028, 1)
-    t1030 = xp.abs(1/xp.where(t1029, t1027, 1))
+    t1030 = 1/xp.abs(xp.where(t1029, t1027, 1))
     t1031 = xp.where(t1026, xp.where(xp.greater_equal(t1027, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1029, t1030/(1 + xp.sqrt(1 + t1030**2)), 1/(t1028 + xp.sqrt(1 + t1028**2))), 0)
     t1032 = 1/xp.sqrt(1 + t1031**2)
     t1033 = t991*t1031
@@ -3991,10 +3991,10 @@ def condition_number(q):
     t1059 = t1057 + t1031*t1056
     t1060 = t1005*t1038 + t1009*t1042 + t1013*t1046 + t1017*t1050 + t1021*t1054 + t1025*t1058
     t1061 = xp.not_equal(t1060, 0)
-    t1062 = 0.5*(-t1034 + t1001)/xp.where(t1061, t1060, 1)
+    t1062 = (-t1034 + t1001)/xp.where(t1061, 2*t1060, 1)
     t1063 = xp.abs(t1062)
     t1064 = xp.greater_equal(t1063, 1)
-    t1065 = xp.abs(1/xp.where(t1064, t1062, 1))
+    t1065 = 1/xp.abs(xp.where(t1064, t1062, 1))
     t1066 = xp.where(t1061, xp.where(xp.greater_equal(t1062, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1064, t1065/(1 + xp.sqrt(1 + t1065**2)), 1/(t1063 + xp.sqrt(1 + t1063**2))), 0)
     t1067 = 1/xp.sqrt(1 + t1066**2)
     t1068 = t1060*t1066
@@ -4026,10 +4026,10 @@ def condition_number(q):
     t1094 = t1092 + t1066*t1091
     t1095 = t1039*t1074 + t1043*t1078 + t1047*t1082 + t1051*t1086 + t1055*t1090 + t1059*t1094
     t1096 = xp.not_equal(t1095, 0)
-    t1097 = 0.5*(-t1035 + t1070)/xp.where(t1096, t1095, 1)
+    t1097 = (-t1035 + t1070)/xp.where(t1096, 2*t1095, 1)
     t1098 = xp.abs(t1097)
     t1099 = xp.greater_equal(t1098, 1)
-    t1100 = xp.abs(1/xp.where(t1099, t1097, 1))
+    t1100 = 1/xp.abs(xp.where(t1099, t1097, 1))
     t1101 = xp.where(t1096, xp.where(xp.greater_equal(t1097, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1099, t1100/(1 + xp.sqrt(1 + t1100**2)), 1/(t1098 + xp.sqrt(1 + t1098**2))), 0)
     t1102 = 1/xp.sqrt(1 + t1101**2)
     t1103 = t1095*t1101
@@ -4060,10 +4060,10 @@ def condition_number(q):
     t1128 = t1126 - t1101*t1127
     t1129 = t1127 + t1101*t1126
     t1130 = xp.not_equal(t920, 0)
-    t1131 = 0.5*(-t754 + t894)/xp.where(t1130, t920, 1)
+    t1131 = (-t754 + t894)/xp.where(t1130, 2*t920, 1)
     t1132 = xp.abs(t1131)
     t1133 = xp.greater_equal(t1132, 1)
-    t1134 = xp.abs(1/xp.where(t1133, t1131, 1))
+    t1134 = 1/xp.abs(xp.where(t1133, t1131, 1))
     t1135 = xp.where(t1130, xp.where(xp.greater_equal(t1131, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1133, t1134/(1 + xp.sqrt(1 + t1134**2)), 1/(t1132 + xp.sqrt(1 + t1132**2))), 0)
     t1136 = 1/xp.sqrt(1 + t1135**2)
     t1137 = t920*t1135
@@ -4095,10 +4095,10 @@ def condition_number(q):
     t1163 = t1161 + t1135*t1160
     t1164 = t1004*t1142 + t1008*t1146 + t1012*t1150 + t1016*t1154 + t1020*t1158 + t1024*t1162
     t1165 = xp.not_equal(t1164, 0)
-    t1166 = 0.5*(-t1138 + t1000)/xp.where(t1165, t1164, 1)
+    t1166 = (-t1138 + t1000)/xp.where(t1165, 2*t1164, 1)
     t1167 = xp.abs(t1166)
     t1168 = xp.greater_equal(t1167, 1)
-    t1169 = xp.abs(1/xp.where(t1168, t1166, 1))
+    t1169 = 1/xp.abs(xp.where(t1168, t1166, 1))
     t1170 = xp.where(t1165, xp.where(xp.greater_equal(t1166, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1168, t1169/(1 + xp.sqrt(1 + t1169**2)), 1/(t1167 + xp.sqrt(1 + t1167**2))), 0)
     t1171 = 1/xp.sqrt(1 + t1170**2)
     t1172 = t1164*t1170
@@ -4131,10 +4131,10 @@ def condition_number(q):
     t1199 = t1073*t1177 + t1077*t1181 + t1081*t1185 + t1085*t1189 + t1089*t1193 + t1093*t1197
     t1200 = t1143*t1178 + t1147*t1182 + t1151*t1186 + t1155*t1190 + t1159*t1194 + t1163*t1198
     t1201 = xp.not_equal(t1199, 0)
-    t1202 = 0.5*(-t1173 + t1069)/xp.where(t1201, t1199, 1)
+    t1202 = (-t1173 + t1069)/xp.where(t1201, 2*t1199, 1)
     t1203 = xp.abs(t1202)
     t1204 = xp.greater_equal(t1203, 1)
-    t1205 = xp.abs(1/xp.where(t1204, t1202, 1))
+    t1205 = 1/xp.abs(xp.where(t1204, t1202, 1))
     t1206 = xp.where(t1201, xp.where(xp.greater_equal(t1202, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1204, t1205/(1 + xp.sqrt(1 + t1205**2)), 1/(t1203 + xp.sqrt(1 + t1203**2))), 0)
     t1207 = 1/xp.sqrt(1 + t1206**2)
     t1208 = t1199*t1206
@@ -4166,10 +4166,10 @@ def condition_number(q):
     t1234 = t1232 + t1206*t1231
     t1235 = t1108*t1213 + t1112*t1217 + t1116*t1221 + t1120*t1225 + t1124*t1229 + t1128*t1233
     t1236 = xp.not_equal(t1235, 0)
-    t1237 = 0.5*(-t1209 + t1104)/xp.where(t1236, t1235, 1)
+    t1237 = (-t1209 + t1104)/xp.where(t1236, 2*t1235, 1)
     t1238 = xp.abs(t1237)
     t1239 = xp.greater_equal(t1238, 1)
-    t1240 = xp.abs(1/xp.where(t1239, t1237, 1))
+    t1240 = 1/xp.abs(xp.where(t1239, t1237, 1))
     t1241 = xp.where(t1236, xp.where(xp.greater_equal(t1237, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1239, t1240/(1 + xp.sqrt(1 + t1240**2)), 1/(t1238 + xp.sqrt(1 + t1238**2))), 0)
     t1242 = 1/xp.sqrt(1 + t1241**2)
     t1243 = t1235*t1241
@@ -4201,10 +4201,10 @@ def condition_number(q):
     t1269 = t1267 + t1241*t1266
     t1270 = t1109*t1248 + t1113*t1252 + t1117*t1256 + t1121*t1260 + t1125*t1264 + t1129*t1268
     t1271 = xp.not_equal(t1270, 0)
-    t1272 = 0.5*(-t1244 + t1105)/xp.where(t1271, t1270, 1)
+    t1272 = (-t1244 + t1105)/xp.where(t1271, 2*t1270, 1)
     t1273 = xp.abs(t1272)
     t1274 = xp.greater_equal(t1273, 1)
-    t1275 = xp.abs(1/xp.where(t1274, t1272, 1))
+    t1275 = 1/xp.abs(xp.where(t1274, t1272, 1))
     t1276 = xp.where(t1271, xp.where(xp.greater_equal(t1272, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1274, t1275/(1 + xp.sqrt(1 + t1275**2)), 1/(t1273 + xp.sqrt(1 + t1273**2))), 0)
     t1277 = 1/xp.sqrt(1 + t1276**2)
     t1278 = t1270*t1276
@@ -4235,10 +4235,10 @@ def condition_number(q):
     t1303 = t1301 - t1276*t1302
     t1304 = t1302 + t1276*t1301
     t1305 = xp.not_equal(t1200, 0)
-    t1306 = 0.5*(-t1139 + t1174)/xp.where(t1305, t1200, 1)
+    t1306 = (-t1139 + t1174)/xp.where(t1305, 2*t1200, 1)
     t1307 = xp.abs(t1306)
     t1308 = xp.greater_equal(t1307, 1)
-    t1309 = xp.abs(1/xp.where(t1308, t1306, 1))
+    t1309 = 1/xp.abs(xp.where(t1308, t1306, 1))
     t1310 = xp.where(t1305, xp.where(xp.greater_equal(t1306, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1308, t1309/(1 + xp.sqrt(1 + t1309**2)), 1/(t1307 + xp.sqrt(1 + t1307**2))), 0)
     t1311 = 1/xp.sqrt(1 + t1310**2)
     t1312 = t1200*t1310
@@ -4270,10 +4270,10 @@ def condition_number(q):
     t1338 = t1336 + t1310*t1335
     t1339 = t1214*t1317 + t1218*t1321 + t1222*t1325 + t1226*t1329 + t1230*t1333 + t1234*t1337
     t1340 = xp.not_equal(t1339, 0)
-    t1341 = 0.5*(-t1313 + t1210)/xp.where(t1340, t1339, 1)
+    t1341 = (-t1313 + t1210)/xp.where(t1340, 2*t1339, 1)
     t1342 = xp.abs(t1341)
     t1343 = xp.greater_equal(t1342, 1)
-    t1344 = xp.abs(1/xp.where(t1343, t1341, 1))
+    t1344 = 1/xp.abs(xp.where(t1343, t1341, 1))
     t1345 = xp.where(t1340, xp.where(xp.greater_equal(t1341, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1343, t1344/(1 + xp.sqrt(1 + t1344**2)), 1/(t1342 + xp.sqrt(1 + t1342**2))), 0)
     t1346 = 1/xp.sqrt(1 + t1345**2)
     t1347 = t1339*t1345
@@ -4306,10 +4306,10 @@ def condition_number(q):
     t1374 = t1249*t1352 + t1253*t1356 + t1257*t1360 + t1261*t1364 + t1265*t1368 + t1269*t1372
     t1375 = t1318*t1353 + t1322*t1357 + t1326*t1361 + t1330*t1365 + t1334*t1369 + t1338*t1373
     t1376 = xp.not_equal(t1374, 0)
-    t1377 = 0.5*(-t1348 + t1245)/xp.where(t1376, t1374, 1)
+    t1377 = (-t1348 + t1245)/xp.where(t1376, 2*t1374, 1)
     t1378 = xp.abs(t1377)
     t1379 = xp.greater_equal(t1378, 1)
-    t1380 = xp.abs(1/xp.where(t1379, t1377, 1))
+    t1380 = 1/xp.abs(xp.where(t1379, t1377, 1))
     t1381 = xp.where(t1376, xp.where(xp.greater_equal(t1377, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1379, t1380/(1 + xp.sqrt(1 + t1380**2)), 1/(t1378 + xp.sqrt(1 + t1378**2))), 0)
     t1382 = 1/xp.sqrt(1 + t1381**2)
     t1383 = t1374*t1381
@@ -4341,10 +4341,10 @@ def condition_number(q):
     t1409 = t1407 + t1381*t1406
     t1410 = t1284*t1388 + t1288*t1392 + t1292*t1396 + t1296*t1400 + t1300*t1404 + t1304*t1408
     t1411 = xp.not_equal(t1410, 0)
-    t1412 = 0.5*(-t1384 + t1280)/xp.where(t1411, t1410, 1)
+    t1412 = (-t1384 + t1280)/xp.where(t1411, 2*t1410, 1)
     t1413 = xp.abs(t1412)
     t1414 = xp.greater_equal(t1413, 1)
-    t1415 = xp.abs(1/xp.where(t1414, t1412, 1))
+    t1415 = 1/xp.abs(xp.where(t1414, t1412, 1))
     t1416 = xp.where(t1411, xp.where(xp.greater_equal(t1412, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1414, t1415/(1 + xp.sqrt(1 + t1415**2)), 1/(t1413 + xp.sqrt(1 + t1413**2))), 0)
     t1417 = 1/xp.sqrt(1 + t1416**2)
     t1418 = t1410*t1416
@@ -4376,10 +4376,10 @@ def condition_number(q):
     t1444 = t1442 + t1416*t1441
     t1445 = t1283*t1423 + t1287*t1427 + t1291*t1431 + t1295*t1435 + t1299*t1439 + t1303*t1443
     t1446 = xp.not_equal(t1375, 0)
-    t1447 = 0.5*(-t1314 + t1349)/xp.where(t1446, t1375, 1)
+    t1447 = (-t1314 + t1349)/xp.where(t1446, 2*t1375, 1)
     t1448 = xp.abs(t1447)
     t1449 = xp.greater_equal(t1448, 1)
-    t1450 = xp.abs(1/xp.where(t1449, t1447, 1))
+    t1450 = 1/xp.abs(xp.where(t1449, t1447, 1))
     t1451 = xp.where(t1446, xp.where(xp.greater_equal(t1447, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1449, t1450/(1 + xp.sqrt(1 + t1450**2)), 1/(t1448 + xp.sqrt(1 + t1448**2))), 0)
     t1452 = 1/xp.sqrt(1 + t1451**2)
     t1453 = t1375*t1451
@@ -4411,10 +4411,10 @@ def condition_number(q):
     t1479 = t1477 + t1451*t1476
     t1480 = t1389*t1458 + t1393*t1462 + t1397*t1466 + t1401*t1470 + t1405*t1474 + t1409*t1478
     t1481 = xp.not_equal(t1480, 0)
-    t1482 = 0.5*(-t1454 + t1385)/xp.where(t1481, t1480, 1)
+    t1482 = (-t1454 + t1385)/xp.where(t1481, 2*t1480, 1)
     t1483 = xp.abs(t1482)
     t1484 = xp.greater_equal(t1483, 1)
-    t1485 = xp.abs(1/xp.where(t1484, t1482, 1))
+    t1485 = 1/xp.abs(xp.where(t1484, t1482, 1))
     t1486 = xp.where(t1481, xp.where(xp.greater_equal(t1482, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1484, t1485/(1 + xp.sqrt(1 + t1485**2)), 1/(t1483 + xp.sqrt(1 + t1483**2))), 0)
     t1487 = 1/xp.sqrt(1 + t1486**2)
     t1488 = t1480*t1486
@@ -4447,10 +4447,10 @@ def condition_number(q):
     t1515 = t1424*t1493 + t1428*t1497 + t1432*t1501 + t1436*t1505 + t1440*t1509 + t1444*t1513
     t1516 = t1459*t1494 + t1463*t1498 + t1467*t1502 + t1471*t1506 + t1475*t1510 + t1479*t1514
     t1517 = xp.not_equal(t1515, 0)
-    t1518 = 0.5*(-t1489 + t1420)/xp.where(t1517, t1515, 1)
+    t1518 = (-t1489 + t1420)/xp.where(t1517, 2*t1515, 1)
     t1519 = xp.abs(t1518)
     t1520 = xp.greater_equal(t1519, 1)
-    t1521 = xp.abs(1/xp.where(t1520, t1518, 1))
+    t1521 = 1/xp.abs(xp.where(t1520, t1518, 1))
     t1522 = xp.where(t1517, xp.where(xp.greater_equal(t1518, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1520, t1521/(1 + xp.sqrt(1 + t1521**2)), 1/(t1519 + xp.sqrt(1 + t1519**2))), 0)
     t1523 = 1/xp.sqrt(1 + t1522**2)
     t1524 = t1515*t1522
@@ -4481,10 +4481,10 @@ def condition_number(q):
     t1549 = t1547 - t1522*t1548
     t1550 = t1548 + t1522*t1547
     t1551 = xp.not_equal(t1516, 0)
-    t1552 = 0.5*(-t1455 + t1490)/xp.where(t1551, t1516, 1)
+    t1552 = (-t1455 + t1490)/xp.where(t1551, 2*t1516, 1)
     t1553 = xp.abs(t1552)
     t1554 = xp.greater_equal(t1553, 1)
-    t1555 = xp.abs(1/xp.where(t1554, t1552, 1))
+    t1555 = 1/xp.abs(xp.where(t1554, t1552, 1))
     t1556 = xp.where(t1551, xp.where(xp.greater_equal(t1552, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1554, t1555/(1 + xp.sqrt(1 + t1555**2)), 1/(t1553 + xp.sqrt(1 + t1553**2))), 0)
     t1557 = 1/xp.sqrt(1 + t1556**2)
     t1558 = t1516*t1556
@@ -4516,10 +4516,10 @@ def condition_number(q):
     t1584 = t1582 + t1556*t1581
     t1585 = t1530*t1563 + t1534*t1567 + t1538*t1571 + t1542*t1575 + t1546*t1579 + t1550*t1583
     t1586 = xp.not_equal(t1585, 0)
-    t1587 = 0.5*(-t1559 + t1526)/xp.where(t1586, t1585, 1)
+    t1587 = (-t1559 + t1526)/xp.where(t1586, 2*t1585, 1)
     t1588 = xp.abs(t1587)
     t1589 = xp.greater_equal(t1588, 1)
-    t1590 = xp.abs(1/xp.where(t1589, t1587, 1))
+    t1590 = 1/xp.abs(xp.where(t1589, t1587, 1))
     t1591 = xp.where(t1586, xp.where(xp.greater_equal(t1587, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1589, t1590/(1 + xp.sqrt(1 + t1590**2)), 1/(t1588 + xp.sqrt(1 + t1588**2))), 0)
     t1592 = 1/xp.sqrt(1 + t1591**2)
     t1593 = t1585*t1591
@@ -4551,10 +4551,10 @@ def condition_number(q):
     t1619 = t1617 + t1591*t1616
     t1620 = t1564*t1599 + t1568*t1603 + t1572*t1607 + t1576*t1611 + t1580*t1615 + t1584*t1619
     t1621 = xp.not_equal(t1620, 0)
-    t1622 = 0.5*(-t1560 + t1595)/xp.where(t1621, t1620, 1)
+    t1622 = (-t1560 + t1595)/xp.where(t1621, 2*t1620, 1)
     t1623 = xp.abs(t1622)
     t1624 = xp.greater_equal(t1623, 1)
-    t1625 = xp.abs(1/xp.where(t1624, t1622, 1))
+    t1625 = 1/xp.abs(xp.where(t1624, t1622, 1))
     t1626 = xp.where(t1621, xp.where(xp.greater_equal(t1622, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1624, t1625/(1 + xp.sqrt(1 + t1625**2)), 1/(t1623 + xp.sqrt(1 + t1623**2))), 0)
     t1627 = 1/xp.sqrt(1 + t1626**2)
     t1628 = t1620*t1626
@@ -4585,10 +4585,10 @@ def condition_number(q):
     t1653 = t1651 - t1626*t1652
     t1654 = t1652 + t1626*t1651
     t1655 = xp.not_equal(t1445, 0)
-    t1656 = 0.5*(-t1279 + t1419)/xp.where(t1655, t1445, 1)
+    t1656 = (-t1279 + t1419)/xp.where(t1655, 2*t1445, 1)
     t1657 = xp.abs(t1656)
     t1658 = xp.greater_equal(t1657, 1)
-    t1659 = xp.abs(1/xp.where(t1658, t1656, 1))
+    t1659 = 1/xp.abs(xp.where(t1658, t1656, 1))
     t1660 = xp.where(t1655, xp.where(xp.greater_equal(t1656, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1658, t1659/(1 + xp.sqrt(1 + t1659**2)), 1/(t1657 + xp.sqrt(1 + t1657**2))), 0)
     t1661 = 1/xp.sqrt(1 + t1660**2)
     t1662 = t1445*t1660
@@ -4620,10 +4620,10 @@ def condition_number(q):
     t1688 = t1686 + t1660*t1685
     t1689 = t1529*t1667 + t1533*t1671 + t1537*t1675 + t1541*t1679 + t1545*t1683 + t1549*t1687
     t1690 = xp.not_equal(t1689, 0)
-    t1691 = 0.5*(-t1663 + t1525)/xp.where(t1690, t1689, 1)
+    t1691 = (-t1663 + t1525)/xp.where(t1690, 2*t1689, 1)
     t1692 = xp.abs(t1691)
     t1693 = xp.greater_equal(t1692, 1)
-    t1694 = xp.abs(1/xp.where(t1693, t1691, 1))
+    t1694 = 1/xp.abs(xp.where(t1693, t1691, 1))
     t1695 = xp.where(t1690, xp.where(xp.greater_equal(t1691, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1693, t1694/(1 + xp.sqrt(1 + t1694**2)), 1/(t1692 + xp.sqrt(1 + t1692**2))), 0)
     t1696 = 1/xp.sqrt(1 + t1695**2)
     t1697 = t1689*t1695
@@ -4656,10 +4656,10 @@ def condition_number(q):
     t1724 = t1598*t1702 + t1602*t1706 + t1606*t1710 + t1610*t1714 + t1614*t1718 + t1618*t1722
     t1725 = t1668*t1703 + t1672*t1707 + t1676*t1711 + t1680*t1715 + t1684*t1719 + t1688*t1723
     t1726 = xp.not_equal(t1724, 0)
-    t1727 = 0.5*(-t1698 + t1594)/xp.where(t1726, t1724, 1)
+    t1727 = (-t1698 + t1594)/xp.where(t1726, 2*t1724, 1)
     t1728 = xp.abs(t1727)
     t1729 = xp.greater_equal(t1728, 1)
-    t1730 = xp.abs(1/xp.where(t1729, t1727, 1))
+    t1730 = 1/xp.abs(xp.where(t1729, t1727, 1))
     t1731 = xp.where(t1726, xp.where(xp.greater_equal(t1727, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1729, t1730/(1 + xp.sqrt(1 + t1730**2)), 1/(t1728 + xp.sqrt(1 + t1728**2))), 0)
     t1732 = 1/xp.sqrt(1 + t1731**2)
     t1733 = t1724*t1731
@@ -4691,10 +4691,10 @@ def condition_number(q):
     t1759 = t1757 + t1731*t1756
     t1760 = t1633*t1738 + t1637*t1742 + t1641*t1746 + t1645*t1750 + t1649*t1754 + t1653*t1758
     t1761 = xp.not_equal(t1760, 0)
-    t1762 = 0.5*(-t1734 + t1629)/xp.where(t1761, t1760, 1)
+    t1762 = (-t1734 + t1629)/xp.where(t1761, 2*t1760, 1)
     t1763 = xp.abs(t1762)
     t1764 = xp.greater_equal(t1763, 1)
-    t1765 = xp.abs(1/xp.where(t1764, t1762, 1))
+    t1765 = 1/xp.abs(xp.where(t1764, t1762, 1))
     t1766 = xp.where(t1761, xp.where(xp.greater_equal(t1762, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1764, t1765/(1 + xp.sqrt(1 + t1765**2)), 1/(t1763 + xp.sqrt(1 + t1763**2))), 0)
     t1767 = 1/xp.sqrt(1 + t1766**2)
     t1768 = t1760*t1766
@@ -4726,10 +4726,10 @@ def condition_number(q):
     t1794 = t1792 + t1766*t1791
     t1795 = t1634*t1773 + t1638*t1777 + t1642*t1781 + t1646*t1785 + t1650*t1789 + t1654*t1793
     t1796 = xp.not_equal(t1795, 0)
-    t1797 = 0.5*(-t1769 + t1630)/xp.where(t1796, t1795, 1)
+    t1797 = (-t1769 + t1630)/xp.where(t1796, 2*t1795, 1)
     t1798 = xp.abs(t1797)
     t1799 = xp.greater_equal(t1798, 1)
-    t1800 = xp.abs(1/xp.where(t1799, t1797, 1))
+    t1800 = 1/xp.abs(xp.where(t1799, t1797, 1))
     t1801 = xp.where(t1796, xp.where(xp.greater_equal(t1797, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1799, t1800/(1 + xp.sqrt(1 + t1800**2)), 1/(t1798 + xp.sqrt(1 + t1798**2))), 0)
     t1802 = 1/xp.sqrt(1 + t1801**2)
     t1803 = t1795*t1801
@@ -4760,10 +4760,10 @@ def condition_number(q):
     t1828 = t1826 - t1801*t1827
     t1829 = t1827 + t1801*t1826
     t1830 = xp.not_equal(t1725, 0)
-    t1831 = 0.5*(-t1664 + t1699)/xp.where(t1830, t1725, 1)
+    t1831 = (-t1664 + t1699)/xp.where(t1830, 2*t1725, 1)
     t1832 = xp.abs(t1831)
     t1833 = xp.greater_equal(t1832, 1)
-    t1834 = xp.abs(1/xp.where(t1833, t1831, 1))
+    t1834 = 1/xp.abs(xp.where(t1833, t1831, 1))
     t1835 = xp.where(t1830, xp.where(xp.greater_equal(t1831, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1833, t1834/(1 + xp.sqrt(1 + t1834**2)), 1/(t1832 + xp.sqrt(1 + t1832**2))), 0)
     t1836 = 1/xp.sqrt(1 + t1835**2)
     t1837 = t1725*t1835
@@ -4795,10 +4795,10 @@ def condition_number(q):
     t1863 = t1861 + t1835*t1860
     t1864 = t1739*t1842 + t1743*t1846 + t1747*t1850 + t1751*t1854 + t1755*t1858 + t1759*t1862
     t1865 = xp.not_equal(t1864, 0)
-    t1866 = 0.5*(-t1838 + t1735)/xp.where(t1865, t1864, 1)
+    t1866 = (-t1838 + t1735)/xp.where(t1865, 2*t1864, 1)
     t1867 = xp.abs(t1866)
     t1868 = xp.greater_equal(t1867, 1)
-    t1869 = xp.abs(1/xp.where(t1868, t1866, 1))
+    t1869 = 1/xp.abs(xp.where(t1868, t1866, 1))
     t1870 = xp.where(t1865, xp.where(xp.greater_equal(t1866, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1868, t1869/(1 + xp.sqrt(1 + t1869**2)), 1/(t1867 + xp.sqrt(1 + t1867**2))), 0)
     t1871 = 1/xp.sqrt(1 + t1870**2)
     t1872 = t1864*t1870
@@ -4831,10 +4831,10 @@ def condition_number(q):
     t1899 = t1774*t1877 + t1778*t1881 + t1782*t1885 + t1786*t1889 + t1790*t1893 + t1794*t1897
     t1900 = t1843*t1878 + t1847*t1882 + t1851*t1886 + t1855*t1890 + t1859*t1894 + t1863*t1898
     t1901 = xp.not_equal(t1899, 0)
-    t1902 = 0.5*(-t1873 + t1770)/xp.where(t1901, t1899, 1)
+    t1902 = (-t1873 + t1770)/xp.where(t1901, 2*t1899, 1)
     t1903 = xp.abs(t1902)
     t1904 = xp.greater_equal(t1903, 1)
-    t1905 = xp.abs(1/xp.where(t1904, t1902, 1))
+    t1905 = 1/xp.abs(xp.where(t1904, t1902, 1))
     t1906 = xp.where(t1901, xp.where(xp.greater_equal(t1902, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1904, t1905/(1 + xp.sqrt(1 + t1905**2)), 1/(t1903 + xp.sqrt(1 + t1903**2))), 0)
     t1907 = 1/xp.sqrt(1 + t1906**2)
     t1908 = t1899*t1906
@@ -4866,10 +4866,10 @@ def condition_number(q):
     t1934 = t1932 + t1906*t1931
     t1935 = t1809*t1913 + t1813*t1917 + t1817*t1921 + t1821*t1925 + t1825*t1929 + t1829*t1933
     t1936 = xp.not_equal(t1935, 0)
-    t1937 = 0.5*(-t1909 + t1805)/xp.where(t1936, t1935, 1)
+    t1937 = (-t1909 + t1805)/xp.where(t1936, 2*t1935, 1)
     t1938 = xp.abs(t1937)
     t1939 = xp.greater_equal(t1938, 1)
-    t1940 = xp.abs(1/xp.where(t1939, t1937, 1))
+    t1940 = 1/xp.abs(xp.where(t1939, t1937, 1))
     t1941 = xp.where(t1936, xp.where(xp.greater_equal(t1937, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1939, t1940/(1 + xp.sqrt(1 + t1940**2)), 1/(t1938 + xp.sqrt(1 + t1938**2))), 0)
     t1942 = 1/xp.sqrt(1 + t1941**2)
     t1943 = t1935*t1941
@@ -4901,10 +4901,10 @@ def condition_number(q):
     t1969 = t1967 + t1941*t1966
     t1970 = t1808*t1948 + t1812*t1952 + t1816*t1956 + t1820*t1960 + t1824*t1964 + t1828*t1968
     t1971 = xp.not_equal(t1900, 0)
-    t1972 = 0.5*(-t1839 + t1874)/xp.where(t1971, t1900, 1)
+    t1972 = (-t1839 + t1874)/xp.where(t1971, 2*t1900, 1)
     t1973 = xp.abs(t1972)
     t1974 = xp.greater_equal(t1973, 1)
-    t1975 = xp.abs(1/xp.where(t1974, t1972, 1))
+    t1975 = 1/xp.abs(xp.where(t1974, t1972, 1))
     t1976 = xp.where(t1971, xp.where(xp.greater_equal(t1972, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1974, t1975/(1 + xp.sqrt(1 + t1975**2)), 1/(t1973 + xp.sqrt(1 + t1973**2))), 0)
     t1977 = 1/xp.sqrt(1 + t1976**2)
     t1978 = t1900*t1976
@@ -4936,10 +4936,10 @@ def condition_number(q):
     t2004 = t2002 + t1976*t2001
     t2005 = t1914*t1983 + t1918*t1987 + t1922*t1991 + t1926*t1995 + t1930*t1999 + t1934*t2003
     t2006 = xp.not_equal(t2005, 0)
-    t2007 = 0.5*(-t1979 + t1910)/xp.where(t2006, t2005, 1)
+    t2007 = (-t1979 + t1910)/xp.where(t2006, 2*t2005, 1)
     t2008 = xp.abs(t2007)
     t2009 = xp.greater_equal(t2008, 1)
-    t2010 = xp.abs(1/xp.where(t2009, t2007, 1))
+    t2010 = 1/xp.abs(xp.where(t2009, t2007, 1))
     t2011 = xp.where(t2006, xp.where(xp.greater_equal(t2007, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2009, t2010/(1 + xp.sqrt(1 + t2010**2)), 1/(t2008 + xp.sqrt(1 + t2008**2))), 0)
     t2012 = 1/xp.sqrt(1 + t2011**2)
     t2013 = t2005*t2011
@@ -4972,10 +4972,10 @@ def condition_number(q):
     t2040 = t1949*t2018 + t1953*t2022 + t1957*t2026 + t1961*t2030 + t1965*t2034 + t1969*t2038
     t2041 = t1984*t2019 + t1988*t2023 + t1992*t2027 + t1996*t2031 + t2000*t2035 + t2004*t2039
     t2042 = xp.not_equal(t2040, 0)
-    t2043 = 0.5*(-t2014 + t1945)/xp.where(t2042, t2040, 1)
+    t2043 = (-t2014 + t1945)/xp.where(t2042, 2*t2040, 1)
     t2044 = xp.abs(t2043)
     t2045 = xp.greater_equal(t2044, 1)
-    t2046 = xp.abs(1/xp.where(t2045, t2043, 1))
+    t2046 = 1/xp.abs(xp.where(t2045, t2043, 1))
     t2047 = xp.where(t2042, xp.where(xp.greater_equal(t2043, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2045, t2046/(1 + xp.sqrt(1 + t2046**2)), 1/(t2044 + xp.sqrt(1 + t2044**2))), 0)
     t2048 = 1/xp.sqrt(1 + t2047**2)
     t2049 = t2040*t2047
@@ -5006,10 +5006,10 @@ def condition_number(q):
     t2074 = t2072 - t2047*t2073
     t2075 = t2073 + t2047*t2072
     t2076 = xp.not_equal(t2041, 0)
-    t2077 = 0.5*(-t1980 + t2015)/xp.where(t2076, t2041, 1)
+    t2077 = (-t1980 + t2015)/xp.where(t2076, 2*t2041, 1)
     t2078 = xp.abs(t2077)
     t2079 = xp.greater_equal(t2078, 1)
-    t2080 = xp.abs(1/xp.where(t2079, t2077, 1))
+    t2080 = 1/xp.abs(xp.where(t2079, t2077, 1))
     t2081 = xp.where(t2076, xp.where(xp.greater_equal(t2077, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2079, t2080/(1 + xp.sqrt(1 + t2080**2)), 1/(t2078 + xp.sqrt(1 + t2078**2))), 0)
     t2082 = 1/xp.sqrt(1 + t2081**2)
     t2083 = t2041*t2081
@@ -5041,10 +5041,10 @@ def condition_number(q):
     t2109 = t2107 + t2081*t2106
     t2110 = t2055*t2088 + t2059*t2092 + t2063*t2096 + t2067*t2100 + t2071*t2104 + t2075*t2108
     t2111 = xp.not_equal(t2110, 0)
-    t2112 = 0.5*(-t2084 + t2051)/xp.where(t2111, t2110, 1)
+    t2112 = (-t2084 + t2051)/xp.where(t2111, 2*t2110, 1)
     t2113 = xp.abs(t2112)
     t2114 = xp.greater_equal(t2113, 1)
-    t2115 = xp.abs(1/xp.where(t2114, t2112, 1))
+    t2115 = 1/xp.abs(xp.where(t2114, t2112, 1))
     t2116 = xp.where(t2111, xp.where(xp.greater_equal(t2112, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2114, t2115/(1 + xp.sqrt(1 + t2115**2)), 1/(t2113 + xp.sqrt(1 + t2113**2))), 0)
     t2117 = 1/xp.sqrt(1 + t2116**2)
     t2118 = t2110*t2116
@@ -5076,10 +5076,10 @@ def condition_number(q):
     t2144 = t2142 + t2116*t2141
     t2145 = t2089*t2124 + t2093*t2128 + t2097*t2132 + t2101*t2136 + t2105*t2140 + t2109*t2144
     t2146 = xp.not_equal(t2145, 0)
-    t2147 = 0.5*(-t2085 + t2120)/xp.where(t2146, t2145, 1)
+    t2147 = (-t2085 + t2120)/xp.where(t2146, 2*t2145, 1)
     t2148 = xp.abs(t2147)
     t2149 = xp.greater_equal(t2148, 1)
-    t2150 = xp.abs(1/xp.where(t2149, t2147, 1))
+    t2150 = 1/xp.abs(xp.where(t2149, t2147, 1))
     t2151 = xp.where(t2146, xp.where(xp.greater_equal(t2147, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2149, t2150/(1 + xp.sqrt(1 + t2150**2)), 1/(t2148 + xp.sqrt(1 + t2148**2))), 0)
     t2152 = 1/xp.sqrt(1 + t2151**2)
     t2153 = t2145*t2151
@@ -5110,10 +5110,10 @@ def condition_number(q):
     t2178 = t2176 - t2151*t2177
     t2179 = t2177 + t2151*t2176
     t2180 = xp.not_equal(t1970, 0)
-    t2181 = 0.5*(-t1804 + t1944)/xp.where(t2180, t1970, 1)
+    t2181 = (-t1804 + t1944)/xp.where(t2180, 2*t1970, 1)
     t2182 = xp.abs(t2181)
     t2183 = xp.greater_equal(t2182, 1)
-    t2184 = xp.abs(1/xp.where(t2183, t2181, 1))
+    t2184 = 1/xp.abs(xp.where(t2183, t2181, 1))
     t2185 = xp.where(t2180, xp.where(xp.greater_equal(t2181, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2183, t2184/(1 + xp.sqrt(1 + t2184**2)), 1/(t2182 + xp.sqrt(1 + t2182**2))), 0)
     t2186 = 1/xp.sqrt(1 + t2185**2)
     t2187 = t1970*t2185
@@ -5145,10 +5145,10 @@ def condition_number(q):
     t2213 = t2211 + t2185*t2210
     t2214 = t2054*t2192 + t2058*t2196 + t2062*t2200 + t2066*t2204 + t2070*t2208 + t2074*t2212
     t2215 = xp.not_equal(t2214, 0)
-    t2216 = 0.5*(-t2188 + t2050)/xp.where(t2215, t2214, 1)
+    t2216 = (-t2188 + t2050)/xp.where(t2215, 2*t2214, 1)
     t2217 = xp.abs(t2216)
     t2218 = xp.greater_equal(t2217, 1)
-    t2219 = xp.abs(1/xp.where(t2218, t2216, 1))
+    t2219 = 1/xp.abs(xp.where(t2218, t2216, 1))
     t2220 = xp.where(t2215, xp.where(xp.greater_equal(t2216, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2218, t2219/(1 + xp.sqrt(1 + t2219**2)), 1/(t2217 + xp.sqrt(1 + t2217**2))), 0)
     t2221 = 1/xp.sqrt(1 + t2220**2)
     t2222 = t2214*t2220
@@ -5181,10 +5181,10 @@ def condition_number(q):
     t2249 = t2123*t2227 + t2127*t2231 + t2131*t2235 + t2135*t2239 + t2139*t2243 + t2143*t2247
     t2250 = t2193*t2228 + t2197*t2232 + t2201*t2236 + t2205*t2240 + t2209*t2244 + t2213*t2248
     t2251 = xp.not_equal(t2249, 0)
-    t2252 = 0.5*(-t2223 + t2119)/xp.where(t2251, t2249, 1)
+    t2252 = (-t2223 + t2119)/xp.where(t2251, 2*t2249, 1)
     t2253 = xp.abs(t2252)
     t2254 = xp.greater_equal(t2253, 1)
-    t2255 = xp.abs(1/xp.where(t2254, t2252, 1))
+    t2255 = 1/xp.abs(xp.where(t2254, t2252, 1))
     t2256 = xp.where(t2251, xp.where(xp.greater_equal(t2252, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2254, t2255/(1 + xp.sqrt(1 + t2255**2)), 1/(t2253 + xp.sqrt(1 + t2253**2))), 0)
     t2257 = 1/xp.sqrt(1 + t2256**2)
     t2258 = t2249*t2256
@@ -5216,10 +5216,10 @@ def condition_number(q):
     t2284 = t2282 + t2256*t2281
     t2285 = t2158*t2263 + t2162*t2267 + t2166*t2271 + t2170*t2275 + t2174*t2279 + t2178*t2283
     t2286 = xp.not_equal(t2285, 0)
-    t2287 = 0.5*(-t2259 + t2154)/xp.where(t2286, t2285, 1)
+    t2287 = (-t2259 + t2154)/xp.where(t2286, 2*t2285, 1)
     t2288 = xp.abs(t2287)
     t2289 = xp.greater_equal(t2288, 1)
-    t2290 = xp.abs(1/xp.where(t2289, t2287, 1))
+    t2290 = 1/xp.abs(xp.where(t2289, t2287, 1))
     t2291 = xp.where(t2286, xp.where(xp.greater_equal(t2287, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2289, t2290/(1 + xp.sqrt(1 + t2290**2)), 1/(t2288 + xp.sqrt(1 + t2288**2))), 0)
     t2292 = 1/xp.sqrt(1 + t2291**2)
     t2293 = t2285*t2291
@@ -5251,10 +5251,10 @@ def condition_number(q):
     t2319 = t2317 + t2291*t2316
     t2320 = t2159*t2298 + t2163*t2302 + t2167*t2306 + t2171*t2310 + t2175*t2314 + t2179*t2318
     t2321 = xp.not_equal(t2320, 0)
-    t2322 = 0.5*(-t2294 + t2155)/xp.where(t2321, t2320, 1)
+    t2322 = (-t2294 + t2155)/xp.where(t2321, 2*t2320, 1)
     t2323 = xp.abs(t2322)
     t2324 = xp.greater_equal(t2323, 1)
-    t2325 = xp.abs(1/xp.where(t2324, t2322, 1))
+    t2325 = 1/xp.abs(xp.where(t2324, t2322, 1))
     t2326 = xp.where(t2321, xp.where(xp.greater_equal(t2322, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2324, t2325/(1 + xp.sqrt(1 + t2325**2)), 1/(t2323 + xp.sqrt(1 + t2323**2))), 0)
     t2327 = 1/xp.sqrt(1 + t2326**2)
     t2328 = t2320*t2326
@@ -5285,10 +5285,10 @@ def condition_number(q):
     t2353 = t2351 - t2326*t2352
     t2354 = t2352 + t2326*t2351
     t2355 = xp.not_equal(t2250, 0)
-    t2356 = 0.5*(-t2189 + t2224)/xp.where(t2355, t2250, 1)
+    t2356 = (-t2189 + t2224)/xp.where(t2355, 2*t2250, 1)
     t2357 = xp.abs(t2356)
     t2358 = xp.greater_equal(t2357, 1)
-    t2359 = xp.abs(1/xp.where(t2358, t2356, 1))
+    t2359 = 1/xp.abs(xp.where(t2358, t2356, 1))
     t2360 = xp.where(t2355, xp.where(xp.greater_equal(t2356, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2358, t2359/(1 + xp.sqrt(1 + t2359**2)), 1/(t2357 + xp.sqrt(1 + t2357**2))), 0)
     t2361 = 1/xp.sqrt(1 + t2360**2)
     t2362 = t2250*t2360
@@ -5320,10 +5320,10 @@ def condition_number(q):
     t2388 = t2386 + t2360*t2385
     t2389 = t2264*t2367 + t2268*t2371 + t2272*t2375 + t2276*t2379 + t2280*t2383 + t2284*t2387
     t2390 = xp.not_equal(t2389, 0)
-    t2391 = 0.5*(-t2363 + t2260)/xp.where(t2390, t2389, 1)
+    t2391 = (-t2363 + t2260)/xp.where(t2390, 2*t2389, 1)
     t2392 = xp.abs(t2391)
     t2393 = xp.greater_equal(t2392, 1)
-    t2394 = xp.abs(1/xp.where(t2393, t2391, 1))
+    t2394 = 1/xp.abs(xp.where(t2393, t2391, 1))
     t2395 = xp.where(t2390, xp.where(xp.greater_equal(t2391, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2393, t2394/(1 + xp.sqrt(1 + t2394**2)), 1/(t2392 + xp.sqrt(1 + t2392**2))), 0)
     t2396 = 1/xp.sqrt(1 + t2395**2)
     t2397 = t2389*t2395
@@ -5356,10 +5356,10 @@ def condition_number(q):
     t2424 = t2299*t2402 + t2303*t2406 + t2307*t2410 + t2311*t2414 + t2315*t2418 + t2319*t2422
     t2425 = t2368*t2403 + t2372*t2407 + t2376*t2411 + t2380*t2415 + t2384*t2419 + t2388*t2423
     t2426 = xp.not_equal(t2424, 0)
-    t2427 = 0.5*(-t2398 + t2295)/xp.where(t2426, t2424, 1)
+    t2427 = (-t2398 + t2295)/xp.where(t2426, 2*t2424, 1)
     t2428 = xp.abs(t2427)
     t2429 = xp.greater_equal(t2428, 1)
-    t2430 = xp.abs(1/xp.where(t2429, t2427, 1))
+    t2430 = 1/xp.abs(xp.where(t2429, t2427, 1))
     t2431 = xp.where(t2426, xp.where(xp.greater_equal(t2427, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2429, t2430/(1 + xp.sqrt(1 + t2430**2)), 1/(t2428 + xp.sqrt(1 + t2428**2))), 0)
     t2432 = 1/xp.sqrt(1 + t2431**2)
     t2433 = t2424*t2431
@@ -5391,10 +5391,10 @@ def condition_number(q):
     t2459 = t2457 + t2431*t2456
     t2460 = t2334*t2438 + t2338*t2442 + t2342*t2446 + t2346*t2450 + t2350*t2454 + t2354*t2458
     t2461 = xp.not_equal(t2460, 0)
-    t2462 = 0.5*(-t2434 + t2330)/xp.where(t2461, t2460, 1)
+    t2462 = (-t2434 + t2330)/xp.where(t2461, 2*t2460, 1)
     t2463 = xp.abs(t2462)
     t2464 = xp.greater_equal(t2463, 1)
-    t2465 = xp.abs(1/xp.where(t2464, t2462, 1))
+    t2465 = 1/xp.abs(xp.where(t2464, t2462, 1))
     t2466 = xp.where(t2461, xp.where(xp.greater_equal(t2462, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2464, t2465/(1 + xp.sqrt(1 + t2465**2)), 1/(t2463 + xp.sqrt(1 + t2463**2))), 0)
     t2467 = 1/xp.sqrt(1 + t2466**2)
     t2468 = t2460*t2466
@@ -5426,10 +5426,10 @@ def condition_number(q):
     t2494 = t2492 + t2466*t2491
     t2495 = t2333*t2473 + t2337*t2477 + t2341*t2481 + t2345*t2485 + t2349*t2489 + t2353*t2493
     t2496 = xp.not_equal(t2425, 0)
-    t2497 = 0.5*(-t2364 + t2399)/xp.where(t2496, t2425, 1)
+    t2497 = (-t2364 + t2399)/xp.where(t2496, 2*t2425, 1)
     t2498 = xp.abs(t2497)
     t2499 = xp.greater_equal(t2498, 1)
-    t2500 = xp.abs(1/xp.where(t2499, t2497, 1))
+    t2500 = 1/xp.abs(xp.where(t2499, t2497, 1))
     t2501 = xp.where(t2496, xp.where(xp.greater_equal(t2497, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2499, t2500/(1 + xp.sqrt(1 + t2500**2)), 1/(t2498 + xp.sqrt(1 + t2498**2))), 0)
     t2502 = 1/xp.sqrt(1 + t2501**2)
     t2503 = t2425*t2501
@@ -5461,10 +5461,10 @@ def condition_number(q):
     t2529 = t2527 + t2501*t2526
     t2530 = t2439*t2508 + t2443*t2512 + t2447*t2516 + t2451*t2520 + t2455*t2524 + t2459*t2528
     t2531 = xp.not_equal(t2530, 0)
-    t2532 = 0.5*(-t2504 + t2435)/xp.where(t2531, t2530, 1)
+    t2532 = (-t2504 + t2435)/xp.where(t2531, 2*t2530, 1)
     t2533 = xp.abs(t2532)
     t2534 = xp.greater_equal(t2533, 1)
-    t2535 = xp.abs(1/xp.where(t2534, t2532, 1))
+    t2535 = 1/xp.abs(xp.where(t2534, t2532, 1))
     t2536 = xp.where(t2531, xp.where(xp.greater_equal(t2532, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2534, t2535/(1 + xp.sqrt(1 + t2535**2)), 1/(t2533 + xp.sqrt(1 + t2533**2))), 0)
     t2537 = 1/xp.sqrt(1 + t2536**2)
     t2538 = t2530*t2536
@@ -5497,10 +5497,10 @@ def condition_number(q):
     t2565 = t2474*t2543 + t2478*t2547 + t2482*t2551 + t2486*t2555 + t2490*t2559 + t2494*t2563
     t2566 = t2509*t2544 + t2513*t2548 + t2517*t2552 + t2521*t2556 + t2525*t2560 + t2529*t2564
     t2567 = xp.not_equal(t2565, 0)
-    t2568 = 0.5*(-t2539 + t2470)/xp.where(t2567, t2565, 1)
+    t2568 = (-t2539 + t2470)/xp.where(t2567, 2*t2565, 1)
     t2569 = xp.abs(t2568)
     t2570 = xp.greater_equal(t2569, 1)
-    t2571 = xp.abs(1/xp.where(t2570, t2568, 1))
+    t2571 = 1/xp.abs(xp.where(t2570, t2568, 1))
     t2572 = xp.where(t2567, xp.where(xp.greater_equal(t2568, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2570, t2571/(1 + xp.sqrt(1 + t2571**2)), 1/(t2569 + xp.sqrt(1 + t2569**2))), 0)
     t2573 = 1/xp.sqrt(1 + t2572**2)
     t2574 = t2565*t2572
@@ -5531,10 +5531,10 @@ def condition_number(q):
     t2599 = t2597 - t2572*t2598
     t2600 = t2598 + t2572*t2597
     t2601 = xp.not_equal(t2566, 0)
-    t2602 = 0.5*(-t2505 + t2540)/xp.where(t2601, t2566, 1)
+    t2602 = (-t2505 + t2540)/xp.where(t2601, 2*t2566, 1)
     t2603 = xp.abs(t2602)
     t2604 = xp.greater_equal(t2603, 1)
-    t2605 = xp.abs(1/xp.where(t2604, t2602, 1))
+    t2605 = 1/xp.abs(xp.where(t2604, t2602, 1))
     t2606 = xp.where(t2601, xp.where(xp.greater_equal(t2602, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2604, t2605/(1 + xp.sqrt(1 + t2605**2)), 1/(t2603 + xp.sqrt(1 + t2603**2))), 0)
     t2607 = 1/xp.sqrt(1 + t2606**2)
     t2608 = t2566*t2606
@@ -5566,10 +5566,10 @@ def condition_number(q):
     t2634 = t2632 + t2606*t2631
     t2635 = t2580*t2613 + t2584*t2617 + t2588*t2621 + t2592*t2625 + t2596*t2629 + t2600*t2633
     t2636 = xp.not_equal(t2635, 0)
-    t2637 = 0.5*(-t2609 + t2576)/xp.where(t2636, t2635, 1)
+    t2637 = (-t2609 + t2576)/xp.where(t2636, 2*t2635, 1)
     t2638 = xp.abs(t2637)
     t2639 = xp.greater_equal(t2638, 1)
-    t2640 = xp.abs(1/xp.where(t2639, t2637, 1))
+    t2640 = 1/xp.abs(xp.where(t2639, t2637, 1))
     t2641 = xp.where(t2636, xp.where(xp.greater_equal(t2637, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2639, t2640/(1 + xp.sqrt(1 + t2640**2)), 1/(t2638 + xp.sqrt(1 + t2638**2))), 0)
     t2642 = 1/xp.sqrt(1 + t2641**2)
     t2643 = t2635*t2641
@@ -5601,10 +5601,10 @@ def condition_number(q):
     t2669 = t2667 + t2641*t2666
     t2670 = t2614*t2649 + t2618*t2653 + t2622*t2657 + t2626*t2661 + t2630*t2665 + t2634*t2669
     t2671 = xp.not_equal(t2670, 0)
-    t2672 = 0.5*(-t2610 + t2645)/xp.where(t2671, t2670, 1)
+    t2672 = (-t2610 + t2645)/xp.where(t2671, 2*t2670, 1)
     t2673 = xp.abs(t2672)
     t2674 = xp.greater_equal(t2673, 1)
-    t2675 = xp.abs(1/xp.where(t2674, t2672, 1))
+    t2675 = 1/xp.abs(xp.where(t2674, t2672, 1))
     t2676 = xp.where(t2671, xp.where(xp.greater_equal(t2672, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2674, t2675/(1 + xp.sqrt(1 + t2675**2)), 1/(t2673 + xp.sqrt(1 + t2673**2))), 0)
     t2677 = 1/xp.sqrt(1 + t2676**2)
     t2678 = t2670*t2676
@@ -5635,10 +5635,10 @@ def condition_number(q):
     t2703 = t2701 - t2676*t2702
     t2704 = t2702 + t2676*t2701
     t2705 = xp.not_equal(t2495, 0)
-    t2706 = 0.5*(-t2329 + t2469)/xp.where(t2705, t2495, 1)
+    t2706 = (-t2329 + t2469)/xp.where(t2705, 2*t2495, 1)
     t2707 = xp.abs(t2706)
     t2708 = xp.greater_equal(t2707, 1)
-    t2709 = xp.abs(1/xp.where(t2708, t2706, 1))
+    t2709 = 1/xp.abs(xp.where(t2708, t2706, 1))
     t2710 = xp.where(t2705, xp.where(xp.greater_equal(t2706, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2708, t2709/(1 + xp.sqrt(1 + t2709**2)), 1/(t2707 + xp.sqrt(1 + t2707**2))), 0)
     t2711 = 1/xp.sqrt(1 + t2710**2)
     t2712 = t2495*t2710
@@ -5670,10 +5670,10 @@ def condition_number(q):
     t2738 = t2736 + t2710*t2735
     t2739 = t2579*t2717 + t2583*t2721 + t2587*t2725 + t2591*t2729 + t2595*t2733 + t2599*t2737
     t2740 = xp.not_equal(t2739, 0)
-    t2741 = 0.5*(-t2713 + t2575)/xp.where(t2740, t2739, 1)
+    t2741 = (-t2713 + t2575)/xp.where(t2740, 2*t2739, 1)
     t2742 = xp.abs(t2741)
     t2743 = xp.greater_equal(t2742, 1)
-    t2744 = xp.abs(1/xp.where(t2743, t2741, 1))
+    t2744 = 1/xp.abs(xp.where(t2743, t2741, 1))
     t2745 = xp.where(t2740, xp.where(xp.greater_equal(t2741, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2743, t2744/(1 + xp.sqrt(1 + t2744**2)), 1/(t2742 + xp.sqrt(1 + t2742**2))), 0)
     t2746 = 1/xp.sqrt(1 + t2745**2)
     t2747 = t2739*t2745
@@ -5706,10 +5706,10 @@ def condition_number(q):
     t2774 = t2648*t2752 + t2652*t2756 + t2656*t2760 + t2660*t2764 + t2664*t2768 + t2668*t2772
     t2775 = t2718*t2753 + t2722*t2757 + t2726*t2761 + t2730*t2765 + t2734*t2769 + t2738*t2773
     t2776 = xp.not_equal(t2774, 0)
-    t2777 = 0.5*(-t2748 + t2644)/xp.where(t2776, t2774, 1)
+    t2777 = (-t2748 + t2644)/xp.where(t2776, 2*t2774, 1)
     t2778 = xp.abs(t2777)
     t2779 = xp.greater_equal(t2778, 1)
-    t2780 = xp.abs(1/xp.where(t2779, t2777, 1))
+    t2780 = 1/xp.abs(xp.where(t2779, t2777, 1))
     t2781 = xp.where(t2776, xp.where(xp.greater_equal(t2777, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2779, t2780/(1 + xp.sqrt(1 + t2780**2)), 1/(t2778 + xp.sqrt(1 + t2778**2))), 0)
     t2782 = 1/xp.sqrt(1 + t2781**2)
     t2783 = t2774*t2781
@@ -5741,10 +5741,10 @@ def condition_number(q):
     t2809 = t2807 + t2781*t2806
     t2810 = t2683*t2788 + t2687*t2792 + t2691*t2796 + t2695*t2800 + t2699*t2804 + t2703*t2808
     t2811 = xp.not_equal(t2810, 0)
-    t2812 = 0.5*(-t2784 + t2679)/xp.where(t2811, t2810, 1)
+    t2812 = (-t2784 + t2679)/xp.where(t2811, 2*t2810, 1)
     t2813 = xp.abs(t2812)
     t2814 = xp.greater_equal(t2813, 1)
-    t2815 = xp.abs(1/xp.where(t2814, t2812, 1))
+    t2815 = 1/xp.abs(xp.where(t2814, t2812, 1))
     t2816 = xp.where(t2811, xp.where(xp.greater_equal(t2812, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2814, t2815/(1 + xp.sqrt(1 + t2815**2)), 1/(t2813 + xp.sqrt(1 + t2813**2))), 0)
     t2817 = 1/xp.sqrt(1 + t2816**2)
     t2818 = t2810*t2816
@@ -5776,10 +5776,10 @@ def condition_number(q):
     t2844 = t2842 + t2816*t2841
     t2845 = t2684*t2823 + t2688*t2827 + t2692*t2831 + t2696*t2835 + t2700*t2839 + t2704*t2843
     t2846 = xp.not_equal(t2845, 0)
-    t2847 = 0.5*(-t2819 + t2680)/xp.where(t2846, t2845, 1)
+    t2847 = (-t2819 + t2680)/xp.where(t2846, 2*t2845, 1)
     t2848 = xp.abs(t2847)
     t2849 = xp.greater_equal(t2848, 1)
-    t2850 = xp.abs(1/xp.where(t2849, t2847, 1))
+    t2850 = 1/xp.abs(xp.where(t2849, t2847, 1))
     t2851 = xp.where(t2846, xp.where(xp.greater_equal(t2847, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2849, t2850/(1 + xp.sqrt(1 + t2850**2)), 1/(t2848 + xp.sqrt(1 + t2848**2))), 0)
     t2852 = 1/xp.sqrt(1 + t2851**2)
     t2853 = t2845*t2851
@@ -5810,10 +5810,10 @@ def condition_number(q):
     t2878 = t2876 - t2851*t2877
     t2879 = t2877 + t2851*t2876
     t2880 = xp.not_equal(t2775, 0)
-    t2881 = 0.5*(-t2714 + t2749)/xp.where(t2880, t2775, 1)
+    t2881 = (-t2714 + t2749)/xp.where(t2880, 2*t2775, 1)
     t2882 = xp.abs(t2881)
     t2883 = xp.greater_equal(t2882, 1)
-    t2884 = xp.abs(1/xp.where(t2883, t2881, 1))
+    t2884 = 1/xp.abs(xp.where(t2883, t2881, 1))
     t2885 = xp.where(t2880, xp.where(xp.greater_equal(t2881, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2883, t2884/(1 + xp.sqrt(1 + t2884**2)), 1/(t2882 + xp.sqrt(1 + t2882**2))), 0)
     t2886 = 1/xp.sqrt(1 + t2885**2)
     t2887 = t2775*t2885
@@ -5845,10 +5845,10 @@ def condition_number(q):
     t2913 = t2911 + t2885*t2910
     t2914 = t2789*t2892 + t2793*t2896 + t2797*t2900 + t2801*t2904 + t2805*t2908 + t2809*t2912
     t2915 = xp.not_equal(t2914, 0)
-    t2916 = 0.5*(-t2888 + t2785)/xp.where(t2915, t2914, 1)
+    t2916 = (-t2888 + t2785)/xp.where(t2915, 2*t2914, 1)
     t2917 = xp.abs(t2916)
     t2918 = xp.greater_equal(t2917, 1)
-    t2919 = xp.abs(1/xp.where(t2918, t2916, 1))
+    t2919 = 1/xp.abs(xp.where(t2918, t2916, 1))
     t2920 = xp.where(t2915, xp.where(xp.greater_equal(t2916, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2918, t2919/(1 + xp.sqrt(1 + t2919**2)), 1/(t2917 + xp.sqrt(1 + t2917**2))), 0)
     t2921 = 1/xp.sqrt(1 + t2920**2)
     t2922 = t2914*t2920
@@ -5881,10 +5881,10 @@ def condition_number(q):
     t2949 = t2824*t2927 + t2828*t2931 + t2832*t2935 + t2836*t2939 + t2840*t2943 + t2844*t2947
     t2950 = t2893*t2928 + t2897*t2932 + t2901*t2936 + t2905*t2940 + t2909*t2944 + t2913*t2948
     t2951 = xp.not_equal(t2949, 0)
-    t2952 = 0.5*(-t2923 + t2820)/xp.where(t2951, t2949, 1)
+    t2952 = (-t2923 + t2820)/xp.where(t2951, 2*t2949, 1)
     t2953 = xp.abs(t2952)
     t2954 = xp.greater_equal(t2953, 1)
-    t2955 = xp.abs(1/xp.where(t2954, t2952, 1))
+    t2955 = 1/xp.abs(xp.where(t2954, t2952, 1))
     t2956 = xp.where(t2951, xp.where(xp.greater_equal(t2952, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2954, t2955/(1 + xp.sqrt(1 + t2955**2)), 1/(t2953 + xp.sqrt(1 + t2953**2))), 0)
     t2957 = 1/xp.sqrt(1 + t2956**2)
     t2958 = t2949*t2956
@@ -5916,10 +5916,10 @@ def condition_number(q):
     t2984 = t2982 + t2956*t2981
     t2985 = t2859*t2963 + t2863*t2967 + t2867*t2971 + t2871*t2975 + t2875*t2979 + t2879*t2983
     t2986 = xp.not_equal(t2985, 0)
-    t2987 = 0.5*(-t2959 + t2855)/xp.where(t2986, t2985, 1)
+    t2987 = (-t2959 + t2855)/xp.where(t2986, 2*t2985, 1)
     t2988 = xp.abs(t2987)
     t2989 = xp.greater_equal(t2988, 1)
-    t2990 = xp.abs(1/xp.where(t2989, t2987, 1))
+    t2990 = 1/xp.abs(xp.where(t2989, t2987, 1))
     t2991 = xp.where(t2986, xp.where(xp.greater_equal(t2987, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2989, t2990/(1 + xp.sqrt(1 + t2990**2)), 1/(t2988 + xp.sqrt(1 + t2988**2))), 0)
     t2992 = 1/xp.sqrt(1 + t2991**2)
     t2993 = t2985*t2991
@@ -5951,10 +5951,10 @@ def condition_number(q):
     t3019 = t3017 + t2991*t3016
     t3020 = t2858*t2998 + t2862*t3002 + t2866*t3006 + t2870*t3010 + t2874*t3014 + t2878*t3018
     t3021 = xp.not_equal(t2950, 0)
-    t3022 = 0.5*(-t2889 + t2924)/xp.where(t3021, t2950, 1)
+    t3022 = (-t2889 + t2924)/xp.where(t3021, 2*t2950, 1)
     t3023 = xp.abs(t3022)
     t3024 = xp.greater_equal(t3023, 1)
-    t3025 = xp.abs(1/xp.where(t3024, t3022, 1))
+    t3025 = 1/xp.abs(xp.where(t3024, t3022, 1))
     t3026 = xp.where(t3021, xp.where(xp.greater_equal(t3022, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3024, t3025/(1 + xp.sqrt(1 + t3025**2)), 1/(t3023 + xp.sqrt(1 + t3023**2))), 0)
     t3027 = 1/xp.sqrt(1 + t3026**2)
     t3028 = t2950*t3026
@@ -5986,10 +5986,10 @@ def condition_number(q):
     t3054 = t3052 + t3026*t3051
     t3055 = t2964*t3033 + t2968*t3037 + t2972*t3041 + t2976*t3045 + t2980*t3049 + t2984*t3053
     t3056 = xp.not_equal(t3055, 0)
-    t3057 = 0.5*(-t3029 + t2960)/xp.where(t3056, t3055, 1)
+    t3057 = (-t3029 + t2960)/xp.where(t3056, 2*t3055, 1)
     t3058 = xp.abs(t3057)
     t3059 = xp.greater_equal(t3058, 1)
-    t3060 = xp.abs(1/xp.where(t3059, t3057, 1))
+    t3060 = 1/xp.abs(xp.where(t3059, t3057, 1))
     t3061 = xp.where(t3056, xp.where(xp.greater_equal(t3057, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3059, t3060/(1 + xp.sqrt(1 + t3060**2)), 1/(t3058 + xp.sqrt(1 + t3058**2))), 0)
     t3062 = 1/xp.sqrt(1 + t3061**2)
     t3063 = t3055*t3061
@@ -6022,10 +6022,10 @@ def condition_number(q):
     t3090 = t2999*t3068 + t3003*t3072 + t3007*t3076 + t3011*t3080 + t3015*t3084 + t3019*t3088
     t3091 = t3034*t3069 + t3038*t3073 + t3042*t3077 + t3046*t3081 + t3050*t3085 + t3054*t3089
     t3092 = xp.not_equal(t3090, 0)
-    t3093 = 0.5*(-t3064 + t2995)/xp.where(t3092, t3090, 1)
+    t3093 = (-t3064 + t2995)/xp.where(t3092, 2*t3090, 1)
     t3094 = xp.abs(t3093)
     t3095 = xp.greater_equal(t3094, 1)
-    t3096 = xp.abs(1/xp.where(t3095, t3093, 1))
+    t3096 = 1/xp.abs(xp.where(t3095, t3093, 1))
     t3097 = xp.where(t3092, xp.where(xp.greater_equal(t3093, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3095, t3096/(1 + xp.sqrt(1 + t3096**2)), 1/(t3094 + xp.sqrt(1 + t3094**2))), 0)
     t3098 = 1/xp.sqrt(1 + t3097**2)
     t3099 = t3090*t3097
@@ -6056,10 +6056,10 @@ def condition_number(q):
     t3124 = t3122 - t3097*t3123
     t3125 = t3123 + t3097*t3122
     t3126 = xp.not_equal(t3091, 0)
-    t3127 = 0.5*(-t3030 + t3065)/xp.where(t3126, t3091, 1)
+    t3127 = (-t3030 + t3065)/xp.where(t3126, 2*t3091, 1)
     t3128 = xp.abs(t3127)
     t3129 = xp.greater_equal(t3128, 1)
-    t3130 = xp.abs(1/xp.where(t3129, t3127, 1))
+    t3130 = 1/xp.abs(xp.where(t3129, t3127, 1))
     t3131 = xp.where(t3126, xp.where(xp.greater_equal(t3127, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3129, t3130/(1 + xp.sqrt(1 + t3130**2)), 1/(t3128 + xp.sqrt(1 + t3128**2))), 0)
     t3132 = 1/xp.sqrt(1 + t3131**2)
     t3133 = t3091*t3131
@@ -6091,10 +6091,10 @@ def condition_number(q):
     t3159 = t3157 + t3131*t3156
     t3160 = t3105*t3138 + t3109*t3142 + t3113*t3146 + t3117*t3150 + t3121*t3154 + t3125*t3158
     t3161 = xp.not_equal(t3160, 0)
-    t3162 = 0.5*(-t3134 + t3101)/xp.where(t3161, t3160, 1)
+    t3162 = (-t3134 + t3101)/xp.where(t3161, 2*t3160, 1)
     t3163 = xp.abs(t3162)
     t3164 = xp.greater_equal(t3163, 1)
-    t3165 = xp.abs(1/xp.where(t3164, t3162, 1))
+    t3165 = 1/xp.abs(xp.where(t3164, t3162, 1))
     t3166 = xp.where(t3161, xp.where(xp.greater_equal(t3162, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3164, t3165/(1 + xp.sqrt(1 + t3165**2)), 1/(t3163 + xp.sqrt(1 + t3163**2))), 0)
     t3167 = 1/xp.sqrt(1 + t3166**2)
     t3168 = t3160*t3166
@@ -6126,10 +6126,10 @@ def condition_number(q):
     t3194 = t3192 + t3166*t3191
     t3195 = t3139*t3174 + t3143*t3178 + t3147*t3182 + t3151*t3186 + t3155*t3190 + t3159*t3194
     t3196 = xp.not_equal(t3195, 0)
-    t3197 = 0.5*(-t3135 + t3170)/xp.where(t3196, t3195, 1)
+    t3197 = (-t3135 + t3170)/xp.where(t3196, 2*t3195, 1)
     t3198 = xp.abs(t3197)
     t3199 = xp.greater_equal(t3198, 1)
-    t3200 = xp.abs(1/xp.where(t3199, t3197, 1))
+    t3200 = 1/xp.abs(xp.where(t3199, t3197, 1))
     t3201 = xp.where(t3196, xp.where(xp.greater_equal(t3197, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3199, t3200/(1 + xp.sqrt(1 + t3200**2)), 1/(t3198 + xp.sqrt(1 + t3198**2))), 0)
     t3202 = 1/xp.sqrt(1 + t3201**2)
     t3203 = t3195*t3201
@@ -6160,10 +6160,10 @@ def condition_number(q):
     t3228 = t3226 - t3201*t3227
     t3229 = t3227 + t3201*t3226
     t3230 = xp.not_equal(t3020, 0)
-    t3231 = 0.5*(-t2854 + t2994)/xp.where(t3230, t3020, 1)
+    t3231 = (-t2854 + t2994)/xp.where(t3230, 2*t3020, 1)
     t3232 = xp.abs(t3231)
     t3233 = xp.greater_equal(t3232, 1)
-    t3234 = xp.abs(1/xp.where(t3233, t3231, 1))
+    t3234 = 1/xp.abs(xp.where(t3233, t3231, 1))
     t3235 = xp.where(t3230, xp.where(xp.greater_equal(t3231, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3233, t3234/(1 + xp.sqrt(1 + t3234**2)), 1/(t3232 + xp.sqrt(1 + t3232**2))), 0)
     t3236 = 1/xp.sqrt(1 + t3235**2)
     t3237 = t3020*t3235
@@ -6195,10 +6195,10 @@ def condition_number(q):
     t3263 = t3261 + t3235*t3260
     t3264 = t3104*t3242 + t3108*t3246 + t3112*t3250 + t3116*t3254 + t3120*t3258 + t3124*t3262
     t3265 = xp.not_equal(t3264, 0)
-    t3266 = 0.5*(-t3238 + t3100)/xp.where(t3265, t3264, 1)
+    t3266 = (-t3238 + t3100)/xp.where(t3265, 2*t3264, 1)
     t3267 = xp.abs(t3266)
     t3268 = xp.greater_equal(t3267, 1)
-    t3269 = xp.abs(1/xp.where(t3268, t3266, 1))
+    t3269 = 1/xp.abs(xp.where(t3268, t3266, 1))
     t3270 = xp.where(t3265, xp.where(xp.greater_equal(t3266, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3268, t3269/(1 + xp.sqrt(1 + t3269**2)), 1/(t3267 + xp.sqrt(1 + t3267**2))), 0)
     t3271 = 1/xp.sqrt(1 + t3270**2)
     t3272 = t3264*t3270
@@ -6231,10 +6231,10 @@ def condition_number(q):
     t3299 = t3173*t3277 + t3177*t3281 + t3181*t3285 + t3185*t3289 + t3189*t3293 + t3193*t3297
     t3300 = t3243*t3278 + t3247*t3282 + t3251*t3286 + t3255*t3290 + t3259*t3294 + t3263*t3298
     t3301 = xp.not_equal(t3299, 0)
-    t3302 = 0.5*(-t3273 + t3169)/xp.where(t3301, t3299, 1)
+    t3302 = (-t3273 + t3169)/xp.where(t3301, 2*t3299, 1)
     t3303 = xp.abs(t3302)
     t3304 = xp.greater_equal(t3303, 1)
-    t3305 = xp.abs(1/xp.where(t3304, t3302, 1))
+    t3305 = 1/xp.abs(xp.where(t3304, t3302, 1))
     t3306 = xp.where(t3301, xp.where(xp.greater_equal(t3302, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3304, t3305/(1 + xp.sqrt(1 + t3305**2)), 1/(t3303 + xp.sqrt(1 + t3303**2))), 0)
     t3307 = 1/xp.sqrt(1 + t3306**2)
     t3308 = t3299*t3306
@@ -6266,10 +6266,10 @@ def condition_number(q):
     t3334 = t3332 + t3306*t3331
     t3335 = t3208*t3313 + t3212*t3317 + t3216*t3321 + t3220*t3325 + t3224*t3329 + t3228*t3333
     t3336 = xp.not_equal(t3335, 0)
-    t3337 = 0.5*(-t3309 + t3204)/xp.where(t3336, t3335, 1)
+    t3337 = (-t3309 + t3204)/xp.where(t3336, 2*t3335, 1)
     t3338 = xp.abs(t3337)
     t3339 = xp.greater_equal(t3338, 1)
-    t3340 = xp.abs(1/xp.where(t3339, t3337, 1))
+    t3340 = 1/xp.abs(xp.where(t3339, t3337, 1))
     t3341 = xp.where(t3336, xp.where(xp.greater_equal(t3337, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3339, t3340/(1 + xp.sqrt(1 + t3340**2)), 1/(t3338 + xp.sqrt(1 + t3338**2))), 0)
     t3342 = 1/xp.sqrt(1 + t3341**2)
     t3343 = t3335*t3341
@@ -6301,10 +6301,10 @@ def condition_number(q):
     t3369 = t3367 + t3341*t3366
     t3370 = t3209*t3348 + t3213*t3352 + t3217*t3356 + t3221*t3360 + t3225*t3364 + t3229*t3368
     t3371 = xp.not_equal(t3370, 0)
-    t3372 = 0.5*(-t3344 + t3205)/xp.where(t3371, t3370, 1)
+    t3372 = (-t3344 + t3205)/xp.where(t3371, 2*t3370, 1)
     t3373 = xp.abs(t3372)
     t3374 = xp.greater_equal(t3373, 1)
-    t3375 = xp.abs(1/xp.where(t3374, t3372, 1))
+    t3375 = 1/xp.abs(xp.where(t3374, t3372, 1))
     t3376 = xp.where(t3371, xp.where(xp.greater_equal(t3372, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3374, t3375/(1 + xp.sqrt(1 + t3375**2)), 1/(t3373 + xp.sqrt(1 + t3373**2))), 0)
     t3377 = 1/xp.sqrt(1 + t3376**2)
     t3378 = t3205 + t3370*t3376
@@ -6334,10 +6334,10 @@ def condition_number(q):
     t3402 = t3400 + t3376*t3399
     t3403 = xp.sqrt(t3381**2 + t3385**2 + t3389**2 + t3393**2 + t3397**2 + t3401**2)
     t3404 = xp.not_equal(t3300, 0)
-    t3405 = 0.5*(-t3239 + t3274)/xp.where(t3404, t3300, 1)
+    t3405 = (-t3239 + t3274)/xp.where(t3404, 2*t3300, 1)
     t3406 = xp.abs(t3405)
     t3407 = xp.greater_equal(t3406, 1)
-    t3408 = xp.abs(1/xp.where(t3407, t3405, 1))
+    t3408 = 1/xp.abs(xp.where(t3407, t3405, 1))
     t3409 = xp.where(t3404, xp.where(xp.greater_equal(t3405, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3407, t3408/(1 + xp.sqrt(1 + t3408**2)), 1/(t3406 + xp.sqrt(1 + t3406**2))), 0)
     t3410 = 1/xp.sqrt(1 + t3409**2)
     t3411 = t3300*t3409
@@ -6369,10 +6369,10 @@ def condition_number(q):
     t3437 = t3435 + t3409*t3434
     t3438 = t3314*t3416 + t3318*t3420 + t3322*t3424 + t3326*t3428 + t3330*t3432 + t3334*t3436
     t3439 = xp.not_equal(t3438, 0)
-    t3440 = 0.5*(-t3412 + t3310)/xp.where(t3439, t3438, 1)
+    t3440 = (-t3412 + t3310)/xp.where(t3439, 2*t3438, 1)
     t3441 = xp.abs(t3440)
     t3442 = xp.greater_equal(t3441, 1)
-    t3443 = xp.abs(1/xp.where(t3442, t3440, 1))
+    t3443 = 1/xp.abs(xp.where(t3442, t3440, 1))
     t3444 = xp.where(t3439, xp.where(xp.greater_equal(t3440, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3442, t3443/(1 + xp.sqrt(1 + t3443**2)), 1/(t3441 + xp.sqrt(1 + t3441**2))), 0)
     t3445 = 1/xp.sqrt(1 + t3444**2)
     t3446 = t3438*t3444
@@ -6405,10 +6405,10 @@ def condition_number(q):
     t3473 = t3349*t3451 + t3353*t3455 + t3357*t3459 + t3361*t3463 + t3365*t3467 + t3369*t3471
     t3474 = t3417*t3452 + t3421*t3456 + t3425*t3460 + t3429*t3464 + t3433*t3468 + t3437*t3472
     t3475 = xp.not_equal(t3473, 0)
-    t3476 = 0.5*(-t3447 + t3345)/xp.where(t3475, t3473, 1)
+    t3476 = (-t3447 + t3345)/xp.where(t3475, 2*t3473, 1)
     t3477 = xp.abs(t3476)
     t3478 = xp.greater_equal(t3477, 1)
-    t3479 = xp.abs(1/xp.where(t3478, t3476, 1))
+    t3479 = 1/xp.abs(xp.where(t3478, t3476, 1))
     t3480 = xp.where(t3475, xp.where(xp.greater_equal(t3476, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3478, t3479/(1 + xp.sqrt(1 + t3479**2)), 1/(t3477 + xp.sqrt(1 + t3477**2))), 0)
     t3481 = 1/xp.sqrt(1 + t3480**2)
     t3482 = t3473*t3480
@@ -6440,10 +6440,10 @@ def condition_number(q):
     t3508 = t3506 + t3480*t3505
     t3509 = t3382*t3487 + t3386*t3491 + t3390*t3495 + t3394*t3499 + t3398*t3503 + t3402*t3507
     t3510 = xp.not_equal(t3509, 0)
-    t3511 = 0.5*(-t3483 + t3378)/xp.where(t3510, t3509, 1)
+    t3511 = (-t3483 + t3378)/xp.where(t3510, 2*t3509, 1)
     t3512 = xp.abs(t3511)
     t3513 = xp.greater_equal(t3512, 1)
-    t3514 = xp.abs(1/xp.where(t3513, t3511, 1))
+    t3514 = 1/xp.abs(xp.where(t3513, t3511, 1))
     t3515 = xp.where(t3510, xp.where(xp.greater_equal(t3511, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3513, t3514/(1 + xp.sqrt(1 + t3514**2)), 1/(t3512 + xp.sqrt(1 + t3512**2))), 0)
     t3516 = 1/xp.sqrt(1 + t3515**2)
     t3517 = t3378 + t3509*t3515
@@ -6475,10 +6475,10 @@ def condition_number(q):
     t3543 = xp.where(xp.greater(t3542, t3403), t3542, t3403)
     t3544 = xp.where(xp.less(t3542, t3403), t3542, t3403)
     t3545 = xp.not_equal(t3474, 0)
-    t3546 = 0.5*(-t3413 + t3448)/xp.where(t3545, t3474, 1)
+    t3546 = (-t3413 + t3448)/xp.where(t3545, 2*t3474, 1)
     t3547 = xp.abs(t3546)
     t3548 = xp.greater_equal(t3547, 1)
-    t3549 = xp.abs(1/xp.where(t3548, t3546, 1))
+    t3549 = 1/xp.abs(xp.where(t3548, t3546, 1))
     t3550 = xp.where(t3545, xp.where(xp.greater_equal(t3546, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3548, t3549/(1 + xp.sqrt(1 + t3549**2)), 1/(t3547 + xp.sqrt(1 + t3547**2))), 0)
     t3551 = 1/xp.sqrt(1 + t3550**2)
     t3552 = t3474*t3550
@@ -6510,10 +6510,10 @@ def condition_number(q):
     t3578 = t3576 + t3550*t3575
     t3579 = t3488*t3557 + t3492*t3561 + t3496*t3565 + t3500*t3569 + t3504*t3573 + t3508*t3577
     t3580 = xp.not_equal(t3579, 0)
-    t3581 = 0.5*(-t3553 + t3484)/xp.where(t3580, t3579, 1)
+    t3581 = (-t3553 + t3484)/xp.where(t3580, 2*t3579, 1)
     t3582 = xp.abs(t3581)
     t3583 = xp.greater_equal(t3582, 1)
-    t3584 = xp.abs(1/xp.where(t3583, t3581, 1))
+    t3584 = 1/xp.abs(xp.where(t3583, t3581, 1))
     t3585 = xp.where(t3580, xp.where(xp.greater_equal(t3581, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3583, t3584/(1 + xp.sqrt(1 + t3584**2)), 1/(t3582 + xp.sqrt(1 + t3582**2))), 0)
     t3586 = 1/xp.sqrt(1 + t3585**2)
     t3587 = t3579*t3585
@@ -6546,10 +6546,10 @@ def condition_number(q):
     t3614 = t3521*t3592 + t3525*t3596 + t3529*t3600 + t3533*t3604 + t3537*t3608 + t3541*t3612
     t3615 = t3558*t3593 + t3562*t3597 + t3566*t3601 + t3570*t3605 + t3574*t3609 + t3578*t3613
     t3616 = xp.not_equal(t3614, 0)
-    t3617 = 0.5*(-t3588 + t3517)/xp.where(t3616, t3614, 1)
+    t3617 = (-t3588 + t3517)/xp.where(t3616, 2*t3614, 1)
     t3618 = xp.abs(t3617)
     t3619 = xp.greater_equal(t3618, 1)
-    t3620 = xp.abs(1/xp.where(t3619, t3617, 1))
+    t3620 = 1/xp.abs(xp.where(t3619, t3617, 1))
     t3621 = xp.where(t3616, xp.where(xp.greater_equal(t3617, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3619, t3620/(1 + xp.sqrt(1 + t3620**2)), 1/(t3618 + xp.sqrt(1 + t3618**2))), 0)
     t3622 = 1/xp.sqrt(1 + t3621**2)
     t3623 = t3517 + t3614*t3621
@@ -6581,10 +6581,10 @@ def condition_number(q):
     t3649 = xp.where(xp.greater(t3648, t3543), t3648, t3543)
     t3650 = xp.where(xp.less(t3648, t3544), t3648, t3544)
     t3651 = xp.not_equal(t3615, 0)
-    t3652 = 0.5*(-t3554 + t3589)/xp.where(t3651, t3615, 1)
+    t3652 = (-t3554 + t3589)/xp.where(t3651, 2*t3615, 1)
     t3653 = xp.abs(t3652)
     t3654 = xp.greater_equal(t3653, 1)
-    t3655 = xp.abs(1/xp.where(t3654, t3652, 1))
+    t3655 = 1/xp.abs(xp.where(t3654, t3652, 1))
     t3656 = xp.where(t3651, xp.where(xp.greater_equal(t3652, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3654, t3655/(1 + xp.sqrt(1 + t3655**2)), 1/(t3653 + xp.sqrt(1 + t3653**2))), 0)
     t3657 = 1/xp.sqrt(1 + t3656**2)
     t3658 = t3615*t3656
@@ -6616,10 +6616,10 @@ def condition_number(q):
     t3684 = t3682 + t3656*t3681
     t3685 = t3627*t3663 + t3631*t3667 + t3635*t3671 + t3639*t3675 + t3643*t3679 + t3647*t3683
     t3686 = xp.not_equal(t3685, 0)
-    t3687 = 0.5*(-t3659 + t3623)/xp.where(t3686, t3685, 1)
+    t3687 = (-t3659 + t3623)/xp.where(t3686, 2*t3685, 1)
     t3688 = xp.abs(t3687)
     t3689 = xp.greater_equal(t3688, 1)
-    t3690 = xp.abs(1/xp.where(t3689, t3687, 1))
+    t3690 = 1/xp.abs(xp.where(t3689, t3687, 1))
     t3691 = xp.where(t3686, xp.where(xp.greater_equal(t3687, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3689, t3690/(1 + xp.sqrt(1 + t3690**2)), 1/(t3688 + xp.sqrt(1 + t3688**2))), 0)
     t3692 = 1/xp.sqrt(1 + t3691**2)
     t3693 = t3623 + t3685*t3691
@@ -6652,10 +6652,10 @@ def condition_number(q):
     t3720 = xp.where(xp.greater(t3719, t3649), t3719, t3649)
     t3721 = xp.where(xp.less(t3719, t3650), t3719, t3650)
     t3722 = xp.not_equal(t3718, 0)
-    t3723 = 0.5*(-t3660 + t3693)/xp.where(t3722, t3718, 1)
+    t3723 = (-t3660 + t3693)/xp.where(t3722, 2*t3718, 1)
     t3724 = xp.abs(t3723)
     t3725 = xp.greater_equal(t3724, 1)
-    t3726 = xp.abs(1/xp.where(t3725, t3723, 1))
+    t3726 = 1/xp.abs(xp.where(t3725, t3723, 1))
     t3727 = xp.where(t3722, xp.where(xp.greater_equal(t3723, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3725, t3726/(1 + xp.sqrt(1 + t3726**2)), 1/(t3724 + xp.sqrt(1 + t3724**2))), 0)
     t3728 = 1/xp.sqrt(1 + t3727**2)
     t3729 = t3664*t3728
@@ -6688,7 +6688,9 @@ def condition_number(q):
     t3756 = xp.where(xp.less(t3753, t3721), t3753, t3721)
     t3757 = xp.where(xp.greater(t3754, t3755), t3754, t3755)
     t3758 = xp.where(xp.less(t3754, t3756), t3754, t3756)
-    kappa = xp.broadcast_to(xp.where(xp.greater(t3757, 0), t3757, 1)/xp.where(xp.less_equal(t3758, 1e-12*t3757), 0, t3758), batch)
+    t3759 = xp.where(xp.less_equal(t3758, 1e-12*t3757), 0, t3758)
+    t3760 = xp.where(xp.greater(t3757, 0), t3757, 1)
+    kappa = xp.broadcast_to(t3760/t3759, batch)
     return kappa
 
 

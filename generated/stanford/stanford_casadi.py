@@ -1456,10 +1456,10 @@ def _velocity_ellipsoid(q):
     t48 = t47**2
     t49 = t25*t29
     t50 = (t49 != 0)
-    t51 = 0.5*(-t31 + t38)/casadi.if_else(t50, -t49, 1)
+    t51 = (-t31 + t38)/casadi.if_else(t50, -2*t49, 1)
     t52 = casadi.fabs(t51)
     t53 = (t52 >= 1)
-    t54 = casadi.fabs(1/casadi.if_else(t53, t51, 1))
+    t54 = 1/casadi.fabs(casadi.if_else(t53, t51, 1))
     t55 = casadi.if_else(t50, casadi.if_else((t51 >= 0), 1, -1)*casadi.if_else(t53, t54/(1 + casadi.sqrt(1 + t54**2)), 1/(t52 + casadi.sqrt(1 + t52**2))), 0)
     t56 = 1/casadi.sqrt(1 + t55**2)
     t57 = t49*t55
@@ -1475,10 +1475,10 @@ def _velocity_ellipsoid(q):
     t67 = t66*t55
     t68 = t64*t62 - t67*t44
     t69 = (t68 != 0)
-    t70 = 0.5*(-t58 + t65)/casadi.if_else(t69, t68, 1)
+    t70 = (-t58 + t65)/casadi.if_else(t69, 2*t68, 1)
     t71 = casadi.fabs(t70)
     t72 = (t71 >= 1)
-    t73 = casadi.fabs(1/casadi.if_else(t72, t70, 1))
+    t73 = 1/casadi.fabs(casadi.if_else(t72, t70, 1))
     t74 = casadi.if_else(t69, casadi.if_else((t70 >= 0), 1, -1)*casadi.if_else(t72, t73/(1 + casadi.sqrt(1 + t73**2)), 1/(t71 + casadi.sqrt(1 + t71**2))), 0)
     t75 = 1/casadi.sqrt(1 + t74**2)
     t76 = t68*t74
@@ -1494,10 +1494,10 @@ def _velocity_ellipsoid(q):
     t86 = -t84 + t83*t74
     t87 = t63*t82 + t66*t86
     t88 = (t87 != 0)
-    t89 = 0.5*(-t59 + t78)/casadi.if_else(t88, -t87, 1)
+    t89 = (-t59 + t78)/casadi.if_else(t88, -2*t87, 1)
     t90 = casadi.fabs(t89)
     t91 = (t90 >= 1)
-    t92 = casadi.fabs(1/casadi.if_else(t91, t89, 1))
+    t92 = 1/casadi.fabs(casadi.if_else(t91, t89, 1))
     t93 = casadi.if_else(t88, casadi.if_else((t89 >= 0), 1, -1)*casadi.if_else(t91, t92/(1 + casadi.sqrt(1 + t92**2)), 1/(t90 + casadi.sqrt(1 + t90**2))), 0)
     t94 = 1/casadi.sqrt(1 + t93**2)
     t95 = t87*t93
@@ -1523,10 +1523,10 @@ def _velocity_ellipsoid(q):
     t115 = t93*t94
     t116 = t81*t100 - t85*t105 + t48*t109*t115*t75
     t117 = (t116 != 0)
-    t118 = 0.5*(-t77 + t96)/casadi.if_else(t117, t116, 1)
+    t118 = (-t77 + t96)/casadi.if_else(t117, 2*t116, 1)
     t119 = casadi.fabs(t118)
     t120 = (t119 >= 1)
-    t121 = casadi.fabs(1/casadi.if_else(t120, t118, 1))
+    t121 = 1/casadi.fabs(casadi.if_else(t120, t118, 1))
     t122 = casadi.if_else(t117, casadi.if_else((t118 >= 0), 1, -1)*casadi.if_else(t120, t121/(1 + casadi.sqrt(1 + t121**2)), 1/(t119 + casadi.sqrt(1 + t119**2))), 0)
     t123 = 1/casadi.sqrt(1 + t122**2)
     t124 = t116*t122
@@ -1560,10 +1560,10 @@ def _velocity_ellipsoid(q):
     t152 = t75*t94
     t153 = t101*t129 + t106*t133 - t47*t152*t142
     t154 = (t153 != 0)
-    t155 = 0.5*(-t125 + t97)/casadi.if_else(t154, t153, 1)
+    t155 = (-t125 + t97)/casadi.if_else(t154, 2*t153, 1)
     t156 = casadi.fabs(t155)
     t157 = (t156 >= 1)
-    t158 = casadi.fabs(1/casadi.if_else(t157, t155, 1))
+    t158 = 1/casadi.fabs(casadi.if_else(t157, t155, 1))
     t159 = casadi.if_else(t154, casadi.if_else((t155 >= 0), 1, -1)*casadi.if_else(t157, t158/(1 + casadi.sqrt(1 + t158**2)), 1/(t156 + casadi.sqrt(1 + t156**2))), 0)
     t160 = 1/casadi.sqrt(1 + t159**2)
     t161 = t153*t159
@@ -1595,10 +1595,10 @@ def _velocity_ellipsoid(q):
     t187 = t186 - t159*t173
     t188 = t173 + t159*t186
     t189 = (t177 != 0)
-    t190 = 0.5*(-t126 + t163)/casadi.if_else(t189, t177, 1)
+    t190 = (-t126 + t163)/casadi.if_else(t189, 2*t177, 1)
     t191 = casadi.fabs(t190)
     t192 = (t191 >= 1)
-    t193 = casadi.fabs(1/casadi.if_else(t192, t190, 1))
+    t193 = 1/casadi.fabs(casadi.if_else(t192, t190, 1))
     t194 = casadi.if_else(t189, casadi.if_else((t190 >= 0), 1, -1)*casadi.if_else(t192, t193/(1 + casadi.sqrt(1 + t193**2)), 1/(t191 + casadi.sqrt(1 + t191**2))), 0)
     t195 = 1/casadi.sqrt(1 + t194**2)
     t196 = t177*t194
@@ -1630,10 +1630,10 @@ def _velocity_ellipsoid(q):
     t222 = t220 + t194*t221
     t223 = t221 - t194*t220
     t224 = (t211 != 0)
-    t225 = 0.5*(-t162 + t197)/casadi.if_else(t224, t211, 1)
+    t225 = (-t162 + t197)/casadi.if_else(t224, 2*t211, 1)
     t226 = casadi.fabs(t225)
     t227 = (t226 >= 1)
-    t228 = casadi.fabs(1/casadi.if_else(t227, t225, 1))
+    t228 = 1/casadi.fabs(casadi.if_else(t227, t225, 1))
     t229 = casadi.if_else(t224, casadi.if_else((t225 >= 0), 1, -1)*casadi.if_else(t227, t228/(1 + casadi.sqrt(1 + t228**2)), 1/(t226 + casadi.sqrt(1 + t226**2))), 0)
     t230 = 1/casadi.sqrt(1 + t229**2)
     t231 = t211*t229
@@ -1665,10 +1665,10 @@ def _velocity_ellipsoid(q):
     t257 = t255 + t229*t256
     t258 = -t256 + t229*t255
     t259 = (t246 != 0)
-    t260 = 0.5*(-t232 + t198)/casadi.if_else(t259, t246, 1)
+    t260 = (-t232 + t198)/casadi.if_else(t259, 2*t246, 1)
     t261 = casadi.fabs(t260)
     t262 = (t261 >= 1)
-    t263 = casadi.fabs(1/casadi.if_else(t262, t260, 1))
+    t263 = 1/casadi.fabs(casadi.if_else(t262, t260, 1))
     t264 = casadi.if_else(t259, casadi.if_else((t260 >= 0), 1, -1)*casadi.if_else(t262, t263/(1 + casadi.sqrt(1 + t263**2)), 1/(t261 + casadi.sqrt(1 + t261**2))), 0)
     t265 = 1/casadi.sqrt(1 + t264**2)
     t266 = t246*t264
@@ -1700,10 +1700,10 @@ def _velocity_ellipsoid(q):
     t292 = t290 - t264*t291
     t293 = t291 + t264*t290
     t294 = (t281 != 0)
-    t295 = 0.5*(-t233 + t268)/casadi.if_else(t294, t281, 1)
+    t295 = (-t233 + t268)/casadi.if_else(t294, 2*t281, 1)
     t296 = casadi.fabs(t295)
     t297 = (t296 >= 1)
-    t298 = casadi.fabs(1/casadi.if_else(t297, t295, 1))
+    t298 = 1/casadi.fabs(casadi.if_else(t297, t295, 1))
     t299 = casadi.if_else(t294, casadi.if_else((t295 >= 0), 1, -1)*casadi.if_else(t297, t298/(1 + casadi.sqrt(1 + t298**2)), 1/(t296 + casadi.sqrt(1 + t296**2))), 0)
     t300 = 1/casadi.sqrt(1 + t299**2)
     t301 = t281*t299
@@ -1735,10 +1735,10 @@ def _velocity_ellipsoid(q):
     t327 = t325 - t299*t326
     t328 = t326 + t299*t325
     t329 = (t316 != 0)
-    t330 = 0.5*(-t267 + t302)/casadi.if_else(t329, t316, 1)
+    t330 = (-t267 + t302)/casadi.if_else(t329, 2*t316, 1)
     t331 = casadi.fabs(t330)
     t332 = (t331 >= 1)
-    t333 = casadi.fabs(1/casadi.if_else(t332, t330, 1))
+    t333 = 1/casadi.fabs(casadi.if_else(t332, t330, 1))
     t334 = casadi.if_else(t329, casadi.if_else((t330 >= 0), 1, -1)*casadi.if_else(t332, t333/(1 + casadi.sqrt(1 + t333**2)), 1/(t331 + casadi.sqrt(1 + t331**2))), 0)
     t335 = 1/casadi.sqrt(1 + t334**2)
     t336 = t316*t334
@@ -1770,10 +1770,10 @@ def _velocity_ellipsoid(q):
     t362 = t360 - t334*t361
     t363 = t361 + t334*t360
     t364 = (t351 != 0)
-    t365 = 0.5*(-t337 + t303)/casadi.if_else(t364, t351, 1)
+    t365 = (-t337 + t303)/casadi.if_else(t364, 2*t351, 1)
     t366 = casadi.fabs(t365)
     t367 = (t366 >= 1)
-    t368 = casadi.fabs(1/casadi.if_else(t367, t365, 1))
+    t368 = 1/casadi.fabs(casadi.if_else(t367, t365, 1))
     t369 = casadi.if_else(t364, casadi.if_else((t365 >= 0), 1, -1)*casadi.if_else(t367, t368/(1 + casadi.sqrt(1 + t368**2)), 1/(t366 + casadi.sqrt(1 + t366**2))), 0)
     t370 = 1/casadi.sqrt(1 + t369**2)
     t371 = t351*t369
@@ -1805,10 +1805,10 @@ def _velocity_ellipsoid(q):
     t397 = t395 - t369*t396
     t398 = t396 + t369*t395
     t399 = (t386 != 0)
-    t400 = 0.5*(-t338 + t373)/casadi.if_else(t399, t386, 1)
+    t400 = (-t338 + t373)/casadi.if_else(t399, 2*t386, 1)
     t401 = casadi.fabs(t400)
     t402 = (t401 >= 1)
-    t403 = casadi.fabs(1/casadi.if_else(t402, t400, 1))
+    t403 = 1/casadi.fabs(casadi.if_else(t402, t400, 1))
     t404 = casadi.if_else(t399, casadi.if_else((t400 >= 0), 1, -1)*casadi.if_else(t402, t403/(1 + casadi.sqrt(1 + t403**2)), 1/(t401 + casadi.sqrt(1 + t401**2))), 0)
     t405 = 1/casadi.sqrt(1 + t404**2)
     t406 = t386*t404
@@ -1840,10 +1840,10 @@ def _velocity_ellipsoid(q):
     t432 = t430 - t404*t431
     t433 = t431 + t404*t430
     t434 = (t421 != 0)
-    t435 = 0.5*(-t372 + t407)/casadi.if_else(t434, t421, 1)
+    t435 = (-t372 + t407)/casadi.if_else(t434, 2*t421, 1)
     t436 = casadi.fabs(t435)
     t437 = (t436 >= 1)
-    t438 = casadi.fabs(1/casadi.if_else(t437, t435, 1))
+    t438 = 1/casadi.fabs(casadi.if_else(t437, t435, 1))
     t439 = casadi.if_else(t434, casadi.if_else((t435 >= 0), 1, -1)*casadi.if_else(t437, t438/(1 + casadi.sqrt(1 + t438**2)), 1/(t436 + casadi.sqrt(1 + t436**2))), 0)
     t440 = 1/casadi.sqrt(1 + t439**2)
     t441 = t421*t439
@@ -1875,10 +1875,10 @@ def _velocity_ellipsoid(q):
     t467 = t465 - t439*t466
     t468 = t466 + t439*t465
     t469 = (t456 != 0)
-    t470 = 0.5*(-t442 + t408)/casadi.if_else(t469, t456, 1)
+    t470 = (-t442 + t408)/casadi.if_else(t469, 2*t456, 1)
     t471 = casadi.fabs(t470)
     t472 = (t471 >= 1)
-    t473 = casadi.fabs(1/casadi.if_else(t472, t470, 1))
+    t473 = 1/casadi.fabs(casadi.if_else(t472, t470, 1))
     t474 = casadi.if_else(t469, casadi.if_else((t470 >= 0), 1, -1)*casadi.if_else(t472, t473/(1 + casadi.sqrt(1 + t473**2)), 1/(t471 + casadi.sqrt(1 + t471**2))), 0)
     t475 = 1/casadi.sqrt(1 + t474**2)
     t476 = t408 + t456*t474
@@ -1909,10 +1909,10 @@ def _velocity_ellipsoid(q):
     t501 = t499 - t474*t500
     t502 = t500 + t474*t499
     t503 = (t489 != 0)
-    t504 = 0.5*(-t443 + t476)/casadi.if_else(t503, t489, 1)
+    t504 = (-t443 + t476)/casadi.if_else(t503, 2*t489, 1)
     t505 = casadi.fabs(t504)
     t506 = (t505 >= 1)
-    t507 = casadi.fabs(1/casadi.if_else(t506, t504, 1))
+    t507 = 1/casadi.fabs(casadi.if_else(t506, t504, 1))
     t508 = casadi.if_else(t503, casadi.if_else((t504 >= 0), 1, -1)*casadi.if_else(t506, t507/(1 + casadi.sqrt(1 + t507**2)), 1/(t505 + casadi.sqrt(1 + t505**2))), 0)
     t509 = 1/casadi.sqrt(1 + t508**2)
     t510 = t447*t509
@@ -2003,10 +2003,10 @@ def _velocity_ellipsoid(q):
     t595 = t594**2
     t596 = t584**2 + t590**2 + t595
     t597 = (t581 != 0)
-    t598 = 0.5*(-t569 + t580)/casadi.if_else(t597, t581, 1)
+    t598 = (-t569 + t580)/casadi.if_else(t597, 2*t581, 1)
     t599 = casadi.fabs(t598)
     t600 = (t599 >= 1)
-    t601 = casadi.fabs(1/casadi.if_else(t600, t598, 1))
+    t601 = 1/casadi.fabs(casadi.if_else(t600, t598, 1))
     t602 = casadi.if_else(t597, casadi.if_else((t598 >= 0), 1, -1)*casadi.if_else(t600, t601/(1 + casadi.sqrt(1 + t601**2)), 1/(t599 + casadi.sqrt(1 + t599**2))), 0)
     t603 = 1/casadi.sqrt(1 + t602**2)
     t604 = t581*t602
@@ -2020,10 +2020,10 @@ def _velocity_ellipsoid(q):
     t612 = t602*t611
     t613 = t584*t609 + t590*t612
     t614 = (t613 != 0)
-    t615 = 0.5*(-t605 + t596)/casadi.if_else(t614, t613, 1)
+    t615 = (-t605 + t596)/casadi.if_else(t614, 2*t613, 1)
     t616 = casadi.fabs(t615)
     t617 = (t616 >= 1)
-    t618 = casadi.fabs(1/casadi.if_else(t617, t615, 1))
+    t618 = 1/casadi.fabs(casadi.if_else(t617, t615, 1))
     t619 = casadi.if_else(t614, casadi.if_else((t615 >= 0), 1, -1)*casadi.if_else(t617, t618/(1 + casadi.sqrt(1 + t618**2)), 1/(t616 + casadi.sqrt(1 + t616**2))), 0)
     t620 = 1/casadi.sqrt(1 + t619**2)
     t621 = t613*t619
@@ -2039,10 +2039,10 @@ def _velocity_ellipsoid(q):
     t631 = t629 + t619*t628
     t632 = t610*t627 + t631*t611
     t633 = (t632 != 0)
-    t634 = 0.5*(-t606 + t623)/casadi.if_else(t633, -t632, 1)
+    t634 = (-t606 + t623)/casadi.if_else(t633, -2*t632, 1)
     t635 = casadi.fabs(t634)
     t636 = (t635 >= 1)
-    t637 = casadi.fabs(1/casadi.if_else(t636, t634, 1))
+    t637 = 1/casadi.fabs(casadi.if_else(t636, t634, 1))
     t638 = casadi.if_else(t633, casadi.if_else((t634 >= 0), 1, -1)*casadi.if_else(t636, t637/(1 + casadi.sqrt(1 + t637**2)), 1/(t635 + casadi.sqrt(1 + t635**2))), 0)
     t639 = 1/casadi.sqrt(1 + t638**2)
     t640 = t632*t638
@@ -2068,10 +2068,10 @@ def _velocity_ellipsoid(q):
     t660 = t638*t639
     t661 = t626*t645 + t630*t650 - t620*t595*t654*t660
     t662 = (t661 != 0)
-    t663 = 0.5*(-t622 + t641)/casadi.if_else(t662, -t661, 1)
+    t663 = (-t622 + t641)/casadi.if_else(t662, -2*t661, 1)
     t664 = casadi.fabs(t663)
     t665 = (t664 >= 1)
-    t666 = casadi.fabs(1/casadi.if_else(t665, t663, 1))
+    t666 = 1/casadi.fabs(casadi.if_else(t665, t663, 1))
     t667 = casadi.if_else(t662, casadi.if_else((t663 >= 0), 1, -1)*casadi.if_else(t665, t666/(1 + casadi.sqrt(1 + t666**2)), 1/(t664 + casadi.sqrt(1 + t664**2))), 0)
     t668 = 1/casadi.sqrt(1 + t667**2)
     t669 = t661*t667
@@ -2105,10 +2105,10 @@ def _velocity_ellipsoid(q):
     t697 = t620*t639
     t698 = t646*t674 + t651*t678 - t594*t687*t697
     t699 = (t698 != 0)
-    t700 = 0.5*(-t670 + t642)/casadi.if_else(t699, t698, 1)
+    t700 = (-t670 + t642)/casadi.if_else(t699, 2*t698, 1)
     t701 = casadi.fabs(t700)
     t702 = (t701 >= 1)
-    t703 = casadi.fabs(1/casadi.if_else(t702, t700, 1))
+    t703 = 1/casadi.fabs(casadi.if_else(t702, t700, 1))
     t704 = casadi.if_else(t699, casadi.if_else((t700 >= 0), 1, -1)*casadi.if_else(t702, t703/(1 + casadi.sqrt(1 + t703**2)), 1/(t701 + casadi.sqrt(1 + t701**2))), 0)
     t705 = 1/casadi.sqrt(1 + t704**2)
     t706 = t698*t704
@@ -2140,10 +2140,10 @@ def _velocity_ellipsoid(q):
     t732 = t731 - t704*t718
     t733 = t718 + t704*t731
     t734 = (t722 != 0)
-    t735 = 0.5*(-t671 + t708)/casadi.if_else(t734, t722, 1)
+    t735 = (-t671 + t708)/casadi.if_else(t734, 2*t722, 1)
     t736 = casadi.fabs(t735)
     t737 = (t736 >= 1)
-    t738 = casadi.fabs(1/casadi.if_else(t737, t735, 1))
+    t738 = 1/casadi.fabs(casadi.if_else(t737, t735, 1))
     t739 = casadi.if_else(t734, casadi.if_else((t735 >= 0), 1, -1)*casadi.if_else(t737, t738/(1 + casadi.sqrt(1 + t738**2)), 1/(t736 + casadi.sqrt(1 + t736**2))), 0)
     t740 = 1/casadi.sqrt(1 + t739**2)
     t741 = t722*t739
@@ -2175,10 +2175,10 @@ def _velocity_ellipsoid(q):
     t767 = t765 + t739*t766
     t768 = t766 - t739*t765
     t769 = (t756 != 0)
-    t770 = 0.5*(-t707 + t742)/casadi.if_else(t769, t756, 1)
+    t770 = (-t707 + t742)/casadi.if_else(t769, 2*t756, 1)
     t771 = casadi.fabs(t770)
     t772 = (t771 >= 1)
-    t773 = casadi.fabs(1/casadi.if_else(t772, t770, 1))
+    t773 = 1/casadi.fabs(casadi.if_else(t772, t770, 1))
     t774 = casadi.if_else(t769, casadi.if_else((t770 >= 0), 1, -1)*casadi.if_else(t772, t773/(1 + casadi.sqrt(1 + t773**2)), 1/(t771 + casadi.sqrt(1 + t771**2))), 0)
     t775 = 1/casadi.sqrt(1 + t774**2)
     t776 = t756*t774
@@ -2210,10 +2210,10 @@ def _velocity_ellipsoid(q):
     t802 = t800 + t774*t801
     t803 = -t801 + t774*t800
     t804 = (t791 != 0)
-    t805 = 0.5*(-t777 + t743)/casadi.if_else(t804, t791, 1)
+    t805 = (-t777 + t743)/casadi.if_else(t804, 2*t791, 1)
     t806 = casadi.fabs(t805)
     t807 = (t806 >= 1)
-    t808 = casadi.fabs(1/casadi.if_else(t807, t805, 1))
+    t808 = 1/casadi.fabs(casadi.if_else(t807, t805, 1))
     t809 = casadi.if_else(t804, casadi.if_else((t805 >= 0), 1, -1)*casadi.if_else(t807, t808/(1 + casadi.sqrt(1 + t808**2)), 1/(t806 + casadi.sqrt(1 + t806**2))), 0)
     t810 = 1/casadi.sqrt(1 + t809**2)
     t811 = t791*t809
@@ -2245,10 +2245,10 @@ def _velocity_ellipsoid(q):
     t837 = t835 - t809*t836
     t838 = t836 + t809*t835
     t839 = (t826 != 0)
-    t840 = 0.5*(-t778 + t813)/casadi.if_else(t839, t826, 1)
+    t840 = (-t778 + t813)/casadi.if_else(t839, 2*t826, 1)
     t841 = casadi.fabs(t840)
     t842 = (t841 >= 1)
-    t843 = casadi.fabs(1/casadi.if_else(t842, t840, 1))
+    t843 = 1/casadi.fabs(casadi.if_else(t842, t840, 1))
     t844 = casadi.if_else(t839, casadi.if_else((t840 >= 0), 1, -1)*casadi.if_else(t842, t843/(1 + casadi.sqrt(1 + t843**2)), 1/(t841 + casadi.sqrt(1 + t841**2))), 0)
     t845 = 1/casadi.sqrt(1 + t844**2)
     t846 = t826*t844
@@ -2280,10 +2280,10 @@ def _velocity_ellipsoid(q):
     t872 = t870 - t844*t871
     t873 = t871 + t844*t870
     t874 = (t861 != 0)
-    t875 = 0.5*(-t812 + t847)/casadi.if_else(t874, t861, 1)
+    t875 = (-t812 + t847)/casadi.if_else(t874, 2*t861, 1)
     t876 = casadi.fabs(t875)
     t877 = (t876 >= 1)
-    t878 = casadi.fabs(1/casadi.if_else(t877, t875, 1))
+    t878 = 1/casadi.fabs(casadi.if_else(t877, t875, 1))
     t879 = casadi.if_else(t874, casadi.if_else((t875 >= 0), 1, -1)*casadi.if_else(t877, t878/(1 + casadi.sqrt(1 + t878**2)), 1/(t876 + casadi.sqrt(1 + t876**2))), 0)
     t880 = 1/casadi.sqrt(1 + t879**2)
     t881 = t861*t879
@@ -2315,10 +2315,10 @@ def _velocity_ellipsoid(q):
     t907 = t905 - t879*t906
     t908 = t906 + t879*t905
     t909 = (t896 != 0)
-    t910 = 0.5*(-t882 + t848)/casadi.if_else(t909, t896, 1)
+    t910 = (-t882 + t848)/casadi.if_else(t909, 2*t896, 1)
     t911 = casadi.fabs(t910)
     t912 = (t911 >= 1)
-    t913 = casadi.fabs(1/casadi.if_else(t912, t910, 1))
+    t913 = 1/casadi.fabs(casadi.if_else(t912, t910, 1))
     t914 = casadi.if_else(t909, casadi.if_else((t910 >= 0), 1, -1)*casadi.if_else(t912, t913/(1 + casadi.sqrt(1 + t913**2)), 1/(t911 + casadi.sqrt(1 + t911**2))), 0)
     t915 = 1/casadi.sqrt(1 + t914**2)
     t916 = t896*t914
@@ -2350,10 +2350,10 @@ def _velocity_ellipsoid(q):
     t942 = t940 - t914*t941
     t943 = t941 + t914*t940
     t944 = (t931 != 0)
-    t945 = 0.5*(-t883 + t918)/casadi.if_else(t944, t931, 1)
+    t945 = (-t883 + t918)/casadi.if_else(t944, 2*t931, 1)
     t946 = casadi.fabs(t945)
     t947 = (t946 >= 1)
-    t948 = casadi.fabs(1/casadi.if_else(t947, t945, 1))
+    t948 = 1/casadi.fabs(casadi.if_else(t947, t945, 1))
     t949 = casadi.if_else(t944, casadi.if_else((t945 >= 0), 1, -1)*casadi.if_else(t947, t948/(1 + casadi.sqrt(1 + t948**2)), 1/(t946 + casadi.sqrt(1 + t946**2))), 0)
     t950 = 1/casadi.sqrt(1 + t949**2)
     t951 = t931*t949
@@ -2385,10 +2385,10 @@ def _velocity_ellipsoid(q):
     t977 = t975 - t949*t976
     t978 = t976 + t949*t975
     t979 = (t966 != 0)
-    t980 = 0.5*(-t917 + t952)/casadi.if_else(t979, t966, 1)
+    t980 = (-t917 + t952)/casadi.if_else(t979, 2*t966, 1)
     t981 = casadi.fabs(t980)
     t982 = (t981 >= 1)
-    t983 = casadi.fabs(1/casadi.if_else(t982, t980, 1))
+    t983 = 1/casadi.fabs(casadi.if_else(t982, t980, 1))
     t984 = casadi.if_else(t979, casadi.if_else((t980 >= 0), 1, -1)*casadi.if_else(t982, t983/(1 + casadi.sqrt(1 + t983**2)), 1/(t981 + casadi.sqrt(1 + t981**2))), 0)
     t985 = 1/casadi.sqrt(1 + t984**2)
     t986 = t966*t984
@@ -2420,10 +2420,10 @@ def _velocity_ellipsoid(q):
     t1012 = t1010 - t984*t1011
     t1013 = t1011 + t984*t1010
     t1014 = (t1001 != 0)
-    t1015 = 0.5*(-t987 + t953)/casadi.if_else(t1014, t1001, 1)
+    t1015 = (-t987 + t953)/casadi.if_else(t1014, 2*t1001, 1)
     t1016 = casadi.fabs(t1015)
     t1017 = (t1016 >= 1)
-    t1018 = casadi.fabs(1/casadi.if_else(t1017, t1015, 1))
+    t1018 = 1/casadi.fabs(casadi.if_else(t1017, t1015, 1))
     t1019 = casadi.if_else(t1014, casadi.if_else((t1015 >= 0), 1, -1)*casadi.if_else(t1017, t1018/(1 + casadi.sqrt(1 + t1018**2)), 1/(t1016 + casadi.sqrt(1 + t1016**2))), 0)
     t1020 = 1/casadi.sqrt(1 + t1019**2)
     t1021 = t953 + t1001*t1019
@@ -2454,10 +2454,10 @@ def _velocity_ellipsoid(q):
     t1046 = t1044 - t1019*t1045
     t1047 = t1045 + t1019*t1044
     t1048 = (t1034 != 0)
-    t1049 = 0.5*(-t988 + t1021)/casadi.if_else(t1048, t1034, 1)
+    t1049 = (-t988 + t1021)/casadi.if_else(t1048, 2*t1034, 1)
     t1050 = casadi.fabs(t1049)
     t1051 = (t1050 >= 1)
-    t1052 = casadi.fabs(1/casadi.if_else(t1051, t1049, 1))
+    t1052 = 1/casadi.fabs(casadi.if_else(t1051, t1049, 1))
     t1053 = casadi.if_else(t1048, casadi.if_else((t1049 >= 0), 1, -1)*casadi.if_else(t1051, t1052/(1 + casadi.sqrt(1 + t1052**2)), 1/(t1050 + casadi.sqrt(1 + t1050**2))), 0)
     t1054 = 1/casadi.sqrt(1 + t1053**2)
     t1055 = t992*t1054
@@ -2677,10 +2677,10 @@ def _condition_number(q):
     t109 = t55*t81
     t110 = t60*t71 + t84*t93 + t107*t75 - t108*t78 + t109*t87
     t111 = (t110 != 0)
-    t112 = 0.5*(-t106 + t95)/casadi.if_else(t111, -t110, 1)
+    t112 = (-t106 + t95)/casadi.if_else(t111, -2*t110, 1)
     t113 = casadi.fabs(t112)
     t114 = (t113 >= 1)
-    t115 = casadi.fabs(1/casadi.if_else(t114, t112, 1))
+    t115 = 1/casadi.fabs(casadi.if_else(t114, t112, 1))
     t116 = casadi.if_else(t111, casadi.if_else((t112 >= 0), 1, -1)*casadi.if_else(t114, t115/(1 + casadi.sqrt(1 + t115**2)), 1/(t113 + casadi.sqrt(1 + t113**2))), 0)
     t117 = 1/casadi.sqrt(1 + t116**2)
     t118 = t110*t116
@@ -2708,10 +2708,10 @@ def _condition_number(q):
     t140 = -t138 + t137*t116
     t141 = t97*t127 + t101*t131 - t102*t135 + t103*t139
     t142 = (t141 != 0)
-    t143 = 0.5*(-t119 + t104)/casadi.if_else(t142, t141, 1)
+    t143 = (-t119 + t104)/casadi.if_else(t142, 2*t141, 1)
     t144 = casadi.fabs(t143)
     t145 = (t144 >= 1)
-    t146 = casadi.fabs(1/casadi.if_else(t145, t143, 1))
+    t146 = 1/casadi.fabs(casadi.if_else(t145, t143, 1))
     t147 = casadi.if_else(t142, casadi.if_else((t143 >= 0), 1, -1)*casadi.if_else(t145, t146/(1 + casadi.sqrt(1 + t146**2)), 1/(t144 + casadi.sqrt(1 + t144**2))), 0)
     t148 = 1/casadi.sqrt(1 + t147**2)
     t149 = t141*t147
@@ -2735,10 +2735,10 @@ def _condition_number(q):
     t167 = t165 + t164*t147
     t168 = t21*t158 + t25*t162 - t34*t166
     t169 = (t168 != 0)
-    t170 = 0.5*(-t150 + t42)/casadi.if_else(t169, -t168, 1)
+    t170 = (-t150 + t42)/casadi.if_else(t169, -2*t168, 1)
     t171 = casadi.fabs(t170)
     t172 = (t171 >= 1)
-    t173 = casadi.fabs(1/casadi.if_else(t172, t170, 1))
+    t173 = 1/casadi.fabs(casadi.if_else(t172, t170, 1))
     t174 = casadi.if_else(t169, casadi.if_else((t170 >= 0), 1, -1)*casadi.if_else(t172, t173/(1 + casadi.sqrt(1 + t173**2)), 1/(t171 + casadi.sqrt(1 + t171**2))), 0)
     t175 = 1/casadi.sqrt(1 + t174**2)
     t176 = t168*t174
@@ -2758,10 +2758,10 @@ def _condition_number(q):
     t190 = t188 + t187*t174
     t191 = t29*t185 - t38*t189
     t192 = (t191 != 0)
-    t193 = 0.5*(-t177 + t43)/casadi.if_else(t192, t191, 1)
+    t193 = (-t177 + t43)/casadi.if_else(t192, 2*t191, 1)
     t194 = casadi.fabs(t193)
     t195 = (t194 >= 1)
-    t196 = casadi.fabs(1/casadi.if_else(t195, t193, 1))
+    t196 = 1/casadi.fabs(casadi.if_else(t195, t193, 1))
     t197 = casadi.if_else(t192, casadi.if_else((t193 >= 0), 1, -1)*casadi.if_else(t195, t196/(1 + casadi.sqrt(1 + t196**2)), 1/(t194 + casadi.sqrt(1 + t194**2))), 0)
     t198 = 1/casadi.sqrt(1 + t197**2)
     t199 = t191*t197
@@ -2777,10 +2777,10 @@ def _condition_number(q):
     t209 = -t207 + t206*t197
     t210 = t41*t208
     t211 = (t210 != 0)
-    t212 = 0.5*(-t200 + t44)/casadi.if_else(t211, -t210, 1)
+    t212 = (-t200 + t44)/casadi.if_else(t211, -2*t210, 1)
     t213 = casadi.fabs(t212)
     t214 = (t213 >= 1)
-    t215 = casadi.fabs(1/casadi.if_else(t214, t212, 1))
+    t215 = 1/casadi.fabs(casadi.if_else(t214, t212, 1))
     t216 = casadi.if_else(t211, casadi.if_else((t212 >= 0), 1, -1)*casadi.if_else(t214, t215/(1 + casadi.sqrt(1 + t215**2)), 1/(t213 + casadi.sqrt(1 + t213**2))), 0)
     t217 = 1/casadi.sqrt(1 + t216**2)
     t218 = t210*t216
@@ -2794,10 +2794,10 @@ def _condition_number(q):
     t226 = t225*t123
     t227 = -t128*t155 + t132*t159 + t136*t163 + t140*t167 + t105*t225*t116*t117**2 + t226*t124
     t228 = (t227 != 0)
-    t229 = 0.5*(-t120 + t151)/casadi.if_else(t228, t227, 1)
+    t229 = (-t120 + t151)/casadi.if_else(t228, 2*t227, 1)
     t230 = casadi.fabs(t229)
     t231 = (t230 >= 1)
-    t232 = casadi.fabs(1/casadi.if_else(t231, t229, 1))
+    t232 = 1/casadi.fabs(casadi.if_else(t231, t229, 1))
     t233 = casadi.if_else(t228, casadi.if_else((t229 >= 0), 1, -1)*casadi.if_else(t231, t232/(1 + casadi.sqrt(1 + t232**2)), 1/(t230 + casadi.sqrt(1 + t230**2))), 0)
     t234 = 1/casadi.sqrt(1 + t233**2)
     t235 = t227*t233
@@ -2836,10 +2836,10 @@ def _condition_number(q):
     t268 = t264*t154
     t269 = t182*t254 + t186*t258 + t190*t262 - t266*t242 + t267*t246 + t268*t250
     t270 = (t269 != 0)
-    t271 = 0.5*(-t236 + t178)/casadi.if_else(t270, t269, 1)
+    t271 = (-t236 + t178)/casadi.if_else(t270, 2*t269, 1)
     t272 = casadi.fabs(t271)
     t273 = (t272 >= 1)
-    t274 = casadi.fabs(1/casadi.if_else(t273, t271, 1))
+    t274 = 1/casadi.fabs(casadi.if_else(t273, t271, 1))
     t275 = casadi.if_else(t270, casadi.if_else((t271 >= 0), 1, -1)*casadi.if_else(t273, t274/(1 + casadi.sqrt(1 + t274**2)), 1/(t272 + casadi.sqrt(1 + t272**2))), 0)
     t276 = 1/casadi.sqrt(1 + t275**2)
     t277 = t269*t275
@@ -2882,10 +2882,10 @@ def _condition_number(q):
     t314 = t313*t197
     t315 = -t205*t298 + t209*t302 - t308*t282 + t310*t286 + t312*t290 + t314*t294
     t316 = (t315 != 0)
-    t317 = 0.5*(-t278 + t201)/casadi.if_else(t316, t315, 1)
+    t317 = (-t278 + t201)/casadi.if_else(t316, 2*t315, 1)
     t318 = casadi.fabs(t317)
     t319 = (t318 >= 1)
-    t320 = casadi.fabs(1/casadi.if_else(t319, t317, 1))
+    t320 = 1/casadi.fabs(casadi.if_else(t319, t317, 1))
     t321 = casadi.if_else(t316, casadi.if_else((t317 >= 0), 1, -1)*casadi.if_else(t319, t320/(1 + casadi.sqrt(1 + t320**2)), 1/(t318 + casadi.sqrt(1 + t318**2))), 0)
     t322 = 1/casadi.sqrt(1 + t321**2)
     t323 = t315*t321
@@ -2927,10 +2927,10 @@ def _condition_number(q):
     t359 = t358*t216
     t360 = t224*t348 - t351*t328 + t353*t332 + t355*t336 + t357*t340 + t359*t344
     t361 = (t360 != 0)
-    t362 = 0.5*(-t324 + t220)/casadi.if_else(t361, t360, 1)
+    t362 = (-t324 + t220)/casadi.if_else(t361, 2*t360, 1)
     t363 = casadi.fabs(t362)
     t364 = (t363 >= 1)
-    t365 = casadi.fabs(1/casadi.if_else(t364, t362, 1))
+    t365 = 1/casadi.fabs(casadi.if_else(t364, t362, 1))
     t366 = casadi.if_else(t361, casadi.if_else((t362 >= 0), 1, -1)*casadi.if_else(t364, t365/(1 + casadi.sqrt(1 + t365**2)), 1/(t363 + casadi.sqrt(1 + t363**2))), 0)
     t367 = 1/casadi.sqrt(1 + t366**2)
     t368 = t360*t366
@@ -2962,10 +2962,10 @@ def _condition_number(q):
     t394 = t392 + t391*t366
     t395 = t223*t393 - t350*t373 + t352*t377 + t354*t381 + t356*t385 + t358*t389
     t396 = (t304 != 0)
-    t397 = 0.5*(-t237 + t279)/casadi.if_else(t396, t304, 1)
+    t397 = (-t237 + t279)/casadi.if_else(t396, 2*t304, 1)
     t398 = casadi.fabs(t397)
     t399 = (t398 >= 1)
-    t400 = casadi.fabs(1/casadi.if_else(t399, t397, 1))
+    t400 = 1/casadi.fabs(casadi.if_else(t399, t397, 1))
     t401 = casadi.if_else(t396, casadi.if_else((t397 >= 0), 1, -1)*casadi.if_else(t399, t400/(1 + casadi.sqrt(1 + t400**2)), 1/(t398 + casadi.sqrt(1 + t398**2))), 0)
     t402 = 1/casadi.sqrt(1 + t401**2)
     t403 = t304*t401
@@ -2997,10 +2997,10 @@ def _condition_number(q):
     t429 = t427 + t426*t401
     t430 = -t329*t408 + t333*t412 + t337*t416 + t341*t420 + t345*t424 + t349*t428
     t431 = (t430 != 0)
-    t432 = 0.5*(-t404 + t325)/casadi.if_else(t431, t430, 1)
+    t432 = (-t404 + t325)/casadi.if_else(t431, 2*t430, 1)
     t433 = casadi.fabs(t432)
     t434 = (t433 >= 1)
-    t435 = casadi.fabs(1/casadi.if_else(t434, t432, 1))
+    t435 = 1/casadi.fabs(casadi.if_else(t434, t432, 1))
     t436 = casadi.if_else(t431, casadi.if_else((t432 >= 0), 1, -1)*casadi.if_else(t434, t435/(1 + casadi.sqrt(1 + t435**2)), 1/(t433 + casadi.sqrt(1 + t433**2))), 0)
     t437 = 1/casadi.sqrt(1 + t436**2)
     t438 = t430*t436
@@ -3033,10 +3033,10 @@ def _condition_number(q):
     t465 = -t374*t443 + t378*t447 + t382*t451 + t386*t455 + t390*t459 + t394*t463
     t466 = t409*t444 + t413*t448 + t417*t452 + t421*t456 + t425*t460 + t429*t464
     t467 = (t465 != 0)
-    t468 = 0.5*(-t439 + t370)/casadi.if_else(t467, t465, 1)
+    t468 = (-t439 + t370)/casadi.if_else(t467, 2*t465, 1)
     t469 = casadi.fabs(t468)
     t470 = (t469 >= 1)
-    t471 = casadi.fabs(1/casadi.if_else(t470, t468, 1))
+    t471 = 1/casadi.fabs(casadi.if_else(t470, t468, 1))
     t472 = casadi.if_else(t467, casadi.if_else((t468 >= 0), 1, -1)*casadi.if_else(t470, t471/(1 + casadi.sqrt(1 + t471**2)), 1/(t469 + casadi.sqrt(1 + t469**2))), 0)
     t473 = 1/casadi.sqrt(1 + t472**2)
     t474 = t465*t472
@@ -3067,10 +3067,10 @@ def _condition_number(q):
     t499 = t497 - t498*t472
     t500 = t498 + t497*t472
     t501 = (t466 != 0)
-    t502 = 0.5*(-t405 + t440)/casadi.if_else(t501, t466, 1)
+    t502 = (-t405 + t440)/casadi.if_else(t501, 2*t466, 1)
     t503 = casadi.fabs(t502)
     t504 = (t503 >= 1)
-    t505 = casadi.fabs(1/casadi.if_else(t504, t502, 1))
+    t505 = 1/casadi.fabs(casadi.if_else(t504, t502, 1))
     t506 = casadi.if_else(t501, casadi.if_else((t502 >= 0), 1, -1)*casadi.if_else(t504, t505/(1 + casadi.sqrt(1 + t505**2)), 1/(t503 + casadi.sqrt(1 + t503**2))), 0)
     t507 = 1/casadi.sqrt(1 + t506**2)
     t508 = t466*t506
@@ -3102,10 +3102,10 @@ def _condition_number(q):
     t534 = t532 + t531*t506
     t535 = t480*t513 + t484*t517 + t488*t521 + t492*t525 + t496*t529 + t500*t533
     t536 = (t535 != 0)
-    t537 = 0.5*(-t509 + t476)/casadi.if_else(t536, t535, 1)
+    t537 = (-t509 + t476)/casadi.if_else(t536, 2*t535, 1)
     t538 = casadi.fabs(t537)
     t539 = (t538 >= 1)
-    t540 = casadi.fabs(1/casadi.if_else(t539, t537, 1))
+    t540 = 1/casadi.fabs(casadi.if_else(t539, t537, 1))
     t541 = casadi.if_else(t536, casadi.if_else((t537 >= 0), 1, -1)*casadi.if_else(t539, t540/(1 + casadi.sqrt(1 + t540**2)), 1/(t538 + casadi.sqrt(1 + t538**2))), 0)
     t542 = 1/casadi.sqrt(1 + t541**2)
     t543 = t535*t541
@@ -3137,10 +3137,10 @@ def _condition_number(q):
     t569 = t567 + t566*t541
     t570 = t514*t549 + t518*t553 + t522*t557 + t526*t561 + t530*t565 + t534*t569
     t571 = (t570 != 0)
-    t572 = 0.5*(-t510 + t545)/casadi.if_else(t571, t570, 1)
+    t572 = (-t510 + t545)/casadi.if_else(t571, 2*t570, 1)
     t573 = casadi.fabs(t572)
     t574 = (t573 >= 1)
-    t575 = casadi.fabs(1/casadi.if_else(t574, t572, 1))
+    t575 = 1/casadi.fabs(casadi.if_else(t574, t572, 1))
     t576 = casadi.if_else(t571, casadi.if_else((t572 >= 0), 1, -1)*casadi.if_else(t574, t575/(1 + casadi.sqrt(1 + t575**2)), 1/(t573 + casadi.sqrt(1 + t573**2))), 0)
     t577 = 1/casadi.sqrt(1 + t576**2)
     t578 = t570*t576
@@ -3171,10 +3171,10 @@ def _condition_number(q):
     t603 = t601 - t602*t576
     t604 = t602 + t601*t576
     t605 = (t395 != 0)
-    t606 = 0.5*(-t219 + t369)/casadi.if_else(t605, t395, 1)
+    t606 = (-t219 + t369)/casadi.if_else(t605, 2*t395, 1)
     t607 = casadi.fabs(t606)
     t608 = (t607 >= 1)
-    t609 = casadi.fabs(1/casadi.if_else(t608, t606, 1))
+    t609 = 1/casadi.fabs(casadi.if_else(t608, t606, 1))
     t610 = casadi.if_else(t605, casadi.if_else((t606 >= 0), 1, -1)*casadi.if_else(t608, t609/(1 + casadi.sqrt(1 + t609**2)), 1/(t607 + casadi.sqrt(1 + t607**2))), 0)
     t611 = 1/casadi.sqrt(1 + t610**2)
     t612 = t395*t610
@@ -3206,10 +3206,10 @@ def _condition_number(q):
     t638 = t636 + t635*t610
     t639 = t479*t617 + t483*t621 + t487*t625 + t491*t629 + t495*t633 + t499*t637
     t640 = (t639 != 0)
-    t641 = 0.5*(-t613 + t475)/casadi.if_else(t640, t639, 1)
+    t641 = (-t613 + t475)/casadi.if_else(t640, 2*t639, 1)
     t642 = casadi.fabs(t641)
     t643 = (t642 >= 1)
-    t644 = casadi.fabs(1/casadi.if_else(t643, t641, 1))
+    t644 = 1/casadi.fabs(casadi.if_else(t643, t641, 1))
     t645 = casadi.if_else(t640, casadi.if_else((t641 >= 0), 1, -1)*casadi.if_else(t643, t644/(1 + casadi.sqrt(1 + t644**2)), 1/(t642 + casadi.sqrt(1 + t642**2))), 0)
     t646 = 1/casadi.sqrt(1 + t645**2)
     t647 = t639*t645
@@ -3242,10 +3242,10 @@ def _condition_number(q):
     t674 = t548*t652 + t552*t656 + t556*t660 + t560*t664 + t564*t668 + t568*t672
     t675 = -t618*t653 + t622*t657 + t626*t661 + t630*t665 + t634*t669 + t638*t673
     t676 = (t674 != 0)
-    t677 = 0.5*(-t648 + t544)/casadi.if_else(t676, t674, 1)
+    t677 = (-t648 + t544)/casadi.if_else(t676, 2*t674, 1)
     t678 = casadi.fabs(t677)
     t679 = (t678 >= 1)
-    t680 = casadi.fabs(1/casadi.if_else(t679, t677, 1))
+    t680 = 1/casadi.fabs(casadi.if_else(t679, t677, 1))
     t681 = casadi.if_else(t676, casadi.if_else((t677 >= 0), 1, -1)*casadi.if_else(t679, t680/(1 + casadi.sqrt(1 + t680**2)), 1/(t678 + casadi.sqrt(1 + t678**2))), 0)
     t682 = 1/casadi.sqrt(1 + t681**2)
     t683 = t674*t681
@@ -3277,10 +3277,10 @@ def _condition_number(q):
     t709 = t707 + t706*t681
     t710 = t583*t688 + t587*t692 + t591*t696 + t595*t700 + t599*t704 + t603*t708
     t711 = (t710 != 0)
-    t712 = 0.5*(-t684 + t579)/casadi.if_else(t711, t710, 1)
+    t712 = (-t684 + t579)/casadi.if_else(t711, 2*t710, 1)
     t713 = casadi.fabs(t712)
     t714 = (t713 >= 1)
-    t715 = casadi.fabs(1/casadi.if_else(t714, t712, 1))
+    t715 = 1/casadi.fabs(casadi.if_else(t714, t712, 1))
     t716 = casadi.if_else(t711, casadi.if_else((t712 >= 0), 1, -1)*casadi.if_else(t714, t715/(1 + casadi.sqrt(1 + t715**2)), 1/(t713 + casadi.sqrt(1 + t713**2))), 0)
     t717 = 1/casadi.sqrt(1 + t716**2)
     t718 = t710*t716
@@ -3312,10 +3312,10 @@ def _condition_number(q):
     t744 = t742 + t741*t716
     t745 = t584*t723 + t588*t727 + t592*t731 + t596*t735 + t600*t739 + t604*t743
     t746 = (t745 != 0)
-    t747 = 0.5*(-t719 + t580)/casadi.if_else(t746, t745, 1)
+    t747 = (-t719 + t580)/casadi.if_else(t746, 2*t745, 1)
     t748 = casadi.fabs(t747)
     t749 = (t748 >= 1)
-    t750 = casadi.fabs(1/casadi.if_else(t749, t747, 1))
+    t750 = 1/casadi.fabs(casadi.if_else(t749, t747, 1))
     t751 = casadi.if_else(t746, casadi.if_else((t747 >= 0), 1, -1)*casadi.if_else(t749, t750/(1 + casadi.sqrt(1 + t750**2)), 1/(t748 + casadi.sqrt(1 + t748**2))), 0)
     t752 = 1/casadi.sqrt(1 + t751**2)
     t753 = t745*t751
@@ -3346,10 +3346,10 @@ def _condition_number(q):
     t778 = t776 - t777*t751
     t779 = t777 + t776*t751
     t780 = (t675 != 0)
-    t781 = 0.5*(-t614 + t649)/casadi.if_else(t780, t675, 1)
+    t781 = (-t614 + t649)/casadi.if_else(t780, 2*t675, 1)
     t782 = casadi.fabs(t781)
     t783 = (t782 >= 1)
-    t784 = casadi.fabs(1/casadi.if_else(t783, t781, 1))
+    t784 = 1/casadi.fabs(casadi.if_else(t783, t781, 1))
     t785 = casadi.if_else(t780, casadi.if_else((t781 >= 0), 1, -1)*casadi.if_else(t783, t784/(1 + casadi.sqrt(1 + t784**2)), 1/(t782 + casadi.sqrt(1 + t782**2))), 0)
     t786 = 1/casadi.sqrt(1 + t785**2)
     t787 = t675*t785
@@ -3381,10 +3381,10 @@ def _condition_number(q):
     t813 = t811 + t810*t785
     t814 = t689*t792 + t693*t796 + t697*t800 + t701*t804 + t705*t808 + t709*t812
     t815 = (t814 != 0)
-    t816 = 0.5*(-t788 + t685)/casadi.if_else(t815, t814, 1)
+    t816 = (-t788 + t685)/casadi.if_else(t815, 2*t814, 1)
     t817 = casadi.fabs(t816)
     t818 = (t817 >= 1)
-    t819 = casadi.fabs(1/casadi.if_else(t818, t816, 1))
+    t819 = 1/casadi.fabs(casadi.if_else(t818, t816, 1))
     t820 = casadi.if_else(t815, casadi.if_else((t816 >= 0), 1, -1)*casadi.if_else(t818, t819/(1 + casadi.sqrt(1 + t819**2)), 1/(t817 + casadi.sqrt(1 + t817**2))), 0)
     t821 = 1/casadi.sqrt(1 + t820**2)
     t822 = t814*t820
@@ -3417,10 +3417,10 @@ def _condition_number(q):
     t849 = t724*t827 + t728*t831 + t732*t835 + t736*t839 + t740*t843 + t744*t847
     t850 = t793*t828 + t797*t832 + t801*t836 + t805*t840 + t809*t844 + t813*t848
     t851 = (t849 != 0)
-    t852 = 0.5*(-t823 + t720)/casadi.if_else(t851, t849, 1)
+    t852 = (-t823 + t720)/casadi.if_else(t851, 2*t849, 1)
     t853 = casadi.fabs(t852)
     t854 = (t853 >= 1)
-    t855 = casadi.fabs(1/casadi.if_else(t854, t852, 1))
+    t855 = 1/casadi.fabs(casadi.if_else(t854, t852, 1))
     t856 = casadi.if_else(t851, casadi.if_else((t852 >= 0), 1, -1)*casadi.if_else(t854, t855/(1 + casadi.sqrt(1 + t855**2)), 1/(t853 + casadi.sqrt(1 + t853**2))), 0)
     t857 = 1/casadi.sqrt(1 + t856**2)
     t858 = t849*t856
@@ -3452,10 +3452,10 @@ def _condition_number(q):
     t884 = t882 + t881*t856
     t885 = t759*t863 + t763*t867 + t767*t871 + t771*t875 + t775*t879 + t779*t883
     t886 = (t885 != 0)
-    t887 = 0.5*(-t859 + t755)/casadi.if_else(t886, t885, 1)
+    t887 = (-t859 + t755)/casadi.if_else(t886, 2*t885, 1)
     t888 = casadi.fabs(t887)
     t889 = (t888 >= 1)
-    t890 = casadi.fabs(1/casadi.if_else(t889, t887, 1))
+    t890 = 1/casadi.fabs(casadi.if_else(t889, t887, 1))
     t891 = casadi.if_else(t886, casadi.if_else((t887 >= 0), 1, -1)*casadi.if_else(t889, t890/(1 + casadi.sqrt(1 + t890**2)), 1/(t888 + casadi.sqrt(1 + t888**2))), 0)
     t892 = 1/casadi.sqrt(1 + t891**2)
     t893 = t885*t891
@@ -3487,10 +3487,10 @@ def _condition_number(q):
     t919 = t917 + t916*t891
     t920 = t758*t898 + t762*t902 + t766*t906 + t770*t910 + t774*t914 + t778*t918
     t921 = (t850 != 0)
-    t922 = 0.5*(-t789 + t824)/casadi.if_else(t921, t850, 1)
+    t922 = (-t789 + t824)/casadi.if_else(t921, 2*t850, 1)
     t923 = casadi.fabs(t922)
     t924 = (t923 >= 1)
-    t925 = casadi.fabs(1/casadi.if_else(t924, t922, 1))
+    t925 = 1/casadi.fabs(casadi.if_else(t924, t922, 1))
     t926 = casadi.if_else(t921, casadi.if_else((t922 >= 0), 1, -1)*casadi.if_else(t924, t925/(1 + casadi.sqrt(1 + t925**2)), 1/(t923 + casadi.sqrt(1 + t923**2))), 0)
     t927 = 1/casadi.sqrt(1 + t926**2)
     t928 = t850*t926
@@ -3522,10 +3522,10 @@ def _condition_number(q):
     t954 = t952 + t951*t926
     t955 = t864*t933 + t868*t937 + t872*t941 + t876*t945 + t880*t949 + t884*t953
     t956 = (t955 != 0)
-    t957 = 0.5*(-t929 + t860)/casadi.if_else(t956, t955, 1)
+    t957 = (-t929 + t860)/casadi.if_else(t956, 2*t955, 1)
     t958 = casadi.fabs(t957)
     t959 = (t958 >= 1)
-    t960 = casadi.fabs(1/casadi.if_else(t959, t957, 1))
+    t960 = 1/casadi.fabs(casadi.if_else(t959, t957, 1))
     t961 = casadi.if_else(t956, casadi.if_else((t957 >= 0), 1, -1)*casadi.if_else(t959, t960/(1 + casadi.sqrt(1 + t960**2)), 1/(t958 + casadi.sqrt(1 + t958**2))), 0)
     t962 = 1/casadi.sqrt(1 + t961**2)
     t963 = t955*t961
@@ -3558,10 +3558,10 @@ def _condition_number(q):
     t990 = t899*t968 + t903*t972 + t907*t976 + t911*t980 + t915*t984 + t919*t988
     t991 = t934*t969 + t938*t973 + t942*t977 + t946*t981 + t950*t985 + t954*t989
     t992 = (t990 != 0)
-    t993 = 0.5*(-t964 + t895)/casadi.if_else(t992, t990, 1)
+    t993 = (-t964 + t895)/casadi.if_else(t992, 2*t990, 1)
     t994 = casadi.fabs(t993)
     t995 = (t994 >= 1)
-    t996 = casadi.fabs(1/casadi.if_else(t995, t993, 1))
+    t996 = 1/casadi.fabs(casadi.if_else(t995, t993, 1))
     t997 = casadi.if_else(t992, casadi.if_else((t993 >= 0), 1, -1)*casadi.if_else(t995, t996/(1 + casadi.sqrt(1 + t996**2)), 1/(t994 + casadi.sqrt(1 + t994**2))), 0)
     t998 = 1/casadi.sqrt(1 + t997**2)
     t999 = t990*t997
@@ -3592,10 +3592,10 @@ def _condition_number(q):
     t1024 = t1022 - t1023*t997
     t1025 = t1023 + t1022*t997
     t1026 = (t991 != 0)
-    t1027 = 0.5*(-t930 + t965)/casadi.if_else(t1026, t991, 1)
+    t1027 = (-t930 + t965)/casadi.if_else(t1026, 2*t991, 1)
     t1028 = casadi.fabs(t1027)
     t1029 = (t1028 >= 1)
-    t1030 = casadi.fabs(1/casadi.if_else(t1029, t1027, 1))
+    t1030 = 1/casadi.fabs(casadi.if_else(t1029, t1027, 1))
     t1031 = casadi.if_else(t1026, casadi.if_else((t1027 >= 0), 1, -1)*casadi.if_else(t1029, t1030/(1 + casadi.sqrt(1 + t1030**2)), 1/(t1028 + casadi.sqrt(1 + t1028**2))), 0)
     t1032 = 1/casadi.sqrt(1 + t1031**2)
     t1033 = t991*t1031
@@ -3627,10 +3627,10 @@ def _condition_number(q):
     t1059 = t1057 + t1031*t1056
     t1060 = t1005*t1038 + t1009*t1042 + t1013*t1046 + t1017*t1050 + t1021*t1054 + t1025*t1058
     t1061 = (t1060 != 0)
-    t1062 = 0.5*(-t1034 + t1001)/casadi.if_else(t1061, t1060, 1)
+    t1062 = (-t1034 + t1001)/casadi.if_else(t1061, 2*t1060, 1)
     t1063 = casadi.fabs(t1062)
     t1064 = (t1063 >= 1)
-    t1065 = casadi.fabs(1/casadi.if_else(t1064, t1062, 1))
+    t1065 = 1/casadi.fabs(casadi.if_else(t1064, t1062, 1))
     t1066 = casadi.if_else(t1061, casadi.if_else((t1062 >= 0), 1, -1)*casadi.if_else(t1064, t1065/(1 + casadi.sqrt(1 + t1065**2)), 1/(t1063 + casadi.sqrt(1 + t1063**2))), 0)
     t1067 = 1/casadi.sqrt(1 + t1066**2)
     t1068 = t1060*t1066
@@ -3662,10 +3662,10 @@ def _condition_number(q):
     t1094 = t1092 + t1066*t1091
     t1095 = t1039*t1074 + t1043*t1078 + t1047*t1082 + t1051*t1086 + t1055*t1090 + t1059*t1094
     t1096 = (t1095 != 0)
-    t1097 = 0.5*(-t1035 + t1070)/casadi.if_else(t1096, t1095, 1)
+    t1097 = (-t1035 + t1070)/casadi.if_else(t1096, 2*t1095, 1)
     t1098 = casadi.fabs(t1097)
     t1099 = (t1098 >= 1)
-    t1100 = casadi.fabs(1/casadi.if_else(t1099, t1097, 1))
+    t1100 = 1/casadi.fabs(casadi.if_else(t1099, t1097, 1))
     t1101 = casadi.if_else(t1096, casadi.if_else((t1097 >= 0), 1, -1)*casadi.if_else(t1099, t1100/(1 + casadi.sqrt(1 + t1100**2)), 1/(t1098 + casadi.sqrt(1 + t1098**2))), 0)
     t1102 = 1/casadi.sqrt(1 + t1101**2)
     t1103 = t1095*t1101
@@ -3696,10 +3696,10 @@ def _condition_number(q):
     t1128 = t1126 - t1101*t1127
     t1129 = t1127 + t1101*t1126
     t1130 = (t920 != 0)
-    t1131 = 0.5*(-t754 + t894)/casadi.if_else(t1130, t920, 1)
+    t1131 = (-t754 + t894)/casadi.if_else(t1130, 2*t920, 1)
     t1132 = casadi.fabs(t1131)
     t1133 = (t1132 >= 1)
-    t1134 = casadi.fabs(1/casadi.if_else(t1133, t1131, 1))
+    t1134 = 1/casadi.fabs(casadi.if_else(t1133, t1131, 1))
     t1135 = casadi.if_else(t1130, casadi.if_else((t1131 >= 0), 1, -1)*casadi.if_else(t1133, t1134/(1 + casadi.sqrt(1 + t1134**2)), 1/(t1132 + casadi.sqrt(1 + t1132**2))), 0)
     t1136 = 1/casadi.sqrt(1 + t1135**2)
     t1137 = t920*t1135
@@ -3731,10 +3731,10 @@ def _condition_number(q):
     t1163 = t1161 + t1135*t1160
     t1164 = t1004*t1142 + t1008*t1146 + t1012*t1150 + t1016*t1154 + t1020*t1158 + t1024*t1162
     t1165 = (t1164 != 0)
-    t1166 = 0.5*(-t1138 + t1000)/casadi.if_else(t1165, t1164, 1)
+    t1166 = (-t1138 + t1000)/casadi.if_else(t1165, 2*t1164, 1)
     t1167 = casadi.fabs(t1166)
     t1168 = (t1167 >= 1)
-    t1169 = casadi.fabs(1/casadi.if_else(t1168, t1166, 1))
+    t1169 = 1/casadi.fabs(casadi.if_else(t1168, t1166, 1))
     t1170 = casadi.if_else(t1165, casadi.if_else((t1166 >= 0), 1, -1)*casadi.if_else(t1168, t1169/(1 + casadi.sqrt(1 + t1169**2)), 1/(t1167 + casadi.sqrt(1 + t1167**2))), 0)
     t1171 = 1/casadi.sqrt(1 + t1170**2)
     t1172 = t1164*t1170
@@ -3767,10 +3767,10 @@ def _condition_number(q):
     t1199 = t1073*t1177 + t1077*t1181 + t1081*t1185 + t1085*t1189 + t1089*t1193 + t1093*t1197
     t1200 = t1143*t1178 + t1147*t1182 + t1151*t1186 + t1155*t1190 + t1159*t1194 + t1163*t1198
     t1201 = (t1199 != 0)
-    t1202 = 0.5*(-t1173 + t1069)/casadi.if_else(t1201, t1199, 1)
+    t1202 = (-t1173 + t1069)/casadi.if_else(t1201, 2*t1199, 1)
     t1203 = casadi.fabs(t1202)
     t1204 = (t1203 >= 1)
-    t1205 = casadi.fabs(1/casadi.if_else(t1204, t1202, 1))
+    t1205 = 1/casadi.fabs(casadi.if_else(t1204, t1202, 1))
     t1206 = casadi.if_else(t1201, casadi.if_else((t1202 >= 0), 1, -1)*casadi.if_else(t1204, t1205/(1 + casadi.sqrt(1 + t1205**2)), 1/(t1203 + casadi.sqrt(1 + t1203**2))), 0)
     t1207 = 1/casadi.sqrt(1 + t1206**2)
     t1208 = t1199*t1206
@@ -3802,10 +3802,10 @@ def _condition_number(q):
     t1234 = t1232 + t1206*t1231
     t1235 = t1108*t1213 + t1112*t1217 + t1116*t1221 + t1120*t1225 + t1124*t1229 + t1128*t1233
     t1236 = (t1235 != 0)
-    t1237 = 0.5*(-t1209 + t1104)/casadi.if_else(t1236, t1235, 1)
+    t1237 = (-t1209 + t1104)/casadi.if_else(t1236, 2*t1235, 1)
     t1238 = casadi.fabs(t1237)
     t1239 = (t1238 >= 1)
-    t1240 = casadi.fabs(1/casadi.if_else(t1239, t1237, 1))
+    t1240 = 1/casadi.fabs(casadi.if_else(t1239, t1237, 1))
     t1241 = casadi.if_else(t1236, casadi.if_else((t1237 >= 0), 1, -1)*casadi.if_else(t1239, t1240/(1 + casadi.sqrt(1 + t1240**2)), 1/(t1238 + casadi.sqrt(1 + t1238**2))), 0)
     t1242 = 1/casadi.sqrt(1 + t1241**2)
     t1243 = t1235*t1241
@@ -3837,10 +3837,10 @@ def _condition_number(q):
     t1269 = t1267 + t1241*t1266
     t1270 = t1109*t1248 + t1113*t1252 + t1117*t1256 + t1121*t1260 + t1125*t1264 + t1129*t1268
     t1271 = (t1270 != 0)
-    t1272 = 0.5*(-t1244 + t1105)/casadi.if_else(t1271, t1270, 1)
+    t1272 = (-t1244 + t1105)/casadi.if_else(t1271, 2*t1270, 1)
     t1273 = casadi.fabs(t1272)
     t1274 = (t1273 >= 1)
-    t1275 = casadi.fabs(1/casadi.if_else(t1274, t1272, 1))
+    t1275 = 1/casadi.fabs(casadi.if_else(t1274, t1272, 1))
     t1276 = casadi.if_else(t1271, casadi.if_else((t1272 >= 0), 1, -1)*casadi.if_else(t1274, t1275/(1 + casadi.sqrt(1 + t1275**2)), 1/(t1273 + casadi.sqrt(1 + t1273**2))), 0)
     t1277 = 1/casadi.sqrt(1 + t1276**2)
     t1278 = t1270*t1276
@@ -3871,10 +3871,10 @@ def _condition_number(q):
     t1303 = t1301 - t1276*t1302
     t1304 = t1302 + t1276*t1301
     t1305 = (t1200 != 0)
-    t1306 = 0.5*(-t1139 + t1174)/casadi.if_else(t1305, t1200, 1)
+    t1306 = (-t1139 + t1174)/casadi.if_else(t1305, 2*t1200, 1)
     t1307 = casadi.fabs(t1306)
     t1308 = (t1307 >= 1)
-    t1309 = casadi.fabs(1/casadi.if_else(t1308, t1306, 1))
+    t1309 = 1/casadi.fabs(casadi.if_else(t1308, t1306, 1))
     t1310 = casadi.if_else(t1305, casadi.if_else((t1306 >= 0), 1, -1)*casadi.if_else(t1308, t1309/(1 + casadi.sqrt(1 + t1309**2)), 1/(t1307 + casadi.sqrt(1 + t1307**2))), 0)
     t1311 = 1/casadi.sqrt(1 + t1310**2)
     t1312 = t1200*t1310
@@ -3906,10 +3906,10 @@ def _condition_number(q):
     t1338 = t1336 + t1310*t1335
     t1339 = t1214*t1317 + t1218*t1321 + t1222*t1325 + t1226*t1329 + t1230*t1333 + t1234*t1337
     t1340 = (t1339 != 0)
-    t1341 = 0.5*(-t1313 + t1210)/casadi.if_else(t1340, t1339, 1)
+    t1341 = (-t1313 + t1210)/casadi.if_else(t1340, 2*t1339, 1)
     t1342 = casadi.fabs(t1341)
     t1343 = (t1342 >= 1)
-    t1344 = casadi.fabs(1/casadi.if_else(t1343, t1341, 1))
+    t1344 = 1/casadi.fabs(casadi.if_else(t1343, t1341, 1))
     t1345 = casadi.if_else(t1340, casadi.if_else((t1341 >= 0), 1, -1)*casadi.if_else(t1343, t1344/(1 + casadi.sqrt(1 + t1344**2)), 1/(t1342 + casadi.sqrt(1 + t1342**2))), 0)
     t1346 = 1/casadi.sqrt(1 + t1345**2)
     t1347 = t1339*t1345
@@ -3942,10 +3942,10 @@ def _condition_number(q):
     t1374 = t1249*t1352 + t1253*t1356 + t1257*t1360 + t1261*t1364 + t1265*t1368 + t1269*t1372
     t1375 = t1318*t1353 + t1322*t1357 + t1326*t1361 + t1330*t1365 + t1334*t1369 + t1338*t1373
     t1376 = (t1374 != 0)
-    t1377 = 0.5*(-t1348 + t1245)/casadi.if_else(t1376, t1374, 1)
+    t1377 = (-t1348 + t1245)/casadi.if_else(t1376, 2*t1374, 1)
     t1378 = casadi.fabs(t1377)
     t1379 = (t1378 >= 1)
-    t1380 = casadi.fabs(1/casadi.if_else(t1379, t1377, 1))
+    t1380 = 1/casadi.fabs(casadi.if_else(t1379, t1377, 1))
     t1381 = casadi.if_else(t1376, casadi.if_else((t1377 >= 0), 1, -1)*casadi.if_else(t1379, t1380/(1 + casadi.sqrt(1 + t1380**2)), 1/(t1378 + casadi.sqrt(1 + t1378**2))), 0)
     t1382 = 1/casadi.sqrt(1 + t1381**2)
     t1383 = t1374*t1381
@@ -3977,10 +3977,10 @@ def _condition_number(q):
     t1409 = t1407 + t1381*t1406
     t1410 = t1284*t1388 + t1288*t1392 + t1292*t1396 + t1296*t1400 + t1300*t1404 + t1304*t1408
     t1411 = (t1410 != 0)
-    t1412 = 0.5*(-t1384 + t1280)/casadi.if_else(t1411, t1410, 1)
+    t1412 = (-t1384 + t1280)/casadi.if_else(t1411, 2*t1410, 1)
     t1413 = casadi.fabs(t1412)
     t1414 = (t1413 >= 1)
-    t1415 = casadi.fabs(1/casadi.if_else(t1414, t1412, 1))
+    t1415 = 1/casadi.fabs(casadi.if_else(t1414, t1412, 1))
     t1416 = casadi.if_else(t1411, casadi.if_else((t1412 >= 0), 1, -1)*casadi.if_else(t1414, t1415/(1 + casadi.sqrt(1 + t1415**2)), 1/(t1413 + casadi.sqrt(1 + t1413**2))), 0)
     t1417 = 1/casadi.sqrt(1 + t1416**2)
     t1418 = t1410*t1416
@@ -4012,10 +4012,10 @@ def _condition_number(q):
     t1444 = t1442 + t1416*t1441
     t1445 = t1283*t1423 + t1287*t1427 + t1291*t1431 + t1295*t1435 + t1299*t1439 + t1303*t1443
     t1446 = (t1375 != 0)
-    t1447 = 0.5*(-t1314 + t1349)/casadi.if_else(t1446, t1375, 1)
+    t1447 = (-t1314 + t1349)/casadi.if_else(t1446, 2*t1375, 1)
     t1448 = casadi.fabs(t1447)
     t1449 = (t1448 >= 1)
-    t1450 = casadi.fabs(1/casadi.if_else(t1449, t1447, 1))
+    t1450 = 1/casadi.fabs(casadi.if_else(t1449, t1447, 1))
     t1451 = casadi.if_else(t1446, casadi.if_else((t1447 >= 0), 1, -1)*casadi.if_else(t1449, t1450/(1 + casadi.sqrt(1 + t1450**2)), 1/(t1448 + casadi.sqrt(1 + t1448**2))), 0)
     t1452 = 1/casadi.sqrt(1 + t1451**2)
     t1453 = t1375*t1451
@@ -4047,10 +4047,10 @@ def _condition_number(q):
     t1479 = t1477 + t1451*t1476
     t1480 = t1389*t1458 + t1393*t1462 + t1397*t1466 + t1401*t1470 + t1405*t1474 + t1409*t1478
     t1481 = (t1480 != 0)
-    t1482 = 0.5*(-t1454 + t1385)/casadi.if_else(t1481, t1480, 1)
+    t1482 = (-t1454 + t1385)/casadi.if_else(t1481, 2*t1480, 1)
     t1483 = casadi.fabs(t1482)
     t1484 = (t1483 >= 1)
-    t1485 = casadi.fabs(1/casadi.if_else(t1484, t1482, 1))
+    t1485 = 1/casadi.fabs(casadi.if_else(t1484, t1482, 1))
     t1486 = casadi.if_else(t1481, casadi.if_else((t1482 >= 0), 1, -1)*casadi.if_else(t1484, t1485/(1 + casadi.sqrt(1 + t1485**2)), 1/(t1483 + casadi.sqrt(1 + t1483**2))), 0)
     t1487 = 1/casadi.sqrt(1 + t1486**2)
     t1488 = t1480*t1486
@@ -4083,10 +4083,10 @@ def _condition_number(q):
     t1515 = t1424*t1493 + t1428*t1497 + t1432*t1501 + t1436*t1505 + t1440*t1509 + t1444*t1513
     t1516 = t1459*t1494 + t1463*t1498 + t1467*t1502 + t1471*t1506 + t1475*t1510 + t1479*t1514
     t1517 = (t1515 != 0)
-    t1518 = 0.5*(-t1489 + t1420)/casadi.if_else(t1517, t1515, 1)
+    t1518 = (-t1489 + t1420)/casadi.if_else(t1517, 2*t1515, 1)
     t1519 = casadi.fabs(t1518)
     t1520 = (t1519 >= 1)
-    t1521 = casadi.fabs(1/casadi.if_else(t1520, t1518, 1))
+    t1521 = 1/casadi.fabs(casadi.if_else(t1520, t1518, 1))
     t1522 = casadi.if_else(t1517, casadi.if_else((t1518 >= 0), 1, -1)*casadi.if_else(t1520, t1521/(1 + casadi.sqrt(1 + t1521**2)), 1/(t1519 + casadi.sqrt(1 + t1519**2))), 0)
     t1523 = 1/casadi.sqrt(1 + t1522**2)
     t1524 = t1515*t1522
@@ -4117,10 +4117,10 @@ def _condition_number(q):
     t1549 = t1547 - t1522*t1548
     t1550 = t1548 + t1522*t1547
     t1551 = (t1516 != 0)
-    t1552 = 0.5*(-t1455 + t1490)/casadi.if_else(t1551, t1516, 1)
+    t1552 = (-t1455 + t1490)/casadi.if_else(t1551, 2*t1516, 1)
     t1553 = casadi.fabs(t1552)
     t1554 = (t1553 >= 1)
-    t1555 = casadi.fabs(1/casadi.if_else(t1554, t1552, 1))
+    t1555 = 1/casadi.fabs(casadi.if_else(t1554, t1552, 1))
     t1556 = casadi.if_else(t1551, casadi.if_else((t1552 >= 0), 1, -1)*casadi.if_else(t1554, t1555/(1 + casadi.sqrt(1 + t1555**2)), 1/(t1553 + casadi.sqrt(1 + t1553**2))), 0)
     t1557 = 1/casadi.sqrt(1 + t1556**2)
     t1558 = t1516*t1556
@@ -4152,10 +4152,10 @@ def _condition_number(q):
     t1584 = t1582 + t1556*t1581
     t1585 = t1530*t1563 + t1534*t1567 + t1538*t1571 + t1542*t1575 + t1546*t1579 + t1550*t1583
     t1586 = (t1585 != 0)
-    t1587 = 0.5*(-t1559 + t1526)/casadi.if_else(t1586, t1585, 1)
+    t1587 = (-t1559 + t1526)/casadi.if_else(t1586, 2*t1585, 1)
     t1588 = casadi.fabs(t1587)
     t1589 = (t1588 >= 1)
-    t1590 = casadi.fabs(1/casadi.if_else(t1589, t1587, 1))
+    t1590 = 1/casadi.fabs(casadi.if_else(t1589, t1587, 1))
     t1591 = casadi.if_else(t1586, casadi.if_else((t1587 >= 0), 1, -1)*casadi.if_else(t1589, t1590/(1 + casadi.sqrt(1 + t1590**2)), 1/(t1588 + casadi.sqrt(1 + t1588**2))), 0)
     t1592 = 1/casadi.sqrt(1 + t1591**2)
     t1593 = t1585*t1591
@@ -4187,10 +4187,10 @@ def _condition_number(q):
     t1619 = t1617 + t1591*t1616
     t1620 = t1564*t1599 + t1568*t1603 + t1572*t1607 + t1576*t1611 + t1580*t1615 + t1584*t1619
     t1621 = (t1620 != 0)
-    t1622 = 0.5*(-t1560 + t1595)/casadi.if_else(t1621, t1620, 1)
+    t1622 = (-t1560 + t1595)/casadi.if_else(t1621, 2*t1620, 1)
     t1623 = casadi.fabs(t1622)
     t1624 = (t1623 >= 1)
-    t1625 = casadi.fabs(1/casadi.if_else(t1624, t1622, 1))
+    t1625 = 1/casadi.fabs(casadi.if_else(t1624, t1622, 1))
     t1626 = casadi.if_else(t1621, casadi.if_else((t1622 >= 0), 1, -1)*casadi.if_else(t1624, t1625/(1 + casadi.sqrt(1 + t1625**2)), 1/(t1623 + casadi.sqrt(1 + t1623**2))), 0)
     t1627 = 1/casadi.sqrt(1 + t1626**2)
     t1628 = t1620*t1626
@@ -4221,10 +4221,10 @@ def _condition_number(q):
     t1653 = t1651 - t1626*t1652
     t1654 = t1652 + t1626*t1651
     t1655 = (t1445 != 0)
-    t1656 = 0.5*(-t1279 + t1419)/casadi.if_else(t1655, t1445, 1)
+    t1656 = (-t1279 + t1419)/casadi.if_else(t1655, 2*t1445, 1)
     t1657 = casadi.fabs(t1656)
     t1658 = (t1657 >= 1)
-    t1659 = casadi.fabs(1/casadi.if_else(t1658, t1656, 1))
+    t1659 = 1/casadi.fabs(casadi.if_else(t1658, t1656, 1))
     t1660 = casadi.if_else(t1655, casadi.if_else((t1656 >= 0), 1, -1)*casadi.if_else(t1658, t1659/(1 + casadi.sqrt(1 + t1659**2)), 1/(t1657 + casadi.sqrt(1 + t1657**2))), 0)
     t1661 = 1/casadi.sqrt(1 + t1660**2)
     t1662 = t1445*t1660
@@ -4256,10 +4256,10 @@ def _condition_number(q):
     t1688 = t1686 + t1660*t1685
     t1689 = t1529*t1667 + t1533*t1671 + t1537*t1675 + t1541*t1679 + t1545*t1683 + t1549*t1687
     t1690 = (t1689 != 0)
-    t1691 = 0.5*(-t1663 + t1525)/casadi.if_else(t1690, t1689, 1)
+    t1691 = (-t1663 + t1525)/casadi.if_else(t1690, 2*t1689, 1)
     t1692 = casadi.fabs(t1691)
     t1693 = (t1692 >= 1)
-    t1694 = casadi.fabs(1/casadi.if_else(t1693, t1691, 1))
+    t1694 = 1/casadi.fabs(casadi.if_else(t1693, t1691, 1))
     t1695 = casadi.if_else(t1690, casadi.if_else((t1691 >= 0), 1, -1)*casadi.if_else(t1693, t1694/(1 + casadi.sqrt(1 + t1694**2)), 1/(t1692 + casadi.sqrt(1 + t1692**2))), 0)
     t1696 = 1/casadi.sqrt(1 + t1695**2)
     t1697 = t1689*t1695
@@ -4292,10 +4292,10 @@ def _condition_number(q):
     t1724 = t1598*t1702 + t1602*t1706 + t1606*t1710 + t1610*t1714 + t1614*t1718 + t1618*t1722
     t1725 = t1668*t1703 + t1672*t1707 + t1676*t1711 + t1680*t1715 + t1684*t1719 + t1688*t1723
     t1726 = (t1724 != 0)
-    t1727 = 0.5*(-t1698 + t1594)/casadi.if_else(t1726, t1724, 1)
+    t1727 = (-t1698 + t1594)/casadi.if_else(t1726, 2*t1724, 1)
     t1728 = casadi.fabs(t1727)
     t1729 = (t1728 >= 1)
-    t1730 = casadi.fabs(1/casadi.if_else(t1729, t1727, 1))
+    t1730 = 1/casadi.fabs(casadi.if_else(t1729, t1727, 1))
     t1731 = casadi.if_else(t1726, casadi.if_else((t1727 >= 0), 1, -1)*casadi.if_else(t1729, t1730/(1 + casadi.sqrt(1 + t1730**2)), 1/(t1728 + casadi.sqrt(1 + t1728**2))), 0)
     t1732 = 1/casadi.sqrt(1 + t1731**2)
     t1733 = t1724*t1731
@@ -4327,10 +4327,10 @@ def _condition_number(q):
     t1759 = t1757 + t1731*t1756
     t1760 = t1633*t1738 + t1637*t1742 + t1641*t1746 + t1645*t1750 + t1649*t1754 + t1653*t1758
     t1761 = (t1760 != 0)
-    t1762 = 0.5*(-t1734 + t1629)/casadi.if_else(t1761, t1760, 1)
+    t1762 = (-t1734 + t1629)/casadi.if_else(t1761, 2*t1760, 1)
     t1763 = casadi.fabs(t1762)
     t1764 = (t1763 >= 1)
-    t1765 = casadi.fabs(1/casadi.if_else(t1764, t1762, 1))
+    t1765 = 1/casadi.fabs(casadi.if_else(t1764, t1762, 1))
     t1766 = casadi.if_else(t1761, casadi.if_else((t1762 >= 0), 1, -1)*casadi.if_else(t1764, t1765/(1 + casadi.sqrt(1 + t1765**2)), 1/(t1763 + casadi.sqrt(1 + t1763**2))), 0)
     t1767 = 1/casadi.sqrt(1 + t1766**2)
     t1768 = t1760*t1766
@@ -4362,10 +4362,10 @@ def _condition_number(q):
     t1794 = t1792 + t1766*t1791
     t1795 = t1634*t1773 + t1638*t1777 + t1642*t1781 + t1646*t1785 + t1650*t1789 + t1654*t1793
     t1796 = (t1795 != 0)
-    t1797 = 0.5*(-t1769 + t1630)/casadi.if_else(t1796, t1795, 1)
+    t1797 = (-t1769 + t1630)/casadi.if_else(t1796, 2*t1795, 1)
     t1798 = casadi.fabs(t1797)
     t1799 = (t1798 >= 1)
-    t1800 = casadi.fabs(1/casadi.if_else(t1799, t1797, 1))
+    t1800 = 1/casadi.fabs(casadi.if_else(t1799, t1797, 1))
     t1801 = casadi.if_else(t1796, casadi.if_else((t1797 >= 0), 1, -1)*casadi.if_else(t1799, t1800/(1 + casadi.sqrt(1 + t1800**2)), 1/(t1798 + casadi.sqrt(1 + t1798**2))), 0)
     t1802 = 1/casadi.sqrt(1 + t1801**2)
     t1803 = t1795*t1801
@@ -4396,10 +4396,10 @@ def _condition_number(q):
     t1828 = t1826 - t1801*t1827
     t1829 = t1827 + t1801*t1826
     t1830 = (t1725 != 0)
-    t1831 = 0.5*(-t1664 + t1699)/casadi.if_else(t1830, t1725, 1)
+    t1831 = (-t1664 + t1699)/casadi.if_else(t1830, 2*t1725, 1)
     t1832 = casadi.fabs(t1831)
     t1833 = (t1832 >= 1)
-    t1834 = casadi.fabs(1/casadi.if_else(t1833, t1831, 1))
+    t1834 = 1/casadi.fabs(casadi.if_else(t1833, t1831, 1))
     t1835 = casadi.if_else(t1830, casadi.if_else((t1831 >= 0), 1, -1)*casadi.if_else(t1833, t1834/(1 + casadi.sqrt(1 + t1834**2)), 1/(t1832 + casadi.sqrt(1 + t1832**2))), 0)
     t1836 = 1/casadi.sqrt(1 + t1835**2)
     t1837 = t1725*t1835
@@ -4431,10 +4431,10 @@ def _condition_number(q):
     t1863 = t1861 + t1835*t1860
     t1864 = t1739*t1842 + t1743*t1846 + t1747*t1850 + t1751*t1854 + t1755*t1858 + t1759*t1862
     t1865 = (t1864 != 0)
-    t1866 = 0.5*(-t1838 + t1735)/casadi.if_else(t1865, t1864, 1)
+    t1866 = (-t1838 + t1735)/casadi.if_else(t1865, 2*t1864, 1)
     t1867 = casadi.fabs(t1866)
     t1868 = (t1867 >= 1)
-    t1869 = casadi.fabs(1/casadi.if_else(t1868, t1866, 1))
+    t1869 = 1/casadi.fabs(casadi.if_else(t1868, t1866, 1))
     t1870 = casadi.if_else(t1865, casadi.if_else((t1866 >= 0), 1, -1)*casadi.if_else(t1868, t1869/(1 + casadi.sqrt(1 + t1869**2)), 1/(t1867 + casadi.sqrt(1 + t1867**2))), 0)
     t1871 = 1/casadi.sqrt(1 + t1870**2)
     t1872 = t1864*t1870
@@ -4467,10 +4467,10 @@ def _condition_number(q):
     t1899 = t1774*t1877 + t1778*t1881 + t1782*t1885 + t1786*t1889 + t1790*t1893 + t1794*t1897
     t1900 = t1843*t1878 + t1847*t1882 + t1851*t1886 + t1855*t1890 + t1859*t1894 + t1863*t1898
     t1901 = (t1899 != 0)
-    t1902 = 0.5*(-t1873 + t1770)/casadi.if_else(t1901, t1899, 1)
+    t1902 = (-t1873 + t1770)/casadi.if_else(t1901, 2*t1899, 1)
     t1903 = casadi.fabs(t1902)
     t1904 = (t1903 >= 1)
-    t1905 = casadi.fabs(1/casadi.if_else(t1904, t1902, 1))
+    t1905 = 1/casadi.fabs(casadi.if_else(t1904, t1902, 1))
     t1906 = casadi.if_else(t1901, casadi.if_else((t1902 >= 0), 1, -1)*casadi.if_else(t1904, t1905/(1 + casadi.sqrt(1 + t1905**2)), 1/(t1903 + casadi.sqrt(1 + t1903**2))), 0)
     t1907 = 1/casadi.sqrt(1 + t1906**2)
     t1908 = t1899*t1906
@@ -4502,10 +4502,10 @@ def _condition_number(q):
     t1934 = t1932 + t1906*t1931
     t1935 = t1809*t1913 + t1813*t1917 + t1817*t1921 + t1821*t1925 + t1825*t1929 + t1829*t1933
     t1936 = (t1935 != 0)
-    t1937 = 0.5*(-t1909 + t1805)/casadi.if_else(t1936, t1935, 1)
+    t1937 = (-t1909 + t1805)/casadi.if_else(t1936, 2*t1935, 1)
     t1938 = casadi.fabs(t1937)
     t1939 = (t1938 >= 1)
-    t1940 = casadi.fabs(1/casadi.if_else(t1939, t1937, 1))
+    t1940 = 1/casadi.fabs(casadi.if_else(t1939, t1937, 1))
     t1941 = casadi.if_else(t1936, casadi.if_else((t1937 >= 0), 1, -1)*casadi.if_else(t1939, t1940/(1 + casadi.sqrt(1 + t1940**2)), 1/(t1938 + casadi.sqrt(1 + t1938**2))), 0)
     t1942 = 1/casadi.sqrt(1 + t1941**2)
     t1943 = t1935*t1941
@@ -4537,10 +4537,10 @@ def _condition_number(q):
     t1969 = t1967 + t1941*t1966
     t1970 = t1808*t1948 + t1812*t1952 + t1816*t1956 + t1820*t1960 + t1824*t1964 + t1828*t1968
     t1971 = (t1900 != 0)
-    t1972 = 0.5*(-t1839 + t1874)/casadi.if_else(t1971, t1900, 1)
+    t1972 = (-t1839 + t1874)/casadi.if_else(t1971, 2*t1900, 1)
     t1973 = casadi.fabs(t1972)
     t1974 = (t1973 >= 1)
-    t1975 = casadi.fabs(1/casadi.if_else(t1974, t1972, 1))
+    t1975 = 1/casadi.fabs(casadi.if_else(t1974, t1972, 1))
     t1976 = casadi.if_else(t1971, casadi.if_else((t1972 >= 0), 1, -1)*casadi.if_else(t1974, t1975/(1 + casadi.sqrt(1 + t1975**2)), 1/(t1973 + casadi.sqrt(1 + t1973**2))), 0)
     t1977 = 1/casadi.sqrt(1 + t1976**2)
     t1978 = t1900*t1976
@@ -4572,10 +4572,10 @@ def _condition_number(q):
     t2004 = t2002 + t1976*t2001
     t2005 = t1914*t1983 + t1918*t1987 + t1922*t1991 + t1926*t1995 + t1930*t1999 + t1934*t2003
     t2006 = (t2005 != 0)
-    t2007 = 0.5*(-t1979 + t1910)/casadi.if_else(t2006, t2005, 1)
+    t2007 = (-t1979 + t1910)/casadi.if_else(t2006, 2*t2005, 1)
     t2008 = casadi.fabs(t2007)
     t2009 = (t2008 >= 1)
-    t2010 = casadi.fabs(1/casadi.if_else(t2009, t2007, 1))
+    t2010 = 1/casadi.fabs(casadi.if_else(t2009, t2007, 1))
     t2011 = casadi.if_else(t2006, casadi.if_else((t2007 >= 0), 1, -1)*casadi.if_else(t2009, t2010/(1 + casadi.sqrt(1 + t2010**2)), 1/(t2008 + casadi.sqrt(1 + t2008**2))), 0)
     t2012 = 1/casadi.sqrt(1 + t2011**2)
     t2013 = t2005*t2011
@@ -4608,10 +4608,10 @@ def _condition_number(q):
     t2040 = t1949*t2018 + t1953*t2022 + t1957*t2026 + t1961*t2030 + t1965*t2034 + t1969*t2038
     t2041 = t1984*t2019 + t1988*t2023 + t1992*t2027 + t1996*t2031 + t2000*t2035 + t2004*t2039
     t2042 = (t2040 != 0)
-    t2043 = 0.5*(-t2014 + t1945)/casadi.if_else(t2042, t2040, 1)
+    t2043 = (-t2014 + t1945)/casadi.if_else(t2042, 2*t2040, 1)
     t2044 = casadi.fabs(t2043)
     t2045 = (t2044 >= 1)
-    t2046 = casadi.fabs(1/casadi.if_else(t2045, t2043, 1))
+    t2046 = 1/casadi.fabs(casadi.if_else(t2045, t2043, 1))
     t2047 = casadi.if_else(t2042, casadi.if_else((t2043 >= 0), 1, -1)*casadi.if_else(t2045, t2046/(1 + casadi.sqrt(1 + t2046**2)), 1/(t2044 + casadi.sqrt(1 + t2044**2))), 0)
     t2048 = 1/casadi.sqrt(1 + t2047**2)
     t2049 = t2040*t2047
@@ -4642,10 +4642,10 @@ def _condition_number(q):
     t2074 = t2072 - t2047*t2073
     t2075 = t2073 + t2047*t2072
     t2076 = (t2041 != 0)
-    t2077 = 0.5*(-t1980 + t2015)/casadi.if_else(t2076, t2041, 1)
+    t2077 = (-t1980 + t2015)/casadi.if_else(t2076, 2*t2041, 1)
     t2078 = casadi.fabs(t2077)
     t2079 = (t2078 >= 1)
-    t2080 = casadi.fabs(1/casadi.if_else(t2079, t2077, 1))
+    t2080 = 1/casadi.fabs(casadi.if_else(t2079, t2077, 1))
     t2081 = casadi.if_else(t2076, casadi.if_else((t2077 >= 0), 1, -1)*casadi.if_else(t2079, t2080/(1 + casadi.sqrt(1 + t2080**2)), 1/(t2078 + casadi.sqrt(1 + t2078**2))), 0)
     t2082 = 1/casadi.sqrt(1 + t2081**2)
     t2083 = t2041*t2081
@@ -4677,10 +4677,10 @@ def _condition_number(q):
     t2109 = t2107 + t2081*t2106
     t2110 = t2055*t2088 + t2059*t2092 + t2063*t2096 + t2067*t2100 + t2071*t2104 + t2075*t2108
     t2111 = (t2110 != 0)
-    t2112 = 0.5*(-t2084 + t2051)/casadi.if_else(t2111, t2110, 1)
+    t2112 = (-t2084 + t2051)/casadi.if_else(t2111, 2*t2110, 1)
     t2113 = casadi.fabs(t2112)
     t2114 = (t2113 >= 1)
-    t2115 = casadi.fabs(1/casadi.if_else(t2114, t2112, 1))
+    t2115 = 1/casadi.fabs(casadi.if_else(t2114, t2112, 1))
     t2116 = casadi.if_else(t2111, casadi.if_else((t2112 >= 0), 1, -1)*casadi.if_else(t2114, t2115/(1 + casadi.sqrt(1 + t2115**2)), 1/(t2113 + casadi.sqrt(1 + t2113**2))), 0)
     t2117 = 1/casadi.sqrt(1 + t2116**2)
     t2118 = t2110*t2116
@@ -4712,10 +4712,10 @@ def _condition_number(q):
     t2144 = t2142 + t2116*t2141
     t2145 = t2089*t2124 + t2093*t2128 + t2097*t2132 + t2101*t2136 + t2105*t2140 + t2109*t2144
     t2146 = (t2145 != 0)
-    t2147 = 0.5*(-t2085 + t2120)/casadi.if_else(t2146, t2145, 1)
+    t2147 = (-t2085 + t2120)/casadi.if_else(t2146, 2*t2145, 1)
     t2148 = casadi.fabs(t2147)
     t2149 = (t2148 >= 1)
-    t2150 = casadi.fabs(1/casadi.if_else(t2149, t2147, 1))
+    t2150 = 1/casadi.fabs(casadi.if_else(t2149, t2147, 1))
     t2151 = casadi.if_else(t2146, casadi.if_else((t2147 >= 0), 1, -1)*casadi.if_else(t2149, t2150/(1 + casadi.sqrt(1 + t2150**2)), 1/(t2148 + casadi.sqrt(1 + t2148**2))), 0)
     t2152 = 1/casadi.sqrt(1 + t2151**2)
     t2153 = t2145*t2151
@@ -4746,10 +4746,10 @@ def _condition_number(q):
     t2178 = t2176 - t2151*t2177
     t2179 = t2177 + t2151*t2176
     t2180 = (t1970 != 0)
-    t2181 = 0.5*(-t1804 + t1944)/casadi.if_else(t2180, t1970, 1)
+    t2181 = (-t1804 + t1944)/casadi.if_else(t2180, 2*t1970, 1)
     t2182 = casadi.fabs(t2181)
     t2183 = (t2182 >= 1)
-    t2184 = casadi.fabs(1/casadi.if_else(t2183, t2181, 1))
+    t2184 = 1/casadi.fabs(casadi.if_else(t2183, t2181, 1))
     t2185 = casadi.if_else(t2180, casadi.if_else((t2181 >= 0), 1, -1)*casadi.if_else(t2183, t2184/(1 + casadi.sqrt(1 + t2184**2)), 1/(t2182 + casadi.sqrt(1 + t2182**2))), 0)
     t2186 = 1/casadi.sqrt(1 + t2185**2)
     t2187 = t1970*t2185
@@ -4781,10 +4781,10 @@ def _condition_number(q):
     t2213 = t2211 + t2185*t2210
     t2214 = t2054*t2192 + t2058*t2196 + t2062*t2200 + t2066*t2204 + t2070*t2208 + t2074*t2212
     t2215 = (t2214 != 0)
-    t2216 = 0.5*(-t2188 + t2050)/casadi.if_else(t2215, t2214, 1)
+    t2216 = (-t2188 + t2050)/casadi.if_else(t2215, 2*t2214, 1)
     t2217 = casadi.fabs(t2216)
     t2218 = (t2217 >= 1)
-    t2219 = casadi.fabs(1/casadi.if_else(t2218, t2216, 1))
+    t2219 = 1/casadi.fabs(casadi.if_else(t2218, t2216, 1))
     t2220 = casadi.if_else(t2215, casadi.if_else((t2216 >= 0), 1, -1)*casadi.if_else(t2218, t2219/(1 + casadi.sqrt(1 + t2219**2)), 1/(t2217 + casadi.sqrt(1 + t2217**2))), 0)
     t2221 = 1/casadi.sqrt(1 + t2220**2)
     t2222 = t2214*t2220
@@ -4817,10 +4817,10 @@ def _condition_number(q):
     t2249 = t2123*t2227 + t2127*t2231 + t2131*t2235 + t2135*t2239 + t2139*t2243 + t2143*t2247
     t2250 = t2193*t2228 + t2197*t2232 + t2201*t2236 + t2205*t2240 + t2209*t2244 + t2213*t2248
     t2251 = (t2249 != 0)
-    t2252 = 0.5*(-t2223 + t2119)/casadi.if_else(t2251, t2249, 1)
+    t2252 = (-t2223 + t2119)/casadi.if_else(t2251, 2*t2249, 1)
     t2253 = casadi.fabs(t2252)
     t2254 = (t2253 >= 1)
-    t2255 = casadi.fabs(1/casadi.if_else(t2254, t2252, 1))
+    t2255 = 1/casadi.fabs(casadi.if_else(t2254, t2252, 1))
     t2256 = casadi.if_else(t2251, casadi.if_else((t2252 >= 0), 1, -1)*casadi.if_else(t2254, t2255/(1 + casadi.sqrt(1 + t2255**2)), 1/(t2253 + casadi.sqrt(1 + t2253**2))), 0)
     t2257 = 1/casadi.sqrt(1 + t2256**2)
     t2258 = t2249*t2256
@@ -4852,10 +4852,10 @@ def _condition_number(q):
     t2284 = t2282 + t2256*t2281
     t2285 = t2158*t2263 + t2162*t2267 + t2166*t2271 + t2170*t2275 + t2174*t2279 + t2178*t2283
     t2286 = (t2285 != 0)
-    t2287 = 0.5*(-t2259 + t2154)/casadi.if_else(t2286, t2285, 1)
+    t2287 = (-t2259 + t2154)/casadi.if_else(t2286, 2*t2285, 1)
     t2288 = casadi.fabs(t2287)
     t2289 = (t2288 >= 1)
-    t2290 = casadi.fabs(1/casadi.if_else(t2289, t2287, 1))
+    t2290 = 1/casadi.fabs(casadi.if_else(t2289, t2287, 1))
     t2291 = casadi.if_else(t2286, casadi.if_else((t2287 >= 0), 1, -1)*casadi.if_else(t2289, t2290/(1 + casadi.sqrt(1 + t2290**2)), 1/(t2288 + casadi.sqrt(1 + t2288**2))), 0)
     t2292 = 1/casadi.sqrt(1 + t2291**2)
     t2293 = t2285*t2291
@@ -4887,10 +4887,10 @@ def _condition_number(q):
     t2319 = t2317 + t2291*t2316
     t2320 = t2159*t2298 + t2163*t2302 + t2167*t2306 + t2171*t2310 + t2175*t2314 + t2179*t2318
     t2321 = (t2320 != 0)
-    t2322 = 0.5*(-t2294 + t2155)/casadi.if_else(t2321, t2320, 1)
+    t2322 = (-t2294 + t2155)/casadi.if_else(t2321, 2*t2320, 1)
     t2323 = casadi.fabs(t2322)
     t2324 = (t2323 >= 1)
-    t2325 = casadi.fabs(1/casadi.if_else(t2324, t2322, 1))
+    t2325 = 1/casadi.fabs(casadi.if_else(t2324, t2322, 1))
     t2326 = casadi.if_else(t2321, casadi.if_else((t2322 >= 0), 1, -1)*casadi.if_else(t2324, t2325/(1 + casadi.sqrt(1 + t2325**2)), 1/(t2323 + casadi.sqrt(1 + t2323**2))), 0)
     t2327 = 1/casadi.sqrt(1 + t2326**2)
     t2328 = t2320*t2326
@@ -4921,10 +4921,10 @@ def _condition_number(q):
     t2353 = t2351 - t2326*t2352
     t2354 = t2352 + t2326*t2351
     t2355 = (t2250 != 0)
-    t2356 = 0.5*(-t2189 + t2224)/casadi.if_else(t2355, t2250, 1)
+    t2356 = (-t2189 + t2224)/casadi.if_else(t2355, 2*t2250, 1)
     t2357 = casadi.fabs(t2356)
     t2358 = (t2357 >= 1)
-    t2359 = casadi.fabs(1/casadi.if_else(t2358, t2356, 1))
+    t2359 = 1/casadi.fabs(casadi.if_else(t2358, t2356, 1))
     t2360 = casadi.if_else(t2355, casadi.if_else((t2356 >= 0), 1, -1)*casadi.if_else(t2358, t2359/(1 + casadi.sqrt(1 + t2359**2)), 1/(t2357 + casadi.sqrt(1 + t2357**2))), 0)
     t2361 = 1/casadi.sqrt(1 + t2360**2)
     t2362 = t2250*t2360
@@ -4956,10 +4956,10 @@ def _condition_number(q):
     t2388 = t2386 + t2360*t2385
     t2389 = t2264*t2367 + t2268*t2371 + t2272*t2375 + t2276*t2379 + t2280*t2383 + t2284*t2387
     t2390 = (t2389 != 0)
-    t2391 = 0.5*(-t2363 + t2260)/casadi.if_else(t2390, t2389, 1)
+    t2391 = (-t2363 + t2260)/casadi.if_else(t2390, 2*t2389, 1)
     t2392 = casadi.fabs(t2391)
     t2393 = (t2392 >= 1)
-    t2394 = casadi.fabs(1/casadi.if_else(t2393, t2391, 1))
+    t2394 = 1/casadi.fabs(casadi.if_else(t2393, t2391, 1))
     t2395 = casadi.if_else(t2390, casadi.if_else((t2391 >= 0), 1, -1)*casadi.if_else(t2393, t2394/(1 + casadi.sqrt(1 + t2394**2)), 1/(t2392 + casadi.sqrt(1 + t2392**2))), 0)
     t2396 = 1/casadi.sqrt(1 + t2395**2)
     t2397 = t2389*t2395
@@ -4992,10 +4992,10 @@ def _condition_number(q):
     t2424 = t2299*t2402 + t2303*t2406 + t2307*t2410 + t2311*t2414 + t2315*t2418 + t2319*t2422
     t2425 = t2368*t2403 + t2372*t2407 + t2376*t2411 + t2380*t2415 + t2384*t2419 + t2388*t2423
     t2426 = (t2424 != 0)
-    t2427 = 0.5*(-t2398 + t2295)/casadi.if_else(t2426, t2424, 1)
+    t2427 = (-t2398 + t2295)/casadi.if_else(t2426, 2*t2424, 1)
     t2428 = casadi.fabs(t2427)
     t2429 = (t2428 >= 1)
-    t2430 = casadi.fabs(1/casadi.if_else(t2429, t2427, 1))
+    t2430 = 1/casadi.fabs(casadi.if_else(t2429, t2427, 1))
     t2431 = casadi.if_else(t2426, casadi.if_else((t2427 >= 0), 1, -1)*casadi.if_else(t2429, t2430/(1 + casadi.sqrt(1 + t2430**2)), 1/(t2428 + casadi.sqrt(1 + t2428**2))), 0)
     t2432 = 1/casadi.sqrt(1 + t2431**2)
     t2433 = t2424*t2431
@@ -5027,10 +5027,10 @@ def _condition_number(q):
     t2459 = t2457 + t2431*t2456
     t2460 = t2334*t2438 + t2338*t2442 + t2342*t2446 + t2346*t2450 + t2350*t2454 + t2354*t2458
     t2461 = (t2460 != 0)
-    t2462 = 0.5*(-t2434 + t2330)/casadi.if_else(t2461, t2460, 1)
+    t2462 = (-t2434 + t2330)/casadi.if_else(t2461, 2*t2460, 1)
     t2463 = casadi.fabs(t2462)
     t2464 = (t2463 >= 1)
-    t2465 = casadi.fabs(1/casadi.if_else(t2464, t2462, 1))
+    t2465 = 1/casadi.fabs(casadi.if_else(t2464, t2462, 1))
     t2466 = casadi.if_else(t2461, casadi.if_else((t2462 >= 0), 1, -1)*casadi.if_else(t2464, t2465/(1 + casadi.sqrt(1 + t2465**2)), 1/(t2463 + casadi.sqrt(1 + t2463**2))), 0)
     t2467 = 1/casadi.sqrt(1 + t2466**2)
     t2468 = t2460*t2466
@@ -5062,10 +5062,10 @@ def _condition_number(q):
     t2494 = t2492 + t2466*t2491
     t2495 = t2333*t2473 + t2337*t2477 + t2341*t2481 + t2345*t2485 + t2349*t2489 + t2353*t2493
     t2496 = (t2425 != 0)
-    t2497 = 0.5*(-t2364 + t2399)/casadi.if_else(t2496, t2425, 1)
+    t2497 = (-t2364 + t2399)/casadi.if_else(t2496, 2*t2425, 1)
     t2498 = casadi.fabs(t2497)
     t2499 = (t2498 >= 1)
-    t2500 = casadi.fabs(1/casadi.if_else(t2499, t2497, 1))
+    t2500 = 1/casadi.fabs(casadi.if_else(t2499, t2497, 1))
     t2501 = casadi.if_else(t2496, casadi.if_else((t2497 >= 0), 1, -1)*casadi.if_else(t2499, t2500/(1 + casadi.sqrt(1 + t2500**2)), 1/(t2498 + casadi.sqrt(1 + t2498**2))), 0)
     t2502 = 1/casadi.sqrt(1 + t2501**2)
     t2503 = t2425*t2501
@@ -5097,10 +5097,10 @@ def _condition_number(q):
     t2529 = t2527 + t2501*t2526
     t2530 = t2439*t2508 + t2443*t2512 + t2447*t2516 + t2451*t2520 + t2455*t2524 + t2459*t2528
     t2531 = (t2530 != 0)
-    t2532 = 0.5*(-t2504 + t2435)/casadi.if_else(t2531, t2530, 1)
+    t2532 = (-t2504 + t2435)/casadi.if_else(t2531, 2*t2530, 1)
     t2533 = casadi.fabs(t2532)
     t2534 = (t2533 >= 1)
-    t2535 = casadi.fabs(1/casadi.if_else(t2534, t2532, 1))
+    t2535 = 1/casadi.fabs(casadi.if_else(t2534, t2532, 1))
     t2536 = casadi.if_else(t2531, casadi.if_else((t2532 >= 0), 1, -1)*casadi.if_else(t2534, t2535/(1 + casadi.sqrt(1 + t2535**2)), 1/(t2533 + casadi.sqrt(1 + t2533**2))), 0)
     t2537 = 1/casadi.sqrt(1 + t2536**2)
     t2538 = t2530*t2536
@@ -5133,10 +5133,10 @@ def _condition_number(q):
     t2565 = t2474*t2543 + t2478*t2547 + t2482*t2551 + t2486*t2555 + t2490*t2559 + t2494*t2563
     t2566 = t2509*t2544 + t2513*t2548 + t2517*t2552 + t2521*t2556 + t2525*t2560 + t2529*t2564
     t2567 = (t2565 != 0)
-    t2568 = 0.5*(-t2539 + t2470)/casadi.if_else(t2567, t2565, 1)
+    t2568 = (-t2539 + t2470)/casadi.if_else(t2567, 2*t2565, 1)
     t2569 = casadi.fabs(t2568)
     t2570 = (t2569 >= 1)
-    t2571 = casadi.fabs(1/casadi.if_else(t2570, t2568, 1))
+    t2571 = 1/casadi.fabs(casadi.if_else(t2570, t2568, 1))
     t2572 = casadi.if_else(t2567, casadi.if_else((t2568 >= 0), 1, -1)*casadi.if_else(t2570, t2571/(1 + casadi.sqrt(1 + t2571**2)), 1/(t2569 + casadi.sqrt(1 + t2569**2))), 0)
     t2573 = 1/casadi.sqrt(1 + t2572**2)
     t2574 = t2565*t2572
@@ -5167,10 +5167,10 @@ def _condition_number(q):
     t2599 = t2597 - t2572*t2598
     t2600 = t2598 + t2572*t2597
     t2601 = (t2566 != 0)
-    t2602 = 0.5*(-t2505 + t2540)/casadi.if_else(t2601, t2566, 1)
+    t2602 = (-t2505 + t2540)/casadi.if_else(t2601, 2*t2566, 1)
     t2603 = casadi.fabs(t2602)
     t2604 = (t2603 >= 1)
-    t2605 = casadi.fabs(1/casadi.if_else(t2604, t2602, 1))
+    t2605 = 1/casadi.fabs(casadi.if_else(t2604, t2602, 1))
     t2606 = casadi.if_else(t2601, casadi.if_else((t2602 >= 0), 1, -1)*casadi.if_else(t2604, t2605/(1 + casadi.sqrt(1 + t2605**2)), 1/(t2603 + casadi.sqrt(1 + t2603**2))), 0)
     t2607 = 1/casadi.sqrt(1 + t2606**2)
     t2608 = t2566*t2606
@@ -5202,10 +5202,10 @@ def _condition_number(q):
     t2634 = t2632 + t2606*t2631
     t2635 = t2580*t2613 + t2584*t2617 + t2588*t2621 + t2592*t2625 + t2596*t2629 + t2600*t2633
     t2636 = (t2635 != 0)
-    t2637 = 0.5*(-t2609 + t2576)/casadi.if_else(t2636, t2635, 1)
+    t2637 = (-t2609 + t2576)/casadi.if_else(t2636, 2*t2635, 1)
     t2638 = casadi.fabs(t2637)
     t2639 = (t2638 >= 1)
-    t2640 = casadi.fabs(1/casadi.if_else(t2639, t2637, 1))
+    t2640 = 1/casadi.fabs(casadi.if_else(t2639, t2637, 1))
     t2641 = casadi.if_else(t2636, casadi.if_else((t2637 >= 0), 1, -1)*casadi.if_else(t2639, t2640/(1 + casadi.sqrt(1 + t2640**2)), 1/(t2638 + casadi.sqrt(1 + t2638**2))), 0)
     t2642 = 1/casadi.sqrt(1 + t2641**2)
     t2643 = t2635*t2641
@@ -5237,10 +5237,10 @@ def _condition_number(q):
     t2669 = t2667 + t2641*t2666
     t2670 = t2614*t2649 + t2618*t2653 + t2622*t2657 + t2626*t2661 + t2630*t2665 + t2634*t2669
     t2671 = (t2670 != 0)
-    t2672 = 0.5*(-t2610 + t2645)/casadi.if_else(t2671, t2670, 1)
+    t2672 = (-t2610 + t2645)/casadi.if_else(t2671, 2*t2670, 1)
     t2673 = casadi.fabs(t2672)
     t2674 = (t2673 >= 1)
-    t2675 = casadi.fabs(1/casadi.if_else(t2674, t2672, 1))
+    t2675 = 1/casadi.fabs(casadi.if_else(t2674, t2672, 1))
     t2676 = casadi.if_else(t2671, casadi.if_else((t2672 >= 0), 1, -1)*casadi.if_else(t2674, t2675/(1 + casadi.sqrt(1 + t2675**2)), 1/(t2673 + casadi.sqrt(1 + t2673**2))), 0)
     t2677 = 1/casadi.sqrt(1 + t2676**2)
     t2678 = t2670*t2676
@@ -5271,10 +5271,10 @@ def _condition_number(q):
     t2703 = t2701 - t2676*t2702
     t2704 = t2702 + t2676*t2701
     t2705 = (t2495 != 0)
-    t2706 = 0.5*(-t2329 + t2469)/casadi.if_else(t2705, t2495, 1)
+    t2706 = (-t2329 + t2469)/casadi.if_else(t2705, 2*t2495, 1)
     t2707 = casadi.fabs(t2706)
     t2708 = (t2707 >= 1)
-    t2709 = casadi.fabs(1/casadi.if_else(t2708, t2706, 1))
+    t2709 = 1/casadi.fabs(casadi.if_else(t2708, t2706, 1))
     t2710 = casadi.if_else(t2705, casadi.if_else((t2706 >= 0), 1, -1)*casadi.if_else(t2708, t2709/(1 + casadi.sqrt(1 + t2709**2)), 1/(t2707 + casadi.sqrt(1 + t2707**2))), 0)
     t2711 = 1/casadi.sqrt(1 + t2710**2)
     t2712 = t2495*t2710
@@ -5306,10 +5306,10 @@ def _condition_number(q):
     t2738 = t2736 + t2710*t2735
     t2739 = t2579*t2717 + t2583*t2721 + t2587*t2725 + t2591*t2729 + t2595*t2733 + t2599*t2737
     t2740 = (t2739 != 0)
-    t2741 = 0.5*(-t2713 + t2575)/casadi.if_else(t2740, t2739, 1)
+    t2741 = (-t2713 + t2575)/casadi.if_else(t2740, 2*t2739, 1)
     t2742 = casadi.fabs(t2741)
     t2743 = (t2742 >= 1)
-    t2744 = casadi.fabs(1/casadi.if_else(t2743, t2741, 1))
+    t2744 = 1/casadi.fabs(casadi.if_else(t2743, t2741, 1))
     t2745 = casadi.if_else(t2740, casadi.if_else((t2741 >= 0), 1, -1)*casadi.if_else(t2743, t2744/(1 + casadi.sqrt(1 + t2744**2)), 1/(t2742 + casadi.sqrt(1 + t2742**2))), 0)
     t2746 = 1/casadi.sqrt(1 + t2745**2)
     t2747 = t2739*t2745
@@ -5342,10 +5342,10 @@ def _condition_number(q):
     t2774 = t2648*t2752 + t2652*t2756 + t2656*t2760 + t2660*t2764 + t2664*t2768 + t2668*t2772
     t2775 = t2718*t2753 + t2722*t2757 + t2726*t2761 + t2730*t2765 + t2734*t2769 + t2738*t2773
     t2776 = (t2774 != 0)
-    t2777 = 0.5*(-t2748 + t2644)/casadi.if_else(t2776, t2774, 1)
+    t2777 = (-t2748 + t2644)/casadi.if_else(t2776, 2*t2774, 1)
     t2778 = casadi.fabs(t2777)
     t2779 = (t2778 >= 1)
-    t2780 = casadi.fabs(1/casadi.if_else(t2779, t2777, 1))
+    t2780 = 1/casadi.fabs(casadi.if_else(t2779, t2777, 1))
     t2781 = casadi.if_else(t2776, casadi.if_else((t2777 >= 0), 1, -1)*casadi.if_else(t2779, t2780/(1 + casadi.sqrt(1 + t2780**2)), 1/(t2778 + casadi.sqrt(1 + t2778**2))), 0)
     t2782 = 1/casadi.sqrt(1 + t2781**2)
     t2783 = t2774*t2781
@@ -5377,10 +5377,10 @@ def _condition_number(q):
     t2809 = t2807 + t2781*t2806
     t2810 = t2683*t2788 + t2687*t2792 + t2691*t2796 + t2695*t2800 + t2699*t2804 + t2703*t2808
     t2811 = (t2810 != 0)
-    t2812 = 0.5*(-t2784 + t2679)/casadi.if_else(t2811, t2810, 1)
+    t2812 = (-t2784 + t2679)/casadi.if_else(t2811, 2*t2810, 1)
     t2813 = casadi.fabs(t2812)
     t2814 = (t2813 >= 1)
-    t2815 = casadi.fabs(1/casadi.if_else(t2814, t2812, 1))
+    t2815 = 1/casadi.fabs(casadi.if_else(t2814, t2812, 1))
     t2816 = casadi.if_else(t2811, casadi.if_else((t2812 >= 0), 1, -1)*casadi.if_else(t2814, t2815/(1 + casadi.sqrt(1 + t2815**2)), 1/(t2813 + casadi.sqrt(1 + t2813**2))), 0)
     t2817 = 1/casadi.sqrt(1 + t2816**2)
     t2818 = t2810*t2816
@@ -5412,10 +5412,10 @@ def _condition_number(q):
     t2844 = t2842 + t2816*t2841
     t2845 = t2684*t2823 + t2688*t2827 + t2692*t2831 + t2696*t2835 + t2700*t2839 + t2704*t2843
     t2846 = (t2845 != 0)
-    t2847 = 0.5*(-t2819 + t2680)/casadi.if_else(t2846, t2845, 1)
+    t2847 = (-t2819 + t2680)/casadi.if_else(t2846, 2*t2845, 1)
     t2848 = casadi.fabs(t2847)
     t2849 = (t2848 >= 1)
-    t2850 = casadi.fabs(1/casadi.if_else(t2849, t2847, 1))
+    t2850 = 1/casadi.fabs(casadi.if_else(t2849, t2847, 1))
     t2851 = casadi.if_else(t2846, casadi.if_else((t2847 >= 0), 1, -1)*casadi.if_else(t2849, t2850/(1 + casadi.sqrt(1 + t2850**2)), 1/(t2848 + casadi.sqrt(1 + t2848**2))), 0)
     t2852 = 1/casadi.sqrt(1 + t2851**2)
     t2853 = t2845*t2851
@@ -5446,10 +5446,10 @@ def _condition_number(q):
     t2878 = t2876 - t2851*t2877
     t2879 = t2877 + t2851*t2876
     t2880 = (t2775 != 0)
-    t2881 = 0.5*(-t2714 + t2749)/casadi.if_else(t2880, t2775, 1)
+    t2881 = (-t2714 + t2749)/casadi.if_else(t2880, 2*t2775, 1)
     t2882 = casadi.fabs(t2881)
     t2883 = (t2882 >= 1)
-    t2884 = casadi.fabs(1/casadi.if_else(t2883, t2881, 1))
+    t2884 = 1/casadi.fabs(casadi.if_else(t2883, t2881, 1))
     t2885 = casadi.if_else(t2880, casadi.if_else((t2881 >= 0), 1, -1)*casadi.if_else(t2883, t2884/(1 + casadi.sqrt(1 + t2884**2)), 1/(t2882 + casadi.sqrt(1 + t2882**2))), 0)
     t2886 = 1/casadi.sqrt(1 + t2885**2)
     t2887 = t2775*t2885
@@ -5481,10 +5481,10 @@ def _condition_number(q):
     t2913 = t2911 + t2885*t2910
     t2914 = t2789*t2892 + t2793*t2896 + t2797*t2900 + t2801*t2904 + t2805*t2908 + t2809*t2912
     t2915 = (t2914 != 0)
-    t2916 = 0.5*(-t2888 + t2785)/casadi.if_else(t2915, t2914, 1)
+    t2916 = (-t2888 + t2785)/casadi.if_else(t2915, 2*t2914, 1)
     t2917 = casadi.fabs(t2916)
     t2918 = (t2917 >= 1)
-    t2919 = casadi.fabs(1/casadi.if_else(t2918, t2916, 1))
+    t2919 = 1/casadi.fabs(casadi.if_else(t2918, t2916, 1))
     t2920 = casadi.if_else(t2915, casadi.if_else((t2916 >= 0), 1, -1)*casadi.if_else(t2918, t2919/(1 + casadi.sqrt(1 + t2919**2)), 1/(t2917 + casadi.sqrt(1 + t2917**2))), 0)
     t2921 = 1/casadi.sqrt(1 + t2920**2)
     t2922 = t2914*t2920
@@ -5517,10 +5517,10 @@ def _condition_number(q):
     t2949 = t2824*t2927 + t2828*t2931 + t2832*t2935 + t2836*t2939 + t2840*t2943 + t2844*t2947
     t2950 = t2893*t2928 + t2897*t2932 + t2901*t2936 + t2905*t2940 + t2909*t2944 + t2913*t2948
     t2951 = (t2949 != 0)
-    t2952 = 0.5*(-t2923 + t2820)/casadi.if_else(t2951, t2949, 1)
+    t2952 = (-t2923 + t2820)/casadi.if_else(t2951, 2*t2949, 1)
     t2953 = casadi.fabs(t2952)
     t2954 = (t2953 >= 1)
-    t2955 = casadi.fabs(1/casadi.if_else(t2954, t2952, 1))
+    t2955 = 1/casadi.fabs(casadi.if_else(t2954, t2952, 1))
     t2956 = casadi.if_else(t2951, casadi.if_else((t2952 >= 0), 1, -1)*casadi.if_else(t2954, t2955/(1 + casadi.sqrt(1 + t2955**2)), 1/(t2953 + casadi.sqrt(1 + t2953**2))), 0)
     t2957 = 1/casadi.sqrt(1 + t2956**2)
     t2958 = t2949*t2956
@@ -5552,10 +5552,10 @@ def _condition_number(q):
     t2984 = t2982 + t2956*t2981
     t2985 = t2859*t2963 + t2863*t2967 + t2867*t2971 + t2871*t2975 + t2875*t2979 + t2879*t2983
     t2986 = (t2985 != 0)
-    t2987 = 0.5*(-t2959 + t2855)/casadi.if_else(t2986, t2985, 1)
+    t2987 = (-t2959 + t2855)/casadi.if_else(t2986, 2*t2985, 1)
     t2988 = casadi.fabs(t2987)
     t2989 = (t2988 >= 1)
-    t2990 = casadi.fabs(1/casadi.if_else(t2989, t2987, 1))
+    t2990 = 1/casadi.fabs(casadi.if_else(t2989, t2987, 1))
     t2991 = casadi.if_else(t2986, casadi.if_else((t2987 >= 0), 1, -1)*casadi.if_else(t2989, t2990/(1 + casadi.sqrt(1 + t2990**2)), 1/(t2988 + casadi.sqrt(1 + t2988**2))), 0)
     t2992 = 1/casadi.sqrt(1 + t2991**2)
     t2993 = t2985*t2991
@@ -5587,10 +5587,10 @@ def _condition_number(q):
     t3019 = t3017 + t2991*t3016
     t3020 = t2858*t2998 + t2862*t3002 + t2866*t3006 + t2870*t3010 + t2874*t3014 + t2878*t3018
     t3021 = (t2950 != 0)
-    t3022 = 0.5*(-t2889 + t2924)/casadi.if_else(t3021, t2950, 1)
+    t3022 = (-t2889 + t2924)/casadi.if_else(t3021, 2*t2950, 1)
     t3023 = casadi.fabs(t3022)
     t3024 = (t3023 >= 1)
-    t3025 = casadi.fabs(1/casadi.if_else(t3024, t3022, 1))
+    t3025 = 1/casadi.fabs(casadi.if_else(t3024, t3022, 1))
     t3026 = casadi.if_else(t3021, casadi.if_else((t3022 >= 0), 1, -1)*casadi.if_else(t3024, t3025/(1 + casadi.sqrt(1 + t3025**2)), 1/(t3023 + casadi.sqrt(1 + t3023**2))), 0)
     t3027 = 1/casadi.sqrt(1 + t3026**2)
     t3028 = t2950*t3026
@@ -5622,10 +5622,10 @@ def _condition_number(q):
     t3054 = t3052 + t3026*t3051
     t3055 = t2964*t3033 + t2968*t3037 + t2972*t3041 + t2976*t3045 + t2980*t3049 + t2984*t3053
     t3056 = (t3055 != 0)
-    t3057 = 0.5*(-t3029 + t2960)/casadi.if_else(t3056, t3055, 1)
+    t3057 = (-t3029 + t2960)/casadi.if_else(t3056, 2*t3055, 1)
     t3058 = casadi.fabs(t3057)
     t3059 = (t3058 >= 1)
-    t3060 = casadi.fabs(1/casadi.if_else(t3059, t3057, 1))
+    t3060 = 1/casadi.fabs(casadi.if_else(t3059, t3057, 1))
     t3061 = casadi.if_else(t3056, casadi.if_else((t3057 >= 0), 1, -1)*casadi.if_else(t3059, t3060/(1 + casadi.sqrt(1 + t3060**2)), 1/(t3058 + casadi.sqrt(1 + t3058**2))), 0)
     t3062 = 1/casadi.sqrt(1 + t3061**2)
     t3063 = t3055*t3061
@@ -5658,10 +5658,10 @@ def _condition_number(q):
     t3090 = t2999*t3068 + t3003*t3072 + t3007*t3076 + t3011*t3080 + t3015*t3084 + t3019*t3088
     t3091 = t3034*t3069 + t3038*t3073 + t3042*t3077 + t3046*t3081 + t3050*t3085 + t3054*t3089
     t3092 = (t3090 != 0)
-    t3093 = 0.5*(-t3064 + t2995)/casadi.if_else(t3092, t3090, 1)
+    t3093 = (-t3064 + t2995)/casadi.if_else(t3092, 2*t3090, 1)
     t3094 = casadi.fabs(t3093)
     t3095 = (t3094 >= 1)
-    t3096 = casadi.fabs(1/casadi.if_else(t3095, t3093, 1))
+    t3096 = 1/casadi.fabs(casadi.if_else(t3095, t3093, 1))
     t3097 = casadi.if_else(t3092, casadi.if_else((t3093 >= 0), 1, -1)*casadi.if_else(t3095, t3096/(1 + casadi.sqrt(1 + t3096**2)), 1/(t3094 + casadi.sqrt(1 + t3094**2))), 0)
     t3098 = 1/casadi.sqrt(1 + t3097**2)
     t3099 = t3090*t3097
@@ -5692,10 +5692,10 @@ def _condition_number(q):
     t3124 = t3122 - t3097*t3123
     t3125 = t3123 + t3097*t3122
     t3126 = (t3091 != 0)
-    t3127 = 0.5*(-t3030 + t3065)/casadi.if_else(t3126, t3091, 1)
+    t3127 = (-t3030 + t3065)/casadi.if_else(t3126, 2*t3091, 1)
     t3128 = casadi.fabs(t3127)
     t3129 = (t3128 >= 1)
-    t3130 = casadi.fabs(1/casadi.if_else(t3129, t3127, 1))
+    t3130 = 1/casadi.fabs(casadi.if_else(t3129, t3127, 1))
     t3131 = casadi.if_else(t3126, casadi.if_else((t3127 >= 0), 1, -1)*casadi.if_else(t3129, t3130/(1 + casadi.sqrt(1 + t3130**2)), 1/(t3128 + casadi.sqrt(1 + t3128**2))), 0)
     t3132 = 1/casadi.sqrt(1 + t3131**2)
     t3133 = t3091*t3131
@@ -5727,10 +5727,10 @@ def _condition_number(q):
     t3159 = t3157 + t3131*t3156
     t3160 = t3105*t3138 + t3109*t3142 + t3113*t3146 + t3117*t3150 + t3121*t3154 + t3125*t3158
     t3161 = (t3160 != 0)
-    t3162 = 0.5*(-t3134 + t3101)/casadi.if_else(t3161, t3160, 1)
+    t3162 = (-t3134 + t3101)/casadi.if_else(t3161, 2*t3160, 1)
     t3163 = casadi.fabs(t3162)
     t3164 = (t3163 >= 1)
-    t3165 = casadi.fabs(1/casadi.if_else(t3164, t3162, 1))
+    t3165 = 1/casadi.fabs(casadi.if_else(t3164, t3162, 1))
     t3166 = casadi.if_else(t3161, casadi.if_else((t3162 >= 0), 1, -1)*casadi.if_else(t3164, t3165/(1 + casadi.sqrt(1 + t3165**2)), 1/(t3163 + casadi.sqrt(1 + t3163**2))), 0)
     t3167 = 1/casadi.sqrt(1 + t3166**2)
     t3168 = t3160*t3166
@@ -5762,10 +5762,10 @@ def _condition_number(q):
     t3194 = t3192 + t3166*t3191
     t3195 = t3139*t3174 + t3143*t3178 + t3147*t3182 + t3151*t3186 + t3155*t3190 + t3159*t3194
     t3196 = (t3195 != 0)
-    t3197 = 0.5*(-t3135 + t3170)/casadi.if_else(t3196, t3195, 1)
+    t3197 = (-t3135 + t3170)/casadi.if_else(t3196, 2*t3195, 1)
     t3198 = casadi.fabs(t3197)
     t3199 = (t3198 >= 1)
-    t3200 = casadi.fabs(1/casadi.if_else(t3199, t3197, 1))
+    t3200 = 1/casadi.fabs(casadi.if_else(t3199, t3197, 1))
     t3201 = casadi.if_else(t3196, casadi.if_else((t3197 >= 0), 1, -1)*casadi.if_else(t3199, t3200/(1 + casadi.sqrt(1 + t3200**2)), 1/(t3198 + casadi.sqrt(1 + t3198**2))), 0)
     t3202 = 1/casadi.sqrt(1 + t3201**2)
     t3203 = t3195*t3201
@@ -5796,10 +5796,10 @@ def _condition_number(q):
     t3228 = t3226 - t3201*t3227
     t3229 = t3227 + t3201*t3226
     t3230 = (t3020 != 0)
-    t3231 = 0.5*(-t2854 + t2994)/casadi.if_else(t3230, t3020, 1)
+    t3231 = (-t2854 + t2994)/casadi.if_else(t3230, 2*t3020, 1)
     t3232 = casadi.fabs(t3231)
     t3233 = (t3232 >= 1)
-    t3234 = casadi.fabs(1/casadi.if_else(t3233, t3231, 1))
+    t3234 = 1/casadi.fabs(casadi.if_else(t3233, t3231, 1))
     t3235 = casadi.if_else(t3230, casadi.if_else((t3231 >= 0), 1, -1)*casadi.if_else(t3233, t3234/(1 + casadi.sqrt(1 + t3234**2)), 1/(t3232 + casadi.sqrt(1 + t3232**2))), 0)
     t3236 = 1/casadi.sqrt(1 + t3235**2)
     t3237 = t3020*t3235
@@ -5831,10 +5831,10 @@ def _condition_number(q):
     t3263 = t3261 + t3235*t3260
     t3264 = t3104*t3242 + t3108*t3246 + t3112*t3250 + t3116*t3254 + t3120*t3258 + t3124*t3262
     t3265 = (t3264 != 0)
-    t3266 = 0.5*(-t3238 + t3100)/casadi.if_else(t3265, t3264, 1)
+    t3266 = (-t3238 + t3100)/casadi.if_else(t3265, 2*t3264, 1)
     t3267 = casadi.fabs(t3266)
     t3268 = (t3267 >= 1)
-    t3269 = casadi.fabs(1/casadi.if_else(t3268, t3266, 1))
+    t3269 = 1/casadi.fabs(casadi.if_else(t3268, t3266, 1))
     t3270 = casadi.if_else(t3265, casadi.if_else((t3266 >= 0), 1, -1)*casadi.if_else(t3268, t3269/(1 + casadi.sqrt(1 + t3269**2)), 1/(t3267 + casadi.sqrt(1 + t3267**2))), 0)
     t3271 = 1/casadi.sqrt(1 + t3270**2)
     t3272 = t3264*t3270
@@ -5867,10 +5867,10 @@ def _condition_number(q):
     t3299 = t3173*t3277 + t3177*t3281 + t3181*t3285 + t3185*t3289 + t3189*t3293 + t3193*t3297
     t3300 = t3243*t3278 + t3247*t3282 + t3251*t3286 + t3255*t3290 + t3259*t3294 + t3263*t3298
     t3301 = (t3299 != 0)
-    t3302 = 0.5*(-t3273 + t3169)/casadi.if_else(t3301, t3299, 1)
+    t3302 = (-t3273 + t3169)/casadi.if_else(t3301, 2*t3299, 1)
     t3303 = casadi.fabs(t3302)
     t3304 = (t3303 >= 1)
-    t3305 = casadi.fabs(1/casadi.if_else(t3304, t3302, 1))
+    t3305 = 1/casadi.fabs(casadi.if_else(t3304, t3302, 1))
     t3306 = casadi.if_else(t3301, casadi.if_else((t3302 >= 0), 1, -1)*casadi.if_else(t3304, t3305/(1 + casadi.sqrt(1 + t3305**2)), 1/(t3303 + casadi.sqrt(1 + t3303**2))), 0)
     t3307 = 1/casadi.sqrt(1 + t3306**2)
     t3308 = t3299*t3306
@@ -5902,10 +5902,10 @@ def _condition_number(q):
     t3334 = t3332 + t3306*t3331
     t3335 = t3208*t3313 + t3212*t3317 + t3216*t3321 + t3220*t3325 + t3224*t3329 + t3228*t3333
     t3336 = (t3335 != 0)
-    t3337 = 0.5*(-t3309 + t3204)/casadi.if_else(t3336, t3335, 1)
+    t3337 = (-t3309 + t3204)/casadi.if_else(t3336, 2*t3335, 1)
     t3338 = casadi.fabs(t3337)
     t3339 = (t3338 >= 1)
-    t3340 = casadi.fabs(1/casadi.if_else(t3339, t3337, 1))
+    t3340 = 1/casadi.fabs(casadi.if_else(t3339, t3337, 1))
     t3341 = casadi.if_else(t3336, casadi.if_else((t3337 >= 0), 1, -1)*casadi.if_else(t3339, t3340/(1 + casadi.sqrt(1 + t3340**2)), 1/(t3338 + casadi.sqrt(1 + t3338**2))), 0)
     t3342 = 1/casadi.sqrt(1 + t3341**2)
     t3343 = t3335*t3341
@@ -5937,10 +5937,10 @@ def _condition_number(q):
     t3369 = t3367 + t3341*t3366
     t3370 = t3209*t3348 + t3213*t3352 + t3217*t3356 + t3221*t3360 + t3225*t3364 + t3229*t3368
     t3371 = (t3370 != 0)
-    t3372 = 0.5*(-t3344 + t3205)/casadi.if_else(t3371, t3370, 1)
+    t3372 = (-t3344 + t3205)/casadi.if_else(t3371, 2*t3370, 1)
     t3373 = casadi.fabs(t3372)
     t3374 = (t3373 >= 1)
-    t3375 = casadi.fabs(1/casadi.if_else(t3374, t3372, 1))
+    t3375 = 1/casadi.fabs(casadi.if_else(t3374, t3372, 1))
     t3376 = casadi.if_else(t3371, casadi.if_else((t3372 >= 0), 1, -1)*casadi.if_else(t3374, t3375/(1 + casadi.sqrt(1 + t3375**2)), 1/(t3373 + casadi.sqrt(1 + t3373**2))), 0)
     t3377 = 1/casadi.sqrt(1 + t3376**2)
     t3378 = t3205 + t3370*t3376
@@ -5970,10 +5970,10 @@ def _condition_number(q):
     t3402 = t3400 + t3376*t3399
     t3403 = casadi.sqrt(t3381**2 + t3385**2 + t3389**2 + t3393**2 + t3397**2 + t3401**2)
     t3404 = (t3300 != 0)
-    t3405 = 0.5*(-t3239 + t3274)/casadi.if_else(t3404, t3300, 1)
+    t3405 = (-t3239 + t3274)/casadi.if_else(t3404, 2*t3300, 1)
     t3406 = casadi.fabs(t3405)
     t3407 = (t3406 >= 1)
-    t3408 = casadi.fabs(1/casadi.if_else(t3407, t3405, 1))
+    t3408 = 1/casadi.fabs(casadi.if_else(t3407, t3405, 1))
     t3409 = casadi.if_else(t3404, casadi.if_else((t3405 >= 0), 1, -1)*casadi.if_else(t3407, t3408/(1 + casadi.sqrt(1 + t3408**2)), 1/(t3406 + casadi.sqrt(1 + t3406**2))), 0)
     t3410 = 1/casadi.sqrt(1 + t3409**2)
     t3411 = t3300*t3409
@@ -6005,10 +6005,10 @@ def _condition_number(q):
     t3437 = t3435 + t3409*t3434
     t3438 = t3314*t3416 + t3318*t3420 + t3322*t3424 + t3326*t3428 + t3330*t3432 + t3334*t3436
     t3439 = (t3438 != 0)
-    t3440 = 0.5*(-t3412 + t3310)/casadi.if_else(t3439, t3438, 1)
+    t3440 = (-t3412 + t3310)/casadi.if_else(t3439, 2*t3438, 1)
     t3441 = casadi.fabs(t3440)
     t3442 = (t3441 >= 1)
-    t3443 = casadi.fabs(1/casadi.if_else(t3442, t3440, 1))
+    t3443 = 1/casadi.fabs(casadi.if_else(t3442, t3440, 1))
     t3444 = casadi.if_else(t3439, casadi.if_else((t3440 >= 0), 1, -1)*casadi.if_else(t3442, t3443/(1 + casadi.sqrt(1 + t3443**2)), 1/(t3441 + casadi.sqrt(1 + t3441**2))), 0)
     t3445 = 1/casadi.sqrt(1 + t3444**2)
     t3446 = t3438*t3444
@@ -6041,10 +6041,10 @@ def _condition_number(q):
     t3473 = t3349*t3451 + t3353*t3455 + t3357*t3459 + t3361*t3463 + t3365*t3467 + t3369*t3471
     t3474 = t3417*t3452 + t3421*t3456 + t3425*t3460 + t3429*t3464 + t3433*t3468 + t3437*t3472
     t3475 = (t3473 != 0)
-    t3476 = 0.5*(-t3447 + t3345)/casadi.if_else(t3475, t3473, 1)
+    t3476 = (-t3447 + t3345)/casadi.if_else(t3475, 2*t3473, 1)
     t3477 = casadi.fabs(t3476)
     t3478 = (t3477 >= 1)
-    t3479 = casadi.fabs(1/casadi.if_else(t3478, t3476, 1))
+    t3479 = 1/casadi.fabs(casadi.if_else(t3478, t3476, 1))
     t3480 = casadi.if_else(t3475, casadi.if_else((t3476 >= 0), 1, -1)*casadi.if_else(t3478, t3479/(1 + casadi.sqrt(1 + t3479**2)), 1/(t3477 + casadi.sqrt(1 + t3477**2))), 0)
     t3481 = 1/casadi.sqrt(1 + t3480**2)
     t3482 = t3473*t3480
@@ -6076,10 +6076,10 @@ def _condition_number(q):
     t3508 = t3506 + t3480*t3505
     t3509 = t3382*t3487 + t3386*t3491 + t3390*t3495 + t3394*t3499 + t3398*t3503 + t3402*t3507
     t3510 = (t3509 != 0)
-    t3511 = 0.5*(-t3483 + t3378)/casadi.if_else(t3510, t3509, 1)
+    t3511 = (-t3483 + t3378)/casadi.if_else(t3510, 2*t3509, 1)
     t3512 = casadi.fabs(t3511)
     t3513 = (t3512 >= 1)
-    t3514 = casadi.fabs(1/casadi.if_else(t3513, t3511, 1))
+    t3514 = 1/casadi.fabs(casadi.if_else(t3513, t3511, 1))
     t3515 = casadi.if_else(t3510, casadi.if_else((t3511 >= 0), 1, -1)*casadi.if_else(t3513, t3514/(1 + casadi.sqrt(1 + t3514**2)), 1/(t3512 + casadi.sqrt(1 + t3512**2))), 0)
     t3516 = 1/casadi.sqrt(1 + t3515**2)
     t3517 = t3378 + t3509*t3515
@@ -6111,10 +6111,10 @@ def _condition_number(q):
     t3543 = casadi.if_else((t3542 > t3403), t3542, t3403)
     t3544 = casadi.if_else((t3542 < t3403), t3542, t3403)
     t3545 = (t3474 != 0)
-    t3546 = 0.5*(-t3413 + t3448)/casadi.if_else(t3545, t3474, 1)
+    t3546 = (-t3413 + t3448)/casadi.if_else(t3545, 2*t3474, 1)
     t3547 = casadi.fabs(t3546)
     t3548 = (t3547 >= 1)
-    t3549 = casadi.fabs(1/casadi.if_else(t3548, t3546, 1))
+    t3549 = 1/casadi.fabs(casadi.if_else(t3548, t3546, 1))
     t3550 = casadi.if_else(t3545, casadi.if_else((t3546 >= 0), 1, -1)*casadi.if_else(t3548, t3549/(1 + casadi.sqrt(1 + t3549**2)), 1/(t3547 + casadi.sqrt(1 + t3547**2))), 0)
     t3551 = 1/casadi.sqrt(1 + t3550**2)
     t3552 = t3474*t3550
@@ -6146,10 +6146,10 @@ def _condition_number(q):
     t3578 = t3576 + t3550*t3575
     t3579 = t3488*t3557 + t3492*t3561 + t3496*t3565 + t3500*t3569 + t3504*t3573 + t3508*t3577
     t3580 = (t3579 != 0)
-    t3581 = 0.5*(-t3553 + t3484)/casadi.if_else(t3580, t3579, 1)
+    t3581 = (-t3553 + t3484)/casadi.if_else(t3580, 2*t3579, 1)
     t3582 = casadi.fabs(t3581)
     t3583 = (t3582 >= 1)
-    t3584 = casadi.fabs(1/casadi.if_else(t3583, t3581, 1))
+    t3584 = 1/casadi.fabs(casadi.if_else(t3583, t3581, 1))
     t3585 = casadi.if_else(t3580, casadi.if_else((t3581 >= 0), 1, -1)*casadi.if_else(t3583, t3584/(1 + casadi.sqrt(1 + t3584**2)), 1/(t3582 + casadi.sqrt(1 + t3582**2))), 0)
     t3586 = 1/casadi.sqrt(1 + t3585**2)
     t3587 = t3579*t3585
@@ -6182,10 +6182,10 @@ def _condition_number(q):
     t3614 = t3521*t3592 + t3525*t3596 + t3529*t3600 + t3533*t3604 + t3537*t3608 + t3541*t3612
     t3615 = t3558*t3593 + t3562*t3597 + t3566*t3601 + t3570*t3605 + t3574*t3609 + t3578*t3613
     t3616 = (t3614 != 0)
-    t3617 = 0.5*(-t3588 + t3517)/casadi.if_else(t3616, t3614, 1)
+    t3617 = (-t3588 + t3517)/casadi.if_else(t3616, 2*t3614, 1)
     t3618 = casadi.fabs(t3617)
     t3619 = (t3618 >= 1)
-    t3620 = casadi.fabs(1/casadi.if_else(t3619, t3617, 1))
+    t3620 = 1/casadi.fabs(casadi.if_else(t3619, t3617, 1))
     t3621 = casadi.if_else(t3616, casadi.if_else((t3617 >= 0), 1, -1)*casadi.if_else(t3619, t3620/(1 + casadi.sqrt(1 + t3620**2)), 1/(t3618 + casadi.sqrt(1 + t3618**2))), 0)
     t3622 = 1/casadi.sqrt(1 + t3621**2)
     t3623 = t3517 + t3614*t3621
@@ -6217,10 +6217,10 @@ def _condition_number(q):
     t3649 = casadi.if_else((t3648 > t3543), t3648, t3543)
     t3650 = casadi.if_else((t3648 < t3544), t3648, t3544)
     t3651 = (t3615 != 0)
-    t3652 = 0.5*(-t3554 + t3589)/casadi.if_else(t3651, t3615, 1)
+    t3652 = (-t3554 + t3589)/casadi.if_else(t3651, 2*t3615, 1)
     t3653 = casadi.fabs(t3652)
     t3654 = (t3653 >= 1)
-    t3655 = casadi.fabs(1/casadi.if_else(t3654, t3652, 1))
+    t3655 = 1/casadi.fabs(casadi.if_else(t3654, t3652, 1))
     t3656 = casadi.if_else(t3651, casadi.if_else((t3652 >= 0), 1, -1)*casadi.if_else(t3654, t3655/(1 + casadi.sqrt(1 + t3655**2)), 1/(t3653 + casadi.sqrt(1 + t3653**2))), 0)
     t3657 = 1/casadi.sqrt(1 + t3656**2)
     t3658 = t3615*t3656
@@ -6252,10 +6252,10 @@ def _condition_number(q):
     t3684 = t3682 + t3656*t3681
     t3685 = t3627*t3663 + t3631*t3667 + t3635*t3671 + t3639*t3675 + t3643*t3679 + t3647*t3683
     t3686 = (t3685 != 0)
-    t3687 = 0.5*(-t3659 + t3623)/casadi.if_else(t3686, t3685, 1)
+    t3687 = (-t3659 + t3623)/casadi.if_else(t3686, 2*t3685, 1)
     t3688 = casadi.fabs(t3687)
     t3689 = (t3688 >= 1)
-    t3690 = casadi.fabs(1/casadi.if_else(t3689, t3687, 1))
+    t3690 = 1/casadi.fabs(casadi.if_else(t3689, t3687, 1))
     t3691 = casadi.if_else(t3686, casadi.if_else((t3687 >= 0), 1, -1)*casadi.if_else(t3689, t3690/(1 + casadi.sqrt(1 + t3690**2)), 1/(t3688 + casadi.sqrt(1 + t3688**2))), 0)
     t3692 = 1/casadi.sqrt(1 + t3691**2)
     t3693 = t3623 + t3685*t3691
@@ -6288,10 +6288,10 @@ def _condition_number(q):
     t3720 = casadi.if_else((t3719 > t3649), t3719, t3649)
     t3721 = casadi.if_else((t3719 < t3650), t3719, t3650)
     t3722 = (t3718 != 0)
-    t3723 = 0.5*(-t3660 + t3693)/casadi.if_else(t3722, t3718, 1)
+    t3723 = (-t3660 + t3693)/casadi.if_else(t3722, 2*t3718, 1)
     t3724 = casadi.fabs(t3723)
     t3725 = (t3724 >= 1)
-    t3726 = casadi.fabs(1/casadi.if_else(t3725, t3723, 1))
+    t3726 = 1/casadi.fabs(casadi.if_else(t3725, t3723, 1))
     t3727 = casadi.if_else(t3722, casadi.if_else((t3723 >= 0), 1, -1)*casadi.if_else(t3725, t3726/(1 + casadi.sqrt(1 + t3726**2)), 1/(t3724 + casadi.sqrt(1 + t3724**2))), 0)
     t3728 = 1/casadi.sqrt(1 + t3727**2)
     t3729 = t3664*t3728
@@ -6324,8 +6324,10 @@ def _condition_number(q):
     t3756 = casadi.if_else((t3753 < t3721), t3753, t3721)
     t3757 = casadi.if_else((t3754 > t3755), t3754, t3755)
     t3758 = casadi.if_else((t3754 < t3756), t3754, t3756)
+    t3759 = casadi.if_else((t3758 <= 1e-12*t3757), 0, t3758)
+    t3760 = casadi.if_else((t3757 > 0), t3757, 1)
     kappa = casadi.SX(1, 1)
-    kappa[0, 0] = casadi.if_else((t3757 > 0), t3757, 1)/casadi.if_else((t3758 <= 1e-12*t3757), 0, t3758)
+    kappa[0, 0] = t3760/t3759
     return [kappa]
 
 

@@ -2067,10 +2067,10 @@ def _velocity_ellipsoid(q):
     t63 = t62**2
     t64 = t31*t37
     t65 = (t64 != 0)
-    t66 = 0.5*(-t34 + t47)/casadi.if_else(t65, -t64, 1)
+    t66 = (-t34 + t47)/casadi.if_else(t65, -2*t64, 1)
     t67 = casadi.fabs(t66)
     t68 = (t67 >= 1)
-    t69 = casadi.fabs(1/casadi.if_else(t68, t66, 1))
+    t69 = 1/casadi.fabs(casadi.if_else(t68, t66, 1))
     t70 = casadi.if_else(t65, casadi.if_else((t66 >= 0), 1, -1)*casadi.if_else(t68, t69/(1 + casadi.sqrt(1 + t69**2)), 1/(t67 + casadi.sqrt(1 + t67**2))), 0)
     t71 = 1/casadi.sqrt(1 + t70**2)
     t72 = t64*t70
@@ -2086,10 +2086,10 @@ def _velocity_ellipsoid(q):
     t82 = t81*t70
     t83 = t79*t77 + t82*t57
     t84 = (t83 != 0)
-    t85 = 0.5*(-t73 + t80)/casadi.if_else(t84, t83, 1)
+    t85 = (-t73 + t80)/casadi.if_else(t84, 2*t83, 1)
     t86 = casadi.fabs(t85)
     t87 = (t86 >= 1)
-    t88 = casadi.fabs(1/casadi.if_else(t87, t85, 1))
+    t88 = 1/casadi.fabs(casadi.if_else(t87, t85, 1))
     t89 = casadi.if_else(t84, casadi.if_else((t85 >= 0), 1, -1)*casadi.if_else(t87, t88/(1 + casadi.sqrt(1 + t88**2)), 1/(t86 + casadi.sqrt(1 + t86**2))), 0)
     t90 = 1/casadi.sqrt(1 + t89**2)
     t91 = t83*t89
@@ -2105,10 +2105,10 @@ def _velocity_ellipsoid(q):
     t101 = t99 + t98*t89
     t102 = t78*t97 + t81*t101
     t103 = (t102 != 0)
-    t104 = 0.5*(-t74 + t93)/casadi.if_else(t103, -t102, 1)
+    t104 = (-t74 + t93)/casadi.if_else(t103, -2*t102, 1)
     t105 = casadi.fabs(t104)
     t106 = (t105 >= 1)
-    t107 = casadi.fabs(1/casadi.if_else(t106, t104, 1))
+    t107 = 1/casadi.fabs(casadi.if_else(t106, t104, 1))
     t108 = casadi.if_else(t103, casadi.if_else((t104 >= 0), 1, -1)*casadi.if_else(t106, t107/(1 + casadi.sqrt(1 + t107**2)), 1/(t105 + casadi.sqrt(1 + t105**2))), 0)
     t109 = 1/casadi.sqrt(1 + t108**2)
     t110 = t102*t108
@@ -2134,10 +2134,10 @@ def _velocity_ellipsoid(q):
     t130 = t108*t109
     t131 = t96*t115 - t100*t120 + t63*t124*t130*t90
     t132 = (t131 != 0)
-    t133 = 0.5*(-t92 + t111)/casadi.if_else(t132, t131, 1)
+    t133 = (-t92 + t111)/casadi.if_else(t132, 2*t131, 1)
     t134 = casadi.fabs(t133)
     t135 = (t134 >= 1)
-    t136 = casadi.fabs(1/casadi.if_else(t135, t133, 1))
+    t136 = 1/casadi.fabs(casadi.if_else(t135, t133, 1))
     t137 = casadi.if_else(t132, casadi.if_else((t133 >= 0), 1, -1)*casadi.if_else(t135, t136/(1 + casadi.sqrt(1 + t136**2)), 1/(t134 + casadi.sqrt(1 + t134**2))), 0)
     t138 = 1/casadi.sqrt(1 + t137**2)
     t139 = t131*t137
@@ -2171,10 +2171,10 @@ def _velocity_ellipsoid(q):
     t167 = t90*t109
     t168 = t116*t144 + t121*t148 - t62*t167*t157
     t169 = (t168 != 0)
-    t170 = 0.5*(-t140 + t112)/casadi.if_else(t169, t168, 1)
+    t170 = (-t140 + t112)/casadi.if_else(t169, 2*t168, 1)
     t171 = casadi.fabs(t170)
     t172 = (t171 >= 1)
-    t173 = casadi.fabs(1/casadi.if_else(t172, t170, 1))
+    t173 = 1/casadi.fabs(casadi.if_else(t172, t170, 1))
     t174 = casadi.if_else(t169, casadi.if_else((t170 >= 0), 1, -1)*casadi.if_else(t172, t173/(1 + casadi.sqrt(1 + t173**2)), 1/(t171 + casadi.sqrt(1 + t171**2))), 0)
     t175 = 1/casadi.sqrt(1 + t174**2)
     t176 = t168*t174
@@ -2206,10 +2206,10 @@ def _velocity_ellipsoid(q):
     t202 = t201 - t188*t174
     t203 = t188 + t201*t174
     t204 = (t192 != 0)
-    t205 = 0.5*(-t141 + t178)/casadi.if_else(t204, t192, 1)
+    t205 = (-t141 + t178)/casadi.if_else(t204, 2*t192, 1)
     t206 = casadi.fabs(t205)
     t207 = (t206 >= 1)
-    t208 = casadi.fabs(1/casadi.if_else(t207, t205, 1))
+    t208 = 1/casadi.fabs(casadi.if_else(t207, t205, 1))
     t209 = casadi.if_else(t204, casadi.if_else((t205 >= 0), 1, -1)*casadi.if_else(t207, t208/(1 + casadi.sqrt(1 + t208**2)), 1/(t206 + casadi.sqrt(1 + t206**2))), 0)
     t210 = 1/casadi.sqrt(1 + t209**2)
     t211 = t192*t209
@@ -2241,10 +2241,10 @@ def _velocity_ellipsoid(q):
     t237 = t235 + t236*t209
     t238 = t236 - t235*t209
     t239 = (t226 != 0)
-    t240 = 0.5*(-t177 + t212)/casadi.if_else(t239, t226, 1)
+    t240 = (-t177 + t212)/casadi.if_else(t239, 2*t226, 1)
     t241 = casadi.fabs(t240)
     t242 = (t241 >= 1)
-    t243 = casadi.fabs(1/casadi.if_else(t242, t240, 1))
+    t243 = 1/casadi.fabs(casadi.if_else(t242, t240, 1))
     t244 = casadi.if_else(t239, casadi.if_else((t240 >= 0), 1, -1)*casadi.if_else(t242, t243/(1 + casadi.sqrt(1 + t243**2)), 1/(t241 + casadi.sqrt(1 + t241**2))), 0)
     t245 = 1/casadi.sqrt(1 + t244**2)
     t246 = t226*t244
@@ -2276,10 +2276,10 @@ def _velocity_ellipsoid(q):
     t272 = t270 + t271*t244
     t273 = -t271 + t270*t244
     t274 = (t261 != 0)
-    t275 = 0.5*(-t247 + t213)/casadi.if_else(t274, t261, 1)
+    t275 = (-t247 + t213)/casadi.if_else(t274, 2*t261, 1)
     t276 = casadi.fabs(t275)
     t277 = (t276 >= 1)
-    t278 = casadi.fabs(1/casadi.if_else(t277, t275, 1))
+    t278 = 1/casadi.fabs(casadi.if_else(t277, t275, 1))
     t279 = casadi.if_else(t274, casadi.if_else((t275 >= 0), 1, -1)*casadi.if_else(t277, t278/(1 + casadi.sqrt(1 + t278**2)), 1/(t276 + casadi.sqrt(1 + t276**2))), 0)
     t280 = 1/casadi.sqrt(1 + t279**2)
     t281 = t261*t279
@@ -2311,10 +2311,10 @@ def _velocity_ellipsoid(q):
     t307 = t305 - t279*t306
     t308 = t306 + t279*t305
     t309 = (t296 != 0)
-    t310 = 0.5*(-t248 + t283)/casadi.if_else(t309, t296, 1)
+    t310 = (-t248 + t283)/casadi.if_else(t309, 2*t296, 1)
     t311 = casadi.fabs(t310)
     t312 = (t311 >= 1)
-    t313 = casadi.fabs(1/casadi.if_else(t312, t310, 1))
+    t313 = 1/casadi.fabs(casadi.if_else(t312, t310, 1))
     t314 = casadi.if_else(t309, casadi.if_else((t310 >= 0), 1, -1)*casadi.if_else(t312, t313/(1 + casadi.sqrt(1 + t313**2)), 1/(t311 + casadi.sqrt(1 + t311**2))), 0)
     t315 = 1/casadi.sqrt(1 + t314**2)
     t316 = t296*t314
@@ -2346,10 +2346,10 @@ def _velocity_ellipsoid(q):
     t342 = t340 - t314*t341
     t343 = t341 + t314*t340
     t344 = (t331 != 0)
-    t345 = 0.5*(-t282 + t317)/casadi.if_else(t344, t331, 1)
+    t345 = (-t282 + t317)/casadi.if_else(t344, 2*t331, 1)
     t346 = casadi.fabs(t345)
     t347 = (t346 >= 1)
-    t348 = casadi.fabs(1/casadi.if_else(t347, t345, 1))
+    t348 = 1/casadi.fabs(casadi.if_else(t347, t345, 1))
     t349 = casadi.if_else(t344, casadi.if_else((t345 >= 0), 1, -1)*casadi.if_else(t347, t348/(1 + casadi.sqrt(1 + t348**2)), 1/(t346 + casadi.sqrt(1 + t346**2))), 0)
     t350 = 1/casadi.sqrt(1 + t349**2)
     t351 = t331*t349
@@ -2381,10 +2381,10 @@ def _velocity_ellipsoid(q):
     t377 = t375 - t349*t376
     t378 = t376 + t349*t375
     t379 = (t366 != 0)
-    t380 = 0.5*(-t352 + t318)/casadi.if_else(t379, t366, 1)
+    t380 = (-t352 + t318)/casadi.if_else(t379, 2*t366, 1)
     t381 = casadi.fabs(t380)
     t382 = (t381 >= 1)
-    t383 = casadi.fabs(1/casadi.if_else(t382, t380, 1))
+    t383 = 1/casadi.fabs(casadi.if_else(t382, t380, 1))
     t384 = casadi.if_else(t379, casadi.if_else((t380 >= 0), 1, -1)*casadi.if_else(t382, t383/(1 + casadi.sqrt(1 + t383**2)), 1/(t381 + casadi.sqrt(1 + t381**2))), 0)
     t385 = 1/casadi.sqrt(1 + t384**2)
     t386 = t366*t384
@@ -2416,10 +2416,10 @@ def _velocity_ellipsoid(q):
     t412 = t410 - t384*t411
     t413 = t411 + t384*t410
     t414 = (t401 != 0)
-    t415 = 0.5*(-t353 + t388)/casadi.if_else(t414, t401, 1)
+    t415 = (-t353 + t388)/casadi.if_else(t414, 2*t401, 1)
     t416 = casadi.fabs(t415)
     t417 = (t416 >= 1)
-    t418 = casadi.fabs(1/casadi.if_else(t417, t415, 1))
+    t418 = 1/casadi.fabs(casadi.if_else(t417, t415, 1))
     t419 = casadi.if_else(t414, casadi.if_else((t415 >= 0), 1, -1)*casadi.if_else(t417, t418/(1 + casadi.sqrt(1 + t418**2)), 1/(t416 + casadi.sqrt(1 + t416**2))), 0)
     t420 = 1/casadi.sqrt(1 + t419**2)
     t421 = t401*t419
@@ -2451,10 +2451,10 @@ def _velocity_ellipsoid(q):
     t447 = t445 - t419*t446
     t448 = t446 + t419*t445
     t449 = (t436 != 0)
-    t450 = 0.5*(-t387 + t422)/casadi.if_else(t449, t436, 1)
+    t450 = (-t387 + t422)/casadi.if_else(t449, 2*t436, 1)
     t451 = casadi.fabs(t450)
     t452 = (t451 >= 1)
-    t453 = casadi.fabs(1/casadi.if_else(t452, t450, 1))
+    t453 = 1/casadi.fabs(casadi.if_else(t452, t450, 1))
     t454 = casadi.if_else(t449, casadi.if_else((t450 >= 0), 1, -1)*casadi.if_else(t452, t453/(1 + casadi.sqrt(1 + t453**2)), 1/(t451 + casadi.sqrt(1 + t451**2))), 0)
     t455 = 1/casadi.sqrt(1 + t454**2)
     t456 = t436*t454
@@ -2486,10 +2486,10 @@ def _velocity_ellipsoid(q):
     t482 = t480 - t454*t481
     t483 = t481 + t454*t480
     t484 = (t471 != 0)
-    t485 = 0.5*(-t457 + t423)/casadi.if_else(t484, t471, 1)
+    t485 = (-t457 + t423)/casadi.if_else(t484, 2*t471, 1)
     t486 = casadi.fabs(t485)
     t487 = (t486 >= 1)
-    t488 = casadi.fabs(1/casadi.if_else(t487, t485, 1))
+    t488 = 1/casadi.fabs(casadi.if_else(t487, t485, 1))
     t489 = casadi.if_else(t484, casadi.if_else((t485 >= 0), 1, -1)*casadi.if_else(t487, t488/(1 + casadi.sqrt(1 + t488**2)), 1/(t486 + casadi.sqrt(1 + t486**2))), 0)
     t490 = 1/casadi.sqrt(1 + t489**2)
     t491 = t423 + t471*t489
@@ -2520,10 +2520,10 @@ def _velocity_ellipsoid(q):
     t516 = t514 - t489*t515
     t517 = t515 + t489*t514
     t518 = (t504 != 0)
-    t519 = 0.5*(-t458 + t491)/casadi.if_else(t518, t504, 1)
+    t519 = (-t458 + t491)/casadi.if_else(t518, 2*t504, 1)
     t520 = casadi.fabs(t519)
     t521 = (t520 >= 1)
-    t522 = casadi.fabs(1/casadi.if_else(t521, t519, 1))
+    t522 = 1/casadi.fabs(casadi.if_else(t521, t519, 1))
     t523 = casadi.if_else(t518, casadi.if_else((t519 >= 0), 1, -1)*casadi.if_else(t521, t522/(1 + casadi.sqrt(1 + t522**2)), 1/(t520 + casadi.sqrt(1 + t520**2))), 0)
     t524 = 1/casadi.sqrt(1 + t523**2)
     t525 = t462*t524
@@ -2614,10 +2614,10 @@ def _velocity_ellipsoid(q):
     t610 = t609**2
     t611 = t593**2 + t604**2 + t610
     t612 = (t601 != 0)
-    t613 = 0.5*(-t586 + t600)/casadi.if_else(t612, t601, 1)
+    t613 = (-t586 + t600)/casadi.if_else(t612, 2*t601, 1)
     t614 = casadi.fabs(t613)
     t615 = (t614 >= 1)
-    t616 = casadi.fabs(1/casadi.if_else(t615, t613, 1))
+    t616 = 1/casadi.fabs(casadi.if_else(t615, t613, 1))
     t617 = casadi.if_else(t612, casadi.if_else((t613 >= 0), 1, -1)*casadi.if_else(t615, t616/(1 + casadi.sqrt(1 + t616**2)), 1/(t614 + casadi.sqrt(1 + t614**2))), 0)
     t618 = 1/casadi.sqrt(1 + t617**2)
     t619 = t601*t617
@@ -2631,10 +2631,10 @@ def _velocity_ellipsoid(q):
     t627 = t617*t626
     t628 = t593*t624 - t604*t627
     t629 = (t628 != 0)
-    t630 = 0.5*(-t620 + t611)/casadi.if_else(t629, t628, 1)
+    t630 = (-t620 + t611)/casadi.if_else(t629, 2*t628, 1)
     t631 = casadi.fabs(t630)
     t632 = (t631 >= 1)
-    t633 = casadi.fabs(1/casadi.if_else(t632, t630, 1))
+    t633 = 1/casadi.fabs(casadi.if_else(t632, t630, 1))
     t634 = casadi.if_else(t629, casadi.if_else((t630 >= 0), 1, -1)*casadi.if_else(t632, t633/(1 + casadi.sqrt(1 + t633**2)), 1/(t631 + casadi.sqrt(1 + t631**2))), 0)
     t635 = 1/casadi.sqrt(1 + t634**2)
     t636 = t628*t634
@@ -2650,10 +2650,10 @@ def _velocity_ellipsoid(q):
     t646 = -t644 + t634*t643
     t647 = t625*t642 + t646*t626
     t648 = (t647 != 0)
-    t649 = 0.5*(-t621 + t638)/casadi.if_else(t648, -t647, 1)
+    t649 = (-t621 + t638)/casadi.if_else(t648, -2*t647, 1)
     t650 = casadi.fabs(t649)
     t651 = (t650 >= 1)
-    t652 = casadi.fabs(1/casadi.if_else(t651, t649, 1))
+    t652 = 1/casadi.fabs(casadi.if_else(t651, t649, 1))
     t653 = casadi.if_else(t648, casadi.if_else((t649 >= 0), 1, -1)*casadi.if_else(t651, t652/(1 + casadi.sqrt(1 + t652**2)), 1/(t650 + casadi.sqrt(1 + t650**2))), 0)
     t654 = 1/casadi.sqrt(1 + t653**2)
     t655 = t647*t653
@@ -2679,10 +2679,10 @@ def _velocity_ellipsoid(q):
     t675 = t653*t654
     t676 = t641*t660 + t645*t665 - t635*t610*t669*t675
     t677 = (t676 != 0)
-    t678 = 0.5*(-t637 + t656)/casadi.if_else(t677, -t676, 1)
+    t678 = (-t637 + t656)/casadi.if_else(t677, -2*t676, 1)
     t679 = casadi.fabs(t678)
     t680 = (t679 >= 1)
-    t681 = casadi.fabs(1/casadi.if_else(t680, t678, 1))
+    t681 = 1/casadi.fabs(casadi.if_else(t680, t678, 1))
     t682 = casadi.if_else(t677, casadi.if_else((t678 >= 0), 1, -1)*casadi.if_else(t680, t681/(1 + casadi.sqrt(1 + t681**2)), 1/(t679 + casadi.sqrt(1 + t679**2))), 0)
     t683 = 1/casadi.sqrt(1 + t682**2)
     t684 = t676*t682
@@ -2716,10 +2716,10 @@ def _velocity_ellipsoid(q):
     t712 = t635*t654
     t713 = t661*t689 + t666*t693 - t609*t702*t712
     t714 = (t713 != 0)
-    t715 = 0.5*(-t685 + t657)/casadi.if_else(t714, t713, 1)
+    t715 = (-t685 + t657)/casadi.if_else(t714, 2*t713, 1)
     t716 = casadi.fabs(t715)
     t717 = (t716 >= 1)
-    t718 = casadi.fabs(1/casadi.if_else(t717, t715, 1))
+    t718 = 1/casadi.fabs(casadi.if_else(t717, t715, 1))
     t719 = casadi.if_else(t714, casadi.if_else((t715 >= 0), 1, -1)*casadi.if_else(t717, t718/(1 + casadi.sqrt(1 + t718**2)), 1/(t716 + casadi.sqrt(1 + t716**2))), 0)
     t720 = 1/casadi.sqrt(1 + t719**2)
     t721 = t713*t719
@@ -2751,10 +2751,10 @@ def _velocity_ellipsoid(q):
     t747 = t746 - t719*t733
     t748 = t733 + t719*t746
     t749 = (t737 != 0)
-    t750 = 0.5*(-t686 + t723)/casadi.if_else(t749, t737, 1)
+    t750 = (-t686 + t723)/casadi.if_else(t749, 2*t737, 1)
     t751 = casadi.fabs(t750)
     t752 = (t751 >= 1)
-    t753 = casadi.fabs(1/casadi.if_else(t752, t750, 1))
+    t753 = 1/casadi.fabs(casadi.if_else(t752, t750, 1))
     t754 = casadi.if_else(t749, casadi.if_else((t750 >= 0), 1, -1)*casadi.if_else(t752, t753/(1 + casadi.sqrt(1 + t753**2)), 1/(t751 + casadi.sqrt(1 + t751**2))), 0)
     t755 = 1/casadi.sqrt(1 + t754**2)
     t756 = t737*t754
@@ -2786,10 +2786,10 @@ def _velocity_ellipsoid(q):
     t782 = t780 + t754*t781
     t783 = t781 - t754*t780
     t784 = (t771 != 0)
-    t785 = 0.5*(-t722 + t757)/casadi.if_else(t784, t771, 1)
+    t785 = (-t722 + t757)/casadi.if_else(t784, 2*t771, 1)
     t786 = casadi.fabs(t785)
     t787 = (t786 >= 1)
-    t788 = casadi.fabs(1/casadi.if_else(t787, t785, 1))
+    t788 = 1/casadi.fabs(casadi.if_else(t787, t785, 1))
     t789 = casadi.if_else(t784, casadi.if_else((t785 >= 0), 1, -1)*casadi.if_else(t787, t788/(1 + casadi.sqrt(1 + t788**2)), 1/(t786 + casadi.sqrt(1 + t786**2))), 0)
     t790 = 1/casadi.sqrt(1 + t789**2)
     t791 = t771*t789
@@ -2821,10 +2821,10 @@ def _velocity_ellipsoid(q):
     t817 = t815 + t789*t816
     t818 = -t816 + t789*t815
     t819 = (t806 != 0)
-    t820 = 0.5*(-t792 + t758)/casadi.if_else(t819, t806, 1)
+    t820 = (-t792 + t758)/casadi.if_else(t819, 2*t806, 1)
     t821 = casadi.fabs(t820)
     t822 = (t821 >= 1)
-    t823 = casadi.fabs(1/casadi.if_else(t822, t820, 1))
+    t823 = 1/casadi.fabs(casadi.if_else(t822, t820, 1))
     t824 = casadi.if_else(t819, casadi.if_else((t820 >= 0), 1, -1)*casadi.if_else(t822, t823/(1 + casadi.sqrt(1 + t823**2)), 1/(t821 + casadi.sqrt(1 + t821**2))), 0)
     t825 = 1/casadi.sqrt(1 + t824**2)
     t826 = t806*t824
@@ -2856,10 +2856,10 @@ def _velocity_ellipsoid(q):
     t852 = t850 - t824*t851
     t853 = t851 + t824*t850
     t854 = (t841 != 0)
-    t855 = 0.5*(-t793 + t828)/casadi.if_else(t854, t841, 1)
+    t855 = (-t793 + t828)/casadi.if_else(t854, 2*t841, 1)
     t856 = casadi.fabs(t855)
     t857 = (t856 >= 1)
-    t858 = casadi.fabs(1/casadi.if_else(t857, t855, 1))
+    t858 = 1/casadi.fabs(casadi.if_else(t857, t855, 1))
     t859 = casadi.if_else(t854, casadi.if_else((t855 >= 0), 1, -1)*casadi.if_else(t857, t858/(1 + casadi.sqrt(1 + t858**2)), 1/(t856 + casadi.sqrt(1 + t856**2))), 0)
     t860 = 1/casadi.sqrt(1 + t859**2)
     t861 = t841*t859
@@ -2891,10 +2891,10 @@ def _velocity_ellipsoid(q):
     t887 = t885 - t859*t886
     t888 = t886 + t859*t885
     t889 = (t876 != 0)
-    t890 = 0.5*(-t827 + t862)/casadi.if_else(t889, t876, 1)
+    t890 = (-t827 + t862)/casadi.if_else(t889, 2*t876, 1)
     t891 = casadi.fabs(t890)
     t892 = (t891 >= 1)
-    t893 = casadi.fabs(1/casadi.if_else(t892, t890, 1))
+    t893 = 1/casadi.fabs(casadi.if_else(t892, t890, 1))
     t894 = casadi.if_else(t889, casadi.if_else((t890 >= 0), 1, -1)*casadi.if_else(t892, t893/(1 + casadi.sqrt(1 + t893**2)), 1/(t891 + casadi.sqrt(1 + t891**2))), 0)
     t895 = 1/casadi.sqrt(1 + t894**2)
     t896 = t876*t894
@@ -2926,10 +2926,10 @@ def _velocity_ellipsoid(q):
     t922 = t920 - t894*t921
     t923 = t921 + t894*t920
     t924 = (t911 != 0)
-    t925 = 0.5*(-t897 + t863)/casadi.if_else(t924, t911, 1)
+    t925 = (-t897 + t863)/casadi.if_else(t924, 2*t911, 1)
     t926 = casadi.fabs(t925)
     t927 = (t926 >= 1)
-    t928 = casadi.fabs(1/casadi.if_else(t927, t925, 1))
+    t928 = 1/casadi.fabs(casadi.if_else(t927, t925, 1))
     t929 = casadi.if_else(t924, casadi.if_else((t925 >= 0), 1, -1)*casadi.if_else(t927, t928/(1 + casadi.sqrt(1 + t928**2)), 1/(t926 + casadi.sqrt(1 + t926**2))), 0)
     t930 = 1/casadi.sqrt(1 + t929**2)
     t931 = t911*t929
@@ -2961,10 +2961,10 @@ def _velocity_ellipsoid(q):
     t957 = t955 - t929*t956
     t958 = t956 + t929*t955
     t959 = (t946 != 0)
-    t960 = 0.5*(-t898 + t933)/casadi.if_else(t959, t946, 1)
+    t960 = (-t898 + t933)/casadi.if_else(t959, 2*t946, 1)
     t961 = casadi.fabs(t960)
     t962 = (t961 >= 1)
-    t963 = casadi.fabs(1/casadi.if_else(t962, t960, 1))
+    t963 = 1/casadi.fabs(casadi.if_else(t962, t960, 1))
     t964 = casadi.if_else(t959, casadi.if_else((t960 >= 0), 1, -1)*casadi.if_else(t962, t963/(1 + casadi.sqrt(1 + t963**2)), 1/(t961 + casadi.sqrt(1 + t961**2))), 0)
     t965 = 1/casadi.sqrt(1 + t964**2)
     t966 = t946*t964
@@ -2996,10 +2996,10 @@ def _velocity_ellipsoid(q):
     t992 = t990 - t964*t991
     t993 = t991 + t964*t990
     t994 = (t981 != 0)
-    t995 = 0.5*(-t932 + t967)/casadi.if_else(t994, t981, 1)
+    t995 = (-t932 + t967)/casadi.if_else(t994, 2*t981, 1)
     t996 = casadi.fabs(t995)
     t997 = (t996 >= 1)
-    t998 = casadi.fabs(1/casadi.if_else(t997, t995, 1))
+    t998 = 1/casadi.fabs(casadi.if_else(t997, t995, 1))
     t999 = casadi.if_else(t994, casadi.if_else((t995 >= 0), 1, -1)*casadi.if_else(t997, t998/(1 + casadi.sqrt(1 + t998**2)), 1/(t996 + casadi.sqrt(1 + t996**2))), 0)
     t1000 = 1/casadi.sqrt(1 + t999**2)
     t1001 = t981*t999
@@ -3031,10 +3031,10 @@ def _velocity_ellipsoid(q):
     t1027 = t1025 - t999*t1026
     t1028 = t1026 + t999*t1025
     t1029 = (t1016 != 0)
-    t1030 = 0.5*(-t1002 + t968)/casadi.if_else(t1029, t1016, 1)
+    t1030 = (-t1002 + t968)/casadi.if_else(t1029, 2*t1016, 1)
     t1031 = casadi.fabs(t1030)
     t1032 = (t1031 >= 1)
-    t1033 = casadi.fabs(1/casadi.if_else(t1032, t1030, 1))
+    t1033 = 1/casadi.fabs(casadi.if_else(t1032, t1030, 1))
     t1034 = casadi.if_else(t1029, casadi.if_else((t1030 >= 0), 1, -1)*casadi.if_else(t1032, t1033/(1 + casadi.sqrt(1 + t1033**2)), 1/(t1031 + casadi.sqrt(1 + t1031**2))), 0)
     t1035 = 1/casadi.sqrt(1 + t1034**2)
     t1036 = t968 + t1016*t1034
@@ -3065,10 +3065,10 @@ def _velocity_ellipsoid(q):
     t1061 = t1059 - t1034*t1060
     t1062 = t1060 + t1034*t1059
     t1063 = (t1049 != 0)
-    t1064 = 0.5*(-t1003 + t1036)/casadi.if_else(t1063, t1049, 1)
+    t1064 = (-t1003 + t1036)/casadi.if_else(t1063, 2*t1049, 1)
     t1065 = casadi.fabs(t1064)
     t1066 = (t1065 >= 1)
-    t1067 = casadi.fabs(1/casadi.if_else(t1066, t1064, 1))
+    t1067 = 1/casadi.fabs(casadi.if_else(t1066, t1064, 1))
     t1068 = casadi.if_else(t1063, casadi.if_else((t1064 >= 0), 1, -1)*casadi.if_else(t1066, t1067/(1 + casadi.sqrt(1 + t1067**2)), 1/(t1065 + casadi.sqrt(1 + t1065**2))), 0)
     t1069 = 1/casadi.sqrt(1 + t1068**2)
     t1070 = t1007*t1069
@@ -3331,10 +3331,10 @@ def _condition_number(q):
     t146 = t35*t93
     t147 = t42*t56 + t37*t119 + t144*t71 + t145*t76 - t146*t99
     t148 = (t147 != 0)
-    t149 = 0.5*(-t143 + t136)/casadi.if_else(t148, -t147, 1)
+    t149 = (-t143 + t136)/casadi.if_else(t148, -2*t147, 1)
     t150 = casadi.fabs(t149)
     t151 = (t150 >= 1)
-    t152 = casadi.fabs(1/casadi.if_else(t151, t149, 1))
+    t152 = 1/casadi.fabs(casadi.if_else(t151, t149, 1))
     t153 = casadi.if_else(t148, casadi.if_else((t149 >= 0), 1, -1)*casadi.if_else(t151, t152/(1 + casadi.sqrt(1 + t152**2)), 1/(t150 + casadi.sqrt(1 + t150**2))), 0)
     t154 = 1/casadi.sqrt(1 + t153**2)
     t155 = t147*t153
@@ -3362,10 +3362,10 @@ def _condition_number(q):
     t177 = -t175 + t174*t153
     t178 = t85*t168 + t104*t172 + t124*t176 - t81*t164
     t179 = (t178 != 0)
-    t180 = 0.5*(-t156 + t137)/casadi.if_else(t179, -t178, 1)
+    t180 = (-t156 + t137)/casadi.if_else(t179, -2*t178, 1)
     t181 = casadi.fabs(t180)
     t182 = (t181 >= 1)
-    t183 = casadi.fabs(1/casadi.if_else(t182, t180, 1))
+    t183 = 1/casadi.fabs(casadi.if_else(t182, t180, 1))
     t184 = casadi.if_else(t179, casadi.if_else((t180 >= 0), 1, -1)*casadi.if_else(t182, t183/(1 + casadi.sqrt(1 + t183**2)), 1/(t181 + casadi.sqrt(1 + t181**2))), 0)
     t185 = 1/casadi.sqrt(1 + t184**2)
     t186 = t178*t184
@@ -3389,10 +3389,10 @@ def _condition_number(q):
     t204 = -t202 + t201*t184
     t205 = t108*t199 + t128*t203 - t89*t195
     t206 = (t205 != 0)
-    t207 = 0.5*(-t187 + t138)/casadi.if_else(t206, -t205, 1)
+    t207 = (-t187 + t138)/casadi.if_else(t206, -2*t205, 1)
     t208 = casadi.fabs(t207)
     t209 = (t208 >= 1)
-    t210 = casadi.fabs(1/casadi.if_else(t209, t207, 1))
+    t210 = 1/casadi.fabs(casadi.if_else(t209, t207, 1))
     t211 = casadi.if_else(t206, casadi.if_else((t207 >= 0), 1, -1)*casadi.if_else(t209, t210/(1 + casadi.sqrt(1 + t210**2)), 1/(t208 + casadi.sqrt(1 + t208**2))), 0)
     t212 = 1/casadi.sqrt(1 + t211**2)
     t213 = t205*t211
@@ -3412,10 +3412,10 @@ def _condition_number(q):
     t227 = -t225 + t224*t211
     t228 = t112*t222 + t132*t226
     t229 = (t228 != 0)
-    t230 = 0.5*(-t214 + t139)/casadi.if_else(t229, -t228, 1)
+    t230 = (-t214 + t139)/casadi.if_else(t229, -2*t228, 1)
     t231 = casadi.fabs(t230)
     t232 = (t231 >= 1)
-    t233 = casadi.fabs(1/casadi.if_else(t232, t230, 1))
+    t233 = 1/casadi.fabs(casadi.if_else(t232, t230, 1))
     t234 = casadi.if_else(t229, casadi.if_else((t230 >= 0), 1, -1)*casadi.if_else(t232, t233/(1 + casadi.sqrt(1 + t233**2)), 1/(t231 + casadi.sqrt(1 + t231**2))), 0)
     t235 = 1/casadi.sqrt(1 + t234**2)
     t236 = t228*t234
@@ -3431,10 +3431,10 @@ def _condition_number(q):
     t246 = -t244 + t243*t234
     t247 = t135*t245
     t248 = (t247 != 0)
-    t249 = 0.5*(-t237 + t140)/casadi.if_else(t248, -t247, 1)
+    t249 = (-t237 + t140)/casadi.if_else(t248, -2*t247, 1)
     t250 = casadi.fabs(t249)
     t251 = (t250 >= 1)
-    t252 = casadi.fabs(1/casadi.if_else(t251, t249, 1))
+    t252 = 1/casadi.fabs(casadi.if_else(t251, t249, 1))
     t253 = casadi.if_else(t248, casadi.if_else((t249 >= 0), 1, -1)*casadi.if_else(t251, t252/(1 + casadi.sqrt(1 + t252**2)), 1/(t250 + casadi.sqrt(1 + t250**2))), 0)
     t254 = 1/casadi.sqrt(1 + t253**2)
     t255 = t247*t253
@@ -3448,10 +3448,10 @@ def _condition_number(q):
     t263 = t262*t160
     t264 = -t165*t192 + t169*t196 - t173*t200 + t177*t204 + t141*t262*t153*t154**2 + t263*t161
     t265 = (t264 != 0)
-    t266 = 0.5*(-t157 + t188)/casadi.if_else(t265, t264, 1)
+    t266 = (-t157 + t188)/casadi.if_else(t265, 2*t264, 1)
     t267 = casadi.fabs(t266)
     t268 = (t267 >= 1)
-    t269 = casadi.fabs(1/casadi.if_else(t268, t266, 1))
+    t269 = 1/casadi.fabs(casadi.if_else(t268, t266, 1))
     t270 = casadi.if_else(t265, casadi.if_else((t266 >= 0), 1, -1)*casadi.if_else(t268, t269/(1 + casadi.sqrt(1 + t269**2)), 1/(t267 + casadi.sqrt(1 + t267**2))), 0)
     t271 = 1/casadi.sqrt(1 + t270**2)
     t272 = t264*t270
@@ -3490,10 +3490,10 @@ def _condition_number(q):
     t305 = t301*t191
     t306 = -t219*t291 - t223*t295 + t227*t299 - t303*t279 + t304*t283 + t305*t287
     t307 = (t306 != 0)
-    t308 = 0.5*(-t273 + t215)/casadi.if_else(t307, t306, 1)
+    t308 = (-t273 + t215)/casadi.if_else(t307, 2*t306, 1)
     t309 = casadi.fabs(t308)
     t310 = (t309 >= 1)
-    t311 = casadi.fabs(1/casadi.if_else(t310, t308, 1))
+    t311 = 1/casadi.fabs(casadi.if_else(t310, t308, 1))
     t312 = casadi.if_else(t307, casadi.if_else((t308 >= 0), 1, -1)*casadi.if_else(t310, t311/(1 + casadi.sqrt(1 + t311**2)), 1/(t309 + casadi.sqrt(1 + t309**2))), 0)
     t313 = 1/casadi.sqrt(1 + t312**2)
     t314 = t306*t312
@@ -3536,10 +3536,10 @@ def _condition_number(q):
     t351 = t350*t234
     t352 = -t242*t335 + t246*t339 - t345*t319 + t347*t323 + t349*t327 + t351*t331
     t353 = (t352 != 0)
-    t354 = 0.5*(-t315 + t238)/casadi.if_else(t353, t352, 1)
+    t354 = (-t315 + t238)/casadi.if_else(t353, 2*t352, 1)
     t355 = casadi.fabs(t354)
     t356 = (t355 >= 1)
-    t357 = casadi.fabs(1/casadi.if_else(t356, t354, 1))
+    t357 = 1/casadi.fabs(casadi.if_else(t356, t354, 1))
     t358 = casadi.if_else(t353, casadi.if_else((t354 >= 0), 1, -1)*casadi.if_else(t356, t357/(1 + casadi.sqrt(1 + t357**2)), 1/(t355 + casadi.sqrt(1 + t355**2))), 0)
     t359 = 1/casadi.sqrt(1 + t358**2)
     t360 = t352*t358
@@ -3581,10 +3581,10 @@ def _condition_number(q):
     t396 = t395*t253
     t397 = t261*t385 - t388*t365 + t390*t369 + t392*t373 + t394*t377 - t396*t381
     t398 = (t397 != 0)
-    t399 = 0.5*(-t361 + t257)/casadi.if_else(t398, t397, 1)
+    t399 = (-t361 + t257)/casadi.if_else(t398, 2*t397, 1)
     t400 = casadi.fabs(t399)
     t401 = (t400 >= 1)
-    t402 = casadi.fabs(1/casadi.if_else(t401, t399, 1))
+    t402 = 1/casadi.fabs(casadi.if_else(t401, t399, 1))
     t403 = casadi.if_else(t398, casadi.if_else((t399 >= 0), 1, -1)*casadi.if_else(t401, t402/(1 + casadi.sqrt(1 + t402**2)), 1/(t400 + casadi.sqrt(1 + t400**2))), 0)
     t404 = 1/casadi.sqrt(1 + t403**2)
     t405 = t397*t403
@@ -3616,10 +3616,10 @@ def _condition_number(q):
     t431 = t429 + t428*t403
     t432 = t260*t430 - t387*t410 + t389*t414 + t391*t418 + t393*t422 - t395*t426
     t433 = (t341 != 0)
-    t434 = 0.5*(-t274 + t316)/casadi.if_else(t433, t341, 1)
+    t434 = (-t274 + t316)/casadi.if_else(t433, 2*t341, 1)
     t435 = casadi.fabs(t434)
     t436 = (t435 >= 1)
-    t437 = casadi.fabs(1/casadi.if_else(t436, t434, 1))
+    t437 = 1/casadi.fabs(casadi.if_else(t436, t434, 1))
     t438 = casadi.if_else(t433, casadi.if_else((t434 >= 0), 1, -1)*casadi.if_else(t436, t437/(1 + casadi.sqrt(1 + t437**2)), 1/(t435 + casadi.sqrt(1 + t435**2))), 0)
     t439 = 1/casadi.sqrt(1 + t438**2)
     t440 = t341*t438
@@ -3651,10 +3651,10 @@ def _condition_number(q):
     t466 = t464 + t463*t438
     t467 = -t366*t445 + t370*t449 + t374*t453 + t378*t457 + t382*t461 + t386*t465
     t468 = (t467 != 0)
-    t469 = 0.5*(-t441 + t362)/casadi.if_else(t468, t467, 1)
+    t469 = (-t441 + t362)/casadi.if_else(t468, 2*t467, 1)
     t470 = casadi.fabs(t469)
     t471 = (t470 >= 1)
-    t472 = casadi.fabs(1/casadi.if_else(t471, t469, 1))
+    t472 = 1/casadi.fabs(casadi.if_else(t471, t469, 1))
     t473 = casadi.if_else(t468, casadi.if_else((t469 >= 0), 1, -1)*casadi.if_else(t471, t472/(1 + casadi.sqrt(1 + t472**2)), 1/(t470 + casadi.sqrt(1 + t470**2))), 0)
     t474 = 1/casadi.sqrt(1 + t473**2)
     t475 = t467*t473
@@ -3687,10 +3687,10 @@ def _condition_number(q):
     t502 = -t411*t480 + t415*t484 + t419*t488 + t423*t492 + t427*t496 + t431*t500
     t503 = t446*t481 + t450*t485 + t454*t489 + t458*t493 + t462*t497 + t466*t501
     t504 = (t502 != 0)
-    t505 = 0.5*(-t476 + t407)/casadi.if_else(t504, t502, 1)
+    t505 = (-t476 + t407)/casadi.if_else(t504, 2*t502, 1)
     t506 = casadi.fabs(t505)
     t507 = (t506 >= 1)
-    t508 = casadi.fabs(1/casadi.if_else(t507, t505, 1))
+    t508 = 1/casadi.fabs(casadi.if_else(t507, t505, 1))
     t509 = casadi.if_else(t504, casadi.if_else((t505 >= 0), 1, -1)*casadi.if_else(t507, t508/(1 + casadi.sqrt(1 + t508**2)), 1/(t506 + casadi.sqrt(1 + t506**2))), 0)
     t510 = 1/casadi.sqrt(1 + t509**2)
     t511 = t502*t509
@@ -3721,10 +3721,10 @@ def _condition_number(q):
     t536 = t534 - t535*t509
     t537 = t535 + t534*t509
     t538 = (t503 != 0)
-    t539 = 0.5*(-t442 + t477)/casadi.if_else(t538, t503, 1)
+    t539 = (-t442 + t477)/casadi.if_else(t538, 2*t503, 1)
     t540 = casadi.fabs(t539)
     t541 = (t540 >= 1)
-    t542 = casadi.fabs(1/casadi.if_else(t541, t539, 1))
+    t542 = 1/casadi.fabs(casadi.if_else(t541, t539, 1))
     t543 = casadi.if_else(t538, casadi.if_else((t539 >= 0), 1, -1)*casadi.if_else(t541, t542/(1 + casadi.sqrt(1 + t542**2)), 1/(t540 + casadi.sqrt(1 + t540**2))), 0)
     t544 = 1/casadi.sqrt(1 + t543**2)
     t545 = t503*t543
@@ -3756,10 +3756,10 @@ def _condition_number(q):
     t571 = t569 + t568*t543
     t572 = t517*t550 + t521*t554 + t525*t558 + t529*t562 + t533*t566 + t537*t570
     t573 = (t572 != 0)
-    t574 = 0.5*(-t546 + t513)/casadi.if_else(t573, t572, 1)
+    t574 = (-t546 + t513)/casadi.if_else(t573, 2*t572, 1)
     t575 = casadi.fabs(t574)
     t576 = (t575 >= 1)
-    t577 = casadi.fabs(1/casadi.if_else(t576, t574, 1))
+    t577 = 1/casadi.fabs(casadi.if_else(t576, t574, 1))
     t578 = casadi.if_else(t573, casadi.if_else((t574 >= 0), 1, -1)*casadi.if_else(t576, t577/(1 + casadi.sqrt(1 + t577**2)), 1/(t575 + casadi.sqrt(1 + t575**2))), 0)
     t579 = 1/casadi.sqrt(1 + t578**2)
     t580 = t572*t578
@@ -3791,10 +3791,10 @@ def _condition_number(q):
     t606 = t604 + t603*t578
     t607 = t551*t586 + t555*t590 + t559*t594 + t563*t598 + t567*t602 + t571*t606
     t608 = (t607 != 0)
-    t609 = 0.5*(-t547 + t582)/casadi.if_else(t608, t607, 1)
+    t609 = (-t547 + t582)/casadi.if_else(t608, 2*t607, 1)
     t610 = casadi.fabs(t609)
     t611 = (t610 >= 1)
-    t612 = casadi.fabs(1/casadi.if_else(t611, t609, 1))
+    t612 = 1/casadi.fabs(casadi.if_else(t611, t609, 1))
     t613 = casadi.if_else(t608, casadi.if_else((t609 >= 0), 1, -1)*casadi.if_else(t611, t612/(1 + casadi.sqrt(1 + t612**2)), 1/(t610 + casadi.sqrt(1 + t610**2))), 0)
     t614 = 1/casadi.sqrt(1 + t613**2)
     t615 = t607*t613
@@ -3825,10 +3825,10 @@ def _condition_number(q):
     t640 = t638 - t639*t613
     t641 = t639 + t638*t613
     t642 = (t432 != 0)
-    t643 = 0.5*(-t256 + t406)/casadi.if_else(t642, t432, 1)
+    t643 = (-t256 + t406)/casadi.if_else(t642, 2*t432, 1)
     t644 = casadi.fabs(t643)
     t645 = (t644 >= 1)
-    t646 = casadi.fabs(1/casadi.if_else(t645, t643, 1))
+    t646 = 1/casadi.fabs(casadi.if_else(t645, t643, 1))
     t647 = casadi.if_else(t642, casadi.if_else((t643 >= 0), 1, -1)*casadi.if_else(t645, t646/(1 + casadi.sqrt(1 + t646**2)), 1/(t644 + casadi.sqrt(1 + t644**2))), 0)
     t648 = 1/casadi.sqrt(1 + t647**2)
     t649 = t432*t647
@@ -3860,10 +3860,10 @@ def _condition_number(q):
     t675 = t673 + t672*t647
     t676 = t516*t654 + t520*t658 + t524*t662 + t528*t666 + t532*t670 + t536*t674
     t677 = (t676 != 0)
-    t678 = 0.5*(-t650 + t512)/casadi.if_else(t677, t676, 1)
+    t678 = (-t650 + t512)/casadi.if_else(t677, 2*t676, 1)
     t679 = casadi.fabs(t678)
     t680 = (t679 >= 1)
-    t681 = casadi.fabs(1/casadi.if_else(t680, t678, 1))
+    t681 = 1/casadi.fabs(casadi.if_else(t680, t678, 1))
     t682 = casadi.if_else(t677, casadi.if_else((t678 >= 0), 1, -1)*casadi.if_else(t680, t681/(1 + casadi.sqrt(1 + t681**2)), 1/(t679 + casadi.sqrt(1 + t679**2))), 0)
     t683 = 1/casadi.sqrt(1 + t682**2)
     t684 = t676*t682
@@ -3896,10 +3896,10 @@ def _condition_number(q):
     t711 = t585*t689 + t589*t693 + t593*t697 + t597*t701 + t601*t705 + t605*t709
     t712 = -t655*t690 + t659*t694 + t663*t698 + t667*t702 + t671*t706 + t675*t710
     t713 = (t711 != 0)
-    t714 = 0.5*(-t685 + t581)/casadi.if_else(t713, t711, 1)
+    t714 = (-t685 + t581)/casadi.if_else(t713, 2*t711, 1)
     t715 = casadi.fabs(t714)
     t716 = (t715 >= 1)
-    t717 = casadi.fabs(1/casadi.if_else(t716, t714, 1))
+    t717 = 1/casadi.fabs(casadi.if_else(t716, t714, 1))
     t718 = casadi.if_else(t713, casadi.if_else((t714 >= 0), 1, -1)*casadi.if_else(t716, t717/(1 + casadi.sqrt(1 + t717**2)), 1/(t715 + casadi.sqrt(1 + t715**2))), 0)
     t719 = 1/casadi.sqrt(1 + t718**2)
     t720 = t711*t718
@@ -3931,10 +3931,10 @@ def _condition_number(q):
     t746 = t744 + t743*t718
     t747 = t620*t725 + t624*t729 + t628*t733 + t632*t737 + t636*t741 + t640*t745
     t748 = (t747 != 0)
-    t749 = 0.5*(-t721 + t616)/casadi.if_else(t748, t747, 1)
+    t749 = (-t721 + t616)/casadi.if_else(t748, 2*t747, 1)
     t750 = casadi.fabs(t749)
     t751 = (t750 >= 1)
-    t752 = casadi.fabs(1/casadi.if_else(t751, t749, 1))
+    t752 = 1/casadi.fabs(casadi.if_else(t751, t749, 1))
     t753 = casadi.if_else(t748, casadi.if_else((t749 >= 0), 1, -1)*casadi.if_else(t751, t752/(1 + casadi.sqrt(1 + t752**2)), 1/(t750 + casadi.sqrt(1 + t750**2))), 0)
     t754 = 1/casadi.sqrt(1 + t753**2)
     t755 = t747*t753
@@ -3966,10 +3966,10 @@ def _condition_number(q):
     t781 = t779 + t778*t753
     t782 = t621*t760 + t625*t764 + t629*t768 + t633*t772 + t637*t776 + t641*t780
     t783 = (t782 != 0)
-    t784 = 0.5*(-t756 + t617)/casadi.if_else(t783, t782, 1)
+    t784 = (-t756 + t617)/casadi.if_else(t783, 2*t782, 1)
     t785 = casadi.fabs(t784)
     t786 = (t785 >= 1)
-    t787 = casadi.fabs(1/casadi.if_else(t786, t784, 1))
+    t787 = 1/casadi.fabs(casadi.if_else(t786, t784, 1))
     t788 = casadi.if_else(t783, casadi.if_else((t784 >= 0), 1, -1)*casadi.if_else(t786, t787/(1 + casadi.sqrt(1 + t787**2)), 1/(t785 + casadi.sqrt(1 + t785**2))), 0)
     t789 = 1/casadi.sqrt(1 + t788**2)
     t790 = t782*t788
@@ -4000,10 +4000,10 @@ def _condition_number(q):
     t815 = t813 - t814*t788
     t816 = t814 + t813*t788
     t817 = (t712 != 0)
-    t818 = 0.5*(-t651 + t686)/casadi.if_else(t817, t712, 1)
+    t818 = (-t651 + t686)/casadi.if_else(t817, 2*t712, 1)
     t819 = casadi.fabs(t818)
     t820 = (t819 >= 1)
-    t821 = casadi.fabs(1/casadi.if_else(t820, t818, 1))
+    t821 = 1/casadi.fabs(casadi.if_else(t820, t818, 1))
     t822 = casadi.if_else(t817, casadi.if_else((t818 >= 0), 1, -1)*casadi.if_else(t820, t821/(1 + casadi.sqrt(1 + t821**2)), 1/(t819 + casadi.sqrt(1 + t819**2))), 0)
     t823 = 1/casadi.sqrt(1 + t822**2)
     t824 = t712*t822
@@ -4035,10 +4035,10 @@ def _condition_number(q):
     t850 = t848 + t847*t822
     t851 = t726*t829 + t730*t833 + t734*t837 + t738*t841 + t742*t845 + t746*t849
     t852 = (t851 != 0)
-    t853 = 0.5*(-t825 + t722)/casadi.if_else(t852, t851, 1)
+    t853 = (-t825 + t722)/casadi.if_else(t852, 2*t851, 1)
     t854 = casadi.fabs(t853)
     t855 = (t854 >= 1)
-    t856 = casadi.fabs(1/casadi.if_else(t855, t853, 1))
+    t856 = 1/casadi.fabs(casadi.if_else(t855, t853, 1))
     t857 = casadi.if_else(t852, casadi.if_else((t853 >= 0), 1, -1)*casadi.if_else(t855, t856/(1 + casadi.sqrt(1 + t856**2)), 1/(t854 + casadi.sqrt(1 + t854**2))), 0)
     t858 = 1/casadi.sqrt(1 + t857**2)
     t859 = t851*t857
@@ -4071,10 +4071,10 @@ def _condition_number(q):
     t886 = t761*t864 + t765*t868 + t769*t872 + t773*t876 + t777*t880 + t781*t884
     t887 = t830*t865 + t834*t869 + t838*t873 + t842*t877 + t846*t881 + t850*t885
     t888 = (t886 != 0)
-    t889 = 0.5*(-t860 + t757)/casadi.if_else(t888, t886, 1)
+    t889 = (-t860 + t757)/casadi.if_else(t888, 2*t886, 1)
     t890 = casadi.fabs(t889)
     t891 = (t890 >= 1)
-    t892 = casadi.fabs(1/casadi.if_else(t891, t889, 1))
+    t892 = 1/casadi.fabs(casadi.if_else(t891, t889, 1))
     t893 = casadi.if_else(t888, casadi.if_else((t889 >= 0), 1, -1)*casadi.if_else(t891, t892/(1 + casadi.sqrt(1 + t892**2)), 1/(t890 + casadi.sqrt(1 + t890**2))), 0)
     t894 = 1/casadi.sqrt(1 + t893**2)
     t895 = t886*t893
@@ -4106,10 +4106,10 @@ def _condition_number(q):
     t921 = t919 + t918*t893
     t922 = t796*t900 + t800*t904 + t804*t908 + t808*t912 + t812*t916 + t816*t920
     t923 = (t922 != 0)
-    t924 = 0.5*(-t896 + t792)/casadi.if_else(t923, t922, 1)
+    t924 = (-t896 + t792)/casadi.if_else(t923, 2*t922, 1)
     t925 = casadi.fabs(t924)
     t926 = (t925 >= 1)
-    t927 = casadi.fabs(1/casadi.if_else(t926, t924, 1))
+    t927 = 1/casadi.fabs(casadi.if_else(t926, t924, 1))
     t928 = casadi.if_else(t923, casadi.if_else((t924 >= 0), 1, -1)*casadi.if_else(t926, t927/(1 + casadi.sqrt(1 + t927**2)), 1/(t925 + casadi.sqrt(1 + t925**2))), 0)
     t929 = 1/casadi.sqrt(1 + t928**2)
     t930 = t922*t928
@@ -4141,10 +4141,10 @@ def _condition_number(q):
     t956 = t954 + t953*t928
     t957 = t795*t935 + t799*t939 + t803*t943 + t807*t947 + t811*t951 + t815*t955
     t958 = (t887 != 0)
-    t959 = 0.5*(-t826 + t861)/casadi.if_else(t958, t887, 1)
+    t959 = (-t826 + t861)/casadi.if_else(t958, 2*t887, 1)
     t960 = casadi.fabs(t959)
     t961 = (t960 >= 1)
-    t962 = casadi.fabs(1/casadi.if_else(t961, t959, 1))
+    t962 = 1/casadi.fabs(casadi.if_else(t961, t959, 1))
     t963 = casadi.if_else(t958, casadi.if_else((t959 >= 0), 1, -1)*casadi.if_else(t961, t962/(1 + casadi.sqrt(1 + t962**2)), 1/(t960 + casadi.sqrt(1 + t960**2))), 0)
     t964 = 1/casadi.sqrt(1 + t963**2)
     t965 = t887*t963
@@ -4176,10 +4176,10 @@ def _condition_number(q):
     t991 = t989 + t988*t963
     t992 = t901*t970 + t905*t974 + t909*t978 + t913*t982 + t917*t986 + t921*t990
     t993 = (t992 != 0)
-    t994 = 0.5*(-t966 + t897)/casadi.if_else(t993, t992, 1)
+    t994 = (-t966 + t897)/casadi.if_else(t993, 2*t992, 1)
     t995 = casadi.fabs(t994)
     t996 = (t995 >= 1)
-    t997 = casadi.fabs(1/casadi.if_else(t996, t994, 1))
+    t997 = 1/casadi.fabs(casadi.if_else(t996, t994, 1))
     t998 = casadi.if_else(t993, casadi.if_else((t994 >= 0), 1, -1)*casadi.if_else(t996, t997/(1 + casadi.sqrt(1 + t997**2)), 1/(t995 + casadi.sqrt(1 + t995**2))), 0)
     t999 = 1/casadi.sqrt(1 + t998**2)
     t1000 = t992*t998
@@ -4212,10 +4212,10 @@ def _condition_number(q):
     t1027 = t936*t1005 + t940*t1009 + t944*t1013 + t948*t1017 + t952*t1021 + t956*t1025
     t1028 = t971*t1006 + t975*t1010 + t979*t1014 + t983*t1018 + t987*t1022 + t991*t1026
     t1029 = (t1027 != 0)
-    t1030 = 0.5*(-t1001 + t932)/casadi.if_else(t1029, t1027, 1)
+    t1030 = (-t1001 + t932)/casadi.if_else(t1029, 2*t1027, 1)
     t1031 = casadi.fabs(t1030)
     t1032 = (t1031 >= 1)
-    t1033 = casadi.fabs(1/casadi.if_else(t1032, t1030, 1))
+    t1033 = 1/casadi.fabs(casadi.if_else(t1032, t1030, 1))
     t1034 = casadi.if_else(t1029, casadi.if_else((t1030 >= 0), 1, -1)*casadi.if_else(t1032, t1033/(1 + casadi.sqrt(1 + t1033**2)), 1/(t1031 + casadi.sqrt(1 + t1031**2))), 0)
     t1035 = 1/casadi.sqrt(1 + t1034**2)
     t1036 = t1027*t1034
@@ -4246,10 +4246,10 @@ def _condition_number(q):
     t1061 = t1059 - t1060*t1034
     t1062 = t1060 + t1059*t1034
     t1063 = (t1028 != 0)
-    t1064 = 0.5*(-t967 + t1002)/casadi.if_else(t1063, t1028, 1)
+    t1064 = (-t967 + t1002)/casadi.if_else(t1063, 2*t1028, 1)
     t1065 = casadi.fabs(t1064)
     t1066 = (t1065 >= 1)
-    t1067 = casadi.fabs(1/casadi.if_else(t1066, t1064, 1))
+    t1067 = 1/casadi.fabs(casadi.if_else(t1066, t1064, 1))
     t1068 = casadi.if_else(t1063, casadi.if_else((t1064 >= 0), 1, -1)*casadi.if_else(t1066, t1067/(1 + casadi.sqrt(1 + t1067**2)), 1/(t1065 + casadi.sqrt(1 + t1065**2))), 0)
     t1069 = 1/casadi.sqrt(1 + t1068**2)
     t1070 = t1028*t1068
@@ -4281,10 +4281,10 @@ def _condition_number(q):
     t1096 = t1094 + t1068*t1093
     t1097 = t1042*t1075 + t1046*t1079 + t1050*t1083 + t1054*t1087 + t1058*t1091 + t1062*t1095
     t1098 = (t1097 != 0)
-    t1099 = 0.5*(-t1071 + t1038)/casadi.if_else(t1098, t1097, 1)
+    t1099 = (-t1071 + t1038)/casadi.if_else(t1098, 2*t1097, 1)
     t1100 = casadi.fabs(t1099)
     t1101 = (t1100 >= 1)
-    t1102 = casadi.fabs(1/casadi.if_else(t1101, t1099, 1))
+    t1102 = 1/casadi.fabs(casadi.if_else(t1101, t1099, 1))
     t1103 = casadi.if_else(t1098, casadi.if_else((t1099 >= 0), 1, -1)*casadi.if_else(t1101, t1102/(1 + casadi.sqrt(1 + t1102**2)), 1/(t1100 + casadi.sqrt(1 + t1100**2))), 0)
     t1104 = 1/casadi.sqrt(1 + t1103**2)
     t1105 = t1097*t1103
@@ -4316,10 +4316,10 @@ def _condition_number(q):
     t1131 = t1129 + t1103*t1128
     t1132 = t1076*t1111 + t1080*t1115 + t1084*t1119 + t1088*t1123 + t1092*t1127 + t1096*t1131
     t1133 = (t1132 != 0)
-    t1134 = 0.5*(-t1072 + t1107)/casadi.if_else(t1133, t1132, 1)
+    t1134 = (-t1072 + t1107)/casadi.if_else(t1133, 2*t1132, 1)
     t1135 = casadi.fabs(t1134)
     t1136 = (t1135 >= 1)
-    t1137 = casadi.fabs(1/casadi.if_else(t1136, t1134, 1))
+    t1137 = 1/casadi.fabs(casadi.if_else(t1136, t1134, 1))
     t1138 = casadi.if_else(t1133, casadi.if_else((t1134 >= 0), 1, -1)*casadi.if_else(t1136, t1137/(1 + casadi.sqrt(1 + t1137**2)), 1/(t1135 + casadi.sqrt(1 + t1135**2))), 0)
     t1139 = 1/casadi.sqrt(1 + t1138**2)
     t1140 = t1132*t1138
@@ -4350,10 +4350,10 @@ def _condition_number(q):
     t1165 = t1163 - t1138*t1164
     t1166 = t1164 + t1138*t1163
     t1167 = (t957 != 0)
-    t1168 = 0.5*(-t791 + t931)/casadi.if_else(t1167, t957, 1)
+    t1168 = (-t791 + t931)/casadi.if_else(t1167, 2*t957, 1)
     t1169 = casadi.fabs(t1168)
     t1170 = (t1169 >= 1)
-    t1171 = casadi.fabs(1/casadi.if_else(t1170, t1168, 1))
+    t1171 = 1/casadi.fabs(casadi.if_else(t1170, t1168, 1))
     t1172 = casadi.if_else(t1167, casadi.if_else((t1168 >= 0), 1, -1)*casadi.if_else(t1170, t1171/(1 + casadi.sqrt(1 + t1171**2)), 1/(t1169 + casadi.sqrt(1 + t1169**2))), 0)
     t1173 = 1/casadi.sqrt(1 + t1172**2)
     t1174 = t957*t1172
@@ -4385,10 +4385,10 @@ def _condition_number(q):
     t1200 = t1198 + t1172*t1197
     t1201 = t1041*t1179 + t1045*t1183 + t1049*t1187 + t1053*t1191 + t1057*t1195 + t1061*t1199
     t1202 = (t1201 != 0)
-    t1203 = 0.5*(-t1175 + t1037)/casadi.if_else(t1202, t1201, 1)
+    t1203 = (-t1175 + t1037)/casadi.if_else(t1202, 2*t1201, 1)
     t1204 = casadi.fabs(t1203)
     t1205 = (t1204 >= 1)
-    t1206 = casadi.fabs(1/casadi.if_else(t1205, t1203, 1))
+    t1206 = 1/casadi.fabs(casadi.if_else(t1205, t1203, 1))
     t1207 = casadi.if_else(t1202, casadi.if_else((t1203 >= 0), 1, -1)*casadi.if_else(t1205, t1206/(1 + casadi.sqrt(1 + t1206**2)), 1/(t1204 + casadi.sqrt(1 + t1204**2))), 0)
     t1208 = 1/casadi.sqrt(1 + t1207**2)
     t1209 = t1201*t1207
@@ -4421,10 +4421,10 @@ def _condition_number(q):
     t1236 = t1110*t1214 + t1114*t1218 + t1118*t1222 + t1122*t1226 + t1126*t1230 + t1130*t1234
     t1237 = t1180*t1215 + t1184*t1219 + t1188*t1223 + t1192*t1227 + t1196*t1231 + t1200*t1235
     t1238 = (t1236 != 0)
-    t1239 = 0.5*(-t1210 + t1106)/casadi.if_else(t1238, t1236, 1)
+    t1239 = (-t1210 + t1106)/casadi.if_else(t1238, 2*t1236, 1)
     t1240 = casadi.fabs(t1239)
     t1241 = (t1240 >= 1)
-    t1242 = casadi.fabs(1/casadi.if_else(t1241, t1239, 1))
+    t1242 = 1/casadi.fabs(casadi.if_else(t1241, t1239, 1))
     t1243 = casadi.if_else(t1238, casadi.if_else((t1239 >= 0), 1, -1)*casadi.if_else(t1241, t1242/(1 + casadi.sqrt(1 + t1242**2)), 1/(t1240 + casadi.sqrt(1 + t1240**2))), 0)
     t1244 = 1/casadi.sqrt(1 + t1243**2)
     t1245 = t1236*t1243
@@ -4456,10 +4456,10 @@ def _condition_number(q):
     t1271 = t1269 + t1243*t1268
     t1272 = t1145*t1250 + t1149*t1254 + t1153*t1258 + t1157*t1262 + t1161*t1266 + t1165*t1270
     t1273 = (t1272 != 0)
-    t1274 = 0.5*(-t1246 + t1141)/casadi.if_else(t1273, t1272, 1)
+    t1274 = (-t1246 + t1141)/casadi.if_else(t1273, 2*t1272, 1)
     t1275 = casadi.fabs(t1274)
     t1276 = (t1275 >= 1)
-    t1277 = casadi.fabs(1/casadi.if_else(t1276, t1274, 1))
+    t1277 = 1/casadi.fabs(casadi.if_else(t1276, t1274, 1))
     t1278 = casadi.if_else(t1273, casadi.if_else((t1274 >= 0), 1, -1)*casadi.if_else(t1276, t1277/(1 + casadi.sqrt(1 + t1277**2)), 1/(t1275 + casadi.sqrt(1 + t1275**2))), 0)
     t1279 = 1/casadi.sqrt(1 + t1278**2)
     t1280 = t1272*t1278
@@ -4491,10 +4491,10 @@ def _condition_number(q):
     t1306 = t1304 + t1278*t1303
     t1307 = t1146*t1285 + t1150*t1289 + t1154*t1293 + t1158*t1297 + t1162*t1301 + t1166*t1305
     t1308 = (t1307 != 0)
-    t1309 = 0.5*(-t1281 + t1142)/casadi.if_else(t1308, t1307, 1)
+    t1309 = (-t1281 + t1142)/casadi.if_else(t1308, 2*t1307, 1)
     t1310 = casadi.fabs(t1309)
     t1311 = (t1310 >= 1)
-    t1312 = casadi.fabs(1/casadi.if_else(t1311, t1309, 1))
+    t1312 = 1/casadi.fabs(casadi.if_else(t1311, t1309, 1))
     t1313 = casadi.if_else(t1308, casadi.if_else((t1309 >= 0), 1, -1)*casadi.if_else(t1311, t1312/(1 + casadi.sqrt(1 + t1312**2)), 1/(t1310 + casadi.sqrt(1 + t1310**2))), 0)
     t1314 = 1/casadi.sqrt(1 + t1313**2)
     t1315 = t1307*t1313
@@ -4525,10 +4525,10 @@ def _condition_number(q):
     t1340 = t1338 - t1313*t1339
     t1341 = t1339 + t1313*t1338
     t1342 = (t1237 != 0)
-    t1343 = 0.5*(-t1176 + t1211)/casadi.if_else(t1342, t1237, 1)
+    t1343 = (-t1176 + t1211)/casadi.if_else(t1342, 2*t1237, 1)
     t1344 = casadi.fabs(t1343)
     t1345 = (t1344 >= 1)
-    t1346 = casadi.fabs(1/casadi.if_else(t1345, t1343, 1))
+    t1346 = 1/casadi.fabs(casadi.if_else(t1345, t1343, 1))
     t1347 = casadi.if_else(t1342, casadi.if_else((t1343 >= 0), 1, -1)*casadi.if_else(t1345, t1346/(1 + casadi.sqrt(1 + t1346**2)), 1/(t1344 + casadi.sqrt(1 + t1344**2))), 0)
     t1348 = 1/casadi.sqrt(1 + t1347**2)
     t1349 = t1237*t1347
@@ -4560,10 +4560,10 @@ def _condition_number(q):
     t1375 = t1373 + t1347*t1372
     t1376 = t1251*t1354 + t1255*t1358 + t1259*t1362 + t1263*t1366 + t1267*t1370 + t1271*t1374
     t1377 = (t1376 != 0)
-    t1378 = 0.5*(-t1350 + t1247)/casadi.if_else(t1377, t1376, 1)
+    t1378 = (-t1350 + t1247)/casadi.if_else(t1377, 2*t1376, 1)
     t1379 = casadi.fabs(t1378)
     t1380 = (t1379 >= 1)
-    t1381 = casadi.fabs(1/casadi.if_else(t1380, t1378, 1))
+    t1381 = 1/casadi.fabs(casadi.if_else(t1380, t1378, 1))
     t1382 = casadi.if_else(t1377, casadi.if_else((t1378 >= 0), 1, -1)*casadi.if_else(t1380, t1381/(1 + casadi.sqrt(1 + t1381**2)), 1/(t1379 + casadi.sqrt(1 + t1379**2))), 0)
     t1383 = 1/casadi.sqrt(1 + t1382**2)
     t1384 = t1376*t1382
@@ -4596,10 +4596,10 @@ def _condition_number(q):
     t1411 = t1286*t1389 + t1290*t1393 + t1294*t1397 + t1298*t1401 + t1302*t1405 + t1306*t1409
     t1412 = t1355*t1390 + t1359*t1394 + t1363*t1398 + t1367*t1402 + t1371*t1406 + t1375*t1410
     t1413 = (t1411 != 0)
-    t1414 = 0.5*(-t1385 + t1282)/casadi.if_else(t1413, t1411, 1)
+    t1414 = (-t1385 + t1282)/casadi.if_else(t1413, 2*t1411, 1)
     t1415 = casadi.fabs(t1414)
     t1416 = (t1415 >= 1)
-    t1417 = casadi.fabs(1/casadi.if_else(t1416, t1414, 1))
+    t1417 = 1/casadi.fabs(casadi.if_else(t1416, t1414, 1))
     t1418 = casadi.if_else(t1413, casadi.if_else((t1414 >= 0), 1, -1)*casadi.if_else(t1416, t1417/(1 + casadi.sqrt(1 + t1417**2)), 1/(t1415 + casadi.sqrt(1 + t1415**2))), 0)
     t1419 = 1/casadi.sqrt(1 + t1418**2)
     t1420 = t1411*t1418
@@ -4631,10 +4631,10 @@ def _condition_number(q):
     t1446 = t1444 + t1418*t1443
     t1447 = t1321*t1425 + t1325*t1429 + t1329*t1433 + t1333*t1437 + t1337*t1441 + t1341*t1445
     t1448 = (t1447 != 0)
-    t1449 = 0.5*(-t1421 + t1317)/casadi.if_else(t1448, t1447, 1)
+    t1449 = (-t1421 + t1317)/casadi.if_else(t1448, 2*t1447, 1)
     t1450 = casadi.fabs(t1449)
     t1451 = (t1450 >= 1)
-    t1452 = casadi.fabs(1/casadi.if_else(t1451, t1449, 1))
+    t1452 = 1/casadi.fabs(casadi.if_else(t1451, t1449, 1))
     t1453 = casadi.if_else(t1448, casadi.if_else((t1449 >= 0), 1, -1)*casadi.if_else(t1451, t1452/(1 + casadi.sqrt(1 + t1452**2)), 1/(t1450 + casadi.sqrt(1 + t1450**2))), 0)
     t1454 = 1/casadi.sqrt(1 + t1453**2)
     t1455 = t1447*t1453
@@ -4666,10 +4666,10 @@ def _condition_number(q):
     t1481 = t1479 + t1453*t1478
     t1482 = t1320*t1460 + t1324*t1464 + t1328*t1468 + t1332*t1472 + t1336*t1476 + t1340*t1480
     t1483 = (t1412 != 0)
-    t1484 = 0.5*(-t1351 + t1386)/casadi.if_else(t1483, t1412, 1)
+    t1484 = (-t1351 + t1386)/casadi.if_else(t1483, 2*t1412, 1)
     t1485 = casadi.fabs(t1484)
     t1486 = (t1485 >= 1)
-    t1487 = casadi.fabs(1/casadi.if_else(t1486, t1484, 1))
+    t1487 = 1/casadi.fabs(casadi.if_else(t1486, t1484, 1))
     t1488 = casadi.if_else(t1483, casadi.if_else((t1484 >= 0), 1, -1)*casadi.if_else(t1486, t1487/(1 + casadi.sqrt(1 + t1487**2)), 1/(t1485 + casadi.sqrt(1 + t1485**2))), 0)
     t1489 = 1/casadi.sqrt(1 + t1488**2)
     t1490 = t1412*t1488
@@ -4701,10 +4701,10 @@ def _condition_number(q):
     t1516 = t1514 + t1488*t1513
     t1517 = t1426*t1495 + t1430*t1499 + t1434*t1503 + t1438*t1507 + t1442*t1511 + t1446*t1515
     t1518 = (t1517 != 0)
-    t1519 = 0.5*(-t1491 + t1422)/casadi.if_else(t1518, t1517, 1)
+    t1519 = (-t1491 + t1422)/casadi.if_else(t1518, 2*t1517, 1)
     t1520 = casadi.fabs(t1519)
     t1521 = (t1520 >= 1)
-    t1522 = casadi.fabs(1/casadi.if_else(t1521, t1519, 1))
+    t1522 = 1/casadi.fabs(casadi.if_else(t1521, t1519, 1))
     t1523 = casadi.if_else(t1518, casadi.if_else((t1519 >= 0), 1, -1)*casadi.if_else(t1521, t1522/(1 + casadi.sqrt(1 + t1522**2)), 1/(t1520 + casadi.sqrt(1 + t1520**2))), 0)
     t1524 = 1/casadi.sqrt(1 + t1523**2)
     t1525 = t1517*t1523
@@ -4737,10 +4737,10 @@ def _condition_number(q):
     t1552 = t1461*t1530 + t1465*t1534 + t1469*t1538 + t1473*t1542 + t1477*t1546 + t1481*t1550
     t1553 = t1496*t1531 + t1500*t1535 + t1504*t1539 + t1508*t1543 + t1512*t1547 + t1516*t1551
     t1554 = (t1552 != 0)
-    t1555 = 0.5*(-t1526 + t1457)/casadi.if_else(t1554, t1552, 1)
+    t1555 = (-t1526 + t1457)/casadi.if_else(t1554, 2*t1552, 1)
     t1556 = casadi.fabs(t1555)
     t1557 = (t1556 >= 1)
-    t1558 = casadi.fabs(1/casadi.if_else(t1557, t1555, 1))
+    t1558 = 1/casadi.fabs(casadi.if_else(t1557, t1555, 1))
     t1559 = casadi.if_else(t1554, casadi.if_else((t1555 >= 0), 1, -1)*casadi.if_else(t1557, t1558/(1 + casadi.sqrt(1 + t1558**2)), 1/(t1556 + casadi.sqrt(1 + t1556**2))), 0)
     t1560 = 1/casadi.sqrt(1 + t1559**2)
     t1561 = t1552*t1559
@@ -4771,10 +4771,10 @@ def _condition_number(q):
     t1586 = t1584 - t1559*t1585
     t1587 = t1585 + t1559*t1584
     t1588 = (t1553 != 0)
-    t1589 = 0.5*(-t1492 + t1527)/casadi.if_else(t1588, t1553, 1)
+    t1589 = (-t1492 + t1527)/casadi.if_else(t1588, 2*t1553, 1)
     t1590 = casadi.fabs(t1589)
     t1591 = (t1590 >= 1)
-    t1592 = casadi.fabs(1/casadi.if_else(t1591, t1589, 1))
+    t1592 = 1/casadi.fabs(casadi.if_else(t1591, t1589, 1))
     t1593 = casadi.if_else(t1588, casadi.if_else((t1589 >= 0), 1, -1)*casadi.if_else(t1591, t1592/(1 + casadi.sqrt(1 + t1592**2)), 1/(t1590 + casadi.sqrt(1 + t1590**2))), 0)
     t1594 = 1/casadi.sqrt(1 + t1593**2)
     t1595 = t1553*t1593
@@ -4806,10 +4806,10 @@ def _condition_number(q):
     t1621 = t1619 + t1593*t1618
     t1622 = t1567*t1600 + t1571*t1604 + t1575*t1608 + t1579*t1612 + t1583*t1616 + t1587*t1620
     t1623 = (t1622 != 0)
-    t1624 = 0.5*(-t1596 + t1563)/casadi.if_else(t1623, t1622, 1)
+    t1624 = (-t1596 + t1563)/casadi.if_else(t1623, 2*t1622, 1)
     t1625 = casadi.fabs(t1624)
     t1626 = (t1625 >= 1)
-    t1627 = casadi.fabs(1/casadi.if_else(t1626, t1624, 1))
+    t1627 = 1/casadi.fabs(casadi.if_else(t1626, t1624, 1))
     t1628 = casadi.if_else(t1623, casadi.if_else((t1624 >= 0), 1, -1)*casadi.if_else(t1626, t1627/(1 + casadi.sqrt(1 + t1627**2)), 1/(t1625 + casadi.sqrt(1 + t1625**2))), 0)
     t1629 = 1/casadi.sqrt(1 + t1628**2)
     t1630 = t1622*t1628
@@ -4841,10 +4841,10 @@ def _condition_number(q):
     t1656 = t1654 + t1628*t1653
     t1657 = t1601*t1636 + t1605*t1640 + t1609*t1644 + t1613*t1648 + t1617*t1652 + t1621*t1656
     t1658 = (t1657 != 0)
-    t1659 = 0.5*(-t1597 + t1632)/casadi.if_else(t1658, t1657, 1)
+    t1659 = (-t1597 + t1632)/casadi.if_else(t1658, 2*t1657, 1)
     t1660 = casadi.fabs(t1659)
     t1661 = (t1660 >= 1)
-    t1662 = casadi.fabs(1/casadi.if_else(t1661, t1659, 1))
+    t1662 = 1/casadi.fabs(casadi.if_else(t1661, t1659, 1))
     t1663 = casadi.if_else(t1658, casadi.if_else((t1659 >= 0), 1, -1)*casadi.if_else(t1661, t1662/(1 + casadi.sqrt(1 + t1662**2)), 1/(t1660 + casadi.sqrt(1 + t1660**2))), 0)
     t1664 = 1/casadi.sqrt(1 + t1663**2)
     t1665 = t1657*t1663
@@ -4875,10 +4875,10 @@ def _condition_number(q):
     t1690 = t1688 - t1663*t1689
     t1691 = t1689 + t1663*t1688
     t1692 = (t1482 != 0)
-    t1693 = 0.5*(-t1316 + t1456)/casadi.if_else(t1692, t1482, 1)
+    t1693 = (-t1316 + t1456)/casadi.if_else(t1692, 2*t1482, 1)
     t1694 = casadi.fabs(t1693)
     t1695 = (t1694 >= 1)
-    t1696 = casadi.fabs(1/casadi.if_else(t1695, t1693, 1))
+    t1696 = 1/casadi.fabs(casadi.if_else(t1695, t1693, 1))
     t1697 = casadi.if_else(t1692, casadi.if_else((t1693 >= 0), 1, -1)*casadi.if_else(t1695, t1696/(1 + casadi.sqrt(1 + t1696**2)), 1/(t1694 + casadi.sqrt(1 + t1694**2))), 0)
     t1698 = 1/casadi.sqrt(1 + t1697**2)
     t1699 = t1482*t1697
@@ -4910,10 +4910,10 @@ def _condition_number(q):
     t1725 = t1723 + t1697*t1722
     t1726 = t1566*t1704 + t1570*t1708 + t1574*t1712 + t1578*t1716 + t1582*t1720 + t1586*t1724
     t1727 = (t1726 != 0)
-    t1728 = 0.5*(-t1700 + t1562)/casadi.if_else(t1727, t1726, 1)
+    t1728 = (-t1700 + t1562)/casadi.if_else(t1727, 2*t1726, 1)
     t1729 = casadi.fabs(t1728)
     t1730 = (t1729 >= 1)
-    t1731 = casadi.fabs(1/casadi.if_else(t1730, t1728, 1))
+    t1731 = 1/casadi.fabs(casadi.if_else(t1730, t1728, 1))
     t1732 = casadi.if_else(t1727, casadi.if_else((t1728 >= 0), 1, -1)*casadi.if_else(t1730, t1731/(1 + casadi.sqrt(1 + t1731**2)), 1/(t1729 + casadi.sqrt(1 + t1729**2))), 0)
     t1733 = 1/casadi.sqrt(1 + t1732**2)
     t1734 = t1726*t1732
@@ -4946,10 +4946,10 @@ def _condition_number(q):
     t1761 = t1635*t1739 + t1639*t1743 + t1643*t1747 + t1647*t1751 + t1651*t1755 + t1655*t1759
     t1762 = t1705*t1740 + t1709*t1744 + t1713*t1748 + t1717*t1752 + t1721*t1756 + t1725*t1760
     t1763 = (t1761 != 0)
-    t1764 = 0.5*(-t1735 + t1631)/casadi.if_else(t1763, t1761, 1)
+    t1764 = (-t1735 + t1631)/casadi.if_else(t1763, 2*t1761, 1)
     t1765 = casadi.fabs(t1764)
     t1766 = (t1765 >= 1)
-    t1767 = casadi.fabs(1/casadi.if_else(t1766, t1764, 1))
+    t1767 = 1/casadi.fabs(casadi.if_else(t1766, t1764, 1))
     t1768 = casadi.if_else(t1763, casadi.if_else((t1764 >= 0), 1, -1)*casadi.if_else(t1766, t1767/(1 + casadi.sqrt(1 + t1767**2)), 1/(t1765 + casadi.sqrt(1 + t1765**2))), 0)
     t1769 = 1/casadi.sqrt(1 + t1768**2)
     t1770 = t1761*t1768
@@ -4981,10 +4981,10 @@ def _condition_number(q):
     t1796 = t1794 + t1768*t1793
     t1797 = t1670*t1775 + t1674*t1779 + t1678*t1783 + t1682*t1787 + t1686*t1791 + t1690*t1795
     t1798 = (t1797 != 0)
-    t1799 = 0.5*(-t1771 + t1666)/casadi.if_else(t1798, t1797, 1)
+    t1799 = (-t1771 + t1666)/casadi.if_else(t1798, 2*t1797, 1)
     t1800 = casadi.fabs(t1799)
     t1801 = (t1800 >= 1)
-    t1802 = casadi.fabs(1/casadi.if_else(t1801, t1799, 1))
+    t1802 = 1/casadi.fabs(casadi.if_else(t1801, t1799, 1))
     t1803 = casadi.if_else(t1798, casadi.if_else((t1799 >= 0), 1, -1)*casadi.if_else(t1801, t1802/(1 + casadi.sqrt(1 + t1802**2)), 1/(t1800 + casadi.sqrt(1 + t1800**2))), 0)
     t1804 = 1/casadi.sqrt(1 + t1803**2)
     t1805 = t1797*t1803
@@ -5016,10 +5016,10 @@ def _condition_number(q):
     t1831 = t1829 + t1803*t1828
     t1832 = t1671*t1810 + t1675*t1814 + t1679*t1818 + t1683*t1822 + t1687*t1826 + t1691*t1830
     t1833 = (t1832 != 0)
-    t1834 = 0.5*(-t1806 + t1667)/casadi.if_else(t1833, t1832, 1)
+    t1834 = (-t1806 + t1667)/casadi.if_else(t1833, 2*t1832, 1)
     t1835 = casadi.fabs(t1834)
     t1836 = (t1835 >= 1)
-    t1837 = casadi.fabs(1/casadi.if_else(t1836, t1834, 1))
+    t1837 = 1/casadi.fabs(casadi.if_else(t1836, t1834, 1))
     t1838 = casadi.if_else(t1833, casadi.if_else((t1834 >= 0), 1, -1)*casadi.if_else(t1836, t1837/(1 + casadi.sqrt(1 + t1837**2)), 1/(t1835 + casadi.sqrt(1 + t1835**2))), 0)
     t1839 = 1/casadi.sqrt(1 + t1838**2)
     t1840 = t1832*t1838
@@ -5050,10 +5050,10 @@ def _condition_number(q):
     t1865 = t1863 - t1838*t1864
     t1866 = t1864 + t1838*t1863
     t1867 = (t1762 != 0)
-    t1868 = 0.5*(-t1701 + t1736)/casadi.if_else(t1867, t1762, 1)
+    t1868 = (-t1701 + t1736)/casadi.if_else(t1867, 2*t1762, 1)
     t1869 = casadi.fabs(t1868)
     t1870 = (t1869 >= 1)
-    t1871 = casadi.fabs(1/casadi.if_else(t1870, t1868, 1))
+    t1871 = 1/casadi.fabs(casadi.if_else(t1870, t1868, 1))
     t1872 = casadi.if_else(t1867, casadi.if_else((t1868 >= 0), 1, -1)*casadi.if_else(t1870, t1871/(1 + casadi.sqrt(1 + t1871**2)), 1/(t1869 + casadi.sqrt(1 + t1869**2))), 0)
     t1873 = 1/casadi.sqrt(1 + t1872**2)
     t1874 = t1762*t1872
@@ -5085,10 +5085,10 @@ def _condition_number(q):
     t1900 = t1898 + t1872*t1897
     t1901 = t1776*t1879 + t1780*t1883 + t1784*t1887 + t1788*t1891 + t1792*t1895 + t1796*t1899
     t1902 = (t1901 != 0)
-    t1903 = 0.5*(-t1875 + t1772)/casadi.if_else(t1902, t1901, 1)
+    t1903 = (-t1875 + t1772)/casadi.if_else(t1902, 2*t1901, 1)
     t1904 = casadi.fabs(t1903)
     t1905 = (t1904 >= 1)
-    t1906 = casadi.fabs(1/casadi.if_else(t1905, t1903, 1))
+    t1906 = 1/casadi.fabs(casadi.if_else(t1905, t1903, 1))
     t1907 = casadi.if_else(t1902, casadi.if_else((t1903 >= 0), 1, -1)*casadi.if_else(t1905, t1906/(1 + casadi.sqrt(1 + t1906**2)), 1/(t1904 + casadi.sqrt(1 + t1904**2))), 0)
     t1908 = 1/casadi.sqrt(1 + t1907**2)
     t1909 = t1901*t1907
@@ -5121,10 +5121,10 @@ def _condition_number(q):
     t1936 = t1811*t1914 + t1815*t1918 + t1819*t1922 + t1823*t1926 + t1827*t1930 + t1831*t1934
     t1937 = t1880*t1915 + t1884*t1919 + t1888*t1923 + t1892*t1927 + t1896*t1931 + t1900*t1935
     t1938 = (t1936 != 0)
-    t1939 = 0.5*(-t1910 + t1807)/casadi.if_else(t1938, t1936, 1)
+    t1939 = (-t1910 + t1807)/casadi.if_else(t1938, 2*t1936, 1)
     t1940 = casadi.fabs(t1939)
     t1941 = (t1940 >= 1)
-    t1942 = casadi.fabs(1/casadi.if_else(t1941, t1939, 1))
+    t1942 = 1/casadi.fabs(casadi.if_else(t1941, t1939, 1))
     t1943 = casadi.if_else(t1938, casadi.if_else((t1939 >= 0), 1, -1)*casadi.if_else(t1941, t1942/(1 + casadi.sqrt(1 + t1942**2)), 1/(t1940 + casadi.sqrt(1 + t1940**2))), 0)
     t1944 = 1/casadi.sqrt(1 + t1943**2)
     t1945 = t1936*t1943
@@ -5156,10 +5156,10 @@ def _condition_number(q):
     t1971 = t1969 + t1943*t1968
     t1972 = t1846*t1950 + t1850*t1954 + t1854*t1958 + t1858*t1962 + t1862*t1966 + t1866*t1970
     t1973 = (t1972 != 0)
-    t1974 = 0.5*(-t1946 + t1842)/casadi.if_else(t1973, t1972, 1)
+    t1974 = (-t1946 + t1842)/casadi.if_else(t1973, 2*t1972, 1)
     t1975 = casadi.fabs(t1974)
     t1976 = (t1975 >= 1)
-    t1977 = casadi.fabs(1/casadi.if_else(t1976, t1974, 1))
+    t1977 = 1/casadi.fabs(casadi.if_else(t1976, t1974, 1))
     t1978 = casadi.if_else(t1973, casadi.if_else((t1974 >= 0), 1, -1)*casadi.if_else(t1976, t1977/(1 + casadi.sqrt(1 + t1977**2)), 1/(t1975 + casadi.sqrt(1 + t1975**2))), 0)
     t1979 = 1/casadi.sqrt(1 + t1978**2)
     t1980 = t1972*t1978
@@ -5191,10 +5191,10 @@ def _condition_number(q):
     t2006 = t2004 + t1978*t2003
     t2007 = t1845*t1985 + t1849*t1989 + t1853*t1993 + t1857*t1997 + t1861*t2001 + t1865*t2005
     t2008 = (t1937 != 0)
-    t2009 = 0.5*(-t1876 + t1911)/casadi.if_else(t2008, t1937, 1)
+    t2009 = (-t1876 + t1911)/casadi.if_else(t2008, 2*t1937, 1)
     t2010 = casadi.fabs(t2009)
     t2011 = (t2010 >= 1)
-    t2012 = casadi.fabs(1/casadi.if_else(t2011, t2009, 1))
+    t2012 = 1/casadi.fabs(casadi.if_else(t2011, t2009, 1))
     t2013 = casadi.if_else(t2008, casadi.if_else((t2009 >= 0), 1, -1)*casadi.if_else(t2011, t2012/(1 + casadi.sqrt(1 + t2012**2)), 1/(t2010 + casadi.sqrt(1 + t2010**2))), 0)
     t2014 = 1/casadi.sqrt(1 + t2013**2)
     t2015 = t1937*t2013
@@ -5226,10 +5226,10 @@ def _condition_number(q):
     t2041 = t2039 + t2013*t2038
     t2042 = t1951*t2020 + t1955*t2024 + t1959*t2028 + t1963*t2032 + t1967*t2036 + t1971*t2040
     t2043 = (t2042 != 0)
-    t2044 = 0.5*(-t2016 + t1947)/casadi.if_else(t2043, t2042, 1)
+    t2044 = (-t2016 + t1947)/casadi.if_else(t2043, 2*t2042, 1)
     t2045 = casadi.fabs(t2044)
     t2046 = (t2045 >= 1)
-    t2047 = casadi.fabs(1/casadi.if_else(t2046, t2044, 1))
+    t2047 = 1/casadi.fabs(casadi.if_else(t2046, t2044, 1))
     t2048 = casadi.if_else(t2043, casadi.if_else((t2044 >= 0), 1, -1)*casadi.if_else(t2046, t2047/(1 + casadi.sqrt(1 + t2047**2)), 1/(t2045 + casadi.sqrt(1 + t2045**2))), 0)
     t2049 = 1/casadi.sqrt(1 + t2048**2)
     t2050 = t2042*t2048
@@ -5262,10 +5262,10 @@ def _condition_number(q):
     t2077 = t1986*t2055 + t1990*t2059 + t1994*t2063 + t1998*t2067 + t2002*t2071 + t2006*t2075
     t2078 = t2021*t2056 + t2025*t2060 + t2029*t2064 + t2033*t2068 + t2037*t2072 + t2041*t2076
     t2079 = (t2077 != 0)
-    t2080 = 0.5*(-t2051 + t1982)/casadi.if_else(t2079, t2077, 1)
+    t2080 = (-t2051 + t1982)/casadi.if_else(t2079, 2*t2077, 1)
     t2081 = casadi.fabs(t2080)
     t2082 = (t2081 >= 1)
-    t2083 = casadi.fabs(1/casadi.if_else(t2082, t2080, 1))
+    t2083 = 1/casadi.fabs(casadi.if_else(t2082, t2080, 1))
     t2084 = casadi.if_else(t2079, casadi.if_else((t2080 >= 0), 1, -1)*casadi.if_else(t2082, t2083/(1 + casadi.sqrt(1 + t2083**2)), 1/(t2081 + casadi.sqrt(1 + t2081**2))), 0)
     t2085 = 1/casadi.sqrt(1 + t2084**2)
     t2086 = t2077*t2084
@@ -5296,10 +5296,10 @@ def _condition_number(q):
     t2111 = t2109 - t2084*t2110
     t2112 = t2110 + t2084*t2109
     t2113 = (t2078 != 0)
-    t2114 = 0.5*(-t2017 + t2052)/casadi.if_else(t2113, t2078, 1)
+    t2114 = (-t2017 + t2052)/casadi.if_else(t2113, 2*t2078, 1)
     t2115 = casadi.fabs(t2114)
     t2116 = (t2115 >= 1)
-    t2117 = casadi.fabs(1/casadi.if_else(t2116, t2114, 1))
+    t2117 = 1/casadi.fabs(casadi.if_else(t2116, t2114, 1))
     t2118 = casadi.if_else(t2113, casadi.if_else((t2114 >= 0), 1, -1)*casadi.if_else(t2116, t2117/(1 + casadi.sqrt(1 + t2117**2)), 1/(t2115 + casadi.sqrt(1 + t2115**2))), 0)
     t2119 = 1/casadi.sqrt(1 + t2118**2)
     t2120 = t2078*t2118
@@ -5331,10 +5331,10 @@ def _condition_number(q):
     t2146 = t2144 + t2118*t2143
     t2147 = t2092*t2125 + t2096*t2129 + t2100*t2133 + t2104*t2137 + t2108*t2141 + t2112*t2145
     t2148 = (t2147 != 0)
-    t2149 = 0.5*(-t2121 + t2088)/casadi.if_else(t2148, t2147, 1)
+    t2149 = (-t2121 + t2088)/casadi.if_else(t2148, 2*t2147, 1)
     t2150 = casadi.fabs(t2149)
     t2151 = (t2150 >= 1)
-    t2152 = casadi.fabs(1/casadi.if_else(t2151, t2149, 1))
+    t2152 = 1/casadi.fabs(casadi.if_else(t2151, t2149, 1))
     t2153 = casadi.if_else(t2148, casadi.if_else((t2149 >= 0), 1, -1)*casadi.if_else(t2151, t2152/(1 + casadi.sqrt(1 + t2152**2)), 1/(t2150 + casadi.sqrt(1 + t2150**2))), 0)
     t2154 = 1/casadi.sqrt(1 + t2153**2)
     t2155 = t2147*t2153
@@ -5366,10 +5366,10 @@ def _condition_number(q):
     t2181 = t2179 + t2153*t2178
     t2182 = t2126*t2161 + t2130*t2165 + t2134*t2169 + t2138*t2173 + t2142*t2177 + t2146*t2181
     t2183 = (t2182 != 0)
-    t2184 = 0.5*(-t2122 + t2157)/casadi.if_else(t2183, t2182, 1)
+    t2184 = (-t2122 + t2157)/casadi.if_else(t2183, 2*t2182, 1)
     t2185 = casadi.fabs(t2184)
     t2186 = (t2185 >= 1)
-    t2187 = casadi.fabs(1/casadi.if_else(t2186, t2184, 1))
+    t2187 = 1/casadi.fabs(casadi.if_else(t2186, t2184, 1))
     t2188 = casadi.if_else(t2183, casadi.if_else((t2184 >= 0), 1, -1)*casadi.if_else(t2186, t2187/(1 + casadi.sqrt(1 + t2187**2)), 1/(t2185 + casadi.sqrt(1 + t2185**2))), 0)
     t2189 = 1/casadi.sqrt(1 + t2188**2)
     t2190 = t2182*t2188
@@ -5400,10 +5400,10 @@ def _condition_number(q):
     t2215 = t2213 - t2188*t2214
     t2216 = t2214 + t2188*t2213
     t2217 = (t2007 != 0)
-    t2218 = 0.5*(-t1841 + t1981)/casadi.if_else(t2217, t2007, 1)
+    t2218 = (-t1841 + t1981)/casadi.if_else(t2217, 2*t2007, 1)
     t2219 = casadi.fabs(t2218)
     t2220 = (t2219 >= 1)
-    t2221 = casadi.fabs(1/casadi.if_else(t2220, t2218, 1))
+    t2221 = 1/casadi.fabs(casadi.if_else(t2220, t2218, 1))
     t2222 = casadi.if_else(t2217, casadi.if_else((t2218 >= 0), 1, -1)*casadi.if_else(t2220, t2221/(1 + casadi.sqrt(1 + t2221**2)), 1/(t2219 + casadi.sqrt(1 + t2219**2))), 0)
     t2223 = 1/casadi.sqrt(1 + t2222**2)
     t2224 = t2007*t2222
@@ -5435,10 +5435,10 @@ def _condition_number(q):
     t2250 = t2248 + t2222*t2247
     t2251 = t2091*t2229 + t2095*t2233 + t2099*t2237 + t2103*t2241 + t2107*t2245 + t2111*t2249
     t2252 = (t2251 != 0)
-    t2253 = 0.5*(-t2225 + t2087)/casadi.if_else(t2252, t2251, 1)
+    t2253 = (-t2225 + t2087)/casadi.if_else(t2252, 2*t2251, 1)
     t2254 = casadi.fabs(t2253)
     t2255 = (t2254 >= 1)
-    t2256 = casadi.fabs(1/casadi.if_else(t2255, t2253, 1))
+    t2256 = 1/casadi.fabs(casadi.if_else(t2255, t2253, 1))
     t2257 = casadi.if_else(t2252, casadi.if_else((t2253 >= 0), 1, -1)*casadi.if_else(t2255, t2256/(1 + casadi.sqrt(1 + t2256**2)), 1/(t2254 + casadi.sqrt(1 + t2254**2))), 0)
     t2258 = 1/casadi.sqrt(1 + t2257**2)
     t2259 = t2251*t2257
@@ -5471,10 +5471,10 @@ def _condition_number(q):
     t2286 = t2160*t2264 + t2164*t2268 + t2168*t2272 + t2172*t2276 + t2176*t2280 + t2180*t2284
     t2287 = t2230*t2265 + t2234*t2269 + t2238*t2273 + t2242*t2277 + t2246*t2281 + t2250*t2285
     t2288 = (t2286 != 0)
-    t2289 = 0.5*(-t2260 + t2156)/casadi.if_else(t2288, t2286, 1)
+    t2289 = (-t2260 + t2156)/casadi.if_else(t2288, 2*t2286, 1)
     t2290 = casadi.fabs(t2289)
     t2291 = (t2290 >= 1)
-    t2292 = casadi.fabs(1/casadi.if_else(t2291, t2289, 1))
+    t2292 = 1/casadi.fabs(casadi.if_else(t2291, t2289, 1))
     t2293 = casadi.if_else(t2288, casadi.if_else((t2289 >= 0), 1, -1)*casadi.if_else(t2291, t2292/(1 + casadi.sqrt(1 + t2292**2)), 1/(t2290 + casadi.sqrt(1 + t2290**2))), 0)
     t2294 = 1/casadi.sqrt(1 + t2293**2)
     t2295 = t2286*t2293
@@ -5506,10 +5506,10 @@ def _condition_number(q):
     t2321 = t2319 + t2293*t2318
     t2322 = t2195*t2300 + t2199*t2304 + t2203*t2308 + t2207*t2312 + t2211*t2316 + t2215*t2320
     t2323 = (t2322 != 0)
-    t2324 = 0.5*(-t2296 + t2191)/casadi.if_else(t2323, t2322, 1)
+    t2324 = (-t2296 + t2191)/casadi.if_else(t2323, 2*t2322, 1)
     t2325 = casadi.fabs(t2324)
     t2326 = (t2325 >= 1)
-    t2327 = casadi.fabs(1/casadi.if_else(t2326, t2324, 1))
+    t2327 = 1/casadi.fabs(casadi.if_else(t2326, t2324, 1))
     t2328 = casadi.if_else(t2323, casadi.if_else((t2324 >= 0), 1, -1)*casadi.if_else(t2326, t2327/(1 + casadi.sqrt(1 + t2327**2)), 1/(t2325 + casadi.sqrt(1 + t2325**2))), 0)
     t2329 = 1/casadi.sqrt(1 + t2328**2)
     t2330 = t2322*t2328
@@ -5541,10 +5541,10 @@ def _condition_number(q):
     t2356 = t2354 + t2328*t2353
     t2357 = t2196*t2335 + t2200*t2339 + t2204*t2343 + t2208*t2347 + t2212*t2351 + t2216*t2355
     t2358 = (t2357 != 0)
-    t2359 = 0.5*(-t2331 + t2192)/casadi.if_else(t2358, t2357, 1)
+    t2359 = (-t2331 + t2192)/casadi.if_else(t2358, 2*t2357, 1)
     t2360 = casadi.fabs(t2359)
     t2361 = (t2360 >= 1)
-    t2362 = casadi.fabs(1/casadi.if_else(t2361, t2359, 1))
+    t2362 = 1/casadi.fabs(casadi.if_else(t2361, t2359, 1))
     t2363 = casadi.if_else(t2358, casadi.if_else((t2359 >= 0), 1, -1)*casadi.if_else(t2361, t2362/(1 + casadi.sqrt(1 + t2362**2)), 1/(t2360 + casadi.sqrt(1 + t2360**2))), 0)
     t2364 = 1/casadi.sqrt(1 + t2363**2)
     t2365 = t2357*t2363
@@ -5575,10 +5575,10 @@ def _condition_number(q):
     t2390 = t2388 - t2363*t2389
     t2391 = t2389 + t2363*t2388
     t2392 = (t2287 != 0)
-    t2393 = 0.5*(-t2226 + t2261)/casadi.if_else(t2392, t2287, 1)
+    t2393 = (-t2226 + t2261)/casadi.if_else(t2392, 2*t2287, 1)
     t2394 = casadi.fabs(t2393)
     t2395 = (t2394 >= 1)
-    t2396 = casadi.fabs(1/casadi.if_else(t2395, t2393, 1))
+    t2396 = 1/casadi.fabs(casadi.if_else(t2395, t2393, 1))
     t2397 = casadi.if_else(t2392, casadi.if_else((t2393 >= 0), 1, -1)*casadi.if_else(t2395, t2396/(1 + casadi.sqrt(1 + t2396**2)), 1/(t2394 + casadi.sqrt(1 + t2394**2))), 0)
     t2398 = 1/casadi.sqrt(1 + t2397**2)
     t2399 = t2287*t2397
@@ -5610,10 +5610,10 @@ def _condition_number(q):
     t2425 = t2423 + t2397*t2422
     t2426 = t2301*t2404 + t2305*t2408 + t2309*t2412 + t2313*t2416 + t2317*t2420 + t2321*t2424
     t2427 = (t2426 != 0)
-    t2428 = 0.5*(-t2400 + t2297)/casadi.if_else(t2427, t2426, 1)
+    t2428 = (-t2400 + t2297)/casadi.if_else(t2427, 2*t2426, 1)
     t2429 = casadi.fabs(t2428)
     t2430 = (t2429 >= 1)
-    t2431 = casadi.fabs(1/casadi.if_else(t2430, t2428, 1))
+    t2431 = 1/casadi.fabs(casadi.if_else(t2430, t2428, 1))
     t2432 = casadi.if_else(t2427, casadi.if_else((t2428 >= 0), 1, -1)*casadi.if_else(t2430, t2431/(1 + casadi.sqrt(1 + t2431**2)), 1/(t2429 + casadi.sqrt(1 + t2429**2))), 0)
     t2433 = 1/casadi.sqrt(1 + t2432**2)
     t2434 = t2426*t2432
@@ -5646,10 +5646,10 @@ def _condition_number(q):
     t2461 = t2336*t2439 + t2340*t2443 + t2344*t2447 + t2348*t2451 + t2352*t2455 + t2356*t2459
     t2462 = t2405*t2440 + t2409*t2444 + t2413*t2448 + t2417*t2452 + t2421*t2456 + t2425*t2460
     t2463 = (t2461 != 0)
-    t2464 = 0.5*(-t2435 + t2332)/casadi.if_else(t2463, t2461, 1)
+    t2464 = (-t2435 + t2332)/casadi.if_else(t2463, 2*t2461, 1)
     t2465 = casadi.fabs(t2464)
     t2466 = (t2465 >= 1)
-    t2467 = casadi.fabs(1/casadi.if_else(t2466, t2464, 1))
+    t2467 = 1/casadi.fabs(casadi.if_else(t2466, t2464, 1))
     t2468 = casadi.if_else(t2463, casadi.if_else((t2464 >= 0), 1, -1)*casadi.if_else(t2466, t2467/(1 + casadi.sqrt(1 + t2467**2)), 1/(t2465 + casadi.sqrt(1 + t2465**2))), 0)
     t2469 = 1/casadi.sqrt(1 + t2468**2)
     t2470 = t2461*t2468
@@ -5681,10 +5681,10 @@ def _condition_number(q):
     t2496 = t2494 + t2468*t2493
     t2497 = t2371*t2475 + t2375*t2479 + t2379*t2483 + t2383*t2487 + t2387*t2491 + t2391*t2495
     t2498 = (t2497 != 0)
-    t2499 = 0.5*(-t2471 + t2367)/casadi.if_else(t2498, t2497, 1)
+    t2499 = (-t2471 + t2367)/casadi.if_else(t2498, 2*t2497, 1)
     t2500 = casadi.fabs(t2499)
     t2501 = (t2500 >= 1)
-    t2502 = casadi.fabs(1/casadi.if_else(t2501, t2499, 1))
+    t2502 = 1/casadi.fabs(casadi.if_else(t2501, t2499, 1))
     t2503 = casadi.if_else(t2498, casadi.if_else((t2499 >= 0), 1, -1)*casadi.if_else(t2501, t2502/(1 + casadi.sqrt(1 + t2502**2)), 1/(t2500 + casadi.sqrt(1 + t2500**2))), 0)
     t2504 = 1/casadi.sqrt(1 + t2503**2)
     t2505 = t2497*t2503
@@ -5716,10 +5716,10 @@ def _condition_number(q):
     t2531 = t2529 + t2503*t2528
     t2532 = t2370*t2510 + t2374*t2514 + t2378*t2518 + t2382*t2522 + t2386*t2526 + t2390*t2530
     t2533 = (t2462 != 0)
-    t2534 = 0.5*(-t2401 + t2436)/casadi.if_else(t2533, t2462, 1)
+    t2534 = (-t2401 + t2436)/casadi.if_else(t2533, 2*t2462, 1)
     t2535 = casadi.fabs(t2534)
     t2536 = (t2535 >= 1)
-    t2537 = casadi.fabs(1/casadi.if_else(t2536, t2534, 1))
+    t2537 = 1/casadi.fabs(casadi.if_else(t2536, t2534, 1))
     t2538 = casadi.if_else(t2533, casadi.if_else((t2534 >= 0), 1, -1)*casadi.if_else(t2536, t2537/(1 + casadi.sqrt(1 + t2537**2)), 1/(t2535 + casadi.sqrt(1 + t2535**2))), 0)
     t2539 = 1/casadi.sqrt(1 + t2538**2)
     t2540 = t2462*t2538
@@ -5751,10 +5751,10 @@ def _condition_number(q):
     t2566 = t2564 + t2538*t2563
     t2567 = t2476*t2545 + t2480*t2549 + t2484*t2553 + t2488*t2557 + t2492*t2561 + t2496*t2565
     t2568 = (t2567 != 0)
-    t2569 = 0.5*(-t2541 + t2472)/casadi.if_else(t2568, t2567, 1)
+    t2569 = (-t2541 + t2472)/casadi.if_else(t2568, 2*t2567, 1)
     t2570 = casadi.fabs(t2569)
     t2571 = (t2570 >= 1)
-    t2572 = casadi.fabs(1/casadi.if_else(t2571, t2569, 1))
+    t2572 = 1/casadi.fabs(casadi.if_else(t2571, t2569, 1))
     t2573 = casadi.if_else(t2568, casadi.if_else((t2569 >= 0), 1, -1)*casadi.if_else(t2571, t2572/(1 + casadi.sqrt(1 + t2572**2)), 1/(t2570 + casadi.sqrt(1 + t2570**2))), 0)
     t2574 = 1/casadi.sqrt(1 + t2573**2)
     t2575 = t2567*t2573
@@ -5787,10 +5787,10 @@ def _condition_number(q):
     t2602 = t2511*t2580 + t2515*t2584 + t2519*t2588 + t2523*t2592 + t2527*t2596 + t2531*t2600
     t2603 = t2546*t2581 + t2550*t2585 + t2554*t2589 + t2558*t2593 + t2562*t2597 + t2566*t2601
     t2604 = (t2602 != 0)
-    t2605 = 0.5*(-t2576 + t2507)/casadi.if_else(t2604, t2602, 1)
+    t2605 = (-t2576 + t2507)/casadi.if_else(t2604, 2*t2602, 1)
     t2606 = casadi.fabs(t2605)
     t2607 = (t2606 >= 1)
-    t2608 = casadi.fabs(1/casadi.if_else(t2607, t2605, 1))
+    t2608 = 1/casadi.fabs(casadi.if_else(t2607, t2605, 1))
     t2609 = casadi.if_else(t2604, casadi.if_else((t2605 >= 0), 1, -1)*casadi.if_else(t2607, t2608/(1 + casadi.sqrt(1 + t2608**2)), 1/(t2606 + casadi.sqrt(1 + t2606**2))), 0)
     t2610 = 1/casadi.sqrt(1 + t2609**2)
     t2611 = t2602*t2609
@@ -5821,10 +5821,10 @@ def _condition_number(q):
     t2636 = t2634 - t2609*t2635
     t2637 = t2635 + t2609*t2634
     t2638 = (t2603 != 0)
-    t2639 = 0.5*(-t2542 + t2577)/casadi.if_else(t2638, t2603, 1)
+    t2639 = (-t2542 + t2577)/casadi.if_else(t2638, 2*t2603, 1)
     t2640 = casadi.fabs(t2639)
     t2641 = (t2640 >= 1)
-    t2642 = casadi.fabs(1/casadi.if_else(t2641, t2639, 1))
+    t2642 = 1/casadi.fabs(casadi.if_else(t2641, t2639, 1))
     t2643 = casadi.if_else(t2638, casadi.if_else((t2639 >= 0), 1, -1)*casadi.if_else(t2641, t2642/(1 + casadi.sqrt(1 + t2642**2)), 1/(t2640 + casadi.sqrt(1 + t2640**2))), 0)
     t2644 = 1/casadi.sqrt(1 + t2643**2)
     t2645 = t2603*t2643
@@ -5856,10 +5856,10 @@ def _condition_number(q):
     t2671 = t2669 + t2643*t2668
     t2672 = t2617*t2650 + t2621*t2654 + t2625*t2658 + t2629*t2662 + t2633*t2666 + t2637*t2670
     t2673 = (t2672 != 0)
-    t2674 = 0.5*(-t2646 + t2613)/casadi.if_else(t2673, t2672, 1)
+    t2674 = (-t2646 + t2613)/casadi.if_else(t2673, 2*t2672, 1)
     t2675 = casadi.fabs(t2674)
     t2676 = (t2675 >= 1)
-    t2677 = casadi.fabs(1/casadi.if_else(t2676, t2674, 1))
+    t2677 = 1/casadi.fabs(casadi.if_else(t2676, t2674, 1))
     t2678 = casadi.if_else(t2673, casadi.if_else((t2674 >= 0), 1, -1)*casadi.if_else(t2676, t2677/(1 + casadi.sqrt(1 + t2677**2)), 1/(t2675 + casadi.sqrt(1 + t2675**2))), 0)
     t2679 = 1/casadi.sqrt(1 + t2678**2)
     t2680 = t2672*t2678
@@ -5891,10 +5891,10 @@ def _condition_number(q):
     t2706 = t2704 + t2678*t2703
     t2707 = t2651*t2686 + t2655*t2690 + t2659*t2694 + t2663*t2698 + t2667*t2702 + t2671*t2706
     t2708 = (t2707 != 0)
-    t2709 = 0.5*(-t2647 + t2682)/casadi.if_else(t2708, t2707, 1)
+    t2709 = (-t2647 + t2682)/casadi.if_else(t2708, 2*t2707, 1)
     t2710 = casadi.fabs(t2709)
     t2711 = (t2710 >= 1)
-    t2712 = casadi.fabs(1/casadi.if_else(t2711, t2709, 1))
+    t2712 = 1/casadi.fabs(casadi.if_else(t2711, t2709, 1))
     t2713 = casadi.if_else(t2708, casadi.if_else((t2709 >= 0), 1, -1)*casadi.if_else(t2711, t2712/(1 + casadi.sqrt(1 + t2712**2)), 1/(t2710 + casadi.sqrt(1 + t2710**2))), 0)
     t2714 = 1/casadi.sqrt(1 + t2713**2)
     t2715 = t2707*t2713
@@ -5925,10 +5925,10 @@ def _condition_number(q):
     t2740 = t2738 - t2713*t2739
     t2741 = t2739 + t2713*t2738
     t2742 = (t2532 != 0)
-    t2743 = 0.5*(-t2366 + t2506)/casadi.if_else(t2742, t2532, 1)
+    t2743 = (-t2366 + t2506)/casadi.if_else(t2742, 2*t2532, 1)
     t2744 = casadi.fabs(t2743)
     t2745 = (t2744 >= 1)
-    t2746 = casadi.fabs(1/casadi.if_else(t2745, t2743, 1))
+    t2746 = 1/casadi.fabs(casadi.if_else(t2745, t2743, 1))
     t2747 = casadi.if_else(t2742, casadi.if_else((t2743 >= 0), 1, -1)*casadi.if_else(t2745, t2746/(1 + casadi.sqrt(1 + t2746**2)), 1/(t2744 + casadi.sqrt(1 + t2744**2))), 0)
     t2748 = 1/casadi.sqrt(1 + t2747**2)
     t2749 = t2532*t2747
@@ -5960,10 +5960,10 @@ def _condition_number(q):
     t2775 = t2773 + t2747*t2772
     t2776 = t2616*t2754 + t2620*t2758 + t2624*t2762 + t2628*t2766 + t2632*t2770 + t2636*t2774
     t2777 = (t2776 != 0)
-    t2778 = 0.5*(-t2750 + t2612)/casadi.if_else(t2777, t2776, 1)
+    t2778 = (-t2750 + t2612)/casadi.if_else(t2777, 2*t2776, 1)
     t2779 = casadi.fabs(t2778)
     t2780 = (t2779 >= 1)
-    t2781 = casadi.fabs(1/casadi.if_else(t2780, t2778, 1))
+    t2781 = 1/casadi.fabs(casadi.if_else(t2780, t2778, 1))
     t2782 = casadi.if_else(t2777, casadi.if_else((t2778 >= 0), 1, -1)*casadi.if_else(t2780, t2781/(1 + casadi.sqrt(1 + t2781**2)), 1/(t2779 + casadi.sqrt(1 + t2779**2))), 0)
     t2783 = 1/casadi.sqrt(1 + t2782**2)
     t2784 = t2776*t2782
@@ -5996,10 +5996,10 @@ def _condition_number(q):
     t2811 = t2685*t2789 + t2689*t2793 + t2693*t2797 + t2697*t2801 + t2701*t2805 + t2705*t2809
     t2812 = t2755*t2790 + t2759*t2794 + t2763*t2798 + t2767*t2802 + t2771*t2806 + t2775*t2810
     t2813 = (t2811 != 0)
-    t2814 = 0.5*(-t2785 + t2681)/casadi.if_else(t2813, t2811, 1)
+    t2814 = (-t2785 + t2681)/casadi.if_else(t2813, 2*t2811, 1)
     t2815 = casadi.fabs(t2814)
     t2816 = (t2815 >= 1)
-    t2817 = casadi.fabs(1/casadi.if_else(t2816, t2814, 1))
+    t2817 = 1/casadi.fabs(casadi.if_else(t2816, t2814, 1))
     t2818 = casadi.if_else(t2813, casadi.if_else((t2814 >= 0), 1, -1)*casadi.if_else(t2816, t2817/(1 + casadi.sqrt(1 + t2817**2)), 1/(t2815 + casadi.sqrt(1 + t2815**2))), 0)
     t2819 = 1/casadi.sqrt(1 + t2818**2)
     t2820 = t2811*t2818
@@ -6031,10 +6031,10 @@ def _condition_number(q):
     t2846 = t2844 + t2818*t2843
     t2847 = t2720*t2825 + t2724*t2829 + t2728*t2833 + t2732*t2837 + t2736*t2841 + t2740*t2845
     t2848 = (t2847 != 0)
-    t2849 = 0.5*(-t2821 + t2716)/casadi.if_else(t2848, t2847, 1)
+    t2849 = (-t2821 + t2716)/casadi.if_else(t2848, 2*t2847, 1)
     t2850 = casadi.fabs(t2849)
     t2851 = (t2850 >= 1)
-    t2852 = casadi.fabs(1/casadi.if_else(t2851, t2849, 1))
+    t2852 = 1/casadi.fabs(casadi.if_else(t2851, t2849, 1))
     t2853 = casadi.if_else(t2848, casadi.if_else((t2849 >= 0), 1, -1)*casadi.if_else(t2851, t2852/(1 + casadi.sqrt(1 + t2852**2)), 1/(t2850 + casadi.sqrt(1 + t2850**2))), 0)
     t2854 = 1/casadi.sqrt(1 + t2853**2)
     t2855 = t2847*t2853
@@ -6066,10 +6066,10 @@ def _condition_number(q):
     t2881 = t2879 + t2853*t2878
     t2882 = t2721*t2860 + t2725*t2864 + t2729*t2868 + t2733*t2872 + t2737*t2876 + t2741*t2880
     t2883 = (t2882 != 0)
-    t2884 = 0.5*(-t2856 + t2717)/casadi.if_else(t2883, t2882, 1)
+    t2884 = (-t2856 + t2717)/casadi.if_else(t2883, 2*t2882, 1)
     t2885 = casadi.fabs(t2884)
     t2886 = (t2885 >= 1)
-    t2887 = casadi.fabs(1/casadi.if_else(t2886, t2884, 1))
+    t2887 = 1/casadi.fabs(casadi.if_else(t2886, t2884, 1))
     t2888 = casadi.if_else(t2883, casadi.if_else((t2884 >= 0), 1, -1)*casadi.if_else(t2886, t2887/(1 + casadi.sqrt(1 + t2887**2)), 1/(t2885 + casadi.sqrt(1 + t2885**2))), 0)
     t2889 = 1/casadi.sqrt(1 + t2888**2)
     t2890 = t2882*t2888
@@ -6100,10 +6100,10 @@ def _condition_number(q):
     t2915 = t2913 - t2888*t2914
     t2916 = t2914 + t2888*t2913
     t2917 = (t2812 != 0)
-    t2918 = 0.5*(-t2751 + t2786)/casadi.if_else(t2917, t2812, 1)
+    t2918 = (-t2751 + t2786)/casadi.if_else(t2917, 2*t2812, 1)
     t2919 = casadi.fabs(t2918)
     t2920 = (t2919 >= 1)
-    t2921 = casadi.fabs(1/casadi.if_else(t2920, t2918, 1))
+    t2921 = 1/casadi.fabs(casadi.if_else(t2920, t2918, 1))
     t2922 = casadi.if_else(t2917, casadi.if_else((t2918 >= 0), 1, -1)*casadi.if_else(t2920, t2921/(1 + casadi.sqrt(1 + t2921**2)), 1/(t2919 + casadi.sqrt(1 + t2919**2))), 0)
     t2923 = 1/casadi.sqrt(1 + t2922**2)
     t2924 = t2812*t2922
@@ -6135,10 +6135,10 @@ def _condition_number(q):
     t2950 = t2948 + t2922*t2947
     t2951 = t2826*t2929 + t2830*t2933 + t2834*t2937 + t2838*t2941 + t2842*t2945 + t2846*t2949
     t2952 = (t2951 != 0)
-    t2953 = 0.5*(-t2925 + t2822)/casadi.if_else(t2952, t2951, 1)
+    t2953 = (-t2925 + t2822)/casadi.if_else(t2952, 2*t2951, 1)
     t2954 = casadi.fabs(t2953)
     t2955 = (t2954 >= 1)
-    t2956 = casadi.fabs(1/casadi.if_else(t2955, t2953, 1))
+    t2956 = 1/casadi.fabs(casadi.if_else(t2955, t2953, 1))
     t2957 = casadi.if_else(t2952, casadi.if_else((t2953 >= 0), 1, -1)*casadi.if_else(t2955, t2956/(1 + casadi.sqrt(1 + t2956**2)), 1/(t2954 + casadi.sqrt(1 + t2954**2))), 0)
     t2958 = 1/casadi.sqrt(1 + t2957**2)
     t2959 = t2951*t2957
@@ -6171,10 +6171,10 @@ def _condition_number(q):
     t2986 = t2861*t2964 + t2865*t2968 + t2869*t2972 + t2873*t2976 + t2877*t2980 + t2881*t2984
     t2987 = t2930*t2965 + t2934*t2969 + t2938*t2973 + t2942*t2977 + t2946*t2981 + t2950*t2985
     t2988 = (t2986 != 0)
-    t2989 = 0.5*(-t2960 + t2857)/casadi.if_else(t2988, t2986, 1)
+    t2989 = (-t2960 + t2857)/casadi.if_else(t2988, 2*t2986, 1)
     t2990 = casadi.fabs(t2989)
     t2991 = (t2990 >= 1)
-    t2992 = casadi.fabs(1/casadi.if_else(t2991, t2989, 1))
+    t2992 = 1/casadi.fabs(casadi.if_else(t2991, t2989, 1))
     t2993 = casadi.if_else(t2988, casadi.if_else((t2989 >= 0), 1, -1)*casadi.if_else(t2991, t2992/(1 + casadi.sqrt(1 + t2992**2)), 1/(t2990 + casadi.sqrt(1 + t2990**2))), 0)
     t2994 = 1/casadi.sqrt(1 + t2993**2)
     t2995 = t2986*t2993
@@ -6206,10 +6206,10 @@ def _condition_number(q):
     t3021 = t3019 + t2993*t3018
     t3022 = t2896*t3000 + t2900*t3004 + t2904*t3008 + t2908*t3012 + t2912*t3016 + t2916*t3020
     t3023 = (t3022 != 0)
-    t3024 = 0.5*(-t2996 + t2892)/casadi.if_else(t3023, t3022, 1)
+    t3024 = (-t2996 + t2892)/casadi.if_else(t3023, 2*t3022, 1)
     t3025 = casadi.fabs(t3024)
     t3026 = (t3025 >= 1)
-    t3027 = casadi.fabs(1/casadi.if_else(t3026, t3024, 1))
+    t3027 = 1/casadi.fabs(casadi.if_else(t3026, t3024, 1))
     t3028 = casadi.if_else(t3023, casadi.if_else((t3024 >= 0), 1, -1)*casadi.if_else(t3026, t3027/(1 + casadi.sqrt(1 + t3027**2)), 1/(t3025 + casadi.sqrt(1 + t3025**2))), 0)
     t3029 = 1/casadi.sqrt(1 + t3028**2)
     t3030 = t3022*t3028
@@ -6241,10 +6241,10 @@ def _condition_number(q):
     t3056 = t3054 + t3028*t3053
     t3057 = t2895*t3035 + t2899*t3039 + t2903*t3043 + t2907*t3047 + t2911*t3051 + t2915*t3055
     t3058 = (t2987 != 0)
-    t3059 = 0.5*(-t2926 + t2961)/casadi.if_else(t3058, t2987, 1)
+    t3059 = (-t2926 + t2961)/casadi.if_else(t3058, 2*t2987, 1)
     t3060 = casadi.fabs(t3059)
     t3061 = (t3060 >= 1)
-    t3062 = casadi.fabs(1/casadi.if_else(t3061, t3059, 1))
+    t3062 = 1/casadi.fabs(casadi.if_else(t3061, t3059, 1))
     t3063 = casadi.if_else(t3058, casadi.if_else((t3059 >= 0), 1, -1)*casadi.if_else(t3061, t3062/(1 + casadi.sqrt(1 + t3062**2)), 1/(t3060 + casadi.sqrt(1 + t3060**2))), 0)
     t3064 = 1/casadi.sqrt(1 + t3063**2)
     t3065 = t2987*t3063
@@ -6276,10 +6276,10 @@ def _condition_number(q):
     t3091 = t3089 + t3063*t3088
     t3092 = t3001*t3070 + t3005*t3074 + t3009*t3078 + t3013*t3082 + t3017*t3086 + t3021*t3090
     t3093 = (t3092 != 0)
-    t3094 = 0.5*(-t3066 + t2997)/casadi.if_else(t3093, t3092, 1)
+    t3094 = (-t3066 + t2997)/casadi.if_else(t3093, 2*t3092, 1)
     t3095 = casadi.fabs(t3094)
     t3096 = (t3095 >= 1)
-    t3097 = casadi.fabs(1/casadi.if_else(t3096, t3094, 1))
+    t3097 = 1/casadi.fabs(casadi.if_else(t3096, t3094, 1))
     t3098 = casadi.if_else(t3093, casadi.if_else((t3094 >= 0), 1, -1)*casadi.if_else(t3096, t3097/(1 + casadi.sqrt(1 + t3097**2)), 1/(t3095 + casadi.sqrt(1 + t3095**2))), 0)
     t3099 = 1/casadi.sqrt(1 + t3098**2)
     t3100 = t3092*t3098
@@ -6312,10 +6312,10 @@ def _condition_number(q):
     t3127 = t3036*t3105 + t3040*t3109 + t3044*t3113 + t3048*t3117 + t3052*t3121 + t3056*t3125
     t3128 = t3071*t3106 + t3075*t3110 + t3079*t3114 + t3083*t3118 + t3087*t3122 + t3091*t3126
     t3129 = (t3127 != 0)
-    t3130 = 0.5*(-t3101 + t3032)/casadi.if_else(t3129, t3127, 1)
+    t3130 = (-t3101 + t3032)/casadi.if_else(t3129, 2*t3127, 1)
     t3131 = casadi.fabs(t3130)
     t3132 = (t3131 >= 1)
-    t3133 = casadi.fabs(1/casadi.if_else(t3132, t3130, 1))
+    t3133 = 1/casadi.fabs(casadi.if_else(t3132, t3130, 1))
     t3134 = casadi.if_else(t3129, casadi.if_else((t3130 >= 0), 1, -1)*casadi.if_else(t3132, t3133/(1 + casadi.sqrt(1 + t3133**2)), 1/(t3131 + casadi.sqrt(1 + t3131**2))), 0)
     t3135 = 1/casadi.sqrt(1 + t3134**2)
     t3136 = t3127*t3134
@@ -6346,10 +6346,10 @@ def _condition_number(q):
     t3161 = t3159 - t3134*t3160
     t3162 = t3160 + t3134*t3159
     t3163 = (t3128 != 0)
-    t3164 = 0.5*(-t3067 + t3102)/casadi.if_else(t3163, t3128, 1)
+    t3164 = (-t3067 + t3102)/casadi.if_else(t3163, 2*t3128, 1)
     t3165 = casadi.fabs(t3164)
     t3166 = (t3165 >= 1)
-    t3167 = casadi.fabs(1/casadi.if_else(t3166, t3164, 1))
+    t3167 = 1/casadi.fabs(casadi.if_else(t3166, t3164, 1))
     t3168 = casadi.if_else(t3163, casadi.if_else((t3164 >= 0), 1, -1)*casadi.if_else(t3166, t3167/(1 + casadi.sqrt(1 + t3167**2)), 1/(t3165 + casadi.sqrt(1 + t3165**2))), 0)
     t3169 = 1/casadi.sqrt(1 + t3168**2)
     t3170 = t3128*t3168
@@ -6381,10 +6381,10 @@ def _condition_number(q):
     t3196 = t3194 + t3168*t3193
     t3197 = t3142*t3175 + t3146*t3179 + t3150*t3183 + t3154*t3187 + t3158*t3191 + t3162*t3195
     t3198 = (t3197 != 0)
-    t3199 = 0.5*(-t3171 + t3138)/casadi.if_else(t3198, t3197, 1)
+    t3199 = (-t3171 + t3138)/casadi.if_else(t3198, 2*t3197, 1)
     t3200 = casadi.fabs(t3199)
     t3201 = (t3200 >= 1)
-    t3202 = casadi.fabs(1/casadi.if_else(t3201, t3199, 1))
+    t3202 = 1/casadi.fabs(casadi.if_else(t3201, t3199, 1))
     t3203 = casadi.if_else(t3198, casadi.if_else((t3199 >= 0), 1, -1)*casadi.if_else(t3201, t3202/(1 + casadi.sqrt(1 + t3202**2)), 1/(t3200 + casadi.sqrt(1 + t3200**2))), 0)
     t3204 = 1/casadi.sqrt(1 + t3203**2)
     t3205 = t3197*t3203
@@ -6416,10 +6416,10 @@ def _condition_number(q):
     t3231 = t3229 + t3203*t3228
     t3232 = t3176*t3211 + t3180*t3215 + t3184*t3219 + t3188*t3223 + t3192*t3227 + t3196*t3231
     t3233 = (t3232 != 0)
-    t3234 = 0.5*(-t3172 + t3207)/casadi.if_else(t3233, t3232, 1)
+    t3234 = (-t3172 + t3207)/casadi.if_else(t3233, 2*t3232, 1)
     t3235 = casadi.fabs(t3234)
     t3236 = (t3235 >= 1)
-    t3237 = casadi.fabs(1/casadi.if_else(t3236, t3234, 1))
+    t3237 = 1/casadi.fabs(casadi.if_else(t3236, t3234, 1))
     t3238 = casadi.if_else(t3233, casadi.if_else((t3234 >= 0), 1, -1)*casadi.if_else(t3236, t3237/(1 + casadi.sqrt(1 + t3237**2)), 1/(t3235 + casadi.sqrt(1 + t3235**2))), 0)
     t3239 = 1/casadi.sqrt(1 + t3238**2)
     t3240 = t3232*t3238
@@ -6450,10 +6450,10 @@ def _condition_number(q):
     t3265 = t3263 - t3238*t3264
     t3266 = t3264 + t3238*t3263
     t3267 = (t3057 != 0)
-    t3268 = 0.5*(-t2891 + t3031)/casadi.if_else(t3267, t3057, 1)
+    t3268 = (-t2891 + t3031)/casadi.if_else(t3267, 2*t3057, 1)
     t3269 = casadi.fabs(t3268)
     t3270 = (t3269 >= 1)
-    t3271 = casadi.fabs(1/casadi.if_else(t3270, t3268, 1))
+    t3271 = 1/casadi.fabs(casadi.if_else(t3270, t3268, 1))
     t3272 = casadi.if_else(t3267, casadi.if_else((t3268 >= 0), 1, -1)*casadi.if_else(t3270, t3271/(1 + casadi.sqrt(1 + t3271**2)), 1/(t3269 + casadi.sqrt(1 + t3269**2))), 0)
     t3273 = 1/casadi.sqrt(1 + t3272**2)
     t3274 = t3057*t3272
@@ -6485,10 +6485,10 @@ def _condition_number(q):
     t3300 = t3298 + t3272*t3297
     t3301 = t3141*t3279 + t3145*t3283 + t3149*t3287 + t3153*t3291 + t3157*t3295 + t3161*t3299
     t3302 = (t3301 != 0)
-    t3303 = 0.5*(-t3275 + t3137)/casadi.if_else(t3302, t3301, 1)
+    t3303 = (-t3275 + t3137)/casadi.if_else(t3302, 2*t3301, 1)
     t3304 = casadi.fabs(t3303)
     t3305 = (t3304 >= 1)
-    t3306 = casadi.fabs(1/casadi.if_else(t3305, t3303, 1))
+    t3306 = 1/casadi.fabs(casadi.if_else(t3305, t3303, 1))
     t3307 = casadi.if_else(t3302, casadi.if_else((t3303 >= 0), 1, -1)*casadi.if_else(t3305, t3306/(1 + casadi.sqrt(1 + t3306**2)), 1/(t3304 + casadi.sqrt(1 + t3304**2))), 0)
     t3308 = 1/casadi.sqrt(1 + t3307**2)
     t3309 = t3301*t3307
@@ -6521,10 +6521,10 @@ def _condition_number(q):
     t3336 = t3210*t3314 + t3214*t3318 + t3218*t3322 + t3222*t3326 + t3226*t3330 + t3230*t3334
     t3337 = t3280*t3315 + t3284*t3319 + t3288*t3323 + t3292*t3327 + t3296*t3331 + t3300*t3335
     t3338 = (t3336 != 0)
-    t3339 = 0.5*(-t3310 + t3206)/casadi.if_else(t3338, t3336, 1)
+    t3339 = (-t3310 + t3206)/casadi.if_else(t3338, 2*t3336, 1)
     t3340 = casadi.fabs(t3339)
     t3341 = (t3340 >= 1)
-    t3342 = casadi.fabs(1/casadi.if_else(t3341, t3339, 1))
+    t3342 = 1/casadi.fabs(casadi.if_else(t3341, t3339, 1))
     t3343 = casadi.if_else(t3338, casadi.if_else((t3339 >= 0), 1, -1)*casadi.if_else(t3341, t3342/(1 + casadi.sqrt(1 + t3342**2)), 1/(t3340 + casadi.sqrt(1 + t3340**2))), 0)
     t3344 = 1/casadi.sqrt(1 + t3343**2)
     t3345 = t3336*t3343
@@ -6556,10 +6556,10 @@ def _condition_number(q):
     t3371 = t3369 + t3343*t3368
     t3372 = t3245*t3350 + t3249*t3354 + t3253*t3358 + t3257*t3362 + t3261*t3366 + t3265*t3370
     t3373 = (t3372 != 0)
-    t3374 = 0.5*(-t3346 + t3241)/casadi.if_else(t3373, t3372, 1)
+    t3374 = (-t3346 + t3241)/casadi.if_else(t3373, 2*t3372, 1)
     t3375 = casadi.fabs(t3374)
     t3376 = (t3375 >= 1)
-    t3377 = casadi.fabs(1/casadi.if_else(t3376, t3374, 1))
+    t3377 = 1/casadi.fabs(casadi.if_else(t3376, t3374, 1))
     t3378 = casadi.if_else(t3373, casadi.if_else((t3374 >= 0), 1, -1)*casadi.if_else(t3376, t3377/(1 + casadi.sqrt(1 + t3377**2)), 1/(t3375 + casadi.sqrt(1 + t3375**2))), 0)
     t3379 = 1/casadi.sqrt(1 + t3378**2)
     t3380 = t3372*t3378
@@ -6591,10 +6591,10 @@ def _condition_number(q):
     t3406 = t3404 + t3378*t3403
     t3407 = t3246*t3385 + t3250*t3389 + t3254*t3393 + t3258*t3397 + t3262*t3401 + t3266*t3405
     t3408 = (t3407 != 0)
-    t3409 = 0.5*(-t3381 + t3242)/casadi.if_else(t3408, t3407, 1)
+    t3409 = (-t3381 + t3242)/casadi.if_else(t3408, 2*t3407, 1)
     t3410 = casadi.fabs(t3409)
     t3411 = (t3410 >= 1)
-    t3412 = casadi.fabs(1/casadi.if_else(t3411, t3409, 1))
+    t3412 = 1/casadi.fabs(casadi.if_else(t3411, t3409, 1))
     t3413 = casadi.if_else(t3408, casadi.if_else((t3409 >= 0), 1, -1)*casadi.if_else(t3411, t3412/(1 + casadi.sqrt(1 + t3412**2)), 1/(t3410 + casadi.sqrt(1 + t3410**2))), 0)
     t3414 = 1/casadi.sqrt(1 + t3413**2)
     t3415 = t3242 + t3407*t3413
@@ -6624,10 +6624,10 @@ def _condition_number(q):
     t3439 = t3437 + t3413*t3436
     t3440 = casadi.sqrt(t3418**2 + t3422**2 + t3426**2 + t3430**2 + t3434**2 + t3438**2)
     t3441 = (t3337 != 0)
-    t3442 = 0.5*(-t3276 + t3311)/casadi.if_else(t3441, t3337, 1)
+    t3442 = (-t3276 + t3311)/casadi.if_else(t3441, 2*t3337, 1)
     t3443 = casadi.fabs(t3442)
     t3444 = (t3443 >= 1)
-    t3445 = casadi.fabs(1/casadi.if_else(t3444, t3442, 1))
+    t3445 = 1/casadi.fabs(casadi.if_else(t3444, t3442, 1))
     t3446 = casadi.if_else(t3441, casadi.if_else((t3442 >= 0), 1, -1)*casadi.if_else(t3444, t3445/(1 + casadi.sqrt(1 + t3445**2)), 1/(t3443 + casadi.sqrt(1 + t3443**2))), 0)
     t3447 = 1/casadi.sqrt(1 + t3446**2)
     t3448 = t3337*t3446
@@ -6659,10 +6659,10 @@ def _condition_number(q):
     t3474 = t3472 + t3446*t3471
     t3475 = t3351*t3453 + t3355*t3457 + t3359*t3461 + t3363*t3465 + t3367*t3469 + t3371*t3473
     t3476 = (t3475 != 0)
-    t3477 = 0.5*(-t3449 + t3347)/casadi.if_else(t3476, t3475, 1)
+    t3477 = (-t3449 + t3347)/casadi.if_else(t3476, 2*t3475, 1)
     t3478 = casadi.fabs(t3477)
     t3479 = (t3478 >= 1)
-    t3480 = casadi.fabs(1/casadi.if_else(t3479, t3477, 1))
+    t3480 = 1/casadi.fabs(casadi.if_else(t3479, t3477, 1))
     t3481 = casadi.if_else(t3476, casadi.if_else((t3477 >= 0), 1, -1)*casadi.if_else(t3479, t3480/(1 + casadi.sqrt(1 + t3480**2)), 1/(t3478 + casadi.sqrt(1 + t3478**2))), 0)
     t3482 = 1/casadi.sqrt(1 + t3481**2)
     t3483 = t3475*t3481
@@ -6695,10 +6695,10 @@ def _condition_number(q):
     t3510 = t3386*t3488 + t3390*t3492 + t3394*t3496 + t3398*t3500 + t3402*t3504 + t3406*t3508
     t3511 = t3454*t3489 + t3458*t3493 + t3462*t3497 + t3466*t3501 + t3470*t3505 + t3474*t3509
     t3512 = (t3510 != 0)
-    t3513 = 0.5*(-t3484 + t3382)/casadi.if_else(t3512, t3510, 1)
+    t3513 = (-t3484 + t3382)/casadi.if_else(t3512, 2*t3510, 1)
     t3514 = casadi.fabs(t3513)
     t3515 = (t3514 >= 1)
-    t3516 = casadi.fabs(1/casadi.if_else(t3515, t3513, 1))
+    t3516 = 1/casadi.fabs(casadi.if_else(t3515, t3513, 1))
     t3517 = casadi.if_else(t3512, casadi.if_else((t3513 >= 0), 1, -1)*casadi.if_else(t3515, t3516/(1 + casadi.sqrt(1 + t3516**2)), 1/(t3514 + casadi.sqrt(1 + t3514**2))), 0)
     t3518 = 1/casadi.sqrt(1 + t3517**2)
     t3519 = t3510*t3517
@@ -6730,10 +6730,10 @@ def _condition_number(q):
     t3545 = t3543 + t3517*t3542
     t3546 = t3419*t3524 + t3423*t3528 + t3427*t3532 + t3431*t3536 + t3435*t3540 + t3439*t3544
     t3547 = (t3546 != 0)
-    t3548 = 0.5*(-t3520 + t3415)/casadi.if_else(t3547, t3546, 1)
+    t3548 = (-t3520 + t3415)/casadi.if_else(t3547, 2*t3546, 1)
     t3549 = casadi.fabs(t3548)
     t3550 = (t3549 >= 1)
-    t3551 = casadi.fabs(1/casadi.if_else(t3550, t3548, 1))
+    t3551 = 1/casadi.fabs(casadi.if_else(t3550, t3548, 1))
     t3552 = casadi.if_else(t3547, casadi.if_else((t3548 >= 0), 1, -1)*casadi.if_else(t3550, t3551/(1 + casadi.sqrt(1 + t3551**2)), 1/(t3549 + casadi.sqrt(1 + t3549**2))), 0)
     t3553 = 1/casadi.sqrt(1 + t3552**2)
     t3554 = t3415 + t3546*t3552
@@ -6765,10 +6765,10 @@ def _condition_number(q):
     t3580 = casadi.if_else((t3579 > t3440), t3579, t3440)
     t3581 = casadi.if_else((t3579 < t3440), t3579, t3440)
     t3582 = (t3511 != 0)
-    t3583 = 0.5*(-t3450 + t3485)/casadi.if_else(t3582, t3511, 1)
+    t3583 = (-t3450 + t3485)/casadi.if_else(t3582, 2*t3511, 1)
     t3584 = casadi.fabs(t3583)
     t3585 = (t3584 >= 1)
-    t3586 = casadi.fabs(1/casadi.if_else(t3585, t3583, 1))
+    t3586 = 1/casadi.fabs(casadi.if_else(t3585, t3583, 1))
     t3587 = casadi.if_else(t3582, casadi.if_else((t3583 >= 0), 1, -1)*casadi.if_else(t3585, t3586/(1 + casadi.sqrt(1 + t3586**2)), 1/(t3584 + casadi.sqrt(1 + t3584**2))), 0)
     t3588 = 1/casadi.sqrt(1 + t3587**2)
     t3589 = t3511*t3587
@@ -6800,10 +6800,10 @@ def _condition_number(q):
     t3615 = t3613 + t3587*t3612
     t3616 = t3525*t3594 + t3529*t3598 + t3533*t3602 + t3537*t3606 + t3541*t3610 + t3545*t3614
     t3617 = (t3616 != 0)
-    t3618 = 0.5*(-t3590 + t3521)/casadi.if_else(t3617, t3616, 1)
+    t3618 = (-t3590 + t3521)/casadi.if_else(t3617, 2*t3616, 1)
     t3619 = casadi.fabs(t3618)
     t3620 = (t3619 >= 1)
-    t3621 = casadi.fabs(1/casadi.if_else(t3620, t3618, 1))
+    t3621 = 1/casadi.fabs(casadi.if_else(t3620, t3618, 1))
     t3622 = casadi.if_else(t3617, casadi.if_else((t3618 >= 0), 1, -1)*casadi.if_else(t3620, t3621/(1 + casadi.sqrt(1 + t3621**2)), 1/(t3619 + casadi.sqrt(1 + t3619**2))), 0)
     t3623 = 1/casadi.sqrt(1 + t3622**2)
     t3624 = t3616*t3622
@@ -6836,10 +6836,10 @@ def _condition_number(q):
     t3651 = t3558*t3629 + t3562*t3633 + t3566*t3637 + t3570*t3641 + t3574*t3645 + t3578*t3649
     t3652 = t3595*t3630 + t3599*t3634 + t3603*t3638 + t3607*t3642 + t3611*t3646 + t3615*t3650
     t3653 = (t3651 != 0)
-    t3654 = 0.5*(-t3625 + t3554)/casadi.if_else(t3653, t3651, 1)
+    t3654 = (-t3625 + t3554)/casadi.if_else(t3653, 2*t3651, 1)
     t3655 = casadi.fabs(t3654)
     t3656 = (t3655 >= 1)
-    t3657 = casadi.fabs(1/casadi.if_else(t3656, t3654, 1))
+    t3657 = 1/casadi.fabs(casadi.if_else(t3656, t3654, 1))
     t3658 = casadi.if_else(t3653, casadi.if_else((t3654 >= 0), 1, -1)*casadi.if_else(t3656, t3657/(1 + casadi.sqrt(1 + t3657**2)), 1/(t3655 + casadi.sqrt(1 + t3655**2))), 0)
     t3659 = 1/casadi.sqrt(1 + t3658**2)
     t3660 = t3554 + t3651*t3658
@@ -6871,10 +6871,10 @@ def _condition_number(q):
     t3686 = casadi.if_else((t3685 > t3580), t3685, t3580)
     t3687 = casadi.if_else((t3685 < t3581), t3685, t3581)
     t3688 = (t3652 != 0)
-    t3689 = 0.5*(-t3591 + t3626)/casadi.if_else(t3688, t3652, 1)
+    t3689 = (-t3591 + t3626)/casadi.if_else(t3688, 2*t3652, 1)
     t3690 = casadi.fabs(t3689)
     t3691 = (t3690 >= 1)
-    t3692 = casadi.fabs(1/casadi.if_else(t3691, t3689, 1))
+    t3692 = 1/casadi.fabs(casadi.if_else(t3691, t3689, 1))
     t3693 = casadi.if_else(t3688, casadi.if_else((t3689 >= 0), 1, -1)*casadi.if_else(t3691, t3692/(1 + casadi.sqrt(1 + t3692**2)), 1/(t3690 + casadi.sqrt(1 + t3690**2))), 0)
     t3694 = 1/casadi.sqrt(1 + t3693**2)
     t3695 = t3652*t3693
@@ -6906,10 +6906,10 @@ def _condition_number(q):
     t3721 = t3719 + t3693*t3718
     t3722 = t3664*t3700 + t3668*t3704 + t3672*t3708 + t3676*t3712 + t3680*t3716 + t3684*t3720
     t3723 = (t3722 != 0)
-    t3724 = 0.5*(-t3696 + t3660)/casadi.if_else(t3723, t3722, 1)
+    t3724 = (-t3696 + t3660)/casadi.if_else(t3723, 2*t3722, 1)
     t3725 = casadi.fabs(t3724)
     t3726 = (t3725 >= 1)
-    t3727 = casadi.fabs(1/casadi.if_else(t3726, t3724, 1))
+    t3727 = 1/casadi.fabs(casadi.if_else(t3726, t3724, 1))
     t3728 = casadi.if_else(t3723, casadi.if_else((t3724 >= 0), 1, -1)*casadi.if_else(t3726, t3727/(1 + casadi.sqrt(1 + t3727**2)), 1/(t3725 + casadi.sqrt(1 + t3725**2))), 0)
     t3729 = 1/casadi.sqrt(1 + t3728**2)
     t3730 = t3660 + t3722*t3728
@@ -6942,10 +6942,10 @@ def _condition_number(q):
     t3757 = casadi.if_else((t3756 > t3686), t3756, t3686)
     t3758 = casadi.if_else((t3756 < t3687), t3756, t3687)
     t3759 = (t3755 != 0)
-    t3760 = 0.5*(-t3697 + t3730)/casadi.if_else(t3759, t3755, 1)
+    t3760 = (-t3697 + t3730)/casadi.if_else(t3759, 2*t3755, 1)
     t3761 = casadi.fabs(t3760)
     t3762 = (t3761 >= 1)
-    t3763 = casadi.fabs(1/casadi.if_else(t3762, t3760, 1))
+    t3763 = 1/casadi.fabs(casadi.if_else(t3762, t3760, 1))
     t3764 = casadi.if_else(t3759, casadi.if_else((t3760 >= 0), 1, -1)*casadi.if_else(t3762, t3763/(1 + casadi.sqrt(1 + t3763**2)), 1/(t3761 + casadi.sqrt(1 + t3761**2))), 0)
     t3765 = 1/casadi.sqrt(1 + t3764**2)
     t3766 = t3701*t3765
@@ -6978,8 +6978,10 @@ def _condition_number(q):
     t3793 = casadi.if_else((t3790 < t3758), t3790, t3758)
     t3794 = casadi.if_else((t3791 > t3792), t3791, t3792)
     t3795 = casadi.if_else((t3791 < t3793), t3791, t3793)
+    t3796 = casadi.if_else((t3795 <= 1e-12*t3794), 0, t3795)
+    t3797 = casadi.if_else((t3794 > 0), t3794, 1)
     kappa = casadi.SX(1, 1)
-    kappa[0, 0] = casadi.if_else((t3794 > 0), t3794, 1)/casadi.if_else((t3795 <= 1e-12*t3794), 0, t3795)
+    kappa[0, 0] = t3797/t3796
     return [kappa]
 
 

@@ -4086,10 +4086,10 @@ def velocity_ellipsoid(q):
     t147 = t144**2
     t148 = t117*t121
     t149 = xp.not_equal(t148, 0)
-    t150 = 0.5*(-t145 + t146)/xp.where(t149, -t148, 1)
+    t150 = (-t145 + t146)/xp.where(t149, -2*t148, 1)
     t151 = xp.abs(t150)
     t152 = xp.greater_equal(t151, 1)
-    t153 = xp.abs(1/xp.where(t152, t150, 1))
+    t153 = 1/xp.abs(xp.where(t152, t150, 1))
     t154 = xp.where(t149, xp.where(xp.greater_equal(t150, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t152, t153/(1 + xp.sqrt(1 + t153**2)), 1/(t151 + xp.sqrt(1 + t151**2))), 0)
     t155 = 1/xp.sqrt(1 + t154**2)
     t156 = t148*t154
@@ -4105,10 +4105,10 @@ def velocity_ellipsoid(q):
     t166 = t165*t154
     t167 = t163*t161 + t166*t138
     t168 = xp.not_equal(t167, 0)
-    t169 = 0.5*(-t157 + t164)/xp.where(t168, t167, 1)
+    t169 = (-t157 + t164)/xp.where(t168, 2*t167, 1)
     t170 = xp.abs(t169)
     t171 = xp.greater_equal(t170, 1)
-    t172 = xp.abs(1/xp.where(t171, t169, 1))
+    t172 = 1/xp.abs(xp.where(t171, t169, 1))
     t173 = xp.where(t168, xp.where(xp.greater_equal(t169, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t171, t172/(1 + xp.sqrt(1 + t172**2)), 1/(t170 + xp.sqrt(1 + t170**2))), 0)
     t174 = 1/xp.sqrt(1 + t173**2)
     t175 = t167*t173
@@ -4124,10 +4124,10 @@ def velocity_ellipsoid(q):
     t185 = t183 + t182*t173
     t186 = t162*t181 + t165*t185
     t187 = xp.not_equal(t186, 0)
-    t188 = 0.5*(-t158 + t177)/xp.where(t187, -t186, 1)
+    t188 = (-t158 + t177)/xp.where(t187, -2*t186, 1)
     t189 = xp.abs(t188)
     t190 = xp.greater_equal(t189, 1)
-    t191 = xp.abs(1/xp.where(t190, t188, 1))
+    t191 = 1/xp.abs(xp.where(t190, t188, 1))
     t192 = xp.where(t187, xp.where(xp.greater_equal(t188, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t190, t191/(1 + xp.sqrt(1 + t191**2)), 1/(t189 + xp.sqrt(1 + t189**2))), 0)
     t193 = 1/xp.sqrt(1 + t192**2)
     t194 = t186*t192
@@ -4153,10 +4153,10 @@ def velocity_ellipsoid(q):
     t214 = t192*t193
     t215 = t180*t199 - t184*t204 + t147*t208*t214*t174
     t216 = xp.not_equal(t215, 0)
-    t217 = 0.5*(-t176 + t195)/xp.where(t216, t215, 1)
+    t217 = (-t176 + t195)/xp.where(t216, 2*t215, 1)
     t218 = xp.abs(t217)
     t219 = xp.greater_equal(t218, 1)
-    t220 = xp.abs(1/xp.where(t219, t217, 1))
+    t220 = 1/xp.abs(xp.where(t219, t217, 1))
     t221 = xp.where(t216, xp.where(xp.greater_equal(t217, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t219, t220/(1 + xp.sqrt(1 + t220**2)), 1/(t218 + xp.sqrt(1 + t218**2))), 0)
     t222 = 1/xp.sqrt(1 + t221**2)
     t223 = t215*t221
@@ -4190,10 +4190,10 @@ def velocity_ellipsoid(q):
     t251 = t174*t193
     t252 = t200*t228 + t205*t232 - t144*t251*t241
     t253 = xp.not_equal(t252, 0)
-    t254 = 0.5*(-t224 + t196)/xp.where(t253, t252, 1)
+    t254 = (-t224 + t196)/xp.where(t253, 2*t252, 1)
     t255 = xp.abs(t254)
     t256 = xp.greater_equal(t255, 1)
-    t257 = xp.abs(1/xp.where(t256, t254, 1))
+    t257 = 1/xp.abs(xp.where(t256, t254, 1))
     t258 = xp.where(t253, xp.where(xp.greater_equal(t254, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t256, t257/(1 + xp.sqrt(1 + t257**2)), 1/(t255 + xp.sqrt(1 + t255**2))), 0)
     t259 = 1/xp.sqrt(1 + t258**2)
     t260 = t252*t258
@@ -4225,10 +4225,10 @@ def velocity_ellipsoid(q):
     t286 = t285 - t272*t258
     t287 = t272 + t285*t258
     t288 = xp.not_equal(t276, 0)
-    t289 = 0.5*(-t225 + t262)/xp.where(t288, t276, 1)
+    t289 = (-t225 + t262)/xp.where(t288, 2*t276, 1)
     t290 = xp.abs(t289)
     t291 = xp.greater_equal(t290, 1)
-    t292 = xp.abs(1/xp.where(t291, t289, 1))
+    t292 = 1/xp.abs(xp.where(t291, t289, 1))
     t293 = xp.where(t288, xp.where(xp.greater_equal(t289, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t291, t292/(1 + xp.sqrt(1 + t292**2)), 1/(t290 + xp.sqrt(1 + t290**2))), 0)
     t294 = 1/xp.sqrt(1 + t293**2)
     t295 = t276*t293
@@ -4260,10 +4260,10 @@ def velocity_ellipsoid(q):
     t321 = t319 + t320*t293
     t322 = t320 - t319*t293
     t323 = xp.not_equal(t310, 0)
-    t324 = 0.5*(-t261 + t296)/xp.where(t323, t310, 1)
+    t324 = (-t261 + t296)/xp.where(t323, 2*t310, 1)
     t325 = xp.abs(t324)
     t326 = xp.greater_equal(t325, 1)
-    t327 = xp.abs(1/xp.where(t326, t324, 1))
+    t327 = 1/xp.abs(xp.where(t326, t324, 1))
     t328 = xp.where(t323, xp.where(xp.greater_equal(t324, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t326, t327/(1 + xp.sqrt(1 + t327**2)), 1/(t325 + xp.sqrt(1 + t325**2))), 0)
     t329 = 1/xp.sqrt(1 + t328**2)
     t330 = t310*t328
@@ -4295,10 +4295,10 @@ def velocity_ellipsoid(q):
     t356 = t354 + t355*t328
     t357 = -t355 + t354*t328
     t358 = xp.not_equal(t345, 0)
-    t359 = 0.5*(-t331 + t297)/xp.where(t358, t345, 1)
+    t359 = (-t331 + t297)/xp.where(t358, 2*t345, 1)
     t360 = xp.abs(t359)
     t361 = xp.greater_equal(t360, 1)
-    t362 = xp.abs(1/xp.where(t361, t359, 1))
+    t362 = 1/xp.abs(xp.where(t361, t359, 1))
     t363 = xp.where(t358, xp.where(xp.greater_equal(t359, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t361, t362/(1 + xp.sqrt(1 + t362**2)), 1/(t360 + xp.sqrt(1 + t360**2))), 0)
     t364 = 1/xp.sqrt(1 + t363**2)
     t365 = t345*t363
@@ -4330,10 +4330,10 @@ def velocity_ellipsoid(q):
     t391 = t389 - t390*t363
     t392 = t390 + t389*t363
     t393 = xp.not_equal(t380, 0)
-    t394 = 0.5*(-t332 + t367)/xp.where(t393, t380, 1)
+    t394 = (-t332 + t367)/xp.where(t393, 2*t380, 1)
     t395 = xp.abs(t394)
     t396 = xp.greater_equal(t395, 1)
-    t397 = xp.abs(1/xp.where(t396, t394, 1))
+    t397 = 1/xp.abs(xp.where(t396, t394, 1))
     t398 = xp.where(t393, xp.where(xp.greater_equal(t394, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t396, t397/(1 + xp.sqrt(1 + t397**2)), 1/(t395 + xp.sqrt(1 + t395**2))), 0)
     t399 = 1/xp.sqrt(1 + t398**2)
     t400 = t380*t398
@@ -4365,10 +4365,10 @@ def velocity_ellipsoid(q):
     t426 = t424 - t425*t398
     t427 = t425 + t424*t398
     t428 = xp.not_equal(t415, 0)
-    t429 = 0.5*(-t366 + t401)/xp.where(t428, t415, 1)
+    t429 = (-t366 + t401)/xp.where(t428, 2*t415, 1)
     t430 = xp.abs(t429)
     t431 = xp.greater_equal(t430, 1)
-    t432 = xp.abs(1/xp.where(t431, t429, 1))
+    t432 = 1/xp.abs(xp.where(t431, t429, 1))
     t433 = xp.where(t428, xp.where(xp.greater_equal(t429, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t431, t432/(1 + xp.sqrt(1 + t432**2)), 1/(t430 + xp.sqrt(1 + t430**2))), 0)
     t434 = 1/xp.sqrt(1 + t433**2)
     t435 = t415*t433
@@ -4400,10 +4400,10 @@ def velocity_ellipsoid(q):
     t461 = t459 - t433*t460
     t462 = t460 + t433*t459
     t463 = xp.not_equal(t450, 0)
-    t464 = 0.5*(-t436 + t402)/xp.where(t463, t450, 1)
+    t464 = (-t436 + t402)/xp.where(t463, 2*t450, 1)
     t465 = xp.abs(t464)
     t466 = xp.greater_equal(t465, 1)
-    t467 = xp.abs(1/xp.where(t466, t464, 1))
+    t467 = 1/xp.abs(xp.where(t466, t464, 1))
     t468 = xp.where(t463, xp.where(xp.greater_equal(t464, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t466, t467/(1 + xp.sqrt(1 + t467**2)), 1/(t465 + xp.sqrt(1 + t465**2))), 0)
     t469 = 1/xp.sqrt(1 + t468**2)
     t470 = t450*t468
@@ -4435,10 +4435,10 @@ def velocity_ellipsoid(q):
     t496 = t494 - t468*t495
     t497 = t495 + t468*t494
     t498 = xp.not_equal(t485, 0)
-    t499 = 0.5*(-t437 + t472)/xp.where(t498, t485, 1)
+    t499 = (-t437 + t472)/xp.where(t498, 2*t485, 1)
     t500 = xp.abs(t499)
     t501 = xp.greater_equal(t500, 1)
-    t502 = xp.abs(1/xp.where(t501, t499, 1))
+    t502 = 1/xp.abs(xp.where(t501, t499, 1))
     t503 = xp.where(t498, xp.where(xp.greater_equal(t499, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t501, t502/(1 + xp.sqrt(1 + t502**2)), 1/(t500 + xp.sqrt(1 + t500**2))), 0)
     t504 = 1/xp.sqrt(1 + t503**2)
     t505 = t485*t503
@@ -4470,10 +4470,10 @@ def velocity_ellipsoid(q):
     t531 = t529 - t503*t530
     t532 = t530 + t503*t529
     t533 = xp.not_equal(t520, 0)
-    t534 = 0.5*(-t471 + t506)/xp.where(t533, t520, 1)
+    t534 = (-t471 + t506)/xp.where(t533, 2*t520, 1)
     t535 = xp.abs(t534)
     t536 = xp.greater_equal(t535, 1)
-    t537 = xp.abs(1/xp.where(t536, t534, 1))
+    t537 = 1/xp.abs(xp.where(t536, t534, 1))
     t538 = xp.where(t533, xp.where(xp.greater_equal(t534, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t536, t537/(1 + xp.sqrt(1 + t537**2)), 1/(t535 + xp.sqrt(1 + t535**2))), 0)
     t539 = 1/xp.sqrt(1 + t538**2)
     t540 = t520*t538
@@ -4505,10 +4505,10 @@ def velocity_ellipsoid(q):
     t566 = t564 - t538*t565
     t567 = t565 + t538*t564
     t568 = xp.not_equal(t555, 0)
-    t569 = 0.5*(-t541 + t507)/xp.where(t568, t555, 1)
+    t569 = (-t541 + t507)/xp.where(t568, 2*t555, 1)
     t570 = xp.abs(t569)
     t571 = xp.greater_equal(t570, 1)
-    t572 = xp.abs(1/xp.where(t571, t569, 1))
+    t572 = 1/xp.abs(xp.where(t571, t569, 1))
     t573 = xp.where(t568, xp.where(xp.greater_equal(t569, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t571, t572/(1 + xp.sqrt(1 + t572**2)), 1/(t570 + xp.sqrt(1 + t570**2))), 0)
     t574 = 1/xp.sqrt(1 + t573**2)
     t575 = t507 + t555*t573
@@ -4539,10 +4539,10 @@ def velocity_ellipsoid(q):
     t600 = t598 - t573*t599
     t601 = t599 + t573*t598
     t602 = xp.not_equal(t588, 0)
-    t603 = 0.5*(-t542 + t575)/xp.where(t602, t588, 1)
+    t603 = (-t542 + t575)/xp.where(t602, 2*t588, 1)
     t604 = xp.abs(t603)
     t605 = xp.greater_equal(t604, 1)
-    t606 = xp.abs(1/xp.where(t605, t603, 1))
+    t606 = 1/xp.abs(xp.where(t605, t603, 1))
     t607 = xp.where(t602, xp.where(xp.greater_equal(t603, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t605, t606/(1 + xp.sqrt(1 + t606**2)), 1/(t604 + xp.sqrt(1 + t604**2))), 0)
     t608 = 1/xp.sqrt(1 + t607**2)
     t609 = t546*t608
@@ -4636,10 +4636,10 @@ def velocity_ellipsoid(q):
     t697 = t694**2
     t698 = t677**2 + t688**2 + t697
     t699 = xp.not_equal(t696, 0)
-    t700 = 0.5*(-t668 + t695)/xp.where(t699, t696, 1)
+    t700 = (-t668 + t695)/xp.where(t699, 2*t696, 1)
     t701 = xp.abs(t700)
     t702 = xp.greater_equal(t701, 1)
-    t703 = xp.abs(1/xp.where(t702, t700, 1))
+    t703 = 1/xp.abs(xp.where(t702, t700, 1))
     t704 = xp.where(t699, xp.where(xp.greater_equal(t700, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t702, t703/(1 + xp.sqrt(1 + t703**2)), 1/(t701 + xp.sqrt(1 + t701**2))), 0)
     t705 = 1/xp.sqrt(1 + t704**2)
     t706 = t696*t704
@@ -4653,10 +4653,10 @@ def velocity_ellipsoid(q):
     t714 = t704*t713
     t715 = t677*t711 + t688*t714
     t716 = xp.not_equal(t715, 0)
-    t717 = 0.5*(-t707 + t698)/xp.where(t716, t715, 1)
+    t717 = (-t707 + t698)/xp.where(t716, 2*t715, 1)
     t718 = xp.abs(t717)
     t719 = xp.greater_equal(t718, 1)
-    t720 = xp.abs(1/xp.where(t719, t717, 1))
+    t720 = 1/xp.abs(xp.where(t719, t717, 1))
     t721 = xp.where(t716, xp.where(xp.greater_equal(t717, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t719, t720/(1 + xp.sqrt(1 + t720**2)), 1/(t718 + xp.sqrt(1 + t718**2))), 0)
     t722 = 1/xp.sqrt(1 + t721**2)
     t723 = t715*t721
@@ -4672,10 +4672,10 @@ def velocity_ellipsoid(q):
     t733 = t731 + t721*t730
     t734 = t712*t729 + t733*t713
     t735 = xp.not_equal(t734, 0)
-    t736 = 0.5*(-t708 + t725)/xp.where(t735, -t734, 1)
+    t736 = (-t708 + t725)/xp.where(t735, -2*t734, 1)
     t737 = xp.abs(t736)
     t738 = xp.greater_equal(t737, 1)
-    t739 = xp.abs(1/xp.where(t738, t736, 1))
+    t739 = 1/xp.abs(xp.where(t738, t736, 1))
     t740 = xp.where(t735, xp.where(xp.greater_equal(t736, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t738, t739/(1 + xp.sqrt(1 + t739**2)), 1/(t737 + xp.sqrt(1 + t737**2))), 0)
     t741 = 1/xp.sqrt(1 + t740**2)
     t742 = t734*t740
@@ -4701,10 +4701,10 @@ def velocity_ellipsoid(q):
     t762 = t740*t741
     t763 = t728*t747 + t732*t752 - t722*t697*t756*t762
     t764 = xp.not_equal(t763, 0)
-    t765 = 0.5*(-t724 + t743)/xp.where(t764, -t763, 1)
+    t765 = (-t724 + t743)/xp.where(t764, -2*t763, 1)
     t766 = xp.abs(t765)
     t767 = xp.greater_equal(t766, 1)
-    t768 = xp.abs(1/xp.where(t767, t765, 1))
+    t768 = 1/xp.abs(xp.where(t767, t765, 1))
     t769 = xp.where(t764, xp.where(xp.greater_equal(t765, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t767, t768/(1 + xp.sqrt(1 + t768**2)), 1/(t766 + xp.sqrt(1 + t766**2))), 0)
     t770 = 1/xp.sqrt(1 + t769**2)
     t771 = t763*t769
@@ -4738,10 +4738,10 @@ def velocity_ellipsoid(q):
     t799 = t722*t741
     t800 = t748*t776 + t753*t780 - t694*t789*t799
     t801 = xp.not_equal(t800, 0)
-    t802 = 0.5*(-t772 + t744)/xp.where(t801, t800, 1)
+    t802 = (-t772 + t744)/xp.where(t801, 2*t800, 1)
     t803 = xp.abs(t802)
     t804 = xp.greater_equal(t803, 1)
-    t805 = xp.abs(1/xp.where(t804, t802, 1))
+    t805 = 1/xp.abs(xp.where(t804, t802, 1))
     t806 = xp.where(t801, xp.where(xp.greater_equal(t802, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t804, t805/(1 + xp.sqrt(1 + t805**2)), 1/(t803 + xp.sqrt(1 + t803**2))), 0)
     t807 = 1/xp.sqrt(1 + t806**2)
     t808 = t800*t806
@@ -4773,10 +4773,10 @@ def velocity_ellipsoid(q):
     t834 = t833 - t806*t820
     t835 = t820 + t806*t833
     t836 = xp.not_equal(t824, 0)
-    t837 = 0.5*(-t773 + t810)/xp.where(t836, t824, 1)
+    t837 = (-t773 + t810)/xp.where(t836, 2*t824, 1)
     t838 = xp.abs(t837)
     t839 = xp.greater_equal(t838, 1)
-    t840 = xp.abs(1/xp.where(t839, t837, 1))
+    t840 = 1/xp.abs(xp.where(t839, t837, 1))
     t841 = xp.where(t836, xp.where(xp.greater_equal(t837, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t839, t840/(1 + xp.sqrt(1 + t840**2)), 1/(t838 + xp.sqrt(1 + t838**2))), 0)
     t842 = 1/xp.sqrt(1 + t841**2)
     t843 = t824*t841
@@ -4808,10 +4808,10 @@ def velocity_ellipsoid(q):
     t869 = t867 + t841*t868
     t870 = t868 - t841*t867
     t871 = xp.not_equal(t858, 0)
-    t872 = 0.5*(-t809 + t844)/xp.where(t871, t858, 1)
+    t872 = (-t809 + t844)/xp.where(t871, 2*t858, 1)
     t873 = xp.abs(t872)
     t874 = xp.greater_equal(t873, 1)
-    t875 = xp.abs(1/xp.where(t874, t872, 1))
+    t875 = 1/xp.abs(xp.where(t874, t872, 1))
     t876 = xp.where(t871, xp.where(xp.greater_equal(t872, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t874, t875/(1 + xp.sqrt(1 + t875**2)), 1/(t873 + xp.sqrt(1 + t873**2))), 0)
     t877 = 1/xp.sqrt(1 + t876**2)
     t878 = t858*t876
@@ -4843,10 +4843,10 @@ def velocity_ellipsoid(q):
     t904 = t902 + t876*t903
     t905 = -t903 + t876*t902
     t906 = xp.not_equal(t893, 0)
-    t907 = 0.5*(-t879 + t845)/xp.where(t906, t893, 1)
+    t907 = (-t879 + t845)/xp.where(t906, 2*t893, 1)
     t908 = xp.abs(t907)
     t909 = xp.greater_equal(t908, 1)
-    t910 = xp.abs(1/xp.where(t909, t907, 1))
+    t910 = 1/xp.abs(xp.where(t909, t907, 1))
     t911 = xp.where(t906, xp.where(xp.greater_equal(t907, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t909, t910/(1 + xp.sqrt(1 + t910**2)), 1/(t908 + xp.sqrt(1 + t908**2))), 0)
     t912 = 1/xp.sqrt(1 + t911**2)
     t913 = t893*t911
@@ -4878,10 +4878,10 @@ def velocity_ellipsoid(q):
     t939 = t937 - t911*t938
     t940 = t938 + t911*t937
     t941 = xp.not_equal(t928, 0)
-    t942 = 0.5*(-t880 + t915)/xp.where(t941, t928, 1)
+    t942 = (-t880 + t915)/xp.where(t941, 2*t928, 1)
     t943 = xp.abs(t942)
     t944 = xp.greater_equal(t943, 1)
-    t945 = xp.abs(1/xp.where(t944, t942, 1))
+    t945 = 1/xp.abs(xp.where(t944, t942, 1))
     t946 = xp.where(t941, xp.where(xp.greater_equal(t942, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t944, t945/(1 + xp.sqrt(1 + t945**2)), 1/(t943 + xp.sqrt(1 + t943**2))), 0)
     t947 = 1/xp.sqrt(1 + t946**2)
     t948 = t928*t946
@@ -4913,10 +4913,10 @@ def velocity_ellipsoid(q):
     t974 = t972 - t946*t973
     t975 = t973 + t946*t972
     t976 = xp.not_equal(t963, 0)
-    t977 = 0.5*(-t914 + t949)/xp.where(t976, t963, 1)
+    t977 = (-t914 + t949)/xp.where(t976, 2*t963, 1)
     t978 = xp.abs(t977)
     t979 = xp.greater_equal(t978, 1)
-    t980 = xp.abs(1/xp.where(t979, t977, 1))
+    t980 = 1/xp.abs(xp.where(t979, t977, 1))
     t981 = xp.where(t976, xp.where(xp.greater_equal(t977, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t979, t980/(1 + xp.sqrt(1 + t980**2)), 1/(t978 + xp.sqrt(1 + t978**2))), 0)
     t982 = 1/xp.sqrt(1 + t981**2)
     t983 = t963*t981
@@ -4948,10 +4948,10 @@ def velocity_ellipsoid(q):
     t1009 = t1007 - t981*t1008
     t1010 = t1008 + t981*t1007
     t1011 = xp.not_equal(t998, 0)
-    t1012 = 0.5*(-t984 + t950)/xp.where(t1011, t998, 1)
+    t1012 = (-t984 + t950)/xp.where(t1011, 2*t998, 1)
     t1013 = xp.abs(t1012)
     t1014 = xp.greater_equal(t1013, 1)
-    t1015 = xp.abs(1/xp.where(t1014, t1012, 1))
+    t1015 = 1/xp.abs(xp.where(t1014, t1012, 1))
     t1016 = xp.where(t1011, xp.where(xp.greater_equal(t1012, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1014, t1015/(1 + xp.sqrt(1 + t1015**2)), 1/(t1013 + xp.sqrt(1 + t1013**2))), 0)
     t1017 = 1/xp.sqrt(1 + t1016**2)
     t1018 = t998*t1016
@@ -4983,10 +4983,10 @@ def velocity_ellipsoid(q):
     t1044 = t1042 - t1016*t1043
     t1045 = t1043 + t1016*t1042
     t1046 = xp.not_equal(t1033, 0)
-    t1047 = 0.5*(-t985 + t1020)/xp.where(t1046, t1033, 1)
+    t1047 = (-t985 + t1020)/xp.where(t1046, 2*t1033, 1)
     t1048 = xp.abs(t1047)
     t1049 = xp.greater_equal(t1048, 1)
-    t1050 = xp.abs(1/xp.where(t1049, t1047, 1))
+    t1050 = 1/xp.abs(xp.where(t1049, t1047, 1))
     t1051 = xp.where(t1046, xp.where(xp.greater_equal(t1047, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1049, t1050/(1 + xp.sqrt(1 + t1050**2)), 1/(t1048 + xp.sqrt(1 + t1048**2))), 0)
     t1052 = 1/xp.sqrt(1 + t1051**2)
     t1053 = t1033*t1051
@@ -5018,10 +5018,10 @@ def velocity_ellipsoid(q):
     t1079 = t1077 - t1051*t1078
     t1080 = t1078 + t1051*t1077
     t1081 = xp.not_equal(t1068, 0)
-    t1082 = 0.5*(-t1019 + t1054)/xp.where(t1081, t1068, 1)
+    t1082 = (-t1019 + t1054)/xp.where(t1081, 2*t1068, 1)
     t1083 = xp.abs(t1082)
     t1084 = xp.greater_equal(t1083, 1)
-    t1085 = xp.abs(1/xp.where(t1084, t1082, 1))
+    t1085 = 1/xp.abs(xp.where(t1084, t1082, 1))
     t1086 = xp.where(t1081, xp.where(xp.greater_equal(t1082, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1084, t1085/(1 + xp.sqrt(1 + t1085**2)), 1/(t1083 + xp.sqrt(1 + t1083**2))), 0)
     t1087 = 1/xp.sqrt(1 + t1086**2)
     t1088 = t1068*t1086
@@ -5053,10 +5053,10 @@ def velocity_ellipsoid(q):
     t1114 = t1112 - t1086*t1113
     t1115 = t1113 + t1086*t1112
     t1116 = xp.not_equal(t1103, 0)
-    t1117 = 0.5*(-t1089 + t1055)/xp.where(t1116, t1103, 1)
+    t1117 = (-t1089 + t1055)/xp.where(t1116, 2*t1103, 1)
     t1118 = xp.abs(t1117)
     t1119 = xp.greater_equal(t1118, 1)
-    t1120 = xp.abs(1/xp.where(t1119, t1117, 1))
+    t1120 = 1/xp.abs(xp.where(t1119, t1117, 1))
     t1121 = xp.where(t1116, xp.where(xp.greater_equal(t1117, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1119, t1120/(1 + xp.sqrt(1 + t1120**2)), 1/(t1118 + xp.sqrt(1 + t1118**2))), 0)
     t1122 = 1/xp.sqrt(1 + t1121**2)
     t1123 = t1055 + t1103*t1121
@@ -5087,10 +5087,10 @@ def velocity_ellipsoid(q):
     t1148 = t1146 - t1121*t1147
     t1149 = t1147 + t1121*t1146
     t1150 = xp.not_equal(t1136, 0)
-    t1151 = 0.5*(-t1090 + t1123)/xp.where(t1150, t1136, 1)
+    t1151 = (-t1090 + t1123)/xp.where(t1150, 2*t1136, 1)
     t1152 = xp.abs(t1151)
     t1153 = xp.greater_equal(t1152, 1)
-    t1154 = xp.abs(1/xp.where(t1153, t1151, 1))
+    t1154 = 1/xp.abs(xp.where(t1153, t1151, 1))
     t1155 = xp.where(t1150, xp.where(xp.greater_equal(t1151, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1153, t1154/(1 + xp.sqrt(1 + t1154**2)), 1/(t1152 + xp.sqrt(1 + t1152**2))), 0)
     t1156 = 1/xp.sqrt(1 + t1155**2)
     t1157 = t1094*t1156
@@ -5439,10 +5439,10 @@ def condition_number(q):
     t232 = t138*t130
     t233 = t148*t155 - t140*t177 + t230*t159 + t231*t165 - t232*t171
     t234 = xp.not_equal(t233, 0)
-    t235 = 0.5*(-t229 + t222)/xp.where(t234, -t233, 1)
+    t235 = (-t229 + t222)/xp.where(t234, -2*t233, 1)
     t236 = xp.abs(t235)
     t237 = xp.greater_equal(t236, 1)
-    t238 = xp.abs(1/xp.where(t237, t235, 1))
+    t238 = 1/xp.abs(xp.where(t237, t235, 1))
     t239 = xp.where(t234, xp.where(xp.greater_equal(t235, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t237, t238/(1 + xp.sqrt(1 + t238**2)), 1/(t236 + xp.sqrt(1 + t236**2))), 0)
     t240 = 1/xp.sqrt(1 + t239**2)
     t241 = t233*t239
@@ -5470,10 +5470,10 @@ def condition_number(q):
     t263 = t261 + t260*t239
     t264 = t183*t250 - t187*t254 + t192*t258 + t197*t262
     t265 = xp.not_equal(t264, 0)
-    t266 = 0.5*(-t242 + t223)/xp.where(t265, t264, 1)
+    t266 = (-t242 + t223)/xp.where(t265, 2*t264, 1)
     t267 = xp.abs(t266)
     t268 = xp.greater_equal(t267, 1)
-    t269 = xp.abs(1/xp.where(t268, t266, 1))
+    t269 = 1/xp.abs(xp.where(t268, t266, 1))
     t270 = xp.where(t265, xp.where(xp.greater_equal(t266, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t268, t269/(1 + xp.sqrt(1 + t269**2)), 1/(t267 + xp.sqrt(1 + t267**2))), 0)
     t271 = 1/xp.sqrt(1 + t270**2)
     t272 = t264*t270
@@ -5497,10 +5497,10 @@ def condition_number(q):
     t290 = t288 + t287*t270
     t291 = t202*t281 + t206*t285 + t210*t289
     t292 = xp.not_equal(t291, 0)
-    t293 = 0.5*(-t273 + t224)/xp.where(t292, t291, 1)
+    t293 = (-t273 + t224)/xp.where(t292, 2*t291, 1)
     t294 = xp.abs(t293)
     t295 = xp.greater_equal(t294, 1)
-    t296 = xp.abs(1/xp.where(t295, t293, 1))
+    t296 = 1/xp.abs(xp.where(t295, t293, 1))
     t297 = xp.where(t292, xp.where(xp.greater_equal(t293, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t295, t296/(1 + xp.sqrt(1 + t296**2)), 1/(t294 + xp.sqrt(1 + t294**2))), 0)
     t298 = 1/xp.sqrt(1 + t297**2)
     t299 = t291*t297
@@ -5520,10 +5520,10 @@ def condition_number(q):
     t313 = t311 + t310*t297
     t314 = -t214*t308 + t218*t312
     t315 = xp.not_equal(t314, 0)
-    t316 = 0.5*(-t300 + t225)/xp.where(t315, t314, 1)
+    t316 = (-t300 + t225)/xp.where(t315, 2*t314, 1)
     t317 = xp.abs(t316)
     t318 = xp.greater_equal(t317, 1)
-    t319 = xp.abs(1/xp.where(t318, t316, 1))
+    t319 = 1/xp.abs(xp.where(t318, t316, 1))
     t320 = xp.where(t315, xp.where(xp.greater_equal(t316, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t318, t319/(1 + xp.sqrt(1 + t319**2)), 1/(t317 + xp.sqrt(1 + t317**2))), 0)
     t321 = 1/xp.sqrt(1 + t320**2)
     t322 = t314*t320
@@ -5539,10 +5539,10 @@ def condition_number(q):
     t332 = t330 + t329*t320
     t333 = t221*t331
     t334 = xp.not_equal(t333, 0)
-    t335 = 0.5*(-t323 + t226)/xp.where(t334, -t333, 1)
+    t335 = (-t323 + t226)/xp.where(t334, -2*t333, 1)
     t336 = xp.abs(t335)
     t337 = xp.greater_equal(t336, 1)
-    t338 = xp.abs(1/xp.where(t337, t335, 1))
+    t338 = 1/xp.abs(xp.where(t337, t335, 1))
     t339 = xp.where(t334, xp.where(xp.greater_equal(t335, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t337, t338/(1 + xp.sqrt(1 + t338**2)), 1/(t336 + xp.sqrt(1 + t336**2))), 0)
     t340 = 1/xp.sqrt(1 + t339**2)
     t341 = t333*t339
@@ -5556,10 +5556,10 @@ def condition_number(q):
     t349 = t348*t246
     t350 = -t251*t278 + t255*t282 - t259*t286 + t263*t290 + t227*t348*t239*t240**2 + t349*t247
     t351 = xp.not_equal(t350, 0)
-    t352 = 0.5*(-t243 + t274)/xp.where(t351, t350, 1)
+    t352 = (-t243 + t274)/xp.where(t351, 2*t350, 1)
     t353 = xp.abs(t352)
     t354 = xp.greater_equal(t353, 1)
-    t355 = xp.abs(1/xp.where(t354, t352, 1))
+    t355 = 1/xp.abs(xp.where(t354, t352, 1))
     t356 = xp.where(t351, xp.where(xp.greater_equal(t352, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t354, t355/(1 + xp.sqrt(1 + t355**2)), 1/(t353 + xp.sqrt(1 + t353**2))), 0)
     t357 = 1/xp.sqrt(1 + t356**2)
     t358 = t350*t356
@@ -5598,10 +5598,10 @@ def condition_number(q):
     t391 = t387*t277
     t392 = -t305*t377 - t309*t381 + t313*t385 - t389*t365 + t390*t369 + t391*t373
     t393 = xp.not_equal(t392, 0)
-    t394 = 0.5*(-t359 + t301)/xp.where(t393, t392, 1)
+    t394 = (-t359 + t301)/xp.where(t393, 2*t392, 1)
     t395 = xp.abs(t394)
     t396 = xp.greater_equal(t395, 1)
-    t397 = xp.abs(1/xp.where(t396, t394, 1))
+    t397 = 1/xp.abs(xp.where(t396, t394, 1))
     t398 = xp.where(t393, xp.where(xp.greater_equal(t394, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t396, t397/(1 + xp.sqrt(1 + t397**2)), 1/(t395 + xp.sqrt(1 + t395**2))), 0)
     t399 = 1/xp.sqrt(1 + t398**2)
     t400 = t392*t398
@@ -5644,10 +5644,10 @@ def condition_number(q):
     t437 = t436*t320
     t438 = -t328*t421 + t332*t425 - t431*t405 + t433*t409 + t435*t413 + t437*t417
     t439 = xp.not_equal(t438, 0)
-    t440 = 0.5*(-t401 + t324)/xp.where(t439, t438, 1)
+    t440 = (-t401 + t324)/xp.where(t439, 2*t438, 1)
     t441 = xp.abs(t440)
     t442 = xp.greater_equal(t441, 1)
-    t443 = xp.abs(1/xp.where(t442, t440, 1))
+    t443 = 1/xp.abs(xp.where(t442, t440, 1))
     t444 = xp.where(t439, xp.where(xp.greater_equal(t440, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t442, t443/(1 + xp.sqrt(1 + t443**2)), 1/(t441 + xp.sqrt(1 + t441**2))), 0)
     t445 = 1/xp.sqrt(1 + t444**2)
     t446 = t438*t444
@@ -5689,10 +5689,10 @@ def condition_number(q):
     t482 = t481*t339
     t483 = t347*t471 - t474*t451 + t476*t455 + t478*t459 + t480*t463 - t482*t467
     t484 = xp.not_equal(t483, 0)
-    t485 = 0.5*(-t447 + t343)/xp.where(t484, t483, 1)
+    t485 = (-t447 + t343)/xp.where(t484, 2*t483, 1)
     t486 = xp.abs(t485)
     t487 = xp.greater_equal(t486, 1)
-    t488 = xp.abs(1/xp.where(t487, t485, 1))
+    t488 = 1/xp.abs(xp.where(t487, t485, 1))
     t489 = xp.where(t484, xp.where(xp.greater_equal(t485, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t487, t488/(1 + xp.sqrt(1 + t488**2)), 1/(t486 + xp.sqrt(1 + t486**2))), 0)
     t490 = 1/xp.sqrt(1 + t489**2)
     t491 = t483*t489
@@ -5724,10 +5724,10 @@ def condition_number(q):
     t517 = t515 + t514*t489
     t518 = t346*t516 - t473*t496 + t475*t500 + t477*t504 + t479*t508 - t481*t512
     t519 = xp.not_equal(t427, 0)
-    t520 = 0.5*(-t360 + t402)/xp.where(t519, t427, 1)
+    t520 = (-t360 + t402)/xp.where(t519, 2*t427, 1)
     t521 = xp.abs(t520)
     t522 = xp.greater_equal(t521, 1)
-    t523 = xp.abs(1/xp.where(t522, t520, 1))
+    t523 = 1/xp.abs(xp.where(t522, t520, 1))
     t524 = xp.where(t519, xp.where(xp.greater_equal(t520, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t522, t523/(1 + xp.sqrt(1 + t523**2)), 1/(t521 + xp.sqrt(1 + t521**2))), 0)
     t525 = 1/xp.sqrt(1 + t524**2)
     t526 = t427*t524
@@ -5759,10 +5759,10 @@ def condition_number(q):
     t552 = t550 + t549*t524
     t553 = -t452*t531 + t456*t535 + t460*t539 + t464*t543 + t468*t547 + t472*t551
     t554 = xp.not_equal(t553, 0)
-    t555 = 0.5*(-t527 + t448)/xp.where(t554, t553, 1)
+    t555 = (-t527 + t448)/xp.where(t554, 2*t553, 1)
     t556 = xp.abs(t555)
     t557 = xp.greater_equal(t556, 1)
-    t558 = xp.abs(1/xp.where(t557, t555, 1))
+    t558 = 1/xp.abs(xp.where(t557, t555, 1))
     t559 = xp.where(t554, xp.where(xp.greater_equal(t555, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t557, t558/(1 + xp.sqrt(1 + t558**2)), 1/(t556 + xp.sqrt(1 + t556**2))), 0)
     t560 = 1/xp.sqrt(1 + t559**2)
     t561 = t553*t559
@@ -5795,10 +5795,10 @@ def condition_number(q):
     t588 = -t497*t566 + t501*t570 + t505*t574 + t509*t578 + t513*t582 + t517*t586
     t589 = t532*t567 + t536*t571 + t540*t575 + t544*t579 + t548*t583 + t552*t587
     t590 = xp.not_equal(t588, 0)
-    t591 = 0.5*(-t562 + t493)/xp.where(t590, t588, 1)
+    t591 = (-t562 + t493)/xp.where(t590, 2*t588, 1)
     t592 = xp.abs(t591)
     t593 = xp.greater_equal(t592, 1)
-    t594 = xp.abs(1/xp.where(t593, t591, 1))
+    t594 = 1/xp.abs(xp.where(t593, t591, 1))
     t595 = xp.where(t590, xp.where(xp.greater_equal(t591, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t593, t594/(1 + xp.sqrt(1 + t594**2)), 1/(t592 + xp.sqrt(1 + t592**2))), 0)
     t596 = 1/xp.sqrt(1 + t595**2)
     t597 = t588*t595
@@ -5829,10 +5829,10 @@ def condition_number(q):
     t622 = t620 - t621*t595
     t623 = t621 + t620*t595
     t624 = xp.not_equal(t589, 0)
-    t625 = 0.5*(-t528 + t563)/xp.where(t624, t589, 1)
+    t625 = (-t528 + t563)/xp.where(t624, 2*t589, 1)
     t626 = xp.abs(t625)
     t627 = xp.greater_equal(t626, 1)
-    t628 = xp.abs(1/xp.where(t627, t625, 1))
+    t628 = 1/xp.abs(xp.where(t627, t625, 1))
     t629 = xp.where(t624, xp.where(xp.greater_equal(t625, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t627, t628/(1 + xp.sqrt(1 + t628**2)), 1/(t626 + xp.sqrt(1 + t626**2))), 0)
     t630 = 1/xp.sqrt(1 + t629**2)
     t631 = t589*t629
@@ -5864,10 +5864,10 @@ def condition_number(q):
     t657 = t655 + t654*t629
     t658 = t603*t636 + t607*t640 + t611*t644 + t615*t648 + t619*t652 + t623*t656
     t659 = xp.not_equal(t658, 0)
-    t660 = 0.5*(-t632 + t599)/xp.where(t659, t658, 1)
+    t660 = (-t632 + t599)/xp.where(t659, 2*t658, 1)
     t661 = xp.abs(t660)
     t662 = xp.greater_equal(t661, 1)
-    t663 = xp.abs(1/xp.where(t662, t660, 1))
+    t663 = 1/xp.abs(xp.where(t662, t660, 1))
     t664 = xp.where(t659, xp.where(xp.greater_equal(t660, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t662, t663/(1 + xp.sqrt(1 + t663**2)), 1/(t661 + xp.sqrt(1 + t661**2))), 0)
     t665 = 1/xp.sqrt(1 + t664**2)
     t666 = t658*t664
@@ -5899,10 +5899,10 @@ def condition_number(q):
     t692 = t690 + t689*t664
     t693 = t637*t672 + t641*t676 + t645*t680 + t649*t684 + t653*t688 + t657*t692
     t694 = xp.not_equal(t693, 0)
-    t695 = 0.5*(-t633 + t668)/xp.where(t694, t693, 1)
+    t695 = (-t633 + t668)/xp.where(t694, 2*t693, 1)
     t696 = xp.abs(t695)
     t697 = xp.greater_equal(t696, 1)
-    t698 = xp.abs(1/xp.where(t697, t695, 1))
+    t698 = 1/xp.abs(xp.where(t697, t695, 1))
     t699 = xp.where(t694, xp.where(xp.greater_equal(t695, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t697, t698/(1 + xp.sqrt(1 + t698**2)), 1/(t696 + xp.sqrt(1 + t696**2))), 0)
     t700 = 1/xp.sqrt(1 + t699**2)
     t701 = t693*t699
@@ -5933,10 +5933,10 @@ def condition_number(q):
     t726 = t724 - t725*t699
     t727 = t725 + t724*t699
     t728 = xp.not_equal(t518, 0)
-    t729 = 0.5*(-t342 + t492)/xp.where(t728, t518, 1)
+    t729 = (-t342 + t492)/xp.where(t728, 2*t518, 1)
     t730 = xp.abs(t729)
     t731 = xp.greater_equal(t730, 1)
-    t732 = xp.abs(1/xp.where(t731, t729, 1))
+    t732 = 1/xp.abs(xp.where(t731, t729, 1))
     t733 = xp.where(t728, xp.where(xp.greater_equal(t729, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t731, t732/(1 + xp.sqrt(1 + t732**2)), 1/(t730 + xp.sqrt(1 + t730**2))), 0)
     t734 = 1/xp.sqrt(1 + t733**2)
     t735 = t518*t733
@@ -5968,10 +5968,10 @@ def condition_number(q):
     t761 = t759 + t758*t733
     t762 = t602*t740 + t606*t744 + t610*t748 + t614*t752 + t618*t756 + t622*t760
     t763 = xp.not_equal(t762, 0)
-    t764 = 0.5*(-t736 + t598)/xp.where(t763, t762, 1)
+    t764 = (-t736 + t598)/xp.where(t763, 2*t762, 1)
     t765 = xp.abs(t764)
     t766 = xp.greater_equal(t765, 1)
-    t767 = xp.abs(1/xp.where(t766, t764, 1))
+    t767 = 1/xp.abs(xp.where(t766, t764, 1))
     t768 = xp.where(t763, xp.where(xp.greater_equal(t764, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t766, t767/(1 + xp.sqrt(1 + t767**2)), 1/(t765 + xp.sqrt(1 + t765**2))), 0)
     t769 = 1/xp.sqrt(1 + t768**2)
     t770 = t762*t768
@@ -6004,10 +6004,10 @@ def condition_number(q):
     t797 = t671*t775 + t675*t779 + t679*t783 + t683*t787 + t687*t791 + t691*t795
     t798 = -t741*t776 + t745*t780 + t749*t784 + t753*t788 + t757*t792 + t761*t796
     t799 = xp.not_equal(t797, 0)
-    t800 = 0.5*(-t771 + t667)/xp.where(t799, t797, 1)
+    t800 = (-t771 + t667)/xp.where(t799, 2*t797, 1)
     t801 = xp.abs(t800)
     t802 = xp.greater_equal(t801, 1)
-    t803 = xp.abs(1/xp.where(t802, t800, 1))
+    t803 = 1/xp.abs(xp.where(t802, t800, 1))
     t804 = xp.where(t799, xp.where(xp.greater_equal(t800, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t802, t803/(1 + xp.sqrt(1 + t803**2)), 1/(t801 + xp.sqrt(1 + t801**2))), 0)
     t805 = 1/xp.sqrt(1 + t804**2)
     t806 = t797*t804
@@ -6039,10 +6039,10 @@ def condition_number(q):
     t832 = t830 + t829*t804
     t833 = t706*t811 + t710*t815 + t714*t819 + t718*t823 + t722*t827 + t726*t831
     t834 = xp.not_equal(t833, 0)
-    t835 = 0.5*(-t807 + t702)/xp.where(t834, t833, 1)
+    t835 = (-t807 + t702)/xp.where(t834, 2*t833, 1)
     t836 = xp.abs(t835)
     t837 = xp.greater_equal(t836, 1)
-    t838 = xp.abs(1/xp.where(t837, t835, 1))
+    t838 = 1/xp.abs(xp.where(t837, t835, 1))
     t839 = xp.where(t834, xp.where(xp.greater_equal(t835, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t837, t838/(1 + xp.sqrt(1 + t838**2)), 1/(t836 + xp.sqrt(1 + t836**2))), 0)
     t840 = 1/xp.sqrt(1 + t839**2)
     t841 = t833*t839
@@ -6074,10 +6074,10 @@ def condition_number(q):
     t867 = t865 + t864*t839
     t868 = t707*t846 + t711*t850 + t715*t854 + t719*t858 + t723*t862 + t727*t866
     t869 = xp.not_equal(t868, 0)
-    t870 = 0.5*(-t842 + t703)/xp.where(t869, t868, 1)
+    t870 = (-t842 + t703)/xp.where(t869, 2*t868, 1)
     t871 = xp.abs(t870)
     t872 = xp.greater_equal(t871, 1)
-    t873 = xp.abs(1/xp.where(t872, t870, 1))
+    t873 = 1/xp.abs(xp.where(t872, t870, 1))
     t874 = xp.where(t869, xp.where(xp.greater_equal(t870, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t872, t873/(1 + xp.sqrt(1 + t873**2)), 1/(t871 + xp.sqrt(1 + t871**2))), 0)
     t875 = 1/xp.sqrt(1 + t874**2)
     t876 = t868*t874
@@ -6108,10 +6108,10 @@ def condition_number(q):
     t901 = t899 - t900*t874
     t902 = t900 + t899*t874
     t903 = xp.not_equal(t798, 0)
-    t904 = 0.5*(-t737 + t772)/xp.where(t903, t798, 1)
+    t904 = (-t737 + t772)/xp.where(t903, 2*t798, 1)
     t905 = xp.abs(t904)
     t906 = xp.greater_equal(t905, 1)
-    t907 = xp.abs(1/xp.where(t906, t904, 1))
+    t907 = 1/xp.abs(xp.where(t906, t904, 1))
     t908 = xp.where(t903, xp.where(xp.greater_equal(t904, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t906, t907/(1 + xp.sqrt(1 + t907**2)), 1/(t905 + xp.sqrt(1 + t905**2))), 0)
     t909 = 1/xp.sqrt(1 + t908**2)
     t910 = t798*t908
@@ -6143,10 +6143,10 @@ def condition_number(q):
     t936 = t934 + t933*t908
     t937 = t812*t915 + t816*t919 + t820*t923 + t824*t927 + t828*t931 + t832*t935
     t938 = xp.not_equal(t937, 0)
-    t939 = 0.5*(-t911 + t808)/xp.where(t938, t937, 1)
+    t939 = (-t911 + t808)/xp.where(t938, 2*t937, 1)
     t940 = xp.abs(t939)
     t941 = xp.greater_equal(t940, 1)
-    t942 = xp.abs(1/xp.where(t941, t939, 1))
+    t942 = 1/xp.abs(xp.where(t941, t939, 1))
     t943 = xp.where(t938, xp.where(xp.greater_equal(t939, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t941, t942/(1 + xp.sqrt(1 + t942**2)), 1/(t940 + xp.sqrt(1 + t940**2))), 0)
     t944 = 1/xp.sqrt(1 + t943**2)
     t945 = t937*t943
@@ -6179,10 +6179,10 @@ def condition_number(q):
     t972 = t847*t950 + t851*t954 + t855*t958 + t859*t962 + t863*t966 + t867*t970
     t973 = t916*t951 + t920*t955 + t924*t959 + t928*t963 + t932*t967 + t936*t971
     t974 = xp.not_equal(t972, 0)
-    t975 = 0.5*(-t946 + t843)/xp.where(t974, t972, 1)
+    t975 = (-t946 + t843)/xp.where(t974, 2*t972, 1)
     t976 = xp.abs(t975)
     t977 = xp.greater_equal(t976, 1)
-    t978 = xp.abs(1/xp.where(t977, t975, 1))
+    t978 = 1/xp.abs(xp.where(t977, t975, 1))
     t979 = xp.where(t974, xp.where(xp.greater_equal(t975, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t977, t978/(1 + xp.sqrt(1 + t978**2)), 1/(t976 + xp.sqrt(1 + t976**2))), 0)
     t980 = 1/xp.sqrt(1 + t979**2)
     t981 = t972*t979
@@ -6214,10 +6214,10 @@ def condition_number(q):
     t1007 = t1005 + t1004*t979
     t1008 = t882*t986 + t886*t990 + t890*t994 + t894*t998 + t898*t1002 + t902*t1006
     t1009 = xp.not_equal(t1008, 0)
-    t1010 = 0.5*(-t982 + t878)/xp.where(t1009, t1008, 1)
+    t1010 = (-t982 + t878)/xp.where(t1009, 2*t1008, 1)
     t1011 = xp.abs(t1010)
     t1012 = xp.greater_equal(t1011, 1)
-    t1013 = xp.abs(1/xp.where(t1012, t1010, 1))
+    t1013 = 1/xp.abs(xp.where(t1012, t1010, 1))
     t1014 = xp.where(t1009, xp.where(xp.greater_equal(t1010, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1012, t1013/(1 + xp.sqrt(1 + t1013**2)), 1/(t1011 + xp.sqrt(1 + t1011**2))), 0)
     t1015 = 1/xp.sqrt(1 + t1014**2)
     t1016 = t1008*t1014
@@ -6249,10 +6249,10 @@ def condition_number(q):
     t1042 = t1040 + t1039*t1014
     t1043 = t881*t1021 + t885*t1025 + t889*t1029 + t893*t1033 + t897*t1037 + t901*t1041
     t1044 = xp.not_equal(t973, 0)
-    t1045 = 0.5*(-t912 + t947)/xp.where(t1044, t973, 1)
+    t1045 = (-t912 + t947)/xp.where(t1044, 2*t973, 1)
     t1046 = xp.abs(t1045)
     t1047 = xp.greater_equal(t1046, 1)
-    t1048 = xp.abs(1/xp.where(t1047, t1045, 1))
+    t1048 = 1/xp.abs(xp.where(t1047, t1045, 1))
     t1049 = xp.where(t1044, xp.where(xp.greater_equal(t1045, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1047, t1048/(1 + xp.sqrt(1 + t1048**2)), 1/(t1046 + xp.sqrt(1 + t1046**2))), 0)
     t1050 = 1/xp.sqrt(1 + t1049**2)
     t1051 = t973*t1049
@@ -6284,10 +6284,10 @@ def condition_number(q):
     t1077 = t1075 + t1074*t1049
     t1078 = t987*t1056 + t991*t1060 + t995*t1064 + t999*t1068 + t1003*t1072 + t1007*t1076
     t1079 = xp.not_equal(t1078, 0)
-    t1080 = 0.5*(-t1052 + t983)/xp.where(t1079, t1078, 1)
+    t1080 = (-t1052 + t983)/xp.where(t1079, 2*t1078, 1)
     t1081 = xp.abs(t1080)
     t1082 = xp.greater_equal(t1081, 1)
-    t1083 = xp.abs(1/xp.where(t1082, t1080, 1))
+    t1083 = 1/xp.abs(xp.where(t1082, t1080, 1))
     t1084 = xp.where(t1079, xp.where(xp.greater_equal(t1080, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1082, t1083/(1 + xp.sqrt(1 + t1083**2)), 1/(t1081 + xp.sqrt(1 + t1081**2))), 0)
     t1085 = 1/xp.sqrt(1 + t1084**2)
     t1086 = t1078*t1084
@@ -6320,10 +6320,10 @@ def condition_number(q):
     t1113 = t1022*t1091 + t1026*t1095 + t1030*t1099 + t1034*t1103 + t1038*t1107 + t1042*t1111
     t1114 = t1057*t1092 + t1061*t1096 + t1065*t1100 + t1069*t1104 + t1073*t1108 + t1077*t1112
     t1115 = xp.not_equal(t1113, 0)
-    t1116 = 0.5*(-t1087 + t1018)/xp.where(t1115, t1113, 1)
+    t1116 = (-t1087 + t1018)/xp.where(t1115, 2*t1113, 1)
     t1117 = xp.abs(t1116)
     t1118 = xp.greater_equal(t1117, 1)
-    t1119 = xp.abs(1/xp.where(t1118, t1116, 1))
+    t1119 = 1/xp.abs(xp.where(t1118, t1116, 1))
     t1120 = xp.where(t1115, xp.where(xp.greater_equal(t1116, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1118, t1119/(1 + xp.sqrt(1 + t1119**2)), 1/(t1117 + xp.sqrt(1 + t1117**2))), 0)
     t1121 = 1/xp.sqrt(1 + t1120**2)
     t1122 = t1113*t1120
@@ -6354,10 +6354,10 @@ def condition_number(q):
     t1147 = t1145 - t1146*t1120
     t1148 = t1146 + t1145*t1120
     t1149 = xp.not_equal(t1114, 0)
-    t1150 = 0.5*(-t1053 + t1088)/xp.where(t1149, t1114, 1)
+    t1150 = (-t1053 + t1088)/xp.where(t1149, 2*t1114, 1)
     t1151 = xp.abs(t1150)
     t1152 = xp.greater_equal(t1151, 1)
-    t1153 = xp.abs(1/xp.where(t1152, t1150, 1))
+    t1153 = 1/xp.abs(xp.where(t1152, t1150, 1))
     t1154 = xp.where(t1149, xp.where(xp.greater_equal(t1150, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1152, t1153/(1 + xp.sqrt(1 + t1153**2)), 1/(t1151 + xp.sqrt(1 + t1151**2))), 0)
     t1155 = 1/xp.sqrt(1 + t1154**2)
     t1156 = t1114*t1154
@@ -6389,10 +6389,10 @@ def condition_number(q):
     t1182 = t1180 + t1179*t1154
     t1183 = t1128*t1161 + t1132*t1165 + t1136*t1169 + t1140*t1173 + t1144*t1177 + t1148*t1181
     t1184 = xp.not_equal(t1183, 0)
-    t1185 = 0.5*(-t1157 + t1124)/xp.where(t1184, t1183, 1)
+    t1185 = (-t1157 + t1124)/xp.where(t1184, 2*t1183, 1)
     t1186 = xp.abs(t1185)
     t1187 = xp.greater_equal(t1186, 1)
-    t1188 = xp.abs(1/xp.where(t1187, t1185, 1))
+    t1188 = 1/xp.abs(xp.where(t1187, t1185, 1))
     t1189 = xp.where(t1184, xp.where(xp.greater_equal(t1185, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1187, t1188/(1 + xp.sqrt(1 + t1188**2)), 1/(t1186 + xp.sqrt(1 + t1186**2))), 0)
     t1190 = 1/xp.sqrt(1 + t1189**2)
     t1191 = t1183*t1189
@@ -6424,10 +6424,10 @@ def condition_number(q):
     t1217 = t1215 + t1189*t1214
     t1218 = t1162*t1197 + t1166*t1201 + t1170*t1205 + t1174*t1209 + t1178*t1213 + t1182*t1217
     t1219 = xp.not_equal(t1218, 0)
-    t1220 = 0.5*(-t1158 + t1193)/xp.where(t1219, t1218, 1)
+    t1220 = (-t1158 + t1193)/xp.where(t1219, 2*t1218, 1)
     t1221 = xp.abs(t1220)
     t1222 = xp.greater_equal(t1221, 1)
-    t1223 = xp.abs(1/xp.where(t1222, t1220, 1))
+    t1223 = 1/xp.abs(xp.where(t1222, t1220, 1))
     t1224 = xp.where(t1219, xp.where(xp.greater_equal(t1220, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1222, t1223/(1 + xp.sqrt(1 + t1223**2)), 1/(t1221 + xp.sqrt(1 + t1221**2))), 0)
     t1225 = 1/xp.sqrt(1 + t1224**2)
     t1226 = t1218*t1224
@@ -6458,10 +6458,10 @@ def condition_number(q):
     t1251 = t1249 - t1224*t1250
     t1252 = t1250 + t1224*t1249
     t1253 = xp.not_equal(t1043, 0)
-    t1254 = 0.5*(-t877 + t1017)/xp.where(t1253, t1043, 1)
+    t1254 = (-t877 + t1017)/xp.where(t1253, 2*t1043, 1)
     t1255 = xp.abs(t1254)
     t1256 = xp.greater_equal(t1255, 1)
-    t1257 = xp.abs(1/xp.where(t1256, t1254, 1))
+    t1257 = 1/xp.abs(xp.where(t1256, t1254, 1))
     t1258 = xp.where(t1253, xp.where(xp.greater_equal(t1254, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1256, t1257/(1 + xp.sqrt(1 + t1257**2)), 1/(t1255 + xp.sqrt(1 + t1255**2))), 0)
     t1259 = 1/xp.sqrt(1 + t1258**2)
     t1260 = t1043*t1258
@@ -6493,10 +6493,10 @@ def condition_number(q):
     t1286 = t1284 + t1258*t1283
     t1287 = t1127*t1265 + t1131*t1269 + t1135*t1273 + t1139*t1277 + t1143*t1281 + t1147*t1285
     t1288 = xp.not_equal(t1287, 0)
-    t1289 = 0.5*(-t1261 + t1123)/xp.where(t1288, t1287, 1)
+    t1289 = (-t1261 + t1123)/xp.where(t1288, 2*t1287, 1)
     t1290 = xp.abs(t1289)
     t1291 = xp.greater_equal(t1290, 1)
-    t1292 = xp.abs(1/xp.where(t1291, t1289, 1))
+    t1292 = 1/xp.abs(xp.where(t1291, t1289, 1))
     t1293 = xp.where(t1288, xp.where(xp.greater_equal(t1289, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1291, t1292/(1 + xp.sqrt(1 + t1292**2)), 1/(t1290 + xp.sqrt(1 + t1290**2))), 0)
     t1294 = 1/xp.sqrt(1 + t1293**2)
     t1295 = t1287*t1293
@@ -6529,10 +6529,10 @@ def condition_number(q):
     t1322 = t1196*t1300 + t1200*t1304 + t1204*t1308 + t1208*t1312 + t1212*t1316 + t1216*t1320
     t1323 = t1266*t1301 + t1270*t1305 + t1274*t1309 + t1278*t1313 + t1282*t1317 + t1286*t1321
     t1324 = xp.not_equal(t1322, 0)
-    t1325 = 0.5*(-t1296 + t1192)/xp.where(t1324, t1322, 1)
+    t1325 = (-t1296 + t1192)/xp.where(t1324, 2*t1322, 1)
     t1326 = xp.abs(t1325)
     t1327 = xp.greater_equal(t1326, 1)
-    t1328 = xp.abs(1/xp.where(t1327, t1325, 1))
+    t1328 = 1/xp.abs(xp.where(t1327, t1325, 1))
     t1329 = xp.where(t1324, xp.where(xp.greater_equal(t1325, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1327, t1328/(1 + xp.sqrt(1 + t1328**2)), 1/(t1326 + xp.sqrt(1 + t1326**2))), 0)
     t1330 = 1/xp.sqrt(1 + t1329**2)
     t1331 = t1322*t1329
@@ -6564,10 +6564,10 @@ def condition_number(q):
     t1357 = t1355 + t1329*t1354
     t1358 = t1231*t1336 + t1235*t1340 + t1239*t1344 + t1243*t1348 + t1247*t1352 + t1251*t1356
     t1359 = xp.not_equal(t1358, 0)
-    t1360 = 0.5*(-t1332 + t1227)/xp.where(t1359, t1358, 1)
+    t1360 = (-t1332 + t1227)/xp.where(t1359, 2*t1358, 1)
     t1361 = xp.abs(t1360)
     t1362 = xp.greater_equal(t1361, 1)
-    t1363 = xp.abs(1/xp.where(t1362, t1360, 1))
+    t1363 = 1/xp.abs(xp.where(t1362, t1360, 1))
     t1364 = xp.where(t1359, xp.where(xp.greater_equal(t1360, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1362, t1363/(1 + xp.sqrt(1 + t1363**2)), 1/(t1361 + xp.sqrt(1 + t1361**2))), 0)
     t1365 = 1/xp.sqrt(1 + t1364**2)
     t1366 = t1358*t1364
@@ -6599,10 +6599,10 @@ def condition_number(q):
     t1392 = t1390 + t1364*t1389
     t1393 = t1232*t1371 + t1236*t1375 + t1240*t1379 + t1244*t1383 + t1248*t1387 + t1252*t1391
     t1394 = xp.not_equal(t1393, 0)
-    t1395 = 0.5*(-t1367 + t1228)/xp.where(t1394, t1393, 1)
+    t1395 = (-t1367 + t1228)/xp.where(t1394, 2*t1393, 1)
     t1396 = xp.abs(t1395)
     t1397 = xp.greater_equal(t1396, 1)
-    t1398 = xp.abs(1/xp.where(t1397, t1395, 1))
+    t1398 = 1/xp.abs(xp.where(t1397, t1395, 1))
     t1399 = xp.where(t1394, xp.where(xp.greater_equal(t1395, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1397, t1398/(1 + xp.sqrt(1 + t1398**2)), 1/(t1396 + xp.sqrt(1 + t1396**2))), 0)
     t1400 = 1/xp.sqrt(1 + t1399**2)
     t1401 = t1393*t1399
@@ -6633,10 +6633,10 @@ def condition_number(q):
     t1426 = t1424 - t1399*t1425
     t1427 = t1425 + t1399*t1424
     t1428 = xp.not_equal(t1323, 0)
-    t1429 = 0.5*(-t1262 + t1297)/xp.where(t1428, t1323, 1)
+    t1429 = (-t1262 + t1297)/xp.where(t1428, 2*t1323, 1)
     t1430 = xp.abs(t1429)
     t1431 = xp.greater_equal(t1430, 1)
-    t1432 = xp.abs(1/xp.where(t1431, t1429, 1))
+    t1432 = 1/xp.abs(xp.where(t1431, t1429, 1))
     t1433 = xp.where(t1428, xp.where(xp.greater_equal(t1429, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1431, t1432/(1 + xp.sqrt(1 + t1432**2)), 1/(t1430 + xp.sqrt(1 + t1430**2))), 0)
     t1434 = 1/xp.sqrt(1 + t1433**2)
     t1435 = t1323*t1433
@@ -6668,10 +6668,10 @@ def condition_number(q):
     t1461 = t1459 + t1433*t1458
     t1462 = t1337*t1440 + t1341*t1444 + t1345*t1448 + t1349*t1452 + t1353*t1456 + t1357*t1460
     t1463 = xp.not_equal(t1462, 0)
-    t1464 = 0.5*(-t1436 + t1333)/xp.where(t1463, t1462, 1)
+    t1464 = (-t1436 + t1333)/xp.where(t1463, 2*t1462, 1)
     t1465 = xp.abs(t1464)
     t1466 = xp.greater_equal(t1465, 1)
-    t1467 = xp.abs(1/xp.where(t1466, t1464, 1))
+    t1467 = 1/xp.abs(xp.where(t1466, t1464, 1))
     t1468 = xp.where(t1463, xp.where(xp.greater_equal(t1464, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1466, t1467/(1 + xp.sqrt(1 + t1467**2)), 1/(t1465 + xp.sqrt(1 + t1465**2))), 0)
     t1469 = 1/xp.sqrt(1 + t1468**2)
     t1470 = t1462*t1468
@@ -6704,10 +6704,10 @@ def condition_number(q):
     t1497 = t1372*t1475 + t1376*t1479 + t1380*t1483 + t1384*t1487 + t1388*t1491 + t1392*t1495
     t1498 = t1441*t1476 + t1445*t1480 + t1449*t1484 + t1453*t1488 + t1457*t1492 + t1461*t1496
     t1499 = xp.not_equal(t1497, 0)
-    t1500 = 0.5*(-t1471 + t1368)/xp.where(t1499, t1497, 1)
+    t1500 = (-t1471 + t1368)/xp.where(t1499, 2*t1497, 1)
     t1501 = xp.abs(t1500)
     t1502 = xp.greater_equal(t1501, 1)
-    t1503 = xp.abs(1/xp.where(t1502, t1500, 1))
+    t1503 = 1/xp.abs(xp.where(t1502, t1500, 1))
     t1504 = xp.where(t1499, xp.where(xp.greater_equal(t1500, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1502, t1503/(1 + xp.sqrt(1 + t1503**2)), 1/(t1501 + xp.sqrt(1 + t1501**2))), 0)
     t1505 = 1/xp.sqrt(1 + t1504**2)
     t1506 = t1497*t1504
@@ -6739,10 +6739,10 @@ def condition_number(q):
     t1532 = t1530 + t1504*t1529
     t1533 = t1407*t1511 + t1411*t1515 + t1415*t1519 + t1419*t1523 + t1423*t1527 + t1427*t1531
     t1534 = xp.not_equal(t1533, 0)
-    t1535 = 0.5*(-t1507 + t1403)/xp.where(t1534, t1533, 1)
+    t1535 = (-t1507 + t1403)/xp.where(t1534, 2*t1533, 1)
     t1536 = xp.abs(t1535)
     t1537 = xp.greater_equal(t1536, 1)
-    t1538 = xp.abs(1/xp.where(t1537, t1535, 1))
+    t1538 = 1/xp.abs(xp.where(t1537, t1535, 1))
     t1539 = xp.where(t1534, xp.where(xp.greater_equal(t1535, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1537, t1538/(1 + xp.sqrt(1 + t1538**2)), 1/(t1536 + xp.sqrt(1 + t1536**2))), 0)
     t1540 = 1/xp.sqrt(1 + t1539**2)
     t1541 = t1533*t1539
@@ -6774,10 +6774,10 @@ def condition_number(q):
     t1567 = t1565 + t1539*t1564
     t1568 = t1406*t1546 + t1410*t1550 + t1414*t1554 + t1418*t1558 + t1422*t1562 + t1426*t1566
     t1569 = xp.not_equal(t1498, 0)
-    t1570 = 0.5*(-t1437 + t1472)/xp.where(t1569, t1498, 1)
+    t1570 = (-t1437 + t1472)/xp.where(t1569, 2*t1498, 1)
     t1571 = xp.abs(t1570)
     t1572 = xp.greater_equal(t1571, 1)
-    t1573 = xp.abs(1/xp.where(t1572, t1570, 1))
+    t1573 = 1/xp.abs(xp.where(t1572, t1570, 1))
     t1574 = xp.where(t1569, xp.where(xp.greater_equal(t1570, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1572, t1573/(1 + xp.sqrt(1 + t1573**2)), 1/(t1571 + xp.sqrt(1 + t1571**2))), 0)
     t1575 = 1/xp.sqrt(1 + t1574**2)
     t1576 = t1498*t1574
@@ -6809,10 +6809,10 @@ def condition_number(q):
     t1602 = t1600 + t1574*t1599
     t1603 = t1512*t1581 + t1516*t1585 + t1520*t1589 + t1524*t1593 + t1528*t1597 + t1532*t1601
     t1604 = xp.not_equal(t1603, 0)
-    t1605 = 0.5*(-t1577 + t1508)/xp.where(t1604, t1603, 1)
+    t1605 = (-t1577 + t1508)/xp.where(t1604, 2*t1603, 1)
     t1606 = xp.abs(t1605)
     t1607 = xp.greater_equal(t1606, 1)
-    t1608 = xp.abs(1/xp.where(t1607, t1605, 1))
+    t1608 = 1/xp.abs(xp.where(t1607, t1605, 1))
     t1609 = xp.where(t1604, xp.where(xp.greater_equal(t1605, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1607, t1608/(1 + xp.sqrt(1 + t1608**2)), 1/(t1606 + xp.sqrt(1 + t1606**2))), 0)
     t1610 = 1/xp.sqrt(1 + t1609**2)
     t1611 = t1603*t1609
@@ -6845,10 +6845,10 @@ def condition_number(q):
     t1638 = t1547*t1616 + t1551*t1620 + t1555*t1624 + t1559*t1628 + t1563*t1632 + t1567*t1636
     t1639 = t1582*t1617 + t1586*t1621 + t1590*t1625 + t1594*t1629 + t1598*t1633 + t1602*t1637
     t1640 = xp.not_equal(t1638, 0)
-    t1641 = 0.5*(-t1612 + t1543)/xp.where(t1640, t1638, 1)
+    t1641 = (-t1612 + t1543)/xp.where(t1640, 2*t1638, 1)
     t1642 = xp.abs(t1641)
     t1643 = xp.greater_equal(t1642, 1)
-    t1644 = xp.abs(1/xp.where(t1643, t1641, 1))
+    t1644 = 1/xp.abs(xp.where(t1643, t1641, 1))
     t1645 = xp.where(t1640, xp.where(xp.greater_equal(t1641, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1643, t1644/(1 + xp.sqrt(1 + t1644**2)), 1/(t1642 + xp.sqrt(1 + t1642**2))), 0)
     t1646 = 1/xp.sqrt(1 + t1645**2)
     t1647 = t1638*t1645
@@ -6879,10 +6879,10 @@ def condition_number(q):
     t1672 = t1670 - t1645*t1671
     t1673 = t1671 + t1645*t1670
     t1674 = xp.not_equal(t1639, 0)
-    t1675 = 0.5*(-t1578 + t1613)/xp.where(t1674, t1639, 1)
+    t1675 = (-t1578 + t1613)/xp.where(t1674, 2*t1639, 1)
     t1676 = xp.abs(t1675)
     t1677 = xp.greater_equal(t1676, 1)
-    t1678 = xp.abs(1/xp.where(t1677, t1675, 1))
+    t1678 = 1/xp.abs(xp.where(t1677, t1675, 1))
     t1679 = xp.where(t1674, xp.where(xp.greater_equal(t1675, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1677, t1678/(1 + xp.sqrt(1 + t1678**2)), 1/(t1676 + xp.sqrt(1 + t1676**2))), 0)
     t1680 = 1/xp.sqrt(1 + t1679**2)
     t1681 = t1639*t1679
@@ -6914,10 +6914,10 @@ def condition_number(q):
     t1707 = t1705 + t1679*t1704
     t1708 = t1653*t1686 + t1657*t1690 + t1661*t1694 + t1665*t1698 + t1669*t1702 + t1673*t1706
     t1709 = xp.not_equal(t1708, 0)
-    t1710 = 0.5*(-t1682 + t1649)/xp.where(t1709, t1708, 1)
+    t1710 = (-t1682 + t1649)/xp.where(t1709, 2*t1708, 1)
     t1711 = xp.abs(t1710)
     t1712 = xp.greater_equal(t1711, 1)
-    t1713 = xp.abs(1/xp.where(t1712, t1710, 1))
+    t1713 = 1/xp.abs(xp.where(t1712, t1710, 1))
     t1714 = xp.where(t1709, xp.where(xp.greater_equal(t1710, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1712, t1713/(1 + xp.sqrt(1 + t1713**2)), 1/(t1711 + xp.sqrt(1 + t1711**2))), 0)
     t1715 = 1/xp.sqrt(1 + t1714**2)
     t1716 = t1708*t1714
@@ -6949,10 +6949,10 @@ def condition_number(q):
     t1742 = t1740 + t1714*t1739
     t1743 = t1687*t1722 + t1691*t1726 + t1695*t1730 + t1699*t1734 + t1703*t1738 + t1707*t1742
     t1744 = xp.not_equal(t1743, 0)
-    t1745 = 0.5*(-t1683 + t1718)/xp.where(t1744, t1743, 1)
+    t1745 = (-t1683 + t1718)/xp.where(t1744, 2*t1743, 1)
     t1746 = xp.abs(t1745)
     t1747 = xp.greater_equal(t1746, 1)
-    t1748 = xp.abs(1/xp.where(t1747, t1745, 1))
+    t1748 = 1/xp.abs(xp.where(t1747, t1745, 1))
     t1749 = xp.where(t1744, xp.where(xp.greater_equal(t1745, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1747, t1748/(1 + xp.sqrt(1 + t1748**2)), 1/(t1746 + xp.sqrt(1 + t1746**2))), 0)
     t1750 = 1/xp.sqrt(1 + t1749**2)
     t1751 = t1743*t1749
@@ -6983,10 +6983,10 @@ def condition_number(q):
     t1776 = t1774 - t1749*t1775
     t1777 = t1775 + t1749*t1774
     t1778 = xp.not_equal(t1568, 0)
-    t1779 = 0.5*(-t1402 + t1542)/xp.where(t1778, t1568, 1)
+    t1779 = (-t1402 + t1542)/xp.where(t1778, 2*t1568, 1)
     t1780 = xp.abs(t1779)
     t1781 = xp.greater_equal(t1780, 1)
-    t1782 = xp.abs(1/xp.where(t1781, t1779, 1))
+    t1782 = 1/xp.abs(xp.where(t1781, t1779, 1))
     t1783 = xp.where(t1778, xp.where(xp.greater_equal(t1779, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1781, t1782/(1 + xp.sqrt(1 + t1782**2)), 1/(t1780 + xp.sqrt(1 + t1780**2))), 0)
     t1784 = 1/xp.sqrt(1 + t1783**2)
     t1785 = t1568*t1783
@@ -7018,10 +7018,10 @@ def condition_number(q):
     t1811 = t1809 + t1783*t1808
     t1812 = t1652*t1790 + t1656*t1794 + t1660*t1798 + t1664*t1802 + t1668*t1806 + t1672*t1810
     t1813 = xp.not_equal(t1812, 0)
-    t1814 = 0.5*(-t1786 + t1648)/xp.where(t1813, t1812, 1)
+    t1814 = (-t1786 + t1648)/xp.where(t1813, 2*t1812, 1)
     t1815 = xp.abs(t1814)
     t1816 = xp.greater_equal(t1815, 1)
-    t1817 = xp.abs(1/xp.where(t1816, t1814, 1))
+    t1817 = 1/xp.abs(xp.where(t1816, t1814, 1))
     t1818 = xp.where(t1813, xp.where(xp.greater_equal(t1814, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1816, t1817/(1 + xp.sqrt(1 + t1817**2)), 1/(t1815 + xp.sqrt(1 + t1815**2))), 0)
     t1819 = 1/xp.sqrt(1 + t1818**2)
     t1820 = t1812*t1818
@@ -7054,10 +7054,10 @@ def condition_number(q):
     t1847 = t1721*t1825 + t1725*t1829 + t1729*t1833 + t1733*t1837 + t1737*t1841 + t1741*t1845
     t1848 = t1791*t1826 + t1795*t1830 + t1799*t1834 + t1803*t1838 + t1807*t1842 + t1811*t1846
     t1849 = xp.not_equal(t1847, 0)
-    t1850 = 0.5*(-t1821 + t1717)/xp.where(t1849, t1847, 1)
+    t1850 = (-t1821 + t1717)/xp.where(t1849, 2*t1847, 1)
     t1851 = xp.abs(t1850)
     t1852 = xp.greater_equal(t1851, 1)
-    t1853 = xp.abs(1/xp.where(t1852, t1850, 1))
+    t1853 = 1/xp.abs(xp.where(t1852, t1850, 1))
     t1854 = xp.where(t1849, xp.where(xp.greater_equal(t1850, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1852, t1853/(1 + xp.sqrt(1 + t1853**2)), 1/(t1851 + xp.sqrt(1 + t1851**2))), 0)
     t1855 = 1/xp.sqrt(1 + t1854**2)
     t1856 = t1847*t1854
@@ -7089,10 +7089,10 @@ def condition_number(q):
     t1882 = t1880 + t1854*t1879
     t1883 = t1756*t1861 + t1760*t1865 + t1764*t1869 + t1768*t1873 + t1772*t1877 + t1776*t1881
     t1884 = xp.not_equal(t1883, 0)
-    t1885 = 0.5*(-t1857 + t1752)/xp.where(t1884, t1883, 1)
+    t1885 = (-t1857 + t1752)/xp.where(t1884, 2*t1883, 1)
     t1886 = xp.abs(t1885)
     t1887 = xp.greater_equal(t1886, 1)
-    t1888 = xp.abs(1/xp.where(t1887, t1885, 1))
+    t1888 = 1/xp.abs(xp.where(t1887, t1885, 1))
     t1889 = xp.where(t1884, xp.where(xp.greater_equal(t1885, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1887, t1888/(1 + xp.sqrt(1 + t1888**2)), 1/(t1886 + xp.sqrt(1 + t1886**2))), 0)
     t1890 = 1/xp.sqrt(1 + t1889**2)
     t1891 = t1883*t1889
@@ -7124,10 +7124,10 @@ def condition_number(q):
     t1917 = t1915 + t1889*t1914
     t1918 = t1757*t1896 + t1761*t1900 + t1765*t1904 + t1769*t1908 + t1773*t1912 + t1777*t1916
     t1919 = xp.not_equal(t1918, 0)
-    t1920 = 0.5*(-t1892 + t1753)/xp.where(t1919, t1918, 1)
+    t1920 = (-t1892 + t1753)/xp.where(t1919, 2*t1918, 1)
     t1921 = xp.abs(t1920)
     t1922 = xp.greater_equal(t1921, 1)
-    t1923 = xp.abs(1/xp.where(t1922, t1920, 1))
+    t1923 = 1/xp.abs(xp.where(t1922, t1920, 1))
     t1924 = xp.where(t1919, xp.where(xp.greater_equal(t1920, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1922, t1923/(1 + xp.sqrt(1 + t1923**2)), 1/(t1921 + xp.sqrt(1 + t1921**2))), 0)
     t1925 = 1/xp.sqrt(1 + t1924**2)
     t1926 = t1918*t1924
@@ -7158,10 +7158,10 @@ def condition_number(q):
     t1951 = t1949 - t1924*t1950
     t1952 = t1950 + t1924*t1949
     t1953 = xp.not_equal(t1848, 0)
-    t1954 = 0.5*(-t1787 + t1822)/xp.where(t1953, t1848, 1)
+    t1954 = (-t1787 + t1822)/xp.where(t1953, 2*t1848, 1)
     t1955 = xp.abs(t1954)
     t1956 = xp.greater_equal(t1955, 1)
-    t1957 = xp.abs(1/xp.where(t1956, t1954, 1))
+    t1957 = 1/xp.abs(xp.where(t1956, t1954, 1))
     t1958 = xp.where(t1953, xp.where(xp.greater_equal(t1954, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1956, t1957/(1 + xp.sqrt(1 + t1957**2)), 1/(t1955 + xp.sqrt(1 + t1955**2))), 0)
     t1959 = 1/xp.sqrt(1 + t1958**2)
     t1960 = t1848*t1958
@@ -7193,10 +7193,10 @@ def condition_number(q):
     t1986 = t1984 + t1958*t1983
     t1987 = t1862*t1965 + t1866*t1969 + t1870*t1973 + t1874*t1977 + t1878*t1981 + t1882*t1985
     t1988 = xp.not_equal(t1987, 0)
-    t1989 = 0.5*(-t1961 + t1858)/xp.where(t1988, t1987, 1)
+    t1989 = (-t1961 + t1858)/xp.where(t1988, 2*t1987, 1)
     t1990 = xp.abs(t1989)
     t1991 = xp.greater_equal(t1990, 1)
-    t1992 = xp.abs(1/xp.where(t1991, t1989, 1))
+    t1992 = 1/xp.abs(xp.where(t1991, t1989, 1))
     t1993 = xp.where(t1988, xp.where(xp.greater_equal(t1989, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t1991, t1992/(1 + xp.sqrt(1 + t1992**2)), 1/(t1990 + xp.sqrt(1 + t1990**2))), 0)
     t1994 = 1/xp.sqrt(1 + t1993**2)
     t1995 = t1987*t1993
@@ -7229,10 +7229,10 @@ def condition_number(q):
     t2022 = t1897*t2000 + t1901*t2004 + t1905*t2008 + t1909*t2012 + t1913*t2016 + t1917*t2020
     t2023 = t1966*t2001 + t1970*t2005 + t1974*t2009 + t1978*t2013 + t1982*t2017 + t1986*t2021
     t2024 = xp.not_equal(t2022, 0)
-    t2025 = 0.5*(-t1996 + t1893)/xp.where(t2024, t2022, 1)
+    t2025 = (-t1996 + t1893)/xp.where(t2024, 2*t2022, 1)
     t2026 = xp.abs(t2025)
     t2027 = xp.greater_equal(t2026, 1)
-    t2028 = xp.abs(1/xp.where(t2027, t2025, 1))
+    t2028 = 1/xp.abs(xp.where(t2027, t2025, 1))
     t2029 = xp.where(t2024, xp.where(xp.greater_equal(t2025, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2027, t2028/(1 + xp.sqrt(1 + t2028**2)), 1/(t2026 + xp.sqrt(1 + t2026**2))), 0)
     t2030 = 1/xp.sqrt(1 + t2029**2)
     t2031 = t2022*t2029
@@ -7264,10 +7264,10 @@ def condition_number(q):
     t2057 = t2055 + t2029*t2054
     t2058 = t1932*t2036 + t1936*t2040 + t1940*t2044 + t1944*t2048 + t1948*t2052 + t1952*t2056
     t2059 = xp.not_equal(t2058, 0)
-    t2060 = 0.5*(-t2032 + t1928)/xp.where(t2059, t2058, 1)
+    t2060 = (-t2032 + t1928)/xp.where(t2059, 2*t2058, 1)
     t2061 = xp.abs(t2060)
     t2062 = xp.greater_equal(t2061, 1)
-    t2063 = xp.abs(1/xp.where(t2062, t2060, 1))
+    t2063 = 1/xp.abs(xp.where(t2062, t2060, 1))
     t2064 = xp.where(t2059, xp.where(xp.greater_equal(t2060, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2062, t2063/(1 + xp.sqrt(1 + t2063**2)), 1/(t2061 + xp.sqrt(1 + t2061**2))), 0)
     t2065 = 1/xp.sqrt(1 + t2064**2)
     t2066 = t2058*t2064
@@ -7299,10 +7299,10 @@ def condition_number(q):
     t2092 = t2090 + t2064*t2089
     t2093 = t1931*t2071 + t1935*t2075 + t1939*t2079 + t1943*t2083 + t1947*t2087 + t1951*t2091
     t2094 = xp.not_equal(t2023, 0)
-    t2095 = 0.5*(-t1962 + t1997)/xp.where(t2094, t2023, 1)
+    t2095 = (-t1962 + t1997)/xp.where(t2094, 2*t2023, 1)
     t2096 = xp.abs(t2095)
     t2097 = xp.greater_equal(t2096, 1)
-    t2098 = xp.abs(1/xp.where(t2097, t2095, 1))
+    t2098 = 1/xp.abs(xp.where(t2097, t2095, 1))
     t2099 = xp.where(t2094, xp.where(xp.greater_equal(t2095, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2097, t2098/(1 + xp.sqrt(1 + t2098**2)), 1/(t2096 + xp.sqrt(1 + t2096**2))), 0)
     t2100 = 1/xp.sqrt(1 + t2099**2)
     t2101 = t2023*t2099
@@ -7334,10 +7334,10 @@ def condition_number(q):
     t2127 = t2125 + t2099*t2124
     t2128 = t2037*t2106 + t2041*t2110 + t2045*t2114 + t2049*t2118 + t2053*t2122 + t2057*t2126
     t2129 = xp.not_equal(t2128, 0)
-    t2130 = 0.5*(-t2102 + t2033)/xp.where(t2129, t2128, 1)
+    t2130 = (-t2102 + t2033)/xp.where(t2129, 2*t2128, 1)
     t2131 = xp.abs(t2130)
     t2132 = xp.greater_equal(t2131, 1)
-    t2133 = xp.abs(1/xp.where(t2132, t2130, 1))
+    t2133 = 1/xp.abs(xp.where(t2132, t2130, 1))
     t2134 = xp.where(t2129, xp.where(xp.greater_equal(t2130, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2132, t2133/(1 + xp.sqrt(1 + t2133**2)), 1/(t2131 + xp.sqrt(1 + t2131**2))), 0)
     t2135 = 1/xp.sqrt(1 + t2134**2)
     t2136 = t2128*t2134
@@ -7370,10 +7370,10 @@ def condition_number(q):
     t2163 = t2072*t2141 + t2076*t2145 + t2080*t2149 + t2084*t2153 + t2088*t2157 + t2092*t2161
     t2164 = t2107*t2142 + t2111*t2146 + t2115*t2150 + t2119*t2154 + t2123*t2158 + t2127*t2162
     t2165 = xp.not_equal(t2163, 0)
-    t2166 = 0.5*(-t2137 + t2068)/xp.where(t2165, t2163, 1)
+    t2166 = (-t2137 + t2068)/xp.where(t2165, 2*t2163, 1)
     t2167 = xp.abs(t2166)
     t2168 = xp.greater_equal(t2167, 1)
-    t2169 = xp.abs(1/xp.where(t2168, t2166, 1))
+    t2169 = 1/xp.abs(xp.where(t2168, t2166, 1))
     t2170 = xp.where(t2165, xp.where(xp.greater_equal(t2166, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2168, t2169/(1 + xp.sqrt(1 + t2169**2)), 1/(t2167 + xp.sqrt(1 + t2167**2))), 0)
     t2171 = 1/xp.sqrt(1 + t2170**2)
     t2172 = t2163*t2170
@@ -7404,10 +7404,10 @@ def condition_number(q):
     t2197 = t2195 - t2170*t2196
     t2198 = t2196 + t2170*t2195
     t2199 = xp.not_equal(t2164, 0)
-    t2200 = 0.5*(-t2103 + t2138)/xp.where(t2199, t2164, 1)
+    t2200 = (-t2103 + t2138)/xp.where(t2199, 2*t2164, 1)
     t2201 = xp.abs(t2200)
     t2202 = xp.greater_equal(t2201, 1)
-    t2203 = xp.abs(1/xp.where(t2202, t2200, 1))
+    t2203 = 1/xp.abs(xp.where(t2202, t2200, 1))
     t2204 = xp.where(t2199, xp.where(xp.greater_equal(t2200, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2202, t2203/(1 + xp.sqrt(1 + t2203**2)), 1/(t2201 + xp.sqrt(1 + t2201**2))), 0)
     t2205 = 1/xp.sqrt(1 + t2204**2)
     t2206 = t2164*t2204
@@ -7439,10 +7439,10 @@ def condition_number(q):
     t2232 = t2230 + t2204*t2229
     t2233 = t2178*t2211 + t2182*t2215 + t2186*t2219 + t2190*t2223 + t2194*t2227 + t2198*t2231
     t2234 = xp.not_equal(t2233, 0)
-    t2235 = 0.5*(-t2207 + t2174)/xp.where(t2234, t2233, 1)
+    t2235 = (-t2207 + t2174)/xp.where(t2234, 2*t2233, 1)
     t2236 = xp.abs(t2235)
     t2237 = xp.greater_equal(t2236, 1)
-    t2238 = xp.abs(1/xp.where(t2237, t2235, 1))
+    t2238 = 1/xp.abs(xp.where(t2237, t2235, 1))
     t2239 = xp.where(t2234, xp.where(xp.greater_equal(t2235, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2237, t2238/(1 + xp.sqrt(1 + t2238**2)), 1/(t2236 + xp.sqrt(1 + t2236**2))), 0)
     t2240 = 1/xp.sqrt(1 + t2239**2)
     t2241 = t2233*t2239
@@ -7474,10 +7474,10 @@ def condition_number(q):
     t2267 = t2265 + t2239*t2264
     t2268 = t2212*t2247 + t2216*t2251 + t2220*t2255 + t2224*t2259 + t2228*t2263 + t2232*t2267
     t2269 = xp.not_equal(t2268, 0)
-    t2270 = 0.5*(-t2208 + t2243)/xp.where(t2269, t2268, 1)
+    t2270 = (-t2208 + t2243)/xp.where(t2269, 2*t2268, 1)
     t2271 = xp.abs(t2270)
     t2272 = xp.greater_equal(t2271, 1)
-    t2273 = xp.abs(1/xp.where(t2272, t2270, 1))
+    t2273 = 1/xp.abs(xp.where(t2272, t2270, 1))
     t2274 = xp.where(t2269, xp.where(xp.greater_equal(t2270, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2272, t2273/(1 + xp.sqrt(1 + t2273**2)), 1/(t2271 + xp.sqrt(1 + t2271**2))), 0)
     t2275 = 1/xp.sqrt(1 + t2274**2)
     t2276 = t2268*t2274
@@ -7508,10 +7508,10 @@ def condition_number(q):
     t2301 = t2299 - t2274*t2300
     t2302 = t2300 + t2274*t2299
     t2303 = xp.not_equal(t2093, 0)
-    t2304 = 0.5*(-t1927 + t2067)/xp.where(t2303, t2093, 1)
+    t2304 = (-t1927 + t2067)/xp.where(t2303, 2*t2093, 1)
     t2305 = xp.abs(t2304)
     t2306 = xp.greater_equal(t2305, 1)
-    t2307 = xp.abs(1/xp.where(t2306, t2304, 1))
+    t2307 = 1/xp.abs(xp.where(t2306, t2304, 1))
     t2308 = xp.where(t2303, xp.where(xp.greater_equal(t2304, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2306, t2307/(1 + xp.sqrt(1 + t2307**2)), 1/(t2305 + xp.sqrt(1 + t2305**2))), 0)
     t2309 = 1/xp.sqrt(1 + t2308**2)
     t2310 = t2093*t2308
@@ -7543,10 +7543,10 @@ def condition_number(q):
     t2336 = t2334 + t2308*t2333
     t2337 = t2177*t2315 + t2181*t2319 + t2185*t2323 + t2189*t2327 + t2193*t2331 + t2197*t2335
     t2338 = xp.not_equal(t2337, 0)
-    t2339 = 0.5*(-t2311 + t2173)/xp.where(t2338, t2337, 1)
+    t2339 = (-t2311 + t2173)/xp.where(t2338, 2*t2337, 1)
     t2340 = xp.abs(t2339)
     t2341 = xp.greater_equal(t2340, 1)
-    t2342 = xp.abs(1/xp.where(t2341, t2339, 1))
+    t2342 = 1/xp.abs(xp.where(t2341, t2339, 1))
     t2343 = xp.where(t2338, xp.where(xp.greater_equal(t2339, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2341, t2342/(1 + xp.sqrt(1 + t2342**2)), 1/(t2340 + xp.sqrt(1 + t2340**2))), 0)
     t2344 = 1/xp.sqrt(1 + t2343**2)
     t2345 = t2337*t2343
@@ -7579,10 +7579,10 @@ def condition_number(q):
     t2372 = t2246*t2350 + t2250*t2354 + t2254*t2358 + t2258*t2362 + t2262*t2366 + t2266*t2370
     t2373 = t2316*t2351 + t2320*t2355 + t2324*t2359 + t2328*t2363 + t2332*t2367 + t2336*t2371
     t2374 = xp.not_equal(t2372, 0)
-    t2375 = 0.5*(-t2346 + t2242)/xp.where(t2374, t2372, 1)
+    t2375 = (-t2346 + t2242)/xp.where(t2374, 2*t2372, 1)
     t2376 = xp.abs(t2375)
     t2377 = xp.greater_equal(t2376, 1)
-    t2378 = xp.abs(1/xp.where(t2377, t2375, 1))
+    t2378 = 1/xp.abs(xp.where(t2377, t2375, 1))
     t2379 = xp.where(t2374, xp.where(xp.greater_equal(t2375, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2377, t2378/(1 + xp.sqrt(1 + t2378**2)), 1/(t2376 + xp.sqrt(1 + t2376**2))), 0)
     t2380 = 1/xp.sqrt(1 + t2379**2)
     t2381 = t2372*t2379
@@ -7614,10 +7614,10 @@ def condition_number(q):
     t2407 = t2405 + t2379*t2404
     t2408 = t2281*t2386 + t2285*t2390 + t2289*t2394 + t2293*t2398 + t2297*t2402 + t2301*t2406
     t2409 = xp.not_equal(t2408, 0)
-    t2410 = 0.5*(-t2382 + t2277)/xp.where(t2409, t2408, 1)
+    t2410 = (-t2382 + t2277)/xp.where(t2409, 2*t2408, 1)
     t2411 = xp.abs(t2410)
     t2412 = xp.greater_equal(t2411, 1)
-    t2413 = xp.abs(1/xp.where(t2412, t2410, 1))
+    t2413 = 1/xp.abs(xp.where(t2412, t2410, 1))
     t2414 = xp.where(t2409, xp.where(xp.greater_equal(t2410, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2412, t2413/(1 + xp.sqrt(1 + t2413**2)), 1/(t2411 + xp.sqrt(1 + t2411**2))), 0)
     t2415 = 1/xp.sqrt(1 + t2414**2)
     t2416 = t2408*t2414
@@ -7649,10 +7649,10 @@ def condition_number(q):
     t2442 = t2440 + t2414*t2439
     t2443 = t2282*t2421 + t2286*t2425 + t2290*t2429 + t2294*t2433 + t2298*t2437 + t2302*t2441
     t2444 = xp.not_equal(t2443, 0)
-    t2445 = 0.5*(-t2417 + t2278)/xp.where(t2444, t2443, 1)
+    t2445 = (-t2417 + t2278)/xp.where(t2444, 2*t2443, 1)
     t2446 = xp.abs(t2445)
     t2447 = xp.greater_equal(t2446, 1)
-    t2448 = xp.abs(1/xp.where(t2447, t2445, 1))
+    t2448 = 1/xp.abs(xp.where(t2447, t2445, 1))
     t2449 = xp.where(t2444, xp.where(xp.greater_equal(t2445, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2447, t2448/(1 + xp.sqrt(1 + t2448**2)), 1/(t2446 + xp.sqrt(1 + t2446**2))), 0)
     t2450 = 1/xp.sqrt(1 + t2449**2)
     t2451 = t2443*t2449
@@ -7683,10 +7683,10 @@ def condition_number(q):
     t2476 = t2474 - t2449*t2475
     t2477 = t2475 + t2449*t2474
     t2478 = xp.not_equal(t2373, 0)
-    t2479 = 0.5*(-t2312 + t2347)/xp.where(t2478, t2373, 1)
+    t2479 = (-t2312 + t2347)/xp.where(t2478, 2*t2373, 1)
     t2480 = xp.abs(t2479)
     t2481 = xp.greater_equal(t2480, 1)
-    t2482 = xp.abs(1/xp.where(t2481, t2479, 1))
+    t2482 = 1/xp.abs(xp.where(t2481, t2479, 1))
     t2483 = xp.where(t2478, xp.where(xp.greater_equal(t2479, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2481, t2482/(1 + xp.sqrt(1 + t2482**2)), 1/(t2480 + xp.sqrt(1 + t2480**2))), 0)
     t2484 = 1/xp.sqrt(1 + t2483**2)
     t2485 = t2373*t2483
@@ -7718,10 +7718,10 @@ def condition_number(q):
     t2511 = t2509 + t2483*t2508
     t2512 = t2387*t2490 + t2391*t2494 + t2395*t2498 + t2399*t2502 + t2403*t2506 + t2407*t2510
     t2513 = xp.not_equal(t2512, 0)
-    t2514 = 0.5*(-t2486 + t2383)/xp.where(t2513, t2512, 1)
+    t2514 = (-t2486 + t2383)/xp.where(t2513, 2*t2512, 1)
     t2515 = xp.abs(t2514)
     t2516 = xp.greater_equal(t2515, 1)
-    t2517 = xp.abs(1/xp.where(t2516, t2514, 1))
+    t2517 = 1/xp.abs(xp.where(t2516, t2514, 1))
     t2518 = xp.where(t2513, xp.where(xp.greater_equal(t2514, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2516, t2517/(1 + xp.sqrt(1 + t2517**2)), 1/(t2515 + xp.sqrt(1 + t2515**2))), 0)
     t2519 = 1/xp.sqrt(1 + t2518**2)
     t2520 = t2512*t2518
@@ -7754,10 +7754,10 @@ def condition_number(q):
     t2547 = t2422*t2525 + t2426*t2529 + t2430*t2533 + t2434*t2537 + t2438*t2541 + t2442*t2545
     t2548 = t2491*t2526 + t2495*t2530 + t2499*t2534 + t2503*t2538 + t2507*t2542 + t2511*t2546
     t2549 = xp.not_equal(t2547, 0)
-    t2550 = 0.5*(-t2521 + t2418)/xp.where(t2549, t2547, 1)
+    t2550 = (-t2521 + t2418)/xp.where(t2549, 2*t2547, 1)
     t2551 = xp.abs(t2550)
     t2552 = xp.greater_equal(t2551, 1)
-    t2553 = xp.abs(1/xp.where(t2552, t2550, 1))
+    t2553 = 1/xp.abs(xp.where(t2552, t2550, 1))
     t2554 = xp.where(t2549, xp.where(xp.greater_equal(t2550, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2552, t2553/(1 + xp.sqrt(1 + t2553**2)), 1/(t2551 + xp.sqrt(1 + t2551**2))), 0)
     t2555 = 1/xp.sqrt(1 + t2554**2)
     t2556 = t2547*t2554
@@ -7789,10 +7789,10 @@ def condition_number(q):
     t2582 = t2580 + t2554*t2579
     t2583 = t2457*t2561 + t2461*t2565 + t2465*t2569 + t2469*t2573 + t2473*t2577 + t2477*t2581
     t2584 = xp.not_equal(t2583, 0)
-    t2585 = 0.5*(-t2557 + t2453)/xp.where(t2584, t2583, 1)
+    t2585 = (-t2557 + t2453)/xp.where(t2584, 2*t2583, 1)
     t2586 = xp.abs(t2585)
     t2587 = xp.greater_equal(t2586, 1)
-    t2588 = xp.abs(1/xp.where(t2587, t2585, 1))
+    t2588 = 1/xp.abs(xp.where(t2587, t2585, 1))
     t2589 = xp.where(t2584, xp.where(xp.greater_equal(t2585, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2587, t2588/(1 + xp.sqrt(1 + t2588**2)), 1/(t2586 + xp.sqrt(1 + t2586**2))), 0)
     t2590 = 1/xp.sqrt(1 + t2589**2)
     t2591 = t2583*t2589
@@ -7824,10 +7824,10 @@ def condition_number(q):
     t2617 = t2615 + t2589*t2614
     t2618 = t2456*t2596 + t2460*t2600 + t2464*t2604 + t2468*t2608 + t2472*t2612 + t2476*t2616
     t2619 = xp.not_equal(t2548, 0)
-    t2620 = 0.5*(-t2487 + t2522)/xp.where(t2619, t2548, 1)
+    t2620 = (-t2487 + t2522)/xp.where(t2619, 2*t2548, 1)
     t2621 = xp.abs(t2620)
     t2622 = xp.greater_equal(t2621, 1)
-    t2623 = xp.abs(1/xp.where(t2622, t2620, 1))
+    t2623 = 1/xp.abs(xp.where(t2622, t2620, 1))
     t2624 = xp.where(t2619, xp.where(xp.greater_equal(t2620, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2622, t2623/(1 + xp.sqrt(1 + t2623**2)), 1/(t2621 + xp.sqrt(1 + t2621**2))), 0)
     t2625 = 1/xp.sqrt(1 + t2624**2)
     t2626 = t2548*t2624
@@ -7859,10 +7859,10 @@ def condition_number(q):
     t2652 = t2650 + t2624*t2649
     t2653 = t2562*t2631 + t2566*t2635 + t2570*t2639 + t2574*t2643 + t2578*t2647 + t2582*t2651
     t2654 = xp.not_equal(t2653, 0)
-    t2655 = 0.5*(-t2627 + t2558)/xp.where(t2654, t2653, 1)
+    t2655 = (-t2627 + t2558)/xp.where(t2654, 2*t2653, 1)
     t2656 = xp.abs(t2655)
     t2657 = xp.greater_equal(t2656, 1)
-    t2658 = xp.abs(1/xp.where(t2657, t2655, 1))
+    t2658 = 1/xp.abs(xp.where(t2657, t2655, 1))
     t2659 = xp.where(t2654, xp.where(xp.greater_equal(t2655, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2657, t2658/(1 + xp.sqrt(1 + t2658**2)), 1/(t2656 + xp.sqrt(1 + t2656**2))), 0)
     t2660 = 1/xp.sqrt(1 + t2659**2)
     t2661 = t2653*t2659
@@ -7895,10 +7895,10 @@ def condition_number(q):
     t2688 = t2597*t2666 + t2601*t2670 + t2605*t2674 + t2609*t2678 + t2613*t2682 + t2617*t2686
     t2689 = t2632*t2667 + t2636*t2671 + t2640*t2675 + t2644*t2679 + t2648*t2683 + t2652*t2687
     t2690 = xp.not_equal(t2688, 0)
-    t2691 = 0.5*(-t2662 + t2593)/xp.where(t2690, t2688, 1)
+    t2691 = (-t2662 + t2593)/xp.where(t2690, 2*t2688, 1)
     t2692 = xp.abs(t2691)
     t2693 = xp.greater_equal(t2692, 1)
-    t2694 = xp.abs(1/xp.where(t2693, t2691, 1))
+    t2694 = 1/xp.abs(xp.where(t2693, t2691, 1))
     t2695 = xp.where(t2690, xp.where(xp.greater_equal(t2691, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2693, t2694/(1 + xp.sqrt(1 + t2694**2)), 1/(t2692 + xp.sqrt(1 + t2692**2))), 0)
     t2696 = 1/xp.sqrt(1 + t2695**2)
     t2697 = t2688*t2695
@@ -7929,10 +7929,10 @@ def condition_number(q):
     t2722 = t2720 - t2695*t2721
     t2723 = t2721 + t2695*t2720
     t2724 = xp.not_equal(t2689, 0)
-    t2725 = 0.5*(-t2628 + t2663)/xp.where(t2724, t2689, 1)
+    t2725 = (-t2628 + t2663)/xp.where(t2724, 2*t2689, 1)
     t2726 = xp.abs(t2725)
     t2727 = xp.greater_equal(t2726, 1)
-    t2728 = xp.abs(1/xp.where(t2727, t2725, 1))
+    t2728 = 1/xp.abs(xp.where(t2727, t2725, 1))
     t2729 = xp.where(t2724, xp.where(xp.greater_equal(t2725, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2727, t2728/(1 + xp.sqrt(1 + t2728**2)), 1/(t2726 + xp.sqrt(1 + t2726**2))), 0)
     t2730 = 1/xp.sqrt(1 + t2729**2)
     t2731 = t2689*t2729
@@ -7964,10 +7964,10 @@ def condition_number(q):
     t2757 = t2755 + t2729*t2754
     t2758 = t2703*t2736 + t2707*t2740 + t2711*t2744 + t2715*t2748 + t2719*t2752 + t2723*t2756
     t2759 = xp.not_equal(t2758, 0)
-    t2760 = 0.5*(-t2732 + t2699)/xp.where(t2759, t2758, 1)
+    t2760 = (-t2732 + t2699)/xp.where(t2759, 2*t2758, 1)
     t2761 = xp.abs(t2760)
     t2762 = xp.greater_equal(t2761, 1)
-    t2763 = xp.abs(1/xp.where(t2762, t2760, 1))
+    t2763 = 1/xp.abs(xp.where(t2762, t2760, 1))
     t2764 = xp.where(t2759, xp.where(xp.greater_equal(t2760, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2762, t2763/(1 + xp.sqrt(1 + t2763**2)), 1/(t2761 + xp.sqrt(1 + t2761**2))), 0)
     t2765 = 1/xp.sqrt(1 + t2764**2)
     t2766 = t2758*t2764
@@ -7999,10 +7999,10 @@ def condition_number(q):
     t2792 = t2790 + t2764*t2789
     t2793 = t2737*t2772 + t2741*t2776 + t2745*t2780 + t2749*t2784 + t2753*t2788 + t2757*t2792
     t2794 = xp.not_equal(t2793, 0)
-    t2795 = 0.5*(-t2733 + t2768)/xp.where(t2794, t2793, 1)
+    t2795 = (-t2733 + t2768)/xp.where(t2794, 2*t2793, 1)
     t2796 = xp.abs(t2795)
     t2797 = xp.greater_equal(t2796, 1)
-    t2798 = xp.abs(1/xp.where(t2797, t2795, 1))
+    t2798 = 1/xp.abs(xp.where(t2797, t2795, 1))
     t2799 = xp.where(t2794, xp.where(xp.greater_equal(t2795, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2797, t2798/(1 + xp.sqrt(1 + t2798**2)), 1/(t2796 + xp.sqrt(1 + t2796**2))), 0)
     t2800 = 1/xp.sqrt(1 + t2799**2)
     t2801 = t2793*t2799
@@ -8033,10 +8033,10 @@ def condition_number(q):
     t2826 = t2824 - t2799*t2825
     t2827 = t2825 + t2799*t2824
     t2828 = xp.not_equal(t2618, 0)
-    t2829 = 0.5*(-t2452 + t2592)/xp.where(t2828, t2618, 1)
+    t2829 = (-t2452 + t2592)/xp.where(t2828, 2*t2618, 1)
     t2830 = xp.abs(t2829)
     t2831 = xp.greater_equal(t2830, 1)
-    t2832 = xp.abs(1/xp.where(t2831, t2829, 1))
+    t2832 = 1/xp.abs(xp.where(t2831, t2829, 1))
     t2833 = xp.where(t2828, xp.where(xp.greater_equal(t2829, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2831, t2832/(1 + xp.sqrt(1 + t2832**2)), 1/(t2830 + xp.sqrt(1 + t2830**2))), 0)
     t2834 = 1/xp.sqrt(1 + t2833**2)
     t2835 = t2618*t2833
@@ -8068,10 +8068,10 @@ def condition_number(q):
     t2861 = t2859 + t2833*t2858
     t2862 = t2702*t2840 + t2706*t2844 + t2710*t2848 + t2714*t2852 + t2718*t2856 + t2722*t2860
     t2863 = xp.not_equal(t2862, 0)
-    t2864 = 0.5*(-t2836 + t2698)/xp.where(t2863, t2862, 1)
+    t2864 = (-t2836 + t2698)/xp.where(t2863, 2*t2862, 1)
     t2865 = xp.abs(t2864)
     t2866 = xp.greater_equal(t2865, 1)
-    t2867 = xp.abs(1/xp.where(t2866, t2864, 1))
+    t2867 = 1/xp.abs(xp.where(t2866, t2864, 1))
     t2868 = xp.where(t2863, xp.where(xp.greater_equal(t2864, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2866, t2867/(1 + xp.sqrt(1 + t2867**2)), 1/(t2865 + xp.sqrt(1 + t2865**2))), 0)
     t2869 = 1/xp.sqrt(1 + t2868**2)
     t2870 = t2862*t2868
@@ -8104,10 +8104,10 @@ def condition_number(q):
     t2897 = t2771*t2875 + t2775*t2879 + t2779*t2883 + t2783*t2887 + t2787*t2891 + t2791*t2895
     t2898 = t2841*t2876 + t2845*t2880 + t2849*t2884 + t2853*t2888 + t2857*t2892 + t2861*t2896
     t2899 = xp.not_equal(t2897, 0)
-    t2900 = 0.5*(-t2871 + t2767)/xp.where(t2899, t2897, 1)
+    t2900 = (-t2871 + t2767)/xp.where(t2899, 2*t2897, 1)
     t2901 = xp.abs(t2900)
     t2902 = xp.greater_equal(t2901, 1)
-    t2903 = xp.abs(1/xp.where(t2902, t2900, 1))
+    t2903 = 1/xp.abs(xp.where(t2902, t2900, 1))
     t2904 = xp.where(t2899, xp.where(xp.greater_equal(t2900, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2902, t2903/(1 + xp.sqrt(1 + t2903**2)), 1/(t2901 + xp.sqrt(1 + t2901**2))), 0)
     t2905 = 1/xp.sqrt(1 + t2904**2)
     t2906 = t2897*t2904
@@ -8139,10 +8139,10 @@ def condition_number(q):
     t2932 = t2930 + t2904*t2929
     t2933 = t2806*t2911 + t2810*t2915 + t2814*t2919 + t2818*t2923 + t2822*t2927 + t2826*t2931
     t2934 = xp.not_equal(t2933, 0)
-    t2935 = 0.5*(-t2907 + t2802)/xp.where(t2934, t2933, 1)
+    t2935 = (-t2907 + t2802)/xp.where(t2934, 2*t2933, 1)
     t2936 = xp.abs(t2935)
     t2937 = xp.greater_equal(t2936, 1)
-    t2938 = xp.abs(1/xp.where(t2937, t2935, 1))
+    t2938 = 1/xp.abs(xp.where(t2937, t2935, 1))
     t2939 = xp.where(t2934, xp.where(xp.greater_equal(t2935, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2937, t2938/(1 + xp.sqrt(1 + t2938**2)), 1/(t2936 + xp.sqrt(1 + t2936**2))), 0)
     t2940 = 1/xp.sqrt(1 + t2939**2)
     t2941 = t2933*t2939
@@ -8174,10 +8174,10 @@ def condition_number(q):
     t2967 = t2965 + t2939*t2964
     t2968 = t2807*t2946 + t2811*t2950 + t2815*t2954 + t2819*t2958 + t2823*t2962 + t2827*t2966
     t2969 = xp.not_equal(t2968, 0)
-    t2970 = 0.5*(-t2942 + t2803)/xp.where(t2969, t2968, 1)
+    t2970 = (-t2942 + t2803)/xp.where(t2969, 2*t2968, 1)
     t2971 = xp.abs(t2970)
     t2972 = xp.greater_equal(t2971, 1)
-    t2973 = xp.abs(1/xp.where(t2972, t2970, 1))
+    t2973 = 1/xp.abs(xp.where(t2972, t2970, 1))
     t2974 = xp.where(t2969, xp.where(xp.greater_equal(t2970, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t2972, t2973/(1 + xp.sqrt(1 + t2973**2)), 1/(t2971 + xp.sqrt(1 + t2971**2))), 0)
     t2975 = 1/xp.sqrt(1 + t2974**2)
     t2976 = t2968*t2974
@@ -8208,10 +8208,10 @@ def condition_number(q):
     t3001 = t2999 - t2974*t3000
     t3002 = t3000 + t2974*t2999
     t3003 = xp.not_equal(t2898, 0)
-    t3004 = 0.5*(-t2837 + t2872)/xp.where(t3003, t2898, 1)
+    t3004 = (-t2837 + t2872)/xp.where(t3003, 2*t2898, 1)
     t3005 = xp.abs(t3004)
     t3006 = xp.greater_equal(t3005, 1)
-    t3007 = xp.abs(1/xp.where(t3006, t3004, 1))
+    t3007 = 1/xp.abs(xp.where(t3006, t3004, 1))
     t3008 = xp.where(t3003, xp.where(xp.greater_equal(t3004, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3006, t3007/(1 + xp.sqrt(1 + t3007**2)), 1/(t3005 + xp.sqrt(1 + t3005**2))), 0)
     t3009 = 1/xp.sqrt(1 + t3008**2)
     t3010 = t2898*t3008
@@ -8243,10 +8243,10 @@ def condition_number(q):
     t3036 = t3034 + t3008*t3033
     t3037 = t2912*t3015 + t2916*t3019 + t2920*t3023 + t2924*t3027 + t2928*t3031 + t2932*t3035
     t3038 = xp.not_equal(t3037, 0)
-    t3039 = 0.5*(-t3011 + t2908)/xp.where(t3038, t3037, 1)
+    t3039 = (-t3011 + t2908)/xp.where(t3038, 2*t3037, 1)
     t3040 = xp.abs(t3039)
     t3041 = xp.greater_equal(t3040, 1)
-    t3042 = xp.abs(1/xp.where(t3041, t3039, 1))
+    t3042 = 1/xp.abs(xp.where(t3041, t3039, 1))
     t3043 = xp.where(t3038, xp.where(xp.greater_equal(t3039, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3041, t3042/(1 + xp.sqrt(1 + t3042**2)), 1/(t3040 + xp.sqrt(1 + t3040**2))), 0)
     t3044 = 1/xp.sqrt(1 + t3043**2)
     t3045 = t3037*t3043
@@ -8279,10 +8279,10 @@ def condition_number(q):
     t3072 = t2947*t3050 + t2951*t3054 + t2955*t3058 + t2959*t3062 + t2963*t3066 + t2967*t3070
     t3073 = t3016*t3051 + t3020*t3055 + t3024*t3059 + t3028*t3063 + t3032*t3067 + t3036*t3071
     t3074 = xp.not_equal(t3072, 0)
-    t3075 = 0.5*(-t3046 + t2943)/xp.where(t3074, t3072, 1)
+    t3075 = (-t3046 + t2943)/xp.where(t3074, 2*t3072, 1)
     t3076 = xp.abs(t3075)
     t3077 = xp.greater_equal(t3076, 1)
-    t3078 = xp.abs(1/xp.where(t3077, t3075, 1))
+    t3078 = 1/xp.abs(xp.where(t3077, t3075, 1))
     t3079 = xp.where(t3074, xp.where(xp.greater_equal(t3075, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3077, t3078/(1 + xp.sqrt(1 + t3078**2)), 1/(t3076 + xp.sqrt(1 + t3076**2))), 0)
     t3080 = 1/xp.sqrt(1 + t3079**2)
     t3081 = t3072*t3079
@@ -8314,10 +8314,10 @@ def condition_number(q):
     t3107 = t3105 + t3079*t3104
     t3108 = t2982*t3086 + t2986*t3090 + t2990*t3094 + t2994*t3098 + t2998*t3102 + t3002*t3106
     t3109 = xp.not_equal(t3108, 0)
-    t3110 = 0.5*(-t3082 + t2978)/xp.where(t3109, t3108, 1)
+    t3110 = (-t3082 + t2978)/xp.where(t3109, 2*t3108, 1)
     t3111 = xp.abs(t3110)
     t3112 = xp.greater_equal(t3111, 1)
-    t3113 = xp.abs(1/xp.where(t3112, t3110, 1))
+    t3113 = 1/xp.abs(xp.where(t3112, t3110, 1))
     t3114 = xp.where(t3109, xp.where(xp.greater_equal(t3110, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3112, t3113/(1 + xp.sqrt(1 + t3113**2)), 1/(t3111 + xp.sqrt(1 + t3111**2))), 0)
     t3115 = 1/xp.sqrt(1 + t3114**2)
     t3116 = t3108*t3114
@@ -8349,10 +8349,10 @@ def condition_number(q):
     t3142 = t3140 + t3114*t3139
     t3143 = t2981*t3121 + t2985*t3125 + t2989*t3129 + t2993*t3133 + t2997*t3137 + t3001*t3141
     t3144 = xp.not_equal(t3073, 0)
-    t3145 = 0.5*(-t3012 + t3047)/xp.where(t3144, t3073, 1)
+    t3145 = (-t3012 + t3047)/xp.where(t3144, 2*t3073, 1)
     t3146 = xp.abs(t3145)
     t3147 = xp.greater_equal(t3146, 1)
-    t3148 = xp.abs(1/xp.where(t3147, t3145, 1))
+    t3148 = 1/xp.abs(xp.where(t3147, t3145, 1))
     t3149 = xp.where(t3144, xp.where(xp.greater_equal(t3145, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3147, t3148/(1 + xp.sqrt(1 + t3148**2)), 1/(t3146 + xp.sqrt(1 + t3146**2))), 0)
     t3150 = 1/xp.sqrt(1 + t3149**2)
     t3151 = t3073*t3149
@@ -8384,10 +8384,10 @@ def condition_number(q):
     t3177 = t3175 + t3149*t3174
     t3178 = t3087*t3156 + t3091*t3160 + t3095*t3164 + t3099*t3168 + t3103*t3172 + t3107*t3176
     t3179 = xp.not_equal(t3178, 0)
-    t3180 = 0.5*(-t3152 + t3083)/xp.where(t3179, t3178, 1)
+    t3180 = (-t3152 + t3083)/xp.where(t3179, 2*t3178, 1)
     t3181 = xp.abs(t3180)
     t3182 = xp.greater_equal(t3181, 1)
-    t3183 = xp.abs(1/xp.where(t3182, t3180, 1))
+    t3183 = 1/xp.abs(xp.where(t3182, t3180, 1))
     t3184 = xp.where(t3179, xp.where(xp.greater_equal(t3180, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3182, t3183/(1 + xp.sqrt(1 + t3183**2)), 1/(t3181 + xp.sqrt(1 + t3181**2))), 0)
     t3185 = 1/xp.sqrt(1 + t3184**2)
     t3186 = t3178*t3184
@@ -8420,10 +8420,10 @@ def condition_number(q):
     t3213 = t3122*t3191 + t3126*t3195 + t3130*t3199 + t3134*t3203 + t3138*t3207 + t3142*t3211
     t3214 = t3157*t3192 + t3161*t3196 + t3165*t3200 + t3169*t3204 + t3173*t3208 + t3177*t3212
     t3215 = xp.not_equal(t3213, 0)
-    t3216 = 0.5*(-t3187 + t3118)/xp.where(t3215, t3213, 1)
+    t3216 = (-t3187 + t3118)/xp.where(t3215, 2*t3213, 1)
     t3217 = xp.abs(t3216)
     t3218 = xp.greater_equal(t3217, 1)
-    t3219 = xp.abs(1/xp.where(t3218, t3216, 1))
+    t3219 = 1/xp.abs(xp.where(t3218, t3216, 1))
     t3220 = xp.where(t3215, xp.where(xp.greater_equal(t3216, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3218, t3219/(1 + xp.sqrt(1 + t3219**2)), 1/(t3217 + xp.sqrt(1 + t3217**2))), 0)
     t3221 = 1/xp.sqrt(1 + t3220**2)
     t3222 = t3213*t3220
@@ -8454,10 +8454,10 @@ def condition_number(q):
     t3247 = t3245 - t3220*t3246
     t3248 = t3246 + t3220*t3245
     t3249 = xp.not_equal(t3214, 0)
-    t3250 = 0.5*(-t3153 + t3188)/xp.where(t3249, t3214, 1)
+    t3250 = (-t3153 + t3188)/xp.where(t3249, 2*t3214, 1)
     t3251 = xp.abs(t3250)
     t3252 = xp.greater_equal(t3251, 1)
-    t3253 = xp.abs(1/xp.where(t3252, t3250, 1))
+    t3253 = 1/xp.abs(xp.where(t3252, t3250, 1))
     t3254 = xp.where(t3249, xp.where(xp.greater_equal(t3250, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3252, t3253/(1 + xp.sqrt(1 + t3253**2)), 1/(t3251 + xp.sqrt(1 + t3251**2))), 0)
     t3255 = 1/xp.sqrt(1 + t3254**2)
     t3256 = t3214*t3254
@@ -8489,10 +8489,10 @@ def condition_number(q):
     t3282 = t3280 + t3254*t3279
     t3283 = t3228*t3261 + t3232*t3265 + t3236*t3269 + t3240*t3273 + t3244*t3277 + t3248*t3281
     t3284 = xp.not_equal(t3283, 0)
-    t3285 = 0.5*(-t3257 + t3224)/xp.where(t3284, t3283, 1)
+    t3285 = (-t3257 + t3224)/xp.where(t3284, 2*t3283, 1)
     t3286 = xp.abs(t3285)
     t3287 = xp.greater_equal(t3286, 1)
-    t3288 = xp.abs(1/xp.where(t3287, t3285, 1))
+    t3288 = 1/xp.abs(xp.where(t3287, t3285, 1))
     t3289 = xp.where(t3284, xp.where(xp.greater_equal(t3285, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3287, t3288/(1 + xp.sqrt(1 + t3288**2)), 1/(t3286 + xp.sqrt(1 + t3286**2))), 0)
     t3290 = 1/xp.sqrt(1 + t3289**2)
     t3291 = t3283*t3289
@@ -8524,10 +8524,10 @@ def condition_number(q):
     t3317 = t3315 + t3289*t3314
     t3318 = t3262*t3297 + t3266*t3301 + t3270*t3305 + t3274*t3309 + t3278*t3313 + t3282*t3317
     t3319 = xp.not_equal(t3318, 0)
-    t3320 = 0.5*(-t3258 + t3293)/xp.where(t3319, t3318, 1)
+    t3320 = (-t3258 + t3293)/xp.where(t3319, 2*t3318, 1)
     t3321 = xp.abs(t3320)
     t3322 = xp.greater_equal(t3321, 1)
-    t3323 = xp.abs(1/xp.where(t3322, t3320, 1))
+    t3323 = 1/xp.abs(xp.where(t3322, t3320, 1))
     t3324 = xp.where(t3319, xp.where(xp.greater_equal(t3320, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3322, t3323/(1 + xp.sqrt(1 + t3323**2)), 1/(t3321 + xp.sqrt(1 + t3321**2))), 0)
     t3325 = 1/xp.sqrt(1 + t3324**2)
     t3326 = t3318*t3324
@@ -8558,10 +8558,10 @@ def condition_number(q):
     t3351 = t3349 - t3324*t3350
     t3352 = t3350 + t3324*t3349
     t3353 = xp.not_equal(t3143, 0)
-    t3354 = 0.5*(-t2977 + t3117)/xp.where(t3353, t3143, 1)
+    t3354 = (-t2977 + t3117)/xp.where(t3353, 2*t3143, 1)
     t3355 = xp.abs(t3354)
     t3356 = xp.greater_equal(t3355, 1)
-    t3357 = xp.abs(1/xp.where(t3356, t3354, 1))
+    t3357 = 1/xp.abs(xp.where(t3356, t3354, 1))
     t3358 = xp.where(t3353, xp.where(xp.greater_equal(t3354, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3356, t3357/(1 + xp.sqrt(1 + t3357**2)), 1/(t3355 + xp.sqrt(1 + t3355**2))), 0)
     t3359 = 1/xp.sqrt(1 + t3358**2)
     t3360 = t3143*t3358
@@ -8593,10 +8593,10 @@ def condition_number(q):
     t3386 = t3384 + t3358*t3383
     t3387 = t3227*t3365 + t3231*t3369 + t3235*t3373 + t3239*t3377 + t3243*t3381 + t3247*t3385
     t3388 = xp.not_equal(t3387, 0)
-    t3389 = 0.5*(-t3361 + t3223)/xp.where(t3388, t3387, 1)
+    t3389 = (-t3361 + t3223)/xp.where(t3388, 2*t3387, 1)
     t3390 = xp.abs(t3389)
     t3391 = xp.greater_equal(t3390, 1)
-    t3392 = xp.abs(1/xp.where(t3391, t3389, 1))
+    t3392 = 1/xp.abs(xp.where(t3391, t3389, 1))
     t3393 = xp.where(t3388, xp.where(xp.greater_equal(t3389, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3391, t3392/(1 + xp.sqrt(1 + t3392**2)), 1/(t3390 + xp.sqrt(1 + t3390**2))), 0)
     t3394 = 1/xp.sqrt(1 + t3393**2)
     t3395 = t3387*t3393
@@ -8629,10 +8629,10 @@ def condition_number(q):
     t3422 = t3296*t3400 + t3300*t3404 + t3304*t3408 + t3308*t3412 + t3312*t3416 + t3316*t3420
     t3423 = t3366*t3401 + t3370*t3405 + t3374*t3409 + t3378*t3413 + t3382*t3417 + t3386*t3421
     t3424 = xp.not_equal(t3422, 0)
-    t3425 = 0.5*(-t3396 + t3292)/xp.where(t3424, t3422, 1)
+    t3425 = (-t3396 + t3292)/xp.where(t3424, 2*t3422, 1)
     t3426 = xp.abs(t3425)
     t3427 = xp.greater_equal(t3426, 1)
-    t3428 = xp.abs(1/xp.where(t3427, t3425, 1))
+    t3428 = 1/xp.abs(xp.where(t3427, t3425, 1))
     t3429 = xp.where(t3424, xp.where(xp.greater_equal(t3425, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3427, t3428/(1 + xp.sqrt(1 + t3428**2)), 1/(t3426 + xp.sqrt(1 + t3426**2))), 0)
     t3430 = 1/xp.sqrt(1 + t3429**2)
     t3431 = t3422*t3429
@@ -8664,10 +8664,10 @@ def condition_number(q):
     t3457 = t3455 + t3429*t3454
     t3458 = t3331*t3436 + t3335*t3440 + t3339*t3444 + t3343*t3448 + t3347*t3452 + t3351*t3456
     t3459 = xp.not_equal(t3458, 0)
-    t3460 = 0.5*(-t3432 + t3327)/xp.where(t3459, t3458, 1)
+    t3460 = (-t3432 + t3327)/xp.where(t3459, 2*t3458, 1)
     t3461 = xp.abs(t3460)
     t3462 = xp.greater_equal(t3461, 1)
-    t3463 = xp.abs(1/xp.where(t3462, t3460, 1))
+    t3463 = 1/xp.abs(xp.where(t3462, t3460, 1))
     t3464 = xp.where(t3459, xp.where(xp.greater_equal(t3460, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3462, t3463/(1 + xp.sqrt(1 + t3463**2)), 1/(t3461 + xp.sqrt(1 + t3461**2))), 0)
     t3465 = 1/xp.sqrt(1 + t3464**2)
     t3466 = t3458*t3464
@@ -8699,10 +8699,10 @@ def condition_number(q):
     t3492 = t3490 + t3464*t3489
     t3493 = t3332*t3471 + t3336*t3475 + t3340*t3479 + t3344*t3483 + t3348*t3487 + t3352*t3491
     t3494 = xp.not_equal(t3493, 0)
-    t3495 = 0.5*(-t3467 + t3328)/xp.where(t3494, t3493, 1)
+    t3495 = (-t3467 + t3328)/xp.where(t3494, 2*t3493, 1)
     t3496 = xp.abs(t3495)
     t3497 = xp.greater_equal(t3496, 1)
-    t3498 = xp.abs(1/xp.where(t3497, t3495, 1))
+    t3498 = 1/xp.abs(xp.where(t3497, t3495, 1))
     t3499 = xp.where(t3494, xp.where(xp.greater_equal(t3495, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3497, t3498/(1 + xp.sqrt(1 + t3498**2)), 1/(t3496 + xp.sqrt(1 + t3496**2))), 0)
     t3500 = 1/xp.sqrt(1 + t3499**2)
     t3501 = t3328 + t3493*t3499
@@ -8732,10 +8732,10 @@ def condition_number(q):
     t3525 = t3523 + t3499*t3522
     t3526 = xp.sqrt(t3504**2 + t3508**2 + t3512**2 + t3516**2 + t3520**2 + t3524**2)
     t3527 = xp.not_equal(t3423, 0)
-    t3528 = 0.5*(-t3362 + t3397)/xp.where(t3527, t3423, 1)
+    t3528 = (-t3362 + t3397)/xp.where(t3527, 2*t3423, 1)
     t3529 = xp.abs(t3528)
     t3530 = xp.greater_equal(t3529, 1)
-    t3531 = xp.abs(1/xp.where(t3530, t3528, 1))
+    t3531 = 1/xp.abs(xp.where(t3530, t3528, 1))
     t3532 = xp.where(t3527, xp.where(xp.greater_equal(t3528, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3530, t3531/(1 + xp.sqrt(1 + t3531**2)), 1/(t3529 + xp.sqrt(1 + t3529**2))), 0)
     t3533 = 1/xp.sqrt(1 + t3532**2)
     t3534 = t3423*t3532
@@ -8767,10 +8767,10 @@ def condition_number(q):
     t3560 = t3558 + t3532*t3557
     t3561 = t3437*t3539 + t3441*t3543 + t3445*t3547 + t3449*t3551 + t3453*t3555 + t3457*t3559
     t3562 = xp.not_equal(t3561, 0)
-    t3563 = 0.5*(-t3535 + t3433)/xp.where(t3562, t3561, 1)
+    t3563 = (-t3535 + t3433)/xp.where(t3562, 2*t3561, 1)
     t3564 = xp.abs(t3563)
     t3565 = xp.greater_equal(t3564, 1)
-    t3566 = xp.abs(1/xp.where(t3565, t3563, 1))
+    t3566 = 1/xp.abs(xp.where(t3565, t3563, 1))
     t3567 = xp.where(t3562, xp.where(xp.greater_equal(t3563, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3565, t3566/(1 + xp.sqrt(1 + t3566**2)), 1/(t3564 + xp.sqrt(1 + t3564**2))), 0)
     t3568 = 1/xp.sqrt(1 + t3567**2)
     t3569 = t3561*t3567
@@ -8803,10 +8803,10 @@ def condition_number(q):
     t3596 = t3472*t3574 + t3476*t3578 + t3480*t3582 + t3484*t3586 + t3488*t3590 + t3492*t3594
     t3597 = t3540*t3575 + t3544*t3579 + t3548*t3583 + t3552*t3587 + t3556*t3591 + t3560*t3595
     t3598 = xp.not_equal(t3596, 0)
-    t3599 = 0.5*(-t3570 + t3468)/xp.where(t3598, t3596, 1)
+    t3599 = (-t3570 + t3468)/xp.where(t3598, 2*t3596, 1)
     t3600 = xp.abs(t3599)
     t3601 = xp.greater_equal(t3600, 1)
-    t3602 = xp.abs(1/xp.where(t3601, t3599, 1))
+    t3602 = 1/xp.abs(xp.where(t3601, t3599, 1))
     t3603 = xp.where(t3598, xp.where(xp.greater_equal(t3599, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3601, t3602/(1 + xp.sqrt(1 + t3602**2)), 1/(t3600 + xp.sqrt(1 + t3600**2))), 0)
     t3604 = 1/xp.sqrt(1 + t3603**2)
     t3605 = t3596*t3603
@@ -8838,10 +8838,10 @@ def condition_number(q):
     t3631 = t3629 + t3603*t3628
     t3632 = t3505*t3610 + t3509*t3614 + t3513*t3618 + t3517*t3622 + t3521*t3626 + t3525*t3630
     t3633 = xp.not_equal(t3632, 0)
-    t3634 = 0.5*(-t3606 + t3501)/xp.where(t3633, t3632, 1)
+    t3634 = (-t3606 + t3501)/xp.where(t3633, 2*t3632, 1)
     t3635 = xp.abs(t3634)
     t3636 = xp.greater_equal(t3635, 1)
-    t3637 = xp.abs(1/xp.where(t3636, t3634, 1))
+    t3637 = 1/xp.abs(xp.where(t3636, t3634, 1))
     t3638 = xp.where(t3633, xp.where(xp.greater_equal(t3634, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3636, t3637/(1 + xp.sqrt(1 + t3637**2)), 1/(t3635 + xp.sqrt(1 + t3635**2))), 0)
     t3639 = 1/xp.sqrt(1 + t3638**2)
     t3640 = t3501 + t3632*t3638
@@ -8873,10 +8873,10 @@ def condition_number(q):
     t3666 = xp.where(xp.greater(t3665, t3526), t3665, t3526)
     t3667 = xp.where(xp.less(t3665, t3526), t3665, t3526)
     t3668 = xp.not_equal(t3597, 0)
-    t3669 = 0.5*(-t3536 + t3571)/xp.where(t3668, t3597, 1)
+    t3669 = (-t3536 + t3571)/xp.where(t3668, 2*t3597, 1)
     t3670 = xp.abs(t3669)
     t3671 = xp.greater_equal(t3670, 1)
-    t3672 = xp.abs(1/xp.where(t3671, t3669, 1))
+    t3672 = 1/xp.abs(xp.where(t3671, t3669, 1))
     t3673 = xp.where(t3668, xp.where(xp.greater_equal(t3669, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3671, t3672/(1 + xp.sqrt(1 + t3672**2)), 1/(t3670 + xp.sqrt(1 + t3670**2))), 0)
     t3674 = 1/xp.sqrt(1 + t3673**2)
     t3675 = t3597*t3673
@@ -8908,10 +8908,10 @@ def condition_number(q):
     t3701 = t3699 + t3673*t3698
     t3702 = t3611*t3680 + t3615*t3684 + t3619*t3688 + t3623*t3692 + t3627*t3696 + t3631*t3700
     t3703 = xp.not_equal(t3702, 0)
-    t3704 = 0.5*(-t3676 + t3607)/xp.where(t3703, t3702, 1)
+    t3704 = (-t3676 + t3607)/xp.where(t3703, 2*t3702, 1)
     t3705 = xp.abs(t3704)
     t3706 = xp.greater_equal(t3705, 1)
-    t3707 = xp.abs(1/xp.where(t3706, t3704, 1))
+    t3707 = 1/xp.abs(xp.where(t3706, t3704, 1))
     t3708 = xp.where(t3703, xp.where(xp.greater_equal(t3704, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3706, t3707/(1 + xp.sqrt(1 + t3707**2)), 1/(t3705 + xp.sqrt(1 + t3705**2))), 0)
     t3709 = 1/xp.sqrt(1 + t3708**2)
     t3710 = t3702*t3708
@@ -8944,10 +8944,10 @@ def condition_number(q):
     t3737 = t3644*t3715 + t3648*t3719 + t3652*t3723 + t3656*t3727 + t3660*t3731 + t3664*t3735
     t3738 = t3681*t3716 + t3685*t3720 + t3689*t3724 + t3693*t3728 + t3697*t3732 + t3701*t3736
     t3739 = xp.not_equal(t3737, 0)
-    t3740 = 0.5*(-t3711 + t3640)/xp.where(t3739, t3737, 1)
+    t3740 = (-t3711 + t3640)/xp.where(t3739, 2*t3737, 1)
     t3741 = xp.abs(t3740)
     t3742 = xp.greater_equal(t3741, 1)
-    t3743 = xp.abs(1/xp.where(t3742, t3740, 1))
+    t3743 = 1/xp.abs(xp.where(t3742, t3740, 1))
     t3744 = xp.where(t3739, xp.where(xp.greater_equal(t3740, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3742, t3743/(1 + xp.sqrt(1 + t3743**2)), 1/(t3741 + xp.sqrt(1 + t3741**2))), 0)
     t3745 = 1/xp.sqrt(1 + t3744**2)
     t3746 = t3640 + t3737*t3744
@@ -8979,10 +8979,10 @@ def condition_number(q):
     t3772 = xp.where(xp.greater(t3771, t3666), t3771, t3666)
     t3773 = xp.where(xp.less(t3771, t3667), t3771, t3667)
     t3774 = xp.not_equal(t3738, 0)
-    t3775 = 0.5*(-t3677 + t3712)/xp.where(t3774, t3738, 1)
+    t3775 = (-t3677 + t3712)/xp.where(t3774, 2*t3738, 1)
     t3776 = xp.abs(t3775)
     t3777 = xp.greater_equal(t3776, 1)
-    t3778 = xp.abs(1/xp.where(t3777, t3775, 1))
+    t3778 = 1/xp.abs(xp.where(t3777, t3775, 1))
     t3779 = xp.where(t3774, xp.where(xp.greater_equal(t3775, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3777, t3778/(1 + xp.sqrt(1 + t3778**2)), 1/(t3776 + xp.sqrt(1 + t3776**2))), 0)
     t3780 = 1/xp.sqrt(1 + t3779**2)
     t3781 = t3738*t3779
@@ -9014,10 +9014,10 @@ def condition_number(q):
     t3807 = t3805 + t3779*t3804
     t3808 = t3750*t3786 + t3754*t3790 + t3758*t3794 + t3762*t3798 + t3766*t3802 + t3770*t3806
     t3809 = xp.not_equal(t3808, 0)
-    t3810 = 0.5*(-t3782 + t3746)/xp.where(t3809, t3808, 1)
+    t3810 = (-t3782 + t3746)/xp.where(t3809, 2*t3808, 1)
     t3811 = xp.abs(t3810)
     t3812 = xp.greater_equal(t3811, 1)
-    t3813 = xp.abs(1/xp.where(t3812, t3810, 1))
+    t3813 = 1/xp.abs(xp.where(t3812, t3810, 1))
     t3814 = xp.where(t3809, xp.where(xp.greater_equal(t3810, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3812, t3813/(1 + xp.sqrt(1 + t3813**2)), 1/(t3811 + xp.sqrt(1 + t3811**2))), 0)
     t3815 = 1/xp.sqrt(1 + t3814**2)
     t3816 = t3746 + t3808*t3814
@@ -9050,10 +9050,10 @@ def condition_number(q):
     t3843 = xp.where(xp.greater(t3842, t3772), t3842, t3772)
     t3844 = xp.where(xp.less(t3842, t3773), t3842, t3773)
     t3845 = xp.not_equal(t3841, 0)
-    t3846 = 0.5*(-t3783 + t3816)/xp.where(t3845, t3841, 1)
+    t3846 = (-t3783 + t3816)/xp.where(t3845, 2*t3841, 1)
     t3847 = xp.abs(t3846)
     t3848 = xp.greater_equal(t3847, 1)
-    t3849 = xp.abs(1/xp.where(t3848, t3846, 1))
+    t3849 = 1/xp.abs(xp.where(t3848, t3846, 1))
     t3850 = xp.where(t3845, xp.where(xp.greater_equal(t3846, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t3848, t3849/(1 + xp.sqrt(1 + t3849**2)), 1/(t3847 + xp.sqrt(1 + t3847**2))), 0)
     t3851 = 1/xp.sqrt(1 + t3850**2)
     t3852 = t3787*t3851
@@ -9086,7 +9086,9 @@ def condition_number(q):
     t3879 = xp.where(xp.less(t3876, t3844), t3876, t3844)
     t3880 = xp.where(xp.greater(t3877, t3878), t3877, t3878)
     t3881 = xp.where(xp.less(t3877, t3879), t3877, t3879)
-    kappa = xp.broadcast_to(xp.where(xp.greater(t3880, 0), t3880, 1)/xp.where(xp.less_equal(t3881, 1e-12*t3880), 0, t3881), batch)
+    t3882 = xp.where(xp.less_equal(t3881, 1e-12*t3880), 0, t3881)
+    t3883 = xp.where(xp.greater(t3880, 0), t3880, 1)
+    kappa = xp.broadcast_to(t3883/t3882, batch)
     return kappa
 
 

@@ -76,8 +76,8 @@ def js_layers(generator, task_jacobian: sympy.Matrix) -> list[numpy.ndarray]:
 
 def scaled_js(generator, js: sympy.Matrix) -> numpy.ndarray:
     """Js with its position rows divided by the characteristic length (`model.dexterity`)."""
-    g = generator.graph
-    inverse = g.value(1 / generator.model.dexterity.length)
+    g, length = generator.graph, generator.model.dexterity.length
+    inverse = g.number(1) if length == 1 else g.value(1 / length)
     rows = [g.values(js[r, :]).flatten() * (inverse if component in ("x", "y", "z") else 1)
             for r, component in enumerate(generator.robot.task)]
     return elementwise(generator.name_node, numpy.stack(rows))
@@ -139,8 +139,8 @@ def functions(generator, js: sympy.Matrix, task_jacobian: sympy.Matrix) -> list[
             largest = name(g.select(g.relation(">", value, largest), value, largest))
             smallest = name(g.select(g.relation("<", value, smallest), value, smallest))
         # sigma_min at most EPS sigma_max is rounding's: 0, and kappa infinite (x / 0 in IEEE arithmetic)
-        smallest = g.select(g.relation("<=", smallest, g.symbol(EPS) * largest), g.number(0), smallest)
-        positive = g.select(g.relation(">", largest, g.number(0)), largest, g.number(1))
+        smallest = name(g.select(g.relation("<=", smallest, g.symbol(EPS) * largest), g.number(0), smallest))
+        positive = name(g.select(g.relation(">", largest, g.number(0)), largest, g.number(1)))
         made.append(generator.function("condition_number", "sigma_max / sigma_min of Js with its position rows "
                                        "divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max "
                                        "(Js singular to rounding)", scalar("kappa", positive / smallest)))

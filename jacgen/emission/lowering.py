@@ -127,9 +127,10 @@ class Lowering:
                                                  sympy.numbered_symbols(f"{names.INTERNAL_PREFIX}r", real=True),
                                                  self._negations)
         named, reduced = list(zip((s for s, _ in named), reduced)), reduced[len(named):]
-        # A named value that CSE found elsewhere too is its temporary, and a temporary that the
-        # reuse pass found equal to another is that one: read it, not a copy of it.
-        shared = {symbol for symbol, _ in replacements}
+        # A named value that CSE found elsewhere too is its temporary, a temporary that the
+        # reuse pass found equal to another is that one, and a named value that folded to
+        # another (a QR column whose first entry is 0): read it, not a copy of it.
+        shared = {symbol for symbol, _ in replacements} | {symbol for symbol, _ in named}
         copies = {s: v for s, v in named + replacements if v.kind == SYMBOL and v.value in shared}
         for s, v in copies.items():
             while v.value in copies:

@@ -45,6 +45,11 @@ IK_NUMERIC_DAMPING = {"start": 1e-6, "min": 1e-12, "max": 1e8}
 IK_NUMERIC_PROGRESS = 1e-6
 
 
+def named(name: Callable, value: Node) -> Node:
+    """`value` named, unless it is a symbol or number already (where the graph folded a zero)."""
+    return name(value) if value.args else value
+
+
 def triangulate(A, g: Graph, name: Callable, right=()) -> tuple[list, list, list, list]:
     """Householder QR of the p x k matrix A (rows of nodes, p >= k): R (k x k, upper triangular,
     as rows), Q^T applied to each column of `right` (p long), the norms of the reflected
@@ -57,17 +62,17 @@ def triangulate(A, g: Graph, name: Callable, right=()) -> tuple[list, list, list
     for j in range(k):
         column = [A[i][j] for i in range(j, p)]
         norm = name(g.sqrt(sum(c**2 for c in column)))
-        alpha = name(-g.select(g.relation(">=", column[0], zero), one, -one) * norm)  # R[j][j]; the sign
-        v = [name(column[0] - alpha)] + column[1:]  # avoids cancellation
+        alpha = named(name, -g.select(g.relation(">=", column[0], zero), one, -one) * norm)  # R[j][j]; the sign
+        v = [named(name, column[0] - alpha)] + column[1:]  # avoids cancellation
         beta = name(g.select(g.relation(">", norm, zero), 1 / (norm * (norm + g.call("Abs", column[0]))), zero))
         for c in range(j + 1, k):  # beta = 2 / |v|^2
             s = name(beta * sum(v[i - j] * A[i][c] for i in range(j, p)))
             for i in range(j, p):
-                A[i][c] = name(A[i][c] - s * v[i - j])
+                A[i][c] = named(name, A[i][c] - s * v[i - j])
         for b in right:
             s = name(beta * sum(v[i - j] * b[i] for i in range(j, p)))
             for i in range(j, p):
-                b[i] = name(b[i] - s * v[i - j])
+                b[i] = named(name, b[i] - s * v[i - j])
         A[j][j] = alpha
         norms.append(norm)
         reflections.append((v, beta))

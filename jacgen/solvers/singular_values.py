@@ -24,7 +24,7 @@ from typing import Callable
 from jacgen.model.graph import Graph
 from jacgen.model.node import OR, Node
 from jacgen.model.tolerance_symbols import RANK
-from jacgen.solvers.differential import triangulate
+from jacgen.solvers.differential import named, triangulate
 
 # Sweeps of the one-sided Jacobi by the size k of the triangular factor R, rotating R's columns
 # (the singular vectors: velocity_ellipsoid) or, faster, its rows (the values alone:
@@ -53,23 +53,23 @@ def jacobi(R: list, g: Graph, name: Callable, vectors: bool) -> tuple[list[Node]
         for i in range(k - 1):
             for j in range(i + 1, k):
                 a, b = squares[i], squares[j]
-                c = name(sum(x * y for x, y in zip(W[i], W[j])))
+                c = named(name, sum(x * y for x, y in zip(W[i], W[j])))
                 rotated = g.relation("!=", c, zero)
-                zeta = name((b - a) / (2 * g.select(rotated, c, one)))
+                zeta = named(name, (b - a) / g.select(rotated, 2 * c, one))
                 sign = g.select(g.relation(">=", zeta, zero), one, -one)
                 large = g.relation(">=", g.call("Abs", zeta), one)
-                w = name(g.call("Abs", 1 / g.select(large, zeta, one)))  # |1 / zeta| where that is <= 1
+                w = named(name, 1 / g.call("Abs", g.select(large, zeta, one)))  # |1 / zeta| where that is <= 1
                 small = g.call("Abs", zeta)
-                t = name(g.select(rotated, sign * g.select(large, w / (1 + g.sqrt(1 + w**2)),
+                t = named(name, g.select(rotated, sign * g.select(large, w / (1 + g.sqrt(1 + w**2)),
                                                            1 / (small + g.sqrt(1 + small**2))), zero))
-                cos = name(1 / g.sqrt(1 + t**2))
-                sin = name(cos * t)
-                squares[i], squares[j] = name(a - t * c), name(b + t * c)
+                cos = named(name, 1 / g.sqrt(1 + t**2))
+                sin = named(name, cos * t)
+                squares[i], squares[j] = named(name, a - t * c), named(name, b + t * c)
                 pairs = [W] + ([V] if vectors else [])
                 for columns in pairs:
                     x, y = columns[i], columns[j]
-                    columns[i] = [name(cos * p - sin * r) for p, r in zip(x, y)]
-                    columns[j] = [name(sin * p + cos * r) for p, r in zip(x, y)]
+                    columns[i] = [named(name, cos * p - sin * r) for p, r in zip(x, y)]
+                    columns[j] = [named(name, sin * p + cos * r) for p, r in zip(x, y)]
     norms = [name(g.sqrt(sum(e**2 for e in column))) for column in W]
     return norms, V and [[V[c][r] for c in range(k)] for r in range(k)]
 
@@ -94,14 +94,14 @@ def left_singular_3(A: list, g: Graph, name: Callable) -> tuple[list, list]:
     columns = [[V[r][c] for r in range(3)] for c in range(3)]
     for i, j in ((0, 1), (1, 2), (0, 1)):  # a sorting network, descending
         swap = g.relation("<", s[i], s[j])
-        s[i], s[j] = name(g.select(swap, s[j], s[i])), name(g.select(swap, s[i], s[j]))
-        columns[i], columns[j] = ([name(g.select(swap, y, x)) for x, y in zip(columns[i], columns[j])],
-                                  [name(g.select(swap, x, y)) for x, y in zip(columns[i], columns[j])])
+        s[i], s[j] = named(name, g.select(swap, s[j], s[i])), named(name, g.select(swap, s[i], s[j]))
+        columns[i], columns[j] = ([named(name, g.select(swap, y, x)) for x, y in zip(columns[i], columns[j])],
+                                  [named(name, g.select(swap, x, y)) for x, y in zip(columns[i], columns[j])])
     u, v, w = columns
     determinant = name(u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
                        + u[2] * (v[0] * w[1] - v[1] * w[0]))
     flip = g.select(g.relation("<", determinant, g.number(0)), g.number(-1), g.number(1))
-    columns[2] = [name(flip * e) for e in w]
+    columns[2] = [named(name, flip * e) for e in w]
     return [[columns[c][r] for c in range(3)] for r in range(3)], s
 
 
