@@ -387,7 +387,8 @@ class Generator:
         """The selected functions this robot does not have, each with why."""
         made = {f.name for f in (*self._functions, *self.loops)}
         why = {"ik": f"no closed form ({self.model.structure.reason})",
-               "jacobian_det": f"Js is {len(self.robot.task)} x {self.robot.dof}, not square"}
+               "jacobian_det": f"Js is {len(self.robot.task)} x {self.robot.dof}, not square",
+               "condition_number": "Js is singular at every configuration: sigma_min is 0 everywhere"}
         why["ik_branches"] = why["ik_nearest"] = why["ik"]
         return [f"{name}: {why.get(name, 'not generated for this robot')}"
                 for name in FUNCTION_NAMES if name in (self.selection or ()) and name not in made]

@@ -16,6 +16,7 @@ from jacgen.model import kinematics
 from jacgen.model.graph import elementwise
 from jacgen.model.js_rank import singularity_rows
 from jacgen.model.kinematics import generated_symbol
+from jacgen.model.node import NUMBER
 from jacgen.model.tolerance_symbols import EPS
 from jacgen.solvers import differential, singular_values
 
@@ -138,7 +139,10 @@ def functions(generator, js: sympy.Matrix, task_jacobian: sympy.Matrix) -> list[
         for value in values[1:]:
             largest = name(g.select(g.relation(">", value, largest), value, largest))
             smallest = name(g.select(g.relation("<", value, smallest), value, smallest))
-        # sigma_min at most EPS sigma_max is rounding's: 0, and kappa infinite (x / 0 in IEEE arithmetic)
+        # sigma_min at most EPS sigma_max is rounding's: 0, and kappa infinite (x / 0 in IEEE arithmetic).
+        # A Js singular everywhere (a smallest value that is the number 0) gets no condition_number.
+        if smallest.kind == NUMBER:
+            return made + _rate_functions(generator, js, task_jacobian, q)
         smallest = name(g.select(g.relation("<=", smallest, g.symbol(EPS) * largest), g.number(0), smallest))
         positive = name(g.select(g.relation(">", largest, g.number(0)), largest, g.number(1)))
         made.append(generator.function("condition_number", "sigma_max / sigma_min of Js with its position rows "
