@@ -167,7 +167,7 @@ class Generator:
         """velocity_ik: q_dot solving Js q_dot = mu_dot, and the status (`differential`)."""
         m, n = js.shape
         mu_dot = Argument("mu_dot", sympy.Matrix([generated_symbol("mu_dot", i) for i in range(m)]))
-        damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True, default="0.0")
+        damping = self.damping_argument()
         q_dot, outcome = differential.velocity_ik(js, list(self.q), list(mu_dot.symbols), damping.symbols[0],
                                                   self.graph, self.name_node)
         form = "Js^-1 mu_dot (damping 0) or " if m == n else ""
@@ -181,7 +181,7 @@ class Generator:
         robot, n = self.robot, self.robot.dof
         target = self._ik_target()
         given = Argument("q", sympy.Matrix([generated_symbol("qs", i + 1) for i in range(n)]))
-        damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True, default="0.0")
+        damping = self.damping_argument()
         limits = [joint.limits for joint in robot.joints]
         bindings = {qi: differential.clamp(given_i, bounds, self.graph)
                     for qi, given_i, bounds in zip(self.q, given.symbols, limits)}
@@ -206,6 +206,11 @@ class Generator:
     def _ik_target(self) -> Argument:
         """ik_numeric's target: the 4x4 pose for a six-component task, else the task vector."""
         return self._target(len(self.robot.task) == 6, "target")
+
+    @staticmethod
+    def damping_argument() -> Argument:
+        """The damping of velocity_ik and its relatives and of ik_numeric's step, 0 by default."""
+        return Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True, default="0.0")
 
     @staticmethod
     def _free_argument() -> Argument:

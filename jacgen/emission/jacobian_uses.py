@@ -133,23 +133,30 @@ def functions(generator, js: sympy.Matrix, task_jacobian: sympy.Matrix) -> list[
                                        vector("s_v", s_v), matrix("U_w", numpy.array(U_w, dtype=object)),
                                        vector("s_w", s_w)))
     if generator.generates("condition_number"):
-        scaled = scaled_js(generator, js)
-        values = singular_values.singular_values((scaled.T if m <= n else scaled).tolist(), g, name)
-        largest, smallest = values[0], values[0]
-        for value in values[1:]:
-            largest = name(g.select(g.relation(">", value, largest), value, largest))
-            smallest = name(g.select(g.relation("<", value, smallest), value, smallest))
-        # sigma_min at most EPS sigma_max is rounding's: 0, and kappa infinite (x / 0 in IEEE arithmetic).
-        # A Js singular everywhere (a smallest value that is the number 0) gets no condition_number.
-        if smallest.kind == NUMBER:
-            return made + _rate_functions(generator, js, task_jacobian, q)
-        smallest = name(g.select(g.relation("<=", smallest, g.symbol(EPS) * largest), g.number(0), smallest))
-        positive = name(g.select(g.relation(">", largest, g.number(0)), largest, g.number(1)))
-        made.append(generator.function("condition_number", "sigma_max / sigma_min of Js with its position rows "
-                                       "divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max "
-                                       "(Js singular to rounding)", scalar("kappa", positive / smallest)))
+        made.append(condition_number_function(generator, js))
     made += _rate_functions(generator, js, task_jacobian, q)
     return made
+
+
+def condition_number_function(generator, js: sympy.Matrix) -> Function | None:
+    """condition_number: the singular values of Js with its position rows divided by L, their
+    largest over their smallest; None where Js is singular at every configuration."""
+    g, name, m, n = generator.graph, generator.name_node, js.rows, generator.robot.dof
+    scaled = scaled_js(generator, js)
+    values = singular_values.singular_values((scaled.T if m <= n else scaled).tolist(), g, name)
+    largest, smallest = values[0], values[0]
+    for value in values[1:]:
+        largest = name(g.select(g.relation(">", value, largest), value, largest))
+        smallest = name(g.select(g.relation("<", value, smallest), value, smallest))
+    # sigma_min at most EPS sigma_max is rounding's: 0, and kappa infinite (x / 0 in IEEE arithmetic).
+    # A Js singular everywhere (a smallest value that is the number 0) gets no condition_number.
+    if smallest.kind == NUMBER:
+        return None
+    smallest = name(g.select(g.relation("<=", smallest, g.symbol(EPS) * largest), g.number(0), smallest))
+    positive = name(g.select(g.relation(">", largest, g.number(0)), largest, g.number(1)))
+    return generator.function("condition_number", "sigma_max / sigma_min of Js with its position rows divided by "
+                              "CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to "
+                              "rounding)", scalar("kappa", positive / smallest))
 
 
 def _rate_functions(generator, js: sympy.Matrix, task_jacobian: sympy.Matrix,
@@ -157,7 +164,7 @@ def _rate_functions(generator, js: sympy.Matrix, task_jacobian: sympy.Matrix,
     """velocity_ik_nullspace and resolved_rate: velocity_ik's solve with null-space motion z."""
     g, name, n, m = generator.graph, generator.name_node, generator.robot.dof, js.rows
     z = Argument("z", sympy.Matrix([generated_symbol("qz", i + 1) for i in range(n)]))
-    damping = Argument("damping", sympy.Matrix([sympy.Symbol("damping", real=True)]), scalar=True, default="0.0")
+    damping = generator.damping_argument()
     solve = "Js# mu_dot + (I - Js# Js) z" + (" (Js has no null space: z is not used)" if m >= n else "")
     made = []
     if generator.generates("velocity_ik_nullspace"):
