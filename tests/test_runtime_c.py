@@ -22,7 +22,7 @@ INCLUDED = ("-Wno-unused-function",)  # static helpers for the code around them
 # The native glue's per-robot part (templates/native/module.c.jinja) for a module of one function.
 NATIVE_STUB = """
 static const jacgen_function jacgen_functions[1] = {
-    {"f", "f(q)", "(6)->()", 1, 1, 1, 0, 1.0, {{"q", JACGEN_REAL, 1, {6}, 6, 8, NULL}, {"y", JACGEN_REAL, 0, {0}, 1, 1, NULL}}},
+    {"f", "f(q)", "(6)->()", 1, 1, 1, 0, 1.0, {{"q", JACGEN_REAL, 1, {6}, 6, 8, NULL, 0}, {"y", JACGEN_REAL, 0, {0}, 1, 1, NULL, 0}}},
 };
 static const jacgen_kernels *const jacgen_builds[2] = {NULL, NULL};
 """

@@ -99,31 +99,31 @@ void iiwa_singularity_factors(const iiwa_real q[IIWA_DOF], iiwa_real f[IIWA_NUM_
 iiwa_real iiwa_manipulability(const iiwa_real q[IIWA_DOF]);
 
 /* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
- * Result: dw[i], i < 7. 1726 operations. */
+ * Result: dw[i], i < 7. 1713 operations. */
 void iiwa_manipulability_gradient(const iiwa_real q[IIWA_DOF], iiwa_real dw[IIWA_DOF]);
 
 /* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
- * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2676 operations. */
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2696 operations. */
 void iiwa_velocity_ellipsoid(const iiwa_real q[IIWA_DOF], iiwa_real U_v[9], iiwa_real s_v[3], iiwa_real U_w[9], iiwa_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 9185 operations. */
+ * Result: returned as a scalar. 9183 operations. */
 iiwa_real iiwa_condition_number(const iiwa_real q[IIWA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 7; returned as a scalar. 1034 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1013 operations. */
 int iiwa_velocity_ik(const iiwa_real q[IIWA_DOF], const iiwa_real mu_dot[IIWA_TASK_DIM], iiwa_real damping, iiwa_real q_dot[IIWA_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 7; returned as a scalar. 1117 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1096 operations. */
 int iiwa_velocity_ik_nullspace(const iiwa_real q[IIWA_DOF], const iiwa_real mu_dot[IIWA_TASK_DIM], const iiwa_real z[IIWA_DOF], iiwa_real damping, iiwa_real q_dot[IIWA_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 7; returned as a scalar. 1274 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1253 operations. */
 int iiwa_resolved_rate(const iiwa_real q[IIWA_DOF], const iiwa_real target[16], const iiwa_real target_rate[IIWA_TASK_DIM], const iiwa_real gain[IIWA_TASK_DIM], const iiwa_real z[IIWA_DOF], iiwa_real damping, iiwa_real q_dot[IIWA_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1109 operations. */
+ * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1088 operations. */
 iiwa_real iiwa_ik_numeric_step(const iiwa_real target[16], const iiwa_real q[IIWA_DOF], iiwa_real damping, iiwa_real q_start[IIWA_DOF], iiwa_real q_next[IIWA_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.

@@ -101,31 +101,31 @@ jaco_real jaco_manipulability(const jaco_real q[JACO_DOF]);
 jaco_real jaco_jacobian_det(const jaco_real q[JACO_DOF]);
 
 /* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
- * Result: dw[i], i < 6. 1533 operations. */
+ * Result: dw[i], i < 6. 1513 operations. */
 void jaco_manipulability_gradient(const jaco_real q[JACO_DOF], jaco_real dw[JACO_DOF]);
 
 /* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
- * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2674 operations. */
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2690 operations. */
 void jaco_velocity_ellipsoid(const jaco_real q[JACO_DOF], jaco_real U_v[9], jaco_real s_v[3], jaco_real U_w[9], jaco_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 9199 operations. */
+ * Result: returned as a scalar. 9198 operations. */
 jaco_real jaco_condition_number(const jaco_real q[JACO_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1456 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1426 operations. */
 int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TASK_DIM], jaco_real damping, jaco_real q_dot[JACO_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1462 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1432 operations. */
 int jaco_velocity_ik_nullspace(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TASK_DIM], const jaco_real z[JACO_DOF], jaco_real damping, jaco_real q_dot[JACO_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1636 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1606 operations. */
 int jaco_resolved_rate(const jaco_real q[JACO_DOF], const jaco_real target[16], const jaco_real target_rate[JACO_TASK_DIM], const jaco_real gain[JACO_TASK_DIM], const jaco_real z[JACO_DOF], jaco_real damping, jaco_real q_dot[JACO_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1090 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1069 operations. */
 jaco_real jaco_ik_numeric_step(const jaco_real target[16], const jaco_real q[JACO_DOF], jaco_real damping, jaco_real q_start[JACO_DOF], jaco_real q_next[JACO_DOF]);
 
 /* The general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9).

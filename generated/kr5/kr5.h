@@ -101,31 +101,31 @@ kr5_real kr5_manipulability(const kr5_real q[KR5_DOF]);
 kr5_real kr5_jacobian_det(const kr5_real q[KR5_DOF]);
 
 /* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
- * Result: dw[i], i < 6. 1223 operations. */
+ * Result: dw[i], i < 6. 1198 operations. */
 void kr5_manipulability_gradient(const kr5_real q[KR5_DOF], kr5_real dw[KR5_DOF]);
 
 /* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
- * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2600 operations. */
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2614 operations. */
 void kr5_velocity_ellipsoid(const kr5_real q[KR5_DOF], kr5_real U_v[9], kr5_real s_v[3], kr5_real U_w[9], kr5_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 9080 operations. */
+ * Result: returned as a scalar. 9072 operations. */
 kr5_real kr5_condition_number(const kr5_real q[KR5_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1345 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1319 operations. */
 int kr5_velocity_ik(const kr5_real q[KR5_DOF], const kr5_real mu_dot[KR5_TASK_DIM], kr5_real damping, kr5_real q_dot[KR5_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1351 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1325 operations. */
 int kr5_velocity_ik_nullspace(const kr5_real q[KR5_DOF], const kr5_real mu_dot[KR5_TASK_DIM], const kr5_real z[KR5_DOF], kr5_real damping, kr5_real q_dot[KR5_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1512 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1486 operations. */
 int kr5_resolved_rate(const kr5_real q[KR5_DOF], const kr5_real target[16], const kr5_real target_rate[KR5_TASK_DIM], const kr5_real gain[KR5_TASK_DIM], const kr5_real z[KR5_DOF], kr5_real damping, kr5_real q_dot[KR5_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1000 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 979 operations. */
 kr5_real kr5_ik_numeric_step(const kr5_real target[16], const kr5_real q[KR5_DOF], kr5_real damping, kr5_real q_start[KR5_DOF], kr5_real q_next[KR5_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.

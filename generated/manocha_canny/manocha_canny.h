@@ -101,31 +101,31 @@ manocha_canny_real manocha_canny_manipulability(const manocha_canny_real q[MANOC
 manocha_canny_real manocha_canny_jacobian_det(const manocha_canny_real q[MANOCHA_CANNY_DOF]);
 
 /* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
- * Result: dw[i], i < 6. 1136 operations. */
+ * Result: dw[i], i < 6. 1110 operations. */
 void manocha_canny_manipulability_gradient(const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real dw[MANOCHA_CANNY_DOF]);
 
 /* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
- * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2626 operations. */
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2640 operations. */
 void manocha_canny_velocity_ellipsoid(const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real U_v[9], manocha_canny_real s_v[3], manocha_canny_real U_w[9], manocha_canny_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 9063 operations. */
+ * Result: returned as a scalar. 9053 operations. */
 manocha_canny_real manocha_canny_condition_number(const manocha_canny_real q[MANOCHA_CANNY_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1373 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1341 operations. */
 int manocha_canny_velocity_ik(const manocha_canny_real q[MANOCHA_CANNY_DOF], const manocha_canny_real mu_dot[MANOCHA_CANNY_TASK_DIM], manocha_canny_real damping, manocha_canny_real q_dot[MANOCHA_CANNY_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1379 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1347 operations. */
 int manocha_canny_velocity_ik_nullspace(const manocha_canny_real q[MANOCHA_CANNY_DOF], const manocha_canny_real mu_dot[MANOCHA_CANNY_TASK_DIM], const manocha_canny_real z[MANOCHA_CANNY_DOF], manocha_canny_real damping, manocha_canny_real q_dot[MANOCHA_CANNY_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1552 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1520 operations. */
 int manocha_canny_resolved_rate(const manocha_canny_real q[MANOCHA_CANNY_DOF], const manocha_canny_real target[16], const manocha_canny_real target_rate[MANOCHA_CANNY_TASK_DIM], const manocha_canny_real gain[MANOCHA_CANNY_TASK_DIM], const manocha_canny_real z[MANOCHA_CANNY_DOF], manocha_canny_real damping, manocha_canny_real q_dot[MANOCHA_CANNY_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1026 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1005 operations. */
 manocha_canny_real manocha_canny_ik_numeric_step(const manocha_canny_real target[16], const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real damping, manocha_canny_real q_start[MANOCHA_CANNY_DOF], manocha_canny_real q_next[MANOCHA_CANNY_DOF]);
 
 /* The general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9).

@@ -101,31 +101,31 @@ mico_real mico_manipulability(const mico_real q[MICO_DOF]);
 mico_real mico_jacobian_det(const mico_real q[MICO_DOF]);
 
 /* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
- * Result: dw[i], i < 6. 1533 operations. */
+ * Result: dw[i], i < 6. 1513 operations. */
 void mico_manipulability_gradient(const mico_real q[MICO_DOF], mico_real dw[MICO_DOF]);
 
 /* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
- * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2674 operations. */
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2690 operations. */
 void mico_velocity_ellipsoid(const mico_real q[MICO_DOF], mico_real U_v[9], mico_real s_v[3], mico_real U_w[9], mico_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 9199 operations. */
+ * Result: returned as a scalar. 9198 operations. */
 mico_real mico_condition_number(const mico_real q[MICO_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1456 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1426 operations. */
 int mico_velocity_ik(const mico_real q[MICO_DOF], const mico_real mu_dot[MICO_TASK_DIM], mico_real damping, mico_real q_dot[MICO_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1462 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1432 operations. */
 int mico_velocity_ik_nullspace(const mico_real q[MICO_DOF], const mico_real mu_dot[MICO_TASK_DIM], const mico_real z[MICO_DOF], mico_real damping, mico_real q_dot[MICO_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1636 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1606 operations. */
 int mico_resolved_rate(const mico_real q[MICO_DOF], const mico_real target[16], const mico_real target_rate[MICO_TASK_DIM], const mico_real gain[MICO_TASK_DIM], const mico_real z[MICO_DOF], mico_real damping, mico_real q_dot[MICO_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1090 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1069 operations. */
 mico_real mico_ik_numeric_step(const mico_real target[16], const mico_real q[MICO_DOF], mico_real damping, mico_real q_start[MICO_DOF], mico_real q_next[MICO_DOF]);
 
 /* The general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9).

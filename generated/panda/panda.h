@@ -99,31 +99,31 @@ void panda_singularity_factors(const panda_real q[PANDA_DOF], panda_real f[PANDA
 panda_real panda_manipulability(const panda_real q[PANDA_DOF]);
 
 /* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
- * Result: dw[i], i < 7. 1755 operations. */
+ * Result: dw[i], i < 7. 1742 operations. */
 void panda_manipulability_gradient(const panda_real q[PANDA_DOF], panda_real dw[PANDA_DOF]);
 
 /* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
- * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2703 operations. */
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2723 operations. */
 void panda_velocity_ellipsoid(const panda_real q[PANDA_DOF], panda_real U_v[9], panda_real s_v[3], panda_real U_w[9], panda_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 9213 operations. */
+ * Result: returned as a scalar. 9211 operations. */
 panda_real panda_condition_number(const panda_real q[PANDA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 7; returned as a scalar. 1061 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1040 operations. */
 int panda_velocity_ik(const panda_real q[PANDA_DOF], const panda_real mu_dot[PANDA_TASK_DIM], panda_real damping, panda_real q_dot[PANDA_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 7; returned as a scalar. 1143 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1122 operations. */
 int panda_velocity_ik_nullspace(const panda_real q[PANDA_DOF], const panda_real mu_dot[PANDA_TASK_DIM], const panda_real z[PANDA_DOF], panda_real damping, panda_real q_dot[PANDA_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 7; returned as a scalar. 1304 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1283 operations. */
 int panda_resolved_rate(const panda_real q[PANDA_DOF], const panda_real target[16], const panda_real target_rate[PANDA_TASK_DIM], const panda_real gain[PANDA_TASK_DIM], const panda_real z[PANDA_DOF], panda_real damping, panda_real q_dot[PANDA_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1140 operations. */
+ * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1119 operations. */
 panda_real panda_ik_numeric_step(const panda_real target[16], const panda_real q[PANDA_DOF], panda_real damping, panda_real q_start[PANDA_DOF], panda_real q_next[PANDA_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.

@@ -99,31 +99,31 @@ void panda_calibrated_singularity_factors(const panda_calibrated_real q[PANDA_CA
 panda_calibrated_real panda_calibrated_manipulability(const panda_calibrated_real q[PANDA_CALIBRATED_DOF]);
 
 /* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
- * Result: dw[i], i < 7. 2353 operations. */
+ * Result: dw[i], i < 7. 2340 operations. */
 void panda_calibrated_manipulability_gradient(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real dw[PANDA_CALIBRATED_DOF]);
 
 /* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
- * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2900 operations. */
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2918 operations. */
 void panda_calibrated_velocity_ellipsoid(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real U_v[9], panda_calibrated_real s_v[3], panda_calibrated_real U_w[9], panda_calibrated_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 9438 operations. */
+ * Result: returned as a scalar. 9439 operations. */
 panda_calibrated_real panda_calibrated_condition_number(const panda_calibrated_real q[PANDA_CALIBRATED_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 7; returned as a scalar. 1305 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1284 operations. */
 int panda_calibrated_velocity_ik(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real mu_dot[PANDA_CALIBRATED_TASK_DIM], panda_calibrated_real damping, panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 7; returned as a scalar. 1401 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1380 operations. */
 int panda_calibrated_velocity_ik_nullspace(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real mu_dot[PANDA_CALIBRATED_TASK_DIM], const panda_calibrated_real z[PANDA_CALIBRATED_DOF], panda_calibrated_real damping, panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 7; returned as a scalar. 1576 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1555 operations. */
 int panda_calibrated_resolved_rate(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real target[16], const panda_calibrated_real target_rate[PANDA_CALIBRATED_TASK_DIM], const panda_calibrated_real gain[PANDA_CALIBRATED_TASK_DIM], const panda_calibrated_real z[PANDA_CALIBRATED_DOF], panda_calibrated_real damping, panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1393 operations. */
+ * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1372 operations. */
 panda_calibrated_real panda_calibrated_ik_numeric_step(const panda_calibrated_real target[16], const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real damping, panda_calibrated_real q_start[PANDA_CALIBRATED_DOF], panda_calibrated_real q_next[PANDA_CALIBRATED_DOF]);
 
 /* The general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9).

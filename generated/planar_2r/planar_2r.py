@@ -571,7 +571,7 @@ def jacobian_det(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def manipulability_gradient(q):
-    """d manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): (2 x 1), 91 operations."""
+    """d manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): (2 x 1), 84 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (2,)))
     trig = _cos_sin(xp, q, (0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -587,31 +587,31 @@ def manipulability_gradient(q):
     t4 = xp.sqrt(c12**2 + t0**2 + t3)
     t5 = xp.sqrt(t3)
     t6 = t5*xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)
-    t7 = -t1 + t6
-    t8 = xp.where(xp.greater(t5, 0), 1/(t5*(t5 + xp.abs(t1))), 0)
-    t9 = t8*(t0*t7 - c12*s12)
-    t10 = t0 - t7*t9
-    t11 = c12 + s12*t9
-    t12 = 1 - t7**2*t8
-    t13 = xp.where(xp.greater(t6, 0), xp.asarray(-1, dtype=dtype), 1)
-    t14 = xp.abs(t11)
-    t15 = t14*xp.where(xp.greater_equal(t11, 0), xp.asarray(1, dtype=dtype), -1)
-    t16 = t11 + t15
-    t17 = xp.where(xp.greater(t14, 0), 1/(t14*2*t14), 0)
-    t18 = 1 - t16**2*t17
-    t19 = xp.where(xp.greater(t15, 0), -t13, t13)
-    t20 = t8*t18
-    t21 = t2*t20
-    t22 = -t21 + t18
-    t23 = s12*t7
-    t24 = t15*t12 + t10*t20*t23
-    t25 = t10*t22 + t8*t15*t23
-    t26 = 1e-12*t4
-    t27 = xp.where(xp.less_equal(t5, t26) | xp.less_equal(t14, t26), 0, t19)
-    t28 = s12*t6
-    t29 = c12*t25 + t22*t28
-    t30 = t27*(t0*t24 + t1*t7*t20*t28 + t29)
-    t31 = t27*(c12*t24 + t29 + t6*t7*t21)
+    t7 = xp.where(xp.greater(t6, 0), xp.asarray(-1, dtype=dtype), 1)
+    t8 = xp.greater(t5, 0)
+    t9 = xp.where(t8, 1/(-t1 + t6), 0)
+    t10 = xp.where(t8, 1 + xp.abs(t1)/t5, 0)
+    t11 = 1 - t10
+    t12 = s12*t9
+    t13 = t10*(t0 - c12*t12)
+    t14 = -t13 + t0
+    t15 = c12 + t13*t12
+    t16 = xp.abs(t15)
+    t17 = xp.where(xp.greater_equal(t15, 0), xp.asarray(1, dtype=dtype), -1)*t16
+    t18 = xp.where(xp.greater(t16, 0), xp.asarray(2, dtype=dtype), 0)
+    t19 = 1 - t18
+    t20 = xp.where(xp.greater(t17, 0), -t7, t7)
+    t21 = t10*t19
+    t22 = t2*t21
+    t23 = t19 - t9**2*t22
+    t24 = t14*t23 + t10*t17*t12
+    t25 = t12*t21
+    t26 = t17*t11 + t14*t25
+    t27 = 1e-12*t4
+    t28 = xp.where(xp.less_equal(t5, t27) | xp.less_equal(t16, t27), 0, t20)
+    t29 = c12*t24 + s12*t6*t23
+    t30 = t28*(t0*t26 + t1*t6*t25 + t29)
+    t31 = t28*(c12*t26 + t29 + t6*t9*t22)
     dw = _stack(xp, [
         t30,  # 0
         t31,  # 1
@@ -621,7 +621,7 @@ def manipulability_gradient(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ellipsoid(q):
-    """axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: (3 x 3 and 3 x 1 and 3 x 3 and 3 x 1), 364 operations."""
+    """axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: (3 x 3 and 3 x 1 and 3 x 3 and 3 x 1), 365 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (2,)))
     trig = _cos_sin(xp, q, (0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -634,168 +634,170 @@ def velocity_ellipsoid(q):
     t1 = s1 + s12
     t2 = xp.sqrt(s12**2 + t1**2)
     t3 = t2*xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)
-    t4 = -t1 + t3
-    t5 = xp.where(xp.greater(t2, 0), 1/(t2*(t2 + xp.abs(t1))), 0)
-    t6 = t5*(t0*t4 - c12*s12)
-    t7 = t0 - t4*t6
-    t8 = c12 + s12*t6
-    t9 = xp.abs(t8)
-    t10 = t9*xp.where(xp.greater_equal(t8, 0), xp.asarray(1, dtype=dtype), -1)
-    t11 = t3**2
-    t12 = t10**2
-    t13 = t12 + t7**2
-    t14 = t3*t7
-    t15 = xp.not_equal(t14, 0)
-    t16 = (-t11 + t13)/xp.where(t15, -2*t14, 1)
-    t17 = xp.abs(t16)
-    t18 = xp.greater_equal(t17, 1)
-    t19 = 1/xp.abs(xp.where(t18, t16, 1))
-    t20 = xp.where(t15, xp.where(xp.greater_equal(t16, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t18, t19/(1 + xp.sqrt(1 + t19**2)), 1/(t17 + xp.sqrt(1 + t17**2))), 0)
-    t21 = 1/xp.sqrt(1 + t20**2)
-    t22 = t14*t20
-    t23 = t22 + t11
-    t24 = -t22 + t13
-    t25 = t3*t21
-    t26 = t7*t21
-    t27 = t25 + t26*t20
-    t28 = t26 - t25*t20
-    t29 = t27*t28 + t12*t20*t21**2
-    t30 = xp.not_equal(t29, 0)
-    t31 = (-t23 + t24)/xp.where(t30, -2*t29, 1)
-    t32 = xp.abs(t31)
-    t33 = xp.greater_equal(t32, 1)
-    t34 = 1/xp.abs(xp.where(t33, t31, 1))
-    t35 = xp.where(t30, xp.where(xp.greater_equal(t31, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t33, t34/(1 + xp.sqrt(1 + t34**2)), 1/(t32 + xp.sqrt(1 + t32**2))), 0)
-    t36 = 1/xp.sqrt(1 + t35**2)
-    t37 = t29*t35
-    t38 = t23 + t37
-    t39 = -t37 + t24
-    t40 = t27*t36
-    t41 = t28*t36
-    t42 = t40 + t35*t41
-    t43 = t41 - t35*t40
-    t44 = t21*t36
-    t45 = t10*t44
-    t46 = t20*t45
-    t47 = t46 + t35*t45
-    t48 = -t45 + t35*t46
-    t49 = -t42*t43 + t47*t48
-    t50 = t20*t44
-    t51 = t44 - t35*t50
-    t52 = t50 + t35*t44
-    t53 = xp.not_equal(t49, 0)
-    t54 = (-t38 + t39)/xp.where(t53, 2*t49, 1)
-    t55 = xp.abs(t54)
-    t56 = xp.greater_equal(t55, 1)
-    t57 = 1/xp.abs(xp.where(t56, t54, 1))
-    t58 = xp.where(t53, xp.where(xp.greater_equal(t54, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t56, t57/(1 + xp.sqrt(1 + t57**2)), 1/(t55 + xp.sqrt(1 + t55**2))), 0)
-    t59 = 1/xp.sqrt(1 + t58**2)
-    t60 = t49*t58
-    t61 = -t60 + t38
-    t62 = t39 + t60
-    t63 = t42*t59
-    t64 = t43*t59
-    t65 = t63 + t58*t64
-    t66 = t64 - t58*t63
-    t67 = t47*t59
-    t68 = t48*t59
-    t69 = t67 - t58*t68
-    t70 = t68 + t58*t67
-    t71 = -t65*t66 + t69*t70
-    t72 = t51*t59
-    t73 = t52*t59
-    t74 = t72 - t58*t73
-    t75 = t73 + t58*t72
-    t76 = xp.not_equal(t71, 0)
-    t77 = (-t61 + t62)/xp.where(t76, 2*t71, 1)
-    t78 = xp.abs(t77)
-    t79 = xp.greater_equal(t78, 1)
-    t80 = 1/xp.abs(xp.where(t79, t77, 1))
-    t81 = xp.where(t76, xp.where(xp.greater_equal(t77, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t79, t80/(1 + xp.sqrt(1 + t80**2)), 1/(t78 + xp.sqrt(1 + t78**2))), 0)
-    t82 = 1/xp.sqrt(1 + t81**2)
-    t83 = t71*t81
-    t84 = -t83 + t61
-    t85 = t62 + t83
-    t86 = t65*t82
-    t87 = t66*t82
-    t88 = t86 + t81*t87
-    t89 = t87 - t81*t86
-    t90 = t69*t82
-    t91 = t70*t82
-    t92 = t90 - t81*t91
-    t93 = t91 + t81*t90
-    t94 = -t88*t89 + t92*t93
-    t95 = t74*t82
-    t96 = t75*t82
-    t97 = t95 - t81*t96
-    t98 = t96 + t81*t95
-    t99 = xp.not_equal(t94, 0)
-    t100 = (-t84 + t85)/xp.where(t99, 2*t94, 1)
-    t101 = xp.abs(t100)
-    t102 = xp.greater_equal(t101, 1)
-    t103 = 1/xp.abs(xp.where(t102, t100, 1))
-    t104 = xp.where(t99, xp.where(xp.greater_equal(t100, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t102, t103/(1 + xp.sqrt(1 + t103**2)), 1/(t101 + xp.sqrt(1 + t101**2))), 0)
-    t105 = 1/xp.sqrt(1 + t104**2)
-    t106 = t88*t105
-    t107 = t89*t105
-    t108 = t106 + t104*t107
-    t109 = t107 - t104*t106
-    t110 = t92*t105
-    t111 = t93*t105
-    t112 = t110 - t104*t111
-    t113 = t111 + t104*t110
-    t114 = xp.sqrt(t108**2 + t112**2)
-    t115 = xp.sqrt(t109**2 + t113**2)
-    t116 = t97*t105
-    t117 = t98*t105
-    t118 = t116 - t104*t117
-    t119 = t117 + t104*t116
-    t120 = xp.less(t114, t115)
-    t121 = xp.where(t120, t115, t114)
-    t122 = xp.where(t120, t114, t115)
-    t123 = xp.where(t120, t119, t118)
-    t124 = xp.where(t120, t118, t119)
-    t125 = -t119
-    t126 = xp.where(t120, t118, t125)
-    t127 = xp.where(t120, t125, t118)
-    t128 = xp.less(t122, 0)
-    t129 = xp.where(t128, 0, t122)
-    t130 = xp.where(t128, t122, 0)
-    t131 = xp.where(t128, 0, t124)
-    t132 = xp.where(t128, 0, t127)
-    t133 = xp.where(t128, xp.asarray(1, dtype=dtype), 0)
-    t134 = xp.where(t128, t124, 0)
-    t135 = xp.where(t128, t127, 0)
-    t136 = xp.where(t128, xp.asarray(0, dtype=dtype), 1)
-    t137 = xp.less(t121, t129)
-    t138 = xp.where(t137, t129, t121)
-    t139 = xp.where(t137, t121, t129)
-    t140 = xp.where(t137, t131, t123)
-    t141 = xp.where(t137, t132, t126)
-    t142 = xp.where(t137, t133, 0)
-    t143 = xp.where(t137, t123, t131)
-    t144 = xp.where(t137, t126, t132)
-    t145 = xp.where(t137, 0, t133)
-    t146 = t140*(t136*t144 - t135*t145) - t141*(t136*t143 - t134*t145) + t142*(t135*t143 - t134*t144)
-    t147 = xp.where(xp.less(t146, 0), xp.asarray(-1, dtype=dtype), 1)
-    t148 = t134*t147
-    t149 = t135*t147
-    t150 = t136*t147
+    t4 = t3**2
+    t5 = xp.greater(t2, 0)
+    t6 = xp.where(t5, 1/(-t1 + t3), 0)
+    t7 = xp.where(t5, 1 + xp.abs(t1)/t2, 0)
+    t8 = s12*t6
+    t9 = t7*(t0 - c12*t8)
+    t10 = -t9 + t0
+    t11 = c12 + t8*t9
+    t12 = xp.abs(t11)
+    t13 = t12*xp.where(xp.greater_equal(t11, 0), xp.asarray(1, dtype=dtype), -1)
+    t14 = t13**2
+    t15 = t14 + t10**2
+    t16 = t3*t10
+    t17 = xp.not_equal(t16, 0)
+    t18 = (-t4 + t15)/xp.where(t17, -2*t16, 1)
+    t19 = xp.abs(t18)
+    t20 = xp.greater_equal(t19, 1)
+    t21 = 1/xp.abs(xp.where(t20, t18, 1))
+    t22 = xp.where(t17, xp.where(xp.greater_equal(t18, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t20, t21/(1 + xp.sqrt(1 + t21**2)), 1/(t19 + xp.sqrt(1 + t19**2))), 0)
+    t23 = 1/xp.sqrt(1 + t22**2)
+    t24 = t16*t22
+    t25 = t24 + t4
+    t26 = -t24 + t15
+    t27 = t3*t23
+    t28 = t10*t23
+    t29 = t27 + t28*t22
+    t30 = t28 - t27*t22
+    t31 = t29*t30 + t14*t22*t23**2
+    t32 = xp.not_equal(t31, 0)
+    t33 = (-t25 + t26)/xp.where(t32, -2*t31, 1)
+    t34 = xp.abs(t33)
+    t35 = xp.greater_equal(t34, 1)
+    t36 = 1/xp.abs(xp.where(t35, t33, 1))
+    t37 = xp.where(t32, xp.where(xp.greater_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t35, t36/(1 + xp.sqrt(1 + t36**2)), 1/(t34 + xp.sqrt(1 + t34**2))), 0)
+    t38 = 1/xp.sqrt(1 + t37**2)
+    t39 = t31*t37
+    t40 = t25 + t39
+    t41 = -t39 + t26
+    t42 = t29*t38
+    t43 = t30*t38
+    t44 = t42 + t37*t43
+    t45 = t43 - t37*t42
+    t46 = t23*t38
+    t47 = t13*t46
+    t48 = t22*t47
+    t49 = t48 + t37*t47
+    t50 = -t47 + t37*t48
+    t51 = -t44*t45 + t49*t50
+    t52 = t22*t46
+    t53 = t46 - t37*t52
+    t54 = t52 + t37*t46
+    t55 = xp.not_equal(t51, 0)
+    t56 = (-t40 + t41)/xp.where(t55, 2*t51, 1)
+    t57 = xp.abs(t56)
+    t58 = xp.greater_equal(t57, 1)
+    t59 = 1/xp.abs(xp.where(t58, t56, 1))
+    t60 = xp.where(t55, xp.where(xp.greater_equal(t56, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t58, t59/(1 + xp.sqrt(1 + t59**2)), 1/(t57 + xp.sqrt(1 + t57**2))), 0)
+    t61 = 1/xp.sqrt(1 + t60**2)
+    t62 = t51*t60
+    t63 = -t62 + t40
+    t64 = t41 + t62
+    t65 = t44*t61
+    t66 = t45*t61
+    t67 = t65 + t60*t66
+    t68 = t66 - t60*t65
+    t69 = t49*t61
+    t70 = t50*t61
+    t71 = t69 - t60*t70
+    t72 = t70 + t60*t69
+    t73 = -t67*t68 + t71*t72
+    t74 = t53*t61
+    t75 = t54*t61
+    t76 = t74 - t60*t75
+    t77 = t75 + t60*t74
+    t78 = xp.not_equal(t73, 0)
+    t79 = (-t63 + t64)/xp.where(t78, 2*t73, 1)
+    t80 = xp.abs(t79)
+    t81 = xp.greater_equal(t80, 1)
+    t82 = 1/xp.abs(xp.where(t81, t79, 1))
+    t83 = xp.where(t78, xp.where(xp.greater_equal(t79, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t81, t82/(1 + xp.sqrt(1 + t82**2)), 1/(t80 + xp.sqrt(1 + t80**2))), 0)
+    t84 = 1/xp.sqrt(1 + t83**2)
+    t85 = t73*t83
+    t86 = -t85 + t63
+    t87 = t64 + t85
+    t88 = t67*t84
+    t89 = t68*t84
+    t90 = t88 + t83*t89
+    t91 = t89 - t83*t88
+    t92 = t71*t84
+    t93 = t72*t84
+    t94 = t92 - t83*t93
+    t95 = t93 + t83*t92
+    t96 = -t90*t91 + t94*t95
+    t97 = t76*t84
+    t98 = t77*t84
+    t99 = t97 - t83*t98
+    t100 = t98 + t83*t97
+    t101 = xp.not_equal(t96, 0)
+    t102 = (-t86 + t87)/xp.where(t101, 2*t96, 1)
+    t103 = xp.abs(t102)
+    t104 = xp.greater_equal(t103, 1)
+    t105 = 1/xp.abs(xp.where(t104, t102, 1))
+    t106 = xp.where(t101, xp.where(xp.greater_equal(t102, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t104, t105/(1 + xp.sqrt(1 + t105**2)), 1/(t103 + xp.sqrt(1 + t103**2))), 0)
+    t107 = 1/xp.sqrt(1 + t106**2)
+    t108 = t90*t107
+    t109 = t91*t107
+    t110 = t108 + t106*t109
+    t111 = t109 - t106*t108
+    t112 = t94*t107
+    t113 = t95*t107
+    t114 = t112 - t106*t113
+    t115 = t113 + t106*t112
+    t116 = xp.sqrt(t110**2 + t114**2)
+    t117 = xp.sqrt(t111**2 + t115**2)
+    t118 = t99*t107
+    t119 = t100*t107
+    t120 = t118 - t106*t119
+    t121 = t119 + t106*t118
+    t122 = xp.less(t116, t117)
+    t123 = xp.where(t122, t117, t116)
+    t124 = xp.where(t122, t116, t117)
+    t125 = xp.where(t122, t121, t120)
+    t126 = xp.where(t122, t120, t121)
+    t127 = -t121
+    t128 = xp.where(t122, t120, t127)
+    t129 = xp.where(t122, t127, t120)
+    t130 = xp.less(t124, 0)
+    t131 = xp.where(t130, 0, t124)
+    t132 = xp.where(t130, t124, 0)
+    t133 = xp.where(t130, 0, t126)
+    t134 = xp.where(t130, 0, t129)
+    t135 = xp.where(t130, xp.asarray(1, dtype=dtype), 0)
+    t136 = xp.where(t130, t126, 0)
+    t137 = xp.where(t130, t129, 0)
+    t138 = xp.where(t130, xp.asarray(0, dtype=dtype), 1)
+    t139 = xp.less(t123, t131)
+    t140 = xp.where(t139, t131, t123)
+    t141 = xp.where(t139, t123, t131)
+    t142 = xp.where(t139, t133, t125)
+    t143 = xp.where(t139, t134, t128)
+    t144 = xp.where(t139, t135, 0)
+    t145 = xp.where(t139, t125, t133)
+    t146 = xp.where(t139, t128, t134)
+    t147 = xp.where(t139, 0, t135)
+    t148 = t142*(t138*t146 - t137*t147) - t143*(t138*t145 - t136*t147) + t144*(t137*t145 - t136*t146)
+    t149 = xp.where(xp.less(t148, 0), xp.asarray(-1, dtype=dtype), 1)
+    t150 = t136*t149
+    t151 = t137*t149
+    t152 = t138*t149
     U_v = _stack(xp, [
-        t140,  # 0, 0
-        t143,  # 0, 1
-        t148,  # 0, 2
-        t141,  # 1, 0
-        t144,  # 1, 1
-        t149,  # 1, 2
-        t142,  # 2, 0
-        t145,  # 2, 1
-        t150,  # 2, 2
+        t142,  # 0, 0
+        t145,  # 0, 1
+        t150,  # 0, 2
+        t143,  # 1, 0
+        t146,  # 1, 1
+        t151,  # 1, 2
+        t144,  # 2, 0
+        t147,  # 2, 1
+        t152,  # 2, 2
     ], (3, 3))
     s_v = _stack(xp, [
-        t138,  # 0
-        t139,  # 1
-        t130,  # 2
+        t140,  # 0
+        t141,  # 1
+        t132,  # 2
     ], (3,))
     U_w = _stack(xp, [
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 0
@@ -818,7 +820,7 @@ def velocity_ellipsoid(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def condition_number(q):
-    """sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): (1 x 1), 99 operations."""
+    """sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): (1 x 1), 100 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (2,)))
     trig = _cos_sin(xp, q, (0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -831,43 +833,45 @@ def condition_number(q):
     t1 = s1 + s12
     t2 = xp.sqrt(s12**2 + t1**2)
     t3 = t2*xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)
-    t4 = -t1 + t3
-    t5 = xp.where(xp.greater(t2, 0), 1/(t2*(t2 + xp.abs(t1))), 0)
-    t6 = t5*(t0*t4 - c12*s12)
-    t7 = t0 - t4*t6
-    t8 = c12 + s12*t6
-    t9 = xp.abs(t8)
-    t10 = t9*xp.where(xp.greater_equal(t8, 0), xp.asarray(1, dtype=dtype), -1)
-    t11 = t10**2
-    t12 = t3**2
-    t13 = t12 + t7**2
-    t14 = t7*t10
-    t15 = xp.not_equal(t14, 0)
-    t16 = (-t13 + t11)/xp.where(t15, -2*t14, 1)
-    t17 = xp.abs(t16)
-    t18 = xp.greater_equal(t17, 1)
-    t19 = 1/xp.abs(xp.where(t18, t16, 1))
-    t20 = xp.where(t15, xp.where(xp.greater_equal(t16, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t18, t19/(1 + xp.sqrt(1 + t19**2)), 1/(t17 + xp.sqrt(1 + t17**2))), 0)
-    t21 = t20**2
-    t22 = 1/xp.sqrt(1 + t21)
-    t23 = t7*t22
-    t24 = t10*t22
-    t25 = t23 + t24*t20
-    t26 = -t24 + t23*t20
-    t27 = t12*t22**2
-    t28 = xp.sqrt(t27 + t25**2)
-    t29 = xp.sqrt(t26**2 + t21*t27)
-    t30 = xp.where(xp.greater(t29, t28), t29, t28)
-    t31 = xp.where(xp.less(t29, t28), t29, t28)
-    t32 = xp.where(xp.less_equal(t31, 1e-12*t30), 0, t31)
-    t33 = xp.where(xp.greater(t30, 0), t30, 1)
-    kappa = xp.broadcast_to(t33/t32, batch)
+    t4 = xp.greater(t2, 0)
+    t5 = xp.where(t4, 1/(-t1 + t3), 0)
+    t6 = xp.where(t4, 1 + xp.abs(t1)/t2, 0)
+    t7 = s12*t5
+    t8 = t6*(t0 - c12*t7)
+    t9 = -t8 + t0
+    t10 = c12 + t7*t8
+    t11 = xp.abs(t10)
+    t12 = t11*xp.where(xp.greater_equal(t10, 0), xp.asarray(1, dtype=dtype), -1)
+    t13 = t12**2
+    t14 = t3**2
+    t15 = t14 + t9**2
+    t16 = t9*t12
+    t17 = xp.not_equal(t16, 0)
+    t18 = (-t15 + t13)/xp.where(t17, -2*t16, 1)
+    t19 = xp.abs(t18)
+    t20 = xp.greater_equal(t19, 1)
+    t21 = 1/xp.abs(xp.where(t20, t18, 1))
+    t22 = xp.where(t17, xp.where(xp.greater_equal(t18, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t20, t21/(1 + xp.sqrt(1 + t21**2)), 1/(t19 + xp.sqrt(1 + t19**2))), 0)
+    t23 = t22**2
+    t24 = 1/xp.sqrt(1 + t23)
+    t25 = t9*t24
+    t26 = t12*t24
+    t27 = t25 + t26*t22
+    t28 = -t26 + t25*t22
+    t29 = t14*t24**2
+    t30 = xp.sqrt(t29 + t27**2)
+    t31 = xp.sqrt(t28**2 + t23*t29)
+    t32 = xp.where(xp.greater(t31, t30), t31, t30)
+    t33 = xp.where(xp.less(t31, t30), t31, t30)
+    t34 = xp.where(xp.less_equal(t33, 1e-12*t32), 0, t33)
+    t35 = xp.where(xp.greater(t32, 0), t32, 1)
+    kappa = xp.broadcast_to(t35/t34, batch)
     return kappa
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (2 x 1 and 1 x 1), 173 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (2 x 1 and 1 x 1), 160 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (2,)), ("mu_dot", mu_dot, (2,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -882,74 +886,77 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = c12*s12 + t0*t1
+    t2 = t0*t1 + c12*s12
     t3 = t1**2
     t4 = s12**2 + t3
     t5 = t0**2
     t6 = xp.sqrt(t3 + t5)
     t7 = xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)*t6
-    t8 = xp.where(xp.greater(t6, 0), 1/(t6*(xp.abs(t1) + t6)), 0)
-    t9 = c12**2 + t5
-    t10 = xp.sqrt(t4 + t9)
-    t11 = t2**2
-    t12 = damping**2
-    t13 = t4 + t12
-    t14 = t13**2
-    t15 = xp.sqrt(t11 + t14)
-    t16 = t15*xp.where(xp.greater_equal(t13, 0), xp.asarray(1, dtype=dtype), -1)
-    t17 = t13 + t16
-    t18 = xp.where(xp.greater(t15, 0), 1/(t15*(t15 + xp.abs(t13))), 0)
-    t19 = t18*(mu_dot0*t17 - mu_dot1*t2)
-    t20 = mu_dot0 - t17*t19
-    t21 = mu_dot1 + t2*t19
-    t22 = t9 + t12
-    t23 = xp.sqrt(2*t11 + t14 + t22**2)
-    t24 = -t18*(t2*t17 + t22*t2)
-    t25 = t2 + t17*t24
-    t26 = t22 + t2*t24
-    t27 = xp.abs(t26)
-    t28 = t27*xp.where(xp.greater_equal(t26, 0), xp.asarray(1, dtype=dtype), -1)
-    t29 = t26 + t28
-    t30 = xp.where(xp.greater(t27, 0), 1/(t27*2*t27), 0)
-    t31 = t21 - t21*t29**2*t30
-    t32 = xp.where(xp.not_equal(t28, 0), -t31/t28, 0)
-    t33 = xp.where(xp.not_equal(t16, 0), -(t20 + t25*t32)/t16, 0)
+    t8 = c12**2 + t5
+    t9 = xp.sqrt(t4 + t8)
+    t10 = t2**2
+    t11 = damping**2
+    t12 = t4 + t11
+    t13 = t12**2
+    t14 = xp.sqrt(t10 + t13)
+    t15 = t14*xp.where(xp.greater_equal(t12, 0), xp.asarray(1, dtype=dtype), -1)
+    t16 = t8 + t11
+    t17 = xp.sqrt(2*t10 + t13 + t16**2)
+    t18 = xp.greater(t14, 0)
+    t19 = xp.where(t18, 1/(t12 + t15), 0)
+    t20 = xp.where(t18, 1 + xp.abs(t12)/t14, 0)
+    t21 = t2*t19
+    t22 = -t20*(t2 + t16*t21)
+    t23 = t2 + t22
+    t24 = t16 + t21*t22
+    t25 = t20*(mu_dot0 - t21*mu_dot1)
+    t26 = -t25 + mu_dot0
+    t27 = mu_dot1 + t21*t25
+    t28 = xp.abs(t24)
+    t29 = t28*xp.where(xp.greater_equal(t24, 0), xp.asarray(1, dtype=dtype), -1)
+    t30 = xp.where(xp.greater(t28, 0), xp.asarray(2, dtype=dtype), 0)
+    t31 = t27 - t27*t30
+    t32 = xp.where(xp.not_equal(t29, 0), -t31/t29, 0)
+    t33 = xp.where(xp.not_equal(t15, 0), -(t26 + t23*t32)/t15, 0)
     t34 = -t1*t33 + t0*t32
     t35 = -s12*t33 + c12*t32
-    t36 = -t1
-    t37 = t36 + t7
-    t38 = t8*(c12*t0 - s12*t37)
-    t39 = s12 + t37*t38
-    t40 = c12 - t0*t38
-    t41 = t8*(mu_dot0*t37 + t0*mu_dot1)
-    t42 = mu_dot0 - t37*t41
-    t43 = mu_dot1 - t0*t41
-    t44 = -s12 + q1 + q2 + c12 + t0 + t36 + mu_dot0 + mu_dot1 + damping
-    t45 = xp.abs(t40)
-    t46 = t45*xp.where(xp.greater_equal(t40, 0), xp.asarray(1, dtype=dtype), -1)
-    t47 = t40 + t46
-    t48 = xp.where(xp.greater(t45, 0), 1/(t45*2*t45), 0)
-    t49 = t43 - t43*t47**2*t48
-    t50 = xp.where(xp.not_equal(t46, 0), -t49/t46, 0)
-    t51 = xp.where(xp.not_equal(t7, 0), -(t42 + t39*t50)/t7, 0)
-    t52 = xp.isfinite(t44)
-    t53 = xp.greater_equal(damping, 0)
-    t54 = xp.greater(damping, 0)
-    t55 = 1e-12*t23
-    t56 = 1e-12*t10
-    t57 = (t54 & (xp.less_equal(t15, t55) | xp.less_equal(t27, t55))) | (xp.less_equal(damping, 0) & (xp.less_equal(t6, t56) | xp.less_equal(t45, t56)))
-    t58 = t52 & t53 & xp.logical_not(t57)
+    t36 = xp.greater(t6, 0)
+    t37 = xp.where(t36, 1 + xp.abs(t1)/t6, 0)
+    t38 = -t1
+    t39 = xp.where(t36, 1/(t38 + t7), 0)
+    t40 = -s12
+    t41 = q1 + q2 + c12 + t0 + t38 + t40 + mu_dot0 + mu_dot1 + damping
+    t42 = t0*t39
+    t43 = t37*(t40 + c12*t42)
+    t44 = s12 + t43
+    t45 = c12 - t42*t43
+    t46 = t37*(mu_dot0 + t42*mu_dot1)
+    t47 = -t46 + mu_dot0
+    t48 = mu_dot1 - t42*t46
+    t49 = xp.abs(t45)
+    t50 = t49*xp.where(xp.greater_equal(t45, 0), xp.asarray(1, dtype=dtype), -1)
+    t51 = xp.where(xp.greater(t49, 0), xp.asarray(2, dtype=dtype), 0)
+    t52 = t48 - t48*t51
+    t53 = xp.where(xp.not_equal(t50, 0), -t52/t50, 0)
+    t54 = xp.where(xp.not_equal(t7, 0), -(t47 + t44*t53)/t7, 0)
+    t55 = xp.isfinite(t41)
+    t56 = xp.greater_equal(damping, 0)
+    t57 = xp.greater(damping, 0)
+    t58 = 1e-12*t17
+    t59 = 1e-12*t9
+    t60 = (t57 & (xp.less_equal(t14, t58) | xp.less_equal(t28, t58))) | (xp.less_equal(damping, 0) & (xp.less_equal(t6, t59) | xp.less_equal(t49, t59)))
+    t61 = t55 & t56 & xp.logical_not(t60)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t58, xp.where(t54, t34, t51), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t58, xp.where(t54, t35, t50), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t61, xp.where(t57, t34, t54), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t61, xp.where(t57, t35, t53), 0), batch),  # 1
     ], (2,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t52 & t53), 2, xp.where(t57, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t55 & t56), 2, xp.where(t60, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
-    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (2 x 1 and 1 x 1), 175 operations."""
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (2 x 1 and 1 x 1), 162 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (2,)), ("mu_dot", mu_dot, (2,)), ("z", z, (2,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -966,74 +973,77 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = c12*s12 + t0*t1
+    t2 = t0*t1 + c12*s12
     t3 = t1**2
     t4 = s12**2 + t3
     t5 = t0**2
     t6 = xp.sqrt(t3 + t5)
     t7 = xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)*t6
-    t8 = xp.where(xp.greater(t6, 0), 1/(t6*(xp.abs(t1) + t6)), 0)
-    t9 = c12**2 + t5
-    t10 = xp.sqrt(t4 + t9)
-    t11 = t2**2
-    t12 = damping**2
-    t13 = t4 + t12
-    t14 = t13**2
-    t15 = xp.sqrt(t11 + t14)
-    t16 = t15*xp.where(xp.greater_equal(t13, 0), xp.asarray(1, dtype=dtype), -1)
-    t17 = t13 + t16
-    t18 = xp.where(xp.greater(t15, 0), 1/(t15*(t15 + xp.abs(t13))), 0)
-    t19 = t18*(mu_dot0*t17 - mu_dot1*t2)
-    t20 = mu_dot0 - t17*t19
-    t21 = mu_dot1 + t2*t19
-    t22 = t9 + t12
-    t23 = xp.sqrt(2*t11 + t14 + t22**2)
-    t24 = -t18*(t2*t17 + t22*t2)
-    t25 = t2 + t17*t24
-    t26 = t22 + t2*t24
-    t27 = xp.abs(t26)
-    t28 = t27*xp.where(xp.greater_equal(t26, 0), xp.asarray(1, dtype=dtype), -1)
-    t29 = t26 + t28
-    t30 = xp.where(xp.greater(t27, 0), 1/(t27*2*t27), 0)
-    t31 = t21 - t21*t29**2*t30
-    t32 = xp.where(xp.not_equal(t28, 0), -t31/t28, 0)
-    t33 = xp.where(xp.not_equal(t16, 0), -(t20 + t25*t32)/t16, 0)
+    t8 = c12**2 + t5
+    t9 = xp.sqrt(t4 + t8)
+    t10 = t2**2
+    t11 = damping**2
+    t12 = t4 + t11
+    t13 = t12**2
+    t14 = xp.sqrt(t10 + t13)
+    t15 = t14*xp.where(xp.greater_equal(t12, 0), xp.asarray(1, dtype=dtype), -1)
+    t16 = t8 + t11
+    t17 = xp.sqrt(2*t10 + t13 + t16**2)
+    t18 = xp.greater(t14, 0)
+    t19 = xp.where(t18, 1/(t12 + t15), 0)
+    t20 = xp.where(t18, 1 + xp.abs(t12)/t14, 0)
+    t21 = t2*t19
+    t22 = -t20*(t2 + t16*t21)
+    t23 = t2 + t22
+    t24 = t16 + t21*t22
+    t25 = t20*(mu_dot0 - t21*mu_dot1)
+    t26 = -t25 + mu_dot0
+    t27 = mu_dot1 + t21*t25
+    t28 = xp.abs(t24)
+    t29 = t28*xp.where(xp.greater_equal(t24, 0), xp.asarray(1, dtype=dtype), -1)
+    t30 = xp.where(xp.greater(t28, 0), xp.asarray(2, dtype=dtype), 0)
+    t31 = t27 - t27*t30
+    t32 = xp.where(xp.not_equal(t29, 0), -t31/t29, 0)
+    t33 = xp.where(xp.not_equal(t15, 0), -(t26 + t23*t32)/t15, 0)
     t34 = -t1*t33 + t0*t32
     t35 = -s12*t33 + c12*t32
-    t36 = -t1
-    t37 = t36 + t7
-    t38 = t8*(c12*t0 - s12*t37)
-    t39 = s12 + t37*t38
-    t40 = c12 - t0*t38
-    t41 = t8*(mu_dot0*t37 + t0*mu_dot1)
-    t42 = mu_dot0 - t37*t41
-    t43 = mu_dot1 - t0*t41
-    t44 = -s12 + q1 + q2 + c12 + t0 + t36 + mu_dot0 + mu_dot1 + damping + qz1 + qz2
-    t45 = xp.abs(t40)
-    t46 = t45*xp.where(xp.greater_equal(t40, 0), xp.asarray(1, dtype=dtype), -1)
-    t47 = t40 + t46
-    t48 = xp.where(xp.greater(t45, 0), 1/(t45*2*t45), 0)
-    t49 = t43 - t43*t47**2*t48
-    t50 = xp.where(xp.not_equal(t46, 0), -t49/t46, 0)
-    t51 = xp.where(xp.not_equal(t7, 0), -(t42 + t39*t50)/t7, 0)
-    t52 = xp.isfinite(t44)
-    t53 = xp.greater_equal(damping, 0)
-    t54 = xp.greater(damping, 0)
-    t55 = 1e-12*t23
-    t56 = 1e-12*t10
-    t57 = (t54 & (xp.less_equal(t15, t55) | xp.less_equal(t27, t55))) | (xp.less_equal(damping, 0) & (xp.less_equal(t6, t56) | xp.less_equal(t45, t56)))
-    t58 = t52 & t53 & xp.logical_not(t57)
+    t36 = xp.greater(t6, 0)
+    t37 = xp.where(t36, 1 + xp.abs(t1)/t6, 0)
+    t38 = -t1
+    t39 = xp.where(t36, 1/(t38 + t7), 0)
+    t40 = -s12
+    t41 = q1 + q2 + c12 + t0 + t38 + t40 + mu_dot0 + mu_dot1 + damping + qz1 + qz2
+    t42 = t0*t39
+    t43 = t37*(t40 + c12*t42)
+    t44 = s12 + t43
+    t45 = c12 - t42*t43
+    t46 = t37*(mu_dot0 + t42*mu_dot1)
+    t47 = -t46 + mu_dot0
+    t48 = mu_dot1 - t42*t46
+    t49 = xp.abs(t45)
+    t50 = t49*xp.where(xp.greater_equal(t45, 0), xp.asarray(1, dtype=dtype), -1)
+    t51 = xp.where(xp.greater(t49, 0), xp.asarray(2, dtype=dtype), 0)
+    t52 = t48 - t48*t51
+    t53 = xp.where(xp.not_equal(t50, 0), -t52/t50, 0)
+    t54 = xp.where(xp.not_equal(t7, 0), -(t47 + t44*t53)/t7, 0)
+    t55 = xp.isfinite(t41)
+    t56 = xp.greater_equal(damping, 0)
+    t57 = xp.greater(damping, 0)
+    t58 = 1e-12*t17
+    t59 = 1e-12*t9
+    t60 = (t57 & (xp.less_equal(t14, t58) | xp.less_equal(t28, t58))) | (xp.less_equal(damping, 0) & (xp.less_equal(t6, t59) | xp.less_equal(t49, t59)))
+    t61 = t55 & t56 & xp.logical_not(t60)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t58, xp.where(t54, t34, t51), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t58, xp.where(t54, t35, t50), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t61, xp.where(t57, t34, t54), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t61, xp.where(t57, t35, t53), 0), batch),  # 1
     ], (2,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t52 & t53), 2, xp.where(t57, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t55 & t56), 2, xp.where(t60, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (2 x 1 and 1 x 1), 181 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (2 x 1 and 1 x 1), 168 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (2,)), ("target", target, (2,)), ("target_rate", target_rate, (2,)), ("gain", gain, (2,)), ("z", z, (2,)), ("damping", damping, ()), every=("gain", ))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -1054,76 +1064,79 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = c12*s12 + t0*t1
+    t2 = t0*t1 + c12*s12
     t3 = mu_dot0 + gain0*(-t0 + mu0)
     t4 = t1**2
     t5 = s12**2 + t4
     t6 = t0**2
     t7 = xp.sqrt(t4 + t6)
     t8 = xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)*t7
-    t9 = xp.where(xp.greater(t7, 0), 1/(t7*(xp.abs(t1) + t7)), 0)
-    t10 = c12**2 + t6
-    t11 = xp.sqrt(t5 + t10)
-    t12 = t2**2
-    t13 = damping**2
-    t14 = t5 + t13
-    t15 = t14**2
-    t16 = xp.sqrt(t12 + t15)
-    t17 = t16*xp.where(xp.greater_equal(t14, 0), xp.asarray(1, dtype=dtype), -1)
-    t18 = t14 + t17
-    t19 = xp.where(xp.greater(t16, 0), 1/(t16*(t16 + xp.abs(t14))), 0)
-    t20 = t10 + t13
-    t21 = xp.sqrt(2*t12 + t15 + t20**2)
-    t22 = -t19*(t2*t18 + t20*t2)
-    t23 = t2 + t18*t22
-    t24 = t20 + t2*t22
-    t25 = xp.abs(t24)
-    t26 = t25*xp.where(xp.greater_equal(t24, 0), xp.asarray(1, dtype=dtype), -1)
-    t27 = t24 + t26
-    t28 = xp.where(xp.greater(t25, 0), 1/(t25*2*t25), 0)
-    t29 = -t1
-    t30 = t29 + t8
-    t31 = t9*(c12*t0 - s12*t30)
-    t32 = s12 + t30*t31
-    t33 = c12 - t0*t31
-    t34 = mu_dot1 + gain1*(t29 + mu1)
-    t35 = t19*(t18*t3 - t2*t34)
-    t36 = t3 - t18*t35
-    t37 = t34 + t2*t35
-    t38 = t37 - t27**2*t28*t37
-    t39 = xp.where(xp.not_equal(t26, 0), -t38/t26, 0)
-    t40 = xp.where(xp.not_equal(t17, 0), -(t36 + t23*t39)/t17, 0)
-    t41 = -t1*t40 + t0*t39
-    t42 = -s12*t40 + c12*t39
-    t43 = t9*(t30*t3 + t0*t34)
-    t44 = t3 - t30*t43
-    t45 = t34 - t0*t43
-    t46 = -s12 + q1 + q2 + c12 + t0 + t29 + damping + qz1 + qz2 + t3 + t34
-    t47 = xp.abs(t33)
-    t48 = t47*xp.where(xp.greater_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)
-    t49 = t33 + t48
-    t50 = xp.where(xp.greater(t47, 0), 1/(t47*2*t47), 0)
-    t51 = t45 - t49**2*t50*t45
-    t52 = xp.where(xp.not_equal(t48, 0), -t51/t48, 0)
-    t53 = xp.where(xp.not_equal(t8, 0), -(t44 + t32*t52)/t8, 0)
-    t54 = xp.isfinite(t46)
-    t55 = xp.greater_equal(damping, 0)
-    t56 = xp.greater(damping, 0)
-    t57 = 1e-12*t21
-    t58 = 1e-12*t11
-    t59 = (t56 & (xp.less_equal(t16, t57) | xp.less_equal(t25, t57))) | (xp.less_equal(damping, 0) & (xp.less_equal(t7, t58) | xp.less_equal(t47, t58)))
-    t60 = t54 & t55 & xp.logical_not(t59)
+    t9 = c12**2 + t6
+    t10 = xp.sqrt(t5 + t9)
+    t11 = t2**2
+    t12 = damping**2
+    t13 = t5 + t12
+    t14 = t13**2
+    t15 = xp.sqrt(t11 + t14)
+    t16 = t15*xp.where(xp.greater_equal(t13, 0), xp.asarray(1, dtype=dtype), -1)
+    t17 = t9 + t12
+    t18 = xp.sqrt(2*t11 + t14 + t17**2)
+    t19 = xp.greater(t15, 0)
+    t20 = xp.where(t19, 1/(t13 + t16), 0)
+    t21 = xp.where(t19, 1 + xp.abs(t13)/t15, 0)
+    t22 = t2*t20
+    t23 = -t21*(t2 + t17*t22)
+    t24 = t2 + t23
+    t25 = t17 + t22*t23
+    t26 = xp.abs(t25)
+    t27 = t26*xp.where(xp.greater_equal(t25, 0), xp.asarray(1, dtype=dtype), -1)
+    t28 = xp.where(xp.greater(t26, 0), xp.asarray(2, dtype=dtype), 0)
+    t29 = xp.greater(t7, 0)
+    t30 = xp.where(t29, 1 + xp.abs(t1)/t7, 0)
+    t31 = -t1
+    t32 = xp.where(t29, 1/(t31 + t8), 0)
+    t33 = mu_dot1 + gain1*(t31 + mu1)
+    t34 = t21*(t3 - t22*t33)
+    t35 = -t34 + t3
+    t36 = t33 + t22*t34
+    t37 = t36 - t28*t36
+    t38 = xp.where(xp.not_equal(t27, 0), -t37/t27, 0)
+    t39 = xp.where(xp.not_equal(t16, 0), -(t35 + t24*t38)/t16, 0)
+    t40 = -t1*t39 + t0*t38
+    t41 = -s12*t39 + c12*t38
+    t42 = -s12
+    t43 = q1 + q2 + c12 + t0 + t31 + t42 + damping + qz1 + qz2 + t3 + t33
+    t44 = t0*t32
+    t45 = t30*(t42 + c12*t44)
+    t46 = s12 + t45
+    t47 = c12 - t44*t45
+    t48 = t30*(t3 + t44*t33)
+    t49 = -t48 + t3
+    t50 = t33 - t44*t48
+    t51 = xp.abs(t47)
+    t52 = t51*xp.where(xp.greater_equal(t47, 0), xp.asarray(1, dtype=dtype), -1)
+    t53 = xp.where(xp.greater(t51, 0), xp.asarray(2, dtype=dtype), 0)
+    t54 = t50 - t53*t50
+    t55 = xp.where(xp.not_equal(t52, 0), -t54/t52, 0)
+    t56 = xp.where(xp.not_equal(t8, 0), -(t49 + t46*t55)/t8, 0)
+    t57 = xp.isfinite(t43)
+    t58 = xp.greater_equal(damping, 0)
+    t59 = xp.greater(damping, 0)
+    t60 = 1e-12*t18
+    t61 = 1e-12*t10
+    t62 = (t59 & (xp.less_equal(t15, t60) | xp.less_equal(t26, t60))) | (xp.less_equal(damping, 0) & (xp.less_equal(t7, t61) | xp.less_equal(t51, t61)))
+    t63 = t57 & t58 & xp.logical_not(t62)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t60, xp.where(t56, t41, t53), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t60, xp.where(t56, t42, t52), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t63, xp.where(t59, t40, t56), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t63, xp.where(t59, t41, t55), 0), batch),  # 1
     ], (2,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t54 & t55), 2, xp.where(t59, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t57 & t58), 2, xp.where(t62, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (2 x 1 and 2 x 1 and 1 x 1), 94 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (2 x 1 and 2 x 1 and 1 x 1), 87 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (2,)), ("q", q, (2,)), ("damping", damping, ()))
     mu0 = target[..., 0]
     mu1 = target[..., 1]
@@ -1140,7 +1153,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = s12**2 + t1**2
-    t3 = c12*s12 + t0*t1
+    t3 = t0*t1 + c12*s12
     t4 = c12**2 + t0**2
     t5 = -t0 + mu0
     t6 = -t1 + mu1
@@ -1149,31 +1162,32 @@ def ik_numeric_step(target, q, damping=0.0):
     t9 = damping + t2
     t10 = xp.sqrt(t9**2 + t3**2)
     t11 = t10*xp.where(xp.greater_equal(t9, 0), xp.asarray(1, dtype=dtype), -1)
-    t12 = t9 + t11
-    t13 = xp.where(xp.greater(t10, 0), 1/(t10*(t10 + xp.abs(t9))), 0)
-    t14 = t13*(t5*t12 - t3*t6)
-    t15 = t5 - t12*t14
-    t16 = t6 + t3*t14
-    t17 = damping + t4
-    t18 = -t13*(t3*t12 + t17*t3)
-    t19 = t3 + t12*t18
-    t20 = t17 + t3*t18
-    t21 = xp.abs(t20)
-    t22 = t21*xp.where(xp.greater_equal(t20, 0), xp.asarray(1, dtype=dtype), -1)
-    t23 = t20 + t22
-    t24 = xp.where(xp.greater(t21, 0), 1/(t21*2*t21), 0)
-    t25 = t16 - t16*t23**2*t24
-    t26 = xp.where(xp.not_equal(t22, 0), -t25/t22, 0)
-    t27 = xp.where(xp.not_equal(t11, 0), -(t15 + t19*t26)/t11, 0)
-    t28 = q1 - t1*t27 + t0*t26
-    t29 = q2 - s12*t27 + c12*t26
+    t12 = xp.greater(t10, 0)
+    t13 = xp.where(t12, 1/(t9 + t11), 0)
+    t14 = xp.where(t12, 1 + xp.abs(t9)/t10, 0)
+    t15 = damping + t4
+    t16 = t3*t13
+    t17 = -t14*(t3 + t15*t16)
+    t18 = t3 + t17
+    t19 = t15 + t16*t17
+    t20 = t14*(t5 - t16*t6)
+    t21 = -t20 + t5
+    t22 = t6 + t16*t20
+    t23 = xp.abs(t19)
+    t24 = t23*xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)
+    t25 = xp.where(xp.greater(t23, 0), xp.asarray(2, dtype=dtype), 0)
+    t26 = t22 - t22*t25
+    t27 = xp.where(xp.not_equal(t24, 0), -t26/t24, 0)
+    t28 = xp.where(xp.not_equal(t11, 0), -(t21 + t18*t27)/t11, 0)
+    t29 = q1 - t1*t28 + t0*t27
+    t30 = q2 - s12*t28 + c12*t27
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
     ], (2,))
     q_next = _stack(xp, [
-        xp.broadcast_to(t28, batch),  # 0
-        xp.broadcast_to(t29, batch),  # 1
+        xp.broadcast_to(t29, batch),  # 0
+        xp.broadcast_to(t30, batch),  # 1
     ], (2,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t8), t7, -1), batch)
     return q_start, q_next, cost

@@ -389,7 +389,7 @@ def _jacobian_det(q):
 
 
 def _manipulability_gradient(q):
-    """D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): 91 operations."""
+    """D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): 84 operations."""
     q1 = q[0]
     q2 = q[1]
     c1 = casadi.cos(q1)
@@ -405,31 +405,31 @@ def _manipulability_gradient(q):
     t4 = casadi.sqrt(c12**2 + t0**2 + t3)
     t5 = casadi.sqrt(t3)
     t6 = t5*casadi.if_else((t1 <= 0), 1, -1)
-    t7 = -t1 + t6
-    t8 = casadi.if_else((t5 > 0), 1/(t5*(t5 + casadi.fabs(t1))), 0)
-    t9 = t8*(t0*t7 - c12*s12)
-    t10 = t0 - t7*t9
-    t11 = c12 + s12*t9
-    t12 = 1 - t7**2*t8
-    t13 = casadi.if_else((t6 > 0), -1, 1)
-    t14 = casadi.fabs(t11)
-    t15 = t14*casadi.if_else((t11 >= 0), 1, -1)
-    t16 = t11 + t15
-    t17 = casadi.if_else((t14 > 0), 1/(t14*2*t14), 0)
-    t18 = 1 - t16**2*t17
-    t19 = casadi.if_else((t15 > 0), -t13, t13)
-    t20 = t8*t18
-    t21 = t2*t20
-    t22 = -t21 + t18
-    t23 = s12*t7
-    t24 = t15*t12 + t10*t20*t23
-    t25 = t10*t22 + t8*t15*t23
-    t26 = 1e-12*t4
-    t27 = casadi.if_else(casadi.logic_or((t5 <= t26), (t14 <= t26)), 0, t19)
-    t28 = s12*t6
-    t29 = c12*t25 + t22*t28
-    t30 = t27*(t0*t24 + t1*t7*t20*t28 + t29)
-    t31 = t27*(c12*t24 + t29 + t6*t7*t21)
+    t7 = casadi.if_else((t6 > 0), -1, 1)
+    t8 = (t5 > 0)
+    t9 = casadi.if_else(t8, 1/(-t1 + t6), 0)
+    t10 = casadi.if_else(t8, 1 + casadi.fabs(t1)/t5, 0)
+    t11 = 1 - t10
+    t12 = s12*t9
+    t13 = t10*(t0 - c12*t12)
+    t14 = -t13 + t0
+    t15 = c12 + t13*t12
+    t16 = casadi.fabs(t15)
+    t17 = casadi.if_else((t15 >= 0), 1, -1)*t16
+    t18 = casadi.if_else((t16 > 0), 2, 0)
+    t19 = 1 - t18
+    t20 = casadi.if_else((t17 > 0), -t7, t7)
+    t21 = t10*t19
+    t22 = t2*t21
+    t23 = t19 - t9**2*t22
+    t24 = t14*t23 + t10*t17*t12
+    t25 = t12*t21
+    t26 = t17*t11 + t14*t25
+    t27 = 1e-12*t4
+    t28 = casadi.if_else(casadi.logic_or((t5 <= t27), (t16 <= t27)), 0, t20)
+    t29 = c12*t24 + s12*t6*t23
+    t30 = t28*(t0*t26 + t1*t6*t25 + t29)
+    t31 = t28*(c12*t26 + t29 + t6*t9*t22)
     dw = casadi.SX(2, 1)
     dw[0, 0] = t30
     dw[1, 0] = t31
@@ -437,7 +437,7 @@ def _manipulability_gradient(q):
 
 
 def _velocity_ellipsoid(q):
-    """Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: 364 operations."""
+    """Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: 365 operations."""
     q1 = q[0]
     q2 = q[1]
     c1 = casadi.cos(q1)
@@ -450,167 +450,169 @@ def _velocity_ellipsoid(q):
     t1 = s1 + s12
     t2 = casadi.sqrt(s12**2 + t1**2)
     t3 = t2*casadi.if_else((t1 <= 0), 1, -1)
-    t4 = -t1 + t3
-    t5 = casadi.if_else((t2 > 0), 1/(t2*(t2 + casadi.fabs(t1))), 0)
-    t6 = t5*(t0*t4 - c12*s12)
-    t7 = t0 - t4*t6
-    t8 = c12 + s12*t6
-    t9 = casadi.fabs(t8)
-    t10 = t9*casadi.if_else((t8 >= 0), 1, -1)
-    t11 = t3**2
-    t12 = t10**2
-    t13 = t12 + t7**2
-    t14 = t3*t7
-    t15 = (t14 != 0)
-    t16 = (-t11 + t13)/casadi.if_else(t15, -2*t14, 1)
-    t17 = casadi.fabs(t16)
-    t18 = (t17 >= 1)
-    t19 = 1/casadi.fabs(casadi.if_else(t18, t16, 1))
-    t20 = casadi.if_else(t15, casadi.if_else((t16 >= 0), 1, -1)*casadi.if_else(t18, t19/(1 + casadi.sqrt(1 + t19**2)), 1/(t17 + casadi.sqrt(1 + t17**2))), 0)
-    t21 = 1/casadi.sqrt(1 + t20**2)
-    t22 = t14*t20
-    t23 = t22 + t11
-    t24 = -t22 + t13
-    t25 = t3*t21
-    t26 = t7*t21
-    t27 = t25 + t26*t20
-    t28 = t26 - t25*t20
-    t29 = t27*t28 + t12*t20*t21**2
-    t30 = (t29 != 0)
-    t31 = (-t23 + t24)/casadi.if_else(t30, -2*t29, 1)
-    t32 = casadi.fabs(t31)
-    t33 = (t32 >= 1)
-    t34 = 1/casadi.fabs(casadi.if_else(t33, t31, 1))
-    t35 = casadi.if_else(t30, casadi.if_else((t31 >= 0), 1, -1)*casadi.if_else(t33, t34/(1 + casadi.sqrt(1 + t34**2)), 1/(t32 + casadi.sqrt(1 + t32**2))), 0)
-    t36 = 1/casadi.sqrt(1 + t35**2)
-    t37 = t29*t35
-    t38 = t23 + t37
-    t39 = -t37 + t24
-    t40 = t27*t36
-    t41 = t28*t36
-    t42 = t40 + t35*t41
-    t43 = t41 - t35*t40
-    t44 = t21*t36
-    t45 = t10*t44
-    t46 = t20*t45
-    t47 = t46 + t35*t45
-    t48 = -t45 + t35*t46
-    t49 = -t42*t43 + t47*t48
-    t50 = t20*t44
-    t51 = t44 - t35*t50
-    t52 = t50 + t35*t44
-    t53 = (t49 != 0)
-    t54 = (-t38 + t39)/casadi.if_else(t53, 2*t49, 1)
-    t55 = casadi.fabs(t54)
-    t56 = (t55 >= 1)
-    t57 = 1/casadi.fabs(casadi.if_else(t56, t54, 1))
-    t58 = casadi.if_else(t53, casadi.if_else((t54 >= 0), 1, -1)*casadi.if_else(t56, t57/(1 + casadi.sqrt(1 + t57**2)), 1/(t55 + casadi.sqrt(1 + t55**2))), 0)
-    t59 = 1/casadi.sqrt(1 + t58**2)
-    t60 = t49*t58
-    t61 = -t60 + t38
-    t62 = t39 + t60
-    t63 = t42*t59
-    t64 = t43*t59
-    t65 = t63 + t58*t64
-    t66 = t64 - t58*t63
-    t67 = t47*t59
-    t68 = t48*t59
-    t69 = t67 - t58*t68
-    t70 = t68 + t58*t67
-    t71 = -t65*t66 + t69*t70
-    t72 = t51*t59
-    t73 = t52*t59
-    t74 = t72 - t58*t73
-    t75 = t73 + t58*t72
-    t76 = (t71 != 0)
-    t77 = (-t61 + t62)/casadi.if_else(t76, 2*t71, 1)
-    t78 = casadi.fabs(t77)
-    t79 = (t78 >= 1)
-    t80 = 1/casadi.fabs(casadi.if_else(t79, t77, 1))
-    t81 = casadi.if_else(t76, casadi.if_else((t77 >= 0), 1, -1)*casadi.if_else(t79, t80/(1 + casadi.sqrt(1 + t80**2)), 1/(t78 + casadi.sqrt(1 + t78**2))), 0)
-    t82 = 1/casadi.sqrt(1 + t81**2)
-    t83 = t71*t81
-    t84 = -t83 + t61
-    t85 = t62 + t83
-    t86 = t65*t82
-    t87 = t66*t82
-    t88 = t86 + t81*t87
-    t89 = t87 - t81*t86
-    t90 = t69*t82
-    t91 = t70*t82
-    t92 = t90 - t81*t91
-    t93 = t91 + t81*t90
-    t94 = -t88*t89 + t92*t93
-    t95 = t74*t82
-    t96 = t75*t82
-    t97 = t95 - t81*t96
-    t98 = t96 + t81*t95
-    t99 = (t94 != 0)
-    t100 = (-t84 + t85)/casadi.if_else(t99, 2*t94, 1)
-    t101 = casadi.fabs(t100)
-    t102 = (t101 >= 1)
-    t103 = 1/casadi.fabs(casadi.if_else(t102, t100, 1))
-    t104 = casadi.if_else(t99, casadi.if_else((t100 >= 0), 1, -1)*casadi.if_else(t102, t103/(1 + casadi.sqrt(1 + t103**2)), 1/(t101 + casadi.sqrt(1 + t101**2))), 0)
-    t105 = 1/casadi.sqrt(1 + t104**2)
-    t106 = t88*t105
-    t107 = t89*t105
-    t108 = t106 + t104*t107
-    t109 = t107 - t104*t106
-    t110 = t92*t105
-    t111 = t93*t105
-    t112 = t110 - t104*t111
-    t113 = t111 + t104*t110
-    t114 = casadi.sqrt(t108**2 + t112**2)
-    t115 = casadi.sqrt(t109**2 + t113**2)
-    t116 = t97*t105
-    t117 = t98*t105
-    t118 = t116 - t104*t117
-    t119 = t117 + t104*t116
-    t120 = (t114 < t115)
-    t121 = casadi.if_else(t120, t115, t114)
-    t122 = casadi.if_else(t120, t114, t115)
-    t123 = casadi.if_else(t120, t119, t118)
-    t124 = casadi.if_else(t120, t118, t119)
-    t125 = -t119
-    t126 = casadi.if_else(t120, t118, t125)
-    t127 = casadi.if_else(t120, t125, t118)
-    t128 = (t122 < 0)
-    t129 = casadi.if_else(t128, 0, t122)
-    t130 = casadi.if_else(t128, t122, 0)
-    t131 = casadi.if_else(t128, 0, t124)
-    t132 = casadi.if_else(t128, 0, t127)
-    t133 = casadi.if_else(t128, 1, 0)
-    t134 = casadi.if_else(t128, t124, 0)
-    t135 = casadi.if_else(t128, t127, 0)
-    t136 = casadi.if_else(t128, 0, 1)
-    t137 = (t121 < t129)
-    t138 = casadi.if_else(t137, t129, t121)
-    t139 = casadi.if_else(t137, t121, t129)
-    t140 = casadi.if_else(t137, t131, t123)
-    t141 = casadi.if_else(t137, t132, t126)
-    t142 = casadi.if_else(t137, t133, 0)
-    t143 = casadi.if_else(t137, t123, t131)
-    t144 = casadi.if_else(t137, t126, t132)
-    t145 = casadi.if_else(t137, 0, t133)
-    t146 = t140*(t136*t144 - t135*t145) - t141*(t136*t143 - t134*t145) + t142*(t135*t143 - t134*t144)
-    t147 = casadi.if_else((t146 < 0), -1, 1)
-    t148 = t134*t147
-    t149 = t135*t147
-    t150 = t136*t147
+    t4 = t3**2
+    t5 = (t2 > 0)
+    t6 = casadi.if_else(t5, 1/(-t1 + t3), 0)
+    t7 = casadi.if_else(t5, 1 + casadi.fabs(t1)/t2, 0)
+    t8 = s12*t6
+    t9 = t7*(t0 - c12*t8)
+    t10 = -t9 + t0
+    t11 = c12 + t8*t9
+    t12 = casadi.fabs(t11)
+    t13 = t12*casadi.if_else((t11 >= 0), 1, -1)
+    t14 = t13**2
+    t15 = t14 + t10**2
+    t16 = t3*t10
+    t17 = (t16 != 0)
+    t18 = (-t4 + t15)/casadi.if_else(t17, -2*t16, 1)
+    t19 = casadi.fabs(t18)
+    t20 = (t19 >= 1)
+    t21 = 1/casadi.fabs(casadi.if_else(t20, t18, 1))
+    t22 = casadi.if_else(t17, casadi.if_else((t18 >= 0), 1, -1)*casadi.if_else(t20, t21/(1 + casadi.sqrt(1 + t21**2)), 1/(t19 + casadi.sqrt(1 + t19**2))), 0)
+    t23 = 1/casadi.sqrt(1 + t22**2)
+    t24 = t16*t22
+    t25 = t24 + t4
+    t26 = -t24 + t15
+    t27 = t3*t23
+    t28 = t10*t23
+    t29 = t27 + t28*t22
+    t30 = t28 - t27*t22
+    t31 = t29*t30 + t14*t22*t23**2
+    t32 = (t31 != 0)
+    t33 = (-t25 + t26)/casadi.if_else(t32, -2*t31, 1)
+    t34 = casadi.fabs(t33)
+    t35 = (t34 >= 1)
+    t36 = 1/casadi.fabs(casadi.if_else(t35, t33, 1))
+    t37 = casadi.if_else(t32, casadi.if_else((t33 >= 0), 1, -1)*casadi.if_else(t35, t36/(1 + casadi.sqrt(1 + t36**2)), 1/(t34 + casadi.sqrt(1 + t34**2))), 0)
+    t38 = 1/casadi.sqrt(1 + t37**2)
+    t39 = t31*t37
+    t40 = t25 + t39
+    t41 = -t39 + t26
+    t42 = t29*t38
+    t43 = t30*t38
+    t44 = t42 + t37*t43
+    t45 = t43 - t37*t42
+    t46 = t23*t38
+    t47 = t13*t46
+    t48 = t22*t47
+    t49 = t48 + t37*t47
+    t50 = -t47 + t37*t48
+    t51 = -t44*t45 + t49*t50
+    t52 = t22*t46
+    t53 = t46 - t37*t52
+    t54 = t52 + t37*t46
+    t55 = (t51 != 0)
+    t56 = (-t40 + t41)/casadi.if_else(t55, 2*t51, 1)
+    t57 = casadi.fabs(t56)
+    t58 = (t57 >= 1)
+    t59 = 1/casadi.fabs(casadi.if_else(t58, t56, 1))
+    t60 = casadi.if_else(t55, casadi.if_else((t56 >= 0), 1, -1)*casadi.if_else(t58, t59/(1 + casadi.sqrt(1 + t59**2)), 1/(t57 + casadi.sqrt(1 + t57**2))), 0)
+    t61 = 1/casadi.sqrt(1 + t60**2)
+    t62 = t51*t60
+    t63 = -t62 + t40
+    t64 = t41 + t62
+    t65 = t44*t61
+    t66 = t45*t61
+    t67 = t65 + t60*t66
+    t68 = t66 - t60*t65
+    t69 = t49*t61
+    t70 = t50*t61
+    t71 = t69 - t60*t70
+    t72 = t70 + t60*t69
+    t73 = -t67*t68 + t71*t72
+    t74 = t53*t61
+    t75 = t54*t61
+    t76 = t74 - t60*t75
+    t77 = t75 + t60*t74
+    t78 = (t73 != 0)
+    t79 = (-t63 + t64)/casadi.if_else(t78, 2*t73, 1)
+    t80 = casadi.fabs(t79)
+    t81 = (t80 >= 1)
+    t82 = 1/casadi.fabs(casadi.if_else(t81, t79, 1))
+    t83 = casadi.if_else(t78, casadi.if_else((t79 >= 0), 1, -1)*casadi.if_else(t81, t82/(1 + casadi.sqrt(1 + t82**2)), 1/(t80 + casadi.sqrt(1 + t80**2))), 0)
+    t84 = 1/casadi.sqrt(1 + t83**2)
+    t85 = t73*t83
+    t86 = -t85 + t63
+    t87 = t64 + t85
+    t88 = t67*t84
+    t89 = t68*t84
+    t90 = t88 + t83*t89
+    t91 = t89 - t83*t88
+    t92 = t71*t84
+    t93 = t72*t84
+    t94 = t92 - t83*t93
+    t95 = t93 + t83*t92
+    t96 = -t90*t91 + t94*t95
+    t97 = t76*t84
+    t98 = t77*t84
+    t99 = t97 - t83*t98
+    t100 = t98 + t83*t97
+    t101 = (t96 != 0)
+    t102 = (-t86 + t87)/casadi.if_else(t101, 2*t96, 1)
+    t103 = casadi.fabs(t102)
+    t104 = (t103 >= 1)
+    t105 = 1/casadi.fabs(casadi.if_else(t104, t102, 1))
+    t106 = casadi.if_else(t101, casadi.if_else((t102 >= 0), 1, -1)*casadi.if_else(t104, t105/(1 + casadi.sqrt(1 + t105**2)), 1/(t103 + casadi.sqrt(1 + t103**2))), 0)
+    t107 = 1/casadi.sqrt(1 + t106**2)
+    t108 = t90*t107
+    t109 = t91*t107
+    t110 = t108 + t106*t109
+    t111 = t109 - t106*t108
+    t112 = t94*t107
+    t113 = t95*t107
+    t114 = t112 - t106*t113
+    t115 = t113 + t106*t112
+    t116 = casadi.sqrt(t110**2 + t114**2)
+    t117 = casadi.sqrt(t111**2 + t115**2)
+    t118 = t99*t107
+    t119 = t100*t107
+    t120 = t118 - t106*t119
+    t121 = t119 + t106*t118
+    t122 = (t116 < t117)
+    t123 = casadi.if_else(t122, t117, t116)
+    t124 = casadi.if_else(t122, t116, t117)
+    t125 = casadi.if_else(t122, t121, t120)
+    t126 = casadi.if_else(t122, t120, t121)
+    t127 = -t121
+    t128 = casadi.if_else(t122, t120, t127)
+    t129 = casadi.if_else(t122, t127, t120)
+    t130 = (t124 < 0)
+    t131 = casadi.if_else(t130, 0, t124)
+    t132 = casadi.if_else(t130, t124, 0)
+    t133 = casadi.if_else(t130, 0, t126)
+    t134 = casadi.if_else(t130, 0, t129)
+    t135 = casadi.if_else(t130, 1, 0)
+    t136 = casadi.if_else(t130, t126, 0)
+    t137 = casadi.if_else(t130, t129, 0)
+    t138 = casadi.if_else(t130, 0, 1)
+    t139 = (t123 < t131)
+    t140 = casadi.if_else(t139, t131, t123)
+    t141 = casadi.if_else(t139, t123, t131)
+    t142 = casadi.if_else(t139, t133, t125)
+    t143 = casadi.if_else(t139, t134, t128)
+    t144 = casadi.if_else(t139, t135, 0)
+    t145 = casadi.if_else(t139, t125, t133)
+    t146 = casadi.if_else(t139, t128, t134)
+    t147 = casadi.if_else(t139, 0, t135)
+    t148 = t142*(t138*t146 - t137*t147) - t143*(t138*t145 - t136*t147) + t144*(t137*t145 - t136*t146)
+    t149 = casadi.if_else((t148 < 0), -1, 1)
+    t150 = t136*t149
+    t151 = t137*t149
+    t152 = t138*t149
     U_v = casadi.SX(3, 3)
-    U_v[0, 0] = t140
-    U_v[0, 1] = t143
-    U_v[0, 2] = t148
-    U_v[1, 0] = t141
-    U_v[1, 1] = t144
-    U_v[1, 2] = t149
-    U_v[2, 0] = t142
-    U_v[2, 1] = t145
-    U_v[2, 2] = t150
+    U_v[0, 0] = t142
+    U_v[0, 1] = t145
+    U_v[0, 2] = t150
+    U_v[1, 0] = t143
+    U_v[1, 1] = t146
+    U_v[1, 2] = t151
+    U_v[2, 0] = t144
+    U_v[2, 1] = t147
+    U_v[2, 2] = t152
     s_v = casadi.SX(3, 1)
-    s_v[0, 0] = t138
-    s_v[1, 0] = t139
-    s_v[2, 0] = t130
+    s_v[0, 0] = t140
+    s_v[1, 0] = t141
+    s_v[2, 0] = t132
     U_w = casadi.SX(3, 3)
     U_w[0, 1] = 1
     U_w[1, 2] = 1
@@ -621,7 +623,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 99 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 100 operations."""
     q1 = q[0]
     q2 = q[1]
     c1 = casadi.cos(q1)
@@ -634,43 +636,45 @@ def _condition_number(q):
     t1 = s1 + s12
     t2 = casadi.sqrt(s12**2 + t1**2)
     t3 = t2*casadi.if_else((t1 <= 0), 1, -1)
-    t4 = -t1 + t3
-    t5 = casadi.if_else((t2 > 0), 1/(t2*(t2 + casadi.fabs(t1))), 0)
-    t6 = t5*(t0*t4 - c12*s12)
-    t7 = t0 - t4*t6
-    t8 = c12 + s12*t6
-    t9 = casadi.fabs(t8)
-    t10 = t9*casadi.if_else((t8 >= 0), 1, -1)
-    t11 = t10**2
-    t12 = t3**2
-    t13 = t12 + t7**2
-    t14 = t7*t10
-    t15 = (t14 != 0)
-    t16 = (-t13 + t11)/casadi.if_else(t15, -2*t14, 1)
-    t17 = casadi.fabs(t16)
-    t18 = (t17 >= 1)
-    t19 = 1/casadi.fabs(casadi.if_else(t18, t16, 1))
-    t20 = casadi.if_else(t15, casadi.if_else((t16 >= 0), 1, -1)*casadi.if_else(t18, t19/(1 + casadi.sqrt(1 + t19**2)), 1/(t17 + casadi.sqrt(1 + t17**2))), 0)
-    t21 = t20**2
-    t22 = 1/casadi.sqrt(1 + t21)
-    t23 = t7*t22
-    t24 = t10*t22
-    t25 = t23 + t24*t20
-    t26 = -t24 + t23*t20
-    t27 = t12*t22**2
-    t28 = casadi.sqrt(t27 + t25**2)
-    t29 = casadi.sqrt(t26**2 + t21*t27)
-    t30 = casadi.if_else((t29 > t28), t29, t28)
-    t31 = casadi.if_else((t29 < t28), t29, t28)
-    t32 = casadi.if_else((t31 <= 1e-12*t30), 0, t31)
-    t33 = casadi.if_else((t30 > 0), t30, 1)
+    t4 = (t2 > 0)
+    t5 = casadi.if_else(t4, 1/(-t1 + t3), 0)
+    t6 = casadi.if_else(t4, 1 + casadi.fabs(t1)/t2, 0)
+    t7 = s12*t5
+    t8 = t6*(t0 - c12*t7)
+    t9 = -t8 + t0
+    t10 = c12 + t7*t8
+    t11 = casadi.fabs(t10)
+    t12 = t11*casadi.if_else((t10 >= 0), 1, -1)
+    t13 = t12**2
+    t14 = t3**2
+    t15 = t14 + t9**2
+    t16 = t9*t12
+    t17 = (t16 != 0)
+    t18 = (-t15 + t13)/casadi.if_else(t17, -2*t16, 1)
+    t19 = casadi.fabs(t18)
+    t20 = (t19 >= 1)
+    t21 = 1/casadi.fabs(casadi.if_else(t20, t18, 1))
+    t22 = casadi.if_else(t17, casadi.if_else((t18 >= 0), 1, -1)*casadi.if_else(t20, t21/(1 + casadi.sqrt(1 + t21**2)), 1/(t19 + casadi.sqrt(1 + t19**2))), 0)
+    t23 = t22**2
+    t24 = 1/casadi.sqrt(1 + t23)
+    t25 = t9*t24
+    t26 = t12*t24
+    t27 = t25 + t26*t22
+    t28 = -t26 + t25*t22
+    t29 = t14*t24**2
+    t30 = casadi.sqrt(t29 + t27**2)
+    t31 = casadi.sqrt(t28**2 + t23*t29)
+    t32 = casadi.if_else((t31 > t30), t31, t30)
+    t33 = casadi.if_else((t31 < t30), t31, t30)
+    t34 = casadi.if_else((t33 <= 1e-12*t32), 0, t33)
+    t35 = casadi.if_else((t32 > 0), t32, 1)
     kappa = casadi.SX(1, 1)
-    kappa[0, 0] = t33/t32
+    kappa[0, 0] = t35/t34
     return [kappa]
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 173 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 160 operations."""
     q1 = q[0]
     q2 = q[1]
     mu_dot0 = mu_dot[0]
@@ -683,73 +687,76 @@ def _velocity_ik(q, mu_dot, damping):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = c12*s12 + t0*t1
+    t2 = t0*t1 + c12*s12
     t3 = t1**2
     t4 = s12**2 + t3
     t5 = t0**2
     t6 = casadi.sqrt(t3 + t5)
     t7 = casadi.if_else((t1 <= 0), 1, -1)*t6
-    t8 = casadi.if_else((t6 > 0), 1/(t6*(casadi.fabs(t1) + t6)), 0)
-    t9 = c12**2 + t5
-    t10 = casadi.sqrt(t4 + t9)
-    t11 = t2**2
-    t12 = damping**2
-    t13 = t4 + t12
-    t14 = t13**2
-    t15 = casadi.sqrt(t11 + t14)
-    t16 = t15*casadi.if_else((t13 >= 0), 1, -1)
-    t17 = t13 + t16
-    t18 = casadi.if_else((t15 > 0), 1/(t15*(t15 + casadi.fabs(t13))), 0)
-    t19 = t18*(mu_dot0*t17 - mu_dot1*t2)
-    t20 = mu_dot0 - t17*t19
-    t21 = mu_dot1 + t2*t19
-    t22 = t9 + t12
-    t23 = casadi.sqrt(2*t11 + t14 + t22**2)
-    t24 = -t18*(t2*t17 + t22*t2)
-    t25 = t2 + t17*t24
-    t26 = t22 + t2*t24
-    t27 = casadi.fabs(t26)
-    t28 = t27*casadi.if_else((t26 >= 0), 1, -1)
-    t29 = t26 + t28
-    t30 = casadi.if_else((t27 > 0), 1/(t27*2*t27), 0)
-    t31 = t21 - t21*t29**2*t30
-    t32 = casadi.if_else((t28 != 0), -t31/t28, 0)
-    t33 = casadi.if_else((t16 != 0), -(t20 + t25*t32)/t16, 0)
+    t8 = c12**2 + t5
+    t9 = casadi.sqrt(t4 + t8)
+    t10 = t2**2
+    t11 = damping**2
+    t12 = t4 + t11
+    t13 = t12**2
+    t14 = casadi.sqrt(t10 + t13)
+    t15 = t14*casadi.if_else((t12 >= 0), 1, -1)
+    t16 = t8 + t11
+    t17 = casadi.sqrt(2*t10 + t13 + t16**2)
+    t18 = (t14 > 0)
+    t19 = casadi.if_else(t18, 1/(t12 + t15), 0)
+    t20 = casadi.if_else(t18, 1 + casadi.fabs(t12)/t14, 0)
+    t21 = t2*t19
+    t22 = -t20*(t2 + t16*t21)
+    t23 = t2 + t22
+    t24 = t16 + t21*t22
+    t25 = t20*(mu_dot0 - t21*mu_dot1)
+    t26 = -t25 + mu_dot0
+    t27 = mu_dot1 + t21*t25
+    t28 = casadi.fabs(t24)
+    t29 = t28*casadi.if_else((t24 >= 0), 1, -1)
+    t30 = casadi.if_else((t28 > 0), 2, 0)
+    t31 = t27 - t27*t30
+    t32 = casadi.if_else((t29 != 0), -t31/t29, 0)
+    t33 = casadi.if_else((t15 != 0), -(t26 + t23*t32)/t15, 0)
     t34 = -t1*t33 + t0*t32
     t35 = -s12*t33 + c12*t32
-    t36 = -t1
-    t37 = t36 + t7
-    t38 = t8*(c12*t0 - s12*t37)
-    t39 = s12 + t37*t38
-    t40 = c12 - t0*t38
-    t41 = t8*(mu_dot0*t37 + t0*mu_dot1)
-    t42 = mu_dot0 - t37*t41
-    t43 = mu_dot1 - t0*t41
-    t44 = -s12 + q1 + q2 + c12 + t0 + t36 + mu_dot0 + mu_dot1 + damping
-    t45 = casadi.fabs(t40)
-    t46 = t45*casadi.if_else((t40 >= 0), 1, -1)
-    t47 = t40 + t46
-    t48 = casadi.if_else((t45 > 0), 1/(t45*2*t45), 0)
-    t49 = t43 - t43*t47**2*t48
-    t50 = casadi.if_else((t46 != 0), -t49/t46, 0)
-    t51 = casadi.if_else((t7 != 0), -(t42 + t39*t50)/t7, 0)
-    t52 = (casadi.fabs(t44) < casadi.inf)
-    t53 = (damping >= 0)
-    t54 = (damping > 0)
-    t55 = 1e-12*t23
-    t56 = 1e-12*t10
-    t57 = casadi.logic_or(casadi.logic_and(t54, casadi.logic_or((t15 <= t55), (t27 <= t55))), casadi.logic_and((damping <= 0), casadi.logic_or((t6 <= t56), (t45 <= t56))))
-    t58 = casadi.logic_and(casadi.logic_and(t52, t53), casadi.logic_not(t57))
+    t36 = (t6 > 0)
+    t37 = casadi.if_else(t36, 1 + casadi.fabs(t1)/t6, 0)
+    t38 = -t1
+    t39 = casadi.if_else(t36, 1/(t38 + t7), 0)
+    t40 = -s12
+    t41 = q1 + q2 + c12 + t0 + t38 + t40 + mu_dot0 + mu_dot1 + damping
+    t42 = t0*t39
+    t43 = t37*(t40 + c12*t42)
+    t44 = s12 + t43
+    t45 = c12 - t42*t43
+    t46 = t37*(mu_dot0 + t42*mu_dot1)
+    t47 = -t46 + mu_dot0
+    t48 = mu_dot1 - t42*t46
+    t49 = casadi.fabs(t45)
+    t50 = t49*casadi.if_else((t45 >= 0), 1, -1)
+    t51 = casadi.if_else((t49 > 0), 2, 0)
+    t52 = t48 - t48*t51
+    t53 = casadi.if_else((t50 != 0), -t52/t50, 0)
+    t54 = casadi.if_else((t7 != 0), -(t47 + t44*t53)/t7, 0)
+    t55 = (casadi.fabs(t41) < casadi.inf)
+    t56 = (damping >= 0)
+    t57 = (damping > 0)
+    t58 = 1e-12*t17
+    t59 = 1e-12*t9
+    t60 = casadi.logic_or(casadi.logic_and(t57, casadi.logic_or((t14 <= t58), (t28 <= t58))), casadi.logic_and((damping <= 0), casadi.logic_or((t6 <= t59), (t49 <= t59))))
+    t61 = casadi.logic_and(casadi.logic_and(t55, t56), casadi.logic_not(t60))
     q_dot = casadi.SX(2, 1)
-    q_dot[0, 0] = casadi.if_else(t58, casadi.if_else(t54, t34, t51), 0)
-    q_dot[1, 0] = casadi.if_else(t58, casadi.if_else(t54, t35, t50), 0)
+    q_dot[0, 0] = casadi.if_else(t61, casadi.if_else(t57, t34, t54), 0)
+    q_dot[1, 0] = casadi.if_else(t61, casadi.if_else(t57, t35, t53), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t52, t53)), 2, casadi.if_else(t57, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t55, t56)), 2, casadi.if_else(t60, 1, 0))
     return [q_dot, status]
 
 
 def _velocity_ik_nullspace(q, mu_dot, z, damping):
-    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 175 operations."""
+    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 162 operations."""
     q1 = q[0]
     q2 = q[1]
     mu_dot0 = mu_dot[0]
@@ -764,73 +771,76 @@ def _velocity_ik_nullspace(q, mu_dot, z, damping):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = c12*s12 + t0*t1
+    t2 = t0*t1 + c12*s12
     t3 = t1**2
     t4 = s12**2 + t3
     t5 = t0**2
     t6 = casadi.sqrt(t3 + t5)
     t7 = casadi.if_else((t1 <= 0), 1, -1)*t6
-    t8 = casadi.if_else((t6 > 0), 1/(t6*(casadi.fabs(t1) + t6)), 0)
-    t9 = c12**2 + t5
-    t10 = casadi.sqrt(t4 + t9)
-    t11 = t2**2
-    t12 = damping**2
-    t13 = t4 + t12
-    t14 = t13**2
-    t15 = casadi.sqrt(t11 + t14)
-    t16 = t15*casadi.if_else((t13 >= 0), 1, -1)
-    t17 = t13 + t16
-    t18 = casadi.if_else((t15 > 0), 1/(t15*(t15 + casadi.fabs(t13))), 0)
-    t19 = t18*(mu_dot0*t17 - mu_dot1*t2)
-    t20 = mu_dot0 - t17*t19
-    t21 = mu_dot1 + t2*t19
-    t22 = t9 + t12
-    t23 = casadi.sqrt(2*t11 + t14 + t22**2)
-    t24 = -t18*(t2*t17 + t22*t2)
-    t25 = t2 + t17*t24
-    t26 = t22 + t2*t24
-    t27 = casadi.fabs(t26)
-    t28 = t27*casadi.if_else((t26 >= 0), 1, -1)
-    t29 = t26 + t28
-    t30 = casadi.if_else((t27 > 0), 1/(t27*2*t27), 0)
-    t31 = t21 - t21*t29**2*t30
-    t32 = casadi.if_else((t28 != 0), -t31/t28, 0)
-    t33 = casadi.if_else((t16 != 0), -(t20 + t25*t32)/t16, 0)
+    t8 = c12**2 + t5
+    t9 = casadi.sqrt(t4 + t8)
+    t10 = t2**2
+    t11 = damping**2
+    t12 = t4 + t11
+    t13 = t12**2
+    t14 = casadi.sqrt(t10 + t13)
+    t15 = t14*casadi.if_else((t12 >= 0), 1, -1)
+    t16 = t8 + t11
+    t17 = casadi.sqrt(2*t10 + t13 + t16**2)
+    t18 = (t14 > 0)
+    t19 = casadi.if_else(t18, 1/(t12 + t15), 0)
+    t20 = casadi.if_else(t18, 1 + casadi.fabs(t12)/t14, 0)
+    t21 = t2*t19
+    t22 = -t20*(t2 + t16*t21)
+    t23 = t2 + t22
+    t24 = t16 + t21*t22
+    t25 = t20*(mu_dot0 - t21*mu_dot1)
+    t26 = -t25 + mu_dot0
+    t27 = mu_dot1 + t21*t25
+    t28 = casadi.fabs(t24)
+    t29 = t28*casadi.if_else((t24 >= 0), 1, -1)
+    t30 = casadi.if_else((t28 > 0), 2, 0)
+    t31 = t27 - t27*t30
+    t32 = casadi.if_else((t29 != 0), -t31/t29, 0)
+    t33 = casadi.if_else((t15 != 0), -(t26 + t23*t32)/t15, 0)
     t34 = -t1*t33 + t0*t32
     t35 = -s12*t33 + c12*t32
-    t36 = -t1
-    t37 = t36 + t7
-    t38 = t8*(c12*t0 - s12*t37)
-    t39 = s12 + t37*t38
-    t40 = c12 - t0*t38
-    t41 = t8*(mu_dot0*t37 + t0*mu_dot1)
-    t42 = mu_dot0 - t37*t41
-    t43 = mu_dot1 - t0*t41
-    t44 = -s12 + q1 + q2 + c12 + t0 + t36 + mu_dot0 + mu_dot1 + damping + qz1 + qz2
-    t45 = casadi.fabs(t40)
-    t46 = t45*casadi.if_else((t40 >= 0), 1, -1)
-    t47 = t40 + t46
-    t48 = casadi.if_else((t45 > 0), 1/(t45*2*t45), 0)
-    t49 = t43 - t43*t47**2*t48
-    t50 = casadi.if_else((t46 != 0), -t49/t46, 0)
-    t51 = casadi.if_else((t7 != 0), -(t42 + t39*t50)/t7, 0)
-    t52 = (casadi.fabs(t44) < casadi.inf)
-    t53 = (damping >= 0)
-    t54 = (damping > 0)
-    t55 = 1e-12*t23
-    t56 = 1e-12*t10
-    t57 = casadi.logic_or(casadi.logic_and(t54, casadi.logic_or((t15 <= t55), (t27 <= t55))), casadi.logic_and((damping <= 0), casadi.logic_or((t6 <= t56), (t45 <= t56))))
-    t58 = casadi.logic_and(casadi.logic_and(t52, t53), casadi.logic_not(t57))
+    t36 = (t6 > 0)
+    t37 = casadi.if_else(t36, 1 + casadi.fabs(t1)/t6, 0)
+    t38 = -t1
+    t39 = casadi.if_else(t36, 1/(t38 + t7), 0)
+    t40 = -s12
+    t41 = q1 + q2 + c12 + t0 + t38 + t40 + mu_dot0 + mu_dot1 + damping + qz1 + qz2
+    t42 = t0*t39
+    t43 = t37*(t40 + c12*t42)
+    t44 = s12 + t43
+    t45 = c12 - t42*t43
+    t46 = t37*(mu_dot0 + t42*mu_dot1)
+    t47 = -t46 + mu_dot0
+    t48 = mu_dot1 - t42*t46
+    t49 = casadi.fabs(t45)
+    t50 = t49*casadi.if_else((t45 >= 0), 1, -1)
+    t51 = casadi.if_else((t49 > 0), 2, 0)
+    t52 = t48 - t48*t51
+    t53 = casadi.if_else((t50 != 0), -t52/t50, 0)
+    t54 = casadi.if_else((t7 != 0), -(t47 + t44*t53)/t7, 0)
+    t55 = (casadi.fabs(t41) < casadi.inf)
+    t56 = (damping >= 0)
+    t57 = (damping > 0)
+    t58 = 1e-12*t17
+    t59 = 1e-12*t9
+    t60 = casadi.logic_or(casadi.logic_and(t57, casadi.logic_or((t14 <= t58), (t28 <= t58))), casadi.logic_and((damping <= 0), casadi.logic_or((t6 <= t59), (t49 <= t59))))
+    t61 = casadi.logic_and(casadi.logic_and(t55, t56), casadi.logic_not(t60))
     q_dot = casadi.SX(2, 1)
-    q_dot[0, 0] = casadi.if_else(t58, casadi.if_else(t54, t34, t51), 0)
-    q_dot[1, 0] = casadi.if_else(t58, casadi.if_else(t54, t35, t50), 0)
+    q_dot[0, 0] = casadi.if_else(t61, casadi.if_else(t57, t34, t54), 0)
+    q_dot[1, 0] = casadi.if_else(t61, casadi.if_else(t57, t35, t53), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t52, t53)), 2, casadi.if_else(t57, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t55, t56)), 2, casadi.if_else(t60, 1, 0))
     return [q_dot, status]
 
 
 def _resolved_rate(q, target, target_rate, gain, z, damping):
-    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 181 operations."""
+    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 168 operations."""
     q1 = q[0]
     q2 = q[1]
     mu0 = target[0]
@@ -849,75 +859,78 @@ def _resolved_rate(q, target, target_rate, gain, z, damping):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = c12*s12 + t0*t1
+    t2 = t0*t1 + c12*s12
     t3 = mu_dot0 + gain0*(-t0 + mu0)
     t4 = t1**2
     t5 = s12**2 + t4
     t6 = t0**2
     t7 = casadi.sqrt(t4 + t6)
     t8 = casadi.if_else((t1 <= 0), 1, -1)*t7
-    t9 = casadi.if_else((t7 > 0), 1/(t7*(casadi.fabs(t1) + t7)), 0)
-    t10 = c12**2 + t6
-    t11 = casadi.sqrt(t5 + t10)
-    t12 = t2**2
-    t13 = damping**2
-    t14 = t5 + t13
-    t15 = t14**2
-    t16 = casadi.sqrt(t12 + t15)
-    t17 = t16*casadi.if_else((t14 >= 0), 1, -1)
-    t18 = t14 + t17
-    t19 = casadi.if_else((t16 > 0), 1/(t16*(t16 + casadi.fabs(t14))), 0)
-    t20 = t10 + t13
-    t21 = casadi.sqrt(2*t12 + t15 + t20**2)
-    t22 = -t19*(t2*t18 + t20*t2)
-    t23 = t2 + t18*t22
-    t24 = t20 + t2*t22
-    t25 = casadi.fabs(t24)
-    t26 = t25*casadi.if_else((t24 >= 0), 1, -1)
-    t27 = t24 + t26
-    t28 = casadi.if_else((t25 > 0), 1/(t25*2*t25), 0)
-    t29 = -t1
-    t30 = t29 + t8
-    t31 = t9*(c12*t0 - s12*t30)
-    t32 = s12 + t30*t31
-    t33 = c12 - t0*t31
-    t34 = mu_dot1 + gain1*(t29 + mu1)
-    t35 = t19*(t18*t3 - t2*t34)
-    t36 = t3 - t18*t35
-    t37 = t34 + t2*t35
-    t38 = t37 - t27**2*t28*t37
-    t39 = casadi.if_else((t26 != 0), -t38/t26, 0)
-    t40 = casadi.if_else((t17 != 0), -(t36 + t23*t39)/t17, 0)
-    t41 = -t1*t40 + t0*t39
-    t42 = -s12*t40 + c12*t39
-    t43 = t9*(t30*t3 + t0*t34)
-    t44 = t3 - t30*t43
-    t45 = t34 - t0*t43
-    t46 = -s12 + q1 + q2 + c12 + t0 + t29 + damping + qz1 + qz2 + t3 + t34
-    t47 = casadi.fabs(t33)
-    t48 = t47*casadi.if_else((t33 >= 0), 1, -1)
-    t49 = t33 + t48
-    t50 = casadi.if_else((t47 > 0), 1/(t47*2*t47), 0)
-    t51 = t45 - t49**2*t50*t45
-    t52 = casadi.if_else((t48 != 0), -t51/t48, 0)
-    t53 = casadi.if_else((t8 != 0), -(t44 + t32*t52)/t8, 0)
-    t54 = (casadi.fabs(t46) < casadi.inf)
-    t55 = (damping >= 0)
-    t56 = (damping > 0)
-    t57 = 1e-12*t21
-    t58 = 1e-12*t11
-    t59 = casadi.logic_or(casadi.logic_and(t56, casadi.logic_or((t16 <= t57), (t25 <= t57))), casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t58), (t47 <= t58))))
-    t60 = casadi.logic_and(casadi.logic_and(t54, t55), casadi.logic_not(t59))
+    t9 = c12**2 + t6
+    t10 = casadi.sqrt(t5 + t9)
+    t11 = t2**2
+    t12 = damping**2
+    t13 = t5 + t12
+    t14 = t13**2
+    t15 = casadi.sqrt(t11 + t14)
+    t16 = t15*casadi.if_else((t13 >= 0), 1, -1)
+    t17 = t9 + t12
+    t18 = casadi.sqrt(2*t11 + t14 + t17**2)
+    t19 = (t15 > 0)
+    t20 = casadi.if_else(t19, 1/(t13 + t16), 0)
+    t21 = casadi.if_else(t19, 1 + casadi.fabs(t13)/t15, 0)
+    t22 = t2*t20
+    t23 = -t21*(t2 + t17*t22)
+    t24 = t2 + t23
+    t25 = t17 + t22*t23
+    t26 = casadi.fabs(t25)
+    t27 = t26*casadi.if_else((t25 >= 0), 1, -1)
+    t28 = casadi.if_else((t26 > 0), 2, 0)
+    t29 = (t7 > 0)
+    t30 = casadi.if_else(t29, 1 + casadi.fabs(t1)/t7, 0)
+    t31 = -t1
+    t32 = casadi.if_else(t29, 1/(t31 + t8), 0)
+    t33 = mu_dot1 + gain1*(t31 + mu1)
+    t34 = t21*(t3 - t22*t33)
+    t35 = -t34 + t3
+    t36 = t33 + t22*t34
+    t37 = t36 - t28*t36
+    t38 = casadi.if_else((t27 != 0), -t37/t27, 0)
+    t39 = casadi.if_else((t16 != 0), -(t35 + t24*t38)/t16, 0)
+    t40 = -t1*t39 + t0*t38
+    t41 = -s12*t39 + c12*t38
+    t42 = -s12
+    t43 = q1 + q2 + c12 + t0 + t31 + t42 + damping + qz1 + qz2 + t3 + t33
+    t44 = t0*t32
+    t45 = t30*(t42 + c12*t44)
+    t46 = s12 + t45
+    t47 = c12 - t44*t45
+    t48 = t30*(t3 + t44*t33)
+    t49 = -t48 + t3
+    t50 = t33 - t44*t48
+    t51 = casadi.fabs(t47)
+    t52 = t51*casadi.if_else((t47 >= 0), 1, -1)
+    t53 = casadi.if_else((t51 > 0), 2, 0)
+    t54 = t50 - t53*t50
+    t55 = casadi.if_else((t52 != 0), -t54/t52, 0)
+    t56 = casadi.if_else((t8 != 0), -(t49 + t46*t55)/t8, 0)
+    t57 = (casadi.fabs(t43) < casadi.inf)
+    t58 = (damping >= 0)
+    t59 = (damping > 0)
+    t60 = 1e-12*t18
+    t61 = 1e-12*t10
+    t62 = casadi.logic_or(casadi.logic_and(t59, casadi.logic_or((t15 <= t60), (t26 <= t60))), casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t61), (t51 <= t61))))
+    t63 = casadi.logic_and(casadi.logic_and(t57, t58), casadi.logic_not(t62))
     q_dot = casadi.SX(2, 1)
-    q_dot[0, 0] = casadi.if_else(t60, casadi.if_else(t56, t41, t53), 0)
-    q_dot[1, 0] = casadi.if_else(t60, casadi.if_else(t56, t42, t52), 0)
+    q_dot[0, 0] = casadi.if_else(t63, casadi.if_else(t59, t40, t56), 0)
+    q_dot[1, 0] = casadi.if_else(t63, casadi.if_else(t59, t41, t55), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t54, t55)), 2, casadi.if_else(t59, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t57, t58)), 2, casadi.if_else(t62, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 94 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 87 operations."""
     mu0 = target[0]
     mu1 = target[1]
     qs1 = q[0]
@@ -933,7 +946,7 @@ def _ik_numeric_step(target, q, damping):
     t0 = c1 + c12
     t1 = s1 + s12
     t2 = s12**2 + t1**2
-    t3 = c12*s12 + t0*t1
+    t3 = t0*t1 + c12*s12
     t4 = c12**2 + t0**2
     t5 = -t0 + mu0
     t6 = -t1 + mu1
@@ -942,30 +955,31 @@ def _ik_numeric_step(target, q, damping):
     t9 = damping + t2
     t10 = casadi.sqrt(t9**2 + t3**2)
     t11 = t10*casadi.if_else((t9 >= 0), 1, -1)
-    t12 = t9 + t11
-    t13 = casadi.if_else((t10 > 0), 1/(t10*(t10 + casadi.fabs(t9))), 0)
-    t14 = t13*(t5*t12 - t3*t6)
-    t15 = t5 - t12*t14
-    t16 = t6 + t3*t14
-    t17 = damping + t4
-    t18 = -t13*(t3*t12 + t17*t3)
-    t19 = t3 + t12*t18
-    t20 = t17 + t3*t18
-    t21 = casadi.fabs(t20)
-    t22 = t21*casadi.if_else((t20 >= 0), 1, -1)
-    t23 = t20 + t22
-    t24 = casadi.if_else((t21 > 0), 1/(t21*2*t21), 0)
-    t25 = t16 - t16*t23**2*t24
-    t26 = casadi.if_else((t22 != 0), -t25/t22, 0)
-    t27 = casadi.if_else((t11 != 0), -(t15 + t19*t26)/t11, 0)
-    t28 = q1 - t1*t27 + t0*t26
-    t29 = q2 - s12*t27 + c12*t26
+    t12 = (t10 > 0)
+    t13 = casadi.if_else(t12, 1/(t9 + t11), 0)
+    t14 = casadi.if_else(t12, 1 + casadi.fabs(t9)/t10, 0)
+    t15 = damping + t4
+    t16 = t3*t13
+    t17 = -t14*(t3 + t15*t16)
+    t18 = t3 + t17
+    t19 = t15 + t16*t17
+    t20 = t14*(t5 - t16*t6)
+    t21 = -t20 + t5
+    t22 = t6 + t16*t20
+    t23 = casadi.fabs(t19)
+    t24 = t23*casadi.if_else((t19 >= 0), 1, -1)
+    t25 = casadi.if_else((t23 > 0), 2, 0)
+    t26 = t22 - t22*t25
+    t27 = casadi.if_else((t24 != 0), -t26/t24, 0)
+    t28 = casadi.if_else((t11 != 0), -(t21 + t18*t27)/t11, 0)
+    t29 = q1 - t1*t28 + t0*t27
+    t30 = q2 - s12*t28 + c12*t27
     q_start = casadi.SX(2, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
     q_next = casadi.SX(2, 1)
-    q_next[0, 0] = t28
-    q_next[1, 0] = t29
+    q_next[0, 0] = t29
+    q_next[1, 0] = t30
     cost = casadi.SX(1, 1)
     cost[0, 0] = casadi.if_else((casadi.fabs(t8) < casadi.inf), t7, -1)
     return [q_start, q_next, cost]

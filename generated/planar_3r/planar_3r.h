@@ -98,31 +98,31 @@ planar_3r_real planar_3r_manipulability(const planar_3r_real q[PLANAR_3R_DOF]);
 planar_3r_real planar_3r_jacobian_det(const planar_3r_real q[PLANAR_3R_DOF]);
 
 /* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
- * Result: dw[i], i < 3. 207 operations. */
+ * Result: dw[i], i < 3. 197 operations. */
 void planar_3r_manipulability_gradient(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real dw[PLANAR_3R_DOF]);
 
 /* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
- * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 385 operations. */
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 387 operations. */
 void planar_3r_velocity_ellipsoid(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real U_v[9], planar_3r_real s_v[3], planar_3r_real U_w[9], planar_3r_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 990 operations. */
+ * Result: returned as a scalar. 992 operations. */
 planar_3r_real planar_3r_condition_number(const planar_3r_real q[PLANAR_3R_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 3; returned as a scalar. 328 operations. */
+ * Result: q_dot[i], i < 3; returned as a scalar. 315 operations. */
 int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 3; returned as a scalar. 331 operations. */
+ * Result: q_dot[i], i < 3; returned as a scalar. 318 operations. */
 int planar_3r_velocity_ik_nullspace(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], const planar_3r_real z[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 3; returned as a scalar. 347 operations. */
+ * Result: q_dot[i], i < 3; returned as a scalar. 334 operations. */
 int planar_3r_resolved_rate(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real target_rate[PLANAR_3R_TASK_DIM], const planar_3r_real gain[PLANAR_3R_TASK_DIM], const planar_3r_real z[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 3; q_next[i], i < 3; returned as a scalar. 194 operations. */
+ * Result: q_start[i], i < 3; q_next[i], i < 3; returned as a scalar. 185 operations. */
 planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_start[PLANAR_3R_DOF], planar_3r_real q_next[PLANAR_3R_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.

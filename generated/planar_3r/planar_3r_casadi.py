@@ -572,7 +572,7 @@ def _jacobian_det(q):
 
 
 def _manipulability_gradient(q):
-    """D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): 207 operations."""
+    """D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): 197 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -594,75 +594,76 @@ def _manipulability_gradient(q):
     t5 = casadi.sqrt(3 + c123**2 + t0**2 + t2**2 + t4)
     t6 = casadi.sqrt(t4)
     t7 = t6*casadi.if_else((t3 <= 0), 1, -1)
-    t8 = -t3 + t7
-    t9 = casadi.if_else((t6 > 0), 1/(t6*(t6 + casadi.fabs(t3))), 0)
-    t10 = -t9*(-t2*t8 + t0*t1 + c123*s123)
-    t11 = t2 - t8*t10
-    t12 = t0 + t1*t10
-    t13 = c123 + s123*t10
-    t14 = -t9*(t1 + s123 - t8)
-    t15 = 1 - t8*t14
-    t16 = 1 + t1*t14
-    t17 = 1 + s123*t14
-    t18 = 1 - t8**2*t9
-    t19 = casadi.if_else((t7 > 0), -1, 1)
-    t20 = t13**2
-    t21 = casadi.sqrt(t20 + t12**2)
-    t22 = t21*casadi.if_else((t12 >= 0), 1, -1)
-    t23 = t12 + t22
-    t24 = casadi.if_else((t21 > 0), 1/(t21*(t21 + casadi.fabs(t12))), 0)
-    t25 = t24*(t16*t23 + t13*t17)
-    t26 = t16 - t23*t25
-    t27 = t17 - t13*t25
-    t28 = 1 - t23**2*t24
-    t29 = -(t11*t26 + t15*t22)
-    t30 = casadi.if_else((t22 > 0), -t19, t19)
-    t31 = casadi.fabs(t27)
-    t32 = t31*casadi.if_else((t27 >= 0), 1, -1)
-    t33 = t27 + t32
-    t34 = casadi.if_else((t31 > 0), 1/(t31*2*t31), 0)
-    t35 = 1 - t33**2*t34
-    t36 = casadi.if_else((t32 > 0), -t30, t30)
-    t37 = t24*t35
-    t38 = t35 - t20*t37
-    t39 = t13*t23
-    t40 = t24*t39
-    t41 = t9*(-t1*t28 + s123*t40)
-    t42 = t28 + t1*t41
-    t43 = -t40 + s123*t41
-    t44 = t37*t39
-    t45 = t9*(-s123*t38 + t1*t44)
-    t46 = -t44 + t1*t45
-    t47 = t38 + s123*t45
-    t48 = t22*t32
-    t49 = t8*t32*t41
-    t50 = t8*t45
-    t51 = t18*t48 - t11*t49 + t29*t50
-    t52 = t7*t26
-    t53 = t7*t49 + t50*t52
-    t54 = t8*t9*t48
-    t55 = t32*t42
-    t56 = -t46*t29 + t1*t54 + t11*t55
-    t57 = t7*t55 + t46*t52
-    t58 = t32*t43
-    t59 = -t47*t29 + s123*t54 + t11*t58
-    t60 = t7*t58 + t47*t52
-    t61 = 1e-12*t5
-    t62 = casadi.if_else(casadi.logic_or(casadi.logic_or((t6 <= t61), (t21 <= t61)), (t31 <= t61)), 0, t36)
-    t63 = c123*t59 + s123*t60
-    t64 = -t62*(c123*t51 + c123*t56 + s123*t57 + t63 - s123*t53)
-    t65 = t0*t56 + t1*t57 + t63
-    t66 = -t62*(t2*t51 + t65 - t3*t53)
-    t67 = -t62*(t0*t51 + t65 - t1*t53)
+    t8 = casadi.if_else((t7 > 0), -1, 1)
+    t9 = (t6 > 0)
+    t10 = casadi.if_else(t9, 1/(-t3 + t7), 0)
+    t11 = casadi.if_else(t9, 1 + casadi.fabs(t3)/t6, 0)
+    t12 = 1 - t11
+    t13 = t1*t10
+    t14 = s123*t10
+    t15 = -t11*(-t2 + t0*t13 + c123*t14)
+    t16 = -t15 + t2
+    t17 = t0 + t13*t15
+    t18 = c123 + t14*t15
+    t19 = -t11*(-1 + t13 + t14)
+    t20 = 1 - t19
+    t21 = 1 + t13*t19
+    t22 = 1 + t14*t19
+    t23 = t18**2
+    t24 = casadi.sqrt(t17**2 + t23)
+    t25 = t24*casadi.if_else((t17 >= 0), 1, -1)
+    t26 = casadi.if_else((t25 > 0), -t8, t8)
+    t27 = (t24 > 0)
+    t28 = casadi.if_else(t27, 1/(t17 + t25), 0)
+    t29 = casadi.if_else(t27, 1 + casadi.fabs(t17)/t24, 0)
+    t30 = 1 - t29
+    t31 = t18*t28
+    t32 = t29*(t21 + t22*t31)
+    t33 = -t32 + t21
+    t34 = t22 - t32*t31
+    t35 = -(t16*t33 + t20*t25)
+    t36 = casadi.fabs(t34)
+    t37 = casadi.if_else((t34 >= 0), 1, -1)*t36
+    t38 = casadi.if_else((t36 > 0), 2, 0)
+    t39 = 1 - t38
+    t40 = t39 - t28**2*t29*t39*t23
+    t41 = casadi.if_else((t37 > 0), -t26, t26)
+    t42 = t29*t31
+    t43 = t11*(-t13*t30 + t14*t42)
+    t44 = t30 + t13*t43
+    t45 = -t42 + t14*t43
+    t46 = t39*t42
+    t47 = t11*(t13*t46 - t14*t40)
+    t48 = -t46 + t13*t47
+    t49 = t40 + t14*t47
+    t50 = t25*t37
+    t51 = t37*t43
+    t52 = t47*t35 + t12*t50 - t16*t51
+    t53 = t7*t33
+    t54 = t7*t51 + t47*t53
+    t55 = t11*t50
+    t56 = t37*t44
+    t57 = -t48*t35 + t13*t55 + t16*t56
+    t58 = t7*t56 + t48*t53
+    t59 = t37*t45
+    t60 = -t49*t35 + t14*t55 + t16*t59
+    t61 = t7*t59 + t49*t53
+    t62 = 1e-12*t5
+    t63 = casadi.if_else(casadi.logic_or(casadi.logic_or((t6 <= t62), (t24 <= t62)), (t36 <= t62)), 0, t41)
+    t64 = c123*t60 + s123*t61
+    t65 = -t63*(c123*t52 + c123*t57 + s123*t58 + t64 - s123*t54)
+    t66 = t0*t57 + t1*t58 + t64
+    t67 = -t63*(t2*t52 + t66 - t3*t54)
+    t68 = -t63*(t0*t52 + t66 - t1*t54)
     dw = casadi.SX(3, 1)
-    dw[0, 0] = t66
-    dw[1, 0] = t67
-    dw[2, 0] = t64
+    dw[0, 0] = t67
+    dw[1, 0] = t68
+    dw[2, 0] = t65
     return [dw]
 
 
 def _velocity_ellipsoid(q):
-    """Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: 385 operations."""
+    """Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: 387 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -682,168 +683,171 @@ def _velocity_ellipsoid(q):
     t3 = s1 + t1
     t4 = casadi.sqrt(s123**2 + t1**2 + t3**2)
     t5 = t4*casadi.if_else((t3 <= 0), 1, -1)
-    t6 = -t3 + t5
-    t7 = casadi.if_else((t4 > 0), 1/(t4*(t4 + casadi.fabs(t3))), 0)
-    t8 = -t7*(-t2*t6 + t0*t1 + c123*s123)
-    t9 = t2 - t6*t8
-    t10 = t0 + t1*t8
-    t11 = c123 + s123*t8
-    t12 = casadi.sqrt(t10**2 + t11**2)
-    t13 = t12*casadi.if_else((t10 >= 0), 1, -1)
-    t14 = t5**2
-    t15 = t13**2
-    t16 = t15 + t9**2
-    t17 = t5*t9
-    t18 = (t17 != 0)
-    t19 = (-t14 + t16)/casadi.if_else(t18, -2*t17, 1)
-    t20 = casadi.fabs(t19)
-    t21 = (t20 >= 1)
-    t22 = 1/casadi.fabs(casadi.if_else(t21, t19, 1))
-    t23 = casadi.if_else(t18, casadi.if_else((t19 >= 0), 1, -1)*casadi.if_else(t21, t22/(1 + casadi.sqrt(1 + t22**2)), 1/(t20 + casadi.sqrt(1 + t20**2))), 0)
-    t24 = 1/casadi.sqrt(1 + t23**2)
-    t25 = t17*t23
-    t26 = t25 + t14
-    t27 = -t25 + t16
-    t28 = t5*t24
-    t29 = t9*t24
-    t30 = t28 + t29*t23
-    t31 = t29 - t28*t23
-    t32 = t30*t31 + t15*t23*t24**2
-    t33 = (t32 != 0)
-    t34 = (-t26 + t27)/casadi.if_else(t33, -2*t32, 1)
-    t35 = casadi.fabs(t34)
-    t36 = (t35 >= 1)
-    t37 = 1/casadi.fabs(casadi.if_else(t36, t34, 1))
-    t38 = casadi.if_else(t33, casadi.if_else((t34 >= 0), 1, -1)*casadi.if_else(t36, t37/(1 + casadi.sqrt(1 + t37**2)), 1/(t35 + casadi.sqrt(1 + t35**2))), 0)
-    t39 = 1/casadi.sqrt(1 + t38**2)
-    t40 = t32*t38
-    t41 = t40 + t26
-    t42 = -t40 + t27
-    t43 = t30*t39
-    t44 = t31*t39
-    t45 = t43 + t44*t38
-    t46 = t44 - t43*t38
-    t47 = t24*t39
-    t48 = t13*t47
-    t49 = t48*t23
-    t50 = t49 + t48*t38
-    t51 = -t48 + t49*t38
-    t52 = -t45*t46 + t50*t51
-    t53 = t47*t23
-    t54 = t47 - t38*t53
-    t55 = t53 + t47*t38
-    t56 = (t52 != 0)
-    t57 = (-t41 + t42)/casadi.if_else(t56, 2*t52, 1)
-    t58 = casadi.fabs(t57)
-    t59 = (t58 >= 1)
-    t60 = 1/casadi.fabs(casadi.if_else(t59, t57, 1))
-    t61 = casadi.if_else(t56, casadi.if_else((t57 >= 0), 1, -1)*casadi.if_else(t59, t60/(1 + casadi.sqrt(1 + t60**2)), 1/(t58 + casadi.sqrt(1 + t58**2))), 0)
-    t62 = 1/casadi.sqrt(1 + t61**2)
-    t63 = t52*t61
-    t64 = -t63 + t41
-    t65 = t42 + t63
-    t66 = t45*t62
-    t67 = t46*t62
-    t68 = t66 + t61*t67
-    t69 = t67 - t61*t66
-    t70 = t50*t62
-    t71 = t51*t62
-    t72 = t70 - t61*t71
-    t73 = t71 + t61*t70
-    t74 = -t68*t69 + t72*t73
-    t75 = t54*t62
-    t76 = t55*t62
-    t77 = t75 - t61*t76
-    t78 = t76 + t61*t75
-    t79 = (t74 != 0)
-    t80 = (-t64 + t65)/casadi.if_else(t79, 2*t74, 1)
-    t81 = casadi.fabs(t80)
-    t82 = (t81 >= 1)
-    t83 = 1/casadi.fabs(casadi.if_else(t82, t80, 1))
-    t84 = casadi.if_else(t79, casadi.if_else((t80 >= 0), 1, -1)*casadi.if_else(t82, t83/(1 + casadi.sqrt(1 + t83**2)), 1/(t81 + casadi.sqrt(1 + t81**2))), 0)
-    t85 = 1/casadi.sqrt(1 + t84**2)
-    t86 = t74*t84
-    t87 = -t86 + t64
-    t88 = t65 + t86
-    t89 = t68*t85
-    t90 = t69*t85
-    t91 = t89 + t84*t90
-    t92 = t90 - t84*t89
-    t93 = t72*t85
-    t94 = t73*t85
-    t95 = t93 - t84*t94
-    t96 = t94 + t84*t93
-    t97 = -t91*t92 + t95*t96
-    t98 = t77*t85
-    t99 = t78*t85
-    t100 = t98 - t84*t99
-    t101 = t99 + t84*t98
-    t102 = (t97 != 0)
-    t103 = (-t87 + t88)/casadi.if_else(t102, 2*t97, 1)
-    t104 = casadi.fabs(t103)
-    t105 = (t104 >= 1)
-    t106 = 1/casadi.fabs(casadi.if_else(t105, t103, 1))
-    t107 = casadi.if_else(t102, casadi.if_else((t103 >= 0), 1, -1)*casadi.if_else(t105, t106/(1 + casadi.sqrt(1 + t106**2)), 1/(t104 + casadi.sqrt(1 + t104**2))), 0)
-    t108 = 1/casadi.sqrt(1 + t107**2)
-    t109 = t91*t108
-    t110 = t92*t108
-    t111 = t109 + t107*t110
-    t112 = t110 - t107*t109
-    t113 = t95*t108
-    t114 = t96*t108
-    t115 = t113 - t107*t114
-    t116 = t114 + t107*t113
-    t117 = casadi.sqrt(t111**2 + t115**2)
-    t118 = casadi.sqrt(t112**2 + t116**2)
-    t119 = t100*t108
-    t120 = t101*t108
-    t121 = t119 - t107*t120
-    t122 = t120 + t107*t119
-    t123 = (t117 < t118)
-    t124 = casadi.if_else(t123, t118, t117)
-    t125 = casadi.if_else(t123, t117, t118)
-    t126 = casadi.if_else(t123, t122, t121)
-    t127 = casadi.if_else(t123, t121, t122)
-    t128 = -t122
-    t129 = casadi.if_else(t123, t121, t128)
-    t130 = casadi.if_else(t123, t128, t121)
-    t131 = (t125 < 0)
-    t132 = casadi.if_else(t131, 0, t125)
-    t133 = casadi.if_else(t131, t125, 0)
-    t134 = casadi.if_else(t131, 0, t127)
-    t135 = casadi.if_else(t131, 0, t130)
-    t136 = casadi.if_else(t131, 1, 0)
-    t137 = casadi.if_else(t131, t127, 0)
-    t138 = casadi.if_else(t131, t130, 0)
-    t139 = casadi.if_else(t131, 0, 1)
-    t140 = (t124 < t132)
-    t141 = casadi.if_else(t140, t132, t124)
-    t142 = casadi.if_else(t140, t124, t132)
-    t143 = casadi.if_else(t140, t134, t126)
-    t144 = casadi.if_else(t140, t135, t129)
-    t145 = casadi.if_else(t140, t136, 0)
-    t146 = casadi.if_else(t140, t126, t134)
-    t147 = casadi.if_else(t140, t129, t135)
-    t148 = casadi.if_else(t140, 0, t136)
-    t149 = t143*(t139*t147 - t138*t148) - t144*(t139*t146 - t137*t148) + t145*(t138*t146 - t137*t147)
-    t150 = casadi.if_else((t149 < 0), -1, 1)
-    t151 = t137*t150
-    t152 = t138*t150
-    t153 = t139*t150
+    t6 = t5**2
+    t7 = (t4 > 0)
+    t8 = casadi.if_else(t7, 1/(-t3 + t5), 0)
+    t9 = casadi.if_else(t7, 1 + casadi.fabs(t3)/t4, 0)
+    t10 = t1*t8
+    t11 = s123*t8
+    t12 = -t9*(-t2 + t0*t10 + c123*t11)
+    t13 = -t12 + t2
+    t14 = t0 + t10*t12
+    t15 = c123 + t11*t12
+    t16 = casadi.sqrt(t14**2 + t15**2)
+    t17 = t16*casadi.if_else((t14 >= 0), 1, -1)
+    t18 = t17**2
+    t19 = t18 + t13**2
+    t20 = t5*t13
+    t21 = (t20 != 0)
+    t22 = (-t6 + t19)/casadi.if_else(t21, -2*t20, 1)
+    t23 = casadi.fabs(t22)
+    t24 = (t23 >= 1)
+    t25 = 1/casadi.fabs(casadi.if_else(t24, t22, 1))
+    t26 = casadi.if_else(t21, casadi.if_else((t22 >= 0), 1, -1)*casadi.if_else(t24, t25/(1 + casadi.sqrt(1 + t25**2)), 1/(t23 + casadi.sqrt(1 + t23**2))), 0)
+    t27 = 1/casadi.sqrt(1 + t26**2)
+    t28 = t20*t26
+    t29 = t28 + t6
+    t30 = -t28 + t19
+    t31 = t5*t27
+    t32 = t13*t27
+    t33 = t31 + t32*t26
+    t34 = t32 - t31*t26
+    t35 = t33*t34 + t18*t26*t27**2
+    t36 = (t35 != 0)
+    t37 = (-t29 + t30)/casadi.if_else(t36, -2*t35, 1)
+    t38 = casadi.fabs(t37)
+    t39 = (t38 >= 1)
+    t40 = 1/casadi.fabs(casadi.if_else(t39, t37, 1))
+    t41 = casadi.if_else(t36, casadi.if_else((t37 >= 0), 1, -1)*casadi.if_else(t39, t40/(1 + casadi.sqrt(1 + t40**2)), 1/(t38 + casadi.sqrt(1 + t38**2))), 0)
+    t42 = 1/casadi.sqrt(1 + t41**2)
+    t43 = t35*t41
+    t44 = t43 + t29
+    t45 = -t43 + t30
+    t46 = t33*t42
+    t47 = t34*t42
+    t48 = t46 + t47*t41
+    t49 = t47 - t46*t41
+    t50 = t27*t42
+    t51 = t17*t50
+    t52 = t51*t26
+    t53 = t52 + t51*t41
+    t54 = -t51 + t41*t52
+    t55 = -t48*t49 + t53*t54
+    t56 = t50*t26
+    t57 = t50 - t41*t56
+    t58 = t56 + t50*t41
+    t59 = (t55 != 0)
+    t60 = (-t44 + t45)/casadi.if_else(t59, 2*t55, 1)
+    t61 = casadi.fabs(t60)
+    t62 = (t61 >= 1)
+    t63 = 1/casadi.fabs(casadi.if_else(t62, t60, 1))
+    t64 = casadi.if_else(t59, casadi.if_else((t60 >= 0), 1, -1)*casadi.if_else(t62, t63/(1 + casadi.sqrt(1 + t63**2)), 1/(t61 + casadi.sqrt(1 + t61**2))), 0)
+    t65 = 1/casadi.sqrt(1 + t64**2)
+    t66 = t55*t64
+    t67 = -t66 + t44
+    t68 = t45 + t66
+    t69 = t48*t65
+    t70 = t49*t65
+    t71 = t69 + t64*t70
+    t72 = t70 - t64*t69
+    t73 = t53*t65
+    t74 = t54*t65
+    t75 = t73 - t64*t74
+    t76 = t74 + t64*t73
+    t77 = -t71*t72 + t75*t76
+    t78 = t57*t65
+    t79 = t58*t65
+    t80 = t78 - t64*t79
+    t81 = t79 + t64*t78
+    t82 = (t77 != 0)
+    t83 = (-t67 + t68)/casadi.if_else(t82, 2*t77, 1)
+    t84 = casadi.fabs(t83)
+    t85 = (t84 >= 1)
+    t86 = 1/casadi.fabs(casadi.if_else(t85, t83, 1))
+    t87 = casadi.if_else(t82, casadi.if_else((t83 >= 0), 1, -1)*casadi.if_else(t85, t86/(1 + casadi.sqrt(1 + t86**2)), 1/(t84 + casadi.sqrt(1 + t84**2))), 0)
+    t88 = 1/casadi.sqrt(1 + t87**2)
+    t89 = t77*t87
+    t90 = -t89 + t67
+    t91 = t68 + t89
+    t92 = t71*t88
+    t93 = t72*t88
+    t94 = t92 + t87*t93
+    t95 = t93 - t87*t92
+    t96 = t75*t88
+    t97 = t76*t88
+    t98 = t96 - t87*t97
+    t99 = t97 + t87*t96
+    t100 = -t94*t95 + t98*t99
+    t101 = t80*t88
+    t102 = t81*t88
+    t103 = t101 - t87*t102
+    t104 = t102 + t87*t101
+    t105 = (t100 != 0)
+    t106 = (-t90 + t91)/casadi.if_else(t105, 2*t100, 1)
+    t107 = casadi.fabs(t106)
+    t108 = (t107 >= 1)
+    t109 = 1/casadi.fabs(casadi.if_else(t108, t106, 1))
+    t110 = casadi.if_else(t105, casadi.if_else((t106 >= 0), 1, -1)*casadi.if_else(t108, t109/(1 + casadi.sqrt(1 + t109**2)), 1/(t107 + casadi.sqrt(1 + t107**2))), 0)
+    t111 = 1/casadi.sqrt(1 + t110**2)
+    t112 = t94*t111
+    t113 = t95*t111
+    t114 = t112 + t110*t113
+    t115 = t113 - t110*t112
+    t116 = t98*t111
+    t117 = t99*t111
+    t118 = t116 - t110*t117
+    t119 = t117 + t110*t116
+    t120 = casadi.sqrt(t114**2 + t118**2)
+    t121 = casadi.sqrt(t115**2 + t119**2)
+    t122 = t103*t111
+    t123 = t104*t111
+    t124 = t122 - t110*t123
+    t125 = t123 + t110*t122
+    t126 = (t120 < t121)
+    t127 = casadi.if_else(t126, t121, t120)
+    t128 = casadi.if_else(t126, t120, t121)
+    t129 = casadi.if_else(t126, t125, t124)
+    t130 = casadi.if_else(t126, t124, t125)
+    t131 = -t125
+    t132 = casadi.if_else(t126, t124, t131)
+    t133 = casadi.if_else(t126, t131, t124)
+    t134 = (t128 < 0)
+    t135 = casadi.if_else(t134, 0, t128)
+    t136 = casadi.if_else(t134, t128, 0)
+    t137 = casadi.if_else(t134, 0, t130)
+    t138 = casadi.if_else(t134, 0, t133)
+    t139 = casadi.if_else(t134, 1, 0)
+    t140 = casadi.if_else(t134, t130, 0)
+    t141 = casadi.if_else(t134, t133, 0)
+    t142 = casadi.if_else(t134, 0, 1)
+    t143 = (t127 < t135)
+    t144 = casadi.if_else(t143, t135, t127)
+    t145 = casadi.if_else(t143, t127, t135)
+    t146 = casadi.if_else(t143, t137, t129)
+    t147 = casadi.if_else(t143, t138, t132)
+    t148 = casadi.if_else(t143, t139, 0)
+    t149 = casadi.if_else(t143, t129, t137)
+    t150 = casadi.if_else(t143, t132, t138)
+    t151 = casadi.if_else(t143, 0, t139)
+    t152 = t146*(t142*t150 - t141*t151) - t147*(t142*t149 - t140*t151) + t148*(t141*t149 - t140*t150)
+    t153 = casadi.if_else((t152 < 0), -1, 1)
+    t154 = t140*t153
+    t155 = t141*t153
+    t156 = t142*t153
     U_v = casadi.SX(3, 3)
-    U_v[0, 0] = t143
-    U_v[0, 1] = t146
-    U_v[0, 2] = t151
-    U_v[1, 0] = t144
-    U_v[1, 1] = t147
-    U_v[1, 2] = t152
-    U_v[2, 0] = t145
-    U_v[2, 1] = t148
-    U_v[2, 2] = t153
+    U_v[0, 0] = t146
+    U_v[0, 1] = t149
+    U_v[0, 2] = t154
+    U_v[1, 0] = t147
+    U_v[1, 1] = t150
+    U_v[1, 2] = t155
+    U_v[2, 0] = t148
+    U_v[2, 1] = t151
+    U_v[2, 2] = t156
     s_v = casadi.SX(3, 1)
-    s_v[0, 0] = t141
-    s_v[1, 0] = t142
-    s_v[2, 0] = t133
+    s_v[0, 0] = t144
+    s_v[1, 0] = t145
+    s_v[2, 0] = t136
     U_w = casadi.SX(3, 3)
     U_w[0, 1] = 1
     U_w[1, 2] = 1
@@ -854,7 +858,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 990 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 992 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -874,383 +878,388 @@ def _condition_number(q):
     t3 = s1 + t1
     t4 = casadi.sqrt(4.6616714347772055*t3**2 + 4.6616714347772055*t1**2 + 4.6616714347772055*s123**2)
     t5 = 2.159090418388541*t3
-    t6 = casadi.if_else((t4 > 0), 1/(t4*(t4 + casadi.fabs(t5))), 0)
-    t7 = -t5
-    t8 = t4*casadi.if_else((t7 >= 0), 1, -1)
-    t9 = t7 + t8
-    t10 = -t6*(-2.159090418388541*t2*t9 + 4.6616714347772055*t0*t1 + 4.6616714347772055*c123*s123)
-    t11 = 2.159090418388541*t2 - t9*t10
-    t12 = 2.159090418388541*t1
-    t13 = 2.159090418388541*t0 + t12*t10
-    t14 = 2.159090418388541*s123
-    t15 = 2.159090418388541*c123 + t14*t10
-    t16 = -t6*(-t9 + t12 + t14)
-    t17 = 1 - t9*t16
-    t18 = 1 + t12*t16
-    t19 = 1 + t14*t16
-    t20 = casadi.sqrt(t13**2 + t15**2)
-    t21 = t20*casadi.if_else((t13 >= 0), 1, -1)
-    t22 = t13 + t21
-    t23 = casadi.if_else((t20 > 0), 1/(t20*(t20 + casadi.fabs(t13))), 0)
-    t24 = t23*(t18*t22 + t15*t19)
-    t25 = t18 - t22*t24
-    t26 = t19 - t15*t24
-    t27 = casadi.fabs(t26)
-    t28 = t27*casadi.if_else((t26 >= 0), 1, -1)
-    t29 = t21**2 + t25**2
-    t30 = t28**2
-    t31 = -t11*t21 + t17*t25
-    t32 = t8**2
-    t33 = t32 + t11**2 + t17**2
-    t34 = (t31 != 0)
-    t35 = (-t33 + t29)/casadi.if_else(t34, 2*t31, 1)
-    t36 = casadi.fabs(t35)
-    t37 = (t36 >= 1)
-    t38 = 1/casadi.fabs(casadi.if_else(t37, t35, 1))
-    t39 = casadi.if_else(t34, casadi.if_else((t35 >= 0), 1, -1)*casadi.if_else(t37, t38/(1 + casadi.sqrt(1 + t38**2)), 1/(t36 + casadi.sqrt(1 + t36**2))), 0)
-    t40 = 1/casadi.sqrt(1 + t39**2)
-    t41 = t31*t39
-    t42 = -t41 + t33
-    t43 = t41 + t29
-    t44 = t11*t40
-    t45 = t21*t40
-    t46 = t44 + t45*t39
-    t47 = -t45 + t44*t39
-    t48 = t17*t40
-    t49 = t25*t40
-    t50 = t48 - t49*t39
-    t51 = t49 + t48*t39
-    t52 = t28*t50
-    t53 = (t52 != 0)
-    t54 = (-t42 + t30)/casadi.if_else(t53, -2*t52, 1)
-    t55 = casadi.fabs(t54)
-    t56 = (t55 >= 1)
-    t57 = 1/casadi.fabs(casadi.if_else(t56, t54, 1))
-    t58 = casadi.if_else(t53, casadi.if_else((t54 >= 0), 1, -1)*casadi.if_else(t56, t57/(1 + casadi.sqrt(1 + t57**2)), 1/(t55 + casadi.sqrt(1 + t55**2))), 0)
-    t59 = 1/casadi.sqrt(1 + t58**2)
-    t60 = t52*t58
-    t61 = t60 + t42
-    t62 = -t60 + t30
-    t63 = t50*t59
-    t64 = t28*t59
-    t65 = t63 + t64*t58
-    t66 = -t64 + t63*t58
-    t67 = t58*t59
-    t68 = t46*t59
-    t69 = t68*t58
-    t70 = t51*t66 + t32*t67*t39*t40**2 + t69*t47
-    t71 = (t70 != 0)
-    t72 = (-t43 + t62)/casadi.if_else(t71, 2*t70, 1)
-    t73 = casadi.fabs(t72)
-    t74 = (t73 >= 1)
-    t75 = 1/casadi.fabs(casadi.if_else(t74, t72, 1))
-    t76 = casadi.if_else(t71, casadi.if_else((t72 >= 0), 1, -1)*casadi.if_else(t74, t75/(1 + casadi.sqrt(1 + t75**2)), 1/(t73 + casadi.sqrt(1 + t73**2))), 0)
-    t77 = 1/casadi.sqrt(1 + t76**2)
-    t78 = t70*t76
-    t79 = -t78 + t43
-    t80 = t78 + t62
-    t81 = t8*t40
-    t82 = t81*t77
-    t83 = t82*t39
-    t84 = t67*t82
-    t85 = -t83 + t84*t76
-    t86 = t84 + t83*t76
-    t87 = t47*t77
-    t88 = t69*t77
-    t89 = t87 - t88*t76
-    t90 = t88 + t87*t76
-    t91 = t51*t77
-    t92 = t66*t77
-    t93 = t91 - t92*t76
-    t94 = t92 + t91*t76
-    t95 = t81*t59
-    t96 = t65*t93 - t95*t85 + t68*t89
-    t97 = (t96 != 0)
-    t98 = (-t61 + t79)/casadi.if_else(t97, 2*t96, 1)
-    t99 = casadi.fabs(t98)
-    t100 = (t99 >= 1)
-    t101 = 1/casadi.fabs(casadi.if_else(t100, t98, 1))
-    t102 = casadi.if_else(t97, casadi.if_else((t98 >= 0), 1, -1)*casadi.if_else(t100, t101/(1 + casadi.sqrt(1 + t101**2)), 1/(t99 + casadi.sqrt(1 + t99**2))), 0)
-    t103 = 1/casadi.sqrt(1 + t102**2)
-    t104 = t96*t102
-    t105 = -t104 + t61
-    t106 = t104 + t79
-    t107 = t95*t103
-    t108 = t85*t103
-    t109 = t107 + t108*t102
-    t110 = t108 - t107*t102
-    t111 = t68*t103
-    t112 = t89*t103
-    t113 = t111 - t112*t102
-    t114 = t112 + t111*t102
-    t115 = t65*t103
-    t116 = t93*t103
-    t117 = t115 - t116*t102
-    t118 = t116 + t115*t102
-    t119 = t86*t109 + t90*t113 + t94*t117
-    t120 = (t119 != 0)
-    t121 = (-t105 + t80)/casadi.if_else(t120, 2*t119, 1)
-    t122 = casadi.fabs(t121)
-    t123 = (t122 >= 1)
-    t124 = 1/casadi.fabs(casadi.if_else(t123, t121, 1))
-    t125 = casadi.if_else(t120, casadi.if_else((t121 >= 0), 1, -1)*casadi.if_else(t123, t124/(1 + casadi.sqrt(1 + t124**2)), 1/(t122 + casadi.sqrt(1 + t122**2))), 0)
-    t126 = 1/casadi.sqrt(1 + t125**2)
-    t127 = t119*t125
-    t128 = -t127 + t105
-    t129 = t127 + t80
-    t130 = t109*t126
-    t131 = t86*t126
-    t132 = -t130 + t131*t125
-    t133 = t131 + t130*t125
-    t134 = t113*t126
-    t135 = t90*t126
-    t136 = t134 - t125*t135
-    t137 = t135 + t125*t134
-    t138 = t117*t126
-    t139 = t94*t126
-    t140 = t138 - t125*t139
-    t141 = t139 + t125*t138
-    t142 = -t110*t133 + t114*t137 + t118*t141
-    t143 = (t142 != 0)
-    t144 = (-t106 + t129)/casadi.if_else(t143, 2*t142, 1)
-    t145 = casadi.fabs(t144)
-    t146 = (t145 >= 1)
-    t147 = 1/casadi.fabs(casadi.if_else(t146, t144, 1))
-    t148 = casadi.if_else(t143, casadi.if_else((t144 >= 0), 1, -1)*casadi.if_else(t146, t147/(1 + casadi.sqrt(1 + t147**2)), 1/(t145 + casadi.sqrt(1 + t145**2))), 0)
-    t149 = 1/casadi.sqrt(1 + t148**2)
-    t150 = t142*t148
-    t151 = -t150 + t106
-    t152 = t129 + t150
-    t153 = t110*t149
-    t154 = t133*t149
-    t155 = t153 + t148*t154
-    t156 = -t154 + t148*t153
-    t157 = t114*t149
-    t158 = t137*t149
-    t159 = t157 - t148*t158
-    t160 = t158 + t148*t157
-    t161 = t118*t149
-    t162 = t141*t149
-    t163 = t161 - t148*t162
-    t164 = t162 + t148*t161
-    t165 = t132*t155 + t136*t159 + t140*t163
-    t166 = (t165 != 0)
-    t167 = (-t128 + t151)/casadi.if_else(t166, 2*t165, 1)
-    t168 = casadi.fabs(t167)
-    t169 = (t168 >= 1)
-    t170 = 1/casadi.fabs(casadi.if_else(t169, t167, 1))
-    t171 = casadi.if_else(t166, casadi.if_else((t167 >= 0), 1, -1)*casadi.if_else(t169, t170/(1 + casadi.sqrt(1 + t170**2)), 1/(t168 + casadi.sqrt(1 + t168**2))), 0)
-    t172 = 1/casadi.sqrt(1 + t171**2)
-    t173 = t165*t171
-    t174 = -t173 + t128
-    t175 = t151 + t173
-    t176 = t132*t172
-    t177 = t155*t172
-    t178 = t176 - t171*t177
-    t179 = t177 + t171*t176
-    t180 = t136*t172
-    t181 = t159*t172
-    t182 = t180 - t171*t181
-    t183 = t181 + t171*t180
-    t184 = t140*t172
-    t185 = t163*t172
-    t186 = t184 - t171*t185
-    t187 = t185 + t171*t184
-    t188 = t156*t178 + t160*t182 + t164*t186
-    t189 = (t188 != 0)
-    t190 = (-t174 + t152)/casadi.if_else(t189, 2*t188, 1)
-    t191 = casadi.fabs(t190)
-    t192 = (t191 >= 1)
-    t193 = 1/casadi.fabs(casadi.if_else(t192, t190, 1))
-    t194 = casadi.if_else(t189, casadi.if_else((t190 >= 0), 1, -1)*casadi.if_else(t192, t193/(1 + casadi.sqrt(1 + t193**2)), 1/(t191 + casadi.sqrt(1 + t191**2))), 0)
-    t195 = 1/casadi.sqrt(1 + t194**2)
-    t196 = t188*t194
-    t197 = -t196 + t174
-    t198 = t152 + t196
-    t199 = t178*t195
-    t200 = t156*t195
-    t201 = t199 - t194*t200
-    t202 = t200 + t194*t199
-    t203 = t182*t195
-    t204 = t160*t195
-    t205 = t203 - t194*t204
-    t206 = t204 + t194*t203
-    t207 = t186*t195
-    t208 = t164*t195
-    t209 = t207 - t194*t208
-    t210 = t208 + t194*t207
-    t211 = t179*t202 + t183*t206 + t187*t210
-    t212 = (t211 != 0)
-    t213 = (-t175 + t198)/casadi.if_else(t212, 2*t211, 1)
-    t214 = casadi.fabs(t213)
-    t215 = (t214 >= 1)
-    t216 = 1/casadi.fabs(casadi.if_else(t215, t213, 1))
-    t217 = casadi.if_else(t212, casadi.if_else((t213 >= 0), 1, -1)*casadi.if_else(t215, t216/(1 + casadi.sqrt(1 + t216**2)), 1/(t214 + casadi.sqrt(1 + t214**2))), 0)
-    t218 = 1/casadi.sqrt(1 + t217**2)
-    t219 = t211*t217
-    t220 = -t219 + t175
-    t221 = t198 + t219
-    t222 = t179*t218
-    t223 = t202*t218
-    t224 = t222 - t217*t223
-    t225 = t223 + t217*t222
-    t226 = t183*t218
-    t227 = t206*t218
-    t228 = t226 - t217*t227
-    t229 = t227 + t217*t226
-    t230 = t187*t218
-    t231 = t210*t218
-    t232 = t230 - t217*t231
-    t233 = t231 + t217*t230
-    t234 = t201*t224 + t205*t228 + t209*t232
-    t235 = (t234 != 0)
-    t236 = (-t197 + t220)/casadi.if_else(t235, 2*t234, 1)
-    t237 = casadi.fabs(t236)
-    t238 = (t237 >= 1)
-    t239 = 1/casadi.fabs(casadi.if_else(t238, t236, 1))
-    t240 = casadi.if_else(t235, casadi.if_else((t236 >= 0), 1, -1)*casadi.if_else(t238, t239/(1 + casadi.sqrt(1 + t239**2)), 1/(t237 + casadi.sqrt(1 + t237**2))), 0)
-    t241 = 1/casadi.sqrt(1 + t240**2)
-    t242 = t234*t240
-    t243 = -t242 + t197
-    t244 = t220 + t242
-    t245 = t201*t241
-    t246 = t224*t241
-    t247 = t245 - t240*t246
-    t248 = t246 + t240*t245
-    t249 = t205*t241
-    t250 = t228*t241
-    t251 = t249 - t240*t250
-    t252 = t250 + t240*t249
-    t253 = t209*t241
-    t254 = t232*t241
-    t255 = t253 - t240*t254
-    t256 = t254 + t240*t253
-    t257 = t225*t247 + t229*t251 + t233*t255
-    t258 = (t257 != 0)
-    t259 = (-t243 + t221)/casadi.if_else(t258, 2*t257, 1)
-    t260 = casadi.fabs(t259)
-    t261 = (t260 >= 1)
-    t262 = 1/casadi.fabs(casadi.if_else(t261, t259, 1))
-    t263 = casadi.if_else(t258, casadi.if_else((t259 >= 0), 1, -1)*casadi.if_else(t261, t262/(1 + casadi.sqrt(1 + t262**2)), 1/(t260 + casadi.sqrt(1 + t260**2))), 0)
-    t264 = 1/casadi.sqrt(1 + t263**2)
-    t265 = t257*t263
-    t266 = -t265 + t243
-    t267 = t221 + t265
-    t268 = t247*t264
-    t269 = t225*t264
-    t270 = t268 - t263*t269
-    t271 = t269 + t263*t268
-    t272 = t251*t264
-    t273 = t229*t264
-    t274 = t272 - t263*t273
-    t275 = t273 + t263*t272
-    t276 = t255*t264
-    t277 = t233*t264
-    t278 = t276 - t263*t277
-    t279 = t277 + t263*t276
-    t280 = t248*t271 + t252*t275 + t256*t279
-    t281 = (t280 != 0)
-    t282 = (-t244 + t267)/casadi.if_else(t281, 2*t280, 1)
-    t283 = casadi.fabs(t282)
-    t284 = (t283 >= 1)
-    t285 = 1/casadi.fabs(casadi.if_else(t284, t282, 1))
-    t286 = casadi.if_else(t281, casadi.if_else((t282 >= 0), 1, -1)*casadi.if_else(t284, t285/(1 + casadi.sqrt(1 + t285**2)), 1/(t283 + casadi.sqrt(1 + t283**2))), 0)
-    t287 = 1/casadi.sqrt(1 + t286**2)
-    t288 = t280*t286
-    t289 = -t288 + t244
-    t290 = t267 + t288
-    t291 = t248*t287
-    t292 = t271*t287
-    t293 = t291 - t286*t292
-    t294 = t292 + t286*t291
-    t295 = t252*t287
-    t296 = t275*t287
-    t297 = t295 - t286*t296
-    t298 = t296 + t286*t295
-    t299 = t256*t287
-    t300 = t279*t287
-    t301 = t299 - t286*t300
-    t302 = t300 + t286*t299
-    t303 = t270*t293 + t274*t297 + t278*t301
-    t304 = (t303 != 0)
-    t305 = (-t266 + t289)/casadi.if_else(t304, 2*t303, 1)
-    t306 = casadi.fabs(t305)
-    t307 = (t306 >= 1)
-    t308 = 1/casadi.fabs(casadi.if_else(t307, t305, 1))
-    t309 = casadi.if_else(t304, casadi.if_else((t305 >= 0), 1, -1)*casadi.if_else(t307, t308/(1 + casadi.sqrt(1 + t308**2)), 1/(t306 + casadi.sqrt(1 + t306**2))), 0)
-    t310 = 1/casadi.sqrt(1 + t309**2)
-    t311 = t303*t309
-    t312 = -t311 + t266
-    t313 = t289 + t311
-    t314 = t270*t310
-    t315 = t293*t310
-    t316 = t314 - t309*t315
-    t317 = t315 + t309*t314
-    t318 = t274*t310
-    t319 = t297*t310
-    t320 = t318 - t309*t319
-    t321 = t319 + t309*t318
-    t322 = t278*t310
-    t323 = t301*t310
-    t324 = t322 - t309*t323
-    t325 = t323 + t309*t322
-    t326 = t294*t316 + t298*t320 + t302*t324
-    t327 = (t326 != 0)
-    t328 = (-t312 + t290)/casadi.if_else(t327, 2*t326, 1)
-    t329 = casadi.fabs(t328)
-    t330 = (t329 >= 1)
-    t331 = 1/casadi.fabs(casadi.if_else(t330, t328, 1))
-    t332 = casadi.if_else(t327, casadi.if_else((t328 >= 0), 1, -1)*casadi.if_else(t330, t331/(1 + casadi.sqrt(1 + t331**2)), 1/(t329 + casadi.sqrt(1 + t329**2))), 0)
-    t333 = 1/casadi.sqrt(1 + t332**2)
-    t334 = t290 + t326*t332
-    t335 = t316*t333
-    t336 = t294*t333
-    t337 = t335 - t332*t336
-    t338 = t336 + t332*t335
-    t339 = t320*t333
-    t340 = t298*t333
-    t341 = t339 - t332*t340
-    t342 = t340 + t332*t339
-    t343 = t324*t333
-    t344 = t302*t333
-    t345 = t343 - t332*t344
-    t346 = t344 + t332*t343
-    t347 = t317*t338 + t321*t342 + t325*t346
-    t348 = casadi.sqrt(t337**2 + t341**2 + t345**2)
-    t349 = (t347 != 0)
-    t350 = (-t313 + t334)/casadi.if_else(t349, 2*t347, 1)
-    t351 = casadi.fabs(t350)
-    t352 = (t351 >= 1)
-    t353 = 1/casadi.fabs(casadi.if_else(t352, t350, 1))
-    t354 = casadi.if_else(t349, casadi.if_else((t350 >= 0), 1, -1)*casadi.if_else(t352, t353/(1 + casadi.sqrt(1 + t353**2)), 1/(t351 + casadi.sqrt(1 + t351**2))), 0)
-    t355 = 1/casadi.sqrt(1 + t354**2)
-    t356 = t317*t355
-    t357 = t338*t355
-    t358 = t356 - t354*t357
-    t359 = t357 + t354*t356
-    t360 = t321*t355
-    t361 = t342*t355
-    t362 = t360 - t354*t361
-    t363 = t361 + t354*t360
-    t364 = t325*t355
-    t365 = t346*t355
-    t366 = t364 - t354*t365
-    t367 = t365 + t354*t364
-    t368 = casadi.sqrt(t358**2 + t362**2 + t366**2)
-    t369 = casadi.sqrt(t359**2 + t363**2 + t367**2)
-    t370 = casadi.if_else((t368 > t348), t368, t348)
-    t371 = casadi.if_else((t368 < t348), t368, t348)
-    t372 = casadi.if_else((t369 > t370), t369, t370)
-    t373 = casadi.if_else((t369 < t371), t369, t371)
-    t374 = casadi.if_else((t373 <= 1e-12*t372), 0, t373)
-    t375 = casadi.if_else((t372 > 0), t372, 1)
+    t6 = -t5
+    t7 = t4*casadi.if_else((t6 >= 0), 1, -1)
+    t8 = (t4 > 0)
+    t9 = casadi.if_else(t8, 1/(t6 + t7), 0)
+    t10 = casadi.if_else(t8, 1 + casadi.fabs(t5)/t4, 0)
+    t11 = 4.6616714347772055*t9
+    t12 = -t10*(-2.159090418388541*t2 + t0*t1*t11 + c123*s123*t11)
+    t13 = -t12 + 2.159090418388541*t2
+    t14 = 2.159090418388541*t9
+    t15 = t1*t14
+    t16 = 2.159090418388541*t0 + t15*t12
+    t17 = s123*t14
+    t18 = 2.159090418388541*c123 + t17*t12
+    t19 = -t10*(-1 + t15 + t17)
+    t20 = 1 - t19
+    t21 = 1 + t15*t19
+    t22 = 1 + t17*t19
+    t23 = casadi.sqrt(t16**2 + t18**2)
+    t24 = t23*casadi.if_else((t16 >= 0), 1, -1)
+    t25 = (t23 > 0)
+    t26 = casadi.if_else(t25, 1/(t16 + t24), 0)
+    t27 = casadi.if_else(t25, 1 + casadi.fabs(t16)/t23, 0)
+    t28 = t18*t26
+    t29 = t27*(t21 + t28*t22)
+    t30 = -t29 + t21
+    t31 = t22 - t28*t29
+    t32 = casadi.fabs(t31)
+    t33 = t32*casadi.if_else((t31 >= 0), 1, -1)
+    t34 = t24**2 + t30**2
+    t35 = t33**2
+    t36 = -t13*t24 + t20*t30
+    t37 = t7**2
+    t38 = t37 + t13**2 + t20**2
+    t39 = (t36 != 0)
+    t40 = (-t38 + t34)/casadi.if_else(t39, 2*t36, 1)
+    t41 = casadi.fabs(t40)
+    t42 = (t41 >= 1)
+    t43 = 1/casadi.fabs(casadi.if_else(t42, t40, 1))
+    t44 = casadi.if_else(t39, casadi.if_else((t40 >= 0), 1, -1)*casadi.if_else(t42, t43/(1 + casadi.sqrt(1 + t43**2)), 1/(t41 + casadi.sqrt(1 + t41**2))), 0)
+    t45 = 1/casadi.sqrt(1 + t44**2)
+    t46 = t36*t44
+    t47 = -t46 + t38
+    t48 = t46 + t34
+    t49 = t13*t45
+    t50 = t24*t45
+    t51 = t49 + t50*t44
+    t52 = -t50 + t49*t44
+    t53 = t20*t45
+    t54 = t30*t45
+    t55 = t53 - t54*t44
+    t56 = t54 + t53*t44
+    t57 = t33*t55
+    t58 = (t57 != 0)
+    t59 = (-t47 + t35)/casadi.if_else(t58, -2*t57, 1)
+    t60 = casadi.fabs(t59)
+    t61 = (t60 >= 1)
+    t62 = 1/casadi.fabs(casadi.if_else(t61, t59, 1))
+    t63 = casadi.if_else(t58, casadi.if_else((t59 >= 0), 1, -1)*casadi.if_else(t61, t62/(1 + casadi.sqrt(1 + t62**2)), 1/(t60 + casadi.sqrt(1 + t60**2))), 0)
+    t64 = 1/casadi.sqrt(1 + t63**2)
+    t65 = t57*t63
+    t66 = t65 + t47
+    t67 = -t65 + t35
+    t68 = t55*t64
+    t69 = t33*t64
+    t70 = t68 + t69*t63
+    t71 = -t69 + t68*t63
+    t72 = t63*t64
+    t73 = t51*t64
+    t74 = t73*t63
+    t75 = t56*t71 + t37*t72*t44*t45**2 + t74*t52
+    t76 = (t75 != 0)
+    t77 = (-t48 + t67)/casadi.if_else(t76, 2*t75, 1)
+    t78 = casadi.fabs(t77)
+    t79 = (t78 >= 1)
+    t80 = 1/casadi.fabs(casadi.if_else(t79, t77, 1))
+    t81 = casadi.if_else(t76, casadi.if_else((t77 >= 0), 1, -1)*casadi.if_else(t79, t80/(1 + casadi.sqrt(1 + t80**2)), 1/(t78 + casadi.sqrt(1 + t78**2))), 0)
+    t82 = 1/casadi.sqrt(1 + t81**2)
+    t83 = t75*t81
+    t84 = -t83 + t48
+    t85 = t83 + t67
+    t86 = t7*t45
+    t87 = t86*t82
+    t88 = t87*t44
+    t89 = t72*t87
+    t90 = -t88 + t89*t81
+    t91 = t89 + t88*t81
+    t92 = t52*t82
+    t93 = t74*t82
+    t94 = t92 - t93*t81
+    t95 = t93 + t92*t81
+    t96 = t56*t82
+    t97 = t71*t82
+    t98 = t96 - t97*t81
+    t99 = t97 + t96*t81
+    t100 = t86*t64
+    t101 = t70*t98 - t100*t90 + t73*t94
+    t102 = (t101 != 0)
+    t103 = (-t66 + t84)/casadi.if_else(t102, 2*t101, 1)
+    t104 = casadi.fabs(t103)
+    t105 = (t104 >= 1)
+    t106 = 1/casadi.fabs(casadi.if_else(t105, t103, 1))
+    t107 = casadi.if_else(t102, casadi.if_else((t103 >= 0), 1, -1)*casadi.if_else(t105, t106/(1 + casadi.sqrt(1 + t106**2)), 1/(t104 + casadi.sqrt(1 + t104**2))), 0)
+    t108 = 1/casadi.sqrt(1 + t107**2)
+    t109 = t101*t107
+    t110 = -t109 + t66
+    t111 = t109 + t84
+    t112 = t100*t108
+    t113 = t90*t108
+    t114 = t112 + t113*t107
+    t115 = t113 - t112*t107
+    t116 = t73*t108
+    t117 = t94*t108
+    t118 = t116 - t117*t107
+    t119 = t117 + t116*t107
+    t120 = t70*t108
+    t121 = t98*t108
+    t122 = t120 - t121*t107
+    t123 = t121 + t120*t107
+    t124 = t91*t114 + t95*t118 + t99*t122
+    t125 = (t124 != 0)
+    t126 = (-t110 + t85)/casadi.if_else(t125, 2*t124, 1)
+    t127 = casadi.fabs(t126)
+    t128 = (t127 >= 1)
+    t129 = 1/casadi.fabs(casadi.if_else(t128, t126, 1))
+    t130 = casadi.if_else(t125, casadi.if_else((t126 >= 0), 1, -1)*casadi.if_else(t128, t129/(1 + casadi.sqrt(1 + t129**2)), 1/(t127 + casadi.sqrt(1 + t127**2))), 0)
+    t131 = 1/casadi.sqrt(1 + t130**2)
+    t132 = t124*t130
+    t133 = -t132 + t110
+    t134 = t132 + t85
+    t135 = t114*t131
+    t136 = t91*t131
+    t137 = -t135 + t130*t136
+    t138 = t136 + t130*t135
+    t139 = t118*t131
+    t140 = t95*t131
+    t141 = t139 - t130*t140
+    t142 = t140 + t130*t139
+    t143 = t122*t131
+    t144 = t99*t131
+    t145 = t143 - t130*t144
+    t146 = t144 + t130*t143
+    t147 = -t115*t138 + t119*t142 + t123*t146
+    t148 = (t147 != 0)
+    t149 = (-t111 + t134)/casadi.if_else(t148, 2*t147, 1)
+    t150 = casadi.fabs(t149)
+    t151 = (t150 >= 1)
+    t152 = 1/casadi.fabs(casadi.if_else(t151, t149, 1))
+    t153 = casadi.if_else(t148, casadi.if_else((t149 >= 0), 1, -1)*casadi.if_else(t151, t152/(1 + casadi.sqrt(1 + t152**2)), 1/(t150 + casadi.sqrt(1 + t150**2))), 0)
+    t154 = 1/casadi.sqrt(1 + t153**2)
+    t155 = t147*t153
+    t156 = -t155 + t111
+    t157 = t134 + t155
+    t158 = t115*t154
+    t159 = t138*t154
+    t160 = t158 + t153*t159
+    t161 = -t159 + t153*t158
+    t162 = t119*t154
+    t163 = t142*t154
+    t164 = t162 - t153*t163
+    t165 = t163 + t153*t162
+    t166 = t123*t154
+    t167 = t146*t154
+    t168 = t166 - t153*t167
+    t169 = t167 + t153*t166
+    t170 = t137*t160 + t141*t164 + t145*t168
+    t171 = (t170 != 0)
+    t172 = (-t133 + t156)/casadi.if_else(t171, 2*t170, 1)
+    t173 = casadi.fabs(t172)
+    t174 = (t173 >= 1)
+    t175 = 1/casadi.fabs(casadi.if_else(t174, t172, 1))
+    t176 = casadi.if_else(t171, casadi.if_else((t172 >= 0), 1, -1)*casadi.if_else(t174, t175/(1 + casadi.sqrt(1 + t175**2)), 1/(t173 + casadi.sqrt(1 + t173**2))), 0)
+    t177 = 1/casadi.sqrt(1 + t176**2)
+    t178 = t170*t176
+    t179 = -t178 + t133
+    t180 = t156 + t178
+    t181 = t137*t177
+    t182 = t160*t177
+    t183 = t181 - t176*t182
+    t184 = t182 + t176*t181
+    t185 = t141*t177
+    t186 = t164*t177
+    t187 = t185 - t176*t186
+    t188 = t186 + t176*t185
+    t189 = t145*t177
+    t190 = t168*t177
+    t191 = t189 - t176*t190
+    t192 = t190 + t176*t189
+    t193 = t161*t183 + t165*t187 + t169*t191
+    t194 = (t193 != 0)
+    t195 = (-t179 + t157)/casadi.if_else(t194, 2*t193, 1)
+    t196 = casadi.fabs(t195)
+    t197 = (t196 >= 1)
+    t198 = 1/casadi.fabs(casadi.if_else(t197, t195, 1))
+    t199 = casadi.if_else(t194, casadi.if_else((t195 >= 0), 1, -1)*casadi.if_else(t197, t198/(1 + casadi.sqrt(1 + t198**2)), 1/(t196 + casadi.sqrt(1 + t196**2))), 0)
+    t200 = 1/casadi.sqrt(1 + t199**2)
+    t201 = t193*t199
+    t202 = -t201 + t179
+    t203 = t157 + t201
+    t204 = t183*t200
+    t205 = t161*t200
+    t206 = t204 - t199*t205
+    t207 = t205 + t199*t204
+    t208 = t187*t200
+    t209 = t165*t200
+    t210 = t208 - t199*t209
+    t211 = t209 + t199*t208
+    t212 = t191*t200
+    t213 = t169*t200
+    t214 = t212 - t199*t213
+    t215 = t213 + t199*t212
+    t216 = t184*t207 + t188*t211 + t192*t215
+    t217 = (t216 != 0)
+    t218 = (-t180 + t203)/casadi.if_else(t217, 2*t216, 1)
+    t219 = casadi.fabs(t218)
+    t220 = (t219 >= 1)
+    t221 = 1/casadi.fabs(casadi.if_else(t220, t218, 1))
+    t222 = casadi.if_else(t217, casadi.if_else((t218 >= 0), 1, -1)*casadi.if_else(t220, t221/(1 + casadi.sqrt(1 + t221**2)), 1/(t219 + casadi.sqrt(1 + t219**2))), 0)
+    t223 = 1/casadi.sqrt(1 + t222**2)
+    t224 = t216*t222
+    t225 = -t224 + t180
+    t226 = t203 + t224
+    t227 = t184*t223
+    t228 = t207*t223
+    t229 = t227 - t222*t228
+    t230 = t228 + t222*t227
+    t231 = t188*t223
+    t232 = t211*t223
+    t233 = t231 - t222*t232
+    t234 = t232 + t222*t231
+    t235 = t192*t223
+    t236 = t215*t223
+    t237 = t235 - t222*t236
+    t238 = t236 + t222*t235
+    t239 = t206*t229 + t210*t233 + t214*t237
+    t240 = (t239 != 0)
+    t241 = (-t202 + t225)/casadi.if_else(t240, 2*t239, 1)
+    t242 = casadi.fabs(t241)
+    t243 = (t242 >= 1)
+    t244 = 1/casadi.fabs(casadi.if_else(t243, t241, 1))
+    t245 = casadi.if_else(t240, casadi.if_else((t241 >= 0), 1, -1)*casadi.if_else(t243, t244/(1 + casadi.sqrt(1 + t244**2)), 1/(t242 + casadi.sqrt(1 + t242**2))), 0)
+    t246 = 1/casadi.sqrt(1 + t245**2)
+    t247 = t239*t245
+    t248 = -t247 + t202
+    t249 = t225 + t247
+    t250 = t206*t246
+    t251 = t229*t246
+    t252 = t250 - t245*t251
+    t253 = t251 + t245*t250
+    t254 = t210*t246
+    t255 = t233*t246
+    t256 = t254 - t245*t255
+    t257 = t255 + t245*t254
+    t258 = t214*t246
+    t259 = t237*t246
+    t260 = t258 - t245*t259
+    t261 = t259 + t245*t258
+    t262 = t230*t252 + t234*t256 + t238*t260
+    t263 = (t262 != 0)
+    t264 = (-t248 + t226)/casadi.if_else(t263, 2*t262, 1)
+    t265 = casadi.fabs(t264)
+    t266 = (t265 >= 1)
+    t267 = 1/casadi.fabs(casadi.if_else(t266, t264, 1))
+    t268 = casadi.if_else(t263, casadi.if_else((t264 >= 0), 1, -1)*casadi.if_else(t266, t267/(1 + casadi.sqrt(1 + t267**2)), 1/(t265 + casadi.sqrt(1 + t265**2))), 0)
+    t269 = 1/casadi.sqrt(1 + t268**2)
+    t270 = t262*t268
+    t271 = -t270 + t248
+    t272 = t226 + t270
+    t273 = t252*t269
+    t274 = t230*t269
+    t275 = t273 - t268*t274
+    t276 = t274 + t268*t273
+    t277 = t256*t269
+    t278 = t234*t269
+    t279 = t277 - t268*t278
+    t280 = t278 + t268*t277
+    t281 = t260*t269
+    t282 = t238*t269
+    t283 = t281 - t268*t282
+    t284 = t282 + t268*t281
+    t285 = t253*t276 + t257*t280 + t261*t284
+    t286 = (t285 != 0)
+    t287 = (-t249 + t272)/casadi.if_else(t286, 2*t285, 1)
+    t288 = casadi.fabs(t287)
+    t289 = (t288 >= 1)
+    t290 = 1/casadi.fabs(casadi.if_else(t289, t287, 1))
+    t291 = casadi.if_else(t286, casadi.if_else((t287 >= 0), 1, -1)*casadi.if_else(t289, t290/(1 + casadi.sqrt(1 + t290**2)), 1/(t288 + casadi.sqrt(1 + t288**2))), 0)
+    t292 = 1/casadi.sqrt(1 + t291**2)
+    t293 = t285*t291
+    t294 = -t293 + t249
+    t295 = t272 + t293
+    t296 = t253*t292
+    t297 = t276*t292
+    t298 = t296 - t291*t297
+    t299 = t297 + t291*t296
+    t300 = t257*t292
+    t301 = t280*t292
+    t302 = t300 - t291*t301
+    t303 = t301 + t291*t300
+    t304 = t261*t292
+    t305 = t284*t292
+    t306 = t304 - t291*t305
+    t307 = t305 + t291*t304
+    t308 = t275*t298 + t279*t302 + t283*t306
+    t309 = (t308 != 0)
+    t310 = (-t271 + t294)/casadi.if_else(t309, 2*t308, 1)
+    t311 = casadi.fabs(t310)
+    t312 = (t311 >= 1)
+    t313 = 1/casadi.fabs(casadi.if_else(t312, t310, 1))
+    t314 = casadi.if_else(t309, casadi.if_else((t310 >= 0), 1, -1)*casadi.if_else(t312, t313/(1 + casadi.sqrt(1 + t313**2)), 1/(t311 + casadi.sqrt(1 + t311**2))), 0)
+    t315 = 1/casadi.sqrt(1 + t314**2)
+    t316 = t308*t314
+    t317 = -t316 + t271
+    t318 = t294 + t316
+    t319 = t275*t315
+    t320 = t298*t315
+    t321 = t319 - t314*t320
+    t322 = t320 + t314*t319
+    t323 = t279*t315
+    t324 = t302*t315
+    t325 = t323 - t314*t324
+    t326 = t324 + t314*t323
+    t327 = t283*t315
+    t328 = t306*t315
+    t329 = t327 - t314*t328
+    t330 = t328 + t314*t327
+    t331 = t299*t321 + t303*t325 + t307*t329
+    t332 = (t331 != 0)
+    t333 = (-t317 + t295)/casadi.if_else(t332, 2*t331, 1)
+    t334 = casadi.fabs(t333)
+    t335 = (t334 >= 1)
+    t336 = 1/casadi.fabs(casadi.if_else(t335, t333, 1))
+    t337 = casadi.if_else(t332, casadi.if_else((t333 >= 0), 1, -1)*casadi.if_else(t335, t336/(1 + casadi.sqrt(1 + t336**2)), 1/(t334 + casadi.sqrt(1 + t334**2))), 0)
+    t338 = 1/casadi.sqrt(1 + t337**2)
+    t339 = t295 + t331*t337
+    t340 = t321*t338
+    t341 = t299*t338
+    t342 = t340 - t337*t341
+    t343 = t341 + t337*t340
+    t344 = t325*t338
+    t345 = t303*t338
+    t346 = t344 - t337*t345
+    t347 = t345 + t337*t344
+    t348 = t329*t338
+    t349 = t307*t338
+    t350 = t348 - t337*t349
+    t351 = t349 + t337*t348
+    t352 = t322*t343 + t326*t347 + t330*t351
+    t353 = casadi.sqrt(t342**2 + t346**2 + t350**2)
+    t354 = (t352 != 0)
+    t355 = (-t318 + t339)/casadi.if_else(t354, 2*t352, 1)
+    t356 = casadi.fabs(t355)
+    t357 = (t356 >= 1)
+    t358 = 1/casadi.fabs(casadi.if_else(t357, t355, 1))
+    t359 = casadi.if_else(t354, casadi.if_else((t355 >= 0), 1, -1)*casadi.if_else(t357, t358/(1 + casadi.sqrt(1 + t358**2)), 1/(t356 + casadi.sqrt(1 + t356**2))), 0)
+    t360 = 1/casadi.sqrt(1 + t359**2)
+    t361 = t322*t360
+    t362 = t343*t360
+    t363 = t361 - t359*t362
+    t364 = t362 + t359*t361
+    t365 = t326*t360
+    t366 = t347*t360
+    t367 = t365 - t359*t366
+    t368 = t366 + t359*t365
+    t369 = t330*t360
+    t370 = t351*t360
+    t371 = t369 - t359*t370
+    t372 = t370 + t359*t369
+    t373 = casadi.sqrt(t363**2 + t367**2 + t371**2)
+    t374 = casadi.sqrt(t364**2 + t368**2 + t372**2)
+    t375 = casadi.if_else((t373 > t353), t373, t353)
+    t376 = casadi.if_else((t373 < t353), t373, t353)
+    t377 = casadi.if_else((t374 > t375), t374, t375)
+    t378 = casadi.if_else((t374 < t376), t374, t376)
+    t379 = casadi.if_else((t378 <= 1e-12*t377), 0, t378)
+    t380 = casadi.if_else((t377 > 0), t377, 1)
     kappa = casadi.SX(1, 1)
-    kappa[0, 0] = t375/t374
+    kappa[0, 0] = t380/t379
     return [kappa]
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 328 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 315 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1271,113 +1280,125 @@ def _velocity_ik(q, mu_dot, damping):
     t1 = s12 + s123
     t2 = c1 + t0
     t3 = s1 + t1
-    t4 = t0*t1 + c123*s123 + t2*t3
+    t4 = t2*t3 + t0*t1 + c123*s123
     t5 = t3 + t1 + s123
     t6 = t3**2
     t7 = s123**2 + t1**2 + t6
     t8 = t2**2
     t9 = casadi.sqrt(1 + t6 + t8)
     t10 = casadi.if_else((t3 <= 0), 1, -1)*t9
-    t11 = casadi.if_else((t9 > 0), 1/(t9*(casadi.fabs(t3) + t9)), 0)
-    t12 = c123**2 + t0**2 + t8
-    t13 = casadi.sqrt(3 + t7 + t12)
-    t14 = c123 + t0 + t2
-    t15 = t4**2
-    t16 = t5**2
-    t17 = damping**2
-    t18 = t7 + t17
-    t19 = t18**2
-    t20 = casadi.sqrt(t15 + t16 + t19)
-    t21 = t20*casadi.if_else((t18 >= 0), 1, -1)
-    t22 = t18 + t21
-    t23 = casadi.if_else((t20 > 0), 1/(t20*(t20 + casadi.fabs(t18))), 0)
-    t24 = -t23*(-mu_dot0*t22 + mu_dot1*t4 + mu_dot2*t5)
-    t25 = mu_dot0 - t22*t24
-    t26 = mu_dot1 + t4*t24
-    t27 = mu_dot2 + t5*t24
-    t28 = t12 + t17
-    t29 = -t23*(t4*t22 + t28*t4 + t14*t5)
-    t30 = t4 + t22*t29
-    t31 = t28 + t4*t29
-    t32 = t14 + t5*t29
-    t33 = casadi.sqrt(t31**2 + t32**2)
-    t34 = t33*casadi.if_else((t31 >= 0), 1, -1)
-    t35 = t31 + t34
-    t36 = casadi.if_else((t33 > 0), 1/(t33*(t33 + casadi.fabs(t31))), 0)
-    t37 = t36*(t26*t35 + t32*t27)
-    t38 = t26 - t35*t37
-    t39 = t27 - t32*t37
-    t40 = 3 + t17
-    t41 = casadi.sqrt(2*t15 + 2*t16 + 2*t14**2 + t19 + t28**2 + t40**2)
-    t42 = -t23*(t5*t22 + t40*t5 + t14*t4)
-    t43 = t5 + t22*t42
-    t44 = t14 + t4*t42
-    t45 = t40 + t5*t42
-    t46 = t36*(t44*t35 + t32*t45)
-    t47 = t44 - t35*t46
-    t48 = t45 - t32*t46
-    t49 = casadi.fabs(t48)
-    t50 = t49*casadi.if_else((t48 >= 0), 1, -1)
-    t51 = t48 + t50
-    t52 = casadi.if_else((t49 > 0), 1/(t49*2*t49), 0)
-    t53 = t39 - t39*t51**2*t52
-    t54 = casadi.if_else((t50 != 0), -t53/t50, 0)
-    t55 = casadi.if_else((t34 != 0), -(t38 - t47*t54)/t34, 0)
-    t56 = casadi.if_else((t21 != 0), -(t25 + t30*t55 + t43*t54)/t21, 0)
-    t57 = t54 - t3*t56 + t2*t55
-    t58 = t54 - t1*t56 + t0*t55
-    t59 = t54 - s123*t56 + c123*t55
-    t60 = -t3
-    t61 = t60 + t10
-    t62 = t11*(1 - t1*t61 + t0*t2)
-    t63 = t1 + t61*t62
-    t64 = t0 - t2*t62
-    t65 = 1 - t62
-    t66 = t11*(1 + c123*t2 - s123*t61)
-    t67 = s123 + t61*t66
-    t68 = c123 - t2*t66
-    t69 = 1 - t66
-    t70 = t11*(mu_dot2 + mu_dot0*t61 + t2*mu_dot1)
-    t71 = mu_dot0 - t61*t70
-    t72 = mu_dot1 - t2*t70
-    t73 = -t70 + mu_dot2
-    t74 = casadi.sqrt(t64**2 + t65**2)
-    t75 = t74*casadi.if_else((t64 >= 0), 1, -1)
-    t76 = t64 + t75
-    t77 = casadi.if_else((t74 > 0), 1/(t74*(t74 + casadi.fabs(t64))), 0)
-    t78 = t77*(t68*t76 + t65*t69)
-    t79 = t68 - t76*t78
-    t80 = t69 - t65*t78
-    t81 = t77*(t72*t76 + t65*t73)
-    t82 = t72 - t76*t81
-    t83 = t73 - t65*t81
-    t84 = 3 - t1 - s123 + q1 + q2 + q3 + t14 + t60 + mu_dot0 + mu_dot1 + mu_dot2 + damping
-    t85 = casadi.fabs(t80)
-    t86 = t85*casadi.if_else((t80 >= 0), 1, -1)
-    t87 = t80 + t86
-    t88 = casadi.if_else((t85 > 0), 1/(t85*2*t85), 0)
-    t89 = t83 - t83*t87**2*t88
-    t90 = casadi.if_else((t86 != 0), -t89/t86, 0)
-    t91 = casadi.if_else((t75 != 0), -(t82 - t79*t90)/t75, 0)
-    t92 = casadi.if_else((t10 != 0), -(t71 + t63*t91 + t67*t90)/t10, 0)
-    t93 = (casadi.fabs(t84) < casadi.inf)
-    t94 = (damping >= 0)
-    t95 = (damping > 0)
-    t96 = 1e-12*t41
-    t97 = 1e-12*t13
-    t98 = casadi.logic_or(casadi.logic_and(t95, casadi.logic_or(casadi.logic_or((t20 <= t96), (t33 <= t96)), (t49 <= t96))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t9 <= t97), (t74 <= t97)), (t85 <= t97))))
-    t99 = casadi.logic_and(casadi.logic_and(t93, t94), casadi.logic_not(t98))
+    t11 = c123**2 + t0**2 + t8
+    t12 = casadi.sqrt(3 + t7 + t11)
+    t13 = c123 + t0 + t2
+    t14 = t4**2
+    t15 = t5**2
+    t16 = damping**2
+    t17 = t7 + t16
+    t18 = t17**2
+    t19 = casadi.sqrt(t14 + t15 + t18)
+    t20 = t19*casadi.if_else((t17 >= 0), 1, -1)
+    t21 = t11 + t16
+    t22 = 3 + t16
+    t23 = casadi.sqrt(2*t14 + 2*t15 + 2*t13**2 + t18 + t21**2 + t22**2)
+    t24 = (t19 > 0)
+    t25 = casadi.if_else(t24, 1/(t17 + t20), 0)
+    t26 = casadi.if_else(t24, 1 + casadi.fabs(t17)/t19, 0)
+    t27 = t4*t25
+    t28 = t5*t25
+    t29 = -t26*(t4 + t21*t27 + t13*t28)
+    t30 = t4 + t29
+    t31 = t21 + t27*t29
+    t32 = t13 + t28*t29
+    t33 = -t26*(t5 + t22*t28 + t13*t27)
+    t34 = t5 + t33
+    t35 = t13 + t27*t33
+    t36 = t22 + t28*t33
+    t37 = -t26*(-mu_dot0 + t27*mu_dot1 + t28*mu_dot2)
+    t38 = -t37 + mu_dot0
+    t39 = mu_dot1 + t27*t37
+    t40 = mu_dot2 + t28*t37
+    t41 = casadi.sqrt(t31**2 + t32**2)
+    t42 = t41*casadi.if_else((t31 >= 0), 1, -1)
+    t43 = (t41 > 0)
+    t44 = casadi.if_else(t43, 1/(t31 + t42), 0)
+    t45 = casadi.if_else(t43, 1 + casadi.fabs(t31)/t41, 0)
+    t46 = t32*t44
+    t47 = t45*(t35 + t46*t36)
+    t48 = -t47 + t35
+    t49 = t36 - t46*t47
+    t50 = t45*(t39 + t46*t40)
+    t51 = -t50 + t39
+    t52 = t40 - t46*t50
+    t53 = casadi.fabs(t49)
+    t54 = t53*casadi.if_else((t49 >= 0), 1, -1)
+    t55 = casadi.if_else((t53 > 0), 2, 0)
+    t56 = t52 - t52*t55
+    t57 = casadi.if_else((t54 != 0), -t56/t54, 0)
+    t58 = casadi.if_else((t42 != 0), -(t51 - t48*t57)/t42, 0)
+    t59 = casadi.if_else((t20 != 0), -(t38 + t30*t58 + t34*t57)/t20, 0)
+    t60 = t57 - t3*t59 + t2*t58
+    t61 = t57 - t1*t59 + t0*t58
+    t62 = t57 - s123*t59 + c123*t58
+    t63 = (t9 > 0)
+    t64 = casadi.if_else(t63, 1 + casadi.fabs(t3)/t9, 0)
+    t65 = -t3
+    t66 = casadi.if_else(t63, 1/(t65 + t10), 0)
+    t67 = -t1
+    t68 = t2*t66
+    t69 = t64*(t67 + t66 + t0*t68)
+    t70 = t1 + t69
+    t71 = t64*(mu_dot0 + mu_dot2*t66 + t68*mu_dot1)
+    t72 = -t71 + mu_dot0
+    t73 = t66*t69
+    t74 = t0 - t2*t73
+    t75 = 1 - t73
+    t76 = casadi.sqrt(t74**2 + t75**2)
+    t77 = t76*casadi.if_else((t74 >= 0), 1, -1)
+    t78 = -s123
+    t79 = t64*(t78 + t66 + c123*t68)
+    t80 = s123 + t79
+    t81 = 3 + q1 + q2 + q3 + t13 + t65 + t67 + t78 + mu_dot0 + mu_dot1 + mu_dot2 + damping
+    t82 = t66*t79
+    t83 = c123 - t2*t82
+    t84 = 1 - t82
+    t85 = t66*t71
+    t86 = mu_dot1 - t2*t85
+    t87 = -t85 + mu_dot2
+    t88 = (t76 > 0)
+    t89 = casadi.if_else(t88, 1/(t74 + t77), 0)
+    t90 = casadi.if_else(t88, 1 + casadi.fabs(t74)/t76, 0)
+    t91 = t75*t89
+    t92 = t90*(t83 + t91*t84)
+    t93 = -t92 + t83
+    t94 = t84 - t91*t92
+    t95 = t90*(t86 + t91*t87)
+    t96 = -t95 + t86
+    t97 = t87 - t91*t95
+    t98 = casadi.fabs(t94)
+    t99 = t98*casadi.if_else((t94 >= 0), 1, -1)
+    t100 = casadi.if_else((t98 > 0), 2, 0)
+    t101 = t97 - t97*t100
+    t102 = casadi.if_else((t99 != 0), -t101/t99, 0)
+    t103 = casadi.if_else((t77 != 0), -(t96 - t93*t102)/t77, 0)
+    t104 = casadi.if_else((t10 != 0), -(t72 + t70*t103 + t80*t102)/t10, 0)
+    t105 = (casadi.fabs(t81) < casadi.inf)
+    t106 = (damping >= 0)
+    t107 = (damping > 0)
+    t108 = 1e-12*t23
+    t109 = 1e-12*t12
+    t110 = casadi.logic_or(casadi.logic_and(t107, casadi.logic_or(casadi.logic_or((t19 <= t108), (t41 <= t108)), (t53 <= t108))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t9 <= t109), (t76 <= t109)), (t98 <= t109))))
+    t111 = casadi.logic_and(casadi.logic_and(t105, t106), casadi.logic_not(t110))
     q_dot = casadi.SX(3, 1)
-    q_dot[0, 0] = casadi.if_else(t99, casadi.if_else(t95, t57, t92), 0)
-    q_dot[1, 0] = casadi.if_else(t99, casadi.if_else(t95, t58, t91), 0)
-    q_dot[2, 0] = casadi.if_else(t99, casadi.if_else(t95, t59, t90), 0)
+    q_dot[0, 0] = casadi.if_else(t111, casadi.if_else(t107, t60, t104), 0)
+    q_dot[1, 0] = casadi.if_else(t111, casadi.if_else(t107, t61, t103), 0)
+    q_dot[2, 0] = casadi.if_else(t111, casadi.if_else(t107, t62, t102), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t93, t94)), 2, casadi.if_else(t98, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t105, t106)), 2, casadi.if_else(t110, 1, 0))
     return [q_dot, status]
 
 
 def _velocity_ik_nullspace(q, mu_dot, z, damping):
-    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 331 operations."""
+    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 318 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1401,113 +1422,125 @@ def _velocity_ik_nullspace(q, mu_dot, z, damping):
     t1 = s12 + s123
     t2 = c1 + t0
     t3 = s1 + t1
-    t4 = t0*t1 + c123*s123 + t2*t3
+    t4 = t2*t3 + t0*t1 + c123*s123
     t5 = t3 + t1 + s123
     t6 = t3**2
     t7 = s123**2 + t1**2 + t6
     t8 = t2**2
     t9 = casadi.sqrt(1 + t6 + t8)
     t10 = casadi.if_else((t3 <= 0), 1, -1)*t9
-    t11 = casadi.if_else((t9 > 0), 1/(t9*(casadi.fabs(t3) + t9)), 0)
-    t12 = c123**2 + t0**2 + t8
-    t13 = casadi.sqrt(3 + t7 + t12)
-    t14 = c123 + t0 + t2
-    t15 = t4**2
-    t16 = t5**2
-    t17 = damping**2
-    t18 = t7 + t17
-    t19 = t18**2
-    t20 = casadi.sqrt(t15 + t16 + t19)
-    t21 = t20*casadi.if_else((t18 >= 0), 1, -1)
-    t22 = t18 + t21
-    t23 = casadi.if_else((t20 > 0), 1/(t20*(t20 + casadi.fabs(t18))), 0)
-    t24 = -t23*(-mu_dot0*t22 + mu_dot1*t4 + mu_dot2*t5)
-    t25 = mu_dot0 - t22*t24
-    t26 = mu_dot1 + t4*t24
-    t27 = mu_dot2 + t5*t24
-    t28 = t12 + t17
-    t29 = -t23*(t4*t22 + t28*t4 + t14*t5)
-    t30 = t4 + t22*t29
-    t31 = t28 + t4*t29
-    t32 = t14 + t5*t29
-    t33 = casadi.sqrt(t31**2 + t32**2)
-    t34 = t33*casadi.if_else((t31 >= 0), 1, -1)
-    t35 = t31 + t34
-    t36 = casadi.if_else((t33 > 0), 1/(t33*(t33 + casadi.fabs(t31))), 0)
-    t37 = t36*(t26*t35 + t32*t27)
-    t38 = t26 - t35*t37
-    t39 = t27 - t32*t37
-    t40 = 3 + t17
-    t41 = casadi.sqrt(2*t15 + 2*t16 + 2*t14**2 + t19 + t28**2 + t40**2)
-    t42 = -t23*(t5*t22 + t40*t5 + t14*t4)
-    t43 = t5 + t22*t42
-    t44 = t14 + t4*t42
-    t45 = t40 + t5*t42
-    t46 = t36*(t44*t35 + t32*t45)
-    t47 = t44 - t35*t46
-    t48 = t45 - t32*t46
-    t49 = casadi.fabs(t48)
-    t50 = t49*casadi.if_else((t48 >= 0), 1, -1)
-    t51 = t48 + t50
-    t52 = casadi.if_else((t49 > 0), 1/(t49*2*t49), 0)
-    t53 = t39 - t39*t51**2*t52
-    t54 = casadi.if_else((t50 != 0), -t53/t50, 0)
-    t55 = casadi.if_else((t34 != 0), -(t38 - t47*t54)/t34, 0)
-    t56 = casadi.if_else((t21 != 0), -(t25 + t30*t55 + t43*t54)/t21, 0)
-    t57 = t54 - t3*t56 + t2*t55
-    t58 = t54 - t1*t56 + t0*t55
-    t59 = t54 - s123*t56 + c123*t55
-    t60 = -t3
-    t61 = t60 + t10
-    t62 = t11*(1 - t1*t61 + t0*t2)
-    t63 = t1 + t61*t62
-    t64 = t0 - t2*t62
-    t65 = 1 - t62
-    t66 = t11*(1 + c123*t2 - s123*t61)
-    t67 = s123 + t61*t66
-    t68 = c123 - t2*t66
-    t69 = 1 - t66
-    t70 = t11*(mu_dot2 + mu_dot0*t61 + t2*mu_dot1)
-    t71 = mu_dot0 - t61*t70
-    t72 = mu_dot1 - t2*t70
-    t73 = -t70 + mu_dot2
-    t74 = casadi.sqrt(t64**2 + t65**2)
-    t75 = t74*casadi.if_else((t64 >= 0), 1, -1)
-    t76 = t64 + t75
-    t77 = casadi.if_else((t74 > 0), 1/(t74*(t74 + casadi.fabs(t64))), 0)
-    t78 = t77*(t68*t76 + t65*t69)
-    t79 = t68 - t76*t78
-    t80 = t69 - t65*t78
-    t81 = t77*(t72*t76 + t65*t73)
-    t82 = t72 - t76*t81
-    t83 = t73 - t65*t81
-    t84 = 3 - t1 - s123 + q1 + q2 + q3 + t14 + t60 + mu_dot0 + mu_dot1 + mu_dot2 + damping + qz1 + qz2 + qz3
-    t85 = casadi.fabs(t80)
-    t86 = t85*casadi.if_else((t80 >= 0), 1, -1)
-    t87 = t80 + t86
-    t88 = casadi.if_else((t85 > 0), 1/(t85*2*t85), 0)
-    t89 = t83 - t83*t87**2*t88
-    t90 = casadi.if_else((t86 != 0), -t89/t86, 0)
-    t91 = casadi.if_else((t75 != 0), -(t82 - t79*t90)/t75, 0)
-    t92 = casadi.if_else((t10 != 0), -(t71 + t63*t91 + t67*t90)/t10, 0)
-    t93 = (casadi.fabs(t84) < casadi.inf)
-    t94 = (damping >= 0)
-    t95 = (damping > 0)
-    t96 = 1e-12*t41
-    t97 = 1e-12*t13
-    t98 = casadi.logic_or(casadi.logic_and(t95, casadi.logic_or(casadi.logic_or((t20 <= t96), (t33 <= t96)), (t49 <= t96))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t9 <= t97), (t74 <= t97)), (t85 <= t97))))
-    t99 = casadi.logic_and(casadi.logic_and(t93, t94), casadi.logic_not(t98))
+    t11 = c123**2 + t0**2 + t8
+    t12 = casadi.sqrt(3 + t7 + t11)
+    t13 = c123 + t0 + t2
+    t14 = t4**2
+    t15 = t5**2
+    t16 = damping**2
+    t17 = t7 + t16
+    t18 = t17**2
+    t19 = casadi.sqrt(t14 + t15 + t18)
+    t20 = t19*casadi.if_else((t17 >= 0), 1, -1)
+    t21 = t11 + t16
+    t22 = 3 + t16
+    t23 = casadi.sqrt(2*t14 + 2*t15 + 2*t13**2 + t18 + t21**2 + t22**2)
+    t24 = (t19 > 0)
+    t25 = casadi.if_else(t24, 1/(t17 + t20), 0)
+    t26 = casadi.if_else(t24, 1 + casadi.fabs(t17)/t19, 0)
+    t27 = t4*t25
+    t28 = t5*t25
+    t29 = -t26*(t4 + t21*t27 + t13*t28)
+    t30 = t4 + t29
+    t31 = t21 + t27*t29
+    t32 = t13 + t28*t29
+    t33 = -t26*(t5 + t22*t28 + t13*t27)
+    t34 = t5 + t33
+    t35 = t13 + t27*t33
+    t36 = t22 + t28*t33
+    t37 = -t26*(-mu_dot0 + t27*mu_dot1 + t28*mu_dot2)
+    t38 = -t37 + mu_dot0
+    t39 = mu_dot1 + t27*t37
+    t40 = mu_dot2 + t28*t37
+    t41 = casadi.sqrt(t31**2 + t32**2)
+    t42 = t41*casadi.if_else((t31 >= 0), 1, -1)
+    t43 = (t41 > 0)
+    t44 = casadi.if_else(t43, 1/(t31 + t42), 0)
+    t45 = casadi.if_else(t43, 1 + casadi.fabs(t31)/t41, 0)
+    t46 = t32*t44
+    t47 = t45*(t35 + t46*t36)
+    t48 = -t47 + t35
+    t49 = t36 - t46*t47
+    t50 = t45*(t39 + t46*t40)
+    t51 = -t50 + t39
+    t52 = t40 - t46*t50
+    t53 = casadi.fabs(t49)
+    t54 = t53*casadi.if_else((t49 >= 0), 1, -1)
+    t55 = casadi.if_else((t53 > 0), 2, 0)
+    t56 = t52 - t52*t55
+    t57 = casadi.if_else((t54 != 0), -t56/t54, 0)
+    t58 = casadi.if_else((t42 != 0), -(t51 - t48*t57)/t42, 0)
+    t59 = casadi.if_else((t20 != 0), -(t38 + t30*t58 + t34*t57)/t20, 0)
+    t60 = t57 - t3*t59 + t2*t58
+    t61 = t57 - t1*t59 + t0*t58
+    t62 = t57 - s123*t59 + c123*t58
+    t63 = (t9 > 0)
+    t64 = casadi.if_else(t63, 1 + casadi.fabs(t3)/t9, 0)
+    t65 = -t3
+    t66 = casadi.if_else(t63, 1/(t65 + t10), 0)
+    t67 = -t1
+    t68 = t2*t66
+    t69 = t64*(t67 + t66 + t0*t68)
+    t70 = t1 + t69
+    t71 = t64*(mu_dot0 + mu_dot2*t66 + t68*mu_dot1)
+    t72 = -t71 + mu_dot0
+    t73 = t66*t69
+    t74 = t0 - t2*t73
+    t75 = 1 - t73
+    t76 = casadi.sqrt(t74**2 + t75**2)
+    t77 = t76*casadi.if_else((t74 >= 0), 1, -1)
+    t78 = -s123
+    t79 = t64*(t78 + t66 + c123*t68)
+    t80 = s123 + t79
+    t81 = 3 + q1 + q2 + q3 + t13 + t65 + t67 + t78 + mu_dot0 + mu_dot1 + mu_dot2 + damping + qz1 + qz2 + qz3
+    t82 = t66*t79
+    t83 = c123 - t2*t82
+    t84 = 1 - t82
+    t85 = t66*t71
+    t86 = mu_dot1 - t2*t85
+    t87 = -t85 + mu_dot2
+    t88 = (t76 > 0)
+    t89 = casadi.if_else(t88, 1/(t74 + t77), 0)
+    t90 = casadi.if_else(t88, 1 + casadi.fabs(t74)/t76, 0)
+    t91 = t75*t89
+    t92 = t90*(t83 + t91*t84)
+    t93 = -t92 + t83
+    t94 = t84 - t91*t92
+    t95 = t90*(t86 + t91*t87)
+    t96 = -t95 + t86
+    t97 = t87 - t91*t95
+    t98 = casadi.fabs(t94)
+    t99 = t98*casadi.if_else((t94 >= 0), 1, -1)
+    t100 = casadi.if_else((t98 > 0), 2, 0)
+    t101 = t97 - t97*t100
+    t102 = casadi.if_else((t99 != 0), -t101/t99, 0)
+    t103 = casadi.if_else((t77 != 0), -(t96 - t93*t102)/t77, 0)
+    t104 = casadi.if_else((t10 != 0), -(t72 + t70*t103 + t80*t102)/t10, 0)
+    t105 = (casadi.fabs(t81) < casadi.inf)
+    t106 = (damping >= 0)
+    t107 = (damping > 0)
+    t108 = 1e-12*t23
+    t109 = 1e-12*t12
+    t110 = casadi.logic_or(casadi.logic_and(t107, casadi.logic_or(casadi.logic_or((t19 <= t108), (t41 <= t108)), (t53 <= t108))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t9 <= t109), (t76 <= t109)), (t98 <= t109))))
+    t111 = casadi.logic_and(casadi.logic_and(t105, t106), casadi.logic_not(t110))
     q_dot = casadi.SX(3, 1)
-    q_dot[0, 0] = casadi.if_else(t99, casadi.if_else(t95, t57, t92), 0)
-    q_dot[1, 0] = casadi.if_else(t99, casadi.if_else(t95, t58, t91), 0)
-    q_dot[2, 0] = casadi.if_else(t99, casadi.if_else(t95, t59, t90), 0)
+    q_dot[0, 0] = casadi.if_else(t111, casadi.if_else(t107, t60, t104), 0)
+    q_dot[1, 0] = casadi.if_else(t111, casadi.if_else(t107, t61, t103), 0)
+    q_dot[2, 0] = casadi.if_else(t111, casadi.if_else(t107, t62, t102), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t93, t94)), 2, casadi.if_else(t98, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t105, t106)), 2, casadi.if_else(t110, 1, 0))
     return [q_dot, status]
 
 
 def _resolved_rate(q, target, target_rate, gain, z, damping):
-    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 347 operations."""
+    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 334 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1537,7 +1570,7 @@ def _resolved_rate(q, target, target_rate, gain, z, damping):
     t1 = s12 + s123
     t2 = c1 + t0
     t3 = s1 + t1
-    t4 = t0*t1 + c123*s123 + t2*t3
+    t4 = t2*t3 + t0*t1 + c123*s123
     t5 = t3 + t1 + s123
     t6 = mu_dot0 + gain0*(-t2 + mu0)
     t7 = t3**2
@@ -1545,109 +1578,121 @@ def _resolved_rate(q, target, target_rate, gain, z, damping):
     t9 = t2**2
     t10 = casadi.sqrt(1 + t7 + t9)
     t11 = casadi.if_else((t3 <= 0), 1, -1)*t10
-    t12 = casadi.if_else((t10 > 0), 1/(t10*(casadi.fabs(t3) + t10)), 0)
-    t13 = c123**2 + t0**2 + t9
-    t14 = casadi.sqrt(3 + t8 + t13)
-    t15 = c123 + t0 + t2
-    t16 = t4**2
-    t17 = t5**2
-    t18 = damping**2
-    t19 = t8 + t18
-    t20 = t19**2
-    t21 = casadi.sqrt(t16 + t17 + t20)
-    t22 = t21*casadi.if_else((t19 >= 0), 1, -1)
-    t23 = t19 + t22
-    t24 = casadi.if_else((t21 > 0), 1/(t21*(t21 + casadi.fabs(t19))), 0)
-    t25 = t13 + t18
-    t26 = -t24*(t4*t23 + t25*t4 + t15*t5)
-    t27 = t4 + t23*t26
-    t28 = t25 + t4*t26
-    t29 = t15 + t5*t26
-    t30 = casadi.sqrt(t28**2 + t29**2)
-    t31 = t30*casadi.if_else((t28 >= 0), 1, -1)
-    t32 = t28 + t31
-    t33 = casadi.if_else((t30 > 0), 1/(t30*(t30 + casadi.fabs(t28))), 0)
-    t34 = 3 + t18
-    t35 = casadi.sqrt(2*t16 + 2*t17 + 2*t15**2 + t20 + t25**2 + t34**2)
-    t36 = -t24*(t5*t23 + t34*t5 + t15*t4)
-    t37 = t5 + t23*t36
-    t38 = t15 + t4*t36
-    t39 = t34 + t5*t36
-    t40 = t33*(t38*t32 + t29*t39)
-    t41 = t38 - t32*t40
-    t42 = t39 - t29*t40
-    t43 = casadi.fabs(t42)
-    t44 = t43*casadi.if_else((t42 >= 0), 1, -1)
-    t45 = t42 + t44
-    t46 = casadi.if_else((t43 > 0), 1/(t43*2*t43), 0)
-    t47 = -t3
-    t48 = t47 + t11
-    t49 = t12*(1 - t1*t48 + t0*t2)
-    t50 = t1 + t48*t49
-    t51 = t0 - t2*t49
-    t52 = 1 - t49
-    t53 = t12*(1 + c123*t2 - s123*t48)
-    t54 = s123 + t48*t53
-    t55 = c123 - t2*t53
-    t56 = 1 - t53
-    t57 = casadi.sqrt(t51**2 + t52**2)
-    t58 = t57*casadi.if_else((t51 >= 0), 1, -1)
-    t59 = t51 + t58
-    t60 = casadi.if_else((t57 > 0), 1/(t57*(t57 + casadi.fabs(t51))), 0)
-    t61 = t60*(t55*t59 + t52*t56)
-    t62 = t55 - t59*t61
-    t63 = t56 - t52*t61
-    t64 = mu_dot1 + gain1*(t47 + mu1)
-    t65 = casadi.fabs(t63)
-    t66 = t65*casadi.if_else((t63 >= 0), 1, -1)
-    t67 = t63 + t66
-    t68 = casadi.if_else((t65 > 0), 1/(t65*2*t65), 0)
-    t69 = -mu2 + casadi.atan2(s123, c123)
-    t70 = mu_dot2 - gain2*(t69 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t69)))
-    t71 = -t24*(-t23*t6 + t4*t64 + t5*t70)
-    t72 = t6 - t23*t71
-    t73 = t64 + t4*t71
-    t74 = t70 + t5*t71
-    t75 = t33*(t32*t73 + t29*t74)
-    t76 = t73 - t32*t75
-    t77 = t74 - t29*t75
-    t78 = t77 - t45**2*t46*t77
-    t79 = casadi.if_else((t44 != 0), -t78/t44, 0)
-    t80 = casadi.if_else((t31 != 0), -(t76 - t41*t79)/t31, 0)
-    t81 = casadi.if_else((t22 != 0), -(t72 + t27*t80 + t37*t79)/t22, 0)
-    t82 = t79 - t3*t81 + t2*t80
-    t83 = t79 - t1*t81 + t0*t80
-    t84 = t79 - s123*t81 + c123*t80
-    t85 = t12*(t70 + t48*t6 + t2*t64)
-    t86 = t6 - t48*t85
-    t87 = t64 - t2*t85
-    t88 = -t85 + t70
-    t89 = t60*(t59*t87 + t52*t88)
-    t90 = t87 - t59*t89
-    t91 = t88 - t52*t89
-    t92 = t91 - t67**2*t68*t91
-    t93 = casadi.if_else((t66 != 0), -t92/t66, 0)
-    t94 = casadi.if_else((t58 != 0), -(t90 - t62*t93)/t58, 0)
-    t95 = casadi.if_else((t11 != 0), -(t86 + t50*t94 + t54*t93)/t11, 0)
-    t96 = 3 - t1 - s123 + q1 + q2 + q3 + t15 + t47 + damping + qz1 + qz2 + qz3 + t6 + t64 + t70
-    t97 = (casadi.fabs(t96) < casadi.inf)
-    t98 = (damping >= 0)
-    t99 = (damping > 0)
-    t100 = 1e-12*t35
-    t101 = 1e-12*t14
-    t102 = casadi.logic_or(casadi.logic_and(t99, casadi.logic_or(casadi.logic_or((t21 <= t100), (t30 <= t100)), (t43 <= t100))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t10 <= t101), (t57 <= t101)), (t65 <= t101))))
-    t103 = casadi.logic_and(casadi.logic_and(t97, t98), casadi.logic_not(t102))
+    t12 = c123**2 + t0**2 + t9
+    t13 = casadi.sqrt(3 + t8 + t12)
+    t14 = c123 + t0 + t2
+    t15 = t4**2
+    t16 = t5**2
+    t17 = damping**2
+    t18 = t8 + t17
+    t19 = t18**2
+    t20 = casadi.sqrt(t15 + t16 + t19)
+    t21 = t20*casadi.if_else((t18 >= 0), 1, -1)
+    t22 = t12 + t17
+    t23 = 3 + t17
+    t24 = casadi.sqrt(2*t15 + 2*t16 + 2*t14**2 + t19 + t22**2 + t23**2)
+    t25 = (t20 > 0)
+    t26 = casadi.if_else(t25, 1/(t18 + t21), 0)
+    t27 = casadi.if_else(t25, 1 + casadi.fabs(t18)/t20, 0)
+    t28 = t4*t26
+    t29 = t5*t26
+    t30 = -t27*(t4 + t22*t28 + t14*t29)
+    t31 = t4 + t30
+    t32 = t22 + t28*t30
+    t33 = t14 + t29*t30
+    t34 = -t27*(t5 + t23*t29 + t14*t28)
+    t35 = t5 + t34
+    t36 = t14 + t28*t34
+    t37 = t23 + t29*t34
+    t38 = casadi.sqrt(t32**2 + t33**2)
+    t39 = t38*casadi.if_else((t32 >= 0), 1, -1)
+    t40 = (t38 > 0)
+    t41 = casadi.if_else(t40, 1/(t32 + t39), 0)
+    t42 = casadi.if_else(t40, 1 + casadi.fabs(t32)/t38, 0)
+    t43 = t33*t41
+    t44 = t42*(t36 + t43*t37)
+    t45 = -t44 + t36
+    t46 = t37 - t43*t44
+    t47 = casadi.fabs(t46)
+    t48 = t47*casadi.if_else((t46 >= 0), 1, -1)
+    t49 = casadi.if_else((t47 > 0), 2, 0)
+    t50 = (t10 > 0)
+    t51 = casadi.if_else(t50, 1 + casadi.fabs(t3)/t10, 0)
+    t52 = -t3
+    t53 = casadi.if_else(t50, 1/(t52 + t11), 0)
+    t54 = mu_dot1 + gain1*(t52 + mu1)
+    t55 = -t1
+    t56 = t2*t53
+    t57 = t51*(t55 + t53 + t0*t56)
+    t58 = t1 + t57
+    t59 = t53*t57
+    t60 = t0 - t2*t59
+    t61 = 1 - t59
+    t62 = casadi.sqrt(t60**2 + t61**2)
+    t63 = t62*casadi.if_else((t60 >= 0), 1, -1)
+    t64 = -s123
+    t65 = t51*(t64 + t53 + c123*t56)
+    t66 = s123 + t65
+    t67 = t53*t65
+    t68 = c123 - t2*t67
+    t69 = 1 - t67
+    t70 = (t62 > 0)
+    t71 = casadi.if_else(t70, 1/(t60 + t63), 0)
+    t72 = casadi.if_else(t70, 1 + casadi.fabs(t60)/t62, 0)
+    t73 = t61*t71
+    t74 = t72*(t68 + t73*t69)
+    t75 = -t74 + t68
+    t76 = t69 - t73*t74
+    t77 = casadi.fabs(t76)
+    t78 = t77*casadi.if_else((t76 >= 0), 1, -1)
+    t79 = casadi.if_else((t77 > 0), 2, 0)
+    t80 = -mu2 + casadi.atan2(s123, c123)
+    t81 = mu_dot2 - gain2*(t80 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t80)))
+    t82 = -t27*(-t6 + t28*t54 + t29*t81)
+    t83 = -t82 + t6
+    t84 = t54 + t28*t82
+    t85 = t81 + t29*t82
+    t86 = t42*(t84 + t43*t85)
+    t87 = -t86 + t84
+    t88 = t85 - t43*t86
+    t89 = t88 - t49*t88
+    t90 = casadi.if_else((t48 != 0), -t89/t48, 0)
+    t91 = casadi.if_else((t39 != 0), -(t87 - t45*t90)/t39, 0)
+    t92 = casadi.if_else((t21 != 0), -(t83 + t31*t91 + t35*t90)/t21, 0)
+    t93 = t90 - t3*t92 + t2*t91
+    t94 = t90 - t1*t92 + t0*t91
+    t95 = t90 - s123*t92 + c123*t91
+    t96 = t51*(t6 + t53*t81 + t56*t54)
+    t97 = -t96 + t6
+    t98 = 3 + q1 + q2 + q3 + t14 + t52 + t55 + t64 + damping + qz1 + qz2 + qz3 + t6 + t54 + t81
+    t99 = t53*t96
+    t100 = t54 - t2*t99
+    t101 = -t99 + t81
+    t102 = t72*(t100 + t73*t101)
+    t103 = -t102 + t100
+    t104 = t101 - t73*t102
+    t105 = t104 - t79*t104
+    t106 = casadi.if_else((t78 != 0), -t105/t78, 0)
+    t107 = casadi.if_else((t63 != 0), -(t103 - t75*t106)/t63, 0)
+    t108 = casadi.if_else((t11 != 0), -(t97 + t58*t107 + t66*t106)/t11, 0)
+    t109 = (casadi.fabs(t98) < casadi.inf)
+    t110 = (damping >= 0)
+    t111 = (damping > 0)
+    t112 = 1e-12*t24
+    t113 = 1e-12*t13
+    t114 = casadi.logic_or(casadi.logic_and(t111, casadi.logic_or(casadi.logic_or((t20 <= t112), (t38 <= t112)), (t47 <= t112))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t10 <= t113), (t62 <= t113)), (t77 <= t113))))
+    t115 = casadi.logic_and(casadi.logic_and(t109, t110), casadi.logic_not(t114))
     q_dot = casadi.SX(3, 1)
-    q_dot[0, 0] = casadi.if_else(t103, casadi.if_else(t99, t82, t95), 0)
-    q_dot[1, 0] = casadi.if_else(t103, casadi.if_else(t99, t83, t94), 0)
-    q_dot[2, 0] = casadi.if_else(t103, casadi.if_else(t99, t84, t93), 0)
+    q_dot[0, 0] = casadi.if_else(t115, casadi.if_else(t111, t93, t108), 0)
+    q_dot[1, 0] = casadi.if_else(t115, casadi.if_else(t111, t94, t107), 0)
+    q_dot[2, 0] = casadi.if_else(t115, casadi.if_else(t111, t95, t106), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t97, t98)), 2, casadi.if_else(t102, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t109, t110)), 2, casadi.if_else(t114, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 194 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 185 operations."""
     mu0 = target[0]
     mu1 = target[1]
     mu2 = target[2]
@@ -1672,7 +1717,7 @@ def _ik_numeric_step(target, q, damping):
     t2 = c1 + t0
     t3 = s1 + t1
     t4 = s123**2 + t1**2 + t3**2
-    t5 = t0*t1 + c123*s123 + t2*t3
+    t5 = t2*t3 + t0*t1 + c123*s123
     t6 = t3 + t1 + s123
     t7 = c123**2 + t0**2 + t2**2
     t8 = c123 + t0 + t2
@@ -1685,51 +1730,55 @@ def _ik_numeric_step(target, q, damping):
     t15 = damping + t4
     t16 = casadi.sqrt(t15**2 + t5**2 + t6**2)
     t17 = casadi.if_else((t15 >= 0), 1, -1)*t16
-    t18 = t15 + t17
-    t19 = casadi.if_else((t16 > 0), 1/(t16*(t16 + casadi.fabs(t15))), 0)
-    t20 = t19*(t9*t18 - t5*t10 + t6*t13)
-    t21 = t9 - t18*t20
-    t22 = t10 + t5*t20
-    t23 = -t13 + t6*t20
-    t24 = damping + t7
-    t25 = -t19*(t6*t8 + t5*t18 + t24*t5)
-    t26 = t5 + t18*t25
-    t27 = t24 + t5*t25
-    t28 = t8 + t6*t25
-    t29 = casadi.sqrt(t27**2 + t28**2)
-    t30 = t29*casadi.if_else((t27 >= 0), 1, -1)
-    t31 = t27 + t30
-    t32 = casadi.if_else((t29 > 0), 1/(t29*(t29 + casadi.fabs(t27))), 0)
-    t33 = t32*(t22*t31 + t28*t23)
-    t34 = t22 - t31*t33
-    t35 = t23 - t28*t33
-    t36 = 3 + damping
-    t37 = -t19*(t5*t8 + t6*t18 + t36*t6)
-    t38 = t6 + t18*t37
-    t39 = t8 + t5*t37
-    t40 = t36 + t6*t37
-    t41 = t32*(t39*t31 + t28*t40)
-    t42 = t39 - t31*t41
-    t43 = t40 - t28*t41
-    t44 = casadi.fabs(t43)
-    t45 = t44*casadi.if_else((t43 >= 0), 1, -1)
-    t46 = t43 + t45
-    t47 = casadi.if_else((t44 > 0), 1/(t44*2*t44), 0)
-    t48 = t35 - t35*t46**2*t47
-    t49 = casadi.if_else((t45 != 0), -t48/t45, 0)
-    t50 = casadi.if_else((t30 != 0), -(t34 - t42*t49)/t30, 0)
-    t51 = casadi.if_else((t17 != 0), -(t21 + t26*t50 + t38*t49)/t17, 0)
-    t52 = q1 + t49 - t3*t51 + t2*t50
-    t53 = q2 + t49 - t1*t51 + t0*t50
-    t54 = q3 + t49 - s123*t51 + c123*t50
+    t18 = (t16 > 0)
+    t19 = casadi.if_else(t18, 1/(t15 + t17), 0)
+    t20 = casadi.if_else(t18, 1 + casadi.fabs(t15)/t16, 0)
+    t21 = damping + t7
+    t22 = t5*t19
+    t23 = t6*t19
+    t24 = -t20*(t5 + t21*t22 + t23*t8)
+    t25 = t5 + t24
+    t26 = t21 + t22*t24
+    t27 = t8 + t23*t24
+    t28 = t20*(t9 - t22*t10 + t23*t13)
+    t29 = -t28 + t9
+    t30 = t10 + t22*t28
+    t31 = -t13 + t23*t28
+    t32 = casadi.sqrt(t26**2 + t27**2)
+    t33 = t32*casadi.if_else((t26 >= 0), 1, -1)
+    t34 = 3 + damping
+    t35 = -t20*(t6 + t22*t8 + t23*t34)
+    t36 = t6 + t35
+    t37 = t8 + t22*t35
+    t38 = t34 + t23*t35
+    t39 = (t32 > 0)
+    t40 = casadi.if_else(t39, 1/(t26 + t33), 0)
+    t41 = casadi.if_else(t39, 1 + casadi.fabs(t26)/t32, 0)
+    t42 = t27*t40
+    t43 = t41*(t37 + t42*t38)
+    t44 = -t43 + t37
+    t45 = t38 - t42*t43
+    t46 = t41*(t30 + t42*t31)
+    t47 = -t46 + t30
+    t48 = t31 - t42*t46
+    t49 = casadi.fabs(t45)
+    t50 = t49*casadi.if_else((t45 >= 0), 1, -1)
+    t51 = casadi.if_else((t49 > 0), 2, 0)
+    t52 = t48 - t48*t51
+    t53 = casadi.if_else((t50 != 0), -t52/t50, 0)
+    t54 = casadi.if_else((t33 != 0), -(t47 - t44*t53)/t33, 0)
+    t55 = casadi.if_else((t17 != 0), -(t29 + t25*t54 + t36*t53)/t17, 0)
+    t56 = q1 + t53 - t3*t55 + t2*t54
+    t57 = q2 + t53 - t1*t55 + t0*t54
+    t58 = q3 + t53 - s123*t55 + c123*t54
     q_start = casadi.SX(3, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
     q_start[2, 0] = q3
     q_next = casadi.SX(3, 1)
-    q_next[0, 0] = t52
-    q_next[1, 0] = t53
-    q_next[2, 0] = t54
+    q_next[0, 0] = t56
+    q_next[1, 0] = t57
+    q_next[2, 0] = t58
     cost = casadi.SX(1, 1)
     cost[0, 0] = casadi.if_else((casadi.fabs(t11) < casadi.inf), t14, -1)
     return [q_start, q_next, cost]

@@ -101,31 +101,31 @@ puma560_real puma560_manipulability(const puma560_real q[PUMA560_DOF]);
 puma560_real puma560_jacobian_det(const puma560_real q[PUMA560_DOF]);
 
 /* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
- * Result: dw[i], i < 6. 565 operations. */
+ * Result: dw[i], i < 6. 545 operations. */
 void puma560_manipulability_gradient(const puma560_real q[PUMA560_DOF], puma560_real dw[PUMA560_DOF]);
 
 /* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
- * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2538 operations. */
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2549 operations. */
 void puma560_velocity_ellipsoid(const puma560_real q[PUMA560_DOF], puma560_real U_v[9], puma560_real s_v[3], puma560_real U_w[9], puma560_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 8931 operations. */
+ * Result: returned as a scalar. 8914 operations. */
 puma560_real puma560_condition_number(const puma560_real q[PUMA560_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1219 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1195 operations. */
 int puma560_velocity_ik(const puma560_real q[PUMA560_DOF], const puma560_real mu_dot[PUMA560_TASK_DIM], puma560_real damping, puma560_real q_dot[PUMA560_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1225 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1201 operations. */
 int puma560_velocity_ik_nullspace(const puma560_real q[PUMA560_DOF], const puma560_real mu_dot[PUMA560_TASK_DIM], const puma560_real z[PUMA560_DOF], puma560_real damping, puma560_real q_dot[PUMA560_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1386 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1362 operations. */
 int puma560_resolved_rate(const puma560_real q[PUMA560_DOF], const puma560_real target[16], const puma560_real target_rate[PUMA560_TASK_DIM], const puma560_real gain[PUMA560_TASK_DIM], const puma560_real z[PUMA560_DOF], puma560_real damping, puma560_real q_dot[PUMA560_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 899 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 879 operations. */
 puma560_real puma560_ik_numeric_step(const puma560_real target[16], const puma560_real q[PUMA560_DOF], puma560_real damping, puma560_real q_start[PUMA560_DOF], puma560_real q_next[PUMA560_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.

@@ -99,31 +99,31 @@ rexarm_real rexarm_manipulability(const rexarm_real q[REXARM_DOF]);
 rexarm_real rexarm_jacobian_det(const rexarm_real q[REXARM_DOF]);
 
 /* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
- * Result: dw[i], i < 4. 518 operations. */
+ * Result: dw[i], i < 4. 505 operations. */
 void rexarm_manipulability_gradient(const rexarm_real q[REXARM_DOF], rexarm_real dw[REXARM_DOF]);
 
 /* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
- * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2495 operations. */
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2504 operations. */
 void rexarm_velocity_ellipsoid(const rexarm_real q[REXARM_DOF], rexarm_real U_v[9], rexarm_real s_v[3], rexarm_real U_w[9], rexarm_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 3013 operations. */
+ * Result: returned as a scalar. 3010 operations. */
 rexarm_real rexarm_condition_number(const rexarm_real q[REXARM_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 4; returned as a scalar. 599 operations. */
+ * Result: q_dot[i], i < 4; returned as a scalar. 574 operations. */
 int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], rexarm_real damping, rexarm_real q_dot[REXARM_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 4; returned as a scalar. 603 operations. */
+ * Result: q_dot[i], i < 4; returned as a scalar. 578 operations. */
 int rexarm_velocity_ik_nullspace(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], const rexarm_real z[REXARM_DOF], rexarm_real damping, rexarm_real q_dot[REXARM_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 4; returned as a scalar. 624 operations. */
+ * Result: q_dot[i], i < 4; returned as a scalar. 599 operations. */
 int rexarm_resolved_rate(const rexarm_real q[REXARM_DOF], const rexarm_real target[REXARM_TASK_DIM], const rexarm_real target_rate[REXARM_TASK_DIM], const rexarm_real gain[REXARM_TASK_DIM], const rexarm_real z[REXARM_DOF], rexarm_real damping, rexarm_real q_dot[REXARM_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 4; q_next[i], i < 4; returned as a scalar. 395 operations. */
+ * Result: q_start[i], i < 4; q_next[i], i < 4; returned as a scalar. 383 operations. */
 rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], const rexarm_real q[REXARM_DOF], rexarm_real damping, rexarm_real q_start[REXARM_DOF], rexarm_real q_next[REXARM_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.

@@ -1018,7 +1018,7 @@ def _jacobian_det(q):
 
 
 def _manipulability_gradient(q):
-    """D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): 518 operations."""
+    """D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): 505 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1069,152 +1069,154 @@ def _manipulability_gradient(q):
     t31 = casadi.sqrt(t2**2 + t14*t28 + t14*t29 + t30 + t7**2 + t8**2 + t19**2 + 3*t24**2 + t14*t27)
     t32 = casadi.sqrt(t30)
     t33 = t32*casadi.if_else((t6 <= 0), 1, -1)
-    t34 = -t6 + t33
-    t35 = casadi.if_else((t32 > 0), 1/(t32*(t32 + casadi.fabs(t6))), 0)
-    t36 = 1 - t34**2*t35
-    t37 = casadi.if_else((t33 > 0), -1, 1)
-    t38 = c1*s1
-    t39 = t35*(t2*t34 + t27*t38 + t28*t38 + t29*t38)
-    t40 = t2 - t34*t39
-    t41 = s1*t11
-    t42 = c1*t39
-    t43 = -t41 + t11*t42
-    t44 = s1*t10
-    t45 = -t44 + t10*t42
-    t46 = s1*t9
-    t47 = -t46 + t9*t42
-    t48 = casadi.sqrt(t43**2 + t45**2 + t47**2)
-    t49 = t48*casadi.if_else((t43 >= 0), 1, -1)
-    t50 = t43 + t49
-    t51 = casadi.if_else((t48 > 0), 1/(t48*(t48 + casadi.fabs(t43))), 0)
-    t52 = casadi.if_else((t49 > 0), -t37, t37)
-    t53 = c1*t11
-    t54 = c1*t10
-    t55 = c1*t19
-    t56 = -t35*(t7*t53 + t8*t54 + t9*t55)
-    t57 = t7 + t53*t56
-    t58 = t8 + t54*t56
-    t59 = c1*t9
-    t60 = t19 + t59*t56
-    t61 = -t35*(t53*t24 + t54*t24 + t59*t24)
-    t62 = t24 + t53*t61
-    t63 = t24 + t54*t61
-    t64 = t24 + t59*t61
-    t65 = t51*(t57*t50 + t45*t58 + t47*t60)
-    t66 = t57 - t50*t65
-    t67 = t58 - t45*t65
-    t68 = t60 - t47*t65
-    t69 = t51*(t62*t50 + t45*t63 + t47*t64)
-    t70 = t62 - t50*t69
-    t71 = t63 - t45*t69
-    t72 = t64 - t47*t69
-    t73 = t68**2
-    t74 = casadi.sqrt(t73 + t67**2)
-    t75 = t74*casadi.if_else((t67 >= 0), 1, -1)
-    t76 = t67 + t75
-    t77 = casadi.if_else((t74 > 0), 1/(t74*(t74 + casadi.fabs(t67))), 0)
-    t78 = t77*(t71*t76 + t68*t72)
-    t79 = t71 - t76*t78
-    t80 = t72 - t68*t78
-    t81 = 1 - t76**2*t77
-    t82 = -(t66*t79 + t70*t75)
-    t83 = casadi.if_else((t75 > 0), -t52, t52)
-    t84 = casadi.fabs(t80)
-    t85 = casadi.if_else((t80 >= 0), 1, -1)*t84
-    t86 = t80 + t85
-    t87 = casadi.if_else((t84 > 0), 1/(t84*2*t84), 0)
-    t88 = 1 - t86**2*t87
-    t89 = casadi.if_else((t85 > 0), -t83, t83)
-    t90 = t77*t88
-    t91 = t88 - t73*t90
-    t92 = t68*t76
-    t93 = t77*t92
-    t94 = t51*(t45*t81 - t47*t93)
-    t95 = t81 - t45*t94
-    t96 = t47*t94 + t93
-    t97 = t90*t92
-    t98 = t51*(t47*t91 - t45*t97)
-    t99 = t45*t98 + t97
-    t100 = t91 - t47*t98
-    t101 = t50*t51
-    t102 = 1 - t50*t101
-    t103 = t45*t101
-    t104 = t47*t101
-    t105 = t35*(-t53*t102 + t54*t103 + t59*t104)
-    t106 = t102 + t53*t105
-    t107 = -t103 + t54*t105
-    t108 = -t104 + t59*t105
-    t109 = t50*t94
-    t110 = t35*(t53*t109 - t54*t95 + t59*t96)
-    t111 = -t109 + t53*t110
-    t112 = t95 + t54*t110
-    t113 = -t96 + t59*t110
-    t114 = t50*t98
-    t115 = t35*(t53*t114 + t54*t99 - t59*t100)
-    t116 = -t114 + t53*t115
-    t117 = -t99 + t54*t115
-    t118 = t100 + t59*t115
-    t119 = t34*t49
-    t120 = t56*t119
-    t121 = -t40*t66 + t120
-    t122 = t75*t119
-    t123 = -(t40*t82 + t79*t120 + t61*t122)
-    t124 = t75*t85
-    t125 = t34*t105*t124
-    t126 = t85*t121
-    t127 = t34*t110
-    t128 = t34*t115
-    t129 = -t49*t36*t124 + t40*t125 - t126*t127 + t123*t128
-    t130 = t33*t85
-    t131 = t33*t82
-    t132 = t33*t125 + t66*t127*t130 - t128*t131
-    t133 = t35*t85*t122
-    t134 = t106*t124
-    t135 = t116*t123 + t53*t133 + t40*t134 - t111*t126
-    t136 = t111*t130
-    t137 = t33*t134 + t66*t136 - t116*t131
-    t138 = t33*t49
-    t139 = t79*t138
-    t140 = t49*t136 + t116*t139
-    t141 = t107*t124
-    t142 = t117*t123 + t54*t133 + t40*t141 - t112*t126
-    t143 = t112*t130
-    t144 = t33*t141 + t66*t143 - t117*t131
-    t145 = t49*t143 + t117*t139
-    t146 = t108*t124
-    t147 = t118*t123 + t59*t133 + t40*t146 - t113*t126
-    t148 = t113*t130
-    t149 = t33*t146 + t66*t148 - t118*t131
-    t150 = t49*t148 + t118*t139
-    t151 = 1e-12*t31
-    t152 = casadi.if_else(casadi.logic_or(casadi.logic_or(casadi.logic_or((t32 <= t151), (t48 <= t151)), (t74 <= t151)), (t84 <= t151)), 0, t89)
-    t153 = c1*t25
-    t154 = c1*c234
-    t155 = -(t153 + t26*t154)
-    t156 = -(s1*t25 + t4*t26)
-    t157 = t75*t138
-    t158 = (-t4*t155 + t154*t156)*t157
-    t159 = -t152*(t2*t129 + t6*t132 - 0.1*c1*s234*t149 + t41*t135 - t53*t137 + t116*t158 + t44*t142 - t54*t144 + t117*t158 + t46*t147 + t118*t158)
-    t160 = c1*t135
-    t161 = s1*t137
-    t162 = c1*t142
-    t163 = s1*t144
-    t164 = -t157*(c1*s234*t155 + s1*s234*t156)
-    t165 = s1*t19*t149 + t17*t150 - t116*t164 - t117*t164 + t55*t147 - t118*t164
-    t166 = t152*(t17*t140 + t17*t145 + t165 + t46*t129 - t59*t132 + t19*t160 + t19*t161 + t19*t162 + t19*t163)
-    t167 = t16*t145 + t8*t162 + t8*t163 + t165
-    t168 = t152*(t15*t140 + t41*t129 - t53*t132 + t7*t160 + t7*t161 + t167)
-    t169 = t152*(t16*t140 + t167 + t44*t129 - t54*t132 + t8*t160 + t8*t161)
+    t34 = casadi.if_else((t33 > 0), -1, 1)
+    t35 = (t32 > 0)
+    t36 = casadi.if_else(t35, 1/(-t6 + t33), 0)
+    t37 = casadi.if_else(t35, 1 + casadi.fabs(t6)/t32, 0)
+    t38 = 1 - t37
+    t39 = c1*t36
+    t40 = s1*t39
+    t41 = t37*(t2 + t27*t40 + t28*t40 + t29*t40)
+    t42 = -t41 + t2
+    t43 = s1*t11
+    t44 = c1*t11
+    t45 = t36*t41
+    t46 = -t43 + t44*t45
+    t47 = s1*t10
+    t48 = c1*t10
+    t49 = -t47 + t45*t48
+    t50 = s1*t9
+    t51 = t9*t39
+    t52 = -t50 + t51*t41
+    t53 = casadi.sqrt(t46**2 + t49**2 + t52**2)
+    t54 = t53*casadi.if_else((t46 >= 0), 1, -1)
+    t55 = casadi.if_else((t54 > 0), -t34, t34)
+    t56 = t44*t36
+    t57 = t48*t36
+    t58 = -t37*(t7*t56 + t8*t57 + t19*t51)
+    t59 = t7 + t58*t56
+    t60 = t8 + t58*t57
+    t61 = t19 + t51*t58
+    t62 = -t37*(t24*t56 + t24*t57 + t51*t24)
+    t63 = t24 + t62*t56
+    t64 = t24 + t62*t57
+    t65 = t24 + t51*t62
+    t66 = c1*t19
+    t67 = (t53 > 0)
+    t68 = casadi.if_else(t67, 1/(t46 + t54), 0)
+    t69 = casadi.if_else(t67, 1 + casadi.fabs(t46)/t53, 0)
+    t70 = 1 - t69
+    t71 = t49*t68
+    t72 = t52*t68
+    t73 = t69*(t59 + t60*t71 + t61*t72)
+    t74 = -t73 + t59
+    t75 = t60 - t73*t71
+    t76 = t61 - t73*t72
+    t77 = t69*(t63 + t64*t71 + t65*t72)
+    t78 = -t77 + t63
+    t79 = t64 - t77*t71
+    t80 = t65 - t77*t72
+    t81 = t76**2
+    t82 = casadi.sqrt(t75**2 + t81)
+    t83 = t82*casadi.if_else((t75 >= 0), 1, -1)
+    t84 = casadi.if_else((t83 > 0), -t55, t55)
+    t85 = (t82 > 0)
+    t86 = casadi.if_else(t85, 1/(t75 + t83), 0)
+    t87 = casadi.if_else(t85, 1 + casadi.fabs(t75)/t82, 0)
+    t88 = 1 - t87
+    t89 = t76*t86
+    t90 = t87*(t79 + t80*t89)
+    t91 = -t90 + t79
+    t92 = t80 - t90*t89
+    t93 = -(t74*t91 + t78*t83)
+    t94 = casadi.fabs(t92)
+    t95 = casadi.if_else((t92 >= 0), 1, -1)*t94
+    t96 = casadi.if_else((t94 > 0), 2, 0)
+    t97 = 1 - t96
+    t98 = t97 - t86**2*t87*t97*t81
+    t99 = casadi.if_else((t95 > 0), -t84, t84)
+    t100 = t87*t89
+    t101 = t69*(t88*t71 - t72*t100)
+    t102 = t88 - t101*t71
+    t103 = t100 + t101*t72
+    t104 = t37*(t101*t56 - t102*t57 + t51*t103)
+    t105 = -t101 + t104*t56
+    t106 = t102 + t104*t57
+    t107 = -t103 + t51*t104
+    t108 = t97*t100
+    t109 = t69*(-t71*t108 + t98*t72)
+    t110 = t108 + t109*t71
+    t111 = t98 - t109*t72
+    t112 = t37*(t109*t56 + t110*t57 - t51*t111)
+    t113 = -t109 + t112*t56
+    t114 = -t110 + t112*t57
+    t115 = t111 + t51*t112
+    t116 = t69*t71
+    t117 = t69*t72
+    t118 = t37*(-t70*t56 + t57*t116 + t51*t117)
+    t119 = t70 + t118*t56
+    t120 = -t116 + t118*t57
+    t121 = -t117 + t51*t118
+    t122 = t58*t54
+    t123 = -t42*t74 + t122
+    t124 = t54*t83
+    t125 = -(t42*t93 + t91*t122 + t62*t124)
+    t126 = t95*t124
+    t127 = t83*t95
+    t128 = t118*t127
+    t129 = t95*t123
+    t130 = t112*t125 - t38*t126 + t42*t128 - t104*t129
+    t131 = t33*t95
+    t132 = t74*t131
+    t133 = t33*t93
+    t134 = t33*t128 + t104*t132 - t112*t133
+    t135 = t37*t126
+    t136 = t119*t127
+    t137 = t113*t125 + t56*t135 + t42*t136 - t105*t129
+    t138 = t33*t136 + t105*t132 - t113*t133
+    t139 = t54*t131
+    t140 = t33*t113
+    t141 = t54*t91
+    t142 = t105*t139 + t140*t141
+    t143 = t120*t127
+    t144 = t114*t125 + t57*t135 + t42*t143 - t106*t129
+    t145 = t33*t143 + t106*t132 - t114*t133
+    t146 = t33*t141
+    t147 = t106*t139 + t114*t146
+    t148 = t107*t139 + t115*t146
+    t149 = t121*t127
+    t150 = t115*t125 + t51*t135 + t42*t149 - t107*t129
+    t151 = t33*t149 + t107*t132 - t115*t133
+    t152 = 1e-12*t31
+    t153 = casadi.if_else(casadi.logic_or(casadi.logic_or(casadi.logic_or((t32 <= t152), (t53 <= t152)), (t82 <= t152)), (t94 <= t152)), 0, t99)
+    t154 = c1*t25
+    t155 = c1*c234
+    t156 = -(t154 + t26*t155)
+    t157 = -(s1*t25 + t4*t26)
+    t158 = t124*(-t4*t156 + t155*t157)
+    t159 = t33*t158
+    t160 = -t153*(t2*t130 + t6*t134 - 0.1*c1*s234*t151 + t43*t137 - t44*t138 + t140*t158 + t47*t144 - t48*t145 + t114*t159 + t50*t150 + t115*t159)
+    t161 = c1*t137
+    t162 = s1*t138
+    t163 = c1*t144
+    t164 = s1*t145
+    t165 = -t124*(c1*s234*t156 + s1*s234*t157)
+    t166 = t33*t165
+    t167 = s1*t19*t151 + t17*t148 - t140*t165 - t114*t166 + t150*t66 - t115*t166
+    t168 = t153*(t17*t142 + t17*t147 + t167 + t50*t130 - c1*t9*t134 + t19*t161 + t19*t162 + t19*t163 + t19*t164)
+    t169 = t16*t147 + t8*t163 + t8*t164 + t167
+    t170 = t153*(t15*t142 + t43*t130 - t44*t134 + t7*t161 + t7*t162 + t169)
+    t171 = t153*(t16*t142 + t169 + t47*t130 - t48*t134 + t8*t161 + t8*t162)
     dw = casadi.SX(4, 1)
-    dw[0, 0] = t159
-    dw[1, 0] = t168
-    dw[2, 0] = t169
-    dw[3, 0] = t166
+    dw[0, 0] = t160
+    dw[1, 0] = t170
+    dw[2, 0] = t171
+    dw[3, 0] = t168
     return [dw]
 
 
 def _velocity_ellipsoid(q):
-    """Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: 2495 operations."""
+    """Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: 2504 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1251,1128 +1253,1135 @@ def _velocity_ellipsoid(q):
     t17 = 0.01*s234**2
     t18 = casadi.sqrt(t5**2 + t11*t16 + t11*t15 + t11*t17)
     t19 = t18*casadi.if_else((t5 <= 0), 1, -1)
-    t20 = -t5 + t19
-    t21 = casadi.if_else((t18 > 0), 1/(t18*(t18 + casadi.fabs(t5))), 0)
-    t22 = t19**2
-    t23 = c1*s1
-    t24 = t21*(t17*t23 + t2*t20 + t15*t23 + t16*t23)
-    t25 = t2 - t20*t24
-    t26 = c1*t24
-    t27 = -s1*t10 + t10*t26
-    t28 = -s1*t9 + t9*t26
-    t29 = -s1*t8 + t8*t26
-    t30 = casadi.sqrt(t27**2 + t28**2 + t29**2)
-    t31 = t30*casadi.if_else((t27 >= 0), 1, -1)
-    t32 = t27 + t31
-    t33 = casadi.if_else((t30 > 0), 1/(t30*(t30 + casadi.fabs(t27))), 0)
-    t34 = t25**2 + t31**2
-    t35 = c1*t10
-    t36 = c1*t9
-    t37 = c1*t8
-    t38 = -t21*(t37*t14 + t35*t6 + t36*t7)
+    t20 = t19**2
+    t21 = (t18 > 0)
+    t22 = casadi.if_else(t21, 1/(-t5 + t19), 0)
+    t23 = casadi.if_else(t21, 1 + casadi.fabs(t5)/t18, 0)
+    t24 = c1*t22
+    t25 = s1*t24
+    t26 = t23*(t2 + t15*t25 + t17*t25 + t16*t25)
+    t27 = -t26 + t2
+    t28 = t24*t26
+    t29 = -s1*t10 + t10*t28
+    t30 = -s1*t9 + t9*t28
+    t31 = -s1*t8 + t8*t28
+    t32 = casadi.sqrt(t29**2 + t30**2 + t31**2)
+    t33 = t32*casadi.if_else((t29 >= 0), 1, -1)
+    t34 = t27**2 + t33**2
+    t35 = t10*t24
+    t36 = t9*t24
+    t37 = t8*t24
+    t38 = -t23*(t35*t6 + t36*t7 + t37*t14)
     t39 = t6 + t35*t38
     t40 = t7 + t36*t38
     t41 = t14 + t37*t38
-    t42 = t33*(t39*t32 + t28*t40 + t29*t41)
-    t43 = t39 - t32*t42
-    t44 = t40 - t28*t42
-    t45 = t41 - t29*t42
-    t46 = casadi.sqrt(t44**2 + t45**2)
-    t47 = t46*casadi.if_else((t44 >= 0), 1, -1)
-    t48 = t47**2
-    t49 = t19*t25
-    t50 = (t49 != 0)
-    t51 = (-t22 + t34)/casadi.if_else(t50, -2*t49, 1)
-    t52 = casadi.fabs(t51)
-    t53 = (t52 >= 1)
-    t54 = 1/casadi.fabs(casadi.if_else(t53, t51, 1))
-    t55 = casadi.if_else(t50, casadi.if_else((t51 >= 0), 1, -1)*casadi.if_else(t53, t54/(1 + casadi.sqrt(1 + t54**2)), 1/(t52 + casadi.sqrt(1 + t52**2))), 0)
-    t56 = 1/casadi.sqrt(1 + t55**2)
-    t57 = t49*t55
-    t58 = t57 + t22
-    t59 = -t57 + t34
-    t60 = t19*t56
-    t61 = t25*t56
-    t62 = t60 + t61*t55
-    t63 = t61 - t60*t55
-    t64 = t20*t38
-    t65 = t48 + t64**2 + t43**2
-    t66 = t31*t56
-    t67 = t66*t55
-    t68 = t64*t62 + t67*t43
-    t69 = (t68 != 0)
-    t70 = (-t58 + t65)/casadi.if_else(t69, 2*t68, 1)
-    t71 = casadi.fabs(t70)
-    t72 = (t71 >= 1)
-    t73 = 1/casadi.fabs(casadi.if_else(t72, t70, 1))
-    t74 = casadi.if_else(t69, casadi.if_else((t70 >= 0), 1, -1)*casadi.if_else(t72, t73/(1 + casadi.sqrt(1 + t73**2)), 1/(t71 + casadi.sqrt(1 + t71**2))), 0)
-    t75 = 1/casadi.sqrt(1 + t74**2)
-    t76 = t68*t74
-    t77 = -t76 + t58
-    t78 = t76 + t65
-    t79 = t62*t75
-    t80 = t64*t75
-    t81 = -t79 + t80*t74
-    t82 = t80 + t79*t74
-    t83 = t67*t75
-    t84 = t43*t75
-    t85 = t83 - t84*t74
-    t86 = t84 + t83*t74
-    t87 = t63*t82 + t66*t86
-    t88 = (t87 != 0)
-    t89 = (-t59 + t78)/casadi.if_else(t88, -2*t87, 1)
-    t90 = casadi.fabs(t89)
-    t91 = (t90 >= 1)
-    t92 = 1/casadi.fabs(casadi.if_else(t91, t89, 1))
-    t93 = casadi.if_else(t88, casadi.if_else((t89 >= 0), 1, -1)*casadi.if_else(t91, t92/(1 + casadi.sqrt(1 + t92**2)), 1/(t90 + casadi.sqrt(1 + t90**2))), 0)
-    t94 = 1/casadi.sqrt(1 + t93**2)
-    t95 = t87*t93
-    t96 = t95 + t59
-    t97 = -t95 + t78
-    t98 = t63*t94
-    t99 = t82*t94
-    t100 = t98 + t99*t93
-    t101 = -t99 + t98*t93
-    t102 = t56*t94
-    t103 = t31*t102
-    t104 = t86*t94
-    t105 = t103 + t104*t93
-    t106 = t104 - t103*t93
-    t107 = t102*t55
-    t108 = t102*t93
-    t109 = t74*t75
-    t110 = t107 - t108*t109
-    t111 = t108 - t107*t109
-    t112 = t107*t93
-    t113 = t102 + t109*t112
-    t114 = t112 + t102*t109
-    t115 = t93*t94
-    t116 = t81*t100 - t85*t105 + t48*t109*t115*t75
-    t117 = (t116 != 0)
-    t118 = (-t77 + t96)/casadi.if_else(t117, 2*t116, 1)
-    t119 = casadi.fabs(t118)
-    t120 = (t119 >= 1)
-    t121 = 1/casadi.fabs(casadi.if_else(t120, t118, 1))
-    t122 = casadi.if_else(t117, casadi.if_else((t118 >= 0), 1, -1)*casadi.if_else(t120, t121/(1 + casadi.sqrt(1 + t121**2)), 1/(t119 + casadi.sqrt(1 + t119**2))), 0)
-    t123 = 1/casadi.sqrt(1 + t122**2)
-    t124 = t116*t122
-    t125 = -t124 + t77
-    t126 = t124 + t96
-    t127 = t81*t123
-    t128 = t100*t123
-    t129 = t127 - t128*t122
-    t130 = t128 + t127*t122
-    t131 = t85*t123
-    t132 = t105*t123
-    t133 = t131 + t132*t122
-    t134 = -t132 + t131*t122
-    t135 = t75*t123
-    t136 = t135*t74
-    t137 = t47*t136
-    t138 = t115*t135
-    t139 = -t136 + t138*t122
-    t140 = t138 + t136*t122
-    t141 = t47*t138
-    t142 = t137 - t141*t122
-    t143 = t141 + t137*t122
-    t144 = t135*t56
-    t145 = t110*t123
-    t146 = t144 - t145*t122
-    t147 = t145 + t144*t122
-    t148 = t144*t55
-    t149 = t113*t123
-    t150 = t148 + t149*t122
-    t151 = t149 - t148*t122
-    t152 = t75*t94
-    t153 = t101*t129 + t106*t133 - t47*t152*t142
-    t154 = (t153 != 0)
-    t155 = (-t125 + t97)/casadi.if_else(t154, 2*t153, 1)
-    t156 = casadi.fabs(t155)
-    t157 = (t156 >= 1)
-    t158 = 1/casadi.fabs(casadi.if_else(t157, t155, 1))
-    t159 = casadi.if_else(t154, casadi.if_else((t155 >= 0), 1, -1)*casadi.if_else(t157, t158/(1 + casadi.sqrt(1 + t158**2)), 1/(t156 + casadi.sqrt(1 + t156**2))), 0)
-    t160 = 1/casadi.sqrt(1 + t159**2)
-    t161 = t153*t159
-    t162 = -t161 + t125
-    t163 = t161 + t97
-    t164 = t129*t160
-    t165 = t101*t160
-    t166 = t164 - t159*t165
-    t167 = t165 + t164*t159
-    t168 = t133*t160
-    t169 = t106*t160
-    t170 = t168 - t159*t169
-    t171 = t169 + t159*t168
-    t172 = t142*t160
-    t173 = t152*t160
-    t174 = t47*t173
-    t175 = t172 + t159*t174
-    t176 = -t174 + t159*t172
-    t177 = t130*t167 + t134*t171 + t143*t176
-    t178 = t146*t160
-    t179 = t114*t160
-    t180 = t178 - t159*t179
-    t181 = t179 + t159*t178
-    t182 = t150*t160
-    t183 = t111*t160
-    t184 = t182 + t159*t183
-    t185 = t183 - t159*t182
-    t186 = t139*t160
-    t187 = t186 - t159*t173
-    t188 = t173 + t159*t186
-    t189 = (t177 != 0)
-    t190 = (-t126 + t163)/casadi.if_else(t189, 2*t177, 1)
-    t191 = casadi.fabs(t190)
-    t192 = (t191 >= 1)
-    t193 = 1/casadi.fabs(casadi.if_else(t192, t190, 1))
-    t194 = casadi.if_else(t189, casadi.if_else((t190 >= 0), 1, -1)*casadi.if_else(t192, t193/(1 + casadi.sqrt(1 + t193**2)), 1/(t191 + casadi.sqrt(1 + t191**2))), 0)
-    t195 = 1/casadi.sqrt(1 + t194**2)
-    t196 = t177*t194
-    t197 = -t196 + t126
-    t198 = t163 + t196
-    t199 = t130*t195
-    t200 = t167*t195
-    t201 = t199 - t194*t200
-    t202 = t200 + t194*t199
-    t203 = t134*t195
-    t204 = t171*t195
-    t205 = t203 - t194*t204
-    t206 = t204 + t194*t203
-    t207 = t143*t195
-    t208 = t176*t195
-    t209 = t207 - t194*t208
-    t210 = t208 + t194*t207
-    t211 = t166*t201 + t170*t205 + t175*t209
-    t212 = t147*t195
-    t213 = t181*t195
-    t214 = t212 - t194*t213
-    t215 = t213 + t194*t212
-    t216 = t151*t195
-    t217 = t185*t195
-    t218 = t216 - t194*t217
-    t219 = t217 + t194*t216
-    t220 = t140*t195
-    t221 = t188*t195
-    t222 = t220 + t194*t221
-    t223 = t221 - t194*t220
-    t224 = (t211 != 0)
-    t225 = (-t162 + t197)/casadi.if_else(t224, 2*t211, 1)
-    t226 = casadi.fabs(t225)
-    t227 = (t226 >= 1)
-    t228 = 1/casadi.fabs(casadi.if_else(t227, t225, 1))
-    t229 = casadi.if_else(t224, casadi.if_else((t225 >= 0), 1, -1)*casadi.if_else(t227, t228/(1 + casadi.sqrt(1 + t228**2)), 1/(t226 + casadi.sqrt(1 + t226**2))), 0)
-    t230 = 1/casadi.sqrt(1 + t229**2)
-    t231 = t211*t229
-    t232 = -t231 + t162
-    t233 = t197 + t231
-    t234 = t166*t230
-    t235 = t201*t230
-    t236 = t234 - t229*t235
-    t237 = t235 + t229*t234
-    t238 = t170*t230
-    t239 = t205*t230
-    t240 = t238 - t229*t239
-    t241 = t239 + t229*t238
-    t242 = t175*t230
-    t243 = t209*t230
-    t244 = t242 - t229*t243
-    t245 = t243 + t229*t242
-    t246 = t202*t236 + t206*t240 + t210*t244
-    t247 = t180*t230
-    t248 = t214*t230
-    t249 = t247 - t229*t248
-    t250 = t248 + t229*t247
-    t251 = t184*t230
-    t252 = t218*t230
-    t253 = t251 + t229*t252
-    t254 = t252 - t229*t251
-    t255 = t187*t230
-    t256 = t222*t230
-    t257 = t255 + t229*t256
-    t258 = -t256 + t229*t255
-    t259 = (t246 != 0)
-    t260 = (-t232 + t198)/casadi.if_else(t259, 2*t246, 1)
-    t261 = casadi.fabs(t260)
-    t262 = (t261 >= 1)
-    t263 = 1/casadi.fabs(casadi.if_else(t262, t260, 1))
-    t264 = casadi.if_else(t259, casadi.if_else((t260 >= 0), 1, -1)*casadi.if_else(t262, t263/(1 + casadi.sqrt(1 + t263**2)), 1/(t261 + casadi.sqrt(1 + t261**2))), 0)
-    t265 = 1/casadi.sqrt(1 + t264**2)
-    t266 = t246*t264
-    t267 = -t266 + t232
-    t268 = t198 + t266
-    t269 = t236*t265
-    t270 = t202*t265
-    t271 = t269 - t264*t270
-    t272 = t270 + t264*t269
-    t273 = t240*t265
-    t274 = t206*t265
-    t275 = t273 - t264*t274
-    t276 = t274 + t264*t273
-    t277 = t244*t265
-    t278 = t210*t265
-    t279 = t277 - t264*t278
-    t280 = t278 + t264*t277
-    t281 = t237*t272 + t241*t276 + t245*t280
-    t282 = t249*t265
-    t283 = t215*t265
-    t284 = t282 - t264*t283
-    t285 = t283 + t264*t282
-    t286 = t253*t265
-    t287 = t219*t265
-    t288 = t286 + t264*t287
-    t289 = t287 - t264*t286
-    t290 = t257*t265
-    t291 = t223*t265
-    t292 = t290 - t264*t291
-    t293 = t291 + t264*t290
-    t294 = (t281 != 0)
-    t295 = (-t233 + t268)/casadi.if_else(t294, 2*t281, 1)
-    t296 = casadi.fabs(t295)
-    t297 = (t296 >= 1)
-    t298 = 1/casadi.fabs(casadi.if_else(t297, t295, 1))
-    t299 = casadi.if_else(t294, casadi.if_else((t295 >= 0), 1, -1)*casadi.if_else(t297, t298/(1 + casadi.sqrt(1 + t298**2)), 1/(t296 + casadi.sqrt(1 + t296**2))), 0)
-    t300 = 1/casadi.sqrt(1 + t299**2)
-    t301 = t281*t299
-    t302 = -t301 + t233
-    t303 = t268 + t301
-    t304 = t237*t300
-    t305 = t272*t300
-    t306 = t304 - t299*t305
-    t307 = t305 + t299*t304
-    t308 = t241*t300
-    t309 = t276*t300
-    t310 = t308 - t299*t309
-    t311 = t309 + t299*t308
-    t312 = t245*t300
-    t313 = t280*t300
-    t314 = t312 - t299*t313
-    t315 = t313 + t299*t312
-    t316 = t271*t306 + t275*t310 + t279*t314
-    t317 = t250*t300
-    t318 = t285*t300
-    t319 = t317 - t299*t318
-    t320 = t318 + t299*t317
-    t321 = t254*t300
-    t322 = t289*t300
-    t323 = t321 - t299*t322
-    t324 = t322 + t299*t321
-    t325 = t258*t300
-    t326 = t293*t300
-    t327 = t325 - t299*t326
-    t328 = t326 + t299*t325
-    t329 = (t316 != 0)
-    t330 = (-t267 + t302)/casadi.if_else(t329, 2*t316, 1)
-    t331 = casadi.fabs(t330)
-    t332 = (t331 >= 1)
-    t333 = 1/casadi.fabs(casadi.if_else(t332, t330, 1))
-    t334 = casadi.if_else(t329, casadi.if_else((t330 >= 0), 1, -1)*casadi.if_else(t332, t333/(1 + casadi.sqrt(1 + t333**2)), 1/(t331 + casadi.sqrt(1 + t331**2))), 0)
-    t335 = 1/casadi.sqrt(1 + t334**2)
-    t336 = t316*t334
-    t337 = -t336 + t267
-    t338 = t302 + t336
-    t339 = t271*t335
-    t340 = t306*t335
-    t341 = t339 - t334*t340
-    t342 = t340 + t334*t339
-    t343 = t275*t335
-    t344 = t310*t335
-    t345 = t343 - t334*t344
-    t346 = t344 + t334*t343
-    t347 = t279*t335
-    t348 = t314*t335
-    t349 = t347 - t334*t348
-    t350 = t348 + t334*t347
-    t351 = t307*t341 + t311*t345 + t315*t349
-    t352 = t284*t335
-    t353 = t319*t335
-    t354 = t352 - t334*t353
-    t355 = t353 + t334*t352
-    t356 = t288*t335
-    t357 = t323*t335
-    t358 = t356 + t334*t357
-    t359 = t357 - t334*t356
-    t360 = t292*t335
-    t361 = t327*t335
-    t362 = t360 - t334*t361
-    t363 = t361 + t334*t360
-    t364 = (t351 != 0)
-    t365 = (-t337 + t303)/casadi.if_else(t364, 2*t351, 1)
-    t366 = casadi.fabs(t365)
-    t367 = (t366 >= 1)
-    t368 = 1/casadi.fabs(casadi.if_else(t367, t365, 1))
-    t369 = casadi.if_else(t364, casadi.if_else((t365 >= 0), 1, -1)*casadi.if_else(t367, t368/(1 + casadi.sqrt(1 + t368**2)), 1/(t366 + casadi.sqrt(1 + t366**2))), 0)
-    t370 = 1/casadi.sqrt(1 + t369**2)
-    t371 = t351*t369
-    t372 = -t371 + t337
-    t373 = t303 + t371
-    t374 = t341*t370
-    t375 = t307*t370
-    t376 = t374 - t369*t375
-    t377 = t375 + t369*t374
-    t378 = t345*t370
-    t379 = t311*t370
-    t380 = t378 - t369*t379
-    t381 = t379 + t369*t378
-    t382 = t349*t370
-    t383 = t315*t370
-    t384 = t382 - t369*t383
-    t385 = t383 + t369*t382
-    t386 = t342*t377 + t346*t381 + t350*t385
-    t387 = t354*t370
-    t388 = t320*t370
-    t389 = t387 - t369*t388
-    t390 = t388 + t369*t387
-    t391 = t358*t370
-    t392 = t324*t370
-    t393 = t391 + t369*t392
-    t394 = t392 - t369*t391
-    t395 = t362*t370
-    t396 = t328*t370
-    t397 = t395 - t369*t396
-    t398 = t396 + t369*t395
-    t399 = (t386 != 0)
-    t400 = (-t338 + t373)/casadi.if_else(t399, 2*t386, 1)
-    t401 = casadi.fabs(t400)
-    t402 = (t401 >= 1)
-    t403 = 1/casadi.fabs(casadi.if_else(t402, t400, 1))
-    t404 = casadi.if_else(t399, casadi.if_else((t400 >= 0), 1, -1)*casadi.if_else(t402, t403/(1 + casadi.sqrt(1 + t403**2)), 1/(t401 + casadi.sqrt(1 + t401**2))), 0)
-    t405 = 1/casadi.sqrt(1 + t404**2)
-    t406 = t386*t404
-    t407 = -t406 + t338
-    t408 = t373 + t406
-    t409 = t342*t405
-    t410 = t377*t405
-    t411 = t409 - t404*t410
-    t412 = t410 + t404*t409
-    t413 = t346*t405
-    t414 = t381*t405
-    t415 = t413 - t404*t414
-    t416 = t414 + t404*t413
-    t417 = t350*t405
-    t418 = t385*t405
-    t419 = t417 - t404*t418
-    t420 = t418 + t404*t417
-    t421 = t376*t411 + t380*t415 + t384*t419
-    t422 = t355*t405
-    t423 = t390*t405
-    t424 = t422 - t404*t423
-    t425 = t423 + t404*t422
-    t426 = t359*t405
-    t427 = t394*t405
-    t428 = t426 - t404*t427
-    t429 = t427 + t404*t426
-    t430 = t363*t405
-    t431 = t398*t405
-    t432 = t430 - t404*t431
-    t433 = t431 + t404*t430
-    t434 = (t421 != 0)
-    t435 = (-t372 + t407)/casadi.if_else(t434, 2*t421, 1)
-    t436 = casadi.fabs(t435)
-    t437 = (t436 >= 1)
-    t438 = 1/casadi.fabs(casadi.if_else(t437, t435, 1))
-    t439 = casadi.if_else(t434, casadi.if_else((t435 >= 0), 1, -1)*casadi.if_else(t437, t438/(1 + casadi.sqrt(1 + t438**2)), 1/(t436 + casadi.sqrt(1 + t436**2))), 0)
-    t440 = 1/casadi.sqrt(1 + t439**2)
-    t441 = t421*t439
-    t442 = -t441 + t372
-    t443 = t407 + t441
-    t444 = t376*t440
-    t445 = t411*t440
-    t446 = t444 - t439*t445
-    t447 = t445 + t439*t444
-    t448 = t380*t440
-    t449 = t415*t440
-    t450 = t448 - t439*t449
-    t451 = t449 + t439*t448
-    t452 = t384*t440
-    t453 = t419*t440
-    t454 = t452 - t439*t453
-    t455 = t453 + t439*t452
-    t456 = t412*t446 + t416*t450 + t420*t454
-    t457 = t389*t440
-    t458 = t424*t440
-    t459 = t457 - t439*t458
-    t460 = t458 + t439*t457
-    t461 = t393*t440
-    t462 = t428*t440
-    t463 = t461 + t439*t462
-    t464 = t462 - t439*t461
-    t465 = t397*t440
-    t466 = t432*t440
-    t467 = t465 - t439*t466
-    t468 = t466 + t439*t465
-    t469 = (t456 != 0)
-    t470 = (-t442 + t408)/casadi.if_else(t469, 2*t456, 1)
-    t471 = casadi.fabs(t470)
-    t472 = (t471 >= 1)
-    t473 = 1/casadi.fabs(casadi.if_else(t472, t470, 1))
-    t474 = casadi.if_else(t469, casadi.if_else((t470 >= 0), 1, -1)*casadi.if_else(t472, t473/(1 + casadi.sqrt(1 + t473**2)), 1/(t471 + casadi.sqrt(1 + t471**2))), 0)
-    t475 = 1/casadi.sqrt(1 + t474**2)
-    t476 = t408 + t456*t474
-    t477 = t446*t475
-    t478 = t412*t475
-    t479 = t477 - t474*t478
-    t480 = t478 + t474*t477
-    t481 = t450*t475
-    t482 = t416*t475
-    t483 = t481 - t474*t482
-    t484 = t482 + t474*t481
-    t485 = t454*t475
-    t486 = t420*t475
-    t487 = t485 - t474*t486
-    t488 = t486 + t474*t485
-    t489 = t447*t480 + t451*t484 + t455*t488
-    t490 = casadi.sqrt(t479**2 + t483**2 + t487**2)
-    t491 = t459*t475
-    t492 = t425*t475
-    t493 = t491 - t474*t492
-    t494 = t492 + t474*t491
-    t495 = t463*t475
-    t496 = t429*t475
-    t497 = t495 + t474*t496
-    t498 = t496 - t474*t495
-    t499 = t467*t475
-    t500 = t433*t475
-    t501 = t499 - t474*t500
-    t502 = t500 + t474*t499
-    t503 = (t489 != 0)
-    t504 = (-t443 + t476)/casadi.if_else(t503, 2*t489, 1)
-    t505 = casadi.fabs(t504)
-    t506 = (t505 >= 1)
-    t507 = 1/casadi.fabs(casadi.if_else(t506, t504, 1))
-    t508 = casadi.if_else(t503, casadi.if_else((t504 >= 0), 1, -1)*casadi.if_else(t506, t507/(1 + casadi.sqrt(1 + t507**2)), 1/(t505 + casadi.sqrt(1 + t505**2))), 0)
-    t509 = 1/casadi.sqrt(1 + t508**2)
-    t510 = t447*t509
-    t511 = t480*t509
-    t512 = t510 - t508*t511
-    t513 = t511 + t508*t510
-    t514 = t451*t509
-    t515 = t484*t509
-    t516 = t514 - t508*t515
-    t517 = t515 + t508*t514
-    t518 = t455*t509
-    t519 = t488*t509
-    t520 = t518 - t508*t519
-    t521 = t519 + t508*t518
-    t522 = casadi.sqrt(t512**2 + t516**2 + t520**2)
-    t523 = casadi.sqrt(t513**2 + t517**2 + t521**2)
-    t524 = t460*t509
-    t525 = t494*t509
-    t526 = t524 - t508*t525
-    t527 = t525 + t508*t524
-    t528 = t464*t509
-    t529 = t498*t509
-    t530 = t528 - t508*t529
-    t531 = t529 + t508*t528
-    t532 = t468*t509
-    t533 = t502*t509
-    t534 = t532 - t508*t533
-    t535 = t533 + t508*t532
-    t536 = (t490 < t522)
-    t537 = casadi.if_else(t536, t522, t490)
-    t538 = casadi.if_else(t536, t490, t522)
-    t539 = casadi.if_else(t536, t526, t493)
-    t540 = casadi.if_else(t536, t534, t501)
-    t541 = casadi.if_else(t536, t493, t526)
-    t542 = casadi.if_else(t536, t501, t534)
-    t543 = -t497
-    t544 = casadi.if_else(t536, t530, t543)
-    t545 = casadi.if_else(t536, t543, t530)
-    t546 = (t538 < t523)
-    t547 = casadi.if_else(t546, t523, t538)
-    t548 = casadi.if_else(t546, t538, t523)
-    t549 = casadi.if_else(t546, t527, t541)
-    t550 = casadi.if_else(t546, t531, t545)
-    t551 = casadi.if_else(t546, t535, t542)
-    t552 = casadi.if_else(t546, t541, t527)
-    t553 = casadi.if_else(t546, t545, t531)
-    t554 = casadi.if_else(t546, t542, t535)
-    t555 = (t537 < t547)
-    t556 = casadi.if_else(t555, t547, t537)
-    t557 = casadi.if_else(t555, t537, t547)
-    t558 = casadi.if_else(t555, t549, t539)
-    t559 = casadi.if_else(t555, t550, t544)
-    t560 = casadi.if_else(t555, t551, t540)
-    t561 = casadi.if_else(t555, t539, t549)
-    t562 = casadi.if_else(t555, t544, t550)
-    t563 = casadi.if_else(t555, t540, t551)
-    t564 = t558*(t554*t562 - t553*t563) - t559*(t554*t561 - t552*t563) + t560*(t553*t561 - t552*t562)
-    t565 = casadi.if_else((t564 < 0), -1, 1)
-    t566 = t552*t565
-    t567 = t553*t565
-    t568 = t554*t565
-    t569 = 3*t13
-    t570 = casadi.sqrt(t569)
-    t571 = t570**2
-    t572 = casadi.if_else((t570 > 0), 1/t571, 0)
-    t573 = -c1 + c1*t572*t569
-    t574 = casadi.sqrt(3*t573**2)
-    t575 = t574*casadi.if_else((t573 >= 0), 1, -1)
-    t576 = t573 + t575
-    t577 = casadi.if_else((t574 > 0), 1/(t574*(t574 + casadi.fabs(t573))), 0)
-    t578 = t572*t571
+    t42 = (t32 > 0)
+    t43 = casadi.if_else(t42, 1/(t29 + t33), 0)
+    t44 = casadi.if_else(t42, 1 + casadi.fabs(t29)/t32, 0)
+    t45 = t30*t43
+    t46 = t31*t43
+    t47 = t44*(t39 + t45*t40 + t46*t41)
+    t48 = -t47 + t39
+    t49 = t40 - t45*t47
+    t50 = t41 - t46*t47
+    t51 = casadi.sqrt(t49**2 + t50**2)
+    t52 = t51*casadi.if_else((t49 >= 0), 1, -1)
+    t53 = t52**2
+    t54 = t53 + t38**2 + t48**2
+    t55 = t19*t27
+    t56 = (t55 != 0)
+    t57 = (-t20 + t34)/casadi.if_else(t56, -2*t55, 1)
+    t58 = casadi.fabs(t57)
+    t59 = (t58 >= 1)
+    t60 = 1/casadi.fabs(casadi.if_else(t59, t57, 1))
+    t61 = casadi.if_else(t56, casadi.if_else((t57 >= 0), 1, -1)*casadi.if_else(t59, t60/(1 + casadi.sqrt(1 + t60**2)), 1/(t58 + casadi.sqrt(1 + t58**2))), 0)
+    t62 = 1/casadi.sqrt(1 + t61**2)
+    t63 = t55*t61
+    t64 = t63 + t20
+    t65 = -t63 + t34
+    t66 = t19*t62
+    t67 = t27*t62
+    t68 = t66 + t67*t61
+    t69 = t67 - t66*t61
+    t70 = t33*t62
+    t71 = t70*t61
+    t72 = t38*t68 + t48*t71
+    t73 = (t72 != 0)
+    t74 = (-t64 + t54)/casadi.if_else(t73, 2*t72, 1)
+    t75 = casadi.fabs(t74)
+    t76 = (t75 >= 1)
+    t77 = 1/casadi.fabs(casadi.if_else(t76, t74, 1))
+    t78 = casadi.if_else(t73, casadi.if_else((t74 >= 0), 1, -1)*casadi.if_else(t76, t77/(1 + casadi.sqrt(1 + t77**2)), 1/(t75 + casadi.sqrt(1 + t75**2))), 0)
+    t79 = 1/casadi.sqrt(1 + t78**2)
+    t80 = t72*t78
+    t81 = -t80 + t64
+    t82 = t80 + t54
+    t83 = t68*t79
+    t84 = t38*t79
+    t85 = -t83 + t84*t78
+    t86 = t84 + t83*t78
+    t87 = t71*t79
+    t88 = t48*t79
+    t89 = t87 - t88*t78
+    t90 = t88 + t87*t78
+    t91 = t69*t86 + t70*t90
+    t92 = (t91 != 0)
+    t93 = (-t65 + t82)/casadi.if_else(t92, -2*t91, 1)
+    t94 = casadi.fabs(t93)
+    t95 = (t94 >= 1)
+    t96 = 1/casadi.fabs(casadi.if_else(t95, t93, 1))
+    t97 = casadi.if_else(t92, casadi.if_else((t93 >= 0), 1, -1)*casadi.if_else(t95, t96/(1 + casadi.sqrt(1 + t96**2)), 1/(t94 + casadi.sqrt(1 + t94**2))), 0)
+    t98 = 1/casadi.sqrt(1 + t97**2)
+    t99 = t91*t97
+    t100 = t99 + t65
+    t101 = -t99 + t82
+    t102 = t69*t98
+    t103 = t86*t98
+    t104 = t102 + t103*t97
+    t105 = -t103 + t102*t97
+    t106 = t62*t98
+    t107 = t33*t106
+    t108 = t90*t98
+    t109 = t107 + t108*t97
+    t110 = t108 - t107*t97
+    t111 = t106*t61
+    t112 = t106*t97
+    t113 = t78*t79
+    t114 = t111 - t112*t113
+    t115 = t112 - t111*t113
+    t116 = t111*t97
+    t117 = t106 + t113*t116
+    t118 = t116 + t106*t113
+    t119 = t97*t98
+    t120 = t85*t104 - t89*t109 + t53*t113*t119*t79
+    t121 = (t120 != 0)
+    t122 = (-t81 + t100)/casadi.if_else(t121, 2*t120, 1)
+    t123 = casadi.fabs(t122)
+    t124 = (t123 >= 1)
+    t125 = 1/casadi.fabs(casadi.if_else(t124, t122, 1))
+    t126 = casadi.if_else(t121, casadi.if_else((t122 >= 0), 1, -1)*casadi.if_else(t124, t125/(1 + casadi.sqrt(1 + t125**2)), 1/(t123 + casadi.sqrt(1 + t123**2))), 0)
+    t127 = 1/casadi.sqrt(1 + t126**2)
+    t128 = t120*t126
+    t129 = -t128 + t81
+    t130 = t128 + t100
+    t131 = t85*t127
+    t132 = t104*t127
+    t133 = t131 - t132*t126
+    t134 = t132 + t131*t126
+    t135 = t89*t127
+    t136 = t109*t127
+    t137 = t135 + t136*t126
+    t138 = -t136 + t135*t126
+    t139 = t79*t127
+    t140 = t139*t78
+    t141 = t52*t140
+    t142 = t119*t139
+    t143 = -t140 + t142*t126
+    t144 = t142 + t140*t126
+    t145 = t52*t142
+    t146 = t141 - t145*t126
+    t147 = t145 + t141*t126
+    t148 = t139*t62
+    t149 = t114*t127
+    t150 = t148 - t149*t126
+    t151 = t149 + t148*t126
+    t152 = t148*t61
+    t153 = t117*t127
+    t154 = t152 + t153*t126
+    t155 = t153 - t152*t126
+    t156 = t79*t98
+    t157 = t105*t133 + t110*t137 - t52*t156*t146
+    t158 = (t157 != 0)
+    t159 = (-t129 + t101)/casadi.if_else(t158, 2*t157, 1)
+    t160 = casadi.fabs(t159)
+    t161 = (t160 >= 1)
+    t162 = 1/casadi.fabs(casadi.if_else(t161, t159, 1))
+    t163 = casadi.if_else(t158, casadi.if_else((t159 >= 0), 1, -1)*casadi.if_else(t161, t162/(1 + casadi.sqrt(1 + t162**2)), 1/(t160 + casadi.sqrt(1 + t160**2))), 0)
+    t164 = 1/casadi.sqrt(1 + t163**2)
+    t165 = t157*t163
+    t166 = -t165 + t129
+    t167 = t165 + t101
+    t168 = t133*t164
+    t169 = t105*t164
+    t170 = t168 - t163*t169
+    t171 = t169 + t163*t168
+    t172 = t137*t164
+    t173 = t110*t164
+    t174 = t172 - t163*t173
+    t175 = t173 + t163*t172
+    t176 = t146*t164
+    t177 = t156*t164
+    t178 = t52*t177
+    t179 = t176 + t163*t178
+    t180 = -t178 + t163*t176
+    t181 = t134*t171 + t138*t175 + t147*t180
+    t182 = t150*t164
+    t183 = t118*t164
+    t184 = t182 - t163*t183
+    t185 = t183 + t163*t182
+    t186 = t154*t164
+    t187 = t115*t164
+    t188 = t186 + t163*t187
+    t189 = t187 - t163*t186
+    t190 = t143*t164
+    t191 = t190 - t163*t177
+    t192 = t177 + t163*t190
+    t193 = (t181 != 0)
+    t194 = (-t130 + t167)/casadi.if_else(t193, 2*t181, 1)
+    t195 = casadi.fabs(t194)
+    t196 = (t195 >= 1)
+    t197 = 1/casadi.fabs(casadi.if_else(t196, t194, 1))
+    t198 = casadi.if_else(t193, casadi.if_else((t194 >= 0), 1, -1)*casadi.if_else(t196, t197/(1 + casadi.sqrt(1 + t197**2)), 1/(t195 + casadi.sqrt(1 + t195**2))), 0)
+    t199 = 1/casadi.sqrt(1 + t198**2)
+    t200 = t181*t198
+    t201 = -t200 + t130
+    t202 = t167 + t200
+    t203 = t134*t199
+    t204 = t171*t199
+    t205 = t203 - t198*t204
+    t206 = t204 + t198*t203
+    t207 = t138*t199
+    t208 = t175*t199
+    t209 = t207 - t198*t208
+    t210 = t208 + t198*t207
+    t211 = t147*t199
+    t212 = t180*t199
+    t213 = t211 - t198*t212
+    t214 = t212 + t198*t211
+    t215 = t170*t205 + t174*t209 + t179*t213
+    t216 = t151*t199
+    t217 = t185*t199
+    t218 = t216 - t198*t217
+    t219 = t217 + t198*t216
+    t220 = t155*t199
+    t221 = t189*t199
+    t222 = t220 - t198*t221
+    t223 = t221 + t198*t220
+    t224 = t144*t199
+    t225 = t192*t199
+    t226 = t224 + t198*t225
+    t227 = t225 - t198*t224
+    t228 = (t215 != 0)
+    t229 = (-t166 + t201)/casadi.if_else(t228, 2*t215, 1)
+    t230 = casadi.fabs(t229)
+    t231 = (t230 >= 1)
+    t232 = 1/casadi.fabs(casadi.if_else(t231, t229, 1))
+    t233 = casadi.if_else(t228, casadi.if_else((t229 >= 0), 1, -1)*casadi.if_else(t231, t232/(1 + casadi.sqrt(1 + t232**2)), 1/(t230 + casadi.sqrt(1 + t230**2))), 0)
+    t234 = 1/casadi.sqrt(1 + t233**2)
+    t235 = t215*t233
+    t236 = -t235 + t166
+    t237 = t201 + t235
+    t238 = t170*t234
+    t239 = t205*t234
+    t240 = t238 - t233*t239
+    t241 = t239 + t233*t238
+    t242 = t174*t234
+    t243 = t209*t234
+    t244 = t242 - t233*t243
+    t245 = t243 + t233*t242
+    t246 = t179*t234
+    t247 = t213*t234
+    t248 = t246 - t233*t247
+    t249 = t247 + t233*t246
+    t250 = t206*t240 + t210*t244 + t214*t248
+    t251 = t184*t234
+    t252 = t218*t234
+    t253 = t251 - t233*t252
+    t254 = t252 + t233*t251
+    t255 = t188*t234
+    t256 = t222*t234
+    t257 = t255 + t233*t256
+    t258 = t256 - t233*t255
+    t259 = t191*t234
+    t260 = t226*t234
+    t261 = t259 + t233*t260
+    t262 = -t260 + t233*t259
+    t263 = (t250 != 0)
+    t264 = (-t236 + t202)/casadi.if_else(t263, 2*t250, 1)
+    t265 = casadi.fabs(t264)
+    t266 = (t265 >= 1)
+    t267 = 1/casadi.fabs(casadi.if_else(t266, t264, 1))
+    t268 = casadi.if_else(t263, casadi.if_else((t264 >= 0), 1, -1)*casadi.if_else(t266, t267/(1 + casadi.sqrt(1 + t267**2)), 1/(t265 + casadi.sqrt(1 + t265**2))), 0)
+    t269 = 1/casadi.sqrt(1 + t268**2)
+    t270 = t250*t268
+    t271 = -t270 + t236
+    t272 = t202 + t270
+    t273 = t240*t269
+    t274 = t206*t269
+    t275 = t273 - t268*t274
+    t276 = t274 + t268*t273
+    t277 = t244*t269
+    t278 = t210*t269
+    t279 = t277 - t268*t278
+    t280 = t278 + t268*t277
+    t281 = t248*t269
+    t282 = t214*t269
+    t283 = t281 - t268*t282
+    t284 = t282 + t268*t281
+    t285 = t241*t276 + t245*t280 + t249*t284
+    t286 = t253*t269
+    t287 = t219*t269
+    t288 = t286 - t268*t287
+    t289 = t287 + t268*t286
+    t290 = t257*t269
+    t291 = t223*t269
+    t292 = t290 + t268*t291
+    t293 = t291 - t268*t290
+    t294 = t261*t269
+    t295 = t227*t269
+    t296 = t294 - t268*t295
+    t297 = t295 + t268*t294
+    t298 = (t285 != 0)
+    t299 = (-t237 + t272)/casadi.if_else(t298, 2*t285, 1)
+    t300 = casadi.fabs(t299)
+    t301 = (t300 >= 1)
+    t302 = 1/casadi.fabs(casadi.if_else(t301, t299, 1))
+    t303 = casadi.if_else(t298, casadi.if_else((t299 >= 0), 1, -1)*casadi.if_else(t301, t302/(1 + casadi.sqrt(1 + t302**2)), 1/(t300 + casadi.sqrt(1 + t300**2))), 0)
+    t304 = 1/casadi.sqrt(1 + t303**2)
+    t305 = t285*t303
+    t306 = -t305 + t237
+    t307 = t272 + t305
+    t308 = t241*t304
+    t309 = t276*t304
+    t310 = t308 - t303*t309
+    t311 = t309 + t303*t308
+    t312 = t245*t304
+    t313 = t280*t304
+    t314 = t312 - t303*t313
+    t315 = t313 + t303*t312
+    t316 = t249*t304
+    t317 = t284*t304
+    t318 = t316 - t303*t317
+    t319 = t317 + t303*t316
+    t320 = t275*t310 + t279*t314 + t283*t318
+    t321 = t254*t304
+    t322 = t289*t304
+    t323 = t321 - t303*t322
+    t324 = t322 + t303*t321
+    t325 = t258*t304
+    t326 = t293*t304
+    t327 = t325 - t303*t326
+    t328 = t326 + t303*t325
+    t329 = t262*t304
+    t330 = t297*t304
+    t331 = t329 - t303*t330
+    t332 = t330 + t303*t329
+    t333 = (t320 != 0)
+    t334 = (-t271 + t306)/casadi.if_else(t333, 2*t320, 1)
+    t335 = casadi.fabs(t334)
+    t336 = (t335 >= 1)
+    t337 = 1/casadi.fabs(casadi.if_else(t336, t334, 1))
+    t338 = casadi.if_else(t333, casadi.if_else((t334 >= 0), 1, -1)*casadi.if_else(t336, t337/(1 + casadi.sqrt(1 + t337**2)), 1/(t335 + casadi.sqrt(1 + t335**2))), 0)
+    t339 = 1/casadi.sqrt(1 + t338**2)
+    t340 = t320*t338
+    t341 = -t340 + t271
+    t342 = t306 + t340
+    t343 = t275*t339
+    t344 = t310*t339
+    t345 = t343 - t338*t344
+    t346 = t344 + t338*t343
+    t347 = t279*t339
+    t348 = t314*t339
+    t349 = t347 - t338*t348
+    t350 = t348 + t338*t347
+    t351 = t283*t339
+    t352 = t318*t339
+    t353 = t351 - t338*t352
+    t354 = t352 + t338*t351
+    t355 = t311*t345 + t315*t349 + t319*t353
+    t356 = t288*t339
+    t357 = t323*t339
+    t358 = t356 - t338*t357
+    t359 = t357 + t338*t356
+    t360 = t292*t339
+    t361 = t327*t339
+    t362 = t360 + t338*t361
+    t363 = t361 - t338*t360
+    t364 = t296*t339
+    t365 = t331*t339
+    t366 = t364 - t338*t365
+    t367 = t365 + t338*t364
+    t368 = (t355 != 0)
+    t369 = (-t341 + t307)/casadi.if_else(t368, 2*t355, 1)
+    t370 = casadi.fabs(t369)
+    t371 = (t370 >= 1)
+    t372 = 1/casadi.fabs(casadi.if_else(t371, t369, 1))
+    t373 = casadi.if_else(t368, casadi.if_else((t369 >= 0), 1, -1)*casadi.if_else(t371, t372/(1 + casadi.sqrt(1 + t372**2)), 1/(t370 + casadi.sqrt(1 + t370**2))), 0)
+    t374 = 1/casadi.sqrt(1 + t373**2)
+    t375 = t355*t373
+    t376 = -t375 + t341
+    t377 = t307 + t375
+    t378 = t345*t374
+    t379 = t311*t374
+    t380 = t378 - t373*t379
+    t381 = t379 + t373*t378
+    t382 = t349*t374
+    t383 = t315*t374
+    t384 = t382 - t373*t383
+    t385 = t383 + t373*t382
+    t386 = t353*t374
+    t387 = t319*t374
+    t388 = t386 - t373*t387
+    t389 = t387 + t373*t386
+    t390 = t346*t381 + t350*t385 + t354*t389
+    t391 = t358*t374
+    t392 = t324*t374
+    t393 = t391 - t373*t392
+    t394 = t392 + t373*t391
+    t395 = t362*t374
+    t396 = t328*t374
+    t397 = t395 + t373*t396
+    t398 = t396 - t373*t395
+    t399 = t366*t374
+    t400 = t332*t374
+    t401 = t399 - t373*t400
+    t402 = t400 + t373*t399
+    t403 = (t390 != 0)
+    t404 = (-t342 + t377)/casadi.if_else(t403, 2*t390, 1)
+    t405 = casadi.fabs(t404)
+    t406 = (t405 >= 1)
+    t407 = 1/casadi.fabs(casadi.if_else(t406, t404, 1))
+    t408 = casadi.if_else(t403, casadi.if_else((t404 >= 0), 1, -1)*casadi.if_else(t406, t407/(1 + casadi.sqrt(1 + t407**2)), 1/(t405 + casadi.sqrt(1 + t405**2))), 0)
+    t409 = 1/casadi.sqrt(1 + t408**2)
+    t410 = t390*t408
+    t411 = -t410 + t342
+    t412 = t377 + t410
+    t413 = t346*t409
+    t414 = t381*t409
+    t415 = t413 - t408*t414
+    t416 = t414 + t408*t413
+    t417 = t350*t409
+    t418 = t385*t409
+    t419 = t417 - t408*t418
+    t420 = t418 + t408*t417
+    t421 = t354*t409
+    t422 = t389*t409
+    t423 = t421 - t408*t422
+    t424 = t422 + t408*t421
+    t425 = t380*t415 + t384*t419 + t388*t423
+    t426 = t359*t409
+    t427 = t394*t409
+    t428 = t426 - t408*t427
+    t429 = t427 + t408*t426
+    t430 = t363*t409
+    t431 = t398*t409
+    t432 = t430 - t408*t431
+    t433 = t431 + t408*t430
+    t434 = t367*t409
+    t435 = t402*t409
+    t436 = t434 - t408*t435
+    t437 = t435 + t408*t434
+    t438 = (t425 != 0)
+    t439 = (-t376 + t411)/casadi.if_else(t438, 2*t425, 1)
+    t440 = casadi.fabs(t439)
+    t441 = (t440 >= 1)
+    t442 = 1/casadi.fabs(casadi.if_else(t441, t439, 1))
+    t443 = casadi.if_else(t438, casadi.if_else((t439 >= 0), 1, -1)*casadi.if_else(t441, t442/(1 + casadi.sqrt(1 + t442**2)), 1/(t440 + casadi.sqrt(1 + t440**2))), 0)
+    t444 = 1/casadi.sqrt(1 + t443**2)
+    t445 = t425*t443
+    t446 = -t445 + t376
+    t447 = t411 + t445
+    t448 = t380*t444
+    t449 = t415*t444
+    t450 = t448 - t443*t449
+    t451 = t449 + t443*t448
+    t452 = t384*t444
+    t453 = t419*t444
+    t454 = t452 - t443*t453
+    t455 = t453 + t443*t452
+    t456 = t388*t444
+    t457 = t423*t444
+    t458 = t456 - t443*t457
+    t459 = t457 + t443*t456
+    t460 = t416*t450 + t420*t454 + t424*t458
+    t461 = t393*t444
+    t462 = t428*t444
+    t463 = t461 - t443*t462
+    t464 = t462 + t443*t461
+    t465 = t397*t444
+    t466 = t432*t444
+    t467 = t465 + t443*t466
+    t468 = t466 - t443*t465
+    t469 = t401*t444
+    t470 = t436*t444
+    t471 = t469 - t443*t470
+    t472 = t470 + t443*t469
+    t473 = (t460 != 0)
+    t474 = (-t446 + t412)/casadi.if_else(t473, 2*t460, 1)
+    t475 = casadi.fabs(t474)
+    t476 = (t475 >= 1)
+    t477 = 1/casadi.fabs(casadi.if_else(t476, t474, 1))
+    t478 = casadi.if_else(t473, casadi.if_else((t474 >= 0), 1, -1)*casadi.if_else(t476, t477/(1 + casadi.sqrt(1 + t477**2)), 1/(t475 + casadi.sqrt(1 + t475**2))), 0)
+    t479 = 1/casadi.sqrt(1 + t478**2)
+    t480 = t412 + t460*t478
+    t481 = t450*t479
+    t482 = t416*t479
+    t483 = t481 - t478*t482
+    t484 = t482 + t478*t481
+    t485 = t454*t479
+    t486 = t420*t479
+    t487 = t485 - t478*t486
+    t488 = t486 + t478*t485
+    t489 = t458*t479
+    t490 = t424*t479
+    t491 = t489 - t478*t490
+    t492 = t490 + t478*t489
+    t493 = t451*t484 + t455*t488 + t459*t492
+    t494 = casadi.sqrt(t483**2 + t487**2 + t491**2)
+    t495 = t463*t479
+    t496 = t429*t479
+    t497 = t495 - t478*t496
+    t498 = t496 + t478*t495
+    t499 = t467*t479
+    t500 = t433*t479
+    t501 = t499 + t478*t500
+    t502 = t500 - t478*t499
+    t503 = t471*t479
+    t504 = t437*t479
+    t505 = t503 - t478*t504
+    t506 = t504 + t478*t503
+    t507 = (t493 != 0)
+    t508 = (-t447 + t480)/casadi.if_else(t507, 2*t493, 1)
+    t509 = casadi.fabs(t508)
+    t510 = (t509 >= 1)
+    t511 = 1/casadi.fabs(casadi.if_else(t510, t508, 1))
+    t512 = casadi.if_else(t507, casadi.if_else((t508 >= 0), 1, -1)*casadi.if_else(t510, t511/(1 + casadi.sqrt(1 + t511**2)), 1/(t509 + casadi.sqrt(1 + t509**2))), 0)
+    t513 = 1/casadi.sqrt(1 + t512**2)
+    t514 = t451*t513
+    t515 = t484*t513
+    t516 = t514 - t512*t515
+    t517 = t515 + t512*t514
+    t518 = t455*t513
+    t519 = t488*t513
+    t520 = t518 - t512*t519
+    t521 = t519 + t512*t518
+    t522 = t459*t513
+    t523 = t492*t513
+    t524 = t522 - t512*t523
+    t525 = t523 + t512*t522
+    t526 = casadi.sqrt(t516**2 + t520**2 + t524**2)
+    t527 = casadi.sqrt(t517**2 + t521**2 + t525**2)
+    t528 = t464*t513
+    t529 = t498*t513
+    t530 = t528 - t512*t529
+    t531 = t529 + t512*t528
+    t532 = t468*t513
+    t533 = t502*t513
+    t534 = t532 - t512*t533
+    t535 = t533 + t512*t532
+    t536 = t472*t513
+    t537 = t506*t513
+    t538 = t536 - t512*t537
+    t539 = t537 + t512*t536
+    t540 = (t494 < t526)
+    t541 = casadi.if_else(t540, t526, t494)
+    t542 = casadi.if_else(t540, t494, t526)
+    t543 = casadi.if_else(t540, t530, t497)
+    t544 = casadi.if_else(t540, t538, t505)
+    t545 = casadi.if_else(t540, t497, t530)
+    t546 = casadi.if_else(t540, t505, t538)
+    t547 = -t501
+    t548 = casadi.if_else(t540, t534, t547)
+    t549 = casadi.if_else(t540, t547, t534)
+    t550 = (t542 < t527)
+    t551 = casadi.if_else(t550, t527, t542)
+    t552 = casadi.if_else(t550, t542, t527)
+    t553 = casadi.if_else(t550, t531, t545)
+    t554 = casadi.if_else(t550, t535, t549)
+    t555 = casadi.if_else(t550, t539, t546)
+    t556 = casadi.if_else(t550, t545, t531)
+    t557 = casadi.if_else(t550, t549, t535)
+    t558 = casadi.if_else(t550, t546, t539)
+    t559 = (t541 < t551)
+    t560 = casadi.if_else(t559, t551, t541)
+    t561 = casadi.if_else(t559, t541, t551)
+    t562 = casadi.if_else(t559, t553, t543)
+    t563 = casadi.if_else(t559, t554, t548)
+    t564 = casadi.if_else(t559, t555, t544)
+    t565 = casadi.if_else(t559, t543, t553)
+    t566 = casadi.if_else(t559, t548, t554)
+    t567 = casadi.if_else(t559, t544, t555)
+    t568 = t562*(t558*t566 - t557*t567) - t563*(t558*t565 - t556*t567) + t564*(t557*t565 - t556*t566)
+    t569 = casadi.if_else((t568 < 0), -1, 1)
+    t570 = t556*t569
+    t571 = t557*t569
+    t572 = t558*t569
+    t573 = 3*t13
+    t574 = casadi.sqrt(t573)
+    t575 = t574**2
+    t576 = (t574 > 0)
+    t577 = casadi.if_else(t576, 1/t574, 0)
+    t578 = casadi.if_else(t576, 1, 0)
     t579 = 1 - t578
-    t580 = t575**2 + 9*t11*t13*t572*t578
-    t581 = s1*t570*t572
-    t582 = -t577*(t576*t581 + 2*t573*t581)
-    t583 = t576*t582 + t581
-    t584 = t573*t582 + t581
-    t585 = casadi.sqrt(2*t584**2)
-    t586 = t585*casadi.if_else((t584 <= 0), 1, -1)
-    t587 = t586**2
-    t588 = t579**2 + t583**2 + t587
-    t589 = 3*t23
-    t590 = t578*t589
-    t591 = (t590 != 0)
-    t592 = (-t571 + t580)/casadi.if_else(t591, -2*t590, 1)
-    t593 = casadi.fabs(t592)
-    t594 = (t593 >= 1)
-    t595 = 1/casadi.fabs(casadi.if_else(t594, t592, 1))
-    t596 = casadi.if_else(t591, casadi.if_else((t592 >= 0), 1, -1)*casadi.if_else(t594, t595/(1 + casadi.sqrt(1 + t595**2)), 1/(t593 + casadi.sqrt(1 + t593**2))), 0)
-    t597 = 1/casadi.sqrt(1 + t596**2)
-    t598 = t590*t596
-    t599 = t571 + t598
-    t600 = -t598 + t580
-    t601 = t570*t597
-    t602 = t596*t601
-    t603 = t572*t589
-    t604 = t601 + t602*t603
-    t605 = -t602 + t601*t603
-    t606 = t575*t597
-    t607 = t596*t606
-    t608 = t579*t604 + t583*t607
-    t609 = (t608 != 0)
-    t610 = (-t599 + t588)/casadi.if_else(t609, -2*t608, 1)
-    t611 = casadi.fabs(t610)
-    t612 = (t611 >= 1)
-    t613 = 1/casadi.fabs(casadi.if_else(t612, t610, 1))
-    t614 = casadi.if_else(t609, casadi.if_else((t610 >= 0), 1, -1)*casadi.if_else(t612, t613/(1 + casadi.sqrt(1 + t613**2)), 1/(t611 + casadi.sqrt(1 + t611**2))), 0)
-    t615 = 1/casadi.sqrt(1 + t614**2)
-    t616 = t608*t614
-    t617 = t599 + t616
-    t618 = -t616 + t588
-    t619 = t604*t615
-    t620 = t579*t615
-    t621 = t619 + t614*t620
-    t622 = t620 - t614*t619
-    t623 = t615*t607
-    t624 = t583*t615
-    t625 = t623 + t614*t624
-    t626 = -t624 + t614*t623
-    t627 = t605*t622 - t626*t606
-    t628 = (t627 != 0)
-    t629 = (-t600 + t618)/casadi.if_else(t628, 2*t627, 1)
-    t630 = casadi.fabs(t629)
-    t631 = (t630 >= 1)
-    t632 = 1/casadi.fabs(casadi.if_else(t631, t629, 1))
-    t633 = casadi.if_else(t628, casadi.if_else((t629 >= 0), 1, -1)*casadi.if_else(t631, t632/(1 + casadi.sqrt(1 + t632**2)), 1/(t630 + casadi.sqrt(1 + t630**2))), 0)
-    t634 = 1/casadi.sqrt(1 + t633**2)
-    t635 = t627*t633
-    t636 = -t635 + t600
-    t637 = t618 + t635
-    t638 = t605*t634
-    t639 = t622*t634
-    t640 = t638 - t633*t639
-    t641 = t639 + t633*t638
-    t642 = t597*t634
-    t643 = t575*t642
-    t644 = t626*t634
-    t645 = t643 + t633*t644
-    t646 = t644 - t633*t643
-    t647 = t596*t642
-    t648 = t633*t642
-    t649 = t614*t615
-    t650 = t647 - t648*t649
-    t651 = t648 - t647*t649
-    t652 = t633*t647
-    t653 = t642 + t649*t652
-    t654 = t652 + t642*t649
-    t655 = t633*t634
-    t656 = t621*t640 + t625*t645 - t615*t587*t649*t655
-    t657 = (t656 != 0)
-    t658 = (-t617 + t636)/casadi.if_else(t657, -2*t656, 1)
-    t659 = casadi.fabs(t658)
-    t660 = (t659 >= 1)
-    t661 = 1/casadi.fabs(casadi.if_else(t660, t658, 1))
-    t662 = casadi.if_else(t657, casadi.if_else((t658 >= 0), 1, -1)*casadi.if_else(t660, t661/(1 + casadi.sqrt(1 + t661**2)), 1/(t659 + casadi.sqrt(1 + t659**2))), 0)
-    t663 = 1/casadi.sqrt(1 + t662**2)
-    t664 = t656*t662
-    t665 = t617 + t664
-    t666 = -t664 + t636
-    t667 = t621*t663
-    t668 = t640*t663
-    t669 = t667 + t662*t668
-    t670 = t668 - t662*t667
-    t671 = t625*t663
-    t672 = t645*t663
-    t673 = t671 + t662*t672
-    t674 = -t672 + t662*t671
-    t675 = t615*t663
-    t676 = t614*t675
-    t677 = t586*t676
-    t678 = t655*t675
-    t679 = -t676 + t662*t678
-    t680 = t678 + t662*t676
-    t681 = t586*t678
-    t682 = t677 - t662*t681
-    t683 = t681 + t662*t677
-    t684 = t597*t675
-    t685 = t650*t663
-    t686 = t684 - t662*t685
-    t687 = t685 + t662*t684
-    t688 = t596*t684
-    t689 = t653*t663
-    t690 = t688 + t662*t689
-    t691 = t689 - t662*t688
-    t692 = t615*t634
-    t693 = t641*t669 - t646*t673 + t586*t682*t692
-    t694 = (t693 != 0)
-    t695 = (-t665 + t637)/casadi.if_else(t694, -2*t693, 1)
-    t696 = casadi.fabs(t695)
-    t697 = (t696 >= 1)
-    t698 = 1/casadi.fabs(casadi.if_else(t697, t695, 1))
-    t699 = casadi.if_else(t694, casadi.if_else((t695 >= 0), 1, -1)*casadi.if_else(t697, t698/(1 + casadi.sqrt(1 + t698**2)), 1/(t696 + casadi.sqrt(1 + t696**2))), 0)
-    t700 = 1/casadi.sqrt(1 + t699**2)
-    t701 = t693*t699
-    t702 = t665 + t701
-    t703 = -t701 + t637
-    t704 = t669*t700
-    t705 = t641*t700
-    t706 = t704 + t699*t705
-    t707 = t705 - t699*t704
-    t708 = t673*t700
-    t709 = t646*t700
-    t710 = t708 - t699*t709
-    t711 = t709 + t699*t708
-    t712 = t682*t700
-    t713 = t700*t692
-    t714 = t586*t713
-    t715 = t712 + t699*t714
-    t716 = -t714 + t699*t712
-    t717 = t670*t707 + t674*t711 + t683*t716
-    t718 = t686*t700
-    t719 = t654*t700
-    t720 = t718 - t699*t719
-    t721 = t719 + t699*t718
-    t722 = t690*t700
-    t723 = t651*t700
-    t724 = t722 + t699*t723
-    t725 = t723 - t699*t722
-    t726 = t679*t700
-    t727 = t726 - t699*t713
-    t728 = t713 + t699*t726
-    t729 = (t717 != 0)
-    t730 = (-t666 + t703)/casadi.if_else(t729, 2*t717, 1)
-    t731 = casadi.fabs(t730)
-    t732 = (t731 >= 1)
-    t733 = 1/casadi.fabs(casadi.if_else(t732, t730, 1))
-    t734 = casadi.if_else(t729, casadi.if_else((t730 >= 0), 1, -1)*casadi.if_else(t732, t733/(1 + casadi.sqrt(1 + t733**2)), 1/(t731 + casadi.sqrt(1 + t731**2))), 0)
-    t735 = 1/casadi.sqrt(1 + t734**2)
-    t736 = t717*t734
-    t737 = -t736 + t666
-    t738 = t703 + t736
-    t739 = t670*t735
-    t740 = t707*t735
-    t741 = t739 - t734*t740
-    t742 = t740 + t734*t739
-    t743 = t674*t735
-    t744 = t711*t735
-    t745 = t743 - t734*t744
-    t746 = t744 + t734*t743
-    t747 = t683*t735
-    t748 = t716*t735
-    t749 = t747 - t734*t748
-    t750 = t748 + t734*t747
-    t751 = -t706*t741 + t710*t745 + t715*t749
-    t752 = t687*t735
-    t753 = t721*t735
-    t754 = t752 - t734*t753
-    t755 = t753 + t734*t752
-    t756 = t691*t735
-    t757 = t725*t735
-    t758 = t756 - t734*t757
-    t759 = t757 + t734*t756
-    t760 = t680*t735
-    t761 = t728*t735
-    t762 = t760 + t734*t761
-    t763 = t761 - t734*t760
-    t764 = (t751 != 0)
-    t765 = (-t702 + t737)/casadi.if_else(t764, 2*t751, 1)
-    t766 = casadi.fabs(t765)
-    t767 = (t766 >= 1)
-    t768 = 1/casadi.fabs(casadi.if_else(t767, t765, 1))
-    t769 = casadi.if_else(t764, casadi.if_else((t765 >= 0), 1, -1)*casadi.if_else(t767, t768/(1 + casadi.sqrt(1 + t768**2)), 1/(t766 + casadi.sqrt(1 + t766**2))), 0)
-    t770 = 1/casadi.sqrt(1 + t769**2)
-    t771 = t751*t769
-    t772 = -t771 + t702
-    t773 = t737 + t771
-    t774 = t706*t770
-    t775 = t741*t770
-    t776 = t774 + t769*t775
-    t777 = t775 - t769*t774
-    t778 = t710*t770
-    t779 = t745*t770
-    t780 = t778 - t769*t779
-    t781 = t779 + t769*t778
-    t782 = t715*t770
-    t783 = t749*t770
-    t784 = t782 - t769*t783
-    t785 = t783 + t769*t782
-    t786 = -t742*t776 + t746*t780 + t750*t784
-    t787 = t720*t770
-    t788 = t754*t770
-    t789 = t787 - t769*t788
-    t790 = t788 + t769*t787
-    t791 = t724*t770
-    t792 = t758*t770
-    t793 = t791 + t769*t792
-    t794 = t792 - t769*t791
-    t795 = t727*t770
-    t796 = t762*t770
-    t797 = t795 + t769*t796
-    t798 = -t796 + t769*t795
-    t799 = (t786 != 0)
-    t800 = (-t772 + t738)/casadi.if_else(t799, 2*t786, 1)
-    t801 = casadi.fabs(t800)
-    t802 = (t801 >= 1)
-    t803 = 1/casadi.fabs(casadi.if_else(t802, t800, 1))
-    t804 = casadi.if_else(t799, casadi.if_else((t800 >= 0), 1, -1)*casadi.if_else(t802, t803/(1 + casadi.sqrt(1 + t803**2)), 1/(t801 + casadi.sqrt(1 + t801**2))), 0)
-    t805 = 1/casadi.sqrt(1 + t804**2)
-    t806 = t786*t804
-    t807 = -t806 + t772
-    t808 = t738 + t806
-    t809 = t776*t805
-    t810 = t742*t805
-    t811 = t809 + t804*t810
-    t812 = t810 - t804*t809
-    t813 = t780*t805
-    t814 = t746*t805
-    t815 = t813 - t804*t814
-    t816 = t814 + t804*t813
-    t817 = t784*t805
-    t818 = t750*t805
-    t819 = t817 - t804*t818
-    t820 = t818 + t804*t817
-    t821 = t777*t812 + t781*t816 + t785*t820
-    t822 = t789*t805
-    t823 = t755*t805
-    t824 = t822 - t804*t823
-    t825 = t823 + t804*t822
-    t826 = t793*t805
-    t827 = t759*t805
-    t828 = t826 + t804*t827
-    t829 = t827 - t804*t826
-    t830 = t797*t805
-    t831 = t763*t805
-    t832 = t830 - t804*t831
-    t833 = t831 + t804*t830
-    t834 = (t821 != 0)
-    t835 = (-t773 + t808)/casadi.if_else(t834, 2*t821, 1)
-    t836 = casadi.fabs(t835)
-    t837 = (t836 >= 1)
-    t838 = 1/casadi.fabs(casadi.if_else(t837, t835, 1))
-    t839 = casadi.if_else(t834, casadi.if_else((t835 >= 0), 1, -1)*casadi.if_else(t837, t838/(1 + casadi.sqrt(1 + t838**2)), 1/(t836 + casadi.sqrt(1 + t836**2))), 0)
-    t840 = 1/casadi.sqrt(1 + t839**2)
-    t841 = t821*t839
-    t842 = -t841 + t773
-    t843 = t808 + t841
-    t844 = t777*t840
-    t845 = t812*t840
-    t846 = t844 - t839*t845
-    t847 = t845 + t839*t844
-    t848 = t781*t840
-    t849 = t816*t840
-    t850 = t848 - t839*t849
-    t851 = t849 + t839*t848
-    t852 = t785*t840
-    t853 = t820*t840
-    t854 = t852 - t839*t853
-    t855 = t853 + t839*t852
-    t856 = -t811*t846 + t815*t850 + t819*t854
-    t857 = t790*t840
-    t858 = t825*t840
-    t859 = t857 - t839*t858
-    t860 = t858 + t839*t857
-    t861 = t794*t840
-    t862 = t829*t840
-    t863 = t861 - t839*t862
-    t864 = t862 + t839*t861
-    t865 = t798*t840
-    t866 = t833*t840
-    t867 = t865 - t839*t866
-    t868 = t866 + t839*t865
-    t869 = (t856 != 0)
-    t870 = (-t807 + t842)/casadi.if_else(t869, 2*t856, 1)
-    t871 = casadi.fabs(t870)
-    t872 = (t871 >= 1)
-    t873 = 1/casadi.fabs(casadi.if_else(t872, t870, 1))
-    t874 = casadi.if_else(t869, casadi.if_else((t870 >= 0), 1, -1)*casadi.if_else(t872, t873/(1 + casadi.sqrt(1 + t873**2)), 1/(t871 + casadi.sqrt(1 + t871**2))), 0)
-    t875 = 1/casadi.sqrt(1 + t874**2)
-    t876 = t856*t874
-    t877 = -t876 + t807
-    t878 = t842 + t876
-    t879 = t811*t875
-    t880 = t846*t875
-    t881 = t879 + t874*t880
-    t882 = t880 - t874*t879
-    t883 = t815*t875
-    t884 = t850*t875
-    t885 = t883 - t874*t884
-    t886 = t884 + t874*t883
-    t887 = t819*t875
-    t888 = t854*t875
-    t889 = t887 - t874*t888
-    t890 = t888 + t874*t887
-    t891 = -t847*t881 + t851*t885 + t855*t889
-    t892 = t824*t875
-    t893 = t859*t875
-    t894 = t892 - t874*t893
-    t895 = t893 + t874*t892
-    t896 = t828*t875
-    t897 = t863*t875
-    t898 = t896 + t874*t897
-    t899 = t897 - t874*t896
-    t900 = t832*t875
-    t901 = t867*t875
-    t902 = t900 - t874*t901
-    t903 = t901 + t874*t900
-    t904 = (t891 != 0)
-    t905 = (-t877 + t843)/casadi.if_else(t904, 2*t891, 1)
-    t906 = casadi.fabs(t905)
-    t907 = (t906 >= 1)
-    t908 = 1/casadi.fabs(casadi.if_else(t907, t905, 1))
-    t909 = casadi.if_else(t904, casadi.if_else((t905 >= 0), 1, -1)*casadi.if_else(t907, t908/(1 + casadi.sqrt(1 + t908**2)), 1/(t906 + casadi.sqrt(1 + t906**2))), 0)
-    t910 = 1/casadi.sqrt(1 + t909**2)
-    t911 = t891*t909
-    t912 = -t911 + t877
-    t913 = t843 + t911
-    t914 = t881*t910
-    t915 = t847*t910
-    t916 = t914 + t909*t915
-    t917 = t915 - t909*t914
-    t918 = t885*t910
-    t919 = t851*t910
-    t920 = t918 - t909*t919
-    t921 = t919 + t909*t918
-    t922 = t889*t910
-    t923 = t855*t910
-    t924 = t922 - t909*t923
-    t925 = t923 + t909*t922
-    t926 = t882*t917 + t886*t921 + t890*t925
-    t927 = t894*t910
-    t928 = t860*t910
-    t929 = t927 - t909*t928
-    t930 = t928 + t909*t927
-    t931 = t898*t910
-    t932 = t864*t910
-    t933 = t931 + t909*t932
-    t934 = t932 - t909*t931
-    t935 = t902*t910
-    t936 = t868*t910
-    t937 = t935 - t909*t936
-    t938 = t936 + t909*t935
-    t939 = (t926 != 0)
-    t940 = (-t878 + t913)/casadi.if_else(t939, 2*t926, 1)
-    t941 = casadi.fabs(t940)
-    t942 = (t941 >= 1)
-    t943 = 1/casadi.fabs(casadi.if_else(t942, t940, 1))
-    t944 = casadi.if_else(t939, casadi.if_else((t940 >= 0), 1, -1)*casadi.if_else(t942, t943/(1 + casadi.sqrt(1 + t943**2)), 1/(t941 + casadi.sqrt(1 + t941**2))), 0)
-    t945 = 1/casadi.sqrt(1 + t944**2)
-    t946 = t926*t944
-    t947 = -t946 + t878
-    t948 = t913 + t946
-    t949 = t882*t945
-    t950 = t917*t945
-    t951 = t949 - t944*t950
-    t952 = t950 + t944*t949
-    t953 = t886*t945
-    t954 = t921*t945
-    t955 = t953 - t944*t954
-    t956 = t954 + t944*t953
-    t957 = t890*t945
-    t958 = t925*t945
-    t959 = t957 - t944*t958
-    t960 = t958 + t944*t957
-    t961 = -t916*t951 + t920*t955 + t924*t959
-    t962 = t895*t945
-    t963 = t930*t945
-    t964 = t962 - t944*t963
-    t965 = t963 + t944*t962
-    t966 = t899*t945
-    t967 = t934*t945
-    t968 = t966 - t944*t967
-    t969 = t967 + t944*t966
-    t970 = t903*t945
-    t971 = t938*t945
-    t972 = t970 - t944*t971
-    t973 = t971 + t944*t970
-    t974 = (t961 != 0)
-    t975 = (-t912 + t947)/casadi.if_else(t974, 2*t961, 1)
-    t976 = casadi.fabs(t975)
-    t977 = (t976 >= 1)
-    t978 = 1/casadi.fabs(casadi.if_else(t977, t975, 1))
-    t979 = casadi.if_else(t974, casadi.if_else((t975 >= 0), 1, -1)*casadi.if_else(t977, t978/(1 + casadi.sqrt(1 + t978**2)), 1/(t976 + casadi.sqrt(1 + t976**2))), 0)
-    t980 = 1/casadi.sqrt(1 + t979**2)
-    t981 = t961*t979
-    t982 = -t981 + t912
-    t983 = t947 + t981
-    t984 = t916*t980
-    t985 = t951*t980
-    t986 = t984 + t979*t985
-    t987 = t985 - t979*t984
-    t988 = t920*t980
-    t989 = t955*t980
-    t990 = t988 - t979*t989
-    t991 = t989 + t979*t988
-    t992 = t924*t980
-    t993 = t959*t980
-    t994 = t992 - t979*t993
-    t995 = t993 + t979*t992
-    t996 = -t952*t986 + t956*t990 + t960*t994
-    t997 = t929*t980
-    t998 = t964*t980
-    t999 = t997 - t979*t998
-    t1000 = t998 + t979*t997
-    t1001 = t933*t980
-    t1002 = t968*t980
-    t1003 = t1001 + t979*t1002
-    t1004 = t1002 - t979*t1001
-    t1005 = t937*t980
-    t1006 = t972*t980
-    t1007 = t1005 - t979*t1006
-    t1008 = t1006 + t979*t1005
-    t1009 = (t996 != 0)
-    t1010 = (-t982 + t948)/casadi.if_else(t1009, 2*t996, 1)
-    t1011 = casadi.fabs(t1010)
-    t1012 = (t1011 >= 1)
-    t1013 = 1/casadi.fabs(casadi.if_else(t1012, t1010, 1))
-    t1014 = casadi.if_else(t1009, casadi.if_else((t1010 >= 0), 1, -1)*casadi.if_else(t1012, t1013/(1 + casadi.sqrt(1 + t1013**2)), 1/(t1011 + casadi.sqrt(1 + t1011**2))), 0)
-    t1015 = 1/casadi.sqrt(1 + t1014**2)
-    t1016 = t948 + t996*t1014
-    t1017 = t986*t1015
-    t1018 = t952*t1015
-    t1019 = t1017 + t1014*t1018
-    t1020 = t1018 - t1014*t1017
-    t1021 = t990*t1015
-    t1022 = t956*t1015
-    t1023 = t1021 - t1014*t1022
-    t1024 = t1022 + t1014*t1021
-    t1025 = t994*t1015
-    t1026 = t960*t1015
-    t1027 = t1025 - t1014*t1026
-    t1028 = t1026 + t1014*t1025
-    t1029 = t987*t1020 + t991*t1024 + t995*t1028
-    t1030 = casadi.sqrt(t1019**2 + t1023**2 + t1027**2)
-    t1031 = t999*t1015
-    t1032 = t965*t1015
-    t1033 = t1031 - t1014*t1032
-    t1034 = t1032 + t1014*t1031
-    t1035 = t1003*t1015
-    t1036 = t969*t1015
-    t1037 = t1035 + t1014*t1036
-    t1038 = t1036 - t1014*t1035
-    t1039 = t1007*t1015
-    t1040 = t973*t1015
-    t1041 = t1039 - t1014*t1040
-    t1042 = t1040 + t1014*t1039
-    t1043 = (t1029 != 0)
-    t1044 = (-t983 + t1016)/casadi.if_else(t1043, 2*t1029, 1)
-    t1045 = casadi.fabs(t1044)
-    t1046 = (t1045 >= 1)
-    t1047 = 1/casadi.fabs(casadi.if_else(t1046, t1044, 1))
-    t1048 = casadi.if_else(t1043, casadi.if_else((t1044 >= 0), 1, -1)*casadi.if_else(t1046, t1047/(1 + casadi.sqrt(1 + t1047**2)), 1/(t1045 + casadi.sqrt(1 + t1045**2))), 0)
-    t1049 = 1/casadi.sqrt(1 + t1048**2)
-    t1050 = t987*t1049
-    t1051 = t1020*t1049
-    t1052 = t1050 - t1048*t1051
-    t1053 = t1051 + t1048*t1050
-    t1054 = t991*t1049
-    t1055 = t1024*t1049
-    t1056 = t1054 - t1048*t1055
-    t1057 = t1055 + t1048*t1054
-    t1058 = t995*t1049
-    t1059 = t1028*t1049
-    t1060 = t1058 - t1048*t1059
-    t1061 = t1059 + t1048*t1058
-    t1062 = casadi.sqrt(t1052**2 + t1056**2 + t1060**2)
-    t1063 = casadi.sqrt(t1053**2 + t1057**2 + t1061**2)
-    t1064 = t1000*t1049
-    t1065 = t1034*t1049
-    t1066 = t1064 - t1048*t1065
-    t1067 = t1065 + t1048*t1064
-    t1068 = t1004*t1049
-    t1069 = t1038*t1049
-    t1070 = t1068 - t1048*t1069
-    t1071 = t1069 + t1048*t1068
-    t1072 = t1008*t1049
-    t1073 = t1042*t1049
-    t1074 = t1072 - t1048*t1073
-    t1075 = t1073 + t1048*t1072
-    t1076 = (t1030 < t1062)
-    t1077 = casadi.if_else(t1076, t1062, t1030)
-    t1078 = casadi.if_else(t1076, t1030, t1062)
-    t1079 = casadi.if_else(t1076, t1066, t1033)
-    t1080 = casadi.if_else(t1076, t1074, t1041)
-    t1081 = casadi.if_else(t1076, t1033, t1066)
-    t1082 = casadi.if_else(t1076, t1041, t1074)
-    t1083 = -t1037
-    t1084 = casadi.if_else(t1076, t1070, t1083)
-    t1085 = casadi.if_else(t1076, t1083, t1070)
-    t1086 = (t1078 < t1063)
-    t1087 = casadi.if_else(t1086, t1063, t1078)
-    t1088 = casadi.if_else(t1086, t1078, t1063)
-    t1089 = casadi.if_else(t1086, t1067, t1081)
-    t1090 = casadi.if_else(t1086, t1071, t1085)
-    t1091 = casadi.if_else(t1086, t1075, t1082)
-    t1092 = casadi.if_else(t1086, t1081, t1067)
-    t1093 = casadi.if_else(t1086, t1085, t1071)
-    t1094 = casadi.if_else(t1086, t1082, t1075)
-    t1095 = (t1077 < t1087)
-    t1096 = casadi.if_else(t1095, t1087, t1077)
-    t1097 = casadi.if_else(t1095, t1077, t1087)
-    t1098 = casadi.if_else(t1095, t1089, t1079)
-    t1099 = casadi.if_else(t1095, t1090, t1084)
-    t1100 = casadi.if_else(t1095, t1091, t1080)
-    t1101 = casadi.if_else(t1095, t1079, t1089)
-    t1102 = casadi.if_else(t1095, t1084, t1090)
-    t1103 = casadi.if_else(t1095, t1080, t1091)
-    t1104 = t1098*(t1094*t1102 - t1093*t1103) - t1099*(t1094*t1101 - t1092*t1103) + t1100*(t1093*t1101 - t1092*t1102)
-    t1105 = casadi.if_else((t1104 < 0), -1, 1)
-    t1106 = t1092*t1105
-    t1107 = t1093*t1105
-    t1108 = t1094*t1105
+    t580 = t577**2
+    t581 = -c1 + c1*t578*t573*t580
+    t582 = casadi.sqrt(3*t581**2)
+    t583 = t582*casadi.if_else((t581 >= 0), 1, -1)
+    t584 = t583**2 + 9*t11*t13*t578**2*t580
+    t585 = (t582 > 0)
+    t586 = casadi.if_else(t585, 1/(t581 + t583), 0)
+    t587 = casadi.if_else(t585, 1 + casadi.fabs(t581)/t582, 0)
+    t588 = s1*t577*t578
+    t589 = t581*t586
+    t590 = -t587*(t588 + 2*t588*t589)
+    t591 = t590 + t588
+    t592 = t588 + t590*t589
+    t593 = casadi.sqrt(2*t592**2)
+    t594 = t593*casadi.if_else((t592 <= 0), 1, -1)
+    t595 = t594**2
+    t596 = t579**2 + t591**2 + t595
+    t597 = c1*t574*t588
+    t598 = 3*t597
+    t599 = (t598 != 0)
+    t600 = (-t575 + t584)/casadi.if_else(t599, -6*t597, 1)
+    t601 = casadi.fabs(t600)
+    t602 = (t601 >= 1)
+    t603 = 1/casadi.fabs(casadi.if_else(t602, t600, 1))
+    t604 = casadi.if_else(t599, casadi.if_else((t600 >= 0), 1, -1)*casadi.if_else(t602, t603/(1 + casadi.sqrt(1 + t603**2)), 1/(t601 + casadi.sqrt(1 + t601**2))), 0)
+    t605 = 1/casadi.sqrt(1 + t604**2)
+    t606 = t604*t598
+    t607 = t575 + t606
+    t608 = -t606 + t584
+    t609 = t574*t605
+    t610 = 3*c1*t605*t588
+    t611 = t609 + t604*t610
+    t612 = t610 - t604*t609
+    t613 = t583*t605
+    t614 = t604*t613
+    t615 = t579*t611 + t591*t614
+    t616 = (t615 != 0)
+    t617 = (-t607 + t596)/casadi.if_else(t616, -2*t615, 1)
+    t618 = casadi.fabs(t617)
+    t619 = (t618 >= 1)
+    t620 = 1/casadi.fabs(casadi.if_else(t619, t617, 1))
+    t621 = casadi.if_else(t616, casadi.if_else((t617 >= 0), 1, -1)*casadi.if_else(t619, t620/(1 + casadi.sqrt(1 + t620**2)), 1/(t618 + casadi.sqrt(1 + t618**2))), 0)
+    t622 = 1/casadi.sqrt(1 + t621**2)
+    t623 = t615*t621
+    t624 = t607 + t623
+    t625 = -t623 + t596
+    t626 = t611*t622
+    t627 = t579*t622
+    t628 = t626 + t621*t627
+    t629 = t627 - t621*t626
+    t630 = t622*t614
+    t631 = t591*t622
+    t632 = t630 + t621*t631
+    t633 = -t631 + t621*t630
+    t634 = t612*t629 - t633*t613
+    t635 = (t634 != 0)
+    t636 = (-t608 + t625)/casadi.if_else(t635, 2*t634, 1)
+    t637 = casadi.fabs(t636)
+    t638 = (t637 >= 1)
+    t639 = 1/casadi.fabs(casadi.if_else(t638, t636, 1))
+    t640 = casadi.if_else(t635, casadi.if_else((t636 >= 0), 1, -1)*casadi.if_else(t638, t639/(1 + casadi.sqrt(1 + t639**2)), 1/(t637 + casadi.sqrt(1 + t637**2))), 0)
+    t641 = 1/casadi.sqrt(1 + t640**2)
+    t642 = t634*t640
+    t643 = -t642 + t608
+    t644 = t625 + t642
+    t645 = t612*t641
+    t646 = t629*t641
+    t647 = t645 - t640*t646
+    t648 = t646 + t640*t645
+    t649 = t605*t641
+    t650 = t583*t649
+    t651 = t633*t641
+    t652 = t650 + t640*t651
+    t653 = t651 - t640*t650
+    t654 = t604*t649
+    t655 = t640*t649
+    t656 = t621*t622
+    t657 = t654 - t655*t656
+    t658 = t655 - t654*t656
+    t659 = t640*t654
+    t660 = t649 + t656*t659
+    t661 = t659 + t649*t656
+    t662 = t640*t641
+    t663 = t628*t647 + t632*t652 - t622*t595*t656*t662
+    t664 = (t663 != 0)
+    t665 = (-t624 + t643)/casadi.if_else(t664, -2*t663, 1)
+    t666 = casadi.fabs(t665)
+    t667 = (t666 >= 1)
+    t668 = 1/casadi.fabs(casadi.if_else(t667, t665, 1))
+    t669 = casadi.if_else(t664, casadi.if_else((t665 >= 0), 1, -1)*casadi.if_else(t667, t668/(1 + casadi.sqrt(1 + t668**2)), 1/(t666 + casadi.sqrt(1 + t666**2))), 0)
+    t670 = 1/casadi.sqrt(1 + t669**2)
+    t671 = t663*t669
+    t672 = t624 + t671
+    t673 = -t671 + t643
+    t674 = t628*t670
+    t675 = t647*t670
+    t676 = t674 + t669*t675
+    t677 = t675 - t669*t674
+    t678 = t632*t670
+    t679 = t652*t670
+    t680 = t678 + t669*t679
+    t681 = -t679 + t669*t678
+    t682 = t622*t670
+    t683 = t621*t682
+    t684 = t594*t683
+    t685 = t662*t682
+    t686 = -t683 + t669*t685
+    t687 = t685 + t669*t683
+    t688 = t594*t685
+    t689 = t684 - t669*t688
+    t690 = t688 + t669*t684
+    t691 = t605*t682
+    t692 = t657*t670
+    t693 = t691 - t669*t692
+    t694 = t692 + t669*t691
+    t695 = t604*t691
+    t696 = t660*t670
+    t697 = t695 + t669*t696
+    t698 = t696 - t669*t695
+    t699 = t622*t641
+    t700 = t648*t676 - t653*t680 + t594*t689*t699
+    t701 = (t700 != 0)
+    t702 = (-t672 + t644)/casadi.if_else(t701, -2*t700, 1)
+    t703 = casadi.fabs(t702)
+    t704 = (t703 >= 1)
+    t705 = 1/casadi.fabs(casadi.if_else(t704, t702, 1))
+    t706 = casadi.if_else(t701, casadi.if_else((t702 >= 0), 1, -1)*casadi.if_else(t704, t705/(1 + casadi.sqrt(1 + t705**2)), 1/(t703 + casadi.sqrt(1 + t703**2))), 0)
+    t707 = 1/casadi.sqrt(1 + t706**2)
+    t708 = t700*t706
+    t709 = t672 + t708
+    t710 = -t708 + t644
+    t711 = t676*t707
+    t712 = t648*t707
+    t713 = t711 + t706*t712
+    t714 = t712 - t706*t711
+    t715 = t680*t707
+    t716 = t653*t707
+    t717 = t715 - t706*t716
+    t718 = t716 + t706*t715
+    t719 = t689*t707
+    t720 = t707*t699
+    t721 = t594*t720
+    t722 = t719 + t706*t721
+    t723 = -t721 + t706*t719
+    t724 = t677*t714 + t681*t718 + t690*t723
+    t725 = t693*t707
+    t726 = t661*t707
+    t727 = t725 - t706*t726
+    t728 = t726 + t706*t725
+    t729 = t697*t707
+    t730 = t658*t707
+    t731 = t729 + t706*t730
+    t732 = t730 - t706*t729
+    t733 = t686*t707
+    t734 = t733 - t706*t720
+    t735 = t720 + t706*t733
+    t736 = (t724 != 0)
+    t737 = (-t673 + t710)/casadi.if_else(t736, 2*t724, 1)
+    t738 = casadi.fabs(t737)
+    t739 = (t738 >= 1)
+    t740 = 1/casadi.fabs(casadi.if_else(t739, t737, 1))
+    t741 = casadi.if_else(t736, casadi.if_else((t737 >= 0), 1, -1)*casadi.if_else(t739, t740/(1 + casadi.sqrt(1 + t740**2)), 1/(t738 + casadi.sqrt(1 + t738**2))), 0)
+    t742 = 1/casadi.sqrt(1 + t741**2)
+    t743 = t724*t741
+    t744 = -t743 + t673
+    t745 = t710 + t743
+    t746 = t677*t742
+    t747 = t714*t742
+    t748 = t746 - t741*t747
+    t749 = t747 + t741*t746
+    t750 = t681*t742
+    t751 = t718*t742
+    t752 = t750 - t741*t751
+    t753 = t751 + t741*t750
+    t754 = t690*t742
+    t755 = t723*t742
+    t756 = t754 - t741*t755
+    t757 = t755 + t741*t754
+    t758 = -t713*t748 + t717*t752 + t722*t756
+    t759 = t694*t742
+    t760 = t728*t742
+    t761 = t759 - t741*t760
+    t762 = t760 + t741*t759
+    t763 = t698*t742
+    t764 = t732*t742
+    t765 = t763 - t741*t764
+    t766 = t764 + t741*t763
+    t767 = t687*t742
+    t768 = t735*t742
+    t769 = t767 + t741*t768
+    t770 = t768 - t741*t767
+    t771 = (t758 != 0)
+    t772 = (-t709 + t744)/casadi.if_else(t771, 2*t758, 1)
+    t773 = casadi.fabs(t772)
+    t774 = (t773 >= 1)
+    t775 = 1/casadi.fabs(casadi.if_else(t774, t772, 1))
+    t776 = casadi.if_else(t771, casadi.if_else((t772 >= 0), 1, -1)*casadi.if_else(t774, t775/(1 + casadi.sqrt(1 + t775**2)), 1/(t773 + casadi.sqrt(1 + t773**2))), 0)
+    t777 = 1/casadi.sqrt(1 + t776**2)
+    t778 = t758*t776
+    t779 = -t778 + t709
+    t780 = t744 + t778
+    t781 = t713*t777
+    t782 = t748*t777
+    t783 = t781 + t776*t782
+    t784 = t782 - t776*t781
+    t785 = t717*t777
+    t786 = t752*t777
+    t787 = t785 - t776*t786
+    t788 = t786 + t776*t785
+    t789 = t722*t777
+    t790 = t756*t777
+    t791 = t789 - t776*t790
+    t792 = t790 + t776*t789
+    t793 = -t749*t783 + t753*t787 + t757*t791
+    t794 = t727*t777
+    t795 = t761*t777
+    t796 = t794 - t776*t795
+    t797 = t795 + t776*t794
+    t798 = t731*t777
+    t799 = t765*t777
+    t800 = t798 + t776*t799
+    t801 = t799 - t776*t798
+    t802 = t734*t777
+    t803 = t769*t777
+    t804 = t802 + t776*t803
+    t805 = -t803 + t776*t802
+    t806 = (t793 != 0)
+    t807 = (-t779 + t745)/casadi.if_else(t806, 2*t793, 1)
+    t808 = casadi.fabs(t807)
+    t809 = (t808 >= 1)
+    t810 = 1/casadi.fabs(casadi.if_else(t809, t807, 1))
+    t811 = casadi.if_else(t806, casadi.if_else((t807 >= 0), 1, -1)*casadi.if_else(t809, t810/(1 + casadi.sqrt(1 + t810**2)), 1/(t808 + casadi.sqrt(1 + t808**2))), 0)
+    t812 = 1/casadi.sqrt(1 + t811**2)
+    t813 = t793*t811
+    t814 = -t813 + t779
+    t815 = t745 + t813
+    t816 = t783*t812
+    t817 = t749*t812
+    t818 = t816 + t811*t817
+    t819 = t817 - t811*t816
+    t820 = t787*t812
+    t821 = t753*t812
+    t822 = t820 - t811*t821
+    t823 = t821 + t811*t820
+    t824 = t791*t812
+    t825 = t757*t812
+    t826 = t824 - t811*t825
+    t827 = t825 + t811*t824
+    t828 = t784*t819 + t788*t823 + t792*t827
+    t829 = t796*t812
+    t830 = t762*t812
+    t831 = t829 - t811*t830
+    t832 = t830 + t811*t829
+    t833 = t800*t812
+    t834 = t766*t812
+    t835 = t833 + t811*t834
+    t836 = t834 - t811*t833
+    t837 = t804*t812
+    t838 = t770*t812
+    t839 = t837 - t811*t838
+    t840 = t838 + t811*t837
+    t841 = (t828 != 0)
+    t842 = (-t780 + t815)/casadi.if_else(t841, 2*t828, 1)
+    t843 = casadi.fabs(t842)
+    t844 = (t843 >= 1)
+    t845 = 1/casadi.fabs(casadi.if_else(t844, t842, 1))
+    t846 = casadi.if_else(t841, casadi.if_else((t842 >= 0), 1, -1)*casadi.if_else(t844, t845/(1 + casadi.sqrt(1 + t845**2)), 1/(t843 + casadi.sqrt(1 + t843**2))), 0)
+    t847 = 1/casadi.sqrt(1 + t846**2)
+    t848 = t828*t846
+    t849 = -t848 + t780
+    t850 = t815 + t848
+    t851 = t784*t847
+    t852 = t819*t847
+    t853 = t851 - t846*t852
+    t854 = t852 + t846*t851
+    t855 = t788*t847
+    t856 = t823*t847
+    t857 = t855 - t846*t856
+    t858 = t856 + t846*t855
+    t859 = t792*t847
+    t860 = t827*t847
+    t861 = t859 - t846*t860
+    t862 = t860 + t846*t859
+    t863 = -t818*t853 + t822*t857 + t826*t861
+    t864 = t797*t847
+    t865 = t832*t847
+    t866 = t864 - t846*t865
+    t867 = t865 + t846*t864
+    t868 = t801*t847
+    t869 = t836*t847
+    t870 = t868 - t846*t869
+    t871 = t869 + t846*t868
+    t872 = t805*t847
+    t873 = t840*t847
+    t874 = t872 - t846*t873
+    t875 = t873 + t846*t872
+    t876 = (t863 != 0)
+    t877 = (-t814 + t849)/casadi.if_else(t876, 2*t863, 1)
+    t878 = casadi.fabs(t877)
+    t879 = (t878 >= 1)
+    t880 = 1/casadi.fabs(casadi.if_else(t879, t877, 1))
+    t881 = casadi.if_else(t876, casadi.if_else((t877 >= 0), 1, -1)*casadi.if_else(t879, t880/(1 + casadi.sqrt(1 + t880**2)), 1/(t878 + casadi.sqrt(1 + t878**2))), 0)
+    t882 = 1/casadi.sqrt(1 + t881**2)
+    t883 = t863*t881
+    t884 = -t883 + t814
+    t885 = t849 + t883
+    t886 = t818*t882
+    t887 = t853*t882
+    t888 = t886 + t881*t887
+    t889 = t887 - t881*t886
+    t890 = t822*t882
+    t891 = t857*t882
+    t892 = t890 - t881*t891
+    t893 = t891 + t881*t890
+    t894 = t826*t882
+    t895 = t861*t882
+    t896 = t894 - t881*t895
+    t897 = t895 + t881*t894
+    t898 = -t854*t888 + t858*t892 + t862*t896
+    t899 = t831*t882
+    t900 = t866*t882
+    t901 = t899 - t881*t900
+    t902 = t900 + t881*t899
+    t903 = t835*t882
+    t904 = t870*t882
+    t905 = t903 + t881*t904
+    t906 = t904 - t881*t903
+    t907 = t839*t882
+    t908 = t874*t882
+    t909 = t907 - t881*t908
+    t910 = t908 + t881*t907
+    t911 = (t898 != 0)
+    t912 = (-t884 + t850)/casadi.if_else(t911, 2*t898, 1)
+    t913 = casadi.fabs(t912)
+    t914 = (t913 >= 1)
+    t915 = 1/casadi.fabs(casadi.if_else(t914, t912, 1))
+    t916 = casadi.if_else(t911, casadi.if_else((t912 >= 0), 1, -1)*casadi.if_else(t914, t915/(1 + casadi.sqrt(1 + t915**2)), 1/(t913 + casadi.sqrt(1 + t913**2))), 0)
+    t917 = 1/casadi.sqrt(1 + t916**2)
+    t918 = t898*t916
+    t919 = -t918 + t884
+    t920 = t850 + t918
+    t921 = t888*t917
+    t922 = t854*t917
+    t923 = t921 + t916*t922
+    t924 = t922 - t916*t921
+    t925 = t892*t917
+    t926 = t858*t917
+    t927 = t925 - t916*t926
+    t928 = t926 + t916*t925
+    t929 = t896*t917
+    t930 = t862*t917
+    t931 = t929 - t916*t930
+    t932 = t930 + t916*t929
+    t933 = t889*t924 + t893*t928 + t897*t932
+    t934 = t901*t917
+    t935 = t867*t917
+    t936 = t934 - t916*t935
+    t937 = t935 + t916*t934
+    t938 = t905*t917
+    t939 = t871*t917
+    t940 = t938 + t916*t939
+    t941 = t939 - t916*t938
+    t942 = t909*t917
+    t943 = t875*t917
+    t944 = t942 - t916*t943
+    t945 = t943 + t916*t942
+    t946 = (t933 != 0)
+    t947 = (-t885 + t920)/casadi.if_else(t946, 2*t933, 1)
+    t948 = casadi.fabs(t947)
+    t949 = (t948 >= 1)
+    t950 = 1/casadi.fabs(casadi.if_else(t949, t947, 1))
+    t951 = casadi.if_else(t946, casadi.if_else((t947 >= 0), 1, -1)*casadi.if_else(t949, t950/(1 + casadi.sqrt(1 + t950**2)), 1/(t948 + casadi.sqrt(1 + t948**2))), 0)
+    t952 = 1/casadi.sqrt(1 + t951**2)
+    t953 = t933*t951
+    t954 = -t953 + t885
+    t955 = t920 + t953
+    t956 = t889*t952
+    t957 = t924*t952
+    t958 = t956 - t951*t957
+    t959 = t957 + t951*t956
+    t960 = t893*t952
+    t961 = t928*t952
+    t962 = t960 - t951*t961
+    t963 = t961 + t951*t960
+    t964 = t897*t952
+    t965 = t932*t952
+    t966 = t964 - t951*t965
+    t967 = t965 + t951*t964
+    t968 = -t923*t958 + t927*t962 + t931*t966
+    t969 = t902*t952
+    t970 = t937*t952
+    t971 = t969 - t951*t970
+    t972 = t970 + t951*t969
+    t973 = t906*t952
+    t974 = t941*t952
+    t975 = t973 - t951*t974
+    t976 = t974 + t951*t973
+    t977 = t910*t952
+    t978 = t945*t952
+    t979 = t977 - t951*t978
+    t980 = t978 + t951*t977
+    t981 = (t968 != 0)
+    t982 = (-t919 + t954)/casadi.if_else(t981, 2*t968, 1)
+    t983 = casadi.fabs(t982)
+    t984 = (t983 >= 1)
+    t985 = 1/casadi.fabs(casadi.if_else(t984, t982, 1))
+    t986 = casadi.if_else(t981, casadi.if_else((t982 >= 0), 1, -1)*casadi.if_else(t984, t985/(1 + casadi.sqrt(1 + t985**2)), 1/(t983 + casadi.sqrt(1 + t983**2))), 0)
+    t987 = 1/casadi.sqrt(1 + t986**2)
+    t988 = t968*t986
+    t989 = -t988 + t919
+    t990 = t954 + t988
+    t991 = t923*t987
+    t992 = t958*t987
+    t993 = t991 + t986*t992
+    t994 = t992 - t986*t991
+    t995 = t927*t987
+    t996 = t962*t987
+    t997 = t995 - t986*t996
+    t998 = t996 + t986*t995
+    t999 = t931*t987
+    t1000 = t966*t987
+    t1001 = t999 - t986*t1000
+    t1002 = t1000 + t986*t999
+    t1003 = -t959*t993 + t963*t997 + t967*t1001
+    t1004 = t936*t987
+    t1005 = t971*t987
+    t1006 = t1004 - t986*t1005
+    t1007 = t1005 + t986*t1004
+    t1008 = t940*t987
+    t1009 = t975*t987
+    t1010 = t1008 + t986*t1009
+    t1011 = t1009 - t986*t1008
+    t1012 = t944*t987
+    t1013 = t979*t987
+    t1014 = t1012 - t986*t1013
+    t1015 = t1013 + t986*t1012
+    t1016 = (t1003 != 0)
+    t1017 = (-t989 + t955)/casadi.if_else(t1016, 2*t1003, 1)
+    t1018 = casadi.fabs(t1017)
+    t1019 = (t1018 >= 1)
+    t1020 = 1/casadi.fabs(casadi.if_else(t1019, t1017, 1))
+    t1021 = casadi.if_else(t1016, casadi.if_else((t1017 >= 0), 1, -1)*casadi.if_else(t1019, t1020/(1 + casadi.sqrt(1 + t1020**2)), 1/(t1018 + casadi.sqrt(1 + t1018**2))), 0)
+    t1022 = 1/casadi.sqrt(1 + t1021**2)
+    t1023 = t955 + t1003*t1021
+    t1024 = t993*t1022
+    t1025 = t959*t1022
+    t1026 = t1024 + t1021*t1025
+    t1027 = t1025 - t1021*t1024
+    t1028 = t997*t1022
+    t1029 = t963*t1022
+    t1030 = t1028 - t1021*t1029
+    t1031 = t1029 + t1021*t1028
+    t1032 = t1001*t1022
+    t1033 = t967*t1022
+    t1034 = t1032 - t1021*t1033
+    t1035 = t1033 + t1021*t1032
+    t1036 = t994*t1027 + t998*t1031 + t1002*t1035
+    t1037 = casadi.sqrt(t1026**2 + t1030**2 + t1034**2)
+    t1038 = t1006*t1022
+    t1039 = t972*t1022
+    t1040 = t1038 - t1021*t1039
+    t1041 = t1039 + t1021*t1038
+    t1042 = t1010*t1022
+    t1043 = t976*t1022
+    t1044 = t1042 + t1021*t1043
+    t1045 = t1043 - t1021*t1042
+    t1046 = t1014*t1022
+    t1047 = t980*t1022
+    t1048 = t1046 - t1021*t1047
+    t1049 = t1047 + t1021*t1046
+    t1050 = (t1036 != 0)
+    t1051 = (-t990 + t1023)/casadi.if_else(t1050, 2*t1036, 1)
+    t1052 = casadi.fabs(t1051)
+    t1053 = (t1052 >= 1)
+    t1054 = 1/casadi.fabs(casadi.if_else(t1053, t1051, 1))
+    t1055 = casadi.if_else(t1050, casadi.if_else((t1051 >= 0), 1, -1)*casadi.if_else(t1053, t1054/(1 + casadi.sqrt(1 + t1054**2)), 1/(t1052 + casadi.sqrt(1 + t1052**2))), 0)
+    t1056 = 1/casadi.sqrt(1 + t1055**2)
+    t1057 = t994*t1056
+    t1058 = t1027*t1056
+    t1059 = t1057 - t1055*t1058
+    t1060 = t1058 + t1055*t1057
+    t1061 = t998*t1056
+    t1062 = t1031*t1056
+    t1063 = t1061 - t1055*t1062
+    t1064 = t1062 + t1055*t1061
+    t1065 = t1002*t1056
+    t1066 = t1035*t1056
+    t1067 = t1065 - t1055*t1066
+    t1068 = t1066 + t1055*t1065
+    t1069 = casadi.sqrt(t1059**2 + t1063**2 + t1067**2)
+    t1070 = casadi.sqrt(t1060**2 + t1064**2 + t1068**2)
+    t1071 = t1007*t1056
+    t1072 = t1041*t1056
+    t1073 = t1071 - t1055*t1072
+    t1074 = t1072 + t1055*t1071
+    t1075 = t1011*t1056
+    t1076 = t1045*t1056
+    t1077 = t1075 - t1055*t1076
+    t1078 = t1076 + t1055*t1075
+    t1079 = t1015*t1056
+    t1080 = t1049*t1056
+    t1081 = t1079 - t1055*t1080
+    t1082 = t1080 + t1055*t1079
+    t1083 = (t1037 < t1069)
+    t1084 = casadi.if_else(t1083, t1069, t1037)
+    t1085 = casadi.if_else(t1083, t1037, t1069)
+    t1086 = casadi.if_else(t1083, t1073, t1040)
+    t1087 = casadi.if_else(t1083, t1081, t1048)
+    t1088 = casadi.if_else(t1083, t1040, t1073)
+    t1089 = casadi.if_else(t1083, t1048, t1081)
+    t1090 = -t1044
+    t1091 = casadi.if_else(t1083, t1077, t1090)
+    t1092 = casadi.if_else(t1083, t1090, t1077)
+    t1093 = (t1085 < t1070)
+    t1094 = casadi.if_else(t1093, t1070, t1085)
+    t1095 = casadi.if_else(t1093, t1085, t1070)
+    t1096 = casadi.if_else(t1093, t1074, t1088)
+    t1097 = casadi.if_else(t1093, t1078, t1092)
+    t1098 = casadi.if_else(t1093, t1082, t1089)
+    t1099 = casadi.if_else(t1093, t1088, t1074)
+    t1100 = casadi.if_else(t1093, t1092, t1078)
+    t1101 = casadi.if_else(t1093, t1089, t1082)
+    t1102 = (t1084 < t1094)
+    t1103 = casadi.if_else(t1102, t1094, t1084)
+    t1104 = casadi.if_else(t1102, t1084, t1094)
+    t1105 = casadi.if_else(t1102, t1096, t1086)
+    t1106 = casadi.if_else(t1102, t1097, t1091)
+    t1107 = casadi.if_else(t1102, t1098, t1087)
+    t1108 = casadi.if_else(t1102, t1086, t1096)
+    t1109 = casadi.if_else(t1102, t1091, t1097)
+    t1110 = casadi.if_else(t1102, t1087, t1098)
+    t1111 = t1105*(t1101*t1109 - t1100*t1110) - t1106*(t1101*t1108 - t1099*t1110) + t1107*(t1100*t1108 - t1099*t1109)
+    t1112 = casadi.if_else((t1111 < 0), -1, 1)
+    t1113 = t1099*t1112
+    t1114 = t1100*t1112
+    t1115 = t1101*t1112
     U_v = casadi.SX(3, 3)
-    U_v[0, 0] = t558
-    U_v[0, 1] = t561
-    U_v[0, 2] = t566
-    U_v[1, 0] = t559
-    U_v[1, 1] = t562
-    U_v[1, 2] = t567
-    U_v[2, 0] = t560
-    U_v[2, 1] = t563
-    U_v[2, 2] = t568
+    U_v[0, 0] = t562
+    U_v[0, 1] = t565
+    U_v[0, 2] = t570
+    U_v[1, 0] = t563
+    U_v[1, 1] = t566
+    U_v[1, 2] = t571
+    U_v[2, 0] = t564
+    U_v[2, 1] = t567
+    U_v[2, 2] = t572
     s_v = casadi.SX(3, 1)
-    s_v[0, 0] = t556
-    s_v[1, 0] = t557
-    s_v[2, 0] = t548
+    s_v[0, 0] = t560
+    s_v[1, 0] = t561
+    s_v[2, 0] = t552
     U_w = casadi.SX(3, 3)
-    U_w[0, 0] = t1098
-    U_w[0, 1] = t1101
-    U_w[0, 2] = t1106
-    U_w[1, 0] = t1099
-    U_w[1, 1] = t1102
-    U_w[1, 2] = t1107
-    U_w[2, 0] = t1100
-    U_w[2, 1] = t1103
-    U_w[2, 2] = t1108
+    U_w[0, 0] = t1105
+    U_w[0, 1] = t1108
+    U_w[0, 2] = t1113
+    U_w[1, 0] = t1106
+    U_w[1, 1] = t1109
+    U_w[1, 2] = t1114
+    U_w[2, 0] = t1107
+    U_w[2, 1] = t1110
+    U_w[2, 2] = t1115
     s_w = casadi.SX(3, 1)
-    s_w[0, 0] = t1096
-    s_w[1, 0] = t1097
-    s_w[2, 0] = t1088
+    s_w[0, 0] = t1103
+    s_w[1, 0] = t1104
+    s_w[2, 0] = t1095
     return [U_v, s_v, U_w, s_w]
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 3013 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 3010 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -2412,1196 +2421,1200 @@ def _condition_number(q):
     t20 = 2.8163319331152348*s234**2
     t21 = casadi.sqrt(t17*t18 + t18*t19 + t10*t20 + 281.6331933115235*t7**2)
     t22 = 16.78193055972773*t7
-    t23 = casadi.if_else((t21 > 0), 1/(t21*(t21 + casadi.fabs(t22))), 0)
-    t24 = -t22
-    t25 = t21*casadi.if_else((t24 >= 0), 1, -1)
-    t26 = t24 + t25
-    t27 = 16.78193055972773*t4
-    t28 = c1*s1
-    t29 = 281.6331933115235*t28
-    t30 = t23*(t27*t26 + t17*t29 + t19*t29 + t20*t28)
-    t31 = t27 - t26*t30
-    t32 = 16.78193055972773*s1
-    t33 = c1*t30
-    t34 = 16.78193055972773*t33
-    t35 = t1*t34 - t1*t32
-    t36 = t0*t34 - t0*t32
-    t37 = 1.678193055972773*s234
-    t38 = -s1*t37 + t33*t37
-    t39 = casadi.sqrt(t35**2 + t36**2 + t38**2)
-    t40 = t39*casadi.if_else((t35 >= 0), 1, -1)
-    t41 = t35 + t40
-    t42 = casadi.if_else((t39 > 0), 1/(t39*(t39 + casadi.fabs(t35))), 0)
-    t43 = 16.78193055972773*c1
+    t23 = -t22
+    t24 = t21*casadi.if_else((t23 >= 0), 1, -1)
+    t25 = (t21 > 0)
+    t26 = casadi.if_else(t25, 1/(t23 + t24), 0)
+    t27 = casadi.if_else(t25, 1 + casadi.fabs(t22)/t21, 0)
+    t28 = 16.78193055972773*t4
+    t29 = c1*t26
+    t30 = s1*t29
+    t31 = 281.6331933115235*t30
+    t32 = t27*(t28 + t17*t31 + t19*t31 + t20*t30)
+    t33 = -t32 + t28
+    t34 = 16.78193055972773*s1
+    t35 = t29*t32
+    t36 = 16.78193055972773*t35
+    t37 = -t1*t34 + t1*t36
+    t38 = -t0*t34 + t0*t36
+    t39 = 1.678193055972773*s234
+    t40 = -s1*t39 + t35*t39
+    t41 = casadi.sqrt(t37**2 + t38**2 + t40**2)
+    t42 = t41*casadi.if_else((t37 >= 0), 1, -1)
+    t43 = 16.78193055972773*t29
     t44 = t1*t43
     t45 = t0*t43
-    t46 = c1*t37
-    t47 = -t23*(t44*t8 + t45*t9 + t46*t16)
+    t46 = t29*t39
+    t47 = -t27*(t44*t8 + t45*t9 + t46*t16)
     t48 = t8 + t44*t47
     t49 = t9 + t45*t47
     t50 = t16 + t46*t47
-    t51 = -t23*(t44*t15 + t45*t15 + t46*t15)
+    t51 = -t27*(t46*t15 + t44*t15 + t45*t15)
     t52 = t15 + t44*t51
     t53 = t15 + t45*t51
     t54 = t15 + t46*t51
-    t55 = t42*(t48*t41 + t36*t49 + t38*t50)
-    t56 = t48 - t41*t55
-    t57 = t49 - t36*t55
-    t58 = t50 - t38*t55
-    t59 = t42*(t52*t41 + t36*t53 + t38*t54)
-    t60 = t52 - t41*t59
-    t61 = t53 - t36*t59
-    t62 = t54 - t38*t59
-    t63 = casadi.sqrt(t57**2 + t58**2)
-    t64 = t63*casadi.if_else((t57 >= 0), 1, -1)
-    t65 = t57 + t64
-    t66 = casadi.if_else((t63 > 0), 1/(t63*(t63 + casadi.fabs(t57))), 0)
-    t67 = t66*(t61*t65 + t58*t62)
-    t68 = t61 - t65*t67
-    t69 = t62 - t58*t67
-    t70 = casadi.fabs(t69)
-    t71 = t70*casadi.if_else((t69 >= 0), 1, -1)
-    t72 = t40**2 + t56**2 + t60**2
-    t73 = t64**2 + t68**2
-    t74 = t71**2
-    t75 = t25**2
-    t76 = t26**2
-    t77 = t75 + t31**2 + t76*t47**2 + t76*t51**2
-    t78 = t26*t47
-    t79 = t26*t51
-    t80 = t31*t40 + t78*t56 + t79*t60
-    t81 = (t80 != 0)
-    t82 = (-t77 + t72)/casadi.if_else(t81, -2*t80, 1)
-    t83 = casadi.fabs(t82)
-    t84 = (t83 >= 1)
-    t85 = 1/casadi.fabs(casadi.if_else(t84, t82, 1))
-    t86 = casadi.if_else(t81, casadi.if_else((t82 >= 0), 1, -1)*casadi.if_else(t84, t85/(1 + casadi.sqrt(1 + t85**2)), 1/(t83 + casadi.sqrt(1 + t83**2))), 0)
-    t87 = 1/casadi.sqrt(1 + t86**2)
-    t88 = t80*t86
-    t89 = t88 + t77
-    t90 = -t88 + t72
-    t91 = t31*t87
-    t92 = t40*t87
-    t93 = t91 + t92*t86
-    t94 = -t92 + t91*t86
-    t95 = t78*t87
-    t96 = t56*t87
-    t97 = t95 + t96*t86
-    t98 = t96 - t95*t86
-    t99 = t79*t87
-    t100 = t60*t87
-    t101 = t99 + t100*t86
-    t102 = t100 - t99*t86
-    t103 = t64*t97 - t68*t101
-    t104 = (t103 != 0)
-    t105 = (-t89 + t73)/casadi.if_else(t104, 2*t103, 1)
-    t106 = casadi.fabs(t105)
-    t107 = (t106 >= 1)
-    t108 = 1/casadi.fabs(casadi.if_else(t107, t105, 1))
-    t109 = casadi.if_else(t104, casadi.if_else((t105 >= 0), 1, -1)*casadi.if_else(t107, t108/(1 + casadi.sqrt(1 + t108**2)), 1/(t106 + casadi.sqrt(1 + t106**2))), 0)
-    t110 = 1/casadi.sqrt(1 + t109**2)
-    t111 = t103*t109
-    t112 = -t111 + t89
-    t113 = t111 + t73
-    t114 = t97*t110
-    t115 = t64*t110
-    t116 = -t114 + t115*t109
-    t117 = t115 + t114*t109
-    t118 = t101*t110
-    t119 = t68*t110
-    t120 = t118 + t119*t109
-    t121 = t119 - t118*t109
-    t122 = t71*t120
-    t123 = (t122 != 0)
-    t124 = (-t112 + t74)/casadi.if_else(t123, 2*t122, 1)
-    t125 = casadi.fabs(t124)
-    t126 = (t125 >= 1)
-    t127 = 1/casadi.fabs(casadi.if_else(t126, t124, 1))
-    t128 = casadi.if_else(t123, casadi.if_else((t124 >= 0), 1, -1)*casadi.if_else(t126, t127/(1 + casadi.sqrt(1 + t127**2)), 1/(t125 + casadi.sqrt(1 + t125**2))), 0)
-    t129 = 1/casadi.sqrt(1 + t128**2)
-    t130 = t122*t128
-    t131 = -t130 + t112
-    t132 = t130 + t74
-    t133 = t120*t129
-    t134 = t71*t129
-    t135 = -t133 + t134*t128
-    t136 = t134 + t133*t128
-    t137 = t109*t110
-    t138 = t93*t110
-    t139 = t138*t109
-    t140 = -t98*t117 + t102*t121 + t75*t137*t86*t87**2 + t139*t94
-    t141 = (t140 != 0)
-    t142 = (-t90 + t113)/casadi.if_else(t141, 2*t140, 1)
-    t143 = casadi.fabs(t142)
-    t144 = (t143 >= 1)
-    t145 = 1/casadi.fabs(casadi.if_else(t144, t142, 1))
-    t146 = casadi.if_else(t141, casadi.if_else((t142 >= 0), 1, -1)*casadi.if_else(t144, t145/(1 + casadi.sqrt(1 + t145**2)), 1/(t143 + casadi.sqrt(1 + t143**2))), 0)
-    t147 = 1/casadi.sqrt(1 + t146**2)
-    t148 = t140*t146
-    t149 = -t148 + t90
-    t150 = t148 + t113
-    t151 = t25*t87
-    t152 = t151*t147
-    t153 = t152*t86
-    t154 = t137*t152
-    t155 = -t153 + t154*t146
-    t156 = t154 + t153*t146
-    t157 = t94*t147
-    t158 = t139*t147
-    t159 = t157 - t158*t146
-    t160 = t158 + t157*t146
-    t161 = t98*t147
-    t162 = t117*t147
-    t163 = t161 + t162*t146
-    t164 = -t162 + t161*t146
-    t165 = t102*t147
-    t166 = t121*t147
-    t167 = t165 - t166*t146
-    t168 = t166 + t165*t146
-    t169 = t151*t110*t129
-    t170 = t169*t128
-    t171 = t138*t129
-    t172 = t171*t128
-    t173 = t116*t129
-    t174 = t173*t128
-    t175 = -t136*t167 - t170*t155 + t172*t159 + t174*t163
-    t176 = (t175 != 0)
-    t177 = (-t149 + t132)/casadi.if_else(t176, 2*t175, 1)
-    t178 = casadi.fabs(t177)
-    t179 = (t178 >= 1)
-    t180 = 1/casadi.fabs(casadi.if_else(t179, t177, 1))
-    t181 = casadi.if_else(t176, casadi.if_else((t177 >= 0), 1, -1)*casadi.if_else(t179, t180/(1 + casadi.sqrt(1 + t180**2)), 1/(t178 + casadi.sqrt(1 + t178**2))), 0)
-    t182 = 1/casadi.sqrt(1 + t181**2)
-    t183 = t175*t181
-    t184 = -t183 + t149
-    t185 = t183 + t132
-    t186 = t155*t182
-    t187 = t170*t182
-    t188 = t186 + t187*t181
-    t189 = -t187 + t186*t181
-    t190 = t159*t182
-    t191 = t172*t182
-    t192 = t190 - t191*t181
-    t193 = t191 + t190*t181
-    t194 = t163*t182
-    t195 = t174*t182
-    t196 = t194 - t195*t181
-    t197 = t195 + t194*t181
-    t198 = t167*t182
-    t199 = t136*t182
-    t200 = t198 + t199*t181
-    t201 = -t199 + t198*t181
-    t202 = -t156*t189 + t160*t193 + t164*t197 + t168*t201
-    t203 = t135*t200 - t169*t188 + t171*t192 + t173*t196
-    t204 = (t202 != 0)
-    t205 = (-t150 + t185)/casadi.if_else(t204, 2*t202, 1)
-    t206 = casadi.fabs(t205)
-    t207 = (t206 >= 1)
-    t208 = 1/casadi.fabs(casadi.if_else(t207, t205, 1))
-    t209 = casadi.if_else(t204, casadi.if_else((t205 >= 0), 1, -1)*casadi.if_else(t207, t208/(1 + casadi.sqrt(1 + t208**2)), 1/(t206 + casadi.sqrt(1 + t206**2))), 0)
-    t210 = 1/casadi.sqrt(1 + t209**2)
-    t211 = t202*t209
-    t212 = -t211 + t150
-    t213 = t211 + t185
-    t214 = t156*t210
-    t215 = t189*t210
-    t216 = t214 + t215*t209
-    t217 = t215 - t214*t209
-    t218 = t160*t210
-    t219 = t193*t210
-    t220 = t218 - t219*t209
-    t221 = t219 + t218*t209
-    t222 = t164*t210
-    t223 = t197*t210
-    t224 = t222 - t223*t209
-    t225 = t223 + t222*t209
-    t226 = t168*t210
-    t227 = t201*t210
-    t228 = t226 - t227*t209
-    t229 = t227 + t226*t209
-    t230 = (t203 != 0)
-    t231 = (-t131 + t184)/casadi.if_else(t230, 2*t203, 1)
-    t232 = casadi.fabs(t231)
-    t233 = (t232 >= 1)
-    t234 = 1/casadi.fabs(casadi.if_else(t233, t231, 1))
-    t235 = casadi.if_else(t230, casadi.if_else((t231 >= 0), 1, -1)*casadi.if_else(t233, t234/(1 + casadi.sqrt(1 + t234**2)), 1/(t232 + casadi.sqrt(1 + t232**2))), 0)
-    t236 = 1/casadi.sqrt(1 + t235**2)
-    t237 = t203*t235
-    t238 = -t237 + t131
-    t239 = t237 + t184
-    t240 = t169*t236
-    t241 = t188*t236
-    t242 = t240 + t241*t235
-    t243 = t241 - t240*t235
-    t244 = t171*t236
-    t245 = t192*t236
-    t246 = t244 - t245*t235
-    t247 = t245 + t244*t235
-    t248 = t173*t236
-    t249 = t196*t236
-    t250 = t248 - t249*t235
-    t251 = t249 + t248*t235
-    t252 = t135*t236
-    t253 = t200*t236
-    t254 = t252 - t253*t235
-    t255 = t253 + t252*t235
-    t256 = t216*t242 + t220*t246 + t224*t250 + t228*t254
-    t257 = (t256 != 0)
-    t258 = (-t238 + t212)/casadi.if_else(t257, 2*t256, 1)
-    t259 = casadi.fabs(t258)
-    t260 = (t259 >= 1)
-    t261 = 1/casadi.fabs(casadi.if_else(t260, t258, 1))
-    t262 = casadi.if_else(t257, casadi.if_else((t258 >= 0), 1, -1)*casadi.if_else(t260, t261/(1 + casadi.sqrt(1 + t261**2)), 1/(t259 + casadi.sqrt(1 + t259**2))), 0)
-    t263 = 1/casadi.sqrt(1 + t262**2)
-    t264 = t256*t262
-    t265 = -t264 + t238
-    t266 = t264 + t212
-    t267 = t242*t263
-    t268 = t216*t263
-    t269 = -t267 + t268*t262
-    t270 = t268 + t267*t262
-    t271 = t246*t263
-    t272 = t220*t263
-    t273 = t271 - t272*t262
-    t274 = t272 + t271*t262
-    t275 = t250*t263
-    t276 = t224*t263
-    t277 = t275 - t276*t262
-    t278 = t276 + t275*t262
-    t279 = t254*t263
-    t280 = t228*t263
-    t281 = t279 - t280*t262
-    t282 = t280 + t279*t262
-    t283 = t217*t269 + t221*t273 + t225*t277 + t229*t281
-    t284 = -t243*t270 + t247*t274 + t251*t278 + t255*t282
-    t285 = (t283 != 0)
-    t286 = (-t265 + t213)/casadi.if_else(t285, 2*t283, 1)
-    t287 = casadi.fabs(t286)
-    t288 = (t287 >= 1)
-    t289 = 1/casadi.fabs(casadi.if_else(t288, t286, 1))
-    t290 = casadi.if_else(t285, casadi.if_else((t286 >= 0), 1, -1)*casadi.if_else(t288, t289/(1 + casadi.sqrt(1 + t289**2)), 1/(t287 + casadi.sqrt(1 + t287**2))), 0)
-    t291 = 1/casadi.sqrt(1 + t290**2)
-    t292 = t283*t290
-    t293 = -t292 + t265
-    t294 = t292 + t213
-    t295 = t269*t291
-    t296 = t217*t291
-    t297 = t295 - t296*t290
-    t298 = t296 + t295*t290
-    t299 = t273*t291
-    t300 = t221*t291
-    t301 = t299 - t300*t290
-    t302 = t300 + t299*t290
-    t303 = t277*t291
-    t304 = t225*t291
-    t305 = t303 - t304*t290
-    t306 = t304 + t303*t290
-    t307 = t281*t291
-    t308 = t229*t291
-    t309 = t307 - t308*t290
-    t310 = t308 + t307*t290
-    t311 = (t284 != 0)
-    t312 = (-t239 + t266)/casadi.if_else(t311, 2*t284, 1)
-    t313 = casadi.fabs(t312)
-    t314 = (t313 >= 1)
-    t315 = 1/casadi.fabs(casadi.if_else(t314, t312, 1))
-    t316 = casadi.if_else(t311, casadi.if_else((t312 >= 0), 1, -1)*casadi.if_else(t314, t315/(1 + casadi.sqrt(1 + t315**2)), 1/(t313 + casadi.sqrt(1 + t313**2))), 0)
-    t317 = 1/casadi.sqrt(1 + t316**2)
-    t318 = t284*t316
-    t319 = -t318 + t239
-    t320 = t318 + t266
-    t321 = t243*t317
-    t322 = t270*t317
-    t323 = t321 + t322*t316
-    t324 = -t322 + t321*t316
-    t325 = t247*t317
-    t326 = t274*t317
-    t327 = t325 - t326*t316
-    t328 = t326 + t325*t316
-    t329 = t251*t317
-    t330 = t278*t317
-    t331 = t329 - t330*t316
-    t332 = t330 + t329*t316
-    t333 = t255*t317
-    t334 = t282*t317
-    t335 = t333 - t334*t316
-    t336 = t334 + t333*t316
-    t337 = t298*t323 + t302*t327 + t306*t331 + t310*t335
-    t338 = (t337 != 0)
-    t339 = (-t319 + t294)/casadi.if_else(t338, 2*t337, 1)
-    t340 = casadi.fabs(t339)
-    t341 = (t340 >= 1)
-    t342 = 1/casadi.fabs(casadi.if_else(t341, t339, 1))
-    t343 = casadi.if_else(t338, casadi.if_else((t339 >= 0), 1, -1)*casadi.if_else(t341, t342/(1 + casadi.sqrt(1 + t342**2)), 1/(t340 + casadi.sqrt(1 + t340**2))), 0)
-    t344 = 1/casadi.sqrt(1 + t343**2)
-    t345 = t337*t343
-    t346 = -t345 + t319
-    t347 = t345 + t294
-    t348 = t323*t344
-    t349 = t298*t344
-    t350 = t348 - t349*t343
-    t351 = t349 + t348*t343
-    t352 = t327*t344
-    t353 = t302*t344
-    t354 = t352 - t353*t343
-    t355 = t353 + t352*t343
-    t356 = t331*t344
-    t357 = t306*t344
-    t358 = t356 - t357*t343
-    t359 = t357 + t356*t343
-    t360 = t335*t344
-    t361 = t310*t344
-    t362 = t360 - t361*t343
-    t363 = t361 + t360*t343
-    t364 = t324*t351 + t328*t355 + t332*t359 + t336*t363
-    t365 = t297*t350 + t301*t354 + t305*t358 + t309*t362
-    t366 = (t364 != 0)
-    t367 = (-t320 + t347)/casadi.if_else(t366, 2*t364, 1)
-    t368 = casadi.fabs(t367)
-    t369 = (t368 >= 1)
-    t370 = 1/casadi.fabs(casadi.if_else(t369, t367, 1))
-    t371 = casadi.if_else(t366, casadi.if_else((t367 >= 0), 1, -1)*casadi.if_else(t369, t370/(1 + casadi.sqrt(1 + t370**2)), 1/(t368 + casadi.sqrt(1 + t368**2))), 0)
-    t372 = 1/casadi.sqrt(1 + t371**2)
-    t373 = t364*t371
-    t374 = -t373 + t320
-    t375 = t373 + t347
-    t376 = t324*t372
-    t377 = t351*t372
-    t378 = t376 - t377*t371
-    t379 = t377 + t376*t371
-    t380 = t328*t372
-    t381 = t355*t372
-    t382 = t380 - t381*t371
-    t383 = t381 + t380*t371
-    t384 = t332*t372
-    t385 = t359*t372
-    t386 = t384 - t385*t371
-    t387 = t385 + t384*t371
-    t388 = t336*t372
-    t389 = t363*t372
-    t390 = t388 - t389*t371
-    t391 = t389 + t388*t371
-    t392 = (t365 != 0)
-    t393 = (-t293 + t346)/casadi.if_else(t392, 2*t365, 1)
-    t394 = casadi.fabs(t393)
-    t395 = (t394 >= 1)
-    t396 = 1/casadi.fabs(casadi.if_else(t395, t393, 1))
-    t397 = casadi.if_else(t392, casadi.if_else((t393 >= 0), 1, -1)*casadi.if_else(t395, t396/(1 + casadi.sqrt(1 + t396**2)), 1/(t394 + casadi.sqrt(1 + t394**2))), 0)
-    t398 = 1/casadi.sqrt(1 + t397**2)
-    t399 = t365*t397
-    t400 = -t399 + t293
-    t401 = t399 + t346
-    t402 = t297*t398
-    t403 = t350*t398
-    t404 = t402 - t403*t397
-    t405 = t403 + t402*t397
-    t406 = t301*t398
-    t407 = t354*t398
-    t408 = t406 - t407*t397
-    t409 = t407 + t406*t397
-    t410 = t305*t398
-    t411 = t358*t398
-    t412 = t410 - t411*t397
-    t413 = t411 + t410*t397
-    t414 = t309*t398
-    t415 = t362*t398
-    t416 = t414 - t415*t397
-    t417 = t415 + t414*t397
-    t418 = t378*t404 + t382*t408 + t386*t412 + t390*t416
-    t419 = (t418 != 0)
-    t420 = (-t400 + t374)/casadi.if_else(t419, 2*t418, 1)
-    t421 = casadi.fabs(t420)
-    t422 = (t421 >= 1)
-    t423 = 1/casadi.fabs(casadi.if_else(t422, t420, 1))
-    t424 = casadi.if_else(t419, casadi.if_else((t420 >= 0), 1, -1)*casadi.if_else(t422, t423/(1 + casadi.sqrt(1 + t423**2)), 1/(t421 + casadi.sqrt(1 + t421**2))), 0)
-    t425 = 1/casadi.sqrt(1 + t424**2)
-    t426 = t418*t424
-    t427 = -t426 + t400
-    t428 = t426 + t374
-    t429 = t404*t425
-    t430 = t378*t425
-    t431 = t429 - t430*t424
-    t432 = t430 + t429*t424
-    t433 = t408*t425
-    t434 = t382*t425
-    t435 = t433 - t434*t424
-    t436 = t434 + t433*t424
-    t437 = t412*t425
-    t438 = t386*t425
-    t439 = t437 - t438*t424
-    t440 = t438 + t437*t424
-    t441 = t416*t425
-    t442 = t390*t425
-    t443 = t441 - t442*t424
-    t444 = t442 + t441*t424
-    t445 = t379*t431 + t383*t435 + t387*t439 + t391*t443
-    t446 = t405*t432 + t409*t436 + t413*t440 + t417*t444
-    t447 = (t445 != 0)
-    t448 = (-t427 + t375)/casadi.if_else(t447, 2*t445, 1)
-    t449 = casadi.fabs(t448)
-    t450 = (t449 >= 1)
-    t451 = 1/casadi.fabs(casadi.if_else(t450, t448, 1))
-    t452 = casadi.if_else(t447, casadi.if_else((t448 >= 0), 1, -1)*casadi.if_else(t450, t451/(1 + casadi.sqrt(1 + t451**2)), 1/(t449 + casadi.sqrt(1 + t449**2))), 0)
-    t453 = 1/casadi.sqrt(1 + t452**2)
-    t454 = t445*t452
-    t455 = -t454 + t427
-    t456 = t454 + t375
-    t457 = t431*t453
-    t458 = t379*t453
-    t459 = t457 - t458*t452
-    t460 = t458 + t457*t452
-    t461 = t435*t453
-    t462 = t383*t453
-    t463 = t461 - t462*t452
-    t464 = t462 + t461*t452
-    t465 = t439*t453
-    t466 = t387*t453
-    t467 = t465 - t466*t452
-    t468 = t466 + t465*t452
-    t469 = t443*t453
-    t470 = t391*t453
-    t471 = t469 - t470*t452
-    t472 = t470 + t469*t452
-    t473 = (t446 != 0)
-    t474 = (-t401 + t428)/casadi.if_else(t473, 2*t446, 1)
-    t475 = casadi.fabs(t474)
-    t476 = (t475 >= 1)
-    t477 = 1/casadi.fabs(casadi.if_else(t476, t474, 1))
-    t478 = casadi.if_else(t473, casadi.if_else((t474 >= 0), 1, -1)*casadi.if_else(t476, t477/(1 + casadi.sqrt(1 + t477**2)), 1/(t475 + casadi.sqrt(1 + t475**2))), 0)
-    t479 = 1/casadi.sqrt(1 + t478**2)
-    t480 = t446*t478
-    t481 = -t480 + t401
-    t482 = t480 + t428
-    t483 = t405*t479
-    t484 = t432*t479
-    t485 = t483 - t484*t478
-    t486 = t484 + t483*t478
-    t487 = t409*t479
-    t488 = t436*t479
-    t489 = t487 - t488*t478
-    t490 = t488 + t487*t478
-    t491 = t413*t479
-    t492 = t440*t479
-    t493 = t491 - t492*t478
-    t494 = t492 + t491*t478
-    t495 = t417*t479
-    t496 = t444*t479
-    t497 = t495 - t496*t478
-    t498 = t496 + t495*t478
-    t499 = t460*t485 + t464*t489 + t468*t493 + t472*t497
-    t500 = (t499 != 0)
-    t501 = (-t481 + t456)/casadi.if_else(t500, 2*t499, 1)
-    t502 = casadi.fabs(t501)
-    t503 = (t502 >= 1)
-    t504 = 1/casadi.fabs(casadi.if_else(t503, t501, 1))
-    t505 = casadi.if_else(t500, casadi.if_else((t501 >= 0), 1, -1)*casadi.if_else(t503, t504/(1 + casadi.sqrt(1 + t504**2)), 1/(t502 + casadi.sqrt(1 + t502**2))), 0)
-    t506 = 1/casadi.sqrt(1 + t505**2)
-    t507 = t499*t505
-    t508 = -t507 + t481
-    t509 = t507 + t456
-    t510 = t485*t506
-    t511 = t460*t506
-    t512 = t510 - t511*t505
-    t513 = t511 + t510*t505
-    t514 = t489*t506
-    t515 = t464*t506
-    t516 = t514 - t515*t505
-    t517 = t515 + t514*t505
-    t518 = t493*t506
-    t519 = t468*t506
-    t520 = t518 - t519*t505
-    t521 = t519 + t518*t505
-    t522 = t497*t506
-    t523 = t472*t506
-    t524 = t522 - t523*t505
-    t525 = t523 + t522*t505
-    t526 = t486*t513 + t490*t517 + t494*t521 + t498*t525
-    t527 = t459*t512 + t463*t516 + t467*t520 + t471*t524
-    t528 = (t526 != 0)
-    t529 = (-t482 + t509)/casadi.if_else(t528, 2*t526, 1)
-    t530 = casadi.fabs(t529)
-    t531 = (t530 >= 1)
-    t532 = 1/casadi.fabs(casadi.if_else(t531, t529, 1))
-    t533 = casadi.if_else(t528, casadi.if_else((t529 >= 0), 1, -1)*casadi.if_else(t531, t532/(1 + casadi.sqrt(1 + t532**2)), 1/(t530 + casadi.sqrt(1 + t530**2))), 0)
-    t534 = 1/casadi.sqrt(1 + t533**2)
-    t535 = t526*t533
-    t536 = -t535 + t482
-    t537 = t535 + t509
-    t538 = t486*t534
-    t539 = t513*t534
-    t540 = t538 - t539*t533
-    t541 = t539 + t538*t533
-    t542 = t490*t534
-    t543 = t517*t534
-    t544 = t542 - t543*t533
-    t545 = t543 + t542*t533
-    t546 = t494*t534
-    t547 = t521*t534
-    t548 = t546 - t547*t533
-    t549 = t547 + t546*t533
-    t550 = t498*t534
-    t551 = t525*t534
-    t552 = t550 - t551*t533
-    t553 = t551 + t550*t533
-    t554 = (t527 != 0)
-    t555 = (-t455 + t508)/casadi.if_else(t554, 2*t527, 1)
-    t556 = casadi.fabs(t555)
-    t557 = (t556 >= 1)
-    t558 = 1/casadi.fabs(casadi.if_else(t557, t555, 1))
-    t559 = casadi.if_else(t554, casadi.if_else((t555 >= 0), 1, -1)*casadi.if_else(t557, t558/(1 + casadi.sqrt(1 + t558**2)), 1/(t556 + casadi.sqrt(1 + t556**2))), 0)
-    t560 = 1/casadi.sqrt(1 + t559**2)
-    t561 = t527*t559
-    t562 = -t561 + t455
-    t563 = t561 + t508
-    t564 = t459*t560
-    t565 = t512*t560
-    t566 = t564 - t565*t559
-    t567 = t565 + t564*t559
-    t568 = t463*t560
-    t569 = t516*t560
-    t570 = t568 - t569*t559
-    t571 = t569 + t568*t559
-    t572 = t467*t560
-    t573 = t520*t560
-    t574 = t572 - t573*t559
-    t575 = t573 + t572*t559
-    t576 = t471*t560
-    t577 = t524*t560
-    t578 = t576 - t577*t559
-    t579 = t577 + t576*t559
-    t580 = t540*t566 + t544*t570 + t548*t574 + t552*t578
-    t581 = (t580 != 0)
-    t582 = (-t562 + t536)/casadi.if_else(t581, 2*t580, 1)
-    t583 = casadi.fabs(t582)
-    t584 = (t583 >= 1)
-    t585 = 1/casadi.fabs(casadi.if_else(t584, t582, 1))
-    t586 = casadi.if_else(t581, casadi.if_else((t582 >= 0), 1, -1)*casadi.if_else(t584, t585/(1 + casadi.sqrt(1 + t585**2)), 1/(t583 + casadi.sqrt(1 + t583**2))), 0)
-    t587 = 1/casadi.sqrt(1 + t586**2)
-    t588 = t580*t586
-    t589 = -t588 + t562
-    t590 = t588 + t536
-    t591 = t566*t587
-    t592 = t540*t587
-    t593 = t591 - t592*t586
-    t594 = t592 + t591*t586
-    t595 = t570*t587
-    t596 = t544*t587
-    t597 = t595 - t596*t586
-    t598 = t596 + t595*t586
-    t599 = t574*t587
-    t600 = t548*t587
-    t601 = t599 - t600*t586
-    t602 = t600 + t599*t586
-    t603 = t578*t587
-    t604 = t552*t587
-    t605 = t603 - t604*t586
-    t606 = t604 + t603*t586
-    t607 = t541*t593 + t545*t597 + t549*t601 + t553*t605
-    t608 = t567*t594 + t571*t598 + t575*t602 + t579*t606
-    t609 = (t607 != 0)
-    t610 = (-t589 + t537)/casadi.if_else(t609, 2*t607, 1)
-    t611 = casadi.fabs(t610)
-    t612 = (t611 >= 1)
-    t613 = 1/casadi.fabs(casadi.if_else(t612, t610, 1))
-    t614 = casadi.if_else(t609, casadi.if_else((t610 >= 0), 1, -1)*casadi.if_else(t612, t613/(1 + casadi.sqrt(1 + t613**2)), 1/(t611 + casadi.sqrt(1 + t611**2))), 0)
-    t615 = 1/casadi.sqrt(1 + t614**2)
-    t616 = t607*t614
-    t617 = -t616 + t589
-    t618 = t616 + t537
-    t619 = t593*t615
-    t620 = t541*t615
-    t621 = t619 - t620*t614
-    t622 = t620 + t619*t614
-    t623 = t597*t615
-    t624 = t545*t615
-    t625 = t623 - t624*t614
-    t626 = t624 + t623*t614
-    t627 = t601*t615
-    t628 = t549*t615
-    t629 = t627 - t628*t614
-    t630 = t628 + t627*t614
-    t631 = t605*t615
-    t632 = t553*t615
-    t633 = t631 - t632*t614
-    t634 = t632 + t631*t614
-    t635 = (t608 != 0)
-    t636 = (-t563 + t590)/casadi.if_else(t635, 2*t608, 1)
-    t637 = casadi.fabs(t636)
-    t638 = (t637 >= 1)
-    t639 = 1/casadi.fabs(casadi.if_else(t638, t636, 1))
-    t640 = casadi.if_else(t635, casadi.if_else((t636 >= 0), 1, -1)*casadi.if_else(t638, t639/(1 + casadi.sqrt(1 + t639**2)), 1/(t637 + casadi.sqrt(1 + t637**2))), 0)
-    t641 = 1/casadi.sqrt(1 + t640**2)
-    t642 = t608*t640
-    t643 = -t642 + t563
-    t644 = t642 + t590
-    t645 = t567*t641
-    t646 = t594*t641
-    t647 = t645 - t646*t640
-    t648 = t646 + t645*t640
-    t649 = t571*t641
-    t650 = t598*t641
-    t651 = t649 - t650*t640
-    t652 = t650 + t649*t640
-    t653 = t575*t641
-    t654 = t602*t641
-    t655 = t653 - t654*t640
-    t656 = t654 + t653*t640
-    t657 = t579*t641
-    t658 = t606*t641
-    t659 = t657 - t658*t640
-    t660 = t658 + t657*t640
-    t661 = t622*t647 + t626*t651 + t630*t655 + t634*t659
-    t662 = (t661 != 0)
-    t663 = (-t643 + t618)/casadi.if_else(t662, 2*t661, 1)
-    t664 = casadi.fabs(t663)
-    t665 = (t664 >= 1)
-    t666 = 1/casadi.fabs(casadi.if_else(t665, t663, 1))
-    t667 = casadi.if_else(t662, casadi.if_else((t663 >= 0), 1, -1)*casadi.if_else(t665, t666/(1 + casadi.sqrt(1 + t666**2)), 1/(t664 + casadi.sqrt(1 + t664**2))), 0)
-    t668 = 1/casadi.sqrt(1 + t667**2)
-    t669 = t661*t667
-    t670 = -t669 + t643
-    t671 = t669 + t618
-    t672 = t647*t668
-    t673 = t622*t668
-    t674 = t672 - t673*t667
-    t675 = t673 + t672*t667
-    t676 = t651*t668
-    t677 = t626*t668
-    t678 = t676 - t677*t667
-    t679 = t677 + t676*t667
-    t680 = t655*t668
-    t681 = t630*t668
-    t682 = t680 - t681*t667
-    t683 = t681 + t680*t667
-    t684 = t659*t668
-    t685 = t634*t668
-    t686 = t684 - t685*t667
-    t687 = t685 + t684*t667
-    t688 = t648*t675 + t652*t679 + t656*t683 + t660*t687
-    t689 = t621*t674 + t625*t678 + t629*t682 + t633*t686
-    t690 = (t688 != 0)
-    t691 = (-t644 + t671)/casadi.if_else(t690, 2*t688, 1)
-    t692 = casadi.fabs(t691)
-    t693 = (t692 >= 1)
-    t694 = 1/casadi.fabs(casadi.if_else(t693, t691, 1))
-    t695 = casadi.if_else(t690, casadi.if_else((t691 >= 0), 1, -1)*casadi.if_else(t693, t694/(1 + casadi.sqrt(1 + t694**2)), 1/(t692 + casadi.sqrt(1 + t692**2))), 0)
-    t696 = 1/casadi.sqrt(1 + t695**2)
-    t697 = t688*t695
-    t698 = -t697 + t644
-    t699 = t697 + t671
-    t700 = t648*t696
-    t701 = t675*t696
-    t702 = t700 - t701*t695
-    t703 = t701 + t700*t695
-    t704 = t652*t696
-    t705 = t679*t696
-    t706 = t704 - t705*t695
-    t707 = t705 + t704*t695
-    t708 = t656*t696
-    t709 = t683*t696
-    t710 = t708 - t709*t695
-    t711 = t709 + t708*t695
-    t712 = t660*t696
-    t713 = t687*t696
-    t714 = t712 - t713*t695
-    t715 = t713 + t712*t695
-    t716 = (t689 != 0)
-    t717 = (-t617 + t670)/casadi.if_else(t716, 2*t689, 1)
-    t718 = casadi.fabs(t717)
-    t719 = (t718 >= 1)
-    t720 = 1/casadi.fabs(casadi.if_else(t719, t717, 1))
-    t721 = casadi.if_else(t716, casadi.if_else((t717 >= 0), 1, -1)*casadi.if_else(t719, t720/(1 + casadi.sqrt(1 + t720**2)), 1/(t718 + casadi.sqrt(1 + t718**2))), 0)
-    t722 = 1/casadi.sqrt(1 + t721**2)
-    t723 = t689*t721
-    t724 = -t723 + t617
-    t725 = t723 + t670
-    t726 = t621*t722
-    t727 = t674*t722
-    t728 = t726 - t727*t721
-    t729 = t727 + t726*t721
-    t730 = t625*t722
-    t731 = t678*t722
-    t732 = t730 - t731*t721
-    t733 = t731 + t730*t721
-    t734 = t629*t722
-    t735 = t682*t722
-    t736 = t734 - t735*t721
-    t737 = t735 + t734*t721
-    t738 = t633*t722
-    t739 = t686*t722
-    t740 = t738 - t739*t721
-    t741 = t739 + t738*t721
-    t742 = t702*t728 + t706*t732 + t710*t736 + t714*t740
-    t743 = (t742 != 0)
-    t744 = (-t724 + t698)/casadi.if_else(t743, 2*t742, 1)
-    t745 = casadi.fabs(t744)
-    t746 = (t745 >= 1)
-    t747 = 1/casadi.fabs(casadi.if_else(t746, t744, 1))
-    t748 = casadi.if_else(t743, casadi.if_else((t744 >= 0), 1, -1)*casadi.if_else(t746, t747/(1 + casadi.sqrt(1 + t747**2)), 1/(t745 + casadi.sqrt(1 + t745**2))), 0)
-    t749 = 1/casadi.sqrt(1 + t748**2)
-    t750 = t742*t748
-    t751 = -t750 + t724
-    t752 = t750 + t698
-    t753 = t728*t749
-    t754 = t702*t749
-    t755 = t753 - t754*t748
-    t756 = t754 + t753*t748
-    t757 = t732*t749
-    t758 = t706*t749
-    t759 = t757 - t758*t748
-    t760 = t758 + t757*t748
-    t761 = t736*t749
-    t762 = t710*t749
-    t763 = t761 - t762*t748
-    t764 = t762 + t761*t748
-    t765 = t740*t749
-    t766 = t714*t749
-    t767 = t765 - t766*t748
-    t768 = t766 + t765*t748
-    t769 = t703*t755 + t707*t759 + t711*t763 + t715*t767
-    t770 = t729*t756 + t733*t760 + t737*t764 + t741*t768
-    t771 = (t769 != 0)
-    t772 = (-t751 + t699)/casadi.if_else(t771, 2*t769, 1)
-    t773 = casadi.fabs(t772)
-    t774 = (t773 >= 1)
-    t775 = 1/casadi.fabs(casadi.if_else(t774, t772, 1))
-    t776 = casadi.if_else(t771, casadi.if_else((t772 >= 0), 1, -1)*casadi.if_else(t774, t775/(1 + casadi.sqrt(1 + t775**2)), 1/(t773 + casadi.sqrt(1 + t773**2))), 0)
-    t777 = 1/casadi.sqrt(1 + t776**2)
-    t778 = t769*t776
-    t779 = -t778 + t751
-    t780 = t778 + t699
-    t781 = t755*t777
-    t782 = t703*t777
-    t783 = t781 - t782*t776
-    t784 = t782 + t781*t776
-    t785 = t759*t777
-    t786 = t707*t777
-    t787 = t785 - t786*t776
-    t788 = t786 + t785*t776
-    t789 = t763*t777
-    t790 = t711*t777
-    t791 = t789 - t790*t776
-    t792 = t790 + t789*t776
-    t793 = t767*t777
-    t794 = t715*t777
-    t795 = t793 - t794*t776
-    t796 = t794 + t793*t776
-    t797 = (t770 != 0)
-    t798 = (-t725 + t752)/casadi.if_else(t797, 2*t770, 1)
-    t799 = casadi.fabs(t798)
-    t800 = (t799 >= 1)
-    t801 = 1/casadi.fabs(casadi.if_else(t800, t798, 1))
-    t802 = casadi.if_else(t797, casadi.if_else((t798 >= 0), 1, -1)*casadi.if_else(t800, t801/(1 + casadi.sqrt(1 + t801**2)), 1/(t799 + casadi.sqrt(1 + t799**2))), 0)
-    t803 = 1/casadi.sqrt(1 + t802**2)
-    t804 = t770*t802
-    t805 = -t804 + t725
-    t806 = t804 + t752
-    t807 = t729*t803
-    t808 = t756*t803
-    t809 = t807 - t808*t802
-    t810 = t808 + t807*t802
-    t811 = t733*t803
-    t812 = t760*t803
-    t813 = t811 - t812*t802
-    t814 = t812 + t811*t802
-    t815 = t737*t803
-    t816 = t764*t803
-    t817 = t815 - t816*t802
-    t818 = t816 + t815*t802
-    t819 = t741*t803
-    t820 = t768*t803
-    t821 = t819 - t820*t802
-    t822 = t820 + t819*t802
-    t823 = t784*t809 + t788*t813 + t792*t817 + t796*t821
-    t824 = (t823 != 0)
-    t825 = (-t805 + t780)/casadi.if_else(t824, 2*t823, 1)
-    t826 = casadi.fabs(t825)
-    t827 = (t826 >= 1)
-    t828 = 1/casadi.fabs(casadi.if_else(t827, t825, 1))
-    t829 = casadi.if_else(t824, casadi.if_else((t825 >= 0), 1, -1)*casadi.if_else(t827, t828/(1 + casadi.sqrt(1 + t828**2)), 1/(t826 + casadi.sqrt(1 + t826**2))), 0)
-    t830 = 1/casadi.sqrt(1 + t829**2)
-    t831 = t823*t829
-    t832 = -t831 + t805
-    t833 = t831 + t780
-    t834 = t809*t830
-    t835 = t784*t830
-    t836 = t834 - t835*t829
-    t837 = t835 + t834*t829
-    t838 = t813*t830
-    t839 = t788*t830
-    t840 = t838 - t839*t829
-    t841 = t839 + t838*t829
-    t842 = t817*t830
-    t843 = t792*t830
-    t844 = t842 - t843*t829
-    t845 = t843 + t842*t829
-    t846 = t821*t830
-    t847 = t796*t830
-    t848 = t846 - t847*t829
-    t849 = t847 + t846*t829
-    t850 = t810*t837 + t814*t841 + t818*t845 + t822*t849
-    t851 = t783*t836 + t787*t840 + t791*t844 + t795*t848
-    t852 = (t850 != 0)
-    t853 = (-t806 + t833)/casadi.if_else(t852, 2*t850, 1)
-    t854 = casadi.fabs(t853)
-    t855 = (t854 >= 1)
-    t856 = 1/casadi.fabs(casadi.if_else(t855, t853, 1))
-    t857 = casadi.if_else(t852, casadi.if_else((t853 >= 0), 1, -1)*casadi.if_else(t855, t856/(1 + casadi.sqrt(1 + t856**2)), 1/(t854 + casadi.sqrt(1 + t854**2))), 0)
-    t858 = 1/casadi.sqrt(1 + t857**2)
-    t859 = t850*t857
-    t860 = -t859 + t806
-    t861 = t859 + t833
-    t862 = t810*t858
-    t863 = t837*t858
-    t864 = t862 - t863*t857
-    t865 = t863 + t862*t857
-    t866 = t814*t858
-    t867 = t841*t858
-    t868 = t866 - t867*t857
-    t869 = t867 + t866*t857
-    t870 = t818*t858
-    t871 = t845*t858
-    t872 = t870 - t871*t857
-    t873 = t871 + t870*t857
-    t874 = t822*t858
-    t875 = t849*t858
-    t876 = t874 - t875*t857
-    t877 = t875 + t874*t857
-    t878 = (t851 != 0)
-    t879 = (-t779 + t832)/casadi.if_else(t878, 2*t851, 1)
-    t880 = casadi.fabs(t879)
-    t881 = (t880 >= 1)
-    t882 = 1/casadi.fabs(casadi.if_else(t881, t879, 1))
-    t883 = casadi.if_else(t878, casadi.if_else((t879 >= 0), 1, -1)*casadi.if_else(t881, t882/(1 + casadi.sqrt(1 + t882**2)), 1/(t880 + casadi.sqrt(1 + t880**2))), 0)
-    t884 = 1/casadi.sqrt(1 + t883**2)
-    t885 = t851*t883
-    t886 = -t885 + t779
-    t887 = t885 + t832
-    t888 = t783*t884
-    t889 = t836*t884
-    t890 = t888 - t889*t883
-    t891 = t889 + t888*t883
-    t892 = t787*t884
-    t893 = t840*t884
-    t894 = t892 - t893*t883
-    t895 = t893 + t892*t883
-    t896 = t791*t884
-    t897 = t844*t884
-    t898 = t896 - t897*t883
-    t899 = t897 + t896*t883
-    t900 = t795*t884
-    t901 = t848*t884
-    t902 = t900 - t901*t883
-    t903 = t901 + t900*t883
-    t904 = t864*t890 + t868*t894 + t872*t898 + t876*t902
-    t905 = (t904 != 0)
-    t906 = (-t886 + t860)/casadi.if_else(t905, 2*t904, 1)
-    t907 = casadi.fabs(t906)
-    t908 = (t907 >= 1)
-    t909 = 1/casadi.fabs(casadi.if_else(t908, t906, 1))
-    t910 = casadi.if_else(t905, casadi.if_else((t906 >= 0), 1, -1)*casadi.if_else(t908, t909/(1 + casadi.sqrt(1 + t909**2)), 1/(t907 + casadi.sqrt(1 + t907**2))), 0)
-    t911 = 1/casadi.sqrt(1 + t910**2)
-    t912 = t904*t910
-    t913 = -t912 + t886
-    t914 = t912 + t860
-    t915 = t890*t911
-    t916 = t864*t911
-    t917 = t915 - t916*t910
-    t918 = t916 + t915*t910
-    t919 = t894*t911
-    t920 = t868*t911
-    t921 = t919 - t920*t910
-    t922 = t920 + t919*t910
-    t923 = t898*t911
-    t924 = t872*t911
-    t925 = t923 - t924*t910
-    t926 = t924 + t923*t910
-    t927 = t902*t911
-    t928 = t876*t911
-    t929 = t927 - t928*t910
-    t930 = t928 + t927*t910
-    t931 = t865*t917 + t869*t921 + t873*t925 + t877*t929
-    t932 = t891*t918 + t895*t922 + t899*t926 + t903*t930
-    t933 = (t931 != 0)
-    t934 = (-t913 + t861)/casadi.if_else(t933, 2*t931, 1)
-    t935 = casadi.fabs(t934)
-    t936 = (t935 >= 1)
-    t937 = 1/casadi.fabs(casadi.if_else(t936, t934, 1))
-    t938 = casadi.if_else(t933, casadi.if_else((t934 >= 0), 1, -1)*casadi.if_else(t936, t937/(1 + casadi.sqrt(1 + t937**2)), 1/(t935 + casadi.sqrt(1 + t935**2))), 0)
-    t939 = 1/casadi.sqrt(1 + t938**2)
-    t940 = t931*t938
-    t941 = -t940 + t913
-    t942 = t940 + t861
-    t943 = t917*t939
-    t944 = t865*t939
-    t945 = t943 - t944*t938
-    t946 = t944 + t943*t938
-    t947 = t921*t939
-    t948 = t869*t939
-    t949 = t947 - t948*t938
-    t950 = t948 + t947*t938
-    t951 = t925*t939
-    t952 = t873*t939
-    t953 = t951 - t952*t938
-    t954 = t952 + t951*t938
-    t955 = t929*t939
-    t956 = t877*t939
-    t957 = t955 - t956*t938
-    t958 = t956 + t955*t938
-    t959 = (t932 != 0)
-    t960 = (-t887 + t914)/casadi.if_else(t959, 2*t932, 1)
-    t961 = casadi.fabs(t960)
-    t962 = (t961 >= 1)
-    t963 = 1/casadi.fabs(casadi.if_else(t962, t960, 1))
-    t964 = casadi.if_else(t959, casadi.if_else((t960 >= 0), 1, -1)*casadi.if_else(t962, t963/(1 + casadi.sqrt(1 + t963**2)), 1/(t961 + casadi.sqrt(1 + t961**2))), 0)
-    t965 = 1/casadi.sqrt(1 + t964**2)
-    t966 = t932*t964
-    t967 = -t966 + t887
-    t968 = t966 + t914
-    t969 = t891*t965
-    t970 = t918*t965
-    t971 = t969 - t970*t964
-    t972 = t970 + t969*t964
-    t973 = t895*t965
-    t974 = t922*t965
-    t975 = t973 - t974*t964
-    t976 = t974 + t973*t964
-    t977 = t899*t965
-    t978 = t926*t965
-    t979 = t977 - t978*t964
-    t980 = t978 + t977*t964
-    t981 = t903*t965
-    t982 = t930*t965
-    t983 = t981 - t982*t964
-    t984 = t982 + t981*t964
-    t985 = t946*t971 + t950*t975 + t954*t979 + t958*t983
-    t986 = (t985 != 0)
-    t987 = (-t967 + t942)/casadi.if_else(t986, 2*t985, 1)
-    t988 = casadi.fabs(t987)
-    t989 = (t988 >= 1)
-    t990 = 1/casadi.fabs(casadi.if_else(t989, t987, 1))
-    t991 = casadi.if_else(t986, casadi.if_else((t987 >= 0), 1, -1)*casadi.if_else(t989, t990/(1 + casadi.sqrt(1 + t990**2)), 1/(t988 + casadi.sqrt(1 + t988**2))), 0)
-    t992 = 1/casadi.sqrt(1 + t991**2)
-    t993 = t985*t991
-    t994 = -t993 + t967
-    t995 = t993 + t942
-    t996 = t971*t992
-    t997 = t946*t992
-    t998 = t996 - t997*t991
-    t999 = t997 + t996*t991
-    t1000 = t975*t992
-    t1001 = t950*t992
-    t1002 = t1000 - t1001*t991
-    t1003 = t1001 + t1000*t991
-    t1004 = t979*t992
-    t1005 = t954*t992
-    t1006 = t1004 - t1005*t991
-    t1007 = t1005 + t1004*t991
-    t1008 = t983*t992
-    t1009 = t958*t992
-    t1010 = t1008 - t1009*t991
-    t1011 = t1009 + t1008*t991
-    t1012 = t972*t999 + t976*t1003 + t980*t1007 + t984*t1011
-    t1013 = t945*t998 + t949*t1002 + t953*t1006 + t957*t1010
-    t1014 = (t1012 != 0)
-    t1015 = (-t968 + t995)/casadi.if_else(t1014, 2*t1012, 1)
-    t1016 = casadi.fabs(t1015)
-    t1017 = (t1016 >= 1)
-    t1018 = 1/casadi.fabs(casadi.if_else(t1017, t1015, 1))
-    t1019 = casadi.if_else(t1014, casadi.if_else((t1015 >= 0), 1, -1)*casadi.if_else(t1017, t1018/(1 + casadi.sqrt(1 + t1018**2)), 1/(t1016 + casadi.sqrt(1 + t1016**2))), 0)
-    t1020 = 1/casadi.sqrt(1 + t1019**2)
-    t1021 = t1012*t1019
-    t1022 = -t1021 + t968
-    t1023 = t1021 + t995
-    t1024 = t972*t1020
-    t1025 = t999*t1020
-    t1026 = t1024 - t1025*t1019
-    t1027 = t1025 + t1024*t1019
-    t1028 = t976*t1020
-    t1029 = t1003*t1020
-    t1030 = t1028 - t1029*t1019
-    t1031 = t1029 + t1028*t1019
-    t1032 = t980*t1020
-    t1033 = t1007*t1020
-    t1034 = t1032 - t1033*t1019
-    t1035 = t1033 + t1032*t1019
-    t1036 = t984*t1020
-    t1037 = t1011*t1020
-    t1038 = t1036 - t1037*t1019
-    t1039 = t1037 + t1036*t1019
-    t1040 = (t1013 != 0)
-    t1041 = (-t941 + t994)/casadi.if_else(t1040, 2*t1013, 1)
-    t1042 = casadi.fabs(t1041)
-    t1043 = (t1042 >= 1)
-    t1044 = 1/casadi.fabs(casadi.if_else(t1043, t1041, 1))
-    t1045 = casadi.if_else(t1040, casadi.if_else((t1041 >= 0), 1, -1)*casadi.if_else(t1043, t1044/(1 + casadi.sqrt(1 + t1044**2)), 1/(t1042 + casadi.sqrt(1 + t1042**2))), 0)
-    t1046 = 1/casadi.sqrt(1 + t1045**2)
-    t1047 = t1013*t1045
-    t1048 = -t1047 + t941
-    t1049 = t1047 + t994
-    t1050 = t945*t1046
-    t1051 = t998*t1046
-    t1052 = t1050 - t1051*t1045
-    t1053 = t1051 + t1050*t1045
-    t1054 = t949*t1046
-    t1055 = t1002*t1046
-    t1056 = t1054 - t1055*t1045
-    t1057 = t1055 + t1054*t1045
-    t1058 = t953*t1046
-    t1059 = t1006*t1046
-    t1060 = t1058 - t1059*t1045
-    t1061 = t1059 + t1058*t1045
-    t1062 = t957*t1046
-    t1063 = t1010*t1046
-    t1064 = t1062 - t1063*t1045
-    t1065 = t1063 + t1062*t1045
-    t1066 = t1026*t1052 + t1030*t1056 + t1034*t1060 + t1038*t1064
-    t1067 = (t1066 != 0)
-    t1068 = (-t1048 + t1022)/casadi.if_else(t1067, 2*t1066, 1)
-    t1069 = casadi.fabs(t1068)
-    t1070 = (t1069 >= 1)
-    t1071 = 1/casadi.fabs(casadi.if_else(t1070, t1068, 1))
-    t1072 = casadi.if_else(t1067, casadi.if_else((t1068 >= 0), 1, -1)*casadi.if_else(t1070, t1071/(1 + casadi.sqrt(1 + t1071**2)), 1/(t1069 + casadi.sqrt(1 + t1069**2))), 0)
-    t1073 = 1/casadi.sqrt(1 + t1072**2)
-    t1074 = t1066*t1072
-    t1075 = -t1074 + t1048
-    t1076 = t1074 + t1022
-    t1077 = t1052*t1073
-    t1078 = t1026*t1073
-    t1079 = t1077 - t1078*t1072
-    t1080 = t1078 + t1077*t1072
-    t1081 = t1056*t1073
-    t1082 = t1030*t1073
-    t1083 = t1081 - t1072*t1082
-    t1084 = t1082 + t1072*t1081
-    t1085 = t1060*t1073
-    t1086 = t1034*t1073
-    t1087 = t1085 - t1072*t1086
-    t1088 = t1086 + t1072*t1085
-    t1089 = t1064*t1073
-    t1090 = t1038*t1073
-    t1091 = t1089 - t1072*t1090
-    t1092 = t1090 + t1072*t1089
-    t1093 = t1027*t1079 + t1031*t1083 + t1035*t1087 + t1039*t1091
-    t1094 = t1053*t1080 + t1057*t1084 + t1061*t1088 + t1065*t1092
-    t1095 = (t1093 != 0)
-    t1096 = (-t1075 + t1023)/casadi.if_else(t1095, 2*t1093, 1)
-    t1097 = casadi.fabs(t1096)
-    t1098 = (t1097 >= 1)
-    t1099 = 1/casadi.fabs(casadi.if_else(t1098, t1096, 1))
-    t1100 = casadi.if_else(t1095, casadi.if_else((t1096 >= 0), 1, -1)*casadi.if_else(t1098, t1099/(1 + casadi.sqrt(1 + t1099**2)), 1/(t1097 + casadi.sqrt(1 + t1097**2))), 0)
-    t1101 = 1/casadi.sqrt(1 + t1100**2)
-    t1102 = t1023 + t1093*t1100
-    t1103 = t1079*t1101
-    t1104 = t1027*t1101
-    t1105 = t1103 - t1100*t1104
-    t1106 = t1104 + t1100*t1103
-    t1107 = t1083*t1101
-    t1108 = t1031*t1101
-    t1109 = t1107 - t1100*t1108
-    t1110 = t1108 + t1100*t1107
-    t1111 = t1087*t1101
-    t1112 = t1035*t1101
-    t1113 = t1111 - t1100*t1112
-    t1114 = t1112 + t1100*t1111
-    t1115 = t1091*t1101
-    t1116 = t1039*t1101
-    t1117 = t1115 - t1100*t1116
-    t1118 = t1116 + t1100*t1115
-    t1119 = casadi.sqrt(t1105**2 + t1109**2 + t1113**2 + t1117**2)
-    t1120 = (t1094 != 0)
-    t1121 = (-t1049 + t1076)/casadi.if_else(t1120, 2*t1094, 1)
-    t1122 = casadi.fabs(t1121)
-    t1123 = (t1122 >= 1)
-    t1124 = 1/casadi.fabs(casadi.if_else(t1123, t1121, 1))
-    t1125 = casadi.if_else(t1120, casadi.if_else((t1121 >= 0), 1, -1)*casadi.if_else(t1123, t1124/(1 + casadi.sqrt(1 + t1124**2)), 1/(t1122 + casadi.sqrt(1 + t1122**2))), 0)
-    t1126 = 1/casadi.sqrt(1 + t1125**2)
-    t1127 = t1094*t1125
-    t1128 = -t1127 + t1049
-    t1129 = t1076 + t1127
-    t1130 = t1053*t1126
-    t1131 = t1080*t1126
-    t1132 = t1130 - t1125*t1131
-    t1133 = t1131 + t1125*t1130
-    t1134 = t1057*t1126
-    t1135 = t1084*t1126
-    t1136 = t1134 - t1125*t1135
-    t1137 = t1135 + t1125*t1134
-    t1138 = t1061*t1126
-    t1139 = t1088*t1126
-    t1140 = t1138 - t1125*t1139
-    t1141 = t1139 + t1125*t1138
-    t1142 = t1065*t1126
-    t1143 = t1092*t1126
-    t1144 = t1142 - t1125*t1143
-    t1145 = t1143 + t1125*t1142
-    t1146 = t1106*t1132 + t1110*t1136 + t1114*t1140 + t1118*t1144
-    t1147 = (t1146 != 0)
-    t1148 = (-t1128 + t1102)/casadi.if_else(t1147, 2*t1146, 1)
-    t1149 = casadi.fabs(t1148)
-    t1150 = (t1149 >= 1)
-    t1151 = 1/casadi.fabs(casadi.if_else(t1150, t1148, 1))
-    t1152 = casadi.if_else(t1147, casadi.if_else((t1148 >= 0), 1, -1)*casadi.if_else(t1150, t1151/(1 + casadi.sqrt(1 + t1151**2)), 1/(t1149 + casadi.sqrt(1 + t1149**2))), 0)
-    t1153 = 1/casadi.sqrt(1 + t1152**2)
-    t1154 = t1102 + t1146*t1152
-    t1155 = t1132*t1153
-    t1156 = t1106*t1153
-    t1157 = t1155 - t1152*t1156
-    t1158 = t1156 + t1152*t1155
-    t1159 = t1136*t1153
-    t1160 = t1110*t1153
-    t1161 = t1159 - t1152*t1160
-    t1162 = t1160 + t1152*t1159
-    t1163 = t1140*t1153
-    t1164 = t1114*t1153
-    t1165 = t1163 - t1152*t1164
-    t1166 = t1164 + t1152*t1163
-    t1167 = t1144*t1153
-    t1168 = t1118*t1153
-    t1169 = t1167 - t1152*t1168
-    t1170 = t1168 + t1152*t1167
-    t1171 = t1133*t1158 + t1137*t1162 + t1141*t1166 + t1145*t1170
-    t1172 = casadi.sqrt(t1157**2 + t1161**2 + t1165**2 + t1169**2)
-    t1173 = casadi.if_else((t1172 > t1119), t1172, t1119)
-    t1174 = casadi.if_else((t1172 < t1119), t1172, t1119)
-    t1175 = (t1171 != 0)
-    t1176 = (-t1129 + t1154)/casadi.if_else(t1175, 2*t1171, 1)
-    t1177 = casadi.fabs(t1176)
-    t1178 = (t1177 >= 1)
-    t1179 = 1/casadi.fabs(casadi.if_else(t1178, t1176, 1))
-    t1180 = casadi.if_else(t1175, casadi.if_else((t1176 >= 0), 1, -1)*casadi.if_else(t1178, t1179/(1 + casadi.sqrt(1 + t1179**2)), 1/(t1177 + casadi.sqrt(1 + t1177**2))), 0)
-    t1181 = 1/casadi.sqrt(1 + t1180**2)
-    t1182 = t1133*t1181
-    t1183 = t1158*t1181
-    t1184 = t1182 - t1180*t1183
-    t1185 = t1183 + t1180*t1182
-    t1186 = t1137*t1181
-    t1187 = t1162*t1181
-    t1188 = t1186 - t1180*t1187
-    t1189 = t1187 + t1180*t1186
-    t1190 = t1141*t1181
-    t1191 = t1166*t1181
-    t1192 = t1190 - t1180*t1191
-    t1193 = t1191 + t1180*t1190
-    t1194 = t1145*t1181
-    t1195 = t1170*t1181
-    t1196 = t1194 - t1180*t1195
-    t1197 = t1195 + t1180*t1194
-    t1198 = casadi.sqrt(t1184**2 + t1188**2 + t1192**2 + t1196**2)
-    t1199 = casadi.sqrt(t1185**2 + t1189**2 + t1193**2 + t1197**2)
-    t1200 = casadi.if_else((t1198 > t1173), t1198, t1173)
-    t1201 = casadi.if_else((t1198 < t1174), t1198, t1174)
-    t1202 = casadi.if_else((t1199 > t1200), t1199, t1200)
-    t1203 = casadi.if_else((t1199 < t1201), t1199, t1201)
-    t1204 = casadi.if_else((t1203 <= 1e-12*t1202), 0, t1203)
-    t1205 = casadi.if_else((t1202 > 0), t1202, 1)
+    t55 = (t41 > 0)
+    t56 = casadi.if_else(t55, 1/(t37 + t42), 0)
+    t57 = casadi.if_else(t55, 1 + casadi.fabs(t37)/t41, 0)
+    t58 = t38*t56
+    t59 = t40*t56
+    t60 = t57*(t48 + t58*t49 + t59*t50)
+    t61 = -t60 + t48
+    t62 = t49 - t58*t60
+    t63 = t50 - t59*t60
+    t64 = t57*(t52 + t58*t53 + t59*t54)
+    t65 = -t64 + t52
+    t66 = t53 - t58*t64
+    t67 = t54 - t59*t64
+    t68 = casadi.sqrt(t62**2 + t63**2)
+    t69 = t68*casadi.if_else((t62 >= 0), 1, -1)
+    t70 = t42**2 + t61**2 + t65**2
+    t71 = t33*t42 + t47*t61 + t51*t65
+    t72 = (t68 > 0)
+    t73 = casadi.if_else(t72, 1/(t62 + t69), 0)
+    t74 = casadi.if_else(t72, 1 + casadi.fabs(t62)/t68, 0)
+    t75 = t63*t73
+    t76 = t74*(t66 + t75*t67)
+    t77 = -t76 + t66
+    t78 = t67 - t75*t76
+    t79 = casadi.fabs(t78)
+    t80 = t79*casadi.if_else((t78 >= 0), 1, -1)
+    t81 = t69**2 + t77**2
+    t82 = t80**2
+    t83 = t24**2
+    t84 = t83 + t33**2 + t47**2 + t51**2
+    t85 = (t71 != 0)
+    t86 = (-t84 + t70)/casadi.if_else(t85, -2*t71, 1)
+    t87 = casadi.fabs(t86)
+    t88 = (t87 >= 1)
+    t89 = 1/casadi.fabs(casadi.if_else(t88, t86, 1))
+    t90 = casadi.if_else(t85, casadi.if_else((t86 >= 0), 1, -1)*casadi.if_else(t88, t89/(1 + casadi.sqrt(1 + t89**2)), 1/(t87 + casadi.sqrt(1 + t87**2))), 0)
+    t91 = 1/casadi.sqrt(1 + t90**2)
+    t92 = t71*t90
+    t93 = t92 + t84
+    t94 = -t92 + t70
+    t95 = t33*t91
+    t96 = t42*t91
+    t97 = t95 + t96*t90
+    t98 = -t96 + t95*t90
+    t99 = t47*t91
+    t100 = t61*t91
+    t101 = t99 + t100*t90
+    t102 = t100 - t99*t90
+    t103 = t51*t91
+    t104 = t65*t91
+    t105 = t103 + t104*t90
+    t106 = t104 - t103*t90
+    t107 = t69*t101 - t77*t105
+    t108 = (t107 != 0)
+    t109 = (-t93 + t81)/casadi.if_else(t108, 2*t107, 1)
+    t110 = casadi.fabs(t109)
+    t111 = (t110 >= 1)
+    t112 = 1/casadi.fabs(casadi.if_else(t111, t109, 1))
+    t113 = casadi.if_else(t108, casadi.if_else((t109 >= 0), 1, -1)*casadi.if_else(t111, t112/(1 + casadi.sqrt(1 + t112**2)), 1/(t110 + casadi.sqrt(1 + t110**2))), 0)
+    t114 = 1/casadi.sqrt(1 + t113**2)
+    t115 = t107*t113
+    t116 = -t115 + t93
+    t117 = t115 + t81
+    t118 = t101*t114
+    t119 = t69*t114
+    t120 = -t118 + t119*t113
+    t121 = t119 + t118*t113
+    t122 = t105*t114
+    t123 = t77*t114
+    t124 = t122 + t123*t113
+    t125 = t123 - t122*t113
+    t126 = t80*t124
+    t127 = (t126 != 0)
+    t128 = (-t116 + t82)/casadi.if_else(t127, 2*t126, 1)
+    t129 = casadi.fabs(t128)
+    t130 = (t129 >= 1)
+    t131 = 1/casadi.fabs(casadi.if_else(t130, t128, 1))
+    t132 = casadi.if_else(t127, casadi.if_else((t128 >= 0), 1, -1)*casadi.if_else(t130, t131/(1 + casadi.sqrt(1 + t131**2)), 1/(t129 + casadi.sqrt(1 + t129**2))), 0)
+    t133 = 1/casadi.sqrt(1 + t132**2)
+    t134 = t126*t132
+    t135 = -t134 + t116
+    t136 = t134 + t82
+    t137 = t124*t133
+    t138 = t80*t133
+    t139 = -t137 + t138*t132
+    t140 = t138 + t137*t132
+    t141 = t113*t114
+    t142 = t97*t114
+    t143 = t142*t113
+    t144 = -t102*t121 + t106*t125 + t83*t141*t90*t91**2 + t143*t98
+    t145 = (t144 != 0)
+    t146 = (-t94 + t117)/casadi.if_else(t145, 2*t144, 1)
+    t147 = casadi.fabs(t146)
+    t148 = (t147 >= 1)
+    t149 = 1/casadi.fabs(casadi.if_else(t148, t146, 1))
+    t150 = casadi.if_else(t145, casadi.if_else((t146 >= 0), 1, -1)*casadi.if_else(t148, t149/(1 + casadi.sqrt(1 + t149**2)), 1/(t147 + casadi.sqrt(1 + t147**2))), 0)
+    t151 = 1/casadi.sqrt(1 + t150**2)
+    t152 = t144*t150
+    t153 = -t152 + t94
+    t154 = t152 + t117
+    t155 = t24*t91
+    t156 = t155*t151
+    t157 = t156*t90
+    t158 = t141*t156
+    t159 = -t157 + t158*t150
+    t160 = t158 + t157*t150
+    t161 = t98*t151
+    t162 = t143*t151
+    t163 = t161 - t162*t150
+    t164 = t162 + t161*t150
+    t165 = t102*t151
+    t166 = t121*t151
+    t167 = t165 + t166*t150
+    t168 = -t166 + t165*t150
+    t169 = t106*t151
+    t170 = t125*t151
+    t171 = t169 - t170*t150
+    t172 = t170 + t169*t150
+    t173 = t155*t114*t133
+    t174 = t173*t132
+    t175 = t142*t133
+    t176 = t175*t132
+    t177 = t120*t133
+    t178 = t177*t132
+    t179 = -t140*t171 - t174*t159 + t176*t163 + t178*t167
+    t180 = (t179 != 0)
+    t181 = (-t153 + t136)/casadi.if_else(t180, 2*t179, 1)
+    t182 = casadi.fabs(t181)
+    t183 = (t182 >= 1)
+    t184 = 1/casadi.fabs(casadi.if_else(t183, t181, 1))
+    t185 = casadi.if_else(t180, casadi.if_else((t181 >= 0), 1, -1)*casadi.if_else(t183, t184/(1 + casadi.sqrt(1 + t184**2)), 1/(t182 + casadi.sqrt(1 + t182**2))), 0)
+    t186 = 1/casadi.sqrt(1 + t185**2)
+    t187 = t179*t185
+    t188 = -t187 + t153
+    t189 = t187 + t136
+    t190 = t159*t186
+    t191 = t174*t186
+    t192 = t190 + t191*t185
+    t193 = -t191 + t190*t185
+    t194 = t163*t186
+    t195 = t176*t186
+    t196 = t194 - t195*t185
+    t197 = t195 + t194*t185
+    t198 = t167*t186
+    t199 = t178*t186
+    t200 = t198 - t199*t185
+    t201 = t199 + t198*t185
+    t202 = t171*t186
+    t203 = t140*t186
+    t204 = t202 + t203*t185
+    t205 = -t203 + t202*t185
+    t206 = -t160*t193 + t164*t197 + t168*t201 + t172*t205
+    t207 = t139*t204 - t173*t192 + t175*t196 + t177*t200
+    t208 = (t206 != 0)
+    t209 = (-t154 + t189)/casadi.if_else(t208, 2*t206, 1)
+    t210 = casadi.fabs(t209)
+    t211 = (t210 >= 1)
+    t212 = 1/casadi.fabs(casadi.if_else(t211, t209, 1))
+    t213 = casadi.if_else(t208, casadi.if_else((t209 >= 0), 1, -1)*casadi.if_else(t211, t212/(1 + casadi.sqrt(1 + t212**2)), 1/(t210 + casadi.sqrt(1 + t210**2))), 0)
+    t214 = 1/casadi.sqrt(1 + t213**2)
+    t215 = t206*t213
+    t216 = -t215 + t154
+    t217 = t215 + t189
+    t218 = t160*t214
+    t219 = t193*t214
+    t220 = t218 + t219*t213
+    t221 = t219 - t218*t213
+    t222 = t164*t214
+    t223 = t197*t214
+    t224 = t222 - t223*t213
+    t225 = t223 + t222*t213
+    t226 = t168*t214
+    t227 = t201*t214
+    t228 = t226 - t227*t213
+    t229 = t227 + t226*t213
+    t230 = t172*t214
+    t231 = t205*t214
+    t232 = t230 - t231*t213
+    t233 = t231 + t230*t213
+    t234 = (t207 != 0)
+    t235 = (-t135 + t188)/casadi.if_else(t234, 2*t207, 1)
+    t236 = casadi.fabs(t235)
+    t237 = (t236 >= 1)
+    t238 = 1/casadi.fabs(casadi.if_else(t237, t235, 1))
+    t239 = casadi.if_else(t234, casadi.if_else((t235 >= 0), 1, -1)*casadi.if_else(t237, t238/(1 + casadi.sqrt(1 + t238**2)), 1/(t236 + casadi.sqrt(1 + t236**2))), 0)
+    t240 = 1/casadi.sqrt(1 + t239**2)
+    t241 = t207*t239
+    t242 = -t241 + t135
+    t243 = t241 + t188
+    t244 = t173*t240
+    t245 = t192*t240
+    t246 = t244 + t245*t239
+    t247 = t245 - t244*t239
+    t248 = t175*t240
+    t249 = t196*t240
+    t250 = t248 - t249*t239
+    t251 = t249 + t248*t239
+    t252 = t177*t240
+    t253 = t200*t240
+    t254 = t252 - t253*t239
+    t255 = t253 + t252*t239
+    t256 = t139*t240
+    t257 = t204*t240
+    t258 = t256 - t257*t239
+    t259 = t257 + t256*t239
+    t260 = t220*t246 + t224*t250 + t228*t254 + t232*t258
+    t261 = (t260 != 0)
+    t262 = (-t242 + t216)/casadi.if_else(t261, 2*t260, 1)
+    t263 = casadi.fabs(t262)
+    t264 = (t263 >= 1)
+    t265 = 1/casadi.fabs(casadi.if_else(t264, t262, 1))
+    t266 = casadi.if_else(t261, casadi.if_else((t262 >= 0), 1, -1)*casadi.if_else(t264, t265/(1 + casadi.sqrt(1 + t265**2)), 1/(t263 + casadi.sqrt(1 + t263**2))), 0)
+    t267 = 1/casadi.sqrt(1 + t266**2)
+    t268 = t260*t266
+    t269 = -t268 + t242
+    t270 = t268 + t216
+    t271 = t246*t267
+    t272 = t220*t267
+    t273 = -t271 + t272*t266
+    t274 = t272 + t271*t266
+    t275 = t250*t267
+    t276 = t224*t267
+    t277 = t275 - t276*t266
+    t278 = t276 + t275*t266
+    t279 = t254*t267
+    t280 = t228*t267
+    t281 = t279 - t280*t266
+    t282 = t280 + t279*t266
+    t283 = t258*t267
+    t284 = t232*t267
+    t285 = t283 - t284*t266
+    t286 = t284 + t283*t266
+    t287 = t221*t273 + t225*t277 + t229*t281 + t233*t285
+    t288 = -t247*t274 + t251*t278 + t255*t282 + t259*t286
+    t289 = (t287 != 0)
+    t290 = (-t269 + t217)/casadi.if_else(t289, 2*t287, 1)
+    t291 = casadi.fabs(t290)
+    t292 = (t291 >= 1)
+    t293 = 1/casadi.fabs(casadi.if_else(t292, t290, 1))
+    t294 = casadi.if_else(t289, casadi.if_else((t290 >= 0), 1, -1)*casadi.if_else(t292, t293/(1 + casadi.sqrt(1 + t293**2)), 1/(t291 + casadi.sqrt(1 + t291**2))), 0)
+    t295 = 1/casadi.sqrt(1 + t294**2)
+    t296 = t287*t294
+    t297 = -t296 + t269
+    t298 = t296 + t217
+    t299 = t273*t295
+    t300 = t221*t295
+    t301 = t299 - t300*t294
+    t302 = t300 + t299*t294
+    t303 = t277*t295
+    t304 = t225*t295
+    t305 = t303 - t304*t294
+    t306 = t304 + t303*t294
+    t307 = t281*t295
+    t308 = t229*t295
+    t309 = t307 - t308*t294
+    t310 = t308 + t307*t294
+    t311 = t285*t295
+    t312 = t233*t295
+    t313 = t311 - t312*t294
+    t314 = t312 + t311*t294
+    t315 = (t288 != 0)
+    t316 = (-t243 + t270)/casadi.if_else(t315, 2*t288, 1)
+    t317 = casadi.fabs(t316)
+    t318 = (t317 >= 1)
+    t319 = 1/casadi.fabs(casadi.if_else(t318, t316, 1))
+    t320 = casadi.if_else(t315, casadi.if_else((t316 >= 0), 1, -1)*casadi.if_else(t318, t319/(1 + casadi.sqrt(1 + t319**2)), 1/(t317 + casadi.sqrt(1 + t317**2))), 0)
+    t321 = 1/casadi.sqrt(1 + t320**2)
+    t322 = t288*t320
+    t323 = -t322 + t243
+    t324 = t322 + t270
+    t325 = t247*t321
+    t326 = t274*t321
+    t327 = t325 + t326*t320
+    t328 = -t326 + t325*t320
+    t329 = t251*t321
+    t330 = t278*t321
+    t331 = t329 - t330*t320
+    t332 = t330 + t329*t320
+    t333 = t255*t321
+    t334 = t282*t321
+    t335 = t333 - t334*t320
+    t336 = t334 + t333*t320
+    t337 = t259*t321
+    t338 = t286*t321
+    t339 = t337 - t338*t320
+    t340 = t338 + t337*t320
+    t341 = t302*t327 + t306*t331 + t310*t335 + t314*t339
+    t342 = (t341 != 0)
+    t343 = (-t323 + t298)/casadi.if_else(t342, 2*t341, 1)
+    t344 = casadi.fabs(t343)
+    t345 = (t344 >= 1)
+    t346 = 1/casadi.fabs(casadi.if_else(t345, t343, 1))
+    t347 = casadi.if_else(t342, casadi.if_else((t343 >= 0), 1, -1)*casadi.if_else(t345, t346/(1 + casadi.sqrt(1 + t346**2)), 1/(t344 + casadi.sqrt(1 + t344**2))), 0)
+    t348 = 1/casadi.sqrt(1 + t347**2)
+    t349 = t341*t347
+    t350 = -t349 + t323
+    t351 = t349 + t298
+    t352 = t327*t348
+    t353 = t302*t348
+    t354 = t352 - t353*t347
+    t355 = t353 + t352*t347
+    t356 = t331*t348
+    t357 = t306*t348
+    t358 = t356 - t357*t347
+    t359 = t357 + t356*t347
+    t360 = t335*t348
+    t361 = t310*t348
+    t362 = t360 - t361*t347
+    t363 = t361 + t360*t347
+    t364 = t339*t348
+    t365 = t314*t348
+    t366 = t364 - t365*t347
+    t367 = t365 + t364*t347
+    t368 = t328*t355 + t332*t359 + t336*t363 + t340*t367
+    t369 = t301*t354 + t305*t358 + t309*t362 + t313*t366
+    t370 = (t368 != 0)
+    t371 = (-t324 + t351)/casadi.if_else(t370, 2*t368, 1)
+    t372 = casadi.fabs(t371)
+    t373 = (t372 >= 1)
+    t374 = 1/casadi.fabs(casadi.if_else(t373, t371, 1))
+    t375 = casadi.if_else(t370, casadi.if_else((t371 >= 0), 1, -1)*casadi.if_else(t373, t374/(1 + casadi.sqrt(1 + t374**2)), 1/(t372 + casadi.sqrt(1 + t372**2))), 0)
+    t376 = 1/casadi.sqrt(1 + t375**2)
+    t377 = t368*t375
+    t378 = -t377 + t324
+    t379 = t377 + t351
+    t380 = t328*t376
+    t381 = t355*t376
+    t382 = t380 - t381*t375
+    t383 = t381 + t380*t375
+    t384 = t332*t376
+    t385 = t359*t376
+    t386 = t384 - t385*t375
+    t387 = t385 + t384*t375
+    t388 = t336*t376
+    t389 = t363*t376
+    t390 = t388 - t389*t375
+    t391 = t389 + t388*t375
+    t392 = t340*t376
+    t393 = t367*t376
+    t394 = t392 - t393*t375
+    t395 = t393 + t392*t375
+    t396 = (t369 != 0)
+    t397 = (-t297 + t350)/casadi.if_else(t396, 2*t369, 1)
+    t398 = casadi.fabs(t397)
+    t399 = (t398 >= 1)
+    t400 = 1/casadi.fabs(casadi.if_else(t399, t397, 1))
+    t401 = casadi.if_else(t396, casadi.if_else((t397 >= 0), 1, -1)*casadi.if_else(t399, t400/(1 + casadi.sqrt(1 + t400**2)), 1/(t398 + casadi.sqrt(1 + t398**2))), 0)
+    t402 = 1/casadi.sqrt(1 + t401**2)
+    t403 = t369*t401
+    t404 = -t403 + t297
+    t405 = t403 + t350
+    t406 = t301*t402
+    t407 = t354*t402
+    t408 = t406 - t407*t401
+    t409 = t407 + t406*t401
+    t410 = t305*t402
+    t411 = t358*t402
+    t412 = t410 - t411*t401
+    t413 = t411 + t410*t401
+    t414 = t309*t402
+    t415 = t362*t402
+    t416 = t414 - t415*t401
+    t417 = t415 + t414*t401
+    t418 = t313*t402
+    t419 = t366*t402
+    t420 = t418 - t419*t401
+    t421 = t419 + t418*t401
+    t422 = t382*t408 + t386*t412 + t390*t416 + t394*t420
+    t423 = (t422 != 0)
+    t424 = (-t404 + t378)/casadi.if_else(t423, 2*t422, 1)
+    t425 = casadi.fabs(t424)
+    t426 = (t425 >= 1)
+    t427 = 1/casadi.fabs(casadi.if_else(t426, t424, 1))
+    t428 = casadi.if_else(t423, casadi.if_else((t424 >= 0), 1, -1)*casadi.if_else(t426, t427/(1 + casadi.sqrt(1 + t427**2)), 1/(t425 + casadi.sqrt(1 + t425**2))), 0)
+    t429 = 1/casadi.sqrt(1 + t428**2)
+    t430 = t422*t428
+    t431 = -t430 + t404
+    t432 = t430 + t378
+    t433 = t408*t429
+    t434 = t382*t429
+    t435 = t433 - t434*t428
+    t436 = t434 + t433*t428
+    t437 = t412*t429
+    t438 = t386*t429
+    t439 = t437 - t438*t428
+    t440 = t438 + t437*t428
+    t441 = t416*t429
+    t442 = t390*t429
+    t443 = t441 - t442*t428
+    t444 = t442 + t441*t428
+    t445 = t420*t429
+    t446 = t394*t429
+    t447 = t445 - t446*t428
+    t448 = t446 + t445*t428
+    t449 = t383*t435 + t387*t439 + t391*t443 + t395*t447
+    t450 = t409*t436 + t413*t440 + t417*t444 + t421*t448
+    t451 = (t449 != 0)
+    t452 = (-t431 + t379)/casadi.if_else(t451, 2*t449, 1)
+    t453 = casadi.fabs(t452)
+    t454 = (t453 >= 1)
+    t455 = 1/casadi.fabs(casadi.if_else(t454, t452, 1))
+    t456 = casadi.if_else(t451, casadi.if_else((t452 >= 0), 1, -1)*casadi.if_else(t454, t455/(1 + casadi.sqrt(1 + t455**2)), 1/(t453 + casadi.sqrt(1 + t453**2))), 0)
+    t457 = 1/casadi.sqrt(1 + t456**2)
+    t458 = t449*t456
+    t459 = -t458 + t431
+    t460 = t458 + t379
+    t461 = t435*t457
+    t462 = t383*t457
+    t463 = t461 - t462*t456
+    t464 = t462 + t461*t456
+    t465 = t439*t457
+    t466 = t387*t457
+    t467 = t465 - t466*t456
+    t468 = t466 + t465*t456
+    t469 = t443*t457
+    t470 = t391*t457
+    t471 = t469 - t470*t456
+    t472 = t470 + t469*t456
+    t473 = t447*t457
+    t474 = t395*t457
+    t475 = t473 - t474*t456
+    t476 = t474 + t473*t456
+    t477 = (t450 != 0)
+    t478 = (-t405 + t432)/casadi.if_else(t477, 2*t450, 1)
+    t479 = casadi.fabs(t478)
+    t480 = (t479 >= 1)
+    t481 = 1/casadi.fabs(casadi.if_else(t480, t478, 1))
+    t482 = casadi.if_else(t477, casadi.if_else((t478 >= 0), 1, -1)*casadi.if_else(t480, t481/(1 + casadi.sqrt(1 + t481**2)), 1/(t479 + casadi.sqrt(1 + t479**2))), 0)
+    t483 = 1/casadi.sqrt(1 + t482**2)
+    t484 = t450*t482
+    t485 = -t484 + t405
+    t486 = t484 + t432
+    t487 = t409*t483
+    t488 = t436*t483
+    t489 = t487 - t488*t482
+    t490 = t488 + t487*t482
+    t491 = t413*t483
+    t492 = t440*t483
+    t493 = t491 - t492*t482
+    t494 = t492 + t491*t482
+    t495 = t417*t483
+    t496 = t444*t483
+    t497 = t495 - t496*t482
+    t498 = t496 + t495*t482
+    t499 = t421*t483
+    t500 = t448*t483
+    t501 = t499 - t500*t482
+    t502 = t500 + t499*t482
+    t503 = t464*t489 + t468*t493 + t472*t497 + t476*t501
+    t504 = (t503 != 0)
+    t505 = (-t485 + t460)/casadi.if_else(t504, 2*t503, 1)
+    t506 = casadi.fabs(t505)
+    t507 = (t506 >= 1)
+    t508 = 1/casadi.fabs(casadi.if_else(t507, t505, 1))
+    t509 = casadi.if_else(t504, casadi.if_else((t505 >= 0), 1, -1)*casadi.if_else(t507, t508/(1 + casadi.sqrt(1 + t508**2)), 1/(t506 + casadi.sqrt(1 + t506**2))), 0)
+    t510 = 1/casadi.sqrt(1 + t509**2)
+    t511 = t503*t509
+    t512 = -t511 + t485
+    t513 = t511 + t460
+    t514 = t489*t510
+    t515 = t464*t510
+    t516 = t514 - t515*t509
+    t517 = t515 + t514*t509
+    t518 = t493*t510
+    t519 = t468*t510
+    t520 = t518 - t519*t509
+    t521 = t519 + t518*t509
+    t522 = t497*t510
+    t523 = t472*t510
+    t524 = t522 - t523*t509
+    t525 = t523 + t522*t509
+    t526 = t501*t510
+    t527 = t476*t510
+    t528 = t526 - t527*t509
+    t529 = t527 + t526*t509
+    t530 = t490*t517 + t494*t521 + t498*t525 + t502*t529
+    t531 = t463*t516 + t467*t520 + t471*t524 + t475*t528
+    t532 = (t530 != 0)
+    t533 = (-t486 + t513)/casadi.if_else(t532, 2*t530, 1)
+    t534 = casadi.fabs(t533)
+    t535 = (t534 >= 1)
+    t536 = 1/casadi.fabs(casadi.if_else(t535, t533, 1))
+    t537 = casadi.if_else(t532, casadi.if_else((t533 >= 0), 1, -1)*casadi.if_else(t535, t536/(1 + casadi.sqrt(1 + t536**2)), 1/(t534 + casadi.sqrt(1 + t534**2))), 0)
+    t538 = 1/casadi.sqrt(1 + t537**2)
+    t539 = t530*t537
+    t540 = -t539 + t486
+    t541 = t539 + t513
+    t542 = t490*t538
+    t543 = t517*t538
+    t544 = t542 - t543*t537
+    t545 = t543 + t542*t537
+    t546 = t494*t538
+    t547 = t521*t538
+    t548 = t546 - t547*t537
+    t549 = t547 + t546*t537
+    t550 = t498*t538
+    t551 = t525*t538
+    t552 = t550 - t551*t537
+    t553 = t551 + t550*t537
+    t554 = t502*t538
+    t555 = t529*t538
+    t556 = t554 - t555*t537
+    t557 = t555 + t554*t537
+    t558 = (t531 != 0)
+    t559 = (-t459 + t512)/casadi.if_else(t558, 2*t531, 1)
+    t560 = casadi.fabs(t559)
+    t561 = (t560 >= 1)
+    t562 = 1/casadi.fabs(casadi.if_else(t561, t559, 1))
+    t563 = casadi.if_else(t558, casadi.if_else((t559 >= 0), 1, -1)*casadi.if_else(t561, t562/(1 + casadi.sqrt(1 + t562**2)), 1/(t560 + casadi.sqrt(1 + t560**2))), 0)
+    t564 = 1/casadi.sqrt(1 + t563**2)
+    t565 = t531*t563
+    t566 = -t565 + t459
+    t567 = t565 + t512
+    t568 = t463*t564
+    t569 = t516*t564
+    t570 = t568 - t569*t563
+    t571 = t569 + t568*t563
+    t572 = t467*t564
+    t573 = t520*t564
+    t574 = t572 - t573*t563
+    t575 = t573 + t572*t563
+    t576 = t471*t564
+    t577 = t524*t564
+    t578 = t576 - t577*t563
+    t579 = t577 + t576*t563
+    t580 = t475*t564
+    t581 = t528*t564
+    t582 = t580 - t581*t563
+    t583 = t581 + t580*t563
+    t584 = t544*t570 + t548*t574 + t552*t578 + t556*t582
+    t585 = (t584 != 0)
+    t586 = (-t566 + t540)/casadi.if_else(t585, 2*t584, 1)
+    t587 = casadi.fabs(t586)
+    t588 = (t587 >= 1)
+    t589 = 1/casadi.fabs(casadi.if_else(t588, t586, 1))
+    t590 = casadi.if_else(t585, casadi.if_else((t586 >= 0), 1, -1)*casadi.if_else(t588, t589/(1 + casadi.sqrt(1 + t589**2)), 1/(t587 + casadi.sqrt(1 + t587**2))), 0)
+    t591 = 1/casadi.sqrt(1 + t590**2)
+    t592 = t584*t590
+    t593 = -t592 + t566
+    t594 = t592 + t540
+    t595 = t570*t591
+    t596 = t544*t591
+    t597 = t595 - t596*t590
+    t598 = t596 + t595*t590
+    t599 = t574*t591
+    t600 = t548*t591
+    t601 = t599 - t600*t590
+    t602 = t600 + t599*t590
+    t603 = t578*t591
+    t604 = t552*t591
+    t605 = t603 - t604*t590
+    t606 = t604 + t603*t590
+    t607 = t582*t591
+    t608 = t556*t591
+    t609 = t607 - t608*t590
+    t610 = t608 + t607*t590
+    t611 = t545*t597 + t549*t601 + t553*t605 + t557*t609
+    t612 = t571*t598 + t575*t602 + t579*t606 + t583*t610
+    t613 = (t611 != 0)
+    t614 = (-t593 + t541)/casadi.if_else(t613, 2*t611, 1)
+    t615 = casadi.fabs(t614)
+    t616 = (t615 >= 1)
+    t617 = 1/casadi.fabs(casadi.if_else(t616, t614, 1))
+    t618 = casadi.if_else(t613, casadi.if_else((t614 >= 0), 1, -1)*casadi.if_else(t616, t617/(1 + casadi.sqrt(1 + t617**2)), 1/(t615 + casadi.sqrt(1 + t615**2))), 0)
+    t619 = 1/casadi.sqrt(1 + t618**2)
+    t620 = t611*t618
+    t621 = -t620 + t593
+    t622 = t620 + t541
+    t623 = t597*t619
+    t624 = t545*t619
+    t625 = t623 - t624*t618
+    t626 = t624 + t623*t618
+    t627 = t601*t619
+    t628 = t549*t619
+    t629 = t627 - t628*t618
+    t630 = t628 + t627*t618
+    t631 = t605*t619
+    t632 = t553*t619
+    t633 = t631 - t632*t618
+    t634 = t632 + t631*t618
+    t635 = t609*t619
+    t636 = t557*t619
+    t637 = t635 - t636*t618
+    t638 = t636 + t635*t618
+    t639 = (t612 != 0)
+    t640 = (-t567 + t594)/casadi.if_else(t639, 2*t612, 1)
+    t641 = casadi.fabs(t640)
+    t642 = (t641 >= 1)
+    t643 = 1/casadi.fabs(casadi.if_else(t642, t640, 1))
+    t644 = casadi.if_else(t639, casadi.if_else((t640 >= 0), 1, -1)*casadi.if_else(t642, t643/(1 + casadi.sqrt(1 + t643**2)), 1/(t641 + casadi.sqrt(1 + t641**2))), 0)
+    t645 = 1/casadi.sqrt(1 + t644**2)
+    t646 = t612*t644
+    t647 = -t646 + t567
+    t648 = t646 + t594
+    t649 = t571*t645
+    t650 = t598*t645
+    t651 = t649 - t650*t644
+    t652 = t650 + t649*t644
+    t653 = t575*t645
+    t654 = t602*t645
+    t655 = t653 - t654*t644
+    t656 = t654 + t653*t644
+    t657 = t579*t645
+    t658 = t606*t645
+    t659 = t657 - t658*t644
+    t660 = t658 + t657*t644
+    t661 = t583*t645
+    t662 = t610*t645
+    t663 = t661 - t662*t644
+    t664 = t662 + t661*t644
+    t665 = t626*t651 + t630*t655 + t634*t659 + t638*t663
+    t666 = (t665 != 0)
+    t667 = (-t647 + t622)/casadi.if_else(t666, 2*t665, 1)
+    t668 = casadi.fabs(t667)
+    t669 = (t668 >= 1)
+    t670 = 1/casadi.fabs(casadi.if_else(t669, t667, 1))
+    t671 = casadi.if_else(t666, casadi.if_else((t667 >= 0), 1, -1)*casadi.if_else(t669, t670/(1 + casadi.sqrt(1 + t670**2)), 1/(t668 + casadi.sqrt(1 + t668**2))), 0)
+    t672 = 1/casadi.sqrt(1 + t671**2)
+    t673 = t665*t671
+    t674 = -t673 + t647
+    t675 = t673 + t622
+    t676 = t651*t672
+    t677 = t626*t672
+    t678 = t676 - t677*t671
+    t679 = t677 + t676*t671
+    t680 = t655*t672
+    t681 = t630*t672
+    t682 = t680 - t681*t671
+    t683 = t681 + t680*t671
+    t684 = t659*t672
+    t685 = t634*t672
+    t686 = t684 - t685*t671
+    t687 = t685 + t684*t671
+    t688 = t663*t672
+    t689 = t638*t672
+    t690 = t688 - t689*t671
+    t691 = t689 + t688*t671
+    t692 = t652*t679 + t656*t683 + t660*t687 + t664*t691
+    t693 = t625*t678 + t629*t682 + t633*t686 + t637*t690
+    t694 = (t692 != 0)
+    t695 = (-t648 + t675)/casadi.if_else(t694, 2*t692, 1)
+    t696 = casadi.fabs(t695)
+    t697 = (t696 >= 1)
+    t698 = 1/casadi.fabs(casadi.if_else(t697, t695, 1))
+    t699 = casadi.if_else(t694, casadi.if_else((t695 >= 0), 1, -1)*casadi.if_else(t697, t698/(1 + casadi.sqrt(1 + t698**2)), 1/(t696 + casadi.sqrt(1 + t696**2))), 0)
+    t700 = 1/casadi.sqrt(1 + t699**2)
+    t701 = t692*t699
+    t702 = -t701 + t648
+    t703 = t701 + t675
+    t704 = t652*t700
+    t705 = t679*t700
+    t706 = t704 - t705*t699
+    t707 = t705 + t704*t699
+    t708 = t656*t700
+    t709 = t683*t700
+    t710 = t708 - t709*t699
+    t711 = t709 + t708*t699
+    t712 = t660*t700
+    t713 = t687*t700
+    t714 = t712 - t713*t699
+    t715 = t713 + t712*t699
+    t716 = t664*t700
+    t717 = t691*t700
+    t718 = t716 - t717*t699
+    t719 = t717 + t716*t699
+    t720 = (t693 != 0)
+    t721 = (-t621 + t674)/casadi.if_else(t720, 2*t693, 1)
+    t722 = casadi.fabs(t721)
+    t723 = (t722 >= 1)
+    t724 = 1/casadi.fabs(casadi.if_else(t723, t721, 1))
+    t725 = casadi.if_else(t720, casadi.if_else((t721 >= 0), 1, -1)*casadi.if_else(t723, t724/(1 + casadi.sqrt(1 + t724**2)), 1/(t722 + casadi.sqrt(1 + t722**2))), 0)
+    t726 = 1/casadi.sqrt(1 + t725**2)
+    t727 = t693*t725
+    t728 = -t727 + t621
+    t729 = t727 + t674
+    t730 = t625*t726
+    t731 = t678*t726
+    t732 = t730 - t731*t725
+    t733 = t731 + t730*t725
+    t734 = t629*t726
+    t735 = t682*t726
+    t736 = t734 - t735*t725
+    t737 = t735 + t734*t725
+    t738 = t633*t726
+    t739 = t686*t726
+    t740 = t738 - t739*t725
+    t741 = t739 + t738*t725
+    t742 = t637*t726
+    t743 = t690*t726
+    t744 = t742 - t743*t725
+    t745 = t743 + t742*t725
+    t746 = t706*t732 + t710*t736 + t714*t740 + t718*t744
+    t747 = (t746 != 0)
+    t748 = (-t728 + t702)/casadi.if_else(t747, 2*t746, 1)
+    t749 = casadi.fabs(t748)
+    t750 = (t749 >= 1)
+    t751 = 1/casadi.fabs(casadi.if_else(t750, t748, 1))
+    t752 = casadi.if_else(t747, casadi.if_else((t748 >= 0), 1, -1)*casadi.if_else(t750, t751/(1 + casadi.sqrt(1 + t751**2)), 1/(t749 + casadi.sqrt(1 + t749**2))), 0)
+    t753 = 1/casadi.sqrt(1 + t752**2)
+    t754 = t746*t752
+    t755 = -t754 + t728
+    t756 = t754 + t702
+    t757 = t732*t753
+    t758 = t706*t753
+    t759 = t757 - t758*t752
+    t760 = t758 + t757*t752
+    t761 = t736*t753
+    t762 = t710*t753
+    t763 = t761 - t762*t752
+    t764 = t762 + t761*t752
+    t765 = t740*t753
+    t766 = t714*t753
+    t767 = t765 - t766*t752
+    t768 = t766 + t765*t752
+    t769 = t744*t753
+    t770 = t718*t753
+    t771 = t769 - t770*t752
+    t772 = t770 + t769*t752
+    t773 = t707*t759 + t711*t763 + t715*t767 + t719*t771
+    t774 = t733*t760 + t737*t764 + t741*t768 + t745*t772
+    t775 = (t773 != 0)
+    t776 = (-t755 + t703)/casadi.if_else(t775, 2*t773, 1)
+    t777 = casadi.fabs(t776)
+    t778 = (t777 >= 1)
+    t779 = 1/casadi.fabs(casadi.if_else(t778, t776, 1))
+    t780 = casadi.if_else(t775, casadi.if_else((t776 >= 0), 1, -1)*casadi.if_else(t778, t779/(1 + casadi.sqrt(1 + t779**2)), 1/(t777 + casadi.sqrt(1 + t777**2))), 0)
+    t781 = 1/casadi.sqrt(1 + t780**2)
+    t782 = t773*t780
+    t783 = -t782 + t755
+    t784 = t782 + t703
+    t785 = t759*t781
+    t786 = t707*t781
+    t787 = t785 - t786*t780
+    t788 = t786 + t785*t780
+    t789 = t763*t781
+    t790 = t711*t781
+    t791 = t789 - t790*t780
+    t792 = t790 + t789*t780
+    t793 = t767*t781
+    t794 = t715*t781
+    t795 = t793 - t794*t780
+    t796 = t794 + t793*t780
+    t797 = t771*t781
+    t798 = t719*t781
+    t799 = t797 - t798*t780
+    t800 = t798 + t797*t780
+    t801 = (t774 != 0)
+    t802 = (-t729 + t756)/casadi.if_else(t801, 2*t774, 1)
+    t803 = casadi.fabs(t802)
+    t804 = (t803 >= 1)
+    t805 = 1/casadi.fabs(casadi.if_else(t804, t802, 1))
+    t806 = casadi.if_else(t801, casadi.if_else((t802 >= 0), 1, -1)*casadi.if_else(t804, t805/(1 + casadi.sqrt(1 + t805**2)), 1/(t803 + casadi.sqrt(1 + t803**2))), 0)
+    t807 = 1/casadi.sqrt(1 + t806**2)
+    t808 = t774*t806
+    t809 = -t808 + t729
+    t810 = t808 + t756
+    t811 = t733*t807
+    t812 = t760*t807
+    t813 = t811 - t812*t806
+    t814 = t812 + t811*t806
+    t815 = t737*t807
+    t816 = t764*t807
+    t817 = t815 - t816*t806
+    t818 = t816 + t815*t806
+    t819 = t741*t807
+    t820 = t768*t807
+    t821 = t819 - t820*t806
+    t822 = t820 + t819*t806
+    t823 = t745*t807
+    t824 = t772*t807
+    t825 = t823 - t824*t806
+    t826 = t824 + t823*t806
+    t827 = t788*t813 + t792*t817 + t796*t821 + t800*t825
+    t828 = (t827 != 0)
+    t829 = (-t809 + t784)/casadi.if_else(t828, 2*t827, 1)
+    t830 = casadi.fabs(t829)
+    t831 = (t830 >= 1)
+    t832 = 1/casadi.fabs(casadi.if_else(t831, t829, 1))
+    t833 = casadi.if_else(t828, casadi.if_else((t829 >= 0), 1, -1)*casadi.if_else(t831, t832/(1 + casadi.sqrt(1 + t832**2)), 1/(t830 + casadi.sqrt(1 + t830**2))), 0)
+    t834 = 1/casadi.sqrt(1 + t833**2)
+    t835 = t827*t833
+    t836 = -t835 + t809
+    t837 = t835 + t784
+    t838 = t813*t834
+    t839 = t788*t834
+    t840 = t838 - t839*t833
+    t841 = t839 + t838*t833
+    t842 = t817*t834
+    t843 = t792*t834
+    t844 = t842 - t843*t833
+    t845 = t843 + t842*t833
+    t846 = t821*t834
+    t847 = t796*t834
+    t848 = t846 - t847*t833
+    t849 = t847 + t846*t833
+    t850 = t825*t834
+    t851 = t800*t834
+    t852 = t850 - t851*t833
+    t853 = t851 + t850*t833
+    t854 = t814*t841 + t818*t845 + t822*t849 + t826*t853
+    t855 = t787*t840 + t791*t844 + t795*t848 + t799*t852
+    t856 = (t854 != 0)
+    t857 = (-t810 + t837)/casadi.if_else(t856, 2*t854, 1)
+    t858 = casadi.fabs(t857)
+    t859 = (t858 >= 1)
+    t860 = 1/casadi.fabs(casadi.if_else(t859, t857, 1))
+    t861 = casadi.if_else(t856, casadi.if_else((t857 >= 0), 1, -1)*casadi.if_else(t859, t860/(1 + casadi.sqrt(1 + t860**2)), 1/(t858 + casadi.sqrt(1 + t858**2))), 0)
+    t862 = 1/casadi.sqrt(1 + t861**2)
+    t863 = t854*t861
+    t864 = -t863 + t810
+    t865 = t863 + t837
+    t866 = t814*t862
+    t867 = t841*t862
+    t868 = t866 - t867*t861
+    t869 = t867 + t866*t861
+    t870 = t818*t862
+    t871 = t845*t862
+    t872 = t870 - t871*t861
+    t873 = t871 + t870*t861
+    t874 = t822*t862
+    t875 = t849*t862
+    t876 = t874 - t875*t861
+    t877 = t875 + t874*t861
+    t878 = t826*t862
+    t879 = t853*t862
+    t880 = t878 - t879*t861
+    t881 = t879 + t878*t861
+    t882 = (t855 != 0)
+    t883 = (-t783 + t836)/casadi.if_else(t882, 2*t855, 1)
+    t884 = casadi.fabs(t883)
+    t885 = (t884 >= 1)
+    t886 = 1/casadi.fabs(casadi.if_else(t885, t883, 1))
+    t887 = casadi.if_else(t882, casadi.if_else((t883 >= 0), 1, -1)*casadi.if_else(t885, t886/(1 + casadi.sqrt(1 + t886**2)), 1/(t884 + casadi.sqrt(1 + t884**2))), 0)
+    t888 = 1/casadi.sqrt(1 + t887**2)
+    t889 = t855*t887
+    t890 = -t889 + t783
+    t891 = t889 + t836
+    t892 = t787*t888
+    t893 = t840*t888
+    t894 = t892 - t893*t887
+    t895 = t893 + t892*t887
+    t896 = t791*t888
+    t897 = t844*t888
+    t898 = t896 - t897*t887
+    t899 = t897 + t896*t887
+    t900 = t795*t888
+    t901 = t848*t888
+    t902 = t900 - t901*t887
+    t903 = t901 + t900*t887
+    t904 = t799*t888
+    t905 = t852*t888
+    t906 = t904 - t905*t887
+    t907 = t905 + t904*t887
+    t908 = t868*t894 + t872*t898 + t876*t902 + t880*t906
+    t909 = (t908 != 0)
+    t910 = (-t890 + t864)/casadi.if_else(t909, 2*t908, 1)
+    t911 = casadi.fabs(t910)
+    t912 = (t911 >= 1)
+    t913 = 1/casadi.fabs(casadi.if_else(t912, t910, 1))
+    t914 = casadi.if_else(t909, casadi.if_else((t910 >= 0), 1, -1)*casadi.if_else(t912, t913/(1 + casadi.sqrt(1 + t913**2)), 1/(t911 + casadi.sqrt(1 + t911**2))), 0)
+    t915 = 1/casadi.sqrt(1 + t914**2)
+    t916 = t908*t914
+    t917 = -t916 + t890
+    t918 = t916 + t864
+    t919 = t894*t915
+    t920 = t868*t915
+    t921 = t919 - t920*t914
+    t922 = t920 + t919*t914
+    t923 = t898*t915
+    t924 = t872*t915
+    t925 = t923 - t924*t914
+    t926 = t924 + t923*t914
+    t927 = t902*t915
+    t928 = t876*t915
+    t929 = t927 - t928*t914
+    t930 = t928 + t927*t914
+    t931 = t906*t915
+    t932 = t880*t915
+    t933 = t931 - t932*t914
+    t934 = t932 + t931*t914
+    t935 = t869*t921 + t873*t925 + t877*t929 + t881*t933
+    t936 = t895*t922 + t899*t926 + t903*t930 + t907*t934
+    t937 = (t935 != 0)
+    t938 = (-t917 + t865)/casadi.if_else(t937, 2*t935, 1)
+    t939 = casadi.fabs(t938)
+    t940 = (t939 >= 1)
+    t941 = 1/casadi.fabs(casadi.if_else(t940, t938, 1))
+    t942 = casadi.if_else(t937, casadi.if_else((t938 >= 0), 1, -1)*casadi.if_else(t940, t941/(1 + casadi.sqrt(1 + t941**2)), 1/(t939 + casadi.sqrt(1 + t939**2))), 0)
+    t943 = 1/casadi.sqrt(1 + t942**2)
+    t944 = t935*t942
+    t945 = -t944 + t917
+    t946 = t944 + t865
+    t947 = t921*t943
+    t948 = t869*t943
+    t949 = t947 - t948*t942
+    t950 = t948 + t947*t942
+    t951 = t925*t943
+    t952 = t873*t943
+    t953 = t951 - t952*t942
+    t954 = t952 + t951*t942
+    t955 = t929*t943
+    t956 = t877*t943
+    t957 = t955 - t956*t942
+    t958 = t956 + t955*t942
+    t959 = t933*t943
+    t960 = t881*t943
+    t961 = t959 - t960*t942
+    t962 = t960 + t959*t942
+    t963 = (t936 != 0)
+    t964 = (-t891 + t918)/casadi.if_else(t963, 2*t936, 1)
+    t965 = casadi.fabs(t964)
+    t966 = (t965 >= 1)
+    t967 = 1/casadi.fabs(casadi.if_else(t966, t964, 1))
+    t968 = casadi.if_else(t963, casadi.if_else((t964 >= 0), 1, -1)*casadi.if_else(t966, t967/(1 + casadi.sqrt(1 + t967**2)), 1/(t965 + casadi.sqrt(1 + t965**2))), 0)
+    t969 = 1/casadi.sqrt(1 + t968**2)
+    t970 = t936*t968
+    t971 = -t970 + t891
+    t972 = t970 + t918
+    t973 = t895*t969
+    t974 = t922*t969
+    t975 = t973 - t974*t968
+    t976 = t974 + t973*t968
+    t977 = t899*t969
+    t978 = t926*t969
+    t979 = t977 - t978*t968
+    t980 = t978 + t977*t968
+    t981 = t903*t969
+    t982 = t930*t969
+    t983 = t981 - t982*t968
+    t984 = t982 + t981*t968
+    t985 = t907*t969
+    t986 = t934*t969
+    t987 = t985 - t986*t968
+    t988 = t986 + t985*t968
+    t989 = t950*t975 + t954*t979 + t958*t983 + t962*t987
+    t990 = (t989 != 0)
+    t991 = (-t971 + t946)/casadi.if_else(t990, 2*t989, 1)
+    t992 = casadi.fabs(t991)
+    t993 = (t992 >= 1)
+    t994 = 1/casadi.fabs(casadi.if_else(t993, t991, 1))
+    t995 = casadi.if_else(t990, casadi.if_else((t991 >= 0), 1, -1)*casadi.if_else(t993, t994/(1 + casadi.sqrt(1 + t994**2)), 1/(t992 + casadi.sqrt(1 + t992**2))), 0)
+    t996 = 1/casadi.sqrt(1 + t995**2)
+    t997 = t989*t995
+    t998 = -t997 + t971
+    t999 = t997 + t946
+    t1000 = t975*t996
+    t1001 = t950*t996
+    t1002 = t1000 - t1001*t995
+    t1003 = t1001 + t1000*t995
+    t1004 = t979*t996
+    t1005 = t954*t996
+    t1006 = t1004 - t1005*t995
+    t1007 = t1005 + t1004*t995
+    t1008 = t983*t996
+    t1009 = t958*t996
+    t1010 = t1008 - t1009*t995
+    t1011 = t1009 + t1008*t995
+    t1012 = t987*t996
+    t1013 = t962*t996
+    t1014 = t1012 - t1013*t995
+    t1015 = t1013 + t1012*t995
+    t1016 = t976*t1003 + t980*t1007 + t984*t1011 + t988*t1015
+    t1017 = t949*t1002 + t953*t1006 + t957*t1010 + t961*t1014
+    t1018 = (t1016 != 0)
+    t1019 = (-t972 + t999)/casadi.if_else(t1018, 2*t1016, 1)
+    t1020 = casadi.fabs(t1019)
+    t1021 = (t1020 >= 1)
+    t1022 = 1/casadi.fabs(casadi.if_else(t1021, t1019, 1))
+    t1023 = casadi.if_else(t1018, casadi.if_else((t1019 >= 0), 1, -1)*casadi.if_else(t1021, t1022/(1 + casadi.sqrt(1 + t1022**2)), 1/(t1020 + casadi.sqrt(1 + t1020**2))), 0)
+    t1024 = 1/casadi.sqrt(1 + t1023**2)
+    t1025 = t1016*t1023
+    t1026 = -t1025 + t972
+    t1027 = t1025 + t999
+    t1028 = t976*t1024
+    t1029 = t1003*t1024
+    t1030 = t1028 - t1029*t1023
+    t1031 = t1029 + t1028*t1023
+    t1032 = t980*t1024
+    t1033 = t1007*t1024
+    t1034 = t1032 - t1033*t1023
+    t1035 = t1033 + t1032*t1023
+    t1036 = t984*t1024
+    t1037 = t1011*t1024
+    t1038 = t1036 - t1037*t1023
+    t1039 = t1037 + t1036*t1023
+    t1040 = t988*t1024
+    t1041 = t1015*t1024
+    t1042 = t1040 - t1041*t1023
+    t1043 = t1041 + t1040*t1023
+    t1044 = (t1017 != 0)
+    t1045 = (-t945 + t998)/casadi.if_else(t1044, 2*t1017, 1)
+    t1046 = casadi.fabs(t1045)
+    t1047 = (t1046 >= 1)
+    t1048 = 1/casadi.fabs(casadi.if_else(t1047, t1045, 1))
+    t1049 = casadi.if_else(t1044, casadi.if_else((t1045 >= 0), 1, -1)*casadi.if_else(t1047, t1048/(1 + casadi.sqrt(1 + t1048**2)), 1/(t1046 + casadi.sqrt(1 + t1046**2))), 0)
+    t1050 = 1/casadi.sqrt(1 + t1049**2)
+    t1051 = t1017*t1049
+    t1052 = -t1051 + t945
+    t1053 = t1051 + t998
+    t1054 = t949*t1050
+    t1055 = t1002*t1050
+    t1056 = t1054 - t1055*t1049
+    t1057 = t1055 + t1054*t1049
+    t1058 = t953*t1050
+    t1059 = t1006*t1050
+    t1060 = t1058 - t1059*t1049
+    t1061 = t1059 + t1058*t1049
+    t1062 = t957*t1050
+    t1063 = t1010*t1050
+    t1064 = t1062 - t1063*t1049
+    t1065 = t1063 + t1062*t1049
+    t1066 = t961*t1050
+    t1067 = t1014*t1050
+    t1068 = t1066 - t1067*t1049
+    t1069 = t1067 + t1066*t1049
+    t1070 = t1030*t1056 + t1034*t1060 + t1038*t1064 + t1042*t1068
+    t1071 = (t1070 != 0)
+    t1072 = (-t1052 + t1026)/casadi.if_else(t1071, 2*t1070, 1)
+    t1073 = casadi.fabs(t1072)
+    t1074 = (t1073 >= 1)
+    t1075 = 1/casadi.fabs(casadi.if_else(t1074, t1072, 1))
+    t1076 = casadi.if_else(t1071, casadi.if_else((t1072 >= 0), 1, -1)*casadi.if_else(t1074, t1075/(1 + casadi.sqrt(1 + t1075**2)), 1/(t1073 + casadi.sqrt(1 + t1073**2))), 0)
+    t1077 = 1/casadi.sqrt(1 + t1076**2)
+    t1078 = t1070*t1076
+    t1079 = -t1078 + t1052
+    t1080 = t1078 + t1026
+    t1081 = t1056*t1077
+    t1082 = t1030*t1077
+    t1083 = t1081 - t1082*t1076
+    t1084 = t1082 + t1081*t1076
+    t1085 = t1060*t1077
+    t1086 = t1034*t1077
+    t1087 = t1085 - t1086*t1076
+    t1088 = t1086 + t1085*t1076
+    t1089 = t1064*t1077
+    t1090 = t1038*t1077
+    t1091 = t1089 - t1076*t1090
+    t1092 = t1090 + t1076*t1089
+    t1093 = t1068*t1077
+    t1094 = t1042*t1077
+    t1095 = t1093 - t1076*t1094
+    t1096 = t1094 + t1076*t1093
+    t1097 = t1031*t1083 + t1035*t1087 + t1039*t1091 + t1043*t1095
+    t1098 = t1057*t1084 + t1061*t1088 + t1065*t1092 + t1069*t1096
+    t1099 = (t1097 != 0)
+    t1100 = (-t1079 + t1027)/casadi.if_else(t1099, 2*t1097, 1)
+    t1101 = casadi.fabs(t1100)
+    t1102 = (t1101 >= 1)
+    t1103 = 1/casadi.fabs(casadi.if_else(t1102, t1100, 1))
+    t1104 = casadi.if_else(t1099, casadi.if_else((t1100 >= 0), 1, -1)*casadi.if_else(t1102, t1103/(1 + casadi.sqrt(1 + t1103**2)), 1/(t1101 + casadi.sqrt(1 + t1101**2))), 0)
+    t1105 = 1/casadi.sqrt(1 + t1104**2)
+    t1106 = t1027 + t1097*t1104
+    t1107 = t1083*t1105
+    t1108 = t1031*t1105
+    t1109 = t1107 - t1104*t1108
+    t1110 = t1108 + t1104*t1107
+    t1111 = t1087*t1105
+    t1112 = t1035*t1105
+    t1113 = t1111 - t1104*t1112
+    t1114 = t1112 + t1104*t1111
+    t1115 = t1091*t1105
+    t1116 = t1039*t1105
+    t1117 = t1115 - t1104*t1116
+    t1118 = t1116 + t1104*t1115
+    t1119 = t1095*t1105
+    t1120 = t1043*t1105
+    t1121 = t1119 - t1104*t1120
+    t1122 = t1120 + t1104*t1119
+    t1123 = casadi.sqrt(t1109**2 + t1113**2 + t1117**2 + t1121**2)
+    t1124 = (t1098 != 0)
+    t1125 = (-t1053 + t1080)/casadi.if_else(t1124, 2*t1098, 1)
+    t1126 = casadi.fabs(t1125)
+    t1127 = (t1126 >= 1)
+    t1128 = 1/casadi.fabs(casadi.if_else(t1127, t1125, 1))
+    t1129 = casadi.if_else(t1124, casadi.if_else((t1125 >= 0), 1, -1)*casadi.if_else(t1127, t1128/(1 + casadi.sqrt(1 + t1128**2)), 1/(t1126 + casadi.sqrt(1 + t1126**2))), 0)
+    t1130 = 1/casadi.sqrt(1 + t1129**2)
+    t1131 = t1098*t1129
+    t1132 = -t1131 + t1053
+    t1133 = t1080 + t1131
+    t1134 = t1057*t1130
+    t1135 = t1084*t1130
+    t1136 = t1134 - t1129*t1135
+    t1137 = t1135 + t1129*t1134
+    t1138 = t1061*t1130
+    t1139 = t1088*t1130
+    t1140 = t1138 - t1129*t1139
+    t1141 = t1139 + t1129*t1138
+    t1142 = t1065*t1130
+    t1143 = t1092*t1130
+    t1144 = t1142 - t1129*t1143
+    t1145 = t1143 + t1129*t1142
+    t1146 = t1069*t1130
+    t1147 = t1096*t1130
+    t1148 = t1146 - t1129*t1147
+    t1149 = t1147 + t1129*t1146
+    t1150 = t1110*t1136 + t1114*t1140 + t1118*t1144 + t1122*t1148
+    t1151 = (t1150 != 0)
+    t1152 = (-t1132 + t1106)/casadi.if_else(t1151, 2*t1150, 1)
+    t1153 = casadi.fabs(t1152)
+    t1154 = (t1153 >= 1)
+    t1155 = 1/casadi.fabs(casadi.if_else(t1154, t1152, 1))
+    t1156 = casadi.if_else(t1151, casadi.if_else((t1152 >= 0), 1, -1)*casadi.if_else(t1154, t1155/(1 + casadi.sqrt(1 + t1155**2)), 1/(t1153 + casadi.sqrt(1 + t1153**2))), 0)
+    t1157 = 1/casadi.sqrt(1 + t1156**2)
+    t1158 = t1106 + t1150*t1156
+    t1159 = t1136*t1157
+    t1160 = t1110*t1157
+    t1161 = t1159 - t1156*t1160
+    t1162 = t1160 + t1156*t1159
+    t1163 = t1140*t1157
+    t1164 = t1114*t1157
+    t1165 = t1163 - t1156*t1164
+    t1166 = t1164 + t1156*t1163
+    t1167 = t1144*t1157
+    t1168 = t1118*t1157
+    t1169 = t1167 - t1156*t1168
+    t1170 = t1168 + t1156*t1167
+    t1171 = t1148*t1157
+    t1172 = t1122*t1157
+    t1173 = t1171 - t1156*t1172
+    t1174 = t1172 + t1156*t1171
+    t1175 = t1137*t1162 + t1141*t1166 + t1145*t1170 + t1149*t1174
+    t1176 = casadi.sqrt(t1161**2 + t1165**2 + t1169**2 + t1173**2)
+    t1177 = casadi.if_else((t1176 > t1123), t1176, t1123)
+    t1178 = casadi.if_else((t1176 < t1123), t1176, t1123)
+    t1179 = (t1175 != 0)
+    t1180 = (-t1133 + t1158)/casadi.if_else(t1179, 2*t1175, 1)
+    t1181 = casadi.fabs(t1180)
+    t1182 = (t1181 >= 1)
+    t1183 = 1/casadi.fabs(casadi.if_else(t1182, t1180, 1))
+    t1184 = casadi.if_else(t1179, casadi.if_else((t1180 >= 0), 1, -1)*casadi.if_else(t1182, t1183/(1 + casadi.sqrt(1 + t1183**2)), 1/(t1181 + casadi.sqrt(1 + t1181**2))), 0)
+    t1185 = 1/casadi.sqrt(1 + t1184**2)
+    t1186 = t1137*t1185
+    t1187 = t1162*t1185
+    t1188 = t1186 - t1184*t1187
+    t1189 = t1187 + t1184*t1186
+    t1190 = t1141*t1185
+    t1191 = t1166*t1185
+    t1192 = t1190 - t1184*t1191
+    t1193 = t1191 + t1184*t1190
+    t1194 = t1145*t1185
+    t1195 = t1170*t1185
+    t1196 = t1194 - t1184*t1195
+    t1197 = t1195 + t1184*t1194
+    t1198 = t1149*t1185
+    t1199 = t1174*t1185
+    t1200 = t1198 - t1184*t1199
+    t1201 = t1199 + t1184*t1198
+    t1202 = casadi.sqrt(t1188**2 + t1192**2 + t1196**2 + t1200**2)
+    t1203 = casadi.sqrt(t1189**2 + t1193**2 + t1197**2 + t1201**2)
+    t1204 = casadi.if_else((t1202 > t1177), t1202, t1177)
+    t1205 = casadi.if_else((t1202 < t1178), t1202, t1178)
+    t1206 = casadi.if_else((t1203 > t1204), t1203, t1204)
+    t1207 = casadi.if_else((t1203 < t1205), t1203, t1205)
+    t1208 = casadi.if_else((t1207 <= 1e-12*t1206), 0, t1207)
+    t1209 = casadi.if_else((t1206 > 0), t1206, 1)
     kappa = casadi.SX(1, 1)
-    kappa[0, 0] = t1205/t1204
+    kappa[0, 0] = t1209/t1208
     return [kappa]
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 599 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 574 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -3648,172 +3661,187 @@ def _velocity_ik(q, mu_dot, damping):
     t23 = t21 + t22
     t24 = casadi.sqrt(t23)
     t25 = casadi.if_else((t5 <= 0), 1, -1)*t24
-    t26 = casadi.if_else((t24 > 0), 1/(t24*(casadi.fabs(t5) + t24)), 0)
-    t27 = t6**2
-    t28 = t27 + t7**2 + t15**2
-    t29 = t10**2
-    t30 = t9**2
-    t31 = 0.01*s234**2
-    t32 = t11*t29 + t11*t30 + t11*t31
-    t33 = t22 + t32
-    t34 = t13*t29 + t13*t30 + t13*t31
-    t35 = casadi.sqrt(t20 + t23 + t28 + t32 + t34)
-    t36 = t21 + t34
-    t37 = c1*s1
-    t38 = -t2*t5 + t29*t37 + t30*t37 + t31*t37
-    t39 = c1*t10
-    t40 = c1*t9
-    t41 = c1*t8
-    t42 = t6*t39 + t7*t40 + t15*t41
-    t43 = t39*t17 + t40*t17 + t41*t17
-    t44 = s1*t10
-    t45 = s1*t9
-    t46 = s1*t8
-    t47 = t6*t44 + t7*t45 + t15*t46
-    t48 = t44*t17 + t45*t17 + t17*t46
-    t49 = t38**2
+    t26 = t6**2
+    t27 = t26 + t7**2 + t15**2
+    t28 = t10**2
+    t29 = t9**2
+    t30 = 0.01*s234**2
+    t31 = t11*t28 + t11*t30 + t11*t29
+    t32 = t22 + t31
+    t33 = t13*t28 + t13*t29 + t13*t30
+    t34 = casadi.sqrt(t20 + t23 + t27 + t31 + t33)
+    t35 = t21 + t33
+    t36 = c1*s1
+    t37 = -t2*t5 + t28*t36 + t29*t36 + t30*t36
+    t38 = c1*t10
+    t39 = c1*t9
+    t40 = c1*t8
+    t41 = t6*t38 + t7*t39 + t15*t40
+    t42 = t40*t17 + t38*t17 + t39*t17
+    t43 = s1*t10
+    t44 = s1*t9
+    t45 = s1*t8
+    t46 = t6*t43 + t7*t44 + t15*t45
+    t47 = t17*t45 + t44*t17 + t43*t17
+    t48 = t37**2
+    t49 = t41**2
     t50 = t42**2
-    t51 = t43**2
-    t52 = damping**2
-    t53 = t52 + t33
-    t54 = t53**2
-    t55 = casadi.sqrt(t49 + t50 + t51 + t54)
-    t56 = t55*casadi.if_else((t53 >= 0), 1, -1)
-    t57 = t53 + t56
-    t58 = casadi.if_else((t55 > 0), 1/(t55*(t55 + casadi.fabs(t53))), 0)
-    t59 = t58*(mu_dot0*t57 + mu_dot1*t38 - mu_dot2*t42 - mu_dot3*t43)
-    t60 = mu_dot0 - t57*t59
-    t61 = mu_dot1 - t38*t59
-    t62 = mu_dot2 + t42*t59
-    t63 = mu_dot3 + t43*t59
-    t64 = t52 + t36
-    t65 = t58*(t38*t57 + t42*t47 + t43*t48 + t64*t38)
-    t66 = t38 - t57*t65
-    t67 = t64 - t38*t65
-    t68 = -t47 + t42*t65
-    t69 = -t48 + t43*t65
-    t70 = casadi.sqrt(t67**2 + t68**2 + t69**2)
-    t71 = t70*casadi.if_else((t67 >= 0), 1, -1)
-    t72 = t67 + t71
-    t73 = casadi.if_else((t70 > 0), 1/(t70*(t70 + casadi.fabs(t67))), 0)
-    t74 = t73*(t61*t72 + t68*t62 + t69*t63)
-    t75 = t61 - t72*t74
-    t76 = t62 - t68*t74
-    t77 = t63 - t69*t74
-    t78 = t28 + t52
-    t79 = -t58*(t42*t57 + t38*t47 + t43*t18 + t78*t42)
-    t80 = t42 + t57*t79
-    t81 = t47 + t38*t79
-    t82 = t78 + t42*t79
-    t83 = t18 + t43*t79
-    t84 = t73*(-t81*t72 + t68*t82 + t69*t83)
-    t85 = t81 + t72*t84
-    t86 = t82 - t68*t84
-    t87 = t83 - t69*t84
-    t88 = casadi.sqrt(t86**2 + t87**2)
-    t89 = t88*casadi.if_else((t86 >= 0), 1, -1)
-    t90 = t86 + t89
-    t91 = casadi.if_else((t88 > 0), 1/(t88*(t88 + casadi.fabs(t86))), 0)
-    t92 = t91*(t76*t90 + t87*t77)
-    t93 = t76 - t90*t92
-    t94 = t77 - t87*t92
-    t95 = t20 + t52
-    t96 = casadi.sqrt(2*t49 + 2*t50 + 2*t47**2 + 2*t51 + 2*t48**2 + 2*t18**2 + t54 + t64**2 + t78**2 + t95**2)
-    t97 = -t58*(t43*t57 + t38*t48 + t42*t18 + t95*t43)
-    t98 = t43 + t57*t97
-    t99 = t48 + t38*t97
-    t100 = t18 + t42*t97
-    t101 = t95 + t43*t97
-    t102 = t73*(-t99*t72 + t68*t100 + t69*t101)
-    t103 = t99 + t72*t102
-    t104 = t100 - t68*t102
-    t105 = t101 - t69*t102
-    t106 = t91*(t104*t90 + t87*t105)
-    t107 = t104 - t90*t106
-    t108 = t105 - t87*t106
-    t109 = casadi.fabs(t108)
-    t110 = t109*casadi.if_else((t108 >= 0), 1, -1)
-    t111 = t108 + t110
-    t112 = casadi.if_else((t109 > 0), 1/(t109*2*t109), 0)
-    t113 = t94 - t94*t111**2*t112
-    t114 = casadi.if_else((t110 != 0), -t113/t110, 0)
-    t115 = casadi.if_else((t89 != 0), -(t93 - t107*t114)/t89, 0)
-    t116 = casadi.if_else((t71 != 0), -(t75 + t85*t115 + t103*t114)/t71, 0)
-    t117 = casadi.if_else((t56 != 0), -(t60 + t80*t115 + t98*t114 - t66*t116)/t56, 0)
-    t118 = -t5*t117 + t2*t116
-    t119 = t17*t114
-    t120 = t119 + t6*t115 - t39*t117 - t44*t116
-    t121 = t119 + t7*t115 - t40*t117 - t45*t116
-    t122 = t119 + t15*t115 - t41*t117 - t46*t116
-    t123 = -t5
-    t124 = t123 + t25
-    t125 = -t26*(t39*t124 + t2*t44)
-    t126 = t39 + t124*t125
-    t127 = t44 + t2*t125
-    t128 = -t26*(t40*t124 + t2*t45)
-    t129 = t40 + t124*t128
-    t130 = t45 + t2*t128
-    t131 = -t26*(t41*t124 + t2*t46)
-    t132 = t41 + t124*t131
-    t133 = t46 + t2*t131
-    t134 = t26*(mu_dot0*t124 + t2*mu_dot1)
-    t135 = mu_dot0 - t124*t134
-    t136 = mu_dot1 - t2*t134
-    t137 = casadi.sqrt(t19 + t27 + t127**2)
-    t138 = t137*casadi.if_else((t127 <= 0), 1, -1)
-    t139 = -t127 + t138
-    t140 = casadi.if_else((t137 > 0), 1/(t137*(t137 + casadi.fabs(t127))), 0)
-    t141 = t140*(t19 - t130*t139 + t6*t7)
-    t142 = t130 + t139*t141
-    t143 = t7 - t6*t141
-    t144 = t17 - t17*t141
-    t145 = t140*(t19 - t133*t139 + t6*t15)
-    t146 = t133 + t139*t145
-    t147 = t15 - t6*t145
-    t148 = t17 - t17*t145
-    t149 = t140*(t136*t139 + t6*mu_dot2 + t17*mu_dot3)
-    t150 = t136 - t139*t149
-    t151 = mu_dot2 - t6*t149
-    t152 = mu_dot3 - t17*t149
-    t153 = casadi.sqrt(t143**2 + t144**2)
-    t154 = t153*casadi.if_else((t143 >= 0), 1, -1)
-    t155 = t143 + t154
-    t156 = casadi.if_else((t153 > 0), 1/(t153*(t153 + casadi.fabs(t143))), 0)
-    t157 = t156*(t147*t155 + t144*t148)
-    t158 = t147 - t155*t157
-    t159 = t148 - t144*t157
-    t160 = t156*(t151*t155 + t144*t152)
-    t161 = t151 - t155*t160
-    t162 = t152 - t144*t160
-    t163 = -t39 - t40 - t41 - t44 - t45 - t46 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + 3*t17 + t123 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping
-    t164 = casadi.fabs(t159)
-    t165 = t164*casadi.if_else((t159 >= 0), 1, -1)
-    t166 = t159 + t165
-    t167 = casadi.if_else((t164 > 0), 1/(t164*2*t164), 0)
-    t168 = t162 - t162*t166**2*t167
-    t169 = casadi.if_else((t165 != 0), -t168/t165, 0)
-    t170 = casadi.if_else((t154 != 0), -(t161 - t158*t169)/t154, 0)
-    t171 = casadi.if_else((t138 != 0), -(t150 + t142*t170 + t146*t169)/t138, 0)
-    t172 = casadi.if_else((t25 != 0), -(t135 + t126*t171 + t129*t170 + t132*t169)/t25, 0)
-    t173 = (casadi.fabs(t163) < casadi.inf)
-    t174 = (damping >= 0)
-    t175 = (damping > 0)
-    t176 = 1e-12*t96
-    t177 = 1e-12*t35
-    t178 = casadi.logic_or(casadi.logic_and(t175, casadi.logic_or(casadi.logic_or(casadi.logic_or((t55 <= t176), (t70 <= t176)), (t88 <= t176)), (t109 <= t176))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t24 <= t177), (t137 <= t177)), (t153 <= t177)), (t164 <= t177))))
-    t179 = casadi.logic_and(casadi.logic_and(t173, t174), casadi.logic_not(t178))
+    t51 = damping**2
+    t52 = t51 + t32
+    t53 = t52**2
+    t54 = casadi.sqrt(t48 + t49 + t50 + t53)
+    t55 = t54*casadi.if_else((t52 >= 0), 1, -1)
+    t56 = t51 + t35
+    t57 = t27 + t51
+    t58 = t20 + t51
+    t59 = casadi.sqrt(2*t48 + 2*t49 + 2*t46**2 + 2*t50 + 2*t47**2 + 2*t18**2 + t53 + t56**2 + t57**2 + t58**2)
+    t60 = (t54 > 0)
+    t61 = casadi.if_else(t60, 1/(t52 + t55), 0)
+    t62 = casadi.if_else(t60, 1 + casadi.fabs(t52)/t54, 0)
+    t63 = t37*t61
+    t64 = t41*t61
+    t65 = t42*t61
+    t66 = t62*(t37 + t56*t63 + t64*t46 + t65*t47)
+    t67 = -t66 + t37
+    t68 = t56 - t63*t66
+    t69 = -t46 + t64*t66
+    t70 = -t47 + t65*t66
+    t71 = -t62*(t41 + t63*t46 + t57*t64 + t65*t18)
+    t72 = t41 + t71
+    t73 = t46 + t63*t71
+    t74 = t57 + t64*t71
+    t75 = t18 + t65*t71
+    t76 = -t62*(t42 + t63*t47 + t64*t18 + t58*t65)
+    t77 = t42 + t76
+    t78 = t47 + t63*t76
+    t79 = t18 + t64*t76
+    t80 = t58 + t65*t76
+    t81 = t62*(mu_dot0 + t63*mu_dot1 - t64*mu_dot2 - t65*mu_dot3)
+    t82 = -t81 + mu_dot0
+    t83 = mu_dot1 - t63*t81
+    t84 = mu_dot2 + t64*t81
+    t85 = mu_dot3 + t65*t81
+    t86 = casadi.sqrt(t68**2 + t69**2 + t70**2)
+    t87 = t86*casadi.if_else((t68 >= 0), 1, -1)
+    t88 = (t86 > 0)
+    t89 = casadi.if_else(t88, 1/(t68 + t87), 0)
+    t90 = casadi.if_else(t88, 1 + casadi.fabs(t68)/t86, 0)
+    t91 = t69*t89
+    t92 = t70*t89
+    t93 = t90*(-t73 + t91*t74 + t92*t75)
+    t94 = t73 + t93
+    t95 = t74 - t91*t93
+    t96 = t75 - t92*t93
+    t97 = t90*(-t78 + t91*t79 + t92*t80)
+    t98 = t78 + t97
+    t99 = t79 - t91*t97
+    t100 = t80 - t92*t97
+    t101 = t90*(t83 + t91*t84 + t92*t85)
+    t102 = -t101 + t83
+    t103 = t84 - t91*t101
+    t104 = t85 - t92*t101
+    t105 = casadi.sqrt(t95**2 + t96**2)
+    t106 = t105*casadi.if_else((t95 >= 0), 1, -1)
+    t107 = (t105 > 0)
+    t108 = casadi.if_else(t107, 1/(t95 + t106), 0)
+    t109 = casadi.if_else(t107, 1 + casadi.fabs(t95)/t105, 0)
+    t110 = t96*t108
+    t111 = t109*(t99 + t110*t100)
+    t112 = -t111 + t99
+    t113 = t100 - t110*t111
+    t114 = t109*(t103 + t110*t104)
+    t115 = -t114 + t103
+    t116 = t104 - t110*t114
+    t117 = casadi.fabs(t113)
+    t118 = t117*casadi.if_else((t113 >= 0), 1, -1)
+    t119 = casadi.if_else((t117 > 0), 2, 0)
+    t120 = t116 - t116*t119
+    t121 = casadi.if_else((t118 != 0), -t120/t118, 0)
+    t122 = casadi.if_else((t106 != 0), -(t115 - t112*t121)/t106, 0)
+    t123 = casadi.if_else((t87 != 0), -(t102 + t94*t122 + t98*t121)/t87, 0)
+    t124 = casadi.if_else((t55 != 0), -(t82 + t72*t122 + t77*t121 - t67*t123)/t55, 0)
+    t125 = -t5*t124 + t2*t123
+    t126 = t17*t121
+    t127 = t126 + t6*t122 - t38*t124 - t43*t123
+    t128 = t126 + t7*t122 - t39*t124 - t44*t123
+    t129 = t126 + t15*t122 - t40*t124 - t45*t123
+    t130 = (t24 > 0)
+    t131 = casadi.if_else(t130, 1 + casadi.fabs(t5)/t24, 0)
+    t132 = -t5
+    t133 = casadi.if_else(t130, 1/(t132 + t25), 0)
+    t134 = -t38 - t39 - t40 - t43 - t44 - t45 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + 3*t17 + t132 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping
+    t135 = t2*t133
+    t136 = -t131*(t38 + t43*t135)
+    t137 = t38 + t136
+    t138 = t43 + t135*t136
+    t139 = -t131*(t39 + t44*t135)
+    t140 = t39 + t139
+    t141 = t44 + t135*t139
+    t142 = -t131*(t40 + t45*t135)
+    t143 = t40 + t142
+    t144 = t45 + t135*t142
+    t145 = t131*(mu_dot0 + t135*mu_dot1)
+    t146 = -t145 + mu_dot0
+    t147 = mu_dot1 - t135*t145
+    t148 = casadi.sqrt(t19 + t26 + t138**2)
+    t149 = t148*casadi.if_else((t138 <= 0), 1, -1)
+    t150 = (t148 > 0)
+    t151 = casadi.if_else(t150, 1/(-t138 + t149), 0)
+    t152 = casadi.if_else(t150, 1 + casadi.fabs(t138)/t148, 0)
+    t153 = t6*t151
+    t154 = t19*t151
+    t155 = t152*(-t141 + t154 + t7*t153)
+    t156 = t141 + t155
+    t157 = t7 - t153*t155
+    t158 = t152*(-t144 + t154 + t15*t153)
+    t159 = t144 + t158
+    t160 = t15 - t153*t158
+    t161 = t17*t151
+    t162 = t17 - t161*t155
+    t163 = t17 - t161*t158
+    t164 = t152*(t147 + t153*mu_dot2 + t161*mu_dot3)
+    t165 = -t164 + t147
+    t166 = mu_dot2 - t153*t164
+    t167 = mu_dot3 - t161*t164
+    t168 = casadi.sqrt(t157**2 + t162**2)
+    t169 = t168*casadi.if_else((t157 >= 0), 1, -1)
+    t170 = (t168 > 0)
+    t171 = casadi.if_else(t170, 1/(t157 + t169), 0)
+    t172 = casadi.if_else(t170, 1 + casadi.fabs(t157)/t168, 0)
+    t173 = t162*t171
+    t174 = t172*(t160 + t173*t163)
+    t175 = -t174 + t160
+    t176 = t163 - t173*t174
+    t177 = t172*(t166 + t173*t167)
+    t178 = -t177 + t166
+    t179 = t167 - t173*t177
+    t180 = casadi.fabs(t176)
+    t181 = t180*casadi.if_else((t176 >= 0), 1, -1)
+    t182 = casadi.if_else((t180 > 0), 2, 0)
+    t183 = t179 - t179*t182
+    t184 = casadi.if_else((t181 != 0), -t183/t181, 0)
+    t185 = casadi.if_else((t169 != 0), -(t178 - t175*t184)/t169, 0)
+    t186 = casadi.if_else((t149 != 0), -(t165 + t156*t185 + t159*t184)/t149, 0)
+    t187 = casadi.if_else((t25 != 0), -(t146 + t137*t186 + t140*t185 + t143*t184)/t25, 0)
+    t188 = (casadi.fabs(t134) < casadi.inf)
+    t189 = (damping >= 0)
+    t190 = (damping > 0)
+    t191 = 1e-12*t59
+    t192 = 1e-12*t34
+    t193 = casadi.logic_or(casadi.logic_and(t190, casadi.logic_or(casadi.logic_or(casadi.logic_or((t54 <= t191), (t86 <= t191)), (t105 <= t191)), (t117 <= t191))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t24 <= t192), (t148 <= t192)), (t168 <= t192)), (t180 <= t192))))
+    t194 = casadi.logic_and(casadi.logic_and(t188, t189), casadi.logic_not(t193))
     q_dot = casadi.SX(4, 1)
-    q_dot[0, 0] = casadi.if_else(t179, casadi.if_else(t175, t118, t172), 0)
-    q_dot[1, 0] = casadi.if_else(t179, casadi.if_else(t175, t120, t171), 0)
-    q_dot[2, 0] = casadi.if_else(t179, casadi.if_else(t175, t121, t170), 0)
-    q_dot[3, 0] = casadi.if_else(t179, casadi.if_else(t175, t122, t169), 0)
+    q_dot[0, 0] = casadi.if_else(t194, casadi.if_else(t190, t125, t187), 0)
+    q_dot[1, 0] = casadi.if_else(t194, casadi.if_else(t190, t127, t186), 0)
+    q_dot[2, 0] = casadi.if_else(t194, casadi.if_else(t190, t128, t185), 0)
+    q_dot[3, 0] = casadi.if_else(t194, casadi.if_else(t190, t129, t184), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t173, t174)), 2, casadi.if_else(t178, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t188, t189)), 2, casadi.if_else(t193, 1, 0))
     return [q_dot, status]
 
 
 def _velocity_ik_nullspace(q, mu_dot, z, damping):
-    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 603 operations."""
+    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 578 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -3864,172 +3892,187 @@ def _velocity_ik_nullspace(q, mu_dot, z, damping):
     t23 = t21 + t22
     t24 = casadi.sqrt(t23)
     t25 = casadi.if_else((t5 <= 0), 1, -1)*t24
-    t26 = casadi.if_else((t24 > 0), 1/(t24*(casadi.fabs(t5) + t24)), 0)
-    t27 = t6**2
-    t28 = t27 + t7**2 + t15**2
-    t29 = t10**2
-    t30 = t9**2
-    t31 = 0.01*s234**2
-    t32 = t11*t29 + t11*t30 + t11*t31
-    t33 = t22 + t32
-    t34 = t13*t29 + t13*t30 + t13*t31
-    t35 = casadi.sqrt(t20 + t23 + t28 + t32 + t34)
-    t36 = t21 + t34
-    t37 = c1*s1
-    t38 = -t2*t5 + t29*t37 + t30*t37 + t31*t37
-    t39 = c1*t10
-    t40 = c1*t9
-    t41 = c1*t8
-    t42 = t6*t39 + t7*t40 + t15*t41
-    t43 = t39*t17 + t40*t17 + t41*t17
-    t44 = s1*t10
-    t45 = s1*t9
-    t46 = s1*t8
-    t47 = t6*t44 + t7*t45 + t15*t46
-    t48 = t44*t17 + t45*t17 + t17*t46
-    t49 = t38**2
+    t26 = t6**2
+    t27 = t26 + t7**2 + t15**2
+    t28 = t10**2
+    t29 = t9**2
+    t30 = 0.01*s234**2
+    t31 = t11*t28 + t11*t30 + t11*t29
+    t32 = t22 + t31
+    t33 = t13*t28 + t13*t29 + t13*t30
+    t34 = casadi.sqrt(t20 + t23 + t27 + t31 + t33)
+    t35 = t21 + t33
+    t36 = c1*s1
+    t37 = -t2*t5 + t28*t36 + t29*t36 + t30*t36
+    t38 = c1*t10
+    t39 = c1*t9
+    t40 = c1*t8
+    t41 = t6*t38 + t7*t39 + t15*t40
+    t42 = t40*t17 + t38*t17 + t39*t17
+    t43 = s1*t10
+    t44 = s1*t9
+    t45 = s1*t8
+    t46 = t6*t43 + t7*t44 + t15*t45
+    t47 = t17*t45 + t44*t17 + t43*t17
+    t48 = t37**2
+    t49 = t41**2
     t50 = t42**2
-    t51 = t43**2
-    t52 = damping**2
-    t53 = t52 + t33
-    t54 = t53**2
-    t55 = casadi.sqrt(t49 + t50 + t51 + t54)
-    t56 = t55*casadi.if_else((t53 >= 0), 1, -1)
-    t57 = t53 + t56
-    t58 = casadi.if_else((t55 > 0), 1/(t55*(t55 + casadi.fabs(t53))), 0)
-    t59 = t58*(mu_dot0*t57 + mu_dot1*t38 - mu_dot2*t42 - mu_dot3*t43)
-    t60 = mu_dot0 - t57*t59
-    t61 = mu_dot1 - t38*t59
-    t62 = mu_dot2 + t42*t59
-    t63 = mu_dot3 + t43*t59
-    t64 = t52 + t36
-    t65 = t58*(t38*t57 + t42*t47 + t43*t48 + t64*t38)
-    t66 = t38 - t57*t65
-    t67 = t64 - t38*t65
-    t68 = -t47 + t42*t65
-    t69 = -t48 + t43*t65
-    t70 = casadi.sqrt(t67**2 + t68**2 + t69**2)
-    t71 = t70*casadi.if_else((t67 >= 0), 1, -1)
-    t72 = t67 + t71
-    t73 = casadi.if_else((t70 > 0), 1/(t70*(t70 + casadi.fabs(t67))), 0)
-    t74 = t73*(t61*t72 + t68*t62 + t69*t63)
-    t75 = t61 - t72*t74
-    t76 = t62 - t68*t74
-    t77 = t63 - t69*t74
-    t78 = t28 + t52
-    t79 = -t58*(t42*t57 + t38*t47 + t43*t18 + t78*t42)
-    t80 = t42 + t57*t79
-    t81 = t47 + t38*t79
-    t82 = t78 + t42*t79
-    t83 = t18 + t43*t79
-    t84 = t73*(-t81*t72 + t68*t82 + t69*t83)
-    t85 = t81 + t72*t84
-    t86 = t82 - t68*t84
-    t87 = t83 - t69*t84
-    t88 = casadi.sqrt(t86**2 + t87**2)
-    t89 = t88*casadi.if_else((t86 >= 0), 1, -1)
-    t90 = t86 + t89
-    t91 = casadi.if_else((t88 > 0), 1/(t88*(t88 + casadi.fabs(t86))), 0)
-    t92 = t91*(t76*t90 + t87*t77)
-    t93 = t76 - t90*t92
-    t94 = t77 - t87*t92
-    t95 = t20 + t52
-    t96 = casadi.sqrt(2*t49 + 2*t50 + 2*t47**2 + 2*t51 + 2*t48**2 + 2*t18**2 + t54 + t64**2 + t78**2 + t95**2)
-    t97 = -t58*(t43*t57 + t38*t48 + t42*t18 + t95*t43)
-    t98 = t43 + t57*t97
-    t99 = t48 + t38*t97
-    t100 = t18 + t42*t97
-    t101 = t95 + t43*t97
-    t102 = t73*(-t99*t72 + t68*t100 + t69*t101)
-    t103 = t99 + t72*t102
-    t104 = t100 - t68*t102
-    t105 = t101 - t69*t102
-    t106 = t91*(t104*t90 + t87*t105)
-    t107 = t104 - t90*t106
-    t108 = t105 - t87*t106
-    t109 = casadi.fabs(t108)
-    t110 = t109*casadi.if_else((t108 >= 0), 1, -1)
-    t111 = t108 + t110
-    t112 = casadi.if_else((t109 > 0), 1/(t109*2*t109), 0)
-    t113 = t94 - t94*t111**2*t112
-    t114 = casadi.if_else((t110 != 0), -t113/t110, 0)
-    t115 = casadi.if_else((t89 != 0), -(t93 - t107*t114)/t89, 0)
-    t116 = casadi.if_else((t71 != 0), -(t75 + t85*t115 + t103*t114)/t71, 0)
-    t117 = casadi.if_else((t56 != 0), -(t60 + t80*t115 + t98*t114 - t66*t116)/t56, 0)
-    t118 = -t5*t117 + t2*t116
-    t119 = t17*t114
-    t120 = t119 + t6*t115 - t39*t117 - t44*t116
-    t121 = t119 + t7*t115 - t40*t117 - t45*t116
-    t122 = t119 + t15*t115 - t41*t117 - t46*t116
-    t123 = -t5
-    t124 = t123 + t25
-    t125 = -t26*(t39*t124 + t2*t44)
-    t126 = t39 + t124*t125
-    t127 = t44 + t2*t125
-    t128 = -t26*(t40*t124 + t2*t45)
-    t129 = t40 + t124*t128
-    t130 = t45 + t2*t128
-    t131 = -t26*(t41*t124 + t2*t46)
-    t132 = t41 + t124*t131
-    t133 = t46 + t2*t131
-    t134 = t26*(mu_dot0*t124 + t2*mu_dot1)
-    t135 = mu_dot0 - t124*t134
-    t136 = mu_dot1 - t2*t134
-    t137 = casadi.sqrt(t19 + t27 + t127**2)
-    t138 = t137*casadi.if_else((t127 <= 0), 1, -1)
-    t139 = -t127 + t138
-    t140 = casadi.if_else((t137 > 0), 1/(t137*(t137 + casadi.fabs(t127))), 0)
-    t141 = t140*(t19 - t130*t139 + t6*t7)
-    t142 = t130 + t139*t141
-    t143 = t7 - t6*t141
-    t144 = t17 - t17*t141
-    t145 = t140*(t19 - t133*t139 + t6*t15)
-    t146 = t133 + t139*t145
-    t147 = t15 - t6*t145
-    t148 = t17 - t17*t145
-    t149 = t140*(t136*t139 + t6*mu_dot2 + t17*mu_dot3)
-    t150 = t136 - t139*t149
-    t151 = mu_dot2 - t6*t149
-    t152 = mu_dot3 - t17*t149
-    t153 = casadi.sqrt(t143**2 + t144**2)
-    t154 = t153*casadi.if_else((t143 >= 0), 1, -1)
-    t155 = t143 + t154
-    t156 = casadi.if_else((t153 > 0), 1/(t153*(t153 + casadi.fabs(t143))), 0)
-    t157 = t156*(t147*t155 + t144*t148)
-    t158 = t147 - t155*t157
-    t159 = t148 - t144*t157
-    t160 = t156*(t151*t155 + t144*t152)
-    t161 = t151 - t155*t160
-    t162 = t152 - t144*t160
-    t163 = -t39 - t40 - t41 - t44 - t45 - t46 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + 3*t17 + t123 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + qz1 + qz2 + qz3 + qz4
-    t164 = casadi.fabs(t159)
-    t165 = t164*casadi.if_else((t159 >= 0), 1, -1)
-    t166 = t159 + t165
-    t167 = casadi.if_else((t164 > 0), 1/(t164*2*t164), 0)
-    t168 = t162 - t162*t166**2*t167
-    t169 = casadi.if_else((t165 != 0), -t168/t165, 0)
-    t170 = casadi.if_else((t154 != 0), -(t161 - t158*t169)/t154, 0)
-    t171 = casadi.if_else((t138 != 0), -(t150 + t142*t170 + t146*t169)/t138, 0)
-    t172 = casadi.if_else((t25 != 0), -(t135 + t126*t171 + t129*t170 + t132*t169)/t25, 0)
-    t173 = (casadi.fabs(t163) < casadi.inf)
-    t174 = (damping >= 0)
-    t175 = (damping > 0)
-    t176 = 1e-12*t96
-    t177 = 1e-12*t35
-    t178 = casadi.logic_or(casadi.logic_and(t175, casadi.logic_or(casadi.logic_or(casadi.logic_or((t55 <= t176), (t70 <= t176)), (t88 <= t176)), (t109 <= t176))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t24 <= t177), (t137 <= t177)), (t153 <= t177)), (t164 <= t177))))
-    t179 = casadi.logic_and(casadi.logic_and(t173, t174), casadi.logic_not(t178))
+    t51 = damping**2
+    t52 = t51 + t32
+    t53 = t52**2
+    t54 = casadi.sqrt(t48 + t49 + t50 + t53)
+    t55 = t54*casadi.if_else((t52 >= 0), 1, -1)
+    t56 = t51 + t35
+    t57 = t27 + t51
+    t58 = t20 + t51
+    t59 = casadi.sqrt(2*t48 + 2*t49 + 2*t46**2 + 2*t50 + 2*t47**2 + 2*t18**2 + t53 + t56**2 + t57**2 + t58**2)
+    t60 = (t54 > 0)
+    t61 = casadi.if_else(t60, 1/(t52 + t55), 0)
+    t62 = casadi.if_else(t60, 1 + casadi.fabs(t52)/t54, 0)
+    t63 = t37*t61
+    t64 = t41*t61
+    t65 = t42*t61
+    t66 = t62*(t37 + t56*t63 + t64*t46 + t65*t47)
+    t67 = -t66 + t37
+    t68 = t56 - t63*t66
+    t69 = -t46 + t64*t66
+    t70 = -t47 + t65*t66
+    t71 = -t62*(t41 + t63*t46 + t57*t64 + t65*t18)
+    t72 = t41 + t71
+    t73 = t46 + t63*t71
+    t74 = t57 + t64*t71
+    t75 = t18 + t65*t71
+    t76 = -t62*(t42 + t63*t47 + t64*t18 + t58*t65)
+    t77 = t42 + t76
+    t78 = t47 + t63*t76
+    t79 = t18 + t64*t76
+    t80 = t58 + t65*t76
+    t81 = t62*(mu_dot0 + t63*mu_dot1 - t64*mu_dot2 - t65*mu_dot3)
+    t82 = -t81 + mu_dot0
+    t83 = mu_dot1 - t63*t81
+    t84 = mu_dot2 + t64*t81
+    t85 = mu_dot3 + t65*t81
+    t86 = casadi.sqrt(t68**2 + t69**2 + t70**2)
+    t87 = t86*casadi.if_else((t68 >= 0), 1, -1)
+    t88 = (t86 > 0)
+    t89 = casadi.if_else(t88, 1/(t68 + t87), 0)
+    t90 = casadi.if_else(t88, 1 + casadi.fabs(t68)/t86, 0)
+    t91 = t69*t89
+    t92 = t70*t89
+    t93 = t90*(-t73 + t91*t74 + t92*t75)
+    t94 = t73 + t93
+    t95 = t74 - t91*t93
+    t96 = t75 - t92*t93
+    t97 = t90*(-t78 + t91*t79 + t92*t80)
+    t98 = t78 + t97
+    t99 = t79 - t91*t97
+    t100 = t80 - t92*t97
+    t101 = t90*(t83 + t91*t84 + t92*t85)
+    t102 = -t101 + t83
+    t103 = t84 - t91*t101
+    t104 = t85 - t92*t101
+    t105 = casadi.sqrt(t95**2 + t96**2)
+    t106 = t105*casadi.if_else((t95 >= 0), 1, -1)
+    t107 = (t105 > 0)
+    t108 = casadi.if_else(t107, 1/(t95 + t106), 0)
+    t109 = casadi.if_else(t107, 1 + casadi.fabs(t95)/t105, 0)
+    t110 = t96*t108
+    t111 = t109*(t99 + t110*t100)
+    t112 = -t111 + t99
+    t113 = t100 - t110*t111
+    t114 = t109*(t103 + t110*t104)
+    t115 = -t114 + t103
+    t116 = t104 - t110*t114
+    t117 = casadi.fabs(t113)
+    t118 = t117*casadi.if_else((t113 >= 0), 1, -1)
+    t119 = casadi.if_else((t117 > 0), 2, 0)
+    t120 = t116 - t116*t119
+    t121 = casadi.if_else((t118 != 0), -t120/t118, 0)
+    t122 = casadi.if_else((t106 != 0), -(t115 - t112*t121)/t106, 0)
+    t123 = casadi.if_else((t87 != 0), -(t102 + t94*t122 + t98*t121)/t87, 0)
+    t124 = casadi.if_else((t55 != 0), -(t82 + t72*t122 + t77*t121 - t67*t123)/t55, 0)
+    t125 = -t5*t124 + t2*t123
+    t126 = t17*t121
+    t127 = t126 + t6*t122 - t38*t124 - t43*t123
+    t128 = t126 + t7*t122 - t39*t124 - t44*t123
+    t129 = t126 + t15*t122 - t40*t124 - t45*t123
+    t130 = (t24 > 0)
+    t131 = casadi.if_else(t130, 1 + casadi.fabs(t5)/t24, 0)
+    t132 = -t5
+    t133 = casadi.if_else(t130, 1/(t132 + t25), 0)
+    t134 = -t38 - t39 - t40 - t43 - t44 - t45 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + 3*t17 + t132 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + qz1 + qz2 + qz3 + qz4
+    t135 = t2*t133
+    t136 = -t131*(t38 + t43*t135)
+    t137 = t38 + t136
+    t138 = t43 + t135*t136
+    t139 = -t131*(t39 + t44*t135)
+    t140 = t39 + t139
+    t141 = t44 + t135*t139
+    t142 = -t131*(t40 + t45*t135)
+    t143 = t40 + t142
+    t144 = t45 + t135*t142
+    t145 = t131*(mu_dot0 + t135*mu_dot1)
+    t146 = -t145 + mu_dot0
+    t147 = mu_dot1 - t135*t145
+    t148 = casadi.sqrt(t19 + t26 + t138**2)
+    t149 = t148*casadi.if_else((t138 <= 0), 1, -1)
+    t150 = (t148 > 0)
+    t151 = casadi.if_else(t150, 1/(-t138 + t149), 0)
+    t152 = casadi.if_else(t150, 1 + casadi.fabs(t138)/t148, 0)
+    t153 = t6*t151
+    t154 = t19*t151
+    t155 = t152*(-t141 + t154 + t7*t153)
+    t156 = t141 + t155
+    t157 = t7 - t153*t155
+    t158 = t152*(-t144 + t154 + t15*t153)
+    t159 = t144 + t158
+    t160 = t15 - t153*t158
+    t161 = t17*t151
+    t162 = t17 - t161*t155
+    t163 = t17 - t161*t158
+    t164 = t152*(t147 + t153*mu_dot2 + t161*mu_dot3)
+    t165 = -t164 + t147
+    t166 = mu_dot2 - t153*t164
+    t167 = mu_dot3 - t161*t164
+    t168 = casadi.sqrt(t157**2 + t162**2)
+    t169 = t168*casadi.if_else((t157 >= 0), 1, -1)
+    t170 = (t168 > 0)
+    t171 = casadi.if_else(t170, 1/(t157 + t169), 0)
+    t172 = casadi.if_else(t170, 1 + casadi.fabs(t157)/t168, 0)
+    t173 = t162*t171
+    t174 = t172*(t160 + t173*t163)
+    t175 = -t174 + t160
+    t176 = t163 - t173*t174
+    t177 = t172*(t166 + t173*t167)
+    t178 = -t177 + t166
+    t179 = t167 - t173*t177
+    t180 = casadi.fabs(t176)
+    t181 = t180*casadi.if_else((t176 >= 0), 1, -1)
+    t182 = casadi.if_else((t180 > 0), 2, 0)
+    t183 = t179 - t179*t182
+    t184 = casadi.if_else((t181 != 0), -t183/t181, 0)
+    t185 = casadi.if_else((t169 != 0), -(t178 - t175*t184)/t169, 0)
+    t186 = casadi.if_else((t149 != 0), -(t165 + t156*t185 + t159*t184)/t149, 0)
+    t187 = casadi.if_else((t25 != 0), -(t146 + t137*t186 + t140*t185 + t143*t184)/t25, 0)
+    t188 = (casadi.fabs(t134) < casadi.inf)
+    t189 = (damping >= 0)
+    t190 = (damping > 0)
+    t191 = 1e-12*t59
+    t192 = 1e-12*t34
+    t193 = casadi.logic_or(casadi.logic_and(t190, casadi.logic_or(casadi.logic_or(casadi.logic_or((t54 <= t191), (t86 <= t191)), (t105 <= t191)), (t117 <= t191))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t24 <= t192), (t148 <= t192)), (t168 <= t192)), (t180 <= t192))))
+    t194 = casadi.logic_and(casadi.logic_and(t188, t189), casadi.logic_not(t193))
     q_dot = casadi.SX(4, 1)
-    q_dot[0, 0] = casadi.if_else(t179, casadi.if_else(t175, t118, t172), 0)
-    q_dot[1, 0] = casadi.if_else(t179, casadi.if_else(t175, t120, t171), 0)
-    q_dot[2, 0] = casadi.if_else(t179, casadi.if_else(t175, t121, t170), 0)
-    q_dot[3, 0] = casadi.if_else(t179, casadi.if_else(t175, t122, t169), 0)
+    q_dot[0, 0] = casadi.if_else(t194, casadi.if_else(t190, t125, t187), 0)
+    q_dot[1, 0] = casadi.if_else(t194, casadi.if_else(t190, t127, t186), 0)
+    q_dot[2, 0] = casadi.if_else(t194, casadi.if_else(t190, t128, t185), 0)
+    q_dot[3, 0] = casadi.if_else(t194, casadi.if_else(t190, t129, t184), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t173, t174)), 2, casadi.if_else(t178, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t188, t189)), 2, casadi.if_else(t193, 1, 0))
     return [q_dot, status]
 
 
 def _resolved_rate(q, target, target_rate, gain, z, damping):
-    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 624 operations."""
+    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 599 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -4092,175 +4135,190 @@ def _resolved_rate(q, target, target_rate, gain, z, damping):
     t27 = t25 + t26
     t28 = casadi.sqrt(t27)
     t29 = casadi.if_else((t6 <= 0), 1, -1)*t28
-    t30 = casadi.if_else((t28 > 0), 1/(t28*(casadi.fabs(t6) + t28)), 0)
-    t31 = t7**2
-    t32 = t31 + t8**2 + t18**2
-    t33 = t11**2
-    t34 = t10**2
-    t35 = 0.01*s234**2
-    t36 = t14*t35 + t14*t33 + t14*t34
-    t37 = t26 + t36
-    t38 = t16*t33 + t16*t34 + t16*t35
-    t39 = casadi.sqrt(t24 + t27 + t32 + t36 + t38)
-    t40 = t25 + t38
-    t41 = c1*s1
-    t42 = t35*t41 - t2*t6 + t33*t41 + t34*t41
-    t43 = c1*t11
-    t44 = c1*t10
-    t45 = c1*t9
-    t46 = t7*t43 + t8*t44 + t18*t45
-    t47 = t43*t21 + t45*t21 + t44*t21
-    t48 = s1*t11
-    t49 = s1*t10
-    t50 = s1*t9
-    t51 = t7*t48 + t8*t49 + t18*t50
-    t52 = t48*t21 + t21*t49 + t21*t50
-    t53 = t42**2
+    t30 = t7**2
+    t31 = t30 + t8**2 + t18**2
+    t32 = t11**2
+    t33 = t10**2
+    t34 = 0.01*s234**2
+    t35 = t14*t33 + t14*t32 + t14*t34
+    t36 = t26 + t35
+    t37 = t16*t32 + t16*t33 + t16*t34
+    t38 = casadi.sqrt(t24 + t27 + t31 + t35 + t37)
+    t39 = t25 + t37
+    t40 = c1*s1
+    t41 = t34*t40 - t2*t6 + t32*t40 + t33*t40
+    t42 = c1*t11
+    t43 = c1*t10
+    t44 = c1*t9
+    t45 = t7*t42 + t8*t43 + t18*t44
+    t46 = t43*t21 + t44*t21 + t42*t21
+    t47 = s1*t11
+    t48 = s1*t10
+    t49 = s1*t9
+    t50 = t7*t47 + t8*t48 + t18*t49
+    t51 = t21*t48 + t21*t49 + t47*t21
+    t52 = t41**2
+    t53 = t45**2
     t54 = t46**2
-    t55 = t47**2
-    t56 = damping**2
-    t57 = t56 + t37
-    t58 = t57**2
-    t59 = casadi.sqrt(t53 + t54 + t55 + t58)
-    t60 = t59*casadi.if_else((t57 >= 0), 1, -1)
-    t61 = t57 + t60
-    t62 = casadi.if_else((t59 > 0), 1/(t59*(t59 + casadi.fabs(t57))), 0)
-    t63 = t56 + t40
-    t64 = t62*(t42*t61 + t46*t51 + t47*t52 + t63*t42)
-    t65 = t42 - t61*t64
-    t66 = t63 - t42*t64
-    t67 = -t51 + t46*t64
-    t68 = -t52 + t47*t64
-    t69 = casadi.sqrt(t66**2 + t67**2 + t68**2)
-    t70 = t69*casadi.if_else((t66 >= 0), 1, -1)
-    t71 = t66 + t70
-    t72 = casadi.if_else((t69 > 0), 1/(t69*(t69 + casadi.fabs(t66))), 0)
-    t73 = t32 + t56
-    t74 = -t62*(t46*t61 + t42*t51 + t47*t22 + t73*t46)
-    t75 = t46 + t61*t74
-    t76 = t51 + t42*t74
-    t77 = t73 + t46*t74
-    t78 = t22 + t47*t74
-    t79 = t72*(-t76*t71 + t67*t77 + t68*t78)
-    t80 = t76 + t71*t79
-    t81 = t77 - t67*t79
-    t82 = t78 - t68*t79
-    t83 = casadi.sqrt(t81**2 + t82**2)
-    t84 = t83*casadi.if_else((t81 >= 0), 1, -1)
-    t85 = t81 + t84
-    t86 = casadi.if_else((t83 > 0), 1/(t83*(t83 + casadi.fabs(t81))), 0)
-    t87 = t24 + t56
-    t88 = casadi.sqrt(2*t53 + 2*t54 + 2*t51**2 + 2*t55 + 2*t52**2 + 2*t22**2 + t58 + t63**2 + t73**2 + t87**2)
-    t89 = -t62*(t47*t61 + t42*t52 + t46*t22 + t87*t47)
-    t90 = t47 + t61*t89
-    t91 = t52 + t42*t89
-    t92 = t22 + t46*t89
-    t93 = t87 + t47*t89
-    t94 = t72*(-t91*t71 + t67*t92 + t68*t93)
-    t95 = t91 + t71*t94
-    t96 = t92 - t67*t94
-    t97 = t93 - t68*t94
-    t98 = t86*(t96*t85 + t82*t97)
-    t99 = t96 - t85*t98
-    t100 = t97 - t82*t98
-    t101 = casadi.fabs(t100)
-    t102 = t101*casadi.if_else((t100 >= 0), 1, -1)
-    t103 = t100 + t102
-    t104 = casadi.if_else((t101 > 0), 1/(t101*2*t101), 0)
-    t105 = -t6
-    t106 = t105 + t29
-    t107 = -t30*(t43*t106 + t2*t48)
-    t108 = t43 + t106*t107
-    t109 = t48 + t2*t107
-    t110 = -t30*(t44*t106 + t2*t49)
-    t111 = t44 + t106*t110
-    t112 = t49 + t2*t110
-    t113 = -t30*(t45*t106 + t2*t50)
-    t114 = t45 + t106*t113
-    t115 = t50 + t2*t113
-    t116 = casadi.sqrt(t23 + t31 + t109**2)
-    t117 = t116*casadi.if_else((t109 <= 0), 1, -1)
-    t118 = -t109 + t117
-    t119 = casadi.if_else((t116 > 0), 1/(t116*(t116 + casadi.fabs(t109))), 0)
-    t120 = t119*(t23 - t112*t118 + t7*t8)
-    t121 = t112 + t118*t120
-    t122 = t8 - t7*t120
-    t123 = t21 - t21*t120
-    t124 = t119*(t23 - t115*t118 + t7*t18)
-    t125 = t115 + t118*t124
-    t126 = t18 - t7*t124
-    t127 = t21 - t21*t124
-    t128 = casadi.sqrt(t122**2 + t123**2)
-    t129 = t128*casadi.if_else((t122 >= 0), 1, -1)
-    t130 = t122 + t129
-    t131 = casadi.if_else((t128 > 0), 1/(t128*(t128 + casadi.fabs(t122))), 0)
-    t132 = t131*(t126*t130 + t123*t127)
-    t133 = t126 - t130*t132
-    t134 = t127 - t123*t132
-    t135 = mu_dot1 + gain1*(t105 + mu1)
-    t136 = t30*(t106*t3 + t2*t135)
-    t137 = t3 - t106*t136
-    t138 = t135 - t2*t136
-    t139 = casadi.fabs(t134)
-    t140 = t139*casadi.if_else((t134 >= 0), 1, -1)
-    t141 = t134 + t140
-    t142 = casadi.if_else((t139 > 0), 1/(t139*2*t139), 0)
-    t143 = -mu3 + casadi.atan2(-s234, t20)
-    t144 = mu_dot3 - gain3*(t143 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t143)))
-    t145 = t62*(t61*t3 + t42*t135 - t46*t13 - t47*t144)
-    t146 = t3 - t61*t145
-    t147 = t135 - t42*t145
-    t148 = t13 + t46*t145
-    t149 = t144 + t47*t145
-    t150 = t72*(t71*t147 + t67*t148 + t68*t149)
-    t151 = t147 - t71*t150
-    t152 = t148 - t67*t150
-    t153 = t149 - t68*t150
-    t154 = t86*(t85*t152 + t82*t153)
-    t155 = t152 - t85*t154
-    t156 = t153 - t82*t154
-    t157 = t156 - t103**2*t104*t156
-    t158 = casadi.if_else((t102 != 0), -t157/t102, 0)
-    t159 = casadi.if_else((t84 != 0), -(t155 - t99*t158)/t84, 0)
-    t160 = casadi.if_else((t70 != 0), -(t151 + t80*t159 + t95*t158)/t70, 0)
-    t161 = casadi.if_else((t60 != 0), -(t146 + t75*t159 + t90*t158 - t65*t160)/t60, 0)
-    t162 = -t6*t161 + t2*t160
-    t163 = t119*(t118*t138 + t7*t13 + t21*t144)
-    t164 = t138 - t118*t163
-    t165 = t13 - t7*t163
-    t166 = t144 - t21*t163
-    t167 = t131*(t130*t165 + t123*t166)
-    t168 = t165 - t130*t167
-    t169 = t166 - t123*t167
-    t170 = t169 - t141**2*t142*t169
-    t171 = casadi.if_else((t140 != 0), -t170/t140, 0)
-    t172 = casadi.if_else((t129 != 0), -(t168 - t133*t171)/t129, 0)
-    t173 = casadi.if_else((t117 != 0), -(t164 + t121*t172 + t125*t171)/t117, 0)
-    t174 = casadi.if_else((t29 != 0), -(t137 + t108*t173 + t111*t172 + t114*t171)/t29, 0)
-    t175 = -t43 - t44 - t45 - t48 - t49 - t50 + q1 + q2 + q3 + q4 + t2 + t7 + t8 + t18 + 3*t21 + t105 + damping + qz1 + qz2 + qz3 + qz4 + t3 + t135 + t13 + t144
-    t176 = t21*t158
-    t177 = t176 + t7*t159 - t43*t161 - t48*t160
-    t178 = t176 + t8*t159 - t44*t161 - t49*t160
-    t179 = t176 + t18*t159 - t45*t161 - t50*t160
-    t180 = (casadi.fabs(t175) < casadi.inf)
-    t181 = (damping >= 0)
-    t182 = (damping > 0)
-    t183 = 1e-12*t88
-    t184 = 1e-12*t39
-    t185 = casadi.logic_or(casadi.logic_and(t182, casadi.logic_or(casadi.logic_or(casadi.logic_or((t59 <= t183), (t69 <= t183)), (t83 <= t183)), (t101 <= t183))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t28 <= t184), (t116 <= t184)), (t128 <= t184)), (t139 <= t184))))
-    t186 = casadi.logic_and(casadi.logic_and(t180, t181), casadi.logic_not(t185))
+    t55 = damping**2
+    t56 = t55 + t36
+    t57 = t56**2
+    t58 = casadi.sqrt(t52 + t53 + t54 + t57)
+    t59 = t58*casadi.if_else((t56 >= 0), 1, -1)
+    t60 = t55 + t39
+    t61 = t31 + t55
+    t62 = t24 + t55
+    t63 = casadi.sqrt(2*t52 + 2*t53 + 2*t50**2 + 2*t54 + 2*t51**2 + 2*t22**2 + t57 + t60**2 + t61**2 + t62**2)
+    t64 = (t58 > 0)
+    t65 = casadi.if_else(t64, 1/(t56 + t59), 0)
+    t66 = casadi.if_else(t64, 1 + casadi.fabs(t56)/t58, 0)
+    t67 = t41*t65
+    t68 = t45*t65
+    t69 = t46*t65
+    t70 = t66*(t41 + t60*t67 + t68*t50 + t69*t51)
+    t71 = -t70 + t41
+    t72 = t60 - t67*t70
+    t73 = -t50 + t68*t70
+    t74 = -t51 + t69*t70
+    t75 = -t66*(t45 + t67*t50 + t61*t68 + t69*t22)
+    t76 = t45 + t75
+    t77 = t50 + t67*t75
+    t78 = t61 + t68*t75
+    t79 = t22 + t69*t75
+    t80 = -t66*(t46 + t68*t22 + t67*t51 + t62*t69)
+    t81 = t46 + t80
+    t82 = t51 + t67*t80
+    t83 = t22 + t68*t80
+    t84 = t62 + t69*t80
+    t85 = casadi.sqrt(t72**2 + t73**2 + t74**2)
+    t86 = t85*casadi.if_else((t72 >= 0), 1, -1)
+    t87 = (t85 > 0)
+    t88 = casadi.if_else(t87, 1/(t72 + t86), 0)
+    t89 = casadi.if_else(t87, 1 + casadi.fabs(t72)/t85, 0)
+    t90 = t73*t88
+    t91 = t74*t88
+    t92 = t89*(-t77 + t90*t78 + t91*t79)
+    t93 = t77 + t92
+    t94 = t78 - t90*t92
+    t95 = t79 - t91*t92
+    t96 = t89*(-t82 + t90*t83 + t91*t84)
+    t97 = t82 + t96
+    t98 = t83 - t90*t96
+    t99 = t84 - t91*t96
+    t100 = casadi.sqrt(t94**2 + t95**2)
+    t101 = t100*casadi.if_else((t94 >= 0), 1, -1)
+    t102 = (t100 > 0)
+    t103 = casadi.if_else(t102, 1/(t94 + t101), 0)
+    t104 = casadi.if_else(t102, 1 + casadi.fabs(t94)/t100, 0)
+    t105 = t95*t103
+    t106 = t104*(t98 + t105*t99)
+    t107 = -t106 + t98
+    t108 = t99 - t105*t106
+    t109 = casadi.fabs(t108)
+    t110 = t109*casadi.if_else((t108 >= 0), 1, -1)
+    t111 = casadi.if_else((t109 > 0), 2, 0)
+    t112 = (t28 > 0)
+    t113 = casadi.if_else(t112, 1 + casadi.fabs(t6)/t28, 0)
+    t114 = -t6
+    t115 = casadi.if_else(t112, 1/(t114 + t29), 0)
+    t116 = mu_dot1 + gain1*(t114 + mu1)
+    t117 = t2*t115
+    t118 = -t113*(t42 + t47*t117)
+    t119 = t42 + t118
+    t120 = t47 + t117*t118
+    t121 = -t113*(t43 + t48*t117)
+    t122 = t43 + t121
+    t123 = t48 + t117*t121
+    t124 = -t113*(t44 + t49*t117)
+    t125 = t44 + t124
+    t126 = t49 + t117*t124
+    t127 = casadi.sqrt(t23 + t30 + t120**2)
+    t128 = t127*casadi.if_else((t120 <= 0), 1, -1)
+    t129 = t113*(t3 + t117*t116)
+    t130 = -t129 + t3
+    t131 = t116 - t117*t129
+    t132 = (t127 > 0)
+    t133 = casadi.if_else(t132, 1/(-t120 + t128), 0)
+    t134 = casadi.if_else(t132, 1 + casadi.fabs(t120)/t127, 0)
+    t135 = t7*t133
+    t136 = t23*t133
+    t137 = t134*(-t123 + t136 + t8*t135)
+    t138 = t123 + t137
+    t139 = t8 - t135*t137
+    t140 = t134*(-t126 + t136 + t18*t135)
+    t141 = t126 + t140
+    t142 = t18 - t135*t140
+    t143 = t21*t133
+    t144 = t21 - t143*t137
+    t145 = t21 - t143*t140
+    t146 = casadi.sqrt(t139**2 + t144**2)
+    t147 = t146*casadi.if_else((t139 >= 0), 1, -1)
+    t148 = (t146 > 0)
+    t149 = casadi.if_else(t148, 1/(t139 + t147), 0)
+    t150 = casadi.if_else(t148, 1 + casadi.fabs(t139)/t146, 0)
+    t151 = t144*t149
+    t152 = t150*(t142 + t151*t145)
+    t153 = -t152 + t142
+    t154 = t145 - t151*t152
+    t155 = casadi.fabs(t154)
+    t156 = t155*casadi.if_else((t154 >= 0), 1, -1)
+    t157 = casadi.if_else((t155 > 0), 2, 0)
+    t158 = -mu3 + casadi.atan2(-s234, t20)
+    t159 = mu_dot3 - gain3*(t158 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t158)))
+    t160 = t66*(t3 + t67*t116 - t68*t13 - t69*t159)
+    t161 = -t160 + t3
+    t162 = t116 - t67*t160
+    t163 = t13 + t68*t160
+    t164 = t159 + t69*t160
+    t165 = t89*(t162 + t90*t163 + t91*t164)
+    t166 = -t165 + t162
+    t167 = t163 - t90*t165
+    t168 = t164 - t91*t165
+    t169 = t104*(t167 + t105*t168)
+    t170 = -t169 + t167
+    t171 = t168 - t105*t169
+    t172 = t171 - t111*t171
+    t173 = casadi.if_else((t110 != 0), -t172/t110, 0)
+    t174 = casadi.if_else((t101 != 0), -(t170 - t107*t173)/t101, 0)
+    t175 = casadi.if_else((t86 != 0), -(t166 + t93*t174 + t97*t173)/t86, 0)
+    t176 = casadi.if_else((t59 != 0), -(t161 + t76*t174 + t81*t173 - t71*t175)/t59, 0)
+    t177 = -t6*t176 + t2*t175
+    t178 = t134*(t131 + t135*t13 + t143*t159)
+    t179 = -t178 + t131
+    t180 = t13 - t135*t178
+    t181 = t159 - t143*t178
+    t182 = t150*(t180 + t151*t181)
+    t183 = -t182 + t180
+    t184 = t181 - t151*t182
+    t185 = t184 - t157*t184
+    t186 = casadi.if_else((t156 != 0), -t185/t156, 0)
+    t187 = casadi.if_else((t147 != 0), -(t183 - t153*t186)/t147, 0)
+    t188 = casadi.if_else((t128 != 0), -(t179 + t138*t187 + t141*t186)/t128, 0)
+    t189 = casadi.if_else((t29 != 0), -(t130 + t119*t188 + t122*t187 + t125*t186)/t29, 0)
+    t190 = -t42 - t43 - t44 - t47 - t48 - t49 + q1 + q2 + q3 + q4 + t2 + t7 + t8 + t18 + 3*t21 + t114 + damping + qz1 + qz2 + qz3 + qz4 + t3 + t116 + t13 + t159
+    t191 = t21*t173
+    t192 = t191 + t7*t174 - t42*t176 - t47*t175
+    t193 = t191 + t8*t174 - t43*t176 - t48*t175
+    t194 = t191 + t18*t174 - t44*t176 - t49*t175
+    t195 = (casadi.fabs(t190) < casadi.inf)
+    t196 = (damping >= 0)
+    t197 = (damping > 0)
+    t198 = 1e-12*t63
+    t199 = 1e-12*t38
+    t200 = casadi.logic_or(casadi.logic_and(t197, casadi.logic_or(casadi.logic_or(casadi.logic_or((t58 <= t198), (t85 <= t198)), (t100 <= t198)), (t109 <= t198))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t28 <= t199), (t127 <= t199)), (t146 <= t199)), (t155 <= t199))))
+    t201 = casadi.logic_and(casadi.logic_and(t195, t196), casadi.logic_not(t200))
     q_dot = casadi.SX(4, 1)
-    q_dot[0, 0] = casadi.if_else(t186, casadi.if_else(t182, t162, t174), 0)
-    q_dot[1, 0] = casadi.if_else(t186, casadi.if_else(t182, t177, t173), 0)
-    q_dot[2, 0] = casadi.if_else(t186, casadi.if_else(t182, t178, t172), 0)
-    q_dot[3, 0] = casadi.if_else(t186, casadi.if_else(t182, t179, t171), 0)
+    q_dot[0, 0] = casadi.if_else(t201, casadi.if_else(t197, t177, t189), 0)
+    q_dot[1, 0] = casadi.if_else(t201, casadi.if_else(t197, t192, t188), 0)
+    q_dot[2, 0] = casadi.if_else(t201, casadi.if_else(t197, t193, t187), 0)
+    q_dot[3, 0] = casadi.if_else(t201, casadi.if_else(t197, t194, t186), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t180, t181)), 2, casadi.if_else(t185, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t195, t196)), 2, casadi.if_else(t200, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 395 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 383 operations."""
     mu0 = target[0]
     mu1 = target[1]
     mu2 = target[2]
@@ -4335,81 +4393,89 @@ def _ik_numeric_step(target, q, damping):
     t47 = damping + t30
     t48 = casadi.sqrt(t47**2 + t33**2 + t37**2 + t38**2)
     t49 = t48*casadi.if_else((t47 >= 0), 1, -1)
-    t50 = t47 + t49
-    t51 = casadi.if_else((t48 > 0), 1/(t48*(t48 + casadi.fabs(t47))), 0)
-    t52 = t51*(t4*t50 + t33*t10 - t37*t15 + t38*t45)
-    t53 = t4 - t50*t52
-    t54 = t10 - t33*t52
-    t55 = t15 + t37*t52
-    t56 = -t45 + t38*t52
-    t57 = damping + t31
-    t58 = t51*(t37*t42 + t38*t43 + t33*t50 + t57*t33)
-    t59 = t33 - t50*t58
-    t60 = t57 - t33*t58
-    t61 = -t42 + t37*t58
-    t62 = -t43 + t38*t58
-    t63 = casadi.sqrt(t60**2 + t61**2 + t62**2)
-    t64 = t63*casadi.if_else((t60 >= 0), 1, -1)
-    t65 = t60 + t64
-    t66 = casadi.if_else((t63 > 0), 1/(t63*(t63 + casadi.fabs(t60))), 0)
-    t67 = t66*(t54*t65 + t61*t55 + t62*t56)
-    t68 = t54 - t65*t67
-    t69 = t55 - t61*t67
-    t70 = t56 - t62*t67
-    t71 = damping + t21
-    t72 = -t51*(t33*t42 + t38*t25 + t37*t50 + t71*t37)
-    t73 = t37 + t50*t72
-    t74 = t42 + t33*t72
-    t75 = t71 + t37*t72
-    t76 = t25 + t38*t72
-    t77 = t66*(-t74*t65 + t61*t75 + t62*t76)
-    t78 = t74 + t65*t77
-    t79 = t75 - t61*t77
-    t80 = t76 - t62*t77
-    t81 = casadi.sqrt(t79**2 + t80**2)
-    t82 = t81*casadi.if_else((t79 >= 0), 1, -1)
-    t83 = t79 + t82
-    t84 = casadi.if_else((t81 > 0), 1/(t81*(t81 + casadi.fabs(t79))), 0)
-    t85 = t84*(t69*t83 + t80*t70)
-    t86 = t69 - t83*t85
-    t87 = t70 - t80*t85
-    t88 = damping + t26
-    t89 = -t51*(t33*t43 + t37*t25 + t38*t50 + t88*t38)
-    t90 = t38 + t50*t89
-    t91 = t43 + t33*t89
-    t92 = t25 + t37*t89
-    t93 = t88 + t38*t89
-    t94 = t66*(-t91*t65 + t61*t92 + t62*t93)
-    t95 = t91 + t65*t94
-    t96 = t92 - t61*t94
-    t97 = t93 - t62*t94
-    t98 = t84*(t96*t83 + t80*t97)
-    t99 = t96 - t83*t98
-    t100 = t97 - t80*t98
-    t101 = casadi.fabs(t100)
-    t102 = t101*casadi.if_else((t100 >= 0), 1, -1)
-    t103 = t100 + t102
-    t104 = casadi.if_else((t101 > 0), 1/(t101*2*t101), 0)
-    t105 = t87 - t87*t103**2*t104
-    t106 = casadi.if_else((t102 != 0), -t105/t102, 0)
-    t107 = casadi.if_else((t82 != 0), -(t86 - t99*t106)/t82, 0)
-    t108 = casadi.if_else((t64 != 0), -(t68 + t78*t107 + t95*t106)/t64, 0)
-    t109 = casadi.if_else((t49 != 0), -(t53 + t73*t107 + t90*t106 - t59*t108)/t49, 0)
-    t110 = q1 - t7*t109 + t3*t108
-    t111 = t24*t106
-    t112 = q2 + t111 + t8*t107 - t34*t109 - t39*t108
-    t113 = q3 + t111 + t9*t107 - t35*t109 - t40*t108
-    t114 = q4 + t111 + t20*t107 - t36*t109 - t41*t108
+    t50 = (t48 > 0)
+    t51 = casadi.if_else(t50, 1/(t47 + t49), 0)
+    t52 = casadi.if_else(t50, 1 + casadi.fabs(t47)/t48, 0)
+    t53 = damping + t31
+    t54 = t33*t51
+    t55 = t37*t51
+    t56 = t38*t51
+    t57 = t52*(t33 + t53*t54 + t55*t42 + t56*t43)
+    t58 = -t57 + t33
+    t59 = t53 - t54*t57
+    t60 = -t42 + t55*t57
+    t61 = -t43 + t56*t57
+    t62 = t52*(t4 + t54*t10 - t55*t15 + t56*t45)
+    t63 = -t62 + t4
+    t64 = t10 - t54*t62
+    t65 = t15 + t55*t62
+    t66 = -t45 + t56*t62
+    t67 = casadi.sqrt(t59**2 + t60**2 + t61**2)
+    t68 = t67*casadi.if_else((t59 >= 0), 1, -1)
+    t69 = damping + t21
+    t70 = -t52*(t37 + t54*t42 + t55*t69 + t56*t25)
+    t71 = t37 + t70
+    t72 = t42 + t54*t70
+    t73 = t69 + t55*t70
+    t74 = t25 + t56*t70
+    t75 = damping + t26
+    t76 = -t52*(t38 + t54*t43 + t55*t25 + t56*t75)
+    t77 = t38 + t76
+    t78 = t43 + t54*t76
+    t79 = t25 + t55*t76
+    t80 = t75 + t56*t76
+    t81 = (t67 > 0)
+    t82 = casadi.if_else(t81, 1/(t59 + t68), 0)
+    t83 = casadi.if_else(t81, 1 + casadi.fabs(t59)/t67, 0)
+    t84 = t60*t82
+    t85 = t61*t82
+    t86 = t83*(-t72 + t84*t73 + t85*t74)
+    t87 = t72 + t86
+    t88 = t73 - t84*t86
+    t89 = t74 - t85*t86
+    t90 = t83*(-t78 + t84*t79 + t85*t80)
+    t91 = t78 + t90
+    t92 = t79 - t84*t90
+    t93 = t80 - t85*t90
+    t94 = t83*(t64 + t84*t65 + t85*t66)
+    t95 = -t94 + t64
+    t96 = t65 - t84*t94
+    t97 = t66 - t85*t94
+    t98 = casadi.sqrt(t88**2 + t89**2)
+    t99 = t98*casadi.if_else((t88 >= 0), 1, -1)
+    t100 = (t98 > 0)
+    t101 = casadi.if_else(t100, 1/(t88 + t99), 0)
+    t102 = casadi.if_else(t100, 1 + casadi.fabs(t88)/t98, 0)
+    t103 = t89*t101
+    t104 = t102*(t92 + t103*t93)
+    t105 = -t104 + t92
+    t106 = t93 - t103*t104
+    t107 = t102*(t96 + t103*t97)
+    t108 = -t107 + t96
+    t109 = t97 - t103*t107
+    t110 = casadi.fabs(t106)
+    t111 = t110*casadi.if_else((t106 >= 0), 1, -1)
+    t112 = casadi.if_else((t110 > 0), 2, 0)
+    t113 = t109 - t109*t112
+    t114 = casadi.if_else((t111 != 0), -t113/t111, 0)
+    t115 = casadi.if_else((t99 != 0), -(t108 - t105*t114)/t99, 0)
+    t116 = casadi.if_else((t68 != 0), -(t95 + t87*t115 + t91*t114)/t68, 0)
+    t117 = casadi.if_else((t49 != 0), -(t63 + t71*t115 + t77*t114 - t58*t116)/t49, 0)
+    t118 = q1 - t7*t117 + t3*t116
+    t119 = t24*t114
+    t120 = q2 + t119 + t8*t115 - t34*t117 - t39*t116
+    t121 = q3 + t119 + t9*t115 - t35*t117 - t40*t116
+    t122 = q4 + t119 + t20*t115 - t36*t117 - t41*t116
     q_start = casadi.SX(4, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
     q_start[2, 0] = q3
     q_start[3, 0] = q4
     q_next = casadi.SX(4, 1)
-    q_next[0, 0] = casadi.if_else((t110 < -3.141592653589793), -3.141592653589793, casadi.if_else((t110 > 3.141592653589793), 3.141592653589793, t110))
-    q_next[1, 0] = casadi.if_else((t112 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((t112 > 2.0943951023931953), 2.0943951023931953, t112))
-    q_next[2, 0] = casadi.if_else((t113 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((t113 > 2.0943951023931953), 2.0943951023931953, t113))
-    q_next[3, 0] = casadi.if_else((t114 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((t114 > 2.0943951023931953), 2.0943951023931953, t114))
+    q_next[0, 0] = casadi.if_else((t118 < -3.141592653589793), -3.141592653589793, casadi.if_else((t118 > 3.141592653589793), 3.141592653589793, t118))
+    q_next[1, 0] = casadi.if_else((t120 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((t120 > 2.0943951023931953), 2.0943951023931953, t120))
+    q_next[2, 0] = casadi.if_else((t121 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((t121 > 2.0943951023931953), 2.0943951023931953, t121))
+    q_next[3, 0] = casadi.if_else((t122 < -2.0943951023931953), -2.0943951023931953, casadi.if_else((t122 > 2.0943951023931953), 2.0943951023931953, t122))
     cost = casadi.SX(1, 1)
     cost[0, 0] = casadi.if_else((casadi.fabs(t0) < casadi.inf), t46, -1)
     return [q_start, q_next, cost]

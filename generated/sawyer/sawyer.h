@@ -99,31 +99,31 @@ void sawyer_singularity_factors(const sawyer_real q[SAWYER_DOF], sawyer_real f[S
 sawyer_real sawyer_manipulability(const sawyer_real q[SAWYER_DOF]);
 
 /* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
- * Result: dw[i], i < 7. 1752 operations. */
+ * Result: dw[i], i < 7. 1739 operations. */
 void sawyer_manipulability_gradient(const sawyer_real q[SAWYER_DOF], sawyer_real dw[SAWYER_DOF]);
 
 /* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
- * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2695 operations. */
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2715 operations. */
 void sawyer_velocity_ellipsoid(const sawyer_real q[SAWYER_DOF], sawyer_real U_v[9], sawyer_real s_v[3], sawyer_real U_w[9], sawyer_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 9207 operations. */
+ * Result: returned as a scalar. 9205 operations. */
 sawyer_real sawyer_condition_number(const sawyer_real q[SAWYER_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 7; returned as a scalar. 1053 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1032 operations. */
 int sawyer_velocity_ik(const sawyer_real q[SAWYER_DOF], const sawyer_real mu_dot[SAWYER_TASK_DIM], sawyer_real damping, sawyer_real q_dot[SAWYER_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 7; returned as a scalar. 1135 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1114 operations. */
 int sawyer_velocity_ik_nullspace(const sawyer_real q[SAWYER_DOF], const sawyer_real mu_dot[SAWYER_TASK_DIM], const sawyer_real z[SAWYER_DOF], sawyer_real damping, sawyer_real q_dot[SAWYER_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 7; returned as a scalar. 1297 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1276 operations. */
 int sawyer_resolved_rate(const sawyer_real q[SAWYER_DOF], const sawyer_real target[16], const sawyer_real target_rate[SAWYER_TASK_DIM], const sawyer_real gain[SAWYER_TASK_DIM], const sawyer_real z[SAWYER_DOF], sawyer_real damping, sawyer_real q_dot[SAWYER_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1132 operations. */
+ * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1111 operations. */
 sawyer_real sawyer_ik_numeric_step(const sawyer_real target[16], const sawyer_real q[SAWYER_DOF], sawyer_real damping, sawyer_real q_start[SAWYER_DOF], sawyer_real q_next[SAWYER_DOF]);
 
 /* The general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9).

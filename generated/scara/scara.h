@@ -99,31 +99,31 @@ scara_real scara_manipulability(const scara_real q[SCARA_DOF]);
 scara_real scara_jacobian_det(const scara_real q[SCARA_DOF]);
 
 /* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
- * Result: dw[i], i < 4. 100 operations. */
+ * Result: dw[i], i < 4. 94 operations. */
 void scara_manipulability_gradient(const scara_real q[SCARA_DOF], scara_real dw[SCARA_DOF]);
 
 /* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
- * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 370 operations. */
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 372 operations. */
 void scara_velocity_ellipsoid(const scara_real q[SCARA_DOF], scara_real U_v[9], scara_real s_v[3], scara_real U_w[9], scara_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 1300 operations. */
+ * Result: returned as a scalar. 1294 operations. */
 scara_real scara_condition_number(const scara_real q[SCARA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 4; returned as a scalar. 332 operations. */
+ * Result: q_dot[i], i < 4; returned as a scalar. 315 operations. */
 int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], scara_real damping, scara_real q_dot[SCARA_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 4; returned as a scalar. 336 operations. */
+ * Result: q_dot[i], i < 4; returned as a scalar. 319 operations. */
 int scara_velocity_ik_nullspace(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], const scara_real z[SCARA_DOF], scara_real damping, scara_real q_dot[SCARA_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 4; returned as a scalar. 364 operations. */
+ * Result: q_dot[i], i < 4; returned as a scalar. 347 operations. */
 int scara_resolved_rate(const scara_real q[SCARA_DOF], const scara_real target[SCARA_TASK_DIM], const scara_real target_rate[SCARA_TASK_DIM], const scara_real gain[SCARA_TASK_DIM], const scara_real z[SCARA_DOF], scara_real damping, scara_real q_dot[SCARA_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 4; q_next[i], i < 4; returned as a scalar. 219 operations. */
+ * Result: q_start[i], i < 4; q_next[i], i < 4; returned as a scalar. 204 operations. */
 scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const scara_real q[SCARA_DOF], scara_real damping, scara_real q_start[SCARA_DOF], scara_real q_next[SCARA_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.

@@ -854,7 +854,7 @@ def jacobian_det(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def manipulability_gradient(q):
-    """d manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): (4 x 1), 100 operations."""
+    """d manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule): (4 x 1), 94 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -872,31 +872,31 @@ def manipulability_gradient(q):
     t6 = xp.sqrt(4 + t1**2 + t5 + 0.075625*c12**2)
     t7 = xp.sqrt(t5)
     t8 = t7*xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)
-    t9 = -t3 + t8
-    t10 = xp.where(xp.greater(t7, 0), 1/(t7*(t7 + xp.abs(t3))), 0)
-    t11 = t10*(t1*t9 - 0.075625*c12*s12)
-    t12 = t1 - t9*t11
-    t13 = t0 + t2*t11
-    t14 = 1 - t9**2*t10
-    t15 = xp.where(xp.greater(t8, 0), xp.asarray(-1, dtype=dtype), 1)
-    t16 = xp.abs(t13)
-    t17 = t16*xp.where(xp.greater_equal(t13, 0), xp.asarray(1, dtype=dtype), -1)
-    t18 = t13 + t17
-    t19 = xp.where(xp.greater(t16, 0), 1/(t16*2*t16), 0)
-    t20 = 1 - t18**2*t19
-    t21 = xp.where(xp.greater(t17, 0), -t15, t15)
-    t22 = t10*t20
-    t23 = t4*t22
-    t24 = -t23 + t20
-    t25 = t2*t9
-    t26 = t17*t14 + t22*t12*t25
-    t27 = t12*t24 + t10*t17*t25
-    t28 = 1e-12*t6
-    t29 = xp.where(xp.less_equal(t7, t28) | xp.less_equal(t16, t28) | xp.less_equal(1, t28), 0, t21)
-    t30 = t2*t8
-    t31 = t0*t27 + t24*t30
-    t32 = t29*(t1*t26 + t3*t22*t9*t30 + t31)
-    t33 = t29*(t31 + t0*t26 + t8*t9*t23)
+    t9 = xp.where(xp.greater(t8, 0), xp.asarray(-1, dtype=dtype), 1)
+    t10 = xp.greater(t7, 0)
+    t11 = xp.where(t10, 1/(-t3 + t8), 0)
+    t12 = xp.where(t10, 1 + xp.abs(t3)/t7, 0)
+    t13 = t12*(t1 - 0.075625*c12*s12*t11)
+    t14 = -t13 + t1
+    t15 = 1 - t12
+    t16 = t2*t11
+    t17 = t0 + t16*t13
+    t18 = xp.abs(t17)
+    t19 = xp.where(xp.greater_equal(t17, 0), xp.asarray(1, dtype=dtype), -1)*t18
+    t20 = xp.where(xp.greater(t18, 0), xp.asarray(2, dtype=dtype), 0)
+    t21 = 1 - t20
+    t22 = xp.where(xp.greater(t19, 0), -t9, t9)
+    t23 = t12*t21
+    t24 = t4*t23
+    t25 = t21 - t11**2*t24
+    t26 = t14*t25 + t16*t12*t19
+    t27 = t16*t23
+    t28 = t19*t15 + t14*t27
+    t29 = 1e-12*t6
+    t30 = xp.where(xp.less_equal(t7, t29) | xp.less_equal(t18, t29) | xp.less_equal(1, t29), 0, t22)
+    t31 = t0*t26 + t2*t8*t25
+    t32 = t30*(t1*t28 + t3*t8*t27 + t31)
+    t33 = t30*(t31 + t0*t28 + t8*t11*t24)
     dw = _stack(xp, [
         t32,  # 0
         t33,  # 1
@@ -908,7 +908,7 @@ def manipulability_gradient(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ellipsoid(q):
-    """axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: (3 x 3 and 3 x 1 and 3 x 3 and 3 x 1), 370 operations."""
+    """axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: (3 x 3 and 3 x 1 and 3 x 3 and 3 x 1), 372 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -923,168 +923,169 @@ def velocity_ellipsoid(q):
     t3 = 0.325*s1 + t2
     t4 = xp.sqrt(t3**2 + 0.075625*s12**2)
     t5 = t4*xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)
-    t6 = -t3 + t5
-    t7 = xp.where(xp.greater(t4, 0), 1/(t4*(t4 + xp.abs(t3))), 0)
-    t8 = t7*(t1*t6 - 0.075625*c12*s12)
-    t9 = t1 - t6*t8
-    t10 = t0 + t2*t8
-    t11 = xp.abs(t10)
-    t12 = t11*xp.where(xp.greater_equal(t10, 0), xp.asarray(1, dtype=dtype), -1)
-    t13 = t5**2
-    t14 = t12**2
-    t15 = t14 + t9**2
-    t16 = t5*t9
-    t17 = xp.not_equal(t16, 0)
-    t18 = (-t13 + t15)/xp.where(t17, -2*t16, 1)
-    t19 = xp.abs(t18)
-    t20 = xp.greater_equal(t19, 1)
-    t21 = 1/xp.abs(xp.where(t20, t18, 1))
-    t22 = xp.where(t17, xp.where(xp.greater_equal(t18, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t20, t21/(1 + xp.sqrt(1 + t21**2)), 1/(t19 + xp.sqrt(1 + t19**2))), 0)
-    t23 = 1/xp.sqrt(1 + t22**2)
-    t24 = t16*t22
-    t25 = t24 + t13
-    t26 = -t24 + t15
-    t27 = t5*t23
-    t28 = t9*t23
-    t29 = t27 + t28*t22
-    t30 = t28 - t27*t22
-    t31 = t29*t30 + t14*t22*t23**2
-    t32 = xp.not_equal(t31, 0)
-    t33 = (-t25 + t26)/xp.where(t32, -2*t31, 1)
-    t34 = xp.abs(t33)
-    t35 = xp.greater_equal(t34, 1)
-    t36 = 1/xp.abs(xp.where(t35, t33, 1))
-    t37 = xp.where(t32, xp.where(xp.greater_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t35, t36/(1 + xp.sqrt(1 + t36**2)), 1/(t34 + xp.sqrt(1 + t34**2))), 0)
-    t38 = 1/xp.sqrt(1 + t37**2)
-    t39 = t31*t37
-    t40 = t25 + t39
-    t41 = -t39 + t26
-    t42 = t29*t38
-    t43 = t30*t38
-    t44 = t42 + t37*t43
-    t45 = t43 - t37*t42
-    t46 = t23*t38
-    t47 = t12*t46
-    t48 = t22*t47
-    t49 = t48 + t37*t47
-    t50 = -t47 + t37*t48
-    t51 = -t44*t45 + t49*t50
-    t52 = t22*t46
-    t53 = t46 - t37*t52
-    t54 = t52 + t37*t46
-    t55 = xp.not_equal(t51, 0)
-    t56 = (-t40 + t41)/xp.where(t55, 2*t51, 1)
-    t57 = xp.abs(t56)
-    t58 = xp.greater_equal(t57, 1)
-    t59 = 1/xp.abs(xp.where(t58, t56, 1))
-    t60 = xp.where(t55, xp.where(xp.greater_equal(t56, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t58, t59/(1 + xp.sqrt(1 + t59**2)), 1/(t57 + xp.sqrt(1 + t57**2))), 0)
-    t61 = 1/xp.sqrt(1 + t60**2)
-    t62 = t51*t60
-    t63 = -t62 + t40
-    t64 = t41 + t62
-    t65 = t44*t61
-    t66 = t45*t61
-    t67 = t65 + t60*t66
-    t68 = t66 - t60*t65
-    t69 = t49*t61
-    t70 = t50*t61
-    t71 = t69 - t60*t70
-    t72 = t70 + t60*t69
-    t73 = -t67*t68 + t71*t72
-    t74 = t53*t61
-    t75 = t54*t61
-    t76 = t74 - t60*t75
-    t77 = t75 + t60*t74
-    t78 = xp.not_equal(t73, 0)
-    t79 = (-t63 + t64)/xp.where(t78, 2*t73, 1)
-    t80 = xp.abs(t79)
-    t81 = xp.greater_equal(t80, 1)
-    t82 = 1/xp.abs(xp.where(t81, t79, 1))
-    t83 = xp.where(t78, xp.where(xp.greater_equal(t79, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t81, t82/(1 + xp.sqrt(1 + t82**2)), 1/(t80 + xp.sqrt(1 + t80**2))), 0)
-    t84 = 1/xp.sqrt(1 + t83**2)
-    t85 = t73*t83
-    t86 = -t85 + t63
-    t87 = t64 + t85
-    t88 = t67*t84
-    t89 = t68*t84
-    t90 = t88 + t83*t89
-    t91 = t89 - t83*t88
-    t92 = t71*t84
-    t93 = t72*t84
-    t94 = t92 - t83*t93
-    t95 = t93 + t83*t92
-    t96 = -t90*t91 + t94*t95
-    t97 = t76*t84
-    t98 = t77*t84
-    t99 = t97 - t83*t98
-    t100 = t98 + t83*t97
-    t101 = xp.not_equal(t96, 0)
-    t102 = (-t86 + t87)/xp.where(t101, 2*t96, 1)
-    t103 = xp.abs(t102)
-    t104 = xp.greater_equal(t103, 1)
-    t105 = 1/xp.abs(xp.where(t104, t102, 1))
-    t106 = xp.where(t101, xp.where(xp.greater_equal(t102, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t104, t105/(1 + xp.sqrt(1 + t105**2)), 1/(t103 + xp.sqrt(1 + t103**2))), 0)
-    t107 = 1/xp.sqrt(1 + t106**2)
-    t108 = t90*t107
-    t109 = t91*t107
-    t110 = t108 + t106*t109
-    t111 = t109 - t106*t108
-    t112 = t94*t107
-    t113 = t95*t107
-    t114 = t112 - t106*t113
-    t115 = t113 + t106*t112
-    t116 = xp.sqrt(t110**2 + t114**2)
+    t6 = t5**2
+    t7 = xp.greater(t4, 0)
+    t8 = xp.where(t7, 1/(-t3 + t5), 0)
+    t9 = xp.where(t7, 1 + xp.abs(t3)/t4, 0)
+    t10 = t9*(t1 - 0.075625*c12*s12*t8)
+    t11 = -t10 + t1
+    t12 = t0 + t2*t8*t10
+    t13 = xp.abs(t12)
+    t14 = t13*xp.where(xp.greater_equal(t12, 0), xp.asarray(1, dtype=dtype), -1)
+    t15 = t14**2
+    t16 = t15 + t11**2
+    t17 = t5*t11
+    t18 = xp.not_equal(t17, 0)
+    t19 = (-t6 + t16)/xp.where(t18, -2*t17, 1)
+    t20 = xp.abs(t19)
+    t21 = xp.greater_equal(t20, 1)
+    t22 = 1/xp.abs(xp.where(t21, t19, 1))
+    t23 = xp.where(t18, xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t21, t22/(1 + xp.sqrt(1 + t22**2)), 1/(t20 + xp.sqrt(1 + t20**2))), 0)
+    t24 = 1/xp.sqrt(1 + t23**2)
+    t25 = t17*t23
+    t26 = t25 + t6
+    t27 = -t25 + t16
+    t28 = t5*t24
+    t29 = t11*t24
+    t30 = t28 + t29*t23
+    t31 = t29 - t28*t23
+    t32 = t30*t31 + t15*t23*t24**2
+    t33 = xp.not_equal(t32, 0)
+    t34 = (-t26 + t27)/xp.where(t33, -2*t32, 1)
+    t35 = xp.abs(t34)
+    t36 = xp.greater_equal(t35, 1)
+    t37 = 1/xp.abs(xp.where(t36, t34, 1))
+    t38 = xp.where(t33, xp.where(xp.greater_equal(t34, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t36, t37/(1 + xp.sqrt(1 + t37**2)), 1/(t35 + xp.sqrt(1 + t35**2))), 0)
+    t39 = 1/xp.sqrt(1 + t38**2)
+    t40 = t32*t38
+    t41 = t26 + t40
+    t42 = -t40 + t27
+    t43 = t30*t39
+    t44 = t31*t39
+    t45 = t43 + t38*t44
+    t46 = t44 - t38*t43
+    t47 = t24*t39
+    t48 = t14*t47
+    t49 = t23*t48
+    t50 = t49 + t38*t48
+    t51 = -t48 + t38*t49
+    t52 = -t45*t46 + t50*t51
+    t53 = t23*t47
+    t54 = t47 - t38*t53
+    t55 = t53 + t38*t47
+    t56 = xp.not_equal(t52, 0)
+    t57 = (-t41 + t42)/xp.where(t56, 2*t52, 1)
+    t58 = xp.abs(t57)
+    t59 = xp.greater_equal(t58, 1)
+    t60 = 1/xp.abs(xp.where(t59, t57, 1))
+    t61 = xp.where(t56, xp.where(xp.greater_equal(t57, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t59, t60/(1 + xp.sqrt(1 + t60**2)), 1/(t58 + xp.sqrt(1 + t58**2))), 0)
+    t62 = 1/xp.sqrt(1 + t61**2)
+    t63 = t52*t61
+    t64 = -t63 + t41
+    t65 = t42 + t63
+    t66 = t45*t62
+    t67 = t46*t62
+    t68 = t66 + t61*t67
+    t69 = t67 - t61*t66
+    t70 = t50*t62
+    t71 = t51*t62
+    t72 = t70 - t61*t71
+    t73 = t71 + t61*t70
+    t74 = -t68*t69 + t72*t73
+    t75 = t54*t62
+    t76 = t55*t62
+    t77 = t75 - t61*t76
+    t78 = t76 + t61*t75
+    t79 = xp.not_equal(t74, 0)
+    t80 = (-t64 + t65)/xp.where(t79, 2*t74, 1)
+    t81 = xp.abs(t80)
+    t82 = xp.greater_equal(t81, 1)
+    t83 = 1/xp.abs(xp.where(t82, t80, 1))
+    t84 = xp.where(t79, xp.where(xp.greater_equal(t80, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t82, t83/(1 + xp.sqrt(1 + t83**2)), 1/(t81 + xp.sqrt(1 + t81**2))), 0)
+    t85 = 1/xp.sqrt(1 + t84**2)
+    t86 = t74*t84
+    t87 = -t86 + t64
+    t88 = t65 + t86
+    t89 = t68*t85
+    t90 = t69*t85
+    t91 = t89 + t84*t90
+    t92 = t90 - t84*t89
+    t93 = t72*t85
+    t94 = t73*t85
+    t95 = t93 - t84*t94
+    t96 = t94 + t84*t93
+    t97 = -t91*t92 + t95*t96
+    t98 = t77*t85
+    t99 = t78*t85
+    t100 = t98 - t84*t99
+    t101 = t99 + t84*t98
+    t102 = xp.not_equal(t97, 0)
+    t103 = (-t87 + t88)/xp.where(t102, 2*t97, 1)
+    t104 = xp.abs(t103)
+    t105 = xp.greater_equal(t104, 1)
+    t106 = 1/xp.abs(xp.where(t105, t103, 1))
+    t107 = xp.where(t102, xp.where(xp.greater_equal(t103, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t105, t106/(1 + xp.sqrt(1 + t106**2)), 1/(t104 + xp.sqrt(1 + t104**2))), 0)
+    t108 = 1/xp.sqrt(1 + t107**2)
+    t109 = t91*t108
+    t110 = t92*t108
+    t111 = t109 + t107*t110
+    t112 = t110 - t107*t109
+    t113 = t95*t108
+    t114 = t96*t108
+    t115 = t113 - t107*t114
+    t116 = t114 + t107*t113
     t117 = xp.sqrt(t111**2 + t115**2)
-    t118 = t99*t107
-    t119 = t100*t107
-    t120 = t118 - t106*t119
-    t121 = t119 + t106*t118
-    t122 = xp.less(t116, t117)
-    t123 = xp.where(t122, t117, t116)
-    t124 = xp.where(t122, t116, t117)
-    t125 = xp.where(t122, t121, t120)
-    t126 = xp.where(t122, t120, t121)
-    t127 = -t121
-    t128 = xp.where(t122, t120, t127)
-    t129 = xp.where(t122, t127, t120)
-    t130 = xp.less(t124, 1)
-    t131 = xp.where(t130, 1, t124)
-    t132 = xp.where(t130, t124, 1)
-    t133 = xp.where(t130, 0, t126)
-    t134 = xp.where(t130, 0, t129)
-    t135 = xp.where(t130, xp.asarray(1, dtype=dtype), 0)
-    t136 = xp.where(t130, t126, 0)
-    t137 = xp.where(t130, t129, 0)
-    t138 = xp.where(t130, xp.asarray(0, dtype=dtype), 1)
-    t139 = xp.less(t123, t131)
-    t140 = xp.where(t139, t131, t123)
-    t141 = xp.where(t139, t123, t131)
-    t142 = xp.where(t139, t133, t125)
-    t143 = xp.where(t139, t134, t128)
-    t144 = xp.where(t139, t135, 0)
-    t145 = xp.where(t139, t125, t133)
-    t146 = xp.where(t139, t128, t134)
-    t147 = xp.where(t139, 0, t135)
-    t148 = t142*(t138*t146 - t137*t147) - t143*(t138*t145 - t136*t147) + t144*(t137*t145 - t136*t146)
-    t149 = xp.where(xp.less(t148, 0), xp.asarray(-1, dtype=dtype), 1)
-    t150 = t136*t149
-    t151 = t137*t149
-    t152 = t138*t149
+    t118 = xp.sqrt(t112**2 + t116**2)
+    t119 = t100*t108
+    t120 = t101*t108
+    t121 = t119 - t107*t120
+    t122 = t120 + t107*t119
+    t123 = xp.less(t117, t118)
+    t124 = xp.where(t123, t118, t117)
+    t125 = xp.where(t123, t117, t118)
+    t126 = xp.where(t123, t122, t121)
+    t127 = xp.where(t123, t121, t122)
+    t128 = -t122
+    t129 = xp.where(t123, t121, t128)
+    t130 = xp.where(t123, t128, t121)
+    t131 = xp.less(t125, 1)
+    t132 = xp.where(t131, 1, t125)
+    t133 = xp.where(t131, t125, 1)
+    t134 = xp.where(t131, 0, t127)
+    t135 = xp.where(t131, 0, t130)
+    t136 = xp.where(t131, xp.asarray(1, dtype=dtype), 0)
+    t137 = xp.where(t131, t127, 0)
+    t138 = xp.where(t131, t130, 0)
+    t139 = xp.where(t131, xp.asarray(0, dtype=dtype), 1)
+    t140 = xp.less(t124, t132)
+    t141 = xp.where(t140, t132, t124)
+    t142 = xp.where(t140, t124, t132)
+    t143 = xp.where(t140, t134, t126)
+    t144 = xp.where(t140, t135, t129)
+    t145 = xp.where(t140, t136, 0)
+    t146 = xp.where(t140, t126, t134)
+    t147 = xp.where(t140, t129, t135)
+    t148 = xp.where(t140, 0, t136)
+    t149 = t143*(t139*t147 - t138*t148) - t144*(t139*t146 - t137*t148) + t145*(t138*t146 - t137*t147)
+    t150 = xp.where(xp.less(t149, 0), xp.asarray(-1, dtype=dtype), 1)
+    t151 = t137*t150
+    t152 = t138*t150
+    t153 = t139*t150
     U_v = _stack(xp, [
-        t142,  # 0, 0
-        t145,  # 0, 1
-        t150,  # 0, 2
-        t143,  # 1, 0
-        t146,  # 1, 1
-        t151,  # 1, 2
-        t144,  # 2, 0
-        t147,  # 2, 1
-        t152,  # 2, 2
+        t143,  # 0, 0
+        t146,  # 0, 1
+        t151,  # 0, 2
+        t144,  # 1, 0
+        t147,  # 1, 1
+        t152,  # 1, 2
+        t145,  # 2, 0
+        t148,  # 2, 1
+        t153,  # 2, 2
     ], (3, 3))
     s_v = _stack(xp, [
-        t140,  # 0
-        t141,  # 1
-        t132,  # 2
+        t141,  # 0
+        t142,  # 1
+        t133,  # 2
     ], (3,))
     U_w = _stack(xp, [
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 0
@@ -1107,7 +1108,7 @@ def velocity_ellipsoid(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def condition_number(q):
-    """sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): (1 x 1), 1300 operations."""
+    """sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): (1 x 1), 1294 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (4,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -1120,513 +1121,514 @@ def condition_number(q):
     t1 = 0.275*s12 + 0.325*s1
     t2 = xp.sqrt(3.5432525951557095*t1**2 + 0.26795847750865054*s12**2)
     t3 = 1.8823529411764706*t1
-    t4 = xp.where(xp.greater(t2, 0), 1/(t2*(t2 + xp.abs(t3))), 0)
-    t5 = -t3
-    t6 = t2*xp.where(xp.greater_equal(t5, 0), xp.asarray(1, dtype=dtype), -1)
-    t7 = t5 + t6
-    t8 = 1.8823529411764706*t0
-    t9 = t4*(-0.26795847750865054*c12*s12 + t8*t7)
-    t10 = t8 - t7*t9
-    t11 = 0.5176470588235293*s12
-    t12 = 0.5176470588235293*c12 + t11*t9
-    t13 = t4*(-t11 + t7)
-    t14 = 1 - t7*t13
-    t15 = 1 + t11*t13
-    t16 = xp.abs(t12)
-    t17 = t16*xp.where(xp.greater_equal(t12, 0), xp.asarray(1, dtype=dtype), -1)
-    t18 = t12 + t17
-    t19 = xp.where(xp.greater(t16, 0), 1/(t16*2*t16), 0)
-    t20 = t15 - t15*t18**2*t19
-    t21 = t17**2 + t20**2
-    t22 = -t10*t17 + t14*t20
-    t23 = t6**2
-    t24 = t23 + t10**2 + t14**2
-    t25 = xp.not_equal(t22, 0)
-    t26 = (-t24 + t21)/xp.where(t25, 2*t22, 1)
-    t27 = xp.abs(t26)
-    t28 = xp.greater_equal(t27, 1)
-    t29 = 1/xp.abs(xp.where(t28, t26, 1))
-    t30 = xp.where(t25, xp.where(xp.greater_equal(t26, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t28, t29/(1 + xp.sqrt(1 + t29**2)), 1/(t27 + xp.sqrt(1 + t27**2))), 0)
-    t31 = 1/xp.sqrt(1 + t30**2)
-    t32 = t22*t30
-    t33 = -t32 + t24
-    t34 = t32 + t21
-    t35 = t10*t31
-    t36 = t17*t31
-    t37 = t35 + t36*t30
-    t38 = -t36 + t35*t30
-    t39 = t14*t31
-    t40 = t20*t31
-    t41 = t39 - t40*t30
-    t42 = t40 + t39*t30
-    t43 = xp.not_equal(t41, 0)
-    t44 = (1.0 - t33)/xp.where(t43, 2*t41, 1)
-    t45 = xp.abs(t44)
-    t46 = xp.greater_equal(t45, 1)
-    t47 = 1/xp.abs(xp.where(t46, t44, 1))
-    t48 = xp.where(t43, xp.where(xp.greater_equal(t44, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t46, t47/(1 + xp.sqrt(1 + t47**2)), 1/(t45 + xp.sqrt(1 + t45**2))), 0)
-    t49 = 1/xp.sqrt(1 + t48**2)
-    t50 = t41*t48
-    t51 = -t50 + t33
-    t52 = 1.0 + t50
-    t53 = t49 + t50*t49
-    t54 = t48*t49
-    t55 = -t54 + t41*t49
-    t56 = t54*t37
-    t57 = t42*t53 + t23*t54*t30*t31**2 + t56*t38
-    t58 = xp.not_equal(t57, 0)
-    t59 = (-t34 + t52)/xp.where(t58, 2*t57, 1)
-    t60 = xp.abs(t59)
-    t61 = xp.greater_equal(t60, 1)
-    t62 = 1/xp.abs(xp.where(t61, t59, 1))
-    t63 = xp.where(t58, xp.where(xp.greater_equal(t59, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t61, t62/(1 + xp.sqrt(1 + t62**2)), 1/(t60 + xp.sqrt(1 + t60**2))), 0)
-    t64 = 1/xp.sqrt(1 + t63**2)
-    t65 = t57*t63
-    t66 = -t65 + t34
-    t67 = t65 + t52
-    t68 = t6*t31
-    t69 = t68*t64
-    t70 = t69*t30
-    t71 = t54*t69
-    t72 = -t70 + t71*t63
-    t73 = t71 + t70*t63
-    t74 = t38*t64
-    t75 = t56*t64
-    t76 = t74 - t75*t63
-    t77 = t75 + t74*t63
-    t78 = t42*t64
-    t79 = t53*t64
-    t80 = t78 - t79*t63
-    t81 = t79 + t78*t63
-    t82 = t68*t49
-    t83 = t37*t49
-    t84 = t55*t80 - t82*t72 + t83*t76
-    t85 = xp.not_equal(t84, 0)
-    t86 = (-t51 + t66)/xp.where(t85, 2*t84, 1)
-    t87 = xp.abs(t86)
-    t88 = xp.greater_equal(t87, 1)
-    t89 = 1/xp.abs(xp.where(t88, t86, 1))
-    t90 = xp.where(t85, xp.where(xp.greater_equal(t86, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t88, t89/(1 + xp.sqrt(1 + t89**2)), 1/(t87 + xp.sqrt(1 + t87**2))), 0)
-    t91 = 1/xp.sqrt(1 + t90**2)
-    t92 = t84*t90
-    t93 = -t92 + t51
-    t94 = t92 + t66
-    t95 = t82*t91
-    t96 = t72*t91
-    t97 = t95 + t96*t90
-    t98 = t96 - t95*t90
-    t99 = t83*t91
-    t100 = t76*t91
-    t101 = t99 - t100*t90
-    t102 = t100 + t99*t90
-    t103 = t55*t91
-    t104 = t80*t91
-    t105 = t103 - t104*t90
-    t106 = t104 + t103*t90
-    t107 = t73*t97 + t77*t101 + t81*t105
-    t108 = xp.not_equal(t107, 0)
-    t109 = (-t93 + t67)/xp.where(t108, 2*t107, 1)
-    t110 = xp.abs(t109)
-    t111 = xp.greater_equal(t110, 1)
-    t112 = 1/xp.abs(xp.where(t111, t109, 1))
-    t113 = xp.where(t108, xp.where(xp.greater_equal(t109, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t111, t112/(1 + xp.sqrt(1 + t112**2)), 1/(t110 + xp.sqrt(1 + t110**2))), 0)
-    t114 = 1/xp.sqrt(1 + t113**2)
-    t115 = t107*t113
-    t116 = -t115 + t93
-    t117 = t115 + t67
-    t118 = t97*t114
-    t119 = t73*t114
-    t120 = -t118 + t119*t113
-    t121 = t119 + t118*t113
-    t122 = t101*t114
-    t123 = t77*t114
-    t124 = t122 - t123*t113
-    t125 = t123 + t122*t113
-    t126 = t105*t114
-    t127 = t81*t114
-    t128 = t126 - t127*t113
-    t129 = t127 + t126*t113
-    t130 = -t98*t121 + t102*t125 + t106*t129
-    t131 = xp.not_equal(t130, 0)
-    t132 = (-t94 + t117)/xp.where(t131, 2*t130, 1)
-    t133 = xp.abs(t132)
-    t134 = xp.greater_equal(t133, 1)
-    t135 = 1/xp.abs(xp.where(t134, t132, 1))
-    t136 = xp.where(t131, xp.where(xp.greater_equal(t132, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t134, t135/(1 + xp.sqrt(1 + t135**2)), 1/(t133 + xp.sqrt(1 + t133**2))), 0)
-    t137 = 1/xp.sqrt(1 + t136**2)
-    t138 = t130*t136
-    t139 = -t138 + t94
-    t140 = t117 + t138
-    t141 = t98*t137
-    t142 = t121*t137
-    t143 = t141 + t136*t142
-    t144 = -t142 + t136*t141
-    t145 = t102*t137
-    t146 = t125*t137
-    t147 = t145 - t136*t146
-    t148 = t146 + t136*t145
-    t149 = t106*t137
-    t150 = t129*t137
-    t151 = t149 - t136*t150
-    t152 = t150 + t136*t149
-    t153 = t120*t143 + t124*t147 + t128*t151
-    t154 = xp.not_equal(t153, 0)
-    t155 = (-t116 + t139)/xp.where(t154, 2*t153, 1)
-    t156 = xp.abs(t155)
-    t157 = xp.greater_equal(t156, 1)
-    t158 = 1/xp.abs(xp.where(t157, t155, 1))
-    t159 = xp.where(t154, xp.where(xp.greater_equal(t155, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t157, t158/(1 + xp.sqrt(1 + t158**2)), 1/(t156 + xp.sqrt(1 + t156**2))), 0)
-    t160 = 1/xp.sqrt(1 + t159**2)
-    t161 = t153*t159
-    t162 = -t161 + t116
-    t163 = t139 + t161
-    t164 = t120*t160
-    t165 = t143*t160
-    t166 = t164 - t159*t165
-    t167 = t165 + t159*t164
-    t168 = t124*t160
-    t169 = t147*t160
-    t170 = t168 - t159*t169
-    t171 = t169 + t159*t168
-    t172 = t128*t160
-    t173 = t151*t160
-    t174 = t172 - t159*t173
-    t175 = t173 + t159*t172
-    t176 = t144*t166 + t148*t170 + t152*t174
-    t177 = xp.not_equal(t176, 0)
-    t178 = (-t162 + t140)/xp.where(t177, 2*t176, 1)
-    t179 = xp.abs(t178)
-    t180 = xp.greater_equal(t179, 1)
-    t181 = 1/xp.abs(xp.where(t180, t178, 1))
-    t182 = xp.where(t177, xp.where(xp.greater_equal(t178, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t180, t181/(1 + xp.sqrt(1 + t181**2)), 1/(t179 + xp.sqrt(1 + t179**2))), 0)
-    t183 = 1/xp.sqrt(1 + t182**2)
-    t184 = t176*t182
-    t185 = -t184 + t162
-    t186 = t140 + t184
-    t187 = t166*t183
-    t188 = t144*t183
-    t189 = t187 - t182*t188
-    t190 = t188 + t182*t187
-    t191 = t170*t183
-    t192 = t148*t183
-    t193 = t191 - t182*t192
-    t194 = t192 + t182*t191
-    t195 = t174*t183
-    t196 = t152*t183
-    t197 = t195 - t182*t196
-    t198 = t196 + t182*t195
-    t199 = t167*t190 + t171*t194 + t175*t198
-    t200 = xp.not_equal(t199, 0)
-    t201 = (-t163 + t186)/xp.where(t200, 2*t199, 1)
-    t202 = xp.abs(t201)
-    t203 = xp.greater_equal(t202, 1)
-    t204 = 1/xp.abs(xp.where(t203, t201, 1))
-    t205 = xp.where(t200, xp.where(xp.greater_equal(t201, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t203, t204/(1 + xp.sqrt(1 + t204**2)), 1/(t202 + xp.sqrt(1 + t202**2))), 0)
-    t206 = 1/xp.sqrt(1 + t205**2)
-    t207 = t199*t205
-    t208 = -t207 + t163
-    t209 = t186 + t207
-    t210 = t167*t206
-    t211 = t190*t206
-    t212 = t210 - t205*t211
-    t213 = t211 + t205*t210
-    t214 = t171*t206
-    t215 = t194*t206
-    t216 = t214 - t205*t215
-    t217 = t215 + t205*t214
-    t218 = t175*t206
-    t219 = t198*t206
-    t220 = t218 - t205*t219
-    t221 = t219 + t205*t218
-    t222 = t189*t212 + t193*t216 + t197*t220
-    t223 = xp.not_equal(t222, 0)
-    t224 = (-t185 + t208)/xp.where(t223, 2*t222, 1)
-    t225 = xp.abs(t224)
-    t226 = xp.greater_equal(t225, 1)
-    t227 = 1/xp.abs(xp.where(t226, t224, 1))
-    t228 = xp.where(t223, xp.where(xp.greater_equal(t224, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t226, t227/(1 + xp.sqrt(1 + t227**2)), 1/(t225 + xp.sqrt(1 + t225**2))), 0)
-    t229 = 1/xp.sqrt(1 + t228**2)
-    t230 = t222*t228
-    t231 = -t230 + t185
-    t232 = t208 + t230
-    t233 = t189*t229
-    t234 = t212*t229
-    t235 = t233 - t228*t234
-    t236 = t234 + t228*t233
-    t237 = t193*t229
-    t238 = t216*t229
-    t239 = t237 - t228*t238
-    t240 = t238 + t228*t237
-    t241 = t197*t229
-    t242 = t220*t229
-    t243 = t241 - t228*t242
-    t244 = t242 + t228*t241
-    t245 = t213*t235 + t217*t239 + t221*t243
-    t246 = xp.not_equal(t245, 0)
-    t247 = (-t231 + t209)/xp.where(t246, 2*t245, 1)
-    t248 = xp.abs(t247)
-    t249 = xp.greater_equal(t248, 1)
-    t250 = 1/xp.abs(xp.where(t249, t247, 1))
-    t251 = xp.where(t246, xp.where(xp.greater_equal(t247, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t249, t250/(1 + xp.sqrt(1 + t250**2)), 1/(t248 + xp.sqrt(1 + t248**2))), 0)
-    t252 = 1/xp.sqrt(1 + t251**2)
-    t253 = t245*t251
-    t254 = -t253 + t231
-    t255 = t209 + t253
-    t256 = t235*t252
-    t257 = t213*t252
-    t258 = t256 - t251*t257
-    t259 = t257 + t251*t256
-    t260 = t239*t252
-    t261 = t217*t252
-    t262 = t260 - t251*t261
-    t263 = t261 + t251*t260
-    t264 = t243*t252
-    t265 = t221*t252
-    t266 = t264 - t251*t265
-    t267 = t265 + t251*t264
-    t268 = t236*t259 + t240*t263 + t244*t267
-    t269 = xp.not_equal(t268, 0)
-    t270 = (-t232 + t255)/xp.where(t269, 2*t268, 1)
-    t271 = xp.abs(t270)
-    t272 = xp.greater_equal(t271, 1)
-    t273 = 1/xp.abs(xp.where(t272, t270, 1))
-    t274 = xp.where(t269, xp.where(xp.greater_equal(t270, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t272, t273/(1 + xp.sqrt(1 + t273**2)), 1/(t271 + xp.sqrt(1 + t271**2))), 0)
-    t275 = 1/xp.sqrt(1 + t274**2)
-    t276 = t268*t274
-    t277 = -t276 + t232
-    t278 = t255 + t276
-    t279 = t236*t275
-    t280 = t259*t275
-    t281 = t279 - t274*t280
-    t282 = t280 + t274*t279
-    t283 = t240*t275
-    t284 = t263*t275
-    t285 = t283 - t274*t284
-    t286 = t284 + t274*t283
-    t287 = t244*t275
-    t288 = t267*t275
-    t289 = t287 - t274*t288
-    t290 = t288 + t274*t287
-    t291 = t258*t281 + t262*t285 + t266*t289
-    t292 = xp.not_equal(t291, 0)
-    t293 = (-t254 + t277)/xp.where(t292, 2*t291, 1)
-    t294 = xp.abs(t293)
-    t295 = xp.greater_equal(t294, 1)
-    t296 = 1/xp.abs(xp.where(t295, t293, 1))
-    t297 = xp.where(t292, xp.where(xp.greater_equal(t293, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t295, t296/(1 + xp.sqrt(1 + t296**2)), 1/(t294 + xp.sqrt(1 + t294**2))), 0)
-    t298 = 1/xp.sqrt(1 + t297**2)
-    t299 = t291*t297
-    t300 = -t299 + t254
-    t301 = t277 + t299
-    t302 = t258*t298
-    t303 = t281*t298
-    t304 = t302 - t297*t303
-    t305 = t303 + t297*t302
-    t306 = t262*t298
-    t307 = t285*t298
-    t308 = t306 - t297*t307
-    t309 = t307 + t297*t306
-    t310 = t266*t298
-    t311 = t289*t298
-    t312 = t310 - t297*t311
-    t313 = t311 + t297*t310
-    t314 = t282*t304 + t286*t308 + t290*t312
-    t315 = xp.not_equal(t314, 0)
-    t316 = (-t300 + t278)/xp.where(t315, 2*t314, 1)
-    t317 = xp.abs(t316)
-    t318 = xp.greater_equal(t317, 1)
-    t319 = 1/xp.abs(xp.where(t318, t316, 1))
-    t320 = xp.where(t315, xp.where(xp.greater_equal(t316, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t318, t319/(1 + xp.sqrt(1 + t319**2)), 1/(t317 + xp.sqrt(1 + t317**2))), 0)
-    t321 = 1/xp.sqrt(1 + t320**2)
-    t322 = t314*t320
-    t323 = -t322 + t300
-    t324 = t278 + t322
-    t325 = t304*t321
-    t326 = t282*t321
-    t327 = t325 - t320*t326
-    t328 = t326 + t320*t325
-    t329 = t308*t321
-    t330 = t286*t321
-    t331 = t329 - t320*t330
-    t332 = t330 + t320*t329
-    t333 = t312*t321
-    t334 = t290*t321
-    t335 = t333 - t320*t334
-    t336 = t334 + t320*t333
-    t337 = t305*t328 + t309*t332 + t313*t336
-    t338 = xp.not_equal(t337, 0)
-    t339 = (-t301 + t324)/xp.where(t338, 2*t337, 1)
-    t340 = xp.abs(t339)
-    t341 = xp.greater_equal(t340, 1)
-    t342 = 1/xp.abs(xp.where(t341, t339, 1))
-    t343 = xp.where(t338, xp.where(xp.greater_equal(t339, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t341, t342/(1 + xp.sqrt(1 + t342**2)), 1/(t340 + xp.sqrt(1 + t340**2))), 0)
-    t344 = 1/xp.sqrt(1 + t343**2)
-    t345 = t337*t343
-    t346 = -t345 + t301
-    t347 = t324 + t345
-    t348 = t305*t344
-    t349 = t328*t344
-    t350 = t348 - t343*t349
-    t351 = t349 + t343*t348
-    t352 = t309*t344
-    t353 = t332*t344
-    t354 = t352 - t343*t353
-    t355 = t353 + t343*t352
-    t356 = t313*t344
-    t357 = t336*t344
-    t358 = t356 - t343*t357
-    t359 = t357 + t343*t356
-    t360 = t327*t350 + t331*t354 + t335*t358
-    t361 = xp.not_equal(t360, 0)
-    t362 = (-t323 + t346)/xp.where(t361, 2*t360, 1)
-    t363 = xp.abs(t362)
-    t364 = xp.greater_equal(t363, 1)
-    t365 = 1/xp.abs(xp.where(t364, t362, 1))
-    t366 = xp.where(t361, xp.where(xp.greater_equal(t362, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t364, t365/(1 + xp.sqrt(1 + t365**2)), 1/(t363 + xp.sqrt(1 + t363**2))), 0)
-    t367 = 1/xp.sqrt(1 + t366**2)
-    t368 = t360*t366
-    t369 = -t368 + t323
-    t370 = t346 + t368
-    t371 = t327*t367
-    t372 = t350*t367
-    t373 = t371 - t366*t372
-    t374 = t372 + t366*t371
-    t375 = t331*t367
-    t376 = t354*t367
-    t377 = t375 - t366*t376
-    t378 = t376 + t366*t375
-    t379 = t335*t367
-    t380 = t358*t367
-    t381 = t379 - t366*t380
-    t382 = t380 + t366*t379
-    t383 = t351*t373 + t355*t377 + t359*t381
-    t384 = xp.not_equal(t383, 0)
-    t385 = (-t369 + t347)/xp.where(t384, 2*t383, 1)
-    t386 = xp.abs(t385)
-    t387 = xp.greater_equal(t386, 1)
-    t388 = 1/xp.abs(xp.where(t387, t385, 1))
-    t389 = xp.where(t384, xp.where(xp.greater_equal(t385, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t387, t388/(1 + xp.sqrt(1 + t388**2)), 1/(t386 + xp.sqrt(1 + t386**2))), 0)
-    t390 = 1/xp.sqrt(1 + t389**2)
-    t391 = t383*t389
-    t392 = -t391 + t369
-    t393 = t347 + t391
-    t394 = t373*t390
-    t395 = t351*t390
-    t396 = t394 - t389*t395
-    t397 = t395 + t389*t394
-    t398 = t377*t390
-    t399 = t355*t390
-    t400 = t398 - t389*t399
-    t401 = t399 + t389*t398
-    t402 = t381*t390
-    t403 = t359*t390
-    t404 = t402 - t389*t403
-    t405 = t403 + t389*t402
-    t406 = t374*t397 + t378*t401 + t382*t405
-    t407 = xp.not_equal(t406, 0)
-    t408 = (-t370 + t393)/xp.where(t407, 2*t406, 1)
-    t409 = xp.abs(t408)
-    t410 = xp.greater_equal(t409, 1)
-    t411 = 1/xp.abs(xp.where(t410, t408, 1))
-    t412 = xp.where(t407, xp.where(xp.greater_equal(t408, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t410, t411/(1 + xp.sqrt(1 + t411**2)), 1/(t409 + xp.sqrt(1 + t409**2))), 0)
-    t413 = 1/xp.sqrt(1 + t412**2)
-    t414 = t406*t412
-    t415 = -t414 + t370
-    t416 = t393 + t414
-    t417 = t374*t413
-    t418 = t397*t413
-    t419 = t417 - t412*t418
-    t420 = t418 + t412*t417
-    t421 = t378*t413
-    t422 = t401*t413
-    t423 = t421 - t412*t422
-    t424 = t422 + t412*t421
-    t425 = t382*t413
-    t426 = t405*t413
-    t427 = t425 - t412*t426
-    t428 = t426 + t412*t425
-    t429 = t396*t419 + t400*t423 + t404*t427
-    t430 = xp.not_equal(t429, 0)
-    t431 = (-t392 + t415)/xp.where(t430, 2*t429, 1)
-    t432 = xp.abs(t431)
-    t433 = xp.greater_equal(t432, 1)
-    t434 = 1/xp.abs(xp.where(t433, t431, 1))
-    t435 = xp.where(t430, xp.where(xp.greater_equal(t431, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t433, t434/(1 + xp.sqrt(1 + t434**2)), 1/(t432 + xp.sqrt(1 + t432**2))), 0)
-    t436 = 1/xp.sqrt(1 + t435**2)
-    t437 = t429*t435
-    t438 = -t437 + t392
-    t439 = t415 + t437
-    t440 = t396*t436
-    t441 = t419*t436
-    t442 = t440 - t435*t441
-    t443 = t441 + t435*t440
-    t444 = t400*t436
-    t445 = t423*t436
-    t446 = t444 - t435*t445
-    t447 = t445 + t435*t444
-    t448 = t404*t436
-    t449 = t427*t436
-    t450 = t448 - t435*t449
-    t451 = t449 + t435*t448
-    t452 = t420*t442 + t424*t446 + t428*t450
-    t453 = xp.not_equal(t452, 0)
-    t454 = (-t438 + t416)/xp.where(t453, 2*t452, 1)
-    t455 = xp.abs(t454)
-    t456 = xp.greater_equal(t455, 1)
-    t457 = 1/xp.abs(xp.where(t456, t454, 1))
-    t458 = xp.where(t453, xp.where(xp.greater_equal(t454, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t456, t457/(1 + xp.sqrt(1 + t457**2)), 1/(t455 + xp.sqrt(1 + t455**2))), 0)
-    t459 = 1/xp.sqrt(1 + t458**2)
-    t460 = t416 + t452*t458
-    t461 = t442*t459
-    t462 = t420*t459
-    t463 = t461 - t458*t462
-    t464 = t462 + t458*t461
-    t465 = t446*t459
-    t466 = t424*t459
-    t467 = t465 - t458*t466
-    t468 = t466 + t458*t465
-    t469 = t450*t459
-    t470 = t428*t459
-    t471 = t469 - t458*t470
-    t472 = t470 + t458*t469
-    t473 = t443*t464 + t447*t468 + t451*t472
-    t474 = xp.sqrt(t463**2 + t467**2 + t471**2)
-    t475 = xp.not_equal(t473, 0)
-    t476 = (-t439 + t460)/xp.where(t475, 2*t473, 1)
-    t477 = xp.abs(t476)
-    t478 = xp.greater_equal(t477, 1)
-    t479 = 1/xp.abs(xp.where(t478, t476, 1))
-    t480 = xp.where(t475, xp.where(xp.greater_equal(t476, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t478, t479/(1 + xp.sqrt(1 + t479**2)), 1/(t477 + xp.sqrt(1 + t477**2))), 0)
-    t481 = 1/xp.sqrt(1 + t480**2)
-    t482 = t443*t481
-    t483 = t464*t481
-    t484 = t482 - t480*t483
-    t485 = t483 + t480*t482
-    t486 = t447*t481
-    t487 = t468*t481
-    t488 = t486 - t480*t487
-    t489 = t487 + t480*t486
-    t490 = t451*t481
-    t491 = t472*t481
-    t492 = t490 - t480*t491
-    t493 = t491 + t480*t490
-    t494 = xp.sqrt(t484**2 + t488**2 + t492**2)
+    t4 = -t3
+    t5 = t2*xp.where(xp.greater_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)
+    t6 = xp.greater(t2, 0)
+    t7 = xp.where(t6, 1/(t4 + t5), 0)
+    t8 = xp.where(t6, 1 + xp.abs(t3)/t2, 0)
+    t9 = 1.8823529411764706*t0
+    t10 = s12*t7
+    t11 = t8*(t9 - 0.26795847750865054*c12*t10)
+    t12 = -t11 + t9
+    t13 = 0.5176470588235293*t10
+    t14 = 0.5176470588235293*c12 + t13*t11
+    t15 = t8*(1.0 - t13)
+    t16 = 1 - t15
+    t17 = 1 + t13*t15
+    t18 = xp.abs(t14)
+    t19 = t18*xp.where(xp.greater_equal(t14, 0), xp.asarray(1, dtype=dtype), -1)
+    t20 = xp.where(xp.greater(t18, 0), xp.asarray(2, dtype=dtype), 0)
+    t21 = t17 - t17*t20
+    t22 = t19**2 + t21**2
+    t23 = -t12*t19 + t16*t21
+    t24 = t5**2
+    t25 = t24 + t12**2 + t16**2
+    t26 = xp.not_equal(t23, 0)
+    t27 = (-t25 + t22)/xp.where(t26, 2*t23, 1)
+    t28 = xp.abs(t27)
+    t29 = xp.greater_equal(t28, 1)
+    t30 = 1/xp.abs(xp.where(t29, t27, 1))
+    t31 = xp.where(t26, xp.where(xp.greater_equal(t27, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t29, t30/(1 + xp.sqrt(1 + t30**2)), 1/(t28 + xp.sqrt(1 + t28**2))), 0)
+    t32 = 1/xp.sqrt(1 + t31**2)
+    t33 = t23*t31
+    t34 = -t33 + t25
+    t35 = t33 + t22
+    t36 = t12*t32
+    t37 = t19*t32
+    t38 = t36 + t37*t31
+    t39 = -t37 + t36*t31
+    t40 = t16*t32
+    t41 = t21*t32
+    t42 = t40 - t41*t31
+    t43 = t41 + t40*t31
+    t44 = xp.not_equal(t42, 0)
+    t45 = (1.0 - t34)/xp.where(t44, 2*t42, 1)
+    t46 = xp.abs(t45)
+    t47 = xp.greater_equal(t46, 1)
+    t48 = 1/xp.abs(xp.where(t47, t45, 1))
+    t49 = xp.where(t44, xp.where(xp.greater_equal(t45, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t47, t48/(1 + xp.sqrt(1 + t48**2)), 1/(t46 + xp.sqrt(1 + t46**2))), 0)
+    t50 = 1/xp.sqrt(1 + t49**2)
+    t51 = t42*t49
+    t52 = -t51 + t34
+    t53 = 1.0 + t51
+    t54 = t50 + t51*t50
+    t55 = t49*t50
+    t56 = -t55 + t42*t50
+    t57 = t55*t38
+    t58 = t43*t54 + t24*t55*t31*t32**2 + t57*t39
+    t59 = xp.not_equal(t58, 0)
+    t60 = (-t35 + t53)/xp.where(t59, 2*t58, 1)
+    t61 = xp.abs(t60)
+    t62 = xp.greater_equal(t61, 1)
+    t63 = 1/xp.abs(xp.where(t62, t60, 1))
+    t64 = xp.where(t59, xp.where(xp.greater_equal(t60, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t62, t63/(1 + xp.sqrt(1 + t63**2)), 1/(t61 + xp.sqrt(1 + t61**2))), 0)
+    t65 = 1/xp.sqrt(1 + t64**2)
+    t66 = t58*t64
+    t67 = -t66 + t35
+    t68 = t66 + t53
+    t69 = t5*t32
+    t70 = t69*t65
+    t71 = t70*t31
+    t72 = t55*t70
+    t73 = -t71 + t72*t64
+    t74 = t72 + t71*t64
+    t75 = t39*t65
+    t76 = t57*t65
+    t77 = t75 - t76*t64
+    t78 = t76 + t75*t64
+    t79 = t43*t65
+    t80 = t54*t65
+    t81 = t79 - t80*t64
+    t82 = t80 + t79*t64
+    t83 = t69*t50
+    t84 = t38*t50
+    t85 = t56*t81 - t83*t73 + t84*t77
+    t86 = xp.not_equal(t85, 0)
+    t87 = (-t52 + t67)/xp.where(t86, 2*t85, 1)
+    t88 = xp.abs(t87)
+    t89 = xp.greater_equal(t88, 1)
+    t90 = 1/xp.abs(xp.where(t89, t87, 1))
+    t91 = xp.where(t86, xp.where(xp.greater_equal(t87, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t89, t90/(1 + xp.sqrt(1 + t90**2)), 1/(t88 + xp.sqrt(1 + t88**2))), 0)
+    t92 = 1/xp.sqrt(1 + t91**2)
+    t93 = t85*t91
+    t94 = -t93 + t52
+    t95 = t93 + t67
+    t96 = t83*t92
+    t97 = t73*t92
+    t98 = t96 + t97*t91
+    t99 = t97 - t96*t91
+    t100 = t84*t92
+    t101 = t77*t92
+    t102 = t100 - t101*t91
+    t103 = t101 + t100*t91
+    t104 = t56*t92
+    t105 = t81*t92
+    t106 = t104 - t105*t91
+    t107 = t105 + t104*t91
+    t108 = t74*t98 + t78*t102 + t82*t106
+    t109 = xp.not_equal(t108, 0)
+    t110 = (-t94 + t68)/xp.where(t109, 2*t108, 1)
+    t111 = xp.abs(t110)
+    t112 = xp.greater_equal(t111, 1)
+    t113 = 1/xp.abs(xp.where(t112, t110, 1))
+    t114 = xp.where(t109, xp.where(xp.greater_equal(t110, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t112, t113/(1 + xp.sqrt(1 + t113**2)), 1/(t111 + xp.sqrt(1 + t111**2))), 0)
+    t115 = 1/xp.sqrt(1 + t114**2)
+    t116 = t108*t114
+    t117 = -t116 + t94
+    t118 = t116 + t68
+    t119 = t98*t115
+    t120 = t74*t115
+    t121 = -t119 + t120*t114
+    t122 = t120 + t119*t114
+    t123 = t102*t115
+    t124 = t78*t115
+    t125 = t123 - t124*t114
+    t126 = t124 + t123*t114
+    t127 = t106*t115
+    t128 = t82*t115
+    t129 = t127 - t114*t128
+    t130 = t128 + t127*t114
+    t131 = -t99*t122 + t103*t126 + t107*t130
+    t132 = xp.not_equal(t131, 0)
+    t133 = (-t95 + t118)/xp.where(t132, 2*t131, 1)
+    t134 = xp.abs(t133)
+    t135 = xp.greater_equal(t134, 1)
+    t136 = 1/xp.abs(xp.where(t135, t133, 1))
+    t137 = xp.where(t132, xp.where(xp.greater_equal(t133, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t135, t136/(1 + xp.sqrt(1 + t136**2)), 1/(t134 + xp.sqrt(1 + t134**2))), 0)
+    t138 = 1/xp.sqrt(1 + t137**2)
+    t139 = t131*t137
+    t140 = -t139 + t95
+    t141 = t118 + t139
+    t142 = t99*t138
+    t143 = t122*t138
+    t144 = t142 + t137*t143
+    t145 = -t143 + t137*t142
+    t146 = t103*t138
+    t147 = t126*t138
+    t148 = t146 - t137*t147
+    t149 = t147 + t137*t146
+    t150 = t107*t138
+    t151 = t130*t138
+    t152 = t150 - t137*t151
+    t153 = t151 + t137*t150
+    t154 = t121*t144 + t125*t148 + t129*t152
+    t155 = xp.not_equal(t154, 0)
+    t156 = (-t117 + t140)/xp.where(t155, 2*t154, 1)
+    t157 = xp.abs(t156)
+    t158 = xp.greater_equal(t157, 1)
+    t159 = 1/xp.abs(xp.where(t158, t156, 1))
+    t160 = xp.where(t155, xp.where(xp.greater_equal(t156, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t158, t159/(1 + xp.sqrt(1 + t159**2)), 1/(t157 + xp.sqrt(1 + t157**2))), 0)
+    t161 = 1/xp.sqrt(1 + t160**2)
+    t162 = t154*t160
+    t163 = -t162 + t117
+    t164 = t140 + t162
+    t165 = t121*t161
+    t166 = t144*t161
+    t167 = t165 - t160*t166
+    t168 = t166 + t160*t165
+    t169 = t125*t161
+    t170 = t148*t161
+    t171 = t169 - t160*t170
+    t172 = t170 + t160*t169
+    t173 = t129*t161
+    t174 = t152*t161
+    t175 = t173 - t160*t174
+    t176 = t174 + t160*t173
+    t177 = t145*t167 + t149*t171 + t153*t175
+    t178 = xp.not_equal(t177, 0)
+    t179 = (-t163 + t141)/xp.where(t178, 2*t177, 1)
+    t180 = xp.abs(t179)
+    t181 = xp.greater_equal(t180, 1)
+    t182 = 1/xp.abs(xp.where(t181, t179, 1))
+    t183 = xp.where(t178, xp.where(xp.greater_equal(t179, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t181, t182/(1 + xp.sqrt(1 + t182**2)), 1/(t180 + xp.sqrt(1 + t180**2))), 0)
+    t184 = 1/xp.sqrt(1 + t183**2)
+    t185 = t177*t183
+    t186 = -t185 + t163
+    t187 = t141 + t185
+    t188 = t167*t184
+    t189 = t145*t184
+    t190 = t188 - t183*t189
+    t191 = t189 + t183*t188
+    t192 = t171*t184
+    t193 = t149*t184
+    t194 = t192 - t183*t193
+    t195 = t193 + t183*t192
+    t196 = t175*t184
+    t197 = t153*t184
+    t198 = t196 - t183*t197
+    t199 = t197 + t183*t196
+    t200 = t168*t191 + t172*t195 + t176*t199
+    t201 = xp.not_equal(t200, 0)
+    t202 = (-t164 + t187)/xp.where(t201, 2*t200, 1)
+    t203 = xp.abs(t202)
+    t204 = xp.greater_equal(t203, 1)
+    t205 = 1/xp.abs(xp.where(t204, t202, 1))
+    t206 = xp.where(t201, xp.where(xp.greater_equal(t202, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t204, t205/(1 + xp.sqrt(1 + t205**2)), 1/(t203 + xp.sqrt(1 + t203**2))), 0)
+    t207 = 1/xp.sqrt(1 + t206**2)
+    t208 = t200*t206
+    t209 = -t208 + t164
+    t210 = t187 + t208
+    t211 = t168*t207
+    t212 = t191*t207
+    t213 = t211 - t206*t212
+    t214 = t212 + t206*t211
+    t215 = t172*t207
+    t216 = t195*t207
+    t217 = t215 - t206*t216
+    t218 = t216 + t206*t215
+    t219 = t176*t207
+    t220 = t199*t207
+    t221 = t219 - t206*t220
+    t222 = t220 + t206*t219
+    t223 = t190*t213 + t194*t217 + t198*t221
+    t224 = xp.not_equal(t223, 0)
+    t225 = (-t186 + t209)/xp.where(t224, 2*t223, 1)
+    t226 = xp.abs(t225)
+    t227 = xp.greater_equal(t226, 1)
+    t228 = 1/xp.abs(xp.where(t227, t225, 1))
+    t229 = xp.where(t224, xp.where(xp.greater_equal(t225, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t227, t228/(1 + xp.sqrt(1 + t228**2)), 1/(t226 + xp.sqrt(1 + t226**2))), 0)
+    t230 = 1/xp.sqrt(1 + t229**2)
+    t231 = t223*t229
+    t232 = -t231 + t186
+    t233 = t209 + t231
+    t234 = t190*t230
+    t235 = t213*t230
+    t236 = t234 - t229*t235
+    t237 = t235 + t229*t234
+    t238 = t194*t230
+    t239 = t217*t230
+    t240 = t238 - t229*t239
+    t241 = t239 + t229*t238
+    t242 = t198*t230
+    t243 = t221*t230
+    t244 = t242 - t229*t243
+    t245 = t243 + t229*t242
+    t246 = t214*t236 + t218*t240 + t222*t244
+    t247 = xp.not_equal(t246, 0)
+    t248 = (-t232 + t210)/xp.where(t247, 2*t246, 1)
+    t249 = xp.abs(t248)
+    t250 = xp.greater_equal(t249, 1)
+    t251 = 1/xp.abs(xp.where(t250, t248, 1))
+    t252 = xp.where(t247, xp.where(xp.greater_equal(t248, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t250, t251/(1 + xp.sqrt(1 + t251**2)), 1/(t249 + xp.sqrt(1 + t249**2))), 0)
+    t253 = 1/xp.sqrt(1 + t252**2)
+    t254 = t246*t252
+    t255 = -t254 + t232
+    t256 = t210 + t254
+    t257 = t236*t253
+    t258 = t214*t253
+    t259 = t257 - t252*t258
+    t260 = t258 + t252*t257
+    t261 = t240*t253
+    t262 = t218*t253
+    t263 = t261 - t252*t262
+    t264 = t262 + t252*t261
+    t265 = t244*t253
+    t266 = t222*t253
+    t267 = t265 - t252*t266
+    t268 = t266 + t252*t265
+    t269 = t237*t260 + t241*t264 + t245*t268
+    t270 = xp.not_equal(t269, 0)
+    t271 = (-t233 + t256)/xp.where(t270, 2*t269, 1)
+    t272 = xp.abs(t271)
+    t273 = xp.greater_equal(t272, 1)
+    t274 = 1/xp.abs(xp.where(t273, t271, 1))
+    t275 = xp.where(t270, xp.where(xp.greater_equal(t271, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t273, t274/(1 + xp.sqrt(1 + t274**2)), 1/(t272 + xp.sqrt(1 + t272**2))), 0)
+    t276 = 1/xp.sqrt(1 + t275**2)
+    t277 = t269*t275
+    t278 = -t277 + t233
+    t279 = t256 + t277
+    t280 = t237*t276
+    t281 = t260*t276
+    t282 = t280 - t275*t281
+    t283 = t281 + t275*t280
+    t284 = t241*t276
+    t285 = t264*t276
+    t286 = t284 - t275*t285
+    t287 = t285 + t275*t284
+    t288 = t245*t276
+    t289 = t268*t276
+    t290 = t288 - t275*t289
+    t291 = t289 + t275*t288
+    t292 = t259*t282 + t263*t286 + t267*t290
+    t293 = xp.not_equal(t292, 0)
+    t294 = (-t255 + t278)/xp.where(t293, 2*t292, 1)
+    t295 = xp.abs(t294)
+    t296 = xp.greater_equal(t295, 1)
+    t297 = 1/xp.abs(xp.where(t296, t294, 1))
+    t298 = xp.where(t293, xp.where(xp.greater_equal(t294, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t296, t297/(1 + xp.sqrt(1 + t297**2)), 1/(t295 + xp.sqrt(1 + t295**2))), 0)
+    t299 = 1/xp.sqrt(1 + t298**2)
+    t300 = t292*t298
+    t301 = -t300 + t255
+    t302 = t278 + t300
+    t303 = t259*t299
+    t304 = t282*t299
+    t305 = t303 - t298*t304
+    t306 = t304 + t298*t303
+    t307 = t263*t299
+    t308 = t286*t299
+    t309 = t307 - t298*t308
+    t310 = t308 + t298*t307
+    t311 = t267*t299
+    t312 = t290*t299
+    t313 = t311 - t298*t312
+    t314 = t312 + t298*t311
+    t315 = t283*t305 + t287*t309 + t291*t313
+    t316 = xp.not_equal(t315, 0)
+    t317 = (-t301 + t279)/xp.where(t316, 2*t315, 1)
+    t318 = xp.abs(t317)
+    t319 = xp.greater_equal(t318, 1)
+    t320 = 1/xp.abs(xp.where(t319, t317, 1))
+    t321 = xp.where(t316, xp.where(xp.greater_equal(t317, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t319, t320/(1 + xp.sqrt(1 + t320**2)), 1/(t318 + xp.sqrt(1 + t318**2))), 0)
+    t322 = 1/xp.sqrt(1 + t321**2)
+    t323 = t315*t321
+    t324 = -t323 + t301
+    t325 = t279 + t323
+    t326 = t305*t322
+    t327 = t283*t322
+    t328 = t326 - t321*t327
+    t329 = t327 + t321*t326
+    t330 = t309*t322
+    t331 = t287*t322
+    t332 = t330 - t321*t331
+    t333 = t331 + t321*t330
+    t334 = t313*t322
+    t335 = t291*t322
+    t336 = t334 - t321*t335
+    t337 = t335 + t321*t334
+    t338 = t306*t329 + t310*t333 + t314*t337
+    t339 = xp.not_equal(t338, 0)
+    t340 = (-t302 + t325)/xp.where(t339, 2*t338, 1)
+    t341 = xp.abs(t340)
+    t342 = xp.greater_equal(t341, 1)
+    t343 = 1/xp.abs(xp.where(t342, t340, 1))
+    t344 = xp.where(t339, xp.where(xp.greater_equal(t340, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t342, t343/(1 + xp.sqrt(1 + t343**2)), 1/(t341 + xp.sqrt(1 + t341**2))), 0)
+    t345 = 1/xp.sqrt(1 + t344**2)
+    t346 = t338*t344
+    t347 = -t346 + t302
+    t348 = t325 + t346
+    t349 = t306*t345
+    t350 = t329*t345
+    t351 = t349 - t344*t350
+    t352 = t350 + t344*t349
+    t353 = t310*t345
+    t354 = t333*t345
+    t355 = t353 - t344*t354
+    t356 = t354 + t344*t353
+    t357 = t314*t345
+    t358 = t337*t345
+    t359 = t357 - t344*t358
+    t360 = t358 + t344*t357
+    t361 = t328*t351 + t332*t355 + t336*t359
+    t362 = xp.not_equal(t361, 0)
+    t363 = (-t324 + t347)/xp.where(t362, 2*t361, 1)
+    t364 = xp.abs(t363)
+    t365 = xp.greater_equal(t364, 1)
+    t366 = 1/xp.abs(xp.where(t365, t363, 1))
+    t367 = xp.where(t362, xp.where(xp.greater_equal(t363, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t365, t366/(1 + xp.sqrt(1 + t366**2)), 1/(t364 + xp.sqrt(1 + t364**2))), 0)
+    t368 = 1/xp.sqrt(1 + t367**2)
+    t369 = t361*t367
+    t370 = -t369 + t324
+    t371 = t347 + t369
+    t372 = t328*t368
+    t373 = t351*t368
+    t374 = t372 - t367*t373
+    t375 = t373 + t367*t372
+    t376 = t332*t368
+    t377 = t355*t368
+    t378 = t376 - t367*t377
+    t379 = t377 + t367*t376
+    t380 = t336*t368
+    t381 = t359*t368
+    t382 = t380 - t367*t381
+    t383 = t381 + t367*t380
+    t384 = t352*t374 + t356*t378 + t360*t382
+    t385 = xp.not_equal(t384, 0)
+    t386 = (-t370 + t348)/xp.where(t385, 2*t384, 1)
+    t387 = xp.abs(t386)
+    t388 = xp.greater_equal(t387, 1)
+    t389 = 1/xp.abs(xp.where(t388, t386, 1))
+    t390 = xp.where(t385, xp.where(xp.greater_equal(t386, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t388, t389/(1 + xp.sqrt(1 + t389**2)), 1/(t387 + xp.sqrt(1 + t387**2))), 0)
+    t391 = 1/xp.sqrt(1 + t390**2)
+    t392 = t384*t390
+    t393 = -t392 + t370
+    t394 = t348 + t392
+    t395 = t374*t391
+    t396 = t352*t391
+    t397 = t395 - t390*t396
+    t398 = t396 + t390*t395
+    t399 = t378*t391
+    t400 = t356*t391
+    t401 = t399 - t390*t400
+    t402 = t400 + t390*t399
+    t403 = t382*t391
+    t404 = t360*t391
+    t405 = t403 - t390*t404
+    t406 = t404 + t390*t403
+    t407 = t375*t398 + t379*t402 + t383*t406
+    t408 = xp.not_equal(t407, 0)
+    t409 = (-t371 + t394)/xp.where(t408, 2*t407, 1)
+    t410 = xp.abs(t409)
+    t411 = xp.greater_equal(t410, 1)
+    t412 = 1/xp.abs(xp.where(t411, t409, 1))
+    t413 = xp.where(t408, xp.where(xp.greater_equal(t409, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t411, t412/(1 + xp.sqrt(1 + t412**2)), 1/(t410 + xp.sqrt(1 + t410**2))), 0)
+    t414 = 1/xp.sqrt(1 + t413**2)
+    t415 = t407*t413
+    t416 = -t415 + t371
+    t417 = t394 + t415
+    t418 = t375*t414
+    t419 = t398*t414
+    t420 = t418 - t413*t419
+    t421 = t419 + t413*t418
+    t422 = t379*t414
+    t423 = t402*t414
+    t424 = t422 - t413*t423
+    t425 = t423 + t413*t422
+    t426 = t383*t414
+    t427 = t406*t414
+    t428 = t426 - t413*t427
+    t429 = t427 + t413*t426
+    t430 = t397*t420 + t401*t424 + t405*t428
+    t431 = xp.not_equal(t430, 0)
+    t432 = (-t393 + t416)/xp.where(t431, 2*t430, 1)
+    t433 = xp.abs(t432)
+    t434 = xp.greater_equal(t433, 1)
+    t435 = 1/xp.abs(xp.where(t434, t432, 1))
+    t436 = xp.where(t431, xp.where(xp.greater_equal(t432, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t434, t435/(1 + xp.sqrt(1 + t435**2)), 1/(t433 + xp.sqrt(1 + t433**2))), 0)
+    t437 = 1/xp.sqrt(1 + t436**2)
+    t438 = t430*t436
+    t439 = -t438 + t393
+    t440 = t416 + t438
+    t441 = t397*t437
+    t442 = t420*t437
+    t443 = t441 - t436*t442
+    t444 = t442 + t436*t441
+    t445 = t401*t437
+    t446 = t424*t437
+    t447 = t445 - t436*t446
+    t448 = t446 + t436*t445
+    t449 = t405*t437
+    t450 = t428*t437
+    t451 = t449 - t436*t450
+    t452 = t450 + t436*t449
+    t453 = t421*t443 + t425*t447 + t429*t451
+    t454 = xp.not_equal(t453, 0)
+    t455 = (-t439 + t417)/xp.where(t454, 2*t453, 1)
+    t456 = xp.abs(t455)
+    t457 = xp.greater_equal(t456, 1)
+    t458 = 1/xp.abs(xp.where(t457, t455, 1))
+    t459 = xp.where(t454, xp.where(xp.greater_equal(t455, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t457, t458/(1 + xp.sqrt(1 + t458**2)), 1/(t456 + xp.sqrt(1 + t456**2))), 0)
+    t460 = 1/xp.sqrt(1 + t459**2)
+    t461 = t417 + t453*t459
+    t462 = t443*t460
+    t463 = t421*t460
+    t464 = t462 - t459*t463
+    t465 = t463 + t459*t462
+    t466 = t447*t460
+    t467 = t425*t460
+    t468 = t466 - t459*t467
+    t469 = t467 + t459*t466
+    t470 = t451*t460
+    t471 = t429*t460
+    t472 = t470 - t459*t471
+    t473 = t471 + t459*t470
+    t474 = t444*t465 + t448*t469 + t452*t473
+    t475 = xp.sqrt(t464**2 + t468**2 + t472**2)
+    t476 = xp.not_equal(t474, 0)
+    t477 = (-t440 + t461)/xp.where(t476, 2*t474, 1)
+    t478 = xp.abs(t477)
+    t479 = xp.greater_equal(t478, 1)
+    t480 = 1/xp.abs(xp.where(t479, t477, 1))
+    t481 = xp.where(t476, xp.where(xp.greater_equal(t477, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t479, t480/(1 + xp.sqrt(1 + t480**2)), 1/(t478 + xp.sqrt(1 + t478**2))), 0)
+    t482 = 1/xp.sqrt(1 + t481**2)
+    t483 = t444*t482
+    t484 = t465*t482
+    t485 = t483 - t481*t484
+    t486 = t484 + t481*t483
+    t487 = t448*t482
+    t488 = t469*t482
+    t489 = t487 - t481*t488
+    t490 = t488 + t481*t487
+    t491 = t452*t482
+    t492 = t473*t482
+    t493 = t491 - t481*t492
+    t494 = t492 + t481*t491
     t495 = xp.sqrt(t485**2 + t489**2 + t493**2)
-    t496 = xp.where(xp.greater(t494, t474), t494, t474)
-    t497 = xp.where(xp.less(t494, t474), t494, t474)
-    t498 = xp.where(xp.greater(1.8823529411764706, t496), 1.8823529411764706, t496)
-    t499 = xp.where(xp.less(1.8823529411764706, t497), 1.8823529411764706, t497)
-    t500 = xp.where(xp.greater(t495, t498), t495, t498)
-    t501 = xp.where(xp.less(t495, t499), t495, t499)
-    t502 = xp.where(xp.less_equal(t501, 1e-12*t500), 0, t501)
-    t503 = xp.where(xp.greater(t500, 0), t500, 1)
-    kappa = xp.broadcast_to(t503/t502, batch)
+    t496 = xp.sqrt(t486**2 + t490**2 + t494**2)
+    t497 = xp.where(xp.greater(t495, t475), t495, t475)
+    t498 = xp.where(xp.less(t495, t475), t495, t475)
+    t499 = xp.where(xp.greater(1.8823529411764706, t497), 1.8823529411764706, t497)
+    t500 = xp.where(xp.less(1.8823529411764706, t498), 1.8823529411764706, t498)
+    t501 = xp.where(xp.greater(t496, t499), t496, t499)
+    t502 = xp.where(xp.less(t496, t500), t496, t500)
+    t503 = xp.where(xp.less_equal(t502, 1e-12*t501), 0, t502)
+    t504 = xp.where(xp.greater(t501, 0), t501, 1)
+    kappa = xp.broadcast_to(t504/t503, batch)
     return kappa
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 332 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 315 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (4,)), ("mu_dot", mu_dot, (4,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -1647,119 +1649,129 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t1 = 0.325*c1 + t0
     t2 = 0.275*s12
     t3 = 0.325*s1 + t2
-    t4 = 0.075625*c12*s12 + t1*t3
+    t4 = t1*t3 + 0.075625*c12*s12
     t5 = t3 + t2
     t6 = t3**2
     t7 = t6 + 0.075625*s12**2
     t8 = t1**2
     t9 = xp.sqrt(1 + t6 + t8)
     t10 = xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)*t9
-    t11 = xp.where(xp.greater(t9, 0), 1/(t9*(xp.abs(t3) + t9)), 0)
-    t12 = -1 + t11
-    t13 = t8 + 0.075625*c12**2
-    t14 = xp.sqrt(4 + t7 + t13)
-    t15 = t1 + t0
-    t16 = t4**2
-    t17 = t5**2
-    t18 = damping**2
-    t19 = t7 + t18
-    t20 = t19**2
-    t21 = xp.sqrt(t16 + t17 + t20)
-    t22 = t21*xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)
-    t23 = t19 + t22
-    t24 = xp.where(xp.greater(t21, 0), 1/(t21*(t21 + xp.abs(t19))), 0)
-    t25 = -t24*(-mu_dot0*t23 + mu_dot1*t4 + mu_dot3*t5)
-    t26 = mu_dot0 - t23*t25
-    t27 = mu_dot1 + t4*t25
-    t28 = mu_dot3 + t5*t25
-    t29 = t13 + t18
-    t30 = -t24*(t4*t23 + t29*t4 + t15*t5)
-    t31 = t4 + t23*t30
-    t32 = t29 + t4*t30
-    t33 = t15 + t5*t30
-    t34 = xp.sqrt(t32**2 + t33**2)
-    t35 = t34*xp.where(xp.greater_equal(t32, 0), xp.asarray(1, dtype=dtype), -1)
-    t36 = t32 + t35
-    t37 = xp.where(xp.greater(t34, 0), 1/(t34*(t34 + xp.abs(t32))), 0)
-    t38 = t37*(t27*t36 + t33*t28)
-    t39 = t27 - t36*t38
-    t40 = t28 - t33*t38
-    t41 = 1 + t18
-    t42 = 3 + t18
-    t43 = xp.sqrt(2*t16 + 2*t17 + 2*t15**2 + t20 + t29**2 + t41**2 + t42**2)
-    t44 = -t24*(t5*t23 + t42*t5 + t15*t4)
-    t45 = t5 + t23*t44
-    t46 = t15 + t4*t44
-    t47 = t42 + t5*t44
-    t48 = t37*(t46*t36 + t33*t47)
-    t49 = t46 - t36*t48
-    t50 = t47 - t33*t48
-    t51 = xp.abs(t41)
-    t52 = t51*xp.where(xp.greater_equal(t41, 0), xp.asarray(1, dtype=dtype), -1)
-    t53 = t41 + t52
-    t54 = xp.where(xp.greater(t51, 0), 1/(t51*2*t51), 0)
-    t55 = mu_dot2 - mu_dot2*t53**2*t54
-    t56 = xp.where(xp.not_equal(t52, 0), -t55/t52, 0)
-    t57 = xp.abs(t50)
-    t58 = t57*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
-    t59 = t50 + t58
-    t60 = xp.where(xp.greater(t57, 0), 1/(t57*2*t57), 0)
-    t61 = t40 - t40*t59**2*t60
-    t62 = xp.where(xp.not_equal(t58, 0), -t61/t58, 0)
-    t63 = xp.where(xp.not_equal(t35, 0), -(t39 - t49*t62)/t35, 0)
-    t64 = xp.where(xp.not_equal(t22, 0), -(t26 + t31*t63 + t45*t62)/t22, 0)
-    t65 = t62 - t3*t64 + t1*t63
-    t66 = t62 - t2*t64 + t0*t63
-    t67 = -t3
-    t68 = t67 + t10
-    t69 = t11*(1 - t2*t68 + t1*t0)
-    t70 = t2 + t68*t69
-    t71 = t0 - t1*t69
-    t72 = 1 - t69
-    t73 = t11*(mu_dot3 + mu_dot0*t68 + t1*mu_dot1)
-    t74 = mu_dot0 - t68*t73
-    t75 = mu_dot1 - t1*t73
-    t76 = -t73 + mu_dot3
-    t77 = xp.sqrt(t71**2 + t72**2)
-    t78 = t77*xp.where(xp.greater_equal(t71, 0), xp.asarray(1, dtype=dtype), -1)
-    t79 = t71 + t78
-    t80 = xp.where(xp.greater(t77, 0), 1/(t77*(t77 + xp.abs(t71))), 0)
-    t81 = t80*(t75*t79 + t72*t76)
-    t82 = t75 - t79*t81
-    t83 = t76 - t72*t81
-    t84 = -t2 + q1 + q2 + q3 + q4 + t15 + t67 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping
-    t85 = t1*t11
-    t86 = t80*(t72*t12 + t85*t79)
-    t87 = t85 - t79*t86
-    t88 = t12 - t72*t86
-    t89 = xp.abs(t88)
-    t90 = t89*xp.where(xp.greater_equal(t88, 0), xp.asarray(1, dtype=dtype), -1)
-    t91 = t88 + t90
-    t92 = xp.where(xp.greater(t89, 0), 1/(t89*2*t89), 0)
-    t93 = t83 - t83*t91**2*t92
-    t94 = xp.where(xp.not_equal(t90, 0), -t93/t90, 0)
-    t95 = xp.where(xp.not_equal(t78, 0), -(t82 - t87*t94)/t78, 0)
-    t96 = xp.where(xp.not_equal(t10, 0), -(-(-t70*t95 + t68*t11*t94) + t74)/t10, 0)
-    t97 = xp.isfinite(t84)
-    t98 = xp.greater_equal(damping, 0)
-    t99 = xp.greater(damping, 0)
-    t100 = 1e-12*t43
-    t101 = 1e-12*t14
-    t102 = (t99 & (xp.less_equal(t21, t100) | xp.less_equal(t34, t100) | xp.less_equal(t51, t100) | xp.less_equal(t57, t100))) | (xp.less_equal(damping, 0) & (xp.less_equal(t9, t101) | xp.less_equal(t77, t101) | xp.less_equal(1, t101) | xp.less_equal(t89, t101)))
-    t103 = t97 & t98 & xp.logical_not(t102)
+    t11 = t8 + 0.075625*c12**2
+    t12 = xp.sqrt(4 + t7 + t11)
+    t13 = t1 + t0
+    t14 = t4**2
+    t15 = t5**2
+    t16 = damping**2
+    t17 = t7 + t16
+    t18 = t17**2
+    t19 = xp.sqrt(t14 + t15 + t18)
+    t20 = t19*xp.where(xp.greater_equal(t17, 0), xp.asarray(1, dtype=dtype), -1)
+    t21 = t11 + t16
+    t22 = 1 + t16
+    t23 = 3 + t16
+    t24 = xp.sqrt(2*t14 + 2*t15 + 2*t13**2 + t18 + t21**2 + t22**2 + t23**2)
+    t25 = xp.greater(t19, 0)
+    t26 = xp.where(t25, 1/(t17 + t20), 0)
+    t27 = xp.where(t25, 1 + xp.abs(t17)/t19, 0)
+    t28 = t4*t26
+    t29 = t5*t26
+    t30 = -t27*(t4 + t21*t28 + t13*t29)
+    t31 = t4 + t30
+    t32 = t21 + t28*t30
+    t33 = t13 + t29*t30
+    t34 = -t27*(t5 + t23*t29 + t13*t28)
+    t35 = t5 + t34
+    t36 = t13 + t28*t34
+    t37 = t23 + t29*t34
+    t38 = -t27*(-mu_dot0 + t28*mu_dot1 + t29*mu_dot3)
+    t39 = -t38 + mu_dot0
+    t40 = mu_dot1 + t28*t38
+    t41 = mu_dot3 + t29*t38
+    t42 = xp.sqrt(t32**2 + t33**2)
+    t43 = t42*xp.where(xp.greater_equal(t32, 0), xp.asarray(1, dtype=dtype), -1)
+    t44 = xp.greater(t42, 0)
+    t45 = xp.where(t44, 1/(t32 + t43), 0)
+    t46 = xp.where(t44, 1 + xp.abs(t32)/t42, 0)
+    t47 = t33*t45
+    t48 = t46*(t36 + t47*t37)
+    t49 = -t48 + t36
+    t50 = t37 - t47*t48
+    t51 = t46*(t40 + t47*t41)
+    t52 = -t51 + t40
+    t53 = t41 - t47*t51
+    t54 = xp.abs(t22)
+    t55 = t54*xp.where(xp.greater_equal(t22, 0), xp.asarray(1, dtype=dtype), -1)
+    t56 = xp.where(xp.greater(t54, 0), xp.asarray(2, dtype=dtype), 0)
+    t57 = mu_dot2 - mu_dot2*t56
+    t58 = xp.where(xp.not_equal(t55, 0), -t57/t55, 0)
+    t59 = xp.abs(t50)
+    t60 = t59*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
+    t61 = xp.where(xp.greater(t59, 0), xp.asarray(2, dtype=dtype), 0)
+    t62 = t53 - t53*t61
+    t63 = xp.where(xp.not_equal(t60, 0), -t62/t60, 0)
+    t64 = xp.where(xp.not_equal(t43, 0), -(t52 - t49*t63)/t43, 0)
+    t65 = xp.where(xp.not_equal(t20, 0), -(t39 + t31*t64 + t35*t63)/t20, 0)
+    t66 = t63 - t3*t65 + t1*t64
+    t67 = t63 - t2*t65 + t0*t64
+    t68 = xp.greater(t9, 0)
+    t69 = xp.where(t68, 1 + xp.abs(t3)/t9, 0)
+    t70 = -t3
+    t71 = xp.where(t68, 1/(t70 + t10), 0)
+    t72 = -t2
+    t73 = q1 + q2 + q3 + q4 + t13 + t70 + t72 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping
+    t74 = t1*t71
+    t75 = t69*(t72 + t71 + t0*t74)
+    t76 = t2 + t75
+    t77 = t69*(mu_dot0 + mu_dot3*t71 + t74*mu_dot1)
+    t78 = -t77 + mu_dot0
+    t79 = t71*t75
+    t80 = t0 - t1*t79
+    t81 = 1 - t79
+    t82 = xp.sqrt(t80**2 + t81**2)
+    t83 = t82*xp.where(xp.greater_equal(t80, 0), xp.asarray(1, dtype=dtype), -1)
+    t84 = t71**2*t69
+    t85 = t1*t84
+    t86 = -1 + t84
+    t87 = t71*t77
+    t88 = mu_dot1 - t1*t87
+    t89 = -t87 + mu_dot3
+    t90 = xp.greater(t82, 0)
+    t91 = xp.where(t90, 1/(t80 + t83), 0)
+    t92 = xp.where(t90, 1 + xp.abs(t80)/t82, 0)
+    t93 = t81*t91
+    t94 = t92*(t85 + t93*t86)
+    t95 = -t94 + t85
+    t96 = t86 - t93*t94
+    t97 = t92*(t88 + t93*t89)
+    t98 = -t97 + t88
+    t99 = t89 - t93*t97
+    t100 = xp.abs(t96)
+    t101 = t100*xp.where(xp.greater_equal(t96, 0), xp.asarray(1, dtype=dtype), -1)
+    t102 = xp.where(xp.greater(t100, 0), xp.asarray(2, dtype=dtype), 0)
+    t103 = t99 - t99*t102
+    t104 = xp.where(xp.not_equal(t101, 0), -t103/t101, 0)
+    t105 = xp.where(xp.not_equal(t83, 0), -(t98 - t95*t104)/t83, 0)
+    t106 = xp.where(xp.not_equal(t10, 0), -(-(-t76*t105 + t71*t69*t104) + t78)/t10, 0)
+    t107 = xp.isfinite(t73)
+    t108 = xp.greater_equal(damping, 0)
+    t109 = xp.greater(damping, 0)
+    t110 = 1e-12*t24
+    t111 = 1e-12*t12
+    t112 = (t109 & (xp.less_equal(t19, t110) | xp.less_equal(t42, t110) | xp.less_equal(t54, t110) | xp.less_equal(t59, t110))) | (xp.less_equal(damping, 0) & (xp.less_equal(t9, t111) | xp.less_equal(t82, t111) | xp.less_equal(1, t111) | xp.less_equal(t100, t111)))
+    t113 = t107 & t108 & xp.logical_not(t112)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t103, xp.where(t99, t65, t96), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t103, xp.where(t99, t66, t95), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t103, xp.where(t99, -t56, -mu_dot2), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t103, xp.where(t99, -t62, t94), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t113, xp.where(t109, t66, t106), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t113, xp.where(t109, t67, t105), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t113, xp.where(t109, -t58, -mu_dot2), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t113, xp.where(t109, -t63, t104), 0), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t97 & t98), 2, xp.where(t102, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t107 & t108), 2, xp.where(t112, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
-    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 336 operations."""
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 319 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (4,)), ("mu_dot", mu_dot, (4,)), ("z", z, (4,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -1784,119 +1796,129 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     t1 = 0.325*c1 + t0
     t2 = 0.275*s12
     t3 = 0.325*s1 + t2
-    t4 = 0.075625*c12*s12 + t1*t3
+    t4 = t1*t3 + 0.075625*c12*s12
     t5 = t3 + t2
     t6 = t3**2
     t7 = t6 + 0.075625*s12**2
     t8 = t1**2
     t9 = xp.sqrt(1 + t6 + t8)
     t10 = xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)*t9
-    t11 = xp.where(xp.greater(t9, 0), 1/(t9*(xp.abs(t3) + t9)), 0)
-    t12 = -1 + t11
-    t13 = t8 + 0.075625*c12**2
-    t14 = xp.sqrt(4 + t7 + t13)
-    t15 = t1 + t0
-    t16 = t4**2
-    t17 = t5**2
-    t18 = damping**2
-    t19 = t7 + t18
-    t20 = t19**2
-    t21 = xp.sqrt(t16 + t17 + t20)
-    t22 = t21*xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)
-    t23 = t19 + t22
-    t24 = xp.where(xp.greater(t21, 0), 1/(t21*(t21 + xp.abs(t19))), 0)
-    t25 = -t24*(-mu_dot0*t23 + mu_dot1*t4 + mu_dot3*t5)
-    t26 = mu_dot0 - t23*t25
-    t27 = mu_dot1 + t4*t25
-    t28 = mu_dot3 + t5*t25
-    t29 = t13 + t18
-    t30 = -t24*(t4*t23 + t29*t4 + t15*t5)
-    t31 = t4 + t23*t30
-    t32 = t29 + t4*t30
-    t33 = t15 + t5*t30
-    t34 = xp.sqrt(t32**2 + t33**2)
-    t35 = t34*xp.where(xp.greater_equal(t32, 0), xp.asarray(1, dtype=dtype), -1)
-    t36 = t32 + t35
-    t37 = xp.where(xp.greater(t34, 0), 1/(t34*(t34 + xp.abs(t32))), 0)
-    t38 = t37*(t27*t36 + t33*t28)
-    t39 = t27 - t36*t38
-    t40 = t28 - t33*t38
-    t41 = 1 + t18
-    t42 = 3 + t18
-    t43 = xp.sqrt(2*t16 + 2*t17 + 2*t15**2 + t20 + t29**2 + t41**2 + t42**2)
-    t44 = -t24*(t5*t23 + t42*t5 + t15*t4)
-    t45 = t5 + t23*t44
-    t46 = t15 + t4*t44
-    t47 = t42 + t5*t44
-    t48 = t37*(t46*t36 + t33*t47)
-    t49 = t46 - t36*t48
-    t50 = t47 - t33*t48
-    t51 = xp.abs(t41)
-    t52 = t51*xp.where(xp.greater_equal(t41, 0), xp.asarray(1, dtype=dtype), -1)
-    t53 = t41 + t52
-    t54 = xp.where(xp.greater(t51, 0), 1/(t51*2*t51), 0)
-    t55 = mu_dot2 - mu_dot2*t53**2*t54
-    t56 = xp.where(xp.not_equal(t52, 0), -t55/t52, 0)
-    t57 = xp.abs(t50)
-    t58 = t57*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
-    t59 = t50 + t58
-    t60 = xp.where(xp.greater(t57, 0), 1/(t57*2*t57), 0)
-    t61 = t40 - t40*t59**2*t60
-    t62 = xp.where(xp.not_equal(t58, 0), -t61/t58, 0)
-    t63 = xp.where(xp.not_equal(t35, 0), -(t39 - t49*t62)/t35, 0)
-    t64 = xp.where(xp.not_equal(t22, 0), -(t26 + t31*t63 + t45*t62)/t22, 0)
-    t65 = t62 - t3*t64 + t1*t63
-    t66 = t62 - t2*t64 + t0*t63
-    t67 = -t3
-    t68 = t67 + t10
-    t69 = t11*(1 - t2*t68 + t1*t0)
-    t70 = t2 + t68*t69
-    t71 = t0 - t1*t69
-    t72 = 1 - t69
-    t73 = t11*(mu_dot3 + mu_dot0*t68 + t1*mu_dot1)
-    t74 = mu_dot0 - t68*t73
-    t75 = mu_dot1 - t1*t73
-    t76 = -t73 + mu_dot3
-    t77 = xp.sqrt(t71**2 + t72**2)
-    t78 = t77*xp.where(xp.greater_equal(t71, 0), xp.asarray(1, dtype=dtype), -1)
-    t79 = t71 + t78
-    t80 = xp.where(xp.greater(t77, 0), 1/(t77*(t77 + xp.abs(t71))), 0)
-    t81 = t80*(t75*t79 + t72*t76)
-    t82 = t75 - t79*t81
-    t83 = t76 - t72*t81
-    t84 = -t2 + q1 + q2 + q3 + q4 + t15 + t67 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + qz1 + qz2 + qz3 + qz4
-    t85 = t1*t11
-    t86 = t80*(t72*t12 + t85*t79)
-    t87 = t85 - t79*t86
-    t88 = t12 - t72*t86
-    t89 = xp.abs(t88)
-    t90 = t89*xp.where(xp.greater_equal(t88, 0), xp.asarray(1, dtype=dtype), -1)
-    t91 = t88 + t90
-    t92 = xp.where(xp.greater(t89, 0), 1/(t89*2*t89), 0)
-    t93 = t83 - t83*t91**2*t92
-    t94 = xp.where(xp.not_equal(t90, 0), -t93/t90, 0)
-    t95 = xp.where(xp.not_equal(t78, 0), -(t82 - t87*t94)/t78, 0)
-    t96 = xp.where(xp.not_equal(t10, 0), -(-(-t70*t95 + t68*t11*t94) + t74)/t10, 0)
-    t97 = xp.isfinite(t84)
-    t98 = xp.greater_equal(damping, 0)
-    t99 = xp.greater(damping, 0)
-    t100 = 1e-12*t43
-    t101 = 1e-12*t14
-    t102 = (t99 & (xp.less_equal(t21, t100) | xp.less_equal(t34, t100) | xp.less_equal(t51, t100) | xp.less_equal(t57, t100))) | (xp.less_equal(damping, 0) & (xp.less_equal(t9, t101) | xp.less_equal(t77, t101) | xp.less_equal(1, t101) | xp.less_equal(t89, t101)))
-    t103 = t97 & t98 & xp.logical_not(t102)
+    t11 = t8 + 0.075625*c12**2
+    t12 = xp.sqrt(4 + t7 + t11)
+    t13 = t1 + t0
+    t14 = t4**2
+    t15 = t5**2
+    t16 = damping**2
+    t17 = t7 + t16
+    t18 = t17**2
+    t19 = xp.sqrt(t14 + t15 + t18)
+    t20 = t19*xp.where(xp.greater_equal(t17, 0), xp.asarray(1, dtype=dtype), -1)
+    t21 = t11 + t16
+    t22 = 1 + t16
+    t23 = 3 + t16
+    t24 = xp.sqrt(2*t14 + 2*t15 + 2*t13**2 + t18 + t21**2 + t22**2 + t23**2)
+    t25 = xp.greater(t19, 0)
+    t26 = xp.where(t25, 1/(t17 + t20), 0)
+    t27 = xp.where(t25, 1 + xp.abs(t17)/t19, 0)
+    t28 = t4*t26
+    t29 = t5*t26
+    t30 = -t27*(t4 + t21*t28 + t13*t29)
+    t31 = t4 + t30
+    t32 = t21 + t28*t30
+    t33 = t13 + t29*t30
+    t34 = -t27*(t5 + t23*t29 + t13*t28)
+    t35 = t5 + t34
+    t36 = t13 + t28*t34
+    t37 = t23 + t29*t34
+    t38 = -t27*(-mu_dot0 + t28*mu_dot1 + t29*mu_dot3)
+    t39 = -t38 + mu_dot0
+    t40 = mu_dot1 + t28*t38
+    t41 = mu_dot3 + t29*t38
+    t42 = xp.sqrt(t32**2 + t33**2)
+    t43 = t42*xp.where(xp.greater_equal(t32, 0), xp.asarray(1, dtype=dtype), -1)
+    t44 = xp.greater(t42, 0)
+    t45 = xp.where(t44, 1/(t32 + t43), 0)
+    t46 = xp.where(t44, 1 + xp.abs(t32)/t42, 0)
+    t47 = t33*t45
+    t48 = t46*(t36 + t47*t37)
+    t49 = -t48 + t36
+    t50 = t37 - t47*t48
+    t51 = t46*(t40 + t47*t41)
+    t52 = -t51 + t40
+    t53 = t41 - t47*t51
+    t54 = xp.abs(t22)
+    t55 = t54*xp.where(xp.greater_equal(t22, 0), xp.asarray(1, dtype=dtype), -1)
+    t56 = xp.where(xp.greater(t54, 0), xp.asarray(2, dtype=dtype), 0)
+    t57 = mu_dot2 - mu_dot2*t56
+    t58 = xp.where(xp.not_equal(t55, 0), -t57/t55, 0)
+    t59 = xp.abs(t50)
+    t60 = t59*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
+    t61 = xp.where(xp.greater(t59, 0), xp.asarray(2, dtype=dtype), 0)
+    t62 = t53 - t53*t61
+    t63 = xp.where(xp.not_equal(t60, 0), -t62/t60, 0)
+    t64 = xp.where(xp.not_equal(t43, 0), -(t52 - t49*t63)/t43, 0)
+    t65 = xp.where(xp.not_equal(t20, 0), -(t39 + t31*t64 + t35*t63)/t20, 0)
+    t66 = t63 - t3*t65 + t1*t64
+    t67 = t63 - t2*t65 + t0*t64
+    t68 = xp.greater(t9, 0)
+    t69 = xp.where(t68, 1 + xp.abs(t3)/t9, 0)
+    t70 = -t3
+    t71 = xp.where(t68, 1/(t70 + t10), 0)
+    t72 = -t2
+    t73 = q1 + q2 + q3 + q4 + t13 + t70 + t72 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + qz1 + qz2 + qz3 + qz4
+    t74 = t1*t71
+    t75 = t69*(t72 + t71 + t0*t74)
+    t76 = t2 + t75
+    t77 = t69*(mu_dot0 + mu_dot3*t71 + t74*mu_dot1)
+    t78 = -t77 + mu_dot0
+    t79 = t71*t75
+    t80 = t0 - t1*t79
+    t81 = 1 - t79
+    t82 = xp.sqrt(t80**2 + t81**2)
+    t83 = t82*xp.where(xp.greater_equal(t80, 0), xp.asarray(1, dtype=dtype), -1)
+    t84 = t71**2*t69
+    t85 = t1*t84
+    t86 = -1 + t84
+    t87 = t71*t77
+    t88 = mu_dot1 - t1*t87
+    t89 = -t87 + mu_dot3
+    t90 = xp.greater(t82, 0)
+    t91 = xp.where(t90, 1/(t80 + t83), 0)
+    t92 = xp.where(t90, 1 + xp.abs(t80)/t82, 0)
+    t93 = t81*t91
+    t94 = t92*(t85 + t93*t86)
+    t95 = -t94 + t85
+    t96 = t86 - t93*t94
+    t97 = t92*(t88 + t93*t89)
+    t98 = -t97 + t88
+    t99 = t89 - t93*t97
+    t100 = xp.abs(t96)
+    t101 = t100*xp.where(xp.greater_equal(t96, 0), xp.asarray(1, dtype=dtype), -1)
+    t102 = xp.where(xp.greater(t100, 0), xp.asarray(2, dtype=dtype), 0)
+    t103 = t99 - t99*t102
+    t104 = xp.where(xp.not_equal(t101, 0), -t103/t101, 0)
+    t105 = xp.where(xp.not_equal(t83, 0), -(t98 - t95*t104)/t83, 0)
+    t106 = xp.where(xp.not_equal(t10, 0), -(-(-t76*t105 + t71*t69*t104) + t78)/t10, 0)
+    t107 = xp.isfinite(t73)
+    t108 = xp.greater_equal(damping, 0)
+    t109 = xp.greater(damping, 0)
+    t110 = 1e-12*t24
+    t111 = 1e-12*t12
+    t112 = (t109 & (xp.less_equal(t19, t110) | xp.less_equal(t42, t110) | xp.less_equal(t54, t110) | xp.less_equal(t59, t110))) | (xp.less_equal(damping, 0) & (xp.less_equal(t9, t111) | xp.less_equal(t82, t111) | xp.less_equal(1, t111) | xp.less_equal(t100, t111)))
+    t113 = t107 & t108 & xp.logical_not(t112)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t103, xp.where(t99, t65, t96), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t103, xp.where(t99, t66, t95), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t103, xp.where(t99, -t56, -mu_dot2), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t103, xp.where(t99, -t62, t94), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t113, xp.where(t109, t66, t106), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t113, xp.where(t109, t67, t105), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t113, xp.where(t109, -t58, -mu_dot2), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t113, xp.where(t109, -t63, t104), 0), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t97 & t98), 2, xp.where(t102, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t107 & t108), 2, xp.where(t112, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 364 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 347 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (4,)), ("target", target, (4,)), ("target_rate", target_rate, (4,)), ("gain", gain, (4,)), ("z", z, (4,)), ("damping", damping, ()), every=("gain", ))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -1936,122 +1958,132 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t6 = mu_dot0 + gain0*(-t5 + mu0)
     t7 = 0.275*s12
     t8 = 0.325*s1 + t7
-    t9 = 0.075625*c12*s12 + t5*t8
+    t9 = t5*t8 + 0.075625*c12*s12
     t10 = t8 + t7
     t11 = t8**2
     t12 = t11 + 0.075625*s12**2
     t13 = t5**2
     t14 = xp.sqrt(1 + t11 + t13)
     t15 = xp.where(xp.less_equal(t8, 0), xp.asarray(1, dtype=dtype), -1)*t14
-    t16 = xp.where(xp.greater(t14, 0), 1/(t14*(xp.abs(t8) + t14)), 0)
-    t17 = -1 + t16
-    t18 = t13 + 0.075625*c12**2
-    t19 = xp.sqrt(4 + t12 + t18)
-    t20 = t5 + t4
-    t21 = t9**2
-    t22 = t10**2
-    t23 = damping**2
-    t24 = t12 + t23
-    t25 = t24**2
-    t26 = xp.sqrt(t21 + t22 + t25)
-    t27 = t26*xp.where(xp.greater_equal(t24, 0), xp.asarray(1, dtype=dtype), -1)
-    t28 = t24 + t27
-    t29 = xp.where(xp.greater(t26, 0), 1/(t26*(t26 + xp.abs(t24))), 0)
-    t30 = t18 + t23
-    t31 = -t29*(t9*t28 + t30*t9 + t20*t10)
-    t32 = t9 + t28*t31
-    t33 = t30 + t9*t31
-    t34 = t20 + t10*t31
-    t35 = xp.sqrt(t33**2 + t34**2)
-    t36 = t35*xp.where(xp.greater_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)
-    t37 = t33 + t36
-    t38 = xp.where(xp.greater(t35, 0), 1/(t35*(t35 + xp.abs(t33))), 0)
-    t39 = 1 + t23
-    t40 = 3 + t23
-    t41 = xp.sqrt(2*t21 + 2*t22 + 2*t20**2 + t25 + t30**2 + t39**2 + t40**2)
-    t42 = -t29*(t10*t28 + t40*t10 + t20*t9)
-    t43 = t10 + t28*t42
-    t44 = t20 + t9*t42
-    t45 = t40 + t10*t42
-    t46 = t38*(t44*t37 + t34*t45)
-    t47 = t44 - t37*t46
-    t48 = t45 - t34*t46
-    t49 = xp.abs(t39)
-    t50 = t49*xp.where(xp.greater_equal(t39, 0), xp.asarray(1, dtype=dtype), -1)
-    t51 = t39 + t50
-    t52 = xp.where(xp.greater(t49, 0), 1/(t49*2*t49), 0)
-    t53 = t3 - t51**2*t52*t3
-    t54 = xp.where(xp.not_equal(t50, 0), -t53/t50, 0)
-    t55 = xp.abs(t48)
-    t56 = t55*xp.where(xp.greater_equal(t48, 0), xp.asarray(1, dtype=dtype), -1)
-    t57 = t48 + t56
-    t58 = xp.where(xp.greater(t55, 0), 1/(t55*2*t55), 0)
-    t59 = -t8
-    t60 = t59 + t15
-    t61 = t16*(1 - t7*t60 + t5*t4)
-    t62 = t7 + t60*t61
-    t63 = t4 - t5*t61
-    t64 = 1 - t61
-    t65 = xp.sqrt(t63**2 + t64**2)
-    t66 = t65*xp.where(xp.greater_equal(t63, 0), xp.asarray(1, dtype=dtype), -1)
-    t67 = t63 + t66
-    t68 = xp.where(xp.greater(t65, 0), 1/(t65*(t65 + xp.abs(t63))), 0)
-    t69 = mu_dot1 + gain1*(t59 + mu1)
-    t70 = t5*t16
-    t71 = t68*(t64*t17 + t70*t67)
-    t72 = t70 - t67*t71
-    t73 = t17 - t64*t71
-    t74 = xp.abs(t73)
-    t75 = t74*xp.where(xp.greater_equal(t73, 0), xp.asarray(1, dtype=dtype), -1)
-    t76 = t73 + t75
-    t77 = xp.where(xp.greater(t74, 0), 1/(t74*2*t74), 0)
-    t78 = -mu3 + xp.atan2(t2, t1)
-    t79 = mu_dot3 - gain3*(t78 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t78)))
-    t80 = -t29*(-t28*t6 + t9*t69 + t10*t79)
-    t81 = t6 - t28*t80
-    t82 = t69 + t9*t80
-    t83 = t79 + t10*t80
-    t84 = t38*(t37*t82 + t34*t83)
-    t85 = t82 - t37*t84
-    t86 = t83 - t34*t84
-    t87 = t86 - t57**2*t58*t86
-    t88 = xp.where(xp.not_equal(t56, 0), -t87/t56, 0)
-    t89 = xp.where(xp.not_equal(t36, 0), -(t85 - t47*t88)/t36, 0)
-    t90 = xp.where(xp.not_equal(t27, 0), -(t81 + t32*t89 + t43*t88)/t27, 0)
-    t91 = t88 - t8*t90 + t5*t89
-    t92 = t88 - t7*t90 + t4*t89
-    t93 = t16*(t79 + t60*t6 + t5*t69)
-    t94 = t6 - t60*t93
-    t95 = t69 - t5*t93
-    t96 = -t93 + t79
-    t97 = t68*(t67*t95 + t64*t96)
-    t98 = t95 - t67*t97
-    t99 = t96 - t64*t97
-    t100 = t99 - t76**2*t77*t99
-    t101 = xp.where(xp.not_equal(t75, 0), -t100/t75, 0)
-    t102 = xp.where(xp.not_equal(t66, 0), -(t98 - t72*t101)/t66, 0)
-    t103 = xp.where(xp.not_equal(t15, 0), -(-(-t62*t102 + t60*t16*t101) + t94)/t15, 0)
-    t104 = -t7 + q1 + q2 + q3 + q4 + t20 + t59 + damping + qz1 + qz2 + qz3 + qz4 + t6 + t69 + t3 + t79
-    t105 = xp.isfinite(t104)
-    t106 = xp.greater_equal(damping, 0)
-    t107 = xp.greater(damping, 0)
-    t108 = 1e-12*t41
-    t109 = 1e-12*t19
-    t110 = (t107 & (xp.less_equal(t26, t108) | xp.less_equal(t35, t108) | xp.less_equal(t49, t108) | xp.less_equal(t55, t108))) | (xp.less_equal(damping, 0) & (xp.less_equal(t14, t109) | xp.less_equal(t65, t109) | xp.less_equal(1, t109) | xp.less_equal(t74, t109)))
-    t111 = t105 & t106 & xp.logical_not(t110)
+    t16 = t13 + 0.075625*c12**2
+    t17 = xp.sqrt(4 + t12 + t16)
+    t18 = t5 + t4
+    t19 = t9**2
+    t20 = t10**2
+    t21 = damping**2
+    t22 = t12 + t21
+    t23 = t22**2
+    t24 = xp.sqrt(t19 + t20 + t23)
+    t25 = t24*xp.where(xp.greater_equal(t22, 0), xp.asarray(1, dtype=dtype), -1)
+    t26 = t16 + t21
+    t27 = 1 + t21
+    t28 = 3 + t21
+    t29 = xp.sqrt(2*t19 + 2*t20 + 2*t18**2 + t23 + t26**2 + t27**2 + t28**2)
+    t30 = xp.greater(t24, 0)
+    t31 = xp.where(t30, 1/(t22 + t25), 0)
+    t32 = xp.where(t30, 1 + xp.abs(t22)/t24, 0)
+    t33 = t9*t31
+    t34 = t10*t31
+    t35 = -t32*(t9 + t26*t33 + t18*t34)
+    t36 = t9 + t35
+    t37 = t26 + t33*t35
+    t38 = t18 + t34*t35
+    t39 = -t32*(t10 + t28*t34 + t18*t33)
+    t40 = t10 + t39
+    t41 = t18 + t33*t39
+    t42 = t28 + t34*t39
+    t43 = xp.sqrt(t37**2 + t38**2)
+    t44 = t43*xp.where(xp.greater_equal(t37, 0), xp.asarray(1, dtype=dtype), -1)
+    t45 = xp.greater(t43, 0)
+    t46 = xp.where(t45, 1/(t37 + t44), 0)
+    t47 = xp.where(t45, 1 + xp.abs(t37)/t43, 0)
+    t48 = t38*t46
+    t49 = t47*(t41 + t48*t42)
+    t50 = -t49 + t41
+    t51 = t42 - t48*t49
+    t52 = xp.abs(t27)
+    t53 = t52*xp.where(xp.greater_equal(t27, 0), xp.asarray(1, dtype=dtype), -1)
+    t54 = xp.where(xp.greater(t52, 0), xp.asarray(2, dtype=dtype), 0)
+    t55 = t3 - t54*t3
+    t56 = xp.where(xp.not_equal(t53, 0), -t55/t53, 0)
+    t57 = xp.abs(t51)
+    t58 = t57*xp.where(xp.greater_equal(t51, 0), xp.asarray(1, dtype=dtype), -1)
+    t59 = xp.where(xp.greater(t57, 0), xp.asarray(2, dtype=dtype), 0)
+    t60 = xp.greater(t14, 0)
+    t61 = xp.where(t60, 1 + xp.abs(t8)/t14, 0)
+    t62 = -t8
+    t63 = xp.where(t60, 1/(t62 + t15), 0)
+    t64 = mu_dot1 + gain1*(t62 + mu1)
+    t65 = -t7
+    t66 = t5*t63
+    t67 = t61*(t65 + t63 + t4*t66)
+    t68 = t7 + t67
+    t69 = t63*t67
+    t70 = t4 - t5*t69
+    t71 = 1 - t69
+    t72 = xp.sqrt(t70**2 + t71**2)
+    t73 = t72*xp.where(xp.greater_equal(t70, 0), xp.asarray(1, dtype=dtype), -1)
+    t74 = t63**2*t61
+    t75 = t5*t74
+    t76 = -1 + t74
+    t77 = xp.greater(t72, 0)
+    t78 = xp.where(t77, 1/(t70 + t73), 0)
+    t79 = xp.where(t77, 1 + xp.abs(t70)/t72, 0)
+    t80 = t71*t78
+    t81 = t79*(t75 + t80*t76)
+    t82 = -t81 + t75
+    t83 = t76 - t80*t81
+    t84 = xp.abs(t83)
+    t85 = t84*xp.where(xp.greater_equal(t83, 0), xp.asarray(1, dtype=dtype), -1)
+    t86 = xp.where(xp.greater(t84, 0), xp.asarray(2, dtype=dtype), 0)
+    t87 = -mu3 + xp.atan2(t2, t1)
+    t88 = mu_dot3 - gain3*(t87 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t87)))
+    t89 = -t32*(-t6 + t33*t64 + t34*t88)
+    t90 = -t89 + t6
+    t91 = t64 + t33*t89
+    t92 = t88 + t34*t89
+    t93 = t47*(t91 + t48*t92)
+    t94 = -t93 + t91
+    t95 = t92 - t48*t93
+    t96 = t95 - t59*t95
+    t97 = xp.where(xp.not_equal(t58, 0), -t96/t58, 0)
+    t98 = xp.where(xp.not_equal(t44, 0), -(t94 - t50*t97)/t44, 0)
+    t99 = xp.where(xp.not_equal(t25, 0), -(t90 + t36*t98 + t40*t97)/t25, 0)
+    t100 = t97 - t8*t99 + t5*t98
+    t101 = t97 - t7*t99 + t4*t98
+    t102 = t61*(t6 + t63*t88 + t66*t64)
+    t103 = -t102 + t6
+    t104 = q1 + q2 + q3 + q4 + t18 + t62 + t65 + damping + qz1 + qz2 + qz3 + qz4 + t6 + t64 + t3 + t88
+    t105 = t63*t102
+    t106 = t64 - t5*t105
+    t107 = -t105 + t88
+    t108 = t79*(t106 + t80*t107)
+    t109 = -t108 + t106
+    t110 = t107 - t80*t108
+    t111 = t110 - t86*t110
+    t112 = xp.where(xp.not_equal(t85, 0), -t111/t85, 0)
+    t113 = xp.where(xp.not_equal(t73, 0), -(t109 - t82*t112)/t73, 0)
+    t114 = xp.where(xp.not_equal(t15, 0), -(-(-t68*t113 + t63*t61*t112) + t103)/t15, 0)
+    t115 = xp.isfinite(t104)
+    t116 = xp.greater_equal(damping, 0)
+    t117 = xp.greater(damping, 0)
+    t118 = 1e-12*t29
+    t119 = 1e-12*t17
+    t120 = (t117 & (xp.less_equal(t24, t118) | xp.less_equal(t43, t118) | xp.less_equal(t52, t118) | xp.less_equal(t57, t118))) | (xp.less_equal(damping, 0) & (xp.less_equal(t14, t119) | xp.less_equal(t72, t119) | xp.less_equal(1, t119) | xp.less_equal(t84, t119)))
+    t121 = t115 & t116 & xp.logical_not(t120)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t111, xp.where(t107, t91, t103), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t111, xp.where(t107, t92, t102), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t111, xp.where(t107, -t54, -t3), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t111, xp.where(t107, -t88, t101), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t121, xp.where(t117, t100, t114), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t121, xp.where(t117, t101, t113), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t121, xp.where(t117, -t56, -t3), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t121, xp.where(t117, -t97, t112), 0), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t105 & t106), 2, xp.where(t110, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t115 & t116), 2, xp.where(t120, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (4 x 1 and 4 x 1 and 1 x 1), 219 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (4 x 1 and 4 x 1 and 1 x 1), 204 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4,)), ("q", q, (4,)), ("damping", damping, ()))
     mu0 = target[..., 0]
     mu1 = target[..., 1]
@@ -2087,7 +2119,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t11 = 0.275*s12
     t12 = 0.325*s1 + t11
     t13 = t12**2 + 0.075625*s12**2
-    t14 = 0.075625*c12*s12 + t7*t12
+    t14 = t7*t12 + 0.075625*c12*s12
     t15 = t12 + t11
     t16 = -t12 + mu1
     t17 = -mu3 + xp.atan2(t2, t1)
@@ -2096,50 +2128,53 @@ def ik_numeric_step(target, q, damping=0.0):
     t20 = damping + t13
     t21 = xp.sqrt(t20**2 + t14**2 + t15**2)
     t22 = t21*xp.where(xp.greater_equal(t20, 0), xp.asarray(1, dtype=dtype), -1)
-    t23 = t20 + t22
-    t24 = xp.where(xp.greater(t21, 0), 1/(t21*(t21 + xp.abs(t20))), 0)
-    t25 = t24*(t10*t23 - t14*t16 + t15*t18)
-    t26 = t10 - t23*t25
-    t27 = t16 + t14*t25
-    t28 = -t18 + t15*t25
-    t29 = damping + t8
-    t30 = -t24*(t15*t9 + t14*t23 + t29*t14)
-    t31 = t14 + t23*t30
-    t32 = t29 + t14*t30
-    t33 = t9 + t15*t30
-    t34 = xp.sqrt(t32**2 + t33**2)
-    t35 = t34*xp.where(xp.greater_equal(t32, 0), xp.asarray(1, dtype=dtype), -1)
-    t36 = t32 + t35
-    t37 = xp.where(xp.greater(t34, 0), 1/(t34*(t34 + xp.abs(t32))), 0)
-    t38 = t37*(t27*t36 + t33*t28)
-    t39 = t27 - t36*t38
-    t40 = t28 - t33*t38
-    t41 = 3 + damping
-    t42 = -t24*(t14*t9 + t15*t23 + t41*t15)
-    t43 = t15 + t23*t42
-    t44 = t9 + t14*t42
-    t45 = t41 + t15*t42
-    t46 = t37*(t44*t36 + t33*t45)
-    t47 = t44 - t36*t46
-    t48 = t45 - t33*t46
-    t49 = xp.abs(t4)
-    t50 = t49*xp.where(xp.greater_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)
-    t51 = t4 + t50
-    t52 = xp.where(xp.greater(t49, 0), 1/(t49*2*t49), 0)
-    t53 = t3 - t3*t51**2*t52
-    t54 = xp.where(xp.not_equal(t50, 0), -t53/t50, 0)
-    t55 = -t54 + q3
-    t56 = xp.abs(t48)
-    t57 = t56*xp.where(xp.greater_equal(t48, 0), xp.asarray(1, dtype=dtype), -1)
-    t58 = t48 + t57
-    t59 = xp.where(xp.greater(t56, 0), 1/(t56*2*t56), 0)
-    t60 = t40 - t40*t58**2*t59
-    t61 = xp.where(xp.not_equal(t57, 0), -t60/t57, 0)
-    t62 = xp.where(xp.not_equal(t35, 0), -(t39 - t47*t61)/t35, 0)
-    t63 = xp.where(xp.not_equal(t22, 0), -(t26 + t31*t62 + t43*t61)/t22, 0)
-    t64 = q1 + t61 - t12*t63 + t7*t62
-    t65 = q2 + t61 - t11*t63 + t6*t62
-    t66 = -t61 + q4
+    t23 = xp.greater(t21, 0)
+    t24 = xp.where(t23, 1/(t20 + t22), 0)
+    t25 = xp.where(t23, 1 + xp.abs(t20)/t21, 0)
+    t26 = damping + t8
+    t27 = t14*t24
+    t28 = t15*t24
+    t29 = -t25*(t14 + t26*t27 + t28*t9)
+    t30 = t14 + t29
+    t31 = t26 + t27*t29
+    t32 = t9 + t28*t29
+    t33 = t25*(t10 - t27*t16 + t28*t18)
+    t34 = -t33 + t10
+    t35 = t16 + t27*t33
+    t36 = -t18 + t28*t33
+    t37 = xp.sqrt(t31**2 + t32**2)
+    t38 = t37*xp.where(xp.greater_equal(t31, 0), xp.asarray(1, dtype=dtype), -1)
+    t39 = 3 + damping
+    t40 = -t25*(t15 + t27*t9 + t28*t39)
+    t41 = t15 + t40
+    t42 = t9 + t27*t40
+    t43 = t39 + t28*t40
+    t44 = xp.greater(t37, 0)
+    t45 = xp.where(t44, 1/(t31 + t38), 0)
+    t46 = xp.where(t44, 1 + xp.abs(t31)/t37, 0)
+    t47 = t32*t45
+    t48 = t46*(t42 + t47*t43)
+    t49 = -t48 + t42
+    t50 = t43 - t47*t48
+    t51 = t46*(t35 + t47*t36)
+    t52 = -t51 + t35
+    t53 = t36 - t47*t51
+    t54 = xp.abs(t4)
+    t55 = t54*xp.where(xp.greater_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)
+    t56 = xp.where(xp.greater(t54, 0), xp.asarray(2, dtype=dtype), 0)
+    t57 = t3 - t3*t56
+    t58 = xp.where(xp.not_equal(t55, 0), -t57/t55, 0)
+    t59 = -t58 + q3
+    t60 = xp.abs(t50)
+    t61 = t60*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
+    t62 = xp.where(xp.greater(t60, 0), xp.asarray(2, dtype=dtype), 0)
+    t63 = t53 - t53*t62
+    t64 = xp.where(xp.not_equal(t61, 0), -t63/t61, 0)
+    t65 = xp.where(xp.not_equal(t38, 0), -(t52 - t49*t64)/t38, 0)
+    t66 = xp.where(xp.not_equal(t22, 0), -(t34 + t30*t65 + t41*t64)/t22, 0)
+    t67 = q1 + t64 - t12*t66 + t7*t65
+    t68 = q2 + t64 - t11*t66 + t6*t65
+    t69 = -t64 + q4
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -2147,10 +2182,10 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q4, batch),  # 3
     ], (4,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t64, -0.8726646259971648), -0.8726646259971648, xp.where(xp.greater(t64, 0.8726646259971648), 0.8726646259971648, t64)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t65, -1.53588974175501), -1.53588974175501, xp.where(xp.greater(t65, 1.53588974175501), 1.53588974175501, t65)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t55, 0.0), 0.0, xp.where(xp.greater(t55, 0.21), 0.21, t55)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t66, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t66, 6.283185307179586), 6.283185307179586, t66)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t67, -0.8726646259971648), -0.8726646259971648, xp.where(xp.greater(t67, 0.8726646259971648), 0.8726646259971648, t67)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t68, -1.53588974175501), -1.53588974175501, xp.where(xp.greater(t68, 1.53588974175501), 1.53588974175501, t68)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t59, 0.0), 0.0, xp.where(xp.greater(t59, 0.21), 0.21, t59)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t69, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t69, 6.283185307179586), 6.283185307179586, t69)), batch),  # 3
     ], (4,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t5), t19, -1), batch)
     return q_start, q_next, cost

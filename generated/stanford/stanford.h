@@ -101,31 +101,31 @@ stanford_real stanford_manipulability(const stanford_real q[STANFORD_DOF]);
 stanford_real stanford_jacobian_det(const stanford_real q[STANFORD_DOF]);
 
 /* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
- * Result: dw[i], i < 6. 523 operations. */
+ * Result: dw[i], i < 6. 503 operations. */
 void stanford_manipulability_gradient(const stanford_real q[STANFORD_DOF], stanford_real dw[STANFORD_DOF]);
 
 /* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
- * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2493 operations. */
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2505 operations. */
 void stanford_velocity_ellipsoid(const stanford_real q[STANFORD_DOF], stanford_real U_v[9], stanford_real s_v[3], stanford_real U_w[9], stanford_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 8903 operations. */
+ * Result: returned as a scalar. 8893 operations. */
 stanford_real stanford_condition_number(const stanford_real q[STANFORD_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1164 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1137 operations. */
 int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_real mu_dot[STANFORD_TASK_DIM], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1170 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1143 operations. */
 int stanford_velocity_ik_nullspace(const stanford_real q[STANFORD_DOF], const stanford_real mu_dot[STANFORD_TASK_DIM], const stanford_real z[STANFORD_DOF], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1331 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1304 operations. */
 int stanford_resolved_rate(const stanford_real q[STANFORD_DOF], const stanford_real target[16], const stanford_real target_rate[STANFORD_TASK_DIM], const stanford_real gain[STANFORD_TASK_DIM], const stanford_real z[STANFORD_DOF], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 853 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 834 operations. */
 stanford_real stanford_ik_numeric_step(const stanford_real target[16], const stanford_real q[STANFORD_DOF], stanford_real damping, stanford_real q_start[STANFORD_DOF], stanford_real q_next[STANFORD_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.

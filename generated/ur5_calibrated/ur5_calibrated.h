@@ -101,31 +101,31 @@ ur5_calibrated_real ur5_calibrated_manipulability(const ur5_calibrated_real q[UR
 ur5_calibrated_real ur5_calibrated_jacobian_det(const ur5_calibrated_real q[UR5_CALIBRATED_DOF]);
 
 /* D manipulability / dq (DOF), from the hessian's layers; 0 where Js is singular (velocity_ik's rule).
- * Result: dw[i], i < 6. 1792 operations. */
+ * Result: dw[i], i < 6. 1773 operations. */
 void ur5_calibrated_manipulability_gradient(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real dw[UR5_CALIBRATED_DOF]);
 
 /* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
- * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2815 operations. */
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2832 operations. */
 void ur5_calibrated_velocity_ellipsoid(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real U_v[9], ur5_calibrated_real s_v[3], ur5_calibrated_real U_w[9], ur5_calibrated_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 9320 operations. */
+ * Result: returned as a scalar. 9315 operations. */
 ur5_calibrated_real ur5_calibrated_condition_number(const ur5_calibrated_real q[UR5_CALIBRATED_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1621 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1587 operations. */
 int ur5_calibrated_velocity_ik(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], const ur5_calibrated_real mu_dot[UR5_CALIBRATED_TASK_DIM], ur5_calibrated_real damping, ur5_calibrated_real q_dot[UR5_CALIBRATED_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1627 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1593 operations. */
 int ur5_calibrated_velocity_ik_nullspace(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], const ur5_calibrated_real mu_dot[UR5_CALIBRATED_TASK_DIM], const ur5_calibrated_real z[UR5_CALIBRATED_DOF], ur5_calibrated_real damping, ur5_calibrated_real q_dot[UR5_CALIBRATED_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1789 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1755 operations. */
 int ur5_calibrated_resolved_rate(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], const ur5_calibrated_real target[16], const ur5_calibrated_real target_rate[UR5_CALIBRATED_TASK_DIM], const ur5_calibrated_real gain[UR5_CALIBRATED_TASK_DIM], const ur5_calibrated_real z[UR5_CALIBRATED_DOF], ur5_calibrated_real damping, ur5_calibrated_real q_dot[UR5_CALIBRATED_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1259 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1238 operations. */
 ur5_calibrated_real ur5_calibrated_ik_numeric_step(const ur5_calibrated_real target[16], const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real damping, ur5_calibrated_real q_start[UR5_CALIBRATED_DOF], ur5_calibrated_real q_next[UR5_CALIBRATED_DOF]);
 
 /* The general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9).

@@ -76,7 +76,9 @@ GENERATED_NAMES = frozenset("""
     worse fk_jacobian_dot jacobian_dot bias_acceleration task_jacobian_dot hessian Jd H a
     ik_nearest q_seed q_free weights in_limits IK_FREE_JOINT IK_NEAREST_OK IK_NEAREST_NO_SOLUTION
     IK_NEAREST_NOT_FINITE limits keep xp dtype device trig branches_q branches_valid
-    branches_in_limits
+    branches_in_limits link_poses link_velocities velocity_ellipsoid condition_number
+    manipulability_gradient velocity_ik_nullspace resolved_rate CHARACTERISTIC_LENGTH z gain
+    target_rate U_v U_w s_v s_w V dw kappa
 """.split())
 # Every symbol name the generator makes up: a prefix and indices (`qb3_1`). This table is their
 # one owner: the generator builds its symbols with `indexed` and `trig`, and a parameter may

@@ -54,7 +54,12 @@ def triangulate(A, g: Graph, name: Callable, right=()) -> tuple[list, list, list
     """Householder QR of the p x k matrix A (rows of nodes, p >= k): R (k x k, upper triangular,
     as rows), Q^T applied to each column of `right` (p long), the norms of the reflected
     columns (|R_jj|), and the reflections (v, beta), H_j = I - beta v v^T acting on rows j..p-1,
-    A = H_0 ... H_{k-1} [R; 0]. alpha = R_jj takes the sign that avoids cancellation in v."""
+    A = H_0 ... H_{k-1} [R; 0]. alpha = R_jj takes the sign that avoids cancellation.
+
+    v is scaled to v_0 = 1 (LAPACK's dlarfg): v_i = x_i / (x_0 - alpha), at most 1, and
+    beta = 1 + |x_0| / |x| in [1, 2]. The unscaled 2 / |x - alpha e_0|^2 overflows for a column
+    of norm below 1e-19 in float; these do not: |x| is 0 or at least the square root of the
+    least subnormal, so neither division overflows."""
     p, k = len(A), len(A[0])
     zero, one = g.number(0), g.number(1)
     A, right = [list(row) for row in A], [list(column) for column in right]
@@ -62,10 +67,12 @@ def triangulate(A, g: Graph, name: Callable, right=()) -> tuple[list, list, list
     for j in range(k):
         column = [A[i][j] for i in range(j, p)]
         norm = name(g.sqrt(sum(c**2 for c in column)))
+        reflected = g.relation(">", norm, zero)
         alpha = named(name, -g.select(g.relation(">=", column[0], zero), one, -one) * norm)  # R[j][j]; the sign
-        v = [named(name, column[0] - alpha)] + column[1:]  # avoids cancellation
-        beta = name(g.select(g.relation(">", norm, zero), 1 / (norm * (norm + g.call("Abs", column[0]))), zero))
-        for c in range(j + 1, k):  # beta = 2 / |v|^2
+        scale = name(g.select(reflected, 1 / (column[0] - alpha), zero))
+        v = [one] + [named(name, c * scale) for c in column[1:]]
+        beta = name(g.select(reflected, 1 + g.call("Abs", column[0]) / norm, zero))
+        for c in range(j + 1, k):
             s = name(beta * sum(v[i - j] * A[i][c] for i in range(j, p)))
             for i in range(j, p):
                 A[i][c] = named(name, A[i][c] - s * v[i - j])
