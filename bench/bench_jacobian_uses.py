@@ -22,7 +22,7 @@ translation unit) times, per robot and round, after a warm-up round:
 
 The table gives medians over the rounds in ns per call and the ratios the issue bounds
 (resolved_rate / velocity_ik, link_poses / fk). Then NAME_native (built from `--lang native`
-in a temporary folder by `jacgen.checking.c_library.build_native`) on `--rows` configurations
+in a temporary folder by `jacgen.loading.load_native`) on `--rows` configurations
 uniform within the limits: condition_number and manipulability_gradient as one batch each
 (its gufunc: SIMD kernels over every usable processor), median of `--batch-rounds`; beside
 them, for scale, rtb's `manipulability(q, method="invcondition")` and `jacobm(q)` per call
@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 import common
-from jacgen.checking.c_library import build_native
+from jacgen.loading import load_native
 
 ROBOTS = ("puma560", "ur5", "panda")
 OURS = ("fk", "link_poses", "link_velocities", "velocity_ellipsoid", "condition_number", "manipulability_gradient",
@@ -159,7 +159,7 @@ def batch_table(rows: int, rounds: int) -> None:
     q = np.random.default_rng(48).uniform(limits[:, 0], limits[:, 1], (rows, robot.dof))
     with tempfile.TemporaryDirectory(prefix="jacgen-bench-") as temporary:
         start = time.perf_counter()
-        native = build_native(common.generate(robot, Path(temporary), ("native",)), robot.name)
+        native = load_native(common.generate(robot, Path(temporary), ("native",)), robot.name)
         print(f"\n{robot.name}_native: built in {time.perf_counter() - start:.0f} s, SIMD {native.SIMD}, "
               f"{len(os.sched_getaffinity(0))} usable processors")
         times = common.median_times({"condition_number": lambda: native.condition_number(q),

@@ -4,7 +4,7 @@
                                  [--batch-rounds 3]
 
 At the start, `generate --lang native` is rendered for each robot into a temporary folder and
-built with `jacgen.compile.build_native` (the build time and `NAME_native.SIMD` are printed).
+built with `jacgen.loading.load_native` (the build time and `NAME_native.SIMD` are printed).
 Then, for `fk`, `fk_jacobian`, `ik` and `velocity_ik` of each robot, one row per batch size
 (1: one call; then each of `--sizes`) and one column per implementation:
 
@@ -64,7 +64,7 @@ import numpy as np
 
 import common
 from jacgen.checking import reference
-from jacgen.checking.c_library import build_native
+from jacgen.loading import load_native
 
 FUNCTIONS = ("fk", "fk_jacobian", "ik", "velocity_ik")
 PEERS = ("pinocchio", "rtb", "eaik", "casadi")
@@ -440,7 +440,7 @@ def build_natives(robots, folder: Path) -> dict:
     for robot in robots:
         source = common.generate(robot, folder, ("native",))
         start = time.perf_counter()
-        natives[robot.name] = build_native(source, robot.name)
+        natives[robot.name] = load_native(source, robot.name)
         print(f"{robot.name}_native: built in {time.perf_counter() - start:.1f} s, SIMD {natives[robot.name].SIMD}")
     return natives
 

@@ -11,23 +11,19 @@ with CasADi"): ur5's generated/ur5/ur5_casadi.py, as `jacgen generate robots/ur5
 Each prints its time and how far its answer is from what it asked for.
 """
 
-import importlib.util
 import time
-from pathlib import Path
 
 import casadi
 import numpy as np
 
-GENERATED = Path(__file__).resolve().parent.parent / "generated"
+import jacgen
+
 QUIET = {"print_time": False}
 
 
 def load(name: str = "ur5"):
-    """The generated CasADi module of a robot."""
-    spec = importlib.util.spec_from_file_location(f"{name}_casadi", GENERATED / name / f"{name}_casadi.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    """The generated CasADi module of a robot (built once, then cached)."""
+    return jacgen.arm(name, backend="casadi")
 
 
 def pose_error(robot, q, target):

@@ -1,24 +1,33 @@
 """ur5's fk + J and every IK branch for many poses on a dask.distributed cluster, through
 ur5_native's gufuncs (README, section 6).
 
-    jacgen generate robots/ur5.yaml --lang native -o native/ && pip install native/ur5
-    python examples/dask_cluster.py --poses 100000000 [--scheduler tcp://host:8786]
+    .venv/bin/pip install -e '.[dask,native]'
+    .venv/bin/python examples/dask_cluster.py --poses 10000000 [--scheduler tcp://host:8786]
 
-Without --scheduler it starts a LocalCluster of this machine's processes. Every worker needs
-ur5_native installed. Prints the mean number of IK solutions per pose, the largest distance
-of a solution's pose from its target, and the least manipulability met.
+Without --scheduler it starts a LocalCluster of this machine's processes, which import the
+module `jacgen.arm` built (from its cache folder) by name: nothing to install on them. Workers
+on other machines need the same cache folder ($JACGEN_CACHE_DIR on a shared disk), or
+`jacgen generate --lang native` and `pip install` of the module there. Prints the mean number of
+IK solutions per pose, the largest distance of a solution's pose from its target, and the
+least manipulability met.
 """
 
 import argparse
+import sys
 import time
 
-import dask.array as da
-from dask.distributed import Client, LocalCluster
+try:
+    import dask.array as da
+    from dask.distributed import Client, LocalCluster
+except ImportError:
+    sys.exit("examples/dask_cluster.py needs dask: .venv/bin/pip install -e '.[dask,native]'")
 
-import ur5_native as ur5
+import jacgen
+
+FUNCTIONS = ("fk", "fk_jacobian", "ik_branches", "manipulability")
 
 
-def survey(poses: int, chunk: int):
+def survey(ur5, poses: int, chunk: int):
     """The statistics of `poses` random configurations, computed on the cluster in chunks."""
     q = da.random.uniform(-3.14, 3.14, size=(poses, ur5.DOF), chunks=(chunk, ur5.DOF))
     T, J = da.apply_gufunc(ur5.gufuncs.fk_jacobian, "(j)->(r,c),(k,j)", q,  # dask names the core dimensions
@@ -38,10 +47,11 @@ def main():
     parser.add_argument("--chunk", type=int, default=1_000_000)
     parser.add_argument("--scheduler", default=None, help="the cluster's address (default: a LocalCluster here)")
     arguments = parser.parse_args()
+    ur5 = jacgen.arm("ur5", backend="native", functions=FUNCTIONS)
     cluster = None if arguments.scheduler else LocalCluster(processes=True, threads_per_worker=1, dashboard_address=None)
     with Client(arguments.scheduler or cluster):
         start = time.perf_counter()
-        solutions, worst, weakest = survey(arguments.poses, min(arguments.chunk, arguments.poses))
+        solutions, worst, weakest = survey(ur5, arguments.poses, min(arguments.chunk, arguments.poses))
         seconds = time.perf_counter() - start
     print(f"{arguments.poses} poses in {seconds:.1f} s: {solutions:.3f} IK solutions per pose, "
           f"worst solution {worst:.1e} from its target, least manipulability {weakest:.2e}")

@@ -13,12 +13,11 @@ error and the manipulability at the start and the end of each run, and plots bot
 """
 
 import argparse
-import importlib.util
-from pathlib import Path
 
 import numpy as np
 
-GENERATED = Path(__file__).resolve().parent.parent / "generated"
+import jacgen
+
 # rad, within the limits. Not a symmetric pose: where q1 = q3 = q5 = 0 the manipulability is
 # stationary along the self-motion, and z would do nothing.
 START = np.array([0.5, -0.5, 1.5, -1.8, -0.5, 1.4, 0.785])
@@ -29,11 +28,8 @@ NULL_SPACE_GAINS = (0.0, 20.0)  # k of z = k manipulability_gradient(q), one run
 
 
 def load(name: str = "panda"):
-    """The generated numpy module of a robot."""
-    spec = importlib.util.spec_from_file_location(name, GENERATED / name / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    """The generated numpy module of a robot (built once, then cached)."""
+    return jacgen.arm(name)
 
 
 def circle(start: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray]:

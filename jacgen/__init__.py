@@ -3,6 +3,8 @@
 Scripting entry points::
 
     import jacgen
+    ur5 = jacgen.arm("ur5", backend="native")  # the generated module, built once and cached
+    T, J = ur5.fk_jacobian([0.1, -0.5, 0.3, 0.2, 0.4, 0.0])
     robot = jacgen.load_robot("robots/puma560.yaml")
     kin = jacgen.Kinematics(robot)          # readable sympy matrices: kin.fk, kin.jacobian, ...
     files = jacgen.render_robot(robot)      # {"puma560/puma560.py": text, ...}
@@ -16,9 +18,10 @@ from importlib import import_module
 from jacgen.version import __version__
 
 _HOMES = {"JacgenError": "errors", "RobotFileError": "errors", "Kinematics": "model.kinematics",
-          "render_robot": "emission.render", "Robot": "inputs.robot", "load_robot": "inputs.robot_file"}
+          "render_robot": "emission.render", "Robot": "inputs.robot", "load_robot": "inputs.robot_file",
+          "arm": "loading", "BuildError": "loading"}
 
-__all__ = ["JacgenError", "Kinematics", "Robot", "RobotFileError", "load_robot", "render_robot", "__version__"]
+__all__ = ["BuildError", "JacgenError", "Kinematics", "Robot", "RobotFileError", "load_robot", "render_robot", "__version__", "arm"]
 
 
 def __getattr__(name: str):

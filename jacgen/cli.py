@@ -172,6 +172,22 @@ def _remember(robots: list, files: dict[str, str], keys: dict[Path, str | None])
 
 
 @main.command()
+@click.argument("robots", nargs=-1, required=True)
+@click.option("--backend", type=click.Choice(["native", "python", "casadi"]), default="native", show_default=True,
+              help="The module to build.")
+@click.option("--functions", "functions", default=None, callback=_functions, metavar="NAMES",
+              help="Comma-separated functions to generate (with those they call); default: all.")
+def build(robots, backend, functions):
+    """Fill jacgen.arm's cache for each of ROBOTS (robot files, URDFs or shipped robots' names),
+    ahead of time: for container images and CI. Exit 2 when a module cannot be built."""
+    from jacgen.loading import arm
+
+    for robot in robots:
+        module = arm(robot, backend=backend, functions=functions)
+        click.echo(f"{robot}: {module.__name__} ({module.__file__})")
+
+
+@main.command()
 @robot_files
 def validate(robot_files):
     """Check robot files only."""

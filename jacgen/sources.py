@@ -24,6 +24,12 @@ def template_folder() -> Path:
     return next(path for path in TEMPLATE_FOLDER_CANDIDATES if path.is_dir())
 
 
+def robot_folder() -> Path:
+    """The shipped robot files: robots/ of a source checkout, or of the installed package."""
+    return next((path for path in (PACKAGE.parent / "robots", PACKAGE / "robots") if path.is_dir()),
+                PACKAGE / "robots")
+
+
 @functools.cache
 def digest() -> str:
     """sha256 of jacgen's modules, its templates and the versions of OUTPUT_LIBRARIES."""

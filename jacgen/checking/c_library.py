@@ -2,16 +2,13 @@
 
 The C is compiled with the warning flags contract §3 promises (any warning is an error) and
 loaded with ctypes; `CLibrary.evaluate` runs one generated function on a batch of joint
-vectors, one native call per configuration. `build_native` builds and imports the native
-module (`generate --lang native`) the way pip does, through its own setup.py.
+vectors, one native call per configuration.
 """
 
 import ctypes
-import importlib.util
 import os
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +16,7 @@ import numpy as np
 from jacgen.emission.catalogue import Signature
 from jacgen.errors import JacgenError
 from jacgen.inputs.robot import Robot
+from jacgen.loading import first_error
 
 # contract §3: the generated C compiles without a warning under these flags.
 WARNING_FLAGS = ("-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Wconversion", "-Wshadow",
@@ -53,31 +51,6 @@ def compile_shared(sources: list[Path], output: Path, flags: tuple[str, ...] = (
         names = ", ".join(Path(source).name for source in sources)
         raise CompileError(f"{compiler} failed on {names}: {first_error(result.stderr)}")
     return output
-
-
-def build_native(folder: Path, name: str):
-    """Build NAME_native in `folder` (what `generate --lang native` wrote for the robot) with its
-    setup.py, and import it; CompileError with the first error."""
-    result = subprocess.run([sys.executable, "setup.py", "-q", "build_ext", "--inplace"], cwd=folder,
-                            capture_output=True, text=True)
-    built = sorted(folder.glob(f"{name}_native.*.so")) + sorted(folder.glob(f"{name}_native.*.pyd"))
-    if result.returncode != 0 or not built:
-        raise CompileError(f"building {name}_native failed: {first_error(result.stderr + result.stdout)}")
-    module_name = f"{name}_native"
-    if module_name in sys.modules:  # an extension module loads once per process
-        return sys.modules[module_name]
-    spec = importlib.util.spec_from_file_location(module_name, built[0])
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    sys.modules[module_name] = module
-    return module
-
-
-def first_error(output: str) -> str:
-    """The line of a compiler's (or tool's) output worth one error line: its first error."""
-    lines = output.splitlines()
-    return next((line for line in lines if " error: " in line or "cannot build: " in line),
-                lines[0] if lines else "no output").strip()
 
 
 class CLibrary:

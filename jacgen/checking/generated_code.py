@@ -3,7 +3,6 @@ module, the CasADi module, the C built for the host (double and float, through c
 for an emulated target (`target.Emulator`). `jacgen verify` compares what it returns with
 the reference; the tests call the same functions through it."""
 
-import importlib.util
 from pathlib import Path
 
 import numpy as np
@@ -12,6 +11,7 @@ from jacgen.checking.c_library import CLibrary
 from jacgen.checking.cortex_m4f import Emulator
 from jacgen.emission.catalogue import Signature
 from jacgen.inputs.robot import Robot
+from jacgen.loading import import_module
 
 HOST_BACKENDS = ("python", "casadi", "c double", "c float")  # what `jacgen verify` compares on the host
 # NAME_native as `verify --native` calls it: batches of float64 (the double C) and float32 (the
@@ -19,13 +19,6 @@ HOST_BACKENDS = ("python", "casadi", "c double", "c float")  # what `jacgen veri
 NATIVE_BACKENDS = ("native double", "native double scalar", "native double one", "native float",
                    "native float scalar")
 TARGET_BACKENDS = {"cortex-m4f": "cortex-m4f float"}  # `verify --target`: the target's float C alone
-
-
-def import_module(path: Path, module_name: str):
-    spec = importlib.util.spec_from_file_location(module_name, path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 class GeneratedCode:

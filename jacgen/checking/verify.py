@@ -28,7 +28,7 @@ from typing import Callable
 import numpy as np
 
 from jacgen.checking import reference
-from jacgen.checking.c_library import build_native, c_compiler, compile_shared
+from jacgen.checking.c_library import c_compiler, compile_shared
 from jacgen.checking.cortex_m4f import Emulator, check_tools
 from jacgen.checking.dexterity_checks import CHECKED_HERE, dexterity_results, velocity_ik_residual
 from jacgen.checking.generated_code import HOST_BACKENDS, GeneratedCode
@@ -39,6 +39,7 @@ from jacgen.emission.generator import Generator
 from jacgen.emission.render import render_robot
 from jacgen.files import write_files
 from jacgen.inputs.robot import EULER_ANGLES, Robot
+from jacgen.loading import load_native
 from jacgen.model import js_rank
 from jacgen.parallel import for_each_robot
 from jacgen.solvers import ik
@@ -343,7 +344,7 @@ def verify_on_host(robot: Robot, samples: int, seed: int, folder: Path, native: 
     with ThreadPoolExecutor(2) as pool:
         builds = {real: pool.submit(compile_shared, [work / real / robot.name / f"{robot.name}.c"],
                                     work / f"{robot.name}_{real}.so") for real in ("double", "float")}
-        module = build_native(work / "native" / robot.name, robot.name) if native else None
+        module = load_native(work / "native" / robot.name, robot.name) if native else None
         built = {real: build.result() for real, build in builds.items()}
     random, q = configurations(robot, generator.singularities, samples, seed)
     return verify_robot(robot, GeneratedCode(robot, generator.signatures(), work / "double", built, native=module),

@@ -295,8 +295,41 @@ static int jacgen_build(const jacgen_function *f, const jacgen_arguments *a)
     return given > 0 && floats == given ? JACGEN_FLOAT : JACGEN_DOUBLE;
 }
 
+/* A list or tuple of Python numbers (nested as the operand's shape) into `real` and `single`;
+ * 0 where it is not that (numpy then converts it). */
+static int jacgen_listed(const jacgen_operand *o, PyObject *value, int d, npy_intp *at, double *real, float *single)
+{
+    Py_ssize_t i, n;
+    if (!(PyList_CheckExact(value) || PyTuple_CheckExact(value)) || (n = PySequence_Fast_GET_SIZE(value)) != o->shape[d]) {
+        return 0;
+    }
+    for (i = 0; i < n; i++) {
+        PyObject *item = PySequence_Fast_GET_ITEM(value, i);
+        if (d + 1 < o->ndim) {
+            if (!jacgen_listed(o, item, d + 1, at, real, single)) {
+                return 0;
+            }
+            continue;
+        }
+        if (PyFloat_CheckExact(item)) {
+            real[*at] = PyFloat_AS_DOUBLE(item);
+        } else if (PyLong_CheckExact(item)) {
+            real[*at] = PyLong_AsDouble(item);
+            if (real[*at] == -1.0 && PyErr_Occurred()) {
+                PyErr_Clear();
+                return 0;
+            }
+        } else {
+            return 0;
+        }
+        single[*at] = (float)real[*at];
+        ++*at;
+    }
+    return 1;
+}
+
 /* The input as the C takes it for one configuration, without a copy (`real`/`integer` hold a
- * number); NULL where the gufunc must take it. */
+ * number, or a short list's numbers); NULL where the gufunc must take it. */
 static void *jacgen_direct(const jacgen_operand *o, PyObject *value, int build, double *real, float *single, int *integer)
 {
     if (o->kind == JACGEN_INT) {
@@ -322,6 +355,10 @@ static void *jacgen_direct(const jacgen_operand *o, PyObject *value, int build, 
         *single = (float)number;
         return build == JACGEN_DOUBLE ? (void *)real : (void *)single;
     }
+    if (o->kind == JACGEN_REAL && o->ndim > 0 && o->size <= JACGEN_HELD && (PyList_CheckExact(value) || PyTuple_CheckExact(value))) {
+        npy_intp at = 0;
+        return !jacgen_listed(o, value, 0, &at, real, single) ? NULL : build == JACGEN_DOUBLE ? (void *)real : (void *)single;
+    }
     if (PyArray_CheckExact(value)) {
         PyArrayObject *array = (PyArrayObject *)value;
         int d;
@@ -342,7 +379,7 @@ static void *jacgen_direct(const jacgen_operand *o, PyObject *value, int build, 
 /* The inputs of one configuration, each as the C takes it without a copy (`held` keeps the
  * numbers); 0 where the gufunc must take them. */
 static int jacgen_direct_inputs(const jacgen_function *f, int build, const jacgen_arguments *a, void **buffer,
-                                double *real, float *single, int *integer)
+                                double (*real)[JACGEN_HELD], float (*single)[JACGEN_HELD], int *integer)
 {
     int k;
     if (a->out != NULL) {
@@ -350,7 +387,7 @@ static int jacgen_direct_inputs(const jacgen_function *f, int build, const jacge
     }
     for (k = 0; k < f->inputs; k++) {
         PyObject *value = a->value[k] != NULL ? a->value[k] : jacgen_default[f - jacgen_functions][k][build];
-        if ((buffer[k] = jacgen_direct(&f->operand[k], value, build, &real[k], &single[k], &integer[k])) == NULL) {
+        if ((buffer[k] = jacgen_direct(&f->operand[k], value, build, real[k], single[k], &integer[k])) == NULL) {
             return 0;
         }
     }
@@ -363,8 +400,8 @@ static PyObject *jacgen_one(const jacgen_function *f, int build, const jacgen_ar
 {
     const int operands = f->inputs + f->outputs;
     void *buffer[JACGEN_OPERANDS];
-    double real[JACGEN_OPERANDS];
-    float single[JACGEN_OPERANDS];
+    double real[JACGEN_OPERANDS][JACGEN_HELD];
+    float single[JACGEN_OPERANDS][JACGEN_HELD];
     int integer[JACGEN_OPERANDS], flags[JACGEN_OPERANDS][JACGEN_FLAGS];
     PyObject *result[JACGEN_OPERANDS], *tuple;
     int k, j;
@@ -490,8 +527,8 @@ static PyObject *jacgen_ik_one(const jacgen_function *f, int build, const jacgen
     const jacgen_operand *q = &f->operand[f->inputs];
     const size_t element = jacgen_packed_size(JACGEN_REAL, build), row = (size_t)q->shape[1] * element;
     void *buffer[JACGEN_OPERANDS];
-    double real[JACGEN_OPERANDS], solutions[JACGEN_FLAGS * JACGEN_DOF];
-    float single[JACGEN_OPERANDS];
+    double real[JACGEN_OPERANDS][JACGEN_HELD], solutions[JACGEN_FLAGS * JACGEN_DOF];
+    float single[JACGEN_OPERANDS][JACGEN_HELD];
     int integer[JACGEN_OPERANDS], valid[JACGEN_FLAGS], in_limits[JACGEN_FLAGS], i, kept = 0;
     npy_intp shape[2];
     PyObject *result;
@@ -586,21 +623,26 @@ static const char *jacgen_simd(void)
 }
 
 /* The module of `definition`, with its `count` constants (name, Python expression), SIMD, and
- * its gufuncs as the module `gufuncs_name`. */
-static PyObject *jacgen_init(struct PyModuleDef *definition, const char *gufuncs_name, const char *const constants[][2],
-                             int count)
+ * its gufuncs as the module NAME.gufuncs, NAME the module's full name (jacgen.arm's modules
+ * live in a package). */
+static PyObject *jacgen_init(struct PyModuleDef *definition, const char *const constants[][2], int count)
 {
-    PyObject *module, *gufuncs;
+    PyObject *module, *name, *gufuncs = NULL, *gufuncs_name = NULL;
     int i, k, build;
     import_array();
     import_umath();
     module = PyModule_Create(definition);
-    gufuncs = module == NULL ? NULL : PyModule_New(gufuncs_name);
+    name = module == NULL ? NULL : PyModule_GetNameObject(module);
+    gufuncs_name = name == NULL ? NULL : PyUnicode_FromFormat("%U.gufuncs", name);
+    Py_XDECREF(name);
+    gufuncs = gufuncs_name == NULL ? NULL : PyModule_NewObject(gufuncs_name);
     /* in sys.modules too: numpy pickles a ufunc by the module that holds it (dask sends them) */
-    if (gufuncs == NULL || PyDict_SetItemString(PyImport_GetModuleDict(), gufuncs_name, gufuncs) != 0
+    if (gufuncs == NULL || PyDict_SetItem(PyImport_GetModuleDict(), gufuncs_name, gufuncs) != 0
         || PyModule_AddObject(module, "gufuncs", gufuncs) != 0) {
+        Py_XDECREF(gufuncs_name);
         goto fail;
     }
+    Py_DECREF(gufuncs_name);
     for (i = 0; i < count; i++) {
         PyObject *value = jacgen_evaluate(constants[i][1]);
         if (value == NULL || PyModule_AddObject(module, constants[i][0], value) != 0) {

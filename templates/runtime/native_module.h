@@ -26,6 +26,7 @@ typedef char jacgen_int_is_int32[sizeof(int) == sizeof(npy_int32) ? 1 : -1];
 enum { JACGEN_DOUBLE, JACGEN_FLOAT };
 enum { JACGEN_REAL, JACGEN_INT, JACGEN_BOOL };
 #define JACGEN_MAX_THREADS 256
+#define JACGEN_HELD 32 /* a list of at most this many numbers is read straight into the C's arguments */
 #define JACGEN_ALIGN 64
 
 typedef struct {
