@@ -32,7 +32,6 @@ beside jacgen.compile's warning flags.
 """
 
 import importlib
-import importlib.util
 import json
 import math
 import statistics
@@ -57,6 +56,7 @@ import sympy  # noqa: E402
 from jacgen.checking import reference  # noqa: E402
 from jacgen.checking.c_library import c_compiler, compile_shared  # noqa: E402
 from jacgen.files import write_files  # noqa: E402
+from jacgen.loading import import_module  # noqa: E402
 from jacgen.emission.render import render_robot  # noqa: E402
 from jacgen.inputs.robot_file import load_robot  # noqa: E402
 
@@ -102,11 +102,8 @@ def generate(robot, folder: Path, languages=("c",), real: str = "double") -> Pat
 
 
 def load_module(path: Path, name: str | None = None):
-    """Import a generated Python file by its path (generated modules are not a package)."""
-    spec = importlib.util.spec_from_file_location(name or f"bench_{path.stem}", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    """Import a generated Python file by its path (jacgen.loading.import_module)."""
+    return import_module(path, name or f"bench_{path.stem}")
 
 
 def shared_library(source: Path) -> Path:

@@ -16,7 +16,6 @@ random configurations inside the joint limits, to 1e-9:
 rtb's Jacobian rows are vx vy vz wx wy wz, the same as jacgen's.
 """
 
-import importlib.util
 import math
 import warnings
 from functools import lru_cache
@@ -28,6 +27,7 @@ from numpy.testing import assert_allclose
 
 from jacgen.inputs import numeric_chain
 from jacgen.checking import reference
+from jacgen.loading import import_module
 
 with warnings.catch_warnings():
     warnings.simplefilter("ignore")
@@ -119,10 +119,7 @@ def iiwa_urdf_path():
 def generated_module(name):
     path = GENERATED / name / f"{name}.py"
     assert path.is_file(), f"{path} is missing: run `jacgen generate robots/{name}.yaml`"
-    spec = importlib.util.spec_from_file_location(f"_jacgen_generated_{name}", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return import_module(path, f"_jacgen_generated_{name}")
 
 
 @lru_cache(maxsize=None)

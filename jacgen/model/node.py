@@ -131,6 +131,13 @@ TOLERANCE_VALUES = {real: {symbol: float(value) for symbol, value in numbers.ite
                     for real, numbers in TOLERANCES.items()}
 
 
+def _power(base, exponent):
+    """base ** exponent as IEEE arithmetic has it (C's pow): 0 to a negative power is inf."""
+    if isinstance(base, float) and base == 0 and isinstance(exponent, (int, float)) and exponent < 0:
+        return math.copysign(math.inf, base) if float(exponent).is_integer() and int(exponent) % 2 else math.inf
+    return base ** exponent
+
+
 def evaluate(node: Node, values: dict, functions: dict = MATH, _done: dict | None = None):
     """The value of `node`, `values` giving each symbol's: in floats (truth values as bools),
     or with `functions` of another library (numpy's, over arrays: arithmetic and calls only)."""
@@ -144,6 +151,10 @@ def evaluate(node: Node, values: dict, functions: dict = MATH, _done: dict | Non
         result = values[node.value]
     elif kind == TRUTH:
         result = node.value
+    elif kind == SELECT:  # the value chosen only: a side not taken may divide by 0
+        chosen = next((value for condition, value in zip(args[:-1:2], args[1:-1:2])
+                       if evaluate(condition, values, functions, done)), args[-1])
+        result = evaluate(chosen, values, functions, done)
     else:
         operands = [evaluate(arg, values, functions, done) for arg in args]
         if kind == ADD:
@@ -151,12 +162,9 @@ def evaluate(node: Node, values: dict, functions: dict = MATH, _done: dict | Non
         elif kind == MUL:
             result = math.prod(operands)
         elif kind == POW:
-            result = operands[0] ** operands[1]
+            result = _power(*operands)
         elif kind == CALL:
             result = functions[node.value](*operands)
-        elif kind == SELECT:
-            result = next((value for condition, value in zip(operands[:-1:2], operands[1:-1:2]) if condition),
-                          operands[-1])
         elif kind == RELATION:
             result = RELATIONS[node.value](*operands)
         elif kind == AND:
