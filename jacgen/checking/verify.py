@@ -332,11 +332,13 @@ def verify(robots: list[Robot], samples: int, seed: int,
         return results
 
 
-def verify_on_host(robot: Robot, samples: int, seed: int, folder: Path, native: bool = False) -> list[Result]:
+def verify_on_host(robot: Robot, samples: int, seed: int, folder: Path, native: bool = False,
+                   functions=None) -> list[Result]:
     """One robot on the host: generated into folder/NAME/{double,float}, its C built for
     both real types (at once), every backend compared with the reference; with `native`,
-    NAME_native too (generated into folder/NAME/native and built by its setup.py)."""
-    work, generator = folder / robot.name, Generator(robot)
+    NAME_native too (generated into folder/NAME/native and built by its setup.py). `functions`:
+    only those and their callees (all by default)."""
+    work, generator = folder / robot.name, Generator(robot, selection=functions)
     write_files(render_robot(robot, ("c", "python", "casadi"), "double", generator), work / "double")
     write_files(render_robot(robot, ("c",), "float", generator), work / "float")
     if native:
