@@ -4,8 +4,8 @@
 
 In an empty cache folder of its own: the first `jacgen.arm(robot, backend="native")` (generate
 and compile, in this process), the same call again in this process, and a hit in a fresh
-process (Python's start, `import jacgen`, the key, the entry's hashes and the module's import,
-timed by the child from its first line, and the whole process from outside). Beside them, in
+process (Python's start, `import jacgen`, the key, the entry's hashes and the module's import:
+the whole process, timed from outside). Beside them, in
 the same run: the old way to the same module (`jacgen generate --lang native` then `pip
 install --no-build-isolation` of it, into a temporary target), and the peers' one-line
 loaders in a fresh process (Robotics Toolbox's `rtb.models.DH.UR5()`, pytorch_kinematics'
@@ -74,15 +74,18 @@ def main():
         times = {name: [] for name in PEERS}
         for _ in range(arguments.rounds):  # interleaved
             for name, program in PEERS.items():
+                if times[name] is None:
+                    continue
                 try:
                     times[name].append(fresh_process(program.format(robot=arguments.robot, urdf=urdf), environment))
-                except subprocess.CalledProcessError:
+                except subprocess.CalledProcessError as error:
                     times[name] = None
+                    print(f"  {name}: {error.stderr.decode().strip().splitlines()[-1]}")
         ours = float(np.median(times["jacgen.arm hit"]))
         print(f"\nfresh process, start to exit (median of {arguments.rounds}):")
         for name, measured in times.items():
             if measured is None:
-                print(f"  {name:26s}  not installed")
+                print(f"  {name:26s}  failed (above)")
                 continue
             print(f"  {name:26s} {np.median(measured):6.2f} s   / jacgen.arm hit: {np.median(measured) / ours:5.2f}")
         empty = float(np.median([fresh_process("pass", environment) for _ in range(arguments.rounds)]))
