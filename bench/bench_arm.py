@@ -5,8 +5,7 @@
 In an empty cache folder of its own: the first `jacgen.arm(robot, backend="native")` (generate
 and compile, in this process), the same call again in this process, and a hit in a fresh
 process (Python's start, `import jacgen`, the key, the entry's hashes and the module's import:
-the whole process, timed from outside). Beside them, in
-the same run: the old way to the same module (`jacgen generate --lang native` then `pip
+the whole process, timed from outside). Beside them, in the same run: the old way to the same module (`jacgen generate --lang native` then `pip
 install --no-build-isolation` of it, into a temporary target), and the peers' one-line
 loaders in a fresh process (Robotics Toolbox's `rtb.models.DH.UR5()`, pytorch_kinematics'
 chain from the UR5's URDF), each median of `--rounds`. Then one `fk_jacobian` call with the
@@ -80,7 +79,7 @@ def main():
                     times[name].append(fresh_process(program.format(robot=arguments.robot, urdf=urdf), environment))
                 except subprocess.CalledProcessError as error:
                     times[name] = None
-                    print(f"  {name}: {error.stderr.decode().strip().splitlines()[-1]}")
+                    print(f"  {name}: {(error.stderr.decode().strip().splitlines() or ['no message'])[-1]}")
         ours = float(np.median(times["jacgen.arm hit"]))
         print(f"\nfresh process, start to exit (median of {arguments.rounds}):")
         for name, measured in times.items():
