@@ -3,13 +3,13 @@
     python bench/bench_arm.py [--robot ur5] [--rounds 5]
 
 In an empty cache folder of its own: the first `jacgen.arm(robot, backend="native")` (generate
-and compile, in this process), the same call again in this process, and a hit in a fresh
-process (Python's start, `import jacgen`, the key, the entry's hashes and the module's import:
-the whole process, timed from outside). Beside them, in the same run: the old way to the same module (`jacgen generate --lang native` then `pip
-install --no-build-isolation` of it, into a temporary target), and the peers' one-line
-loaders in a fresh process (Robotics Toolbox's `rtb.models.DH.UR5()`, pytorch_kinematics'
-chain from the UR5's URDF), each median of `--rounds`. Then one `fk_jacobian` call with the
-joint vector as a list, a tuple and an array.
+and compile, in this process), the same call again in this process, and a hit in a fresh process
+(Python's start, `import jacgen`, the key, the entry's hashes and the module's import: the whole
+process, timed from outside). Beside them, in the same run: the old way to the same module
+(`jacgen generate --lang native` then `pip install --no-build-isolation` of it, into a temporary
+target), and the peers' one-line loaders in a fresh process (Robotics Toolbox's
+`rtb.models.DH.UR5()`, pytorch_kinematics' chain from the UR5's URDF), each median of
+`--rounds`. Then one `fk_jacobian` call with the joint vector as a list, a tuple and an array.
 """
 
 import argparse
