@@ -1,7 +1,8 @@
 """How many one-sided Jacobi sweeps the straight-line SVD needs (`jacgen/solvers/singular_values.py`).
 
-The same arithmetic as the generated code (a Householder QR of A^T, then cyclic rotations of
-the triangular factor's columns or rows, the squared norms updated by each rotation), in numpy, on k x k factors of matrices with known singular
+The same arithmetic as the generated code (a Householder QR of A^T, then round-robin rotations
+of the triangular factor's columns or rows, the squared norms summed afresh
+each sweep and updated by each rotation), in numpy, on k x k factors of matrices with known singular
 values (U diag(s) V^T, U and V orthogonal): spread over 1e-8 ... 1, one of 1e-16 ... 1e-6,
 clustered within 1e-12 ... 1e-2 of 1, two zeros. Prints, per size and kind, the worst error
 of the singular values relative to the largest after each number of sweeps, turning R's columns
@@ -13,26 +14,25 @@ of the singular values relative to the largest after each number of sweeps, turn
 
 import numpy as np
 
-from jacgen.solvers.singular_values import SWEEPS
+from jacgen.solvers.singular_values import SWEEPS, rounds
 
 KINDS = ("random", "spread", "tiny", "clustered", "zeros")
 
 
 def jacobi_norms(R: np.ndarray, sweeps: int) -> np.ndarray:
     W, k = R.copy(), R.shape[1]
-    squares = [W[:, i] @ W[:, i] for i in range(k)]  # updated by each rotation, as the generated code does
     for _ in range(sweeps):
-        for i in range(k - 1):
-            for j in range(i + 1, k):
-                a, b, c = squares[i], squares[j], W[:, i] @ W[:, j]
-                if c == 0:
-                    continue
-                with np.errstate(over="ignore"):
-                    zeta = (b - a) / (2 * c)
-                    t = (1.0 if zeta >= 0 else -1.0) / (abs(zeta) + np.sqrt(1 + zeta * zeta))
-                cos = 1 / np.sqrt(1 + t * t)
-                W[:, i], W[:, j] = cos * W[:, i] - cos * t * W[:, j], cos * t * W[:, i] + cos * W[:, j]
-                squares[i], squares[j] = a - t * c, b + t * c
+        squares = [W[:, i] @ W[:, i] for i in range(k)]  # summed afresh each sweep, updated by each rotation
+        for i, j in (pair for pairs in rounds(k) for pair in pairs):
+            a, b, c = squares[i], squares[j], W[:, i] @ W[:, j]
+            d = b - a
+            h = np.sqrt(d * d + 4 * c * c)
+            if abs(d) + h == 0:
+                continue
+            t = (2 * c if d >= 0 else -2 * c) / (abs(d) + h)
+            cos = 1 / np.sqrt(1 + t * t)
+            W[:, i], W[:, j] = cos * W[:, i] - cos * t * W[:, j], cos * t * W[:, i] + cos * W[:, j]
+            squares[i], squares[j] = a - t * c, b + t * c
     return np.linalg.norm(W, axis=0)
 
 
@@ -66,8 +66,9 @@ def worst_errors(rows: int, cols: int, kind: str, trials: int, sweeps: int, turn
 
 def main():
     rng = np.random.default_rng(0)
-    for turned in ("columns", "rows"):
-        for rows, cols, trials in ((3, 7, 2000), (3, 6, 2000), (6, 7, 500), (6, 6, 500)):
+    for turned, shapes in (("columns", ((3, 7, 2000), (3, 6, 2000))),
+                           ("rows", ((3, 7, 2000), (3, 6, 2000), (6, 7, 500), (6, 6, 500)))):
+        for rows, cols, trials in shapes:
             k = min(rows, cols)
             sweeps = SWEEPS[turned][k]
             print(f"{rows} x {cols}, R's {turned} turned: {sweeps} sweeps; worst error after 0, 1, ... sweeps")

@@ -621,7 +621,7 @@ def manipulability_gradient(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ellipsoid(q):
-    """axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: (3 x 3 and 3 x 1 and 3 x 3 and 3 x 1), 365 operations."""
+    """axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: (3 x 3 and 3 x 1 and 3 x 3 and 3 x 1), 319 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (2,)))
     trig = _cos_sin(xp, q, (0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -634,170 +634,168 @@ def velocity_ellipsoid(q):
     t1 = s1 + s12
     t2 = xp.sqrt(s12**2 + t1**2)
     t3 = t2*xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)
-    t4 = t3**2
-    t5 = xp.greater(t2, 0)
-    t6 = xp.where(t5, 1/(-t1 + t3), 0)
-    t7 = xp.where(t5, 1 + xp.abs(t1)/t2, 0)
-    t8 = s12*t6
-    t9 = t7*(t0 - c12*t8)
-    t10 = -t9 + t0
-    t11 = c12 + t8*t9
-    t12 = xp.abs(t11)
-    t13 = t12*xp.where(xp.greater_equal(t11, 0), xp.asarray(1, dtype=dtype), -1)
-    t14 = t13**2
-    t15 = t14 + t10**2
-    t16 = t3*t10
-    t17 = xp.not_equal(t16, 0)
-    t18 = (-t4 + t15)/xp.where(t17, -2*t16, 1)
-    t19 = xp.abs(t18)
-    t20 = xp.greater_equal(t19, 1)
-    t21 = 1/xp.abs(xp.where(t20, t18, 1))
-    t22 = xp.where(t17, xp.where(xp.greater_equal(t18, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t20, t21/(1 + xp.sqrt(1 + t21**2)), 1/(t19 + xp.sqrt(1 + t19**2))), 0)
-    t23 = 1/xp.sqrt(1 + t22**2)
-    t24 = t16*t22
-    t25 = t24 + t4
-    t26 = -t24 + t15
-    t27 = t3*t23
-    t28 = t10*t23
-    t29 = t27 + t28*t22
-    t30 = t28 - t27*t22
-    t31 = t29*t30 + t14*t22*t23**2
-    t32 = xp.not_equal(t31, 0)
-    t33 = (-t25 + t26)/xp.where(t32, -2*t31, 1)
-    t34 = xp.abs(t33)
-    t35 = xp.greater_equal(t34, 1)
-    t36 = 1/xp.abs(xp.where(t35, t33, 1))
-    t37 = xp.where(t32, xp.where(xp.greater_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t35, t36/(1 + xp.sqrt(1 + t36**2)), 1/(t34 + xp.sqrt(1 + t34**2))), 0)
-    t38 = 1/xp.sqrt(1 + t37**2)
-    t39 = t31*t37
-    t40 = t25 + t39
-    t41 = -t39 + t26
-    t42 = t29*t38
-    t43 = t30*t38
-    t44 = t42 + t37*t43
-    t45 = t43 - t37*t42
-    t46 = t23*t38
-    t47 = t13*t46
-    t48 = t22*t47
-    t49 = t48 + t37*t47
-    t50 = -t47 + t37*t48
-    t51 = -t44*t45 + t49*t50
-    t52 = t22*t46
-    t53 = t46 - t37*t52
-    t54 = t52 + t37*t46
-    t55 = xp.not_equal(t51, 0)
-    t56 = (-t40 + t41)/xp.where(t55, 2*t51, 1)
-    t57 = xp.abs(t56)
-    t58 = xp.greater_equal(t57, 1)
-    t59 = 1/xp.abs(xp.where(t58, t56, 1))
-    t60 = xp.where(t55, xp.where(xp.greater_equal(t56, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t58, t59/(1 + xp.sqrt(1 + t59**2)), 1/(t57 + xp.sqrt(1 + t57**2))), 0)
+    t4 = xp.greater(t2, 0)
+    t5 = xp.where(t4, 1/(-t1 + t3), 0)
+    t6 = xp.where(t4, 1 + xp.abs(t1)/t2, 0)
+    t7 = s12*t5
+    t8 = t6*(t0 - c12*t7)
+    t9 = -t8 + t0
+    t10 = c12 + t7*t8
+    t11 = xp.abs(t10)
+    t12 = t11*xp.where(xp.greater_equal(t10, 0), xp.asarray(1, dtype=dtype), -1)
+    t13 = t3**2
+    t14 = t9**2
+    t15 = t12**2
+    t16 = t14 + t15
+    t17 = -t13 + t16
+    t18 = xp.sqrt(t17**2 + 4*t13*t14)
+    t19 = t18 + xp.abs(t17)
+    t20 = xp.greater(t19, 0)
+    t21 = 2*t3*t9
+    t22 = xp.where(t20, xp.where(xp.greater_equal(t17, 0), -t21, t21)/xp.where(t20, t19, 1), 0)
+    t23 = t22**2
+    t24 = 1/xp.sqrt(1 + t23)
+    t25 = t3*t24
+    t26 = t9*t24
+    t27 = t25 + t26*t22
+    t28 = t26 - t25*t22
+    t29 = t15*t24**2
+    t30 = t27**2 + t23*t29
+    t31 = t28**2 + t29
+    t32 = t27*t28 + t22*t29
+    t33 = -t30 + t31
+    t34 = xp.sqrt(4*t32**2 + t33**2)
+    t35 = t34 + xp.abs(t33)
+    t36 = xp.greater(t35, 0)
+    t37 = 2*t32
+    t38 = xp.where(t36, xp.where(xp.greater_equal(t33, 0), -t37, t37)/xp.where(t36, t35, 1), 0)
+    t39 = 1/xp.sqrt(1 + t38**2)
+    t40 = t27*t39
+    t41 = t28*t39
+    t42 = t40 + t38*t41
+    t43 = t41 - t38*t40
+    t44 = t24*t39
+    t45 = t12*t44
+    t46 = t22*t45
+    t47 = t46 + t38*t45
+    t48 = -t45 + t38*t46
+    t49 = t42**2 + t47**2
+    t50 = t43**2 + t48**2
+    t51 = -t42*t43 + t47*t48
+    t52 = -t49 + t50
+    t53 = xp.sqrt(4*t51**2 + t52**2)
+    t54 = t53 + xp.abs(t52)
+    t55 = t22*t44
+    t56 = t44 - t38*t55
+    t57 = t55 + t38*t44
+    t58 = xp.greater(t54, 0)
+    t59 = 2*t51
+    t60 = xp.where(t58, xp.where(xp.greater_equal(t52, 0), t59, -t59)/xp.where(t58, t54, 1), 0)
     t61 = 1/xp.sqrt(1 + t60**2)
-    t62 = t51*t60
-    t63 = -t62 + t40
-    t64 = t41 + t62
-    t65 = t44*t61
-    t66 = t45*t61
-    t67 = t65 + t60*t66
-    t68 = t66 - t60*t65
-    t69 = t49*t61
-    t70 = t50*t61
-    t71 = t69 - t60*t70
-    t72 = t70 + t60*t69
-    t73 = -t67*t68 + t71*t72
-    t74 = t53*t61
-    t75 = t54*t61
-    t76 = t74 - t60*t75
-    t77 = t75 + t60*t74
-    t78 = xp.not_equal(t73, 0)
-    t79 = (-t63 + t64)/xp.where(t78, 2*t73, 1)
-    t80 = xp.abs(t79)
-    t81 = xp.greater_equal(t80, 1)
-    t82 = 1/xp.abs(xp.where(t81, t79, 1))
-    t83 = xp.where(t78, xp.where(xp.greater_equal(t79, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t81, t82/(1 + xp.sqrt(1 + t82**2)), 1/(t80 + xp.sqrt(1 + t80**2))), 0)
-    t84 = 1/xp.sqrt(1 + t83**2)
-    t85 = t73*t83
-    t86 = -t85 + t63
-    t87 = t64 + t85
-    t88 = t67*t84
-    t89 = t68*t84
-    t90 = t88 + t83*t89
-    t91 = t89 - t83*t88
-    t92 = t71*t84
-    t93 = t72*t84
-    t94 = t92 - t83*t93
-    t95 = t93 + t83*t92
-    t96 = -t90*t91 + t94*t95
-    t97 = t76*t84
-    t98 = t77*t84
-    t99 = t97 - t83*t98
-    t100 = t98 + t83*t97
-    t101 = xp.not_equal(t96, 0)
-    t102 = (-t86 + t87)/xp.where(t101, 2*t96, 1)
-    t103 = xp.abs(t102)
-    t104 = xp.greater_equal(t103, 1)
-    t105 = 1/xp.abs(xp.where(t104, t102, 1))
-    t106 = xp.where(t101, xp.where(xp.greater_equal(t102, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t104, t105/(1 + xp.sqrt(1 + t105**2)), 1/(t103 + xp.sqrt(1 + t103**2))), 0)
-    t107 = 1/xp.sqrt(1 + t106**2)
-    t108 = t90*t107
-    t109 = t91*t107
-    t110 = t108 + t106*t109
-    t111 = t109 - t106*t108
-    t112 = t94*t107
-    t113 = t95*t107
-    t114 = t112 - t106*t113
-    t115 = t113 + t106*t112
-    t116 = xp.sqrt(t110**2 + t114**2)
-    t117 = xp.sqrt(t111**2 + t115**2)
-    t118 = t99*t107
-    t119 = t100*t107
-    t120 = t118 - t106*t119
-    t121 = t119 + t106*t118
-    t122 = xp.less(t116, t117)
-    t123 = xp.where(t122, t117, t116)
-    t124 = xp.where(t122, t116, t117)
-    t125 = xp.where(t122, t121, t120)
-    t126 = xp.where(t122, t120, t121)
-    t127 = -t121
-    t128 = xp.where(t122, t120, t127)
-    t129 = xp.where(t122, t127, t120)
-    t130 = xp.less(t124, 0)
-    t131 = xp.where(t130, 0, t124)
-    t132 = xp.where(t130, t124, 0)
-    t133 = xp.where(t130, 0, t126)
-    t134 = xp.where(t130, 0, t129)
-    t135 = xp.where(t130, xp.asarray(1, dtype=dtype), 0)
-    t136 = xp.where(t130, t126, 0)
-    t137 = xp.where(t130, t129, 0)
-    t138 = xp.where(t130, xp.asarray(0, dtype=dtype), 1)
-    t139 = xp.less(t123, t131)
-    t140 = xp.where(t139, t131, t123)
-    t141 = xp.where(t139, t123, t131)
-    t142 = xp.where(t139, t133, t125)
-    t143 = xp.where(t139, t134, t128)
-    t144 = xp.where(t139, t135, 0)
-    t145 = xp.where(t139, t125, t133)
-    t146 = xp.where(t139, t128, t134)
-    t147 = xp.where(t139, 0, t135)
-    t148 = t142*(t138*t146 - t137*t147) - t143*(t138*t145 - t136*t147) + t144*(t137*t145 - t136*t146)
-    t149 = xp.where(xp.less(t148, 0), xp.asarray(-1, dtype=dtype), 1)
-    t150 = t136*t149
-    t151 = t137*t149
-    t152 = t138*t149
+    t62 = t42*t61
+    t63 = t43*t61
+    t64 = t62 + t60*t63
+    t65 = t63 - t60*t62
+    t66 = t47*t61
+    t67 = t48*t61
+    t68 = t66 - t60*t67
+    t69 = t67 + t60*t66
+    t70 = t64**2 + t68**2
+    t71 = t65**2 + t69**2
+    t72 = -t64*t65 + t68*t69
+    t73 = -t70 + t71
+    t74 = xp.sqrt(4*t72**2 + t73**2)
+    t75 = t74 + xp.abs(t73)
+    t76 = t56*t61
+    t77 = t57*t61
+    t78 = t76 - t60*t77
+    t79 = t77 + t60*t76
+    t80 = xp.greater(t75, 0)
+    t81 = 2*t72
+    t82 = xp.where(t80, xp.where(xp.greater_equal(t73, 0), t81, -t81)/xp.where(t80, t75, 1), 0)
+    t83 = 1/xp.sqrt(1 + t82**2)
+    t84 = t64*t83
+    t85 = t65*t83
+    t86 = t84 + t82*t85
+    t87 = t85 - t82*t84
+    t88 = t68*t83
+    t89 = t69*t83
+    t90 = t88 - t82*t89
+    t91 = t89 + t82*t88
+    t92 = t86**2 + t90**2
+    t93 = t87**2 + t91**2
+    t94 = -t86*t87 + t90*t91
+    t95 = -t92 + t93
+    t96 = xp.sqrt(4*t94**2 + t95**2)
+    t97 = t96 + xp.abs(t95)
+    t98 = t78*t83
+    t99 = t79*t83
+    t100 = t98 - t82*t99
+    t101 = t99 + t82*t98
+    t102 = xp.greater(t97, 0)
+    t103 = 2*t94
+    t104 = xp.where(t102, xp.where(xp.greater_equal(t95, 0), t103, -t103)/xp.where(t102, t97, 1), 0)
+    t105 = 1/xp.sqrt(1 + t104**2)
+    t106 = t86*t105
+    t107 = t87*t105
+    t108 = t106 + t104*t107
+    t109 = t107 - t104*t106
+    t110 = t90*t105
+    t111 = t91*t105
+    t112 = t110 - t104*t111
+    t113 = t111 + t104*t110
+    t114 = xp.sqrt(t108**2 + t112**2)
+    t115 = xp.sqrt(t109**2 + t113**2)
+    t116 = t100*t105
+    t117 = t101*t105
+    t118 = t116 - t104*t117
+    t119 = t117 + t104*t116
+    t120 = xp.less(t114, t115)
+    t121 = xp.where(t120, t115, t114)
+    t122 = xp.where(t120, t114, t115)
+    t123 = xp.where(t120, t119, t118)
+    t124 = xp.where(t120, t118, t119)
+    t125 = -t119
+    t126 = xp.where(t120, t118, t125)
+    t127 = xp.where(t120, t125, t118)
+    t128 = xp.less(t122, 0)
+    t129 = xp.where(t128, 0, t122)
+    t130 = xp.where(t128, t122, 0)
+    t131 = xp.where(t128, 0, t124)
+    t132 = xp.where(t128, 0, t127)
+    t133 = xp.where(t128, xp.asarray(1, dtype=dtype), 0)
+    t134 = xp.where(t128, t124, 0)
+    t135 = xp.where(t128, t127, 0)
+    t136 = xp.where(t128, xp.asarray(0, dtype=dtype), 1)
+    t137 = xp.less(t121, t129)
+    t138 = xp.where(t137, t129, t121)
+    t139 = xp.where(t137, t121, t129)
+    t140 = xp.where(t137, t131, t123)
+    t141 = xp.where(t137, t132, t126)
+    t142 = xp.where(t137, t133, 0)
+    t143 = xp.where(t137, t123, t131)
+    t144 = xp.where(t137, t126, t132)
+    t145 = xp.where(t137, 0, t133)
+    t146 = t140*(t136*t144 - t135*t145) - t141*(t136*t143 - t134*t145) + t142*(t135*t143 - t134*t144)
+    t147 = xp.where(xp.less(t146, 0), xp.asarray(-1, dtype=dtype), 1)
+    t148 = t134*t147
+    t149 = t135*t147
+    t150 = t136*t147
     U_v = _stack(xp, [
-        t142,  # 0, 0
-        t145,  # 0, 1
-        t150,  # 0, 2
-        t143,  # 1, 0
-        t146,  # 1, 1
-        t151,  # 1, 2
-        t144,  # 2, 0
-        t147,  # 2, 1
-        t152,  # 2, 2
+        t140,  # 0, 0
+        t143,  # 0, 1
+        t148,  # 0, 2
+        t141,  # 1, 0
+        t144,  # 1, 1
+        t149,  # 1, 2
+        t142,  # 2, 0
+        t145,  # 2, 1
+        t150,  # 2, 2
     ], (3, 3))
     s_v = _stack(xp, [
-        t140,  # 0
-        t141,  # 1
-        t132,  # 2
+        t138,  # 0
+        t139,  # 1
+        t130,  # 2
     ], (3,))
     U_w = _stack(xp, [
         xp.full(batch, 0, dtype=dtype, device=device),  # 0, 0
@@ -820,7 +818,7 @@ def velocity_ellipsoid(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def condition_number(q):
-    """sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): (1 x 1), 100 operations."""
+    """sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): (1 x 1), 88 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (2,)))
     trig = _cos_sin(xp, q, (0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -842,25 +840,25 @@ def condition_number(q):
     t10 = c12 + t7*t8
     t11 = xp.abs(t10)
     t12 = t11*xp.where(xp.greater_equal(t10, 0), xp.asarray(1, dtype=dtype), -1)
-    t13 = t12**2
-    t14 = t3**2
-    t15 = t14 + t9**2
-    t16 = t9*t12
-    t17 = xp.not_equal(t16, 0)
-    t18 = (-t15 + t13)/xp.where(t17, -2*t16, 1)
-    t19 = xp.abs(t18)
-    t20 = xp.greater_equal(t19, 1)
-    t21 = 1/xp.abs(xp.where(t20, t18, 1))
-    t22 = xp.where(t17, xp.where(xp.greater_equal(t18, 0), xp.asarray(1, dtype=dtype), -1)*xp.where(t20, t21/(1 + xp.sqrt(1 + t21**2)), 1/(t19 + xp.sqrt(1 + t19**2))), 0)
+    t13 = t3**2
+    t14 = t9**2
+    t15 = t13 + t14
+    t16 = t12**2
+    t17 = -t15 + t16
+    t18 = xp.sqrt(t17**2 + 4*t14*t16)
+    t19 = t18 + xp.abs(t17)
+    t20 = xp.greater(t19, 0)
+    t21 = 2*t9*t12
+    t22 = xp.where(t20, xp.where(xp.greater_equal(t17, 0), -t21, t21)/xp.where(t20, t19, 1), 0)
     t23 = t22**2
     t24 = 1/xp.sqrt(1 + t23)
     t25 = t9*t24
     t26 = t12*t24
     t27 = t25 + t26*t22
     t28 = -t26 + t25*t22
-    t29 = t14*t24**2
+    t29 = t13*t24**2
     t30 = xp.sqrt(t29 + t27**2)
-    t31 = xp.sqrt(t28**2 + t23*t29)
+    t31 = xp.sqrt(t23*t29 + t28**2)
     t32 = xp.where(xp.greater(t31, t30), t31, t30)
     t33 = xp.where(xp.less(t31, t30), t31, t30)
     t34 = xp.where(xp.less_equal(t33, 1e-12*t32), 0, t33)
@@ -1167,7 +1165,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t14 = xp.where(t12, 1 + xp.abs(t9)/t10, 0)
     t15 = damping + t4
     t16 = t3*t13
-    t17 = -t14*(t3 + t15*t16)
+    t17 = -t14*(t15*t16 + t3)
     t18 = t3 + t17
     t19 = t15 + t16*t17
     t20 = t14*(t5 - t16*t6)

@@ -124,8 +124,7 @@ def functions(generator, js: sympy.Matrix, task_jacobian: sympy.Matrix) -> list[
                                        "layers; 0 where Js is singular (velocity_ik's rule)", vector("dw", gradient)))
     if generator.generates("velocity_ellipsoid"):
         blocks = elementwise(name, g.values(generator.jacobian))
-        (U_v, s_v), (U_w, s_w) = (singular_values.left_singular_3(blocks[rows].tolist(), g, name)
-                                  for rows in (slice(0, 3), slice(3, 6)))
+        (U_v, s_v), (U_w, s_w) = singular_values.left_singular_3([blocks[:3].tolist(), blocks[3:].tolist()], g, name)
         made.append(generator.function("velocity_ellipsoid", "axes (U's columns, a rotation) and semi-axes s "
                                        "(descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and "
                                        "angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same "

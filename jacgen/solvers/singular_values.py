@@ -7,16 +7,15 @@ J J^T, which MoveIt's metrics and Robotics Toolbox's ellipsoids take, lose half 
 there, because squaring does. The QR first makes the Jacobi's matrix k x k (k = min(rows,
 cols)) and nearly diagonal in its columns' norms.
 
-A cyclic sweep rotates every pair of columns once, and Jacobi converges quadratically: once
-the error is small, each sweep squares it. `SWEEPS` are run, with no test, one more than the
-first count that reached rounding on every kind of matrix `bench/bench_jacobi_sweeps.py` tries
-(singular values random, spread over 1e-8 ... 1, one of 1e-16 ... 1e-6, clustered within
-1e-12 ... 1e-2, two zeros; 2,000 of each for k = 3, 500 for k = 6). The worst error relative
-to the largest value, after each sweep: turning R's columns, k = 3: 4e-2, 7e-7, 1e-15 after
-sweeps 2, 3, 4; k = 6: 2e-2, 9e-6, 1e-9, 7e-15 after sweeps 4, 5, 6, 7. Turning its rows,
-k = 3: 2e-3, 2e-12, 1e-15 after sweeps 2, 3, 4; k = 6: 9e-4, 1e-7, 1e-12, 2e-15 after sweeps
-3, 4, 5, 6. The extra sweep squares an error already at rounding: the margin for a matrix
-slower than those.
+A sweep rotates every pair of columns once, in rounds of disjoint pairs (`rounds`), and
+Jacobi converges quadratically: once the error is small, each sweep squares it. `SWEEPS` are
+run, with no test, one more than the first count that reached rounding on every kind of
+matrix `bench/bench_jacobi_sweeps.py` tries (singular values random, spread over 1e-8 ... 1,
+one of 1e-16 ... 1e-6, clustered within 1e-12 ... 1e-2, two zeros; 2,000 of each for k = 3,
+500 for k = 6). The worst error relative to the largest value, after each sweep: turning R's
+columns, k = 3: 5e-2, 3e-6, 1e-15 after sweeps 2, 3, 4. Turning its rows, k = 3: 3e-3, 2e-12,
+1e-15 after sweeps 2, 3, 4; k = 6: 2e-3, 2e-7, 4e-11, 2e-15 after sweeps 3, 4, 5, 6. The extra
+sweep squares an error already at rounding: the margin for a matrix slower than those.
 """
 
 from typing import Callable
@@ -28,69 +27,112 @@ from jacgen.solvers.differential import named, triangulate
 
 # Sweeps of the one-sided Jacobi by the size k of the triangular factor R, rotating R's columns
 # (the singular vectors: velocity_ellipsoid) or, faster, its rows (the values alone:
-# condition_number). A 2 x 2 is diagonal after its one rotation; 3 and 6 as measured (the
-# module's docstring), 4 and 5 as 6.
-SWEEPS = {"columns": {1: 0, 2: 1, 3: 5, 4: 8, 5: 8, 6: 8}, "rows": {1: 0, 2: 1, 3: 5, 4: 7, 5: 7, 6: 7}}
+# condition_number; a 3 x n block's R is 3 x 3). A 2 x 2 is diagonal after its one rotation;
+# 3 and 6 as measured (the module's docstring), 4 and 5 as 6.
+SWEEPS = {"columns": {1: 0, 2: 1, 3: 5}, "rows": {1: 0, 2: 1, 3: 5, 4: 7, 5: 7, 6: 7}}
 
 
-def jacobi(R: list, g: Graph, name: Callable, vectors: bool) -> tuple[list[Node], list | None]:
-    """The column norms of R V, with V the product of one-sided Jacobi rotations that make R's
-    columns orthogonal: the singular values of R (unsorted), and V (k x k, as rows) when
-    `vectors`: R's right singular vectors, as its columns. Without vectors, the rotations turn
-    R's rows (the columns of R^T, whose singular values are the same): that converges faster.
+def rounds(k: int) -> list[list[tuple[int, int]]]:
+    """Every pair of k columns once, as k - 1 rounds (k odd: k) of disjoint pairs (the circle
+    method of a round-robin tournament): a round's rotations are independent of each other, so
+    the processor overlaps them, where the cyclic order's share a column, one after the other."""
+    players = list(range(k)) + ([None] if k % 2 else [])
+    count = len(players)
+    result = []
+    for _ in range(count - 1):
+        pairs = [(players[i], players[count - 1 - i]) for i in range(count // 2)]
+        result.append([(min(pair), max(pair)) for pair in pairs if None not in pair])
+        players = [players[0], players[-1]] + players[1:-1]
+    return result
 
-    A rotation of columns i, j with a = |w_i|^2, b = |w_j|^2, c = w_i . w_j: zeta = (b - a) /
-    2c, t = sign(zeta) / (|zeta| + sqrt(1 + zeta^2)) (the smaller angle; for |zeta| >= 1 as
-    sign(zeta) |1/zeta| / (1 + sqrt(1 + 1/zeta^2)), which does not overflow), and none where
-    c = 0 (selects of divisors that stay finite, so that the gradients of JAX and PyTorch do too).
-    It makes a and b a - t c and b + t c, which are kept rather than summed again."""
-    k = len(R)
+
+def jacobi(matrices: list, g: Graph, name: Callable, vectors: bool) -> list[tuple[list[Node], list | None]]:
+    """For each k x k R of `matrices`: the column norms of R V, with V the product of one-sided
+    Jacobi rotations that make R's columns orthogonal: the singular values of R (unsorted), and
+    V (k x k, as rows) when `vectors`: R's right singular vectors, as its columns. Without
+    vectors, the rotations turn R's rows (the columns of R^T, whose singular values are the
+    same): that converges faster.
+
+    The matrices are rotated in lockstep, a round of `rounds` at a time, each step for every
+    rotation of the round before the next: the generated code is in the order the values are
+    built, so that the processor finds the independent rotations side by side, rather than
+    one rotation's chain of square roots and divisions after another's.
+
+    The squared column norms are summed afresh at the start of each sweep, and updated by each
+    rotation within it: an update a - t c carries an error of a rounding of a, which stalls the
+    convergence of two close values far below it where they came out of larger columns (sigma
+    1.02e-8 and 1.01e-8 beside 0.98, updated only: by 15 % a sweep, still 4e-12 off after 8).
+    Within a sweep, the updates of small columns are from small values."""
     zero, one = g.number(0), g.number(1)
-    W = [[R[r][c] for r in range(k)] for c in range(k)] if vectors else [list(row) for row in R]  # turned
-    V = [[one if r == c else zero for r in range(k)] for c in range(k)] if vectors else None
-    squares = [name(sum(e**2 for e in column)) for column in W]
+    k = len(matrices[0])
+    turned = [[[R[r][c] for r in range(k)] for c in range(k)] if vectors else [list(row) for row in R]
+              for R in matrices]
+    V = [[[one if r == c else zero for r in range(k)] for c in range(k)] for _ in matrices] if vectors else None
     for _ in range(SWEEPS["columns" if vectors else "rows"][k]):
-        for i in range(k - 1):
-            for j in range(i + 1, k):
-                a, b = squares[i], squares[j]
-                c = named(name, sum(x * y for x, y in zip(W[i], W[j])))
-                rotated = g.relation("!=", c, zero)
-                zeta = named(name, (b - a) / g.select(rotated, 2 * c, one))
-                sign = g.select(g.relation(">=", zeta, zero), one, -one)
-                large = g.relation(">=", g.call("Abs", zeta), one)
-                w = named(name, 1 / g.call("Abs", g.select(large, zeta, one)))  # |1 / zeta| where that is <= 1
-                small = g.call("Abs", zeta)
-                t = named(name, g.select(rotated, sign * g.select(large, w / (1 + g.sqrt(1 + w**2)),
-                                                           1 / (small + g.sqrt(1 + small**2))), zero))
-                cos = named(name, 1 / g.sqrt(1 + t**2))
+        squares = [[named(name, sum(e**2 for e in column)) for column in W] for W in turned]
+        for pairs in rounds(k):
+            work = [(m, i, j) for m in range(len(matrices)) for i, j in pairs]
+            products = [named(name, sum(x * y for x, y in zip(turned[m][i], turned[m][j]))) for m, i, j in work]
+            angles = [rotation(squares[m][i], squares[m][j], c, g, name)
+                      for (m, i, j), c in zip(work, products)]
+            for (m, i, j), c, (cos, t) in zip(work, products, angles):
+                a, b = squares[m][i], squares[m][j]
+                squares[m][i], squares[m][j] = named(name, a - t * c), named(name, b + t * c)
                 sin = named(name, cos * t)
-                squares[i], squares[j] = named(name, a - t * c), named(name, b + t * c)
-                pairs = [W] + ([V] if vectors else [])
-                for columns in pairs:
+                for columns in [turned[m]] + ([V[m]] if vectors else []):
                     x, y = columns[i], columns[j]
                     columns[i] = [named(name, cos * p - sin * r) for p, r in zip(x, y)]
                     columns[j] = [named(name, sin * p + cos * r) for p, r in zip(x, y)]
-    norms = [name(g.sqrt(sum(e**2 for e in column))) for column in W]
-    return norms, V and [[V[c][r] for c in range(k)] for r in range(k)]
+    norms = [[name(g.sqrt(sum(e**2 for e in column))) for column in W] for W in turned]
+    return [(s, V and [[V[m][c][r] for c in range(k)] for r in range(k)]) for m, s in enumerate(norms)]
+
+
+def rotation(a: Node, b: Node, c: Node, g: Graph, name: Callable) -> tuple[Node, Node]:
+    """cos and tan of the rotation that makes columns w_i, w_j with a = |w_i|^2, b = |w_j|^2,
+    c = w_i . w_j orthogonal, by the smaller angle: t = 2c sign(d) / (|d| + h), with d = b - a
+    and h = sqrt(d^2 + 4c^2) (the textbook's zeta = d / 2c overflows where c is tiny; its guard
+    took a third square root and a select), and cos = 1 / sqrt(1 + t^2). The columns become cos w_i - sin w_j and
+    sin w_i + cos w_j, and a, b: a - t c, b + t c. (Not as cos (w_i - t w_j): with that form
+    XLA's fusion blows up, and jax.jit of the Panda's condition_number took 112 s at 5 sweeps
+    and over 10 minutes at 7, against 6 s and 5 s with this one.)
+
+    cos is computed from t, so the rotation is orthogonal to a rounding whatever h's accuracy:
+    where d^2 + 4c^2 underflows (|d| and |c| below 1e-154, float 1e-19) it is only a worse
+    angle. Where d = c = 0 the columns are left as they are (selects of values that
+    stay finite, so that the gradients of JAX and PyTorch do too)."""
+    zero, one = g.number(0), g.number(1)
+    d = named(name, b - a)
+    h = named(name, g.sqrt(d**2 + 4 * c**2))
+    divisor = named(name, g.call("Abs", d) + h)
+    rotated = g.relation(">", divisor, zero)
+    t = named(name, g.select(rotated, g.select(g.relation(">=", d, zero), 2 * c, -2 * c)
+                             / g.select(rotated, divisor, one), zero))
+    return named(name, 1 / g.sqrt(1 + t**2)), t
 
 
 def singular_values(A: list, g: Graph, name: Callable) -> list[Node]:
     """The singular values of the p x k matrix A (rows of nodes, p >= k), unsorted."""
     R, _, _, _ = triangulate(A, g, name)
-    return jacobi(R, g, name, vectors=False)[0]
+    return jacobi([R], g, name, vectors=False)[0][0]
 
 
-def left_singular_3(A: list, g: Graph, name: Callable) -> tuple[list, list]:
-    """(U, s) of a 3 x n matrix (rows of nodes): the left singular vectors (U's columns, as rows
-    of U) and the singular values, descending, 0 past n; U a rotation (det +1, the third
-    column's sign chosen), so that it orients an ellipsoid.
+def left_singular_3(matrices: list, g: Graph, name: Callable) -> list[tuple[list, list]]:
+    """(U, s) of each 3 x n matrix (rows of nodes): the left singular vectors (U's columns, as
+    rows of U) and the singular values, descending, 0 past n; U a rotation (det +1, the third
+    column's sign chosen), so that it orients an ellipsoid. The matrices' Jacobi run in lockstep.
 
     A^T = Q R (A^T padded with zero rows to at least 3), so A = R^T Q^T; with R V = W of
     orthogonal columns, R^T = V S W'^T and A's left singular vectors are V's columns."""
-    rows = [[A[r][c] for r in range(3)] for c in range(len(A[0]))]
-    rows += [[g.number(0)] * 3] * (3 - len(rows))
-    R, _, _, _ = triangulate(rows, g, name)
-    s, V = jacobi(R, g, name, vectors=True)
+    triangles = []
+    for A in matrices:
+        rows = [[A[r][c] for r in range(3)] for c in range(len(A[0]))]
+        rows += [[g.number(0)] * 3] * (3 - len(rows))
+        triangles.append(triangulate(rows, g, name)[0])
+    return [_sorted_rotation(s, V, g, name) for s, V in jacobi(triangles, g, name, vectors=True)]
+
+
+def _sorted_rotation(s: list, V: list, g: Graph, name: Callable) -> tuple[list, list]:
+    """V's columns and the values s sorted descending, the third column's sign making V a rotation."""
     columns = [[V[r][c] for r in range(3)] for c in range(3)]
     for i, j in ((0, 1), (1, 2), (0, 1)):  # a sorting network, descending
         swap = g.relation("<", s[i], s[j])
