@@ -3,6 +3,8 @@ one harness, then NAME_native's batches beside the Robotics Toolbox.
 
     PYTHONPATH=. python bench/bench_jacobian_uses.py [--calls 200000] [--rounds 7] [--rows 1000000]
 
+(Pinocchio's C++ needs Eigen's headers in the venv: `pip install cmeel-eigen`.)
+
 One C++ program (common.py's harness: -O2, one call per iteration, the joint vector changing
 every call, results into a sink) linked with jacgen's generated C (double, its own
 translation unit) times, per robot and round, after a warm-up round:
