@@ -6,14 +6,16 @@ pi + 10^-k (k = 3 ... 15), for every shipped special class, in numpy (one batch)
 - Every pose has a solution.
 
 Closer to a singularity the split of a nearly free angle is not fixed by the pose to 1e-6, so
-only the pose error is asked there. The native module prints the same graph; it is not run
-on these poses here.
+only the pose error is asked there. NAME_native (built with ik alone) runs them too: batched
+through its SIMD kernels ("native double") and row by row through the C ("native double
+scalar").
 """
 
 import numpy as np
 import pytest
 
-from jacgen.checking import reference
+from jacgen.checking import generated_code, reference
+from jacgen.loading import load_native
 
 from conftest import robot
 from support.ik import target_error, without_limits, wrapped_distance
@@ -21,7 +23,7 @@ from support.ik import target_error, without_limits, wrapped_distance
 # One robot of each shipped special class (planar, yaw_pitch, spherical wrist with parallel,
 # intersecting (a free joint, a chain solved backwards) and prismatic shoulders, three parallel)
 ROBOTS = ["planar_2r", "scara", "rexarm", "puma560", "kr5", "panda", "iiwa", "stanford", "ur5"]
-BACKENDS = ["python", "c double"]
+BACKENDS = ["python", "c double", "native double", "native double scalar"]
 EXPONENTS = range(3, 16)
 TOLERANCE = 1e-9
 
@@ -45,15 +47,29 @@ def near_singular(arm, free, seeds=4):
     return np.array(rows), np.array(joints), np.array(exponents)
 
 
+def backends(generated, arm, backend: str) -> tuple:
+    """(the numpy module, the backends that answer `backend`'s ik calls): the generated code's,
+    or for a native backend NAME_native's, built once per robot with ik and its callees."""
+    if not backend.startswith("native"):
+        code = generated(arm, ("c", "python", "casadi"))
+        return code.python, code.backends
+    code = generated(arm, ("python", "casadi", "native"), functions=("ik",))
+    if not hasattr(code, "native_backends"):
+        module = load_native(code.folder / arm.name, arm.name)
+        code.native_backends = generated_code.GeneratedCode(arm, code.signatures(("ik",)), code.folder, {},
+                                                             native=module)
+    return code.python, code.native_backends
+
+
 @pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("name", ROBOTS)
 def test_exact_up_to_the_singularity(generated, name, backend):
     arm = without_limits(robot(name))
-    code = generated(arm, ("c", "python", "casadi"))
-    free = getattr(code.python, "IK_FREE_JOINT", None)
+    python, calls = backends(generated, arm, backend)
+    free = getattr(python, "IK_FREE_JOINT", None)
     q, joints, exponents = near_singular(arm, free)
     targets = reference.ik_target(arm, q)
-    solutions, _ = code.backends.ik(backend, targets, None if free is None else q[:, free])
+    solutions, _ = calls.ik(backend, targets, None if free is None else q[:, free])
     scale = 1 + arm.reach
     for row, found in enumerate(solutions):
         where = f"{name} {backend}: joint {joints[row] + 1} at {q[row, joints[row]]!r} (k = {exponents[row]})"
@@ -68,10 +84,9 @@ def test_the_ur5_pose_that_broke_the_wrist_rule(generated):
     """A pose 6.77e-7 rad from ur5's wrist singularity: the branches with q5 = 0 (taken as
     singular) were 6e-7 from it, and its own configuration was not among them."""
     arm = without_limits(robot("ur5"))
-    code = generated(arm, ("c", "python", "casadi"))
     q = np.array([-0.479485, -1.968904, -2.353171, -0.967762, 6.77e-7, 1.494600])
     target = reference.fk(arm, q)
     for backend in BACKENDS:
-        [found], _ = code.backends.ik(backend, target[None], None)
+        [found], _ = backends(generated, arm, backend)[1].ik(backend, target[None], None)
         assert target_error(arm, reference.fk(arm, found), target).max() <= TOLERANCE * (1 + arm.reach)
         assert wrapped_distance(arm, found, q).min() <= 1e-9, backend
