@@ -11,6 +11,8 @@ through its SIMD kernels ("native double") and row by row through the C ("native
 scalar").
 """
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -49,10 +51,13 @@ def near_singular(arm, free, seeds=4):
 
 def backends(generated, arm, backend: str) -> tuple:
     """(the numpy module, the backends that answer `backend`'s ik calls): the generated code's,
-    or for a native backend NAME_native's, built once per robot with ik and its callees."""
+    or for a native backend NAME_native's, built once per robot with ik and its callees. The
+    native arm is renamed NAME_ik: an extension module loads once per process, and a worker
+    that runs tests/test_native.py after this file must find its own full NAME_native."""
     if not backend.startswith("native"):
         code = generated(arm, ("c", "python", "casadi"))
         return code.python, code.backends
+    arm = dataclasses.replace(arm, name=f"{arm.name}_ik")
     code = generated(arm, ("python", "casadi", "native"), functions=("ik",))
     if not hasattr(code, "native_backends"):
         module = load_native(code.folder / arm.name, arm.name)
