@@ -1,9 +1,9 @@
 """How many one-sided Jacobi sweeps the straight-line SVD needs (`jacgen/solvers/singular_values.py`).
 
 The same arithmetic as the generated code (a Householder QR of A^T, then round-robin rotations
-of the triangular factor's columns or rows, the squared norms summed afresh
-each sweep and updated by each rotation), in numpy, on k x k factors of matrices with known singular
-values (U diag(s) V^T, U and V orthogonal): spread over 1e-8 ... 1, one of 1e-16 ... 1e-6,
+of the triangular factor's columns or rows, the squared norms summed afresh each sweep and
+updated by each rotation), in numpy, on k x k factors of matrices with known singular values
+(U diag(s) V^T, U and V orthogonal): spread over 1e-8 ... 1, one of 1e-16 ... 1e-6,
 clustered within 1e-12 ... 1e-2 of 1, two zeros. Prints, per size and kind, the worst error
 of the singular values relative to the largest after each number of sweeps, turning R's columns
 (as velocity_ellipsoid does, for the vectors) or its rows (condition_number); the sweeps chosen

@@ -16,8 +16,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from jacgen.checking import generated_code, reference
-from jacgen.loading import load_native
+from jacgen.checking import reference
 
 from conftest import robot
 from support.ik import target_error, without_limits, wrapped_distance
@@ -57,12 +56,7 @@ def backends(generated, arm, backend: str) -> tuple:
     if not backend.startswith("native"):
         code = generated(arm, ("c", "python", "casadi"))
         return code.python, code.backends
-    arm = dataclasses.replace(arm, name=f"{arm.name}_ik")
-    code = generated(arm, ("python", "casadi", "native"), functions=("ik",))
-    if not hasattr(code, "native_backends"):
-        module = load_native(code.folder / arm.name, arm.name)
-        code.native_backends = generated_code.GeneratedCode(arm, code.signatures(("ik",)), code.folder, {},
-                                                             native=module)
+    code = generated(dataclasses.replace(arm, name=f"{arm.name}_ik"), ("python", "casadi", "native"), functions=("ik",))
     return code.python, code.native_backends
 
 

@@ -91,15 +91,15 @@ def rotation(a: Node, b: Node, c: Node, g: Graph, name: Callable) -> tuple[Node,
     """cos and tan of the rotation that makes columns w_i, w_j with a = |w_i|^2, b = |w_j|^2,
     c = w_i . w_j orthogonal, by the smaller angle: t = 2c sign(d) / (|d| + h), with d = b - a
     and h = sqrt(d^2 + 4c^2) (the textbook's zeta = d / 2c overflows where c is tiny; its guard
-    took a third square root and a select), and cos = 1 / sqrt(1 + t^2). The columns become cos w_i - sin w_j and
-    sin w_i + cos w_j, and a, b: a - t c, b + t c. (Not as cos (w_i - t w_j): with that form
-    XLA's fusion blows up, and jax.jit of the Panda's condition_number took 112 s at 5 sweeps
-    and over 10 minutes at 7, against 6 s and 5 s with this one.)
+    took a third square root and a select), and cos = 1 / sqrt(1 + t^2). `jacobi` makes the
+    columns cos w_i - sin w_j and sin w_i + cos w_j, and a, b: a - t c, b + t c. (Not
+    cos (w_i - t w_j): with that form XLA's fusion blows up, and jax.jit of the Panda's
+    condition_number took 112 s at 5 sweeps and over 10 minutes at 7, against 6 s and 5 s.)
 
     cos is computed from t, so the rotation is orthogonal to a rounding whatever h's accuracy:
     where d^2 + 4c^2 underflows (|d| and |c| below 1e-154, float 1e-19) it is only a worse
-    angle. Where d = c = 0 the columns are left as they are (selects of values that
-    stay finite, so that the gradients of JAX and PyTorch do too)."""
+    angle. Where d = c = 0 the columns are left as they are (selects of values that stay
+    finite, so that the gradients of JAX and PyTorch do too)."""
     zero, one = g.number(0), g.number(1)
     d = named(name, b - a)
     h = named(name, g.sqrt(d**2 + 4 * c**2))

@@ -21,7 +21,7 @@ from jacgen.checking import generated_code
 from jacgen.checking.c_library import CLibrary, compile_shared
 from jacgen.emission.catalogue import with_callees
 from jacgen.emission.generator import Generator
-from jacgen.loading import import_module
+from jacgen.loading import import_module, load_native
 from jacgen.files import write_files
 from jacgen.emission.render import render_robot
 from jacgen.inputs.robot import Robot
@@ -79,6 +79,13 @@ class Code:
         """Python, CasADi and this C, called on batches as `jacgen verify` calls them (backend
         names "python", "casadi", "c double" or "c float")."""
         return generated_code.GeneratedCode(self.robot, self.signatures(), self.folder, {self.real: self.shared_library})
+
+    @functools.cached_property
+    def native_backends(self) -> generated_code.GeneratedCode:
+        """NAME_native built from this code (generated with "native" among its languages) and
+        called as `jacgen verify --native` calls it (backend names "native double", ...)."""
+        module = load_native(self.folder / self.robot.name, self.robot.name)
+        return generated_code.GeneratedCode(self.robot, self.signatures(), self.folder, {}, native=module)
 
 
 class GeneratedCode:
