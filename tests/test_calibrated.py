@@ -9,11 +9,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import sympy
 
 from jacgen.checking import reference
+from jacgen.inputs.robot_file import load_robot
+from jacgen.inputs.values import Value
 from jacgen.model import structure
 from jacgen.solvers.model import Model
-from jacgen.inputs.robot_file import load_robot
 
 from conftest import GENERATED, robot
 from support.ik import wrapped
@@ -21,10 +23,32 @@ from support.ik import wrapped
 DATA = Path(__file__).parent / "data" / "calibrated"
 ARMS = {"ur5_calibrated": robot("ur5_calibrated"),
         "puma560_calibrated": load_robot(DATA / "puma560_calibrated.yaml"),
-        "kr5_calibrated": load_robot(DATA / "kr5_calibrated.yaml")}
+        "kr5_calibrated": load_robot(DATA / "kr5_calibrated.yaml"),
+        "panda_calibrated": robot("panda_calibrated")}
 NOMINAL = {"ur5_calibrated": ("three_parallel", 3),
            "puma560_calibrated": ("spherical_wrist_intersecting", 4),
-           "kr5_calibrated": ("spherical_wrist_parallel", 4)}
+           "kr5_calibrated": ("spherical_wrist_parallel", 4),
+           "panda_calibrated": ("spherical_wrist_intersecting", 4)}
+# The share of random poses each arm's fast path decides, at least (measured on 2 x 10^4: 81.5 %,
+# 90.3 %, 94.9 %, 83.2 %): a floor against regressions of the certificate, not a target.
+DECIDED = {"ur5_calibrated": 0.78, "puma560_calibrated": 0.87, "kr5_calibrated": 0.92, "panda_calibrated": 0.80}
+
+
+def _perturbed(name: str, seed: int):
+    """A calibrated arm nobody tuned for: shipped arm `name` with each twist moved by up to
+    5e-3 rad and each length a, d by up to 0.5 mm, at random."""
+    arm = robot(name)
+    rng = np.random.default_rng(seed)
+
+    def moved(value, by):
+        x = round(value.approx + rng.uniform(-by, by), 9)
+        return Value(sympy.Rational(repr(x)), x)
+    joints = tuple(dataclasses.replace(joint, alpha=moved(joint.alpha, 5e-3), a=moved(joint.a, 5e-4),
+                                       d=moved(joint.d, 5e-4)) for joint in arm.joints)
+    return dataclasses.replace(arm, name=f"{name}_perturbed{seed}", joints=joints)
+
+
+PERTURBED = {"ur5_perturbed": _perturbed("ur5", 1), "puma560_perturbed": _perturbed("puma560", 2)}
 
 
 def _eigenproblem_only(arm):
@@ -32,31 +56,62 @@ def _eigenproblem_only(arm):
     return dataclasses.replace(arm, name=f"{arm.name}_general", nearest_class=False)
 
 
-def _random_poses(arm, count: int, seed: int) -> np.ndarray:
-    q = np.random.default_rng(seed).uniform(-math.pi, math.pi, (count, 6))
-    return reference.fk(arm, q)
+def _free_angles(arm, q: np.ndarray) -> tuple:
+    """The general solver's input angle of a 7R arm at configurations q, as ik_branches takes it."""
+    free = Model(arm).closed_form.free
+    return () if free is None else (q[:, free],)
 
 
-def _near_singular_poses(arm, count: int, seed: int) -> np.ndarray:
-    """`count` poses per joint with that joint within 1e-3 rad of 0 or pi (for these arms the
-    wrist's, the elbow's and the shoulder's singular configurations are among them)."""
+def _random_configurations(arm, count: int, seed: int) -> np.ndarray:
+    return np.random.default_rng(seed).uniform(-math.pi, math.pi, (count, arm.dof))
+
+
+def _near_singular_configurations(arm, count: int, seed: int) -> np.ndarray:
+    """`count` random configurations per joint with that joint 10^-k rad (k uniform in 3 ... 12)
+    from 0 or pi, and `count` with the elbow (the nominal closed form's SP3 joint) 10^-k from
+    where it is straight or folded (where the least singular value of the Jacobian of the six
+    joints ik solves is least along its turn): wrists near aligned, elbows near straight."""
     rng = np.random.default_rng(seed)
-    q = rng.uniform(-math.pi, math.pi, (6, count, 6))
-    for joint in range(6):
-        q[joint, :, joint] = rng.choice([0.0, math.pi], count) + rng.uniform(-1e-3, 1e-3, count)
-    return reference.fk(arm, q.reshape(-1, 6))
+    form = Model(arm).closed_form
+    q = rng.uniform(-math.pi, math.pi, (arm.dof + 1, count, arm.dof))
+    offsets = rng.choice([-1.0, 1.0], (arm.dof + 1, count)) * 10.0 ** rng.uniform(-12, -3, (arm.dof + 1, count))
+    for joint in range(arm.dof):
+        q[joint, :, joint] = rng.choice([0.0, math.pi], count) + offsets[joint]
+    elbow = form.joints[form.fast_path.form.joints[2]]
+
+    def least_singular_value(angles):  # of the configurations q[-1] with the elbow at `angles` (count, m)
+        trial = np.repeat(q[-1][:, None, :], angles.shape[1], axis=1)
+        trial[..., elbow] = angles
+        return np.linalg.svd(reference.jacobian(arm, trial)[..., list(form.joints)], compute_uv=False)[..., -1]
+    grid = np.linspace(-math.pi, math.pi, 181)
+    best = grid[np.argmin(least_singular_value(np.broadcast_to(grid, (count, len(grid)))), axis=1)]
+    low, high = best - 2 * math.pi / 180, best + 2 * math.pi / 180
+    for _ in range(60):  # golden-section search within the grid's cell
+        a, b = high - 0.618 * (high - low), low + 0.618 * (high - low)
+        left = least_singular_value(a[:, None])[:, 0] < least_singular_value(b[:, None])[:, 0]
+        high, low = np.where(left, b, high), np.where(left, low, a)
+    q[-1, :, elbow] = (low + high) / 2 + offsets[-1]
+    return q.reshape(-1, arm.dof)
 
 
-def _differences(ours, valid, theirs, valid_theirs) -> tuple[int, int]:
-    """(missed, extra): solutions of `theirs` not in `ours`, and of `ours` not in `theirs` (to 1e-7 rad)."""
-    missed = extra = 0
-    for mine, mine_valid, other, other_valid in zip(ours, valid, theirs, valid_theirs):
+def _differences(arm, poses, ours, valid, theirs, valid_theirs) -> tuple[int, int, int]:
+    """(missed, extra, eigenproblem missed): solutions of `theirs` not in `ours` (to 1e-7 rad);
+    of `ours` not in `theirs` that do not reach their pose to 1e-9 (1 + reach), or repeat one;
+    and of `ours` not in `theirs` that do: solutions the eigenproblem does not find."""
+    missed = repeated = 0
+    alone, targets = [], []
+    for T, mine, mine_valid, other, other_valid in zip(poses, ours, valid, theirs, valid_theirs):
         a, b = mine[mine_valid.astype(bool)], other[other_valid.astype(bool)]
-        close = np.abs(wrapped(a[:, None, :] - b[None, :, :])).max(axis=-1) < 1e-7 if len(a) and len(b) else \
-            np.zeros((len(a), len(b)), dtype=bool)
+        close = np.abs(wrapped(a[:, None, :] - b[None, :, :])).max(axis=-1) < 1e-7
         missed += int((~close.any(axis=0)).sum())
-        extra += int((~close.any(axis=1)).sum())
-    return missed, extra
+        same = np.abs(wrapped(a[:, None, :] - a[None, :, :])).max(axis=-1) < 1e-6
+        repeated += int(same.sum() - len(a))
+        alone += list(a[~close.any(axis=1)])
+        targets += [T] * int((~close.any(axis=1)).sum())
+    if not alone:
+        return missed, repeated, 0
+    reached = np.abs(reference.fk(arm, np.array(alone)) - np.array(targets)).max(axis=(-2, -1)) < 1e-9 * (1 + arm.reach)
+    return missed, repeated + int((~reached).sum()), int(reached.sum())
 
 
 @pytest.mark.parametrize("name", ARMS)
@@ -77,20 +132,36 @@ def test_ur5_calibrated_snaps_its_two_twists_and_the_wrist_offset():
         (GENERATED / "ur5_calibrated" / "ur5_calibrated.md").read_text()
 
 
+def _compare(arm, code, general_code, q) -> tuple[int, int, int]:
+    """ik_branches of the fast path and of the eigenproblem alone (numpy) at the poses of q."""
+    poses, free = reference.fk(arm, q), _free_angles(arm, q)
+    ours = code.ik_branches(poses, *free)[:2]
+    theirs = general_code.ik_branches(poses, *free)[:2]
+    return _differences(arm, poses, *ours, *theirs)
+
+
 @pytest.mark.parametrize("name", ARMS)
 def test_numpy_finds_what_the_eigenproblem_finds(name, generated):
-    """10^4 random poses and 6 x 500 near-singular ones: 0 missed, 0 extra; every solution
-    reaches its pose to 1e-9 (1 + reach); the fast path decides most random poses."""
+    """10^4 random poses and 7 x 1000 near-singular ones: 0 missed, 0 extra; the fast path
+    decides at least DECIDED of the random ones."""
     arm = ARMS[name]
     fast = generated(arm, functions=("ik_branches",)).python
     general = generated(_eigenproblem_only(arm), functions=("ik_branches",)).python
-    for poses, decided_at_least in ((_random_poses(arm, 10_000, 1), 0.5), (_near_singular_poses(arm, 500, 2), 0.0)):
-        q, valid, _ = fast.ik_branches(poses)
-        q_general, valid_general, _ = general.ik_branches(poses)
-        assert _differences(q, valid, q_general, valid_general) == (0, 0)
-        reached = np.abs(reference.fk(arm, q) - poses[:, None]).max(axis=(-2, -1))
-        assert reached[valid].max() < 1e-9 * (1 + arm.reach)
-        assert fast._fast_branches(poses)[2].mean() >= decided_at_least
+    q = _random_configurations(arm, 10_000, 1)
+    assert _compare(arm, fast, general, q)[:2] == (0, 0)
+    assert fast._fast_branches(reference.fk(arm, q), *_free_angles(arm, q))[2].mean() >= DECIDED[name]
+    assert _compare(arm, fast, general, _near_singular_configurations(arm, 1000, 2))[:2] == (0, 0)
+
+
+@pytest.mark.parametrize("name", PERTURBED)
+def test_arms_nobody_tuned_for(name, generated):
+    """Shipped arms with twists off by up to 5e-3 rad and lengths by up to 0.5 mm: the same."""
+    arm = PERTURBED[name]
+    assert Model(arm).closed_form.fast_path is not None
+    fast = generated(arm, functions=("ik_branches",)).python
+    general = generated(_eigenproblem_only(arm), functions=("ik_branches",)).python
+    for q in (_random_configurations(arm, 4000, 3), _near_singular_configurations(arm, 300, 4)):
+        assert _compare(arm, fast, general, q)[:2] == (0, 0)
 
 
 @pytest.mark.parametrize("name", ARMS)
@@ -98,9 +169,23 @@ def test_c_finds_what_its_eigenproblem_finds(name, generated):
     arm = ARMS[name]
     fast = generated(arm, ("c",), functions=("ik_branches",)).library("ik_branches")
     general = generated(_eigenproblem_only(arm), ("c",), functions=("ik_branches",)).library("ik_branches")
-    poses = np.concatenate([_random_poses(arm, 1400, 3), _near_singular_poses(arm, 100, 4)])
-    ours, theirs = zip(*([fast.call("ik_branches", T)[:2], general.call("ik_branches", T)[:2]] for T in poses))
-    q, valid = map(np.array, zip(*ours))
-    assert _differences(q, valid, *map(np.array, zip(*theirs))) == (0, 0)
-    reached = np.abs(reference.fk(arm, q) - poses[:, None]).max(axis=(-2, -1))
-    assert reached[valid.astype(bool)].max() < 1e-9 * (1 + arm.reach)
+    q = np.concatenate([_random_configurations(arm, 1400, 3), _near_singular_configurations(arm, 100, 4)])
+    poses, free = reference.fk(arm, q), _free_angles(arm, q)
+    rows = [(fast.call("ik_branches", T, *f)[:2], general.call("ik_branches", T, *f)[:2])
+            for T, *f in zip(poses, *free)]
+    ours, theirs = zip(*rows)
+    assert _differences(arm, poses, *map(np.array, zip(*ours)), *map(np.array, zip(*theirs)))[:2] == (0, 0)
+
+
+def test_the_mismatch_bound_holds():
+    """The arms' mismatch (general6r.mismatch, summed from their DH differences) bounds the
+    difference of their tool poses at 10^5 random configurations, and is within 3 x of it."""
+    for arm in (*ARMS.values(), *PERTURBED.values()):
+        fast = Model(arm).closed_form.fast_path
+        q = _random_configurations(arm, 100_000, 5)
+        exact, nominal = reference.fk(arm, q), reference.fk(fast.nominal.robot, q)
+        position = np.linalg.norm(exact[:, :3, 3] - nominal[:, :3, 3], axis=-1).max()
+        chord = np.linalg.norm(exact[:, :3, :3] - nominal[:, :3, :3], axis=(-2, -1)) / (2 * math.sqrt(2))
+        rotation = (2 * np.arcsin(np.minimum(chord, 1.0))).max()  # |R1 - R2| = 2 sqrt(2) sin(angle / 2)
+        assert position <= fast.position < 3 * position
+        assert rotation <= fast.rotation + 1e-15 and fast.rotation <= 3 * rotation

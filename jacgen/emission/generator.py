@@ -155,11 +155,12 @@ class Generator:
         parts = [equations_function, start, step, limits]
         if form.fast_path:
             free_angle = None if form.free is None else self.q[form.free]
-            q, valid, margin = general6r_target.nominal_branches(form, sp, target.symbols, free_angle)
+            q, valid, certified = general6r_target.nominal_branches(form, sp, target.symbols, free_angle,
+                                                                           self.lowering.value_of)
             parts.append(self.function("ik_general_nominal", "the fast path's starting points: every branch of the "
                                        "nearest special class's closed form (the nominal arm's), whether its target "
-                                       "allows it, and the least margin of its subproblems", matrix("q", q),
-                                       vector("valid", valid), scalar("margin", margin),
+                                       "allows it, and whether its certificate holds", matrix("q", q),
+                                       vector("valid", valid), status("certified", certified),
                                        arguments=(target, *free_input), bindings=bindings, part_of="ik_branches"))
         return parts
 

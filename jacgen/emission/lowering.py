@@ -48,6 +48,7 @@ class Lowering:
         self.graph = Graph()
         self._names: dict[object, sympy.Symbol] = {}  # named values, by `_key`
         self._named_symbols: set[sympy.Symbol] = set()
+        self._values: dict[sympy.Symbol, Node] = {}  # each defined symbol's value
         self._negations: dict[Node, Node | None] = {}  # eliminate_common's, shared by every lowering
         self._lowered: dict[tuple, Body] = {}
 
@@ -56,6 +57,11 @@ class Lowering:
         now: nodes are ordered by when they were built (`graph._order`), so every value is
         built in the algorithms' order, never in the order a set iterates."""
         self.definitions.append((symbol, self.graph.convert(value)))
+        self._values[symbol] = self.definitions[-1][1]
+
+    def value_of(self, symbol: sympy.Symbol) -> Node | None:
+        """The value a symbol is defined as, None for an input."""
+        return self._values.get(symbol)
 
     def name(self, value: sympy.Expr) -> sympy.Expr:
         """`name_node` for a sympy value (the chain's), as a sympy value: its symbol, or minus it.
@@ -91,6 +97,7 @@ class Lowering:
             return graph.negate(self._named(negated, False))
         symbol = sympy.Symbol(f"{names.INTERNAL_PREFIX}n{len(self.definitions)}", real=True)
         self.definitions.append((symbol, node))
+        self._values[symbol] = node
         self._names[key] = symbol
         self._named_symbols.add(symbol)
         return graph.symbol(symbol)

@@ -185,7 +185,8 @@ def _fast_path_line(model: Model) -> str:
             f"{', '.join(fast.nominal.snapped)} (the arms differ by {fast.position:.3g} {model.robot.length_unit} "
             f"and {fast.rotation:.3g} rad at most). Its closed form, then up to {general6r.FAST_STEPS} Newton steps "
             f"per branch on this arm; the eigenproblem decides when a branch does not converge, two reach one "
-            f"solution, or a subproblem is within {fast.margin:.2g} of a double root or a free angle")
+            f"solution, or the closed form's certificate fails (a target within the mismatch of a double root "
+            f"or a free angle)")
 
 
 def describe(model: Model) -> str:

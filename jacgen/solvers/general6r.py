@@ -31,6 +31,7 @@ s^2 = 1 - c^2 for every joint; the twists' cosines and sines enter as 60-digit n
 the structure stage, and what cancels between them (below 1e-40) is dropped.
 """
 
+import math
 from dataclasses import dataclass, replace
 from functools import cached_property
 
@@ -322,19 +323,12 @@ ALONG_C = (0, 1, 3, 4, 6, 7, 9, 10)
 ALONG_B = tuple(range(9))
 NEWTON_STEPS = 6  # at most, on the pose, after the back-substitution (a near-double root needs more than 2)
 # The fast path of a calibrated arm (a nearest_class.Nominal): the nominal arm's closed form, then up
-# to FAST_STEPS Newton steps on the exact arm from each branch that the target allows or that
-# misses it by at most FAST_BAND times the arms' mismatch (the largest position and rotation error
-# between them at one configuration, over FAST_SAMPLES random ones). Each must reach T to
-# CONVERGED (1 + reach), at a solution of its own, and every margin of the closed form (see
-# Subproblems.margins: its discriminants, and the rotating parts of its SP1s and SP4s) must be at
-# least FAST_MARGIN times the relative mismatch (position / reach, or rotation): near a double root
-# or a nearly free angle the two arms' solutions differ by far more than the mismatch, and may be
-# more or fewer. Else the eigenproblem decides. FAST_MARGIN = 50 is measured, not derived: on 4
-# calibrated arms and 1.9e5 random and near-singular poses, 20 let 1 pose miss solutions, 30 none.
+# to FAST_STEPS Newton steps on the exact arm from each branch that the target allows. Each must
+# reach T to CONVERGED (1 + reach), at a solution of its own, and the closed form's certificate
+# must hold for every target within the arms' mismatch (`mismatch`; `Subproblems.certify`): no
+# branch appears or vanishes there, so the exact arm has one solution near each branch and no
+# other (contract §2, "Calibrated arms"). Else the eigenproblem decides.
 FAST_STEPS = 4
-FAST_BAND = 3.0
-FAST_MARGIN = 50.0
-FAST_SAMPLES = 1000
 CONVERGED = {"double": 1e-12, "float": 1e-5}
 # An eigenvalue is a root when |imaginary part| <= this (1 + |x|): a double root the target's
 # rounding splits into a complex pair (by about the square root of that rounding) still counts,
@@ -419,14 +413,22 @@ def _numeric_chain(links: list[Link], theta: np.ndarray) -> np.ndarray:
 
 
 def mismatch(robot: Robot, nominal: Robot) -> tuple[float, float]:
-    """The largest position error and the largest rotation angle between the two arms' tool
-    poses at one configuration, over FAST_SAMPLES random configurations: how far a nominal
-    solution can miss."""
-    q = np.random.default_rng(0).uniform(-np.pi, np.pi, (FAST_SAMPLES, robot.dof))
-    exact, near = numeric_chain.link_frames(robot, q)[1], numeric_chain.link_frames(nominal, q)[1]
-    position = np.linalg.norm(exact[:, :3, 3] - near[:, :3, 3], axis=-1)
-    cos = (np.einsum("nij,nij->n", exact[:, :3, :3], near[:, :3, :3]) - 1) / 2
-    return float(position.max()), float(np.arccos(np.clip(cos, -1.0, 1.0)).max())
+    """Bounds on the position error and the rotation angle between the two arms' tool poses at
+    any one configuration (the arms differ only in DH twists and lengths: `nearest_class`).
+    Telescoping the chain, link i's difference adds its twist's to the angle, and to the
+    position its own length's plus the twist's times the farthest the tool point can be from
+    where that twist turns (the lengths after it, or from it in the modified convention)."""
+    lengths = [math.hypot(joint.a.approx, joint.d.approx if joint.revolute else max(map(abs, robot.ranges[i])))
+               for i, joint in enumerate(robot.joints)]
+    tool = math.sqrt(sum(v.approx ** 2 for v in robot.tool.xyz))
+    after = 1 if robot.convention == "standard" else 0
+    position = rotation = 0.0
+    for i, (exact, near) in enumerate(zip(robot.joints, nominal.joints)):
+        twist = abs(exact.alpha.approx - near.alpha.approx)
+        length = math.hypot(exact.a.approx - near.a.approx, (exact.d.approx - near.d.approx) if exact.revolute else 0.0)
+        rotation += twist
+        position += length + twist * (sum(lengths[i + after:]) + tool)
+    return position, rotation
 
 
 def work_bytes(real: str) -> int:

@@ -11,8 +11,10 @@ from sympy.core.parameters import distribute
 
 from jacgen.inputs.robot import Robot
 from jacgen.inputs.transforms import rigid_inverse, rot_z, twist
+from jacgen.model.node import AND
+from jacgen.model.tangents import Tangents
 from jacgen.solvers import general6r, ik
-from jacgen.solvers.subproblems import Subproblems
+from jacgen.solvers.subproblems import CERTIFICATE, Subproblems
 
 
 def equations_at(robot: Robot, form: "ik.ClosedForm", target: sympy.Matrix, name) -> tuple[sympy.Matrix, ...]:
@@ -69,14 +71,59 @@ def loop_configuration(robot: Robot, form: "ik.ClosedForm", n: sympy.Matrix, ang
     return q
 
 
-def nominal_branches(form: "ik.ClosedForm", sp: Subproblems, target: sympy.Matrix, free_angle) -> tuple:
-    """(q, valid, margin): a calibrated arm's fast path's starting points, every branch of its
-    nominal arm's closed form at `target`, whether the target allows it, and the least margin
-    of its subproblems."""
+def nominal_branches(form: "ik.ClosedForm", sp: Subproblems, target: sympy.Matrix, free_angle,
+                     value_of) -> tuple:
+    """(q, valid, certified): a calibrated arm's fast path's starting points, every branch of
+    its nominal arm's closed form at `target`, whether the target allows it, and whether its
+    certificate holds (`Certificate`). `value_of` gives a named value's definition."""
     fast = form.fast_path
-    sp.margins = []
+    certificate = Certificate(sp, target, value_of, fast.rotation, fast.position)
+    sp.margins = certificate.test
     q, valid, _ = ik.branches(fast.nominal.robot, fast.form, sp, target, free_angle)
-    g, margin = sp.graph, sp.margins[0]
-    for other in sp.margins[1:]:
-        margin = sp.name(g.select(g.relation("<=", margin, other), margin, other))
-    return q, valid, margin
+    sp.margins = None
+    return q, valid, sp.graph.logic(AND, *certificate.tests)
+
+
+class Certificate:
+    """Whether every margin m of a branch that the target allows is at least CERTIFICATE times
+    its radius, the most it moves to first order while the target turns by up to `rotation`
+    and its position moves by up to `position`: |m| >= CERTIFICATE (rotation |dm/dw| + position
+    |dm/dv|), T' = (exp(w) R, t + v). A margin is 0 where a root is double or an angle free, so
+    where this holds no branch appears, vanishes or meets another for any target within that
+    distance (contract §2, "Calibrated arms"). Each test is built as its margin is recorded, so
+    that the generated code computes it while the margin's values are at hand."""
+
+    def __init__(self, sp: Subproblems, target: sympy.Matrix, value_of, rotation: float, position: float):
+        g = self.graph = sp.graph
+        self.name, self.rotation, self.position = sp.name, rotation, position
+        rows = [[g.symbol(target[i, j]) for j in range(4)] for i in range(3)]
+        seeds = {}
+        for i in range(3):  # the directions along which the target moves (not the rotation's where it does not turn)
+            for j in range(3):  # d(exp(w) R)/dw_k = e_k x R
+                column = [rows[m][j] for m in range(3)]
+                seeds[rows[i][j]] = tuple(_cross_unit(k, column)[i] if rotation else None for k in range(3)) + \
+                    (None,) * 3
+            seeds[rows[i][3]] = (None,) * 3 + tuple(g.number(1) if k == i else None for k in range(3))
+        self.tangents = Tangents(g, sp.name, value_of, seeds)
+        self.tests: list = []
+
+    def test(self, margin, parts: list, valid) -> None:
+        """Records the test of one margin (see `Subproblems._margin`), which counts where `valid`."""
+        g = self.graph
+        radius = g.number(0)
+        for factor, part in parts:  # |a move| <= rotation |d/dw| + position |d/dv| (Frobenius norms)
+            entries = part if isinstance(part, tuple) else (part,)
+            d = [[x or g.number(0) for x in self.tangents.of(entry)] for entry in entries]
+            turned, moved = (g.sqrt(sum((row[k] * row[k] for row in d for k in directions), g.number(0)))
+                             for directions in ((0, 1, 2), (3, 4, 5)))
+            radius += factor * (self.rotation * turned + self.position * moved)
+        slack = self.name(g.select(valid, margin - CERTIFICATE * radius, g.number(1)))  # NaN fails the test
+        self.tests.append(g.relation(">=", slack, g.number(0)))
+
+
+def _cross_unit(k: int, v: list) -> list:
+    """e_k x v."""
+    i, j = (k + 1) % 3, (k + 2) % 3
+    out = [None] * 3
+    out[i], out[j] = -v[j], v[i]
+    return out

@@ -9,7 +9,6 @@ Paden-Kahan subproblems of `subproblems.py`, and the fk pipeline prints them for
 backend as `ik_branches`.
 """
 
-import math
 from dataclasses import dataclass
 
 import numpy
@@ -46,22 +45,12 @@ class ClosedForm:
 @dataclass(frozen=True)
 class FastPath:
     """A calibrated arm's fast path (see general6r.FAST_STEPS): the nominal arm, its closed
-    form, and how far the two arms' tool poses differ at one configuration at most."""
+    form, and bounds on how far the two arms' tool poses differ at one configuration."""
 
     nominal: Nominal
     form: ClosedForm
     position: float  # in the robot's length unit
     rotation: float  # rad
-
-    @property
-    def band(self) -> float:
-        """|pose error| within which a branch the target does not allow is polished."""
-        return general6r.FAST_BAND * math.hypot(self.position, self.rotation)
-
-    @property
-    def margin(self) -> float:
-        """The least discriminant of the closed form at which the fast path decides."""
-        return general6r.FAST_MARGIN * max(self.position / self.nominal.robot.reach, self.rotation)
 
 
 def _scalar(value) -> Matrix:
@@ -213,7 +202,7 @@ def _planar_branches(sp: Subproblems, k: dict, target, form: ClosedForm, dof: in
                                      sp.sub(k["tool_point"], k["wrist"])))
     d = sp.sub(point, k["p1"])
     branches = []
-    for elbow in sp.sp3(sp.sub(k["wrist"], k["p2"]), sp.sub(k["p1"], k["p2"]), k["k2"], sp.dot(d, d)):
+    for elbow in sp.sp3(sp.sub(k["wrist"], k["p2"]), sp.sub(k["p1"], k["p2"]), k["k2"], d):
         shoulder = sp.sp1(sp.sub(sp.add(k["p2"], sp.turn(k["k2"], elbow.angle, sp.sub(k["wrist"], k["p2"]))), k["p1"]),
                           d, k["k1"])
         q = [g.number(0)] * dof
@@ -240,7 +229,7 @@ def _yaw_pitch_branches(sp: Subproblems, k: dict, target, form: ClosedForm, dof:
         for phi in approaches:
             wrist = sp.sub(w, sp.turn(k["h2"], phi.angle, sp.sub(k["tool_point"], k["p4"])))
             d = sp.sub(wrist, k["p2"])
-            for elbow in sp.sp3(sp.sub(k["p4"], k["p3"]), sp.sub(k["p2"], k["p3"]), k["h3"], sp.dot(d, d)):
+            for elbow in sp.sp3(sp.sub(k["p4"], k["p3"]), sp.sub(k["p2"], k["p3"]), k["h3"], d):
                 shoulder = sp.sp1(sp.sub(sp.add(k["p3"], sp.turn(k["h3"], elbow.angle, sp.sub(k["p4"], k["p3"]))), k["p2"]),
                                   d, k["h2"])
                 last = k["sign4"] * (phi.angle.theta - shoulder.theta - k["sign3"] * elbow.angle.theta)
@@ -271,16 +260,18 @@ def _spherical_wrist_parallel_branches(sp: Subproblems, k: dict, target, form: C
     R, _, wc = _pose_start(sp, k, target)
     branches = []
     for t1 in sp.sp4(sp.sub(wc, k["p1"]), k["h2"], k["h1"], k["reach"]):
-        d = sp.sub(sp.add(k["p1"], sp.turn(k["h1"], t1.angle, sp.sub(wc, k["p1"]), back=True)), k["p2"])
-        for t3 in sp.sp3(sp.sub(k["centre"], k["p3"]), sp.sub(k["p2"], k["p3"]), k["h3"], sp.dot(d, d)):
-            t2 = sp.sp1(sp.sub(sp.add(k["p3"], sp.turn(k["h3"], t3.angle, sp.sub(k["centre"], k["p3"]))), k["p2"]),
-                        d, k["h2"])
-            # R2 R3 = rot(h2, q2 + sign3 q3), h3 = sign3 h2: one turn back for both
-            c23 = t2.c * t3.angle.c - k["sign3"] * t2.s * t3.angle.s
-            s23 = t2.s * t3.angle.c + k["sign3"] * t2.c * t3.angle.s
-            turns = ((k["h1"], t1.angle), (k["h2"], Angle(None, sp.name(c23), sp.name(s23))))
-            branches += _wrist_branches(sp, k, R, turns, (t1.angle.theta, t2.theta, t3.angle.theta),
-                                        sp.graph.logic(AND, t1.valid, t3.valid))
+        with sp.given(t1.valid):
+            d = sp.sub(sp.add(k["p1"], sp.turn(k["h1"], t1.angle, sp.sub(wc, k["p1"]), back=True)), k["p2"])
+            for t3 in sp.sp3(sp.sub(k["centre"], k["p3"]), sp.sub(k["p2"], k["p3"]), k["h3"], d):
+                with sp.given(t3.valid):
+                    t2 = sp.sp1(sp.sub(sp.add(k["p3"], sp.turn(k["h3"], t3.angle, sp.sub(k["centre"], k["p3"]))),
+                                       k["p2"]), d, k["h2"])
+                    # R2 R3 = rot(h2, q2 + sign3 q3), h3 = sign3 h2: one turn back for both
+                    c23 = t2.c * t3.angle.c - k["sign3"] * t2.s * t3.angle.s
+                    s23 = t2.s * t3.angle.c + k["sign3"] * t2.c * t3.angle.s
+                    turns = ((k["h1"], t1.angle), (k["h2"], Angle(None, sp.name(c23), sp.name(s23))))
+                    branches += _wrist_branches(sp, k, R, turns, (t1.angle.theta, t2.theta, t3.angle.theta),
+                                                sp.graph.logic(AND, t1.valid, t3.valid))
     return branches
 
 
@@ -290,12 +281,14 @@ def _spherical_wrist_intersecting_branches(sp: Subproblems, k: dict, target, for
     R, _, wc = _pose_start(sp, k, target)
     d = sp.sub(wc, k["shoulder"])
     branches = []
-    for t3 in sp.sp3(sp.sub(k["centre"], k["p3"]), sp.sub(k["shoulder"], k["p3"]), k["h3"], sp.dot(d, d)):
-        reached = sp.sub(sp.add(k["p3"], sp.turn(k["h3"], t3.angle, sp.sub(k["centre"], k["p3"]))), k["shoulder"])
-        for t1, t2, valid in sp.sp2(reached, d, k["h1"], k["h2"]):
-            turns = ((k["h1"], t1), (k["h2"], t2), (k["h3"], t3.angle))
-            branches += _wrist_branches(sp, k, R, turns, (t1.theta, t2.theta, t3.angle.theta),
-                                        sp.graph.logic(AND, t3.valid, valid))
+    for t3 in sp.sp3(sp.sub(k["centre"], k["p3"]), sp.sub(k["shoulder"], k["p3"]), k["h3"], d):
+        with sp.given(t3.valid):
+            reached = sp.sub(sp.add(k["p3"], sp.turn(k["h3"], t3.angle, sp.sub(k["centre"], k["p3"]))), k["shoulder"])
+            for t1, t2, valid in sp.sp2(reached, d, k["h1"], k["h2"]):
+                with sp.given(valid):
+                    turns = ((k["h1"], t1), (k["h2"], t2), (k["h3"], t3.angle))
+                    branches += _wrist_branches(sp, k, R, turns, (t1.theta, t2.theta, t3.angle.theta),
+                                                sp.graph.logic(AND, t3.valid, valid))
     return branches
 
 
@@ -331,28 +324,32 @@ def _three_parallel_branches(sp: Subproblems, k: dict, target, form: ClosedForm,
     h = k["h"]
     branches = []
     for t1 in sp.sp4(sp.sub(wc, k["p1"]), h, k["h1"], k["reach"]):
-        g = sp.turn(k["h1"], t1.angle, h)
-        w = sp.add(k["p1"], sp.turn(k["h1"], t1.angle, sp.sub(wc, k["p1"]), back=True))
-        t6 = total = None  # set by the first root of q5
-        ga = sp.cross(g, a)
-        wrists = sp.sp4(h, k["h6"], k["h5"], sp.dot(g, a), across=sp.dot(ga, ga))
-        for j, t5 in enumerate(wrists):
-            if j == 1 and form.flip:
-                # The flipped wrist is another configuration (q4 and q6 turned by pi, the elbow
-                # elsewhere) also where the two roots of q5 meet: valid with the first, or a pose
-                # whose q5 is within 1e-6 of 0 or pi could find only the flip it cannot reach.
-                t5 = Root(t5.angle, wrists[0].valid)
-                t6, total = t6.turned_half(), total.turned_half()
-            else:
-                t6 = sp.sp1(times_transposed(sp, R, g), sp.turn(k["h5"], t5.angle, h, back=True), k["h6"])
-                x = sp.turn(k["h6"], t6, sp.turn(k["h5"], t5.angle, k["v"], back=True), back=True)
-                total = sp.sp1(k["v"], sp.turn(k["h1"], t1.angle, times(sp, R, x), back=True), h)
-            d = sp.sub(sp.sub(w, sp.turn(h, total, sp.sub(k["centre"], k["p4"]))), k["p2"])
-            for t3 in sp.sp3(sp.sub(k["p4"], k["p3"]), sp.sub(k["p2"], k["p3"]), k["h3"], sp.dot(d, d)):
-                t2 = sp.sp1(sp.sub(sp.add(k["p3"], sp.turn(k["h3"], t3.angle, sp.sub(k["p4"], k["p3"]))), k["p2"]), d, h)
-                t4 = k["sign4"] * (total.theta - t2.theta - k["sign3"] * t3.angle.theta)
-                branches.append(((t1.angle.theta, t2.theta, t3.angle.theta, t4, t5.angle.theta, t6.theta),
-                                 sp.graph.logic(AND, t1.valid, t5.valid, t3.valid)))
+        with sp.given(t1.valid):
+            g = sp.turn(k["h1"], t1.angle, h)
+            w = sp.add(k["p1"], sp.turn(k["h1"], t1.angle, sp.sub(wc, k["p1"]), back=True))
+            t6 = total = None  # set by the first root of q5
+            ga = sp.cross(g, a)
+            wrists = sp.sp4(h, k["h6"], k["h5"], sp.dot(g, a), across=sp.dot(ga, ga), between=(g, a))
+            for j, t5 in enumerate(wrists):
+                if j == 1 and form.flip:
+                    # The flipped wrist is another configuration (q4 and q6 turned by pi, the elbow
+                    # elsewhere) also where the two roots of q5 meet: valid with the first, or a pose
+                    # whose q5 is within 1e-6 of 0 or pi could find only the flip it cannot reach.
+                    t5 = Root(t5.angle, wrists[0].valid)
+                    t6, total = t6.turned_half(), total.turned_half()
+                with sp.given(t5.valid):
+                    if j == 0 or not form.flip:
+                        t6 = sp.sp1(times_transposed(sp, R, g), sp.turn(k["h5"], t5.angle, h, back=True), k["h6"])
+                        x = sp.turn(k["h6"], t6, sp.turn(k["h5"], t5.angle, k["v"], back=True), back=True)
+                        total = sp.sp1(k["v"], sp.turn(k["h1"], t1.angle, times(sp, R, x), back=True), h)
+                    d = sp.sub(sp.sub(w, sp.turn(h, total, sp.sub(k["centre"], k["p4"]))), k["p2"])
+                    for t3 in sp.sp3(sp.sub(k["p4"], k["p3"]), sp.sub(k["p2"], k["p3"]), k["h3"], d):
+                        with sp.given(t3.valid):
+                            t2 = sp.sp1(sp.sub(sp.add(k["p3"], sp.turn(k["h3"], t3.angle, sp.sub(k["p4"], k["p3"]))),
+                                               k["p2"]), d, h)
+                        t4 = k["sign4"] * (total.theta - t2.theta - k["sign3"] * t3.angle.theta)
+                        branches.append(((t1.angle.theta, t2.theta, t3.angle.theta, t4, t5.angle.theta, t6.theta),
+                                         sp.graph.logic(AND, t1.valid, t5.valid, t3.valid)))
     return branches
 
 

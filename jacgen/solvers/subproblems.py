@@ -16,6 +16,7 @@ replaced by the numbers of the build's real type when printed (`nodes.TOLERANCES
   leaves free is 0.
 """
 
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Callable
 
@@ -26,6 +27,9 @@ from jacgen.model.node import AND, CALL, NUMBER, OR, SELECT, Node
 from jacgen.model.tolerance_symbols import EPS, TINY
 
 Vector = tuple[Node, Node, Node]
+# The calibrated fast path's certificate (general6r_target.certificate): a margin must be this many
+# times its first-order radius, so that the first-order term dominates what it leaves out.
+CERTIFICATE = 2.0
 
 
 @dataclass(frozen=True)
@@ -56,17 +60,65 @@ class Subproblems:
         self.graph = graph
         self.name = name
         self.eps, self.tiny = graph.symbol(EPS), graph.symbol(TINY)
-        # Sizes that are near 0 where the closed form is sensitive to the target, dimensionless,
-        # recorded only when the fast path asks (a list here; it reads the least, general6r.FAST_MARGIN):
-        # - an SP2 or SP4 discriminant (a squared sine): two roots near one double root;
-        # - the rotating part of SP1 or SP4 (the product of the sines of its vectors' angles to
-        #   the axis): an angle that is nearly free, as at a wrist singularity.
-        self.margins: list[Node] | None = None
+        # Sizes that are 0 where a root is double or an angle free, recorded (with the validity of
+        # the branch that computes them) only when the fast path asks, by its certificate
+        # (general6r_target.Certificate). Each is a difference of lengths
+        # (or their product), never of squares: its first-order change bounds its change, also
+        # where a square's gradient vanishes (a folded elbow whose links are nearly equal).
+        # - where two roots meet, appear or vanish: SP4's rotating part less |its right-hand
+        #   side| (or, for a d that is the cosine of an angle, how far inside its range that angle
+        #   is), SP3's third side's distance from the two others' sum and difference, and in SP2,
+        #   how far inside its range the angle of q to k1 is;
+        # - where an angle is free, as at a wrist singularity: the rotating part of SP1 or SP4
+        #   (the product of its vectors' distances from the axis).
+        self.margins: Callable[[Node, list, Node], None] | None = None  # records (margin, parts, valid)
+        self._given: list[Node] = []  # the validity of the branches being built (see `given`)
 
-    def _margin(self, size: Callable[[], Node]) -> None:
-        """Records size() when the margins are asked for (built only then)."""
+    def _margin(self, size: Callable[[], tuple[Node, list]]) -> None:
+        """Records size() = (margin, its parts) when the margins are asked for (built only then).
+        Each part is (factor, value), a value a number or a vector: the margin moves by at most
+        the sum of factor |value's move|, also across the kink of an |x| or of a least of two,
+        and for a length |v| also where v is near 0 (its move across v is not first order)."""
         if self.margins is not None:
-            self.margins.append(size())
+            g = self.graph
+            self.margins(*size(), g.logic(AND, *self._given) if self._given else g.truth(True))
+
+    def _product_margin(self, u: Vector, v: Vector) -> tuple[Node, list]:
+        """|u| |v|, the rotating part of SP1 and SP4."""
+        size_u, size_v = self.norm(u), self.norm(v)
+        return self.name(size_u * size_v), [(size_v, u), (size_u, v)]
+
+    def _fold_margin(self, h_perp: Vector, p_perp: Vector, rhs: Node) -> tuple[Node, list]:
+        """SP4's |h_perp| |p_perp| - |rhs|: two roots where positive, none where negative."""
+        size_h, size_p = self.norm(h_perp), self.norm(p_perp)
+        g = self.graph
+        return g.call("Abs", size_h * size_p - g.call("Abs", rhs)), [(size_p, h_perp), (size_h, p_perp), (1, rhs)]
+
+    def _angle_margin(self, x: Vector, y: Vector, h: Vector, p: Vector, k: Vector) -> tuple[Node, list]:
+        """The angle b between x and y against the range of the angle between h and rot(k, t) p,
+        [|t_h - t_p|, min(t_h + t_p, 2 pi - t_h - t_p)] (t_h, t_p the angles of h and p to k):
+        some t turns p to angle b from h where b is inside. An angle between u and v moves by
+        |u's move| / |u| + |v's move| / |v| to first order."""
+        g = self.graph
+        angle, h_to_k, p_to_k = (g.call("atan2", self.norm(self.cross(u, v)), self.dot(u, v))
+                                 for u, v in ((x, y), (h, k), (p, k)))
+        spread = h_to_k + p_to_k
+        margin = _least(g, _least(g, angle - g.call("Abs", h_to_k - p_to_k), spread - angle),
+                        2 * sympy.pi - spread - angle)
+        return g.call("Abs", margin), [(1 / self.norm(u), u) for u in (x, y, h, p, k)]
+
+    def norm(self, v: Vector) -> Node:
+        return self.name(self.graph.sqrt(self.dot(v, v)))
+
+    @contextmanager
+    def given(self, valid: Node):
+        """Margins recorded within belong to a branch that exists only where `valid`: where it does
+        not, and the certificate shows it cannot for any target near, its margins do not matter."""
+        self._given.append(valid)
+        try:
+            yield
+        finally:
+            self._given.pop()
 
     def vector(self, values) -> Vector:
         return tuple(self.name(v) for v in values)
@@ -123,14 +175,15 @@ class Subproblems:
         y = self.dot(k, self.cross(p_perp, q_perp))
         rr = self.name(x * x + y * y)
         pq = self.name(self.dot(p, p) * self.dot(q, q))
-        self._margin(lambda: g.select(g.relation(">", pq, zero), g.sqrt(rr / pq), zero))
+        self._margin(lambda: self._product_margin(p_perp, q_perp))
         free = g.relation("<=", rr, self.tiny * pq)
         scale = self.name(g.select(free, one, 1 / g.sqrt(rr)))  # never 1/0, even for constant vectors
         return Angle(g.select(free, zero, g.call("atan2", y, x)), self.name(g.select(free, one, x * scale)),
                      self.name(g.select(free, zero, y * scale)))
 
     def sp4(self, h: Vector, p: Vector, k: Vector, d: Node, across: Node | None = None,
-            spread: Node | None = None) -> tuple[Root, Root]:
+            spread: Node | None = None, fold_margin: bool = True,
+            between: tuple[Vector, Vector] | None = None) -> tuple[Root, Root]:
         """SP4: the angles t with h . rot(k, t) p = d, (phi + alpha, phi - alpha), for unit h
         and k.
 
@@ -145,7 +198,9 @@ class Subproblems:
         its digits where alpha is small and an error in it moves the pose to first order (a
         wrist axis nearly parallel to h); 1 - cos(alpha)^2 would leave alpha only
         sqrt(rounding) ~ 1e-8. `spread` is (A^2 + B^2) sin(alpha)^2 itself, where the caller
-        has a form without cancellation (`sp3`)."""
+        has a form without cancellation (`sp3`, which records the margin of its fold itself).
+        `between`, for the certificate, is the pair of unit vectors whose angle d is the cosine of,
+        where h, p are unit vectors too."""
         g = self.graph
         zero, one = g.number(0), g.number(1)
         hk, kp = self.dot(h, k), self.dot(k, p)
@@ -155,7 +210,11 @@ class Subproblems:
         rhs = self.name(d - hk * kp)
         r2 = self.name(a * a + b * b)
         scale = self.name(self.dot(h, h) * self.dot(p, p))
-        self._margin(lambda: g.select(g.relation(">", scale, zero), g.sqrt(r2 / scale), zero))
+        self._margin(lambda: self._product_margin(h_perp, p_perp))
+        if fold_margin and between is None:
+            self._margin(lambda: self._fold_margin(h_perp, p_perp, rhs))
+        elif fold_margin:  # d = cos(b), b within the range of the angles of h to rot(k, t) p
+            self._margin(lambda: self._angle_margin(*between, h, p, k))
         constant = g.relation("<=", r2, self.tiny * scale)
         inverse_r = self.name(g.select(constant, one, 1 / g.sqrt(r2)))
         cos_phi, sin_phi = self.name(a * inverse_r), self.name(b * inverse_r)
@@ -164,7 +223,6 @@ class Subproblems:
             hxk = self.cross(h, k)
             spread = self.dot(hxk, hxk) * across - (kp - hk * d)**2
         disc = self.name(1 - cos_alpha**2 if spread is None else spread * inverse_r**2)
-        self._margin(lambda: g.call("Abs", disc))
         two, real = g.relation(">", disc, self.eps), g.relation(">", disc, zero)
         # beyond a double root (cos(alpha) = +-1 to rounding): sin(alpha) = 0
         cos_alpha = self.name(g.select(real, cos_alpha, g.select(g.relation(">", cos_alpha, zero), one, -one)))
@@ -179,8 +237,8 @@ class Subproblems:
                              g.logic(AND, g.negation(constant), g.relation(">=", disc, -self.eps)))
         return Root(plus, plus_valid), Root(minus, g.logic(AND, g.negation(constant), two))
 
-    def sp3(self, p: Vector, q: Vector, k: Vector, dd: Node) -> tuple[Root, Root]:
-        """SP3: the angles t with |rot(k, t) p - q|^2 = dd (p, q relative to a point of the axis).
+    def sp3(self, p: Vector, q: Vector, k: Vector, d: Vector) -> tuple[Root, Root]:
+        """SP3: the angles t with |rot(k, t) p - q| = |d| (p, q relative to a point of the axis).
 
         Across k, the distances |p_perp|, |q_perp| from the axis and c, the one asked between
         the two points, are a triangle, and (A^2 + B^2) sin(alpha)^2 is 4 times its area squared
@@ -189,9 +247,17 @@ class Subproblems:
         p_perp, q_perp = self.perpendicular(p, k), self.perpendicular(q, k)
         a = self.name(self.graph.sqrt(self.dot(p_perp, p_perp)))
         b = self.name(self.graph.sqrt(self.dot(q_perp, q_perp)))
-        c = self.name(self.clamped_sqrt(self.name(dd - (self.dot(k, p) - self.dot(k, q))**2)))
+        g = self.graph
+        dd, height = self.dot(d, d), self.name(self.dot(k, p) - self.dot(k, q))
+        c = self.name(self.clamped_sqrt(self.name(dd - height**2)))
         spread = self.name((c - a + b) * (c + a - b) * (a + b - c) * (a + b + c) / 4)
-        return self.sp4(q, p, k, self.name((self.dot(p, p) + self.dot(q, q) - dd) / 2), spread=spread)
+        # c's distance from a + b and from |a - b|; c = sqrt(|d|^2 - height^2) moves by |d| / c times
+        # d's move, and by |height| / c times p's and q's, which move a and b by at most their own
+        self._margin(lambda: (g.call("Abs", _least(g, a + b - c, c - g.call("Abs", a - b))),
+                              [(self.norm(d) / c, d), (1 + g.call("Abs", height) / c, p),
+                               (1 + g.call("Abs", height) / c, q)]))
+        return self.sp4(q, p, k, self.name((self.dot(p, p) + self.dot(q, q) - dd) / 2), spread=spread,
+                        fold_margin=False)
 
     def sp2(self, p: Vector, q: Vector, k1: Vector, k2: Vector) -> tuple[tuple[Angle, Angle, Node], ...]:
         """SP2: the angle pairs (t1, t2, valid) with rot(k1, t1) rot(k2, t2) p = q, for two axes
@@ -199,7 +265,6 @@ class Subproblems:
         c = alpha k1 + beta k2 +- gamma k1 x k2. One pair when gamma^2 is within EPS |p|^2 of 0
         (gamma kept as it is, as alpha in `sp4`)."""
         g = self.graph
-        zero = g.number(0)
         k12 = self.dot(k1, k2)
         nn = self.name(1 - k12**2)
         u, v = self.dot(k1, q), self.dot(k2, p)
@@ -213,14 +278,16 @@ class Subproblems:
         q_across, p_across = self.dot(k1q, k1q), self.dot(k2p, k2p)
         gg = self.name(g.select(g.relation("<", p_across, q_across), p_across - nn * alpha**2,
                                 q_across - nn * beta**2) / nn)
-        self._margin(lambda: g.select(g.relation(">", pp, zero), g.call("Abs", gg) / pp, zero))
+        # c exists where rot(k2, t2) p can make the angle of q with k1 (SP4 for t2)
+        self._margin(lambda: self._angle_margin(k1, q, k1, p, k2))
         two = g.relation(">", gg, self.eps * pp)
         gamma = self.name(self.clamped_sqrt(gg))
         normal = self.cross(k1, k2)
         pairs = []
         for sign, valid in ((1, g.relation(">=", gg, -self.eps * pp)), (-1, two)):
             c = self.vector(alpha * k1[i] + beta * k2[i] + sign * gamma * normal[i] for i in range(3))
-            pairs.append((self.sp1(c, q, k1), self.sp1(p, c, k2), valid))
+            with self.given(valid):
+                pairs.append((self.sp1(c, q, k1), self.sp1(p, c, k2), valid))
         return tuple(pairs)
 
     def wrist(self, a: Vector, b: Vector, h4: Vector, h5: Vector, h6: Vector, v6: Vector,
@@ -234,12 +301,17 @@ class Subproblems:
         pairs = self.sp2(h6, a, h4, h5)
         solutions = []
         for t4, t5, valid in pairs[:1] if flip is not None else pairs:
-            t6 = self.sp1(v6, self.turn(h5, t5, self.turn(h4, t4, b, back=True), back=True), h6)
+            with self.given(valid):
+                t6 = self.sp1(v6, self.turn(h5, t5, self.turn(h4, t4, b, back=True), back=True), h6)
             solutions.append(((t4.theta, t5.theta, t6.theta), valid))
         if flip is not None:
             (t4, t5, t6), _ = solutions[0]
             solutions.append(((t4 + sympy.pi, flip - t5, t6 + sympy.pi), pairs[1][2]))
         return tuple(solutions)
+
+
+def _least(g: Graph, a: Node, b: Node) -> Node:
+    return g.select(g.relation("<=", a, b), a, b)
 
 
 def relative(sp: Subproblems, T, rotation, position):

@@ -118,9 +118,7 @@ def ik_context(robot: Robot, generator: Generator, real: str, number: Callable, 
             "work_bytes": general6r.work_bytes(real),
             "joints": form.joints,
             "fast": form.fast_path and {
-                "rows": form.fast_path.form.info.max_solutions, "steps": general6r.FAST_STEPS,
-                "band_squared": number(form.fast_path.band ** 2),
-                "margin": number(form.fast_path.margin)}},
+                "rows": form.fast_path.form.info.max_solutions, "steps": general6r.FAST_STEPS}},
     }
 
 
