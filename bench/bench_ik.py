@@ -20,7 +20,8 @@ robot's closed form (structure detection and exact constants, `jacgen.ik.closed_
 printed first.
 
 A second table has the general 6R solver (class general_6r) on the shipped Jaco, Manocha-Canny
-arm and calibrated UR5, the calibrated Puma 560 and KR5 of tests/data/calibrated/, and the
+arm and calibrated UR5, the calibrated Puma 560 and KR5 of tests/data/calibrated/, the UR5 and
+Puma 560 perturbed at random there (twists by up to 5e-3 rad, lengths by up to 0.5 mm), and the
 7-axis Sawyer and calibrated Panda with joint 7 free (at its generating value), on random
 poses (fk of uniform joint vectors): the C `NAME_ik` in a native loop (for a
 calibrated arm: with its fast path, with the eigenproblem alone, and the nominal arm's own
@@ -52,7 +53,8 @@ from jacgen.solvers.model import Model
 from jacgen.inputs.robot_file import load_robot
 
 ROBOTS = {"ur5": IkGeoRobot.three_parallel_two_intersecting, "puma560": IkGeoRobot.spherical_two_parallel}
-GENERAL = ("jaco", "manocha_canny", "ur5_calibrated", "puma560_calibrated", "kr5_calibrated", "sawyer", "panda_calibrated")
+GENERAL = ("jaco", "manocha_canny", "ur5_calibrated", "puma560_calibrated", "kr5_calibrated", "ur5_perturbed",
+           "puma560_perturbed", "sawyer", "panda_calibrated")
 
 
 def per_pose(solve, targets, rounds: int) -> tuple[float, int]:
