@@ -9,11 +9,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import sympy
 
 from jacgen.checking import reference
+from jacgen.emission.generator import Generator
 from jacgen.inputs.robot_file import load_robot
 from jacgen.model import structure
+from jacgen.model.node import TOLERANCE_VALUES, evaluate
+from jacgen.solvers import ik
+from jacgen.solvers.general6r_target import Certificate
 from jacgen.solvers.model import Model
+from jacgen.solvers.subproblems import Subproblems
 
 from conftest import GENERATED, robot
 from support.ik import wrapped
@@ -175,3 +181,65 @@ def test_the_mismatch_bound_holds():
         rotation = (2 * np.arcsin(np.minimum(chord, 1.0))).max()  # |R1 - R2| = 2 sqrt(2) sin(angle / 2)
         assert position <= fast.position < 3 * position
         assert rotation <= fast.rotation + 1e-15 and fast.rotation <= 3 * rotation
+
+
+def _rotation(w: np.ndarray) -> np.ndarray:
+    """exp([w]x), Rodrigues."""
+    angle = np.linalg.norm(w)
+    k = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]]) / angle
+    return np.eye(3) + math.sin(angle) * k + (1 - math.cos(angle)) * k @ k
+
+
+@pytest.mark.parametrize("name", ["ur5_calibrated", "puma560_calibrated"])
+def test_the_certificates_assumption_holds_where_it_certifies(name):
+    """The certificate's assumption (contract §2): over the mismatch ball, a margin moves by
+    less than twice its first-order radius, so one that is 2 radii from 0 keeps its sign. Each
+    margin of the nominal closed form, evaluated from the value graph at 30 random poses and
+    at 12 targets on the ball's boundary around each."""
+    arm = ARMS[name]
+    generator = Generator(arm, selection=("ik_branches",))
+    fast = generator.closed_form.fast_path
+    sp = Subproblems(generator.graph, generator.name_node)
+    target = sympy.Matrix(4, 4, lambda i, j: sympy.Symbol(f"T{i}{j}", real=True))
+    certificate = Certificate(sp, target, generator.lowering.value_of, fast.rotation, fast.position)
+    margins = []  # (margin, its slack: margin - 2 radius where valid, else 1)
+
+    def record(margin, parts, valid):
+        certificate.test(margin, parts, valid)
+        if certificate.tests[-1].args:  # not a constant margin's test, decided when generated
+            margins.append((margin, certificate.tests[-1].args[0]))
+    sp.margins = record
+    ik.branches(fast.nominal.robot, fast.form, sp, target, None)
+    needed, frontier = set(), set().union(*(node.free_symbols for pair in margins for node in pair))
+    while frontier:
+        symbol = frontier.pop()
+        if symbol not in needed and generator.lowering.value_of(symbol) is not None:
+            needed.add(symbol)
+            frontier |= generator.lowering.value_of(symbol).free_symbols
+    definitions = [(s, v) for s, v in generator.lowering.definitions if s in needed]
+
+    def evaluated(T):
+        values = {target[i, j]: float(T[i, j]) for i in range(4) for j in range(4)}
+        values.update(TOLERANCE_VALUES["double"])
+        for symbol, value in definitions:
+            values[symbol] = evaluate(value, values)
+        return np.array([[evaluate(node, values) for node in pair] for pair in margins])
+
+    rng = np.random.default_rng(7)
+    checked = 0
+    for T in reference.fk(arm, _random_configurations(arm, 30, 6)):
+        at_target = evaluated(T)
+        margin, slack = at_target[:, 0], at_target[:, 1]
+        certified = slack < 1  # the margins of the branches T allows (the others have slack 1)
+        certified &= slack >= 0
+        radius = (margin - slack) / 2
+        for _ in range(12):
+            w, v = rng.normal(size=3), rng.normal(size=3)
+            moved = T.copy()
+            if fast.rotation:
+                moved[:3, :3] = _rotation(w / np.linalg.norm(w) * fast.rotation) @ T[:3, :3]
+            moved[:3, 3] += v / np.linalg.norm(v) * fast.position
+            change = np.abs(evaluated(moved)[:, 0] - margin)
+            assert (change[certified] <= 2 * radius[certified] + 1e-12).all()
+            checked += int(certified.sum())
+    assert checked > 1000
