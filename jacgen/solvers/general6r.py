@@ -325,7 +325,7 @@ NEWTON_STEPS = 6  # at most, on the pose, after the back-substitution (a near-do
 # The fast path of a calibrated arm (a nearest_class.Nominal): the nominal arm's closed form, then up
 # to FAST_STEPS Newton steps on the exact arm from each branch that the target allows. Each must
 # reach T to CONVERGED (1 + reach), at a solution of its own, and the closed form's certificate
-# must hold for every target within the arms' mismatch (`mismatch`; `Subproblems.certify`): no
+# must hold for every target within the arms' mismatch (`mismatch`; general6r_target.Certificate): no
 # branch appears or vanishes there, so the exact arm has one solution near each branch and no
 # other (contract §2, "Calibrated arms"). Else the eigenproblem decides.
 FAST_STEPS = 4
@@ -418,7 +418,8 @@ def mismatch(robot: Robot, nominal: Robot) -> tuple[float, float]:
     Telescoping the chain, link i's difference adds its twist's to the angle, and to the
     position its own length's plus the twist's times the farthest the tool point can be from
     where that twist turns (the lengths after it, or from it in the modified convention)."""
-    lengths = [math.hypot(joint.a.approx, joint.d.approx if joint.revolute else max(map(abs, robot.ranges[i])))
+    lengths = [math.hypot(joint.a.approx, joint.d.approx if joint.revolute
+                          else abs(joint.offset.approx) + max(map(abs, robot.ranges[i])))  # a prismatic joint's travel
                for i, joint in enumerate(robot.joints)]
     tool = math.sqrt(sum(v.approx ** 2 for v in robot.tool.xyz))
     after = 1 if robot.convention == "standard" else 0
