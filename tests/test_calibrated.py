@@ -210,20 +210,14 @@ def test_the_certificates_assumption_holds_where_it_certifies(name):
             margins.append((margin, certificate.tests[-1].args[0]))
     sp.margins = record
     ik.branches(fast.nominal.robot, fast.form, sp, target, None)
-    needed, frontier = set(), set().union(*(node.free_symbols for pair in margins for node in pair))
-    while frontier:
-        symbol = frontier.pop()
-        if symbol not in needed and generator.lowering.value_of(symbol) is not None:
-            needed.add(symbol)
-            frontier |= generator.lowering.value_of(symbol).free_symbols
-    definitions = [(s, v) for s, v in generator.lowering.definitions if s in needed]
+    body = generator.lower([node for pair in margins for node in pair])  # as the backends print them
 
     def evaluated(T):
         values = {target[i, j]: float(T[i, j]) for i in range(4) for j in range(4)}
         values.update(TOLERANCE_VALUES["double"])
-        for symbol, value in definitions:
+        for symbol, value in body.definitions:
             values[symbol] = evaluate(value, values)
-        return np.array([[evaluate(node, values) for node in pair] for pair in margins])
+        return np.array([evaluate(node, values) for node in body.outputs]).reshape(-1, 2)
 
     rng = np.random.default_rng(7)
     checked = 0

@@ -15,9 +15,9 @@ Tangent = tuple  # one Node per direction, None where the value does not move al
 
 
 class Tangents:
-    """The tangents of values on `graph` along `len(seed)` directions: `seeds` gives those of
-    the symbols that move (the inputs), `value_of` the definition of a named symbol (None for
-    an input), and every derivative of a definition is named with `name`."""
+    """The tangents of values on `graph` along as many directions as a seed has: `seeds` gives
+    those of the symbols that move (the inputs), `value_of` the definition of a named symbol
+    (None for an input), and every derivative of a definition is named with `name`."""
 
     def __init__(self, graph: Graph, name: Callable[[Node], Node], value_of: Callable[[sympy.Symbol], Node | None],
                  seeds: dict[Node, Tangent]):

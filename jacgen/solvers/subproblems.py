@@ -27,7 +27,7 @@ from jacgen.model.node import AND, CALL, NUMBER, OR, SELECT, Node
 from jacgen.model.tolerance_symbols import EPS, TINY
 
 Vector = tuple[Node, Node, Node]
-# The calibrated fast path's certificate (general6r_target.certificate): a margin must be this many
+# The calibrated fast path's certificate (general6r_target.Certificate): a margin must be this many
 # times its first-order radius, so that the first-order term dominates what it leaves out.
 CERTIFICATE = 2.0
 
@@ -62,8 +62,8 @@ class Subproblems:
         self.eps, self.tiny = graph.symbol(EPS), graph.symbol(TINY)
         # Sizes that are 0 where a root is double or an angle free, recorded (with the validity of
         # the branch that computes them) only when the fast path asks, by its certificate
-        # (general6r_target.Certificate). Each is a difference of lengths
-        # (or their product), never of squares: its first-order change bounds its change, also
+        # (general6r_target.Certificate). Each is a difference of lengths or angles (or a product
+        # of lengths), never of squares: its first-order change bounds its change, also
         # where a square's gradient vanishes (a folded elbow whose links are nearly equal).
         # - where two roots meet, appear or vanish: SP4's rotating part less |its right-hand
         #   side| (or, for a d that is the cosine of an angle, how far inside its range that angle
@@ -245,8 +245,7 @@ class Subproblems:
         (Heron's product): it keeps its digits where c is small (a folded arm whose two links
         are equal, a target near the base), where 1 - cos(alpha)^2 would lose them."""
         p_perp, q_perp = self.perpendicular(p, k), self.perpendicular(q, k)
-        a = self.name(self.graph.sqrt(self.dot(p_perp, p_perp)))
-        b = self.name(self.graph.sqrt(self.dot(q_perp, q_perp)))
+        a, b = self.norm(p_perp), self.norm(q_perp)
         g = self.graph
         dd, height = self.dot(d, d), self.name(self.dot(k, p) - self.dot(k, q))
         c = self.name(self.clamped_sqrt(self.name(dd - height**2)))
