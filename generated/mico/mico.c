@@ -243,7 +243,8 @@ static void jacgen_g6_left_null(double q[14][8], const double beta[8], double n[
     }
 }
 
-/* x solving a x = b in place (a: n x n, b: n x nb, both row by row), by LU with partial pivoting.
+/* x solving a x = b in place (a: n x n, b: n x nb, both row by row), by LU with partial pivoting
+ * (a is left with U above its diagonal and scratch below).
  * Returns -1 when a pivot is 0. */
 static int jacgen_g6_solve(int n, double *a, int nb, double *b) {
     for (int k = 0; k < n; k++) {
@@ -251,11 +252,14 @@ static int jacgen_g6_solve(int n, double *a, int nb, double *b) {
         for (int i = k + 1; i < n; i++)
             if (fabs(a[i * n + k]) > fabs(a[p * n + k])) p = i;
         if (!(fabs(a[p * n + k]) > 0.0)) return -1;
-        for (int j = 0; j < n; j++) { double t = a[k * n + j]; a[k * n + j] = a[p * n + j]; a[p * n + j] = t; }
-        for (int j = 0; j < nb; j++) { double t = b[k * nb + j]; b[k * nb + j] = b[p * nb + j]; b[p * nb + j] = t; }
+        if (p != k) {
+            for (int j = k; j < n; j++) { double t = a[k * n + j]; a[k * n + j] = a[p * n + j]; a[p * n + j] = t; }
+            for (int j = 0; j < nb; j++) { double t = b[k * nb + j]; b[k * nb + j] = b[p * nb + j]; b[p * nb + j] = t; }
+        }
+        double inverse = 1.0 / a[k * n + k];
         for (int i = k + 1; i < n; i++) {
-            double f = a[i * n + k] / a[k * n + k];
-            for (int j = k; j < n; j++) a[i * n + j] -= f * a[k * n + j];
+            double f = a[i * n + k] * inverse;
+            for (int j = k + 1; j < n; j++) a[i * n + j] -= f * a[k * n + j];
             for (int j = 0; j < nb; j++) b[i * nb + j] -= f * b[k * nb + j];
         }
     }
@@ -11507,12 +11511,9 @@ static int mico_ik_general_add(const mico_real x[MICO_DOF], int count, mico_real
 {
     int i, j;
     for (i = 0; i < count; ++i) {
-        double largest = 0.0;
-        for (j = 0; j < MICO_DOF; ++j) {
-            double d = remainder((double)x[j] - (double)q[MICO_DOF * i + j], 6.283185307179586);
-            largest = fmax(largest, fabs(d));
-        }
-        if (largest < 1e-6) return 0;
+        for (j = 0; j < MICO_DOF; ++j)  /* the first joint that differs tells them apart */
+            if (!(fabs(remainder((double)x[j] - (double)q[MICO_DOF * i + j], 6.283185307179586)) < 1e-6)) break;
+        if (j == MICO_DOF) return 0;
     }
     in_limits[count] = mico_ik_general_limits(x, q + MICO_DOF * count);
     valid[count] = 1;
