@@ -244,7 +244,7 @@ static void jacgen_g6_left_null(double q[14][8], const double beta[8], double n[
 }
 
 /* x solving a x = b in place (a: n x n, b: n x nb, both row by row), by LU with partial pivoting
- * (a is left with U above its diagonal and scratch below).
+ * (a is left with U above its diagonal, its pivots' inverses on it and scratch below).
  * Returns -1 when a pivot is 0. */
 static int jacgen_g6_solve(int n, double *a, int nb, double *b) {
     for (int k = 0; k < n; k++) {
@@ -256,7 +256,7 @@ static int jacgen_g6_solve(int n, double *a, int nb, double *b) {
             for (int j = k; j < n; j++) { double t = a[k * n + j]; a[k * n + j] = a[p * n + j]; a[p * n + j] = t; }
             for (int j = 0; j < nb; j++) { double t = b[k * nb + j]; b[k * nb + j] = b[p * nb + j]; b[p * nb + j] = t; }
         }
-        double inverse = 1.0 / a[k * n + k];
+        double inverse = a[k * n + k] = 1.0 / a[k * n + k];
         for (int i = k + 1; i < n; i++) {
             double f = a[i * n + k] * inverse;
             for (int j = k + 1; j < n; j++) a[i * n + j] -= f * a[k * n + j];
@@ -267,7 +267,7 @@ static int jacgen_g6_solve(int n, double *a, int nb, double *b) {
         for (int j = 0; j < nb; j++) {
             double s = b[k * nb + j];
             for (int i = k + 1; i < n; i++) s -= a[k * n + i] * b[i * nb + j];
-            b[k * nb + j] = s / a[k * n + k];
+            b[k * nb + j] = s * a[k * n + k];
         }
     return 0;
 }
