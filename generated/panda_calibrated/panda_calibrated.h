@@ -143,7 +143,7 @@ void panda_calibrated_ik_general_residual(const panda_calibrated_real target[16]
 int panda_calibrated_ik_general_limits(const panda_calibrated_real q_solution[PANDA_CALIBRATED_DOF], panda_calibrated_real q[PANDA_CALIBRATED_DOF]);
 
 /* The fast path's starting points: every branch of the nearest special class's closed form (the nominal arm's), whether its target allows it, and whether its certificate holds.
- * Result: q: 8 x 7 row-major, element (r, c) at q[r * 7 + c]; valid[i], i < 8; returned as a scalar. 10120 operations. */
+ * Result: q: 8 x 7 row-major, element (r, c) at q[r * 7 + c]; valid[i], i < 8; returned as a scalar. 14953 operations. */
 int panda_calibrated_ik_general_nominal(const panda_calibrated_real T[16], panda_calibrated_real q_free, panda_calibrated_real q[56], int valid[8]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

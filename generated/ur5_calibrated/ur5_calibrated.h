@@ -145,7 +145,7 @@ void ur5_calibrated_ik_general_residual(const ur5_calibrated_real target[16], co
 int ur5_calibrated_ik_general_limits(const ur5_calibrated_real q_solution[UR5_CALIBRATED_DOF], ur5_calibrated_real q[UR5_CALIBRATED_DOF]);
 
 /* The fast path's starting points: every branch of the nearest special class's closed form (the nominal arm's), whether its target allows it, and whether its certificate holds.
- * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; returned as a scalar. 9182 operations. */
+ * Result: q: 8 x 6 row-major, element (r, c) at q[r * 6 + c]; valid[i], i < 8; returned as a scalar. 10841 operations. */
 int ur5_calibrated_ik_general_nominal(const ur5_calibrated_real T[16], ur5_calibrated_real q[48], int valid[8]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.

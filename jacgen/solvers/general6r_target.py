@@ -11,10 +11,10 @@ from sympy.core.parameters import distribute
 
 from jacgen.inputs.robot import Robot
 from jacgen.inputs.transforms import rigid_inverse, rot_z, twist
-from jacgen.model.node import AND
+from jacgen.model.node import AND, OR, Node
 from jacgen.model.tangents import Tangents
 from jacgen.solvers import general6r, ik
-from jacgen.solvers.subproblems import CERTIFICATE, Subproblems
+from jacgen.solvers.subproblems import CERTIFICATE, Fold, Subproblems
 
 
 def equations_at(robot: Robot, form: "ik.ClosedForm", target: sympy.Matrix, name) -> tuple[sympy.Matrix, ...]:
@@ -90,12 +90,20 @@ class Certificate:
     and its position moves by up to `position`: |m| >= CERTIFICATE (rotation |dm/dw| + position
     |dm/dv|), T' = (exp(w) R, t + v). A margin is 0 where a root is double or an angle free, so
     where this holds no branch appears, vanishes or meets another for any target within that
-    distance (contract §2, "Calibrated arms"). Each test is built as its margin is recorded, so
-    that the generated code computes it while the margin's values are at hand."""
+    distance (contract §2, "Calibrated arms").
+
+    A fold (`Fold`: two roots that meet) whose margin is positive but below that is *relaxed*
+    instead, unless a fold it depends on is: over the targets within the mismatch its two
+    roots lie on one sheet, between (1 - cos) bounds of their half-gap, which holds at most two
+    of the exact arm's solutions, and the two branches must reach two. Every margin computed
+    from the sheet's roots then adds, where the fold is relaxed, how far it moves along the
+    sheet: |dm/dtheta| (the roots' first-order move + their half-gap + the greatest half-gap +
+    the midpoint's turn). Each test is built as its margin is recorded, so that the generated
+    code computes it while the margin's values are at hand."""
 
     def __init__(self, sp: Subproblems, target: sympy.Matrix, value_of, rotation: float, position: float):
         g = self.graph = sp.graph
-        self.name, self.rotation, self.position = sp.name, rotation, position
+        self.name, self.value_of, self.rotation, self.position = sp.name, value_of, rotation, position
         rows = [[g.symbol(target[i, j]) for j in range(4)] for i in range(3)]
         seeds = {}
         for i in range(3):  # the directions along which the target moves (not the rotation's where it does not turn)
@@ -106,19 +114,64 @@ class Certificate:
             seeds[rows[i][3]] = (None,) * 3 + tuple(g.number(1) if k == i else None for k in range(3))
         self.tangents = Tangents(g, sp.name, value_of, seeds)
         self.tests: list = []
+        self.slacks: list = []  # each test's margin - CERTIFICATE radius where its branch is allowed, else 1
+        self._sheets: list[tuple] = []  # (relaxed, span, tangents along the roots) of each fold
 
-    def test(self, margin, parts: list, valid) -> None:
-        """Records the test of one margin (see `Subproblems._margin`), which counts where `valid`."""
+    def _radius(self, parts: list, rates) -> Node:
+        """The sum of factor |a part's move|, each move's size `rates(the part's entries)`."""
         g = self.graph
         radius = g.number(0)
-        for factor, part in parts:  # |a move| <= rotation |d/dw| + position |d/dv| (Frobenius norms)
-            entries = part if isinstance(part, tuple) else (part,)
-            d = [[x or g.number(0) for x in self.tangents.of(entry)] for entry in entries]
-            turned, moved = (g.sqrt(sum((row[k] * row[k] for row in d for k in directions), g.number(0)))
-                             for directions in ((0, 1, 2), (3, 4, 5)))
-            radius += factor * (self.rotation * turned + self.position * moved)
+        for factor, part in parts:
+            radius += factor * rates(_entries(part))
+        return radius
+
+    def _target_move(self, entries) -> Node:
+        """rotation |d/dw| + position |d/dv| of a vector (Frobenius norms)."""
+        g = self.graph
+        d = [[x or g.number(0) for x in self.tangents.of(entry)] for entry in entries]
+        turned, moved = (g.sqrt(sum((row[k] * row[k] for row in d for k in directions), g.number(0)))
+                         for directions in ((0, 1, 2), (3, 4, 5)))
+        return self.rotation * turned + self.position * moved
+
+    def test(self, margin, parts: list, valid, fold: Fold | None = None) -> None:
+        """Records the test of one margin (see `Subproblems._margin`), which counts where `valid`."""
+        g = self.graph
+        radius = self._radius(parts, self._target_move)
+        upstream = []
+        for relaxed, span, along in self._sheets:
+            if all(along.of(entry)[0] is None for _, part in parts for entry in _entries(part)):
+                continue  # not computed from this fold's roots
+            turning = self._radius(parts, lambda entries: g.sqrt(sum(
+                ((along.of(entry)[0] or g.number(0)) ** 2 for entry in entries), g.number(0))))
+            radius += g.select(relaxed, turning * span, g.number(0))
+            upstream.append(relaxed)
         slack = self.name(g.select(valid, margin - CERTIFICATE * radius, g.number(1)))  # NaN fails the test
-        self.tests.append(g.relation(">=", slack, g.number(0)))
+        test = g.relation(">=", slack, g.number(0))
+        if fold is not None:
+            greatest, turn, bounded = fold.sheet(radius)
+            relaxed = g.logic(AND, g.relation("<", slack, g.number(0)), g.relation(">", fold.signed, g.number(0)),
+                              fold.both, bounded, *(g.negation(r) for r in upstream))
+            along = Tangents(g, self.name, self.value_of, fold.along)
+            self._sheets.append((relaxed, self._span(fold, greatest, turn), along))
+            test = g.logic(OR, test, relaxed)
+        self.slacks.append(slack)
+        self.tests.append(test)
+
+    def _span(self, fold: Fold, greatest, turn) -> Node:
+        """How far a root of the fold can move along its sheet: its first-order move + the
+        half-gap now + the greatest half-gap + the midpoint's move."""
+        g = self.graph
+        moves = [self._target_move((coordinate,)) for coordinate in fold.coordinates]
+        return self.name(_greatest(g, *moves) + fold.half_gap + greatest + turn)
+
+
+def _entries(part) -> tuple:
+    """A part's values: a vector's entries, or the one number."""
+    return part if isinstance(part, tuple) else (part,)
+
+
+def _greatest(g, a, b):
+    return g.select(g.relation(">=", a, b), a, b)
 
 
 def _cross_unit(k: int, v: list) -> list:

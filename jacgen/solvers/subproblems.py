@@ -53,6 +53,25 @@ class Root:
     valid: Node
 
 
+@dataclass(frozen=True)
+class Fold:
+    """Where a subproblem's two roots meet (an elbow straight or folded, SP4's right-hand side
+    at its amplitude, SP2's cones touching): both exist where `signed` > 0 (`both`: where the
+    target allows both), neither where it is negative. Along the fold the roots are the values
+    of one coordinate (an angle, or SP2's gamma): `coordinates` at each root, `along` the
+    derivative along it of the values each root's branch reads, `half_gap` half their distance.
+    `sheet(radius)`, where `signed` moves by up to `radius` to first order, bounds the greatest
+    half-gap and how far their midpoint moves: (half-gap, move, whether these bounds hold). The
+    certificate's relaxed fold (general6r_target.Certificate) reads them."""
+
+    signed: Node
+    both: Node
+    coordinates: tuple[Node, Node]
+    along: dict
+    half_gap: Node
+    sheet: Callable[[Node], tuple[Node, Node, Node]]
+
+
 class Subproblems:
     """Vector algebra and the subproblems on `graph`, naming every intermediate with `name`."""
 
@@ -71,41 +90,92 @@ class Subproblems:
         #   how far inside its range the angle of q to k1 is;
         # - where an angle is free, as at a wrist singularity: the rotating part of SP1 or SP4
         #   (the product of its vectors' distances from the axis).
-        self.margins: Callable[[Node, list, Node], None] | None = None  # records (margin, parts, valid)
+        self.margins: Callable[..., None] | None = None  # records (margin, parts, valid, fold)
         self._given: list[Node] = []  # the validity of the branches being built (see `given`)
 
-    def _margin(self, size: Callable[[], tuple[Node, list]]) -> None:
-        """Records size() = (margin, its parts) when the margins are asked for (built only then).
-        Each part is (factor, value), a value a number or a vector: the margin moves by at most
-        the sum of factor |value's move|, also across the kink of an |x| or of a least of two,
-        and for a length |v| also where v is near 0 (its move across v is not first order)."""
+    def _margin(self, size: Callable[[], tuple]) -> None:
+        """Records size() = (margin, its parts[, its Fold]) when the margins are asked for (built
+        only then). Each part is (factor, value), a value a number or a vector: the margin moves
+        by at most the sum of factor |value's move|, also across the kink of an |x| or of a least
+        of two, and for a length |v| also where v is near 0 (its move across v is not first order)."""
         if self.margins is not None:
             g = self.graph
-            self.margins(*size(), g.logic(AND, *self._given) if self._given else g.truth(True))
+            margin, parts, *fold = size()
+            self.margins(margin, parts, g.logic(AND, *self._given) if self._given else g.truth(True), *fold)
 
     def _product_margin(self, u: Vector, v: Vector) -> tuple[Node, list]:
         """|u| |v|, the rotating part of SP1 and SP4."""
         size_u, size_v = self.norm(u), self.norm(v)
         return self.name(size_u * size_v), [(size_v, u), (size_u, v)]
 
-    def _fold_margin(self, h_perp: Vector, p_perp: Vector, rhs: Node) -> tuple[Node, list]:
-        """SP4's |h_perp| |p_perp| - |rhs|: two roots where positive, none where negative."""
+    def _fold_margin(self, h_perp: Vector, p_perp: Vector, rhs: Node, roots: tuple[Root, Root]) -> tuple:
+        """SP4's |h_perp| |p_perp| - |rhs|: two roots where positive, none where negative. With
+        A = |h_perp| |p_perp|, 1 - cos(half-gap) = margin / A, and (A cos, A sin) of the midpoint
+        moves by at most what A does."""
         size_h, size_p = self.norm(h_perp), self.norm(p_perp)
         g = self.graph
-        return g.call("Abs", size_h * size_p - g.call("Abs", rhs)), [(size_p, h_perp), (size_h, p_perp), (1, rhs)]
+        amplitude = self.name(size_h * size_p)
+        signed = self.name(amplitude - g.call("Abs", rhs))
+
+        def sheet(radius):
+            least = amplitude - 2 * radius
+            return (signed + 2 * radius) / least, 2 * radius / least, g.relation(">", least, g.number(0))
+        return g.call("Abs", signed), [(size_p, h_perp), (size_h, p_perp), (1, rhs)], self._angle_fold(signed, roots, sheet)
+
+    def _angle_fold(self, signed: Node, roots: tuple[Root, Root], sheet: Callable) -> Fold:
+        """The fold of two roots t = phi +- alpha, `sheet(radius)` giving a bound on 1 - cos of
+        the greatest half-gap (min(alpha, pi - alpha)) and the midpoint's turn."""
+        g = self.graph
+        (c, s), (c2, s2) = ((root.angle.c, root.angle.s) for root in roots)
+        along = {}
+        for root in roots:
+            along.update({root.angle.c: (-root.angle.s,), root.angle.s: (root.angle.c,), root.angle.theta: (g.number(1),)})
+
+        def angles(radius):
+            bound, turn, hold = sheet(radius)
+            return 2 * g.call("asin", g.sqrt(_within(g, bound, 0, 2) / 2)), turn, hold
+        return Fold(signed, roots[1].valid, (roots[0].angle.theta, roots[1].angle.theta), along,
+                    g.call("Abs", g.call("atan2", s * c2 - c * s2, c * c2 + s * s2)) / 2, angles)
 
     def _angle_margin(self, x: Vector, y: Vector, h: Vector, p: Vector, k: Vector) -> tuple[Node, list]:
         """The angle b between x and y against the range of the angle between h and rot(k, t) p,
         [|t_h - t_p|, min(t_h + t_p, 2 pi - t_h - t_p)] (t_h, t_p the angles of h and p to k):
         some t turns p to angle b from h where b is inside. An angle between u and v moves by
         |u's move| / |u| + |v's move| / |v| to first order."""
+        signed, parts, _ = self._angle_range(x, y, h, p, k)
+        return self.graph.call("Abs", signed), parts
+
+    def _angle_range(self, x: Vector, y: Vector, h: Vector, p: Vector, k: Vector) -> tuple[Node, list, tuple]:
+        """`_angle_margin` signed (positive inside), its parts, and the angles of h and p to k."""
         g = self.graph
         angle, h_to_k, p_to_k = (g.call("atan2", self.norm(self.cross(u, v)), self.dot(u, v))
                                  for u, v in ((x, y), (h, k), (p, k)))
         spread = h_to_k + p_to_k
-        margin = _least(g, _least(g, angle - g.call("Abs", h_to_k - p_to_k), spread - angle),
-                        2 * sympy.pi - spread - angle)
-        return g.call("Abs", margin), [(1 / self.norm(u), u) for u in (x, y, h, p, k)]
+        signed = self.name(_least(g, _least(g, angle - g.call("Abs", h_to_k - p_to_k), spread - angle),
+                                  2 * sympy.pi - spread - angle))
+        return signed, [(1 / self.norm(u), u) for u in (x, y, h, p, k)], (h_to_k, p_to_k)
+
+    def _cones_margin(self, k1: Vector, q: Vector, p: Vector, k2: Vector, gamma: Node, roots: tuple,
+                      both: Node) -> tuple:
+        """SP2's margin, how far inside its range the angle b of q to k1 is, as a fold of gamma:
+        c = rot(k2, t) p on its cone (angle t_p to k2) is at angle b to k1 (angle psi to k2) at
+        tau from the plane of k1 and k2 where sin(t_p) sin(psi) (1 - |cos tau|) <= the margin,
+        and gamma = |p_perp| sin(tau) / sin(psi), p_perp p's part across k2. Each of the angles
+        b, t_p, psi moves by at most the margin's radius, and |p_perp| by 4 |p| times it."""
+        g = self.graph
+        signed, parts, (psi, t_p) = self._angle_range(k1, q, k1, p, k2)
+        across, size = self.norm(self.perpendicular(p, k2)), self.norm(p)
+
+        def sheet(radius):
+            sin_psi, sin_p = g.call("sin", psi) - 2 * radius, g.call("sin", t_p) - 2 * radius
+            bound = (signed + 2 * radius) / (sin_p * sin_psi)  # 1 - cos(tau) at most
+            bound = _within(g, bound, 0, 1)
+            sine = g.sqrt(bound * (2 - bound))
+            hold = g.logic(AND, g.relation(">", sin_p, g.number(0)), g.relation(">", sin_psi, g.number(0)))
+            return (across + 4 * size * radius) / sin_psi * sine, g.number(0), hold
+        normal = self.cross(k1, k2)
+        along = {c[i]: (normal[i],) for c in roots for i in range(3)}  # c = alpha k1 + beta k2 + gamma' normal
+        return g.call("Abs", signed), parts, Fold(signed, both, (gamma, gamma), along, gamma, sheet)
 
     def norm(self, v: Vector) -> Node:
         return self.name(self.graph.sqrt(self.dot(v, v)))
@@ -211,9 +281,7 @@ class Subproblems:
         r2 = self.name(a * a + b * b)
         scale = self.name(self.dot(h, h) * self.dot(p, p))
         self._margin(lambda: self._product_margin(h_perp, p_perp))
-        if fold_margin and between is None:
-            self._margin(lambda: self._fold_margin(h_perp, p_perp, rhs))
-        elif fold_margin:  # d = cos(b), b within the range of the angles of h to rot(k, t) p
+        if fold_margin and between is not None:  # d = cos(b), b within the range of the angles of h to rot(k, t) p
             self._margin(lambda: self._angle_margin(*between, h, p, k))
         constant = g.relation("<=", r2, self.tiny * scale)
         inverse_r = self.name(g.select(constant, one, 1 / g.sqrt(r2)))
@@ -235,7 +303,10 @@ class Subproblems:
                       self.name(sin_phi * cos_alpha - cos_phi * sin_alpha))
         plus_valid = g.logic(OR, g.logic(AND, constant, g.relation("<=", rhs**2, self.eps * scale)),
                              g.logic(AND, g.negation(constant), g.relation(">=", disc, -self.eps)))
-        return Root(plus, plus_valid), Root(minus, g.logic(AND, g.negation(constant), two))
+        roots = Root(plus, plus_valid), Root(minus, g.logic(AND, g.negation(constant), two))
+        if fold_margin and between is None:
+            self._margin(lambda: self._fold_margin(h_perp, p_perp, rhs, roots))
+        return roots
 
     def sp3(self, p: Vector, q: Vector, k: Vector, d: Vector) -> tuple[Root, Root]:
         """SP3: the angles t with |rot(k, t) p - q| = |d| (p, q relative to a point of the axis).
@@ -250,13 +321,29 @@ class Subproblems:
         dd, height = self.dot(d, d), self.name(self.dot(k, p) - self.dot(k, q))
         c = self.name(self.clamped_sqrt(self.name(dd - height**2)))
         spread = self.name((c - a + b) * (c + a - b) * (a + b - c) * (a + b + c) / 4)
-        # c's distance from a + b and from |a - b|; c = sqrt(|d|^2 - height^2) moves by |d| / c times
-        # d's move, and by |height| / c times p's and q's, which move a and b by at most their own
-        self._margin(lambda: (g.call("Abs", _least(g, a + b - c, c - g.call("Abs", a - b))),
-                              [(self.norm(d) / c, d), (1 + g.call("Abs", height) / c, p),
-                               (1 + g.call("Abs", height) / c, q)]))
-        return self.sp4(q, p, k, self.name((self.dot(p, p) + self.dot(q, q) - dd) / 2), spread=spread,
-                        fold_margin=False)
+        roots = self.sp4(q, p, k, self.name((self.dot(p, p) + self.dot(q, q) - dd) / 2), spread=spread,
+                         fold_margin=False)
+        self._margin(lambda: self._triangle_margin(a, b, c, (d, p, q), height, roots))
+        return roots
+
+    def _triangle_margin(self, a: Node, b: Node, c: Node, moving: tuple[Vector, Vector, Vector], height: Node,
+                         roots: tuple[Root, Root]) -> tuple:
+        """SP3's c's distance from a + b and from |a - b|: two roots where positive, none where
+        negative. c = sqrt(|d|^2 - height^2) moves by |d| / c times d's move, and by |height| / c
+        times p's and q's, which move a and b by at most their own. 1 - cos(half-gap) is
+        (a + b - c)(a + b + c) / 2ab or (c - |a - b|)(c + |a - b|) / 2ab, and (A cos, A sin) of
+        the midpoint, A = ab, moves by at most max(a, b) times p's and q's moves."""
+        g = self.graph
+        d, p, q = moving
+        signed = self.name(_least(g, a + b - c, c - g.call("Abs", a - b)))
+
+        def sheet(radius):
+            least = _least(g, a, b) - 2 * radius
+            bound = (signed + 2 * radius) * (a + b + c + 6 * radius) / (2 * (a - 2 * radius) * (b - 2 * radius))
+            return bound, 2 * radius / least, g.relation(">", least, g.number(0))
+        slope = 1 + g.call("Abs", height) / c
+        return (g.call("Abs", signed), [(self.norm(d) / c, d), (slope, p), (slope, q)],
+                self._angle_fold(signed, roots, sheet))
 
     def sp2(self, p: Vector, q: Vector, k1: Vector, k2: Vector) -> tuple[tuple[Angle, Angle, Node], ...]:
         """SP2: the angle pairs (t1, t2, valid) with rot(k1, t1) rot(k2, t2) p = q, for two axes
@@ -277,14 +364,15 @@ class Subproblems:
         q_across, p_across = self.dot(k1q, k1q), self.dot(k2p, k2p)
         gg = self.name(g.select(g.relation("<", p_across, q_across), p_across - nn * alpha**2,
                                 q_across - nn * beta**2) / nn)
-        # c exists where rot(k2, t2) p can make the angle of q with k1 (SP4 for t2)
-        self._margin(lambda: self._angle_margin(k1, q, k1, p, k2))
         two = g.relation(">", gg, self.eps * pp)
         gamma = self.name(self.clamped_sqrt(gg))
         normal = self.cross(k1, k2)
+        roots = [(self.vector(alpha * k1[i] + beta * k2[i] + sign * gamma * normal[i] for i in range(3)), valid)
+                 for sign, valid in ((1, g.relation(">=", gg, -self.eps * pp)), (-1, two))]
+        # c exists where rot(k2, t2) p can make the angle of q with k1 (SP4 for t2)
+        self._margin(lambda: self._cones_margin(k1, q, p, k2, gamma, tuple(c for c, _ in roots), two))
         pairs = []
-        for sign, valid in ((1, g.relation(">=", gg, -self.eps * pp)), (-1, two)):
-            c = self.vector(alpha * k1[i] + beta * k2[i] + sign * gamma * normal[i] for i in range(3))
+        for c, valid in roots:
             with self.given(valid):
                 pairs.append((self.sp1(c, q, k1), self.sp1(p, c, k2), valid))
         return tuple(pairs)
@@ -307,6 +395,12 @@ class Subproblems:
             (t4, t5, t6), _ = solutions[0]
             solutions.append(((t4 + sympy.pi, flip - t5, t6 + sympy.pi), pairs[1][2]))
         return tuple(solutions)
+
+
+def _within(g: Graph, x: Node, low: float, high: float) -> Node:
+    """x clamped to [low, high] (low where x is NaN)."""
+    return g.select(g.relation(">", x, g.number(high)), g.number(high), g.relation(">", x, g.number(low)), x,
+                    g.number(low))
 
 
 def _least(g: Graph, a: Node, b: Node) -> Node:
