@@ -110,8 +110,9 @@ class Subproblems:
 
     def _fold_margin(self, h_perp: Vector, p_perp: Vector, rhs: Node, roots: tuple[Root, Root]) -> tuple:
         """SP4's |h_perp| |p_perp| - |rhs|: two roots where positive, none where negative. With
-        A = |h_perp| |p_perp|, 1 - cos(half-gap) = margin / A, and (A cos, A sin) of the midpoint
-        moves by at most what A does."""
+        A = |h_perp| |p_perp|, 1 - cos(half-gap) = margin / A, and the midpoint's (A cos, A sin)
+        moves by at most the radius to first order (its parts are the margin's first two), so
+        by twice that over the ball (the certificate's factor 2), as A does."""
         size_h, size_p = self.norm(h_perp), self.norm(p_perp)
         g = self.graph
         amplitude = self.name(size_h * size_p)
@@ -120,16 +121,18 @@ class Subproblems:
         def sheet(radius):
             least = amplitude - 2 * radius
             return (signed + 2 * radius) / least, 2 * radius / least, g.relation(">", least, g.number(0))
-        return g.call("Abs", signed), [(size_p, h_perp), (size_h, p_perp), (1, rhs)], self._angle_fold(signed, roots, sheet)
+        parts = [(size_p, h_perp), (size_h, p_perp), (1, rhs)]
+        return g.call("Abs", signed), parts, self._angle_fold(signed, roots, sheet)
 
     def _angle_fold(self, signed: Node, roots: tuple[Root, Root], sheet: Callable) -> Fold:
         """The fold of two roots t = phi +- alpha, `sheet(radius)` giving a bound on 1 - cos of
         the greatest half-gap (min(alpha, pi - alpha)) and the midpoint's turn."""
         g = self.graph
         (c, s), (c2, s2) = ((root.angle.c, root.angle.s) for root in roots)
-        along = {}
+        along = {}  # d/dt (cos t, sin t, t)
         for root in roots:
-            along.update({root.angle.c: (-root.angle.s,), root.angle.s: (root.angle.c,), root.angle.theta: (g.number(1),)})
+            angle = root.angle
+            along.update({angle.c: (-angle.s,), angle.s: (angle.c,), angle.theta: (g.number(1),)})
 
         def angles(radius):
             bound, turn, hold = sheet(radius)
@@ -160,8 +163,9 @@ class Subproblems:
         """SP2's margin, how far inside its range the angle b of q to k1 is, as a fold of gamma:
         c = rot(k2, t) p on its cone (angle t_p to k2) is at angle b to k1 (angle psi to k2) at
         tau from the plane of k1 and k2 where sin(t_p) sin(psi) (1 - |cos tau|) <= the margin,
-        and gamma = |p_perp| sin(tau) / sin(psi), p_perp p's part across k2. Each of the angles
-        b, t_p, psi moves by at most the margin's radius, and |p_perp| by 4 |p| times it."""
+        and gamma = |p_perp| sin(tau) / sin(psi), p_perp p's part across k2. To first order each
+        of the angles b, t_p, psi moves by at most the margin's radius and |p_perp| by 2 |p| times
+        it; over the ball, by twice that (the certificate's factor 2)."""
         g = self.graph
         signed, parts, (psi, t_p) = self._angle_range(k1, q, k1, p, k2)
         across, size = self.norm(self.perpendicular(p, k2)), self.norm(p)
