@@ -14,7 +14,7 @@ from jacgen.inputs.transforms import rigid_inverse, rot_z, twist
 from jacgen.model.node import AND, OR, Node
 from jacgen.model.tangents import Tangents
 from jacgen.solvers import general6r, ik
-from jacgen.solvers.subproblems import CERTIFICATE, Fold, Subproblems
+from jacgen.solvers.subproblems import CERTIFICATE, Fold, Subproblems, greatest
 
 
 def equations_at(robot: Robot, form: "ik.ClosedForm", target: sympy.Matrix, name) -> tuple[sympy.Matrix, ...]:
@@ -148,30 +148,26 @@ class Certificate:
         slack = self.name(g.select(valid, margin - CERTIFICATE * radius, g.number(1)))  # NaN fails the test
         test = g.relation(">=", slack, g.number(0))
         if fold is not None:
-            greatest, turn, bounded = fold.sheet(radius)
+            widest, turn, bounded = fold.sheet(radius)
             relaxed = g.logic(AND, g.relation("<", slack, g.number(0)), g.relation(">", fold.signed, g.number(0)),
                               fold.both, bounded, *(g.negation(r) for r in upstream))
             along = Tangents(g, self.name, self.value_of, fold.along)
-            self._sheets.append((relaxed, self._span(fold, greatest, turn), along))
+            self._sheets.append((relaxed, self._span(fold, widest, turn), along))
             test = g.logic(OR, test, relaxed)
         self.slacks.append(slack)
         self.tests.append(test)
 
-    def _span(self, fold: Fold, greatest, turn) -> Node:
+    def _span(self, fold: Fold, widest, turn) -> Node:
         """How far a root of the fold can move along its sheet: its first-order move + the
         half-gap now + the greatest half-gap + the midpoint's move."""
         g = self.graph
         moves = [self._target_move((coordinate,)) for coordinate in fold.coordinates]
-        return self.name(_greatest(g, *moves) + fold.half_gap + greatest + turn)
+        return self.name(greatest(g, *moves) + fold.half_gap + widest + turn)
 
 
 def _entries(part) -> tuple:
     """A part's values: a vector's entries, or the one number."""
     return part if isinstance(part, tuple) else (part,)
-
-
-def _greatest(g, a, b):
-    return g.select(g.relation(">=", a, b), a, b)
 
 
 def _cross_unit(k: int, v: list) -> list:

@@ -119,8 +119,8 @@ class Subproblems:
         signed = self.name(amplitude - g.call("Abs", rhs))
 
         def sheet(radius):
-            least = amplitude - 2 * radius
-            return (signed + 2 * radius) / least, 2 * radius / least, g.relation(">", least, g.number(0))
+            lower = amplitude - 2 * radius  # the amplitude over the ball, at least
+            return (signed + 2 * radius) / lower, 2 * radius / lower, g.relation(">", lower, g.number(0))
         parts = [(size_p, h_perp), (size_h, p_perp), (1, rhs)]
         return g.call("Abs", signed), parts, self._angle_fold(signed, roots, sheet)
 
@@ -154,7 +154,7 @@ class Subproblems:
         angle, h_to_k, p_to_k = (g.call("atan2", self.norm(self.cross(u, v)), self.dot(u, v))
                                  for u, v in ((x, y), (h, k), (p, k)))
         spread = h_to_k + p_to_k
-        signed = self.name(_least(g, _least(g, angle - g.call("Abs", h_to_k - p_to_k), spread - angle),
+        signed = self.name(least(g, least(g, angle - g.call("Abs", h_to_k - p_to_k), spread - angle),
                                   2 * sympy.pi - spread - angle))
         return signed, [(1 / self.norm(u), u) for u in (x, y, h, p, k)], (h_to_k, p_to_k)
 
@@ -339,12 +339,12 @@ class Subproblems:
         the midpoint, A = ab, moves by at most max(a, b) times p's and q's moves."""
         g = self.graph
         d, p, q = moving
-        signed = self.name(_least(g, a + b - c, c - g.call("Abs", a - b)))
+        signed = self.name(least(g, a + b - c, c - g.call("Abs", a - b)))
 
         def sheet(radius):
-            least = _least(g, a, b) - 2 * radius
+            lower = least(g, a, b) - 2 * radius  # the shorter side over the ball, at least
             bound = (signed + 2 * radius) * (a + b + c + 6 * radius) / (2 * (a - 2 * radius) * (b - 2 * radius))
-            return bound, 2 * radius / least, g.relation(">", least, g.number(0))
+            return bound, 2 * radius / lower, g.relation(">", lower, g.number(0))
         slope = 1 + g.call("Abs", height) / c
         return (g.call("Abs", signed), [(self.norm(d) / c, d), (slope, p), (slope, q)],
                 self._angle_fold(signed, roots, sheet))
@@ -407,8 +407,12 @@ def _within(g: Graph, x: Node, low: float, high: float) -> Node:
                     g.number(low))
 
 
-def _least(g: Graph, a: Node, b: Node) -> Node:
+def least(g: Graph, a: Node, b: Node) -> Node:
     return g.select(g.relation("<=", a, b), a, b)
+
+
+def greatest(g: Graph, a: Node, b: Node) -> Node:
+    return g.select(g.relation(">=", a, b), a, b)
 
 
 def relative(sp: Subproblems, T, rotation, position):
