@@ -11,7 +11,7 @@ from jacgen.emission.backends import DEFAULT_LANGUAGES, LANGUAGES
 from jacgen.errors import JacgenError
 from jacgen.files import stale_files, write_files
 from jacgen.parallel import usable_cpus
-from jacgen.tolerances import ANGLE_SNAP, URDF_AGREEMENT
+from jacgen.tolerances import URDF_AGREEMENT
 from jacgen.version import __version__
 
 # Each command imports what it needs when it runs: `jacgen --help`, `validate` and a cached
@@ -308,8 +308,9 @@ def verify(robot_files, samples, seed, target, sources, native, jobs):
 @click.option("--name", default=None, help="Robot name (default: the URDF's, made a valid name).")
 @click.option("--task", default=None, metavar="x,y,...",
               help="Task components (default: all six, or for fewer than six joints the first independent ones).")
-@click.option("--snap", default=ANGLE_SNAP, show_default=True, type=click.FloatRange(0, 0.01), metavar="RADIANS",
-              help="Angles and axes this close to a multiple of 90 degrees become exact (1e-5 takes a URDF's 1.5708).")
+@click.option("--snap", default=None, type=click.FloatRange(0, 0.01), metavar="RADIANS",
+              help="Angles and axes this close to a multiple of 90 degrees become exact (default: an angle that is "
+                   "one to the digits it is written with, as 1.5708; docs/urdf.md).")
 @click.option("-o", "--output", default=None, type=click.Path(dir_okay=False), metavar="FILE.yaml",
               help="Write the robot file here (default: standard output).")
 def import_urdf_command(urdf_file, base, tip, convention, name, task, snap, output):
@@ -323,10 +324,12 @@ def import_urdf_command(urdf_file, base, tip, convention, name, task, snap, outp
         click.echo(f"jacgen: wrote {output}", err=True)
     else:
         click.echo(imported.text, nl=False)
+    made_exact = [f"angles made exact by up to {imported.snapped:.1g} rad"] if imported.snapped else []
+    made_exact += [f"{len(imported.zeroed)} length(s) of rounding level made 0"] if imported.zeroed else []
+    made_exact = f" ({'; '.join(made_exact)})" if made_exact else ""
     click.echo(f"jacgen: {imported.robot.name}: {imported.robot.dof} joints; fk within "
-               f"{imported.fk_difference:.1g} of the URDF chain as read, at {CHECK_CONFIGURATIONS} random configurations"
-               f"{'' if imported.snapped == 0 else f' (angles made exact moved it by up to {imported.snapped:.1g} rad)'}",
-               err=True)
+               f"{imported.fk_difference:.1g} of the URDF as written, at {CHECK_CONFIGURATIONS} random configurations"
+               f"{made_exact}", err=True)
 
 
 def _check_unique_names(robots: list[tuple[str, str]]) -> None:

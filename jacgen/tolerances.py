@@ -10,6 +10,11 @@ it, and the 4-6 digits of a robot file or a URDF far above it.
 
 # The arm's geometry: what is made exact, or counts as equal
 ANGLE_SNAP = 1e-9  # an angle this close to a multiple of pi/2 is that multiple (robot files, import-urdf --snap)
+# import-urdf: a URDF angle within this many units of its last written digit of k*pi/2 (k != 0),
+# and within WRITTEN_ANGLE_SNAP rad, is k*pi/2 (urdf.Snapper). A rounded or truncated pi/2 is
+# within one unit; rtb-data's Puma 560 writes 1.570796325, 1.8 units off.
+WRITTEN_ANGLE_UNITS = 2
+WRITTEN_ANGLE_SNAP = 1e-3
 PARALLEL = 1e-9  # |z_a x z_b| below which two unit axes are parallel
 ROOT = 1e-9  # |factor| (relative to its scale) at a numerically found root of a singularity factor
 URDF_AGREEMENT = 1e-9  # `show --compare-urdf`: a difference that agrees

@@ -7,7 +7,8 @@ joints, and compares the file's fk with a plain walk of the URDF chain.
 
 import hashlib
 import re
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, replace
 from decimal import Context, Decimal
 from pathlib import Path
 
@@ -17,76 +18,161 @@ import yaml
 
 from jacgen.checking import reference
 from jacgen.errors import JacgenError, RobotFileError
-from jacgen.inputs.dh_fit import Axis, exact_or_float, fit
+from jacgen.inputs.dh_fit import Axis, Table, exact_or_float, fit
 from jacgen.inputs.names import robot_name_problem
+from jacgen.inputs import values
+from jacgen.inputs.values import ExpressionError
 from jacgen.inputs.robot import TASK_COMPONENTS, Robot
-from jacgen.inputs.robot_file import FORBIDDEN_IN_TEXT, IDENTIFIER_PATTERN, NAME_PATTERN, parse_robot, task_problem
+from jacgen.inputs.robot_file import (FORBIDDEN_IN_TEXT, IDENTIFIER_PATTERN, NAME_PATTERN, SMALLEST_LENGTH, parse_robot,
+                                      task_problem)
 from jacgen.inputs.urdf import MOVABLE, LinkChain, Snapper, joint_axes, read_chain
 from jacgen.version import __version__
-from jacgen.tolerances import ANGLE_SNAP
 
 CHECK_CONFIGURATIONS = 20
 CHECK_SEED = 0
+# Consecutive axes less than NEARLY_PARALLEL rad from parallel, whose common normal puts DH
+# lengths more than FAR_NORMAL times the URDF chain's own extent away, are refused with the
+# --snap that makes them parallel (docs/urdf.md). MAX_SNAP is --snap's largest value.
+NEARLY_PARALLEL = 1e-3
+FAR_NORMAL = 10
+MAX_SNAP = 1e-2
 
 
 @dataclass(frozen=True)
 class Imported:
-    """A robot file made from a URDF: its text, the robot it reads as, the largest fk
-    difference from the URDF chain at CHECK_CONFIGURATIONS random configurations, and the
-    largest change (radians) that making angles exact caused."""
+    """A robot file made from a URDF: its text, the robot it reads as, the largest difference
+    of its fk from the URDF's as written (entries of the 4x4 pose) at CHECK_CONFIGURATIONS
+    random configurations, the largest change (radians) that making angles exact caused, and
+    the lengths the fit computed at rounding level that were made 0 (key, value)."""
 
     text: str
     robot: Robot
     fk_difference: float
     snapped: float
+    zeroed: tuple[tuple[str, float], ...] = ()
 
 
 def import_urdf(path: str, base: str | None = None, tip: str | None = None, convention: str = "standard",
                 name: str | None = None, task: tuple[str, ...] | None = None,
-                snap: float = ANGLE_SNAP) -> Imported:
-    """The robot file for the chain of `path`, checked against the URDF's own fk."""
+                snap: float | None = None) -> Imported:
+    """The robot file for the chain of `path`, checked against the URDF's own fk. `snap` is the
+    tolerance of the angles made exact (default: each URDF angle's own written digits, Snapper)."""
+    return _import(path, base, tip, convention, name, task, snap, suggest=True)
+
+
+def _import(path, base, tip, convention, name, task, snap, suggest: bool) -> Imported:
     snapper = Snapper(snap)
     chain = read_chain(path, base, tip, snapper)
+    as_written = read_chain(path, base, tip, Snapper(0.0))
     axes, tip_frame = _axes(chain)
     table = fit(axes, tip_frame, convention, snapper)
     name = name or _robot_name(chain.robot_name)
     problem = robot_name_problem(name) if NAME_PATTERN.fullmatch(name) else f"does not match {NAME_PATTERN.pattern}"
     if problem:
         raise JacgenError(f"{path}: robot name {name!r} {problem}; choose another with --name")
-    snapped = snapper.largest
-    digest = hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16]
-    source = _text(Path(path).name)
-    header = [
-        f"Imported by jacgen {__version__} import-urdf from {source} (sha256 {digest}), "
-        f"robot {_text(chain.robot_name)!r}, links {_text(chain.base)} -> {_text(chain.tip)}.",
-        f"{len(axes)} moving joint(s); fixed joints folded into the DH, base and tool transforms: "
-        f"{_text(', '.join(chain.folded)) or 'none'}. DH frames as in docs/urdf.md.",
-        f"Angles and axes within {snap:g} rad of a multiple of 90 deg were made exact; "
-        f"largest change {snapped:.2g} rad.",
-    ]
-    description = f"{_text(chain.robot_name)} imported from {source} (links {_text(chain.base)} -> {_text(chain.tip)})"
-
-    def text(components):
-        return _robot_file(name, description, header, convention, table, components)
-
     if task is not None and (not task or any(component not in TASK_COMPONENTS for component in task)):
         raise JacgenError(f"--task: expected components of {', '.join(TASK_COMPONENTS)}, got {','.join(task)!r}")
     if task is not None and (problem := task_problem(list(task))):
         raise JacgenError(f"--task: {problem}")
+    if far := _far_normal(chain, axes, table, snapper):
+        raise _nearly_parallel_error(path, far, (base, tip, convention, name, task) if suggest else None)
+    digest = hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16]
+    source = _text(Path(path).name)
+    rule = (f"within {snap:g} rad of a multiple of 90 deg" if snap is not None
+            else "multiples of 90 deg to the digits the URDF writes them with")
+    description = f"{_text(chain.robot_name)} imported from {source} (links {_text(chain.base)} -> {_text(chain.tip)})"
+
+    def text(components, checked=""):
+        header = [
+            f"Imported by jacgen {__version__} import-urdf from {source} (sha256 {digest}), "
+            f"robot {_text(chain.robot_name)!r}, links {_text(chain.base)} -> {_text(chain.tip)}.",
+            f"{len(axes)} moving joint(s); fixed joints folded into the DH, base and tool transforms: "
+            f"{_text(', '.join(chain.folded)) or 'none'}. DH frames as in docs/urdf.md.",
+            f"Angles and axes {rule} were made exact; largest change {snapper.largest:.2g} rad.",
+        ]
+        if zeroed:
+            header.append(f"Lengths the DH fit computed below {SMALLEST_LENGTH:g} of the arm's size were made 0: "
+                          + ", ".join(f"{key} {value:.2g}" for key, value in zeroed) + ".")
+        if checked:
+            header.append(checked)
+        return _robot_file(name, description, header, convention, table, components)
+
+    zeroed: list[tuple[str, float]] = []
+    table, zeroed = _without_rounding_lengths(table, _read_back(text(TASK_COMPONENTS), path, rounding_lengths=True).reach)
     if task is None:
         task = () if len(axes) >= 6 else _independent_task(_read_back(text(TASK_COMPONENTS), path))
-    result = text(task)
-    robot = _read_back(result, path)
-    return Imported(result, robot, _fk_difference(robot, chain), snapped)
+    difference = _fk_difference(_read_back(text(task), path), as_written)
+    result = text(task, f"Its fk differs from the URDF's as written by at most {difference:.2g} (an entry of the 4x4 "
+                        f"pose) at {CHECK_CONFIGURATIONS} random configurations within the limits.")
+    return Imported(result, _read_back(result, path), difference, snapper.largest, tuple(zeroed))
 
 
-def _read_back(text: str, path: str) -> Robot:
+def _read_back(text: str, path: str, rounding_lengths: bool = False) -> Robot:
     """The robot of the file written for the URDF at `path`, validated as every robot file is:
     a rule the chain breaks there (its size, equal limits) is the URDF's, and named."""
     try:
-        return parse_robot(text.encode(), "<imported robot file>")
+        return parse_robot(text.encode(), "<imported robot file>", rounding_lengths)
     except RobotFileError as error:
         raise JacgenError(f"{path}: the chain makes no valid robot file: {error.key}: {error.message}") from None
+
+
+def _without_rounding_lengths(table: Table, reach: float) -> tuple[Table, list[tuple[str, float]]]:
+    """The table with every length (a, and a revolute row's d) below the robot files' smallest
+    one (SMALLEST_LENGTH of the arm's size) made 0: the fit computed it from angles that are
+    k*90 deg to their written digits, or from a pi/4 written in a double. Robot files refuse
+    such a length, since the arm is singular everywhere to rounding there."""
+    rows, zeroed = [], []
+    for k, row in enumerate(table.rows):
+        changes = {}
+        for key in ("a", "d") if row.axis.kind == "revolute" else ("a",):
+            value = float(getattr(row, key))
+            if value and abs(value) < SMALLEST_LENGTH * reach:
+                changes[key] = sympy.Integer(0)
+                zeroed.append((f"joints[{k}].{key}", value))
+        rows.append(replace(row, **changes))
+    return replace(table, rows=tuple(rows)), zeroed
+
+
+@dataclass(frozen=True)
+class _FarNormal:
+    """Consecutive axes that are not parallel but nearly so, whose common normal lies far
+    outside the URDF's chain."""
+
+    joints: tuple[str, str]
+    angle: float  # rad, between the axes
+    length: float  # the largest DH length of the two rows
+    extent: float  # the URDF chain's own length: its joint origins' distances summed
+
+
+def _far_normal(chain: LinkChain, axes: list[Axis], table: Table, snapper: Snapper) -> _FarNormal | None:
+    """The nearly parallel axes whose common normal puts DH lengths more than FAR_NORMAL times
+    the chain's extent away, if any (a URDF that writes pi/2 with too few digits for the default rule)."""
+    extent = sum(float(sympy.sqrt(sum(e**2 for e in joint.origin[:3, 3]))) for joint in chain.joints)
+    lengths = [max(abs(float(row.a)), abs(float(row.d))) for row in table.rows]
+    pairs = []
+    for k, (here, there) in enumerate(zip(axes, axes[1:])):
+        sine = math.sqrt(sum(float(e) ** 2 for e in here.direction.cross(there.direction)))
+        if 0 < math.asin(min(sine, 1.0)) < NEARLY_PARALLEL and not snapper.close(sine):
+            pairs.append(_FarNormal((here.name, there.name), math.asin(min(sine, 1.0)), max(lengths[k], lengths[k + 1]), extent))
+    far = [pair for pair in pairs if pair.length > FAR_NORMAL * max(extent, 1e-3)]
+    return min(far, key=lambda pair: pair.angle) if far else None
+
+
+def _nearly_parallel_error(path: str, far: _FarNormal, options) -> JacgenError:
+    """The refusal of nearly parallel axes: which joints, how far from parallel, the DH length
+    it would need, and the --snap value that imports the URDF with its effect on fk."""
+    message = (f"{path}: joints {far.joints[0]!r} and {far.joints[1]!r}: their axes are {far.angle:.2g} rad from "
+               f"parallel, so the DH common normal between them needs lengths of {far.length:.3g} m, where the "
+               f"URDF's chain spans {far.extent:.3g} m")
+    snap = 10.0 ** math.ceil(math.log10(far.angle * 1.01))
+    if options is not None and snap <= MAX_SNAP:
+        try:
+            effect = _import(path, *options, snap, suggest=False).fk_difference
+            message += (f"; if they are meant to be parallel, import with --snap {snap:g}, which makes them so and "
+                        f"moves fk by at most {effect:.2g} from the URDF as written")
+        except JacgenError:
+            message += f"; --snap {snap:g} does not import it either"
+    return JacgenError(message)
 
 
 def _axes(chain: LinkChain) -> tuple[list[Axis], sympy.Matrix]:
@@ -132,11 +218,21 @@ def _text(text: str) -> str:
 
 
 def literal(value: sympy.Expr) -> str:
-    """A robot-file value: an exact decimal, "p/q", "r*sqrt(s)" or "k*pi/m" when exact, else
-    the shortest decimal that round-trips the double."""
+    """A robot-file value: an exact decimal, "p/q", "r*sqrt(s)" or "k*pi/m" when exact and a
+    robot file can hold it (contract §1 "Numbers"), else the shortest decimal that round-trips
+    the double (rounding noise squared under a sqrt can need hundreds of digits)."""
     value = sympy.sympify(value)
-    if value.has(sympy.Float):
-        return repr(float(value)) if value != 0 else "0"
+    if not value.has(sympy.Float):
+        text = _exact_literal(value)
+        try:
+            values.parse(text.strip('"'), lambda name: None)
+            return text
+        except ExpressionError:
+            pass
+    return repr(float(value)) if value != 0 else "0"
+
+
+def _exact_literal(value: sympy.Expr) -> str:
     if value.is_Rational:
         return _rational(value)
     coefficient, rest = value.as_coeff_Mul()

@@ -20,7 +20,7 @@ from jacgen.inputs.robot_file import parse_robot
 
 from conftest import ROBOT_NAMES, ROOT, random_configurations, robot
 from support.random_arms import random_arm_text
-from support.urdf import DATA, URDFS, imported
+from support.urdf import DATA, URDFS, as_read, imported
 
 matplotlib = pytest.importorskip("matplotlib")
 matplotlib.use("Agg")
@@ -284,24 +284,27 @@ def _pinocchio_chain(path, base, tip, arm, q):
 
 @pytest.mark.parametrize("convention", ["standard", "modified"])
 @pytest.mark.parametrize("key", URDFS)
-def test_imported_robot_files_agree_with_their_urdf(key, convention):
-    """The robot file import-urdf writes describes the URDF's chain as Pinocchio reads it (not
+def test_imported_robot_files_agree_with_their_urdf(key, convention, tmp_path):
+    """The robot file import-urdf writes describes the URDF's chain (its angles made exact as
+    docs/urdf.md says) as Pinocchio reads it (not
     jacgen's URDF reader, which import and compare share): at q = 0 and random configurations
     every axis (direction, and the URDF joint's origin on the robot file's line) and the tool
     pose agree to 1e-9; and compare_urdf finds them agreeing."""
     result = imported(key, convention)
     arm = result.robot
     file, base, tip, _ = URDFS[key]
+    urdf = tmp_path / file  # with its angles made exact as import-urdf reads them (docs/urdf.md)
+    urdf.write_text(as_read((DATA / file).read_text()))
     tip_link = tip or re.search(r"-> (\w+)\)", arm.description).group(1)
     for q in [np.zeros(arm.dof), *random_configurations(arm, 10, seed=32)]:
         frames, tool = reference.frames(arm, q)
-        axes, tip_pose = _pinocchio_chain(DATA / file, base, tip_link, arm, q)
+        axes, tip_pose = _pinocchio_chain(urdf, base, tip_link, arm, q)
         for joint, frame, (point, direction) in zip(arm.joints, frames, axes):
             ours, offset = frame[:3, 2], point - frame[:3, 3]
             assert np.abs(direction - ours).max() < 1e-9, (key, joint.name, q)
             assert not joint.revolute or np.abs(offset - offset @ ours * ours).max() < 1e-9, (key, joint.name, q)
         assert np.abs(tool - tip_pose).max() < 1e-9, (key, q)
-    comparison = compare_urdf(arm, str(DATA / file), base, tip)
+    comparison = compare_urdf(arm, str(urdf), base, tip)
     assert max(max(axis) for axis in comparison.axes) < 1e-9 and max(comparison.tool) < 1e-9, comparison
     assert first_difference(comparison, 1e-9) is None
 

@@ -19,33 +19,10 @@ from jacgen.inputs.robot_file import load_robot, parse_robot
 from jacgen.model.structure import classify
 
 from conftest import ROOT
-from support.urdf import DATA, URDFS, imported
+from support.urdf import DATA, URDFS, as_read, imported
 
 FK_TOLERANCE = 1e-12
-# so101's URDF writes angles to 5 or 6 digits; one DH angle comes out 1.4e-11 rad from 90
-# degrees and is made exact, as robot files make every such angle (docs/urdf.md).
-FK_TOLERANCE_BY_NAME = {"so101": 5e-11}
 REACH = 2.0  # metres: bounds the lever arm of every arm here
-
-
-def as_read(text: str, snap: float = 1e-9) -> str:
-    """The URDF with each rpy angle that jacgen makes exact written out as that multiple of
-    pi/2 to full double precision, so that Pinocchio reads the numbers jacgen reads."""
-
-    def exact(match):
-        values = []
-        for token in match.group(1).split():
-            try:
-                value = float(token)
-            except ValueError:  # xacro left-overs off the chain (tiago)
-                values.append(token)
-                continue
-            quarter_turns = round(value / (math.pi / 2))
-            values.append(repr(quarter_turns * math.pi / 2) if abs(value - quarter_turns * math.pi / 2) < snap
-                          else token)
-        return f'rpy="{" ".join(values)}"'
-
-    return re.sub(r'rpy="([^"]*)"', exact, text)
 
 
 def pinocchio_fk(urdf_text: str, tmp_path, robot, base: str | None, tip: str, configurations):
@@ -65,8 +42,8 @@ def pinocchio_fk(urdf_text: str, tmp_path, robot, base: str | None, tip: str, co
             else:
                 q_pin[model_joint.idx_q] = value
         pin.framesForwardKinematics(model, data, q_pin)
-        base_pose = data.oMf[model.getFrameId(base)] if base else pin.SE3.Identity()
-        poses.append((base_pose.inverse() * data.oMf[model.getFrameId(tip)]).homogeneous)
+        base_pose = data.oMf[model.getFrameId(base, pin.BODY)] if base else pin.SE3.Identity()
+        poses.append((base_pose.inverse() * data.oMf[model.getFrameId(tip, pin.BODY)]).homogeneous)
     return poses
 
 
@@ -87,13 +64,13 @@ def test_fk_equals_pinocchio(name, convention, tmp_path):
     text = (DATA / file).read_text()
     ours = reference.fk(robot, np.array(qs))
     exact = max(np.abs(a - b).max() for a, b in zip(ours, pinocchio_fk(as_read(text), tmp_path, robot, base, tip, qs)))
-    assert exact < FK_TOLERANCE_BY_NAME.get(name, FK_TOLERANCE)
-    # Against the numbers as written: each angle made exact turns the rest of the arm by at most
-    # `snapped`, so the tool moves by at most that times the reach, per joint transform.
+    assert exact < FK_TOLERANCE
+    # Against the numbers as written: the difference import-urdf reports (at its own 20
+    # configurations), and each angle made exact turns the rest of the arm by at most `snapped`,
+    # so the tool moves by at most that times the reach, per joint transform.
     literal_difference = max(np.abs(a - b).max() for a, b in zip(ours, pinocchio_fk(text, tmp_path, robot, base, tip, qs)))
-    bound = REACH * result.snapped * (text.count("<joint") + 2)
-    assert literal_difference < FK_TOLERANCE_BY_NAME.get(name, FK_TOLERANCE) + bound
-    assert result.fk_difference < FK_TOLERANCE_BY_NAME.get(name, FK_TOLERANCE)
+    assert literal_difference < 2 * result.fk_difference + FK_TOLERANCE
+    assert result.fk_difference < REACH * result.snapped * (text.count("<joint") + 2) + FK_TOLERANCE
 
 
 @pytest.mark.parametrize("name", list(URDFS))
@@ -205,7 +182,7 @@ def test_degenerate_geometry_takes_the_documented_choices():
     assert [j.d.exact for j in ur5.joints[1:4]] == [0, 0, sympy.Rational("0.10915")]
     pendulum = imported("pendulum").robot  # 2 joints in the base's y-z plane
     assert pendulum.task == ("y", "z")
-    xarm = imported("xarm7", snap=1e-5).robot  # its URDF writes 1.5708: exact with --snap 1e-5
+    xarm = imported("xarm7").robot  # its URDF writes 1.5708: pi/2 to its digits
     assert [j.alpha.exact for j in xarm.joints] == [-sympy.pi / 2] + [sympy.pi / 2] * 4 + [-sympy.pi / 2, 0]
 
 
@@ -293,6 +270,48 @@ def test_hostile_xml_is_one_line_and_exit_2(case, tmp_path):
     assert line.startswith(where.lstrip(":")) or where == ":", result.stderr
     assert message in result.stderr
     assert output.read_text() == "kept\n"  # nothing on disk is damaged
+
+
+NEARLY_PARALLEL_URDF = """<robot name="skewed">
+<link name="l0"/><link name="l1"/><link name="l2"/><link name="l3"/>
+<joint name="j1" type="revolute"><parent link="l0"/><child link="l1"/><axis xyz="0 0 1"/>
+  <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+<joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0.4 0 0"/><axis xyz="0.00001 0 1"/>
+  <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+<joint name="j3" type="fixed"><parent link="l2"/><child link="l3"/><origin xyz="0.3 0 0"/></joint>
+</robot>
+"""
+
+
+def test_nearly_parallel_axes_are_refused_with_the_snap_that_imports_them(tmp_path):
+    """Axes 1e-5 rad from parallel whose URDF no digit rule can judge (an axis, not an rpy):
+    the common normal lies 4e4 m away. The one line names the joints, the angle, the DH length
+    it would need and the --snap that imports the arm, with its effect on fk; that --snap does."""
+    path = tmp_path / "skewed.urdf"
+    path.write_text(NEARLY_PARALLEL_URDF)
+    result = run("import-urdf", path)
+    assert result.exit_code == 2 and result.stderr.count("\n") == 1, result.output
+    assert re.fullmatch(rf"jacgen: error: {re.escape(str(path))}: joints 'j1' and 'j2': their axes are 1e-05 rad from "
+                        r"parallel, so the DH common normal between them needs lengths of 4e\+04 m, where the URDF's "
+                        r"chain spans 0.7 m; if they are meant to be parallel, import with --snap 0.0001, which makes "
+                        r"them so and moves fk by at most (\S+) from the URDF as written\n", result.stderr), result.stderr
+    effect = float(re.search(r"at most (\S+) from", result.stderr).group(1))
+    assert 1e-6 < effect < 1e-5  # the tool 0.3 m beyond a joint turned by 1e-5 rad
+    snapped = run("import-urdf", path, "--snap", "0.0001")
+    assert snapped.exit_code == 0 and parse_robot(snapped.stdout.encode()).joints[1].alpha.exact == 0
+
+
+def test_lengths_of_rounding_level_are_made_0_and_reported(tmp_path):
+    """A URDF whose zeros a composed export wrote as 0.316 * cos(pi/2) (Franka's d = -1.93e-17):
+    the DH lengths it gives are made 0, the header and the stderr line say so."""
+    text = (DATA / "ur5_robot.urdf").read_text().replace('xyz="0.0 0.13585 0.0"', 'xyz="1.9349e-17 0.13585 0.0"')
+    path = tmp_path / "ur5_noise.urdf"
+    path.write_text(text)
+    result = run("import-urdf", path, "--base", "base", "--tip", "tool0")
+    assert result.exit_code == 0, result.output
+    assert "# Lengths the DH fit computed below 1e-07 of the arm's size were made 0: joints[0].a -1.9e-17." in result.stdout
+    assert "1 length(s) of rounding level made 0" in result.stderr
+    assert parse_robot(result.stdout.encode()).joints[0].a.exact == 0
 
 
 def test_huge_file_is_refused_before_parsing(tmp_path):

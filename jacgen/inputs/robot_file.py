@@ -49,8 +49,10 @@ def load_robot(path: str | Path) -> Robot:
     return parse_robot(data, path)
 
 
-def parse_robot(data: bytes, path: str = "<robot>") -> Robot:
-    """Validate the bytes of a robot file (`path` only names it in messages)."""
+def parse_robot(data: bytes, path: str = "<robot>", rounding_lengths: bool = False) -> Robot:
+    """Validate the bytes of a robot file (`path` only names it in messages). With
+    `rounding_lengths`, a length below SMALLEST_LENGTH of the arm's size is let through
+    (import-urdf reads its fit so, to find such lengths and make them 0)."""
     if len(data) > MAX_FILE_BYTES:
         raise RobotFileError(path, 1, 1, "", f"file larger than {MAX_FILE_BYTES} bytes")
     try:
@@ -75,7 +77,7 @@ def parse_robot(data: bytes, path: str = "<robot>") -> Robot:
                              "is not allowed") from None
     if root is None:
         raise RobotFileError(path, 1, 1, "", "file is empty")
-    return _RobotReader(path, data).read(root)
+    return _RobotReader(path, data, rounding_lengths).read(root)
 
 
 class _Refused(yaml.MarkedYAMLError):
@@ -104,8 +106,8 @@ class _Composer(yaml.SafeLoader):
 
 
 class _RobotReader:
-    def __init__(self, path: str, data: bytes):
-        self.path, self.data = path, data
+    def __init__(self, path: str, data: bytes, rounding_lengths: bool = False):
+        self.path, self.data, self.rounding_lengths = path, data, rounding_lengths
         self.values: dict[str, Value] = {}
         self.angle_scale = Value(("integer", 1), 1.0)
         self.lengths: list[tuple[yaml.Node, str, Value]] = []  # the link lengths read, for check_sizes
@@ -247,7 +249,7 @@ class _RobotReader:
                              f"{robot.length_unit}: jacgen supports {REACH[0]:g} to {REACH[1]:g} (its tolerances "
                              f"are absolute); write the lengths in another unit")
         for node, key, value in self.lengths:
-            if value.approx and abs(value.approx) < SMALLEST_LENGTH * reach:
+            if value.approx and abs(value.approx) < SMALLEST_LENGTH * reach and not self.rounding_lengths:
                 raise self.error(node, key, f"length {value.approx:.3g} is below {SMALLEST_LENGTH:g} of the arm's "
                                  f"size {reach:.3g}, where the arm is singular everywhere to rounding: write 0")
 

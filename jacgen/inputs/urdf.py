@@ -6,13 +6,14 @@ external entities can happen, and an undeclared entity is an XML error. The tree
 without recursion and the file size is capped. Every mistake is one RobotFileError naming
 the file, line, column and element path.
 
-Numbers keep their decimal text as exact rationals. An angle within tolerances.ANGLE_SNAP of a
-multiple of pi/2 and an axis within it of +-x/y/z become exact, and the largest change this
-makes is recorded; everything else is a 30-digit float.
+Numbers keep their decimal text as exact rationals. An angle that is a multiple of pi/2 to the
+digits it is written with (Snapper) and an axis within tolerances.ANGLE_SNAP of +-x/y/z become
+exact, and the largest change this makes is recorded; everything else is a 30-digit float.
 """
 
 import math
 from dataclasses import dataclass, field
+from decimal import Decimal
 from pathlib import Path
 from xml.parsers import expat
 
@@ -25,7 +26,7 @@ from jacgen.inputs import values
 from jacgen.inputs.robot_file import MAX_JOINTS
 from jacgen.inputs.transforms import xyz_rpy_transform
 from jacgen.inputs.values import ExpressionError
-from jacgen.tolerances import ANGLE_SNAP
+from jacgen.tolerances import ANGLE_SNAP, WRITTEN_ANGLE_UNITS, WRITTEN_ANGLE_SNAP
 
 MAX_URDF_BYTES = 16 << 20
 DIGITS = 30  # of the numbers that are not exact (cos and sin of general angles)
@@ -73,23 +74,51 @@ class LinkChain:
 
 
 class Snapper:
-    """Makes angles and directions within `tolerance` of exact (a multiple of pi/2, a
-    coordinate axis) exact, and remembers the largest change that made."""
+    """Makes angles and directions that are nearly exact (a multiple of pi/2, a coordinate axis)
+    exact, and remembers the largest change that made.
 
-    def __init__(self, tolerance: float = ANGLE_SNAP):
+    With no `tolerance` (the default) a URDF angle is k*pi/2 (k != 0) when it is so to the digits
+    it is written with: within WRITTEN_ANGLE_UNITS units of its last digit, and within
+    WRITTEN_ANGLE_SNAP rad. `1.5708`, `1.57079632679` and `1.570796325` are pi/2; `1.6` is not, nor
+    is a calibration's `1.6e-06`, whose digits are all significant. Any value within ANGLE_SNAP
+    is exact too. An angle computed from the URDF's (a DH twist, the angle between two axes)
+    is exact within the sum of the last-digit units of the general angles written on the chain:
+    they are known to no better. With a `tolerance`, every test uses that tolerance alone."""
+
+    def __init__(self, tolerance: float | None = None):
         self.tolerance, self.largest = tolerance, 0.0
+        self.written_units = 0.0  # of the angles read that were not made exact
 
-    def close(self, change: float) -> bool:
-        """Whether a value `change` away from exact is to be made exact (recorded if so)."""
-        if change < self.tolerance:
+    def close(self, change: float, tolerance: float | None = None) -> bool:
+        """Whether a value `change` away from exact is to be made exact (recorded if so): within
+        `tolerance`, by default the one of values computed from the URDF's."""
+        if change < (self.computed_tolerance() if tolerance is None else tolerance):
             self.largest = max(self.largest, change)
             return True
         return False
 
-    def angle(self, value: sympy.Expr) -> sympy.Expr:
-        """Exactly k*pi/2 when within the tolerance of it; otherwise the value itself."""
+    def computed_tolerance(self) -> float:
+        if self.tolerance is not None:
+            return self.tolerance
+        return max(ANGLE_SNAP, min(self.written_units, WRITTEN_ANGLE_SNAP))
+
+    def angle(self, value: sympy.Expr, text: str | None = None) -> sympy.Expr:
+        """Exactly k*pi/2 when nearly so; otherwise the value itself. `text` is the decimal the
+        URDF writes for it, if any."""
         quarter_turns = round(float(value) / (math.pi / 2))
-        return quarter_turns * sympy.pi / 2 if self.close(abs(float(value) - quarter_turns * math.pi / 2)) else value
+        change = abs(float(value) - quarter_turns * math.pi / 2)
+        tolerance = None
+        if text is not None:
+            unit = float(Decimal(1).scaleb(Decimal(text).as_tuple().exponent))
+            tolerance = self.tolerance
+            if tolerance is None:
+                digits = min(WRITTEN_ANGLE_UNITS * unit, WRITTEN_ANGLE_SNAP) if quarter_turns else 0.0
+                tolerance = max(ANGLE_SNAP, digits)
+        if self.close(change, tolerance):
+            return quarter_turns * sympy.pi / 2
+        if text is not None and value != 0:
+            self.written_units += unit
+        return value
 
 
 def parse_xml(data: bytes, path: str) -> Element:
@@ -272,7 +301,9 @@ class _UrdfReader:
                              "another joint's, and a DH row needs a joint of its own")
         origin = element.child("origin")
         xyz = self.numbers(origin, f"{key}.origin", "xyz")
-        rpy = [self.snapper.angle(value) for value in self.numbers(origin, f"{key}.origin", "rpy")]
+        rpy_text = (origin.attributes.get("rpy", "0 0 0") if origin is not None else "0 0 0").split()
+        rpy = [self.snapper.angle(value, text) for value, text in
+               zip(self.numbers(origin, f"{key}.origin", "rpy"), rpy_text)]
         transform = xyz_rpy_transform(xyz, rpy, _cos_sin)
         axis = Matrix([1, 0, 0])
         limits = None
@@ -317,7 +348,8 @@ class _UrdfReader:
         unit = [float(v) / length for v in vector]
         for k in range(3):
             for sign in (1, -1):
-                if self.snapper.close(math.dist(unit, [sign * (i == k) for i in range(3)])):
+                if self.snapper.close(math.dist(unit, [sign * (i == k) for i in range(3)]),
+                                      ANGLE_SNAP if self.snapper.tolerance is None else self.snapper.tolerance):
                     return Matrix([sign * int(i == k) for i in range(3)])
         return (vector / sympy.sqrt(sum(v**2 for v in vector))).evalf(DIGITS)
 

@@ -2,6 +2,9 @@
 tests/test_urdf_import.py (fk against Pinocchio) and tests/test_urdf_round_trip.py (generate
 and verify)."""
 
+import math
+import re
+from decimal import Decimal
 from pathlib import Path
 
 from jacgen.urdf_import import import_urdf
@@ -13,7 +16,7 @@ URDFS = {
     "ur10": ("ur10_robot.urdf", "base_link", "ee_link", "three_parallel"),
     "panda": ("panda.urdf", None, "panda_hand_tcp", "spherical_wrist_intersecting"),  # joint 7 free
     "kinova_jaco2": ("kinova.urdf", None, "j2s6s200_end_effector", "spherical_wrist_parallel"),
-    "xarm7": ("xarm7.urdf", None, None, "general_6r"),  # joint 7 (or 1) free
+    "xarm7": ("xarm7.urdf", None, None, "spherical_wrist_intersecting"),  # writes 1.5708: pi/2 to its digits
     "z1": ("z1.urdf", None, "link06", "three_parallel"),
     "tiago": ("tiago_no_hand.urdf", "base_footprint", "arm_tool_link", None),
     "pr2": ("pr2.urdf", "base_link", "r_gripper_palm_link", None),
@@ -29,3 +32,26 @@ def imported(key: str, convention: str = "standard", **options):
     """The import of URDFS[key] (jacgen.urdf_import.Imported)."""
     file, base, tip, _ = URDFS[key]
     return import_urdf(str(DATA / file), base, tip, convention, **options)
+
+
+def as_read(text: str) -> str:
+    """The URDF with each rpy angle that docs/urdf.md makes exact written out as that multiple
+    of pi/2 to full double precision, so that Pinocchio reads the numbers jacgen reads: an angle
+    within 1e-9 of k*pi/2, or, for k != 0, within two units of its last written digit and 1e-3."""
+
+    def exact(match):
+        values = []
+        for token in match.group(1).split():
+            try:
+                value = float(token)
+            except ValueError:  # xacro left-overs off the chain (tiago)
+                values.append(token)
+                continue
+            quarter_turns = round(value / (math.pi / 2))
+            change = abs(value - quarter_turns * math.pi / 2)
+            unit = 10.0 ** Decimal(token).as_tuple().exponent
+            values.append(repr(quarter_turns * math.pi / 2) if change < 1e-9 or quarter_turns and change < min(2 * unit, 1e-3)
+                          else token)
+        return f'rpy="{" ".join(values)}"'
+
+    return re.sub(r'rpy="([^"]*)"', exact, text)
