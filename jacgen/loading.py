@@ -25,6 +25,7 @@ import importlib.machinery
 import importlib.util
 import json
 import os
+import platform
 import shutil
 import subprocess
 import sys
@@ -131,7 +132,7 @@ def robot_path(source) -> Path:
 def _key(path: Path, options: dict) -> str:
     sha = hashlib.sha256(f"jacgen arm {FORMAT}\0{sources.digest()}\0".encode())
     if options["backend"] == "native":
-        sha.update(f"{sysconfig.get_config_var('EXT_SUFFIX')}\0{sys.version}\0".encode())
+        sha.update(f"{sysconfig.get_config_var('EXT_SUFFIX')}\0{sys.version}\0{host_instruction_set()}\0".encode())
     sha.update(json.dumps(options, sort_keys=True).encode() + b"\0")
     sha.update(path.name.encode() + b"\0" + path.read_bytes())
     return sha.hexdigest()[:32]
@@ -252,21 +253,40 @@ def _render(entry: Path, key: str, path: Path, backend: str, functions, urdf, pr
 
 def build_native(folder: Path, name: str, progress: "Progress | None" = None) -> Path:
     """Builds NAME_native in `folder` (what `generate --lang native` wrote for the robot) with
-    its setup.py, in place; the built file's path. BuildError with the first error."""
+    its setup.py, in place, for this machine's instruction set (host_instruction_set); the
+    built file's path. BuildError with the first error."""
     try:
         import setuptools  # noqa: F401 (setup.py needs it)
     except ImportError:
         raise BuildError(f"building {name}_native needs setuptools: pip install 'jacgen[native]' "
                          "(backend='python' needs no compiler)") from None
+    environment = dict(os.environ)
+    if (instruction_set := host_instruction_set()) is not None:
+        environment["JACGEN_INSTRUCTION_SET"] = instruction_set
     with tempfile.TemporaryDirectory() as scratch:
         command = [sys.executable, "setup.py", "-q", "build_ext", "--inplace", "--build-temp", scratch]
-        with subprocess.Popen(command, cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True) as run:
+        with subprocess.Popen(command, cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                              env=environment) as run:
             output = _wait(run, progress)
     shutil.rmtree(folder / "build", ignore_errors=True)
     built = sorted(folder.glob(f"{name}_native.*.so")) + sorted(folder.glob(f"{name}_native.*.pyd"))
     if run.returncode != 0 or not built:
         raise BuildError(f"building {name}_native failed: {first_error(output)} (backend='python' needs no compiler)")
     return built[0]
+
+
+def host_instruction_set() -> str | None:
+    """The widest of the native kernels' instruction sets (avx512f, avx2, default) that this
+    x86-64 processor runs, from /proc/cpuinfo; None where it cannot tell or there is no choice
+    (setup.py then builds what it builds for a package: the three clones on x86-64)."""
+    if platform.machine() not in ("x86_64", "AMD64"):
+        return None
+    try:
+        with open("/proc/cpuinfo", encoding="ascii", errors="replace") as cpuinfo:
+            flags = next(line for line in cpuinfo if line.startswith("flags")).split()
+    except (OSError, StopIteration):
+        return None
+    return "avx512f" if "avx512f" in flags else "avx2" if "avx2" in flags else "default"
 
 
 def load_native(folder: Path, name: str):

@@ -24,7 +24,7 @@ from click.testing import CliRunner
 from jacgen.cli import main
 from jacgen.emission.generator import Generator
 from jacgen.checking.generated_code import NATIVE_BACKENDS
-from jacgen.loading import import_module
+from jacgen.loading import host_instruction_set, import_module
 from jacgen.files import write_files
 from jacgen.emission.render import render_robot
 from jacgen.inputs.robot_file import load_robot, parse_robot
@@ -222,19 +222,37 @@ def test_dask_on_a_cluster_of_two_processes(built, monkeypatch):
     assert (keep == numpy_ur5.ik(T)[1]).all()
 
 
+# What NAME_native.SIMD says for the kernels of each instruction set (a build with vector math).
+SIMD_NAMES = {"avx512f": "avx512f", "avx2": "avx2", "default": "baseline"}
+
+
+def test_builds_for_this_machine_compile_one_instruction_set(built):
+    """jacgen's own builds (jacgen.arm, verify --native, these tests) compile the kernels for the
+    widest set /proc/cpuinfo names, not the three clones of a package meant to be shipped; the
+    module's SIMD, which the C reads from its build, says which."""
+    _, native, _, _ = built["ur5"]
+    if host_instruction_set() is None or native.SIMD == "scalar":
+        pytest.skip("not x86-64 with vector math: there is no instruction set to choose")
+    assert native.SIMD == SIMD_NAMES[host_instruction_set()]
+
+
 def test_pip_builds_and_installs_it(tmp_path):
     """`pip install --no-build-isolation DIR/NAME` of a generated folder (planar_2r: quick to
-    build), and the module imports and computes in a fresh interpreter."""
+    build), and the module imports and computes in a fresh interpreter. pip builds the package
+    to ship, with the three clones: the processor picks one at load time, the one jacgen's own
+    builds compile for."""
     robot = load_robot(ROOT / "robots" / "planar_2r.yaml")
     write_files(render_robot(robot, ("native",), "double", Generator(robot)), tmp_path / "src")
     installed = subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-build-isolation", "--no-deps",
                                 "--target", str(tmp_path / "site"), str(tmp_path / "src" / "planar_2r")],
                                capture_output=True, text=True)
     assert installed.returncode == 0, installed.stderr
-    run = subprocess.run([sys.executable, "-c", "import planar_2r_native as arm; print(arm.fk([0.0, 0.0])[0, 3])"],
+    run = subprocess.run([sys.executable, "-c", "import planar_2r_native as arm; print(arm.fk([0.0, 0.0])[0, 3], arm.SIMD)"],
                          capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(tmp_path / "site")})
     assert run.returncode == 0, run.stderr
-    assert float(run.stdout) == 2.0  # two unit links, stretched along x
+    reach, simd = run.stdout.split()
+    assert float(reach) == 2.0  # two unit links, stretched along x
+    assert simd == "scalar" or host_instruction_set() is None or simd == SIMD_NAMES[host_instruction_set()]
 
 
 def test_no_compiler_is_one_line(tmp_path):

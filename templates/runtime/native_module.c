@@ -615,6 +615,8 @@ static const char *jacgen_simd(void)
 #if defined(JACGEN_SIMD) && defined(JACGEN_CLONES)
     __builtin_cpu_init();
     return __builtin_cpu_supports("avx512f") ? "avx512f" : __builtin_cpu_supports("avx2") ? "avx2" : "baseline";
+#elif defined(JACGEN_SIMD) && defined(JACGEN_INSTRUCTION_SET)
+    return JACGEN_INSTRUCTION_SET; /* the one set setup.py compiled for */
 #elif defined(JACGEN_SIMD)
     return "baseline";
 #else
