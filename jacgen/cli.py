@@ -324,12 +324,12 @@ def import_urdf_command(urdf_file, base, tip, convention, name, task, snap, outp
         click.echo(f"jacgen: wrote {output}", err=True)
     else:
         click.echo(imported.text, nl=False)
-    made_exact = [f"angles made exact by up to {imported.snapped:.1g} rad"] if imported.snapped else []
-    made_exact += [f"{len(imported.zeroed)} length(s) of rounding level made 0"] if imported.zeroed else []
-    made_exact = f" ({'; '.join(made_exact)})" if made_exact else ""
+    changes = [f"angles made exact by up to {imported.snapped:.1g} rad"] if imported.snapped else []
+    changes += [f"{len(imported.zeroed)} length(s) of rounding level made 0"] if imported.zeroed else []
+    changed = f" ({'; '.join(changes)})" if changes else ""
     click.echo(f"jacgen: {imported.robot.name}: {imported.robot.dof} joints; fk within "
                f"{imported.fk_difference:.1g} of the URDF as written, at {CHECK_CONFIGURATIONS} random configurations"
-               f"{made_exact}", err=True)
+               f"{changed}", err=True)
 
 
 def _check_unique_names(robots: list[tuple[str, str]]) -> None:

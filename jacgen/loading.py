@@ -275,6 +275,7 @@ def build_native(folder: Path, name: str, progress: "Progress | None" = None) ->
     return built[0]
 
 
+@functools.cache
 def host_instruction_set() -> str | None:
     """The widest of the native kernels' instruction sets (avx512f, avx2, default) that this
     x86-64 processor runs, from /proc/cpuinfo; None where it cannot tell or there is no choice

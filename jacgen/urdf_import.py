@@ -82,7 +82,7 @@ def _import(path, base, tip, convention, name, task, snap, suggest: bool) -> Imp
             else "multiples of 90 deg to the digits the URDF writes them with")
     description = f"{_text(chain.robot_name)} imported from {source} (links {_text(chain.base)} -> {_text(chain.tip)})"
 
-    def text(components, checked=""):
+    def text(table, zeroed, components, checked=""):
         header = [
             f"Imported by jacgen {__version__} import-urdf from {source} (sha256 {digest}), "
             f"robot {_text(chain.robot_name)!r}, links {_text(chain.base)} -> {_text(chain.tip)}.",
@@ -97,13 +97,13 @@ def _import(path, base, tip, convention, name, task, snap, suggest: bool) -> Imp
             header.append(checked)
         return _robot_file(name, description, header, convention, table, components)
 
-    zeroed: list[tuple[str, float]] = []
-    table, zeroed = _without_rounding_lengths(table, _read_back(text(TASK_COMPONENTS), path, rounding_lengths=True).reach)
+    fitted = _read_back(text(table, (), TASK_COMPONENTS), path, rounding_lengths=True)
+    table, zeroed = _without_rounding_lengths(table, fitted.reach)
     if task is None:
-        task = () if len(axes) >= 6 else _independent_task(_read_back(text(TASK_COMPONENTS), path))
-    difference = _fk_difference(_read_back(text(task), path), as_written)
-    result = text(task, f"Its fk differs from the URDF's as written by at most {difference:.2g} (an entry of the 4x4 "
-                        f"pose) at {CHECK_CONFIGURATIONS} random configurations within the limits.")
+        task = () if len(axes) >= 6 else _independent_task(_read_back(text(table, zeroed, TASK_COMPONENTS), path))
+    difference = _fk_difference(_read_back(text(table, zeroed, task), path), as_written)
+    result = text(table, zeroed, task, f"Its fk differs from the URDF's as written by at most {difference:.2g} (an "
+                  f"entry of the 4x4 pose) at {CHECK_CONFIGURATIONS} random configurations within the limits.")
     return Imported(result, _read_back(result, path), difference, snapper.largest, tuple(zeroed))
 
 
@@ -147,14 +147,14 @@ class _FarNormal:
 def _far_normal(chain: LinkChain, axes: list[Axis], table: Table, snapper: Snapper) -> _FarNormal | None:
     """The nearly parallel axes whose common normal puts DH lengths more than FAR_NORMAL times
     the chain's extent away, if any (a URDF that writes pi/2 with too few digits for the default rule)."""
-    extent = sum(float(sympy.sqrt(sum(e**2 for e in joint.origin[:3, 3]))) for joint in chain.joints)
+    extent = sum(math.hypot(*map(float, joint.origin[:3, 3])) for joint in chain.joints)
     lengths = [max(abs(float(row.a)), abs(float(row.d))) for row in table.rows]
-    pairs = []
+    far = []
     for k, (here, there) in enumerate(zip(axes, axes[1:])):
-        sine = math.sqrt(sum(float(e) ** 2 for e in here.direction.cross(there.direction)))
-        if 0 < math.asin(min(sine, 1.0)) < NEARLY_PARALLEL and not snapper.close(sine):
-            pairs.append(_FarNormal((here.name, there.name), math.asin(min(sine, 1.0)), max(lengths[k], lengths[k + 1]), extent))
-    far = [pair for pair in pairs if pair.length > FAR_NORMAL * max(extent, 1e-3)]
+        sine = math.hypot(*map(float, here.direction.cross(there.direction)))
+        angle, length = math.asin(min(sine, 1.0)), max(lengths[k], lengths[k + 1])
+        if snapper.computed_tolerance() <= sine and angle < NEARLY_PARALLEL and length > FAR_NORMAL * max(extent, 1e-3):
+            far.append(_FarNormal((here.name, there.name), angle, length, extent))
     return min(far, key=lambda pair: pair.angle) if far else None
 
 

@@ -6,7 +6,6 @@ import math
 import re
 
 import numpy as np
-import pinocchio as pin
 import pytest
 import sympy
 from click.testing import CliRunner
@@ -19,38 +18,10 @@ from jacgen.inputs.robot_file import load_robot, parse_robot
 from jacgen.model.structure import classify
 
 from conftest import ROOT
-from support.urdf import DATA, URDFS, as_read, imported
+from support.urdf import DATA, URDFS, as_read, configurations, imported, pinocchio_fk
 
 FK_TOLERANCE = 1e-12
 REACH = 2.0  # metres: bounds the lever arm of every arm here
-
-
-def pinocchio_fk(urdf_text: str, tmp_path, robot, base: str | None, tip: str, configurations):
-    """Pinocchio's pose of `tip` in `base` at each configuration of the imported robot's joints
-    (the URDF joint names are the robot file's; continuous joints take (cos, sin))."""
-    path = tmp_path / "model.urdf"
-    path.write_text(urdf_text)
-    model = pin.buildModelFromUrdf(str(path))
-    data = model.createData()
-    poses = []
-    for q in configurations:
-        q_pin = pin.neutral(model)
-        for joint, value in zip(robot.joints, q):
-            model_joint = model.joints[model.getJointId(joint.name)]
-            if model_joint.nq == 2:
-                q_pin[model_joint.idx_q:model_joint.idx_q + 2] = (math.cos(value), math.sin(value))
-            else:
-                q_pin[model_joint.idx_q] = value
-        pin.framesForwardKinematics(model, data, q_pin)
-        base_pose = data.oMf[model.getFrameId(base, pin.BODY)] if base else pin.SE3.Identity()
-        poses.append((base_pose.inverse() * data.oMf[model.getFrameId(tip, pin.BODY)]).homogeneous)
-    return poses
-
-
-def configurations(robot, count=30, seed=1):
-    rng = np.random.default_rng(seed)
-    return [np.array([rng.uniform(*j.limits) if j.limits else rng.uniform(-math.pi, math.pi) for j in robot.joints])
-            for _ in range(count)]
 
 
 @pytest.mark.parametrize("convention", ["standard", "modified"])

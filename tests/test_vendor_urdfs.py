@@ -17,8 +17,7 @@ from jacgen.checking import reference
 from jacgen.model.structure import classify
 from jacgen.urdf_import import import_urdf
 
-from support.urdf import DATA
-from test_urdf_import import configurations, pinocchio_fk
+from support.urdf import DATA, configurations, pinocchio_fk
 
 # file: (base link, tip link, closed-form IK class of the arm with exact axes)
 CORPUS = {

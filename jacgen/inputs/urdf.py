@@ -98,9 +98,12 @@ class Snapper:
         return False
 
     def computed_tolerance(self) -> float:
-        if self.tolerance is not None:
-            return self.tolerance
-        return max(ANGLE_SNAP, min(self.written_units, WRITTEN_ANGLE_SNAP))
+        """The tolerance of a value computed from the URDF's."""
+        return self.written_tolerance(min(self.written_units, WRITTEN_ANGLE_SNAP))
+
+    def written_tolerance(self, digits: float = 0.0) -> float:
+        """The tolerance of a value whose written digits allow it to be `digits` off exact."""
+        return self.tolerance if self.tolerance is not None else max(ANGLE_SNAP, digits)
 
     def angle(self, value: sympy.Expr, text: str | None = None) -> sympy.Expr:
         """Exactly k*pi/2 when nearly so; otherwise the value itself. `text` is the decimal the
@@ -110,10 +113,7 @@ class Snapper:
         tolerance = None
         if text is not None:
             unit = float(Decimal(1).scaleb(Decimal(text).as_tuple().exponent))
-            tolerance = self.tolerance
-            if tolerance is None:
-                digits = min(WRITTEN_ANGLE_UNITS * unit, WRITTEN_ANGLE_SNAP) if quarter_turns else 0.0
-                tolerance = max(ANGLE_SNAP, digits)
+            tolerance = self.written_tolerance(min(WRITTEN_ANGLE_UNITS * unit, WRITTEN_ANGLE_SNAP) if quarter_turns else 0.0)
         if self.close(change, tolerance):
             return quarter_turns * sympy.pi / 2
         if text is not None and value != 0:
@@ -348,8 +348,7 @@ class _UrdfReader:
         unit = [float(v) / length for v in vector]
         for k in range(3):
             for sign in (1, -1):
-                if self.snapper.close(math.dist(unit, [sign * (i == k) for i in range(3)]),
-                                      ANGLE_SNAP if self.snapper.tolerance is None else self.snapper.tolerance):
+                if self.snapper.close(math.dist(unit, [sign * (i == k) for i in range(3)]), self.snapper.written_tolerance()):
                     return Matrix([sign * int(i == k) for i in range(3)])
         return (vector / sympy.sqrt(sum(v**2 for v in vector))).evalf(DIGITS)
 

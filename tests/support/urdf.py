@@ -1,11 +1,14 @@
-"""The URDFs of tests/data/urdf (tests/data/urdf/README.md) and their import, for
-tests/test_urdf_import.py (fk against Pinocchio) and tests/test_urdf_round_trip.py (generate
-and verify)."""
+"""The URDFs of tests/data/urdf (tests/data/urdf/README.md), their import and Pinocchio's fk
+of them, for tests/test_urdf_import.py and tests/test_vendor_urdfs.py (fk against Pinocchio)
+and tests/test_urdf_round_trip.py (generate and verify)."""
 
 import math
 import re
 from decimal import Decimal
 from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
 
 from jacgen.urdf_import import import_urdf
 
@@ -55,3 +58,31 @@ def as_read(text: str) -> str:
         return f'rpy="{" ".join(values)}"'
 
     return re.sub(r'rpy="([^"]*)"', exact, text)
+
+
+def pinocchio_fk(urdf_text: str, tmp_path, robot, base: str | None, tip: str, configurations):
+    """Pinocchio's pose of `tip` in `base` at each configuration of the imported robot's joints
+    (the URDF joint names are the robot file's; continuous joints take (cos, sin))."""
+    path = tmp_path / "model.urdf"
+    path.write_text(urdf_text)
+    model = pin.buildModelFromUrdf(str(path))
+    data = model.createData()
+    poses = []
+    for q in configurations:
+        q_pin = pin.neutral(model)
+        for joint, value in zip(robot.joints, q):
+            model_joint = model.joints[model.getJointId(joint.name)]
+            if model_joint.nq == 2:
+                q_pin[model_joint.idx_q:model_joint.idx_q + 2] = (math.cos(value), math.sin(value))
+            else:
+                q_pin[model_joint.idx_q] = value
+        pin.framesForwardKinematics(model, data, q_pin)
+        base_pose = data.oMf[model.getFrameId(base, pin.BODY)] if base else pin.SE3.Identity()
+        poses.append((base_pose.inverse() * data.oMf[model.getFrameId(tip, pin.BODY)]).homogeneous)
+    return poses
+
+
+def configurations(robot, count=30, seed=1):
+    rng = np.random.default_rng(seed)
+    return [np.array([rng.uniform(*j.limits) if j.limits else rng.uniform(-math.pi, math.pi) for j in robot.joints])
+            for _ in range(count)]
