@@ -14,7 +14,7 @@ from jacgen.emission.lowering import Lowering
 from jacgen.emission.operation_count import operation_count
 from jacgen.inputs.robot_file import load_robot, parse_robot
 from conftest import ROOT
-from support.graph_sympy import to_sympy
+from support.graph_sympy import kernel_count_ops, to_sympy
 from support.random_arms import random_arm_text
 
 x, y, z, w = sympy.symbols("x y z w", real=True)
@@ -53,7 +53,8 @@ def test_every_body_counts_as_count_ops(source):
     for function in Generator(robot).functions():
         body = function.body
         expressions = [e for _, e in body.definitions] + list(body.outputs)
-        assert body.operation_count == sympy.count_ops([to_sympy(e) for e in expressions]), function.name
+        assert body.operation_count == (sympy.count_ops([to_sympy(e) for e in expressions])
+                                        + kernel_count_ops(expressions)), function.name
         assert not [s for s, e in body.definitions if s in body.names and e.kind == "symbol"], function.name
 
 
@@ -137,3 +138,49 @@ def test_a_value_and_its_negation_are_named_once():
     assert lowering.name_node(c - a * b) is first
     assert lowering.name_node(a * b - c) is g.negate(first)
     assert len(lowering.definitions) == 1
+
+
+def test_a_kernel_runs_as_its_step_written_out():
+    """A REPEAT's value (`evaluate`) and its lowered Body are the step applied `count` times,
+    as Python runs the same step on floats; a run on constants is folded where it is built."""
+    lowering = Lowering()
+    g = lowering.graph
+
+    def step(state):  # a rotation by the angle of (3, 4), and a sum
+        a, b, c = state
+        return [lowering.name_node(0.6 * a - 0.8 * b), lowering.name_node(0.8 * a + 0.6 * b),
+                lowering.name_node(c + a * b)]
+
+    X, Y = g.symbol(x), g.symbol(y)
+    final = lowering.repeated("turn", "a turn", 5, step, [X, Y, X + Y])
+    values = {x: 0.3, y: -1.7}
+    a, b, c = values[x], values[y], values[x] + values[y]
+    for _ in range(5):
+        a, b, c = 0.6 * a - 0.8 * b, 0.8 * a + 0.6 * b, c + a * b
+    assert [evaluate(e, values) for e in final] == pytest.approx([a, b, c], rel=1e-14)
+    body = lowering.lower(final)
+    assert [e.kind for _, e in body.definitions].count("repeat") == 1
+    kernel = next(e.value[0] for _, e in body.definitions if e.kind == "repeat")
+    assert body.operation_count == 1 + 5 * kernel.body.operation_count  # x + y, then five runs
+    folded = lowering.repeated("turn", "a turn", 5, step, [g.number(1), g.number(0), g.number(0)])
+    assert all(e.kind == "number" for e in folded)
+    assert float(folded[0].value) == pytest.approx(turned_unit_vector(5)[0], rel=1e-14)
+
+
+def turned_unit_vector(count: int) -> tuple:
+    """(cos, sin) of count times the angle of (3, 4): the rotation's first column after count runs."""
+    import math
+
+    angle = count * math.atan2(0.8, 0.6)
+    return math.cos(angle), math.sin(angle)
+
+
+def test_each_kernel_is_defined_once_and_loops():
+    """ur5.c defines each Jacobi sweep once, as a loop, and its functions call it: the
+    sweeps are not written out."""
+    text = (ROOT / "generated" / "ur5" / "ur5.c").read_text()
+    for kernel in ("jacgen_jacobi6_rows", "jacgen_jacobi3_columns_2"):
+        assert text.count(f"static {kernel}_state {kernel}(int count, {kernel}_state state)") == 1
+        assert text.count(f"= {kernel}(") == 1
+    assert text.count("for (int run = 0; run < count; run++)") == 2
+    assert len(text) < 300_000  # 458 KB with the sweeps written out

@@ -105,11 +105,11 @@ jaco_real jaco_jacobian_det(const jaco_real q[JACO_DOF]);
 void jaco_manipulability_gradient(const jaco_real q[JACO_DOF], jaco_real dw[JACO_DOF]);
 
 /* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
- * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2470 operations. */
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2594 operations. */
 void jaco_velocity_ellipsoid(const jaco_real q[JACO_DOF], jaco_real U_v[9], jaco_real s_v[3], jaco_real U_w[9], jaco_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 8349 operations. */
+ * Result: returned as a scalar. 8509 operations. */
 jaco_real jaco_condition_number(const jaco_real q[JACO_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

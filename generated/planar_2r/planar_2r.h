@@ -100,7 +100,7 @@ planar_2r_real planar_2r_jacobian_det(const planar_2r_real q[PLANAR_2R_DOF]);
 void planar_2r_manipulability_gradient(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real dw[PLANAR_2R_DOF]);
 
 /* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
- * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 319 operations. */
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2235 operations. */
 void planar_2r_velocity_ellipsoid(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real U_v[9], planar_2r_real s_v[3], planar_2r_real U_w[9], planar_2r_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).

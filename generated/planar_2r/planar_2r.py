@@ -78,6 +78,259 @@ def _stack(xp, values, shape):
     return xp.reshape(xp.stack(values, axis=-1), (*values[0].shape, *shape))
 
 
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _jacobi3_columns_2(xp, count, state):
+    """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
+        t0 = w0**2 + w1**2 + w2**2
+        t1 = w3**2 + w4**2 + w5**2
+        t2 = w6**2 + w7**2 + w8**2
+        t3 = w9**2 + w10**2 + w11**2
+        t4 = w12**2 + w13**2 + w14**2
+        t5 = w15**2 + w16**2 + w17**2
+        t6 = w3*w6 + w4*w7 + w5*w8
+        t7 = w12*w15 + w13*w16 + w14*w17
+        t8 = -t1 + t2
+        t9 = xp.sqrt(t8**2 + 4*t6**2)
+        t10 = t9 + xp.abs(t8)
+        t11 = -t4 + t5
+        t12 = xp.sqrt(4*t7**2 + t11**2)
+        t13 = t12 + xp.abs(t11)
+        t14 = xp.greater(t10, 0)
+        t15 = 2*t6
+        t16 = xp.where(t14, xp.where(xp.greater_equal(t8, 0), t15, -t15)/xp.where(t14, t10, 1), 0)
+        t17 = 1/xp.sqrt(1 + t16**2)
+        t18 = xp.greater(t13, 0)
+        t19 = 2*t7
+        t20 = xp.where(t18, xp.where(xp.greater_equal(t11, 0), t19, -t19)/xp.where(t18, t13, 1), 0)
+        t21 = 1/xp.sqrt(1 + t20**2)
+        t22 = t6*t16
+        t23 = -t22 + t1
+        t24 = t22 + t2
+        t25 = -t0 + t24
+        t26 = w3*t17
+        t27 = w6*t17
+        t28 = t26 - t27*t16
+        t29 = t27 + t26*t16
+        t30 = w4*t17
+        t31 = w7*t17
+        t32 = t30 - t31*t16
+        t33 = t31 + t30*t16
+        t34 = w5*t17
+        t35 = w8*t17
+        t36 = t34 - t16*t35
+        t37 = t35 + t34*t16
+        t38 = w0*t29 + w1*t33 + w2*t37
+        t39 = xp.sqrt(4*t38**2 + t25**2)
+        t40 = t39 + xp.abs(t25)
+        t41 = w21*t17
+        t42 = w24*t17
+        t43 = t41 - t16*t42
+        t44 = t42 + t16*t41
+        t45 = w22*t17
+        t46 = w25*t17
+        t47 = t45 - t16*t46
+        t48 = t46 + t16*t45
+        t49 = w23*t17
+        t50 = w26*t17
+        t51 = t49 - t16*t50
+        t52 = t50 + t16*t49
+        t53 = t7*t20
+        t54 = -t53 + t4
+        t55 = t5 + t53
+        t56 = -t3 + t55
+        t57 = w12*t21
+        t58 = w15*t21
+        t59 = t57 - t20*t58
+        t60 = t58 + t20*t57
+        t61 = w13*t21
+        t62 = w16*t21
+        t63 = t61 - t20*t62
+        t64 = t62 + t20*t61
+        t65 = w14*t21
+        t66 = w17*t21
+        t67 = t65 - t20*t66
+        t68 = t66 + t20*t65
+        t69 = w9*t60 + w10*t64 + w11*t68
+        t70 = xp.sqrt(4*t69**2 + t56**2)
+        t71 = t70 + xp.abs(t56)
+        t72 = w30*t21
+        t73 = w33*t21
+        t74 = t72 - t20*t73
+        t75 = t73 + t20*t72
+        t76 = w31*t21
+        t77 = w34*t21
+        t78 = t76 - t20*t77
+        t79 = t77 + t20*t76
+        t80 = w32*t21
+        t81 = w35*t21
+        t82 = t80 - t20*t81
+        t83 = t81 + t20*t80
+        t84 = xp.greater(t40, 0)
+        t85 = 2*t38
+        t86 = xp.where(t84, xp.where(xp.greater_equal(t25, 0), t85, -t85)/xp.where(t84, t40, 1), 0)
+        t87 = 1/xp.sqrt(1 + t86**2)
+        t88 = t0 - t38*t86
+        t89 = -t88 + t23
+        t90 = xp.greater(t71, 0)
+        t91 = 2*t69
+        t92 = xp.where(t90, xp.where(xp.greater_equal(t56, 0), t91, -t91)/xp.where(t90, t71, 1), 0)
+        t93 = 1/xp.sqrt(1 + t92**2)
+        t94 = t3 - t69*t92
+        t95 = -t94 + t54
+        t96 = w0*t87
+        t97 = t29*t87
+        t98 = t96 - t86*t97
+        t99 = t97 + t86*t96
+        t100 = w1*t87
+        t101 = t33*t87
+        t102 = t100 - t86*t101
+        t103 = t101 + t86*t100
+        t104 = w2*t87
+        t105 = t37*t87
+        t106 = t104 - t86*t105
+        t107 = t105 + t86*t104
+        t108 = t28*t98 + t32*t102 + t36*t106
+        t109 = xp.sqrt(4*t108**2 + t89**2)
+        t110 = t109 + xp.abs(t89)
+        t111 = w18*t87
+        t112 = t44*t87
+        t113 = t111 - t86*t112
+        t114 = t112 + t86*t111
+        t115 = w19*t87
+        t116 = t48*t87
+        t117 = t115 - t86*t116
+        t118 = t116 + t86*t115
+        t119 = w20*t87
+        t120 = t52*t87
+        t121 = t119 - t86*t120
+        t122 = t120 + t86*t119
+        t123 = w9*t93
+        t124 = t60*t93
+        t125 = t123 - t92*t124
+        t126 = t124 + t92*t123
+        t127 = w10*t93
+        t128 = t64*t93
+        t129 = t127 - t92*t128
+        t130 = t128 + t92*t127
+        t131 = w11*t93
+        t132 = t68*t93
+        t133 = t131 - t92*t132
+        t134 = t132 + t92*t131
+        t135 = t59*t125 + t63*t129 + t67*t133
+        t136 = xp.sqrt(4*t135**2 + t95**2)
+        t137 = t136 + xp.abs(t95)
+        t138 = w27*t93
+        t139 = t75*t93
+        t140 = t138 - t92*t139
+        t141 = t139 + t92*t138
+        t142 = w28*t93
+        t143 = t79*t93
+        t144 = t142 - t92*t143
+        t145 = t143 + t92*t142
+        t146 = w29*t93
+        t147 = t83*t93
+        t148 = t146 - t92*t147
+        t149 = t147 + t92*t146
+        t150 = xp.greater(t110, 0)
+        t151 = 2*t108
+        t152 = xp.where(t150, xp.where(xp.greater_equal(t89, 0), t151, -t151)/xp.where(t150, t110, 1), 0)
+        t153 = 1/xp.sqrt(1 + t152**2)
+        t154 = xp.greater(t137, 0)
+        t155 = 2*t135
+        t156 = xp.where(t154, xp.where(xp.greater_equal(t95, 0), t155, -t155)/xp.where(t154, t137, 1), 0)
+        t157 = 1/xp.sqrt(1 + t156**2)
+        t158 = t98*t153
+        t159 = t28*t153
+        t160 = t158 - t152*t159
+        t161 = t159 + t152*t158
+        t162 = t102*t153
+        t163 = t32*t153
+        t164 = t162 - t152*t163
+        t165 = t163 + t152*t162
+        t166 = t106*t153
+        t167 = t36*t153
+        t168 = t166 - t152*t167
+        t169 = t167 + t152*t166
+        t170 = t113*t153
+        t171 = t43*t153
+        t172 = t170 - t152*t171
+        t173 = t171 + t152*t170
+        t174 = t117*t153
+        t175 = t47*t153
+        t176 = t174 - t152*t175
+        t177 = t175 + t152*t174
+        t178 = t121*t153
+        t179 = t51*t153
+        t180 = t178 - t152*t179
+        t181 = t179 + t152*t178
+        t182 = t125*t157
+        t183 = t59*t157
+        t184 = t182 - t156*t183
+        t185 = t183 + t156*t182
+        t186 = t129*t157
+        t187 = t63*t157
+        t188 = t186 - t156*t187
+        t189 = t187 + t156*t186
+        t190 = t133*t157
+        t191 = t67*t157
+        t192 = t190 - t156*t191
+        t193 = t191 + t156*t190
+        t194 = t140*t157
+        t195 = t74*t157
+        t196 = t194 - t156*t195
+        t197 = t195 + t156*t194
+        t198 = t144*t157
+        t199 = t78*t157
+        t200 = t198 - t156*t199
+        t201 = t199 + t156*t198
+        t202 = t148*t157
+        t203 = t82*t157
+        t204 = t202 - t156*t203
+        t205 = t203 + t156*t202
+        state = (
+            t160,
+            t164,
+            t168,
+            t161,
+            t165,
+            t169,
+            t99,
+            t103,
+            t107,
+            t184,
+            t188,
+            t192,
+            t185,
+            t189,
+            t193,
+            t126,
+            t130,
+            t134,
+            t172,
+            t176,
+            t180,
+            t173,
+            t177,
+            t181,
+            t114,
+            t118,
+            t122,
+            t196,
+            t200,
+            t204,
+            t197,
+            t201,
+            t205,
+            t141,
+            t145,
+            t149,
+        )
+    return state
+
+
 def fk(q):
     """pose of the tool frame in the world frame (4x4 homogeneous): (4 x 4), 13 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (2,)))
@@ -621,7 +874,7 @@ def manipulability_gradient(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ellipsoid(q):
-    """axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: (3 x 3 and 3 x 1 and 3 x 3 and 3 x 1), 319 operations."""
+    """axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: (3 x 3 and 3 x 1 and 3 x 3 and 3 x 1), 2235 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (2,)))
     trig = _cos_sin(xp, q, (0.0, 0.0), device)
     c1 = trig[..., 0]
@@ -643,175 +896,126 @@ def velocity_ellipsoid(q):
     t10 = c12 + t7*t8
     t11 = xp.abs(t10)
     t12 = t11*xp.where(xp.greater_equal(t10, 0), xp.asarray(1, dtype=dtype), -1)
-    t13 = t3**2
-    t14 = t9**2
-    t15 = t12**2
-    t16 = t14 + t15
-    t17 = -t13 + t16
-    t18 = xp.sqrt(t17**2 + 4*t13*t14)
-    t19 = t18 + xp.abs(t17)
-    t20 = xp.greater(t19, 0)
-    t21 = 2*t3*t9
-    t22 = xp.where(t20, xp.where(xp.greater_equal(t17, 0), -t21, t21)/xp.where(t20, t19, 1), 0)
-    t23 = t22**2
-    t24 = 1/xp.sqrt(1 + t23)
-    t25 = t3*t24
-    t26 = t9*t24
-    t27 = t25 + t26*t22
-    t28 = t26 - t25*t22
-    t29 = t15*t24**2
-    t30 = t27**2 + t23*t29
-    t31 = t28**2 + t29
-    t32 = t27*t28 + t22*t29
-    t33 = -t30 + t31
-    t34 = xp.sqrt(4*t32**2 + t33**2)
-    t35 = t34 + xp.abs(t33)
-    t36 = xp.greater(t35, 0)
-    t37 = 2*t32
-    t38 = xp.where(t36, xp.where(xp.greater_equal(t33, 0), -t37, t37)/xp.where(t36, t35, 1), 0)
-    t39 = 1/xp.sqrt(1 + t38**2)
-    t40 = t27*t39
-    t41 = t28*t39
-    t42 = t40 + t38*t41
-    t43 = t41 - t38*t40
-    t44 = t24*t39
-    t45 = t12*t44
-    t46 = t22*t45
-    t47 = t46 + t38*t45
-    t48 = -t45 + t38*t46
-    t49 = t42**2 + t47**2
-    t50 = t43**2 + t48**2
-    t51 = -t42*t43 + t47*t48
-    t52 = -t49 + t50
-    t53 = xp.sqrt(4*t51**2 + t52**2)
-    t54 = t53 + xp.abs(t52)
-    t55 = t22*t44
-    t56 = t44 - t38*t55
-    t57 = t55 + t38*t44
-    t58 = xp.greater(t54, 0)
-    t59 = 2*t51
-    t60 = xp.where(t58, xp.where(xp.greater_equal(t52, 0), t59, -t59)/xp.where(t58, t54, 1), 0)
-    t61 = 1/xp.sqrt(1 + t60**2)
-    t62 = t42*t61
-    t63 = t43*t61
-    t64 = t62 + t60*t63
-    t65 = t63 - t60*t62
-    t66 = t47*t61
-    t67 = t48*t61
-    t68 = t66 - t60*t67
-    t69 = t67 + t60*t66
-    t70 = t64**2 + t68**2
-    t71 = t65**2 + t69**2
-    t72 = -t64*t65 + t68*t69
-    t73 = -t70 + t71
-    t74 = xp.sqrt(4*t72**2 + t73**2)
-    t75 = t74 + xp.abs(t73)
-    t76 = t56*t61
-    t77 = t57*t61
-    t78 = t76 - t60*t77
-    t79 = t77 + t60*t76
-    t80 = xp.greater(t75, 0)
-    t81 = 2*t72
-    t82 = xp.where(t80, xp.where(xp.greater_equal(t73, 0), t81, -t81)/xp.where(t80, t75, 1), 0)
-    t83 = 1/xp.sqrt(1 + t82**2)
-    t84 = t64*t83
-    t85 = t65*t83
-    t86 = t84 + t82*t85
-    t87 = t85 - t82*t84
-    t88 = t68*t83
-    t89 = t69*t83
-    t90 = t88 - t82*t89
-    t91 = t89 + t82*t88
-    t92 = t86**2 + t90**2
-    t93 = t87**2 + t91**2
-    t94 = -t86*t87 + t90*t91
-    t95 = -t92 + t93
-    t96 = xp.sqrt(4*t94**2 + t95**2)
-    t97 = t96 + xp.abs(t95)
-    t98 = t78*t83
-    t99 = t79*t83
-    t100 = t98 - t82*t99
-    t101 = t99 + t82*t98
-    t102 = xp.greater(t97, 0)
-    t103 = 2*t94
-    t104 = xp.where(t102, xp.where(xp.greater_equal(t95, 0), t103, -t103)/xp.where(t102, t97, 1), 0)
-    t105 = 1/xp.sqrt(1 + t104**2)
-    t106 = t86*t105
-    t107 = t87*t105
-    t108 = t106 + t104*t107
-    t109 = t107 - t104*t106
-    t110 = t90*t105
-    t111 = t91*t105
-    t112 = t110 - t104*t111
-    t113 = t111 + t104*t110
-    t114 = xp.sqrt(t108**2 + t112**2)
-    t115 = xp.sqrt(t109**2 + t113**2)
-    t116 = t100*t105
-    t117 = t101*t105
-    t118 = t116 - t104*t117
-    t119 = t117 + t104*t116
-    t120 = xp.less(t114, t115)
-    t121 = xp.where(t120, t115, t114)
-    t122 = xp.where(t120, t114, t115)
-    t123 = xp.where(t120, t119, t118)
-    t124 = xp.where(t120, t118, t119)
-    t125 = -t119
-    t126 = xp.where(t120, t118, t125)
-    t127 = xp.where(t120, t125, t118)
-    t128 = xp.less(t122, 0)
-    t129 = xp.where(t128, 0, t122)
-    t130 = xp.where(t128, t122, 0)
-    t131 = xp.where(t128, 0, t124)
-    t132 = xp.where(t128, 0, t127)
-    t133 = xp.where(t128, xp.asarray(1, dtype=dtype), 0)
-    t134 = xp.where(t128, t124, 0)
-    t135 = xp.where(t128, t127, 0)
-    t136 = xp.where(t128, xp.asarray(0, dtype=dtype), 1)
-    t137 = xp.less(t121, t129)
-    t138 = xp.where(t137, t129, t121)
-    t139 = xp.where(t137, t121, t129)
-    t140 = xp.where(t137, t131, t123)
-    t141 = xp.where(t137, t132, t126)
-    t142 = xp.where(t137, t133, 0)
-    t143 = xp.where(t137, t123, t131)
-    t144 = xp.where(t137, t126, t132)
-    t145 = xp.where(t137, 0, t133)
-    t146 = t140*(t136*t144 - t135*t145) - t141*(t136*t143 - t134*t145) + t142*(t135*t143 - t134*t144)
-    t147 = xp.where(xp.less(t146, 0), xp.asarray(-1, dtype=dtype), 1)
-    t148 = t134*t147
-    t149 = t135*t147
-    t150 = t136*t147
+    t13 = _jacobi3_columns_2(xp, 5, (-t3, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), t9, -t12, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 1, dtype=dtype, device=device), xp.full(batch, 1, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 1, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 1, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 1, dtype=dtype, device=device), xp.full(batch, 1, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 1, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 1, dtype=dtype, device=device),))
+    t14 = xp.sqrt(t13[0]**2 + t13[1]**2 + t13[2]**2)
+    t15 = xp.sqrt(t13[3]**2 + t13[4]**2 + t13[5]**2)
+    t16 = xp.sqrt(t13[6]**2 + t13[7]**2 + t13[8]**2)
+    t17 = xp.sqrt(t13[9]**2 + t13[10]**2 + t13[11]**2)
+    t18 = xp.sqrt(t13[12]**2 + t13[13]**2 + t13[14]**2)
+    t19 = xp.sqrt(t13[15]**2 + t13[16]**2 + t13[17]**2)
+    t20 = xp.less(t14, t15)
+    t21 = xp.where(t20, t15, t14)
+    t22 = xp.where(t20, t14, t15)
+    t23 = t13[21]
+    t24 = t13[18]
+    t25 = xp.where(t20, t23, t24)
+    t26 = xp.where(t20, t24, t23)
+    t27 = t13[22]
+    t28 = t13[19]
+    t29 = xp.where(t20, t27, t28)
+    t30 = xp.where(t20, t28, t27)
+    t31 = t13[23]
+    t32 = t13[20]
+    t33 = xp.where(t20, t31, t32)
+    t34 = xp.where(t20, t32, t31)
+    t35 = xp.less(t22, t16)
+    t36 = xp.where(t35, t16, t22)
+    t37 = xp.where(t35, t22, t16)
+    t38 = t13[24]
+    t39 = xp.where(t35, t38, t26)
+    t40 = xp.where(t35, t26, t38)
+    t41 = t13[25]
+    t42 = xp.where(t35, t41, t30)
+    t43 = xp.where(t35, t30, t41)
+    t44 = t13[26]
+    t45 = xp.where(t35, t44, t34)
+    t46 = xp.where(t35, t34, t44)
+    t47 = xp.less(t21, t36)
+    t48 = xp.where(t47, t36, t21)
+    t49 = xp.where(t47, t21, t36)
+    t50 = xp.where(t47, t39, t25)
+    t51 = xp.where(t47, t42, t29)
+    t52 = xp.where(t47, t45, t33)
+    t53 = xp.where(t47, t25, t39)
+    t54 = xp.where(t47, t29, t42)
+    t55 = xp.where(t47, t33, t45)
+    t56 = t50*(t46*t54 - t43*t55) - t51*(t46*t53 - t40*t55) + t52*(t43*t53 - t40*t54)
+    t57 = xp.where(xp.less(t56, 0), xp.asarray(-1, dtype=dtype), 1)
+    t58 = t57*t40
+    t59 = t57*t43
+    t60 = t57*t46
+    t61 = xp.less(t17, t18)
+    t62 = xp.where(t61, t18, t17)
+    t63 = xp.where(t61, t17, t18)
+    t64 = t13[30]
+    t65 = t13[27]
+    t66 = xp.where(t61, t64, t65)
+    t67 = xp.where(t61, t65, t64)
+    t68 = t13[31]
+    t69 = t13[28]
+    t70 = xp.where(t61, t68, t69)
+    t71 = xp.where(t61, t69, t68)
+    t72 = t13[32]
+    t73 = t13[29]
+    t74 = xp.where(t61, t72, t73)
+    t75 = xp.where(t61, t73, t72)
+    t76 = xp.less(t63, t19)
+    t77 = xp.where(t76, t19, t63)
+    t78 = xp.where(t76, t63, t19)
+    t79 = t13[33]
+    t80 = xp.where(t76, t79, t67)
+    t81 = xp.where(t76, t67, t79)
+    t82 = t13[34]
+    t83 = xp.where(t76, t82, t71)
+    t84 = xp.where(t76, t71, t82)
+    t85 = t13[35]
+    t86 = xp.where(t76, t85, t75)
+    t87 = xp.where(t76, t75, t85)
+    t88 = xp.less(t62, t77)
+    t89 = xp.where(t88, t77, t62)
+    t90 = xp.where(t88, t62, t77)
+    t91 = xp.where(t88, t80, t66)
+    t92 = xp.where(t88, t83, t70)
+    t93 = xp.where(t88, t86, t74)
+    t94 = xp.where(t88, t66, t80)
+    t95 = xp.where(t88, t70, t83)
+    t96 = xp.where(t88, t74, t86)
+    t97 = t91*(t87*t95 - t84*t96) - t92*(t87*t94 - t81*t96) + t93*(t84*t94 - t81*t95)
+    t98 = xp.where(xp.less(t97, 0), xp.asarray(-1, dtype=dtype), 1)
+    t99 = t98*t81
+    t100 = t98*t84
+    t101 = t98*t87
     U_v = _stack(xp, [
-        t140,  # 0, 0
-        t143,  # 0, 1
-        t148,  # 0, 2
-        t141,  # 1, 0
-        t144,  # 1, 1
-        t149,  # 1, 2
-        t142,  # 2, 0
-        t145,  # 2, 1
-        t150,  # 2, 2
+        t50,  # 0, 0
+        t53,  # 0, 1
+        t58,  # 0, 2
+        t51,  # 1, 0
+        t54,  # 1, 1
+        t59,  # 1, 2
+        t52,  # 2, 0
+        t55,  # 2, 1
+        t60,  # 2, 2
     ], (3, 3))
     s_v = _stack(xp, [
-        t138,  # 0
-        t139,  # 1
-        t130,  # 2
+        t48,  # 0
+        t49,  # 1
+        t37,  # 2
     ], (3,))
     U_w = _stack(xp, [
-        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 0
-        xp.full(batch, 1, dtype=dtype, device=device),  # 0, 1
-        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2
-        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0
-        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1
-        xp.full(batch, 1, dtype=dtype, device=device),  # 1, 2
-        xp.full(batch, 1, dtype=dtype, device=device),  # 2, 0
-        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1
-        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2
+        t91,  # 0, 0
+        t94,  # 0, 1
+        t99,  # 0, 2
+        t92,  # 1, 0
+        t95,  # 1, 1
+        t100,  # 1, 2
+        t93,  # 2, 0
+        t96,  # 2, 1
+        t101,  # 2, 2
     ], (3, 3))
     s_w = _stack(xp, [
-        xp.full(batch, 1.4142135623730951, dtype=dtype, device=device),  # 0
-        xp.full(batch, 0, dtype=dtype, device=device),  # 1
-        xp.full(batch, 0, dtype=dtype, device=device),  # 2
+        t89,  # 0
+        t90,  # 1
+        t78,  # 2
     ], (3,))
     return U_v, s_v, U_w, s_w
 
@@ -858,7 +1062,7 @@ def condition_number(q):
     t28 = -t26 + t25*t22
     t29 = t13*t24**2
     t30 = xp.sqrt(t29 + t27**2)
-    t31 = xp.sqrt(t23*t29 + t28**2)
+    t31 = xp.sqrt(t28**2 + t23*t29)
     t32 = xp.where(xp.greater(t31, t30), t31, t30)
     t33 = xp.where(xp.less(t31, t30), t31, t30)
     t34 = xp.where(xp.less_equal(t33, 1e-12*t32), 0, t33)
@@ -1165,7 +1369,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t14 = xp.where(t12, 1 + xp.abs(t9)/t10, 0)
     t15 = damping + t4
     t16 = t3*t13
-    t17 = -t14*(t15*t16 + t3)
+    t17 = -t14*(t3 + t15*t16)
     t18 = t3 + t17
     t19 = t15 + t16*t17
     t20 = t14*(t5 - t16*t6)

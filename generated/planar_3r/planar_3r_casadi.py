@@ -18,6 +18,342 @@ TASK = ("x", "y", "yaw", )
 CHARACTERISTIC_LENGTH = 0.463158
 
 
+def _jacobi3_columns_2(count, state):
+    """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
+        t0 = w0**2 + w1**2 + w2**2
+        t1 = w3**2 + w4**2 + w5**2
+        t2 = w6**2 + w7**2 + w8**2
+        t3 = w9**2 + w10**2 + w11**2
+        t4 = w12**2 + w13**2 + w14**2
+        t5 = w15**2 + w16**2 + w17**2
+        t6 = w3*w6 + w4*w7 + w5*w8
+        t7 = w12*w15 + w13*w16 + w14*w17
+        t8 = -t1 + t2
+        t9 = casadi.sqrt(t8**2 + 4*t6**2)
+        t10 = t9 + casadi.fabs(t8)
+        t11 = -t4 + t5
+        t12 = casadi.sqrt(4*t7**2 + t11**2)
+        t13 = t12 + casadi.fabs(t11)
+        t14 = (t10 > 0)
+        t15 = 2*t6
+        t16 = casadi.if_else(t14, casadi.if_else((t8 >= 0), t15, -t15)/casadi.if_else(t14, t10, 1), 0)
+        t17 = 1/casadi.sqrt(1 + t16**2)
+        t18 = (t13 > 0)
+        t19 = 2*t7
+        t20 = casadi.if_else(t18, casadi.if_else((t11 >= 0), t19, -t19)/casadi.if_else(t18, t13, 1), 0)
+        t21 = 1/casadi.sqrt(1 + t20**2)
+        t22 = t6*t16
+        t23 = -t22 + t1
+        t24 = t22 + t2
+        t25 = -t0 + t24
+        t26 = w3*t17
+        t27 = w6*t17
+        t28 = t26 - t27*t16
+        t29 = t27 + t26*t16
+        t30 = w4*t17
+        t31 = w7*t17
+        t32 = t30 - t31*t16
+        t33 = t31 + t30*t16
+        t34 = w5*t17
+        t35 = w8*t17
+        t36 = t34 - t35*t16
+        t37 = t35 + t34*t16
+        t38 = w0*t29 + w1*t33 + w2*t37
+        t39 = casadi.sqrt(4*t38**2 + t25**2)
+        t40 = t39 + casadi.fabs(t25)
+        t41 = w21*t17
+        t42 = w24*t17
+        t43 = t41 - t42*t16
+        t44 = t42 + t41*t16
+        t45 = w22*t17
+        t46 = w25*t17
+        t47 = t45 - t46*t16
+        t48 = t46 + t45*t16
+        t49 = w23*t17
+        t50 = w26*t17
+        t51 = t49 - t50*t16
+        t52 = t50 + t49*t16
+        t53 = t7*t20
+        t54 = -t53 + t4
+        t55 = t53 + t5
+        t56 = -t3 + t55
+        t57 = w12*t21
+        t58 = w15*t21
+        t59 = t57 - t20*t58
+        t60 = t58 + t57*t20
+        t61 = w13*t21
+        t62 = w16*t21
+        t63 = t61 - t20*t62
+        t64 = t62 + t20*t61
+        t65 = w14*t21
+        t66 = w17*t21
+        t67 = t65 - t20*t66
+        t68 = t66 + t20*t65
+        t69 = w9*t60 + w10*t64 + w11*t68
+        t70 = casadi.sqrt(4*t69**2 + t56**2)
+        t71 = t70 + casadi.fabs(t56)
+        t72 = w30*t21
+        t73 = w33*t21
+        t74 = t72 - t20*t73
+        t75 = t73 + t20*t72
+        t76 = w31*t21
+        t77 = w34*t21
+        t78 = t76 - t20*t77
+        t79 = t77 + t20*t76
+        t80 = w32*t21
+        t81 = w35*t21
+        t82 = t80 - t20*t81
+        t83 = t81 + t20*t80
+        t84 = (t40 > 0)
+        t85 = 2*t38
+        t86 = casadi.if_else(t84, casadi.if_else((t25 >= 0), t85, -t85)/casadi.if_else(t84, t40, 1), 0)
+        t87 = 1/casadi.sqrt(1 + t86**2)
+        t88 = t0 - t38*t86
+        t89 = -t88 + t23
+        t90 = (t71 > 0)
+        t91 = 2*t69
+        t92 = casadi.if_else(t90, casadi.if_else((t56 >= 0), t91, -t91)/casadi.if_else(t90, t71, 1), 0)
+        t93 = 1/casadi.sqrt(1 + t92**2)
+        t94 = t3 - t69*t92
+        t95 = -t94 + t54
+        t96 = w0*t87
+        t97 = t29*t87
+        t98 = t96 - t86*t97
+        t99 = t97 + t86*t96
+        t100 = w1*t87
+        t101 = t33*t87
+        t102 = t100 - t86*t101
+        t103 = t101 + t86*t100
+        t104 = w2*t87
+        t105 = t37*t87
+        t106 = t104 - t86*t105
+        t107 = t105 + t86*t104
+        t108 = t28*t98 + t32*t102 + t36*t106
+        t109 = casadi.sqrt(4*t108**2 + t89**2)
+        t110 = t109 + casadi.fabs(t89)
+        t111 = w18*t87
+        t112 = t44*t87
+        t113 = t111 - t86*t112
+        t114 = t112 + t86*t111
+        t115 = w19*t87
+        t116 = t48*t87
+        t117 = t115 - t86*t116
+        t118 = t116 + t86*t115
+        t119 = w20*t87
+        t120 = t52*t87
+        t121 = t119 - t86*t120
+        t122 = t120 + t86*t119
+        t123 = w9*t93
+        t124 = t60*t93
+        t125 = t123 - t92*t124
+        t126 = t124 + t92*t123
+        t127 = w10*t93
+        t128 = t64*t93
+        t129 = t127 - t92*t128
+        t130 = t128 + t92*t127
+        t131 = w11*t93
+        t132 = t68*t93
+        t133 = t131 - t92*t132
+        t134 = t132 + t92*t131
+        t135 = t59*t125 + t63*t129 + t67*t133
+        t136 = casadi.sqrt(4*t135**2 + t95**2)
+        t137 = t136 + casadi.fabs(t95)
+        t138 = w27*t93
+        t139 = t75*t93
+        t140 = t138 - t92*t139
+        t141 = t139 + t92*t138
+        t142 = w28*t93
+        t143 = t79*t93
+        t144 = t142 - t92*t143
+        t145 = t143 + t92*t142
+        t146 = w29*t93
+        t147 = t83*t93
+        t148 = t146 - t92*t147
+        t149 = t147 + t92*t146
+        t150 = (t110 > 0)
+        t151 = 2*t108
+        t152 = casadi.if_else(t150, casadi.if_else((t89 >= 0), t151, -t151)/casadi.if_else(t150, t110, 1), 0)
+        t153 = 1/casadi.sqrt(1 + t152**2)
+        t154 = (t137 > 0)
+        t155 = 2*t135
+        t156 = casadi.if_else(t154, casadi.if_else((t95 >= 0), t155, -t155)/casadi.if_else(t154, t137, 1), 0)
+        t157 = 1/casadi.sqrt(1 + t156**2)
+        t158 = t98*t153
+        t159 = t28*t153
+        t160 = t158 - t152*t159
+        t161 = t159 + t152*t158
+        t162 = t102*t153
+        t163 = t32*t153
+        t164 = t162 - t152*t163
+        t165 = t163 + t152*t162
+        t166 = t106*t153
+        t167 = t36*t153
+        t168 = t166 - t152*t167
+        t169 = t167 + t152*t166
+        t170 = t113*t153
+        t171 = t43*t153
+        t172 = t170 - t152*t171
+        t173 = t171 + t152*t170
+        t174 = t117*t153
+        t175 = t47*t153
+        t176 = t174 - t152*t175
+        t177 = t175 + t152*t174
+        t178 = t121*t153
+        t179 = t51*t153
+        t180 = t178 - t152*t179
+        t181 = t179 + t152*t178
+        t182 = t125*t157
+        t183 = t59*t157
+        t184 = t182 - t156*t183
+        t185 = t183 + t156*t182
+        t186 = t129*t157
+        t187 = t63*t157
+        t188 = t186 - t156*t187
+        t189 = t187 + t156*t186
+        t190 = t133*t157
+        t191 = t67*t157
+        t192 = t190 - t156*t191
+        t193 = t191 + t156*t190
+        t194 = t140*t157
+        t195 = t74*t157
+        t196 = t194 - t156*t195
+        t197 = t195 + t156*t194
+        t198 = t144*t157
+        t199 = t78*t157
+        t200 = t198 - t156*t199
+        t201 = t199 + t156*t198
+        t202 = t148*t157
+        t203 = t82*t157
+        t204 = t202 - t156*t203
+        t205 = t203 + t156*t202
+        state = (
+            t160,
+            t164,
+            t168,
+            t161,
+            t165,
+            t169,
+            t99,
+            t103,
+            t107,
+            t184,
+            t188,
+            t192,
+            t185,
+            t189,
+            t193,
+            t126,
+            t130,
+            t134,
+            t172,
+            t176,
+            t180,
+            t173,
+            t177,
+            t181,
+            t114,
+            t118,
+            t122,
+            t196,
+            t200,
+            t204,
+            t197,
+            t201,
+            t205,
+            t141,
+            t145,
+            t149,
+        )
+    return state
+
+
+def _jacobi3_rows(count, state):
+    """One-sided Jacobi sweep of a 3 x 3 matrix (its rows), `count` times: 152 operations a run."""
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, = state
+        t0 = w0**2 + w1**2 + w2**2
+        t1 = w3**2 + w4**2 + w5**2
+        t2 = w6**2 + w7**2 + w8**2
+        t3 = w3*w6 + w4*w7 + w5*w8
+        t4 = -t1 + t2
+        t5 = casadi.sqrt(t4**2 + 4*t3**2)
+        t6 = t5 + casadi.fabs(t4)
+        t7 = (t6 > 0)
+        t8 = 2*t3
+        t9 = casadi.if_else(t7, casadi.if_else((t4 >= 0), t8, -t8)/casadi.if_else(t7, t6, 1), 0)
+        t10 = 1/casadi.sqrt(1 + t9**2)
+        t11 = t3*t9
+        t12 = -t11 + t1
+        t13 = t11 + t2
+        t14 = -t0 + t13
+        t15 = w3*t10
+        t16 = w6*t10
+        t17 = t15 - t16*t9
+        t18 = t16 + t15*t9
+        t19 = w4*t10
+        t20 = w7*t10
+        t21 = t19 - t20*t9
+        t22 = t20 + t19*t9
+        t23 = w5*t10
+        t24 = w8*t10
+        t25 = t23 - t24*t9
+        t26 = t24 + t23*t9
+        t27 = w0*t18 + w1*t22 + w2*t26
+        t28 = casadi.sqrt(4*t27**2 + t14**2)
+        t29 = t28 + casadi.fabs(t14)
+        t30 = (t29 > 0)
+        t31 = 2*t27
+        t32 = casadi.if_else(t30, casadi.if_else((t14 >= 0), t31, -t31)/casadi.if_else(t30, t29, 1), 0)
+        t33 = 1/casadi.sqrt(1 + t32**2)
+        t34 = t0 - t27*t32
+        t35 = -t34 + t12
+        t36 = w0*t33
+        t37 = t18*t33
+        t38 = t36 - t37*t32
+        t39 = t37 + t36*t32
+        t40 = w1*t33
+        t41 = t22*t33
+        t42 = t40 - t41*t32
+        t43 = t41 + t40*t32
+        t44 = w2*t33
+        t45 = t26*t33
+        t46 = t44 - t45*t32
+        t47 = t45 + t44*t32
+        t48 = t17*t38 + t21*t42 + t25*t46
+        t49 = casadi.sqrt(4*t48**2 + t35**2)
+        t50 = t49 + casadi.fabs(t35)
+        t51 = (t50 > 0)
+        t52 = 2*t48
+        t53 = casadi.if_else(t51, casadi.if_else((t35 >= 0), t52, -t52)/casadi.if_else(t51, t50, 1), 0)
+        t54 = 1/casadi.sqrt(1 + t53**2)
+        t55 = t38*t54
+        t56 = t17*t54
+        t57 = t55 - t53*t56
+        t58 = t56 + t53*t55
+        t59 = t42*t54
+        t60 = t21*t54
+        t61 = t59 - t53*t60
+        t62 = t60 + t53*t59
+        t63 = t46*t54
+        t64 = t25*t54
+        t65 = t63 - t53*t64
+        t66 = t64 + t53*t63
+        state = (
+            t57,
+            t61,
+            t65,
+            t58,
+            t62,
+            t66,
+            t39,
+            t43,
+            t47,
+        )
+    return state
+
+
 def _fk(q):
     """Pose of the tool frame in the world frame (4x4 homogeneous): 23 operations."""
     q1 = q[0]
@@ -663,7 +999,7 @@ def _manipulability_gradient(q):
 
 
 def _velocity_ellipsoid(q):
-    """Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: 341 operations."""
+    """Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s: 2258 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -694,169 +1030,128 @@ def _velocity_ellipsoid(q):
     t14 = c123 + t10*t11
     t15 = casadi.sqrt(t13**2 + t14**2)
     t16 = t15*casadi.if_else((t13 >= 0), 1, -1)
-    t17 = t5**2
-    t18 = t12**2
-    t19 = t16**2
-    t20 = t18 + t19
-    t21 = -t17 + t20
-    t22 = casadi.sqrt(t21**2 + 4*t17*t18)
-    t23 = t22 + casadi.fabs(t21)
-    t24 = (t23 > 0)
-    t25 = 2*t5*t12
-    t26 = casadi.if_else(t24, casadi.if_else((t21 >= 0), -t25, t25)/casadi.if_else(t24, t23, 1), 0)
-    t27 = t26**2
-    t28 = 1/casadi.sqrt(1 + t27)
-    t29 = t5*t28
-    t30 = t12*t28
-    t31 = t29 + t30*t26
-    t32 = t30 - t29*t26
-    t33 = t19*t28**2
-    t34 = t31**2 + t27*t33
-    t35 = t33 + t32**2
-    t36 = t31*t32 + t33*t26
-    t37 = -t34 + t35
-    t38 = casadi.sqrt(4*t36**2 + t37**2)
-    t39 = t38 + casadi.fabs(t37)
-    t40 = (t39 > 0)
-    t41 = 2*t36
-    t42 = casadi.if_else(t40, casadi.if_else((t37 >= 0), -t41, t41)/casadi.if_else(t40, t39, 1), 0)
-    t43 = 1/casadi.sqrt(1 + t42**2)
-    t44 = t31*t43
-    t45 = t32*t43
-    t46 = t44 + t45*t42
-    t47 = t45 - t44*t42
-    t48 = t28*t43
-    t49 = t16*t48
-    t50 = t49*t26
-    t51 = t50 + t49*t42
-    t52 = -t49 + t50*t42
-    t53 = t46**2 + t51**2
-    t54 = t47**2 + t52**2
-    t55 = -t46*t47 + t51*t52
-    t56 = -t53 + t54
-    t57 = casadi.sqrt(4*t55**2 + t56**2)
-    t58 = t57 + casadi.fabs(t56)
-    t59 = t48*t26
-    t60 = t48 - t42*t59
-    t61 = t59 + t48*t42
-    t62 = (t58 > 0)
-    t63 = 2*t55
-    t64 = casadi.if_else(t62, casadi.if_else((t56 >= 0), t63, -t63)/casadi.if_else(t62, t58, 1), 0)
-    t65 = 1/casadi.sqrt(1 + t64**2)
-    t66 = t46*t65
-    t67 = t47*t65
-    t68 = t66 + t64*t67
-    t69 = t67 - t64*t66
-    t70 = t51*t65
-    t71 = t52*t65
-    t72 = t70 - t64*t71
-    t73 = t71 + t64*t70
-    t74 = t68**2 + t72**2
-    t75 = t69**2 + t73**2
-    t76 = -t68*t69 + t72*t73
-    t77 = -t74 + t75
-    t78 = casadi.sqrt(4*t76**2 + t77**2)
-    t79 = t78 + casadi.fabs(t77)
-    t80 = t60*t65
-    t81 = t61*t65
-    t82 = t80 - t64*t81
-    t83 = t81 + t64*t80
-    t84 = (t79 > 0)
-    t85 = 2*t76
-    t86 = casadi.if_else(t84, casadi.if_else((t77 >= 0), t85, -t85)/casadi.if_else(t84, t79, 1), 0)
-    t87 = 1/casadi.sqrt(1 + t86**2)
-    t88 = t68*t87
-    t89 = t69*t87
-    t90 = t88 + t86*t89
-    t91 = t89 - t86*t88
-    t92 = t72*t87
-    t93 = t73*t87
-    t94 = t92 - t86*t93
-    t95 = t93 + t86*t92
-    t96 = t90**2 + t94**2
-    t97 = t91**2 + t95**2
-    t98 = -t90*t91 + t94*t95
-    t99 = -t96 + t97
-    t100 = casadi.sqrt(4*t98**2 + t99**2)
-    t101 = t100 + casadi.fabs(t99)
-    t102 = t82*t87
-    t103 = t83*t87
-    t104 = t102 - t86*t103
-    t105 = t103 + t86*t102
-    t106 = (t101 > 0)
-    t107 = 2*t98
-    t108 = casadi.if_else(t106, casadi.if_else((t99 >= 0), t107, -t107)/casadi.if_else(t106, t101, 1), 0)
-    t109 = 1/casadi.sqrt(1 + t108**2)
-    t110 = t90*t109
-    t111 = t91*t109
-    t112 = t110 + t108*t111
-    t113 = t111 - t108*t110
-    t114 = t94*t109
-    t115 = t95*t109
-    t116 = t114 - t108*t115
-    t117 = t115 + t108*t114
-    t118 = casadi.sqrt(t112**2 + t116**2)
-    t119 = casadi.sqrt(t113**2 + t117**2)
-    t120 = t104*t109
-    t121 = t105*t109
-    t122 = t120 - t108*t121
-    t123 = t121 + t108*t120
-    t124 = (t118 < t119)
-    t125 = casadi.if_else(t124, t119, t118)
-    t126 = casadi.if_else(t124, t118, t119)
-    t127 = casadi.if_else(t124, t123, t122)
-    t128 = casadi.if_else(t124, t122, t123)
-    t129 = -t123
-    t130 = casadi.if_else(t124, t122, t129)
-    t131 = casadi.if_else(t124, t129, t122)
-    t132 = (t126 < 0)
-    t133 = casadi.if_else(t132, 0, t126)
-    t134 = casadi.if_else(t132, t126, 0)
-    t135 = casadi.if_else(t132, 0, t128)
-    t136 = casadi.if_else(t132, 0, t131)
-    t137 = casadi.if_else(t132, 1, 0)
-    t138 = casadi.if_else(t132, t128, 0)
-    t139 = casadi.if_else(t132, t131, 0)
-    t140 = casadi.if_else(t132, 0, 1)
-    t141 = (t125 < t133)
-    t142 = casadi.if_else(t141, t133, t125)
-    t143 = casadi.if_else(t141, t125, t133)
-    t144 = casadi.if_else(t141, t135, t127)
-    t145 = casadi.if_else(t141, t136, t130)
-    t146 = casadi.if_else(t141, t137, 0)
-    t147 = casadi.if_else(t141, t127, t135)
-    t148 = casadi.if_else(t141, t130, t136)
-    t149 = casadi.if_else(t141, 0, t137)
-    t150 = t144*(t140*t148 - t139*t149) - t145*(t140*t147 - t138*t149) + t146*(t139*t147 - t138*t148)
-    t151 = casadi.if_else((t150 < 0), -1, 1)
-    t152 = t138*t151
-    t153 = t139*t151
-    t154 = t140*t151
+    t17 = _jacobi3_columns_2(5, (-t5, 0, 0, t12, -t16, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, -1, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 0, 0, 0, 1, 0, 0, 0, 1,))
+    t18 = casadi.sqrt(t17[0]**2 + t17[1]**2 + t17[2]**2)
+    t19 = casadi.sqrt(t17[3]**2 + t17[4]**2 + t17[5]**2)
+    t20 = casadi.sqrt(t17[6]**2 + t17[7]**2 + t17[8]**2)
+    t21 = casadi.sqrt(t17[9]**2 + t17[10]**2 + t17[11]**2)
+    t22 = casadi.sqrt(t17[12]**2 + t17[13]**2 + t17[14]**2)
+    t23 = casadi.sqrt(t17[15]**2 + t17[16]**2 + t17[17]**2)
+    t24 = (t18 < t19)
+    t25 = casadi.if_else(t24, t19, t18)
+    t26 = casadi.if_else(t24, t18, t19)
+    t27 = t17[21]
+    t28 = t17[18]
+    t29 = casadi.if_else(t24, t27, t28)
+    t30 = casadi.if_else(t24, t28, t27)
+    t31 = t17[22]
+    t32 = t17[19]
+    t33 = casadi.if_else(t24, t31, t32)
+    t34 = casadi.if_else(t24, t32, t31)
+    t35 = t17[23]
+    t36 = t17[20]
+    t37 = casadi.if_else(t24, t35, t36)
+    t38 = casadi.if_else(t24, t36, t35)
+    t39 = (t26 < t20)
+    t40 = casadi.if_else(t39, t20, t26)
+    t41 = casadi.if_else(t39, t26, t20)
+    t42 = t17[24]
+    t43 = casadi.if_else(t39, t42, t30)
+    t44 = casadi.if_else(t39, t30, t42)
+    t45 = t17[25]
+    t46 = casadi.if_else(t39, t45, t34)
+    t47 = casadi.if_else(t39, t34, t45)
+    t48 = t17[26]
+    t49 = casadi.if_else(t39, t48, t38)
+    t50 = casadi.if_else(t39, t38, t48)
+    t51 = (t25 < t40)
+    t52 = casadi.if_else(t51, t40, t25)
+    t53 = casadi.if_else(t51, t25, t40)
+    t54 = casadi.if_else(t51, t43, t29)
+    t55 = casadi.if_else(t51, t46, t33)
+    t56 = casadi.if_else(t51, t49, t37)
+    t57 = casadi.if_else(t51, t29, t43)
+    t58 = casadi.if_else(t51, t33, t46)
+    t59 = casadi.if_else(t51, t37, t49)
+    t60 = t54*(t50*t58 - t47*t59) - t55*(t50*t57 - t44*t59) + t56*(t47*t57 - t44*t58)
+    t61 = casadi.if_else((t60 < 0), -1, 1)
+    t62 = t61*t44
+    t63 = t61*t47
+    t64 = t61*t50
+    t65 = (t21 < t22)
+    t66 = casadi.if_else(t65, t22, t21)
+    t67 = casadi.if_else(t65, t21, t22)
+    t68 = t17[30]
+    t69 = t17[27]
+    t70 = casadi.if_else(t65, t68, t69)
+    t71 = casadi.if_else(t65, t69, t68)
+    t72 = t17[31]
+    t73 = t17[28]
+    t74 = casadi.if_else(t65, t72, t73)
+    t75 = casadi.if_else(t65, t73, t72)
+    t76 = t17[32]
+    t77 = t17[29]
+    t78 = casadi.if_else(t65, t76, t77)
+    t79 = casadi.if_else(t65, t77, t76)
+    t80 = (t67 < t23)
+    t81 = casadi.if_else(t80, t23, t67)
+    t82 = casadi.if_else(t80, t67, t23)
+    t83 = t17[33]
+    t84 = casadi.if_else(t80, t83, t71)
+    t85 = casadi.if_else(t80, t71, t83)
+    t86 = t17[34]
+    t87 = casadi.if_else(t80, t86, t75)
+    t88 = casadi.if_else(t80, t75, t86)
+    t89 = t17[35]
+    t90 = casadi.if_else(t80, t89, t79)
+    t91 = casadi.if_else(t80, t79, t89)
+    t92 = (t66 < t81)
+    t93 = casadi.if_else(t92, t81, t66)
+    t94 = casadi.if_else(t92, t66, t81)
+    t95 = casadi.if_else(t92, t84, t70)
+    t96 = casadi.if_else(t92, t87, t74)
+    t97 = casadi.if_else(t92, t90, t78)
+    t98 = casadi.if_else(t92, t70, t84)
+    t99 = casadi.if_else(t92, t74, t87)
+    t100 = casadi.if_else(t92, t78, t90)
+    t101 = t95*(t91*t99 - t88*t100) - t96*(t91*t98 - t85*t100) + t97*(t88*t98 - t85*t99)
+    t102 = casadi.if_else((t101 < 0), -1, 1)
+    t103 = t102*t85
+    t104 = t102*t88
+    t105 = t102*t91
     U_v = casadi.SX(3, 3)
-    U_v[0, 0] = t144
-    U_v[0, 1] = t147
-    U_v[0, 2] = t152
-    U_v[1, 0] = t145
-    U_v[1, 1] = t148
-    U_v[1, 2] = t153
-    U_v[2, 0] = t146
-    U_v[2, 1] = t149
-    U_v[2, 2] = t154
+    U_v[0, 0] = t54
+    U_v[0, 1] = t57
+    U_v[0, 2] = t62
+    U_v[1, 0] = t55
+    U_v[1, 1] = t58
+    U_v[1, 2] = t63
+    U_v[2, 0] = t56
+    U_v[2, 1] = t59
+    U_v[2, 2] = t64
     s_v = casadi.SX(3, 1)
-    s_v[0, 0] = t142
-    s_v[1, 0] = t143
-    s_v[2, 0] = t134
+    s_v[0, 0] = t52
+    s_v[1, 0] = t53
+    s_v[2, 0] = t41
     U_w = casadi.SX(3, 3)
-    U_w[0, 1] = 1
-    U_w[1, 2] = 1
-    U_w[2, 0] = 1
+    U_w[0, 0] = t95
+    U_w[0, 1] = t98
+    U_w[0, 2] = t103
+    U_w[1, 0] = t96
+    U_w[1, 1] = t99
+    U_w[1, 2] = t104
+    U_w[2, 0] = t97
+    U_w[2, 1] = t100
+    U_w[2, 2] = t105
     s_w = casadi.SX(3, 1)
-    s_w[0, 0] = 1.7320508075688772
+    s_w[0, 0] = t93
+    s_w[1, 0] = t94
+    s_w[2, 0] = t82
     return [U_v, s_v, U_w, s_w]
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 863 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 894 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -904,348 +1199,18 @@ def _condition_number(q):
     t31 = t22 - t28*t29
     t32 = casadi.fabs(t31)
     t33 = t32*casadi.if_else((t31 >= 0), 1, -1)
-    t34 = t7**2
-    t35 = t34 + t13**2 + t20**2
-    t36 = t30**2
-    t37 = t36 + t24**2
-    t38 = t33**2
-    t39 = -t37 + t38
-    t40 = casadi.sqrt(t39**2 + 4*t36*t38)
-    t41 = t40 + casadi.fabs(t39)
-    t42 = (t41 > 0)
-    t43 = t30*t33
-    t44 = 2*t43
-    t45 = casadi.if_else(t42, casadi.if_else((t39 >= 0), -t44, t44)/casadi.if_else(t42, t41, 1), 0)
-    t46 = 1/casadi.sqrt(1 + t45**2)
-    t47 = t43*t45
-    t48 = t47 + t37
-    t49 = -t47 + t38
-    t50 = -t35 + t49
-    t51 = t30*t46
-    t52 = t33*t46
-    t53 = t51 + t52*t45
-    t54 = -t52 + t51*t45
-    t55 = t24*t46
-    t56 = t55*t45
-    t57 = t20*t54 - t56*t13
-    t58 = casadi.sqrt(4*t57**2 + t50**2)
-    t59 = t58 + casadi.fabs(t50)
-    t60 = (t59 > 0)
-    t61 = 2*t57
-    t62 = casadi.if_else(t60, casadi.if_else((t50 >= 0), t61, -t61)/casadi.if_else(t60, t59, 1), 0)
-    t63 = t35 - t57*t62
-    t64 = -t63 + t48
-    t65 = t62**2
-    t66 = 1/casadi.sqrt(1 + t65)
-    t67 = t13*t66
-    t68 = t56*t66
-    t69 = t67 + t68*t62
-    t70 = -t68 + t67*t62
-    t71 = t20*t66
-    t72 = t54*t66
-    t73 = t71 - t72*t62
-    t74 = t72 + t71*t62
-    t75 = t53*t73 - t55*t69
-    t76 = casadi.sqrt(4*t75**2 + t64**2)
-    t77 = t76 + casadi.fabs(t64)
-    t78 = (t77 > 0)
-    t79 = 2*t75
-    t80 = casadi.if_else(t78, casadi.if_else((t64 >= 0), t79, -t79)/casadi.if_else(t78, t77, 1), 0)
-    t81 = t80**2
-    t82 = 1/casadi.sqrt(1 + t81)
-    t83 = t69*t82
-    t84 = t55*t82
-    t85 = t83 + t84*t80
-    t86 = -t84 + t83*t80
-    t87 = t73*t82
-    t88 = t53*t82
-    t89 = t87 - t88*t80
-    t90 = t88 + t87*t80
-    t91 = t34*t66**2
-    t92 = t70**2 + t74**2 + t65*t91
-    t93 = t91*t82**2
-    t94 = t93 + t85**2 + t89**2
-    t95 = t86**2 + t90**2 + t81*t93
-    t96 = -t95 + t92
-    t97 = t80*t82
-    t98 = t70*t86 + t74*t90 + t91*t97*t62
-    t99 = casadi.sqrt(4*t98**2 + t96**2)
-    t100 = t99 + casadi.fabs(t96)
-    t101 = (t100 > 0)
-    t102 = 2*t98
-    t103 = casadi.if_else(t101, casadi.if_else((t96 >= 0), t102, -t102)/casadi.if_else(t101, t100, 1), 0)
-    t104 = 1/casadi.sqrt(1 + t103**2)
-    t105 = t98*t103
-    t106 = -t105 + t95
-    t107 = t105 + t92
-    t108 = -t94 + t107
-    t109 = t7*t66
-    t110 = t109*t104
-    t111 = t97*t110
-    t112 = t110*t62
-    t113 = -t111 + t112*t103
-    t114 = t112 + t111*t103
-    t115 = t86*t104
-    t116 = t70*t104
-    t117 = t115 - t116*t103
-    t118 = t116 + t115*t103
-    t119 = t90*t104
-    t120 = t74*t104
-    t121 = t119 - t120*t103
-    t122 = t120 + t119*t103
-    t123 = t109*t82
-    t124 = t85*t118 + t89*t122 + t123*t114
-    t125 = casadi.sqrt(4*t124**2 + t108**2)
-    t126 = t125 + casadi.fabs(t108)
-    t127 = (t126 > 0)
-    t128 = 2*t124
-    t129 = casadi.if_else(t127, casadi.if_else((t108 >= 0), t128, -t128)/casadi.if_else(t127, t126, 1), 0)
-    t130 = 1/casadi.sqrt(1 + t129**2)
-    t131 = t94 - t124*t129
-    t132 = -t131 + t106
-    t133 = t123*t130
-    t134 = t114*t130
-    t135 = -t133 + t129*t134
-    t136 = t134 + t129*t133
-    t137 = t85*t130
-    t138 = t118*t130
-    t139 = t137 - t129*t138
-    t140 = t138 + t129*t137
-    t141 = t89*t130
-    t142 = t122*t130
-    t143 = t141 - t129*t142
-    t144 = t142 + t129*t141
-    t145 = t113*t135 + t117*t139 + t121*t143
-    t146 = casadi.sqrt(4*t145**2 + t132**2)
-    t147 = t146 + casadi.fabs(t132)
-    t148 = t136**2 + t140**2 + t144**2
-    t149 = (t147 > 0)
-    t150 = 2*t145
-    t151 = casadi.if_else(t149, casadi.if_else((t132 >= 0), t150, -t150)/casadi.if_else(t149, t147, 1), 0)
-    t152 = 1/casadi.sqrt(1 + t151**2)
-    t153 = t135*t152
-    t154 = t113*t152
-    t155 = t153 - t151*t154
-    t156 = t154 + t151*t153
-    t157 = t139*t152
-    t158 = t117*t152
-    t159 = t157 - t151*t158
-    t160 = t158 + t151*t157
-    t161 = t143*t152
-    t162 = t121*t152
-    t163 = t161 - t151*t162
-    t164 = t162 + t151*t161
-    t165 = t155**2 + t159**2 + t163**2
-    t166 = t156**2 + t160**2 + t164**2
-    t167 = -t136*t156 + t140*t160 + t144*t164
-    t168 = -t166 + t148
-    t169 = casadi.sqrt(4*t167**2 + t168**2)
-    t170 = t169 + casadi.fabs(t168)
-    t171 = (t170 > 0)
-    t172 = 2*t167
-    t173 = casadi.if_else(t171, casadi.if_else((t168 >= 0), t172, -t172)/casadi.if_else(t171, t170, 1), 0)
-    t174 = 1/casadi.sqrt(1 + t173**2)
-    t175 = t167*t173
-    t176 = -t175 + t166
-    t177 = t148 + t175
-    t178 = -t165 + t177
-    t179 = t156*t174
-    t180 = t136*t174
-    t181 = t179 + t173*t180
-    t182 = -t180 + t173*t179
-    t183 = t160*t174
-    t184 = t140*t174
-    t185 = t183 - t173*t184
-    t186 = t184 + t173*t183
-    t187 = t164*t174
-    t188 = t144*t174
-    t189 = t187 - t173*t188
-    t190 = t188 + t173*t187
-    t191 = t155*t182 + t159*t186 + t163*t190
-    t192 = casadi.sqrt(4*t191**2 + t178**2)
-    t193 = t192 + casadi.fabs(t178)
-    t194 = (t193 > 0)
-    t195 = 2*t191
-    t196 = casadi.if_else(t194, casadi.if_else((t178 >= 0), t195, -t195)/casadi.if_else(t194, t193, 1), 0)
-    t197 = 1/casadi.sqrt(1 + t196**2)
-    t198 = t165 - t191*t196
-    t199 = -t198 + t176
-    t200 = t155*t197
-    t201 = t182*t197
-    t202 = t200 - t196*t201
-    t203 = t201 + t196*t200
-    t204 = t159*t197
-    t205 = t186*t197
-    t206 = t204 - t196*t205
-    t207 = t205 + t196*t204
-    t208 = t163*t197
-    t209 = t190*t197
-    t210 = t208 - t196*t209
-    t211 = t209 + t196*t208
-    t212 = t181*t202 + t185*t206 + t189*t210
-    t213 = casadi.sqrt(4*t212**2 + t199**2)
-    t214 = t213 + casadi.fabs(t199)
-    t215 = t203**2 + t207**2 + t211**2
-    t216 = (t214 > 0)
-    t217 = 2*t212
-    t218 = casadi.if_else(t216, casadi.if_else((t199 >= 0), t217, -t217)/casadi.if_else(t216, t214, 1), 0)
-    t219 = 1/casadi.sqrt(1 + t218**2)
-    t220 = t202*t219
-    t221 = t181*t219
-    t222 = t220 - t218*t221
-    t223 = t221 + t218*t220
-    t224 = t206*t219
-    t225 = t185*t219
-    t226 = t224 - t218*t225
-    t227 = t225 + t218*t224
-    t228 = t210*t219
-    t229 = t189*t219
-    t230 = t228 - t218*t229
-    t231 = t229 + t218*t228
-    t232 = t222**2 + t226**2 + t230**2
-    t233 = t223**2 + t227**2 + t231**2
-    t234 = t203*t223 + t207*t227 + t211*t231
-    t235 = -t233 + t215
-    t236 = casadi.sqrt(4*t234**2 + t235**2)
-    t237 = t236 + casadi.fabs(t235)
-    t238 = (t237 > 0)
-    t239 = 2*t234
-    t240 = casadi.if_else(t238, casadi.if_else((t235 >= 0), t239, -t239)/casadi.if_else(t238, t237, 1), 0)
-    t241 = 1/casadi.sqrt(1 + t240**2)
-    t242 = t234*t240
-    t243 = -t242 + t233
-    t244 = t215 + t242
-    t245 = -t232 + t244
-    t246 = t223*t241
-    t247 = t203*t241
-    t248 = t246 - t240*t247
-    t249 = t247 + t240*t246
-    t250 = t227*t241
-    t251 = t207*t241
-    t252 = t250 - t240*t251
-    t253 = t251 + t240*t250
-    t254 = t231*t241
-    t255 = t211*t241
-    t256 = t254 - t240*t255
-    t257 = t255 + t240*t254
-    t258 = t222*t249 + t226*t253 + t230*t257
-    t259 = casadi.sqrt(4*t258**2 + t245**2)
-    t260 = t259 + casadi.fabs(t245)
-    t261 = (t260 > 0)
-    t262 = 2*t258
-    t263 = casadi.if_else(t261, casadi.if_else((t245 >= 0), t262, -t262)/casadi.if_else(t261, t260, 1), 0)
-    t264 = 1/casadi.sqrt(1 + t263**2)
-    t265 = t232 - t258*t263
-    t266 = -t265 + t243
-    t267 = t222*t264
-    t268 = t249*t264
-    t269 = t267 - t263*t268
-    t270 = t268 + t263*t267
-    t271 = t226*t264
-    t272 = t253*t264
-    t273 = t271 - t263*t272
-    t274 = t272 + t263*t271
-    t275 = t230*t264
-    t276 = t257*t264
-    t277 = t275 - t263*t276
-    t278 = t276 + t263*t275
-    t279 = t248*t269 + t252*t273 + t256*t277
-    t280 = casadi.sqrt(4*t279**2 + t266**2)
-    t281 = t280 + casadi.fabs(t266)
-    t282 = t270**2 + t274**2 + t278**2
-    t283 = (t281 > 0)
-    t284 = 2*t279
-    t285 = casadi.if_else(t283, casadi.if_else((t266 >= 0), t284, -t284)/casadi.if_else(t283, t281, 1), 0)
-    t286 = 1/casadi.sqrt(1 + t285**2)
-    t287 = t269*t286
-    t288 = t248*t286
-    t289 = t287 - t285*t288
-    t290 = t288 + t285*t287
-    t291 = t273*t286
-    t292 = t252*t286
-    t293 = t291 - t285*t292
-    t294 = t292 + t285*t291
-    t295 = t277*t286
-    t296 = t256*t286
-    t297 = t295 - t285*t296
-    t298 = t296 + t285*t295
-    t299 = t289**2 + t293**2 + t297**2
-    t300 = t290**2 + t294**2 + t298**2
-    t301 = t270*t290 + t274*t294 + t278*t298
-    t302 = -t300 + t282
-    t303 = casadi.sqrt(4*t301**2 + t302**2)
-    t304 = t303 + casadi.fabs(t302)
-    t305 = (t304 > 0)
-    t306 = 2*t301
-    t307 = casadi.if_else(t305, casadi.if_else((t302 >= 0), t306, -t306)/casadi.if_else(t305, t304, 1), 0)
-    t308 = 1/casadi.sqrt(1 + t307**2)
-    t309 = t301*t307
-    t310 = -t309 + t300
-    t311 = t282 + t309
-    t312 = -t299 + t311
-    t313 = t290*t308
-    t314 = t270*t308
-    t315 = t313 - t307*t314
-    t316 = t314 + t307*t313
-    t317 = t294*t308
-    t318 = t274*t308
-    t319 = t317 - t307*t318
-    t320 = t318 + t307*t317
-    t321 = t298*t308
-    t322 = t278*t308
-    t323 = t321 - t307*t322
-    t324 = t322 + t307*t321
-    t325 = t289*t316 + t293*t320 + t297*t324
-    t326 = casadi.sqrt(4*t325**2 + t312**2)
-    t327 = t326 + casadi.fabs(t312)
-    t328 = (t327 > 0)
-    t329 = 2*t325
-    t330 = casadi.if_else(t328, casadi.if_else((t312 >= 0), t329, -t329)/casadi.if_else(t328, t327, 1), 0)
-    t331 = 1/casadi.sqrt(1 + t330**2)
-    t332 = t299 - t325*t330
-    t333 = -t332 + t310
-    t334 = t289*t331
-    t335 = t316*t331
-    t336 = t334 - t330*t335
-    t337 = t335 + t330*t334
-    t338 = t293*t331
-    t339 = t320*t331
-    t340 = t338 - t330*t339
-    t341 = t339 + t330*t338
-    t342 = t297*t331
-    t343 = t324*t331
-    t344 = t342 - t330*t343
-    t345 = t343 + t330*t342
-    t346 = t315*t336 + t319*t340 + t323*t344
-    t347 = casadi.sqrt(4*t346**2 + t333**2)
-    t348 = t347 + casadi.fabs(t333)
-    t349 = casadi.sqrt(t337**2 + t341**2 + t345**2)
-    t350 = (t348 > 0)
-    t351 = 2*t346
-    t352 = casadi.if_else(t350, casadi.if_else((t333 >= 0), t351, -t351)/casadi.if_else(t350, t348, 1), 0)
-    t353 = 1/casadi.sqrt(1 + t352**2)
-    t354 = t336*t353
-    t355 = t315*t353
-    t356 = t354 - t352*t355
-    t357 = t355 + t352*t354
-    t358 = t340*t353
-    t359 = t319*t353
-    t360 = t358 - t352*t359
-    t361 = t359 + t352*t358
-    t362 = t344*t353
-    t363 = t323*t353
-    t364 = t362 - t352*t363
-    t365 = t363 + t352*t362
-    t366 = casadi.sqrt(t356**2 + t360**2 + t364**2)
-    t367 = casadi.sqrt(t357**2 + t361**2 + t365**2)
-    t368 = casadi.if_else((t367 > t366), t367, t366)
-    t369 = casadi.if_else((t367 < t366), t367, t366)
-    t370 = casadi.if_else((t349 > t368), t349, t368)
-    t371 = casadi.if_else((t349 < t369), t349, t369)
-    t372 = casadi.if_else((t371 <= 1e-12*t370), 0, t371)
-    t373 = casadi.if_else((t370 > 0), t370, 1)
+    t34 = _jacobi3_rows(5, (-t7, t13, t20, 0, -t24, t30, 0, 0, -t33,))
+    t35 = casadi.sqrt(t34[0]**2 + t34[1]**2 + t34[2]**2)
+    t36 = casadi.sqrt(t34[3]**2 + t34[4]**2 + t34[5]**2)
+    t37 = casadi.sqrt(t34[6]**2 + t34[7]**2 + t34[8]**2)
+    t38 = casadi.if_else((t36 > t35), t36, t35)
+    t39 = casadi.if_else((t36 < t35), t36, t35)
+    t40 = casadi.if_else((t37 > t38), t37, t38)
+    t41 = casadi.if_else((t37 < t39), t37, t39)
+    t42 = casadi.if_else((t41 <= 1e-12*t40), 0, t41)
+    t43 = casadi.if_else((t40 > 0), t40, 1)
     kappa = casadi.SX(1, 1)
-    kappa[0, 0] = t373/t372
+    kappa[0, 0] = t43/t42
     return [kappa]
 
 
@@ -1727,7 +1692,7 @@ def _ik_numeric_step(target, q, damping):
     t21 = damping + t7
     t22 = t5*t19
     t23 = t6*t19
-    t24 = -t20*(t21*t22 + t5 + t23*t8)
+    t24 = -t20*(t5 + t21*t22 + t23*t8)
     t25 = t5 + t24
     t26 = t21 + t22*t24
     t27 = t8 + t23*t24

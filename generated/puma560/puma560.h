@@ -105,11 +105,11 @@ puma560_real puma560_jacobian_det(const puma560_real q[PUMA560_DOF]);
 void puma560_manipulability_gradient(const puma560_real q[PUMA560_DOF], puma560_real dw[PUMA560_DOF]);
 
 /* Axes (U's columns, a rotation) and semi-axes s (descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same axes and semi-axes 1/s.
- * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2329 operations. */
+ * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2452 operations. */
 void puma560_velocity_ellipsoid(const puma560_real q[PUMA560_DOF], puma560_real U_v[9], puma560_real s_v[3], puma560_real U_w[9], puma560_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 8067 operations. */
+ * Result: returned as a scalar. 8225 operations. */
 puma560_real puma560_condition_number(const puma560_real q[PUMA560_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

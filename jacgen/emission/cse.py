@@ -10,7 +10,7 @@ import sympy
 from sympy.simplify.cse_main import Unevaluated, match_common_args
 
 from jacgen.model.graph import Graph
-from jacgen.model.node import ADD, CALL, MUL, NUMBER, POW, SELECT, Node, negative_coefficient
+from jacgen.model.node import ADD, CALL, MUL, NUMBER, PART, POW, REPEAT, SELECT, Node, negative_coefficient
 
 
 def eliminate_common(graph: Graph, exprs: list[Node], symbols, negations: dict) -> tuple[list, list[Node]]:
@@ -89,7 +89,7 @@ def eliminate_common(graph: Graph, exprs: list[Node], symbols, negations: dict) 
             new = form
         else:
             new = _rebuilt(graph, form, args)
-        if node in repeated:
+        if node in repeated or isinstance(node, Node) and node.kind == REPEAT:  # a statement in C
             symbol = next(symbols)
             named[node] = graph.symbol(symbol)
             replacements.append((symbol, new))
@@ -192,8 +192,8 @@ def _negation(graph: Graph, node: Node) -> Node | None:
 
 def _rebuilt(graph: Graph, form: Node, args: list[Node]) -> Node:
     """form with new arguments: a call or select of temporaries as it is (one of numbers was
-    folded before); anything else as its kind evaluates (`Graph.rebuilt`), so that a sum whose
+    folded before), and a REPEAT or PART, as it is; anything else as its kind evaluates (`Graph.rebuilt`), so that a sum whose
     terms became the same temporary, x - x, is 0."""
-    if form.kind in (CALL, SELECT):
+    if form.kind in (CALL, SELECT, REPEAT, PART):
         return graph.node(form.kind, tuple(args), form.value)
     return graph.rebuilt(form, tuple(args))

@@ -124,7 +124,8 @@ def functions(generator, js: sympy.Matrix, task_jacobian: sympy.Matrix) -> list[
                                        "layers; 0 where Js is singular (velocity_ik's rule)", vector("dw", gradient)))
     if generator.generates("velocity_ellipsoid"):
         blocks = elementwise(name, g.values(generator.jacobian))
-        (U_v, s_v), (U_w, s_w) = singular_values.left_singular_3([blocks[:3].tolist(), blocks[3:].tolist()], g, name)
+        (U_v, s_v), (U_w, s_w) = singular_values.left_singular_3([blocks[:3].tolist(), blocks[3:].tolist()], g, name,
+                                                                     generator.lowering.repeated)
         made.append(generator.function("velocity_ellipsoid", "axes (U's columns, a rotation) and semi-axes s "
                                        "(descending) of the tool's velocity ellipsoids for |q_dot| = 1, linear (v) and "
                                        "angular (w): the SVD of jacobian's blocks; the force ellipsoids have the same "
@@ -142,7 +143,8 @@ def condition_number_function(generator, js: sympy.Matrix) -> Function | None:
     largest over their smallest; None where Js is singular at every configuration."""
     g, name, m, n = generator.graph, generator.name_node, js.rows, generator.robot.dof
     scaled = scaled_js(generator, js)
-    values = singular_values.singular_values((scaled.T if m <= n else scaled).tolist(), g, name)
+    values = singular_values.singular_values((scaled.T if m <= n else scaled).tolist(), g, name,
+                                             generator.lowering.repeated)
     largest, smallest = values[0], values[0]
     for value in values[1:]:
         largest = name(g.select(g.relation(">", value, largest), value, largest))

@@ -4,13 +4,15 @@ The algorithms (`kinematics`, `subproblems`, `ik`, `differential`) name every in
 value with `Lowering.name`, so that no expression they build grows with the chain; a
 function's outputs are then lowered to a `Body` on the value graph (`graph.py`): the named
 values and trig symbols they read, common-subexpression elimination (`cse.py`), temporaries
-numbered in a fixed order (the output does not depend on hashing). Every printer turns a Body
-into its language; `operation_count.py` counts it.
+numbered in a fixed order (the output does not depend on hashing). A body that runs a fixed
+number of times is a kernel (`repeated`), lowered once and run by REPEAT nodes. Every printer
+turns a Body into its language; `operation_count.py` counts it.
 """
 
 import heapq
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
+from typing import Callable
 
 import sympy
 
@@ -18,7 +20,9 @@ from jacgen.emission.cse import eliminate_common
 from jacgen.emission.operation_count import operation_count
 from jacgen.inputs import names
 from jacgen.model.graph import Graph
-from jacgen.model.node import ADD, MUL, SYMBOL, TOLERANCE_VALUES, Node, evaluate, negative_coefficient
+from jacgen.model.tolerance_symbols import TOLERANCE_SYMBOLS
+from jacgen.model.node import (ADD, MUL, PART, REPEAT, SYMBOL, TOLERANCE_VALUES, Kernel, Node, evaluate,
+                               negative_coefficient)
 
 
 @dataclass(frozen=True)
@@ -51,6 +55,7 @@ class Lowering:
         self._values: dict[sympy.Symbol, Node] = {}  # each defined symbol's value
         self._negations: dict[Node, Node | None] = {}  # eliminate_common's, shared by every lowering
         self._lowered: dict[tuple, Body] = {}
+        self._kernels: dict[str, Kernel] = {}
 
     def define(self, symbol: sympy.Symbol, value: sympy.Expr):
         """A symbol of the generated code (a joint's cos) and its value, taken onto the graph
@@ -102,6 +107,32 @@ class Lowering:
         self._named_symbols.add(symbol)
         return graph.symbol(symbol)
 
+    def repeated(self, name: str, summary: str, count: int, step: Callable[[list[Node]], list[Node]],
+                 state: list[Node]) -> list[Node]:
+        """The state after `count` runs of `step` (a function of the state's nodes, naming its
+        values with `name_node`, to the next state's) from `state`: one REPEAT of the kernel
+        `name`, built on its first use, and read by PART nodes. A body run once, or on a
+        constant state, is built in place (folded, for constants)."""
+        graph = self.graph
+        state = [graph.value(value) for value in state]
+        if count <= 1 or all(value.constant for value in state):
+            for _ in range(count):
+                state = [graph.value(value) for value in step(state)]
+            return state
+        kernel = self._kernels.get(name)
+        if kernel is None:
+            symbols = tuple(sympy.Symbol(f"{names.INTERNAL_PREFIX}w{k}", real=True) for k in range(len(state)))
+            body = self.lower(step([graph.symbol(symbol) for symbol in symbols]))
+            outer = body.read - set(symbols) - TOLERANCE_SYMBOLS
+            if outer:
+                raise ValueError(f"kernel {name}'s step reads {sorted(map(str, outer))} besides its state")
+            body = replace(body, names=body.names | {symbol: f"w{k}" for k, symbol in enumerate(symbols)})
+            kernel = self._kernels[name] = Kernel(name, summary, symbols, body)
+        if len(kernel.state) != len(state):
+            raise ValueError(f"kernel {name} has a state of {len(kernel.state)}, given {len(state)}")
+        run = graph.node(REPEAT, tuple(state), (kernel, count))
+        return [graph.node(PART, (run,), k) for k in range(len(state))]
+
     def lower(self, outputs: list[sympy.Basic], bindings: dict | None = None) -> Body:
         """`_lower`, once per outputs and bindings (jacobian_det's determinant is lowered to
         compare its two forms, then again as a function)."""
@@ -152,6 +183,22 @@ class Lowering:
         read = set().union(*(e.free_symbols for _, e in definitions), *(e.free_symbols for e in reduced))
         return Body(frozenset(read - {symbol for symbol, _ in definitions}), tuple(definitions), tuple(reduced),
                     {symbol: f"t{k}" for k, symbol in enumerate(temporaries)})
+
+
+def kernels_of(bodies) -> list[Kernel]:
+    """The kernels the bodies run, each once, in the order first run, a kernel after those its
+    own step runs (so that each is defined before use)."""
+    found = {}
+
+    def visit(body: Body):
+        for _, value in body.definitions:
+            if value.kind == REPEAT and value.value[0] not in found:
+                visit(value.value[0].body)
+                found[value.value[0]] = None
+
+    for body in bodies:
+        visit(body)
+    return list(found)
 
 
 def _key(graph: Graph, node: Node):

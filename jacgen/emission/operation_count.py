@@ -8,7 +8,7 @@ from fractions import Fraction
 
 import sympy
 
-from jacgen.model.node import (ADD, AND, CALL, FINITE, MUL, NOT, NUMBER, OR, POW, RELATION, SELECT, TRUTH, Node,
+from jacgen.model.node import (ADD, AND, CALL, FINITE, MUL, NOT, NUMBER, OR, POW, RELATION, REPEAT, SELECT, TRUTH, Node,
                                negative_coefficient)
 
 
@@ -33,6 +33,9 @@ def operation_count(nodes) -> int:
                                 + sum(negated_count(t) if n else count(t) for t, n in zip(terms, negatives)))
             elif node.kind == POW and node.args[1].value == -1:
                 counts[node] = 1 + count(node.args[0])
+            elif node.kind == REPEAT:  # its state, then its kernel's step, so many times
+                kernel, runs = node.value
+                counts[node] = sum(map(count, node.args)) + runs * kernel.body.operation_count
             else:
                 counts[node] = fallthrough(node)
         return counts[node]

@@ -1,7 +1,8 @@
 """Expression printers: one walk over a lowered Body's nodes, with the rules of each language.
 
 A Body is nodes of the value graph (`graph.py`): sums, products, powers, the math functions,
-selects, comparisons, and/or/not, `isfinite`. `Printer` walks them once each (the text of a
+selects, comparisons, and/or/not, `isfinite`, and the runs of a kernel (a repeated body, which
+the backends define once per file as a function that loops) and the entries of their state. `Printer` walks them once each (the text of a
 node is kept for every later reader of it) and prints the arguments of sums and products in
 the order the graph keeps them, never by hash: the text is deterministic and nothing is
 re-sorted or rebuilt while printing. Each language is a subclass that says how a function,
@@ -66,6 +67,11 @@ class Printer:
         kind = node.kind
         if kind == kinds.SYMBOL and node.value not in TOLERANCE_SYMBOLS:
             return self._names.get(node.value, node.value.name), ATOM
+        if kind == kinds.REPEAT:
+            kernel, count = node.value
+            return self.repeat(kernel.name, count, [self._state(arg) for arg in node.args]), ATOM
+        if kind == kinds.PART and not node.constant:
+            return self.part(self._print(node.args[0])[0], node.value), ATOM
         if kind == kinds.NUMBER and isinstance(node.value, int) and abs(node.value) <= EXACT_INTEGER:
             return str(node.value), SUM if node.value < 0 else ATOM
         if node.boolean:
@@ -149,6 +155,10 @@ class Printer:
             return self.relation(self.doprint(node.args[0]), node.value, self.doprint(node.args[1]))
         raise ValueError(f"unsupported in {type(self).__name__}: {node.kind}")
 
+    def _state(self, node: Node) -> str:
+        """An entry of a kernel's starting state."""
+        return self.doprint(node)
+
     def number(self, value) -> str:
         """The literal of a template's constant (REACHED squared, 10)."""
         return self.literal(float(value))
@@ -178,6 +188,13 @@ class Printer:
 
     def finite(self, text: str) -> str:
         raise NotImplementedError
+
+    def repeat(self, kernel: str, count: int, state: list[str]) -> str:
+        """The final state of `count` runs of `kernel` from `state`."""
+        return f"_{kernel}({count}, ({', '.join(state)},))"
+
+    def part(self, state: str, index: int) -> str:
+        return f"{state}[{index}]"
 
 
 # The functions the expressions use, by sympy's name, and their name in C99's math.h (numpy

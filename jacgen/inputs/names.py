@@ -91,12 +91,13 @@ GENERATED_PREFIXES = {
     "mu": "the entries of a task target mu0..", "mu_dot": "task rates mu_dot0..",
     "qz": "null-space joint rates qz1..", "gain": "resolved_rate's gains gain0..",
     "c": "cos of a joint or a sum of joints c1.., c23..", "s": "sin of the same s1.., s23..",
-    "t": "printed temporaries t0..",
+    "t": "printed temporaries t0..", "w": "the state of a kernel (a repeated body) w0..",
 }
 INTERNAL_PREFIX = "_"  # the generator's own temporaries (`_n3`), never printed under that name
+KERNEL_PREFIX = "jacgen_"  # the C's kernels and their state types (`jacgen_jacobi6_rows`)
 _GENERATED_PATTERN = re.compile(
     "^(?:(?:" + "|".join(sorted(GENERATED_PREFIXES, key=len, reverse=True)) + r")[0-9]+(?:_[0-9]+)*"
-    + "|" + INTERNAL_PREFIX + r".*|M_\w+|FP_\w+)$")  # and <math.h>'s M_PI, FP_NAN...
+    + "|" + INTERNAL_PREFIX + r".*|" + KERNEL_PREFIX + r"\w+|M_\w+|FP_\w+)$")  # and <math.h>'s M_PI, FP_NAN...
 
 
 def indexed(prefix: str, *indices: int, separator: str = "_") -> str:
@@ -126,8 +127,8 @@ ROBOT_NAME_RULE = ("a robot name may not be a C or Python keyword, a C standard 
                    "Python module name, since it names the generated files and modules")
 PARAMETER_NAME_RULE = ("parameter names may not be C, C++ or Python keywords, Python builtins, "
                        "<math.h> names, names the generated code uses (q, p, fk, t0, c1, s1, q1, "
-                       "T00, mu0, see jacgen/inputs/names.py), start with '_' or with the robot's "
-                       "name and '_'")
+                       "T00, mu0, see jacgen/inputs/names.py), start with '_', 'jacgen_' or with "
+                       "the robot's name and '_'")
 
 
 def robot_name_problem(name: str) -> str | None:

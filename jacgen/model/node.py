@@ -6,6 +6,7 @@ constants and the analysis and the tests read a node's number.
 
 import math
 import operator
+from dataclasses import dataclass
 from fractions import Fraction
 
 from jacgen.model.tolerance_symbols import TOLERANCE_SYMBOLS, TOLERANCES
@@ -18,6 +19,9 @@ from jacgen.model.tolerance_symbols import TOLERANCE_SYMBOLS, TOLERANCES
 NUMBER, SYMBOL, TRUTH = "number", "symbol", "truth"
 ADD, MUL, POW, CALL, SELECT = "add", "mul", "pow", "call", "select"
 RELATION, AND, OR, NOT, FINITE = "relation", "and", "or", "not", "finite"
+# A repeated body (`Kernel`): a REPEAT's value is (kernel, count), its args the state it starts
+# from; a PART's value is an index into the final state of its one arg, a REPEAT.
+REPEAT, PART = "repeat", "part"
 FOLDED_DIGITS = 30
 BOOLEAN_KINDS = frozenset((TRUTH, RELATION, AND, OR, NOT, FINITE))
 
@@ -115,6 +119,19 @@ class Node:
         return f"{self.kind}({self.value!r}, {len(self.args)} args)" if self.args else f"{self.kind}({self.value!r})"
 
 
+@dataclass(frozen=True, eq=False)
+class Kernel:
+    """A body that runs a fixed number of times: one step, straight-line code (`body`, a
+    lowered Body) from the state (`state`, symbols its body reads) to the next state (its
+    outputs). A REPEAT node runs it from a starting state; every backend prints it once per
+    file, as a loop (`Lowering.repeated` builds it)."""
+
+    name: str
+    summary: str  # what one step does, for the reader of the generated code
+    state: tuple  # sympy Symbols
+    body: object  # lowering.Body
+
+
 def is_zero(node: Node) -> bool:
     """The exact number 0 (a structural zero of a matrix)."""
     return node.kind == NUMBER and node.value == 0 and not isinstance(node.value, Folded)
@@ -151,6 +168,16 @@ def evaluate(node: Node, values: dict, functions: dict = MATH, _done: dict | Non
         result = values[node.value]
     elif kind == TRUTH:
         result = node.value
+    elif kind == REPEAT:
+        kernel, count = node.value
+        result = [evaluate(arg, values, functions, done) for arg in args]
+        for _ in range(count):
+            step, step_done = dict(values) | dict(zip(kernel.state, result)), {}
+            for symbol, value in kernel.body.definitions:
+                step[symbol] = evaluate(value, step, functions, step_done)
+            result = [evaluate(output, step, functions, step_done) for output in kernel.body.outputs]
+    elif kind == PART:
+        result = evaluate(args[0], values, functions, done)[node.value]
     elif kind == SELECT:  # the value chosen only: a side not taken may divide by 0
         chosen = next((value for condition, value in zip(args[:-1:2], args[1:-1:2])
                        if evaluate(condition, values, functions, done)), args[-1])

@@ -1,5 +1,6 @@
-"""Singular values and vectors on the value graph, as straight-line code: a Householder QR
-(`differential.triangulate`), then one-sided Jacobi rotations on the triangular factor.
+"""Singular values and vectors on the value graph: a Householder QR
+(`differential.triangulate`), then one-sided Jacobi rotations on the triangular factor, a
+sweep of them a kernel (`Lowering.repeated`) that the generated code runs in a loop.
 
 Both steps are backward stable on the matrix itself, so every singular value is accurate to a
 few roundings of its largest one, also where the smallest is 1e-8 or 0: the eigenvalues of
@@ -46,15 +47,18 @@ def rounds(k: int) -> list[list[tuple[int, int]]]:
     return result
 
 
-def jacobi(matrices: list, g: Graph, name: Callable, vectors: bool) -> list[tuple[list[Node], list | None]]:
+def jacobi(matrices: list, g: Graph, name: Callable, repeat: Callable, vectors: bool
+           ) -> list[tuple[list[Node], list | None]]:
     """For each k x k R of `matrices`: the column norms of R V, with V the product of one-sided
     Jacobi rotations that make R's columns orthogonal: the singular values of R (unsorted), and
     V (k x k, as rows) when `vectors`: R's right singular vectors, as its columns. Without
     vectors, the rotations turn R's rows (the columns of R^T, whose singular values are the
     same): that converges faster.
 
-    The matrices are rotated in lockstep, a round of `rounds` at a time, each step for every
-    rotation of the round before the next: the generated code is in the order the values are
+    A sweep is one kernel (`repeat`: `Lowering.repeated`), run SWEEPS times on the state of
+    every matrix's turned columns (and V's): the generated code loops over the sweeps, written
+    once. The matrices are rotated in lockstep, a round of `rounds` at a time, each step for
+    every rotation of the round before the next: the step is in the order the values are
     built, so that the processor finds the independent rotations side by side, rather than
     one rotation's chain of square roots and divisions after another's.
 
@@ -64,14 +68,17 @@ def jacobi(matrices: list, g: Graph, name: Callable, vectors: bool) -> list[tupl
     1.02e-8 and 1.01e-8 beside 0.98, updated only: by 15 % a sweep, still 4e-12 off after 8).
     Within a sweep, the updates of small columns are from small values."""
     zero, one = g.number(0), g.number(1)
-    k = len(matrices[0])
+    k, count = len(matrices[0]), len(matrices)
     turned = [[[R[r][c] for r in range(k)] for c in range(k)] if vectors else [list(row) for row in R]
               for R in matrices]
-    V = [[[one if r == c else zero for r in range(k)] for c in range(k)] for _ in matrices] if vectors else None
-    for _ in range(SWEEPS["columns" if vectors else "rows"][k]):
+    V = [[[one if r == c else zero for r in range(k)] for c in range(k)] for _ in matrices] if vectors else []
+
+    def sweep(state: list[Node]) -> list[Node]:
+        blocks = [[state[(b * k + c) * k:(b * k + c + 1) * k] for c in range(k)] for b in range(len(state) // k**2)]
+        turned, V = blocks[:count], blocks[count:]
         squares = [[named(name, sum(e**2 for e in column)) for column in W] for W in turned]
         for pairs in rounds(k):
-            work = [(m, i, j) for m in range(len(matrices)) for i, j in pairs]
+            work = [(m, i, j) for m in range(count) for i, j in pairs]
             products = [named(name, sum(x * y for x, y in zip(turned[m][i], turned[m][j]))) for m, i, j in work]
             angles = [rotation(squares[m][i], squares[m][j], c, g, name)
                       for (m, i, j), c in zip(work, products)]
@@ -83,6 +90,15 @@ def jacobi(matrices: list, g: Graph, name: Callable, vectors: bool) -> list[tupl
                     x, y = columns[i], columns[j]
                     columns[i] = [named(name, cos * p - sin * r) for p, r in zip(x, y)]
                     columns[j] = [named(name, sin * p + cos * r) for p, r in zip(x, y)]
+        return [e for W in turned + V for column in W for e in column]
+
+    kind = "columns" if vectors else "rows"
+    state = repeat(f"jacobi{k}_{kind}" + (f"_{count}" if count > 1 else ""),
+                   f"one-sided Jacobi sweep of {f'{count} {k} x {k} matrices' if count > 1 else f'a {k} x {k} matrix'}"
+                   f" (its {kind})" + (", with V" if vectors else ""),
+                   SWEEPS[kind][k], sweep, [e for W in turned + V for column in W for e in column])
+    blocks = [[state[(b * k + c) * k:(b * k + c + 1) * k] for c in range(k)] for b in range(len(state) // k**2)]
+    turned, V = blocks[:count], blocks[count:]
     norms = [[name(g.sqrt(sum(e**2 for e in column))) for column in W] for W in turned]
     return [(s, V and [[V[m][c][r] for c in range(k)] for r in range(k)]) for m, s in enumerate(norms)]
 
@@ -110,13 +126,13 @@ def rotation(a: Node, b: Node, c: Node, g: Graph, name: Callable) -> tuple[Node,
     return named(name, 1 / g.sqrt(1 + t**2)), t
 
 
-def singular_values(A: list, g: Graph, name: Callable) -> list[Node]:
+def singular_values(A: list, g: Graph, name: Callable, repeat: Callable) -> list[Node]:
     """The singular values of the p x k matrix A (rows of nodes, p >= k), unsorted."""
     R, _, _, _ = triangulate(A, g, name)
-    return jacobi([R], g, name, vectors=False)[0][0]
+    return jacobi([R], g, name, repeat, vectors=False)[0][0]
 
 
-def left_singular_3(matrices: list, g: Graph, name: Callable) -> list[tuple[list, list]]:
+def left_singular_3(matrices: list, g: Graph, name: Callable, repeat: Callable) -> list[tuple[list, list]]:
     """(U, s) of each 3 x n matrix (rows of nodes): the left singular vectors (U's columns, as
     rows of U) and the singular values, descending, 0 past n; U a rotation (det +1, the third
     column's sign chosen), so that it orients an ellipsoid. The matrices' Jacobi run in lockstep.
@@ -128,7 +144,7 @@ def left_singular_3(matrices: list, g: Graph, name: Callable) -> list[tuple[list
         rows = [[A[r][c] for r in range(3)] for c in range(len(A[0]))]
         rows += [[g.number(0)] * 3] * (3 - len(rows))
         triangles.append(triangulate(rows, g, name)[0])
-    return [_sorted_rotation(s, V, g, name) for s, V in jacobi(triangles, g, name, vectors=True)]
+    return [_sorted_rotation(s, V, g, name) for s, V in jacobi(triangles, g, name, repeat, vectors=True)]
 
 
 def _sorted_rotation(s: list, V: list, g: Graph, name: Callable) -> tuple[list, list]:

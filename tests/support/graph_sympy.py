@@ -49,10 +49,36 @@ def to_sympy(node: kinds.Node, _done: dict | None = None) -> sympy.Basic:
         result = RELATIONS[value](*args, evaluate=False)
     elif kind == kinds.FINITE:
         result = IsFinite(*args)
+    elif kind == kinds.REPEAT:  # the state it starts from (its kernel's runs: `kernel_count_ops`)
+        result = sympy.Tuple(*args)
+    elif kind == kinds.PART:  # an entry of a state: no operation
+        result = sympy.Symbol(f"part{value}_of_{args[0]}")
     else:
         result = {kinds.AND: sympy.And, kinds.OR: sympy.Or, kinds.NOT: sympy.Not}[kind](*args, evaluate=False)
     done[node] = result
     return result
+
+
+def kernel_count_ops(expressions) -> int:
+    """sympy's count_ops of the kernels' runs in `expressions` (each REPEAT: its count times its
+    step's lowered definitions and outputs), which `to_sympy` leaves out."""
+    total, seen = 0, set()
+
+    def walk(node):
+        nonlocal total
+        if node in seen:
+            return
+        seen.add(node)
+        if node.kind == kinds.REPEAT:
+            kernel, count = node.value
+            step = [value for _, value in kernel.body.definitions] + list(kernel.body.outputs)
+            total += count * (sympy.count_ops([to_sympy(e) for e in step]) + kernel_count_ops(step))
+        for arg in node.args:
+            walk(arg)
+
+    for expression in expressions:
+        walk(expression)
+    return total
 
 
 def printed(printer, expr: sympy.Basic) -> str:

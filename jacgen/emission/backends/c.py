@@ -5,11 +5,14 @@ eigensolver's runtime is C of its own, `templates/runtime/`)."""
 import numpy
 
 from jacgen.emission.backends.common import (Backend, characteristic_length, common_context, ik_context, ik_numeric_context,
-                                             joint_lines, parameters_read, sentence, task_lines, velocity_ik_context)
+                                             joint_lines, kernels_context, parameters_read, sentence, task_lines,
+                                             velocity_ik_context)
 from jacgen.emission.catalogue import Argument, Call, Function, Output
 from jacgen.emission.generator import Generator
 from jacgen.emission.printers import AND, ATOM, MATH_FUNCTIONS, PRODUCT, RELATION, Printer
+from jacgen.inputs import names
 from jacgen.inputs.robot import Robot
+from jacgen.model.node import REPEAT
 from jacgen.model.tolerance_symbols import TOLERANCES
 
 _FLOAT_MAX = float(numpy.finfo(numpy.float32).max)
@@ -68,6 +71,23 @@ class CPrinter(Printer):
 
     def finite(self, text):
         return f"isfinite({text})"
+
+    def repeat(self, kernel, count, state):
+        """A kernel's state is a struct, so that its run is an expression: (`kernel_type`)."""
+        return f"{kernel_function(kernel)}({count}, ({kernel_type(kernel)}){{{{{', '.join(state)}}}}})"
+
+    def part(self, state, index):
+        return f"{state}.w[{index}]"
+
+
+def kernel_function(kernel: str) -> str:
+    """The C function of a kernel (static: each file defines those it runs)."""
+    return f"{names.KERNEL_PREFIX}{kernel}"
+
+
+def kernel_type(kernel: str) -> str:
+    """The C struct of a kernel's state."""
+    return f"{kernel_function(kernel)}_state"
 
 
 # The contract's C array extent of each argument and output (`function.output`, or the function
@@ -142,8 +162,8 @@ def _c_function(function: Function, robot: Robot, printer: CPrinter, macros: dic
         "calls": [_c_call(call, functions[call.function], robot, macros) for call in function.calls],
         "inputs": [(types.get(argument.name, real), str(symbol), f"{argument.name}[{row * argument.symbols.cols + col}]")
                    for symbol, argument, row, col in inputs] + [(real, name, f"p->{name}") for name in parameters],
-        "definitions": [("int" if e.boolean else real, body.name(symbol), text)
-                        for (symbol, e), text in zip(body.definitions, definitions)],
+        "definitions": [("int" if e.boolean else kernel_type(e.value[0].name) if e.kind == REPEAT else real,
+                         body.name(symbol), text) for (symbol, e), text in zip(body.definitions, definitions)],
         "outputs": [(f"{output.name}[{k}]", text) for output in arrays for k, text in enumerate(values[output])],
         "result": values[returned][0] if returned else None,
     }
@@ -174,6 +194,8 @@ def c_context(robot: Robot, generator: Generator, printer: CPrinter, real: str) 
         "joint_lines": joint_lines(robot),
         "task_lines": task_lines(robot),
         "functions": [_c_function(f, robot, printer, macros, by_name) for f in functions],
+        "kernels": [kernel | {"function": kernel_function(kernel["name"]), "type": kernel_type(kernel["name"])}
+                    for kernel in kernels_context(generator, functions, printer)],
         "ik": ik_context(robot, generator, real, printer.number, f"{robot.name.upper()}_MAX_IK_SOLUTIONS"),
         "ik_numeric": generator.generates("ik_numeric") and ik_numeric_context(robot, printer.number),
         "velocity_ik": generator.generates("velocity_ik") and velocity_ik_context(robot, real),

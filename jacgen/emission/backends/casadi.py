@@ -2,7 +2,7 @@
 and its printer."""
 
 from jacgen.emission.backends.common import (Backend, characteristic_length, common_context, ik_numeric_context,
-                                             parameters_read, sentence)
+                                             kernels_context, parameters_read, sentence)
 from jacgen.emission.backends.python import python_number
 from jacgen.emission.catalogue import Function
 from jacgen.emission.generator import Generator
@@ -71,6 +71,7 @@ def casadi_context(robot: Robot, generator: Generator, printer: CasadiPrinter, r
     context = common_context(robot)
     functions = generator.without_loops()
     context["functions"] = [_casadi_function(f, robot, printer) for f in functions]
+    context["kernels"] = kernels_context(generator, functions, printer)
     context["arguments"] = sorted({(a.name, a.symbols.rows, a.symbols.cols) for f in functions for a in f.arguments},
                                   key=lambda a: ("q", "q_dot", "mu_dot", "z", "target_rate", "gain", "damping", "target", "T", "mu", "q_seed",
                                                  "q_free", "weights").index(a[0]))

@@ -7,8 +7,10 @@ from typing import Callable
 
 from jacgen.emission.catalogue import DECLARED, Output
 from jacgen.emission.generator import Generator
+from jacgen.emission.lowering import kernels_of
 from jacgen.inputs.robot import Robot
 from jacgen.model import js_rank
+from jacgen.model.node import SELECT
 from jacgen.model.tolerance_symbols import RANK, TOLERANCES
 from jacgen.reports import ik_documentation
 from jacgen.reports.description import characteristic_length_note
@@ -39,6 +41,30 @@ def common_context(robot: Robot) -> dict:
         "joints": [{"name": j.name, "kind": j.kind} for j in robot.joints],
         "parameters": [{"name": p.name, "value": repr(p.value)} for p in robot.symbolic_parameters],
     }
+
+
+def kernels_context(generator: Generator, functions: list, printer) -> list[dict]:
+    """The kernels the functions run (`Lowering.repeated`), each once, as its file defines them:
+    its step's definitions (flagged boolean) and the next state, over the state's entries
+    w0, w1, ... (`names`; `state`: those the step reads, with their index)."""
+    made = []
+    for kernel in kernels_of(function.body for function in functions):
+        body = kernel.body
+        definitions, outputs = printer.body(body)
+        values = [value for _, value in body.definitions] + list(body.outputs)
+        made.append({
+            "name": kernel.name,
+            "summary": sentence(kernel.summary),
+            "size": len(kernel.state),
+            "names": [body.name(symbol) for symbol in kernel.state],
+            "operations": body.operation_count,
+            "state": [(body.name(symbol), k) for k, symbol in enumerate(kernel.state) if symbol in body.read],
+            "definitions": [(value.boolean, body.name(symbol), text)
+                            for (symbol, value), text in zip(body.definitions, definitions)],
+            "outputs": outputs,
+            "selects": any(value.contains(SELECT) for value in values),
+        })
+    return made
 
 
 def dimensions(output: Output) -> str:

@@ -5,7 +5,7 @@ import numpy
 import sympy
 
 from jacgen.emission.backends.common import (Backend, characteristic_length, common_context, dimensions, ik_context,
-                                             ik_numeric_context, velocity_ik_context)
+                                             ik_numeric_context, kernels_context, velocity_ik_context)
 from jacgen.emission.catalogue import Function
 from jacgen.emission.generator import Generator
 from jacgen.model.node import ADD, CALL, MUL, NUMBER, SELECT, SYMBOL
@@ -41,6 +41,15 @@ class PythonPrinter(Printer):
 
     def finite(self, text):
         return f"xp.isfinite({text})"
+
+    def _state(self, node):
+        """A constant entry of a kernel's state as an array of the batch's shape, as the state's
+        every entry is (the kernel broadcasts the others), so that each part read is one."""
+        text = self.doprint(node)
+        return f"xp.full(batch, {text}, dtype=dtype, device=device)" if node.constant else text
+
+    def repeat(self, kernel, count, state):
+        return f"_{kernel}(xp, {count}, ({', '.join(state)},))"
 
 
 def python_number(value) -> str:
@@ -137,6 +146,7 @@ def python_context(robot: Robot, generator: Generator, printer: PythonPrinter, r
     """The numpy module's templates: every function and the IK documentation (double only)."""
     context = common_context(robot)
     context["functions"] = [_python_function(f, printer, context["parameters"]) for f in generator.functions()]
+    context["kernels"] = kernels_context(generator, generator.functions(), printer)
     context["ik"] = ik_context(robot, generator, "double", python_number, "MAX_IK_SOLUTIONS")
     context["characteristic_length"] = characteristic_length(robot, generator, python_number)
     context["ik_numeric"] = generator.generates("ik_numeric") and (
