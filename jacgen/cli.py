@@ -37,13 +37,20 @@ def _functions(ctx, param, value: str | None) -> tuple[str, ...] | None:
     names = tuple(dict.fromkeys(part.strip() for part in value.split(",") if part.strip()))
     if not names:
         raise click.BadParameter("expected a comma-separated list of function names")
+    return names
+
+
+def _check_functions(names: tuple[str, ...] | None) -> None:
+    """--functions names the catalogue has, checked where something is rendered (the catalogue
+    imports sympy: a cached `generate --check` needs neither)."""
+    if names is None:
+        return
     from jacgen.emission.catalogue import with_callees
 
     try:
         with_callees(names)
     except ValueError as error:
-        raise click.BadParameter(str(error)) from None
-    return names
+        raise click.BadParameter(str(error), param_hint="'--functions'") from None
 
 
 def _error_line(message: str) -> None:
@@ -139,6 +146,7 @@ def generate(robot_files, output, languages, real, check, functions, budget_seco
         from jacgen.emission.render import render_robots
         from jacgen.inputs.robot_file import load_robot
 
+        _check_functions(functions)
         budget.set_seconds(budget_seconds)
         robots = [load_robot(path) for path in paths if path not in cached]  # validate all before writing any
     _check_unique_names([(robot.name, robot.source) for robot in robots] +
@@ -182,6 +190,7 @@ def build(robots, backend, functions):
     ahead of time: for container images and CI. Exit 2 when a module cannot be built."""
     from jacgen.loading import arm
 
+    _check_functions(functions)
     for robot in robots:
         module = arm(robot, backend=backend, functions=functions)
         click.echo(f"{robot}: {module.__name__} ({module.__file__})")

@@ -134,6 +134,21 @@ def test_functions_option_emits_only_the_named_functions_and_their_callees(tmp_p
     assert not hasattr(module, "jacobian") and not hasattr(module, "ik_numeric") and hasattr(module, "ik_nearest")
 
 
+def test_the_report_analyses_singularities_for_the_functions_that_read_them(tmp_path):
+    """`--functions fk` skips the singularity analysis, and its report says so; with
+    singularity_factors the report lists the UR5's three conditions (Spong: the wrist's
+    s5 = 0, the elbow's s3 = 0, and the shoulder's)."""
+    for functions, folder in (("fk", "fk"), ("fk,singularity_factors", "factors")):
+        result = run("generate", ROOT / "robots" / "ur5.yaml", "-o", tmp_path / folder, "--functions", functions,
+                     "--no-cache")
+        assert result.exit_code == 0, result.output
+    section = lambda folder: (tmp_path / folder / "ur5" / "ur5.md").read_text().split("## Singularities")[1] \
+        .split("## Dexterity")[0]  # noqa: E731
+    assert section("fk").strip().startswith("Not analysed: no function generated reads the analysis")
+    assert [line[:3] for line in section("factors").splitlines() if line[:2] in ("1.", "2.", "3.", "4.")] \
+        == ["1. ", "2. ", "3. "]
+
+
 def test_functions_option_rejects_what_cannot_be_made(tmp_path):
     unknown = run("generate", ROOT / "robots" / "ur5.yaml", "-o", tmp_path, "--functions", "fk,fkk")
     assert unknown.exit_code == 2

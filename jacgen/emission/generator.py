@@ -30,6 +30,10 @@ from jacgen.solvers.model import Model
 from jacgen.solvers.subproblems import Subproblems, wrapped
 
 
+# The functions the singularity analysis shapes (`Model.singularities`).
+SINGULARITY_FUNCTIONS = ("singularity_factors", "manipulability", "jacobian_det")
+
+
 class Generator:
     """Builds the emitted functions of one robot, sharing the symbolic chain between them:
     every function, or those of `selection` (names of FUNCTION_NAMES, callees included), whose
@@ -276,13 +280,18 @@ class Generator:
         """|value|, of a named value."""
         return self.graph.call("Abs", self.name_node(value))
 
+    @property
+    def analyses_singularities(self) -> bool:
+        """Whether a function generated reads the singularity analysis (the report describes it then)."""
+        return any(map(self.generates, SINGULARITY_FUNCTIONS))
+
     def singularity_functions(self, js: sympy.Matrix) -> list[Function]:
         """singularity_factors, manipulability and (square Js) jacobian_det, from Js.
 
         The exact factors come first; where they are not the whole condition, the numeric
         rank determinant follows them. jacobian_det is the product of the exact factors
         when they are complete and cheaper to compute than the expansion of det(Js)."""
-        if not any(map(self.generates, ("singularity_factors", "manipulability", "jacobian_det"))):
+        if not self.analyses_singularities:
             return []
         singular, (m, n) = self.singularities, js.shape
         atoms = {}
