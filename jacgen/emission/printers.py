@@ -2,7 +2,8 @@
 
 A Body is nodes of the value graph (`graph.py`): sums, products, powers, the math functions,
 selects, comparisons, and/or/not, `isfinite`, and the runs of a kernel (a repeated body, which
-the backends define once per file as a function that loops) and the entries of their state. `Printer` walks them once each (the text of a
+the backends define once per file as a function that loops) and the entries of their state.
+`Printer` walks them once each (the text of a
 node is kept for every later reader of it) and prints the arguments of sums and products in
 the order the graph keeps them, never by hash: the text is deterministic and nothing is
 re-sorted or rebuilt while printing. Each language is a subclass that says how a function,
