@@ -192,8 +192,8 @@ def _negation(graph: Graph, node: Node) -> Node | None:
 
 def _rebuilt(graph: Graph, form: Node, args: list[Node]) -> Node:
     """form with new arguments: a call or select of temporaries as it is (one of numbers was
-    folded before), and a REPEAT or PART, as it is; anything else as its kind evaluates (`Graph.rebuilt`), so that a sum whose
-    terms became the same temporary, x - x, is 0."""
+    folded before), a kernel's run or an entry of its state too; anything else as its kind
+    evaluates (`Graph.rebuilt`), so that a sum whose terms became the same temporary, x - x, is 0."""
     if form.kind in (CALL, SELECT, REPEAT, PART):
         return graph.node(form.kind, tuple(args), form.value)
     return graph.rebuilt(form, tuple(args))

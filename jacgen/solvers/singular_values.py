@@ -68,17 +68,17 @@ def jacobi(matrices: list, g: Graph, name: Callable, repeat: Callable, vectors: 
     1.02e-8 and 1.01e-8 beside 0.98, updated only: by 15 % a sweep, still 4e-12 off after 8).
     Within a sweep, the updates of small columns are from small values."""
     zero, one = g.number(0), g.number(1)
-    k, count = len(matrices[0]), len(matrices)
+    k, many = len(matrices[0]), len(matrices)
     turned = [[[R[r][c] for r in range(k)] for c in range(k)] if vectors else [list(row) for row in R]
               for R in matrices]
     V = [[[one if r == c else zero for r in range(k)] for c in range(k)] for _ in matrices] if vectors else []
 
     def sweep(state: list[Node]) -> list[Node]:
-        blocks = [[state[(b * k + c) * k:(b * k + c + 1) * k] for c in range(k)] for b in range(len(state) // k**2)]
-        turned, V = blocks[:count], blocks[count:]
+        blocks = _blocks(state, k)
+        turned, V = blocks[:many], blocks[many:]
         squares = [[named(name, sum(e**2 for e in column)) for column in W] for W in turned]
         for pairs in rounds(k):
-            work = [(m, i, j) for m in range(count) for i, j in pairs]
+            work = [(m, i, j) for m in range(many) for i, j in pairs]
             products = [named(name, sum(x * y for x, y in zip(turned[m][i], turned[m][j]))) for m, i, j in work]
             angles = [rotation(squares[m][i], squares[m][j], c, g, name)
                       for (m, i, j), c in zip(work, products)]
@@ -90,17 +90,27 @@ def jacobi(matrices: list, g: Graph, name: Callable, repeat: Callable, vectors: 
                     x, y = columns[i], columns[j]
                     columns[i] = [named(name, cos * p - sin * r) for p, r in zip(x, y)]
                     columns[j] = [named(name, sin * p + cos * r) for p, r in zip(x, y)]
-        return [e for W in turned + V for column in W for e in column]
+        return _flat(turned + V)
 
     kind = "columns" if vectors else "rows"
-    state = repeat(f"jacobi{k}_{kind}" + (f"_{count}" if count > 1 else ""),
-                   f"one-sided Jacobi sweep of {f'{count} {k} x {k} matrices' if count > 1 else f'a {k} x {k} matrix'}"
+    state = repeat(f"jacobi{k}_{kind}" + (f"_{many}" if many > 1 else ""),
+                   f"one-sided Jacobi sweep of {f'{many} {k} x {k} matrices' if many > 1 else f'a {k} x {k} matrix'}"
                    f" (its {kind})" + (", with V" if vectors else ""),
-                   SWEEPS[kind][k], sweep, [e for W in turned + V for column in W for e in column])
-    blocks = [[state[(b * k + c) * k:(b * k + c + 1) * k] for c in range(k)] for b in range(len(state) // k**2)]
-    turned, V = blocks[:count], blocks[count:]
+                   SWEEPS[kind][k], sweep, _flat(turned + V))
+    blocks = _blocks(state, k)
+    turned, V = blocks[:many], blocks[many:]
     norms = [[name(g.sqrt(sum(e**2 for e in column))) for column in W] for W in turned]
     return [(s, V and [[V[m][c][r] for c in range(k)] for r in range(k)]) for m, s in enumerate(norms)]
+
+
+def _flat(blocks: list) -> list[Node]:
+    """k x k blocks (lists of columns, or of rows) as one state: block by block, column by column."""
+    return [e for block in blocks for column in block for e in column]
+
+
+def _blocks(state: list[Node], k: int) -> list:
+    """`_flat`'s state as its k x k blocks again."""
+    return [[state[(b * k + c) * k:(b * k + c + 1) * k] for c in range(k)] for b in range(len(state) // k**2)]
 
 
 def rotation(a: Node, b: Node, c: Node, g: Graph, name: Callable) -> tuple[Node, Node]:
