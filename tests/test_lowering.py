@@ -2,6 +2,9 @@
 (the reference every report and bench quotes), its common-subexpression elimination against
 `cse`, each on the sympy expression of the same structure (`support.graph_sympy`)."""
 
+import math
+import re
+
 import pytest
 import sympy
 from sympy.core.parameters import distribute
@@ -169,18 +172,41 @@ def test_a_kernel_runs_as_its_step_written_out():
 
 def turned_unit_vector(count: int) -> tuple:
     """(cos, sin) of count times the angle of (3, 4): the rotation's first column after count runs."""
-    import math
-
     angle = count * math.atan2(0.8, 0.6)
     return math.cos(angle), math.sin(angle)
 
 
+def test_a_called_kernel_is_one_body_for_every_caller():
+    """`called`: one kernel for the same step on two sets of values, each run's value (and its
+    Body's) the step's on those values, with fewer outputs than inputs."""
+    lowering = Lowering()
+    g = lowering.graph
+
+    def step(values):  # the length and the product of a 2-vector
+        a, b = values
+        return [lowering.name_node(g.sqrt(a * a + b * b)), lowering.name_node(a * b)]
+
+    X, Y = g.symbol(x), g.symbol(y)
+    first = lowering.called("measure", "a measure", step, [X, Y])
+    second = lowering.called("measure", "a measure", step, [X + Y, X - Y])
+    body = lowering.lower(first[:1] + second)
+    runs = [e for _, e in body.definitions if e.kind == "repeat"]
+    assert len(runs) == 2 and runs[0].value[0] is runs[1].value[0] and len(runs[0].value[0].body.outputs) == 2
+    values = {x: 0.3, y: -1.7}
+    assert [evaluate(e, values) for e in (*first, *second)] == pytest.approx(
+        [math.hypot(0.3, -1.7), 0.3 * -1.7, math.hypot(-1.4, 2.0), -1.4 * 2.0], rel=1e-14)
+    with pytest.raises(ValueError, match="maps 2 values to 2, given 3"):
+        lowering.called("measure", "a measure", step, [X, Y, X])
+
+
 def test_each_kernel_is_defined_once_and_loops():
-    """ur5.c defines each Jacobi sweep once, as a loop, and its functions call it: the
-    sweeps are not written out."""
+    """ur5.c defines each Jacobi sweep, the Gram solve and ik_nearest's step over the branches
+    once, as a loop on a state it changes in place, and its functions call them: they are not
+    written out."""
     text = (ROOT / "generated" / "ur5" / "ur5.c").read_text()
-    for kernel in ("jacgen_jacobi6_rows", "jacgen_jacobi3_columns_2"):
-        assert text.count(f"static {kernel}_state {kernel}(int count, {kernel}_state state)") == 1
-        assert text.count(f"= {kernel}(") == 1
-    assert text.count("for (int run = 0; run < count; run++)") == 2
-    assert len(text) < 300_000  # 458 KB with the sweeps written out
+    for kernel, calls in (("jacgen_jacobi6_rows", 1), ("jacgen_jacobi3_columns_2", 1), ("jacgen_symmetric_solve6", 4),
+                          ("jacgen_nearer_branch", 8)):
+        assert text.count(f"static void {kernel}(int count, {kernel}_state *state)") == 1
+        assert len(re.findall(rf"    {kernel}\((\d+), &t\d+\);", text)) == calls, kernel
+    assert text.count("for (int run = 0; run < count; run++)") == 4
+    assert len(text) < 250_000  # 458 KB with the sweeps written out, 286 KB with the solves

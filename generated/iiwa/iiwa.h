@@ -123,7 +123,7 @@ int iiwa_velocity_ik_nullspace(const iiwa_real q[IIWA_DOF], const iiwa_real mu_d
 int iiwa_resolved_rate(const iiwa_real q[IIWA_DOF], const iiwa_real target[16], const iiwa_real target_rate[IIWA_TASK_DIM], const iiwa_real gain[IIWA_TASK_DIM], const iiwa_real z[IIWA_DOF], iiwa_real damping, iiwa_real q_dot[IIWA_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1088 operations. */
+ * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1148 operations. */
 iiwa_real iiwa_ik_numeric_step(const iiwa_real target[16], const iiwa_real q[IIWA_DOF], iiwa_real damping, iiwa_real q_start[IIWA_DOF], iiwa_real q_next[IIWA_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
@@ -131,7 +131,7 @@ iiwa_real iiwa_ik_numeric_step(const iiwa_real target[16], const iiwa_real q[IIW
 void iiwa_ik_branches(const iiwa_real T[16], iiwa_real q_free, iiwa_real q[IIWA_MAX_IK_SOLUTIONS * IIWA_DOF], int valid[IIWA_MAX_IK_SOLUTIONS], int in_limits[IIWA_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 7; returned as a scalar. 1007 operations. */
+ * Result: q[i], i < 7; returned as a scalar. 1005 operations. */
 int iiwa_ik_nearest(const iiwa_real T[16], const iiwa_real q_seed[IIWA_DOF], iiwa_real q_free, const iiwa_real weights[IIWA_DOF], iiwa_real q[IIWA_DOF]);
 
 /* Statuses of iiwa_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

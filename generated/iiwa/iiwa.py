@@ -82,6 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -335,6 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi6_rows(xp, count, state):
     """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2 + w4**2 + w5**2
@@ -896,6 +898,257 @@ def _jacobi6_rows(xp, count, state):
             t489,
             t493,
             t497,
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _symmetric_solve6(xp, count, state):
+    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w1**2
+        t1 = w2**2
+        t2 = w3**2
+        t3 = w4**2
+        t4 = w5**2
+        t5 = w0**2
+        t6 = xp.sqrt(t5 + 2*t0 + 2*t1 + 2*w7**2 + 2*t2 + 2*w8**2 + 2*w12**2 + 2*t3 + 2*w9**2 + 2*w13**2 + 2*w16**2 + 2*t4 + 2*w10**2 + 2*w14**2 + 2*w17**2 + 2*w19**2 + w6**2 + w11**2 + w15**2 + w18**2 + w20**2)
+        t7 = xp.sqrt(t0 + t1 + t2 + t3 + t4 + t5)
+        t8 = t7*xp.where(xp.greater_equal(w0, 0), xp.asarray(1, dtype=dtype), -1)
+        t9 = xp.greater(t7, 0)
+        t10 = xp.where(t9, 1/(w0 + t8), 0)
+        t11 = xp.where(t9, 1 + xp.abs(w0)/t7, 0)
+        t12 = w1*t10
+        t13 = w2*t10
+        t14 = w3*t10
+        t15 = w4*t10
+        t16 = w5*t10
+        t17 = t11*(w1 + t12*w6 + t13*w7 + t14*w8 + t15*w9 + t16*w10)
+        t18 = -t17 + w1
+        t19 = w6 - t12*t17
+        t20 = w7 - t13*t17
+        t21 = w8 - t14*t17
+        t22 = w9 - t15*t17
+        t23 = w10 - t16*t17
+        t24 = t11*(w2 + t12*w7 + t13*w11 + t14*w12 + t15*w13 + t16*w14)
+        t25 = -t24 + w2
+        t26 = w7 - t12*t24
+        t27 = w11 - t13*t24
+        t28 = w12 - t14*t24
+        t29 = w13 - t15*t24
+        t30 = w14 - t16*t24
+        t31 = t11*(w3 + t12*w8 + t13*w12 + t14*w15 + t15*w16 + t16*w17)
+        t32 = -t31 + w3
+        t33 = w8 - t12*t31
+        t34 = w12 - t13*t31
+        t35 = w15 - t14*t31
+        t36 = w16 - t15*t31
+        t37 = w17 - t16*t31
+        t38 = t11*(w4 + t12*w9 + t13*w13 + t14*w16 + t15*w18 + t16*w19)
+        t39 = -t38 + w4
+        t40 = w9 - t12*t38
+        t41 = w13 - t13*t38
+        t42 = w16 - t14*t38
+        t43 = w18 - t15*t38
+        t44 = w19 - t16*t38
+        t45 = t11*(w5 + t12*w10 + t13*w14 + t14*w17 + t15*w19 + t16*w20)
+        t46 = -t45 + w5
+        t47 = w10 - t12*t45
+        t48 = w14 - t13*t45
+        t49 = w17 - t14*t45
+        t50 = w19 - t15*t45
+        t51 = w20 - t16*t45
+        t52 = t11*(w21 + t12*w22 + t13*w23 + t14*w24 + t15*w25 + t16*w26)
+        t53 = -t52 + w21
+        t54 = w22 - t12*t52
+        t55 = w23 - t13*t52
+        t56 = w24 - t14*t52
+        t57 = w25 - t15*t52
+        t58 = w26 - t16*t52
+        t59 = xp.sqrt(t19**2 + t20**2 + t21**2 + t22**2 + t23**2)
+        t60 = t59*xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)
+        t61 = xp.greater(t59, 0)
+        t62 = xp.where(t61, 1/(t19 + t60), 0)
+        t63 = xp.where(t61, 1 + xp.abs(t19)/t59, 0)
+        t64 = t20*t62
+        t65 = t21*t62
+        t66 = t22*t62
+        t67 = t23*t62
+        t68 = t63*(t26 + t64*t27 + t65*t28 + t66*t29 + t67*t30)
+        t69 = -t68 + t26
+        t70 = t27 - t64*t68
+        t71 = t28 - t65*t68
+        t72 = t29 - t66*t68
+        t73 = t30 - t67*t68
+        t74 = t63*(t33 + t64*t34 + t65*t35 + t66*t36 + t67*t37)
+        t75 = -t74 + t33
+        t76 = t34 - t64*t74
+        t77 = t35 - t65*t74
+        t78 = t36 - t66*t74
+        t79 = t37 - t67*t74
+        t80 = t63*(t40 + t64*t41 + t65*t42 + t66*t43 + t67*t44)
+        t81 = -t80 + t40
+        t82 = t41 - t64*t80
+        t83 = t42 - t65*t80
+        t84 = t43 - t66*t80
+        t85 = t44 - t67*t80
+        t86 = t63*(t47 + t64*t48 + t65*t49 + t66*t50 + t67*t51)
+        t87 = -t86 + t47
+        t88 = t48 - t64*t86
+        t89 = t49 - t65*t86
+        t90 = t50 - t66*t86
+        t91 = t51 - t67*t86
+        t92 = t63*(t54 + t64*t55 + t65*t56 + t66*t57 + t67*t58)
+        t93 = -t92 + t54
+        t94 = t55 - t64*t92
+        t95 = t56 - t65*t92
+        t96 = t57 - t66*t92
+        t97 = t58 - t67*t92
+        t98 = xp.sqrt(t70**2 + t71**2 + t72**2 + t73**2)
+        t99 = t98*xp.where(xp.greater_equal(t70, 0), xp.asarray(1, dtype=dtype), -1)
+        t100 = xp.greater(t98, 0)
+        t101 = xp.where(t100, 1/(t70 + t99), 0)
+        t102 = xp.where(t100, 1 + xp.abs(t70)/t98, 0)
+        t103 = t71*t101
+        t104 = t72*t101
+        t105 = t73*t101
+        t106 = t102*(t76 + t103*t77 + t104*t78 + t105*t79)
+        t107 = -t106 + t76
+        t108 = t77 - t103*t106
+        t109 = t78 - t104*t106
+        t110 = t79 - t105*t106
+        t111 = t102*(t82 + t103*t83 + t104*t84 + t105*t85)
+        t112 = -t111 + t82
+        t113 = t83 - t103*t111
+        t114 = t84 - t104*t111
+        t115 = t85 - t105*t111
+        t116 = t102*(t88 + t103*t89 + t104*t90 + t105*t91)
+        t117 = -t116 + t88
+        t118 = t89 - t103*t116
+        t119 = t90 - t104*t116
+        t120 = t91 - t105*t116
+        t121 = t102*(t94 + t103*t95 + t104*t96 + t105*t97)
+        t122 = -t121 + t94
+        t123 = t95 - t103*t121
+        t124 = t96 - t104*t121
+        t125 = t97 - t105*t121
+        t126 = xp.sqrt(t108**2 + t109**2 + t110**2)
+        t127 = t126*xp.where(xp.greater_equal(t108, 0), xp.asarray(1, dtype=dtype), -1)
+        t128 = xp.greater(t126, 0)
+        t129 = xp.where(t128, 1/(t108 + t127), 0)
+        t130 = xp.where(t128, 1 + xp.abs(t108)/t126, 0)
+        t131 = t109*t129
+        t132 = t110*t129
+        t133 = t130*(t113 + t131*t114 + t132*t115)
+        t134 = -t133 + t113
+        t135 = t114 - t131*t133
+        t136 = t115 - t132*t133
+        t137 = t130*(t118 + t131*t119 + t132*t120)
+        t138 = -t137 + t118
+        t139 = t119 - t131*t137
+        t140 = t120 - t132*t137
+        t141 = t130*(t123 + t131*t124 + t132*t125)
+        t142 = -t141 + t123
+        t143 = t124 - t131*t141
+        t144 = t125 - t132*t141
+        t145 = xp.sqrt(t135**2 + t136**2)
+        t146 = t145*xp.where(xp.greater_equal(t135, 0), xp.asarray(1, dtype=dtype), -1)
+        t147 = xp.greater(t145, 0)
+        t148 = xp.where(t147, 1/(t135 + t146), 0)
+        t149 = xp.where(t147, 1 + xp.abs(t135)/t145, 0)
+        t150 = t136*t148
+        t151 = t149*(t139 + t150*t140)
+        t152 = -t151 + t139
+        t153 = t140 - t150*t151
+        t154 = t149*(t143 + t150*t144)
+        t155 = -t154 + t143
+        t156 = t144 - t150*t154
+        t157 = xp.abs(t153)
+        t158 = t157*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
+        t159 = xp.where(xp.greater(t157, 0), xp.asarray(2, dtype=dtype), 0)
+        t160 = t156 - t156*t159
+        t161 = xp.where(xp.not_equal(t158, 0), -t160/t158, 0)
+        t162 = xp.where(xp.not_equal(t146, 0), -(t155 - t152*t161)/t146, 0)
+        t163 = xp.where(xp.not_equal(t127, 0), -(-(t134*t162 + t138*t161) + t142)/t127, 0)
+        t164 = xp.where(xp.not_equal(t99, 0), -(-(t107*t163 + t112*t162 + t117*t161) + t122)/t99, 0)
+        t165 = xp.where(xp.not_equal(t60, 0), -(-(t69*t164 + t75*t163 + t81*t162 + t87*t161) + t93)/t60, 0)
+        t166 = xp.where(xp.not_equal(t8, 0), -(-(t18*t165 + t25*t164 + t32*t163 + t39*t162 + t46*t161) + t53)/t8, 0)
+        t167 = 1e-12*t6
+        state = (
+            t166,
+            t165,
+            t164,
+            t163,
+            t162,
+            t161,
+            xp.where(xp.less_equal(t7, t167) | xp.less_equal(t59, t167) | xp.less_equal(t98, t167) | xp.less_equal(t126, t167) | xp.less_equal(t145, t167) | xp.less_equal(t157, t167), xp.asarray(1, dtype=dtype), 0),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _nearer_branch(xp, count, state):
+    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 119 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, = state
+        t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w8))
+        t1 = w1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w1 + w9))
+        t2 = w3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w3 + w11))
+        t3 = w4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w4 + w12))
+        t4 = w5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w5 + w13))
+        t5 = w6 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w6 + w14))
+        t6 = xp.where(xp.less(t0, w8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t7 = t6 + t0
+        t8 = -t6 + t0
+        t9 = xp.where(xp.greater_equal(t0, -2.9670597283903604) & xp.less_equal(t0, 2.9670597283903604), t0, xp.where(xp.greater_equal(t7, -2.9670597283903604) & xp.less_equal(t7, 2.9670597283903604), t7, xp.where(xp.greater_equal(t8, -2.9670597283903604) & xp.less_equal(t8, 2.9670597283903604), t8, w0)))
+        t10 = xp.where(xp.less(t1, w9), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t11 = t10 + t1
+        t12 = -t10 + t1
+        t13 = xp.where(xp.greater_equal(t1, -2.0943951023931953) & xp.less_equal(t1, 2.0943951023931953), t1, xp.where(xp.greater_equal(t11, -2.0943951023931953) & xp.less_equal(t11, 2.0943951023931953), t11, xp.where(xp.greater_equal(t12, -2.0943951023931953) & xp.less_equal(t12, 2.0943951023931953), t12, w1)))
+        t14 = xp.where(xp.less(t2, w11), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t15 = t14 + t2
+        t16 = -t14 + t2
+        t17 = xp.where(xp.greater_equal(t2, -2.0943951023931953) & xp.less_equal(t2, 2.0943951023931953), t2, xp.where(xp.greater_equal(t15, -2.0943951023931953) & xp.less_equal(t15, 2.0943951023931953), t15, xp.where(xp.greater_equal(t16, -2.0943951023931953) & xp.less_equal(t16, 2.0943951023931953), t16, w3)))
+        t18 = xp.where(xp.less(t3, w12), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t19 = t18 + t3
+        t20 = -t18 + t3
+        t21 = xp.where(xp.greater_equal(t3, -2.9670597283903604) & xp.less_equal(t3, 2.9670597283903604), t3, xp.where(xp.greater_equal(t19, -2.9670597283903604) & xp.less_equal(t19, 2.9670597283903604), t19, xp.where(xp.greater_equal(t20, -2.9670597283903604) & xp.less_equal(t20, 2.9670597283903604), t20, w4)))
+        t22 = xp.where(xp.less(t4, w13), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t23 = t22 + t4
+        t24 = -t22 + t4
+        t25 = xp.where(xp.greater_equal(t4, -2.0943951023931953) & xp.less_equal(t4, 2.0943951023931953), t4, xp.where(xp.greater_equal(t23, -2.0943951023931953) & xp.less_equal(t23, 2.0943951023931953), t23, xp.where(xp.greater_equal(t24, -2.0943951023931953) & xp.less_equal(t24, 2.0943951023931953), t24, w5)))
+        t26 = xp.where(xp.less(t5, w14), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t27 = t26 + t5
+        t28 = -t26 + t5
+        t29 = xp.where(xp.greater_equal(t5, -3.0543261909900767) & xp.less_equal(t5, 3.0543261909900767), t5, xp.where(xp.greater_equal(t27, -3.0543261909900767) & xp.less_equal(t27, 3.0543261909900767), t27, xp.where(xp.greater_equal(t28, -3.0543261909900767) & xp.less_equal(t28, 3.0543261909900767), t28, w6)))
+        t30 = w15*(-w8 + t9)**2 + w16*(-w9 + t13)**2 + w17*(-w10 + w2)**2 + w18*(-w11 + t17)**2 + w19*(-w12 + t21)**2 + w20*(-w13 + t25)**2 + w21*(-w14 + t29)**2
+        t31 = xp.greater(w7, 0)
+        t32 = xp.where(t31 & (xp.less(w30, 1) | xp.less(t30, w29)), xp.asarray(1, dtype=dtype), 0)
+        t33 = xp.where(t31, 1, w30)
+        t34 = xp.greater(t32, 0)
+        t35 = xp.where(t34, t9, w22)
+        t36 = xp.where(t34, t13, w23)
+        t37 = xp.where(t34, w2, w24)
+        t38 = xp.where(t34, t17, w25)
+        t39 = xp.where(t34, t21, w26)
+        t40 = xp.where(t34, t25, w27)
+        t41 = xp.where(t34, t29, w28)
+        t42 = xp.where(t34, t30, w29)
+        state = (
+            t35,
+            t36,
+            t37,
+            t38,
+            t39,
+            t40,
+            t41,
+            t42,
+            t33,
         )
     return state
 
@@ -4407,205 +4660,38 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t76 = -t58 - t6*t3 + t10*t16 - t12*t18 + t13*t19 + t58*t74
     t77 = t3**2 + t16**2 + t18**2 + t19**2 + t54 + t68*t74
     t78 = 1 + c2**2 + t22**2 + t25**2 + t26**2 + s3**2*t74
-    t79 = t59**2
-    t80 = t61**2
-    t81 = t64**2
-    t82 = t55**2
-    t83 = t67**2
-    t84 = damping**2
-    t85 = t84 + t57
-    t86 = t85**2
-    t87 = xp.sqrt(t79 + t80 + t81 + t82 + t83 + t86)
-    t88 = t87*xp.where(xp.greater_equal(t85, 0), xp.asarray(1, dtype=dtype), -1)
-    t89 = t84 + t69
-    t90 = t84 + t40
-    t91 = t84 + t75
-    t92 = t84 + t77
-    t93 = t84 + t78
-    t94 = xp.sqrt(2*t79 + 2*t80 + 2*t72**2 + 2*t81 + 2*t70**2 + 2*t73**2 + 2*t82 + 2*t65**2 + 2*t62**2 + 2*t76**2 + 2*t83 + 2*t53**2 + 2*t41**2 + 2*t27**2 + 2*t28**2 + t86 + t89**2 + t90**2 + t91**2 + t92**2 + t93**2)
-    t95 = xp.greater(t87, 0)
-    t96 = xp.where(t95, 1/(t85 + t88), 0)
-    t97 = xp.where(t95, 1 + xp.abs(t85)/t87, 0)
-    t98 = t59*t96
-    t99 = t61*t96
-    t100 = t64*t96
-    t101 = t55*t96
-    t102 = t67*t96
-    t103 = t97*(t59 - t100*t70 + t89*t98 - t99*t72 + t101*t65 + t102*t53)
-    t104 = -t103 + t59
-    t105 = t89 - t98*t103
-    t106 = t72 + t99*t103
-    t107 = t70 + t100*t103
-    t108 = t65 - t101*t103
-    t109 = t53 - t102*t103
-    t110 = t97*(t61 - t101*t62 - t98*t72 + t90*t99 + t100*t73 + t102*t41)
-    t111 = -t110 + t61
-    t112 = t72 + t98*t110
-    t113 = t90 - t99*t110
-    t114 = t73 - t100*t110
-    t115 = t62 + t101*t110
-    t116 = t41 - t102*t110
-    t117 = t97*(t64 + t91*t100 + t102*t27 - t98*t70 + t99*t73 + t101*t76)
-    t118 = -t117 + t64
-    t119 = t70 + t98*t117
-    t120 = t73 - t99*t117
-    t121 = t91 - t100*t117
-    t122 = t76 - t101*t117
-    t123 = t27 - t102*t117
-    t124 = t97*(t55 + t92*t101 + t98*t65 - t99*t62 + t100*t76 + t102*t28)
-    t125 = -t124 + t55
-    t126 = t65 - t98*t124
-    t127 = t62 + t99*t124
-    t128 = t76 - t100*t124
-    t129 = t92 - t101*t124
-    t130 = t28 - t102*t124
-    t131 = t97*(t67 + t93*t102 + t98*t53 + t99*t41 + t100*t27 + t101*t28)
-    t132 = -t131 + t67
-    t133 = t53 - t98*t131
-    t134 = t41 - t99*t131
-    t135 = t27 - t100*t131
-    t136 = t28 - t101*t131
-    t137 = t93 - t102*t131
-    t138 = xp.sqrt(t105**2 + t106**2 + t107**2 + t108**2 + t109**2)
-    t139 = t138*xp.where(xp.greater_equal(t105, 0), xp.asarray(1, dtype=dtype), -1)
-    t140 = t97*(mu_dot0 + t98*mu_dot1 + t99*mu_dot2 + t100*mu_dot3 + t101*mu_dot4 + t102*mu_dot5)
-    t141 = -t140 + mu_dot0
-    t142 = mu_dot1 - t98*t140
-    t143 = mu_dot2 - t99*t140
-    t144 = mu_dot3 - t100*t140
-    t145 = mu_dot4 - t101*t140
-    t146 = mu_dot5 - t102*t140
-    t147 = xp.greater(t138, 0)
-    t148 = xp.where(t147, 1/(t105 + t139), 0)
-    t149 = xp.where(t147, 1 + xp.abs(t105)/t138, 0)
-    t150 = t106*t148
-    t151 = t107*t148
-    t152 = t108*t148
-    t153 = t109*t148
-    t154 = -t149*(t112 + t150*t113 + t151*t114 + t152*t115 - t153*t116)
-    t155 = t112 + t154
-    t156 = t113 + t150*t154
-    t157 = t114 + t151*t154
-    t158 = t115 + t152*t154
-    t159 = t116 - t153*t154
-    t160 = -t149*(t119 + t150*t120 + t151*t121 - t152*t122 - t153*t123)
-    t161 = t119 + t160
-    t162 = t120 + t150*t160
-    t163 = t121 + t151*t160
-    t164 = t122 - t152*t160
-    t165 = t123 - t153*t160
-    t166 = t149*(t126 + t150*t127 - t151*t128 + t152*t129 + t153*t130)
-    t167 = -t166 + t126
-    t168 = -t127 + t150*t166
-    t169 = t128 + t151*t166
-    t170 = t129 - t152*t166
-    t171 = t130 - t153*t166
-    t172 = t149*(t133 - t150*t134 - t151*t135 + t152*t136 + t153*t137)
-    t173 = -t172 + t133
-    t174 = t134 + t150*t172
-    t175 = t135 + t151*t172
-    t176 = t136 - t152*t172
-    t177 = t137 - t153*t172
-    t178 = xp.sqrt(t156**2 + t157**2 + t158**2 + t159**2)
-    t179 = t178*xp.where(xp.greater_equal(t156, 0), xp.asarray(1, dtype=dtype), -1)
-    t180 = t149*(t142 - t150*t143 - t151*t144 + t152*t145 + t153*t146)
-    t181 = -t180 + t142
-    t182 = t143 + t150*t180
-    t183 = t144 + t151*t180
-    t184 = t145 - t152*t180
-    t185 = t146 - t153*t180
-    t186 = xp.greater(t178, 0)
-    t187 = xp.where(t186, 1/(t156 + t179), 0)
-    t188 = xp.where(t186, 1 + xp.abs(t156)/t178, 0)
-    t189 = t157*t187
-    t190 = t158*t187
-    t191 = t159*t187
-    t192 = t188*(t162 + t189*t163 - t190*t164 + t191*t165)
-    t193 = -t192 + t162
-    t194 = t163 - t189*t192
-    t195 = t164 + t190*t192
-    t196 = t165 - t191*t192
-    t197 = t188*(t168 + t189*t169 - t190*t170 + t191*t171)
-    t198 = -t197 + t168
-    t199 = t169 - t189*t197
-    t200 = t170 + t190*t197
-    t201 = t171 - t191*t197
-    t202 = t188*(t174 + t189*t175 - t190*t176 + t191*t177)
-    t203 = -t202 + t174
-    t204 = t175 - t189*t202
-    t205 = t176 + t190*t202
-    t206 = t177 - t191*t202
-    t207 = xp.sqrt(t194**2 + t195**2 + t196**2)
-    t208 = t207*xp.where(xp.greater_equal(t194, 0), xp.asarray(1, dtype=dtype), -1)
-    t209 = t188*(t182 + t189*t183 - t190*t184 + t191*t185)
-    t210 = -t209 + t182
-    t211 = t183 - t189*t209
-    t212 = t184 + t190*t209
-    t213 = t185 - t191*t209
-    t214 = xp.greater(t207, 0)
-    t215 = xp.where(t214, 1/(t194 + t208), 0)
-    t216 = xp.where(t214, 1 + xp.abs(t194)/t207, 0)
-    t217 = t195*t215
-    t218 = t196*t215
-    t219 = t216*(t199 + t217*t200 + t218*t201)
-    t220 = -t219 + t199
-    t221 = t200 - t217*t219
-    t222 = t201 - t218*t219
-    t223 = t216*(t204 + t217*t205 + t218*t206)
-    t224 = -t223 + t204
-    t225 = t205 - t217*t223
-    t226 = t206 - t218*t223
-    t227 = xp.sqrt(t221**2 + t222**2)
-    t228 = t227*xp.where(xp.greater_equal(t221, 0), xp.asarray(1, dtype=dtype), -1)
-    t229 = t216*(t211 + t217*t212 + t218*t213)
-    t230 = -t229 + t211
-    t231 = t212 - t217*t229
-    t232 = t213 - t218*t229
-    t233 = xp.greater(t227, 0)
-    t234 = xp.where(t233, 1/(t221 + t228), 0)
-    t235 = xp.where(t233, 1 + xp.abs(t221)/t227, 0)
-    t236 = t222*t234
-    t237 = t235*(t225 + t236*t226)
-    t238 = -t237 + t225
-    t239 = t226 - t236*t237
-    t240 = t235*(t231 + t236*t232)
-    t241 = -t240 + t231
-    t242 = t232 - t236*t240
-    t243 = xp.abs(t239)
-    t244 = t243*xp.where(xp.greater_equal(t239, 0), xp.asarray(1, dtype=dtype), -1)
-    t245 = xp.where(xp.greater(t243, 0), xp.asarray(2, dtype=dtype), 0)
-    t246 = t242 - t245*t242
-    t247 = xp.where(xp.not_equal(t244, 0), -t246/t244, 0)
-    t248 = xp.where(xp.not_equal(t228, 0), -(t241 - t238*t247)/t228, 0)
-    t249 = xp.where(xp.not_equal(t208, 0), -(-(t220*t248 + t224*t247) + t230)/t208, 0)
-    t250 = xp.where(xp.not_equal(t179, 0), -(-(t193*t249 + t198*t248 + t203*t247) + t210)/t179, 0)
-    t251 = xp.where(xp.not_equal(t139, 0), -(-(-t155*t250 - t161*t249 + t167*t248 + t173*t247) + t181)/t139, 0)
-    t252 = xp.where(xp.not_equal(t88, 0), -(-(t104*t251 + t111*t250 + t118*t249 + t125*t248 + t132*t247) + t141)/t88, 0)
-    t253 = t247 - t34*t252 + t31*t251
-    t254 = t45*t252 + t49*t251 + t36*t250 + c2*t247 + t8*t249 + t14*t248
-    t255 = t46*t252 - t50*t251 + t37*t250 + t6*t249 - t3*t248 - t23*t247
-    t256 = t47*t252 + t51*t251 + t38*t250 + t10*t249 + t16*t248 + t22*t247
-    t257 = t48*t252 + t52*t251 - t39*t250 - t12*t249 + t18*t248 + t25*t247
-    t258 = t13*t249 + t19*t248 + t26*t247
-    t259 = c1*t44
-    t260 = s1*t44
-    t261 = -t35*t250 - s1*t249 + c1*t248 + t259*t252 + t260*t251
-    t262 = 1 - t50 - t35 - t39 - s1 - t12 - t3 - t23 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t10 + t16 + t22 + q5 + t18 + t25 + q6 + t13 + t19 + t26 + q7 + t31 + t8 + t14 + t66 + t45 + t46 + t47 + t48 + t49 + t51 + t52 + t36 + t37 + t38 + t259 + t260 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t263 = xp.isfinite(t262)
-    t264 = xp.greater_equal(damping, 0)
-    t265 = 1e-12*t94
-    t266 = xp.less_equal(t87, t265) | xp.less_equal(t138, t265) | xp.less_equal(t178, t265) | xp.less_equal(t207, t265) | xp.less_equal(t227, t265) | xp.less_equal(t243, t265)
-    t267 = t263 & t264 & xp.logical_not(t266)
+    t79 = damping**2
+    t80 = _symmetric_solve6(xp, 1, (t79 + t57, t59, t61, t64, t55, t67, t79 + t69, -t72, -t70, t65, t53, t79 + t40, t73, -t62, t41, t79 + t75, t76, t27, t79 + t77, t28, t79 + t78, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t81 = t80[5]
+    t82 = t80[0]
+    t83 = t80[1]
+    t84 = t81 - t34*t82 + t31*t83
+    t85 = c1*t44
+    t86 = s1*t44
+    t87 = 1 - t50 - t35 - t39 - s1 - t12 - t3 - t23 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t10 + t16 + t22 + q5 + t18 + t25 + q6 + t13 + t19 + t26 + q7 + t31 + t8 + t14 + t66 + t85 + t45 + t46 + t47 + t48 + t49 + t51 + t52 + t36 + t37 + t38 + t86 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t88 = t80[2]
+    t89 = t80[3]
+    t90 = t80[4]
+    t91 = t82*t85 + t83*t86 - t35*t88 - s1*t89 + c1*t90
+    t92 = t36*t88 + t82*t45 + t83*t49 + t8*t89 + t14*t90 + c2*t81
+    t93 = t82*t46 - t83*t50 + t37*t88 + t6*t89 - t3*t90 - t23*t81
+    t94 = t10*t89 + t82*t47 + t83*t51 + t38*t88 + t16*t90 + t22*t81
+    t95 = -t12*t89 + t82*t48 + t83*t52 - t39*t88 + t18*t90 + t25*t81
+    t96 = t26*t81 + t13*t89 + t19*t90
+    t97 = xp.isfinite(t87)
+    t98 = xp.greater_equal(damping, 0)
+    t99 = t80[6]
+    t100 = t97 & t98 & xp.less_equal(t99, 0)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t267, t253, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t267, t261, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t267, t254, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t267, t255, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t267, t256, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t267, t257, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t267, t258, 0), batch),  # 6
+        xp.broadcast_to(xp.where(t100, t84, 0), batch),  # 0
+        xp.broadcast_to(xp.where(t100, t91, 0), batch),  # 1
+        xp.broadcast_to(xp.where(t100, t92, 0), batch),  # 2
+        xp.broadcast_to(xp.where(t100, t93, 0), batch),  # 3
+        xp.broadcast_to(xp.where(t100, t94, 0), batch),  # 4
+        xp.broadcast_to(xp.where(t100, t95, 0), batch),  # 5
+        xp.broadcast_to(xp.where(t100, t96, 0), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t263 & t264), 2, xp.where(t266, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t97 & t98), 2, xp.where(xp.greater(t99, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -4733,212 +4819,45 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     t84 = s1*qz2
     t85 = -(t32*qz1 + t51*qz3 - t52*qz4 + t53*qz5 + t54*qz6 + t46*t84) + mu_dot1
     t86 = -(-t84 + t6*qz4 + t10*qz5 - t12*qz6 + t13*qz7 + t8*qz3) + mu_dot3
-    t87 = t61**2
-    t88 = t63**2
-    t89 = t66**2
-    t90 = t57**2
-    t91 = t69**2
-    t92 = damping**2
-    t93 = t92 + t59
-    t94 = t93**2
-    t95 = xp.sqrt(t87 + t88 + t89 + t90 + t91 + t94)
-    t96 = t95*xp.where(xp.greater_equal(t93, 0), xp.asarray(1, dtype=dtype), -1)
-    t97 = t92 + t71
-    t98 = t92 + t41
-    t99 = t92 + t77
-    t100 = t92 + t79
-    t101 = t92 + t80
-    t102 = xp.sqrt(2*t87 + 2*t88 + 2*t74**2 + 2*t89 + 2*t72**2 + 2*t75**2 + 2*t90 + 2*t67**2 + 2*t64**2 + 2*t78**2 + 2*t91 + 2*t55**2 + 2*t42**2 + 2*t27**2 + 2*t28**2 + t94 + t97**2 + t98**2 + t99**2 + t100**2 + t101**2)
-    t103 = xp.greater(t95, 0)
-    t104 = xp.where(t103, 1/(t93 + t96), 0)
-    t105 = xp.where(t103, 1 + xp.abs(t93)/t95, 0)
-    t106 = t61*t104
-    t107 = t63*t104
-    t108 = t66*t104
-    t109 = t57*t104
-    t110 = t69*t104
-    t111 = t105*(t61 + t97*t106 - t107*t74 - t108*t72 + t109*t67 + t110*t55)
-    t112 = -t111 + t61
-    t113 = t97 - t106*t111
-    t114 = t74 + t107*t111
-    t115 = t72 + t108*t111
-    t116 = t67 - t109*t111
-    t117 = t55 - t110*t111
-    t118 = t105*(t63 - t106*t74 + t98*t107 + t108*t75 - t109*t64 + t110*t42)
-    t119 = -t118 + t63
-    t120 = t74 + t106*t118
-    t121 = t98 - t107*t118
-    t122 = t75 - t108*t118
-    t123 = t64 + t109*t118
-    t124 = t42 - t110*t118
-    t125 = t105*(t66 - t106*t72 + t107*t75 + t99*t108 + t109*t78 + t110*t27)
-    t126 = -t125 + t66
-    t127 = t72 + t106*t125
-    t128 = t75 - t107*t125
-    t129 = t99 - t108*t125
-    t130 = t78 - t109*t125
-    t131 = t27 - t110*t125
-    t132 = t105*(t57 + t106*t67 - t107*t64 + t108*t78 + t100*t109 + t110*t28)
-    t133 = -t132 + t57
-    t134 = t67 - t106*t132
-    t135 = t64 + t107*t132
-    t136 = t78 - t108*t132
-    t137 = t100 - t109*t132
-    t138 = t28 - t110*t132
-    t139 = t105*(t69 + t106*t55 + t107*t42 + t108*t27 + t109*t28 + t101*t110)
-    t140 = -t139 + t69
-    t141 = t55 - t106*t139
-    t142 = t42 - t107*t139
-    t143 = t27 - t108*t139
-    t144 = t28 - t109*t139
-    t145 = t101 - t110*t139
-    t146 = t105*(t82 + t106*t85 + t107*t43 + t108*t86 + t109*t83 + t110*t29)
-    t147 = -t146 + t82
-    t148 = t85 - t106*t146
-    t149 = t43 - t107*t146
-    t150 = t86 - t108*t146
-    t151 = t83 - t109*t146
-    t152 = t29 - t110*t146
-    t153 = xp.sqrt(t113**2 + t114**2 + t115**2 + t116**2 + t117**2)
-    t154 = t153*xp.where(xp.greater_equal(t113, 0), xp.asarray(1, dtype=dtype), -1)
-    t155 = xp.greater(t153, 0)
-    t156 = xp.where(t155, 1/(t113 + t154), 0)
-    t157 = xp.where(t155, 1 + xp.abs(t113)/t153, 0)
-    t158 = t114*t156
-    t159 = t115*t156
-    t160 = t116*t156
-    t161 = t117*t156
-    t162 = -t157*(t120 + t158*t121 + t159*t122 + t160*t123 - t161*t124)
-    t163 = t120 + t162
-    t164 = t121 + t158*t162
-    t165 = t122 + t159*t162
-    t166 = t123 + t160*t162
-    t167 = t124 - t161*t162
-    t168 = -t157*(t127 + t158*t128 + t159*t129 - t160*t130 - t161*t131)
-    t169 = t127 + t168
-    t170 = t128 + t158*t168
-    t171 = t129 + t159*t168
-    t172 = t130 - t160*t168
-    t173 = t131 - t161*t168
-    t174 = t157*(t134 + t158*t135 - t159*t136 + t160*t137 + t161*t138)
-    t175 = -t174 + t134
-    t176 = -t135 + t158*t174
-    t177 = t136 + t159*t174
-    t178 = t137 - t160*t174
-    t179 = t138 - t161*t174
-    t180 = t157*(t141 - t158*t142 - t159*t143 + t160*t144 + t161*t145)
-    t181 = -t180 + t141
-    t182 = t142 + t158*t180
-    t183 = t143 + t159*t180
-    t184 = t144 - t160*t180
-    t185 = t145 - t161*t180
-    t186 = t157*(t148 - t158*t149 - t159*t150 + t160*t151 + t161*t152)
-    t187 = -t186 + t148
-    t188 = t149 + t158*t186
-    t189 = t150 + t159*t186
-    t190 = t151 - t160*t186
-    t191 = t152 - t161*t186
-    t192 = xp.sqrt(t164**2 + t165**2 + t166**2 + t167**2)
-    t193 = t192*xp.where(xp.greater_equal(t164, 0), xp.asarray(1, dtype=dtype), -1)
-    t194 = xp.greater(t192, 0)
-    t195 = xp.where(t194, 1/(t164 + t193), 0)
-    t196 = xp.where(t194, 1 + xp.abs(t164)/t192, 0)
-    t197 = t165*t195
-    t198 = t166*t195
-    t199 = t167*t195
-    t200 = t196*(t170 + t197*t171 - t198*t172 + t199*t173)
-    t201 = -t200 + t170
-    t202 = t171 - t197*t200
-    t203 = t172 + t198*t200
-    t204 = t173 - t199*t200
-    t205 = t196*(t176 + t197*t177 - t198*t178 + t199*t179)
-    t206 = -t205 + t176
-    t207 = t177 - t197*t205
-    t208 = t178 + t198*t205
-    t209 = t179 - t199*t205
-    t210 = t196*(t182 + t197*t183 - t198*t184 + t199*t185)
-    t211 = -t210 + t182
-    t212 = t183 - t197*t210
-    t213 = t184 + t198*t210
-    t214 = t185 - t199*t210
-    t215 = t196*(t188 + t197*t189 - t198*t190 + t199*t191)
-    t216 = -t215 + t188
-    t217 = t189 - t197*t215
-    t218 = t190 + t198*t215
-    t219 = t191 - t199*t215
-    t220 = xp.sqrt(t202**2 + t203**2 + t204**2)
-    t221 = t220*xp.where(xp.greater_equal(t202, 0), xp.asarray(1, dtype=dtype), -1)
-    t222 = xp.greater(t220, 0)
-    t223 = xp.where(t222, 1/(t202 + t221), 0)
-    t224 = xp.where(t222, 1 + xp.abs(t202)/t220, 0)
-    t225 = t203*t223
-    t226 = t204*t223
-    t227 = t224*(t207 + t225*t208 + t226*t209)
-    t228 = -t227 + t207
-    t229 = t208 - t225*t227
-    t230 = t209 - t226*t227
-    t231 = t224*(t212 + t225*t213 + t226*t214)
-    t232 = -t231 + t212
-    t233 = t213 - t225*t231
-    t234 = t214 - t226*t231
-    t235 = t224*(t217 + t225*t218 + t226*t219)
-    t236 = -t235 + t217
-    t237 = t218 - t225*t235
-    t238 = t219 - t226*t235
-    t239 = xp.sqrt(t229**2 + t230**2)
-    t240 = t239*xp.where(xp.greater_equal(t229, 0), xp.asarray(1, dtype=dtype), -1)
-    t241 = xp.greater(t239, 0)
-    t242 = xp.where(t241, 1/(t229 + t240), 0)
-    t243 = xp.where(t241, 1 + xp.abs(t229)/t239, 0)
-    t244 = t230*t242
-    t245 = t243*(t233 + t244*t234)
-    t246 = -t245 + t233
-    t247 = t234 - t244*t245
-    t248 = t243*(t237 + t244*t238)
-    t249 = -t248 + t237
-    t250 = t238 - t244*t248
-    t251 = xp.abs(t247)
-    t252 = t251*xp.where(xp.greater_equal(t247, 0), xp.asarray(1, dtype=dtype), -1)
-    t253 = xp.where(xp.greater(t251, 0), xp.asarray(2, dtype=dtype), 0)
-    t254 = t250 - t250*t253
-    t255 = xp.where(xp.not_equal(t252, 0), -t254/t252, 0)
-    t256 = xp.where(xp.not_equal(t240, 0), -(t249 - t246*t255)/t240, 0)
-    t257 = xp.where(xp.not_equal(t221, 0), -(-(t228*t256 + t232*t255) + t236)/t221, 0)
-    t258 = xp.where(xp.not_equal(t193, 0), -(-(t201*t257 + t206*t256 + t211*t255) + t216)/t193, 0)
-    t259 = xp.where(xp.not_equal(t154, 0), -(-(-t163*t258 - t169*t257 + t175*t256 + t181*t255) + t187)/t154, 0)
-    t260 = xp.where(xp.not_equal(t96, 0), -(-(t112*t259 + t119*t258 + t126*t257 + t133*t256 + t140*t255) + t147)/t96, 0)
-    t261 = t255 - t35*t260 + t32*t259
-    t262 = t47*t260 + t51*t259 + t37*t258 + c2*t255 + t8*t257 + t14*t256
-    t263 = t48*t260 - t52*t259 + t38*t258 + t6*t257 - t3*t256 - t23*t255
-    t264 = t49*t260 + t53*t259 + t39*t258 + t10*t257 + t16*t256 + t22*t255
-    t265 = t50*t260 + t54*t259 - t40*t258 - t12*t257 + t18*t256 + t25*t255
-    t266 = t13*t257 + t19*t256 + t26*t255
-    t267 = qz1 + t261
-    t268 = qz3 + t262
-    t269 = qz4 + t263
-    t270 = qz5 + t264
-    t271 = qz6 + t265
-    t272 = qz7 + t266
-    t273 = c1*t46
-    t274 = s1*t46
-    t275 = -t36*t258 - s1*t257 + c1*t256 + t273*t260 + t274*t259
-    t276 = qz2 + t275
-    t277 = 1 - t52 - t36 - t40 - s1 - t12 - t3 - t23 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t10 + t16 + t22 + q5 + t18 + t25 + q6 + t13 + t19 + t26 + q7 + t32 + t8 + t14 + t68 + t47 + t48 + t49 + t50 + t51 + t53 + t54 + t37 + t38 + t39 + t273 + t274 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7
-    t278 = xp.isfinite(t277)
-    t279 = xp.greater_equal(damping, 0)
-    t280 = 1e-12*t102
-    t281 = xp.less_equal(t95, t280) | xp.less_equal(t153, t280) | xp.less_equal(t192, t280) | xp.less_equal(t220, t280) | xp.less_equal(t239, t280) | xp.less_equal(t251, t280)
-    t282 = t278 & t279 & xp.logical_not(t281)
+    t87 = damping**2
+    t88 = _symmetric_solve6(xp, 1, (t87 + t59, t61, t63, t66, t57, t69, t87 + t71, -t74, -t72, t67, t55, t87 + t41, t75, -t64, t42, t87 + t77, t78, t27, t87 + t79, t28, t87 + t80, t82, t85, t43, t86, t83, t29,))
+    t89 = t88[5]
+    t90 = t88[0]
+    t91 = t88[1]
+    t92 = t89 - t35*t90 + t32*t91
+    t93 = qz1 + t92
+    t94 = c1*t46
+    t95 = s1*t46
+    t96 = 1 - t52 - t36 - t40 - s1 - t12 - t3 - t23 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t10 + t16 + t22 + q5 + t18 + t25 + q6 + t13 + t19 + t26 + q7 + t32 + t8 + t14 + t68 + t47 + t48 + t49 + t50 + t51 + t53 + t54 + t37 + t38 + t39 + t94 + t95 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7
+    t97 = t88[2]
+    t98 = t88[3]
+    t99 = t88[4]
+    t100 = t90*t94 + t91*t95 - t36*t97 - s1*t98 + c1*t99
+    t101 = t51*t91 + c2*t89 + t37*t97 + t90*t47 + t8*t98 + t14*t99
+    t102 = t90*t48 - t52*t91 + t38*t97 + t6*t98 - t3*t99 - t23*t89
+    t103 = t39*t97 + t16*t99 + t90*t49 + t53*t91 + t10*t98 + t22*t89
+    t104 = t25*t89 + t90*t50 + t54*t91 - t40*t97 - t12*t98 + t18*t99
+    t105 = t26*t89 + t13*t98 + t19*t99
+    t106 = qz2 + t100
+    t107 = qz3 + t101
+    t108 = qz4 + t102
+    t109 = qz5 + t103
+    t110 = qz6 + t104
+    t111 = qz7 + t105
+    t112 = xp.isfinite(t96)
+    t113 = xp.greater_equal(damping, 0)
+    t114 = t88[6]
+    t115 = t112 & t113 & xp.less_equal(t114, 0)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t282, t267, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t282, t276, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t282, t268, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t282, t269, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t282, t270, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t282, t271, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t282, t272, 0), batch),  # 6
+        xp.broadcast_to(xp.where(t115, t93, 0), batch),  # 0
+        xp.broadcast_to(xp.where(t115, t106, 0), batch),  # 1
+        xp.broadcast_to(xp.where(t115, t107, 0), batch),  # 2
+        xp.broadcast_to(xp.where(t115, t108, 0), batch),  # 3
+        xp.broadcast_to(xp.where(t115, t109, 0), batch),  # 4
+        xp.broadcast_to(xp.where(t115, t110, 0), batch),  # 5
+        xp.broadcast_to(xp.where(t115, t111, 0), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t278 & t279), 2, xp.where(t281, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t112 & t113), 2, xp.where(xp.greater(t114, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -5108,240 +5027,73 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t106 = -t87 - t6*t3 + t10*t22 - t12*t24 + t14*t26 + t87*t104
     t107 = t3**2 + t22**2 + t24**2 + t26**2 + t83 + t98*t104
     t108 = 1 + c2**2 + t35**2 + t38**2 + t40**2 + s3**2*t104
-    t109 = t88**2
-    t110 = t90**2
-    t111 = t93**2
-    t112 = t84**2
-    t113 = t96**2
-    t114 = damping**2
-    t115 = t114 + t86
-    t116 = t115**2
-    t117 = xp.sqrt(t109 + t110 + t111 + t112 + t113 + t116)
-    t118 = t117*xp.where(xp.greater_equal(t115, 0), xp.asarray(1, dtype=dtype), -1)
-    t119 = t114 + t99
-    t120 = t114 + t66
-    t121 = t114 + t105
-    t122 = t114 + t107
-    t123 = t114 + t108
-    t124 = xp.sqrt(2*t109 + 2*t110 + 2*t102**2 + 2*t111 + 2*t100**2 + 2*t103**2 + 2*t112 + 2*t94**2 + 2*t91**2 + 2*t106**2 + 2*t113 + 2*t80**2 + 2*t67**2 + 2*t43**2 + 2*t44**2 + t116 + t119**2 + t120**2 + t121**2 + t122**2 + t123**2)
-    t125 = xp.greater(t117, 0)
-    t126 = xp.where(t125, 1/(t115 + t118), 0)
-    t127 = xp.where(t125, 1 + xp.abs(t115)/t117, 0)
-    t128 = t88*t126
-    t129 = t90*t126
-    t130 = t93*t126
-    t131 = t84*t126
-    t132 = t96*t126
-    t133 = t127*(t88 - t130*t100 + t119*t128 - t129*t102 + t131*t94 + t132*t80)
-    t134 = -t133 + t88
-    t135 = t119 - t128*t133
-    t136 = t102 + t129*t133
-    t137 = t100 + t130*t133
-    t138 = t94 - t131*t133
-    t139 = t80 - t132*t133
-    t140 = t127*(t90 - t131*t91 - t128*t102 + t120*t129 + t130*t103 + t132*t67)
-    t141 = -t140 + t90
-    t142 = t102 + t128*t140
-    t143 = t120 - t129*t140
-    t144 = t103 - t130*t140
-    t145 = t91 + t131*t140
-    t146 = t67 - t132*t140
-    t147 = t127*(t93 + t121*t130 + t132*t43 - t128*t100 + t129*t103 + t131*t106)
-    t148 = -t147 + t93
-    t149 = t100 + t128*t147
-    t150 = t103 - t129*t147
-    t151 = t121 - t130*t147
-    t152 = t106 - t131*t147
-    t153 = t43 - t132*t147
-    t154 = t127*(t84 + t122*t131 + t128*t94 - t129*t91 + t130*t106 + t132*t44)
-    t155 = -t154 + t84
-    t156 = t94 - t128*t154
-    t157 = t91 + t129*t154
-    t158 = t106 - t130*t154
-    t159 = t122 - t131*t154
-    t160 = t44 - t132*t154
-    t161 = t127*(t96 + t123*t132 + t128*t80 + t129*t67 + t130*t43 + t131*t44)
-    t162 = -t161 + t96
-    t163 = t80 - t128*t161
-    t164 = t67 - t129*t161
-    t165 = t43 - t130*t161
-    t166 = t44 - t131*t161
-    t167 = t123 - t132*t161
-    t168 = xp.sqrt(t135**2 + t136**2 + t137**2 + t138**2 + t139**2)
-    t169 = t168*xp.where(xp.greater_equal(t135, 0), xp.asarray(1, dtype=dtype), -1)
-    t170 = xp.greater(t168, 0)
-    t171 = xp.where(t170, 1/(t135 + t169), 0)
-    t172 = xp.where(t170, 1 + xp.abs(t135)/t168, 0)
-    t173 = t136*t171
-    t174 = t137*t171
-    t175 = t138*t171
-    t176 = t139*t171
-    t177 = -t172*(t142 + t173*t143 + t174*t144 + t175*t145 - t176*t146)
-    t178 = t142 + t177
-    t179 = t143 + t173*t177
-    t180 = t144 + t174*t177
-    t181 = t145 + t175*t177
-    t182 = t146 - t176*t177
-    t183 = -t172*(t149 + t173*t150 + t174*t151 - t175*t152 - t176*t153)
-    t184 = t149 + t183
-    t185 = t150 + t173*t183
-    t186 = t151 + t174*t183
-    t187 = t152 - t175*t183
-    t188 = t153 - t176*t183
-    t189 = t172*(t156 + t173*t157 - t174*t158 + t175*t159 + t176*t160)
-    t190 = -t189 + t156
-    t191 = -t157 + t173*t189
-    t192 = t158 + t174*t189
-    t193 = t159 - t175*t189
-    t194 = t160 - t176*t189
-    t195 = t172*(t163 - t173*t164 - t174*t165 + t175*t166 + t176*t167)
-    t196 = -t195 + t163
-    t197 = t164 + t173*t195
-    t198 = t165 + t174*t195
-    t199 = t166 - t175*t195
-    t200 = t167 - t176*t195
-    t201 = xp.sqrt(t179**2 + t180**2 + t181**2 + t182**2)
-    t202 = t201*xp.where(xp.greater_equal(t179, 0), xp.asarray(1, dtype=dtype), -1)
-    t203 = xp.greater(t201, 0)
-    t204 = xp.where(t203, 1/(t179 + t202), 0)
-    t205 = xp.where(t203, 1 + xp.abs(t179)/t201, 0)
-    t206 = t180*t204
-    t207 = t181*t204
-    t208 = t182*t204
-    t209 = t205*(t185 + t206*t186 - t207*t187 + t208*t188)
-    t210 = -t209 + t185
-    t211 = t186 - t206*t209
-    t212 = t187 + t207*t209
-    t213 = t188 - t208*t209
-    t214 = t205*(t191 + t206*t192 - t207*t193 + t208*t194)
-    t215 = -t214 + t191
-    t216 = t192 - t206*t214
-    t217 = t193 + t207*t214
-    t218 = t194 - t208*t214
-    t219 = t205*(t197 + t206*t198 - t207*t199 + t208*t200)
-    t220 = -t219 + t197
-    t221 = t198 - t206*t219
-    t222 = t199 + t207*t219
-    t223 = t200 - t208*t219
-    t224 = xp.sqrt(t211**2 + t212**2 + t213**2)
-    t225 = t224*xp.where(xp.greater_equal(t211, 0), xp.asarray(1, dtype=dtype), -1)
-    t226 = xp.greater(t224, 0)
-    t227 = xp.where(t226, 1/(t211 + t225), 0)
-    t228 = xp.where(t226, 1 + xp.abs(t211)/t224, 0)
-    t229 = t212*t227
-    t230 = t213*t227
-    t231 = t228*(t216 + t229*t217 + t230*t218)
-    t232 = -t231 + t216
-    t233 = t217 - t229*t231
-    t234 = t218 - t230*t231
-    t235 = t228*(t221 + t229*t222 + t230*t223)
-    t236 = -t235 + t221
-    t237 = t222 - t229*t235
-    t238 = t223 - t230*t235
-    t239 = xp.sqrt(t233**2 + t234**2)
-    t240 = t239*xp.where(xp.greater_equal(t233, 0), xp.asarray(1, dtype=dtype), -1)
-    t241 = xp.greater(t239, 0)
-    t242 = xp.where(t241, 1/(t233 + t240), 0)
-    t243 = xp.where(t241, 1 + xp.abs(t233)/t239, 0)
-    t244 = t234*t242
-    t245 = t243*(t237 + t244*t238)
-    t246 = -t245 + t237
-    t247 = t238 - t244*t245
-    t248 = xp.abs(t247)
-    t249 = t248*xp.where(xp.greater_equal(t247, 0), xp.asarray(1, dtype=dtype), -1)
-    t250 = xp.where(xp.greater(t248, 0), xp.asarray(2, dtype=dtype), 0)
-    t251 = xp.greater_equal(t17, t30) & xp.greater_equal(t17, t47)
-    t252 = xp.greater_equal(t30, t47)
-    t253 = xp.where(t251, 0.5*(1 + t17), xp.where(t252, 0.5*t29, 0.5*t45))
-    t254 = xp.where(t251, 0.5*t18, xp.where(t252, 0.5*(1 + t30), 0.5*t46))
-    t255 = xp.where(t251, 0.5*t19, xp.where(t252, 0.5*t31, 0.5*(1 + t47)))
-    t256 = xp.sqrt(t253**2 + t254**2 + t255**2)
-    t257 = xp.where(xp.greater_equal(t48*t253 + t49*t254 + t32*t255, 0), xp.asarray(1, dtype=dtype), -1)
-    t258 = xp.greater(t51, 1e-06) | xp.greater(t50, 0)
-    t259 = t52*t257/t256
-    t260 = xp.where(t258, t48*t53, t259*t253)
-    t261 = xp.where(t258, t49*t53, t259*t254)
-    t262 = xp.where(t258, t32*t53, t259*t255)
-    t263 = mu_dot3 + t260*gain3
-    t264 = mu_dot4 + t261*gain4
-    t265 = mu_dot5 + t262*gain5
-    t266 = -(qz1 + c2*qz3 + t35*qz5 + t38*qz6 + t40*qz7 - t36*qz4) + t265
-    t267 = c1*qz2
-    t268 = -(-t60*qz1 + t72*qz3 + t73*qz4 + t74*qz5 + t75*qz6 + t70*t267) + t57
-    t269 = -(t267 - t3*qz4 + t22*qz5 + t24*qz6 + t26*qz7 + t20*qz3) + t264
-    t270 = s1*qz2
-    t271 = -(t56*qz1 + t76*qz3 - t77*qz4 + t78*qz5 + t79*qz6 + t70*t270) + t97
-    t272 = -(-t270 + t6*qz4 + t10*qz5 - t12*qz6 + t14*qz7 + t8*qz3) + t263
-    t273 = t127*(t268 + t128*t271 + t129*t82 + t130*t272 + t131*t269 + t132*t266)
-    t274 = -t273 + t268
-    t275 = t271 - t128*t273
-    t276 = t82 - t129*t273
-    t277 = t272 - t130*t273
-    t278 = t269 - t131*t273
-    t279 = t266 - t132*t273
-    t280 = t172*(t275 - t173*t276 - t174*t277 + t175*t278 + t176*t279)
-    t281 = -t280 + t275
-    t282 = t276 + t173*t280
-    t283 = t277 + t174*t280
-    t284 = t278 - t175*t280
-    t285 = t279 - t176*t280
-    t286 = t205*(t282 + t206*t283 - t207*t284 + t208*t285)
-    t287 = -t286 + t282
-    t288 = t283 - t206*t286
-    t289 = t284 + t207*t286
-    t290 = t285 - t208*t286
-    t291 = t228*(t288 + t229*t289 + t230*t290)
-    t292 = -t291 + t288
-    t293 = t289 - t229*t291
-    t294 = t290 - t230*t291
-    t295 = t243*(t293 + t244*t294)
-    t296 = -t295 + t293
-    t297 = t294 - t244*t295
-    t298 = t297 - t250*t297
-    t299 = xp.where(xp.not_equal(t249, 0), -t298/t249, 0)
-    t300 = xp.where(xp.not_equal(t240, 0), -(t296 - t246*t299)/t240, 0)
-    t301 = xp.where(xp.not_equal(t225, 0), -(-(t232*t300 + t236*t299) + t292)/t225, 0)
-    t302 = xp.where(xp.not_equal(t202, 0), -(-(t210*t301 + t215*t300 + t220*t299) + t287)/t202, 0)
-    t303 = xp.where(xp.not_equal(t169, 0), -(-(-t178*t302 - t184*t301 + t190*t300 + t196*t299) + t281)/t169, 0)
-    t304 = xp.where(xp.not_equal(t118, 0), -(-(t134*t303 + t141*t302 + t148*t301 + t155*t300 + t162*t299) + t274)/t118, 0)
-    t305 = t299 - t60*t304 + t56*t303
-    t306 = t72*t304 + t76*t303 + t62*t302 + c2*t299 + t8*t301 + t20*t300
-    t307 = t73*t304 - t77*t303 + t63*t302 + t6*t301 - t3*t300 - t36*t299
-    t308 = t74*t304 + t78*t303 + t64*t302 + t10*t301 + t22*t300 + t35*t299
-    t309 = t75*t304 + t79*t303 - t65*t302 - t12*t301 + t24*t300 + t38*t299
-    t310 = t14*t301 + t26*t300 + t40*t299
-    t311 = qz1 + t305
-    t312 = qz3 + t306
-    t313 = qz4 + t307
-    t314 = qz5 + t308
-    t315 = qz6 + t309
-    t316 = qz7 + t310
-    t317 = c1*t70
-    t318 = s1*t70
-    t319 = -t61*t302 - s1*t301 + c1*t300 + t317*t304 + t318*t303
-    t320 = qz2 + t319
-    t321 = 1 - t77 - t61 - t65 - s1 - t12 - t3 - t36 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t10 + t22 + t35 + q5 + t24 + t38 + q6 + t14 + t26 + t40 + q7 + t56 + t8 + t20 + t95 + t72 + t73 + t74 + t75 + t76 + t78 + t79 + t62 + t63 + t64 + t317 + t318 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7 + t57 + t97 + t81 + t263 + t264 + t265
-    t322 = xp.isfinite(t321)
-    t323 = xp.greater_equal(damping, 0)
-    t324 = 1e-12*t124
-    t325 = xp.less_equal(t117, t324) | xp.less_equal(t168, t324) | xp.less_equal(t201, t324) | xp.less_equal(t224, t324) | xp.less_equal(t239, t324) | xp.less_equal(t248, t324)
-    t326 = t322 & t323 & xp.logical_not(t325)
+    t109 = xp.greater_equal(t17, t30) & xp.greater_equal(t17, t47)
+    t110 = xp.greater_equal(t30, t47)
+    t111 = xp.where(t109, 0.5*(1 + t17), xp.where(t110, 0.5*t29, 0.5*t45))
+    t112 = xp.where(t109, 0.5*t18, xp.where(t110, 0.5*(1 + t30), 0.5*t46))
+    t113 = xp.where(t109, 0.5*t19, xp.where(t110, 0.5*t31, 0.5*(1 + t47)))
+    t114 = xp.sqrt(t111**2 + t112**2 + t113**2)
+    t115 = xp.where(xp.greater_equal(t48*t111 + t49*t112 + t32*t113, 0), xp.asarray(1, dtype=dtype), -1)
+    t116 = xp.greater(t51, 1e-06) | xp.greater(t50, 0)
+    t117 = t52*t115/t114
+    t118 = xp.where(t116, t48*t53, t117*t111)
+    t119 = xp.where(t116, t49*t53, t117*t112)
+    t120 = xp.where(t116, t32*t53, t117*t113)
+    t121 = mu_dot3 + t118*gain3
+    t122 = mu_dot4 + t119*gain4
+    t123 = mu_dot5 + t120*gain5
+    t124 = -(qz1 + c2*qz3 + t35*qz5 + t38*qz6 + t40*qz7 - t36*qz4) + t123
+    t125 = c1*qz2
+    t126 = -(-t60*qz1 + t72*qz3 + t73*qz4 + t74*qz5 + t75*qz6 + t70*t125) + t57
+    t127 = -(t125 - t3*qz4 + t22*qz5 + t24*qz6 + t26*qz7 + t20*qz3) + t122
+    t128 = s1*qz2
+    t129 = -(t70*t128 + t56*qz1 + t76*qz3 - t77*qz4 + t78*qz5 + t79*qz6) + t97
+    t130 = -(-t128 + t6*qz4 + t10*qz5 - t12*qz6 + t14*qz7 + t8*qz3) + t121
+    t131 = damping**2
+    t132 = _symmetric_solve6(xp, 1, (t131 + t86, t88, t90, t93, t84, t96, t131 + t99, -t102, -t100, t94, t80, t131 + t66, t103, -t91, t67, t131 + t105, t106, t43, t131 + t107, t44, t131 + t108, t126, t129, t82, t130, t127, t124,))
+    t133 = t132[5]
+    t134 = t132[0]
+    t135 = t132[1]
+    t136 = t133 - t60*t134 + t56*t135
+    t137 = qz1 + t136
+    t138 = c1*t70
+    t139 = s1*t70
+    t140 = 1 - t77 - t61 - t65 - s1 - t12 - t3 - t36 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t10 + t22 + t35 + q5 + t24 + t38 + q6 + t14 + t26 + t40 + q7 + t56 + t8 + t20 + t95 + t72 + t73 + t74 + t75 + t76 + t78 + t79 + t62 + t63 + t64 + t138 + t139 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7 + t57 + t97 + t81 + t121 + t122 + t123
+    t141 = t132[2]
+    t142 = t132[3]
+    t143 = t132[4]
+    t144 = t134*t138 + t135*t139 - t61*t141 - s1*t142 + c1*t143
+    t145 = t72*t134 + t76*t135 + t62*t141 + t8*t142 + t20*t143 + c2*t133
+    t146 = t73*t134 - t77*t135 + t63*t141 + t6*t142 - t3*t143 - t36*t133
+    t147 = t74*t134 + t78*t135 + t64*t141 + t10*t142 + t22*t143 + t35*t133
+    t148 = t79*t135 + t75*t134 - t65*t141 - t12*t142 + t24*t143 + t38*t133
+    t149 = t14*t142 + t26*t143 + t40*t133
+    t150 = qz2 + t144
+    t151 = qz3 + t145
+    t152 = qz4 + t146
+    t153 = qz5 + t147
+    t154 = qz6 + t148
+    t155 = qz7 + t149
+    t156 = xp.isfinite(t140)
+    t157 = xp.greater_equal(damping, 0)
+    t158 = t132[6]
+    t159 = t156 & t157 & xp.less_equal(t158, 0)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t326, t311, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t326, t320, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t326, t312, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t326, t313, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t326, t314, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t326, t315, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t326, t316, 0), batch),  # 6
+        xp.broadcast_to(xp.where(t159, t137, 0), batch),  # 0
+        xp.broadcast_to(xp.where(t159, t150, 0), batch),  # 1
+        xp.broadcast_to(xp.where(t159, t151, 0), batch),  # 2
+        xp.broadcast_to(xp.where(t159, t152, 0), batch),  # 3
+        xp.broadcast_to(xp.where(t159, t153, 0), batch),  # 4
+        xp.broadcast_to(xp.where(t159, t154, 0), batch),  # 5
+        xp.broadcast_to(xp.where(t159, t155, 0), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t322 & t323), 2, xp.where(t325, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t156 & t157), 2, xp.where(xp.greater(t158, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (7 x 1 and 7 x 1 and 1 x 1), 1088 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (7 x 1 and 7 x 1 and 1 x 1), 1148 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (7,)), ("damping", damping, ()))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
@@ -5505,179 +5257,20 @@ def ik_numeric_step(target, q, damping=0.0):
     t119 = xp.where(t116, t50*t54, t117*t112)
     t120 = xp.where(t116, t33*t54, t117*t113)
     t121 = t118**2 + t119**2 + t120**2 + t58**2 + t97**2 + t82**2
-    t122 = damping + t86
-    t123 = xp.sqrt(t122**2 + t88**2 + t90**2 + t93**2 + t84**2 + t96**2)
-    t124 = t123*xp.where(xp.greater_equal(t122, 0), xp.asarray(1, dtype=dtype), -1)
-    t125 = xp.greater(t123, 0)
-    t126 = xp.where(t125, 1/(t122 + t124), 0)
-    t127 = xp.where(t125, 1 + xp.abs(t122)/t123, 0)
-    t128 = damping + t99
-    t129 = t88*t126
-    t130 = t90*t126
-    t131 = t93*t126
-    t132 = t84*t126
-    t133 = t96*t126
-    t134 = t127*(t88 + t128*t129 - t130*t102 - t131*t100 + t132*t94 + t133*t81)
-    t135 = -t134 + t88
-    t136 = t128 - t129*t134
-    t137 = t102 + t130*t134
-    t138 = t100 + t131*t134
-    t139 = t94 - t132*t134
-    t140 = t81 - t133*t134
-    t141 = t127*(t58 + t129*t97 + t130*t82 + t131*t118 + t132*t119 + t133*t120)
-    t142 = -t141 + t58
-    t143 = t97 - t129*t141
-    t144 = t82 - t130*t141
-    t145 = t118 - t131*t141
-    t146 = t119 - t132*t141
-    t147 = t120 - t133*t141
-    t148 = xp.sqrt(t136**2 + t137**2 + t138**2 + t139**2 + t140**2)
-    t149 = t148*xp.where(xp.greater_equal(t136, 0), xp.asarray(1, dtype=dtype), -1)
-    t150 = damping + t67
-    t151 = t127*(t90 - t129*t102 + t130*t150 + t131*t103 - t132*t91 + t133*t68)
-    t152 = -t151 + t90
-    t153 = t102 + t129*t151
-    t154 = t150 - t130*t151
-    t155 = t103 - t131*t151
-    t156 = t91 + t132*t151
-    t157 = t68 - t133*t151
-    t158 = damping + t105
-    t159 = t127*(t93 - t129*t100 + t130*t103 + t131*t158 + t132*t106 + t133*t44)
-    t160 = -t159 + t93
-    t161 = t100 + t129*t159
-    t162 = t103 - t130*t159
-    t163 = t158 - t131*t159
-    t164 = t106 - t132*t159
-    t165 = t44 - t133*t159
-    t166 = damping + t107
-    t167 = t127*(t84 + t129*t94 - t130*t91 + t131*t106 + t132*t166 + t133*t45)
-    t168 = -t167 + t84
-    t169 = t94 - t129*t167
-    t170 = t91 + t130*t167
-    t171 = t106 - t131*t167
-    t172 = t166 - t132*t167
-    t173 = t45 - t133*t167
-    t174 = damping + t108
-    t175 = t127*(t96 + t129*t81 + t130*t68 + t131*t44 + t132*t45 + t133*t174)
-    t176 = -t175 + t96
-    t177 = t81 - t129*t175
-    t178 = t68 - t130*t175
-    t179 = t44 - t131*t175
-    t180 = t45 - t132*t175
-    t181 = t174 - t133*t175
-    t182 = xp.greater(t148, 0)
-    t183 = xp.where(t182, 1/(t136 + t149), 0)
-    t184 = xp.where(t182, 1 + xp.abs(t136)/t148, 0)
-    t185 = t137*t183
-    t186 = t138*t183
-    t187 = t139*t183
-    t188 = t140*t183
-    t189 = -t184*(t153 + t185*t154 + t186*t155 + t187*t156 - t188*t157)
-    t190 = t153 + t189
-    t191 = t154 + t185*t189
-    t192 = t155 + t186*t189
-    t193 = t156 + t187*t189
-    t194 = t157 - t188*t189
-    t195 = -t184*(t161 + t185*t162 + t186*t163 - t187*t164 - t188*t165)
-    t196 = t161 + t195
-    t197 = t162 + t185*t195
-    t198 = t163 + t186*t195
-    t199 = t164 - t187*t195
-    t200 = t165 - t188*t195
-    t201 = t184*(t169 + t185*t170 - t186*t171 + t187*t172 + t188*t173)
-    t202 = -t201 + t169
-    t203 = -t170 + t185*t201
-    t204 = t171 + t186*t201
-    t205 = t172 - t187*t201
-    t206 = t173 - t188*t201
-    t207 = t184*(t177 - t185*t178 - t186*t179 + t187*t180 + t188*t181)
-    t208 = -t207 + t177
-    t209 = t178 + t185*t207
-    t210 = t179 + t186*t207
-    t211 = t180 - t187*t207
-    t212 = t181 - t188*t207
-    t213 = t184*(t143 - t185*t144 - t186*t145 + t187*t146 + t188*t147)
-    t214 = -t213 + t143
-    t215 = t144 + t185*t213
-    t216 = t145 + t186*t213
-    t217 = t146 - t187*t213
-    t218 = t147 - t188*t213
-    t219 = xp.sqrt(t191**2 + t192**2 + t193**2 + t194**2)
-    t220 = t219*xp.where(xp.greater_equal(t191, 0), xp.asarray(1, dtype=dtype), -1)
-    t221 = xp.greater(t219, 0)
-    t222 = xp.where(t221, 1/(t191 + t220), 0)
-    t223 = xp.where(t221, 1 + xp.abs(t191)/t219, 0)
-    t224 = t192*t222
-    t225 = t193*t222
-    t226 = t194*t222
-    t227 = t223*(t197 + t224*t198 - t225*t199 + t226*t200)
-    t228 = -t227 + t197
-    t229 = t198 - t224*t227
-    t230 = t199 + t225*t227
-    t231 = t200 - t226*t227
-    t232 = t223*(t203 + t224*t204 - t225*t205 + t226*t206)
-    t233 = -t232 + t203
-    t234 = t204 - t224*t232
-    t235 = t205 + t225*t232
-    t236 = t206 - t226*t232
-    t237 = t223*(t209 + t224*t210 - t225*t211 + t226*t212)
-    t238 = -t237 + t209
-    t239 = t210 - t224*t237
-    t240 = t211 + t225*t237
-    t241 = t212 - t226*t237
-    t242 = t223*(t215 + t224*t216 - t225*t217 + t226*t218)
-    t243 = -t242 + t215
-    t244 = t216 - t224*t242
-    t245 = t217 + t225*t242
-    t246 = t218 - t226*t242
-    t247 = xp.sqrt(t229**2 + t230**2 + t231**2)
-    t248 = t247*xp.where(xp.greater_equal(t229, 0), xp.asarray(1, dtype=dtype), -1)
-    t249 = xp.greater(t247, 0)
-    t250 = xp.where(t249, 1/(t229 + t248), 0)
-    t251 = xp.where(t249, 1 + xp.abs(t229)/t247, 0)
-    t252 = t230*t250
-    t253 = t231*t250
-    t254 = t251*(t234 + t252*t235 + t253*t236)
-    t255 = -t254 + t234
-    t256 = t235 - t252*t254
-    t257 = t236 - t253*t254
-    t258 = t251*(t239 + t252*t240 + t253*t241)
-    t259 = -t258 + t239
-    t260 = t240 - t252*t258
-    t261 = t241 - t253*t258
-    t262 = t251*(t244 + t252*t245 + t253*t246)
-    t263 = -t262 + t244
-    t264 = t245 - t252*t262
-    t265 = t246 - t253*t262
-    t266 = xp.sqrt(t256**2 + t257**2)
-    t267 = t266*xp.where(xp.greater_equal(t256, 0), xp.asarray(1, dtype=dtype), -1)
-    t268 = xp.greater(t266, 0)
-    t269 = xp.where(t268, 1/(t256 + t267), 0)
-    t270 = xp.where(t268, 1 + xp.abs(t256)/t266, 0)
-    t271 = t257*t269
-    t272 = t270*(t260 + t271*t261)
-    t273 = -t272 + t260
-    t274 = t261 - t271*t272
-    t275 = t270*(t264 + t271*t265)
-    t276 = -t275 + t264
-    t277 = t265 - t271*t275
-    t278 = xp.abs(t274)
-    t279 = t278*xp.where(xp.greater_equal(t274, 0), xp.asarray(1, dtype=dtype), -1)
-    t280 = xp.where(xp.greater(t278, 0), xp.asarray(2, dtype=dtype), 0)
-    t281 = t277 - t277*t280
-    t282 = xp.where(xp.not_equal(t279, 0), -t281/t279, 0)
-    t283 = xp.where(xp.not_equal(t267, 0), -(t276 - t273*t282)/t267, 0)
-    t284 = xp.where(xp.not_equal(t248, 0), -(-(t255*t283 + t259*t282) + t263)/t248, 0)
-    t285 = xp.where(xp.not_equal(t220, 0), -(-(t228*t284 + t233*t283 + t238*t282) + t243)/t220, 0)
-    t286 = xp.where(xp.not_equal(t149, 0), -(-(-t190*t285 - t196*t284 + t202*t283 + t208*t282) + t214)/t149, 0)
-    t287 = xp.where(xp.not_equal(t124, 0), -(-(t135*t286 + t152*t285 + t160*t284 + t168*t283 + t176*t282) + t142)/t124, 0)
-    t288 = q1 + t282 - t61*t287 + t57*t286
-    t289 = q2 + c1*t71*t287 + s1*t71*t286 - t62*t285 - s1*t284 + c1*t283
-    t290 = q3 + t73*t287 + t77*t286 + t63*t285 + c2*t282 + t9*t284 + t21*t283
-    t291 = q4 + t74*t287 - t78*t286 + t64*t285 + t7*t284 - t4*t283 - t37*t282
-    t292 = q5 + t75*t287 + t79*t286 + t65*t285 + t11*t284 + t23*t283 + t36*t282
-    t293 = q6 + t76*t287 + t80*t286 - t66*t285 - t13*t284 + t25*t283 + t39*t282
-    t294 = q7 + t15*t284 + t27*t283 + t41*t282
+    t122 = _symmetric_solve6(xp, 1, (damping + t86, t88, t90, t93, t84, t96, damping + t99, -t102, -t100, t94, t81, damping + t67, t103, -t91, t68, damping + t105, t106, t44, damping + t107, t45, damping + t108, t58, t97, t82, t118, t119, t120,))
+    t123 = t122[5]
+    t124 = t122[0]
+    t125 = t122[1]
+    t126 = q1 + t123 - t61*t124 + t57*t125
+    t127 = t122[2]
+    t128 = t122[3]
+    t129 = t122[4]
+    t130 = q2 + c1*t71*t124 + s1*t71*t125 - t62*t127 - s1*t128 + c1*t129
+    t131 = q3 + c2*t123 + t73*t124 + t77*t125 + t63*t127 + t9*t128 + t21*t129
+    t132 = q4 - t4*t129 + t74*t124 - t78*t125 + t64*t127 + t7*t128 - t37*t123
+    t133 = q5 + t36*t123 + t75*t124 + t79*t125 + t65*t127 + t11*t128 + t23*t129
+    t134 = q6 - t66*t127 + t76*t124 + t80*t125 - t13*t128 + t25*t129 + t39*t123
+    t135 = q7 + t41*t123 + t15*t128 + t27*t129
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -5688,13 +5281,13 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q7, batch),  # 6
     ], (7,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t288, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t288, 2.9670597283903604), 2.9670597283903604, t288)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t289, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t289, 2.0943951023931953), 2.0943951023931953, t289)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t290, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t290, 2.9670597283903604), 2.9670597283903604, t290)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t291, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t291, 2.0943951023931953), 2.0943951023931953, t291)), batch),  # 3
-        xp.broadcast_to(xp.where(xp.less(t292, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t292, 2.9670597283903604), 2.9670597283903604, t292)), batch),  # 4
-        xp.broadcast_to(xp.where(xp.less(t293, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t293, 2.0943951023931953), 2.0943951023931953, t293)), batch),  # 5
-        xp.broadcast_to(xp.where(xp.less(t294, -3.0543261909900767), -3.0543261909900767, xp.where(xp.greater(t294, 3.0543261909900767), 3.0543261909900767, t294)), batch),  # 6
+        xp.broadcast_to(xp.where(xp.less(t126, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t126, 2.9670597283903604), 2.9670597283903604, t126)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t130, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t130, 2.0943951023931953), 2.0943951023931953, t130)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t131, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t131, 2.9670597283903604), 2.9670597283903604, t131)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t132, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t132, 2.0943951023931953), 2.0943951023931953, t132)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t133, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t133, 2.9670597283903604), 2.9670597283903604, t133)), batch),  # 4
+        xp.broadcast_to(xp.where(xp.less(t134, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t134, 2.0943951023931953), 2.0943951023931953, t134)), batch),  # 5
+        xp.broadcast_to(xp.where(xp.less(t135, -3.0543261909900767), -3.0543261909900767, xp.where(xp.greater(t135, 3.0543261909900767), 3.0543261909900767, t135)), batch),  # 6
     ], (7,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t0), t121, -1), batch)
     return q_start, q_next, cost
@@ -6351,7 +5944,7 @@ def ik_branches(T, q_free):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (7 x 1 and 1 x 1), 1007 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (7 x 1 and 1 x 1), 1005 operations."""
     xp, dtype, device, batch, (T, q_seed, q_free, weights,) = _arguments(("T", T, (4, 4)), ("q_seed", q_seed, (7,)), ("q_free", q_free, ()), ("weights", weights, (7,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(T, q_free)
     T00 = T[..., 0, 0]
@@ -6452,376 +6045,28 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     lb5 = branches_in_limits[..., 5]
     lb6 = branches_in_limits[..., 6]
     lb7 = branches_in_limits[..., 7]
-    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
-    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
-    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
-    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
-    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
-    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_6 + qn7)) + qb0_6
-    t6 = xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0)
-    t7 = xp.where(xp.greater(t6, 0), xp.asarray(1, dtype=dtype), 0)
-    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
-    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
-    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
-    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
-    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
-    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_6 + qn7)) + qb1_6
-    t14 = xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0)
-    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
-    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
-    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
-    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
-    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
-    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_6 + qn7)) + qb2_6
-    t21 = xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0)
-    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
-    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
-    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
-    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
-    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
-    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_6 + qn7)) + qb3_6
-    t28 = xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0)
-    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
-    t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
-    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
-    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
-    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
-    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_6 + qn7)) + qb4_6
-    t35 = xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0)
-    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
-    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
-    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
-    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
-    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
-    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_6 + qn7)) + qb5_6
-    t42 = xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0)
-    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
-    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
-    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
-    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
-    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
-    t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_6 + qn7)) + qb6_6
-    t49 = xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0)
-    t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
-    t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
-    t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
-    t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
-    t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
-    t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_6 + qn7)) + qb7_6
-    t56 = xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0)
-    t57 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7
-    t58 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t59 = t58 + t0
-    t60 = -t58 + t0
-    t61 = xp.where(xp.greater_equal(t0, -2.9670597283903604) & xp.less_equal(t0, 2.9670597283903604), t0, xp.where(xp.greater_equal(t59, -2.9670597283903604) & xp.less_equal(t59, 2.9670597283903604), t59, xp.where(xp.greater_equal(t60, -2.9670597283903604) & xp.less_equal(t60, 2.9670597283903604), t60, qb0_0)))
-    t62 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t63 = t62 + t1
-    t64 = -t62 + t1
-    t65 = xp.where(xp.greater_equal(t1, -2.0943951023931953) & xp.less_equal(t1, 2.0943951023931953), t1, xp.where(xp.greater_equal(t63, -2.0943951023931953) & xp.less_equal(t63, 2.0943951023931953), t63, xp.where(xp.greater_equal(t64, -2.0943951023931953) & xp.less_equal(t64, 2.0943951023931953), t64, qb0_1)))
-    t66 = xp.where(xp.less(t2, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t67 = t66 + t2
-    t68 = -t66 + t2
-    t69 = xp.where(xp.greater_equal(t2, -2.0943951023931953) & xp.less_equal(t2, 2.0943951023931953), t2, xp.where(xp.greater_equal(t67, -2.0943951023931953) & xp.less_equal(t67, 2.0943951023931953), t67, xp.where(xp.greater_equal(t68, -2.0943951023931953) & xp.less_equal(t68, 2.0943951023931953), t68, qb0_3)))
-    t70 = xp.where(xp.less(t3, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t71 = t70 + t3
-    t72 = -t70 + t3
-    t73 = xp.where(xp.greater_equal(t3, -2.9670597283903604) & xp.less_equal(t3, 2.9670597283903604), t3, xp.where(xp.greater_equal(t71, -2.9670597283903604) & xp.less_equal(t71, 2.9670597283903604), t71, xp.where(xp.greater_equal(t72, -2.9670597283903604) & xp.less_equal(t72, 2.9670597283903604), t72, qb0_4)))
-    t74 = xp.where(xp.less(t4, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t75 = t74 + t4
-    t76 = -t74 + t4
-    t77 = xp.where(xp.greater_equal(t4, -2.0943951023931953) & xp.less_equal(t4, 2.0943951023931953), t4, xp.where(xp.greater_equal(t75, -2.0943951023931953) & xp.less_equal(t75, 2.0943951023931953), t75, xp.where(xp.greater_equal(t76, -2.0943951023931953) & xp.less_equal(t76, 2.0943951023931953), t76, qb0_5)))
-    t78 = xp.where(xp.less(t5, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t79 = t78 + t5
-    t80 = -t78 + t5
-    t81 = xp.where(xp.greater_equal(t5, -3.0543261909900767) & xp.less_equal(t5, 3.0543261909900767), t5, xp.where(xp.greater_equal(t79, -3.0543261909900767) & xp.less_equal(t79, 3.0543261909900767), t79, xp.where(xp.greater_equal(t80, -3.0543261909900767) & xp.less_equal(t80, 3.0543261909900767), t80, qb0_6)))
-    t82 = -qn1
-    t83 = -qn2
-    t84 = -qn3
-    t85 = -qn4
-    t86 = -qn5
-    t87 = -qn6
-    t88 = -qn7
-    t89 = qw1*(t82 + t61)**2 + qw2*(t83 + t65)**2 + qw3*(t84 + qb0_2)**2 + qw4*(t85 + t69)**2 + qw5*(t86 + t73)**2 + qw6*(t87 + t77)**2 + qw7*(t88 + t81)**2
-    t90 = xp.greater(t7, 0)
-    t91 = xp.where(t90, t61, qn1)
-    t92 = xp.where(t90, t65, qn2)
-    t93 = xp.where(t90, qb0_2, qn3)
-    t94 = xp.where(t90, t69, qn4)
-    t95 = xp.where(t90, t73, qn5)
-    t96 = xp.where(t90, t77, qn6)
-    t97 = xp.where(t90, t81, qn7)
-    t98 = xp.where(t90, t89, 0)
-    t99 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t100 = t99 + t8
-    t101 = -t99 + t8
-    t102 = xp.where(xp.greater_equal(t8, -2.9670597283903604) & xp.less_equal(t8, 2.9670597283903604), t8, xp.where(xp.greater_equal(t100, -2.9670597283903604) & xp.less_equal(t100, 2.9670597283903604), t100, xp.where(xp.greater_equal(t101, -2.9670597283903604) & xp.less_equal(t101, 2.9670597283903604), t101, qb1_0)))
-    t103 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t104 = t103 + t9
-    t105 = -t103 + t9
-    t106 = xp.where(xp.greater_equal(t9, -2.0943951023931953) & xp.less_equal(t9, 2.0943951023931953), t9, xp.where(xp.greater_equal(t104, -2.0943951023931953) & xp.less_equal(t104, 2.0943951023931953), t104, xp.where(xp.greater_equal(t105, -2.0943951023931953) & xp.less_equal(t105, 2.0943951023931953), t105, qb1_1)))
-    t107 = xp.where(xp.less(t10, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t108 = t107 + t10
-    t109 = -t107 + t10
-    t110 = xp.where(xp.greater_equal(t10, -2.0943951023931953) & xp.less_equal(t10, 2.0943951023931953), t10, xp.where(xp.greater_equal(t108, -2.0943951023931953) & xp.less_equal(t108, 2.0943951023931953), t108, xp.where(xp.greater_equal(t109, -2.0943951023931953) & xp.less_equal(t109, 2.0943951023931953), t109, qb1_3)))
-    t111 = xp.where(xp.less(t11, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t112 = t111 + t11
-    t113 = -t111 + t11
-    t114 = xp.where(xp.greater_equal(t11, -2.9670597283903604) & xp.less_equal(t11, 2.9670597283903604), t11, xp.where(xp.greater_equal(t112, -2.9670597283903604) & xp.less_equal(t112, 2.9670597283903604), t112, xp.where(xp.greater_equal(t113, -2.9670597283903604) & xp.less_equal(t113, 2.9670597283903604), t113, qb1_4)))
-    t115 = xp.where(xp.less(t12, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t116 = t115 + t12
-    t117 = -t115 + t12
-    t118 = xp.where(xp.greater_equal(t12, -2.0943951023931953) & xp.less_equal(t12, 2.0943951023931953), t12, xp.where(xp.greater_equal(t116, -2.0943951023931953) & xp.less_equal(t116, 2.0943951023931953), t116, xp.where(xp.greater_equal(t117, -2.0943951023931953) & xp.less_equal(t117, 2.0943951023931953), t117, qb1_5)))
-    t119 = xp.where(xp.less(t13, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t120 = t119 + t13
-    t121 = -t119 + t13
-    t122 = xp.where(xp.greater_equal(t13, -3.0543261909900767) & xp.less_equal(t13, 3.0543261909900767), t13, xp.where(xp.greater_equal(t120, -3.0543261909900767) & xp.less_equal(t120, 3.0543261909900767), t120, xp.where(xp.greater_equal(t121, -3.0543261909900767) & xp.less_equal(t121, 3.0543261909900767), t121, qb1_6)))
-    t123 = qw1*(t82 + t102)**2 + qw2*(t83 + t106)**2 + qw3*(t84 + qb1_2)**2 + qw4*(t85 + t110)**2 + qw5*(t86 + t114)**2 + qw6*(t87 + t118)**2 + qw7*(t88 + t122)**2
-    t124 = xp.greater(t14, 0)
-    t125 = xp.where(t124 & (xp.less(t7, 1) | xp.less(t123, t98)), xp.asarray(1, dtype=dtype), 0)
-    t126 = xp.where(t124, 1, t7)
-    t127 = xp.greater(t125, 0)
-    t128 = xp.where(t127, t102, t91)
-    t129 = xp.where(t127, t106, t92)
-    t130 = xp.where(t127, qb1_2, t93)
-    t131 = xp.where(t127, t110, t94)
-    t132 = xp.where(t127, t114, t95)
-    t133 = xp.where(t127, t118, t96)
-    t134 = xp.where(t127, t122, t97)
-    t135 = xp.where(t127, t123, t98)
-    t136 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t137 = t136 + t15
-    t138 = -t136 + t15
-    t139 = xp.where(xp.greater_equal(t15, -2.9670597283903604) & xp.less_equal(t15, 2.9670597283903604), t15, xp.where(xp.greater_equal(t137, -2.9670597283903604) & xp.less_equal(t137, 2.9670597283903604), t137, xp.where(xp.greater_equal(t138, -2.9670597283903604) & xp.less_equal(t138, 2.9670597283903604), t138, qb2_0)))
-    t140 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t141 = t140 + t16
-    t142 = -t140 + t16
-    t143 = xp.where(xp.greater_equal(t16, -2.0943951023931953) & xp.less_equal(t16, 2.0943951023931953), t16, xp.where(xp.greater_equal(t141, -2.0943951023931953) & xp.less_equal(t141, 2.0943951023931953), t141, xp.where(xp.greater_equal(t142, -2.0943951023931953) & xp.less_equal(t142, 2.0943951023931953), t142, qb2_1)))
-    t144 = xp.where(xp.less(t17, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t145 = t144 + t17
-    t146 = -t144 + t17
-    t147 = xp.where(xp.greater_equal(t17, -2.0943951023931953) & xp.less_equal(t17, 2.0943951023931953), t17, xp.where(xp.greater_equal(t145, -2.0943951023931953) & xp.less_equal(t145, 2.0943951023931953), t145, xp.where(xp.greater_equal(t146, -2.0943951023931953) & xp.less_equal(t146, 2.0943951023931953), t146, qb2_3)))
-    t148 = xp.where(xp.less(t18, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t149 = t148 + t18
-    t150 = -t148 + t18
-    t151 = xp.where(xp.greater_equal(t18, -2.9670597283903604) & xp.less_equal(t18, 2.9670597283903604), t18, xp.where(xp.greater_equal(t149, -2.9670597283903604) & xp.less_equal(t149, 2.9670597283903604), t149, xp.where(xp.greater_equal(t150, -2.9670597283903604) & xp.less_equal(t150, 2.9670597283903604), t150, qb2_4)))
-    t152 = xp.where(xp.less(t19, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t153 = t152 + t19
-    t154 = -t152 + t19
-    t155 = xp.where(xp.greater_equal(t19, -2.0943951023931953) & xp.less_equal(t19, 2.0943951023931953), t19, xp.where(xp.greater_equal(t153, -2.0943951023931953) & xp.less_equal(t153, 2.0943951023931953), t153, xp.where(xp.greater_equal(t154, -2.0943951023931953) & xp.less_equal(t154, 2.0943951023931953), t154, qb2_5)))
-    t156 = xp.where(xp.less(t20, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t157 = t156 + t20
-    t158 = -t156 + t20
-    t159 = xp.where(xp.greater_equal(t20, -3.0543261909900767) & xp.less_equal(t20, 3.0543261909900767), t20, xp.where(xp.greater_equal(t157, -3.0543261909900767) & xp.less_equal(t157, 3.0543261909900767), t157, xp.where(xp.greater_equal(t158, -3.0543261909900767) & xp.less_equal(t158, 3.0543261909900767), t158, qb2_6)))
-    t160 = qw1*(t82 + t139)**2 + qw2*(t83 + t143)**2 + qw3*(t84 + qb2_2)**2 + qw4*(t85 + t147)**2 + qw5*(t86 + t151)**2 + qw6*(t87 + t155)**2 + qw7*(t88 + t159)**2
-    t161 = xp.greater(t21, 0)
-    t162 = xp.where(t161 & (xp.less(t126, 1) | xp.less(t160, t135)), xp.asarray(1, dtype=dtype), 0)
-    t163 = xp.where(t161, 1, t126)
-    t164 = xp.greater(t162, 0)
-    t165 = xp.where(t164, t139, t128)
-    t166 = xp.where(t164, t143, t129)
-    t167 = xp.where(t164, qb2_2, t130)
-    t168 = xp.where(t164, t147, t131)
-    t169 = xp.where(t164, t151, t132)
-    t170 = xp.where(t164, t155, t133)
-    t171 = xp.where(t164, t159, t134)
-    t172 = xp.where(t164, t160, t135)
-    t173 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t174 = t173 + t22
-    t175 = -t173 + t22
-    t176 = xp.where(xp.greater_equal(t22, -2.9670597283903604) & xp.less_equal(t22, 2.9670597283903604), t22, xp.where(xp.greater_equal(t174, -2.9670597283903604) & xp.less_equal(t174, 2.9670597283903604), t174, xp.where(xp.greater_equal(t175, -2.9670597283903604) & xp.less_equal(t175, 2.9670597283903604), t175, qb3_0)))
-    t177 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t178 = t177 + t23
-    t179 = -t177 + t23
-    t180 = xp.where(xp.greater_equal(t23, -2.0943951023931953) & xp.less_equal(t23, 2.0943951023931953), t23, xp.where(xp.greater_equal(t178, -2.0943951023931953) & xp.less_equal(t178, 2.0943951023931953), t178, xp.where(xp.greater_equal(t179, -2.0943951023931953) & xp.less_equal(t179, 2.0943951023931953), t179, qb3_1)))
-    t181 = xp.where(xp.less(t24, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t182 = t181 + t24
-    t183 = -t181 + t24
-    t184 = xp.where(xp.greater_equal(t24, -2.0943951023931953) & xp.less_equal(t24, 2.0943951023931953), t24, xp.where(xp.greater_equal(t182, -2.0943951023931953) & xp.less_equal(t182, 2.0943951023931953), t182, xp.where(xp.greater_equal(t183, -2.0943951023931953) & xp.less_equal(t183, 2.0943951023931953), t183, qb3_3)))
-    t185 = xp.where(xp.less(t25, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t186 = t185 + t25
-    t187 = -t185 + t25
-    t188 = xp.where(xp.greater_equal(t25, -2.9670597283903604) & xp.less_equal(t25, 2.9670597283903604), t25, xp.where(xp.greater_equal(t186, -2.9670597283903604) & xp.less_equal(t186, 2.9670597283903604), t186, xp.where(xp.greater_equal(t187, -2.9670597283903604) & xp.less_equal(t187, 2.9670597283903604), t187, qb3_4)))
-    t189 = xp.where(xp.less(t26, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t190 = t189 + t26
-    t191 = -t189 + t26
-    t192 = xp.where(xp.greater_equal(t26, -2.0943951023931953) & xp.less_equal(t26, 2.0943951023931953), t26, xp.where(xp.greater_equal(t190, -2.0943951023931953) & xp.less_equal(t190, 2.0943951023931953), t190, xp.where(xp.greater_equal(t191, -2.0943951023931953) & xp.less_equal(t191, 2.0943951023931953), t191, qb3_5)))
-    t193 = xp.where(xp.less(t27, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t194 = t193 + t27
-    t195 = -t193 + t27
-    t196 = xp.where(xp.greater_equal(t27, -3.0543261909900767) & xp.less_equal(t27, 3.0543261909900767), t27, xp.where(xp.greater_equal(t194, -3.0543261909900767) & xp.less_equal(t194, 3.0543261909900767), t194, xp.where(xp.greater_equal(t195, -3.0543261909900767) & xp.less_equal(t195, 3.0543261909900767), t195, qb3_6)))
-    t197 = qw1*(t82 + t176)**2 + qw2*(t83 + t180)**2 + qw3*(t84 + qb3_2)**2 + qw4*(t85 + t184)**2 + qw5*(t86 + t188)**2 + qw6*(t87 + t192)**2 + qw7*(t88 + t196)**2
-    t198 = xp.greater(t28, 0)
-    t199 = xp.where(t198 & (xp.less(t163, 1) | xp.less(t197, t172)), xp.asarray(1, dtype=dtype), 0)
-    t200 = xp.where(t198, 1, t163)
-    t201 = xp.greater(t199, 0)
-    t202 = xp.where(t201, t176, t165)
-    t203 = xp.where(t201, t180, t166)
-    t204 = xp.where(t201, qb3_2, t167)
-    t205 = xp.where(t201, t184, t168)
-    t206 = xp.where(t201, t188, t169)
-    t207 = xp.where(t201, t192, t170)
-    t208 = xp.where(t201, t196, t171)
-    t209 = xp.where(t201, t197, t172)
-    t210 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t211 = t210 + t29
-    t212 = -t210 + t29
-    t213 = xp.where(xp.greater_equal(t29, -2.9670597283903604) & xp.less_equal(t29, 2.9670597283903604), t29, xp.where(xp.greater_equal(t211, -2.9670597283903604) & xp.less_equal(t211, 2.9670597283903604), t211, xp.where(xp.greater_equal(t212, -2.9670597283903604) & xp.less_equal(t212, 2.9670597283903604), t212, qb4_0)))
-    t214 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t215 = t214 + t30
-    t216 = -t214 + t30
-    t217 = xp.where(xp.greater_equal(t30, -2.0943951023931953) & xp.less_equal(t30, 2.0943951023931953), t30, xp.where(xp.greater_equal(t215, -2.0943951023931953) & xp.less_equal(t215, 2.0943951023931953), t215, xp.where(xp.greater_equal(t216, -2.0943951023931953) & xp.less_equal(t216, 2.0943951023931953), t216, qb4_1)))
-    t218 = xp.where(xp.less(t31, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t219 = t218 + t31
-    t220 = -t218 + t31
-    t221 = xp.where(xp.greater_equal(t31, -2.0943951023931953) & xp.less_equal(t31, 2.0943951023931953), t31, xp.where(xp.greater_equal(t219, -2.0943951023931953) & xp.less_equal(t219, 2.0943951023931953), t219, xp.where(xp.greater_equal(t220, -2.0943951023931953) & xp.less_equal(t220, 2.0943951023931953), t220, qb4_3)))
-    t222 = xp.where(xp.less(t32, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t223 = t222 + t32
-    t224 = -t222 + t32
-    t225 = xp.where(xp.greater_equal(t32, -2.9670597283903604) & xp.less_equal(t32, 2.9670597283903604), t32, xp.where(xp.greater_equal(t223, -2.9670597283903604) & xp.less_equal(t223, 2.9670597283903604), t223, xp.where(xp.greater_equal(t224, -2.9670597283903604) & xp.less_equal(t224, 2.9670597283903604), t224, qb4_4)))
-    t226 = xp.where(xp.less(t33, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t227 = t226 + t33
-    t228 = -t226 + t33
-    t229 = xp.where(xp.greater_equal(t33, -2.0943951023931953) & xp.less_equal(t33, 2.0943951023931953), t33, xp.where(xp.greater_equal(t227, -2.0943951023931953) & xp.less_equal(t227, 2.0943951023931953), t227, xp.where(xp.greater_equal(t228, -2.0943951023931953) & xp.less_equal(t228, 2.0943951023931953), t228, qb4_5)))
-    t230 = xp.where(xp.less(t34, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t231 = t230 + t34
-    t232 = -t230 + t34
-    t233 = xp.where(xp.greater_equal(t34, -3.0543261909900767) & xp.less_equal(t34, 3.0543261909900767), t34, xp.where(xp.greater_equal(t231, -3.0543261909900767) & xp.less_equal(t231, 3.0543261909900767), t231, xp.where(xp.greater_equal(t232, -3.0543261909900767) & xp.less_equal(t232, 3.0543261909900767), t232, qb4_6)))
-    t234 = qw1*(t82 + t213)**2 + qw2*(t83 + t217)**2 + qw3*(t84 + qb4_2)**2 + qw4*(t85 + t221)**2 + qw5*(t86 + t225)**2 + qw6*(t87 + t229)**2 + qw7*(t88 + t233)**2
-    t235 = xp.greater(t35, 0)
-    t236 = xp.where(t235 & (xp.less(t200, 1) | xp.less(t234, t209)), xp.asarray(1, dtype=dtype), 0)
-    t237 = xp.where(t235, 1, t200)
-    t238 = xp.greater(t236, 0)
-    t239 = xp.where(t238, t213, t202)
-    t240 = xp.where(t238, t217, t203)
-    t241 = xp.where(t238, qb4_2, t204)
-    t242 = xp.where(t238, t221, t205)
-    t243 = xp.where(t238, t225, t206)
-    t244 = xp.where(t238, t229, t207)
-    t245 = xp.where(t238, t233, t208)
-    t246 = xp.where(t238, t234, t209)
-    t247 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t248 = t247 + t36
-    t249 = -t247 + t36
-    t250 = xp.where(xp.greater_equal(t36, -2.9670597283903604) & xp.less_equal(t36, 2.9670597283903604), t36, xp.where(xp.greater_equal(t248, -2.9670597283903604) & xp.less_equal(t248, 2.9670597283903604), t248, xp.where(xp.greater_equal(t249, -2.9670597283903604) & xp.less_equal(t249, 2.9670597283903604), t249, qb5_0)))
-    t251 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t252 = t251 + t37
-    t253 = -t251 + t37
-    t254 = xp.where(xp.greater_equal(t37, -2.0943951023931953) & xp.less_equal(t37, 2.0943951023931953), t37, xp.where(xp.greater_equal(t252, -2.0943951023931953) & xp.less_equal(t252, 2.0943951023931953), t252, xp.where(xp.greater_equal(t253, -2.0943951023931953) & xp.less_equal(t253, 2.0943951023931953), t253, qb5_1)))
-    t255 = xp.where(xp.less(t38, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t256 = t255 + t38
-    t257 = -t255 + t38
-    t258 = xp.where(xp.greater_equal(t38, -2.0943951023931953) & xp.less_equal(t38, 2.0943951023931953), t38, xp.where(xp.greater_equal(t256, -2.0943951023931953) & xp.less_equal(t256, 2.0943951023931953), t256, xp.where(xp.greater_equal(t257, -2.0943951023931953) & xp.less_equal(t257, 2.0943951023931953), t257, qb5_3)))
-    t259 = xp.where(xp.less(t39, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t260 = t259 + t39
-    t261 = -t259 + t39
-    t262 = xp.where(xp.greater_equal(t39, -2.9670597283903604) & xp.less_equal(t39, 2.9670597283903604), t39, xp.where(xp.greater_equal(t260, -2.9670597283903604) & xp.less_equal(t260, 2.9670597283903604), t260, xp.where(xp.greater_equal(t261, -2.9670597283903604) & xp.less_equal(t261, 2.9670597283903604), t261, qb5_4)))
-    t263 = xp.where(xp.less(t40, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t264 = t263 + t40
-    t265 = -t263 + t40
-    t266 = xp.where(xp.greater_equal(t40, -2.0943951023931953) & xp.less_equal(t40, 2.0943951023931953), t40, xp.where(xp.greater_equal(t264, -2.0943951023931953) & xp.less_equal(t264, 2.0943951023931953), t264, xp.where(xp.greater_equal(t265, -2.0943951023931953) & xp.less_equal(t265, 2.0943951023931953), t265, qb5_5)))
-    t267 = xp.where(xp.less(t41, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t268 = t267 + t41
-    t269 = -t267 + t41
-    t270 = xp.where(xp.greater_equal(t41, -3.0543261909900767) & xp.less_equal(t41, 3.0543261909900767), t41, xp.where(xp.greater_equal(t268, -3.0543261909900767) & xp.less_equal(t268, 3.0543261909900767), t268, xp.where(xp.greater_equal(t269, -3.0543261909900767) & xp.less_equal(t269, 3.0543261909900767), t269, qb5_6)))
-    t271 = qw1*(t82 + t250)**2 + qw2*(t83 + t254)**2 + qw3*(t84 + qb5_2)**2 + qw4*(t85 + t258)**2 + qw5*(t86 + t262)**2 + qw6*(t87 + t266)**2 + qw7*(t88 + t270)**2
-    t272 = xp.greater(t42, 0)
-    t273 = xp.where(t272 & (xp.less(t237, 1) | xp.less(t271, t246)), xp.asarray(1, dtype=dtype), 0)
-    t274 = xp.where(t272, 1, t237)
-    t275 = xp.greater(t273, 0)
-    t276 = xp.where(t275, t250, t239)
-    t277 = xp.where(t275, t254, t240)
-    t278 = xp.where(t275, qb5_2, t241)
-    t279 = xp.where(t275, t258, t242)
-    t280 = xp.where(t275, t262, t243)
-    t281 = xp.where(t275, t266, t244)
-    t282 = xp.where(t275, t270, t245)
-    t283 = xp.where(t275, t271, t246)
-    t284 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t285 = t284 + t43
-    t286 = -t284 + t43
-    t287 = xp.where(xp.greater_equal(t43, -2.9670597283903604) & xp.less_equal(t43, 2.9670597283903604), t43, xp.where(xp.greater_equal(t285, -2.9670597283903604) & xp.less_equal(t285, 2.9670597283903604), t285, xp.where(xp.greater_equal(t286, -2.9670597283903604) & xp.less_equal(t286, 2.9670597283903604), t286, qb6_0)))
-    t288 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t289 = t288 + t44
-    t290 = -t288 + t44
-    t291 = xp.where(xp.greater_equal(t44, -2.0943951023931953) & xp.less_equal(t44, 2.0943951023931953), t44, xp.where(xp.greater_equal(t289, -2.0943951023931953) & xp.less_equal(t289, 2.0943951023931953), t289, xp.where(xp.greater_equal(t290, -2.0943951023931953) & xp.less_equal(t290, 2.0943951023931953), t290, qb6_1)))
-    t292 = xp.where(xp.less(t45, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t293 = t292 + t45
-    t294 = -t292 + t45
-    t295 = xp.where(xp.greater_equal(t45, -2.0943951023931953) & xp.less_equal(t45, 2.0943951023931953), t45, xp.where(xp.greater_equal(t293, -2.0943951023931953) & xp.less_equal(t293, 2.0943951023931953), t293, xp.where(xp.greater_equal(t294, -2.0943951023931953) & xp.less_equal(t294, 2.0943951023931953), t294, qb6_3)))
-    t296 = xp.where(xp.less(t46, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t297 = t296 + t46
-    t298 = -t296 + t46
-    t299 = xp.where(xp.greater_equal(t46, -2.9670597283903604) & xp.less_equal(t46, 2.9670597283903604), t46, xp.where(xp.greater_equal(t297, -2.9670597283903604) & xp.less_equal(t297, 2.9670597283903604), t297, xp.where(xp.greater_equal(t298, -2.9670597283903604) & xp.less_equal(t298, 2.9670597283903604), t298, qb6_4)))
-    t300 = xp.where(xp.less(t47, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t301 = t300 + t47
-    t302 = -t300 + t47
-    t303 = xp.where(xp.greater_equal(t47, -2.0943951023931953) & xp.less_equal(t47, 2.0943951023931953), t47, xp.where(xp.greater_equal(t301, -2.0943951023931953) & xp.less_equal(t301, 2.0943951023931953), t301, xp.where(xp.greater_equal(t302, -2.0943951023931953) & xp.less_equal(t302, 2.0943951023931953), t302, qb6_5)))
-    t304 = xp.where(xp.less(t48, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t305 = t304 + t48
-    t306 = -t304 + t48
-    t307 = xp.where(xp.greater_equal(t48, -3.0543261909900767) & xp.less_equal(t48, 3.0543261909900767), t48, xp.where(xp.greater_equal(t305, -3.0543261909900767) & xp.less_equal(t305, 3.0543261909900767), t305, xp.where(xp.greater_equal(t306, -3.0543261909900767) & xp.less_equal(t306, 3.0543261909900767), t306, qb6_6)))
-    t308 = qw1*(t82 + t287)**2 + qw2*(t83 + t291)**2 + qw3*(t84 + qb6_2)**2 + qw4*(t85 + t295)**2 + qw5*(t86 + t299)**2 + qw6*(t87 + t303)**2 + qw7*(t88 + t307)**2
-    t309 = xp.greater(t49, 0)
-    t310 = xp.where(t309 & (xp.less(t274, 1) | xp.less(t308, t283)), xp.asarray(1, dtype=dtype), 0)
-    t311 = xp.where(t309, 1, t274)
-    t312 = xp.greater(t310, 0)
-    t313 = xp.where(t312, t287, t276)
-    t314 = xp.where(t312, t291, t277)
-    t315 = xp.where(t312, qb6_2, t278)
-    t316 = xp.where(t312, t295, t279)
-    t317 = xp.where(t312, t299, t280)
-    t318 = xp.where(t312, t303, t281)
-    t319 = xp.where(t312, t307, t282)
-    t320 = xp.where(t312, t308, t283)
-    t321 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t322 = t321 + t50
-    t323 = -t321 + t50
-    t324 = xp.where(xp.greater_equal(t50, -2.9670597283903604) & xp.less_equal(t50, 2.9670597283903604), t50, xp.where(xp.greater_equal(t322, -2.9670597283903604) & xp.less_equal(t322, 2.9670597283903604), t322, xp.where(xp.greater_equal(t323, -2.9670597283903604) & xp.less_equal(t323, 2.9670597283903604), t323, qb7_0)))
-    t325 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t326 = t325 + t51
-    t327 = -t325 + t51
-    t328 = xp.where(xp.greater_equal(t51, -2.0943951023931953) & xp.less_equal(t51, 2.0943951023931953), t51, xp.where(xp.greater_equal(t326, -2.0943951023931953) & xp.less_equal(t326, 2.0943951023931953), t326, xp.where(xp.greater_equal(t327, -2.0943951023931953) & xp.less_equal(t327, 2.0943951023931953), t327, qb7_1)))
-    t329 = xp.where(xp.less(t52, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t330 = t329 + t52
-    t331 = -t329 + t52
-    t332 = xp.where(xp.greater_equal(t52, -2.0943951023931953) & xp.less_equal(t52, 2.0943951023931953), t52, xp.where(xp.greater_equal(t330, -2.0943951023931953) & xp.less_equal(t330, 2.0943951023931953), t330, xp.where(xp.greater_equal(t331, -2.0943951023931953) & xp.less_equal(t331, 2.0943951023931953), t331, qb7_3)))
-    t333 = xp.where(xp.less(t53, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t334 = t333 + t53
-    t335 = -t333 + t53
-    t336 = xp.where(xp.greater_equal(t53, -2.9670597283903604) & xp.less_equal(t53, 2.9670597283903604), t53, xp.where(xp.greater_equal(t334, -2.9670597283903604) & xp.less_equal(t334, 2.9670597283903604), t334, xp.where(xp.greater_equal(t335, -2.9670597283903604) & xp.less_equal(t335, 2.9670597283903604), t335, qb7_4)))
-    t337 = xp.where(xp.less(t54, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t338 = t337 + t54
-    t339 = -t337 + t54
-    t340 = xp.where(xp.greater_equal(t54, -2.0943951023931953) & xp.less_equal(t54, 2.0943951023931953), t54, xp.where(xp.greater_equal(t338, -2.0943951023931953) & xp.less_equal(t338, 2.0943951023931953), t338, xp.where(xp.greater_equal(t339, -2.0943951023931953) & xp.less_equal(t339, 2.0943951023931953), t339, qb7_5)))
-    t341 = xp.where(xp.less(t55, qn7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t342 = t341 + t55
-    t343 = -t341 + t55
-    t344 = xp.where(xp.greater_equal(t55, -3.0543261909900767) & xp.less_equal(t55, 3.0543261909900767), t55, xp.where(xp.greater_equal(t342, -3.0543261909900767) & xp.less_equal(t342, 3.0543261909900767), t342, xp.where(xp.greater_equal(t343, -3.0543261909900767) & xp.less_equal(t343, 3.0543261909900767), t343, qb7_6)))
-    t345 = qw1*(t82 + t324)**2 + qw2*(t83 + t328)**2 + qw3*(t84 + qb7_2)**2 + qw4*(t85 + t332)**2 + qw5*(t86 + t336)**2 + qw6*(t87 + t340)**2 + qw7*(t88 + t344)**2
-    t346 = xp.greater(t56, 0)
-    t347 = xp.where(t346 & (xp.less(t311, 1) | xp.less(t345, t320)), xp.asarray(1, dtype=dtype), 0)
-    t348 = xp.where(t346, 1, t311)
-    t349 = xp.greater(t347, 0)
-    t350 = xp.where(t349, t324, t313)
-    t351 = xp.where(t349, t328, t314)
-    t352 = xp.where(t349, qb7_2, t315)
-    t353 = xp.where(t349, t332, t316)
-    t354 = xp.where(t349, t336, t317)
-    t355 = xp.where(t349, t340, t318)
-    t356 = xp.where(t349, t344, t319)
-    t357 = xp.greater(t348, 0)
-    t358 = xp.isfinite(t57)
-    t359 = t357 & t358
+    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7
+    t1 = _nearer_branch(xp, 1, (qb0_0, qb0_1, qb0_2, qb0_3, qb0_4, qb0_5, qb0_6, xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, qn1, qn2, qn3, qn4, qn5, qn6, qn7, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
+    t2 = _nearer_branch(xp, 1, (qb1_0, qb1_1, qb1_2, qb1_3, qb1_4, qb1_5, qb1_6, xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t1[0], t1[1], t1[2], t1[3], t1[4], t1[5], t1[6], t1[7], t1[8],))
+    t3 = _nearer_branch(xp, 1, (qb2_0, qb2_1, qb2_2, qb2_3, qb2_4, qb2_5, qb2_6, xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t2[0], t2[1], t2[2], t2[3], t2[4], t2[5], t2[6], t2[7], t2[8],))
+    t4 = _nearer_branch(xp, 1, (qb3_0, qb3_1, qb3_2, qb3_3, qb3_4, qb3_5, qb3_6, xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t3[0], t3[1], t3[2], t3[3], t3[4], t3[5], t3[6], t3[7], t3[8],))
+    t5 = _nearer_branch(xp, 1, (qb4_0, qb4_1, qb4_2, qb4_3, qb4_4, qb4_5, qb4_6, xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t4[0], t4[1], t4[2], t4[3], t4[4], t4[5], t4[6], t4[7], t4[8],))
+    t6 = _nearer_branch(xp, 1, (qb5_0, qb5_1, qb5_2, qb5_3, qb5_4, qb5_5, qb5_6, xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t5[0], t5[1], t5[2], t5[3], t5[4], t5[5], t5[6], t5[7], t5[8],))
+    t7 = _nearer_branch(xp, 1, (qb6_0, qb6_1, qb6_2, qb6_3, qb6_4, qb6_5, qb6_6, xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t6[0], t6[1], t6[2], t6[3], t6[4], t6[5], t6[6], t6[7], t6[8],))
+    t8 = _nearer_branch(xp, 1, (qb7_0, qb7_1, qb7_2, qb7_3, qb7_4, qb7_5, qb7_6, xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t7[0], t7[1], t7[2], t7[3], t7[4], t7[5], t7[6], t7[7], t7[8],))
+    t9 = xp.greater(t8[8], 0)
+    t10 = xp.isfinite(t0)
+    t11 = t9 & t10
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t359, t350, qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t359, t351, qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t359, t352, qn3), batch),  # 2
-        xp.broadcast_to(xp.where(t359, t353, qn4), batch),  # 3
-        xp.broadcast_to(xp.where(t359, t354, qn5), batch),  # 4
-        xp.broadcast_to(xp.where(t359, t355, qn6), batch),  # 5
-        xp.broadcast_to(xp.where(t359, t356, qn7), batch),  # 6
+        xp.broadcast_to(xp.where(t11, t8[0], qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t11, t8[1], qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t11, t8[2], qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t11, t8[3], qn4), batch),  # 3
+        xp.broadcast_to(xp.where(t11, t8[4], qn5), batch),  # 4
+        xp.broadcast_to(xp.where(t11, t8[5], qn6), batch),  # 5
+        xp.broadcast_to(xp.where(t11, t8[6], qn7), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t358), 2, xp.where(t357, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t10), 2, xp.where(t9, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

@@ -836,6 +836,249 @@ def _jacobi6_rows(count, state):
     return state
 
 
+def _symmetric_solve6(count, state):
+    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w1**2
+        t1 = w2**2
+        t2 = w3**2
+        t3 = w4**2
+        t4 = w5**2
+        t5 = w0**2
+        t6 = casadi.sqrt(t5 + 2*t0 + 2*t1 + 2*w7**2 + 2*t2 + 2*w8**2 + 2*w12**2 + 2*t3 + 2*w9**2 + 2*w13**2 + 2*w16**2 + 2*t4 + 2*w10**2 + 2*w14**2 + 2*w17**2 + 2*w19**2 + w6**2 + w11**2 + w15**2 + w18**2 + w20**2)
+        t7 = casadi.sqrt(t0 + t1 + t2 + t3 + t4 + t5)
+        t8 = t7*casadi.if_else((w0 >= 0), 1, -1)
+        t9 = (t7 > 0)
+        t10 = casadi.if_else(t9, 1/(w0 + t8), 0)
+        t11 = casadi.if_else(t9, 1 + casadi.fabs(w0)/t7, 0)
+        t12 = w1*t10
+        t13 = w2*t10
+        t14 = w3*t10
+        t15 = w4*t10
+        t16 = w5*t10
+        t17 = t11*(w1 + t12*w6 + t13*w7 + t14*w8 + t15*w9 + t16*w10)
+        t18 = -t17 + w1
+        t19 = w6 - t12*t17
+        t20 = w7 - t13*t17
+        t21 = w8 - t14*t17
+        t22 = w9 - t15*t17
+        t23 = w10 - t16*t17
+        t24 = t11*(w2 + t12*w7 + t13*w11 + t14*w12 + t15*w13 + t16*w14)
+        t25 = -t24 + w2
+        t26 = w7 - t12*t24
+        t27 = w11 - t13*t24
+        t28 = w12 - t14*t24
+        t29 = w13 - t15*t24
+        t30 = w14 - t16*t24
+        t31 = t11*(w3 + t12*w8 + t13*w12 + t14*w15 + t15*w16 + t16*w17)
+        t32 = -t31 + w3
+        t33 = w8 - t12*t31
+        t34 = w12 - t13*t31
+        t35 = w15 - t14*t31
+        t36 = w16 - t15*t31
+        t37 = w17 - t16*t31
+        t38 = t11*(w4 + t12*w9 + t13*w13 + t14*w16 + t15*w18 + t16*w19)
+        t39 = -t38 + w4
+        t40 = w9 - t12*t38
+        t41 = w13 - t13*t38
+        t42 = w16 - t14*t38
+        t43 = w18 - t15*t38
+        t44 = w19 - t16*t38
+        t45 = t11*(w5 + t12*w10 + t13*w14 + t14*w17 + t15*w19 + t16*w20)
+        t46 = -t45 + w5
+        t47 = w10 - t12*t45
+        t48 = w14 - t13*t45
+        t49 = w17 - t14*t45
+        t50 = w19 - t15*t45
+        t51 = w20 - t16*t45
+        t52 = t11*(w21 + t12*w22 + t13*w23 + t14*w24 + t15*w25 + t16*w26)
+        t53 = -t52 + w21
+        t54 = w22 - t12*t52
+        t55 = w23 - t13*t52
+        t56 = w24 - t14*t52
+        t57 = w25 - t15*t52
+        t58 = w26 - t16*t52
+        t59 = casadi.sqrt(t19**2 + t20**2 + t21**2 + t22**2 + t23**2)
+        t60 = t59*casadi.if_else((t19 >= 0), 1, -1)
+        t61 = (t59 > 0)
+        t62 = casadi.if_else(t61, 1/(t19 + t60), 0)
+        t63 = casadi.if_else(t61, 1 + casadi.fabs(t19)/t59, 0)
+        t64 = t20*t62
+        t65 = t21*t62
+        t66 = t22*t62
+        t67 = t23*t62
+        t68 = t63*(t26 + t64*t27 + t65*t28 + t66*t29 + t67*t30)
+        t69 = -t68 + t26
+        t70 = t27 - t64*t68
+        t71 = t28 - t65*t68
+        t72 = t29 - t66*t68
+        t73 = t30 - t67*t68
+        t74 = t63*(t33 + t64*t34 + t65*t35 + t66*t36 + t67*t37)
+        t75 = -t74 + t33
+        t76 = t34 - t64*t74
+        t77 = t35 - t65*t74
+        t78 = t36 - t66*t74
+        t79 = t37 - t67*t74
+        t80 = t63*(t40 + t64*t41 + t65*t42 + t66*t43 + t67*t44)
+        t81 = -t80 + t40
+        t82 = t41 - t64*t80
+        t83 = t42 - t65*t80
+        t84 = t43 - t66*t80
+        t85 = t44 - t67*t80
+        t86 = t63*(t47 + t64*t48 + t65*t49 + t66*t50 + t67*t51)
+        t87 = -t86 + t47
+        t88 = t48 - t64*t86
+        t89 = t49 - t65*t86
+        t90 = t50 - t66*t86
+        t91 = t51 - t67*t86
+        t92 = t63*(t54 + t64*t55 + t65*t56 + t66*t57 + t67*t58)
+        t93 = -t92 + t54
+        t94 = t55 - t64*t92
+        t95 = t56 - t65*t92
+        t96 = t57 - t66*t92
+        t97 = t58 - t67*t92
+        t98 = casadi.sqrt(t70**2 + t71**2 + t72**2 + t73**2)
+        t99 = t98*casadi.if_else((t70 >= 0), 1, -1)
+        t100 = (t98 > 0)
+        t101 = casadi.if_else(t100, 1/(t70 + t99), 0)
+        t102 = casadi.if_else(t100, 1 + casadi.fabs(t70)/t98, 0)
+        t103 = t71*t101
+        t104 = t72*t101
+        t105 = t73*t101
+        t106 = t102*(t76 + t103*t77 + t104*t78 + t105*t79)
+        t107 = -t106 + t76
+        t108 = t77 - t103*t106
+        t109 = t78 - t104*t106
+        t110 = t79 - t105*t106
+        t111 = t102*(t82 + t103*t83 + t104*t84 + t105*t85)
+        t112 = -t111 + t82
+        t113 = t83 - t103*t111
+        t114 = t84 - t104*t111
+        t115 = t85 - t105*t111
+        t116 = t102*(t88 + t103*t89 + t104*t90 + t105*t91)
+        t117 = -t116 + t88
+        t118 = t89 - t103*t116
+        t119 = t90 - t104*t116
+        t120 = t91 - t105*t116
+        t121 = t102*(t94 + t103*t95 + t104*t96 + t105*t97)
+        t122 = -t121 + t94
+        t123 = t95 - t103*t121
+        t124 = t96 - t104*t121
+        t125 = t97 - t105*t121
+        t126 = casadi.sqrt(t108**2 + t109**2 + t110**2)
+        t127 = t126*casadi.if_else((t108 >= 0), 1, -1)
+        t128 = (t126 > 0)
+        t129 = casadi.if_else(t128, 1/(t108 + t127), 0)
+        t130 = casadi.if_else(t128, 1 + casadi.fabs(t108)/t126, 0)
+        t131 = t109*t129
+        t132 = t110*t129
+        t133 = t130*(t113 + t131*t114 + t132*t115)
+        t134 = -t133 + t113
+        t135 = t114 - t131*t133
+        t136 = t115 - t132*t133
+        t137 = t130*(t118 + t131*t119 + t132*t120)
+        t138 = -t137 + t118
+        t139 = t119 - t131*t137
+        t140 = t120 - t132*t137
+        t141 = t130*(t123 + t131*t124 + t132*t125)
+        t142 = -t141 + t123
+        t143 = t124 - t131*t141
+        t144 = t125 - t132*t141
+        t145 = casadi.sqrt(t135**2 + t136**2)
+        t146 = t145*casadi.if_else((t135 >= 0), 1, -1)
+        t147 = (t145 > 0)
+        t148 = casadi.if_else(t147, 1/(t135 + t146), 0)
+        t149 = casadi.if_else(t147, 1 + casadi.fabs(t135)/t145, 0)
+        t150 = t136*t148
+        t151 = t149*(t139 + t150*t140)
+        t152 = -t151 + t139
+        t153 = t140 - t150*t151
+        t154 = t149*(t143 + t150*t144)
+        t155 = -t154 + t143
+        t156 = t144 - t150*t154
+        t157 = casadi.fabs(t153)
+        t158 = t157*casadi.if_else((t153 >= 0), 1, -1)
+        t159 = casadi.if_else((t157 > 0), 2, 0)
+        t160 = t156 - t156*t159
+        t161 = casadi.if_else((t158 != 0), -t160/t158, 0)
+        t162 = casadi.if_else((t146 != 0), -(t155 - t152*t161)/t146, 0)
+        t163 = casadi.if_else((t127 != 0), -(-(t134*t162 + t138*t161) + t142)/t127, 0)
+        t164 = casadi.if_else((t99 != 0), -(-(t107*t163 + t112*t162 + t117*t161) + t122)/t99, 0)
+        t165 = casadi.if_else((t60 != 0), -(-(t69*t164 + t75*t163 + t81*t162 + t87*t161) + t93)/t60, 0)
+        t166 = casadi.if_else((t8 != 0), -(-(t18*t165 + t25*t164 + t32*t163 + t39*t162 + t46*t161) + t53)/t8, 0)
+        t167 = 1e-12*t6
+        state = (
+            t166,
+            t165,
+            t164,
+            t163,
+            t162,
+            t161,
+            casadi.if_else(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t7 <= t167), (t59 <= t167)), (t98 <= t167)), (t126 <= t167)), (t145 <= t167)), (t157 <= t167)), 1, 0),
+        )
+    return state
+
+
+def _nearer_branch(count, state):
+    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 114 operations a run."""
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-w0 + w7))
+        t1 = w1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-w1 + w8))
+        t2 = w2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-w2 + w9))
+        t3 = w3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-w3 + w10))
+        t4 = w4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-w4 + w11))
+        t5 = w5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-w5 + w12))
+        t6 = casadi.if_else((t0 < w7), 6.283185307179586, -6.283185307179586)
+        t7 = t6 + t0
+        t8 = -t6 + t0
+        t9 = casadi.if_else(casadi.logic_and((t0 >= -2.705260340591211), (t0 <= 2.705260340591211)), t0, casadi.if_else(casadi.logic_and((t7 >= -2.705260340591211), (t7 <= 2.705260340591211)), t7, casadi.if_else(casadi.logic_and((t8 >= -2.705260340591211), (t8 <= 2.705260340591211)), t8, w0)))
+        t10 = casadi.if_else((t1 < w8), 6.283185307179586, -6.283185307179586)
+        t11 = t10 + t1
+        t12 = -t10 + t1
+        t13 = casadi.if_else(casadi.logic_and((t1 >= -3.141592653589793), (t1 <= 1.1344640137963142)), t1, casadi.if_else(casadi.logic_and((t11 >= -3.141592653589793), (t11 <= 1.1344640137963142)), t11, casadi.if_else(casadi.logic_and((t12 >= -3.141592653589793), (t12 <= 1.1344640137963142)), t12, w1)))
+        t14 = casadi.if_else((t2 < w9), 6.283185307179586, -6.283185307179586)
+        t15 = t14 + t2
+        t16 = -t14 + t2
+        t17 = casadi.if_else(casadi.logic_and((t2 >= -0.2617993877991494), (t2 <= 2.7576202181510405)), t2, casadi.if_else(casadi.logic_and((t15 >= -0.2617993877991494), (t15 <= 2.7576202181510405)), t15, casadi.if_else(casadi.logic_and((t16 >= -0.2617993877991494), (t16 <= 2.7576202181510405)), t16, w2)))
+        t18 = casadi.if_else((t3 < w10), 6.283185307179586, -6.283185307179586)
+        t19 = t18 + t3
+        t20 = -t18 + t3
+        t21 = casadi.if_else(casadi.logic_and((t3 >= -6.1086523819801535), (t3 <= 6.1086523819801535)), t3, casadi.if_else(casadi.logic_and((t19 >= -6.1086523819801535), (t19 <= 6.1086523819801535)), t19, casadi.if_else(casadi.logic_and((t20 >= -6.1086523819801535), (t20 <= 6.1086523819801535)), t20, w3)))
+        t22 = casadi.if_else((t4 < w11), 6.283185307179586, -6.283185307179586)
+        t23 = t22 + t4
+        t24 = -t22 + t4
+        t25 = casadi.if_else(casadi.logic_and((t4 >= -2.2689280275926285), (t4 <= 2.2689280275926285)), t4, casadi.if_else(casadi.logic_and((t23 >= -2.2689280275926285), (t23 <= 2.2689280275926285)), t23, casadi.if_else(casadi.logic_and((t24 >= -2.2689280275926285), (t24 <= 2.2689280275926285)), t24, w4)))
+        t26 = casadi.if_else((t5 < w12), 6.283185307179586, -6.283185307179586)
+        t27 = t26 + t5
+        t28 = -t26 + t5
+        t29 = casadi.if_else(casadi.logic_and((t5 >= -6.1086523819801535), (t5 <= 6.1086523819801535)), t5, casadi.if_else(casadi.logic_and((t27 >= -6.1086523819801535), (t27 <= 6.1086523819801535)), t27, casadi.if_else(casadi.logic_and((t28 >= -6.1086523819801535), (t28 <= 6.1086523819801535)), t28, w5)))
+        t30 = w13*(-w7 + t9)**2 + w14*(-w8 + t13)**2 + w15*(-w9 + t17)**2 + w16*(-w10 + t21)**2 + w17*(-w11 + t25)**2 + w18*(-w12 + t29)**2
+        t31 = (w6 > 0)
+        t32 = casadi.if_else(casadi.logic_and(t31, casadi.logic_or((w26 < 1), (t30 < w25))), 1, 0)
+        t33 = casadi.if_else(t31, 1, w26)
+        t34 = (t32 > 0)
+        t35 = casadi.if_else(t34, t9, w19)
+        t36 = casadi.if_else(t34, t13, w20)
+        t37 = casadi.if_else(t34, t17, w21)
+        t38 = casadi.if_else(t34, t21, w22)
+        t39 = casadi.if_else(t34, t25, w23)
+        t40 = casadi.if_else(t34, t29, w24)
+        t41 = casadi.if_else(t34, t30, w25)
+        state = (
+            t35,
+            t36,
+            t37,
+            t38,
+            t39,
+            t40,
+            t41,
+            t33,
+        )
+    return state
+
+
 def _fk(q):
     """Pose of the tool frame in the world frame (4x4 homogeneous): 102 operations."""
     q1 = q[0]
@@ -3370,7 +3613,7 @@ def _condition_number(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1319 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1321 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -3479,357 +3722,190 @@ def _velocity_ik(q, mu_dot, damping):
     t81 = -t7*t18 + t78 + t79 + t9*t17
     t82 = 2*c1
     t83 = -t7*t4 + t10*t12 - s1*t82 + t53*t65
-    t84 = t66**2
-    t85 = t69**2
-    t86 = t74**2
-    t87 = t52**2
-    t88 = t77**2
-    t89 = damping**2
-    t90 = t89 + t61
-    t91 = t90**2
-    t92 = casadi.sqrt(t84 + t85 + t86 + t87 + t88 + t91)
-    t93 = t92*casadi.if_else((t90 >= 0), 1, -1)
-    t94 = t89 + t64
-    t95 = t48 + t89
-    t96 = t54 + t89
-    t97 = t55 + t89
-    t98 = t89 + t57
-    t99 = casadi.sqrt(2*t84 + 2*t85 + 2*t80**2 + 2*t86 + 2*t50**2 + 2*t81**2 + 2*t87 + 2*t75**2 + 2*t70**2 + 2*t83**2 + 2*t88 + 2*t38**2 + 2*t39**2 + 2*t40**2 + 2*t41**2 + t91 + t94**2 + t95**2 + t96**2 + t97**2 + t98**2)
-    t100 = (t92 > 0)
-    t101 = casadi.if_else(t100, 1/(t90 + t93), 0)
-    t102 = casadi.if_else(t100, 1 + casadi.fabs(t90)/t92, 0)
-    t103 = t66*t101
-    t104 = t69*t101
-    t105 = t74*t101
-    t106 = t52*t101
-    t107 = t77*t101
-    t108 = t102*(t66 + t94*t103 - t104*t80 + t105*t50 + t106*t75 + t107*t38)
-    t109 = -t108 + t66
-    t110 = t94 - t103*t108
-    t111 = t80 + t104*t108
-    t112 = -t50 + t105*t108
-    t113 = t75 - t106*t108
-    t114 = t38 - t107*t108
-    t115 = t102*(t69 - t103*t80 + t95*t104 - t105*t81 + t106*t70 + t107*t39)
-    t116 = -t115 + t69
-    t117 = t80 + t103*t115
-    t118 = t95 - t104*t115
-    t119 = t81 + t105*t115
-    t120 = t70 - t106*t115
-    t121 = t39 - t107*t115
-    t122 = -t102*(t74 + t103*t50 - t104*t81 + t96*t105 - t106*t83 + t107*t40)
-    t123 = t74 + t122
-    t124 = t50 + t103*t122
-    t125 = t81 - t104*t122
-    t126 = t96 + t105*t122
-    t127 = t83 - t106*t122
-    t128 = t40 + t107*t122
-    t129 = t102*(t52 + t103*t75 + t104*t70 - t105*t83 + t97*t106 + t107*t41)
-    t130 = -t129 + t52
-    t131 = t75 - t103*t129
-    t132 = t70 - t104*t129
-    t133 = t83 + t105*t129
-    t134 = t97 - t106*t129
-    t135 = t41 - t107*t129
-    t136 = t102*(t77 + t103*t38 + t104*t39 + t105*t40 + t106*t41 + t98*t107)
-    t137 = -t136 + t77
-    t138 = t38 - t103*t136
-    t139 = t39 - t104*t136
-    t140 = -t40 + t105*t136
-    t141 = t41 - t106*t136
-    t142 = t98 - t107*t136
-    t143 = t102*(mu_dot0 + t103*mu_dot1 + t104*mu_dot2 - t105*mu_dot3 + t106*mu_dot4 + t107*mu_dot5)
-    t144 = -t143 + mu_dot0
-    t145 = mu_dot1 - t103*t143
-    t146 = mu_dot2 - t104*t143
-    t147 = mu_dot3 + t105*t143
-    t148 = mu_dot4 - t106*t143
-    t149 = mu_dot5 - t107*t143
-    t150 = casadi.sqrt(t110**2 + t111**2 + t112**2 + t113**2 + t114**2)
-    t151 = t150*casadi.if_else((t110 >= 0), 1, -1)
-    t152 = (t150 > 0)
-    t153 = casadi.if_else(t152, 1/(t110 + t151), 0)
-    t154 = casadi.if_else(t152, 1 + casadi.fabs(t110)/t150, 0)
-    t155 = t111*t153
-    t156 = t112*t153
-    t157 = t113*t153
-    t158 = t114*t153
-    t159 = t154*(-t117 - t155*t118 + t156*t119 + t157*t120 + t158*t121)
-    t160 = t117 + t159
-    t161 = t118 + t155*t159
-    t162 = t119 - t156*t159
-    t163 = t120 - t157*t159
-    t164 = t121 - t158*t159
-    t165 = -t154*(t124 + t155*t125 - t156*t126 - t157*t127 + t158*t128)
-    t166 = t124 + t165
-    t167 = t125 + t155*t165
-    t168 = t126 - t156*t165
-    t169 = t127 - t157*t165
-    t170 = t128 + t158*t165
-    t171 = t154*(t131 - t155*t132 + t156*t133 + t157*t134 + t158*t135)
-    t172 = -t171 + t131
-    t173 = t132 + t155*t171
-    t174 = t133 - t156*t171
-    t175 = t134 - t157*t171
-    t176 = t135 - t158*t171
-    t177 = t154*(t138 - t155*t139 + t156*t140 + t157*t141 + t158*t142)
-    t178 = -t177 + t138
-    t179 = t139 + t155*t177
-    t180 = t140 - t156*t177
-    t181 = t141 - t157*t177
-    t182 = t142 - t158*t177
-    t183 = t154*(t145 - t155*t146 + t156*t147 + t157*t148 + t158*t149)
-    t184 = -t183 + t145
-    t185 = t146 + t155*t183
-    t186 = t147 - t156*t183
-    t187 = t148 - t157*t183
-    t188 = t149 - t158*t183
-    t189 = casadi.sqrt(t161**2 + t162**2 + t163**2 + t164**2)
-    t190 = t189*casadi.if_else((t161 >= 0), 1, -1)
-    t191 = (t189 > 0)
-    t192 = casadi.if_else(t191, 1/(t161 + t190), 0)
-    t193 = casadi.if_else(t191, 1 + casadi.fabs(t161)/t189, 0)
-    t194 = t162*t192
-    t195 = t163*t192
-    t196 = t164*t192
-    t197 = t193*(t167 + t194*t168 + t195*t169 - t196*t170)
-    t198 = -t197 + t167
-    t199 = t168 - t194*t197
-    t200 = t169 - t195*t197
-    t201 = t170 + t196*t197
-    t202 = t193*(t173 + t194*t174 + t195*t175 + t196*t176)
-    t203 = -t202 + t173
-    t204 = t174 - t194*t202
-    t205 = t175 - t195*t202
-    t206 = t176 - t196*t202
-    t207 = t193*(t179 + t194*t180 + t195*t181 + t196*t182)
-    t208 = -t207 + t179
-    t209 = t180 - t194*t207
-    t210 = t181 - t195*t207
-    t211 = t182 - t196*t207
-    t212 = t193*(t185 + t194*t186 + t195*t187 + t196*t188)
-    t213 = -t212 + t185
-    t214 = t186 - t194*t212
-    t215 = t187 - t195*t212
-    t216 = t188 - t196*t212
-    t217 = casadi.sqrt(t199**2 + t200**2 + t201**2)
-    t218 = t217*casadi.if_else((t199 >= 0), 1, -1)
-    t219 = (t217 > 0)
-    t220 = casadi.if_else(t219, 1/(t199 + t218), 0)
-    t221 = casadi.if_else(t219, 1 + casadi.fabs(t199)/t217, 0)
-    t222 = t200*t220
-    t223 = t201*t220
-    t224 = t221*(t204 + t222*t205 - t223*t206)
-    t225 = -t224 + t204
-    t226 = t205 - t222*t224
-    t227 = t206 + t223*t224
-    t228 = t221*(t209 + t222*t210 - t223*t211)
-    t229 = -t228 + t209
-    t230 = t210 - t222*t228
-    t231 = t211 + t223*t228
-    t232 = t221*(t214 + t222*t215 - t223*t216)
-    t233 = -t232 + t214
-    t234 = t215 - t222*t232
-    t235 = t216 + t223*t232
-    t236 = casadi.sqrt(t226**2 + t227**2)
-    t237 = t236*casadi.if_else((t226 >= 0), 1, -1)
-    t238 = (t236 > 0)
-    t239 = casadi.if_else(t238, 1/(t226 + t237), 0)
-    t240 = casadi.if_else(t238, 1 + casadi.fabs(t226)/t236, 0)
-    t241 = t227*t239
-    t242 = t240*(t230 + t241*t231)
-    t243 = -t242 + t230
-    t244 = t231 - t241*t242
-    t245 = t240*(t234 + t241*t235)
-    t246 = -t245 + t234
-    t247 = t235 - t241*t245
-    t248 = casadi.fabs(t244)
-    t249 = t248*casadi.if_else((t244 >= 0), 1, -1)
-    t250 = casadi.if_else((t248 > 0), 2, 0)
-    t251 = t247 - t247*t250
-    t252 = casadi.if_else((t249 != 0), -t251/t249, 0)
-    t253 = casadi.if_else((t237 != 0), -(t246 - t243*t252)/t237, 0)
-    t254 = casadi.if_else((t218 != 0), -(-(t225*t253 + t229*t252) + t233)/t218, 0)
-    t255 = casadi.if_else((t190 != 0), -(-(t198*t254 + t203*t253 + t208*t252) + t213)/t190, 0)
-    t256 = casadi.if_else((t151 != 0), -(-(-t160*t255 - t166*t254 + t172*t253 + t178*t252) + t184)/t151, 0)
-    t257 = casadi.if_else((t93 != 0), -(-(t109*t256 + t116*t255 - t123*t254 + t130*t253 + t137*t252) + t144)/t93, 0)
-    t258 = t252 - t33*t257 + t32*t256
-    t259 = t23*t257 - t24*t256 + t17*t255 + c23*t252 + t9*t254 + t11*t253
-    t260 = t36*t257 + t37*t256 + t18*t255 - t7*t254 + t4*t253 + t35*t252
-    t261 = t10*t254 + t12*t253 - t0*t252
-    t262 = s1*t22
-    t263 = -s1*t254 + c1*t253
-    t264 = t263 - t34*t255 + t71*t257 + t262*t256
-    t265 = s1*t21
-    t266 = t263 - t28*t255 + t72*t257 + t265*t256
-    t267 = (t45 > 0)
-    t268 = casadi.if_else(t267, 1/(t76 + t46), 0)
-    t269 = casadi.if_else(t267, 1 + casadi.fabs(t33)/t45, 0)
-    t270 = t32*t268
-    t271 = t269*(t71 + t262*t270)
-    t272 = -t271 + t71
-    t273 = t262 - t270*t271
-    t274 = t269*(t72 + t265*t270)
-    t275 = -t274 + t72
-    t276 = t269*(t23 + c23*t268 - t24*t270)
-    t277 = -t276 + t23
-    t278 = t269*(t36 + t37*t270 + t35*t268)
-    t279 = -t278 + t36
-    t280 = t269*(mu_dot0 + mu_dot5*t268 + t270*mu_dot1)
-    t281 = -t280 + mu_dot0
-    t282 = t268*t274
-    t283 = t265 - t32*t282
-    t284 = t268*t276
-    t285 = t24 + t32*t284
-    t286 = -t284 + c23
-    t287 = t268*t278
-    t288 = t37 - t32*t287
-    t289 = -t287 + t35
-    t290 = t268**2
-    t291 = casadi.sqrt(t47 + t49 + t51 + t273**2 + t290*t271**2)
-    t292 = t291*casadi.if_else((t273 >= 0), 1, -1)
-    t293 = t0*t269
-    t294 = t290*t293
-    t295 = t32*t294
-    t296 = -t0
-    t297 = t294 + t296
-    t298 = t268*t280
-    t299 = mu_dot1 - t32*t298
-    t300 = -t298 + mu_dot5
-    t301 = (t291 > 0)
-    t302 = casadi.if_else(t301, 1/(t273 + t292), 0)
-    t303 = casadi.if_else(t301, 1 + casadi.fabs(t273)/t291, 0)
-    t304 = t34*t302
-    t305 = t271*t302
-    t306 = t303*(t283 + t28*t304 + t49*t302 + t51*t302 + t290*t305*t274)
-    t307 = -t306 + t283
-    t308 = -t28
-    t309 = t308 + t304*t306
-    t310 = t302*t306
-    t311 = -s1 + s1*t310
-    t312 = c1 - c1*t310
-    t313 = t268*t271
-    t314 = -t282 + t310*t313
-    t315 = casadi.sqrt(t309**2 + t311**2 + t312**2 + t314**2)
-    t316 = t315*casadi.if_else((t309 >= 0), 1, -1)
-    t317 = t305*t268
-    t318 = -t303*(t285 + t17*t304 + t317*t286)
-    t319 = t285 + t318
-    t320 = t17 + t304*t318
-    t321 = t302*t318
-    t322 = t9 + s1*t321
-    t323 = t11 - c1*t321
-    t324 = t286 + t313*t321
-    t325 = s1*t302
-    t326 = c1*t302
-    t327 = t303*(t288 - t18*t304 + t7*t325 + t4*t326 - t317*t289)
-    t328 = -t327 + t288
-    t329 = t18 + t304*t327
-    t330 = t4 - t326*t327
-    t331 = t289 + t317*t327
-    t332 = t303*(t295 - t10*t325 + t12*t326 - t317*t297)
-    t333 = -t332 + t295
-    t334 = t10 + t325*t332
-    t335 = t12 - t326*t332
-    t336 = t297 + t317*t332
-    t337 = -t303*(-t299 + t304*mu_dot2 + t325*mu_dot3 - t326*mu_dot4 + t317*t300)
-    t338 = -t337 + t299
-    t339 = mu_dot2 + t304*t337
-    t340 = mu_dot3 + t325*t337
-    t341 = mu_dot4 - t326*t337
-    t342 = t300 + t317*t337
-    t343 = -t7
-    t344 = t343 + t325*t327
-    t345 = 1 - t24 - t34 + q1 + q2 + q3 + c23 + q4 + t4 + q5 + t10 + t12 + q6 + t32 + t9 + t11 + t35 + t23 + t36 + t37 + t17 + t18 - 2*s1 + t71 + t72 + t76 + t82 + t262 + t265 + t296 + t308 + t343 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t346 = (t315 > 0)
-    t347 = casadi.if_else(t346, 1/(t309 + t316), 0)
-    t348 = casadi.if_else(t346, 1 + casadi.fabs(t309)/t315, 0)
-    t349 = t311*t347
-    t350 = t312*t347
-    t351 = t314*t347
-    t352 = t348*(t320 + t349*t322 + t350*t323 + t351*t324)
-    t353 = -t352 + t320
-    t354 = t322 - t349*t352
-    t355 = t323 - t350*t352
-    t356 = t324 - t351*t352
-    t357 = t348*(t329 + t349*t344 + t350*t330 + t351*t331)
-    t358 = -t357 + t329
-    t359 = t344 - t349*t357
-    t360 = t330 - t350*t357
-    t361 = t331 - t351*t357
-    t362 = t348*(t339 + t349*t340 + t350*t341 + t351*t342)
-    t363 = -t362 + t339
-    t364 = t340 - t349*t362
-    t365 = t341 - t350*t362
-    t366 = t342 - t351*t362
-    t367 = casadi.sqrt(t354**2 + t355**2 + t356**2)
-    t368 = t367*casadi.if_else((t354 >= 0), 1, -1)
-    t369 = t304*t332
-    t370 = t348*(t369 + t349*t334 + t350*t335 + t351*t336)
-    t371 = -t370 + t369
-    t372 = t334 - t349*t370
-    t373 = t335 - t350*t370
-    t374 = t336 - t351*t370
-    t375 = (t367 > 0)
-    t376 = casadi.if_else(t375, 1/(t354 + t368), 0)
-    t377 = casadi.if_else(t375, 1 + casadi.fabs(t354)/t367, 0)
-    t378 = t355*t376
-    t379 = t356*t376
-    t380 = t377*(t359 + t378*t360 + t379*t361)
-    t381 = -t380 + t359
-    t382 = t360 - t378*t380
-    t383 = t361 - t379*t380
-    t384 = t377*(t372 + t378*t373 + t379*t374)
-    t385 = -t384 + t372
-    t386 = t373 - t378*t384
-    t387 = t374 - t379*t384
-    t388 = t377*(t364 + t378*t365 + t379*t366)
-    t389 = -t388 + t364
-    t390 = t365 - t378*t388
-    t391 = t366 - t379*t388
-    t392 = casadi.sqrt(t382**2 + t383**2)
-    t393 = t392*casadi.if_else((t382 >= 0), 1, -1)
-    t394 = (t392 > 0)
-    t395 = casadi.if_else(t394, 1/(t382 + t393), 0)
-    t396 = casadi.if_else(t394, 1 + casadi.fabs(t382)/t392, 0)
-    t397 = t383*t395
-    t398 = t396*(t386 + t397*t387)
-    t399 = -t398 + t386
-    t400 = t387 - t397*t398
-    t401 = t396*(t390 + t397*t391)
-    t402 = -t401 + t390
-    t403 = t391 - t397*t401
-    t404 = casadi.fabs(t400)
-    t405 = t404*casadi.if_else((t400 >= 0), 1, -1)
-    t406 = casadi.if_else((t404 > 0), 2, 0)
-    t407 = t403 - t403*t406
-    t408 = casadi.if_else((t405 != 0), -t407/t405, 0)
-    t409 = casadi.if_else((t393 != 0), -(t402 - t399*t408)/t393, 0)
-    t410 = casadi.if_else((t368 != 0), -(-(t381*t409 + t385*t408) + t389)/t368, 0)
-    t411 = casadi.if_else((t316 != 0), -(-(t353*t410 + t358*t409 + t371*t408) + t363)/t316, 0)
-    t412 = casadi.if_else((t292 != 0), -(-(t307*t411 - t319*t410 + t328*t409 + t333*t408) + t338)/t292, 0)
-    t413 = casadi.if_else((t46 != 0), -(-(t272*t412 + t275*t411 + t277*t410 + t279*t409 + t293*t268*t408) + t281)/t46, 0)
-    t414 = (casadi.fabs(t345) < casadi.inf)
-    t415 = (damping >= 0)
-    t416 = (damping > 0)
-    t417 = 1e-12*t99
-    t418 = 1e-12*t63
-    t419 = casadi.logic_or(casadi.logic_and(t416, casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t92 <= t417), (t150 <= t417)), (t189 <= t417)), (t217 <= t417)), (t236 <= t417)), (t248 <= t417))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t45 <= t418), (t291 <= t418)), (t315 <= t418)), (t367 <= t418)), (t392 <= t418)), (t404 <= t418))))
-    t420 = casadi.logic_and(casadi.logic_and(t414, t415), casadi.logic_not(t419))
+    t84 = damping**2
+    t85 = _symmetric_solve6(1, (t84 + t61, t66, t69, -t74, t52, t77, t84 + t64, -t80, -t50, t75, t38, t48 + t84, t81, t70, t39, t54 + t84, t83, -t40, t55 + t84, t41, t84 + t57, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t86 = t85[5]
+    t87 = t85[0]
+    t88 = t85[1]
+    t89 = t86 - t33*t87 + t32*t88
+    t90 = s1*t22
+    t91 = t85[2]
+    t92 = t85[3]
+    t93 = t85[4]
+    t94 = t23*t87 - t24*t88 + t17*t91 + t9*t92 + t11*t93 + c23*t86
+    t95 = t36*t87 + t37*t88 + t18*t91 - t7*t92 + t4*t93 + t35*t86
+    t96 = t10*t92 + t12*t93 - t0*t86
+    t97 = -s1*t92 + c1*t93
+    t98 = t97 + t71*t87 + t88*t90 - t34*t91
+    t99 = s1*t21
+    t100 = t97 + t72*t87 + t88*t99 - t28*t91
+    t101 = (t45 > 0)
+    t102 = casadi.if_else(t101, 1/(t76 + t46), 0)
+    t103 = casadi.if_else(t101, 1 + casadi.fabs(t33)/t45, 0)
+    t104 = t32*t102
+    t105 = t103*(t71 + t90*t104)
+    t106 = -t105 + t71
+    t107 = t90 - t104*t105
+    t108 = t103*(t72 + t99*t104)
+    t109 = -t108 + t72
+    t110 = t103*(t23 + c23*t102 - t24*t104)
+    t111 = -t110 + t23
+    t112 = t103*(t36 + t37*t104 + t35*t102)
+    t113 = -t112 + t36
+    t114 = t103*(mu_dot0 + mu_dot5*t102 + t104*mu_dot1)
+    t115 = -t114 + mu_dot0
+    t116 = t102*t108
+    t117 = t99 - t32*t116
+    t118 = t102*t110
+    t119 = t24 + t32*t118
+    t120 = -t118 + c23
+    t121 = t102*t112
+    t122 = t37 - t32*t121
+    t123 = -t121 + t35
+    t124 = t102**2
+    t125 = casadi.sqrt(t47 + t49 + t51 + t107**2 + t124*t105**2)
+    t126 = t125*casadi.if_else((t107 >= 0), 1, -1)
+    t127 = t0*t103
+    t128 = t124*t127
+    t129 = t32*t128
+    t130 = -t0
+    t131 = t128 + t130
+    t132 = t102*t114
+    t133 = mu_dot1 - t32*t132
+    t134 = -t132 + mu_dot5
+    t135 = (t125 > 0)
+    t136 = casadi.if_else(t135, 1/(t107 + t126), 0)
+    t137 = casadi.if_else(t135, 1 + casadi.fabs(t107)/t125, 0)
+    t138 = t34*t136
+    t139 = t105*t136
+    t140 = t137*(t117 + t28*t138 + t49*t136 + t51*t136 + t124*t139*t108)
+    t141 = -t140 + t117
+    t142 = -t28
+    t143 = t142 + t138*t140
+    t144 = t136*t140
+    t145 = -s1 + s1*t144
+    t146 = c1 - c1*t144
+    t147 = t102*t105
+    t148 = -t116 + t144*t147
+    t149 = casadi.sqrt(t143**2 + t145**2 + t146**2 + t148**2)
+    t150 = t149*casadi.if_else((t143 >= 0), 1, -1)
+    t151 = t139*t102
+    t152 = -t137*(t119 + t17*t138 + t151*t120)
+    t153 = t119 + t152
+    t154 = t17 + t138*t152
+    t155 = t136*t152
+    t156 = t9 + s1*t155
+    t157 = t11 - c1*t155
+    t158 = t120 + t147*t155
+    t159 = s1*t136
+    t160 = c1*t136
+    t161 = t137*(t122 - t18*t138 + t7*t159 + t4*t160 - t151*t123)
+    t162 = -t161 + t122
+    t163 = t18 + t138*t161
+    t164 = t4 - t160*t161
+    t165 = t123 + t151*t161
+    t166 = t137*(t129 - t10*t159 + t12*t160 - t151*t131)
+    t167 = -t166 + t129
+    t168 = t10 + t159*t166
+    t169 = t12 - t160*t166
+    t170 = t131 + t151*t166
+    t171 = -t137*(-t133 + t138*mu_dot2 + t159*mu_dot3 - t160*mu_dot4 + t151*t134)
+    t172 = -t171 + t133
+    t173 = mu_dot2 + t138*t171
+    t174 = mu_dot3 + t159*t171
+    t175 = mu_dot4 - t160*t171
+    t176 = t134 + t151*t171
+    t177 = -t7
+    t178 = t177 + t159*t161
+    t179 = 1 - t24 - t34 + q1 + q2 + q3 + c23 + q4 + t4 + q5 + t10 + t12 + q6 + t32 + t9 + t11 + t35 + t23 + t36 + t37 + t17 + t18 - 2*s1 + t71 + t72 + t76 + t82 + t90 + t99 + t130 + t142 + t177 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t180 = (t149 > 0)
+    t181 = casadi.if_else(t180, 1/(t143 + t150), 0)
+    t182 = casadi.if_else(t180, 1 + casadi.fabs(t143)/t149, 0)
+    t183 = t145*t181
+    t184 = t146*t181
+    t185 = t148*t181
+    t186 = t182*(t154 + t183*t156 + t184*t157 + t185*t158)
+    t187 = -t186 + t154
+    t188 = t156 - t183*t186
+    t189 = t157 - t184*t186
+    t190 = t158 - t185*t186
+    t191 = t182*(t163 + t183*t178 + t184*t164 + t185*t165)
+    t192 = -t191 + t163
+    t193 = t178 - t183*t191
+    t194 = t164 - t184*t191
+    t195 = t165 - t185*t191
+    t196 = t182*(t173 + t183*t174 + t184*t175 + t185*t176)
+    t197 = -t196 + t173
+    t198 = t174 - t183*t196
+    t199 = t175 - t184*t196
+    t200 = t176 - t185*t196
+    t201 = casadi.sqrt(t188**2 + t189**2 + t190**2)
+    t202 = t201*casadi.if_else((t188 >= 0), 1, -1)
+    t203 = t138*t166
+    t204 = t182*(t203 + t183*t168 + t184*t169 + t185*t170)
+    t205 = -t204 + t203
+    t206 = t168 - t183*t204
+    t207 = t169 - t184*t204
+    t208 = t170 - t185*t204
+    t209 = (t201 > 0)
+    t210 = casadi.if_else(t209, 1/(t188 + t202), 0)
+    t211 = casadi.if_else(t209, 1 + casadi.fabs(t188)/t201, 0)
+    t212 = t189*t210
+    t213 = t190*t210
+    t214 = t211*(t193 + t212*t194 + t213*t195)
+    t215 = -t214 + t193
+    t216 = t194 - t212*t214
+    t217 = t195 - t213*t214
+    t218 = t211*(t206 + t212*t207 + t213*t208)
+    t219 = -t218 + t206
+    t220 = t207 - t212*t218
+    t221 = t208 - t213*t218
+    t222 = t211*(t198 + t212*t199 + t213*t200)
+    t223 = -t222 + t198
+    t224 = t199 - t212*t222
+    t225 = t200 - t213*t222
+    t226 = casadi.sqrt(t216**2 + t217**2)
+    t227 = t226*casadi.if_else((t216 >= 0), 1, -1)
+    t228 = (t226 > 0)
+    t229 = casadi.if_else(t228, 1/(t216 + t227), 0)
+    t230 = casadi.if_else(t228, 1 + casadi.fabs(t216)/t226, 0)
+    t231 = t217*t229
+    t232 = t230*(t220 + t231*t221)
+    t233 = -t232 + t220
+    t234 = t221 - t231*t232
+    t235 = t230*(t224 + t231*t225)
+    t236 = -t235 + t224
+    t237 = t225 - t231*t235
+    t238 = casadi.fabs(t234)
+    t239 = t238*casadi.if_else((t234 >= 0), 1, -1)
+    t240 = casadi.if_else((t238 > 0), 2, 0)
+    t241 = t237 - t237*t240
+    t242 = casadi.if_else((t239 != 0), -t241/t239, 0)
+    t243 = casadi.if_else((t227 != 0), -(t236 - t233*t242)/t227, 0)
+    t244 = casadi.if_else((t202 != 0), -(-(t215*t243 + t219*t242) + t223)/t202, 0)
+    t245 = casadi.if_else((t150 != 0), -(-(t187*t244 + t192*t243 + t205*t242) + t197)/t150, 0)
+    t246 = casadi.if_else((t126 != 0), -(-(t141*t245 - t153*t244 + t162*t243 + t167*t242) + t172)/t126, 0)
+    t247 = casadi.if_else((t46 != 0), -(-(t106*t246 + t109*t245 + t111*t244 + t113*t243 + t127*t102*t242) + t115)/t46, 0)
+    t248 = (casadi.fabs(t179) < casadi.inf)
+    t249 = (damping >= 0)
+    t250 = (damping > 0)
+    t251 = 1e-12*t63
+    t252 = casadi.logic_or(casadi.logic_and(t250, (t85[6] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t45 <= t251), (t125 <= t251)), (t149 <= t251)), (t201 <= t251)), (t226 <= t251)), (t238 <= t251))))
+    t253 = casadi.logic_and(casadi.logic_and(t248, t249), casadi.logic_not(t252))
     q_dot = casadi.SX(6, 1)
-    q_dot[0, 0] = casadi.if_else(t420, casadi.if_else(t416, t258, t413), 0)
-    q_dot[1, 0] = casadi.if_else(t420, casadi.if_else(t416, t264, t412), 0)
-    q_dot[2, 0] = casadi.if_else(t420, casadi.if_else(t416, t266, t411), 0)
-    q_dot[3, 0] = casadi.if_else(t420, casadi.if_else(t416, t259, t410), 0)
-    q_dot[4, 0] = casadi.if_else(t420, casadi.if_else(t416, t260, t409), 0)
-    q_dot[5, 0] = casadi.if_else(t420, casadi.if_else(t416, t261, t408), 0)
+    q_dot[0, 0] = casadi.if_else(t253, casadi.if_else(t250, t89, t247), 0)
+    q_dot[1, 0] = casadi.if_else(t253, casadi.if_else(t250, t98, t246), 0)
+    q_dot[2, 0] = casadi.if_else(t253, casadi.if_else(t250, t100, t245), 0)
+    q_dot[3, 0] = casadi.if_else(t253, casadi.if_else(t250, t94, t244), 0)
+    q_dot[4, 0] = casadi.if_else(t253, casadi.if_else(t250, t95, t243), 0)
+    q_dot[5, 0] = casadi.if_else(t253, casadi.if_else(t250, t96, t242), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t414, t415)), 2, casadi.if_else(t419, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t248, t249)), 2, casadi.if_else(t252, 1, 0))
     return [q_dot, status]
 
 
 def _velocity_ik_nullspace(q, mu_dot, z, damping):
-    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 1325 operations."""
+    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 1327 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -3944,357 +4020,190 @@ def _velocity_ik_nullspace(q, mu_dot, z, damping):
     t81 = -t7*t18 + t78 + t79 + t9*t17
     t82 = 2*c1
     t83 = -t7*t4 + t10*t12 - s1*t82 + t53*t65
-    t84 = t66**2
-    t85 = t69**2
-    t86 = t74**2
-    t87 = t52**2
-    t88 = t77**2
-    t89 = damping**2
-    t90 = t89 + t61
-    t91 = t90**2
-    t92 = casadi.sqrt(t84 + t85 + t86 + t87 + t88 + t91)
-    t93 = t92*casadi.if_else((t90 >= 0), 1, -1)
-    t94 = t89 + t64
-    t95 = t48 + t89
-    t96 = t54 + t89
-    t97 = t55 + t89
-    t98 = t89 + t57
-    t99 = casadi.sqrt(2*t84 + 2*t85 + 2*t80**2 + 2*t86 + 2*t50**2 + 2*t81**2 + 2*t87 + 2*t75**2 + 2*t70**2 + 2*t83**2 + 2*t88 + 2*t38**2 + 2*t39**2 + 2*t40**2 + 2*t41**2 + t91 + t94**2 + t95**2 + t96**2 + t97**2 + t98**2)
-    t100 = (t92 > 0)
-    t101 = casadi.if_else(t100, 1/(t90 + t93), 0)
-    t102 = casadi.if_else(t100, 1 + casadi.fabs(t90)/t92, 0)
-    t103 = t66*t101
-    t104 = t69*t101
-    t105 = t74*t101
-    t106 = t52*t101
-    t107 = t77*t101
-    t108 = t102*(t66 + t94*t103 - t104*t80 + t105*t50 + t106*t75 + t107*t38)
-    t109 = -t108 + t66
-    t110 = t94 - t103*t108
-    t111 = t80 + t104*t108
-    t112 = -t50 + t105*t108
-    t113 = t75 - t106*t108
-    t114 = t38 - t107*t108
-    t115 = t102*(t69 - t103*t80 + t95*t104 - t105*t81 + t106*t70 + t107*t39)
-    t116 = -t115 + t69
-    t117 = t80 + t103*t115
-    t118 = t95 - t104*t115
-    t119 = t81 + t105*t115
-    t120 = t70 - t106*t115
-    t121 = t39 - t107*t115
-    t122 = -t102*(t74 + t103*t50 - t104*t81 + t96*t105 - t106*t83 + t107*t40)
-    t123 = t74 + t122
-    t124 = t50 + t103*t122
-    t125 = t81 - t104*t122
-    t126 = t96 + t105*t122
-    t127 = t83 - t106*t122
-    t128 = t40 + t107*t122
-    t129 = t102*(t52 + t103*t75 + t104*t70 - t105*t83 + t97*t106 + t107*t41)
-    t130 = -t129 + t52
-    t131 = t75 - t103*t129
-    t132 = t70 - t104*t129
-    t133 = t83 + t105*t129
-    t134 = t97 - t106*t129
-    t135 = t41 - t107*t129
-    t136 = t102*(t77 + t103*t38 + t104*t39 + t105*t40 + t106*t41 + t98*t107)
-    t137 = -t136 + t77
-    t138 = t38 - t103*t136
-    t139 = t39 - t104*t136
-    t140 = -t40 + t105*t136
-    t141 = t41 - t106*t136
-    t142 = t98 - t107*t136
-    t143 = t102*(mu_dot0 + t103*mu_dot1 + t104*mu_dot2 - t105*mu_dot3 + t106*mu_dot4 + t107*mu_dot5)
-    t144 = -t143 + mu_dot0
-    t145 = mu_dot1 - t103*t143
-    t146 = mu_dot2 - t104*t143
-    t147 = mu_dot3 + t105*t143
-    t148 = mu_dot4 - t106*t143
-    t149 = mu_dot5 - t107*t143
-    t150 = casadi.sqrt(t110**2 + t111**2 + t112**2 + t113**2 + t114**2)
-    t151 = t150*casadi.if_else((t110 >= 0), 1, -1)
-    t152 = (t150 > 0)
-    t153 = casadi.if_else(t152, 1/(t110 + t151), 0)
-    t154 = casadi.if_else(t152, 1 + casadi.fabs(t110)/t150, 0)
-    t155 = t111*t153
-    t156 = t112*t153
-    t157 = t113*t153
-    t158 = t114*t153
-    t159 = t154*(-t117 - t155*t118 + t156*t119 + t157*t120 + t158*t121)
-    t160 = t117 + t159
-    t161 = t118 + t155*t159
-    t162 = t119 - t156*t159
-    t163 = t120 - t157*t159
-    t164 = t121 - t158*t159
-    t165 = -t154*(t124 + t155*t125 - t156*t126 - t157*t127 + t158*t128)
-    t166 = t124 + t165
-    t167 = t125 + t155*t165
-    t168 = t126 - t156*t165
-    t169 = t127 - t157*t165
-    t170 = t128 + t158*t165
-    t171 = t154*(t131 - t155*t132 + t156*t133 + t157*t134 + t158*t135)
-    t172 = -t171 + t131
-    t173 = t132 + t155*t171
-    t174 = t133 - t156*t171
-    t175 = t134 - t157*t171
-    t176 = t135 - t158*t171
-    t177 = t154*(t138 - t155*t139 + t156*t140 + t157*t141 + t158*t142)
-    t178 = -t177 + t138
-    t179 = t139 + t155*t177
-    t180 = t140 - t156*t177
-    t181 = t141 - t157*t177
-    t182 = t142 - t158*t177
-    t183 = t154*(t145 - t155*t146 + t156*t147 + t157*t148 + t158*t149)
-    t184 = -t183 + t145
-    t185 = t146 + t155*t183
-    t186 = t147 - t156*t183
-    t187 = t148 - t157*t183
-    t188 = t149 - t158*t183
-    t189 = casadi.sqrt(t161**2 + t162**2 + t163**2 + t164**2)
-    t190 = t189*casadi.if_else((t161 >= 0), 1, -1)
-    t191 = (t189 > 0)
-    t192 = casadi.if_else(t191, 1/(t161 + t190), 0)
-    t193 = casadi.if_else(t191, 1 + casadi.fabs(t161)/t189, 0)
-    t194 = t162*t192
-    t195 = t163*t192
-    t196 = t164*t192
-    t197 = t193*(t167 + t194*t168 + t195*t169 - t196*t170)
-    t198 = -t197 + t167
-    t199 = t168 - t194*t197
-    t200 = t169 - t195*t197
-    t201 = t170 + t196*t197
-    t202 = t193*(t173 + t194*t174 + t195*t175 + t196*t176)
-    t203 = -t202 + t173
-    t204 = t174 - t194*t202
-    t205 = t175 - t195*t202
-    t206 = t176 - t196*t202
-    t207 = t193*(t179 + t194*t180 + t195*t181 + t196*t182)
-    t208 = -t207 + t179
-    t209 = t180 - t194*t207
-    t210 = t181 - t195*t207
-    t211 = t182 - t196*t207
-    t212 = t193*(t185 + t194*t186 + t195*t187 + t196*t188)
-    t213 = -t212 + t185
-    t214 = t186 - t194*t212
-    t215 = t187 - t195*t212
-    t216 = t188 - t196*t212
-    t217 = casadi.sqrt(t199**2 + t200**2 + t201**2)
-    t218 = t217*casadi.if_else((t199 >= 0), 1, -1)
-    t219 = (t217 > 0)
-    t220 = casadi.if_else(t219, 1/(t199 + t218), 0)
-    t221 = casadi.if_else(t219, 1 + casadi.fabs(t199)/t217, 0)
-    t222 = t200*t220
-    t223 = t201*t220
-    t224 = t221*(t204 + t222*t205 - t223*t206)
-    t225 = -t224 + t204
-    t226 = t205 - t222*t224
-    t227 = t206 + t223*t224
-    t228 = t221*(t209 + t222*t210 - t223*t211)
-    t229 = -t228 + t209
-    t230 = t210 - t222*t228
-    t231 = t211 + t223*t228
-    t232 = t221*(t214 + t222*t215 - t223*t216)
-    t233 = -t232 + t214
-    t234 = t215 - t222*t232
-    t235 = t216 + t223*t232
-    t236 = casadi.sqrt(t226**2 + t227**2)
-    t237 = t236*casadi.if_else((t226 >= 0), 1, -1)
-    t238 = (t236 > 0)
-    t239 = casadi.if_else(t238, 1/(t226 + t237), 0)
-    t240 = casadi.if_else(t238, 1 + casadi.fabs(t226)/t236, 0)
-    t241 = t227*t239
-    t242 = t240*(t230 + t241*t231)
-    t243 = -t242 + t230
-    t244 = t231 - t241*t242
-    t245 = t240*(t234 + t241*t235)
-    t246 = -t245 + t234
-    t247 = t235 - t241*t245
-    t248 = casadi.fabs(t244)
-    t249 = t248*casadi.if_else((t244 >= 0), 1, -1)
-    t250 = casadi.if_else((t248 > 0), 2, 0)
-    t251 = t247 - t247*t250
-    t252 = casadi.if_else((t249 != 0), -t251/t249, 0)
-    t253 = casadi.if_else((t237 != 0), -(t246 - t243*t252)/t237, 0)
-    t254 = casadi.if_else((t218 != 0), -(-(t225*t253 + t229*t252) + t233)/t218, 0)
-    t255 = casadi.if_else((t190 != 0), -(-(t198*t254 + t203*t253 + t208*t252) + t213)/t190, 0)
-    t256 = casadi.if_else((t151 != 0), -(-(-t160*t255 - t166*t254 + t172*t253 + t178*t252) + t184)/t151, 0)
-    t257 = casadi.if_else((t93 != 0), -(-(t109*t256 + t116*t255 - t123*t254 + t130*t253 + t137*t252) + t144)/t93, 0)
-    t258 = t252 - t33*t257 + t32*t256
-    t259 = t23*t257 - t24*t256 + t17*t255 + c23*t252 + t9*t254 + t11*t253
-    t260 = t36*t257 + t37*t256 + t18*t255 - t7*t254 + t4*t253 + t35*t252
-    t261 = t10*t254 + t12*t253 - t0*t252
-    t262 = s1*t22
-    t263 = -s1*t254 + c1*t253
-    t264 = t263 - t34*t255 + t71*t257 + t262*t256
-    t265 = s1*t21
-    t266 = t263 - t28*t255 + t72*t257 + t265*t256
-    t267 = (t45 > 0)
-    t268 = casadi.if_else(t267, 1/(t76 + t46), 0)
-    t269 = casadi.if_else(t267, 1 + casadi.fabs(t33)/t45, 0)
-    t270 = t32*t268
-    t271 = t269*(t71 + t262*t270)
-    t272 = -t271 + t71
-    t273 = t262 - t270*t271
-    t274 = t269*(t72 + t265*t270)
-    t275 = -t274 + t72
-    t276 = t269*(t23 + c23*t268 - t24*t270)
-    t277 = -t276 + t23
-    t278 = t269*(t36 + t37*t270 + t35*t268)
-    t279 = -t278 + t36
-    t280 = t269*(mu_dot0 + mu_dot5*t268 + t270*mu_dot1)
-    t281 = -t280 + mu_dot0
-    t282 = t268*t274
-    t283 = t265 - t32*t282
-    t284 = t268*t276
-    t285 = t24 + t32*t284
-    t286 = -t284 + c23
-    t287 = t268*t278
-    t288 = t37 - t32*t287
-    t289 = -t287 + t35
-    t290 = t268**2
-    t291 = casadi.sqrt(t47 + t49 + t51 + t273**2 + t290*t271**2)
-    t292 = t291*casadi.if_else((t273 >= 0), 1, -1)
-    t293 = t0*t269
-    t294 = t290*t293
-    t295 = t32*t294
-    t296 = -t0
-    t297 = t294 + t296
-    t298 = t268*t280
-    t299 = mu_dot1 - t32*t298
-    t300 = -t298 + mu_dot5
-    t301 = (t291 > 0)
-    t302 = casadi.if_else(t301, 1/(t273 + t292), 0)
-    t303 = casadi.if_else(t301, 1 + casadi.fabs(t273)/t291, 0)
-    t304 = t34*t302
-    t305 = t271*t302
-    t306 = t303*(t283 + t28*t304 + t49*t302 + t51*t302 + t290*t305*t274)
-    t307 = -t306 + t283
-    t308 = -t28
-    t309 = t308 + t304*t306
-    t310 = t302*t306
-    t311 = -s1 + s1*t310
-    t312 = c1 - c1*t310
-    t313 = t268*t271
-    t314 = -t282 + t310*t313
-    t315 = casadi.sqrt(t309**2 + t311**2 + t312**2 + t314**2)
-    t316 = t315*casadi.if_else((t309 >= 0), 1, -1)
-    t317 = t305*t268
-    t318 = -t303*(t285 + t17*t304 + t317*t286)
-    t319 = t285 + t318
-    t320 = t17 + t304*t318
-    t321 = t302*t318
-    t322 = t9 + s1*t321
-    t323 = t11 - c1*t321
-    t324 = t286 + t313*t321
-    t325 = s1*t302
-    t326 = c1*t302
-    t327 = t303*(t288 - t18*t304 + t7*t325 + t4*t326 - t317*t289)
-    t328 = -t327 + t288
-    t329 = t18 + t304*t327
-    t330 = t4 - t326*t327
-    t331 = t289 + t317*t327
-    t332 = t303*(t295 - t10*t325 + t12*t326 - t317*t297)
-    t333 = -t332 + t295
-    t334 = t10 + t325*t332
-    t335 = t12 - t326*t332
-    t336 = t297 + t317*t332
-    t337 = -t303*(-t299 + t304*mu_dot2 + t325*mu_dot3 - t326*mu_dot4 + t317*t300)
-    t338 = -t337 + t299
-    t339 = mu_dot2 + t304*t337
-    t340 = mu_dot3 + t325*t337
-    t341 = mu_dot4 - t326*t337
-    t342 = t300 + t317*t337
-    t343 = -t7
-    t344 = t343 + t325*t327
-    t345 = 1 - t24 - t34 + q1 + q2 + q3 + c23 + q4 + t4 + q5 + t10 + t12 + q6 + t32 + t9 + t11 + t35 + t23 + t36 + t37 + t17 + t18 - 2*s1 + t71 + t72 + t76 + t82 + t262 + t265 + t296 + t308 + t343 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6
-    t346 = (t315 > 0)
-    t347 = casadi.if_else(t346, 1/(t309 + t316), 0)
-    t348 = casadi.if_else(t346, 1 + casadi.fabs(t309)/t315, 0)
-    t349 = t311*t347
-    t350 = t312*t347
-    t351 = t314*t347
-    t352 = t348*(t320 + t349*t322 + t350*t323 + t351*t324)
-    t353 = -t352 + t320
-    t354 = t322 - t349*t352
-    t355 = t323 - t350*t352
-    t356 = t324 - t351*t352
-    t357 = t348*(t329 + t349*t344 + t350*t330 + t351*t331)
-    t358 = -t357 + t329
-    t359 = t344 - t349*t357
-    t360 = t330 - t350*t357
-    t361 = t331 - t351*t357
-    t362 = t348*(t339 + t349*t340 + t350*t341 + t351*t342)
-    t363 = -t362 + t339
-    t364 = t340 - t349*t362
-    t365 = t341 - t350*t362
-    t366 = t342 - t351*t362
-    t367 = casadi.sqrt(t354**2 + t355**2 + t356**2)
-    t368 = t367*casadi.if_else((t354 >= 0), 1, -1)
-    t369 = t304*t332
-    t370 = t348*(t369 + t349*t334 + t350*t335 + t351*t336)
-    t371 = -t370 + t369
-    t372 = t334 - t349*t370
-    t373 = t335 - t350*t370
-    t374 = t336 - t351*t370
-    t375 = (t367 > 0)
-    t376 = casadi.if_else(t375, 1/(t354 + t368), 0)
-    t377 = casadi.if_else(t375, 1 + casadi.fabs(t354)/t367, 0)
-    t378 = t355*t376
-    t379 = t356*t376
-    t380 = t377*(t359 + t378*t360 + t379*t361)
-    t381 = -t380 + t359
-    t382 = t360 - t378*t380
-    t383 = t361 - t379*t380
-    t384 = t377*(t372 + t378*t373 + t379*t374)
-    t385 = -t384 + t372
-    t386 = t373 - t378*t384
-    t387 = t374 - t379*t384
-    t388 = t377*(t364 + t378*t365 + t379*t366)
-    t389 = -t388 + t364
-    t390 = t365 - t378*t388
-    t391 = t366 - t379*t388
-    t392 = casadi.sqrt(t382**2 + t383**2)
-    t393 = t392*casadi.if_else((t382 >= 0), 1, -1)
-    t394 = (t392 > 0)
-    t395 = casadi.if_else(t394, 1/(t382 + t393), 0)
-    t396 = casadi.if_else(t394, 1 + casadi.fabs(t382)/t392, 0)
-    t397 = t383*t395
-    t398 = t396*(t386 + t397*t387)
-    t399 = -t398 + t386
-    t400 = t387 - t397*t398
-    t401 = t396*(t390 + t397*t391)
-    t402 = -t401 + t390
-    t403 = t391 - t397*t401
-    t404 = casadi.fabs(t400)
-    t405 = t404*casadi.if_else((t400 >= 0), 1, -1)
-    t406 = casadi.if_else((t404 > 0), 2, 0)
-    t407 = t403 - t403*t406
-    t408 = casadi.if_else((t405 != 0), -t407/t405, 0)
-    t409 = casadi.if_else((t393 != 0), -(t402 - t399*t408)/t393, 0)
-    t410 = casadi.if_else((t368 != 0), -(-(t381*t409 + t385*t408) + t389)/t368, 0)
-    t411 = casadi.if_else((t316 != 0), -(-(t353*t410 + t358*t409 + t371*t408) + t363)/t316, 0)
-    t412 = casadi.if_else((t292 != 0), -(-(t307*t411 - t319*t410 + t328*t409 + t333*t408) + t338)/t292, 0)
-    t413 = casadi.if_else((t46 != 0), -(-(t272*t412 + t275*t411 + t277*t410 + t279*t409 + t293*t268*t408) + t281)/t46, 0)
-    t414 = (casadi.fabs(t345) < casadi.inf)
-    t415 = (damping >= 0)
-    t416 = (damping > 0)
-    t417 = 1e-12*t99
-    t418 = 1e-12*t63
-    t419 = casadi.logic_or(casadi.logic_and(t416, casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t92 <= t417), (t150 <= t417)), (t189 <= t417)), (t217 <= t417)), (t236 <= t417)), (t248 <= t417))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t45 <= t418), (t291 <= t418)), (t315 <= t418)), (t367 <= t418)), (t392 <= t418)), (t404 <= t418))))
-    t420 = casadi.logic_and(casadi.logic_and(t414, t415), casadi.logic_not(t419))
+    t84 = damping**2
+    t85 = _symmetric_solve6(1, (t84 + t61, t66, t69, -t74, t52, t77, t84 + t64, -t80, -t50, t75, t38, t48 + t84, t81, t70, t39, t54 + t84, t83, -t40, t55 + t84, t41, t84 + t57, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t86 = t85[5]
+    t87 = t85[0]
+    t88 = t85[1]
+    t89 = t86 - t33*t87 + t32*t88
+    t90 = s1*t22
+    t91 = t85[2]
+    t92 = t85[3]
+    t93 = t85[4]
+    t94 = t23*t87 - t24*t88 + t17*t91 + t9*t92 + t11*t93 + c23*t86
+    t95 = t36*t87 + t37*t88 + t18*t91 - t7*t92 + t4*t93 + t35*t86
+    t96 = t10*t92 + t12*t93 - t0*t86
+    t97 = -s1*t92 + c1*t93
+    t98 = t97 + t71*t87 + t88*t90 - t34*t91
+    t99 = s1*t21
+    t100 = t97 + t72*t87 + t88*t99 - t28*t91
+    t101 = (t45 > 0)
+    t102 = casadi.if_else(t101, 1/(t76 + t46), 0)
+    t103 = casadi.if_else(t101, 1 + casadi.fabs(t33)/t45, 0)
+    t104 = t32*t102
+    t105 = t103*(t71 + t90*t104)
+    t106 = -t105 + t71
+    t107 = t90 - t104*t105
+    t108 = t103*(t72 + t99*t104)
+    t109 = -t108 + t72
+    t110 = t103*(t23 + c23*t102 - t24*t104)
+    t111 = -t110 + t23
+    t112 = t103*(t36 + t37*t104 + t35*t102)
+    t113 = -t112 + t36
+    t114 = t103*(mu_dot0 + mu_dot5*t102 + t104*mu_dot1)
+    t115 = -t114 + mu_dot0
+    t116 = t102*t108
+    t117 = t99 - t32*t116
+    t118 = t102*t110
+    t119 = t24 + t32*t118
+    t120 = -t118 + c23
+    t121 = t102*t112
+    t122 = t37 - t32*t121
+    t123 = -t121 + t35
+    t124 = t102**2
+    t125 = casadi.sqrt(t47 + t49 + t51 + t107**2 + t124*t105**2)
+    t126 = t125*casadi.if_else((t107 >= 0), 1, -1)
+    t127 = t0*t103
+    t128 = t124*t127
+    t129 = t32*t128
+    t130 = -t0
+    t131 = t128 + t130
+    t132 = t102*t114
+    t133 = mu_dot1 - t32*t132
+    t134 = -t132 + mu_dot5
+    t135 = (t125 > 0)
+    t136 = casadi.if_else(t135, 1/(t107 + t126), 0)
+    t137 = casadi.if_else(t135, 1 + casadi.fabs(t107)/t125, 0)
+    t138 = t34*t136
+    t139 = t105*t136
+    t140 = t137*(t117 + t28*t138 + t49*t136 + t51*t136 + t124*t139*t108)
+    t141 = -t140 + t117
+    t142 = -t28
+    t143 = t142 + t138*t140
+    t144 = t136*t140
+    t145 = -s1 + s1*t144
+    t146 = c1 - c1*t144
+    t147 = t102*t105
+    t148 = -t116 + t144*t147
+    t149 = casadi.sqrt(t143**2 + t145**2 + t146**2 + t148**2)
+    t150 = t149*casadi.if_else((t143 >= 0), 1, -1)
+    t151 = t139*t102
+    t152 = -t137*(t119 + t17*t138 + t151*t120)
+    t153 = t119 + t152
+    t154 = t17 + t138*t152
+    t155 = t136*t152
+    t156 = t9 + s1*t155
+    t157 = t11 - c1*t155
+    t158 = t120 + t147*t155
+    t159 = s1*t136
+    t160 = c1*t136
+    t161 = t137*(t122 - t18*t138 + t7*t159 + t4*t160 - t151*t123)
+    t162 = -t161 + t122
+    t163 = t18 + t138*t161
+    t164 = t4 - t160*t161
+    t165 = t123 + t151*t161
+    t166 = t137*(t129 - t10*t159 + t12*t160 - t151*t131)
+    t167 = -t166 + t129
+    t168 = t10 + t159*t166
+    t169 = t12 - t160*t166
+    t170 = t131 + t151*t166
+    t171 = -t137*(-t133 + t138*mu_dot2 + t159*mu_dot3 - t160*mu_dot4 + t151*t134)
+    t172 = -t171 + t133
+    t173 = mu_dot2 + t138*t171
+    t174 = mu_dot3 + t159*t171
+    t175 = mu_dot4 - t160*t171
+    t176 = t134 + t151*t171
+    t177 = -t7
+    t178 = t177 + t159*t161
+    t179 = 1 - t24 - t34 + q1 + q2 + q3 + c23 + q4 + t4 + q5 + t10 + t12 + q6 + t32 + t9 + t11 + t35 + t23 + t36 + t37 + t17 + t18 - 2*s1 + t71 + t72 + t76 + t82 + t90 + t99 + t130 + t142 + t177 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6
+    t180 = (t149 > 0)
+    t181 = casadi.if_else(t180, 1/(t143 + t150), 0)
+    t182 = casadi.if_else(t180, 1 + casadi.fabs(t143)/t149, 0)
+    t183 = t145*t181
+    t184 = t146*t181
+    t185 = t148*t181
+    t186 = t182*(t154 + t183*t156 + t184*t157 + t185*t158)
+    t187 = -t186 + t154
+    t188 = t156 - t183*t186
+    t189 = t157 - t184*t186
+    t190 = t158 - t185*t186
+    t191 = t182*(t163 + t183*t178 + t184*t164 + t185*t165)
+    t192 = -t191 + t163
+    t193 = t178 - t183*t191
+    t194 = t164 - t184*t191
+    t195 = t165 - t185*t191
+    t196 = t182*(t173 + t183*t174 + t184*t175 + t185*t176)
+    t197 = -t196 + t173
+    t198 = t174 - t183*t196
+    t199 = t175 - t184*t196
+    t200 = t176 - t185*t196
+    t201 = casadi.sqrt(t188**2 + t189**2 + t190**2)
+    t202 = t201*casadi.if_else((t188 >= 0), 1, -1)
+    t203 = t138*t166
+    t204 = t182*(t203 + t183*t168 + t184*t169 + t185*t170)
+    t205 = -t204 + t203
+    t206 = t168 - t183*t204
+    t207 = t169 - t184*t204
+    t208 = t170 - t185*t204
+    t209 = (t201 > 0)
+    t210 = casadi.if_else(t209, 1/(t188 + t202), 0)
+    t211 = casadi.if_else(t209, 1 + casadi.fabs(t188)/t201, 0)
+    t212 = t189*t210
+    t213 = t190*t210
+    t214 = t211*(t193 + t212*t194 + t213*t195)
+    t215 = -t214 + t193
+    t216 = t194 - t212*t214
+    t217 = t195 - t213*t214
+    t218 = t211*(t206 + t212*t207 + t213*t208)
+    t219 = -t218 + t206
+    t220 = t207 - t212*t218
+    t221 = t208 - t213*t218
+    t222 = t211*(t198 + t212*t199 + t213*t200)
+    t223 = -t222 + t198
+    t224 = t199 - t212*t222
+    t225 = t200 - t213*t222
+    t226 = casadi.sqrt(t216**2 + t217**2)
+    t227 = t226*casadi.if_else((t216 >= 0), 1, -1)
+    t228 = (t226 > 0)
+    t229 = casadi.if_else(t228, 1/(t216 + t227), 0)
+    t230 = casadi.if_else(t228, 1 + casadi.fabs(t216)/t226, 0)
+    t231 = t217*t229
+    t232 = t230*(t220 + t231*t221)
+    t233 = -t232 + t220
+    t234 = t221 - t231*t232
+    t235 = t230*(t224 + t231*t225)
+    t236 = -t235 + t224
+    t237 = t225 - t231*t235
+    t238 = casadi.fabs(t234)
+    t239 = t238*casadi.if_else((t234 >= 0), 1, -1)
+    t240 = casadi.if_else((t238 > 0), 2, 0)
+    t241 = t237 - t237*t240
+    t242 = casadi.if_else((t239 != 0), -t241/t239, 0)
+    t243 = casadi.if_else((t227 != 0), -(t236 - t233*t242)/t227, 0)
+    t244 = casadi.if_else((t202 != 0), -(-(t215*t243 + t219*t242) + t223)/t202, 0)
+    t245 = casadi.if_else((t150 != 0), -(-(t187*t244 + t192*t243 + t205*t242) + t197)/t150, 0)
+    t246 = casadi.if_else((t126 != 0), -(-(t141*t245 - t153*t244 + t162*t243 + t167*t242) + t172)/t126, 0)
+    t247 = casadi.if_else((t46 != 0), -(-(t106*t246 + t109*t245 + t111*t244 + t113*t243 + t127*t102*t242) + t115)/t46, 0)
+    t248 = (casadi.fabs(t179) < casadi.inf)
+    t249 = (damping >= 0)
+    t250 = (damping > 0)
+    t251 = 1e-12*t63
+    t252 = casadi.logic_or(casadi.logic_and(t250, (t85[6] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t45 <= t251), (t125 <= t251)), (t149 <= t251)), (t201 <= t251)), (t226 <= t251)), (t238 <= t251))))
+    t253 = casadi.logic_and(casadi.logic_and(t248, t249), casadi.logic_not(t252))
     q_dot = casadi.SX(6, 1)
-    q_dot[0, 0] = casadi.if_else(t420, casadi.if_else(t416, t258, t413), 0)
-    q_dot[1, 0] = casadi.if_else(t420, casadi.if_else(t416, t264, t412), 0)
-    q_dot[2, 0] = casadi.if_else(t420, casadi.if_else(t416, t266, t411), 0)
-    q_dot[3, 0] = casadi.if_else(t420, casadi.if_else(t416, t259, t410), 0)
-    q_dot[4, 0] = casadi.if_else(t420, casadi.if_else(t416, t260, t409), 0)
-    q_dot[5, 0] = casadi.if_else(t420, casadi.if_else(t416, t261, t408), 0)
+    q_dot[0, 0] = casadi.if_else(t253, casadi.if_else(t250, t89, t247), 0)
+    q_dot[1, 0] = casadi.if_else(t253, casadi.if_else(t250, t98, t246), 0)
+    q_dot[2, 0] = casadi.if_else(t253, casadi.if_else(t250, t100, t245), 0)
+    q_dot[3, 0] = casadi.if_else(t253, casadi.if_else(t250, t94, t244), 0)
+    q_dot[4, 0] = casadi.if_else(t253, casadi.if_else(t250, t95, t243), 0)
+    q_dot[5, 0] = casadi.if_else(t253, casadi.if_else(t250, t96, t242), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t414, t415)), 2, casadi.if_else(t419, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t248, t249)), 2, casadi.if_else(t252, 1, 0))
     return [q_dot, status]
 
 
 def _resolved_rate(q, target, target_rate, gain, z, damping):
-    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 1486 operations."""
+    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 1488 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -4456,376 +4365,209 @@ def _resolved_rate(q, target, target_rate, gain, z, damping):
     t108 = -t6*t44 + t105 + t106 + t8*t43
     t109 = 2*c1
     t110 = -t6*t3 + t10*t18 - s1*t109 + t79*t91
-    t111 = t92**2
-    t112 = t95**2
-    t113 = t100**2
-    t114 = t78**2
-    t115 = t103**2
-    t116 = damping**2
-    t117 = t116 + t87
-    t118 = t117**2
-    t119 = casadi.sqrt(t111 + t112 + t113 + t114 + t115 + t118)
-    t120 = t119*casadi.if_else((t117 >= 0), 1, -1)
-    t121 = t116 + t90
-    t122 = t74 + t116
-    t123 = t80 + t116
-    t124 = t81 + t116
-    t125 = t116 + t83
-    t126 = casadi.sqrt(2*t111 + 2*t112 + 2*t107**2 + 2*t113 + 2*t76**2 + 2*t108**2 + 2*t114 + 2*t101**2 + 2*t96**2 + 2*t110**2 + 2*t115 + 2*t66**2 + 2*t45**2 + 2*t31**2 + 2*t32**2 + t118 + t121**2 + t122**2 + t123**2 + t124**2 + t125**2)
-    t127 = (t119 > 0)
-    t128 = casadi.if_else(t127, 1/(t117 + t120), 0)
-    t129 = casadi.if_else(t127, 1 + casadi.fabs(t117)/t119, 0)
-    t130 = t92*t128
-    t131 = t95*t128
-    t132 = t100*t128
-    t133 = t78*t128
-    t134 = t103*t128
-    t135 = t129*(t92 + t121*t130 - t131*t107 + t132*t76 + t133*t101 + t134*t66)
-    t136 = -t135 + t92
-    t137 = t121 - t130*t135
-    t138 = t107 + t131*t135
-    t139 = -t76 + t132*t135
-    t140 = t101 - t133*t135
-    t141 = t66 - t134*t135
-    t142 = t129*(t95 - t130*t107 + t122*t131 - t132*t108 + t133*t96 + t134*t45)
-    t143 = -t142 + t95
-    t144 = t107 + t130*t142
-    t145 = t122 - t131*t142
-    t146 = t108 + t132*t142
-    t147 = t96 - t133*t142
-    t148 = t45 - t134*t142
-    t149 = -t129*(t100 - t131*t108 + t123*t132 + t130*t76 - t133*t110 + t134*t31)
-    t150 = t100 + t149
-    t151 = t76 + t130*t149
-    t152 = t108 - t131*t149
-    t153 = t123 + t132*t149
-    t154 = t110 - t133*t149
-    t155 = t31 + t134*t149
-    t156 = t129*(t78 - t132*t110 + t124*t133 + t130*t101 + t131*t96 + t134*t32)
-    t157 = -t156 + t78
-    t158 = t101 - t130*t156
-    t159 = t96 - t131*t156
-    t160 = t110 + t132*t156
-    t161 = t124 - t133*t156
-    t162 = t32 - t134*t156
-    t163 = t129*(t103 + t133*t32 + t130*t66 + t131*t45 + t132*t31 + t125*t134)
-    t164 = -t163 + t103
-    t165 = t66 - t130*t163
-    t166 = t45 - t131*t163
-    t167 = -t31 + t132*t163
-    t168 = t32 - t133*t163
-    t169 = t125 - t134*t163
-    t170 = casadi.sqrt(t137**2 + t138**2 + t139**2 + t140**2 + t141**2)
-    t171 = t170*casadi.if_else((t137 >= 0), 1, -1)
-    t172 = (t170 > 0)
-    t173 = casadi.if_else(t172, 1/(t137 + t171), 0)
-    t174 = casadi.if_else(t172, 1 + casadi.fabs(t137)/t170, 0)
-    t175 = t138*t173
-    t176 = t139*t173
-    t177 = t140*t173
-    t178 = t141*t173
-    t179 = t174*(-t144 - t175*t145 + t176*t146 + t177*t147 + t178*t148)
-    t180 = t144 + t179
-    t181 = t145 + t175*t179
-    t182 = t146 - t176*t179
-    t183 = t147 - t177*t179
-    t184 = t148 - t178*t179
-    t185 = -t174*(t151 + t175*t152 - t176*t153 - t177*t154 + t178*t155)
-    t186 = t151 + t185
-    t187 = t152 + t175*t185
-    t188 = t153 - t176*t185
-    t189 = t154 - t177*t185
-    t190 = t155 + t178*t185
-    t191 = t174*(t158 - t175*t159 + t176*t160 + t177*t161 + t178*t162)
-    t192 = -t191 + t158
-    t193 = t159 + t175*t191
-    t194 = t160 - t176*t191
-    t195 = t161 - t177*t191
-    t196 = t162 - t178*t191
-    t197 = t174*(t165 - t175*t166 + t176*t167 + t177*t168 + t178*t169)
-    t198 = -t197 + t165
-    t199 = t166 + t175*t197
-    t200 = t167 - t176*t197
-    t201 = t168 - t177*t197
-    t202 = t169 - t178*t197
-    t203 = casadi.sqrt(t181**2 + t182**2 + t183**2 + t184**2)
-    t204 = t203*casadi.if_else((t181 >= 0), 1, -1)
-    t205 = (t203 > 0)
-    t206 = casadi.if_else(t205, 1/(t181 + t204), 0)
-    t207 = casadi.if_else(t205, 1 + casadi.fabs(t181)/t203, 0)
-    t208 = t182*t206
-    t209 = t183*t206
-    t210 = t184*t206
-    t211 = t207*(t187 + t208*t188 + t209*t189 - t210*t190)
-    t212 = -t211 + t187
-    t213 = t188 - t208*t211
-    t214 = t189 - t209*t211
-    t215 = t190 + t210*t211
-    t216 = t207*(t193 + t208*t194 + t209*t195 + t210*t196)
-    t217 = -t216 + t193
-    t218 = t194 - t208*t216
-    t219 = t195 - t209*t216
-    t220 = t196 - t210*t216
-    t221 = t207*(t199 + t208*t200 + t209*t201 + t210*t202)
-    t222 = -t221 + t199
-    t223 = t200 - t208*t221
-    t224 = t201 - t209*t221
-    t225 = t202 - t210*t221
-    t226 = casadi.sqrt(t213**2 + t214**2 + t215**2)
-    t227 = t226*casadi.if_else((t213 >= 0), 1, -1)
-    t228 = (t226 > 0)
-    t229 = casadi.if_else(t228, 1/(t213 + t227), 0)
-    t230 = casadi.if_else(t228, 1 + casadi.fabs(t213)/t226, 0)
-    t231 = t214*t229
-    t232 = t215*t229
-    t233 = t230*(t218 + t231*t219 - t232*t220)
-    t234 = -t233 + t218
-    t235 = t219 - t231*t233
-    t236 = t220 + t232*t233
-    t237 = t230*(t223 + t231*t224 - t232*t225)
-    t238 = -t237 + t223
-    t239 = t224 - t231*t237
-    t240 = t225 + t232*t237
-    t241 = casadi.sqrt(t235**2 + t236**2)
-    t242 = t241*casadi.if_else((t235 >= 0), 1, -1)
-    t243 = (t241 > 0)
-    t244 = casadi.if_else(t243, 1/(t235 + t242), 0)
-    t245 = casadi.if_else(t243, 1 + casadi.fabs(t235)/t241, 0)
-    t246 = t236*t244
-    t247 = t245*(t239 + t246*t240)
-    t248 = -t247 + t239
-    t249 = t240 - t246*t247
-    t250 = casadi.fabs(t249)
-    t251 = t250*casadi.if_else((t249 >= 0), 1, -1)
-    t252 = casadi.if_else((t250 > 0), 2, 0)
-    t253 = (t71 > 0)
-    t254 = casadi.if_else(t253, 1/(t102 + t72), 0)
-    t255 = casadi.if_else(t253, 1 + casadi.fabs(t64)/t71, 0)
-    t256 = s1*t49
-    t257 = t63*t254
-    t258 = t255*(t97 + t256*t257)
-    t259 = -t258 + t97
-    t260 = t256 - t257*t258
-    t261 = t255*(t51 + c23*t254 - t53*t257)
-    t262 = -t261 + t51
-    t263 = t255*(t52 + t54*t257 + t28*t254)
-    t264 = -t263 + t52
-    t265 = s1*t48
-    t266 = t255*(t98 + t257*t265)
-    t267 = -t266 + t98
-    t268 = t254*t266
-    t269 = t265 - t63*t268
-    t270 = t254*t261
-    t271 = t53 + t63*t270
-    t272 = -t270 + c23
-    t273 = t254*t263
-    t274 = t54 - t63*t273
-    t275 = -t273 + t28
-    t276 = t254**2
-    t277 = casadi.sqrt(t73 + t75 + t77 + t260**2 + t276*t258**2)
-    t278 = t277*casadi.if_else((t260 >= 0), 1, -1)
-    t279 = t27*t255
-    t280 = t276*t279
-    t281 = t63*t280
-    t282 = -t27
-    t283 = t280 + t282
-    t284 = (t277 > 0)
-    t285 = casadi.if_else(t284, 1/(t260 + t278), 0)
-    t286 = casadi.if_else(t284, 1 + casadi.fabs(t260)/t277, 0)
-    t287 = t65*t285
-    t288 = t258*t285
-    t289 = t286*(t269 + t75*t285 + t59*t287 + t77*t285 + t276*t288*t266)
-    t290 = -t289 + t269
-    t291 = -t59
-    t292 = t291 + t287*t289
-    t293 = t285*t289
-    t294 = -s1 + s1*t293
-    t295 = c1 - c1*t293
-    t296 = t254*t258
-    t297 = -t268 + t293*t296
-    t298 = casadi.sqrt(t292**2 + t294**2 + t295**2 + t297**2)
-    t299 = t298*casadi.if_else((t292 >= 0), 1, -1)
-    t300 = t288*t254
-    t301 = -t286*(t271 + t43*t287 + t300*t272)
-    t302 = t271 + t301
-    t303 = t43 + t287*t301
-    t304 = t285*t301
-    t305 = t8 + s1*t304
-    t306 = t16 - c1*t304
-    t307 = t272 + t296*t304
-    t308 = s1*t285
-    t309 = c1*t285
-    t310 = t286*(t274 - t44*t287 + t6*t308 + t3*t309 - t300*t275)
-    t311 = -t310 + t274
-    t312 = t44 + t287*t310
-    t313 = t3 - t309*t310
-    t314 = t275 + t300*t310
-    t315 = t286*(t281 - t10*t308 + t18*t309 - t300*t283)
-    t316 = -t315 + t281
-    t317 = t10 + t308*t315
-    t318 = t18 - t309*t315
-    t319 = t283 + t300*t315
-    t320 = -t6
-    t321 = t320 + t308*t310
-    t322 = (t298 > 0)
-    t323 = casadi.if_else(t322, 1/(t292 + t299), 0)
-    t324 = casadi.if_else(t322, 1 + casadi.fabs(t292)/t298, 0)
-    t325 = t294*t323
-    t326 = t295*t323
-    t327 = t297*t323
-    t328 = t324*(t303 + t325*t305 + t326*t306 + t327*t307)
-    t329 = -t328 + t303
-    t330 = t305 - t325*t328
-    t331 = t306 - t326*t328
-    t332 = t307 - t327*t328
-    t333 = t324*(t312 + t325*t321 + t326*t313 + t327*t314)
-    t334 = -t333 + t312
-    t335 = t321 - t325*t333
-    t336 = t313 - t326*t333
-    t337 = t314 - t327*t333
-    t338 = casadi.sqrt(t330**2 + t331**2 + t332**2)
-    t339 = t338*casadi.if_else((t330 >= 0), 1, -1)
-    t340 = t287*t315
-    t341 = t324*(t340 + t325*t317 + t326*t318 + t327*t319)
-    t342 = -t341 + t340
-    t343 = t317 - t325*t341
-    t344 = t318 - t326*t341
-    t345 = t319 - t327*t341
-    t346 = (t338 > 0)
-    t347 = casadi.if_else(t346, 1/(t330 + t339), 0)
-    t348 = casadi.if_else(t346, 1 + casadi.fabs(t330)/t338, 0)
-    t349 = t331*t347
-    t350 = t332*t347
-    t351 = t348*(t335 + t349*t336 + t350*t337)
-    t352 = -t351 + t335
-    t353 = t336 - t349*t351
-    t354 = t337 - t350*t351
-    t355 = t348*(t343 + t349*t344 + t350*t345)
-    t356 = -t355 + t343
-    t357 = t344 - t349*t355
-    t358 = t345 - t350*t355
-    t359 = casadi.sqrt(t353**2 + t354**2)
-    t360 = t359*casadi.if_else((t353 >= 0), 1, -1)
-    t361 = (t359 > 0)
-    t362 = casadi.if_else(t361, 1/(t353 + t360), 0)
-    t363 = casadi.if_else(t361, 1 + casadi.fabs(t353)/t359, 0)
-    t364 = t354*t362
-    t365 = t363*(t357 + t364*t358)
-    t366 = -t365 + t357
-    t367 = t358 - t364*t365
-    t368 = casadi.fabs(t367)
-    t369 = t368*casadi.if_else((t367 >= 0), 1, -1)
-    t370 = casadi.if_else((t368 > 0), 2, 0)
-    t371 = -t22
-    t372 = 0.5*(-1 + t371 + t13 + t35)
-    t373 = casadi.atan2(t38, t372)
-    t374 = casadi.if_else((t38 > 0), t373/t38, 1)
-    t375 = casadi.logic_and((t13 >= t371), (t13 >= t35))
-    t376 = (t371 >= t35)
-    t377 = casadi.if_else(t375, 0.5*(1 + t13), casadi.if_else(t376, -0.5*t21, 0.5*t33))
-    t378 = casadi.if_else(t375, 0.5*t14, casadi.if_else(t376, 0.5*(1 + t371), 0.5*t34))
-    t379 = casadi.if_else(t375, 0.5*t15, casadi.if_else(t376, -0.5*t23, 0.5*(1 + t35)))
-    t380 = casadi.sqrt(t377**2 + t378**2 + t379**2)
-    t381 = casadi.if_else((t36*t377 + t37*t378 + t24*t379 >= 0), 1, -1)
-    t382 = casadi.logic_or((t38 > 1e-06), (t372 > 0))
-    t383 = t373*t381/t380
-    t384 = casadi.if_else(t382, t36*t374, t383*t377)
-    t385 = casadi.if_else(t382, t37*t374, t383*t378)
-    t386 = casadi.if_else(t382, t24*t374, t383*t379)
-    t387 = mu_dot3 + t384*gain3
-    t388 = mu_dot4 + t385*gain4
-    t389 = mu_dot5 + t386*gain5
-    t390 = t129*(t67 + t130*t104 + t131*t55 - t132*t387 + t133*t388 + t134*t389)
-    t391 = -t390 + t67
-    t392 = t104 - t130*t390
-    t393 = t55 - t131*t390
-    t394 = t387 + t132*t390
-    t395 = t388 - t133*t390
-    t396 = t389 - t134*t390
-    t397 = t174*(t392 - t175*t393 + t176*t394 + t177*t395 + t178*t396)
-    t398 = -t397 + t392
-    t399 = t393 + t175*t397
-    t400 = t394 - t176*t397
-    t401 = t395 - t177*t397
-    t402 = t396 - t178*t397
-    t403 = t207*(t399 + t208*t400 + t209*t401 + t210*t402)
-    t404 = -t403 + t399
-    t405 = t400 - t208*t403
-    t406 = t401 - t209*t403
-    t407 = t402 - t210*t403
-    t408 = t230*(t405 + t231*t406 - t232*t407)
-    t409 = -t408 + t405
-    t410 = t406 - t231*t408
-    t411 = t407 + t232*t408
-    t412 = t245*(t410 + t246*t411)
-    t413 = -t412 + t410
-    t414 = t411 - t246*t412
-    t415 = t414 - t252*t414
-    t416 = casadi.if_else((t251 != 0), -t415/t251, 0)
-    t417 = casadi.if_else((t242 != 0), -(t413 - t248*t416)/t242, 0)
-    t418 = casadi.if_else((t227 != 0), -(-(t234*t417 + t238*t416) + t409)/t227, 0)
-    t419 = casadi.if_else((t204 != 0), -(-(t212*t418 + t217*t417 + t222*t416) + t404)/t204, 0)
-    t420 = casadi.if_else((t171 != 0), -(-(-t180*t419 - t186*t418 + t192*t417 + t198*t416) + t398)/t171, 0)
-    t421 = casadi.if_else((t120 != 0), -(-(t136*t420 + t143*t419 - t150*t418 + t157*t417 + t164*t416) + t391)/t120, 0)
-    t422 = t416 - t64*t421 + t63*t420
-    t423 = t51*t421 - t53*t420 + t43*t419 + c23*t416 + t8*t418 + t16*t417
-    t424 = t52*t421 + t54*t420 + t44*t419 - t6*t418 + t3*t417 + t28*t416
-    t425 = t10*t418 + t18*t417 - t27*t416
-    t426 = t255*(t67 + t254*t389 + t257*t104)
-    t427 = -t426 + t67
-    t428 = 1 - t53 - t65 + q1 + q2 + q3 + c23 + q4 + t3 + q5 + t10 + t18 + q6 + t63 + t8 + t16 + t28 + t51 + t52 + t54 + t43 + t44 - 2*s1 + t97 + t98 + t102 + t109 + t256 + t265 + t282 + t291 + t320 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t67 + t104 + t55 + t387 + t388 + t389
-    t429 = -s1*t418 + c1*t417
-    t430 = t429 - t65*t419 + t97*t421 + t256*t420
-    t431 = t429 - t59*t419 + t98*t421 + t265*t420
-    t432 = t254*t426
-    t433 = t104 - t63*t432
-    t434 = -t432 + t389
-    t435 = -t286*(-t433 + t287*t55 + t308*t387 - t309*t388 + t300*t434)
-    t436 = -t435 + t433
-    t437 = t55 + t287*t435
-    t438 = t387 + t308*t435
-    t439 = t388 - t309*t435
-    t440 = t434 + t300*t435
-    t441 = t324*(t437 + t325*t438 + t326*t439 + t327*t440)
-    t442 = -t441 + t437
-    t443 = t438 - t325*t441
-    t444 = t439 - t326*t441
-    t445 = t440 - t327*t441
-    t446 = t348*(t443 + t349*t444 + t350*t445)
-    t447 = -t446 + t443
-    t448 = t444 - t349*t446
-    t449 = t445 - t350*t446
-    t450 = t363*(t448 + t364*t449)
-    t451 = -t450 + t448
-    t452 = t449 - t364*t450
-    t453 = t452 - t370*t452
-    t454 = casadi.if_else((t369 != 0), -t453/t369, 0)
-    t455 = casadi.if_else((t360 != 0), -(t451 - t366*t454)/t360, 0)
-    t456 = casadi.if_else((t339 != 0), -(-(t352*t455 + t356*t454) + t447)/t339, 0)
-    t457 = casadi.if_else((t299 != 0), -(-(t329*t456 + t334*t455 + t342*t454) + t442)/t299, 0)
-    t458 = casadi.if_else((t278 != 0), -(-(t290*t457 - t302*t456 + t311*t455 + t316*t454) + t436)/t278, 0)
-    t459 = casadi.if_else((t72 != 0), -(-(t259*t458 + t267*t457 + t262*t456 + t264*t455 + t279*t254*t454) + t427)/t72, 0)
-    t460 = (casadi.fabs(t428) < casadi.inf)
-    t461 = (damping >= 0)
-    t462 = (damping > 0)
-    t463 = 1e-12*t126
-    t464 = 1e-12*t89
-    t465 = casadi.logic_or(casadi.logic_and(t462, casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t119 <= t463), (t170 <= t463)), (t203 <= t463)), (t226 <= t463)), (t241 <= t463)), (t250 <= t463))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t71 <= t464), (t277 <= t464)), (t298 <= t464)), (t338 <= t464)), (t359 <= t464)), (t368 <= t464))))
-    t466 = casadi.logic_and(casadi.logic_and(t460, t461), casadi.logic_not(t465))
+    t111 = (t71 > 0)
+    t112 = casadi.if_else(t111, 1/(t102 + t72), 0)
+    t113 = casadi.if_else(t111, 1 + casadi.fabs(t64)/t71, 0)
+    t114 = s1*t49
+    t115 = t63*t112
+    t116 = t113*(t97 + t114*t115)
+    t117 = -t116 + t97
+    t118 = t114 - t115*t116
+    t119 = t113*(t51 + c23*t112 - t53*t115)
+    t120 = -t119 + t51
+    t121 = t113*(t52 + t54*t115 + t28*t112)
+    t122 = -t121 + t52
+    t123 = s1*t48
+    t124 = t113*(t98 + t115*t123)
+    t125 = -t124 + t98
+    t126 = t112*t124
+    t127 = t123 - t63*t126
+    t128 = t112*t119
+    t129 = t53 + t63*t128
+    t130 = -t128 + c23
+    t131 = t112*t121
+    t132 = t54 - t63*t131
+    t133 = -t131 + t28
+    t134 = t112**2
+    t135 = casadi.sqrt(t73 + t75 + t77 + t118**2 + t134*t116**2)
+    t136 = t135*casadi.if_else((t118 >= 0), 1, -1)
+    t137 = t27*t113
+    t138 = t134*t137
+    t139 = t63*t138
+    t140 = -t27
+    t141 = t138 + t140
+    t142 = (t135 > 0)
+    t143 = casadi.if_else(t142, 1/(t118 + t136), 0)
+    t144 = casadi.if_else(t142, 1 + casadi.fabs(t118)/t135, 0)
+    t145 = t65*t143
+    t146 = t116*t143
+    t147 = t144*(t127 + t75*t143 + t59*t145 + t77*t143 + t134*t146*t124)
+    t148 = -t147 + t127
+    t149 = -t59
+    t150 = t149 + t145*t147
+    t151 = t143*t147
+    t152 = -s1 + s1*t151
+    t153 = c1 - c1*t151
+    t154 = t112*t116
+    t155 = -t126 + t151*t154
+    t156 = casadi.sqrt(t150**2 + t152**2 + t153**2 + t155**2)
+    t157 = t156*casadi.if_else((t150 >= 0), 1, -1)
+    t158 = t146*t112
+    t159 = -t144*(t129 + t43*t145 + t158*t130)
+    t160 = t129 + t159
+    t161 = t43 + t145*t159
+    t162 = t143*t159
+    t163 = t8 + s1*t162
+    t164 = t16 - c1*t162
+    t165 = t130 + t154*t162
+    t166 = s1*t143
+    t167 = c1*t143
+    t168 = t144*(t132 - t44*t145 + t6*t166 + t3*t167 - t158*t133)
+    t169 = -t168 + t132
+    t170 = t44 + t145*t168
+    t171 = t3 - t167*t168
+    t172 = t133 + t158*t168
+    t173 = t144*(t139 - t10*t166 + t18*t167 - t158*t141)
+    t174 = -t173 + t139
+    t175 = t10 + t166*t173
+    t176 = t18 - t167*t173
+    t177 = t141 + t158*t173
+    t178 = -t6
+    t179 = t178 + t166*t168
+    t180 = (t156 > 0)
+    t181 = casadi.if_else(t180, 1/(t150 + t157), 0)
+    t182 = casadi.if_else(t180, 1 + casadi.fabs(t150)/t156, 0)
+    t183 = t152*t181
+    t184 = t153*t181
+    t185 = t155*t181
+    t186 = t182*(t161 + t183*t163 + t184*t164 + t185*t165)
+    t187 = -t186 + t161
+    t188 = t163 - t183*t186
+    t189 = t164 - t184*t186
+    t190 = t165 - t185*t186
+    t191 = t182*(t170 + t183*t179 + t184*t171 + t185*t172)
+    t192 = -t191 + t170
+    t193 = t179 - t183*t191
+    t194 = t171 - t184*t191
+    t195 = t172 - t185*t191
+    t196 = casadi.sqrt(t188**2 + t189**2 + t190**2)
+    t197 = t196*casadi.if_else((t188 >= 0), 1, -1)
+    t198 = t145*t173
+    t199 = t182*(t198 + t183*t175 + t184*t176 + t185*t177)
+    t200 = -t199 + t198
+    t201 = t175 - t183*t199
+    t202 = t176 - t184*t199
+    t203 = t177 - t185*t199
+    t204 = (t196 > 0)
+    t205 = casadi.if_else(t204, 1/(t188 + t197), 0)
+    t206 = casadi.if_else(t204, 1 + casadi.fabs(t188)/t196, 0)
+    t207 = t189*t205
+    t208 = t190*t205
+    t209 = t206*(t193 + t207*t194 + t208*t195)
+    t210 = -t209 + t193
+    t211 = t194 - t207*t209
+    t212 = t195 - t208*t209
+    t213 = t206*(t201 + t207*t202 + t208*t203)
+    t214 = -t213 + t201
+    t215 = t202 - t207*t213
+    t216 = t203 - t208*t213
+    t217 = casadi.sqrt(t211**2 + t212**2)
+    t218 = t217*casadi.if_else((t211 >= 0), 1, -1)
+    t219 = (t217 > 0)
+    t220 = casadi.if_else(t219, 1/(t211 + t218), 0)
+    t221 = casadi.if_else(t219, 1 + casadi.fabs(t211)/t217, 0)
+    t222 = t212*t220
+    t223 = t221*(t215 + t222*t216)
+    t224 = -t223 + t215
+    t225 = t216 - t222*t223
+    t226 = casadi.fabs(t225)
+    t227 = t226*casadi.if_else((t225 >= 0), 1, -1)
+    t228 = casadi.if_else((t226 > 0), 2, 0)
+    t229 = -t22
+    t230 = 0.5*(-1 + t229 + t13 + t35)
+    t231 = casadi.atan2(t38, t230)
+    t232 = casadi.if_else((t38 > 0), t231/t38, 1)
+    t233 = casadi.logic_and((t13 >= t229), (t13 >= t35))
+    t234 = (t229 >= t35)
+    t235 = casadi.if_else(t233, 0.5*(1 + t13), casadi.if_else(t234, -0.5*t21, 0.5*t33))
+    t236 = casadi.if_else(t233, 0.5*t14, casadi.if_else(t234, 0.5*(1 + t229), 0.5*t34))
+    t237 = casadi.if_else(t233, 0.5*t15, casadi.if_else(t234, -0.5*t23, 0.5*(1 + t35)))
+    t238 = casadi.sqrt(t235**2 + t236**2 + t237**2)
+    t239 = casadi.if_else((t36*t235 + t37*t236 + t24*t237 >= 0), 1, -1)
+    t240 = casadi.logic_or((t38 > 1e-06), (t230 > 0))
+    t241 = t231*t239/t238
+    t242 = casadi.if_else(t240, t36*t232, t241*t235)
+    t243 = casadi.if_else(t240, t37*t232, t241*t236)
+    t244 = casadi.if_else(t240, t24*t232, t241*t237)
+    t245 = mu_dot3 + t242*gain3
+    t246 = mu_dot4 + t243*gain4
+    t247 = mu_dot5 + t244*gain5
+    t248 = t113*(t67 + t112*t247 + t115*t104)
+    t249 = -t248 + t67
+    t250 = 1 - t53 - t65 + q1 + q2 + q3 + c23 + q4 + t3 + q5 + t10 + t18 + q6 + t63 + t8 + t16 + t28 + t51 + t52 + t54 + t43 + t44 - 2*s1 + t97 + t98 + t102 + t109 + t114 + t123 + t140 + t149 + t178 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t67 + t104 + t55 + t245 + t246 + t247
+    t251 = damping**2
+    t252 = _symmetric_solve6(1, (t251 + t87, t92, t95, -t100, t78, t103, t251 + t90, -t107, -t76, t101, t66, t74 + t251, t108, t96, t45, t80 + t251, t110, -t31, t81 + t251, t32, t251 + t83, t67, t104, t55, t245, t246, t247,))
+    t253 = t252[5]
+    t254 = t252[0]
+    t255 = t252[1]
+    t256 = t253 - t64*t254 + t63*t255
+    t257 = t252[2]
+    t258 = t252[3]
+    t259 = t252[4]
+    t260 = t51*t254 - t53*t255 + t43*t257 + t8*t258 + t16*t259 + c23*t253
+    t261 = t52*t254 + t54*t255 + t44*t257 - t6*t258 + t3*t259 + t28*t253
+    t262 = t10*t258 + t18*t259 - t27*t253
+    t263 = -s1*t258 + c1*t259
+    t264 = t263 + t97*t254 + t114*t255 - t65*t257
+    t265 = t263 + t98*t254 + t123*t255 - t59*t257
+    t266 = t112*t248
+    t267 = t104 - t63*t266
+    t268 = -t266 + t247
+    t269 = -t144*(-t267 + t145*t55 + t166*t245 - t167*t246 + t158*t268)
+    t270 = -t269 + t267
+    t271 = t55 + t145*t269
+    t272 = t245 + t166*t269
+    t273 = t246 - t167*t269
+    t274 = t268 + t158*t269
+    t275 = t182*(t271 + t183*t272 + t184*t273 + t185*t274)
+    t276 = -t275 + t271
+    t277 = t272 - t183*t275
+    t278 = t273 - t184*t275
+    t279 = t274 - t185*t275
+    t280 = t206*(t277 + t207*t278 + t208*t279)
+    t281 = -t280 + t277
+    t282 = t278 - t207*t280
+    t283 = t279 - t208*t280
+    t284 = t221*(t282 + t222*t283)
+    t285 = -t284 + t282
+    t286 = t283 - t222*t284
+    t287 = t286 - t228*t286
+    t288 = casadi.if_else((t227 != 0), -t287/t227, 0)
+    t289 = casadi.if_else((t218 != 0), -(t285 - t224*t288)/t218, 0)
+    t290 = casadi.if_else((t197 != 0), -(-(t210*t289 + t214*t288) + t281)/t197, 0)
+    t291 = casadi.if_else((t157 != 0), -(-(t187*t290 + t192*t289 + t200*t288) + t276)/t157, 0)
+    t292 = casadi.if_else((t136 != 0), -(-(t148*t291 - t160*t290 + t169*t289 + t174*t288) + t270)/t136, 0)
+    t293 = casadi.if_else((t72 != 0), -(-(t117*t292 + t125*t291 + t120*t290 + t122*t289 + t137*t112*t288) + t249)/t72, 0)
+    t294 = (casadi.fabs(t250) < casadi.inf)
+    t295 = (damping >= 0)
+    t296 = (damping > 0)
+    t297 = 1e-12*t89
+    t298 = casadi.logic_or(casadi.logic_and(t296, (t252[6] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t71 <= t297), (t135 <= t297)), (t156 <= t297)), (t196 <= t297)), (t217 <= t297)), (t226 <= t297))))
+    t299 = casadi.logic_and(casadi.logic_and(t294, t295), casadi.logic_not(t298))
     q_dot = casadi.SX(6, 1)
-    q_dot[0, 0] = casadi.if_else(t466, casadi.if_else(t462, t422, t459), 0)
-    q_dot[1, 0] = casadi.if_else(t466, casadi.if_else(t462, t430, t458), 0)
-    q_dot[2, 0] = casadi.if_else(t466, casadi.if_else(t462, t431, t457), 0)
-    q_dot[3, 0] = casadi.if_else(t466, casadi.if_else(t462, t423, t456), 0)
-    q_dot[4, 0] = casadi.if_else(t466, casadi.if_else(t462, t424, t455), 0)
-    q_dot[5, 0] = casadi.if_else(t466, casadi.if_else(t462, t425, t454), 0)
+    q_dot[0, 0] = casadi.if_else(t299, casadi.if_else(t296, t256, t293), 0)
+    q_dot[1, 0] = casadi.if_else(t299, casadi.if_else(t296, t264, t292), 0)
+    q_dot[2, 0] = casadi.if_else(t299, casadi.if_else(t296, t265, t291), 0)
+    q_dot[3, 0] = casadi.if_else(t299, casadi.if_else(t296, t260, t290), 0)
+    q_dot[4, 0] = casadi.if_else(t299, casadi.if_else(t296, t261, t289), 0)
+    q_dot[5, 0] = casadi.if_else(t299, casadi.if_else(t296, t262, t288), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t460, t461)), 2, casadi.if_else(t465, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t294, t295)), 2, casadi.if_else(t298, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 979 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 1040 operations."""
     T00 = target[0, 0]
     T01 = target[0, 1]
     T02 = target[0, 2]
@@ -4980,181 +4722,22 @@ def _ik_numeric_step(target, q, damping):
     t113 = casadi.if_else(t110, t38*t102, t111*t106)
     t114 = casadi.if_else(t110, t25*t102, t111*t107)
     t115 = t112**2 + t113**2 + t114**2 + t69**2 + t86**2 + t56**2
-    t116 = damping + t74
-    t117 = casadi.sqrt(t116**2 + t76**2 + t79**2 + t82**2 + t71**2 + t85**2)
-    t118 = t117*casadi.if_else((t116 >= 0), 1, -1)
-    t119 = (t117 > 0)
-    t120 = casadi.if_else(t119, 1/(t116 + t118), 0)
-    t121 = casadi.if_else(t119, 1 + casadi.fabs(t116)/t117, 0)
-    t122 = damping + t88
-    t123 = t76*t120
-    t124 = t79*t120
-    t125 = t82*t120
-    t126 = t71*t120
-    t127 = t85*t120
-    t128 = t121*(t76 + t122*t123 - t124*t92 + t125*t89 + t126*t83 + t127*t67)
-    t129 = -t128 + t76
-    t130 = t122 - t123*t128
-    t131 = t92 + t124*t128
-    t132 = -t89 + t125*t128
-    t133 = t83 - t126*t128
-    t134 = t67 - t127*t128
-    t135 = t121*(t69 + t123*t86 + t124*t56 - t125*t112 + t126*t113 + t127*t114)
-    t136 = -t135 + t69
-    t137 = t86 - t123*t135
-    t138 = t56 - t124*t135
-    t139 = t112 + t125*t135
-    t140 = t113 - t126*t135
-    t141 = t114 - t127*t135
-    t142 = casadi.sqrt(t130**2 + t131**2 + t132**2 + t133**2 + t134**2)
-    t143 = t142*casadi.if_else((t130 >= 0), 1, -1)
-    t144 = damping + t68
-    t145 = t121*(t124*t144 + t79 - t123*t92 - t125*t93 + t126*t80 + t127*t46)
-    t146 = -t145 + t79
-    t147 = t92 + t123*t145
-    t148 = t144 - t124*t145
-    t149 = t93 + t125*t145
-    t150 = t80 - t126*t145
-    t151 = t46 - t127*t145
-    t152 = damping + t95
-    t153 = -t121*(t82 + t123*t89 - t124*t93 + t125*t152 - t126*t96 + t127*t32)
-    t154 = t82 + t153
-    t155 = t89 + t123*t153
-    t156 = t93 - t124*t153
-    t157 = t152 + t125*t153
-    t158 = t96 - t126*t153
-    t159 = t32 + t127*t153
-    t160 = damping + t97
-    t161 = t121*(t126*t160 + t71 + t123*t83 + t124*t80 - t125*t96 + t127*t33)
-    t162 = -t161 + t71
-    t163 = t83 - t123*t161
-    t164 = t80 - t124*t161
-    t165 = t96 + t125*t161
-    t166 = t160 - t126*t161
-    t167 = t33 - t127*t161
-    t168 = damping + t98
-    t169 = t121*(t85 + t123*t67 + t124*t46 + t125*t32 + t126*t33 + t127*t168)
-    t170 = -t169 + t85
-    t171 = t67 - t123*t169
-    t172 = t46 - t124*t169
-    t173 = -t32 + t125*t169
-    t174 = t33 - t126*t169
-    t175 = t168 - t127*t169
-    t176 = (t142 > 0)
-    t177 = casadi.if_else(t176, 1/(t130 + t143), 0)
-    t178 = casadi.if_else(t176, 1 + casadi.fabs(t130)/t142, 0)
-    t179 = t131*t177
-    t180 = t132*t177
-    t181 = t133*t177
-    t182 = t134*t177
-    t183 = t178*(-t147 - t179*t148 + t180*t149 + t181*t150 + t182*t151)
-    t184 = t147 + t183
-    t185 = t148 + t179*t183
-    t186 = t149 - t180*t183
-    t187 = t150 - t181*t183
-    t188 = t151 - t182*t183
-    t189 = -t178*(t155 + t179*t156 - t180*t157 - t181*t158 + t182*t159)
-    t190 = t155 + t189
-    t191 = t156 + t179*t189
-    t192 = t157 - t180*t189
-    t193 = t158 - t181*t189
-    t194 = t159 + t182*t189
-    t195 = t178*(t163 - t179*t164 + t180*t165 + t181*t166 + t182*t167)
-    t196 = -t195 + t163
-    t197 = t164 + t179*t195
-    t198 = t165 - t180*t195
-    t199 = t166 - t181*t195
-    t200 = t167 - t182*t195
-    t201 = t178*(t171 - t179*t172 + t180*t173 + t181*t174 + t182*t175)
-    t202 = -t201 + t171
-    t203 = t172 + t179*t201
-    t204 = t173 - t180*t201
-    t205 = t174 - t181*t201
-    t206 = t175 - t182*t201
-    t207 = t178*(t137 - t179*t138 + t180*t139 + t181*t140 + t182*t141)
-    t208 = -t207 + t137
-    t209 = t138 + t179*t207
-    t210 = t139 - t180*t207
-    t211 = t140 - t181*t207
-    t212 = t141 - t182*t207
-    t213 = casadi.sqrt(t185**2 + t186**2 + t187**2 + t188**2)
-    t214 = t213*casadi.if_else((t185 >= 0), 1, -1)
-    t215 = (t213 > 0)
-    t216 = casadi.if_else(t215, 1/(t185 + t214), 0)
-    t217 = casadi.if_else(t215, 1 + casadi.fabs(t185)/t213, 0)
-    t218 = t186*t216
-    t219 = t187*t216
-    t220 = t188*t216
-    t221 = t217*(t191 + t218*t192 + t219*t193 - t220*t194)
-    t222 = -t221 + t191
-    t223 = t192 - t218*t221
-    t224 = t193 - t219*t221
-    t225 = t194 + t220*t221
-    t226 = t217*(t197 + t218*t198 + t219*t199 + t220*t200)
-    t227 = -t226 + t197
-    t228 = t198 - t218*t226
-    t229 = t199 - t219*t226
-    t230 = t200 - t220*t226
-    t231 = t217*(t203 + t218*t204 + t219*t205 + t220*t206)
-    t232 = -t231 + t203
-    t233 = t204 - t218*t231
-    t234 = t205 - t219*t231
-    t235 = t206 - t220*t231
-    t236 = t217*(t209 + t218*t210 + t219*t211 + t220*t212)
-    t237 = -t236 + t209
-    t238 = t210 - t218*t236
-    t239 = t211 - t219*t236
-    t240 = t212 - t220*t236
-    t241 = casadi.sqrt(t223**2 + t224**2 + t225**2)
-    t242 = t241*casadi.if_else((t223 >= 0), 1, -1)
-    t243 = (t241 > 0)
-    t244 = casadi.if_else(t243, 1/(t223 + t242), 0)
-    t245 = casadi.if_else(t243, 1 + casadi.fabs(t223)/t241, 0)
-    t246 = t224*t244
-    t247 = t225*t244
-    t248 = t245*(t228 + t246*t229 - t247*t230)
-    t249 = -t248 + t228
-    t250 = t229 - t246*t248
-    t251 = t230 + t247*t248
-    t252 = t245*(t233 + t246*t234 - t247*t235)
-    t253 = -t252 + t233
-    t254 = t234 - t246*t252
-    t255 = t235 + t247*t252
-    t256 = t245*(t238 + t246*t239 - t247*t240)
-    t257 = -t256 + t238
-    t258 = t239 - t246*t256
-    t259 = t240 + t247*t256
-    t260 = casadi.sqrt(t250**2 + t251**2)
-    t261 = t260*casadi.if_else((t250 >= 0), 1, -1)
-    t262 = (t260 > 0)
-    t263 = casadi.if_else(t262, 1/(t250 + t261), 0)
-    t264 = casadi.if_else(t262, 1 + casadi.fabs(t250)/t260, 0)
-    t265 = t251*t263
-    t266 = t264*(t254 + t265*t255)
-    t267 = -t266 + t254
-    t268 = t255 - t265*t266
-    t269 = t264*(t258 + t265*t259)
-    t270 = -t269 + t258
-    t271 = t259 - t265*t269
-    t272 = casadi.fabs(t268)
-    t273 = t272*casadi.if_else((t268 >= 0), 1, -1)
-    t274 = casadi.if_else((t272 > 0), 2, 0)
-    t275 = t271 - t271*t274
-    t276 = casadi.if_else((t273 != 0), -t275/t273, 0)
-    t277 = casadi.if_else((t261 != 0), -(t270 - t267*t276)/t261, 0)
-    t278 = casadi.if_else((t242 != 0), -(-(t249*t277 + t253*t276) + t257)/t242, 0)
-    t279 = casadi.if_else((t214 != 0), -(-(t222*t278 + t227*t277 + t232*t276) + t237)/t214, 0)
-    t280 = casadi.if_else((t143 != 0), -(-(-t184*t279 - t190*t278 + t196*t277 + t202*t276) + t208)/t143, 0)
-    t281 = casadi.if_else((t118 != 0), -(-(t129*t280 + t146*t279 - t154*t278 + t162*t277 + t170*t276) + t136)/t118, 0)
-    t282 = q1 + t276 - t65*t281 + t64*t280
-    t283 = q4 + t52*t281 - t54*t280 + t44*t279 + c23*t276 + t9*t278 + t17*t277
-    t284 = q5 + t53*t281 + t55*t280 + t45*t279 - t7*t278 + t4*t277 + t29*t276
-    t285 = q6 + t11*t278 + t19*t277 - t28*t276
-    t286 = c1*t281
-    t287 = s1*t280
-    t288 = -s1*t278 + c1*t277
-    t289 = q2 + t288 - t66*t279 + t50*t286 + t50*t287
-    t290 = q3 + t288 - t60*t279 + t49*t286 + t49*t287
+    t116 = _symmetric_solve6(1, (damping + t74, t76, t79, -t82, t71, t85, damping + t88, -t92, -t89, t83, t67, damping + t68, t93, t80, t46, damping + t95, t96, -t32, damping + t97, t33, damping + t98, t69, t86, t56, t112, t113, t114,))
+    t117 = t116[5]
+    t118 = t116[0]
+    t119 = t116[1]
+    t120 = q1 + t117 - t65*t118 + t64*t119
+    t121 = c1*t118
+    t122 = s1*t119
+    t123 = t116[2]
+    t124 = t116[3]
+    t125 = t116[4]
+    t126 = q4 + t52*t118 - t54*t119 + t44*t123 + t9*t124 + t17*t125 + c23*t117
+    t127 = q5 + t53*t118 + t55*t119 + t45*t123 - t7*t124 + t4*t125 + t29*t117
+    t128 = q6 + t11*t124 + t19*t125 - t28*t117
+    t129 = -s1*t124 + c1*t125
+    t130 = q2 + t129 + t50*t121 + t50*t122 - t66*t123
+    t131 = q3 + t129 + t49*t122 + t49*t121 - t60*t123
     q_start = casadi.SX(6, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -5163,12 +4746,12 @@ def _ik_numeric_step(target, q, damping):
     q_start[4, 0] = q5
     q_start[5, 0] = q6
     q_next = casadi.SX(6, 1)
-    q_next[0, 0] = casadi.if_else((t282 < -2.705260340591211), -2.705260340591211, casadi.if_else((t282 > 2.705260340591211), 2.705260340591211, t282))
-    q_next[1, 0] = casadi.if_else((t289 < -3.141592653589793), -3.141592653589793, casadi.if_else((t289 > 1.1344640137963142), 1.1344640137963142, t289))
-    q_next[2, 0] = casadi.if_else((t290 < -0.2617993877991494), -0.2617993877991494, casadi.if_else((t290 > 2.7576202181510405), 2.7576202181510405, t290))
-    q_next[3, 0] = casadi.if_else((t283 < -6.1086523819801535), -6.1086523819801535, casadi.if_else((t283 > 6.1086523819801535), 6.1086523819801535, t283))
-    q_next[4, 0] = casadi.if_else((t284 < -2.2689280275926285), -2.2689280275926285, casadi.if_else((t284 > 2.2689280275926285), 2.2689280275926285, t284))
-    q_next[5, 0] = casadi.if_else((t285 < -6.1086523819801535), -6.1086523819801535, casadi.if_else((t285 > 6.1086523819801535), 6.1086523819801535, t285))
+    q_next[0, 0] = casadi.if_else((t120 < -2.705260340591211), -2.705260340591211, casadi.if_else((t120 > 2.705260340591211), 2.705260340591211, t120))
+    q_next[1, 0] = casadi.if_else((t130 < -3.141592653589793), -3.141592653589793, casadi.if_else((t130 > 1.1344640137963142), 1.1344640137963142, t130))
+    q_next[2, 0] = casadi.if_else((t131 < -0.2617993877991494), -0.2617993877991494, casadi.if_else((t131 > 2.7576202181510405), 2.7576202181510405, t131))
+    q_next[3, 0] = casadi.if_else((t126 < -6.1086523819801535), -6.1086523819801535, casadi.if_else((t126 > 6.1086523819801535), 6.1086523819801535, t126))
+    q_next[4, 0] = casadi.if_else((t127 < -2.2689280275926285), -2.2689280275926285, casadi.if_else((t127 > 2.2689280275926285), 2.2689280275926285, t127))
+    q_next[5, 0] = casadi.if_else((t128 < -6.1086523819801535), -6.1086523819801535, casadi.if_else((t128 > 6.1086523819801535), 6.1086523819801535, t128))
     cost = casadi.SX(1, 1)
     cost[0, 0] = casadi.if_else((casadi.fabs(t0) < casadi.inf), t115, -1)
     return [q_start, q_next, cost]
@@ -5752,7 +5335,7 @@ def _ik_branches(T):
 
 
 def _ik_nearest(T, q_seed, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 963 operations."""
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 962 operations."""
     branches_q, branches_valid, branches_in_limits = _ik_branches(T)
     T00 = T[0, 0]
     T01 = T[0, 1]
@@ -5842,366 +5425,27 @@ def _ik_nearest(T, q_seed, weights):
     lb5 = branches_in_limits[5]
     lb6 = branches_in_limits[6]
     lb7 = branches_in_limits[7]
-    t0 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
-    t1 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
-    t2 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
-    t3 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
-    t4 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
-    t5 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
-    t6 = casadi.if_else(casadi.logic_and(vb0, lb0), 1, 0)
-    t7 = casadi.if_else((t6 > 0), 1, 0)
-    t8 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
-    t9 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
-    t10 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
-    t11 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
-    t12 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
-    t13 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
-    t14 = casadi.if_else(casadi.logic_and(vb1, lb1), 1, 0)
-    t15 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
-    t16 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
-    t17 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
-    t18 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
-    t19 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
-    t20 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
-    t21 = casadi.if_else(casadi.logic_and(vb2, lb2), 1, 0)
-    t22 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
-    t23 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
-    t24 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
-    t25 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
-    t26 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
-    t27 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
-    t28 = casadi.if_else(casadi.logic_and(vb3, lb3), 1, 0)
-    t29 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
-    t30 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
-    t31 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
-    t32 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
-    t33 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
-    t34 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
-    t35 = casadi.if_else(casadi.logic_and(vb4, lb4), 1, 0)
-    t36 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
-    t37 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
-    t38 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
-    t39 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
-    t40 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
-    t41 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
-    t42 = casadi.if_else(casadi.logic_and(vb5, lb5), 1, 0)
-    t43 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
-    t44 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
-    t45 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
-    t46 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
-    t47 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
-    t48 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
-    t49 = casadi.if_else(casadi.logic_and(vb6, lb6), 1, 0)
-    t50 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
-    t51 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
-    t52 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
-    t53 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
-    t54 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
-    t55 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
-    t56 = casadi.if_else(casadi.logic_and(vb7, lb7), 1, 0)
-    t57 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
-    t58 = casadi.if_else((t0 < qn1), 6.283185307179586, -6.283185307179586)
-    t59 = t58 + t0
-    t60 = -t58 + t0
-    t61 = casadi.if_else(casadi.logic_and((t0 >= -2.705260340591211), (t0 <= 2.705260340591211)), t0, casadi.if_else(casadi.logic_and((t59 >= -2.705260340591211), (t59 <= 2.705260340591211)), t59, casadi.if_else(casadi.logic_and((t60 >= -2.705260340591211), (t60 <= 2.705260340591211)), t60, qb0_0)))
-    t62 = casadi.if_else((t1 < qn2), 6.283185307179586, -6.283185307179586)
-    t63 = t62 + t1
-    t64 = -t62 + t1
-    t65 = casadi.if_else(casadi.logic_and((t1 >= -3.141592653589793), (t1 <= 1.1344640137963142)), t1, casadi.if_else(casadi.logic_and((t63 >= -3.141592653589793), (t63 <= 1.1344640137963142)), t63, casadi.if_else(casadi.logic_and((t64 >= -3.141592653589793), (t64 <= 1.1344640137963142)), t64, qb0_1)))
-    t66 = casadi.if_else((t2 < qn3), 6.283185307179586, -6.283185307179586)
-    t67 = t66 + t2
-    t68 = -t66 + t2
-    t69 = casadi.if_else(casadi.logic_and((t2 >= -0.2617993877991494), (t2 <= 2.7576202181510405)), t2, casadi.if_else(casadi.logic_and((t67 >= -0.2617993877991494), (t67 <= 2.7576202181510405)), t67, casadi.if_else(casadi.logic_and((t68 >= -0.2617993877991494), (t68 <= 2.7576202181510405)), t68, qb0_2)))
-    t70 = casadi.if_else((t3 < qn4), 6.283185307179586, -6.283185307179586)
-    t71 = t70 + t3
-    t72 = -t70 + t3
-    t73 = casadi.if_else(casadi.logic_and((t3 >= -6.1086523819801535), (t3 <= 6.1086523819801535)), t3, casadi.if_else(casadi.logic_and((t71 >= -6.1086523819801535), (t71 <= 6.1086523819801535)), t71, casadi.if_else(casadi.logic_and((t72 >= -6.1086523819801535), (t72 <= 6.1086523819801535)), t72, qb0_3)))
-    t74 = casadi.if_else((t4 < qn5), 6.283185307179586, -6.283185307179586)
-    t75 = t74 + t4
-    t76 = -t74 + t4
-    t77 = casadi.if_else(casadi.logic_and((t4 >= -2.2689280275926285), (t4 <= 2.2689280275926285)), t4, casadi.if_else(casadi.logic_and((t75 >= -2.2689280275926285), (t75 <= 2.2689280275926285)), t75, casadi.if_else(casadi.logic_and((t76 >= -2.2689280275926285), (t76 <= 2.2689280275926285)), t76, qb0_4)))
-    t78 = casadi.if_else((t5 < qn6), 6.283185307179586, -6.283185307179586)
-    t79 = t78 + t5
-    t80 = -t78 + t5
-    t81 = casadi.if_else(casadi.logic_and((t5 >= -6.1086523819801535), (t5 <= 6.1086523819801535)), t5, casadi.if_else(casadi.logic_and((t79 >= -6.1086523819801535), (t79 <= 6.1086523819801535)), t79, casadi.if_else(casadi.logic_and((t80 >= -6.1086523819801535), (t80 <= 6.1086523819801535)), t80, qb0_5)))
-    t82 = -qn1
-    t83 = -qn2
-    t84 = -qn3
-    t85 = -qn4
-    t86 = -qn5
-    t87 = -qn6
-    t88 = qw1*(t82 + t61)**2 + qw2*(t83 + t65)**2 + qw3*(t84 + t69)**2 + qw4*(t85 + t73)**2 + qw5*(t86 + t77)**2 + qw6*(t87 + t81)**2
-    t89 = (t7 > 0)
-    t90 = casadi.if_else(t89, t61, qn1)
-    t91 = casadi.if_else(t89, t65, qn2)
-    t92 = casadi.if_else(t89, t69, qn3)
-    t93 = casadi.if_else(t89, t73, qn4)
-    t94 = casadi.if_else(t89, t77, qn5)
-    t95 = casadi.if_else(t89, t81, qn6)
-    t96 = casadi.if_else(t89, t88, 0)
-    t97 = casadi.if_else((t8 < qn1), 6.283185307179586, -6.283185307179586)
-    t98 = t97 + t8
-    t99 = -t97 + t8
-    t100 = casadi.if_else(casadi.logic_and((t8 >= -2.705260340591211), (t8 <= 2.705260340591211)), t8, casadi.if_else(casadi.logic_and((t98 >= -2.705260340591211), (t98 <= 2.705260340591211)), t98, casadi.if_else(casadi.logic_and((t99 >= -2.705260340591211), (t99 <= 2.705260340591211)), t99, qb1_0)))
-    t101 = casadi.if_else((t9 < qn2), 6.283185307179586, -6.283185307179586)
-    t102 = t101 + t9
-    t103 = -t101 + t9
-    t104 = casadi.if_else(casadi.logic_and((t9 >= -3.141592653589793), (t9 <= 1.1344640137963142)), t9, casadi.if_else(casadi.logic_and((t102 >= -3.141592653589793), (t102 <= 1.1344640137963142)), t102, casadi.if_else(casadi.logic_and((t103 >= -3.141592653589793), (t103 <= 1.1344640137963142)), t103, qb1_1)))
-    t105 = casadi.if_else((t10 < qn3), 6.283185307179586, -6.283185307179586)
-    t106 = t105 + t10
-    t107 = -t105 + t10
-    t108 = casadi.if_else(casadi.logic_and((t10 >= -0.2617993877991494), (t10 <= 2.7576202181510405)), t10, casadi.if_else(casadi.logic_and((t106 >= -0.2617993877991494), (t106 <= 2.7576202181510405)), t106, casadi.if_else(casadi.logic_and((t107 >= -0.2617993877991494), (t107 <= 2.7576202181510405)), t107, qb1_2)))
-    t109 = casadi.if_else((t11 < qn4), 6.283185307179586, -6.283185307179586)
-    t110 = t109 + t11
-    t111 = -t109 + t11
-    t112 = casadi.if_else(casadi.logic_and((t11 >= -6.1086523819801535), (t11 <= 6.1086523819801535)), t11, casadi.if_else(casadi.logic_and((t110 >= -6.1086523819801535), (t110 <= 6.1086523819801535)), t110, casadi.if_else(casadi.logic_and((t111 >= -6.1086523819801535), (t111 <= 6.1086523819801535)), t111, qb1_3)))
-    t113 = casadi.if_else((t12 < qn5), 6.283185307179586, -6.283185307179586)
-    t114 = t113 + t12
-    t115 = -t113 + t12
-    t116 = casadi.if_else(casadi.logic_and((t12 >= -2.2689280275926285), (t12 <= 2.2689280275926285)), t12, casadi.if_else(casadi.logic_and((t114 >= -2.2689280275926285), (t114 <= 2.2689280275926285)), t114, casadi.if_else(casadi.logic_and((t115 >= -2.2689280275926285), (t115 <= 2.2689280275926285)), t115, qb1_4)))
-    t117 = casadi.if_else((t13 < qn6), 6.283185307179586, -6.283185307179586)
-    t118 = t117 + t13
-    t119 = -t117 + t13
-    t120 = casadi.if_else(casadi.logic_and((t13 >= -6.1086523819801535), (t13 <= 6.1086523819801535)), t13, casadi.if_else(casadi.logic_and((t118 >= -6.1086523819801535), (t118 <= 6.1086523819801535)), t118, casadi.if_else(casadi.logic_and((t119 >= -6.1086523819801535), (t119 <= 6.1086523819801535)), t119, qb1_5)))
-    t121 = qw1*(t82 + t100)**2 + qw2*(t83 + t104)**2 + qw3*(t84 + t108)**2 + qw4*(t85 + t112)**2 + qw5*(t86 + t116)**2 + qw6*(t87 + t120)**2
-    t122 = (t14 > 0)
-    t123 = casadi.if_else(casadi.logic_and(t122, casadi.logic_or((t7 < 1), (t121 < t96))), 1, 0)
-    t124 = casadi.if_else(t122, 1, t7)
-    t125 = (t123 > 0)
-    t126 = casadi.if_else(t125, t100, t90)
-    t127 = casadi.if_else(t125, t104, t91)
-    t128 = casadi.if_else(t125, t108, t92)
-    t129 = casadi.if_else(t125, t112, t93)
-    t130 = casadi.if_else(t125, t116, t94)
-    t131 = casadi.if_else(t125, t120, t95)
-    t132 = casadi.if_else(t125, t121, t96)
-    t133 = casadi.if_else((t15 < qn1), 6.283185307179586, -6.283185307179586)
-    t134 = t133 + t15
-    t135 = -t133 + t15
-    t136 = casadi.if_else(casadi.logic_and((t15 >= -2.705260340591211), (t15 <= 2.705260340591211)), t15, casadi.if_else(casadi.logic_and((t134 >= -2.705260340591211), (t134 <= 2.705260340591211)), t134, casadi.if_else(casadi.logic_and((t135 >= -2.705260340591211), (t135 <= 2.705260340591211)), t135, qb2_0)))
-    t137 = casadi.if_else((t16 < qn2), 6.283185307179586, -6.283185307179586)
-    t138 = t137 + t16
-    t139 = -t137 + t16
-    t140 = casadi.if_else(casadi.logic_and((t16 >= -3.141592653589793), (t16 <= 1.1344640137963142)), t16, casadi.if_else(casadi.logic_and((t138 >= -3.141592653589793), (t138 <= 1.1344640137963142)), t138, casadi.if_else(casadi.logic_and((t139 >= -3.141592653589793), (t139 <= 1.1344640137963142)), t139, qb2_1)))
-    t141 = casadi.if_else((t17 < qn3), 6.283185307179586, -6.283185307179586)
-    t142 = t141 + t17
-    t143 = -t141 + t17
-    t144 = casadi.if_else(casadi.logic_and((t17 >= -0.2617993877991494), (t17 <= 2.7576202181510405)), t17, casadi.if_else(casadi.logic_and((t142 >= -0.2617993877991494), (t142 <= 2.7576202181510405)), t142, casadi.if_else(casadi.logic_and((t143 >= -0.2617993877991494), (t143 <= 2.7576202181510405)), t143, qb2_2)))
-    t145 = casadi.if_else((t18 < qn4), 6.283185307179586, -6.283185307179586)
-    t146 = t145 + t18
-    t147 = -t145 + t18
-    t148 = casadi.if_else(casadi.logic_and((t18 >= -6.1086523819801535), (t18 <= 6.1086523819801535)), t18, casadi.if_else(casadi.logic_and((t146 >= -6.1086523819801535), (t146 <= 6.1086523819801535)), t146, casadi.if_else(casadi.logic_and((t147 >= -6.1086523819801535), (t147 <= 6.1086523819801535)), t147, qb2_3)))
-    t149 = casadi.if_else((t19 < qn5), 6.283185307179586, -6.283185307179586)
-    t150 = t149 + t19
-    t151 = -t149 + t19
-    t152 = casadi.if_else(casadi.logic_and((t19 >= -2.2689280275926285), (t19 <= 2.2689280275926285)), t19, casadi.if_else(casadi.logic_and((t150 >= -2.2689280275926285), (t150 <= 2.2689280275926285)), t150, casadi.if_else(casadi.logic_and((t151 >= -2.2689280275926285), (t151 <= 2.2689280275926285)), t151, qb2_4)))
-    t153 = casadi.if_else((t20 < qn6), 6.283185307179586, -6.283185307179586)
-    t154 = t153 + t20
-    t155 = -t153 + t20
-    t156 = casadi.if_else(casadi.logic_and((t20 >= -6.1086523819801535), (t20 <= 6.1086523819801535)), t20, casadi.if_else(casadi.logic_and((t154 >= -6.1086523819801535), (t154 <= 6.1086523819801535)), t154, casadi.if_else(casadi.logic_and((t155 >= -6.1086523819801535), (t155 <= 6.1086523819801535)), t155, qb2_5)))
-    t157 = qw1*(t82 + t136)**2 + qw2*(t83 + t140)**2 + qw3*(t84 + t144)**2 + qw4*(t85 + t148)**2 + qw5*(t86 + t152)**2 + qw6*(t87 + t156)**2
-    t158 = (t21 > 0)
-    t159 = casadi.if_else(casadi.logic_and(t158, casadi.logic_or((t124 < 1), (t157 < t132))), 1, 0)
-    t160 = casadi.if_else(t158, 1, t124)
-    t161 = (t159 > 0)
-    t162 = casadi.if_else(t161, t136, t126)
-    t163 = casadi.if_else(t161, t140, t127)
-    t164 = casadi.if_else(t161, t144, t128)
-    t165 = casadi.if_else(t161, t148, t129)
-    t166 = casadi.if_else(t161, t152, t130)
-    t167 = casadi.if_else(t161, t156, t131)
-    t168 = casadi.if_else(t161, t157, t132)
-    t169 = casadi.if_else((t22 < qn1), 6.283185307179586, -6.283185307179586)
-    t170 = t169 + t22
-    t171 = -t169 + t22
-    t172 = casadi.if_else(casadi.logic_and((t22 >= -2.705260340591211), (t22 <= 2.705260340591211)), t22, casadi.if_else(casadi.logic_and((t170 >= -2.705260340591211), (t170 <= 2.705260340591211)), t170, casadi.if_else(casadi.logic_and((t171 >= -2.705260340591211), (t171 <= 2.705260340591211)), t171, qb3_0)))
-    t173 = casadi.if_else((t23 < qn2), 6.283185307179586, -6.283185307179586)
-    t174 = t173 + t23
-    t175 = -t173 + t23
-    t176 = casadi.if_else(casadi.logic_and((t23 >= -3.141592653589793), (t23 <= 1.1344640137963142)), t23, casadi.if_else(casadi.logic_and((t174 >= -3.141592653589793), (t174 <= 1.1344640137963142)), t174, casadi.if_else(casadi.logic_and((t175 >= -3.141592653589793), (t175 <= 1.1344640137963142)), t175, qb3_1)))
-    t177 = casadi.if_else((t24 < qn3), 6.283185307179586, -6.283185307179586)
-    t178 = t177 + t24
-    t179 = -t177 + t24
-    t180 = casadi.if_else(casadi.logic_and((t24 >= -0.2617993877991494), (t24 <= 2.7576202181510405)), t24, casadi.if_else(casadi.logic_and((t178 >= -0.2617993877991494), (t178 <= 2.7576202181510405)), t178, casadi.if_else(casadi.logic_and((t179 >= -0.2617993877991494), (t179 <= 2.7576202181510405)), t179, qb3_2)))
-    t181 = casadi.if_else((t25 < qn4), 6.283185307179586, -6.283185307179586)
-    t182 = t181 + t25
-    t183 = -t181 + t25
-    t184 = casadi.if_else(casadi.logic_and((t25 >= -6.1086523819801535), (t25 <= 6.1086523819801535)), t25, casadi.if_else(casadi.logic_and((t182 >= -6.1086523819801535), (t182 <= 6.1086523819801535)), t182, casadi.if_else(casadi.logic_and((t183 >= -6.1086523819801535), (t183 <= 6.1086523819801535)), t183, qb3_3)))
-    t185 = casadi.if_else((t26 < qn5), 6.283185307179586, -6.283185307179586)
-    t186 = t185 + t26
-    t187 = -t185 + t26
-    t188 = casadi.if_else(casadi.logic_and((t26 >= -2.2689280275926285), (t26 <= 2.2689280275926285)), t26, casadi.if_else(casadi.logic_and((t186 >= -2.2689280275926285), (t186 <= 2.2689280275926285)), t186, casadi.if_else(casadi.logic_and((t187 >= -2.2689280275926285), (t187 <= 2.2689280275926285)), t187, qb3_4)))
-    t189 = casadi.if_else((t27 < qn6), 6.283185307179586, -6.283185307179586)
-    t190 = t189 + t27
-    t191 = -t189 + t27
-    t192 = casadi.if_else(casadi.logic_and((t27 >= -6.1086523819801535), (t27 <= 6.1086523819801535)), t27, casadi.if_else(casadi.logic_and((t190 >= -6.1086523819801535), (t190 <= 6.1086523819801535)), t190, casadi.if_else(casadi.logic_and((t191 >= -6.1086523819801535), (t191 <= 6.1086523819801535)), t191, qb3_5)))
-    t193 = qw1*(t82 + t172)**2 + qw2*(t83 + t176)**2 + qw3*(t84 + t180)**2 + qw4*(t85 + t184)**2 + qw5*(t86 + t188)**2 + qw6*(t87 + t192)**2
-    t194 = (t28 > 0)
-    t195 = casadi.if_else(casadi.logic_and(t194, casadi.logic_or((t160 < 1), (t193 < t168))), 1, 0)
-    t196 = casadi.if_else(t194, 1, t160)
-    t197 = (t195 > 0)
-    t198 = casadi.if_else(t197, t172, t162)
-    t199 = casadi.if_else(t197, t176, t163)
-    t200 = casadi.if_else(t197, t180, t164)
-    t201 = casadi.if_else(t197, t184, t165)
-    t202 = casadi.if_else(t197, t188, t166)
-    t203 = casadi.if_else(t197, t192, t167)
-    t204 = casadi.if_else(t197, t193, t168)
-    t205 = casadi.if_else((t29 < qn1), 6.283185307179586, -6.283185307179586)
-    t206 = t205 + t29
-    t207 = -t205 + t29
-    t208 = casadi.if_else(casadi.logic_and((t29 >= -2.705260340591211), (t29 <= 2.705260340591211)), t29, casadi.if_else(casadi.logic_and((t206 >= -2.705260340591211), (t206 <= 2.705260340591211)), t206, casadi.if_else(casadi.logic_and((t207 >= -2.705260340591211), (t207 <= 2.705260340591211)), t207, qb4_0)))
-    t209 = casadi.if_else((t30 < qn2), 6.283185307179586, -6.283185307179586)
-    t210 = t209 + t30
-    t211 = -t209 + t30
-    t212 = casadi.if_else(casadi.logic_and((t30 >= -3.141592653589793), (t30 <= 1.1344640137963142)), t30, casadi.if_else(casadi.logic_and((t210 >= -3.141592653589793), (t210 <= 1.1344640137963142)), t210, casadi.if_else(casadi.logic_and((t211 >= -3.141592653589793), (t211 <= 1.1344640137963142)), t211, qb4_1)))
-    t213 = casadi.if_else((t31 < qn3), 6.283185307179586, -6.283185307179586)
-    t214 = t213 + t31
-    t215 = -t213 + t31
-    t216 = casadi.if_else(casadi.logic_and((t31 >= -0.2617993877991494), (t31 <= 2.7576202181510405)), t31, casadi.if_else(casadi.logic_and((t214 >= -0.2617993877991494), (t214 <= 2.7576202181510405)), t214, casadi.if_else(casadi.logic_and((t215 >= -0.2617993877991494), (t215 <= 2.7576202181510405)), t215, qb4_2)))
-    t217 = casadi.if_else((t32 < qn4), 6.283185307179586, -6.283185307179586)
-    t218 = t217 + t32
-    t219 = -t217 + t32
-    t220 = casadi.if_else(casadi.logic_and((t32 >= -6.1086523819801535), (t32 <= 6.1086523819801535)), t32, casadi.if_else(casadi.logic_and((t218 >= -6.1086523819801535), (t218 <= 6.1086523819801535)), t218, casadi.if_else(casadi.logic_and((t219 >= -6.1086523819801535), (t219 <= 6.1086523819801535)), t219, qb4_3)))
-    t221 = casadi.if_else((t33 < qn5), 6.283185307179586, -6.283185307179586)
-    t222 = t221 + t33
-    t223 = -t221 + t33
-    t224 = casadi.if_else(casadi.logic_and((t33 >= -2.2689280275926285), (t33 <= 2.2689280275926285)), t33, casadi.if_else(casadi.logic_and((t222 >= -2.2689280275926285), (t222 <= 2.2689280275926285)), t222, casadi.if_else(casadi.logic_and((t223 >= -2.2689280275926285), (t223 <= 2.2689280275926285)), t223, qb4_4)))
-    t225 = casadi.if_else((t34 < qn6), 6.283185307179586, -6.283185307179586)
-    t226 = t225 + t34
-    t227 = -t225 + t34
-    t228 = casadi.if_else(casadi.logic_and((t34 >= -6.1086523819801535), (t34 <= 6.1086523819801535)), t34, casadi.if_else(casadi.logic_and((t226 >= -6.1086523819801535), (t226 <= 6.1086523819801535)), t226, casadi.if_else(casadi.logic_and((t227 >= -6.1086523819801535), (t227 <= 6.1086523819801535)), t227, qb4_5)))
-    t229 = qw1*(t82 + t208)**2 + qw2*(t83 + t212)**2 + qw3*(t84 + t216)**2 + qw4*(t85 + t220)**2 + qw5*(t86 + t224)**2 + qw6*(t87 + t228)**2
-    t230 = (t35 > 0)
-    t231 = casadi.if_else(casadi.logic_and(t230, casadi.logic_or((t196 < 1), (t229 < t204))), 1, 0)
-    t232 = casadi.if_else(t230, 1, t196)
-    t233 = (t231 > 0)
-    t234 = casadi.if_else(t233, t208, t198)
-    t235 = casadi.if_else(t233, t212, t199)
-    t236 = casadi.if_else(t233, t216, t200)
-    t237 = casadi.if_else(t233, t220, t201)
-    t238 = casadi.if_else(t233, t224, t202)
-    t239 = casadi.if_else(t233, t228, t203)
-    t240 = casadi.if_else(t233, t229, t204)
-    t241 = casadi.if_else((t36 < qn1), 6.283185307179586, -6.283185307179586)
-    t242 = t241 + t36
-    t243 = -t241 + t36
-    t244 = casadi.if_else(casadi.logic_and((t36 >= -2.705260340591211), (t36 <= 2.705260340591211)), t36, casadi.if_else(casadi.logic_and((t242 >= -2.705260340591211), (t242 <= 2.705260340591211)), t242, casadi.if_else(casadi.logic_and((t243 >= -2.705260340591211), (t243 <= 2.705260340591211)), t243, qb5_0)))
-    t245 = casadi.if_else((t37 < qn2), 6.283185307179586, -6.283185307179586)
-    t246 = t245 + t37
-    t247 = -t245 + t37
-    t248 = casadi.if_else(casadi.logic_and((t37 >= -3.141592653589793), (t37 <= 1.1344640137963142)), t37, casadi.if_else(casadi.logic_and((t246 >= -3.141592653589793), (t246 <= 1.1344640137963142)), t246, casadi.if_else(casadi.logic_and((t247 >= -3.141592653589793), (t247 <= 1.1344640137963142)), t247, qb5_1)))
-    t249 = casadi.if_else((t38 < qn3), 6.283185307179586, -6.283185307179586)
-    t250 = t249 + t38
-    t251 = -t249 + t38
-    t252 = casadi.if_else(casadi.logic_and((t38 >= -0.2617993877991494), (t38 <= 2.7576202181510405)), t38, casadi.if_else(casadi.logic_and((t250 >= -0.2617993877991494), (t250 <= 2.7576202181510405)), t250, casadi.if_else(casadi.logic_and((t251 >= -0.2617993877991494), (t251 <= 2.7576202181510405)), t251, qb5_2)))
-    t253 = casadi.if_else((t39 < qn4), 6.283185307179586, -6.283185307179586)
-    t254 = t253 + t39
-    t255 = -t253 + t39
-    t256 = casadi.if_else(casadi.logic_and((t39 >= -6.1086523819801535), (t39 <= 6.1086523819801535)), t39, casadi.if_else(casadi.logic_and((t254 >= -6.1086523819801535), (t254 <= 6.1086523819801535)), t254, casadi.if_else(casadi.logic_and((t255 >= -6.1086523819801535), (t255 <= 6.1086523819801535)), t255, qb5_3)))
-    t257 = casadi.if_else((t40 < qn5), 6.283185307179586, -6.283185307179586)
-    t258 = t257 + t40
-    t259 = -t257 + t40
-    t260 = casadi.if_else(casadi.logic_and((t40 >= -2.2689280275926285), (t40 <= 2.2689280275926285)), t40, casadi.if_else(casadi.logic_and((t258 >= -2.2689280275926285), (t258 <= 2.2689280275926285)), t258, casadi.if_else(casadi.logic_and((t259 >= -2.2689280275926285), (t259 <= 2.2689280275926285)), t259, qb5_4)))
-    t261 = casadi.if_else((t41 < qn6), 6.283185307179586, -6.283185307179586)
-    t262 = t261 + t41
-    t263 = -t261 + t41
-    t264 = casadi.if_else(casadi.logic_and((t41 >= -6.1086523819801535), (t41 <= 6.1086523819801535)), t41, casadi.if_else(casadi.logic_and((t262 >= -6.1086523819801535), (t262 <= 6.1086523819801535)), t262, casadi.if_else(casadi.logic_and((t263 >= -6.1086523819801535), (t263 <= 6.1086523819801535)), t263, qb5_5)))
-    t265 = qw1*(t82 + t244)**2 + qw2*(t83 + t248)**2 + qw3*(t84 + t252)**2 + qw4*(t85 + t256)**2 + qw5*(t86 + t260)**2 + qw6*(t87 + t264)**2
-    t266 = (t42 > 0)
-    t267 = casadi.if_else(casadi.logic_and(t266, casadi.logic_or((t232 < 1), (t265 < t240))), 1, 0)
-    t268 = casadi.if_else(t266, 1, t232)
-    t269 = (t267 > 0)
-    t270 = casadi.if_else(t269, t244, t234)
-    t271 = casadi.if_else(t269, t248, t235)
-    t272 = casadi.if_else(t269, t252, t236)
-    t273 = casadi.if_else(t269, t256, t237)
-    t274 = casadi.if_else(t269, t260, t238)
-    t275 = casadi.if_else(t269, t264, t239)
-    t276 = casadi.if_else(t269, t265, t240)
-    t277 = casadi.if_else((t43 < qn1), 6.283185307179586, -6.283185307179586)
-    t278 = t277 + t43
-    t279 = -t277 + t43
-    t280 = casadi.if_else(casadi.logic_and((t43 >= -2.705260340591211), (t43 <= 2.705260340591211)), t43, casadi.if_else(casadi.logic_and((t278 >= -2.705260340591211), (t278 <= 2.705260340591211)), t278, casadi.if_else(casadi.logic_and((t279 >= -2.705260340591211), (t279 <= 2.705260340591211)), t279, qb6_0)))
-    t281 = casadi.if_else((t44 < qn2), 6.283185307179586, -6.283185307179586)
-    t282 = t281 + t44
-    t283 = -t281 + t44
-    t284 = casadi.if_else(casadi.logic_and((t44 >= -3.141592653589793), (t44 <= 1.1344640137963142)), t44, casadi.if_else(casadi.logic_and((t282 >= -3.141592653589793), (t282 <= 1.1344640137963142)), t282, casadi.if_else(casadi.logic_and((t283 >= -3.141592653589793), (t283 <= 1.1344640137963142)), t283, qb6_1)))
-    t285 = casadi.if_else((t45 < qn3), 6.283185307179586, -6.283185307179586)
-    t286 = t285 + t45
-    t287 = -t285 + t45
-    t288 = casadi.if_else(casadi.logic_and((t45 >= -0.2617993877991494), (t45 <= 2.7576202181510405)), t45, casadi.if_else(casadi.logic_and((t286 >= -0.2617993877991494), (t286 <= 2.7576202181510405)), t286, casadi.if_else(casadi.logic_and((t287 >= -0.2617993877991494), (t287 <= 2.7576202181510405)), t287, qb6_2)))
-    t289 = casadi.if_else((t46 < qn4), 6.283185307179586, -6.283185307179586)
-    t290 = t289 + t46
-    t291 = -t289 + t46
-    t292 = casadi.if_else(casadi.logic_and((t46 >= -6.1086523819801535), (t46 <= 6.1086523819801535)), t46, casadi.if_else(casadi.logic_and((t290 >= -6.1086523819801535), (t290 <= 6.1086523819801535)), t290, casadi.if_else(casadi.logic_and((t291 >= -6.1086523819801535), (t291 <= 6.1086523819801535)), t291, qb6_3)))
-    t293 = casadi.if_else((t47 < qn5), 6.283185307179586, -6.283185307179586)
-    t294 = t293 + t47
-    t295 = -t293 + t47
-    t296 = casadi.if_else(casadi.logic_and((t47 >= -2.2689280275926285), (t47 <= 2.2689280275926285)), t47, casadi.if_else(casadi.logic_and((t294 >= -2.2689280275926285), (t294 <= 2.2689280275926285)), t294, casadi.if_else(casadi.logic_and((t295 >= -2.2689280275926285), (t295 <= 2.2689280275926285)), t295, qb6_4)))
-    t297 = casadi.if_else((t48 < qn6), 6.283185307179586, -6.283185307179586)
-    t298 = t297 + t48
-    t299 = -t297 + t48
-    t300 = casadi.if_else(casadi.logic_and((t48 >= -6.1086523819801535), (t48 <= 6.1086523819801535)), t48, casadi.if_else(casadi.logic_and((t298 >= -6.1086523819801535), (t298 <= 6.1086523819801535)), t298, casadi.if_else(casadi.logic_and((t299 >= -6.1086523819801535), (t299 <= 6.1086523819801535)), t299, qb6_5)))
-    t301 = qw1*(t82 + t280)**2 + qw2*(t83 + t284)**2 + qw3*(t84 + t288)**2 + qw4*(t85 + t292)**2 + qw5*(t86 + t296)**2 + qw6*(t87 + t300)**2
-    t302 = (t49 > 0)
-    t303 = casadi.if_else(casadi.logic_and(t302, casadi.logic_or((t268 < 1), (t301 < t276))), 1, 0)
-    t304 = casadi.if_else(t302, 1, t268)
-    t305 = (t303 > 0)
-    t306 = casadi.if_else(t305, t280, t270)
-    t307 = casadi.if_else(t305, t284, t271)
-    t308 = casadi.if_else(t305, t288, t272)
-    t309 = casadi.if_else(t305, t292, t273)
-    t310 = casadi.if_else(t305, t296, t274)
-    t311 = casadi.if_else(t305, t300, t275)
-    t312 = casadi.if_else(t305, t301, t276)
-    t313 = casadi.if_else((t50 < qn1), 6.283185307179586, -6.283185307179586)
-    t314 = t313 + t50
-    t315 = -t313 + t50
-    t316 = casadi.if_else(casadi.logic_and((t50 >= -2.705260340591211), (t50 <= 2.705260340591211)), t50, casadi.if_else(casadi.logic_and((t314 >= -2.705260340591211), (t314 <= 2.705260340591211)), t314, casadi.if_else(casadi.logic_and((t315 >= -2.705260340591211), (t315 <= 2.705260340591211)), t315, qb7_0)))
-    t317 = casadi.if_else((t51 < qn2), 6.283185307179586, -6.283185307179586)
-    t318 = t317 + t51
-    t319 = -t317 + t51
-    t320 = casadi.if_else(casadi.logic_and((t51 >= -3.141592653589793), (t51 <= 1.1344640137963142)), t51, casadi.if_else(casadi.logic_and((t318 >= -3.141592653589793), (t318 <= 1.1344640137963142)), t318, casadi.if_else(casadi.logic_and((t319 >= -3.141592653589793), (t319 <= 1.1344640137963142)), t319, qb7_1)))
-    t321 = casadi.if_else((t52 < qn3), 6.283185307179586, -6.283185307179586)
-    t322 = t321 + t52
-    t323 = -t321 + t52
-    t324 = casadi.if_else(casadi.logic_and((t52 >= -0.2617993877991494), (t52 <= 2.7576202181510405)), t52, casadi.if_else(casadi.logic_and((t322 >= -0.2617993877991494), (t322 <= 2.7576202181510405)), t322, casadi.if_else(casadi.logic_and((t323 >= -0.2617993877991494), (t323 <= 2.7576202181510405)), t323, qb7_2)))
-    t325 = casadi.if_else((t53 < qn4), 6.283185307179586, -6.283185307179586)
-    t326 = t325 + t53
-    t327 = -t325 + t53
-    t328 = casadi.if_else(casadi.logic_and((t53 >= -6.1086523819801535), (t53 <= 6.1086523819801535)), t53, casadi.if_else(casadi.logic_and((t326 >= -6.1086523819801535), (t326 <= 6.1086523819801535)), t326, casadi.if_else(casadi.logic_and((t327 >= -6.1086523819801535), (t327 <= 6.1086523819801535)), t327, qb7_3)))
-    t329 = casadi.if_else((t54 < qn5), 6.283185307179586, -6.283185307179586)
-    t330 = t329 + t54
-    t331 = -t329 + t54
-    t332 = casadi.if_else(casadi.logic_and((t54 >= -2.2689280275926285), (t54 <= 2.2689280275926285)), t54, casadi.if_else(casadi.logic_and((t330 >= -2.2689280275926285), (t330 <= 2.2689280275926285)), t330, casadi.if_else(casadi.logic_and((t331 >= -2.2689280275926285), (t331 <= 2.2689280275926285)), t331, qb7_4)))
-    t333 = casadi.if_else((t55 < qn6), 6.283185307179586, -6.283185307179586)
-    t334 = t333 + t55
-    t335 = -t333 + t55
-    t336 = casadi.if_else(casadi.logic_and((t55 >= -6.1086523819801535), (t55 <= 6.1086523819801535)), t55, casadi.if_else(casadi.logic_and((t334 >= -6.1086523819801535), (t334 <= 6.1086523819801535)), t334, casadi.if_else(casadi.logic_and((t335 >= -6.1086523819801535), (t335 <= 6.1086523819801535)), t335, qb7_5)))
-    t337 = qw1*(t82 + t316)**2 + qw2*(t83 + t320)**2 + qw3*(t84 + t324)**2 + qw4*(t85 + t328)**2 + qw5*(t86 + t332)**2 + qw6*(t87 + t336)**2
-    t338 = (t56 > 0)
-    t339 = casadi.if_else(casadi.logic_and(t338, casadi.logic_or((t304 < 1), (t337 < t312))), 1, 0)
-    t340 = casadi.if_else(t338, 1, t304)
-    t341 = (t339 > 0)
-    t342 = casadi.if_else(t341, t316, t306)
-    t343 = casadi.if_else(t341, t320, t307)
-    t344 = casadi.if_else(t341, t324, t308)
-    t345 = casadi.if_else(t341, t328, t309)
-    t346 = casadi.if_else(t341, t332, t310)
-    t347 = casadi.if_else(t341, t336, t311)
-    t348 = (t340 > 0)
-    t349 = (casadi.fabs(t57) < casadi.inf)
-    t350 = casadi.logic_and(t348, t349)
+    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
+    t1 = _nearer_branch(1, (qb0_0, qb0_1, qb0_2, qb0_3, qb0_4, qb0_5, casadi.if_else(casadi.logic_and(vb0, lb0), 1, 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, qn1, qn2, qn3, qn4, qn5, qn6, 0, 0,))
+    t2 = _nearer_branch(1, (qb1_0, qb1_1, qb1_2, qb1_3, qb1_4, qb1_5, casadi.if_else(casadi.logic_and(vb1, lb1), 1, 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t1[0], t1[1], t1[2], t1[3], t1[4], t1[5], t1[6], t1[7],))
+    t3 = _nearer_branch(1, (qb2_0, qb2_1, qb2_2, qb2_3, qb2_4, qb2_5, casadi.if_else(casadi.logic_and(vb2, lb2), 1, 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t2[0], t2[1], t2[2], t2[3], t2[4], t2[5], t2[6], t2[7],))
+    t4 = _nearer_branch(1, (qb3_0, qb3_1, qb3_2, qb3_3, qb3_4, qb3_5, casadi.if_else(casadi.logic_and(vb3, lb3), 1, 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t3[0], t3[1], t3[2], t3[3], t3[4], t3[5], t3[6], t3[7],))
+    t5 = _nearer_branch(1, (qb4_0, qb4_1, qb4_2, qb4_3, qb4_4, qb4_5, casadi.if_else(casadi.logic_and(vb4, lb4), 1, 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t4[0], t4[1], t4[2], t4[3], t4[4], t4[5], t4[6], t4[7],))
+    t6 = _nearer_branch(1, (qb5_0, qb5_1, qb5_2, qb5_3, qb5_4, qb5_5, casadi.if_else(casadi.logic_and(vb5, lb5), 1, 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t5[0], t5[1], t5[2], t5[3], t5[4], t5[5], t5[6], t5[7],))
+    t7 = _nearer_branch(1, (qb6_0, qb6_1, qb6_2, qb6_3, qb6_4, qb6_5, casadi.if_else(casadi.logic_and(vb6, lb6), 1, 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t6[0], t6[1], t6[2], t6[3], t6[4], t6[5], t6[6], t6[7],))
+    t8 = _nearer_branch(1, (qb7_0, qb7_1, qb7_2, qb7_3, qb7_4, qb7_5, casadi.if_else(casadi.logic_and(vb7, lb7), 1, 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t7[0], t7[1], t7[2], t7[3], t7[4], t7[5], t7[6], t7[7],))
+    t9 = (t8[7] > 0)
+    t10 = (casadi.fabs(t0) < casadi.inf)
+    t11 = casadi.logic_and(t9, t10)
     q = casadi.SX(6, 1)
-    q[0, 0] = casadi.if_else(t350, t342, qn1)
-    q[1, 0] = casadi.if_else(t350, t343, qn2)
-    q[2, 0] = casadi.if_else(t350, t344, qn3)
-    q[3, 0] = casadi.if_else(t350, t345, qn4)
-    q[4, 0] = casadi.if_else(t350, t346, qn5)
-    q[5, 0] = casadi.if_else(t350, t347, qn6)
+    q[0, 0] = casadi.if_else(t11, t8[0], qn1)
+    q[1, 0] = casadi.if_else(t11, t8[1], qn2)
+    q[2, 0] = casadi.if_else(t11, t8[2], qn3)
+    q[3, 0] = casadi.if_else(t11, t8[3], qn4)
+    q[4, 0] = casadi.if_else(t11, t8[4], qn5)
+    q[5, 0] = casadi.if_else(t11, t8[5], qn6)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t349), 2, casadi.if_else(t348, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t10), 2, casadi.if_else(t9, 0, 1))
     return [q, status]
 
 

@@ -82,6 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -335,6 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi6_rows(xp, count, state):
     """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2 + w4**2 + w5**2
@@ -896,6 +898,231 @@ def _jacobi6_rows(xp, count, state):
             t489,
             t493,
             t497,
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _symmetric_solve6(xp, count, state):
+    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w1**2
+        t1 = w2**2
+        t2 = w3**2
+        t3 = w4**2
+        t4 = w5**2
+        t5 = w0**2
+        t6 = xp.sqrt(t5 + 2*t0 + 2*t1 + 2*w7**2 + 2*t2 + 2*w8**2 + 2*w12**2 + 2*t3 + 2*w9**2 + 2*w13**2 + 2*w16**2 + 2*t4 + 2*w10**2 + 2*w14**2 + 2*w17**2 + 2*w19**2 + w6**2 + w11**2 + w15**2 + w18**2 + w20**2)
+        t7 = xp.sqrt(t0 + t1 + t2 + t3 + t4 + t5)
+        t8 = t7*xp.where(xp.greater_equal(w0, 0), xp.asarray(1, dtype=dtype), -1)
+        t9 = xp.greater(t7, 0)
+        t10 = xp.where(t9, 1/(w0 + t8), 0)
+        t11 = xp.where(t9, 1 + xp.abs(w0)/t7, 0)
+        t12 = w1*t10
+        t13 = w2*t10
+        t14 = w3*t10
+        t15 = w4*t10
+        t16 = w5*t10
+        t17 = t11*(w1 + t12*w6 + t13*w7 + t14*w8 + t15*w9 + t16*w10)
+        t18 = -t17 + w1
+        t19 = w6 - t12*t17
+        t20 = w7 - t13*t17
+        t21 = w8 - t14*t17
+        t22 = w9 - t15*t17
+        t23 = w10 - t16*t17
+        t24 = t11*(w2 + t12*w7 + t13*w11 + t14*w12 + t15*w13 + t16*w14)
+        t25 = -t24 + w2
+        t26 = w7 - t12*t24
+        t27 = w11 - t13*t24
+        t28 = w12 - t14*t24
+        t29 = w13 - t15*t24
+        t30 = w14 - t16*t24
+        t31 = t11*(w3 + t12*w8 + t13*w12 + t14*w15 + t15*w16 + t16*w17)
+        t32 = -t31 + w3
+        t33 = w8 - t12*t31
+        t34 = w12 - t13*t31
+        t35 = w15 - t14*t31
+        t36 = w16 - t15*t31
+        t37 = w17 - t16*t31
+        t38 = t11*(w4 + t12*w9 + t13*w13 + t14*w16 + t15*w18 + t16*w19)
+        t39 = -t38 + w4
+        t40 = w9 - t12*t38
+        t41 = w13 - t13*t38
+        t42 = w16 - t14*t38
+        t43 = w18 - t15*t38
+        t44 = w19 - t16*t38
+        t45 = t11*(w5 + t12*w10 + t13*w14 + t14*w17 + t15*w19 + t16*w20)
+        t46 = -t45 + w5
+        t47 = w10 - t12*t45
+        t48 = w14 - t13*t45
+        t49 = w17 - t14*t45
+        t50 = w19 - t15*t45
+        t51 = w20 - t16*t45
+        t52 = t11*(w21 + t12*w22 + t13*w23 + t14*w24 + t15*w25 + t16*w26)
+        t53 = -t52 + w21
+        t54 = w22 - t12*t52
+        t55 = w23 - t13*t52
+        t56 = w24 - t14*t52
+        t57 = w25 - t15*t52
+        t58 = w26 - t16*t52
+        t59 = xp.sqrt(t19**2 + t20**2 + t21**2 + t22**2 + t23**2)
+        t60 = t59*xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)
+        t61 = xp.greater(t59, 0)
+        t62 = xp.where(t61, 1/(t19 + t60), 0)
+        t63 = xp.where(t61, 1 + xp.abs(t19)/t59, 0)
+        t64 = t20*t62
+        t65 = t21*t62
+        t66 = t22*t62
+        t67 = t23*t62
+        t68 = t63*(t26 + t64*t27 + t65*t28 + t66*t29 + t67*t30)
+        t69 = -t68 + t26
+        t70 = t27 - t64*t68
+        t71 = t28 - t65*t68
+        t72 = t29 - t66*t68
+        t73 = t30 - t67*t68
+        t74 = t63*(t33 + t64*t34 + t65*t35 + t66*t36 + t67*t37)
+        t75 = -t74 + t33
+        t76 = t34 - t64*t74
+        t77 = t35 - t65*t74
+        t78 = t36 - t66*t74
+        t79 = t37 - t67*t74
+        t80 = t63*(t40 + t64*t41 + t65*t42 + t66*t43 + t67*t44)
+        t81 = -t80 + t40
+        t82 = t41 - t64*t80
+        t83 = t42 - t65*t80
+        t84 = t43 - t66*t80
+        t85 = t44 - t67*t80
+        t86 = t63*(t47 + t64*t48 + t65*t49 + t66*t50 + t67*t51)
+        t87 = -t86 + t47
+        t88 = t48 - t64*t86
+        t89 = t49 - t65*t86
+        t90 = t50 - t66*t86
+        t91 = t51 - t67*t86
+        t92 = t63*(t54 + t64*t55 + t65*t56 + t66*t57 + t67*t58)
+        t93 = -t92 + t54
+        t94 = t55 - t64*t92
+        t95 = t56 - t65*t92
+        t96 = t57 - t66*t92
+        t97 = t58 - t67*t92
+        t98 = xp.sqrt(t70**2 + t71**2 + t72**2 + t73**2)
+        t99 = t98*xp.where(xp.greater_equal(t70, 0), xp.asarray(1, dtype=dtype), -1)
+        t100 = xp.greater(t98, 0)
+        t101 = xp.where(t100, 1/(t70 + t99), 0)
+        t102 = xp.where(t100, 1 + xp.abs(t70)/t98, 0)
+        t103 = t71*t101
+        t104 = t72*t101
+        t105 = t73*t101
+        t106 = t102*(t76 + t103*t77 + t104*t78 + t105*t79)
+        t107 = -t106 + t76
+        t108 = t77 - t103*t106
+        t109 = t78 - t104*t106
+        t110 = t79 - t105*t106
+        t111 = t102*(t82 + t103*t83 + t104*t84 + t105*t85)
+        t112 = -t111 + t82
+        t113 = t83 - t103*t111
+        t114 = t84 - t104*t111
+        t115 = t85 - t105*t111
+        t116 = t102*(t88 + t103*t89 + t104*t90 + t105*t91)
+        t117 = -t116 + t88
+        t118 = t89 - t103*t116
+        t119 = t90 - t104*t116
+        t120 = t91 - t105*t116
+        t121 = t102*(t94 + t103*t95 + t104*t96 + t105*t97)
+        t122 = -t121 + t94
+        t123 = t95 - t103*t121
+        t124 = t96 - t104*t121
+        t125 = t97 - t105*t121
+        t126 = xp.sqrt(t108**2 + t109**2 + t110**2)
+        t127 = t126*xp.where(xp.greater_equal(t108, 0), xp.asarray(1, dtype=dtype), -1)
+        t128 = xp.greater(t126, 0)
+        t129 = xp.where(t128, 1/(t108 + t127), 0)
+        t130 = xp.where(t128, 1 + xp.abs(t108)/t126, 0)
+        t131 = t109*t129
+        t132 = t110*t129
+        t133 = t130*(t113 + t131*t114 + t132*t115)
+        t134 = -t133 + t113
+        t135 = t114 - t131*t133
+        t136 = t115 - t132*t133
+        t137 = t130*(t118 + t131*t119 + t132*t120)
+        t138 = -t137 + t118
+        t139 = t119 - t131*t137
+        t140 = t120 - t132*t137
+        t141 = t130*(t123 + t131*t124 + t132*t125)
+        t142 = -t141 + t123
+        t143 = t124 - t131*t141
+        t144 = t125 - t132*t141
+        t145 = xp.sqrt(t135**2 + t136**2)
+        t146 = t145*xp.where(xp.greater_equal(t135, 0), xp.asarray(1, dtype=dtype), -1)
+        t147 = xp.greater(t145, 0)
+        t148 = xp.where(t147, 1/(t135 + t146), 0)
+        t149 = xp.where(t147, 1 + xp.abs(t135)/t145, 0)
+        t150 = t136*t148
+        t151 = t149*(t139 + t150*t140)
+        t152 = -t151 + t139
+        t153 = t140 - t150*t151
+        t154 = t149*(t143 + t150*t144)
+        t155 = -t154 + t143
+        t156 = t144 - t150*t154
+        t157 = xp.abs(t153)
+        t158 = t157*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
+        t159 = xp.where(xp.greater(t157, 0), xp.asarray(2, dtype=dtype), 0)
+        t160 = t156 - t156*t159
+        t161 = xp.where(xp.not_equal(t158, 0), -t160/t158, 0)
+        t162 = xp.where(xp.not_equal(t146, 0), -(t155 - t152*t161)/t146, 0)
+        t163 = xp.where(xp.not_equal(t127, 0), -(-(t134*t162 + t138*t161) + t142)/t127, 0)
+        t164 = xp.where(xp.not_equal(t99, 0), -(-(t107*t163 + t112*t162 + t117*t161) + t122)/t99, 0)
+        t165 = xp.where(xp.not_equal(t60, 0), -(-(t69*t164 + t75*t163 + t81*t162 + t87*t161) + t93)/t60, 0)
+        t166 = xp.where(xp.not_equal(t8, 0), -(-(t18*t165 + t25*t164 + t32*t163 + t39*t162 + t46*t161) + t53)/t8, 0)
+        t167 = 1e-12*t6
+        state = (
+            t166,
+            t165,
+            t164,
+            t163,
+            t162,
+            t161,
+            xp.where(xp.less_equal(t7, t167) | xp.less_equal(t59, t167) | xp.less_equal(t98, t167) | xp.less_equal(t126, t167) | xp.less_equal(t145, t167) | xp.less_equal(t157, t167), xp.asarray(1, dtype=dtype), 0),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _nearer_branch(xp, count, state):
+    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 72 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w7))
+        t1 = w1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w1 + w8))
+        t2 = w2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w2 + w9))
+        t3 = w3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w3 + w10))
+        t4 = w4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w4 + w11))
+        t5 = w5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w5 + w12))
+        t6 = w13*(-w7 + t0)**2 + w14*(-w8 + t1)**2 + w15*(-w9 + t2)**2 + w16*(-w10 + t3)**2 + w17*(-w11 + t4)**2 + w18*(-w12 + t5)**2
+        t7 = xp.greater(w6, 0)
+        t8 = xp.where(t7 & (xp.less(w26, 1) | xp.less(t6, w25)), xp.asarray(1, dtype=dtype), 0)
+        t9 = xp.where(t7, 1, w26)
+        t10 = xp.greater(t8, 0)
+        t11 = xp.where(t10, t0, w19)
+        t12 = xp.where(t10, t1, w20)
+        t13 = xp.where(t10, t2, w21)
+        t14 = xp.where(t10, t3, w22)
+        t15 = xp.where(t10, t4, w23)
+        t16 = xp.where(t10, t5, w24)
+        t17 = xp.where(t10, t6, w25)
+        state = (
+            t11,
+            t12,
+            t13,
+            t14,
+            t15,
+            t16,
+            t17,
+            t9,
         )
     return state
 
@@ -3830,7 +4057,7 @@ def condition_number(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1341 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1344 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -3950,355 +4177,188 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t92 = s1*t43
     t93 = t56*t44 - t57*t45 + t53*t92
     t94 = -t13*t45 + t92 + t4*t44
-    t95 = t84**2
-    t96 = t87**2
-    t97 = t90**2
-    t98 = t70**2
-    t99 = t58**2
-    t100 = damping**2
-    t101 = t100 + t73
-    t102 = t101**2
-    t103 = xp.sqrt(t95 + t96 + t97 + t98 + t99 + t102)
-    t104 = t103*xp.where(xp.greater_equal(t101, 0), xp.asarray(1, dtype=dtype), -1)
-    t105 = t100 + t77
-    t106 = t63 + t100
-    t107 = t78 + t100
-    t108 = t79 + t100
-    t109 = t100 + t82
-    t110 = xp.sqrt(2*t95 + 2*t96 + 2*t93**2 + 2*t97 + 2*t75**2 + 2*t94**2 + 2*t98 + 2*t91**2 + 2*t88**2 + 2*t85**2 + 2*t99 + 2*t59**2 + 2*t46**2 + 2*t60**2 + 2*t61**2 + t102 + t105**2 + t106**2 + t107**2 + t108**2 + t109**2)
-    t111 = xp.greater(t103, 0)
-    t112 = xp.where(t111, 1/(t101 + t104), 0)
-    t113 = xp.where(t111, 1 + xp.abs(t101)/t103, 0)
-    t114 = t84*t112
-    t115 = t87*t112
-    t116 = t90*t112
-    t117 = t70*t112
-    t118 = t58*t112
-    t119 = t113*(t84 + t105*t114 - t115*t93 + t116*t75 - t117*t91 - t118*t59)
-    t120 = -t119 + t84
-    t121 = t105 - t114*t119
-    t122 = t93 + t115*t119
-    t123 = -t75 + t116*t119
-    t124 = t91 + t117*t119
-    t125 = t59 + t118*t119
-    t126 = t113*(t87 - t114*t93 + t106*t115 - t116*t94 - t117*t88 + t118*t46)
-    t127 = -t126 + t87
-    t128 = t93 + t114*t126
-    t129 = t106 - t115*t126
-    t130 = t94 + t116*t126
-    t131 = t88 + t117*t126
-    t132 = -t46 + t118*t126
-    t133 = -t113*(t90 + t114*t75 - t115*t94 + t107*t116 - t117*t85 + t118*t60)
-    t134 = t90 + t133
-    t135 = t75 + t114*t133
-    t136 = t94 - t115*t133
-    t137 = t107 + t116*t133
-    t138 = t85 - t117*t133
-    t139 = t60 + t118*t133
-    t140 = -t113*(-t70 + t114*t91 + t115*t88 + t116*t85 - t108*t117 + t118*t61)
-    t141 = -t140 + t70
-    t142 = t91 + t114*t140
-    t143 = t88 + t115*t140
-    t144 = t85 + t116*t140
-    t145 = t108 - t117*t140
-    t146 = t61 + t118*t140
-    t147 = -t113*(t58 - t114*t59 + t115*t46 + t116*t60 - t117*t61 + t109*t118)
-    t148 = t58 + t147
-    t149 = t59 - t114*t147
-    t150 = t46 + t115*t147
-    t151 = t60 + t116*t147
-    t152 = t61 - t117*t147
-    t153 = t109 + t118*t147
-    t154 = t113*(mu_dot0 + t114*mu_dot1 + t115*mu_dot2 - t116*mu_dot3 + t117*mu_dot4 - t118*mu_dot5)
-    t155 = -t154 + mu_dot0
-    t156 = mu_dot1 - t114*t154
-    t157 = mu_dot2 - t115*t154
-    t158 = mu_dot3 + t116*t154
-    t159 = mu_dot4 - t117*t154
-    t160 = mu_dot5 + t118*t154
-    t161 = xp.sqrt(t121**2 + t122**2 + t123**2 + t124**2 + t125**2)
-    t162 = t161*xp.where(xp.greater_equal(t121, 0), xp.asarray(1, dtype=dtype), -1)
-    t163 = xp.greater(t161, 0)
-    t164 = xp.where(t163, 1/(t121 + t162), 0)
-    t165 = xp.where(t163, 1 + xp.abs(t121)/t161, 0)
-    t166 = t122*t164
-    t167 = t123*t164
-    t168 = t124*t164
-    t169 = t125*t164
-    t170 = t165*(-t128 - t166*t129 + t167*t130 + t168*t131 + t169*t132)
-    t171 = t128 + t170
-    t172 = t129 + t166*t170
-    t173 = t130 - t167*t170
-    t174 = -t131 + t168*t170
-    t175 = t132 - t169*t170
-    t176 = -t165*(t135 + t166*t136 - t167*t137 + t168*t138 - t169*t139)
-    t177 = t135 + t176
-    t178 = t136 + t166*t176
-    t179 = t137 - t167*t176
-    t180 = t138 + t168*t176
-    t181 = t139 - t169*t176
-    t182 = t165*(-t142 + t166*t143 + t167*t144 - t168*t145 + t169*t146)
-    t183 = t142 + t182
-    t184 = -t143 + t166*t182
-    t185 = t144 - t167*t182
-    t186 = t145 + t168*t182
-    t187 = t146 - t169*t182
-    t188 = t165*(t149 + t166*t150 + t167*t151 - t168*t152 + t169*t153)
-    t189 = -t188 + t149
-    t190 = -t150 + t166*t188
-    t191 = t151 - t167*t188
-    t192 = t152 + t168*t188
-    t193 = t153 - t169*t188
-    t194 = t165*(t156 - t166*t157 + t167*t158 - t168*t159 + t169*t160)
-    t195 = -t194 + t156
-    t196 = t157 + t166*t194
-    t197 = t158 - t167*t194
-    t198 = t159 + t168*t194
-    t199 = t160 - t169*t194
-    t200 = xp.sqrt(t172**2 + t173**2 + t174**2 + t175**2)
-    t201 = t200*xp.where(xp.greater_equal(t172, 0), xp.asarray(1, dtype=dtype), -1)
-    t202 = xp.greater(t200, 0)
-    t203 = xp.where(t202, 1/(t172 + t201), 0)
-    t204 = xp.where(t202, 1 + xp.abs(t172)/t200, 0)
-    t205 = t173*t203
-    t206 = t174*t203
-    t207 = t175*t203
-    t208 = t204*(t178 + t205*t179 + t206*t180 + t207*t181)
-    t209 = -t208 + t178
-    t210 = t179 - t205*t208
-    t211 = t180 - t206*t208
-    t212 = t181 - t207*t208
-    t213 = t204*(t184 + t205*t185 + t206*t186 + t207*t187)
-    t214 = -t213 + t184
-    t215 = t185 - t205*t213
-    t216 = t186 - t206*t213
-    t217 = t187 - t207*t213
-    t218 = t204*(t190 + t205*t191 + t206*t192 + t207*t193)
-    t219 = -t218 + t190
-    t220 = t191 - t205*t218
-    t221 = t192 - t206*t218
-    t222 = t193 - t207*t218
-    t223 = t204*(t196 + t205*t197 + t206*t198 + t207*t199)
-    t224 = -t223 + t196
-    t225 = t197 - t205*t223
-    t226 = t198 - t206*t223
-    t227 = t199 - t207*t223
-    t228 = xp.sqrt(t210**2 + t211**2 + t212**2)
-    t229 = t228*xp.where(xp.greater_equal(t210, 0), xp.asarray(1, dtype=dtype), -1)
-    t230 = xp.greater(t228, 0)
-    t231 = xp.where(t230, 1/(t210 + t229), 0)
-    t232 = xp.where(t230, 1 + xp.abs(t210)/t228, 0)
-    t233 = t211*t231
-    t234 = t212*t231
-    t235 = t232*(t215 + t233*t216 + t234*t217)
-    t236 = -t235 + t215
-    t237 = t216 - t233*t235
-    t238 = t217 - t234*t235
-    t239 = t232*(t220 + t233*t221 + t234*t222)
-    t240 = -t239 + t220
-    t241 = t221 - t233*t239
-    t242 = t222 - t234*t239
-    t243 = t232*(t225 + t233*t226 + t234*t227)
-    t244 = -t243 + t225
-    t245 = t226 - t233*t243
-    t246 = t227 - t234*t243
-    t247 = xp.sqrt(t237**2 + t238**2)
-    t248 = t247*xp.where(xp.greater_equal(t237, 0), xp.asarray(1, dtype=dtype), -1)
-    t249 = xp.greater(t247, 0)
-    t250 = xp.where(t249, 1/(t237 + t248), 0)
-    t251 = xp.where(t249, 1 + xp.abs(t237)/t247, 0)
-    t252 = t238*t250
-    t253 = t251*(t241 + t252*t242)
-    t254 = -t253 + t241
-    t255 = t242 - t252*t253
-    t256 = t251*(t245 + t252*t246)
-    t257 = -t256 + t245
-    t258 = t246 - t252*t256
-    t259 = xp.abs(t255)
-    t260 = t259*xp.where(xp.greater_equal(t255, 0), xp.asarray(1, dtype=dtype), -1)
-    t261 = xp.where(xp.greater(t259, 0), xp.asarray(2, dtype=dtype), 0)
-    t262 = t258 - t258*t261
-    t263 = xp.where(xp.not_equal(t260, 0), -t262/t260, 0)
-    t264 = xp.where(xp.not_equal(t248, 0), -(t257 - t254*t263)/t248, 0)
-    t265 = xp.where(xp.not_equal(t229, 0), -(-(t236*t264 + t240*t263) + t244)/t229, 0)
-    t266 = xp.where(xp.not_equal(t201, 0), -(-(t209*t265 + t214*t264 + t219*t263) + t224)/t201, 0)
-    t267 = xp.where(xp.not_equal(t162, 0), -(t195 + t171*t266 + t177*t265 + t183*t264 - t189*t263)/t162, 0)
-    t268 = xp.where(xp.not_equal(t104, 0), -(-(t120*t267 + t127*t266 - t134*t265 + t141*t264 - t148*t263) + t155)/t104, 0)
-    t269 = t263 - t42*t268 + t34*t267
-    t270 = t54*t268 - t56*t267 + t44*t266 - t0*t263 + t4*t265 + t8*t264
-    t271 = t55*t268 + t57*t267 + t45*t266 - t13*t265 - t19*t264 - t24*t263
-    t272 = t15*t265 + t21*t264 - t26*t263
-    t273 = t31*t265 + t39*t264 + t51*t263
-    t274 = c1*t53
-    t275 = s1*t53
-    t276 = c1*t264 - t43*t266 - s1*t265 + t274*t268 + t275*t267
-    t277 = xp.greater(t67, 0)
-    t278 = xp.where(t277, 1 + xp.abs(t42)/t67, 0)
-    t279 = -t42
-    t280 = xp.where(t277, 1/(t279 + t68), 0)
-    t281 = t34*t280
-    t282 = -t278*(t274 + t275*t281)
-    t283 = t274 + t282
-    t284 = t275 + t281*t282
-    t285 = -t278*(-t54 + t0*t280 + t56*t281)
-    t286 = -t285 + t54
-    t287 = t278*(t55 - t24*t280 + t57*t281)
-    t288 = -t287 + t55
-    t289 = t278*(mu_dot0 + mu_dot5*t280 + t281*mu_dot1)
-    t290 = -t289 + mu_dot0
-    t291 = t280*t285
-    t292 = t56 + t34*t291
-    t293 = t0 + t291
-    t294 = t280*t287
-    t295 = t57 - t34*t294
-    t296 = t24 + t294
-    t297 = t280**2
-    t298 = xp.sqrt(t62 + t69 + t74 + t284**2 + t297*t282**2)
-    t299 = t298*xp.where(xp.less_equal(t284, 0), xp.asarray(1, dtype=dtype), -1)
-    t300 = t297*t278
-    t301 = t26*t300
-    t302 = t34*t301
-    t303 = -t301 + t26
-    t304 = t51*t300
-    t305 = t34*t304
-    t306 = -t51
-    t307 = t304 + t306
-    t308 = t280*t289
-    t309 = mu_dot1 - t34*t308
-    t310 = -t308 + mu_dot5
-    t311 = xp.greater(t298, 0)
-    t312 = xp.where(t311, 1/(-t284 + t299), 0)
-    t313 = xp.where(t311, 1 + xp.abs(t284)/t298, 0)
-    t314 = t43*t312
-    t315 = s1*t312
-    t316 = c1*t312
-    t317 = t280*t282*t312
-    t318 = t313*(-t292 + t44*t314 + t317*t293 + t4*t315 - t8*t316)
-    t319 = t292 + t318
-    t320 = t44 - t314*t318
-    t321 = t4 - t315*t318
-    t322 = t8 + t316*t318
-    t323 = -t293 + t317*t318
-    t324 = t313*(t295 + t45*t314 - t13*t315 + t19*t316 + t317*t296)
-    t325 = -t324 + t295
-    t326 = t45 - t314*t324
-    t327 = t13 + t315*t324
-    t328 = -t296 + t317*t324
-    t329 = -t313*(t302 + t15*t315 - t21*t316 + t317*t303)
-    t330 = t302 + t329
-    t331 = t15 + t315*t329
-    t332 = t303 + t317*t329
-    t333 = t313*(t305 - t31*t315 + t39*t316 - t317*t307)
-    t334 = -t333 + t305
-    t335 = t31 + t315*t333
-    t336 = t307 + t317*t333
-    t337 = t313*(t309 + t314*mu_dot2 + t315*mu_dot3 - t316*mu_dot4 - t317*t310)
-    t338 = -t337 + t309
-    t339 = mu_dot2 - t314*t337
-    t340 = mu_dot3 - t315*t337
-    t341 = mu_dot4 + t316*t337
-    t342 = t310 + t317*t337
-    t343 = xp.sqrt(t320**2 + t321**2 + t322**2 + t323**2)
-    t344 = t343*xp.where(xp.greater_equal(t320, 0), xp.asarray(1, dtype=dtype), -1)
-    t345 = -t19
-    t346 = t345 + t316*t324
-    t347 = -t21
-    t348 = t347 + t316*t329
-    t349 = -t39
-    t350 = t349 + t316*t333
-    t351 = 1 - t56 - t13 - t15 - t31 - c1 - t0 - t24 - t274 - t275 + q1 + q2 + s1 + q3 + q4 + t26 + q5 + q6 + t34 + t4 + t8 + t54 + t55 + t57 + t43 + t44 + t45 + t279 + t306 + t345 + t347 + t349 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t352 = xp.greater(t343, 0)
-    t353 = xp.where(t352, 1/(t320 + t344), 0)
-    t354 = xp.where(t352, 1 + xp.abs(t320)/t343, 0)
-    t355 = t321*t353
-    t356 = t322*t353
-    t357 = t323*t353
-    t358 = t354*(t326 - t355*t327 + t356*t346 + t357*t328)
-    t359 = -t358 + t326
-    t360 = t327 + t355*t358
-    t361 = t346 - t356*t358
-    t362 = t328 - t357*t358
-    t363 = t354*(t339 + t355*t340 + t356*t341 + t357*t342)
-    t364 = -t363 + t339
-    t365 = t340 - t355*t363
-    t366 = t341 - t356*t363
-    t367 = t342 - t357*t363
-    t368 = xp.sqrt(t360**2 + t361**2 + t362**2)
-    t369 = t368*xp.where(xp.less_equal(t360, 0), xp.asarray(1, dtype=dtype), -1)
-    t370 = t314*t329
-    t371 = t354*(-t370 - t355*t331 + t356*t348 + t357*t332)
-    t372 = t370 + t371
-    t373 = t331 + t355*t371
-    t374 = t348 - t356*t371
-    t375 = t332 - t357*t371
-    t376 = t314*t333
-    t377 = t354*(-t376 - t355*t335 + t356*t350 + t357*t336)
-    t378 = t376 + t377
-    t379 = t335 + t355*t377
-    t380 = t350 - t356*t377
-    t381 = t336 - t357*t377
-    t382 = xp.greater(t368, 0)
-    t383 = xp.where(t382, 1/(-t360 + t369), 0)
-    t384 = xp.where(t382, 1 + xp.abs(t360)/t368, 0)
-    t385 = t361*t383
-    t386 = t362*t383
-    t387 = t384*(-t373 + t385*t374 + t386*t375)
-    t388 = t373 + t387
-    t389 = t374 - t385*t387
-    t390 = t375 - t386*t387
-    t391 = t384*(-t379 + t385*t380 + t386*t381)
-    t392 = t379 + t391
-    t393 = t380 - t385*t391
-    t394 = t381 - t386*t391
-    t395 = t384*(t365 + t385*t366 + t386*t367)
-    t396 = -t395 + t365
-    t397 = t366 - t385*t395
-    t398 = t367 - t386*t395
-    t399 = xp.sqrt(t389**2 + t390**2)
-    t400 = t399*xp.where(xp.greater_equal(t389, 0), xp.asarray(1, dtype=dtype), -1)
-    t401 = xp.greater(t399, 0)
-    t402 = xp.where(t401, 1/(t389 + t400), 0)
-    t403 = xp.where(t401, 1 + xp.abs(t389)/t399, 0)
-    t404 = t390*t402
-    t405 = t403*(t393 + t404*t394)
-    t406 = -t405 + t393
-    t407 = t394 - t404*t405
-    t408 = t403*(t397 + t404*t398)
-    t409 = -t408 + t397
-    t410 = t398 - t404*t408
-    t411 = xp.abs(t407)
-    t412 = t411*xp.where(xp.greater_equal(t407, 0), xp.asarray(1, dtype=dtype), -1)
-    t413 = xp.where(xp.greater(t411, 0), xp.asarray(2, dtype=dtype), 0)
-    t414 = t410 - t410*t413
-    t415 = xp.where(xp.not_equal(t412, 0), -t414/t412, 0)
-    t416 = xp.where(xp.not_equal(t400, 0), -(t409 - t406*t415)/t400, 0)
-    t417 = xp.where(xp.not_equal(t369, 0), -(t396 + t388*t416 + t392*t415)/t369, 0)
-    t418 = xp.where(xp.not_equal(t344, 0), -(t364 + t372*t416 + t378*t415 - t359*t417)/t344, 0)
-    t419 = xp.where(xp.not_equal(t299, 0), -(-(-t319*t418 + t325*t417 - t330*t416 + t334*t415) + t338)/t299, 0)
-    t420 = t280*t278
-    t421 = xp.where(xp.not_equal(t68, 0), -(-(-t283*t419 + t286*t418 + t288*t417 - t26*t420*t416 + t51*t420*t415) + t290)/t68, 0)
-    t422 = xp.isfinite(t351)
-    t423 = xp.greater_equal(damping, 0)
-    t424 = xp.greater(damping, 0)
-    t425 = 1e-12*t110
-    t426 = 1e-12*t81
-    t427 = (t424 & (xp.less_equal(t103, t425) | xp.less_equal(t161, t425) | xp.less_equal(t200, t425) | xp.less_equal(t228, t425) | xp.less_equal(t247, t425) | xp.less_equal(t259, t425))) | (xp.less_equal(damping, 0) & (xp.less_equal(t67, t426) | xp.less_equal(t298, t426) | xp.less_equal(t343, t426) | xp.less_equal(t368, t426) | xp.less_equal(t399, t426) | xp.less_equal(t411, t426)))
-    t428 = t422 & t423 & xp.logical_not(t427)
+    t95 = damping**2
+    t96 = _symmetric_solve6(xp, 1, (t95 + t73, t84, t87, -t90, t70, -t58, t95 + t77, -t93, -t75, -t91, t59, t63 + t95, t94, -t88, -t46, t78 + t95, t85, t60, t79 + t95, t61, t95 + t82, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t97 = t96[5]
+    t98 = t96[0]
+    t99 = t96[1]
+    t100 = t97 - t42*t98 + t34*t99
+    t101 = c1*t53
+    t102 = s1*t53
+    t103 = t96[2]
+    t104 = t96[3]
+    t105 = t96[4]
+    t106 = t98*t101 + t99*t102 - t43*t103 - s1*t104 + c1*t105
+    t107 = t54*t98 - t56*t99 + t44*t103 - t0*t97 + t4*t104 + t8*t105
+    t108 = t55*t98 + t57*t99 + t45*t103 - t13*t104 - t19*t105 - t24*t97
+    t109 = t15*t104 + t21*t105 - t26*t97
+    t110 = t39*t105 + t31*t104 + t51*t97
+    t111 = xp.greater(t67, 0)
+    t112 = xp.where(t111, 1 + xp.abs(t42)/t67, 0)
+    t113 = -t42
+    t114 = xp.where(t111, 1/(t113 + t68), 0)
+    t115 = t34*t114
+    t116 = -t112*(t101 + t102*t115)
+    t117 = t101 + t116
+    t118 = t102 + t115*t116
+    t119 = -t112*(-t54 + t0*t114 + t56*t115)
+    t120 = -t119 + t54
+    t121 = t112*(t55 - t24*t114 + t57*t115)
+    t122 = -t121 + t55
+    t123 = t112*(mu_dot0 + mu_dot5*t114 + t115*mu_dot1)
+    t124 = -t123 + mu_dot0
+    t125 = t114*t119
+    t126 = t56 + t34*t125
+    t127 = t0 + t125
+    t128 = t114*t121
+    t129 = t57 - t34*t128
+    t130 = t24 + t128
+    t131 = t114**2
+    t132 = xp.sqrt(t62 + t69 + t74 + t118**2 + t131*t116**2)
+    t133 = t132*xp.where(xp.less_equal(t118, 0), xp.asarray(1, dtype=dtype), -1)
+    t134 = t131*t112
+    t135 = t26*t134
+    t136 = t34*t135
+    t137 = -t135 + t26
+    t138 = t51*t134
+    t139 = t34*t138
+    t140 = -t51
+    t141 = t138 + t140
+    t142 = t114*t123
+    t143 = mu_dot1 - t34*t142
+    t144 = -t142 + mu_dot5
+    t145 = xp.greater(t132, 0)
+    t146 = xp.where(t145, 1/(-t118 + t133), 0)
+    t147 = xp.where(t145, 1 + xp.abs(t118)/t132, 0)
+    t148 = t43*t146
+    t149 = s1*t146
+    t150 = c1*t146
+    t151 = t114*t116*t146
+    t152 = t147*(-t126 + t44*t148 + t151*t127 + t4*t149 - t8*t150)
+    t153 = t126 + t152
+    t154 = t44 - t148*t152
+    t155 = t4 - t149*t152
+    t156 = t8 + t150*t152
+    t157 = -t127 + t151*t152
+    t158 = t147*(t129 + t45*t148 - t13*t149 + t19*t150 + t151*t130)
+    t159 = -t158 + t129
+    t160 = t45 - t148*t158
+    t161 = t13 + t149*t158
+    t162 = -t130 + t151*t158
+    t163 = -t147*(t136 + t15*t149 - t21*t150 + t151*t137)
+    t164 = t136 + t163
+    t165 = t15 + t149*t163
+    t166 = t137 + t151*t163
+    t167 = t147*(t139 - t31*t149 + t39*t150 - t151*t141)
+    t168 = -t167 + t139
+    t169 = t31 + t149*t167
+    t170 = t141 + t151*t167
+    t171 = t147*(t143 + t148*mu_dot2 + t149*mu_dot3 - t150*mu_dot4 - t151*t144)
+    t172 = -t171 + t143
+    t173 = mu_dot2 - t148*t171
+    t174 = mu_dot3 - t149*t171
+    t175 = mu_dot4 + t150*t171
+    t176 = t144 + t151*t171
+    t177 = xp.sqrt(t154**2 + t155**2 + t156**2 + t157**2)
+    t178 = t177*xp.where(xp.greater_equal(t154, 0), xp.asarray(1, dtype=dtype), -1)
+    t179 = -t19
+    t180 = t179 + t150*t158
+    t181 = -t21
+    t182 = t181 + t150*t163
+    t183 = -t39
+    t184 = t183 + t150*t167
+    t185 = 1 - t56 - t13 - t15 - t31 - c1 - t0 - t24 - t101 - t102 + q1 + q2 + s1 + q3 + q4 + t26 + q5 + q6 + t34 + t4 + t8 + t54 + t55 + t57 + t43 + t44 + t45 + t113 + t140 + t179 + t181 + t183 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t186 = xp.greater(t177, 0)
+    t187 = xp.where(t186, 1/(t154 + t178), 0)
+    t188 = xp.where(t186, 1 + xp.abs(t154)/t177, 0)
+    t189 = t155*t187
+    t190 = t156*t187
+    t191 = t157*t187
+    t192 = t188*(t160 - t189*t161 + t190*t180 + t191*t162)
+    t193 = -t192 + t160
+    t194 = t161 + t189*t192
+    t195 = t180 - t190*t192
+    t196 = t162 - t191*t192
+    t197 = t188*(t173 + t189*t174 + t190*t175 + t191*t176)
+    t198 = -t197 + t173
+    t199 = t174 - t189*t197
+    t200 = t175 - t190*t197
+    t201 = t176 - t191*t197
+    t202 = xp.sqrt(t194**2 + t195**2 + t196**2)
+    t203 = t202*xp.where(xp.less_equal(t194, 0), xp.asarray(1, dtype=dtype), -1)
+    t204 = t148*t163
+    t205 = t188*(-t204 - t189*t165 + t190*t182 + t191*t166)
+    t206 = t204 + t205
+    t207 = t165 + t189*t205
+    t208 = t182 - t190*t205
+    t209 = t166 - t191*t205
+    t210 = t148*t167
+    t211 = t188*(-t210 - t189*t169 + t190*t184 + t191*t170)
+    t212 = t210 + t211
+    t213 = t169 + t189*t211
+    t214 = t184 - t190*t211
+    t215 = t170 - t191*t211
+    t216 = xp.greater(t202, 0)
+    t217 = xp.where(t216, 1/(-t194 + t203), 0)
+    t218 = xp.where(t216, 1 + xp.abs(t194)/t202, 0)
+    t219 = t195*t217
+    t220 = t196*t217
+    t221 = t218*(-t207 + t219*t208 + t220*t209)
+    t222 = t207 + t221
+    t223 = t208 - t219*t221
+    t224 = t209 - t220*t221
+    t225 = t218*(-t213 + t219*t214 + t220*t215)
+    t226 = t213 + t225
+    t227 = t214 - t219*t225
+    t228 = t215 - t220*t225
+    t229 = t218*(t199 + t219*t200 + t220*t201)
+    t230 = -t229 + t199
+    t231 = t200 - t219*t229
+    t232 = t201 - t220*t229
+    t233 = xp.sqrt(t223**2 + t224**2)
+    t234 = t233*xp.where(xp.greater_equal(t223, 0), xp.asarray(1, dtype=dtype), -1)
+    t235 = xp.greater(t233, 0)
+    t236 = xp.where(t235, 1/(t223 + t234), 0)
+    t237 = xp.where(t235, 1 + xp.abs(t223)/t233, 0)
+    t238 = t224*t236
+    t239 = t237*(t227 + t238*t228)
+    t240 = -t239 + t227
+    t241 = t228 - t238*t239
+    t242 = t237*(t231 + t238*t232)
+    t243 = -t242 + t231
+    t244 = t232 - t238*t242
+    t245 = xp.abs(t241)
+    t246 = t245*xp.where(xp.greater_equal(t241, 0), xp.asarray(1, dtype=dtype), -1)
+    t247 = xp.where(xp.greater(t245, 0), xp.asarray(2, dtype=dtype), 0)
+    t248 = t244 - t244*t247
+    t249 = xp.where(xp.not_equal(t246, 0), -t248/t246, 0)
+    t250 = xp.where(xp.not_equal(t234, 0), -(t243 - t240*t249)/t234, 0)
+    t251 = xp.where(xp.not_equal(t203, 0), -(t230 + t222*t250 + t226*t249)/t203, 0)
+    t252 = xp.where(xp.not_equal(t178, 0), -(t198 + t206*t250 + t212*t249 - t193*t251)/t178, 0)
+    t253 = xp.where(xp.not_equal(t133, 0), -(-(-t153*t252 + t159*t251 - t164*t250 + t168*t249) + t172)/t133, 0)
+    t254 = t114*t112
+    t255 = xp.where(xp.not_equal(t68, 0), -(-(-t117*t253 + t120*t252 + t122*t251 - t26*t254*t250 + t51*t254*t249) + t124)/t68, 0)
+    t256 = xp.isfinite(t185)
+    t257 = xp.greater_equal(damping, 0)
+    t258 = xp.greater(damping, 0)
+    t259 = 1e-12*t81
+    t260 = (t258 & xp.greater(t96[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t67, t259) | xp.less_equal(t132, t259) | xp.less_equal(t177, t259) | xp.less_equal(t202, t259) | xp.less_equal(t233, t259) | xp.less_equal(t245, t259)))
+    t261 = t256 & t257 & xp.logical_not(t260)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t428, xp.where(t424, t269, t421), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t428, xp.where(t424, -t276, t419), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t428, xp.where(t424, t270, t418), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t428, xp.where(t424, t271, t417), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t428, xp.where(t424, -t272, t416), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t428, xp.where(t424, -t273, t415), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t261, xp.where(t258, t100, t255), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t261, xp.where(t258, -t106, t253), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t261, xp.where(t258, t107, t252), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t261, xp.where(t258, t108, t251), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t261, xp.where(t258, -t109, t250), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t261, xp.where(t258, -t110, t249), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t422 & t423), 2, xp.where(t427, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t256 & t257), 2, xp.where(t260, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
-    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1347 operations."""
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1350 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("z", z, (6,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -4424,355 +4484,188 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     t92 = s1*t43
     t93 = t56*t44 - t57*t45 + t53*t92
     t94 = -t13*t45 + t92 + t4*t44
-    t95 = t84**2
-    t96 = t87**2
-    t97 = t90**2
-    t98 = t70**2
-    t99 = t58**2
-    t100 = damping**2
-    t101 = t100 + t73
-    t102 = t101**2
-    t103 = xp.sqrt(t95 + t96 + t97 + t98 + t99 + t102)
-    t104 = t103*xp.where(xp.greater_equal(t101, 0), xp.asarray(1, dtype=dtype), -1)
-    t105 = t100 + t77
-    t106 = t63 + t100
-    t107 = t78 + t100
-    t108 = t79 + t100
-    t109 = t100 + t82
-    t110 = xp.sqrt(2*t95 + 2*t96 + 2*t93**2 + 2*t97 + 2*t75**2 + 2*t94**2 + 2*t98 + 2*t91**2 + 2*t88**2 + 2*t85**2 + 2*t99 + 2*t59**2 + 2*t46**2 + 2*t60**2 + 2*t61**2 + t102 + t105**2 + t106**2 + t107**2 + t108**2 + t109**2)
-    t111 = xp.greater(t103, 0)
-    t112 = xp.where(t111, 1/(t101 + t104), 0)
-    t113 = xp.where(t111, 1 + xp.abs(t101)/t103, 0)
-    t114 = t84*t112
-    t115 = t87*t112
-    t116 = t90*t112
-    t117 = t70*t112
-    t118 = t58*t112
-    t119 = t113*(t84 + t105*t114 - t115*t93 + t116*t75 - t117*t91 - t118*t59)
-    t120 = -t119 + t84
-    t121 = t105 - t114*t119
-    t122 = t93 + t115*t119
-    t123 = -t75 + t116*t119
-    t124 = t91 + t117*t119
-    t125 = t59 + t118*t119
-    t126 = t113*(t87 - t114*t93 + t106*t115 - t116*t94 - t117*t88 + t118*t46)
-    t127 = -t126 + t87
-    t128 = t93 + t114*t126
-    t129 = t106 - t115*t126
-    t130 = t94 + t116*t126
-    t131 = t88 + t117*t126
-    t132 = -t46 + t118*t126
-    t133 = -t113*(t90 + t114*t75 - t115*t94 + t107*t116 - t117*t85 + t118*t60)
-    t134 = t90 + t133
-    t135 = t75 + t114*t133
-    t136 = t94 - t115*t133
-    t137 = t107 + t116*t133
-    t138 = t85 - t117*t133
-    t139 = t60 + t118*t133
-    t140 = -t113*(-t70 + t114*t91 + t115*t88 + t116*t85 - t108*t117 + t118*t61)
-    t141 = -t140 + t70
-    t142 = t91 + t114*t140
-    t143 = t88 + t115*t140
-    t144 = t85 + t116*t140
-    t145 = t108 - t117*t140
-    t146 = t61 + t118*t140
-    t147 = -t113*(t58 - t114*t59 + t115*t46 + t116*t60 - t117*t61 + t109*t118)
-    t148 = t58 + t147
-    t149 = t59 - t114*t147
-    t150 = t46 + t115*t147
-    t151 = t60 + t116*t147
-    t152 = t61 - t117*t147
-    t153 = t109 + t118*t147
-    t154 = t113*(mu_dot0 + t114*mu_dot1 + t115*mu_dot2 - t116*mu_dot3 + t117*mu_dot4 - t118*mu_dot5)
-    t155 = -t154 + mu_dot0
-    t156 = mu_dot1 - t114*t154
-    t157 = mu_dot2 - t115*t154
-    t158 = mu_dot3 + t116*t154
-    t159 = mu_dot4 - t117*t154
-    t160 = mu_dot5 + t118*t154
-    t161 = xp.sqrt(t121**2 + t122**2 + t123**2 + t124**2 + t125**2)
-    t162 = t161*xp.where(xp.greater_equal(t121, 0), xp.asarray(1, dtype=dtype), -1)
-    t163 = xp.greater(t161, 0)
-    t164 = xp.where(t163, 1/(t121 + t162), 0)
-    t165 = xp.where(t163, 1 + xp.abs(t121)/t161, 0)
-    t166 = t122*t164
-    t167 = t123*t164
-    t168 = t124*t164
-    t169 = t125*t164
-    t170 = t165*(-t128 - t166*t129 + t167*t130 + t168*t131 + t169*t132)
-    t171 = t128 + t170
-    t172 = t129 + t166*t170
-    t173 = t130 - t167*t170
-    t174 = -t131 + t168*t170
-    t175 = t132 - t169*t170
-    t176 = -t165*(t135 + t166*t136 - t167*t137 + t168*t138 - t169*t139)
-    t177 = t135 + t176
-    t178 = t136 + t166*t176
-    t179 = t137 - t167*t176
-    t180 = t138 + t168*t176
-    t181 = t139 - t169*t176
-    t182 = t165*(-t142 + t166*t143 + t167*t144 - t168*t145 + t169*t146)
-    t183 = t142 + t182
-    t184 = -t143 + t166*t182
-    t185 = t144 - t167*t182
-    t186 = t145 + t168*t182
-    t187 = t146 - t169*t182
-    t188 = t165*(t149 + t166*t150 + t167*t151 - t168*t152 + t169*t153)
-    t189 = -t188 + t149
-    t190 = -t150 + t166*t188
-    t191 = t151 - t167*t188
-    t192 = t152 + t168*t188
-    t193 = t153 - t169*t188
-    t194 = t165*(t156 - t166*t157 + t167*t158 - t168*t159 + t169*t160)
-    t195 = -t194 + t156
-    t196 = t157 + t166*t194
-    t197 = t158 - t167*t194
-    t198 = t159 + t168*t194
-    t199 = t160 - t169*t194
-    t200 = xp.sqrt(t172**2 + t173**2 + t174**2 + t175**2)
-    t201 = t200*xp.where(xp.greater_equal(t172, 0), xp.asarray(1, dtype=dtype), -1)
-    t202 = xp.greater(t200, 0)
-    t203 = xp.where(t202, 1/(t172 + t201), 0)
-    t204 = xp.where(t202, 1 + xp.abs(t172)/t200, 0)
-    t205 = t173*t203
-    t206 = t174*t203
-    t207 = t175*t203
-    t208 = t204*(t178 + t205*t179 + t206*t180 + t207*t181)
-    t209 = -t208 + t178
-    t210 = t179 - t205*t208
-    t211 = t180 - t206*t208
-    t212 = t181 - t207*t208
-    t213 = t204*(t184 + t205*t185 + t206*t186 + t207*t187)
-    t214 = -t213 + t184
-    t215 = t185 - t205*t213
-    t216 = t186 - t206*t213
-    t217 = t187 - t207*t213
-    t218 = t204*(t190 + t205*t191 + t206*t192 + t207*t193)
-    t219 = -t218 + t190
-    t220 = t191 - t205*t218
-    t221 = t192 - t206*t218
-    t222 = t193 - t207*t218
-    t223 = t204*(t196 + t205*t197 + t206*t198 + t207*t199)
-    t224 = -t223 + t196
-    t225 = t197 - t205*t223
-    t226 = t198 - t206*t223
-    t227 = t199 - t207*t223
-    t228 = xp.sqrt(t210**2 + t211**2 + t212**2)
-    t229 = t228*xp.where(xp.greater_equal(t210, 0), xp.asarray(1, dtype=dtype), -1)
-    t230 = xp.greater(t228, 0)
-    t231 = xp.where(t230, 1/(t210 + t229), 0)
-    t232 = xp.where(t230, 1 + xp.abs(t210)/t228, 0)
-    t233 = t211*t231
-    t234 = t212*t231
-    t235 = t232*(t215 + t233*t216 + t234*t217)
-    t236 = -t235 + t215
-    t237 = t216 - t233*t235
-    t238 = t217 - t234*t235
-    t239 = t232*(t220 + t233*t221 + t234*t222)
-    t240 = -t239 + t220
-    t241 = t221 - t233*t239
-    t242 = t222 - t234*t239
-    t243 = t232*(t225 + t233*t226 + t234*t227)
-    t244 = -t243 + t225
-    t245 = t226 - t233*t243
-    t246 = t227 - t234*t243
-    t247 = xp.sqrt(t237**2 + t238**2)
-    t248 = t247*xp.where(xp.greater_equal(t237, 0), xp.asarray(1, dtype=dtype), -1)
-    t249 = xp.greater(t247, 0)
-    t250 = xp.where(t249, 1/(t237 + t248), 0)
-    t251 = xp.where(t249, 1 + xp.abs(t237)/t247, 0)
-    t252 = t238*t250
-    t253 = t251*(t241 + t252*t242)
-    t254 = -t253 + t241
-    t255 = t242 - t252*t253
-    t256 = t251*(t245 + t252*t246)
-    t257 = -t256 + t245
-    t258 = t246 - t252*t256
-    t259 = xp.abs(t255)
-    t260 = t259*xp.where(xp.greater_equal(t255, 0), xp.asarray(1, dtype=dtype), -1)
-    t261 = xp.where(xp.greater(t259, 0), xp.asarray(2, dtype=dtype), 0)
-    t262 = t258 - t258*t261
-    t263 = xp.where(xp.not_equal(t260, 0), -t262/t260, 0)
-    t264 = xp.where(xp.not_equal(t248, 0), -(t257 - t254*t263)/t248, 0)
-    t265 = xp.where(xp.not_equal(t229, 0), -(-(t236*t264 + t240*t263) + t244)/t229, 0)
-    t266 = xp.where(xp.not_equal(t201, 0), -(-(t209*t265 + t214*t264 + t219*t263) + t224)/t201, 0)
-    t267 = xp.where(xp.not_equal(t162, 0), -(t195 + t171*t266 + t177*t265 + t183*t264 - t189*t263)/t162, 0)
-    t268 = xp.where(xp.not_equal(t104, 0), -(-(t120*t267 + t127*t266 - t134*t265 + t141*t264 - t148*t263) + t155)/t104, 0)
-    t269 = t263 - t42*t268 + t34*t267
-    t270 = t54*t268 - t56*t267 + t44*t266 - t0*t263 + t4*t265 + t8*t264
-    t271 = t55*t268 + t57*t267 + t45*t266 - t13*t265 - t19*t264 - t24*t263
-    t272 = t15*t265 + t21*t264 - t26*t263
-    t273 = t31*t265 + t39*t264 + t51*t263
-    t274 = c1*t53
-    t275 = s1*t53
-    t276 = c1*t264 - t43*t266 - s1*t265 + t274*t268 + t275*t267
-    t277 = xp.greater(t67, 0)
-    t278 = xp.where(t277, 1 + xp.abs(t42)/t67, 0)
-    t279 = -t42
-    t280 = xp.where(t277, 1/(t279 + t68), 0)
-    t281 = t34*t280
-    t282 = -t278*(t274 + t275*t281)
-    t283 = t274 + t282
-    t284 = t275 + t281*t282
-    t285 = -t278*(-t54 + t0*t280 + t56*t281)
-    t286 = -t285 + t54
-    t287 = t278*(t55 - t24*t280 + t57*t281)
-    t288 = -t287 + t55
-    t289 = t278*(mu_dot0 + mu_dot5*t280 + t281*mu_dot1)
-    t290 = -t289 + mu_dot0
-    t291 = t280*t285
-    t292 = t56 + t34*t291
-    t293 = t0 + t291
-    t294 = t280*t287
-    t295 = t57 - t34*t294
-    t296 = t24 + t294
-    t297 = t280**2
-    t298 = xp.sqrt(t62 + t69 + t74 + t284**2 + t297*t282**2)
-    t299 = t298*xp.where(xp.less_equal(t284, 0), xp.asarray(1, dtype=dtype), -1)
-    t300 = t297*t278
-    t301 = t26*t300
-    t302 = t34*t301
-    t303 = -t301 + t26
-    t304 = t51*t300
-    t305 = t34*t304
-    t306 = -t51
-    t307 = t304 + t306
-    t308 = t280*t289
-    t309 = mu_dot1 - t34*t308
-    t310 = -t308 + mu_dot5
-    t311 = xp.greater(t298, 0)
-    t312 = xp.where(t311, 1/(-t284 + t299), 0)
-    t313 = xp.where(t311, 1 + xp.abs(t284)/t298, 0)
-    t314 = t43*t312
-    t315 = s1*t312
-    t316 = c1*t312
-    t317 = t280*t282*t312
-    t318 = t313*(-t292 + t44*t314 + t317*t293 + t4*t315 - t8*t316)
-    t319 = t292 + t318
-    t320 = t44 - t314*t318
-    t321 = t4 - t315*t318
-    t322 = t8 + t316*t318
-    t323 = -t293 + t317*t318
-    t324 = t313*(t295 + t45*t314 - t13*t315 + t19*t316 + t317*t296)
-    t325 = -t324 + t295
-    t326 = t45 - t314*t324
-    t327 = t13 + t315*t324
-    t328 = -t296 + t317*t324
-    t329 = -t313*(t302 + t15*t315 - t21*t316 + t317*t303)
-    t330 = t302 + t329
-    t331 = t15 + t315*t329
-    t332 = t303 + t317*t329
-    t333 = t313*(t305 - t31*t315 + t39*t316 - t317*t307)
-    t334 = -t333 + t305
-    t335 = t31 + t315*t333
-    t336 = t307 + t317*t333
-    t337 = t313*(t309 + t314*mu_dot2 + t315*mu_dot3 - t316*mu_dot4 - t317*t310)
-    t338 = -t337 + t309
-    t339 = mu_dot2 - t314*t337
-    t340 = mu_dot3 - t315*t337
-    t341 = mu_dot4 + t316*t337
-    t342 = t310 + t317*t337
-    t343 = xp.sqrt(t320**2 + t321**2 + t322**2 + t323**2)
-    t344 = t343*xp.where(xp.greater_equal(t320, 0), xp.asarray(1, dtype=dtype), -1)
-    t345 = -t19
-    t346 = t345 + t316*t324
-    t347 = -t21
-    t348 = t347 + t316*t329
-    t349 = -t39
-    t350 = t349 + t316*t333
-    t351 = 1 - t56 - t13 - t15 - t31 - c1 - t0 - t24 - t274 - t275 + q1 + q2 + s1 + q3 + q4 + t26 + q5 + q6 + t34 + t4 + t8 + t54 + t55 + t57 + t43 + t44 + t45 + t279 + t306 + t345 + t347 + t349 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6
-    t352 = xp.greater(t343, 0)
-    t353 = xp.where(t352, 1/(t320 + t344), 0)
-    t354 = xp.where(t352, 1 + xp.abs(t320)/t343, 0)
-    t355 = t321*t353
-    t356 = t322*t353
-    t357 = t323*t353
-    t358 = t354*(t326 - t355*t327 + t356*t346 + t357*t328)
-    t359 = -t358 + t326
-    t360 = t327 + t355*t358
-    t361 = t346 - t356*t358
-    t362 = t328 - t357*t358
-    t363 = t354*(t339 + t355*t340 + t356*t341 + t357*t342)
-    t364 = -t363 + t339
-    t365 = t340 - t355*t363
-    t366 = t341 - t356*t363
-    t367 = t342 - t357*t363
-    t368 = xp.sqrt(t360**2 + t361**2 + t362**2)
-    t369 = t368*xp.where(xp.less_equal(t360, 0), xp.asarray(1, dtype=dtype), -1)
-    t370 = t314*t329
-    t371 = t354*(-t370 - t355*t331 + t356*t348 + t357*t332)
-    t372 = t370 + t371
-    t373 = t331 + t355*t371
-    t374 = t348 - t356*t371
-    t375 = t332 - t357*t371
-    t376 = t314*t333
-    t377 = t354*(-t376 - t355*t335 + t356*t350 + t357*t336)
-    t378 = t376 + t377
-    t379 = t335 + t355*t377
-    t380 = t350 - t356*t377
-    t381 = t336 - t357*t377
-    t382 = xp.greater(t368, 0)
-    t383 = xp.where(t382, 1/(-t360 + t369), 0)
-    t384 = xp.where(t382, 1 + xp.abs(t360)/t368, 0)
-    t385 = t361*t383
-    t386 = t362*t383
-    t387 = t384*(-t373 + t385*t374 + t386*t375)
-    t388 = t373 + t387
-    t389 = t374 - t385*t387
-    t390 = t375 - t386*t387
-    t391 = t384*(-t379 + t385*t380 + t386*t381)
-    t392 = t379 + t391
-    t393 = t380 - t385*t391
-    t394 = t381 - t386*t391
-    t395 = t384*(t365 + t385*t366 + t386*t367)
-    t396 = -t395 + t365
-    t397 = t366 - t385*t395
-    t398 = t367 - t386*t395
-    t399 = xp.sqrt(t389**2 + t390**2)
-    t400 = t399*xp.where(xp.greater_equal(t389, 0), xp.asarray(1, dtype=dtype), -1)
-    t401 = xp.greater(t399, 0)
-    t402 = xp.where(t401, 1/(t389 + t400), 0)
-    t403 = xp.where(t401, 1 + xp.abs(t389)/t399, 0)
-    t404 = t390*t402
-    t405 = t403*(t393 + t404*t394)
-    t406 = -t405 + t393
-    t407 = t394 - t404*t405
-    t408 = t403*(t397 + t404*t398)
-    t409 = -t408 + t397
-    t410 = t398 - t404*t408
-    t411 = xp.abs(t407)
-    t412 = t411*xp.where(xp.greater_equal(t407, 0), xp.asarray(1, dtype=dtype), -1)
-    t413 = xp.where(xp.greater(t411, 0), xp.asarray(2, dtype=dtype), 0)
-    t414 = t410 - t410*t413
-    t415 = xp.where(xp.not_equal(t412, 0), -t414/t412, 0)
-    t416 = xp.where(xp.not_equal(t400, 0), -(t409 - t406*t415)/t400, 0)
-    t417 = xp.where(xp.not_equal(t369, 0), -(t396 + t388*t416 + t392*t415)/t369, 0)
-    t418 = xp.where(xp.not_equal(t344, 0), -(t364 + t372*t416 + t378*t415 - t359*t417)/t344, 0)
-    t419 = xp.where(xp.not_equal(t299, 0), -(-(-t319*t418 + t325*t417 - t330*t416 + t334*t415) + t338)/t299, 0)
-    t420 = t280*t278
-    t421 = xp.where(xp.not_equal(t68, 0), -(-(-t283*t419 + t286*t418 + t288*t417 - t26*t420*t416 + t51*t420*t415) + t290)/t68, 0)
-    t422 = xp.isfinite(t351)
-    t423 = xp.greater_equal(damping, 0)
-    t424 = xp.greater(damping, 0)
-    t425 = 1e-12*t110
-    t426 = 1e-12*t81
-    t427 = (t424 & (xp.less_equal(t103, t425) | xp.less_equal(t161, t425) | xp.less_equal(t200, t425) | xp.less_equal(t228, t425) | xp.less_equal(t247, t425) | xp.less_equal(t259, t425))) | (xp.less_equal(damping, 0) & (xp.less_equal(t67, t426) | xp.less_equal(t298, t426) | xp.less_equal(t343, t426) | xp.less_equal(t368, t426) | xp.less_equal(t399, t426) | xp.less_equal(t411, t426)))
-    t428 = t422 & t423 & xp.logical_not(t427)
+    t95 = damping**2
+    t96 = _symmetric_solve6(xp, 1, (t95 + t73, t84, t87, -t90, t70, -t58, t95 + t77, -t93, -t75, -t91, t59, t63 + t95, t94, -t88, -t46, t78 + t95, t85, t60, t79 + t95, t61, t95 + t82, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t97 = t96[5]
+    t98 = t96[0]
+    t99 = t96[1]
+    t100 = t97 - t42*t98 + t34*t99
+    t101 = c1*t53
+    t102 = s1*t53
+    t103 = t96[2]
+    t104 = t96[3]
+    t105 = t96[4]
+    t106 = t98*t101 + t99*t102 - t43*t103 - s1*t104 + c1*t105
+    t107 = t54*t98 - t56*t99 + t44*t103 - t0*t97 + t4*t104 + t8*t105
+    t108 = t55*t98 + t57*t99 + t45*t103 - t13*t104 - t19*t105 - t24*t97
+    t109 = t15*t104 + t21*t105 - t26*t97
+    t110 = t39*t105 + t31*t104 + t51*t97
+    t111 = xp.greater(t67, 0)
+    t112 = xp.where(t111, 1 + xp.abs(t42)/t67, 0)
+    t113 = -t42
+    t114 = xp.where(t111, 1/(t113 + t68), 0)
+    t115 = t34*t114
+    t116 = -t112*(t101 + t102*t115)
+    t117 = t101 + t116
+    t118 = t102 + t115*t116
+    t119 = -t112*(-t54 + t0*t114 + t56*t115)
+    t120 = -t119 + t54
+    t121 = t112*(t55 - t24*t114 + t57*t115)
+    t122 = -t121 + t55
+    t123 = t112*(mu_dot0 + mu_dot5*t114 + t115*mu_dot1)
+    t124 = -t123 + mu_dot0
+    t125 = t114*t119
+    t126 = t56 + t34*t125
+    t127 = t0 + t125
+    t128 = t114*t121
+    t129 = t57 - t34*t128
+    t130 = t24 + t128
+    t131 = t114**2
+    t132 = xp.sqrt(t62 + t69 + t74 + t118**2 + t131*t116**2)
+    t133 = t132*xp.where(xp.less_equal(t118, 0), xp.asarray(1, dtype=dtype), -1)
+    t134 = t131*t112
+    t135 = t26*t134
+    t136 = t34*t135
+    t137 = -t135 + t26
+    t138 = t51*t134
+    t139 = t34*t138
+    t140 = -t51
+    t141 = t138 + t140
+    t142 = t114*t123
+    t143 = mu_dot1 - t34*t142
+    t144 = -t142 + mu_dot5
+    t145 = xp.greater(t132, 0)
+    t146 = xp.where(t145, 1/(-t118 + t133), 0)
+    t147 = xp.where(t145, 1 + xp.abs(t118)/t132, 0)
+    t148 = t43*t146
+    t149 = s1*t146
+    t150 = c1*t146
+    t151 = t114*t116*t146
+    t152 = t147*(-t126 + t44*t148 + t151*t127 + t4*t149 - t8*t150)
+    t153 = t126 + t152
+    t154 = t44 - t148*t152
+    t155 = t4 - t149*t152
+    t156 = t8 + t150*t152
+    t157 = -t127 + t151*t152
+    t158 = t147*(t129 + t45*t148 - t13*t149 + t19*t150 + t151*t130)
+    t159 = -t158 + t129
+    t160 = t45 - t148*t158
+    t161 = t13 + t149*t158
+    t162 = -t130 + t151*t158
+    t163 = -t147*(t136 + t15*t149 - t21*t150 + t151*t137)
+    t164 = t136 + t163
+    t165 = t15 + t149*t163
+    t166 = t137 + t151*t163
+    t167 = t147*(t139 - t31*t149 + t39*t150 - t151*t141)
+    t168 = -t167 + t139
+    t169 = t31 + t149*t167
+    t170 = t141 + t151*t167
+    t171 = t147*(t143 + t148*mu_dot2 + t149*mu_dot3 - t150*mu_dot4 - t151*t144)
+    t172 = -t171 + t143
+    t173 = mu_dot2 - t148*t171
+    t174 = mu_dot3 - t149*t171
+    t175 = mu_dot4 + t150*t171
+    t176 = t144 + t151*t171
+    t177 = xp.sqrt(t154**2 + t155**2 + t156**2 + t157**2)
+    t178 = t177*xp.where(xp.greater_equal(t154, 0), xp.asarray(1, dtype=dtype), -1)
+    t179 = -t19
+    t180 = t179 + t150*t158
+    t181 = -t21
+    t182 = t181 + t150*t163
+    t183 = -t39
+    t184 = t183 + t150*t167
+    t185 = 1 - t56 - t13 - t15 - t31 - c1 - t0 - t24 - t101 - t102 + q1 + q2 + s1 + q3 + q4 + t26 + q5 + q6 + t34 + t4 + t8 + t54 + t55 + t57 + t43 + t44 + t45 + t113 + t140 + t179 + t181 + t183 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6
+    t186 = xp.greater(t177, 0)
+    t187 = xp.where(t186, 1/(t154 + t178), 0)
+    t188 = xp.where(t186, 1 + xp.abs(t154)/t177, 0)
+    t189 = t155*t187
+    t190 = t156*t187
+    t191 = t157*t187
+    t192 = t188*(t160 - t189*t161 + t190*t180 + t191*t162)
+    t193 = -t192 + t160
+    t194 = t161 + t189*t192
+    t195 = t180 - t190*t192
+    t196 = t162 - t191*t192
+    t197 = t188*(t173 + t189*t174 + t190*t175 + t191*t176)
+    t198 = -t197 + t173
+    t199 = t174 - t189*t197
+    t200 = t175 - t190*t197
+    t201 = t176 - t191*t197
+    t202 = xp.sqrt(t194**2 + t195**2 + t196**2)
+    t203 = t202*xp.where(xp.less_equal(t194, 0), xp.asarray(1, dtype=dtype), -1)
+    t204 = t148*t163
+    t205 = t188*(-t204 - t189*t165 + t190*t182 + t191*t166)
+    t206 = t204 + t205
+    t207 = t165 + t189*t205
+    t208 = t182 - t190*t205
+    t209 = t166 - t191*t205
+    t210 = t148*t167
+    t211 = t188*(-t210 - t189*t169 + t190*t184 + t191*t170)
+    t212 = t210 + t211
+    t213 = t169 + t189*t211
+    t214 = t184 - t190*t211
+    t215 = t170 - t191*t211
+    t216 = xp.greater(t202, 0)
+    t217 = xp.where(t216, 1/(-t194 + t203), 0)
+    t218 = xp.where(t216, 1 + xp.abs(t194)/t202, 0)
+    t219 = t195*t217
+    t220 = t196*t217
+    t221 = t218*(-t207 + t219*t208 + t220*t209)
+    t222 = t207 + t221
+    t223 = t208 - t219*t221
+    t224 = t209 - t220*t221
+    t225 = t218*(-t213 + t219*t214 + t220*t215)
+    t226 = t213 + t225
+    t227 = t214 - t219*t225
+    t228 = t215 - t220*t225
+    t229 = t218*(t199 + t219*t200 + t220*t201)
+    t230 = -t229 + t199
+    t231 = t200 - t219*t229
+    t232 = t201 - t220*t229
+    t233 = xp.sqrt(t223**2 + t224**2)
+    t234 = t233*xp.where(xp.greater_equal(t223, 0), xp.asarray(1, dtype=dtype), -1)
+    t235 = xp.greater(t233, 0)
+    t236 = xp.where(t235, 1/(t223 + t234), 0)
+    t237 = xp.where(t235, 1 + xp.abs(t223)/t233, 0)
+    t238 = t224*t236
+    t239 = t237*(t227 + t238*t228)
+    t240 = -t239 + t227
+    t241 = t228 - t238*t239
+    t242 = t237*(t231 + t238*t232)
+    t243 = -t242 + t231
+    t244 = t232 - t238*t242
+    t245 = xp.abs(t241)
+    t246 = t245*xp.where(xp.greater_equal(t241, 0), xp.asarray(1, dtype=dtype), -1)
+    t247 = xp.where(xp.greater(t245, 0), xp.asarray(2, dtype=dtype), 0)
+    t248 = t244 - t244*t247
+    t249 = xp.where(xp.not_equal(t246, 0), -t248/t246, 0)
+    t250 = xp.where(xp.not_equal(t234, 0), -(t243 - t240*t249)/t234, 0)
+    t251 = xp.where(xp.not_equal(t203, 0), -(t230 + t222*t250 + t226*t249)/t203, 0)
+    t252 = xp.where(xp.not_equal(t178, 0), -(t198 + t206*t250 + t212*t249 - t193*t251)/t178, 0)
+    t253 = xp.where(xp.not_equal(t133, 0), -(-(-t153*t252 + t159*t251 - t164*t250 + t168*t249) + t172)/t133, 0)
+    t254 = t114*t112
+    t255 = xp.where(xp.not_equal(t68, 0), -(-(-t117*t253 + t120*t252 + t122*t251 - t26*t254*t250 + t51*t254*t249) + t124)/t68, 0)
+    t256 = xp.isfinite(t185)
+    t257 = xp.greater_equal(damping, 0)
+    t258 = xp.greater(damping, 0)
+    t259 = 1e-12*t81
+    t260 = (t258 & xp.greater(t96[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t67, t259) | xp.less_equal(t132, t259) | xp.less_equal(t177, t259) | xp.less_equal(t202, t259) | xp.less_equal(t233, t259) | xp.less_equal(t245, t259)))
+    t261 = t256 & t257 & xp.logical_not(t260)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t428, xp.where(t424, t269, t421), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t428, xp.where(t424, -t276, t419), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t428, xp.where(t424, t270, t418), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t428, xp.where(t424, t271, t417), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t428, xp.where(t424, -t272, t416), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t428, xp.where(t424, -t273, t415), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t261, xp.where(t258, t100, t255), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t261, xp.where(t258, -t106, t253), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t261, xp.where(t258, t107, t252), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t261, xp.where(t258, t108, t251), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t261, xp.where(t258, -t109, t250), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t261, xp.where(t258, -t110, t249), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t422 & t423), 2, xp.where(t427, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t256 & t257), 2, xp.where(t260, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1520 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1523 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (6,)), ("target", target, (4, 4)), ("target_rate", target_rate, (6,)), ("gain", gain, (6,)), ("z", z, (6,)), ("damping", damping, ()), every=("gain", ))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -4954,371 +4847,204 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t128 = s1*t42
     t129 = t54*t43 - t55*t44 + t51*t128
     t130 = -t13*t44 + t128 + t4*t43
-    t131 = t120**2
-    t132 = t123**2
-    t133 = t126**2
-    t134 = t106**2
-    t135 = t56**2
-    t136 = damping**2
-    t137 = t136 + t109
-    t138 = t137**2
-    t139 = xp.sqrt(t131 + t132 + t133 + t134 + t135 + t138)
-    t140 = t139*xp.where(xp.greater_equal(t137, 0), xp.asarray(1, dtype=dtype), -1)
-    t141 = t136 + t113
-    t142 = t99 + t136
-    t143 = t114 + t136
-    t144 = t115 + t136
-    t145 = t136 + t118
-    t146 = xp.sqrt(2*t131 + 2*t132 + 2*t129**2 + 2*t133 + 2*t111**2 + 2*t130**2 + 2*t134 + 2*t127**2 + 2*t124**2 + 2*t121**2 + 2*t135 + 2*t57**2 + 2*t45**2 + 2*t87**2 + 2*t88**2 + t138 + t141**2 + t142**2 + t143**2 + t144**2 + t145**2)
-    t147 = xp.greater(t139, 0)
-    t148 = xp.where(t147, 1/(t137 + t140), 0)
-    t149 = xp.where(t147, 1 + xp.abs(t137)/t139, 0)
-    t150 = t120*t148
-    t151 = t123*t148
-    t152 = t126*t148
-    t153 = t106*t148
-    t154 = t56*t148
-    t155 = t149*(t120 + t141*t150 - t151*t129 + t152*t111 - t153*t127 - t154*t57)
-    t156 = -t155 + t120
-    t157 = t141 - t150*t155
-    t158 = t129 + t151*t155
-    t159 = -t111 + t152*t155
-    t160 = t127 + t153*t155
-    t161 = t57 + t154*t155
-    t162 = t149*(t123 + t142*t151 - t150*t129 - t152*t130 - t153*t124 + t154*t45)
-    t163 = -t162 + t123
-    t164 = t129 + t150*t162
-    t165 = t142 - t151*t162
-    t166 = t130 + t152*t162
-    t167 = t124 + t153*t162
-    t168 = -t45 + t154*t162
-    t169 = -t149*(t126 + t150*t111 - t151*t130 + t143*t152 - t153*t121 + t154*t87)
-    t170 = t126 + t169
-    t171 = t111 + t150*t169
-    t172 = t130 - t151*t169
-    t173 = t143 + t152*t169
-    t174 = t121 - t153*t169
-    t175 = t87 + t154*t169
-    t176 = -t149*(-t106 + t150*t127 + t151*t124 + t152*t121 - t144*t153 + t154*t88)
-    t177 = -t176 + t106
-    t178 = t127 + t150*t176
-    t179 = t124 + t151*t176
-    t180 = t121 + t152*t176
-    t181 = t144 - t153*t176
-    t182 = t88 + t154*t176
-    t183 = -t149*(t56 + t151*t45 - t150*t57 + t152*t87 - t153*t88 + t145*t154)
-    t184 = t56 + t183
-    t185 = t57 - t150*t183
-    t186 = t45 + t151*t183
-    t187 = t87 + t152*t183
-    t188 = t88 - t153*t183
-    t189 = t145 + t154*t183
-    t190 = xp.sqrt(t157**2 + t158**2 + t159**2 + t160**2 + t161**2)
-    t191 = t190*xp.where(xp.greater_equal(t157, 0), xp.asarray(1, dtype=dtype), -1)
-    t192 = xp.greater(t190, 0)
-    t193 = xp.where(t192, 1/(t157 + t191), 0)
-    t194 = xp.where(t192, 1 + xp.abs(t157)/t190, 0)
-    t195 = t158*t193
-    t196 = t159*t193
-    t197 = t160*t193
-    t198 = t161*t193
-    t199 = t194*(-t164 - t195*t165 + t196*t166 + t197*t167 + t198*t168)
-    t200 = t164 + t199
-    t201 = t165 + t195*t199
-    t202 = t166 - t196*t199
-    t203 = -t167 + t197*t199
-    t204 = t168 - t198*t199
-    t205 = -t194*(t171 + t195*t172 - t196*t173 + t197*t174 - t198*t175)
-    t206 = t171 + t205
-    t207 = t172 + t195*t205
-    t208 = t173 - t196*t205
-    t209 = t174 + t197*t205
-    t210 = t175 - t198*t205
-    t211 = t194*(-t178 + t195*t179 + t196*t180 - t197*t181 + t198*t182)
-    t212 = t178 + t211
-    t213 = -t179 + t195*t211
-    t214 = t180 - t196*t211
-    t215 = t181 + t197*t211
-    t216 = t182 - t198*t211
-    t217 = t194*(t185 + t195*t186 + t196*t187 - t197*t188 + t198*t189)
-    t218 = -t217 + t185
-    t219 = -t186 + t195*t217
-    t220 = t187 - t196*t217
-    t221 = t188 + t197*t217
-    t222 = t189 - t198*t217
-    t223 = xp.sqrt(t201**2 + t202**2 + t203**2 + t204**2)
-    t224 = t223*xp.where(xp.greater_equal(t201, 0), xp.asarray(1, dtype=dtype), -1)
-    t225 = xp.greater(t223, 0)
-    t226 = xp.where(t225, 1/(t201 + t224), 0)
-    t227 = xp.where(t225, 1 + xp.abs(t201)/t223, 0)
-    t228 = t202*t226
-    t229 = t203*t226
-    t230 = t204*t226
-    t231 = t227*(t207 + t228*t208 + t229*t209 + t230*t210)
-    t232 = -t231 + t207
-    t233 = t208 - t228*t231
-    t234 = t209 - t229*t231
-    t235 = t210 - t230*t231
-    t236 = t227*(t213 + t228*t214 + t229*t215 + t230*t216)
-    t237 = -t236 + t213
-    t238 = t214 - t228*t236
-    t239 = t215 - t229*t236
-    t240 = t216 - t230*t236
-    t241 = t227*(t219 + t228*t220 + t229*t221 + t230*t222)
-    t242 = -t241 + t219
-    t243 = t220 - t228*t241
-    t244 = t221 - t229*t241
-    t245 = t222 - t230*t241
-    t246 = xp.sqrt(t233**2 + t234**2 + t235**2)
-    t247 = t246*xp.where(xp.greater_equal(t233, 0), xp.asarray(1, dtype=dtype), -1)
-    t248 = xp.greater(t246, 0)
-    t249 = xp.where(t248, 1/(t233 + t247), 0)
-    t250 = xp.where(t248, 1 + xp.abs(t233)/t246, 0)
-    t251 = t234*t249
-    t252 = t235*t249
-    t253 = t250*(t238 + t251*t239 + t252*t240)
-    t254 = -t253 + t238
-    t255 = t239 - t251*t253
-    t256 = t240 - t252*t253
-    t257 = t250*(t243 + t251*t244 + t252*t245)
-    t258 = -t257 + t243
-    t259 = t244 - t251*t257
-    t260 = t245 - t252*t257
-    t261 = xp.sqrt(t255**2 + t256**2)
-    t262 = t261*xp.where(xp.greater_equal(t255, 0), xp.asarray(1, dtype=dtype), -1)
-    t263 = xp.greater(t261, 0)
-    t264 = xp.where(t263, 1/(t255 + t262), 0)
-    t265 = xp.where(t263, 1 + xp.abs(t255)/t261, 0)
-    t266 = t256*t264
-    t267 = t265*(t259 + t266*t260)
-    t268 = -t267 + t259
-    t269 = t260 - t266*t267
-    t270 = xp.abs(t269)
-    t271 = t270*xp.where(xp.greater_equal(t269, 0), xp.asarray(1, dtype=dtype), -1)
-    t272 = xp.where(xp.greater(t270, 0), xp.asarray(2, dtype=dtype), 0)
-    t273 = xp.greater(t103, 0)
-    t274 = xp.where(t273, 1 + xp.abs(t41)/t103, 0)
-    t275 = -t41
-    t276 = xp.where(t273, 1/(t275 + t104), 0)
-    t277 = mu_dot1 + gain1*(t275 + T13)
-    t278 = c1*t51
-    t279 = s1*t51
-    t280 = t33*t276
-    t281 = -t274*(t278 + t279*t280)
-    t282 = t278 + t281
-    t283 = t279 + t280*t281
-    t284 = -t274*(-t52 + t0*t276 + t54*t280)
-    t285 = -t284 + t52
-    t286 = t274*(t53 - t24*t276 + t55*t280)
-    t287 = -t286 + t53
-    t288 = t276*t284
-    t289 = t54 + t33*t288
-    t290 = t0 + t288
-    t291 = t276*t286
-    t292 = t55 - t33*t291
-    t293 = t24 + t291
-    t294 = t276**2
-    t295 = xp.sqrt(t98 + t105 + t110 + t283**2 + t294*t281**2)
-    t296 = t295*xp.where(xp.less_equal(t283, 0), xp.asarray(1, dtype=dtype), -1)
-    t297 = t294*t274
-    t298 = t26*t297
-    t299 = t33*t298
-    t300 = -t298 + t26
-    t301 = t82*t297
-    t302 = t33*t301
-    t303 = -t82
-    t304 = t301 + t303
-    t305 = xp.greater(t295, 0)
-    t306 = xp.where(t305, 1/(-t283 + t296), 0)
-    t307 = xp.where(t305, 1 + xp.abs(t283)/t295, 0)
-    t308 = t42*t306
-    t309 = s1*t306
-    t310 = c1*t306
-    t311 = t276*t281*t306
-    t312 = t307*(-t289 + t43*t308 + t311*t290 + t4*t309 - t8*t310)
-    t313 = t289 + t312
-    t314 = t43 - t308*t312
-    t315 = t4 - t309*t312
-    t316 = t8 + t310*t312
-    t317 = -t290 + t311*t312
-    t318 = t307*(t292 + t44*t308 - t13*t309 + t19*t310 + t311*t293)
-    t319 = -t318 + t292
-    t320 = t44 - t308*t318
-    t321 = t13 + t309*t318
-    t322 = -t293 + t311*t318
-    t323 = -t307*(t299 + t15*t309 - t21*t310 + t311*t300)
-    t324 = t299 + t323
-    t325 = t15 + t309*t323
-    t326 = t300 + t311*t323
-    t327 = t307*(t302 - t61*t309 + t71*t310 - t311*t304)
-    t328 = -t327 + t302
-    t329 = t61 + t309*t327
-    t330 = t304 + t311*t327
-    t331 = xp.sqrt(t314**2 + t315**2 + t316**2 + t317**2)
-    t332 = t331*xp.where(xp.greater_equal(t314, 0), xp.asarray(1, dtype=dtype), -1)
-    t333 = -t19
-    t334 = t333 + t310*t318
-    t335 = -t21
-    t336 = t335 + t310*t323
-    t337 = -t71
-    t338 = t337 + t310*t327
-    t339 = xp.greater(t331, 0)
-    t340 = xp.where(t339, 1/(t314 + t332), 0)
-    t341 = xp.where(t339, 1 + xp.abs(t314)/t331, 0)
-    t342 = t315*t340
-    t343 = t316*t340
-    t344 = t317*t340
-    t345 = t341*(t320 - t342*t321 + t343*t334 + t344*t322)
-    t346 = -t345 + t320
-    t347 = t321 + t342*t345
-    t348 = t334 - t343*t345
-    t349 = t322 - t344*t345
-    t350 = xp.sqrt(t347**2 + t348**2 + t349**2)
-    t351 = t350*xp.where(xp.less_equal(t347, 0), xp.asarray(1, dtype=dtype), -1)
-    t352 = t308*t323
-    t353 = t341*(-t352 - t342*t325 + t343*t336 + t344*t326)
-    t354 = t352 + t353
-    t355 = t325 + t342*t353
-    t356 = t336 - t343*t353
-    t357 = t326 - t344*t353
-    t358 = t308*t327
-    t359 = t341*(-t358 - t342*t329 + t343*t338 + t344*t330)
-    t360 = t358 + t359
-    t361 = t329 + t342*t359
-    t362 = t338 - t343*t359
-    t363 = t330 - t344*t359
-    t364 = xp.greater(t350, 0)
-    t365 = xp.where(t364, 1/(-t347 + t351), 0)
-    t366 = xp.where(t364, 1 + xp.abs(t347)/t350, 0)
-    t367 = t348*t365
-    t368 = t349*t365
-    t369 = t366*(-t355 + t367*t356 + t368*t357)
-    t370 = t355 + t369
-    t371 = t356 - t367*t369
-    t372 = t357 - t368*t369
-    t373 = t366*(-t361 + t367*t362 + t368*t363)
-    t374 = t361 + t373
-    t375 = t362 - t367*t373
-    t376 = t363 - t368*t373
-    t377 = xp.sqrt(t371**2 + t372**2)
-    t378 = t377*xp.where(xp.greater_equal(t371, 0), xp.asarray(1, dtype=dtype), -1)
-    t379 = xp.greater(t377, 0)
-    t380 = xp.where(t379, 1/(t371 + t378), 0)
-    t381 = xp.where(t379, 1 + xp.abs(t371)/t377, 0)
-    t382 = t372*t380
-    t383 = t381*(t375 + t382*t376)
-    t384 = -t383 + t375
-    t385 = t376 - t382*t383
-    t386 = xp.abs(t385)
-    t387 = t386*xp.where(xp.greater_equal(t385, 0), xp.asarray(1, dtype=dtype), -1)
-    t388 = xp.where(xp.greater(t386, 0), xp.asarray(2, dtype=dtype), 0)
-    t389 = xp.greater_equal(t66, t77) & xp.greater_equal(t66, t91)
-    t390 = xp.greater_equal(t77, t91)
-    t391 = xp.where(t389, 0.5*(1 + t66), xp.where(t390, 0.5*t76, 0.5*t89))
-    t392 = xp.where(t389, 0.5*t67, xp.where(t390, 0.5*(1 + t77), 0.5*t90))
-    t393 = xp.where(t389, 0.5*t68, xp.where(t390, 0.5*t78, 0.5*(1 + t91)))
-    t394 = xp.sqrt(t391**2 + t392**2 + t393**2)
-    t395 = xp.where(xp.greater_equal(t92*t391 + t93*t392 + t79*t393, 0), xp.asarray(1, dtype=dtype), -1)
-    t396 = xp.greater(t95, 1e-06) | xp.greater(t94, 0)
-    t397 = t96*t395/t394
-    t398 = xp.where(t396, t92*t97, t397*t391)
-    t399 = xp.where(t396, t93*t97, t397*t392)
-    t400 = xp.where(t396, t79*t97, t397*t393)
-    t401 = mu_dot3 + t398*gain3
-    t402 = mu_dot4 + t399*gain4
-    t403 = mu_dot5 + t400*gain5
-    t404 = t149*(t34 + t150*t277 + t151*t58 - t152*t401 + t153*t402 - t154*t403)
-    t405 = -t404 + t34
-    t406 = t277 - t150*t404
-    t407 = t58 - t151*t404
-    t408 = t401 + t152*t404
-    t409 = t402 - t153*t404
-    t410 = t403 + t154*t404
-    t411 = t194*(t406 - t195*t407 + t196*t408 - t197*t409 + t198*t410)
-    t412 = -t411 + t406
-    t413 = t407 + t195*t411
-    t414 = t408 - t196*t411
-    t415 = t409 + t197*t411
-    t416 = t410 - t198*t411
-    t417 = t227*(t413 + t228*t414 + t229*t415 + t230*t416)
-    t418 = -t417 + t413
-    t419 = t414 - t228*t417
-    t420 = t415 - t229*t417
-    t421 = t416 - t230*t417
-    t422 = t250*(t419 + t251*t420 + t252*t421)
-    t423 = -t422 + t419
-    t424 = t420 - t251*t422
-    t425 = t421 - t252*t422
-    t426 = t265*(t424 + t266*t425)
-    t427 = -t426 + t424
-    t428 = t425 - t266*t426
-    t429 = t428 - t272*t428
-    t430 = xp.where(xp.not_equal(t271, 0), -t429/t271, 0)
-    t431 = xp.where(xp.not_equal(t262, 0), -(t427 - t268*t430)/t262, 0)
-    t432 = xp.where(xp.not_equal(t247, 0), -(-(t254*t431 + t258*t430) + t423)/t247, 0)
-    t433 = xp.where(xp.not_equal(t224, 0), -(-(t232*t432 + t237*t431 + t242*t430) + t418)/t224, 0)
-    t434 = xp.where(xp.not_equal(t191, 0), -(t412 + t200*t433 + t206*t432 + t212*t431 - t218*t430)/t191, 0)
-    t435 = xp.where(xp.not_equal(t140, 0), -(-(t156*t434 + t163*t433 - t170*t432 + t177*t431 - t184*t430) + t405)/t140, 0)
-    t436 = t430 - t41*t435 + t33*t434
-    t437 = c1*t431 - t42*t433 - s1*t432 + t278*t435 + t279*t434
-    t438 = t52*t435 - t54*t434 + t43*t433 - t0*t430 + t4*t432 + t8*t431
-    t439 = t53*t435 + t55*t434 + t44*t433 - t13*t432 - t19*t431 - t24*t430
-    t440 = t15*t432 + t21*t431 - t26*t430
-    t441 = t61*t432 + t71*t431 + t82*t430
-    t442 = t274*(t34 + t276*t403 + t280*t277)
-    t443 = -t442 + t34
-    t444 = 1 - t54 - t13 - t15 - t61 - c1 - t0 - t24 - t278 - t279 + q1 + q2 + s1 + q3 + q4 + t26 + q5 + q6 + t33 + t4 + t8 + t52 + t53 + t55 + t42 + t43 + t44 + t275 + t303 + t333 + t335 + t337 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t34 + t277 + t58 + t401 + t402 + t403
-    t445 = t276*t442
-    t446 = t277 - t33*t445
-    t447 = -t445 + t403
-    t448 = t307*(t446 + t308*t58 + t309*t401 - t310*t402 - t311*t447)
-    t449 = -t448 + t446
-    t450 = t58 - t308*t448
-    t451 = t401 - t309*t448
-    t452 = t402 + t310*t448
-    t453 = t447 + t311*t448
-    t454 = t341*(t450 + t342*t451 + t343*t452 + t344*t453)
-    t455 = -t454 + t450
-    t456 = t451 - t342*t454
-    t457 = t452 - t343*t454
-    t458 = t453 - t344*t454
-    t459 = t366*(t456 + t367*t457 + t368*t458)
-    t460 = -t459 + t456
-    t461 = t457 - t367*t459
-    t462 = t458 - t368*t459
-    t463 = t381*(t461 + t382*t462)
-    t464 = -t463 + t461
-    t465 = t462 - t382*t463
-    t466 = t465 - t388*t465
-    t467 = xp.where(xp.not_equal(t387, 0), -t466/t387, 0)
-    t468 = xp.where(xp.not_equal(t378, 0), -(t464 - t384*t467)/t378, 0)
-    t469 = xp.where(xp.not_equal(t351, 0), -(t460 + t370*t468 + t374*t467)/t351, 0)
-    t470 = xp.where(xp.not_equal(t332, 0), -(t455 + t354*t468 + t360*t467 - t346*t469)/t332, 0)
-    t471 = xp.where(xp.not_equal(t296, 0), -(-(-t313*t470 + t319*t469 - t324*t468 + t328*t467) + t449)/t296, 0)
-    t472 = t276*t274
-    t473 = xp.where(xp.not_equal(t104, 0), -(-(-t282*t471 + t285*t470 + t287*t469 - t26*t472*t468 + t82*t472*t467) + t443)/t104, 0)
-    t474 = xp.isfinite(t444)
-    t475 = xp.greater_equal(damping, 0)
-    t476 = xp.greater(damping, 0)
-    t477 = 1e-12*t146
-    t478 = 1e-12*t117
-    t479 = (t476 & (xp.less_equal(t139, t477) | xp.less_equal(t190, t477) | xp.less_equal(t223, t477) | xp.less_equal(t246, t477) | xp.less_equal(t261, t477) | xp.less_equal(t270, t477))) | (xp.less_equal(damping, 0) & (xp.less_equal(t103, t478) | xp.less_equal(t295, t478) | xp.less_equal(t331, t478) | xp.less_equal(t350, t478) | xp.less_equal(t377, t478) | xp.less_equal(t386, t478)))
-    t480 = t474 & t475 & xp.logical_not(t479)
+    t131 = xp.greater(t103, 0)
+    t132 = xp.where(t131, 1 + xp.abs(t41)/t103, 0)
+    t133 = -t41
+    t134 = xp.where(t131, 1/(t133 + t104), 0)
+    t135 = mu_dot1 + gain1*(t133 + T13)
+    t136 = c1*t51
+    t137 = s1*t51
+    t138 = t33*t134
+    t139 = -t132*(t136 + t137*t138)
+    t140 = t136 + t139
+    t141 = t137 + t138*t139
+    t142 = -t132*(-t52 + t0*t134 + t54*t138)
+    t143 = -t142 + t52
+    t144 = t132*(t53 - t24*t134 + t55*t138)
+    t145 = -t144 + t53
+    t146 = t134*t142
+    t147 = t54 + t33*t146
+    t148 = t0 + t146
+    t149 = t134*t144
+    t150 = t55 - t33*t149
+    t151 = t24 + t149
+    t152 = t134**2
+    t153 = xp.sqrt(t98 + t105 + t110 + t141**2 + t152*t139**2)
+    t154 = t153*xp.where(xp.less_equal(t141, 0), xp.asarray(1, dtype=dtype), -1)
+    t155 = t152*t132
+    t156 = t26*t155
+    t157 = t33*t156
+    t158 = -t156 + t26
+    t159 = t82*t155
+    t160 = t33*t159
+    t161 = -t82
+    t162 = t159 + t161
+    t163 = xp.greater(t153, 0)
+    t164 = xp.where(t163, 1/(-t141 + t154), 0)
+    t165 = xp.where(t163, 1 + xp.abs(t141)/t153, 0)
+    t166 = t42*t164
+    t167 = s1*t164
+    t168 = c1*t164
+    t169 = t134*t139*t164
+    t170 = t165*(-t147 + t43*t166 + t169*t148 + t4*t167 - t8*t168)
+    t171 = t147 + t170
+    t172 = t43 - t166*t170
+    t173 = t4 - t167*t170
+    t174 = t8 + t168*t170
+    t175 = -t148 + t169*t170
+    t176 = t165*(t150 + t44*t166 - t13*t167 + t19*t168 + t169*t151)
+    t177 = -t176 + t150
+    t178 = t44 - t166*t176
+    t179 = t13 + t167*t176
+    t180 = -t151 + t169*t176
+    t181 = -t165*(t157 + t15*t167 - t21*t168 + t169*t158)
+    t182 = t157 + t181
+    t183 = t15 + t167*t181
+    t184 = t158 + t169*t181
+    t185 = t165*(t160 - t61*t167 + t71*t168 - t169*t162)
+    t186 = -t185 + t160
+    t187 = t61 + t167*t185
+    t188 = t162 + t169*t185
+    t189 = xp.sqrt(t172**2 + t173**2 + t174**2 + t175**2)
+    t190 = t189*xp.where(xp.greater_equal(t172, 0), xp.asarray(1, dtype=dtype), -1)
+    t191 = -t19
+    t192 = t191 + t168*t176
+    t193 = -t21
+    t194 = t193 + t168*t181
+    t195 = -t71
+    t196 = t195 + t168*t185
+    t197 = xp.greater(t189, 0)
+    t198 = xp.where(t197, 1/(t172 + t190), 0)
+    t199 = xp.where(t197, 1 + xp.abs(t172)/t189, 0)
+    t200 = t173*t198
+    t201 = t174*t198
+    t202 = t175*t198
+    t203 = t199*(t178 - t200*t179 + t201*t192 + t202*t180)
+    t204 = -t203 + t178
+    t205 = t179 + t200*t203
+    t206 = t192 - t201*t203
+    t207 = t180 - t202*t203
+    t208 = xp.sqrt(t205**2 + t206**2 + t207**2)
+    t209 = t208*xp.where(xp.less_equal(t205, 0), xp.asarray(1, dtype=dtype), -1)
+    t210 = t166*t181
+    t211 = t199*(-t210 - t200*t183 + t201*t194 + t202*t184)
+    t212 = t210 + t211
+    t213 = t183 + t200*t211
+    t214 = t194 - t201*t211
+    t215 = t184 - t202*t211
+    t216 = t166*t185
+    t217 = t199*(-t216 - t200*t187 + t201*t196 + t202*t188)
+    t218 = t216 + t217
+    t219 = t187 + t200*t217
+    t220 = t196 - t201*t217
+    t221 = t188 - t202*t217
+    t222 = xp.greater(t208, 0)
+    t223 = xp.where(t222, 1/(-t205 + t209), 0)
+    t224 = xp.where(t222, 1 + xp.abs(t205)/t208, 0)
+    t225 = t206*t223
+    t226 = t207*t223
+    t227 = t224*(-t213 + t225*t214 + t226*t215)
+    t228 = t213 + t227
+    t229 = t214 - t225*t227
+    t230 = t215 - t226*t227
+    t231 = t224*(-t219 + t225*t220 + t226*t221)
+    t232 = t219 + t231
+    t233 = t220 - t225*t231
+    t234 = t221 - t226*t231
+    t235 = xp.sqrt(t229**2 + t230**2)
+    t236 = t235*xp.where(xp.greater_equal(t229, 0), xp.asarray(1, dtype=dtype), -1)
+    t237 = xp.greater(t235, 0)
+    t238 = xp.where(t237, 1/(t229 + t236), 0)
+    t239 = xp.where(t237, 1 + xp.abs(t229)/t235, 0)
+    t240 = t230*t238
+    t241 = t239*(t233 + t240*t234)
+    t242 = -t241 + t233
+    t243 = t234 - t240*t241
+    t244 = xp.abs(t243)
+    t245 = t244*xp.where(xp.greater_equal(t243, 0), xp.asarray(1, dtype=dtype), -1)
+    t246 = xp.where(xp.greater(t244, 0), xp.asarray(2, dtype=dtype), 0)
+    t247 = xp.greater_equal(t66, t77) & xp.greater_equal(t66, t91)
+    t248 = xp.greater_equal(t77, t91)
+    t249 = xp.where(t247, 0.5*(1 + t66), xp.where(t248, 0.5*t76, 0.5*t89))
+    t250 = xp.where(t247, 0.5*t67, xp.where(t248, 0.5*(1 + t77), 0.5*t90))
+    t251 = xp.where(t247, 0.5*t68, xp.where(t248, 0.5*t78, 0.5*(1 + t91)))
+    t252 = xp.sqrt(t249**2 + t250**2 + t251**2)
+    t253 = xp.where(xp.greater_equal(t92*t249 + t93*t250 + t79*t251, 0), xp.asarray(1, dtype=dtype), -1)
+    t254 = xp.greater(t95, 1e-06) | xp.greater(t94, 0)
+    t255 = t96*t253/t252
+    t256 = xp.where(t254, t92*t97, t255*t249)
+    t257 = xp.where(t254, t93*t97, t255*t250)
+    t258 = xp.where(t254, t79*t97, t255*t251)
+    t259 = mu_dot3 + t256*gain3
+    t260 = mu_dot4 + t257*gain4
+    t261 = mu_dot5 + t258*gain5
+    t262 = t132*(t34 + t134*t261 + t138*t135)
+    t263 = -t262 + t34
+    t264 = 1 - t54 - t13 - t15 - t61 - c1 - t0 - t24 - t136 - t137 + q1 + q2 + s1 + q3 + q4 + t26 + q5 + q6 + t33 + t4 + t8 + t52 + t53 + t55 + t42 + t43 + t44 + t133 + t161 + t191 + t193 + t195 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t34 + t135 + t58 + t259 + t260 + t261
+    t265 = damping**2
+    t266 = _symmetric_solve6(xp, 1, (t265 + t109, t120, t123, -t126, t106, -t56, t265 + t113, -t129, -t111, -t127, t57, t99 + t265, t130, -t124, -t45, t114 + t265, t121, t87, t115 + t265, t88, t265 + t118, t34, t135, t58, t259, t260, t261,))
+    t267 = t266[5]
+    t268 = t266[0]
+    t269 = t266[1]
+    t270 = t267 - t41*t268 + t33*t269
+    t271 = t266[2]
+    t272 = t266[3]
+    t273 = t266[4]
+    t274 = t136*t268 + t137*t269 - t42*t271 - s1*t272 + c1*t273
+    t275 = t52*t268 - t54*t269 + t43*t271 - t0*t267 + t4*t272 + t8*t273
+    t276 = t53*t268 + t55*t269 + t44*t271 - t13*t272 - t19*t273 - t24*t267
+    t277 = t15*t272 + t21*t273 - t26*t267
+    t278 = t61*t272 + t71*t273 + t82*t267
+    t279 = t134*t262
+    t280 = t135 - t33*t279
+    t281 = -t279 + t261
+    t282 = t165*(t280 + t166*t58 + t167*t259 - t168*t260 - t169*t281)
+    t283 = -t282 + t280
+    t284 = t58 - t166*t282
+    t285 = t259 - t167*t282
+    t286 = t260 + t168*t282
+    t287 = t281 + t169*t282
+    t288 = t199*(t284 + t200*t285 + t201*t286 + t202*t287)
+    t289 = -t288 + t284
+    t290 = t285 - t200*t288
+    t291 = t286 - t201*t288
+    t292 = t287 - t202*t288
+    t293 = t224*(t290 + t225*t291 + t226*t292)
+    t294 = -t293 + t290
+    t295 = t291 - t225*t293
+    t296 = t292 - t226*t293
+    t297 = t239*(t295 + t240*t296)
+    t298 = -t297 + t295
+    t299 = t296 - t240*t297
+    t300 = t299 - t246*t299
+    t301 = xp.where(xp.not_equal(t245, 0), -t300/t245, 0)
+    t302 = xp.where(xp.not_equal(t236, 0), -(t298 - t242*t301)/t236, 0)
+    t303 = xp.where(xp.not_equal(t209, 0), -(t294 + t228*t302 + t232*t301)/t209, 0)
+    t304 = xp.where(xp.not_equal(t190, 0), -(t289 + t212*t302 + t218*t301 - t204*t303)/t190, 0)
+    t305 = xp.where(xp.not_equal(t154, 0), -(-(-t171*t304 + t177*t303 - t182*t302 + t186*t301) + t283)/t154, 0)
+    t306 = t134*t132
+    t307 = xp.where(xp.not_equal(t104, 0), -(-(-t140*t305 + t143*t304 + t145*t303 - t26*t306*t302 + t82*t306*t301) + t263)/t104, 0)
+    t308 = xp.isfinite(t264)
+    t309 = xp.greater_equal(damping, 0)
+    t310 = xp.greater(damping, 0)
+    t311 = 1e-12*t117
+    t312 = (t310 & xp.greater(t266[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t103, t311) | xp.less_equal(t153, t311) | xp.less_equal(t189, t311) | xp.less_equal(t208, t311) | xp.less_equal(t235, t311) | xp.less_equal(t244, t311)))
+    t313 = t308 & t309 & xp.logical_not(t312)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t480, xp.where(t476, t436, t473), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t480, xp.where(t476, -t437, t471), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t480, xp.where(t476, t438, t470), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t480, xp.where(t476, t439, t469), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t480, xp.where(t476, -t440, t468), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t480, xp.where(t476, -t441, t467), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t313, xp.where(t310, t270, t307), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t313, xp.where(t310, -t274, t305), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t313, xp.where(t310, t275, t304), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t313, xp.where(t310, t276, t303), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t313, xp.where(t310, -t277, t302), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t313, xp.where(t310, -t278, t301), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t474 & t475), 2, xp.where(t479, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t308 & t309), 2, xp.where(t312, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 1005 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 1067 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (6,)), ("damping", damping, ()))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
@@ -5492,178 +5218,19 @@ def ik_numeric_step(target, q, damping=0.0):
     t133 = xp.where(t130, t97*t101, t131*t126)
     t134 = xp.where(t130, t82*t101, t131*t127)
     t135 = t132**2 + t133**2 + t134**2 + t35**2 + t48**2 + t61**2
-    t136 = damping + t106
-    t137 = xp.sqrt(t136**2 + t108**2 + t111**2 + t114**2 + t103**2 + t59**2)
-    t138 = t137*xp.where(xp.greater_equal(t136, 0), xp.asarray(1, dtype=dtype), -1)
-    t139 = xp.greater(t137, 0)
-    t140 = xp.where(t139, 1/(t136 + t138), 0)
-    t141 = xp.where(t139, 1 + xp.abs(t136)/t137, 0)
-    t142 = damping + t117
-    t143 = t108*t140
-    t144 = t111*t140
-    t145 = t114*t140
-    t146 = t103*t140
-    t147 = t59*t140
-    t148 = t141*(t108 + t142*t143 - t144*t121 + t145*t118 - t146*t115 - t147*t60)
-    t149 = -t148 + t108
-    t150 = t142 - t143*t148
-    t151 = t121 + t144*t148
-    t152 = -t118 + t145*t148
-    t153 = t115 + t146*t148
-    t154 = t60 + t147*t148
-    t155 = t141*(t35 + t143*t48 + t144*t61 - t145*t132 + t146*t133 - t147*t134)
-    t156 = -t155 + t35
-    t157 = t48 - t143*t155
-    t158 = t61 - t144*t155
-    t159 = t132 + t145*t155
-    t160 = t133 - t146*t155
-    t161 = t134 + t147*t155
-    t162 = xp.sqrt(t150**2 + t151**2 + t152**2 + t153**2 + t154**2)
-    t163 = t162*xp.where(xp.greater_equal(t150, 0), xp.asarray(1, dtype=dtype), -1)
-    t164 = damping + t46
-    t165 = t141*(t111 - t143*t121 + t144*t164 - t145*t122 - t146*t112 + t147*t47)
-    t166 = -t165 + t111
-    t167 = t121 + t143*t165
-    t168 = t164 - t144*t165
-    t169 = t122 + t145*t165
-    t170 = t112 + t146*t165
-    t171 = -t47 + t147*t165
-    t172 = damping + t119
-    t173 = -t141*(t114 + t143*t118 - t144*t122 + t145*t172 - t146*t109 + t147*t90)
-    t174 = t114 + t173
-    t175 = t118 + t143*t173
-    t176 = t122 - t144*t173
-    t177 = t172 + t145*t173
-    t178 = t109 - t146*t173
-    t179 = t90 + t147*t173
-    t180 = damping + t104
-    t181 = -t141*(-t103 + t143*t115 + t144*t112 + t145*t109 - t146*t180 + t147*t91)
-    t182 = -t181 + t103
-    t183 = t115 + t143*t181
-    t184 = t112 + t144*t181
-    t185 = t109 + t145*t181
-    t186 = t180 - t146*t181
-    t187 = t91 + t147*t181
-    t188 = damping + t92
-    t189 = -t141*(t59 - t143*t60 + t144*t47 + t145*t90 - t146*t91 + t147*t188)
-    t190 = t59 + t189
-    t191 = t60 - t143*t189
-    t192 = t47 + t144*t189
-    t193 = t90 + t145*t189
-    t194 = t91 - t146*t189
-    t195 = t188 + t147*t189
-    t196 = xp.greater(t162, 0)
-    t197 = xp.where(t196, 1/(t150 + t163), 0)
-    t198 = xp.where(t196, 1 + xp.abs(t150)/t162, 0)
-    t199 = t151*t197
-    t200 = t152*t197
-    t201 = t153*t197
-    t202 = t154*t197
-    t203 = t198*(-t167 - t199*t168 + t200*t169 + t201*t170 + t202*t171)
-    t204 = t167 + t203
-    t205 = t168 + t199*t203
-    t206 = t169 - t200*t203
-    t207 = -t170 + t201*t203
-    t208 = t171 - t202*t203
-    t209 = -t198*(t175 + t199*t176 - t200*t177 + t201*t178 - t202*t179)
-    t210 = t175 + t209
-    t211 = t176 + t199*t209
-    t212 = t177 - t200*t209
-    t213 = t178 + t201*t209
-    t214 = t179 - t202*t209
-    t215 = t198*(-t183 + t199*t184 + t200*t185 - t201*t186 + t202*t187)
-    t216 = t183 + t215
-    t217 = -t184 + t199*t215
-    t218 = t185 - t200*t215
-    t219 = t186 + t201*t215
-    t220 = t187 - t202*t215
-    t221 = t198*(t191 + t199*t192 + t200*t193 - t201*t194 + t202*t195)
-    t222 = -t221 + t191
-    t223 = -t192 + t199*t221
-    t224 = t193 - t200*t221
-    t225 = t194 + t201*t221
-    t226 = t195 - t202*t221
-    t227 = t198*(t157 - t199*t158 + t200*t159 - t201*t160 + t202*t161)
-    t228 = -t227 + t157
-    t229 = t158 + t199*t227
-    t230 = t159 - t200*t227
-    t231 = t160 + t201*t227
-    t232 = t161 - t202*t227
-    t233 = xp.sqrt(t205**2 + t206**2 + t207**2 + t208**2)
-    t234 = t233*xp.where(xp.greater_equal(t205, 0), xp.asarray(1, dtype=dtype), -1)
-    t235 = xp.greater(t233, 0)
-    t236 = xp.where(t235, 1/(t205 + t234), 0)
-    t237 = xp.where(t235, 1 + xp.abs(t205)/t233, 0)
-    t238 = t206*t236
-    t239 = t207*t236
-    t240 = t208*t236
-    t241 = t237*(t211 + t238*t212 + t239*t213 + t240*t214)
-    t242 = -t241 + t211
-    t243 = t212 - t238*t241
-    t244 = t213 - t239*t241
-    t245 = t214 - t240*t241
-    t246 = t237*(t217 + t238*t218 + t239*t219 + t240*t220)
-    t247 = -t246 + t217
-    t248 = t218 - t238*t246
-    t249 = t219 - t239*t246
-    t250 = t220 - t240*t246
-    t251 = t237*(t223 + t238*t224 + t239*t225 + t240*t226)
-    t252 = -t251 + t223
-    t253 = t224 - t238*t251
-    t254 = t225 - t239*t251
-    t255 = t226 - t240*t251
-    t256 = t237*(t229 + t238*t230 + t239*t231 + t240*t232)
-    t257 = -t256 + t229
-    t258 = t230 - t238*t256
-    t259 = t231 - t239*t256
-    t260 = t232 - t240*t256
-    t261 = xp.sqrt(t243**2 + t244**2 + t245**2)
-    t262 = t261*xp.where(xp.greater_equal(t243, 0), xp.asarray(1, dtype=dtype), -1)
-    t263 = xp.greater(t261, 0)
-    t264 = xp.where(t263, 1/(t243 + t262), 0)
-    t265 = xp.where(t263, 1 + xp.abs(t243)/t261, 0)
-    t266 = t244*t264
-    t267 = t245*t264
-    t268 = t265*(t248 + t266*t249 + t267*t250)
-    t269 = -t268 + t248
-    t270 = t249 - t266*t268
-    t271 = t250 - t267*t268
-    t272 = t265*(t253 + t266*t254 + t267*t255)
-    t273 = -t272 + t253
-    t274 = t254 - t266*t272
-    t275 = t255 - t267*t272
-    t276 = t265*(t258 + t266*t259 + t267*t260)
-    t277 = -t276 + t258
-    t278 = t259 - t266*t276
-    t279 = t260 - t267*t276
-    t280 = xp.sqrt(t270**2 + t271**2)
-    t281 = t280*xp.where(xp.greater_equal(t270, 0), xp.asarray(1, dtype=dtype), -1)
-    t282 = xp.greater(t280, 0)
-    t283 = xp.where(t282, 1/(t270 + t281), 0)
-    t284 = xp.where(t282, 1 + xp.abs(t270)/t280, 0)
-    t285 = t271*t283
-    t286 = t284*(t274 + t285*t275)
-    t287 = -t286 + t274
-    t288 = t275 - t285*t286
-    t289 = t284*(t278 + t285*t279)
-    t290 = -t289 + t278
-    t291 = t279 - t285*t289
-    t292 = xp.abs(t288)
-    t293 = t292*xp.where(xp.greater_equal(t288, 0), xp.asarray(1, dtype=dtype), -1)
-    t294 = xp.where(xp.greater(t292, 0), xp.asarray(2, dtype=dtype), 0)
-    t295 = t291 - t291*t294
-    t296 = xp.where(xp.not_equal(t293, 0), -t295/t293, 0)
-    t297 = xp.where(xp.not_equal(t281, 0), -(t290 - t287*t296)/t281, 0)
-    t298 = xp.where(xp.not_equal(t262, 0), -(-(t269*t297 + t273*t296) + t277)/t262, 0)
-    t299 = xp.where(xp.not_equal(t234, 0), -(-(t242*t298 + t247*t297 + t252*t296) + t257)/t234, 0)
-    t300 = xp.where(xp.not_equal(t163, 0), -(t228 + t204*t299 + t210*t298 + t216*t297 - t222*t296)/t163, 0)
-    t301 = xp.where(xp.not_equal(t138, 0), -(-(t149*t300 + t166*t299 - t174*t298 + t182*t297 - t190*t296) + t156)/t138, 0)
-    t302 = q1 + t296 - t42*t301 + t34*t300
-    t303 = q2 - c1*t54*t301 - s1*t54*t300 + t43*t299 + s1*t298 - c1*t297
-    t304 = q3 + t55*t301 - t57*t300 + t44*t299 - t0*t296 + t5*t298 + t9*t297
-    t305 = q4 + t56*t301 + t58*t300 + t45*t299 - t14*t298 - t20*t297 - t25*t296
-    t306 = q5 - t16*t298 - t22*t297 + t27*t296
-    t307 = -q6 + t64*t298 + t74*t297 + t85*t296
+    t136 = _symmetric_solve6(xp, 1, (damping + t106, t108, t111, -t114, t103, -t59, damping + t117, -t121, -t118, -t115, t60, damping + t46, t122, -t112, -t47, damping + t119, t109, t90, damping + t104, t91, damping + t92, t35, t48, t61, t132, t133, t134,))
+    t137 = t136[5]
+    t138 = t136[0]
+    t139 = t136[1]
+    t140 = q1 + t137 - t42*t138 + t34*t139
+    t141 = t136[2]
+    t142 = t136[3]
+    t143 = t136[4]
+    t144 = q2 - c1*t54*t138 - s1*t54*t139 + t43*t141 + s1*t142 - c1*t143
+    t145 = q3 + t55*t138 - t57*t139 + t44*t141 - t0*t137 + t5*t142 + t9*t143
+    t146 = q4 + t56*t138 + t58*t139 + t45*t141 - t14*t142 - t20*t143 - t25*t137
+    t147 = q5 - t16*t142 - t22*t143 + t27*t137
+    t148 = -q6 + t74*t143 + t64*t142 + t85*t137
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -5673,12 +5240,12 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q6, batch),  # 5
     ], (6,))
     q_next = _stack(xp, [
-        xp.broadcast_to(t302, batch),  # 0
-        xp.broadcast_to(t303, batch),  # 1
-        xp.broadcast_to(t304, batch),  # 2
-        xp.broadcast_to(t305, batch),  # 3
-        xp.broadcast_to(t306, batch),  # 4
-        xp.broadcast_to(-t307, batch),  # 5
+        xp.broadcast_to(t140, batch),  # 0
+        xp.broadcast_to(t144, batch),  # 1
+        xp.broadcast_to(t145, batch),  # 2
+        xp.broadcast_to(t146, batch),  # 3
+        xp.broadcast_to(t147, batch),  # 4
+        xp.broadcast_to(-t148, batch),  # 5
     ], (6,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t2), t135, -1), batch)
     return q_start, q_next, cost
@@ -6531,7 +6098,7 @@ def ik_general_limits(q_solution):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 1219 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 1218 operations."""
     xp, dtype, device, batch, (T, q_seed, weights,) = _arguments(("T", T, (4, 4)), ("q_seed", q_seed, (6,)), ("weights", weights, (6,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(T)
     T00 = T[..., 0, 0]
@@ -6686,326 +6253,35 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     lb13 = branches_in_limits[..., 13]
     lb14 = branches_in_limits[..., 14]
     lb15 = branches_in_limits[..., 15]
-    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
-    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
-    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
-    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
-    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
-    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
-    t6 = xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0)
-    t7 = xp.where(xp.greater(t6, 0), xp.asarray(1, dtype=dtype), 0)
-    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
-    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
-    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
-    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
-    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
-    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
-    t14 = xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0)
-    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
-    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
-    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
-    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
-    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
-    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
-    t21 = xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0)
-    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
-    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
-    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
-    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
-    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
-    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
-    t28 = xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0)
-    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
-    t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
-    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
-    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
-    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
-    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
-    t35 = xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0)
-    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
-    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
-    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
-    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
-    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
-    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
-    t42 = xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0)
-    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
-    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
-    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
-    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
-    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
-    t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
-    t49 = xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0)
-    t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
-    t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
-    t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
-    t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
-    t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
-    t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
-    t56 = xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0)
-    t57 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_0 + qn1)) + qb8_0
-    t58 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_1 + qn2)) + qb8_1
-    t59 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_2 + qn3)) + qb8_2
-    t60 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_3 + qn4)) + qb8_3
-    t61 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_4 + qn5)) + qb8_4
-    t62 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_5 + qn6)) + qb8_5
-    t63 = xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0)
-    t64 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_0 + qn1)) + qb9_0
-    t65 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_1 + qn2)) + qb9_1
-    t66 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_2 + qn3)) + qb9_2
-    t67 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_3 + qn4)) + qb9_3
-    t68 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_4 + qn5)) + qb9_4
-    t69 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_5 + qn6)) + qb9_5
-    t70 = xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0)
-    t71 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_0 + qn1)) + qb10_0
-    t72 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_1 + qn2)) + qb10_1
-    t73 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_2 + qn3)) + qb10_2
-    t74 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_3 + qn4)) + qb10_3
-    t75 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_4 + qn5)) + qb10_4
-    t76 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_5 + qn6)) + qb10_5
-    t77 = xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0)
-    t78 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_0 + qn1)) + qb11_0
-    t79 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_1 + qn2)) + qb11_1
-    t80 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_2 + qn3)) + qb11_2
-    t81 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_3 + qn4)) + qb11_3
-    t82 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_4 + qn5)) + qb11_4
-    t83 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_5 + qn6)) + qb11_5
-    t84 = xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0)
-    t85 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_0 + qn1)) + qb12_0
-    t86 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_1 + qn2)) + qb12_1
-    t87 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_2 + qn3)) + qb12_2
-    t88 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_3 + qn4)) + qb12_3
-    t89 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_4 + qn5)) + qb12_4
-    t90 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_5 + qn6)) + qb12_5
-    t91 = xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0)
-    t92 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_0 + qn1)) + qb13_0
-    t93 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_1 + qn2)) + qb13_1
-    t94 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_2 + qn3)) + qb13_2
-    t95 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_3 + qn4)) + qb13_3
-    t96 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_4 + qn5)) + qb13_4
-    t97 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_5 + qn6)) + qb13_5
-    t98 = xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0)
-    t99 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_0 + qn1)) + qb14_0
-    t100 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_1 + qn2)) + qb14_1
-    t101 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_2 + qn3)) + qb14_2
-    t102 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_3 + qn4)) + qb14_3
-    t103 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_4 + qn5)) + qb14_4
-    t104 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_5 + qn6)) + qb14_5
-    t105 = xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0)
-    t106 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_0 + qn1)) + qb15_0
-    t107 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_1 + qn2)) + qb15_1
-    t108 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_2 + qn3)) + qb15_2
-    t109 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_3 + qn4)) + qb15_3
-    t110 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_4 + qn5)) + qb15_4
-    t111 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_5 + qn6)) + qb15_5
-    t112 = xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0)
-    t113 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
-    t114 = -qn1
-    t115 = -qn2
-    t116 = -qn3
-    t117 = -qn4
-    t118 = -qn5
-    t119 = -qn6
-    t120 = qw1*(t114 + t0)**2 + qw2*(t115 + t1)**2 + qw3*(t116 + t2)**2 + qw4*(t117 + t3)**2 + qw5*(t118 + t4)**2 + qw6*(t119 + t5)**2
-    t121 = qw1*(t114 + t8)**2 + qw2*(t115 + t9)**2 + qw3*(t116 + t10)**2 + qw4*(t117 + t11)**2 + qw5*(t118 + t12)**2 + qw6*(t119 + t13)**2
-    t122 = qw1*(t114 + t15)**2 + qw2*(t115 + t16)**2 + qw3*(t116 + t17)**2 + qw4*(t117 + t18)**2 + qw5*(t118 + t19)**2 + qw6*(t119 + t20)**2
-    t123 = qw1*(t114 + t22)**2 + qw2*(t115 + t23)**2 + qw3*(t116 + t24)**2 + qw4*(t117 + t25)**2 + qw5*(t118 + t26)**2 + qw6*(t119 + t27)**2
-    t124 = qw1*(t114 + t29)**2 + qw2*(t115 + t30)**2 + qw3*(t116 + t31)**2 + qw4*(t117 + t32)**2 + qw5*(t118 + t33)**2 + qw6*(t119 + t34)**2
-    t125 = qw1*(t114 + t36)**2 + qw2*(t115 + t37)**2 + qw3*(t116 + t38)**2 + qw4*(t117 + t39)**2 + qw5*(t118 + t40)**2 + qw6*(t119 + t41)**2
-    t126 = qw1*(t114 + t43)**2 + qw2*(t115 + t44)**2 + qw3*(t116 + t45)**2 + qw4*(t117 + t46)**2 + qw5*(t118 + t47)**2 + qw6*(t119 + t48)**2
-    t127 = qw1*(t114 + t50)**2 + qw2*(t115 + t51)**2 + qw3*(t116 + t52)**2 + qw4*(t117 + t53)**2 + qw5*(t118 + t54)**2 + qw6*(t119 + t55)**2
-    t128 = qw1*(t114 + t57)**2 + qw2*(t115 + t58)**2 + qw3*(t116 + t59)**2 + qw4*(t117 + t60)**2 + qw5*(t118 + t61)**2 + qw6*(t119 + t62)**2
-    t129 = qw1*(t114 + t64)**2 + qw2*(t115 + t65)**2 + qw3*(t116 + t66)**2 + qw4*(t117 + t67)**2 + qw5*(t118 + t68)**2 + qw6*(t119 + t69)**2
-    t130 = qw1*(t114 + t71)**2 + qw2*(t115 + t72)**2 + qw3*(t116 + t73)**2 + qw4*(t117 + t74)**2 + qw5*(t118 + t75)**2 + qw6*(t119 + t76)**2
-    t131 = qw1*(t114 + t78)**2 + qw2*(t115 + t79)**2 + qw3*(t116 + t80)**2 + qw4*(t117 + t81)**2 + qw5*(t118 + t82)**2 + qw6*(t119 + t83)**2
-    t132 = qw1*(t114 + t85)**2 + qw2*(t115 + t86)**2 + qw3*(t116 + t87)**2 + qw4*(t117 + t88)**2 + qw5*(t118 + t89)**2 + qw6*(t119 + t90)**2
-    t133 = qw1*(t114 + t92)**2 + qw2*(t115 + t93)**2 + qw3*(t116 + t94)**2 + qw4*(t117 + t95)**2 + qw5*(t118 + t96)**2 + qw6*(t119 + t97)**2
-    t134 = qw1*(t114 + t99)**2 + qw2*(t115 + t100)**2 + qw3*(t116 + t101)**2 + qw4*(t117 + t102)**2 + qw5*(t118 + t103)**2 + qw6*(t119 + t104)**2
-    t135 = qw1*(t114 + t106)**2 + qw2*(t115 + t107)**2 + qw3*(t116 + t108)**2 + qw4*(t117 + t109)**2 + qw5*(t118 + t110)**2 + qw6*(t119 + t111)**2
-    t136 = xp.greater(t7, 0)
-    t137 = xp.where(t136, t0, qn1)
-    t138 = xp.where(t136, t1, qn2)
-    t139 = xp.where(t136, t2, qn3)
-    t140 = xp.where(t136, t3, qn4)
-    t141 = xp.where(t136, t4, qn5)
-    t142 = xp.where(t136, t5, qn6)
-    t143 = xp.where(t136, t120, 0)
-    t144 = xp.greater(t14, 0)
-    t145 = xp.where(t144 & (xp.less(t7, 1) | xp.less(t121, t143)), xp.asarray(1, dtype=dtype), 0)
-    t146 = xp.where(t144, 1, t7)
-    t147 = xp.greater(t145, 0)
-    t148 = xp.where(t147, t8, t137)
-    t149 = xp.where(t147, t9, t138)
-    t150 = xp.where(t147, t10, t139)
-    t151 = xp.where(t147, t11, t140)
-    t152 = xp.where(t147, t12, t141)
-    t153 = xp.where(t147, t13, t142)
-    t154 = xp.where(t147, t121, t143)
-    t155 = xp.greater(t21, 0)
-    t156 = xp.where(t155 & (xp.less(t146, 1) | xp.less(t122, t154)), xp.asarray(1, dtype=dtype), 0)
-    t157 = xp.where(t155, 1, t146)
-    t158 = xp.greater(t156, 0)
-    t159 = xp.where(t158, t15, t148)
-    t160 = xp.where(t158, t16, t149)
-    t161 = xp.where(t158, t17, t150)
-    t162 = xp.where(t158, t18, t151)
-    t163 = xp.where(t158, t19, t152)
-    t164 = xp.where(t158, t20, t153)
-    t165 = xp.where(t158, t122, t154)
-    t166 = xp.greater(t28, 0)
-    t167 = xp.where(t166 & (xp.less(t157, 1) | xp.less(t123, t165)), xp.asarray(1, dtype=dtype), 0)
-    t168 = xp.where(t166, 1, t157)
-    t169 = xp.greater(t167, 0)
-    t170 = xp.where(t169, t22, t159)
-    t171 = xp.where(t169, t23, t160)
-    t172 = xp.where(t169, t24, t161)
-    t173 = xp.where(t169, t25, t162)
-    t174 = xp.where(t169, t26, t163)
-    t175 = xp.where(t169, t27, t164)
-    t176 = xp.where(t169, t123, t165)
-    t177 = xp.greater(t35, 0)
-    t178 = xp.where(t177 & (xp.less(t168, 1) | xp.less(t124, t176)), xp.asarray(1, dtype=dtype), 0)
-    t179 = xp.where(t177, 1, t168)
-    t180 = xp.greater(t178, 0)
-    t181 = xp.where(t180, t29, t170)
-    t182 = xp.where(t180, t30, t171)
-    t183 = xp.where(t180, t31, t172)
-    t184 = xp.where(t180, t32, t173)
-    t185 = xp.where(t180, t33, t174)
-    t186 = xp.where(t180, t34, t175)
-    t187 = xp.where(t180, t124, t176)
-    t188 = xp.greater(t42, 0)
-    t189 = xp.where(t188 & (xp.less(t179, 1) | xp.less(t125, t187)), xp.asarray(1, dtype=dtype), 0)
-    t190 = xp.where(t188, 1, t179)
-    t191 = xp.greater(t189, 0)
-    t192 = xp.where(t191, t36, t181)
-    t193 = xp.where(t191, t37, t182)
-    t194 = xp.where(t191, t38, t183)
-    t195 = xp.where(t191, t39, t184)
-    t196 = xp.where(t191, t40, t185)
-    t197 = xp.where(t191, t41, t186)
-    t198 = xp.where(t191, t125, t187)
-    t199 = xp.greater(t49, 0)
-    t200 = xp.where(t199 & (xp.less(t190, 1) | xp.less(t126, t198)), xp.asarray(1, dtype=dtype), 0)
-    t201 = xp.where(t199, 1, t190)
-    t202 = xp.greater(t200, 0)
-    t203 = xp.where(t202, t43, t192)
-    t204 = xp.where(t202, t44, t193)
-    t205 = xp.where(t202, t45, t194)
-    t206 = xp.where(t202, t46, t195)
-    t207 = xp.where(t202, t47, t196)
-    t208 = xp.where(t202, t48, t197)
-    t209 = xp.where(t202, t126, t198)
-    t210 = xp.greater(t56, 0)
-    t211 = xp.where(t210 & (xp.less(t201, 1) | xp.less(t127, t209)), xp.asarray(1, dtype=dtype), 0)
-    t212 = xp.where(t210, 1, t201)
-    t213 = xp.greater(t211, 0)
-    t214 = xp.where(t213, t50, t203)
-    t215 = xp.where(t213, t51, t204)
-    t216 = xp.where(t213, t52, t205)
-    t217 = xp.where(t213, t53, t206)
-    t218 = xp.where(t213, t54, t207)
-    t219 = xp.where(t213, t55, t208)
-    t220 = xp.where(t213, t127, t209)
-    t221 = xp.greater(t63, 0)
-    t222 = xp.where(t221 & (xp.less(t212, 1) | xp.less(t128, t220)), xp.asarray(1, dtype=dtype), 0)
-    t223 = xp.where(t221, 1, t212)
-    t224 = xp.greater(t222, 0)
-    t225 = xp.where(t224, t57, t214)
-    t226 = xp.where(t224, t58, t215)
-    t227 = xp.where(t224, t59, t216)
-    t228 = xp.where(t224, t60, t217)
-    t229 = xp.where(t224, t61, t218)
-    t230 = xp.where(t224, t62, t219)
-    t231 = xp.where(t224, t128, t220)
-    t232 = xp.greater(t70, 0)
-    t233 = xp.where(t232 & (xp.less(t223, 1) | xp.less(t129, t231)), xp.asarray(1, dtype=dtype), 0)
-    t234 = xp.where(t232, 1, t223)
-    t235 = xp.greater(t233, 0)
-    t236 = xp.where(t235, t64, t225)
-    t237 = xp.where(t235, t65, t226)
-    t238 = xp.where(t235, t66, t227)
-    t239 = xp.where(t235, t67, t228)
-    t240 = xp.where(t235, t68, t229)
-    t241 = xp.where(t235, t69, t230)
-    t242 = xp.where(t235, t129, t231)
-    t243 = xp.greater(t77, 0)
-    t244 = xp.where(t243 & (xp.less(t234, 1) | xp.less(t130, t242)), xp.asarray(1, dtype=dtype), 0)
-    t245 = xp.where(t243, 1, t234)
-    t246 = xp.greater(t244, 0)
-    t247 = xp.where(t246, t71, t236)
-    t248 = xp.where(t246, t72, t237)
-    t249 = xp.where(t246, t73, t238)
-    t250 = xp.where(t246, t74, t239)
-    t251 = xp.where(t246, t75, t240)
-    t252 = xp.where(t246, t76, t241)
-    t253 = xp.where(t246, t130, t242)
-    t254 = xp.greater(t84, 0)
-    t255 = xp.where(t254 & (xp.less(t245, 1) | xp.less(t131, t253)), xp.asarray(1, dtype=dtype), 0)
-    t256 = xp.where(t254, 1, t245)
-    t257 = xp.greater(t255, 0)
-    t258 = xp.where(t257, t78, t247)
-    t259 = xp.where(t257, t79, t248)
-    t260 = xp.where(t257, t80, t249)
-    t261 = xp.where(t257, t81, t250)
-    t262 = xp.where(t257, t82, t251)
-    t263 = xp.where(t257, t83, t252)
-    t264 = xp.where(t257, t131, t253)
-    t265 = xp.greater(t91, 0)
-    t266 = xp.where(t265 & (xp.less(t256, 1) | xp.less(t132, t264)), xp.asarray(1, dtype=dtype), 0)
-    t267 = xp.where(t265, 1, t256)
-    t268 = xp.greater(t266, 0)
-    t269 = xp.where(t268, t85, t258)
-    t270 = xp.where(t268, t86, t259)
-    t271 = xp.where(t268, t87, t260)
-    t272 = xp.where(t268, t88, t261)
-    t273 = xp.where(t268, t89, t262)
-    t274 = xp.where(t268, t90, t263)
-    t275 = xp.where(t268, t132, t264)
-    t276 = xp.greater(t98, 0)
-    t277 = xp.where(t276 & (xp.less(t267, 1) | xp.less(t133, t275)), xp.asarray(1, dtype=dtype), 0)
-    t278 = xp.where(t276, 1, t267)
-    t279 = xp.greater(t277, 0)
-    t280 = xp.where(t279, t92, t269)
-    t281 = xp.where(t279, t93, t270)
-    t282 = xp.where(t279, t94, t271)
-    t283 = xp.where(t279, t95, t272)
-    t284 = xp.where(t279, t96, t273)
-    t285 = xp.where(t279, t97, t274)
-    t286 = xp.where(t279, t133, t275)
-    t287 = xp.greater(t105, 0)
-    t288 = xp.where(t287 & (xp.less(t278, 1) | xp.less(t134, t286)), xp.asarray(1, dtype=dtype), 0)
-    t289 = xp.where(t287, 1, t278)
-    t290 = xp.greater(t288, 0)
-    t291 = xp.where(t290, t99, t280)
-    t292 = xp.where(t290, t100, t281)
-    t293 = xp.where(t290, t101, t282)
-    t294 = xp.where(t290, t102, t283)
-    t295 = xp.where(t290, t103, t284)
-    t296 = xp.where(t290, t104, t285)
-    t297 = xp.where(t290, t134, t286)
-    t298 = xp.greater(t112, 0)
-    t299 = xp.where(t298 & (xp.less(t289, 1) | xp.less(t135, t297)), xp.asarray(1, dtype=dtype), 0)
-    t300 = xp.where(t298, 1, t289)
-    t301 = xp.greater(t299, 0)
-    t302 = xp.where(t301, t106, t291)
-    t303 = xp.where(t301, t107, t292)
-    t304 = xp.where(t301, t108, t293)
-    t305 = xp.where(t301, t109, t294)
-    t306 = xp.where(t301, t110, t295)
-    t307 = xp.where(t301, t111, t296)
-    t308 = xp.greater(t300, 0)
-    t309 = xp.isfinite(t113)
-    t310 = t308 & t309
+    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
+    t1 = _nearer_branch(xp, 1, (qb0_0, qb0_1, qb0_2, qb0_3, qb0_4, qb0_5, xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, qn1, qn2, qn3, qn4, qn5, qn6, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
+    t2 = _nearer_branch(xp, 1, (qb1_0, qb1_1, qb1_2, qb1_3, qb1_4, qb1_5, xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t1[0], t1[1], t1[2], t1[3], t1[4], t1[5], t1[6], t1[7],))
+    t3 = _nearer_branch(xp, 1, (qb2_0, qb2_1, qb2_2, qb2_3, qb2_4, qb2_5, xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t2[0], t2[1], t2[2], t2[3], t2[4], t2[5], t2[6], t2[7],))
+    t4 = _nearer_branch(xp, 1, (qb3_0, qb3_1, qb3_2, qb3_3, qb3_4, qb3_5, xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t3[0], t3[1], t3[2], t3[3], t3[4], t3[5], t3[6], t3[7],))
+    t5 = _nearer_branch(xp, 1, (qb4_0, qb4_1, qb4_2, qb4_3, qb4_4, qb4_5, xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t4[0], t4[1], t4[2], t4[3], t4[4], t4[5], t4[6], t4[7],))
+    t6 = _nearer_branch(xp, 1, (qb5_0, qb5_1, qb5_2, qb5_3, qb5_4, qb5_5, xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t5[0], t5[1], t5[2], t5[3], t5[4], t5[5], t5[6], t5[7],))
+    t7 = _nearer_branch(xp, 1, (qb6_0, qb6_1, qb6_2, qb6_3, qb6_4, qb6_5, xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t6[0], t6[1], t6[2], t6[3], t6[4], t6[5], t6[6], t6[7],))
+    t8 = _nearer_branch(xp, 1, (qb7_0, qb7_1, qb7_2, qb7_3, qb7_4, qb7_5, xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t7[0], t7[1], t7[2], t7[3], t7[4], t7[5], t7[6], t7[7],))
+    t9 = _nearer_branch(xp, 1, (qb8_0, qb8_1, qb8_2, qb8_3, qb8_4, qb8_5, xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t8[0], t8[1], t8[2], t8[3], t8[4], t8[5], t8[6], t8[7],))
+    t10 = _nearer_branch(xp, 1, (qb9_0, qb9_1, qb9_2, qb9_3, qb9_4, qb9_5, xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t9[0], t9[1], t9[2], t9[3], t9[4], t9[5], t9[6], t9[7],))
+    t11 = _nearer_branch(xp, 1, (qb10_0, qb10_1, qb10_2, qb10_3, qb10_4, qb10_5, xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t10[0], t10[1], t10[2], t10[3], t10[4], t10[5], t10[6], t10[7],))
+    t12 = _nearer_branch(xp, 1, (qb11_0, qb11_1, qb11_2, qb11_3, qb11_4, qb11_5, xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t11[0], t11[1], t11[2], t11[3], t11[4], t11[5], t11[6], t11[7],))
+    t13 = _nearer_branch(xp, 1, (qb12_0, qb12_1, qb12_2, qb12_3, qb12_4, qb12_5, xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t12[0], t12[1], t12[2], t12[3], t12[4], t12[5], t12[6], t12[7],))
+    t14 = _nearer_branch(xp, 1, (qb13_0, qb13_1, qb13_2, qb13_3, qb13_4, qb13_5, xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t13[0], t13[1], t13[2], t13[3], t13[4], t13[5], t13[6], t13[7],))
+    t15 = _nearer_branch(xp, 1, (qb14_0, qb14_1, qb14_2, qb14_3, qb14_4, qb14_5, xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t14[0], t14[1], t14[2], t14[3], t14[4], t14[5], t14[6], t14[7],))
+    t16 = _nearer_branch(xp, 1, (qb15_0, qb15_1, qb15_2, qb15_3, qb15_4, qb15_5, xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t15[0], t15[1], t15[2], t15[3], t15[4], t15[5], t15[6], t15[7],))
+    t17 = xp.greater(t16[7], 0)
+    t18 = xp.isfinite(t0)
+    t19 = t17 & t18
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t310, t302, qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t310, t303, qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t310, t304, qn3), batch),  # 2
-        xp.broadcast_to(xp.where(t310, t305, qn4), batch),  # 3
-        xp.broadcast_to(xp.where(t310, t306, qn5), batch),  # 4
-        xp.broadcast_to(xp.where(t310, t307, qn6), batch),  # 5
+        xp.broadcast_to(xp.where(t19, t16[0], qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t19, t16[1], qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t19, t16[2], qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t19, t16[3], qn4), batch),  # 3
+        xp.broadcast_to(xp.where(t19, t16[4], qn5), batch),  # 4
+        xp.broadcast_to(xp.where(t19, t16[5], qn6), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t309), 2, xp.where(t308, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t18), 2, xp.where(t17, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

@@ -82,6 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -335,6 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi6_rows(xp, count, state):
     """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2 + w4**2 + w5**2
@@ -896,6 +898,231 @@ def _jacobi6_rows(xp, count, state):
             t489,
             t493,
             t497,
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _symmetric_solve6(xp, count, state):
+    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w1**2
+        t1 = w2**2
+        t2 = w3**2
+        t3 = w4**2
+        t4 = w5**2
+        t5 = w0**2
+        t6 = xp.sqrt(t5 + 2*t0 + 2*t1 + 2*w7**2 + 2*t2 + 2*w8**2 + 2*w12**2 + 2*t3 + 2*w9**2 + 2*w13**2 + 2*w16**2 + 2*t4 + 2*w10**2 + 2*w14**2 + 2*w17**2 + 2*w19**2 + w6**2 + w11**2 + w15**2 + w18**2 + w20**2)
+        t7 = xp.sqrt(t0 + t1 + t2 + t3 + t4 + t5)
+        t8 = t7*xp.where(xp.greater_equal(w0, 0), xp.asarray(1, dtype=dtype), -1)
+        t9 = xp.greater(t7, 0)
+        t10 = xp.where(t9, 1/(w0 + t8), 0)
+        t11 = xp.where(t9, 1 + xp.abs(w0)/t7, 0)
+        t12 = w1*t10
+        t13 = w2*t10
+        t14 = w3*t10
+        t15 = w4*t10
+        t16 = w5*t10
+        t17 = t11*(w1 + t12*w6 + t13*w7 + t14*w8 + t15*w9 + t16*w10)
+        t18 = -t17 + w1
+        t19 = w6 - t12*t17
+        t20 = w7 - t13*t17
+        t21 = w8 - t14*t17
+        t22 = w9 - t15*t17
+        t23 = w10 - t16*t17
+        t24 = t11*(w2 + t12*w7 + t13*w11 + t14*w12 + t15*w13 + t16*w14)
+        t25 = -t24 + w2
+        t26 = w7 - t12*t24
+        t27 = w11 - t13*t24
+        t28 = w12 - t14*t24
+        t29 = w13 - t15*t24
+        t30 = w14 - t16*t24
+        t31 = t11*(w3 + t12*w8 + t13*w12 + t14*w15 + t15*w16 + t16*w17)
+        t32 = -t31 + w3
+        t33 = w8 - t12*t31
+        t34 = w12 - t13*t31
+        t35 = w15 - t14*t31
+        t36 = w16 - t15*t31
+        t37 = w17 - t16*t31
+        t38 = t11*(w4 + t12*w9 + t13*w13 + t14*w16 + t15*w18 + t16*w19)
+        t39 = -t38 + w4
+        t40 = w9 - t12*t38
+        t41 = w13 - t13*t38
+        t42 = w16 - t14*t38
+        t43 = w18 - t15*t38
+        t44 = w19 - t16*t38
+        t45 = t11*(w5 + t12*w10 + t13*w14 + t14*w17 + t15*w19 + t16*w20)
+        t46 = -t45 + w5
+        t47 = w10 - t12*t45
+        t48 = w14 - t13*t45
+        t49 = w17 - t14*t45
+        t50 = w19 - t15*t45
+        t51 = w20 - t16*t45
+        t52 = t11*(w21 + t12*w22 + t13*w23 + t14*w24 + t15*w25 + t16*w26)
+        t53 = -t52 + w21
+        t54 = w22 - t12*t52
+        t55 = w23 - t13*t52
+        t56 = w24 - t14*t52
+        t57 = w25 - t15*t52
+        t58 = w26 - t16*t52
+        t59 = xp.sqrt(t19**2 + t20**2 + t21**2 + t22**2 + t23**2)
+        t60 = t59*xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)
+        t61 = xp.greater(t59, 0)
+        t62 = xp.where(t61, 1/(t19 + t60), 0)
+        t63 = xp.where(t61, 1 + xp.abs(t19)/t59, 0)
+        t64 = t20*t62
+        t65 = t21*t62
+        t66 = t22*t62
+        t67 = t23*t62
+        t68 = t63*(t26 + t64*t27 + t65*t28 + t66*t29 + t67*t30)
+        t69 = -t68 + t26
+        t70 = t27 - t64*t68
+        t71 = t28 - t65*t68
+        t72 = t29 - t66*t68
+        t73 = t30 - t67*t68
+        t74 = t63*(t33 + t64*t34 + t65*t35 + t66*t36 + t67*t37)
+        t75 = -t74 + t33
+        t76 = t34 - t64*t74
+        t77 = t35 - t65*t74
+        t78 = t36 - t66*t74
+        t79 = t37 - t67*t74
+        t80 = t63*(t40 + t64*t41 + t65*t42 + t66*t43 + t67*t44)
+        t81 = -t80 + t40
+        t82 = t41 - t64*t80
+        t83 = t42 - t65*t80
+        t84 = t43 - t66*t80
+        t85 = t44 - t67*t80
+        t86 = t63*(t47 + t64*t48 + t65*t49 + t66*t50 + t67*t51)
+        t87 = -t86 + t47
+        t88 = t48 - t64*t86
+        t89 = t49 - t65*t86
+        t90 = t50 - t66*t86
+        t91 = t51 - t67*t86
+        t92 = t63*(t54 + t64*t55 + t65*t56 + t66*t57 + t67*t58)
+        t93 = -t92 + t54
+        t94 = t55 - t64*t92
+        t95 = t56 - t65*t92
+        t96 = t57 - t66*t92
+        t97 = t58 - t67*t92
+        t98 = xp.sqrt(t70**2 + t71**2 + t72**2 + t73**2)
+        t99 = t98*xp.where(xp.greater_equal(t70, 0), xp.asarray(1, dtype=dtype), -1)
+        t100 = xp.greater(t98, 0)
+        t101 = xp.where(t100, 1/(t70 + t99), 0)
+        t102 = xp.where(t100, 1 + xp.abs(t70)/t98, 0)
+        t103 = t71*t101
+        t104 = t72*t101
+        t105 = t73*t101
+        t106 = t102*(t76 + t103*t77 + t104*t78 + t105*t79)
+        t107 = -t106 + t76
+        t108 = t77 - t103*t106
+        t109 = t78 - t104*t106
+        t110 = t79 - t105*t106
+        t111 = t102*(t82 + t103*t83 + t104*t84 + t105*t85)
+        t112 = -t111 + t82
+        t113 = t83 - t103*t111
+        t114 = t84 - t104*t111
+        t115 = t85 - t105*t111
+        t116 = t102*(t88 + t103*t89 + t104*t90 + t105*t91)
+        t117 = -t116 + t88
+        t118 = t89 - t103*t116
+        t119 = t90 - t104*t116
+        t120 = t91 - t105*t116
+        t121 = t102*(t94 + t103*t95 + t104*t96 + t105*t97)
+        t122 = -t121 + t94
+        t123 = t95 - t103*t121
+        t124 = t96 - t104*t121
+        t125 = t97 - t105*t121
+        t126 = xp.sqrt(t108**2 + t109**2 + t110**2)
+        t127 = t126*xp.where(xp.greater_equal(t108, 0), xp.asarray(1, dtype=dtype), -1)
+        t128 = xp.greater(t126, 0)
+        t129 = xp.where(t128, 1/(t108 + t127), 0)
+        t130 = xp.where(t128, 1 + xp.abs(t108)/t126, 0)
+        t131 = t109*t129
+        t132 = t110*t129
+        t133 = t130*(t113 + t131*t114 + t132*t115)
+        t134 = -t133 + t113
+        t135 = t114 - t131*t133
+        t136 = t115 - t132*t133
+        t137 = t130*(t118 + t131*t119 + t132*t120)
+        t138 = -t137 + t118
+        t139 = t119 - t131*t137
+        t140 = t120 - t132*t137
+        t141 = t130*(t123 + t131*t124 + t132*t125)
+        t142 = -t141 + t123
+        t143 = t124 - t131*t141
+        t144 = t125 - t132*t141
+        t145 = xp.sqrt(t135**2 + t136**2)
+        t146 = t145*xp.where(xp.greater_equal(t135, 0), xp.asarray(1, dtype=dtype), -1)
+        t147 = xp.greater(t145, 0)
+        t148 = xp.where(t147, 1/(t135 + t146), 0)
+        t149 = xp.where(t147, 1 + xp.abs(t135)/t145, 0)
+        t150 = t136*t148
+        t151 = t149*(t139 + t150*t140)
+        t152 = -t151 + t139
+        t153 = t140 - t150*t151
+        t154 = t149*(t143 + t150*t144)
+        t155 = -t154 + t143
+        t156 = t144 - t150*t154
+        t157 = xp.abs(t153)
+        t158 = t157*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
+        t159 = xp.where(xp.greater(t157, 0), xp.asarray(2, dtype=dtype), 0)
+        t160 = t156 - t156*t159
+        t161 = xp.where(xp.not_equal(t158, 0), -t160/t158, 0)
+        t162 = xp.where(xp.not_equal(t146, 0), -(t155 - t152*t161)/t146, 0)
+        t163 = xp.where(xp.not_equal(t127, 0), -(-(t134*t162 + t138*t161) + t142)/t127, 0)
+        t164 = xp.where(xp.not_equal(t99, 0), -(-(t107*t163 + t112*t162 + t117*t161) + t122)/t99, 0)
+        t165 = xp.where(xp.not_equal(t60, 0), -(-(t69*t164 + t75*t163 + t81*t162 + t87*t161) + t93)/t60, 0)
+        t166 = xp.where(xp.not_equal(t8, 0), -(-(t18*t165 + t25*t164 + t32*t163 + t39*t162 + t46*t161) + t53)/t8, 0)
+        t167 = 1e-12*t6
+        state = (
+            t166,
+            t165,
+            t164,
+            t163,
+            t162,
+            t161,
+            xp.where(xp.less_equal(t7, t167) | xp.less_equal(t59, t167) | xp.less_equal(t98, t167) | xp.less_equal(t126, t167) | xp.less_equal(t145, t167) | xp.less_equal(t157, t167), xp.asarray(1, dtype=dtype), 0),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _nearer_branch(xp, count, state):
+    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 72 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w7))
+        t1 = w1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w1 + w8))
+        t2 = w2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w2 + w9))
+        t3 = w3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w3 + w10))
+        t4 = w4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w4 + w11))
+        t5 = w5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w5 + w12))
+        t6 = w13*(-w7 + t0)**2 + w14*(-w8 + t1)**2 + w15*(-w9 + t2)**2 + w16*(-w10 + t3)**2 + w17*(-w11 + t4)**2 + w18*(-w12 + t5)**2
+        t7 = xp.greater(w6, 0)
+        t8 = xp.where(t7 & (xp.less(w26, 1) | xp.less(t6, w25)), xp.asarray(1, dtype=dtype), 0)
+        t9 = xp.where(t7, 1, w26)
+        t10 = xp.greater(t8, 0)
+        t11 = xp.where(t10, t0, w19)
+        t12 = xp.where(t10, t1, w20)
+        t13 = xp.where(t10, t2, w21)
+        t14 = xp.where(t10, t3, w22)
+        t15 = xp.where(t10, t4, w23)
+        t16 = xp.where(t10, t5, w24)
+        t17 = xp.where(t10, t6, w25)
+        state = (
+            t11,
+            t12,
+            t13,
+            t14,
+            t15,
+            t16,
+            t17,
+            t9,
         )
     return state
 
@@ -4010,7 +4237,7 @@ def condition_number(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1426 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1432 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -4134,361 +4361,194 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t96 = s1*t37
     t97 = t45*t95 - t44*t96 + t49*t38 + t50*t39 + t51*t40
     t98 = -t96 + t95 + t12*t38 + t19*t39 + t27*t40
-    t99 = t84**2
-    t100 = t88**2
-    t101 = t93**2
-    t102 = t70**2
-    t103 = t59**2
-    t104 = damping**2
-    t105 = t104 + t79
-    t106 = t105**2
-    t107 = xp.sqrt(t99 + t100 + t101 + t102 + t103 + t106)
-    t108 = t107*xp.where(xp.greater_equal(t105, 0), xp.asarray(1, dtype=dtype), -1)
-    t109 = t104 + t82
-    t110 = t75 + t104
-    t111 = t68 + t104
-    t112 = t71 + t104
-    t113 = t104 + t73
-    t114 = xp.sqrt(2*t99 + 2*t100 + 2*t97**2 + 2*t101 + 2*t67**2 + 2*t98**2 + 2*t102 + 2*t94**2 + 2*t89**2 + 2*t85**2 + 2*t103 + 2*t60**2 + 2*t52**2 + 2*t53**2 + 2*t54**2 + t106 + t109**2 + t110**2 + t111**2 + t112**2 + t113**2)
-    t115 = xp.greater(t107, 0)
-    t116 = xp.where(t115, 1/(t105 + t108), 0)
-    t117 = xp.where(t115, 1 + xp.abs(t105)/t107, 0)
-    t118 = t84*t116
-    t119 = t88*t116
-    t120 = t93*t116
-    t121 = t70*t116
-    t122 = t59*t116
-    t123 = -t117*(t84 + t109*t118 + t119*t97 + t120*t67 + t121*t94 + t122*t60)
-    t124 = t84 + t123
-    t125 = t109 + t118*t123
-    t126 = t97 + t119*t123
-    t127 = t67 + t120*t123
-    t128 = t94 + t121*t123
-    t129 = t60 + t122*t123
-    t130 = -t117*(t88 + t118*t97 + t110*t119 + t120*t98 + t121*t89 + t122*t52)
-    t131 = t88 + t130
-    t132 = t97 + t118*t130
-    t133 = t110 + t119*t130
-    t134 = t98 + t120*t130
-    t135 = t89 + t121*t130
-    t136 = t52 + t122*t130
-    t137 = t117*(t93 + t118*t67 + t119*t98 + t111*t120 + t121*t85 + t122*t53)
-    t138 = -t137 + t93
-    t139 = -t67 + t118*t137
-    t140 = -t98 + t119*t137
-    t141 = t111 - t120*t137
-    t142 = t85 - t121*t137
-    t143 = -t53 + t122*t137
-    t144 = t117*(t70 + t118*t94 + t119*t89 + t120*t85 + t112*t121 + t122*t54)
-    t145 = -t144 + t70
-    t146 = -t94 + t118*t144
-    t147 = -t89 + t119*t144
-    t148 = t85 - t120*t144
-    t149 = t112 - t121*t144
-    t150 = -t54 + t122*t144
-    t151 = -t117*(t59 + t118*t60 + t119*t52 + t120*t53 + t121*t54 + t113*t122)
-    t152 = t59 + t151
-    t153 = t60 + t118*t151
-    t154 = t52 + t119*t151
-    t155 = t53 + t120*t151
-    t156 = t54 + t121*t151
-    t157 = t113 + t122*t151
-    t158 = t117*(mu_dot0 - t118*mu_dot1 - t119*mu_dot2 + t120*mu_dot3 + t121*mu_dot4 - t122*mu_dot5)
-    t159 = -t158 + mu_dot0
-    t160 = mu_dot1 + t118*t158
-    t161 = mu_dot2 + t119*t158
-    t162 = mu_dot3 - t120*t158
-    t163 = mu_dot4 - t121*t158
-    t164 = mu_dot5 + t122*t158
-    t165 = xp.sqrt(t125**2 + t126**2 + t127**2 + t128**2 + t129**2)
-    t166 = t165*xp.where(xp.greater_equal(t125, 0), xp.asarray(1, dtype=dtype), -1)
-    t167 = xp.greater(t165, 0)
-    t168 = xp.where(t167, 1/(t125 + t166), 0)
-    t169 = xp.where(t167, 1 + xp.abs(t125)/t165, 0)
-    t170 = t126*t168
-    t171 = t127*t168
-    t172 = t128*t168
-    t173 = t129*t168
-    t174 = t169*(t132 + t170*t133 + t171*t134 + t172*t135 + t173*t136)
-    t175 = -t174 + t132
-    t176 = t133 - t170*t174
-    t177 = -t134 + t171*t174
-    t178 = -t135 + t172*t174
-    t179 = t136 - t173*t174
-    t180 = t169*(t139 + t170*t140 - t171*t141 - t172*t142 + t173*t143)
-    t181 = -t180 + t139
-    t182 = t140 - t170*t180
-    t183 = t141 + t171*t180
-    t184 = t142 + t172*t180
-    t185 = t143 - t173*t180
-    t186 = t169*(t146 + t170*t147 - t171*t148 - t172*t149 + t173*t150)
-    t187 = -t186 + t146
-    t188 = t147 - t170*t186
-    t189 = t148 + t171*t186
-    t190 = t149 + t172*t186
-    t191 = t150 - t173*t186
-    t192 = t169*(t153 + t170*t154 + t171*t155 + t172*t156 + t173*t157)
-    t193 = -t192 + t153
-    t194 = t154 - t170*t192
-    t195 = -t155 + t171*t192
-    t196 = -t156 + t172*t192
-    t197 = t157 - t173*t192
-    t198 = t169*(t160 + t170*t161 - t171*t162 - t172*t163 + t173*t164)
-    t199 = -t198 + t160
-    t200 = t161 - t170*t198
-    t201 = t162 + t171*t198
-    t202 = t163 + t172*t198
-    t203 = t164 - t173*t198
-    t204 = xp.sqrt(t176**2 + t177**2 + t178**2 + t179**2)
-    t205 = t204*xp.where(xp.greater_equal(t176, 0), xp.asarray(1, dtype=dtype), -1)
-    t206 = xp.greater(t204, 0)
-    t207 = xp.where(t206, 1/(t176 + t205), 0)
-    t208 = xp.where(t206, 1 + xp.abs(t176)/t204, 0)
-    t209 = t177*t207
-    t210 = t178*t207
-    t211 = t179*t207
-    t212 = t208*(t182 + t209*t183 + t210*t184 + t211*t185)
-    t213 = -t212 + t182
-    t214 = t183 - t209*t212
-    t215 = t184 - t210*t212
-    t216 = t185 - t211*t212
-    t217 = t208*(t188 + t209*t189 + t210*t190 + t211*t191)
-    t218 = -t217 + t188
-    t219 = t189 - t209*t217
-    t220 = t190 - t210*t217
-    t221 = t191 - t211*t217
-    t222 = t208*(t194 + t209*t195 + t210*t196 + t211*t197)
-    t223 = -t222 + t194
-    t224 = t195 - t209*t222
-    t225 = t196 - t210*t222
-    t226 = t197 - t211*t222
-    t227 = t208*(t200 + t209*t201 + t210*t202 + t211*t203)
-    t228 = -t227 + t200
-    t229 = t201 - t209*t227
-    t230 = t202 - t210*t227
-    t231 = t203 - t211*t227
-    t232 = xp.sqrt(t214**2 + t215**2 + t216**2)
-    t233 = t232*xp.where(xp.greater_equal(t214, 0), xp.asarray(1, dtype=dtype), -1)
-    t234 = xp.greater(t232, 0)
-    t235 = xp.where(t234, 1/(t214 + t233), 0)
-    t236 = xp.where(t234, 1 + xp.abs(t214)/t232, 0)
-    t237 = t215*t235
-    t238 = t216*t235
-    t239 = t236*(t219 + t237*t220 + t238*t221)
-    t240 = -t239 + t219
-    t241 = t220 - t237*t239
-    t242 = t221 - t238*t239
-    t243 = t236*(t224 + t237*t225 + t238*t226)
-    t244 = -t243 + t224
-    t245 = t225 - t237*t243
-    t246 = t226 - t238*t243
-    t247 = t236*(t229 + t237*t230 + t238*t231)
-    t248 = -t247 + t229
-    t249 = t230 - t237*t247
-    t250 = t231 - t238*t247
-    t251 = xp.sqrt(t241**2 + t242**2)
-    t252 = t251*xp.where(xp.greater_equal(t241, 0), xp.asarray(1, dtype=dtype), -1)
-    t253 = xp.greater(t251, 0)
-    t254 = xp.where(t253, 1/(t241 + t252), 0)
-    t255 = xp.where(t253, 1 + xp.abs(t241)/t251, 0)
-    t256 = t242*t254
-    t257 = t255*(t245 + t256*t246)
-    t258 = -t257 + t245
-    t259 = t246 - t256*t257
-    t260 = t255*(t249 + t256*t250)
-    t261 = -t260 + t249
-    t262 = t250 - t256*t260
-    t263 = xp.abs(t259)
-    t264 = t263*xp.where(xp.greater_equal(t259, 0), xp.asarray(1, dtype=dtype), -1)
-    t265 = xp.where(xp.greater(t263, 0), xp.asarray(2, dtype=dtype), 0)
-    t266 = t262 - t262*t265
-    t267 = xp.where(xp.not_equal(t264, 0), -t266/t264, 0)
-    t268 = xp.where(xp.not_equal(t252, 0), -(t261 - t258*t267)/t252, 0)
-    t269 = xp.where(xp.not_equal(t233, 0), -(-(t240*t268 + t244*t267) + t248)/t233, 0)
-    t270 = xp.where(xp.not_equal(t205, 0), -(-(t213*t269 + t218*t268 + t223*t267) + t228)/t205, 0)
-    t271 = xp.where(xp.not_equal(t166, 0), -(-(t175*t270 + t181*t269 + t187*t268 + t193*t267) + t199)/t166, 0)
-    t272 = xp.where(xp.not_equal(t108, 0), -(t159 + t124*t271 + t131*t270 + t152*t267 - t138*t269 - t145*t268)/t108, 0)
-    t273 = t267 + t56*t271 - t57*t272
-    t274 = -t46*t272 + t49*t271 + t38*t270 - t12*t269 - t13*t268 + t4*t267
-    t275 = -t47*t272 + t50*t271 + t39*t270 - t19*t269 - t21*t268 + t25*t267
-    t276 = -t48*t272 + t51*t271 + t40*t270 - t27*t269 - t32*t268 + t41*t267
-    t277 = s1*t45
-    t278 = s1*t269 + c1*t268
-    t279 = t278 - t58*t270 + t90*t272 - t277*t271
-    t280 = s1*t44
-    t281 = t278 + t37*t270 + t91*t272 - t280*t271
-    t282 = xp.greater(t64, 0)
-    t283 = xp.where(t282, 1/(t57 + t65), 0)
-    t284 = xp.where(t282, 1 + xp.abs(t57)/t64, 0)
-    t285 = t56*t283
-    t286 = -t284*(t90 + t277*t285)
-    t287 = t90 + t286
-    t288 = t277 + t285*t286
-    t289 = t284*(t91 + t280*t285)
-    t290 = -t289 + t91
-    t291 = -t284*(t46 + t4*t283 + t49*t285)
-    t292 = t46 + t291
-    t293 = -t284*(t47 + t50*t285 + t25*t283)
-    t294 = t47 + t293
-    t295 = -t284*(t48 + t51*t285 + t41*t283)
-    t296 = t48 + t295
-    t297 = -t284*(-mu_dot0 + mu_dot5*t283 + t285*mu_dot1)
-    t298 = -t297 + mu_dot0
-    t299 = -t280
-    t300 = t283*t289
-    t301 = t299 + t56*t300
-    t302 = t283*t291
-    t303 = t49 + t56*t302
-    t304 = t4 + t302
-    t305 = t283*t293
-    t306 = t50 + t56*t305
-    t307 = t25 + t305
-    t308 = t283*t295
-    t309 = t51 + t56*t308
-    t310 = t41 + t308
-    t311 = t283*t297
-    t312 = mu_dot1 + t56*t311
-    t313 = t311 + mu_dot5
-    t314 = t283**2
-    t315 = xp.sqrt(t66 + t69 + t74 + t288**2 + t314*t286**2)
-    t316 = t315*xp.where(xp.greater_equal(t288, 0), xp.asarray(1, dtype=dtype), -1)
-    t317 = xp.greater(t315, 0)
-    t318 = xp.where(t317, 1/(t288 + t316), 0)
-    t319 = xp.where(t317, 1 + xp.abs(t288)/t315, 0)
-    t320 = t58*t318
-    t321 = t286*t318
-    t322 = t319*(t301 + t37*t320 - t66*t318 - t69*t318 + t314*t321*t289)
-    t323 = -t322 + t301
-    t324 = t37 - t320*t322
-    t325 = t318*t322
-    t326 = s1 + s1*t325
-    t327 = c1 + c1*t325
-    t328 = s1*t318
-    t329 = c1*t318
-    t330 = t321*t283
-    t331 = t300 - t330*t322
-    t332 = t319*(t303 + t38*t320 + t12*t328 + t13*t329 + t330*t304)
-    t333 = -t332 + t303
-    t334 = t38 - t320*t332
-    t335 = t304 - t330*t332
-    t336 = t319*(t306 + t39*t320 + t330*t307 + t19*t328 + t21*t329)
-    t337 = -t336 + t306
-    t338 = t39 - t320*t336
-    t339 = t307 - t330*t336
-    t340 = t319*(t309 + t40*t320 + t330*t310 + t27*t328 + t32*t329)
-    t341 = -t340 + t309
-    t342 = t40 - t320*t340
-    t343 = t310 - t330*t340
-    t344 = t319*(t312 + t320*mu_dot2 - t328*mu_dot3 - t329*mu_dot4 + t330*t313)
-    t345 = -t344 + t312
-    t346 = mu_dot2 - t320*t344
-    t347 = mu_dot3 + t328*t344
-    t348 = mu_dot4 + t329*t344
-    t349 = t313 - t330*t344
-    t350 = xp.sqrt(t324**2 + t326**2 + t327**2 + t331**2)
-    t351 = t350*xp.where(xp.greater_equal(t324, 0), xp.asarray(1, dtype=dtype), -1)
-    t352 = -t12
-    t353 = t352 + t328*t332
-    t354 = -t13
-    t355 = t354 + t329*t332
-    t356 = -t19
-    t357 = t356 + t328*t336
-    t358 = -t21
-    t359 = t358 + t329*t336
-    t360 = -t27
-    t361 = t360 + t328*t340
-    t362 = -t32
-    t363 = t362 + t329*t340
-    t364 = -1 - t46 - t47 - t48 - t56 - t90 + q1 + q2 + q3 + t4 + q4 + q5 + q6 + t57 + t25 + t41 + t91 + t49 + t50 + t51 + t58 + t37 + t38 + t39 + t40 + t277 + t299 + t352 + t354 + t356 + t358 + t360 + t362 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t365 = xp.greater(t350, 0)
-    t366 = xp.where(t365, 1/(t324 + t351), 0)
-    t367 = xp.where(t365, 1 + xp.abs(t324)/t350, 0)
-    t368 = t326*t366
-    t369 = t327*t366
-    t370 = t331*t366
-    t371 = t367*(t334 + t368*t353 + t369*t355 + t370*t335)
-    t372 = -t371 + t334
-    t373 = t353 - t368*t371
-    t374 = t355 - t369*t371
-    t375 = t335 - t370*t371
-    t376 = t367*(t338 + t368*t357 + t369*t359 + t370*t339)
-    t377 = -t376 + t338
-    t378 = t357 - t368*t376
-    t379 = t359 - t369*t376
-    t380 = t339 - t370*t376
-    t381 = t367*(t342 + t368*t361 + t369*t363 + t370*t343)
-    t382 = -t381 + t342
-    t383 = t361 - t368*t381
-    t384 = t363 - t369*t381
-    t385 = t343 - t370*t381
-    t386 = t367*(t346 + t368*t347 + t369*t348 + t370*t349)
-    t387 = -t386 + t346
-    t388 = t347 - t368*t386
-    t389 = t348 - t369*t386
-    t390 = t349 - t370*t386
-    t391 = xp.sqrt(t373**2 + t374**2 + t375**2)
-    t392 = t391*xp.where(xp.greater_equal(t373, 0), xp.asarray(1, dtype=dtype), -1)
-    t393 = xp.greater(t391, 0)
-    t394 = xp.where(t393, 1/(t373 + t392), 0)
-    t395 = xp.where(t393, 1 + xp.abs(t373)/t391, 0)
-    t396 = t374*t394
-    t397 = t375*t394
-    t398 = t395*(t378 + t396*t379 + t397*t380)
-    t399 = -t398 + t378
-    t400 = t379 - t396*t398
-    t401 = t380 - t397*t398
-    t402 = t395*(t383 + t396*t384 + t397*t385)
-    t403 = -t402 + t383
-    t404 = t384 - t396*t402
-    t405 = t385 - t397*t402
-    t406 = t395*(t388 + t396*t389 + t397*t390)
-    t407 = -t406 + t388
-    t408 = t389 - t396*t406
-    t409 = t390 - t397*t406
-    t410 = xp.sqrt(t400**2 + t401**2)
-    t411 = t410*xp.where(xp.greater_equal(t400, 0), xp.asarray(1, dtype=dtype), -1)
-    t412 = xp.greater(t410, 0)
-    t413 = xp.where(t412, 1/(t400 + t411), 0)
-    t414 = xp.where(t412, 1 + xp.abs(t400)/t410, 0)
-    t415 = t401*t413
-    t416 = t414*(t404 + t415*t405)
-    t417 = -t416 + t404
-    t418 = t405 - t415*t416
-    t419 = t414*(t408 + t415*t409)
-    t420 = -t419 + t408
-    t421 = t409 - t415*t419
-    t422 = xp.abs(t418)
-    t423 = t422*xp.where(xp.greater_equal(t418, 0), xp.asarray(1, dtype=dtype), -1)
-    t424 = xp.where(xp.greater(t422, 0), xp.asarray(2, dtype=dtype), 0)
-    t425 = t421 - t421*t424
-    t426 = xp.where(xp.not_equal(t423, 0), -t425/t423, 0)
-    t427 = xp.where(xp.not_equal(t411, 0), -(t420 - t417*t426)/t411, 0)
-    t428 = xp.where(xp.not_equal(t392, 0), -(-(t399*t427 + t403*t426) + t407)/t392, 0)
-    t429 = xp.where(xp.not_equal(t351, 0), -(-(t372*t428 + t377*t427 + t382*t426) + t387)/t351, 0)
-    t430 = xp.where(xp.not_equal(t316, 0), -(-(t323*t429 + t333*t428 + t337*t427 + t341*t426) + t345)/t316, 0)
-    t431 = xp.where(xp.not_equal(t65, 0), -(t298 + t287*t430 + t292*t428 + t294*t427 + t296*t426 - t290*t429)/t65, 0)
-    t432 = xp.isfinite(t364)
-    t433 = xp.greater_equal(damping, 0)
-    t434 = xp.greater(damping, 0)
-    t435 = 1e-12*t114
-    t436 = 1e-12*t81
-    t437 = (t434 & (xp.less_equal(t107, t435) | xp.less_equal(t165, t435) | xp.less_equal(t204, t435) | xp.less_equal(t232, t435) | xp.less_equal(t251, t435) | xp.less_equal(t263, t435))) | (xp.less_equal(damping, 0) & (xp.less_equal(t64, t436) | xp.less_equal(t315, t436) | xp.less_equal(t350, t436) | xp.less_equal(t391, t436) | xp.less_equal(t410, t436) | xp.less_equal(t422, t436)))
-    t438 = t432 & t433 & xp.logical_not(t437)
+    t99 = damping**2
+    t100 = _symmetric_solve6(xp, 1, (t99 + t79, -t84, -t88, t93, t70, -t59, t99 + t82, t97, -t67, -t94, t60, t75 + t99, -t98, -t89, t52, t68 + t99, t85, -t53, t71 + t99, -t54, t99 + t73, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t101 = t100[5]
+    t102 = t100[0]
+    t103 = t100[1]
+    t104 = t101 - t57*t102 + t56*t103
+    t105 = s1*t45
+    t106 = t100[2]
+    t107 = t100[3]
+    t108 = t100[4]
+    t109 = -t102*t46 + t103*t49 + t38*t106 - t12*t107 - t13*t108 + t4*t101
+    t110 = -t102*t47 + t103*t50 + t39*t106 - t19*t107 - t21*t108 + t25*t101
+    t111 = t40*t106 - t102*t48 + t103*t51 - t27*t107 - t32*t108 + t41*t101
+    t112 = s1*t107 + c1*t108
+    t113 = t112 + t90*t102 - t103*t105 - t58*t106
+    t114 = s1*t44
+    t115 = t112 + t37*t106 + t91*t102 - t103*t114
+    t116 = xp.greater(t64, 0)
+    t117 = xp.where(t116, 1/(t57 + t65), 0)
+    t118 = xp.where(t116, 1 + xp.abs(t57)/t64, 0)
+    t119 = t56*t117
+    t120 = -t118*(t90 + t105*t119)
+    t121 = t90 + t120
+    t122 = t105 + t119*t120
+    t123 = t118*(t91 + t114*t119)
+    t124 = -t123 + t91
+    t125 = -t118*(t46 + t49*t119 + t4*t117)
+    t126 = t46 + t125
+    t127 = -t118*(t47 + t50*t119 + t25*t117)
+    t128 = t47 + t127
+    t129 = -t118*(t48 + t51*t119 + t41*t117)
+    t130 = t48 + t129
+    t131 = -t118*(-mu_dot0 + mu_dot5*t117 + t119*mu_dot1)
+    t132 = -t131 + mu_dot0
+    t133 = -t114
+    t134 = t117*t123
+    t135 = t133 + t56*t134
+    t136 = t117*t125
+    t137 = t49 + t56*t136
+    t138 = t4 + t136
+    t139 = t117*t127
+    t140 = t50 + t56*t139
+    t141 = t25 + t139
+    t142 = t117*t129
+    t143 = t51 + t56*t142
+    t144 = t41 + t142
+    t145 = t117*t131
+    t146 = mu_dot1 + t56*t145
+    t147 = t145 + mu_dot5
+    t148 = t117**2
+    t149 = xp.sqrt(t66 + t69 + t74 + t122**2 + t148*t120**2)
+    t150 = t149*xp.where(xp.greater_equal(t122, 0), xp.asarray(1, dtype=dtype), -1)
+    t151 = xp.greater(t149, 0)
+    t152 = xp.where(t151, 1/(t122 + t150), 0)
+    t153 = xp.where(t151, 1 + xp.abs(t122)/t149, 0)
+    t154 = t58*t152
+    t155 = t120*t152
+    t156 = t153*(t135 + t37*t154 - t66*t152 - t69*t152 + t148*t155*t123)
+    t157 = -t156 + t135
+    t158 = t37 - t154*t156
+    t159 = t152*t156
+    t160 = s1 + s1*t159
+    t161 = c1 + c1*t159
+    t162 = s1*t152
+    t163 = c1*t152
+    t164 = t155*t117
+    t165 = t134 - t164*t156
+    t166 = t153*(t137 + t38*t154 + t12*t162 + t13*t163 + t164*t138)
+    t167 = -t166 + t137
+    t168 = t38 - t154*t166
+    t169 = t138 - t164*t166
+    t170 = t153*(t140 + t39*t154 + t164*t141 + t19*t162 + t21*t163)
+    t171 = -t170 + t140
+    t172 = t39 - t154*t170
+    t173 = t141 - t164*t170
+    t174 = t153*(t143 + t40*t154 + t164*t144 + t27*t162 + t32*t163)
+    t175 = -t174 + t143
+    t176 = t40 - t154*t174
+    t177 = t144 - t164*t174
+    t178 = t153*(t146 + t154*mu_dot2 - t162*mu_dot3 - t163*mu_dot4 + t164*t147)
+    t179 = -t178 + t146
+    t180 = mu_dot2 - t154*t178
+    t181 = mu_dot3 + t162*t178
+    t182 = mu_dot4 + t163*t178
+    t183 = t147 - t164*t178
+    t184 = xp.sqrt(t158**2 + t160**2 + t161**2 + t165**2)
+    t185 = t184*xp.where(xp.greater_equal(t158, 0), xp.asarray(1, dtype=dtype), -1)
+    t186 = -t12
+    t187 = t186 + t162*t166
+    t188 = -t13
+    t189 = t188 + t163*t166
+    t190 = -t19
+    t191 = t190 + t162*t170
+    t192 = -t21
+    t193 = t192 + t163*t170
+    t194 = -t27
+    t195 = t194 + t162*t174
+    t196 = -t32
+    t197 = t196 + t163*t174
+    t198 = -1 - t46 - t47 - t48 - t56 - t90 + q1 + q2 + q3 + t4 + q4 + q5 + q6 + t57 + t25 + t41 + t91 + t49 + t50 + t51 + t58 + t37 + t38 + t39 + t40 + t105 + t133 + t186 + t188 + t190 + t192 + t194 + t196 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t199 = xp.greater(t184, 0)
+    t200 = xp.where(t199, 1/(t158 + t185), 0)
+    t201 = xp.where(t199, 1 + xp.abs(t158)/t184, 0)
+    t202 = t160*t200
+    t203 = t161*t200
+    t204 = t165*t200
+    t205 = t201*(t168 + t202*t187 + t203*t189 + t204*t169)
+    t206 = -t205 + t168
+    t207 = t187 - t202*t205
+    t208 = t189 - t203*t205
+    t209 = t169 - t204*t205
+    t210 = t201*(t172 + t202*t191 + t203*t193 + t204*t173)
+    t211 = -t210 + t172
+    t212 = t191 - t202*t210
+    t213 = t193 - t203*t210
+    t214 = t173 - t204*t210
+    t215 = t201*(t176 + t202*t195 + t203*t197 + t204*t177)
+    t216 = -t215 + t176
+    t217 = t195 - t202*t215
+    t218 = t197 - t203*t215
+    t219 = t177 - t204*t215
+    t220 = t201*(t180 + t202*t181 + t203*t182 + t204*t183)
+    t221 = -t220 + t180
+    t222 = t181 - t202*t220
+    t223 = t182 - t203*t220
+    t224 = t183 - t204*t220
+    t225 = xp.sqrt(t207**2 + t208**2 + t209**2)
+    t226 = t225*xp.where(xp.greater_equal(t207, 0), xp.asarray(1, dtype=dtype), -1)
+    t227 = xp.greater(t225, 0)
+    t228 = xp.where(t227, 1/(t207 + t226), 0)
+    t229 = xp.where(t227, 1 + xp.abs(t207)/t225, 0)
+    t230 = t208*t228
+    t231 = t209*t228
+    t232 = t229*(t212 + t230*t213 + t231*t214)
+    t233 = -t232 + t212
+    t234 = t213 - t230*t232
+    t235 = t214 - t231*t232
+    t236 = t229*(t217 + t230*t218 + t231*t219)
+    t237 = -t236 + t217
+    t238 = t218 - t230*t236
+    t239 = t219 - t231*t236
+    t240 = t229*(t222 + t230*t223 + t231*t224)
+    t241 = -t240 + t222
+    t242 = t223 - t230*t240
+    t243 = t224 - t231*t240
+    t244 = xp.sqrt(t234**2 + t235**2)
+    t245 = t244*xp.where(xp.greater_equal(t234, 0), xp.asarray(1, dtype=dtype), -1)
+    t246 = xp.greater(t244, 0)
+    t247 = xp.where(t246, 1/(t234 + t245), 0)
+    t248 = xp.where(t246, 1 + xp.abs(t234)/t244, 0)
+    t249 = t235*t247
+    t250 = t248*(t238 + t249*t239)
+    t251 = -t250 + t238
+    t252 = t239 - t249*t250
+    t253 = t248*(t242 + t249*t243)
+    t254 = -t253 + t242
+    t255 = t243 - t249*t253
+    t256 = xp.abs(t252)
+    t257 = t256*xp.where(xp.greater_equal(t252, 0), xp.asarray(1, dtype=dtype), -1)
+    t258 = xp.where(xp.greater(t256, 0), xp.asarray(2, dtype=dtype), 0)
+    t259 = t255 - t255*t258
+    t260 = xp.where(xp.not_equal(t257, 0), -t259/t257, 0)
+    t261 = xp.where(xp.not_equal(t245, 0), -(t254 - t251*t260)/t245, 0)
+    t262 = xp.where(xp.not_equal(t226, 0), -(-(t233*t261 + t237*t260) + t241)/t226, 0)
+    t263 = xp.where(xp.not_equal(t185, 0), -(-(t206*t262 + t211*t261 + t216*t260) + t221)/t185, 0)
+    t264 = xp.where(xp.not_equal(t150, 0), -(-(t157*t263 + t167*t262 + t171*t261 + t175*t260) + t179)/t150, 0)
+    t265 = xp.where(xp.not_equal(t65, 0), -(t132 + t121*t264 + t126*t262 + t128*t261 + t130*t260 - t124*t263)/t65, 0)
+    t266 = xp.isfinite(t198)
+    t267 = xp.greater_equal(damping, 0)
+    t268 = xp.greater(damping, 0)
+    t269 = 1e-12*t81
+    t270 = (t268 & xp.greater(t100[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t64, t269) | xp.less_equal(t149, t269) | xp.less_equal(t184, t269) | xp.less_equal(t225, t269) | xp.less_equal(t244, t269) | xp.less_equal(t256, t269)))
+    t271 = t266 & t267 & xp.logical_not(t270)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t438, xp.where(t434, -t273, t431), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t438, xp.where(t434, -t279, t430), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t438, xp.where(t434, t281, t429), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t438, xp.where(t434, t274, t428), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t438, xp.where(t434, t275, t427), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t438, xp.where(t434, t276, t426), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t271, xp.where(t268, -t104, t265), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t271, xp.where(t268, -t113, t264), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t271, xp.where(t268, t115, t263), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t271, xp.where(t268, t109, t262), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t271, xp.where(t268, t110, t261), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t271, xp.where(t268, t111, t260), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t432 & t433), 2, xp.where(t437, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t266 & t267), 2, xp.where(t270, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
-    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1432 operations."""
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1438 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("z", z, (6,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -4618,361 +4678,194 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     t96 = s1*t37
     t97 = t45*t95 - t44*t96 + t49*t38 + t50*t39 + t51*t40
     t98 = -t96 + t95 + t12*t38 + t19*t39 + t27*t40
-    t99 = t84**2
-    t100 = t88**2
-    t101 = t93**2
-    t102 = t70**2
-    t103 = t59**2
-    t104 = damping**2
-    t105 = t104 + t79
-    t106 = t105**2
-    t107 = xp.sqrt(t99 + t100 + t101 + t102 + t103 + t106)
-    t108 = t107*xp.where(xp.greater_equal(t105, 0), xp.asarray(1, dtype=dtype), -1)
-    t109 = t104 + t82
-    t110 = t75 + t104
-    t111 = t68 + t104
-    t112 = t71 + t104
-    t113 = t104 + t73
-    t114 = xp.sqrt(2*t99 + 2*t100 + 2*t97**2 + 2*t101 + 2*t67**2 + 2*t98**2 + 2*t102 + 2*t94**2 + 2*t89**2 + 2*t85**2 + 2*t103 + 2*t60**2 + 2*t52**2 + 2*t53**2 + 2*t54**2 + t106 + t109**2 + t110**2 + t111**2 + t112**2 + t113**2)
-    t115 = xp.greater(t107, 0)
-    t116 = xp.where(t115, 1/(t105 + t108), 0)
-    t117 = xp.where(t115, 1 + xp.abs(t105)/t107, 0)
-    t118 = t84*t116
-    t119 = t88*t116
-    t120 = t93*t116
-    t121 = t70*t116
-    t122 = t59*t116
-    t123 = -t117*(t84 + t109*t118 + t119*t97 + t120*t67 + t121*t94 + t122*t60)
-    t124 = t84 + t123
-    t125 = t109 + t118*t123
-    t126 = t97 + t119*t123
-    t127 = t67 + t120*t123
-    t128 = t94 + t121*t123
-    t129 = t60 + t122*t123
-    t130 = -t117*(t88 + t118*t97 + t110*t119 + t120*t98 + t121*t89 + t122*t52)
-    t131 = t88 + t130
-    t132 = t97 + t118*t130
-    t133 = t110 + t119*t130
-    t134 = t98 + t120*t130
-    t135 = t89 + t121*t130
-    t136 = t52 + t122*t130
-    t137 = t117*(t93 + t118*t67 + t119*t98 + t111*t120 + t121*t85 + t122*t53)
-    t138 = -t137 + t93
-    t139 = -t67 + t118*t137
-    t140 = -t98 + t119*t137
-    t141 = t111 - t120*t137
-    t142 = t85 - t121*t137
-    t143 = -t53 + t122*t137
-    t144 = t117*(t70 + t118*t94 + t119*t89 + t120*t85 + t112*t121 + t122*t54)
-    t145 = -t144 + t70
-    t146 = -t94 + t118*t144
-    t147 = -t89 + t119*t144
-    t148 = t85 - t120*t144
-    t149 = t112 - t121*t144
-    t150 = -t54 + t122*t144
-    t151 = -t117*(t59 + t118*t60 + t119*t52 + t120*t53 + t121*t54 + t113*t122)
-    t152 = t59 + t151
-    t153 = t60 + t118*t151
-    t154 = t52 + t119*t151
-    t155 = t53 + t120*t151
-    t156 = t54 + t121*t151
-    t157 = t113 + t122*t151
-    t158 = t117*(mu_dot0 - t118*mu_dot1 - t119*mu_dot2 + t120*mu_dot3 + t121*mu_dot4 - t122*mu_dot5)
-    t159 = -t158 + mu_dot0
-    t160 = mu_dot1 + t118*t158
-    t161 = mu_dot2 + t119*t158
-    t162 = mu_dot3 - t120*t158
-    t163 = mu_dot4 - t121*t158
-    t164 = mu_dot5 + t122*t158
-    t165 = xp.sqrt(t125**2 + t126**2 + t127**2 + t128**2 + t129**2)
-    t166 = t165*xp.where(xp.greater_equal(t125, 0), xp.asarray(1, dtype=dtype), -1)
-    t167 = xp.greater(t165, 0)
-    t168 = xp.where(t167, 1/(t125 + t166), 0)
-    t169 = xp.where(t167, 1 + xp.abs(t125)/t165, 0)
-    t170 = t126*t168
-    t171 = t127*t168
-    t172 = t128*t168
-    t173 = t129*t168
-    t174 = t169*(t132 + t170*t133 + t171*t134 + t172*t135 + t173*t136)
-    t175 = -t174 + t132
-    t176 = t133 - t170*t174
-    t177 = -t134 + t171*t174
-    t178 = -t135 + t172*t174
-    t179 = t136 - t173*t174
-    t180 = t169*(t139 + t170*t140 - t171*t141 - t172*t142 + t173*t143)
-    t181 = -t180 + t139
-    t182 = t140 - t170*t180
-    t183 = t141 + t171*t180
-    t184 = t142 + t172*t180
-    t185 = t143 - t173*t180
-    t186 = t169*(t146 + t170*t147 - t171*t148 - t172*t149 + t173*t150)
-    t187 = -t186 + t146
-    t188 = t147 - t170*t186
-    t189 = t148 + t171*t186
-    t190 = t149 + t172*t186
-    t191 = t150 - t173*t186
-    t192 = t169*(t153 + t170*t154 + t171*t155 + t172*t156 + t173*t157)
-    t193 = -t192 + t153
-    t194 = t154 - t170*t192
-    t195 = -t155 + t171*t192
-    t196 = -t156 + t172*t192
-    t197 = t157 - t173*t192
-    t198 = t169*(t160 + t170*t161 - t171*t162 - t172*t163 + t173*t164)
-    t199 = -t198 + t160
-    t200 = t161 - t170*t198
-    t201 = t162 + t171*t198
-    t202 = t163 + t172*t198
-    t203 = t164 - t173*t198
-    t204 = xp.sqrt(t176**2 + t177**2 + t178**2 + t179**2)
-    t205 = t204*xp.where(xp.greater_equal(t176, 0), xp.asarray(1, dtype=dtype), -1)
-    t206 = xp.greater(t204, 0)
-    t207 = xp.where(t206, 1/(t176 + t205), 0)
-    t208 = xp.where(t206, 1 + xp.abs(t176)/t204, 0)
-    t209 = t177*t207
-    t210 = t178*t207
-    t211 = t179*t207
-    t212 = t208*(t182 + t209*t183 + t210*t184 + t211*t185)
-    t213 = -t212 + t182
-    t214 = t183 - t209*t212
-    t215 = t184 - t210*t212
-    t216 = t185 - t211*t212
-    t217 = t208*(t188 + t209*t189 + t210*t190 + t211*t191)
-    t218 = -t217 + t188
-    t219 = t189 - t209*t217
-    t220 = t190 - t210*t217
-    t221 = t191 - t211*t217
-    t222 = t208*(t194 + t209*t195 + t210*t196 + t211*t197)
-    t223 = -t222 + t194
-    t224 = t195 - t209*t222
-    t225 = t196 - t210*t222
-    t226 = t197 - t211*t222
-    t227 = t208*(t200 + t209*t201 + t210*t202 + t211*t203)
-    t228 = -t227 + t200
-    t229 = t201 - t209*t227
-    t230 = t202 - t210*t227
-    t231 = t203 - t211*t227
-    t232 = xp.sqrt(t214**2 + t215**2 + t216**2)
-    t233 = t232*xp.where(xp.greater_equal(t214, 0), xp.asarray(1, dtype=dtype), -1)
-    t234 = xp.greater(t232, 0)
-    t235 = xp.where(t234, 1/(t214 + t233), 0)
-    t236 = xp.where(t234, 1 + xp.abs(t214)/t232, 0)
-    t237 = t215*t235
-    t238 = t216*t235
-    t239 = t236*(t219 + t237*t220 + t238*t221)
-    t240 = -t239 + t219
-    t241 = t220 - t237*t239
-    t242 = t221 - t238*t239
-    t243 = t236*(t224 + t237*t225 + t238*t226)
-    t244 = -t243 + t224
-    t245 = t225 - t237*t243
-    t246 = t226 - t238*t243
-    t247 = t236*(t229 + t237*t230 + t238*t231)
-    t248 = -t247 + t229
-    t249 = t230 - t237*t247
-    t250 = t231 - t238*t247
-    t251 = xp.sqrt(t241**2 + t242**2)
-    t252 = t251*xp.where(xp.greater_equal(t241, 0), xp.asarray(1, dtype=dtype), -1)
-    t253 = xp.greater(t251, 0)
-    t254 = xp.where(t253, 1/(t241 + t252), 0)
-    t255 = xp.where(t253, 1 + xp.abs(t241)/t251, 0)
-    t256 = t242*t254
-    t257 = t255*(t245 + t256*t246)
-    t258 = -t257 + t245
-    t259 = t246 - t256*t257
-    t260 = t255*(t249 + t256*t250)
-    t261 = -t260 + t249
-    t262 = t250 - t256*t260
-    t263 = xp.abs(t259)
-    t264 = t263*xp.where(xp.greater_equal(t259, 0), xp.asarray(1, dtype=dtype), -1)
-    t265 = xp.where(xp.greater(t263, 0), xp.asarray(2, dtype=dtype), 0)
-    t266 = t262 - t262*t265
-    t267 = xp.where(xp.not_equal(t264, 0), -t266/t264, 0)
-    t268 = xp.where(xp.not_equal(t252, 0), -(t261 - t258*t267)/t252, 0)
-    t269 = xp.where(xp.not_equal(t233, 0), -(-(t240*t268 + t244*t267) + t248)/t233, 0)
-    t270 = xp.where(xp.not_equal(t205, 0), -(-(t213*t269 + t218*t268 + t223*t267) + t228)/t205, 0)
-    t271 = xp.where(xp.not_equal(t166, 0), -(-(t175*t270 + t181*t269 + t187*t268 + t193*t267) + t199)/t166, 0)
-    t272 = xp.where(xp.not_equal(t108, 0), -(t159 + t124*t271 + t131*t270 + t152*t267 - t138*t269 - t145*t268)/t108, 0)
-    t273 = t267 + t56*t271 - t57*t272
-    t274 = -t46*t272 + t49*t271 + t38*t270 - t12*t269 - t13*t268 + t4*t267
-    t275 = -t47*t272 + t50*t271 + t39*t270 - t19*t269 - t21*t268 + t25*t267
-    t276 = -t48*t272 + t51*t271 + t40*t270 - t27*t269 - t32*t268 + t41*t267
-    t277 = s1*t45
-    t278 = s1*t269 + c1*t268
-    t279 = t278 - t58*t270 + t90*t272 - t277*t271
-    t280 = s1*t44
-    t281 = t278 + t37*t270 + t91*t272 - t280*t271
-    t282 = xp.greater(t64, 0)
-    t283 = xp.where(t282, 1/(t57 + t65), 0)
-    t284 = xp.where(t282, 1 + xp.abs(t57)/t64, 0)
-    t285 = t56*t283
-    t286 = -t284*(t90 + t277*t285)
-    t287 = t90 + t286
-    t288 = t277 + t285*t286
-    t289 = t284*(t91 + t280*t285)
-    t290 = -t289 + t91
-    t291 = -t284*(t46 + t4*t283 + t49*t285)
-    t292 = t46 + t291
-    t293 = -t284*(t47 + t50*t285 + t25*t283)
-    t294 = t47 + t293
-    t295 = -t284*(t48 + t51*t285 + t41*t283)
-    t296 = t48 + t295
-    t297 = -t284*(-mu_dot0 + mu_dot5*t283 + t285*mu_dot1)
-    t298 = -t297 + mu_dot0
-    t299 = -t280
-    t300 = t283*t289
-    t301 = t299 + t56*t300
-    t302 = t283*t291
-    t303 = t49 + t56*t302
-    t304 = t4 + t302
-    t305 = t283*t293
-    t306 = t50 + t56*t305
-    t307 = t25 + t305
-    t308 = t283*t295
-    t309 = t51 + t56*t308
-    t310 = t41 + t308
-    t311 = t283*t297
-    t312 = mu_dot1 + t56*t311
-    t313 = t311 + mu_dot5
-    t314 = t283**2
-    t315 = xp.sqrt(t66 + t69 + t74 + t288**2 + t314*t286**2)
-    t316 = t315*xp.where(xp.greater_equal(t288, 0), xp.asarray(1, dtype=dtype), -1)
-    t317 = xp.greater(t315, 0)
-    t318 = xp.where(t317, 1/(t288 + t316), 0)
-    t319 = xp.where(t317, 1 + xp.abs(t288)/t315, 0)
-    t320 = t58*t318
-    t321 = t286*t318
-    t322 = t319*(t301 + t37*t320 - t66*t318 - t69*t318 + t314*t321*t289)
-    t323 = -t322 + t301
-    t324 = t37 - t320*t322
-    t325 = t318*t322
-    t326 = s1 + s1*t325
-    t327 = c1 + c1*t325
-    t328 = s1*t318
-    t329 = c1*t318
-    t330 = t321*t283
-    t331 = t300 - t330*t322
-    t332 = t319*(t303 + t38*t320 + t12*t328 + t13*t329 + t330*t304)
-    t333 = -t332 + t303
-    t334 = t38 - t320*t332
-    t335 = t304 - t330*t332
-    t336 = t319*(t306 + t39*t320 + t330*t307 + t19*t328 + t21*t329)
-    t337 = -t336 + t306
-    t338 = t39 - t320*t336
-    t339 = t307 - t330*t336
-    t340 = t319*(t309 + t40*t320 + t330*t310 + t27*t328 + t32*t329)
-    t341 = -t340 + t309
-    t342 = t40 - t320*t340
-    t343 = t310 - t330*t340
-    t344 = t319*(t312 + t320*mu_dot2 - t328*mu_dot3 - t329*mu_dot4 + t330*t313)
-    t345 = -t344 + t312
-    t346 = mu_dot2 - t320*t344
-    t347 = mu_dot3 + t328*t344
-    t348 = mu_dot4 + t329*t344
-    t349 = t313 - t330*t344
-    t350 = xp.sqrt(t324**2 + t326**2 + t327**2 + t331**2)
-    t351 = t350*xp.where(xp.greater_equal(t324, 0), xp.asarray(1, dtype=dtype), -1)
-    t352 = -t12
-    t353 = t352 + t328*t332
-    t354 = -t13
-    t355 = t354 + t329*t332
-    t356 = -t19
-    t357 = t356 + t328*t336
-    t358 = -t21
-    t359 = t358 + t329*t336
-    t360 = -t27
-    t361 = t360 + t328*t340
-    t362 = -t32
-    t363 = t362 + t329*t340
-    t364 = -1 - t46 - t47 - t48 - t56 - t90 + q1 + q2 + q3 + t4 + q4 + q5 + q6 + t57 + t25 + t41 + t91 + t49 + t50 + t51 + t58 + t37 + t38 + t39 + t40 + t277 + t299 + t352 + t354 + t356 + t358 + t360 + t362 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6
-    t365 = xp.greater(t350, 0)
-    t366 = xp.where(t365, 1/(t324 + t351), 0)
-    t367 = xp.where(t365, 1 + xp.abs(t324)/t350, 0)
-    t368 = t326*t366
-    t369 = t327*t366
-    t370 = t331*t366
-    t371 = t367*(t334 + t368*t353 + t369*t355 + t370*t335)
-    t372 = -t371 + t334
-    t373 = t353 - t368*t371
-    t374 = t355 - t369*t371
-    t375 = t335 - t370*t371
-    t376 = t367*(t338 + t368*t357 + t369*t359 + t370*t339)
-    t377 = -t376 + t338
-    t378 = t357 - t368*t376
-    t379 = t359 - t369*t376
-    t380 = t339 - t370*t376
-    t381 = t367*(t342 + t368*t361 + t369*t363 + t370*t343)
-    t382 = -t381 + t342
-    t383 = t361 - t368*t381
-    t384 = t363 - t369*t381
-    t385 = t343 - t370*t381
-    t386 = t367*(t346 + t368*t347 + t369*t348 + t370*t349)
-    t387 = -t386 + t346
-    t388 = t347 - t368*t386
-    t389 = t348 - t369*t386
-    t390 = t349 - t370*t386
-    t391 = xp.sqrt(t373**2 + t374**2 + t375**2)
-    t392 = t391*xp.where(xp.greater_equal(t373, 0), xp.asarray(1, dtype=dtype), -1)
-    t393 = xp.greater(t391, 0)
-    t394 = xp.where(t393, 1/(t373 + t392), 0)
-    t395 = xp.where(t393, 1 + xp.abs(t373)/t391, 0)
-    t396 = t374*t394
-    t397 = t375*t394
-    t398 = t395*(t378 + t396*t379 + t397*t380)
-    t399 = -t398 + t378
-    t400 = t379 - t396*t398
-    t401 = t380 - t397*t398
-    t402 = t395*(t383 + t396*t384 + t397*t385)
-    t403 = -t402 + t383
-    t404 = t384 - t396*t402
-    t405 = t385 - t397*t402
-    t406 = t395*(t388 + t396*t389 + t397*t390)
-    t407 = -t406 + t388
-    t408 = t389 - t396*t406
-    t409 = t390 - t397*t406
-    t410 = xp.sqrt(t400**2 + t401**2)
-    t411 = t410*xp.where(xp.greater_equal(t400, 0), xp.asarray(1, dtype=dtype), -1)
-    t412 = xp.greater(t410, 0)
-    t413 = xp.where(t412, 1/(t400 + t411), 0)
-    t414 = xp.where(t412, 1 + xp.abs(t400)/t410, 0)
-    t415 = t401*t413
-    t416 = t414*(t404 + t415*t405)
-    t417 = -t416 + t404
-    t418 = t405 - t415*t416
-    t419 = t414*(t408 + t415*t409)
-    t420 = -t419 + t408
-    t421 = t409 - t415*t419
-    t422 = xp.abs(t418)
-    t423 = t422*xp.where(xp.greater_equal(t418, 0), xp.asarray(1, dtype=dtype), -1)
-    t424 = xp.where(xp.greater(t422, 0), xp.asarray(2, dtype=dtype), 0)
-    t425 = t421 - t421*t424
-    t426 = xp.where(xp.not_equal(t423, 0), -t425/t423, 0)
-    t427 = xp.where(xp.not_equal(t411, 0), -(t420 - t417*t426)/t411, 0)
-    t428 = xp.where(xp.not_equal(t392, 0), -(-(t399*t427 + t403*t426) + t407)/t392, 0)
-    t429 = xp.where(xp.not_equal(t351, 0), -(-(t372*t428 + t377*t427 + t382*t426) + t387)/t351, 0)
-    t430 = xp.where(xp.not_equal(t316, 0), -(-(t323*t429 + t333*t428 + t337*t427 + t341*t426) + t345)/t316, 0)
-    t431 = xp.where(xp.not_equal(t65, 0), -(t298 + t287*t430 + t292*t428 + t294*t427 + t296*t426 - t290*t429)/t65, 0)
-    t432 = xp.isfinite(t364)
-    t433 = xp.greater_equal(damping, 0)
-    t434 = xp.greater(damping, 0)
-    t435 = 1e-12*t114
-    t436 = 1e-12*t81
-    t437 = (t434 & (xp.less_equal(t107, t435) | xp.less_equal(t165, t435) | xp.less_equal(t204, t435) | xp.less_equal(t232, t435) | xp.less_equal(t251, t435) | xp.less_equal(t263, t435))) | (xp.less_equal(damping, 0) & (xp.less_equal(t64, t436) | xp.less_equal(t315, t436) | xp.less_equal(t350, t436) | xp.less_equal(t391, t436) | xp.less_equal(t410, t436) | xp.less_equal(t422, t436)))
-    t438 = t432 & t433 & xp.logical_not(t437)
+    t99 = damping**2
+    t100 = _symmetric_solve6(xp, 1, (t99 + t79, -t84, -t88, t93, t70, -t59, t99 + t82, t97, -t67, -t94, t60, t75 + t99, -t98, -t89, t52, t68 + t99, t85, -t53, t71 + t99, -t54, t99 + t73, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t101 = t100[5]
+    t102 = t100[0]
+    t103 = t100[1]
+    t104 = t101 - t57*t102 + t56*t103
+    t105 = s1*t45
+    t106 = t100[2]
+    t107 = t100[3]
+    t108 = t100[4]
+    t109 = -t102*t46 + t103*t49 + t38*t106 - t12*t107 - t13*t108 + t4*t101
+    t110 = -t102*t47 + t103*t50 + t39*t106 - t19*t107 - t21*t108 + t25*t101
+    t111 = t40*t106 - t102*t48 + t103*t51 - t27*t107 - t32*t108 + t41*t101
+    t112 = s1*t107 + c1*t108
+    t113 = t112 + t90*t102 - t103*t105 - t58*t106
+    t114 = s1*t44
+    t115 = t112 + t37*t106 + t91*t102 - t103*t114
+    t116 = xp.greater(t64, 0)
+    t117 = xp.where(t116, 1/(t57 + t65), 0)
+    t118 = xp.where(t116, 1 + xp.abs(t57)/t64, 0)
+    t119 = t56*t117
+    t120 = -t118*(t90 + t105*t119)
+    t121 = t90 + t120
+    t122 = t105 + t119*t120
+    t123 = t118*(t91 + t114*t119)
+    t124 = -t123 + t91
+    t125 = -t118*(t46 + t49*t119 + t4*t117)
+    t126 = t46 + t125
+    t127 = -t118*(t47 + t50*t119 + t25*t117)
+    t128 = t47 + t127
+    t129 = -t118*(t48 + t51*t119 + t41*t117)
+    t130 = t48 + t129
+    t131 = -t118*(-mu_dot0 + mu_dot5*t117 + t119*mu_dot1)
+    t132 = -t131 + mu_dot0
+    t133 = -t114
+    t134 = t117*t123
+    t135 = t133 + t56*t134
+    t136 = t117*t125
+    t137 = t49 + t56*t136
+    t138 = t4 + t136
+    t139 = t117*t127
+    t140 = t50 + t56*t139
+    t141 = t25 + t139
+    t142 = t117*t129
+    t143 = t51 + t56*t142
+    t144 = t41 + t142
+    t145 = t117*t131
+    t146 = mu_dot1 + t56*t145
+    t147 = t145 + mu_dot5
+    t148 = t117**2
+    t149 = xp.sqrt(t66 + t69 + t74 + t122**2 + t148*t120**2)
+    t150 = t149*xp.where(xp.greater_equal(t122, 0), xp.asarray(1, dtype=dtype), -1)
+    t151 = xp.greater(t149, 0)
+    t152 = xp.where(t151, 1/(t122 + t150), 0)
+    t153 = xp.where(t151, 1 + xp.abs(t122)/t149, 0)
+    t154 = t58*t152
+    t155 = t120*t152
+    t156 = t153*(t135 + t37*t154 - t66*t152 - t69*t152 + t148*t155*t123)
+    t157 = -t156 + t135
+    t158 = t37 - t154*t156
+    t159 = t152*t156
+    t160 = s1 + s1*t159
+    t161 = c1 + c1*t159
+    t162 = s1*t152
+    t163 = c1*t152
+    t164 = t155*t117
+    t165 = t134 - t164*t156
+    t166 = t153*(t137 + t38*t154 + t12*t162 + t13*t163 + t164*t138)
+    t167 = -t166 + t137
+    t168 = t38 - t154*t166
+    t169 = t138 - t164*t166
+    t170 = t153*(t140 + t39*t154 + t164*t141 + t19*t162 + t21*t163)
+    t171 = -t170 + t140
+    t172 = t39 - t154*t170
+    t173 = t141 - t164*t170
+    t174 = t153*(t143 + t40*t154 + t164*t144 + t27*t162 + t32*t163)
+    t175 = -t174 + t143
+    t176 = t40 - t154*t174
+    t177 = t144 - t164*t174
+    t178 = t153*(t146 + t154*mu_dot2 - t162*mu_dot3 - t163*mu_dot4 + t164*t147)
+    t179 = -t178 + t146
+    t180 = mu_dot2 - t154*t178
+    t181 = mu_dot3 + t162*t178
+    t182 = mu_dot4 + t163*t178
+    t183 = t147 - t164*t178
+    t184 = xp.sqrt(t158**2 + t160**2 + t161**2 + t165**2)
+    t185 = t184*xp.where(xp.greater_equal(t158, 0), xp.asarray(1, dtype=dtype), -1)
+    t186 = -t12
+    t187 = t186 + t162*t166
+    t188 = -t13
+    t189 = t188 + t163*t166
+    t190 = -t19
+    t191 = t190 + t162*t170
+    t192 = -t21
+    t193 = t192 + t163*t170
+    t194 = -t27
+    t195 = t194 + t162*t174
+    t196 = -t32
+    t197 = t196 + t163*t174
+    t198 = -1 - t46 - t47 - t48 - t56 - t90 + q1 + q2 + q3 + t4 + q4 + q5 + q6 + t57 + t25 + t41 + t91 + t49 + t50 + t51 + t58 + t37 + t38 + t39 + t40 + t105 + t133 + t186 + t188 + t190 + t192 + t194 + t196 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6
+    t199 = xp.greater(t184, 0)
+    t200 = xp.where(t199, 1/(t158 + t185), 0)
+    t201 = xp.where(t199, 1 + xp.abs(t158)/t184, 0)
+    t202 = t160*t200
+    t203 = t161*t200
+    t204 = t165*t200
+    t205 = t201*(t168 + t202*t187 + t203*t189 + t204*t169)
+    t206 = -t205 + t168
+    t207 = t187 - t202*t205
+    t208 = t189 - t203*t205
+    t209 = t169 - t204*t205
+    t210 = t201*(t172 + t202*t191 + t203*t193 + t204*t173)
+    t211 = -t210 + t172
+    t212 = t191 - t202*t210
+    t213 = t193 - t203*t210
+    t214 = t173 - t204*t210
+    t215 = t201*(t176 + t202*t195 + t203*t197 + t204*t177)
+    t216 = -t215 + t176
+    t217 = t195 - t202*t215
+    t218 = t197 - t203*t215
+    t219 = t177 - t204*t215
+    t220 = t201*(t180 + t202*t181 + t203*t182 + t204*t183)
+    t221 = -t220 + t180
+    t222 = t181 - t202*t220
+    t223 = t182 - t203*t220
+    t224 = t183 - t204*t220
+    t225 = xp.sqrt(t207**2 + t208**2 + t209**2)
+    t226 = t225*xp.where(xp.greater_equal(t207, 0), xp.asarray(1, dtype=dtype), -1)
+    t227 = xp.greater(t225, 0)
+    t228 = xp.where(t227, 1/(t207 + t226), 0)
+    t229 = xp.where(t227, 1 + xp.abs(t207)/t225, 0)
+    t230 = t208*t228
+    t231 = t209*t228
+    t232 = t229*(t212 + t230*t213 + t231*t214)
+    t233 = -t232 + t212
+    t234 = t213 - t230*t232
+    t235 = t214 - t231*t232
+    t236 = t229*(t217 + t230*t218 + t231*t219)
+    t237 = -t236 + t217
+    t238 = t218 - t230*t236
+    t239 = t219 - t231*t236
+    t240 = t229*(t222 + t230*t223 + t231*t224)
+    t241 = -t240 + t222
+    t242 = t223 - t230*t240
+    t243 = t224 - t231*t240
+    t244 = xp.sqrt(t234**2 + t235**2)
+    t245 = t244*xp.where(xp.greater_equal(t234, 0), xp.asarray(1, dtype=dtype), -1)
+    t246 = xp.greater(t244, 0)
+    t247 = xp.where(t246, 1/(t234 + t245), 0)
+    t248 = xp.where(t246, 1 + xp.abs(t234)/t244, 0)
+    t249 = t235*t247
+    t250 = t248*(t238 + t249*t239)
+    t251 = -t250 + t238
+    t252 = t239 - t249*t250
+    t253 = t248*(t242 + t249*t243)
+    t254 = -t253 + t242
+    t255 = t243 - t249*t253
+    t256 = xp.abs(t252)
+    t257 = t256*xp.where(xp.greater_equal(t252, 0), xp.asarray(1, dtype=dtype), -1)
+    t258 = xp.where(xp.greater(t256, 0), xp.asarray(2, dtype=dtype), 0)
+    t259 = t255 - t255*t258
+    t260 = xp.where(xp.not_equal(t257, 0), -t259/t257, 0)
+    t261 = xp.where(xp.not_equal(t245, 0), -(t254 - t251*t260)/t245, 0)
+    t262 = xp.where(xp.not_equal(t226, 0), -(-(t233*t261 + t237*t260) + t241)/t226, 0)
+    t263 = xp.where(xp.not_equal(t185, 0), -(-(t206*t262 + t211*t261 + t216*t260) + t221)/t185, 0)
+    t264 = xp.where(xp.not_equal(t150, 0), -(-(t157*t263 + t167*t262 + t171*t261 + t175*t260) + t179)/t150, 0)
+    t265 = xp.where(xp.not_equal(t65, 0), -(t132 + t121*t264 + t126*t262 + t128*t261 + t130*t260 - t124*t263)/t65, 0)
+    t266 = xp.isfinite(t198)
+    t267 = xp.greater_equal(damping, 0)
+    t268 = xp.greater(damping, 0)
+    t269 = 1e-12*t81
+    t270 = (t268 & xp.greater(t100[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t64, t269) | xp.less_equal(t149, t269) | xp.less_equal(t184, t269) | xp.less_equal(t225, t269) | xp.less_equal(t244, t269) | xp.less_equal(t256, t269)))
+    t271 = t266 & t267 & xp.logical_not(t270)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t438, xp.where(t434, -t273, t431), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t438, xp.where(t434, -t279, t430), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t438, xp.where(t434, t281, t429), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t438, xp.where(t434, t274, t428), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t438, xp.where(t434, t275, t427), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t438, xp.where(t434, t276, t426), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t271, xp.where(t268, -t104, t265), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t271, xp.where(t268, -t113, t264), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t271, xp.where(t268, t115, t263), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t271, xp.where(t268, t109, t262), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t271, xp.where(t268, t110, t261), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t271, xp.where(t268, t111, t260), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t432 & t433), 2, xp.where(t437, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t266 & t267), 2, xp.where(t270, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1606 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1612 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (6,)), ("target", target, (4, 4)), ("target_rate", target_rate, (6,)), ("gain", gain, (6,)), ("z", z, (6,)), ("damping", damping, ()), every=("gain", ))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -5154,382 +5047,215 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t128 = s1*t44
     t129 = t57*t45 + t58*t46 + t59*t47 + t52*t127 - t51*t128
     t130 = -t128 + t12*t45 + t127 + t17*t46 + t34*t47
-    t131 = t116**2
-    t132 = t120**2
-    t133 = t125**2
-    t134 = t102**2
-    t135 = t90**2
-    t136 = damping**2
-    t137 = t136 + t111
-    t138 = t137**2
-    t139 = xp.sqrt(t131 + t132 + t133 + t134 + t135 + t138)
-    t140 = t139*xp.where(xp.greater_equal(t137, 0), xp.asarray(1, dtype=dtype), -1)
-    t141 = t136 + t114
-    t142 = t107 + t136
-    t143 = t100 + t136
-    t144 = t103 + t136
-    t145 = t136 + t105
-    t146 = xp.sqrt(2*t131 + 2*t132 + 2*t129**2 + 2*t133 + 2*t99**2 + 2*t130**2 + 2*t134 + 2*t126**2 + 2*t121**2 + 2*t117**2 + 2*t135 + 2*t91**2 + 2*t60**2 + 2*t61**2 + 2*t62**2 + t138 + t141**2 + t142**2 + t143**2 + t144**2 + t145**2)
-    t147 = xp.greater(t139, 0)
-    t148 = xp.where(t147, 1/(t137 + t140), 0)
-    t149 = xp.where(t147, 1 + xp.abs(t137)/t139, 0)
-    t150 = t116*t148
-    t151 = t120*t148
-    t152 = t125*t148
-    t153 = t102*t148
-    t154 = t90*t148
-    t155 = -t149*(t116 + t141*t150 + t151*t129 + t152*t99 + t153*t126 + t154*t91)
-    t156 = t116 + t155
-    t157 = t141 + t150*t155
-    t158 = t129 + t151*t155
-    t159 = t99 + t152*t155
-    t160 = t126 + t153*t155
-    t161 = t91 + t154*t155
-    t162 = -t149*(t120 + t150*t129 + t142*t151 + t152*t130 + t153*t121 + t154*t60)
-    t163 = t120 + t162
-    t164 = t129 + t150*t162
-    t165 = t142 + t151*t162
-    t166 = t130 + t152*t162
-    t167 = t121 + t153*t162
-    t168 = t60 + t154*t162
-    t169 = t149*(t125 + t150*t99 + t151*t130 + t143*t152 + t153*t117 + t154*t61)
-    t170 = -t169 + t125
-    t171 = -t99 + t150*t169
-    t172 = -t130 + t151*t169
-    t173 = t143 - t152*t169
-    t174 = t117 - t153*t169
-    t175 = -t61 + t154*t169
-    t176 = t149*(t102 + t150*t126 + t151*t121 + t152*t117 + t144*t153 + t154*t62)
-    t177 = -t176 + t102
-    t178 = -t126 + t150*t176
-    t179 = -t121 + t151*t176
-    t180 = t117 - t152*t176
-    t181 = t144 - t153*t176
-    t182 = -t62 + t154*t176
-    t183 = -t149*(t90 + t150*t91 + t151*t60 + t152*t61 + t153*t62 + t145*t154)
-    t184 = t90 + t183
-    t185 = t91 + t150*t183
-    t186 = t60 + t151*t183
-    t187 = t61 + t152*t183
-    t188 = t62 + t153*t183
-    t189 = t145 + t154*t183
-    t190 = xp.sqrt(t157**2 + t158**2 + t159**2 + t160**2 + t161**2)
-    t191 = t190*xp.where(xp.greater_equal(t157, 0), xp.asarray(1, dtype=dtype), -1)
-    t192 = xp.greater(t190, 0)
-    t193 = xp.where(t192, 1/(t157 + t191), 0)
-    t194 = xp.where(t192, 1 + xp.abs(t157)/t190, 0)
-    t195 = t158*t193
-    t196 = t159*t193
-    t197 = t160*t193
-    t198 = t161*t193
-    t199 = t194*(t164 + t195*t165 + t196*t166 + t197*t167 + t198*t168)
-    t200 = -t199 + t164
-    t201 = t165 - t195*t199
-    t202 = -t166 + t196*t199
-    t203 = -t167 + t197*t199
-    t204 = t168 - t198*t199
-    t205 = t194*(t171 + t195*t172 - t196*t173 - t197*t174 + t198*t175)
-    t206 = -t205 + t171
-    t207 = t172 - t195*t205
-    t208 = t173 + t196*t205
-    t209 = t174 + t197*t205
-    t210 = t175 - t198*t205
-    t211 = t194*(t178 + t195*t179 - t196*t180 - t197*t181 + t198*t182)
-    t212 = -t211 + t178
-    t213 = t179 - t195*t211
-    t214 = t180 + t196*t211
-    t215 = t181 + t197*t211
-    t216 = t182 - t198*t211
-    t217 = t194*(t185 + t195*t186 + t196*t187 + t197*t188 + t198*t189)
-    t218 = -t217 + t185
-    t219 = t186 - t195*t217
-    t220 = -t187 + t196*t217
-    t221 = -t188 + t197*t217
-    t222 = t189 - t198*t217
-    t223 = xp.sqrt(t201**2 + t202**2 + t203**2 + t204**2)
-    t224 = t223*xp.where(xp.greater_equal(t201, 0), xp.asarray(1, dtype=dtype), -1)
-    t225 = xp.greater(t223, 0)
-    t226 = xp.where(t225, 1/(t201 + t224), 0)
-    t227 = xp.where(t225, 1 + xp.abs(t201)/t223, 0)
-    t228 = t202*t226
-    t229 = t203*t226
-    t230 = t204*t226
-    t231 = t227*(t207 + t228*t208 + t229*t209 + t230*t210)
-    t232 = -t231 + t207
-    t233 = t208 - t228*t231
-    t234 = t209 - t229*t231
-    t235 = t210 - t230*t231
-    t236 = t227*(t213 + t228*t214 + t229*t215 + t230*t216)
-    t237 = -t236 + t213
-    t238 = t214 - t228*t236
-    t239 = t215 - t229*t236
-    t240 = t216 - t230*t236
-    t241 = t227*(t219 + t228*t220 + t229*t221 + t230*t222)
-    t242 = -t241 + t219
-    t243 = t220 - t228*t241
-    t244 = t221 - t229*t241
-    t245 = t222 - t230*t241
-    t246 = xp.sqrt(t233**2 + t234**2 + t235**2)
-    t247 = t246*xp.where(xp.greater_equal(t233, 0), xp.asarray(1, dtype=dtype), -1)
-    t248 = xp.greater(t246, 0)
-    t249 = xp.where(t248, 1/(t233 + t247), 0)
-    t250 = xp.where(t248, 1 + xp.abs(t233)/t246, 0)
-    t251 = t234*t249
-    t252 = t235*t249
-    t253 = t250*(t238 + t251*t239 + t252*t240)
-    t254 = -t253 + t238
-    t255 = t239 - t251*t253
-    t256 = t240 - t252*t253
-    t257 = t250*(t243 + t251*t244 + t252*t245)
-    t258 = -t257 + t243
-    t259 = t244 - t251*t257
-    t260 = t245 - t252*t257
-    t261 = xp.sqrt(t255**2 + t256**2)
-    t262 = t261*xp.where(xp.greater_equal(t255, 0), xp.asarray(1, dtype=dtype), -1)
-    t263 = xp.greater(t261, 0)
-    t264 = xp.where(t263, 1/(t255 + t262), 0)
-    t265 = xp.where(t263, 1 + xp.abs(t255)/t261, 0)
-    t266 = t256*t264
-    t267 = t265*(t259 + t266*t260)
-    t268 = -t267 + t259
-    t269 = t260 - t266*t267
-    t270 = xp.abs(t269)
-    t271 = t270*xp.where(xp.greater_equal(t269, 0), xp.asarray(1, dtype=dtype), -1)
-    t272 = xp.where(xp.greater(t270, 0), xp.asarray(2, dtype=dtype), 0)
-    t273 = xp.greater(t96, 0)
-    t274 = xp.where(t273, 1/(t88 + t97), 0)
-    t275 = xp.where(t273, 1 + xp.abs(t88)/t96, 0)
-    t276 = s1*t52
-    t277 = t87*t274
-    t278 = -t275*(t122 + t276*t277)
-    t279 = t122 + t278
-    t280 = t276 + t277*t278
-    t281 = -t275*(t54 + t4*t274 + t57*t277)
-    t282 = t54 + t281
-    t283 = -t275*(t55 + t22*t274 + t58*t277)
-    t284 = t55 + t283
-    t285 = -t275*(t56 + t59*t277 + t48*t274)
-    t286 = t56 + t285
-    t287 = s1*t51
-    t288 = t275*(t123 + t277*t287)
-    t289 = -t288 + t123
-    t290 = -t287
-    t291 = t274*t288
-    t292 = t290 + t87*t291
-    t293 = t274*t281
-    t294 = t57 + t87*t293
-    t295 = t4 + t293
-    t296 = t274*t283
-    t297 = t58 + t87*t296
-    t298 = t22 + t296
-    t299 = t274*t285
-    t300 = t59 + t87*t299
-    t301 = t48 + t299
-    t302 = t274**2
-    t303 = xp.sqrt(t98 + t101 + t106 + t280**2 + t302*t278**2)
-    t304 = t303*xp.where(xp.greater_equal(t280, 0), xp.asarray(1, dtype=dtype), -1)
-    t305 = xp.greater(t303, 0)
-    t306 = xp.where(t305, 1/(t280 + t304), 0)
-    t307 = xp.where(t305, 1 + xp.abs(t280)/t303, 0)
-    t308 = t89*t306
-    t309 = t278*t306
-    t310 = t307*(t292 + t44*t308 - t98*t306 - t101*t306 + t302*t309*t288)
-    t311 = -t310 + t292
-    t312 = t44 - t308*t310
-    t313 = t306*t310
-    t314 = s1 + s1*t313
-    t315 = c1 + c1*t313
-    t316 = s1*t306
-    t317 = c1*t306
-    t318 = t309*t274
-    t319 = t291 - t318*t310
-    t320 = t307*(t294 + t45*t308 + t12*t316 + t13*t317 + t318*t295)
-    t321 = -t320 + t294
-    t322 = t45 - t308*t320
-    t323 = t295 - t318*t320
-    t324 = t307*(t297 + t46*t308 + t318*t298 + t17*t316 + t19*t317)
-    t325 = -t324 + t297
-    t326 = t46 - t308*t324
-    t327 = t298 - t318*t324
-    t328 = t307*(t300 + t47*t308 + t318*t301 + t34*t316 + t39*t317)
-    t329 = -t328 + t300
-    t330 = t47 - t308*t328
-    t331 = t301 - t318*t328
-    t332 = xp.sqrt(t312**2 + t314**2 + t315**2 + t319**2)
-    t333 = t332*xp.where(xp.greater_equal(t312, 0), xp.asarray(1, dtype=dtype), -1)
-    t334 = -t12
-    t335 = t334 + t316*t320
-    t336 = -t13
-    t337 = t336 + t317*t320
-    t338 = -t17
-    t339 = t338 + t316*t324
-    t340 = -t19
-    t341 = t340 + t317*t324
-    t342 = -t34
-    t343 = t342 + t316*t328
-    t344 = -t39
-    t345 = t344 + t317*t328
-    t346 = xp.greater(t332, 0)
-    t347 = xp.where(t346, 1/(t312 + t333), 0)
-    t348 = xp.where(t346, 1 + xp.abs(t312)/t332, 0)
-    t349 = t314*t347
-    t350 = t315*t347
-    t351 = t319*t347
-    t352 = t348*(t322 + t349*t335 + t350*t337 + t351*t323)
-    t353 = -t352 + t322
-    t354 = t335 - t349*t352
-    t355 = t337 - t350*t352
-    t356 = t323 - t351*t352
-    t357 = t348*(t326 + t349*t339 + t350*t341 + t351*t327)
-    t358 = -t357 + t326
-    t359 = t339 - t349*t357
-    t360 = t341 - t350*t357
-    t361 = t327 - t351*t357
-    t362 = t348*(t330 + t349*t343 + t350*t345 + t351*t331)
-    t363 = -t362 + t330
-    t364 = t343 - t349*t362
-    t365 = t345 - t350*t362
-    t366 = t331 - t351*t362
-    t367 = xp.sqrt(t354**2 + t355**2 + t356**2)
-    t368 = t367*xp.where(xp.greater_equal(t354, 0), xp.asarray(1, dtype=dtype), -1)
-    t369 = xp.greater(t367, 0)
-    t370 = xp.where(t369, 1/(t354 + t368), 0)
-    t371 = xp.where(t369, 1 + xp.abs(t354)/t367, 0)
-    t372 = t355*t370
-    t373 = t356*t370
-    t374 = t371*(t359 + t372*t360 + t373*t361)
-    t375 = -t374 + t359
-    t376 = t360 - t372*t374
-    t377 = t361 - t373*t374
-    t378 = t371*(t364 + t372*t365 + t373*t366)
-    t379 = -t378 + t364
-    t380 = t365 - t372*t378
-    t381 = t366 - t373*t378
-    t382 = xp.sqrt(t376**2 + t377**2)
-    t383 = t382*xp.where(xp.greater_equal(t376, 0), xp.asarray(1, dtype=dtype), -1)
-    t384 = xp.greater(t382, 0)
-    t385 = xp.where(t384, 1/(t376 + t383), 0)
-    t386 = xp.where(t384, 1 + xp.abs(t376)/t382, 0)
-    t387 = t377*t385
-    t388 = t386*(t380 + t387*t381)
-    t389 = -t388 + t380
-    t390 = t381 - t387*t388
-    t391 = xp.abs(t390)
-    t392 = t391*xp.where(xp.greater_equal(t390, 0), xp.asarray(1, dtype=dtype), -1)
-    t393 = xp.where(xp.greater(t391, 0), xp.asarray(2, dtype=dtype), 0)
-    t394 = -t82
-    t395 = 0.5*(-1 + t394 + t67 + t74)
-    t396 = xp.atan2(t85, t395)
-    t397 = xp.where(xp.greater(t85, 0), t396/t85, 1)
-    t398 = xp.greater_equal(t67, t74) & xp.greater_equal(t67, t394)
-    t399 = xp.greater_equal(t74, t394)
-    t400 = xp.where(t398, 0.5*(1 + t67), xp.where(t399, 0.5*t73, -0.5*t80))
-    t401 = xp.where(t398, 0.5*t68, xp.where(t399, 0.5*(1 + t74), -0.5*t81))
-    t402 = xp.where(t398, 0.5*t69, xp.where(t399, 0.5*t75, 0.5*(1 + t394)))
-    t403 = xp.sqrt(t400**2 + t401**2 + t402**2)
-    t404 = xp.where(xp.greater_equal(t83*t400 + t84*t401 + t76*t402, 0), xp.asarray(1, dtype=dtype), -1)
-    t405 = xp.greater(t85, 1e-06) | xp.greater(t395, 0)
-    t406 = t396*t404/t403
-    t407 = xp.where(t405, t83*t397, t406*t400)
-    t408 = xp.where(t405, t84*t397, t406*t401)
-    t409 = xp.where(t405, t76*t397, t406*t402)
-    t410 = mu_dot3 + t407*gain3
-    t411 = mu_dot4 + t408*gain4
-    t412 = mu_dot5 + t409*gain5
-    t413 = -t87
-    t414 = mu_dot0 + gain0*(t413 + T03)
-    t415 = t149*(t414 - t150*t92 - t151*t63 + t152*t410 + t153*t411 - t154*t412)
-    t416 = -t415 + t414
-    t417 = t92 + t150*t415
-    t418 = t63 + t151*t415
-    t419 = t410 - t152*t415
-    t420 = t411 - t153*t415
-    t421 = t412 + t154*t415
-    t422 = t194*(t417 + t195*t418 - t196*t419 - t197*t420 + t198*t421)
-    t423 = -t422 + t417
-    t424 = t418 - t195*t422
-    t425 = t419 + t196*t422
-    t426 = t420 + t197*t422
-    t427 = t421 - t198*t422
-    t428 = t227*(t424 + t228*t425 + t229*t426 + t230*t427)
-    t429 = -t428 + t424
-    t430 = t425 - t228*t428
-    t431 = t426 - t229*t428
-    t432 = t427 - t230*t428
-    t433 = t250*(t430 + t251*t431 + t252*t432)
-    t434 = -t433 + t430
-    t435 = t431 - t251*t433
-    t436 = t432 - t252*t433
-    t437 = t265*(t435 + t266*t436)
-    t438 = -t437 + t435
-    t439 = t436 - t266*t437
-    t440 = t439 - t272*t439
-    t441 = xp.where(xp.not_equal(t271, 0), -t440/t271, 0)
-    t442 = xp.where(xp.not_equal(t262, 0), -(t438 - t268*t441)/t262, 0)
-    t443 = xp.where(xp.not_equal(t247, 0), -(-(t254*t442 + t258*t441) + t434)/t247, 0)
-    t444 = xp.where(xp.not_equal(t224, 0), -(-(t232*t443 + t237*t442 + t242*t441) + t429)/t224, 0)
-    t445 = xp.where(xp.not_equal(t191, 0), -(-(t200*t444 + t206*t443 + t212*t442 + t218*t441) + t423)/t191, 0)
-    t446 = xp.where(xp.not_equal(t140, 0), -(t416 + t156*t445 + t163*t444 + t184*t441 - t170*t443 - t177*t442)/t140, 0)
-    t447 = t441 + t87*t445 - t88*t446
-    t448 = -t54*t446 + t57*t445 + t45*t444 - t12*t443 - t13*t442 + t4*t441
-    t449 = -t55*t446 + t58*t445 + t46*t444 - t17*t443 - t19*t442 + t22*t441
-    t450 = -t56*t446 + t59*t445 + t47*t444 - t34*t443 - t39*t442 + t48*t441
-    t451 = -t275*(-t414 + t274*t412 + t277*t92)
-    t452 = -t451 + t414
-    t453 = -1 - t54 - t55 - t56 - t122 + q1 + q2 + q3 + t4 + q4 + q5 + q6 + t88 + t22 + t48 + t123 + t57 + t58 + t59 + t89 + t44 + t45 + t46 + t47 + t276 + t290 + t334 + t336 + t338 + t340 + t342 + t344 + t413 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t414 + t92 + t63 + t410 + t411 + t412
-    t454 = s1*t443 + c1*t442
-    t455 = t454 - t89*t444 + t122*t446 - t276*t445
-    t456 = t454 + t44*t444 + t123*t446 - t287*t445
-    t457 = t274*t451
-    t458 = t92 + t87*t457
-    t459 = t457 + t412
-    t460 = t307*(t458 + t308*t63 - t316*t410 - t317*t411 + t318*t459)
-    t461 = -t460 + t458
-    t462 = t63 - t308*t460
-    t463 = t410 + t316*t460
-    t464 = t411 + t317*t460
-    t465 = t459 - t318*t460
-    t466 = t348*(t462 + t349*t463 + t350*t464 + t351*t465)
-    t467 = -t466 + t462
-    t468 = t463 - t349*t466
-    t469 = t464 - t350*t466
-    t470 = t465 - t351*t466
-    t471 = t371*(t468 + t372*t469 + t373*t470)
-    t472 = -t471 + t468
-    t473 = t469 - t372*t471
-    t474 = t470 - t373*t471
-    t475 = t386*(t473 + t387*t474)
-    t476 = -t475 + t473
-    t477 = t474 - t387*t475
-    t478 = t477 - t393*t477
-    t479 = xp.where(xp.not_equal(t392, 0), -t478/t392, 0)
-    t480 = xp.where(xp.not_equal(t383, 0), -(t476 - t389*t479)/t383, 0)
-    t481 = xp.where(xp.not_equal(t368, 0), -(-(t375*t480 + t379*t479) + t472)/t368, 0)
-    t482 = xp.where(xp.not_equal(t333, 0), -(-(t353*t481 + t358*t480 + t363*t479) + t467)/t333, 0)
-    t483 = xp.where(xp.not_equal(t304, 0), -(-(t311*t482 + t321*t481 + t325*t480 + t329*t479) + t461)/t304, 0)
-    t484 = xp.where(xp.not_equal(t97, 0), -(t452 + t279*t483 + t282*t481 + t284*t480 + t286*t479 - t289*t482)/t97, 0)
-    t485 = xp.isfinite(t453)
-    t486 = xp.greater_equal(damping, 0)
-    t487 = xp.greater(damping, 0)
-    t488 = 1e-12*t146
-    t489 = 1e-12*t113
-    t490 = (t487 & (xp.less_equal(t139, t488) | xp.less_equal(t190, t488) | xp.less_equal(t223, t488) | xp.less_equal(t246, t488) | xp.less_equal(t261, t488) | xp.less_equal(t270, t488))) | (xp.less_equal(damping, 0) & (xp.less_equal(t96, t489) | xp.less_equal(t303, t489) | xp.less_equal(t332, t489) | xp.less_equal(t367, t489) | xp.less_equal(t382, t489) | xp.less_equal(t391, t489)))
-    t491 = t485 & t486 & xp.logical_not(t490)
+    t131 = xp.greater(t96, 0)
+    t132 = xp.where(t131, 1/(t88 + t97), 0)
+    t133 = xp.where(t131, 1 + xp.abs(t88)/t96, 0)
+    t134 = s1*t52
+    t135 = t87*t132
+    t136 = -t133*(t122 + t134*t135)
+    t137 = t122 + t136
+    t138 = t134 + t135*t136
+    t139 = -t133*(t54 + t4*t132 + t57*t135)
+    t140 = t54 + t139
+    t141 = -t133*(t55 + t22*t132 + t58*t135)
+    t142 = t55 + t141
+    t143 = -t133*(t56 + t59*t135 + t48*t132)
+    t144 = t56 + t143
+    t145 = s1*t51
+    t146 = t133*(t123 + t135*t145)
+    t147 = -t146 + t123
+    t148 = -t145
+    t149 = t132*t146
+    t150 = t148 + t87*t149
+    t151 = t132*t139
+    t152 = t57 + t87*t151
+    t153 = t4 + t151
+    t154 = t132*t141
+    t155 = t58 + t87*t154
+    t156 = t22 + t154
+    t157 = t132*t143
+    t158 = t59 + t87*t157
+    t159 = t48 + t157
+    t160 = t132**2
+    t161 = xp.sqrt(t98 + t101 + t106 + t138**2 + t160*t136**2)
+    t162 = t161*xp.where(xp.greater_equal(t138, 0), xp.asarray(1, dtype=dtype), -1)
+    t163 = xp.greater(t161, 0)
+    t164 = xp.where(t163, 1/(t138 + t162), 0)
+    t165 = xp.where(t163, 1 + xp.abs(t138)/t161, 0)
+    t166 = t89*t164
+    t167 = t136*t164
+    t168 = t165*(t44*t166 + t150 - t98*t164 - t101*t164 + t160*t167*t146)
+    t169 = -t168 + t150
+    t170 = t44 - t166*t168
+    t171 = t164*t168
+    t172 = s1 + s1*t171
+    t173 = c1 + c1*t171
+    t174 = s1*t164
+    t175 = c1*t164
+    t176 = t167*t132
+    t177 = t149 - t176*t168
+    t178 = t165*(t45*t166 + t152 + t12*t174 + t13*t175 + t176*t153)
+    t179 = -t178 + t152
+    t180 = t45 - t166*t178
+    t181 = t153 - t176*t178
+    t182 = t165*(t155 + t46*t166 + t176*t156 + t17*t174 + t19*t175)
+    t183 = -t182 + t155
+    t184 = t46 - t166*t182
+    t185 = t156 - t176*t182
+    t186 = t165*(t47*t166 + t158 + t176*t159 + t34*t174 + t39*t175)
+    t187 = -t186 + t158
+    t188 = t47 - t166*t186
+    t189 = t159 - t176*t186
+    t190 = xp.sqrt(t170**2 + t172**2 + t173**2 + t177**2)
+    t191 = t190*xp.where(xp.greater_equal(t170, 0), xp.asarray(1, dtype=dtype), -1)
+    t192 = -t12
+    t193 = t192 + t174*t178
+    t194 = -t13
+    t195 = t194 + t175*t178
+    t196 = -t17
+    t197 = t196 + t174*t182
+    t198 = -t19
+    t199 = t198 + t175*t182
+    t200 = -t34
+    t201 = t200 + t174*t186
+    t202 = -t39
+    t203 = t202 + t175*t186
+    t204 = xp.greater(t190, 0)
+    t205 = xp.where(t204, 1/(t170 + t191), 0)
+    t206 = xp.where(t204, 1 + xp.abs(t170)/t190, 0)
+    t207 = t172*t205
+    t208 = t173*t205
+    t209 = t177*t205
+    t210 = t206*(t180 + t207*t193 + t208*t195 + t209*t181)
+    t211 = -t210 + t180
+    t212 = t193 - t207*t210
+    t213 = t195 - t208*t210
+    t214 = t181 - t209*t210
+    t215 = t206*(t184 + t207*t197 + t208*t199 + t209*t185)
+    t216 = -t215 + t184
+    t217 = t197 - t207*t215
+    t218 = t199 - t208*t215
+    t219 = t185 - t209*t215
+    t220 = t206*(t188 + t207*t201 + t208*t203 + t209*t189)
+    t221 = -t220 + t188
+    t222 = t201 - t207*t220
+    t223 = t203 - t208*t220
+    t224 = t189 - t209*t220
+    t225 = xp.sqrt(t212**2 + t213**2 + t214**2)
+    t226 = t225*xp.where(xp.greater_equal(t212, 0), xp.asarray(1, dtype=dtype), -1)
+    t227 = xp.greater(t225, 0)
+    t228 = xp.where(t227, 1/(t212 + t226), 0)
+    t229 = xp.where(t227, 1 + xp.abs(t212)/t225, 0)
+    t230 = t213*t228
+    t231 = t214*t228
+    t232 = t229*(t217 + t230*t218 + t231*t219)
+    t233 = -t232 + t217
+    t234 = t218 - t230*t232
+    t235 = t219 - t231*t232
+    t236 = t229*(t222 + t230*t223 + t231*t224)
+    t237 = -t236 + t222
+    t238 = t223 - t230*t236
+    t239 = t224 - t231*t236
+    t240 = xp.sqrt(t234**2 + t235**2)
+    t241 = t240*xp.where(xp.greater_equal(t234, 0), xp.asarray(1, dtype=dtype), -1)
+    t242 = xp.greater(t240, 0)
+    t243 = xp.where(t242, 1/(t234 + t241), 0)
+    t244 = xp.where(t242, 1 + xp.abs(t234)/t240, 0)
+    t245 = t235*t243
+    t246 = t244*(t238 + t245*t239)
+    t247 = -t246 + t238
+    t248 = t239 - t245*t246
+    t249 = xp.abs(t248)
+    t250 = t249*xp.where(xp.greater_equal(t248, 0), xp.asarray(1, dtype=dtype), -1)
+    t251 = xp.where(xp.greater(t249, 0), xp.asarray(2, dtype=dtype), 0)
+    t252 = -t82
+    t253 = 0.5*(-1 + t252 + t67 + t74)
+    t254 = xp.atan2(t85, t253)
+    t255 = xp.where(xp.greater(t85, 0), t254/t85, 1)
+    t256 = xp.greater_equal(t67, t74) & xp.greater_equal(t67, t252)
+    t257 = xp.greater_equal(t74, t252)
+    t258 = xp.where(t256, 0.5*(1 + t67), xp.where(t257, 0.5*t73, -0.5*t80))
+    t259 = xp.where(t256, 0.5*t68, xp.where(t257, 0.5*(1 + t74), -0.5*t81))
+    t260 = xp.where(t256, 0.5*t69, xp.where(t257, 0.5*t75, 0.5*(1 + t252)))
+    t261 = xp.sqrt(t258**2 + t259**2 + t260**2)
+    t262 = xp.where(xp.greater_equal(t83*t258 + t84*t259 + t76*t260, 0), xp.asarray(1, dtype=dtype), -1)
+    t263 = xp.greater(t85, 1e-06) | xp.greater(t253, 0)
+    t264 = t254*t262/t261
+    t265 = xp.where(t263, t83*t255, t264*t258)
+    t266 = xp.where(t263, t84*t255, t264*t259)
+    t267 = xp.where(t263, t76*t255, t264*t260)
+    t268 = mu_dot3 + t265*gain3
+    t269 = mu_dot4 + t266*gain4
+    t270 = mu_dot5 + t267*gain5
+    t271 = -t87
+    t272 = mu_dot0 + gain0*(t271 + T03)
+    t273 = -t133*(-t272 + t132*t270 + t135*t92)
+    t274 = -t273 + t272
+    t275 = -1 - t54 - t55 - t56 - t122 + q1 + q2 + q3 + t4 + q4 + q5 + q6 + t88 + t22 + t48 + t123 + t57 + t58 + t59 + t89 + t44 + t45 + t46 + t47 + t134 + t148 + t192 + t194 + t196 + t198 + t200 + t202 + t271 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t272 + t92 + t63 + t268 + t269 + t270
+    t276 = damping**2
+    t277 = _symmetric_solve6(xp, 1, (t276 + t111, -t116, -t120, t125, t102, -t90, t276 + t114, t129, -t99, -t126, t91, t107 + t276, -t130, -t121, t60, t100 + t276, t117, -t61, t103 + t276, -t62, t276 + t105, t272, t92, t63, t268, t269, t270,))
+    t278 = t277[5]
+    t279 = t277[0]
+    t280 = t277[1]
+    t281 = t278 - t88*t279 + t87*t280
+    t282 = t277[2]
+    t283 = t277[3]
+    t284 = t277[4]
+    t285 = -t54*t279 + t57*t280 + t45*t282 - t12*t283 - t13*t284 + t4*t278
+    t286 = -t55*t279 + t58*t280 + t46*t282 - t17*t283 - t19*t284 + t22*t278
+    t287 = -t56*t279 + t59*t280 + t47*t282 - t34*t283 - t39*t284 + t48*t278
+    t288 = s1*t283 + c1*t284
+    t289 = t288 + t122*t279 - t134*t280 - t89*t282
+    t290 = t288 + t123*t279 - t145*t280 + t44*t282
+    t291 = t132*t273
+    t292 = t92 + t87*t291
+    t293 = t291 + t270
+    t294 = t165*(t292 + t166*t63 - t174*t268 - t175*t269 + t176*t293)
+    t295 = -t294 + t292
+    t296 = t63 - t166*t294
+    t297 = t268 + t174*t294
+    t298 = t269 + t175*t294
+    t299 = t293 - t176*t294
+    t300 = t206*(t296 + t207*t297 + t208*t298 + t209*t299)
+    t301 = -t300 + t296
+    t302 = t297 - t207*t300
+    t303 = t298 - t208*t300
+    t304 = t299 - t209*t300
+    t305 = t229*(t302 + t230*t303 + t231*t304)
+    t306 = -t305 + t302
+    t307 = t303 - t230*t305
+    t308 = t304 - t231*t305
+    t309 = t244*(t307 + t245*t308)
+    t310 = -t309 + t307
+    t311 = t308 - t245*t309
+    t312 = t311 - t251*t311
+    t313 = xp.where(xp.not_equal(t250, 0), -t312/t250, 0)
+    t314 = xp.where(xp.not_equal(t241, 0), -(t310 - t247*t313)/t241, 0)
+    t315 = xp.where(xp.not_equal(t226, 0), -(-(t233*t314 + t237*t313) + t306)/t226, 0)
+    t316 = xp.where(xp.not_equal(t191, 0), -(-(t211*t315 + t216*t314 + t221*t313) + t301)/t191, 0)
+    t317 = xp.where(xp.not_equal(t162, 0), -(-(t169*t316 + t179*t315 + t183*t314 + t187*t313) + t295)/t162, 0)
+    t318 = xp.where(xp.not_equal(t97, 0), -(t274 + t137*t317 + t140*t315 + t142*t314 + t144*t313 - t147*t316)/t97, 0)
+    t319 = xp.isfinite(t275)
+    t320 = xp.greater_equal(damping, 0)
+    t321 = xp.greater(damping, 0)
+    t322 = 1e-12*t113
+    t323 = (t321 & xp.greater(t277[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t96, t322) | xp.less_equal(t161, t322) | xp.less_equal(t190, t322) | xp.less_equal(t225, t322) | xp.less_equal(t240, t322) | xp.less_equal(t249, t322)))
+    t324 = t319 & t320 & xp.logical_not(t323)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t491, xp.where(t487, -t447, t484), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t491, xp.where(t487, -t455, t483), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t491, xp.where(t487, t456, t482), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t491, xp.where(t487, t448, t481), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t491, xp.where(t487, t449, t480), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t491, xp.where(t487, t450, t479), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t324, xp.where(t321, -t281, t318), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t324, xp.where(t321, -t289, t317), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t324, xp.where(t321, t290, t316), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t324, xp.where(t321, t285, t315), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t324, xp.where(t321, t286, t314), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t324, xp.where(t321, t287, t313), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t485 & t486), 2, xp.where(t490, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t319 & t320), 2, xp.where(t323, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 1069 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 1134 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (6,)), ("damping", damping, ()))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
@@ -5705,182 +5431,23 @@ def ik_numeric_step(target, q, damping=0.0):
     t135 = xp.where(t132, t86*t124, t133*t128)
     t136 = xp.where(t132, t78*t124, t133*t129)
     t137 = t134**2 + t135**2 + t136**2 + t95**2 + t96**2 + t65**2
-    t138 = damping + t102
-    t139 = xp.sqrt(t138**2 + t104**2 + t108**2 + t111**2 + t98**2 + t92**2)
-    t140 = t139*xp.where(xp.greater_equal(t138, 0), xp.asarray(1, dtype=dtype), -1)
-    t141 = xp.greater(t139, 0)
-    t142 = xp.where(t141, 1/(t138 + t140), 0)
-    t143 = xp.where(t141, 1 + xp.abs(t138)/t139, 0)
-    t144 = damping + t114
-    t145 = t104*t142
-    t146 = t108*t142
-    t147 = t111*t142
-    t148 = t98*t142
-    t149 = t92*t142
-    t150 = -t143*(t104 + t144*t145 + t146*t119 + t147*t115 + t148*t112 + t149*t93)
-    t151 = t104 + t150
-    t152 = t144 + t145*t150
-    t153 = t119 + t146*t150
-    t154 = t115 + t147*t150
-    t155 = t112 + t148*t150
-    t156 = t93 + t149*t150
-    t157 = t143*(t95 - t145*t96 - t146*t65 + t147*t134 + t148*t135 - t149*t136)
-    t158 = -t157 + t95
-    t159 = t96 + t145*t157
-    t160 = t65 + t146*t157
-    t161 = t134 - t147*t157
-    t162 = t135 - t148*t157
-    t163 = t136 + t149*t157
-    t164 = xp.sqrt(t152**2 + t153**2 + t154**2 + t155**2 + t156**2)
-    t165 = t164*xp.where(xp.greater_equal(t152, 0), xp.asarray(1, dtype=dtype), -1)
-    t166 = damping + t94
-    t167 = -t143*(t108 + t145*t119 + t146*t166 + t147*t120 + t148*t109 + t149*t61)
-    t168 = t108 + t167
-    t169 = t119 + t145*t167
-    t170 = t166 + t146*t167
-    t171 = t120 + t147*t167
-    t172 = t109 + t148*t167
-    t173 = t61 + t149*t167
-    t174 = damping + t116
-    t175 = t143*(t111 + t145*t115 + t146*t120 + t147*t174 + t148*t105 + t149*t62)
-    t176 = -t175 + t111
-    t177 = -t115 + t145*t175
-    t178 = -t120 + t146*t175
-    t179 = t174 - t147*t175
-    t180 = t105 - t148*t175
-    t181 = -t62 + t149*t175
-    t182 = damping + t99
-    t183 = t143*(t98 + t145*t112 + t146*t109 + t147*t105 + t148*t182 + t149*t63)
-    t184 = -t183 + t98
-    t185 = -t112 + t145*t183
-    t186 = -t109 + t146*t183
-    t187 = t105 - t147*t183
-    t188 = t182 - t148*t183
-    t189 = -t63 + t149*t183
-    t190 = damping + t64
-    t191 = -t143*(t92 + t145*t93 + t146*t61 + t147*t62 + t148*t63 + t149*t190)
-    t192 = t92 + t191
-    t193 = t93 + t145*t191
-    t194 = t61 + t146*t191
-    t195 = t62 + t147*t191
-    t196 = t63 + t148*t191
-    t197 = t190 + t149*t191
-    t198 = xp.greater(t164, 0)
-    t199 = xp.where(t198, 1/(t152 + t165), 0)
-    t200 = xp.where(t198, 1 + xp.abs(t152)/t164, 0)
-    t201 = t153*t199
-    t202 = t154*t199
-    t203 = t155*t199
-    t204 = t156*t199
-    t205 = t200*(t169 + t201*t170 + t202*t171 + t203*t172 + t204*t173)
-    t206 = -t205 + t169
-    t207 = t170 - t201*t205
-    t208 = -t171 + t202*t205
-    t209 = -t172 + t203*t205
-    t210 = t173 - t204*t205
-    t211 = t200*(t177 + t201*t178 - t202*t179 - t203*t180 + t204*t181)
-    t212 = -t211 + t177
-    t213 = t178 - t201*t211
-    t214 = t179 + t202*t211
-    t215 = t180 + t203*t211
-    t216 = t181 - t204*t211
-    t217 = t200*(t185 + t201*t186 - t202*t187 - t203*t188 + t204*t189)
-    t218 = -t217 + t185
-    t219 = t186 - t201*t217
-    t220 = t187 + t202*t217
-    t221 = t188 + t203*t217
-    t222 = t189 - t204*t217
-    t223 = t200*(t193 + t201*t194 + t202*t195 + t203*t196 + t204*t197)
-    t224 = -t223 + t193
-    t225 = t194 - t201*t223
-    t226 = -t195 + t202*t223
-    t227 = -t196 + t203*t223
-    t228 = t197 - t204*t223
-    t229 = t200*(t159 + t201*t160 - t202*t161 - t203*t162 + t204*t163)
-    t230 = -t229 + t159
-    t231 = t160 - t201*t229
-    t232 = t161 + t202*t229
-    t233 = t162 + t203*t229
-    t234 = t163 - t204*t229
-    t235 = xp.sqrt(t207**2 + t208**2 + t209**2 + t210**2)
-    t236 = t235*xp.where(xp.greater_equal(t207, 0), xp.asarray(1, dtype=dtype), -1)
-    t237 = xp.greater(t235, 0)
-    t238 = xp.where(t237, 1/(t207 + t236), 0)
-    t239 = xp.where(t237, 1 + xp.abs(t207)/t235, 0)
-    t240 = t208*t238
-    t241 = t209*t238
-    t242 = t210*t238
-    t243 = t239*(t213 + t240*t214 + t241*t215 + t242*t216)
-    t244 = -t243 + t213
-    t245 = t214 - t240*t243
-    t246 = t215 - t241*t243
-    t247 = t216 - t242*t243
-    t248 = t239*(t219 + t240*t220 + t241*t221 + t242*t222)
-    t249 = -t248 + t219
-    t250 = t220 - t240*t248
-    t251 = t221 - t241*t248
-    t252 = t222 - t242*t248
-    t253 = t239*(t225 + t240*t226 + t241*t227 + t242*t228)
-    t254 = -t253 + t225
-    t255 = t226 - t240*t253
-    t256 = t227 - t241*t253
-    t257 = t228 - t242*t253
-    t258 = t239*(t231 + t240*t232 + t241*t233 + t242*t234)
-    t259 = -t258 + t231
-    t260 = t232 - t240*t258
-    t261 = t233 - t241*t258
-    t262 = t234 - t242*t258
-    t263 = xp.sqrt(t245**2 + t246**2 + t247**2)
-    t264 = t263*xp.where(xp.greater_equal(t245, 0), xp.asarray(1, dtype=dtype), -1)
-    t265 = xp.greater(t263, 0)
-    t266 = xp.where(t265, 1/(t245 + t264), 0)
-    t267 = xp.where(t265, 1 + xp.abs(t245)/t263, 0)
-    t268 = t246*t266
-    t269 = t247*t266
-    t270 = t267*(t250 + t268*t251 + t269*t252)
-    t271 = -t270 + t250
-    t272 = t251 - t268*t270
-    t273 = t252 - t269*t270
-    t274 = t267*(t255 + t268*t256 + t269*t257)
-    t275 = -t274 + t255
-    t276 = t256 - t268*t274
-    t277 = t257 - t269*t274
-    t278 = t267*(t260 + t268*t261 + t269*t262)
-    t279 = -t278 + t260
-    t280 = t261 - t268*t278
-    t281 = t262 - t269*t278
-    t282 = xp.sqrt(t272**2 + t273**2)
-    t283 = t282*xp.where(xp.greater_equal(t272, 0), xp.asarray(1, dtype=dtype), -1)
-    t284 = xp.greater(t282, 0)
-    t285 = xp.where(t284, 1/(t272 + t283), 0)
-    t286 = xp.where(t284, 1 + xp.abs(t272)/t282, 0)
-    t287 = t273*t285
-    t288 = t286*(t276 + t287*t277)
-    t289 = -t288 + t276
-    t290 = t277 - t287*t288
-    t291 = t286*(t280 + t287*t281)
-    t292 = -t291 + t280
-    t293 = t281 - t287*t291
-    t294 = xp.abs(t290)
-    t295 = t294*xp.where(xp.greater_equal(t290, 0), xp.asarray(1, dtype=dtype), -1)
-    t296 = xp.where(xp.greater(t294, 0), xp.asarray(2, dtype=dtype), 0)
-    t297 = t293 - t293*t296
-    t298 = xp.where(xp.not_equal(t295, 0), -t297/t295, 0)
-    t299 = xp.where(xp.not_equal(t283, 0), -(t292 - t289*t298)/t283, 0)
-    t300 = xp.where(xp.not_equal(t264, 0), -(-(t271*t299 + t275*t298) + t279)/t264, 0)
-    t301 = xp.where(xp.not_equal(t236, 0), -(-(t244*t300 + t249*t299 + t254*t298) + t259)/t236, 0)
-    t302 = xp.where(xp.not_equal(t165, 0), -(-(t206*t301 + t212*t300 + t218*t299 + t224*t298) + t230)/t165, 0)
-    t303 = xp.where(xp.not_equal(t140, 0), -(t158 + t151*t302 + t168*t301 + t192*t298 - t176*t300 - t184*t299)/t140, 0)
-    t304 = -t298 + q1 + t90*t303 - t89*t302
-    t305 = q4 - t55*t303 + t58*t302 + t46*t301 - t13*t300 - t14*t299 + t5*t298
-    t306 = q5 - t56*t303 + t59*t302 + t47*t301 - t18*t300 - t20*t299 + t23*t298
-    t307 = q6 - t57*t303 + t60*t302 + t48*t301 - t35*t300 - t40*t299 + t49*t298
-    t308 = c1*t303
-    t309 = s1*t302
-    t310 = s1*t300
-    t311 = c1*t299
-    t312 = -t310 - t311 + q2 + t91*t301 - t53*t308 + t53*t309
-    t313 = q3 + t310 + t311 + t45*t301 + t52*t308 - t52*t309
+    t138 = _symmetric_solve6(xp, 1, (damping + t102, -t104, -t108, t111, t98, -t92, damping + t114, t119, -t115, -t112, t93, damping + t94, -t120, -t109, t61, damping + t116, t105, -t62, damping + t99, -t63, damping + t64, t95, t96, t65, t134, t135, t136,))
+    t139 = t138[5]
+    t140 = t138[0]
+    t141 = t138[1]
+    t142 = -t139 + q1 + t90*t140 - t89*t141
+    t143 = c1*t140
+    t144 = s1*t141
+    t145 = t138[2]
+    t146 = t138[3]
+    t147 = s1*t146
+    t148 = t138[4]
+    t149 = q4 + t46*t145 - t13*t146 - t140*t55 + t141*t58 - t14*t148 + t5*t139
+    t150 = q5 + t47*t145 - t18*t146 - t140*t56 + t141*t59 - t20*t148 + t23*t139
+    t151 = q6 + t49*t139 + t141*t60 + t48*t145 - t140*t57 - t35*t146 - t40*t148
+    t152 = c1*t148
+    t153 = -t147 - t152 + q2 + t91*t145 + t53*t144 - t53*t143
+    t154 = q3 + t147 + t152 + t45*t145 + t52*t143 - t52*t144
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -5890,12 +5457,12 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q6, batch),  # 5
     ], (6,))
     q_next = _stack(xp, [
-        xp.broadcast_to(t304, batch),  # 0
-        xp.broadcast_to(t312, batch),  # 1
-        xp.broadcast_to(t313, batch),  # 2
-        xp.broadcast_to(t305, batch),  # 3
-        xp.broadcast_to(t306, batch),  # 4
-        xp.broadcast_to(t307, batch),  # 5
+        xp.broadcast_to(t142, batch),  # 0
+        xp.broadcast_to(t153, batch),  # 1
+        xp.broadcast_to(t154, batch),  # 2
+        xp.broadcast_to(t149, batch),  # 3
+        xp.broadcast_to(t150, batch),  # 4
+        xp.broadcast_to(t151, batch),  # 5
     ], (6,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t0), t137, -1), batch)
     return q_start, q_next, cost
@@ -6738,7 +6305,7 @@ def ik_general_limits(q_solution):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 1219 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 1218 operations."""
     xp, dtype, device, batch, (T, q_seed, weights,) = _arguments(("T", T, (4, 4)), ("q_seed", q_seed, (6,)), ("weights", weights, (6,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(T)
     T00 = T[..., 0, 0]
@@ -6893,326 +6460,35 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     lb13 = branches_in_limits[..., 13]
     lb14 = branches_in_limits[..., 14]
     lb15 = branches_in_limits[..., 15]
-    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
-    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
-    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
-    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
-    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
-    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
-    t6 = xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0)
-    t7 = xp.where(xp.greater(t6, 0), xp.asarray(1, dtype=dtype), 0)
-    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
-    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
-    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
-    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
-    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
-    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
-    t14 = xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0)
-    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
-    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
-    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
-    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
-    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
-    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
-    t21 = xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0)
-    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
-    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
-    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
-    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
-    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
-    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
-    t28 = xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0)
-    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
-    t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
-    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
-    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
-    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
-    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
-    t35 = xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0)
-    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
-    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
-    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
-    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
-    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
-    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
-    t42 = xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0)
-    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
-    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
-    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
-    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
-    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
-    t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
-    t49 = xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0)
-    t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
-    t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
-    t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
-    t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
-    t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
-    t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
-    t56 = xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0)
-    t57 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_0 + qn1)) + qb8_0
-    t58 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_1 + qn2)) + qb8_1
-    t59 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_2 + qn3)) + qb8_2
-    t60 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_3 + qn4)) + qb8_3
-    t61 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_4 + qn5)) + qb8_4
-    t62 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_5 + qn6)) + qb8_5
-    t63 = xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0)
-    t64 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_0 + qn1)) + qb9_0
-    t65 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_1 + qn2)) + qb9_1
-    t66 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_2 + qn3)) + qb9_2
-    t67 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_3 + qn4)) + qb9_3
-    t68 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_4 + qn5)) + qb9_4
-    t69 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_5 + qn6)) + qb9_5
-    t70 = xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0)
-    t71 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_0 + qn1)) + qb10_0
-    t72 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_1 + qn2)) + qb10_1
-    t73 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_2 + qn3)) + qb10_2
-    t74 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_3 + qn4)) + qb10_3
-    t75 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_4 + qn5)) + qb10_4
-    t76 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_5 + qn6)) + qb10_5
-    t77 = xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0)
-    t78 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_0 + qn1)) + qb11_0
-    t79 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_1 + qn2)) + qb11_1
-    t80 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_2 + qn3)) + qb11_2
-    t81 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_3 + qn4)) + qb11_3
-    t82 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_4 + qn5)) + qb11_4
-    t83 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_5 + qn6)) + qb11_5
-    t84 = xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0)
-    t85 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_0 + qn1)) + qb12_0
-    t86 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_1 + qn2)) + qb12_1
-    t87 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_2 + qn3)) + qb12_2
-    t88 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_3 + qn4)) + qb12_3
-    t89 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_4 + qn5)) + qb12_4
-    t90 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_5 + qn6)) + qb12_5
-    t91 = xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0)
-    t92 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_0 + qn1)) + qb13_0
-    t93 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_1 + qn2)) + qb13_1
-    t94 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_2 + qn3)) + qb13_2
-    t95 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_3 + qn4)) + qb13_3
-    t96 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_4 + qn5)) + qb13_4
-    t97 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_5 + qn6)) + qb13_5
-    t98 = xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0)
-    t99 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_0 + qn1)) + qb14_0
-    t100 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_1 + qn2)) + qb14_1
-    t101 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_2 + qn3)) + qb14_2
-    t102 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_3 + qn4)) + qb14_3
-    t103 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_4 + qn5)) + qb14_4
-    t104 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_5 + qn6)) + qb14_5
-    t105 = xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0)
-    t106 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_0 + qn1)) + qb15_0
-    t107 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_1 + qn2)) + qb15_1
-    t108 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_2 + qn3)) + qb15_2
-    t109 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_3 + qn4)) + qb15_3
-    t110 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_4 + qn5)) + qb15_4
-    t111 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_5 + qn6)) + qb15_5
-    t112 = xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0)
-    t113 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
-    t114 = -qn1
-    t115 = -qn2
-    t116 = -qn3
-    t117 = -qn4
-    t118 = -qn5
-    t119 = -qn6
-    t120 = qw1*(t114 + t0)**2 + qw2*(t115 + t1)**2 + qw3*(t116 + t2)**2 + qw4*(t117 + t3)**2 + qw5*(t118 + t4)**2 + qw6*(t119 + t5)**2
-    t121 = qw1*(t114 + t8)**2 + qw2*(t115 + t9)**2 + qw3*(t116 + t10)**2 + qw4*(t117 + t11)**2 + qw5*(t118 + t12)**2 + qw6*(t119 + t13)**2
-    t122 = qw1*(t114 + t15)**2 + qw2*(t115 + t16)**2 + qw3*(t116 + t17)**2 + qw4*(t117 + t18)**2 + qw5*(t118 + t19)**2 + qw6*(t119 + t20)**2
-    t123 = qw1*(t114 + t22)**2 + qw2*(t115 + t23)**2 + qw3*(t116 + t24)**2 + qw4*(t117 + t25)**2 + qw5*(t118 + t26)**2 + qw6*(t119 + t27)**2
-    t124 = qw1*(t114 + t29)**2 + qw2*(t115 + t30)**2 + qw3*(t116 + t31)**2 + qw4*(t117 + t32)**2 + qw5*(t118 + t33)**2 + qw6*(t119 + t34)**2
-    t125 = qw1*(t114 + t36)**2 + qw2*(t115 + t37)**2 + qw3*(t116 + t38)**2 + qw4*(t117 + t39)**2 + qw5*(t118 + t40)**2 + qw6*(t119 + t41)**2
-    t126 = qw1*(t114 + t43)**2 + qw2*(t115 + t44)**2 + qw3*(t116 + t45)**2 + qw4*(t117 + t46)**2 + qw5*(t118 + t47)**2 + qw6*(t119 + t48)**2
-    t127 = qw1*(t114 + t50)**2 + qw2*(t115 + t51)**2 + qw3*(t116 + t52)**2 + qw4*(t117 + t53)**2 + qw5*(t118 + t54)**2 + qw6*(t119 + t55)**2
-    t128 = qw1*(t114 + t57)**2 + qw2*(t115 + t58)**2 + qw3*(t116 + t59)**2 + qw4*(t117 + t60)**2 + qw5*(t118 + t61)**2 + qw6*(t119 + t62)**2
-    t129 = qw1*(t114 + t64)**2 + qw2*(t115 + t65)**2 + qw3*(t116 + t66)**2 + qw4*(t117 + t67)**2 + qw5*(t118 + t68)**2 + qw6*(t119 + t69)**2
-    t130 = qw1*(t114 + t71)**2 + qw2*(t115 + t72)**2 + qw3*(t116 + t73)**2 + qw4*(t117 + t74)**2 + qw5*(t118 + t75)**2 + qw6*(t119 + t76)**2
-    t131 = qw1*(t114 + t78)**2 + qw2*(t115 + t79)**2 + qw3*(t116 + t80)**2 + qw4*(t117 + t81)**2 + qw5*(t118 + t82)**2 + qw6*(t119 + t83)**2
-    t132 = qw1*(t114 + t85)**2 + qw2*(t115 + t86)**2 + qw3*(t116 + t87)**2 + qw4*(t117 + t88)**2 + qw5*(t118 + t89)**2 + qw6*(t119 + t90)**2
-    t133 = qw1*(t114 + t92)**2 + qw2*(t115 + t93)**2 + qw3*(t116 + t94)**2 + qw4*(t117 + t95)**2 + qw5*(t118 + t96)**2 + qw6*(t119 + t97)**2
-    t134 = qw1*(t114 + t99)**2 + qw2*(t115 + t100)**2 + qw3*(t116 + t101)**2 + qw4*(t117 + t102)**2 + qw5*(t118 + t103)**2 + qw6*(t119 + t104)**2
-    t135 = qw1*(t114 + t106)**2 + qw2*(t115 + t107)**2 + qw3*(t116 + t108)**2 + qw4*(t117 + t109)**2 + qw5*(t118 + t110)**2 + qw6*(t119 + t111)**2
-    t136 = xp.greater(t7, 0)
-    t137 = xp.where(t136, t0, qn1)
-    t138 = xp.where(t136, t1, qn2)
-    t139 = xp.where(t136, t2, qn3)
-    t140 = xp.where(t136, t3, qn4)
-    t141 = xp.where(t136, t4, qn5)
-    t142 = xp.where(t136, t5, qn6)
-    t143 = xp.where(t136, t120, 0)
-    t144 = xp.greater(t14, 0)
-    t145 = xp.where(t144 & (xp.less(t7, 1) | xp.less(t121, t143)), xp.asarray(1, dtype=dtype), 0)
-    t146 = xp.where(t144, 1, t7)
-    t147 = xp.greater(t145, 0)
-    t148 = xp.where(t147, t8, t137)
-    t149 = xp.where(t147, t9, t138)
-    t150 = xp.where(t147, t10, t139)
-    t151 = xp.where(t147, t11, t140)
-    t152 = xp.where(t147, t12, t141)
-    t153 = xp.where(t147, t13, t142)
-    t154 = xp.where(t147, t121, t143)
-    t155 = xp.greater(t21, 0)
-    t156 = xp.where(t155 & (xp.less(t146, 1) | xp.less(t122, t154)), xp.asarray(1, dtype=dtype), 0)
-    t157 = xp.where(t155, 1, t146)
-    t158 = xp.greater(t156, 0)
-    t159 = xp.where(t158, t15, t148)
-    t160 = xp.where(t158, t16, t149)
-    t161 = xp.where(t158, t17, t150)
-    t162 = xp.where(t158, t18, t151)
-    t163 = xp.where(t158, t19, t152)
-    t164 = xp.where(t158, t20, t153)
-    t165 = xp.where(t158, t122, t154)
-    t166 = xp.greater(t28, 0)
-    t167 = xp.where(t166 & (xp.less(t157, 1) | xp.less(t123, t165)), xp.asarray(1, dtype=dtype), 0)
-    t168 = xp.where(t166, 1, t157)
-    t169 = xp.greater(t167, 0)
-    t170 = xp.where(t169, t22, t159)
-    t171 = xp.where(t169, t23, t160)
-    t172 = xp.where(t169, t24, t161)
-    t173 = xp.where(t169, t25, t162)
-    t174 = xp.where(t169, t26, t163)
-    t175 = xp.where(t169, t27, t164)
-    t176 = xp.where(t169, t123, t165)
-    t177 = xp.greater(t35, 0)
-    t178 = xp.where(t177 & (xp.less(t168, 1) | xp.less(t124, t176)), xp.asarray(1, dtype=dtype), 0)
-    t179 = xp.where(t177, 1, t168)
-    t180 = xp.greater(t178, 0)
-    t181 = xp.where(t180, t29, t170)
-    t182 = xp.where(t180, t30, t171)
-    t183 = xp.where(t180, t31, t172)
-    t184 = xp.where(t180, t32, t173)
-    t185 = xp.where(t180, t33, t174)
-    t186 = xp.where(t180, t34, t175)
-    t187 = xp.where(t180, t124, t176)
-    t188 = xp.greater(t42, 0)
-    t189 = xp.where(t188 & (xp.less(t179, 1) | xp.less(t125, t187)), xp.asarray(1, dtype=dtype), 0)
-    t190 = xp.where(t188, 1, t179)
-    t191 = xp.greater(t189, 0)
-    t192 = xp.where(t191, t36, t181)
-    t193 = xp.where(t191, t37, t182)
-    t194 = xp.where(t191, t38, t183)
-    t195 = xp.where(t191, t39, t184)
-    t196 = xp.where(t191, t40, t185)
-    t197 = xp.where(t191, t41, t186)
-    t198 = xp.where(t191, t125, t187)
-    t199 = xp.greater(t49, 0)
-    t200 = xp.where(t199 & (xp.less(t190, 1) | xp.less(t126, t198)), xp.asarray(1, dtype=dtype), 0)
-    t201 = xp.where(t199, 1, t190)
-    t202 = xp.greater(t200, 0)
-    t203 = xp.where(t202, t43, t192)
-    t204 = xp.where(t202, t44, t193)
-    t205 = xp.where(t202, t45, t194)
-    t206 = xp.where(t202, t46, t195)
-    t207 = xp.where(t202, t47, t196)
-    t208 = xp.where(t202, t48, t197)
-    t209 = xp.where(t202, t126, t198)
-    t210 = xp.greater(t56, 0)
-    t211 = xp.where(t210 & (xp.less(t201, 1) | xp.less(t127, t209)), xp.asarray(1, dtype=dtype), 0)
-    t212 = xp.where(t210, 1, t201)
-    t213 = xp.greater(t211, 0)
-    t214 = xp.where(t213, t50, t203)
-    t215 = xp.where(t213, t51, t204)
-    t216 = xp.where(t213, t52, t205)
-    t217 = xp.where(t213, t53, t206)
-    t218 = xp.where(t213, t54, t207)
-    t219 = xp.where(t213, t55, t208)
-    t220 = xp.where(t213, t127, t209)
-    t221 = xp.greater(t63, 0)
-    t222 = xp.where(t221 & (xp.less(t212, 1) | xp.less(t128, t220)), xp.asarray(1, dtype=dtype), 0)
-    t223 = xp.where(t221, 1, t212)
-    t224 = xp.greater(t222, 0)
-    t225 = xp.where(t224, t57, t214)
-    t226 = xp.where(t224, t58, t215)
-    t227 = xp.where(t224, t59, t216)
-    t228 = xp.where(t224, t60, t217)
-    t229 = xp.where(t224, t61, t218)
-    t230 = xp.where(t224, t62, t219)
-    t231 = xp.where(t224, t128, t220)
-    t232 = xp.greater(t70, 0)
-    t233 = xp.where(t232 & (xp.less(t223, 1) | xp.less(t129, t231)), xp.asarray(1, dtype=dtype), 0)
-    t234 = xp.where(t232, 1, t223)
-    t235 = xp.greater(t233, 0)
-    t236 = xp.where(t235, t64, t225)
-    t237 = xp.where(t235, t65, t226)
-    t238 = xp.where(t235, t66, t227)
-    t239 = xp.where(t235, t67, t228)
-    t240 = xp.where(t235, t68, t229)
-    t241 = xp.where(t235, t69, t230)
-    t242 = xp.where(t235, t129, t231)
-    t243 = xp.greater(t77, 0)
-    t244 = xp.where(t243 & (xp.less(t234, 1) | xp.less(t130, t242)), xp.asarray(1, dtype=dtype), 0)
-    t245 = xp.where(t243, 1, t234)
-    t246 = xp.greater(t244, 0)
-    t247 = xp.where(t246, t71, t236)
-    t248 = xp.where(t246, t72, t237)
-    t249 = xp.where(t246, t73, t238)
-    t250 = xp.where(t246, t74, t239)
-    t251 = xp.where(t246, t75, t240)
-    t252 = xp.where(t246, t76, t241)
-    t253 = xp.where(t246, t130, t242)
-    t254 = xp.greater(t84, 0)
-    t255 = xp.where(t254 & (xp.less(t245, 1) | xp.less(t131, t253)), xp.asarray(1, dtype=dtype), 0)
-    t256 = xp.where(t254, 1, t245)
-    t257 = xp.greater(t255, 0)
-    t258 = xp.where(t257, t78, t247)
-    t259 = xp.where(t257, t79, t248)
-    t260 = xp.where(t257, t80, t249)
-    t261 = xp.where(t257, t81, t250)
-    t262 = xp.where(t257, t82, t251)
-    t263 = xp.where(t257, t83, t252)
-    t264 = xp.where(t257, t131, t253)
-    t265 = xp.greater(t91, 0)
-    t266 = xp.where(t265 & (xp.less(t256, 1) | xp.less(t132, t264)), xp.asarray(1, dtype=dtype), 0)
-    t267 = xp.where(t265, 1, t256)
-    t268 = xp.greater(t266, 0)
-    t269 = xp.where(t268, t85, t258)
-    t270 = xp.where(t268, t86, t259)
-    t271 = xp.where(t268, t87, t260)
-    t272 = xp.where(t268, t88, t261)
-    t273 = xp.where(t268, t89, t262)
-    t274 = xp.where(t268, t90, t263)
-    t275 = xp.where(t268, t132, t264)
-    t276 = xp.greater(t98, 0)
-    t277 = xp.where(t276 & (xp.less(t267, 1) | xp.less(t133, t275)), xp.asarray(1, dtype=dtype), 0)
-    t278 = xp.where(t276, 1, t267)
-    t279 = xp.greater(t277, 0)
-    t280 = xp.where(t279, t92, t269)
-    t281 = xp.where(t279, t93, t270)
-    t282 = xp.where(t279, t94, t271)
-    t283 = xp.where(t279, t95, t272)
-    t284 = xp.where(t279, t96, t273)
-    t285 = xp.where(t279, t97, t274)
-    t286 = xp.where(t279, t133, t275)
-    t287 = xp.greater(t105, 0)
-    t288 = xp.where(t287 & (xp.less(t278, 1) | xp.less(t134, t286)), xp.asarray(1, dtype=dtype), 0)
-    t289 = xp.where(t287, 1, t278)
-    t290 = xp.greater(t288, 0)
-    t291 = xp.where(t290, t99, t280)
-    t292 = xp.where(t290, t100, t281)
-    t293 = xp.where(t290, t101, t282)
-    t294 = xp.where(t290, t102, t283)
-    t295 = xp.where(t290, t103, t284)
-    t296 = xp.where(t290, t104, t285)
-    t297 = xp.where(t290, t134, t286)
-    t298 = xp.greater(t112, 0)
-    t299 = xp.where(t298 & (xp.less(t289, 1) | xp.less(t135, t297)), xp.asarray(1, dtype=dtype), 0)
-    t300 = xp.where(t298, 1, t289)
-    t301 = xp.greater(t299, 0)
-    t302 = xp.where(t301, t106, t291)
-    t303 = xp.where(t301, t107, t292)
-    t304 = xp.where(t301, t108, t293)
-    t305 = xp.where(t301, t109, t294)
-    t306 = xp.where(t301, t110, t295)
-    t307 = xp.where(t301, t111, t296)
-    t308 = xp.greater(t300, 0)
-    t309 = xp.isfinite(t113)
-    t310 = t308 & t309
+    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
+    t1 = _nearer_branch(xp, 1, (qb0_0, qb0_1, qb0_2, qb0_3, qb0_4, qb0_5, xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, qn1, qn2, qn3, qn4, qn5, qn6, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
+    t2 = _nearer_branch(xp, 1, (qb1_0, qb1_1, qb1_2, qb1_3, qb1_4, qb1_5, xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t1[0], t1[1], t1[2], t1[3], t1[4], t1[5], t1[6], t1[7],))
+    t3 = _nearer_branch(xp, 1, (qb2_0, qb2_1, qb2_2, qb2_3, qb2_4, qb2_5, xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t2[0], t2[1], t2[2], t2[3], t2[4], t2[5], t2[6], t2[7],))
+    t4 = _nearer_branch(xp, 1, (qb3_0, qb3_1, qb3_2, qb3_3, qb3_4, qb3_5, xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t3[0], t3[1], t3[2], t3[3], t3[4], t3[5], t3[6], t3[7],))
+    t5 = _nearer_branch(xp, 1, (qb4_0, qb4_1, qb4_2, qb4_3, qb4_4, qb4_5, xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t4[0], t4[1], t4[2], t4[3], t4[4], t4[5], t4[6], t4[7],))
+    t6 = _nearer_branch(xp, 1, (qb5_0, qb5_1, qb5_2, qb5_3, qb5_4, qb5_5, xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t5[0], t5[1], t5[2], t5[3], t5[4], t5[5], t5[6], t5[7],))
+    t7 = _nearer_branch(xp, 1, (qb6_0, qb6_1, qb6_2, qb6_3, qb6_4, qb6_5, xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t6[0], t6[1], t6[2], t6[3], t6[4], t6[5], t6[6], t6[7],))
+    t8 = _nearer_branch(xp, 1, (qb7_0, qb7_1, qb7_2, qb7_3, qb7_4, qb7_5, xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t7[0], t7[1], t7[2], t7[3], t7[4], t7[5], t7[6], t7[7],))
+    t9 = _nearer_branch(xp, 1, (qb8_0, qb8_1, qb8_2, qb8_3, qb8_4, qb8_5, xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t8[0], t8[1], t8[2], t8[3], t8[4], t8[5], t8[6], t8[7],))
+    t10 = _nearer_branch(xp, 1, (qb9_0, qb9_1, qb9_2, qb9_3, qb9_4, qb9_5, xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t9[0], t9[1], t9[2], t9[3], t9[4], t9[5], t9[6], t9[7],))
+    t11 = _nearer_branch(xp, 1, (qb10_0, qb10_1, qb10_2, qb10_3, qb10_4, qb10_5, xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t10[0], t10[1], t10[2], t10[3], t10[4], t10[5], t10[6], t10[7],))
+    t12 = _nearer_branch(xp, 1, (qb11_0, qb11_1, qb11_2, qb11_3, qb11_4, qb11_5, xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t11[0], t11[1], t11[2], t11[3], t11[4], t11[5], t11[6], t11[7],))
+    t13 = _nearer_branch(xp, 1, (qb12_0, qb12_1, qb12_2, qb12_3, qb12_4, qb12_5, xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t12[0], t12[1], t12[2], t12[3], t12[4], t12[5], t12[6], t12[7],))
+    t14 = _nearer_branch(xp, 1, (qb13_0, qb13_1, qb13_2, qb13_3, qb13_4, qb13_5, xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t13[0], t13[1], t13[2], t13[3], t13[4], t13[5], t13[6], t13[7],))
+    t15 = _nearer_branch(xp, 1, (qb14_0, qb14_1, qb14_2, qb14_3, qb14_4, qb14_5, xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t14[0], t14[1], t14[2], t14[3], t14[4], t14[5], t14[6], t14[7],))
+    t16 = _nearer_branch(xp, 1, (qb15_0, qb15_1, qb15_2, qb15_3, qb15_4, qb15_5, xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t15[0], t15[1], t15[2], t15[3], t15[4], t15[5], t15[6], t15[7],))
+    t17 = xp.greater(t16[7], 0)
+    t18 = xp.isfinite(t0)
+    t19 = t17 & t18
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t310, t302, qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t310, t303, qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t310, t304, qn3), batch),  # 2
-        xp.broadcast_to(xp.where(t310, t305, qn4), batch),  # 3
-        xp.broadcast_to(xp.where(t310, t306, qn5), batch),  # 4
-        xp.broadcast_to(xp.where(t310, t307, qn6), batch),  # 5
+        xp.broadcast_to(xp.where(t19, t16[0], qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t19, t16[1], qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t19, t16[2], qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t19, t16[3], qn4), batch),  # 3
+        xp.broadcast_to(xp.where(t19, t16[4], qn5), batch),  # 4
+        xp.broadcast_to(xp.where(t19, t16[5], qn6), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t309), 2, xp.where(t308, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t18), 2, xp.where(t17, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

@@ -111,19 +111,19 @@ void panda_velocity_ellipsoid(const panda_real q[PANDA_DOF], panda_real U_v[9], 
 panda_real panda_condition_number(const panda_real q[PANDA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 7; returned as a scalar. 1040 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1041 operations. */
 int panda_velocity_ik(const panda_real q[PANDA_DOF], const panda_real mu_dot[PANDA_TASK_DIM], panda_real damping, panda_real q_dot[PANDA_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 7; returned as a scalar. 1122 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1123 operations. */
 int panda_velocity_ik_nullspace(const panda_real q[PANDA_DOF], const panda_real mu_dot[PANDA_TASK_DIM], const panda_real z[PANDA_DOF], panda_real damping, panda_real q_dot[PANDA_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 7; returned as a scalar. 1283 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1284 operations. */
 int panda_resolved_rate(const panda_real q[PANDA_DOF], const panda_real target[16], const panda_real target_rate[PANDA_TASK_DIM], const panda_real gain[PANDA_TASK_DIM], const panda_real z[PANDA_DOF], panda_real damping, panda_real q_dot[PANDA_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1119 operations. */
+ * Result: q_start[i], i < 7; q_next[i], i < 7; returned as a scalar. 1180 operations. */
 panda_real panda_ik_numeric_step(const panda_real target[16], const panda_real q[PANDA_DOF], panda_real damping, panda_real q_start[PANDA_DOF], panda_real q_next[PANDA_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
@@ -131,7 +131,7 @@ panda_real panda_ik_numeric_step(const panda_real target[16], const panda_real q
 void panda_ik_branches(const panda_real T[16], panda_real q_free, panda_real q[PANDA_MAX_IK_SOLUTIONS * PANDA_DOF], int valid[PANDA_MAX_IK_SOLUTIONS], int in_limits[PANDA_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 7; returned as a scalar. 1007 operations. */
+ * Result: q[i], i < 7; returned as a scalar. 1005 operations. */
 int panda_ik_nearest(const panda_real T[16], const panda_real q_seed[PANDA_DOF], panda_real q_free, const panda_real weights[PANDA_DOF], panda_real q[PANDA_DOF]);
 
 /* Statuses of panda_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

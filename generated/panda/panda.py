@@ -82,6 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -335,6 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi6_rows(xp, count, state):
     """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2 + w4**2 + w5**2
@@ -896,6 +898,257 @@ def _jacobi6_rows(xp, count, state):
             t489,
             t493,
             t497,
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _symmetric_solve6(xp, count, state):
+    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w1**2
+        t1 = w2**2
+        t2 = w3**2
+        t3 = w4**2
+        t4 = w5**2
+        t5 = w0**2
+        t6 = xp.sqrt(t5 + 2*t0 + 2*t1 + 2*w7**2 + 2*t2 + 2*w8**2 + 2*w12**2 + 2*t3 + 2*w9**2 + 2*w13**2 + 2*w16**2 + 2*t4 + 2*w10**2 + 2*w14**2 + 2*w17**2 + 2*w19**2 + w6**2 + w11**2 + w15**2 + w18**2 + w20**2)
+        t7 = xp.sqrt(t0 + t1 + t2 + t3 + t4 + t5)
+        t8 = t7*xp.where(xp.greater_equal(w0, 0), xp.asarray(1, dtype=dtype), -1)
+        t9 = xp.greater(t7, 0)
+        t10 = xp.where(t9, 1/(w0 + t8), 0)
+        t11 = xp.where(t9, 1 + xp.abs(w0)/t7, 0)
+        t12 = w1*t10
+        t13 = w2*t10
+        t14 = w3*t10
+        t15 = w4*t10
+        t16 = w5*t10
+        t17 = t11*(w1 + t12*w6 + t13*w7 + t14*w8 + t15*w9 + t16*w10)
+        t18 = -t17 + w1
+        t19 = w6 - t12*t17
+        t20 = w7 - t13*t17
+        t21 = w8 - t14*t17
+        t22 = w9 - t15*t17
+        t23 = w10 - t16*t17
+        t24 = t11*(w2 + t12*w7 + t13*w11 + t14*w12 + t15*w13 + t16*w14)
+        t25 = -t24 + w2
+        t26 = w7 - t12*t24
+        t27 = w11 - t13*t24
+        t28 = w12 - t14*t24
+        t29 = w13 - t15*t24
+        t30 = w14 - t16*t24
+        t31 = t11*(w3 + t12*w8 + t13*w12 + t14*w15 + t15*w16 + t16*w17)
+        t32 = -t31 + w3
+        t33 = w8 - t12*t31
+        t34 = w12 - t13*t31
+        t35 = w15 - t14*t31
+        t36 = w16 - t15*t31
+        t37 = w17 - t16*t31
+        t38 = t11*(w4 + t12*w9 + t13*w13 + t14*w16 + t15*w18 + t16*w19)
+        t39 = -t38 + w4
+        t40 = w9 - t12*t38
+        t41 = w13 - t13*t38
+        t42 = w16 - t14*t38
+        t43 = w18 - t15*t38
+        t44 = w19 - t16*t38
+        t45 = t11*(w5 + t12*w10 + t13*w14 + t14*w17 + t15*w19 + t16*w20)
+        t46 = -t45 + w5
+        t47 = w10 - t12*t45
+        t48 = w14 - t13*t45
+        t49 = w17 - t14*t45
+        t50 = w19 - t15*t45
+        t51 = w20 - t16*t45
+        t52 = t11*(w21 + t12*w22 + t13*w23 + t14*w24 + t15*w25 + t16*w26)
+        t53 = -t52 + w21
+        t54 = w22 - t12*t52
+        t55 = w23 - t13*t52
+        t56 = w24 - t14*t52
+        t57 = w25 - t15*t52
+        t58 = w26 - t16*t52
+        t59 = xp.sqrt(t19**2 + t20**2 + t21**2 + t22**2 + t23**2)
+        t60 = t59*xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)
+        t61 = xp.greater(t59, 0)
+        t62 = xp.where(t61, 1/(t19 + t60), 0)
+        t63 = xp.where(t61, 1 + xp.abs(t19)/t59, 0)
+        t64 = t20*t62
+        t65 = t21*t62
+        t66 = t22*t62
+        t67 = t23*t62
+        t68 = t63*(t26 + t64*t27 + t65*t28 + t66*t29 + t67*t30)
+        t69 = -t68 + t26
+        t70 = t27 - t64*t68
+        t71 = t28 - t65*t68
+        t72 = t29 - t66*t68
+        t73 = t30 - t67*t68
+        t74 = t63*(t33 + t64*t34 + t65*t35 + t66*t36 + t67*t37)
+        t75 = -t74 + t33
+        t76 = t34 - t64*t74
+        t77 = t35 - t65*t74
+        t78 = t36 - t66*t74
+        t79 = t37 - t67*t74
+        t80 = t63*(t40 + t64*t41 + t65*t42 + t66*t43 + t67*t44)
+        t81 = -t80 + t40
+        t82 = t41 - t64*t80
+        t83 = t42 - t65*t80
+        t84 = t43 - t66*t80
+        t85 = t44 - t67*t80
+        t86 = t63*(t47 + t64*t48 + t65*t49 + t66*t50 + t67*t51)
+        t87 = -t86 + t47
+        t88 = t48 - t64*t86
+        t89 = t49 - t65*t86
+        t90 = t50 - t66*t86
+        t91 = t51 - t67*t86
+        t92 = t63*(t54 + t64*t55 + t65*t56 + t66*t57 + t67*t58)
+        t93 = -t92 + t54
+        t94 = t55 - t64*t92
+        t95 = t56 - t65*t92
+        t96 = t57 - t66*t92
+        t97 = t58 - t67*t92
+        t98 = xp.sqrt(t70**2 + t71**2 + t72**2 + t73**2)
+        t99 = t98*xp.where(xp.greater_equal(t70, 0), xp.asarray(1, dtype=dtype), -1)
+        t100 = xp.greater(t98, 0)
+        t101 = xp.where(t100, 1/(t70 + t99), 0)
+        t102 = xp.where(t100, 1 + xp.abs(t70)/t98, 0)
+        t103 = t71*t101
+        t104 = t72*t101
+        t105 = t73*t101
+        t106 = t102*(t76 + t103*t77 + t104*t78 + t105*t79)
+        t107 = -t106 + t76
+        t108 = t77 - t103*t106
+        t109 = t78 - t104*t106
+        t110 = t79 - t105*t106
+        t111 = t102*(t82 + t103*t83 + t104*t84 + t105*t85)
+        t112 = -t111 + t82
+        t113 = t83 - t103*t111
+        t114 = t84 - t104*t111
+        t115 = t85 - t105*t111
+        t116 = t102*(t88 + t103*t89 + t104*t90 + t105*t91)
+        t117 = -t116 + t88
+        t118 = t89 - t103*t116
+        t119 = t90 - t104*t116
+        t120 = t91 - t105*t116
+        t121 = t102*(t94 + t103*t95 + t104*t96 + t105*t97)
+        t122 = -t121 + t94
+        t123 = t95 - t103*t121
+        t124 = t96 - t104*t121
+        t125 = t97 - t105*t121
+        t126 = xp.sqrt(t108**2 + t109**2 + t110**2)
+        t127 = t126*xp.where(xp.greater_equal(t108, 0), xp.asarray(1, dtype=dtype), -1)
+        t128 = xp.greater(t126, 0)
+        t129 = xp.where(t128, 1/(t108 + t127), 0)
+        t130 = xp.where(t128, 1 + xp.abs(t108)/t126, 0)
+        t131 = t109*t129
+        t132 = t110*t129
+        t133 = t130*(t113 + t131*t114 + t132*t115)
+        t134 = -t133 + t113
+        t135 = t114 - t131*t133
+        t136 = t115 - t132*t133
+        t137 = t130*(t118 + t131*t119 + t132*t120)
+        t138 = -t137 + t118
+        t139 = t119 - t131*t137
+        t140 = t120 - t132*t137
+        t141 = t130*(t123 + t131*t124 + t132*t125)
+        t142 = -t141 + t123
+        t143 = t124 - t131*t141
+        t144 = t125 - t132*t141
+        t145 = xp.sqrt(t135**2 + t136**2)
+        t146 = t145*xp.where(xp.greater_equal(t135, 0), xp.asarray(1, dtype=dtype), -1)
+        t147 = xp.greater(t145, 0)
+        t148 = xp.where(t147, 1/(t135 + t146), 0)
+        t149 = xp.where(t147, 1 + xp.abs(t135)/t145, 0)
+        t150 = t136*t148
+        t151 = t149*(t139 + t150*t140)
+        t152 = -t151 + t139
+        t153 = t140 - t150*t151
+        t154 = t149*(t143 + t150*t144)
+        t155 = -t154 + t143
+        t156 = t144 - t150*t154
+        t157 = xp.abs(t153)
+        t158 = t157*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
+        t159 = xp.where(xp.greater(t157, 0), xp.asarray(2, dtype=dtype), 0)
+        t160 = t156 - t156*t159
+        t161 = xp.where(xp.not_equal(t158, 0), -t160/t158, 0)
+        t162 = xp.where(xp.not_equal(t146, 0), -(t155 - t152*t161)/t146, 0)
+        t163 = xp.where(xp.not_equal(t127, 0), -(-(t134*t162 + t138*t161) + t142)/t127, 0)
+        t164 = xp.where(xp.not_equal(t99, 0), -(-(t107*t163 + t112*t162 + t117*t161) + t122)/t99, 0)
+        t165 = xp.where(xp.not_equal(t60, 0), -(-(t69*t164 + t75*t163 + t81*t162 + t87*t161) + t93)/t60, 0)
+        t166 = xp.where(xp.not_equal(t8, 0), -(-(t18*t165 + t25*t164 + t32*t163 + t39*t162 + t46*t161) + t53)/t8, 0)
+        t167 = 1e-12*t6
+        state = (
+            t166,
+            t165,
+            t164,
+            t163,
+            t162,
+            t161,
+            xp.where(xp.less_equal(t7, t167) | xp.less_equal(t59, t167) | xp.less_equal(t98, t167) | xp.less_equal(t126, t167) | xp.less_equal(t145, t167) | xp.less_equal(t157, t167), xp.asarray(1, dtype=dtype), 0),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _nearer_branch(xp, count, state):
+    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 119 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, = state
+        t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w8))
+        t1 = w1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w1 + w9))
+        t2 = w2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w2 + w10))
+        t3 = w3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w3 + w11))
+        t4 = w4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w4 + w12))
+        t5 = w5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w5 + w13))
+        t6 = xp.where(xp.less(t0, w8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t7 = t6 + t0
+        t8 = -t6 + t0
+        t9 = xp.where(xp.greater_equal(t0, -2.8973) & xp.less_equal(t0, 2.8973), t0, xp.where(xp.greater_equal(t7, -2.8973) & xp.less_equal(t7, 2.8973), t7, xp.where(xp.greater_equal(t8, -2.8973) & xp.less_equal(t8, 2.8973), t8, w0)))
+        t10 = xp.where(xp.less(t1, w9), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t11 = t10 + t1
+        t12 = -t10 + t1
+        t13 = xp.where(xp.greater_equal(t1, -1.7627999999999997) & xp.less_equal(t1, 1.7627999999999997), t1, xp.where(xp.greater_equal(t11, -1.7627999999999997) & xp.less_equal(t11, 1.7627999999999997), t11, xp.where(xp.greater_equal(t12, -1.7627999999999997) & xp.less_equal(t12, 1.7627999999999997), t12, w1)))
+        t14 = xp.where(xp.less(t2, w10), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t15 = t14 + t2
+        t16 = -t14 + t2
+        t17 = xp.where(xp.greater_equal(t2, -2.8973) & xp.less_equal(t2, 2.8973), t2, xp.where(xp.greater_equal(t15, -2.8973) & xp.less_equal(t15, 2.8973), t15, xp.where(xp.greater_equal(t16, -2.8973) & xp.less_equal(t16, 2.8973), t16, w2)))
+        t18 = xp.where(xp.less(t3, w11), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t19 = t18 + t3
+        t20 = -t18 + t3
+        t21 = xp.where(xp.greater_equal(t3, -3.0718) & xp.less_equal(t3, -0.0698), t3, xp.where(xp.greater_equal(t19, -3.0718) & xp.less_equal(t19, -0.0698), t19, xp.where(xp.greater_equal(t20, -3.0718) & xp.less_equal(t20, -0.0698), t20, w3)))
+        t22 = xp.where(xp.less(t4, w12), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t23 = t22 + t4
+        t24 = -t22 + t4
+        t25 = xp.where(xp.greater_equal(t4, -2.8973) & xp.less_equal(t4, 2.8973), t4, xp.where(xp.greater_equal(t23, -2.8973) & xp.less_equal(t23, 2.8973), t23, xp.where(xp.greater_equal(t24, -2.8973) & xp.less_equal(t24, 2.8973), t24, w4)))
+        t26 = xp.where(xp.less(t5, w13), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t27 = t26 + t5
+        t28 = -t26 + t5
+        t29 = xp.where(xp.greater_equal(t5, -0.0175) & xp.less_equal(t5, 3.7525000000000004), t5, xp.where(xp.greater_equal(t27, -0.0175) & xp.less_equal(t27, 3.7525000000000004), t27, xp.where(xp.greater_equal(t28, -0.0175) & xp.less_equal(t28, 3.7525000000000004), t28, w5)))
+        t30 = w15*(-w8 + t9)**2 + w16*(-w9 + t13)**2 + w17*(-w10 + t17)**2 + w18*(-w11 + t21)**2 + w19*(-w12 + t25)**2 + w20*(-w13 + t29)**2 + w21*(-w14 + w6)**2
+        t31 = xp.greater(w7, 0)
+        t32 = xp.where(t31 & (xp.less(w30, 1) | xp.less(t30, w29)), xp.asarray(1, dtype=dtype), 0)
+        t33 = xp.where(t31, 1, w30)
+        t34 = xp.greater(t32, 0)
+        t35 = xp.where(t34, t9, w22)
+        t36 = xp.where(t34, t13, w23)
+        t37 = xp.where(t34, t17, w24)
+        t38 = xp.where(t34, t21, w25)
+        t39 = xp.where(t34, t25, w26)
+        t40 = xp.where(t34, t29, w27)
+        t41 = xp.where(t34, w6, w28)
+        t42 = xp.where(t34, t30, w29)
+        state = (
+            t35,
+            t36,
+            t37,
+            t38,
+            t39,
+            t40,
+            t41,
+            t42,
+            t33,
         )
     return state
 
@@ -4542,7 +4795,7 @@ def condition_number(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (7 x 1 and 1 x 1), 1040 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (7 x 1 and 1 x 1), 1041 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (7,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -4657,211 +4910,44 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t84 = -t68 - t6*t3 + t11*t23 - t13*t25 + t15*t27 + t68*t82
     t85 = t3**2 + t23**2 + t25**2 + t27**2 + t64 + t76*t82
     t86 = 1 + c2**2 + t41**2 + t44**2 + t46**2 + s3**2*t82
-    t87 = t69**2
-    t88 = t71**2
-    t89 = t74**2
-    t90 = t65**2
-    t91 = t59**2
-    t92 = damping**2
-    t93 = t92 + t67
-    t94 = t93**2
-    t95 = xp.sqrt(t87 + t88 + t89 + t90 + t91 + t94)
-    t96 = t95*xp.where(xp.greater_equal(t93, 0), xp.asarray(1, dtype=dtype), -1)
-    t97 = t92 + t77
-    t98 = t92 + t37
-    t99 = t92 + t83
-    t100 = t92 + t85
-    t101 = t92 + t86
-    t102 = xp.sqrt(t94 + t97**2 + t98**2 + t99**2 + t100**2 + t101**2 + 2*t87 + 2*t88 + 2*t80**2 + 2*t89 + 2*t78**2 + 2*t81**2 + 2*t90 + 2*t75**2 + 2*t72**2 + 2*t84**2 + 2*t91 + 2*t60**2 + 2*t61**2 + 2*t62**2 + 2*t63**2)
-    t103 = xp.greater(t95, 0)
-    t104 = xp.where(t103, 1/(t93 + t96), 0)
-    t105 = xp.where(t103, 1 + xp.abs(t93)/t95, 0)
-    t106 = t69*t104
-    t107 = t71*t104
-    t108 = t74*t104
-    t109 = t65*t104
-    t110 = t59*t104
-    t111 = t105*(t69 - t108*t78 + t97*t106 - t107*t80 + t109*t75 - t110*t60)
-    t112 = -t111 + t69
-    t113 = t97 - t106*t111
-    t114 = t80 + t107*t111
-    t115 = t78 + t108*t111
-    t116 = t75 - t109*t111
-    t117 = t60 + t110*t111
-    t118 = t105*(t71 - t109*t72 - t106*t80 + t98*t107 + t108*t81 - t110*t61)
-    t119 = -t118 + t71
-    t120 = t80 + t106*t118
-    t121 = t98 - t107*t118
-    t122 = t81 - t108*t118
-    t123 = t72 + t109*t118
-    t124 = t61 + t110*t118
-    t125 = t105*(t74 + t99*t108 - t106*t78 + t107*t81 + t109*t84 - t110*t62)
-    t126 = -t125 + t74
-    t127 = t78 + t106*t125
-    t128 = t81 - t107*t125
-    t129 = t99 - t108*t125
-    t130 = t84 - t109*t125
-    t131 = t62 + t110*t125
-    t132 = t105*(t65 + t100*t109 + t106*t75 - t107*t72 + t108*t84 - t110*t63)
-    t133 = -t132 + t65
-    t134 = t75 - t106*t132
-    t135 = t72 + t107*t132
-    t136 = t84 - t108*t132
-    t137 = t100 - t109*t132
-    t138 = t63 + t110*t132
-    t139 = t105*(-t59 + t106*t60 + t107*t61 + t108*t62 + t109*t63 - t101*t110)
-    t140 = t59 + t139
-    t141 = t60 - t106*t139
-    t142 = t61 - t107*t139
-    t143 = t62 - t108*t139
-    t144 = t63 - t109*t139
-    t145 = t101 + t110*t139
-    t146 = xp.sqrt(t113**2 + t114**2 + t115**2 + t116**2 + t117**2)
-    t147 = t146*xp.where(xp.greater_equal(t113, 0), xp.asarray(1, dtype=dtype), -1)
-    t148 = t105*(mu_dot0 + t106*mu_dot1 + t107*mu_dot2 + t108*mu_dot3 + t109*mu_dot4 - t110*mu_dot5)
-    t149 = -t148 + mu_dot0
-    t150 = mu_dot1 - t106*t148
-    t151 = mu_dot2 - t107*t148
-    t152 = mu_dot3 - t108*t148
-    t153 = mu_dot4 - t109*t148
-    t154 = mu_dot5 + t110*t148
-    t155 = xp.greater(t146, 0)
-    t156 = xp.where(t155, 1/(t113 + t147), 0)
-    t157 = xp.where(t155, 1 + xp.abs(t113)/t146, 0)
-    t158 = t114*t156
-    t159 = t115*t156
-    t160 = t116*t156
-    t161 = t117*t156
-    t162 = -t157*(t120 + t158*t121 + t159*t122 + t160*t123 - t161*t124)
-    t163 = t120 + t162
-    t164 = t121 + t158*t162
-    t165 = t122 + t159*t162
-    t166 = t123 + t160*t162
-    t167 = t124 - t161*t162
-    t168 = -t157*(t127 + t158*t128 + t159*t129 - t160*t130 - t161*t131)
-    t169 = t127 + t168
-    t170 = t128 + t158*t168
-    t171 = t129 + t159*t168
-    t172 = t130 - t160*t168
-    t173 = t131 - t161*t168
-    t174 = t157*(t134 + t158*t135 - t159*t136 + t160*t137 + t161*t138)
-    t175 = -t174 + t134
-    t176 = -t135 + t158*t174
-    t177 = t136 + t159*t174
-    t178 = t137 - t160*t174
-    t179 = t138 - t161*t174
-    t180 = t157*(t141 - t158*t142 - t159*t143 + t160*t144 + t161*t145)
-    t181 = -t180 + t141
-    t182 = t142 + t158*t180
-    t183 = t143 + t159*t180
-    t184 = t144 - t160*t180
-    t185 = t145 - t161*t180
-    t186 = xp.sqrt(t164**2 + t165**2 + t166**2 + t167**2)
-    t187 = t186*xp.where(xp.greater_equal(t164, 0), xp.asarray(1, dtype=dtype), -1)
-    t188 = t157*(t150 - t158*t151 - t159*t152 + t160*t153 + t161*t154)
-    t189 = -t188 + t150
-    t190 = t151 + t158*t188
-    t191 = t152 + t159*t188
-    t192 = t153 - t160*t188
-    t193 = t154 - t161*t188
-    t194 = xp.greater(t186, 0)
-    t195 = xp.where(t194, 1/(t164 + t187), 0)
-    t196 = xp.where(t194, 1 + xp.abs(t164)/t186, 0)
-    t197 = t165*t195
-    t198 = t166*t195
-    t199 = t167*t195
-    t200 = t196*(t170 + t197*t171 - t198*t172 + t199*t173)
-    t201 = -t200 + t170
-    t202 = t171 - t197*t200
-    t203 = t172 + t198*t200
-    t204 = t173 - t199*t200
-    t205 = t196*(t176 + t197*t177 - t198*t178 + t199*t179)
-    t206 = -t205 + t176
-    t207 = t177 - t197*t205
-    t208 = t178 + t198*t205
-    t209 = t179 - t199*t205
-    t210 = t196*(t182 + t197*t183 - t198*t184 + t199*t185)
-    t211 = -t210 + t182
-    t212 = t183 - t197*t210
-    t213 = t184 + t198*t210
-    t214 = t185 - t199*t210
-    t215 = xp.sqrt(t202**2 + t203**2 + t204**2)
-    t216 = t215*xp.where(xp.greater_equal(t202, 0), xp.asarray(1, dtype=dtype), -1)
-    t217 = t196*(t190 + t197*t191 - t198*t192 + t199*t193)
-    t218 = -t217 + t190
-    t219 = t191 - t197*t217
-    t220 = t192 + t198*t217
-    t221 = t193 - t199*t217
-    t222 = xp.greater(t215, 0)
-    t223 = xp.where(t222, 1/(t202 + t216), 0)
-    t224 = xp.where(t222, 1 + xp.abs(t202)/t215, 0)
-    t225 = t203*t223
-    t226 = t204*t223
-    t227 = t224*(t207 + t225*t208 + t226*t209)
-    t228 = -t227 + t207
-    t229 = t208 - t225*t227
-    t230 = t209 - t226*t227
-    t231 = t224*(t212 + t225*t213 + t226*t214)
-    t232 = -t231 + t212
-    t233 = t213 - t225*t231
-    t234 = t214 - t226*t231
-    t235 = xp.sqrt(t229**2 + t230**2)
-    t236 = t235*xp.where(xp.greater_equal(t229, 0), xp.asarray(1, dtype=dtype), -1)
-    t237 = t224*(t219 + t225*t220 + t226*t221)
-    t238 = -t237 + t219
-    t239 = t220 - t225*t237
-    t240 = t221 - t226*t237
-    t241 = xp.greater(t235, 0)
-    t242 = xp.where(t241, 1/(t229 + t236), 0)
-    t243 = xp.where(t241, 1 + xp.abs(t229)/t235, 0)
-    t244 = t230*t242
-    t245 = t243*(t233 + t244*t234)
-    t246 = -t245 + t233
-    t247 = t234 - t244*t245
-    t248 = t243*(t239 + t244*t240)
-    t249 = -t248 + t239
-    t250 = t240 - t244*t248
-    t251 = xp.abs(t247)
-    t252 = t251*xp.where(xp.greater_equal(t247, 0), xp.asarray(1, dtype=dtype), -1)
-    t253 = xp.where(xp.greater(t251, 0), xp.asarray(2, dtype=dtype), 0)
-    t254 = t250 - t253*t250
-    t255 = xp.where(xp.not_equal(t252, 0), -t254/t252, 0)
-    t256 = xp.where(xp.not_equal(t236, 0), -(t249 - t246*t255)/t236, 0)
-    t257 = xp.where(xp.not_equal(t216, 0), -(-(t228*t256 + t232*t255) + t238)/t216, 0)
-    t258 = xp.where(xp.not_equal(t187, 0), -(-(t201*t257 + t206*t256 + t211*t255) + t218)/t187, 0)
-    t259 = xp.where(xp.not_equal(t147, 0), -(-(-t163*t258 - t169*t257 + t175*t256 + t181*t255) + t189)/t147, 0)
-    t260 = xp.where(xp.not_equal(t96, 0), -(-(t112*t259 + t119*t258 + t126*t257 + t133*t256 - t140*t255) + t149)/t96, 0)
-    t261 = t255 - t31*t260 + t19*t259
-    t262 = t51*t260 + t55*t259 + t33*t258 + c2*t255 + t8*t257 + t20*t256
-    t263 = t52*t260 - t56*t259 + t34*t258 + t6*t257 - t3*t256 - t42*t255
-    t264 = t53*t260 + t57*t259 + t35*t258 + t11*t257 + t23*t256 + t41*t255
-    t265 = t54*t260 - t58*t259 + t36*t258 + t13*t257 - t25*t256 - t44*t255
-    t266 = t15*t257 + t27*t256 + t46*t255
-    t267 = c1*t50
-    t268 = s1*t50
-    t269 = -t32*t258 - s1*t257 + c1*t256 + t267*t260 + t268*t259
-    t270 = 1 - t31 - t56 - t58 - t32 - s1 - t15 - t3 - t25 - t27 - t44 - t46 - t42 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t11 + t23 + t41 + q5 + t13 + q6 + q7 + t19 + t8 + t20 + t51 + t52 + t53 + t54 + t55 + t57 + t33 + t34 + t35 + t36 + t267 + t268 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t271 = xp.isfinite(t270)
-    t272 = xp.greater_equal(damping, 0)
-    t273 = 1e-12*t102
-    t274 = xp.less_equal(t95, t273) | xp.less_equal(t146, t273) | xp.less_equal(t186, t273) | xp.less_equal(t215, t273) | xp.less_equal(t235, t273) | xp.less_equal(t251, t273)
-    t275 = t271 & t272 & xp.logical_not(t274)
+    t87 = damping**2
+    t88 = _symmetric_solve6(xp, 1, (t87 + t67, t69, t71, t74, t65, -t59, t87 + t77, -t80, -t78, t75, t60, t87 + t37, t81, -t72, t61, t87 + t83, t84, t62, t87 + t85, t63, t87 + t86, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t89 = t88[5]
+    t90 = t88[0]
+    t91 = t88[1]
+    t92 = t89 + t19*t91 - t31*t90
+    t93 = c1*t50
+    t94 = s1*t50
+    t95 = 1 - t31 - t56 - t58 - t32 - s1 - t15 - t3 - t25 - t27 - t44 - t46 - t42 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t11 + t23 + t41 + q5 + t13 + q6 + q7 + t19 + t8 + t20 + t93 + t94 + t51 + t52 + t53 + t54 + t55 + t57 + t33 + t34 + t35 + t36 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t96 = t88[2]
+    t97 = t88[3]
+    t98 = t88[4]
+    t99 = c1*t98 + t90*t93 + t91*t94 - t96*t32 - s1*t97
+    t100 = t90*t51 + t91*t55 + t96*t33 + t8*t97 + t20*t98 + c2*t89
+    t101 = -t42*t89 + t90*t52 - t91*t56 + t96*t34 + t6*t97 - t3*t98
+    t102 = t90*t53 + t91*t57 + t96*t35 + t11*t97 + t23*t98 + t41*t89
+    t103 = -t91*t58 - t44*t89 + t90*t54 + t96*t36 + t13*t97 - t25*t98
+    t104 = t15*t97 + t27*t98 + t46*t89
+    t105 = xp.isfinite(t95)
+    t106 = xp.greater_equal(damping, 0)
+    t107 = t88[6]
+    t108 = t105 & t106 & xp.less_equal(t107, 0)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t275, t261, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t275, t269, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t275, t262, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t275, t263, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t275, t264, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t275, t265, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t275, -t266, 0), batch),  # 6
+        xp.broadcast_to(xp.where(t108, t92, 0), batch),  # 0
+        xp.broadcast_to(xp.where(t108, t99, 0), batch),  # 1
+        xp.broadcast_to(xp.where(t108, t100, 0), batch),  # 2
+        xp.broadcast_to(xp.where(t108, t101, 0), batch),  # 3
+        xp.broadcast_to(xp.where(t108, t102, 0), batch),  # 4
+        xp.broadcast_to(xp.where(t108, t103, 0), batch),  # 5
+        xp.broadcast_to(xp.where(t108, -t104, 0), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t271 & t272), 2, xp.where(t274, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t105 & t106), 2, xp.where(xp.greater(t107, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
-    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1122 operations."""
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1123 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (7,)), ("mu_dot", mu_dot, (6,)), ("z", z, (7,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -4991,218 +5077,51 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     t92 = s1*qz2
     t93 = -(t19*qz1 + t56*qz3 - t57*qz4 + t58*qz5 - t59*qz6 + t51*t92) + mu_dot1
     t94 = -(-t92 + t6*qz4 + t11*qz5 + t13*qz6 - t15*qz7 + t8*qz3) + mu_dot3
-    t95 = t71**2
-    t96 = t73**2
-    t97 = t76**2
-    t98 = t67**2
-    t99 = t60**2
-    t100 = damping**2
-    t101 = t100 + t69
-    t102 = t101**2
-    t103 = xp.sqrt(t95 + t96 + t97 + t98 + t99 + t102)
-    t104 = t103*xp.where(xp.greater_equal(t101, 0), xp.asarray(1, dtype=dtype), -1)
-    t105 = t100 + t79
-    t106 = t100 + t37
-    t107 = t100 + t85
-    t108 = t100 + t87
-    t109 = t100 + t88
-    t110 = xp.sqrt(t102 + t105**2 + t106**2 + t107**2 + t108**2 + 2*t95 + 2*t96 + 2*t82**2 + 2*t97 + 2*t80**2 + 2*t83**2 + 2*t98 + 2*t77**2 + 2*t74**2 + 2*t86**2 + 2*t99 + 2*t61**2 + 2*t62**2 + 2*t63**2 + 2*t64**2 + t109**2)
-    t111 = xp.greater(t103, 0)
-    t112 = xp.where(t111, 1/(t101 + t104), 0)
-    t113 = xp.where(t111, 1 + xp.abs(t101)/t103, 0)
-    t114 = t71*t112
-    t115 = t73*t112
-    t116 = t76*t112
-    t117 = t67*t112
-    t118 = t60*t112
-    t119 = t113*(t71 + t105*t114 - t115*t82 - t116*t80 + t117*t77 - t118*t61)
-    t120 = -t119 + t71
-    t121 = t105 - t114*t119
-    t122 = t82 + t115*t119
-    t123 = t80 + t116*t119
-    t124 = t77 - t117*t119
-    t125 = t61 + t118*t119
-    t126 = t113*(t73 - t114*t82 + t106*t115 + t116*t83 - t117*t74 - t118*t62)
-    t127 = -t126 + t73
-    t128 = t82 + t114*t126
-    t129 = t106 - t115*t126
-    t130 = t83 - t116*t126
-    t131 = t74 + t117*t126
-    t132 = t62 + t118*t126
-    t133 = t113*(t76 - t114*t80 + t115*t83 + t107*t116 + t117*t86 - t118*t63)
-    t134 = -t133 + t76
-    t135 = t80 + t114*t133
-    t136 = t83 - t115*t133
-    t137 = t107 - t116*t133
-    t138 = t86 - t117*t133
-    t139 = t63 + t118*t133
-    t140 = t113*(t67 + t114*t77 - t115*t74 + t116*t86 + t108*t117 - t118*t64)
-    t141 = -t140 + t67
-    t142 = t77 - t114*t140
-    t143 = t74 + t115*t140
-    t144 = t86 - t116*t140
-    t145 = t108 - t117*t140
-    t146 = t64 + t118*t140
-    t147 = t113*(-t60 + t114*t61 + t115*t62 + t116*t63 + t117*t64 - t109*t118)
-    t148 = t60 + t147
-    t149 = t61 - t114*t147
-    t150 = t62 - t115*t147
-    t151 = t63 - t116*t147
-    t152 = t64 - t117*t147
-    t153 = t109 + t118*t147
-    t154 = t113*(t90 + t114*t93 + t115*t38 + t116*t94 + t117*t91 - t118*t65)
-    t155 = -t154 + t90
-    t156 = t93 - t114*t154
-    t157 = t38 - t115*t154
-    t158 = t94 - t116*t154
-    t159 = t91 - t117*t154
-    t160 = t65 + t118*t154
-    t161 = xp.sqrt(t121**2 + t122**2 + t123**2 + t124**2 + t125**2)
-    t162 = t161*xp.where(xp.greater_equal(t121, 0), xp.asarray(1, dtype=dtype), -1)
-    t163 = xp.greater(t161, 0)
-    t164 = xp.where(t163, 1/(t121 + t162), 0)
-    t165 = xp.where(t163, 1 + xp.abs(t121)/t161, 0)
-    t166 = t122*t164
-    t167 = t123*t164
-    t168 = t124*t164
-    t169 = t125*t164
-    t170 = -t165*(t128 + t166*t129 + t167*t130 + t168*t131 - t169*t132)
-    t171 = t128 + t170
-    t172 = t129 + t166*t170
-    t173 = t130 + t167*t170
-    t174 = t131 + t168*t170
-    t175 = t132 - t169*t170
-    t176 = -t165*(t135 + t166*t136 + t167*t137 - t168*t138 - t169*t139)
-    t177 = t135 + t176
-    t178 = t136 + t166*t176
-    t179 = t137 + t167*t176
-    t180 = t138 - t168*t176
-    t181 = t139 - t169*t176
-    t182 = t165*(t142 + t166*t143 - t167*t144 + t168*t145 + t169*t146)
-    t183 = -t182 + t142
-    t184 = -t143 + t166*t182
-    t185 = t144 + t167*t182
-    t186 = t145 - t168*t182
-    t187 = t146 - t169*t182
-    t188 = t165*(t149 - t166*t150 - t167*t151 + t168*t152 + t169*t153)
-    t189 = -t188 + t149
-    t190 = t150 + t166*t188
-    t191 = t151 + t167*t188
-    t192 = t152 - t168*t188
-    t193 = t153 - t169*t188
-    t194 = t165*(t156 - t166*t157 - t167*t158 + t168*t159 + t169*t160)
-    t195 = -t194 + t156
-    t196 = t157 + t166*t194
-    t197 = t158 + t167*t194
-    t198 = t159 - t168*t194
-    t199 = t160 - t169*t194
-    t200 = xp.sqrt(t172**2 + t173**2 + t174**2 + t175**2)
-    t201 = t200*xp.where(xp.greater_equal(t172, 0), xp.asarray(1, dtype=dtype), -1)
-    t202 = xp.greater(t200, 0)
-    t203 = xp.where(t202, 1/(t172 + t201), 0)
-    t204 = xp.where(t202, 1 + xp.abs(t172)/t200, 0)
-    t205 = t173*t203
-    t206 = t174*t203
-    t207 = t175*t203
-    t208 = t204*(t178 + t205*t179 - t206*t180 + t207*t181)
-    t209 = -t208 + t178
-    t210 = t179 - t205*t208
-    t211 = t180 + t206*t208
-    t212 = t181 - t207*t208
-    t213 = t204*(t184 + t205*t185 - t206*t186 + t207*t187)
-    t214 = -t213 + t184
-    t215 = t185 - t205*t213
-    t216 = t186 + t206*t213
-    t217 = t187 - t207*t213
-    t218 = t204*(t190 + t205*t191 - t206*t192 + t207*t193)
-    t219 = -t218 + t190
-    t220 = t191 - t205*t218
-    t221 = t192 + t206*t218
-    t222 = t193 - t207*t218
-    t223 = t204*(t196 + t205*t197 - t206*t198 + t207*t199)
-    t224 = -t223 + t196
-    t225 = t197 - t205*t223
-    t226 = t198 + t206*t223
-    t227 = t199 - t207*t223
-    t228 = xp.sqrt(t210**2 + t211**2 + t212**2)
-    t229 = t228*xp.where(xp.greater_equal(t210, 0), xp.asarray(1, dtype=dtype), -1)
-    t230 = xp.greater(t228, 0)
-    t231 = xp.where(t230, 1/(t210 + t229), 0)
-    t232 = xp.where(t230, 1 + xp.abs(t210)/t228, 0)
-    t233 = t211*t231
-    t234 = t212*t231
-    t235 = t232*(t215 + t233*t216 + t234*t217)
-    t236 = -t235 + t215
-    t237 = t216 - t233*t235
-    t238 = t217 - t234*t235
-    t239 = t232*(t220 + t233*t221 + t234*t222)
-    t240 = -t239 + t220
-    t241 = t221 - t233*t239
-    t242 = t222 - t234*t239
-    t243 = t232*(t225 + t233*t226 + t234*t227)
-    t244 = -t243 + t225
-    t245 = t226 - t233*t243
-    t246 = t227 - t234*t243
-    t247 = xp.sqrt(t237**2 + t238**2)
-    t248 = t247*xp.where(xp.greater_equal(t237, 0), xp.asarray(1, dtype=dtype), -1)
-    t249 = xp.greater(t247, 0)
-    t250 = xp.where(t249, 1/(t237 + t248), 0)
-    t251 = xp.where(t249, 1 + xp.abs(t237)/t247, 0)
-    t252 = t238*t250
-    t253 = t251*(t241 + t252*t242)
-    t254 = -t253 + t241
-    t255 = t242 - t252*t253
-    t256 = t251*(t245 + t252*t246)
-    t257 = -t256 + t245
-    t258 = t246 - t252*t256
-    t259 = xp.abs(t255)
-    t260 = t259*xp.where(xp.greater_equal(t255, 0), xp.asarray(1, dtype=dtype), -1)
-    t261 = xp.where(xp.greater(t259, 0), xp.asarray(2, dtype=dtype), 0)
-    t262 = t258 - t258*t261
-    t263 = xp.where(xp.not_equal(t260, 0), -t262/t260, 0)
-    t264 = xp.where(xp.not_equal(t248, 0), -(t257 - t254*t263)/t248, 0)
-    t265 = xp.where(xp.not_equal(t229, 0), -(-(t236*t264 + t240*t263) + t244)/t229, 0)
-    t266 = xp.where(xp.not_equal(t201, 0), -(-(t209*t265 + t214*t264 + t219*t263) + t224)/t201, 0)
-    t267 = xp.where(xp.not_equal(t162, 0), -(-(-t171*t266 - t177*t265 + t183*t264 + t189*t263) + t195)/t162, 0)
-    t268 = xp.where(xp.not_equal(t104, 0), -(-(t120*t267 + t127*t266 + t134*t265 + t141*t264 - t148*t263) + t155)/t104, 0)
-    t269 = t263 - t31*t268 + t19*t267
-    t270 = t52*t268 + t56*t267 + t33*t266 + c2*t263 + t8*t265 + t20*t264
-    t271 = t53*t268 - t57*t267 + t34*t266 + t6*t265 - t3*t264 - t43*t263
-    t272 = t54*t268 + t58*t267 + t35*t266 + t11*t265 + t23*t264 + t42*t263
-    t273 = t55*t268 - t59*t267 + t36*t266 + t13*t265 - t25*t264 - t45*t263
-    t274 = t15*t265 + t27*t264 + t47*t263
-    t275 = qz1 + t269
-    t276 = qz3 + t270
-    t277 = qz4 + t271
-    t278 = qz5 + t272
-    t279 = qz6 + t273
-    t280 = -t274 + qz7
-    t281 = c1*t51
-    t282 = s1*t51
-    t283 = -t32*t266 - s1*t265 + c1*t264 + t281*t268 + t282*t267
-    t284 = qz2 + t283
-    t285 = 1 - t31 - t57 - t59 - t32 - s1 - t15 - t3 - t25 - t27 - t45 - t47 - t43 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t11 + t23 + t42 + q5 + t13 + q6 + q7 + t19 + t8 + t20 + t52 + t53 + t54 + t55 + t56 + t58 + t33 + t34 + t35 + t36 + t281 + t282 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7
-    t286 = xp.isfinite(t285)
-    t287 = xp.greater_equal(damping, 0)
-    t288 = 1e-12*t110
-    t289 = xp.less_equal(t103, t288) | xp.less_equal(t161, t288) | xp.less_equal(t200, t288) | xp.less_equal(t228, t288) | xp.less_equal(t247, t288) | xp.less_equal(t259, t288)
-    t290 = t286 & t287 & xp.logical_not(t289)
+    t95 = damping**2
+    t96 = _symmetric_solve6(xp, 1, (t95 + t69, t71, t73, t76, t67, -t60, t95 + t79, -t82, -t80, t77, t61, t95 + t37, t83, -t74, t62, t95 + t85, t86, t63, t95 + t87, t64, t95 + t88, t90, t93, t38, t94, t91, t65,))
+    t97 = t96[5]
+    t98 = t96[0]
+    t99 = t96[1]
+    t100 = t97 - t31*t98 + t19*t99
+    t101 = qz1 + t100
+    t102 = c1*t51
+    t103 = s1*t51
+    t104 = 1 - t31 - t57 - t59 - t32 - s1 - t15 - t3 - t25 - t27 - t45 - t47 - t43 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t11 + t23 + t42 + q5 + t13 + q6 + q7 + t19 + t8 + t20 + t102 + t103 + t52 + t53 + t54 + t55 + t56 + t58 + t33 + t34 + t35 + t36 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7
+    t105 = t96[2]
+    t106 = t96[3]
+    t107 = t96[4]
+    t108 = t98*t102 + t99*t103 - t105*t32 - s1*t106 + c1*t107
+    t109 = t98*t52 + t99*t56 + t105*t33 + t8*t106 + t20*t107 + c2*t97
+    t110 = -t3*t107 + t98*t53 - t99*t57 + t105*t34 + t6*t106 - t43*t97
+    t111 = t11*t106 + t98*t54 + t99*t58 + t105*t35 + t23*t107 + t42*t97
+    t112 = t13*t106 + t98*t55 - t99*t59 + t105*t36 - t25*t107 - t45*t97
+    t113 = t47*t97 + t15*t106 + t27*t107
+    t114 = qz2 + t108
+    t115 = qz3 + t109
+    t116 = qz4 + t110
+    t117 = qz5 + t111
+    t118 = qz6 + t112
+    t119 = -t113 + qz7
+    t120 = xp.isfinite(t104)
+    t121 = xp.greater_equal(damping, 0)
+    t122 = t96[6]
+    t123 = t120 & t121 & xp.less_equal(t122, 0)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t290, t275, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t290, t284, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t290, t276, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t290, t277, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t290, t278, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t290, t279, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t290, t280, 0), batch),  # 6
+        xp.broadcast_to(xp.where(t123, t101, 0), batch),  # 0
+        xp.broadcast_to(xp.where(t123, t114, 0), batch),  # 1
+        xp.broadcast_to(xp.where(t123, t115, 0), batch),  # 2
+        xp.broadcast_to(xp.where(t123, t116, 0), batch),  # 3
+        xp.broadcast_to(xp.where(t123, t117, 0), batch),  # 4
+        xp.broadcast_to(xp.where(t123, t118, 0), batch),  # 5
+        xp.broadcast_to(xp.where(t123, t119, 0), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t286 & t287), 2, xp.where(t289, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t120 & t121), 2, xp.where(xp.greater(t122, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1283 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1284 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (7,)), ("target", target, (4, 4)), ("target_rate", target_rate, (6,)), ("gain", gain, (6,)), ("z", z, (7,)), ("damping", damping, ()), every=("gain", ))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -5382,242 +5301,75 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t122 = -t106 - t6*t3 + t11*t26 - t13*t28 + t15*t30 + t106*t120
     t123 = t3**2 + t26**2 + t28**2 + t30**2 + t102 + t114*t120
     t124 = 1 + c2**2 + t46**2 + t49**2 + t51**2 + s3**2*t120
-    t125 = t107**2
-    t126 = t109**2
-    t127 = t112**2
-    t128 = t103**2
-    t129 = t67**2
-    t130 = damping**2
-    t131 = t130 + t105
-    t132 = t131**2
-    t133 = xp.sqrt(t125 + t126 + t127 + t128 + t129 + t132)
-    t134 = t133*xp.where(xp.greater_equal(t131, 0), xp.asarray(1, dtype=dtype), -1)
-    t135 = t130 + t115
-    t136 = t130 + t42
-    t137 = t130 + t121
-    t138 = t130 + t123
-    t139 = t130 + t124
-    t140 = xp.sqrt(t132 + 2*t125 + 2*t126 + 2*t118**2 + 2*t127 + 2*t116**2 + 2*t119**2 + 2*t128 + 2*t113**2 + 2*t110**2 + 2*t122**2 + 2*t129 + 2*t68**2 + 2*t69**2 + 2*t70**2 + 2*t71**2 + t135**2 + t136**2 + t137**2 + t138**2 + t139**2)
-    t141 = xp.greater(t133, 0)
-    t142 = xp.where(t141, 1/(t131 + t134), 0)
-    t143 = xp.where(t141, 1 + xp.abs(t131)/t133, 0)
-    t144 = t107*t142
-    t145 = t109*t142
-    t146 = t112*t142
-    t147 = t103*t142
-    t148 = t67*t142
-    t149 = t143*(t107 + t135*t144 - t145*t118 - t146*t116 + t147*t113 - t148*t68)
-    t150 = -t149 + t107
-    t151 = t135 - t144*t149
-    t152 = t118 + t145*t149
-    t153 = t116 + t146*t149
-    t154 = t113 - t147*t149
-    t155 = t68 + t148*t149
-    t156 = t143*(t109 - t144*t118 + t136*t145 + t146*t119 - t147*t110 - t148*t69)
-    t157 = -t156 + t109
-    t158 = t118 + t144*t156
-    t159 = t136 - t145*t156
-    t160 = t119 - t146*t156
-    t161 = t110 + t147*t156
-    t162 = t69 + t148*t156
-    t163 = t143*(t112 - t144*t116 + t145*t119 + t137*t146 + t147*t122 - t148*t70)
-    t164 = -t163 + t112
-    t165 = t116 + t144*t163
-    t166 = t119 - t145*t163
-    t167 = t137 - t146*t163
-    t168 = t122 - t147*t163
-    t169 = t70 + t148*t163
-    t170 = t143*(t103 + t144*t113 - t145*t110 + t146*t122 + t138*t147 - t148*t71)
-    t171 = -t170 + t103
-    t172 = t113 - t144*t170
-    t173 = t110 + t145*t170
-    t174 = t122 - t146*t170
-    t175 = t138 - t147*t170
-    t176 = t71 + t148*t170
-    t177 = t143*(-t67 + t144*t68 + t145*t69 + t146*t70 + t147*t71 - t139*t148)
-    t178 = t67 + t177
-    t179 = t68 - t144*t177
-    t180 = t69 - t145*t177
-    t181 = t70 - t146*t177
-    t182 = t71 - t147*t177
-    t183 = t139 + t148*t177
-    t184 = xp.sqrt(t151**2 + t152**2 + t153**2 + t154**2 + t155**2)
-    t185 = t184*xp.where(xp.greater_equal(t151, 0), xp.asarray(1, dtype=dtype), -1)
-    t186 = xp.greater(t184, 0)
-    t187 = xp.where(t186, 1/(t151 + t185), 0)
-    t188 = xp.where(t186, 1 + xp.abs(t151)/t184, 0)
-    t189 = t152*t187
-    t190 = t153*t187
-    t191 = t154*t187
-    t192 = t155*t187
-    t193 = -t188*(t158 + t189*t159 + t190*t160 + t191*t161 - t192*t162)
-    t194 = t158 + t193
-    t195 = t159 + t189*t193
-    t196 = t160 + t190*t193
-    t197 = t161 + t191*t193
-    t198 = t162 - t192*t193
-    t199 = -t188*(t165 + t189*t166 + t190*t167 - t191*t168 - t192*t169)
-    t200 = t165 + t199
-    t201 = t166 + t189*t199
-    t202 = t167 + t190*t199
-    t203 = t168 - t191*t199
-    t204 = t169 - t192*t199
-    t205 = t188*(t172 + t189*t173 - t190*t174 + t191*t175 + t192*t176)
-    t206 = -t205 + t172
-    t207 = -t173 + t189*t205
-    t208 = t174 + t190*t205
-    t209 = t175 - t191*t205
-    t210 = t176 - t192*t205
-    t211 = t188*(t179 - t189*t180 - t190*t181 + t191*t182 + t192*t183)
-    t212 = -t211 + t179
-    t213 = t180 + t189*t211
-    t214 = t181 + t190*t211
-    t215 = t182 - t191*t211
-    t216 = t183 - t192*t211
-    t217 = xp.sqrt(t195**2 + t196**2 + t197**2 + t198**2)
-    t218 = t217*xp.where(xp.greater_equal(t195, 0), xp.asarray(1, dtype=dtype), -1)
-    t219 = xp.greater(t217, 0)
-    t220 = xp.where(t219, 1/(t195 + t218), 0)
-    t221 = xp.where(t219, 1 + xp.abs(t195)/t217, 0)
-    t222 = t196*t220
-    t223 = t197*t220
-    t224 = t198*t220
-    t225 = t221*(t201 + t222*t202 - t223*t203 + t224*t204)
-    t226 = -t225 + t201
-    t227 = t202 - t222*t225
-    t228 = t203 + t223*t225
-    t229 = t204 - t224*t225
-    t230 = t221*(t207 + t222*t208 - t223*t209 + t224*t210)
-    t231 = -t230 + t207
-    t232 = t208 - t222*t230
-    t233 = t209 + t223*t230
-    t234 = t210 - t224*t230
-    t235 = t221*(t213 + t222*t214 - t223*t215 + t224*t216)
-    t236 = -t235 + t213
-    t237 = t214 - t222*t235
-    t238 = t215 + t223*t235
-    t239 = t216 - t224*t235
-    t240 = xp.sqrt(t227**2 + t228**2 + t229**2)
-    t241 = t240*xp.where(xp.greater_equal(t227, 0), xp.asarray(1, dtype=dtype), -1)
-    t242 = xp.greater(t240, 0)
-    t243 = xp.where(t242, 1/(t227 + t241), 0)
-    t244 = xp.where(t242, 1 + xp.abs(t227)/t240, 0)
-    t245 = t228*t243
-    t246 = t229*t243
-    t247 = t244*(t232 + t245*t233 + t246*t234)
-    t248 = -t247 + t232
-    t249 = t233 - t245*t247
-    t250 = t234 - t246*t247
-    t251 = t244*(t237 + t245*t238 + t246*t239)
-    t252 = -t251 + t237
-    t253 = t238 - t245*t251
-    t254 = t239 - t246*t251
-    t255 = xp.sqrt(t249**2 + t250**2)
-    t256 = t255*xp.where(xp.greater_equal(t249, 0), xp.asarray(1, dtype=dtype), -1)
-    t257 = xp.greater(t255, 0)
-    t258 = xp.where(t257, 1/(t249 + t256), 0)
-    t259 = xp.where(t257, 1 + xp.abs(t249)/t255, 0)
-    t260 = t250*t258
-    t261 = t259*(t253 + t260*t254)
-    t262 = -t261 + t253
-    t263 = t254 - t260*t261
-    t264 = xp.abs(t263)
-    t265 = t264*xp.where(xp.greater_equal(t263, 0), xp.asarray(1, dtype=dtype), -1)
-    t266 = xp.where(xp.greater(t264, 0), xp.asarray(2, dtype=dtype), 0)
-    t267 = xp.greater_equal(t78, t86) & xp.greater_equal(t78, t95)
-    t268 = xp.greater_equal(t86, t95)
-    t269 = xp.where(t267, 0.5*(1 + t78), xp.where(t268, 0.5*t85, 0.5*t93))
-    t270 = xp.where(t267, 0.5*t79, xp.where(t268, 0.5*(1 + t86), 0.5*t94))
-    t271 = xp.where(t267, 0.5*t80, xp.where(t268, 0.5*t87, 0.5*(1 + t95)))
-    t272 = xp.sqrt(t269**2 + t270**2 + t271**2)
-    t273 = xp.where(xp.greater_equal(t96*t269 + t97*t270 + t88*t271, 0), xp.asarray(1, dtype=dtype), -1)
-    t274 = xp.greater(t99, 1e-06) | xp.greater(t98, 0)
-    t275 = t100*t273/t272
-    t276 = xp.where(t274, t96*t101, t275*t269)
-    t277 = xp.where(t274, t97*t101, t275*t270)
-    t278 = xp.where(t274, t88*t101, t275*t271)
-    t279 = mu_dot3 + t276*gain3
-    t280 = mu_dot4 + t277*gain4
-    t281 = mu_dot5 + t278*gain5
-    t282 = -(qz1 + c2*qz3 + t46*qz5 - t49*qz6 - t51*qz7 - t47*qz4) + t281
-    t283 = -t36
-    t284 = mu_dot1 + gain1*(t283 + T13)
-    t285 = c1*qz2
-    t286 = -(-t36*qz1 + t59*qz3 + t60*qz4 + t61*qz5 + t62*qz6 + t57*t285) + t22
-    t287 = -(t285 - t3*qz4 + t26*qz5 - t28*qz6 - t30*qz7 + t23*qz3) + t280
-    t288 = s1*qz2
-    t289 = -(t21*qz1 + t63*qz3 - t64*qz4 + t65*qz5 - t66*qz6 + t57*t288) + t284
-    t290 = -(-t288 + t6*qz4 + t11*qz5 + t13*qz6 - t15*qz7 + t8*qz3) + t279
-    t291 = t143*(t286 + t144*t289 + t145*t73 + t146*t290 + t147*t287 - t148*t282)
-    t292 = -t291 + t286
-    t293 = t289 - t144*t291
-    t294 = t73 - t145*t291
-    t295 = t290 - t146*t291
-    t296 = t287 - t147*t291
-    t297 = t282 + t148*t291
-    t298 = t188*(t293 - t189*t294 - t190*t295 + t191*t296 + t192*t297)
-    t299 = -t298 + t293
-    t300 = t294 + t189*t298
-    t301 = t295 + t190*t298
-    t302 = t296 - t191*t298
-    t303 = t297 - t192*t298
-    t304 = t221*(t300 + t222*t301 - t223*t302 + t224*t303)
-    t305 = -t304 + t300
-    t306 = t301 - t222*t304
-    t307 = t302 + t223*t304
-    t308 = t303 - t224*t304
-    t309 = t244*(t306 + t245*t307 + t246*t308)
-    t310 = -t309 + t306
-    t311 = t307 - t245*t309
-    t312 = t308 - t246*t309
-    t313 = t259*(t311 + t260*t312)
-    t314 = -t313 + t311
-    t315 = t312 - t260*t313
-    t316 = t315 - t266*t315
-    t317 = xp.where(xp.not_equal(t265, 0), -t316/t265, 0)
-    t318 = xp.where(xp.not_equal(t256, 0), -(t314 - t262*t317)/t256, 0)
-    t319 = xp.where(xp.not_equal(t241, 0), -(-(t248*t318 + t252*t317) + t310)/t241, 0)
-    t320 = xp.where(xp.not_equal(t218, 0), -(-(t226*t319 + t231*t318 + t236*t317) + t305)/t218, 0)
-    t321 = xp.where(xp.not_equal(t185, 0), -(-(-t194*t320 - t200*t319 + t206*t318 + t212*t317) + t299)/t185, 0)
-    t322 = xp.where(xp.not_equal(t134, 0), -(-(t150*t321 + t157*t320 + t164*t319 + t171*t318 - t178*t317) + t292)/t134, 0)
-    t323 = t317 - t36*t322 + t21*t321
-    t324 = t59*t322 + t63*t321 + t38*t320 + c2*t317 + t8*t319 + t23*t318
-    t325 = t60*t322 - t64*t321 + t39*t320 + t6*t319 - t3*t318 - t47*t317
-    t326 = t61*t322 + t65*t321 + t40*t320 + t11*t319 + t26*t318 + t46*t317
-    t327 = t62*t322 - t66*t321 + t41*t320 + t13*t319 - t28*t318 - t49*t317
-    t328 = t15*t319 + t30*t318 + t51*t317
-    t329 = qz1 + t323
-    t330 = qz3 + t324
-    t331 = qz4 + t325
-    t332 = qz5 + t326
-    t333 = qz6 + t327
-    t334 = -t328 + qz7
-    t335 = c1*t57
-    t336 = s1*t57
-    t337 = -t37*t320 - s1*t319 + c1*t318 + t335*t322 + t336*t321
-    t338 = qz2 + t337
-    t339 = 1 - t64 - t66 - t37 - s1 - t15 - t3 - t28 - t30 - t49 - t51 - t47 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t11 + t26 + t46 + q5 + t13 + q6 + q7 + t21 + t8 + t23 + t59 + t60 + t61 + t62 + t63 + t65 + t38 + t39 + t40 + t41 + t283 + t335 + t336 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7 + t22 + t284 + t72 + t279 + t280 + t281
-    t340 = xp.isfinite(t339)
-    t341 = xp.greater_equal(damping, 0)
-    t342 = 1e-12*t140
-    t343 = xp.less_equal(t133, t342) | xp.less_equal(t184, t342) | xp.less_equal(t217, t342) | xp.less_equal(t240, t342) | xp.less_equal(t255, t342) | xp.less_equal(t264, t342)
-    t344 = t340 & t341 & xp.logical_not(t343)
+    t125 = xp.greater_equal(t78, t86) & xp.greater_equal(t78, t95)
+    t126 = xp.greater_equal(t86, t95)
+    t127 = xp.where(t125, 0.5*(1 + t78), xp.where(t126, 0.5*t85, 0.5*t93))
+    t128 = xp.where(t125, 0.5*t79, xp.where(t126, 0.5*(1 + t86), 0.5*t94))
+    t129 = xp.where(t125, 0.5*t80, xp.where(t126, 0.5*t87, 0.5*(1 + t95)))
+    t130 = xp.sqrt(t127**2 + t128**2 + t129**2)
+    t131 = xp.where(xp.greater_equal(t96*t127 + t97*t128 + t88*t129, 0), xp.asarray(1, dtype=dtype), -1)
+    t132 = xp.greater(t99, 1e-06) | xp.greater(t98, 0)
+    t133 = t100*t131/t130
+    t134 = xp.where(t132, t96*t101, t133*t127)
+    t135 = xp.where(t132, t97*t101, t133*t128)
+    t136 = xp.where(t132, t88*t101, t133*t129)
+    t137 = mu_dot3 + t134*gain3
+    t138 = mu_dot4 + t135*gain4
+    t139 = mu_dot5 + t136*gain5
+    t140 = -(qz1 + c2*qz3 + t46*qz5 - t49*qz6 - t51*qz7 - t47*qz4) + t139
+    t141 = -t36
+    t142 = mu_dot1 + gain1*(t141 + T13)
+    t143 = c1*qz2
+    t144 = -(-t36*qz1 + t59*qz3 + t60*qz4 + t61*qz5 + t62*qz6 + t57*t143) + t22
+    t145 = -(t143 - t3*qz4 + t26*qz5 - t28*qz6 - t30*qz7 + t23*qz3) + t138
+    t146 = s1*qz2
+    t147 = -(t21*qz1 + t63*qz3 - t64*qz4 + t65*qz5 - t66*qz6 + t57*t146) + t142
+    t148 = -(-t146 + t6*qz4 + t11*qz5 + t13*qz6 - t15*qz7 + t8*qz3) + t137
+    t149 = damping**2
+    t150 = _symmetric_solve6(xp, 1, (t149 + t105, t107, t109, t112, t103, -t67, t149 + t115, -t118, -t116, t113, t68, t149 + t42, t119, -t110, t69, t149 + t121, t122, t70, t149 + t123, t71, t149 + t124, t144, t147, t73, t148, t145, t140,))
+    t151 = t150[5]
+    t152 = t150[0]
+    t153 = t150[1]
+    t154 = t151 - t36*t152 + t21*t153
+    t155 = qz1 + t154
+    t156 = c1*t57
+    t157 = s1*t57
+    t158 = 1 - t64 - t66 - t37 - s1 - t15 - t3 - t28 - t30 - t49 - t51 - t47 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t11 + t26 + t46 + q5 + t13 + q6 + q7 + t21 + t8 + t23 + t141 + t59 + t60 + t61 + t62 + t63 + t65 + t38 + t39 + t40 + t41 + t156 + t157 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7 + t22 + t142 + t72 + t137 + t138 + t139
+    t159 = t150[2]
+    t160 = t150[3]
+    t161 = t150[4]
+    t162 = t152*t156 + t153*t157 - t37*t159 - s1*t160 + c1*t161
+    t163 = c2*t151 + t59*t152 + t63*t153 + t38*t159 + t8*t160 + t23*t161
+    t164 = t60*t152 - t64*t153 + t39*t159 + t6*t160 - t3*t161 - t47*t151
+    t165 = t46*t151 + t61*t152 + t65*t153 + t40*t159 + t11*t160 + t26*t161
+    t166 = -t66*t153 + t62*t152 + t41*t159 + t13*t160 - t28*t161 - t49*t151
+    t167 = t51*t151 + t15*t160 + t30*t161
+    t168 = qz2 + t162
+    t169 = qz3 + t163
+    t170 = qz4 + t164
+    t171 = qz5 + t165
+    t172 = qz6 + t166
+    t173 = -t167 + qz7
+    t174 = xp.isfinite(t158)
+    t175 = xp.greater_equal(damping, 0)
+    t176 = t150[6]
+    t177 = t174 & t175 & xp.less_equal(t176, 0)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t344, t329, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t344, t338, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t344, t330, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t344, t331, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t344, t332, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t344, t333, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t344, t334, 0), batch),  # 6
+        xp.broadcast_to(xp.where(t177, t155, 0), batch),  # 0
+        xp.broadcast_to(xp.where(t177, t168, 0), batch),  # 1
+        xp.broadcast_to(xp.where(t177, t169, 0), batch),  # 2
+        xp.broadcast_to(xp.where(t177, t170, 0), batch),  # 3
+        xp.broadcast_to(xp.where(t177, t171, 0), batch),  # 4
+        xp.broadcast_to(xp.where(t177, t172, 0), batch),  # 5
+        xp.broadcast_to(xp.where(t177, t173, 0), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t340 & t341), 2, xp.where(t343, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t174 & t175), 2, xp.where(xp.greater(t176, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (7 x 1 and 7 x 1 and 1 x 1), 1119 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (7 x 1 and 7 x 1 and 1 x 1), 1180 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (7,)), ("damping", damping, ()))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
@@ -5799,180 +5551,21 @@ def ik_numeric_step(target, q, damping=0.0):
     t137 = xp.where(t134, t99*t103, t135*t130)
     t138 = xp.where(t134, t90*t103, t135*t131)
     t139 = t136**2 + t137**2 + t138**2 + t29**2 + t49**2 + t75**2
-    t140 = damping + t107
-    t141 = xp.sqrt(t140**2 + t109**2 + t111**2 + t114**2 + t105**2 + t70**2)
-    t142 = t141*xp.where(xp.greater_equal(t140, 0), xp.asarray(1, dtype=dtype), -1)
-    t143 = xp.greater(t141, 0)
-    t144 = xp.where(t143, 1/(t140 + t142), 0)
-    t145 = xp.where(t143, 1 + xp.abs(t140)/t141, 0)
-    t146 = damping + t117
-    t147 = t109*t144
-    t148 = t111*t144
-    t149 = t114*t144
-    t150 = t105*t144
-    t151 = t70*t144
-    t152 = t145*(t109 - t149*t118 - t148*t120 + t150*t115 - t151*t71 + t146*t147)
-    t153 = -t152 + t109
-    t154 = t146 - t147*t152
-    t155 = t120 + t148*t152
-    t156 = t118 + t149*t152
-    t157 = t115 - t150*t152
-    t158 = t71 + t151*t152
-    t159 = t145*(t29 + t147*t49 + t148*t75 + t149*t136 + t150*t137 - t151*t138)
-    t160 = -t159 + t29
-    t161 = t49 - t147*t159
-    t162 = t75 - t148*t159
-    t163 = t136 - t149*t159
-    t164 = t137 - t150*t159
-    t165 = t138 + t151*t159
-    t166 = xp.sqrt(t154**2 + t155**2 + t156**2 + t157**2 + t158**2)
-    t167 = t166*xp.where(xp.greater_equal(t154, 0), xp.asarray(1, dtype=dtype), -1)
-    t168 = damping + t48
-    t169 = t145*(t111 - t150*t112 - t147*t120 + t149*t121 - t151*t72 + t148*t168)
-    t170 = -t169 + t111
-    t171 = t120 + t147*t169
-    t172 = t168 - t148*t169
-    t173 = t121 - t149*t169
-    t174 = t112 + t150*t169
-    t175 = t72 + t151*t169
-    t176 = damping + t123
-    t177 = t145*(t114 - t147*t118 + t148*t121 + t150*t124 - t151*t73 + t149*t176)
-    t178 = -t177 + t114
-    t179 = t118 + t147*t177
-    t180 = t121 - t148*t177
-    t181 = t176 - t149*t177
-    t182 = t124 - t150*t177
-    t183 = t73 + t151*t177
-    t184 = damping + t125
-    t185 = t145*(t105 + t147*t115 - t148*t112 + t149*t124 - t151*t74 + t150*t184)
-    t186 = -t185 + t105
-    t187 = t115 - t147*t185
-    t188 = t112 + t148*t185
-    t189 = t124 - t149*t185
-    t190 = t184 - t150*t185
-    t191 = t74 + t151*t185
-    t192 = damping + t126
-    t193 = t145*(-t70 + t147*t71 + t148*t72 + t149*t73 + t150*t74 - t151*t192)
-    t194 = t70 + t193
-    t195 = t71 - t147*t193
-    t196 = t72 - t148*t193
-    t197 = t73 - t149*t193
-    t198 = t74 - t150*t193
-    t199 = t192 + t151*t193
-    t200 = xp.greater(t166, 0)
-    t201 = xp.where(t200, 1/(t154 + t167), 0)
-    t202 = xp.where(t200, 1 + xp.abs(t154)/t166, 0)
-    t203 = t155*t201
-    t204 = t156*t201
-    t205 = t157*t201
-    t206 = t158*t201
-    t207 = -t202*(t171 + t203*t172 + t204*t173 + t205*t174 - t206*t175)
-    t208 = t171 + t207
-    t209 = t172 + t203*t207
-    t210 = t173 + t204*t207
-    t211 = t174 + t205*t207
-    t212 = t175 - t206*t207
-    t213 = -t202*(t179 + t203*t180 + t204*t181 - t205*t182 - t206*t183)
-    t214 = t179 + t213
-    t215 = t180 + t203*t213
-    t216 = t181 + t204*t213
-    t217 = t182 - t205*t213
-    t218 = t183 - t206*t213
-    t219 = t202*(t187 + t203*t188 - t204*t189 + t205*t190 + t206*t191)
-    t220 = -t219 + t187
-    t221 = -t188 + t203*t219
-    t222 = t189 + t204*t219
-    t223 = t190 - t205*t219
-    t224 = t191 - t206*t219
-    t225 = t202*(t195 - t203*t196 - t204*t197 + t205*t198 + t206*t199)
-    t226 = -t225 + t195
-    t227 = t196 + t203*t225
-    t228 = t197 + t204*t225
-    t229 = t198 - t205*t225
-    t230 = t199 - t206*t225
-    t231 = t202*(t161 - t203*t162 - t204*t163 + t205*t164 + t206*t165)
-    t232 = -t231 + t161
-    t233 = t162 + t203*t231
-    t234 = t163 + t204*t231
-    t235 = t164 - t205*t231
-    t236 = t165 - t206*t231
-    t237 = xp.sqrt(t209**2 + t210**2 + t211**2 + t212**2)
-    t238 = t237*xp.where(xp.greater_equal(t209, 0), xp.asarray(1, dtype=dtype), -1)
-    t239 = xp.greater(t237, 0)
-    t240 = xp.where(t239, 1/(t209 + t238), 0)
-    t241 = xp.where(t239, 1 + xp.abs(t209)/t237, 0)
-    t242 = t210*t240
-    t243 = t211*t240
-    t244 = t212*t240
-    t245 = t241*(t215 + t242*t216 - t243*t217 + t244*t218)
-    t246 = -t245 + t215
-    t247 = t216 - t242*t245
-    t248 = t217 + t243*t245
-    t249 = t218 - t244*t245
-    t250 = t241*(t221 + t242*t222 - t243*t223 + t244*t224)
-    t251 = -t250 + t221
-    t252 = t222 - t242*t250
-    t253 = t223 + t243*t250
-    t254 = t224 - t244*t250
-    t255 = t241*(t227 + t242*t228 - t243*t229 + t244*t230)
-    t256 = -t255 + t227
-    t257 = t228 - t242*t255
-    t258 = t229 + t243*t255
-    t259 = t230 - t244*t255
-    t260 = t241*(t233 + t242*t234 - t243*t235 + t244*t236)
-    t261 = -t260 + t233
-    t262 = t234 - t242*t260
-    t263 = t235 + t243*t260
-    t264 = t236 - t244*t260
-    t265 = xp.sqrt(t247**2 + t248**2 + t249**2)
-    t266 = t265*xp.where(xp.greater_equal(t247, 0), xp.asarray(1, dtype=dtype), -1)
-    t267 = xp.greater(t265, 0)
-    t268 = xp.where(t267, 1/(t247 + t266), 0)
-    t269 = xp.where(t267, 1 + xp.abs(t247)/t265, 0)
-    t270 = t248*t268
-    t271 = t249*t268
-    t272 = t269*(t252 + t270*t253 + t271*t254)
-    t273 = -t272 + t252
-    t274 = t253 - t270*t272
-    t275 = t254 - t271*t272
-    t276 = t269*(t257 + t270*t258 + t271*t259)
-    t277 = -t276 + t257
-    t278 = t258 - t270*t276
-    t279 = t259 - t271*t276
-    t280 = t269*(t262 + t270*t263 + t271*t264)
-    t281 = -t280 + t262
-    t282 = t263 - t270*t280
-    t283 = t264 - t271*t280
-    t284 = xp.sqrt(t274**2 + t275**2)
-    t285 = t284*xp.where(xp.greater_equal(t274, 0), xp.asarray(1, dtype=dtype), -1)
-    t286 = xp.greater(t284, 0)
-    t287 = xp.where(t286, 1/(t274 + t285), 0)
-    t288 = xp.where(t286, 1 + xp.abs(t274)/t284, 0)
-    t289 = t275*t287
-    t290 = t288*(t278 + t289*t279)
-    t291 = -t290 + t278
-    t292 = t279 - t289*t290
-    t293 = t288*(t282 + t289*t283)
-    t294 = -t293 + t282
-    t295 = t283 - t289*t293
-    t296 = xp.abs(t292)
-    t297 = t296*xp.where(xp.greater_equal(t292, 0), xp.asarray(1, dtype=dtype), -1)
-    t298 = xp.where(xp.greater(t296, 0), xp.asarray(2, dtype=dtype), 0)
-    t299 = t295 - t295*t298
-    t300 = xp.where(xp.not_equal(t297, 0), -t299/t297, 0)
-    t301 = xp.where(xp.not_equal(t285, 0), -(t294 - t291*t300)/t285, 0)
-    t302 = xp.where(xp.not_equal(t266, 0), -(-(t273*t301 + t277*t300) + t281)/t266, 0)
-    t303 = xp.where(xp.not_equal(t238, 0), -(-(t246*t302 + t251*t301 + t256*t300) + t261)/t238, 0)
-    t304 = xp.where(xp.not_equal(t167, 0), -(-(-t208*t303 - t214*t302 + t220*t301 + t226*t300) + t232)/t167, 0)
-    t305 = xp.where(xp.not_equal(t142, 0), -(-(t153*t304 + t170*t303 + t178*t302 + t186*t301 - t194*t300) + t160)/t142, 0)
-    t306 = q1 + t300 - t42*t305 + t28*t304
-    t307 = q2 + c1*t60*t305 + s1*t60*t304 - t43*t303 - s1*t302 + c1*t301
-    t308 = q3 + t62*t305 + t66*t304 + t44*t303 + c2*t300 + t16*t302 + t30*t301
-    t309 = q4 + t63*t305 - t67*t304 + t45*t303 + t7*t302 - t4*t301 - t50*t300
-    t310 = q5 + t64*t305 + t68*t304 + t46*t303 + t18*t302 + t32*t301 + t15*t300
-    t311 = q6 + t65*t305 - t69*t304 + t47*t303 + t20*t302 - t34*t301 - t52*t300
-    t312 = -q7 + t22*t302 + t36*t301 + t54*t300
-    t313 = -t312
+    t140 = _symmetric_solve6(xp, 1, (damping + t107, t109, t111, t114, t105, -t70, damping + t117, -t120, -t118, t115, t71, damping + t48, t121, -t112, t72, damping + t123, t124, t73, damping + t125, t74, damping + t126, t29, t49, t75, t136, t137, t138,))
+    t141 = t140[5]
+    t142 = t140[0]
+    t143 = t140[1]
+    t144 = q1 + t141 - t42*t142 + t28*t143
+    t145 = t140[2]
+    t146 = t140[3]
+    t147 = t140[4]
+    t148 = q2 + c1*t60*t142 + s1*t60*t143 - t43*t145 - s1*t146 + c1*t147
+    t149 = q3 + t142*t62 + t66*t143 + t44*t145 + t16*t146 + t30*t147 + c2*t141
+    t150 = q4 + t142*t63 - t67*t143 + t45*t145 + t7*t146 - t4*t147 - t50*t141
+    t151 = q5 + t15*t141 + t142*t64 + t68*t143 + t46*t145 + t18*t146 + t32*t147
+    t152 = q6 + t47*t145 + t142*t65 - t69*t143 + t20*t146 - t34*t147 - t52*t141
+    t153 = -q7 + t22*t146 + t36*t147 + t54*t141
+    t154 = -t153
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -5983,13 +5576,13 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q7, batch),  # 6
     ], (7,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t306, -2.8973), -2.8973, xp.where(xp.greater(t306, 2.8973), 2.8973, t306)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t307, -1.7627999999999997), -1.7627999999999997, xp.where(xp.greater(t307, 1.7627999999999997), 1.7627999999999997, t307)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t308, -2.8973), -2.8973, xp.where(xp.greater(t308, 2.8973), 2.8973, t308)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t309, -3.0718), -3.0718, xp.where(xp.greater(t309, -0.0698), -0.0698, t309)), batch),  # 3
-        xp.broadcast_to(xp.where(xp.less(t310, -2.8973), -2.8973, xp.where(xp.greater(t310, 2.8973), 2.8973, t310)), batch),  # 4
-        xp.broadcast_to(xp.where(xp.less(t311, -0.0175), -0.0175, xp.where(xp.greater(t311, 3.7525000000000004), 3.7525000000000004, t311)), batch),  # 5
-        xp.broadcast_to(xp.where(xp.less(t313, -2.8973), -2.8973, xp.where(xp.greater(t313, 2.8973), 2.8973, t313)), batch),  # 6
+        xp.broadcast_to(xp.where(xp.less(t144, -2.8973), -2.8973, xp.where(xp.greater(t144, 2.8973), 2.8973, t144)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t148, -1.7627999999999997), -1.7627999999999997, xp.where(xp.greater(t148, 1.7627999999999997), 1.7627999999999997, t148)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t149, -2.8973), -2.8973, xp.where(xp.greater(t149, 2.8973), 2.8973, t149)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t150, -3.0718), -3.0718, xp.where(xp.greater(t150, -0.0698), -0.0698, t150)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t151, -2.8973), -2.8973, xp.where(xp.greater(t151, 2.8973), 2.8973, t151)), batch),  # 4
+        xp.broadcast_to(xp.where(xp.less(t152, -0.0175), -0.0175, xp.where(xp.greater(t152, 3.7525000000000004), 3.7525000000000004, t152)), batch),  # 5
+        xp.broadcast_to(xp.where(xp.less(t154, -2.8973), -2.8973, xp.where(xp.greater(t154, 2.8973), 2.8973, t154)), batch),  # 6
     ], (7,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t0), t139, -1), batch)
     return q_start, q_next, cost
@@ -6700,7 +6293,7 @@ def ik_branches(T, q_free):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (7 x 1 and 1 x 1), 1007 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (7 x 1 and 1 x 1), 1005 operations."""
     xp, dtype, device, batch, (T, q_seed, q_free, weights,) = _arguments(("T", T, (4, 4)), ("q_seed", q_seed, (7,)), ("q_free", q_free, ()), ("weights", weights, (7,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(T, q_free)
     T00 = T[..., 0, 0]
@@ -6801,376 +6394,28 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     lb5 = branches_in_limits[..., 5]
     lb6 = branches_in_limits[..., 6]
     lb7 = branches_in_limits[..., 7]
-    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
-    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
-    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
-    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
-    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
-    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
-    t6 = xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0)
-    t7 = xp.where(xp.greater(t6, 0), xp.asarray(1, dtype=dtype), 0)
-    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
-    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
-    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
-    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
-    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
-    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
-    t14 = xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0)
-    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
-    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
-    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
-    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
-    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
-    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
-    t21 = xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0)
-    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
-    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
-    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
-    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
-    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
-    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
-    t28 = xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0)
-    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
-    t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
-    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
-    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
-    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
-    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
-    t35 = xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0)
-    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
-    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
-    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
-    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
-    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
-    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
-    t42 = xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0)
-    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
-    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
-    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
-    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
-    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
-    t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
-    t49 = xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0)
-    t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
-    t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
-    t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
-    t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
-    t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
-    t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
-    t56 = xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0)
-    t57 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7
-    t58 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t59 = t58 + t0
-    t60 = -t58 + t0
-    t61 = xp.where(xp.greater_equal(t0, -2.8973) & xp.less_equal(t0, 2.8973), t0, xp.where(xp.greater_equal(t59, -2.8973) & xp.less_equal(t59, 2.8973), t59, xp.where(xp.greater_equal(t60, -2.8973) & xp.less_equal(t60, 2.8973), t60, qb0_0)))
-    t62 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t63 = t62 + t1
-    t64 = -t62 + t1
-    t65 = xp.where(xp.greater_equal(t1, -1.7627999999999997) & xp.less_equal(t1, 1.7627999999999997), t1, xp.where(xp.greater_equal(t63, -1.7627999999999997) & xp.less_equal(t63, 1.7627999999999997), t63, xp.where(xp.greater_equal(t64, -1.7627999999999997) & xp.less_equal(t64, 1.7627999999999997), t64, qb0_1)))
-    t66 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t67 = t66 + t2
-    t68 = -t66 + t2
-    t69 = xp.where(xp.greater_equal(t2, -2.8973) & xp.less_equal(t2, 2.8973), t2, xp.where(xp.greater_equal(t67, -2.8973) & xp.less_equal(t67, 2.8973), t67, xp.where(xp.greater_equal(t68, -2.8973) & xp.less_equal(t68, 2.8973), t68, qb0_2)))
-    t70 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t71 = t70 + t3
-    t72 = -t70 + t3
-    t73 = xp.where(xp.greater_equal(t3, -3.0718) & xp.less_equal(t3, -0.0698), t3, xp.where(xp.greater_equal(t71, -3.0718) & xp.less_equal(t71, -0.0698), t71, xp.where(xp.greater_equal(t72, -3.0718) & xp.less_equal(t72, -0.0698), t72, qb0_3)))
-    t74 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t75 = t74 + t4
-    t76 = -t74 + t4
-    t77 = xp.where(xp.greater_equal(t4, -2.8973) & xp.less_equal(t4, 2.8973), t4, xp.where(xp.greater_equal(t75, -2.8973) & xp.less_equal(t75, 2.8973), t75, xp.where(xp.greater_equal(t76, -2.8973) & xp.less_equal(t76, 2.8973), t76, qb0_4)))
-    t78 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t79 = t78 + t5
-    t80 = -t78 + t5
-    t81 = xp.where(xp.greater_equal(t5, -0.0175) & xp.less_equal(t5, 3.7525000000000004), t5, xp.where(xp.greater_equal(t79, -0.0175) & xp.less_equal(t79, 3.7525000000000004), t79, xp.where(xp.greater_equal(t80, -0.0175) & xp.less_equal(t80, 3.7525000000000004), t80, qb0_5)))
-    t82 = -qn1
-    t83 = -qn2
-    t84 = -qn3
-    t85 = -qn4
-    t86 = -qn5
-    t87 = -qn6
-    t88 = -qn7
-    t89 = qw1*(t82 + t61)**2 + qw2*(t83 + t65)**2 + qw3*(t84 + t69)**2 + qw4*(t85 + t73)**2 + qw5*(t86 + t77)**2 + qw6*(t87 + t81)**2 + qw7*(t88 + qb0_6)**2
-    t90 = xp.greater(t7, 0)
-    t91 = xp.where(t90, t61, qn1)
-    t92 = xp.where(t90, t65, qn2)
-    t93 = xp.where(t90, t69, qn3)
-    t94 = xp.where(t90, t73, qn4)
-    t95 = xp.where(t90, t77, qn5)
-    t96 = xp.where(t90, t81, qn6)
-    t97 = xp.where(t90, qb0_6, qn7)
-    t98 = xp.where(t90, t89, 0)
-    t99 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t100 = t99 + t8
-    t101 = -t99 + t8
-    t102 = xp.where(xp.greater_equal(t8, -2.8973) & xp.less_equal(t8, 2.8973), t8, xp.where(xp.greater_equal(t100, -2.8973) & xp.less_equal(t100, 2.8973), t100, xp.where(xp.greater_equal(t101, -2.8973) & xp.less_equal(t101, 2.8973), t101, qb1_0)))
-    t103 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t104 = t103 + t9
-    t105 = -t103 + t9
-    t106 = xp.where(xp.greater_equal(t9, -1.7627999999999997) & xp.less_equal(t9, 1.7627999999999997), t9, xp.where(xp.greater_equal(t104, -1.7627999999999997) & xp.less_equal(t104, 1.7627999999999997), t104, xp.where(xp.greater_equal(t105, -1.7627999999999997) & xp.less_equal(t105, 1.7627999999999997), t105, qb1_1)))
-    t107 = xp.where(xp.less(t10, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t108 = t107 + t10
-    t109 = -t107 + t10
-    t110 = xp.where(xp.greater_equal(t10, -2.8973) & xp.less_equal(t10, 2.8973), t10, xp.where(xp.greater_equal(t108, -2.8973) & xp.less_equal(t108, 2.8973), t108, xp.where(xp.greater_equal(t109, -2.8973) & xp.less_equal(t109, 2.8973), t109, qb1_2)))
-    t111 = xp.where(xp.less(t11, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t112 = t111 + t11
-    t113 = -t111 + t11
-    t114 = xp.where(xp.greater_equal(t11, -3.0718) & xp.less_equal(t11, -0.0698), t11, xp.where(xp.greater_equal(t112, -3.0718) & xp.less_equal(t112, -0.0698), t112, xp.where(xp.greater_equal(t113, -3.0718) & xp.less_equal(t113, -0.0698), t113, qb1_3)))
-    t115 = xp.where(xp.less(t12, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t116 = t115 + t12
-    t117 = -t115 + t12
-    t118 = xp.where(xp.greater_equal(t12, -2.8973) & xp.less_equal(t12, 2.8973), t12, xp.where(xp.greater_equal(t116, -2.8973) & xp.less_equal(t116, 2.8973), t116, xp.where(xp.greater_equal(t117, -2.8973) & xp.less_equal(t117, 2.8973), t117, qb1_4)))
-    t119 = xp.where(xp.less(t13, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t120 = t119 + t13
-    t121 = -t119 + t13
-    t122 = xp.where(xp.greater_equal(t13, -0.0175) & xp.less_equal(t13, 3.7525000000000004), t13, xp.where(xp.greater_equal(t120, -0.0175) & xp.less_equal(t120, 3.7525000000000004), t120, xp.where(xp.greater_equal(t121, -0.0175) & xp.less_equal(t121, 3.7525000000000004), t121, qb1_5)))
-    t123 = qw1*(t82 + t102)**2 + qw2*(t83 + t106)**2 + qw3*(t84 + t110)**2 + qw4*(t85 + t114)**2 + qw5*(t86 + t118)**2 + qw6*(t87 + t122)**2 + qw7*(t88 + qb1_6)**2
-    t124 = xp.greater(t14, 0)
-    t125 = xp.where(t124 & (xp.less(t7, 1) | xp.less(t123, t98)), xp.asarray(1, dtype=dtype), 0)
-    t126 = xp.where(t124, 1, t7)
-    t127 = xp.greater(t125, 0)
-    t128 = xp.where(t127, t102, t91)
-    t129 = xp.where(t127, t106, t92)
-    t130 = xp.where(t127, t110, t93)
-    t131 = xp.where(t127, t114, t94)
-    t132 = xp.where(t127, t118, t95)
-    t133 = xp.where(t127, t122, t96)
-    t134 = xp.where(t127, qb1_6, t97)
-    t135 = xp.where(t127, t123, t98)
-    t136 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t137 = t136 + t15
-    t138 = -t136 + t15
-    t139 = xp.where(xp.greater_equal(t15, -2.8973) & xp.less_equal(t15, 2.8973), t15, xp.where(xp.greater_equal(t137, -2.8973) & xp.less_equal(t137, 2.8973), t137, xp.where(xp.greater_equal(t138, -2.8973) & xp.less_equal(t138, 2.8973), t138, qb2_0)))
-    t140 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t141 = t140 + t16
-    t142 = -t140 + t16
-    t143 = xp.where(xp.greater_equal(t16, -1.7627999999999997) & xp.less_equal(t16, 1.7627999999999997), t16, xp.where(xp.greater_equal(t141, -1.7627999999999997) & xp.less_equal(t141, 1.7627999999999997), t141, xp.where(xp.greater_equal(t142, -1.7627999999999997) & xp.less_equal(t142, 1.7627999999999997), t142, qb2_1)))
-    t144 = xp.where(xp.less(t17, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t145 = t144 + t17
-    t146 = -t144 + t17
-    t147 = xp.where(xp.greater_equal(t17, -2.8973) & xp.less_equal(t17, 2.8973), t17, xp.where(xp.greater_equal(t145, -2.8973) & xp.less_equal(t145, 2.8973), t145, xp.where(xp.greater_equal(t146, -2.8973) & xp.less_equal(t146, 2.8973), t146, qb2_2)))
-    t148 = xp.where(xp.less(t18, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t149 = t148 + t18
-    t150 = -t148 + t18
-    t151 = xp.where(xp.greater_equal(t18, -3.0718) & xp.less_equal(t18, -0.0698), t18, xp.where(xp.greater_equal(t149, -3.0718) & xp.less_equal(t149, -0.0698), t149, xp.where(xp.greater_equal(t150, -3.0718) & xp.less_equal(t150, -0.0698), t150, qb2_3)))
-    t152 = xp.where(xp.less(t19, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t153 = t152 + t19
-    t154 = -t152 + t19
-    t155 = xp.where(xp.greater_equal(t19, -2.8973) & xp.less_equal(t19, 2.8973), t19, xp.where(xp.greater_equal(t153, -2.8973) & xp.less_equal(t153, 2.8973), t153, xp.where(xp.greater_equal(t154, -2.8973) & xp.less_equal(t154, 2.8973), t154, qb2_4)))
-    t156 = xp.where(xp.less(t20, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t157 = t156 + t20
-    t158 = -t156 + t20
-    t159 = xp.where(xp.greater_equal(t20, -0.0175) & xp.less_equal(t20, 3.7525000000000004), t20, xp.where(xp.greater_equal(t157, -0.0175) & xp.less_equal(t157, 3.7525000000000004), t157, xp.where(xp.greater_equal(t158, -0.0175) & xp.less_equal(t158, 3.7525000000000004), t158, qb2_5)))
-    t160 = qw1*(t82 + t139)**2 + qw2*(t83 + t143)**2 + qw3*(t84 + t147)**2 + qw4*(t85 + t151)**2 + qw5*(t86 + t155)**2 + qw6*(t87 + t159)**2 + qw7*(t88 + qb2_6)**2
-    t161 = xp.greater(t21, 0)
-    t162 = xp.where(t161 & (xp.less(t126, 1) | xp.less(t160, t135)), xp.asarray(1, dtype=dtype), 0)
-    t163 = xp.where(t161, 1, t126)
-    t164 = xp.greater(t162, 0)
-    t165 = xp.where(t164, t139, t128)
-    t166 = xp.where(t164, t143, t129)
-    t167 = xp.where(t164, t147, t130)
-    t168 = xp.where(t164, t151, t131)
-    t169 = xp.where(t164, t155, t132)
-    t170 = xp.where(t164, t159, t133)
-    t171 = xp.where(t164, qb2_6, t134)
-    t172 = xp.where(t164, t160, t135)
-    t173 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t174 = t173 + t22
-    t175 = -t173 + t22
-    t176 = xp.where(xp.greater_equal(t22, -2.8973) & xp.less_equal(t22, 2.8973), t22, xp.where(xp.greater_equal(t174, -2.8973) & xp.less_equal(t174, 2.8973), t174, xp.where(xp.greater_equal(t175, -2.8973) & xp.less_equal(t175, 2.8973), t175, qb3_0)))
-    t177 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t178 = t177 + t23
-    t179 = -t177 + t23
-    t180 = xp.where(xp.greater_equal(t23, -1.7627999999999997) & xp.less_equal(t23, 1.7627999999999997), t23, xp.where(xp.greater_equal(t178, -1.7627999999999997) & xp.less_equal(t178, 1.7627999999999997), t178, xp.where(xp.greater_equal(t179, -1.7627999999999997) & xp.less_equal(t179, 1.7627999999999997), t179, qb3_1)))
-    t181 = xp.where(xp.less(t24, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t182 = t181 + t24
-    t183 = -t181 + t24
-    t184 = xp.where(xp.greater_equal(t24, -2.8973) & xp.less_equal(t24, 2.8973), t24, xp.where(xp.greater_equal(t182, -2.8973) & xp.less_equal(t182, 2.8973), t182, xp.where(xp.greater_equal(t183, -2.8973) & xp.less_equal(t183, 2.8973), t183, qb3_2)))
-    t185 = xp.where(xp.less(t25, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t186 = t185 + t25
-    t187 = -t185 + t25
-    t188 = xp.where(xp.greater_equal(t25, -3.0718) & xp.less_equal(t25, -0.0698), t25, xp.where(xp.greater_equal(t186, -3.0718) & xp.less_equal(t186, -0.0698), t186, xp.where(xp.greater_equal(t187, -3.0718) & xp.less_equal(t187, -0.0698), t187, qb3_3)))
-    t189 = xp.where(xp.less(t26, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t190 = t189 + t26
-    t191 = -t189 + t26
-    t192 = xp.where(xp.greater_equal(t26, -2.8973) & xp.less_equal(t26, 2.8973), t26, xp.where(xp.greater_equal(t190, -2.8973) & xp.less_equal(t190, 2.8973), t190, xp.where(xp.greater_equal(t191, -2.8973) & xp.less_equal(t191, 2.8973), t191, qb3_4)))
-    t193 = xp.where(xp.less(t27, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t194 = t193 + t27
-    t195 = -t193 + t27
-    t196 = xp.where(xp.greater_equal(t27, -0.0175) & xp.less_equal(t27, 3.7525000000000004), t27, xp.where(xp.greater_equal(t194, -0.0175) & xp.less_equal(t194, 3.7525000000000004), t194, xp.where(xp.greater_equal(t195, -0.0175) & xp.less_equal(t195, 3.7525000000000004), t195, qb3_5)))
-    t197 = qw1*(t82 + t176)**2 + qw2*(t83 + t180)**2 + qw3*(t84 + t184)**2 + qw4*(t85 + t188)**2 + qw5*(t86 + t192)**2 + qw6*(t87 + t196)**2 + qw7*(t88 + qb3_6)**2
-    t198 = xp.greater(t28, 0)
-    t199 = xp.where(t198 & (xp.less(t163, 1) | xp.less(t197, t172)), xp.asarray(1, dtype=dtype), 0)
-    t200 = xp.where(t198, 1, t163)
-    t201 = xp.greater(t199, 0)
-    t202 = xp.where(t201, t176, t165)
-    t203 = xp.where(t201, t180, t166)
-    t204 = xp.where(t201, t184, t167)
-    t205 = xp.where(t201, t188, t168)
-    t206 = xp.where(t201, t192, t169)
-    t207 = xp.where(t201, t196, t170)
-    t208 = xp.where(t201, qb3_6, t171)
-    t209 = xp.where(t201, t197, t172)
-    t210 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t211 = t210 + t29
-    t212 = -t210 + t29
-    t213 = xp.where(xp.greater_equal(t29, -2.8973) & xp.less_equal(t29, 2.8973), t29, xp.where(xp.greater_equal(t211, -2.8973) & xp.less_equal(t211, 2.8973), t211, xp.where(xp.greater_equal(t212, -2.8973) & xp.less_equal(t212, 2.8973), t212, qb4_0)))
-    t214 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t215 = t214 + t30
-    t216 = -t214 + t30
-    t217 = xp.where(xp.greater_equal(t30, -1.7627999999999997) & xp.less_equal(t30, 1.7627999999999997), t30, xp.where(xp.greater_equal(t215, -1.7627999999999997) & xp.less_equal(t215, 1.7627999999999997), t215, xp.where(xp.greater_equal(t216, -1.7627999999999997) & xp.less_equal(t216, 1.7627999999999997), t216, qb4_1)))
-    t218 = xp.where(xp.less(t31, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t219 = t218 + t31
-    t220 = -t218 + t31
-    t221 = xp.where(xp.greater_equal(t31, -2.8973) & xp.less_equal(t31, 2.8973), t31, xp.where(xp.greater_equal(t219, -2.8973) & xp.less_equal(t219, 2.8973), t219, xp.where(xp.greater_equal(t220, -2.8973) & xp.less_equal(t220, 2.8973), t220, qb4_2)))
-    t222 = xp.where(xp.less(t32, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t223 = t222 + t32
-    t224 = -t222 + t32
-    t225 = xp.where(xp.greater_equal(t32, -3.0718) & xp.less_equal(t32, -0.0698), t32, xp.where(xp.greater_equal(t223, -3.0718) & xp.less_equal(t223, -0.0698), t223, xp.where(xp.greater_equal(t224, -3.0718) & xp.less_equal(t224, -0.0698), t224, qb4_3)))
-    t226 = xp.where(xp.less(t33, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t227 = t226 + t33
-    t228 = -t226 + t33
-    t229 = xp.where(xp.greater_equal(t33, -2.8973) & xp.less_equal(t33, 2.8973), t33, xp.where(xp.greater_equal(t227, -2.8973) & xp.less_equal(t227, 2.8973), t227, xp.where(xp.greater_equal(t228, -2.8973) & xp.less_equal(t228, 2.8973), t228, qb4_4)))
-    t230 = xp.where(xp.less(t34, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t231 = t230 + t34
-    t232 = -t230 + t34
-    t233 = xp.where(xp.greater_equal(t34, -0.0175) & xp.less_equal(t34, 3.7525000000000004), t34, xp.where(xp.greater_equal(t231, -0.0175) & xp.less_equal(t231, 3.7525000000000004), t231, xp.where(xp.greater_equal(t232, -0.0175) & xp.less_equal(t232, 3.7525000000000004), t232, qb4_5)))
-    t234 = qw1*(t82 + t213)**2 + qw2*(t83 + t217)**2 + qw3*(t84 + t221)**2 + qw4*(t85 + t225)**2 + qw5*(t86 + t229)**2 + qw6*(t87 + t233)**2 + qw7*(t88 + qb4_6)**2
-    t235 = xp.greater(t35, 0)
-    t236 = xp.where(t235 & (xp.less(t200, 1) | xp.less(t234, t209)), xp.asarray(1, dtype=dtype), 0)
-    t237 = xp.where(t235, 1, t200)
-    t238 = xp.greater(t236, 0)
-    t239 = xp.where(t238, t213, t202)
-    t240 = xp.where(t238, t217, t203)
-    t241 = xp.where(t238, t221, t204)
-    t242 = xp.where(t238, t225, t205)
-    t243 = xp.where(t238, t229, t206)
-    t244 = xp.where(t238, t233, t207)
-    t245 = xp.where(t238, qb4_6, t208)
-    t246 = xp.where(t238, t234, t209)
-    t247 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t248 = t247 + t36
-    t249 = -t247 + t36
-    t250 = xp.where(xp.greater_equal(t36, -2.8973) & xp.less_equal(t36, 2.8973), t36, xp.where(xp.greater_equal(t248, -2.8973) & xp.less_equal(t248, 2.8973), t248, xp.where(xp.greater_equal(t249, -2.8973) & xp.less_equal(t249, 2.8973), t249, qb5_0)))
-    t251 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t252 = t251 + t37
-    t253 = -t251 + t37
-    t254 = xp.where(xp.greater_equal(t37, -1.7627999999999997) & xp.less_equal(t37, 1.7627999999999997), t37, xp.where(xp.greater_equal(t252, -1.7627999999999997) & xp.less_equal(t252, 1.7627999999999997), t252, xp.where(xp.greater_equal(t253, -1.7627999999999997) & xp.less_equal(t253, 1.7627999999999997), t253, qb5_1)))
-    t255 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t256 = t255 + t38
-    t257 = -t255 + t38
-    t258 = xp.where(xp.greater_equal(t38, -2.8973) & xp.less_equal(t38, 2.8973), t38, xp.where(xp.greater_equal(t256, -2.8973) & xp.less_equal(t256, 2.8973), t256, xp.where(xp.greater_equal(t257, -2.8973) & xp.less_equal(t257, 2.8973), t257, qb5_2)))
-    t259 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t260 = t259 + t39
-    t261 = -t259 + t39
-    t262 = xp.where(xp.greater_equal(t39, -3.0718) & xp.less_equal(t39, -0.0698), t39, xp.where(xp.greater_equal(t260, -3.0718) & xp.less_equal(t260, -0.0698), t260, xp.where(xp.greater_equal(t261, -3.0718) & xp.less_equal(t261, -0.0698), t261, qb5_3)))
-    t263 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t264 = t263 + t40
-    t265 = -t263 + t40
-    t266 = xp.where(xp.greater_equal(t40, -2.8973) & xp.less_equal(t40, 2.8973), t40, xp.where(xp.greater_equal(t264, -2.8973) & xp.less_equal(t264, 2.8973), t264, xp.where(xp.greater_equal(t265, -2.8973) & xp.less_equal(t265, 2.8973), t265, qb5_4)))
-    t267 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t268 = t267 + t41
-    t269 = -t267 + t41
-    t270 = xp.where(xp.greater_equal(t41, -0.0175) & xp.less_equal(t41, 3.7525000000000004), t41, xp.where(xp.greater_equal(t268, -0.0175) & xp.less_equal(t268, 3.7525000000000004), t268, xp.where(xp.greater_equal(t269, -0.0175) & xp.less_equal(t269, 3.7525000000000004), t269, qb5_5)))
-    t271 = qw1*(t82 + t250)**2 + qw2*(t83 + t254)**2 + qw3*(t84 + t258)**2 + qw4*(t85 + t262)**2 + qw5*(t86 + t266)**2 + qw6*(t87 + t270)**2 + qw7*(t88 + qb5_6)**2
-    t272 = xp.greater(t42, 0)
-    t273 = xp.where(t272 & (xp.less(t237, 1) | xp.less(t271, t246)), xp.asarray(1, dtype=dtype), 0)
-    t274 = xp.where(t272, 1, t237)
-    t275 = xp.greater(t273, 0)
-    t276 = xp.where(t275, t250, t239)
-    t277 = xp.where(t275, t254, t240)
-    t278 = xp.where(t275, t258, t241)
-    t279 = xp.where(t275, t262, t242)
-    t280 = xp.where(t275, t266, t243)
-    t281 = xp.where(t275, t270, t244)
-    t282 = xp.where(t275, qb5_6, t245)
-    t283 = xp.where(t275, t271, t246)
-    t284 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t285 = t284 + t43
-    t286 = -t284 + t43
-    t287 = xp.where(xp.greater_equal(t43, -2.8973) & xp.less_equal(t43, 2.8973), t43, xp.where(xp.greater_equal(t285, -2.8973) & xp.less_equal(t285, 2.8973), t285, xp.where(xp.greater_equal(t286, -2.8973) & xp.less_equal(t286, 2.8973), t286, qb6_0)))
-    t288 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t289 = t288 + t44
-    t290 = -t288 + t44
-    t291 = xp.where(xp.greater_equal(t44, -1.7627999999999997) & xp.less_equal(t44, 1.7627999999999997), t44, xp.where(xp.greater_equal(t289, -1.7627999999999997) & xp.less_equal(t289, 1.7627999999999997), t289, xp.where(xp.greater_equal(t290, -1.7627999999999997) & xp.less_equal(t290, 1.7627999999999997), t290, qb6_1)))
-    t292 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t293 = t292 + t45
-    t294 = -t292 + t45
-    t295 = xp.where(xp.greater_equal(t45, -2.8973) & xp.less_equal(t45, 2.8973), t45, xp.where(xp.greater_equal(t293, -2.8973) & xp.less_equal(t293, 2.8973), t293, xp.where(xp.greater_equal(t294, -2.8973) & xp.less_equal(t294, 2.8973), t294, qb6_2)))
-    t296 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t297 = t296 + t46
-    t298 = -t296 + t46
-    t299 = xp.where(xp.greater_equal(t46, -3.0718) & xp.less_equal(t46, -0.0698), t46, xp.where(xp.greater_equal(t297, -3.0718) & xp.less_equal(t297, -0.0698), t297, xp.where(xp.greater_equal(t298, -3.0718) & xp.less_equal(t298, -0.0698), t298, qb6_3)))
-    t300 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t301 = t300 + t47
-    t302 = -t300 + t47
-    t303 = xp.where(xp.greater_equal(t47, -2.8973) & xp.less_equal(t47, 2.8973), t47, xp.where(xp.greater_equal(t301, -2.8973) & xp.less_equal(t301, 2.8973), t301, xp.where(xp.greater_equal(t302, -2.8973) & xp.less_equal(t302, 2.8973), t302, qb6_4)))
-    t304 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t305 = t304 + t48
-    t306 = -t304 + t48
-    t307 = xp.where(xp.greater_equal(t48, -0.0175) & xp.less_equal(t48, 3.7525000000000004), t48, xp.where(xp.greater_equal(t305, -0.0175) & xp.less_equal(t305, 3.7525000000000004), t305, xp.where(xp.greater_equal(t306, -0.0175) & xp.less_equal(t306, 3.7525000000000004), t306, qb6_5)))
-    t308 = qw1*(t82 + t287)**2 + qw2*(t83 + t291)**2 + qw3*(t84 + t295)**2 + qw4*(t85 + t299)**2 + qw5*(t86 + t303)**2 + qw6*(t87 + t307)**2 + qw7*(t88 + qb6_6)**2
-    t309 = xp.greater(t49, 0)
-    t310 = xp.where(t309 & (xp.less(t274, 1) | xp.less(t308, t283)), xp.asarray(1, dtype=dtype), 0)
-    t311 = xp.where(t309, 1, t274)
-    t312 = xp.greater(t310, 0)
-    t313 = xp.where(t312, t287, t276)
-    t314 = xp.where(t312, t291, t277)
-    t315 = xp.where(t312, t295, t278)
-    t316 = xp.where(t312, t299, t279)
-    t317 = xp.where(t312, t303, t280)
-    t318 = xp.where(t312, t307, t281)
-    t319 = xp.where(t312, qb6_6, t282)
-    t320 = xp.where(t312, t308, t283)
-    t321 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t322 = t321 + t50
-    t323 = -t321 + t50
-    t324 = xp.where(xp.greater_equal(t50, -2.8973) & xp.less_equal(t50, 2.8973), t50, xp.where(xp.greater_equal(t322, -2.8973) & xp.less_equal(t322, 2.8973), t322, xp.where(xp.greater_equal(t323, -2.8973) & xp.less_equal(t323, 2.8973), t323, qb7_0)))
-    t325 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t326 = t325 + t51
-    t327 = -t325 + t51
-    t328 = xp.where(xp.greater_equal(t51, -1.7627999999999997) & xp.less_equal(t51, 1.7627999999999997), t51, xp.where(xp.greater_equal(t326, -1.7627999999999997) & xp.less_equal(t326, 1.7627999999999997), t326, xp.where(xp.greater_equal(t327, -1.7627999999999997) & xp.less_equal(t327, 1.7627999999999997), t327, qb7_1)))
-    t329 = xp.where(xp.less(t52, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t330 = t329 + t52
-    t331 = -t329 + t52
-    t332 = xp.where(xp.greater_equal(t52, -2.8973) & xp.less_equal(t52, 2.8973), t52, xp.where(xp.greater_equal(t330, -2.8973) & xp.less_equal(t330, 2.8973), t330, xp.where(xp.greater_equal(t331, -2.8973) & xp.less_equal(t331, 2.8973), t331, qb7_2)))
-    t333 = xp.where(xp.less(t53, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t334 = t333 + t53
-    t335 = -t333 + t53
-    t336 = xp.where(xp.greater_equal(t53, -3.0718) & xp.less_equal(t53, -0.0698), t53, xp.where(xp.greater_equal(t334, -3.0718) & xp.less_equal(t334, -0.0698), t334, xp.where(xp.greater_equal(t335, -3.0718) & xp.less_equal(t335, -0.0698), t335, qb7_3)))
-    t337 = xp.where(xp.less(t54, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t338 = t337 + t54
-    t339 = -t337 + t54
-    t340 = xp.where(xp.greater_equal(t54, -2.8973) & xp.less_equal(t54, 2.8973), t54, xp.where(xp.greater_equal(t338, -2.8973) & xp.less_equal(t338, 2.8973), t338, xp.where(xp.greater_equal(t339, -2.8973) & xp.less_equal(t339, 2.8973), t339, qb7_4)))
-    t341 = xp.where(xp.less(t55, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t342 = t341 + t55
-    t343 = -t341 + t55
-    t344 = xp.where(xp.greater_equal(t55, -0.0175) & xp.less_equal(t55, 3.7525000000000004), t55, xp.where(xp.greater_equal(t342, -0.0175) & xp.less_equal(t342, 3.7525000000000004), t342, xp.where(xp.greater_equal(t343, -0.0175) & xp.less_equal(t343, 3.7525000000000004), t343, qb7_5)))
-    t345 = qw1*(t82 + t324)**2 + qw2*(t83 + t328)**2 + qw3*(t84 + t332)**2 + qw4*(t85 + t336)**2 + qw5*(t86 + t340)**2 + qw6*(t87 + t344)**2 + qw7*(t88 + qb7_6)**2
-    t346 = xp.greater(t56, 0)
-    t347 = xp.where(t346 & (xp.less(t311, 1) | xp.less(t345, t320)), xp.asarray(1, dtype=dtype), 0)
-    t348 = xp.where(t346, 1, t311)
-    t349 = xp.greater(t347, 0)
-    t350 = xp.where(t349, t324, t313)
-    t351 = xp.where(t349, t328, t314)
-    t352 = xp.where(t349, t332, t315)
-    t353 = xp.where(t349, t336, t316)
-    t354 = xp.where(t349, t340, t317)
-    t355 = xp.where(t349, t344, t318)
-    t356 = xp.where(t349, qb7_6, t319)
-    t357 = xp.greater(t348, 0)
-    t358 = xp.isfinite(t57)
-    t359 = t357 & t358
+    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7
+    t1 = _nearer_branch(xp, 1, (qb0_0, qb0_1, qb0_2, qb0_3, qb0_4, qb0_5, qb0_6, xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, qn1, qn2, qn3, qn4, qn5, qn6, qn7, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
+    t2 = _nearer_branch(xp, 1, (qb1_0, qb1_1, qb1_2, qb1_3, qb1_4, qb1_5, qb1_6, xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t1[0], t1[1], t1[2], t1[3], t1[4], t1[5], t1[6], t1[7], t1[8],))
+    t3 = _nearer_branch(xp, 1, (qb2_0, qb2_1, qb2_2, qb2_3, qb2_4, qb2_5, qb2_6, xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t2[0], t2[1], t2[2], t2[3], t2[4], t2[5], t2[6], t2[7], t2[8],))
+    t4 = _nearer_branch(xp, 1, (qb3_0, qb3_1, qb3_2, qb3_3, qb3_4, qb3_5, qb3_6, xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t3[0], t3[1], t3[2], t3[3], t3[4], t3[5], t3[6], t3[7], t3[8],))
+    t5 = _nearer_branch(xp, 1, (qb4_0, qb4_1, qb4_2, qb4_3, qb4_4, qb4_5, qb4_6, xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t4[0], t4[1], t4[2], t4[3], t4[4], t4[5], t4[6], t4[7], t4[8],))
+    t6 = _nearer_branch(xp, 1, (qb5_0, qb5_1, qb5_2, qb5_3, qb5_4, qb5_5, qb5_6, xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t5[0], t5[1], t5[2], t5[3], t5[4], t5[5], t5[6], t5[7], t5[8],))
+    t7 = _nearer_branch(xp, 1, (qb6_0, qb6_1, qb6_2, qb6_3, qb6_4, qb6_5, qb6_6, xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t6[0], t6[1], t6[2], t6[3], t6[4], t6[5], t6[6], t6[7], t6[8],))
+    t8 = _nearer_branch(xp, 1, (qb7_0, qb7_1, qb7_2, qb7_3, qb7_4, qb7_5, qb7_6, xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t7[0], t7[1], t7[2], t7[3], t7[4], t7[5], t7[6], t7[7], t7[8],))
+    t9 = xp.greater(t8[8], 0)
+    t10 = xp.isfinite(t0)
+    t11 = t9 & t10
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t359, t350, qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t359, t351, qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t359, t352, qn3), batch),  # 2
-        xp.broadcast_to(xp.where(t359, t353, qn4), batch),  # 3
-        xp.broadcast_to(xp.where(t359, t354, qn5), batch),  # 4
-        xp.broadcast_to(xp.where(t359, t355, qn6), batch),  # 5
-        xp.broadcast_to(xp.where(t359, t356, qn7), batch),  # 6
+        xp.broadcast_to(xp.where(t11, t8[0], qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t11, t8[1], qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t11, t8[2], qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t11, t8[3], qn4), batch),  # 3
+        xp.broadcast_to(xp.where(t11, t8[4], qn5), batch),  # 4
+        xp.broadcast_to(xp.where(t11, t8[5], qn6), batch),  # 5
+        xp.broadcast_to(xp.where(t11, t8[6], qn7), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t358), 2, xp.where(t357, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t10), 2, xp.where(t9, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

@@ -82,6 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -335,6 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi6_rows(xp, count, state):
     """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2 + w4**2 + w5**2
@@ -896,6 +898,257 @@ def _jacobi6_rows(xp, count, state):
             t489,
             t493,
             t497,
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _symmetric_solve6(xp, count, state):
+    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w1**2
+        t1 = w2**2
+        t2 = w3**2
+        t3 = w4**2
+        t4 = w5**2
+        t5 = w0**2
+        t6 = xp.sqrt(t5 + 2*t0 + 2*t1 + 2*w7**2 + 2*t2 + 2*w8**2 + 2*w12**2 + 2*t3 + 2*w9**2 + 2*w13**2 + 2*w16**2 + 2*t4 + 2*w10**2 + 2*w14**2 + 2*w17**2 + 2*w19**2 + w6**2 + w11**2 + w15**2 + w18**2 + w20**2)
+        t7 = xp.sqrt(t0 + t1 + t2 + t3 + t4 + t5)
+        t8 = t7*xp.where(xp.greater_equal(w0, 0), xp.asarray(1, dtype=dtype), -1)
+        t9 = xp.greater(t7, 0)
+        t10 = xp.where(t9, 1/(w0 + t8), 0)
+        t11 = xp.where(t9, 1 + xp.abs(w0)/t7, 0)
+        t12 = w1*t10
+        t13 = w2*t10
+        t14 = w3*t10
+        t15 = w4*t10
+        t16 = w5*t10
+        t17 = t11*(w1 + t12*w6 + t13*w7 + t14*w8 + t15*w9 + t16*w10)
+        t18 = -t17 + w1
+        t19 = w6 - t12*t17
+        t20 = w7 - t13*t17
+        t21 = w8 - t14*t17
+        t22 = w9 - t15*t17
+        t23 = w10 - t16*t17
+        t24 = t11*(w2 + t12*w7 + t13*w11 + t14*w12 + t15*w13 + t16*w14)
+        t25 = -t24 + w2
+        t26 = w7 - t12*t24
+        t27 = w11 - t13*t24
+        t28 = w12 - t14*t24
+        t29 = w13 - t15*t24
+        t30 = w14 - t16*t24
+        t31 = t11*(w3 + t12*w8 + t13*w12 + t14*w15 + t15*w16 + t16*w17)
+        t32 = -t31 + w3
+        t33 = w8 - t12*t31
+        t34 = w12 - t13*t31
+        t35 = w15 - t14*t31
+        t36 = w16 - t15*t31
+        t37 = w17 - t16*t31
+        t38 = t11*(w4 + t12*w9 + t13*w13 + t14*w16 + t15*w18 + t16*w19)
+        t39 = -t38 + w4
+        t40 = w9 - t12*t38
+        t41 = w13 - t13*t38
+        t42 = w16 - t14*t38
+        t43 = w18 - t15*t38
+        t44 = w19 - t16*t38
+        t45 = t11*(w5 + t12*w10 + t13*w14 + t14*w17 + t15*w19 + t16*w20)
+        t46 = -t45 + w5
+        t47 = w10 - t12*t45
+        t48 = w14 - t13*t45
+        t49 = w17 - t14*t45
+        t50 = w19 - t15*t45
+        t51 = w20 - t16*t45
+        t52 = t11*(w21 + t12*w22 + t13*w23 + t14*w24 + t15*w25 + t16*w26)
+        t53 = -t52 + w21
+        t54 = w22 - t12*t52
+        t55 = w23 - t13*t52
+        t56 = w24 - t14*t52
+        t57 = w25 - t15*t52
+        t58 = w26 - t16*t52
+        t59 = xp.sqrt(t19**2 + t20**2 + t21**2 + t22**2 + t23**2)
+        t60 = t59*xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)
+        t61 = xp.greater(t59, 0)
+        t62 = xp.where(t61, 1/(t19 + t60), 0)
+        t63 = xp.where(t61, 1 + xp.abs(t19)/t59, 0)
+        t64 = t20*t62
+        t65 = t21*t62
+        t66 = t22*t62
+        t67 = t23*t62
+        t68 = t63*(t26 + t64*t27 + t65*t28 + t66*t29 + t67*t30)
+        t69 = -t68 + t26
+        t70 = t27 - t64*t68
+        t71 = t28 - t65*t68
+        t72 = t29 - t66*t68
+        t73 = t30 - t67*t68
+        t74 = t63*(t33 + t64*t34 + t65*t35 + t66*t36 + t67*t37)
+        t75 = -t74 + t33
+        t76 = t34 - t64*t74
+        t77 = t35 - t65*t74
+        t78 = t36 - t66*t74
+        t79 = t37 - t67*t74
+        t80 = t63*(t40 + t64*t41 + t65*t42 + t66*t43 + t67*t44)
+        t81 = -t80 + t40
+        t82 = t41 - t64*t80
+        t83 = t42 - t65*t80
+        t84 = t43 - t66*t80
+        t85 = t44 - t67*t80
+        t86 = t63*(t47 + t64*t48 + t65*t49 + t66*t50 + t67*t51)
+        t87 = -t86 + t47
+        t88 = t48 - t64*t86
+        t89 = t49 - t65*t86
+        t90 = t50 - t66*t86
+        t91 = t51 - t67*t86
+        t92 = t63*(t54 + t64*t55 + t65*t56 + t66*t57 + t67*t58)
+        t93 = -t92 + t54
+        t94 = t55 - t64*t92
+        t95 = t56 - t65*t92
+        t96 = t57 - t66*t92
+        t97 = t58 - t67*t92
+        t98 = xp.sqrt(t70**2 + t71**2 + t72**2 + t73**2)
+        t99 = t98*xp.where(xp.greater_equal(t70, 0), xp.asarray(1, dtype=dtype), -1)
+        t100 = xp.greater(t98, 0)
+        t101 = xp.where(t100, 1/(t70 + t99), 0)
+        t102 = xp.where(t100, 1 + xp.abs(t70)/t98, 0)
+        t103 = t71*t101
+        t104 = t72*t101
+        t105 = t73*t101
+        t106 = t102*(t76 + t103*t77 + t104*t78 + t105*t79)
+        t107 = -t106 + t76
+        t108 = t77 - t103*t106
+        t109 = t78 - t104*t106
+        t110 = t79 - t105*t106
+        t111 = t102*(t82 + t103*t83 + t104*t84 + t105*t85)
+        t112 = -t111 + t82
+        t113 = t83 - t103*t111
+        t114 = t84 - t104*t111
+        t115 = t85 - t105*t111
+        t116 = t102*(t88 + t103*t89 + t104*t90 + t105*t91)
+        t117 = -t116 + t88
+        t118 = t89 - t103*t116
+        t119 = t90 - t104*t116
+        t120 = t91 - t105*t116
+        t121 = t102*(t94 + t103*t95 + t104*t96 + t105*t97)
+        t122 = -t121 + t94
+        t123 = t95 - t103*t121
+        t124 = t96 - t104*t121
+        t125 = t97 - t105*t121
+        t126 = xp.sqrt(t108**2 + t109**2 + t110**2)
+        t127 = t126*xp.where(xp.greater_equal(t108, 0), xp.asarray(1, dtype=dtype), -1)
+        t128 = xp.greater(t126, 0)
+        t129 = xp.where(t128, 1/(t108 + t127), 0)
+        t130 = xp.where(t128, 1 + xp.abs(t108)/t126, 0)
+        t131 = t109*t129
+        t132 = t110*t129
+        t133 = t130*(t113 + t131*t114 + t132*t115)
+        t134 = -t133 + t113
+        t135 = t114 - t131*t133
+        t136 = t115 - t132*t133
+        t137 = t130*(t118 + t131*t119 + t132*t120)
+        t138 = -t137 + t118
+        t139 = t119 - t131*t137
+        t140 = t120 - t132*t137
+        t141 = t130*(t123 + t131*t124 + t132*t125)
+        t142 = -t141 + t123
+        t143 = t124 - t131*t141
+        t144 = t125 - t132*t141
+        t145 = xp.sqrt(t135**2 + t136**2)
+        t146 = t145*xp.where(xp.greater_equal(t135, 0), xp.asarray(1, dtype=dtype), -1)
+        t147 = xp.greater(t145, 0)
+        t148 = xp.where(t147, 1/(t135 + t146), 0)
+        t149 = xp.where(t147, 1 + xp.abs(t135)/t145, 0)
+        t150 = t136*t148
+        t151 = t149*(t139 + t150*t140)
+        t152 = -t151 + t139
+        t153 = t140 - t150*t151
+        t154 = t149*(t143 + t150*t144)
+        t155 = -t154 + t143
+        t156 = t144 - t150*t154
+        t157 = xp.abs(t153)
+        t158 = t157*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
+        t159 = xp.where(xp.greater(t157, 0), xp.asarray(2, dtype=dtype), 0)
+        t160 = t156 - t156*t159
+        t161 = xp.where(xp.not_equal(t158, 0), -t160/t158, 0)
+        t162 = xp.where(xp.not_equal(t146, 0), -(t155 - t152*t161)/t146, 0)
+        t163 = xp.where(xp.not_equal(t127, 0), -(-(t134*t162 + t138*t161) + t142)/t127, 0)
+        t164 = xp.where(xp.not_equal(t99, 0), -(-(t107*t163 + t112*t162 + t117*t161) + t122)/t99, 0)
+        t165 = xp.where(xp.not_equal(t60, 0), -(-(t69*t164 + t75*t163 + t81*t162 + t87*t161) + t93)/t60, 0)
+        t166 = xp.where(xp.not_equal(t8, 0), -(-(t18*t165 + t25*t164 + t32*t163 + t39*t162 + t46*t161) + t53)/t8, 0)
+        t167 = 1e-12*t6
+        state = (
+            t166,
+            t165,
+            t164,
+            t163,
+            t162,
+            t161,
+            xp.where(xp.less_equal(t7, t167) | xp.less_equal(t59, t167) | xp.less_equal(t98, t167) | xp.less_equal(t126, t167) | xp.less_equal(t145, t167) | xp.less_equal(t157, t167), xp.asarray(1, dtype=dtype), 0),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _nearer_branch(xp, count, state):
+    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 119 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, = state
+        t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w8))
+        t1 = w1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w1 + w9))
+        t2 = w2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w2 + w10))
+        t3 = w3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w3 + w11))
+        t4 = w4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w4 + w12))
+        t5 = w5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w5 + w13))
+        t6 = xp.where(xp.less(t0, w8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t7 = t6 + t0
+        t8 = -t6 + t0
+        t9 = xp.where(xp.greater_equal(t0, -2.8973) & xp.less_equal(t0, 2.8973), t0, xp.where(xp.greater_equal(t7, -2.8973) & xp.less_equal(t7, 2.8973), t7, xp.where(xp.greater_equal(t8, -2.8973) & xp.less_equal(t8, 2.8973), t8, w0)))
+        t10 = xp.where(xp.less(t1, w9), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t11 = t10 + t1
+        t12 = -t10 + t1
+        t13 = xp.where(xp.greater_equal(t1, -1.7628) & xp.less_equal(t1, 1.7628), t1, xp.where(xp.greater_equal(t11, -1.7628) & xp.less_equal(t11, 1.7628), t11, xp.where(xp.greater_equal(t12, -1.7628) & xp.less_equal(t12, 1.7628), t12, w1)))
+        t14 = xp.where(xp.less(t2, w10), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t15 = t14 + t2
+        t16 = -t14 + t2
+        t17 = xp.where(xp.greater_equal(t2, -2.8973) & xp.less_equal(t2, 2.8973), t2, xp.where(xp.greater_equal(t15, -2.8973) & xp.less_equal(t15, 2.8973), t15, xp.where(xp.greater_equal(t16, -2.8973) & xp.less_equal(t16, 2.8973), t16, w2)))
+        t18 = xp.where(xp.less(t3, w11), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t19 = t18 + t3
+        t20 = -t18 + t3
+        t21 = xp.where(xp.greater_equal(t3, -3.0718) & xp.less_equal(t3, -0.0698), t3, xp.where(xp.greater_equal(t19, -3.0718) & xp.less_equal(t19, -0.0698), t19, xp.where(xp.greater_equal(t20, -3.0718) & xp.less_equal(t20, -0.0698), t20, w3)))
+        t22 = xp.where(xp.less(t4, w12), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t23 = t22 + t4
+        t24 = -t22 + t4
+        t25 = xp.where(xp.greater_equal(t4, -2.8973) & xp.less_equal(t4, 2.8973), t4, xp.where(xp.greater_equal(t23, -2.8973) & xp.less_equal(t23, 2.8973), t23, xp.where(xp.greater_equal(t24, -2.8973) & xp.less_equal(t24, 2.8973), t24, w4)))
+        t26 = xp.where(xp.less(t5, w13), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t27 = t26 + t5
+        t28 = -t26 + t5
+        t29 = xp.where(xp.greater_equal(t5, -0.0175) & xp.less_equal(t5, 3.7525), t5, xp.where(xp.greater_equal(t27, -0.0175) & xp.less_equal(t27, 3.7525), t27, xp.where(xp.greater_equal(t28, -0.0175) & xp.less_equal(t28, 3.7525), t28, w5)))
+        t30 = w15*(-w8 + t9)**2 + w16*(-w9 + t13)**2 + w17*(-w10 + t17)**2 + w18*(-w11 + t21)**2 + w19*(-w12 + t25)**2 + w20*(-w13 + t29)**2 + w21*(-w14 + w6)**2
+        t31 = xp.greater(w7, 0)
+        t32 = xp.where(t31 & (xp.less(w30, 1) | xp.less(t30, w29)), xp.asarray(1, dtype=dtype), 0)
+        t33 = xp.where(t31, 1, w30)
+        t34 = xp.greater(t32, 0)
+        t35 = xp.where(t34, t9, w22)
+        t36 = xp.where(t34, t13, w23)
+        t37 = xp.where(t34, t17, w24)
+        t38 = xp.where(t34, t21, w25)
+        t39 = xp.where(t34, t25, w26)
+        t40 = xp.where(t34, t29, w27)
+        t41 = xp.where(t34, w6, w28)
+        t42 = xp.where(t34, t30, w29)
+        state = (
+            t35,
+            t36,
+            t37,
+            t38,
+            t39,
+            t40,
+            t41,
+            t42,
+            t33,
         )
     return state
 
@@ -5908,7 +6161,7 @@ def condition_number(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (7 x 1 and 1 x 1), 1284 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (7 x 1 and 1 x 1), 1283 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (7,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -6086,208 +6339,41 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t147 = 0.0002999999820000003*t88
     t148 = -t147 + t7*t123 + t22*t124 + t37*t125 + t52*t126 + t67*t127 + t90*t128
     t149 = t147 - t8*t98 + t23*t99 + t38*t100 + t53*t101 + t68*t102 + t108*t103
-    t150 = t138**2
-    t151 = t141**2
-    t152 = t130**2
-    t153 = t142**2
-    t154 = t139**2
-    t155 = damping**2
-    t156 = t155 + t129
-    t157 = t156**2
-    t158 = xp.sqrt(t150 + t151 + t152 + t153 + t154 + t157)
-    t159 = t158*xp.where(xp.greater_equal(t156, 0), xp.asarray(1, dtype=dtype), -1)
-    t160 = t155 + t144
-    t161 = t155 + t146
-    t162 = t155 + t89
-    t163 = t155 + t107
-    t164 = t155 + t135
-    t165 = xp.sqrt(t157 + t160**2 + t161**2 + t162**2 + t163**2 + t164**2 + 2*t150 + 2*t151 + 2*t145**2 + 2*t152 + 2*t131**2 + 2*t104**2 + 2*t153 + 2*t148**2 + 2*t105**2 + 2*t106**2 + 2*t154 + 2*t132**2 + 2*t149**2 + 2*t133**2 + 2*t134**2)
-    t166 = xp.greater(t158, 0)
-    t167 = xp.where(t166, 1/(t156 + t159), 0)
-    t168 = xp.where(t166, 1 + xp.abs(t156)/t158, 0)
-    t169 = t138*t167
-    t170 = t141*t167
-    t171 = t130*t167
-    t172 = t142*t167
-    t173 = t139*t167
-    t174 = t168*(t138 + t171*t131 + t172*t148 + t160*t169 + t170*t145 + t173*t132)
-    t175 = -t174 + t138
-    t176 = t160 - t169*t174
-    t177 = t145 - t170*t174
-    t178 = t131 - t171*t174
-    t179 = t148 - t172*t174
-    t180 = t132 - t173*t174
-    t181 = t168*(t141 + t172*t105 + t173*t149 + t169*t145 + t161*t170 + t171*t104)
-    t182 = -t181 + t141
-    t183 = t145 - t169*t181
-    t184 = t161 - t170*t181
-    t185 = t104 - t171*t181
-    t186 = t105 - t172*t181
-    t187 = t149 - t173*t181
-    t188 = t168*(t130 + t162*t171 + t173*t133 + t169*t131 + t170*t104 + t172*t106)
-    t189 = -t188 + t130
-    t190 = t131 - t169*t188
-    t191 = t104 - t170*t188
-    t192 = t162 - t171*t188
-    t193 = t106 - t172*t188
-    t194 = t133 - t173*t188
-    t195 = t168*(t142 + t163*t172 + t169*t148 + t170*t105 + t171*t106 + t173*t134)
-    t196 = -t195 + t142
-    t197 = t148 - t169*t195
-    t198 = t105 - t170*t195
-    t199 = t106 - t171*t195
-    t200 = t163 - t172*t195
-    t201 = t134 - t173*t195
-    t202 = t168*(t164*t173 + t139 + t169*t132 + t170*t149 + t171*t133 + t172*t134)
-    t203 = -t202 + t139
-    t204 = t132 - t169*t202
-    t205 = t149 - t170*t202
-    t206 = t133 - t171*t202
-    t207 = t134 - t172*t202
-    t208 = t164 - t173*t202
-    t209 = xp.sqrt(t176**2 + t177**2 + t178**2 + t179**2 + t180**2)
-    t210 = t209*xp.where(xp.greater_equal(t176, 0), xp.asarray(1, dtype=dtype), -1)
-    t211 = t168*(mu_dot0 + t169*mu_dot1 + t170*mu_dot2 + t171*mu_dot3 + t172*mu_dot4 + t173*mu_dot5)
-    t212 = -t211 + mu_dot0
-    t213 = mu_dot1 - t169*t211
-    t214 = mu_dot2 - t170*t211
-    t215 = mu_dot3 - t171*t211
-    t216 = mu_dot4 - t172*t211
-    t217 = mu_dot5 - t173*t211
-    t218 = xp.greater(t209, 0)
-    t219 = xp.where(t218, 1/(t176 + t210), 0)
-    t220 = xp.where(t218, 1 + xp.abs(t176)/t209, 0)
-    t221 = t177*t219
-    t222 = t178*t219
-    t223 = t179*t219
-    t224 = t180*t219
-    t225 = t220*(t183 + t221*t184 + t222*t185 + t223*t186 + t224*t187)
-    t226 = -t225 + t183
-    t227 = t184 - t221*t225
-    t228 = t185 - t222*t225
-    t229 = t186 - t223*t225
-    t230 = t187 - t224*t225
-    t231 = t220*(t190 + t221*t191 + t222*t192 + t223*t193 + t224*t194)
-    t232 = -t231 + t190
-    t233 = t191 - t221*t231
-    t234 = t192 - t222*t231
-    t235 = t193 - t223*t231
-    t236 = t194 - t224*t231
-    t237 = t220*(t197 + t221*t198 + t222*t199 + t223*t200 + t224*t201)
-    t238 = -t237 + t197
-    t239 = t198 - t221*t237
-    t240 = t199 - t222*t237
-    t241 = t200 - t223*t237
-    t242 = t201 - t224*t237
-    t243 = t220*(t204 + t221*t205 + t222*t206 + t223*t207 + t224*t208)
-    t244 = -t243 + t204
-    t245 = t205 - t221*t243
-    t246 = t206 - t222*t243
-    t247 = t207 - t223*t243
-    t248 = t208 - t224*t243
-    t249 = xp.sqrt(t227**2 + t228**2 + t229**2 + t230**2)
-    t250 = t249*xp.where(xp.greater_equal(t227, 0), xp.asarray(1, dtype=dtype), -1)
-    t251 = t220*(t213 + t221*t214 + t222*t215 + t223*t216 + t224*t217)
-    t252 = -t251 + t213
-    t253 = t214 - t221*t251
-    t254 = t215 - t222*t251
-    t255 = t216 - t223*t251
-    t256 = t217 - t224*t251
-    t257 = xp.greater(t249, 0)
-    t258 = xp.where(t257, 1/(t227 + t250), 0)
-    t259 = xp.where(t257, 1 + xp.abs(t227)/t249, 0)
-    t260 = t228*t258
-    t261 = t229*t258
-    t262 = t230*t258
-    t263 = t259*(t233 + t260*t234 + t261*t235 + t262*t236)
-    t264 = -t263 + t233
-    t265 = t234 - t260*t263
-    t266 = t235 - t261*t263
-    t267 = t236 - t262*t263
-    t268 = t259*(t239 + t260*t240 + t261*t241 + t262*t242)
-    t269 = -t268 + t239
-    t270 = t240 - t260*t268
-    t271 = t241 - t261*t268
-    t272 = t242 - t262*t268
-    t273 = t259*(t245 + t260*t246 + t261*t247 + t262*t248)
-    t274 = -t273 + t245
-    t275 = t246 - t260*t273
-    t276 = t247 - t261*t273
-    t277 = t248 - t262*t273
-    t278 = xp.sqrt(t265**2 + t266**2 + t267**2)
-    t279 = t278*xp.where(xp.greater_equal(t265, 0), xp.asarray(1, dtype=dtype), -1)
-    t280 = t259*(t253 + t260*t254 + t261*t255 + t262*t256)
-    t281 = -t280 + t253
-    t282 = t254 - t260*t280
-    t283 = t255 - t261*t280
-    t284 = t256 - t262*t280
-    t285 = xp.greater(t278, 0)
-    t286 = xp.where(t285, 1/(t265 + t279), 0)
-    t287 = xp.where(t285, 1 + xp.abs(t265)/t278, 0)
-    t288 = t266*t286
-    t289 = t267*t286
-    t290 = t287*(t270 + t288*t271 + t289*t272)
-    t291 = -t290 + t270
-    t292 = t271 - t288*t290
-    t293 = t272 - t289*t290
-    t294 = t287*(t275 + t288*t276 + t289*t277)
-    t295 = -t294 + t275
-    t296 = t276 - t288*t294
-    t297 = t277 - t289*t294
-    t298 = xp.sqrt(t292**2 + t293**2)
-    t299 = t298*xp.where(xp.greater_equal(t292, 0), xp.asarray(1, dtype=dtype), -1)
-    t300 = t287*(t282 + t288*t283 + t289*t284)
-    t301 = -t300 + t282
-    t302 = t283 - t288*t300
-    t303 = t284 - t289*t300
-    t304 = xp.greater(t298, 0)
-    t305 = xp.where(t304, 1/(t292 + t299), 0)
-    t306 = xp.where(t304, 1 + xp.abs(t292)/t298, 0)
-    t307 = t293*t305
-    t308 = t306*(t296 + t307*t297)
-    t309 = -t308 + t296
-    t310 = t297 - t307*t308
-    t311 = t306*(t302 + t307*t303)
-    t312 = -t311 + t302
-    t313 = t303 - t307*t311
-    t314 = xp.abs(t310)
-    t315 = t314*xp.where(xp.greater_equal(t310, 0), xp.asarray(1, dtype=dtype), -1)
-    t316 = xp.where(xp.greater(t314, 0), xp.asarray(2, dtype=dtype), 0)
-    t317 = t313 - t316*t313
-    t318 = xp.where(xp.not_equal(t315, 0), -t317/t315, 0)
-    t319 = xp.where(xp.not_equal(t299, 0), -(t312 - t309*t318)/t299, 0)
-    t320 = xp.where(xp.not_equal(t279, 0), -(-(t291*t319 + t295*t318) + t301)/t279, 0)
-    t321 = xp.where(xp.not_equal(t250, 0), -(-(t264*t320 + t269*t319 + t274*t318) + t281)/t250, 0)
-    t322 = xp.where(xp.not_equal(t210, 0), -(-(t226*t321 + t232*t320 + t238*t319 + t244*t318) + t252)/t210, 0)
-    t323 = xp.where(xp.not_equal(t159, 0), -(-(t175*t322 + t182*t321 + t189*t320 + t196*t319 + t203*t318) + t212)/t159, 0)
-    t324 = 0.9999999550000004*t318 - 0.00029999999550000005*t319 - t116*t323 + 0.9999999550000004*t88*t322 + 0.00029999999550000005*t88*t321
-    t325 = t117*t323 + t123*t322 - t98*t321 - t6*t320 + t7*t319 + t8*t318
-    t326 = t118*t323 + t124*t322 + t99*t321 + t21*t320 + t22*t319 + t23*t318
-    t327 = t119*t323 + t125*t322 + t100*t321 + t36*t320 + t37*t319 + t38*t318
-    t328 = t120*t323 + t126*t322 + t101*t321 + t51*t320 + t52*t319 + t53*t318
-    t329 = t121*t323 + t127*t322 + t102*t321 + t66*t320 + t67*t319 + t68*t318
-    t330 = t122*t323 + t128*t322 + t103*t321 + t81*t320 + t90*t319 + t108*t318
-    t331 = xp.isfinite(t136)
-    t332 = xp.greater_equal(damping, 0)
-    t333 = 1e-12*t165
-    t334 = xp.less_equal(t158, t333) | xp.less_equal(t209, t333) | xp.less_equal(t249, t333) | xp.less_equal(t278, t333) | xp.less_equal(t298, t333) | xp.less_equal(t314, t333)
-    t335 = t331 & t332 & xp.logical_not(t334)
+    t150 = damping**2
+    t151 = _symmetric_solve6(xp, 1, (t150 + t129, t138, t141, t130, t142, t139, t150 + t144, t145, t131, t148, t132, t150 + t146, t104, t105, t149, t150 + t89, t106, t133, t150 + t107, t134, t150 + t135, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t152 = t151[5]
+    t153 = t151[4]
+    t154 = t151[0]
+    t155 = t151[1]
+    t156 = t151[2]
+    t157 = 0.9999999550000004*t152 - 0.00029999999550000005*t153 - t154*t116 + 0.9999999550000004*t88*t155 + 0.00029999999550000005*t88*t156
+    t158 = t151[3]
+    t159 = t154*t117 + t155*t123 - t156*t98 - t6*t158 + t7*t153 + t8*t152
+    t160 = t21*t158 + t154*t118 + t155*t124 + t156*t99 + t22*t153 + t23*t152
+    t161 = t36*t158 + t154*t119 + t155*t125 + t156*t100 + t37*t153 + t38*t152
+    t162 = t51*t158 + t154*t120 + t155*t126 + t156*t101 + t52*t153 + t53*t152
+    t163 = t66*t158 + t154*t121 + t155*t127 + t156*t102 + t67*t153 + t68*t152
+    t164 = t90*t153 + t154*t122 + t81*t158 + t108*t152 + t155*t128 + t156*t103
+    t165 = xp.isfinite(t136)
+    t166 = xp.greater_equal(damping, 0)
+    t167 = t151[6]
+    t168 = t165 & t166 & xp.less_equal(t167, 0)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t335, t324, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t335, t325, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t335, t326, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t335, t327, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t335, t328, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t335, t329, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t335, t330, 0), batch),  # 6
+        xp.broadcast_to(xp.where(t168, t157, 0), batch),  # 0
+        xp.broadcast_to(xp.where(t168, t159, 0), batch),  # 1
+        xp.broadcast_to(xp.where(t168, t160, 0), batch),  # 2
+        xp.broadcast_to(xp.where(t168, t161, 0), batch),  # 3
+        xp.broadcast_to(xp.where(t168, t162, 0), batch),  # 4
+        xp.broadcast_to(xp.where(t168, t163, 0), batch),  # 5
+        xp.broadcast_to(xp.where(t168, t164, 0), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t331 & t332), 2, xp.where(t334, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t165 & t166), 2, xp.where(xp.greater(t167, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
-    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1380 operations."""
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1379 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (7,)), ("mu_dot", mu_dot, (6,)), ("z", z, (7,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -6480,215 +6566,48 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     t155 = 0.00029999999550000005*qz1
     t156 = -(-t99*qz2 + t100*qz3 + t101*qz4 + t102*qz5 + t103*qz6 + t104*qz7 + t88*t155) + mu_dot2
     t157 = -(-t155 + t7*qz2 + t22*qz3 + t37*qz4 + t52*qz5 + t67*qz6 + t91*qz7) + mu_dot4
-    t158 = t140**2
-    t159 = t143**2
-    t160 = t131**2
-    t161 = t144**2
-    t162 = t141**2
-    t163 = damping**2
-    t164 = t163 + t130
-    t165 = t164**2
-    t166 = xp.sqrt(t158 + t159 + t160 + t161 + t162 + t165)
-    t167 = t166*xp.where(xp.greater_equal(t164, 0), xp.asarray(1, dtype=dtype), -1)
-    t168 = t163 + t146
-    t169 = t163 + t148
-    t170 = t163 + t89
-    t171 = t163 + t108
-    t172 = t163 + t136
-    t173 = xp.sqrt(t165 + t168**2 + t169**2 + t170**2 + t171**2 + t172**2 + 2*t158 + 2*t159 + 2*t147**2 + 2*t160 + 2*t132**2 + 2*t105**2 + 2*t161 + 2*t150**2 + 2*t106**2 + 2*t107**2 + 2*t162 + 2*t133**2 + 2*t151**2 + 2*t134**2 + 2*t135**2)
-    t174 = xp.greater(t166, 0)
-    t175 = xp.where(t174, 1/(t164 + t167), 0)
-    t176 = xp.where(t174, 1 + xp.abs(t164)/t166, 0)
-    t177 = t140*t175
-    t178 = t143*t175
-    t179 = t131*t175
-    t180 = t144*t175
-    t181 = t141*t175
-    t182 = t176*(t140 + t168*t177 + t178*t147 + t179*t132 + t180*t150 + t181*t133)
-    t183 = -t182 + t140
-    t184 = t168 - t177*t182
-    t185 = t147 - t178*t182
-    t186 = t132 - t179*t182
-    t187 = t150 - t180*t182
-    t188 = t133 - t181*t182
-    t189 = t176*(t143 + t177*t147 + t169*t178 + t179*t105 + t180*t106 + t181*t151)
-    t190 = -t189 + t143
-    t191 = t147 - t177*t189
-    t192 = t169 - t178*t189
-    t193 = t105 - t179*t189
-    t194 = t106 - t180*t189
-    t195 = t151 - t181*t189
-    t196 = t176*(t170*t179 + t131 + t177*t132 + t178*t105 + t180*t107 + t181*t134)
-    t197 = -t196 + t131
-    t198 = t132 - t177*t196
-    t199 = t105 - t178*t196
-    t200 = t170 - t179*t196
-    t201 = t107 - t180*t196
-    t202 = t134 - t181*t196
-    t203 = t176*(t144 + t177*t150 + t178*t106 + t179*t107 + t171*t180 + t181*t135)
-    t204 = -t203 + t144
-    t205 = t150 - t177*t203
-    t206 = t106 - t178*t203
-    t207 = t107 - t179*t203
-    t208 = t171 - t180*t203
-    t209 = t135 - t181*t203
-    t210 = t176*(t141 + t177*t133 + t178*t151 + t179*t134 + t180*t135 + t172*t181)
-    t211 = -t210 + t141
-    t212 = t133 - t177*t210
-    t213 = t151 - t178*t210
-    t214 = t134 - t179*t210
-    t215 = t135 - t180*t210
-    t216 = t172 - t181*t210
-    t217 = t176*(t137 + t177*t153 + t178*t156 + t179*t90 + t180*t157 + t181*t154)
-    t218 = -t217 + t137
-    t219 = t153 - t177*t217
-    t220 = t156 - t178*t217
-    t221 = t90 - t179*t217
-    t222 = t157 - t180*t217
-    t223 = t154 - t181*t217
-    t224 = xp.sqrt(t184**2 + t185**2 + t186**2 + t187**2 + t188**2)
-    t225 = t224*xp.where(xp.greater_equal(t184, 0), xp.asarray(1, dtype=dtype), -1)
-    t226 = xp.greater(t224, 0)
-    t227 = xp.where(t226, 1/(t184 + t225), 0)
-    t228 = xp.where(t226, 1 + xp.abs(t184)/t224, 0)
-    t229 = t185*t227
-    t230 = t186*t227
-    t231 = t187*t227
-    t232 = t188*t227
-    t233 = t228*(t191 + t229*t192 + t230*t193 + t231*t194 + t232*t195)
-    t234 = -t233 + t191
-    t235 = t192 - t229*t233
-    t236 = t193 - t230*t233
-    t237 = t194 - t231*t233
-    t238 = t195 - t232*t233
-    t239 = t228*(t198 + t229*t199 + t230*t200 + t231*t201 + t232*t202)
-    t240 = -t239 + t198
-    t241 = t199 - t229*t239
-    t242 = t200 - t230*t239
-    t243 = t201 - t231*t239
-    t244 = t202 - t232*t239
-    t245 = t228*(t205 + t229*t206 + t230*t207 + t231*t208 + t232*t209)
-    t246 = -t245 + t205
-    t247 = t206 - t229*t245
-    t248 = t207 - t230*t245
-    t249 = t208 - t231*t245
-    t250 = t209 - t232*t245
-    t251 = t228*(t212 + t229*t213 + t230*t214 + t231*t215 + t232*t216)
-    t252 = -t251 + t212
-    t253 = t213 - t229*t251
-    t254 = t214 - t230*t251
-    t255 = t215 - t231*t251
-    t256 = t216 - t232*t251
-    t257 = t228*(t219 + t229*t220 + t230*t221 + t231*t222 + t232*t223)
-    t258 = -t257 + t219
-    t259 = t220 - t229*t257
-    t260 = t221 - t230*t257
-    t261 = t222 - t231*t257
-    t262 = t223 - t232*t257
-    t263 = xp.sqrt(t235**2 + t236**2 + t237**2 + t238**2)
-    t264 = t263*xp.where(xp.greater_equal(t235, 0), xp.asarray(1, dtype=dtype), -1)
-    t265 = xp.greater(t263, 0)
-    t266 = xp.where(t265, 1/(t235 + t264), 0)
-    t267 = xp.where(t265, 1 + xp.abs(t235)/t263, 0)
-    t268 = t236*t266
-    t269 = t237*t266
-    t270 = t238*t266
-    t271 = t267*(t241 + t268*t242 + t269*t243 + t270*t244)
-    t272 = -t271 + t241
-    t273 = t242 - t268*t271
-    t274 = t243 - t269*t271
-    t275 = t244 - t270*t271
-    t276 = t267*(t247 + t268*t248 + t269*t249 + t270*t250)
-    t277 = -t276 + t247
-    t278 = t248 - t268*t276
-    t279 = t249 - t269*t276
-    t280 = t250 - t270*t276
-    t281 = t267*(t253 + t268*t254 + t269*t255 + t270*t256)
-    t282 = -t281 + t253
-    t283 = t254 - t268*t281
-    t284 = t255 - t269*t281
-    t285 = t256 - t270*t281
-    t286 = t267*(t259 + t268*t260 + t269*t261 + t270*t262)
-    t287 = -t286 + t259
-    t288 = t260 - t268*t286
-    t289 = t261 - t269*t286
-    t290 = t262 - t270*t286
-    t291 = xp.sqrt(t273**2 + t274**2 + t275**2)
-    t292 = t291*xp.where(xp.greater_equal(t273, 0), xp.asarray(1, dtype=dtype), -1)
-    t293 = xp.greater(t291, 0)
-    t294 = xp.where(t293, 1/(t273 + t292), 0)
-    t295 = xp.where(t293, 1 + xp.abs(t273)/t291, 0)
-    t296 = t274*t294
-    t297 = t275*t294
-    t298 = t295*(t278 + t296*t279 + t297*t280)
-    t299 = -t298 + t278
-    t300 = t279 - t296*t298
-    t301 = t280 - t297*t298
-    t302 = t295*(t283 + t296*t284 + t297*t285)
-    t303 = -t302 + t283
-    t304 = t284 - t296*t302
-    t305 = t285 - t297*t302
-    t306 = t295*(t288 + t296*t289 + t297*t290)
-    t307 = -t306 + t288
-    t308 = t289 - t296*t306
-    t309 = t290 - t297*t306
-    t310 = xp.sqrt(t300**2 + t301**2)
-    t311 = t310*xp.where(xp.greater_equal(t300, 0), xp.asarray(1, dtype=dtype), -1)
-    t312 = xp.greater(t310, 0)
-    t313 = xp.where(t312, 1/(t300 + t311), 0)
-    t314 = xp.where(t312, 1 + xp.abs(t300)/t310, 0)
-    t315 = t301*t313
-    t316 = t314*(t304 + t315*t305)
-    t317 = -t316 + t304
-    t318 = t305 - t315*t316
-    t319 = t314*(t308 + t315*t309)
-    t320 = -t319 + t308
-    t321 = t309 - t315*t319
-    t322 = xp.abs(t318)
-    t323 = t322*xp.where(xp.greater_equal(t318, 0), xp.asarray(1, dtype=dtype), -1)
-    t324 = xp.where(xp.greater(t322, 0), xp.asarray(2, dtype=dtype), 0)
-    t325 = t321 - t321*t324
-    t326 = xp.where(xp.not_equal(t323, 0), -t325/t323, 0)
-    t327 = xp.where(xp.not_equal(t311, 0), -(t320 - t317*t326)/t311, 0)
-    t328 = xp.where(xp.not_equal(t292, 0), -(-(t299*t327 + t303*t326) + t307)/t292, 0)
-    t329 = xp.where(xp.not_equal(t264, 0), -(-(t272*t328 + t277*t327 + t282*t326) + t287)/t264, 0)
-    t330 = xp.where(xp.not_equal(t225, 0), -(-(t234*t329 + t240*t328 + t246*t327 + t252*t326) + t258)/t225, 0)
-    t331 = xp.where(xp.not_equal(t167, 0), -(-(t183*t330 + t190*t329 + t197*t328 + t204*t327 + t211*t326) + t218)/t167, 0)
-    t332 = 0.9999999550000004*t326 - 0.00029999999550000005*t327 - t117*t331 + 0.9999999550000004*t88*t330 + 0.00029999999550000005*t88*t329
-    t333 = t118*t331 + t124*t330 - t99*t329 - t6*t328 + t7*t327 + t8*t326
-    t334 = t119*t331 + t125*t330 + t100*t329 + t21*t328 + t22*t327 + t23*t326
-    t335 = t120*t331 + t126*t330 + t101*t329 + t36*t328 + t37*t327 + t38*t326
-    t336 = t121*t331 + t127*t330 + t102*t329 + t51*t328 + t52*t327 + t53*t326
-    t337 = t122*t331 + t128*t330 + t103*t329 + t66*t328 + t67*t327 + t68*t326
-    t338 = t123*t331 + t129*t330 + t104*t329 + t81*t328 + t91*t327 + t109*t326
-    t339 = qz1 + t332
-    t340 = qz2 + t333
-    t341 = qz3 + t334
-    t342 = qz4 + t335
-    t343 = qz5 + t336
-    t344 = qz6 + t337
-    t345 = qz7 + t338
-    t346 = xp.isfinite(t138)
-    t347 = xp.greater_equal(damping, 0)
-    t348 = 1e-12*t173
-    t349 = xp.less_equal(t166, t348) | xp.less_equal(t224, t348) | xp.less_equal(t263, t348) | xp.less_equal(t291, t348) | xp.less_equal(t310, t348) | xp.less_equal(t322, t348)
-    t350 = t346 & t347 & xp.logical_not(t349)
+    t158 = damping**2
+    t159 = _symmetric_solve6(xp, 1, (t158 + t130, t140, t143, t131, t144, t141, t158 + t146, t147, t132, t150, t133, t158 + t148, t105, t106, t151, t158 + t89, t107, t134, t158 + t108, t135, t158 + t136, t137, t153, t156, t90, t157, t154,))
+    t160 = t159[5]
+    t161 = t159[4]
+    t162 = t159[0]
+    t163 = t159[1]
+    t164 = t159[2]
+    t165 = 0.9999999550000004*t160 - 0.00029999999550000005*t161 - t162*t117 + 0.9999999550000004*t88*t163 + 0.00029999999550000005*t88*t164
+    t166 = qz1 + t165
+    t167 = t159[3]
+    t168 = t162*t118 + t163*t124 - t164*t99 - t6*t167 + t7*t161 + t8*t160
+    t169 = t162*t119 + t163*t125 + t164*t100 + t21*t167 + t22*t161 + t23*t160
+    t170 = t162*t120 + t163*t126 + t164*t101 + t36*t167 + t37*t161 + t38*t160
+    t171 = t162*t121 + t163*t127 + t164*t102 + t51*t167 + t52*t161 + t53*t160
+    t172 = t162*t122 + t163*t128 + t164*t103 + t66*t167 + t67*t161 + t68*t160
+    t173 = t109*t160 + t162*t123 + t163*t129 + t164*t104 + t81*t167 + t91*t161
+    t174 = qz2 + t168
+    t175 = qz3 + t169
+    t176 = qz4 + t170
+    t177 = qz5 + t171
+    t178 = qz6 + t172
+    t179 = qz7 + t173
+    t180 = xp.isfinite(t138)
+    t181 = xp.greater_equal(damping, 0)
+    t182 = t159[6]
+    t183 = t180 & t181 & xp.less_equal(t182, 0)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t350, t339, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t350, t340, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t350, t341, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t350, t342, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t350, t343, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t350, t344, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t350, t345, 0), batch),  # 6
+        xp.broadcast_to(xp.where(t183, t166, 0), batch),  # 0
+        xp.broadcast_to(xp.where(t183, t174, 0), batch),  # 1
+        xp.broadcast_to(xp.where(t183, t175, 0), batch),  # 2
+        xp.broadcast_to(xp.where(t183, t176, 0), batch),  # 3
+        xp.broadcast_to(xp.where(t183, t177, 0), batch),  # 4
+        xp.broadcast_to(xp.where(t183, t178, 0), batch),  # 5
+        xp.broadcast_to(xp.where(t183, t179, 0), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t346 & t347), 2, xp.where(t349, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t180 & t181), 2, xp.where(xp.greater(t182, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1555 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1554 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (7,)), ("target", target, (4, 4)), ("target_rate", target_rate, (6,)), ("gain", gain, (6,)), ("z", z, (7,)), ("damping", damping, ()), every=("gain", ))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -6928,238 +6847,71 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t182 = 0.0002999999820000003*t88
     t183 = -t182 + t7*t126 + t22*t127 + t37*t128 + t52*t129 + t67*t130 + t92*t131
     t184 = t182 - t8*t100 + t23*t101 + t38*t102 + t53*t103 + t68*t104 + t111*t105
-    t185 = t173**2
-    t186 = t176**2
-    t187 = t133**2
-    t188 = t177**2
-    t189 = t174**2
-    t190 = damping**2
-    t191 = t190 + t132
-    t192 = t191**2
-    t193 = xp.sqrt(t185 + t186 + t187 + t188 + t189 + t192)
-    t194 = t193*xp.where(xp.greater_equal(t191, 0), xp.asarray(1, dtype=dtype), -1)
-    t195 = t190 + t179
-    t196 = t190 + t181
-    t197 = t190 + t90
-    t198 = t190 + t109
-    t199 = t190 + t138
-    t200 = xp.sqrt(t192 + t195**2 + t196**2 + t197**2 + t198**2 + t199**2 + 2*t185 + 2*t186 + 2*t180**2 + 2*t187 + 2*t134**2 + 2*t106**2 + 2*t188 + 2*t183**2 + 2*t107**2 + 2*t108**2 + 2*t189 + 2*t135**2 + 2*t184**2 + 2*t136**2 + 2*t137**2)
-    t201 = xp.greater(t193, 0)
-    t202 = xp.where(t201, 1/(t191 + t194), 0)
-    t203 = xp.where(t201, 1 + xp.abs(t191)/t193, 0)
-    t204 = t173*t202
-    t205 = t176*t202
-    t206 = t133*t202
-    t207 = t177*t202
-    t208 = t174*t202
-    t209 = t203*(t173 + t195*t204 + t205*t180 + t206*t134 + t207*t183 + t208*t135)
-    t210 = -t209 + t173
-    t211 = t195 - t204*t209
-    t212 = t180 - t205*t209
-    t213 = t134 - t206*t209
-    t214 = t183 - t207*t209
-    t215 = t135 - t208*t209
-    t216 = t203*(t196*t205 + t176 + t204*t180 + t206*t106 + t207*t107 + t208*t184)
-    t217 = -t216 + t176
-    t218 = t180 - t204*t216
-    t219 = t196 - t205*t216
-    t220 = t106 - t206*t216
-    t221 = t107 - t207*t216
-    t222 = t184 - t208*t216
-    t223 = t203*(t133 + t205*t106 + t197*t206 + t204*t134 + t207*t108 + t208*t136)
-    t224 = -t223 + t133
-    t225 = t134 - t204*t223
-    t226 = t106 - t205*t223
-    t227 = t197 - t206*t223
-    t228 = t108 - t207*t223
-    t229 = t136 - t208*t223
-    t230 = t203*(t177 + t206*t108 + t198*t207 + t204*t183 + t205*t107 + t208*t137)
-    t231 = -t230 + t177
-    t232 = t183 - t204*t230
-    t233 = t107 - t205*t230
-    t234 = t108 - t206*t230
-    t235 = t198 - t207*t230
-    t236 = t137 - t208*t230
-    t237 = t203*(t174 + t207*t137 + t204*t135 + t205*t184 + t206*t136 + t199*t208)
-    t238 = -t237 + t174
-    t239 = t135 - t204*t237
-    t240 = t184 - t205*t237
-    t241 = t136 - t206*t237
-    t242 = t137 - t207*t237
-    t243 = t199 - t208*t237
-    t244 = xp.sqrt(t211**2 + t212**2 + t213**2 + t214**2 + t215**2)
-    t245 = t244*xp.where(xp.greater_equal(t211, 0), xp.asarray(1, dtype=dtype), -1)
-    t246 = xp.greater(t244, 0)
-    t247 = xp.where(t246, 1/(t211 + t245), 0)
-    t248 = xp.where(t246, 1 + xp.abs(t211)/t244, 0)
-    t249 = t212*t247
-    t250 = t213*t247
-    t251 = t214*t247
-    t252 = t215*t247
-    t253 = t248*(t218 + t249*t219 + t250*t220 + t251*t221 + t252*t222)
-    t254 = -t253 + t218
-    t255 = t219 - t249*t253
-    t256 = t220 - t250*t253
-    t257 = t221 - t251*t253
-    t258 = t222 - t252*t253
-    t259 = t248*(t225 + t249*t226 + t250*t227 + t251*t228 + t252*t229)
-    t260 = -t259 + t225
-    t261 = t226 - t249*t259
-    t262 = t227 - t250*t259
-    t263 = t228 - t251*t259
-    t264 = t229 - t252*t259
-    t265 = t248*(t232 + t249*t233 + t250*t234 + t251*t235 + t252*t236)
-    t266 = -t265 + t232
-    t267 = t233 - t249*t265
-    t268 = t234 - t250*t265
-    t269 = t235 - t251*t265
-    t270 = t236 - t252*t265
-    t271 = t248*(t239 + t249*t240 + t250*t241 + t251*t242 + t252*t243)
-    t272 = -t271 + t239
-    t273 = t240 - t249*t271
-    t274 = t241 - t250*t271
-    t275 = t242 - t251*t271
-    t276 = t243 - t252*t271
-    t277 = xp.sqrt(t255**2 + t256**2 + t257**2 + t258**2)
-    t278 = t277*xp.where(xp.greater_equal(t255, 0), xp.asarray(1, dtype=dtype), -1)
-    t279 = xp.greater(t277, 0)
-    t280 = xp.where(t279, 1/(t255 + t278), 0)
-    t281 = xp.where(t279, 1 + xp.abs(t255)/t277, 0)
-    t282 = t256*t280
-    t283 = t257*t280
-    t284 = t258*t280
-    t285 = t281*(t261 + t282*t262 + t283*t263 + t284*t264)
-    t286 = -t285 + t261
-    t287 = t262 - t282*t285
-    t288 = t263 - t283*t285
-    t289 = t264 - t284*t285
-    t290 = t281*(t267 + t282*t268 + t283*t269 + t284*t270)
-    t291 = -t290 + t267
-    t292 = t268 - t282*t290
-    t293 = t269 - t283*t290
-    t294 = t270 - t284*t290
-    t295 = t281*(t273 + t282*t274 + t283*t275 + t284*t276)
-    t296 = -t295 + t273
-    t297 = t274 - t282*t295
-    t298 = t275 - t283*t295
-    t299 = t276 - t284*t295
-    t300 = xp.sqrt(t287**2 + t288**2 + t289**2)
-    t301 = t300*xp.where(xp.greater_equal(t287, 0), xp.asarray(1, dtype=dtype), -1)
-    t302 = xp.greater(t300, 0)
-    t303 = xp.where(t302, 1/(t287 + t301), 0)
-    t304 = xp.where(t302, 1 + xp.abs(t287)/t300, 0)
-    t305 = t288*t303
-    t306 = t289*t303
-    t307 = t304*(t292 + t305*t293 + t306*t294)
-    t308 = -t307 + t292
-    t309 = t293 - t305*t307
-    t310 = t294 - t306*t307
-    t311 = t304*(t297 + t305*t298 + t306*t299)
-    t312 = -t311 + t297
-    t313 = t298 - t305*t311
-    t314 = t299 - t306*t311
-    t315 = xp.sqrt(t309**2 + t310**2)
-    t316 = t315*xp.where(xp.greater_equal(t309, 0), xp.asarray(1, dtype=dtype), -1)
-    t317 = xp.greater(t315, 0)
-    t318 = xp.where(t317, 1/(t309 + t316), 0)
-    t319 = xp.where(t317, 1 + xp.abs(t309)/t315, 0)
-    t320 = t310*t318
-    t321 = t319*(t313 + t320*t314)
-    t322 = -t321 + t313
-    t323 = t314 - t320*t321
-    t324 = xp.abs(t323)
-    t325 = t324*xp.where(xp.greater_equal(t323, 0), xp.asarray(1, dtype=dtype), -1)
-    t326 = xp.where(xp.greater(t324, 0), xp.asarray(2, dtype=dtype), 0)
-    t327 = xp.greater_equal(t146, t155) & xp.greater_equal(t146, t165)
-    t328 = xp.greater_equal(t155, t165)
-    t329 = xp.where(t327, 0.5*(1 + t146), xp.where(t328, 0.5*t154, 0.5*t163))
-    t330 = xp.where(t327, 0.5*t147, xp.where(t328, 0.5*(1 + t155), 0.5*t164))
-    t331 = xp.where(t327, 0.5*t148, xp.where(t328, 0.5*t156, 0.5*(1 + t165)))
-    t332 = xp.sqrt(t329**2 + t330**2 + t331**2)
-    t333 = xp.where(xp.greater_equal(t166*t329 + t167*t330 + t157*t331, 0), xp.asarray(1, dtype=dtype), -1)
-    t334 = xp.greater(t169, 1e-06) | xp.greater(t168, 0)
-    t335 = t170*t333/t332
-    t336 = xp.where(t334, t166*t171, t335*t329)
-    t337 = xp.where(t334, t167*t171, t335*t330)
-    t338 = xp.where(t334, t157*t171, t335*t331)
-    t339 = mu_dot3 + t336*gain3
-    t340 = mu_dot4 + t337*gain4
-    t341 = mu_dot5 + t338*gain5
-    t342 = -(-t6*qz2 + t21*qz3 + t36*qz4 + t51*qz5 + t66*qz6 + t81*qz7) + t339
-    t343 = 0.9996999550045004 - t119 - t100 - t6 + q1 + q2 + q3 + q4 + q5 + q6 + q7 + t7 + t8 + t21 + t22 + t23 + t36 + t37 + t38 + t51 + t52 + t53 + t66 + t67 + t68 + t81 + t92 + t111 + t120 + t121 + t122 + t123 + t124 + t125 + t126 + t127 + t128 + t129 + t130 + t131 + t101 + t102 + t103 + t104 + t105 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7 + 1.0002999549955003*t88 + t91 + t110 + t139 + t339 + t340 + t341
-    t344 = 0.9999999550000004*qz1
-    t345 = -(t126*qz2 + t127*qz3 + t128*qz4 + t129*qz5 + t130*qz6 + t131*qz7 + t88*t344) + t110
-    t346 = -(t344 + t8*qz2 + t23*qz3 + t38*qz4 + t53*qz5 + t68*qz6 + t111*qz7) + t341
-    t347 = 0.00029999999550000005*qz1
-    t348 = -(-t100*qz2 + t101*qz3 + t102*qz4 + t103*qz5 + t104*qz6 + t105*qz7 + t88*t347) + t139
-    t349 = -(-t347 + t7*qz2 + t22*qz3 + t37*qz4 + t52*qz5 + t67*qz6 + t92*qz7) + t340
-    t350 = t203*(t140 + t204*t345 + t205*t348 + t206*t342 + t207*t349 + t208*t346)
-    t351 = -t350 + t140
-    t352 = t345 - t204*t350
-    t353 = t348 - t205*t350
-    t354 = t342 - t206*t350
-    t355 = t349 - t207*t350
-    t356 = t346 - t208*t350
-    t357 = t248*(t352 + t249*t353 + t250*t354 + t251*t355 + t252*t356)
-    t358 = -t357 + t352
-    t359 = t353 - t249*t357
-    t360 = t354 - t250*t357
-    t361 = t355 - t251*t357
-    t362 = t356 - t252*t357
-    t363 = t281*(t359 + t282*t360 + t283*t361 + t284*t362)
-    t364 = -t363 + t359
-    t365 = t360 - t282*t363
-    t366 = t361 - t283*t363
-    t367 = t362 - t284*t363
-    t368 = t304*(t365 + t305*t366 + t306*t367)
-    t369 = -t368 + t365
-    t370 = t366 - t305*t368
-    t371 = t367 - t306*t368
-    t372 = t319*(t370 + t320*t371)
-    t373 = -t372 + t370
-    t374 = t371 - t320*t372
-    t375 = t374 - t326*t374
-    t376 = xp.where(xp.not_equal(t325, 0), -t375/t325, 0)
-    t377 = xp.where(xp.not_equal(t316, 0), -(t373 - t322*t376)/t316, 0)
-    t378 = xp.where(xp.not_equal(t301, 0), -(-(t308*t377 + t312*t376) + t369)/t301, 0)
-    t379 = xp.where(xp.not_equal(t278, 0), -(-(t286*t378 + t291*t377 + t296*t376) + t364)/t278, 0)
-    t380 = xp.where(xp.not_equal(t245, 0), -(-(t254*t379 + t260*t378 + t266*t377 + t272*t376) + t358)/t245, 0)
-    t381 = xp.where(xp.not_equal(t194, 0), -(-(t210*t380 + t217*t379 + t224*t378 + t231*t377 + t238*t376) + t351)/t194, 0)
-    t382 = 0.9999999550000004*t376 - 0.00029999999550000005*t377 - t119*t381 + 0.9999999550000004*t88*t380 + 0.00029999999550000005*t88*t379
-    t383 = t120*t381 + t126*t380 - t100*t379 - t6*t378 + t7*t377 + t8*t376
-    t384 = t121*t381 + t127*t380 + t101*t379 + t21*t378 + t22*t377 + t23*t376
-    t385 = t122*t381 + t128*t380 + t102*t379 + t36*t378 + t37*t377 + t38*t376
-    t386 = t123*t381 + t129*t380 + t103*t379 + t51*t378 + t52*t377 + t53*t376
-    t387 = t124*t381 + t130*t380 + t104*t379 + t66*t378 + t67*t377 + t68*t376
-    t388 = t125*t381 + t131*t380 + t105*t379 + t81*t378 + t92*t377 + t111*t376
-    t389 = qz1 + t382
-    t390 = qz2 + t383
-    t391 = qz3 + t384
-    t392 = qz4 + t385
-    t393 = qz5 + t386
-    t394 = qz6 + t387
-    t395 = qz7 + t388
-    t396 = xp.isfinite(t343)
-    t397 = xp.greater_equal(damping, 0)
-    t398 = 1e-12*t200
-    t399 = xp.less_equal(t193, t398) | xp.less_equal(t244, t398) | xp.less_equal(t277, t398) | xp.less_equal(t300, t398) | xp.less_equal(t315, t398) | xp.less_equal(t324, t398)
-    t400 = t396 & t397 & xp.logical_not(t399)
+    t185 = xp.greater_equal(t146, t155) & xp.greater_equal(t146, t165)
+    t186 = xp.greater_equal(t155, t165)
+    t187 = xp.where(t185, 0.5*(1 + t146), xp.where(t186, 0.5*t154, 0.5*t163))
+    t188 = xp.where(t185, 0.5*t147, xp.where(t186, 0.5*(1 + t155), 0.5*t164))
+    t189 = xp.where(t185, 0.5*t148, xp.where(t186, 0.5*t156, 0.5*(1 + t165)))
+    t190 = xp.sqrt(t187**2 + t188**2 + t189**2)
+    t191 = xp.where(xp.greater_equal(t166*t187 + t167*t188 + t157*t189, 0), xp.asarray(1, dtype=dtype), -1)
+    t192 = xp.greater(t169, 1e-06) | xp.greater(t168, 0)
+    t193 = t170*t191/t190
+    t194 = xp.where(t192, t166*t171, t193*t187)
+    t195 = xp.where(t192, t167*t171, t193*t188)
+    t196 = xp.where(t192, t157*t171, t193*t189)
+    t197 = mu_dot3 + t194*gain3
+    t198 = mu_dot4 + t195*gain4
+    t199 = mu_dot5 + t196*gain5
+    t200 = -(-t6*qz2 + t21*qz3 + t36*qz4 + t51*qz5 + t66*qz6 + t81*qz7) + t197
+    t201 = 0.9996999550045004 - t119 - t100 - t6 + q1 + q2 + q3 + q4 + q5 + q6 + q7 + t7 + t8 + t21 + t22 + t23 + t36 + t37 + t38 + t51 + t52 + t53 + t66 + t67 + t68 + t81 + t92 + t111 + t120 + t121 + t122 + t123 + t124 + t125 + t126 + t127 + t128 + t129 + t130 + t131 + t101 + t102 + t103 + t104 + t105 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7 + 1.0002999549955003*t88 + t91 + t110 + t139 + t197 + t198 + t199
+    t202 = 0.9999999550000004*qz1
+    t203 = -(t126*qz2 + t127*qz3 + t128*qz4 + t129*qz5 + t130*qz6 + t131*qz7 + t88*t202) + t110
+    t204 = -(t202 + t8*qz2 + t23*qz3 + t38*qz4 + t53*qz5 + t68*qz6 + t111*qz7) + t199
+    t205 = 0.00029999999550000005*qz1
+    t206 = -(-t100*qz2 + t101*qz3 + t102*qz4 + t103*qz5 + t104*qz6 + t105*qz7 + t88*t205) + t139
+    t207 = -(-t205 + t7*qz2 + t22*qz3 + t37*qz4 + t52*qz5 + t67*qz6 + t92*qz7) + t198
+    t208 = damping**2
+    t209 = _symmetric_solve6(xp, 1, (t208 + t132, t173, t176, t133, t177, t174, t208 + t179, t180, t134, t183, t135, t208 + t181, t106, t107, t184, t208 + t90, t108, t136, t208 + t109, t137, t208 + t138, t140, t203, t206, t200, t207, t204,))
+    t210 = t209[5]
+    t211 = t209[4]
+    t212 = t209[0]
+    t213 = t209[1]
+    t214 = t209[2]
+    t215 = 0.9999999550000004*t210 - 0.00029999999550000005*t211 - t212*t119 + 0.9999999550000004*t88*t213 + 0.00029999999550000005*t88*t214
+    t216 = qz1 + t215
+    t217 = t209[3]
+    t218 = t7*t211 + t212*t120 + t213*t126 - t214*t100 - t6*t217 + t8*t210
+    t219 = t212*t121 + t213*t127 + t214*t101 + t21*t217 + t22*t211 + t23*t210
+    t220 = t214*t102 + t212*t122 + t213*t128 + t36*t217 + t37*t211 + t38*t210
+    t221 = t214*t103 + t212*t123 + t213*t129 + t51*t217 + t52*t211 + t53*t210
+    t222 = t212*t124 + t213*t130 + t214*t104 + t66*t217 + t67*t211 + t68*t210
+    t223 = t92*t211 + t214*t105 + t212*t125 + t213*t131 + t81*t217 + t111*t210
+    t224 = qz2 + t218
+    t225 = qz3 + t219
+    t226 = qz4 + t220
+    t227 = qz5 + t221
+    t228 = qz6 + t222
+    t229 = qz7 + t223
+    t230 = xp.isfinite(t201)
+    t231 = xp.greater_equal(damping, 0)
+    t232 = t209[6]
+    t233 = t230 & t231 & xp.less_equal(t232, 0)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t400, t389, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t400, t390, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t400, t391, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t400, t392, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t400, t393, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t400, t394, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t400, t395, 0), batch),  # 6
+        xp.broadcast_to(xp.where(t233, t216, 0), batch),  # 0
+        xp.broadcast_to(xp.where(t233, t224, 0), batch),  # 1
+        xp.broadcast_to(xp.where(t233, t225, 0), batch),  # 2
+        xp.broadcast_to(xp.where(t233, t226, 0), batch),  # 3
+        xp.broadcast_to(xp.where(t233, t227, 0), batch),  # 4
+        xp.broadcast_to(xp.where(t233, t228, 0), batch),  # 5
+        xp.broadcast_to(xp.where(t233, t229, 0), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t396 & t397), 2, xp.where(t399, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t230 & t231), 2, xp.where(xp.greater(t232, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (7 x 1 and 7 x 1 and 1 x 1), 1372 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (7 x 1 and 7 x 1 and 1 x 1), 1431 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (7,)), ("damping", damping, ()))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
@@ -7399,179 +7151,20 @@ def ik_numeric_step(target, q, damping=0.0):
     t195 = xp.where(t192, t167*t171, t193*t188)
     t196 = xp.where(t192, t157*t171, t193*t189)
     t197 = t194**2 + t195**2 + t196**2 + t92**2 + t111**2 + t140**2
-    t198 = damping + t133
-    t199 = xp.sqrt(t198**2 + t173**2 + t176**2 + t134**2 + t177**2 + t174**2)
-    t200 = t199*xp.where(xp.greater_equal(t198, 0), xp.asarray(1, dtype=dtype), -1)
-    t201 = xp.greater(t199, 0)
-    t202 = xp.where(t201, 1/(t198 + t200), 0)
-    t203 = xp.where(t201, 1 + xp.abs(t198)/t199, 0)
-    t204 = damping + t179
-    t205 = t173*t202
-    t206 = t176*t202
-    t207 = t134*t202
-    t208 = t177*t202
-    t209 = t174*t202
-    t210 = t203*(t173 + t209*t136 + t204*t205 + t206*t180 + t207*t135 + t208*t183)
-    t211 = -t210 + t173
-    t212 = t204 - t205*t210
-    t213 = t180 - t206*t210
-    t214 = t135 - t207*t210
-    t215 = t183 - t208*t210
-    t216 = t136 - t209*t210
-    t217 = t203*(t92 + t205*t111 + t206*t140 + t207*t194 + t208*t195 + t209*t196)
-    t218 = -t217 + t92
-    t219 = t111 - t205*t217
-    t220 = t140 - t206*t217
-    t221 = t194 - t207*t217
-    t222 = t195 - t208*t217
-    t223 = t196 - t209*t217
-    t224 = xp.sqrt(t212**2 + t213**2 + t214**2 + t215**2 + t216**2)
-    t225 = t224*xp.where(xp.greater_equal(t212, 0), xp.asarray(1, dtype=dtype), -1)
-    t226 = damping + t181
-    t227 = t203*(t176 + t205*t180 + t206*t226 + t207*t107 + t208*t108 + t209*t184)
-    t228 = -t227 + t176
-    t229 = t180 - t205*t227
-    t230 = t226 - t206*t227
-    t231 = t107 - t207*t227
-    t232 = t108 - t208*t227
-    t233 = t184 - t209*t227
-    t234 = damping + t91
-    t235 = t203*(t134 + t205*t135 + t206*t107 + t207*t234 + t208*t109 + t209*t137)
-    t236 = -t235 + t134
-    t237 = t135 - t205*t235
-    t238 = t107 - t206*t235
-    t239 = t234 - t207*t235
-    t240 = t109 - t208*t235
-    t241 = t137 - t209*t235
-    t242 = damping + t110
-    t243 = t203*(t177 + t205*t183 + t206*t108 + t207*t109 + t208*t242 + t209*t138)
-    t244 = -t243 + t177
-    t245 = t183 - t205*t243
-    t246 = t108 - t206*t243
-    t247 = t109 - t207*t243
-    t248 = t242 - t208*t243
-    t249 = t138 - t209*t243
-    t250 = damping + t139
-    t251 = t203*(t174 + t205*t136 + t206*t184 + t207*t137 + t208*t138 + t209*t250)
-    t252 = -t251 + t174
-    t253 = t136 - t205*t251
-    t254 = t184 - t206*t251
-    t255 = t137 - t207*t251
-    t256 = t138 - t208*t251
-    t257 = t250 - t209*t251
-    t258 = xp.greater(t224, 0)
-    t259 = xp.where(t258, 1/(t212 + t225), 0)
-    t260 = xp.where(t258, 1 + xp.abs(t212)/t224, 0)
-    t261 = t213*t259
-    t262 = t214*t259
-    t263 = t215*t259
-    t264 = t216*t259
-    t265 = t260*(t229 + t261*t230 + t262*t231 + t263*t232 + t264*t233)
-    t266 = -t265 + t229
-    t267 = t230 - t261*t265
-    t268 = t231 - t262*t265
-    t269 = t232 - t263*t265
-    t270 = t233 - t264*t265
-    t271 = t260*(t237 + t261*t238 + t262*t239 + t263*t240 + t264*t241)
-    t272 = -t271 + t237
-    t273 = t238 - t261*t271
-    t274 = t239 - t262*t271
-    t275 = t240 - t263*t271
-    t276 = t241 - t264*t271
-    t277 = t260*(t245 + t261*t246 + t262*t247 + t263*t248 + t264*t249)
-    t278 = -t277 + t245
-    t279 = t246 - t261*t277
-    t280 = t247 - t262*t277
-    t281 = t248 - t263*t277
-    t282 = t249 - t264*t277
-    t283 = t260*(t253 + t261*t254 + t262*t255 + t263*t256 + t264*t257)
-    t284 = -t283 + t253
-    t285 = t254 - t261*t283
-    t286 = t255 - t262*t283
-    t287 = t256 - t263*t283
-    t288 = t257 - t264*t283
-    t289 = t260*(t219 + t261*t220 + t262*t221 + t263*t222 + t264*t223)
-    t290 = -t289 + t219
-    t291 = t220 - t261*t289
-    t292 = t221 - t262*t289
-    t293 = t222 - t263*t289
-    t294 = t223 - t264*t289
-    t295 = xp.sqrt(t267**2 + t268**2 + t269**2 + t270**2)
-    t296 = t295*xp.where(xp.greater_equal(t267, 0), xp.asarray(1, dtype=dtype), -1)
-    t297 = xp.greater(t295, 0)
-    t298 = xp.where(t297, 1/(t267 + t296), 0)
-    t299 = xp.where(t297, 1 + xp.abs(t267)/t295, 0)
-    t300 = t268*t298
-    t301 = t269*t298
-    t302 = t270*t298
-    t303 = t299*(t273 + t300*t274 + t301*t275 + t302*t276)
-    t304 = -t303 + t273
-    t305 = t274 - t300*t303
-    t306 = t275 - t301*t303
-    t307 = t276 - t302*t303
-    t308 = t299*(t279 + t300*t280 + t301*t281 + t302*t282)
-    t309 = -t308 + t279
-    t310 = t280 - t300*t308
-    t311 = t281 - t301*t308
-    t312 = t282 - t302*t308
-    t313 = t299*(t285 + t300*t286 + t301*t287 + t302*t288)
-    t314 = -t313 + t285
-    t315 = t286 - t300*t313
-    t316 = t287 - t301*t313
-    t317 = t288 - t302*t313
-    t318 = t299*(t291 + t300*t292 + t301*t293 + t302*t294)
-    t319 = -t318 + t291
-    t320 = t292 - t300*t318
-    t321 = t293 - t301*t318
-    t322 = t294 - t302*t318
-    t323 = xp.sqrt(t305**2 + t306**2 + t307**2)
-    t324 = t323*xp.where(xp.greater_equal(t305, 0), xp.asarray(1, dtype=dtype), -1)
-    t325 = xp.greater(t323, 0)
-    t326 = xp.where(t325, 1/(t305 + t324), 0)
-    t327 = xp.where(t325, 1 + xp.abs(t305)/t323, 0)
-    t328 = t306*t326
-    t329 = t307*t326
-    t330 = t327*(t310 + t328*t311 + t329*t312)
-    t331 = -t330 + t310
-    t332 = t311 - t328*t330
-    t333 = t312 - t329*t330
-    t334 = t327*(t315 + t328*t316 + t329*t317)
-    t335 = -t334 + t315
-    t336 = t316 - t328*t334
-    t337 = t317 - t329*t334
-    t338 = t327*(t320 + t328*t321 + t329*t322)
-    t339 = -t338 + t320
-    t340 = t321 - t328*t338
-    t341 = t322 - t329*t338
-    t342 = xp.sqrt(t332**2 + t333**2)
-    t343 = t342*xp.where(xp.greater_equal(t332, 0), xp.asarray(1, dtype=dtype), -1)
-    t344 = xp.greater(t342, 0)
-    t345 = xp.where(t344, 1/(t332 + t343), 0)
-    t346 = xp.where(t344, 1 + xp.abs(t332)/t342, 0)
-    t347 = t333*t345
-    t348 = t346*(t336 + t347*t337)
-    t349 = -t348 + t336
-    t350 = t337 - t347*t348
-    t351 = t346*(t340 + t347*t341)
-    t352 = -t351 + t340
-    t353 = t341 - t347*t351
-    t354 = xp.abs(t350)
-    t355 = t354*xp.where(xp.greater_equal(t350, 0), xp.asarray(1, dtype=dtype), -1)
-    t356 = xp.where(xp.greater(t354, 0), xp.asarray(2, dtype=dtype), 0)
-    t357 = t353 - t353*t356
-    t358 = xp.where(xp.not_equal(t355, 0), -t357/t355, 0)
-    t359 = xp.where(xp.not_equal(t343, 0), -(t352 - t349*t358)/t343, 0)
-    t360 = xp.where(xp.not_equal(t324, 0), -(-(t331*t359 + t335*t358) + t339)/t324, 0)
-    t361 = xp.where(xp.not_equal(t296, 0), -(-(t304*t360 + t309*t359 + t314*t358) + t319)/t296, 0)
-    t362 = xp.where(xp.not_equal(t225, 0), -(-(t266*t361 + t272*t360 + t278*t359 + t284*t358) + t290)/t225, 0)
-    t363 = xp.where(xp.not_equal(t200, 0), -(-(t211*t362 + t228*t361 + t236*t360 + t244*t359 + t252*t358) + t218)/t200, 0)
-    t364 = 0.9999999550000004*t358 - 0.00029999999550000005*t359 + q1 - t120*t363 + 0.9999999550000004*t89*t362 + 0.00029999999550000005*t89*t361
-    t365 = q2 + t121*t363 + t127*t362 - t101*t361 - t6*t360 + t8*t359 + t9*t358
-    t366 = q3 + t122*t363 + t128*t362 + t102*t361 + t22*t360 + t23*t359 + t24*t358
-    t367 = q4 + t123*t363 + t129*t362 + t103*t361 + t37*t360 + t38*t359 + t39*t358
-    t368 = q5 + t124*t363 + t130*t362 + t104*t361 + t52*t360 + t53*t359 + t54*t358
-    t369 = q6 + t125*t363 + t131*t362 + t105*t361 + t67*t360 + t68*t359 + t69*t358
-    t370 = q7 + t126*t363 + t132*t362 + t106*t361 + t82*t360 + t93*t359 + t112*t358
+    t198 = _symmetric_solve6(xp, 1, (damping + t133, t173, t176, t134, t177, t174, damping + t179, t180, t135, t183, t136, damping + t181, t107, t108, t184, damping + t91, t109, t137, damping + t110, t138, damping + t139, t92, t111, t140, t194, t195, t196,))
+    t199 = t198[5]
+    t200 = t198[4]
+    t201 = t198[0]
+    t202 = t198[1]
+    t203 = t198[2]
+    t204 = 0.9999999550000004*t199 - 0.00029999999550000005*t200 + q1 - t201*t120 + 0.9999999550000004*t89*t202 + 0.00029999999550000005*t89*t203
+    t205 = t198[3]
+    t206 = q2 + t201*t121 + t202*t127 - t203*t101 - t6*t205 + t8*t200 + t9*t199
+    t207 = q3 + t203*t102 + t201*t122 + t202*t128 + t22*t205 + t23*t200 + t24*t199
+    t208 = q4 + t201*t123 + t202*t129 + t203*t103 + t37*t205 + t38*t200 + t39*t199
+    t209 = q5 + t201*t124 + t202*t130 + t203*t104 + t52*t205 + t53*t200 + t54*t199
+    t210 = q6 + t203*t105 + t201*t125 + t202*t131 + t67*t205 + t68*t200 + t69*t199
+    t211 = q7 + t93*t200 + t203*t106 + t201*t126 + t202*t132 + t82*t205 + t112*t199
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -7582,13 +7175,13 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q7, batch),  # 6
     ], (7,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t364, -2.8973), -2.8973, xp.where(xp.greater(t364, 2.8973), 2.8973, t364)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t365, -1.7628), -1.7628, xp.where(xp.greater(t365, 1.7628), 1.7628, t365)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t366, -2.8973), -2.8973, xp.where(xp.greater(t366, 2.8973), 2.8973, t366)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t367, -3.0718), -3.0718, xp.where(xp.greater(t367, -0.0698), -0.0698, t367)), batch),  # 3
-        xp.broadcast_to(xp.where(xp.less(t368, -2.8973), -2.8973, xp.where(xp.greater(t368, 2.8973), 2.8973, t368)), batch),  # 4
-        xp.broadcast_to(xp.where(xp.less(t369, -0.0175), -0.0175, xp.where(xp.greater(t369, 3.7525), 3.7525, t369)), batch),  # 5
-        xp.broadcast_to(xp.where(xp.less(t370, -2.8973), -2.8973, xp.where(xp.greater(t370, 2.8973), 2.8973, t370)), batch),  # 6
+        xp.broadcast_to(xp.where(xp.less(t204, -2.8973), -2.8973, xp.where(xp.greater(t204, 2.8973), 2.8973, t204)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t206, -1.7628), -1.7628, xp.where(xp.greater(t206, 1.7628), 1.7628, t206)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t207, -2.8973), -2.8973, xp.where(xp.greater(t207, 2.8973), 2.8973, t207)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t208, -3.0718), -3.0718, xp.where(xp.greater(t208, -0.0698), -0.0698, t208)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t209, -2.8973), -2.8973, xp.where(xp.greater(t209, 2.8973), 2.8973, t209)), batch),  # 4
+        xp.broadcast_to(xp.where(xp.less(t210, -0.0175), -0.0175, xp.where(xp.greater(t210, 3.7525), 3.7525, t210)), batch),  # 5
+        xp.broadcast_to(xp.where(xp.less(t211, -2.8973), -2.8973, xp.where(xp.greater(t211, 2.8973), 2.8973, t211)), batch),  # 6
     ], (7,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t7), t197, -1), batch)
     return q_start, q_next, cost
@@ -13133,7 +12726,7 @@ def ik_general_nominal(T, q_free):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (7 x 1 and 1 x 1), 1975 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (7 x 1 and 1 x 1), 1973 operations."""
     xp, dtype, device, batch, (T, q_seed, q_free, weights,) = _arguments(("T", T, (4, 4)), ("q_seed", q_seed, (7,)), ("q_free", q_free, ()), ("weights", weights, (7,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(T, q_free)
     T00 = T[..., 0, 0]
@@ -13306,728 +12899,36 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     lb13 = branches_in_limits[..., 13]
     lb14 = branches_in_limits[..., 14]
     lb15 = branches_in_limits[..., 15]
-    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
-    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
-    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
-    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
-    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
-    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
-    t6 = xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0)
-    t7 = xp.where(xp.greater(t6, 0), xp.asarray(1, dtype=dtype), 0)
-    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
-    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
-    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
-    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
-    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
-    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
-    t14 = xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0)
-    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
-    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
-    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
-    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
-    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
-    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
-    t21 = xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0)
-    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
-    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
-    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
-    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
-    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
-    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
-    t28 = xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0)
-    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
-    t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
-    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
-    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
-    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
-    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
-    t35 = xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0)
-    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
-    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
-    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
-    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
-    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
-    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
-    t42 = xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0)
-    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
-    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
-    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
-    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
-    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
-    t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
-    t49 = xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0)
-    t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
-    t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
-    t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
-    t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
-    t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
-    t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
-    t56 = xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0)
-    t57 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_0 + qn1)) + qb8_0
-    t58 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_1 + qn2)) + qb8_1
-    t59 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_2 + qn3)) + qb8_2
-    t60 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_3 + qn4)) + qb8_3
-    t61 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_4 + qn5)) + qb8_4
-    t62 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_5 + qn6)) + qb8_5
-    t63 = xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0)
-    t64 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_0 + qn1)) + qb9_0
-    t65 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_1 + qn2)) + qb9_1
-    t66 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_2 + qn3)) + qb9_2
-    t67 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_3 + qn4)) + qb9_3
-    t68 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_4 + qn5)) + qb9_4
-    t69 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_5 + qn6)) + qb9_5
-    t70 = xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0)
-    t71 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_0 + qn1)) + qb10_0
-    t72 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_1 + qn2)) + qb10_1
-    t73 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_2 + qn3)) + qb10_2
-    t74 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_3 + qn4)) + qb10_3
-    t75 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_4 + qn5)) + qb10_4
-    t76 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_5 + qn6)) + qb10_5
-    t77 = xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0)
-    t78 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_0 + qn1)) + qb11_0
-    t79 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_1 + qn2)) + qb11_1
-    t80 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_2 + qn3)) + qb11_2
-    t81 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_3 + qn4)) + qb11_3
-    t82 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_4 + qn5)) + qb11_4
-    t83 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_5 + qn6)) + qb11_5
-    t84 = xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0)
-    t85 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_0 + qn1)) + qb12_0
-    t86 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_1 + qn2)) + qb12_1
-    t87 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_2 + qn3)) + qb12_2
-    t88 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_3 + qn4)) + qb12_3
-    t89 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_4 + qn5)) + qb12_4
-    t90 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_5 + qn6)) + qb12_5
-    t91 = xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0)
-    t92 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_0 + qn1)) + qb13_0
-    t93 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_1 + qn2)) + qb13_1
-    t94 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_2 + qn3)) + qb13_2
-    t95 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_3 + qn4)) + qb13_3
-    t96 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_4 + qn5)) + qb13_4
-    t97 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_5 + qn6)) + qb13_5
-    t98 = xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0)
-    t99 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_0 + qn1)) + qb14_0
-    t100 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_1 + qn2)) + qb14_1
-    t101 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_2 + qn3)) + qb14_2
-    t102 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_3 + qn4)) + qb14_3
-    t103 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_4 + qn5)) + qb14_4
-    t104 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_5 + qn6)) + qb14_5
-    t105 = xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0)
-    t106 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_0 + qn1)) + qb15_0
-    t107 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_1 + qn2)) + qb15_1
-    t108 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_2 + qn3)) + qb15_2
-    t109 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_3 + qn4)) + qb15_3
-    t110 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_4 + qn5)) + qb15_4
-    t111 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_5 + qn6)) + qb15_5
-    t112 = xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0)
-    t113 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7
-    t114 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t115 = t114 + t0
-    t116 = -t114 + t0
-    t117 = xp.where(xp.greater_equal(t0, -2.8973) & xp.less_equal(t0, 2.8973), t0, xp.where(xp.greater_equal(t115, -2.8973) & xp.less_equal(t115, 2.8973), t115, xp.where(xp.greater_equal(t116, -2.8973) & xp.less_equal(t116, 2.8973), t116, qb0_0)))
-    t118 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t119 = t118 + t1
-    t120 = -t118 + t1
-    t121 = xp.where(xp.greater_equal(t1, -1.7628) & xp.less_equal(t1, 1.7628), t1, xp.where(xp.greater_equal(t119, -1.7628) & xp.less_equal(t119, 1.7628), t119, xp.where(xp.greater_equal(t120, -1.7628) & xp.less_equal(t120, 1.7628), t120, qb0_1)))
-    t122 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t123 = t122 + t2
-    t124 = -t122 + t2
-    t125 = xp.where(xp.greater_equal(t2, -2.8973) & xp.less_equal(t2, 2.8973), t2, xp.where(xp.greater_equal(t123, -2.8973) & xp.less_equal(t123, 2.8973), t123, xp.where(xp.greater_equal(t124, -2.8973) & xp.less_equal(t124, 2.8973), t124, qb0_2)))
-    t126 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t127 = t126 + t3
-    t128 = -t126 + t3
-    t129 = xp.where(xp.greater_equal(t3, -3.0718) & xp.less_equal(t3, -0.0698), t3, xp.where(xp.greater_equal(t127, -3.0718) & xp.less_equal(t127, -0.0698), t127, xp.where(xp.greater_equal(t128, -3.0718) & xp.less_equal(t128, -0.0698), t128, qb0_3)))
-    t130 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t131 = t130 + t4
-    t132 = -t130 + t4
-    t133 = xp.where(xp.greater_equal(t4, -2.8973) & xp.less_equal(t4, 2.8973), t4, xp.where(xp.greater_equal(t131, -2.8973) & xp.less_equal(t131, 2.8973), t131, xp.where(xp.greater_equal(t132, -2.8973) & xp.less_equal(t132, 2.8973), t132, qb0_4)))
-    t134 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t135 = t134 + t5
-    t136 = -t134 + t5
-    t137 = xp.where(xp.greater_equal(t5, -0.0175) & xp.less_equal(t5, 3.7525), t5, xp.where(xp.greater_equal(t135, -0.0175) & xp.less_equal(t135, 3.7525), t135, xp.where(xp.greater_equal(t136, -0.0175) & xp.less_equal(t136, 3.7525), t136, qb0_5)))
-    t138 = -qn1
-    t139 = -qn2
-    t140 = -qn3
-    t141 = -qn4
-    t142 = -qn5
-    t143 = -qn6
-    t144 = -qn7
-    t145 = qw1*(t138 + t117)**2 + qw2*(t139 + t121)**2 + qw3*(t140 + t125)**2 + qw4*(t141 + t129)**2 + qw5*(t142 + t133)**2 + qw6*(t143 + t137)**2 + qw7*(t144 + qb0_6)**2
-    t146 = xp.greater(t7, 0)
-    t147 = xp.where(t146, t117, qn1)
-    t148 = xp.where(t146, t121, qn2)
-    t149 = xp.where(t146, t125, qn3)
-    t150 = xp.where(t146, t129, qn4)
-    t151 = xp.where(t146, t133, qn5)
-    t152 = xp.where(t146, t137, qn6)
-    t153 = xp.where(t146, qb0_6, qn7)
-    t154 = xp.where(t146, t145, 0)
-    t155 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t156 = t155 + t8
-    t157 = -t155 + t8
-    t158 = xp.where(xp.greater_equal(t8, -2.8973) & xp.less_equal(t8, 2.8973), t8, xp.where(xp.greater_equal(t156, -2.8973) & xp.less_equal(t156, 2.8973), t156, xp.where(xp.greater_equal(t157, -2.8973) & xp.less_equal(t157, 2.8973), t157, qb1_0)))
-    t159 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t160 = t159 + t9
-    t161 = -t159 + t9
-    t162 = xp.where(xp.greater_equal(t9, -1.7628) & xp.less_equal(t9, 1.7628), t9, xp.where(xp.greater_equal(t160, -1.7628) & xp.less_equal(t160, 1.7628), t160, xp.where(xp.greater_equal(t161, -1.7628) & xp.less_equal(t161, 1.7628), t161, qb1_1)))
-    t163 = xp.where(xp.less(t10, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t164 = t163 + t10
-    t165 = -t163 + t10
-    t166 = xp.where(xp.greater_equal(t10, -2.8973) & xp.less_equal(t10, 2.8973), t10, xp.where(xp.greater_equal(t164, -2.8973) & xp.less_equal(t164, 2.8973), t164, xp.where(xp.greater_equal(t165, -2.8973) & xp.less_equal(t165, 2.8973), t165, qb1_2)))
-    t167 = xp.where(xp.less(t11, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t168 = t167 + t11
-    t169 = -t167 + t11
-    t170 = xp.where(xp.greater_equal(t11, -3.0718) & xp.less_equal(t11, -0.0698), t11, xp.where(xp.greater_equal(t168, -3.0718) & xp.less_equal(t168, -0.0698), t168, xp.where(xp.greater_equal(t169, -3.0718) & xp.less_equal(t169, -0.0698), t169, qb1_3)))
-    t171 = xp.where(xp.less(t12, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t172 = t171 + t12
-    t173 = -t171 + t12
-    t174 = xp.where(xp.greater_equal(t12, -2.8973) & xp.less_equal(t12, 2.8973), t12, xp.where(xp.greater_equal(t172, -2.8973) & xp.less_equal(t172, 2.8973), t172, xp.where(xp.greater_equal(t173, -2.8973) & xp.less_equal(t173, 2.8973), t173, qb1_4)))
-    t175 = xp.where(xp.less(t13, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t176 = t175 + t13
-    t177 = -t175 + t13
-    t178 = xp.where(xp.greater_equal(t13, -0.0175) & xp.less_equal(t13, 3.7525), t13, xp.where(xp.greater_equal(t176, -0.0175) & xp.less_equal(t176, 3.7525), t176, xp.where(xp.greater_equal(t177, -0.0175) & xp.less_equal(t177, 3.7525), t177, qb1_5)))
-    t179 = qw1*(t138 + t158)**2 + qw2*(t139 + t162)**2 + qw3*(t140 + t166)**2 + qw4*(t141 + t170)**2 + qw5*(t142 + t174)**2 + qw6*(t143 + t178)**2 + qw7*(t144 + qb1_6)**2
-    t180 = xp.greater(t14, 0)
-    t181 = xp.where(t180 & (xp.less(t7, 1) | xp.less(t179, t154)), xp.asarray(1, dtype=dtype), 0)
-    t182 = xp.where(t180, 1, t7)
-    t183 = xp.greater(t181, 0)
-    t184 = xp.where(t183, t158, t147)
-    t185 = xp.where(t183, t162, t148)
-    t186 = xp.where(t183, t166, t149)
-    t187 = xp.where(t183, t170, t150)
-    t188 = xp.where(t183, t174, t151)
-    t189 = xp.where(t183, t178, t152)
-    t190 = xp.where(t183, qb1_6, t153)
-    t191 = xp.where(t183, t179, t154)
-    t192 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t193 = t192 + t15
-    t194 = -t192 + t15
-    t195 = xp.where(xp.greater_equal(t15, -2.8973) & xp.less_equal(t15, 2.8973), t15, xp.where(xp.greater_equal(t193, -2.8973) & xp.less_equal(t193, 2.8973), t193, xp.where(xp.greater_equal(t194, -2.8973) & xp.less_equal(t194, 2.8973), t194, qb2_0)))
-    t196 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t197 = t196 + t16
-    t198 = -t196 + t16
-    t199 = xp.where(xp.greater_equal(t16, -1.7628) & xp.less_equal(t16, 1.7628), t16, xp.where(xp.greater_equal(t197, -1.7628) & xp.less_equal(t197, 1.7628), t197, xp.where(xp.greater_equal(t198, -1.7628) & xp.less_equal(t198, 1.7628), t198, qb2_1)))
-    t200 = xp.where(xp.less(t17, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t201 = t200 + t17
-    t202 = -t200 + t17
-    t203 = xp.where(xp.greater_equal(t17, -2.8973) & xp.less_equal(t17, 2.8973), t17, xp.where(xp.greater_equal(t201, -2.8973) & xp.less_equal(t201, 2.8973), t201, xp.where(xp.greater_equal(t202, -2.8973) & xp.less_equal(t202, 2.8973), t202, qb2_2)))
-    t204 = xp.where(xp.less(t18, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t205 = t204 + t18
-    t206 = -t204 + t18
-    t207 = xp.where(xp.greater_equal(t18, -3.0718) & xp.less_equal(t18, -0.0698), t18, xp.where(xp.greater_equal(t205, -3.0718) & xp.less_equal(t205, -0.0698), t205, xp.where(xp.greater_equal(t206, -3.0718) & xp.less_equal(t206, -0.0698), t206, qb2_3)))
-    t208 = xp.where(xp.less(t19, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t209 = t208 + t19
-    t210 = -t208 + t19
-    t211 = xp.where(xp.greater_equal(t19, -2.8973) & xp.less_equal(t19, 2.8973), t19, xp.where(xp.greater_equal(t209, -2.8973) & xp.less_equal(t209, 2.8973), t209, xp.where(xp.greater_equal(t210, -2.8973) & xp.less_equal(t210, 2.8973), t210, qb2_4)))
-    t212 = xp.where(xp.less(t20, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t213 = t212 + t20
-    t214 = -t212 + t20
-    t215 = xp.where(xp.greater_equal(t20, -0.0175) & xp.less_equal(t20, 3.7525), t20, xp.where(xp.greater_equal(t213, -0.0175) & xp.less_equal(t213, 3.7525), t213, xp.where(xp.greater_equal(t214, -0.0175) & xp.less_equal(t214, 3.7525), t214, qb2_5)))
-    t216 = qw1*(t138 + t195)**2 + qw2*(t139 + t199)**2 + qw3*(t140 + t203)**2 + qw4*(t141 + t207)**2 + qw5*(t142 + t211)**2 + qw6*(t143 + t215)**2 + qw7*(t144 + qb2_6)**2
-    t217 = xp.greater(t21, 0)
-    t218 = xp.where(t217 & (xp.less(t182, 1) | xp.less(t216, t191)), xp.asarray(1, dtype=dtype), 0)
-    t219 = xp.where(t217, 1, t182)
-    t220 = xp.greater(t218, 0)
-    t221 = xp.where(t220, t195, t184)
-    t222 = xp.where(t220, t199, t185)
-    t223 = xp.where(t220, t203, t186)
-    t224 = xp.where(t220, t207, t187)
-    t225 = xp.where(t220, t211, t188)
-    t226 = xp.where(t220, t215, t189)
-    t227 = xp.where(t220, qb2_6, t190)
-    t228 = xp.where(t220, t216, t191)
-    t229 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t230 = t229 + t22
-    t231 = -t229 + t22
-    t232 = xp.where(xp.greater_equal(t22, -2.8973) & xp.less_equal(t22, 2.8973), t22, xp.where(xp.greater_equal(t230, -2.8973) & xp.less_equal(t230, 2.8973), t230, xp.where(xp.greater_equal(t231, -2.8973) & xp.less_equal(t231, 2.8973), t231, qb3_0)))
-    t233 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t234 = t233 + t23
-    t235 = -t233 + t23
-    t236 = xp.where(xp.greater_equal(t23, -1.7628) & xp.less_equal(t23, 1.7628), t23, xp.where(xp.greater_equal(t234, -1.7628) & xp.less_equal(t234, 1.7628), t234, xp.where(xp.greater_equal(t235, -1.7628) & xp.less_equal(t235, 1.7628), t235, qb3_1)))
-    t237 = xp.where(xp.less(t24, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t238 = t237 + t24
-    t239 = -t237 + t24
-    t240 = xp.where(xp.greater_equal(t24, -2.8973) & xp.less_equal(t24, 2.8973), t24, xp.where(xp.greater_equal(t238, -2.8973) & xp.less_equal(t238, 2.8973), t238, xp.where(xp.greater_equal(t239, -2.8973) & xp.less_equal(t239, 2.8973), t239, qb3_2)))
-    t241 = xp.where(xp.less(t25, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t242 = t241 + t25
-    t243 = -t241 + t25
-    t244 = xp.where(xp.greater_equal(t25, -3.0718) & xp.less_equal(t25, -0.0698), t25, xp.where(xp.greater_equal(t242, -3.0718) & xp.less_equal(t242, -0.0698), t242, xp.where(xp.greater_equal(t243, -3.0718) & xp.less_equal(t243, -0.0698), t243, qb3_3)))
-    t245 = xp.where(xp.less(t26, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t246 = t245 + t26
-    t247 = -t245 + t26
-    t248 = xp.where(xp.greater_equal(t26, -2.8973) & xp.less_equal(t26, 2.8973), t26, xp.where(xp.greater_equal(t246, -2.8973) & xp.less_equal(t246, 2.8973), t246, xp.where(xp.greater_equal(t247, -2.8973) & xp.less_equal(t247, 2.8973), t247, qb3_4)))
-    t249 = xp.where(xp.less(t27, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t250 = t249 + t27
-    t251 = -t249 + t27
-    t252 = xp.where(xp.greater_equal(t27, -0.0175) & xp.less_equal(t27, 3.7525), t27, xp.where(xp.greater_equal(t250, -0.0175) & xp.less_equal(t250, 3.7525), t250, xp.where(xp.greater_equal(t251, -0.0175) & xp.less_equal(t251, 3.7525), t251, qb3_5)))
-    t253 = qw1*(t138 + t232)**2 + qw2*(t139 + t236)**2 + qw3*(t140 + t240)**2 + qw4*(t141 + t244)**2 + qw5*(t142 + t248)**2 + qw6*(t143 + t252)**2 + qw7*(t144 + qb3_6)**2
-    t254 = xp.greater(t28, 0)
-    t255 = xp.where(t254 & (xp.less(t219, 1) | xp.less(t253, t228)), xp.asarray(1, dtype=dtype), 0)
-    t256 = xp.where(t254, 1, t219)
-    t257 = xp.greater(t255, 0)
-    t258 = xp.where(t257, t232, t221)
-    t259 = xp.where(t257, t236, t222)
-    t260 = xp.where(t257, t240, t223)
-    t261 = xp.where(t257, t244, t224)
-    t262 = xp.where(t257, t248, t225)
-    t263 = xp.where(t257, t252, t226)
-    t264 = xp.where(t257, qb3_6, t227)
-    t265 = xp.where(t257, t253, t228)
-    t266 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t267 = t266 + t29
-    t268 = -t266 + t29
-    t269 = xp.where(xp.greater_equal(t29, -2.8973) & xp.less_equal(t29, 2.8973), t29, xp.where(xp.greater_equal(t267, -2.8973) & xp.less_equal(t267, 2.8973), t267, xp.where(xp.greater_equal(t268, -2.8973) & xp.less_equal(t268, 2.8973), t268, qb4_0)))
-    t270 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t271 = t270 + t30
-    t272 = -t270 + t30
-    t273 = xp.where(xp.greater_equal(t30, -1.7628) & xp.less_equal(t30, 1.7628), t30, xp.where(xp.greater_equal(t271, -1.7628) & xp.less_equal(t271, 1.7628), t271, xp.where(xp.greater_equal(t272, -1.7628) & xp.less_equal(t272, 1.7628), t272, qb4_1)))
-    t274 = xp.where(xp.less(t31, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t275 = t274 + t31
-    t276 = -t274 + t31
-    t277 = xp.where(xp.greater_equal(t31, -2.8973) & xp.less_equal(t31, 2.8973), t31, xp.where(xp.greater_equal(t275, -2.8973) & xp.less_equal(t275, 2.8973), t275, xp.where(xp.greater_equal(t276, -2.8973) & xp.less_equal(t276, 2.8973), t276, qb4_2)))
-    t278 = xp.where(xp.less(t32, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t279 = t278 + t32
-    t280 = -t278 + t32
-    t281 = xp.where(xp.greater_equal(t32, -3.0718) & xp.less_equal(t32, -0.0698), t32, xp.where(xp.greater_equal(t279, -3.0718) & xp.less_equal(t279, -0.0698), t279, xp.where(xp.greater_equal(t280, -3.0718) & xp.less_equal(t280, -0.0698), t280, qb4_3)))
-    t282 = xp.where(xp.less(t33, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t283 = t282 + t33
-    t284 = -t282 + t33
-    t285 = xp.where(xp.greater_equal(t33, -2.8973) & xp.less_equal(t33, 2.8973), t33, xp.where(xp.greater_equal(t283, -2.8973) & xp.less_equal(t283, 2.8973), t283, xp.where(xp.greater_equal(t284, -2.8973) & xp.less_equal(t284, 2.8973), t284, qb4_4)))
-    t286 = xp.where(xp.less(t34, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t287 = t286 + t34
-    t288 = -t286 + t34
-    t289 = xp.where(xp.greater_equal(t34, -0.0175) & xp.less_equal(t34, 3.7525), t34, xp.where(xp.greater_equal(t287, -0.0175) & xp.less_equal(t287, 3.7525), t287, xp.where(xp.greater_equal(t288, -0.0175) & xp.less_equal(t288, 3.7525), t288, qb4_5)))
-    t290 = qw1*(t138 + t269)**2 + qw2*(t139 + t273)**2 + qw3*(t140 + t277)**2 + qw4*(t141 + t281)**2 + qw5*(t142 + t285)**2 + qw6*(t143 + t289)**2 + qw7*(t144 + qb4_6)**2
-    t291 = xp.greater(t35, 0)
-    t292 = xp.where(t291 & (xp.less(t256, 1) | xp.less(t290, t265)), xp.asarray(1, dtype=dtype), 0)
-    t293 = xp.where(t291, 1, t256)
-    t294 = xp.greater(t292, 0)
-    t295 = xp.where(t294, t269, t258)
-    t296 = xp.where(t294, t273, t259)
-    t297 = xp.where(t294, t277, t260)
-    t298 = xp.where(t294, t281, t261)
-    t299 = xp.where(t294, t285, t262)
-    t300 = xp.where(t294, t289, t263)
-    t301 = xp.where(t294, qb4_6, t264)
-    t302 = xp.where(t294, t290, t265)
-    t303 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t304 = t303 + t36
-    t305 = -t303 + t36
-    t306 = xp.where(xp.greater_equal(t36, -2.8973) & xp.less_equal(t36, 2.8973), t36, xp.where(xp.greater_equal(t304, -2.8973) & xp.less_equal(t304, 2.8973), t304, xp.where(xp.greater_equal(t305, -2.8973) & xp.less_equal(t305, 2.8973), t305, qb5_0)))
-    t307 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t308 = t307 + t37
-    t309 = -t307 + t37
-    t310 = xp.where(xp.greater_equal(t37, -1.7628) & xp.less_equal(t37, 1.7628), t37, xp.where(xp.greater_equal(t308, -1.7628) & xp.less_equal(t308, 1.7628), t308, xp.where(xp.greater_equal(t309, -1.7628) & xp.less_equal(t309, 1.7628), t309, qb5_1)))
-    t311 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t312 = t311 + t38
-    t313 = -t311 + t38
-    t314 = xp.where(xp.greater_equal(t38, -2.8973) & xp.less_equal(t38, 2.8973), t38, xp.where(xp.greater_equal(t312, -2.8973) & xp.less_equal(t312, 2.8973), t312, xp.where(xp.greater_equal(t313, -2.8973) & xp.less_equal(t313, 2.8973), t313, qb5_2)))
-    t315 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t316 = t315 + t39
-    t317 = -t315 + t39
-    t318 = xp.where(xp.greater_equal(t39, -3.0718) & xp.less_equal(t39, -0.0698), t39, xp.where(xp.greater_equal(t316, -3.0718) & xp.less_equal(t316, -0.0698), t316, xp.where(xp.greater_equal(t317, -3.0718) & xp.less_equal(t317, -0.0698), t317, qb5_3)))
-    t319 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t320 = t319 + t40
-    t321 = -t319 + t40
-    t322 = xp.where(xp.greater_equal(t40, -2.8973) & xp.less_equal(t40, 2.8973), t40, xp.where(xp.greater_equal(t320, -2.8973) & xp.less_equal(t320, 2.8973), t320, xp.where(xp.greater_equal(t321, -2.8973) & xp.less_equal(t321, 2.8973), t321, qb5_4)))
-    t323 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t324 = t323 + t41
-    t325 = -t323 + t41
-    t326 = xp.where(xp.greater_equal(t41, -0.0175) & xp.less_equal(t41, 3.7525), t41, xp.where(xp.greater_equal(t324, -0.0175) & xp.less_equal(t324, 3.7525), t324, xp.where(xp.greater_equal(t325, -0.0175) & xp.less_equal(t325, 3.7525), t325, qb5_5)))
-    t327 = qw1*(t138 + t306)**2 + qw2*(t139 + t310)**2 + qw3*(t140 + t314)**2 + qw4*(t141 + t318)**2 + qw5*(t142 + t322)**2 + qw6*(t143 + t326)**2 + qw7*(t144 + qb5_6)**2
-    t328 = xp.greater(t42, 0)
-    t329 = xp.where(t328 & (xp.less(t293, 1) | xp.less(t327, t302)), xp.asarray(1, dtype=dtype), 0)
-    t330 = xp.where(t328, 1, t293)
-    t331 = xp.greater(t329, 0)
-    t332 = xp.where(t331, t306, t295)
-    t333 = xp.where(t331, t310, t296)
-    t334 = xp.where(t331, t314, t297)
-    t335 = xp.where(t331, t318, t298)
-    t336 = xp.where(t331, t322, t299)
-    t337 = xp.where(t331, t326, t300)
-    t338 = xp.where(t331, qb5_6, t301)
-    t339 = xp.where(t331, t327, t302)
-    t340 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t341 = t340 + t43
-    t342 = -t340 + t43
-    t343 = xp.where(xp.greater_equal(t43, -2.8973) & xp.less_equal(t43, 2.8973), t43, xp.where(xp.greater_equal(t341, -2.8973) & xp.less_equal(t341, 2.8973), t341, xp.where(xp.greater_equal(t342, -2.8973) & xp.less_equal(t342, 2.8973), t342, qb6_0)))
-    t344 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t345 = t344 + t44
-    t346 = -t344 + t44
-    t347 = xp.where(xp.greater_equal(t44, -1.7628) & xp.less_equal(t44, 1.7628), t44, xp.where(xp.greater_equal(t345, -1.7628) & xp.less_equal(t345, 1.7628), t345, xp.where(xp.greater_equal(t346, -1.7628) & xp.less_equal(t346, 1.7628), t346, qb6_1)))
-    t348 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t349 = t348 + t45
-    t350 = -t348 + t45
-    t351 = xp.where(xp.greater_equal(t45, -2.8973) & xp.less_equal(t45, 2.8973), t45, xp.where(xp.greater_equal(t349, -2.8973) & xp.less_equal(t349, 2.8973), t349, xp.where(xp.greater_equal(t350, -2.8973) & xp.less_equal(t350, 2.8973), t350, qb6_2)))
-    t352 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t353 = t352 + t46
-    t354 = -t352 + t46
-    t355 = xp.where(xp.greater_equal(t46, -3.0718) & xp.less_equal(t46, -0.0698), t46, xp.where(xp.greater_equal(t353, -3.0718) & xp.less_equal(t353, -0.0698), t353, xp.where(xp.greater_equal(t354, -3.0718) & xp.less_equal(t354, -0.0698), t354, qb6_3)))
-    t356 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t357 = t356 + t47
-    t358 = -t356 + t47
-    t359 = xp.where(xp.greater_equal(t47, -2.8973) & xp.less_equal(t47, 2.8973), t47, xp.where(xp.greater_equal(t357, -2.8973) & xp.less_equal(t357, 2.8973), t357, xp.where(xp.greater_equal(t358, -2.8973) & xp.less_equal(t358, 2.8973), t358, qb6_4)))
-    t360 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t361 = t360 + t48
-    t362 = -t360 + t48
-    t363 = xp.where(xp.greater_equal(t48, -0.0175) & xp.less_equal(t48, 3.7525), t48, xp.where(xp.greater_equal(t361, -0.0175) & xp.less_equal(t361, 3.7525), t361, xp.where(xp.greater_equal(t362, -0.0175) & xp.less_equal(t362, 3.7525), t362, qb6_5)))
-    t364 = qw1*(t138 + t343)**2 + qw2*(t139 + t347)**2 + qw3*(t140 + t351)**2 + qw4*(t141 + t355)**2 + qw5*(t142 + t359)**2 + qw6*(t143 + t363)**2 + qw7*(t144 + qb6_6)**2
-    t365 = xp.greater(t49, 0)
-    t366 = xp.where(t365 & (xp.less(t330, 1) | xp.less(t364, t339)), xp.asarray(1, dtype=dtype), 0)
-    t367 = xp.where(t365, 1, t330)
-    t368 = xp.greater(t366, 0)
-    t369 = xp.where(t368, t343, t332)
-    t370 = xp.where(t368, t347, t333)
-    t371 = xp.where(t368, t351, t334)
-    t372 = xp.where(t368, t355, t335)
-    t373 = xp.where(t368, t359, t336)
-    t374 = xp.where(t368, t363, t337)
-    t375 = xp.where(t368, qb6_6, t338)
-    t376 = xp.where(t368, t364, t339)
-    t377 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t378 = t377 + t50
-    t379 = -t377 + t50
-    t380 = xp.where(xp.greater_equal(t50, -2.8973) & xp.less_equal(t50, 2.8973), t50, xp.where(xp.greater_equal(t378, -2.8973) & xp.less_equal(t378, 2.8973), t378, xp.where(xp.greater_equal(t379, -2.8973) & xp.less_equal(t379, 2.8973), t379, qb7_0)))
-    t381 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t382 = t381 + t51
-    t383 = -t381 + t51
-    t384 = xp.where(xp.greater_equal(t51, -1.7628) & xp.less_equal(t51, 1.7628), t51, xp.where(xp.greater_equal(t382, -1.7628) & xp.less_equal(t382, 1.7628), t382, xp.where(xp.greater_equal(t383, -1.7628) & xp.less_equal(t383, 1.7628), t383, qb7_1)))
-    t385 = xp.where(xp.less(t52, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t386 = t385 + t52
-    t387 = -t385 + t52
-    t388 = xp.where(xp.greater_equal(t52, -2.8973) & xp.less_equal(t52, 2.8973), t52, xp.where(xp.greater_equal(t386, -2.8973) & xp.less_equal(t386, 2.8973), t386, xp.where(xp.greater_equal(t387, -2.8973) & xp.less_equal(t387, 2.8973), t387, qb7_2)))
-    t389 = xp.where(xp.less(t53, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t390 = t389 + t53
-    t391 = -t389 + t53
-    t392 = xp.where(xp.greater_equal(t53, -3.0718) & xp.less_equal(t53, -0.0698), t53, xp.where(xp.greater_equal(t390, -3.0718) & xp.less_equal(t390, -0.0698), t390, xp.where(xp.greater_equal(t391, -3.0718) & xp.less_equal(t391, -0.0698), t391, qb7_3)))
-    t393 = xp.where(xp.less(t54, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t394 = t393 + t54
-    t395 = -t393 + t54
-    t396 = xp.where(xp.greater_equal(t54, -2.8973) & xp.less_equal(t54, 2.8973), t54, xp.where(xp.greater_equal(t394, -2.8973) & xp.less_equal(t394, 2.8973), t394, xp.where(xp.greater_equal(t395, -2.8973) & xp.less_equal(t395, 2.8973), t395, qb7_4)))
-    t397 = xp.where(xp.less(t55, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t398 = t397 + t55
-    t399 = -t397 + t55
-    t400 = xp.where(xp.greater_equal(t55, -0.0175) & xp.less_equal(t55, 3.7525), t55, xp.where(xp.greater_equal(t398, -0.0175) & xp.less_equal(t398, 3.7525), t398, xp.where(xp.greater_equal(t399, -0.0175) & xp.less_equal(t399, 3.7525), t399, qb7_5)))
-    t401 = qw1*(t138 + t380)**2 + qw2*(t139 + t384)**2 + qw3*(t140 + t388)**2 + qw4*(t141 + t392)**2 + qw5*(t142 + t396)**2 + qw6*(t143 + t400)**2 + qw7*(t144 + qb7_6)**2
-    t402 = xp.greater(t56, 0)
-    t403 = xp.where(t402 & (xp.less(t367, 1) | xp.less(t401, t376)), xp.asarray(1, dtype=dtype), 0)
-    t404 = xp.where(t402, 1, t367)
-    t405 = xp.greater(t403, 0)
-    t406 = xp.where(t405, t380, t369)
-    t407 = xp.where(t405, t384, t370)
-    t408 = xp.where(t405, t388, t371)
-    t409 = xp.where(t405, t392, t372)
-    t410 = xp.where(t405, t396, t373)
-    t411 = xp.where(t405, t400, t374)
-    t412 = xp.where(t405, qb7_6, t375)
-    t413 = xp.where(t405, t401, t376)
-    t414 = xp.where(xp.less(t57, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t415 = t414 + t57
-    t416 = -t414 + t57
-    t417 = xp.where(xp.greater_equal(t57, -2.8973) & xp.less_equal(t57, 2.8973), t57, xp.where(xp.greater_equal(t415, -2.8973) & xp.less_equal(t415, 2.8973), t415, xp.where(xp.greater_equal(t416, -2.8973) & xp.less_equal(t416, 2.8973), t416, qb8_0)))
-    t418 = xp.where(xp.less(t58, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t419 = t418 + t58
-    t420 = -t418 + t58
-    t421 = xp.where(xp.greater_equal(t58, -1.7628) & xp.less_equal(t58, 1.7628), t58, xp.where(xp.greater_equal(t419, -1.7628) & xp.less_equal(t419, 1.7628), t419, xp.where(xp.greater_equal(t420, -1.7628) & xp.less_equal(t420, 1.7628), t420, qb8_1)))
-    t422 = xp.where(xp.less(t59, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t423 = t422 + t59
-    t424 = -t422 + t59
-    t425 = xp.where(xp.greater_equal(t59, -2.8973) & xp.less_equal(t59, 2.8973), t59, xp.where(xp.greater_equal(t423, -2.8973) & xp.less_equal(t423, 2.8973), t423, xp.where(xp.greater_equal(t424, -2.8973) & xp.less_equal(t424, 2.8973), t424, qb8_2)))
-    t426 = xp.where(xp.less(t60, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t427 = t426 + t60
-    t428 = -t426 + t60
-    t429 = xp.where(xp.greater_equal(t60, -3.0718) & xp.less_equal(t60, -0.0698), t60, xp.where(xp.greater_equal(t427, -3.0718) & xp.less_equal(t427, -0.0698), t427, xp.where(xp.greater_equal(t428, -3.0718) & xp.less_equal(t428, -0.0698), t428, qb8_3)))
-    t430 = xp.where(xp.less(t61, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t431 = t430 + t61
-    t432 = -t430 + t61
-    t433 = xp.where(xp.greater_equal(t61, -2.8973) & xp.less_equal(t61, 2.8973), t61, xp.where(xp.greater_equal(t431, -2.8973) & xp.less_equal(t431, 2.8973), t431, xp.where(xp.greater_equal(t432, -2.8973) & xp.less_equal(t432, 2.8973), t432, qb8_4)))
-    t434 = xp.where(xp.less(t62, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t435 = t434 + t62
-    t436 = -t434 + t62
-    t437 = xp.where(xp.greater_equal(t62, -0.0175) & xp.less_equal(t62, 3.7525), t62, xp.where(xp.greater_equal(t435, -0.0175) & xp.less_equal(t435, 3.7525), t435, xp.where(xp.greater_equal(t436, -0.0175) & xp.less_equal(t436, 3.7525), t436, qb8_5)))
-    t438 = qw1*(t138 + t417)**2 + qw2*(t139 + t421)**2 + qw3*(t140 + t425)**2 + qw4*(t141 + t429)**2 + qw5*(t142 + t433)**2 + qw6*(t143 + t437)**2 + qw7*(t144 + qb8_6)**2
-    t439 = xp.greater(t63, 0)
-    t440 = xp.where(t439 & (xp.less(t404, 1) | xp.less(t438, t413)), xp.asarray(1, dtype=dtype), 0)
-    t441 = xp.where(t439, 1, t404)
-    t442 = xp.greater(t440, 0)
-    t443 = xp.where(t442, t417, t406)
-    t444 = xp.where(t442, t421, t407)
-    t445 = xp.where(t442, t425, t408)
-    t446 = xp.where(t442, t429, t409)
-    t447 = xp.where(t442, t433, t410)
-    t448 = xp.where(t442, t437, t411)
-    t449 = xp.where(t442, qb8_6, t412)
-    t450 = xp.where(t442, t438, t413)
-    t451 = xp.where(xp.less(t64, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t452 = t451 + t64
-    t453 = -t451 + t64
-    t454 = xp.where(xp.greater_equal(t64, -2.8973) & xp.less_equal(t64, 2.8973), t64, xp.where(xp.greater_equal(t452, -2.8973) & xp.less_equal(t452, 2.8973), t452, xp.where(xp.greater_equal(t453, -2.8973) & xp.less_equal(t453, 2.8973), t453, qb9_0)))
-    t455 = xp.where(xp.less(t65, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t456 = t455 + t65
-    t457 = -t455 + t65
-    t458 = xp.where(xp.greater_equal(t65, -1.7628) & xp.less_equal(t65, 1.7628), t65, xp.where(xp.greater_equal(t456, -1.7628) & xp.less_equal(t456, 1.7628), t456, xp.where(xp.greater_equal(t457, -1.7628) & xp.less_equal(t457, 1.7628), t457, qb9_1)))
-    t459 = xp.where(xp.less(t66, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t460 = t459 + t66
-    t461 = -t459 + t66
-    t462 = xp.where(xp.greater_equal(t66, -2.8973) & xp.less_equal(t66, 2.8973), t66, xp.where(xp.greater_equal(t460, -2.8973) & xp.less_equal(t460, 2.8973), t460, xp.where(xp.greater_equal(t461, -2.8973) & xp.less_equal(t461, 2.8973), t461, qb9_2)))
-    t463 = xp.where(xp.less(t67, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t464 = t463 + t67
-    t465 = -t463 + t67
-    t466 = xp.where(xp.greater_equal(t67, -3.0718) & xp.less_equal(t67, -0.0698), t67, xp.where(xp.greater_equal(t464, -3.0718) & xp.less_equal(t464, -0.0698), t464, xp.where(xp.greater_equal(t465, -3.0718) & xp.less_equal(t465, -0.0698), t465, qb9_3)))
-    t467 = xp.where(xp.less(t68, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t468 = t467 + t68
-    t469 = -t467 + t68
-    t470 = xp.where(xp.greater_equal(t68, -2.8973) & xp.less_equal(t68, 2.8973), t68, xp.where(xp.greater_equal(t468, -2.8973) & xp.less_equal(t468, 2.8973), t468, xp.where(xp.greater_equal(t469, -2.8973) & xp.less_equal(t469, 2.8973), t469, qb9_4)))
-    t471 = xp.where(xp.less(t69, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t472 = t471 + t69
-    t473 = -t471 + t69
-    t474 = xp.where(xp.greater_equal(t69, -0.0175) & xp.less_equal(t69, 3.7525), t69, xp.where(xp.greater_equal(t472, -0.0175) & xp.less_equal(t472, 3.7525), t472, xp.where(xp.greater_equal(t473, -0.0175) & xp.less_equal(t473, 3.7525), t473, qb9_5)))
-    t475 = qw1*(t138 + t454)**2 + qw2*(t139 + t458)**2 + qw3*(t140 + t462)**2 + qw4*(t141 + t466)**2 + qw5*(t142 + t470)**2 + qw6*(t143 + t474)**2 + qw7*(t144 + qb9_6)**2
-    t476 = xp.greater(t70, 0)
-    t477 = xp.where(t476 & (xp.less(t441, 1) | xp.less(t475, t450)), xp.asarray(1, dtype=dtype), 0)
-    t478 = xp.where(t476, 1, t441)
-    t479 = xp.greater(t477, 0)
-    t480 = xp.where(t479, t454, t443)
-    t481 = xp.where(t479, t458, t444)
-    t482 = xp.where(t479, t462, t445)
-    t483 = xp.where(t479, t466, t446)
-    t484 = xp.where(t479, t470, t447)
-    t485 = xp.where(t479, t474, t448)
-    t486 = xp.where(t479, qb9_6, t449)
-    t487 = xp.where(t479, t475, t450)
-    t488 = xp.where(xp.less(t71, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t489 = t488 + t71
-    t490 = -t488 + t71
-    t491 = xp.where(xp.greater_equal(t71, -2.8973) & xp.less_equal(t71, 2.8973), t71, xp.where(xp.greater_equal(t489, -2.8973) & xp.less_equal(t489, 2.8973), t489, xp.where(xp.greater_equal(t490, -2.8973) & xp.less_equal(t490, 2.8973), t490, qb10_0)))
-    t492 = xp.where(xp.less(t72, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t493 = t492 + t72
-    t494 = -t492 + t72
-    t495 = xp.where(xp.greater_equal(t72, -1.7628) & xp.less_equal(t72, 1.7628), t72, xp.where(xp.greater_equal(t493, -1.7628) & xp.less_equal(t493, 1.7628), t493, xp.where(xp.greater_equal(t494, -1.7628) & xp.less_equal(t494, 1.7628), t494, qb10_1)))
-    t496 = xp.where(xp.less(t73, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t497 = t496 + t73
-    t498 = -t496 + t73
-    t499 = xp.where(xp.greater_equal(t73, -2.8973) & xp.less_equal(t73, 2.8973), t73, xp.where(xp.greater_equal(t497, -2.8973) & xp.less_equal(t497, 2.8973), t497, xp.where(xp.greater_equal(t498, -2.8973) & xp.less_equal(t498, 2.8973), t498, qb10_2)))
-    t500 = xp.where(xp.less(t74, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t501 = t500 + t74
-    t502 = -t500 + t74
-    t503 = xp.where(xp.greater_equal(t74, -3.0718) & xp.less_equal(t74, -0.0698), t74, xp.where(xp.greater_equal(t501, -3.0718) & xp.less_equal(t501, -0.0698), t501, xp.where(xp.greater_equal(t502, -3.0718) & xp.less_equal(t502, -0.0698), t502, qb10_3)))
-    t504 = xp.where(xp.less(t75, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t505 = t504 + t75
-    t506 = -t504 + t75
-    t507 = xp.where(xp.greater_equal(t75, -2.8973) & xp.less_equal(t75, 2.8973), t75, xp.where(xp.greater_equal(t505, -2.8973) & xp.less_equal(t505, 2.8973), t505, xp.where(xp.greater_equal(t506, -2.8973) & xp.less_equal(t506, 2.8973), t506, qb10_4)))
-    t508 = xp.where(xp.less(t76, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t509 = t508 + t76
-    t510 = -t508 + t76
-    t511 = xp.where(xp.greater_equal(t76, -0.0175) & xp.less_equal(t76, 3.7525), t76, xp.where(xp.greater_equal(t509, -0.0175) & xp.less_equal(t509, 3.7525), t509, xp.where(xp.greater_equal(t510, -0.0175) & xp.less_equal(t510, 3.7525), t510, qb10_5)))
-    t512 = qw1*(t138 + t491)**2 + qw2*(t139 + t495)**2 + qw3*(t140 + t499)**2 + qw4*(t141 + t503)**2 + qw5*(t142 + t507)**2 + qw6*(t143 + t511)**2 + qw7*(t144 + qb10_6)**2
-    t513 = xp.greater(t77, 0)
-    t514 = xp.where(t513 & (xp.less(t478, 1) | xp.less(t512, t487)), xp.asarray(1, dtype=dtype), 0)
-    t515 = xp.where(t513, 1, t478)
-    t516 = xp.greater(t514, 0)
-    t517 = xp.where(t516, t491, t480)
-    t518 = xp.where(t516, t495, t481)
-    t519 = xp.where(t516, t499, t482)
-    t520 = xp.where(t516, t503, t483)
-    t521 = xp.where(t516, t507, t484)
-    t522 = xp.where(t516, t511, t485)
-    t523 = xp.where(t516, qb10_6, t486)
-    t524 = xp.where(t516, t512, t487)
-    t525 = xp.where(xp.less(t78, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t526 = t525 + t78
-    t527 = -t525 + t78
-    t528 = xp.where(xp.greater_equal(t78, -2.8973) & xp.less_equal(t78, 2.8973), t78, xp.where(xp.greater_equal(t526, -2.8973) & xp.less_equal(t526, 2.8973), t526, xp.where(xp.greater_equal(t527, -2.8973) & xp.less_equal(t527, 2.8973), t527, qb11_0)))
-    t529 = xp.where(xp.less(t79, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t530 = t529 + t79
-    t531 = -t529 + t79
-    t532 = xp.where(xp.greater_equal(t79, -1.7628) & xp.less_equal(t79, 1.7628), t79, xp.where(xp.greater_equal(t530, -1.7628) & xp.less_equal(t530, 1.7628), t530, xp.where(xp.greater_equal(t531, -1.7628) & xp.less_equal(t531, 1.7628), t531, qb11_1)))
-    t533 = xp.where(xp.less(t80, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t534 = t533 + t80
-    t535 = -t533 + t80
-    t536 = xp.where(xp.greater_equal(t80, -2.8973) & xp.less_equal(t80, 2.8973), t80, xp.where(xp.greater_equal(t534, -2.8973) & xp.less_equal(t534, 2.8973), t534, xp.where(xp.greater_equal(t535, -2.8973) & xp.less_equal(t535, 2.8973), t535, qb11_2)))
-    t537 = xp.where(xp.less(t81, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t538 = t537 + t81
-    t539 = -t537 + t81
-    t540 = xp.where(xp.greater_equal(t81, -3.0718) & xp.less_equal(t81, -0.0698), t81, xp.where(xp.greater_equal(t538, -3.0718) & xp.less_equal(t538, -0.0698), t538, xp.where(xp.greater_equal(t539, -3.0718) & xp.less_equal(t539, -0.0698), t539, qb11_3)))
-    t541 = xp.where(xp.less(t82, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t542 = t541 + t82
-    t543 = -t541 + t82
-    t544 = xp.where(xp.greater_equal(t82, -2.8973) & xp.less_equal(t82, 2.8973), t82, xp.where(xp.greater_equal(t542, -2.8973) & xp.less_equal(t542, 2.8973), t542, xp.where(xp.greater_equal(t543, -2.8973) & xp.less_equal(t543, 2.8973), t543, qb11_4)))
-    t545 = xp.where(xp.less(t83, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t546 = t545 + t83
-    t547 = -t545 + t83
-    t548 = xp.where(xp.greater_equal(t83, -0.0175) & xp.less_equal(t83, 3.7525), t83, xp.where(xp.greater_equal(t546, -0.0175) & xp.less_equal(t546, 3.7525), t546, xp.where(xp.greater_equal(t547, -0.0175) & xp.less_equal(t547, 3.7525), t547, qb11_5)))
-    t549 = qw1*(t138 + t528)**2 + qw2*(t139 + t532)**2 + qw3*(t140 + t536)**2 + qw4*(t141 + t540)**2 + qw5*(t142 + t544)**2 + qw6*(t143 + t548)**2 + qw7*(t144 + qb11_6)**2
-    t550 = xp.greater(t84, 0)
-    t551 = xp.where(t550 & (xp.less(t515, 1) | xp.less(t549, t524)), xp.asarray(1, dtype=dtype), 0)
-    t552 = xp.where(t550, 1, t515)
-    t553 = xp.greater(t551, 0)
-    t554 = xp.where(t553, t528, t517)
-    t555 = xp.where(t553, t532, t518)
-    t556 = xp.where(t553, t536, t519)
-    t557 = xp.where(t553, t540, t520)
-    t558 = xp.where(t553, t544, t521)
-    t559 = xp.where(t553, t548, t522)
-    t560 = xp.where(t553, qb11_6, t523)
-    t561 = xp.where(t553, t549, t524)
-    t562 = xp.where(xp.less(t85, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t563 = t562 + t85
-    t564 = -t562 + t85
-    t565 = xp.where(xp.greater_equal(t85, -2.8973) & xp.less_equal(t85, 2.8973), t85, xp.where(xp.greater_equal(t563, -2.8973) & xp.less_equal(t563, 2.8973), t563, xp.where(xp.greater_equal(t564, -2.8973) & xp.less_equal(t564, 2.8973), t564, qb12_0)))
-    t566 = xp.where(xp.less(t86, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t567 = t566 + t86
-    t568 = -t566 + t86
-    t569 = xp.where(xp.greater_equal(t86, -1.7628) & xp.less_equal(t86, 1.7628), t86, xp.where(xp.greater_equal(t567, -1.7628) & xp.less_equal(t567, 1.7628), t567, xp.where(xp.greater_equal(t568, -1.7628) & xp.less_equal(t568, 1.7628), t568, qb12_1)))
-    t570 = xp.where(xp.less(t87, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t571 = t570 + t87
-    t572 = -t570 + t87
-    t573 = xp.where(xp.greater_equal(t87, -2.8973) & xp.less_equal(t87, 2.8973), t87, xp.where(xp.greater_equal(t571, -2.8973) & xp.less_equal(t571, 2.8973), t571, xp.where(xp.greater_equal(t572, -2.8973) & xp.less_equal(t572, 2.8973), t572, qb12_2)))
-    t574 = xp.where(xp.less(t88, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t575 = t574 + t88
-    t576 = -t574 + t88
-    t577 = xp.where(xp.greater_equal(t88, -3.0718) & xp.less_equal(t88, -0.0698), t88, xp.where(xp.greater_equal(t575, -3.0718) & xp.less_equal(t575, -0.0698), t575, xp.where(xp.greater_equal(t576, -3.0718) & xp.less_equal(t576, -0.0698), t576, qb12_3)))
-    t578 = xp.where(xp.less(t89, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t579 = t578 + t89
-    t580 = -t578 + t89
-    t581 = xp.where(xp.greater_equal(t89, -2.8973) & xp.less_equal(t89, 2.8973), t89, xp.where(xp.greater_equal(t579, -2.8973) & xp.less_equal(t579, 2.8973), t579, xp.where(xp.greater_equal(t580, -2.8973) & xp.less_equal(t580, 2.8973), t580, qb12_4)))
-    t582 = xp.where(xp.less(t90, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t583 = t582 + t90
-    t584 = -t582 + t90
-    t585 = xp.where(xp.greater_equal(t90, -0.0175) & xp.less_equal(t90, 3.7525), t90, xp.where(xp.greater_equal(t583, -0.0175) & xp.less_equal(t583, 3.7525), t583, xp.where(xp.greater_equal(t584, -0.0175) & xp.less_equal(t584, 3.7525), t584, qb12_5)))
-    t586 = qw1*(t138 + t565)**2 + qw2*(t139 + t569)**2 + qw3*(t140 + t573)**2 + qw4*(t141 + t577)**2 + qw5*(t142 + t581)**2 + qw6*(t143 + t585)**2 + qw7*(t144 + qb12_6)**2
-    t587 = xp.greater(t91, 0)
-    t588 = xp.where(t587 & (xp.less(t552, 1) | xp.less(t586, t561)), xp.asarray(1, dtype=dtype), 0)
-    t589 = xp.where(t587, 1, t552)
-    t590 = xp.greater(t588, 0)
-    t591 = xp.where(t590, t565, t554)
-    t592 = xp.where(t590, t569, t555)
-    t593 = xp.where(t590, t573, t556)
-    t594 = xp.where(t590, t577, t557)
-    t595 = xp.where(t590, t581, t558)
-    t596 = xp.where(t590, t585, t559)
-    t597 = xp.where(t590, qb12_6, t560)
-    t598 = xp.where(t590, t586, t561)
-    t599 = xp.where(xp.less(t92, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t600 = t599 + t92
-    t601 = -t599 + t92
-    t602 = xp.where(xp.greater_equal(t92, -2.8973) & xp.less_equal(t92, 2.8973), t92, xp.where(xp.greater_equal(t600, -2.8973) & xp.less_equal(t600, 2.8973), t600, xp.where(xp.greater_equal(t601, -2.8973) & xp.less_equal(t601, 2.8973), t601, qb13_0)))
-    t603 = xp.where(xp.less(t93, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t604 = t603 + t93
-    t605 = -t603 + t93
-    t606 = xp.where(xp.greater_equal(t93, -1.7628) & xp.less_equal(t93, 1.7628), t93, xp.where(xp.greater_equal(t604, -1.7628) & xp.less_equal(t604, 1.7628), t604, xp.where(xp.greater_equal(t605, -1.7628) & xp.less_equal(t605, 1.7628), t605, qb13_1)))
-    t607 = xp.where(xp.less(t94, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t608 = t607 + t94
-    t609 = -t607 + t94
-    t610 = xp.where(xp.greater_equal(t94, -2.8973) & xp.less_equal(t94, 2.8973), t94, xp.where(xp.greater_equal(t608, -2.8973) & xp.less_equal(t608, 2.8973), t608, xp.where(xp.greater_equal(t609, -2.8973) & xp.less_equal(t609, 2.8973), t609, qb13_2)))
-    t611 = xp.where(xp.less(t95, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t612 = t611 + t95
-    t613 = -t611 + t95
-    t614 = xp.where(xp.greater_equal(t95, -3.0718) & xp.less_equal(t95, -0.0698), t95, xp.where(xp.greater_equal(t612, -3.0718) & xp.less_equal(t612, -0.0698), t612, xp.where(xp.greater_equal(t613, -3.0718) & xp.less_equal(t613, -0.0698), t613, qb13_3)))
-    t615 = xp.where(xp.less(t96, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t616 = t615 + t96
-    t617 = -t615 + t96
-    t618 = xp.where(xp.greater_equal(t96, -2.8973) & xp.less_equal(t96, 2.8973), t96, xp.where(xp.greater_equal(t616, -2.8973) & xp.less_equal(t616, 2.8973), t616, xp.where(xp.greater_equal(t617, -2.8973) & xp.less_equal(t617, 2.8973), t617, qb13_4)))
-    t619 = xp.where(xp.less(t97, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t620 = t619 + t97
-    t621 = -t619 + t97
-    t622 = xp.where(xp.greater_equal(t97, -0.0175) & xp.less_equal(t97, 3.7525), t97, xp.where(xp.greater_equal(t620, -0.0175) & xp.less_equal(t620, 3.7525), t620, xp.where(xp.greater_equal(t621, -0.0175) & xp.less_equal(t621, 3.7525), t621, qb13_5)))
-    t623 = qw1*(t138 + t602)**2 + qw2*(t139 + t606)**2 + qw3*(t140 + t610)**2 + qw4*(t141 + t614)**2 + qw5*(t142 + t618)**2 + qw6*(t143 + t622)**2 + qw7*(t144 + qb13_6)**2
-    t624 = xp.greater(t98, 0)
-    t625 = xp.where(t624 & (xp.less(t589, 1) | xp.less(t623, t598)), xp.asarray(1, dtype=dtype), 0)
-    t626 = xp.where(t624, 1, t589)
-    t627 = xp.greater(t625, 0)
-    t628 = xp.where(t627, t602, t591)
-    t629 = xp.where(t627, t606, t592)
-    t630 = xp.where(t627, t610, t593)
-    t631 = xp.where(t627, t614, t594)
-    t632 = xp.where(t627, t618, t595)
-    t633 = xp.where(t627, t622, t596)
-    t634 = xp.where(t627, qb13_6, t597)
-    t635 = xp.where(t627, t623, t598)
-    t636 = xp.where(xp.less(t99, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t637 = t636 + t99
-    t638 = -t636 + t99
-    t639 = xp.where(xp.greater_equal(t99, -2.8973) & xp.less_equal(t99, 2.8973), t99, xp.where(xp.greater_equal(t637, -2.8973) & xp.less_equal(t637, 2.8973), t637, xp.where(xp.greater_equal(t638, -2.8973) & xp.less_equal(t638, 2.8973), t638, qb14_0)))
-    t640 = xp.where(xp.less(t100, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t641 = t640 + t100
-    t642 = -t640 + t100
-    t643 = xp.where(xp.greater_equal(t100, -1.7628) & xp.less_equal(t100, 1.7628), t100, xp.where(xp.greater_equal(t641, -1.7628) & xp.less_equal(t641, 1.7628), t641, xp.where(xp.greater_equal(t642, -1.7628) & xp.less_equal(t642, 1.7628), t642, qb14_1)))
-    t644 = xp.where(xp.less(t101, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t645 = t644 + t101
-    t646 = -t644 + t101
-    t647 = xp.where(xp.greater_equal(t101, -2.8973) & xp.less_equal(t101, 2.8973), t101, xp.where(xp.greater_equal(t645, -2.8973) & xp.less_equal(t645, 2.8973), t645, xp.where(xp.greater_equal(t646, -2.8973) & xp.less_equal(t646, 2.8973), t646, qb14_2)))
-    t648 = xp.where(xp.less(t102, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t649 = t648 + t102
-    t650 = -t648 + t102
-    t651 = xp.where(xp.greater_equal(t102, -3.0718) & xp.less_equal(t102, -0.0698), t102, xp.where(xp.greater_equal(t649, -3.0718) & xp.less_equal(t649, -0.0698), t649, xp.where(xp.greater_equal(t650, -3.0718) & xp.less_equal(t650, -0.0698), t650, qb14_3)))
-    t652 = xp.where(xp.less(t103, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t653 = t652 + t103
-    t654 = -t652 + t103
-    t655 = xp.where(xp.greater_equal(t103, -2.8973) & xp.less_equal(t103, 2.8973), t103, xp.where(xp.greater_equal(t653, -2.8973) & xp.less_equal(t653, 2.8973), t653, xp.where(xp.greater_equal(t654, -2.8973) & xp.less_equal(t654, 2.8973), t654, qb14_4)))
-    t656 = xp.where(xp.less(t104, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t657 = t656 + t104
-    t658 = -t656 + t104
-    t659 = xp.where(xp.greater_equal(t104, -0.0175) & xp.less_equal(t104, 3.7525), t104, xp.where(xp.greater_equal(t657, -0.0175) & xp.less_equal(t657, 3.7525), t657, xp.where(xp.greater_equal(t658, -0.0175) & xp.less_equal(t658, 3.7525), t658, qb14_5)))
-    t660 = qw1*(t138 + t639)**2 + qw2*(t139 + t643)**2 + qw3*(t140 + t647)**2 + qw4*(t141 + t651)**2 + qw5*(t142 + t655)**2 + qw6*(t143 + t659)**2 + qw7*(t144 + qb14_6)**2
-    t661 = xp.greater(t105, 0)
-    t662 = xp.where(t661 & (xp.less(t626, 1) | xp.less(t660, t635)), xp.asarray(1, dtype=dtype), 0)
-    t663 = xp.where(t661, 1, t626)
-    t664 = xp.greater(t662, 0)
-    t665 = xp.where(t664, t639, t628)
-    t666 = xp.where(t664, t643, t629)
-    t667 = xp.where(t664, t647, t630)
-    t668 = xp.where(t664, t651, t631)
-    t669 = xp.where(t664, t655, t632)
-    t670 = xp.where(t664, t659, t633)
-    t671 = xp.where(t664, qb14_6, t634)
-    t672 = xp.where(t664, t660, t635)
-    t673 = xp.where(xp.less(t106, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t674 = t673 + t106
-    t675 = -t673 + t106
-    t676 = xp.where(xp.greater_equal(t106, -2.8973) & xp.less_equal(t106, 2.8973), t106, xp.where(xp.greater_equal(t674, -2.8973) & xp.less_equal(t674, 2.8973), t674, xp.where(xp.greater_equal(t675, -2.8973) & xp.less_equal(t675, 2.8973), t675, qb15_0)))
-    t677 = xp.where(xp.less(t107, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t678 = t677 + t107
-    t679 = -t677 + t107
-    t680 = xp.where(xp.greater_equal(t107, -1.7628) & xp.less_equal(t107, 1.7628), t107, xp.where(xp.greater_equal(t678, -1.7628) & xp.less_equal(t678, 1.7628), t678, xp.where(xp.greater_equal(t679, -1.7628) & xp.less_equal(t679, 1.7628), t679, qb15_1)))
-    t681 = xp.where(xp.less(t108, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t682 = t681 + t108
-    t683 = -t681 + t108
-    t684 = xp.where(xp.greater_equal(t108, -2.8973) & xp.less_equal(t108, 2.8973), t108, xp.where(xp.greater_equal(t682, -2.8973) & xp.less_equal(t682, 2.8973), t682, xp.where(xp.greater_equal(t683, -2.8973) & xp.less_equal(t683, 2.8973), t683, qb15_2)))
-    t685 = xp.where(xp.less(t109, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t686 = t685 + t109
-    t687 = -t685 + t109
-    t688 = xp.where(xp.greater_equal(t109, -3.0718) & xp.less_equal(t109, -0.0698), t109, xp.where(xp.greater_equal(t686, -3.0718) & xp.less_equal(t686, -0.0698), t686, xp.where(xp.greater_equal(t687, -3.0718) & xp.less_equal(t687, -0.0698), t687, qb15_3)))
-    t689 = xp.where(xp.less(t110, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t690 = t689 + t110
-    t691 = -t689 + t110
-    t692 = xp.where(xp.greater_equal(t110, -2.8973) & xp.less_equal(t110, 2.8973), t110, xp.where(xp.greater_equal(t690, -2.8973) & xp.less_equal(t690, 2.8973), t690, xp.where(xp.greater_equal(t691, -2.8973) & xp.less_equal(t691, 2.8973), t691, qb15_4)))
-    t693 = xp.where(xp.less(t111, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t694 = t693 + t111
-    t695 = -t693 + t111
-    t696 = xp.where(xp.greater_equal(t111, -0.0175) & xp.less_equal(t111, 3.7525), t111, xp.where(xp.greater_equal(t694, -0.0175) & xp.less_equal(t694, 3.7525), t694, xp.where(xp.greater_equal(t695, -0.0175) & xp.less_equal(t695, 3.7525), t695, qb15_5)))
-    t697 = qw1*(t138 + t676)**2 + qw2*(t139 + t680)**2 + qw3*(t140 + t684)**2 + qw4*(t141 + t688)**2 + qw5*(t142 + t692)**2 + qw6*(t143 + t696)**2 + qw7*(t144 + qb15_6)**2
-    t698 = xp.greater(t112, 0)
-    t699 = xp.where(t698 & (xp.less(t663, 1) | xp.less(t697, t672)), xp.asarray(1, dtype=dtype), 0)
-    t700 = xp.where(t698, 1, t663)
-    t701 = xp.greater(t699, 0)
-    t702 = xp.where(t701, t676, t665)
-    t703 = xp.where(t701, t680, t666)
-    t704 = xp.where(t701, t684, t667)
-    t705 = xp.where(t701, t688, t668)
-    t706 = xp.where(t701, t692, t669)
-    t707 = xp.where(t701, t696, t670)
-    t708 = xp.where(t701, qb15_6, t671)
-    t709 = xp.greater(t700, 0)
-    t710 = xp.isfinite(t113)
-    t711 = t709 & t710
+    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7
+    t1 = _nearer_branch(xp, 1, (qb0_0, qb0_1, qb0_2, qb0_3, qb0_4, qb0_5, qb0_6, xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, qn1, qn2, qn3, qn4, qn5, qn6, qn7, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
+    t2 = _nearer_branch(xp, 1, (qb1_0, qb1_1, qb1_2, qb1_3, qb1_4, qb1_5, qb1_6, xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t1[0], t1[1], t1[2], t1[3], t1[4], t1[5], t1[6], t1[7], t1[8],))
+    t3 = _nearer_branch(xp, 1, (qb2_0, qb2_1, qb2_2, qb2_3, qb2_4, qb2_5, qb2_6, xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t2[0], t2[1], t2[2], t2[3], t2[4], t2[5], t2[6], t2[7], t2[8],))
+    t4 = _nearer_branch(xp, 1, (qb3_0, qb3_1, qb3_2, qb3_3, qb3_4, qb3_5, qb3_6, xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t3[0], t3[1], t3[2], t3[3], t3[4], t3[5], t3[6], t3[7], t3[8],))
+    t5 = _nearer_branch(xp, 1, (qb4_0, qb4_1, qb4_2, qb4_3, qb4_4, qb4_5, qb4_6, xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t4[0], t4[1], t4[2], t4[3], t4[4], t4[5], t4[6], t4[7], t4[8],))
+    t6 = _nearer_branch(xp, 1, (qb5_0, qb5_1, qb5_2, qb5_3, qb5_4, qb5_5, qb5_6, xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t5[0], t5[1], t5[2], t5[3], t5[4], t5[5], t5[6], t5[7], t5[8],))
+    t7 = _nearer_branch(xp, 1, (qb6_0, qb6_1, qb6_2, qb6_3, qb6_4, qb6_5, qb6_6, xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t6[0], t6[1], t6[2], t6[3], t6[4], t6[5], t6[6], t6[7], t6[8],))
+    t8 = _nearer_branch(xp, 1, (qb7_0, qb7_1, qb7_2, qb7_3, qb7_4, qb7_5, qb7_6, xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t7[0], t7[1], t7[2], t7[3], t7[4], t7[5], t7[6], t7[7], t7[8],))
+    t9 = _nearer_branch(xp, 1, (qb8_0, qb8_1, qb8_2, qb8_3, qb8_4, qb8_5, qb8_6, xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t8[0], t8[1], t8[2], t8[3], t8[4], t8[5], t8[6], t8[7], t8[8],))
+    t10 = _nearer_branch(xp, 1, (qb9_0, qb9_1, qb9_2, qb9_3, qb9_4, qb9_5, qb9_6, xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t9[0], t9[1], t9[2], t9[3], t9[4], t9[5], t9[6], t9[7], t9[8],))
+    t11 = _nearer_branch(xp, 1, (qb10_0, qb10_1, qb10_2, qb10_3, qb10_4, qb10_5, qb10_6, xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t10[0], t10[1], t10[2], t10[3], t10[4], t10[5], t10[6], t10[7], t10[8],))
+    t12 = _nearer_branch(xp, 1, (qb11_0, qb11_1, qb11_2, qb11_3, qb11_4, qb11_5, qb11_6, xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t11[0], t11[1], t11[2], t11[3], t11[4], t11[5], t11[6], t11[7], t11[8],))
+    t13 = _nearer_branch(xp, 1, (qb12_0, qb12_1, qb12_2, qb12_3, qb12_4, qb12_5, qb12_6, xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t12[0], t12[1], t12[2], t12[3], t12[4], t12[5], t12[6], t12[7], t12[8],))
+    t14 = _nearer_branch(xp, 1, (qb13_0, qb13_1, qb13_2, qb13_3, qb13_4, qb13_5, qb13_6, xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t13[0], t13[1], t13[2], t13[3], t13[4], t13[5], t13[6], t13[7], t13[8],))
+    t15 = _nearer_branch(xp, 1, (qb14_0, qb14_1, qb14_2, qb14_3, qb14_4, qb14_5, qb14_6, xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t14[0], t14[1], t14[2], t14[3], t14[4], t14[5], t14[6], t14[7], t14[8],))
+    t16 = _nearer_branch(xp, 1, (qb15_0, qb15_1, qb15_2, qb15_3, qb15_4, qb15_5, qb15_6, xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t15[0], t15[1], t15[2], t15[3], t15[4], t15[5], t15[6], t15[7], t15[8],))
+    t17 = xp.greater(t16[8], 0)
+    t18 = xp.isfinite(t0)
+    t19 = t17 & t18
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t711, t702, qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t711, t703, qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t711, t704, qn3), batch),  # 2
-        xp.broadcast_to(xp.where(t711, t705, qn4), batch),  # 3
-        xp.broadcast_to(xp.where(t711, t706, qn5), batch),  # 4
-        xp.broadcast_to(xp.where(t711, t707, qn6), batch),  # 5
-        xp.broadcast_to(xp.where(t711, t708, qn7), batch),  # 6
+        xp.broadcast_to(xp.where(t19, t16[0], qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t19, t16[1], qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t19, t16[2], qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t19, t16[3], qn4), batch),  # 3
+        xp.broadcast_to(xp.where(t19, t16[4], qn5), batch),  # 4
+        xp.broadcast_to(xp.where(t19, t16[5], qn6), batch),  # 5
+        xp.broadcast_to(xp.where(t19, t16[6], qn7), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t710), 2, xp.where(t709, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t18), 2, xp.where(t17, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

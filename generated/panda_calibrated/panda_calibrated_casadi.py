@@ -836,6 +836,190 @@ def _jacobi6_rows(count, state):
     return state
 
 
+def _symmetric_solve6(count, state):
+    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w1**2
+        t1 = w2**2
+        t2 = w3**2
+        t3 = w4**2
+        t4 = w5**2
+        t5 = w0**2
+        t6 = casadi.sqrt(t5 + 2*t0 + 2*t1 + 2*w7**2 + 2*t2 + 2*w8**2 + 2*w12**2 + 2*t3 + 2*w9**2 + 2*w13**2 + 2*w16**2 + 2*t4 + 2*w10**2 + 2*w14**2 + 2*w17**2 + 2*w19**2 + w6**2 + w11**2 + w15**2 + w18**2 + w20**2)
+        t7 = casadi.sqrt(t0 + t1 + t2 + t3 + t4 + t5)
+        t8 = t7*casadi.if_else((w0 >= 0), 1, -1)
+        t9 = (t7 > 0)
+        t10 = casadi.if_else(t9, 1/(w0 + t8), 0)
+        t11 = casadi.if_else(t9, 1 + casadi.fabs(w0)/t7, 0)
+        t12 = w1*t10
+        t13 = w2*t10
+        t14 = w3*t10
+        t15 = w4*t10
+        t16 = w5*t10
+        t17 = t11*(w1 + t12*w6 + t13*w7 + t14*w8 + t15*w9 + t16*w10)
+        t18 = -t17 + w1
+        t19 = w6 - t12*t17
+        t20 = w7 - t13*t17
+        t21 = w8 - t14*t17
+        t22 = w9 - t15*t17
+        t23 = w10 - t16*t17
+        t24 = t11*(w2 + t12*w7 + t13*w11 + t14*w12 + t15*w13 + t16*w14)
+        t25 = -t24 + w2
+        t26 = w7 - t12*t24
+        t27 = w11 - t13*t24
+        t28 = w12 - t14*t24
+        t29 = w13 - t15*t24
+        t30 = w14 - t16*t24
+        t31 = t11*(w3 + t12*w8 + t13*w12 + t14*w15 + t15*w16 + t16*w17)
+        t32 = -t31 + w3
+        t33 = w8 - t12*t31
+        t34 = w12 - t13*t31
+        t35 = w15 - t14*t31
+        t36 = w16 - t15*t31
+        t37 = w17 - t16*t31
+        t38 = t11*(w4 + t12*w9 + t13*w13 + t14*w16 + t15*w18 + t16*w19)
+        t39 = -t38 + w4
+        t40 = w9 - t12*t38
+        t41 = w13 - t13*t38
+        t42 = w16 - t14*t38
+        t43 = w18 - t15*t38
+        t44 = w19 - t16*t38
+        t45 = t11*(w5 + t12*w10 + t13*w14 + t14*w17 + t15*w19 + t16*w20)
+        t46 = -t45 + w5
+        t47 = w10 - t12*t45
+        t48 = w14 - t13*t45
+        t49 = w17 - t14*t45
+        t50 = w19 - t15*t45
+        t51 = w20 - t16*t45
+        t52 = t11*(w21 + t12*w22 + t13*w23 + t14*w24 + t15*w25 + t16*w26)
+        t53 = -t52 + w21
+        t54 = w22 - t12*t52
+        t55 = w23 - t13*t52
+        t56 = w24 - t14*t52
+        t57 = w25 - t15*t52
+        t58 = w26 - t16*t52
+        t59 = casadi.sqrt(t19**2 + t20**2 + t21**2 + t22**2 + t23**2)
+        t60 = t59*casadi.if_else((t19 >= 0), 1, -1)
+        t61 = (t59 > 0)
+        t62 = casadi.if_else(t61, 1/(t19 + t60), 0)
+        t63 = casadi.if_else(t61, 1 + casadi.fabs(t19)/t59, 0)
+        t64 = t20*t62
+        t65 = t21*t62
+        t66 = t22*t62
+        t67 = t23*t62
+        t68 = t63*(t26 + t64*t27 + t65*t28 + t66*t29 + t67*t30)
+        t69 = -t68 + t26
+        t70 = t27 - t64*t68
+        t71 = t28 - t65*t68
+        t72 = t29 - t66*t68
+        t73 = t30 - t67*t68
+        t74 = t63*(t33 + t64*t34 + t65*t35 + t66*t36 + t67*t37)
+        t75 = -t74 + t33
+        t76 = t34 - t64*t74
+        t77 = t35 - t65*t74
+        t78 = t36 - t66*t74
+        t79 = t37 - t67*t74
+        t80 = t63*(t40 + t64*t41 + t65*t42 + t66*t43 + t67*t44)
+        t81 = -t80 + t40
+        t82 = t41 - t64*t80
+        t83 = t42 - t65*t80
+        t84 = t43 - t66*t80
+        t85 = t44 - t67*t80
+        t86 = t63*(t47 + t64*t48 + t65*t49 + t66*t50 + t67*t51)
+        t87 = -t86 + t47
+        t88 = t48 - t64*t86
+        t89 = t49 - t65*t86
+        t90 = t50 - t66*t86
+        t91 = t51 - t67*t86
+        t92 = t63*(t54 + t64*t55 + t65*t56 + t66*t57 + t67*t58)
+        t93 = -t92 + t54
+        t94 = t55 - t64*t92
+        t95 = t56 - t65*t92
+        t96 = t57 - t66*t92
+        t97 = t58 - t67*t92
+        t98 = casadi.sqrt(t70**2 + t71**2 + t72**2 + t73**2)
+        t99 = t98*casadi.if_else((t70 >= 0), 1, -1)
+        t100 = (t98 > 0)
+        t101 = casadi.if_else(t100, 1/(t70 + t99), 0)
+        t102 = casadi.if_else(t100, 1 + casadi.fabs(t70)/t98, 0)
+        t103 = t71*t101
+        t104 = t72*t101
+        t105 = t73*t101
+        t106 = t102*(t76 + t103*t77 + t104*t78 + t105*t79)
+        t107 = -t106 + t76
+        t108 = t77 - t103*t106
+        t109 = t78 - t104*t106
+        t110 = t79 - t105*t106
+        t111 = t102*(t82 + t103*t83 + t104*t84 + t105*t85)
+        t112 = -t111 + t82
+        t113 = t83 - t103*t111
+        t114 = t84 - t104*t111
+        t115 = t85 - t105*t111
+        t116 = t102*(t88 + t103*t89 + t104*t90 + t105*t91)
+        t117 = -t116 + t88
+        t118 = t89 - t103*t116
+        t119 = t90 - t104*t116
+        t120 = t91 - t105*t116
+        t121 = t102*(t94 + t103*t95 + t104*t96 + t105*t97)
+        t122 = -t121 + t94
+        t123 = t95 - t103*t121
+        t124 = t96 - t104*t121
+        t125 = t97 - t105*t121
+        t126 = casadi.sqrt(t108**2 + t109**2 + t110**2)
+        t127 = t126*casadi.if_else((t108 >= 0), 1, -1)
+        t128 = (t126 > 0)
+        t129 = casadi.if_else(t128, 1/(t108 + t127), 0)
+        t130 = casadi.if_else(t128, 1 + casadi.fabs(t108)/t126, 0)
+        t131 = t109*t129
+        t132 = t110*t129
+        t133 = t130*(t113 + t131*t114 + t132*t115)
+        t134 = -t133 + t113
+        t135 = t114 - t131*t133
+        t136 = t115 - t132*t133
+        t137 = t130*(t118 + t131*t119 + t132*t120)
+        t138 = -t137 + t118
+        t139 = t119 - t131*t137
+        t140 = t120 - t132*t137
+        t141 = t130*(t123 + t131*t124 + t132*t125)
+        t142 = -t141 + t123
+        t143 = t124 - t131*t141
+        t144 = t125 - t132*t141
+        t145 = casadi.sqrt(t135**2 + t136**2)
+        t146 = t145*casadi.if_else((t135 >= 0), 1, -1)
+        t147 = (t145 > 0)
+        t148 = casadi.if_else(t147, 1/(t135 + t146), 0)
+        t149 = casadi.if_else(t147, 1 + casadi.fabs(t135)/t145, 0)
+        t150 = t136*t148
+        t151 = t149*(t139 + t150*t140)
+        t152 = -t151 + t139
+        t153 = t140 - t150*t151
+        t154 = t149*(t143 + t150*t144)
+        t155 = -t154 + t143
+        t156 = t144 - t150*t154
+        t157 = casadi.fabs(t153)
+        t158 = t157*casadi.if_else((t153 >= 0), 1, -1)
+        t159 = casadi.if_else((t157 > 0), 2, 0)
+        t160 = t156 - t156*t159
+        t161 = casadi.if_else((t158 != 0), -t160/t158, 0)
+        t162 = casadi.if_else((t146 != 0), -(t155 - t152*t161)/t146, 0)
+        t163 = casadi.if_else((t127 != 0), -(-(t134*t162 + t138*t161) + t142)/t127, 0)
+        t164 = casadi.if_else((t99 != 0), -(-(t107*t163 + t112*t162 + t117*t161) + t122)/t99, 0)
+        t165 = casadi.if_else((t60 != 0), -(-(t69*t164 + t75*t163 + t81*t162 + t87*t161) + t93)/t60, 0)
+        t166 = casadi.if_else((t8 != 0), -(-(t18*t165 + t25*t164 + t32*t163 + t39*t162 + t46*t161) + t53)/t8, 0)
+        t167 = 1e-12*t6
+        state = (
+            t166,
+            t165,
+            t164,
+            t163,
+            t162,
+            t161,
+            casadi.if_else(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t7 <= t167), (t59 <= t167)), (t98 <= t167)), (t126 <= t167)), (t145 <= t167)), (t157 <= t167)), 1, 0),
+        )
+    return state
+
+
 def _fk(q):
     """Pose of the tool frame in the world frame (4x4 homogeneous): 316 operations."""
     q1 = q[0]
@@ -5775,7 +5959,7 @@ def _condition_number(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1284 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1283 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -5951,207 +6135,40 @@ def _velocity_ik(q, mu_dot, damping):
     t147 = 0.0002999999820000003*t88
     t148 = -t147 + t7*t123 + t22*t124 + t37*t125 + t52*t126 + t67*t127 + t90*t128
     t149 = t147 - t8*t98 + t23*t99 + t38*t100 + t53*t101 + t68*t102 + t108*t103
-    t150 = t138**2
-    t151 = t141**2
-    t152 = t130**2
-    t153 = t142**2
-    t154 = t139**2
-    t155 = damping**2
-    t156 = t155 + t129
-    t157 = t156**2
-    t158 = casadi.sqrt(t150 + t151 + t152 + t153 + t154 + t157)
-    t159 = t158*casadi.if_else((t156 >= 0), 1, -1)
-    t160 = t155 + t144
-    t161 = t155 + t146
-    t162 = t155 + t89
-    t163 = t155 + t107
-    t164 = t155 + t135
-    t165 = casadi.sqrt(t157 + t160**2 + t161**2 + t162**2 + t163**2 + t164**2 + 2*t150 + 2*t151 + 2*t145**2 + 2*t152 + 2*t131**2 + 2*t104**2 + 2*t153 + 2*t148**2 + 2*t105**2 + 2*t106**2 + 2*t154 + 2*t132**2 + 2*t149**2 + 2*t133**2 + 2*t134**2)
-    t166 = (t158 > 0)
-    t167 = casadi.if_else(t166, 1/(t156 + t159), 0)
-    t168 = casadi.if_else(t166, 1 + casadi.fabs(t156)/t158, 0)
-    t169 = t138*t167
-    t170 = t141*t167
-    t171 = t130*t167
-    t172 = t142*t167
-    t173 = t139*t167
-    t174 = t168*(t138 + t171*t131 + t172*t148 + t160*t169 + t170*t145 + t173*t132)
-    t175 = -t174 + t138
-    t176 = t160 - t169*t174
-    t177 = t145 - t170*t174
-    t178 = t131 - t171*t174
-    t179 = t148 - t172*t174
-    t180 = t132 - t173*t174
-    t181 = t168*(t141 + t172*t105 + t173*t149 + t169*t145 + t161*t170 + t171*t104)
-    t182 = -t181 + t141
-    t183 = t145 - t169*t181
-    t184 = t161 - t170*t181
-    t185 = t104 - t171*t181
-    t186 = t105 - t172*t181
-    t187 = t149 - t173*t181
-    t188 = t168*(t130 + t162*t171 + t173*t133 + t169*t131 + t170*t104 + t172*t106)
-    t189 = -t188 + t130
-    t190 = t131 - t169*t188
-    t191 = t104 - t170*t188
-    t192 = t162 - t171*t188
-    t193 = t106 - t172*t188
-    t194 = t133 - t173*t188
-    t195 = t168*(t142 + t163*t172 + t169*t148 + t170*t105 + t171*t106 + t173*t134)
-    t196 = -t195 + t142
-    t197 = t148 - t169*t195
-    t198 = t105 - t170*t195
-    t199 = t106 - t171*t195
-    t200 = t163 - t172*t195
-    t201 = t134 - t173*t195
-    t202 = t168*(t164*t173 + t139 + t169*t132 + t170*t149 + t171*t133 + t172*t134)
-    t203 = -t202 + t139
-    t204 = t132 - t169*t202
-    t205 = t149 - t170*t202
-    t206 = t133 - t171*t202
-    t207 = t134 - t172*t202
-    t208 = t164 - t173*t202
-    t209 = casadi.sqrt(t176**2 + t177**2 + t178**2 + t179**2 + t180**2)
-    t210 = t209*casadi.if_else((t176 >= 0), 1, -1)
-    t211 = t168*(mu_dot0 + t169*mu_dot1 + t170*mu_dot2 + t171*mu_dot3 + t172*mu_dot4 + t173*mu_dot5)
-    t212 = -t211 + mu_dot0
-    t213 = mu_dot1 - t169*t211
-    t214 = mu_dot2 - t170*t211
-    t215 = mu_dot3 - t171*t211
-    t216 = mu_dot4 - t172*t211
-    t217 = mu_dot5 - t173*t211
-    t218 = (t209 > 0)
-    t219 = casadi.if_else(t218, 1/(t176 + t210), 0)
-    t220 = casadi.if_else(t218, 1 + casadi.fabs(t176)/t209, 0)
-    t221 = t177*t219
-    t222 = t178*t219
-    t223 = t179*t219
-    t224 = t180*t219
-    t225 = t220*(t183 + t221*t184 + t222*t185 + t223*t186 + t224*t187)
-    t226 = -t225 + t183
-    t227 = t184 - t221*t225
-    t228 = t185 - t222*t225
-    t229 = t186 - t223*t225
-    t230 = t187 - t224*t225
-    t231 = t220*(t190 + t221*t191 + t222*t192 + t223*t193 + t224*t194)
-    t232 = -t231 + t190
-    t233 = t191 - t221*t231
-    t234 = t192 - t222*t231
-    t235 = t193 - t223*t231
-    t236 = t194 - t224*t231
-    t237 = t220*(t197 + t221*t198 + t222*t199 + t223*t200 + t224*t201)
-    t238 = -t237 + t197
-    t239 = t198 - t221*t237
-    t240 = t199 - t222*t237
-    t241 = t200 - t223*t237
-    t242 = t201 - t224*t237
-    t243 = t220*(t204 + t221*t205 + t222*t206 + t223*t207 + t224*t208)
-    t244 = -t243 + t204
-    t245 = t205 - t221*t243
-    t246 = t206 - t222*t243
-    t247 = t207 - t223*t243
-    t248 = t208 - t224*t243
-    t249 = casadi.sqrt(t227**2 + t228**2 + t229**2 + t230**2)
-    t250 = t249*casadi.if_else((t227 >= 0), 1, -1)
-    t251 = t220*(t213 + t221*t214 + t222*t215 + t223*t216 + t224*t217)
-    t252 = -t251 + t213
-    t253 = t214 - t221*t251
-    t254 = t215 - t222*t251
-    t255 = t216 - t223*t251
-    t256 = t217 - t224*t251
-    t257 = (t249 > 0)
-    t258 = casadi.if_else(t257, 1/(t227 + t250), 0)
-    t259 = casadi.if_else(t257, 1 + casadi.fabs(t227)/t249, 0)
-    t260 = t228*t258
-    t261 = t229*t258
-    t262 = t230*t258
-    t263 = t259*(t233 + t260*t234 + t261*t235 + t262*t236)
-    t264 = -t263 + t233
-    t265 = t234 - t260*t263
-    t266 = t235 - t261*t263
-    t267 = t236 - t262*t263
-    t268 = t259*(t239 + t260*t240 + t261*t241 + t262*t242)
-    t269 = -t268 + t239
-    t270 = t240 - t260*t268
-    t271 = t241 - t261*t268
-    t272 = t242 - t262*t268
-    t273 = t259*(t245 + t260*t246 + t261*t247 + t262*t248)
-    t274 = -t273 + t245
-    t275 = t246 - t260*t273
-    t276 = t247 - t261*t273
-    t277 = t248 - t262*t273
-    t278 = casadi.sqrt(t265**2 + t266**2 + t267**2)
-    t279 = t278*casadi.if_else((t265 >= 0), 1, -1)
-    t280 = t259*(t253 + t260*t254 + t261*t255 + t262*t256)
-    t281 = -t280 + t253
-    t282 = t254 - t260*t280
-    t283 = t255 - t261*t280
-    t284 = t256 - t262*t280
-    t285 = (t278 > 0)
-    t286 = casadi.if_else(t285, 1/(t265 + t279), 0)
-    t287 = casadi.if_else(t285, 1 + casadi.fabs(t265)/t278, 0)
-    t288 = t266*t286
-    t289 = t267*t286
-    t290 = t287*(t270 + t288*t271 + t289*t272)
-    t291 = -t290 + t270
-    t292 = t271 - t288*t290
-    t293 = t272 - t289*t290
-    t294 = t287*(t275 + t288*t276 + t289*t277)
-    t295 = -t294 + t275
-    t296 = t276 - t288*t294
-    t297 = t277 - t289*t294
-    t298 = casadi.sqrt(t292**2 + t293**2)
-    t299 = t298*casadi.if_else((t292 >= 0), 1, -1)
-    t300 = t287*(t282 + t288*t283 + t289*t284)
-    t301 = -t300 + t282
-    t302 = t283 - t288*t300
-    t303 = t284 - t289*t300
-    t304 = (t298 > 0)
-    t305 = casadi.if_else(t304, 1/(t292 + t299), 0)
-    t306 = casadi.if_else(t304, 1 + casadi.fabs(t292)/t298, 0)
-    t307 = t293*t305
-    t308 = t306*(t296 + t307*t297)
-    t309 = -t308 + t296
-    t310 = t297 - t307*t308
-    t311 = t306*(t302 + t307*t303)
-    t312 = -t311 + t302
-    t313 = t303 - t307*t311
-    t314 = casadi.fabs(t310)
-    t315 = t314*casadi.if_else((t310 >= 0), 1, -1)
-    t316 = casadi.if_else((t314 > 0), 2, 0)
-    t317 = t313 - t316*t313
-    t318 = casadi.if_else((t315 != 0), -t317/t315, 0)
-    t319 = casadi.if_else((t299 != 0), -(t312 - t309*t318)/t299, 0)
-    t320 = casadi.if_else((t279 != 0), -(-(t291*t319 + t295*t318) + t301)/t279, 0)
-    t321 = casadi.if_else((t250 != 0), -(-(t264*t320 + t269*t319 + t274*t318) + t281)/t250, 0)
-    t322 = casadi.if_else((t210 != 0), -(-(t226*t321 + t232*t320 + t238*t319 + t244*t318) + t252)/t210, 0)
-    t323 = casadi.if_else((t159 != 0), -(-(t175*t322 + t182*t321 + t189*t320 + t196*t319 + t203*t318) + t212)/t159, 0)
-    t324 = 0.9999999550000004*t318 - 0.00029999999550000005*t319 - t116*t323 + 0.9999999550000004*t88*t322 + 0.00029999999550000005*t88*t321
-    t325 = t117*t323 + t123*t322 - t98*t321 - t6*t320 + t7*t319 + t8*t318
-    t326 = t118*t323 + t124*t322 + t99*t321 + t21*t320 + t22*t319 + t23*t318
-    t327 = t119*t323 + t125*t322 + t100*t321 + t36*t320 + t37*t319 + t38*t318
-    t328 = t120*t323 + t126*t322 + t101*t321 + t51*t320 + t52*t319 + t53*t318
-    t329 = t121*t323 + t127*t322 + t102*t321 + t66*t320 + t67*t319 + t68*t318
-    t330 = t122*t323 + t128*t322 + t103*t321 + t81*t320 + t90*t319 + t108*t318
-    t331 = (casadi.fabs(t136) < casadi.inf)
-    t332 = (damping >= 0)
-    t333 = 1e-12*t165
-    t334 = casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t158 <= t333), (t209 <= t333)), (t249 <= t333)), (t278 <= t333)), (t298 <= t333)), (t314 <= t333))
-    t335 = casadi.logic_and(casadi.logic_and(t331, t332), casadi.logic_not(t334))
+    t150 = damping**2
+    t151 = _symmetric_solve6(1, (t150 + t129, t138, t141, t130, t142, t139, t150 + t144, t145, t131, t148, t132, t150 + t146, t104, t105, t149, t150 + t89, t106, t133, t150 + t107, t134, t150 + t135, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t152 = t151[5]
+    t153 = t151[4]
+    t154 = t151[0]
+    t155 = t151[1]
+    t156 = t151[2]
+    t157 = 0.9999999550000004*t152 - 0.00029999999550000005*t153 - t154*t116 + 0.9999999550000004*t88*t155 + 0.00029999999550000005*t88*t156
+    t158 = t151[3]
+    t159 = t154*t117 + t155*t123 - t156*t98 - t6*t158 + t7*t153 + t8*t152
+    t160 = t21*t158 + t154*t118 + t155*t124 + t156*t99 + t22*t153 + t23*t152
+    t161 = t36*t158 + t154*t119 + t155*t125 + t156*t100 + t37*t153 + t38*t152
+    t162 = t51*t158 + t154*t120 + t155*t126 + t156*t101 + t52*t153 + t53*t152
+    t163 = t66*t158 + t154*t121 + t155*t127 + t156*t102 + t67*t153 + t68*t152
+    t164 = t90*t153 + t154*t122 + t81*t158 + t108*t152 + t155*t128 + t156*t103
+    t165 = (casadi.fabs(t136) < casadi.inf)
+    t166 = (damping >= 0)
+    t167 = t151[6]
+    t168 = casadi.logic_and(casadi.logic_and(t165, t166), (t167 <= 0))
     q_dot = casadi.SX(7, 1)
-    q_dot[0, 0] = casadi.if_else(t335, t324, 0)
-    q_dot[1, 0] = casadi.if_else(t335, t325, 0)
-    q_dot[2, 0] = casadi.if_else(t335, t326, 0)
-    q_dot[3, 0] = casadi.if_else(t335, t327, 0)
-    q_dot[4, 0] = casadi.if_else(t335, t328, 0)
-    q_dot[5, 0] = casadi.if_else(t335, t329, 0)
-    q_dot[6, 0] = casadi.if_else(t335, t330, 0)
+    q_dot[0, 0] = casadi.if_else(t168, t157, 0)
+    q_dot[1, 0] = casadi.if_else(t168, t159, 0)
+    q_dot[2, 0] = casadi.if_else(t168, t160, 0)
+    q_dot[3, 0] = casadi.if_else(t168, t161, 0)
+    q_dot[4, 0] = casadi.if_else(t168, t162, 0)
+    q_dot[5, 0] = casadi.if_else(t168, t163, 0)
+    q_dot[6, 0] = casadi.if_else(t168, t164, 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t331, t332)), 2, casadi.if_else(t334, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t165, t166)), 2, casadi.if_else((t167 > 0), 1, 0))
     return [q_dot, status]
 
 
 def _velocity_ik_nullspace(q, mu_dot, z, damping):
-    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 1380 operations."""
+    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 1379 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -6342,214 +6359,47 @@ def _velocity_ik_nullspace(q, mu_dot, z, damping):
     t155 = 0.00029999999550000005*qz1
     t156 = -(-t99*qz2 + t100*qz3 + t101*qz4 + t102*qz5 + t103*qz6 + t104*qz7 + t88*t155) + mu_dot2
     t157 = -(-t155 + t7*qz2 + t22*qz3 + t37*qz4 + t52*qz5 + t67*qz6 + t91*qz7) + mu_dot4
-    t158 = t140**2
-    t159 = t143**2
-    t160 = t131**2
-    t161 = t144**2
-    t162 = t141**2
-    t163 = damping**2
-    t164 = t163 + t130
-    t165 = t164**2
-    t166 = casadi.sqrt(t158 + t159 + t160 + t161 + t162 + t165)
-    t167 = t166*casadi.if_else((t164 >= 0), 1, -1)
-    t168 = t163 + t146
-    t169 = t163 + t148
-    t170 = t163 + t89
-    t171 = t163 + t108
-    t172 = t163 + t136
-    t173 = casadi.sqrt(t165 + t168**2 + t169**2 + t170**2 + t171**2 + t172**2 + 2*t158 + 2*t159 + 2*t147**2 + 2*t160 + 2*t132**2 + 2*t105**2 + 2*t161 + 2*t150**2 + 2*t106**2 + 2*t107**2 + 2*t162 + 2*t133**2 + 2*t151**2 + 2*t134**2 + 2*t135**2)
-    t174 = (t166 > 0)
-    t175 = casadi.if_else(t174, 1/(t164 + t167), 0)
-    t176 = casadi.if_else(t174, 1 + casadi.fabs(t164)/t166, 0)
-    t177 = t140*t175
-    t178 = t143*t175
-    t179 = t131*t175
-    t180 = t144*t175
-    t181 = t141*t175
-    t182 = t176*(t140 + t168*t177 + t178*t147 + t179*t132 + t180*t150 + t181*t133)
-    t183 = -t182 + t140
-    t184 = t168 - t177*t182
-    t185 = t147 - t178*t182
-    t186 = t132 - t179*t182
-    t187 = t150 - t180*t182
-    t188 = t133 - t181*t182
-    t189 = t176*(t143 + t177*t147 + t169*t178 + t179*t105 + t180*t106 + t181*t151)
-    t190 = -t189 + t143
-    t191 = t147 - t177*t189
-    t192 = t169 - t178*t189
-    t193 = t105 - t179*t189
-    t194 = t106 - t180*t189
-    t195 = t151 - t181*t189
-    t196 = t176*(t170*t179 + t131 + t177*t132 + t178*t105 + t180*t107 + t181*t134)
-    t197 = -t196 + t131
-    t198 = t132 - t177*t196
-    t199 = t105 - t178*t196
-    t200 = t170 - t179*t196
-    t201 = t107 - t180*t196
-    t202 = t134 - t181*t196
-    t203 = t176*(t144 + t177*t150 + t178*t106 + t179*t107 + t171*t180 + t181*t135)
-    t204 = -t203 + t144
-    t205 = t150 - t177*t203
-    t206 = t106 - t178*t203
-    t207 = t107 - t179*t203
-    t208 = t171 - t180*t203
-    t209 = t135 - t181*t203
-    t210 = t176*(t141 + t177*t133 + t178*t151 + t179*t134 + t180*t135 + t172*t181)
-    t211 = -t210 + t141
-    t212 = t133 - t177*t210
-    t213 = t151 - t178*t210
-    t214 = t134 - t179*t210
-    t215 = t135 - t180*t210
-    t216 = t172 - t181*t210
-    t217 = t176*(t137 + t177*t153 + t178*t156 + t179*t90 + t180*t157 + t181*t154)
-    t218 = -t217 + t137
-    t219 = t153 - t177*t217
-    t220 = t156 - t178*t217
-    t221 = t90 - t179*t217
-    t222 = t157 - t180*t217
-    t223 = t154 - t181*t217
-    t224 = casadi.sqrt(t184**2 + t185**2 + t186**2 + t187**2 + t188**2)
-    t225 = t224*casadi.if_else((t184 >= 0), 1, -1)
-    t226 = (t224 > 0)
-    t227 = casadi.if_else(t226, 1/(t184 + t225), 0)
-    t228 = casadi.if_else(t226, 1 + casadi.fabs(t184)/t224, 0)
-    t229 = t185*t227
-    t230 = t186*t227
-    t231 = t187*t227
-    t232 = t188*t227
-    t233 = t228*(t191 + t229*t192 + t230*t193 + t231*t194 + t232*t195)
-    t234 = -t233 + t191
-    t235 = t192 - t229*t233
-    t236 = t193 - t230*t233
-    t237 = t194 - t231*t233
-    t238 = t195 - t232*t233
-    t239 = t228*(t198 + t229*t199 + t230*t200 + t231*t201 + t232*t202)
-    t240 = -t239 + t198
-    t241 = t199 - t229*t239
-    t242 = t200 - t230*t239
-    t243 = t201 - t231*t239
-    t244 = t202 - t232*t239
-    t245 = t228*(t205 + t229*t206 + t230*t207 + t231*t208 + t232*t209)
-    t246 = -t245 + t205
-    t247 = t206 - t229*t245
-    t248 = t207 - t230*t245
-    t249 = t208 - t231*t245
-    t250 = t209 - t232*t245
-    t251 = t228*(t212 + t229*t213 + t230*t214 + t231*t215 + t232*t216)
-    t252 = -t251 + t212
-    t253 = t213 - t229*t251
-    t254 = t214 - t230*t251
-    t255 = t215 - t231*t251
-    t256 = t216 - t232*t251
-    t257 = t228*(t219 + t229*t220 + t230*t221 + t231*t222 + t232*t223)
-    t258 = -t257 + t219
-    t259 = t220 - t229*t257
-    t260 = t221 - t230*t257
-    t261 = t222 - t231*t257
-    t262 = t223 - t232*t257
-    t263 = casadi.sqrt(t235**2 + t236**2 + t237**2 + t238**2)
-    t264 = t263*casadi.if_else((t235 >= 0), 1, -1)
-    t265 = (t263 > 0)
-    t266 = casadi.if_else(t265, 1/(t235 + t264), 0)
-    t267 = casadi.if_else(t265, 1 + casadi.fabs(t235)/t263, 0)
-    t268 = t236*t266
-    t269 = t237*t266
-    t270 = t238*t266
-    t271 = t267*(t241 + t268*t242 + t269*t243 + t270*t244)
-    t272 = -t271 + t241
-    t273 = t242 - t268*t271
-    t274 = t243 - t269*t271
-    t275 = t244 - t270*t271
-    t276 = t267*(t247 + t268*t248 + t269*t249 + t270*t250)
-    t277 = -t276 + t247
-    t278 = t248 - t268*t276
-    t279 = t249 - t269*t276
-    t280 = t250 - t270*t276
-    t281 = t267*(t253 + t268*t254 + t269*t255 + t270*t256)
-    t282 = -t281 + t253
-    t283 = t254 - t268*t281
-    t284 = t255 - t269*t281
-    t285 = t256 - t270*t281
-    t286 = t267*(t259 + t268*t260 + t269*t261 + t270*t262)
-    t287 = -t286 + t259
-    t288 = t260 - t268*t286
-    t289 = t261 - t269*t286
-    t290 = t262 - t270*t286
-    t291 = casadi.sqrt(t273**2 + t274**2 + t275**2)
-    t292 = t291*casadi.if_else((t273 >= 0), 1, -1)
-    t293 = (t291 > 0)
-    t294 = casadi.if_else(t293, 1/(t273 + t292), 0)
-    t295 = casadi.if_else(t293, 1 + casadi.fabs(t273)/t291, 0)
-    t296 = t274*t294
-    t297 = t275*t294
-    t298 = t295*(t278 + t296*t279 + t297*t280)
-    t299 = -t298 + t278
-    t300 = t279 - t296*t298
-    t301 = t280 - t297*t298
-    t302 = t295*(t283 + t296*t284 + t297*t285)
-    t303 = -t302 + t283
-    t304 = t284 - t296*t302
-    t305 = t285 - t297*t302
-    t306 = t295*(t288 + t296*t289 + t297*t290)
-    t307 = -t306 + t288
-    t308 = t289 - t296*t306
-    t309 = t290 - t297*t306
-    t310 = casadi.sqrt(t300**2 + t301**2)
-    t311 = t310*casadi.if_else((t300 >= 0), 1, -1)
-    t312 = (t310 > 0)
-    t313 = casadi.if_else(t312, 1/(t300 + t311), 0)
-    t314 = casadi.if_else(t312, 1 + casadi.fabs(t300)/t310, 0)
-    t315 = t301*t313
-    t316 = t314*(t304 + t315*t305)
-    t317 = -t316 + t304
-    t318 = t305 - t315*t316
-    t319 = t314*(t308 + t315*t309)
-    t320 = -t319 + t308
-    t321 = t309 - t315*t319
-    t322 = casadi.fabs(t318)
-    t323 = t322*casadi.if_else((t318 >= 0), 1, -1)
-    t324 = casadi.if_else((t322 > 0), 2, 0)
-    t325 = t321 - t321*t324
-    t326 = casadi.if_else((t323 != 0), -t325/t323, 0)
-    t327 = casadi.if_else((t311 != 0), -(t320 - t317*t326)/t311, 0)
-    t328 = casadi.if_else((t292 != 0), -(-(t299*t327 + t303*t326) + t307)/t292, 0)
-    t329 = casadi.if_else((t264 != 0), -(-(t272*t328 + t277*t327 + t282*t326) + t287)/t264, 0)
-    t330 = casadi.if_else((t225 != 0), -(-(t234*t329 + t240*t328 + t246*t327 + t252*t326) + t258)/t225, 0)
-    t331 = casadi.if_else((t167 != 0), -(-(t183*t330 + t190*t329 + t197*t328 + t204*t327 + t211*t326) + t218)/t167, 0)
-    t332 = 0.9999999550000004*t326 - 0.00029999999550000005*t327 - t117*t331 + 0.9999999550000004*t88*t330 + 0.00029999999550000005*t88*t329
-    t333 = t118*t331 + t124*t330 - t99*t329 - t6*t328 + t7*t327 + t8*t326
-    t334 = t119*t331 + t125*t330 + t100*t329 + t21*t328 + t22*t327 + t23*t326
-    t335 = t120*t331 + t126*t330 + t101*t329 + t36*t328 + t37*t327 + t38*t326
-    t336 = t121*t331 + t127*t330 + t102*t329 + t51*t328 + t52*t327 + t53*t326
-    t337 = t122*t331 + t128*t330 + t103*t329 + t66*t328 + t67*t327 + t68*t326
-    t338 = t123*t331 + t129*t330 + t104*t329 + t81*t328 + t91*t327 + t109*t326
-    t339 = qz1 + t332
-    t340 = qz2 + t333
-    t341 = qz3 + t334
-    t342 = qz4 + t335
-    t343 = qz5 + t336
-    t344 = qz6 + t337
-    t345 = qz7 + t338
-    t346 = (casadi.fabs(t138) < casadi.inf)
-    t347 = (damping >= 0)
-    t348 = 1e-12*t173
-    t349 = casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t166 <= t348), (t224 <= t348)), (t263 <= t348)), (t291 <= t348)), (t310 <= t348)), (t322 <= t348))
-    t350 = casadi.logic_and(casadi.logic_and(t346, t347), casadi.logic_not(t349))
+    t158 = damping**2
+    t159 = _symmetric_solve6(1, (t158 + t130, t140, t143, t131, t144, t141, t158 + t146, t147, t132, t150, t133, t158 + t148, t105, t106, t151, t158 + t89, t107, t134, t158 + t108, t135, t158 + t136, t137, t153, t156, t90, t157, t154,))
+    t160 = t159[5]
+    t161 = t159[4]
+    t162 = t159[0]
+    t163 = t159[1]
+    t164 = t159[2]
+    t165 = 0.9999999550000004*t160 - 0.00029999999550000005*t161 - t162*t117 + 0.9999999550000004*t88*t163 + 0.00029999999550000005*t88*t164
+    t166 = qz1 + t165
+    t167 = t159[3]
+    t168 = t162*t118 + t163*t124 - t164*t99 - t6*t167 + t7*t161 + t8*t160
+    t169 = t162*t119 + t163*t125 + t164*t100 + t21*t167 + t22*t161 + t23*t160
+    t170 = t162*t120 + t163*t126 + t164*t101 + t36*t167 + t37*t161 + t38*t160
+    t171 = t162*t121 + t163*t127 + t164*t102 + t51*t167 + t52*t161 + t53*t160
+    t172 = t162*t122 + t163*t128 + t164*t103 + t66*t167 + t67*t161 + t68*t160
+    t173 = t109*t160 + t162*t123 + t163*t129 + t164*t104 + t81*t167 + t91*t161
+    t174 = qz2 + t168
+    t175 = qz3 + t169
+    t176 = qz4 + t170
+    t177 = qz5 + t171
+    t178 = qz6 + t172
+    t179 = qz7 + t173
+    t180 = (casadi.fabs(t138) < casadi.inf)
+    t181 = (damping >= 0)
+    t182 = t159[6]
+    t183 = casadi.logic_and(casadi.logic_and(t180, t181), (t182 <= 0))
     q_dot = casadi.SX(7, 1)
-    q_dot[0, 0] = casadi.if_else(t350, t339, 0)
-    q_dot[1, 0] = casadi.if_else(t350, t340, 0)
-    q_dot[2, 0] = casadi.if_else(t350, t341, 0)
-    q_dot[3, 0] = casadi.if_else(t350, t342, 0)
-    q_dot[4, 0] = casadi.if_else(t350, t343, 0)
-    q_dot[5, 0] = casadi.if_else(t350, t344, 0)
-    q_dot[6, 0] = casadi.if_else(t350, t345, 0)
+    q_dot[0, 0] = casadi.if_else(t183, t166, 0)
+    q_dot[1, 0] = casadi.if_else(t183, t174, 0)
+    q_dot[2, 0] = casadi.if_else(t183, t175, 0)
+    q_dot[3, 0] = casadi.if_else(t183, t176, 0)
+    q_dot[4, 0] = casadi.if_else(t183, t177, 0)
+    q_dot[5, 0] = casadi.if_else(t183, t178, 0)
+    q_dot[6, 0] = casadi.if_else(t183, t179, 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t346, t347)), 2, casadi.if_else(t349, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t180, t181)), 2, casadi.if_else((t182 > 0), 1, 0))
     return [q_dot, status]
 
 
 def _resolved_rate(q, target, target_rate, gain, z, damping):
-    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 1555 operations."""
+    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 1554 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -6787,237 +6637,70 @@ def _resolved_rate(q, target, target_rate, gain, z, damping):
     t182 = 0.0002999999820000003*t88
     t183 = -t182 + t7*t126 + t22*t127 + t37*t128 + t52*t129 + t67*t130 + t92*t131
     t184 = t182 - t8*t100 + t23*t101 + t38*t102 + t53*t103 + t68*t104 + t111*t105
-    t185 = t173**2
-    t186 = t176**2
-    t187 = t133**2
-    t188 = t177**2
-    t189 = t174**2
-    t190 = damping**2
-    t191 = t190 + t132
-    t192 = t191**2
-    t193 = casadi.sqrt(t185 + t186 + t187 + t188 + t189 + t192)
-    t194 = t193*casadi.if_else((t191 >= 0), 1, -1)
-    t195 = t190 + t179
-    t196 = t190 + t181
-    t197 = t190 + t90
-    t198 = t190 + t109
-    t199 = t190 + t138
-    t200 = casadi.sqrt(t192 + t195**2 + t196**2 + t197**2 + t198**2 + t199**2 + 2*t185 + 2*t186 + 2*t180**2 + 2*t187 + 2*t134**2 + 2*t106**2 + 2*t188 + 2*t183**2 + 2*t107**2 + 2*t108**2 + 2*t189 + 2*t135**2 + 2*t184**2 + 2*t136**2 + 2*t137**2)
-    t201 = (t193 > 0)
-    t202 = casadi.if_else(t201, 1/(t191 + t194), 0)
-    t203 = casadi.if_else(t201, 1 + casadi.fabs(t191)/t193, 0)
-    t204 = t173*t202
-    t205 = t176*t202
-    t206 = t133*t202
-    t207 = t177*t202
-    t208 = t174*t202
-    t209 = t203*(t173 + t195*t204 + t205*t180 + t206*t134 + t207*t183 + t208*t135)
-    t210 = -t209 + t173
-    t211 = t195 - t204*t209
-    t212 = t180 - t205*t209
-    t213 = t134 - t206*t209
-    t214 = t183 - t207*t209
-    t215 = t135 - t208*t209
-    t216 = t203*(t196*t205 + t176 + t204*t180 + t206*t106 + t207*t107 + t208*t184)
-    t217 = -t216 + t176
-    t218 = t180 - t204*t216
-    t219 = t196 - t205*t216
-    t220 = t106 - t206*t216
-    t221 = t107 - t207*t216
-    t222 = t184 - t208*t216
-    t223 = t203*(t133 + t205*t106 + t197*t206 + t204*t134 + t207*t108 + t208*t136)
-    t224 = -t223 + t133
-    t225 = t134 - t204*t223
-    t226 = t106 - t205*t223
-    t227 = t197 - t206*t223
-    t228 = t108 - t207*t223
-    t229 = t136 - t208*t223
-    t230 = t203*(t177 + t206*t108 + t198*t207 + t204*t183 + t205*t107 + t208*t137)
-    t231 = -t230 + t177
-    t232 = t183 - t204*t230
-    t233 = t107 - t205*t230
-    t234 = t108 - t206*t230
-    t235 = t198 - t207*t230
-    t236 = t137 - t208*t230
-    t237 = t203*(t174 + t207*t137 + t204*t135 + t205*t184 + t206*t136 + t199*t208)
-    t238 = -t237 + t174
-    t239 = t135 - t204*t237
-    t240 = t184 - t205*t237
-    t241 = t136 - t206*t237
-    t242 = t137 - t207*t237
-    t243 = t199 - t208*t237
-    t244 = casadi.sqrt(t211**2 + t212**2 + t213**2 + t214**2 + t215**2)
-    t245 = t244*casadi.if_else((t211 >= 0), 1, -1)
-    t246 = (t244 > 0)
-    t247 = casadi.if_else(t246, 1/(t211 + t245), 0)
-    t248 = casadi.if_else(t246, 1 + casadi.fabs(t211)/t244, 0)
-    t249 = t212*t247
-    t250 = t213*t247
-    t251 = t214*t247
-    t252 = t215*t247
-    t253 = t248*(t218 + t249*t219 + t250*t220 + t251*t221 + t252*t222)
-    t254 = -t253 + t218
-    t255 = t219 - t249*t253
-    t256 = t220 - t250*t253
-    t257 = t221 - t251*t253
-    t258 = t222 - t252*t253
-    t259 = t248*(t225 + t249*t226 + t250*t227 + t251*t228 + t252*t229)
-    t260 = -t259 + t225
-    t261 = t226 - t249*t259
-    t262 = t227 - t250*t259
-    t263 = t228 - t251*t259
-    t264 = t229 - t252*t259
-    t265 = t248*(t232 + t249*t233 + t250*t234 + t251*t235 + t252*t236)
-    t266 = -t265 + t232
-    t267 = t233 - t249*t265
-    t268 = t234 - t250*t265
-    t269 = t235 - t251*t265
-    t270 = t236 - t252*t265
-    t271 = t248*(t239 + t249*t240 + t250*t241 + t251*t242 + t252*t243)
-    t272 = -t271 + t239
-    t273 = t240 - t249*t271
-    t274 = t241 - t250*t271
-    t275 = t242 - t251*t271
-    t276 = t243 - t252*t271
-    t277 = casadi.sqrt(t255**2 + t256**2 + t257**2 + t258**2)
-    t278 = t277*casadi.if_else((t255 >= 0), 1, -1)
-    t279 = (t277 > 0)
-    t280 = casadi.if_else(t279, 1/(t255 + t278), 0)
-    t281 = casadi.if_else(t279, 1 + casadi.fabs(t255)/t277, 0)
-    t282 = t256*t280
-    t283 = t257*t280
-    t284 = t258*t280
-    t285 = t281*(t261 + t282*t262 + t283*t263 + t284*t264)
-    t286 = -t285 + t261
-    t287 = t262 - t282*t285
-    t288 = t263 - t283*t285
-    t289 = t264 - t284*t285
-    t290 = t281*(t267 + t282*t268 + t283*t269 + t284*t270)
-    t291 = -t290 + t267
-    t292 = t268 - t282*t290
-    t293 = t269 - t283*t290
-    t294 = t270 - t284*t290
-    t295 = t281*(t273 + t282*t274 + t283*t275 + t284*t276)
-    t296 = -t295 + t273
-    t297 = t274 - t282*t295
-    t298 = t275 - t283*t295
-    t299 = t276 - t284*t295
-    t300 = casadi.sqrt(t287**2 + t288**2 + t289**2)
-    t301 = t300*casadi.if_else((t287 >= 0), 1, -1)
-    t302 = (t300 > 0)
-    t303 = casadi.if_else(t302, 1/(t287 + t301), 0)
-    t304 = casadi.if_else(t302, 1 + casadi.fabs(t287)/t300, 0)
-    t305 = t288*t303
-    t306 = t289*t303
-    t307 = t304*(t292 + t305*t293 + t306*t294)
-    t308 = -t307 + t292
-    t309 = t293 - t305*t307
-    t310 = t294 - t306*t307
-    t311 = t304*(t297 + t305*t298 + t306*t299)
-    t312 = -t311 + t297
-    t313 = t298 - t305*t311
-    t314 = t299 - t306*t311
-    t315 = casadi.sqrt(t309**2 + t310**2)
-    t316 = t315*casadi.if_else((t309 >= 0), 1, -1)
-    t317 = (t315 > 0)
-    t318 = casadi.if_else(t317, 1/(t309 + t316), 0)
-    t319 = casadi.if_else(t317, 1 + casadi.fabs(t309)/t315, 0)
-    t320 = t310*t318
-    t321 = t319*(t313 + t320*t314)
-    t322 = -t321 + t313
-    t323 = t314 - t320*t321
-    t324 = casadi.fabs(t323)
-    t325 = t324*casadi.if_else((t323 >= 0), 1, -1)
-    t326 = casadi.if_else((t324 > 0), 2, 0)
-    t327 = casadi.logic_and((t146 >= t155), (t146 >= t165))
-    t328 = (t155 >= t165)
-    t329 = casadi.if_else(t327, 0.5*(1 + t146), casadi.if_else(t328, 0.5*t154, 0.5*t163))
-    t330 = casadi.if_else(t327, 0.5*t147, casadi.if_else(t328, 0.5*(1 + t155), 0.5*t164))
-    t331 = casadi.if_else(t327, 0.5*t148, casadi.if_else(t328, 0.5*t156, 0.5*(1 + t165)))
-    t332 = casadi.sqrt(t329**2 + t330**2 + t331**2)
-    t333 = casadi.if_else((t166*t329 + t167*t330 + t157*t331 >= 0), 1, -1)
-    t334 = casadi.logic_or((t169 > 1e-06), (t168 > 0))
-    t335 = t170*t333/t332
-    t336 = casadi.if_else(t334, t166*t171, t335*t329)
-    t337 = casadi.if_else(t334, t167*t171, t335*t330)
-    t338 = casadi.if_else(t334, t157*t171, t335*t331)
-    t339 = mu_dot3 + t336*gain3
-    t340 = mu_dot4 + t337*gain4
-    t341 = mu_dot5 + t338*gain5
-    t342 = -(-t6*qz2 + t21*qz3 + t36*qz4 + t51*qz5 + t66*qz6 + t81*qz7) + t339
-    t343 = 0.9996999550045004 - t119 - t100 - t6 + q1 + q2 + q3 + q4 + q5 + q6 + q7 + t7 + t8 + t21 + t22 + t23 + t36 + t37 + t38 + t51 + t52 + t53 + t66 + t67 + t68 + t81 + t92 + t111 + t120 + t121 + t122 + t123 + t124 + t125 + t126 + t127 + t128 + t129 + t130 + t131 + t101 + t102 + t103 + t104 + t105 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7 + 1.0002999549955003*t88 + t91 + t110 + t139 + t339 + t340 + t341
-    t344 = 0.9999999550000004*qz1
-    t345 = -(t126*qz2 + t127*qz3 + t128*qz4 + t129*qz5 + t130*qz6 + t131*qz7 + t88*t344) + t110
-    t346 = -(t344 + t8*qz2 + t23*qz3 + t38*qz4 + t53*qz5 + t68*qz6 + t111*qz7) + t341
-    t347 = 0.00029999999550000005*qz1
-    t348 = -(-t100*qz2 + t101*qz3 + t102*qz4 + t103*qz5 + t104*qz6 + t105*qz7 + t88*t347) + t139
-    t349 = -(-t347 + t7*qz2 + t22*qz3 + t37*qz4 + t52*qz5 + t67*qz6 + t92*qz7) + t340
-    t350 = t203*(t140 + t204*t345 + t205*t348 + t206*t342 + t207*t349 + t208*t346)
-    t351 = -t350 + t140
-    t352 = t345 - t204*t350
-    t353 = t348 - t205*t350
-    t354 = t342 - t206*t350
-    t355 = t349 - t207*t350
-    t356 = t346 - t208*t350
-    t357 = t248*(t352 + t249*t353 + t250*t354 + t251*t355 + t252*t356)
-    t358 = -t357 + t352
-    t359 = t353 - t249*t357
-    t360 = t354 - t250*t357
-    t361 = t355 - t251*t357
-    t362 = t356 - t252*t357
-    t363 = t281*(t359 + t282*t360 + t283*t361 + t284*t362)
-    t364 = -t363 + t359
-    t365 = t360 - t282*t363
-    t366 = t361 - t283*t363
-    t367 = t362 - t284*t363
-    t368 = t304*(t365 + t305*t366 + t306*t367)
-    t369 = -t368 + t365
-    t370 = t366 - t305*t368
-    t371 = t367 - t306*t368
-    t372 = t319*(t370 + t320*t371)
-    t373 = -t372 + t370
-    t374 = t371 - t320*t372
-    t375 = t374 - t326*t374
-    t376 = casadi.if_else((t325 != 0), -t375/t325, 0)
-    t377 = casadi.if_else((t316 != 0), -(t373 - t322*t376)/t316, 0)
-    t378 = casadi.if_else((t301 != 0), -(-(t308*t377 + t312*t376) + t369)/t301, 0)
-    t379 = casadi.if_else((t278 != 0), -(-(t286*t378 + t291*t377 + t296*t376) + t364)/t278, 0)
-    t380 = casadi.if_else((t245 != 0), -(-(t254*t379 + t260*t378 + t266*t377 + t272*t376) + t358)/t245, 0)
-    t381 = casadi.if_else((t194 != 0), -(-(t210*t380 + t217*t379 + t224*t378 + t231*t377 + t238*t376) + t351)/t194, 0)
-    t382 = 0.9999999550000004*t376 - 0.00029999999550000005*t377 - t119*t381 + 0.9999999550000004*t88*t380 + 0.00029999999550000005*t88*t379
-    t383 = t120*t381 + t126*t380 - t100*t379 - t6*t378 + t7*t377 + t8*t376
-    t384 = t121*t381 + t127*t380 + t101*t379 + t21*t378 + t22*t377 + t23*t376
-    t385 = t122*t381 + t128*t380 + t102*t379 + t36*t378 + t37*t377 + t38*t376
-    t386 = t123*t381 + t129*t380 + t103*t379 + t51*t378 + t52*t377 + t53*t376
-    t387 = t124*t381 + t130*t380 + t104*t379 + t66*t378 + t67*t377 + t68*t376
-    t388 = t125*t381 + t131*t380 + t105*t379 + t81*t378 + t92*t377 + t111*t376
-    t389 = qz1 + t382
-    t390 = qz2 + t383
-    t391 = qz3 + t384
-    t392 = qz4 + t385
-    t393 = qz5 + t386
-    t394 = qz6 + t387
-    t395 = qz7 + t388
-    t396 = (casadi.fabs(t343) < casadi.inf)
-    t397 = (damping >= 0)
-    t398 = 1e-12*t200
-    t399 = casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t193 <= t398), (t244 <= t398)), (t277 <= t398)), (t300 <= t398)), (t315 <= t398)), (t324 <= t398))
-    t400 = casadi.logic_and(casadi.logic_and(t396, t397), casadi.logic_not(t399))
+    t185 = casadi.logic_and((t146 >= t155), (t146 >= t165))
+    t186 = (t155 >= t165)
+    t187 = casadi.if_else(t185, 0.5*(1 + t146), casadi.if_else(t186, 0.5*t154, 0.5*t163))
+    t188 = casadi.if_else(t185, 0.5*t147, casadi.if_else(t186, 0.5*(1 + t155), 0.5*t164))
+    t189 = casadi.if_else(t185, 0.5*t148, casadi.if_else(t186, 0.5*t156, 0.5*(1 + t165)))
+    t190 = casadi.sqrt(t187**2 + t188**2 + t189**2)
+    t191 = casadi.if_else((t166*t187 + t167*t188 + t157*t189 >= 0), 1, -1)
+    t192 = casadi.logic_or((t169 > 1e-06), (t168 > 0))
+    t193 = t170*t191/t190
+    t194 = casadi.if_else(t192, t166*t171, t193*t187)
+    t195 = casadi.if_else(t192, t167*t171, t193*t188)
+    t196 = casadi.if_else(t192, t157*t171, t193*t189)
+    t197 = mu_dot3 + t194*gain3
+    t198 = mu_dot4 + t195*gain4
+    t199 = mu_dot5 + t196*gain5
+    t200 = -(-t6*qz2 + t21*qz3 + t36*qz4 + t51*qz5 + t66*qz6 + t81*qz7) + t197
+    t201 = 0.9996999550045004 - t119 - t100 - t6 + q1 + q2 + q3 + q4 + q5 + q6 + q7 + t7 + t8 + t21 + t22 + t23 + t36 + t37 + t38 + t51 + t52 + t53 + t66 + t67 + t68 + t81 + t92 + t111 + t120 + t121 + t122 + t123 + t124 + t125 + t126 + t127 + t128 + t129 + t130 + t131 + t101 + t102 + t103 + t104 + t105 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7 + 1.0002999549955003*t88 + t91 + t110 + t139 + t197 + t198 + t199
+    t202 = 0.9999999550000004*qz1
+    t203 = -(t126*qz2 + t127*qz3 + t128*qz4 + t129*qz5 + t130*qz6 + t131*qz7 + t88*t202) + t110
+    t204 = -(t202 + t8*qz2 + t23*qz3 + t38*qz4 + t53*qz5 + t68*qz6 + t111*qz7) + t199
+    t205 = 0.00029999999550000005*qz1
+    t206 = -(-t100*qz2 + t101*qz3 + t102*qz4 + t103*qz5 + t104*qz6 + t105*qz7 + t88*t205) + t139
+    t207 = -(-t205 + t7*qz2 + t22*qz3 + t37*qz4 + t52*qz5 + t67*qz6 + t92*qz7) + t198
+    t208 = damping**2
+    t209 = _symmetric_solve6(1, (t208 + t132, t173, t176, t133, t177, t174, t208 + t179, t180, t134, t183, t135, t208 + t181, t106, t107, t184, t208 + t90, t108, t136, t208 + t109, t137, t208 + t138, t140, t203, t206, t200, t207, t204,))
+    t210 = t209[5]
+    t211 = t209[4]
+    t212 = t209[0]
+    t213 = t209[1]
+    t214 = t209[2]
+    t215 = 0.9999999550000004*t210 - 0.00029999999550000005*t211 - t212*t119 + 0.9999999550000004*t88*t213 + 0.00029999999550000005*t88*t214
+    t216 = qz1 + t215
+    t217 = t209[3]
+    t218 = t7*t211 + t212*t120 + t213*t126 - t214*t100 - t6*t217 + t8*t210
+    t219 = t212*t121 + t213*t127 + t214*t101 + t21*t217 + t22*t211 + t23*t210
+    t220 = t214*t102 + t212*t122 + t213*t128 + t36*t217 + t37*t211 + t38*t210
+    t221 = t214*t103 + t212*t123 + t213*t129 + t51*t217 + t52*t211 + t53*t210
+    t222 = t212*t124 + t213*t130 + t214*t104 + t66*t217 + t67*t211 + t68*t210
+    t223 = t92*t211 + t214*t105 + t212*t125 + t213*t131 + t81*t217 + t111*t210
+    t224 = qz2 + t218
+    t225 = qz3 + t219
+    t226 = qz4 + t220
+    t227 = qz5 + t221
+    t228 = qz6 + t222
+    t229 = qz7 + t223
+    t230 = (casadi.fabs(t201) < casadi.inf)
+    t231 = (damping >= 0)
+    t232 = t209[6]
+    t233 = casadi.logic_and(casadi.logic_and(t230, t231), (t232 <= 0))
     q_dot = casadi.SX(7, 1)
-    q_dot[0, 0] = casadi.if_else(t400, t389, 0)
-    q_dot[1, 0] = casadi.if_else(t400, t390, 0)
-    q_dot[2, 0] = casadi.if_else(t400, t391, 0)
-    q_dot[3, 0] = casadi.if_else(t400, t392, 0)
-    q_dot[4, 0] = casadi.if_else(t400, t393, 0)
-    q_dot[5, 0] = casadi.if_else(t400, t394, 0)
-    q_dot[6, 0] = casadi.if_else(t400, t395, 0)
+    q_dot[0, 0] = casadi.if_else(t233, t216, 0)
+    q_dot[1, 0] = casadi.if_else(t233, t224, 0)
+    q_dot[2, 0] = casadi.if_else(t233, t225, 0)
+    q_dot[3, 0] = casadi.if_else(t233, t226, 0)
+    q_dot[4, 0] = casadi.if_else(t233, t227, 0)
+    q_dot[5, 0] = casadi.if_else(t233, t228, 0)
+    q_dot[6, 0] = casadi.if_else(t233, t229, 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t396, t397)), 2, casadi.if_else(t399, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t230, t231)), 2, casadi.if_else((t232 > 0), 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 1372 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 1431 operations."""
     T00 = target[0, 0]
     T01 = target[0, 1]
     T02 = target[0, 2]
@@ -7256,179 +6939,20 @@ def _ik_numeric_step(target, q, damping):
     t195 = casadi.if_else(t192, t167*t171, t193*t188)
     t196 = casadi.if_else(t192, t157*t171, t193*t189)
     t197 = t194**2 + t195**2 + t196**2 + t92**2 + t111**2 + t140**2
-    t198 = damping + t133
-    t199 = casadi.sqrt(t198**2 + t173**2 + t176**2 + t134**2 + t177**2 + t174**2)
-    t200 = t199*casadi.if_else((t198 >= 0), 1, -1)
-    t201 = (t199 > 0)
-    t202 = casadi.if_else(t201, 1/(t198 + t200), 0)
-    t203 = casadi.if_else(t201, 1 + casadi.fabs(t198)/t199, 0)
-    t204 = damping + t179
-    t205 = t173*t202
-    t206 = t176*t202
-    t207 = t134*t202
-    t208 = t177*t202
-    t209 = t174*t202
-    t210 = t203*(t173 + t209*t136 + t204*t205 + t206*t180 + t207*t135 + t208*t183)
-    t211 = -t210 + t173
-    t212 = t204 - t205*t210
-    t213 = t180 - t206*t210
-    t214 = t135 - t207*t210
-    t215 = t183 - t208*t210
-    t216 = t136 - t209*t210
-    t217 = t203*(t92 + t205*t111 + t206*t140 + t207*t194 + t208*t195 + t209*t196)
-    t218 = -t217 + t92
-    t219 = t111 - t205*t217
-    t220 = t140 - t206*t217
-    t221 = t194 - t207*t217
-    t222 = t195 - t208*t217
-    t223 = t196 - t209*t217
-    t224 = casadi.sqrt(t212**2 + t213**2 + t214**2 + t215**2 + t216**2)
-    t225 = t224*casadi.if_else((t212 >= 0), 1, -1)
-    t226 = damping + t181
-    t227 = t203*(t176 + t205*t180 + t206*t226 + t207*t107 + t208*t108 + t209*t184)
-    t228 = -t227 + t176
-    t229 = t180 - t205*t227
-    t230 = t226 - t206*t227
-    t231 = t107 - t207*t227
-    t232 = t108 - t208*t227
-    t233 = t184 - t209*t227
-    t234 = damping + t91
-    t235 = t203*(t134 + t205*t135 + t206*t107 + t207*t234 + t208*t109 + t209*t137)
-    t236 = -t235 + t134
-    t237 = t135 - t205*t235
-    t238 = t107 - t206*t235
-    t239 = t234 - t207*t235
-    t240 = t109 - t208*t235
-    t241 = t137 - t209*t235
-    t242 = damping + t110
-    t243 = t203*(t177 + t205*t183 + t206*t108 + t207*t109 + t208*t242 + t209*t138)
-    t244 = -t243 + t177
-    t245 = t183 - t205*t243
-    t246 = t108 - t206*t243
-    t247 = t109 - t207*t243
-    t248 = t242 - t208*t243
-    t249 = t138 - t209*t243
-    t250 = damping + t139
-    t251 = t203*(t174 + t205*t136 + t206*t184 + t207*t137 + t208*t138 + t209*t250)
-    t252 = -t251 + t174
-    t253 = t136 - t205*t251
-    t254 = t184 - t206*t251
-    t255 = t137 - t207*t251
-    t256 = t138 - t208*t251
-    t257 = t250 - t209*t251
-    t258 = (t224 > 0)
-    t259 = casadi.if_else(t258, 1/(t212 + t225), 0)
-    t260 = casadi.if_else(t258, 1 + casadi.fabs(t212)/t224, 0)
-    t261 = t213*t259
-    t262 = t214*t259
-    t263 = t215*t259
-    t264 = t216*t259
-    t265 = t260*(t229 + t261*t230 + t262*t231 + t263*t232 + t264*t233)
-    t266 = -t265 + t229
-    t267 = t230 - t261*t265
-    t268 = t231 - t262*t265
-    t269 = t232 - t263*t265
-    t270 = t233 - t264*t265
-    t271 = t260*(t237 + t261*t238 + t262*t239 + t263*t240 + t264*t241)
-    t272 = -t271 + t237
-    t273 = t238 - t261*t271
-    t274 = t239 - t262*t271
-    t275 = t240 - t263*t271
-    t276 = t241 - t264*t271
-    t277 = t260*(t245 + t261*t246 + t262*t247 + t263*t248 + t264*t249)
-    t278 = -t277 + t245
-    t279 = t246 - t261*t277
-    t280 = t247 - t262*t277
-    t281 = t248 - t263*t277
-    t282 = t249 - t264*t277
-    t283 = t260*(t253 + t261*t254 + t262*t255 + t263*t256 + t264*t257)
-    t284 = -t283 + t253
-    t285 = t254 - t261*t283
-    t286 = t255 - t262*t283
-    t287 = t256 - t263*t283
-    t288 = t257 - t264*t283
-    t289 = t260*(t219 + t261*t220 + t262*t221 + t263*t222 + t264*t223)
-    t290 = -t289 + t219
-    t291 = t220 - t261*t289
-    t292 = t221 - t262*t289
-    t293 = t222 - t263*t289
-    t294 = t223 - t264*t289
-    t295 = casadi.sqrt(t267**2 + t268**2 + t269**2 + t270**2)
-    t296 = t295*casadi.if_else((t267 >= 0), 1, -1)
-    t297 = (t295 > 0)
-    t298 = casadi.if_else(t297, 1/(t267 + t296), 0)
-    t299 = casadi.if_else(t297, 1 + casadi.fabs(t267)/t295, 0)
-    t300 = t268*t298
-    t301 = t269*t298
-    t302 = t270*t298
-    t303 = t299*(t273 + t300*t274 + t301*t275 + t302*t276)
-    t304 = -t303 + t273
-    t305 = t274 - t300*t303
-    t306 = t275 - t301*t303
-    t307 = t276 - t302*t303
-    t308 = t299*(t279 + t300*t280 + t301*t281 + t302*t282)
-    t309 = -t308 + t279
-    t310 = t280 - t300*t308
-    t311 = t281 - t301*t308
-    t312 = t282 - t302*t308
-    t313 = t299*(t285 + t300*t286 + t301*t287 + t302*t288)
-    t314 = -t313 + t285
-    t315 = t286 - t300*t313
-    t316 = t287 - t301*t313
-    t317 = t288 - t302*t313
-    t318 = t299*(t291 + t300*t292 + t301*t293 + t302*t294)
-    t319 = -t318 + t291
-    t320 = t292 - t300*t318
-    t321 = t293 - t301*t318
-    t322 = t294 - t302*t318
-    t323 = casadi.sqrt(t305**2 + t306**2 + t307**2)
-    t324 = t323*casadi.if_else((t305 >= 0), 1, -1)
-    t325 = (t323 > 0)
-    t326 = casadi.if_else(t325, 1/(t305 + t324), 0)
-    t327 = casadi.if_else(t325, 1 + casadi.fabs(t305)/t323, 0)
-    t328 = t306*t326
-    t329 = t307*t326
-    t330 = t327*(t310 + t328*t311 + t329*t312)
-    t331 = -t330 + t310
-    t332 = t311 - t328*t330
-    t333 = t312 - t329*t330
-    t334 = t327*(t315 + t328*t316 + t329*t317)
-    t335 = -t334 + t315
-    t336 = t316 - t328*t334
-    t337 = t317 - t329*t334
-    t338 = t327*(t320 + t328*t321 + t329*t322)
-    t339 = -t338 + t320
-    t340 = t321 - t328*t338
-    t341 = t322 - t329*t338
-    t342 = casadi.sqrt(t332**2 + t333**2)
-    t343 = t342*casadi.if_else((t332 >= 0), 1, -1)
-    t344 = (t342 > 0)
-    t345 = casadi.if_else(t344, 1/(t332 + t343), 0)
-    t346 = casadi.if_else(t344, 1 + casadi.fabs(t332)/t342, 0)
-    t347 = t333*t345
-    t348 = t346*(t336 + t347*t337)
-    t349 = -t348 + t336
-    t350 = t337 - t347*t348
-    t351 = t346*(t340 + t347*t341)
-    t352 = -t351 + t340
-    t353 = t341 - t347*t351
-    t354 = casadi.fabs(t350)
-    t355 = t354*casadi.if_else((t350 >= 0), 1, -1)
-    t356 = casadi.if_else((t354 > 0), 2, 0)
-    t357 = t353 - t353*t356
-    t358 = casadi.if_else((t355 != 0), -t357/t355, 0)
-    t359 = casadi.if_else((t343 != 0), -(t352 - t349*t358)/t343, 0)
-    t360 = casadi.if_else((t324 != 0), -(-(t331*t359 + t335*t358) + t339)/t324, 0)
-    t361 = casadi.if_else((t296 != 0), -(-(t304*t360 + t309*t359 + t314*t358) + t319)/t296, 0)
-    t362 = casadi.if_else((t225 != 0), -(-(t266*t361 + t272*t360 + t278*t359 + t284*t358) + t290)/t225, 0)
-    t363 = casadi.if_else((t200 != 0), -(-(t211*t362 + t228*t361 + t236*t360 + t244*t359 + t252*t358) + t218)/t200, 0)
-    t364 = 0.9999999550000004*t358 - 0.00029999999550000005*t359 + q1 - t120*t363 + 0.9999999550000004*t89*t362 + 0.00029999999550000005*t89*t361
-    t365 = q2 + t121*t363 + t127*t362 - t101*t361 - t6*t360 + t8*t359 + t9*t358
-    t366 = q3 + t122*t363 + t128*t362 + t102*t361 + t22*t360 + t23*t359 + t24*t358
-    t367 = q4 + t123*t363 + t129*t362 + t103*t361 + t37*t360 + t38*t359 + t39*t358
-    t368 = q5 + t124*t363 + t130*t362 + t104*t361 + t52*t360 + t53*t359 + t54*t358
-    t369 = q6 + t125*t363 + t131*t362 + t105*t361 + t67*t360 + t68*t359 + t69*t358
-    t370 = q7 + t126*t363 + t132*t362 + t106*t361 + t82*t360 + t93*t359 + t112*t358
+    t198 = _symmetric_solve6(1, (damping + t133, t173, t176, t134, t177, t174, damping + t179, t180, t135, t183, t136, damping + t181, t107, t108, t184, damping + t91, t109, t137, damping + t110, t138, damping + t139, t92, t111, t140, t194, t195, t196,))
+    t199 = t198[5]
+    t200 = t198[4]
+    t201 = t198[0]
+    t202 = t198[1]
+    t203 = t198[2]
+    t204 = 0.9999999550000004*t199 - 0.00029999999550000005*t200 + q1 - t201*t120 + 0.9999999550000004*t89*t202 + 0.00029999999550000005*t89*t203
+    t205 = t198[3]
+    t206 = q2 + t201*t121 + t202*t127 - t203*t101 - t6*t205 + t8*t200 + t9*t199
+    t207 = q3 + t203*t102 + t201*t122 + t202*t128 + t22*t205 + t23*t200 + t24*t199
+    t208 = q4 + t201*t123 + t202*t129 + t203*t103 + t37*t205 + t38*t200 + t39*t199
+    t209 = q5 + t201*t124 + t202*t130 + t203*t104 + t52*t205 + t53*t200 + t54*t199
+    t210 = q6 + t203*t105 + t201*t125 + t202*t131 + t67*t205 + t68*t200 + t69*t199
+    t211 = q7 + t93*t200 + t203*t106 + t201*t126 + t202*t132 + t82*t205 + t112*t199
     q_start = casadi.SX(7, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -7438,13 +6962,13 @@ def _ik_numeric_step(target, q, damping):
     q_start[5, 0] = q6
     q_start[6, 0] = q7
     q_next = casadi.SX(7, 1)
-    q_next[0, 0] = casadi.if_else((t364 < -2.8973), -2.8973, casadi.if_else((t364 > 2.8973), 2.8973, t364))
-    q_next[1, 0] = casadi.if_else((t365 < -1.7628), -1.7628, casadi.if_else((t365 > 1.7628), 1.7628, t365))
-    q_next[2, 0] = casadi.if_else((t366 < -2.8973), -2.8973, casadi.if_else((t366 > 2.8973), 2.8973, t366))
-    q_next[3, 0] = casadi.if_else((t367 < -3.0718), -3.0718, casadi.if_else((t367 > -0.0698), -0.0698, t367))
-    q_next[4, 0] = casadi.if_else((t368 < -2.8973), -2.8973, casadi.if_else((t368 > 2.8973), 2.8973, t368))
-    q_next[5, 0] = casadi.if_else((t369 < -0.0175), -0.0175, casadi.if_else((t369 > 3.7525), 3.7525, t369))
-    q_next[6, 0] = casadi.if_else((t370 < -2.8973), -2.8973, casadi.if_else((t370 > 2.8973), 2.8973, t370))
+    q_next[0, 0] = casadi.if_else((t204 < -2.8973), -2.8973, casadi.if_else((t204 > 2.8973), 2.8973, t204))
+    q_next[1, 0] = casadi.if_else((t206 < -1.7628), -1.7628, casadi.if_else((t206 > 1.7628), 1.7628, t206))
+    q_next[2, 0] = casadi.if_else((t207 < -2.8973), -2.8973, casadi.if_else((t207 > 2.8973), 2.8973, t207))
+    q_next[3, 0] = casadi.if_else((t208 < -3.0718), -3.0718, casadi.if_else((t208 > -0.0698), -0.0698, t208))
+    q_next[4, 0] = casadi.if_else((t209 < -2.8973), -2.8973, casadi.if_else((t209 > 2.8973), 2.8973, t209))
+    q_next[5, 0] = casadi.if_else((t210 < -0.0175), -0.0175, casadi.if_else((t210 > 3.7525), 3.7525, t210))
+    q_next[6, 0] = casadi.if_else((t211 < -2.8973), -2.8973, casadi.if_else((t211 > 2.8973), 2.8973, t211))
     cost = casadi.SX(1, 1)
     cost[0, 0] = casadi.if_else((casadi.fabs(t7) < casadi.inf), t197, -1)
     return [q_start, q_next, cost]

@@ -12,46 +12,46 @@
 typedef struct { planar_2r_real w[36]; } jacgen_jacobi3_columns_2_state;
 
 /* One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V: 412 operations a run. */
-static jacgen_jacobi3_columns_2_state jacgen_jacobi3_columns_2(int count, jacgen_jacobi3_columns_2_state state)
+static void jacgen_jacobi3_columns_2(int count, jacgen_jacobi3_columns_2_state *state)
 {
     JACGEN_KERNEL_LOOP
     for (int run = 0; run < count; run++) {
-        const planar_2r_real w0 = state.w[0];
-        const planar_2r_real w1 = state.w[1];
-        const planar_2r_real w2 = state.w[2];
-        const planar_2r_real w3 = state.w[3];
-        const planar_2r_real w4 = state.w[4];
-        const planar_2r_real w5 = state.w[5];
-        const planar_2r_real w6 = state.w[6];
-        const planar_2r_real w7 = state.w[7];
-        const planar_2r_real w8 = state.w[8];
-        const planar_2r_real w9 = state.w[9];
-        const planar_2r_real w10 = state.w[10];
-        const planar_2r_real w11 = state.w[11];
-        const planar_2r_real w12 = state.w[12];
-        const planar_2r_real w13 = state.w[13];
-        const planar_2r_real w14 = state.w[14];
-        const planar_2r_real w15 = state.w[15];
-        const planar_2r_real w16 = state.w[16];
-        const planar_2r_real w17 = state.w[17];
-        const planar_2r_real w18 = state.w[18];
-        const planar_2r_real w19 = state.w[19];
-        const planar_2r_real w20 = state.w[20];
-        const planar_2r_real w21 = state.w[21];
-        const planar_2r_real w22 = state.w[22];
-        const planar_2r_real w23 = state.w[23];
-        const planar_2r_real w24 = state.w[24];
-        const planar_2r_real w25 = state.w[25];
-        const planar_2r_real w26 = state.w[26];
-        const planar_2r_real w27 = state.w[27];
-        const planar_2r_real w28 = state.w[28];
-        const planar_2r_real w29 = state.w[29];
-        const planar_2r_real w30 = state.w[30];
-        const planar_2r_real w31 = state.w[31];
-        const planar_2r_real w32 = state.w[32];
-        const planar_2r_real w33 = state.w[33];
-        const planar_2r_real w34 = state.w[34];
-        const planar_2r_real w35 = state.w[35];
+        const planar_2r_real w0 = state->w[0];
+        const planar_2r_real w1 = state->w[1];
+        const planar_2r_real w2 = state->w[2];
+        const planar_2r_real w3 = state->w[3];
+        const planar_2r_real w4 = state->w[4];
+        const planar_2r_real w5 = state->w[5];
+        const planar_2r_real w6 = state->w[6];
+        const planar_2r_real w7 = state->w[7];
+        const planar_2r_real w8 = state->w[8];
+        const planar_2r_real w9 = state->w[9];
+        const planar_2r_real w10 = state->w[10];
+        const planar_2r_real w11 = state->w[11];
+        const planar_2r_real w12 = state->w[12];
+        const planar_2r_real w13 = state->w[13];
+        const planar_2r_real w14 = state->w[14];
+        const planar_2r_real w15 = state->w[15];
+        const planar_2r_real w16 = state->w[16];
+        const planar_2r_real w17 = state->w[17];
+        const planar_2r_real w18 = state->w[18];
+        const planar_2r_real w19 = state->w[19];
+        const planar_2r_real w20 = state->w[20];
+        const planar_2r_real w21 = state->w[21];
+        const planar_2r_real w22 = state->w[22];
+        const planar_2r_real w23 = state->w[23];
+        const planar_2r_real w24 = state->w[24];
+        const planar_2r_real w25 = state->w[25];
+        const planar_2r_real w26 = state->w[26];
+        const planar_2r_real w27 = state->w[27];
+        const planar_2r_real w28 = state->w[28];
+        const planar_2r_real w29 = state->w[29];
+        const planar_2r_real w30 = state->w[30];
+        const planar_2r_real w31 = state->w[31];
+        const planar_2r_real w32 = state->w[32];
+        const planar_2r_real w33 = state->w[33];
+        const planar_2r_real w34 = state->w[34];
+        const planar_2r_real w35 = state->w[35];
         const planar_2r_real t0 = (w0*w0) + (w1*w1) + (w2*w2);
         const planar_2r_real t1 = (w3*w3) + (w4*w4) + (w5*w5);
         const planar_2r_real t2 = (w6*w6) + (w7*w7) + (w8*w8);
@@ -258,44 +258,118 @@ static jacgen_jacobi3_columns_2_state jacgen_jacobi3_columns_2(int count, jacgen
         const planar_2r_real t203 = t82*t157;
         const planar_2r_real t204 = t202 - t156*t203;
         const planar_2r_real t205 = t203 + t156*t202;
-        state.w[0] = t160;
-        state.w[1] = t164;
-        state.w[2] = t168;
-        state.w[3] = t161;
-        state.w[4] = t165;
-        state.w[5] = t169;
-        state.w[6] = t99;
-        state.w[7] = t103;
-        state.w[8] = t107;
-        state.w[9] = t184;
-        state.w[10] = t188;
-        state.w[11] = t192;
-        state.w[12] = t185;
-        state.w[13] = t189;
-        state.w[14] = t193;
-        state.w[15] = t126;
-        state.w[16] = t130;
-        state.w[17] = t134;
-        state.w[18] = t172;
-        state.w[19] = t176;
-        state.w[20] = t180;
-        state.w[21] = t173;
-        state.w[22] = t177;
-        state.w[23] = t181;
-        state.w[24] = t114;
-        state.w[25] = t118;
-        state.w[26] = t122;
-        state.w[27] = t196;
-        state.w[28] = t200;
-        state.w[29] = t204;
-        state.w[30] = t197;
-        state.w[31] = t201;
-        state.w[32] = t205;
-        state.w[33] = t141;
-        state.w[34] = t145;
-        state.w[35] = t149;
+        state->w[0] = t160;
+        state->w[1] = t164;
+        state->w[2] = t168;
+        state->w[3] = t161;
+        state->w[4] = t165;
+        state->w[5] = t169;
+        state->w[6] = t99;
+        state->w[7] = t103;
+        state->w[8] = t107;
+        state->w[9] = t184;
+        state->w[10] = t188;
+        state->w[11] = t192;
+        state->w[12] = t185;
+        state->w[13] = t189;
+        state->w[14] = t193;
+        state->w[15] = t126;
+        state->w[16] = t130;
+        state->w[17] = t134;
+        state->w[18] = t172;
+        state->w[19] = t176;
+        state->w[20] = t180;
+        state->w[21] = t173;
+        state->w[22] = t177;
+        state->w[23] = t181;
+        state->w[24] = t114;
+        state->w[25] = t118;
+        state->w[26] = t122;
+        state->w[27] = t196;
+        state->w[28] = t200;
+        state->w[29] = t204;
+        state->w[30] = t197;
+        state->w[31] = t201;
+        state->w[32] = t205;
+        state->w[33] = t141;
+        state->w[34] = t145;
+        state->w[35] = t149;
     }
-    return state;
+}
+
+typedef struct { planar_2r_real w[5]; } jacgen_symmetric_solve2_state;
+
+/* X solving a symmetric 2 x 2 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular: 53 operations a run. */
+static void jacgen_symmetric_solve2(int count, jacgen_symmetric_solve2_state *state)
+{
+    JACGEN_KERNEL_LOOP
+    for (int run = 0; run < count; run++) {
+        const planar_2r_real w0 = state->w[0];
+        const planar_2r_real w1 = state->w[1];
+        const planar_2r_real w2 = state->w[2];
+        const planar_2r_real w3 = state->w[3];
+        const planar_2r_real w4 = state->w[4];
+        const planar_2r_real t0 = (w1*w1);
+        const planar_2r_real t1 = (w0*w0);
+        const planar_2r_real t2 = sqrt(2*t0 + t1 + (w2*w2));
+        const planar_2r_real t3 = sqrt(t0 + t1);
+        const planar_2r_real t4 = t3*(w0 >= 0 ? 1 : -1);
+        const int t5 = t3 > 0;
+        const planar_2r_real t6 = (t5 ? 1.0/(w0 + t4) : 0);
+        const planar_2r_real t7 = (t5 ? 1 + fabs(w0)/t3 : 0);
+        const planar_2r_real t8 = w1*t6;
+        const planar_2r_real t9 = t7*(w1 + t8*w2);
+        const planar_2r_real t10 = -t9 + w1;
+        const planar_2r_real t11 = w2 - t8*t9;
+        const planar_2r_real t12 = t7*(w3 + t8*w4);
+        const planar_2r_real t13 = -t12 + w3;
+        const planar_2r_real t14 = w4 - t8*t12;
+        const planar_2r_real t15 = fabs(t11);
+        const planar_2r_real t16 = t15*(t11 >= 0 ? 1 : -1);
+        const planar_2r_real t17 = (t15 > 0 ? 2 : 0);
+        const planar_2r_real t18 = t14 - t14*t17;
+        const planar_2r_real t19 = (t16 != 0 ? -t18/t16 : 0);
+        const planar_2r_real t20 = (t4 != 0 ? -(t13 - t10*t19)/t4 : 0);
+        const planar_2r_real t21 = 1e-12*t2;
+        state->w[0] = t20;
+        state->w[1] = t19;
+        state->w[2] = ((t3 <= t21) || (t15 <= t21) ? 1 : 0);
+    }
+}
+
+typedef struct { planar_2r_real w[11]; } jacgen_nearer_branch_state;
+
+/* The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents: 28 operations a run. */
+static void jacgen_nearer_branch(int count, jacgen_nearer_branch_state *state)
+{
+    JACGEN_KERNEL_LOOP
+    for (int run = 0; run < count; run++) {
+        const planar_2r_real w0 = state->w[0];
+        const planar_2r_real w1 = state->w[1];
+        const planar_2r_real w2 = state->w[2];
+        const planar_2r_real w3 = state->w[3];
+        const planar_2r_real w4 = state->w[4];
+        const planar_2r_real w5 = state->w[5];
+        const planar_2r_real w6 = state->w[6];
+        const planar_2r_real w7 = state->w[7];
+        const planar_2r_real w8 = state->w[8];
+        const planar_2r_real w9 = state->w[9];
+        const planar_2r_real w10 = state->w[10];
+        const planar_2r_real t0 = w0 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(-w0 + w3));
+        const planar_2r_real t1 = w1 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(-w1 + w4));
+        const planar_2r_real t2 = w5*((-w3 + t0)*(-w3 + t0)) + w6*((-w4 + t1)*(-w4 + t1));
+        const int t3 = w2 > 0;
+        const planar_2r_real t4 = (t3 && ((w10 < 1) || (t2 < w9)) ? 1 : 0);
+        const planar_2r_real t5 = (t3 ? 1 : w10);
+        const int t6 = t4 > 0;
+        const planar_2r_real t7 = (t6 ? t0 : w7);
+        const planar_2r_real t8 = (t6 ? t1 : w8);
+        const planar_2r_real t9 = (t6 ? t2 : w9);
+        state->w[0] = t7;
+        state->w[1] = t8;
+        state->w[2] = t9;
+        state->w[3] = t5;
+    }
 }
 
 void planar_2r_fk(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real T[16])
@@ -929,7 +1003,8 @@ void planar_2r_velocity_ellipsoid(const planar_2r_real q[PLANAR_2R_DOF], planar_
     const planar_2r_real t10 = c12 + t7*t8;
     const planar_2r_real t11 = fabs(t10);
     const planar_2r_real t12 = t11*(t10 >= 0 ? 1 : -1);
-    const jacgen_jacobi3_columns_2_state t13 = jacgen_jacobi3_columns_2(5, (jacgen_jacobi3_columns_2_state){{-t3, 0, 0, t9, -t12, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 0, 0, 0, 1, 0, 0, 0, 1}});
+    jacgen_jacobi3_columns_2_state t13 = {{-t3, 0, 0, t9, -t12, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 0, 0, 0, 1, 0, 0, 0, 1}};
+    jacgen_jacobi3_columns_2(5, &t13);
     const planar_2r_real t14 = sqrt((t13.w[0]*t13.w[0]) + (t13.w[1]*t13.w[1]) + (t13.w[2]*t13.w[2]));
     const planar_2r_real t15 = sqrt((t13.w[3]*t13.w[3]) + (t13.w[4]*t13.w[4]) + (t13.w[5]*t13.w[5]));
     const planar_2r_real t16 = sqrt((t13.w[6]*t13.w[6]) + (t13.w[7]*t13.w[7]) + (t13.w[8]*t13.w[8]));
@@ -1129,63 +1204,43 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const planar_2r_real t7 = (t1 <= 0 ? 1 : -1)*t6;
     const planar_2r_real t8 = (c12*c12) + t5;
     const planar_2r_real t9 = sqrt(t4 + t8);
-    const planar_2r_real t10 = (t2*t2);
-    const planar_2r_real t11 = (damping*damping);
-    const planar_2r_real t12 = t4 + t11;
-    const planar_2r_real t13 = (t12*t12);
-    const planar_2r_real t14 = sqrt(t10 + t13);
-    const planar_2r_real t15 = t14*(t12 >= 0 ? 1 : -1);
-    const planar_2r_real t16 = t8 + t11;
-    const planar_2r_real t17 = sqrt(2*t10 + t13 + (t16*t16));
-    const int t18 = t14 > 0;
-    const planar_2r_real t19 = (t18 ? 1.0/(t12 + t15) : 0);
-    const planar_2r_real t20 = (t18 ? 1 + fabs(t12)/t14 : 0);
-    const planar_2r_real t21 = t2*t19;
-    const planar_2r_real t22 = -t20*(t2 + t16*t21);
-    const planar_2r_real t23 = t2 + t22;
-    const planar_2r_real t24 = t16 + t21*t22;
-    const planar_2r_real t25 = t20*(mu_dot0 - t21*mu_dot1);
-    const planar_2r_real t26 = -t25 + mu_dot0;
-    const planar_2r_real t27 = mu_dot1 + t21*t25;
-    const planar_2r_real t28 = fabs(t24);
-    const planar_2r_real t29 = t28*(t24 >= 0 ? 1 : -1);
-    const planar_2r_real t30 = (t28 > 0 ? 2 : 0);
-    const planar_2r_real t31 = t27 - t27*t30;
-    const planar_2r_real t32 = (t29 != 0 ? -t31/t29 : 0);
-    const planar_2r_real t33 = (t15 != 0 ? -(t26 + t23*t32)/t15 : 0);
-    const planar_2r_real t34 = -t1*t33 + t0*t32;
-    const planar_2r_real t35 = -s12*t33 + c12*t32;
-    const int t36 = t6 > 0;
-    const planar_2r_real t37 = (t36 ? 1 + fabs(t1)/t6 : 0);
-    const planar_2r_real t38 = -t1;
-    const planar_2r_real t39 = (t36 ? 1.0/(t38 + t7) : 0);
-    const planar_2r_real t40 = -s12;
-    const planar_2r_real t41 = q1 + q2 + c12 + t0 + t38 + t40 + mu_dot0 + mu_dot1 + damping;
-    const planar_2r_real t42 = t0*t39;
-    const planar_2r_real t43 = t37*(t40 + c12*t42);
-    const planar_2r_real t44 = s12 + t43;
-    const planar_2r_real t45 = c12 - t42*t43;
-    const planar_2r_real t46 = t37*(mu_dot0 + t42*mu_dot1);
-    const planar_2r_real t47 = -t46 + mu_dot0;
-    const planar_2r_real t48 = mu_dot1 - t42*t46;
-    const planar_2r_real t49 = fabs(t45);
-    const planar_2r_real t50 = t49*(t45 >= 0 ? 1 : -1);
-    const planar_2r_real t51 = (t49 > 0 ? 2 : 0);
-    const planar_2r_real t52 = t48 - t48*t51;
-    const planar_2r_real t53 = (t50 != 0 ? -t52/t50 : 0);
-    const planar_2r_real t54 = (t7 != 0 ? -(t47 + t44*t53)/t7 : 0);
-    const int t55 = isfinite(t41);
-    const int t56 = damping >= 0;
-    const int t57 = damping > 0;
-    const planar_2r_real t58 = 1e-12*t17;
-    const planar_2r_real t59 = 1e-12*t9;
-    const int t60 = (t57 && ((t14 <= t58) || (t28 <= t58))) || (damping <= 0 && ((t6 <= t59) || (t49 <= t59)));
-    const int t61 = t55 && t56 && !t60;
+    const planar_2r_real t10 = (damping*damping);
+    jacgen_symmetric_solve2_state t11 = {{t4 + t10, -t2, t8 + t10, mu_dot0, mu_dot1}};
+    jacgen_symmetric_solve2(1, &t11);
+    const planar_2r_real t12 = t11.w[0];
+    const planar_2r_real t13 = t11.w[1];
+    const planar_2r_real t14 = -t1*t12 + t0*t13;
+    const planar_2r_real t15 = -s12*t12 + c12*t13;
+    const int t16 = t6 > 0;
+    const planar_2r_real t17 = (t16 ? 1 + fabs(t1)/t6 : 0);
+    const planar_2r_real t18 = -t1;
+    const planar_2r_real t19 = (t16 ? 1.0/(t18 + t7) : 0);
+    const planar_2r_real t20 = -s12;
+    const planar_2r_real t21 = q1 + q2 + c12 + t0 + t18 + t20 + mu_dot0 + mu_dot1 + damping;
+    const planar_2r_real t22 = t0*t19;
+    const planar_2r_real t23 = t17*(t20 + c12*t22);
+    const planar_2r_real t24 = s12 + t23;
+    const planar_2r_real t25 = c12 - t22*t23;
+    const planar_2r_real t26 = t17*(mu_dot0 + t22*mu_dot1);
+    const planar_2r_real t27 = -t26 + mu_dot0;
+    const planar_2r_real t28 = mu_dot1 - t22*t26;
+    const planar_2r_real t29 = fabs(t25);
+    const planar_2r_real t30 = t29*(t25 >= 0 ? 1 : -1);
+    const planar_2r_real t31 = (t29 > 0 ? 2 : 0);
+    const planar_2r_real t32 = t28 - t28*t31;
+    const planar_2r_real t33 = (t30 != 0 ? -t32/t30 : 0);
+    const planar_2r_real t34 = (t7 != 0 ? -(t27 + t24*t33)/t7 : 0);
+    const int t35 = isfinite(t21);
+    const int t36 = damping >= 0;
+    const int t37 = damping > 0;
+    const planar_2r_real t38 = 1e-12*t9;
+    const int t39 = (t37 && t11.w[2] > 0) || (damping <= 0 && ((t6 <= t38) || (t29 <= t38)));
+    const int t40 = t35 && t36 && !t39;
 
     /* Outputs */
-    q_dot[0] = (t61 ? (t57 ? t34 : t54) : 0);
-    q_dot[1] = (t61 ? (t57 ? t35 : t53) : 0);
-    return (!(t55 && t56) ? 2 : (t60 ? 1 : 0));
+    q_dot[0] = (t40 ? (t37 ? t14 : t34) : 0);
+    q_dot[1] = (t40 ? (t37 ? t15 : t33) : 0);
+    return (!(t35 && t36) ? 2 : (t39 ? 1 : 0));
 }
 
 int planar_2r_velocity_ik_nullspace(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real mu_dot[PLANAR_2R_TASK_DIM], const planar_2r_real z[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF])
@@ -1217,63 +1272,43 @@ int planar_2r_velocity_ik_nullspace(const planar_2r_real q[PLANAR_2R_DOF], const
     const planar_2r_real t7 = (t1 <= 0 ? 1 : -1)*t6;
     const planar_2r_real t8 = (c12*c12) + t5;
     const planar_2r_real t9 = sqrt(t4 + t8);
-    const planar_2r_real t10 = (t2*t2);
-    const planar_2r_real t11 = (damping*damping);
-    const planar_2r_real t12 = t4 + t11;
-    const planar_2r_real t13 = (t12*t12);
-    const planar_2r_real t14 = sqrt(t10 + t13);
-    const planar_2r_real t15 = t14*(t12 >= 0 ? 1 : -1);
-    const planar_2r_real t16 = t8 + t11;
-    const planar_2r_real t17 = sqrt(2*t10 + t13 + (t16*t16));
-    const int t18 = t14 > 0;
-    const planar_2r_real t19 = (t18 ? 1.0/(t12 + t15) : 0);
-    const planar_2r_real t20 = (t18 ? 1 + fabs(t12)/t14 : 0);
-    const planar_2r_real t21 = t2*t19;
-    const planar_2r_real t22 = -t20*(t2 + t16*t21);
-    const planar_2r_real t23 = t2 + t22;
-    const planar_2r_real t24 = t16 + t21*t22;
-    const planar_2r_real t25 = t20*(mu_dot0 - t21*mu_dot1);
-    const planar_2r_real t26 = -t25 + mu_dot0;
-    const planar_2r_real t27 = mu_dot1 + t21*t25;
-    const planar_2r_real t28 = fabs(t24);
-    const planar_2r_real t29 = t28*(t24 >= 0 ? 1 : -1);
-    const planar_2r_real t30 = (t28 > 0 ? 2 : 0);
-    const planar_2r_real t31 = t27 - t27*t30;
-    const planar_2r_real t32 = (t29 != 0 ? -t31/t29 : 0);
-    const planar_2r_real t33 = (t15 != 0 ? -(t26 + t23*t32)/t15 : 0);
-    const planar_2r_real t34 = -t1*t33 + t0*t32;
-    const planar_2r_real t35 = -s12*t33 + c12*t32;
-    const int t36 = t6 > 0;
-    const planar_2r_real t37 = (t36 ? 1 + fabs(t1)/t6 : 0);
-    const planar_2r_real t38 = -t1;
-    const planar_2r_real t39 = (t36 ? 1.0/(t38 + t7) : 0);
-    const planar_2r_real t40 = -s12;
-    const planar_2r_real t41 = q1 + q2 + c12 + t0 + t38 + t40 + mu_dot0 + mu_dot1 + damping + qz1 + qz2;
-    const planar_2r_real t42 = t0*t39;
-    const planar_2r_real t43 = t37*(t40 + c12*t42);
-    const planar_2r_real t44 = s12 + t43;
-    const planar_2r_real t45 = c12 - t42*t43;
-    const planar_2r_real t46 = t37*(mu_dot0 + t42*mu_dot1);
-    const planar_2r_real t47 = -t46 + mu_dot0;
-    const planar_2r_real t48 = mu_dot1 - t42*t46;
-    const planar_2r_real t49 = fabs(t45);
-    const planar_2r_real t50 = t49*(t45 >= 0 ? 1 : -1);
-    const planar_2r_real t51 = (t49 > 0 ? 2 : 0);
-    const planar_2r_real t52 = t48 - t48*t51;
-    const planar_2r_real t53 = (t50 != 0 ? -t52/t50 : 0);
-    const planar_2r_real t54 = (t7 != 0 ? -(t47 + t44*t53)/t7 : 0);
-    const int t55 = isfinite(t41);
-    const int t56 = damping >= 0;
-    const int t57 = damping > 0;
-    const planar_2r_real t58 = 1e-12*t17;
-    const planar_2r_real t59 = 1e-12*t9;
-    const int t60 = (t57 && ((t14 <= t58) || (t28 <= t58))) || (damping <= 0 && ((t6 <= t59) || (t49 <= t59)));
-    const int t61 = t55 && t56 && !t60;
+    const planar_2r_real t10 = (damping*damping);
+    jacgen_symmetric_solve2_state t11 = {{t4 + t10, -t2, t8 + t10, mu_dot0, mu_dot1}};
+    jacgen_symmetric_solve2(1, &t11);
+    const planar_2r_real t12 = t11.w[0];
+    const planar_2r_real t13 = t11.w[1];
+    const planar_2r_real t14 = -t1*t12 + t0*t13;
+    const planar_2r_real t15 = -s12*t12 + c12*t13;
+    const int t16 = t6 > 0;
+    const planar_2r_real t17 = (t16 ? 1 + fabs(t1)/t6 : 0);
+    const planar_2r_real t18 = -t1;
+    const planar_2r_real t19 = (t16 ? 1.0/(t18 + t7) : 0);
+    const planar_2r_real t20 = -s12;
+    const planar_2r_real t21 = q1 + q2 + c12 + t0 + t18 + t20 + mu_dot0 + mu_dot1 + damping + qz1 + qz2;
+    const planar_2r_real t22 = t0*t19;
+    const planar_2r_real t23 = t17*(t20 + c12*t22);
+    const planar_2r_real t24 = s12 + t23;
+    const planar_2r_real t25 = c12 - t22*t23;
+    const planar_2r_real t26 = t17*(mu_dot0 + t22*mu_dot1);
+    const planar_2r_real t27 = -t26 + mu_dot0;
+    const planar_2r_real t28 = mu_dot1 - t22*t26;
+    const planar_2r_real t29 = fabs(t25);
+    const planar_2r_real t30 = t29*(t25 >= 0 ? 1 : -1);
+    const planar_2r_real t31 = (t29 > 0 ? 2 : 0);
+    const planar_2r_real t32 = t28 - t28*t31;
+    const planar_2r_real t33 = (t30 != 0 ? -t32/t30 : 0);
+    const planar_2r_real t34 = (t7 != 0 ? -(t27 + t24*t33)/t7 : 0);
+    const int t35 = isfinite(t21);
+    const int t36 = damping >= 0;
+    const int t37 = damping > 0;
+    const planar_2r_real t38 = 1e-12*t9;
+    const int t39 = (t37 && t11.w[2] > 0) || (damping <= 0 && ((t6 <= t38) || (t29 <= t38)));
+    const int t40 = t35 && t36 && !t39;
 
     /* Outputs */
-    q_dot[0] = (t61 ? (t57 ? t34 : t54) : 0);
-    q_dot[1] = (t61 ? (t57 ? t35 : t53) : 0);
-    return (!(t55 && t56) ? 2 : (t60 ? 1 : 0));
+    q_dot[0] = (t40 ? (t37 ? t14 : t34) : 0);
+    q_dot[1] = (t40 ? (t37 ? t15 : t33) : 0);
+    return (!(t35 && t36) ? 2 : (t39 ? 1 : 0));
 }
 
 int planar_2r_resolved_rate(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real target_rate[PLANAR_2R_TASK_DIM], const planar_2r_real gain[PLANAR_2R_TASK_DIM], const planar_2r_real z[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF])
@@ -1310,69 +1345,49 @@ int planar_2r_resolved_rate(const planar_2r_real q[PLANAR_2R_DOF], const planar_
     const planar_2r_real t8 = (t1 <= 0 ? 1 : -1)*t7;
     const planar_2r_real t9 = (c12*c12) + t6;
     const planar_2r_real t10 = sqrt(t5 + t9);
-    const planar_2r_real t11 = (t2*t2);
-    const planar_2r_real t12 = (damping*damping);
-    const planar_2r_real t13 = t5 + t12;
-    const planar_2r_real t14 = (t13*t13);
-    const planar_2r_real t15 = sqrt(t11 + t14);
-    const planar_2r_real t16 = t15*(t13 >= 0 ? 1 : -1);
-    const planar_2r_real t17 = t9 + t12;
-    const planar_2r_real t18 = sqrt(2*t11 + t14 + (t17*t17));
-    const int t19 = t15 > 0;
-    const planar_2r_real t20 = (t19 ? 1.0/(t13 + t16) : 0);
-    const planar_2r_real t21 = (t19 ? 1 + fabs(t13)/t15 : 0);
-    const planar_2r_real t22 = t2*t20;
-    const planar_2r_real t23 = -t21*(t2 + t17*t22);
-    const planar_2r_real t24 = t2 + t23;
-    const planar_2r_real t25 = t17 + t22*t23;
-    const planar_2r_real t26 = fabs(t25);
-    const planar_2r_real t27 = t26*(t25 >= 0 ? 1 : -1);
-    const planar_2r_real t28 = (t26 > 0 ? 2 : 0);
-    const int t29 = t7 > 0;
-    const planar_2r_real t30 = (t29 ? 1 + fabs(t1)/t7 : 0);
-    const planar_2r_real t31 = -t1;
-    const planar_2r_real t32 = (t29 ? 1.0/(t31 + t8) : 0);
-    const planar_2r_real t33 = mu_dot1 + gain1*(t31 + mu1);
-    const planar_2r_real t34 = t21*(t3 - t22*t33);
-    const planar_2r_real t35 = -t34 + t3;
-    const planar_2r_real t36 = t33 + t22*t34;
-    const planar_2r_real t37 = t36 - t28*t36;
-    const planar_2r_real t38 = (t27 != 0 ? -t37/t27 : 0);
-    const planar_2r_real t39 = (t16 != 0 ? -(t35 + t24*t38)/t16 : 0);
-    const planar_2r_real t40 = -t1*t39 + t0*t38;
-    const planar_2r_real t41 = -s12*t39 + c12*t38;
-    const planar_2r_real t42 = -s12;
-    const planar_2r_real t43 = q1 + q2 + c12 + t0 + t31 + t42 + damping + qz1 + qz2 + t3 + t33;
-    const planar_2r_real t44 = t0*t32;
-    const planar_2r_real t45 = t30*(t42 + c12*t44);
-    const planar_2r_real t46 = s12 + t45;
-    const planar_2r_real t47 = c12 - t44*t45;
-    const planar_2r_real t48 = t30*(t3 + t44*t33);
-    const planar_2r_real t49 = -t48 + t3;
-    const planar_2r_real t50 = t33 - t44*t48;
-    const planar_2r_real t51 = fabs(t47);
-    const planar_2r_real t52 = t51*(t47 >= 0 ? 1 : -1);
-    const planar_2r_real t53 = (t51 > 0 ? 2 : 0);
-    const planar_2r_real t54 = t50 - t53*t50;
-    const planar_2r_real t55 = (t52 != 0 ? -t54/t52 : 0);
-    const planar_2r_real t56 = (t8 != 0 ? -(t49 + t46*t55)/t8 : 0);
-    const int t57 = isfinite(t43);
-    const int t58 = damping >= 0;
-    const int t59 = damping > 0;
-    const planar_2r_real t60 = 1e-12*t18;
-    const planar_2r_real t61 = 1e-12*t10;
-    const int t62 = (t59 && ((t15 <= t60) || (t26 <= t60))) || (damping <= 0 && ((t7 <= t61) || (t51 <= t61)));
-    const int t63 = t57 && t58 && !t62;
+    const int t11 = t7 > 0;
+    const planar_2r_real t12 = (t11 ? 1 + fabs(t1)/t7 : 0);
+    const planar_2r_real t13 = -t1;
+    const planar_2r_real t14 = (t11 ? 1.0/(t13 + t8) : 0);
+    const planar_2r_real t15 = mu_dot1 + gain1*(t13 + mu1);
+    const planar_2r_real t16 = -s12;
+    const planar_2r_real t17 = q1 + q2 + c12 + t0 + t13 + t16 + damping + qz1 + qz2 + t3 + t15;
+    const planar_2r_real t18 = t0*t14;
+    const planar_2r_real t19 = t12*(t16 + c12*t18);
+    const planar_2r_real t20 = s12 + t19;
+    const planar_2r_real t21 = c12 - t18*t19;
+    const planar_2r_real t22 = t12*(t3 + t18*t15);
+    const planar_2r_real t23 = -t22 + t3;
+    const planar_2r_real t24 = t15 - t18*t22;
+    const planar_2r_real t25 = fabs(t21);
+    const planar_2r_real t26 = t25*(t21 >= 0 ? 1 : -1);
+    const planar_2r_real t27 = (t25 > 0 ? 2 : 0);
+    const planar_2r_real t28 = t24 - t27*t24;
+    const planar_2r_real t29 = (t26 != 0 ? -t28/t26 : 0);
+    const planar_2r_real t30 = (t8 != 0 ? -(t23 + t20*t29)/t8 : 0);
+    const planar_2r_real t31 = (damping*damping);
+    jacgen_symmetric_solve2_state t32 = {{t5 + t31, -t2, t9 + t31, t3, t15}};
+    jacgen_symmetric_solve2(1, &t32);
+    const planar_2r_real t33 = t32.w[0];
+    const planar_2r_real t34 = t32.w[1];
+    const planar_2r_real t35 = -t1*t33 + t0*t34;
+    const planar_2r_real t36 = -s12*t33 + c12*t34;
+    const int t37 = isfinite(t17);
+    const int t38 = damping >= 0;
+    const int t39 = damping > 0;
+    const planar_2r_real t40 = 1e-12*t10;
+    const int t41 = (t39 && t32.w[2] > 0) || (damping <= 0 && ((t7 <= t40) || (t25 <= t40)));
+    const int t42 = t37 && t38 && !t41;
 
     /* Outputs */
-    q_dot[0] = (t63 ? (t59 ? t40 : t56) : 0);
-    q_dot[1] = (t63 ? (t59 ? t41 : t55) : 0);
-    return (!(t57 && t58) ? 2 : (t62 ? 1 : 0));
+    q_dot[0] = (t42 ? (t39 ? t35 : t30) : 0);
+    q_dot[1] = (t42 ? (t39 ? t36 : t29) : 0);
+    return (!(t37 && t38) ? 2 : (t41 ? 1 : 0));
 }
 
 planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_start[PLANAR_2R_DOF], planar_2r_real q_next[PLANAR_2R_DOF])
 {
-    /* 87 operations */
+    /* 96 operations */
 
     /* Inputs */
     const planar_2r_real mu0 = target[0];
@@ -1398,34 +1413,18 @@ planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_T
     const planar_2r_real t6 = -t1 + mu1;
     const planar_2r_real t7 = (t5*t5) + (t6*t6);
     const planar_2r_real t8 = mu0 + mu1 + qs1 + qs2;
-    const planar_2r_real t9 = damping + t2;
-    const planar_2r_real t10 = sqrt((t9*t9) + (t3*t3));
-    const planar_2r_real t11 = t10*(t9 >= 0 ? 1 : -1);
-    const int t12 = t10 > 0;
-    const planar_2r_real t13 = (t12 ? 1.0/(t9 + t11) : 0);
-    const planar_2r_real t14 = (t12 ? 1 + fabs(t9)/t10 : 0);
-    const planar_2r_real t15 = damping + t4;
-    const planar_2r_real t16 = t3*t13;
-    const planar_2r_real t17 = -t14*(t3 + t15*t16);
-    const planar_2r_real t18 = t3 + t17;
-    const planar_2r_real t19 = t15 + t16*t17;
-    const planar_2r_real t20 = t14*(t5 - t16*t6);
-    const planar_2r_real t21 = -t20 + t5;
-    const planar_2r_real t22 = t6 + t16*t20;
-    const planar_2r_real t23 = fabs(t19);
-    const planar_2r_real t24 = t23*(t19 >= 0 ? 1 : -1);
-    const planar_2r_real t25 = (t23 > 0 ? 2 : 0);
-    const planar_2r_real t26 = t22 - t22*t25;
-    const planar_2r_real t27 = (t24 != 0 ? -t26/t24 : 0);
-    const planar_2r_real t28 = (t11 != 0 ? -(t21 + t18*t27)/t11 : 0);
-    const planar_2r_real t29 = q1 - t1*t28 + t0*t27;
-    const planar_2r_real t30 = q2 - s12*t28 + c12*t27;
+    jacgen_symmetric_solve2_state t9 = {{damping + t2, -t3, damping + t4, t5, t6}};
+    jacgen_symmetric_solve2(1, &t9);
+    const planar_2r_real t10 = t9.w[0];
+    const planar_2r_real t11 = t9.w[1];
+    const planar_2r_real t12 = q1 - t1*t10 + t0*t11;
+    const planar_2r_real t13 = q2 - s12*t10 + c12*t11;
 
     /* Outputs */
     q_start[0] = q1;
     q_start[1] = q2;
-    q_next[0] = t29;
-    q_next[1] = t30;
+    q_next[0] = t12;
+    q_next[1] = t13;
     return (isfinite(t8) ? t7 : -1);
 }
 
@@ -1477,7 +1476,7 @@ void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2
 
 int planar_2r_ik_nearest(const planar_2r_real mu[PLANAR_2R_TASK_DIM], const planar_2r_real q_seed[PLANAR_2R_DOF], const planar_2r_real weights[PLANAR_2R_DOF], planar_2r_real q[PLANAR_2R_DOF])
 {
-    /* 69 operations */
+    /* 72 operations */
     planar_2r_real branches_q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF];
     int branches_valid[PLANAR_2R_MAX_IK_SOLUTIONS];
     int branches_in_limits[PLANAR_2R_MAX_IK_SOLUTIONS];
@@ -1500,36 +1499,19 @@ int planar_2r_ik_nearest(const planar_2r_real mu[PLANAR_2R_TASK_DIM], const plan
     const int lb1 = branches_in_limits[1];
 
     /* Intermediate terms */
-    const planar_2r_real t0 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0;
-    const planar_2r_real t1 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1;
-    const planar_2r_real t2 = (vb0 && lb0 ? 1 : 0);
-    const planar_2r_real t3 = (t2 > 0 ? 1 : 0);
-    const planar_2r_real t4 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0;
-    const planar_2r_real t5 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1;
-    const planar_2r_real t6 = (vb1 && lb1 ? 1 : 0);
-    const planar_2r_real t7 = mu0 + mu1 + qn1 + qn2 + qw1 + qw2;
-    const planar_2r_real t8 = -qn1;
-    const planar_2r_real t9 = -qn2;
-    const planar_2r_real t10 = qw1*((t8 + t0)*(t8 + t0)) + qw2*((t9 + t1)*(t9 + t1));
-    const planar_2r_real t11 = qw1*((t8 + t4)*(t8 + t4)) + qw2*((t9 + t5)*(t9 + t5));
-    const int t12 = t3 > 0;
-    const planar_2r_real t13 = (t12 ? t0 : qn1);
-    const planar_2r_real t14 = (t12 ? t1 : qn2);
-    const planar_2r_real t15 = (t12 ? t10 : 0);
-    const int t16 = t6 > 0;
-    const planar_2r_real t17 = (t16 && ((t3 < 1) || (t11 < t15)) ? 1 : 0);
-    const planar_2r_real t18 = (t16 ? 1 : t3);
-    const int t19 = t17 > 0;
-    const planar_2r_real t20 = (t19 ? t4 : t13);
-    const planar_2r_real t21 = (t19 ? t5 : t14);
-    const int t22 = t18 > 0;
-    const int t23 = isfinite(t7);
-    const int t24 = t22 && t23;
+    const planar_2r_real t0 = mu0 + mu1 + qn1 + qn2 + qw1 + qw2;
+    jacgen_nearer_branch_state t1 = {{qb0_0, qb0_1, (vb0 && lb0 ? 1 : 0), qn1, qn2, qw1, qw2, qn1, qn2, 0, 0}};
+    jacgen_nearer_branch(1, &t1);
+    jacgen_nearer_branch_state t2 = {{qb1_0, qb1_1, (vb1 && lb1 ? 1 : 0), qn1, qn2, qw1, qw2, t1.w[0], t1.w[1], t1.w[2], t1.w[3]}};
+    jacgen_nearer_branch(1, &t2);
+    const int t3 = t2.w[3] > 0;
+    const int t4 = isfinite(t0);
+    const int t5 = t3 && t4;
 
     /* Outputs */
-    q[0] = (t24 ? t20 : qn1);
-    q[1] = (t24 ? t21 : qn2);
-    return (!t23 ? 2 : (t22 ? 0 : 1));
+    q[0] = (t5 ? t2.w[0] : qn1);
+    q[1] = (t5 ? t2.w[1] : qn2);
+    return (!t4 ? 2 : (t3 ? 0 : 1));
 }
 
 int planar_2r_ik(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF])

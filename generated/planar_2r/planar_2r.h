@@ -120,7 +120,7 @@ int planar_2r_velocity_ik_nullspace(const planar_2r_real q[PLANAR_2R_DOF], const
 int planar_2r_resolved_rate(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real target_rate[PLANAR_2R_TASK_DIM], const planar_2r_real gain[PLANAR_2R_TASK_DIM], const planar_2r_real z[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 2; q_next[i], i < 2; returned as a scalar. 87 operations. */
+ * Result: q_start[i], i < 2; q_next[i], i < 2; returned as a scalar. 96 operations. */
 planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_start[PLANAR_2R_DOF], planar_2r_real q_next[PLANAR_2R_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
@@ -128,7 +128,7 @@ planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_T
 void planar_2r_ik_branches(const planar_2r_real mu[PLANAR_2R_TASK_DIM], planar_2r_real q[PLANAR_2R_MAX_IK_SOLUTIONS * PLANAR_2R_DOF], int valid[PLANAR_2R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_2R_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 2; returned as a scalar. 69 operations. */
+ * Result: q[i], i < 2; returned as a scalar. 72 operations. */
 int planar_2r_ik_nearest(const planar_2r_real mu[PLANAR_2R_TASK_DIM], const planar_2r_real q_seed[PLANAR_2R_DOF], const planar_2r_real weights[PLANAR_2R_DOF], planar_2r_real q[PLANAR_2R_DOF]);
 
 /* Statuses of planar_2r_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -82,6 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -327,6 +328,69 @@ def _jacobi3_columns_2(xp, count, state):
             t141,
             t145,
             t149,
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _symmetric_solve2(xp, count, state):
+    """X solving a symmetric 2 x 2 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 53 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, = state
+        t0 = w1**2
+        t1 = w0**2
+        t2 = xp.sqrt(2*t0 + t1 + w2**2)
+        t3 = xp.sqrt(t0 + t1)
+        t4 = t3*xp.where(xp.greater_equal(w0, 0), xp.asarray(1, dtype=dtype), -1)
+        t5 = xp.greater(t3, 0)
+        t6 = xp.where(t5, 1/(w0 + t4), 0)
+        t7 = xp.where(t5, 1 + xp.abs(w0)/t3, 0)
+        t8 = w1*t6
+        t9 = t7*(w1 + t8*w2)
+        t10 = -t9 + w1
+        t11 = w2 - t8*t9
+        t12 = t7*(w3 + t8*w4)
+        t13 = -t12 + w3
+        t14 = w4 - t8*t12
+        t15 = xp.abs(t11)
+        t16 = t15*xp.where(xp.greater_equal(t11, 0), xp.asarray(1, dtype=dtype), -1)
+        t17 = xp.where(xp.greater(t15, 0), xp.asarray(2, dtype=dtype), 0)
+        t18 = t14 - t14*t17
+        t19 = xp.where(xp.not_equal(t16, 0), -t18/t16, 0)
+        t20 = xp.where(xp.not_equal(t4, 0), -(t13 - t10*t19)/t4, 0)
+        t21 = 1e-12*t2
+        state = (
+            t20,
+            t19,
+            xp.where(xp.less_equal(t3, t21) | xp.less_equal(t15, t21), xp.asarray(1, dtype=dtype), 0),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _nearer_branch(xp, count, state):
+    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 28 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, = state
+        t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w3))
+        t1 = w1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w1 + w4))
+        t2 = w5*(-w3 + t0)**2 + w6*(-w4 + t1)**2
+        t3 = xp.greater(w2, 0)
+        t4 = xp.where(t3 & (xp.less(w10, 1) | xp.less(t2, w9)), xp.asarray(1, dtype=dtype), 0)
+        t5 = xp.where(t3, 1, w10)
+        t6 = xp.greater(t4, 0)
+        t7 = xp.where(t6, t0, w7)
+        t8 = xp.where(t6, t1, w8)
+        t9 = xp.where(t6, t2, w9)
+        state = (
+            t7,
+            t8,
+            t9,
+            t5,
         )
     return state
 
@@ -1096,63 +1160,42 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t7 = xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)*t6
     t8 = c12**2 + t5
     t9 = xp.sqrt(t4 + t8)
-    t10 = t2**2
-    t11 = damping**2
-    t12 = t4 + t11
-    t13 = t12**2
-    t14 = xp.sqrt(t10 + t13)
-    t15 = t14*xp.where(xp.greater_equal(t12, 0), xp.asarray(1, dtype=dtype), -1)
-    t16 = t8 + t11
-    t17 = xp.sqrt(2*t10 + t13 + t16**2)
-    t18 = xp.greater(t14, 0)
-    t19 = xp.where(t18, 1/(t12 + t15), 0)
-    t20 = xp.where(t18, 1 + xp.abs(t12)/t14, 0)
-    t21 = t2*t19
-    t22 = -t20*(t2 + t16*t21)
-    t23 = t2 + t22
-    t24 = t16 + t21*t22
-    t25 = t20*(mu_dot0 - t21*mu_dot1)
-    t26 = -t25 + mu_dot0
-    t27 = mu_dot1 + t21*t25
-    t28 = xp.abs(t24)
-    t29 = t28*xp.where(xp.greater_equal(t24, 0), xp.asarray(1, dtype=dtype), -1)
-    t30 = xp.where(xp.greater(t28, 0), xp.asarray(2, dtype=dtype), 0)
-    t31 = t27 - t27*t30
-    t32 = xp.where(xp.not_equal(t29, 0), -t31/t29, 0)
-    t33 = xp.where(xp.not_equal(t15, 0), -(t26 + t23*t32)/t15, 0)
-    t34 = -t1*t33 + t0*t32
-    t35 = -s12*t33 + c12*t32
-    t36 = xp.greater(t6, 0)
-    t37 = xp.where(t36, 1 + xp.abs(t1)/t6, 0)
-    t38 = -t1
-    t39 = xp.where(t36, 1/(t38 + t7), 0)
-    t40 = -s12
-    t41 = q1 + q2 + c12 + t0 + t38 + t40 + mu_dot0 + mu_dot1 + damping
-    t42 = t0*t39
-    t43 = t37*(t40 + c12*t42)
-    t44 = s12 + t43
-    t45 = c12 - t42*t43
-    t46 = t37*(mu_dot0 + t42*mu_dot1)
-    t47 = -t46 + mu_dot0
-    t48 = mu_dot1 - t42*t46
-    t49 = xp.abs(t45)
-    t50 = t49*xp.where(xp.greater_equal(t45, 0), xp.asarray(1, dtype=dtype), -1)
-    t51 = xp.where(xp.greater(t49, 0), xp.asarray(2, dtype=dtype), 0)
-    t52 = t48 - t48*t51
-    t53 = xp.where(xp.not_equal(t50, 0), -t52/t50, 0)
-    t54 = xp.where(xp.not_equal(t7, 0), -(t47 + t44*t53)/t7, 0)
-    t55 = xp.isfinite(t41)
-    t56 = xp.greater_equal(damping, 0)
-    t57 = xp.greater(damping, 0)
-    t58 = 1e-12*t17
-    t59 = 1e-12*t9
-    t60 = (t57 & (xp.less_equal(t14, t58) | xp.less_equal(t28, t58))) | (xp.less_equal(damping, 0) & (xp.less_equal(t6, t59) | xp.less_equal(t49, t59)))
-    t61 = t55 & t56 & xp.logical_not(t60)
+    t10 = damping**2
+    t11 = _symmetric_solve2(xp, 1, (t4 + t10, -t2, t8 + t10, mu_dot0, mu_dot1,))
+    t12 = t11[0]
+    t13 = t11[1]
+    t14 = -t1*t12 + t0*t13
+    t15 = -s12*t12 + c12*t13
+    t16 = xp.greater(t6, 0)
+    t17 = xp.where(t16, 1 + xp.abs(t1)/t6, 0)
+    t18 = -t1
+    t19 = xp.where(t16, 1/(t18 + t7), 0)
+    t20 = -s12
+    t21 = q1 + q2 + c12 + t0 + t18 + t20 + mu_dot0 + mu_dot1 + damping
+    t22 = t0*t19
+    t23 = t17*(t20 + c12*t22)
+    t24 = s12 + t23
+    t25 = c12 - t22*t23
+    t26 = t17*(mu_dot0 + t22*mu_dot1)
+    t27 = -t26 + mu_dot0
+    t28 = mu_dot1 - t22*t26
+    t29 = xp.abs(t25)
+    t30 = t29*xp.where(xp.greater_equal(t25, 0), xp.asarray(1, dtype=dtype), -1)
+    t31 = xp.where(xp.greater(t29, 0), xp.asarray(2, dtype=dtype), 0)
+    t32 = t28 - t28*t31
+    t33 = xp.where(xp.not_equal(t30, 0), -t32/t30, 0)
+    t34 = xp.where(xp.not_equal(t7, 0), -(t27 + t24*t33)/t7, 0)
+    t35 = xp.isfinite(t21)
+    t36 = xp.greater_equal(damping, 0)
+    t37 = xp.greater(damping, 0)
+    t38 = 1e-12*t9
+    t39 = (t37 & xp.greater(t11[2], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t6, t38) | xp.less_equal(t29, t38)))
+    t40 = t35 & t36 & xp.logical_not(t39)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t61, xp.where(t57, t34, t54), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t61, xp.where(t57, t35, t53), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t40, xp.where(t37, t14, t34), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t40, xp.where(t37, t15, t33), 0), batch),  # 1
     ], (2,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t55 & t56), 2, xp.where(t60, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t35 & t36), 2, xp.where(t39, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -1183,63 +1226,42 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     t7 = xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)*t6
     t8 = c12**2 + t5
     t9 = xp.sqrt(t4 + t8)
-    t10 = t2**2
-    t11 = damping**2
-    t12 = t4 + t11
-    t13 = t12**2
-    t14 = xp.sqrt(t10 + t13)
-    t15 = t14*xp.where(xp.greater_equal(t12, 0), xp.asarray(1, dtype=dtype), -1)
-    t16 = t8 + t11
-    t17 = xp.sqrt(2*t10 + t13 + t16**2)
-    t18 = xp.greater(t14, 0)
-    t19 = xp.where(t18, 1/(t12 + t15), 0)
-    t20 = xp.where(t18, 1 + xp.abs(t12)/t14, 0)
-    t21 = t2*t19
-    t22 = -t20*(t2 + t16*t21)
-    t23 = t2 + t22
-    t24 = t16 + t21*t22
-    t25 = t20*(mu_dot0 - t21*mu_dot1)
-    t26 = -t25 + mu_dot0
-    t27 = mu_dot1 + t21*t25
-    t28 = xp.abs(t24)
-    t29 = t28*xp.where(xp.greater_equal(t24, 0), xp.asarray(1, dtype=dtype), -1)
-    t30 = xp.where(xp.greater(t28, 0), xp.asarray(2, dtype=dtype), 0)
-    t31 = t27 - t27*t30
-    t32 = xp.where(xp.not_equal(t29, 0), -t31/t29, 0)
-    t33 = xp.where(xp.not_equal(t15, 0), -(t26 + t23*t32)/t15, 0)
-    t34 = -t1*t33 + t0*t32
-    t35 = -s12*t33 + c12*t32
-    t36 = xp.greater(t6, 0)
-    t37 = xp.where(t36, 1 + xp.abs(t1)/t6, 0)
-    t38 = -t1
-    t39 = xp.where(t36, 1/(t38 + t7), 0)
-    t40 = -s12
-    t41 = q1 + q2 + c12 + t0 + t38 + t40 + mu_dot0 + mu_dot1 + damping + qz1 + qz2
-    t42 = t0*t39
-    t43 = t37*(t40 + c12*t42)
-    t44 = s12 + t43
-    t45 = c12 - t42*t43
-    t46 = t37*(mu_dot0 + t42*mu_dot1)
-    t47 = -t46 + mu_dot0
-    t48 = mu_dot1 - t42*t46
-    t49 = xp.abs(t45)
-    t50 = t49*xp.where(xp.greater_equal(t45, 0), xp.asarray(1, dtype=dtype), -1)
-    t51 = xp.where(xp.greater(t49, 0), xp.asarray(2, dtype=dtype), 0)
-    t52 = t48 - t48*t51
-    t53 = xp.where(xp.not_equal(t50, 0), -t52/t50, 0)
-    t54 = xp.where(xp.not_equal(t7, 0), -(t47 + t44*t53)/t7, 0)
-    t55 = xp.isfinite(t41)
-    t56 = xp.greater_equal(damping, 0)
-    t57 = xp.greater(damping, 0)
-    t58 = 1e-12*t17
-    t59 = 1e-12*t9
-    t60 = (t57 & (xp.less_equal(t14, t58) | xp.less_equal(t28, t58))) | (xp.less_equal(damping, 0) & (xp.less_equal(t6, t59) | xp.less_equal(t49, t59)))
-    t61 = t55 & t56 & xp.logical_not(t60)
+    t10 = damping**2
+    t11 = _symmetric_solve2(xp, 1, (t4 + t10, -t2, t8 + t10, mu_dot0, mu_dot1,))
+    t12 = t11[0]
+    t13 = t11[1]
+    t14 = -t1*t12 + t0*t13
+    t15 = -s12*t12 + c12*t13
+    t16 = xp.greater(t6, 0)
+    t17 = xp.where(t16, 1 + xp.abs(t1)/t6, 0)
+    t18 = -t1
+    t19 = xp.where(t16, 1/(t18 + t7), 0)
+    t20 = -s12
+    t21 = q1 + q2 + c12 + t0 + t18 + t20 + mu_dot0 + mu_dot1 + damping + qz1 + qz2
+    t22 = t0*t19
+    t23 = t17*(t20 + c12*t22)
+    t24 = s12 + t23
+    t25 = c12 - t22*t23
+    t26 = t17*(mu_dot0 + t22*mu_dot1)
+    t27 = -t26 + mu_dot0
+    t28 = mu_dot1 - t22*t26
+    t29 = xp.abs(t25)
+    t30 = t29*xp.where(xp.greater_equal(t25, 0), xp.asarray(1, dtype=dtype), -1)
+    t31 = xp.where(xp.greater(t29, 0), xp.asarray(2, dtype=dtype), 0)
+    t32 = t28 - t28*t31
+    t33 = xp.where(xp.not_equal(t30, 0), -t32/t30, 0)
+    t34 = xp.where(xp.not_equal(t7, 0), -(t27 + t24*t33)/t7, 0)
+    t35 = xp.isfinite(t21)
+    t36 = xp.greater_equal(damping, 0)
+    t37 = xp.greater(damping, 0)
+    t38 = 1e-12*t9
+    t39 = (t37 & xp.greater(t11[2], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t6, t38) | xp.less_equal(t29, t38)))
+    t40 = t35 & t36 & xp.logical_not(t39)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t61, xp.where(t57, t34, t54), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t61, xp.where(t57, t35, t53), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t40, xp.where(t37, t14, t34), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t40, xp.where(t37, t15, t33), 0), batch),  # 1
     ], (2,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t55 & t56), 2, xp.where(t60, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t35 & t36), 2, xp.where(t39, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -1275,70 +1297,49 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t8 = xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)*t7
     t9 = c12**2 + t6
     t10 = xp.sqrt(t5 + t9)
-    t11 = t2**2
-    t12 = damping**2
-    t13 = t5 + t12
-    t14 = t13**2
-    t15 = xp.sqrt(t11 + t14)
-    t16 = t15*xp.where(xp.greater_equal(t13, 0), xp.asarray(1, dtype=dtype), -1)
-    t17 = t9 + t12
-    t18 = xp.sqrt(2*t11 + t14 + t17**2)
-    t19 = xp.greater(t15, 0)
-    t20 = xp.where(t19, 1/(t13 + t16), 0)
-    t21 = xp.where(t19, 1 + xp.abs(t13)/t15, 0)
-    t22 = t2*t20
-    t23 = -t21*(t2 + t17*t22)
-    t24 = t2 + t23
-    t25 = t17 + t22*t23
-    t26 = xp.abs(t25)
-    t27 = t26*xp.where(xp.greater_equal(t25, 0), xp.asarray(1, dtype=dtype), -1)
-    t28 = xp.where(xp.greater(t26, 0), xp.asarray(2, dtype=dtype), 0)
-    t29 = xp.greater(t7, 0)
-    t30 = xp.where(t29, 1 + xp.abs(t1)/t7, 0)
-    t31 = -t1
-    t32 = xp.where(t29, 1/(t31 + t8), 0)
-    t33 = mu_dot1 + gain1*(t31 + mu1)
-    t34 = t21*(t3 - t22*t33)
-    t35 = -t34 + t3
-    t36 = t33 + t22*t34
-    t37 = t36 - t28*t36
-    t38 = xp.where(xp.not_equal(t27, 0), -t37/t27, 0)
-    t39 = xp.where(xp.not_equal(t16, 0), -(t35 + t24*t38)/t16, 0)
-    t40 = -t1*t39 + t0*t38
-    t41 = -s12*t39 + c12*t38
-    t42 = -s12
-    t43 = q1 + q2 + c12 + t0 + t31 + t42 + damping + qz1 + qz2 + t3 + t33
-    t44 = t0*t32
-    t45 = t30*(t42 + c12*t44)
-    t46 = s12 + t45
-    t47 = c12 - t44*t45
-    t48 = t30*(t3 + t44*t33)
-    t49 = -t48 + t3
-    t50 = t33 - t44*t48
-    t51 = xp.abs(t47)
-    t52 = t51*xp.where(xp.greater_equal(t47, 0), xp.asarray(1, dtype=dtype), -1)
-    t53 = xp.where(xp.greater(t51, 0), xp.asarray(2, dtype=dtype), 0)
-    t54 = t50 - t53*t50
-    t55 = xp.where(xp.not_equal(t52, 0), -t54/t52, 0)
-    t56 = xp.where(xp.not_equal(t8, 0), -(t49 + t46*t55)/t8, 0)
-    t57 = xp.isfinite(t43)
-    t58 = xp.greater_equal(damping, 0)
-    t59 = xp.greater(damping, 0)
-    t60 = 1e-12*t18
-    t61 = 1e-12*t10
-    t62 = (t59 & (xp.less_equal(t15, t60) | xp.less_equal(t26, t60))) | (xp.less_equal(damping, 0) & (xp.less_equal(t7, t61) | xp.less_equal(t51, t61)))
-    t63 = t57 & t58 & xp.logical_not(t62)
+    t11 = xp.greater(t7, 0)
+    t12 = xp.where(t11, 1 + xp.abs(t1)/t7, 0)
+    t13 = -t1
+    t14 = xp.where(t11, 1/(t13 + t8), 0)
+    t15 = mu_dot1 + gain1*(t13 + mu1)
+    t16 = -s12
+    t17 = q1 + q2 + c12 + t0 + t13 + t16 + damping + qz1 + qz2 + t3 + t15
+    t18 = t0*t14
+    t19 = t12*(t16 + c12*t18)
+    t20 = s12 + t19
+    t21 = c12 - t18*t19
+    t22 = t12*(t3 + t18*t15)
+    t23 = -t22 + t3
+    t24 = t15 - t18*t22
+    t25 = xp.abs(t21)
+    t26 = t25*xp.where(xp.greater_equal(t21, 0), xp.asarray(1, dtype=dtype), -1)
+    t27 = xp.where(xp.greater(t25, 0), xp.asarray(2, dtype=dtype), 0)
+    t28 = t24 - t27*t24
+    t29 = xp.where(xp.not_equal(t26, 0), -t28/t26, 0)
+    t30 = xp.where(xp.not_equal(t8, 0), -(t23 + t20*t29)/t8, 0)
+    t31 = damping**2
+    t32 = _symmetric_solve2(xp, 1, (t5 + t31, -t2, t9 + t31, t3, t15,))
+    t33 = t32[0]
+    t34 = t32[1]
+    t35 = -t1*t33 + t0*t34
+    t36 = -s12*t33 + c12*t34
+    t37 = xp.isfinite(t17)
+    t38 = xp.greater_equal(damping, 0)
+    t39 = xp.greater(damping, 0)
+    t40 = 1e-12*t10
+    t41 = (t39 & xp.greater(t32[2], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t7, t40) | xp.less_equal(t25, t40)))
+    t42 = t37 & t38 & xp.logical_not(t41)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t63, xp.where(t59, t40, t56), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t63, xp.where(t59, t41, t55), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t42, xp.where(t39, t35, t30), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t42, xp.where(t39, t36, t29), 0), batch),  # 1
     ], (2,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t57 & t58), 2, xp.where(t62, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t37 & t38), 2, xp.where(t41, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (2 x 1 and 2 x 1 and 1 x 1), 87 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (2 x 1 and 2 x 1 and 1 x 1), 96 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (2,)), ("q", q, (2,)), ("damping", damping, ()))
     mu0 = target[..., 0]
     mu1 = target[..., 1]
@@ -1361,35 +1362,18 @@ def ik_numeric_step(target, q, damping=0.0):
     t6 = -t1 + mu1
     t7 = t5**2 + t6**2
     t8 = mu0 + mu1 + qs1 + qs2
-    t9 = damping + t2
-    t10 = xp.sqrt(t9**2 + t3**2)
-    t11 = t10*xp.where(xp.greater_equal(t9, 0), xp.asarray(1, dtype=dtype), -1)
-    t12 = xp.greater(t10, 0)
-    t13 = xp.where(t12, 1/(t9 + t11), 0)
-    t14 = xp.where(t12, 1 + xp.abs(t9)/t10, 0)
-    t15 = damping + t4
-    t16 = t3*t13
-    t17 = -t14*(t3 + t15*t16)
-    t18 = t3 + t17
-    t19 = t15 + t16*t17
-    t20 = t14*(t5 - t16*t6)
-    t21 = -t20 + t5
-    t22 = t6 + t16*t20
-    t23 = xp.abs(t19)
-    t24 = t23*xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)
-    t25 = xp.where(xp.greater(t23, 0), xp.asarray(2, dtype=dtype), 0)
-    t26 = t22 - t22*t25
-    t27 = xp.where(xp.not_equal(t24, 0), -t26/t24, 0)
-    t28 = xp.where(xp.not_equal(t11, 0), -(t21 + t18*t27)/t11, 0)
-    t29 = q1 - t1*t28 + t0*t27
-    t30 = q2 - s12*t28 + c12*t27
+    t9 = _symmetric_solve2(xp, 1, (damping + t2, -t3, damping + t4, t5, t6,))
+    t10 = t9[0]
+    t11 = t9[1]
+    t12 = q1 - t1*t10 + t0*t11
+    t13 = q2 - s12*t10 + c12*t11
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
     ], (2,))
     q_next = _stack(xp, [
-        xp.broadcast_to(t29, batch),  # 0
-        xp.broadcast_to(t30, batch),  # 1
+        xp.broadcast_to(t12, batch),  # 0
+        xp.broadcast_to(t13, batch),  # 1
     ], (2,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t8), t7, -1), batch)
     return q_start, q_next, cost
@@ -1445,7 +1429,7 @@ def ik_branches(mu):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (2 x 1 and 1 x 1), 69 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (2 x 1 and 1 x 1), 72 operations."""
     xp, dtype, device, batch, (mu, q_seed, weights,) = _arguments(("mu", mu, (2,)), ("q_seed", q_seed, (2,)), ("weights", weights, (2,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(mu)
     mu0 = mu[..., 0]
@@ -1462,36 +1446,17 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     vb1 = branches_valid[..., 1]
     lb0 = branches_in_limits[..., 0]
     lb1 = branches_in_limits[..., 1]
-    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
-    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
-    t2 = xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0)
-    t3 = xp.where(xp.greater(t2, 0), xp.asarray(1, dtype=dtype), 0)
-    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
-    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
-    t6 = xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0)
-    t7 = mu0 + mu1 + qn1 + qn2 + qw1 + qw2
-    t8 = -qn1
-    t9 = -qn2
-    t10 = qw1*(t8 + t0)**2 + qw2*(t9 + t1)**2
-    t11 = qw1*(t8 + t4)**2 + qw2*(t9 + t5)**2
-    t12 = xp.greater(t3, 0)
-    t13 = xp.where(t12, t0, qn1)
-    t14 = xp.where(t12, t1, qn2)
-    t15 = xp.where(t12, t10, 0)
-    t16 = xp.greater(t6, 0)
-    t17 = xp.where(t16 & (xp.less(t3, 1) | xp.less(t11, t15)), xp.asarray(1, dtype=dtype), 0)
-    t18 = xp.where(t16, 1, t3)
-    t19 = xp.greater(t17, 0)
-    t20 = xp.where(t19, t4, t13)
-    t21 = xp.where(t19, t5, t14)
-    t22 = xp.greater(t18, 0)
-    t23 = xp.isfinite(t7)
-    t24 = t22 & t23
+    t0 = mu0 + mu1 + qn1 + qn2 + qw1 + qw2
+    t1 = _nearer_branch(xp, 1, (qb0_0, qb0_1, xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qw1, qw2, qn1, qn2, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
+    t2 = _nearer_branch(xp, 1, (qb1_0, qb1_1, xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qw1, qw2, t1[0], t1[1], t1[2], t1[3],))
+    t3 = xp.greater(t2[3], 0)
+    t4 = xp.isfinite(t0)
+    t5 = t3 & t4
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t24, t20, qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t24, t21, qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t5, t2[0], qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t5, t2[1], qn2), batch),  # 1
     ], (2,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t23), 2, xp.where(t22, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t4), 2, xp.where(t3, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

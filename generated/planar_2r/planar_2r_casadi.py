@@ -269,6 +269,63 @@ def _jacobi3_columns_2(count, state):
     return state
 
 
+def _symmetric_solve2(count, state):
+    """X solving a symmetric 2 x 2 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 53 operations a run."""
+    for _ in range(count):
+        w0, w1, w2, w3, w4, = state
+        t0 = w1**2
+        t1 = w0**2
+        t2 = casadi.sqrt(2*t0 + t1 + w2**2)
+        t3 = casadi.sqrt(t0 + t1)
+        t4 = t3*casadi.if_else((w0 >= 0), 1, -1)
+        t5 = (t3 > 0)
+        t6 = casadi.if_else(t5, 1/(w0 + t4), 0)
+        t7 = casadi.if_else(t5, 1 + casadi.fabs(w0)/t3, 0)
+        t8 = w1*t6
+        t9 = t7*(w1 + t8*w2)
+        t10 = -t9 + w1
+        t11 = w2 - t8*t9
+        t12 = t7*(w3 + t8*w4)
+        t13 = -t12 + w3
+        t14 = w4 - t8*t12
+        t15 = casadi.fabs(t11)
+        t16 = t15*casadi.if_else((t11 >= 0), 1, -1)
+        t17 = casadi.if_else((t15 > 0), 2, 0)
+        t18 = t14 - t14*t17
+        t19 = casadi.if_else((t16 != 0), -t18/t16, 0)
+        t20 = casadi.if_else((t4 != 0), -(t13 - t10*t19)/t4, 0)
+        t21 = 1e-12*t2
+        state = (
+            t20,
+            t19,
+            casadi.if_else(casadi.logic_or((t3 <= t21), (t15 <= t21)), 1, 0),
+        )
+    return state
+
+
+def _nearer_branch(count, state):
+    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 28 operations a run."""
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, = state
+        t0 = w0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-w0 + w3))
+        t1 = w1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-w1 + w4))
+        t2 = w5*(-w3 + t0)**2 + w6*(-w4 + t1)**2
+        t3 = (w2 > 0)
+        t4 = casadi.if_else(casadi.logic_and(t3, casadi.logic_or((w10 < 1), (t2 < w9))), 1, 0)
+        t5 = casadi.if_else(t3, 1, w10)
+        t6 = (t4 > 0)
+        t7 = casadi.if_else(t6, t0, w7)
+        t8 = casadi.if_else(t6, t1, w8)
+        t9 = casadi.if_else(t6, t2, w9)
+        state = (
+            t7,
+            t8,
+            t9,
+            t5,
+        )
+    return state
+
+
 def _fk(q):
     """Pose of the tool frame in the world frame (4x4 homogeneous): 13 operations."""
     q1 = q[0]
@@ -903,63 +960,42 @@ def _velocity_ik(q, mu_dot, damping):
     t7 = casadi.if_else((t1 <= 0), 1, -1)*t6
     t8 = c12**2 + t5
     t9 = casadi.sqrt(t4 + t8)
-    t10 = t2**2
-    t11 = damping**2
-    t12 = t4 + t11
-    t13 = t12**2
-    t14 = casadi.sqrt(t10 + t13)
-    t15 = t14*casadi.if_else((t12 >= 0), 1, -1)
-    t16 = t8 + t11
-    t17 = casadi.sqrt(2*t10 + t13 + t16**2)
-    t18 = (t14 > 0)
-    t19 = casadi.if_else(t18, 1/(t12 + t15), 0)
-    t20 = casadi.if_else(t18, 1 + casadi.fabs(t12)/t14, 0)
-    t21 = t2*t19
-    t22 = -t20*(t2 + t16*t21)
-    t23 = t2 + t22
-    t24 = t16 + t21*t22
-    t25 = t20*(mu_dot0 - t21*mu_dot1)
-    t26 = -t25 + mu_dot0
-    t27 = mu_dot1 + t21*t25
-    t28 = casadi.fabs(t24)
-    t29 = t28*casadi.if_else((t24 >= 0), 1, -1)
-    t30 = casadi.if_else((t28 > 0), 2, 0)
-    t31 = t27 - t27*t30
-    t32 = casadi.if_else((t29 != 0), -t31/t29, 0)
-    t33 = casadi.if_else((t15 != 0), -(t26 + t23*t32)/t15, 0)
-    t34 = -t1*t33 + t0*t32
-    t35 = -s12*t33 + c12*t32
-    t36 = (t6 > 0)
-    t37 = casadi.if_else(t36, 1 + casadi.fabs(t1)/t6, 0)
-    t38 = -t1
-    t39 = casadi.if_else(t36, 1/(t38 + t7), 0)
-    t40 = -s12
-    t41 = q1 + q2 + c12 + t0 + t38 + t40 + mu_dot0 + mu_dot1 + damping
-    t42 = t0*t39
-    t43 = t37*(t40 + c12*t42)
-    t44 = s12 + t43
-    t45 = c12 - t42*t43
-    t46 = t37*(mu_dot0 + t42*mu_dot1)
-    t47 = -t46 + mu_dot0
-    t48 = mu_dot1 - t42*t46
-    t49 = casadi.fabs(t45)
-    t50 = t49*casadi.if_else((t45 >= 0), 1, -1)
-    t51 = casadi.if_else((t49 > 0), 2, 0)
-    t52 = t48 - t48*t51
-    t53 = casadi.if_else((t50 != 0), -t52/t50, 0)
-    t54 = casadi.if_else((t7 != 0), -(t47 + t44*t53)/t7, 0)
-    t55 = (casadi.fabs(t41) < casadi.inf)
-    t56 = (damping >= 0)
-    t57 = (damping > 0)
-    t58 = 1e-12*t17
-    t59 = 1e-12*t9
-    t60 = casadi.logic_or(casadi.logic_and(t57, casadi.logic_or((t14 <= t58), (t28 <= t58))), casadi.logic_and((damping <= 0), casadi.logic_or((t6 <= t59), (t49 <= t59))))
-    t61 = casadi.logic_and(casadi.logic_and(t55, t56), casadi.logic_not(t60))
+    t10 = damping**2
+    t11 = _symmetric_solve2(1, (t4 + t10, -t2, t8 + t10, mu_dot0, mu_dot1,))
+    t12 = t11[0]
+    t13 = t11[1]
+    t14 = -t1*t12 + t0*t13
+    t15 = -s12*t12 + c12*t13
+    t16 = (t6 > 0)
+    t17 = casadi.if_else(t16, 1 + casadi.fabs(t1)/t6, 0)
+    t18 = -t1
+    t19 = casadi.if_else(t16, 1/(t18 + t7), 0)
+    t20 = -s12
+    t21 = q1 + q2 + c12 + t0 + t18 + t20 + mu_dot0 + mu_dot1 + damping
+    t22 = t0*t19
+    t23 = t17*(t20 + c12*t22)
+    t24 = s12 + t23
+    t25 = c12 - t22*t23
+    t26 = t17*(mu_dot0 + t22*mu_dot1)
+    t27 = -t26 + mu_dot0
+    t28 = mu_dot1 - t22*t26
+    t29 = casadi.fabs(t25)
+    t30 = t29*casadi.if_else((t25 >= 0), 1, -1)
+    t31 = casadi.if_else((t29 > 0), 2, 0)
+    t32 = t28 - t28*t31
+    t33 = casadi.if_else((t30 != 0), -t32/t30, 0)
+    t34 = casadi.if_else((t7 != 0), -(t27 + t24*t33)/t7, 0)
+    t35 = (casadi.fabs(t21) < casadi.inf)
+    t36 = (damping >= 0)
+    t37 = (damping > 0)
+    t38 = 1e-12*t9
+    t39 = casadi.logic_or(casadi.logic_and(t37, (t11[2] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or((t6 <= t38), (t29 <= t38))))
+    t40 = casadi.logic_and(casadi.logic_and(t35, t36), casadi.logic_not(t39))
     q_dot = casadi.SX(2, 1)
-    q_dot[0, 0] = casadi.if_else(t61, casadi.if_else(t57, t34, t54), 0)
-    q_dot[1, 0] = casadi.if_else(t61, casadi.if_else(t57, t35, t53), 0)
+    q_dot[0, 0] = casadi.if_else(t40, casadi.if_else(t37, t14, t34), 0)
+    q_dot[1, 0] = casadi.if_else(t40, casadi.if_else(t37, t15, t33), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t55, t56)), 2, casadi.if_else(t60, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t35, t36)), 2, casadi.if_else(t39, 1, 0))
     return [q_dot, status]
 
 
@@ -987,63 +1023,42 @@ def _velocity_ik_nullspace(q, mu_dot, z, damping):
     t7 = casadi.if_else((t1 <= 0), 1, -1)*t6
     t8 = c12**2 + t5
     t9 = casadi.sqrt(t4 + t8)
-    t10 = t2**2
-    t11 = damping**2
-    t12 = t4 + t11
-    t13 = t12**2
-    t14 = casadi.sqrt(t10 + t13)
-    t15 = t14*casadi.if_else((t12 >= 0), 1, -1)
-    t16 = t8 + t11
-    t17 = casadi.sqrt(2*t10 + t13 + t16**2)
-    t18 = (t14 > 0)
-    t19 = casadi.if_else(t18, 1/(t12 + t15), 0)
-    t20 = casadi.if_else(t18, 1 + casadi.fabs(t12)/t14, 0)
-    t21 = t2*t19
-    t22 = -t20*(t2 + t16*t21)
-    t23 = t2 + t22
-    t24 = t16 + t21*t22
-    t25 = t20*(mu_dot0 - t21*mu_dot1)
-    t26 = -t25 + mu_dot0
-    t27 = mu_dot1 + t21*t25
-    t28 = casadi.fabs(t24)
-    t29 = t28*casadi.if_else((t24 >= 0), 1, -1)
-    t30 = casadi.if_else((t28 > 0), 2, 0)
-    t31 = t27 - t27*t30
-    t32 = casadi.if_else((t29 != 0), -t31/t29, 0)
-    t33 = casadi.if_else((t15 != 0), -(t26 + t23*t32)/t15, 0)
-    t34 = -t1*t33 + t0*t32
-    t35 = -s12*t33 + c12*t32
-    t36 = (t6 > 0)
-    t37 = casadi.if_else(t36, 1 + casadi.fabs(t1)/t6, 0)
-    t38 = -t1
-    t39 = casadi.if_else(t36, 1/(t38 + t7), 0)
-    t40 = -s12
-    t41 = q1 + q2 + c12 + t0 + t38 + t40 + mu_dot0 + mu_dot1 + damping + qz1 + qz2
-    t42 = t0*t39
-    t43 = t37*(t40 + c12*t42)
-    t44 = s12 + t43
-    t45 = c12 - t42*t43
-    t46 = t37*(mu_dot0 + t42*mu_dot1)
-    t47 = -t46 + mu_dot0
-    t48 = mu_dot1 - t42*t46
-    t49 = casadi.fabs(t45)
-    t50 = t49*casadi.if_else((t45 >= 0), 1, -1)
-    t51 = casadi.if_else((t49 > 0), 2, 0)
-    t52 = t48 - t48*t51
-    t53 = casadi.if_else((t50 != 0), -t52/t50, 0)
-    t54 = casadi.if_else((t7 != 0), -(t47 + t44*t53)/t7, 0)
-    t55 = (casadi.fabs(t41) < casadi.inf)
-    t56 = (damping >= 0)
-    t57 = (damping > 0)
-    t58 = 1e-12*t17
-    t59 = 1e-12*t9
-    t60 = casadi.logic_or(casadi.logic_and(t57, casadi.logic_or((t14 <= t58), (t28 <= t58))), casadi.logic_and((damping <= 0), casadi.logic_or((t6 <= t59), (t49 <= t59))))
-    t61 = casadi.logic_and(casadi.logic_and(t55, t56), casadi.logic_not(t60))
+    t10 = damping**2
+    t11 = _symmetric_solve2(1, (t4 + t10, -t2, t8 + t10, mu_dot0, mu_dot1,))
+    t12 = t11[0]
+    t13 = t11[1]
+    t14 = -t1*t12 + t0*t13
+    t15 = -s12*t12 + c12*t13
+    t16 = (t6 > 0)
+    t17 = casadi.if_else(t16, 1 + casadi.fabs(t1)/t6, 0)
+    t18 = -t1
+    t19 = casadi.if_else(t16, 1/(t18 + t7), 0)
+    t20 = -s12
+    t21 = q1 + q2 + c12 + t0 + t18 + t20 + mu_dot0 + mu_dot1 + damping + qz1 + qz2
+    t22 = t0*t19
+    t23 = t17*(t20 + c12*t22)
+    t24 = s12 + t23
+    t25 = c12 - t22*t23
+    t26 = t17*(mu_dot0 + t22*mu_dot1)
+    t27 = -t26 + mu_dot0
+    t28 = mu_dot1 - t22*t26
+    t29 = casadi.fabs(t25)
+    t30 = t29*casadi.if_else((t25 >= 0), 1, -1)
+    t31 = casadi.if_else((t29 > 0), 2, 0)
+    t32 = t28 - t28*t31
+    t33 = casadi.if_else((t30 != 0), -t32/t30, 0)
+    t34 = casadi.if_else((t7 != 0), -(t27 + t24*t33)/t7, 0)
+    t35 = (casadi.fabs(t21) < casadi.inf)
+    t36 = (damping >= 0)
+    t37 = (damping > 0)
+    t38 = 1e-12*t9
+    t39 = casadi.logic_or(casadi.logic_and(t37, (t11[2] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or((t6 <= t38), (t29 <= t38))))
+    t40 = casadi.logic_and(casadi.logic_and(t35, t36), casadi.logic_not(t39))
     q_dot = casadi.SX(2, 1)
-    q_dot[0, 0] = casadi.if_else(t61, casadi.if_else(t57, t34, t54), 0)
-    q_dot[1, 0] = casadi.if_else(t61, casadi.if_else(t57, t35, t53), 0)
+    q_dot[0, 0] = casadi.if_else(t40, casadi.if_else(t37, t14, t34), 0)
+    q_dot[1, 0] = casadi.if_else(t40, casadi.if_else(t37, t15, t33), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t55, t56)), 2, casadi.if_else(t60, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t35, t36)), 2, casadi.if_else(t39, 1, 0))
     return [q_dot, status]
 
 
@@ -1076,69 +1091,48 @@ def _resolved_rate(q, target, target_rate, gain, z, damping):
     t8 = casadi.if_else((t1 <= 0), 1, -1)*t7
     t9 = c12**2 + t6
     t10 = casadi.sqrt(t5 + t9)
-    t11 = t2**2
-    t12 = damping**2
-    t13 = t5 + t12
-    t14 = t13**2
-    t15 = casadi.sqrt(t11 + t14)
-    t16 = t15*casadi.if_else((t13 >= 0), 1, -1)
-    t17 = t9 + t12
-    t18 = casadi.sqrt(2*t11 + t14 + t17**2)
-    t19 = (t15 > 0)
-    t20 = casadi.if_else(t19, 1/(t13 + t16), 0)
-    t21 = casadi.if_else(t19, 1 + casadi.fabs(t13)/t15, 0)
-    t22 = t2*t20
-    t23 = -t21*(t2 + t17*t22)
-    t24 = t2 + t23
-    t25 = t17 + t22*t23
-    t26 = casadi.fabs(t25)
-    t27 = t26*casadi.if_else((t25 >= 0), 1, -1)
-    t28 = casadi.if_else((t26 > 0), 2, 0)
-    t29 = (t7 > 0)
-    t30 = casadi.if_else(t29, 1 + casadi.fabs(t1)/t7, 0)
-    t31 = -t1
-    t32 = casadi.if_else(t29, 1/(t31 + t8), 0)
-    t33 = mu_dot1 + gain1*(t31 + mu1)
-    t34 = t21*(t3 - t22*t33)
-    t35 = -t34 + t3
-    t36 = t33 + t22*t34
-    t37 = t36 - t28*t36
-    t38 = casadi.if_else((t27 != 0), -t37/t27, 0)
-    t39 = casadi.if_else((t16 != 0), -(t35 + t24*t38)/t16, 0)
-    t40 = -t1*t39 + t0*t38
-    t41 = -s12*t39 + c12*t38
-    t42 = -s12
-    t43 = q1 + q2 + c12 + t0 + t31 + t42 + damping + qz1 + qz2 + t3 + t33
-    t44 = t0*t32
-    t45 = t30*(t42 + c12*t44)
-    t46 = s12 + t45
-    t47 = c12 - t44*t45
-    t48 = t30*(t3 + t44*t33)
-    t49 = -t48 + t3
-    t50 = t33 - t44*t48
-    t51 = casadi.fabs(t47)
-    t52 = t51*casadi.if_else((t47 >= 0), 1, -1)
-    t53 = casadi.if_else((t51 > 0), 2, 0)
-    t54 = t50 - t53*t50
-    t55 = casadi.if_else((t52 != 0), -t54/t52, 0)
-    t56 = casadi.if_else((t8 != 0), -(t49 + t46*t55)/t8, 0)
-    t57 = (casadi.fabs(t43) < casadi.inf)
-    t58 = (damping >= 0)
-    t59 = (damping > 0)
-    t60 = 1e-12*t18
-    t61 = 1e-12*t10
-    t62 = casadi.logic_or(casadi.logic_and(t59, casadi.logic_or((t15 <= t60), (t26 <= t60))), casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t61), (t51 <= t61))))
-    t63 = casadi.logic_and(casadi.logic_and(t57, t58), casadi.logic_not(t62))
+    t11 = (t7 > 0)
+    t12 = casadi.if_else(t11, 1 + casadi.fabs(t1)/t7, 0)
+    t13 = -t1
+    t14 = casadi.if_else(t11, 1/(t13 + t8), 0)
+    t15 = mu_dot1 + gain1*(t13 + mu1)
+    t16 = -s12
+    t17 = q1 + q2 + c12 + t0 + t13 + t16 + damping + qz1 + qz2 + t3 + t15
+    t18 = t0*t14
+    t19 = t12*(t16 + c12*t18)
+    t20 = s12 + t19
+    t21 = c12 - t18*t19
+    t22 = t12*(t3 + t18*t15)
+    t23 = -t22 + t3
+    t24 = t15 - t18*t22
+    t25 = casadi.fabs(t21)
+    t26 = t25*casadi.if_else((t21 >= 0), 1, -1)
+    t27 = casadi.if_else((t25 > 0), 2, 0)
+    t28 = t24 - t27*t24
+    t29 = casadi.if_else((t26 != 0), -t28/t26, 0)
+    t30 = casadi.if_else((t8 != 0), -(t23 + t20*t29)/t8, 0)
+    t31 = damping**2
+    t32 = _symmetric_solve2(1, (t5 + t31, -t2, t9 + t31, t3, t15,))
+    t33 = t32[0]
+    t34 = t32[1]
+    t35 = -t1*t33 + t0*t34
+    t36 = -s12*t33 + c12*t34
+    t37 = (casadi.fabs(t17) < casadi.inf)
+    t38 = (damping >= 0)
+    t39 = (damping > 0)
+    t40 = 1e-12*t10
+    t41 = casadi.logic_or(casadi.logic_and(t39, (t32[2] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t40), (t25 <= t40))))
+    t42 = casadi.logic_and(casadi.logic_and(t37, t38), casadi.logic_not(t41))
     q_dot = casadi.SX(2, 1)
-    q_dot[0, 0] = casadi.if_else(t63, casadi.if_else(t59, t40, t56), 0)
-    q_dot[1, 0] = casadi.if_else(t63, casadi.if_else(t59, t41, t55), 0)
+    q_dot[0, 0] = casadi.if_else(t42, casadi.if_else(t39, t35, t30), 0)
+    q_dot[1, 0] = casadi.if_else(t42, casadi.if_else(t39, t36, t29), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t57, t58)), 2, casadi.if_else(t62, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t37, t38)), 2, casadi.if_else(t41, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 87 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 96 operations."""
     mu0 = target[0]
     mu1 = target[1]
     qs1 = q[0]
@@ -1160,34 +1154,17 @@ def _ik_numeric_step(target, q, damping):
     t6 = -t1 + mu1
     t7 = t5**2 + t6**2
     t8 = mu0 + mu1 + qs1 + qs2
-    t9 = damping + t2
-    t10 = casadi.sqrt(t9**2 + t3**2)
-    t11 = t10*casadi.if_else((t9 >= 0), 1, -1)
-    t12 = (t10 > 0)
-    t13 = casadi.if_else(t12, 1/(t9 + t11), 0)
-    t14 = casadi.if_else(t12, 1 + casadi.fabs(t9)/t10, 0)
-    t15 = damping + t4
-    t16 = t3*t13
-    t17 = -t14*(t3 + t15*t16)
-    t18 = t3 + t17
-    t19 = t15 + t16*t17
-    t20 = t14*(t5 - t16*t6)
-    t21 = -t20 + t5
-    t22 = t6 + t16*t20
-    t23 = casadi.fabs(t19)
-    t24 = t23*casadi.if_else((t19 >= 0), 1, -1)
-    t25 = casadi.if_else((t23 > 0), 2, 0)
-    t26 = t22 - t22*t25
-    t27 = casadi.if_else((t24 != 0), -t26/t24, 0)
-    t28 = casadi.if_else((t11 != 0), -(t21 + t18*t27)/t11, 0)
-    t29 = q1 - t1*t28 + t0*t27
-    t30 = q2 - s12*t28 + c12*t27
+    t9 = _symmetric_solve2(1, (damping + t2, -t3, damping + t4, t5, t6,))
+    t10 = t9[0]
+    t11 = t9[1]
+    t12 = q1 - t1*t10 + t0*t11
+    t13 = q2 - s12*t10 + c12*t11
     q_start = casadi.SX(2, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
     q_next = casadi.SX(2, 1)
-    q_next[0, 0] = t29
-    q_next[1, 0] = t30
+    q_next[0, 0] = t12
+    q_next[1, 0] = t13
     cost = casadi.SX(1, 1)
     cost[0, 0] = casadi.if_else((casadi.fabs(t8) < casadi.inf), t7, -1)
     return [q_start, q_next, cost]
@@ -1237,7 +1214,7 @@ def _ik_branches(mu):
 
 
 def _ik_nearest(mu, q_seed, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 69 operations."""
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 72 operations."""
     branches_q, branches_valid, branches_in_limits = _ik_branches(mu)
     mu0 = mu[0]
     mu1 = mu[1]
@@ -1253,36 +1230,17 @@ def _ik_nearest(mu, q_seed, weights):
     vb1 = branches_valid[1]
     lb0 = branches_in_limits[0]
     lb1 = branches_in_limits[1]
-    t0 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
-    t1 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
-    t2 = casadi.if_else(casadi.logic_and(vb0, lb0), 1, 0)
-    t3 = casadi.if_else((t2 > 0), 1, 0)
-    t4 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
-    t5 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
-    t6 = casadi.if_else(casadi.logic_and(vb1, lb1), 1, 0)
-    t7 = mu0 + mu1 + qn1 + qn2 + qw1 + qw2
-    t8 = -qn1
-    t9 = -qn2
-    t10 = qw1*(t8 + t0)**2 + qw2*(t9 + t1)**2
-    t11 = qw1*(t8 + t4)**2 + qw2*(t9 + t5)**2
-    t12 = (t3 > 0)
-    t13 = casadi.if_else(t12, t0, qn1)
-    t14 = casadi.if_else(t12, t1, qn2)
-    t15 = casadi.if_else(t12, t10, 0)
-    t16 = (t6 > 0)
-    t17 = casadi.if_else(casadi.logic_and(t16, casadi.logic_or((t3 < 1), (t11 < t15))), 1, 0)
-    t18 = casadi.if_else(t16, 1, t3)
-    t19 = (t17 > 0)
-    t20 = casadi.if_else(t19, t4, t13)
-    t21 = casadi.if_else(t19, t5, t14)
-    t22 = (t18 > 0)
-    t23 = (casadi.fabs(t7) < casadi.inf)
-    t24 = casadi.logic_and(t22, t23)
+    t0 = mu0 + mu1 + qn1 + qn2 + qw1 + qw2
+    t1 = _nearer_branch(1, (qb0_0, qb0_1, casadi.if_else(casadi.logic_and(vb0, lb0), 1, 0), qn1, qn2, qw1, qw2, qn1, qn2, 0, 0,))
+    t2 = _nearer_branch(1, (qb1_0, qb1_1, casadi.if_else(casadi.logic_and(vb1, lb1), 1, 0), qn1, qn2, qw1, qw2, t1[0], t1[1], t1[2], t1[3],))
+    t3 = (t2[3] > 0)
+    t4 = (casadi.fabs(t0) < casadi.inf)
+    t5 = casadi.logic_and(t3, t4)
     q = casadi.SX(2, 1)
-    q[0, 0] = casadi.if_else(t24, t20, qn1)
-    q[1, 0] = casadi.if_else(t24, t21, qn2)
+    q[0, 0] = casadi.if_else(t5, t2[0], qn1)
+    q[1, 0] = casadi.if_else(t5, t2[1], qn2)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t23), 2, casadi.if_else(t22, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t4), 2, casadi.if_else(t3, 0, 1))
     return [q, status]
 
 

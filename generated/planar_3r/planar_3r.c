@@ -12,46 +12,46 @@
 typedef struct { planar_3r_real w[36]; } jacgen_jacobi3_columns_2_state;
 
 /* One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V: 412 operations a run. */
-static jacgen_jacobi3_columns_2_state jacgen_jacobi3_columns_2(int count, jacgen_jacobi3_columns_2_state state)
+static void jacgen_jacobi3_columns_2(int count, jacgen_jacobi3_columns_2_state *state)
 {
     JACGEN_KERNEL_LOOP
     for (int run = 0; run < count; run++) {
-        const planar_3r_real w0 = state.w[0];
-        const planar_3r_real w1 = state.w[1];
-        const planar_3r_real w2 = state.w[2];
-        const planar_3r_real w3 = state.w[3];
-        const planar_3r_real w4 = state.w[4];
-        const planar_3r_real w5 = state.w[5];
-        const planar_3r_real w6 = state.w[6];
-        const planar_3r_real w7 = state.w[7];
-        const planar_3r_real w8 = state.w[8];
-        const planar_3r_real w9 = state.w[9];
-        const planar_3r_real w10 = state.w[10];
-        const planar_3r_real w11 = state.w[11];
-        const planar_3r_real w12 = state.w[12];
-        const planar_3r_real w13 = state.w[13];
-        const planar_3r_real w14 = state.w[14];
-        const planar_3r_real w15 = state.w[15];
-        const planar_3r_real w16 = state.w[16];
-        const planar_3r_real w17 = state.w[17];
-        const planar_3r_real w18 = state.w[18];
-        const planar_3r_real w19 = state.w[19];
-        const planar_3r_real w20 = state.w[20];
-        const planar_3r_real w21 = state.w[21];
-        const planar_3r_real w22 = state.w[22];
-        const planar_3r_real w23 = state.w[23];
-        const planar_3r_real w24 = state.w[24];
-        const planar_3r_real w25 = state.w[25];
-        const planar_3r_real w26 = state.w[26];
-        const planar_3r_real w27 = state.w[27];
-        const planar_3r_real w28 = state.w[28];
-        const planar_3r_real w29 = state.w[29];
-        const planar_3r_real w30 = state.w[30];
-        const planar_3r_real w31 = state.w[31];
-        const planar_3r_real w32 = state.w[32];
-        const planar_3r_real w33 = state.w[33];
-        const planar_3r_real w34 = state.w[34];
-        const planar_3r_real w35 = state.w[35];
+        const planar_3r_real w0 = state->w[0];
+        const planar_3r_real w1 = state->w[1];
+        const planar_3r_real w2 = state->w[2];
+        const planar_3r_real w3 = state->w[3];
+        const planar_3r_real w4 = state->w[4];
+        const planar_3r_real w5 = state->w[5];
+        const planar_3r_real w6 = state->w[6];
+        const planar_3r_real w7 = state->w[7];
+        const planar_3r_real w8 = state->w[8];
+        const planar_3r_real w9 = state->w[9];
+        const planar_3r_real w10 = state->w[10];
+        const planar_3r_real w11 = state->w[11];
+        const planar_3r_real w12 = state->w[12];
+        const planar_3r_real w13 = state->w[13];
+        const planar_3r_real w14 = state->w[14];
+        const planar_3r_real w15 = state->w[15];
+        const planar_3r_real w16 = state->w[16];
+        const planar_3r_real w17 = state->w[17];
+        const planar_3r_real w18 = state->w[18];
+        const planar_3r_real w19 = state->w[19];
+        const planar_3r_real w20 = state->w[20];
+        const planar_3r_real w21 = state->w[21];
+        const planar_3r_real w22 = state->w[22];
+        const planar_3r_real w23 = state->w[23];
+        const planar_3r_real w24 = state->w[24];
+        const planar_3r_real w25 = state->w[25];
+        const planar_3r_real w26 = state->w[26];
+        const planar_3r_real w27 = state->w[27];
+        const planar_3r_real w28 = state->w[28];
+        const planar_3r_real w29 = state->w[29];
+        const planar_3r_real w30 = state->w[30];
+        const planar_3r_real w31 = state->w[31];
+        const planar_3r_real w32 = state->w[32];
+        const planar_3r_real w33 = state->w[33];
+        const planar_3r_real w34 = state->w[34];
+        const planar_3r_real w35 = state->w[35];
         const planar_3r_real t0 = (w0*w0) + (w1*w1) + (w2*w2);
         const planar_3r_real t1 = (w3*w3) + (w4*w4) + (w5*w5);
         const planar_3r_real t2 = (w6*w6) + (w7*w7) + (w8*w8);
@@ -258,62 +258,61 @@ static jacgen_jacobi3_columns_2_state jacgen_jacobi3_columns_2(int count, jacgen
         const planar_3r_real t203 = t82*t157;
         const planar_3r_real t204 = t202 - t156*t203;
         const planar_3r_real t205 = t203 + t156*t202;
-        state.w[0] = t160;
-        state.w[1] = t164;
-        state.w[2] = t168;
-        state.w[3] = t161;
-        state.w[4] = t165;
-        state.w[5] = t169;
-        state.w[6] = t99;
-        state.w[7] = t103;
-        state.w[8] = t107;
-        state.w[9] = t184;
-        state.w[10] = t188;
-        state.w[11] = t192;
-        state.w[12] = t185;
-        state.w[13] = t189;
-        state.w[14] = t193;
-        state.w[15] = t126;
-        state.w[16] = t130;
-        state.w[17] = t134;
-        state.w[18] = t172;
-        state.w[19] = t176;
-        state.w[20] = t180;
-        state.w[21] = t173;
-        state.w[22] = t177;
-        state.w[23] = t181;
-        state.w[24] = t114;
-        state.w[25] = t118;
-        state.w[26] = t122;
-        state.w[27] = t196;
-        state.w[28] = t200;
-        state.w[29] = t204;
-        state.w[30] = t197;
-        state.w[31] = t201;
-        state.w[32] = t205;
-        state.w[33] = t141;
-        state.w[34] = t145;
-        state.w[35] = t149;
+        state->w[0] = t160;
+        state->w[1] = t164;
+        state->w[2] = t168;
+        state->w[3] = t161;
+        state->w[4] = t165;
+        state->w[5] = t169;
+        state->w[6] = t99;
+        state->w[7] = t103;
+        state->w[8] = t107;
+        state->w[9] = t184;
+        state->w[10] = t188;
+        state->w[11] = t192;
+        state->w[12] = t185;
+        state->w[13] = t189;
+        state->w[14] = t193;
+        state->w[15] = t126;
+        state->w[16] = t130;
+        state->w[17] = t134;
+        state->w[18] = t172;
+        state->w[19] = t176;
+        state->w[20] = t180;
+        state->w[21] = t173;
+        state->w[22] = t177;
+        state->w[23] = t181;
+        state->w[24] = t114;
+        state->w[25] = t118;
+        state->w[26] = t122;
+        state->w[27] = t196;
+        state->w[28] = t200;
+        state->w[29] = t204;
+        state->w[30] = t197;
+        state->w[31] = t201;
+        state->w[32] = t205;
+        state->w[33] = t141;
+        state->w[34] = t145;
+        state->w[35] = t149;
     }
-    return state;
 }
 
 typedef struct { planar_3r_real w[9]; } jacgen_jacobi3_rows_state;
 
 /* One-sided Jacobi sweep of a 3 x 3 matrix (its rows): 152 operations a run. */
-static jacgen_jacobi3_rows_state jacgen_jacobi3_rows(int count, jacgen_jacobi3_rows_state state)
+static void jacgen_jacobi3_rows(int count, jacgen_jacobi3_rows_state *state)
 {
     JACGEN_KERNEL_LOOP
     for (int run = 0; run < count; run++) {
-        const planar_3r_real w0 = state.w[0];
-        const planar_3r_real w1 = state.w[1];
-        const planar_3r_real w2 = state.w[2];
-        const planar_3r_real w3 = state.w[3];
-        const planar_3r_real w4 = state.w[4];
-        const planar_3r_real w5 = state.w[5];
-        const planar_3r_real w6 = state.w[6];
-        const planar_3r_real w7 = state.w[7];
-        const planar_3r_real w8 = state.w[8];
+        const planar_3r_real w0 = state->w[0];
+        const planar_3r_real w1 = state->w[1];
+        const planar_3r_real w2 = state->w[2];
+        const planar_3r_real w3 = state->w[3];
+        const planar_3r_real w4 = state->w[4];
+        const planar_3r_real w5 = state->w[5];
+        const planar_3r_real w6 = state->w[6];
+        const planar_3r_real w7 = state->w[7];
+        const planar_3r_real w8 = state->w[8];
         const planar_3r_real t0 = (w0*w0) + (w1*w1) + (w2*w2);
         const planar_3r_real t1 = (w3*w3) + (w4*w4) + (w5*w5);
         const planar_3r_real t2 = (w6*w6) + (w7*w7) + (w8*w8);
@@ -381,17 +380,124 @@ static jacgen_jacobi3_rows_state jacgen_jacobi3_rows(int count, jacgen_jacobi3_r
         const planar_3r_real t64 = t25*t54;
         const planar_3r_real t65 = t63 - t53*t64;
         const planar_3r_real t66 = t64 + t53*t63;
-        state.w[0] = t57;
-        state.w[1] = t61;
-        state.w[2] = t65;
-        state.w[3] = t58;
-        state.w[4] = t62;
-        state.w[5] = t66;
-        state.w[6] = t39;
-        state.w[7] = t43;
-        state.w[8] = t47;
+        state->w[0] = t57;
+        state->w[1] = t61;
+        state->w[2] = t65;
+        state->w[3] = t58;
+        state->w[4] = t62;
+        state->w[5] = t66;
+        state->w[6] = t39;
+        state->w[7] = t43;
+        state->w[8] = t47;
     }
-    return state;
+}
+
+typedef struct { planar_3r_real w[9]; } jacgen_symmetric_solve3_state;
+
+/* X solving a symmetric 3 x 3 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular: 118 operations a run. */
+static void jacgen_symmetric_solve3(int count, jacgen_symmetric_solve3_state *state)
+{
+    JACGEN_KERNEL_LOOP
+    for (int run = 0; run < count; run++) {
+        const planar_3r_real w0 = state->w[0];
+        const planar_3r_real w1 = state->w[1];
+        const planar_3r_real w2 = state->w[2];
+        const planar_3r_real w3 = state->w[3];
+        const planar_3r_real w4 = state->w[4];
+        const planar_3r_real w5 = state->w[5];
+        const planar_3r_real w6 = state->w[6];
+        const planar_3r_real w7 = state->w[7];
+        const planar_3r_real w8 = state->w[8];
+        const planar_3r_real t0 = (w1*w1);
+        const planar_3r_real t1 = (w2*w2);
+        const planar_3r_real t2 = (w0*w0);
+        const planar_3r_real t3 = sqrt(2*t0 + 2*t1 + 2*(w4*w4) + t2 + (w3*w3) + (w5*w5));
+        const planar_3r_real t4 = sqrt(t0 + t1 + t2);
+        const planar_3r_real t5 = t4*(w0 >= 0 ? 1 : -1);
+        const int t6 = t4 > 0;
+        const planar_3r_real t7 = (t6 ? 1.0/(w0 + t5) : 0);
+        const planar_3r_real t8 = (t6 ? 1 + fabs(w0)/t4 : 0);
+        const planar_3r_real t9 = w1*t7;
+        const planar_3r_real t10 = w2*t7;
+        const planar_3r_real t11 = t8*(w1 + t9*w3 + t10*w4);
+        const planar_3r_real t12 = -t11 + w1;
+        const planar_3r_real t13 = w3 - t9*t11;
+        const planar_3r_real t14 = w4 - t10*t11;
+        const planar_3r_real t15 = t8*(w2 + t9*w4 + t10*w5);
+        const planar_3r_real t16 = -t15 + w2;
+        const planar_3r_real t17 = w4 - t9*t15;
+        const planar_3r_real t18 = w5 - t10*t15;
+        const planar_3r_real t19 = t8*(w6 + t9*w7 + t10*w8);
+        const planar_3r_real t20 = -t19 + w6;
+        const planar_3r_real t21 = w7 - t9*t19;
+        const planar_3r_real t22 = w8 - t10*t19;
+        const planar_3r_real t23 = sqrt((t13*t13) + (t14*t14));
+        const planar_3r_real t24 = t23*(t13 >= 0 ? 1 : -1);
+        const int t25 = t23 > 0;
+        const planar_3r_real t26 = (t25 ? 1.0/(t13 + t24) : 0);
+        const planar_3r_real t27 = (t25 ? 1 + fabs(t13)/t23 : 0);
+        const planar_3r_real t28 = t14*t26;
+        const planar_3r_real t29 = t27*(t17 + t28*t18);
+        const planar_3r_real t30 = -t29 + t17;
+        const planar_3r_real t31 = t18 - t28*t29;
+        const planar_3r_real t32 = t27*(t21 + t28*t22);
+        const planar_3r_real t33 = -t32 + t21;
+        const planar_3r_real t34 = t22 - t28*t32;
+        const planar_3r_real t35 = fabs(t31);
+        const planar_3r_real t36 = t35*(t31 >= 0 ? 1 : -1);
+        const planar_3r_real t37 = (t35 > 0 ? 2 : 0);
+        const planar_3r_real t38 = t34 - t34*t37;
+        const planar_3r_real t39 = (t36 != 0 ? -t38/t36 : 0);
+        const planar_3r_real t40 = (t24 != 0 ? -(t33 - t30*t39)/t24 : 0);
+        const planar_3r_real t41 = (t5 != 0 ? -(-(t12*t40 + t16*t39) + t20)/t5 : 0);
+        const planar_3r_real t42 = 1e-12*t3;
+        state->w[0] = t41;
+        state->w[1] = t40;
+        state->w[2] = t39;
+        state->w[3] = ((t4 <= t42) || (t23 <= t42) || (t35 <= t42) ? 1 : 0);
+    }
+}
+
+typedef struct { planar_3r_real w[15]; } jacgen_nearer_branch_state;
+
+/* The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents: 39 operations a run. */
+static void jacgen_nearer_branch(int count, jacgen_nearer_branch_state *state)
+{
+    JACGEN_KERNEL_LOOP
+    for (int run = 0; run < count; run++) {
+        const planar_3r_real w0 = state->w[0];
+        const planar_3r_real w1 = state->w[1];
+        const planar_3r_real w2 = state->w[2];
+        const planar_3r_real w3 = state->w[3];
+        const planar_3r_real w4 = state->w[4];
+        const planar_3r_real w5 = state->w[5];
+        const planar_3r_real w6 = state->w[6];
+        const planar_3r_real w7 = state->w[7];
+        const planar_3r_real w8 = state->w[8];
+        const planar_3r_real w9 = state->w[9];
+        const planar_3r_real w10 = state->w[10];
+        const planar_3r_real w11 = state->w[11];
+        const planar_3r_real w12 = state->w[12];
+        const planar_3r_real w13 = state->w[13];
+        const planar_3r_real w14 = state->w[14];
+        const planar_3r_real t0 = w0 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(-w0 + w4));
+        const planar_3r_real t1 = w1 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(-w1 + w5));
+        const planar_3r_real t2 = w2 + 6.283185307179586*floor(0.5 + 0.15915494309189535*(-w2 + w6));
+        const planar_3r_real t3 = w7*((-w4 + t0)*(-w4 + t0)) + w8*((-w5 + t1)*(-w5 + t1)) + w9*((-w6 + t2)*(-w6 + t2));
+        const int t4 = w3 > 0;
+        const planar_3r_real t5 = (t4 && ((w14 < 1) || (t3 < w13)) ? 1 : 0);
+        const planar_3r_real t6 = (t4 ? 1 : w14);
+        const int t7 = t5 > 0;
+        const planar_3r_real t8 = (t7 ? t0 : w10);
+        const planar_3r_real t9 = (t7 ? t1 : w11);
+        const planar_3r_real t10 = (t7 ? t2 : w12);
+        const planar_3r_real t11 = (t7 ? t3 : w13);
+        state->w[0] = t8;
+        state->w[1] = t9;
+        state->w[2] = t10;
+        state->w[3] = t11;
+        state->w[4] = t6;
+    }
 }
 
 void planar_3r_fk(const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real T[16])
@@ -1310,7 +1416,8 @@ void planar_3r_velocity_ellipsoid(const planar_3r_real q[PLANAR_3R_DOF], planar_
     const planar_3r_real t14 = c123 + t10*t11;
     const planar_3r_real t15 = sqrt((t13*t13) + (t14*t14));
     const planar_3r_real t16 = t15*(t13 >= 0 ? 1 : -1);
-    const jacgen_jacobi3_columns_2_state t17 = jacgen_jacobi3_columns_2(5, (jacgen_jacobi3_columns_2_state){{-t5, 0, 0, t12, -t16, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, -1, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 0, 0, 0, 1, 0, 0, 0, 1}});
+    jacgen_jacobi3_columns_2_state t17 = {{-t5, 0, 0, t12, -t16, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, -1, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 0, 0, 0, 1, 0, 0, 0, 1}};
+    jacgen_jacobi3_columns_2(5, &t17);
     const planar_3r_real t18 = sqrt((t17.w[0]*t17.w[0]) + (t17.w[1]*t17.w[1]) + (t17.w[2]*t17.w[2]));
     const planar_3r_real t19 = sqrt((t17.w[3]*t17.w[3]) + (t17.w[4]*t17.w[4]) + (t17.w[5]*t17.w[5]));
     const planar_3r_real t20 = sqrt((t17.w[6]*t17.w[6]) + (t17.w[7]*t17.w[7]) + (t17.w[8]*t17.w[8]));
@@ -1481,7 +1588,8 @@ planar_3r_real planar_3r_condition_number(const planar_3r_real q[PLANAR_3R_DOF])
     const planar_3r_real t31 = t22 - t28*t29;
     const planar_3r_real t32 = fabs(t31);
     const planar_3r_real t33 = t32*(t31 >= 0 ? 1 : -1);
-    const jacgen_jacobi3_rows_state t34 = jacgen_jacobi3_rows(5, (jacgen_jacobi3_rows_state){{-t7, t13, t20, 0, -t24, t30, 0, 0, -t33}});
+    jacgen_jacobi3_rows_state t34 = {{-t7, t13, t20, 0, -t24, t30, 0, 0, -t33}};
+    jacgen_jacobi3_rows(5, &t34);
     const planar_3r_real t35 = sqrt((t34.w[0]*t34.w[0]) + (t34.w[1]*t34.w[1]) + (t34.w[2]*t34.w[2]));
     const planar_3r_real t36 = sqrt((t34.w[3]*t34.w[3]) + (t34.w[4]*t34.w[4]) + (t34.w[5]*t34.w[5]));
     const planar_3r_real t37 = sqrt((t34.w[6]*t34.w[6]) + (t34.w[7]*t34.w[7]) + (t34.w[8]*t34.w[8]));
@@ -1498,7 +1606,7 @@ planar_3r_real planar_3r_condition_number(const planar_3r_real q[PLANAR_3R_DOF])
 
 int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF])
 {
-    /* 315 operations */
+    /* 314 operations */
 
     /* Inputs */
     const planar_3r_real q1 = q[0];
@@ -1533,115 +1641,74 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
     const planar_3r_real t11 = (c123*c123) + (t0*t0) + t8;
     const planar_3r_real t12 = sqrt(3 + t7 + t11);
     const planar_3r_real t13 = c123 + t0 + t2;
-    const planar_3r_real t14 = (t4*t4);
-    const planar_3r_real t15 = (t5*t5);
-    const planar_3r_real t16 = (damping*damping);
-    const planar_3r_real t17 = t7 + t16;
-    const planar_3r_real t18 = (t17*t17);
-    const planar_3r_real t19 = sqrt(t14 + t15 + t18);
-    const planar_3r_real t20 = t19*(t17 >= 0 ? 1 : -1);
-    const planar_3r_real t21 = t11 + t16;
-    const planar_3r_real t22 = 3 + t16;
-    const planar_3r_real t23 = sqrt(2*t14 + 2*t15 + 2*(t13*t13) + t18 + (t21*t21) + (t22*t22));
-    const int t24 = t19 > 0;
-    const planar_3r_real t25 = (t24 ? 1.0/(t17 + t20) : 0);
-    const planar_3r_real t26 = (t24 ? 1 + fabs(t17)/t19 : 0);
-    const planar_3r_real t27 = t4*t25;
-    const planar_3r_real t28 = t5*t25;
-    const planar_3r_real t29 = -t26*(t4 + t21*t27 + t13*t28);
-    const planar_3r_real t30 = t4 + t29;
-    const planar_3r_real t31 = t21 + t27*t29;
-    const planar_3r_real t32 = t13 + t28*t29;
-    const planar_3r_real t33 = -t26*(t5 + t22*t28 + t13*t27);
-    const planar_3r_real t34 = t5 + t33;
-    const planar_3r_real t35 = t13 + t27*t33;
-    const planar_3r_real t36 = t22 + t28*t33;
-    const planar_3r_real t37 = -t26*(-mu_dot0 + t27*mu_dot1 + t28*mu_dot2);
-    const planar_3r_real t38 = -t37 + mu_dot0;
-    const planar_3r_real t39 = mu_dot1 + t27*t37;
-    const planar_3r_real t40 = mu_dot2 + t28*t37;
-    const planar_3r_real t41 = sqrt((t31*t31) + (t32*t32));
-    const planar_3r_real t42 = t41*(t31 >= 0 ? 1 : -1);
-    const int t43 = t41 > 0;
-    const planar_3r_real t44 = (t43 ? 1.0/(t31 + t42) : 0);
-    const planar_3r_real t45 = (t43 ? 1 + fabs(t31)/t41 : 0);
-    const planar_3r_real t46 = t32*t44;
-    const planar_3r_real t47 = t45*(t35 + t46*t36);
-    const planar_3r_real t48 = -t47 + t35;
-    const planar_3r_real t49 = t36 - t46*t47;
-    const planar_3r_real t50 = t45*(t39 + t46*t40);
-    const planar_3r_real t51 = -t50 + t39;
-    const planar_3r_real t52 = t40 - t46*t50;
-    const planar_3r_real t53 = fabs(t49);
-    const planar_3r_real t54 = t53*(t49 >= 0 ? 1 : -1);
-    const planar_3r_real t55 = (t53 > 0 ? 2 : 0);
-    const planar_3r_real t56 = t52 - t52*t55;
-    const planar_3r_real t57 = (t54 != 0 ? -t56/t54 : 0);
-    const planar_3r_real t58 = (t42 != 0 ? -(t51 - t48*t57)/t42 : 0);
-    const planar_3r_real t59 = (t20 != 0 ? -(t38 + t30*t58 + t34*t57)/t20 : 0);
-    const planar_3r_real t60 = t57 - t3*t59 + t2*t58;
-    const planar_3r_real t61 = t57 - t1*t59 + t0*t58;
-    const planar_3r_real t62 = t57 - s123*t59 + c123*t58;
-    const int t63 = t9 > 0;
-    const planar_3r_real t64 = (t63 ? 1 + fabs(t3)/t9 : 0);
-    const planar_3r_real t65 = -t3;
-    const planar_3r_real t66 = (t63 ? 1.0/(t65 + t10) : 0);
-    const planar_3r_real t67 = -t1;
-    const planar_3r_real t68 = t2*t66;
-    const planar_3r_real t69 = t64*(t67 + t66 + t0*t68);
-    const planar_3r_real t70 = t1 + t69;
-    const planar_3r_real t71 = t64*(mu_dot0 + mu_dot2*t66 + t68*mu_dot1);
-    const planar_3r_real t72 = -t71 + mu_dot0;
-    const planar_3r_real t73 = t66*t69;
-    const planar_3r_real t74 = t0 - t2*t73;
-    const planar_3r_real t75 = 1 - t73;
-    const planar_3r_real t76 = sqrt((t74*t74) + (t75*t75));
-    const planar_3r_real t77 = t76*(t74 >= 0 ? 1 : -1);
-    const planar_3r_real t78 = -s123;
-    const planar_3r_real t79 = t64*(t78 + t66 + c123*t68);
-    const planar_3r_real t80 = s123 + t79;
-    const planar_3r_real t81 = 3 + q1 + q2 + q3 + t13 + t65 + t67 + t78 + mu_dot0 + mu_dot1 + mu_dot2 + damping;
-    const planar_3r_real t82 = t66*t79;
-    const planar_3r_real t83 = c123 - t2*t82;
-    const planar_3r_real t84 = 1 - t82;
-    const planar_3r_real t85 = t66*t71;
-    const planar_3r_real t86 = mu_dot1 - t2*t85;
-    const planar_3r_real t87 = -t85 + mu_dot2;
-    const int t88 = t76 > 0;
-    const planar_3r_real t89 = (t88 ? 1.0/(t74 + t77) : 0);
-    const planar_3r_real t90 = (t88 ? 1 + fabs(t74)/t76 : 0);
-    const planar_3r_real t91 = t75*t89;
-    const planar_3r_real t92 = t90*(t83 + t91*t84);
-    const planar_3r_real t93 = -t92 + t83;
-    const planar_3r_real t94 = t84 - t91*t92;
-    const planar_3r_real t95 = t90*(t86 + t91*t87);
-    const planar_3r_real t96 = -t95 + t86;
-    const planar_3r_real t97 = t87 - t91*t95;
-    const planar_3r_real t98 = fabs(t94);
-    const planar_3r_real t99 = t98*(t94 >= 0 ? 1 : -1);
-    const planar_3r_real t100 = (t98 > 0 ? 2 : 0);
-    const planar_3r_real t101 = t97 - t97*t100;
-    const planar_3r_real t102 = (t99 != 0 ? -t101/t99 : 0);
-    const planar_3r_real t103 = (t77 != 0 ? -(t96 - t93*t102)/t77 : 0);
-    const planar_3r_real t104 = (t10 != 0 ? -(t72 + t70*t103 + t80*t102)/t10 : 0);
-    const int t105 = isfinite(t81);
-    const int t106 = damping >= 0;
-    const int t107 = damping > 0;
-    const planar_3r_real t108 = 1e-12*t23;
-    const planar_3r_real t109 = 1e-12*t12;
-    const int t110 = (t107 && ((t19 <= t108) || (t41 <= t108) || (t53 <= t108))) || (damping <= 0 && ((t9 <= t109) || (t76 <= t109) || (t98 <= t109)));
-    const int t111 = t105 && t106 && !t110;
+    const planar_3r_real t14 = (damping*damping);
+    jacgen_symmetric_solve3_state t15 = {{t7 + t14, -t4, -t5, t11 + t14, t13, 3 + t14, mu_dot0, mu_dot1, mu_dot2}};
+    jacgen_symmetric_solve3(1, &t15);
+    const planar_3r_real t16 = t15.w[2];
+    const planar_3r_real t17 = t15.w[0];
+    const planar_3r_real t18 = t15.w[1];
+    const planar_3r_real t19 = t16 - t3*t17 + t2*t18;
+    const planar_3r_real t20 = t16 - t1*t17 + t0*t18;
+    const planar_3r_real t21 = t16 - s123*t17 + c123*t18;
+    const int t22 = t9 > 0;
+    const planar_3r_real t23 = (t22 ? 1 + fabs(t3)/t9 : 0);
+    const planar_3r_real t24 = -t3;
+    const planar_3r_real t25 = (t22 ? 1.0/(t24 + t10) : 0);
+    const planar_3r_real t26 = -t1;
+    const planar_3r_real t27 = t2*t25;
+    const planar_3r_real t28 = t23*(t26 + t25 + t0*t27);
+    const planar_3r_real t29 = t1 + t28;
+    const planar_3r_real t30 = t23*(mu_dot0 + mu_dot2*t25 + t27*mu_dot1);
+    const planar_3r_real t31 = -t30 + mu_dot0;
+    const planar_3r_real t32 = t25*t28;
+    const planar_3r_real t33 = t0 - t2*t32;
+    const planar_3r_real t34 = 1 - t32;
+    const planar_3r_real t35 = sqrt((t33*t33) + (t34*t34));
+    const planar_3r_real t36 = t35*(t33 >= 0 ? 1 : -1);
+    const planar_3r_real t37 = -s123;
+    const planar_3r_real t38 = t23*(t37 + t25 + c123*t27);
+    const planar_3r_real t39 = s123 + t38;
+    const planar_3r_real t40 = 3 + q1 + q2 + q3 + t13 + t24 + t26 + t37 + mu_dot0 + mu_dot1 + mu_dot2 + damping;
+    const planar_3r_real t41 = t25*t38;
+    const planar_3r_real t42 = c123 - t2*t41;
+    const planar_3r_real t43 = 1 - t41;
+    const planar_3r_real t44 = t25*t30;
+    const planar_3r_real t45 = mu_dot1 - t2*t44;
+    const planar_3r_real t46 = -t44 + mu_dot2;
+    const int t47 = t35 > 0;
+    const planar_3r_real t48 = (t47 ? 1.0/(t33 + t36) : 0);
+    const planar_3r_real t49 = (t47 ? 1 + fabs(t33)/t35 : 0);
+    const planar_3r_real t50 = t34*t48;
+    const planar_3r_real t51 = t49*(t42 + t50*t43);
+    const planar_3r_real t52 = -t51 + t42;
+    const planar_3r_real t53 = t43 - t50*t51;
+    const planar_3r_real t54 = t49*(t45 + t50*t46);
+    const planar_3r_real t55 = -t54 + t45;
+    const planar_3r_real t56 = t46 - t50*t54;
+    const planar_3r_real t57 = fabs(t53);
+    const planar_3r_real t58 = t57*(t53 >= 0 ? 1 : -1);
+    const planar_3r_real t59 = (t57 > 0 ? 2 : 0);
+    const planar_3r_real t60 = t56 - t56*t59;
+    const planar_3r_real t61 = (t58 != 0 ? -t60/t58 : 0);
+    const planar_3r_real t62 = (t36 != 0 ? -(t55 - t52*t61)/t36 : 0);
+    const planar_3r_real t63 = (t10 != 0 ? -(t31 + t29*t62 + t39*t61)/t10 : 0);
+    const int t64 = isfinite(t40);
+    const int t65 = damping >= 0;
+    const int t66 = damping > 0;
+    const planar_3r_real t67 = 1e-12*t12;
+    const int t68 = (t66 && t15.w[3] > 0) || (damping <= 0 && ((t9 <= t67) || (t35 <= t67) || (t57 <= t67)));
+    const int t69 = t64 && t65 && !t68;
 
     /* Outputs */
-    q_dot[0] = (t111 ? (t107 ? t60 : t104) : 0);
-    q_dot[1] = (t111 ? (t107 ? t61 : t103) : 0);
-    q_dot[2] = (t111 ? (t107 ? t62 : t102) : 0);
-    return (!(t105 && t106) ? 2 : (t110 ? 1 : 0));
+    q_dot[0] = (t69 ? (t66 ? t19 : t63) : 0);
+    q_dot[1] = (t69 ? (t66 ? t20 : t62) : 0);
+    q_dot[2] = (t69 ? (t66 ? t21 : t61) : 0);
+    return (!(t64 && t65) ? 2 : (t68 ? 1 : 0));
 }
 
 int planar_3r_velocity_ik_nullspace(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], const planar_3r_real z[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF])
 {
-    /* 318 operations */
+    /* 317 operations */
 
     /* Inputs */
     const planar_3r_real q1 = q[0];
@@ -1679,115 +1746,74 @@ int planar_3r_velocity_ik_nullspace(const planar_3r_real q[PLANAR_3R_DOF], const
     const planar_3r_real t11 = (c123*c123) + (t0*t0) + t8;
     const planar_3r_real t12 = sqrt(3 + t7 + t11);
     const planar_3r_real t13 = c123 + t0 + t2;
-    const planar_3r_real t14 = (t4*t4);
-    const planar_3r_real t15 = (t5*t5);
-    const planar_3r_real t16 = (damping*damping);
-    const planar_3r_real t17 = t7 + t16;
-    const planar_3r_real t18 = (t17*t17);
-    const planar_3r_real t19 = sqrt(t14 + t15 + t18);
-    const planar_3r_real t20 = t19*(t17 >= 0 ? 1 : -1);
-    const planar_3r_real t21 = t11 + t16;
-    const planar_3r_real t22 = 3 + t16;
-    const planar_3r_real t23 = sqrt(2*t14 + 2*t15 + 2*(t13*t13) + t18 + (t21*t21) + (t22*t22));
-    const int t24 = t19 > 0;
-    const planar_3r_real t25 = (t24 ? 1.0/(t17 + t20) : 0);
-    const planar_3r_real t26 = (t24 ? 1 + fabs(t17)/t19 : 0);
-    const planar_3r_real t27 = t4*t25;
-    const planar_3r_real t28 = t5*t25;
-    const planar_3r_real t29 = -t26*(t4 + t21*t27 + t13*t28);
-    const planar_3r_real t30 = t4 + t29;
-    const planar_3r_real t31 = t21 + t27*t29;
-    const planar_3r_real t32 = t13 + t28*t29;
-    const planar_3r_real t33 = -t26*(t5 + t22*t28 + t13*t27);
-    const planar_3r_real t34 = t5 + t33;
-    const planar_3r_real t35 = t13 + t27*t33;
-    const planar_3r_real t36 = t22 + t28*t33;
-    const planar_3r_real t37 = -t26*(-mu_dot0 + t27*mu_dot1 + t28*mu_dot2);
-    const planar_3r_real t38 = -t37 + mu_dot0;
-    const planar_3r_real t39 = mu_dot1 + t27*t37;
-    const planar_3r_real t40 = mu_dot2 + t28*t37;
-    const planar_3r_real t41 = sqrt((t31*t31) + (t32*t32));
-    const planar_3r_real t42 = t41*(t31 >= 0 ? 1 : -1);
-    const int t43 = t41 > 0;
-    const planar_3r_real t44 = (t43 ? 1.0/(t31 + t42) : 0);
-    const planar_3r_real t45 = (t43 ? 1 + fabs(t31)/t41 : 0);
-    const planar_3r_real t46 = t32*t44;
-    const planar_3r_real t47 = t45*(t35 + t46*t36);
-    const planar_3r_real t48 = -t47 + t35;
-    const planar_3r_real t49 = t36 - t46*t47;
-    const planar_3r_real t50 = t45*(t39 + t46*t40);
-    const planar_3r_real t51 = -t50 + t39;
-    const planar_3r_real t52 = t40 - t46*t50;
-    const planar_3r_real t53 = fabs(t49);
-    const planar_3r_real t54 = t53*(t49 >= 0 ? 1 : -1);
-    const planar_3r_real t55 = (t53 > 0 ? 2 : 0);
-    const planar_3r_real t56 = t52 - t52*t55;
-    const planar_3r_real t57 = (t54 != 0 ? -t56/t54 : 0);
-    const planar_3r_real t58 = (t42 != 0 ? -(t51 - t48*t57)/t42 : 0);
-    const planar_3r_real t59 = (t20 != 0 ? -(t38 + t30*t58 + t34*t57)/t20 : 0);
-    const planar_3r_real t60 = t57 - t3*t59 + t2*t58;
-    const planar_3r_real t61 = t57 - t1*t59 + t0*t58;
-    const planar_3r_real t62 = t57 - s123*t59 + c123*t58;
-    const int t63 = t9 > 0;
-    const planar_3r_real t64 = (t63 ? 1 + fabs(t3)/t9 : 0);
-    const planar_3r_real t65 = -t3;
-    const planar_3r_real t66 = (t63 ? 1.0/(t65 + t10) : 0);
-    const planar_3r_real t67 = -t1;
-    const planar_3r_real t68 = t2*t66;
-    const planar_3r_real t69 = t64*(t67 + t66 + t0*t68);
-    const planar_3r_real t70 = t1 + t69;
-    const planar_3r_real t71 = t64*(mu_dot0 + mu_dot2*t66 + t68*mu_dot1);
-    const planar_3r_real t72 = -t71 + mu_dot0;
-    const planar_3r_real t73 = t66*t69;
-    const planar_3r_real t74 = t0 - t2*t73;
-    const planar_3r_real t75 = 1 - t73;
-    const planar_3r_real t76 = sqrt((t74*t74) + (t75*t75));
-    const planar_3r_real t77 = t76*(t74 >= 0 ? 1 : -1);
-    const planar_3r_real t78 = -s123;
-    const planar_3r_real t79 = t64*(t78 + t66 + c123*t68);
-    const planar_3r_real t80 = s123 + t79;
-    const planar_3r_real t81 = 3 + q1 + q2 + q3 + t13 + t65 + t67 + t78 + mu_dot0 + mu_dot1 + mu_dot2 + damping + qz1 + qz2 + qz3;
-    const planar_3r_real t82 = t66*t79;
-    const planar_3r_real t83 = c123 - t2*t82;
-    const planar_3r_real t84 = 1 - t82;
-    const planar_3r_real t85 = t66*t71;
-    const planar_3r_real t86 = mu_dot1 - t2*t85;
-    const planar_3r_real t87 = -t85 + mu_dot2;
-    const int t88 = t76 > 0;
-    const planar_3r_real t89 = (t88 ? 1.0/(t74 + t77) : 0);
-    const planar_3r_real t90 = (t88 ? 1 + fabs(t74)/t76 : 0);
-    const planar_3r_real t91 = t75*t89;
-    const planar_3r_real t92 = t90*(t83 + t91*t84);
-    const planar_3r_real t93 = -t92 + t83;
-    const planar_3r_real t94 = t84 - t91*t92;
-    const planar_3r_real t95 = t90*(t86 + t91*t87);
-    const planar_3r_real t96 = -t95 + t86;
-    const planar_3r_real t97 = t87 - t91*t95;
-    const planar_3r_real t98 = fabs(t94);
-    const planar_3r_real t99 = t98*(t94 >= 0 ? 1 : -1);
-    const planar_3r_real t100 = (t98 > 0 ? 2 : 0);
-    const planar_3r_real t101 = t97 - t97*t100;
-    const planar_3r_real t102 = (t99 != 0 ? -t101/t99 : 0);
-    const planar_3r_real t103 = (t77 != 0 ? -(t96 - t93*t102)/t77 : 0);
-    const planar_3r_real t104 = (t10 != 0 ? -(t72 + t70*t103 + t80*t102)/t10 : 0);
-    const int t105 = isfinite(t81);
-    const int t106 = damping >= 0;
-    const int t107 = damping > 0;
-    const planar_3r_real t108 = 1e-12*t23;
-    const planar_3r_real t109 = 1e-12*t12;
-    const int t110 = (t107 && ((t19 <= t108) || (t41 <= t108) || (t53 <= t108))) || (damping <= 0 && ((t9 <= t109) || (t76 <= t109) || (t98 <= t109)));
-    const int t111 = t105 && t106 && !t110;
+    const planar_3r_real t14 = (damping*damping);
+    jacgen_symmetric_solve3_state t15 = {{t7 + t14, -t4, -t5, t11 + t14, t13, 3 + t14, mu_dot0, mu_dot1, mu_dot2}};
+    jacgen_symmetric_solve3(1, &t15);
+    const planar_3r_real t16 = t15.w[2];
+    const planar_3r_real t17 = t15.w[0];
+    const planar_3r_real t18 = t15.w[1];
+    const planar_3r_real t19 = t16 - t3*t17 + t2*t18;
+    const planar_3r_real t20 = t16 - t1*t17 + t0*t18;
+    const planar_3r_real t21 = t16 - s123*t17 + c123*t18;
+    const int t22 = t9 > 0;
+    const planar_3r_real t23 = (t22 ? 1 + fabs(t3)/t9 : 0);
+    const planar_3r_real t24 = -t3;
+    const planar_3r_real t25 = (t22 ? 1.0/(t24 + t10) : 0);
+    const planar_3r_real t26 = -t1;
+    const planar_3r_real t27 = t2*t25;
+    const planar_3r_real t28 = t23*(t26 + t25 + t0*t27);
+    const planar_3r_real t29 = t1 + t28;
+    const planar_3r_real t30 = t23*(mu_dot0 + mu_dot2*t25 + t27*mu_dot1);
+    const planar_3r_real t31 = -t30 + mu_dot0;
+    const planar_3r_real t32 = t25*t28;
+    const planar_3r_real t33 = t0 - t2*t32;
+    const planar_3r_real t34 = 1 - t32;
+    const planar_3r_real t35 = sqrt((t33*t33) + (t34*t34));
+    const planar_3r_real t36 = t35*(t33 >= 0 ? 1 : -1);
+    const planar_3r_real t37 = -s123;
+    const planar_3r_real t38 = t23*(t37 + t25 + c123*t27);
+    const planar_3r_real t39 = s123 + t38;
+    const planar_3r_real t40 = 3 + q1 + q2 + q3 + t13 + t24 + t26 + t37 + mu_dot0 + mu_dot1 + mu_dot2 + damping + qz1 + qz2 + qz3;
+    const planar_3r_real t41 = t25*t38;
+    const planar_3r_real t42 = c123 - t2*t41;
+    const planar_3r_real t43 = 1 - t41;
+    const planar_3r_real t44 = t25*t30;
+    const planar_3r_real t45 = mu_dot1 - t2*t44;
+    const planar_3r_real t46 = -t44 + mu_dot2;
+    const int t47 = t35 > 0;
+    const planar_3r_real t48 = (t47 ? 1.0/(t33 + t36) : 0);
+    const planar_3r_real t49 = (t47 ? 1 + fabs(t33)/t35 : 0);
+    const planar_3r_real t50 = t34*t48;
+    const planar_3r_real t51 = t49*(t42 + t50*t43);
+    const planar_3r_real t52 = -t51 + t42;
+    const planar_3r_real t53 = t43 - t50*t51;
+    const planar_3r_real t54 = t49*(t45 + t50*t46);
+    const planar_3r_real t55 = -t54 + t45;
+    const planar_3r_real t56 = t46 - t50*t54;
+    const planar_3r_real t57 = fabs(t53);
+    const planar_3r_real t58 = t57*(t53 >= 0 ? 1 : -1);
+    const planar_3r_real t59 = (t57 > 0 ? 2 : 0);
+    const planar_3r_real t60 = t56 - t56*t59;
+    const planar_3r_real t61 = (t58 != 0 ? -t60/t58 : 0);
+    const planar_3r_real t62 = (t36 != 0 ? -(t55 - t52*t61)/t36 : 0);
+    const planar_3r_real t63 = (t10 != 0 ? -(t31 + t29*t62 + t39*t61)/t10 : 0);
+    const int t64 = isfinite(t40);
+    const int t65 = damping >= 0;
+    const int t66 = damping > 0;
+    const planar_3r_real t67 = 1e-12*t12;
+    const int t68 = (t66 && t15.w[3] > 0) || (damping <= 0 && ((t9 <= t67) || (t35 <= t67) || (t57 <= t67)));
+    const int t69 = t64 && t65 && !t68;
 
     /* Outputs */
-    q_dot[0] = (t111 ? (t107 ? t60 : t104) : 0);
-    q_dot[1] = (t111 ? (t107 ? t61 : t103) : 0);
-    q_dot[2] = (t111 ? (t107 ? t62 : t102) : 0);
-    return (!(t105 && t106) ? 2 : (t110 ? 1 : 0));
+    q_dot[0] = (t69 ? (t66 ? t19 : t63) : 0);
+    q_dot[1] = (t69 ? (t66 ? t20 : t62) : 0);
+    q_dot[2] = (t69 ? (t66 ? t21 : t61) : 0);
+    return (!(t64 && t65) ? 2 : (t68 ? 1 : 0));
 }
 
 int planar_3r_resolved_rate(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real target_rate[PLANAR_3R_TASK_DIM], const planar_3r_real gain[PLANAR_3R_TASK_DIM], const planar_3r_real z[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF])
 {
-    /* 334 operations */
+    /* 333 operations */
 
     /* Inputs */
     const planar_3r_real q1 = q[0];
@@ -1832,118 +1858,77 @@ int planar_3r_resolved_rate(const planar_3r_real q[PLANAR_3R_DOF], const planar_
     const planar_3r_real t12 = (c123*c123) + (t0*t0) + t9;
     const planar_3r_real t13 = sqrt(3 + t8 + t12);
     const planar_3r_real t14 = c123 + t0 + t2;
-    const planar_3r_real t15 = (t4*t4);
-    const planar_3r_real t16 = (t5*t5);
-    const planar_3r_real t17 = (damping*damping);
-    const planar_3r_real t18 = t8 + t17;
-    const planar_3r_real t19 = (t18*t18);
-    const planar_3r_real t20 = sqrt(t15 + t16 + t19);
-    const planar_3r_real t21 = t20*(t18 >= 0 ? 1 : -1);
-    const planar_3r_real t22 = t12 + t17;
-    const planar_3r_real t23 = 3 + t17;
-    const planar_3r_real t24 = sqrt(2*t15 + 2*t16 + 2*(t14*t14) + t19 + (t22*t22) + (t23*t23));
-    const int t25 = t20 > 0;
-    const planar_3r_real t26 = (t25 ? 1.0/(t18 + t21) : 0);
-    const planar_3r_real t27 = (t25 ? 1 + fabs(t18)/t20 : 0);
-    const planar_3r_real t28 = t4*t26;
-    const planar_3r_real t29 = t5*t26;
-    const planar_3r_real t30 = -t27*(t4 + t22*t28 + t14*t29);
-    const planar_3r_real t31 = t4 + t30;
-    const planar_3r_real t32 = t22 + t28*t30;
-    const planar_3r_real t33 = t14 + t29*t30;
-    const planar_3r_real t34 = -t27*(t5 + t23*t29 + t14*t28);
-    const planar_3r_real t35 = t5 + t34;
-    const planar_3r_real t36 = t14 + t28*t34;
-    const planar_3r_real t37 = t23 + t29*t34;
-    const planar_3r_real t38 = sqrt((t32*t32) + (t33*t33));
-    const planar_3r_real t39 = t38*(t32 >= 0 ? 1 : -1);
-    const int t40 = t38 > 0;
-    const planar_3r_real t41 = (t40 ? 1.0/(t32 + t39) : 0);
-    const planar_3r_real t42 = (t40 ? 1 + fabs(t32)/t38 : 0);
-    const planar_3r_real t43 = t33*t41;
-    const planar_3r_real t44 = t42*(t36 + t43*t37);
-    const planar_3r_real t45 = -t44 + t36;
-    const planar_3r_real t46 = t37 - t43*t44;
-    const planar_3r_real t47 = fabs(t46);
-    const planar_3r_real t48 = t47*(t46 >= 0 ? 1 : -1);
-    const planar_3r_real t49 = (t47 > 0 ? 2 : 0);
-    const int t50 = t10 > 0;
-    const planar_3r_real t51 = (t50 ? 1 + fabs(t3)/t10 : 0);
-    const planar_3r_real t52 = -t3;
-    const planar_3r_real t53 = (t50 ? 1.0/(t52 + t11) : 0);
-    const planar_3r_real t54 = mu_dot1 + gain1*(t52 + mu1);
-    const planar_3r_real t55 = -t1;
-    const planar_3r_real t56 = t2*t53;
-    const planar_3r_real t57 = t51*(t55 + t53 + t0*t56);
-    const planar_3r_real t58 = t1 + t57;
-    const planar_3r_real t59 = t53*t57;
-    const planar_3r_real t60 = t0 - t2*t59;
-    const planar_3r_real t61 = 1 - t59;
-    const planar_3r_real t62 = sqrt((t60*t60) + (t61*t61));
-    const planar_3r_real t63 = t62*(t60 >= 0 ? 1 : -1);
-    const planar_3r_real t64 = -s123;
-    const planar_3r_real t65 = t51*(t64 + t53 + c123*t56);
-    const planar_3r_real t66 = s123 + t65;
-    const planar_3r_real t67 = t53*t65;
-    const planar_3r_real t68 = c123 - t2*t67;
-    const planar_3r_real t69 = 1 - t67;
-    const int t70 = t62 > 0;
-    const planar_3r_real t71 = (t70 ? 1.0/(t60 + t63) : 0);
-    const planar_3r_real t72 = (t70 ? 1 + fabs(t60)/t62 : 0);
-    const planar_3r_real t73 = t61*t71;
-    const planar_3r_real t74 = t72*(t68 + t73*t69);
-    const planar_3r_real t75 = -t74 + t68;
-    const planar_3r_real t76 = t69 - t73*t74;
-    const planar_3r_real t77 = fabs(t76);
-    const planar_3r_real t78 = t77*(t76 >= 0 ? 1 : -1);
-    const planar_3r_real t79 = (t77 > 0 ? 2 : 0);
-    const planar_3r_real t80 = -mu2 + atan2(s123, c123);
-    const planar_3r_real t81 = mu_dot2 - gain2*(t80 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t80)));
-    const planar_3r_real t82 = -t27*(-t6 + t28*t54 + t29*t81);
-    const planar_3r_real t83 = -t82 + t6;
-    const planar_3r_real t84 = t54 + t28*t82;
-    const planar_3r_real t85 = t81 + t29*t82;
-    const planar_3r_real t86 = t42*(t84 + t43*t85);
-    const planar_3r_real t87 = -t86 + t84;
-    const planar_3r_real t88 = t85 - t43*t86;
-    const planar_3r_real t89 = t88 - t49*t88;
-    const planar_3r_real t90 = (t48 != 0 ? -t89/t48 : 0);
-    const planar_3r_real t91 = (t39 != 0 ? -(t87 - t45*t90)/t39 : 0);
-    const planar_3r_real t92 = (t21 != 0 ? -(t83 + t31*t91 + t35*t90)/t21 : 0);
-    const planar_3r_real t93 = t90 - t3*t92 + t2*t91;
-    const planar_3r_real t94 = t90 - t1*t92 + t0*t91;
-    const planar_3r_real t95 = t90 - s123*t92 + c123*t91;
-    const planar_3r_real t96 = t51*(t6 + t53*t81 + t56*t54);
-    const planar_3r_real t97 = -t96 + t6;
-    const planar_3r_real t98 = 3 + q1 + q2 + q3 + t14 + t52 + t55 + t64 + damping + qz1 + qz2 + qz3 + t6 + t54 + t81;
-    const planar_3r_real t99 = t53*t96;
-    const planar_3r_real t100 = t54 - t2*t99;
-    const planar_3r_real t101 = -t99 + t81;
-    const planar_3r_real t102 = t72*(t100 + t73*t101);
-    const planar_3r_real t103 = -t102 + t100;
-    const planar_3r_real t104 = t101 - t73*t102;
-    const planar_3r_real t105 = t104 - t79*t104;
-    const planar_3r_real t106 = (t78 != 0 ? -t105/t78 : 0);
-    const planar_3r_real t107 = (t63 != 0 ? -(t103 - t75*t106)/t63 : 0);
-    const planar_3r_real t108 = (t11 != 0 ? -(t97 + t58*t107 + t66*t106)/t11 : 0);
-    const int t109 = isfinite(t98);
-    const int t110 = damping >= 0;
-    const int t111 = damping > 0;
-    const planar_3r_real t112 = 1e-12*t24;
-    const planar_3r_real t113 = 1e-12*t13;
-    const int t114 = (t111 && ((t20 <= t112) || (t38 <= t112) || (t47 <= t112))) || (damping <= 0 && ((t10 <= t113) || (t62 <= t113) || (t77 <= t113)));
-    const int t115 = t109 && t110 && !t114;
+    const int t15 = t10 > 0;
+    const planar_3r_real t16 = (t15 ? 1 + fabs(t3)/t10 : 0);
+    const planar_3r_real t17 = -t3;
+    const planar_3r_real t18 = (t15 ? 1.0/(t17 + t11) : 0);
+    const planar_3r_real t19 = mu_dot1 + gain1*(t17 + mu1);
+    const planar_3r_real t20 = -t1;
+    const planar_3r_real t21 = t2*t18;
+    const planar_3r_real t22 = t16*(t20 + t18 + t0*t21);
+    const planar_3r_real t23 = t1 + t22;
+    const planar_3r_real t24 = t18*t22;
+    const planar_3r_real t25 = t0 - t2*t24;
+    const planar_3r_real t26 = 1 - t24;
+    const planar_3r_real t27 = sqrt((t25*t25) + (t26*t26));
+    const planar_3r_real t28 = t27*(t25 >= 0 ? 1 : -1);
+    const planar_3r_real t29 = -s123;
+    const planar_3r_real t30 = t16*(t29 + t18 + c123*t21);
+    const planar_3r_real t31 = s123 + t30;
+    const planar_3r_real t32 = t18*t30;
+    const planar_3r_real t33 = c123 - t2*t32;
+    const planar_3r_real t34 = 1 - t32;
+    const int t35 = t27 > 0;
+    const planar_3r_real t36 = (t35 ? 1.0/(t25 + t28) : 0);
+    const planar_3r_real t37 = (t35 ? 1 + fabs(t25)/t27 : 0);
+    const planar_3r_real t38 = t26*t36;
+    const planar_3r_real t39 = t37*(t33 + t38*t34);
+    const planar_3r_real t40 = -t39 + t33;
+    const planar_3r_real t41 = t34 - t38*t39;
+    const planar_3r_real t42 = fabs(t41);
+    const planar_3r_real t43 = t42*(t41 >= 0 ? 1 : -1);
+    const planar_3r_real t44 = (t42 > 0 ? 2 : 0);
+    const planar_3r_real t45 = -mu2 + atan2(s123, c123);
+    const planar_3r_real t46 = mu_dot2 - gain2*(t45 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t45)));
+    const planar_3r_real t47 = t16*(t6 + t18*t46 + t21*t19);
+    const planar_3r_real t48 = -t47 + t6;
+    const planar_3r_real t49 = 3 + q1 + q2 + q3 + t14 + t17 + t20 + t29 + damping + qz1 + qz2 + qz3 + t6 + t19 + t46;
+    const planar_3r_real t50 = (damping*damping);
+    jacgen_symmetric_solve3_state t51 = {{t8 + t50, -t4, -t5, t12 + t50, t14, 3 + t50, t6, t19, t46}};
+    jacgen_symmetric_solve3(1, &t51);
+    const planar_3r_real t52 = t51.w[2];
+    const planar_3r_real t53 = t51.w[0];
+    const planar_3r_real t54 = t51.w[1];
+    const planar_3r_real t55 = t52 - t3*t53 + t2*t54;
+    const planar_3r_real t56 = t52 - t1*t53 + t0*t54;
+    const planar_3r_real t57 = t52 - s123*t53 + c123*t54;
+    const planar_3r_real t58 = t18*t47;
+    const planar_3r_real t59 = t19 - t2*t58;
+    const planar_3r_real t60 = -t58 + t46;
+    const planar_3r_real t61 = t37*(t59 + t38*t60);
+    const planar_3r_real t62 = -t61 + t59;
+    const planar_3r_real t63 = t60 - t38*t61;
+    const planar_3r_real t64 = t63 - t44*t63;
+    const planar_3r_real t65 = (t43 != 0 ? -t64/t43 : 0);
+    const planar_3r_real t66 = (t28 != 0 ? -(t62 - t40*t65)/t28 : 0);
+    const planar_3r_real t67 = (t11 != 0 ? -(t48 + t23*t66 + t31*t65)/t11 : 0);
+    const int t68 = isfinite(t49);
+    const int t69 = damping >= 0;
+    const int t70 = damping > 0;
+    const planar_3r_real t71 = 1e-12*t13;
+    const int t72 = (t70 && t51.w[3] > 0) || (damping <= 0 && ((t10 <= t71) || (t27 <= t71) || (t42 <= t71)));
+    const int t73 = t68 && t69 && !t72;
 
     /* Outputs */
-    q_dot[0] = (t115 ? (t111 ? t93 : t108) : 0);
-    q_dot[1] = (t115 ? (t111 ? t94 : t107) : 0);
-    q_dot[2] = (t115 ? (t111 ? t95 : t106) : 0);
-    return (!(t109 && t110) ? 2 : (t114 ? 1 : 0));
+    q_dot[0] = (t73 ? (t70 ? t55 : t67) : 0);
+    q_dot[1] = (t73 ? (t70 ? t56 : t66) : 0);
+    q_dot[2] = (t73 ? (t70 ? t57 : t65) : 0);
+    return (!(t68 && t69) ? 2 : (t72 ? 1 : 0));
 }
 
 planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_start[PLANAR_3R_DOF], planar_3r_real q_next[PLANAR_3R_DOF])
 {
-    /* 185 operations */
+    /* 203 operations */
 
     /* Inputs */
     const planar_3r_real mu0 = target[0];
@@ -1982,58 +1967,22 @@ planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_T
     const planar_3r_real t12 = -mu2 + atan2(s123, c123);
     const planar_3r_real t13 = t12 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t12));
     const planar_3r_real t14 = (t9*t9) + (t10*t10) + (t13*t13);
-    const planar_3r_real t15 = damping + t4;
-    const planar_3r_real t16 = sqrt((t15*t15) + (t5*t5) + (t6*t6));
-    const planar_3r_real t17 = (t15 >= 0 ? 1 : -1)*t16;
-    const int t18 = t16 > 0;
-    const planar_3r_real t19 = (t18 ? 1.0/(t15 + t17) : 0);
-    const planar_3r_real t20 = (t18 ? 1 + fabs(t15)/t16 : 0);
-    const planar_3r_real t21 = damping + t7;
-    const planar_3r_real t22 = t5*t19;
-    const planar_3r_real t23 = t6*t19;
-    const planar_3r_real t24 = -t20*(t5 + t21*t22 + t23*t8);
-    const planar_3r_real t25 = t5 + t24;
-    const planar_3r_real t26 = t21 + t22*t24;
-    const planar_3r_real t27 = t8 + t23*t24;
-    const planar_3r_real t28 = t20*(t9 - t22*t10 + t23*t13);
-    const planar_3r_real t29 = -t28 + t9;
-    const planar_3r_real t30 = t10 + t22*t28;
-    const planar_3r_real t31 = -t13 + t23*t28;
-    const planar_3r_real t32 = sqrt((t26*t26) + (t27*t27));
-    const planar_3r_real t33 = t32*(t26 >= 0 ? 1 : -1);
-    const planar_3r_real t34 = 3 + damping;
-    const planar_3r_real t35 = -t20*(t6 + t22*t8 + t23*t34);
-    const planar_3r_real t36 = t6 + t35;
-    const planar_3r_real t37 = t8 + t22*t35;
-    const planar_3r_real t38 = t34 + t23*t35;
-    const int t39 = t32 > 0;
-    const planar_3r_real t40 = (t39 ? 1.0/(t26 + t33) : 0);
-    const planar_3r_real t41 = (t39 ? 1 + fabs(t26)/t32 : 0);
-    const planar_3r_real t42 = t27*t40;
-    const planar_3r_real t43 = t41*(t37 + t42*t38);
-    const planar_3r_real t44 = -t43 + t37;
-    const planar_3r_real t45 = t38 - t42*t43;
-    const planar_3r_real t46 = t41*(t30 + t42*t31);
-    const planar_3r_real t47 = -t46 + t30;
-    const planar_3r_real t48 = t31 - t42*t46;
-    const planar_3r_real t49 = fabs(t45);
-    const planar_3r_real t50 = t49*(t45 >= 0 ? 1 : -1);
-    const planar_3r_real t51 = (t49 > 0 ? 2 : 0);
-    const planar_3r_real t52 = t48 - t48*t51;
-    const planar_3r_real t53 = (t50 != 0 ? -t52/t50 : 0);
-    const planar_3r_real t54 = (t33 != 0 ? -(t47 - t44*t53)/t33 : 0);
-    const planar_3r_real t55 = (t17 != 0 ? -(t29 + t25*t54 + t36*t53)/t17 : 0);
-    const planar_3r_real t56 = q1 + t53 - t3*t55 + t2*t54;
-    const planar_3r_real t57 = q2 + t53 - t1*t55 + t0*t54;
-    const planar_3r_real t58 = q3 + t53 - s123*t55 + c123*t54;
+    jacgen_symmetric_solve3_state t15 = {{damping + t4, -t5, -t6, damping + t7, t8, 3 + damping, t9, t10, -t13}};
+    jacgen_symmetric_solve3(1, &t15);
+    const planar_3r_real t16 = t15.w[2];
+    const planar_3r_real t17 = t15.w[0];
+    const planar_3r_real t18 = t15.w[1];
+    const planar_3r_real t19 = q1 + t16 - t3*t17 + t2*t18;
+    const planar_3r_real t20 = q2 + t16 - t1*t17 + t0*t18;
+    const planar_3r_real t21 = q3 + t16 - s123*t17 + c123*t18;
 
     /* Outputs */
     q_start[0] = q1;
     q_start[1] = q2;
     q_start[2] = q3;
-    q_next[0] = t56;
-    q_next[1] = t57;
-    q_next[2] = t58;
+    q_next[0] = t19;
+    q_next[1] = t20;
+    q_next[2] = t21;
     return (isfinite(t11) ? t14 : -1);
 }
 
@@ -2098,7 +2047,7 @@ void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3
 
 int planar_3r_ik_nearest(const planar_3r_real mu[PLANAR_3R_TASK_DIM], const planar_3r_real q_seed[PLANAR_3R_DOF], const planar_3r_real weights[PLANAR_3R_DOF], planar_3r_real q[PLANAR_3R_DOF])
 {
-    /* 96 operations */
+    /* 98 operations */
     planar_3r_real branches_q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF];
     int branches_valid[PLANAR_3R_MAX_IK_SOLUTIONS];
     int branches_in_limits[PLANAR_3R_MAX_IK_SOLUTIONS];
@@ -2126,42 +2075,20 @@ int planar_3r_ik_nearest(const planar_3r_real mu[PLANAR_3R_TASK_DIM], const plan
     const int lb1 = branches_in_limits[1];
 
     /* Intermediate terms */
-    const planar_3r_real t0 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0;
-    const planar_3r_real t1 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1;
-    const planar_3r_real t2 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2;
-    const planar_3r_real t3 = (vb0 && lb0 ? 1 : 0);
-    const planar_3r_real t4 = (t3 > 0 ? 1 : 0);
-    const planar_3r_real t5 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0;
-    const planar_3r_real t6 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1;
-    const planar_3r_real t7 = 6.283185307179586*floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2;
-    const planar_3r_real t8 = (vb1 && lb1 ? 1 : 0);
-    const planar_3r_real t9 = mu2 + mu0 + mu1 + qn1 + qn2 + qn3 + qw1 + qw2 + qw3;
-    const planar_3r_real t10 = -qn1;
-    const planar_3r_real t11 = -qn2;
-    const planar_3r_real t12 = -qn3;
-    const planar_3r_real t13 = qw1*((t10 + t0)*(t10 + t0)) + qw2*((t11 + t1)*(t11 + t1)) + qw3*((t12 + t2)*(t12 + t2));
-    const planar_3r_real t14 = qw1*((t10 + t5)*(t10 + t5)) + qw2*((t11 + t6)*(t11 + t6)) + qw3*((t12 + t7)*(t12 + t7));
-    const int t15 = t4 > 0;
-    const planar_3r_real t16 = (t15 ? t0 : qn1);
-    const planar_3r_real t17 = (t15 ? t1 : qn2);
-    const planar_3r_real t18 = (t15 ? t2 : qn3);
-    const planar_3r_real t19 = (t15 ? t13 : 0);
-    const int t20 = t8 > 0;
-    const planar_3r_real t21 = (t20 && ((t4 < 1) || (t14 < t19)) ? 1 : 0);
-    const planar_3r_real t22 = (t20 ? 1 : t4);
-    const int t23 = t21 > 0;
-    const planar_3r_real t24 = (t23 ? t5 : t16);
-    const planar_3r_real t25 = (t23 ? t6 : t17);
-    const planar_3r_real t26 = (t23 ? t7 : t18);
-    const int t27 = t22 > 0;
-    const int t28 = isfinite(t9);
-    const int t29 = t27 && t28;
+    const planar_3r_real t0 = mu2 + mu0 + mu1 + qn1 + qn2 + qn3 + qw1 + qw2 + qw3;
+    jacgen_nearer_branch_state t1 = {{qb0_0, qb0_1, qb0_2, (vb0 && lb0 ? 1 : 0), qn1, qn2, qn3, qw1, qw2, qw3, qn1, qn2, qn3, 0, 0}};
+    jacgen_nearer_branch(1, &t1);
+    jacgen_nearer_branch_state t2 = {{qb1_0, qb1_1, qb1_2, (vb1 && lb1 ? 1 : 0), qn1, qn2, qn3, qw1, qw2, qw3, t1.w[0], t1.w[1], t1.w[2], t1.w[3], t1.w[4]}};
+    jacgen_nearer_branch(1, &t2);
+    const int t3 = t2.w[4] > 0;
+    const int t4 = isfinite(t0);
+    const int t5 = t3 && t4;
 
     /* Outputs */
-    q[0] = (t29 ? t24 : qn1);
-    q[1] = (t29 ? t25 : qn2);
-    q[2] = (t29 ? t26 : qn3);
-    return (!t28 ? 2 : (t27 ? 0 : 1));
+    q[0] = (t5 ? t2.w[0] : qn1);
+    q[1] = (t5 ? t2.w[1] : qn2);
+    q[2] = (t5 ? t2.w[2] : qn3);
+    return (!t4 ? 2 : (t3 ? 0 : 1));
 }
 
 int planar_3r_ik(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF])

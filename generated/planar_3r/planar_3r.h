@@ -110,19 +110,19 @@ void planar_3r_velocity_ellipsoid(const planar_3r_real q[PLANAR_3R_DOF], planar_
 planar_3r_real planar_3r_condition_number(const planar_3r_real q[PLANAR_3R_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 3; returned as a scalar. 315 operations. */
+ * Result: q_dot[i], i < 3; returned as a scalar. 314 operations. */
 int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 3; returned as a scalar. 318 operations. */
+ * Result: q_dot[i], i < 3; returned as a scalar. 317 operations. */
 int planar_3r_velocity_ik_nullspace(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], const planar_3r_real z[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 3; returned as a scalar. 334 operations. */
+ * Result: q_dot[i], i < 3; returned as a scalar. 333 operations. */
 int planar_3r_resolved_rate(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real target_rate[PLANAR_3R_TASK_DIM], const planar_3r_real gain[PLANAR_3R_TASK_DIM], const planar_3r_real z[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 3; q_next[i], i < 3; returned as a scalar. 185 operations. */
+ * Result: q_start[i], i < 3; q_next[i], i < 3; returned as a scalar. 203 operations. */
 planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_start[PLANAR_3R_DOF], planar_3r_real q_next[PLANAR_3R_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
@@ -130,7 +130,7 @@ planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_T
 void planar_3r_ik_branches(const planar_3r_real mu[PLANAR_3R_TASK_DIM], planar_3r_real q[PLANAR_3R_MAX_IK_SOLUTIONS * PLANAR_3R_DOF], int valid[PLANAR_3R_MAX_IK_SOLUTIONS], int in_limits[PLANAR_3R_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 3; returned as a scalar. 96 operations. */
+ * Result: q[i], i < 3; returned as a scalar. 98 operations. */
 int planar_3r_ik_nearest(const planar_3r_real mu[PLANAR_3R_TASK_DIM], const planar_3r_real q_seed[PLANAR_3R_DOF], const planar_3r_real weights[PLANAR_3R_DOF], planar_3r_real q[PLANAR_3R_DOF]);
 
 /* Statuses of planar_3r_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

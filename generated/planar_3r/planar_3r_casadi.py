@@ -354,6 +354,88 @@ def _jacobi3_rows(count, state):
     return state
 
 
+def _symmetric_solve3(count, state):
+    """X solving a symmetric 3 x 3 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 118 operations a run."""
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, = state
+        t0 = w1**2
+        t1 = w2**2
+        t2 = w0**2
+        t3 = casadi.sqrt(2*t0 + 2*t1 + 2*w4**2 + t2 + w3**2 + w5**2)
+        t4 = casadi.sqrt(t0 + t1 + t2)
+        t5 = t4*casadi.if_else((w0 >= 0), 1, -1)
+        t6 = (t4 > 0)
+        t7 = casadi.if_else(t6, 1/(w0 + t5), 0)
+        t8 = casadi.if_else(t6, 1 + casadi.fabs(w0)/t4, 0)
+        t9 = w1*t7
+        t10 = w2*t7
+        t11 = t8*(w1 + t9*w3 + t10*w4)
+        t12 = -t11 + w1
+        t13 = w3 - t9*t11
+        t14 = w4 - t10*t11
+        t15 = t8*(w2 + t9*w4 + t10*w5)
+        t16 = -t15 + w2
+        t17 = w4 - t9*t15
+        t18 = w5 - t10*t15
+        t19 = t8*(w6 + t9*w7 + t10*w8)
+        t20 = -t19 + w6
+        t21 = w7 - t9*t19
+        t22 = w8 - t10*t19
+        t23 = casadi.sqrt(t13**2 + t14**2)
+        t24 = t23*casadi.if_else((t13 >= 0), 1, -1)
+        t25 = (t23 > 0)
+        t26 = casadi.if_else(t25, 1/(t13 + t24), 0)
+        t27 = casadi.if_else(t25, 1 + casadi.fabs(t13)/t23, 0)
+        t28 = t14*t26
+        t29 = t27*(t17 + t28*t18)
+        t30 = -t29 + t17
+        t31 = t18 - t28*t29
+        t32 = t27*(t21 + t28*t22)
+        t33 = -t32 + t21
+        t34 = t22 - t28*t32
+        t35 = casadi.fabs(t31)
+        t36 = t35*casadi.if_else((t31 >= 0), 1, -1)
+        t37 = casadi.if_else((t35 > 0), 2, 0)
+        t38 = t34 - t34*t37
+        t39 = casadi.if_else((t36 != 0), -t38/t36, 0)
+        t40 = casadi.if_else((t24 != 0), -(t33 - t30*t39)/t24, 0)
+        t41 = casadi.if_else((t5 != 0), -(-(t12*t40 + t16*t39) + t20)/t5, 0)
+        t42 = 1e-12*t3
+        state = (
+            t41,
+            t40,
+            t39,
+            casadi.if_else(casadi.logic_or(casadi.logic_or((t4 <= t42), (t23 <= t42)), (t35 <= t42)), 1, 0),
+        )
+    return state
+
+
+def _nearer_branch(count, state):
+    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 39 operations a run."""
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, = state
+        t0 = w0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-w0 + w4))
+        t1 = w1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-w1 + w5))
+        t2 = w2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-w2 + w6))
+        t3 = w7*(-w4 + t0)**2 + w8*(-w5 + t1)**2 + w9*(-w6 + t2)**2
+        t4 = (w3 > 0)
+        t5 = casadi.if_else(casadi.logic_and(t4, casadi.logic_or((w14 < 1), (t3 < w13))), 1, 0)
+        t6 = casadi.if_else(t4, 1, w14)
+        t7 = (t5 > 0)
+        t8 = casadi.if_else(t7, t0, w10)
+        t9 = casadi.if_else(t7, t1, w11)
+        t10 = casadi.if_else(t7, t2, w12)
+        t11 = casadi.if_else(t7, t3, w13)
+        state = (
+            t8,
+            t9,
+            t10,
+            t11,
+            t6,
+        )
+    return state
+
+
 def _fk(q):
     """Pose of the tool frame in the world frame (4x4 homogeneous): 23 operations."""
     q1 = q[0]
@@ -1215,7 +1297,7 @@ def _condition_number(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 315 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 314 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1246,115 +1328,73 @@ def _velocity_ik(q, mu_dot, damping):
     t11 = c123**2 + t0**2 + t8
     t12 = casadi.sqrt(3 + t7 + t11)
     t13 = c123 + t0 + t2
-    t14 = t4**2
-    t15 = t5**2
-    t16 = damping**2
-    t17 = t7 + t16
-    t18 = t17**2
-    t19 = casadi.sqrt(t14 + t15 + t18)
-    t20 = t19*casadi.if_else((t17 >= 0), 1, -1)
-    t21 = t11 + t16
-    t22 = 3 + t16
-    t23 = casadi.sqrt(2*t14 + 2*t15 + 2*t13**2 + t18 + t21**2 + t22**2)
-    t24 = (t19 > 0)
-    t25 = casadi.if_else(t24, 1/(t17 + t20), 0)
-    t26 = casadi.if_else(t24, 1 + casadi.fabs(t17)/t19, 0)
-    t27 = t4*t25
-    t28 = t5*t25
-    t29 = -t26*(t4 + t21*t27 + t13*t28)
-    t30 = t4 + t29
-    t31 = t21 + t27*t29
-    t32 = t13 + t28*t29
-    t33 = -t26*(t5 + t22*t28 + t13*t27)
-    t34 = t5 + t33
-    t35 = t13 + t27*t33
-    t36 = t22 + t28*t33
-    t37 = -t26*(-mu_dot0 + t27*mu_dot1 + t28*mu_dot2)
-    t38 = -t37 + mu_dot0
-    t39 = mu_dot1 + t27*t37
-    t40 = mu_dot2 + t28*t37
-    t41 = casadi.sqrt(t31**2 + t32**2)
-    t42 = t41*casadi.if_else((t31 >= 0), 1, -1)
-    t43 = (t41 > 0)
-    t44 = casadi.if_else(t43, 1/(t31 + t42), 0)
-    t45 = casadi.if_else(t43, 1 + casadi.fabs(t31)/t41, 0)
-    t46 = t32*t44
-    t47 = t45*(t35 + t46*t36)
-    t48 = -t47 + t35
-    t49 = t36 - t46*t47
-    t50 = t45*(t39 + t46*t40)
-    t51 = -t50 + t39
-    t52 = t40 - t46*t50
-    t53 = casadi.fabs(t49)
-    t54 = t53*casadi.if_else((t49 >= 0), 1, -1)
-    t55 = casadi.if_else((t53 > 0), 2, 0)
-    t56 = t52 - t52*t55
-    t57 = casadi.if_else((t54 != 0), -t56/t54, 0)
-    t58 = casadi.if_else((t42 != 0), -(t51 - t48*t57)/t42, 0)
-    t59 = casadi.if_else((t20 != 0), -(t38 + t30*t58 + t34*t57)/t20, 0)
-    t60 = t57 - t3*t59 + t2*t58
-    t61 = t57 - t1*t59 + t0*t58
-    t62 = t57 - s123*t59 + c123*t58
-    t63 = (t9 > 0)
-    t64 = casadi.if_else(t63, 1 + casadi.fabs(t3)/t9, 0)
-    t65 = -t3
-    t66 = casadi.if_else(t63, 1/(t65 + t10), 0)
-    t67 = -t1
-    t68 = t2*t66
-    t69 = t64*(t67 + t66 + t0*t68)
-    t70 = t1 + t69
-    t71 = t64*(mu_dot0 + mu_dot2*t66 + t68*mu_dot1)
-    t72 = -t71 + mu_dot0
-    t73 = t66*t69
-    t74 = t0 - t2*t73
-    t75 = 1 - t73
-    t76 = casadi.sqrt(t74**2 + t75**2)
-    t77 = t76*casadi.if_else((t74 >= 0), 1, -1)
-    t78 = -s123
-    t79 = t64*(t78 + t66 + c123*t68)
-    t80 = s123 + t79
-    t81 = 3 + q1 + q2 + q3 + t13 + t65 + t67 + t78 + mu_dot0 + mu_dot1 + mu_dot2 + damping
-    t82 = t66*t79
-    t83 = c123 - t2*t82
-    t84 = 1 - t82
-    t85 = t66*t71
-    t86 = mu_dot1 - t2*t85
-    t87 = -t85 + mu_dot2
-    t88 = (t76 > 0)
-    t89 = casadi.if_else(t88, 1/(t74 + t77), 0)
-    t90 = casadi.if_else(t88, 1 + casadi.fabs(t74)/t76, 0)
-    t91 = t75*t89
-    t92 = t90*(t83 + t91*t84)
-    t93 = -t92 + t83
-    t94 = t84 - t91*t92
-    t95 = t90*(t86 + t91*t87)
-    t96 = -t95 + t86
-    t97 = t87 - t91*t95
-    t98 = casadi.fabs(t94)
-    t99 = t98*casadi.if_else((t94 >= 0), 1, -1)
-    t100 = casadi.if_else((t98 > 0), 2, 0)
-    t101 = t97 - t97*t100
-    t102 = casadi.if_else((t99 != 0), -t101/t99, 0)
-    t103 = casadi.if_else((t77 != 0), -(t96 - t93*t102)/t77, 0)
-    t104 = casadi.if_else((t10 != 0), -(t72 + t70*t103 + t80*t102)/t10, 0)
-    t105 = (casadi.fabs(t81) < casadi.inf)
-    t106 = (damping >= 0)
-    t107 = (damping > 0)
-    t108 = 1e-12*t23
-    t109 = 1e-12*t12
-    t110 = casadi.logic_or(casadi.logic_and(t107, casadi.logic_or(casadi.logic_or((t19 <= t108), (t41 <= t108)), (t53 <= t108))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t9 <= t109), (t76 <= t109)), (t98 <= t109))))
-    t111 = casadi.logic_and(casadi.logic_and(t105, t106), casadi.logic_not(t110))
+    t14 = damping**2
+    t15 = _symmetric_solve3(1, (t7 + t14, -t4, -t5, t11 + t14, t13, 3 + t14, mu_dot0, mu_dot1, mu_dot2,))
+    t16 = t15[2]
+    t17 = t15[0]
+    t18 = t15[1]
+    t19 = t16 - t3*t17 + t2*t18
+    t20 = t16 - t1*t17 + t0*t18
+    t21 = t16 - s123*t17 + c123*t18
+    t22 = (t9 > 0)
+    t23 = casadi.if_else(t22, 1 + casadi.fabs(t3)/t9, 0)
+    t24 = -t3
+    t25 = casadi.if_else(t22, 1/(t24 + t10), 0)
+    t26 = -t1
+    t27 = t2*t25
+    t28 = t23*(t26 + t25 + t0*t27)
+    t29 = t1 + t28
+    t30 = t23*(mu_dot0 + mu_dot2*t25 + t27*mu_dot1)
+    t31 = -t30 + mu_dot0
+    t32 = t25*t28
+    t33 = t0 - t2*t32
+    t34 = 1 - t32
+    t35 = casadi.sqrt(t33**2 + t34**2)
+    t36 = t35*casadi.if_else((t33 >= 0), 1, -1)
+    t37 = -s123
+    t38 = t23*(t37 + t25 + c123*t27)
+    t39 = s123 + t38
+    t40 = 3 + q1 + q2 + q3 + t13 + t24 + t26 + t37 + mu_dot0 + mu_dot1 + mu_dot2 + damping
+    t41 = t25*t38
+    t42 = c123 - t2*t41
+    t43 = 1 - t41
+    t44 = t25*t30
+    t45 = mu_dot1 - t2*t44
+    t46 = -t44 + mu_dot2
+    t47 = (t35 > 0)
+    t48 = casadi.if_else(t47, 1/(t33 + t36), 0)
+    t49 = casadi.if_else(t47, 1 + casadi.fabs(t33)/t35, 0)
+    t50 = t34*t48
+    t51 = t49*(t42 + t50*t43)
+    t52 = -t51 + t42
+    t53 = t43 - t50*t51
+    t54 = t49*(t45 + t50*t46)
+    t55 = -t54 + t45
+    t56 = t46 - t50*t54
+    t57 = casadi.fabs(t53)
+    t58 = t57*casadi.if_else((t53 >= 0), 1, -1)
+    t59 = casadi.if_else((t57 > 0), 2, 0)
+    t60 = t56 - t56*t59
+    t61 = casadi.if_else((t58 != 0), -t60/t58, 0)
+    t62 = casadi.if_else((t36 != 0), -(t55 - t52*t61)/t36, 0)
+    t63 = casadi.if_else((t10 != 0), -(t31 + t29*t62 + t39*t61)/t10, 0)
+    t64 = (casadi.fabs(t40) < casadi.inf)
+    t65 = (damping >= 0)
+    t66 = (damping > 0)
+    t67 = 1e-12*t12
+    t68 = casadi.logic_or(casadi.logic_and(t66, (t15[3] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t9 <= t67), (t35 <= t67)), (t57 <= t67))))
+    t69 = casadi.logic_and(casadi.logic_and(t64, t65), casadi.logic_not(t68))
     q_dot = casadi.SX(3, 1)
-    q_dot[0, 0] = casadi.if_else(t111, casadi.if_else(t107, t60, t104), 0)
-    q_dot[1, 0] = casadi.if_else(t111, casadi.if_else(t107, t61, t103), 0)
-    q_dot[2, 0] = casadi.if_else(t111, casadi.if_else(t107, t62, t102), 0)
+    q_dot[0, 0] = casadi.if_else(t69, casadi.if_else(t66, t19, t63), 0)
+    q_dot[1, 0] = casadi.if_else(t69, casadi.if_else(t66, t20, t62), 0)
+    q_dot[2, 0] = casadi.if_else(t69, casadi.if_else(t66, t21, t61), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t105, t106)), 2, casadi.if_else(t110, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t64, t65)), 2, casadi.if_else(t68, 1, 0))
     return [q_dot, status]
 
 
 def _velocity_ik_nullspace(q, mu_dot, z, damping):
-    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 318 operations."""
+    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 317 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1388,115 +1428,73 @@ def _velocity_ik_nullspace(q, mu_dot, z, damping):
     t11 = c123**2 + t0**2 + t8
     t12 = casadi.sqrt(3 + t7 + t11)
     t13 = c123 + t0 + t2
-    t14 = t4**2
-    t15 = t5**2
-    t16 = damping**2
-    t17 = t7 + t16
-    t18 = t17**2
-    t19 = casadi.sqrt(t14 + t15 + t18)
-    t20 = t19*casadi.if_else((t17 >= 0), 1, -1)
-    t21 = t11 + t16
-    t22 = 3 + t16
-    t23 = casadi.sqrt(2*t14 + 2*t15 + 2*t13**2 + t18 + t21**2 + t22**2)
-    t24 = (t19 > 0)
-    t25 = casadi.if_else(t24, 1/(t17 + t20), 0)
-    t26 = casadi.if_else(t24, 1 + casadi.fabs(t17)/t19, 0)
-    t27 = t4*t25
-    t28 = t5*t25
-    t29 = -t26*(t4 + t21*t27 + t13*t28)
-    t30 = t4 + t29
-    t31 = t21 + t27*t29
-    t32 = t13 + t28*t29
-    t33 = -t26*(t5 + t22*t28 + t13*t27)
-    t34 = t5 + t33
-    t35 = t13 + t27*t33
-    t36 = t22 + t28*t33
-    t37 = -t26*(-mu_dot0 + t27*mu_dot1 + t28*mu_dot2)
-    t38 = -t37 + mu_dot0
-    t39 = mu_dot1 + t27*t37
-    t40 = mu_dot2 + t28*t37
-    t41 = casadi.sqrt(t31**2 + t32**2)
-    t42 = t41*casadi.if_else((t31 >= 0), 1, -1)
-    t43 = (t41 > 0)
-    t44 = casadi.if_else(t43, 1/(t31 + t42), 0)
-    t45 = casadi.if_else(t43, 1 + casadi.fabs(t31)/t41, 0)
-    t46 = t32*t44
-    t47 = t45*(t35 + t46*t36)
-    t48 = -t47 + t35
-    t49 = t36 - t46*t47
-    t50 = t45*(t39 + t46*t40)
-    t51 = -t50 + t39
-    t52 = t40 - t46*t50
-    t53 = casadi.fabs(t49)
-    t54 = t53*casadi.if_else((t49 >= 0), 1, -1)
-    t55 = casadi.if_else((t53 > 0), 2, 0)
-    t56 = t52 - t52*t55
-    t57 = casadi.if_else((t54 != 0), -t56/t54, 0)
-    t58 = casadi.if_else((t42 != 0), -(t51 - t48*t57)/t42, 0)
-    t59 = casadi.if_else((t20 != 0), -(t38 + t30*t58 + t34*t57)/t20, 0)
-    t60 = t57 - t3*t59 + t2*t58
-    t61 = t57 - t1*t59 + t0*t58
-    t62 = t57 - s123*t59 + c123*t58
-    t63 = (t9 > 0)
-    t64 = casadi.if_else(t63, 1 + casadi.fabs(t3)/t9, 0)
-    t65 = -t3
-    t66 = casadi.if_else(t63, 1/(t65 + t10), 0)
-    t67 = -t1
-    t68 = t2*t66
-    t69 = t64*(t67 + t66 + t0*t68)
-    t70 = t1 + t69
-    t71 = t64*(mu_dot0 + mu_dot2*t66 + t68*mu_dot1)
-    t72 = -t71 + mu_dot0
-    t73 = t66*t69
-    t74 = t0 - t2*t73
-    t75 = 1 - t73
-    t76 = casadi.sqrt(t74**2 + t75**2)
-    t77 = t76*casadi.if_else((t74 >= 0), 1, -1)
-    t78 = -s123
-    t79 = t64*(t78 + t66 + c123*t68)
-    t80 = s123 + t79
-    t81 = 3 + q1 + q2 + q3 + t13 + t65 + t67 + t78 + mu_dot0 + mu_dot1 + mu_dot2 + damping + qz1 + qz2 + qz3
-    t82 = t66*t79
-    t83 = c123 - t2*t82
-    t84 = 1 - t82
-    t85 = t66*t71
-    t86 = mu_dot1 - t2*t85
-    t87 = -t85 + mu_dot2
-    t88 = (t76 > 0)
-    t89 = casadi.if_else(t88, 1/(t74 + t77), 0)
-    t90 = casadi.if_else(t88, 1 + casadi.fabs(t74)/t76, 0)
-    t91 = t75*t89
-    t92 = t90*(t83 + t91*t84)
-    t93 = -t92 + t83
-    t94 = t84 - t91*t92
-    t95 = t90*(t86 + t91*t87)
-    t96 = -t95 + t86
-    t97 = t87 - t91*t95
-    t98 = casadi.fabs(t94)
-    t99 = t98*casadi.if_else((t94 >= 0), 1, -1)
-    t100 = casadi.if_else((t98 > 0), 2, 0)
-    t101 = t97 - t97*t100
-    t102 = casadi.if_else((t99 != 0), -t101/t99, 0)
-    t103 = casadi.if_else((t77 != 0), -(t96 - t93*t102)/t77, 0)
-    t104 = casadi.if_else((t10 != 0), -(t72 + t70*t103 + t80*t102)/t10, 0)
-    t105 = (casadi.fabs(t81) < casadi.inf)
-    t106 = (damping >= 0)
-    t107 = (damping > 0)
-    t108 = 1e-12*t23
-    t109 = 1e-12*t12
-    t110 = casadi.logic_or(casadi.logic_and(t107, casadi.logic_or(casadi.logic_or((t19 <= t108), (t41 <= t108)), (t53 <= t108))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t9 <= t109), (t76 <= t109)), (t98 <= t109))))
-    t111 = casadi.logic_and(casadi.logic_and(t105, t106), casadi.logic_not(t110))
+    t14 = damping**2
+    t15 = _symmetric_solve3(1, (t7 + t14, -t4, -t5, t11 + t14, t13, 3 + t14, mu_dot0, mu_dot1, mu_dot2,))
+    t16 = t15[2]
+    t17 = t15[0]
+    t18 = t15[1]
+    t19 = t16 - t3*t17 + t2*t18
+    t20 = t16 - t1*t17 + t0*t18
+    t21 = t16 - s123*t17 + c123*t18
+    t22 = (t9 > 0)
+    t23 = casadi.if_else(t22, 1 + casadi.fabs(t3)/t9, 0)
+    t24 = -t3
+    t25 = casadi.if_else(t22, 1/(t24 + t10), 0)
+    t26 = -t1
+    t27 = t2*t25
+    t28 = t23*(t26 + t25 + t0*t27)
+    t29 = t1 + t28
+    t30 = t23*(mu_dot0 + mu_dot2*t25 + t27*mu_dot1)
+    t31 = -t30 + mu_dot0
+    t32 = t25*t28
+    t33 = t0 - t2*t32
+    t34 = 1 - t32
+    t35 = casadi.sqrt(t33**2 + t34**2)
+    t36 = t35*casadi.if_else((t33 >= 0), 1, -1)
+    t37 = -s123
+    t38 = t23*(t37 + t25 + c123*t27)
+    t39 = s123 + t38
+    t40 = 3 + q1 + q2 + q3 + t13 + t24 + t26 + t37 + mu_dot0 + mu_dot1 + mu_dot2 + damping + qz1 + qz2 + qz3
+    t41 = t25*t38
+    t42 = c123 - t2*t41
+    t43 = 1 - t41
+    t44 = t25*t30
+    t45 = mu_dot1 - t2*t44
+    t46 = -t44 + mu_dot2
+    t47 = (t35 > 0)
+    t48 = casadi.if_else(t47, 1/(t33 + t36), 0)
+    t49 = casadi.if_else(t47, 1 + casadi.fabs(t33)/t35, 0)
+    t50 = t34*t48
+    t51 = t49*(t42 + t50*t43)
+    t52 = -t51 + t42
+    t53 = t43 - t50*t51
+    t54 = t49*(t45 + t50*t46)
+    t55 = -t54 + t45
+    t56 = t46 - t50*t54
+    t57 = casadi.fabs(t53)
+    t58 = t57*casadi.if_else((t53 >= 0), 1, -1)
+    t59 = casadi.if_else((t57 > 0), 2, 0)
+    t60 = t56 - t56*t59
+    t61 = casadi.if_else((t58 != 0), -t60/t58, 0)
+    t62 = casadi.if_else((t36 != 0), -(t55 - t52*t61)/t36, 0)
+    t63 = casadi.if_else((t10 != 0), -(t31 + t29*t62 + t39*t61)/t10, 0)
+    t64 = (casadi.fabs(t40) < casadi.inf)
+    t65 = (damping >= 0)
+    t66 = (damping > 0)
+    t67 = 1e-12*t12
+    t68 = casadi.logic_or(casadi.logic_and(t66, (t15[3] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t9 <= t67), (t35 <= t67)), (t57 <= t67))))
+    t69 = casadi.logic_and(casadi.logic_and(t64, t65), casadi.logic_not(t68))
     q_dot = casadi.SX(3, 1)
-    q_dot[0, 0] = casadi.if_else(t111, casadi.if_else(t107, t60, t104), 0)
-    q_dot[1, 0] = casadi.if_else(t111, casadi.if_else(t107, t61, t103), 0)
-    q_dot[2, 0] = casadi.if_else(t111, casadi.if_else(t107, t62, t102), 0)
+    q_dot[0, 0] = casadi.if_else(t69, casadi.if_else(t66, t19, t63), 0)
+    q_dot[1, 0] = casadi.if_else(t69, casadi.if_else(t66, t20, t62), 0)
+    q_dot[2, 0] = casadi.if_else(t69, casadi.if_else(t66, t21, t61), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t105, t106)), 2, casadi.if_else(t110, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t64, t65)), 2, casadi.if_else(t68, 1, 0))
     return [q_dot, status]
 
 
 def _resolved_rate(q, target, target_rate, gain, z, damping):
-    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 334 operations."""
+    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 333 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1537,118 +1535,76 @@ def _resolved_rate(q, target, target_rate, gain, z, damping):
     t12 = c123**2 + t0**2 + t9
     t13 = casadi.sqrt(3 + t8 + t12)
     t14 = c123 + t0 + t2
-    t15 = t4**2
-    t16 = t5**2
-    t17 = damping**2
-    t18 = t8 + t17
-    t19 = t18**2
-    t20 = casadi.sqrt(t15 + t16 + t19)
-    t21 = t20*casadi.if_else((t18 >= 0), 1, -1)
-    t22 = t12 + t17
-    t23 = 3 + t17
-    t24 = casadi.sqrt(2*t15 + 2*t16 + 2*t14**2 + t19 + t22**2 + t23**2)
-    t25 = (t20 > 0)
-    t26 = casadi.if_else(t25, 1/(t18 + t21), 0)
-    t27 = casadi.if_else(t25, 1 + casadi.fabs(t18)/t20, 0)
-    t28 = t4*t26
-    t29 = t5*t26
-    t30 = -t27*(t4 + t22*t28 + t14*t29)
-    t31 = t4 + t30
-    t32 = t22 + t28*t30
-    t33 = t14 + t29*t30
-    t34 = -t27*(t5 + t23*t29 + t14*t28)
-    t35 = t5 + t34
-    t36 = t14 + t28*t34
-    t37 = t23 + t29*t34
-    t38 = casadi.sqrt(t32**2 + t33**2)
-    t39 = t38*casadi.if_else((t32 >= 0), 1, -1)
-    t40 = (t38 > 0)
-    t41 = casadi.if_else(t40, 1/(t32 + t39), 0)
-    t42 = casadi.if_else(t40, 1 + casadi.fabs(t32)/t38, 0)
-    t43 = t33*t41
-    t44 = t42*(t36 + t43*t37)
-    t45 = -t44 + t36
-    t46 = t37 - t43*t44
-    t47 = casadi.fabs(t46)
-    t48 = t47*casadi.if_else((t46 >= 0), 1, -1)
-    t49 = casadi.if_else((t47 > 0), 2, 0)
-    t50 = (t10 > 0)
-    t51 = casadi.if_else(t50, 1 + casadi.fabs(t3)/t10, 0)
-    t52 = -t3
-    t53 = casadi.if_else(t50, 1/(t52 + t11), 0)
-    t54 = mu_dot1 + gain1*(t52 + mu1)
-    t55 = -t1
-    t56 = t2*t53
-    t57 = t51*(t55 + t53 + t0*t56)
-    t58 = t1 + t57
-    t59 = t53*t57
-    t60 = t0 - t2*t59
-    t61 = 1 - t59
-    t62 = casadi.sqrt(t60**2 + t61**2)
-    t63 = t62*casadi.if_else((t60 >= 0), 1, -1)
-    t64 = -s123
-    t65 = t51*(t64 + t53 + c123*t56)
-    t66 = s123 + t65
-    t67 = t53*t65
-    t68 = c123 - t2*t67
-    t69 = 1 - t67
-    t70 = (t62 > 0)
-    t71 = casadi.if_else(t70, 1/(t60 + t63), 0)
-    t72 = casadi.if_else(t70, 1 + casadi.fabs(t60)/t62, 0)
-    t73 = t61*t71
-    t74 = t72*(t68 + t73*t69)
-    t75 = -t74 + t68
-    t76 = t69 - t73*t74
-    t77 = casadi.fabs(t76)
-    t78 = t77*casadi.if_else((t76 >= 0), 1, -1)
-    t79 = casadi.if_else((t77 > 0), 2, 0)
-    t80 = -mu2 + casadi.atan2(s123, c123)
-    t81 = mu_dot2 - gain2*(t80 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t80)))
-    t82 = -t27*(-t6 + t28*t54 + t29*t81)
-    t83 = -t82 + t6
-    t84 = t54 + t28*t82
-    t85 = t81 + t29*t82
-    t86 = t42*(t84 + t43*t85)
-    t87 = -t86 + t84
-    t88 = t85 - t43*t86
-    t89 = t88 - t49*t88
-    t90 = casadi.if_else((t48 != 0), -t89/t48, 0)
-    t91 = casadi.if_else((t39 != 0), -(t87 - t45*t90)/t39, 0)
-    t92 = casadi.if_else((t21 != 0), -(t83 + t31*t91 + t35*t90)/t21, 0)
-    t93 = t90 - t3*t92 + t2*t91
-    t94 = t90 - t1*t92 + t0*t91
-    t95 = t90 - s123*t92 + c123*t91
-    t96 = t51*(t6 + t53*t81 + t56*t54)
-    t97 = -t96 + t6
-    t98 = 3 + q1 + q2 + q3 + t14 + t52 + t55 + t64 + damping + qz1 + qz2 + qz3 + t6 + t54 + t81
-    t99 = t53*t96
-    t100 = t54 - t2*t99
-    t101 = -t99 + t81
-    t102 = t72*(t100 + t73*t101)
-    t103 = -t102 + t100
-    t104 = t101 - t73*t102
-    t105 = t104 - t79*t104
-    t106 = casadi.if_else((t78 != 0), -t105/t78, 0)
-    t107 = casadi.if_else((t63 != 0), -(t103 - t75*t106)/t63, 0)
-    t108 = casadi.if_else((t11 != 0), -(t97 + t58*t107 + t66*t106)/t11, 0)
-    t109 = (casadi.fabs(t98) < casadi.inf)
-    t110 = (damping >= 0)
-    t111 = (damping > 0)
-    t112 = 1e-12*t24
-    t113 = 1e-12*t13
-    t114 = casadi.logic_or(casadi.logic_and(t111, casadi.logic_or(casadi.logic_or((t20 <= t112), (t38 <= t112)), (t47 <= t112))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t10 <= t113), (t62 <= t113)), (t77 <= t113))))
-    t115 = casadi.logic_and(casadi.logic_and(t109, t110), casadi.logic_not(t114))
+    t15 = (t10 > 0)
+    t16 = casadi.if_else(t15, 1 + casadi.fabs(t3)/t10, 0)
+    t17 = -t3
+    t18 = casadi.if_else(t15, 1/(t17 + t11), 0)
+    t19 = mu_dot1 + gain1*(t17 + mu1)
+    t20 = -t1
+    t21 = t2*t18
+    t22 = t16*(t20 + t18 + t0*t21)
+    t23 = t1 + t22
+    t24 = t18*t22
+    t25 = t0 - t2*t24
+    t26 = 1 - t24
+    t27 = casadi.sqrt(t25**2 + t26**2)
+    t28 = t27*casadi.if_else((t25 >= 0), 1, -1)
+    t29 = -s123
+    t30 = t16*(t29 + t18 + c123*t21)
+    t31 = s123 + t30
+    t32 = t18*t30
+    t33 = c123 - t2*t32
+    t34 = 1 - t32
+    t35 = (t27 > 0)
+    t36 = casadi.if_else(t35, 1/(t25 + t28), 0)
+    t37 = casadi.if_else(t35, 1 + casadi.fabs(t25)/t27, 0)
+    t38 = t26*t36
+    t39 = t37*(t33 + t38*t34)
+    t40 = -t39 + t33
+    t41 = t34 - t38*t39
+    t42 = casadi.fabs(t41)
+    t43 = t42*casadi.if_else((t41 >= 0), 1, -1)
+    t44 = casadi.if_else((t42 > 0), 2, 0)
+    t45 = -mu2 + casadi.atan2(s123, c123)
+    t46 = mu_dot2 - gain2*(t45 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t45)))
+    t47 = t16*(t6 + t18*t46 + t21*t19)
+    t48 = -t47 + t6
+    t49 = 3 + q1 + q2 + q3 + t14 + t17 + t20 + t29 + damping + qz1 + qz2 + qz3 + t6 + t19 + t46
+    t50 = damping**2
+    t51 = _symmetric_solve3(1, (t8 + t50, -t4, -t5, t12 + t50, t14, 3 + t50, t6, t19, t46,))
+    t52 = t51[2]
+    t53 = t51[0]
+    t54 = t51[1]
+    t55 = t52 - t3*t53 + t2*t54
+    t56 = t52 - t1*t53 + t0*t54
+    t57 = t52 - s123*t53 + c123*t54
+    t58 = t18*t47
+    t59 = t19 - t2*t58
+    t60 = -t58 + t46
+    t61 = t37*(t59 + t38*t60)
+    t62 = -t61 + t59
+    t63 = t60 - t38*t61
+    t64 = t63 - t44*t63
+    t65 = casadi.if_else((t43 != 0), -t64/t43, 0)
+    t66 = casadi.if_else((t28 != 0), -(t62 - t40*t65)/t28, 0)
+    t67 = casadi.if_else((t11 != 0), -(t48 + t23*t66 + t31*t65)/t11, 0)
+    t68 = (casadi.fabs(t49) < casadi.inf)
+    t69 = (damping >= 0)
+    t70 = (damping > 0)
+    t71 = 1e-12*t13
+    t72 = casadi.logic_or(casadi.logic_and(t70, (t51[3] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or((t10 <= t71), (t27 <= t71)), (t42 <= t71))))
+    t73 = casadi.logic_and(casadi.logic_and(t68, t69), casadi.logic_not(t72))
     q_dot = casadi.SX(3, 1)
-    q_dot[0, 0] = casadi.if_else(t115, casadi.if_else(t111, t93, t108), 0)
-    q_dot[1, 0] = casadi.if_else(t115, casadi.if_else(t111, t94, t107), 0)
-    q_dot[2, 0] = casadi.if_else(t115, casadi.if_else(t111, t95, t106), 0)
+    q_dot[0, 0] = casadi.if_else(t73, casadi.if_else(t70, t55, t67), 0)
+    q_dot[1, 0] = casadi.if_else(t73, casadi.if_else(t70, t56, t66), 0)
+    q_dot[2, 0] = casadi.if_else(t73, casadi.if_else(t70, t57, t65), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t109, t110)), 2, casadi.if_else(t114, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t68, t69)), 2, casadi.if_else(t72, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 185 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 203 operations."""
     mu0 = target[0]
     mu1 = target[1]
     mu2 = target[2]
@@ -1683,58 +1639,21 @@ def _ik_numeric_step(target, q, damping):
     t12 = -mu2 + casadi.atan2(s123, c123)
     t13 = t12 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t12))
     t14 = t9**2 + t10**2 + t13**2
-    t15 = damping + t4
-    t16 = casadi.sqrt(t15**2 + t5**2 + t6**2)
-    t17 = casadi.if_else((t15 >= 0), 1, -1)*t16
-    t18 = (t16 > 0)
-    t19 = casadi.if_else(t18, 1/(t15 + t17), 0)
-    t20 = casadi.if_else(t18, 1 + casadi.fabs(t15)/t16, 0)
-    t21 = damping + t7
-    t22 = t5*t19
-    t23 = t6*t19
-    t24 = -t20*(t5 + t21*t22 + t23*t8)
-    t25 = t5 + t24
-    t26 = t21 + t22*t24
-    t27 = t8 + t23*t24
-    t28 = t20*(t9 - t22*t10 + t23*t13)
-    t29 = -t28 + t9
-    t30 = t10 + t22*t28
-    t31 = -t13 + t23*t28
-    t32 = casadi.sqrt(t26**2 + t27**2)
-    t33 = t32*casadi.if_else((t26 >= 0), 1, -1)
-    t34 = 3 + damping
-    t35 = -t20*(t6 + t22*t8 + t23*t34)
-    t36 = t6 + t35
-    t37 = t8 + t22*t35
-    t38 = t34 + t23*t35
-    t39 = (t32 > 0)
-    t40 = casadi.if_else(t39, 1/(t26 + t33), 0)
-    t41 = casadi.if_else(t39, 1 + casadi.fabs(t26)/t32, 0)
-    t42 = t27*t40
-    t43 = t41*(t37 + t42*t38)
-    t44 = -t43 + t37
-    t45 = t38 - t42*t43
-    t46 = t41*(t30 + t42*t31)
-    t47 = -t46 + t30
-    t48 = t31 - t42*t46
-    t49 = casadi.fabs(t45)
-    t50 = t49*casadi.if_else((t45 >= 0), 1, -1)
-    t51 = casadi.if_else((t49 > 0), 2, 0)
-    t52 = t48 - t48*t51
-    t53 = casadi.if_else((t50 != 0), -t52/t50, 0)
-    t54 = casadi.if_else((t33 != 0), -(t47 - t44*t53)/t33, 0)
-    t55 = casadi.if_else((t17 != 0), -(t29 + t25*t54 + t36*t53)/t17, 0)
-    t56 = q1 + t53 - t3*t55 + t2*t54
-    t57 = q2 + t53 - t1*t55 + t0*t54
-    t58 = q3 + t53 - s123*t55 + c123*t54
+    t15 = _symmetric_solve3(1, (damping + t4, -t5, -t6, damping + t7, t8, 3 + damping, t9, t10, -t13,))
+    t16 = t15[2]
+    t17 = t15[0]
+    t18 = t15[1]
+    t19 = q1 + t16 - t3*t17 + t2*t18
+    t20 = q2 + t16 - t1*t17 + t0*t18
+    t21 = q3 + t16 - s123*t17 + c123*t18
     q_start = casadi.SX(3, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
     q_start[2, 0] = q3
     q_next = casadi.SX(3, 1)
-    q_next[0, 0] = t56
-    q_next[1, 0] = t57
-    q_next[2, 0] = t58
+    q_next[0, 0] = t19
+    q_next[1, 0] = t20
+    q_next[2, 0] = t21
     cost = casadi.SX(1, 1)
     cost[0, 0] = casadi.if_else((casadi.fabs(t11) < casadi.inf), t14, -1)
     return [q_start, q_next, cost]
@@ -1797,7 +1716,7 @@ def _ik_branches(mu):
 
 
 def _ik_nearest(mu, q_seed, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 96 operations."""
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 98 operations."""
     branches_q, branches_valid, branches_in_limits = _ik_branches(mu)
     mu0 = mu[0]
     mu1 = mu[1]
@@ -1818,42 +1737,18 @@ def _ik_nearest(mu, q_seed, weights):
     vb1 = branches_valid[1]
     lb0 = branches_in_limits[0]
     lb1 = branches_in_limits[1]
-    t0 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
-    t1 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
-    t2 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
-    t3 = casadi.if_else(casadi.logic_and(vb0, lb0), 1, 0)
-    t4 = casadi.if_else((t3 > 0), 1, 0)
-    t5 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
-    t6 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
-    t7 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
-    t8 = casadi.if_else(casadi.logic_and(vb1, lb1), 1, 0)
-    t9 = mu2 + mu0 + mu1 + qn1 + qn2 + qn3 + qw1 + qw2 + qw3
-    t10 = -qn1
-    t11 = -qn2
-    t12 = -qn3
-    t13 = qw1*(t10 + t0)**2 + qw2*(t11 + t1)**2 + qw3*(t12 + t2)**2
-    t14 = qw1*(t10 + t5)**2 + qw2*(t11 + t6)**2 + qw3*(t12 + t7)**2
-    t15 = (t4 > 0)
-    t16 = casadi.if_else(t15, t0, qn1)
-    t17 = casadi.if_else(t15, t1, qn2)
-    t18 = casadi.if_else(t15, t2, qn3)
-    t19 = casadi.if_else(t15, t13, 0)
-    t20 = (t8 > 0)
-    t21 = casadi.if_else(casadi.logic_and(t20, casadi.logic_or((t4 < 1), (t14 < t19))), 1, 0)
-    t22 = casadi.if_else(t20, 1, t4)
-    t23 = (t21 > 0)
-    t24 = casadi.if_else(t23, t5, t16)
-    t25 = casadi.if_else(t23, t6, t17)
-    t26 = casadi.if_else(t23, t7, t18)
-    t27 = (t22 > 0)
-    t28 = (casadi.fabs(t9) < casadi.inf)
-    t29 = casadi.logic_and(t27, t28)
+    t0 = mu2 + mu0 + mu1 + qn1 + qn2 + qn3 + qw1 + qw2 + qw3
+    t1 = _nearer_branch(1, (qb0_0, qb0_1, qb0_2, casadi.if_else(casadi.logic_and(vb0, lb0), 1, 0), qn1, qn2, qn3, qw1, qw2, qw3, qn1, qn2, qn3, 0, 0,))
+    t2 = _nearer_branch(1, (qb1_0, qb1_1, qb1_2, casadi.if_else(casadi.logic_and(vb1, lb1), 1, 0), qn1, qn2, qn3, qw1, qw2, qw3, t1[0], t1[1], t1[2], t1[3], t1[4],))
+    t3 = (t2[4] > 0)
+    t4 = (casadi.fabs(t0) < casadi.inf)
+    t5 = casadi.logic_and(t3, t4)
     q = casadi.SX(3, 1)
-    q[0, 0] = casadi.if_else(t29, t24, qn1)
-    q[1, 0] = casadi.if_else(t29, t25, qn2)
-    q[2, 0] = casadi.if_else(t29, t26, qn3)
+    q[0, 0] = casadi.if_else(t5, t2[0], qn1)
+    q[1, 0] = casadi.if_else(t5, t2[1], qn2)
+    q[2, 0] = casadi.if_else(t5, t2[2], qn3)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t28), 2, casadi.if_else(t27, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t4), 2, casadi.if_else(t3, 0, 1))
     return [q, status]
 
 

@@ -836,6 +836,249 @@ def _jacobi6_rows(count, state):
     return state
 
 
+def _symmetric_solve6(count, state):
+    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w1**2
+        t1 = w2**2
+        t2 = w3**2
+        t3 = w4**2
+        t4 = w5**2
+        t5 = w0**2
+        t6 = casadi.sqrt(t5 + 2*t0 + 2*t1 + 2*w7**2 + 2*t2 + 2*w8**2 + 2*w12**2 + 2*t3 + 2*w9**2 + 2*w13**2 + 2*w16**2 + 2*t4 + 2*w10**2 + 2*w14**2 + 2*w17**2 + 2*w19**2 + w6**2 + w11**2 + w15**2 + w18**2 + w20**2)
+        t7 = casadi.sqrt(t0 + t1 + t2 + t3 + t4 + t5)
+        t8 = t7*casadi.if_else((w0 >= 0), 1, -1)
+        t9 = (t7 > 0)
+        t10 = casadi.if_else(t9, 1/(w0 + t8), 0)
+        t11 = casadi.if_else(t9, 1 + casadi.fabs(w0)/t7, 0)
+        t12 = w1*t10
+        t13 = w2*t10
+        t14 = w3*t10
+        t15 = w4*t10
+        t16 = w5*t10
+        t17 = t11*(w1 + t12*w6 + t13*w7 + t14*w8 + t15*w9 + t16*w10)
+        t18 = -t17 + w1
+        t19 = w6 - t12*t17
+        t20 = w7 - t13*t17
+        t21 = w8 - t14*t17
+        t22 = w9 - t15*t17
+        t23 = w10 - t16*t17
+        t24 = t11*(w2 + t12*w7 + t13*w11 + t14*w12 + t15*w13 + t16*w14)
+        t25 = -t24 + w2
+        t26 = w7 - t12*t24
+        t27 = w11 - t13*t24
+        t28 = w12 - t14*t24
+        t29 = w13 - t15*t24
+        t30 = w14 - t16*t24
+        t31 = t11*(w3 + t12*w8 + t13*w12 + t14*w15 + t15*w16 + t16*w17)
+        t32 = -t31 + w3
+        t33 = w8 - t12*t31
+        t34 = w12 - t13*t31
+        t35 = w15 - t14*t31
+        t36 = w16 - t15*t31
+        t37 = w17 - t16*t31
+        t38 = t11*(w4 + t12*w9 + t13*w13 + t14*w16 + t15*w18 + t16*w19)
+        t39 = -t38 + w4
+        t40 = w9 - t12*t38
+        t41 = w13 - t13*t38
+        t42 = w16 - t14*t38
+        t43 = w18 - t15*t38
+        t44 = w19 - t16*t38
+        t45 = t11*(w5 + t12*w10 + t13*w14 + t14*w17 + t15*w19 + t16*w20)
+        t46 = -t45 + w5
+        t47 = w10 - t12*t45
+        t48 = w14 - t13*t45
+        t49 = w17 - t14*t45
+        t50 = w19 - t15*t45
+        t51 = w20 - t16*t45
+        t52 = t11*(w21 + t12*w22 + t13*w23 + t14*w24 + t15*w25 + t16*w26)
+        t53 = -t52 + w21
+        t54 = w22 - t12*t52
+        t55 = w23 - t13*t52
+        t56 = w24 - t14*t52
+        t57 = w25 - t15*t52
+        t58 = w26 - t16*t52
+        t59 = casadi.sqrt(t19**2 + t20**2 + t21**2 + t22**2 + t23**2)
+        t60 = t59*casadi.if_else((t19 >= 0), 1, -1)
+        t61 = (t59 > 0)
+        t62 = casadi.if_else(t61, 1/(t19 + t60), 0)
+        t63 = casadi.if_else(t61, 1 + casadi.fabs(t19)/t59, 0)
+        t64 = t20*t62
+        t65 = t21*t62
+        t66 = t22*t62
+        t67 = t23*t62
+        t68 = t63*(t26 + t64*t27 + t65*t28 + t66*t29 + t67*t30)
+        t69 = -t68 + t26
+        t70 = t27 - t64*t68
+        t71 = t28 - t65*t68
+        t72 = t29 - t66*t68
+        t73 = t30 - t67*t68
+        t74 = t63*(t33 + t64*t34 + t65*t35 + t66*t36 + t67*t37)
+        t75 = -t74 + t33
+        t76 = t34 - t64*t74
+        t77 = t35 - t65*t74
+        t78 = t36 - t66*t74
+        t79 = t37 - t67*t74
+        t80 = t63*(t40 + t64*t41 + t65*t42 + t66*t43 + t67*t44)
+        t81 = -t80 + t40
+        t82 = t41 - t64*t80
+        t83 = t42 - t65*t80
+        t84 = t43 - t66*t80
+        t85 = t44 - t67*t80
+        t86 = t63*(t47 + t64*t48 + t65*t49 + t66*t50 + t67*t51)
+        t87 = -t86 + t47
+        t88 = t48 - t64*t86
+        t89 = t49 - t65*t86
+        t90 = t50 - t66*t86
+        t91 = t51 - t67*t86
+        t92 = t63*(t54 + t64*t55 + t65*t56 + t66*t57 + t67*t58)
+        t93 = -t92 + t54
+        t94 = t55 - t64*t92
+        t95 = t56 - t65*t92
+        t96 = t57 - t66*t92
+        t97 = t58 - t67*t92
+        t98 = casadi.sqrt(t70**2 + t71**2 + t72**2 + t73**2)
+        t99 = t98*casadi.if_else((t70 >= 0), 1, -1)
+        t100 = (t98 > 0)
+        t101 = casadi.if_else(t100, 1/(t70 + t99), 0)
+        t102 = casadi.if_else(t100, 1 + casadi.fabs(t70)/t98, 0)
+        t103 = t71*t101
+        t104 = t72*t101
+        t105 = t73*t101
+        t106 = t102*(t76 + t103*t77 + t104*t78 + t105*t79)
+        t107 = -t106 + t76
+        t108 = t77 - t103*t106
+        t109 = t78 - t104*t106
+        t110 = t79 - t105*t106
+        t111 = t102*(t82 + t103*t83 + t104*t84 + t105*t85)
+        t112 = -t111 + t82
+        t113 = t83 - t103*t111
+        t114 = t84 - t104*t111
+        t115 = t85 - t105*t111
+        t116 = t102*(t88 + t103*t89 + t104*t90 + t105*t91)
+        t117 = -t116 + t88
+        t118 = t89 - t103*t116
+        t119 = t90 - t104*t116
+        t120 = t91 - t105*t116
+        t121 = t102*(t94 + t103*t95 + t104*t96 + t105*t97)
+        t122 = -t121 + t94
+        t123 = t95 - t103*t121
+        t124 = t96 - t104*t121
+        t125 = t97 - t105*t121
+        t126 = casadi.sqrt(t108**2 + t109**2 + t110**2)
+        t127 = t126*casadi.if_else((t108 >= 0), 1, -1)
+        t128 = (t126 > 0)
+        t129 = casadi.if_else(t128, 1/(t108 + t127), 0)
+        t130 = casadi.if_else(t128, 1 + casadi.fabs(t108)/t126, 0)
+        t131 = t109*t129
+        t132 = t110*t129
+        t133 = t130*(t113 + t131*t114 + t132*t115)
+        t134 = -t133 + t113
+        t135 = t114 - t131*t133
+        t136 = t115 - t132*t133
+        t137 = t130*(t118 + t131*t119 + t132*t120)
+        t138 = -t137 + t118
+        t139 = t119 - t131*t137
+        t140 = t120 - t132*t137
+        t141 = t130*(t123 + t131*t124 + t132*t125)
+        t142 = -t141 + t123
+        t143 = t124 - t131*t141
+        t144 = t125 - t132*t141
+        t145 = casadi.sqrt(t135**2 + t136**2)
+        t146 = t145*casadi.if_else((t135 >= 0), 1, -1)
+        t147 = (t145 > 0)
+        t148 = casadi.if_else(t147, 1/(t135 + t146), 0)
+        t149 = casadi.if_else(t147, 1 + casadi.fabs(t135)/t145, 0)
+        t150 = t136*t148
+        t151 = t149*(t139 + t150*t140)
+        t152 = -t151 + t139
+        t153 = t140 - t150*t151
+        t154 = t149*(t143 + t150*t144)
+        t155 = -t154 + t143
+        t156 = t144 - t150*t154
+        t157 = casadi.fabs(t153)
+        t158 = t157*casadi.if_else((t153 >= 0), 1, -1)
+        t159 = casadi.if_else((t157 > 0), 2, 0)
+        t160 = t156 - t156*t159
+        t161 = casadi.if_else((t158 != 0), -t160/t158, 0)
+        t162 = casadi.if_else((t146 != 0), -(t155 - t152*t161)/t146, 0)
+        t163 = casadi.if_else((t127 != 0), -(-(t134*t162 + t138*t161) + t142)/t127, 0)
+        t164 = casadi.if_else((t99 != 0), -(-(t107*t163 + t112*t162 + t117*t161) + t122)/t99, 0)
+        t165 = casadi.if_else((t60 != 0), -(-(t69*t164 + t75*t163 + t81*t162 + t87*t161) + t93)/t60, 0)
+        t166 = casadi.if_else((t8 != 0), -(-(t18*t165 + t25*t164 + t32*t163 + t39*t162 + t46*t161) + t53)/t8, 0)
+        t167 = 1e-12*t6
+        state = (
+            t166,
+            t165,
+            t164,
+            t163,
+            t162,
+            t161,
+            casadi.if_else(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t7 <= t167), (t59 <= t167)), (t98 <= t167)), (t126 <= t167)), (t145 <= t167)), (t157 <= t167)), 1, 0),
+        )
+    return state
+
+
+def _nearer_branch(count, state):
+    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 114 operations a run."""
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w0 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-w0 + w7))
+        t1 = w1 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-w1 + w8))
+        t2 = w2 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-w2 + w9))
+        t3 = w3 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-w3 + w10))
+        t4 = w4 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-w4 + w11))
+        t5 = w5 + 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-w5 + w12))
+        t6 = casadi.if_else((t0 < w7), 6.283185307179586, -6.283185307179586)
+        t7 = t6 + t0
+        t8 = -t6 + t0
+        t9 = casadi.if_else(casadi.logic_and((t0 >= -2.792526803190927), (t0 <= 2.792526803190927)), t0, casadi.if_else(casadi.logic_and((t7 >= -2.792526803190927), (t7 <= 2.792526803190927)), t7, casadi.if_else(casadi.logic_and((t8 >= -2.792526803190927), (t8 <= 2.792526803190927)), t8, w0)))
+        t10 = casadi.if_else((t1 < w8), 6.283185307179586, -6.283185307179586)
+        t11 = t10 + t1
+        t12 = -t10 + t1
+        t13 = casadi.if_else(casadi.logic_and((t1 >= -0.7853981633974483), (t1 <= 3.9269908169872414)), t1, casadi.if_else(casadi.logic_and((t11 >= -0.7853981633974483), (t11 <= 3.9269908169872414)), t11, casadi.if_else(casadi.logic_and((t12 >= -0.7853981633974483), (t12 <= 3.9269908169872414)), t12, w1)))
+        t14 = casadi.if_else((t2 < w9), 6.283185307179586, -6.283185307179586)
+        t15 = t14 + t2
+        t16 = -t14 + t2
+        t17 = casadi.if_else(casadi.logic_and((t2 >= -3.9269908169872414), (t2 <= 0.7853981633974483)), t2, casadi.if_else(casadi.logic_and((t15 >= -3.9269908169872414), (t15 <= 0.7853981633974483)), t15, casadi.if_else(casadi.logic_and((t16 >= -3.9269908169872414), (t16 <= 0.7853981633974483)), t16, w2)))
+        t18 = casadi.if_else((t3 < w10), 6.283185307179586, -6.283185307179586)
+        t19 = t18 + t3
+        t20 = -t18 + t3
+        t21 = casadi.if_else(casadi.logic_and((t3 >= -1.9198621771937625), (t3 <= 2.9670597283903604)), t3, casadi.if_else(casadi.logic_and((t19 >= -1.9198621771937625), (t19 <= 2.9670597283903604)), t19, casadi.if_else(casadi.logic_and((t20 >= -1.9198621771937625), (t20 <= 2.9670597283903604)), t20, w3)))
+        t22 = casadi.if_else((t4 < w11), 6.283185307179586, -6.283185307179586)
+        t23 = t22 + t4
+        t24 = -t22 + t4
+        t25 = casadi.if_else(casadi.logic_and((t4 >= -1.7453292519943295), (t4 <= 1.7453292519943295)), t4, casadi.if_else(casadi.logic_and((t23 >= -1.7453292519943295), (t23 <= 1.7453292519943295)), t23, casadi.if_else(casadi.logic_and((t24 >= -1.7453292519943295), (t24 <= 1.7453292519943295)), t24, w4)))
+        t26 = casadi.if_else((t5 < w12), 6.283185307179586, -6.283185307179586)
+        t27 = t26 + t5
+        t28 = -t26 + t5
+        t29 = casadi.if_else(casadi.logic_and((t5 >= -4.642575810304916), (t5 <= 4.642575810304916)), t5, casadi.if_else(casadi.logic_and((t27 >= -4.642575810304916), (t27 <= 4.642575810304916)), t27, casadi.if_else(casadi.logic_and((t28 >= -4.642575810304916), (t28 <= 4.642575810304916)), t28, w5)))
+        t30 = w13*(-w7 + t9)**2 + w14*(-w8 + t13)**2 + w15*(-w9 + t17)**2 + w16*(-w10 + t21)**2 + w17*(-w11 + t25)**2 + w18*(-w12 + t29)**2
+        t31 = (w6 > 0)
+        t32 = casadi.if_else(casadi.logic_and(t31, casadi.logic_or((w26 < 1), (t30 < w25))), 1, 0)
+        t33 = casadi.if_else(t31, 1, w26)
+        t34 = (t32 > 0)
+        t35 = casadi.if_else(t34, t9, w19)
+        t36 = casadi.if_else(t34, t13, w20)
+        t37 = casadi.if_else(t34, t17, w21)
+        t38 = casadi.if_else(t34, t21, w22)
+        t39 = casadi.if_else(t34, t25, w23)
+        t40 = casadi.if_else(t34, t29, w24)
+        t41 = casadi.if_else(t34, t30, w25)
+        state = (
+            t35,
+            t36,
+            t37,
+            t38,
+            t39,
+            t40,
+            t41,
+            t33,
+        )
+    return state
+
+
 def _fk(q):
     """Pose of the tool frame in the world frame (4x4 homogeneous): 96 operations."""
     q1 = q[0]
@@ -2873,7 +3116,7 @@ def _condition_number(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1195 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1211 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -2942,375 +3185,206 @@ def _velocity_ik(q, mu_dot, damping):
     t41 = t9**2 + t18**2 + 2*t28 + t36*t39
     t42 = 1 + c23**2 + t0**2 + s4**2*t39
     t43 = casadi.sqrt(t26 + t32 + t38 + t40 + t41 + t42)
-    t44 = t22*t23
-    t45 = s1*c1
-    t46 = -t44 + t30*t45 + t31*t45
-    t47 = c1*t24
-    t48 = c1*t20
-    t49 = t2*t47 + t1*t48
-    t50 = t47 + t48
-    t51 = c1*t2
-    t52 = c1*t1
-    t53 = s1*t51 + s1*t52
-    t54 = s1*t24
-    t55 = s1*t20
-    t56 = t2*t54 + t1*t55
-    t57 = t54 + t55
-    t58 = 2*s1
-    t59 = -t12*t9 + t15*t18 - c1*t58 + t39*t45
-    t60 = s23*s4
-    t61 = c23*t14 + t15*t0 - t12*t60
-    t62 = c23*t17 + t18*t0 + t9*t60
-    t63 = t46**2
-    t64 = t49**2
-    t65 = t29**2
-    t66 = t53**2
-    t67 = damping**2
-    t68 = t32 + t67
-    t69 = t68**2
-    t70 = casadi.sqrt(t27 + t63 + t64 + t65 + t66 + t69)
-    t71 = t70*casadi.if_else((t68 >= 0), 1, -1)
-    t72 = t38 + t67
-    t73 = t26 + t67
-    t74 = t40 + t67
-    t75 = t41 + t67
-    t76 = t42 + t67
-    t77 = casadi.sqrt(2*t33 + 2*t27 + 2*t63 + 2*t64 + 2*t56**2 + 2*t37**2 + 2*t57**2 + 2*t65 + 2*t50**2 + 2*t59**2 + 2*t61**2 + 2*t62**2 + t69 + t72**2 + t73**2 + t74**2 + t75**2 + t76**2 + 4*t66)
-    t78 = (t70 > 0)
-    t79 = casadi.if_else(t78, 1/(t68 + t71), 0)
-    t80 = casadi.if_else(t78, 1 + casadi.fabs(t68)/t70, 0)
-    t81 = t46*t79
-    t82 = t49*t79
-    t83 = t53*t79
-    t84 = t80*(t46 + t72*t81 + t82*t56 + t83*t37 + t83*t29 - t44*t79)
-    t85 = -t84 + t46
-    t86 = t72 - t81*t84
-    t87 = -t56 + t82*t84
-    t88 = -t37 + t83*t84
-    t89 = t79*t84
-    t90 = t53 - t89*t29
-    t91 = t22 + t23*t89
-    t92 = casadi.sqrt(t86**2 + t87**2 + t88**2 + t90**2 + t91**2)
-    t93 = t92*casadi.if_else((t86 >= 0), 1, -1)
-    t94 = t29*t79
-    t95 = -t80*(t49 + t81*t56 + t73*t82 + t83*t57 + t94*t50)
-    t96 = t49 + t95
-    t97 = t56 + t81*t95
-    t98 = t73 + t82*t95
-    t99 = t57 + t83*t95
-    t100 = t50 + t94*t95
-    t101 = t23*t79
-    t102 = -t80*(t53 + t81*t37 + t82*t57 + t74*t83 - t94*t59 - t101*t61)
-    t103 = t53 + t102
-    t104 = t37 + t81*t102
-    t105 = t57 + t82*t102
-    t106 = t74 + t83*t102
-    t107 = t59 - t94*t102
-    t108 = t80*(t29 + t81*t53 + t82*t50 - t83*t59 + t75*t94 + t101*t62)
-    t109 = -t108 + t29
-    t110 = t53 - t81*t108
-    t111 = -t50 + t82*t108
-    t112 = t59 + t83*t108
-    t113 = t75 - t94*t108
-    t114 = -t62 + t101*t108
-    t115 = -t80*(t23 - t22*t81 - t83*t61 + t94*t62 + t76*t101)
-    t116 = t23 + t115
-    t117 = t22 - t81*t115
-    t118 = t62 + t94*t115
-    t119 = t76 + t101*t115
-    t120 = t80*(mu_dot0 + t81*mu_dot1 - t82*mu_dot2 - t83*mu_dot3 + t94*mu_dot4 - t101*mu_dot5)
-    t121 = -t120 + mu_dot0
-    t122 = mu_dot1 - t81*t120
-    t123 = mu_dot2 + t82*t120
-    t124 = mu_dot3 + t83*t120
-    t125 = mu_dot4 - t94*t120
-    t126 = mu_dot5 + t101*t120
-    t127 = -t61
-    t128 = t127 + t101*t102
-    t129 = t127 + t83*t115
-    t130 = (t92 > 0)
-    t131 = casadi.if_else(t130, 1/(t86 + t93), 0)
-    t132 = casadi.if_else(t130, 1 + casadi.fabs(t86)/t92, 0)
-    t133 = t87*t131
-    t134 = t88*t131
-    t135 = t90*t131
-    t136 = t101*t95
-    t137 = t91*t131
-    t138 = t132*(-t97 + t133*t98 + t134*t99 - t135*t100 + t136*t137)
-    t139 = t97 + t138
-    t140 = t98 - t133*t138
-    t141 = t99 - t134*t138
-    t142 = t100 + t135*t138
-    t143 = t136 - t137*t138
-    t144 = t132*(-t104 + t133*t105 + t134*t106 + t135*t107 + t137*t128)
-    t145 = t104 + t144
-    t146 = t105 - t133*t144
-    t147 = t106 - t134*t144
-    t148 = t107 - t135*t144
-    t149 = t128 - t137*t144
-    t150 = t132*(t110 + t133*t111 + t134*t112 + t135*t113 + t137*t114)
-    t151 = -t150 + t110
-    t152 = t111 - t133*t150
-    t153 = t112 - t134*t150
-    t154 = t113 - t135*t150
-    t155 = t114 - t137*t150
-    t156 = t132*(t122 + t133*t123 + t134*t124 + t135*t125 + t137*t126)
-    t157 = -t156 + t122
-    t158 = t123 - t133*t156
-    t159 = t124 - t134*t156
-    t160 = t125 - t135*t156
-    t161 = t126 - t137*t156
-    t162 = casadi.sqrt(t140**2 + t141**2 + t142**2 + t143**2)
-    t163 = t162*casadi.if_else((t140 >= 0), 1, -1)
-    t164 = t82*t115
-    t165 = t132*(t117 + t133*t164 + t134*t129 - t135*t118 + t137*t119)
-    t166 = -t165 + t117
-    t167 = t164 - t133*t165
-    t168 = t129 - t134*t165
-    t169 = t118 + t135*t165
-    t170 = t119 - t137*t165
-    t171 = (t162 > 0)
-    t172 = casadi.if_else(t171, 1/(t140 + t163), 0)
-    t173 = casadi.if_else(t171, 1 + casadi.fabs(t140)/t162, 0)
-    t174 = t141*t172
-    t175 = t142*t172
-    t176 = t143*t172
-    t177 = t173*(t146 + t174*t147 - t175*t148 + t176*t149)
-    t178 = -t177 + t146
-    t179 = t147 - t174*t177
-    t180 = t148 + t175*t177
-    t181 = t149 - t176*t177
-    t182 = t173*(t152 + t174*t153 - t175*t154 + t176*t155)
-    t183 = -t182 + t152
-    t184 = t153 - t174*t182
-    t185 = t154 + t175*t182
-    t186 = t155 - t176*t182
-    t187 = t173*(t167 + t174*t168 + t175*t169 + t176*t170)
-    t188 = -t187 + t167
-    t189 = t168 - t174*t187
-    t190 = -t169 + t175*t187
-    t191 = t170 - t176*t187
-    t192 = t173*(t158 + t174*t159 - t175*t160 + t176*t161)
-    t193 = -t192 + t158
-    t194 = t159 - t174*t192
-    t195 = t160 + t175*t192
-    t196 = t161 - t176*t192
-    t197 = casadi.sqrt(t179**2 + t180**2 + t181**2)
-    t198 = t197*casadi.if_else((t179 >= 0), 1, -1)
-    t199 = (t197 > 0)
-    t200 = casadi.if_else(t199, 1/(t179 + t198), 0)
-    t201 = casadi.if_else(t199, 1 + casadi.fabs(t179)/t197, 0)
-    t202 = t180*t200
-    t203 = t181*t200
-    t204 = t201*(t184 + t202*t185 + t203*t186)
-    t205 = -t204 + t184
-    t206 = t185 - t202*t204
-    t207 = t186 - t203*t204
-    t208 = t201*(t189 + t202*t190 + t203*t191)
-    t209 = -t208 + t189
-    t210 = t190 - t202*t208
-    t211 = t191 - t203*t208
-    t212 = t201*(t194 + t202*t195 + t203*t196)
-    t213 = -t212 + t194
-    t214 = t195 - t202*t212
-    t215 = t196 - t203*t212
-    t216 = casadi.sqrt(t206**2 + t207**2)
-    t217 = t216*casadi.if_else((t206 >= 0), 1, -1)
-    t218 = (t216 > 0)
-    t219 = casadi.if_else(t218, 1/(t206 + t217), 0)
-    t220 = casadi.if_else(t218, 1 + casadi.fabs(t206)/t216, 0)
-    t221 = t207*t219
-    t222 = t220*(t210 + t221*t211)
-    t223 = -t222 + t210
-    t224 = t211 - t221*t222
-    t225 = t220*(t214 + t221*t215)
-    t226 = -t225 + t214
-    t227 = t215 - t221*t225
-    t228 = casadi.fabs(t224)
-    t229 = t228*casadi.if_else((t224 >= 0), 1, -1)
-    t230 = casadi.if_else((t228 > 0), 2, 0)
-    t231 = t227 - t227*t230
-    t232 = casadi.if_else((t229 != 0), -t231/t229, 0)
-    t233 = casadi.if_else((t217 != 0), -(t226 - t223*t232)/t217, 0)
-    t234 = casadi.if_else((t198 != 0), -(-(t205*t233 + t209*t232) + t213)/t198, 0)
-    t235 = casadi.if_else((t163 != 0), -(-(t178*t234 + t183*t233 + t188*t232) + t193)/t163, 0)
-    t236 = casadi.if_else((t93 != 0), -(-(-t139*t235 - t145*t234 + t151*t233 + t166*t232) + t157)/t93, 0)
-    t237 = casadi.if_else((t71 != 0), -(t121 + t96*t235 + t103*t234 + t116*t232 - t85*t236 - t109*t233)/t71, 0)
-    t238 = t232 - t23*t237 + t22*t236
-    t239 = -c23*t232 + t14*t234 + t17*t233
-    t240 = t12*t234 - t9*t233 + t60*t232
-    t241 = t15*t234 + t18*t233 - t0*t232
-    t242 = s1*t2
-    t243 = c1*t233 - s1*t234
-    t244 = t243 - t24*t235 + t51*t237 + t242*t236
-    t245 = s1*t1
-    t246 = t243 - t20*t235 + t52*t237 + t245*t236
-    t247 = (t34 > 0)
-    t248 = casadi.if_else(t247, 1 + casadi.fabs(t23)/t34, 0)
-    t249 = -t23
-    t250 = casadi.if_else(t247, 1/(t249 + t35), 0)
-    t251 = t22*t250
-    t252 = -t248*(t51 + t242*t251)
-    t253 = t51 + t252
-    t254 = t242 + t251*t252
-    t255 = -t248*(t52 + t245*t251)
-    t256 = t52 + t255
-    t257 = t248*(mu_dot0 + mu_dot5*t250 + t251*mu_dot1)
-    t258 = -t257 + mu_dot0
-    t259 = t250*t255
-    t260 = t245 + t22*t259
-    t261 = t250**2
-    t262 = casadi.sqrt(t25 + t28 + t36 + t254**2 + t261*t252**2)
-    t263 = t262*casadi.if_else((t254 <= 0), 1, -1)
-    t264 = t261*t248
-    t265 = c23*t264
-    t266 = t22*t265
-    t267 = -t265 + c23
-    t268 = t60*t264
-    t269 = t22*t268
-    t270 = -t268 + t60
-    t271 = t0*t264
-    t272 = t22*t271
-    t273 = -t271 + t0
-    t274 = t250*t257
-    t275 = mu_dot1 - t22*t274
-    t276 = -t274 + mu_dot5
-    t277 = (t262 > 0)
-    t278 = casadi.if_else(t277, 1/(-t254 + t263), 0)
-    t279 = casadi.if_else(t277, 1 + casadi.fabs(t254)/t262, 0)
-    t280 = t24*t278
-    t281 = t252*t278
-    t282 = t279*(-t260 + t20*t280 + t36*t278 + t28*t278 + t261*t281*t255)
-    t283 = t260 + t282
-    t284 = t20 - t280*t282
-    t285 = t278*t282
-    t286 = s1 - s1*t285
-    t287 = -c1 + c1*t285
-    t288 = t250*t252
-    t289 = -t259 + t285*t288
-    t290 = casadi.sqrt(t284**2 + t286**2 + t287**2 + t289**2)
-    t291 = t290*casadi.if_else((t284 >= 0), 1, -1)
-    t292 = t281*t250
-    t293 = -t279*(t266 + t292*t267)
-    t294 = t266 + t293
-    t295 = t278*t293
-    t296 = t14 + s1*t295
-    t297 = t267 + t288*t295
-    t298 = -t17
-    t299 = t298 + c1*t295
-    t300 = s1*t278
-    t301 = c1*t278
-    t302 = t279*(-t269 + t12*t300 + t9*t301 - t292*t270)
-    t303 = t269 + t302
-    t304 = t12 - t300*t302
-    t305 = t270 + t292*t302
-    t306 = -t279*(t272 + t15*t300 - t18*t301 + t292*t273)
-    t307 = t272 + t306
-    t308 = t15 + t300*t306
-    t309 = t273 + t292*t306
-    t310 = t279*(t275 + t280*mu_dot2 + t300*mu_dot3 - t301*mu_dot4 - t292*t276)
-    t311 = -t310 + t275
-    t312 = mu_dot2 - t280*t310
-    t313 = mu_dot3 - t300*t310
-    t314 = mu_dot4 + t301*t310
-    t315 = t276 + t292*t310
-    t316 = -t9
-    t317 = t316 + t301*t302
-    t318 = -t18
-    t319 = t318 + t301*t306
-    t320 = 1 - t15 - t51 - t52 - t242 - t245 - t14 + q1 + q2 + q3 + c23 + q4 + t12 + q5 + t0 + q6 + t22 + t24 + t20 - 2*c1 + t58 + t60 + t249 + t298 + t316 + t318 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t321 = (t290 > 0)
-    t322 = casadi.if_else(t321, 1/(t284 + t291), 0)
-    t323 = casadi.if_else(t321, 1 + casadi.fabs(t284)/t290, 0)
-    t324 = t280*t293
-    t325 = t286*t322
-    t326 = t287*t322
-    t327 = t289*t322
-    t328 = t323*(-t324 - t325*t296 + t326*t299 + t327*t297)
-    t329 = t324 + t328
-    t330 = t296 + t325*t328
-    t331 = t299 - t326*t328
-    t332 = t297 - t327*t328
-    t333 = t323*(t312 + t325*t313 + t326*t314 + t327*t315)
-    t334 = -t333 + t312
-    t335 = t313 - t325*t333
-    t336 = t314 - t326*t333
-    t337 = t315 - t327*t333
-    t338 = casadi.sqrt(t330**2 + t331**2 + t332**2)
-    t339 = t338*casadi.if_else((t330 <= 0), 1, -1)
-    t340 = t280*t302
-    t341 = t323*(-t340 + t325*t304 + t326*t317 + t327*t305)
-    t342 = t340 + t341
-    t343 = t304 - t325*t341
-    t344 = t317 - t326*t341
-    t345 = t305 - t327*t341
-    t346 = t280*t306
-    t347 = t323*(-t346 - t325*t308 + t326*t319 + t327*t309)
-    t348 = t346 + t347
-    t349 = t308 + t325*t347
-    t350 = t319 - t326*t347
-    t351 = t309 - t327*t347
-    t352 = (t338 > 0)
-    t353 = casadi.if_else(t352, 1/(-t330 + t339), 0)
-    t354 = casadi.if_else(t352, 1 + casadi.fabs(t330)/t338, 0)
-    t355 = t331*t353
-    t356 = t332*t353
-    t357 = t354*(t343 + t355*t344 + t356*t345)
-    t358 = -t357 + t343
-    t359 = t344 - t355*t357
-    t360 = t345 - t356*t357
-    t361 = t354*(-t349 + t355*t350 + t356*t351)
-    t362 = t349 + t361
-    t363 = t350 - t355*t361
-    t364 = t351 - t356*t361
-    t365 = t354*(t335 + t355*t336 + t356*t337)
-    t366 = -t365 + t335
-    t367 = t336 - t355*t365
-    t368 = t337 - t356*t365
-    t369 = casadi.sqrt(t359**2 + t360**2)
-    t370 = t369*casadi.if_else((t359 >= 0), 1, -1)
-    t371 = (t369 > 0)
-    t372 = casadi.if_else(t371, 1/(t359 + t370), 0)
-    t373 = casadi.if_else(t371, 1 + casadi.fabs(t359)/t369, 0)
-    t374 = t360*t372
-    t375 = t373*(t363 + t374*t364)
-    t376 = -t375 + t363
-    t377 = t364 - t374*t375
-    t378 = t373*(t367 + t374*t368)
-    t379 = -t378 + t367
-    t380 = t368 - t374*t378
-    t381 = casadi.fabs(t377)
-    t382 = t381*casadi.if_else((t377 >= 0), 1, -1)
-    t383 = casadi.if_else((t381 > 0), 2, 0)
-    t384 = t380 - t380*t383
-    t385 = casadi.if_else((t382 != 0), -t384/t382, 0)
-    t386 = casadi.if_else((t370 != 0), -(t379 - t376*t385)/t370, 0)
-    t387 = casadi.if_else((t339 != 0), -(-(t358*t386 - t362*t385) + t366)/t339, 0)
-    t388 = casadi.if_else((t291 != 0), -(t334 + t329*t387 + t342*t386 + t348*t385)/t291, 0)
-    t389 = casadi.if_else((t263 != 0), -(t311 + t283*t388 + t294*t387 + t303*t386 + t307*t385)/t263, 0)
-    t390 = t250*t248
-    t391 = casadi.if_else((t35 != 0), -(t258 + t253*t389 + t256*t388 + c23*t390*t387 + t60*t390*t386 + t0*t390*t385)/t35, 0)
-    t392 = (casadi.fabs(t320) < casadi.inf)
-    t393 = (damping >= 0)
-    t394 = (damping > 0)
-    t395 = 1e-12*t77
-    t396 = 1e-12*t43
-    t397 = casadi.logic_or(casadi.logic_and(t394, casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t70 <= t395), (t92 <= t395)), (t162 <= t395)), (t197 <= t395)), (t216 <= t395)), (t228 <= t395))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t34 <= t396), (t262 <= t396)), (t290 <= t396)), (t338 <= t396)), (t369 <= t396)), (t381 <= t396))))
-    t398 = casadi.logic_and(casadi.logic_and(t392, t393), casadi.logic_not(t397))
+    t44 = s1*c1
+    t45 = -t22*t23 + t30*t44 + t31*t44
+    t46 = c1*t24
+    t47 = c1*t20
+    t48 = t1*t47 + t2*t46
+    t49 = t46 + t47
+    t50 = c1*t2
+    t51 = c1*t1
+    t52 = s1*t50 + s1*t51
+    t53 = s1*t24
+    t54 = s1*t20
+    t55 = t1*t54 + t2*t53
+    t56 = t53 + t54
+    t57 = 2*s1
+    t58 = -t12*t9 + t15*t18 - c1*t57 + t39*t44
+    t59 = s23*s4
+    t60 = c23*t14 + t15*t0 - t12*t59
+    t61 = c23*t17 + t18*t0 + t9*t59
+    t62 = damping**2
+    t63 = -t23
+    t64 = _symmetric_solve6(1, (t32 + t62, t45, -t48, -t52, t29, t63, t38 + t62, -t55, -t37, t52, t22, t26 + t62, t56, -t49, 0, t40 + t62, t58, -t60, t41 + t62, -t61, t42 + t62, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t65 = t64[5]
+    t66 = t64[0]
+    t67 = t64[1]
+    t68 = t65 - t23*t66 + t22*t67
+    t69 = s1*t2
+    t70 = t64[2]
+    t71 = t64[3]
+    t72 = t64[4]
+    t73 = t14*t71 + t17*t72 - c23*t65
+    t74 = t12*t71 - t9*t72 + t59*t65
+    t75 = t15*t71 + t18*t72 - t0*t65
+    t76 = -s1*t71 + c1*t72
+    t77 = t76 + t50*t66 + t67*t69 - t24*t70
+    t78 = s1*t1
+    t79 = t76 + t51*t66 + t67*t78 - t20*t70
+    t80 = (t34 > 0)
+    t81 = casadi.if_else(t80, 1/(t63 + t35), 0)
+    t82 = casadi.if_else(t80, 1 + casadi.fabs(t23)/t34, 0)
+    t83 = t22*t81
+    t84 = -t82*(t50 + t69*t83)
+    t85 = t50 + t84
+    t86 = t69 + t83*t84
+    t87 = -t82*(t51 + t78*t83)
+    t88 = t51 + t87
+    t89 = t82*(mu_dot0 + mu_dot5*t81 + t83*mu_dot1)
+    t90 = -t89 + mu_dot0
+    t91 = t81*t87
+    t92 = t78 + t22*t91
+    t93 = t81**2
+    t94 = casadi.sqrt(t25 + t28 + t36 + t86**2 + t93*t84**2)
+    t95 = t94*casadi.if_else((t86 <= 0), 1, -1)
+    t96 = t93*t82
+    t97 = c23*t96
+    t98 = t22*t97
+    t99 = -t97 + c23
+    t100 = t59*t96
+    t101 = t22*t100
+    t102 = -t100 + t59
+    t103 = t0*t96
+    t104 = t22*t103
+    t105 = -t103 + t0
+    t106 = t81*t89
+    t107 = mu_dot1 - t22*t106
+    t108 = -t106 + mu_dot5
+    t109 = (t94 > 0)
+    t110 = casadi.if_else(t109, 1/(-t86 + t95), 0)
+    t111 = casadi.if_else(t109, 1 + casadi.fabs(t86)/t94, 0)
+    t112 = t24*t110
+    t113 = t84*t110
+    t114 = t111*(-t92 + t20*t112 + t36*t110 + t28*t110 + t93*t113*t87)
+    t115 = t92 + t114
+    t116 = t20 - t112*t114
+    t117 = t110*t114
+    t118 = s1 - s1*t117
+    t119 = -c1 + c1*t117
+    t120 = t81*t84
+    t121 = -t91 + t117*t120
+    t122 = casadi.sqrt(t116**2 + t118**2 + t119**2 + t121**2)
+    t123 = t122*casadi.if_else((t116 >= 0), 1, -1)
+    t124 = t113*t81
+    t125 = -t111*(t98 + t124*t99)
+    t126 = t98 + t125
+    t127 = t110*t125
+    t128 = t14 + s1*t127
+    t129 = t99 + t120*t127
+    t130 = -t17
+    t131 = t130 + c1*t127
+    t132 = s1*t110
+    t133 = c1*t110
+    t134 = t111*(-t101 + t12*t132 + t9*t133 - t124*t102)
+    t135 = t101 + t134
+    t136 = t12 - t132*t134
+    t137 = t102 + t124*t134
+    t138 = -t111*(t104 + t15*t132 - t18*t133 + t124*t105)
+    t139 = t104 + t138
+    t140 = t15 + t132*t138
+    t141 = t105 + t124*t138
+    t142 = t111*(t107 + t112*mu_dot2 + t132*mu_dot3 - t133*mu_dot4 - t124*t108)
+    t143 = -t142 + t107
+    t144 = mu_dot2 - t112*t142
+    t145 = mu_dot3 - t132*t142
+    t146 = mu_dot4 + t133*t142
+    t147 = t108 + t124*t142
+    t148 = -t9
+    t149 = t148 + t133*t134
+    t150 = -t18
+    t151 = t150 + t133*t138
+    t152 = 1 - t15 - t50 - t51 - t69 - t78 - t14 + q1 + q2 + q3 + c23 + q4 + t12 + q5 + t0 + q6 + t22 + t24 + t20 - 2*c1 + t57 + t59 + t63 + t130 + t148 + t150 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t153 = (t122 > 0)
+    t154 = casadi.if_else(t153, 1/(t116 + t123), 0)
+    t155 = casadi.if_else(t153, 1 + casadi.fabs(t116)/t122, 0)
+    t156 = t112*t125
+    t157 = t118*t154
+    t158 = t119*t154
+    t159 = t121*t154
+    t160 = t155*(-t156 - t157*t128 + t158*t131 + t159*t129)
+    t161 = t156 + t160
+    t162 = t128 + t157*t160
+    t163 = t131 - t158*t160
+    t164 = t129 - t159*t160
+    t165 = t155*(t144 + t157*t145 + t158*t146 + t159*t147)
+    t166 = -t165 + t144
+    t167 = t145 - t157*t165
+    t168 = t146 - t158*t165
+    t169 = t147 - t159*t165
+    t170 = casadi.sqrt(t162**2 + t163**2 + t164**2)
+    t171 = t170*casadi.if_else((t162 <= 0), 1, -1)
+    t172 = t112*t134
+    t173 = t155*(-t172 + t157*t136 + t158*t149 + t159*t137)
+    t174 = t172 + t173
+    t175 = t136 - t157*t173
+    t176 = t149 - t158*t173
+    t177 = t137 - t159*t173
+    t178 = t112*t138
+    t179 = t155*(-t178 - t157*t140 + t158*t151 + t159*t141)
+    t180 = t178 + t179
+    t181 = t140 + t157*t179
+    t182 = t151 - t158*t179
+    t183 = t141 - t159*t179
+    t184 = (t170 > 0)
+    t185 = casadi.if_else(t184, 1/(-t162 + t171), 0)
+    t186 = casadi.if_else(t184, 1 + casadi.fabs(t162)/t170, 0)
+    t187 = t163*t185
+    t188 = t164*t185
+    t189 = t186*(t175 + t187*t176 + t188*t177)
+    t190 = -t189 + t175
+    t191 = t176 - t187*t189
+    t192 = t177 - t188*t189
+    t193 = t186*(-t181 + t187*t182 + t188*t183)
+    t194 = t181 + t193
+    t195 = t182 - t187*t193
+    t196 = t183 - t188*t193
+    t197 = t186*(t167 + t187*t168 + t188*t169)
+    t198 = -t197 + t167
+    t199 = t168 - t187*t197
+    t200 = t169 - t188*t197
+    t201 = casadi.sqrt(t191**2 + t192**2)
+    t202 = t201*casadi.if_else((t191 >= 0), 1, -1)
+    t203 = (t201 > 0)
+    t204 = casadi.if_else(t203, 1/(t191 + t202), 0)
+    t205 = casadi.if_else(t203, 1 + casadi.fabs(t191)/t201, 0)
+    t206 = t192*t204
+    t207 = t205*(t195 + t206*t196)
+    t208 = -t207 + t195
+    t209 = t196 - t206*t207
+    t210 = t205*(t199 + t206*t200)
+    t211 = -t210 + t199
+    t212 = t200 - t206*t210
+    t213 = casadi.fabs(t209)
+    t214 = t213*casadi.if_else((t209 >= 0), 1, -1)
+    t215 = casadi.if_else((t213 > 0), 2, 0)
+    t216 = t212 - t212*t215
+    t217 = casadi.if_else((t214 != 0), -t216/t214, 0)
+    t218 = casadi.if_else((t202 != 0), -(t211 - t208*t217)/t202, 0)
+    t219 = casadi.if_else((t171 != 0), -(-(t190*t218 - t194*t217) + t198)/t171, 0)
+    t220 = casadi.if_else((t123 != 0), -(t166 + t161*t219 + t174*t218 + t180*t217)/t123, 0)
+    t221 = casadi.if_else((t95 != 0), -(t143 + t115*t220 + t126*t219 + t135*t218 + t139*t217)/t95, 0)
+    t222 = t81*t82
+    t223 = casadi.if_else((t35 != 0), -(t90 + t85*t221 + t88*t220 + c23*t222*t219 + t59*t222*t218 + t0*t222*t217)/t35, 0)
+    t224 = (casadi.fabs(t152) < casadi.inf)
+    t225 = (damping >= 0)
+    t226 = (damping > 0)
+    t227 = 1e-12*t43
+    t228 = casadi.logic_or(casadi.logic_and(t226, (t64[6] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t34 <= t227), (t94 <= t227)), (t122 <= t227)), (t170 <= t227)), (t201 <= t227)), (t213 <= t227))))
+    t229 = casadi.logic_and(casadi.logic_and(t224, t225), casadi.logic_not(t228))
     q_dot = casadi.SX(6, 1)
-    q_dot[0, 0] = casadi.if_else(t398, casadi.if_else(t394, t238, t391), 0)
-    q_dot[1, 0] = casadi.if_else(t398, casadi.if_else(t394, -t244, t389), 0)
-    q_dot[2, 0] = casadi.if_else(t398, casadi.if_else(t394, -t246, t388), 0)
-    q_dot[3, 0] = casadi.if_else(t398, casadi.if_else(t394, -t239, t387), 0)
-    q_dot[4, 0] = casadi.if_else(t398, casadi.if_else(t394, t240, t386), 0)
-    q_dot[5, 0] = casadi.if_else(t398, casadi.if_else(t394, -t241, t385), 0)
+    q_dot[0, 0] = casadi.if_else(t229, casadi.if_else(t226, t68, t223), 0)
+    q_dot[1, 0] = casadi.if_else(t229, casadi.if_else(t226, -t77, t221), 0)
+    q_dot[2, 0] = casadi.if_else(t229, casadi.if_else(t226, -t79, t220), 0)
+    q_dot[3, 0] = casadi.if_else(t229, casadi.if_else(t226, -t73, t219), 0)
+    q_dot[4, 0] = casadi.if_else(t229, casadi.if_else(t226, t74, t218), 0)
+    q_dot[5, 0] = casadi.if_else(t229, casadi.if_else(t226, -t75, t217), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t392, t393)), 2, casadi.if_else(t397, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t224, t225)), 2, casadi.if_else(t228, 1, 0))
     return [q_dot, status]
 
 
 def _velocity_ik_nullspace(q, mu_dot, z, damping):
-    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 1201 operations."""
+    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 1217 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -3385,375 +3459,206 @@ def _velocity_ik_nullspace(q, mu_dot, z, damping):
     t41 = t9**2 + t18**2 + 2*t28 + t36*t39
     t42 = 1 + c23**2 + t0**2 + s4**2*t39
     t43 = casadi.sqrt(t26 + t32 + t38 + t40 + t41 + t42)
-    t44 = t22*t23
-    t45 = s1*c1
-    t46 = -t44 + t30*t45 + t31*t45
-    t47 = c1*t24
-    t48 = c1*t20
-    t49 = t2*t47 + t1*t48
-    t50 = t47 + t48
-    t51 = c1*t2
-    t52 = c1*t1
-    t53 = s1*t51 + s1*t52
-    t54 = s1*t24
-    t55 = s1*t20
-    t56 = t2*t54 + t1*t55
-    t57 = t54 + t55
-    t58 = 2*s1
-    t59 = -t12*t9 + t15*t18 - c1*t58 + t39*t45
-    t60 = s23*s4
-    t61 = c23*t14 + t15*t0 - t12*t60
-    t62 = c23*t17 + t18*t0 + t9*t60
-    t63 = t46**2
-    t64 = t49**2
-    t65 = t29**2
-    t66 = t53**2
-    t67 = damping**2
-    t68 = t32 + t67
-    t69 = t68**2
-    t70 = casadi.sqrt(t27 + t63 + t64 + t65 + t66 + t69)
-    t71 = t70*casadi.if_else((t68 >= 0), 1, -1)
-    t72 = t38 + t67
-    t73 = t26 + t67
-    t74 = t40 + t67
-    t75 = t41 + t67
-    t76 = t42 + t67
-    t77 = casadi.sqrt(2*t33 + 2*t27 + 2*t63 + 2*t64 + 2*t56**2 + 2*t37**2 + 2*t57**2 + 2*t65 + 2*t50**2 + 2*t59**2 + 2*t61**2 + 2*t62**2 + t69 + t72**2 + t73**2 + t74**2 + t75**2 + t76**2 + 4*t66)
-    t78 = (t70 > 0)
-    t79 = casadi.if_else(t78, 1/(t68 + t71), 0)
-    t80 = casadi.if_else(t78, 1 + casadi.fabs(t68)/t70, 0)
-    t81 = t46*t79
-    t82 = t49*t79
-    t83 = t53*t79
-    t84 = t80*(t46 + t72*t81 + t82*t56 + t83*t37 + t83*t29 - t44*t79)
-    t85 = -t84 + t46
-    t86 = t72 - t81*t84
-    t87 = -t56 + t82*t84
-    t88 = -t37 + t83*t84
-    t89 = t79*t84
-    t90 = t53 - t89*t29
-    t91 = t22 + t23*t89
-    t92 = casadi.sqrt(t86**2 + t87**2 + t88**2 + t90**2 + t91**2)
-    t93 = t92*casadi.if_else((t86 >= 0), 1, -1)
-    t94 = t29*t79
-    t95 = -t80*(t49 + t81*t56 + t73*t82 + t83*t57 + t94*t50)
-    t96 = t49 + t95
-    t97 = t56 + t81*t95
-    t98 = t73 + t82*t95
-    t99 = t57 + t83*t95
-    t100 = t50 + t94*t95
-    t101 = t23*t79
-    t102 = -t80*(t53 + t81*t37 + t82*t57 + t74*t83 - t94*t59 - t101*t61)
-    t103 = t53 + t102
-    t104 = t37 + t81*t102
-    t105 = t57 + t82*t102
-    t106 = t74 + t83*t102
-    t107 = t59 - t94*t102
-    t108 = t80*(t29 + t81*t53 + t82*t50 - t83*t59 + t75*t94 + t101*t62)
-    t109 = -t108 + t29
-    t110 = t53 - t81*t108
-    t111 = -t50 + t82*t108
-    t112 = t59 + t83*t108
-    t113 = t75 - t94*t108
-    t114 = -t62 + t101*t108
-    t115 = -t80*(t23 - t22*t81 - t83*t61 + t94*t62 + t76*t101)
-    t116 = t23 + t115
-    t117 = t22 - t81*t115
-    t118 = t62 + t94*t115
-    t119 = t76 + t101*t115
-    t120 = t80*(mu_dot0 + t81*mu_dot1 - t82*mu_dot2 - t83*mu_dot3 + t94*mu_dot4 - t101*mu_dot5)
-    t121 = -t120 + mu_dot0
-    t122 = mu_dot1 - t81*t120
-    t123 = mu_dot2 + t82*t120
-    t124 = mu_dot3 + t83*t120
-    t125 = mu_dot4 - t94*t120
-    t126 = mu_dot5 + t101*t120
-    t127 = -t61
-    t128 = t127 + t101*t102
-    t129 = t127 + t83*t115
-    t130 = (t92 > 0)
-    t131 = casadi.if_else(t130, 1/(t86 + t93), 0)
-    t132 = casadi.if_else(t130, 1 + casadi.fabs(t86)/t92, 0)
-    t133 = t87*t131
-    t134 = t88*t131
-    t135 = t90*t131
-    t136 = t101*t95
-    t137 = t91*t131
-    t138 = t132*(-t97 + t133*t98 + t134*t99 - t135*t100 + t136*t137)
-    t139 = t97 + t138
-    t140 = t98 - t133*t138
-    t141 = t99 - t134*t138
-    t142 = t100 + t135*t138
-    t143 = t136 - t137*t138
-    t144 = t132*(-t104 + t133*t105 + t134*t106 + t135*t107 + t137*t128)
-    t145 = t104 + t144
-    t146 = t105 - t133*t144
-    t147 = t106 - t134*t144
-    t148 = t107 - t135*t144
-    t149 = t128 - t137*t144
-    t150 = t132*(t110 + t133*t111 + t134*t112 + t135*t113 + t137*t114)
-    t151 = -t150 + t110
-    t152 = t111 - t133*t150
-    t153 = t112 - t134*t150
-    t154 = t113 - t135*t150
-    t155 = t114 - t137*t150
-    t156 = t132*(t122 + t133*t123 + t134*t124 + t135*t125 + t137*t126)
-    t157 = -t156 + t122
-    t158 = t123 - t133*t156
-    t159 = t124 - t134*t156
-    t160 = t125 - t135*t156
-    t161 = t126 - t137*t156
-    t162 = casadi.sqrt(t140**2 + t141**2 + t142**2 + t143**2)
-    t163 = t162*casadi.if_else((t140 >= 0), 1, -1)
-    t164 = t82*t115
-    t165 = t132*(t117 + t133*t164 + t134*t129 - t135*t118 + t137*t119)
-    t166 = -t165 + t117
-    t167 = t164 - t133*t165
-    t168 = t129 - t134*t165
-    t169 = t118 + t135*t165
-    t170 = t119 - t137*t165
-    t171 = (t162 > 0)
-    t172 = casadi.if_else(t171, 1/(t140 + t163), 0)
-    t173 = casadi.if_else(t171, 1 + casadi.fabs(t140)/t162, 0)
-    t174 = t141*t172
-    t175 = t142*t172
-    t176 = t143*t172
-    t177 = t173*(t146 + t174*t147 - t175*t148 + t176*t149)
-    t178 = -t177 + t146
-    t179 = t147 - t174*t177
-    t180 = t148 + t175*t177
-    t181 = t149 - t176*t177
-    t182 = t173*(t152 + t174*t153 - t175*t154 + t176*t155)
-    t183 = -t182 + t152
-    t184 = t153 - t174*t182
-    t185 = t154 + t175*t182
-    t186 = t155 - t176*t182
-    t187 = t173*(t167 + t174*t168 + t175*t169 + t176*t170)
-    t188 = -t187 + t167
-    t189 = t168 - t174*t187
-    t190 = -t169 + t175*t187
-    t191 = t170 - t176*t187
-    t192 = t173*(t158 + t174*t159 - t175*t160 + t176*t161)
-    t193 = -t192 + t158
-    t194 = t159 - t174*t192
-    t195 = t160 + t175*t192
-    t196 = t161 - t176*t192
-    t197 = casadi.sqrt(t179**2 + t180**2 + t181**2)
-    t198 = t197*casadi.if_else((t179 >= 0), 1, -1)
-    t199 = (t197 > 0)
-    t200 = casadi.if_else(t199, 1/(t179 + t198), 0)
-    t201 = casadi.if_else(t199, 1 + casadi.fabs(t179)/t197, 0)
-    t202 = t180*t200
-    t203 = t181*t200
-    t204 = t201*(t184 + t202*t185 + t203*t186)
-    t205 = -t204 + t184
-    t206 = t185 - t202*t204
-    t207 = t186 - t203*t204
-    t208 = t201*(t189 + t202*t190 + t203*t191)
-    t209 = -t208 + t189
-    t210 = t190 - t202*t208
-    t211 = t191 - t203*t208
-    t212 = t201*(t194 + t202*t195 + t203*t196)
-    t213 = -t212 + t194
-    t214 = t195 - t202*t212
-    t215 = t196 - t203*t212
-    t216 = casadi.sqrt(t206**2 + t207**2)
-    t217 = t216*casadi.if_else((t206 >= 0), 1, -1)
-    t218 = (t216 > 0)
-    t219 = casadi.if_else(t218, 1/(t206 + t217), 0)
-    t220 = casadi.if_else(t218, 1 + casadi.fabs(t206)/t216, 0)
-    t221 = t207*t219
-    t222 = t220*(t210 + t221*t211)
-    t223 = -t222 + t210
-    t224 = t211 - t221*t222
-    t225 = t220*(t214 + t221*t215)
-    t226 = -t225 + t214
-    t227 = t215 - t221*t225
-    t228 = casadi.fabs(t224)
-    t229 = t228*casadi.if_else((t224 >= 0), 1, -1)
-    t230 = casadi.if_else((t228 > 0), 2, 0)
-    t231 = t227 - t227*t230
-    t232 = casadi.if_else((t229 != 0), -t231/t229, 0)
-    t233 = casadi.if_else((t217 != 0), -(t226 - t223*t232)/t217, 0)
-    t234 = casadi.if_else((t198 != 0), -(-(t205*t233 + t209*t232) + t213)/t198, 0)
-    t235 = casadi.if_else((t163 != 0), -(-(t178*t234 + t183*t233 + t188*t232) + t193)/t163, 0)
-    t236 = casadi.if_else((t93 != 0), -(-(-t139*t235 - t145*t234 + t151*t233 + t166*t232) + t157)/t93, 0)
-    t237 = casadi.if_else((t71 != 0), -(t121 + t96*t235 + t103*t234 + t116*t232 - t85*t236 - t109*t233)/t71, 0)
-    t238 = t232 - t23*t237 + t22*t236
-    t239 = -c23*t232 + t14*t234 + t17*t233
-    t240 = t12*t234 - t9*t233 + t60*t232
-    t241 = t15*t234 + t18*t233 - t0*t232
-    t242 = s1*t2
-    t243 = c1*t233 - s1*t234
-    t244 = t243 - t24*t235 + t51*t237 + t242*t236
-    t245 = s1*t1
-    t246 = t243 - t20*t235 + t52*t237 + t245*t236
-    t247 = (t34 > 0)
-    t248 = casadi.if_else(t247, 1 + casadi.fabs(t23)/t34, 0)
-    t249 = -t23
-    t250 = casadi.if_else(t247, 1/(t249 + t35), 0)
-    t251 = t22*t250
-    t252 = -t248*(t51 + t242*t251)
-    t253 = t51 + t252
-    t254 = t242 + t251*t252
-    t255 = -t248*(t52 + t245*t251)
-    t256 = t52 + t255
-    t257 = t248*(mu_dot0 + mu_dot5*t250 + t251*mu_dot1)
-    t258 = -t257 + mu_dot0
-    t259 = t250*t255
-    t260 = t245 + t22*t259
-    t261 = t250**2
-    t262 = casadi.sqrt(t25 + t28 + t36 + t254**2 + t261*t252**2)
-    t263 = t262*casadi.if_else((t254 <= 0), 1, -1)
-    t264 = t261*t248
-    t265 = c23*t264
-    t266 = t22*t265
-    t267 = -t265 + c23
-    t268 = t60*t264
-    t269 = t22*t268
-    t270 = -t268 + t60
-    t271 = t0*t264
-    t272 = t22*t271
-    t273 = -t271 + t0
-    t274 = t250*t257
-    t275 = mu_dot1 - t22*t274
-    t276 = -t274 + mu_dot5
-    t277 = (t262 > 0)
-    t278 = casadi.if_else(t277, 1/(-t254 + t263), 0)
-    t279 = casadi.if_else(t277, 1 + casadi.fabs(t254)/t262, 0)
-    t280 = t24*t278
-    t281 = t252*t278
-    t282 = t279*(-t260 + t20*t280 + t36*t278 + t28*t278 + t261*t281*t255)
-    t283 = t260 + t282
-    t284 = t20 - t280*t282
-    t285 = t278*t282
-    t286 = s1 - s1*t285
-    t287 = -c1 + c1*t285
-    t288 = t250*t252
-    t289 = -t259 + t285*t288
-    t290 = casadi.sqrt(t284**2 + t286**2 + t287**2 + t289**2)
-    t291 = t290*casadi.if_else((t284 >= 0), 1, -1)
-    t292 = t281*t250
-    t293 = -t279*(t266 + t292*t267)
-    t294 = t266 + t293
-    t295 = t278*t293
-    t296 = t14 + s1*t295
-    t297 = t267 + t288*t295
-    t298 = -t17
-    t299 = t298 + c1*t295
-    t300 = s1*t278
-    t301 = c1*t278
-    t302 = t279*(-t269 + t12*t300 + t9*t301 - t292*t270)
-    t303 = t269 + t302
-    t304 = t12 - t300*t302
-    t305 = t270 + t292*t302
-    t306 = -t279*(t272 + t15*t300 - t18*t301 + t292*t273)
-    t307 = t272 + t306
-    t308 = t15 + t300*t306
-    t309 = t273 + t292*t306
-    t310 = t279*(t275 + t280*mu_dot2 + t300*mu_dot3 - t301*mu_dot4 - t292*t276)
-    t311 = -t310 + t275
-    t312 = mu_dot2 - t280*t310
-    t313 = mu_dot3 - t300*t310
-    t314 = mu_dot4 + t301*t310
-    t315 = t276 + t292*t310
-    t316 = -t9
-    t317 = t316 + t301*t302
-    t318 = -t18
-    t319 = t318 + t301*t306
-    t320 = 1 - t15 - t51 - t52 - t242 - t245 - t14 + q1 + q2 + q3 + c23 + q4 + t12 + q5 + t0 + q6 + t22 + t24 + t20 - 2*c1 + t58 + t60 + t249 + t298 + t316 + t318 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6
-    t321 = (t290 > 0)
-    t322 = casadi.if_else(t321, 1/(t284 + t291), 0)
-    t323 = casadi.if_else(t321, 1 + casadi.fabs(t284)/t290, 0)
-    t324 = t280*t293
-    t325 = t286*t322
-    t326 = t287*t322
-    t327 = t289*t322
-    t328 = t323*(-t324 - t325*t296 + t326*t299 + t327*t297)
-    t329 = t324 + t328
-    t330 = t296 + t325*t328
-    t331 = t299 - t326*t328
-    t332 = t297 - t327*t328
-    t333 = t323*(t312 + t325*t313 + t326*t314 + t327*t315)
-    t334 = -t333 + t312
-    t335 = t313 - t325*t333
-    t336 = t314 - t326*t333
-    t337 = t315 - t327*t333
-    t338 = casadi.sqrt(t330**2 + t331**2 + t332**2)
-    t339 = t338*casadi.if_else((t330 <= 0), 1, -1)
-    t340 = t280*t302
-    t341 = t323*(-t340 + t325*t304 + t326*t317 + t327*t305)
-    t342 = t340 + t341
-    t343 = t304 - t325*t341
-    t344 = t317 - t326*t341
-    t345 = t305 - t327*t341
-    t346 = t280*t306
-    t347 = t323*(-t346 - t325*t308 + t326*t319 + t327*t309)
-    t348 = t346 + t347
-    t349 = t308 + t325*t347
-    t350 = t319 - t326*t347
-    t351 = t309 - t327*t347
-    t352 = (t338 > 0)
-    t353 = casadi.if_else(t352, 1/(-t330 + t339), 0)
-    t354 = casadi.if_else(t352, 1 + casadi.fabs(t330)/t338, 0)
-    t355 = t331*t353
-    t356 = t332*t353
-    t357 = t354*(t343 + t355*t344 + t356*t345)
-    t358 = -t357 + t343
-    t359 = t344 - t355*t357
-    t360 = t345 - t356*t357
-    t361 = t354*(-t349 + t355*t350 + t356*t351)
-    t362 = t349 + t361
-    t363 = t350 - t355*t361
-    t364 = t351 - t356*t361
-    t365 = t354*(t335 + t355*t336 + t356*t337)
-    t366 = -t365 + t335
-    t367 = t336 - t355*t365
-    t368 = t337 - t356*t365
-    t369 = casadi.sqrt(t359**2 + t360**2)
-    t370 = t369*casadi.if_else((t359 >= 0), 1, -1)
-    t371 = (t369 > 0)
-    t372 = casadi.if_else(t371, 1/(t359 + t370), 0)
-    t373 = casadi.if_else(t371, 1 + casadi.fabs(t359)/t369, 0)
-    t374 = t360*t372
-    t375 = t373*(t363 + t374*t364)
-    t376 = -t375 + t363
-    t377 = t364 - t374*t375
-    t378 = t373*(t367 + t374*t368)
-    t379 = -t378 + t367
-    t380 = t368 - t374*t378
-    t381 = casadi.fabs(t377)
-    t382 = t381*casadi.if_else((t377 >= 0), 1, -1)
-    t383 = casadi.if_else((t381 > 0), 2, 0)
-    t384 = t380 - t380*t383
-    t385 = casadi.if_else((t382 != 0), -t384/t382, 0)
-    t386 = casadi.if_else((t370 != 0), -(t379 - t376*t385)/t370, 0)
-    t387 = casadi.if_else((t339 != 0), -(-(t358*t386 - t362*t385) + t366)/t339, 0)
-    t388 = casadi.if_else((t291 != 0), -(t334 + t329*t387 + t342*t386 + t348*t385)/t291, 0)
-    t389 = casadi.if_else((t263 != 0), -(t311 + t283*t388 + t294*t387 + t303*t386 + t307*t385)/t263, 0)
-    t390 = t250*t248
-    t391 = casadi.if_else((t35 != 0), -(t258 + t253*t389 + t256*t388 + c23*t390*t387 + t60*t390*t386 + t0*t390*t385)/t35, 0)
-    t392 = (casadi.fabs(t320) < casadi.inf)
-    t393 = (damping >= 0)
-    t394 = (damping > 0)
-    t395 = 1e-12*t77
-    t396 = 1e-12*t43
-    t397 = casadi.logic_or(casadi.logic_and(t394, casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t70 <= t395), (t92 <= t395)), (t162 <= t395)), (t197 <= t395)), (t216 <= t395)), (t228 <= t395))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t34 <= t396), (t262 <= t396)), (t290 <= t396)), (t338 <= t396)), (t369 <= t396)), (t381 <= t396))))
-    t398 = casadi.logic_and(casadi.logic_and(t392, t393), casadi.logic_not(t397))
+    t44 = s1*c1
+    t45 = -t22*t23 + t30*t44 + t31*t44
+    t46 = c1*t24
+    t47 = c1*t20
+    t48 = t1*t47 + t2*t46
+    t49 = t46 + t47
+    t50 = c1*t2
+    t51 = c1*t1
+    t52 = s1*t50 + s1*t51
+    t53 = s1*t24
+    t54 = s1*t20
+    t55 = t1*t54 + t2*t53
+    t56 = t53 + t54
+    t57 = 2*s1
+    t58 = -t12*t9 + t15*t18 - c1*t57 + t39*t44
+    t59 = s23*s4
+    t60 = c23*t14 + t15*t0 - t12*t59
+    t61 = c23*t17 + t18*t0 + t9*t59
+    t62 = damping**2
+    t63 = -t23
+    t64 = _symmetric_solve6(1, (t32 + t62, t45, -t48, -t52, t29, t63, t38 + t62, -t55, -t37, t52, t22, t26 + t62, t56, -t49, 0, t40 + t62, t58, -t60, t41 + t62, -t61, t42 + t62, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t65 = t64[5]
+    t66 = t64[0]
+    t67 = t64[1]
+    t68 = t65 - t23*t66 + t22*t67
+    t69 = s1*t2
+    t70 = t64[2]
+    t71 = t64[3]
+    t72 = t64[4]
+    t73 = t14*t71 + t17*t72 - c23*t65
+    t74 = t12*t71 - t9*t72 + t59*t65
+    t75 = t15*t71 + t18*t72 - t0*t65
+    t76 = -s1*t71 + c1*t72
+    t77 = t76 + t50*t66 + t67*t69 - t24*t70
+    t78 = s1*t1
+    t79 = t76 + t51*t66 + t67*t78 - t20*t70
+    t80 = (t34 > 0)
+    t81 = casadi.if_else(t80, 1/(t63 + t35), 0)
+    t82 = casadi.if_else(t80, 1 + casadi.fabs(t23)/t34, 0)
+    t83 = t22*t81
+    t84 = -t82*(t50 + t69*t83)
+    t85 = t50 + t84
+    t86 = t69 + t83*t84
+    t87 = -t82*(t51 + t78*t83)
+    t88 = t51 + t87
+    t89 = t82*(mu_dot0 + mu_dot5*t81 + t83*mu_dot1)
+    t90 = -t89 + mu_dot0
+    t91 = t81*t87
+    t92 = t78 + t22*t91
+    t93 = t81**2
+    t94 = casadi.sqrt(t25 + t28 + t36 + t86**2 + t93*t84**2)
+    t95 = t94*casadi.if_else((t86 <= 0), 1, -1)
+    t96 = t93*t82
+    t97 = c23*t96
+    t98 = t22*t97
+    t99 = -t97 + c23
+    t100 = t59*t96
+    t101 = t22*t100
+    t102 = -t100 + t59
+    t103 = t0*t96
+    t104 = t22*t103
+    t105 = -t103 + t0
+    t106 = t81*t89
+    t107 = mu_dot1 - t22*t106
+    t108 = -t106 + mu_dot5
+    t109 = (t94 > 0)
+    t110 = casadi.if_else(t109, 1/(-t86 + t95), 0)
+    t111 = casadi.if_else(t109, 1 + casadi.fabs(t86)/t94, 0)
+    t112 = t24*t110
+    t113 = t84*t110
+    t114 = t111*(-t92 + t20*t112 + t36*t110 + t28*t110 + t93*t113*t87)
+    t115 = t92 + t114
+    t116 = t20 - t112*t114
+    t117 = t110*t114
+    t118 = s1 - s1*t117
+    t119 = -c1 + c1*t117
+    t120 = t81*t84
+    t121 = -t91 + t117*t120
+    t122 = casadi.sqrt(t116**2 + t118**2 + t119**2 + t121**2)
+    t123 = t122*casadi.if_else((t116 >= 0), 1, -1)
+    t124 = t113*t81
+    t125 = -t111*(t98 + t124*t99)
+    t126 = t98 + t125
+    t127 = t110*t125
+    t128 = t14 + s1*t127
+    t129 = t99 + t120*t127
+    t130 = -t17
+    t131 = t130 + c1*t127
+    t132 = s1*t110
+    t133 = c1*t110
+    t134 = t111*(-t101 + t12*t132 + t9*t133 - t124*t102)
+    t135 = t101 + t134
+    t136 = t12 - t132*t134
+    t137 = t102 + t124*t134
+    t138 = -t111*(t104 + t15*t132 - t18*t133 + t124*t105)
+    t139 = t104 + t138
+    t140 = t15 + t132*t138
+    t141 = t105 + t124*t138
+    t142 = t111*(t107 + t112*mu_dot2 + t132*mu_dot3 - t133*mu_dot4 - t124*t108)
+    t143 = -t142 + t107
+    t144 = mu_dot2 - t112*t142
+    t145 = mu_dot3 - t132*t142
+    t146 = mu_dot4 + t133*t142
+    t147 = t108 + t124*t142
+    t148 = -t9
+    t149 = t148 + t133*t134
+    t150 = -t18
+    t151 = t150 + t133*t138
+    t152 = 1 - t15 - t50 - t51 - t69 - t78 - t14 + q1 + q2 + q3 + c23 + q4 + t12 + q5 + t0 + q6 + t22 + t24 + t20 - 2*c1 + t57 + t59 + t63 + t130 + t148 + t150 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6
+    t153 = (t122 > 0)
+    t154 = casadi.if_else(t153, 1/(t116 + t123), 0)
+    t155 = casadi.if_else(t153, 1 + casadi.fabs(t116)/t122, 0)
+    t156 = t112*t125
+    t157 = t118*t154
+    t158 = t119*t154
+    t159 = t121*t154
+    t160 = t155*(-t156 - t157*t128 + t158*t131 + t159*t129)
+    t161 = t156 + t160
+    t162 = t128 + t157*t160
+    t163 = t131 - t158*t160
+    t164 = t129 - t159*t160
+    t165 = t155*(t144 + t157*t145 + t158*t146 + t159*t147)
+    t166 = -t165 + t144
+    t167 = t145 - t157*t165
+    t168 = t146 - t158*t165
+    t169 = t147 - t159*t165
+    t170 = casadi.sqrt(t162**2 + t163**2 + t164**2)
+    t171 = t170*casadi.if_else((t162 <= 0), 1, -1)
+    t172 = t112*t134
+    t173 = t155*(-t172 + t157*t136 + t158*t149 + t159*t137)
+    t174 = t172 + t173
+    t175 = t136 - t157*t173
+    t176 = t149 - t158*t173
+    t177 = t137 - t159*t173
+    t178 = t112*t138
+    t179 = t155*(-t178 - t157*t140 + t158*t151 + t159*t141)
+    t180 = t178 + t179
+    t181 = t140 + t157*t179
+    t182 = t151 - t158*t179
+    t183 = t141 - t159*t179
+    t184 = (t170 > 0)
+    t185 = casadi.if_else(t184, 1/(-t162 + t171), 0)
+    t186 = casadi.if_else(t184, 1 + casadi.fabs(t162)/t170, 0)
+    t187 = t163*t185
+    t188 = t164*t185
+    t189 = t186*(t175 + t187*t176 + t188*t177)
+    t190 = -t189 + t175
+    t191 = t176 - t187*t189
+    t192 = t177 - t188*t189
+    t193 = t186*(-t181 + t187*t182 + t188*t183)
+    t194 = t181 + t193
+    t195 = t182 - t187*t193
+    t196 = t183 - t188*t193
+    t197 = t186*(t167 + t187*t168 + t188*t169)
+    t198 = -t197 + t167
+    t199 = t168 - t187*t197
+    t200 = t169 - t188*t197
+    t201 = casadi.sqrt(t191**2 + t192**2)
+    t202 = t201*casadi.if_else((t191 >= 0), 1, -1)
+    t203 = (t201 > 0)
+    t204 = casadi.if_else(t203, 1/(t191 + t202), 0)
+    t205 = casadi.if_else(t203, 1 + casadi.fabs(t191)/t201, 0)
+    t206 = t192*t204
+    t207 = t205*(t195 + t206*t196)
+    t208 = -t207 + t195
+    t209 = t196 - t206*t207
+    t210 = t205*(t199 + t206*t200)
+    t211 = -t210 + t199
+    t212 = t200 - t206*t210
+    t213 = casadi.fabs(t209)
+    t214 = t213*casadi.if_else((t209 >= 0), 1, -1)
+    t215 = casadi.if_else((t213 > 0), 2, 0)
+    t216 = t212 - t212*t215
+    t217 = casadi.if_else((t214 != 0), -t216/t214, 0)
+    t218 = casadi.if_else((t202 != 0), -(t211 - t208*t217)/t202, 0)
+    t219 = casadi.if_else((t171 != 0), -(-(t190*t218 - t194*t217) + t198)/t171, 0)
+    t220 = casadi.if_else((t123 != 0), -(t166 + t161*t219 + t174*t218 + t180*t217)/t123, 0)
+    t221 = casadi.if_else((t95 != 0), -(t143 + t115*t220 + t126*t219 + t135*t218 + t139*t217)/t95, 0)
+    t222 = t81*t82
+    t223 = casadi.if_else((t35 != 0), -(t90 + t85*t221 + t88*t220 + c23*t222*t219 + t59*t222*t218 + t0*t222*t217)/t35, 0)
+    t224 = (casadi.fabs(t152) < casadi.inf)
+    t225 = (damping >= 0)
+    t226 = (damping > 0)
+    t227 = 1e-12*t43
+    t228 = casadi.logic_or(casadi.logic_and(t226, (t64[6] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t34 <= t227), (t94 <= t227)), (t122 <= t227)), (t170 <= t227)), (t201 <= t227)), (t213 <= t227))))
+    t229 = casadi.logic_and(casadi.logic_and(t224, t225), casadi.logic_not(t228))
     q_dot = casadi.SX(6, 1)
-    q_dot[0, 0] = casadi.if_else(t398, casadi.if_else(t394, t238, t391), 0)
-    q_dot[1, 0] = casadi.if_else(t398, casadi.if_else(t394, -t244, t389), 0)
-    q_dot[2, 0] = casadi.if_else(t398, casadi.if_else(t394, -t246, t388), 0)
-    q_dot[3, 0] = casadi.if_else(t398, casadi.if_else(t394, -t239, t387), 0)
-    q_dot[4, 0] = casadi.if_else(t398, casadi.if_else(t394, t240, t386), 0)
-    q_dot[5, 0] = casadi.if_else(t398, casadi.if_else(t394, -t241, t385), 0)
+    q_dot[0, 0] = casadi.if_else(t229, casadi.if_else(t226, t68, t223), 0)
+    q_dot[1, 0] = casadi.if_else(t229, casadi.if_else(t226, -t77, t221), 0)
+    q_dot[2, 0] = casadi.if_else(t229, casadi.if_else(t226, -t79, t220), 0)
+    q_dot[3, 0] = casadi.if_else(t229, casadi.if_else(t226, -t73, t219), 0)
+    q_dot[4, 0] = casadi.if_else(t229, casadi.if_else(t226, t74, t218), 0)
+    q_dot[5, 0] = casadi.if_else(t229, casadi.if_else(t226, -t75, t217), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t392, t393)), 2, casadi.if_else(t397, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t224, t225)), 2, casadi.if_else(t228, 1, 0))
     return [q_dot, status]
 
 
 def _resolved_rate(q, target, target_rate, gain, z, damping):
-    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 1362 operations."""
+    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 1378 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -3877,392 +3782,223 @@ def _resolved_rate(q, target, target_rate, gain, z, damping):
     t70 = t10**2 + t26**2 + 2*t57 + t65*t68
     t71 = 1 + c23**2 + t37**2 + s4**2*t68
     t72 = casadi.sqrt(t55 + t61 + t67 + t69 + t70 + t71)
-    t73 = t50*t51
-    t74 = s1*c1
-    t75 = -t73 + t59*t74 + t60*t74
-    t76 = c1*t52
-    t77 = c1*t30
-    t78 = t0*t77 + t1*t76
-    t79 = t76 + t77
-    t80 = c1*t1
-    t81 = c1*t0
-    t82 = s1*t80 + s1*t81
-    t83 = s1*t52
-    t84 = s1*t30
-    t85 = t1*t83 + t0*t84
-    t86 = t83 + t84
-    t87 = 2*s1
-    t88 = -t13*t10 + t17*t26 - c1*t87 + t68*t74
-    t89 = t75**2
-    t90 = t78**2
-    t91 = t58**2
-    t92 = t82**2
-    t93 = damping**2
-    t94 = t61 + t93
-    t95 = t94**2
-    t96 = casadi.sqrt(t56 + t89 + t90 + t91 + t92 + t95)
-    t97 = t96*casadi.if_else((t94 >= 0), 1, -1)
-    t98 = t67 + t93
-    t99 = t55 + t93
-    t100 = t69 + t93
-    t101 = t70 + t93
-    t102 = t71 + t93
-    t103 = casadi.sqrt(2*t62 + 2*t56 + 2*t89 + 2*t90 + 2*t85**2 + 2*t66**2 + 2*t86**2 + 2*t91 + 2*t79**2 + 2*t88**2 + 2*t41**2 + 2*t42**2 + t95 + t98**2 + t99**2 + t100**2 + t101**2 + t102**2 + 4*t92)
-    t104 = (t96 > 0)
-    t105 = casadi.if_else(t104, 1/(t94 + t97), 0)
-    t106 = casadi.if_else(t104, 1 + casadi.fabs(t94)/t96, 0)
-    t107 = t75*t105
-    t108 = t78*t105
-    t109 = t82*t105
-    t110 = t106*(t75 + t109*t58 + t98*t107 + t108*t85 + t109*t66 - t73*t105)
-    t111 = -t110 + t75
-    t112 = t98 - t107*t110
-    t113 = -t85 + t108*t110
-    t114 = -t66 + t109*t110
-    t115 = t105*t110
-    t116 = t82 - t115*t58
-    t117 = t50 + t51*t115
-    t118 = casadi.sqrt(t112**2 + t113**2 + t114**2 + t116**2 + t117**2)
-    t119 = t118*casadi.if_else((t112 >= 0), 1, -1)
-    t120 = t58*t105
-    t121 = -t106*(t78 + t107*t85 + t99*t108 + t109*t86 + t120*t79)
-    t122 = t78 + t121
-    t123 = t85 + t107*t121
-    t124 = t99 + t108*t121
-    t125 = t86 + t109*t121
-    t126 = t79 + t120*t121
-    t127 = t51*t105
-    t128 = -t106*(t82 + t108*t86 + t107*t66 + t100*t109 - t120*t88 - t127*t41)
-    t129 = t82 + t128
-    t130 = t66 + t107*t128
-    t131 = t86 + t108*t128
-    t132 = t100 + t109*t128
-    t133 = t88 - t120*t128
-    t134 = t106*(t58 + t101*t120 + t107*t82 + t108*t79 - t109*t88 + t127*t42)
-    t135 = -t134 + t58
-    t136 = t82 - t107*t134
-    t137 = -t79 + t108*t134
-    t138 = t88 + t109*t134
-    t139 = t101 - t120*t134
-    t140 = -t42 + t127*t134
-    t141 = -t106*(t51 + t120*t42 - t50*t107 - t109*t41 + t102*t127)
-    t142 = t51 + t141
-    t143 = t50 - t107*t141
-    t144 = t42 + t120*t141
-    t145 = t102 + t127*t141
-    t146 = -t41
-    t147 = t146 + t127*t128
-    t148 = t146 + t109*t141
-    t149 = (t118 > 0)
-    t150 = casadi.if_else(t149, 1/(t112 + t119), 0)
-    t151 = casadi.if_else(t149, 1 + casadi.fabs(t112)/t118, 0)
-    t152 = t113*t150
-    t153 = t114*t150
-    t154 = t116*t150
-    t155 = t127*t121
-    t156 = t117*t150
-    t157 = t151*(-t123 + t152*t124 + t153*t125 - t154*t126 + t155*t156)
-    t158 = t123 + t157
-    t159 = t124 - t152*t157
-    t160 = t125 - t153*t157
-    t161 = t126 + t154*t157
-    t162 = t155 - t156*t157
-    t163 = t151*(-t130 + t152*t131 + t153*t132 + t154*t133 + t156*t147)
-    t164 = t130 + t163
-    t165 = t131 - t152*t163
-    t166 = t132 - t153*t163
-    t167 = t133 - t154*t163
-    t168 = t147 - t156*t163
-    t169 = t151*(t136 + t152*t137 + t153*t138 + t154*t139 + t156*t140)
-    t170 = -t169 + t136
-    t171 = t137 - t152*t169
-    t172 = t138 - t153*t169
-    t173 = t139 - t154*t169
-    t174 = t140 - t156*t169
-    t175 = casadi.sqrt(t159**2 + t160**2 + t161**2 + t162**2)
-    t176 = t175*casadi.if_else((t159 >= 0), 1, -1)
-    t177 = t108*t141
-    t178 = t151*(t143 + t152*t177 + t153*t148 - t154*t144 + t156*t145)
-    t179 = -t178 + t143
-    t180 = t177 - t152*t178
-    t181 = t148 - t153*t178
-    t182 = t144 + t154*t178
-    t183 = t145 - t156*t178
-    t184 = (t175 > 0)
-    t185 = casadi.if_else(t184, 1/(t159 + t176), 0)
-    t186 = casadi.if_else(t184, 1 + casadi.fabs(t159)/t175, 0)
-    t187 = t160*t185
-    t188 = t161*t185
-    t189 = t162*t185
-    t190 = t186*(t165 + t187*t166 - t188*t167 + t189*t168)
-    t191 = -t190 + t165
-    t192 = t166 - t187*t190
-    t193 = t167 + t188*t190
-    t194 = t168 - t189*t190
-    t195 = t186*(t171 + t187*t172 - t188*t173 + t189*t174)
-    t196 = -t195 + t171
-    t197 = t172 - t187*t195
-    t198 = t173 + t188*t195
-    t199 = t174 - t189*t195
-    t200 = t186*(t180 + t187*t181 + t188*t182 + t189*t183)
-    t201 = -t200 + t180
-    t202 = t181 - t187*t200
-    t203 = -t182 + t188*t200
-    t204 = t183 - t189*t200
-    t205 = casadi.sqrt(t192**2 + t193**2 + t194**2)
-    t206 = t205*casadi.if_else((t192 >= 0), 1, -1)
-    t207 = (t205 > 0)
-    t208 = casadi.if_else(t207, 1/(t192 + t206), 0)
-    t209 = casadi.if_else(t207, 1 + casadi.fabs(t192)/t205, 0)
-    t210 = t193*t208
-    t211 = t194*t208
-    t212 = t209*(t197 + t210*t198 + t211*t199)
-    t213 = -t212 + t197
-    t214 = t198 - t210*t212
-    t215 = t199 - t211*t212
-    t216 = t209*(t202 + t210*t203 + t211*t204)
-    t217 = -t216 + t202
-    t218 = t203 - t210*t216
-    t219 = t204 - t211*t216
-    t220 = casadi.sqrt(t214**2 + t215**2)
-    t221 = t220*casadi.if_else((t214 >= 0), 1, -1)
-    t222 = (t220 > 0)
-    t223 = casadi.if_else(t222, 1/(t214 + t221), 0)
-    t224 = casadi.if_else(t222, 1 + casadi.fabs(t214)/t220, 0)
-    t225 = t215*t223
-    t226 = t224*(t218 + t225*t219)
-    t227 = -t226 + t218
-    t228 = t219 - t225*t226
-    t229 = casadi.fabs(t228)
-    t230 = t229*casadi.if_else((t228 >= 0), 1, -1)
-    t231 = casadi.if_else((t229 > 0), 2, 0)
-    t232 = (t63 > 0)
-    t233 = casadi.if_else(t232, 1 + casadi.fabs(t51)/t63, 0)
-    t234 = -t51
-    t235 = casadi.if_else(t232, 1/(t234 + t64), 0)
-    t236 = mu_dot1 + gain1*(t234 + T13)
-    t237 = s1*t1
-    t238 = t50*t235
-    t239 = -t233*(t80 + t237*t238)
-    t240 = t80 + t239
-    t241 = t237 + t238*t239
-    t242 = s1*t0
-    t243 = -t233*(t81 + t238*t242)
-    t244 = t81 + t243
-    t245 = t235*t243
-    t246 = t242 + t50*t245
-    t247 = t235**2
-    t248 = casadi.sqrt(t54 + t57 + t65 + t241**2 + t247*t239**2)
-    t249 = t248*casadi.if_else((t241 <= 0), 1, -1)
-    t250 = t247*t233
-    t251 = c23*t250
-    t252 = t50*t251
-    t253 = -t251 + c23
-    t254 = t38*t250
-    t255 = t50*t254
-    t256 = -t254 + t38
-    t257 = t37*t250
-    t258 = t50*t257
-    t259 = -t257 + t37
-    t260 = (t248 > 0)
-    t261 = casadi.if_else(t260, 1/(-t241 + t249), 0)
-    t262 = casadi.if_else(t260, 1 + casadi.fabs(t241)/t248, 0)
-    t263 = t52*t261
-    t264 = t239*t261
-    t265 = t262*(-t246 + t30*t263 + t65*t261 + t57*t261 + t247*t264*t243)
-    t266 = t246 + t265
-    t267 = t30 - t263*t265
-    t268 = t261*t265
-    t269 = s1 - s1*t268
-    t270 = -c1 + c1*t268
-    t271 = t235*t239
-    t272 = -t245 + t268*t271
-    t273 = casadi.sqrt(t267**2 + t269**2 + t270**2 + t272**2)
-    t274 = t273*casadi.if_else((t267 >= 0), 1, -1)
-    t275 = t264*t235
-    t276 = -t262*(t252 + t275*t253)
-    t277 = t252 + t276
-    t278 = t261*t276
-    t279 = t15 + s1*t278
-    t280 = t253 + t271*t278
-    t281 = -t24
-    t282 = t281 + c1*t278
-    t283 = s1*t261
-    t284 = c1*t261
-    t285 = t262*(-t255 + t13*t283 + t10*t284 - t275*t256)
-    t286 = t255 + t285
-    t287 = t13 - t283*t285
-    t288 = t256 + t275*t285
-    t289 = -t262*(t258 + t17*t283 - t26*t284 + t275*t259)
-    t290 = t258 + t289
-    t291 = t17 + t283*t289
-    t292 = t259 + t275*t289
-    t293 = -t10
-    t294 = t293 + t284*t285
-    t295 = -t26
-    t296 = t295 + t284*t289
-    t297 = (t273 > 0)
-    t298 = casadi.if_else(t297, 1/(t267 + t274), 0)
-    t299 = casadi.if_else(t297, 1 + casadi.fabs(t267)/t273, 0)
-    t300 = t263*t276
-    t301 = t269*t298
-    t302 = t270*t298
-    t303 = t272*t298
-    t304 = t299*(-t300 - t301*t279 + t302*t282 + t303*t280)
-    t305 = t300 + t304
-    t306 = t279 + t301*t304
-    t307 = t282 - t302*t304
-    t308 = t280 - t303*t304
-    t309 = casadi.sqrt(t306**2 + t307**2 + t308**2)
-    t310 = t309*casadi.if_else((t306 <= 0), 1, -1)
-    t311 = t263*t285
-    t312 = t299*(-t311 + t301*t287 + t302*t294 + t303*t288)
-    t313 = t311 + t312
-    t314 = t287 - t301*t312
-    t315 = t294 - t302*t312
-    t316 = t288 - t303*t312
-    t317 = t263*t289
-    t318 = t299*(-t317 - t301*t291 + t302*t296 + t303*t292)
-    t319 = t317 + t318
-    t320 = t291 + t301*t318
-    t321 = t296 - t302*t318
-    t322 = t292 - t303*t318
-    t323 = (t309 > 0)
-    t324 = casadi.if_else(t323, 1/(-t306 + t310), 0)
-    t325 = casadi.if_else(t323, 1 + casadi.fabs(t306)/t309, 0)
-    t326 = t307*t324
-    t327 = t308*t324
-    t328 = t325*(t314 + t326*t315 + t327*t316)
-    t329 = -t328 + t314
-    t330 = t315 - t326*t328
-    t331 = t316 - t327*t328
-    t332 = t325*(-t320 + t326*t321 + t327*t322)
-    t333 = t320 + t332
-    t334 = t321 - t326*t332
-    t335 = t322 - t327*t332
-    t336 = casadi.sqrt(t330**2 + t331**2)
-    t337 = t336*casadi.if_else((t330 >= 0), 1, -1)
-    t338 = (t336 > 0)
-    t339 = casadi.if_else(t338, 1/(t330 + t337), 0)
-    t340 = casadi.if_else(t338, 1 + casadi.fabs(t330)/t336, 0)
-    t341 = t331*t339
-    t342 = t340*(t334 + t341*t335)
-    t343 = -t342 + t334
-    t344 = t335 - t341*t342
-    t345 = casadi.fabs(t344)
-    t346 = t345*casadi.if_else((t344 >= 0), 1, -1)
-    t347 = casadi.if_else((t345 > 0), 2, 0)
-    t348 = -t21
-    t349 = 0.5*(-1 + t348 + t32 + t45)
-    t350 = casadi.atan2(t48, t349)
-    t351 = casadi.if_else((t48 > 0), t350/t48, 1)
-    t352 = casadi.logic_and((t348 >= t32), (t348 >= t45))
-    t353 = (t32 >= t45)
-    t354 = casadi.if_else(t352, 0.5*(1 + t348), casadi.if_else(t353, 0.5*t31, 0.5*t43))
-    t355 = casadi.if_else(t352, -0.5*t22, casadi.if_else(t353, 0.5*(1 + t32), 0.5*t44))
-    t356 = casadi.if_else(t352, -0.5*t23, casadi.if_else(t353, 0.5*t33, 0.5*(1 + t45)))
-    t357 = casadi.sqrt(t354**2 + t355**2 + t356**2)
-    t358 = casadi.if_else((t46*t354 + t47*t355 + t34*t356 >= 0), 1, -1)
-    t359 = casadi.logic_or((t48 > 1e-06), (t349 > 0))
-    t360 = t350*t358/t357
-    t361 = casadi.if_else(t359, t46*t351, t360*t354)
-    t362 = casadi.if_else(t359, t47*t351, t360*t355)
-    t363 = casadi.if_else(t359, t34*t351, t360*t356)
-    t364 = mu_dot3 + t361*gain3
-    t365 = mu_dot4 + t362*gain4
-    t366 = mu_dot5 + t363*gain5
-    t367 = t106*(t53 + t107*t236 - t108*t3 - t109*t364 + t120*t365 - t127*t366)
-    t368 = -t367 + t53
-    t369 = t236 - t107*t367
-    t370 = t3 + t108*t367
-    t371 = t364 + t109*t367
-    t372 = t365 - t120*t367
-    t373 = t366 + t127*t367
-    t374 = t151*(t369 + t152*t370 + t153*t371 + t154*t372 + t156*t373)
-    t375 = -t374 + t369
-    t376 = t370 - t152*t374
-    t377 = t371 - t153*t374
-    t378 = t372 - t154*t374
-    t379 = t373 - t156*t374
-    t380 = t186*(t376 + t187*t377 - t188*t378 + t189*t379)
-    t381 = -t380 + t376
-    t382 = t377 - t187*t380
-    t383 = t378 + t188*t380
-    t384 = t379 - t189*t380
-    t385 = t209*(t382 + t210*t383 + t211*t384)
-    t386 = -t385 + t382
-    t387 = t383 - t210*t385
-    t388 = t384 - t211*t385
-    t389 = t224*(t387 + t225*t388)
-    t390 = -t389 + t387
-    t391 = t388 - t225*t389
-    t392 = t391 - t231*t391
-    t393 = casadi.if_else((t230 != 0), -t392/t230, 0)
-    t394 = casadi.if_else((t221 != 0), -(t390 - t227*t393)/t221, 0)
-    t395 = casadi.if_else((t206 != 0), -(-(t213*t394 + t217*t393) + t386)/t206, 0)
-    t396 = casadi.if_else((t176 != 0), -(-(t191*t395 + t196*t394 + t201*t393) + t381)/t176, 0)
-    t397 = casadi.if_else((t119 != 0), -(-(-t158*t396 - t164*t395 + t170*t394 + t179*t393) + t375)/t119, 0)
-    t398 = casadi.if_else((t97 != 0), -(t368 + t122*t396 + t129*t395 + t142*t393 - t111*t397 - t135*t394)/t97, 0)
-    t399 = t393 - t51*t398 + t50*t397
-    t400 = -c23*t393 + t15*t395 + t24*t394
-    t401 = t13*t395 - t10*t394 + t38*t393
-    t402 = t17*t395 + t26*t394 - t37*t393
-    t403 = t233*(t53 + t235*t366 + t238*t236)
-    t404 = -t403 + t53
-    t405 = 1 - t17 - t80 - t81 - t237 - t242 - t15 + q1 + q2 + q3 + c23 + q4 + t13 + q5 + t37 + q6 + t50 + t38 + t52 + t30 - 2*c1 + t87 + t234 + t281 + t293 + t295 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t53 + t236 + t3 + t364 + t365 + t366
-    t406 = c1*t394 - s1*t395
-    t407 = t406 - t52*t396 + t80*t398 + t237*t397
-    t408 = t406 - t30*t396 + t81*t398 + t242*t397
-    t409 = t235*t403
-    t410 = t236 - t50*t409
-    t411 = -t409 + t366
-    t412 = t262*(t410 + t263*t3 + t283*t364 - t284*t365 - t275*t411)
-    t413 = -t412 + t410
-    t414 = t3 - t263*t412
-    t415 = t364 - t283*t412
-    t416 = t365 + t284*t412
-    t417 = t411 + t275*t412
-    t418 = t299*(t414 + t301*t415 + t302*t416 + t303*t417)
-    t419 = -t418 + t414
-    t420 = t415 - t301*t418
-    t421 = t416 - t302*t418
-    t422 = t417 - t303*t418
-    t423 = t325*(t420 + t326*t421 + t327*t422)
-    t424 = -t423 + t420
-    t425 = t421 - t326*t423
-    t426 = t422 - t327*t423
-    t427 = t340*(t425 + t341*t426)
-    t428 = -t427 + t425
-    t429 = t426 - t341*t427
-    t430 = t429 - t347*t429
-    t431 = casadi.if_else((t346 != 0), -t430/t346, 0)
-    t432 = casadi.if_else((t337 != 0), -(t428 - t343*t431)/t337, 0)
-    t433 = casadi.if_else((t310 != 0), -(-(t329*t432 - t333*t431) + t424)/t310, 0)
-    t434 = casadi.if_else((t274 != 0), -(t419 + t305*t433 + t313*t432 + t319*t431)/t274, 0)
-    t435 = casadi.if_else((t249 != 0), -(t413 + t266*t434 + t277*t433 + t286*t432 + t290*t431)/t249, 0)
-    t436 = t235*t233
-    t437 = casadi.if_else((t64 != 0), -(t404 + t240*t435 + t244*t434 + c23*t436*t433 + t38*t436*t432 + t37*t436*t431)/t64, 0)
-    t438 = (casadi.fabs(t405) < casadi.inf)
-    t439 = (damping >= 0)
-    t440 = (damping > 0)
-    t441 = 1e-12*t103
-    t442 = 1e-12*t72
-    t443 = casadi.logic_or(casadi.logic_and(t440, casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t96 <= t441), (t118 <= t441)), (t175 <= t441)), (t205 <= t441)), (t220 <= t441)), (t229 <= t441))), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t63 <= t442), (t248 <= t442)), (t273 <= t442)), (t309 <= t442)), (t336 <= t442)), (t345 <= t442))))
-    t444 = casadi.logic_and(casadi.logic_and(t438, t439), casadi.logic_not(t443))
+    t73 = s1*c1
+    t74 = -t50*t51 + t59*t73 + t60*t73
+    t75 = c1*t52
+    t76 = c1*t30
+    t77 = t1*t75 + t0*t76
+    t78 = t75 + t76
+    t79 = c1*t1
+    t80 = c1*t0
+    t81 = s1*t79 + s1*t80
+    t82 = s1*t52
+    t83 = s1*t30
+    t84 = t1*t82 + t0*t83
+    t85 = t82 + t83
+    t86 = 2*s1
+    t87 = -t13*t10 + t17*t26 - c1*t86 + t68*t73
+    t88 = (t63 > 0)
+    t89 = casadi.if_else(t88, 1 + casadi.fabs(t51)/t63, 0)
+    t90 = -t51
+    t91 = casadi.if_else(t88, 1/(t90 + t64), 0)
+    t92 = mu_dot1 + gain1*(t90 + T13)
+    t93 = s1*t1
+    t94 = t50*t91
+    t95 = -t89*(t79 + t93*t94)
+    t96 = t79 + t95
+    t97 = t93 + t94*t95
+    t98 = s1*t0
+    t99 = -t89*(t80 + t94*t98)
+    t100 = t80 + t99
+    t101 = t91*t99
+    t102 = t98 + t50*t101
+    t103 = t91**2
+    t104 = casadi.sqrt(t54 + t57 + t65 + t97**2 + t103*t95**2)
+    t105 = t104*casadi.if_else((t97 <= 0), 1, -1)
+    t106 = t103*t89
+    t107 = c23*t106
+    t108 = t50*t107
+    t109 = -t107 + c23
+    t110 = t38*t106
+    t111 = t50*t110
+    t112 = -t110 + t38
+    t113 = t37*t106
+    t114 = t50*t113
+    t115 = -t113 + t37
+    t116 = (t104 > 0)
+    t117 = casadi.if_else(t116, 1/(-t97 + t105), 0)
+    t118 = casadi.if_else(t116, 1 + casadi.fabs(t97)/t104, 0)
+    t119 = t52*t117
+    t120 = t95*t117
+    t121 = t118*(-t102 + t30*t119 + t65*t117 + t57*t117 + t103*t120*t99)
+    t122 = t102 + t121
+    t123 = t30 - t119*t121
+    t124 = t117*t121
+    t125 = s1 - s1*t124
+    t126 = -c1 + c1*t124
+    t127 = t91*t95
+    t128 = -t101 + t124*t127
+    t129 = casadi.sqrt(t123**2 + t125**2 + t126**2 + t128**2)
+    t130 = t129*casadi.if_else((t123 >= 0), 1, -1)
+    t131 = t120*t91
+    t132 = -t118*(t108 + t131*t109)
+    t133 = t108 + t132
+    t134 = t117*t132
+    t135 = t15 + s1*t134
+    t136 = t109 + t127*t134
+    t137 = -t24
+    t138 = t137 + c1*t134
+    t139 = s1*t117
+    t140 = c1*t117
+    t141 = t118*(-t111 + t13*t139 + t10*t140 - t131*t112)
+    t142 = t111 + t141
+    t143 = t13 - t139*t141
+    t144 = t112 + t131*t141
+    t145 = -t118*(t114 + t17*t139 - t26*t140 + t131*t115)
+    t146 = t114 + t145
+    t147 = t17 + t139*t145
+    t148 = t115 + t131*t145
+    t149 = -t10
+    t150 = t149 + t140*t141
+    t151 = -t26
+    t152 = t151 + t140*t145
+    t153 = (t129 > 0)
+    t154 = casadi.if_else(t153, 1/(t123 + t130), 0)
+    t155 = casadi.if_else(t153, 1 + casadi.fabs(t123)/t129, 0)
+    t156 = t119*t132
+    t157 = t125*t154
+    t158 = t126*t154
+    t159 = t128*t154
+    t160 = t155*(-t156 - t157*t135 + t158*t138 + t159*t136)
+    t161 = t156 + t160
+    t162 = t135 + t157*t160
+    t163 = t138 - t158*t160
+    t164 = t136 - t159*t160
+    t165 = casadi.sqrt(t162**2 + t163**2 + t164**2)
+    t166 = t165*casadi.if_else((t162 <= 0), 1, -1)
+    t167 = t119*t141
+    t168 = t155*(-t167 + t157*t143 + t158*t150 + t159*t144)
+    t169 = t167 + t168
+    t170 = t143 - t157*t168
+    t171 = t150 - t158*t168
+    t172 = t144 - t159*t168
+    t173 = t119*t145
+    t174 = t155*(-t173 - t157*t147 + t158*t152 + t159*t148)
+    t175 = t173 + t174
+    t176 = t147 + t157*t174
+    t177 = t152 - t158*t174
+    t178 = t148 - t159*t174
+    t179 = (t165 > 0)
+    t180 = casadi.if_else(t179, 1/(-t162 + t166), 0)
+    t181 = casadi.if_else(t179, 1 + casadi.fabs(t162)/t165, 0)
+    t182 = t163*t180
+    t183 = t164*t180
+    t184 = t181*(t170 + t182*t171 + t183*t172)
+    t185 = -t184 + t170
+    t186 = t171 - t182*t184
+    t187 = t172 - t183*t184
+    t188 = t181*(-t176 + t182*t177 + t183*t178)
+    t189 = t176 + t188
+    t190 = t177 - t182*t188
+    t191 = t178 - t183*t188
+    t192 = casadi.sqrt(t186**2 + t187**2)
+    t193 = t192*casadi.if_else((t186 >= 0), 1, -1)
+    t194 = (t192 > 0)
+    t195 = casadi.if_else(t194, 1/(t186 + t193), 0)
+    t196 = casadi.if_else(t194, 1 + casadi.fabs(t186)/t192, 0)
+    t197 = t187*t195
+    t198 = t196*(t190 + t197*t191)
+    t199 = -t198 + t190
+    t200 = t191 - t197*t198
+    t201 = casadi.fabs(t200)
+    t202 = t201*casadi.if_else((t200 >= 0), 1, -1)
+    t203 = casadi.if_else((t201 > 0), 2, 0)
+    t204 = -t21
+    t205 = 0.5*(-1 + t204 + t32 + t45)
+    t206 = casadi.atan2(t48, t205)
+    t207 = casadi.if_else((t48 > 0), t206/t48, 1)
+    t208 = casadi.logic_and((t204 >= t32), (t204 >= t45))
+    t209 = (t32 >= t45)
+    t210 = casadi.if_else(t208, 0.5*(1 + t204), casadi.if_else(t209, 0.5*t31, 0.5*t43))
+    t211 = casadi.if_else(t208, -0.5*t22, casadi.if_else(t209, 0.5*(1 + t32), 0.5*t44))
+    t212 = casadi.if_else(t208, -0.5*t23, casadi.if_else(t209, 0.5*t33, 0.5*(1 + t45)))
+    t213 = casadi.sqrt(t210**2 + t211**2 + t212**2)
+    t214 = casadi.if_else((t46*t210 + t47*t211 + t34*t212 >= 0), 1, -1)
+    t215 = casadi.logic_or((t48 > 1e-06), (t205 > 0))
+    t216 = t206*t214/t213
+    t217 = casadi.if_else(t215, t46*t207, t216*t210)
+    t218 = casadi.if_else(t215, t47*t207, t216*t211)
+    t219 = casadi.if_else(t215, t34*t207, t216*t212)
+    t220 = mu_dot3 + t217*gain3
+    t221 = mu_dot4 + t218*gain4
+    t222 = mu_dot5 + t219*gain5
+    t223 = t89*(t53 + t91*t222 + t94*t92)
+    t224 = -t223 + t53
+    t225 = 1 - t17 - t79 - t80 - t93 - t98 - t15 + q1 + q2 + q3 + c23 + q4 + t13 + q5 + t37 + q6 + t50 + t38 + t52 + t30 - 2*c1 + t86 + t90 + t137 + t149 + t151 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t53 + t92 + t3 + t220 + t221 + t222
+    t226 = damping**2
+    t227 = _symmetric_solve6(1, (t61 + t226, t74, -t77, -t81, t58, t90, t67 + t226, -t84, -t66, t81, t50, t55 + t226, t85, -t78, 0, t69 + t226, t87, -t41, t70 + t226, -t42, t71 + t226, t53, t92, t3, t220, t221, t222,))
+    t228 = t227[5]
+    t229 = t227[0]
+    t230 = t227[1]
+    t231 = t228 - t51*t229 + t50*t230
+    t232 = t227[2]
+    t233 = t227[3]
+    t234 = t227[4]
+    t235 = t15*t233 + t24*t234 - c23*t228
+    t236 = t13*t233 - t10*t234 + t38*t228
+    t237 = t17*t233 + t26*t234 - t37*t228
+    t238 = -s1*t233 + c1*t234
+    t239 = t238 + t79*t229 + t93*t230 - t52*t232
+    t240 = t238 + t80*t229 + t98*t230 - t30*t232
+    t241 = t91*t223
+    t242 = t92 - t50*t241
+    t243 = -t241 + t222
+    t244 = t118*(t242 + t119*t3 + t139*t220 - t140*t221 - t131*t243)
+    t245 = -t244 + t242
+    t246 = t3 - t119*t244
+    t247 = t220 - t139*t244
+    t248 = t221 + t140*t244
+    t249 = t243 + t131*t244
+    t250 = t155*(t246 + t157*t247 + t158*t248 + t159*t249)
+    t251 = -t250 + t246
+    t252 = t247 - t157*t250
+    t253 = t248 - t158*t250
+    t254 = t249 - t159*t250
+    t255 = t181*(t252 + t182*t253 + t183*t254)
+    t256 = -t255 + t252
+    t257 = t253 - t182*t255
+    t258 = t254 - t183*t255
+    t259 = t196*(t257 + t197*t258)
+    t260 = -t259 + t257
+    t261 = t258 - t197*t259
+    t262 = t261 - t203*t261
+    t263 = casadi.if_else((t202 != 0), -t262/t202, 0)
+    t264 = casadi.if_else((t193 != 0), -(t260 - t199*t263)/t193, 0)
+    t265 = casadi.if_else((t166 != 0), -(-(t185*t264 - t189*t263) + t256)/t166, 0)
+    t266 = casadi.if_else((t130 != 0), -(t251 + t161*t265 + t169*t264 + t175*t263)/t130, 0)
+    t267 = casadi.if_else((t105 != 0), -(t245 + t122*t266 + t133*t265 + t142*t264 + t146*t263)/t105, 0)
+    t268 = t91*t89
+    t269 = casadi.if_else((t64 != 0), -(t224 + t96*t267 + t100*t266 + c23*t268*t265 + t38*t268*t264 + t37*t268*t263)/t64, 0)
+    t270 = (casadi.fabs(t225) < casadi.inf)
+    t271 = (damping >= 0)
+    t272 = (damping > 0)
+    t273 = 1e-12*t72
+    t274 = casadi.logic_or(casadi.logic_and(t272, (t227[6] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t63 <= t273), (t104 <= t273)), (t129 <= t273)), (t165 <= t273)), (t192 <= t273)), (t201 <= t273))))
+    t275 = casadi.logic_and(casadi.logic_and(t270, t271), casadi.logic_not(t274))
     q_dot = casadi.SX(6, 1)
-    q_dot[0, 0] = casadi.if_else(t444, casadi.if_else(t440, t399, t437), 0)
-    q_dot[1, 0] = casadi.if_else(t444, casadi.if_else(t440, -t407, t435), 0)
-    q_dot[2, 0] = casadi.if_else(t444, casadi.if_else(t440, -t408, t434), 0)
-    q_dot[3, 0] = casadi.if_else(t444, casadi.if_else(t440, -t400, t433), 0)
-    q_dot[4, 0] = casadi.if_else(t444, casadi.if_else(t440, t401, t432), 0)
-    q_dot[5, 0] = casadi.if_else(t444, casadi.if_else(t440, -t402, t431), 0)
+    q_dot[0, 0] = casadi.if_else(t275, casadi.if_else(t272, t231, t269), 0)
+    q_dot[1, 0] = casadi.if_else(t275, casadi.if_else(t272, -t239, t267), 0)
+    q_dot[2, 0] = casadi.if_else(t275, casadi.if_else(t272, -t240, t266), 0)
+    q_dot[3, 0] = casadi.if_else(t275, casadi.if_else(t272, -t235, t265), 0)
+    q_dot[4, 0] = casadi.if_else(t275, casadi.if_else(t272, t236, t264), 0)
+    q_dot[5, 0] = casadi.if_else(t275, casadi.if_else(t272, -t237, t263), 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t438, t439)), 2, casadi.if_else(t443, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t270, t271)), 2, casadi.if_else(t274, 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 879 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 948 operations."""
     T00 = target[0, 0]
     T01 = target[0, 1]
     T02 = target[0, 2]
@@ -4357,227 +4093,65 @@ def _ik_numeric_step(target, q, damping):
     t53 = c1*t51 + s1*t52
     t54 = t53**2 + t31**2
     t55 = -t51 + T03
-    t56 = -t52 + T13
-    t57 = t52**2
-    t58 = c1**2
-    t59 = t1*t58 + t0*t58
-    t60 = t1**2
-    t61 = t0**2
-    t62 = t57 + t58*t60 + t58*t61
-    t63 = t51*t52
-    t64 = s1*c1
-    t65 = -t63 + t61*t64 + t60*t64
-    t66 = t1*t64 + t0*t64
-    t67 = c1*t53
-    t68 = c1*t31
-    t69 = t1*t67 + t0*t68
-    t70 = t67 + t68
-    t71 = s1**2
-    t72 = t51**2 + t60*t71 + t61*t71
-    t73 = t1*t71 + t0*t71
-    t74 = s1*t53
-    t75 = s1*t31
-    t76 = t1*t74 + t0*t75
-    t77 = t74 + t75
-    t78 = s23**2
-    t79 = t14**2 + t18**2 + 2*t71 + t58*t78
-    t80 = -2*t64 - t14*t11 + t18*t27 + t64*t78
-    t81 = t11**2 + t27**2 + 2*t58 + t71*t78
-    t82 = 1 + c23**2 + t38**2 + s4**2*t78
-    t83 = -t22
-    t84 = 0.5*(-1 + t83 + t33 + t46)
-    t85 = casadi.atan2(t49, t84)
-    t86 = casadi.if_else((t49 > 0), t85/t49, 1)
-    t87 = casadi.logic_and((t83 >= t33), (t83 >= t46))
-    t88 = (t33 >= t46)
-    t89 = casadi.if_else(t87, 0.5*(1 + t83), casadi.if_else(t88, 0.5*t32, 0.5*t44))
-    t90 = casadi.if_else(t87, -0.5*t23, casadi.if_else(t88, 0.5*(1 + t33), 0.5*t45))
-    t91 = casadi.if_else(t87, -0.5*t24, casadi.if_else(t88, 0.5*t34, 0.5*(1 + t46)))
-    t92 = casadi.sqrt(t89**2 + t90**2 + t91**2)
-    t93 = casadi.if_else((t47*t89 + t48*t90 + t35*t91 >= 0), 1, -1)
-    t94 = casadi.logic_or((t49 > 1e-06), (t84 > 0))
-    t95 = t85*t93/t92
-    t96 = casadi.if_else(t94, t47*t86, t95*t89)
-    t97 = casadi.if_else(t94, t48*t86, t95*t90)
-    t98 = casadi.if_else(t94, t35*t86, t95*t91)
-    t99 = t96**2 + t97**2 + t98**2 + t55**2 + t56**2 + t3**2
-    t100 = damping + t62
-    t101 = casadi.sqrt(t57 + t100**2 + t65**2 + t69**2 + t66**2 + t59**2)
-    t102 = t101*casadi.if_else((t100 >= 0), 1, -1)
-    t103 = (t101 > 0)
-    t104 = casadi.if_else(t103, 1/(t100 + t102), 0)
-    t105 = casadi.if_else(t103, 1 + casadi.fabs(t100)/t101, 0)
-    t106 = damping + t72
-    t107 = t65*t104
-    t108 = t69*t104
-    t109 = t66*t104
-    t110 = t105*(t65 + t106*t107 + t108*t76 + t109*t73 + t109*t59 - t63*t104)
-    t111 = -t110 + t65
-    t112 = t106 - t107*t110
-    t113 = -t76 + t108*t110
-    t114 = -t73 + t109*t110
-    t115 = t104*t110
-    t116 = t66 - t115*t59
-    t117 = t51 + t52*t115
-    t118 = casadi.sqrt(t112**2 + t113**2 + t114**2 + t116**2 + t117**2)
-    t119 = t118*casadi.if_else((t112 >= 0), 1, -1)
-    t120 = damping + t54
-    t121 = t59*t104
-    t122 = -t105*(t69 + t107*t76 + t108*t120 + t109*t77 + t121*t70)
-    t123 = t69 + t122
-    t124 = t76 + t107*t122
-    t125 = t120 + t108*t122
-    t126 = t77 + t109*t122
-    t127 = t70 + t121*t122
-    t128 = damping + t79
-    t129 = t52*t104
-    t130 = -t105*(t66 + t107*t73 + t108*t77 + t109*t128 - t121*t80 - t129*t42)
-    t131 = t66 + t130
-    t132 = t73 + t107*t130
-    t133 = t77 + t108*t130
-    t134 = t128 + t109*t130
-    t135 = t80 - t121*t130
-    t136 = t105*(t55 + t107*t56 - t108*t3 - t109*t96 + t121*t97 - t129*t98)
-    t137 = -t136 + t55
-    t138 = t56 - t107*t136
-    t139 = t3 + t108*t136
-    t140 = t96 + t109*t136
-    t141 = t97 - t121*t136
-    t142 = t98 + t129*t136
-    t143 = -t42
-    t144 = t143 + t129*t130
-    t145 = damping + t81
-    t146 = t105*(t59 + t107*t66 + t108*t70 - t109*t80 + t121*t145 + t129*t43)
-    t147 = -t146 + t59
-    t148 = t66 - t107*t146
-    t149 = -t70 + t108*t146
-    t150 = t80 + t109*t146
-    t151 = t145 - t121*t146
-    t152 = -t43 + t129*t146
-    t153 = damping + t82
-    t154 = -t105*(t52 - t51*t107 - t109*t42 + t121*t43 + t129*t153)
-    t155 = t52 + t154
-    t156 = t51 - t107*t154
-    t157 = t143 + t109*t154
-    t158 = t43 + t121*t154
-    t159 = t153 + t129*t154
-    t160 = (t118 > 0)
-    t161 = casadi.if_else(t160, 1/(t112 + t119), 0)
-    t162 = casadi.if_else(t160, 1 + casadi.fabs(t112)/t118, 0)
-    t163 = t113*t161
-    t164 = t114*t161
-    t165 = t116*t161
-    t166 = t129*t122
-    t167 = t117*t161
-    t168 = t162*(-t124 + t163*t125 + t164*t126 - t165*t127 + t166*t167)
-    t169 = t124 + t168
-    t170 = t125 - t163*t168
-    t171 = t126 - t164*t168
-    t172 = t127 + t165*t168
-    t173 = t166 - t167*t168
-    t174 = t162*(-t132 + t163*t133 + t164*t134 + t165*t135 + t167*t144)
-    t175 = t132 + t174
-    t176 = t133 - t163*t174
-    t177 = t134 - t164*t174
-    t178 = t135 - t165*t174
-    t179 = t144 - t167*t174
-    t180 = t162*(t148 + t163*t149 + t164*t150 + t165*t151 + t167*t152)
-    t181 = -t180 + t148
-    t182 = t149 - t163*t180
-    t183 = t150 - t164*t180
-    t184 = t151 - t165*t180
-    t185 = t152 - t167*t180
-    t186 = t162*(t138 + t163*t139 + t164*t140 + t165*t141 + t167*t142)
-    t187 = -t186 + t138
-    t188 = t139 - t163*t186
-    t189 = t140 - t164*t186
-    t190 = t141 - t165*t186
-    t191 = t142 - t167*t186
-    t192 = casadi.sqrt(t170**2 + t171**2 + t172**2 + t173**2)
-    t193 = t192*casadi.if_else((t170 >= 0), 1, -1)
-    t194 = t108*t154
-    t195 = t162*(t156 + t163*t194 + t164*t157 - t165*t158 + t167*t159)
-    t196 = -t195 + t156
-    t197 = t194 - t163*t195
-    t198 = t157 - t164*t195
-    t199 = t158 + t165*t195
-    t200 = t159 - t167*t195
-    t201 = (t192 > 0)
-    t202 = casadi.if_else(t201, 1/(t170 + t193), 0)
-    t203 = casadi.if_else(t201, 1 + casadi.fabs(t170)/t192, 0)
-    t204 = t171*t202
-    t205 = t172*t202
-    t206 = t173*t202
-    t207 = t203*(t176 + t204*t177 - t205*t178 + t206*t179)
-    t208 = -t207 + t176
-    t209 = t177 - t204*t207
-    t210 = t178 + t205*t207
-    t211 = t179 - t206*t207
-    t212 = t203*(t182 + t204*t183 - t205*t184 + t206*t185)
-    t213 = -t212 + t182
-    t214 = t183 - t204*t212
-    t215 = t184 + t205*t212
-    t216 = t185 - t206*t212
-    t217 = t203*(t197 + t204*t198 + t205*t199 + t206*t200)
-    t218 = -t217 + t197
-    t219 = t198 - t204*t217
-    t220 = -t199 + t205*t217
-    t221 = t200 - t206*t217
-    t222 = t203*(t188 + t204*t189 - t205*t190 + t206*t191)
-    t223 = -t222 + t188
-    t224 = t189 - t204*t222
-    t225 = t190 + t205*t222
-    t226 = t191 - t206*t222
-    t227 = casadi.sqrt(t209**2 + t210**2 + t211**2)
-    t228 = t227*casadi.if_else((t209 >= 0), 1, -1)
-    t229 = (t227 > 0)
-    t230 = casadi.if_else(t229, 1/(t209 + t228), 0)
-    t231 = casadi.if_else(t229, 1 + casadi.fabs(t209)/t227, 0)
-    t232 = t210*t230
-    t233 = t211*t230
-    t234 = t231*(t214 + t232*t215 + t233*t216)
-    t235 = -t234 + t214
-    t236 = t215 - t232*t234
-    t237 = t216 - t233*t234
-    t238 = t231*(t219 + t232*t220 + t233*t221)
-    t239 = -t238 + t219
-    t240 = t220 - t232*t238
-    t241 = t221 - t233*t238
-    t242 = t231*(t224 + t232*t225 + t233*t226)
-    t243 = -t242 + t224
-    t244 = t225 - t232*t242
-    t245 = t226 - t233*t242
-    t246 = casadi.sqrt(t236**2 + t237**2)
-    t247 = t246*casadi.if_else((t236 >= 0), 1, -1)
-    t248 = (t246 > 0)
-    t249 = casadi.if_else(t248, 1/(t236 + t247), 0)
-    t250 = casadi.if_else(t248, 1 + casadi.fabs(t236)/t246, 0)
-    t251 = t237*t249
-    t252 = t250*(t240 + t251*t241)
-    t253 = -t252 + t240
-    t254 = t241 - t251*t252
-    t255 = t250*(t244 + t251*t245)
-    t256 = -t255 + t244
-    t257 = t245 - t251*t255
-    t258 = casadi.fabs(t254)
-    t259 = t258*casadi.if_else((t254 >= 0), 1, -1)
-    t260 = casadi.if_else((t258 > 0), 2, 0)
-    t261 = t257 - t257*t260
-    t262 = casadi.if_else((t259 != 0), -t261/t259, 0)
-    t263 = casadi.if_else((t247 != 0), -(t256 - t253*t262)/t247, 0)
-    t264 = casadi.if_else((t228 != 0), -(-(t235*t263 + t239*t262) + t243)/t228, 0)
-    t265 = casadi.if_else((t193 != 0), -(-(t208*t264 + t213*t263 + t218*t262) + t223)/t193, 0)
-    t266 = casadi.if_else((t119 != 0), -(-(-t169*t265 - t175*t264 + t181*t263 + t196*t262) + t187)/t119, 0)
-    t267 = casadi.if_else((t102 != 0), -(t137 + t123*t265 + t131*t264 + t155*t262 - t111*t266 - t147*t263)/t102, 0)
-    t268 = q1 + t262 - t52*t267 + t51*t266
-    t269 = q4 + c23*t262 - t16*t264 - t25*t263
-    t270 = q5 + t14*t264 - t11*t263 + t39*t262
-    t271 = q6 - t18*t264 - t27*t263 + t38*t262
-    t272 = c1*t267
-    t273 = s1*t266
-    t274 = s1*t264 - c1*t263
-    t275 = q2 + t274 + t53*t265 - t1*t272 - t1*t273
-    t276 = q3 + t274 + t31*t265 - t0*t272 - t0*t273
+    t56 = c1**2
+    t57 = t1*t56 + t0*t56
+    t58 = t1**2
+    t59 = t0**2
+    t60 = t52**2 + t56*t58 + t56*t59
+    t61 = s1*c1
+    t62 = t58*t61 + t59*t61 - t51*t52
+    t63 = t0*t61 + t1*t61
+    t64 = c1*t53
+    t65 = c1*t31
+    t66 = t1*t64 + t0*t65
+    t67 = t64 + t65
+    t68 = s1**2
+    t69 = t51**2 + t58*t68 + t59*t68
+    t70 = t1*t68 + t0*t68
+    t71 = s1*t53
+    t72 = s1*t31
+    t73 = t1*t71 + t0*t72
+    t74 = t71 + t72
+    t75 = s23**2
+    t76 = t14**2 + t18**2 + 2*t68 + t56*t75
+    t77 = -2*t61 - t14*t11 + t18*t27 + t61*t75
+    t78 = t11**2 + t27**2 + 2*t56 + t68*t75
+    t79 = 1 + c23**2 + t38**2 + s4**2*t75
+    t80 = -t22
+    t81 = 0.5*(-1 + t80 + t33 + t46)
+    t82 = casadi.atan2(t49, t81)
+    t83 = casadi.if_else((t49 > 0), t82/t49, 1)
+    t84 = casadi.logic_and((t80 >= t33), (t80 >= t46))
+    t85 = (t33 >= t46)
+    t86 = casadi.if_else(t84, 0.5*(1 + t80), casadi.if_else(t85, 0.5*t32, 0.5*t44))
+    t87 = casadi.if_else(t84, -0.5*t23, casadi.if_else(t85, 0.5*(1 + t33), 0.5*t45))
+    t88 = casadi.if_else(t84, -0.5*t24, casadi.if_else(t85, 0.5*t34, 0.5*(1 + t46)))
+    t89 = casadi.sqrt(t86**2 + t87**2 + t88**2)
+    t90 = casadi.if_else((t47*t86 + t48*t87 + t35*t88 >= 0), 1, -1)
+    t91 = casadi.logic_or((t49 > 1e-06), (t81 > 0))
+    t92 = t82*t90/t89
+    t93 = casadi.if_else(t91, t47*t83, t92*t86)
+    t94 = casadi.if_else(t91, t48*t83, t92*t87)
+    t95 = casadi.if_else(t91, t35*t83, t92*t88)
+    t96 = -t52
+    t97 = t96 + T13
+    t98 = t93**2 + t94**2 + t95**2 + t55**2 + t97**2 + t3**2
+    t99 = _symmetric_solve6(1, (damping + t60, t62, -t66, -t63, t57, t96, damping + t69, -t73, -t70, t63, t51, damping + t54, t74, -t67, 0, damping + t76, t77, -t42, damping + t78, -t43, damping + t79, t55, t97, t3, t93, t94, t95,))
+    t100 = t99[5]
+    t101 = t99[0]
+    t102 = t99[1]
+    t103 = q1 + t100 - t52*t101 + t51*t102
+    t104 = c1*t101
+    t105 = s1*t102
+    t106 = t99[2]
+    t107 = t99[3]
+    t108 = t99[4]
+    t109 = q4 - t16*t107 - t25*t108 + c23*t100
+    t110 = q5 + t14*t107 - t11*t108 + t39*t100
+    t111 = q6 - t18*t107 - t27*t108 + t38*t100
+    t112 = s1*t107 - c1*t108
+    t113 = q2 + t112 - t1*t104 - t1*t105 + t53*t106
+    t114 = q3 + t112 - t0*t104 - t0*t105 + t31*t106
     q_start = casadi.SX(6, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -4586,14 +4160,14 @@ def _ik_numeric_step(target, q, damping):
     q_start[4, 0] = q5
     q_start[5, 0] = q6
     q_next = casadi.SX(6, 1)
-    q_next[0, 0] = casadi.if_else((t268 < -2.792526803190927), -2.792526803190927, casadi.if_else((t268 > 2.792526803190927), 2.792526803190927, t268))
-    q_next[1, 0] = casadi.if_else((t275 < -0.7853981633974483), -0.7853981633974483, casadi.if_else((t275 > 3.9269908169872414), 3.9269908169872414, t275))
-    q_next[2, 0] = casadi.if_else((t276 < -3.9269908169872414), -3.9269908169872414, casadi.if_else((t276 > 0.7853981633974483), 0.7853981633974483, t276))
-    q_next[3, 0] = casadi.if_else((t269 < -1.9198621771937625), -1.9198621771937625, casadi.if_else((t269 > 2.9670597283903604), 2.9670597283903604, t269))
-    q_next[4, 0] = casadi.if_else((t270 < -1.7453292519943295), -1.7453292519943295, casadi.if_else((t270 > 1.7453292519943295), 1.7453292519943295, t270))
-    q_next[5, 0] = casadi.if_else((t271 < -4.642575810304916), -4.642575810304916, casadi.if_else((t271 > 4.642575810304916), 4.642575810304916, t271))
+    q_next[0, 0] = casadi.if_else((t103 < -2.792526803190927), -2.792526803190927, casadi.if_else((t103 > 2.792526803190927), 2.792526803190927, t103))
+    q_next[1, 0] = casadi.if_else((t113 < -0.7853981633974483), -0.7853981633974483, casadi.if_else((t113 > 3.9269908169872414), 3.9269908169872414, t113))
+    q_next[2, 0] = casadi.if_else((t114 < -3.9269908169872414), -3.9269908169872414, casadi.if_else((t114 > 0.7853981633974483), 0.7853981633974483, t114))
+    q_next[3, 0] = casadi.if_else((t109 < -1.9198621771937625), -1.9198621771937625, casadi.if_else((t109 > 2.9670597283903604), 2.9670597283903604, t109))
+    q_next[4, 0] = casadi.if_else((t110 < -1.7453292519943295), -1.7453292519943295, casadi.if_else((t110 > 1.7453292519943295), 1.7453292519943295, t110))
+    q_next[5, 0] = casadi.if_else((t111 < -4.642575810304916), -4.642575810304916, casadi.if_else((t111 > 4.642575810304916), 4.642575810304916, t111))
     cost = casadi.SX(1, 1)
-    cost[0, 0] = casadi.if_else((casadi.fabs(t4) < casadi.inf), t99, -1)
+    cost[0, 0] = casadi.if_else((casadi.fabs(t4) < casadi.inf), t98, -1)
     return [q_start, q_next, cost]
 
 
@@ -5188,7 +4762,7 @@ def _ik_branches(T):
 
 
 def _ik_nearest(T, q_seed, weights):
-    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 963 operations."""
+    """The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: 962 operations."""
     branches_q, branches_valid, branches_in_limits = _ik_branches(T)
     T00 = T[0, 0]
     T01 = T[0, 1]
@@ -5278,366 +4852,27 @@ def _ik_nearest(T, q_seed, weights):
     lb5 = branches_in_limits[5]
     lb6 = branches_in_limits[6]
     lb7 = branches_in_limits[7]
-    t0 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
-    t1 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
-    t2 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
-    t3 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
-    t4 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
-    t5 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
-    t6 = casadi.if_else(casadi.logic_and(vb0, lb0), 1, 0)
-    t7 = casadi.if_else((t6 > 0), 1, 0)
-    t8 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
-    t9 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
-    t10 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
-    t11 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
-    t12 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
-    t13 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
-    t14 = casadi.if_else(casadi.logic_and(vb1, lb1), 1, 0)
-    t15 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
-    t16 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
-    t17 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
-    t18 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
-    t19 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
-    t20 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
-    t21 = casadi.if_else(casadi.logic_and(vb2, lb2), 1, 0)
-    t22 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
-    t23 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
-    t24 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
-    t25 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
-    t26 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
-    t27 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
-    t28 = casadi.if_else(casadi.logic_and(vb3, lb3), 1, 0)
-    t29 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
-    t30 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
-    t31 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
-    t32 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
-    t33 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
-    t34 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
-    t35 = casadi.if_else(casadi.logic_and(vb4, lb4), 1, 0)
-    t36 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
-    t37 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
-    t38 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
-    t39 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
-    t40 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
-    t41 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
-    t42 = casadi.if_else(casadi.logic_and(vb5, lb5), 1, 0)
-    t43 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
-    t44 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
-    t45 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
-    t46 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
-    t47 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
-    t48 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
-    t49 = casadi.if_else(casadi.logic_and(vb6, lb6), 1, 0)
-    t50 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
-    t51 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
-    t52 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
-    t53 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
-    t54 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
-    t55 = 6.283185307179586*casadi.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
-    t56 = casadi.if_else(casadi.logic_and(vb7, lb7), 1, 0)
-    t57 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
-    t58 = casadi.if_else((t0 < qn1), 6.283185307179586, -6.283185307179586)
-    t59 = t58 + t0
-    t60 = -t58 + t0
-    t61 = casadi.if_else(casadi.logic_and((t0 >= -2.792526803190927), (t0 <= 2.792526803190927)), t0, casadi.if_else(casadi.logic_and((t59 >= -2.792526803190927), (t59 <= 2.792526803190927)), t59, casadi.if_else(casadi.logic_and((t60 >= -2.792526803190927), (t60 <= 2.792526803190927)), t60, qb0_0)))
-    t62 = casadi.if_else((t1 < qn2), 6.283185307179586, -6.283185307179586)
-    t63 = t62 + t1
-    t64 = -t62 + t1
-    t65 = casadi.if_else(casadi.logic_and((t1 >= -0.7853981633974483), (t1 <= 3.9269908169872414)), t1, casadi.if_else(casadi.logic_and((t63 >= -0.7853981633974483), (t63 <= 3.9269908169872414)), t63, casadi.if_else(casadi.logic_and((t64 >= -0.7853981633974483), (t64 <= 3.9269908169872414)), t64, qb0_1)))
-    t66 = casadi.if_else((t2 < qn3), 6.283185307179586, -6.283185307179586)
-    t67 = t66 + t2
-    t68 = -t66 + t2
-    t69 = casadi.if_else(casadi.logic_and((t2 >= -3.9269908169872414), (t2 <= 0.7853981633974483)), t2, casadi.if_else(casadi.logic_and((t67 >= -3.9269908169872414), (t67 <= 0.7853981633974483)), t67, casadi.if_else(casadi.logic_and((t68 >= -3.9269908169872414), (t68 <= 0.7853981633974483)), t68, qb0_2)))
-    t70 = casadi.if_else((t3 < qn4), 6.283185307179586, -6.283185307179586)
-    t71 = t70 + t3
-    t72 = -t70 + t3
-    t73 = casadi.if_else(casadi.logic_and((t3 >= -1.9198621771937625), (t3 <= 2.9670597283903604)), t3, casadi.if_else(casadi.logic_and((t71 >= -1.9198621771937625), (t71 <= 2.9670597283903604)), t71, casadi.if_else(casadi.logic_and((t72 >= -1.9198621771937625), (t72 <= 2.9670597283903604)), t72, qb0_3)))
-    t74 = casadi.if_else((t4 < qn5), 6.283185307179586, -6.283185307179586)
-    t75 = t74 + t4
-    t76 = -t74 + t4
-    t77 = casadi.if_else(casadi.logic_and((t4 >= -1.7453292519943295), (t4 <= 1.7453292519943295)), t4, casadi.if_else(casadi.logic_and((t75 >= -1.7453292519943295), (t75 <= 1.7453292519943295)), t75, casadi.if_else(casadi.logic_and((t76 >= -1.7453292519943295), (t76 <= 1.7453292519943295)), t76, qb0_4)))
-    t78 = casadi.if_else((t5 < qn6), 6.283185307179586, -6.283185307179586)
-    t79 = t78 + t5
-    t80 = -t78 + t5
-    t81 = casadi.if_else(casadi.logic_and((t5 >= -4.642575810304916), (t5 <= 4.642575810304916)), t5, casadi.if_else(casadi.logic_and((t79 >= -4.642575810304916), (t79 <= 4.642575810304916)), t79, casadi.if_else(casadi.logic_and((t80 >= -4.642575810304916), (t80 <= 4.642575810304916)), t80, qb0_5)))
-    t82 = -qn1
-    t83 = -qn2
-    t84 = -qn3
-    t85 = -qn4
-    t86 = -qn5
-    t87 = -qn6
-    t88 = qw1*(t82 + t61)**2 + qw2*(t83 + t65)**2 + qw3*(t84 + t69)**2 + qw4*(t85 + t73)**2 + qw5*(t86 + t77)**2 + qw6*(t87 + t81)**2
-    t89 = (t7 > 0)
-    t90 = casadi.if_else(t89, t61, qn1)
-    t91 = casadi.if_else(t89, t65, qn2)
-    t92 = casadi.if_else(t89, t69, qn3)
-    t93 = casadi.if_else(t89, t73, qn4)
-    t94 = casadi.if_else(t89, t77, qn5)
-    t95 = casadi.if_else(t89, t81, qn6)
-    t96 = casadi.if_else(t89, t88, 0)
-    t97 = casadi.if_else((t8 < qn1), 6.283185307179586, -6.283185307179586)
-    t98 = t97 + t8
-    t99 = -t97 + t8
-    t100 = casadi.if_else(casadi.logic_and((t8 >= -2.792526803190927), (t8 <= 2.792526803190927)), t8, casadi.if_else(casadi.logic_and((t98 >= -2.792526803190927), (t98 <= 2.792526803190927)), t98, casadi.if_else(casadi.logic_and((t99 >= -2.792526803190927), (t99 <= 2.792526803190927)), t99, qb1_0)))
-    t101 = casadi.if_else((t9 < qn2), 6.283185307179586, -6.283185307179586)
-    t102 = t101 + t9
-    t103 = -t101 + t9
-    t104 = casadi.if_else(casadi.logic_and((t9 >= -0.7853981633974483), (t9 <= 3.9269908169872414)), t9, casadi.if_else(casadi.logic_and((t102 >= -0.7853981633974483), (t102 <= 3.9269908169872414)), t102, casadi.if_else(casadi.logic_and((t103 >= -0.7853981633974483), (t103 <= 3.9269908169872414)), t103, qb1_1)))
-    t105 = casadi.if_else((t10 < qn3), 6.283185307179586, -6.283185307179586)
-    t106 = t105 + t10
-    t107 = -t105 + t10
-    t108 = casadi.if_else(casadi.logic_and((t10 >= -3.9269908169872414), (t10 <= 0.7853981633974483)), t10, casadi.if_else(casadi.logic_and((t106 >= -3.9269908169872414), (t106 <= 0.7853981633974483)), t106, casadi.if_else(casadi.logic_and((t107 >= -3.9269908169872414), (t107 <= 0.7853981633974483)), t107, qb1_2)))
-    t109 = casadi.if_else((t11 < qn4), 6.283185307179586, -6.283185307179586)
-    t110 = t109 + t11
-    t111 = -t109 + t11
-    t112 = casadi.if_else(casadi.logic_and((t11 >= -1.9198621771937625), (t11 <= 2.9670597283903604)), t11, casadi.if_else(casadi.logic_and((t110 >= -1.9198621771937625), (t110 <= 2.9670597283903604)), t110, casadi.if_else(casadi.logic_and((t111 >= -1.9198621771937625), (t111 <= 2.9670597283903604)), t111, qb1_3)))
-    t113 = casadi.if_else((t12 < qn5), 6.283185307179586, -6.283185307179586)
-    t114 = t113 + t12
-    t115 = -t113 + t12
-    t116 = casadi.if_else(casadi.logic_and((t12 >= -1.7453292519943295), (t12 <= 1.7453292519943295)), t12, casadi.if_else(casadi.logic_and((t114 >= -1.7453292519943295), (t114 <= 1.7453292519943295)), t114, casadi.if_else(casadi.logic_and((t115 >= -1.7453292519943295), (t115 <= 1.7453292519943295)), t115, qb1_4)))
-    t117 = casadi.if_else((t13 < qn6), 6.283185307179586, -6.283185307179586)
-    t118 = t117 + t13
-    t119 = -t117 + t13
-    t120 = casadi.if_else(casadi.logic_and((t13 >= -4.642575810304916), (t13 <= 4.642575810304916)), t13, casadi.if_else(casadi.logic_and((t118 >= -4.642575810304916), (t118 <= 4.642575810304916)), t118, casadi.if_else(casadi.logic_and((t119 >= -4.642575810304916), (t119 <= 4.642575810304916)), t119, qb1_5)))
-    t121 = qw1*(t82 + t100)**2 + qw2*(t83 + t104)**2 + qw3*(t84 + t108)**2 + qw4*(t85 + t112)**2 + qw5*(t86 + t116)**2 + qw6*(t87 + t120)**2
-    t122 = (t14 > 0)
-    t123 = casadi.if_else(casadi.logic_and(t122, casadi.logic_or((t7 < 1), (t121 < t96))), 1, 0)
-    t124 = casadi.if_else(t122, 1, t7)
-    t125 = (t123 > 0)
-    t126 = casadi.if_else(t125, t100, t90)
-    t127 = casadi.if_else(t125, t104, t91)
-    t128 = casadi.if_else(t125, t108, t92)
-    t129 = casadi.if_else(t125, t112, t93)
-    t130 = casadi.if_else(t125, t116, t94)
-    t131 = casadi.if_else(t125, t120, t95)
-    t132 = casadi.if_else(t125, t121, t96)
-    t133 = casadi.if_else((t15 < qn1), 6.283185307179586, -6.283185307179586)
-    t134 = t133 + t15
-    t135 = -t133 + t15
-    t136 = casadi.if_else(casadi.logic_and((t15 >= -2.792526803190927), (t15 <= 2.792526803190927)), t15, casadi.if_else(casadi.logic_and((t134 >= -2.792526803190927), (t134 <= 2.792526803190927)), t134, casadi.if_else(casadi.logic_and((t135 >= -2.792526803190927), (t135 <= 2.792526803190927)), t135, qb2_0)))
-    t137 = casadi.if_else((t16 < qn2), 6.283185307179586, -6.283185307179586)
-    t138 = t137 + t16
-    t139 = -t137 + t16
-    t140 = casadi.if_else(casadi.logic_and((t16 >= -0.7853981633974483), (t16 <= 3.9269908169872414)), t16, casadi.if_else(casadi.logic_and((t138 >= -0.7853981633974483), (t138 <= 3.9269908169872414)), t138, casadi.if_else(casadi.logic_and((t139 >= -0.7853981633974483), (t139 <= 3.9269908169872414)), t139, qb2_1)))
-    t141 = casadi.if_else((t17 < qn3), 6.283185307179586, -6.283185307179586)
-    t142 = t141 + t17
-    t143 = -t141 + t17
-    t144 = casadi.if_else(casadi.logic_and((t17 >= -3.9269908169872414), (t17 <= 0.7853981633974483)), t17, casadi.if_else(casadi.logic_and((t142 >= -3.9269908169872414), (t142 <= 0.7853981633974483)), t142, casadi.if_else(casadi.logic_and((t143 >= -3.9269908169872414), (t143 <= 0.7853981633974483)), t143, qb2_2)))
-    t145 = casadi.if_else((t18 < qn4), 6.283185307179586, -6.283185307179586)
-    t146 = t145 + t18
-    t147 = -t145 + t18
-    t148 = casadi.if_else(casadi.logic_and((t18 >= -1.9198621771937625), (t18 <= 2.9670597283903604)), t18, casadi.if_else(casadi.logic_and((t146 >= -1.9198621771937625), (t146 <= 2.9670597283903604)), t146, casadi.if_else(casadi.logic_and((t147 >= -1.9198621771937625), (t147 <= 2.9670597283903604)), t147, qb2_3)))
-    t149 = casadi.if_else((t19 < qn5), 6.283185307179586, -6.283185307179586)
-    t150 = t149 + t19
-    t151 = -t149 + t19
-    t152 = casadi.if_else(casadi.logic_and((t19 >= -1.7453292519943295), (t19 <= 1.7453292519943295)), t19, casadi.if_else(casadi.logic_and((t150 >= -1.7453292519943295), (t150 <= 1.7453292519943295)), t150, casadi.if_else(casadi.logic_and((t151 >= -1.7453292519943295), (t151 <= 1.7453292519943295)), t151, qb2_4)))
-    t153 = casadi.if_else((t20 < qn6), 6.283185307179586, -6.283185307179586)
-    t154 = t153 + t20
-    t155 = -t153 + t20
-    t156 = casadi.if_else(casadi.logic_and((t20 >= -4.642575810304916), (t20 <= 4.642575810304916)), t20, casadi.if_else(casadi.logic_and((t154 >= -4.642575810304916), (t154 <= 4.642575810304916)), t154, casadi.if_else(casadi.logic_and((t155 >= -4.642575810304916), (t155 <= 4.642575810304916)), t155, qb2_5)))
-    t157 = qw1*(t82 + t136)**2 + qw2*(t83 + t140)**2 + qw3*(t84 + t144)**2 + qw4*(t85 + t148)**2 + qw5*(t86 + t152)**2 + qw6*(t87 + t156)**2
-    t158 = (t21 > 0)
-    t159 = casadi.if_else(casadi.logic_and(t158, casadi.logic_or((t124 < 1), (t157 < t132))), 1, 0)
-    t160 = casadi.if_else(t158, 1, t124)
-    t161 = (t159 > 0)
-    t162 = casadi.if_else(t161, t136, t126)
-    t163 = casadi.if_else(t161, t140, t127)
-    t164 = casadi.if_else(t161, t144, t128)
-    t165 = casadi.if_else(t161, t148, t129)
-    t166 = casadi.if_else(t161, t152, t130)
-    t167 = casadi.if_else(t161, t156, t131)
-    t168 = casadi.if_else(t161, t157, t132)
-    t169 = casadi.if_else((t22 < qn1), 6.283185307179586, -6.283185307179586)
-    t170 = t169 + t22
-    t171 = -t169 + t22
-    t172 = casadi.if_else(casadi.logic_and((t22 >= -2.792526803190927), (t22 <= 2.792526803190927)), t22, casadi.if_else(casadi.logic_and((t170 >= -2.792526803190927), (t170 <= 2.792526803190927)), t170, casadi.if_else(casadi.logic_and((t171 >= -2.792526803190927), (t171 <= 2.792526803190927)), t171, qb3_0)))
-    t173 = casadi.if_else((t23 < qn2), 6.283185307179586, -6.283185307179586)
-    t174 = t173 + t23
-    t175 = -t173 + t23
-    t176 = casadi.if_else(casadi.logic_and((t23 >= -0.7853981633974483), (t23 <= 3.9269908169872414)), t23, casadi.if_else(casadi.logic_and((t174 >= -0.7853981633974483), (t174 <= 3.9269908169872414)), t174, casadi.if_else(casadi.logic_and((t175 >= -0.7853981633974483), (t175 <= 3.9269908169872414)), t175, qb3_1)))
-    t177 = casadi.if_else((t24 < qn3), 6.283185307179586, -6.283185307179586)
-    t178 = t177 + t24
-    t179 = -t177 + t24
-    t180 = casadi.if_else(casadi.logic_and((t24 >= -3.9269908169872414), (t24 <= 0.7853981633974483)), t24, casadi.if_else(casadi.logic_and((t178 >= -3.9269908169872414), (t178 <= 0.7853981633974483)), t178, casadi.if_else(casadi.logic_and((t179 >= -3.9269908169872414), (t179 <= 0.7853981633974483)), t179, qb3_2)))
-    t181 = casadi.if_else((t25 < qn4), 6.283185307179586, -6.283185307179586)
-    t182 = t181 + t25
-    t183 = -t181 + t25
-    t184 = casadi.if_else(casadi.logic_and((t25 >= -1.9198621771937625), (t25 <= 2.9670597283903604)), t25, casadi.if_else(casadi.logic_and((t182 >= -1.9198621771937625), (t182 <= 2.9670597283903604)), t182, casadi.if_else(casadi.logic_and((t183 >= -1.9198621771937625), (t183 <= 2.9670597283903604)), t183, qb3_3)))
-    t185 = casadi.if_else((t26 < qn5), 6.283185307179586, -6.283185307179586)
-    t186 = t185 + t26
-    t187 = -t185 + t26
-    t188 = casadi.if_else(casadi.logic_and((t26 >= -1.7453292519943295), (t26 <= 1.7453292519943295)), t26, casadi.if_else(casadi.logic_and((t186 >= -1.7453292519943295), (t186 <= 1.7453292519943295)), t186, casadi.if_else(casadi.logic_and((t187 >= -1.7453292519943295), (t187 <= 1.7453292519943295)), t187, qb3_4)))
-    t189 = casadi.if_else((t27 < qn6), 6.283185307179586, -6.283185307179586)
-    t190 = t189 + t27
-    t191 = -t189 + t27
-    t192 = casadi.if_else(casadi.logic_and((t27 >= -4.642575810304916), (t27 <= 4.642575810304916)), t27, casadi.if_else(casadi.logic_and((t190 >= -4.642575810304916), (t190 <= 4.642575810304916)), t190, casadi.if_else(casadi.logic_and((t191 >= -4.642575810304916), (t191 <= 4.642575810304916)), t191, qb3_5)))
-    t193 = qw1*(t82 + t172)**2 + qw2*(t83 + t176)**2 + qw3*(t84 + t180)**2 + qw4*(t85 + t184)**2 + qw5*(t86 + t188)**2 + qw6*(t87 + t192)**2
-    t194 = (t28 > 0)
-    t195 = casadi.if_else(casadi.logic_and(t194, casadi.logic_or((t160 < 1), (t193 < t168))), 1, 0)
-    t196 = casadi.if_else(t194, 1, t160)
-    t197 = (t195 > 0)
-    t198 = casadi.if_else(t197, t172, t162)
-    t199 = casadi.if_else(t197, t176, t163)
-    t200 = casadi.if_else(t197, t180, t164)
-    t201 = casadi.if_else(t197, t184, t165)
-    t202 = casadi.if_else(t197, t188, t166)
-    t203 = casadi.if_else(t197, t192, t167)
-    t204 = casadi.if_else(t197, t193, t168)
-    t205 = casadi.if_else((t29 < qn1), 6.283185307179586, -6.283185307179586)
-    t206 = t205 + t29
-    t207 = -t205 + t29
-    t208 = casadi.if_else(casadi.logic_and((t29 >= -2.792526803190927), (t29 <= 2.792526803190927)), t29, casadi.if_else(casadi.logic_and((t206 >= -2.792526803190927), (t206 <= 2.792526803190927)), t206, casadi.if_else(casadi.logic_and((t207 >= -2.792526803190927), (t207 <= 2.792526803190927)), t207, qb4_0)))
-    t209 = casadi.if_else((t30 < qn2), 6.283185307179586, -6.283185307179586)
-    t210 = t209 + t30
-    t211 = -t209 + t30
-    t212 = casadi.if_else(casadi.logic_and((t30 >= -0.7853981633974483), (t30 <= 3.9269908169872414)), t30, casadi.if_else(casadi.logic_and((t210 >= -0.7853981633974483), (t210 <= 3.9269908169872414)), t210, casadi.if_else(casadi.logic_and((t211 >= -0.7853981633974483), (t211 <= 3.9269908169872414)), t211, qb4_1)))
-    t213 = casadi.if_else((t31 < qn3), 6.283185307179586, -6.283185307179586)
-    t214 = t213 + t31
-    t215 = -t213 + t31
-    t216 = casadi.if_else(casadi.logic_and((t31 >= -3.9269908169872414), (t31 <= 0.7853981633974483)), t31, casadi.if_else(casadi.logic_and((t214 >= -3.9269908169872414), (t214 <= 0.7853981633974483)), t214, casadi.if_else(casadi.logic_and((t215 >= -3.9269908169872414), (t215 <= 0.7853981633974483)), t215, qb4_2)))
-    t217 = casadi.if_else((t32 < qn4), 6.283185307179586, -6.283185307179586)
-    t218 = t217 + t32
-    t219 = -t217 + t32
-    t220 = casadi.if_else(casadi.logic_and((t32 >= -1.9198621771937625), (t32 <= 2.9670597283903604)), t32, casadi.if_else(casadi.logic_and((t218 >= -1.9198621771937625), (t218 <= 2.9670597283903604)), t218, casadi.if_else(casadi.logic_and((t219 >= -1.9198621771937625), (t219 <= 2.9670597283903604)), t219, qb4_3)))
-    t221 = casadi.if_else((t33 < qn5), 6.283185307179586, -6.283185307179586)
-    t222 = t221 + t33
-    t223 = -t221 + t33
-    t224 = casadi.if_else(casadi.logic_and((t33 >= -1.7453292519943295), (t33 <= 1.7453292519943295)), t33, casadi.if_else(casadi.logic_and((t222 >= -1.7453292519943295), (t222 <= 1.7453292519943295)), t222, casadi.if_else(casadi.logic_and((t223 >= -1.7453292519943295), (t223 <= 1.7453292519943295)), t223, qb4_4)))
-    t225 = casadi.if_else((t34 < qn6), 6.283185307179586, -6.283185307179586)
-    t226 = t225 + t34
-    t227 = -t225 + t34
-    t228 = casadi.if_else(casadi.logic_and((t34 >= -4.642575810304916), (t34 <= 4.642575810304916)), t34, casadi.if_else(casadi.logic_and((t226 >= -4.642575810304916), (t226 <= 4.642575810304916)), t226, casadi.if_else(casadi.logic_and((t227 >= -4.642575810304916), (t227 <= 4.642575810304916)), t227, qb4_5)))
-    t229 = qw1*(t82 + t208)**2 + qw2*(t83 + t212)**2 + qw3*(t84 + t216)**2 + qw4*(t85 + t220)**2 + qw5*(t86 + t224)**2 + qw6*(t87 + t228)**2
-    t230 = (t35 > 0)
-    t231 = casadi.if_else(casadi.logic_and(t230, casadi.logic_or((t196 < 1), (t229 < t204))), 1, 0)
-    t232 = casadi.if_else(t230, 1, t196)
-    t233 = (t231 > 0)
-    t234 = casadi.if_else(t233, t208, t198)
-    t235 = casadi.if_else(t233, t212, t199)
-    t236 = casadi.if_else(t233, t216, t200)
-    t237 = casadi.if_else(t233, t220, t201)
-    t238 = casadi.if_else(t233, t224, t202)
-    t239 = casadi.if_else(t233, t228, t203)
-    t240 = casadi.if_else(t233, t229, t204)
-    t241 = casadi.if_else((t36 < qn1), 6.283185307179586, -6.283185307179586)
-    t242 = t241 + t36
-    t243 = -t241 + t36
-    t244 = casadi.if_else(casadi.logic_and((t36 >= -2.792526803190927), (t36 <= 2.792526803190927)), t36, casadi.if_else(casadi.logic_and((t242 >= -2.792526803190927), (t242 <= 2.792526803190927)), t242, casadi.if_else(casadi.logic_and((t243 >= -2.792526803190927), (t243 <= 2.792526803190927)), t243, qb5_0)))
-    t245 = casadi.if_else((t37 < qn2), 6.283185307179586, -6.283185307179586)
-    t246 = t245 + t37
-    t247 = -t245 + t37
-    t248 = casadi.if_else(casadi.logic_and((t37 >= -0.7853981633974483), (t37 <= 3.9269908169872414)), t37, casadi.if_else(casadi.logic_and((t246 >= -0.7853981633974483), (t246 <= 3.9269908169872414)), t246, casadi.if_else(casadi.logic_and((t247 >= -0.7853981633974483), (t247 <= 3.9269908169872414)), t247, qb5_1)))
-    t249 = casadi.if_else((t38 < qn3), 6.283185307179586, -6.283185307179586)
-    t250 = t249 + t38
-    t251 = -t249 + t38
-    t252 = casadi.if_else(casadi.logic_and((t38 >= -3.9269908169872414), (t38 <= 0.7853981633974483)), t38, casadi.if_else(casadi.logic_and((t250 >= -3.9269908169872414), (t250 <= 0.7853981633974483)), t250, casadi.if_else(casadi.logic_and((t251 >= -3.9269908169872414), (t251 <= 0.7853981633974483)), t251, qb5_2)))
-    t253 = casadi.if_else((t39 < qn4), 6.283185307179586, -6.283185307179586)
-    t254 = t253 + t39
-    t255 = -t253 + t39
-    t256 = casadi.if_else(casadi.logic_and((t39 >= -1.9198621771937625), (t39 <= 2.9670597283903604)), t39, casadi.if_else(casadi.logic_and((t254 >= -1.9198621771937625), (t254 <= 2.9670597283903604)), t254, casadi.if_else(casadi.logic_and((t255 >= -1.9198621771937625), (t255 <= 2.9670597283903604)), t255, qb5_3)))
-    t257 = casadi.if_else((t40 < qn5), 6.283185307179586, -6.283185307179586)
-    t258 = t257 + t40
-    t259 = -t257 + t40
-    t260 = casadi.if_else(casadi.logic_and((t40 >= -1.7453292519943295), (t40 <= 1.7453292519943295)), t40, casadi.if_else(casadi.logic_and((t258 >= -1.7453292519943295), (t258 <= 1.7453292519943295)), t258, casadi.if_else(casadi.logic_and((t259 >= -1.7453292519943295), (t259 <= 1.7453292519943295)), t259, qb5_4)))
-    t261 = casadi.if_else((t41 < qn6), 6.283185307179586, -6.283185307179586)
-    t262 = t261 + t41
-    t263 = -t261 + t41
-    t264 = casadi.if_else(casadi.logic_and((t41 >= -4.642575810304916), (t41 <= 4.642575810304916)), t41, casadi.if_else(casadi.logic_and((t262 >= -4.642575810304916), (t262 <= 4.642575810304916)), t262, casadi.if_else(casadi.logic_and((t263 >= -4.642575810304916), (t263 <= 4.642575810304916)), t263, qb5_5)))
-    t265 = qw1*(t82 + t244)**2 + qw2*(t83 + t248)**2 + qw3*(t84 + t252)**2 + qw4*(t85 + t256)**2 + qw5*(t86 + t260)**2 + qw6*(t87 + t264)**2
-    t266 = (t42 > 0)
-    t267 = casadi.if_else(casadi.logic_and(t266, casadi.logic_or((t232 < 1), (t265 < t240))), 1, 0)
-    t268 = casadi.if_else(t266, 1, t232)
-    t269 = (t267 > 0)
-    t270 = casadi.if_else(t269, t244, t234)
-    t271 = casadi.if_else(t269, t248, t235)
-    t272 = casadi.if_else(t269, t252, t236)
-    t273 = casadi.if_else(t269, t256, t237)
-    t274 = casadi.if_else(t269, t260, t238)
-    t275 = casadi.if_else(t269, t264, t239)
-    t276 = casadi.if_else(t269, t265, t240)
-    t277 = casadi.if_else((t43 < qn1), 6.283185307179586, -6.283185307179586)
-    t278 = t277 + t43
-    t279 = -t277 + t43
-    t280 = casadi.if_else(casadi.logic_and((t43 >= -2.792526803190927), (t43 <= 2.792526803190927)), t43, casadi.if_else(casadi.logic_and((t278 >= -2.792526803190927), (t278 <= 2.792526803190927)), t278, casadi.if_else(casadi.logic_and((t279 >= -2.792526803190927), (t279 <= 2.792526803190927)), t279, qb6_0)))
-    t281 = casadi.if_else((t44 < qn2), 6.283185307179586, -6.283185307179586)
-    t282 = t281 + t44
-    t283 = -t281 + t44
-    t284 = casadi.if_else(casadi.logic_and((t44 >= -0.7853981633974483), (t44 <= 3.9269908169872414)), t44, casadi.if_else(casadi.logic_and((t282 >= -0.7853981633974483), (t282 <= 3.9269908169872414)), t282, casadi.if_else(casadi.logic_and((t283 >= -0.7853981633974483), (t283 <= 3.9269908169872414)), t283, qb6_1)))
-    t285 = casadi.if_else((t45 < qn3), 6.283185307179586, -6.283185307179586)
-    t286 = t285 + t45
-    t287 = -t285 + t45
-    t288 = casadi.if_else(casadi.logic_and((t45 >= -3.9269908169872414), (t45 <= 0.7853981633974483)), t45, casadi.if_else(casadi.logic_and((t286 >= -3.9269908169872414), (t286 <= 0.7853981633974483)), t286, casadi.if_else(casadi.logic_and((t287 >= -3.9269908169872414), (t287 <= 0.7853981633974483)), t287, qb6_2)))
-    t289 = casadi.if_else((t46 < qn4), 6.283185307179586, -6.283185307179586)
-    t290 = t289 + t46
-    t291 = -t289 + t46
-    t292 = casadi.if_else(casadi.logic_and((t46 >= -1.9198621771937625), (t46 <= 2.9670597283903604)), t46, casadi.if_else(casadi.logic_and((t290 >= -1.9198621771937625), (t290 <= 2.9670597283903604)), t290, casadi.if_else(casadi.logic_and((t291 >= -1.9198621771937625), (t291 <= 2.9670597283903604)), t291, qb6_3)))
-    t293 = casadi.if_else((t47 < qn5), 6.283185307179586, -6.283185307179586)
-    t294 = t293 + t47
-    t295 = -t293 + t47
-    t296 = casadi.if_else(casadi.logic_and((t47 >= -1.7453292519943295), (t47 <= 1.7453292519943295)), t47, casadi.if_else(casadi.logic_and((t294 >= -1.7453292519943295), (t294 <= 1.7453292519943295)), t294, casadi.if_else(casadi.logic_and((t295 >= -1.7453292519943295), (t295 <= 1.7453292519943295)), t295, qb6_4)))
-    t297 = casadi.if_else((t48 < qn6), 6.283185307179586, -6.283185307179586)
-    t298 = t297 + t48
-    t299 = -t297 + t48
-    t300 = casadi.if_else(casadi.logic_and((t48 >= -4.642575810304916), (t48 <= 4.642575810304916)), t48, casadi.if_else(casadi.logic_and((t298 >= -4.642575810304916), (t298 <= 4.642575810304916)), t298, casadi.if_else(casadi.logic_and((t299 >= -4.642575810304916), (t299 <= 4.642575810304916)), t299, qb6_5)))
-    t301 = qw1*(t82 + t280)**2 + qw2*(t83 + t284)**2 + qw3*(t84 + t288)**2 + qw4*(t85 + t292)**2 + qw5*(t86 + t296)**2 + qw6*(t87 + t300)**2
-    t302 = (t49 > 0)
-    t303 = casadi.if_else(casadi.logic_and(t302, casadi.logic_or((t268 < 1), (t301 < t276))), 1, 0)
-    t304 = casadi.if_else(t302, 1, t268)
-    t305 = (t303 > 0)
-    t306 = casadi.if_else(t305, t280, t270)
-    t307 = casadi.if_else(t305, t284, t271)
-    t308 = casadi.if_else(t305, t288, t272)
-    t309 = casadi.if_else(t305, t292, t273)
-    t310 = casadi.if_else(t305, t296, t274)
-    t311 = casadi.if_else(t305, t300, t275)
-    t312 = casadi.if_else(t305, t301, t276)
-    t313 = casadi.if_else((t50 < qn1), 6.283185307179586, -6.283185307179586)
-    t314 = t313 + t50
-    t315 = -t313 + t50
-    t316 = casadi.if_else(casadi.logic_and((t50 >= -2.792526803190927), (t50 <= 2.792526803190927)), t50, casadi.if_else(casadi.logic_and((t314 >= -2.792526803190927), (t314 <= 2.792526803190927)), t314, casadi.if_else(casadi.logic_and((t315 >= -2.792526803190927), (t315 <= 2.792526803190927)), t315, qb7_0)))
-    t317 = casadi.if_else((t51 < qn2), 6.283185307179586, -6.283185307179586)
-    t318 = t317 + t51
-    t319 = -t317 + t51
-    t320 = casadi.if_else(casadi.logic_and((t51 >= -0.7853981633974483), (t51 <= 3.9269908169872414)), t51, casadi.if_else(casadi.logic_and((t318 >= -0.7853981633974483), (t318 <= 3.9269908169872414)), t318, casadi.if_else(casadi.logic_and((t319 >= -0.7853981633974483), (t319 <= 3.9269908169872414)), t319, qb7_1)))
-    t321 = casadi.if_else((t52 < qn3), 6.283185307179586, -6.283185307179586)
-    t322 = t321 + t52
-    t323 = -t321 + t52
-    t324 = casadi.if_else(casadi.logic_and((t52 >= -3.9269908169872414), (t52 <= 0.7853981633974483)), t52, casadi.if_else(casadi.logic_and((t322 >= -3.9269908169872414), (t322 <= 0.7853981633974483)), t322, casadi.if_else(casadi.logic_and((t323 >= -3.9269908169872414), (t323 <= 0.7853981633974483)), t323, qb7_2)))
-    t325 = casadi.if_else((t53 < qn4), 6.283185307179586, -6.283185307179586)
-    t326 = t325 + t53
-    t327 = -t325 + t53
-    t328 = casadi.if_else(casadi.logic_and((t53 >= -1.9198621771937625), (t53 <= 2.9670597283903604)), t53, casadi.if_else(casadi.logic_and((t326 >= -1.9198621771937625), (t326 <= 2.9670597283903604)), t326, casadi.if_else(casadi.logic_and((t327 >= -1.9198621771937625), (t327 <= 2.9670597283903604)), t327, qb7_3)))
-    t329 = casadi.if_else((t54 < qn5), 6.283185307179586, -6.283185307179586)
-    t330 = t329 + t54
-    t331 = -t329 + t54
-    t332 = casadi.if_else(casadi.logic_and((t54 >= -1.7453292519943295), (t54 <= 1.7453292519943295)), t54, casadi.if_else(casadi.logic_and((t330 >= -1.7453292519943295), (t330 <= 1.7453292519943295)), t330, casadi.if_else(casadi.logic_and((t331 >= -1.7453292519943295), (t331 <= 1.7453292519943295)), t331, qb7_4)))
-    t333 = casadi.if_else((t55 < qn6), 6.283185307179586, -6.283185307179586)
-    t334 = t333 + t55
-    t335 = -t333 + t55
-    t336 = casadi.if_else(casadi.logic_and((t55 >= -4.642575810304916), (t55 <= 4.642575810304916)), t55, casadi.if_else(casadi.logic_and((t334 >= -4.642575810304916), (t334 <= 4.642575810304916)), t334, casadi.if_else(casadi.logic_and((t335 >= -4.642575810304916), (t335 <= 4.642575810304916)), t335, qb7_5)))
-    t337 = qw1*(t82 + t316)**2 + qw2*(t83 + t320)**2 + qw3*(t84 + t324)**2 + qw4*(t85 + t328)**2 + qw5*(t86 + t332)**2 + qw6*(t87 + t336)**2
-    t338 = (t56 > 0)
-    t339 = casadi.if_else(casadi.logic_and(t338, casadi.logic_or((t304 < 1), (t337 < t312))), 1, 0)
-    t340 = casadi.if_else(t338, 1, t304)
-    t341 = (t339 > 0)
-    t342 = casadi.if_else(t341, t316, t306)
-    t343 = casadi.if_else(t341, t320, t307)
-    t344 = casadi.if_else(t341, t324, t308)
-    t345 = casadi.if_else(t341, t328, t309)
-    t346 = casadi.if_else(t341, t332, t310)
-    t347 = casadi.if_else(t341, t336, t311)
-    t348 = (t340 > 0)
-    t349 = (casadi.fabs(t57) < casadi.inf)
-    t350 = casadi.logic_and(t348, t349)
+    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
+    t1 = _nearer_branch(1, (qb0_0, qb0_1, qb0_2, qb0_3, qb0_4, qb0_5, casadi.if_else(casadi.logic_and(vb0, lb0), 1, 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, qn1, qn2, qn3, qn4, qn5, qn6, 0, 0,))
+    t2 = _nearer_branch(1, (qb1_0, qb1_1, qb1_2, qb1_3, qb1_4, qb1_5, casadi.if_else(casadi.logic_and(vb1, lb1), 1, 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t1[0], t1[1], t1[2], t1[3], t1[4], t1[5], t1[6], t1[7],))
+    t3 = _nearer_branch(1, (qb2_0, qb2_1, qb2_2, qb2_3, qb2_4, qb2_5, casadi.if_else(casadi.logic_and(vb2, lb2), 1, 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t2[0], t2[1], t2[2], t2[3], t2[4], t2[5], t2[6], t2[7],))
+    t4 = _nearer_branch(1, (qb3_0, qb3_1, qb3_2, qb3_3, qb3_4, qb3_5, casadi.if_else(casadi.logic_and(vb3, lb3), 1, 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t3[0], t3[1], t3[2], t3[3], t3[4], t3[5], t3[6], t3[7],))
+    t5 = _nearer_branch(1, (qb4_0, qb4_1, qb4_2, qb4_3, qb4_4, qb4_5, casadi.if_else(casadi.logic_and(vb4, lb4), 1, 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t4[0], t4[1], t4[2], t4[3], t4[4], t4[5], t4[6], t4[7],))
+    t6 = _nearer_branch(1, (qb5_0, qb5_1, qb5_2, qb5_3, qb5_4, qb5_5, casadi.if_else(casadi.logic_and(vb5, lb5), 1, 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t5[0], t5[1], t5[2], t5[3], t5[4], t5[5], t5[6], t5[7],))
+    t7 = _nearer_branch(1, (qb6_0, qb6_1, qb6_2, qb6_3, qb6_4, qb6_5, casadi.if_else(casadi.logic_and(vb6, lb6), 1, 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t6[0], t6[1], t6[2], t6[3], t6[4], t6[5], t6[6], t6[7],))
+    t8 = _nearer_branch(1, (qb7_0, qb7_1, qb7_2, qb7_3, qb7_4, qb7_5, casadi.if_else(casadi.logic_and(vb7, lb7), 1, 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t7[0], t7[1], t7[2], t7[3], t7[4], t7[5], t7[6], t7[7],))
+    t9 = (t8[7] > 0)
+    t10 = (casadi.fabs(t0) < casadi.inf)
+    t11 = casadi.logic_and(t9, t10)
     q = casadi.SX(6, 1)
-    q[0, 0] = casadi.if_else(t350, t342, qn1)
-    q[1, 0] = casadi.if_else(t350, t343, qn2)
-    q[2, 0] = casadi.if_else(t350, t344, qn3)
-    q[3, 0] = casadi.if_else(t350, t345, qn4)
-    q[4, 0] = casadi.if_else(t350, t346, qn5)
-    q[5, 0] = casadi.if_else(t350, t347, qn6)
+    q[0, 0] = casadi.if_else(t11, t8[0], qn1)
+    q[1, 0] = casadi.if_else(t11, t8[1], qn2)
+    q[2, 0] = casadi.if_else(t11, t8[2], qn3)
+    q[3, 0] = casadi.if_else(t11, t8[3], qn4)
+    q[4, 0] = casadi.if_else(t11, t8[4], qn5)
+    q[5, 0] = casadi.if_else(t11, t8[5], qn6)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(t349), 2, casadi.if_else(t348, 0, 1))
+    status[0, 0] = casadi.if_else(casadi.logic_not(t10), 2, casadi.if_else(t9, 0, 1))
     return [q, status]
 
 

@@ -111,19 +111,19 @@ void rexarm_velocity_ellipsoid(const rexarm_real q[REXARM_DOF], rexarm_real U_v[
 rexarm_real rexarm_condition_number(const rexarm_real q[REXARM_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 4; returned as a scalar. 574 operations. */
+ * Result: q_dot[i], i < 4; returned as a scalar. 576 operations. */
 int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], rexarm_real damping, rexarm_real q_dot[REXARM_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 4; returned as a scalar. 578 operations. */
+ * Result: q_dot[i], i < 4; returned as a scalar. 580 operations. */
 int rexarm_velocity_ik_nullspace(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], const rexarm_real z[REXARM_DOF], rexarm_real damping, rexarm_real q_dot[REXARM_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 4; returned as a scalar. 599 operations. */
+ * Result: q_dot[i], i < 4; returned as a scalar. 601 operations. */
 int rexarm_resolved_rate(const rexarm_real q[REXARM_DOF], const rexarm_real target[REXARM_TASK_DIM], const rexarm_real target_rate[REXARM_TASK_DIM], const rexarm_real gain[REXARM_TASK_DIM], const rexarm_real z[REXARM_DOF], rexarm_real damping, rexarm_real q_dot[REXARM_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 4; q_next[i], i < 4; returned as a scalar. 383 operations. */
+ * Result: q_start[i], i < 4; q_next[i], i < 4; returned as a scalar. 414 operations. */
 rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], const rexarm_real q[REXARM_DOF], rexarm_real damping, rexarm_real q_start[REXARM_DOF], rexarm_real q_next[REXARM_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
@@ -131,7 +131,7 @@ rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], co
 void rexarm_ik_branches(const rexarm_real mu[REXARM_TASK_DIM], rexarm_real q[REXARM_MAX_IK_SOLUTIONS * REXARM_DOF], int valid[REXARM_MAX_IK_SOLUTIONS], int in_limits[REXARM_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 4; returned as a scalar. 659 operations. */
+ * Result: q[i], i < 4; returned as a scalar. 660 operations. */
 int rexarm_ik_nearest(const rexarm_real mu[REXARM_TASK_DIM], const rexarm_real q_seed[REXARM_DOF], const rexarm_real weights[REXARM_DOF], rexarm_real q[REXARM_DOF]);
 
 /* Statuses of rexarm_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -82,6 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -335,6 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi4_rows(xp, count, state):
     """One-sided Jacobi sweep of a 4 x 4 matrix (its rows), `count` times: 352 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2
@@ -514,6 +516,144 @@ def _jacobi4_rows(xp, count, state):
             t151,
             t155,
             t159,
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _symmetric_solve4(xp, count, state):
+    """X solving a symmetric 4 x 4 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 217 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, = state
+        t0 = w1**2
+        t1 = w2**2
+        t2 = w3**2
+        t3 = w0**2
+        t4 = xp.sqrt(t3 + 2*t0 + 2*t1 + 2*w5**2 + 2*t2 + 2*w6**2 + 2*w8**2 + w4**2 + w7**2 + w9**2)
+        t5 = xp.sqrt(t0 + t1 + t2 + t3)
+        t6 = t5*xp.where(xp.greater_equal(w0, 0), xp.asarray(1, dtype=dtype), -1)
+        t7 = xp.greater(t5, 0)
+        t8 = xp.where(t7, 1/(w0 + t6), 0)
+        t9 = xp.where(t7, 1 + xp.abs(w0)/t5, 0)
+        t10 = w1*t8
+        t11 = w2*t8
+        t12 = w3*t8
+        t13 = t9*(w1 + t10*w4 + t11*w5 + t12*w6)
+        t14 = -t13 + w1
+        t15 = w4 - t10*t13
+        t16 = w5 - t11*t13
+        t17 = w6 - t12*t13
+        t18 = t9*(w2 + t10*w5 + t11*w7 + t12*w8)
+        t19 = -t18 + w2
+        t20 = w5 - t10*t18
+        t21 = w7 - t11*t18
+        t22 = w8 - t12*t18
+        t23 = t9*(w3 + t10*w6 + t11*w8 + t12*w9)
+        t24 = -t23 + w3
+        t25 = w6 - t10*t23
+        t26 = w8 - t11*t23
+        t27 = w9 - t12*t23
+        t28 = t9*(w10 + t10*w11 + t11*w12 + t12*w13)
+        t29 = -t28 + w10
+        t30 = w11 - t10*t28
+        t31 = w12 - t11*t28
+        t32 = w13 - t12*t28
+        t33 = xp.sqrt(t15**2 + t16**2 + t17**2)
+        t34 = t33*xp.where(xp.greater_equal(t15, 0), xp.asarray(1, dtype=dtype), -1)
+        t35 = xp.greater(t33, 0)
+        t36 = xp.where(t35, 1/(t15 + t34), 0)
+        t37 = xp.where(t35, 1 + xp.abs(t15)/t33, 0)
+        t38 = t16*t36
+        t39 = t17*t36
+        t40 = t37*(t20 + t38*t21 + t39*t22)
+        t41 = -t40 + t20
+        t42 = t21 - t38*t40
+        t43 = t22 - t39*t40
+        t44 = t37*(t25 + t38*t26 + t39*t27)
+        t45 = -t44 + t25
+        t46 = t26 - t38*t44
+        t47 = t27 - t39*t44
+        t48 = t37*(t30 + t38*t31 + t39*t32)
+        t49 = -t48 + t30
+        t50 = t31 - t38*t48
+        t51 = t32 - t39*t48
+        t52 = xp.sqrt(t42**2 + t43**2)
+        t53 = t52*xp.where(xp.greater_equal(t42, 0), xp.asarray(1, dtype=dtype), -1)
+        t54 = xp.greater(t52, 0)
+        t55 = xp.where(t54, 1/(t42 + t53), 0)
+        t56 = xp.where(t54, 1 + xp.abs(t42)/t52, 0)
+        t57 = t43*t55
+        t58 = t56*(t46 + t57*t47)
+        t59 = -t58 + t46
+        t60 = t47 - t57*t58
+        t61 = t56*(t50 + t57*t51)
+        t62 = -t61 + t50
+        t63 = t51 - t57*t61
+        t64 = xp.abs(t60)
+        t65 = t64*xp.where(xp.greater_equal(t60, 0), xp.asarray(1, dtype=dtype), -1)
+        t66 = xp.where(xp.greater(t64, 0), xp.asarray(2, dtype=dtype), 0)
+        t67 = t63 - t63*t66
+        t68 = xp.where(xp.not_equal(t65, 0), -t67/t65, 0)
+        t69 = xp.where(xp.not_equal(t53, 0), -(t62 - t59*t68)/t53, 0)
+        t70 = xp.where(xp.not_equal(t34, 0), -(-(t41*t69 + t45*t68) + t49)/t34, 0)
+        t71 = xp.where(xp.not_equal(t6, 0), -(-(t14*t70 + t19*t69 + t24*t68) + t29)/t6, 0)
+        t72 = 1e-12*t4
+        state = (
+            t71,
+            t70,
+            t69,
+            t68,
+            xp.where(xp.less_equal(t5, t72) | xp.less_equal(t33, t72) | xp.less_equal(t52, t72) | xp.less_equal(t64, t72), xp.asarray(1, dtype=dtype), 0),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _nearer_branch(xp, count, state):
+    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 78 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, = state
+        t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w5))
+        t1 = w1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w1 + w6))
+        t2 = w2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w2 + w7))
+        t3 = w3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w3 + w8))
+        t4 = xp.where(xp.less(t0, w5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t5 = t4 + t0
+        t6 = -t4 + t0
+        t7 = xp.where(xp.greater_equal(t0, -3.141592653589793) & xp.less_equal(t0, 3.141592653589793), t0, xp.where(xp.greater_equal(t5, -3.141592653589793) & xp.less_equal(t5, 3.141592653589793), t5, xp.where(xp.greater_equal(t6, -3.141592653589793) & xp.less_equal(t6, 3.141592653589793), t6, w0)))
+        t8 = xp.where(xp.less(t1, w6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t9 = t8 + t1
+        t10 = -t8 + t1
+        t11 = xp.where(xp.greater_equal(t1, -2.0943951023931953) & xp.less_equal(t1, 2.0943951023931953), t1, xp.where(xp.greater_equal(t9, -2.0943951023931953) & xp.less_equal(t9, 2.0943951023931953), t9, xp.where(xp.greater_equal(t10, -2.0943951023931953) & xp.less_equal(t10, 2.0943951023931953), t10, w1)))
+        t12 = xp.where(xp.less(t2, w7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t13 = t12 + t2
+        t14 = -t12 + t2
+        t15 = xp.where(xp.greater_equal(t2, -2.0943951023931953) & xp.less_equal(t2, 2.0943951023931953), t2, xp.where(xp.greater_equal(t13, -2.0943951023931953) & xp.less_equal(t13, 2.0943951023931953), t13, xp.where(xp.greater_equal(t14, -2.0943951023931953) & xp.less_equal(t14, 2.0943951023931953), t14, w2)))
+        t16 = xp.where(xp.less(t3, w8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t17 = t16 + t3
+        t18 = -t16 + t3
+        t19 = xp.where(xp.greater_equal(t3, -2.0943951023931953) & xp.less_equal(t3, 2.0943951023931953), t3, xp.where(xp.greater_equal(t17, -2.0943951023931953) & xp.less_equal(t17, 2.0943951023931953), t17, xp.where(xp.greater_equal(t18, -2.0943951023931953) & xp.less_equal(t18, 2.0943951023931953), t18, w3)))
+        t20 = w9*(-w5 + t7)**2 + w10*(-w6 + t11)**2 + w11*(-w7 + t15)**2 + w12*(-w8 + t19)**2
+        t21 = xp.greater(w4, 0)
+        t22 = xp.where(t21 & (xp.less(w18, 1) | xp.less(t20, w17)), xp.asarray(1, dtype=dtype), 0)
+        t23 = xp.where(t21, 1, w18)
+        t24 = xp.greater(t22, 0)
+        t25 = xp.where(t24, t7, w13)
+        t26 = xp.where(t24, t11, w14)
+        t27 = xp.where(t24, t15, w15)
+        t28 = xp.where(t24, t19, w16)
+        t29 = xp.where(t24, t20, w17)
+        state = (
+            t25,
+            t26,
+            t27,
+            t28,
+            t29,
+            t23,
         )
     return state
 
@@ -2150,7 +2290,7 @@ def condition_number(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 574 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 576 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (4,)), ("mu_dot", mu_dot, (4,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -2221,166 +2361,93 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t45 = s1*t8
     t46 = t6*t43 + t7*t44 + t15*t45
     t47 = t17*t45 + t44*t17 + t43*t17
-    t48 = t37**2
-    t49 = t41**2
-    t50 = t42**2
-    t51 = damping**2
-    t52 = t51 + t32
-    t53 = t52**2
-    t54 = xp.sqrt(t48 + t49 + t50 + t53)
-    t55 = t54*xp.where(xp.greater_equal(t52, 0), xp.asarray(1, dtype=dtype), -1)
-    t56 = t51 + t35
-    t57 = t27 + t51
-    t58 = t20 + t51
-    t59 = xp.sqrt(2*t48 + 2*t49 + 2*t46**2 + 2*t50 + 2*t47**2 + 2*t18**2 + t53 + t56**2 + t57**2 + t58**2)
-    t60 = xp.greater(t54, 0)
-    t61 = xp.where(t60, 1/(t52 + t55), 0)
-    t62 = xp.where(t60, 1 + xp.abs(t52)/t54, 0)
-    t63 = t37*t61
-    t64 = t41*t61
-    t65 = t42*t61
-    t66 = t62*(t37 + t56*t63 + t64*t46 + t65*t47)
-    t67 = -t66 + t37
-    t68 = t56 - t63*t66
-    t69 = -t46 + t64*t66
-    t70 = -t47 + t65*t66
-    t71 = -t62*(t41 + t63*t46 + t57*t64 + t65*t18)
-    t72 = t41 + t71
-    t73 = t46 + t63*t71
-    t74 = t57 + t64*t71
-    t75 = t18 + t65*t71
-    t76 = -t62*(t42 + t63*t47 + t64*t18 + t58*t65)
-    t77 = t42 + t76
-    t78 = t47 + t63*t76
-    t79 = t18 + t64*t76
-    t80 = t58 + t65*t76
-    t81 = t62*(mu_dot0 + t63*mu_dot1 - t64*mu_dot2 - t65*mu_dot3)
-    t82 = -t81 + mu_dot0
-    t83 = mu_dot1 - t63*t81
-    t84 = mu_dot2 + t64*t81
-    t85 = mu_dot3 + t65*t81
-    t86 = xp.sqrt(t68**2 + t69**2 + t70**2)
-    t87 = t86*xp.where(xp.greater_equal(t68, 0), xp.asarray(1, dtype=dtype), -1)
-    t88 = xp.greater(t86, 0)
-    t89 = xp.where(t88, 1/(t68 + t87), 0)
-    t90 = xp.where(t88, 1 + xp.abs(t68)/t86, 0)
-    t91 = t69*t89
-    t92 = t70*t89
-    t93 = t90*(-t73 + t91*t74 + t92*t75)
-    t94 = t73 + t93
-    t95 = t74 - t91*t93
-    t96 = t75 - t92*t93
-    t97 = t90*(-t78 + t91*t79 + t92*t80)
-    t98 = t78 + t97
-    t99 = t79 - t91*t97
-    t100 = t80 - t92*t97
-    t101 = t90*(t83 + t91*t84 + t92*t85)
-    t102 = -t101 + t83
-    t103 = t84 - t91*t101
-    t104 = t85 - t92*t101
-    t105 = xp.sqrt(t95**2 + t96**2)
-    t106 = t105*xp.where(xp.greater_equal(t95, 0), xp.asarray(1, dtype=dtype), -1)
-    t107 = xp.greater(t105, 0)
-    t108 = xp.where(t107, 1/(t95 + t106), 0)
-    t109 = xp.where(t107, 1 + xp.abs(t95)/t105, 0)
-    t110 = t96*t108
-    t111 = t109*(t99 + t110*t100)
-    t112 = -t111 + t99
-    t113 = t100 - t110*t111
-    t114 = t109*(t103 + t110*t104)
-    t115 = -t114 + t103
-    t116 = t104 - t110*t114
-    t117 = xp.abs(t113)
-    t118 = t117*xp.where(xp.greater_equal(t113, 0), xp.asarray(1, dtype=dtype), -1)
-    t119 = xp.where(xp.greater(t117, 0), xp.asarray(2, dtype=dtype), 0)
-    t120 = t116 - t116*t119
-    t121 = xp.where(xp.not_equal(t118, 0), -t120/t118, 0)
-    t122 = xp.where(xp.not_equal(t106, 0), -(t115 - t112*t121)/t106, 0)
-    t123 = xp.where(xp.not_equal(t87, 0), -(t102 + t94*t122 + t98*t121)/t87, 0)
-    t124 = xp.where(xp.not_equal(t55, 0), -(t82 + t72*t122 + t77*t121 - t67*t123)/t55, 0)
-    t125 = -t5*t124 + t2*t123
-    t126 = t17*t121
-    t127 = t126 + t6*t122 - t38*t124 - t43*t123
-    t128 = t126 + t7*t122 - t39*t124 - t44*t123
-    t129 = t126 + t15*t122 - t40*t124 - t45*t123
-    t130 = xp.greater(t24, 0)
-    t131 = xp.where(t130, 1 + xp.abs(t5)/t24, 0)
-    t132 = -t5
-    t133 = xp.where(t130, 1/(t132 + t25), 0)
-    t134 = -t38 - t39 - t40 - t43 - t44 - t45 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + 3*t17 + t132 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping
-    t135 = t2*t133
-    t136 = -t131*(t38 + t43*t135)
-    t137 = t38 + t136
-    t138 = t43 + t135*t136
-    t139 = -t131*(t39 + t44*t135)
-    t140 = t39 + t139
-    t141 = t44 + t135*t139
-    t142 = -t131*(t40 + t45*t135)
-    t143 = t40 + t142
-    t144 = t45 + t135*t142
-    t145 = t131*(mu_dot0 + t135*mu_dot1)
-    t146 = -t145 + mu_dot0
-    t147 = mu_dot1 - t135*t145
-    t148 = xp.sqrt(t19 + t26 + t138**2)
-    t149 = t148*xp.where(xp.less_equal(t138, 0), xp.asarray(1, dtype=dtype), -1)
-    t150 = xp.greater(t148, 0)
-    t151 = xp.where(t150, 1/(-t138 + t149), 0)
-    t152 = xp.where(t150, 1 + xp.abs(t138)/t148, 0)
-    t153 = t6*t151
-    t154 = t19*t151
-    t155 = t152*(-t141 + t154 + t7*t153)
-    t156 = t141 + t155
-    t157 = t7 - t153*t155
-    t158 = t152*(-t144 + t154 + t15*t153)
-    t159 = t144 + t158
-    t160 = t15 - t153*t158
-    t161 = t17*t151
-    t162 = t17 - t161*t155
-    t163 = t17 - t161*t158
-    t164 = t152*(t147 + t153*mu_dot2 + t161*mu_dot3)
-    t165 = -t164 + t147
-    t166 = mu_dot2 - t153*t164
-    t167 = mu_dot3 - t161*t164
-    t168 = xp.sqrt(t157**2 + t162**2)
-    t169 = t168*xp.where(xp.greater_equal(t157, 0), xp.asarray(1, dtype=dtype), -1)
-    t170 = xp.greater(t168, 0)
-    t171 = xp.where(t170, 1/(t157 + t169), 0)
-    t172 = xp.where(t170, 1 + xp.abs(t157)/t168, 0)
-    t173 = t162*t171
-    t174 = t172*(t160 + t173*t163)
-    t175 = -t174 + t160
-    t176 = t163 - t173*t174
-    t177 = t172*(t166 + t173*t167)
-    t178 = -t177 + t166
-    t179 = t167 - t173*t177
-    t180 = xp.abs(t176)
-    t181 = t180*xp.where(xp.greater_equal(t176, 0), xp.asarray(1, dtype=dtype), -1)
-    t182 = xp.where(xp.greater(t180, 0), xp.asarray(2, dtype=dtype), 0)
-    t183 = t179 - t179*t182
-    t184 = xp.where(xp.not_equal(t181, 0), -t183/t181, 0)
-    t185 = xp.where(xp.not_equal(t169, 0), -(t178 - t175*t184)/t169, 0)
-    t186 = xp.where(xp.not_equal(t149, 0), -(t165 + t156*t185 + t159*t184)/t149, 0)
-    t187 = xp.where(xp.not_equal(t25, 0), -(t146 + t137*t186 + t140*t185 + t143*t184)/t25, 0)
-    t188 = xp.isfinite(t134)
-    t189 = xp.greater_equal(damping, 0)
-    t190 = xp.greater(damping, 0)
-    t191 = 1e-12*t59
-    t192 = 1e-12*t34
-    t193 = (t190 & (xp.less_equal(t54, t191) | xp.less_equal(t86, t191) | xp.less_equal(t105, t191) | xp.less_equal(t117, t191))) | (xp.less_equal(damping, 0) & (xp.less_equal(t24, t192) | xp.less_equal(t148, t192) | xp.less_equal(t168, t192) | xp.less_equal(t180, t192)))
-    t194 = t188 & t189 & xp.logical_not(t193)
+    t48 = damping**2
+    t49 = _symmetric_solve4(xp, 1, (t48 + t32, t37, -t41, -t42, t48 + t35, -t46, -t47, t27 + t48, t18, t20 + t48, mu_dot0, mu_dot1, mu_dot2, mu_dot3,))
+    t50 = t49[0]
+    t51 = t49[1]
+    t52 = -t5*t50 + t2*t51
+    t53 = t49[2]
+    t54 = t17*t49[3]
+    t55 = t54 - t38*t50 - t43*t51 + t6*t53
+    t56 = t54 - t39*t50 - t44*t51 + t7*t53
+    t57 = t54 - t40*t50 - t45*t51 + t15*t53
+    t58 = xp.greater(t24, 0)
+    t59 = xp.where(t58, 1 + xp.abs(t5)/t24, 0)
+    t60 = -t5
+    t61 = xp.where(t58, 1/(t60 + t25), 0)
+    t62 = -t38 - t39 - t40 - t43 - t44 - t45 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + 3*t17 + t60 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping
+    t63 = t2*t61
+    t64 = -t59*(t38 + t43*t63)
+    t65 = t38 + t64
+    t66 = t43 + t63*t64
+    t67 = -t59*(t39 + t44*t63)
+    t68 = t39 + t67
+    t69 = t44 + t63*t67
+    t70 = -t59*(t40 + t45*t63)
+    t71 = t40 + t70
+    t72 = t45 + t63*t70
+    t73 = t59*(mu_dot0 + t63*mu_dot1)
+    t74 = -t73 + mu_dot0
+    t75 = mu_dot1 - t63*t73
+    t76 = xp.sqrt(t19 + t26 + t66**2)
+    t77 = t76*xp.where(xp.less_equal(t66, 0), xp.asarray(1, dtype=dtype), -1)
+    t78 = xp.greater(t76, 0)
+    t79 = xp.where(t78, 1/(-t66 + t77), 0)
+    t80 = xp.where(t78, 1 + xp.abs(t66)/t76, 0)
+    t81 = t6*t79
+    t82 = t19*t79
+    t83 = t80*(-t69 + t82 + t7*t81)
+    t84 = t69 + t83
+    t85 = t7 - t81*t83
+    t86 = t80*(-t72 + t82 + t15*t81)
+    t87 = t72 + t86
+    t88 = t15 - t81*t86
+    t89 = t17*t79
+    t90 = t17 - t89*t83
+    t91 = t17 - t89*t86
+    t92 = t80*(t75 + t81*mu_dot2 + t89*mu_dot3)
+    t93 = -t92 + t75
+    t94 = mu_dot2 - t81*t92
+    t95 = mu_dot3 - t89*t92
+    t96 = xp.sqrt(t85**2 + t90**2)
+    t97 = t96*xp.where(xp.greater_equal(t85, 0), xp.asarray(1, dtype=dtype), -1)
+    t98 = xp.greater(t96, 0)
+    t99 = xp.where(t98, 1/(t85 + t97), 0)
+    t100 = xp.where(t98, 1 + xp.abs(t85)/t96, 0)
+    t101 = t90*t99
+    t102 = t100*(t88 + t101*t91)
+    t103 = -t102 + t88
+    t104 = t91 - t101*t102
+    t105 = t100*(t94 + t101*t95)
+    t106 = -t105 + t94
+    t107 = t95 - t101*t105
+    t108 = xp.abs(t104)
+    t109 = t108*xp.where(xp.greater_equal(t104, 0), xp.asarray(1, dtype=dtype), -1)
+    t110 = xp.where(xp.greater(t108, 0), xp.asarray(2, dtype=dtype), 0)
+    t111 = t107 - t107*t110
+    t112 = xp.where(xp.not_equal(t109, 0), -t111/t109, 0)
+    t113 = xp.where(xp.not_equal(t97, 0), -(t106 - t103*t112)/t97, 0)
+    t114 = xp.where(xp.not_equal(t77, 0), -(t93 + t84*t113 + t87*t112)/t77, 0)
+    t115 = xp.where(xp.not_equal(t25, 0), -(t74 + t65*t114 + t68*t113 + t71*t112)/t25, 0)
+    t116 = xp.isfinite(t62)
+    t117 = xp.greater_equal(damping, 0)
+    t118 = xp.greater(damping, 0)
+    t119 = 1e-12*t34
+    t120 = (t118 & xp.greater(t49[4], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t24, t119) | xp.less_equal(t76, t119) | xp.less_equal(t96, t119) | xp.less_equal(t108, t119)))
+    t121 = t116 & t117 & xp.logical_not(t120)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t194, xp.where(t190, t125, t187), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t194, xp.where(t190, t127, t186), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t194, xp.where(t190, t128, t185), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t194, xp.where(t190, t129, t184), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t121, xp.where(t118, t52, t115), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t121, xp.where(t118, t55, t114), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t121, xp.where(t118, t56, t113), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t121, xp.where(t118, t57, t112), 0), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t188 & t189), 2, xp.where(t193, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t116 & t117), 2, xp.where(t120, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
-    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 578 operations."""
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 580 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (4,)), ("mu_dot", mu_dot, (4,)), ("z", z, (4,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -2455,166 +2522,93 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     t45 = s1*t8
     t46 = t6*t43 + t7*t44 + t15*t45
     t47 = t17*t45 + t44*t17 + t43*t17
-    t48 = t37**2
-    t49 = t41**2
-    t50 = t42**2
-    t51 = damping**2
-    t52 = t51 + t32
-    t53 = t52**2
-    t54 = xp.sqrt(t48 + t49 + t50 + t53)
-    t55 = t54*xp.where(xp.greater_equal(t52, 0), xp.asarray(1, dtype=dtype), -1)
-    t56 = t51 + t35
-    t57 = t27 + t51
-    t58 = t20 + t51
-    t59 = xp.sqrt(2*t48 + 2*t49 + 2*t46**2 + 2*t50 + 2*t47**2 + 2*t18**2 + t53 + t56**2 + t57**2 + t58**2)
-    t60 = xp.greater(t54, 0)
-    t61 = xp.where(t60, 1/(t52 + t55), 0)
-    t62 = xp.where(t60, 1 + xp.abs(t52)/t54, 0)
-    t63 = t37*t61
-    t64 = t41*t61
-    t65 = t42*t61
-    t66 = t62*(t37 + t56*t63 + t64*t46 + t65*t47)
-    t67 = -t66 + t37
-    t68 = t56 - t63*t66
-    t69 = -t46 + t64*t66
-    t70 = -t47 + t65*t66
-    t71 = -t62*(t41 + t63*t46 + t57*t64 + t65*t18)
-    t72 = t41 + t71
-    t73 = t46 + t63*t71
-    t74 = t57 + t64*t71
-    t75 = t18 + t65*t71
-    t76 = -t62*(t42 + t63*t47 + t64*t18 + t58*t65)
-    t77 = t42 + t76
-    t78 = t47 + t63*t76
-    t79 = t18 + t64*t76
-    t80 = t58 + t65*t76
-    t81 = t62*(mu_dot0 + t63*mu_dot1 - t64*mu_dot2 - t65*mu_dot3)
-    t82 = -t81 + mu_dot0
-    t83 = mu_dot1 - t63*t81
-    t84 = mu_dot2 + t64*t81
-    t85 = mu_dot3 + t65*t81
-    t86 = xp.sqrt(t68**2 + t69**2 + t70**2)
-    t87 = t86*xp.where(xp.greater_equal(t68, 0), xp.asarray(1, dtype=dtype), -1)
-    t88 = xp.greater(t86, 0)
-    t89 = xp.where(t88, 1/(t68 + t87), 0)
-    t90 = xp.where(t88, 1 + xp.abs(t68)/t86, 0)
-    t91 = t69*t89
-    t92 = t70*t89
-    t93 = t90*(-t73 + t91*t74 + t92*t75)
-    t94 = t73 + t93
-    t95 = t74 - t91*t93
-    t96 = t75 - t92*t93
-    t97 = t90*(-t78 + t91*t79 + t92*t80)
-    t98 = t78 + t97
-    t99 = t79 - t91*t97
-    t100 = t80 - t92*t97
-    t101 = t90*(t83 + t91*t84 + t92*t85)
-    t102 = -t101 + t83
-    t103 = t84 - t91*t101
-    t104 = t85 - t92*t101
-    t105 = xp.sqrt(t95**2 + t96**2)
-    t106 = t105*xp.where(xp.greater_equal(t95, 0), xp.asarray(1, dtype=dtype), -1)
-    t107 = xp.greater(t105, 0)
-    t108 = xp.where(t107, 1/(t95 + t106), 0)
-    t109 = xp.where(t107, 1 + xp.abs(t95)/t105, 0)
-    t110 = t96*t108
-    t111 = t109*(t99 + t110*t100)
-    t112 = -t111 + t99
-    t113 = t100 - t110*t111
-    t114 = t109*(t103 + t110*t104)
-    t115 = -t114 + t103
-    t116 = t104 - t110*t114
-    t117 = xp.abs(t113)
-    t118 = t117*xp.where(xp.greater_equal(t113, 0), xp.asarray(1, dtype=dtype), -1)
-    t119 = xp.where(xp.greater(t117, 0), xp.asarray(2, dtype=dtype), 0)
-    t120 = t116 - t116*t119
-    t121 = xp.where(xp.not_equal(t118, 0), -t120/t118, 0)
-    t122 = xp.where(xp.not_equal(t106, 0), -(t115 - t112*t121)/t106, 0)
-    t123 = xp.where(xp.not_equal(t87, 0), -(t102 + t94*t122 + t98*t121)/t87, 0)
-    t124 = xp.where(xp.not_equal(t55, 0), -(t82 + t72*t122 + t77*t121 - t67*t123)/t55, 0)
-    t125 = -t5*t124 + t2*t123
-    t126 = t17*t121
-    t127 = t126 + t6*t122 - t38*t124 - t43*t123
-    t128 = t126 + t7*t122 - t39*t124 - t44*t123
-    t129 = t126 + t15*t122 - t40*t124 - t45*t123
-    t130 = xp.greater(t24, 0)
-    t131 = xp.where(t130, 1 + xp.abs(t5)/t24, 0)
-    t132 = -t5
-    t133 = xp.where(t130, 1/(t132 + t25), 0)
-    t134 = -t38 - t39 - t40 - t43 - t44 - t45 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + 3*t17 + t132 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + qz1 + qz2 + qz3 + qz4
-    t135 = t2*t133
-    t136 = -t131*(t38 + t43*t135)
-    t137 = t38 + t136
-    t138 = t43 + t135*t136
-    t139 = -t131*(t39 + t44*t135)
-    t140 = t39 + t139
-    t141 = t44 + t135*t139
-    t142 = -t131*(t40 + t45*t135)
-    t143 = t40 + t142
-    t144 = t45 + t135*t142
-    t145 = t131*(mu_dot0 + t135*mu_dot1)
-    t146 = -t145 + mu_dot0
-    t147 = mu_dot1 - t135*t145
-    t148 = xp.sqrt(t19 + t26 + t138**2)
-    t149 = t148*xp.where(xp.less_equal(t138, 0), xp.asarray(1, dtype=dtype), -1)
-    t150 = xp.greater(t148, 0)
-    t151 = xp.where(t150, 1/(-t138 + t149), 0)
-    t152 = xp.where(t150, 1 + xp.abs(t138)/t148, 0)
-    t153 = t6*t151
-    t154 = t19*t151
-    t155 = t152*(-t141 + t154 + t7*t153)
-    t156 = t141 + t155
-    t157 = t7 - t153*t155
-    t158 = t152*(-t144 + t154 + t15*t153)
-    t159 = t144 + t158
-    t160 = t15 - t153*t158
-    t161 = t17*t151
-    t162 = t17 - t161*t155
-    t163 = t17 - t161*t158
-    t164 = t152*(t147 + t153*mu_dot2 + t161*mu_dot3)
-    t165 = -t164 + t147
-    t166 = mu_dot2 - t153*t164
-    t167 = mu_dot3 - t161*t164
-    t168 = xp.sqrt(t157**2 + t162**2)
-    t169 = t168*xp.where(xp.greater_equal(t157, 0), xp.asarray(1, dtype=dtype), -1)
-    t170 = xp.greater(t168, 0)
-    t171 = xp.where(t170, 1/(t157 + t169), 0)
-    t172 = xp.where(t170, 1 + xp.abs(t157)/t168, 0)
-    t173 = t162*t171
-    t174 = t172*(t160 + t173*t163)
-    t175 = -t174 + t160
-    t176 = t163 - t173*t174
-    t177 = t172*(t166 + t173*t167)
-    t178 = -t177 + t166
-    t179 = t167 - t173*t177
-    t180 = xp.abs(t176)
-    t181 = t180*xp.where(xp.greater_equal(t176, 0), xp.asarray(1, dtype=dtype), -1)
-    t182 = xp.where(xp.greater(t180, 0), xp.asarray(2, dtype=dtype), 0)
-    t183 = t179 - t179*t182
-    t184 = xp.where(xp.not_equal(t181, 0), -t183/t181, 0)
-    t185 = xp.where(xp.not_equal(t169, 0), -(t178 - t175*t184)/t169, 0)
-    t186 = xp.where(xp.not_equal(t149, 0), -(t165 + t156*t185 + t159*t184)/t149, 0)
-    t187 = xp.where(xp.not_equal(t25, 0), -(t146 + t137*t186 + t140*t185 + t143*t184)/t25, 0)
-    t188 = xp.isfinite(t134)
-    t189 = xp.greater_equal(damping, 0)
-    t190 = xp.greater(damping, 0)
-    t191 = 1e-12*t59
-    t192 = 1e-12*t34
-    t193 = (t190 & (xp.less_equal(t54, t191) | xp.less_equal(t86, t191) | xp.less_equal(t105, t191) | xp.less_equal(t117, t191))) | (xp.less_equal(damping, 0) & (xp.less_equal(t24, t192) | xp.less_equal(t148, t192) | xp.less_equal(t168, t192) | xp.less_equal(t180, t192)))
-    t194 = t188 & t189 & xp.logical_not(t193)
+    t48 = damping**2
+    t49 = _symmetric_solve4(xp, 1, (t48 + t32, t37, -t41, -t42, t48 + t35, -t46, -t47, t27 + t48, t18, t20 + t48, mu_dot0, mu_dot1, mu_dot2, mu_dot3,))
+    t50 = t49[0]
+    t51 = t49[1]
+    t52 = -t5*t50 + t2*t51
+    t53 = t49[2]
+    t54 = t17*t49[3]
+    t55 = t54 - t38*t50 - t43*t51 + t6*t53
+    t56 = t54 - t39*t50 - t44*t51 + t7*t53
+    t57 = t54 - t40*t50 - t45*t51 + t15*t53
+    t58 = xp.greater(t24, 0)
+    t59 = xp.where(t58, 1 + xp.abs(t5)/t24, 0)
+    t60 = -t5
+    t61 = xp.where(t58, 1/(t60 + t25), 0)
+    t62 = -t38 - t39 - t40 - t43 - t44 - t45 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + 3*t17 + t60 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + qz1 + qz2 + qz3 + qz4
+    t63 = t2*t61
+    t64 = -t59*(t38 + t43*t63)
+    t65 = t38 + t64
+    t66 = t43 + t63*t64
+    t67 = -t59*(t39 + t44*t63)
+    t68 = t39 + t67
+    t69 = t44 + t63*t67
+    t70 = -t59*(t40 + t45*t63)
+    t71 = t40 + t70
+    t72 = t45 + t63*t70
+    t73 = t59*(mu_dot0 + t63*mu_dot1)
+    t74 = -t73 + mu_dot0
+    t75 = mu_dot1 - t63*t73
+    t76 = xp.sqrt(t19 + t26 + t66**2)
+    t77 = t76*xp.where(xp.less_equal(t66, 0), xp.asarray(1, dtype=dtype), -1)
+    t78 = xp.greater(t76, 0)
+    t79 = xp.where(t78, 1/(-t66 + t77), 0)
+    t80 = xp.where(t78, 1 + xp.abs(t66)/t76, 0)
+    t81 = t6*t79
+    t82 = t19*t79
+    t83 = t80*(-t69 + t82 + t7*t81)
+    t84 = t69 + t83
+    t85 = t7 - t81*t83
+    t86 = t80*(-t72 + t82 + t15*t81)
+    t87 = t72 + t86
+    t88 = t15 - t81*t86
+    t89 = t17*t79
+    t90 = t17 - t89*t83
+    t91 = t17 - t89*t86
+    t92 = t80*(t75 + t81*mu_dot2 + t89*mu_dot3)
+    t93 = -t92 + t75
+    t94 = mu_dot2 - t81*t92
+    t95 = mu_dot3 - t89*t92
+    t96 = xp.sqrt(t85**2 + t90**2)
+    t97 = t96*xp.where(xp.greater_equal(t85, 0), xp.asarray(1, dtype=dtype), -1)
+    t98 = xp.greater(t96, 0)
+    t99 = xp.where(t98, 1/(t85 + t97), 0)
+    t100 = xp.where(t98, 1 + xp.abs(t85)/t96, 0)
+    t101 = t90*t99
+    t102 = t100*(t88 + t101*t91)
+    t103 = -t102 + t88
+    t104 = t91 - t101*t102
+    t105 = t100*(t94 + t101*t95)
+    t106 = -t105 + t94
+    t107 = t95 - t101*t105
+    t108 = xp.abs(t104)
+    t109 = t108*xp.where(xp.greater_equal(t104, 0), xp.asarray(1, dtype=dtype), -1)
+    t110 = xp.where(xp.greater(t108, 0), xp.asarray(2, dtype=dtype), 0)
+    t111 = t107 - t107*t110
+    t112 = xp.where(xp.not_equal(t109, 0), -t111/t109, 0)
+    t113 = xp.where(xp.not_equal(t97, 0), -(t106 - t103*t112)/t97, 0)
+    t114 = xp.where(xp.not_equal(t77, 0), -(t93 + t84*t113 + t87*t112)/t77, 0)
+    t115 = xp.where(xp.not_equal(t25, 0), -(t74 + t65*t114 + t68*t113 + t71*t112)/t25, 0)
+    t116 = xp.isfinite(t62)
+    t117 = xp.greater_equal(damping, 0)
+    t118 = xp.greater(damping, 0)
+    t119 = 1e-12*t34
+    t120 = (t118 & xp.greater(t49[4], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t24, t119) | xp.less_equal(t76, t119) | xp.less_equal(t96, t119) | xp.less_equal(t108, t119)))
+    t121 = t116 & t117 & xp.logical_not(t120)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t194, xp.where(t190, t125, t187), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t194, xp.where(t190, t127, t186), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t194, xp.where(t190, t128, t185), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t194, xp.where(t190, t129, t184), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t121, xp.where(t118, t52, t115), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t121, xp.where(t118, t55, t114), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t121, xp.where(t118, t56, t113), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t121, xp.where(t118, t57, t112), 0), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t188 & t189), 2, xp.where(t193, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t116 & t117), 2, xp.where(t120, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 599 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 601 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (4,)), ("target", target, (4,)), ("target_rate", target_rate, (4,)), ("gain", gain, (4,)), ("z", z, (4,)), ("damping", damping, ()), every=("gain", ))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -2701,169 +2695,96 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t49 = s1*t9
     t50 = t7*t47 + t8*t48 + t18*t49
     t51 = t21*t48 + t21*t49 + t47*t21
-    t52 = t41**2
-    t53 = t45**2
-    t54 = t46**2
-    t55 = damping**2
-    t56 = t55 + t36
-    t57 = t56**2
-    t58 = xp.sqrt(t52 + t53 + t54 + t57)
-    t59 = t58*xp.where(xp.greater_equal(t56, 0), xp.asarray(1, dtype=dtype), -1)
-    t60 = t55 + t39
-    t61 = t31 + t55
-    t62 = t24 + t55
-    t63 = xp.sqrt(2*t52 + 2*t53 + 2*t50**2 + 2*t54 + 2*t51**2 + 2*t22**2 + t57 + t60**2 + t61**2 + t62**2)
-    t64 = xp.greater(t58, 0)
-    t65 = xp.where(t64, 1/(t56 + t59), 0)
-    t66 = xp.where(t64, 1 + xp.abs(t56)/t58, 0)
-    t67 = t41*t65
-    t68 = t45*t65
-    t69 = t46*t65
-    t70 = t66*(t41 + t60*t67 + t68*t50 + t69*t51)
-    t71 = -t70 + t41
-    t72 = t60 - t67*t70
-    t73 = -t50 + t68*t70
-    t74 = -t51 + t69*t70
-    t75 = -t66*(t45 + t67*t50 + t61*t68 + t69*t22)
-    t76 = t45 + t75
-    t77 = t50 + t67*t75
-    t78 = t61 + t68*t75
-    t79 = t22 + t69*t75
-    t80 = -t66*(t46 + t68*t22 + t67*t51 + t62*t69)
-    t81 = t46 + t80
-    t82 = t51 + t67*t80
-    t83 = t22 + t68*t80
-    t84 = t62 + t69*t80
-    t85 = xp.sqrt(t72**2 + t73**2 + t74**2)
-    t86 = t85*xp.where(xp.greater_equal(t72, 0), xp.asarray(1, dtype=dtype), -1)
-    t87 = xp.greater(t85, 0)
-    t88 = xp.where(t87, 1/(t72 + t86), 0)
-    t89 = xp.where(t87, 1 + xp.abs(t72)/t85, 0)
-    t90 = t73*t88
-    t91 = t74*t88
-    t92 = t89*(-t77 + t90*t78 + t91*t79)
-    t93 = t77 + t92
-    t94 = t78 - t90*t92
-    t95 = t79 - t91*t92
-    t96 = t89*(-t82 + t90*t83 + t91*t84)
-    t97 = t82 + t96
-    t98 = t83 - t90*t96
-    t99 = t84 - t91*t96
-    t100 = xp.sqrt(t94**2 + t95**2)
-    t101 = t100*xp.where(xp.greater_equal(t94, 0), xp.asarray(1, dtype=dtype), -1)
-    t102 = xp.greater(t100, 0)
-    t103 = xp.where(t102, 1/(t94 + t101), 0)
-    t104 = xp.where(t102, 1 + xp.abs(t94)/t100, 0)
-    t105 = t95*t103
-    t106 = t104*(t98 + t105*t99)
-    t107 = -t106 + t98
-    t108 = t99 - t105*t106
-    t109 = xp.abs(t108)
-    t110 = t109*xp.where(xp.greater_equal(t108, 0), xp.asarray(1, dtype=dtype), -1)
-    t111 = xp.where(xp.greater(t109, 0), xp.asarray(2, dtype=dtype), 0)
-    t112 = xp.greater(t28, 0)
-    t113 = xp.where(t112, 1 + xp.abs(t6)/t28, 0)
-    t114 = -t6
-    t115 = xp.where(t112, 1/(t114 + t29), 0)
-    t116 = mu_dot1 + gain1*(t114 + mu1)
-    t117 = t2*t115
-    t118 = -t113*(t42 + t47*t117)
-    t119 = t42 + t118
-    t120 = t47 + t117*t118
-    t121 = -t113*(t43 + t48*t117)
-    t122 = t43 + t121
-    t123 = t48 + t117*t121
-    t124 = -t113*(t44 + t49*t117)
-    t125 = t44 + t124
-    t126 = t49 + t117*t124
-    t127 = xp.sqrt(t23 + t30 + t120**2)
-    t128 = t127*xp.where(xp.less_equal(t120, 0), xp.asarray(1, dtype=dtype), -1)
-    t129 = t113*(t3 + t117*t116)
-    t130 = -t129 + t3
-    t131 = t116 - t117*t129
-    t132 = xp.greater(t127, 0)
-    t133 = xp.where(t132, 1/(-t120 + t128), 0)
-    t134 = xp.where(t132, 1 + xp.abs(t120)/t127, 0)
-    t135 = t7*t133
-    t136 = t23*t133
-    t137 = t134*(-t123 + t136 + t8*t135)
-    t138 = t123 + t137
-    t139 = t8 - t135*t137
-    t140 = t134*(-t126 + t136 + t18*t135)
-    t141 = t126 + t140
-    t142 = t18 - t135*t140
-    t143 = t21*t133
-    t144 = t21 - t143*t137
-    t145 = t21 - t143*t140
-    t146 = xp.sqrt(t139**2 + t144**2)
-    t147 = t146*xp.where(xp.greater_equal(t139, 0), xp.asarray(1, dtype=dtype), -1)
-    t148 = xp.greater(t146, 0)
-    t149 = xp.where(t148, 1/(t139 + t147), 0)
-    t150 = xp.where(t148, 1 + xp.abs(t139)/t146, 0)
-    t151 = t144*t149
-    t152 = t150*(t142 + t151*t145)
-    t153 = -t152 + t142
-    t154 = t145 - t151*t152
-    t155 = xp.abs(t154)
-    t156 = t155*xp.where(xp.greater_equal(t154, 0), xp.asarray(1, dtype=dtype), -1)
-    t157 = xp.where(xp.greater(t155, 0), xp.asarray(2, dtype=dtype), 0)
-    t158 = -mu3 + xp.atan2(-s234, t20)
-    t159 = mu_dot3 - gain3*(t158 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t158)))
-    t160 = t66*(t3 + t67*t116 - t68*t13 - t69*t159)
-    t161 = -t160 + t3
-    t162 = t116 - t67*t160
-    t163 = t13 + t68*t160
-    t164 = t159 + t69*t160
-    t165 = t89*(t162 + t90*t163 + t91*t164)
-    t166 = -t165 + t162
-    t167 = t163 - t90*t165
-    t168 = t164 - t91*t165
-    t169 = t104*(t167 + t105*t168)
-    t170 = -t169 + t167
-    t171 = t168 - t105*t169
-    t172 = t171 - t111*t171
-    t173 = xp.where(xp.not_equal(t110, 0), -t172/t110, 0)
-    t174 = xp.where(xp.not_equal(t101, 0), -(t170 - t107*t173)/t101, 0)
-    t175 = xp.where(xp.not_equal(t86, 0), -(t166 + t93*t174 + t97*t173)/t86, 0)
-    t176 = xp.where(xp.not_equal(t59, 0), -(t161 + t76*t174 + t81*t173 - t71*t175)/t59, 0)
-    t177 = -t6*t176 + t2*t175
-    t178 = t134*(t131 + t135*t13 + t143*t159)
-    t179 = -t178 + t131
-    t180 = t13 - t135*t178
-    t181 = t159 - t143*t178
-    t182 = t150*(t180 + t151*t181)
-    t183 = -t182 + t180
-    t184 = t181 - t151*t182
-    t185 = t184 - t157*t184
-    t186 = xp.where(xp.not_equal(t156, 0), -t185/t156, 0)
-    t187 = xp.where(xp.not_equal(t147, 0), -(t183 - t153*t186)/t147, 0)
-    t188 = xp.where(xp.not_equal(t128, 0), -(t179 + t138*t187 + t141*t186)/t128, 0)
-    t189 = xp.where(xp.not_equal(t29, 0), -(t130 + t119*t188 + t122*t187 + t125*t186)/t29, 0)
-    t190 = -t42 - t43 - t44 - t47 - t48 - t49 + q1 + q2 + q3 + q4 + t2 + t7 + t8 + t18 + 3*t21 + t114 + damping + qz1 + qz2 + qz3 + qz4 + t3 + t116 + t13 + t159
-    t191 = t21*t173
-    t192 = t191 + t7*t174 - t42*t176 - t47*t175
-    t193 = t191 + t8*t174 - t43*t176 - t48*t175
-    t194 = t191 + t18*t174 - t44*t176 - t49*t175
-    t195 = xp.isfinite(t190)
-    t196 = xp.greater_equal(damping, 0)
-    t197 = xp.greater(damping, 0)
-    t198 = 1e-12*t63
-    t199 = 1e-12*t38
-    t200 = (t197 & (xp.less_equal(t58, t198) | xp.less_equal(t85, t198) | xp.less_equal(t100, t198) | xp.less_equal(t109, t198))) | (xp.less_equal(damping, 0) & (xp.less_equal(t28, t199) | xp.less_equal(t127, t199) | xp.less_equal(t146, t199) | xp.less_equal(t155, t199)))
-    t201 = t195 & t196 & xp.logical_not(t200)
+    t52 = xp.greater(t28, 0)
+    t53 = xp.where(t52, 1 + xp.abs(t6)/t28, 0)
+    t54 = -t6
+    t55 = xp.where(t52, 1/(t54 + t29), 0)
+    t56 = mu_dot1 + gain1*(t54 + mu1)
+    t57 = t2*t55
+    t58 = -t53*(t42 + t47*t57)
+    t59 = t42 + t58
+    t60 = t47 + t57*t58
+    t61 = -t53*(t43 + t48*t57)
+    t62 = t43 + t61
+    t63 = t48 + t57*t61
+    t64 = -t53*(t44 + t49*t57)
+    t65 = t44 + t64
+    t66 = t49 + t57*t64
+    t67 = xp.sqrt(t23 + t30 + t60**2)
+    t68 = t67*xp.where(xp.less_equal(t60, 0), xp.asarray(1, dtype=dtype), -1)
+    t69 = t53*(t3 + t57*t56)
+    t70 = -t69 + t3
+    t71 = t56 - t57*t69
+    t72 = xp.greater(t67, 0)
+    t73 = xp.where(t72, 1/(-t60 + t68), 0)
+    t74 = xp.where(t72, 1 + xp.abs(t60)/t67, 0)
+    t75 = t7*t73
+    t76 = t23*t73
+    t77 = t74*(-t63 + t76 + t8*t75)
+    t78 = t63 + t77
+    t79 = t8 - t75*t77
+    t80 = t74*(-t66 + t76 + t18*t75)
+    t81 = t66 + t80
+    t82 = t18 - t75*t80
+    t83 = t21*t73
+    t84 = t21 - t83*t77
+    t85 = t21 - t83*t80
+    t86 = xp.sqrt(t79**2 + t84**2)
+    t87 = t86*xp.where(xp.greater_equal(t79, 0), xp.asarray(1, dtype=dtype), -1)
+    t88 = xp.greater(t86, 0)
+    t89 = xp.where(t88, 1/(t79 + t87), 0)
+    t90 = xp.where(t88, 1 + xp.abs(t79)/t86, 0)
+    t91 = t84*t89
+    t92 = t90*(t82 + t91*t85)
+    t93 = -t92 + t82
+    t94 = t85 - t91*t92
+    t95 = xp.abs(t94)
+    t96 = t95*xp.where(xp.greater_equal(t94, 0), xp.asarray(1, dtype=dtype), -1)
+    t97 = xp.where(xp.greater(t95, 0), xp.asarray(2, dtype=dtype), 0)
+    t98 = -mu3 + xp.atan2(-s234, t20)
+    t99 = mu_dot3 - gain3*(t98 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t98)))
+    t100 = t74*(t71 + t75*t13 + t83*t99)
+    t101 = -t100 + t71
+    t102 = t13 - t75*t100
+    t103 = t99 - t83*t100
+    t104 = t90*(t102 + t91*t103)
+    t105 = -t104 + t102
+    t106 = t103 - t91*t104
+    t107 = t106 - t97*t106
+    t108 = xp.where(xp.not_equal(t96, 0), -t107/t96, 0)
+    t109 = xp.where(xp.not_equal(t87, 0), -(t105 - t93*t108)/t87, 0)
+    t110 = xp.where(xp.not_equal(t68, 0), -(t101 + t78*t109 + t81*t108)/t68, 0)
+    t111 = xp.where(xp.not_equal(t29, 0), -(t70 + t59*t110 + t62*t109 + t65*t108)/t29, 0)
+    t112 = -t42 - t43 - t44 - t47 - t48 - t49 + q1 + q2 + q3 + q4 + t2 + t7 + t8 + t18 + 3*t21 + t54 + damping + qz1 + qz2 + qz3 + qz4 + t3 + t56 + t13 + t99
+    t113 = damping**2
+    t114 = _symmetric_solve4(xp, 1, (t113 + t36, t41, -t45, -t46, t113 + t39, -t50, -t51, t31 + t113, t22, t24 + t113, t3, t56, t13, t99,))
+    t115 = t114[0]
+    t116 = t114[1]
+    t117 = -t6*t115 + t2*t116
+    t118 = t114[2]
+    t119 = t21*t114[3]
+    t120 = t119 - t42*t115 - t47*t116 + t7*t118
+    t121 = t119 - t43*t115 - t48*t116 + t8*t118
+    t122 = t119 - t44*t115 - t49*t116 + t18*t118
+    t123 = xp.isfinite(t112)
+    t124 = xp.greater_equal(damping, 0)
+    t125 = xp.greater(damping, 0)
+    t126 = 1e-12*t38
+    t127 = (t125 & xp.greater(t114[4], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t28, t126) | xp.less_equal(t67, t126) | xp.less_equal(t86, t126) | xp.less_equal(t95, t126)))
+    t128 = t123 & t124 & xp.logical_not(t127)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t201, xp.where(t197, t177, t189), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t201, xp.where(t197, t192, t188), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t201, xp.where(t197, t193, t187), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t201, xp.where(t197, t194, t186), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t128, xp.where(t125, t117, t111), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t128, xp.where(t125, t120, t110), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t128, xp.where(t125, t121, t109), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t128, xp.where(t125, t122, t108), 0), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t195 & t196), 2, xp.where(t200, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t123 & t124), 2, xp.where(t127, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (4 x 1 and 4 x 1 and 1 x 1), 383 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (4 x 1 and 4 x 1 and 1 x 1), 414 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4,)), ("q", q, (4,)), ("damping", damping, ()))
     mu0 = target[..., 0]
     mu1 = target[..., 1]
@@ -2936,82 +2857,15 @@ def ik_numeric_step(target, q, damping=0.0):
     t44 = -mu3 + xp.atan2(-s234, t23)
     t45 = t44 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t44))
     t46 = t4**2 + t10**2 + t15**2 + t45**2
-    t47 = damping + t30
-    t48 = xp.sqrt(t47**2 + t33**2 + t37**2 + t38**2)
-    t49 = t48*xp.where(xp.greater_equal(t47, 0), xp.asarray(1, dtype=dtype), -1)
-    t50 = xp.greater(t48, 0)
-    t51 = xp.where(t50, 1/(t47 + t49), 0)
-    t52 = xp.where(t50, 1 + xp.abs(t47)/t48, 0)
-    t53 = damping + t31
-    t54 = t33*t51
-    t55 = t37*t51
-    t56 = t38*t51
-    t57 = t52*(t53*t54 + t33 + t55*t42 + t56*t43)
-    t58 = -t57 + t33
-    t59 = t53 - t54*t57
-    t60 = -t42 + t55*t57
-    t61 = -t43 + t56*t57
-    t62 = t52*(t4 + t54*t10 - t55*t15 + t56*t45)
-    t63 = -t62 + t4
-    t64 = t10 - t54*t62
-    t65 = t15 + t55*t62
-    t66 = -t45 + t56*t62
-    t67 = xp.sqrt(t59**2 + t60**2 + t61**2)
-    t68 = t67*xp.where(xp.greater_equal(t59, 0), xp.asarray(1, dtype=dtype), -1)
-    t69 = damping + t21
-    t70 = -t52*(t37 + t54*t42 + t55*t69 + t56*t25)
-    t71 = t37 + t70
-    t72 = t42 + t54*t70
-    t73 = t69 + t55*t70
-    t74 = t25 + t56*t70
-    t75 = damping + t26
-    t76 = -t52*(t38 + t54*t43 + t55*t25 + t56*t75)
-    t77 = t38 + t76
-    t78 = t43 + t54*t76
-    t79 = t25 + t55*t76
-    t80 = t75 + t56*t76
-    t81 = xp.greater(t67, 0)
-    t82 = xp.where(t81, 1/(t59 + t68), 0)
-    t83 = xp.where(t81, 1 + xp.abs(t59)/t67, 0)
-    t84 = t60*t82
-    t85 = t61*t82
-    t86 = t83*(-t72 + t84*t73 + t85*t74)
-    t87 = t72 + t86
-    t88 = t73 - t84*t86
-    t89 = t74 - t85*t86
-    t90 = t83*(-t78 + t84*t79 + t85*t80)
-    t91 = t78 + t90
-    t92 = t79 - t84*t90
-    t93 = t80 - t85*t90
-    t94 = t83*(t64 + t84*t65 + t85*t66)
-    t95 = -t94 + t64
-    t96 = t65 - t84*t94
-    t97 = t66 - t85*t94
-    t98 = xp.sqrt(t88**2 + t89**2)
-    t99 = t98*xp.where(xp.greater_equal(t88, 0), xp.asarray(1, dtype=dtype), -1)
-    t100 = xp.greater(t98, 0)
-    t101 = xp.where(t100, 1/(t88 + t99), 0)
-    t102 = xp.where(t100, 1 + xp.abs(t88)/t98, 0)
-    t103 = t89*t101
-    t104 = t102*(t92 + t103*t93)
-    t105 = -t104 + t92
-    t106 = t93 - t103*t104
-    t107 = t102*(t96 + t103*t97)
-    t108 = -t107 + t96
-    t109 = t97 - t103*t107
-    t110 = xp.abs(t106)
-    t111 = t110*xp.where(xp.greater_equal(t106, 0), xp.asarray(1, dtype=dtype), -1)
-    t112 = xp.where(xp.greater(t110, 0), xp.asarray(2, dtype=dtype), 0)
-    t113 = t109 - t109*t112
-    t114 = xp.where(xp.not_equal(t111, 0), -t113/t111, 0)
-    t115 = xp.where(xp.not_equal(t99, 0), -(t108 - t105*t114)/t99, 0)
-    t116 = xp.where(xp.not_equal(t68, 0), -(t95 + t87*t115 + t91*t114)/t68, 0)
-    t117 = xp.where(xp.not_equal(t49, 0), -(t63 + t71*t115 + t77*t114 - t58*t116)/t49, 0)
-    t118 = q1 - t7*t117 + t3*t116
-    t119 = t24*t114
-    t120 = q2 + t119 + t8*t115 - t34*t117 - t39*t116
-    t121 = q3 + t119 + t9*t115 - t35*t117 - t40*t116
-    t122 = q4 + t119 + t20*t115 - t36*t117 - t41*t116
+    t47 = _symmetric_solve4(xp, 1, (damping + t30, t33, -t37, -t38, damping + t31, -t42, -t43, damping + t21, t25, damping + t26, t4, t10, t15, -t45,))
+    t48 = t47[0]
+    t49 = t47[1]
+    t50 = q1 - t7*t48 + t3*t49
+    t51 = t47[2]
+    t52 = t24*t47[3]
+    t53 = q2 + t52 - t34*t48 - t39*t49 + t8*t51
+    t54 = q3 + t52 + t9*t51 - t35*t48 - t40*t49
+    t55 = q4 + t52 + t20*t51 - t36*t48 - t41*t49
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -3019,10 +2873,10 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q4, batch),  # 3
     ], (4,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t118, -3.141592653589793), -3.141592653589793, xp.where(xp.greater(t118, 3.141592653589793), 3.141592653589793, t118)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t120, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t120, 2.0943951023931953), 2.0943951023931953, t120)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t121, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t121, 2.0943951023931953), 2.0943951023931953, t121)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t122, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t122, 2.0943951023931953), 2.0943951023931953, t122)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t50, -3.141592653589793), -3.141592653589793, xp.where(xp.greater(t50, 3.141592653589793), 3.141592653589793, t50)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t53, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t53, 2.0943951023931953), 2.0943951023931953, t53)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t54, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t54, 2.0943951023931953), 2.0943951023931953, t54)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t55, -2.0943951023931953), -2.0943951023931953, xp.where(xp.greater(t55, 2.0943951023931953), 2.0943951023931953, t55)), batch),  # 3
     ], (4,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t0), t46, -1), batch)
     return q_start, q_next, cost
@@ -3386,7 +3240,7 @@ def ik_branches(mu):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (4 x 1 and 1 x 1), 659 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (4 x 1 and 1 x 1), 660 operations."""
     xp, dtype, device, batch, (mu, q_seed, weights,) = _arguments(("mu", mu, (4,)), ("q_seed", q_seed, (4,)), ("weights", weights, (4,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(mu)
     mu0 = mu[..., 0]
@@ -3449,266 +3303,25 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     lb5 = branches_in_limits[..., 5]
     lb6 = branches_in_limits[..., 6]
     lb7 = branches_in_limits[..., 7]
-    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
-    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
-    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
-    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
-    t4 = xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0)
-    t5 = xp.where(xp.greater(t4, 0), xp.asarray(1, dtype=dtype), 0)
-    t6 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
-    t7 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
-    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
-    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
-    t10 = xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0)
-    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
-    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
-    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
-    t14 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
-    t15 = xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0)
-    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
-    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
-    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
-    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
-    t20 = xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0)
-    t21 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
-    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
-    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
-    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
-    t25 = xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0)
-    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
-    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
-    t28 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
-    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
-    t30 = xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0)
-    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
-    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
-    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
-    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
-    t35 = xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0)
-    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
-    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
-    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
-    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
-    t40 = xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0)
-    t41 = mu3 + mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
-    t42 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t43 = t42 + t0
-    t44 = -t42 + t0
-    t45 = xp.where(xp.greater_equal(t0, -3.141592653589793) & xp.less_equal(t0, 3.141592653589793), t0, xp.where(xp.greater_equal(t43, -3.141592653589793) & xp.less_equal(t43, 3.141592653589793), t43, xp.where(xp.greater_equal(t44, -3.141592653589793) & xp.less_equal(t44, 3.141592653589793), t44, qb0_0)))
-    t46 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t47 = t46 + t1
-    t48 = -t46 + t1
-    t49 = xp.where(xp.greater_equal(t1, -2.0943951023931953) & xp.less_equal(t1, 2.0943951023931953), t1, xp.where(xp.greater_equal(t47, -2.0943951023931953) & xp.less_equal(t47, 2.0943951023931953), t47, xp.where(xp.greater_equal(t48, -2.0943951023931953) & xp.less_equal(t48, 2.0943951023931953), t48, qb0_1)))
-    t50 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t51 = t50 + t2
-    t52 = -t50 + t2
-    t53 = xp.where(xp.greater_equal(t2, -2.0943951023931953) & xp.less_equal(t2, 2.0943951023931953), t2, xp.where(xp.greater_equal(t51, -2.0943951023931953) & xp.less_equal(t51, 2.0943951023931953), t51, xp.where(xp.greater_equal(t52, -2.0943951023931953) & xp.less_equal(t52, 2.0943951023931953), t52, qb0_2)))
-    t54 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t55 = t54 + t3
-    t56 = -t54 + t3
-    t57 = xp.where(xp.greater_equal(t3, -2.0943951023931953) & xp.less_equal(t3, 2.0943951023931953), t3, xp.where(xp.greater_equal(t55, -2.0943951023931953) & xp.less_equal(t55, 2.0943951023931953), t55, xp.where(xp.greater_equal(t56, -2.0943951023931953) & xp.less_equal(t56, 2.0943951023931953), t56, qb0_3)))
-    t58 = -qn1
-    t59 = -qn2
-    t60 = -qn3
-    t61 = -qn4
-    t62 = qw1*(t58 + t45)**2 + qw2*(t59 + t49)**2 + qw3*(t60 + t53)**2 + qw4*(t61 + t57)**2
-    t63 = xp.greater(t5, 0)
-    t64 = xp.where(t63, t45, qn1)
-    t65 = xp.where(t63, t49, qn2)
-    t66 = xp.where(t63, t53, qn3)
-    t67 = xp.where(t63, t57, qn4)
-    t68 = xp.where(t63, t62, 0)
-    t69 = xp.where(xp.less(t6, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t70 = t69 + t6
-    t71 = -t69 + t6
-    t72 = xp.where(xp.greater_equal(t6, -3.141592653589793) & xp.less_equal(t6, 3.141592653589793), t6, xp.where(xp.greater_equal(t70, -3.141592653589793) & xp.less_equal(t70, 3.141592653589793), t70, xp.where(xp.greater_equal(t71, -3.141592653589793) & xp.less_equal(t71, 3.141592653589793), t71, qb1_0)))
-    t73 = xp.where(xp.less(t7, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t74 = t73 + t7
-    t75 = -t73 + t7
-    t76 = xp.where(xp.greater_equal(t7, -2.0943951023931953) & xp.less_equal(t7, 2.0943951023931953), t7, xp.where(xp.greater_equal(t74, -2.0943951023931953) & xp.less_equal(t74, 2.0943951023931953), t74, xp.where(xp.greater_equal(t75, -2.0943951023931953) & xp.less_equal(t75, 2.0943951023931953), t75, qb1_1)))
-    t77 = xp.where(xp.less(t8, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t78 = t77 + t8
-    t79 = -t77 + t8
-    t80 = xp.where(xp.greater_equal(t8, -2.0943951023931953) & xp.less_equal(t8, 2.0943951023931953), t8, xp.where(xp.greater_equal(t78, -2.0943951023931953) & xp.less_equal(t78, 2.0943951023931953), t78, xp.where(xp.greater_equal(t79, -2.0943951023931953) & xp.less_equal(t79, 2.0943951023931953), t79, qb1_2)))
-    t81 = xp.where(xp.less(t9, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t82 = t81 + t9
-    t83 = -t81 + t9
-    t84 = xp.where(xp.greater_equal(t9, -2.0943951023931953) & xp.less_equal(t9, 2.0943951023931953), t9, xp.where(xp.greater_equal(t82, -2.0943951023931953) & xp.less_equal(t82, 2.0943951023931953), t82, xp.where(xp.greater_equal(t83, -2.0943951023931953) & xp.less_equal(t83, 2.0943951023931953), t83, qb1_3)))
-    t85 = qw1*(t58 + t72)**2 + qw2*(t59 + t76)**2 + qw3*(t60 + t80)**2 + qw4*(t61 + t84)**2
-    t86 = xp.greater(t10, 0)
-    t87 = xp.where(t86 & (xp.less(t5, 1) | xp.less(t85, t68)), xp.asarray(1, dtype=dtype), 0)
-    t88 = xp.where(t86, 1, t5)
-    t89 = xp.greater(t87, 0)
-    t90 = xp.where(t89, t72, t64)
-    t91 = xp.where(t89, t76, t65)
-    t92 = xp.where(t89, t80, t66)
-    t93 = xp.where(t89, t84, t67)
-    t94 = xp.where(t89, t85, t68)
-    t95 = xp.where(xp.less(t11, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t96 = t95 + t11
-    t97 = -t95 + t11
-    t98 = xp.where(xp.greater_equal(t11, -3.141592653589793) & xp.less_equal(t11, 3.141592653589793), t11, xp.where(xp.greater_equal(t96, -3.141592653589793) & xp.less_equal(t96, 3.141592653589793), t96, xp.where(xp.greater_equal(t97, -3.141592653589793) & xp.less_equal(t97, 3.141592653589793), t97, qb2_0)))
-    t99 = xp.where(xp.less(t12, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t100 = t99 + t12
-    t101 = -t99 + t12
-    t102 = xp.where(xp.greater_equal(t12, -2.0943951023931953) & xp.less_equal(t12, 2.0943951023931953), t12, xp.where(xp.greater_equal(t100, -2.0943951023931953) & xp.less_equal(t100, 2.0943951023931953), t100, xp.where(xp.greater_equal(t101, -2.0943951023931953) & xp.less_equal(t101, 2.0943951023931953), t101, qb2_1)))
-    t103 = xp.where(xp.less(t13, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t104 = t103 + t13
-    t105 = -t103 + t13
-    t106 = xp.where(xp.greater_equal(t13, -2.0943951023931953) & xp.less_equal(t13, 2.0943951023931953), t13, xp.where(xp.greater_equal(t104, -2.0943951023931953) & xp.less_equal(t104, 2.0943951023931953), t104, xp.where(xp.greater_equal(t105, -2.0943951023931953) & xp.less_equal(t105, 2.0943951023931953), t105, qb2_2)))
-    t107 = xp.where(xp.less(t14, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t108 = t107 + t14
-    t109 = -t107 + t14
-    t110 = xp.where(xp.greater_equal(t14, -2.0943951023931953) & xp.less_equal(t14, 2.0943951023931953), t14, xp.where(xp.greater_equal(t108, -2.0943951023931953) & xp.less_equal(t108, 2.0943951023931953), t108, xp.where(xp.greater_equal(t109, -2.0943951023931953) & xp.less_equal(t109, 2.0943951023931953), t109, qb2_3)))
-    t111 = qw1*(t58 + t98)**2 + qw2*(t59 + t102)**2 + qw3*(t60 + t106)**2 + qw4*(t61 + t110)**2
-    t112 = xp.greater(t15, 0)
-    t113 = xp.where(t112 & (xp.less(t88, 1) | xp.less(t111, t94)), xp.asarray(1, dtype=dtype), 0)
-    t114 = xp.where(t112, 1, t88)
-    t115 = xp.greater(t113, 0)
-    t116 = xp.where(t115, t98, t90)
-    t117 = xp.where(t115, t102, t91)
-    t118 = xp.where(t115, t106, t92)
-    t119 = xp.where(t115, t110, t93)
-    t120 = xp.where(t115, t111, t94)
-    t121 = xp.where(xp.less(t16, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t122 = t121 + t16
-    t123 = -t121 + t16
-    t124 = xp.where(xp.greater_equal(t16, -3.141592653589793) & xp.less_equal(t16, 3.141592653589793), t16, xp.where(xp.greater_equal(t122, -3.141592653589793) & xp.less_equal(t122, 3.141592653589793), t122, xp.where(xp.greater_equal(t123, -3.141592653589793) & xp.less_equal(t123, 3.141592653589793), t123, qb3_0)))
-    t125 = xp.where(xp.less(t17, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t126 = t125 + t17
-    t127 = -t125 + t17
-    t128 = xp.where(xp.greater_equal(t17, -2.0943951023931953) & xp.less_equal(t17, 2.0943951023931953), t17, xp.where(xp.greater_equal(t126, -2.0943951023931953) & xp.less_equal(t126, 2.0943951023931953), t126, xp.where(xp.greater_equal(t127, -2.0943951023931953) & xp.less_equal(t127, 2.0943951023931953), t127, qb3_1)))
-    t129 = xp.where(xp.less(t18, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t130 = t129 + t18
-    t131 = -t129 + t18
-    t132 = xp.where(xp.greater_equal(t18, -2.0943951023931953) & xp.less_equal(t18, 2.0943951023931953), t18, xp.where(xp.greater_equal(t130, -2.0943951023931953) & xp.less_equal(t130, 2.0943951023931953), t130, xp.where(xp.greater_equal(t131, -2.0943951023931953) & xp.less_equal(t131, 2.0943951023931953), t131, qb3_2)))
-    t133 = xp.where(xp.less(t19, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t134 = t133 + t19
-    t135 = -t133 + t19
-    t136 = xp.where(xp.greater_equal(t19, -2.0943951023931953) & xp.less_equal(t19, 2.0943951023931953), t19, xp.where(xp.greater_equal(t134, -2.0943951023931953) & xp.less_equal(t134, 2.0943951023931953), t134, xp.where(xp.greater_equal(t135, -2.0943951023931953) & xp.less_equal(t135, 2.0943951023931953), t135, qb3_3)))
-    t137 = qw1*(t58 + t124)**2 + qw2*(t59 + t128)**2 + qw3*(t60 + t132)**2 + qw4*(t61 + t136)**2
-    t138 = xp.greater(t20, 0)
-    t139 = xp.where(t138 & (xp.less(t114, 1) | xp.less(t137, t120)), xp.asarray(1, dtype=dtype), 0)
-    t140 = xp.where(t138, 1, t114)
-    t141 = xp.greater(t139, 0)
-    t142 = xp.where(t141, t124, t116)
-    t143 = xp.where(t141, t128, t117)
-    t144 = xp.where(t141, t132, t118)
-    t145 = xp.where(t141, t136, t119)
-    t146 = xp.where(t141, t137, t120)
-    t147 = xp.where(xp.less(t21, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t148 = t147 + t21
-    t149 = -t147 + t21
-    t150 = xp.where(xp.greater_equal(t21, -3.141592653589793) & xp.less_equal(t21, 3.141592653589793), t21, xp.where(xp.greater_equal(t148, -3.141592653589793) & xp.less_equal(t148, 3.141592653589793), t148, xp.where(xp.greater_equal(t149, -3.141592653589793) & xp.less_equal(t149, 3.141592653589793), t149, qb4_0)))
-    t151 = xp.where(xp.less(t22, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t152 = t151 + t22
-    t153 = -t151 + t22
-    t154 = xp.where(xp.greater_equal(t22, -2.0943951023931953) & xp.less_equal(t22, 2.0943951023931953), t22, xp.where(xp.greater_equal(t152, -2.0943951023931953) & xp.less_equal(t152, 2.0943951023931953), t152, xp.where(xp.greater_equal(t153, -2.0943951023931953) & xp.less_equal(t153, 2.0943951023931953), t153, qb4_1)))
-    t155 = xp.where(xp.less(t23, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t156 = t155 + t23
-    t157 = -t155 + t23
-    t158 = xp.where(xp.greater_equal(t23, -2.0943951023931953) & xp.less_equal(t23, 2.0943951023931953), t23, xp.where(xp.greater_equal(t156, -2.0943951023931953) & xp.less_equal(t156, 2.0943951023931953), t156, xp.where(xp.greater_equal(t157, -2.0943951023931953) & xp.less_equal(t157, 2.0943951023931953), t157, qb4_2)))
-    t159 = xp.where(xp.less(t24, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t160 = t159 + t24
-    t161 = -t159 + t24
-    t162 = xp.where(xp.greater_equal(t24, -2.0943951023931953) & xp.less_equal(t24, 2.0943951023931953), t24, xp.where(xp.greater_equal(t160, -2.0943951023931953) & xp.less_equal(t160, 2.0943951023931953), t160, xp.where(xp.greater_equal(t161, -2.0943951023931953) & xp.less_equal(t161, 2.0943951023931953), t161, qb4_3)))
-    t163 = qw1*(t58 + t150)**2 + qw2*(t59 + t154)**2 + qw3*(t60 + t158)**2 + qw4*(t61 + t162)**2
-    t164 = xp.greater(t25, 0)
-    t165 = xp.where(t164 & (xp.less(t140, 1) | xp.less(t163, t146)), xp.asarray(1, dtype=dtype), 0)
-    t166 = xp.where(t164, 1, t140)
-    t167 = xp.greater(t165, 0)
-    t168 = xp.where(t167, t150, t142)
-    t169 = xp.where(t167, t154, t143)
-    t170 = xp.where(t167, t158, t144)
-    t171 = xp.where(t167, t162, t145)
-    t172 = xp.where(t167, t163, t146)
-    t173 = xp.where(xp.less(t26, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t174 = t173 + t26
-    t175 = -t173 + t26
-    t176 = xp.where(xp.greater_equal(t26, -3.141592653589793) & xp.less_equal(t26, 3.141592653589793), t26, xp.where(xp.greater_equal(t174, -3.141592653589793) & xp.less_equal(t174, 3.141592653589793), t174, xp.where(xp.greater_equal(t175, -3.141592653589793) & xp.less_equal(t175, 3.141592653589793), t175, qb5_0)))
-    t177 = xp.where(xp.less(t27, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t178 = t177 + t27
-    t179 = -t177 + t27
-    t180 = xp.where(xp.greater_equal(t27, -2.0943951023931953) & xp.less_equal(t27, 2.0943951023931953), t27, xp.where(xp.greater_equal(t178, -2.0943951023931953) & xp.less_equal(t178, 2.0943951023931953), t178, xp.where(xp.greater_equal(t179, -2.0943951023931953) & xp.less_equal(t179, 2.0943951023931953), t179, qb5_1)))
-    t181 = xp.where(xp.less(t28, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t182 = t181 + t28
-    t183 = -t181 + t28
-    t184 = xp.where(xp.greater_equal(t28, -2.0943951023931953) & xp.less_equal(t28, 2.0943951023931953), t28, xp.where(xp.greater_equal(t182, -2.0943951023931953) & xp.less_equal(t182, 2.0943951023931953), t182, xp.where(xp.greater_equal(t183, -2.0943951023931953) & xp.less_equal(t183, 2.0943951023931953), t183, qb5_2)))
-    t185 = xp.where(xp.less(t29, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t186 = t185 + t29
-    t187 = -t185 + t29
-    t188 = xp.where(xp.greater_equal(t29, -2.0943951023931953) & xp.less_equal(t29, 2.0943951023931953), t29, xp.where(xp.greater_equal(t186, -2.0943951023931953) & xp.less_equal(t186, 2.0943951023931953), t186, xp.where(xp.greater_equal(t187, -2.0943951023931953) & xp.less_equal(t187, 2.0943951023931953), t187, qb5_3)))
-    t189 = qw1*(t58 + t176)**2 + qw2*(t59 + t180)**2 + qw3*(t60 + t184)**2 + qw4*(t61 + t188)**2
-    t190 = xp.greater(t30, 0)
-    t191 = xp.where(t190 & (xp.less(t166, 1) | xp.less(t189, t172)), xp.asarray(1, dtype=dtype), 0)
-    t192 = xp.where(t190, 1, t166)
-    t193 = xp.greater(t191, 0)
-    t194 = xp.where(t193, t176, t168)
-    t195 = xp.where(t193, t180, t169)
-    t196 = xp.where(t193, t184, t170)
-    t197 = xp.where(t193, t188, t171)
-    t198 = xp.where(t193, t189, t172)
-    t199 = xp.where(xp.less(t31, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t200 = t199 + t31
-    t201 = -t199 + t31
-    t202 = xp.where(xp.greater_equal(t31, -3.141592653589793) & xp.less_equal(t31, 3.141592653589793), t31, xp.where(xp.greater_equal(t200, -3.141592653589793) & xp.less_equal(t200, 3.141592653589793), t200, xp.where(xp.greater_equal(t201, -3.141592653589793) & xp.less_equal(t201, 3.141592653589793), t201, qb6_0)))
-    t203 = xp.where(xp.less(t32, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t204 = t203 + t32
-    t205 = -t203 + t32
-    t206 = xp.where(xp.greater_equal(t32, -2.0943951023931953) & xp.less_equal(t32, 2.0943951023931953), t32, xp.where(xp.greater_equal(t204, -2.0943951023931953) & xp.less_equal(t204, 2.0943951023931953), t204, xp.where(xp.greater_equal(t205, -2.0943951023931953) & xp.less_equal(t205, 2.0943951023931953), t205, qb6_1)))
-    t207 = xp.where(xp.less(t33, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t208 = t207 + t33
-    t209 = -t207 + t33
-    t210 = xp.where(xp.greater_equal(t33, -2.0943951023931953) & xp.less_equal(t33, 2.0943951023931953), t33, xp.where(xp.greater_equal(t208, -2.0943951023931953) & xp.less_equal(t208, 2.0943951023931953), t208, xp.where(xp.greater_equal(t209, -2.0943951023931953) & xp.less_equal(t209, 2.0943951023931953), t209, qb6_2)))
-    t211 = xp.where(xp.less(t34, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t212 = t211 + t34
-    t213 = -t211 + t34
-    t214 = xp.where(xp.greater_equal(t34, -2.0943951023931953) & xp.less_equal(t34, 2.0943951023931953), t34, xp.where(xp.greater_equal(t212, -2.0943951023931953) & xp.less_equal(t212, 2.0943951023931953), t212, xp.where(xp.greater_equal(t213, -2.0943951023931953) & xp.less_equal(t213, 2.0943951023931953), t213, qb6_3)))
-    t215 = qw1*(t58 + t202)**2 + qw2*(t59 + t206)**2 + qw3*(t60 + t210)**2 + qw4*(t61 + t214)**2
-    t216 = xp.greater(t35, 0)
-    t217 = xp.where(t216 & (xp.less(t192, 1) | xp.less(t215, t198)), xp.asarray(1, dtype=dtype), 0)
-    t218 = xp.where(t216, 1, t192)
-    t219 = xp.greater(t217, 0)
-    t220 = xp.where(t219, t202, t194)
-    t221 = xp.where(t219, t206, t195)
-    t222 = xp.where(t219, t210, t196)
-    t223 = xp.where(t219, t214, t197)
-    t224 = xp.where(t219, t215, t198)
-    t225 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t226 = t225 + t36
-    t227 = -t225 + t36
-    t228 = xp.where(xp.greater_equal(t36, -3.141592653589793) & xp.less_equal(t36, 3.141592653589793), t36, xp.where(xp.greater_equal(t226, -3.141592653589793) & xp.less_equal(t226, 3.141592653589793), t226, xp.where(xp.greater_equal(t227, -3.141592653589793) & xp.less_equal(t227, 3.141592653589793), t227, qb7_0)))
-    t229 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t230 = t229 + t37
-    t231 = -t229 + t37
-    t232 = xp.where(xp.greater_equal(t37, -2.0943951023931953) & xp.less_equal(t37, 2.0943951023931953), t37, xp.where(xp.greater_equal(t230, -2.0943951023931953) & xp.less_equal(t230, 2.0943951023931953), t230, xp.where(xp.greater_equal(t231, -2.0943951023931953) & xp.less_equal(t231, 2.0943951023931953), t231, qb7_1)))
-    t233 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t234 = t233 + t38
-    t235 = -t233 + t38
-    t236 = xp.where(xp.greater_equal(t38, -2.0943951023931953) & xp.less_equal(t38, 2.0943951023931953), t38, xp.where(xp.greater_equal(t234, -2.0943951023931953) & xp.less_equal(t234, 2.0943951023931953), t234, xp.where(xp.greater_equal(t235, -2.0943951023931953) & xp.less_equal(t235, 2.0943951023931953), t235, qb7_2)))
-    t237 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t238 = t237 + t39
-    t239 = -t237 + t39
-    t240 = xp.where(xp.greater_equal(t39, -2.0943951023931953) & xp.less_equal(t39, 2.0943951023931953), t39, xp.where(xp.greater_equal(t238, -2.0943951023931953) & xp.less_equal(t238, 2.0943951023931953), t238, xp.where(xp.greater_equal(t239, -2.0943951023931953) & xp.less_equal(t239, 2.0943951023931953), t239, qb7_3)))
-    t241 = qw1*(t58 + t228)**2 + qw2*(t59 + t232)**2 + qw3*(t60 + t236)**2 + qw4*(t61 + t240)**2
-    t242 = xp.greater(t40, 0)
-    t243 = xp.where(t242 & (xp.less(t218, 1) | xp.less(t241, t224)), xp.asarray(1, dtype=dtype), 0)
-    t244 = xp.where(t242, 1, t218)
-    t245 = xp.greater(t243, 0)
-    t246 = xp.where(t245, t228, t220)
-    t247 = xp.where(t245, t232, t221)
-    t248 = xp.where(t245, t236, t222)
-    t249 = xp.where(t245, t240, t223)
-    t250 = xp.greater(t244, 0)
-    t251 = xp.isfinite(t41)
-    t252 = t250 & t251
+    t0 = mu3 + mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
+    t1 = _nearer_branch(xp, 1, (qb0_0, qb0_1, qb0_2, qb0_3, xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qw1, qw2, qw3, qw4, qn1, qn2, qn3, qn4, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
+    t2 = _nearer_branch(xp, 1, (qb1_0, qb1_1, qb1_2, qb1_3, xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qw1, qw2, qw3, qw4, t1[0], t1[1], t1[2], t1[3], t1[4], t1[5],))
+    t3 = _nearer_branch(xp, 1, (qb2_0, qb2_1, qb2_2, qb2_3, xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qw1, qw2, qw3, qw4, t2[0], t2[1], t2[2], t2[3], t2[4], t2[5],))
+    t4 = _nearer_branch(xp, 1, (qb3_0, qb3_1, qb3_2, qb3_3, xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qw1, qw2, qw3, qw4, t3[0], t3[1], t3[2], t3[3], t3[4], t3[5],))
+    t5 = _nearer_branch(xp, 1, (qb4_0, qb4_1, qb4_2, qb4_3, xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qw1, qw2, qw3, qw4, t4[0], t4[1], t4[2], t4[3], t4[4], t4[5],))
+    t6 = _nearer_branch(xp, 1, (qb5_0, qb5_1, qb5_2, qb5_3, xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qw1, qw2, qw3, qw4, t5[0], t5[1], t5[2], t5[3], t5[4], t5[5],))
+    t7 = _nearer_branch(xp, 1, (qb6_0, qb6_1, qb6_2, qb6_3, xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qw1, qw2, qw3, qw4, t6[0], t6[1], t6[2], t6[3], t6[4], t6[5],))
+    t8 = _nearer_branch(xp, 1, (qb7_0, qb7_1, qb7_2, qb7_3, xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qw1, qw2, qw3, qw4, t7[0], t7[1], t7[2], t7[3], t7[4], t7[5],))
+    t9 = xp.greater(t8[5], 0)
+    t10 = xp.isfinite(t0)
+    t11 = t9 & t10
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t252, t246, qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t252, t247, qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t252, t248, qn3), batch),  # 2
-        xp.broadcast_to(xp.where(t252, t249, qn4), batch),  # 3
+        xp.broadcast_to(xp.where(t11, t8[0], qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t11, t8[1], qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t11, t8[2], qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t11, t8[3], qn4), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t251), 2, xp.where(t250, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t10), 2, xp.where(t9, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

@@ -82,6 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -335,6 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi6_rows(xp, count, state):
     """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2 + w4**2 + w5**2
@@ -896,6 +898,257 @@ def _jacobi6_rows(xp, count, state):
             t489,
             t493,
             t497,
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _symmetric_solve6(xp, count, state):
+    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w1**2
+        t1 = w2**2
+        t2 = w3**2
+        t3 = w4**2
+        t4 = w5**2
+        t5 = w0**2
+        t6 = xp.sqrt(t5 + 2*t0 + 2*t1 + 2*w7**2 + 2*t2 + 2*w8**2 + 2*w12**2 + 2*t3 + 2*w9**2 + 2*w13**2 + 2*w16**2 + 2*t4 + 2*w10**2 + 2*w14**2 + 2*w17**2 + 2*w19**2 + w6**2 + w11**2 + w15**2 + w18**2 + w20**2)
+        t7 = xp.sqrt(t0 + t1 + t2 + t3 + t4 + t5)
+        t8 = t7*xp.where(xp.greater_equal(w0, 0), xp.asarray(1, dtype=dtype), -1)
+        t9 = xp.greater(t7, 0)
+        t10 = xp.where(t9, 1/(w0 + t8), 0)
+        t11 = xp.where(t9, 1 + xp.abs(w0)/t7, 0)
+        t12 = w1*t10
+        t13 = w2*t10
+        t14 = w3*t10
+        t15 = w4*t10
+        t16 = w5*t10
+        t17 = t11*(w1 + t12*w6 + t13*w7 + t14*w8 + t15*w9 + t16*w10)
+        t18 = -t17 + w1
+        t19 = w6 - t12*t17
+        t20 = w7 - t13*t17
+        t21 = w8 - t14*t17
+        t22 = w9 - t15*t17
+        t23 = w10 - t16*t17
+        t24 = t11*(w2 + t12*w7 + t13*w11 + t14*w12 + t15*w13 + t16*w14)
+        t25 = -t24 + w2
+        t26 = w7 - t12*t24
+        t27 = w11 - t13*t24
+        t28 = w12 - t14*t24
+        t29 = w13 - t15*t24
+        t30 = w14 - t16*t24
+        t31 = t11*(w3 + t12*w8 + t13*w12 + t14*w15 + t15*w16 + t16*w17)
+        t32 = -t31 + w3
+        t33 = w8 - t12*t31
+        t34 = w12 - t13*t31
+        t35 = w15 - t14*t31
+        t36 = w16 - t15*t31
+        t37 = w17 - t16*t31
+        t38 = t11*(w4 + t12*w9 + t13*w13 + t14*w16 + t15*w18 + t16*w19)
+        t39 = -t38 + w4
+        t40 = w9 - t12*t38
+        t41 = w13 - t13*t38
+        t42 = w16 - t14*t38
+        t43 = w18 - t15*t38
+        t44 = w19 - t16*t38
+        t45 = t11*(w5 + t12*w10 + t13*w14 + t14*w17 + t15*w19 + t16*w20)
+        t46 = -t45 + w5
+        t47 = w10 - t12*t45
+        t48 = w14 - t13*t45
+        t49 = w17 - t14*t45
+        t50 = w19 - t15*t45
+        t51 = w20 - t16*t45
+        t52 = t11*(w21 + t12*w22 + t13*w23 + t14*w24 + t15*w25 + t16*w26)
+        t53 = -t52 + w21
+        t54 = w22 - t12*t52
+        t55 = w23 - t13*t52
+        t56 = w24 - t14*t52
+        t57 = w25 - t15*t52
+        t58 = w26 - t16*t52
+        t59 = xp.sqrt(t19**2 + t20**2 + t21**2 + t22**2 + t23**2)
+        t60 = t59*xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)
+        t61 = xp.greater(t59, 0)
+        t62 = xp.where(t61, 1/(t19 + t60), 0)
+        t63 = xp.where(t61, 1 + xp.abs(t19)/t59, 0)
+        t64 = t20*t62
+        t65 = t21*t62
+        t66 = t22*t62
+        t67 = t23*t62
+        t68 = t63*(t26 + t64*t27 + t65*t28 + t66*t29 + t67*t30)
+        t69 = -t68 + t26
+        t70 = t27 - t64*t68
+        t71 = t28 - t65*t68
+        t72 = t29 - t66*t68
+        t73 = t30 - t67*t68
+        t74 = t63*(t33 + t64*t34 + t65*t35 + t66*t36 + t67*t37)
+        t75 = -t74 + t33
+        t76 = t34 - t64*t74
+        t77 = t35 - t65*t74
+        t78 = t36 - t66*t74
+        t79 = t37 - t67*t74
+        t80 = t63*(t40 + t64*t41 + t65*t42 + t66*t43 + t67*t44)
+        t81 = -t80 + t40
+        t82 = t41 - t64*t80
+        t83 = t42 - t65*t80
+        t84 = t43 - t66*t80
+        t85 = t44 - t67*t80
+        t86 = t63*(t47 + t64*t48 + t65*t49 + t66*t50 + t67*t51)
+        t87 = -t86 + t47
+        t88 = t48 - t64*t86
+        t89 = t49 - t65*t86
+        t90 = t50 - t66*t86
+        t91 = t51 - t67*t86
+        t92 = t63*(t54 + t64*t55 + t65*t56 + t66*t57 + t67*t58)
+        t93 = -t92 + t54
+        t94 = t55 - t64*t92
+        t95 = t56 - t65*t92
+        t96 = t57 - t66*t92
+        t97 = t58 - t67*t92
+        t98 = xp.sqrt(t70**2 + t71**2 + t72**2 + t73**2)
+        t99 = t98*xp.where(xp.greater_equal(t70, 0), xp.asarray(1, dtype=dtype), -1)
+        t100 = xp.greater(t98, 0)
+        t101 = xp.where(t100, 1/(t70 + t99), 0)
+        t102 = xp.where(t100, 1 + xp.abs(t70)/t98, 0)
+        t103 = t71*t101
+        t104 = t72*t101
+        t105 = t73*t101
+        t106 = t102*(t76 + t103*t77 + t104*t78 + t105*t79)
+        t107 = -t106 + t76
+        t108 = t77 - t103*t106
+        t109 = t78 - t104*t106
+        t110 = t79 - t105*t106
+        t111 = t102*(t82 + t103*t83 + t104*t84 + t105*t85)
+        t112 = -t111 + t82
+        t113 = t83 - t103*t111
+        t114 = t84 - t104*t111
+        t115 = t85 - t105*t111
+        t116 = t102*(t88 + t103*t89 + t104*t90 + t105*t91)
+        t117 = -t116 + t88
+        t118 = t89 - t103*t116
+        t119 = t90 - t104*t116
+        t120 = t91 - t105*t116
+        t121 = t102*(t94 + t103*t95 + t104*t96 + t105*t97)
+        t122 = -t121 + t94
+        t123 = t95 - t103*t121
+        t124 = t96 - t104*t121
+        t125 = t97 - t105*t121
+        t126 = xp.sqrt(t108**2 + t109**2 + t110**2)
+        t127 = t126*xp.where(xp.greater_equal(t108, 0), xp.asarray(1, dtype=dtype), -1)
+        t128 = xp.greater(t126, 0)
+        t129 = xp.where(t128, 1/(t108 + t127), 0)
+        t130 = xp.where(t128, 1 + xp.abs(t108)/t126, 0)
+        t131 = t109*t129
+        t132 = t110*t129
+        t133 = t130*(t113 + t131*t114 + t132*t115)
+        t134 = -t133 + t113
+        t135 = t114 - t131*t133
+        t136 = t115 - t132*t133
+        t137 = t130*(t118 + t131*t119 + t132*t120)
+        t138 = -t137 + t118
+        t139 = t119 - t131*t137
+        t140 = t120 - t132*t137
+        t141 = t130*(t123 + t131*t124 + t132*t125)
+        t142 = -t141 + t123
+        t143 = t124 - t131*t141
+        t144 = t125 - t132*t141
+        t145 = xp.sqrt(t135**2 + t136**2)
+        t146 = t145*xp.where(xp.greater_equal(t135, 0), xp.asarray(1, dtype=dtype), -1)
+        t147 = xp.greater(t145, 0)
+        t148 = xp.where(t147, 1/(t135 + t146), 0)
+        t149 = xp.where(t147, 1 + xp.abs(t135)/t145, 0)
+        t150 = t136*t148
+        t151 = t149*(t139 + t150*t140)
+        t152 = -t151 + t139
+        t153 = t140 - t150*t151
+        t154 = t149*(t143 + t150*t144)
+        t155 = -t154 + t143
+        t156 = t144 - t150*t154
+        t157 = xp.abs(t153)
+        t158 = t157*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
+        t159 = xp.where(xp.greater(t157, 0), xp.asarray(2, dtype=dtype), 0)
+        t160 = t156 - t156*t159
+        t161 = xp.where(xp.not_equal(t158, 0), -t160/t158, 0)
+        t162 = xp.where(xp.not_equal(t146, 0), -(t155 - t152*t161)/t146, 0)
+        t163 = xp.where(xp.not_equal(t127, 0), -(-(t134*t162 + t138*t161) + t142)/t127, 0)
+        t164 = xp.where(xp.not_equal(t99, 0), -(-(t107*t163 + t112*t162 + t117*t161) + t122)/t99, 0)
+        t165 = xp.where(xp.not_equal(t60, 0), -(-(t69*t164 + t75*t163 + t81*t162 + t87*t161) + t93)/t60, 0)
+        t166 = xp.where(xp.not_equal(t8, 0), -(-(t18*t165 + t25*t164 + t32*t163 + t39*t162 + t46*t161) + t53)/t8, 0)
+        t167 = 1e-12*t6
+        state = (
+            t166,
+            t165,
+            t164,
+            t163,
+            t162,
+            t161,
+            xp.where(xp.less_equal(t7, t167) | xp.less_equal(t59, t167) | xp.less_equal(t98, t167) | xp.less_equal(t126, t167) | xp.less_equal(t145, t167) | xp.less_equal(t157, t167), xp.asarray(1, dtype=dtype), 0),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _nearer_branch(xp, count, state):
+    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 119 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, = state
+        t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w8))
+        t1 = w1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w1 + w9))
+        t2 = w2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w2 + w10))
+        t3 = w3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w3 + w11))
+        t4 = w4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w4 + w12))
+        t5 = w5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w5 + w13))
+        t6 = xp.where(xp.less(t0, w8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t7 = t6 + t0
+        t8 = -t6 + t0
+        t9 = xp.where(xp.greater_equal(t0, -3.0543261909900767) & xp.less_equal(t0, 3.0543261909900767), t0, xp.where(xp.greater_equal(t7, -3.0543261909900767) & xp.less_equal(t7, 3.0543261909900767), t7, xp.where(xp.greater_equal(t8, -3.0543261909900767) & xp.less_equal(t8, 3.0543261909900767), t8, w0)))
+        t10 = xp.where(xp.less(t1, w9), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t11 = t10 + t1
+        t12 = -t10 + t1
+        t13 = xp.where(xp.greater_equal(t1, -3.822271061867582) & xp.less_equal(t1, 2.2863813201125716), t1, xp.where(xp.greater_equal(t11, -3.822271061867582) & xp.less_equal(t11, 2.2863813201125716), t11, xp.where(xp.greater_equal(t12, -3.822271061867582) & xp.less_equal(t12, 2.2863813201125716), t12, w1)))
+        t14 = xp.where(xp.less(t2, w10), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t15 = t14 + t2
+        t16 = -t14 + t2
+        t17 = xp.where(xp.greater_equal(t2, -3.0543261909900767) & xp.less_equal(t2, 3.0543261909900767), t2, xp.where(xp.greater_equal(t15, -3.0543261909900767) & xp.less_equal(t15, 3.0543261909900767), t15, xp.where(xp.greater_equal(t16, -3.0543261909900767) & xp.less_equal(t16, 3.0543261909900767), t16, w2)))
+        t18 = xp.where(xp.less(t3, w11), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t19 = t18 + t3
+        t20 = -t18 + t3
+        t21 = xp.where(xp.greater_equal(t3, -3.0543261909900767) & xp.less_equal(t3, 3.0543261909900767), t3, xp.where(xp.greater_equal(t19, -3.0543261909900767) & xp.less_equal(t19, 3.0543261909900767), t19, xp.where(xp.greater_equal(t20, -3.0543261909900767) & xp.less_equal(t20, 3.0543261909900767), t20, w3)))
+        t22 = xp.where(xp.less(t4, w12), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t23 = t22 + t4
+        t24 = -t22 + t4
+        t25 = xp.where(xp.greater_equal(t4, -2.9670597283903604) & xp.less_equal(t4, 2.9670597283903604), t4, xp.where(xp.greater_equal(t23, -2.9670597283903604) & xp.less_equal(t23, 2.9670597283903604), t23, xp.where(xp.greater_equal(t24, -2.9670597283903604) & xp.less_equal(t24, 2.9670597283903604), t24, w4)))
+        t26 = xp.where(xp.less(t5, w13), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t27 = t26 + t5
+        t28 = -t26 + t5
+        t29 = xp.where(xp.greater_equal(t5, -2.9670597283903604) & xp.less_equal(t5, 2.9670597283903604), t5, xp.where(xp.greater_equal(t27, -2.9670597283903604) & xp.less_equal(t27, 2.9670597283903604), t27, xp.where(xp.greater_equal(t28, -2.9670597283903604) & xp.less_equal(t28, 2.9670597283903604), t28, w5)))
+        t30 = w15*(-w8 + t9)**2 + w16*(-w9 + t13)**2 + w17*(-w10 + t17)**2 + w18*(-w11 + t21)**2 + w19*(-w12 + t25)**2 + w20*(-w13 + t29)**2 + w21*(-w14 + w6)**2
+        t31 = xp.greater(w7, 0)
+        t32 = xp.where(t31 & (xp.less(w30, 1) | xp.less(t30, w29)), xp.asarray(1, dtype=dtype), 0)
+        t33 = xp.where(t31, 1, w30)
+        t34 = xp.greater(t32, 0)
+        t35 = xp.where(t34, t9, w22)
+        t36 = xp.where(t34, t13, w23)
+        t37 = xp.where(t34, t17, w24)
+        t38 = xp.where(t34, t21, w25)
+        t39 = xp.where(t34, t25, w26)
+        t40 = xp.where(t34, t29, w27)
+        t41 = xp.where(t34, w6, w28)
+        t42 = xp.where(t34, t30, w29)
+        state = (
+            t35,
+            t36,
+            t37,
+            t38,
+            t39,
+            t40,
+            t41,
+            t42,
+            t33,
         )
     return state
 
@@ -4469,7 +4722,7 @@ def condition_number(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (7 x 1 and 1 x 1), 1032 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (7 x 1 and 1 x 1), 1034 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (7,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -4585,208 +4838,41 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t85 = -t69 - t6*t3 + t10*t22 - t12*t24 + t13*t25 + t69*t83
     t86 = t3**2 + t22**2 + t24**2 + t25**2 + t65 + t77*t83
     t87 = 1 + c2**2 + t40**2 + t43**2 + t44**2 + s3**2*t83
-    t88 = t70**2
-    t89 = t72**2
-    t90 = t75**2
-    t91 = t66**2
-    t92 = t60**2
-    t93 = damping**2
-    t94 = t93 + t68
-    t95 = t94**2
-    t96 = xp.sqrt(t88 + t89 + t90 + t91 + t92 + t95)
-    t97 = t96*xp.where(xp.greater_equal(t94, 0), xp.asarray(1, dtype=dtype), -1)
-    t98 = t93 + t78
-    t99 = t93 + t37
-    t100 = t93 + t84
-    t101 = t93 + t86
-    t102 = t93 + t87
-    t103 = xp.sqrt(2*t88 + 2*t89 + 2*t81**2 + 2*t90 + 2*t79**2 + 2*t82**2 + 2*t91 + 2*t76**2 + 2*t73**2 + 2*t85**2 + 2*t92 + 2*t63**2 + 2*t55**2 + 2*t56**2 + 2*t57**2 + t95 + t98**2 + t99**2 + t100**2 + t101**2 + t102**2)
-    t104 = xp.greater(t96, 0)
-    t105 = xp.where(t104, 1/(t94 + t97), 0)
-    t106 = xp.where(t104, 1 + xp.abs(t94)/t96, 0)
-    t107 = t70*t105
-    t108 = t72*t105
-    t109 = t75*t105
-    t110 = t66*t105
-    t111 = t60*t105
-    t112 = t106*(t70 + t109*t79 + t98*t107 + t108*t81 + t110*t76 - t111*t63)
-    t113 = -t112 + t70
-    t114 = t98 - t107*t112
-    t115 = t81 - t108*t112
-    t116 = -t79 + t109*t112
-    t117 = t76 - t110*t112
-    t118 = t63 + t111*t112
-    t119 = t106*(t72 - t110*t73 + t107*t81 + t99*t108 - t109*t82 - t111*t55)
-    t120 = -t119 + t72
-    t121 = t81 - t107*t119
-    t122 = t99 - t108*t119
-    t123 = t82 + t109*t119
-    t124 = t73 + t110*t119
-    t125 = t55 + t111*t119
-    t126 = -t106*(t75 + t100*t109 + t111*t56 + t107*t79 - t108*t82 - t110*t85)
-    t127 = t75 + t126
-    t128 = t79 + t107*t126
-    t129 = t82 - t108*t126
-    t130 = t100 + t109*t126
-    t131 = t85 - t110*t126
-    t132 = t56 + t111*t126
-    t133 = t106*(t66 + t101*t110 + t107*t76 - t108*t73 - t109*t85 - t111*t57)
-    t134 = -t133 + t66
-    t135 = t76 - t107*t133
-    t136 = t73 + t108*t133
-    t137 = t85 + t109*t133
-    t138 = t101 - t110*t133
-    t139 = t57 + t111*t133
-    t140 = t106*(-t60 + t107*t63 + t108*t55 - t109*t56 + t110*t57 - t102*t111)
-    t141 = t60 + t140
-    t142 = t63 - t107*t140
-    t143 = t55 - t108*t140
-    t144 = t56 + t109*t140
-    t145 = t57 - t110*t140
-    t146 = t102 + t111*t140
-    t147 = xp.sqrt(t114**2 + t115**2 + t116**2 + t117**2 + t118**2)
-    t148 = t147*xp.where(xp.greater_equal(t114, 0), xp.asarray(1, dtype=dtype), -1)
-    t149 = t106*(mu_dot0 + t107*mu_dot1 + t108*mu_dot2 - t109*mu_dot3 + t110*mu_dot4 - t111*mu_dot5)
-    t150 = -t149 + mu_dot0
-    t151 = mu_dot1 - t107*t149
-    t152 = mu_dot2 - t108*t149
-    t153 = mu_dot3 + t109*t149
-    t154 = mu_dot4 - t110*t149
-    t155 = mu_dot5 + t111*t149
-    t156 = xp.greater(t147, 0)
-    t157 = xp.where(t156, 1/(t114 + t148), 0)
-    t158 = xp.where(t156, 1 + xp.abs(t114)/t147, 0)
-    t159 = t115*t157
-    t160 = t116*t157
-    t161 = t117*t157
-    t162 = t118*t157
-    t163 = t158*(t121 + t159*t122 + t160*t123 - t161*t124 + t162*t125)
-    t164 = -t163 + t121
-    t165 = t122 - t159*t163
-    t166 = t123 - t160*t163
-    t167 = t124 + t161*t163
-    t168 = t125 - t162*t163
-    t169 = t158*(-t128 + t159*t129 + t160*t130 + t161*t131 + t162*t132)
-    t170 = t128 + t169
-    t171 = t129 - t159*t169
-    t172 = t130 - t160*t169
-    t173 = t131 - t161*t169
-    t174 = t132 - t162*t169
-    t175 = t158*(t135 - t159*t136 + t160*t137 + t161*t138 + t162*t139)
-    t176 = -t175 + t135
-    t177 = t136 + t159*t175
-    t178 = t137 - t160*t175
-    t179 = t138 - t161*t175
-    t180 = t139 - t162*t175
-    t181 = t158*(t142 + t159*t143 + t160*t144 + t161*t145 + t162*t146)
-    t182 = -t181 + t142
-    t183 = t143 - t159*t181
-    t184 = t144 - t160*t181
-    t185 = t145 - t161*t181
-    t186 = t146 - t162*t181
-    t187 = xp.sqrt(t165**2 + t166**2 + t167**2 + t168**2)
-    t188 = t187*xp.where(xp.greater_equal(t165, 0), xp.asarray(1, dtype=dtype), -1)
-    t189 = t158*(t151 + t159*t152 + t160*t153 + t161*t154 + t162*t155)
-    t190 = -t189 + t151
-    t191 = t152 - t159*t189
-    t192 = t153 - t160*t189
-    t193 = t154 - t161*t189
-    t194 = t155 - t162*t189
-    t195 = xp.greater(t187, 0)
-    t196 = xp.where(t195, 1/(t165 + t188), 0)
-    t197 = xp.where(t195, 1 + xp.abs(t165)/t187, 0)
-    t198 = t166*t196
-    t199 = t167*t196
-    t200 = t168*t196
-    t201 = t197*(t171 + t198*t172 - t199*t173 + t200*t174)
-    t202 = -t201 + t171
-    t203 = t172 - t198*t201
-    t204 = t173 + t199*t201
-    t205 = t174 - t200*t201
-    t206 = t197*(-t177 + t198*t178 - t199*t179 + t200*t180)
-    t207 = t177 + t206
-    t208 = t178 - t198*t206
-    t209 = t179 + t199*t206
-    t210 = t180 - t200*t206
-    t211 = t197*(t183 + t198*t184 - t199*t185 + t200*t186)
-    t212 = -t211 + t183
-    t213 = t184 - t198*t211
-    t214 = t185 + t199*t211
-    t215 = t186 - t200*t211
-    t216 = xp.sqrt(t203**2 + t204**2 + t205**2)
-    t217 = t216*xp.where(xp.greater_equal(t203, 0), xp.asarray(1, dtype=dtype), -1)
-    t218 = t197*(t191 + t198*t192 - t199*t193 + t200*t194)
-    t219 = -t218 + t191
-    t220 = t192 - t198*t218
-    t221 = t193 + t199*t218
-    t222 = t194 - t200*t218
-    t223 = xp.greater(t216, 0)
-    t224 = xp.where(t223, 1/(t203 + t217), 0)
-    t225 = xp.where(t223, 1 + xp.abs(t203)/t216, 0)
-    t226 = t204*t224
-    t227 = t205*t224
-    t228 = t225*(t208 + t226*t209 + t227*t210)
-    t229 = -t228 + t208
-    t230 = t209 - t226*t228
-    t231 = t210 - t227*t228
-    t232 = t225*(t213 + t226*t214 + t227*t215)
-    t233 = -t232 + t213
-    t234 = t214 - t226*t232
-    t235 = t215 - t227*t232
-    t236 = xp.sqrt(t230**2 + t231**2)
-    t237 = t236*xp.where(xp.greater_equal(t230, 0), xp.asarray(1, dtype=dtype), -1)
-    t238 = t225*(t220 + t226*t221 + t227*t222)
-    t239 = -t238 + t220
-    t240 = t221 - t226*t238
-    t241 = t222 - t227*t238
-    t242 = xp.greater(t236, 0)
-    t243 = xp.where(t242, 1/(t230 + t237), 0)
-    t244 = xp.where(t242, 1 + xp.abs(t230)/t236, 0)
-    t245 = t231*t243
-    t246 = t244*(t234 + t245*t235)
-    t247 = -t246 + t234
-    t248 = t235 - t245*t246
-    t249 = t244*(t240 + t245*t241)
-    t250 = -t249 + t240
-    t251 = t241 - t245*t249
-    t252 = xp.abs(t248)
-    t253 = t252*xp.where(xp.greater_equal(t248, 0), xp.asarray(1, dtype=dtype), -1)
-    t254 = xp.where(xp.greater(t252, 0), xp.asarray(2, dtype=dtype), 0)
-    t255 = t251 - t254*t251
-    t256 = xp.where(xp.not_equal(t253, 0), -t255/t253, 0)
-    t257 = xp.where(xp.not_equal(t237, 0), -(t250 - t247*t256)/t237, 0)
-    t258 = xp.where(xp.not_equal(t217, 0), -(-(t229*t257 + t233*t256) + t239)/t217, 0)
-    t259 = xp.where(xp.not_equal(t188, 0), -(-(t202*t258 - t207*t257 + t212*t256) + t219)/t188, 0)
-    t260 = xp.where(xp.not_equal(t148, 0), -(-(t164*t259 - t170*t258 + t176*t257 + t182*t256) + t190)/t148, 0)
-    t261 = xp.where(xp.not_equal(t97, 0), -(-(t113*t260 + t120*t259 - t127*t258 + t134*t257 - t141*t256) + t150)/t97, 0)
-    t262 = t256 - t31*t261 + t19*t260
-    t263 = -t32*t259 - s1*t258 + c1*t257 + t61*t261 + t58*t260
-    t264 = t59*t261 + t62*t260 + t33*t259 - c2*t256 - t8*t258 - t20*t257
-    t265 = -t49*t261 + t52*t260 + t34*t259 + t6*t258 - t3*t257 + t41*t256
-    t266 = t50*t261 + t53*t260 + t35*t259 + t10*t258 + t22*t257 + t40*t256
-    t267 = t51*t261 + t54*t260 + t36*t259 - t12*t258 + t24*t257 - t43*t256
-    t268 = t13*t258 + t25*t257 + t44*t256
-    t269 = xp.isfinite(t64)
-    t270 = xp.greater_equal(damping, 0)
-    t271 = 1e-12*t103
-    t272 = xp.less_equal(t96, t271) | xp.less_equal(t147, t271) | xp.less_equal(t187, t271) | xp.less_equal(t216, t271) | xp.less_equal(t236, t271) | xp.less_equal(t252, t271)
-    t273 = t269 & t270 & xp.logical_not(t272)
+    t88 = damping**2
+    t89 = _symmetric_solve6(xp, 1, (t88 + t68, t70, t72, -t75, t66, -t60, t88 + t78, t81, -t79, t76, t63, t88 + t37, t82, -t73, t55, t88 + t84, t85, t56, t88 + t86, t57, t88 + t87, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t90 = t89[5]
+    t91 = t89[0]
+    t92 = t89[1]
+    t93 = t90 - t31*t91 + t19*t92
+    t94 = t89[2]
+    t95 = t89[3]
+    t96 = t89[4]
+    t97 = c1*t96 + t61*t91 + t58*t92 - t32*t94 - s1*t95
+    t98 = t33*t94 + t91*t59 + t92*t62 - t8*t95 - t20*t96 - c2*t90
+    t99 = t34*t94 - t91*t49 + t92*t52 + t6*t95 - t3*t96 + t41*t90
+    t100 = t91*t50 + t92*t53 + t35*t94 + t10*t95 + t22*t96 + t40*t90
+    t101 = t91*t51 + t92*t54 + t36*t94 - t12*t95 + t24*t96 - t43*t90
+    t102 = t13*t95 + t25*t96 + t44*t90
+    t103 = xp.isfinite(t64)
+    t104 = xp.greater_equal(damping, 0)
+    t105 = t89[6]
+    t106 = t103 & t104 & xp.less_equal(t105, 0)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t273, t262, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t273, t263, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t273, t264, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t273, t265, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t273, t266, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t273, t267, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t273, -t268, 0), batch),  # 6
+        xp.broadcast_to(xp.where(t106, t93, 0), batch),  # 0
+        xp.broadcast_to(xp.where(t106, t97, 0), batch),  # 1
+        xp.broadcast_to(xp.where(t106, t98, 0), batch),  # 2
+        xp.broadcast_to(xp.where(t106, t99, 0), batch),  # 3
+        xp.broadcast_to(xp.where(t106, t100, 0), batch),  # 4
+        xp.broadcast_to(xp.where(t106, t101, 0), batch),  # 5
+        xp.broadcast_to(xp.where(t106, -t102, 0), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t269 & t270), 2, xp.where(t272, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t103 & t104), 2, xp.where(xp.greater(t105, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
-    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1114 operations."""
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1116 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (7,)), ("mu_dot", mu_dot, (6,)), ("z", z, (7,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -4917,215 +5003,48 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     t93 = s1*qz2
     t94 = -(t19*qz1 + t64*qz3 + t53*qz4 + t54*qz5 + t55*qz6 + t49*t93) + mu_dot1
     t95 = t93 + mu_dot3 + t12*qz6 + t13*qz7 + t8*qz3 - t6*qz4 - t10*qz5
-    t96 = t72**2
-    t97 = t74**2
-    t98 = t77**2
-    t99 = t68**2
-    t100 = t62**2
-    t101 = damping**2
-    t102 = t101 + t70
-    t103 = t102**2
-    t104 = xp.sqrt(t96 + t97 + t98 + t99 + t100 + t103)
-    t105 = t104*xp.where(xp.greater_equal(t102, 0), xp.asarray(1, dtype=dtype), -1)
-    t106 = t101 + t80
-    t107 = t101 + t37
-    t108 = t101 + t86
-    t109 = t101 + t88
-    t110 = t101 + t89
-    t111 = xp.sqrt(2*t96 + 2*t97 + 2*t83**2 + 2*t98 + 2*t81**2 + 2*t84**2 + 2*t99 + 2*t78**2 + 2*t75**2 + 2*t87**2 + 2*t100 + 2*t65**2 + 2*t56**2 + 2*t57**2 + 2*t58**2 + t103 + t106**2 + t107**2 + t108**2 + t109**2 + t110**2)
-    t112 = xp.greater(t104, 0)
-    t113 = xp.where(t112, 1/(t102 + t105), 0)
-    t114 = xp.where(t112, 1 + xp.abs(t102)/t104, 0)
-    t115 = t72*t113
-    t116 = t74*t113
-    t117 = t77*t113
-    t118 = t68*t113
-    t119 = t62*t113
-    t120 = t114*(t72 + t106*t115 + t116*t83 + t117*t81 + t118*t78 - t119*t65)
-    t121 = -t120 + t72
-    t122 = t106 - t115*t120
-    t123 = t83 - t116*t120
-    t124 = -t81 + t117*t120
-    t125 = t78 - t118*t120
-    t126 = t65 + t119*t120
-    t127 = t114*(t74 + t115*t83 + t107*t116 - t117*t84 - t118*t75 - t119*t56)
-    t128 = -t127 + t74
-    t129 = t83 - t115*t127
-    t130 = t107 - t116*t127
-    t131 = t84 + t117*t127
-    t132 = t75 + t118*t127
-    t133 = t56 + t119*t127
-    t134 = -t114*(t77 + t115*t81 - t116*t84 + t108*t117 - t118*t87 + t119*t57)
-    t135 = t77 + t134
-    t136 = t81 + t115*t134
-    t137 = t84 - t116*t134
-    t138 = t108 + t117*t134
-    t139 = t87 - t118*t134
-    t140 = t57 + t119*t134
-    t141 = t114*(t68 + t115*t78 - t116*t75 - t117*t87 + t109*t118 - t119*t58)
-    t142 = -t141 + t68
-    t143 = t78 - t115*t141
-    t144 = t75 + t116*t141
-    t145 = t87 + t117*t141
-    t146 = t109 - t118*t141
-    t147 = t58 + t119*t141
-    t148 = t114*(-t62 + t115*t65 + t116*t56 - t117*t57 + t118*t58 - t110*t119)
-    t149 = t62 + t148
-    t150 = t65 - t115*t148
-    t151 = t56 - t116*t148
-    t152 = t57 + t117*t148
-    t153 = t58 - t118*t148
-    t154 = t110 + t119*t148
-    t155 = t114*(t91 + t115*t94 + t116*t38 - t117*t95 + t118*t92 - t119*t59)
-    t156 = -t155 + t91
-    t157 = t94 - t115*t155
-    t158 = t38 - t116*t155
-    t159 = t95 + t117*t155
-    t160 = t92 - t118*t155
-    t161 = t59 + t119*t155
-    t162 = xp.sqrt(t122**2 + t123**2 + t124**2 + t125**2 + t126**2)
-    t163 = t162*xp.where(xp.greater_equal(t122, 0), xp.asarray(1, dtype=dtype), -1)
-    t164 = xp.greater(t162, 0)
-    t165 = xp.where(t164, 1/(t122 + t163), 0)
-    t166 = xp.where(t164, 1 + xp.abs(t122)/t162, 0)
-    t167 = t123*t165
-    t168 = t124*t165
-    t169 = t125*t165
-    t170 = t126*t165
-    t171 = t166*(t129 + t167*t130 + t168*t131 - t169*t132 + t170*t133)
-    t172 = -t171 + t129
-    t173 = t130 - t167*t171
-    t174 = t131 - t168*t171
-    t175 = t132 + t169*t171
-    t176 = t133 - t170*t171
-    t177 = t166*(-t136 + t167*t137 + t168*t138 + t169*t139 + t170*t140)
-    t178 = t136 + t177
-    t179 = t137 - t167*t177
-    t180 = t138 - t168*t177
-    t181 = t139 - t169*t177
-    t182 = t140 - t170*t177
-    t183 = t166*(t143 - t167*t144 + t168*t145 + t169*t146 + t170*t147)
-    t184 = -t183 + t143
-    t185 = t144 + t167*t183
-    t186 = t145 - t168*t183
-    t187 = t146 - t169*t183
-    t188 = t147 - t170*t183
-    t189 = t166*(t150 + t167*t151 + t168*t152 + t169*t153 + t170*t154)
-    t190 = -t189 + t150
-    t191 = t151 - t167*t189
-    t192 = t152 - t168*t189
-    t193 = t153 - t169*t189
-    t194 = t154 - t170*t189
-    t195 = t166*(t157 + t167*t158 + t168*t159 + t169*t160 + t170*t161)
-    t196 = -t195 + t157
-    t197 = t158 - t167*t195
-    t198 = t159 - t168*t195
-    t199 = t160 - t169*t195
-    t200 = t161 - t170*t195
-    t201 = xp.sqrt(t173**2 + t174**2 + t175**2 + t176**2)
-    t202 = t201*xp.where(xp.greater_equal(t173, 0), xp.asarray(1, dtype=dtype), -1)
-    t203 = xp.greater(t201, 0)
-    t204 = xp.where(t203, 1/(t173 + t202), 0)
-    t205 = xp.where(t203, 1 + xp.abs(t173)/t201, 0)
-    t206 = t174*t204
-    t207 = t175*t204
-    t208 = t176*t204
-    t209 = t205*(t179 + t206*t180 - t207*t181 + t208*t182)
-    t210 = -t209 + t179
-    t211 = t180 - t206*t209
-    t212 = t181 + t207*t209
-    t213 = t182 - t208*t209
-    t214 = t205*(-t185 + t206*t186 - t207*t187 + t208*t188)
-    t215 = t185 + t214
-    t216 = t186 - t206*t214
-    t217 = t187 + t207*t214
-    t218 = t188 - t208*t214
-    t219 = t205*(t191 + t206*t192 - t207*t193 + t208*t194)
-    t220 = -t219 + t191
-    t221 = t192 - t206*t219
-    t222 = t193 + t207*t219
-    t223 = t194 - t208*t219
-    t224 = t205*(t197 + t206*t198 - t207*t199 + t208*t200)
-    t225 = -t224 + t197
-    t226 = t198 - t206*t224
-    t227 = t199 + t207*t224
-    t228 = t200 - t208*t224
-    t229 = xp.sqrt(t211**2 + t212**2 + t213**2)
-    t230 = t229*xp.where(xp.greater_equal(t211, 0), xp.asarray(1, dtype=dtype), -1)
-    t231 = xp.greater(t229, 0)
-    t232 = xp.where(t231, 1/(t211 + t230), 0)
-    t233 = xp.where(t231, 1 + xp.abs(t211)/t229, 0)
-    t234 = t212*t232
-    t235 = t213*t232
-    t236 = t233*(t216 + t234*t217 + t235*t218)
-    t237 = -t236 + t216
-    t238 = t217 - t234*t236
-    t239 = t218 - t235*t236
-    t240 = t233*(t221 + t234*t222 + t235*t223)
-    t241 = -t240 + t221
-    t242 = t222 - t234*t240
-    t243 = t223 - t235*t240
-    t244 = t233*(t226 + t234*t227 + t235*t228)
-    t245 = -t244 + t226
-    t246 = t227 - t234*t244
-    t247 = t228 - t235*t244
-    t248 = xp.sqrt(t238**2 + t239**2)
-    t249 = t248*xp.where(xp.greater_equal(t238, 0), xp.asarray(1, dtype=dtype), -1)
-    t250 = xp.greater(t248, 0)
-    t251 = xp.where(t250, 1/(t238 + t249), 0)
-    t252 = xp.where(t250, 1 + xp.abs(t238)/t248, 0)
-    t253 = t239*t251
-    t254 = t252*(t242 + t253*t243)
-    t255 = -t254 + t242
-    t256 = t243 - t253*t254
-    t257 = t252*(t246 + t253*t247)
-    t258 = -t257 + t246
-    t259 = t247 - t253*t257
-    t260 = xp.abs(t256)
-    t261 = t260*xp.where(xp.greater_equal(t256, 0), xp.asarray(1, dtype=dtype), -1)
-    t262 = xp.where(xp.greater(t260, 0), xp.asarray(2, dtype=dtype), 0)
-    t263 = t259 - t259*t262
-    t264 = xp.where(xp.not_equal(t261, 0), -t263/t261, 0)
-    t265 = xp.where(xp.not_equal(t249, 0), -(t258 - t255*t264)/t249, 0)
-    t266 = xp.where(xp.not_equal(t230, 0), -(-(t237*t265 + t241*t264) + t245)/t230, 0)
-    t267 = xp.where(xp.not_equal(t202, 0), -(-(t210*t266 - t215*t265 + t220*t264) + t225)/t202, 0)
-    t268 = xp.where(xp.not_equal(t163, 0), -(-(t172*t267 - t178*t266 + t184*t265 + t190*t264) + t196)/t163, 0)
-    t269 = xp.where(xp.not_equal(t105, 0), -(-(t121*t268 + t128*t267 - t135*t266 + t142*t265 - t149*t264) + t156)/t105, 0)
-    t270 = t264 - t31*t269 + t19*t268
-    t271 = -t32*t267 - s1*t266 + c1*t265 + t63*t269 + t60*t268
-    t272 = t61*t269 + t64*t268 + t33*t267 - c2*t264 - t8*t266 - t20*t265
-    t273 = -t50*t269 + t53*t268 + t34*t267 + t6*t266 - t3*t265 + t42*t264
-    t274 = t51*t269 + t54*t268 + t35*t267 + t10*t266 + t22*t265 + t41*t264
-    t275 = t52*t269 + t55*t268 + t36*t267 - t12*t266 + t24*t265 - t44*t264
-    t276 = t13*t266 + t25*t265 + t45*t264
-    t277 = qz1 + t270
-    t278 = qz2 + t271
-    t279 = qz3 + t272
-    t280 = qz4 + t273
-    t281 = qz5 + t274
-    t282 = qz6 + t275
-    t283 = -t276 + qz7
-    t284 = xp.isfinite(t66)
-    t285 = xp.greater_equal(damping, 0)
-    t286 = 1e-12*t111
-    t287 = xp.less_equal(t104, t286) | xp.less_equal(t162, t286) | xp.less_equal(t201, t286) | xp.less_equal(t229, t286) | xp.less_equal(t248, t286) | xp.less_equal(t260, t286)
-    t288 = t284 & t285 & xp.logical_not(t287)
+    t96 = damping**2
+    t97 = _symmetric_solve6(xp, 1, (t96 + t70, t72, t74, -t77, t68, -t62, t96 + t80, t83, -t81, t78, t65, t96 + t37, t84, -t75, t56, t96 + t86, t87, t57, t96 + t88, t58, t96 + t89, t91, t94, t38, t95, t92, t59,))
+    t98 = t97[5]
+    t99 = t97[0]
+    t100 = t97[1]
+    t101 = t98 - t31*t99 + t19*t100
+    t102 = qz1 + t101
+    t103 = t97[2]
+    t104 = t97[3]
+    t105 = t97[4]
+    t106 = t63*t99 + t60*t100 - t32*t103 - s1*t104 + c1*t105
+    t107 = -c2*t98 + t61*t99 + t64*t100 + t33*t103 - t8*t104 - t20*t105
+    t108 = -t3*t105 - t50*t99 + t53*t100 + t34*t103 + t6*t104 + t42*t98
+    t109 = t41*t98 + t51*t99 + t54*t100 + t35*t103 + t10*t104 + t22*t105
+    t110 = t36*t103 + t52*t99 + t55*t100 - t12*t104 + t24*t105 - t44*t98
+    t111 = t45*t98 + t13*t104 + t25*t105
+    t112 = qz2 + t106
+    t113 = qz3 + t107
+    t114 = qz4 + t108
+    t115 = qz5 + t109
+    t116 = qz6 + t110
+    t117 = -t111 + qz7
+    t118 = xp.isfinite(t66)
+    t119 = xp.greater_equal(damping, 0)
+    t120 = t97[6]
+    t121 = t118 & t119 & xp.less_equal(t120, 0)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t288, t277, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t288, t278, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t288, t279, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t288, t280, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t288, t281, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t288, t282, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t288, t283, 0), batch),  # 6
+        xp.broadcast_to(xp.where(t121, t102, 0), batch),  # 0
+        xp.broadcast_to(xp.where(t121, t112, 0), batch),  # 1
+        xp.broadcast_to(xp.where(t121, t113, 0), batch),  # 2
+        xp.broadcast_to(xp.where(t121, t114, 0), batch),  # 3
+        xp.broadcast_to(xp.where(t121, t115, 0), batch),  # 4
+        xp.broadcast_to(xp.where(t121, t116, 0), batch),  # 5
+        xp.broadcast_to(xp.where(t121, t117, 0), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t284 & t285), 2, xp.where(t287, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t118 & t119), 2, xp.where(xp.greater(t120, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1276 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1278 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (7,)), ("target", target, (4, 4)), ("target_rate", target_rate, (6,)), ("gain", gain, (6,)), ("z", z, (7,)), ("damping", damping, ()), every=("gain", ))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -5293,244 +5212,77 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t110 = -t94 - t6*t3 + t10*t29 - t12*t31 + t14*t33 + t94*t108
     t111 = t3**2 + t29**2 + t31**2 + t33**2 + t90 + t102*t108
     t112 = 1 + c2**2 + t54**2 + t57**2 + t59**2 + s3**2*t108
-    t113 = t95**2
-    t114 = t97**2
-    t115 = t100**2
-    t116 = t91**2
-    t117 = t86**2
-    t118 = damping**2
-    t119 = t118 + t93
-    t120 = t119**2
-    t121 = xp.sqrt(t113 + t114 + t115 + t116 + t117 + t120)
-    t122 = t121*xp.where(xp.greater_equal(t119, 0), xp.asarray(1, dtype=dtype), -1)
-    t123 = t118 + t103
-    t124 = t118 + t47
-    t125 = t118 + t109
-    t126 = t118 + t111
-    t127 = t118 + t112
-    t128 = xp.sqrt(2*t113 + 2*t114 + 2*t106**2 + 2*t115 + 2*t104**2 + 2*t107**2 + 2*t116 + 2*t101**2 + 2*t98**2 + 2*t110**2 + 2*t117 + 2*t89**2 + 2*t73**2 + 2*t74**2 + 2*t75**2 + t120 + t123**2 + t124**2 + t125**2 + t126**2 + t127**2)
-    t129 = xp.greater(t121, 0)
-    t130 = xp.where(t129, 1/(t119 + t122), 0)
-    t131 = xp.where(t129, 1 + xp.abs(t119)/t121, 0)
-    t132 = t95*t130
-    t133 = t97*t130
-    t134 = t100*t130
-    t135 = t91*t130
-    t136 = t86*t130
-    t137 = t131*(t95 + t134*t104 + t123*t132 + t133*t106 + t135*t101 - t136*t89)
-    t138 = -t137 + t95
-    t139 = t123 - t132*t137
-    t140 = t106 - t133*t137
-    t141 = -t104 + t134*t137
-    t142 = t101 - t135*t137
-    t143 = t89 + t136*t137
-    t144 = t131*(t97 - t135*t98 + t132*t106 + t124*t133 - t134*t107 - t136*t73)
-    t145 = -t144 + t97
-    t146 = t106 - t132*t144
-    t147 = t124 - t133*t144
-    t148 = t107 + t134*t144
-    t149 = t98 + t135*t144
-    t150 = t73 + t136*t144
-    t151 = -t131*(t100 + t125*t134 + t136*t74 + t132*t104 - t133*t107 - t135*t110)
-    t152 = t100 + t151
-    t153 = t104 + t132*t151
-    t154 = t107 - t133*t151
-    t155 = t125 + t134*t151
-    t156 = t110 - t135*t151
-    t157 = t74 + t136*t151
-    t158 = t131*(t91 + t126*t135 + t132*t101 - t133*t98 - t134*t110 - t136*t75)
-    t159 = -t158 + t91
-    t160 = t101 - t132*t158
-    t161 = t98 + t133*t158
-    t162 = t110 + t134*t158
-    t163 = t126 - t135*t158
-    t164 = t75 + t136*t158
-    t165 = t131*(-t86 + t132*t89 + t133*t73 - t134*t74 + t135*t75 - t127*t136)
-    t166 = t86 + t165
-    t167 = t89 - t132*t165
-    t168 = t73 - t133*t165
-    t169 = t74 + t134*t165
-    t170 = t75 - t135*t165
-    t171 = t127 + t136*t165
-    t172 = xp.sqrt(t139**2 + t140**2 + t141**2 + t142**2 + t143**2)
-    t173 = t172*xp.where(xp.greater_equal(t139, 0), xp.asarray(1, dtype=dtype), -1)
-    t174 = xp.greater(t172, 0)
-    t175 = xp.where(t174, 1/(t139 + t173), 0)
-    t176 = xp.where(t174, 1 + xp.abs(t139)/t172, 0)
-    t177 = t140*t175
-    t178 = t141*t175
-    t179 = t142*t175
-    t180 = t143*t175
-    t181 = t176*(t146 + t177*t147 + t178*t148 - t179*t149 + t180*t150)
-    t182 = -t181 + t146
-    t183 = t147 - t177*t181
-    t184 = t148 - t178*t181
-    t185 = t149 + t179*t181
-    t186 = t150 - t180*t181
-    t187 = t176*(-t153 + t177*t154 + t178*t155 + t179*t156 + t180*t157)
-    t188 = t153 + t187
-    t189 = t154 - t177*t187
-    t190 = t155 - t178*t187
-    t191 = t156 - t179*t187
-    t192 = t157 - t180*t187
-    t193 = t176*(t160 - t177*t161 + t178*t162 + t179*t163 + t180*t164)
-    t194 = -t193 + t160
-    t195 = t161 + t177*t193
-    t196 = t162 - t178*t193
-    t197 = t163 - t179*t193
-    t198 = t164 - t180*t193
-    t199 = t176*(t167 + t177*t168 + t178*t169 + t179*t170 + t180*t171)
-    t200 = -t199 + t167
-    t201 = t168 - t177*t199
-    t202 = t169 - t178*t199
-    t203 = t170 - t179*t199
-    t204 = t171 - t180*t199
-    t205 = xp.sqrt(t183**2 + t184**2 + t185**2 + t186**2)
-    t206 = t205*xp.where(xp.greater_equal(t183, 0), xp.asarray(1, dtype=dtype), -1)
-    t207 = xp.greater(t205, 0)
-    t208 = xp.where(t207, 1/(t183 + t206), 0)
-    t209 = xp.where(t207, 1 + xp.abs(t183)/t205, 0)
-    t210 = t184*t208
-    t211 = t185*t208
-    t212 = t186*t208
-    t213 = t209*(t189 + t210*t190 - t211*t191 + t212*t192)
-    t214 = -t213 + t189
-    t215 = t190 - t210*t213
-    t216 = t191 + t211*t213
-    t217 = t192 - t212*t213
-    t218 = t209*(-t195 + t210*t196 - t211*t197 + t212*t198)
-    t219 = t195 + t218
-    t220 = t196 - t210*t218
-    t221 = t197 + t211*t218
-    t222 = t198 - t212*t218
-    t223 = t209*(t201 + t210*t202 - t211*t203 + t212*t204)
-    t224 = -t223 + t201
-    t225 = t202 - t210*t223
-    t226 = t203 + t211*t223
-    t227 = t204 - t212*t223
-    t228 = xp.sqrt(t215**2 + t216**2 + t217**2)
-    t229 = t228*xp.where(xp.greater_equal(t215, 0), xp.asarray(1, dtype=dtype), -1)
-    t230 = xp.greater(t228, 0)
-    t231 = xp.where(t230, 1/(t215 + t229), 0)
-    t232 = xp.where(t230, 1 + xp.abs(t215)/t228, 0)
-    t233 = t216*t231
-    t234 = t217*t231
-    t235 = t232*(t220 + t233*t221 + t234*t222)
-    t236 = -t235 + t220
-    t237 = t221 - t233*t235
-    t238 = t222 - t234*t235
-    t239 = t232*(t225 + t233*t226 + t234*t227)
-    t240 = -t239 + t225
-    t241 = t226 - t233*t239
-    t242 = t227 - t234*t239
-    t243 = xp.sqrt(t237**2 + t238**2)
-    t244 = t243*xp.where(xp.greater_equal(t237, 0), xp.asarray(1, dtype=dtype), -1)
-    t245 = xp.greater(t243, 0)
-    t246 = xp.where(t245, 1/(t237 + t244), 0)
-    t247 = xp.where(t245, 1 + xp.abs(t237)/t243, 0)
-    t248 = t238*t246
-    t249 = t247*(t241 + t248*t242)
-    t250 = -t249 + t241
-    t251 = t242 - t248*t249
-    t252 = xp.abs(t251)
-    t253 = t252*xp.where(xp.greater_equal(t251, 0), xp.asarray(1, dtype=dtype), -1)
-    t254 = xp.where(xp.greater(t252, 0), xp.asarray(2, dtype=dtype), 0)
-    t255 = -t49
-    t256 = 0.5*(-1 + t255 + t23 + t78)
-    t257 = xp.atan2(t81, t256)
-    t258 = xp.where(xp.greater(t81, 0), t257/t81, 1)
-    t259 = xp.greater_equal(t23, t255) & xp.greater_equal(t23, t78)
-    t260 = xp.greater_equal(t255, t78)
-    t261 = xp.where(t259, 0.5*(1 + t23), xp.where(t260, -0.5*t48, 0.5*t76))
-    t262 = xp.where(t259, 0.5*t24, xp.where(t260, 0.5*(1 + t255), 0.5*t77))
-    t263 = xp.where(t259, 0.5*t25, xp.where(t260, -0.5*t50, 0.5*(1 + t78)))
-    t264 = xp.sqrt(t261**2 + t262**2 + t263**2)
-    t265 = xp.where(xp.greater_equal(t79*t261 + t80*t262 + t51*t263, 0), xp.asarray(1, dtype=dtype), -1)
-    t266 = xp.greater(t81, 1e-06) | xp.greater(t256, 0)
-    t267 = t257*t265/t264
-    t268 = xp.where(t266, t79*t258, t267*t261)
-    t269 = xp.where(t266, t80*t258, t267*t262)
-    t270 = xp.where(t266, t51*t258, t267*t263)
-    t271 = mu_dot3 + t268*gain3
-    t272 = mu_dot4 + t269*gain4
-    t273 = mu_dot5 + t270*gain5
-    t274 = -(qz1 - c2*qz3 + t54*qz5 - t57*qz6 - t59*qz7 + t55*qz4) + t273
-    t275 = -t41
-    t276 = mu_dot1 + gain1*(t275 + T13)
-    t277 = 1 - t67 - t42 - s1 - t12 - t14 - t3 - t33 - c2 - t57 - t59 - t8 - t27 + q1 + q2 + c1 + q3 + t6 + q4 + t10 + t29 + t54 + q5 + t31 + q6 + q7 + t22 + t55 + t84 + t87 + t85 + t68 + t69 + t88 + t70 + t71 + t72 + t43 + t44 + t45 + t46 + t275 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7 + t26 + t276 + t82 + t271 + t272 + t273
-    t278 = c1*qz2
-    t279 = -(-t41*qz1 + t85*qz3 - t67*qz4 + t68*qz5 + t69*qz6 + t65*t278) + t26
-    t280 = -(t278 - t3*qz4 + t29*qz5 + t31*qz6 - t33*qz7 - t27*qz3) + t272
-    t281 = s1*qz2
-    t282 = -(t22*qz1 + t88*qz3 + t70*qz4 + t71*qz5 + t72*qz6 + t65*t281) + t276
-    t283 = t281 + t12*qz6 + t14*qz7 + t8*qz3 - t6*qz4 - t10*qz5 + t271
-    t284 = t131*(t279 + t132*t282 + t133*t83 - t134*t283 + t135*t280 - t136*t274)
-    t285 = -t284 + t279
-    t286 = t282 - t132*t284
-    t287 = t83 - t133*t284
-    t288 = t283 + t134*t284
-    t289 = t280 - t135*t284
-    t290 = t274 + t136*t284
-    t291 = t176*(t286 + t177*t287 + t178*t288 + t179*t289 + t180*t290)
-    t292 = -t291 + t286
-    t293 = t287 - t177*t291
-    t294 = t288 - t178*t291
-    t295 = t289 - t179*t291
-    t296 = t290 - t180*t291
-    t297 = t209*(t293 + t210*t294 - t211*t295 + t212*t296)
-    t298 = -t297 + t293
-    t299 = t294 - t210*t297
-    t300 = t295 + t211*t297
-    t301 = t296 - t212*t297
-    t302 = t232*(t299 + t233*t300 + t234*t301)
-    t303 = -t302 + t299
-    t304 = t300 - t233*t302
-    t305 = t301 - t234*t302
-    t306 = t247*(t304 + t248*t305)
-    t307 = -t306 + t304
-    t308 = t305 - t248*t306
-    t309 = t308 - t254*t308
-    t310 = xp.where(xp.not_equal(t253, 0), -t309/t253, 0)
-    t311 = xp.where(xp.not_equal(t244, 0), -(t307 - t250*t310)/t244, 0)
-    t312 = xp.where(xp.not_equal(t229, 0), -(-(t236*t311 + t240*t310) + t303)/t229, 0)
-    t313 = xp.where(xp.not_equal(t206, 0), -(-(t214*t312 - t219*t311 + t224*t310) + t298)/t206, 0)
-    t314 = xp.where(xp.not_equal(t173, 0), -(-(t182*t313 - t188*t312 + t194*t311 + t200*t310) + t292)/t173, 0)
-    t315 = xp.where(xp.not_equal(t122, 0), -(-(t138*t314 + t145*t313 - t152*t312 + t159*t311 - t166*t310) + t285)/t122, 0)
-    t316 = t310 - t41*t315 + t22*t314
-    t317 = -t42*t313 - s1*t312 + c1*t311 + t87*t315 + t84*t314
-    t318 = t85*t315 + t88*t314 + t43*t313 - c2*t310 - t8*t312 - t27*t311
-    t319 = -t67*t315 + t70*t314 + t44*t313 + t6*t312 - t3*t311 + t55*t310
-    t320 = t68*t315 + t71*t314 + t45*t313 + t10*t312 + t29*t311 + t54*t310
-    t321 = t69*t315 + t72*t314 + t46*t313 - t12*t312 + t31*t311 - t57*t310
-    t322 = t14*t312 + t33*t311 + t59*t310
-    t323 = qz1 + t316
-    t324 = qz2 + t317
-    t325 = qz3 + t318
-    t326 = qz4 + t319
-    t327 = qz5 + t320
-    t328 = qz6 + t321
-    t329 = -t322 + qz7
-    t330 = xp.isfinite(t277)
-    t331 = xp.greater_equal(damping, 0)
-    t332 = 1e-12*t128
-    t333 = xp.less_equal(t121, t332) | xp.less_equal(t172, t332) | xp.less_equal(t205, t332) | xp.less_equal(t228, t332) | xp.less_equal(t243, t332) | xp.less_equal(t252, t332)
-    t334 = t330 & t331 & xp.logical_not(t333)
+    t113 = -t49
+    t114 = 0.5*(-1 + t113 + t23 + t78)
+    t115 = xp.atan2(t81, t114)
+    t116 = xp.where(xp.greater(t81, 0), t115/t81, 1)
+    t117 = xp.greater_equal(t23, t113) & xp.greater_equal(t23, t78)
+    t118 = xp.greater_equal(t113, t78)
+    t119 = xp.where(t117, 0.5*(1 + t23), xp.where(t118, -0.5*t48, 0.5*t76))
+    t120 = xp.where(t117, 0.5*t24, xp.where(t118, 0.5*(1 + t113), 0.5*t77))
+    t121 = xp.where(t117, 0.5*t25, xp.where(t118, -0.5*t50, 0.5*(1 + t78)))
+    t122 = xp.sqrt(t119**2 + t120**2 + t121**2)
+    t123 = xp.where(xp.greater_equal(t79*t119 + t80*t120 + t51*t121, 0), xp.asarray(1, dtype=dtype), -1)
+    t124 = xp.greater(t81, 1e-06) | xp.greater(t114, 0)
+    t125 = t115*t123/t122
+    t126 = xp.where(t124, t79*t116, t125*t119)
+    t127 = xp.where(t124, t80*t116, t125*t120)
+    t128 = xp.where(t124, t51*t116, t125*t121)
+    t129 = mu_dot3 + t126*gain3
+    t130 = mu_dot4 + t127*gain4
+    t131 = mu_dot5 + t128*gain5
+    t132 = -(qz1 - c2*qz3 + t54*qz5 - t57*qz6 - t59*qz7 + t55*qz4) + t131
+    t133 = -t41
+    t134 = mu_dot1 + gain1*(t133 + T13)
+    t135 = 1 - t67 - t42 - s1 - t12 - t14 - t3 - t33 - c2 - t57 - t59 - t8 - t27 + q1 + q2 + c1 + q3 + t6 + q4 + t10 + t29 + t54 + q5 + t31 + q6 + q7 + t22 + t55 + t84 + t87 + t85 + t68 + t69 + t88 + t70 + t71 + t72 + t43 + t44 + t45 + t46 + t133 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7 + t26 + t134 + t82 + t129 + t130 + t131
+    t136 = c1*qz2
+    t137 = -(t65*t136 - t41*qz1 + t85*qz3 - t67*qz4 + t68*qz5 + t69*qz6) + t26
+    t138 = -(t136 - t3*qz4 + t29*qz5 + t31*qz6 - t33*qz7 - t27*qz3) + t130
+    t139 = s1*qz2
+    t140 = -(t65*t139 + t22*qz1 + t88*qz3 + t70*qz4 + t71*qz5 + t72*qz6) + t134
+    t141 = t139 + t12*qz6 + t14*qz7 + t8*qz3 - t6*qz4 - t10*qz5 + t129
+    t142 = damping**2
+    t143 = _symmetric_solve6(xp, 1, (t142 + t93, t95, t97, -t100, t91, -t86, t142 + t103, t106, -t104, t101, t89, t142 + t47, t107, -t98, t73, t142 + t109, t110, t74, t142 + t111, t75, t142 + t112, t137, t140, t83, t141, t138, t132,))
+    t144 = t143[5]
+    t145 = t143[0]
+    t146 = t143[1]
+    t147 = t144 - t41*t145 + t22*t146
+    t148 = qz1 + t147
+    t149 = t143[2]
+    t150 = t143[3]
+    t151 = t143[4]
+    t152 = t87*t145 + t84*t146 - t42*t149 - s1*t150 + c1*t151
+    t153 = t85*t145 + t88*t146 + t43*t149 - t8*t150 - t27*t151 - c2*t144
+    t154 = t44*t149 - t67*t145 + t70*t146 + t6*t150 - t3*t151 + t55*t144
+    t155 = t45*t149 + t54*t144 + t68*t145 + t71*t146 + t10*t150 + t29*t151
+    t156 = t69*t145 + t72*t146 + t46*t149 - t12*t150 + t31*t151 - t57*t144
+    t157 = t14*t150 + t33*t151 + t59*t144
+    t158 = qz2 + t152
+    t159 = qz3 + t153
+    t160 = qz4 + t154
+    t161 = qz5 + t155
+    t162 = qz6 + t156
+    t163 = -t157 + qz7
+    t164 = xp.isfinite(t135)
+    t165 = xp.greater_equal(damping, 0)
+    t166 = t143[6]
+    t167 = t164 & t165 & xp.less_equal(t166, 0)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t334, t323, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t334, t324, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t334, t325, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t334, t326, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t334, t327, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t334, t328, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t334, t329, 0), batch),  # 6
+        xp.broadcast_to(xp.where(t167, t148, 0), batch),  # 0
+        xp.broadcast_to(xp.where(t167, t158, 0), batch),  # 1
+        xp.broadcast_to(xp.where(t167, t159, 0), batch),  # 2
+        xp.broadcast_to(xp.where(t167, t160, 0), batch),  # 3
+        xp.broadcast_to(xp.where(t167, t161, 0), batch),  # 4
+        xp.broadcast_to(xp.where(t167, t162, 0), batch),  # 5
+        xp.broadcast_to(xp.where(t167, t163, 0), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t330 & t331), 2, xp.where(t333, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t164 & t165), 2, xp.where(xp.greater(t166, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (7 x 1 and 7 x 1 and 1 x 1), 1111 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (7 x 1 and 7 x 1 and 1 x 1), 1173 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (7,)), ("damping", damping, ()))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
@@ -5701,180 +5453,21 @@ def ik_numeric_step(target, q, damping=0.0):
     t126 = xp.where(t123, t86*t115, t124*t119)
     t127 = xp.where(t123, t52*t115, t124*t120)
     t128 = t125**2 + t126**2 + t127**2 + t27**2 + t53**2 + t88**2
-    t129 = damping + t92
-    t130 = xp.sqrt(t129**2 + t94**2 + t96**2 + t99**2 + t90**2 + t77**2)
-    t131 = t130*xp.where(xp.greater_equal(t129, 0), xp.asarray(1, dtype=dtype), -1)
-    t132 = xp.greater(t130, 0)
-    t133 = xp.where(t132, 1/(t129 + t131), 0)
-    t134 = xp.where(t132, 1 + xp.abs(t129)/t130, 0)
-    t135 = damping + t102
-    t136 = t94*t133
-    t137 = t96*t133
-    t138 = t99*t133
-    t139 = t90*t133
-    t140 = t77*t133
-    t141 = t134*(t94 + t135*t136 + t137*t105 + t138*t103 + t139*t100 - t140*t78)
-    t142 = -t141 + t94
-    t143 = t135 - t136*t141
-    t144 = t105 - t137*t141
-    t145 = -t103 + t138*t141
-    t146 = t100 - t139*t141
-    t147 = t78 + t140*t141
-    t148 = t134*(t27 + t136*t53 + t137*t88 - t138*t125 + t139*t126 - t140*t127)
-    t149 = -t148 + t27
-    t150 = t53 - t136*t148
-    t151 = t88 - t137*t148
-    t152 = t125 + t138*t148
-    t153 = t126 - t139*t148
-    t154 = t127 + t140*t148
-    t155 = xp.sqrt(t143**2 + t144**2 + t145**2 + t146**2 + t147**2)
-    t156 = t155*xp.where(xp.greater_equal(t143, 0), xp.asarray(1, dtype=dtype), -1)
-    t157 = damping + t48
-    t158 = t134*(t96 + t136*t105 + t137*t157 - t138*t106 - t139*t97 - t140*t79)
-    t159 = -t158 + t96
-    t160 = t105 - t136*t158
-    t161 = t157 - t137*t158
-    t162 = t106 + t138*t158
-    t163 = t97 + t139*t158
-    t164 = t79 + t140*t158
-    t165 = damping + t108
-    t166 = -t134*(t99 + t136*t103 - t137*t106 + t138*t165 - t139*t109 + t140*t80)
-    t167 = t99 + t166
-    t168 = t103 + t136*t166
-    t169 = t106 - t137*t166
-    t170 = t165 + t138*t166
-    t171 = t109 - t139*t166
-    t172 = t80 + t140*t166
-    t173 = damping + t110
-    t174 = t134*(t90 + t136*t100 - t137*t97 - t138*t109 + t139*t173 - t140*t81)
-    t175 = -t174 + t90
-    t176 = t100 - t136*t174
-    t177 = t97 + t137*t174
-    t178 = t109 + t138*t174
-    t179 = t173 - t139*t174
-    t180 = t81 + t140*t174
-    t181 = damping + t111
-    t182 = t134*(-t77 + t136*t78 + t137*t79 - t138*t80 + t139*t81 - t140*t181)
-    t183 = t77 + t182
-    t184 = t78 - t136*t182
-    t185 = t79 - t137*t182
-    t186 = t80 + t138*t182
-    t187 = t81 - t139*t182
-    t188 = t181 + t140*t182
-    t189 = xp.greater(t155, 0)
-    t190 = xp.where(t189, 1/(t143 + t156), 0)
-    t191 = xp.where(t189, 1 + xp.abs(t143)/t155, 0)
-    t192 = t144*t190
-    t193 = t145*t190
-    t194 = t146*t190
-    t195 = t147*t190
-    t196 = t191*(t160 + t192*t161 + t193*t162 - t194*t163 + t195*t164)
-    t197 = -t196 + t160
-    t198 = t161 - t192*t196
-    t199 = t162 - t193*t196
-    t200 = t163 + t194*t196
-    t201 = t164 - t195*t196
-    t202 = t191*(-t168 + t192*t169 + t193*t170 + t194*t171 + t195*t172)
-    t203 = t168 + t202
-    t204 = t169 - t192*t202
-    t205 = t170 - t193*t202
-    t206 = t171 - t194*t202
-    t207 = t172 - t195*t202
-    t208 = t191*(t176 - t192*t177 + t193*t178 + t194*t179 + t195*t180)
-    t209 = -t208 + t176
-    t210 = t177 + t192*t208
-    t211 = t178 - t193*t208
-    t212 = t179 - t194*t208
-    t213 = t180 - t195*t208
-    t214 = t191*(t184 + t192*t185 + t193*t186 + t194*t187 + t195*t188)
-    t215 = -t214 + t184
-    t216 = t185 - t192*t214
-    t217 = t186 - t193*t214
-    t218 = t187 - t194*t214
-    t219 = t188 - t195*t214
-    t220 = t191*(t150 + t192*t151 + t193*t152 + t194*t153 + t195*t154)
-    t221 = -t220 + t150
-    t222 = t151 - t192*t220
-    t223 = t152 - t193*t220
-    t224 = t153 - t194*t220
-    t225 = t154 - t195*t220
-    t226 = xp.sqrt(t198**2 + t199**2 + t200**2 + t201**2)
-    t227 = t226*xp.where(xp.greater_equal(t198, 0), xp.asarray(1, dtype=dtype), -1)
-    t228 = xp.greater(t226, 0)
-    t229 = xp.where(t228, 1/(t198 + t227), 0)
-    t230 = xp.where(t228, 1 + xp.abs(t198)/t226, 0)
-    t231 = t199*t229
-    t232 = t200*t229
-    t233 = t201*t229
-    t234 = t230*(t204 + t231*t205 - t232*t206 + t233*t207)
-    t235 = -t234 + t204
-    t236 = t205 - t231*t234
-    t237 = t206 + t232*t234
-    t238 = t207 - t233*t234
-    t239 = t230*(-t210 + t231*t211 - t232*t212 + t233*t213)
-    t240 = t210 + t239
-    t241 = t211 - t231*t239
-    t242 = t212 + t232*t239
-    t243 = t213 - t233*t239
-    t244 = t230*(t216 + t231*t217 - t232*t218 + t233*t219)
-    t245 = -t244 + t216
-    t246 = t217 - t231*t244
-    t247 = t218 + t232*t244
-    t248 = t219 - t233*t244
-    t249 = t230*(t222 + t231*t223 - t232*t224 + t233*t225)
-    t250 = -t249 + t222
-    t251 = t223 - t231*t249
-    t252 = t224 + t232*t249
-    t253 = t225 - t233*t249
-    t254 = xp.sqrt(t236**2 + t237**2 + t238**2)
-    t255 = t254*xp.where(xp.greater_equal(t236, 0), xp.asarray(1, dtype=dtype), -1)
-    t256 = xp.greater(t254, 0)
-    t257 = xp.where(t256, 1/(t236 + t255), 0)
-    t258 = xp.where(t256, 1 + xp.abs(t236)/t254, 0)
-    t259 = t237*t257
-    t260 = t238*t257
-    t261 = t258*(t241 + t259*t242 + t260*t243)
-    t262 = -t261 + t241
-    t263 = t242 - t259*t261
-    t264 = t243 - t260*t261
-    t265 = t258*(t246 + t259*t247 + t260*t248)
-    t266 = -t265 + t246
-    t267 = t247 - t259*t265
-    t268 = t248 - t260*t265
-    t269 = t258*(t251 + t259*t252 + t260*t253)
-    t270 = -t269 + t251
-    t271 = t252 - t259*t269
-    t272 = t253 - t260*t269
-    t273 = xp.sqrt(t263**2 + t264**2)
-    t274 = t273*xp.where(xp.greater_equal(t263, 0), xp.asarray(1, dtype=dtype), -1)
-    t275 = xp.greater(t273, 0)
-    t276 = xp.where(t275, 1/(t263 + t274), 0)
-    t277 = xp.where(t275, 1 + xp.abs(t263)/t273, 0)
-    t278 = t264*t276
-    t279 = t277*(t267 + t278*t268)
-    t280 = -t279 + t267
-    t281 = t268 - t278*t279
-    t282 = t277*(t271 + t278*t272)
-    t283 = -t282 + t271
-    t284 = t272 - t278*t282
-    t285 = xp.abs(t281)
-    t286 = t285*xp.where(xp.greater_equal(t281, 0), xp.asarray(1, dtype=dtype), -1)
-    t287 = xp.where(xp.greater(t285, 0), xp.asarray(2, dtype=dtype), 0)
-    t288 = t284 - t284*t287
-    t289 = xp.where(xp.not_equal(t286, 0), -t288/t286, 0)
-    t290 = xp.where(xp.not_equal(t274, 0), -(t283 - t280*t289)/t274, 0)
-    t291 = xp.where(xp.not_equal(t255, 0), -(-(t262*t290 + t266*t289) + t270)/t255, 0)
-    t292 = xp.where(xp.not_equal(t227, 0), -(-(t235*t291 - t240*t290 + t245*t289) + t250)/t227, 0)
-    t293 = xp.where(xp.not_equal(t156, 0), -(-(t197*t292 - t203*t291 + t209*t290 + t215*t289) + t221)/t156, 0)
-    t294 = xp.where(xp.not_equal(t131, 0), -(-(t142*t293 + t159*t292 - t167*t291 + t175*t290 - t183*t289) + t149)/t131, 0)
-    t295 = q1 + t289 - t42*t294 + t23*t293
-    t296 = q2 + c1*t67*t294 + s1*t67*t293 - t43*t292 - s1*t291 + c1*t290
-    t297 = q3 + t69*t294 + t73*t293 + t44*t292 - c2*t289 - t9*t291 - t28*t290
-    t298 = q4 - t70*t294 + t74*t293 + t45*t292 + t7*t291 - t4*t290 + t57*t289
-    t299 = q5 + t71*t294 + t75*t293 + t46*t292 + t11*t291 + t30*t290 + t56*t289
-    t300 = q6 + t72*t294 + t76*t293 + t47*t292 - t13*t291 + t32*t290 - t59*t289
-    t301 = -q7 + t15*t291 + t34*t290 + t61*t289
-    t302 = -t301
+    t129 = _symmetric_solve6(xp, 1, (damping + t92, t94, t96, -t99, t90, -t77, damping + t102, t105, -t103, t100, t78, damping + t48, t106, -t97, t79, damping + t108, t109, t80, damping + t110, t81, damping + t111, t27, t53, t88, t125, t126, t127,))
+    t130 = t129[5]
+    t131 = t129[0]
+    t132 = t129[1]
+    t133 = q1 + t130 - t42*t131 + t23*t132
+    t134 = t129[2]
+    t135 = t129[3]
+    t136 = t129[4]
+    t137 = q2 - t43*t134 - s1*t135 + c1*t136 + c1*t67*t131 + s1*t67*t132
+    t138 = q3 - c2*t130 + t69*t131 + t73*t132 + t44*t134 - t9*t135 - t28*t136
+    t139 = q4 - t4*t136 - t70*t131 + t74*t132 + t45*t134 + t7*t135 + t57*t130
+    t140 = q5 + t56*t130 + t71*t131 + t75*t132 + t46*t134 + t11*t135 + t30*t136
+    t141 = q6 + t47*t134 + t72*t131 + t76*t132 - t13*t135 + t32*t136 - t59*t130
+    t142 = -q7 + t61*t130 + t15*t135 + t34*t136
+    t143 = -t142
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -5885,13 +5478,13 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q7, batch),  # 6
     ], (7,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t295, -3.0543261909900767), -3.0543261909900767, xp.where(xp.greater(t295, 3.0543261909900767), 3.0543261909900767, t295)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t296, -3.822271061867582), -3.822271061867582, xp.where(xp.greater(t296, 2.2863813201125716), 2.2863813201125716, t296)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t297, -3.0543261909900767), -3.0543261909900767, xp.where(xp.greater(t297, 3.0543261909900767), 3.0543261909900767, t297)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t298, -3.0543261909900767), -3.0543261909900767, xp.where(xp.greater(t298, 3.0543261909900767), 3.0543261909900767, t298)), batch),  # 3
-        xp.broadcast_to(xp.where(xp.less(t299, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t299, 2.9670597283903604), 2.9670597283903604, t299)), batch),  # 4
-        xp.broadcast_to(xp.where(xp.less(t300, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t300, 2.9670597283903604), 2.9670597283903604, t300)), batch),  # 5
-        xp.broadcast_to(xp.where(xp.less(t302, -4.71238898038469), -4.71238898038469, xp.where(xp.greater(t302, 4.71238898038469), 4.71238898038469, t302)), batch),  # 6
+        xp.broadcast_to(xp.where(xp.less(t133, -3.0543261909900767), -3.0543261909900767, xp.where(xp.greater(t133, 3.0543261909900767), 3.0543261909900767, t133)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t137, -3.822271061867582), -3.822271061867582, xp.where(xp.greater(t137, 2.2863813201125716), 2.2863813201125716, t137)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t138, -3.0543261909900767), -3.0543261909900767, xp.where(xp.greater(t138, 3.0543261909900767), 3.0543261909900767, t138)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t139, -3.0543261909900767), -3.0543261909900767, xp.where(xp.greater(t139, 3.0543261909900767), 3.0543261909900767, t139)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t140, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t140, 2.9670597283903604), 2.9670597283903604, t140)), batch),  # 4
+        xp.broadcast_to(xp.where(xp.less(t141, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t141, 2.9670597283903604), 2.9670597283903604, t141)), batch),  # 5
+        xp.broadcast_to(xp.where(xp.less(t143, -4.71238898038469), -4.71238898038469, xp.where(xp.greater(t143, 4.71238898038469), 4.71238898038469, t143)), batch),  # 6
     ], (7,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t0), t128, -1), batch)
     return q_start, q_next, cost
@@ -6807,7 +6400,7 @@ def ik_general_limits(q_solution):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (7 x 1 and 1 x 1), 1975 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (7 x 1 and 1 x 1), 1973 operations."""
     xp, dtype, device, batch, (T, q_seed, q_free, weights,) = _arguments(("T", T, (4, 4)), ("q_seed", q_seed, (7,)), ("q_free", q_free, ()), ("weights", weights, (7,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(T, q_free)
     T00 = T[..., 0, 0]
@@ -6980,728 +6573,36 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     lb13 = branches_in_limits[..., 13]
     lb14 = branches_in_limits[..., 14]
     lb15 = branches_in_limits[..., 15]
-    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
-    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
-    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
-    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
-    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
-    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
-    t6 = xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0)
-    t7 = xp.where(xp.greater(t6, 0), xp.asarray(1, dtype=dtype), 0)
-    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
-    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
-    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
-    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
-    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
-    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
-    t14 = xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0)
-    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
-    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
-    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
-    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
-    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
-    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
-    t21 = xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0)
-    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
-    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
-    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
-    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
-    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
-    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
-    t28 = xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0)
-    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
-    t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
-    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
-    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
-    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
-    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
-    t35 = xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0)
-    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
-    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
-    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
-    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
-    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
-    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
-    t42 = xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0)
-    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
-    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
-    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
-    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
-    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
-    t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
-    t49 = xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0)
-    t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
-    t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
-    t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
-    t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
-    t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
-    t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
-    t56 = xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0)
-    t57 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_0 + qn1)) + qb8_0
-    t58 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_1 + qn2)) + qb8_1
-    t59 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_2 + qn3)) + qb8_2
-    t60 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_3 + qn4)) + qb8_3
-    t61 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_4 + qn5)) + qb8_4
-    t62 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_5 + qn6)) + qb8_5
-    t63 = xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0)
-    t64 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_0 + qn1)) + qb9_0
-    t65 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_1 + qn2)) + qb9_1
-    t66 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_2 + qn3)) + qb9_2
-    t67 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_3 + qn4)) + qb9_3
-    t68 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_4 + qn5)) + qb9_4
-    t69 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_5 + qn6)) + qb9_5
-    t70 = xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0)
-    t71 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_0 + qn1)) + qb10_0
-    t72 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_1 + qn2)) + qb10_1
-    t73 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_2 + qn3)) + qb10_2
-    t74 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_3 + qn4)) + qb10_3
-    t75 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_4 + qn5)) + qb10_4
-    t76 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_5 + qn6)) + qb10_5
-    t77 = xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0)
-    t78 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_0 + qn1)) + qb11_0
-    t79 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_1 + qn2)) + qb11_1
-    t80 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_2 + qn3)) + qb11_2
-    t81 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_3 + qn4)) + qb11_3
-    t82 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_4 + qn5)) + qb11_4
-    t83 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_5 + qn6)) + qb11_5
-    t84 = xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0)
-    t85 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_0 + qn1)) + qb12_0
-    t86 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_1 + qn2)) + qb12_1
-    t87 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_2 + qn3)) + qb12_2
-    t88 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_3 + qn4)) + qb12_3
-    t89 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_4 + qn5)) + qb12_4
-    t90 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_5 + qn6)) + qb12_5
-    t91 = xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0)
-    t92 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_0 + qn1)) + qb13_0
-    t93 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_1 + qn2)) + qb13_1
-    t94 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_2 + qn3)) + qb13_2
-    t95 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_3 + qn4)) + qb13_3
-    t96 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_4 + qn5)) + qb13_4
-    t97 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_5 + qn6)) + qb13_5
-    t98 = xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0)
-    t99 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_0 + qn1)) + qb14_0
-    t100 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_1 + qn2)) + qb14_1
-    t101 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_2 + qn3)) + qb14_2
-    t102 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_3 + qn4)) + qb14_3
-    t103 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_4 + qn5)) + qb14_4
-    t104 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_5 + qn6)) + qb14_5
-    t105 = xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0)
-    t106 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_0 + qn1)) + qb15_0
-    t107 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_1 + qn2)) + qb15_1
-    t108 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_2 + qn3)) + qb15_2
-    t109 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_3 + qn4)) + qb15_3
-    t110 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_4 + qn5)) + qb15_4
-    t111 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_5 + qn6)) + qb15_5
-    t112 = xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0)
-    t113 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7
-    t114 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t115 = t114 + t0
-    t116 = -t114 + t0
-    t117 = xp.where(xp.greater_equal(t0, -3.0543261909900767) & xp.less_equal(t0, 3.0543261909900767), t0, xp.where(xp.greater_equal(t115, -3.0543261909900767) & xp.less_equal(t115, 3.0543261909900767), t115, xp.where(xp.greater_equal(t116, -3.0543261909900767) & xp.less_equal(t116, 3.0543261909900767), t116, qb0_0)))
-    t118 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t119 = t118 + t1
-    t120 = -t118 + t1
-    t121 = xp.where(xp.greater_equal(t1, -3.822271061867582) & xp.less_equal(t1, 2.2863813201125716), t1, xp.where(xp.greater_equal(t119, -3.822271061867582) & xp.less_equal(t119, 2.2863813201125716), t119, xp.where(xp.greater_equal(t120, -3.822271061867582) & xp.less_equal(t120, 2.2863813201125716), t120, qb0_1)))
-    t122 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t123 = t122 + t2
-    t124 = -t122 + t2
-    t125 = xp.where(xp.greater_equal(t2, -3.0543261909900767) & xp.less_equal(t2, 3.0543261909900767), t2, xp.where(xp.greater_equal(t123, -3.0543261909900767) & xp.less_equal(t123, 3.0543261909900767), t123, xp.where(xp.greater_equal(t124, -3.0543261909900767) & xp.less_equal(t124, 3.0543261909900767), t124, qb0_2)))
-    t126 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t127 = t126 + t3
-    t128 = -t126 + t3
-    t129 = xp.where(xp.greater_equal(t3, -3.0543261909900767) & xp.less_equal(t3, 3.0543261909900767), t3, xp.where(xp.greater_equal(t127, -3.0543261909900767) & xp.less_equal(t127, 3.0543261909900767), t127, xp.where(xp.greater_equal(t128, -3.0543261909900767) & xp.less_equal(t128, 3.0543261909900767), t128, qb0_3)))
-    t130 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t131 = t130 + t4
-    t132 = -t130 + t4
-    t133 = xp.where(xp.greater_equal(t4, -2.9670597283903604) & xp.less_equal(t4, 2.9670597283903604), t4, xp.where(xp.greater_equal(t131, -2.9670597283903604) & xp.less_equal(t131, 2.9670597283903604), t131, xp.where(xp.greater_equal(t132, -2.9670597283903604) & xp.less_equal(t132, 2.9670597283903604), t132, qb0_4)))
-    t134 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t135 = t134 + t5
-    t136 = -t134 + t5
-    t137 = xp.where(xp.greater_equal(t5, -2.9670597283903604) & xp.less_equal(t5, 2.9670597283903604), t5, xp.where(xp.greater_equal(t135, -2.9670597283903604) & xp.less_equal(t135, 2.9670597283903604), t135, xp.where(xp.greater_equal(t136, -2.9670597283903604) & xp.less_equal(t136, 2.9670597283903604), t136, qb0_5)))
-    t138 = -qn1
-    t139 = -qn2
-    t140 = -qn3
-    t141 = -qn4
-    t142 = -qn5
-    t143 = -qn6
-    t144 = -qn7
-    t145 = qw1*(t138 + t117)**2 + qw2*(t139 + t121)**2 + qw3*(t140 + t125)**2 + qw4*(t141 + t129)**2 + qw5*(t142 + t133)**2 + qw6*(t143 + t137)**2 + qw7*(t144 + qb0_6)**2
-    t146 = xp.greater(t7, 0)
-    t147 = xp.where(t146, t117, qn1)
-    t148 = xp.where(t146, t121, qn2)
-    t149 = xp.where(t146, t125, qn3)
-    t150 = xp.where(t146, t129, qn4)
-    t151 = xp.where(t146, t133, qn5)
-    t152 = xp.where(t146, t137, qn6)
-    t153 = xp.where(t146, qb0_6, qn7)
-    t154 = xp.where(t146, t145, 0)
-    t155 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t156 = t155 + t8
-    t157 = -t155 + t8
-    t158 = xp.where(xp.greater_equal(t8, -3.0543261909900767) & xp.less_equal(t8, 3.0543261909900767), t8, xp.where(xp.greater_equal(t156, -3.0543261909900767) & xp.less_equal(t156, 3.0543261909900767), t156, xp.where(xp.greater_equal(t157, -3.0543261909900767) & xp.less_equal(t157, 3.0543261909900767), t157, qb1_0)))
-    t159 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t160 = t159 + t9
-    t161 = -t159 + t9
-    t162 = xp.where(xp.greater_equal(t9, -3.822271061867582) & xp.less_equal(t9, 2.2863813201125716), t9, xp.where(xp.greater_equal(t160, -3.822271061867582) & xp.less_equal(t160, 2.2863813201125716), t160, xp.where(xp.greater_equal(t161, -3.822271061867582) & xp.less_equal(t161, 2.2863813201125716), t161, qb1_1)))
-    t163 = xp.where(xp.less(t10, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t164 = t163 + t10
-    t165 = -t163 + t10
-    t166 = xp.where(xp.greater_equal(t10, -3.0543261909900767) & xp.less_equal(t10, 3.0543261909900767), t10, xp.where(xp.greater_equal(t164, -3.0543261909900767) & xp.less_equal(t164, 3.0543261909900767), t164, xp.where(xp.greater_equal(t165, -3.0543261909900767) & xp.less_equal(t165, 3.0543261909900767), t165, qb1_2)))
-    t167 = xp.where(xp.less(t11, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t168 = t167 + t11
-    t169 = -t167 + t11
-    t170 = xp.where(xp.greater_equal(t11, -3.0543261909900767) & xp.less_equal(t11, 3.0543261909900767), t11, xp.where(xp.greater_equal(t168, -3.0543261909900767) & xp.less_equal(t168, 3.0543261909900767), t168, xp.where(xp.greater_equal(t169, -3.0543261909900767) & xp.less_equal(t169, 3.0543261909900767), t169, qb1_3)))
-    t171 = xp.where(xp.less(t12, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t172 = t171 + t12
-    t173 = -t171 + t12
-    t174 = xp.where(xp.greater_equal(t12, -2.9670597283903604) & xp.less_equal(t12, 2.9670597283903604), t12, xp.where(xp.greater_equal(t172, -2.9670597283903604) & xp.less_equal(t172, 2.9670597283903604), t172, xp.where(xp.greater_equal(t173, -2.9670597283903604) & xp.less_equal(t173, 2.9670597283903604), t173, qb1_4)))
-    t175 = xp.where(xp.less(t13, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t176 = t175 + t13
-    t177 = -t175 + t13
-    t178 = xp.where(xp.greater_equal(t13, -2.9670597283903604) & xp.less_equal(t13, 2.9670597283903604), t13, xp.where(xp.greater_equal(t176, -2.9670597283903604) & xp.less_equal(t176, 2.9670597283903604), t176, xp.where(xp.greater_equal(t177, -2.9670597283903604) & xp.less_equal(t177, 2.9670597283903604), t177, qb1_5)))
-    t179 = qw1*(t138 + t158)**2 + qw2*(t139 + t162)**2 + qw3*(t140 + t166)**2 + qw4*(t141 + t170)**2 + qw5*(t142 + t174)**2 + qw6*(t143 + t178)**2 + qw7*(t144 + qb1_6)**2
-    t180 = xp.greater(t14, 0)
-    t181 = xp.where(t180 & (xp.less(t7, 1) | xp.less(t179, t154)), xp.asarray(1, dtype=dtype), 0)
-    t182 = xp.where(t180, 1, t7)
-    t183 = xp.greater(t181, 0)
-    t184 = xp.where(t183, t158, t147)
-    t185 = xp.where(t183, t162, t148)
-    t186 = xp.where(t183, t166, t149)
-    t187 = xp.where(t183, t170, t150)
-    t188 = xp.where(t183, t174, t151)
-    t189 = xp.where(t183, t178, t152)
-    t190 = xp.where(t183, qb1_6, t153)
-    t191 = xp.where(t183, t179, t154)
-    t192 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t193 = t192 + t15
-    t194 = -t192 + t15
-    t195 = xp.where(xp.greater_equal(t15, -3.0543261909900767) & xp.less_equal(t15, 3.0543261909900767), t15, xp.where(xp.greater_equal(t193, -3.0543261909900767) & xp.less_equal(t193, 3.0543261909900767), t193, xp.where(xp.greater_equal(t194, -3.0543261909900767) & xp.less_equal(t194, 3.0543261909900767), t194, qb2_0)))
-    t196 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t197 = t196 + t16
-    t198 = -t196 + t16
-    t199 = xp.where(xp.greater_equal(t16, -3.822271061867582) & xp.less_equal(t16, 2.2863813201125716), t16, xp.where(xp.greater_equal(t197, -3.822271061867582) & xp.less_equal(t197, 2.2863813201125716), t197, xp.where(xp.greater_equal(t198, -3.822271061867582) & xp.less_equal(t198, 2.2863813201125716), t198, qb2_1)))
-    t200 = xp.where(xp.less(t17, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t201 = t200 + t17
-    t202 = -t200 + t17
-    t203 = xp.where(xp.greater_equal(t17, -3.0543261909900767) & xp.less_equal(t17, 3.0543261909900767), t17, xp.where(xp.greater_equal(t201, -3.0543261909900767) & xp.less_equal(t201, 3.0543261909900767), t201, xp.where(xp.greater_equal(t202, -3.0543261909900767) & xp.less_equal(t202, 3.0543261909900767), t202, qb2_2)))
-    t204 = xp.where(xp.less(t18, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t205 = t204 + t18
-    t206 = -t204 + t18
-    t207 = xp.where(xp.greater_equal(t18, -3.0543261909900767) & xp.less_equal(t18, 3.0543261909900767), t18, xp.where(xp.greater_equal(t205, -3.0543261909900767) & xp.less_equal(t205, 3.0543261909900767), t205, xp.where(xp.greater_equal(t206, -3.0543261909900767) & xp.less_equal(t206, 3.0543261909900767), t206, qb2_3)))
-    t208 = xp.where(xp.less(t19, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t209 = t208 + t19
-    t210 = -t208 + t19
-    t211 = xp.where(xp.greater_equal(t19, -2.9670597283903604) & xp.less_equal(t19, 2.9670597283903604), t19, xp.where(xp.greater_equal(t209, -2.9670597283903604) & xp.less_equal(t209, 2.9670597283903604), t209, xp.where(xp.greater_equal(t210, -2.9670597283903604) & xp.less_equal(t210, 2.9670597283903604), t210, qb2_4)))
-    t212 = xp.where(xp.less(t20, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t213 = t212 + t20
-    t214 = -t212 + t20
-    t215 = xp.where(xp.greater_equal(t20, -2.9670597283903604) & xp.less_equal(t20, 2.9670597283903604), t20, xp.where(xp.greater_equal(t213, -2.9670597283903604) & xp.less_equal(t213, 2.9670597283903604), t213, xp.where(xp.greater_equal(t214, -2.9670597283903604) & xp.less_equal(t214, 2.9670597283903604), t214, qb2_5)))
-    t216 = qw1*(t138 + t195)**2 + qw2*(t139 + t199)**2 + qw3*(t140 + t203)**2 + qw4*(t141 + t207)**2 + qw5*(t142 + t211)**2 + qw6*(t143 + t215)**2 + qw7*(t144 + qb2_6)**2
-    t217 = xp.greater(t21, 0)
-    t218 = xp.where(t217 & (xp.less(t182, 1) | xp.less(t216, t191)), xp.asarray(1, dtype=dtype), 0)
-    t219 = xp.where(t217, 1, t182)
-    t220 = xp.greater(t218, 0)
-    t221 = xp.where(t220, t195, t184)
-    t222 = xp.where(t220, t199, t185)
-    t223 = xp.where(t220, t203, t186)
-    t224 = xp.where(t220, t207, t187)
-    t225 = xp.where(t220, t211, t188)
-    t226 = xp.where(t220, t215, t189)
-    t227 = xp.where(t220, qb2_6, t190)
-    t228 = xp.where(t220, t216, t191)
-    t229 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t230 = t229 + t22
-    t231 = -t229 + t22
-    t232 = xp.where(xp.greater_equal(t22, -3.0543261909900767) & xp.less_equal(t22, 3.0543261909900767), t22, xp.where(xp.greater_equal(t230, -3.0543261909900767) & xp.less_equal(t230, 3.0543261909900767), t230, xp.where(xp.greater_equal(t231, -3.0543261909900767) & xp.less_equal(t231, 3.0543261909900767), t231, qb3_0)))
-    t233 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t234 = t233 + t23
-    t235 = -t233 + t23
-    t236 = xp.where(xp.greater_equal(t23, -3.822271061867582) & xp.less_equal(t23, 2.2863813201125716), t23, xp.where(xp.greater_equal(t234, -3.822271061867582) & xp.less_equal(t234, 2.2863813201125716), t234, xp.where(xp.greater_equal(t235, -3.822271061867582) & xp.less_equal(t235, 2.2863813201125716), t235, qb3_1)))
-    t237 = xp.where(xp.less(t24, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t238 = t237 + t24
-    t239 = -t237 + t24
-    t240 = xp.where(xp.greater_equal(t24, -3.0543261909900767) & xp.less_equal(t24, 3.0543261909900767), t24, xp.where(xp.greater_equal(t238, -3.0543261909900767) & xp.less_equal(t238, 3.0543261909900767), t238, xp.where(xp.greater_equal(t239, -3.0543261909900767) & xp.less_equal(t239, 3.0543261909900767), t239, qb3_2)))
-    t241 = xp.where(xp.less(t25, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t242 = t241 + t25
-    t243 = -t241 + t25
-    t244 = xp.where(xp.greater_equal(t25, -3.0543261909900767) & xp.less_equal(t25, 3.0543261909900767), t25, xp.where(xp.greater_equal(t242, -3.0543261909900767) & xp.less_equal(t242, 3.0543261909900767), t242, xp.where(xp.greater_equal(t243, -3.0543261909900767) & xp.less_equal(t243, 3.0543261909900767), t243, qb3_3)))
-    t245 = xp.where(xp.less(t26, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t246 = t245 + t26
-    t247 = -t245 + t26
-    t248 = xp.where(xp.greater_equal(t26, -2.9670597283903604) & xp.less_equal(t26, 2.9670597283903604), t26, xp.where(xp.greater_equal(t246, -2.9670597283903604) & xp.less_equal(t246, 2.9670597283903604), t246, xp.where(xp.greater_equal(t247, -2.9670597283903604) & xp.less_equal(t247, 2.9670597283903604), t247, qb3_4)))
-    t249 = xp.where(xp.less(t27, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t250 = t249 + t27
-    t251 = -t249 + t27
-    t252 = xp.where(xp.greater_equal(t27, -2.9670597283903604) & xp.less_equal(t27, 2.9670597283903604), t27, xp.where(xp.greater_equal(t250, -2.9670597283903604) & xp.less_equal(t250, 2.9670597283903604), t250, xp.where(xp.greater_equal(t251, -2.9670597283903604) & xp.less_equal(t251, 2.9670597283903604), t251, qb3_5)))
-    t253 = qw1*(t138 + t232)**2 + qw2*(t139 + t236)**2 + qw3*(t140 + t240)**2 + qw4*(t141 + t244)**2 + qw5*(t142 + t248)**2 + qw6*(t143 + t252)**2 + qw7*(t144 + qb3_6)**2
-    t254 = xp.greater(t28, 0)
-    t255 = xp.where(t254 & (xp.less(t219, 1) | xp.less(t253, t228)), xp.asarray(1, dtype=dtype), 0)
-    t256 = xp.where(t254, 1, t219)
-    t257 = xp.greater(t255, 0)
-    t258 = xp.where(t257, t232, t221)
-    t259 = xp.where(t257, t236, t222)
-    t260 = xp.where(t257, t240, t223)
-    t261 = xp.where(t257, t244, t224)
-    t262 = xp.where(t257, t248, t225)
-    t263 = xp.where(t257, t252, t226)
-    t264 = xp.where(t257, qb3_6, t227)
-    t265 = xp.where(t257, t253, t228)
-    t266 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t267 = t266 + t29
-    t268 = -t266 + t29
-    t269 = xp.where(xp.greater_equal(t29, -3.0543261909900767) & xp.less_equal(t29, 3.0543261909900767), t29, xp.where(xp.greater_equal(t267, -3.0543261909900767) & xp.less_equal(t267, 3.0543261909900767), t267, xp.where(xp.greater_equal(t268, -3.0543261909900767) & xp.less_equal(t268, 3.0543261909900767), t268, qb4_0)))
-    t270 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t271 = t270 + t30
-    t272 = -t270 + t30
-    t273 = xp.where(xp.greater_equal(t30, -3.822271061867582) & xp.less_equal(t30, 2.2863813201125716), t30, xp.where(xp.greater_equal(t271, -3.822271061867582) & xp.less_equal(t271, 2.2863813201125716), t271, xp.where(xp.greater_equal(t272, -3.822271061867582) & xp.less_equal(t272, 2.2863813201125716), t272, qb4_1)))
-    t274 = xp.where(xp.less(t31, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t275 = t274 + t31
-    t276 = -t274 + t31
-    t277 = xp.where(xp.greater_equal(t31, -3.0543261909900767) & xp.less_equal(t31, 3.0543261909900767), t31, xp.where(xp.greater_equal(t275, -3.0543261909900767) & xp.less_equal(t275, 3.0543261909900767), t275, xp.where(xp.greater_equal(t276, -3.0543261909900767) & xp.less_equal(t276, 3.0543261909900767), t276, qb4_2)))
-    t278 = xp.where(xp.less(t32, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t279 = t278 + t32
-    t280 = -t278 + t32
-    t281 = xp.where(xp.greater_equal(t32, -3.0543261909900767) & xp.less_equal(t32, 3.0543261909900767), t32, xp.where(xp.greater_equal(t279, -3.0543261909900767) & xp.less_equal(t279, 3.0543261909900767), t279, xp.where(xp.greater_equal(t280, -3.0543261909900767) & xp.less_equal(t280, 3.0543261909900767), t280, qb4_3)))
-    t282 = xp.where(xp.less(t33, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t283 = t282 + t33
-    t284 = -t282 + t33
-    t285 = xp.where(xp.greater_equal(t33, -2.9670597283903604) & xp.less_equal(t33, 2.9670597283903604), t33, xp.where(xp.greater_equal(t283, -2.9670597283903604) & xp.less_equal(t283, 2.9670597283903604), t283, xp.where(xp.greater_equal(t284, -2.9670597283903604) & xp.less_equal(t284, 2.9670597283903604), t284, qb4_4)))
-    t286 = xp.where(xp.less(t34, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t287 = t286 + t34
-    t288 = -t286 + t34
-    t289 = xp.where(xp.greater_equal(t34, -2.9670597283903604) & xp.less_equal(t34, 2.9670597283903604), t34, xp.where(xp.greater_equal(t287, -2.9670597283903604) & xp.less_equal(t287, 2.9670597283903604), t287, xp.where(xp.greater_equal(t288, -2.9670597283903604) & xp.less_equal(t288, 2.9670597283903604), t288, qb4_5)))
-    t290 = qw1*(t138 + t269)**2 + qw2*(t139 + t273)**2 + qw3*(t140 + t277)**2 + qw4*(t141 + t281)**2 + qw5*(t142 + t285)**2 + qw6*(t143 + t289)**2 + qw7*(t144 + qb4_6)**2
-    t291 = xp.greater(t35, 0)
-    t292 = xp.where(t291 & (xp.less(t256, 1) | xp.less(t290, t265)), xp.asarray(1, dtype=dtype), 0)
-    t293 = xp.where(t291, 1, t256)
-    t294 = xp.greater(t292, 0)
-    t295 = xp.where(t294, t269, t258)
-    t296 = xp.where(t294, t273, t259)
-    t297 = xp.where(t294, t277, t260)
-    t298 = xp.where(t294, t281, t261)
-    t299 = xp.where(t294, t285, t262)
-    t300 = xp.where(t294, t289, t263)
-    t301 = xp.where(t294, qb4_6, t264)
-    t302 = xp.where(t294, t290, t265)
-    t303 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t304 = t303 + t36
-    t305 = -t303 + t36
-    t306 = xp.where(xp.greater_equal(t36, -3.0543261909900767) & xp.less_equal(t36, 3.0543261909900767), t36, xp.where(xp.greater_equal(t304, -3.0543261909900767) & xp.less_equal(t304, 3.0543261909900767), t304, xp.where(xp.greater_equal(t305, -3.0543261909900767) & xp.less_equal(t305, 3.0543261909900767), t305, qb5_0)))
-    t307 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t308 = t307 + t37
-    t309 = -t307 + t37
-    t310 = xp.where(xp.greater_equal(t37, -3.822271061867582) & xp.less_equal(t37, 2.2863813201125716), t37, xp.where(xp.greater_equal(t308, -3.822271061867582) & xp.less_equal(t308, 2.2863813201125716), t308, xp.where(xp.greater_equal(t309, -3.822271061867582) & xp.less_equal(t309, 2.2863813201125716), t309, qb5_1)))
-    t311 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t312 = t311 + t38
-    t313 = -t311 + t38
-    t314 = xp.where(xp.greater_equal(t38, -3.0543261909900767) & xp.less_equal(t38, 3.0543261909900767), t38, xp.where(xp.greater_equal(t312, -3.0543261909900767) & xp.less_equal(t312, 3.0543261909900767), t312, xp.where(xp.greater_equal(t313, -3.0543261909900767) & xp.less_equal(t313, 3.0543261909900767), t313, qb5_2)))
-    t315 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t316 = t315 + t39
-    t317 = -t315 + t39
-    t318 = xp.where(xp.greater_equal(t39, -3.0543261909900767) & xp.less_equal(t39, 3.0543261909900767), t39, xp.where(xp.greater_equal(t316, -3.0543261909900767) & xp.less_equal(t316, 3.0543261909900767), t316, xp.where(xp.greater_equal(t317, -3.0543261909900767) & xp.less_equal(t317, 3.0543261909900767), t317, qb5_3)))
-    t319 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t320 = t319 + t40
-    t321 = -t319 + t40
-    t322 = xp.where(xp.greater_equal(t40, -2.9670597283903604) & xp.less_equal(t40, 2.9670597283903604), t40, xp.where(xp.greater_equal(t320, -2.9670597283903604) & xp.less_equal(t320, 2.9670597283903604), t320, xp.where(xp.greater_equal(t321, -2.9670597283903604) & xp.less_equal(t321, 2.9670597283903604), t321, qb5_4)))
-    t323 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t324 = t323 + t41
-    t325 = -t323 + t41
-    t326 = xp.where(xp.greater_equal(t41, -2.9670597283903604) & xp.less_equal(t41, 2.9670597283903604), t41, xp.where(xp.greater_equal(t324, -2.9670597283903604) & xp.less_equal(t324, 2.9670597283903604), t324, xp.where(xp.greater_equal(t325, -2.9670597283903604) & xp.less_equal(t325, 2.9670597283903604), t325, qb5_5)))
-    t327 = qw1*(t138 + t306)**2 + qw2*(t139 + t310)**2 + qw3*(t140 + t314)**2 + qw4*(t141 + t318)**2 + qw5*(t142 + t322)**2 + qw6*(t143 + t326)**2 + qw7*(t144 + qb5_6)**2
-    t328 = xp.greater(t42, 0)
-    t329 = xp.where(t328 & (xp.less(t293, 1) | xp.less(t327, t302)), xp.asarray(1, dtype=dtype), 0)
-    t330 = xp.where(t328, 1, t293)
-    t331 = xp.greater(t329, 0)
-    t332 = xp.where(t331, t306, t295)
-    t333 = xp.where(t331, t310, t296)
-    t334 = xp.where(t331, t314, t297)
-    t335 = xp.where(t331, t318, t298)
-    t336 = xp.where(t331, t322, t299)
-    t337 = xp.where(t331, t326, t300)
-    t338 = xp.where(t331, qb5_6, t301)
-    t339 = xp.where(t331, t327, t302)
-    t340 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t341 = t340 + t43
-    t342 = -t340 + t43
-    t343 = xp.where(xp.greater_equal(t43, -3.0543261909900767) & xp.less_equal(t43, 3.0543261909900767), t43, xp.where(xp.greater_equal(t341, -3.0543261909900767) & xp.less_equal(t341, 3.0543261909900767), t341, xp.where(xp.greater_equal(t342, -3.0543261909900767) & xp.less_equal(t342, 3.0543261909900767), t342, qb6_0)))
-    t344 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t345 = t344 + t44
-    t346 = -t344 + t44
-    t347 = xp.where(xp.greater_equal(t44, -3.822271061867582) & xp.less_equal(t44, 2.2863813201125716), t44, xp.where(xp.greater_equal(t345, -3.822271061867582) & xp.less_equal(t345, 2.2863813201125716), t345, xp.where(xp.greater_equal(t346, -3.822271061867582) & xp.less_equal(t346, 2.2863813201125716), t346, qb6_1)))
-    t348 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t349 = t348 + t45
-    t350 = -t348 + t45
-    t351 = xp.where(xp.greater_equal(t45, -3.0543261909900767) & xp.less_equal(t45, 3.0543261909900767), t45, xp.where(xp.greater_equal(t349, -3.0543261909900767) & xp.less_equal(t349, 3.0543261909900767), t349, xp.where(xp.greater_equal(t350, -3.0543261909900767) & xp.less_equal(t350, 3.0543261909900767), t350, qb6_2)))
-    t352 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t353 = t352 + t46
-    t354 = -t352 + t46
-    t355 = xp.where(xp.greater_equal(t46, -3.0543261909900767) & xp.less_equal(t46, 3.0543261909900767), t46, xp.where(xp.greater_equal(t353, -3.0543261909900767) & xp.less_equal(t353, 3.0543261909900767), t353, xp.where(xp.greater_equal(t354, -3.0543261909900767) & xp.less_equal(t354, 3.0543261909900767), t354, qb6_3)))
-    t356 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t357 = t356 + t47
-    t358 = -t356 + t47
-    t359 = xp.where(xp.greater_equal(t47, -2.9670597283903604) & xp.less_equal(t47, 2.9670597283903604), t47, xp.where(xp.greater_equal(t357, -2.9670597283903604) & xp.less_equal(t357, 2.9670597283903604), t357, xp.where(xp.greater_equal(t358, -2.9670597283903604) & xp.less_equal(t358, 2.9670597283903604), t358, qb6_4)))
-    t360 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t361 = t360 + t48
-    t362 = -t360 + t48
-    t363 = xp.where(xp.greater_equal(t48, -2.9670597283903604) & xp.less_equal(t48, 2.9670597283903604), t48, xp.where(xp.greater_equal(t361, -2.9670597283903604) & xp.less_equal(t361, 2.9670597283903604), t361, xp.where(xp.greater_equal(t362, -2.9670597283903604) & xp.less_equal(t362, 2.9670597283903604), t362, qb6_5)))
-    t364 = qw1*(t138 + t343)**2 + qw2*(t139 + t347)**2 + qw3*(t140 + t351)**2 + qw4*(t141 + t355)**2 + qw5*(t142 + t359)**2 + qw6*(t143 + t363)**2 + qw7*(t144 + qb6_6)**2
-    t365 = xp.greater(t49, 0)
-    t366 = xp.where(t365 & (xp.less(t330, 1) | xp.less(t364, t339)), xp.asarray(1, dtype=dtype), 0)
-    t367 = xp.where(t365, 1, t330)
-    t368 = xp.greater(t366, 0)
-    t369 = xp.where(t368, t343, t332)
-    t370 = xp.where(t368, t347, t333)
-    t371 = xp.where(t368, t351, t334)
-    t372 = xp.where(t368, t355, t335)
-    t373 = xp.where(t368, t359, t336)
-    t374 = xp.where(t368, t363, t337)
-    t375 = xp.where(t368, qb6_6, t338)
-    t376 = xp.where(t368, t364, t339)
-    t377 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t378 = t377 + t50
-    t379 = -t377 + t50
-    t380 = xp.where(xp.greater_equal(t50, -3.0543261909900767) & xp.less_equal(t50, 3.0543261909900767), t50, xp.where(xp.greater_equal(t378, -3.0543261909900767) & xp.less_equal(t378, 3.0543261909900767), t378, xp.where(xp.greater_equal(t379, -3.0543261909900767) & xp.less_equal(t379, 3.0543261909900767), t379, qb7_0)))
-    t381 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t382 = t381 + t51
-    t383 = -t381 + t51
-    t384 = xp.where(xp.greater_equal(t51, -3.822271061867582) & xp.less_equal(t51, 2.2863813201125716), t51, xp.where(xp.greater_equal(t382, -3.822271061867582) & xp.less_equal(t382, 2.2863813201125716), t382, xp.where(xp.greater_equal(t383, -3.822271061867582) & xp.less_equal(t383, 2.2863813201125716), t383, qb7_1)))
-    t385 = xp.where(xp.less(t52, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t386 = t385 + t52
-    t387 = -t385 + t52
-    t388 = xp.where(xp.greater_equal(t52, -3.0543261909900767) & xp.less_equal(t52, 3.0543261909900767), t52, xp.where(xp.greater_equal(t386, -3.0543261909900767) & xp.less_equal(t386, 3.0543261909900767), t386, xp.where(xp.greater_equal(t387, -3.0543261909900767) & xp.less_equal(t387, 3.0543261909900767), t387, qb7_2)))
-    t389 = xp.where(xp.less(t53, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t390 = t389 + t53
-    t391 = -t389 + t53
-    t392 = xp.where(xp.greater_equal(t53, -3.0543261909900767) & xp.less_equal(t53, 3.0543261909900767), t53, xp.where(xp.greater_equal(t390, -3.0543261909900767) & xp.less_equal(t390, 3.0543261909900767), t390, xp.where(xp.greater_equal(t391, -3.0543261909900767) & xp.less_equal(t391, 3.0543261909900767), t391, qb7_3)))
-    t393 = xp.where(xp.less(t54, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t394 = t393 + t54
-    t395 = -t393 + t54
-    t396 = xp.where(xp.greater_equal(t54, -2.9670597283903604) & xp.less_equal(t54, 2.9670597283903604), t54, xp.where(xp.greater_equal(t394, -2.9670597283903604) & xp.less_equal(t394, 2.9670597283903604), t394, xp.where(xp.greater_equal(t395, -2.9670597283903604) & xp.less_equal(t395, 2.9670597283903604), t395, qb7_4)))
-    t397 = xp.where(xp.less(t55, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t398 = t397 + t55
-    t399 = -t397 + t55
-    t400 = xp.where(xp.greater_equal(t55, -2.9670597283903604) & xp.less_equal(t55, 2.9670597283903604), t55, xp.where(xp.greater_equal(t398, -2.9670597283903604) & xp.less_equal(t398, 2.9670597283903604), t398, xp.where(xp.greater_equal(t399, -2.9670597283903604) & xp.less_equal(t399, 2.9670597283903604), t399, qb7_5)))
-    t401 = qw1*(t138 + t380)**2 + qw2*(t139 + t384)**2 + qw3*(t140 + t388)**2 + qw4*(t141 + t392)**2 + qw5*(t142 + t396)**2 + qw6*(t143 + t400)**2 + qw7*(t144 + qb7_6)**2
-    t402 = xp.greater(t56, 0)
-    t403 = xp.where(t402 & (xp.less(t367, 1) | xp.less(t401, t376)), xp.asarray(1, dtype=dtype), 0)
-    t404 = xp.where(t402, 1, t367)
-    t405 = xp.greater(t403, 0)
-    t406 = xp.where(t405, t380, t369)
-    t407 = xp.where(t405, t384, t370)
-    t408 = xp.where(t405, t388, t371)
-    t409 = xp.where(t405, t392, t372)
-    t410 = xp.where(t405, t396, t373)
-    t411 = xp.where(t405, t400, t374)
-    t412 = xp.where(t405, qb7_6, t375)
-    t413 = xp.where(t405, t401, t376)
-    t414 = xp.where(xp.less(t57, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t415 = t414 + t57
-    t416 = -t414 + t57
-    t417 = xp.where(xp.greater_equal(t57, -3.0543261909900767) & xp.less_equal(t57, 3.0543261909900767), t57, xp.where(xp.greater_equal(t415, -3.0543261909900767) & xp.less_equal(t415, 3.0543261909900767), t415, xp.where(xp.greater_equal(t416, -3.0543261909900767) & xp.less_equal(t416, 3.0543261909900767), t416, qb8_0)))
-    t418 = xp.where(xp.less(t58, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t419 = t418 + t58
-    t420 = -t418 + t58
-    t421 = xp.where(xp.greater_equal(t58, -3.822271061867582) & xp.less_equal(t58, 2.2863813201125716), t58, xp.where(xp.greater_equal(t419, -3.822271061867582) & xp.less_equal(t419, 2.2863813201125716), t419, xp.where(xp.greater_equal(t420, -3.822271061867582) & xp.less_equal(t420, 2.2863813201125716), t420, qb8_1)))
-    t422 = xp.where(xp.less(t59, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t423 = t422 + t59
-    t424 = -t422 + t59
-    t425 = xp.where(xp.greater_equal(t59, -3.0543261909900767) & xp.less_equal(t59, 3.0543261909900767), t59, xp.where(xp.greater_equal(t423, -3.0543261909900767) & xp.less_equal(t423, 3.0543261909900767), t423, xp.where(xp.greater_equal(t424, -3.0543261909900767) & xp.less_equal(t424, 3.0543261909900767), t424, qb8_2)))
-    t426 = xp.where(xp.less(t60, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t427 = t426 + t60
-    t428 = -t426 + t60
-    t429 = xp.where(xp.greater_equal(t60, -3.0543261909900767) & xp.less_equal(t60, 3.0543261909900767), t60, xp.where(xp.greater_equal(t427, -3.0543261909900767) & xp.less_equal(t427, 3.0543261909900767), t427, xp.where(xp.greater_equal(t428, -3.0543261909900767) & xp.less_equal(t428, 3.0543261909900767), t428, qb8_3)))
-    t430 = xp.where(xp.less(t61, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t431 = t430 + t61
-    t432 = -t430 + t61
-    t433 = xp.where(xp.greater_equal(t61, -2.9670597283903604) & xp.less_equal(t61, 2.9670597283903604), t61, xp.where(xp.greater_equal(t431, -2.9670597283903604) & xp.less_equal(t431, 2.9670597283903604), t431, xp.where(xp.greater_equal(t432, -2.9670597283903604) & xp.less_equal(t432, 2.9670597283903604), t432, qb8_4)))
-    t434 = xp.where(xp.less(t62, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t435 = t434 + t62
-    t436 = -t434 + t62
-    t437 = xp.where(xp.greater_equal(t62, -2.9670597283903604) & xp.less_equal(t62, 2.9670597283903604), t62, xp.where(xp.greater_equal(t435, -2.9670597283903604) & xp.less_equal(t435, 2.9670597283903604), t435, xp.where(xp.greater_equal(t436, -2.9670597283903604) & xp.less_equal(t436, 2.9670597283903604), t436, qb8_5)))
-    t438 = qw1*(t138 + t417)**2 + qw2*(t139 + t421)**2 + qw3*(t140 + t425)**2 + qw4*(t141 + t429)**2 + qw5*(t142 + t433)**2 + qw6*(t143 + t437)**2 + qw7*(t144 + qb8_6)**2
-    t439 = xp.greater(t63, 0)
-    t440 = xp.where(t439 & (xp.less(t404, 1) | xp.less(t438, t413)), xp.asarray(1, dtype=dtype), 0)
-    t441 = xp.where(t439, 1, t404)
-    t442 = xp.greater(t440, 0)
-    t443 = xp.where(t442, t417, t406)
-    t444 = xp.where(t442, t421, t407)
-    t445 = xp.where(t442, t425, t408)
-    t446 = xp.where(t442, t429, t409)
-    t447 = xp.where(t442, t433, t410)
-    t448 = xp.where(t442, t437, t411)
-    t449 = xp.where(t442, qb8_6, t412)
-    t450 = xp.where(t442, t438, t413)
-    t451 = xp.where(xp.less(t64, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t452 = t451 + t64
-    t453 = -t451 + t64
-    t454 = xp.where(xp.greater_equal(t64, -3.0543261909900767) & xp.less_equal(t64, 3.0543261909900767), t64, xp.where(xp.greater_equal(t452, -3.0543261909900767) & xp.less_equal(t452, 3.0543261909900767), t452, xp.where(xp.greater_equal(t453, -3.0543261909900767) & xp.less_equal(t453, 3.0543261909900767), t453, qb9_0)))
-    t455 = xp.where(xp.less(t65, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t456 = t455 + t65
-    t457 = -t455 + t65
-    t458 = xp.where(xp.greater_equal(t65, -3.822271061867582) & xp.less_equal(t65, 2.2863813201125716), t65, xp.where(xp.greater_equal(t456, -3.822271061867582) & xp.less_equal(t456, 2.2863813201125716), t456, xp.where(xp.greater_equal(t457, -3.822271061867582) & xp.less_equal(t457, 2.2863813201125716), t457, qb9_1)))
-    t459 = xp.where(xp.less(t66, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t460 = t459 + t66
-    t461 = -t459 + t66
-    t462 = xp.where(xp.greater_equal(t66, -3.0543261909900767) & xp.less_equal(t66, 3.0543261909900767), t66, xp.where(xp.greater_equal(t460, -3.0543261909900767) & xp.less_equal(t460, 3.0543261909900767), t460, xp.where(xp.greater_equal(t461, -3.0543261909900767) & xp.less_equal(t461, 3.0543261909900767), t461, qb9_2)))
-    t463 = xp.where(xp.less(t67, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t464 = t463 + t67
-    t465 = -t463 + t67
-    t466 = xp.where(xp.greater_equal(t67, -3.0543261909900767) & xp.less_equal(t67, 3.0543261909900767), t67, xp.where(xp.greater_equal(t464, -3.0543261909900767) & xp.less_equal(t464, 3.0543261909900767), t464, xp.where(xp.greater_equal(t465, -3.0543261909900767) & xp.less_equal(t465, 3.0543261909900767), t465, qb9_3)))
-    t467 = xp.where(xp.less(t68, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t468 = t467 + t68
-    t469 = -t467 + t68
-    t470 = xp.where(xp.greater_equal(t68, -2.9670597283903604) & xp.less_equal(t68, 2.9670597283903604), t68, xp.where(xp.greater_equal(t468, -2.9670597283903604) & xp.less_equal(t468, 2.9670597283903604), t468, xp.where(xp.greater_equal(t469, -2.9670597283903604) & xp.less_equal(t469, 2.9670597283903604), t469, qb9_4)))
-    t471 = xp.where(xp.less(t69, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t472 = t471 + t69
-    t473 = -t471 + t69
-    t474 = xp.where(xp.greater_equal(t69, -2.9670597283903604) & xp.less_equal(t69, 2.9670597283903604), t69, xp.where(xp.greater_equal(t472, -2.9670597283903604) & xp.less_equal(t472, 2.9670597283903604), t472, xp.where(xp.greater_equal(t473, -2.9670597283903604) & xp.less_equal(t473, 2.9670597283903604), t473, qb9_5)))
-    t475 = qw1*(t138 + t454)**2 + qw2*(t139 + t458)**2 + qw3*(t140 + t462)**2 + qw4*(t141 + t466)**2 + qw5*(t142 + t470)**2 + qw6*(t143 + t474)**2 + qw7*(t144 + qb9_6)**2
-    t476 = xp.greater(t70, 0)
-    t477 = xp.where(t476 & (xp.less(t441, 1) | xp.less(t475, t450)), xp.asarray(1, dtype=dtype), 0)
-    t478 = xp.where(t476, 1, t441)
-    t479 = xp.greater(t477, 0)
-    t480 = xp.where(t479, t454, t443)
-    t481 = xp.where(t479, t458, t444)
-    t482 = xp.where(t479, t462, t445)
-    t483 = xp.where(t479, t466, t446)
-    t484 = xp.where(t479, t470, t447)
-    t485 = xp.where(t479, t474, t448)
-    t486 = xp.where(t479, qb9_6, t449)
-    t487 = xp.where(t479, t475, t450)
-    t488 = xp.where(xp.less(t71, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t489 = t488 + t71
-    t490 = -t488 + t71
-    t491 = xp.where(xp.greater_equal(t71, -3.0543261909900767) & xp.less_equal(t71, 3.0543261909900767), t71, xp.where(xp.greater_equal(t489, -3.0543261909900767) & xp.less_equal(t489, 3.0543261909900767), t489, xp.where(xp.greater_equal(t490, -3.0543261909900767) & xp.less_equal(t490, 3.0543261909900767), t490, qb10_0)))
-    t492 = xp.where(xp.less(t72, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t493 = t492 + t72
-    t494 = -t492 + t72
-    t495 = xp.where(xp.greater_equal(t72, -3.822271061867582) & xp.less_equal(t72, 2.2863813201125716), t72, xp.where(xp.greater_equal(t493, -3.822271061867582) & xp.less_equal(t493, 2.2863813201125716), t493, xp.where(xp.greater_equal(t494, -3.822271061867582) & xp.less_equal(t494, 2.2863813201125716), t494, qb10_1)))
-    t496 = xp.where(xp.less(t73, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t497 = t496 + t73
-    t498 = -t496 + t73
-    t499 = xp.where(xp.greater_equal(t73, -3.0543261909900767) & xp.less_equal(t73, 3.0543261909900767), t73, xp.where(xp.greater_equal(t497, -3.0543261909900767) & xp.less_equal(t497, 3.0543261909900767), t497, xp.where(xp.greater_equal(t498, -3.0543261909900767) & xp.less_equal(t498, 3.0543261909900767), t498, qb10_2)))
-    t500 = xp.where(xp.less(t74, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t501 = t500 + t74
-    t502 = -t500 + t74
-    t503 = xp.where(xp.greater_equal(t74, -3.0543261909900767) & xp.less_equal(t74, 3.0543261909900767), t74, xp.where(xp.greater_equal(t501, -3.0543261909900767) & xp.less_equal(t501, 3.0543261909900767), t501, xp.where(xp.greater_equal(t502, -3.0543261909900767) & xp.less_equal(t502, 3.0543261909900767), t502, qb10_3)))
-    t504 = xp.where(xp.less(t75, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t505 = t504 + t75
-    t506 = -t504 + t75
-    t507 = xp.where(xp.greater_equal(t75, -2.9670597283903604) & xp.less_equal(t75, 2.9670597283903604), t75, xp.where(xp.greater_equal(t505, -2.9670597283903604) & xp.less_equal(t505, 2.9670597283903604), t505, xp.where(xp.greater_equal(t506, -2.9670597283903604) & xp.less_equal(t506, 2.9670597283903604), t506, qb10_4)))
-    t508 = xp.where(xp.less(t76, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t509 = t508 + t76
-    t510 = -t508 + t76
-    t511 = xp.where(xp.greater_equal(t76, -2.9670597283903604) & xp.less_equal(t76, 2.9670597283903604), t76, xp.where(xp.greater_equal(t509, -2.9670597283903604) & xp.less_equal(t509, 2.9670597283903604), t509, xp.where(xp.greater_equal(t510, -2.9670597283903604) & xp.less_equal(t510, 2.9670597283903604), t510, qb10_5)))
-    t512 = qw1*(t138 + t491)**2 + qw2*(t139 + t495)**2 + qw3*(t140 + t499)**2 + qw4*(t141 + t503)**2 + qw5*(t142 + t507)**2 + qw6*(t143 + t511)**2 + qw7*(t144 + qb10_6)**2
-    t513 = xp.greater(t77, 0)
-    t514 = xp.where(t513 & (xp.less(t478, 1) | xp.less(t512, t487)), xp.asarray(1, dtype=dtype), 0)
-    t515 = xp.where(t513, 1, t478)
-    t516 = xp.greater(t514, 0)
-    t517 = xp.where(t516, t491, t480)
-    t518 = xp.where(t516, t495, t481)
-    t519 = xp.where(t516, t499, t482)
-    t520 = xp.where(t516, t503, t483)
-    t521 = xp.where(t516, t507, t484)
-    t522 = xp.where(t516, t511, t485)
-    t523 = xp.where(t516, qb10_6, t486)
-    t524 = xp.where(t516, t512, t487)
-    t525 = xp.where(xp.less(t78, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t526 = t525 + t78
-    t527 = -t525 + t78
-    t528 = xp.where(xp.greater_equal(t78, -3.0543261909900767) & xp.less_equal(t78, 3.0543261909900767), t78, xp.where(xp.greater_equal(t526, -3.0543261909900767) & xp.less_equal(t526, 3.0543261909900767), t526, xp.where(xp.greater_equal(t527, -3.0543261909900767) & xp.less_equal(t527, 3.0543261909900767), t527, qb11_0)))
-    t529 = xp.where(xp.less(t79, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t530 = t529 + t79
-    t531 = -t529 + t79
-    t532 = xp.where(xp.greater_equal(t79, -3.822271061867582) & xp.less_equal(t79, 2.2863813201125716), t79, xp.where(xp.greater_equal(t530, -3.822271061867582) & xp.less_equal(t530, 2.2863813201125716), t530, xp.where(xp.greater_equal(t531, -3.822271061867582) & xp.less_equal(t531, 2.2863813201125716), t531, qb11_1)))
-    t533 = xp.where(xp.less(t80, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t534 = t533 + t80
-    t535 = -t533 + t80
-    t536 = xp.where(xp.greater_equal(t80, -3.0543261909900767) & xp.less_equal(t80, 3.0543261909900767), t80, xp.where(xp.greater_equal(t534, -3.0543261909900767) & xp.less_equal(t534, 3.0543261909900767), t534, xp.where(xp.greater_equal(t535, -3.0543261909900767) & xp.less_equal(t535, 3.0543261909900767), t535, qb11_2)))
-    t537 = xp.where(xp.less(t81, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t538 = t537 + t81
-    t539 = -t537 + t81
-    t540 = xp.where(xp.greater_equal(t81, -3.0543261909900767) & xp.less_equal(t81, 3.0543261909900767), t81, xp.where(xp.greater_equal(t538, -3.0543261909900767) & xp.less_equal(t538, 3.0543261909900767), t538, xp.where(xp.greater_equal(t539, -3.0543261909900767) & xp.less_equal(t539, 3.0543261909900767), t539, qb11_3)))
-    t541 = xp.where(xp.less(t82, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t542 = t541 + t82
-    t543 = -t541 + t82
-    t544 = xp.where(xp.greater_equal(t82, -2.9670597283903604) & xp.less_equal(t82, 2.9670597283903604), t82, xp.where(xp.greater_equal(t542, -2.9670597283903604) & xp.less_equal(t542, 2.9670597283903604), t542, xp.where(xp.greater_equal(t543, -2.9670597283903604) & xp.less_equal(t543, 2.9670597283903604), t543, qb11_4)))
-    t545 = xp.where(xp.less(t83, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t546 = t545 + t83
-    t547 = -t545 + t83
-    t548 = xp.where(xp.greater_equal(t83, -2.9670597283903604) & xp.less_equal(t83, 2.9670597283903604), t83, xp.where(xp.greater_equal(t546, -2.9670597283903604) & xp.less_equal(t546, 2.9670597283903604), t546, xp.where(xp.greater_equal(t547, -2.9670597283903604) & xp.less_equal(t547, 2.9670597283903604), t547, qb11_5)))
-    t549 = qw1*(t138 + t528)**2 + qw2*(t139 + t532)**2 + qw3*(t140 + t536)**2 + qw4*(t141 + t540)**2 + qw5*(t142 + t544)**2 + qw6*(t143 + t548)**2 + qw7*(t144 + qb11_6)**2
-    t550 = xp.greater(t84, 0)
-    t551 = xp.where(t550 & (xp.less(t515, 1) | xp.less(t549, t524)), xp.asarray(1, dtype=dtype), 0)
-    t552 = xp.where(t550, 1, t515)
-    t553 = xp.greater(t551, 0)
-    t554 = xp.where(t553, t528, t517)
-    t555 = xp.where(t553, t532, t518)
-    t556 = xp.where(t553, t536, t519)
-    t557 = xp.where(t553, t540, t520)
-    t558 = xp.where(t553, t544, t521)
-    t559 = xp.where(t553, t548, t522)
-    t560 = xp.where(t553, qb11_6, t523)
-    t561 = xp.where(t553, t549, t524)
-    t562 = xp.where(xp.less(t85, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t563 = t562 + t85
-    t564 = -t562 + t85
-    t565 = xp.where(xp.greater_equal(t85, -3.0543261909900767) & xp.less_equal(t85, 3.0543261909900767), t85, xp.where(xp.greater_equal(t563, -3.0543261909900767) & xp.less_equal(t563, 3.0543261909900767), t563, xp.where(xp.greater_equal(t564, -3.0543261909900767) & xp.less_equal(t564, 3.0543261909900767), t564, qb12_0)))
-    t566 = xp.where(xp.less(t86, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t567 = t566 + t86
-    t568 = -t566 + t86
-    t569 = xp.where(xp.greater_equal(t86, -3.822271061867582) & xp.less_equal(t86, 2.2863813201125716), t86, xp.where(xp.greater_equal(t567, -3.822271061867582) & xp.less_equal(t567, 2.2863813201125716), t567, xp.where(xp.greater_equal(t568, -3.822271061867582) & xp.less_equal(t568, 2.2863813201125716), t568, qb12_1)))
-    t570 = xp.where(xp.less(t87, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t571 = t570 + t87
-    t572 = -t570 + t87
-    t573 = xp.where(xp.greater_equal(t87, -3.0543261909900767) & xp.less_equal(t87, 3.0543261909900767), t87, xp.where(xp.greater_equal(t571, -3.0543261909900767) & xp.less_equal(t571, 3.0543261909900767), t571, xp.where(xp.greater_equal(t572, -3.0543261909900767) & xp.less_equal(t572, 3.0543261909900767), t572, qb12_2)))
-    t574 = xp.where(xp.less(t88, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t575 = t574 + t88
-    t576 = -t574 + t88
-    t577 = xp.where(xp.greater_equal(t88, -3.0543261909900767) & xp.less_equal(t88, 3.0543261909900767), t88, xp.where(xp.greater_equal(t575, -3.0543261909900767) & xp.less_equal(t575, 3.0543261909900767), t575, xp.where(xp.greater_equal(t576, -3.0543261909900767) & xp.less_equal(t576, 3.0543261909900767), t576, qb12_3)))
-    t578 = xp.where(xp.less(t89, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t579 = t578 + t89
-    t580 = -t578 + t89
-    t581 = xp.where(xp.greater_equal(t89, -2.9670597283903604) & xp.less_equal(t89, 2.9670597283903604), t89, xp.where(xp.greater_equal(t579, -2.9670597283903604) & xp.less_equal(t579, 2.9670597283903604), t579, xp.where(xp.greater_equal(t580, -2.9670597283903604) & xp.less_equal(t580, 2.9670597283903604), t580, qb12_4)))
-    t582 = xp.where(xp.less(t90, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t583 = t582 + t90
-    t584 = -t582 + t90
-    t585 = xp.where(xp.greater_equal(t90, -2.9670597283903604) & xp.less_equal(t90, 2.9670597283903604), t90, xp.where(xp.greater_equal(t583, -2.9670597283903604) & xp.less_equal(t583, 2.9670597283903604), t583, xp.where(xp.greater_equal(t584, -2.9670597283903604) & xp.less_equal(t584, 2.9670597283903604), t584, qb12_5)))
-    t586 = qw1*(t138 + t565)**2 + qw2*(t139 + t569)**2 + qw3*(t140 + t573)**2 + qw4*(t141 + t577)**2 + qw5*(t142 + t581)**2 + qw6*(t143 + t585)**2 + qw7*(t144 + qb12_6)**2
-    t587 = xp.greater(t91, 0)
-    t588 = xp.where(t587 & (xp.less(t552, 1) | xp.less(t586, t561)), xp.asarray(1, dtype=dtype), 0)
-    t589 = xp.where(t587, 1, t552)
-    t590 = xp.greater(t588, 0)
-    t591 = xp.where(t590, t565, t554)
-    t592 = xp.where(t590, t569, t555)
-    t593 = xp.where(t590, t573, t556)
-    t594 = xp.where(t590, t577, t557)
-    t595 = xp.where(t590, t581, t558)
-    t596 = xp.where(t590, t585, t559)
-    t597 = xp.where(t590, qb12_6, t560)
-    t598 = xp.where(t590, t586, t561)
-    t599 = xp.where(xp.less(t92, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t600 = t599 + t92
-    t601 = -t599 + t92
-    t602 = xp.where(xp.greater_equal(t92, -3.0543261909900767) & xp.less_equal(t92, 3.0543261909900767), t92, xp.where(xp.greater_equal(t600, -3.0543261909900767) & xp.less_equal(t600, 3.0543261909900767), t600, xp.where(xp.greater_equal(t601, -3.0543261909900767) & xp.less_equal(t601, 3.0543261909900767), t601, qb13_0)))
-    t603 = xp.where(xp.less(t93, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t604 = t603 + t93
-    t605 = -t603 + t93
-    t606 = xp.where(xp.greater_equal(t93, -3.822271061867582) & xp.less_equal(t93, 2.2863813201125716), t93, xp.where(xp.greater_equal(t604, -3.822271061867582) & xp.less_equal(t604, 2.2863813201125716), t604, xp.where(xp.greater_equal(t605, -3.822271061867582) & xp.less_equal(t605, 2.2863813201125716), t605, qb13_1)))
-    t607 = xp.where(xp.less(t94, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t608 = t607 + t94
-    t609 = -t607 + t94
-    t610 = xp.where(xp.greater_equal(t94, -3.0543261909900767) & xp.less_equal(t94, 3.0543261909900767), t94, xp.where(xp.greater_equal(t608, -3.0543261909900767) & xp.less_equal(t608, 3.0543261909900767), t608, xp.where(xp.greater_equal(t609, -3.0543261909900767) & xp.less_equal(t609, 3.0543261909900767), t609, qb13_2)))
-    t611 = xp.where(xp.less(t95, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t612 = t611 + t95
-    t613 = -t611 + t95
-    t614 = xp.where(xp.greater_equal(t95, -3.0543261909900767) & xp.less_equal(t95, 3.0543261909900767), t95, xp.where(xp.greater_equal(t612, -3.0543261909900767) & xp.less_equal(t612, 3.0543261909900767), t612, xp.where(xp.greater_equal(t613, -3.0543261909900767) & xp.less_equal(t613, 3.0543261909900767), t613, qb13_3)))
-    t615 = xp.where(xp.less(t96, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t616 = t615 + t96
-    t617 = -t615 + t96
-    t618 = xp.where(xp.greater_equal(t96, -2.9670597283903604) & xp.less_equal(t96, 2.9670597283903604), t96, xp.where(xp.greater_equal(t616, -2.9670597283903604) & xp.less_equal(t616, 2.9670597283903604), t616, xp.where(xp.greater_equal(t617, -2.9670597283903604) & xp.less_equal(t617, 2.9670597283903604), t617, qb13_4)))
-    t619 = xp.where(xp.less(t97, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t620 = t619 + t97
-    t621 = -t619 + t97
-    t622 = xp.where(xp.greater_equal(t97, -2.9670597283903604) & xp.less_equal(t97, 2.9670597283903604), t97, xp.where(xp.greater_equal(t620, -2.9670597283903604) & xp.less_equal(t620, 2.9670597283903604), t620, xp.where(xp.greater_equal(t621, -2.9670597283903604) & xp.less_equal(t621, 2.9670597283903604), t621, qb13_5)))
-    t623 = qw1*(t138 + t602)**2 + qw2*(t139 + t606)**2 + qw3*(t140 + t610)**2 + qw4*(t141 + t614)**2 + qw5*(t142 + t618)**2 + qw6*(t143 + t622)**2 + qw7*(t144 + qb13_6)**2
-    t624 = xp.greater(t98, 0)
-    t625 = xp.where(t624 & (xp.less(t589, 1) | xp.less(t623, t598)), xp.asarray(1, dtype=dtype), 0)
-    t626 = xp.where(t624, 1, t589)
-    t627 = xp.greater(t625, 0)
-    t628 = xp.where(t627, t602, t591)
-    t629 = xp.where(t627, t606, t592)
-    t630 = xp.where(t627, t610, t593)
-    t631 = xp.where(t627, t614, t594)
-    t632 = xp.where(t627, t618, t595)
-    t633 = xp.where(t627, t622, t596)
-    t634 = xp.where(t627, qb13_6, t597)
-    t635 = xp.where(t627, t623, t598)
-    t636 = xp.where(xp.less(t99, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t637 = t636 + t99
-    t638 = -t636 + t99
-    t639 = xp.where(xp.greater_equal(t99, -3.0543261909900767) & xp.less_equal(t99, 3.0543261909900767), t99, xp.where(xp.greater_equal(t637, -3.0543261909900767) & xp.less_equal(t637, 3.0543261909900767), t637, xp.where(xp.greater_equal(t638, -3.0543261909900767) & xp.less_equal(t638, 3.0543261909900767), t638, qb14_0)))
-    t640 = xp.where(xp.less(t100, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t641 = t640 + t100
-    t642 = -t640 + t100
-    t643 = xp.where(xp.greater_equal(t100, -3.822271061867582) & xp.less_equal(t100, 2.2863813201125716), t100, xp.where(xp.greater_equal(t641, -3.822271061867582) & xp.less_equal(t641, 2.2863813201125716), t641, xp.where(xp.greater_equal(t642, -3.822271061867582) & xp.less_equal(t642, 2.2863813201125716), t642, qb14_1)))
-    t644 = xp.where(xp.less(t101, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t645 = t644 + t101
-    t646 = -t644 + t101
-    t647 = xp.where(xp.greater_equal(t101, -3.0543261909900767) & xp.less_equal(t101, 3.0543261909900767), t101, xp.where(xp.greater_equal(t645, -3.0543261909900767) & xp.less_equal(t645, 3.0543261909900767), t645, xp.where(xp.greater_equal(t646, -3.0543261909900767) & xp.less_equal(t646, 3.0543261909900767), t646, qb14_2)))
-    t648 = xp.where(xp.less(t102, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t649 = t648 + t102
-    t650 = -t648 + t102
-    t651 = xp.where(xp.greater_equal(t102, -3.0543261909900767) & xp.less_equal(t102, 3.0543261909900767), t102, xp.where(xp.greater_equal(t649, -3.0543261909900767) & xp.less_equal(t649, 3.0543261909900767), t649, xp.where(xp.greater_equal(t650, -3.0543261909900767) & xp.less_equal(t650, 3.0543261909900767), t650, qb14_3)))
-    t652 = xp.where(xp.less(t103, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t653 = t652 + t103
-    t654 = -t652 + t103
-    t655 = xp.where(xp.greater_equal(t103, -2.9670597283903604) & xp.less_equal(t103, 2.9670597283903604), t103, xp.where(xp.greater_equal(t653, -2.9670597283903604) & xp.less_equal(t653, 2.9670597283903604), t653, xp.where(xp.greater_equal(t654, -2.9670597283903604) & xp.less_equal(t654, 2.9670597283903604), t654, qb14_4)))
-    t656 = xp.where(xp.less(t104, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t657 = t656 + t104
-    t658 = -t656 + t104
-    t659 = xp.where(xp.greater_equal(t104, -2.9670597283903604) & xp.less_equal(t104, 2.9670597283903604), t104, xp.where(xp.greater_equal(t657, -2.9670597283903604) & xp.less_equal(t657, 2.9670597283903604), t657, xp.where(xp.greater_equal(t658, -2.9670597283903604) & xp.less_equal(t658, 2.9670597283903604), t658, qb14_5)))
-    t660 = qw1*(t138 + t639)**2 + qw2*(t139 + t643)**2 + qw3*(t140 + t647)**2 + qw4*(t141 + t651)**2 + qw5*(t142 + t655)**2 + qw6*(t143 + t659)**2 + qw7*(t144 + qb14_6)**2
-    t661 = xp.greater(t105, 0)
-    t662 = xp.where(t661 & (xp.less(t626, 1) | xp.less(t660, t635)), xp.asarray(1, dtype=dtype), 0)
-    t663 = xp.where(t661, 1, t626)
-    t664 = xp.greater(t662, 0)
-    t665 = xp.where(t664, t639, t628)
-    t666 = xp.where(t664, t643, t629)
-    t667 = xp.where(t664, t647, t630)
-    t668 = xp.where(t664, t651, t631)
-    t669 = xp.where(t664, t655, t632)
-    t670 = xp.where(t664, t659, t633)
-    t671 = xp.where(t664, qb14_6, t634)
-    t672 = xp.where(t664, t660, t635)
-    t673 = xp.where(xp.less(t106, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t674 = t673 + t106
-    t675 = -t673 + t106
-    t676 = xp.where(xp.greater_equal(t106, -3.0543261909900767) & xp.less_equal(t106, 3.0543261909900767), t106, xp.where(xp.greater_equal(t674, -3.0543261909900767) & xp.less_equal(t674, 3.0543261909900767), t674, xp.where(xp.greater_equal(t675, -3.0543261909900767) & xp.less_equal(t675, 3.0543261909900767), t675, qb15_0)))
-    t677 = xp.where(xp.less(t107, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t678 = t677 + t107
-    t679 = -t677 + t107
-    t680 = xp.where(xp.greater_equal(t107, -3.822271061867582) & xp.less_equal(t107, 2.2863813201125716), t107, xp.where(xp.greater_equal(t678, -3.822271061867582) & xp.less_equal(t678, 2.2863813201125716), t678, xp.where(xp.greater_equal(t679, -3.822271061867582) & xp.less_equal(t679, 2.2863813201125716), t679, qb15_1)))
-    t681 = xp.where(xp.less(t108, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t682 = t681 + t108
-    t683 = -t681 + t108
-    t684 = xp.where(xp.greater_equal(t108, -3.0543261909900767) & xp.less_equal(t108, 3.0543261909900767), t108, xp.where(xp.greater_equal(t682, -3.0543261909900767) & xp.less_equal(t682, 3.0543261909900767), t682, xp.where(xp.greater_equal(t683, -3.0543261909900767) & xp.less_equal(t683, 3.0543261909900767), t683, qb15_2)))
-    t685 = xp.where(xp.less(t109, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t686 = t685 + t109
-    t687 = -t685 + t109
-    t688 = xp.where(xp.greater_equal(t109, -3.0543261909900767) & xp.less_equal(t109, 3.0543261909900767), t109, xp.where(xp.greater_equal(t686, -3.0543261909900767) & xp.less_equal(t686, 3.0543261909900767), t686, xp.where(xp.greater_equal(t687, -3.0543261909900767) & xp.less_equal(t687, 3.0543261909900767), t687, qb15_3)))
-    t689 = xp.where(xp.less(t110, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t690 = t689 + t110
-    t691 = -t689 + t110
-    t692 = xp.where(xp.greater_equal(t110, -2.9670597283903604) & xp.less_equal(t110, 2.9670597283903604), t110, xp.where(xp.greater_equal(t690, -2.9670597283903604) & xp.less_equal(t690, 2.9670597283903604), t690, xp.where(xp.greater_equal(t691, -2.9670597283903604) & xp.less_equal(t691, 2.9670597283903604), t691, qb15_4)))
-    t693 = xp.where(xp.less(t111, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t694 = t693 + t111
-    t695 = -t693 + t111
-    t696 = xp.where(xp.greater_equal(t111, -2.9670597283903604) & xp.less_equal(t111, 2.9670597283903604), t111, xp.where(xp.greater_equal(t694, -2.9670597283903604) & xp.less_equal(t694, 2.9670597283903604), t694, xp.where(xp.greater_equal(t695, -2.9670597283903604) & xp.less_equal(t695, 2.9670597283903604), t695, qb15_5)))
-    t697 = qw1*(t138 + t676)**2 + qw2*(t139 + t680)**2 + qw3*(t140 + t684)**2 + qw4*(t141 + t688)**2 + qw5*(t142 + t692)**2 + qw6*(t143 + t696)**2 + qw7*(t144 + qb15_6)**2
-    t698 = xp.greater(t112, 0)
-    t699 = xp.where(t698 & (xp.less(t663, 1) | xp.less(t697, t672)), xp.asarray(1, dtype=dtype), 0)
-    t700 = xp.where(t698, 1, t663)
-    t701 = xp.greater(t699, 0)
-    t702 = xp.where(t701, t676, t665)
-    t703 = xp.where(t701, t680, t666)
-    t704 = xp.where(t701, t684, t667)
-    t705 = xp.where(t701, t688, t668)
-    t706 = xp.where(t701, t692, t669)
-    t707 = xp.where(t701, t696, t670)
-    t708 = xp.where(t701, qb15_6, t671)
-    t709 = xp.greater(t700, 0)
-    t710 = xp.isfinite(t113)
-    t711 = t709 & t710
+    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7
+    t1 = _nearer_branch(xp, 1, (qb0_0, qb0_1, qb0_2, qb0_3, qb0_4, qb0_5, qb0_6, xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, qn1, qn2, qn3, qn4, qn5, qn6, qn7, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
+    t2 = _nearer_branch(xp, 1, (qb1_0, qb1_1, qb1_2, qb1_3, qb1_4, qb1_5, qb1_6, xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t1[0], t1[1], t1[2], t1[3], t1[4], t1[5], t1[6], t1[7], t1[8],))
+    t3 = _nearer_branch(xp, 1, (qb2_0, qb2_1, qb2_2, qb2_3, qb2_4, qb2_5, qb2_6, xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t2[0], t2[1], t2[2], t2[3], t2[4], t2[5], t2[6], t2[7], t2[8],))
+    t4 = _nearer_branch(xp, 1, (qb3_0, qb3_1, qb3_2, qb3_3, qb3_4, qb3_5, qb3_6, xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t3[0], t3[1], t3[2], t3[3], t3[4], t3[5], t3[6], t3[7], t3[8],))
+    t5 = _nearer_branch(xp, 1, (qb4_0, qb4_1, qb4_2, qb4_3, qb4_4, qb4_5, qb4_6, xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t4[0], t4[1], t4[2], t4[3], t4[4], t4[5], t4[6], t4[7], t4[8],))
+    t6 = _nearer_branch(xp, 1, (qb5_0, qb5_1, qb5_2, qb5_3, qb5_4, qb5_5, qb5_6, xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t5[0], t5[1], t5[2], t5[3], t5[4], t5[5], t5[6], t5[7], t5[8],))
+    t7 = _nearer_branch(xp, 1, (qb6_0, qb6_1, qb6_2, qb6_3, qb6_4, qb6_5, qb6_6, xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t6[0], t6[1], t6[2], t6[3], t6[4], t6[5], t6[6], t6[7], t6[8],))
+    t8 = _nearer_branch(xp, 1, (qb7_0, qb7_1, qb7_2, qb7_3, qb7_4, qb7_5, qb7_6, xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t7[0], t7[1], t7[2], t7[3], t7[4], t7[5], t7[6], t7[7], t7[8],))
+    t9 = _nearer_branch(xp, 1, (qb8_0, qb8_1, qb8_2, qb8_3, qb8_4, qb8_5, qb8_6, xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t8[0], t8[1], t8[2], t8[3], t8[4], t8[5], t8[6], t8[7], t8[8],))
+    t10 = _nearer_branch(xp, 1, (qb9_0, qb9_1, qb9_2, qb9_3, qb9_4, qb9_5, qb9_6, xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t9[0], t9[1], t9[2], t9[3], t9[4], t9[5], t9[6], t9[7], t9[8],))
+    t11 = _nearer_branch(xp, 1, (qb10_0, qb10_1, qb10_2, qb10_3, qb10_4, qb10_5, qb10_6, xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t10[0], t10[1], t10[2], t10[3], t10[4], t10[5], t10[6], t10[7], t10[8],))
+    t12 = _nearer_branch(xp, 1, (qb11_0, qb11_1, qb11_2, qb11_3, qb11_4, qb11_5, qb11_6, xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t11[0], t11[1], t11[2], t11[3], t11[4], t11[5], t11[6], t11[7], t11[8],))
+    t13 = _nearer_branch(xp, 1, (qb12_0, qb12_1, qb12_2, qb12_3, qb12_4, qb12_5, qb12_6, xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t12[0], t12[1], t12[2], t12[3], t12[4], t12[5], t12[6], t12[7], t12[8],))
+    t14 = _nearer_branch(xp, 1, (qb13_0, qb13_1, qb13_2, qb13_3, qb13_4, qb13_5, qb13_6, xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t13[0], t13[1], t13[2], t13[3], t13[4], t13[5], t13[6], t13[7], t13[8],))
+    t15 = _nearer_branch(xp, 1, (qb14_0, qb14_1, qb14_2, qb14_3, qb14_4, qb14_5, qb14_6, xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t14[0], t14[1], t14[2], t14[3], t14[4], t14[5], t14[6], t14[7], t14[8],))
+    t16 = _nearer_branch(xp, 1, (qb15_0, qb15_1, qb15_2, qb15_3, qb15_4, qb15_5, qb15_6, xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t15[0], t15[1], t15[2], t15[3], t15[4], t15[5], t15[6], t15[7], t15[8],))
+    t17 = xp.greater(t16[8], 0)
+    t18 = xp.isfinite(t0)
+    t19 = t17 & t18
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t711, t702, qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t711, t703, qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t711, t704, qn3), batch),  # 2
-        xp.broadcast_to(xp.where(t711, t705, qn4), batch),  # 3
-        xp.broadcast_to(xp.where(t711, t706, qn5), batch),  # 4
-        xp.broadcast_to(xp.where(t711, t707, qn6), batch),  # 5
-        xp.broadcast_to(xp.where(t711, t708, qn7), batch),  # 6
+        xp.broadcast_to(xp.where(t19, t16[0], qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t19, t16[1], qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t19, t16[2], qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t19, t16[3], qn4), batch),  # 3
+        xp.broadcast_to(xp.where(t19, t16[4], qn5), batch),  # 4
+        xp.broadcast_to(xp.where(t19, t16[5], qn6), batch),  # 5
+        xp.broadcast_to(xp.where(t19, t16[6], qn7), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t710), 2, xp.where(t709, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t18), 2, xp.where(t17, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

@@ -836,6 +836,190 @@ def _jacobi6_rows(count, state):
     return state
 
 
+def _symmetric_solve6(count, state):
+    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w1**2
+        t1 = w2**2
+        t2 = w3**2
+        t3 = w4**2
+        t4 = w5**2
+        t5 = w0**2
+        t6 = casadi.sqrt(t5 + 2*t0 + 2*t1 + 2*w7**2 + 2*t2 + 2*w8**2 + 2*w12**2 + 2*t3 + 2*w9**2 + 2*w13**2 + 2*w16**2 + 2*t4 + 2*w10**2 + 2*w14**2 + 2*w17**2 + 2*w19**2 + w6**2 + w11**2 + w15**2 + w18**2 + w20**2)
+        t7 = casadi.sqrt(t0 + t1 + t2 + t3 + t4 + t5)
+        t8 = t7*casadi.if_else((w0 >= 0), 1, -1)
+        t9 = (t7 > 0)
+        t10 = casadi.if_else(t9, 1/(w0 + t8), 0)
+        t11 = casadi.if_else(t9, 1 + casadi.fabs(w0)/t7, 0)
+        t12 = w1*t10
+        t13 = w2*t10
+        t14 = w3*t10
+        t15 = w4*t10
+        t16 = w5*t10
+        t17 = t11*(w1 + t12*w6 + t13*w7 + t14*w8 + t15*w9 + t16*w10)
+        t18 = -t17 + w1
+        t19 = w6 - t12*t17
+        t20 = w7 - t13*t17
+        t21 = w8 - t14*t17
+        t22 = w9 - t15*t17
+        t23 = w10 - t16*t17
+        t24 = t11*(w2 + t12*w7 + t13*w11 + t14*w12 + t15*w13 + t16*w14)
+        t25 = -t24 + w2
+        t26 = w7 - t12*t24
+        t27 = w11 - t13*t24
+        t28 = w12 - t14*t24
+        t29 = w13 - t15*t24
+        t30 = w14 - t16*t24
+        t31 = t11*(w3 + t12*w8 + t13*w12 + t14*w15 + t15*w16 + t16*w17)
+        t32 = -t31 + w3
+        t33 = w8 - t12*t31
+        t34 = w12 - t13*t31
+        t35 = w15 - t14*t31
+        t36 = w16 - t15*t31
+        t37 = w17 - t16*t31
+        t38 = t11*(w4 + t12*w9 + t13*w13 + t14*w16 + t15*w18 + t16*w19)
+        t39 = -t38 + w4
+        t40 = w9 - t12*t38
+        t41 = w13 - t13*t38
+        t42 = w16 - t14*t38
+        t43 = w18 - t15*t38
+        t44 = w19 - t16*t38
+        t45 = t11*(w5 + t12*w10 + t13*w14 + t14*w17 + t15*w19 + t16*w20)
+        t46 = -t45 + w5
+        t47 = w10 - t12*t45
+        t48 = w14 - t13*t45
+        t49 = w17 - t14*t45
+        t50 = w19 - t15*t45
+        t51 = w20 - t16*t45
+        t52 = t11*(w21 + t12*w22 + t13*w23 + t14*w24 + t15*w25 + t16*w26)
+        t53 = -t52 + w21
+        t54 = w22 - t12*t52
+        t55 = w23 - t13*t52
+        t56 = w24 - t14*t52
+        t57 = w25 - t15*t52
+        t58 = w26 - t16*t52
+        t59 = casadi.sqrt(t19**2 + t20**2 + t21**2 + t22**2 + t23**2)
+        t60 = t59*casadi.if_else((t19 >= 0), 1, -1)
+        t61 = (t59 > 0)
+        t62 = casadi.if_else(t61, 1/(t19 + t60), 0)
+        t63 = casadi.if_else(t61, 1 + casadi.fabs(t19)/t59, 0)
+        t64 = t20*t62
+        t65 = t21*t62
+        t66 = t22*t62
+        t67 = t23*t62
+        t68 = t63*(t26 + t64*t27 + t65*t28 + t66*t29 + t67*t30)
+        t69 = -t68 + t26
+        t70 = t27 - t64*t68
+        t71 = t28 - t65*t68
+        t72 = t29 - t66*t68
+        t73 = t30 - t67*t68
+        t74 = t63*(t33 + t64*t34 + t65*t35 + t66*t36 + t67*t37)
+        t75 = -t74 + t33
+        t76 = t34 - t64*t74
+        t77 = t35 - t65*t74
+        t78 = t36 - t66*t74
+        t79 = t37 - t67*t74
+        t80 = t63*(t40 + t64*t41 + t65*t42 + t66*t43 + t67*t44)
+        t81 = -t80 + t40
+        t82 = t41 - t64*t80
+        t83 = t42 - t65*t80
+        t84 = t43 - t66*t80
+        t85 = t44 - t67*t80
+        t86 = t63*(t47 + t64*t48 + t65*t49 + t66*t50 + t67*t51)
+        t87 = -t86 + t47
+        t88 = t48 - t64*t86
+        t89 = t49 - t65*t86
+        t90 = t50 - t66*t86
+        t91 = t51 - t67*t86
+        t92 = t63*(t54 + t64*t55 + t65*t56 + t66*t57 + t67*t58)
+        t93 = -t92 + t54
+        t94 = t55 - t64*t92
+        t95 = t56 - t65*t92
+        t96 = t57 - t66*t92
+        t97 = t58 - t67*t92
+        t98 = casadi.sqrt(t70**2 + t71**2 + t72**2 + t73**2)
+        t99 = t98*casadi.if_else((t70 >= 0), 1, -1)
+        t100 = (t98 > 0)
+        t101 = casadi.if_else(t100, 1/(t70 + t99), 0)
+        t102 = casadi.if_else(t100, 1 + casadi.fabs(t70)/t98, 0)
+        t103 = t71*t101
+        t104 = t72*t101
+        t105 = t73*t101
+        t106 = t102*(t76 + t103*t77 + t104*t78 + t105*t79)
+        t107 = -t106 + t76
+        t108 = t77 - t103*t106
+        t109 = t78 - t104*t106
+        t110 = t79 - t105*t106
+        t111 = t102*(t82 + t103*t83 + t104*t84 + t105*t85)
+        t112 = -t111 + t82
+        t113 = t83 - t103*t111
+        t114 = t84 - t104*t111
+        t115 = t85 - t105*t111
+        t116 = t102*(t88 + t103*t89 + t104*t90 + t105*t91)
+        t117 = -t116 + t88
+        t118 = t89 - t103*t116
+        t119 = t90 - t104*t116
+        t120 = t91 - t105*t116
+        t121 = t102*(t94 + t103*t95 + t104*t96 + t105*t97)
+        t122 = -t121 + t94
+        t123 = t95 - t103*t121
+        t124 = t96 - t104*t121
+        t125 = t97 - t105*t121
+        t126 = casadi.sqrt(t108**2 + t109**2 + t110**2)
+        t127 = t126*casadi.if_else((t108 >= 0), 1, -1)
+        t128 = (t126 > 0)
+        t129 = casadi.if_else(t128, 1/(t108 + t127), 0)
+        t130 = casadi.if_else(t128, 1 + casadi.fabs(t108)/t126, 0)
+        t131 = t109*t129
+        t132 = t110*t129
+        t133 = t130*(t113 + t131*t114 + t132*t115)
+        t134 = -t133 + t113
+        t135 = t114 - t131*t133
+        t136 = t115 - t132*t133
+        t137 = t130*(t118 + t131*t119 + t132*t120)
+        t138 = -t137 + t118
+        t139 = t119 - t131*t137
+        t140 = t120 - t132*t137
+        t141 = t130*(t123 + t131*t124 + t132*t125)
+        t142 = -t141 + t123
+        t143 = t124 - t131*t141
+        t144 = t125 - t132*t141
+        t145 = casadi.sqrt(t135**2 + t136**2)
+        t146 = t145*casadi.if_else((t135 >= 0), 1, -1)
+        t147 = (t145 > 0)
+        t148 = casadi.if_else(t147, 1/(t135 + t146), 0)
+        t149 = casadi.if_else(t147, 1 + casadi.fabs(t135)/t145, 0)
+        t150 = t136*t148
+        t151 = t149*(t139 + t150*t140)
+        t152 = -t151 + t139
+        t153 = t140 - t150*t151
+        t154 = t149*(t143 + t150*t144)
+        t155 = -t154 + t143
+        t156 = t144 - t150*t154
+        t157 = casadi.fabs(t153)
+        t158 = t157*casadi.if_else((t153 >= 0), 1, -1)
+        t159 = casadi.if_else((t157 > 0), 2, 0)
+        t160 = t156 - t156*t159
+        t161 = casadi.if_else((t158 != 0), -t160/t158, 0)
+        t162 = casadi.if_else((t146 != 0), -(t155 - t152*t161)/t146, 0)
+        t163 = casadi.if_else((t127 != 0), -(-(t134*t162 + t138*t161) + t142)/t127, 0)
+        t164 = casadi.if_else((t99 != 0), -(-(t107*t163 + t112*t162 + t117*t161) + t122)/t99, 0)
+        t165 = casadi.if_else((t60 != 0), -(-(t69*t164 + t75*t163 + t81*t162 + t87*t161) + t93)/t60, 0)
+        t166 = casadi.if_else((t8 != 0), -(-(t18*t165 + t25*t164 + t32*t163 + t39*t162 + t46*t161) + t53)/t8, 0)
+        t167 = 1e-12*t6
+        state = (
+            t166,
+            t165,
+            t164,
+            t163,
+            t162,
+            t161,
+            casadi.if_else(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t7 <= t167), (t59 <= t167)), (t98 <= t167)), (t126 <= t167)), (t145 <= t167)), (t157 <= t167)), 1, 0),
+        )
+    return state
+
+
 def _fk(q):
     """Pose of the tool frame in the world frame (4x4 homogeneous): 142 operations."""
     q1 = q[0]
@@ -4237,7 +4421,7 @@ def _condition_number(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1032 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 1034 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -4351,207 +4535,40 @@ def _velocity_ik(q, mu_dot, damping):
     t85 = -t69 - t6*t3 + t10*t22 - t12*t24 + t13*t25 + t69*t83
     t86 = t3**2 + t22**2 + t24**2 + t25**2 + t65 + t77*t83
     t87 = 1 + c2**2 + t40**2 + t43**2 + t44**2 + s3**2*t83
-    t88 = t70**2
-    t89 = t72**2
-    t90 = t75**2
-    t91 = t66**2
-    t92 = t60**2
-    t93 = damping**2
-    t94 = t93 + t68
-    t95 = t94**2
-    t96 = casadi.sqrt(t88 + t89 + t90 + t91 + t92 + t95)
-    t97 = t96*casadi.if_else((t94 >= 0), 1, -1)
-    t98 = t93 + t78
-    t99 = t93 + t37
-    t100 = t93 + t84
-    t101 = t93 + t86
-    t102 = t93 + t87
-    t103 = casadi.sqrt(2*t88 + 2*t89 + 2*t81**2 + 2*t90 + 2*t79**2 + 2*t82**2 + 2*t91 + 2*t76**2 + 2*t73**2 + 2*t85**2 + 2*t92 + 2*t63**2 + 2*t55**2 + 2*t56**2 + 2*t57**2 + t95 + t98**2 + t99**2 + t100**2 + t101**2 + t102**2)
-    t104 = (t96 > 0)
-    t105 = casadi.if_else(t104, 1/(t94 + t97), 0)
-    t106 = casadi.if_else(t104, 1 + casadi.fabs(t94)/t96, 0)
-    t107 = t70*t105
-    t108 = t72*t105
-    t109 = t75*t105
-    t110 = t66*t105
-    t111 = t60*t105
-    t112 = t106*(t70 + t109*t79 + t98*t107 + t108*t81 + t110*t76 - t111*t63)
-    t113 = -t112 + t70
-    t114 = t98 - t107*t112
-    t115 = t81 - t108*t112
-    t116 = -t79 + t109*t112
-    t117 = t76 - t110*t112
-    t118 = t63 + t111*t112
-    t119 = t106*(t72 - t110*t73 + t107*t81 + t99*t108 - t109*t82 - t111*t55)
-    t120 = -t119 + t72
-    t121 = t81 - t107*t119
-    t122 = t99 - t108*t119
-    t123 = t82 + t109*t119
-    t124 = t73 + t110*t119
-    t125 = t55 + t111*t119
-    t126 = -t106*(t75 + t100*t109 + t111*t56 + t107*t79 - t108*t82 - t110*t85)
-    t127 = t75 + t126
-    t128 = t79 + t107*t126
-    t129 = t82 - t108*t126
-    t130 = t100 + t109*t126
-    t131 = t85 - t110*t126
-    t132 = t56 + t111*t126
-    t133 = t106*(t66 + t101*t110 + t107*t76 - t108*t73 - t109*t85 - t111*t57)
-    t134 = -t133 + t66
-    t135 = t76 - t107*t133
-    t136 = t73 + t108*t133
-    t137 = t85 + t109*t133
-    t138 = t101 - t110*t133
-    t139 = t57 + t111*t133
-    t140 = t106*(-t60 + t107*t63 + t108*t55 - t109*t56 + t110*t57 - t102*t111)
-    t141 = t60 + t140
-    t142 = t63 - t107*t140
-    t143 = t55 - t108*t140
-    t144 = t56 + t109*t140
-    t145 = t57 - t110*t140
-    t146 = t102 + t111*t140
-    t147 = casadi.sqrt(t114**2 + t115**2 + t116**2 + t117**2 + t118**2)
-    t148 = t147*casadi.if_else((t114 >= 0), 1, -1)
-    t149 = t106*(mu_dot0 + t107*mu_dot1 + t108*mu_dot2 - t109*mu_dot3 + t110*mu_dot4 - t111*mu_dot5)
-    t150 = -t149 + mu_dot0
-    t151 = mu_dot1 - t107*t149
-    t152 = mu_dot2 - t108*t149
-    t153 = mu_dot3 + t109*t149
-    t154 = mu_dot4 - t110*t149
-    t155 = mu_dot5 + t111*t149
-    t156 = (t147 > 0)
-    t157 = casadi.if_else(t156, 1/(t114 + t148), 0)
-    t158 = casadi.if_else(t156, 1 + casadi.fabs(t114)/t147, 0)
-    t159 = t115*t157
-    t160 = t116*t157
-    t161 = t117*t157
-    t162 = t118*t157
-    t163 = t158*(t121 + t159*t122 + t160*t123 - t161*t124 + t162*t125)
-    t164 = -t163 + t121
-    t165 = t122 - t159*t163
-    t166 = t123 - t160*t163
-    t167 = t124 + t161*t163
-    t168 = t125 - t162*t163
-    t169 = t158*(-t128 + t159*t129 + t160*t130 + t161*t131 + t162*t132)
-    t170 = t128 + t169
-    t171 = t129 - t159*t169
-    t172 = t130 - t160*t169
-    t173 = t131 - t161*t169
-    t174 = t132 - t162*t169
-    t175 = t158*(t135 - t159*t136 + t160*t137 + t161*t138 + t162*t139)
-    t176 = -t175 + t135
-    t177 = t136 + t159*t175
-    t178 = t137 - t160*t175
-    t179 = t138 - t161*t175
-    t180 = t139 - t162*t175
-    t181 = t158*(t142 + t159*t143 + t160*t144 + t161*t145 + t162*t146)
-    t182 = -t181 + t142
-    t183 = t143 - t159*t181
-    t184 = t144 - t160*t181
-    t185 = t145 - t161*t181
-    t186 = t146 - t162*t181
-    t187 = casadi.sqrt(t165**2 + t166**2 + t167**2 + t168**2)
-    t188 = t187*casadi.if_else((t165 >= 0), 1, -1)
-    t189 = t158*(t151 + t159*t152 + t160*t153 + t161*t154 + t162*t155)
-    t190 = -t189 + t151
-    t191 = t152 - t159*t189
-    t192 = t153 - t160*t189
-    t193 = t154 - t161*t189
-    t194 = t155 - t162*t189
-    t195 = (t187 > 0)
-    t196 = casadi.if_else(t195, 1/(t165 + t188), 0)
-    t197 = casadi.if_else(t195, 1 + casadi.fabs(t165)/t187, 0)
-    t198 = t166*t196
-    t199 = t167*t196
-    t200 = t168*t196
-    t201 = t197*(t171 + t198*t172 - t199*t173 + t200*t174)
-    t202 = -t201 + t171
-    t203 = t172 - t198*t201
-    t204 = t173 + t199*t201
-    t205 = t174 - t200*t201
-    t206 = t197*(-t177 + t198*t178 - t199*t179 + t200*t180)
-    t207 = t177 + t206
-    t208 = t178 - t198*t206
-    t209 = t179 + t199*t206
-    t210 = t180 - t200*t206
-    t211 = t197*(t183 + t198*t184 - t199*t185 + t200*t186)
-    t212 = -t211 + t183
-    t213 = t184 - t198*t211
-    t214 = t185 + t199*t211
-    t215 = t186 - t200*t211
-    t216 = casadi.sqrt(t203**2 + t204**2 + t205**2)
-    t217 = t216*casadi.if_else((t203 >= 0), 1, -1)
-    t218 = t197*(t191 + t198*t192 - t199*t193 + t200*t194)
-    t219 = -t218 + t191
-    t220 = t192 - t198*t218
-    t221 = t193 + t199*t218
-    t222 = t194 - t200*t218
-    t223 = (t216 > 0)
-    t224 = casadi.if_else(t223, 1/(t203 + t217), 0)
-    t225 = casadi.if_else(t223, 1 + casadi.fabs(t203)/t216, 0)
-    t226 = t204*t224
-    t227 = t205*t224
-    t228 = t225*(t208 + t226*t209 + t227*t210)
-    t229 = -t228 + t208
-    t230 = t209 - t226*t228
-    t231 = t210 - t227*t228
-    t232 = t225*(t213 + t226*t214 + t227*t215)
-    t233 = -t232 + t213
-    t234 = t214 - t226*t232
-    t235 = t215 - t227*t232
-    t236 = casadi.sqrt(t230**2 + t231**2)
-    t237 = t236*casadi.if_else((t230 >= 0), 1, -1)
-    t238 = t225*(t220 + t226*t221 + t227*t222)
-    t239 = -t238 + t220
-    t240 = t221 - t226*t238
-    t241 = t222 - t227*t238
-    t242 = (t236 > 0)
-    t243 = casadi.if_else(t242, 1/(t230 + t237), 0)
-    t244 = casadi.if_else(t242, 1 + casadi.fabs(t230)/t236, 0)
-    t245 = t231*t243
-    t246 = t244*(t234 + t245*t235)
-    t247 = -t246 + t234
-    t248 = t235 - t245*t246
-    t249 = t244*(t240 + t245*t241)
-    t250 = -t249 + t240
-    t251 = t241 - t245*t249
-    t252 = casadi.fabs(t248)
-    t253 = t252*casadi.if_else((t248 >= 0), 1, -1)
-    t254 = casadi.if_else((t252 > 0), 2, 0)
-    t255 = t251 - t254*t251
-    t256 = casadi.if_else((t253 != 0), -t255/t253, 0)
-    t257 = casadi.if_else((t237 != 0), -(t250 - t247*t256)/t237, 0)
-    t258 = casadi.if_else((t217 != 0), -(-(t229*t257 + t233*t256) + t239)/t217, 0)
-    t259 = casadi.if_else((t188 != 0), -(-(t202*t258 - t207*t257 + t212*t256) + t219)/t188, 0)
-    t260 = casadi.if_else((t148 != 0), -(-(t164*t259 - t170*t258 + t176*t257 + t182*t256) + t190)/t148, 0)
-    t261 = casadi.if_else((t97 != 0), -(-(t113*t260 + t120*t259 - t127*t258 + t134*t257 - t141*t256) + t150)/t97, 0)
-    t262 = t256 - t31*t261 + t19*t260
-    t263 = -t32*t259 - s1*t258 + c1*t257 + t61*t261 + t58*t260
-    t264 = t59*t261 + t62*t260 + t33*t259 - c2*t256 - t8*t258 - t20*t257
-    t265 = -t49*t261 + t52*t260 + t34*t259 + t6*t258 - t3*t257 + t41*t256
-    t266 = t50*t261 + t53*t260 + t35*t259 + t10*t258 + t22*t257 + t40*t256
-    t267 = t51*t261 + t54*t260 + t36*t259 - t12*t258 + t24*t257 - t43*t256
-    t268 = t13*t258 + t25*t257 + t44*t256
-    t269 = (casadi.fabs(t64) < casadi.inf)
-    t270 = (damping >= 0)
-    t271 = 1e-12*t103
-    t272 = casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t96 <= t271), (t147 <= t271)), (t187 <= t271)), (t216 <= t271)), (t236 <= t271)), (t252 <= t271))
-    t273 = casadi.logic_and(casadi.logic_and(t269, t270), casadi.logic_not(t272))
+    t88 = damping**2
+    t89 = _symmetric_solve6(1, (t88 + t68, t70, t72, -t75, t66, -t60, t88 + t78, t81, -t79, t76, t63, t88 + t37, t82, -t73, t55, t88 + t84, t85, t56, t88 + t86, t57, t88 + t87, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t90 = t89[5]
+    t91 = t89[0]
+    t92 = t89[1]
+    t93 = t90 - t31*t91 + t19*t92
+    t94 = t89[2]
+    t95 = t89[3]
+    t96 = t89[4]
+    t97 = c1*t96 + t61*t91 + t58*t92 - t32*t94 - s1*t95
+    t98 = t33*t94 + t91*t59 + t92*t62 - t8*t95 - t20*t96 - c2*t90
+    t99 = t34*t94 - t91*t49 + t92*t52 + t6*t95 - t3*t96 + t41*t90
+    t100 = t91*t50 + t92*t53 + t35*t94 + t10*t95 + t22*t96 + t40*t90
+    t101 = t91*t51 + t92*t54 + t36*t94 - t12*t95 + t24*t96 - t43*t90
+    t102 = t13*t95 + t25*t96 + t44*t90
+    t103 = (casadi.fabs(t64) < casadi.inf)
+    t104 = (damping >= 0)
+    t105 = t89[6]
+    t106 = casadi.logic_and(casadi.logic_and(t103, t104), (t105 <= 0))
     q_dot = casadi.SX(7, 1)
-    q_dot[0, 0] = casadi.if_else(t273, t262, 0)
-    q_dot[1, 0] = casadi.if_else(t273, t263, 0)
-    q_dot[2, 0] = casadi.if_else(t273, t264, 0)
-    q_dot[3, 0] = casadi.if_else(t273, t265, 0)
-    q_dot[4, 0] = casadi.if_else(t273, t266, 0)
-    q_dot[5, 0] = casadi.if_else(t273, t267, 0)
-    q_dot[6, 0] = casadi.if_else(t273, -t268, 0)
+    q_dot[0, 0] = casadi.if_else(t106, t93, 0)
+    q_dot[1, 0] = casadi.if_else(t106, t97, 0)
+    q_dot[2, 0] = casadi.if_else(t106, t98, 0)
+    q_dot[3, 0] = casadi.if_else(t106, t99, 0)
+    q_dot[4, 0] = casadi.if_else(t106, t100, 0)
+    q_dot[5, 0] = casadi.if_else(t106, t101, 0)
+    q_dot[6, 0] = casadi.if_else(t106, -t102, 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t269, t270)), 2, casadi.if_else(t272, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t103, t104)), 2, casadi.if_else((t105 > 0), 1, 0))
     return [q_dot, status]
 
 
 def _velocity_ik_nullspace(q, mu_dot, z, damping):
-    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 1114 operations."""
+    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 1116 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -4680,214 +4697,47 @@ def _velocity_ik_nullspace(q, mu_dot, z, damping):
     t93 = s1*qz2
     t94 = -(t19*qz1 + t64*qz3 + t53*qz4 + t54*qz5 + t55*qz6 + t49*t93) + mu_dot1
     t95 = t93 + mu_dot3 + t12*qz6 + t13*qz7 + t8*qz3 - t6*qz4 - t10*qz5
-    t96 = t72**2
-    t97 = t74**2
-    t98 = t77**2
-    t99 = t68**2
-    t100 = t62**2
-    t101 = damping**2
-    t102 = t101 + t70
-    t103 = t102**2
-    t104 = casadi.sqrt(t96 + t97 + t98 + t99 + t100 + t103)
-    t105 = t104*casadi.if_else((t102 >= 0), 1, -1)
-    t106 = t101 + t80
-    t107 = t101 + t37
-    t108 = t101 + t86
-    t109 = t101 + t88
-    t110 = t101 + t89
-    t111 = casadi.sqrt(2*t96 + 2*t97 + 2*t83**2 + 2*t98 + 2*t81**2 + 2*t84**2 + 2*t99 + 2*t78**2 + 2*t75**2 + 2*t87**2 + 2*t100 + 2*t65**2 + 2*t56**2 + 2*t57**2 + 2*t58**2 + t103 + t106**2 + t107**2 + t108**2 + t109**2 + t110**2)
-    t112 = (t104 > 0)
-    t113 = casadi.if_else(t112, 1/(t102 + t105), 0)
-    t114 = casadi.if_else(t112, 1 + casadi.fabs(t102)/t104, 0)
-    t115 = t72*t113
-    t116 = t74*t113
-    t117 = t77*t113
-    t118 = t68*t113
-    t119 = t62*t113
-    t120 = t114*(t72 + t106*t115 + t116*t83 + t117*t81 + t118*t78 - t119*t65)
-    t121 = -t120 + t72
-    t122 = t106 - t115*t120
-    t123 = t83 - t116*t120
-    t124 = -t81 + t117*t120
-    t125 = t78 - t118*t120
-    t126 = t65 + t119*t120
-    t127 = t114*(t74 + t115*t83 + t107*t116 - t117*t84 - t118*t75 - t119*t56)
-    t128 = -t127 + t74
-    t129 = t83 - t115*t127
-    t130 = t107 - t116*t127
-    t131 = t84 + t117*t127
-    t132 = t75 + t118*t127
-    t133 = t56 + t119*t127
-    t134 = -t114*(t77 + t115*t81 - t116*t84 + t108*t117 - t118*t87 + t119*t57)
-    t135 = t77 + t134
-    t136 = t81 + t115*t134
-    t137 = t84 - t116*t134
-    t138 = t108 + t117*t134
-    t139 = t87 - t118*t134
-    t140 = t57 + t119*t134
-    t141 = t114*(t68 + t115*t78 - t116*t75 - t117*t87 + t109*t118 - t119*t58)
-    t142 = -t141 + t68
-    t143 = t78 - t115*t141
-    t144 = t75 + t116*t141
-    t145 = t87 + t117*t141
-    t146 = t109 - t118*t141
-    t147 = t58 + t119*t141
-    t148 = t114*(-t62 + t115*t65 + t116*t56 - t117*t57 + t118*t58 - t110*t119)
-    t149 = t62 + t148
-    t150 = t65 - t115*t148
-    t151 = t56 - t116*t148
-    t152 = t57 + t117*t148
-    t153 = t58 - t118*t148
-    t154 = t110 + t119*t148
-    t155 = t114*(t91 + t115*t94 + t116*t38 - t117*t95 + t118*t92 - t119*t59)
-    t156 = -t155 + t91
-    t157 = t94 - t115*t155
-    t158 = t38 - t116*t155
-    t159 = t95 + t117*t155
-    t160 = t92 - t118*t155
-    t161 = t59 + t119*t155
-    t162 = casadi.sqrt(t122**2 + t123**2 + t124**2 + t125**2 + t126**2)
-    t163 = t162*casadi.if_else((t122 >= 0), 1, -1)
-    t164 = (t162 > 0)
-    t165 = casadi.if_else(t164, 1/(t122 + t163), 0)
-    t166 = casadi.if_else(t164, 1 + casadi.fabs(t122)/t162, 0)
-    t167 = t123*t165
-    t168 = t124*t165
-    t169 = t125*t165
-    t170 = t126*t165
-    t171 = t166*(t129 + t167*t130 + t168*t131 - t169*t132 + t170*t133)
-    t172 = -t171 + t129
-    t173 = t130 - t167*t171
-    t174 = t131 - t168*t171
-    t175 = t132 + t169*t171
-    t176 = t133 - t170*t171
-    t177 = t166*(-t136 + t167*t137 + t168*t138 + t169*t139 + t170*t140)
-    t178 = t136 + t177
-    t179 = t137 - t167*t177
-    t180 = t138 - t168*t177
-    t181 = t139 - t169*t177
-    t182 = t140 - t170*t177
-    t183 = t166*(t143 - t167*t144 + t168*t145 + t169*t146 + t170*t147)
-    t184 = -t183 + t143
-    t185 = t144 + t167*t183
-    t186 = t145 - t168*t183
-    t187 = t146 - t169*t183
-    t188 = t147 - t170*t183
-    t189 = t166*(t150 + t167*t151 + t168*t152 + t169*t153 + t170*t154)
-    t190 = -t189 + t150
-    t191 = t151 - t167*t189
-    t192 = t152 - t168*t189
-    t193 = t153 - t169*t189
-    t194 = t154 - t170*t189
-    t195 = t166*(t157 + t167*t158 + t168*t159 + t169*t160 + t170*t161)
-    t196 = -t195 + t157
-    t197 = t158 - t167*t195
-    t198 = t159 - t168*t195
-    t199 = t160 - t169*t195
-    t200 = t161 - t170*t195
-    t201 = casadi.sqrt(t173**2 + t174**2 + t175**2 + t176**2)
-    t202 = t201*casadi.if_else((t173 >= 0), 1, -1)
-    t203 = (t201 > 0)
-    t204 = casadi.if_else(t203, 1/(t173 + t202), 0)
-    t205 = casadi.if_else(t203, 1 + casadi.fabs(t173)/t201, 0)
-    t206 = t174*t204
-    t207 = t175*t204
-    t208 = t176*t204
-    t209 = t205*(t179 + t206*t180 - t207*t181 + t208*t182)
-    t210 = -t209 + t179
-    t211 = t180 - t206*t209
-    t212 = t181 + t207*t209
-    t213 = t182 - t208*t209
-    t214 = t205*(-t185 + t206*t186 - t207*t187 + t208*t188)
-    t215 = t185 + t214
-    t216 = t186 - t206*t214
-    t217 = t187 + t207*t214
-    t218 = t188 - t208*t214
-    t219 = t205*(t191 + t206*t192 - t207*t193 + t208*t194)
-    t220 = -t219 + t191
-    t221 = t192 - t206*t219
-    t222 = t193 + t207*t219
-    t223 = t194 - t208*t219
-    t224 = t205*(t197 + t206*t198 - t207*t199 + t208*t200)
-    t225 = -t224 + t197
-    t226 = t198 - t206*t224
-    t227 = t199 + t207*t224
-    t228 = t200 - t208*t224
-    t229 = casadi.sqrt(t211**2 + t212**2 + t213**2)
-    t230 = t229*casadi.if_else((t211 >= 0), 1, -1)
-    t231 = (t229 > 0)
-    t232 = casadi.if_else(t231, 1/(t211 + t230), 0)
-    t233 = casadi.if_else(t231, 1 + casadi.fabs(t211)/t229, 0)
-    t234 = t212*t232
-    t235 = t213*t232
-    t236 = t233*(t216 + t234*t217 + t235*t218)
-    t237 = -t236 + t216
-    t238 = t217 - t234*t236
-    t239 = t218 - t235*t236
-    t240 = t233*(t221 + t234*t222 + t235*t223)
-    t241 = -t240 + t221
-    t242 = t222 - t234*t240
-    t243 = t223 - t235*t240
-    t244 = t233*(t226 + t234*t227 + t235*t228)
-    t245 = -t244 + t226
-    t246 = t227 - t234*t244
-    t247 = t228 - t235*t244
-    t248 = casadi.sqrt(t238**2 + t239**2)
-    t249 = t248*casadi.if_else((t238 >= 0), 1, -1)
-    t250 = (t248 > 0)
-    t251 = casadi.if_else(t250, 1/(t238 + t249), 0)
-    t252 = casadi.if_else(t250, 1 + casadi.fabs(t238)/t248, 0)
-    t253 = t239*t251
-    t254 = t252*(t242 + t253*t243)
-    t255 = -t254 + t242
-    t256 = t243 - t253*t254
-    t257 = t252*(t246 + t253*t247)
-    t258 = -t257 + t246
-    t259 = t247 - t253*t257
-    t260 = casadi.fabs(t256)
-    t261 = t260*casadi.if_else((t256 >= 0), 1, -1)
-    t262 = casadi.if_else((t260 > 0), 2, 0)
-    t263 = t259 - t259*t262
-    t264 = casadi.if_else((t261 != 0), -t263/t261, 0)
-    t265 = casadi.if_else((t249 != 0), -(t258 - t255*t264)/t249, 0)
-    t266 = casadi.if_else((t230 != 0), -(-(t237*t265 + t241*t264) + t245)/t230, 0)
-    t267 = casadi.if_else((t202 != 0), -(-(t210*t266 - t215*t265 + t220*t264) + t225)/t202, 0)
-    t268 = casadi.if_else((t163 != 0), -(-(t172*t267 - t178*t266 + t184*t265 + t190*t264) + t196)/t163, 0)
-    t269 = casadi.if_else((t105 != 0), -(-(t121*t268 + t128*t267 - t135*t266 + t142*t265 - t149*t264) + t156)/t105, 0)
-    t270 = t264 - t31*t269 + t19*t268
-    t271 = -t32*t267 - s1*t266 + c1*t265 + t63*t269 + t60*t268
-    t272 = t61*t269 + t64*t268 + t33*t267 - c2*t264 - t8*t266 - t20*t265
-    t273 = -t50*t269 + t53*t268 + t34*t267 + t6*t266 - t3*t265 + t42*t264
-    t274 = t51*t269 + t54*t268 + t35*t267 + t10*t266 + t22*t265 + t41*t264
-    t275 = t52*t269 + t55*t268 + t36*t267 - t12*t266 + t24*t265 - t44*t264
-    t276 = t13*t266 + t25*t265 + t45*t264
-    t277 = qz1 + t270
-    t278 = qz2 + t271
-    t279 = qz3 + t272
-    t280 = qz4 + t273
-    t281 = qz5 + t274
-    t282 = qz6 + t275
-    t283 = -t276 + qz7
-    t284 = (casadi.fabs(t66) < casadi.inf)
-    t285 = (damping >= 0)
-    t286 = 1e-12*t111
-    t287 = casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t104 <= t286), (t162 <= t286)), (t201 <= t286)), (t229 <= t286)), (t248 <= t286)), (t260 <= t286))
-    t288 = casadi.logic_and(casadi.logic_and(t284, t285), casadi.logic_not(t287))
+    t96 = damping**2
+    t97 = _symmetric_solve6(1, (t96 + t70, t72, t74, -t77, t68, -t62, t96 + t80, t83, -t81, t78, t65, t96 + t37, t84, -t75, t56, t96 + t86, t87, t57, t96 + t88, t58, t96 + t89, t91, t94, t38, t95, t92, t59,))
+    t98 = t97[5]
+    t99 = t97[0]
+    t100 = t97[1]
+    t101 = t98 - t31*t99 + t19*t100
+    t102 = qz1 + t101
+    t103 = t97[2]
+    t104 = t97[3]
+    t105 = t97[4]
+    t106 = t63*t99 + t60*t100 - t32*t103 - s1*t104 + c1*t105
+    t107 = -c2*t98 + t61*t99 + t64*t100 + t33*t103 - t8*t104 - t20*t105
+    t108 = -t3*t105 - t50*t99 + t53*t100 + t34*t103 + t6*t104 + t42*t98
+    t109 = t41*t98 + t51*t99 + t54*t100 + t35*t103 + t10*t104 + t22*t105
+    t110 = t36*t103 + t52*t99 + t55*t100 - t12*t104 + t24*t105 - t44*t98
+    t111 = t45*t98 + t13*t104 + t25*t105
+    t112 = qz2 + t106
+    t113 = qz3 + t107
+    t114 = qz4 + t108
+    t115 = qz5 + t109
+    t116 = qz6 + t110
+    t117 = -t111 + qz7
+    t118 = (casadi.fabs(t66) < casadi.inf)
+    t119 = (damping >= 0)
+    t120 = t97[6]
+    t121 = casadi.logic_and(casadi.logic_and(t118, t119), (t120 <= 0))
     q_dot = casadi.SX(7, 1)
-    q_dot[0, 0] = casadi.if_else(t288, t277, 0)
-    q_dot[1, 0] = casadi.if_else(t288, t278, 0)
-    q_dot[2, 0] = casadi.if_else(t288, t279, 0)
-    q_dot[3, 0] = casadi.if_else(t288, t280, 0)
-    q_dot[4, 0] = casadi.if_else(t288, t281, 0)
-    q_dot[5, 0] = casadi.if_else(t288, t282, 0)
-    q_dot[6, 0] = casadi.if_else(t288, t283, 0)
+    q_dot[0, 0] = casadi.if_else(t121, t102, 0)
+    q_dot[1, 0] = casadi.if_else(t121, t112, 0)
+    q_dot[2, 0] = casadi.if_else(t121, t113, 0)
+    q_dot[3, 0] = casadi.if_else(t121, t114, 0)
+    q_dot[4, 0] = casadi.if_else(t121, t115, 0)
+    q_dot[5, 0] = casadi.if_else(t121, t116, 0)
+    q_dot[6, 0] = casadi.if_else(t121, t117, 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t284, t285)), 2, casadi.if_else(t287, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t118, t119)), 2, casadi.if_else((t120 > 0), 1, 0))
     return [q_dot, status]
 
 
 def _resolved_rate(q, target, target_rate, gain, z, damping):
-    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 1276 operations."""
+    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 1278 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -5053,243 +4903,76 @@ def _resolved_rate(q, target, target_rate, gain, z, damping):
     t110 = -t94 - t6*t3 + t10*t29 - t12*t31 + t14*t33 + t94*t108
     t111 = t3**2 + t29**2 + t31**2 + t33**2 + t90 + t102*t108
     t112 = 1 + c2**2 + t54**2 + t57**2 + t59**2 + s3**2*t108
-    t113 = t95**2
-    t114 = t97**2
-    t115 = t100**2
-    t116 = t91**2
-    t117 = t86**2
-    t118 = damping**2
-    t119 = t118 + t93
-    t120 = t119**2
-    t121 = casadi.sqrt(t113 + t114 + t115 + t116 + t117 + t120)
-    t122 = t121*casadi.if_else((t119 >= 0), 1, -1)
-    t123 = t118 + t103
-    t124 = t118 + t47
-    t125 = t118 + t109
-    t126 = t118 + t111
-    t127 = t118 + t112
-    t128 = casadi.sqrt(2*t113 + 2*t114 + 2*t106**2 + 2*t115 + 2*t104**2 + 2*t107**2 + 2*t116 + 2*t101**2 + 2*t98**2 + 2*t110**2 + 2*t117 + 2*t89**2 + 2*t73**2 + 2*t74**2 + 2*t75**2 + t120 + t123**2 + t124**2 + t125**2 + t126**2 + t127**2)
-    t129 = (t121 > 0)
-    t130 = casadi.if_else(t129, 1/(t119 + t122), 0)
-    t131 = casadi.if_else(t129, 1 + casadi.fabs(t119)/t121, 0)
-    t132 = t95*t130
-    t133 = t97*t130
-    t134 = t100*t130
-    t135 = t91*t130
-    t136 = t86*t130
-    t137 = t131*(t95 + t134*t104 + t123*t132 + t133*t106 + t135*t101 - t136*t89)
-    t138 = -t137 + t95
-    t139 = t123 - t132*t137
-    t140 = t106 - t133*t137
-    t141 = -t104 + t134*t137
-    t142 = t101 - t135*t137
-    t143 = t89 + t136*t137
-    t144 = t131*(t97 - t135*t98 + t132*t106 + t124*t133 - t134*t107 - t136*t73)
-    t145 = -t144 + t97
-    t146 = t106 - t132*t144
-    t147 = t124 - t133*t144
-    t148 = t107 + t134*t144
-    t149 = t98 + t135*t144
-    t150 = t73 + t136*t144
-    t151 = -t131*(t100 + t125*t134 + t136*t74 + t132*t104 - t133*t107 - t135*t110)
-    t152 = t100 + t151
-    t153 = t104 + t132*t151
-    t154 = t107 - t133*t151
-    t155 = t125 + t134*t151
-    t156 = t110 - t135*t151
-    t157 = t74 + t136*t151
-    t158 = t131*(t91 + t126*t135 + t132*t101 - t133*t98 - t134*t110 - t136*t75)
-    t159 = -t158 + t91
-    t160 = t101 - t132*t158
-    t161 = t98 + t133*t158
-    t162 = t110 + t134*t158
-    t163 = t126 - t135*t158
-    t164 = t75 + t136*t158
-    t165 = t131*(-t86 + t132*t89 + t133*t73 - t134*t74 + t135*t75 - t127*t136)
-    t166 = t86 + t165
-    t167 = t89 - t132*t165
-    t168 = t73 - t133*t165
-    t169 = t74 + t134*t165
-    t170 = t75 - t135*t165
-    t171 = t127 + t136*t165
-    t172 = casadi.sqrt(t139**2 + t140**2 + t141**2 + t142**2 + t143**2)
-    t173 = t172*casadi.if_else((t139 >= 0), 1, -1)
-    t174 = (t172 > 0)
-    t175 = casadi.if_else(t174, 1/(t139 + t173), 0)
-    t176 = casadi.if_else(t174, 1 + casadi.fabs(t139)/t172, 0)
-    t177 = t140*t175
-    t178 = t141*t175
-    t179 = t142*t175
-    t180 = t143*t175
-    t181 = t176*(t146 + t177*t147 + t178*t148 - t179*t149 + t180*t150)
-    t182 = -t181 + t146
-    t183 = t147 - t177*t181
-    t184 = t148 - t178*t181
-    t185 = t149 + t179*t181
-    t186 = t150 - t180*t181
-    t187 = t176*(-t153 + t177*t154 + t178*t155 + t179*t156 + t180*t157)
-    t188 = t153 + t187
-    t189 = t154 - t177*t187
-    t190 = t155 - t178*t187
-    t191 = t156 - t179*t187
-    t192 = t157 - t180*t187
-    t193 = t176*(t160 - t177*t161 + t178*t162 + t179*t163 + t180*t164)
-    t194 = -t193 + t160
-    t195 = t161 + t177*t193
-    t196 = t162 - t178*t193
-    t197 = t163 - t179*t193
-    t198 = t164 - t180*t193
-    t199 = t176*(t167 + t177*t168 + t178*t169 + t179*t170 + t180*t171)
-    t200 = -t199 + t167
-    t201 = t168 - t177*t199
-    t202 = t169 - t178*t199
-    t203 = t170 - t179*t199
-    t204 = t171 - t180*t199
-    t205 = casadi.sqrt(t183**2 + t184**2 + t185**2 + t186**2)
-    t206 = t205*casadi.if_else((t183 >= 0), 1, -1)
-    t207 = (t205 > 0)
-    t208 = casadi.if_else(t207, 1/(t183 + t206), 0)
-    t209 = casadi.if_else(t207, 1 + casadi.fabs(t183)/t205, 0)
-    t210 = t184*t208
-    t211 = t185*t208
-    t212 = t186*t208
-    t213 = t209*(t189 + t210*t190 - t211*t191 + t212*t192)
-    t214 = -t213 + t189
-    t215 = t190 - t210*t213
-    t216 = t191 + t211*t213
-    t217 = t192 - t212*t213
-    t218 = t209*(-t195 + t210*t196 - t211*t197 + t212*t198)
-    t219 = t195 + t218
-    t220 = t196 - t210*t218
-    t221 = t197 + t211*t218
-    t222 = t198 - t212*t218
-    t223 = t209*(t201 + t210*t202 - t211*t203 + t212*t204)
-    t224 = -t223 + t201
-    t225 = t202 - t210*t223
-    t226 = t203 + t211*t223
-    t227 = t204 - t212*t223
-    t228 = casadi.sqrt(t215**2 + t216**2 + t217**2)
-    t229 = t228*casadi.if_else((t215 >= 0), 1, -1)
-    t230 = (t228 > 0)
-    t231 = casadi.if_else(t230, 1/(t215 + t229), 0)
-    t232 = casadi.if_else(t230, 1 + casadi.fabs(t215)/t228, 0)
-    t233 = t216*t231
-    t234 = t217*t231
-    t235 = t232*(t220 + t233*t221 + t234*t222)
-    t236 = -t235 + t220
-    t237 = t221 - t233*t235
-    t238 = t222 - t234*t235
-    t239 = t232*(t225 + t233*t226 + t234*t227)
-    t240 = -t239 + t225
-    t241 = t226 - t233*t239
-    t242 = t227 - t234*t239
-    t243 = casadi.sqrt(t237**2 + t238**2)
-    t244 = t243*casadi.if_else((t237 >= 0), 1, -1)
-    t245 = (t243 > 0)
-    t246 = casadi.if_else(t245, 1/(t237 + t244), 0)
-    t247 = casadi.if_else(t245, 1 + casadi.fabs(t237)/t243, 0)
-    t248 = t238*t246
-    t249 = t247*(t241 + t248*t242)
-    t250 = -t249 + t241
-    t251 = t242 - t248*t249
-    t252 = casadi.fabs(t251)
-    t253 = t252*casadi.if_else((t251 >= 0), 1, -1)
-    t254 = casadi.if_else((t252 > 0), 2, 0)
-    t255 = -t49
-    t256 = 0.5*(-1 + t255 + t23 + t78)
-    t257 = casadi.atan2(t81, t256)
-    t258 = casadi.if_else((t81 > 0), t257/t81, 1)
-    t259 = casadi.logic_and((t23 >= t255), (t23 >= t78))
-    t260 = (t255 >= t78)
-    t261 = casadi.if_else(t259, 0.5*(1 + t23), casadi.if_else(t260, -0.5*t48, 0.5*t76))
-    t262 = casadi.if_else(t259, 0.5*t24, casadi.if_else(t260, 0.5*(1 + t255), 0.5*t77))
-    t263 = casadi.if_else(t259, 0.5*t25, casadi.if_else(t260, -0.5*t50, 0.5*(1 + t78)))
-    t264 = casadi.sqrt(t261**2 + t262**2 + t263**2)
-    t265 = casadi.if_else((t79*t261 + t80*t262 + t51*t263 >= 0), 1, -1)
-    t266 = casadi.logic_or((t81 > 1e-06), (t256 > 0))
-    t267 = t257*t265/t264
-    t268 = casadi.if_else(t266, t79*t258, t267*t261)
-    t269 = casadi.if_else(t266, t80*t258, t267*t262)
-    t270 = casadi.if_else(t266, t51*t258, t267*t263)
-    t271 = mu_dot3 + t268*gain3
-    t272 = mu_dot4 + t269*gain4
-    t273 = mu_dot5 + t270*gain5
-    t274 = -(qz1 - c2*qz3 + t54*qz5 - t57*qz6 - t59*qz7 + t55*qz4) + t273
-    t275 = -t41
-    t276 = mu_dot1 + gain1*(t275 + T13)
-    t277 = 1 - t67 - t42 - s1 - t12 - t14 - t3 - t33 - c2 - t57 - t59 - t8 - t27 + q1 + q2 + c1 + q3 + t6 + q4 + t10 + t29 + t54 + q5 + t31 + q6 + q7 + t22 + t55 + t84 + t87 + t85 + t68 + t69 + t88 + t70 + t71 + t72 + t43 + t44 + t45 + t46 + t275 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7 + t26 + t276 + t82 + t271 + t272 + t273
-    t278 = c1*qz2
-    t279 = -(-t41*qz1 + t85*qz3 - t67*qz4 + t68*qz5 + t69*qz6 + t65*t278) + t26
-    t280 = -(t278 - t3*qz4 + t29*qz5 + t31*qz6 - t33*qz7 - t27*qz3) + t272
-    t281 = s1*qz2
-    t282 = -(t22*qz1 + t88*qz3 + t70*qz4 + t71*qz5 + t72*qz6 + t65*t281) + t276
-    t283 = t281 + t12*qz6 + t14*qz7 + t8*qz3 - t6*qz4 - t10*qz5 + t271
-    t284 = t131*(t279 + t132*t282 + t133*t83 - t134*t283 + t135*t280 - t136*t274)
-    t285 = -t284 + t279
-    t286 = t282 - t132*t284
-    t287 = t83 - t133*t284
-    t288 = t283 + t134*t284
-    t289 = t280 - t135*t284
-    t290 = t274 + t136*t284
-    t291 = t176*(t286 + t177*t287 + t178*t288 + t179*t289 + t180*t290)
-    t292 = -t291 + t286
-    t293 = t287 - t177*t291
-    t294 = t288 - t178*t291
-    t295 = t289 - t179*t291
-    t296 = t290 - t180*t291
-    t297 = t209*(t293 + t210*t294 - t211*t295 + t212*t296)
-    t298 = -t297 + t293
-    t299 = t294 - t210*t297
-    t300 = t295 + t211*t297
-    t301 = t296 - t212*t297
-    t302 = t232*(t299 + t233*t300 + t234*t301)
-    t303 = -t302 + t299
-    t304 = t300 - t233*t302
-    t305 = t301 - t234*t302
-    t306 = t247*(t304 + t248*t305)
-    t307 = -t306 + t304
-    t308 = t305 - t248*t306
-    t309 = t308 - t254*t308
-    t310 = casadi.if_else((t253 != 0), -t309/t253, 0)
-    t311 = casadi.if_else((t244 != 0), -(t307 - t250*t310)/t244, 0)
-    t312 = casadi.if_else((t229 != 0), -(-(t236*t311 + t240*t310) + t303)/t229, 0)
-    t313 = casadi.if_else((t206 != 0), -(-(t214*t312 - t219*t311 + t224*t310) + t298)/t206, 0)
-    t314 = casadi.if_else((t173 != 0), -(-(t182*t313 - t188*t312 + t194*t311 + t200*t310) + t292)/t173, 0)
-    t315 = casadi.if_else((t122 != 0), -(-(t138*t314 + t145*t313 - t152*t312 + t159*t311 - t166*t310) + t285)/t122, 0)
-    t316 = t310 - t41*t315 + t22*t314
-    t317 = -t42*t313 - s1*t312 + c1*t311 + t87*t315 + t84*t314
-    t318 = t85*t315 + t88*t314 + t43*t313 - c2*t310 - t8*t312 - t27*t311
-    t319 = -t67*t315 + t70*t314 + t44*t313 + t6*t312 - t3*t311 + t55*t310
-    t320 = t68*t315 + t71*t314 + t45*t313 + t10*t312 + t29*t311 + t54*t310
-    t321 = t69*t315 + t72*t314 + t46*t313 - t12*t312 + t31*t311 - t57*t310
-    t322 = t14*t312 + t33*t311 + t59*t310
-    t323 = qz1 + t316
-    t324 = qz2 + t317
-    t325 = qz3 + t318
-    t326 = qz4 + t319
-    t327 = qz5 + t320
-    t328 = qz6 + t321
-    t329 = -t322 + qz7
-    t330 = (casadi.fabs(t277) < casadi.inf)
-    t331 = (damping >= 0)
-    t332 = 1e-12*t128
-    t333 = casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or(casadi.logic_or((t121 <= t332), (t172 <= t332)), (t205 <= t332)), (t228 <= t332)), (t243 <= t332)), (t252 <= t332))
-    t334 = casadi.logic_and(casadi.logic_and(t330, t331), casadi.logic_not(t333))
+    t113 = -t49
+    t114 = 0.5*(-1 + t113 + t23 + t78)
+    t115 = casadi.atan2(t81, t114)
+    t116 = casadi.if_else((t81 > 0), t115/t81, 1)
+    t117 = casadi.logic_and((t23 >= t113), (t23 >= t78))
+    t118 = (t113 >= t78)
+    t119 = casadi.if_else(t117, 0.5*(1 + t23), casadi.if_else(t118, -0.5*t48, 0.5*t76))
+    t120 = casadi.if_else(t117, 0.5*t24, casadi.if_else(t118, 0.5*(1 + t113), 0.5*t77))
+    t121 = casadi.if_else(t117, 0.5*t25, casadi.if_else(t118, -0.5*t50, 0.5*(1 + t78)))
+    t122 = casadi.sqrt(t119**2 + t120**2 + t121**2)
+    t123 = casadi.if_else((t79*t119 + t80*t120 + t51*t121 >= 0), 1, -1)
+    t124 = casadi.logic_or((t81 > 1e-06), (t114 > 0))
+    t125 = t115*t123/t122
+    t126 = casadi.if_else(t124, t79*t116, t125*t119)
+    t127 = casadi.if_else(t124, t80*t116, t125*t120)
+    t128 = casadi.if_else(t124, t51*t116, t125*t121)
+    t129 = mu_dot3 + t126*gain3
+    t130 = mu_dot4 + t127*gain4
+    t131 = mu_dot5 + t128*gain5
+    t132 = -(qz1 - c2*qz3 + t54*qz5 - t57*qz6 - t59*qz7 + t55*qz4) + t131
+    t133 = -t41
+    t134 = mu_dot1 + gain1*(t133 + T13)
+    t135 = 1 - t67 - t42 - s1 - t12 - t14 - t3 - t33 - c2 - t57 - t59 - t8 - t27 + q1 + q2 + c1 + q3 + t6 + q4 + t10 + t29 + t54 + q5 + t31 + q6 + q7 + t22 + t55 + t84 + t87 + t85 + t68 + t69 + t88 + t70 + t71 + t72 + t43 + t44 + t45 + t46 + t133 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7 + t26 + t134 + t82 + t129 + t130 + t131
+    t136 = c1*qz2
+    t137 = -(t65*t136 - t41*qz1 + t85*qz3 - t67*qz4 + t68*qz5 + t69*qz6) + t26
+    t138 = -(t136 - t3*qz4 + t29*qz5 + t31*qz6 - t33*qz7 - t27*qz3) + t130
+    t139 = s1*qz2
+    t140 = -(t65*t139 + t22*qz1 + t88*qz3 + t70*qz4 + t71*qz5 + t72*qz6) + t134
+    t141 = t139 + t12*qz6 + t14*qz7 + t8*qz3 - t6*qz4 - t10*qz5 + t129
+    t142 = damping**2
+    t143 = _symmetric_solve6(1, (t142 + t93, t95, t97, -t100, t91, -t86, t142 + t103, t106, -t104, t101, t89, t142 + t47, t107, -t98, t73, t142 + t109, t110, t74, t142 + t111, t75, t142 + t112, t137, t140, t83, t141, t138, t132,))
+    t144 = t143[5]
+    t145 = t143[0]
+    t146 = t143[1]
+    t147 = t144 - t41*t145 + t22*t146
+    t148 = qz1 + t147
+    t149 = t143[2]
+    t150 = t143[3]
+    t151 = t143[4]
+    t152 = t87*t145 + t84*t146 - t42*t149 - s1*t150 + c1*t151
+    t153 = t85*t145 + t88*t146 + t43*t149 - t8*t150 - t27*t151 - c2*t144
+    t154 = t44*t149 - t67*t145 + t70*t146 + t6*t150 - t3*t151 + t55*t144
+    t155 = t45*t149 + t54*t144 + t68*t145 + t71*t146 + t10*t150 + t29*t151
+    t156 = t69*t145 + t72*t146 + t46*t149 - t12*t150 + t31*t151 - t57*t144
+    t157 = t14*t150 + t33*t151 + t59*t144
+    t158 = qz2 + t152
+    t159 = qz3 + t153
+    t160 = qz4 + t154
+    t161 = qz5 + t155
+    t162 = qz6 + t156
+    t163 = -t157 + qz7
+    t164 = (casadi.fabs(t135) < casadi.inf)
+    t165 = (damping >= 0)
+    t166 = t143[6]
+    t167 = casadi.logic_and(casadi.logic_and(t164, t165), (t166 <= 0))
     q_dot = casadi.SX(7, 1)
-    q_dot[0, 0] = casadi.if_else(t334, t323, 0)
-    q_dot[1, 0] = casadi.if_else(t334, t324, 0)
-    q_dot[2, 0] = casadi.if_else(t334, t325, 0)
-    q_dot[3, 0] = casadi.if_else(t334, t326, 0)
-    q_dot[4, 0] = casadi.if_else(t334, t327, 0)
-    q_dot[5, 0] = casadi.if_else(t334, t328, 0)
-    q_dot[6, 0] = casadi.if_else(t334, t329, 0)
+    q_dot[0, 0] = casadi.if_else(t167, t148, 0)
+    q_dot[1, 0] = casadi.if_else(t167, t158, 0)
+    q_dot[2, 0] = casadi.if_else(t167, t159, 0)
+    q_dot[3, 0] = casadi.if_else(t167, t160, 0)
+    q_dot[4, 0] = casadi.if_else(t167, t161, 0)
+    q_dot[5, 0] = casadi.if_else(t167, t162, 0)
+    q_dot[6, 0] = casadi.if_else(t167, t163, 0)
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t330, t331)), 2, casadi.if_else(t333, 1, 0))
+    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t164, t165)), 2, casadi.if_else((t166 > 0), 1, 0))
     return [q_dot, status]
 
 
 def _ik_numeric_step(target, q, damping):
-    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 1111 operations."""
+    """One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): 1173 operations."""
     T00 = target[0, 0]
     T01 = target[0, 1]
     T02 = target[0, 2]
@@ -5459,180 +5142,21 @@ def _ik_numeric_step(target, q, damping):
     t126 = casadi.if_else(t123, t86*t115, t124*t119)
     t127 = casadi.if_else(t123, t52*t115, t124*t120)
     t128 = t125**2 + t126**2 + t127**2 + t27**2 + t53**2 + t88**2
-    t129 = damping + t92
-    t130 = casadi.sqrt(t129**2 + t94**2 + t96**2 + t99**2 + t90**2 + t77**2)
-    t131 = t130*casadi.if_else((t129 >= 0), 1, -1)
-    t132 = (t130 > 0)
-    t133 = casadi.if_else(t132, 1/(t129 + t131), 0)
-    t134 = casadi.if_else(t132, 1 + casadi.fabs(t129)/t130, 0)
-    t135 = damping + t102
-    t136 = t94*t133
-    t137 = t96*t133
-    t138 = t99*t133
-    t139 = t90*t133
-    t140 = t77*t133
-    t141 = t134*(t94 + t135*t136 + t137*t105 + t138*t103 + t139*t100 - t140*t78)
-    t142 = -t141 + t94
-    t143 = t135 - t136*t141
-    t144 = t105 - t137*t141
-    t145 = -t103 + t138*t141
-    t146 = t100 - t139*t141
-    t147 = t78 + t140*t141
-    t148 = t134*(t27 + t136*t53 + t137*t88 - t138*t125 + t139*t126 - t140*t127)
-    t149 = -t148 + t27
-    t150 = t53 - t136*t148
-    t151 = t88 - t137*t148
-    t152 = t125 + t138*t148
-    t153 = t126 - t139*t148
-    t154 = t127 + t140*t148
-    t155 = casadi.sqrt(t143**2 + t144**2 + t145**2 + t146**2 + t147**2)
-    t156 = t155*casadi.if_else((t143 >= 0), 1, -1)
-    t157 = damping + t48
-    t158 = t134*(t96 + t136*t105 + t137*t157 - t138*t106 - t139*t97 - t140*t79)
-    t159 = -t158 + t96
-    t160 = t105 - t136*t158
-    t161 = t157 - t137*t158
-    t162 = t106 + t138*t158
-    t163 = t97 + t139*t158
-    t164 = t79 + t140*t158
-    t165 = damping + t108
-    t166 = -t134*(t99 + t136*t103 - t137*t106 + t138*t165 - t139*t109 + t140*t80)
-    t167 = t99 + t166
-    t168 = t103 + t136*t166
-    t169 = t106 - t137*t166
-    t170 = t165 + t138*t166
-    t171 = t109 - t139*t166
-    t172 = t80 + t140*t166
-    t173 = damping + t110
-    t174 = t134*(t90 + t136*t100 - t137*t97 - t138*t109 + t139*t173 - t140*t81)
-    t175 = -t174 + t90
-    t176 = t100 - t136*t174
-    t177 = t97 + t137*t174
-    t178 = t109 + t138*t174
-    t179 = t173 - t139*t174
-    t180 = t81 + t140*t174
-    t181 = damping + t111
-    t182 = t134*(-t77 + t136*t78 + t137*t79 - t138*t80 + t139*t81 - t140*t181)
-    t183 = t77 + t182
-    t184 = t78 - t136*t182
-    t185 = t79 - t137*t182
-    t186 = t80 + t138*t182
-    t187 = t81 - t139*t182
-    t188 = t181 + t140*t182
-    t189 = (t155 > 0)
-    t190 = casadi.if_else(t189, 1/(t143 + t156), 0)
-    t191 = casadi.if_else(t189, 1 + casadi.fabs(t143)/t155, 0)
-    t192 = t144*t190
-    t193 = t145*t190
-    t194 = t146*t190
-    t195 = t147*t190
-    t196 = t191*(t160 + t192*t161 + t193*t162 - t194*t163 + t195*t164)
-    t197 = -t196 + t160
-    t198 = t161 - t192*t196
-    t199 = t162 - t193*t196
-    t200 = t163 + t194*t196
-    t201 = t164 - t195*t196
-    t202 = t191*(-t168 + t192*t169 + t193*t170 + t194*t171 + t195*t172)
-    t203 = t168 + t202
-    t204 = t169 - t192*t202
-    t205 = t170 - t193*t202
-    t206 = t171 - t194*t202
-    t207 = t172 - t195*t202
-    t208 = t191*(t176 - t192*t177 + t193*t178 + t194*t179 + t195*t180)
-    t209 = -t208 + t176
-    t210 = t177 + t192*t208
-    t211 = t178 - t193*t208
-    t212 = t179 - t194*t208
-    t213 = t180 - t195*t208
-    t214 = t191*(t184 + t192*t185 + t193*t186 + t194*t187 + t195*t188)
-    t215 = -t214 + t184
-    t216 = t185 - t192*t214
-    t217 = t186 - t193*t214
-    t218 = t187 - t194*t214
-    t219 = t188 - t195*t214
-    t220 = t191*(t150 + t192*t151 + t193*t152 + t194*t153 + t195*t154)
-    t221 = -t220 + t150
-    t222 = t151 - t192*t220
-    t223 = t152 - t193*t220
-    t224 = t153 - t194*t220
-    t225 = t154 - t195*t220
-    t226 = casadi.sqrt(t198**2 + t199**2 + t200**2 + t201**2)
-    t227 = t226*casadi.if_else((t198 >= 0), 1, -1)
-    t228 = (t226 > 0)
-    t229 = casadi.if_else(t228, 1/(t198 + t227), 0)
-    t230 = casadi.if_else(t228, 1 + casadi.fabs(t198)/t226, 0)
-    t231 = t199*t229
-    t232 = t200*t229
-    t233 = t201*t229
-    t234 = t230*(t204 + t231*t205 - t232*t206 + t233*t207)
-    t235 = -t234 + t204
-    t236 = t205 - t231*t234
-    t237 = t206 + t232*t234
-    t238 = t207 - t233*t234
-    t239 = t230*(-t210 + t231*t211 - t232*t212 + t233*t213)
-    t240 = t210 + t239
-    t241 = t211 - t231*t239
-    t242 = t212 + t232*t239
-    t243 = t213 - t233*t239
-    t244 = t230*(t216 + t231*t217 - t232*t218 + t233*t219)
-    t245 = -t244 + t216
-    t246 = t217 - t231*t244
-    t247 = t218 + t232*t244
-    t248 = t219 - t233*t244
-    t249 = t230*(t222 + t231*t223 - t232*t224 + t233*t225)
-    t250 = -t249 + t222
-    t251 = t223 - t231*t249
-    t252 = t224 + t232*t249
-    t253 = t225 - t233*t249
-    t254 = casadi.sqrt(t236**2 + t237**2 + t238**2)
-    t255 = t254*casadi.if_else((t236 >= 0), 1, -1)
-    t256 = (t254 > 0)
-    t257 = casadi.if_else(t256, 1/(t236 + t255), 0)
-    t258 = casadi.if_else(t256, 1 + casadi.fabs(t236)/t254, 0)
-    t259 = t237*t257
-    t260 = t238*t257
-    t261 = t258*(t241 + t259*t242 + t260*t243)
-    t262 = -t261 + t241
-    t263 = t242 - t259*t261
-    t264 = t243 - t260*t261
-    t265 = t258*(t246 + t259*t247 + t260*t248)
-    t266 = -t265 + t246
-    t267 = t247 - t259*t265
-    t268 = t248 - t260*t265
-    t269 = t258*(t251 + t259*t252 + t260*t253)
-    t270 = -t269 + t251
-    t271 = t252 - t259*t269
-    t272 = t253 - t260*t269
-    t273 = casadi.sqrt(t263**2 + t264**2)
-    t274 = t273*casadi.if_else((t263 >= 0), 1, -1)
-    t275 = (t273 > 0)
-    t276 = casadi.if_else(t275, 1/(t263 + t274), 0)
-    t277 = casadi.if_else(t275, 1 + casadi.fabs(t263)/t273, 0)
-    t278 = t264*t276
-    t279 = t277*(t267 + t278*t268)
-    t280 = -t279 + t267
-    t281 = t268 - t278*t279
-    t282 = t277*(t271 + t278*t272)
-    t283 = -t282 + t271
-    t284 = t272 - t278*t282
-    t285 = casadi.fabs(t281)
-    t286 = t285*casadi.if_else((t281 >= 0), 1, -1)
-    t287 = casadi.if_else((t285 > 0), 2, 0)
-    t288 = t284 - t284*t287
-    t289 = casadi.if_else((t286 != 0), -t288/t286, 0)
-    t290 = casadi.if_else((t274 != 0), -(t283 - t280*t289)/t274, 0)
-    t291 = casadi.if_else((t255 != 0), -(-(t262*t290 + t266*t289) + t270)/t255, 0)
-    t292 = casadi.if_else((t227 != 0), -(-(t235*t291 - t240*t290 + t245*t289) + t250)/t227, 0)
-    t293 = casadi.if_else((t156 != 0), -(-(t197*t292 - t203*t291 + t209*t290 + t215*t289) + t221)/t156, 0)
-    t294 = casadi.if_else((t131 != 0), -(-(t142*t293 + t159*t292 - t167*t291 + t175*t290 - t183*t289) + t149)/t131, 0)
-    t295 = q1 + t289 - t42*t294 + t23*t293
-    t296 = q2 + c1*t67*t294 + s1*t67*t293 - t43*t292 - s1*t291 + c1*t290
-    t297 = q3 + t69*t294 + t73*t293 + t44*t292 - c2*t289 - t9*t291 - t28*t290
-    t298 = q4 - t70*t294 + t74*t293 + t45*t292 + t7*t291 - t4*t290 + t57*t289
-    t299 = q5 + t71*t294 + t75*t293 + t46*t292 + t11*t291 + t30*t290 + t56*t289
-    t300 = q6 + t72*t294 + t76*t293 + t47*t292 - t13*t291 + t32*t290 - t59*t289
-    t301 = -q7 + t15*t291 + t34*t290 + t61*t289
-    t302 = -t301
+    t129 = _symmetric_solve6(1, (damping + t92, t94, t96, -t99, t90, -t77, damping + t102, t105, -t103, t100, t78, damping + t48, t106, -t97, t79, damping + t108, t109, t80, damping + t110, t81, damping + t111, t27, t53, t88, t125, t126, t127,))
+    t130 = t129[5]
+    t131 = t129[0]
+    t132 = t129[1]
+    t133 = q1 + t130 - t42*t131 + t23*t132
+    t134 = t129[2]
+    t135 = t129[3]
+    t136 = t129[4]
+    t137 = q2 - t43*t134 - s1*t135 + c1*t136 + c1*t67*t131 + s1*t67*t132
+    t138 = q3 - c2*t130 + t69*t131 + t73*t132 + t44*t134 - t9*t135 - t28*t136
+    t139 = q4 - t4*t136 - t70*t131 + t74*t132 + t45*t134 + t7*t135 + t57*t130
+    t140 = q5 + t56*t130 + t71*t131 + t75*t132 + t46*t134 + t11*t135 + t30*t136
+    t141 = q6 + t47*t134 + t72*t131 + t76*t132 - t13*t135 + t32*t136 - t59*t130
+    t142 = -q7 + t61*t130 + t15*t135 + t34*t136
+    t143 = -t142
     q_start = casadi.SX(7, 1)
     q_start[0, 0] = q1
     q_start[1, 0] = q2
@@ -5642,13 +5166,13 @@ def _ik_numeric_step(target, q, damping):
     q_start[5, 0] = q6
     q_start[6, 0] = q7
     q_next = casadi.SX(7, 1)
-    q_next[0, 0] = casadi.if_else((t295 < -3.0543261909900767), -3.0543261909900767, casadi.if_else((t295 > 3.0543261909900767), 3.0543261909900767, t295))
-    q_next[1, 0] = casadi.if_else((t296 < -3.822271061867582), -3.822271061867582, casadi.if_else((t296 > 2.2863813201125716), 2.2863813201125716, t296))
-    q_next[2, 0] = casadi.if_else((t297 < -3.0543261909900767), -3.0543261909900767, casadi.if_else((t297 > 3.0543261909900767), 3.0543261909900767, t297))
-    q_next[3, 0] = casadi.if_else((t298 < -3.0543261909900767), -3.0543261909900767, casadi.if_else((t298 > 3.0543261909900767), 3.0543261909900767, t298))
-    q_next[4, 0] = casadi.if_else((t299 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((t299 > 2.9670597283903604), 2.9670597283903604, t299))
-    q_next[5, 0] = casadi.if_else((t300 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((t300 > 2.9670597283903604), 2.9670597283903604, t300))
-    q_next[6, 0] = casadi.if_else((t302 < -4.71238898038469), -4.71238898038469, casadi.if_else((t302 > 4.71238898038469), 4.71238898038469, t302))
+    q_next[0, 0] = casadi.if_else((t133 < -3.0543261909900767), -3.0543261909900767, casadi.if_else((t133 > 3.0543261909900767), 3.0543261909900767, t133))
+    q_next[1, 0] = casadi.if_else((t137 < -3.822271061867582), -3.822271061867582, casadi.if_else((t137 > 2.2863813201125716), 2.2863813201125716, t137))
+    q_next[2, 0] = casadi.if_else((t138 < -3.0543261909900767), -3.0543261909900767, casadi.if_else((t138 > 3.0543261909900767), 3.0543261909900767, t138))
+    q_next[3, 0] = casadi.if_else((t139 < -3.0543261909900767), -3.0543261909900767, casadi.if_else((t139 > 3.0543261909900767), 3.0543261909900767, t139))
+    q_next[4, 0] = casadi.if_else((t140 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((t140 > 2.9670597283903604), 2.9670597283903604, t140))
+    q_next[5, 0] = casadi.if_else((t141 < -2.9670597283903604), -2.9670597283903604, casadi.if_else((t141 > 2.9670597283903604), 2.9670597283903604, t141))
+    q_next[6, 0] = casadi.if_else((t143 < -4.71238898038469), -4.71238898038469, casadi.if_else((t143 > 4.71238898038469), 4.71238898038469, t143))
     cost = casadi.SX(1, 1)
     cost[0, 0] = casadi.if_else((casadi.fabs(t0) < casadi.inf), t128, -1)
     return [q_start, q_next, cost]

@@ -111,19 +111,19 @@ void scara_velocity_ellipsoid(const scara_real q[SCARA_DOF], scara_real U_v[9], 
 scara_real scara_condition_number(const scara_real q[SCARA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 4; returned as a scalar. 315 operations. */
+ * Result: q_dot[i], i < 4; returned as a scalar. 400 operations. */
 int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], scara_real damping, scara_real q_dot[SCARA_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 4; returned as a scalar. 319 operations. */
+ * Result: q_dot[i], i < 4; returned as a scalar. 404 operations. */
 int scara_velocity_ik_nullspace(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], const scara_real z[SCARA_DOF], scara_real damping, scara_real q_dot[SCARA_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 4; returned as a scalar. 347 operations. */
+ * Result: q_dot[i], i < 4; returned as a scalar. 432 operations. */
 int scara_resolved_rate(const scara_real q[SCARA_DOF], const scara_real target[SCARA_TASK_DIM], const scara_real target_rate[SCARA_TASK_DIM], const scara_real gain[SCARA_TASK_DIM], const scara_real z[SCARA_DOF], scara_real damping, scara_real q_dot[SCARA_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 4; q_next[i], i < 4; returned as a scalar. 204 operations. */
+ * Result: q_start[i], i < 4; q_next[i], i < 4; returned as a scalar. 311 operations. */
 scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const scara_real q[SCARA_DOF], scara_real damping, scara_real q_start[SCARA_DOF], scara_real q_next[SCARA_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
@@ -131,7 +131,7 @@ scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const 
 void scara_ik_branches(const scara_real mu[SCARA_TASK_DIM], scara_real q[SCARA_MAX_IK_SOLUTIONS * SCARA_DOF], int valid[SCARA_MAX_IK_SOLUTIONS], int in_limits[SCARA_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 4; returned as a scalar. 153 operations. */
+ * Result: q[i], i < 4; returned as a scalar. 154 operations. */
 int scara_ik_nearest(const scara_real mu[SCARA_TASK_DIM], const scara_real q_seed[SCARA_DOF], const scara_real weights[SCARA_DOF], scara_real q[SCARA_DOF]);
 
 /* Statuses of scara_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

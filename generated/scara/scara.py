@@ -82,6 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -335,6 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi4_rows(xp, count, state):
     """One-sided Jacobi sweep of a 4 x 4 matrix (its rows), `count` times: 352 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2
@@ -514,6 +516,139 @@ def _jacobi4_rows(xp, count, state):
             t151,
             t155,
             t159,
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _symmetric_solve4(xp, count, state):
+    """X solving a symmetric 4 x 4 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 217 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, = state
+        t0 = w1**2
+        t1 = w2**2
+        t2 = w3**2
+        t3 = w0**2
+        t4 = xp.sqrt(2*t0 + 2*t1 + 2*w5**2 + 2*t2 + 2*w6**2 + 2*w8**2 + t3 + w4**2 + w7**2 + w9**2)
+        t5 = xp.sqrt(t0 + t1 + t2 + t3)
+        t6 = t5*xp.where(xp.greater_equal(w0, 0), xp.asarray(1, dtype=dtype), -1)
+        t7 = xp.greater(t5, 0)
+        t8 = xp.where(t7, 1/(w0 + t6), 0)
+        t9 = xp.where(t7, 1 + xp.abs(w0)/t5, 0)
+        t10 = w1*t8
+        t11 = w2*t8
+        t12 = w3*t8
+        t13 = t9*(w1 + t10*w4 + t11*w5 + t12*w6)
+        t14 = -t13 + w1
+        t15 = w4 - t10*t13
+        t16 = w5 - t11*t13
+        t17 = w6 - t12*t13
+        t18 = t9*(w2 + t10*w5 + t11*w7 + t12*w8)
+        t19 = -t18 + w2
+        t20 = w5 - t10*t18
+        t21 = w7 - t11*t18
+        t22 = w8 - t12*t18
+        t23 = t9*(w3 + t10*w6 + t11*w8 + t12*w9)
+        t24 = -t23 + w3
+        t25 = w6 - t10*t23
+        t26 = w8 - t11*t23
+        t27 = w9 - t12*t23
+        t28 = t9*(w10 + t10*w11 + t11*w12 + t12*w13)
+        t29 = -t28 + w10
+        t30 = w11 - t10*t28
+        t31 = w12 - t11*t28
+        t32 = w13 - t12*t28
+        t33 = xp.sqrt(t15**2 + t16**2 + t17**2)
+        t34 = t33*xp.where(xp.greater_equal(t15, 0), xp.asarray(1, dtype=dtype), -1)
+        t35 = xp.greater(t33, 0)
+        t36 = xp.where(t35, 1/(t15 + t34), 0)
+        t37 = xp.where(t35, 1 + xp.abs(t15)/t33, 0)
+        t38 = t16*t36
+        t39 = t17*t36
+        t40 = t37*(t20 + t38*t21 + t39*t22)
+        t41 = -t40 + t20
+        t42 = t21 - t38*t40
+        t43 = t22 - t39*t40
+        t44 = t37*(t25 + t38*t26 + t39*t27)
+        t45 = -t44 + t25
+        t46 = t26 - t38*t44
+        t47 = t27 - t39*t44
+        t48 = t37*(t30 + t38*t31 + t39*t32)
+        t49 = -t48 + t30
+        t50 = t31 - t38*t48
+        t51 = t32 - t39*t48
+        t52 = xp.sqrt(t42**2 + t43**2)
+        t53 = t52*xp.where(xp.greater_equal(t42, 0), xp.asarray(1, dtype=dtype), -1)
+        t54 = xp.greater(t52, 0)
+        t55 = xp.where(t54, 1/(t42 + t53), 0)
+        t56 = xp.where(t54, 1 + xp.abs(t42)/t52, 0)
+        t57 = t43*t55
+        t58 = t56*(t46 + t57*t47)
+        t59 = -t58 + t46
+        t60 = t47 - t57*t58
+        t61 = t56*(t50 + t57*t51)
+        t62 = -t61 + t50
+        t63 = t51 - t57*t61
+        t64 = xp.abs(t60)
+        t65 = t64*xp.where(xp.greater_equal(t60, 0), xp.asarray(1, dtype=dtype), -1)
+        t66 = xp.where(xp.greater(t64, 0), xp.asarray(2, dtype=dtype), 0)
+        t67 = t63 - t63*t66
+        t68 = xp.where(xp.not_equal(t65, 0), -t67/t65, 0)
+        t69 = xp.where(xp.not_equal(t53, 0), -(t62 - t59*t68)/t53, 0)
+        t70 = xp.where(xp.not_equal(t34, 0), -(-(t41*t69 + t45*t68) + t49)/t34, 0)
+        t71 = xp.where(xp.not_equal(t6, 0), -(-(t14*t70 + t19*t69 + t24*t68) + t29)/t6, 0)
+        t72 = 1e-12*t4
+        state = (
+            t71,
+            t70,
+            t69,
+            t68,
+            xp.where(xp.less_equal(t5, t72) | xp.less_equal(t33, t72) | xp.less_equal(t52, t72) | xp.less_equal(t64, t72), xp.asarray(1, dtype=dtype), 0),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _nearer_branch(xp, count, state):
+    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 65 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, = state
+        t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w5))
+        t1 = w1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w1 + w6))
+        t2 = w3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w3 + w8))
+        t3 = xp.where(xp.less(t0, w5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t4 = t3 + t0
+        t5 = -t3 + t0
+        t6 = xp.where(xp.greater_equal(t0, -0.8726646259971648) & xp.less_equal(t0, 0.8726646259971648), t0, xp.where(xp.greater_equal(t4, -0.8726646259971648) & xp.less_equal(t4, 0.8726646259971648), t4, xp.where(xp.greater_equal(t5, -0.8726646259971648) & xp.less_equal(t5, 0.8726646259971648), t5, w0)))
+        t7 = xp.where(xp.less(t1, w6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t8 = t7 + t1
+        t9 = -t7 + t1
+        t10 = xp.where(xp.greater_equal(t1, -1.53588974175501) & xp.less_equal(t1, 1.53588974175501), t1, xp.where(xp.greater_equal(t8, -1.53588974175501) & xp.less_equal(t8, 1.53588974175501), t8, xp.where(xp.greater_equal(t9, -1.53588974175501) & xp.less_equal(t9, 1.53588974175501), t9, w1)))
+        t11 = xp.where(xp.less(t2, w8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t12 = t11 + t2
+        t13 = -t11 + t2
+        t14 = xp.where(xp.greater_equal(t2, -6.283185307179586) & xp.less_equal(t2, 6.283185307179586), t2, xp.where(xp.greater_equal(t12, -6.283185307179586) & xp.less_equal(t12, 6.283185307179586), t12, xp.where(xp.greater_equal(t13, -6.283185307179586) & xp.less_equal(t13, 6.283185307179586), t13, w3)))
+        t15 = w9*(-w5 + t6)**2 + w10*(-w6 + t10)**2 + w11*(-w7 + w2)**2 + w12*(-w8 + t14)**2
+        t16 = xp.greater(w4, 0)
+        t17 = xp.where(t16 & (xp.less(w18, 1) | xp.less(t15, w17)), xp.asarray(1, dtype=dtype), 0)
+        t18 = xp.where(t16, 1, w18)
+        t19 = xp.greater(t17, 0)
+        t20 = xp.where(t19, t6, w13)
+        t21 = xp.where(t19, t10, w14)
+        t22 = xp.where(t19, w2, w15)
+        t23 = xp.where(t19, t14, w16)
+        t24 = xp.where(t19, t15, w17)
+        state = (
+            t20,
+            t21,
+            t22,
+            t23,
+            t24,
+            t18,
         )
     return state
 
@@ -1547,7 +1682,7 @@ def condition_number(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 315 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 400 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (4,)), ("mu_dot", mu_dot, (4,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -1578,119 +1713,72 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t11 = t8 + 0.075625*c12**2
     t12 = xp.sqrt(4 + t7 + t11)
     t13 = t1 + t0
-    t14 = t4**2
-    t15 = t5**2
-    t16 = damping**2
-    t17 = t7 + t16
-    t18 = t17**2
-    t19 = xp.sqrt(t14 + t15 + t18)
-    t20 = t19*xp.where(xp.greater_equal(t17, 0), xp.asarray(1, dtype=dtype), -1)
-    t21 = t11 + t16
-    t22 = 1 + t16
-    t23 = 3 + t16
-    t24 = xp.sqrt(2*t14 + 2*t15 + 2*t13**2 + t18 + t21**2 + t22**2 + t23**2)
-    t25 = xp.greater(t19, 0)
-    t26 = xp.where(t25, 1/(t17 + t20), 0)
-    t27 = xp.where(t25, 1 + xp.abs(t17)/t19, 0)
-    t28 = t4*t26
-    t29 = t5*t26
-    t30 = -t27*(t4 + t21*t28 + t13*t29)
-    t31 = t4 + t30
-    t32 = t21 + t28*t30
-    t33 = t13 + t29*t30
-    t34 = -t27*(t5 + t23*t29 + t13*t28)
-    t35 = t5 + t34
-    t36 = t13 + t28*t34
-    t37 = t23 + t29*t34
-    t38 = -t27*(-mu_dot0 + t28*mu_dot1 + t29*mu_dot3)
-    t39 = -t38 + mu_dot0
-    t40 = mu_dot1 + t28*t38
-    t41 = mu_dot3 + t29*t38
-    t42 = xp.sqrt(t32**2 + t33**2)
-    t43 = t42*xp.where(xp.greater_equal(t32, 0), xp.asarray(1, dtype=dtype), -1)
-    t44 = xp.greater(t42, 0)
-    t45 = xp.where(t44, 1/(t32 + t43), 0)
-    t46 = xp.where(t44, 1 + xp.abs(t32)/t42, 0)
-    t47 = t33*t45
-    t48 = t46*(t36 + t47*t37)
-    t49 = -t48 + t36
-    t50 = t37 - t47*t48
-    t51 = t46*(t40 + t47*t41)
-    t52 = -t51 + t40
-    t53 = t41 - t47*t51
-    t54 = xp.abs(t22)
-    t55 = t54*xp.where(xp.greater_equal(t22, 0), xp.asarray(1, dtype=dtype), -1)
+    t14 = damping**2
+    t15 = _symmetric_solve4(xp, 1, (t7 + t14, -t4, xp.full(batch, 0, dtype=dtype, device=device), -t5, t11 + t14, xp.full(batch, 0, dtype=dtype, device=device), t13, 1 + t14, xp.full(batch, 0, dtype=dtype, device=device), 3 + t14, mu_dot0, mu_dot1, mu_dot2, mu_dot3,))
+    t16 = t15[2]
+    t17 = t15[3]
+    t18 = t15[0]
+    t19 = t15[1]
+    t20 = t17 - t3*t18 + t1*t19
+    t21 = t17 - t2*t18 + t0*t19
+    t22 = xp.greater(t9, 0)
+    t23 = xp.where(t22, 1 + xp.abs(t3)/t9, 0)
+    t24 = -t3
+    t25 = xp.where(t22, 1/(t24 + t10), 0)
+    t26 = -t2
+    t27 = q1 + q2 + q3 + q4 + t13 + t24 + t26 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping
+    t28 = t1*t25
+    t29 = t23*(t26 + t25 + t0*t28)
+    t30 = t2 + t29
+    t31 = t23*(mu_dot0 + mu_dot3*t25 + t28*mu_dot1)
+    t32 = -t31 + mu_dot0
+    t33 = t25*t29
+    t34 = t0 - t1*t33
+    t35 = 1 - t33
+    t36 = xp.sqrt(t34**2 + t35**2)
+    t37 = t36*xp.where(xp.greater_equal(t34, 0), xp.asarray(1, dtype=dtype), -1)
+    t38 = t25**2*t23
+    t39 = t1*t38
+    t40 = -1 + t38
+    t41 = t25*t31
+    t42 = mu_dot1 - t1*t41
+    t43 = -t41 + mu_dot3
+    t44 = xp.greater(t36, 0)
+    t45 = xp.where(t44, 1/(t34 + t37), 0)
+    t46 = xp.where(t44, 1 + xp.abs(t34)/t36, 0)
+    t47 = t35*t45
+    t48 = t46*(t39 + t47*t40)
+    t49 = -t48 + t39
+    t50 = t40 - t47*t48
+    t51 = t46*(t42 + t47*t43)
+    t52 = -t51 + t42
+    t53 = t43 - t47*t51
+    t54 = xp.abs(t50)
+    t55 = t54*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
     t56 = xp.where(xp.greater(t54, 0), xp.asarray(2, dtype=dtype), 0)
-    t57 = mu_dot2 - mu_dot2*t56
+    t57 = t53 - t53*t56
     t58 = xp.where(xp.not_equal(t55, 0), -t57/t55, 0)
-    t59 = xp.abs(t50)
-    t60 = t59*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
-    t61 = xp.where(xp.greater(t59, 0), xp.asarray(2, dtype=dtype), 0)
-    t62 = t53 - t53*t61
-    t63 = xp.where(xp.not_equal(t60, 0), -t62/t60, 0)
-    t64 = xp.where(xp.not_equal(t43, 0), -(t52 - t49*t63)/t43, 0)
-    t65 = xp.where(xp.not_equal(t20, 0), -(t39 + t31*t64 + t35*t63)/t20, 0)
-    t66 = t63 - t3*t65 + t1*t64
-    t67 = t63 - t2*t65 + t0*t64
-    t68 = xp.greater(t9, 0)
-    t69 = xp.where(t68, 1 + xp.abs(t3)/t9, 0)
-    t70 = -t3
-    t71 = xp.where(t68, 1/(t70 + t10), 0)
-    t72 = -t2
-    t73 = q1 + q2 + q3 + q4 + t13 + t70 + t72 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping
-    t74 = t1*t71
-    t75 = t69*(t72 + t71 + t0*t74)
-    t76 = t2 + t75
-    t77 = t69*(mu_dot0 + mu_dot3*t71 + t74*mu_dot1)
-    t78 = -t77 + mu_dot0
-    t79 = t71*t75
-    t80 = t0 - t1*t79
-    t81 = 1 - t79
-    t82 = xp.sqrt(t80**2 + t81**2)
-    t83 = t82*xp.where(xp.greater_equal(t80, 0), xp.asarray(1, dtype=dtype), -1)
-    t84 = t71**2*t69
-    t85 = t1*t84
-    t86 = -1 + t84
-    t87 = t71*t77
-    t88 = mu_dot1 - t1*t87
-    t89 = -t87 + mu_dot3
-    t90 = xp.greater(t82, 0)
-    t91 = xp.where(t90, 1/(t80 + t83), 0)
-    t92 = xp.where(t90, 1 + xp.abs(t80)/t82, 0)
-    t93 = t81*t91
-    t94 = t92*(t85 + t93*t86)
-    t95 = -t94 + t85
-    t96 = t86 - t93*t94
-    t97 = t92*(t88 + t93*t89)
-    t98 = -t97 + t88
-    t99 = t89 - t93*t97
-    t100 = xp.abs(t96)
-    t101 = t100*xp.where(xp.greater_equal(t96, 0), xp.asarray(1, dtype=dtype), -1)
-    t102 = xp.where(xp.greater(t100, 0), xp.asarray(2, dtype=dtype), 0)
-    t103 = t99 - t99*t102
-    t104 = xp.where(xp.not_equal(t101, 0), -t103/t101, 0)
-    t105 = xp.where(xp.not_equal(t83, 0), -(t98 - t95*t104)/t83, 0)
-    t106 = xp.where(xp.not_equal(t10, 0), -(-(-t76*t105 + t71*t69*t104) + t78)/t10, 0)
-    t107 = xp.isfinite(t73)
-    t108 = xp.greater_equal(damping, 0)
-    t109 = xp.greater(damping, 0)
-    t110 = 1e-12*t24
-    t111 = 1e-12*t12
-    t112 = (t109 & (xp.less_equal(t19, t110) | xp.less_equal(t42, t110) | xp.less_equal(t54, t110) | xp.less_equal(t59, t110))) | (xp.less_equal(damping, 0) & (xp.less_equal(t9, t111) | xp.less_equal(t82, t111) | xp.less_equal(1, t111) | xp.less_equal(t100, t111)))
-    t113 = t107 & t108 & xp.logical_not(t112)
+    t59 = xp.where(xp.not_equal(t37, 0), -(t52 - t49*t58)/t37, 0)
+    t60 = xp.where(xp.not_equal(t10, 0), -(-(-t30*t59 + t25*t23*t58) + t32)/t10, 0)
+    t61 = xp.isfinite(t27)
+    t62 = xp.greater_equal(damping, 0)
+    t63 = xp.greater(damping, 0)
+    t64 = 1e-12*t12
+    t65 = (t63 & xp.greater(t15[4], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t9, t64) | xp.less_equal(t36, t64) | xp.less_equal(1, t64) | xp.less_equal(t54, t64)))
+    t66 = t61 & t62 & xp.logical_not(t65)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t113, xp.where(t109, t66, t106), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t113, xp.where(t109, t67, t105), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t113, xp.where(t109, -t58, -mu_dot2), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t113, xp.where(t109, -t63, t104), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t66, xp.where(t63, t20, t60), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t66, xp.where(t63, t21, t59), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t66, xp.where(t63, -t16, -mu_dot2), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t66, xp.where(t63, -t17, t58), 0), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t107 & t108), 2, xp.where(t112, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t61 & t62), 2, xp.where(t65, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
-    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 319 operations."""
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 404 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (4,)), ("mu_dot", mu_dot, (4,)), ("z", z, (4,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -1725,119 +1813,72 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     t11 = t8 + 0.075625*c12**2
     t12 = xp.sqrt(4 + t7 + t11)
     t13 = t1 + t0
-    t14 = t4**2
-    t15 = t5**2
-    t16 = damping**2
-    t17 = t7 + t16
-    t18 = t17**2
-    t19 = xp.sqrt(t14 + t15 + t18)
-    t20 = t19*xp.where(xp.greater_equal(t17, 0), xp.asarray(1, dtype=dtype), -1)
-    t21 = t11 + t16
-    t22 = 1 + t16
-    t23 = 3 + t16
-    t24 = xp.sqrt(2*t14 + 2*t15 + 2*t13**2 + t18 + t21**2 + t22**2 + t23**2)
-    t25 = xp.greater(t19, 0)
-    t26 = xp.where(t25, 1/(t17 + t20), 0)
-    t27 = xp.where(t25, 1 + xp.abs(t17)/t19, 0)
-    t28 = t4*t26
-    t29 = t5*t26
-    t30 = -t27*(t4 + t21*t28 + t13*t29)
-    t31 = t4 + t30
-    t32 = t21 + t28*t30
-    t33 = t13 + t29*t30
-    t34 = -t27*(t5 + t23*t29 + t13*t28)
-    t35 = t5 + t34
-    t36 = t13 + t28*t34
-    t37 = t23 + t29*t34
-    t38 = -t27*(-mu_dot0 + t28*mu_dot1 + t29*mu_dot3)
-    t39 = -t38 + mu_dot0
-    t40 = mu_dot1 + t28*t38
-    t41 = mu_dot3 + t29*t38
-    t42 = xp.sqrt(t32**2 + t33**2)
-    t43 = t42*xp.where(xp.greater_equal(t32, 0), xp.asarray(1, dtype=dtype), -1)
-    t44 = xp.greater(t42, 0)
-    t45 = xp.where(t44, 1/(t32 + t43), 0)
-    t46 = xp.where(t44, 1 + xp.abs(t32)/t42, 0)
-    t47 = t33*t45
-    t48 = t46*(t36 + t47*t37)
-    t49 = -t48 + t36
-    t50 = t37 - t47*t48
-    t51 = t46*(t40 + t47*t41)
-    t52 = -t51 + t40
-    t53 = t41 - t47*t51
-    t54 = xp.abs(t22)
-    t55 = t54*xp.where(xp.greater_equal(t22, 0), xp.asarray(1, dtype=dtype), -1)
+    t14 = damping**2
+    t15 = _symmetric_solve4(xp, 1, (t7 + t14, -t4, xp.full(batch, 0, dtype=dtype, device=device), -t5, t11 + t14, xp.full(batch, 0, dtype=dtype, device=device), t13, 1 + t14, xp.full(batch, 0, dtype=dtype, device=device), 3 + t14, mu_dot0, mu_dot1, mu_dot2, mu_dot3,))
+    t16 = t15[2]
+    t17 = t15[3]
+    t18 = t15[0]
+    t19 = t15[1]
+    t20 = t17 - t3*t18 + t1*t19
+    t21 = t17 - t2*t18 + t0*t19
+    t22 = xp.greater(t9, 0)
+    t23 = xp.where(t22, 1 + xp.abs(t3)/t9, 0)
+    t24 = -t3
+    t25 = xp.where(t22, 1/(t24 + t10), 0)
+    t26 = -t2
+    t27 = q1 + q2 + q3 + q4 + t13 + t24 + t26 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + qz1 + qz2 + qz3 + qz4
+    t28 = t1*t25
+    t29 = t23*(t26 + t25 + t0*t28)
+    t30 = t2 + t29
+    t31 = t23*(mu_dot0 + mu_dot3*t25 + t28*mu_dot1)
+    t32 = -t31 + mu_dot0
+    t33 = t25*t29
+    t34 = t0 - t1*t33
+    t35 = 1 - t33
+    t36 = xp.sqrt(t34**2 + t35**2)
+    t37 = t36*xp.where(xp.greater_equal(t34, 0), xp.asarray(1, dtype=dtype), -1)
+    t38 = t25**2*t23
+    t39 = t1*t38
+    t40 = -1 + t38
+    t41 = t25*t31
+    t42 = mu_dot1 - t1*t41
+    t43 = -t41 + mu_dot3
+    t44 = xp.greater(t36, 0)
+    t45 = xp.where(t44, 1/(t34 + t37), 0)
+    t46 = xp.where(t44, 1 + xp.abs(t34)/t36, 0)
+    t47 = t35*t45
+    t48 = t46*(t39 + t47*t40)
+    t49 = -t48 + t39
+    t50 = t40 - t47*t48
+    t51 = t46*(t42 + t47*t43)
+    t52 = -t51 + t42
+    t53 = t43 - t47*t51
+    t54 = xp.abs(t50)
+    t55 = t54*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
     t56 = xp.where(xp.greater(t54, 0), xp.asarray(2, dtype=dtype), 0)
-    t57 = mu_dot2 - mu_dot2*t56
+    t57 = t53 - t53*t56
     t58 = xp.where(xp.not_equal(t55, 0), -t57/t55, 0)
-    t59 = xp.abs(t50)
-    t60 = t59*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
-    t61 = xp.where(xp.greater(t59, 0), xp.asarray(2, dtype=dtype), 0)
-    t62 = t53 - t53*t61
-    t63 = xp.where(xp.not_equal(t60, 0), -t62/t60, 0)
-    t64 = xp.where(xp.not_equal(t43, 0), -(t52 - t49*t63)/t43, 0)
-    t65 = xp.where(xp.not_equal(t20, 0), -(t39 + t31*t64 + t35*t63)/t20, 0)
-    t66 = t63 - t3*t65 + t1*t64
-    t67 = t63 - t2*t65 + t0*t64
-    t68 = xp.greater(t9, 0)
-    t69 = xp.where(t68, 1 + xp.abs(t3)/t9, 0)
-    t70 = -t3
-    t71 = xp.where(t68, 1/(t70 + t10), 0)
-    t72 = -t2
-    t73 = q1 + q2 + q3 + q4 + t13 + t70 + t72 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + qz1 + qz2 + qz3 + qz4
-    t74 = t1*t71
-    t75 = t69*(t72 + t71 + t0*t74)
-    t76 = t2 + t75
-    t77 = t69*(mu_dot0 + mu_dot3*t71 + t74*mu_dot1)
-    t78 = -t77 + mu_dot0
-    t79 = t71*t75
-    t80 = t0 - t1*t79
-    t81 = 1 - t79
-    t82 = xp.sqrt(t80**2 + t81**2)
-    t83 = t82*xp.where(xp.greater_equal(t80, 0), xp.asarray(1, dtype=dtype), -1)
-    t84 = t71**2*t69
-    t85 = t1*t84
-    t86 = -1 + t84
-    t87 = t71*t77
-    t88 = mu_dot1 - t1*t87
-    t89 = -t87 + mu_dot3
-    t90 = xp.greater(t82, 0)
-    t91 = xp.where(t90, 1/(t80 + t83), 0)
-    t92 = xp.where(t90, 1 + xp.abs(t80)/t82, 0)
-    t93 = t81*t91
-    t94 = t92*(t85 + t93*t86)
-    t95 = -t94 + t85
-    t96 = t86 - t93*t94
-    t97 = t92*(t88 + t93*t89)
-    t98 = -t97 + t88
-    t99 = t89 - t93*t97
-    t100 = xp.abs(t96)
-    t101 = t100*xp.where(xp.greater_equal(t96, 0), xp.asarray(1, dtype=dtype), -1)
-    t102 = xp.where(xp.greater(t100, 0), xp.asarray(2, dtype=dtype), 0)
-    t103 = t99 - t99*t102
-    t104 = xp.where(xp.not_equal(t101, 0), -t103/t101, 0)
-    t105 = xp.where(xp.not_equal(t83, 0), -(t98 - t95*t104)/t83, 0)
-    t106 = xp.where(xp.not_equal(t10, 0), -(-(-t76*t105 + t71*t69*t104) + t78)/t10, 0)
-    t107 = xp.isfinite(t73)
-    t108 = xp.greater_equal(damping, 0)
-    t109 = xp.greater(damping, 0)
-    t110 = 1e-12*t24
-    t111 = 1e-12*t12
-    t112 = (t109 & (xp.less_equal(t19, t110) | xp.less_equal(t42, t110) | xp.less_equal(t54, t110) | xp.less_equal(t59, t110))) | (xp.less_equal(damping, 0) & (xp.less_equal(t9, t111) | xp.less_equal(t82, t111) | xp.less_equal(1, t111) | xp.less_equal(t100, t111)))
-    t113 = t107 & t108 & xp.logical_not(t112)
+    t59 = xp.where(xp.not_equal(t37, 0), -(t52 - t49*t58)/t37, 0)
+    t60 = xp.where(xp.not_equal(t10, 0), -(-(-t30*t59 + t25*t23*t58) + t32)/t10, 0)
+    t61 = xp.isfinite(t27)
+    t62 = xp.greater_equal(damping, 0)
+    t63 = xp.greater(damping, 0)
+    t64 = 1e-12*t12
+    t65 = (t63 & xp.greater(t15[4], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t9, t64) | xp.less_equal(t36, t64) | xp.less_equal(1, t64) | xp.less_equal(t54, t64)))
+    t66 = t61 & t62 & xp.logical_not(t65)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t113, xp.where(t109, t66, t106), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t113, xp.where(t109, t67, t105), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t113, xp.where(t109, -t58, -mu_dot2), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t113, xp.where(t109, -t63, t104), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t66, xp.where(t63, t20, t60), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t66, xp.where(t63, t21, t59), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t66, xp.where(t63, -t16, -mu_dot2), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t66, xp.where(t63, -t17, t58), 0), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t107 & t108), 2, xp.where(t112, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t61 & t62), 2, xp.where(t65, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 347 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 432 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (4,)), ("target", target, (4,)), ("target_rate", target_rate, (4,)), ("gain", gain, (4,)), ("z", z, (4,)), ("damping", damping, ()), every=("gain", ))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -1887,122 +1928,75 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t16 = t13 + 0.075625*c12**2
     t17 = xp.sqrt(4 + t12 + t16)
     t18 = t5 + t4
-    t19 = t9**2
-    t20 = t10**2
-    t21 = damping**2
-    t22 = t12 + t21
-    t23 = t22**2
-    t24 = xp.sqrt(t19 + t20 + t23)
-    t25 = t24*xp.where(xp.greater_equal(t22, 0), xp.asarray(1, dtype=dtype), -1)
-    t26 = t16 + t21
-    t27 = 1 + t21
-    t28 = 3 + t21
-    t29 = xp.sqrt(2*t19 + 2*t20 + 2*t18**2 + t23 + t26**2 + t27**2 + t28**2)
-    t30 = xp.greater(t24, 0)
-    t31 = xp.where(t30, 1/(t22 + t25), 0)
-    t32 = xp.where(t30, 1 + xp.abs(t22)/t24, 0)
-    t33 = t9*t31
-    t34 = t10*t31
-    t35 = -t32*(t9 + t26*t33 + t18*t34)
-    t36 = t9 + t35
-    t37 = t26 + t33*t35
-    t38 = t18 + t34*t35
-    t39 = -t32*(t10 + t28*t34 + t18*t33)
-    t40 = t10 + t39
-    t41 = t18 + t33*t39
-    t42 = t28 + t34*t39
-    t43 = xp.sqrt(t37**2 + t38**2)
-    t44 = t43*xp.where(xp.greater_equal(t37, 0), xp.asarray(1, dtype=dtype), -1)
-    t45 = xp.greater(t43, 0)
-    t46 = xp.where(t45, 1/(t37 + t44), 0)
-    t47 = xp.where(t45, 1 + xp.abs(t37)/t43, 0)
-    t48 = t38*t46
-    t49 = t47*(t41 + t48*t42)
-    t50 = -t49 + t41
-    t51 = t42 - t48*t49
-    t52 = xp.abs(t27)
-    t53 = t52*xp.where(xp.greater_equal(t27, 0), xp.asarray(1, dtype=dtype), -1)
-    t54 = xp.where(xp.greater(t52, 0), xp.asarray(2, dtype=dtype), 0)
-    t55 = t3 - t54*t3
-    t56 = xp.where(xp.not_equal(t53, 0), -t55/t53, 0)
-    t57 = xp.abs(t51)
-    t58 = t57*xp.where(xp.greater_equal(t51, 0), xp.asarray(1, dtype=dtype), -1)
-    t59 = xp.where(xp.greater(t57, 0), xp.asarray(2, dtype=dtype), 0)
-    t60 = xp.greater(t14, 0)
-    t61 = xp.where(t60, 1 + xp.abs(t8)/t14, 0)
-    t62 = -t8
-    t63 = xp.where(t60, 1/(t62 + t15), 0)
-    t64 = mu_dot1 + gain1*(t62 + mu1)
-    t65 = -t7
-    t66 = t5*t63
-    t67 = t61*(t65 + t63 + t4*t66)
-    t68 = t7 + t67
-    t69 = t63*t67
-    t70 = t4 - t5*t69
-    t71 = 1 - t69
-    t72 = xp.sqrt(t70**2 + t71**2)
-    t73 = t72*xp.where(xp.greater_equal(t70, 0), xp.asarray(1, dtype=dtype), -1)
-    t74 = t63**2*t61
-    t75 = t5*t74
-    t76 = -1 + t74
-    t77 = xp.greater(t72, 0)
-    t78 = xp.where(t77, 1/(t70 + t73), 0)
-    t79 = xp.where(t77, 1 + xp.abs(t70)/t72, 0)
-    t80 = t71*t78
-    t81 = t79*(t75 + t80*t76)
-    t82 = -t81 + t75
-    t83 = t76 - t80*t81
-    t84 = xp.abs(t83)
-    t85 = t84*xp.where(xp.greater_equal(t83, 0), xp.asarray(1, dtype=dtype), -1)
-    t86 = xp.where(xp.greater(t84, 0), xp.asarray(2, dtype=dtype), 0)
-    t87 = -mu3 + xp.atan2(t2, t1)
-    t88 = mu_dot3 - gain3*(t87 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t87)))
-    t89 = -t32*(-t6 + t33*t64 + t34*t88)
-    t90 = -t89 + t6
-    t91 = t64 + t33*t89
-    t92 = t88 + t34*t89
-    t93 = t47*(t91 + t48*t92)
-    t94 = -t93 + t91
-    t95 = t92 - t48*t93
-    t96 = t95 - t59*t95
-    t97 = xp.where(xp.not_equal(t58, 0), -t96/t58, 0)
-    t98 = xp.where(xp.not_equal(t44, 0), -(t94 - t50*t97)/t44, 0)
-    t99 = xp.where(xp.not_equal(t25, 0), -(t90 + t36*t98 + t40*t97)/t25, 0)
-    t100 = t97 - t8*t99 + t5*t98
-    t101 = t97 - t7*t99 + t4*t98
-    t102 = t61*(t6 + t63*t88 + t66*t64)
-    t103 = -t102 + t6
-    t104 = q1 + q2 + q3 + q4 + t18 + t62 + t65 + damping + qz1 + qz2 + qz3 + qz4 + t6 + t64 + t3 + t88
-    t105 = t63*t102
-    t106 = t64 - t5*t105
-    t107 = -t105 + t88
-    t108 = t79*(t106 + t80*t107)
-    t109 = -t108 + t106
-    t110 = t107 - t80*t108
-    t111 = t110 - t86*t110
-    t112 = xp.where(xp.not_equal(t85, 0), -t111/t85, 0)
-    t113 = xp.where(xp.not_equal(t73, 0), -(t109 - t82*t112)/t73, 0)
-    t114 = xp.where(xp.not_equal(t15, 0), -(-(-t68*t113 + t63*t61*t112) + t103)/t15, 0)
-    t115 = xp.isfinite(t104)
-    t116 = xp.greater_equal(damping, 0)
-    t117 = xp.greater(damping, 0)
-    t118 = 1e-12*t29
-    t119 = 1e-12*t17
-    t120 = (t117 & (xp.less_equal(t24, t118) | xp.less_equal(t43, t118) | xp.less_equal(t52, t118) | xp.less_equal(t57, t118))) | (xp.less_equal(damping, 0) & (xp.less_equal(t14, t119) | xp.less_equal(t72, t119) | xp.less_equal(1, t119) | xp.less_equal(t84, t119)))
-    t121 = t115 & t116 & xp.logical_not(t120)
+    t19 = xp.greater(t14, 0)
+    t20 = xp.where(t19, 1 + xp.abs(t8)/t14, 0)
+    t21 = -t8
+    t22 = xp.where(t19, 1/(t21 + t15), 0)
+    t23 = mu_dot1 + gain1*(t21 + mu1)
+    t24 = -t7
+    t25 = t5*t22
+    t26 = t20*(t24 + t22 + t4*t25)
+    t27 = t7 + t26
+    t28 = t22*t26
+    t29 = t4 - t5*t28
+    t30 = 1 - t28
+    t31 = xp.sqrt(t29**2 + t30**2)
+    t32 = t31*xp.where(xp.greater_equal(t29, 0), xp.asarray(1, dtype=dtype), -1)
+    t33 = t22**2*t20
+    t34 = t5*t33
+    t35 = -1 + t33
+    t36 = xp.greater(t31, 0)
+    t37 = xp.where(t36, 1/(t29 + t32), 0)
+    t38 = xp.where(t36, 1 + xp.abs(t29)/t31, 0)
+    t39 = t30*t37
+    t40 = t38*(t34 + t39*t35)
+    t41 = -t40 + t34
+    t42 = t35 - t39*t40
+    t43 = xp.abs(t42)
+    t44 = t43*xp.where(xp.greater_equal(t42, 0), xp.asarray(1, dtype=dtype), -1)
+    t45 = xp.where(xp.greater(t43, 0), xp.asarray(2, dtype=dtype), 0)
+    t46 = -mu3 + xp.atan2(t2, t1)
+    t47 = mu_dot3 - gain3*(t46 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t46)))
+    t48 = t20*(t6 + t22*t47 + t25*t23)
+    t49 = -t48 + t6
+    t50 = q1 + q2 + q3 + q4 + t18 + t21 + t24 + damping + qz1 + qz2 + qz3 + qz4 + t6 + t23 + t3 + t47
+    t51 = damping**2
+    t52 = _symmetric_solve4(xp, 1, (t12 + t51, -t9, xp.full(batch, 0, dtype=dtype, device=device), -t10, t16 + t51, xp.full(batch, 0, dtype=dtype, device=device), t18, 1 + t51, xp.full(batch, 0, dtype=dtype, device=device), 3 + t51, t6, t23, t3, t47,))
+    t53 = t52[2]
+    t54 = t52[3]
+    t55 = t52[0]
+    t56 = t52[1]
+    t57 = t54 - t8*t55 + t5*t56
+    t58 = t54 - t7*t55 + t4*t56
+    t59 = t22*t48
+    t60 = t23 - t5*t59
+    t61 = -t59 + t47
+    t62 = t38*(t60 + t39*t61)
+    t63 = -t62 + t60
+    t64 = t61 - t39*t62
+    t65 = t64 - t45*t64
+    t66 = xp.where(xp.not_equal(t44, 0), -t65/t44, 0)
+    t67 = xp.where(xp.not_equal(t32, 0), -(t63 - t41*t66)/t32, 0)
+    t68 = xp.where(xp.not_equal(t15, 0), -(-(-t27*t67 + t22*t20*t66) + t49)/t15, 0)
+    t69 = xp.isfinite(t50)
+    t70 = xp.greater_equal(damping, 0)
+    t71 = xp.greater(damping, 0)
+    t72 = 1e-12*t17
+    t73 = (t71 & xp.greater(t52[4], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t14, t72) | xp.less_equal(t31, t72) | xp.less_equal(1, t72) | xp.less_equal(t43, t72)))
+    t74 = t69 & t70 & xp.logical_not(t73)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t121, xp.where(t117, t100, t114), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t121, xp.where(t117, t101, t113), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t121, xp.where(t117, -t56, -t3), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t121, xp.where(t117, -t97, t112), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t74, xp.where(t71, t57, t68), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t74, xp.where(t71, t58, t67), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t74, xp.where(t71, -t53, -t3), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t74, xp.where(t71, -t54, t66), 0), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t115 & t116), 2, xp.where(t120, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t69 & t70), 2, xp.where(t73, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (4 x 1 and 4 x 1 and 1 x 1), 204 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (4 x 1 and 4 x 1 and 1 x 1), 311 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4,)), ("q", q, (4,)), ("damping", damping, ()))
     mu0 = target[..., 0]
     mu1 = target[..., 1]
@@ -2028,72 +2022,29 @@ def ik_numeric_step(target, q, damping=0.0):
     t1 = c12*c4 + s12*s4
     t2 = s12*c4 - c12*s4
     t3 = -t0 + mu2
-    t4 = 1 + damping
-    t5 = mu3 + mu0 + mu1 + mu2 + qs1 + qs2 + qs3 + qs4
-    t6 = 0.275*c12
-    t7 = 0.325*c1 + t6
-    t8 = t7**2 + 0.075625*c12**2
-    t9 = t7 + t6
-    t10 = -t7 + mu0
-    t11 = 0.275*s12
-    t12 = 0.325*s1 + t11
-    t13 = t12**2 + 0.075625*s12**2
-    t14 = t7*t12 + 0.075625*c12*s12
-    t15 = t12 + t11
-    t16 = -t12 + mu1
-    t17 = -mu3 + xp.atan2(t2, t1)
-    t18 = t17 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t17))
-    t19 = t10**2 + t16**2 + t3**2 + t18**2
-    t20 = damping + t13
-    t21 = xp.sqrt(t20**2 + t14**2 + t15**2)
-    t22 = t21*xp.where(xp.greater_equal(t20, 0), xp.asarray(1, dtype=dtype), -1)
-    t23 = xp.greater(t21, 0)
-    t24 = xp.where(t23, 1/(t20 + t22), 0)
-    t25 = xp.where(t23, 1 + xp.abs(t20)/t21, 0)
-    t26 = damping + t8
-    t27 = t14*t24
-    t28 = t15*t24
-    t29 = -t25*(t14 + t26*t27 + t28*t9)
-    t30 = t14 + t29
-    t31 = t26 + t27*t29
-    t32 = t9 + t28*t29
-    t33 = t25*(t10 - t27*t16 + t28*t18)
-    t34 = -t33 + t10
-    t35 = t16 + t27*t33
-    t36 = -t18 + t28*t33
-    t37 = xp.sqrt(t31**2 + t32**2)
-    t38 = t37*xp.where(xp.greater_equal(t31, 0), xp.asarray(1, dtype=dtype), -1)
-    t39 = 3 + damping
-    t40 = -t25*(t15 + t27*t9 + t28*t39)
-    t41 = t15 + t40
-    t42 = t9 + t27*t40
-    t43 = t39 + t28*t40
-    t44 = xp.greater(t37, 0)
-    t45 = xp.where(t44, 1/(t31 + t38), 0)
-    t46 = xp.where(t44, 1 + xp.abs(t31)/t37, 0)
-    t47 = t32*t45
-    t48 = t46*(t42 + t47*t43)
-    t49 = -t48 + t42
-    t50 = t43 - t47*t48
-    t51 = t46*(t35 + t47*t36)
-    t52 = -t51 + t35
-    t53 = t36 - t47*t51
-    t54 = xp.abs(t4)
-    t55 = t54*xp.where(xp.greater_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)
-    t56 = xp.where(xp.greater(t54, 0), xp.asarray(2, dtype=dtype), 0)
-    t57 = t3 - t3*t56
-    t58 = xp.where(xp.not_equal(t55, 0), -t57/t55, 0)
-    t59 = -t58 + q3
-    t60 = xp.abs(t50)
-    t61 = t60*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
-    t62 = xp.where(xp.greater(t60, 0), xp.asarray(2, dtype=dtype), 0)
-    t63 = t53 - t53*t62
-    t64 = xp.where(xp.not_equal(t61, 0), -t63/t61, 0)
-    t65 = xp.where(xp.not_equal(t38, 0), -(t52 - t49*t64)/t38, 0)
-    t66 = xp.where(xp.not_equal(t22, 0), -(t34 + t30*t65 + t41*t64)/t22, 0)
-    t67 = q1 + t64 - t12*t66 + t7*t65
-    t68 = q2 + t64 - t11*t66 + t6*t65
-    t69 = -t64 + q4
+    t4 = mu3 + mu0 + mu1 + mu2 + qs1 + qs2 + qs3 + qs4
+    t5 = 0.275*c12
+    t6 = 0.325*c1 + t5
+    t7 = t6**2 + 0.075625*c12**2
+    t8 = t6 + t5
+    t9 = -t6 + mu0
+    t10 = 0.275*s12
+    t11 = 0.325*s1 + t10
+    t12 = t11**2 + 0.075625*s12**2
+    t13 = t6*t11 + 0.075625*c12*s12
+    t14 = t11 + t10
+    t15 = -t11 + mu1
+    t16 = -mu3 + xp.atan2(t2, t1)
+    t17 = t16 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t16))
+    t18 = t9**2 + t15**2 + t3**2 + t17**2
+    t19 = _symmetric_solve4(xp, 1, (damping + t12, -t13, xp.full(batch, 0, dtype=dtype, device=device), -t14, damping + t7, xp.full(batch, 0, dtype=dtype, device=device), t8, 1 + damping, xp.full(batch, 0, dtype=dtype, device=device), 3 + damping, t9, t15, t3, -t17,))
+    t20 = -t19[2] + q3
+    t21 = t19[3]
+    t22 = -t21 + q4
+    t23 = t19[0]
+    t24 = t19[1]
+    t25 = q1 + t21 - t11*t23 + t6*t24
+    t26 = q2 + t21 - t10*t23 + t5*t24
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -2101,12 +2052,12 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q4, batch),  # 3
     ], (4,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t67, -0.8726646259971648), -0.8726646259971648, xp.where(xp.greater(t67, 0.8726646259971648), 0.8726646259971648, t67)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t68, -1.53588974175501), -1.53588974175501, xp.where(xp.greater(t68, 1.53588974175501), 1.53588974175501, t68)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t59, 0.0), 0.0, xp.where(xp.greater(t59, 0.21), 0.21, t59)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t69, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t69, 6.283185307179586), 6.283185307179586, t69)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t25, -0.8726646259971648), -0.8726646259971648, xp.where(xp.greater(t25, 0.8726646259971648), 0.8726646259971648, t25)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t26, -1.53588974175501), -1.53588974175501, xp.where(xp.greater(t26, 1.53588974175501), 1.53588974175501, t26)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t20, 0.0), 0.0, xp.where(xp.greater(t20, 0.21), 0.21, t20)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t22, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t22, 6.283185307179586), 6.283185307179586, t22)), batch),  # 3
     ], (4,))
-    cost = xp.broadcast_to(xp.where(xp.isfinite(t5), t19, -1), batch)
+    cost = xp.broadcast_to(xp.where(xp.isfinite(t4), t18, -1), batch)
     return q_start, q_next, cost
 
 
@@ -2205,7 +2156,7 @@ def ik_branches(mu):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (4 x 1 and 1 x 1), 153 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (4 x 1 and 1 x 1), 154 operations."""
     xp, dtype, device, batch, (mu, q_seed, weights,) = _arguments(("mu", mu, (4,)), ("q_seed", q_seed, (4,)), ("weights", weights, (4,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(mu)
     mu0 = mu[..., 0]
@@ -2232,70 +2183,19 @@ def ik_nearest(mu, q_seed, weights=(1.0,) * DOF):
     vb1 = branches_valid[..., 1]
     lb0 = branches_in_limits[..., 0]
     lb1 = branches_in_limits[..., 1]
-    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
-    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
-    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
-    t3 = xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0)
-    t4 = xp.where(xp.greater(t3, 0), xp.asarray(1, dtype=dtype), 0)
-    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
-    t6 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
-    t7 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
-    t8 = xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0)
-    t9 = mu3 + mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
-    t10 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t11 = t10 + t0
-    t12 = -t10 + t0
-    t13 = xp.where(xp.greater_equal(t0, -0.8726646259971648) & xp.less_equal(t0, 0.8726646259971648), t0, xp.where(xp.greater_equal(t11, -0.8726646259971648) & xp.less_equal(t11, 0.8726646259971648), t11, xp.where(xp.greater_equal(t12, -0.8726646259971648) & xp.less_equal(t12, 0.8726646259971648), t12, qb0_0)))
-    t14 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t15 = t14 + t1
-    t16 = -t14 + t1
-    t17 = xp.where(xp.greater_equal(t1, -1.53588974175501) & xp.less_equal(t1, 1.53588974175501), t1, xp.where(xp.greater_equal(t15, -1.53588974175501) & xp.less_equal(t15, 1.53588974175501), t15, xp.where(xp.greater_equal(t16, -1.53588974175501) & xp.less_equal(t16, 1.53588974175501), t16, qb0_1)))
-    t18 = xp.where(xp.less(t2, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t19 = t18 + t2
-    t20 = -t18 + t2
-    t21 = xp.where(xp.greater_equal(t2, -6.283185307179586) & xp.less_equal(t2, 6.283185307179586), t2, xp.where(xp.greater_equal(t19, -6.283185307179586) & xp.less_equal(t19, 6.283185307179586), t19, xp.where(xp.greater_equal(t20, -6.283185307179586) & xp.less_equal(t20, 6.283185307179586), t20, qb0_3)))
-    t22 = -qn1
-    t23 = -qn2
-    t24 = -qn3
-    t25 = -qn4
-    t26 = qw1*(t22 + t13)**2 + qw2*(t23 + t17)**2 + qw3*(t24 + qb0_2)**2 + qw4*(t25 + t21)**2
-    t27 = xp.greater(t4, 0)
-    t28 = xp.where(t27, t13, qn1)
-    t29 = xp.where(t27, t17, qn2)
-    t30 = xp.where(t27, qb0_2, qn3)
-    t31 = xp.where(t27, t21, qn4)
-    t32 = xp.where(t27, t26, 0)
-    t33 = xp.where(xp.less(t5, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t34 = t33 + t5
-    t35 = -t33 + t5
-    t36 = xp.where(xp.greater_equal(t5, -0.8726646259971648) & xp.less_equal(t5, 0.8726646259971648), t5, xp.where(xp.greater_equal(t34, -0.8726646259971648) & xp.less_equal(t34, 0.8726646259971648), t34, xp.where(xp.greater_equal(t35, -0.8726646259971648) & xp.less_equal(t35, 0.8726646259971648), t35, qb1_0)))
-    t37 = xp.where(xp.less(t6, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t38 = t37 + t6
-    t39 = -t37 + t6
-    t40 = xp.where(xp.greater_equal(t6, -1.53588974175501) & xp.less_equal(t6, 1.53588974175501), t6, xp.where(xp.greater_equal(t38, -1.53588974175501) & xp.less_equal(t38, 1.53588974175501), t38, xp.where(xp.greater_equal(t39, -1.53588974175501) & xp.less_equal(t39, 1.53588974175501), t39, qb1_1)))
-    t41 = xp.where(xp.less(t7, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t42 = t41 + t7
-    t43 = -t41 + t7
-    t44 = xp.where(xp.greater_equal(t7, -6.283185307179586) & xp.less_equal(t7, 6.283185307179586), t7, xp.where(xp.greater_equal(t42, -6.283185307179586) & xp.less_equal(t42, 6.283185307179586), t42, xp.where(xp.greater_equal(t43, -6.283185307179586) & xp.less_equal(t43, 6.283185307179586), t43, qb1_3)))
-    t45 = qw1*(t22 + t36)**2 + qw2*(t23 + t40)**2 + qw3*(t24 + qb1_2)**2 + qw4*(t25 + t44)**2
-    t46 = xp.greater(t8, 0)
-    t47 = xp.where(t46 & (xp.less(t4, 1) | xp.less(t45, t32)), xp.asarray(1, dtype=dtype), 0)
-    t48 = xp.where(t46, 1, t4)
-    t49 = xp.greater(t47, 0)
-    t50 = xp.where(t49, t36, t28)
-    t51 = xp.where(t49, t40, t29)
-    t52 = xp.where(t49, qb1_2, t30)
-    t53 = xp.where(t49, t44, t31)
-    t54 = xp.greater(t48, 0)
-    t55 = xp.isfinite(t9)
-    t56 = t54 & t55
+    t0 = mu3 + mu0 + mu1 + mu2 + qn1 + qn2 + qn3 + qn4 + qw1 + qw2 + qw3 + qw4
+    t1 = _nearer_branch(xp, 1, (qb0_0, qb0_1, qb0_2, qb0_3, xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qw1, qw2, qw3, qw4, qn1, qn2, qn3, qn4, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
+    t2 = _nearer_branch(xp, 1, (qb1_0, qb1_1, qb1_2, qb1_3, xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qw1, qw2, qw3, qw4, t1[0], t1[1], t1[2], t1[3], t1[4], t1[5],))
+    t3 = xp.greater(t2[5], 0)
+    t4 = xp.isfinite(t0)
+    t5 = t3 & t4
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t56, t50, qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t56, t51, qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t56, t52, qn3), batch),  # 2
-        xp.broadcast_to(xp.where(t56, t53, qn4), batch),  # 3
+        xp.broadcast_to(xp.where(t5, t2[0], qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t5, t2[1], qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t5, t2[2], qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t5, t2[3], qn4), batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t55), 2, xp.where(t54, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t4), 2, xp.where(t3, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

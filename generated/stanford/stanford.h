@@ -113,19 +113,19 @@ void stanford_velocity_ellipsoid(const stanford_real q[STANFORD_DOF], stanford_r
 stanford_real stanford_condition_number(const stanford_real q[STANFORD_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1137 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1153 operations. */
 int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_real mu_dot[STANFORD_TASK_DIM], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1143 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1159 operations. */
 int stanford_velocity_ik_nullspace(const stanford_real q[STANFORD_DOF], const stanford_real mu_dot[STANFORD_TASK_DIM], const stanford_real z[STANFORD_DOF], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1304 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1320 operations. */
 int stanford_resolved_rate(const stanford_real q[STANFORD_DOF], const stanford_real target[16], const stanford_real target_rate[STANFORD_TASK_DIM], const stanford_real gain[STANFORD_TASK_DIM], const stanford_real z[STANFORD_DOF], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 834 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 902 operations. */
 stanford_real stanford_ik_numeric_step(const stanford_real target[16], const stanford_real q[STANFORD_DOF], stanford_real damping, stanford_real q_start[STANFORD_DOF], stanford_real q_next[STANFORD_DOF]);
 
 /* Every branch of the closed-form ik, whether the target allows it and whether it is inside the joint limits.
@@ -133,7 +133,7 @@ stanford_real stanford_ik_numeric_step(const stanford_real target[16], const sta
 void stanford_ik_branches(const stanford_real T[16], stanford_real q[STANFORD_MAX_IK_SOLUTIONS * STANFORD_DOF], int valid[STANFORD_MAX_IK_SOLUTIONS], int in_limits[STANFORD_MAX_IK_SOLUTIONS]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 6; returned as a scalar. 859 operations. */
+ * Result: q[i], i < 6; returned as a scalar. 858 operations. */
 int stanford_ik_nearest(const stanford_real T[16], const stanford_real q_seed[STANFORD_DOF], const stanford_real weights[STANFORD_DOF], stanford_real q[STANFORD_DOF]);
 
 /* Statuses of stanford_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -82,6 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -335,6 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi6_rows(xp, count, state):
     """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2 + w4**2 + w5**2
@@ -896,6 +898,250 @@ def _jacobi6_rows(xp, count, state):
             t489,
             t493,
             t497,
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _symmetric_solve6(xp, count, state):
+    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w1**2
+        t1 = w2**2
+        t2 = w3**2
+        t3 = w4**2
+        t4 = w5**2
+        t5 = w0**2
+        t6 = xp.sqrt(t5 + 2*t0 + 2*t1 + 2*w7**2 + 2*t2 + 2*w8**2 + 2*w12**2 + 2*t3 + 2*w9**2 + 2*w13**2 + 2*w16**2 + 2*t4 + 2*w10**2 + 2*w14**2 + 2*w17**2 + 2*w19**2 + w6**2 + w11**2 + w15**2 + w18**2 + w20**2)
+        t7 = xp.sqrt(t0 + t1 + t2 + t3 + t4 + t5)
+        t8 = t7*xp.where(xp.greater_equal(w0, 0), xp.asarray(1, dtype=dtype), -1)
+        t9 = xp.greater(t7, 0)
+        t10 = xp.where(t9, 1/(w0 + t8), 0)
+        t11 = xp.where(t9, 1 + xp.abs(w0)/t7, 0)
+        t12 = w1*t10
+        t13 = w2*t10
+        t14 = w3*t10
+        t15 = w4*t10
+        t16 = w5*t10
+        t17 = t11*(w1 + t12*w6 + t13*w7 + t14*w8 + t15*w9 + t16*w10)
+        t18 = -t17 + w1
+        t19 = w6 - t12*t17
+        t20 = w7 - t13*t17
+        t21 = w8 - t14*t17
+        t22 = w9 - t15*t17
+        t23 = w10 - t16*t17
+        t24 = t11*(w2 + t12*w7 + t13*w11 + t14*w12 + t15*w13 + t16*w14)
+        t25 = -t24 + w2
+        t26 = w7 - t12*t24
+        t27 = w11 - t13*t24
+        t28 = w12 - t14*t24
+        t29 = w13 - t15*t24
+        t30 = w14 - t16*t24
+        t31 = t11*(w3 + t12*w8 + t13*w12 + t14*w15 + t15*w16 + t16*w17)
+        t32 = -t31 + w3
+        t33 = w8 - t12*t31
+        t34 = w12 - t13*t31
+        t35 = w15 - t14*t31
+        t36 = w16 - t15*t31
+        t37 = w17 - t16*t31
+        t38 = t11*(w4 + t12*w9 + t13*w13 + t14*w16 + t15*w18 + t16*w19)
+        t39 = -t38 + w4
+        t40 = w9 - t12*t38
+        t41 = w13 - t13*t38
+        t42 = w16 - t14*t38
+        t43 = w18 - t15*t38
+        t44 = w19 - t16*t38
+        t45 = t11*(w5 + t12*w10 + t13*w14 + t14*w17 + t15*w19 + t16*w20)
+        t46 = -t45 + w5
+        t47 = w10 - t12*t45
+        t48 = w14 - t13*t45
+        t49 = w17 - t14*t45
+        t50 = w19 - t15*t45
+        t51 = w20 - t16*t45
+        t52 = t11*(w21 + t12*w22 + t13*w23 + t14*w24 + t15*w25 + t16*w26)
+        t53 = -t52 + w21
+        t54 = w22 - t12*t52
+        t55 = w23 - t13*t52
+        t56 = w24 - t14*t52
+        t57 = w25 - t15*t52
+        t58 = w26 - t16*t52
+        t59 = xp.sqrt(t19**2 + t20**2 + t21**2 + t22**2 + t23**2)
+        t60 = t59*xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)
+        t61 = xp.greater(t59, 0)
+        t62 = xp.where(t61, 1/(t19 + t60), 0)
+        t63 = xp.where(t61, 1 + xp.abs(t19)/t59, 0)
+        t64 = t20*t62
+        t65 = t21*t62
+        t66 = t22*t62
+        t67 = t23*t62
+        t68 = t63*(t26 + t64*t27 + t65*t28 + t66*t29 + t67*t30)
+        t69 = -t68 + t26
+        t70 = t27 - t64*t68
+        t71 = t28 - t65*t68
+        t72 = t29 - t66*t68
+        t73 = t30 - t67*t68
+        t74 = t63*(t33 + t64*t34 + t65*t35 + t66*t36 + t67*t37)
+        t75 = -t74 + t33
+        t76 = t34 - t64*t74
+        t77 = t35 - t65*t74
+        t78 = t36 - t66*t74
+        t79 = t37 - t67*t74
+        t80 = t63*(t40 + t64*t41 + t65*t42 + t66*t43 + t67*t44)
+        t81 = -t80 + t40
+        t82 = t41 - t64*t80
+        t83 = t42 - t65*t80
+        t84 = t43 - t66*t80
+        t85 = t44 - t67*t80
+        t86 = t63*(t47 + t64*t48 + t65*t49 + t66*t50 + t67*t51)
+        t87 = -t86 + t47
+        t88 = t48 - t64*t86
+        t89 = t49 - t65*t86
+        t90 = t50 - t66*t86
+        t91 = t51 - t67*t86
+        t92 = t63*(t54 + t64*t55 + t65*t56 + t66*t57 + t67*t58)
+        t93 = -t92 + t54
+        t94 = t55 - t64*t92
+        t95 = t56 - t65*t92
+        t96 = t57 - t66*t92
+        t97 = t58 - t67*t92
+        t98 = xp.sqrt(t70**2 + t71**2 + t72**2 + t73**2)
+        t99 = t98*xp.where(xp.greater_equal(t70, 0), xp.asarray(1, dtype=dtype), -1)
+        t100 = xp.greater(t98, 0)
+        t101 = xp.where(t100, 1/(t70 + t99), 0)
+        t102 = xp.where(t100, 1 + xp.abs(t70)/t98, 0)
+        t103 = t71*t101
+        t104 = t72*t101
+        t105 = t73*t101
+        t106 = t102*(t76 + t103*t77 + t104*t78 + t105*t79)
+        t107 = -t106 + t76
+        t108 = t77 - t103*t106
+        t109 = t78 - t104*t106
+        t110 = t79 - t105*t106
+        t111 = t102*(t82 + t103*t83 + t104*t84 + t105*t85)
+        t112 = -t111 + t82
+        t113 = t83 - t103*t111
+        t114 = t84 - t104*t111
+        t115 = t85 - t105*t111
+        t116 = t102*(t88 + t103*t89 + t104*t90 + t105*t91)
+        t117 = -t116 + t88
+        t118 = t89 - t103*t116
+        t119 = t90 - t104*t116
+        t120 = t91 - t105*t116
+        t121 = t102*(t94 + t103*t95 + t104*t96 + t105*t97)
+        t122 = -t121 + t94
+        t123 = t95 - t103*t121
+        t124 = t96 - t104*t121
+        t125 = t97 - t105*t121
+        t126 = xp.sqrt(t108**2 + t109**2 + t110**2)
+        t127 = t126*xp.where(xp.greater_equal(t108, 0), xp.asarray(1, dtype=dtype), -1)
+        t128 = xp.greater(t126, 0)
+        t129 = xp.where(t128, 1/(t108 + t127), 0)
+        t130 = xp.where(t128, 1 + xp.abs(t108)/t126, 0)
+        t131 = t109*t129
+        t132 = t110*t129
+        t133 = t130*(t113 + t131*t114 + t132*t115)
+        t134 = -t133 + t113
+        t135 = t114 - t131*t133
+        t136 = t115 - t132*t133
+        t137 = t130*(t118 + t131*t119 + t132*t120)
+        t138 = -t137 + t118
+        t139 = t119 - t131*t137
+        t140 = t120 - t132*t137
+        t141 = t130*(t123 + t131*t124 + t132*t125)
+        t142 = -t141 + t123
+        t143 = t124 - t131*t141
+        t144 = t125 - t132*t141
+        t145 = xp.sqrt(t135**2 + t136**2)
+        t146 = t145*xp.where(xp.greater_equal(t135, 0), xp.asarray(1, dtype=dtype), -1)
+        t147 = xp.greater(t145, 0)
+        t148 = xp.where(t147, 1/(t135 + t146), 0)
+        t149 = xp.where(t147, 1 + xp.abs(t135)/t145, 0)
+        t150 = t136*t148
+        t151 = t149*(t139 + t150*t140)
+        t152 = -t151 + t139
+        t153 = t140 - t150*t151
+        t154 = t149*(t143 + t150*t144)
+        t155 = -t154 + t143
+        t156 = t144 - t150*t154
+        t157 = xp.abs(t153)
+        t158 = t157*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
+        t159 = xp.where(xp.greater(t157, 0), xp.asarray(2, dtype=dtype), 0)
+        t160 = t156 - t156*t159
+        t161 = xp.where(xp.not_equal(t158, 0), -t160/t158, 0)
+        t162 = xp.where(xp.not_equal(t146, 0), -(t155 - t152*t161)/t146, 0)
+        t163 = xp.where(xp.not_equal(t127, 0), -(-(t134*t162 + t138*t161) + t142)/t127, 0)
+        t164 = xp.where(xp.not_equal(t99, 0), -(-(t107*t163 + t112*t162 + t117*t161) + t122)/t99, 0)
+        t165 = xp.where(xp.not_equal(t60, 0), -(-(t69*t164 + t75*t163 + t81*t162 + t87*t161) + t93)/t60, 0)
+        t166 = xp.where(xp.not_equal(t8, 0), -(-(t18*t165 + t25*t164 + t32*t163 + t39*t162 + t46*t161) + t53)/t8, 0)
+        t167 = 1e-12*t6
+        state = (
+            t166,
+            t165,
+            t164,
+            t163,
+            t162,
+            t161,
+            xp.where(xp.less_equal(t7, t167) | xp.less_equal(t59, t167) | xp.less_equal(t98, t167) | xp.less_equal(t126, t167) | xp.less_equal(t145, t167) | xp.less_equal(t157, t167), xp.asarray(1, dtype=dtype), 0),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _nearer_branch(xp, count, state):
+    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 101 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w7))
+        t1 = w1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w1 + w8))
+        t2 = w3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w3 + w10))
+        t3 = w4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w4 + w11))
+        t4 = w5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w5 + w12))
+        t5 = xp.where(xp.less(t0, w7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t6 = t5 + t0
+        t7 = -t5 + t0
+        t8 = xp.where(xp.greater_equal(t0, -2.9670597283903604) & xp.less_equal(t0, 2.9670597283903604), t0, xp.where(xp.greater_equal(t6, -2.9670597283903604) & xp.less_equal(t6, 2.9670597283903604), t6, xp.where(xp.greater_equal(t7, -2.9670597283903604) & xp.less_equal(t7, 2.9670597283903604), t7, w0)))
+        t9 = xp.where(xp.less(t1, w8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t10 = t9 + t1
+        t11 = -t9 + t1
+        t12 = xp.where(xp.greater_equal(t1, -2.9670597283903604) & xp.less_equal(t1, 2.9670597283903604), t1, xp.where(xp.greater_equal(t10, -2.9670597283903604) & xp.less_equal(t10, 2.9670597283903604), t10, xp.where(xp.greater_equal(t11, -2.9670597283903604) & xp.less_equal(t11, 2.9670597283903604), t11, w1)))
+        t13 = xp.where(xp.less(t2, w10), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t14 = t13 + t2
+        t15 = -t13 + t2
+        t16 = xp.where(xp.greater_equal(t2, -2.9670597283903604) & xp.less_equal(t2, 2.9670597283903604), t2, xp.where(xp.greater_equal(t14, -2.9670597283903604) & xp.less_equal(t14, 2.9670597283903604), t14, xp.where(xp.greater_equal(t15, -2.9670597283903604) & xp.less_equal(t15, 2.9670597283903604), t15, w3)))
+        t17 = xp.where(xp.less(t3, w11), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t18 = t17 + t3
+        t19 = -t17 + t3
+        t20 = xp.where(xp.greater_equal(t3, -1.5707963267948966) & xp.less_equal(t3, 1.5707963267948966), t3, xp.where(xp.greater_equal(t18, -1.5707963267948966) & xp.less_equal(t18, 1.5707963267948966), t18, xp.where(xp.greater_equal(t19, -1.5707963267948966) & xp.less_equal(t19, 1.5707963267948966), t19, w4)))
+        t21 = xp.where(xp.less(t4, w12), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t22 = t21 + t4
+        t23 = -t21 + t4
+        t24 = xp.where(xp.greater_equal(t4, -2.9670597283903604) & xp.less_equal(t4, 2.9670597283903604), t4, xp.where(xp.greater_equal(t22, -2.9670597283903604) & xp.less_equal(t22, 2.9670597283903604), t22, xp.where(xp.greater_equal(t23, -2.9670597283903604) & xp.less_equal(t23, 2.9670597283903604), t23, w5)))
+        t25 = w13*(-w7 + t8)**2 + w14*(-w8 + t12)**2 + w15*(-w9 + w2)**2 + w16*(-w10 + t16)**2 + w17*(-w11 + t20)**2 + w18*(-w12 + t24)**2
+        t26 = xp.greater(w6, 0)
+        t27 = xp.where(t26 & (xp.less(w26, 1) | xp.less(t25, w25)), xp.asarray(1, dtype=dtype), 0)
+        t28 = xp.where(t26, 1, w26)
+        t29 = xp.greater(t27, 0)
+        t30 = xp.where(t29, t8, w19)
+        t31 = xp.where(t29, t12, w20)
+        t32 = xp.where(t29, w2, w21)
+        t33 = xp.where(t29, t16, w22)
+        t34 = xp.where(t29, t20, w23)
+        t35 = xp.where(t29, t24, w24)
+        t36 = xp.where(t29, t25, w25)
+        state = (
+            t30,
+            t31,
+            t32,
+            t33,
+            t34,
+            t35,
+            t36,
+            t28,
         )
     return state
 
@@ -2946,7 +3192,7 @@ def condition_number(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1137 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1153 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -2995,387 +3241,216 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t23 = t20*t22
     t24 = t4**2
     t25 = q3**2*t17
-    t26 = t19*t25
-    t27 = t24 + t26
-    t28 = t21 + t27
-    t29 = t2**2
-    t30 = xp.sqrt(1 + t24 + t29)
-    t31 = xp.where(xp.less_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)*t30
-    t32 = t29 + t22*t25
-    t33 = t23 + t32
-    t34 = t13**2 + t10**2 + t22
-    t35 = t21 + t34
-    t36 = t9**2 + t15**2 + t19
-    t37 = t23 + t36
-    t38 = 1 + t0**2 + c4**2*t20
-    t39 = xp.sqrt(t16 + 2*t17 + 2*t21 + 2*t23 + t27 + t32 + t34 + t36 + t38)
-    t40 = t17 + t38
-    t41 = t2*t4
-    t42 = s1*c1
-    t43 = t20*t42
-    t44 = -t41 + t43 + t25*t42
-    t45 = -t42 + t43 + t13*t9 + t10*t15
-    t46 = c1*t5
-    t47 = q3*c2
-    t48 = t19*t47
-    t49 = c2*t1
-    t50 = t49 - t46*t47
-    t51 = s1*t5
-    t52 = c2*t3
-    t53 = t52 - t47*t51
-    t54 = t22*t47
-    t55 = s2*c4
-    t56 = -t49 + t10*t0 + t13*t55
-    t57 = -t52 + t15*t0 + t9*t55
-    t58 = t44**2
-    t59 = t50**2
-    t60 = t48**2
-    t61 = damping**2
-    t62 = t61 + t28
-    t63 = t62**2
-    t64 = t61 + t33
-    t65 = t61 + t18
-    t66 = t61 + t35
-    t67 = t61 + t37
-    t68 = t61 + t40
-    t69 = 2*t16
-    t70 = t22*t26
-    t71 = xp.sqrt(2*t29 + 2*t24 + 2*t58 + 2*t59 + 2*t53**2 + 2*t54**2 + 2*t60 + 2*t45**2 + 2*t56**2 + 2*t57**2 + t63 + t64**2 + t65**2 + t66**2 + t67**2 + t68**2 + 4*t70 + t22*t69 + t19*t69)
-    t72 = xp.sqrt(t24 + t58 + t59 + t60 + t63 + t70)
-    t73 = t72*xp.where(xp.greater_equal(t62, 0), xp.asarray(1, dtype=dtype), -1)
-    t74 = xp.greater(t72, 0)
-    t75 = xp.where(t74, 1/(t62 + t73), 0)
-    t76 = xp.where(t74, 1 + xp.abs(t62)/t72, 0)
-    t77 = t44*t75
-    t78 = t50*t75
-    t79 = t42*t47
-    t80 = t79*t75
-    t81 = t48*t75
-    t82 = t76*(t44 + t64*t77 + t78*t53 + t79*t81 - t41*t75 + t54*t80)
-    t83 = -t82 + t44
-    t84 = t64 - t77*t82
-    t85 = t53 - t78*t82
-    t86 = t76*(t50 + t77*t53 + t65*t78 - t46*t54*t75 - t46*t81)
-    t87 = -t86 + t50
-    t88 = t53 - t77*t86
-    t89 = t65 - t78*t86
-    t90 = t51 + t80*t86
-    t91 = t46 + t81*t86
-    t92 = t75*t82
-    t93 = -t54 + t79*t92
-    t94 = t79 - t92*t48
-    t95 = t2 + t4*t92
-    t96 = xp.sqrt(t84**2 + t85**2 + t93**2 + t94**2 + t95**2)
-    t97 = t96*xp.where(xp.greater_equal(t84, 0), xp.asarray(1, dtype=dtype), -1)
-    t98 = t4*t75
-    t99 = t76*(-t79 + t51*t78 - t66*t80 + t81*t45 + t98*t56 - t54*t77)
-    t100 = t79 + t99
-    t101 = t54 + t77*t99
-    t102 = t51 - t78*t99
-    t103 = t66 + t80*t99
-    t104 = t45 - t81*t99
-    t105 = t76*(t48 + t77*t79 - t46*t78 - t80*t45 + t67*t81 + t98*t57)
-    t106 = -t105 + t48
-    t107 = t79 - t77*t105
-    t108 = t46 + t78*t105
-    t109 = t45 + t80*t105
-    t110 = t67 - t81*t105
-    t111 = -t57 + t98*t105
-    t112 = -t76*(t4 - t2*t77 - t80*t56 + t81*t57 + t68*t98)
-    t113 = t4 + t112
-    t114 = t2 - t77*t112
-    t115 = t57 + t81*t112
-    t116 = t68 + t98*t112
-    t117 = t76*(mu_dot0 + t77*mu_dot1 + t78*mu_dot2 - t80*mu_dot3 + t81*mu_dot4 - t98*mu_dot5)
-    t118 = -t117 + mu_dot0
-    t119 = mu_dot1 - t77*t117
-    t120 = mu_dot2 - t78*t117
-    t121 = mu_dot3 + t80*t117
-    t122 = mu_dot4 - t81*t117
-    t123 = mu_dot5 + t98*t117
-    t124 = -t56
-    t125 = t124 + t98*t99
-    t126 = t124 + t80*t112
-    t127 = xp.greater(t96, 0)
-    t128 = xp.where(t127, 1/(t84 + t97), 0)
-    t129 = xp.where(t127, 1 + xp.abs(t84)/t96, 0)
-    t130 = t85*t128
-    t131 = t93*t128
-    t132 = t94*t128
-    t133 = t98*t86
-    t134 = t95*t128
-    t135 = t129*(t88 + t130*t89 + t131*t90 - t132*t91 + t133*t134)
-    t136 = -t135 + t88
-    t137 = t89 - t130*t135
-    t138 = t90 - t131*t135
-    t139 = t91 + t132*t135
-    t140 = t133 - t134*t135
-    t141 = t129*(-t101 + t130*t102 + t131*t103 + t132*t104 + t134*t125)
-    t142 = t101 + t141
-    t143 = t102 - t130*t141
-    t144 = t103 - t131*t141
-    t145 = t104 - t132*t141
-    t146 = t125 - t134*t141
-    t147 = t129*(t107 - t130*t108 + t131*t109 + t132*t110 + t134*t111)
-    t148 = -t147 + t107
-    t149 = t108 + t130*t147
-    t150 = t109 - t131*t147
-    t151 = t110 - t132*t147
-    t152 = t111 - t134*t147
-    t153 = t129*(t119 + t130*t120 + t131*t121 + t132*t122 + t134*t123)
-    t154 = -t153 + t119
-    t155 = t120 - t130*t153
-    t156 = t121 - t131*t153
-    t157 = t122 - t132*t153
-    t158 = t123 - t134*t153
-    t159 = xp.sqrt(t137**2 + t138**2 + t139**2 + t140**2)
-    t160 = t159*xp.where(xp.greater_equal(t137, 0), xp.asarray(1, dtype=dtype), -1)
-    t161 = t78*t112
-    t162 = t129*(t114 - t130*t161 + t131*t126 - t132*t115 + t134*t116)
-    t163 = -t162 + t114
-    t164 = t161 + t130*t162
-    t165 = t126 - t131*t162
-    t166 = t115 + t132*t162
-    t167 = t116 - t134*t162
-    t168 = xp.greater(t159, 0)
-    t169 = xp.where(t168, 1/(t137 + t160), 0)
-    t170 = xp.where(t168, 1 + xp.abs(t137)/t159, 0)
-    t171 = t138*t169
-    t172 = t139*t169
-    t173 = t140*t169
-    t174 = t170*(t143 + t171*t144 - t172*t145 + t173*t146)
-    t175 = -t174 + t143
-    t176 = t144 - t171*t174
-    t177 = t145 + t172*t174
-    t178 = t146 - t173*t174
-    t179 = t170*(-t149 + t171*t150 - t172*t151 + t173*t152)
-    t180 = t149 + t179
-    t181 = t150 - t171*t179
-    t182 = t151 + t172*t179
-    t183 = t152 - t173*t179
-    t184 = t170*(-t164 + t171*t165 + t172*t166 + t173*t167)
-    t185 = t164 + t184
-    t186 = t165 - t171*t184
-    t187 = -t166 + t172*t184
-    t188 = t167 - t173*t184
-    t189 = t170*(t155 + t171*t156 - t172*t157 + t173*t158)
-    t190 = -t189 + t155
-    t191 = t156 - t171*t189
-    t192 = t157 + t172*t189
-    t193 = t158 - t173*t189
-    t194 = xp.sqrt(t176**2 + t177**2 + t178**2)
-    t195 = t194*xp.where(xp.greater_equal(t176, 0), xp.asarray(1, dtype=dtype), -1)
-    t196 = xp.greater(t194, 0)
-    t197 = xp.where(t196, 1/(t176 + t195), 0)
-    t198 = xp.where(t196, 1 + xp.abs(t176)/t194, 0)
-    t199 = t177*t197
-    t200 = t178*t197
-    t201 = t198*(t181 + t199*t182 + t200*t183)
-    t202 = -t201 + t181
-    t203 = t182 - t199*t201
-    t204 = t183 - t200*t201
-    t205 = t198*(t186 + t199*t187 + t200*t188)
-    t206 = -t205 + t186
-    t207 = t187 - t199*t205
-    t208 = t188 - t200*t205
-    t209 = t198*(t191 + t199*t192 + t200*t193)
-    t210 = -t209 + t191
-    t211 = t192 - t199*t209
-    t212 = t193 - t200*t209
-    t213 = xp.sqrt(t203**2 + t204**2)
-    t214 = t213*xp.where(xp.greater_equal(t203, 0), xp.asarray(1, dtype=dtype), -1)
-    t215 = xp.greater(t213, 0)
-    t216 = xp.where(t215, 1/(t203 + t214), 0)
-    t217 = xp.where(t215, 1 + xp.abs(t203)/t213, 0)
-    t218 = t204*t216
-    t219 = t217*(t207 + t218*t208)
-    t220 = -t219 + t207
-    t221 = t208 - t218*t219
-    t222 = t217*(t211 + t218*t212)
-    t223 = -t222 + t211
-    t224 = t212 - t218*t222
-    t225 = xp.abs(t221)
-    t226 = t225*xp.where(xp.greater_equal(t221, 0), xp.asarray(1, dtype=dtype), -1)
-    t227 = xp.where(xp.greater(t225, 0), xp.asarray(2, dtype=dtype), 0)
-    t228 = t224 - t224*t227
-    t229 = xp.where(xp.not_equal(t226, 0), -t228/t226, 0)
-    t230 = xp.where(xp.not_equal(t214, 0), -(t223 - t220*t229)/t214, 0)
-    t231 = xp.where(xp.not_equal(t195, 0), -(-(t202*t230 + t206*t229) + t210)/t195, 0)
-    t232 = xp.where(xp.not_equal(t160, 0), -(t190 + t180*t230 + t185*t229 - t175*t231)/t160, 0)
-    t233 = xp.where(xp.not_equal(t97, 0), -(-(t136*t232 - t142*t231 + t148*t230 + t163*t229) + t154)/t97, 0)
-    t234 = xp.where(xp.not_equal(t73, 0), -(-(t83*t233 + t87*t232 - t100*t231 + t106*t230 - t113*t229) + t118)/t73, 0)
-    t235 = t229 - t4*t234 + t2*t233
-    t236 = c2*t232 + t1*t234 + t3*t233
-    t237 = c2*t229 + t1*t231 + t3*t230
-    t238 = t13*t231 + t9*t230 - t55*t229
-    t239 = t10*t231 + t15*t230 - t0*t229
-    t240 = c1*t47
-    t241 = s1*t47
-    t242 = -t5*t232 - s1*t231 + c1*t230 + t240*t234 + t241*t233
-    t243 = xp.greater(t30, 0)
-    t244 = xp.where(t243, 1 + xp.abs(t4)/t30, 0)
-    t245 = -t4
-    t246 = xp.where(t243, 1/(t245 + t31), 0)
-    t247 = t2*t246
-    t248 = t244*(t240 + t241*t247)
-    t249 = -t248 + t240
-    t250 = t241 - t247*t248
-    t251 = t244*(t1 + t3*t247)
-    t252 = -t251 + t1
-    t253 = t244*(mu_dot0 + mu_dot5*t246 + t247*mu_dot1)
-    t254 = -t253 + mu_dot0
-    t255 = t246*t251
-    t256 = t3 - t2*t255
-    t257 = t246**2
-    t258 = xp.sqrt(t16 + t19 + t22 + t250**2 + t257*t248**2)
-    t259 = t258*xp.where(xp.greater_equal(t250, 0), xp.asarray(1, dtype=dtype), -1)
-    t260 = t257*t244
-    t261 = c2*t260
-    t262 = t2*t261
-    t263 = -t261 + c2
-    t264 = t55*t260
-    t265 = t2*t264
-    t266 = -t55
-    t267 = t264 + t266
-    t268 = t0*t260
-    t269 = t2*t268
-    t270 = -t0
-    t271 = t268 + t270
-    t272 = 1 - t5 - s1 + q1 + q2 + c1 + q3 + t2 + q4 + t13 + t9 + q5 + t10 + t15 + q6 + 2*c2 + 2*t1 + 2*t3 + t240 + t241 + t245 + t266 + t270 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t273 = t246*t253
-    t274 = mu_dot1 - t2*t273
-    t275 = -t273 + mu_dot5
-    t276 = xp.greater(t258, 0)
-    t277 = xp.where(t276, 1/(t250 + t259), 0)
-    t278 = xp.where(t276, 1 + xp.abs(t250)/t258, 0)
-    t279 = t5*t277
-    t280 = t248*t277
-    t281 = t278*(t256 - c2*t279 + t257*t280*t251)
-    t282 = -t281 + t256
-    t283 = c2 + t279*t281
-    t284 = t280*t246
-    t285 = -t255 + t284*t281
-    t286 = -t278*(t262 + t284*t263)
-    t287 = t262 + t286
-    t288 = t263 + t284*t286
-    t289 = t277*t286
-    t290 = t1 + s1*t289
-    t291 = t3 - c1*t289
-    t292 = s1*t277
-    t293 = c1*t277
-    t294 = t278*(t265 - t13*t292 + t9*t293 - t284*t267)
-    t295 = -t294 + t265
-    t296 = t13 + t292*t294
-    t297 = t9 - t293*t294
-    t298 = t267 + t284*t294
-    t299 = t278*(t269 - t10*t292 + t15*t293 - t284*t271)
-    t300 = -t299 + t269
-    t301 = t10 + t292*t299
-    t302 = t15 - t293*t299
-    t303 = t271 + t284*t299
-    t304 = -t278*(-t274 + t279*mu_dot2 + t292*mu_dot3 - t293*mu_dot4 + t284*t275)
-    t305 = -t304 + t274
-    t306 = mu_dot2 + t279*t304
-    t307 = mu_dot3 + t292*t304
-    t308 = mu_dot4 - t293*t304
-    t309 = t275 + t284*t304
-    t310 = t277**2*t281**2
-    t311 = xp.sqrt(t283**2 + t285**2 + t22*t310 + t19*t310)
-    t312 = t311*xp.where(xp.greater_equal(t283, 0), xp.asarray(1, dtype=dtype), -1)
-    t313 = xp.greater(t311, 0)
-    t314 = xp.where(t313, 1/(t283 + t312), 0)
-    t315 = xp.where(t313, 1 + xp.abs(t283)/t311, 0)
-    t316 = t279*t286
-    t317 = t281*t314
-    t318 = t292*t317
-    t319 = t293*t317
-    t320 = t285*t314
-    t321 = t315*(t316 + t318*t290 - t319*t291 + t320*t288)
-    t322 = -t321 + t316
-    t323 = t290 - t318*t321
-    t324 = t291 + t319*t321
-    t325 = t288 - t320*t321
-    t326 = t315*(t306 + t318*t307 - t319*t308 + t320*t309)
-    t327 = -t326 + t306
-    t328 = t307 - t318*t326
-    t329 = t308 + t319*t326
-    t330 = t309 - t320*t326
-    t331 = xp.sqrt(t323**2 + t324**2 + t325**2)
-    t332 = t331*xp.where(xp.greater_equal(t323, 0), xp.asarray(1, dtype=dtype), -1)
-    t333 = t279*t294
-    t334 = t315*(t333 + t318*t296 - t319*t297 + t320*t298)
-    t335 = -t334 + t333
-    t336 = t296 - t318*t334
-    t337 = t297 + t319*t334
-    t338 = t298 - t320*t334
-    t339 = t279*t299
-    t340 = t315*(t339 + t318*t301 - t319*t302 + t320*t303)
-    t341 = -t340 + t339
-    t342 = t301 - t318*t340
-    t343 = t302 + t319*t340
-    t344 = t303 - t320*t340
-    t345 = xp.greater(t331, 0)
-    t346 = xp.where(t345, 1/(t323 + t332), 0)
-    t347 = xp.where(t345, 1 + xp.abs(t323)/t331, 0)
-    t348 = t324*t346
-    t349 = t325*t346
-    t350 = t347*(t336 + t348*t337 + t349*t338)
-    t351 = -t350 + t336
-    t352 = t337 - t348*t350
-    t353 = t338 - t349*t350
-    t354 = t347*(t342 + t348*t343 + t349*t344)
-    t355 = -t354 + t342
-    t356 = t343 - t348*t354
-    t357 = t344 - t349*t354
-    t358 = t347*(t328 + t348*t329 + t349*t330)
-    t359 = -t358 + t328
-    t360 = t329 - t348*t358
-    t361 = t330 - t349*t358
-    t362 = xp.sqrt(t352**2 + t353**2)
-    t363 = t362*xp.where(xp.greater_equal(t352, 0), xp.asarray(1, dtype=dtype), -1)
-    t364 = xp.greater(t362, 0)
-    t365 = xp.where(t364, 1/(t352 + t363), 0)
-    t366 = xp.where(t364, 1 + xp.abs(t352)/t362, 0)
-    t367 = t353*t365
-    t368 = t366*(t356 + t367*t357)
-    t369 = -t368 + t356
-    t370 = t357 - t367*t368
-    t371 = t366*(t360 + t367*t361)
-    t372 = -t371 + t360
-    t373 = t361 - t367*t371
-    t374 = xp.abs(t370)
-    t375 = t374*xp.where(xp.greater_equal(t370, 0), xp.asarray(1, dtype=dtype), -1)
-    t376 = xp.where(xp.greater(t374, 0), xp.asarray(2, dtype=dtype), 0)
-    t377 = t373 - t373*t376
-    t378 = xp.where(xp.not_equal(t375, 0), -t377/t375, 0)
-    t379 = xp.where(xp.not_equal(t363, 0), -(t372 - t369*t378)/t363, 0)
-    t380 = xp.where(xp.not_equal(t332, 0), -(-(t351*t379 + t355*t378) + t359)/t332, 0)
-    t381 = xp.where(xp.not_equal(t312, 0), -(-(t322*t380 + t335*t379 + t341*t378) + t327)/t312, 0)
-    t382 = xp.where(xp.not_equal(t259, 0), -(-(t282*t381 - t287*t380 + t295*t379 + t300*t378) + t305)/t259, 0)
-    t383 = t246*t244
-    t384 = xp.where(xp.not_equal(t31, 0), -(-(t249*t382 + t252*t381 - c2*t383*t380 + t55*t383*t379 + t0*t383*t378) + t254)/t31, 0)
-    t385 = xp.isfinite(t272)
-    t386 = xp.greater_equal(damping, 0)
-    t387 = xp.greater(damping, 0)
-    t388 = 1e-12*t71
-    t389 = 1e-12*t39
-    t390 = (t387 & (xp.less_equal(t72, t388) | xp.less_equal(t96, t388) | xp.less_equal(t159, t388) | xp.less_equal(t194, t388) | xp.less_equal(t213, t388) | xp.less_equal(t225, t388))) | (xp.less_equal(damping, 0) & (xp.less_equal(t30, t389) | xp.less_equal(t258, t389) | xp.less_equal(t311, t389) | xp.less_equal(t331, t389) | xp.less_equal(t362, t389) | xp.less_equal(t374, t389)))
-    t391 = t385 & t386 & xp.logical_not(t390)
+    t26 = t24 + t19*t25
+    t27 = t21 + t26
+    t28 = t2**2
+    t29 = xp.sqrt(1 + t24 + t28)
+    t30 = xp.where(xp.less_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)*t29
+    t31 = t28 + t22*t25
+    t32 = t23 + t31
+    t33 = t13**2 + t10**2 + t22
+    t34 = t21 + t33
+    t35 = t9**2 + t15**2 + t19
+    t36 = t23 + t35
+    t37 = 1 + t0**2 + c4**2*t20
+    t38 = xp.sqrt(t16 + t26 + 2*t17 + 2*t21 + 2*t23 + t31 + t33 + t35 + t37)
+    t39 = t17 + t37
+    t40 = s1*c1
+    t41 = t20*t40
+    t42 = t41 - t2*t4 + t25*t40
+    t43 = -t40 + t41 + t13*t9 + t10*t15
+    t44 = c1*t5
+    t45 = q3*c2
+    t46 = t19*t45
+    t47 = t22*t45
+    t48 = c2*t1
+    t49 = t48 - t44*t45
+    t50 = s1*t5
+    t51 = c2*t3
+    t52 = t51 - t45*t50
+    t53 = s2*c4
+    t54 = -t48 + t10*t0 + t13*t53
+    t55 = -t51 + t15*t0 + t9*t53
+    t56 = damping**2
+    t57 = t40*t45
+    t58 = -t4
+    t59 = _symmetric_solve6(xp, 1, (t56 + t27, t42, t49, -t57, t46, t58, t56 + t32, t52, -t47, t57, t2, t56 + t18, t50, -t44, xp.full(batch, 0, dtype=dtype, device=device), t56 + t34, t43, -t54, t56 + t36, -t55, t56 + t39, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t60 = t59[5]
+    t61 = t59[0]
+    t62 = t59[1]
+    t63 = t60 - t4*t61 + t2*t62
+    t64 = c1*t45
+    t65 = s1*t45
+    t66 = t59[2]
+    t67 = t1*t61 + t3*t62 + c2*t66
+    t68 = t59[3]
+    t69 = t59[4]
+    t70 = t61*t64 + t62*t65 - t5*t66 - s1*t68 + c1*t69
+    t71 = t1*t68 + t3*t69 + c2*t60
+    t72 = t13*t68 + t9*t69 - t53*t60
+    t73 = t10*t68 + t15*t69 - t0*t60
+    t74 = xp.greater(t29, 0)
+    t75 = xp.where(t74, 1/(t58 + t30), 0)
+    t76 = xp.where(t74, 1 + xp.abs(t4)/t29, 0)
+    t77 = t2*t75
+    t78 = t76*(t64 + t65*t77)
+    t79 = -t78 + t64
+    t80 = t65 - t77*t78
+    t81 = t76*(t1 + t3*t77)
+    t82 = -t81 + t1
+    t83 = t76*(mu_dot0 + mu_dot5*t75 + t77*mu_dot1)
+    t84 = -t83 + mu_dot0
+    t85 = t75*t81
+    t86 = t3 - t2*t85
+    t87 = t75**2
+    t88 = xp.sqrt(t16 + t19 + t22 + t80**2 + t87*t78**2)
+    t89 = t88*xp.where(xp.greater_equal(t80, 0), xp.asarray(1, dtype=dtype), -1)
+    t90 = t87*t76
+    t91 = c2*t90
+    t92 = t2*t91
+    t93 = -t91 + c2
+    t94 = t53*t90
+    t95 = t2*t94
+    t96 = -t53
+    t97 = t94 + t96
+    t98 = t0*t90
+    t99 = t2*t98
+    t100 = -t0
+    t101 = t98 + t100
+    t102 = 1 - t5 - s1 + q1 + q2 + c1 + q3 + t2 + q4 + t13 + t9 + q5 + t10 + t15 + q6 + 2*c2 + 2*t1 + 2*t3 + t58 + t64 + t65 + t96 + t100 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t103 = t75*t83
+    t104 = mu_dot1 - t2*t103
+    t105 = -t103 + mu_dot5
+    t106 = xp.greater(t88, 0)
+    t107 = xp.where(t106, 1/(t80 + t89), 0)
+    t108 = xp.where(t106, 1 + xp.abs(t80)/t88, 0)
+    t109 = t5*t107
+    t110 = t78*t107
+    t111 = t108*(t86 - c2*t109 + t87*t110*t81)
+    t112 = -t111 + t86
+    t113 = c2 + t109*t111
+    t114 = t110*t75
+    t115 = -t85 + t114*t111
+    t116 = -t108*(t92 + t114*t93)
+    t117 = t92 + t116
+    t118 = t93 + t114*t116
+    t119 = t107*t116
+    t120 = t1 + s1*t119
+    t121 = t3 - c1*t119
+    t122 = s1*t107
+    t123 = c1*t107
+    t124 = t108*(t95 - t13*t122 + t9*t123 - t114*t97)
+    t125 = -t124 + t95
+    t126 = t13 + t122*t124
+    t127 = t9 - t123*t124
+    t128 = t97 + t114*t124
+    t129 = t108*(t99 - t10*t122 + t15*t123 - t114*t101)
+    t130 = -t129 + t99
+    t131 = t10 + t122*t129
+    t132 = t15 - t123*t129
+    t133 = t101 + t114*t129
+    t134 = -t108*(-t104 + t109*mu_dot2 + t122*mu_dot3 - t123*mu_dot4 + t114*t105)
+    t135 = -t134 + t104
+    t136 = mu_dot2 + t109*t134
+    t137 = mu_dot3 + t122*t134
+    t138 = mu_dot4 - t123*t134
+    t139 = t105 + t114*t134
+    t140 = t107**2*t111**2
+    t141 = xp.sqrt(t113**2 + t115**2 + t22*t140 + t19*t140)
+    t142 = t141*xp.where(xp.greater_equal(t113, 0), xp.asarray(1, dtype=dtype), -1)
+    t143 = xp.greater(t141, 0)
+    t144 = xp.where(t143, 1/(t113 + t142), 0)
+    t145 = xp.where(t143, 1 + xp.abs(t113)/t141, 0)
+    t146 = t109*t116
+    t147 = t111*t144
+    t148 = t122*t147
+    t149 = t123*t147
+    t150 = t115*t144
+    t151 = t145*(t146 + t148*t120 - t149*t121 + t150*t118)
+    t152 = -t151 + t146
+    t153 = t120 - t148*t151
+    t154 = t121 + t149*t151
+    t155 = t118 - t150*t151
+    t156 = t145*(t136 + t148*t137 - t149*t138 + t150*t139)
+    t157 = -t156 + t136
+    t158 = t137 - t148*t156
+    t159 = t138 + t149*t156
+    t160 = t139 - t150*t156
+    t161 = xp.sqrt(t153**2 + t154**2 + t155**2)
+    t162 = t161*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
+    t163 = t109*t124
+    t164 = t145*(t163 + t148*t126 - t149*t127 + t150*t128)
+    t165 = -t164 + t163
+    t166 = t126 - t148*t164
+    t167 = t127 + t149*t164
+    t168 = t128 - t150*t164
+    t169 = t109*t129
+    t170 = t145*(t169 + t148*t131 - t149*t132 + t150*t133)
+    t171 = -t170 + t169
+    t172 = t131 - t148*t170
+    t173 = t132 + t149*t170
+    t174 = t133 - t150*t170
+    t175 = xp.greater(t161, 0)
+    t176 = xp.where(t175, 1/(t153 + t162), 0)
+    t177 = xp.where(t175, 1 + xp.abs(t153)/t161, 0)
+    t178 = t154*t176
+    t179 = t155*t176
+    t180 = t177*(t166 + t178*t167 + t179*t168)
+    t181 = -t180 + t166
+    t182 = t167 - t178*t180
+    t183 = t168 - t179*t180
+    t184 = t177*(t172 + t178*t173 + t179*t174)
+    t185 = -t184 + t172
+    t186 = t173 - t178*t184
+    t187 = t174 - t179*t184
+    t188 = t177*(t158 + t178*t159 + t179*t160)
+    t189 = -t188 + t158
+    t190 = t159 - t178*t188
+    t191 = t160 - t179*t188
+    t192 = xp.sqrt(t182**2 + t183**2)
+    t193 = t192*xp.where(xp.greater_equal(t182, 0), xp.asarray(1, dtype=dtype), -1)
+    t194 = xp.greater(t192, 0)
+    t195 = xp.where(t194, 1/(t182 + t193), 0)
+    t196 = xp.where(t194, 1 + xp.abs(t182)/t192, 0)
+    t197 = t183*t195
+    t198 = t196*(t186 + t197*t187)
+    t199 = -t198 + t186
+    t200 = t187 - t197*t198
+    t201 = t196*(t190 + t197*t191)
+    t202 = -t201 + t190
+    t203 = t191 - t197*t201
+    t204 = xp.abs(t200)
+    t205 = t204*xp.where(xp.greater_equal(t200, 0), xp.asarray(1, dtype=dtype), -1)
+    t206 = xp.where(xp.greater(t204, 0), xp.asarray(2, dtype=dtype), 0)
+    t207 = t203 - t203*t206
+    t208 = xp.where(xp.not_equal(t205, 0), -t207/t205, 0)
+    t209 = xp.where(xp.not_equal(t193, 0), -(t202 - t199*t208)/t193, 0)
+    t210 = xp.where(xp.not_equal(t162, 0), -(-(t181*t209 + t185*t208) + t189)/t162, 0)
+    t211 = xp.where(xp.not_equal(t142, 0), -(-(t152*t210 + t165*t209 + t171*t208) + t157)/t142, 0)
+    t212 = xp.where(xp.not_equal(t89, 0), -(-(t112*t211 - t117*t210 + t125*t209 + t130*t208) + t135)/t89, 0)
+    t213 = t75*t76
+    t214 = xp.where(xp.not_equal(t30, 0), -(-(t79*t212 + t82*t211 - c2*t213*t210 + t53*t213*t209 + t0*t213*t208) + t84)/t30, 0)
+    t215 = xp.isfinite(t102)
+    t216 = xp.greater_equal(damping, 0)
+    t217 = xp.greater(damping, 0)
+    t218 = 1e-12*t38
+    t219 = (t217 & xp.greater(t59[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t29, t218) | xp.less_equal(t88, t218) | xp.less_equal(t141, t218) | xp.less_equal(t161, t218) | xp.less_equal(t192, t218) | xp.less_equal(t204, t218)))
+    t220 = t215 & t216 & xp.logical_not(t219)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t391, xp.where(t387, t235, t384), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t391, xp.where(t387, t242, t382), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t391, xp.where(t387, t236, t381), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t391, xp.where(t387, t237, t380), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t391, xp.where(t387, t238, t379), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t391, xp.where(t387, t239, t378), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t220, xp.where(t217, t63, t214), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t220, xp.where(t217, t70, t212), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t220, xp.where(t217, t67, t211), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t220, xp.where(t217, t71, t210), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t220, xp.where(t217, t72, t209), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t220, xp.where(t217, t73, t208), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t385 & t386), 2, xp.where(t390, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t215 & t216), 2, xp.where(t219, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
-    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1143 operations."""
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1159 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("z", z, (6,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -3430,387 +3505,216 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     t23 = t20*t22
     t24 = t4**2
     t25 = q3**2*t17
-    t26 = t19*t25
-    t27 = t24 + t26
-    t28 = t21 + t27
-    t29 = t2**2
-    t30 = xp.sqrt(1 + t24 + t29)
-    t31 = xp.where(xp.less_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)*t30
-    t32 = t29 + t22*t25
-    t33 = t23 + t32
-    t34 = t13**2 + t10**2 + t22
-    t35 = t21 + t34
-    t36 = t9**2 + t15**2 + t19
-    t37 = t23 + t36
-    t38 = 1 + t0**2 + c4**2*t20
-    t39 = xp.sqrt(t16 + 2*t17 + 2*t21 + 2*t23 + t27 + t32 + t34 + t36 + t38)
-    t40 = t17 + t38
-    t41 = t2*t4
-    t42 = s1*c1
-    t43 = t20*t42
-    t44 = -t41 + t43 + t25*t42
-    t45 = -t42 + t43 + t13*t9 + t10*t15
-    t46 = c1*t5
-    t47 = q3*c2
-    t48 = t19*t47
-    t49 = c2*t1
-    t50 = t49 - t46*t47
-    t51 = s1*t5
-    t52 = c2*t3
-    t53 = t52 - t47*t51
-    t54 = t22*t47
-    t55 = s2*c4
-    t56 = -t49 + t10*t0 + t13*t55
-    t57 = -t52 + t15*t0 + t9*t55
-    t58 = t44**2
-    t59 = t50**2
-    t60 = t48**2
-    t61 = damping**2
-    t62 = t61 + t28
-    t63 = t62**2
-    t64 = t61 + t33
-    t65 = t61 + t18
-    t66 = t61 + t35
-    t67 = t61 + t37
-    t68 = t61 + t40
-    t69 = 2*t16
-    t70 = t22*t26
-    t71 = xp.sqrt(2*t29 + 2*t24 + 2*t58 + 2*t59 + 2*t53**2 + 2*t54**2 + 2*t60 + 2*t45**2 + 2*t56**2 + 2*t57**2 + t63 + t64**2 + t65**2 + t66**2 + t67**2 + t68**2 + 4*t70 + t22*t69 + t19*t69)
-    t72 = xp.sqrt(t24 + t58 + t59 + t60 + t63 + t70)
-    t73 = t72*xp.where(xp.greater_equal(t62, 0), xp.asarray(1, dtype=dtype), -1)
-    t74 = xp.greater(t72, 0)
-    t75 = xp.where(t74, 1/(t62 + t73), 0)
-    t76 = xp.where(t74, 1 + xp.abs(t62)/t72, 0)
-    t77 = t44*t75
-    t78 = t50*t75
-    t79 = t42*t47
-    t80 = t79*t75
-    t81 = t48*t75
-    t82 = t76*(t44 + t64*t77 + t78*t53 + t79*t81 - t41*t75 + t54*t80)
-    t83 = -t82 + t44
-    t84 = t64 - t77*t82
-    t85 = t53 - t78*t82
-    t86 = t76*(t50 + t77*t53 + t65*t78 - t46*t54*t75 - t46*t81)
-    t87 = -t86 + t50
-    t88 = t53 - t77*t86
-    t89 = t65 - t78*t86
-    t90 = t51 + t80*t86
-    t91 = t46 + t81*t86
-    t92 = t75*t82
-    t93 = -t54 + t79*t92
-    t94 = t79 - t92*t48
-    t95 = t2 + t4*t92
-    t96 = xp.sqrt(t84**2 + t85**2 + t93**2 + t94**2 + t95**2)
-    t97 = t96*xp.where(xp.greater_equal(t84, 0), xp.asarray(1, dtype=dtype), -1)
-    t98 = t4*t75
-    t99 = t76*(-t79 + t51*t78 - t66*t80 + t81*t45 + t98*t56 - t54*t77)
-    t100 = t79 + t99
-    t101 = t54 + t77*t99
-    t102 = t51 - t78*t99
-    t103 = t66 + t80*t99
-    t104 = t45 - t81*t99
-    t105 = t76*(t48 + t77*t79 - t46*t78 - t80*t45 + t67*t81 + t98*t57)
-    t106 = -t105 + t48
-    t107 = t79 - t77*t105
-    t108 = t46 + t78*t105
-    t109 = t45 + t80*t105
-    t110 = t67 - t81*t105
-    t111 = -t57 + t98*t105
-    t112 = -t76*(t4 - t2*t77 - t80*t56 + t81*t57 + t68*t98)
-    t113 = t4 + t112
-    t114 = t2 - t77*t112
-    t115 = t57 + t81*t112
-    t116 = t68 + t98*t112
-    t117 = t76*(mu_dot0 + t77*mu_dot1 + t78*mu_dot2 - t80*mu_dot3 + t81*mu_dot4 - t98*mu_dot5)
-    t118 = -t117 + mu_dot0
-    t119 = mu_dot1 - t77*t117
-    t120 = mu_dot2 - t78*t117
-    t121 = mu_dot3 + t80*t117
-    t122 = mu_dot4 - t81*t117
-    t123 = mu_dot5 + t98*t117
-    t124 = -t56
-    t125 = t124 + t98*t99
-    t126 = t124 + t80*t112
-    t127 = xp.greater(t96, 0)
-    t128 = xp.where(t127, 1/(t84 + t97), 0)
-    t129 = xp.where(t127, 1 + xp.abs(t84)/t96, 0)
-    t130 = t85*t128
-    t131 = t93*t128
-    t132 = t94*t128
-    t133 = t98*t86
-    t134 = t95*t128
-    t135 = t129*(t88 + t130*t89 + t131*t90 - t132*t91 + t133*t134)
-    t136 = -t135 + t88
-    t137 = t89 - t130*t135
-    t138 = t90 - t131*t135
-    t139 = t91 + t132*t135
-    t140 = t133 - t134*t135
-    t141 = t129*(-t101 + t130*t102 + t131*t103 + t132*t104 + t134*t125)
-    t142 = t101 + t141
-    t143 = t102 - t130*t141
-    t144 = t103 - t131*t141
-    t145 = t104 - t132*t141
-    t146 = t125 - t134*t141
-    t147 = t129*(t107 - t130*t108 + t131*t109 + t132*t110 + t134*t111)
-    t148 = -t147 + t107
-    t149 = t108 + t130*t147
-    t150 = t109 - t131*t147
-    t151 = t110 - t132*t147
-    t152 = t111 - t134*t147
-    t153 = t129*(t119 + t130*t120 + t131*t121 + t132*t122 + t134*t123)
-    t154 = -t153 + t119
-    t155 = t120 - t130*t153
-    t156 = t121 - t131*t153
-    t157 = t122 - t132*t153
-    t158 = t123 - t134*t153
-    t159 = xp.sqrt(t137**2 + t138**2 + t139**2 + t140**2)
-    t160 = t159*xp.where(xp.greater_equal(t137, 0), xp.asarray(1, dtype=dtype), -1)
-    t161 = t78*t112
-    t162 = t129*(t114 - t130*t161 + t131*t126 - t132*t115 + t134*t116)
-    t163 = -t162 + t114
-    t164 = t161 + t130*t162
-    t165 = t126 - t131*t162
-    t166 = t115 + t132*t162
-    t167 = t116 - t134*t162
-    t168 = xp.greater(t159, 0)
-    t169 = xp.where(t168, 1/(t137 + t160), 0)
-    t170 = xp.where(t168, 1 + xp.abs(t137)/t159, 0)
-    t171 = t138*t169
-    t172 = t139*t169
-    t173 = t140*t169
-    t174 = t170*(t143 + t171*t144 - t172*t145 + t173*t146)
-    t175 = -t174 + t143
-    t176 = t144 - t171*t174
-    t177 = t145 + t172*t174
-    t178 = t146 - t173*t174
-    t179 = t170*(-t149 + t171*t150 - t172*t151 + t173*t152)
-    t180 = t149 + t179
-    t181 = t150 - t171*t179
-    t182 = t151 + t172*t179
-    t183 = t152 - t173*t179
-    t184 = t170*(-t164 + t171*t165 + t172*t166 + t173*t167)
-    t185 = t164 + t184
-    t186 = t165 - t171*t184
-    t187 = -t166 + t172*t184
-    t188 = t167 - t173*t184
-    t189 = t170*(t155 + t171*t156 - t172*t157 + t173*t158)
-    t190 = -t189 + t155
-    t191 = t156 - t171*t189
-    t192 = t157 + t172*t189
-    t193 = t158 - t173*t189
-    t194 = xp.sqrt(t176**2 + t177**2 + t178**2)
-    t195 = t194*xp.where(xp.greater_equal(t176, 0), xp.asarray(1, dtype=dtype), -1)
-    t196 = xp.greater(t194, 0)
-    t197 = xp.where(t196, 1/(t176 + t195), 0)
-    t198 = xp.where(t196, 1 + xp.abs(t176)/t194, 0)
-    t199 = t177*t197
-    t200 = t178*t197
-    t201 = t198*(t181 + t199*t182 + t200*t183)
-    t202 = -t201 + t181
-    t203 = t182 - t199*t201
-    t204 = t183 - t200*t201
-    t205 = t198*(t186 + t199*t187 + t200*t188)
-    t206 = -t205 + t186
-    t207 = t187 - t199*t205
-    t208 = t188 - t200*t205
-    t209 = t198*(t191 + t199*t192 + t200*t193)
-    t210 = -t209 + t191
-    t211 = t192 - t199*t209
-    t212 = t193 - t200*t209
-    t213 = xp.sqrt(t203**2 + t204**2)
-    t214 = t213*xp.where(xp.greater_equal(t203, 0), xp.asarray(1, dtype=dtype), -1)
-    t215 = xp.greater(t213, 0)
-    t216 = xp.where(t215, 1/(t203 + t214), 0)
-    t217 = xp.where(t215, 1 + xp.abs(t203)/t213, 0)
-    t218 = t204*t216
-    t219 = t217*(t207 + t218*t208)
-    t220 = -t219 + t207
-    t221 = t208 - t218*t219
-    t222 = t217*(t211 + t218*t212)
-    t223 = -t222 + t211
-    t224 = t212 - t218*t222
-    t225 = xp.abs(t221)
-    t226 = t225*xp.where(xp.greater_equal(t221, 0), xp.asarray(1, dtype=dtype), -1)
-    t227 = xp.where(xp.greater(t225, 0), xp.asarray(2, dtype=dtype), 0)
-    t228 = t224 - t224*t227
-    t229 = xp.where(xp.not_equal(t226, 0), -t228/t226, 0)
-    t230 = xp.where(xp.not_equal(t214, 0), -(t223 - t220*t229)/t214, 0)
-    t231 = xp.where(xp.not_equal(t195, 0), -(-(t202*t230 + t206*t229) + t210)/t195, 0)
-    t232 = xp.where(xp.not_equal(t160, 0), -(t190 + t180*t230 + t185*t229 - t175*t231)/t160, 0)
-    t233 = xp.where(xp.not_equal(t97, 0), -(-(t136*t232 - t142*t231 + t148*t230 + t163*t229) + t154)/t97, 0)
-    t234 = xp.where(xp.not_equal(t73, 0), -(-(t83*t233 + t87*t232 - t100*t231 + t106*t230 - t113*t229) + t118)/t73, 0)
-    t235 = t229 - t4*t234 + t2*t233
-    t236 = c2*t232 + t1*t234 + t3*t233
-    t237 = c2*t229 + t1*t231 + t3*t230
-    t238 = t13*t231 + t9*t230 - t55*t229
-    t239 = t10*t231 + t15*t230 - t0*t229
-    t240 = c1*t47
-    t241 = s1*t47
-    t242 = -t5*t232 - s1*t231 + c1*t230 + t240*t234 + t241*t233
-    t243 = xp.greater(t30, 0)
-    t244 = xp.where(t243, 1 + xp.abs(t4)/t30, 0)
-    t245 = -t4
-    t246 = xp.where(t243, 1/(t245 + t31), 0)
-    t247 = t2*t246
-    t248 = t244*(t240 + t241*t247)
-    t249 = -t248 + t240
-    t250 = t241 - t247*t248
-    t251 = t244*(t1 + t3*t247)
-    t252 = -t251 + t1
-    t253 = t244*(mu_dot0 + mu_dot5*t246 + t247*mu_dot1)
-    t254 = -t253 + mu_dot0
-    t255 = t246*t251
-    t256 = t3 - t2*t255
-    t257 = t246**2
-    t258 = xp.sqrt(t16 + t19 + t22 + t250**2 + t257*t248**2)
-    t259 = t258*xp.where(xp.greater_equal(t250, 0), xp.asarray(1, dtype=dtype), -1)
-    t260 = t257*t244
-    t261 = c2*t260
-    t262 = t2*t261
-    t263 = -t261 + c2
-    t264 = t55*t260
-    t265 = t2*t264
-    t266 = -t55
-    t267 = t264 + t266
-    t268 = t0*t260
-    t269 = t2*t268
-    t270 = -t0
-    t271 = t268 + t270
-    t272 = 1 - t5 - s1 + q1 + q2 + c1 + q3 + t2 + q4 + t13 + t9 + q5 + t10 + t15 + q6 + 2*c2 + 2*t1 + 2*t3 + t240 + t241 + t245 + t266 + t270 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6
-    t273 = t246*t253
-    t274 = mu_dot1 - t2*t273
-    t275 = -t273 + mu_dot5
-    t276 = xp.greater(t258, 0)
-    t277 = xp.where(t276, 1/(t250 + t259), 0)
-    t278 = xp.where(t276, 1 + xp.abs(t250)/t258, 0)
-    t279 = t5*t277
-    t280 = t248*t277
-    t281 = t278*(t256 - c2*t279 + t257*t280*t251)
-    t282 = -t281 + t256
-    t283 = c2 + t279*t281
-    t284 = t280*t246
-    t285 = -t255 + t284*t281
-    t286 = -t278*(t262 + t284*t263)
-    t287 = t262 + t286
-    t288 = t263 + t284*t286
-    t289 = t277*t286
-    t290 = t1 + s1*t289
-    t291 = t3 - c1*t289
-    t292 = s1*t277
-    t293 = c1*t277
-    t294 = t278*(t265 - t13*t292 + t9*t293 - t284*t267)
-    t295 = -t294 + t265
-    t296 = t13 + t292*t294
-    t297 = t9 - t293*t294
-    t298 = t267 + t284*t294
-    t299 = t278*(t269 - t10*t292 + t15*t293 - t284*t271)
-    t300 = -t299 + t269
-    t301 = t10 + t292*t299
-    t302 = t15 - t293*t299
-    t303 = t271 + t284*t299
-    t304 = -t278*(-t274 + t279*mu_dot2 + t292*mu_dot3 - t293*mu_dot4 + t284*t275)
-    t305 = -t304 + t274
-    t306 = mu_dot2 + t279*t304
-    t307 = mu_dot3 + t292*t304
-    t308 = mu_dot4 - t293*t304
-    t309 = t275 + t284*t304
-    t310 = t277**2*t281**2
-    t311 = xp.sqrt(t283**2 + t285**2 + t22*t310 + t19*t310)
-    t312 = t311*xp.where(xp.greater_equal(t283, 0), xp.asarray(1, dtype=dtype), -1)
-    t313 = xp.greater(t311, 0)
-    t314 = xp.where(t313, 1/(t283 + t312), 0)
-    t315 = xp.where(t313, 1 + xp.abs(t283)/t311, 0)
-    t316 = t279*t286
-    t317 = t281*t314
-    t318 = t292*t317
-    t319 = t293*t317
-    t320 = t285*t314
-    t321 = t315*(t316 + t318*t290 - t319*t291 + t320*t288)
-    t322 = -t321 + t316
-    t323 = t290 - t318*t321
-    t324 = t291 + t319*t321
-    t325 = t288 - t320*t321
-    t326 = t315*(t306 + t318*t307 - t319*t308 + t320*t309)
-    t327 = -t326 + t306
-    t328 = t307 - t318*t326
-    t329 = t308 + t319*t326
-    t330 = t309 - t320*t326
-    t331 = xp.sqrt(t323**2 + t324**2 + t325**2)
-    t332 = t331*xp.where(xp.greater_equal(t323, 0), xp.asarray(1, dtype=dtype), -1)
-    t333 = t279*t294
-    t334 = t315*(t333 + t318*t296 - t319*t297 + t320*t298)
-    t335 = -t334 + t333
-    t336 = t296 - t318*t334
-    t337 = t297 + t319*t334
-    t338 = t298 - t320*t334
-    t339 = t279*t299
-    t340 = t315*(t339 + t318*t301 - t319*t302 + t320*t303)
-    t341 = -t340 + t339
-    t342 = t301 - t318*t340
-    t343 = t302 + t319*t340
-    t344 = t303 - t320*t340
-    t345 = xp.greater(t331, 0)
-    t346 = xp.where(t345, 1/(t323 + t332), 0)
-    t347 = xp.where(t345, 1 + xp.abs(t323)/t331, 0)
-    t348 = t324*t346
-    t349 = t325*t346
-    t350 = t347*(t336 + t348*t337 + t349*t338)
-    t351 = -t350 + t336
-    t352 = t337 - t348*t350
-    t353 = t338 - t349*t350
-    t354 = t347*(t342 + t348*t343 + t349*t344)
-    t355 = -t354 + t342
-    t356 = t343 - t348*t354
-    t357 = t344 - t349*t354
-    t358 = t347*(t328 + t348*t329 + t349*t330)
-    t359 = -t358 + t328
-    t360 = t329 - t348*t358
-    t361 = t330 - t349*t358
-    t362 = xp.sqrt(t352**2 + t353**2)
-    t363 = t362*xp.where(xp.greater_equal(t352, 0), xp.asarray(1, dtype=dtype), -1)
-    t364 = xp.greater(t362, 0)
-    t365 = xp.where(t364, 1/(t352 + t363), 0)
-    t366 = xp.where(t364, 1 + xp.abs(t352)/t362, 0)
-    t367 = t353*t365
-    t368 = t366*(t356 + t367*t357)
-    t369 = -t368 + t356
-    t370 = t357 - t367*t368
-    t371 = t366*(t360 + t367*t361)
-    t372 = -t371 + t360
-    t373 = t361 - t367*t371
-    t374 = xp.abs(t370)
-    t375 = t374*xp.where(xp.greater_equal(t370, 0), xp.asarray(1, dtype=dtype), -1)
-    t376 = xp.where(xp.greater(t374, 0), xp.asarray(2, dtype=dtype), 0)
-    t377 = t373 - t373*t376
-    t378 = xp.where(xp.not_equal(t375, 0), -t377/t375, 0)
-    t379 = xp.where(xp.not_equal(t363, 0), -(t372 - t369*t378)/t363, 0)
-    t380 = xp.where(xp.not_equal(t332, 0), -(-(t351*t379 + t355*t378) + t359)/t332, 0)
-    t381 = xp.where(xp.not_equal(t312, 0), -(-(t322*t380 + t335*t379 + t341*t378) + t327)/t312, 0)
-    t382 = xp.where(xp.not_equal(t259, 0), -(-(t282*t381 - t287*t380 + t295*t379 + t300*t378) + t305)/t259, 0)
-    t383 = t246*t244
-    t384 = xp.where(xp.not_equal(t31, 0), -(-(t249*t382 + t252*t381 - c2*t383*t380 + t55*t383*t379 + t0*t383*t378) + t254)/t31, 0)
-    t385 = xp.isfinite(t272)
-    t386 = xp.greater_equal(damping, 0)
-    t387 = xp.greater(damping, 0)
-    t388 = 1e-12*t71
-    t389 = 1e-12*t39
-    t390 = (t387 & (xp.less_equal(t72, t388) | xp.less_equal(t96, t388) | xp.less_equal(t159, t388) | xp.less_equal(t194, t388) | xp.less_equal(t213, t388) | xp.less_equal(t225, t388))) | (xp.less_equal(damping, 0) & (xp.less_equal(t30, t389) | xp.less_equal(t258, t389) | xp.less_equal(t311, t389) | xp.less_equal(t331, t389) | xp.less_equal(t362, t389) | xp.less_equal(t374, t389)))
-    t391 = t385 & t386 & xp.logical_not(t390)
+    t26 = t24 + t19*t25
+    t27 = t21 + t26
+    t28 = t2**2
+    t29 = xp.sqrt(1 + t24 + t28)
+    t30 = xp.where(xp.less_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)*t29
+    t31 = t28 + t22*t25
+    t32 = t23 + t31
+    t33 = t13**2 + t10**2 + t22
+    t34 = t21 + t33
+    t35 = t9**2 + t15**2 + t19
+    t36 = t23 + t35
+    t37 = 1 + t0**2 + c4**2*t20
+    t38 = xp.sqrt(t16 + t26 + 2*t17 + 2*t21 + 2*t23 + t31 + t33 + t35 + t37)
+    t39 = t17 + t37
+    t40 = s1*c1
+    t41 = t20*t40
+    t42 = t41 - t2*t4 + t25*t40
+    t43 = -t40 + t41 + t13*t9 + t10*t15
+    t44 = c1*t5
+    t45 = q3*c2
+    t46 = t19*t45
+    t47 = t22*t45
+    t48 = c2*t1
+    t49 = t48 - t44*t45
+    t50 = s1*t5
+    t51 = c2*t3
+    t52 = t51 - t45*t50
+    t53 = s2*c4
+    t54 = -t48 + t10*t0 + t13*t53
+    t55 = -t51 + t15*t0 + t9*t53
+    t56 = damping**2
+    t57 = t40*t45
+    t58 = -t4
+    t59 = _symmetric_solve6(xp, 1, (t56 + t27, t42, t49, -t57, t46, t58, t56 + t32, t52, -t47, t57, t2, t56 + t18, t50, -t44, xp.full(batch, 0, dtype=dtype, device=device), t56 + t34, t43, -t54, t56 + t36, -t55, t56 + t39, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t60 = t59[5]
+    t61 = t59[0]
+    t62 = t59[1]
+    t63 = t60 - t4*t61 + t2*t62
+    t64 = c1*t45
+    t65 = s1*t45
+    t66 = t59[2]
+    t67 = t1*t61 + t3*t62 + c2*t66
+    t68 = t59[3]
+    t69 = t59[4]
+    t70 = t61*t64 + t62*t65 - t5*t66 - s1*t68 + c1*t69
+    t71 = t1*t68 + t3*t69 + c2*t60
+    t72 = t13*t68 + t9*t69 - t53*t60
+    t73 = t10*t68 + t15*t69 - t0*t60
+    t74 = xp.greater(t29, 0)
+    t75 = xp.where(t74, 1/(t58 + t30), 0)
+    t76 = xp.where(t74, 1 + xp.abs(t4)/t29, 0)
+    t77 = t2*t75
+    t78 = t76*(t64 + t65*t77)
+    t79 = -t78 + t64
+    t80 = t65 - t77*t78
+    t81 = t76*(t1 + t3*t77)
+    t82 = -t81 + t1
+    t83 = t76*(mu_dot0 + mu_dot5*t75 + t77*mu_dot1)
+    t84 = -t83 + mu_dot0
+    t85 = t75*t81
+    t86 = t3 - t2*t85
+    t87 = t75**2
+    t88 = xp.sqrt(t16 + t19 + t22 + t80**2 + t87*t78**2)
+    t89 = t88*xp.where(xp.greater_equal(t80, 0), xp.asarray(1, dtype=dtype), -1)
+    t90 = t87*t76
+    t91 = c2*t90
+    t92 = t2*t91
+    t93 = -t91 + c2
+    t94 = t53*t90
+    t95 = t2*t94
+    t96 = -t53
+    t97 = t94 + t96
+    t98 = t0*t90
+    t99 = t2*t98
+    t100 = -t0
+    t101 = t98 + t100
+    t102 = 1 - t5 - s1 + q1 + q2 + c1 + q3 + t2 + q4 + t13 + t9 + q5 + t10 + t15 + q6 + 2*c2 + 2*t1 + 2*t3 + t58 + t64 + t65 + t96 + t100 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6
+    t103 = t75*t83
+    t104 = mu_dot1 - t2*t103
+    t105 = -t103 + mu_dot5
+    t106 = xp.greater(t88, 0)
+    t107 = xp.where(t106, 1/(t80 + t89), 0)
+    t108 = xp.where(t106, 1 + xp.abs(t80)/t88, 0)
+    t109 = t5*t107
+    t110 = t78*t107
+    t111 = t108*(t86 - c2*t109 + t87*t110*t81)
+    t112 = -t111 + t86
+    t113 = c2 + t109*t111
+    t114 = t110*t75
+    t115 = -t85 + t114*t111
+    t116 = -t108*(t92 + t114*t93)
+    t117 = t92 + t116
+    t118 = t93 + t114*t116
+    t119 = t107*t116
+    t120 = t1 + s1*t119
+    t121 = t3 - c1*t119
+    t122 = s1*t107
+    t123 = c1*t107
+    t124 = t108*(t95 - t13*t122 + t9*t123 - t114*t97)
+    t125 = -t124 + t95
+    t126 = t13 + t122*t124
+    t127 = t9 - t123*t124
+    t128 = t97 + t114*t124
+    t129 = t108*(t99 - t10*t122 + t15*t123 - t114*t101)
+    t130 = -t129 + t99
+    t131 = t10 + t122*t129
+    t132 = t15 - t123*t129
+    t133 = t101 + t114*t129
+    t134 = -t108*(-t104 + t109*mu_dot2 + t122*mu_dot3 - t123*mu_dot4 + t114*t105)
+    t135 = -t134 + t104
+    t136 = mu_dot2 + t109*t134
+    t137 = mu_dot3 + t122*t134
+    t138 = mu_dot4 - t123*t134
+    t139 = t105 + t114*t134
+    t140 = t107**2*t111**2
+    t141 = xp.sqrt(t113**2 + t115**2 + t22*t140 + t19*t140)
+    t142 = t141*xp.where(xp.greater_equal(t113, 0), xp.asarray(1, dtype=dtype), -1)
+    t143 = xp.greater(t141, 0)
+    t144 = xp.where(t143, 1/(t113 + t142), 0)
+    t145 = xp.where(t143, 1 + xp.abs(t113)/t141, 0)
+    t146 = t109*t116
+    t147 = t111*t144
+    t148 = t122*t147
+    t149 = t123*t147
+    t150 = t115*t144
+    t151 = t145*(t146 + t148*t120 - t149*t121 + t150*t118)
+    t152 = -t151 + t146
+    t153 = t120 - t148*t151
+    t154 = t121 + t149*t151
+    t155 = t118 - t150*t151
+    t156 = t145*(t136 + t148*t137 - t149*t138 + t150*t139)
+    t157 = -t156 + t136
+    t158 = t137 - t148*t156
+    t159 = t138 + t149*t156
+    t160 = t139 - t150*t156
+    t161 = xp.sqrt(t153**2 + t154**2 + t155**2)
+    t162 = t161*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
+    t163 = t109*t124
+    t164 = t145*(t163 + t148*t126 - t149*t127 + t150*t128)
+    t165 = -t164 + t163
+    t166 = t126 - t148*t164
+    t167 = t127 + t149*t164
+    t168 = t128 - t150*t164
+    t169 = t109*t129
+    t170 = t145*(t169 + t148*t131 - t149*t132 + t150*t133)
+    t171 = -t170 + t169
+    t172 = t131 - t148*t170
+    t173 = t132 + t149*t170
+    t174 = t133 - t150*t170
+    t175 = xp.greater(t161, 0)
+    t176 = xp.where(t175, 1/(t153 + t162), 0)
+    t177 = xp.where(t175, 1 + xp.abs(t153)/t161, 0)
+    t178 = t154*t176
+    t179 = t155*t176
+    t180 = t177*(t166 + t178*t167 + t179*t168)
+    t181 = -t180 + t166
+    t182 = t167 - t178*t180
+    t183 = t168 - t179*t180
+    t184 = t177*(t172 + t178*t173 + t179*t174)
+    t185 = -t184 + t172
+    t186 = t173 - t178*t184
+    t187 = t174 - t179*t184
+    t188 = t177*(t158 + t178*t159 + t179*t160)
+    t189 = -t188 + t158
+    t190 = t159 - t178*t188
+    t191 = t160 - t179*t188
+    t192 = xp.sqrt(t182**2 + t183**2)
+    t193 = t192*xp.where(xp.greater_equal(t182, 0), xp.asarray(1, dtype=dtype), -1)
+    t194 = xp.greater(t192, 0)
+    t195 = xp.where(t194, 1/(t182 + t193), 0)
+    t196 = xp.where(t194, 1 + xp.abs(t182)/t192, 0)
+    t197 = t183*t195
+    t198 = t196*(t186 + t197*t187)
+    t199 = -t198 + t186
+    t200 = t187 - t197*t198
+    t201 = t196*(t190 + t197*t191)
+    t202 = -t201 + t190
+    t203 = t191 - t197*t201
+    t204 = xp.abs(t200)
+    t205 = t204*xp.where(xp.greater_equal(t200, 0), xp.asarray(1, dtype=dtype), -1)
+    t206 = xp.where(xp.greater(t204, 0), xp.asarray(2, dtype=dtype), 0)
+    t207 = t203 - t203*t206
+    t208 = xp.where(xp.not_equal(t205, 0), -t207/t205, 0)
+    t209 = xp.where(xp.not_equal(t193, 0), -(t202 - t199*t208)/t193, 0)
+    t210 = xp.where(xp.not_equal(t162, 0), -(-(t181*t209 + t185*t208) + t189)/t162, 0)
+    t211 = xp.where(xp.not_equal(t142, 0), -(-(t152*t210 + t165*t209 + t171*t208) + t157)/t142, 0)
+    t212 = xp.where(xp.not_equal(t89, 0), -(-(t112*t211 - t117*t210 + t125*t209 + t130*t208) + t135)/t89, 0)
+    t213 = t75*t76
+    t214 = xp.where(xp.not_equal(t30, 0), -(-(t79*t212 + t82*t211 - c2*t213*t210 + t53*t213*t209 + t0*t213*t208) + t84)/t30, 0)
+    t215 = xp.isfinite(t102)
+    t216 = xp.greater_equal(damping, 0)
+    t217 = xp.greater(damping, 0)
+    t218 = 1e-12*t38
+    t219 = (t217 & xp.greater(t59[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t29, t218) | xp.less_equal(t88, t218) | xp.less_equal(t141, t218) | xp.less_equal(t161, t218) | xp.less_equal(t192, t218) | xp.less_equal(t204, t218)))
+    t220 = t215 & t216 & xp.logical_not(t219)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t391, xp.where(t387, t235, t384), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t391, xp.where(t387, t242, t382), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t391, xp.where(t387, t236, t381), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t391, xp.where(t387, t237, t380), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t391, xp.where(t387, t238, t379), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t391, xp.where(t387, t239, t378), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t220, xp.where(t217, t63, t214), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t220, xp.where(t217, t70, t212), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t220, xp.where(t217, t67, t211), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t220, xp.where(t217, t71, t210), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t220, xp.where(t217, t72, t209), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t220, xp.where(t217, t73, t208), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t385 & t386), 2, xp.where(t390, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t215 & t216), 2, xp.where(t219, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1304 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1320 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (6,)), ("target", target, (4, 4)), ("target_rate", target_rate, (6,)), ("gain", gain, (6,)), ("z", z, (6,)), ("damping", damping, ()), every=("gain", ))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -3911,407 +3815,236 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t49 = s2**2
     t50 = t47*t49
     t51 = s1**2
-    t52 = t49*t51
-    t53 = t4**2
-    t54 = q3**2*t45
-    t55 = t47*t54
-    t56 = t53 + t55
+    t52 = t6*t51
+    t53 = t49*t51
+    t54 = t4**2
+    t55 = q3**2*t45
+    t56 = t54 + t47*t55
     t57 = t50 + t56
     t58 = t1**2
-    t59 = xp.sqrt(1 + t53 + t58)
+    t59 = xp.sqrt(1 + t54 + t58)
     t60 = xp.where(xp.less_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)*t59
-    t61 = t58 + t51*t54
-    t62 = t52 + t61
+    t61 = t58 + t51*t55
+    t62 = t53 + t61
     t63 = t17**2 + t14**2 + t51
     t64 = t50 + t63
     t65 = t12**2 + t20**2 + t47
-    t66 = t52 + t65
+    t66 = t53 + t65
     t67 = 1 + t34**2 + c4**2*t49
-    t68 = xp.sqrt(t44 + 2*t45 + 2*t50 + 2*t52 + t56 + t61 + t63 + t65 + t67)
+    t68 = xp.sqrt(t44 + 2*t45 + 2*t50 + 2*t53 + t56 + t61 + t63 + t65 + t67)
     t69 = t45 + t67
-    t70 = t1*t4
-    t71 = s1*c1
-    t72 = t49*t71
-    t73 = -t70 + t72 + t54*t71
-    t74 = -t71 + t72 + t17*t12 + t14*t20
-    t75 = c1*t5
-    t76 = c2*t0
-    t77 = t76 - t6*t75
-    t78 = -t76 + t14*t34 + t17*t35
-    t79 = s1*t5
-    t80 = c2*t3
-    t81 = t80 - t6*t79
-    t82 = -t80 + t20*t34 + t12*t35
-    t83 = t6*t51
-    t84 = t73**2
-    t85 = t77**2
-    t86 = t48**2
-    t87 = damping**2
-    t88 = t87 + t57
-    t89 = t88**2
-    t90 = t87 + t62
-    t91 = t87 + t46
-    t92 = t87 + t64
-    t93 = t87 + t66
-    t94 = t87 + t69
-    t95 = 2*t44
-    t96 = t51*t55
-    t97 = xp.sqrt(2*t58 + 2*t53 + 2*t84 + 2*t85 + 2*t81**2 + 2*t83**2 + 2*t86 + 2*t74**2 + 2*t78**2 + 2*t82**2 + t89 + t90**2 + t91**2 + t92**2 + t93**2 + t94**2 + 4*t96 + t51*t95 + t47*t95)
-    t98 = xp.sqrt(t53 + t84 + t85 + t86 + t89 + t96)
-    t99 = t98*xp.where(xp.greater_equal(t88, 0), xp.asarray(1, dtype=dtype), -1)
-    t100 = xp.greater(t98, 0)
-    t101 = xp.where(t100, 1/(t88 + t99), 0)
-    t102 = xp.where(t100, 1 + xp.abs(t88)/t98, 0)
-    t103 = t73*t101
-    t104 = t77*t101
-    t105 = t6*t71
-    t106 = t105*t101
-    t107 = t48*t101
-    t108 = t102*(t73 + t90*t103 + t104*t81 + t105*t107 - t70*t101 + t83*t106)
-    t109 = -t108 + t73
-    t110 = t90 - t103*t108
-    t111 = t81 - t104*t108
-    t112 = t102*(t77 + t103*t81 + t91*t104 - t75*t83*t101 - t75*t107)
-    t113 = -t112 + t77
-    t114 = t81 - t103*t112
-    t115 = t91 - t104*t112
-    t116 = t79 + t106*t112
-    t117 = t75 + t107*t112
-    t118 = t101*t108
-    t119 = -t83 + t105*t118
-    t120 = t105 - t118*t48
-    t121 = t1 + t4*t118
-    t122 = xp.sqrt(t110**2 + t111**2 + t119**2 + t120**2 + t121**2)
-    t123 = t122*xp.where(xp.greater_equal(t110, 0), xp.asarray(1, dtype=dtype), -1)
-    t124 = t4*t101
-    t125 = t102*(-t105 + t79*t104 - t92*t106 + t107*t74 + t124*t78 - t83*t103)
-    t126 = t105 + t125
-    t127 = t83 + t103*t125
-    t128 = t79 - t104*t125
-    t129 = t92 + t106*t125
-    t130 = t74 - t107*t125
-    t131 = t102*(t48 + t103*t105 - t75*t104 - t106*t74 + t93*t107 + t124*t82)
-    t132 = -t131 + t48
-    t133 = t105 - t103*t131
-    t134 = t75 + t104*t131
-    t135 = t74 + t106*t131
-    t136 = t93 - t107*t131
-    t137 = -t82 + t124*t131
-    t138 = -t102*(t4 - t1*t103 - t106*t78 + t107*t82 + t94*t124)
-    t139 = t4 + t138
-    t140 = t1 - t103*t138
-    t141 = t82 + t107*t138
-    t142 = t94 + t124*t138
-    t143 = -t78
-    t144 = t143 + t124*t125
-    t145 = t143 + t106*t138
-    t146 = xp.greater(t122, 0)
-    t147 = xp.where(t146, 1/(t110 + t123), 0)
-    t148 = xp.where(t146, 1 + xp.abs(t110)/t122, 0)
-    t149 = t111*t147
-    t150 = t119*t147
-    t151 = t120*t147
-    t152 = t124*t112
-    t153 = t121*t147
-    t154 = t148*(t114 + t149*t115 + t150*t116 - t151*t117 + t152*t153)
-    t155 = -t154 + t114
-    t156 = t115 - t149*t154
-    t157 = t116 - t150*t154
-    t158 = t117 + t151*t154
-    t159 = t152 - t153*t154
-    t160 = t148*(-t127 + t149*t128 + t150*t129 + t151*t130 + t153*t144)
-    t161 = t127 + t160
-    t162 = t128 - t149*t160
-    t163 = t129 - t150*t160
-    t164 = t130 - t151*t160
-    t165 = t144 - t153*t160
-    t166 = t148*(t133 - t149*t134 + t150*t135 + t151*t136 + t153*t137)
-    t167 = -t166 + t133
-    t168 = t134 + t149*t166
-    t169 = t135 - t150*t166
-    t170 = t136 - t151*t166
-    t171 = t137 - t153*t166
-    t172 = xp.sqrt(t156**2 + t157**2 + t158**2 + t159**2)
-    t173 = t172*xp.where(xp.greater_equal(t156, 0), xp.asarray(1, dtype=dtype), -1)
-    t174 = t104*t138
-    t175 = t148*(t140 - t149*t174 + t150*t145 - t151*t141 + t153*t142)
-    t176 = -t175 + t140
-    t177 = t174 + t149*t175
-    t178 = t145 - t150*t175
-    t179 = t141 + t151*t175
-    t180 = t142 - t153*t175
-    t181 = xp.greater(t172, 0)
-    t182 = xp.where(t181, 1/(t156 + t173), 0)
-    t183 = xp.where(t181, 1 + xp.abs(t156)/t172, 0)
-    t184 = t157*t182
-    t185 = t158*t182
-    t186 = t159*t182
-    t187 = t183*(t162 + t184*t163 - t185*t164 + t186*t165)
-    t188 = -t187 + t162
-    t189 = t163 - t184*t187
-    t190 = t164 + t185*t187
-    t191 = t165 - t186*t187
-    t192 = t183*(-t168 + t184*t169 - t185*t170 + t186*t171)
-    t193 = t168 + t192
-    t194 = t169 - t184*t192
-    t195 = t170 + t185*t192
-    t196 = t171 - t186*t192
-    t197 = t183*(-t177 + t184*t178 + t185*t179 + t186*t180)
-    t198 = t177 + t197
-    t199 = t178 - t184*t197
-    t200 = -t179 + t185*t197
-    t201 = t180 - t186*t197
-    t202 = xp.sqrt(t189**2 + t190**2 + t191**2)
-    t203 = t202*xp.where(xp.greater_equal(t189, 0), xp.asarray(1, dtype=dtype), -1)
-    t204 = xp.greater(t202, 0)
-    t205 = xp.where(t204, 1/(t189 + t203), 0)
-    t206 = xp.where(t204, 1 + xp.abs(t189)/t202, 0)
-    t207 = t190*t205
-    t208 = t191*t205
-    t209 = t206*(t194 + t207*t195 + t208*t196)
-    t210 = -t209 + t194
-    t211 = t195 - t207*t209
-    t212 = t196 - t208*t209
-    t213 = t206*(t199 + t207*t200 + t208*t201)
-    t214 = -t213 + t199
-    t215 = t200 - t207*t213
-    t216 = t201 - t208*t213
-    t217 = xp.sqrt(t211**2 + t212**2)
-    t218 = t217*xp.where(xp.greater_equal(t211, 0), xp.asarray(1, dtype=dtype), -1)
-    t219 = xp.greater(t217, 0)
-    t220 = xp.where(t219, 1/(t211 + t218), 0)
-    t221 = xp.where(t219, 1 + xp.abs(t211)/t217, 0)
-    t222 = t212*t220
-    t223 = t221*(t215 + t222*t216)
-    t224 = -t223 + t215
-    t225 = t216 - t222*t223
-    t226 = xp.abs(t225)
-    t227 = t226*xp.where(xp.greater_equal(t225, 0), xp.asarray(1, dtype=dtype), -1)
-    t228 = xp.where(xp.greater(t226, 0), xp.asarray(2, dtype=dtype), 0)
-    t229 = xp.greater(t59, 0)
-    t230 = xp.where(t229, 1 + xp.abs(t4)/t59, 0)
-    t231 = -t4
-    t232 = xp.where(t229, 1/(t231 + t60), 0)
-    t233 = mu_dot1 + gain1*(t231 + T13)
-    t234 = c1*t6
-    t235 = s1*t6
-    t236 = t1*t232
-    t237 = t230*(t234 + t235*t236)
-    t238 = -t237 + t234
-    t239 = t235 - t236*t237
-    t240 = t230*(t0 + t3*t236)
-    t241 = -t240 + t0
-    t242 = t232*t240
-    t243 = t3 - t1*t242
-    t244 = t232**2
-    t245 = xp.sqrt(t44 + t47 + t51 + t239**2 + t244*t237**2)
-    t246 = t245*xp.where(xp.greater_equal(t239, 0), xp.asarray(1, dtype=dtype), -1)
-    t247 = t244*t230
-    t248 = c2*t247
-    t249 = t1*t248
-    t250 = -t248 + c2
-    t251 = t35*t247
-    t252 = t1*t251
-    t253 = -t35
-    t254 = t251 + t253
-    t255 = t34*t247
-    t256 = t1*t255
-    t257 = -t34
-    t258 = t255 + t257
-    t259 = xp.greater(t245, 0)
-    t260 = xp.where(t259, 1/(t239 + t246), 0)
-    t261 = xp.where(t259, 1 + xp.abs(t239)/t245, 0)
-    t262 = t5*t260
-    t263 = t237*t260
-    t264 = t261*(t243 - c2*t262 + t244*t263*t240)
-    t265 = -t264 + t243
-    t266 = c2 + t262*t264
-    t267 = t263*t232
-    t268 = -t242 + t267*t264
-    t269 = -t261*(t249 + t267*t250)
-    t270 = t249 + t269
-    t271 = t250 + t267*t269
-    t272 = t260*t269
-    t273 = t0 + s1*t272
-    t274 = t3 - c1*t272
-    t275 = s1*t260
-    t276 = c1*t260
-    t277 = t261*(t252 - t17*t275 + t12*t276 - t267*t254)
-    t278 = -t277 + t252
-    t279 = t17 + t275*t277
-    t280 = t12 - t276*t277
-    t281 = t254 + t267*t277
-    t282 = t261*(t256 - t14*t275 + t20*t276 - t267*t258)
-    t283 = -t282 + t256
-    t284 = t14 + t275*t282
-    t285 = t20 - t276*t282
-    t286 = t258 + t267*t282
-    t287 = t260**2*t264**2
-    t288 = xp.sqrt(t266**2 + t268**2 + t47*t287 + t51*t287)
-    t289 = t288*xp.where(xp.greater_equal(t266, 0), xp.asarray(1, dtype=dtype), -1)
-    t290 = xp.greater(t288, 0)
-    t291 = xp.where(t290, 1/(t266 + t289), 0)
-    t292 = xp.where(t290, 1 + xp.abs(t266)/t288, 0)
-    t293 = t262*t269
-    t294 = t264*t291
-    t295 = t275*t294
-    t296 = t276*t294
-    t297 = t268*t291
-    t298 = t292*(t293 + t295*t273 - t296*t274 + t297*t271)
-    t299 = -t298 + t293
-    t300 = t273 - t295*t298
-    t301 = t274 + t296*t298
-    t302 = t271 - t297*t298
-    t303 = xp.sqrt(t300**2 + t301**2 + t302**2)
-    t304 = t303*xp.where(xp.greater_equal(t300, 0), xp.asarray(1, dtype=dtype), -1)
-    t305 = t262*t277
-    t306 = t292*(t305 + t295*t279 - t296*t280 + t297*t281)
-    t307 = -t306 + t305
-    t308 = t279 - t295*t306
-    t309 = t280 + t296*t306
-    t310 = t281 - t297*t306
-    t311 = t262*t282
-    t312 = t292*(t311 + t295*t284 - t296*t285 + t297*t286)
-    t313 = -t312 + t311
-    t314 = t284 - t295*t312
-    t315 = t285 + t296*t312
-    t316 = t286 - t297*t312
-    t317 = xp.greater(t303, 0)
-    t318 = xp.where(t317, 1/(t300 + t304), 0)
-    t319 = xp.where(t317, 1 + xp.abs(t300)/t303, 0)
-    t320 = t301*t318
-    t321 = t302*t318
-    t322 = t319*(t308 + t320*t309 + t321*t310)
-    t323 = -t322 + t308
-    t324 = t309 - t320*t322
-    t325 = t310 - t321*t322
-    t326 = t319*(t314 + t320*t315 + t321*t316)
-    t327 = -t326 + t314
-    t328 = t315 - t320*t326
-    t329 = t316 - t321*t326
-    t330 = xp.sqrt(t324**2 + t325**2)
-    t331 = t330*xp.where(xp.greater_equal(t324, 0), xp.asarray(1, dtype=dtype), -1)
-    t332 = xp.greater(t330, 0)
-    t333 = xp.where(t332, 1/(t324 + t331), 0)
-    t334 = xp.where(t332, 1 + xp.abs(t324)/t330, 0)
-    t335 = t325*t333
-    t336 = t334*(t328 + t335*t329)
-    t337 = -t336 + t328
-    t338 = t329 - t335*t336
-    t339 = xp.abs(t338)
-    t340 = t339*xp.where(xp.greater_equal(t338, 0), xp.asarray(1, dtype=dtype), -1)
-    t341 = xp.where(xp.greater(t339, 0), xp.asarray(2, dtype=dtype), 0)
-    t342 = -t40
-    t343 = 0.5*(-1 + t342 + t25 + t28)
-    t344 = xp.atan2(t43, t343)
-    t345 = xp.where(xp.greater(t43, 0), t344/t43, 1)
-    t346 = xp.greater_equal(t25, t28) & xp.greater_equal(t25, t342)
-    t347 = xp.greater_equal(t28, t342)
-    t348 = xp.where(t346, 0.5*(1 + t25), xp.where(t347, 0.5*t26, -0.5*t38))
-    t349 = xp.where(t346, 0.5*t27, xp.where(t347, 0.5*(1 + t28), -0.5*t39))
-    t350 = xp.where(t346, 0.5*t29, xp.where(t347, 0.5*t30, 0.5*(1 + t342)))
-    t351 = xp.sqrt(t348**2 + t349**2 + t350**2)
-    t352 = xp.where(xp.greater_equal(t41*t348 + t42*t349 + t31*t350, 0), xp.asarray(1, dtype=dtype), -1)
-    t353 = xp.greater(t43, 1e-06) | xp.greater(t343, 0)
-    t354 = t344*t352/t351
-    t355 = xp.where(t353, t41*t345, t354*t348)
-    t356 = xp.where(t353, t42*t345, t354*t349)
-    t357 = xp.where(t353, t31*t345, t354*t350)
-    t358 = mu_dot3 + t355*gain3
-    t359 = mu_dot4 + t356*gain4
-    t360 = mu_dot5 + t357*gain5
-    t361 = t102*(t2 + t103*t233 + t104*t8 - t106*t358 + t107*t359 - t124*t360)
-    t362 = -t361 + t2
-    t363 = t233 - t103*t361
-    t364 = t8 - t104*t361
-    t365 = t358 + t106*t361
-    t366 = t359 - t107*t361
-    t367 = t360 + t124*t361
-    t368 = t148*(t363 + t149*t364 + t150*t365 + t151*t366 + t153*t367)
-    t369 = -t368 + t363
-    t370 = t364 - t149*t368
-    t371 = t365 - t150*t368
-    t372 = t366 - t151*t368
-    t373 = t367 - t153*t368
-    t374 = t183*(t370 + t184*t371 - t185*t372 + t186*t373)
-    t375 = -t374 + t370
-    t376 = t371 - t184*t374
-    t377 = t372 + t185*t374
-    t378 = t373 - t186*t374
-    t379 = t206*(t376 + t207*t377 + t208*t378)
-    t380 = -t379 + t376
-    t381 = t377 - t207*t379
-    t382 = t378 - t208*t379
-    t383 = t221*(t381 + t222*t382)
-    t384 = -t383 + t381
-    t385 = t382 - t222*t383
-    t386 = t385 - t228*t385
-    t387 = xp.where(xp.not_equal(t227, 0), -t386/t227, 0)
-    t388 = xp.where(xp.not_equal(t218, 0), -(t384 - t224*t387)/t218, 0)
-    t389 = xp.where(xp.not_equal(t203, 0), -(-(t210*t388 + t214*t387) + t380)/t203, 0)
-    t390 = xp.where(xp.not_equal(t173, 0), -(t375 + t193*t388 + t198*t387 - t188*t389)/t173, 0)
-    t391 = xp.where(xp.not_equal(t123, 0), -(-(t155*t390 - t161*t389 + t167*t388 + t176*t387) + t369)/t123, 0)
-    t392 = xp.where(xp.not_equal(t99, 0), -(-(t109*t391 + t113*t390 - t126*t389 + t132*t388 - t139*t387) + t362)/t99, 0)
-    t393 = t387 - t4*t392 + t1*t391
-    t394 = -t5*t390 - s1*t389 + c1*t388 + t234*t392 + t235*t391
-    t395 = c2*t390 + t0*t392 + t3*t391
-    t396 = c2*t387 + t0*t389 + t3*t388
-    t397 = t17*t389 + t12*t388 - t35*t387
-    t398 = t14*t389 + t20*t388 - t34*t387
-    t399 = t230*(t2 + t232*t360 + t236*t233)
-    t400 = -t399 + t2
-    t401 = 1 - t5 - s1 + q1 + q2 + c1 + q3 + t1 + q4 + t17 + t12 + q5 + t14 + t20 + q6 + 2*c2 + 2*t0 + 2*t3 + t231 + t234 + t235 + t253 + t257 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t2 + t233 + t8 + t358 + t359 + t360
-    t402 = t232*t399
-    t403 = t233 - t1*t402
-    t404 = -t402 + t360
-    t405 = -t261*(-t403 + t262*t8 + t275*t358 - t276*t359 + t267*t404)
-    t406 = -t405 + t403
-    t407 = t8 + t262*t405
-    t408 = t358 + t275*t405
-    t409 = t359 - t276*t405
-    t410 = t404 + t267*t405
-    t411 = t292*(t407 + t295*t408 - t296*t409 + t297*t410)
-    t412 = -t411 + t407
-    t413 = t408 - t295*t411
-    t414 = t409 + t296*t411
-    t415 = t410 - t297*t411
-    t416 = t319*(t413 + t320*t414 + t321*t415)
-    t417 = -t416 + t413
-    t418 = t414 - t320*t416
-    t419 = t415 - t321*t416
-    t420 = t334*(t418 + t335*t419)
-    t421 = -t420 + t418
-    t422 = t419 - t335*t420
-    t423 = t422 - t341*t422
-    t424 = xp.where(xp.not_equal(t340, 0), -t423/t340, 0)
-    t425 = xp.where(xp.not_equal(t331, 0), -(t421 - t337*t424)/t331, 0)
-    t426 = xp.where(xp.not_equal(t304, 0), -(-(t323*t425 + t327*t424) + t417)/t304, 0)
-    t427 = xp.where(xp.not_equal(t289, 0), -(-(t299*t426 + t307*t425 + t313*t424) + t412)/t289, 0)
-    t428 = xp.where(xp.not_equal(t246, 0), -(-(t265*t427 - t270*t426 + t278*t425 + t283*t424) + t406)/t246, 0)
-    t429 = t232*t230
-    t430 = xp.where(xp.not_equal(t60, 0), -(-(t238*t428 + t241*t427 - c2*t429*t426 + t35*t429*t425 + t34*t429*t424) + t400)/t60, 0)
-    t431 = xp.isfinite(t401)
-    t432 = xp.greater_equal(damping, 0)
-    t433 = xp.greater(damping, 0)
-    t434 = 1e-12*t97
-    t435 = 1e-12*t68
-    t436 = (t433 & (xp.less_equal(t98, t434) | xp.less_equal(t122, t434) | xp.less_equal(t172, t434) | xp.less_equal(t202, t434) | xp.less_equal(t217, t434) | xp.less_equal(t226, t434))) | (xp.less_equal(damping, 0) & (xp.less_equal(t59, t435) | xp.less_equal(t245, t435) | xp.less_equal(t288, t435) | xp.less_equal(t303, t435) | xp.less_equal(t330, t435) | xp.less_equal(t339, t435)))
-    t437 = t431 & t432 & xp.logical_not(t436)
+    t70 = s1*c1
+    t71 = t49*t70
+    t72 = t71 + t55*t70 - t1*t4
+    t73 = -t70 + t71 + t17*t12 + t14*t20
+    t74 = c1*t5
+    t75 = c2*t0
+    t76 = t75 - t6*t74
+    t77 = -t75 + t14*t34 + t17*t35
+    t78 = s1*t5
+    t79 = c2*t3
+    t80 = t79 - t6*t78
+    t81 = -t79 + t20*t34 + t12*t35
+    t82 = xp.greater(t59, 0)
+    t83 = xp.where(t82, 1 + xp.abs(t4)/t59, 0)
+    t84 = -t4
+    t85 = xp.where(t82, 1/(t84 + t60), 0)
+    t86 = mu_dot1 + gain1*(t84 + T13)
+    t87 = c1*t6
+    t88 = s1*t6
+    t89 = t1*t85
+    t90 = t83*(t87 + t88*t89)
+    t91 = -t90 + t87
+    t92 = t88 - t89*t90
+    t93 = t83*(t0 + t3*t89)
+    t94 = -t93 + t0
+    t95 = t85*t93
+    t96 = t3 - t1*t95
+    t97 = t85**2
+    t98 = xp.sqrt(t44 + t47 + t51 + t92**2 + t97*t90**2)
+    t99 = t98*xp.where(xp.greater_equal(t92, 0), xp.asarray(1, dtype=dtype), -1)
+    t100 = t97*t83
+    t101 = c2*t100
+    t102 = t1*t101
+    t103 = -t101 + c2
+    t104 = t35*t100
+    t105 = t1*t104
+    t106 = -t35
+    t107 = t104 + t106
+    t108 = t34*t100
+    t109 = t1*t108
+    t110 = -t34
+    t111 = t108 + t110
+    t112 = xp.greater(t98, 0)
+    t113 = xp.where(t112, 1/(t92 + t99), 0)
+    t114 = xp.where(t112, 1 + xp.abs(t92)/t98, 0)
+    t115 = t5*t113
+    t116 = t90*t113
+    t117 = t114*(t96 - c2*t115 + t97*t116*t93)
+    t118 = -t117 + t96
+    t119 = c2 + t115*t117
+    t120 = t116*t85
+    t121 = -t95 + t120*t117
+    t122 = -t114*(t102 + t120*t103)
+    t123 = t102 + t122
+    t124 = t103 + t120*t122
+    t125 = t113*t122
+    t126 = t0 + s1*t125
+    t127 = t3 - c1*t125
+    t128 = s1*t113
+    t129 = c1*t113
+    t130 = t114*(t105 - t17*t128 + t12*t129 - t120*t107)
+    t131 = -t130 + t105
+    t132 = t17 + t128*t130
+    t133 = t12 - t129*t130
+    t134 = t107 + t120*t130
+    t135 = t114*(t109 - t14*t128 + t20*t129 - t120*t111)
+    t136 = -t135 + t109
+    t137 = t14 + t128*t135
+    t138 = t20 - t129*t135
+    t139 = t111 + t120*t135
+    t140 = t113**2*t117**2
+    t141 = xp.sqrt(t119**2 + t121**2 + t51*t140 + t47*t140)
+    t142 = t141*xp.where(xp.greater_equal(t119, 0), xp.asarray(1, dtype=dtype), -1)
+    t143 = xp.greater(t141, 0)
+    t144 = xp.where(t143, 1/(t119 + t142), 0)
+    t145 = xp.where(t143, 1 + xp.abs(t119)/t141, 0)
+    t146 = t115*t122
+    t147 = t117*t144
+    t148 = t128*t147
+    t149 = t129*t147
+    t150 = t121*t144
+    t151 = t145*(t146 + t148*t126 - t149*t127 + t150*t124)
+    t152 = -t151 + t146
+    t153 = t126 - t148*t151
+    t154 = t127 + t149*t151
+    t155 = t124 - t150*t151
+    t156 = xp.sqrt(t153**2 + t154**2 + t155**2)
+    t157 = t156*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
+    t158 = t115*t130
+    t159 = t145*(t158 + t148*t132 - t149*t133 + t150*t134)
+    t160 = -t159 + t158
+    t161 = t132 - t148*t159
+    t162 = t133 + t149*t159
+    t163 = t134 - t150*t159
+    t164 = t115*t135
+    t165 = t145*(t164 + t148*t137 - t149*t138 + t150*t139)
+    t166 = -t165 + t164
+    t167 = t137 - t148*t165
+    t168 = t138 + t149*t165
+    t169 = t139 - t150*t165
+    t170 = xp.greater(t156, 0)
+    t171 = xp.where(t170, 1/(t153 + t157), 0)
+    t172 = xp.where(t170, 1 + xp.abs(t153)/t156, 0)
+    t173 = t154*t171
+    t174 = t155*t171
+    t175 = t172*(t161 + t173*t162 + t174*t163)
+    t176 = -t175 + t161
+    t177 = t162 - t173*t175
+    t178 = t163 - t174*t175
+    t179 = t172*(t167 + t173*t168 + t174*t169)
+    t180 = -t179 + t167
+    t181 = t168 - t173*t179
+    t182 = t169 - t174*t179
+    t183 = xp.sqrt(t177**2 + t178**2)
+    t184 = t183*xp.where(xp.greater_equal(t177, 0), xp.asarray(1, dtype=dtype), -1)
+    t185 = xp.greater(t183, 0)
+    t186 = xp.where(t185, 1/(t177 + t184), 0)
+    t187 = xp.where(t185, 1 + xp.abs(t177)/t183, 0)
+    t188 = t178*t186
+    t189 = t187*(t181 + t188*t182)
+    t190 = -t189 + t181
+    t191 = t182 - t188*t189
+    t192 = xp.abs(t191)
+    t193 = t192*xp.where(xp.greater_equal(t191, 0), xp.asarray(1, dtype=dtype), -1)
+    t194 = xp.where(xp.greater(t192, 0), xp.asarray(2, dtype=dtype), 0)
+    t195 = -t40
+    t196 = 0.5*(-1 + t195 + t25 + t28)
+    t197 = xp.atan2(t43, t196)
+    t198 = xp.where(xp.greater(t43, 0), t197/t43, 1)
+    t199 = xp.greater_equal(t25, t28) & xp.greater_equal(t25, t195)
+    t200 = xp.greater_equal(t28, t195)
+    t201 = xp.where(t199, 0.5*(1 + t25), xp.where(t200, 0.5*t26, -0.5*t38))
+    t202 = xp.where(t199, 0.5*t27, xp.where(t200, 0.5*(1 + t28), -0.5*t39))
+    t203 = xp.where(t199, 0.5*t29, xp.where(t200, 0.5*t30, 0.5*(1 + t195)))
+    t204 = xp.sqrt(t201**2 + t202**2 + t203**2)
+    t205 = xp.where(xp.greater_equal(t41*t201 + t42*t202 + t31*t203, 0), xp.asarray(1, dtype=dtype), -1)
+    t206 = xp.greater(t43, 1e-06) | xp.greater(t196, 0)
+    t207 = t197*t205/t204
+    t208 = xp.where(t206, t41*t198, t207*t201)
+    t209 = xp.where(t206, t42*t198, t207*t202)
+    t210 = xp.where(t206, t31*t198, t207*t203)
+    t211 = mu_dot3 + t208*gain3
+    t212 = mu_dot4 + t209*gain4
+    t213 = mu_dot5 + t210*gain5
+    t214 = t83*(t2 + t85*t213 + t89*t86)
+    t215 = -t214 + t2
+    t216 = 1 - t5 - s1 + q1 + q2 + c1 + q3 + t1 + q4 + t17 + t12 + q5 + t14 + t20 + q6 + 2*c2 + 2*t0 + 2*t3 + t84 + t87 + t88 + t106 + t110 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t2 + t86 + t8 + t211 + t212 + t213
+    t217 = damping**2
+    t218 = t6*t70
+    t219 = _symmetric_solve6(xp, 1, (t217 + t57, t72, t76, -t218, t48, t84, t217 + t62, t80, -t52, t218, t1, t217 + t46, t78, -t74, xp.full(batch, 0, dtype=dtype, device=device), t217 + t64, t73, -t77, t217 + t66, -t81, t217 + t69, t2, t86, t8, t211, t212, t213,))
+    t220 = t219[5]
+    t221 = t219[0]
+    t222 = t219[1]
+    t223 = t220 - t4*t221 + t1*t222
+    t224 = t219[2]
+    t225 = t0*t221 + t3*t222 + c2*t224
+    t226 = t219[3]
+    t227 = t219[4]
+    t228 = t87*t221 + t88*t222 - t5*t224 - s1*t226 + c1*t227
+    t229 = t0*t226 + t3*t227 + c2*t220
+    t230 = t17*t226 + t12*t227 - t35*t220
+    t231 = t14*t226 + t20*t227 - t34*t220
+    t232 = t85*t214
+    t233 = t86 - t1*t232
+    t234 = -t232 + t213
+    t235 = -t114*(-t233 + t115*t8 + t128*t211 - t129*t212 + t120*t234)
+    t236 = -t235 + t233
+    t237 = t8 + t115*t235
+    t238 = t211 + t128*t235
+    t239 = t212 - t129*t235
+    t240 = t234 + t120*t235
+    t241 = t145*(t237 + t148*t238 - t149*t239 + t150*t240)
+    t242 = -t241 + t237
+    t243 = t238 - t148*t241
+    t244 = t239 + t149*t241
+    t245 = t240 - t150*t241
+    t246 = t172*(t243 + t173*t244 + t174*t245)
+    t247 = -t246 + t243
+    t248 = t244 - t173*t246
+    t249 = t245 - t174*t246
+    t250 = t187*(t248 + t188*t249)
+    t251 = -t250 + t248
+    t252 = t249 - t188*t250
+    t253 = t252 - t194*t252
+    t254 = xp.where(xp.not_equal(t193, 0), -t253/t193, 0)
+    t255 = xp.where(xp.not_equal(t184, 0), -(t251 - t190*t254)/t184, 0)
+    t256 = xp.where(xp.not_equal(t157, 0), -(-(t176*t255 + t180*t254) + t247)/t157, 0)
+    t257 = xp.where(xp.not_equal(t142, 0), -(-(t152*t256 + t160*t255 + t166*t254) + t242)/t142, 0)
+    t258 = xp.where(xp.not_equal(t99, 0), -(-(t118*t257 - t123*t256 + t131*t255 + t136*t254) + t236)/t99, 0)
+    t259 = t85*t83
+    t260 = xp.where(xp.not_equal(t60, 0), -(-(t91*t258 + t94*t257 - c2*t259*t256 + t35*t259*t255 + t34*t259*t254) + t215)/t60, 0)
+    t261 = xp.isfinite(t216)
+    t262 = xp.greater_equal(damping, 0)
+    t263 = xp.greater(damping, 0)
+    t264 = 1e-12*t68
+    t265 = (t263 & xp.greater(t219[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t59, t264) | xp.less_equal(t98, t264) | xp.less_equal(t141, t264) | xp.less_equal(t156, t264) | xp.less_equal(t183, t264) | xp.less_equal(t192, t264)))
+    t266 = t261 & t262 & xp.logical_not(t265)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t437, xp.where(t433, t393, t430), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t437, xp.where(t433, t394, t428), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t437, xp.where(t433, t395, t427), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t437, xp.where(t433, t396, t426), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t437, xp.where(t433, t397, t425), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t437, xp.where(t433, t398, t424), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t266, xp.where(t263, t223, t260), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t266, xp.where(t263, t228, t258), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t266, xp.where(t263, t225, t257), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t266, xp.where(t263, t229, t256), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t266, xp.where(t263, t230, t255), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t266, xp.where(t263, t231, t254), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t431 & t432), 2, xp.where(t436, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t261 & t262), 2, xp.where(t265, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 834 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 902 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (6,)), ("damping", damping, ()))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
@@ -4353,269 +4086,106 @@ def ik_numeric_step(target, q, damping=0.0):
     t3 = 0.1337*c1 + s1*t1
     t4 = c1*t2 + s1*t3
     t5 = -t2 + T03
-    t6 = -t3 + T13
-    t7 = q3*c2
-    t8 = 0.412 + t7
-    t9 = -t8 + T23
-    t10 = s1*c4
-    t11 = c1*s4
-    t12 = t10 + c2*t11
-    t13 = c2*t10 + t11
-    t14 = s1*s4
-    t15 = c1*c4
-    t16 = -t14 + c2*t15
-    t17 = -t15 + c2*t14
-    t18 = c1*s2
-    t19 = t12*c5 - s5*t18
-    t20 = t12*s5 + c5*t18
-    t21 = t16*s6 + t19*c6
-    t22 = t16*c6 - t19*s6
-    t23 = t21*T00 + t22*T01 + t20*T02
-    t24 = t21*T10 + t22*T11 + t20*T12
-    t25 = t21*T20 + t22*T21 + t20*T22
-    t26 = s1*s2
-    t27 = t17*c5 - s5*t26
-    t28 = t17*s5 + c5*t26
-    t29 = t13*s6 + t27*c6
-    t30 = t13*c6 - t27*s6
-    t31 = t29*T00 + t30*T01 + t28*T02
-    t32 = t29*T10 + t30*T11 + t28*T12
-    t33 = t29*T20 + t30*T21 + t28*T22
-    t34 = 0.5*(-t31 + t24)
-    t35 = s2*s4
-    t36 = c2*s5 + c5*t35
-    t37 = -c2*c5 + s5*t35
-    t38 = s2*c4
-    t39 = t36*c6 + s6*t38
-    t40 = t36*s6 - c6*t38
-    t41 = t39*T00 + t37*T02 - t40*T01
-    t42 = t39*T10 + t37*T12 - t40*T11
-    t43 = t39*T20 + t37*T22 - t40*T21
-    t44 = 0.5*(t42 + t33)
-    t45 = -0.5*(t41 + t25)
-    t46 = xp.sqrt(t44**2 + t45**2 + t34**2)
-    t47 = t3**2
-    t48 = c1**2
-    t49 = t7*t48
-    t50 = c2**2
-    t51 = t50 + t4**2
-    t52 = q3**2*t50
-    t53 = t48*t52
-    t54 = s2**2
-    t55 = 1 + t37**2 + t50 + c4**2*t54
-    t56 = t48*t54
-    t57 = t47 + t53 + t56
-    t58 = t2*t3
-    t59 = s1*c1
-    t60 = t54*t59
-    t61 = -t58 + t60 + t52*t59
-    t62 = -t59 + t60 + t16*t13 + t20*t28
-    t63 = c1*t4
-    t64 = c2*t18
-    t65 = t64 - t7*t63
-    t66 = -t64 + t20*t37 + t16*t38
-    t67 = s1**2
-    t68 = t16**2 + t20**2 + t56 + t67
-    t69 = t54*t67
-    t70 = t2**2 + t69 + t52*t67
-    t71 = t13**2 + t28**2 + t48 + t69
-    t72 = s1*t4
-    t73 = c2*t26
-    t74 = t73 - t7*t72
-    t75 = -t73 + t28*t37 + t13*t38
-    t76 = t7*t67
-    t77 = -t43
-    t78 = 0.5*(-1 + t77 + t23 + t32)
-    t79 = xp.atan2(t46, t78)
-    t80 = xp.where(xp.greater(t46, 0), t79/t46, 1)
-    t81 = xp.greater_equal(t23, t32) & xp.greater_equal(t23, t77)
-    t82 = xp.greater_equal(t32, t77)
-    t83 = xp.where(t81, 0.5*(1 + t23), xp.where(t82, 0.5*t31, -0.5*t41))
-    t84 = xp.where(t81, 0.5*t24, xp.where(t82, 0.5*(1 + t32), -0.5*t42))
-    t85 = xp.where(t81, 0.5*t25, xp.where(t82, 0.5*t33, 0.5*(1 + t77)))
-    t86 = xp.sqrt(t83**2 + t84**2 + t85**2)
-    t87 = xp.where(xp.greater_equal(t44*t83 + t45*t84 + t34*t85, 0), xp.asarray(1, dtype=dtype), -1)
-    t88 = xp.greater(t46, 1e-06) | xp.greater(t78, 0)
-    t89 = t79*t87/t86
-    t90 = xp.where(t88, t44*t80, t89*t83)
-    t91 = xp.where(t88, t45*t80, t89*t84)
-    t92 = xp.where(t88, t34*t80, t89*t85)
-    t93 = t90**2 + t91**2 + t92**2 + t5**2 + t6**2 + t9**2
-    t94 = damping + t57
-    t95 = xp.sqrt(t47 + t94**2 + t61**2 + t65**2 + t49**2 + t53*t67)
-    t96 = t95*xp.where(xp.greater_equal(t94, 0), xp.asarray(1, dtype=dtype), -1)
-    t97 = xp.greater(t95, 0)
-    t98 = xp.where(t97, 1/(t94 + t96), 0)
-    t99 = xp.where(t97, 1 + xp.abs(t94)/t95, 0)
-    t100 = damping + t70
-    t101 = t61*t98
-    t102 = t65*t98
-    t103 = t7*t59
-    t104 = t103*t98
-    t105 = t49*t98
-    t106 = t99*(t61 + t100*t101 + t102*t74 + t103*t105 - t58*t98 + t76*t104)
-    t107 = -t106 + t61
-    t108 = t100 - t101*t106
-    t109 = t74 - t102*t106
-    t110 = t98*t106
-    t111 = -t76 + t103*t110
-    t112 = t103 - t110*t49
-    t113 = t2 + t3*t110
-    t114 = xp.sqrt(t108**2 + t109**2 + t111**2 + t112**2 + t113**2)
-    t115 = t114*xp.where(xp.greater_equal(t108, 0), xp.asarray(1, dtype=dtype), -1)
-    t116 = damping + t51
-    t117 = t99*(t65 + t101*t74 + t102*t116 - t63*t76*t98 - t63*t105)
-    t118 = -t117 + t65
-    t119 = t74 - t101*t117
-    t120 = t116 - t102*t117
-    t121 = t72 + t104*t117
-    t122 = t63 + t105*t117
-    t123 = damping + t68
-    t124 = t3*t98
-    t125 = t99*(-t103 + t72*t102 - t104*t123 + t105*t62 + t124*t66 - t76*t101)
-    t126 = t103 + t125
-    t127 = t76 + t101*t125
-    t128 = t72 - t102*t125
-    t129 = t123 + t104*t125
-    t130 = t62 - t105*t125
-    t131 = t99*(t5 + t101*t6 + t102*t9 - t104*t90 + t105*t91 - t124*t92)
-    t132 = -t131 + t5
-    t133 = t6 - t101*t131
-    t134 = t9 - t102*t131
-    t135 = t90 + t104*t131
-    t136 = t91 - t105*t131
-    t137 = t92 + t124*t131
-    t138 = -t66
-    t139 = t138 + t124*t125
-    t140 = damping + t71
-    t141 = t99*(t49 + t101*t103 - t63*t102 - t104*t62 + t105*t140 + t124*t75)
-    t142 = -t141 + t49
-    t143 = t103 - t101*t141
-    t144 = t63 + t102*t141
-    t145 = t62 + t104*t141
-    t146 = t140 - t105*t141
-    t147 = -t75 + t124*t141
-    t148 = damping + t55
-    t149 = -t99*(t3 - t2*t101 - t104*t66 + t105*t75 + t124*t148)
-    t150 = t3 + t149
-    t151 = t2 - t101*t149
-    t152 = t138 + t104*t149
-    t153 = t75 + t105*t149
-    t154 = t148 + t124*t149
-    t155 = xp.greater(t114, 0)
-    t156 = xp.where(t155, 1/(t108 + t115), 0)
-    t157 = xp.where(t155, 1 + xp.abs(t108)/t114, 0)
-    t158 = t109*t156
-    t159 = t111*t156
-    t160 = t112*t156
-    t161 = t124*t117
-    t162 = t113*t156
-    t163 = t157*(t119 + t158*t120 + t159*t121 - t160*t122 + t161*t162)
-    t164 = -t163 + t119
-    t165 = t120 - t158*t163
-    t166 = t121 - t159*t163
-    t167 = t122 + t160*t163
-    t168 = t161 - t162*t163
-    t169 = t157*(-t127 + t158*t128 + t159*t129 + t160*t130 + t162*t139)
-    t170 = t127 + t169
-    t171 = t128 - t158*t169
-    t172 = t129 - t159*t169
-    t173 = t130 - t160*t169
-    t174 = t139 - t162*t169
-    t175 = t157*(t143 - t158*t144 + t159*t145 + t160*t146 + t162*t147)
-    t176 = -t175 + t143
-    t177 = t144 + t158*t175
-    t178 = t145 - t159*t175
-    t179 = t146 - t160*t175
-    t180 = t147 - t162*t175
-    t181 = t157*(t133 + t158*t134 + t159*t135 + t160*t136 + t162*t137)
-    t182 = -t181 + t133
-    t183 = t134 - t158*t181
-    t184 = t135 - t159*t181
-    t185 = t136 - t160*t181
-    t186 = t137 - t162*t181
-    t187 = xp.sqrt(t165**2 + t166**2 + t167**2 + t168**2)
-    t188 = t187*xp.where(xp.greater_equal(t165, 0), xp.asarray(1, dtype=dtype), -1)
-    t189 = t102*t149
-    t190 = t157*(t151 - t158*t189 + t159*t152 - t160*t153 + t162*t154)
-    t191 = -t190 + t151
-    t192 = t189 + t158*t190
-    t193 = t152 - t159*t190
-    t194 = t153 + t160*t190
-    t195 = t154 - t162*t190
-    t196 = xp.greater(t187, 0)
-    t197 = xp.where(t196, 1/(t165 + t188), 0)
-    t198 = xp.where(t196, 1 + xp.abs(t165)/t187, 0)
-    t199 = t166*t197
-    t200 = t167*t197
-    t201 = t168*t197
-    t202 = t198*(t171 + t199*t172 - t200*t173 + t201*t174)
-    t203 = -t202 + t171
-    t204 = t172 - t199*t202
-    t205 = t173 + t200*t202
-    t206 = t174 - t201*t202
-    t207 = t198*(-t177 + t199*t178 - t200*t179 + t201*t180)
-    t208 = t177 + t207
-    t209 = t178 - t199*t207
-    t210 = t179 + t200*t207
-    t211 = t180 - t201*t207
-    t212 = t198*(-t192 + t199*t193 + t200*t194 + t201*t195)
-    t213 = t192 + t212
-    t214 = t193 - t199*t212
-    t215 = -t194 + t200*t212
-    t216 = t195 - t201*t212
-    t217 = t198*(t183 + t199*t184 - t200*t185 + t201*t186)
-    t218 = -t217 + t183
-    t219 = t184 - t199*t217
-    t220 = t185 + t200*t217
-    t221 = t186 - t201*t217
-    t222 = xp.sqrt(t204**2 + t205**2 + t206**2)
-    t223 = t222*xp.where(xp.greater_equal(t204, 0), xp.asarray(1, dtype=dtype), -1)
-    t224 = xp.greater(t222, 0)
-    t225 = xp.where(t224, 1/(t204 + t223), 0)
-    t226 = xp.where(t224, 1 + xp.abs(t204)/t222, 0)
-    t227 = t205*t225
-    t228 = t206*t225
-    t229 = t226*(t209 + t227*t210 + t228*t211)
-    t230 = -t229 + t209
-    t231 = t210 - t227*t229
-    t232 = t211 - t228*t229
-    t233 = t226*(t214 + t227*t215 + t228*t216)
-    t234 = -t233 + t214
-    t235 = t215 - t227*t233
-    t236 = t216 - t228*t233
-    t237 = t226*(t219 + t227*t220 + t228*t221)
-    t238 = -t237 + t219
-    t239 = t220 - t227*t237
-    t240 = t221 - t228*t237
-    t241 = xp.sqrt(t231**2 + t232**2)
-    t242 = t241*xp.where(xp.greater_equal(t231, 0), xp.asarray(1, dtype=dtype), -1)
-    t243 = xp.greater(t241, 0)
-    t244 = xp.where(t243, 1/(t231 + t242), 0)
-    t245 = xp.where(t243, 1 + xp.abs(t231)/t241, 0)
-    t246 = t232*t244
-    t247 = t245*(t235 + t246*t236)
-    t248 = -t247 + t235
-    t249 = t236 - t246*t247
-    t250 = t245*(t239 + t246*t240)
-    t251 = -t250 + t239
-    t252 = t240 - t246*t250
-    t253 = xp.abs(t249)
-    t254 = t253*xp.where(xp.greater_equal(t249, 0), xp.asarray(1, dtype=dtype), -1)
-    t255 = xp.where(xp.greater(t253, 0), xp.asarray(2, dtype=dtype), 0)
-    t256 = t252 - t252*t255
-    t257 = xp.where(xp.not_equal(t254, 0), -t256/t254, 0)
-    t258 = xp.where(xp.not_equal(t242, 0), -(t251 - t248*t257)/t242, 0)
-    t259 = xp.where(xp.not_equal(t223, 0), -(-(t230*t258 + t234*t257) + t238)/t223, 0)
-    t260 = xp.where(xp.not_equal(t188, 0), -(t218 + t208*t258 + t213*t257 - t203*t259)/t188, 0)
-    t261 = xp.where(xp.not_equal(t115, 0), -(-(t164*t260 - t170*t259 + t176*t258 + t191*t257) + t182)/t115, 0)
-    t262 = xp.where(xp.not_equal(t96, 0), -(-(t107*t261 + t118*t260 - t126*t259 + t142*t258 - t150*t257) + t132)/t96, 0)
-    t263 = q1 + t257 - t3*t262 + t2*t261
-    t264 = q2 - t4*t260 - s1*t259 + c1*t258 + c1*t7*t262 + s1*t7*t261
-    t265 = q3 + c2*t260 + t18*t262 + t26*t261
-    t266 = q4 + c2*t257 + t18*t259 + t26*t258
-    t267 = q5 + t16*t259 + t13*t258 - t38*t257
-    t268 = q6 + t20*t259 + t28*t258 - t37*t257
+    t6 = q3*c2
+    t7 = 0.412 + t6
+    t8 = -t7 + T23
+    t9 = s1*c4
+    t10 = c1*s4
+    t11 = t9 + c2*t10
+    t12 = c2*t9 + t10
+    t13 = s1*s4
+    t14 = c1*c4
+    t15 = -t13 + c2*t14
+    t16 = -t14 + c2*t13
+    t17 = c1*s2
+    t18 = t11*c5 - s5*t17
+    t19 = t11*s5 + c5*t17
+    t20 = t15*s6 + t18*c6
+    t21 = t15*c6 - t18*s6
+    t22 = t20*T00 + t21*T01 + t19*T02
+    t23 = t20*T10 + t21*T11 + t19*T12
+    t24 = t20*T20 + t21*T21 + t19*T22
+    t25 = s1*s2
+    t26 = t16*c5 - s5*t25
+    t27 = t16*s5 + c5*t25
+    t28 = t12*s6 + t26*c6
+    t29 = t12*c6 - t26*s6
+    t30 = t28*T00 + t29*T01 + t27*T02
+    t31 = t28*T10 + t29*T11 + t27*T12
+    t32 = t28*T20 + t29*T21 + t27*T22
+    t33 = 0.5*(-t30 + t23)
+    t34 = s2*s4
+    t35 = c2*s5 + c5*t34
+    t36 = -c2*c5 + s5*t34
+    t37 = s2*c4
+    t38 = t35*c6 + s6*t37
+    t39 = t35*s6 - c6*t37
+    t40 = t38*T00 + t36*T02 - t39*T01
+    t41 = t38*T10 + t36*T12 - t39*T11
+    t42 = t38*T20 + t36*T22 - t39*T21
+    t43 = 0.5*(t41 + t32)
+    t44 = -0.5*(t40 + t24)
+    t45 = xp.sqrt(t43**2 + t44**2 + t33**2)
+    t46 = c1**2
+    t47 = t6*t46
+    t48 = c2**2
+    t49 = t48 + t4**2
+    t50 = q3**2*t48
+    t51 = s2**2
+    t52 = 1 + t36**2 + t48 + c4**2*t51
+    t53 = t46*t51
+    t54 = t3**2 + t53 + t46*t50
+    t55 = s1*c1
+    t56 = t51*t55
+    t57 = t56 - t2*t3 + t50*t55
+    t58 = -t55 + t56 + t15*t12 + t19*t27
+    t59 = c1*t4
+    t60 = c2*t17
+    t61 = t60 - t6*t59
+    t62 = -t60 + t19*t36 + t15*t37
+    t63 = s1**2
+    t64 = t6*t63
+    t65 = t15**2 + t19**2 + t53 + t63
+    t66 = t51*t63
+    t67 = t2**2 + t66 + t50*t63
+    t68 = t12**2 + t27**2 + t46 + t66
+    t69 = s1*t4
+    t70 = c2*t25
+    t71 = t70 - t6*t69
+    t72 = -t70 + t27*t36 + t12*t37
+    t73 = -t42
+    t74 = 0.5*(-1 + t73 + t22 + t31)
+    t75 = xp.atan2(t45, t74)
+    t76 = xp.where(xp.greater(t45, 0), t75/t45, 1)
+    t77 = xp.greater_equal(t22, t31) & xp.greater_equal(t22, t73)
+    t78 = xp.greater_equal(t31, t73)
+    t79 = xp.where(t77, 0.5*(1 + t22), xp.where(t78, 0.5*t30, -0.5*t40))
+    t80 = xp.where(t77, 0.5*t23, xp.where(t78, 0.5*(1 + t31), -0.5*t41))
+    t81 = xp.where(t77, 0.5*t24, xp.where(t78, 0.5*t32, 0.5*(1 + t73)))
+    t82 = xp.sqrt(t79**2 + t80**2 + t81**2)
+    t83 = xp.where(xp.greater_equal(t43*t79 + t44*t80 + t33*t81, 0), xp.asarray(1, dtype=dtype), -1)
+    t84 = xp.greater(t45, 1e-06) | xp.greater(t74, 0)
+    t85 = t75*t83/t82
+    t86 = xp.where(t84, t43*t76, t85*t79)
+    t87 = xp.where(t84, t44*t76, t85*t80)
+    t88 = xp.where(t84, t33*t76, t85*t81)
+    t89 = -t3
+    t90 = t89 + T13
+    t91 = t86**2 + t87**2 + t88**2 + t5**2 + t90**2 + t8**2
+    t92 = t6*t55
+    t93 = _symmetric_solve6(xp, 1, (damping + t54, t57, t61, -t92, t47, t89, damping + t67, t71, -t64, t92, t2, damping + t49, t69, -t59, xp.full(batch, 0, dtype=dtype, device=device), damping + t65, t58, -t62, damping + t68, -t72, damping + t52, t5, t90, t8, t86, t87, t88,))
+    t94 = t93[5]
+    t95 = t93[0]
+    t96 = t93[1]
+    t97 = q1 + t94 - t3*t95 + t2*t96
+    t98 = t93[2]
+    t99 = q3 + t17*t95 + t25*t96 + c2*t98
+    t100 = t93[3]
+    t101 = t93[4]
+    t102 = q2 + c1*t6*t95 + s1*t6*t96 - t4*t98 - s1*t100 + c1*t101
+    t103 = q4 + t17*t100 + t25*t101 + c2*t94
+    t104 = q5 + t15*t100 + t12*t101 - t37*t94
+    t105 = q6 + t19*t100 + t27*t101 - t36*t94
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -4625,14 +4195,14 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q6, batch),  # 5
     ], (6,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t263, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t263, 2.9670597283903604), 2.9670597283903604, t263)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t264, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t264, 2.9670597283903604), 2.9670597283903604, t264)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t265, 0.30479999999999996), 0.30479999999999996, xp.where(xp.greater(t265, 1.27), 1.27, t265)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t266, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t266, 2.9670597283903604), 2.9670597283903604, t266)), batch),  # 3
-        xp.broadcast_to(xp.where(xp.less(t267, -1.5707963267948966), -1.5707963267948966, xp.where(xp.greater(t267, 1.5707963267948966), 1.5707963267948966, t267)), batch),  # 4
-        xp.broadcast_to(xp.where(xp.less(t268, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t268, 2.9670597283903604), 2.9670597283903604, t268)), batch),  # 5
+        xp.broadcast_to(xp.where(xp.less(t97, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t97, 2.9670597283903604), 2.9670597283903604, t97)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t102, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t102, 2.9670597283903604), 2.9670597283903604, t102)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t99, 0.30479999999999996), 0.30479999999999996, xp.where(xp.greater(t99, 1.27), 1.27, t99)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t103, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t103, 2.9670597283903604), 2.9670597283903604, t103)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t104, -1.5707963267948966), -1.5707963267948966, xp.where(xp.greater(t104, 1.5707963267948966), 1.5707963267948966, t104)), batch),  # 4
+        xp.broadcast_to(xp.where(xp.less(t105, -2.9670597283903604), -2.9670597283903604, xp.where(xp.greater(t105, 2.9670597283903604), 2.9670597283903604, t105)), batch),  # 5
     ], (6,))
-    cost = xp.broadcast_to(xp.where(xp.isfinite(t0), t93, -1), batch)
+    cost = xp.broadcast_to(xp.where(xp.isfinite(t0), t91, -1), batch)
     return q_start, q_next, cost
 
 
@@ -4866,7 +4436,7 @@ def ik_branches(T):
     t211 = xp.where(xp.greater(t210, 0), xp.sqrt(t210), 0)
     t212 = t208 + t209
     t213 = t211**2
-    t214 = t207*t213 + t206*t213
+    t214 = t206*t213 + t207*t213
     t215 = t209 + t213
     t216 = 1e-40*t215
     t217 = xp.less_equal(t214, t216*t212)
@@ -5112,7 +4682,7 @@ def ik_branches(T):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 859 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 858 operations."""
     xp, dtype, device, batch, (T, q_seed, weights,) = _arguments(("T", T, (4, 4)), ("q_seed", q_seed, (6,)), ("weights", weights, (6,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(T)
     T00 = T[..., 0, 0]
@@ -5203,326 +4773,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     lb5 = branches_in_limits[..., 5]
     lb6 = branches_in_limits[..., 6]
     lb7 = branches_in_limits[..., 7]
-    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
-    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
-    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
-    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
-    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
-    t5 = xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0)
-    t6 = xp.where(xp.greater(t5, 0), xp.asarray(1, dtype=dtype), 0)
-    t7 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
-    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
-    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
-    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
-    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
-    t12 = xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0)
-    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
-    t14 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
-    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
-    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
-    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
-    t18 = xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0)
-    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
-    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
-    t21 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
-    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
-    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
-    t24 = xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0)
-    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
-    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
-    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
-    t28 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
-    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
-    t30 = xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0)
-    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
-    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
-    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
-    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
-    t35 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
-    t36 = xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0)
-    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
-    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
-    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
-    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
-    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
-    t42 = xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0)
-    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
-    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
-    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
-    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
-    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
-    t48 = xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0)
-    t49 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
-    t50 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t51 = t50 + t0
-    t52 = -t50 + t0
-    t53 = xp.where(xp.greater_equal(t0, -2.9670597283903604) & xp.less_equal(t0, 2.9670597283903604), t0, xp.where(xp.greater_equal(t51, -2.9670597283903604) & xp.less_equal(t51, 2.9670597283903604), t51, xp.where(xp.greater_equal(t52, -2.9670597283903604) & xp.less_equal(t52, 2.9670597283903604), t52, qb0_0)))
-    t54 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t55 = t54 + t1
-    t56 = -t54 + t1
-    t57 = xp.where(xp.greater_equal(t1, -2.9670597283903604) & xp.less_equal(t1, 2.9670597283903604), t1, xp.where(xp.greater_equal(t55, -2.9670597283903604) & xp.less_equal(t55, 2.9670597283903604), t55, xp.where(xp.greater_equal(t56, -2.9670597283903604) & xp.less_equal(t56, 2.9670597283903604), t56, qb0_1)))
-    t58 = xp.where(xp.less(t2, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t59 = t58 + t2
-    t60 = -t58 + t2
-    t61 = xp.where(xp.greater_equal(t2, -2.9670597283903604) & xp.less_equal(t2, 2.9670597283903604), t2, xp.where(xp.greater_equal(t59, -2.9670597283903604) & xp.less_equal(t59, 2.9670597283903604), t59, xp.where(xp.greater_equal(t60, -2.9670597283903604) & xp.less_equal(t60, 2.9670597283903604), t60, qb0_3)))
-    t62 = xp.where(xp.less(t3, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t63 = t62 + t3
-    t64 = -t62 + t3
-    t65 = xp.where(xp.greater_equal(t3, -1.5707963267948966) & xp.less_equal(t3, 1.5707963267948966), t3, xp.where(xp.greater_equal(t63, -1.5707963267948966) & xp.less_equal(t63, 1.5707963267948966), t63, xp.where(xp.greater_equal(t64, -1.5707963267948966) & xp.less_equal(t64, 1.5707963267948966), t64, qb0_4)))
-    t66 = xp.where(xp.less(t4, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t67 = t66 + t4
-    t68 = -t66 + t4
-    t69 = xp.where(xp.greater_equal(t4, -2.9670597283903604) & xp.less_equal(t4, 2.9670597283903604), t4, xp.where(xp.greater_equal(t67, -2.9670597283903604) & xp.less_equal(t67, 2.9670597283903604), t67, xp.where(xp.greater_equal(t68, -2.9670597283903604) & xp.less_equal(t68, 2.9670597283903604), t68, qb0_5)))
-    t70 = -qn1
-    t71 = -qn2
-    t72 = -qn3
-    t73 = -qn4
-    t74 = -qn5
-    t75 = -qn6
-    t76 = qw1*(t70 + t53)**2 + qw2*(t71 + t57)**2 + qw3*(t72 + qb0_2)**2 + qw4*(t73 + t61)**2 + qw5*(t74 + t65)**2 + qw6*(t75 + t69)**2
-    t77 = xp.greater(t6, 0)
-    t78 = xp.where(t77, t53, qn1)
-    t79 = xp.where(t77, t57, qn2)
-    t80 = xp.where(t77, qb0_2, qn3)
-    t81 = xp.where(t77, t61, qn4)
-    t82 = xp.where(t77, t65, qn5)
-    t83 = xp.where(t77, t69, qn6)
-    t84 = xp.where(t77, t76, 0)
-    t85 = xp.where(xp.less(t7, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t86 = t85 + t7
-    t87 = -t85 + t7
-    t88 = xp.where(xp.greater_equal(t7, -2.9670597283903604) & xp.less_equal(t7, 2.9670597283903604), t7, xp.where(xp.greater_equal(t86, -2.9670597283903604) & xp.less_equal(t86, 2.9670597283903604), t86, xp.where(xp.greater_equal(t87, -2.9670597283903604) & xp.less_equal(t87, 2.9670597283903604), t87, qb1_0)))
-    t89 = xp.where(xp.less(t8, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t90 = t89 + t8
-    t91 = -t89 + t8
-    t92 = xp.where(xp.greater_equal(t8, -2.9670597283903604) & xp.less_equal(t8, 2.9670597283903604), t8, xp.where(xp.greater_equal(t90, -2.9670597283903604) & xp.less_equal(t90, 2.9670597283903604), t90, xp.where(xp.greater_equal(t91, -2.9670597283903604) & xp.less_equal(t91, 2.9670597283903604), t91, qb1_1)))
-    t93 = xp.where(xp.less(t9, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t94 = t93 + t9
-    t95 = -t93 + t9
-    t96 = xp.where(xp.greater_equal(t9, -2.9670597283903604) & xp.less_equal(t9, 2.9670597283903604), t9, xp.where(xp.greater_equal(t94, -2.9670597283903604) & xp.less_equal(t94, 2.9670597283903604), t94, xp.where(xp.greater_equal(t95, -2.9670597283903604) & xp.less_equal(t95, 2.9670597283903604), t95, qb1_3)))
-    t97 = xp.where(xp.less(t10, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t98 = t97 + t10
-    t99 = -t97 + t10
-    t100 = xp.where(xp.greater_equal(t10, -1.5707963267948966) & xp.less_equal(t10, 1.5707963267948966), t10, xp.where(xp.greater_equal(t98, -1.5707963267948966) & xp.less_equal(t98, 1.5707963267948966), t98, xp.where(xp.greater_equal(t99, -1.5707963267948966) & xp.less_equal(t99, 1.5707963267948966), t99, qb1_4)))
-    t101 = xp.where(xp.less(t11, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t102 = t101 + t11
-    t103 = -t101 + t11
-    t104 = xp.where(xp.greater_equal(t11, -2.9670597283903604) & xp.less_equal(t11, 2.9670597283903604), t11, xp.where(xp.greater_equal(t102, -2.9670597283903604) & xp.less_equal(t102, 2.9670597283903604), t102, xp.where(xp.greater_equal(t103, -2.9670597283903604) & xp.less_equal(t103, 2.9670597283903604), t103, qb1_5)))
-    t105 = qw1*(t70 + t88)**2 + qw2*(t71 + t92)**2 + qw3*(t72 + qb1_2)**2 + qw4*(t73 + t96)**2 + qw5*(t74 + t100)**2 + qw6*(t75 + t104)**2
-    t106 = xp.greater(t12, 0)
-    t107 = xp.where(t106 & (xp.less(t6, 1) | xp.less(t105, t84)), xp.asarray(1, dtype=dtype), 0)
-    t108 = xp.where(t106, 1, t6)
-    t109 = xp.greater(t107, 0)
-    t110 = xp.where(t109, t88, t78)
-    t111 = xp.where(t109, t92, t79)
-    t112 = xp.where(t109, qb1_2, t80)
-    t113 = xp.where(t109, t96, t81)
-    t114 = xp.where(t109, t100, t82)
-    t115 = xp.where(t109, t104, t83)
-    t116 = xp.where(t109, t105, t84)
-    t117 = xp.where(xp.less(t13, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t118 = t117 + t13
-    t119 = -t117 + t13
-    t120 = xp.where(xp.greater_equal(t13, -2.9670597283903604) & xp.less_equal(t13, 2.9670597283903604), t13, xp.where(xp.greater_equal(t118, -2.9670597283903604) & xp.less_equal(t118, 2.9670597283903604), t118, xp.where(xp.greater_equal(t119, -2.9670597283903604) & xp.less_equal(t119, 2.9670597283903604), t119, qb2_0)))
-    t121 = xp.where(xp.less(t14, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t122 = t121 + t14
-    t123 = -t121 + t14
-    t124 = xp.where(xp.greater_equal(t14, -2.9670597283903604) & xp.less_equal(t14, 2.9670597283903604), t14, xp.where(xp.greater_equal(t122, -2.9670597283903604) & xp.less_equal(t122, 2.9670597283903604), t122, xp.where(xp.greater_equal(t123, -2.9670597283903604) & xp.less_equal(t123, 2.9670597283903604), t123, qb2_1)))
-    t125 = xp.where(xp.less(t15, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t126 = t125 + t15
-    t127 = -t125 + t15
-    t128 = xp.where(xp.greater_equal(t15, -2.9670597283903604) & xp.less_equal(t15, 2.9670597283903604), t15, xp.where(xp.greater_equal(t126, -2.9670597283903604) & xp.less_equal(t126, 2.9670597283903604), t126, xp.where(xp.greater_equal(t127, -2.9670597283903604) & xp.less_equal(t127, 2.9670597283903604), t127, qb2_3)))
-    t129 = xp.where(xp.less(t16, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t130 = t129 + t16
-    t131 = -t129 + t16
-    t132 = xp.where(xp.greater_equal(t16, -1.5707963267948966) & xp.less_equal(t16, 1.5707963267948966), t16, xp.where(xp.greater_equal(t130, -1.5707963267948966) & xp.less_equal(t130, 1.5707963267948966), t130, xp.where(xp.greater_equal(t131, -1.5707963267948966) & xp.less_equal(t131, 1.5707963267948966), t131, qb2_4)))
-    t133 = xp.where(xp.less(t17, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t134 = t133 + t17
-    t135 = -t133 + t17
-    t136 = xp.where(xp.greater_equal(t17, -2.9670597283903604) & xp.less_equal(t17, 2.9670597283903604), t17, xp.where(xp.greater_equal(t134, -2.9670597283903604) & xp.less_equal(t134, 2.9670597283903604), t134, xp.where(xp.greater_equal(t135, -2.9670597283903604) & xp.less_equal(t135, 2.9670597283903604), t135, qb2_5)))
-    t137 = qw1*(t70 + t120)**2 + qw2*(t71 + t124)**2 + qw3*(t72 + qb2_2)**2 + qw4*(t73 + t128)**2 + qw5*(t74 + t132)**2 + qw6*(t75 + t136)**2
-    t138 = xp.greater(t18, 0)
-    t139 = xp.where(t138 & (xp.less(t108, 1) | xp.less(t137, t116)), xp.asarray(1, dtype=dtype), 0)
-    t140 = xp.where(t138, 1, t108)
-    t141 = xp.greater(t139, 0)
-    t142 = xp.where(t141, t120, t110)
-    t143 = xp.where(t141, t124, t111)
-    t144 = xp.where(t141, qb2_2, t112)
-    t145 = xp.where(t141, t128, t113)
-    t146 = xp.where(t141, t132, t114)
-    t147 = xp.where(t141, t136, t115)
-    t148 = xp.where(t141, t137, t116)
-    t149 = xp.where(xp.less(t19, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t150 = t149 + t19
-    t151 = -t149 + t19
-    t152 = xp.where(xp.greater_equal(t19, -2.9670597283903604) & xp.less_equal(t19, 2.9670597283903604), t19, xp.where(xp.greater_equal(t150, -2.9670597283903604) & xp.less_equal(t150, 2.9670597283903604), t150, xp.where(xp.greater_equal(t151, -2.9670597283903604) & xp.less_equal(t151, 2.9670597283903604), t151, qb3_0)))
-    t153 = xp.where(xp.less(t20, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t154 = t153 + t20
-    t155 = -t153 + t20
-    t156 = xp.where(xp.greater_equal(t20, -2.9670597283903604) & xp.less_equal(t20, 2.9670597283903604), t20, xp.where(xp.greater_equal(t154, -2.9670597283903604) & xp.less_equal(t154, 2.9670597283903604), t154, xp.where(xp.greater_equal(t155, -2.9670597283903604) & xp.less_equal(t155, 2.9670597283903604), t155, qb3_1)))
-    t157 = xp.where(xp.less(t21, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t158 = t157 + t21
-    t159 = -t157 + t21
-    t160 = xp.where(xp.greater_equal(t21, -2.9670597283903604) & xp.less_equal(t21, 2.9670597283903604), t21, xp.where(xp.greater_equal(t158, -2.9670597283903604) & xp.less_equal(t158, 2.9670597283903604), t158, xp.where(xp.greater_equal(t159, -2.9670597283903604) & xp.less_equal(t159, 2.9670597283903604), t159, qb3_3)))
-    t161 = xp.where(xp.less(t22, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t162 = t161 + t22
-    t163 = -t161 + t22
-    t164 = xp.where(xp.greater_equal(t22, -1.5707963267948966) & xp.less_equal(t22, 1.5707963267948966), t22, xp.where(xp.greater_equal(t162, -1.5707963267948966) & xp.less_equal(t162, 1.5707963267948966), t162, xp.where(xp.greater_equal(t163, -1.5707963267948966) & xp.less_equal(t163, 1.5707963267948966), t163, qb3_4)))
-    t165 = xp.where(xp.less(t23, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t166 = t165 + t23
-    t167 = -t165 + t23
-    t168 = xp.where(xp.greater_equal(t23, -2.9670597283903604) & xp.less_equal(t23, 2.9670597283903604), t23, xp.where(xp.greater_equal(t166, -2.9670597283903604) & xp.less_equal(t166, 2.9670597283903604), t166, xp.where(xp.greater_equal(t167, -2.9670597283903604) & xp.less_equal(t167, 2.9670597283903604), t167, qb3_5)))
-    t169 = qw1*(t70 + t152)**2 + qw2*(t71 + t156)**2 + qw3*(t72 + qb3_2)**2 + qw4*(t73 + t160)**2 + qw5*(t74 + t164)**2 + qw6*(t75 + t168)**2
-    t170 = xp.greater(t24, 0)
-    t171 = xp.where(t170 & (xp.less(t140, 1) | xp.less(t169, t148)), xp.asarray(1, dtype=dtype), 0)
-    t172 = xp.where(t170, 1, t140)
-    t173 = xp.greater(t171, 0)
-    t174 = xp.where(t173, t152, t142)
-    t175 = xp.where(t173, t156, t143)
-    t176 = xp.where(t173, qb3_2, t144)
-    t177 = xp.where(t173, t160, t145)
-    t178 = xp.where(t173, t164, t146)
-    t179 = xp.where(t173, t168, t147)
-    t180 = xp.where(t173, t169, t148)
-    t181 = xp.where(xp.less(t25, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t182 = t181 + t25
-    t183 = -t181 + t25
-    t184 = xp.where(xp.greater_equal(t25, -2.9670597283903604) & xp.less_equal(t25, 2.9670597283903604), t25, xp.where(xp.greater_equal(t182, -2.9670597283903604) & xp.less_equal(t182, 2.9670597283903604), t182, xp.where(xp.greater_equal(t183, -2.9670597283903604) & xp.less_equal(t183, 2.9670597283903604), t183, qb4_0)))
-    t185 = xp.where(xp.less(t26, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t186 = t185 + t26
-    t187 = -t185 + t26
-    t188 = xp.where(xp.greater_equal(t26, -2.9670597283903604) & xp.less_equal(t26, 2.9670597283903604), t26, xp.where(xp.greater_equal(t186, -2.9670597283903604) & xp.less_equal(t186, 2.9670597283903604), t186, xp.where(xp.greater_equal(t187, -2.9670597283903604) & xp.less_equal(t187, 2.9670597283903604), t187, qb4_1)))
-    t189 = xp.where(xp.less(t27, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t190 = t189 + t27
-    t191 = -t189 + t27
-    t192 = xp.where(xp.greater_equal(t27, -2.9670597283903604) & xp.less_equal(t27, 2.9670597283903604), t27, xp.where(xp.greater_equal(t190, -2.9670597283903604) & xp.less_equal(t190, 2.9670597283903604), t190, xp.where(xp.greater_equal(t191, -2.9670597283903604) & xp.less_equal(t191, 2.9670597283903604), t191, qb4_3)))
-    t193 = xp.where(xp.less(t28, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t194 = t193 + t28
-    t195 = -t193 + t28
-    t196 = xp.where(xp.greater_equal(t28, -1.5707963267948966) & xp.less_equal(t28, 1.5707963267948966), t28, xp.where(xp.greater_equal(t194, -1.5707963267948966) & xp.less_equal(t194, 1.5707963267948966), t194, xp.where(xp.greater_equal(t195, -1.5707963267948966) & xp.less_equal(t195, 1.5707963267948966), t195, qb4_4)))
-    t197 = xp.where(xp.less(t29, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t198 = t197 + t29
-    t199 = -t197 + t29
-    t200 = xp.where(xp.greater_equal(t29, -2.9670597283903604) & xp.less_equal(t29, 2.9670597283903604), t29, xp.where(xp.greater_equal(t198, -2.9670597283903604) & xp.less_equal(t198, 2.9670597283903604), t198, xp.where(xp.greater_equal(t199, -2.9670597283903604) & xp.less_equal(t199, 2.9670597283903604), t199, qb4_5)))
-    t201 = qw1*(t70 + t184)**2 + qw2*(t71 + t188)**2 + qw3*(t72 + qb4_2)**2 + qw4*(t73 + t192)**2 + qw5*(t74 + t196)**2 + qw6*(t75 + t200)**2
-    t202 = xp.greater(t30, 0)
-    t203 = xp.where(t202 & (xp.less(t172, 1) | xp.less(t201, t180)), xp.asarray(1, dtype=dtype), 0)
-    t204 = xp.where(t202, 1, t172)
-    t205 = xp.greater(t203, 0)
-    t206 = xp.where(t205, t184, t174)
-    t207 = xp.where(t205, t188, t175)
-    t208 = xp.where(t205, qb4_2, t176)
-    t209 = xp.where(t205, t192, t177)
-    t210 = xp.where(t205, t196, t178)
-    t211 = xp.where(t205, t200, t179)
-    t212 = xp.where(t205, t201, t180)
-    t213 = xp.where(xp.less(t31, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t214 = t213 + t31
-    t215 = -t213 + t31
-    t216 = xp.where(xp.greater_equal(t31, -2.9670597283903604) & xp.less_equal(t31, 2.9670597283903604), t31, xp.where(xp.greater_equal(t214, -2.9670597283903604) & xp.less_equal(t214, 2.9670597283903604), t214, xp.where(xp.greater_equal(t215, -2.9670597283903604) & xp.less_equal(t215, 2.9670597283903604), t215, qb5_0)))
-    t217 = xp.where(xp.less(t32, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t218 = t217 + t32
-    t219 = -t217 + t32
-    t220 = xp.where(xp.greater_equal(t32, -2.9670597283903604) & xp.less_equal(t32, 2.9670597283903604), t32, xp.where(xp.greater_equal(t218, -2.9670597283903604) & xp.less_equal(t218, 2.9670597283903604), t218, xp.where(xp.greater_equal(t219, -2.9670597283903604) & xp.less_equal(t219, 2.9670597283903604), t219, qb5_1)))
-    t221 = xp.where(xp.less(t33, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t222 = t221 + t33
-    t223 = -t221 + t33
-    t224 = xp.where(xp.greater_equal(t33, -2.9670597283903604) & xp.less_equal(t33, 2.9670597283903604), t33, xp.where(xp.greater_equal(t222, -2.9670597283903604) & xp.less_equal(t222, 2.9670597283903604), t222, xp.where(xp.greater_equal(t223, -2.9670597283903604) & xp.less_equal(t223, 2.9670597283903604), t223, qb5_3)))
-    t225 = xp.where(xp.less(t34, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t226 = t225 + t34
-    t227 = -t225 + t34
-    t228 = xp.where(xp.greater_equal(t34, -1.5707963267948966) & xp.less_equal(t34, 1.5707963267948966), t34, xp.where(xp.greater_equal(t226, -1.5707963267948966) & xp.less_equal(t226, 1.5707963267948966), t226, xp.where(xp.greater_equal(t227, -1.5707963267948966) & xp.less_equal(t227, 1.5707963267948966), t227, qb5_4)))
-    t229 = xp.where(xp.less(t35, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t230 = t229 + t35
-    t231 = -t229 + t35
-    t232 = xp.where(xp.greater_equal(t35, -2.9670597283903604) & xp.less_equal(t35, 2.9670597283903604), t35, xp.where(xp.greater_equal(t230, -2.9670597283903604) & xp.less_equal(t230, 2.9670597283903604), t230, xp.where(xp.greater_equal(t231, -2.9670597283903604) & xp.less_equal(t231, 2.9670597283903604), t231, qb5_5)))
-    t233 = qw1*(t70 + t216)**2 + qw2*(t71 + t220)**2 + qw3*(t72 + qb5_2)**2 + qw4*(t73 + t224)**2 + qw5*(t74 + t228)**2 + qw6*(t75 + t232)**2
-    t234 = xp.greater(t36, 0)
-    t235 = xp.where(t234 & (xp.less(t204, 1) | xp.less(t233, t212)), xp.asarray(1, dtype=dtype), 0)
-    t236 = xp.where(t234, 1, t204)
-    t237 = xp.greater(t235, 0)
-    t238 = xp.where(t237, t216, t206)
-    t239 = xp.where(t237, t220, t207)
-    t240 = xp.where(t237, qb5_2, t208)
-    t241 = xp.where(t237, t224, t209)
-    t242 = xp.where(t237, t228, t210)
-    t243 = xp.where(t237, t232, t211)
-    t244 = xp.where(t237, t233, t212)
-    t245 = xp.where(xp.less(t37, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t246 = t245 + t37
-    t247 = -t245 + t37
-    t248 = xp.where(xp.greater_equal(t37, -2.9670597283903604) & xp.less_equal(t37, 2.9670597283903604), t37, xp.where(xp.greater_equal(t246, -2.9670597283903604) & xp.less_equal(t246, 2.9670597283903604), t246, xp.where(xp.greater_equal(t247, -2.9670597283903604) & xp.less_equal(t247, 2.9670597283903604), t247, qb6_0)))
-    t249 = xp.where(xp.less(t38, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t250 = t249 + t38
-    t251 = -t249 + t38
-    t252 = xp.where(xp.greater_equal(t38, -2.9670597283903604) & xp.less_equal(t38, 2.9670597283903604), t38, xp.where(xp.greater_equal(t250, -2.9670597283903604) & xp.less_equal(t250, 2.9670597283903604), t250, xp.where(xp.greater_equal(t251, -2.9670597283903604) & xp.less_equal(t251, 2.9670597283903604), t251, qb6_1)))
-    t253 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t254 = t253 + t39
-    t255 = -t253 + t39
-    t256 = xp.where(xp.greater_equal(t39, -2.9670597283903604) & xp.less_equal(t39, 2.9670597283903604), t39, xp.where(xp.greater_equal(t254, -2.9670597283903604) & xp.less_equal(t254, 2.9670597283903604), t254, xp.where(xp.greater_equal(t255, -2.9670597283903604) & xp.less_equal(t255, 2.9670597283903604), t255, qb6_3)))
-    t257 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t258 = t257 + t40
-    t259 = -t257 + t40
-    t260 = xp.where(xp.greater_equal(t40, -1.5707963267948966) & xp.less_equal(t40, 1.5707963267948966), t40, xp.where(xp.greater_equal(t258, -1.5707963267948966) & xp.less_equal(t258, 1.5707963267948966), t258, xp.where(xp.greater_equal(t259, -1.5707963267948966) & xp.less_equal(t259, 1.5707963267948966), t259, qb6_4)))
-    t261 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t262 = t261 + t41
-    t263 = -t261 + t41
-    t264 = xp.where(xp.greater_equal(t41, -2.9670597283903604) & xp.less_equal(t41, 2.9670597283903604), t41, xp.where(xp.greater_equal(t262, -2.9670597283903604) & xp.less_equal(t262, 2.9670597283903604), t262, xp.where(xp.greater_equal(t263, -2.9670597283903604) & xp.less_equal(t263, 2.9670597283903604), t263, qb6_5)))
-    t265 = qw1*(t70 + t248)**2 + qw2*(t71 + t252)**2 + qw3*(t72 + qb6_2)**2 + qw4*(t73 + t256)**2 + qw5*(t74 + t260)**2 + qw6*(t75 + t264)**2
-    t266 = xp.greater(t42, 0)
-    t267 = xp.where(t266 & (xp.less(t236, 1) | xp.less(t265, t244)), xp.asarray(1, dtype=dtype), 0)
-    t268 = xp.where(t266, 1, t236)
-    t269 = xp.greater(t267, 0)
-    t270 = xp.where(t269, t248, t238)
-    t271 = xp.where(t269, t252, t239)
-    t272 = xp.where(t269, qb6_2, t240)
-    t273 = xp.where(t269, t256, t241)
-    t274 = xp.where(t269, t260, t242)
-    t275 = xp.where(t269, t264, t243)
-    t276 = xp.where(t269, t265, t244)
-    t277 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t278 = t277 + t43
-    t279 = -t277 + t43
-    t280 = xp.where(xp.greater_equal(t43, -2.9670597283903604) & xp.less_equal(t43, 2.9670597283903604), t43, xp.where(xp.greater_equal(t278, -2.9670597283903604) & xp.less_equal(t278, 2.9670597283903604), t278, xp.where(xp.greater_equal(t279, -2.9670597283903604) & xp.less_equal(t279, 2.9670597283903604), t279, qb7_0)))
-    t281 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t282 = t281 + t44
-    t283 = -t281 + t44
-    t284 = xp.where(xp.greater_equal(t44, -2.9670597283903604) & xp.less_equal(t44, 2.9670597283903604), t44, xp.where(xp.greater_equal(t282, -2.9670597283903604) & xp.less_equal(t282, 2.9670597283903604), t282, xp.where(xp.greater_equal(t283, -2.9670597283903604) & xp.less_equal(t283, 2.9670597283903604), t283, qb7_1)))
-    t285 = xp.where(xp.less(t45, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t286 = t285 + t45
-    t287 = -t285 + t45
-    t288 = xp.where(xp.greater_equal(t45, -2.9670597283903604) & xp.less_equal(t45, 2.9670597283903604), t45, xp.where(xp.greater_equal(t286, -2.9670597283903604) & xp.less_equal(t286, 2.9670597283903604), t286, xp.where(xp.greater_equal(t287, -2.9670597283903604) & xp.less_equal(t287, 2.9670597283903604), t287, qb7_3)))
-    t289 = xp.where(xp.less(t46, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t290 = t289 + t46
-    t291 = -t289 + t46
-    t292 = xp.where(xp.greater_equal(t46, -1.5707963267948966) & xp.less_equal(t46, 1.5707963267948966), t46, xp.where(xp.greater_equal(t290, -1.5707963267948966) & xp.less_equal(t290, 1.5707963267948966), t290, xp.where(xp.greater_equal(t291, -1.5707963267948966) & xp.less_equal(t291, 1.5707963267948966), t291, qb7_4)))
-    t293 = xp.where(xp.less(t47, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t294 = t293 + t47
-    t295 = -t293 + t47
-    t296 = xp.where(xp.greater_equal(t47, -2.9670597283903604) & xp.less_equal(t47, 2.9670597283903604), t47, xp.where(xp.greater_equal(t294, -2.9670597283903604) & xp.less_equal(t294, 2.9670597283903604), t294, xp.where(xp.greater_equal(t295, -2.9670597283903604) & xp.less_equal(t295, 2.9670597283903604), t295, qb7_5)))
-    t297 = qw1*(t70 + t280)**2 + qw2*(t71 + t284)**2 + qw3*(t72 + qb7_2)**2 + qw4*(t73 + t288)**2 + qw5*(t74 + t292)**2 + qw6*(t75 + t296)**2
-    t298 = xp.greater(t48, 0)
-    t299 = xp.where(t298 & (xp.less(t268, 1) | xp.less(t297, t276)), xp.asarray(1, dtype=dtype), 0)
-    t300 = xp.where(t298, 1, t268)
-    t301 = xp.greater(t299, 0)
-    t302 = xp.where(t301, t280, t270)
-    t303 = xp.where(t301, t284, t271)
-    t304 = xp.where(t301, qb7_2, t272)
-    t305 = xp.where(t301, t288, t273)
-    t306 = xp.where(t301, t292, t274)
-    t307 = xp.where(t301, t296, t275)
-    t308 = xp.greater(t300, 0)
-    t309 = xp.isfinite(t49)
-    t310 = t308 & t309
+    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
+    t1 = _nearer_branch(xp, 1, (qb0_0, qb0_1, qb0_2, qb0_3, qb0_4, qb0_5, xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, qn1, qn2, qn3, qn4, qn5, qn6, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
+    t2 = _nearer_branch(xp, 1, (qb1_0, qb1_1, qb1_2, qb1_3, qb1_4, qb1_5, xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t1[0], t1[1], t1[2], t1[3], t1[4], t1[5], t1[6], t1[7],))
+    t3 = _nearer_branch(xp, 1, (qb2_0, qb2_1, qb2_2, qb2_3, qb2_4, qb2_5, xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t2[0], t2[1], t2[2], t2[3], t2[4], t2[5], t2[6], t2[7],))
+    t4 = _nearer_branch(xp, 1, (qb3_0, qb3_1, qb3_2, qb3_3, qb3_4, qb3_5, xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t3[0], t3[1], t3[2], t3[3], t3[4], t3[5], t3[6], t3[7],))
+    t5 = _nearer_branch(xp, 1, (qb4_0, qb4_1, qb4_2, qb4_3, qb4_4, qb4_5, xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t4[0], t4[1], t4[2], t4[3], t4[4], t4[5], t4[6], t4[7],))
+    t6 = _nearer_branch(xp, 1, (qb5_0, qb5_1, qb5_2, qb5_3, qb5_4, qb5_5, xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t5[0], t5[1], t5[2], t5[3], t5[4], t5[5], t5[6], t5[7],))
+    t7 = _nearer_branch(xp, 1, (qb6_0, qb6_1, qb6_2, qb6_3, qb6_4, qb6_5, xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t6[0], t6[1], t6[2], t6[3], t6[4], t6[5], t6[6], t6[7],))
+    t8 = _nearer_branch(xp, 1, (qb7_0, qb7_1, qb7_2, qb7_3, qb7_4, qb7_5, xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t7[0], t7[1], t7[2], t7[3], t7[4], t7[5], t7[6], t7[7],))
+    t9 = xp.greater(t8[7], 0)
+    t10 = xp.isfinite(t0)
+    t11 = t9 & t10
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t310, t302, qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t310, t303, qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t310, t304, qn3), batch),  # 2
-        xp.broadcast_to(xp.where(t310, t305, qn4), batch),  # 3
-        xp.broadcast_to(xp.where(t310, t306, qn5), batch),  # 4
-        xp.broadcast_to(xp.where(t310, t307, qn6), batch),  # 5
+        xp.broadcast_to(xp.where(t11, t8[0], qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t11, t8[1], qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t11, t8[2], qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t11, t8[3], qn4), batch),  # 3
+        xp.broadcast_to(xp.where(t11, t8[4], qn5), batch),  # 4
+        xp.broadcast_to(xp.where(t11, t8[5], qn6), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t309), 2, xp.where(t308, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t10), 2, xp.where(t9, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

@@ -82,6 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -335,6 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi6_rows(xp, count, state):
     """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2 + w4**2 + w5**2
@@ -896,6 +898,255 @@ def _jacobi6_rows(xp, count, state):
             t489,
             t493,
             t497,
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _symmetric_solve6(xp, count, state):
+    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w1**2
+        t1 = w2**2
+        t2 = w3**2
+        t3 = w4**2
+        t4 = w5**2
+        t5 = w0**2
+        t6 = xp.sqrt(t5 + 2*t0 + 2*t1 + 2*w7**2 + 2*t2 + 2*w8**2 + 2*w12**2 + 2*t3 + 2*w9**2 + 2*w13**2 + 2*w16**2 + 2*t4 + 2*w10**2 + 2*w14**2 + 2*w17**2 + 2*w19**2 + w6**2 + w11**2 + w15**2 + w18**2 + w20**2)
+        t7 = xp.sqrt(t0 + t1 + t2 + t3 + t4 + t5)
+        t8 = t7*xp.where(xp.greater_equal(w0, 0), xp.asarray(1, dtype=dtype), -1)
+        t9 = xp.greater(t7, 0)
+        t10 = xp.where(t9, 1/(w0 + t8), 0)
+        t11 = xp.where(t9, 1 + xp.abs(w0)/t7, 0)
+        t12 = w1*t10
+        t13 = w2*t10
+        t14 = w3*t10
+        t15 = w4*t10
+        t16 = w5*t10
+        t17 = t11*(w1 + t12*w6 + t13*w7 + t14*w8 + t15*w9 + t16*w10)
+        t18 = -t17 + w1
+        t19 = w6 - t12*t17
+        t20 = w7 - t13*t17
+        t21 = w8 - t14*t17
+        t22 = w9 - t15*t17
+        t23 = w10 - t16*t17
+        t24 = t11*(w2 + t12*w7 + t13*w11 + t14*w12 + t15*w13 + t16*w14)
+        t25 = -t24 + w2
+        t26 = w7 - t12*t24
+        t27 = w11 - t13*t24
+        t28 = w12 - t14*t24
+        t29 = w13 - t15*t24
+        t30 = w14 - t16*t24
+        t31 = t11*(w3 + t12*w8 + t13*w12 + t14*w15 + t15*w16 + t16*w17)
+        t32 = -t31 + w3
+        t33 = w8 - t12*t31
+        t34 = w12 - t13*t31
+        t35 = w15 - t14*t31
+        t36 = w16 - t15*t31
+        t37 = w17 - t16*t31
+        t38 = t11*(w4 + t12*w9 + t13*w13 + t14*w16 + t15*w18 + t16*w19)
+        t39 = -t38 + w4
+        t40 = w9 - t12*t38
+        t41 = w13 - t13*t38
+        t42 = w16 - t14*t38
+        t43 = w18 - t15*t38
+        t44 = w19 - t16*t38
+        t45 = t11*(w5 + t12*w10 + t13*w14 + t14*w17 + t15*w19 + t16*w20)
+        t46 = -t45 + w5
+        t47 = w10 - t12*t45
+        t48 = w14 - t13*t45
+        t49 = w17 - t14*t45
+        t50 = w19 - t15*t45
+        t51 = w20 - t16*t45
+        t52 = t11*(w21 + t12*w22 + t13*w23 + t14*w24 + t15*w25 + t16*w26)
+        t53 = -t52 + w21
+        t54 = w22 - t12*t52
+        t55 = w23 - t13*t52
+        t56 = w24 - t14*t52
+        t57 = w25 - t15*t52
+        t58 = w26 - t16*t52
+        t59 = xp.sqrt(t19**2 + t20**2 + t21**2 + t22**2 + t23**2)
+        t60 = t59*xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)
+        t61 = xp.greater(t59, 0)
+        t62 = xp.where(t61, 1/(t19 + t60), 0)
+        t63 = xp.where(t61, 1 + xp.abs(t19)/t59, 0)
+        t64 = t20*t62
+        t65 = t21*t62
+        t66 = t22*t62
+        t67 = t23*t62
+        t68 = t63*(t26 + t64*t27 + t65*t28 + t66*t29 + t67*t30)
+        t69 = -t68 + t26
+        t70 = t27 - t64*t68
+        t71 = t28 - t65*t68
+        t72 = t29 - t66*t68
+        t73 = t30 - t67*t68
+        t74 = t63*(t33 + t64*t34 + t65*t35 + t66*t36 + t67*t37)
+        t75 = -t74 + t33
+        t76 = t34 - t64*t74
+        t77 = t35 - t65*t74
+        t78 = t36 - t66*t74
+        t79 = t37 - t67*t74
+        t80 = t63*(t40 + t64*t41 + t65*t42 + t66*t43 + t67*t44)
+        t81 = -t80 + t40
+        t82 = t41 - t64*t80
+        t83 = t42 - t65*t80
+        t84 = t43 - t66*t80
+        t85 = t44 - t67*t80
+        t86 = t63*(t47 + t64*t48 + t65*t49 + t66*t50 + t67*t51)
+        t87 = -t86 + t47
+        t88 = t48 - t64*t86
+        t89 = t49 - t65*t86
+        t90 = t50 - t66*t86
+        t91 = t51 - t67*t86
+        t92 = t63*(t54 + t64*t55 + t65*t56 + t66*t57 + t67*t58)
+        t93 = -t92 + t54
+        t94 = t55 - t64*t92
+        t95 = t56 - t65*t92
+        t96 = t57 - t66*t92
+        t97 = t58 - t67*t92
+        t98 = xp.sqrt(t70**2 + t71**2 + t72**2 + t73**2)
+        t99 = t98*xp.where(xp.greater_equal(t70, 0), xp.asarray(1, dtype=dtype), -1)
+        t100 = xp.greater(t98, 0)
+        t101 = xp.where(t100, 1/(t70 + t99), 0)
+        t102 = xp.where(t100, 1 + xp.abs(t70)/t98, 0)
+        t103 = t71*t101
+        t104 = t72*t101
+        t105 = t73*t101
+        t106 = t102*(t76 + t103*t77 + t104*t78 + t105*t79)
+        t107 = -t106 + t76
+        t108 = t77 - t103*t106
+        t109 = t78 - t104*t106
+        t110 = t79 - t105*t106
+        t111 = t102*(t82 + t103*t83 + t104*t84 + t105*t85)
+        t112 = -t111 + t82
+        t113 = t83 - t103*t111
+        t114 = t84 - t104*t111
+        t115 = t85 - t105*t111
+        t116 = t102*(t88 + t103*t89 + t104*t90 + t105*t91)
+        t117 = -t116 + t88
+        t118 = t89 - t103*t116
+        t119 = t90 - t104*t116
+        t120 = t91 - t105*t116
+        t121 = t102*(t94 + t103*t95 + t104*t96 + t105*t97)
+        t122 = -t121 + t94
+        t123 = t95 - t103*t121
+        t124 = t96 - t104*t121
+        t125 = t97 - t105*t121
+        t126 = xp.sqrt(t108**2 + t109**2 + t110**2)
+        t127 = t126*xp.where(xp.greater_equal(t108, 0), xp.asarray(1, dtype=dtype), -1)
+        t128 = xp.greater(t126, 0)
+        t129 = xp.where(t128, 1/(t108 + t127), 0)
+        t130 = xp.where(t128, 1 + xp.abs(t108)/t126, 0)
+        t131 = t109*t129
+        t132 = t110*t129
+        t133 = t130*(t113 + t131*t114 + t132*t115)
+        t134 = -t133 + t113
+        t135 = t114 - t131*t133
+        t136 = t115 - t132*t133
+        t137 = t130*(t118 + t131*t119 + t132*t120)
+        t138 = -t137 + t118
+        t139 = t119 - t131*t137
+        t140 = t120 - t132*t137
+        t141 = t130*(t123 + t131*t124 + t132*t125)
+        t142 = -t141 + t123
+        t143 = t124 - t131*t141
+        t144 = t125 - t132*t141
+        t145 = xp.sqrt(t135**2 + t136**2)
+        t146 = t145*xp.where(xp.greater_equal(t135, 0), xp.asarray(1, dtype=dtype), -1)
+        t147 = xp.greater(t145, 0)
+        t148 = xp.where(t147, 1/(t135 + t146), 0)
+        t149 = xp.where(t147, 1 + xp.abs(t135)/t145, 0)
+        t150 = t136*t148
+        t151 = t149*(t139 + t150*t140)
+        t152 = -t151 + t139
+        t153 = t140 - t150*t151
+        t154 = t149*(t143 + t150*t144)
+        t155 = -t154 + t143
+        t156 = t144 - t150*t154
+        t157 = xp.abs(t153)
+        t158 = t157*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
+        t159 = xp.where(xp.greater(t157, 0), xp.asarray(2, dtype=dtype), 0)
+        t160 = t156 - t156*t159
+        t161 = xp.where(xp.not_equal(t158, 0), -t160/t158, 0)
+        t162 = xp.where(xp.not_equal(t146, 0), -(t155 - t152*t161)/t146, 0)
+        t163 = xp.where(xp.not_equal(t127, 0), -(-(t134*t162 + t138*t161) + t142)/t127, 0)
+        t164 = xp.where(xp.not_equal(t99, 0), -(-(t107*t163 + t112*t162 + t117*t161) + t122)/t99, 0)
+        t165 = xp.where(xp.not_equal(t60, 0), -(-(t69*t164 + t75*t163 + t81*t162 + t87*t161) + t93)/t60, 0)
+        t166 = xp.where(xp.not_equal(t8, 0), -(-(t18*t165 + t25*t164 + t32*t163 + t39*t162 + t46*t161) + t53)/t8, 0)
+        t167 = 1e-12*t6
+        state = (
+            t166,
+            t165,
+            t164,
+            t163,
+            t162,
+            t161,
+            xp.where(xp.less_equal(t7, t167) | xp.less_equal(t59, t167) | xp.less_equal(t98, t167) | xp.less_equal(t126, t167) | xp.less_equal(t145, t167) | xp.less_equal(t157, t167), xp.asarray(1, dtype=dtype), 0),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _nearer_branch(xp, count, state):
+    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 114 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w7))
+        t1 = w1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w1 + w8))
+        t2 = w2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w2 + w9))
+        t3 = w3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w3 + w10))
+        t4 = w4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w4 + w11))
+        t5 = w5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w5 + w12))
+        t6 = xp.where(xp.less(t0, w7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t7 = t6 + t0
+        t8 = -t6 + t0
+        t9 = xp.where(xp.greater_equal(t0, -6.283185307179586) & xp.less_equal(t0, 6.283185307179586), t0, xp.where(xp.greater_equal(t7, -6.283185307179586) & xp.less_equal(t7, 6.283185307179586), t7, xp.where(xp.greater_equal(t8, -6.283185307179586) & xp.less_equal(t8, 6.283185307179586), t8, w0)))
+        t10 = xp.where(xp.less(t1, w8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t11 = t10 + t1
+        t12 = -t10 + t1
+        t13 = xp.where(xp.greater_equal(t1, -6.283185307179586) & xp.less_equal(t1, 6.283185307179586), t1, xp.where(xp.greater_equal(t11, -6.283185307179586) & xp.less_equal(t11, 6.283185307179586), t11, xp.where(xp.greater_equal(t12, -6.283185307179586) & xp.less_equal(t12, 6.283185307179586), t12, w1)))
+        t14 = xp.where(xp.less(t2, w9), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t15 = t14 + t2
+        t16 = -t14 + t2
+        t17 = xp.where(xp.greater_equal(t2, -6.283185307179586) & xp.less_equal(t2, 6.283185307179586), t2, xp.where(xp.greater_equal(t15, -6.283185307179586) & xp.less_equal(t15, 6.283185307179586), t15, xp.where(xp.greater_equal(t16, -6.283185307179586) & xp.less_equal(t16, 6.283185307179586), t16, w2)))
+        t18 = xp.where(xp.less(t3, w10), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t19 = t18 + t3
+        t20 = -t18 + t3
+        t21 = xp.where(xp.greater_equal(t3, -6.283185307179586) & xp.less_equal(t3, 6.283185307179586), t3, xp.where(xp.greater_equal(t19, -6.283185307179586) & xp.less_equal(t19, 6.283185307179586), t19, xp.where(xp.greater_equal(t20, -6.283185307179586) & xp.less_equal(t20, 6.283185307179586), t20, w3)))
+        t22 = xp.where(xp.less(t4, w11), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t23 = t22 + t4
+        t24 = -t22 + t4
+        t25 = xp.where(xp.greater_equal(t4, -6.283185307179586) & xp.less_equal(t4, 6.283185307179586), t4, xp.where(xp.greater_equal(t23, -6.283185307179586) & xp.less_equal(t23, 6.283185307179586), t23, xp.where(xp.greater_equal(t24, -6.283185307179586) & xp.less_equal(t24, 6.283185307179586), t24, w4)))
+        t26 = xp.where(xp.less(t5, w12), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t27 = t26 + t5
+        t28 = -t26 + t5
+        t29 = xp.where(xp.greater_equal(t5, -6.283185307179586) & xp.less_equal(t5, 6.283185307179586), t5, xp.where(xp.greater_equal(t27, -6.283185307179586) & xp.less_equal(t27, 6.283185307179586), t27, xp.where(xp.greater_equal(t28, -6.283185307179586) & xp.less_equal(t28, 6.283185307179586), t28, w5)))
+        t30 = w13*(-w7 + t9)**2 + w14*(-w8 + t13)**2 + w15*(-w9 + t17)**2 + w16*(-w10 + t21)**2 + w17*(-w11 + t25)**2 + w18*(-w12 + t29)**2
+        t31 = xp.greater(w6, 0)
+        t32 = xp.where(t31 & (xp.less(w26, 1) | xp.less(t30, w25)), xp.asarray(1, dtype=dtype), 0)
+        t33 = xp.where(t31, 1, w26)
+        t34 = xp.greater(t32, 0)
+        t35 = xp.where(t34, t9, w19)
+        t36 = xp.where(t34, t13, w20)
+        t37 = xp.where(t34, t17, w21)
+        t38 = xp.where(t34, t21, w22)
+        t39 = xp.where(t34, t25, w23)
+        t40 = xp.where(t34, t29, w24)
+        t41 = xp.where(t34, t30, w25)
+        state = (
+            t35,
+            t36,
+            t37,
+            t38,
+            t39,
+            t40,
+            t41,
+            t33,
         )
     return state
 
@@ -3480,7 +3731,7 @@ def condition_number(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1274 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1278 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -3547,399 +3798,229 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t35 = s234**2
     t36 = t1**2 + 3*t31 + t33*t35
     t37 = t2**2 + 3*t33 + t31*t35
-    t38 = c234**2
-    t39 = 1 + t38 + s5**2*t35
-    t40 = t22**2
-    t41 = t23**2
-    t42 = t40 + t41
-    t43 = xp.sqrt(1 + t42)
-    t44 = xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)*t43
-    t45 = t24**2
-    t46 = t10**2
-    t47 = t45 + t46 + t20**2 + t9**2
-    t48 = t14**2
-    t49 = t13**2
-    t50 = t12**2
-    t51 = t26**2 + t33*t48 + t33*t49 + t33*t50
-    t52 = t41 + t51
-    t53 = t29**2 + t31*t48 + t31*t49 + t31*t50
-    t54 = xp.sqrt(t36 + t37 + t39 + t42 + t47 + t51 + t53)
-    t55 = t40 + t53
-    t56 = c1*s1
-    t57 = t50*t56 - t22*t23 + t26*t29 + t48*t56 + t49*t56
-    t58 = c1*t24
-    t59 = c1*t20
-    t60 = c1*t9
-    t61 = t13*t59 + t26*t10 + t14*t58 + t12*t60
-    t62 = t58 + t59 + t60 - t6*t10
-    t63 = c1*t14
-    t64 = c1*t13
-    t65 = s1*t28 + s1*t63 + s1*t64
-    t66 = t65 + t3*t26
-    t67 = t65 - t6*t29
-    t68 = s1*t24
-    t69 = s1*t20
-    t70 = s1*t9
-    t71 = t29*t10 + t14*t68 + t13*t69 + t12*t70
-    t72 = t68 + t69 + t70 + t3*t10
-    t73 = 3*s1
-    t74 = t1*t2 + c1*t73 - t35*t56
-    t75 = t57**2
-    t76 = t61**2
-    t77 = t66**2
-    t78 = t34**2
-    t79 = t27**2
-    t80 = damping**2
-    t81 = t80 + t52
-    t82 = t81**2
-    t83 = xp.sqrt(t75 + t76 + t77 + t78 + t79 + t82)
-    t84 = t83*xp.where(xp.greater_equal(t81, 0), xp.asarray(1, dtype=dtype), -1)
-    t85 = t80 + t55
-    t86 = t47 + t80
-    t87 = t36 + t80
-    t88 = t37 + t80
-    t89 = t39 + t80
-    t90 = xp.sqrt(2*t75 + 2*t76 + 2*t71**2 + 2*t77 + 2*t32**2 + 2*t72**2 + 2*t78 + 2*t67**2 + 2*t62**2 + 2*t74**2 + 2*t79 + 2*t30**2 + 2*t15**2 + 2*t16**2 + t82 + t85**2 + t86**2 + t87**2 + t88**2 + t89**2 + 2*t38*t46)
-    t91 = xp.greater(t83, 0)
-    t92 = xp.where(t91, 1/(t81 + t84), 0)
-    t93 = xp.where(t91, 1 + xp.abs(t81)/t83, 0)
-    t94 = t57*t92
-    t95 = t61*t92
-    t96 = t66*t92
-    t97 = t34*t92
-    t98 = t27*t92
-    t99 = t93*(t57 + t85*t94 + t95*t71 + t96*t32 + t97*t67 - t98*t30)
-    t100 = -t99 + t57
-    t101 = t85 - t94*t99
-    t102 = t71 - t95*t99
-    t103 = t32 - t96*t99
-    t104 = -t67 + t97*t99
-    t105 = t30 + t98*t99
-    t106 = t93*(t66 + t94*t32 + t95*t72 + t87*t96 + t97*t74 + t98*t15)
-    t107 = -t106 + t66
-    t108 = t32 - t94*t106
-    t109 = t72 - t95*t106
-    t110 = t87 - t96*t106
-    t111 = -t74 + t97*t106
-    t112 = -t15 + t98*t106
-    t113 = -t93*(t34 + t94*t67 + t95*t62 + t96*t74 + t88*t97 + t98*t16)
-    t114 = t34 + t113
-    t115 = t67 + t94*t113
-    t116 = t62 + t95*t113
-    t117 = t74 + t96*t113
-    t118 = t88 + t97*t113
-    t119 = t16 + t98*t113
-    t120 = t93*(mu_dot0 + t94*mu_dot1 + t95*mu_dot2 + t96*mu_dot3 - t97*mu_dot4 - t98*mu_dot5)
-    t121 = -t120 + mu_dot0
-    t122 = mu_dot1 - t94*t120
-    t123 = mu_dot2 - t95*t120
-    t124 = mu_dot3 - t96*t120
-    t125 = mu_dot4 + t97*t120
-    t126 = mu_dot5 + t98*t120
-    t127 = xp.sqrt(t101**2 + t102**2 + t103**2 + t104**2 + t105**2)
-    t128 = t127*xp.where(xp.greater_equal(t101, 0), xp.asarray(1, dtype=dtype), -1)
-    t129 = c234*t10
-    t130 = t93*(t61 + t94*t71 + t86*t95 + t96*t72 + t97*t62 + t98*t129)
-    t131 = -t130 + t61
-    t132 = t71 - t94*t130
-    t133 = t86 - t95*t130
-    t134 = t72 - t96*t130
-    t135 = -t62 + t97*t130
-    t136 = -t129 + t98*t130
-    t137 = -t93*(t27 - t94*t30 + t95*t129 + t96*t15 + t97*t16 + t89*t98)
-    t138 = t27 + t137
-    t139 = t30 - t94*t137
-    t140 = t129 + t95*t137
-    t141 = t15 + t96*t137
-    t142 = t16 + t97*t137
-    t143 = t89 + t98*t137
-    t144 = xp.greater(t127, 0)
-    t145 = xp.where(t144, 1/(t101 + t128), 0)
-    t146 = xp.where(t144, 1 + xp.abs(t101)/t127, 0)
-    t147 = t102*t145
-    t148 = t103*t145
-    t149 = t104*t145
-    t150 = t105*t145
-    t151 = t146*(t132 + t147*t133 + t148*t134 + t149*t135 + t150*t136)
-    t152 = -t151 + t132
-    t153 = t133 - t147*t151
-    t154 = t134 - t148*t151
-    t155 = t135 - t149*t151
-    t156 = t136 - t150*t151
-    t157 = t146*(t108 + t147*t109 + t148*t110 + t149*t111 + t150*t112)
-    t158 = -t157 + t108
-    t159 = t109 - t147*t157
-    t160 = t110 - t148*t157
-    t161 = t111 - t149*t157
-    t162 = t112 - t150*t157
-    t163 = -t146*(t115 + t147*t116 + t148*t117 - t149*t118 - t150*t119)
-    t164 = t115 + t163
-    t165 = t116 + t147*t163
-    t166 = t117 + t148*t163
-    t167 = t118 - t149*t163
-    t168 = t119 - t150*t163
-    t169 = t146*(t139 - t147*t140 - t148*t141 + t149*t142 + t150*t143)
-    t170 = -t169 + t139
-    t171 = t140 + t147*t169
-    t172 = t141 + t148*t169
-    t173 = t142 - t149*t169
-    t174 = t143 - t150*t169
-    t175 = t146*(t122 + t147*t123 + t148*t124 + t149*t125 + t150*t126)
-    t176 = -t175 + t122
-    t177 = t123 - t147*t175
-    t178 = t124 - t148*t175
-    t179 = t125 - t149*t175
-    t180 = t126 - t150*t175
-    t181 = xp.sqrt(t153**2 + t154**2 + t155**2 + t156**2)
-    t182 = t181*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
-    t183 = xp.greater(t181, 0)
-    t184 = xp.where(t183, 1/(t153 + t182), 0)
-    t185 = xp.where(t183, 1 + xp.abs(t153)/t181, 0)
-    t186 = t154*t184
-    t187 = t155*t184
-    t188 = t156*t184
-    t189 = t185*(t159 + t186*t160 + t187*t161 + t188*t162)
-    t190 = -t189 + t159
-    t191 = t160 - t186*t189
-    t192 = t161 - t187*t189
-    t193 = t162 - t188*t189
-    t194 = t185*(-t165 - t186*t166 + t187*t167 + t188*t168)
-    t195 = t165 + t194
-    t196 = t166 + t186*t194
-    t197 = t167 - t187*t194
-    t198 = t168 - t188*t194
-    t199 = t185*(-t171 - t186*t172 + t187*t173 + t188*t174)
-    t200 = t171 + t199
-    t201 = t172 + t186*t199
-    t202 = t173 - t187*t199
-    t203 = t174 - t188*t199
-    t204 = t185*(t177 + t186*t178 + t187*t179 + t188*t180)
-    t205 = -t204 + t177
-    t206 = t178 - t186*t204
-    t207 = t179 - t187*t204
-    t208 = t180 - t188*t204
-    t209 = xp.sqrt(t191**2 + t192**2 + t193**2)
-    t210 = t209*xp.where(xp.greater_equal(t191, 0), xp.asarray(1, dtype=dtype), -1)
-    t211 = xp.greater(t209, 0)
-    t212 = xp.where(t211, 1/(t191 + t210), 0)
-    t213 = xp.where(t211, 1 + xp.abs(t191)/t209, 0)
-    t214 = t192*t212
-    t215 = t193*t212
-    t216 = t213*(-t196 + t214*t197 + t215*t198)
-    t217 = t196 + t216
-    t218 = t197 - t214*t216
-    t219 = t198 - t215*t216
-    t220 = t213*(-t201 + t214*t202 + t215*t203)
-    t221 = t201 + t220
-    t222 = t202 - t214*t220
-    t223 = t203 - t215*t220
-    t224 = t213*(t206 + t214*t207 + t215*t208)
-    t225 = -t224 + t206
-    t226 = t207 - t214*t224
-    t227 = t208 - t215*t224
-    t228 = xp.sqrt(t218**2 + t219**2)
-    t229 = t228*xp.where(xp.greater_equal(t218, 0), xp.asarray(1, dtype=dtype), -1)
-    t230 = xp.greater(t228, 0)
-    t231 = xp.where(t230, 1/(t218 + t229), 0)
-    t232 = xp.where(t230, 1 + xp.abs(t218)/t228, 0)
-    t233 = t219*t231
-    t234 = t232*(t222 + t233*t223)
-    t235 = -t234 + t222
-    t236 = t223 - t233*t234
-    t237 = t232*(t226 + t233*t227)
-    t238 = -t237 + t226
-    t239 = t227 - t233*t237
-    t240 = xp.abs(t236)
-    t241 = t240*xp.where(xp.greater_equal(t236, 0), xp.asarray(1, dtype=dtype), -1)
-    t242 = xp.where(xp.greater(t240, 0), xp.asarray(2, dtype=dtype), 0)
-    t243 = t239 - t239*t242
-    t244 = xp.where(xp.not_equal(t241, 0), -t243/t241, 0)
-    t245 = xp.where(xp.not_equal(t229, 0), -(t238 - t235*t244)/t229, 0)
-    t246 = xp.where(xp.not_equal(t210, 0), -(t225 + t217*t245 + t221*t244)/t210, 0)
-    t247 = xp.where(xp.not_equal(t182, 0), -(t205 + t195*t245 + t200*t244 - t190*t246)/t182, 0)
-    t248 = xp.where(xp.not_equal(t128, 0), -(-(t152*t247 + t158*t246 - t164*t245 + t170*t244) + t176)/t128, 0)
-    t249 = xp.where(xp.not_equal(t84, 0), -(-(t100*t248 + t131*t247 + t107*t246 - t114*t245 - t138*t244) + t121)/t84, 0)
-    t250 = t244 - t23*t249 + t22*t248
-    t251 = t26*t249 + t29*t248 + t10*t247 - c234*t244 + t3*t246 + t6*t245
-    t252 = t2*t245 - t1*t246 + t11*t244
-    t253 = s1*t14
-    t254 = s1*t246 - c1*t245
-    t255 = t254 + t24*t247 + t63*t249 + t253*t248
-    t256 = t254 + t9*t247 + t28*t249 + t25*t248
-    t257 = s1*t13
-    t258 = t254 + t20*t247 + t64*t249 + t257*t248
-    t259 = xp.greater(t43, 0)
-    t260 = xp.where(t259, 1 + xp.abs(t23)/t43, 0)
-    t261 = -t23
-    t262 = xp.where(t259, 1/(t261 + t44), 0)
-    t263 = t22*t262
-    t264 = t260*(t63 + t253*t263)
-    t265 = -t264 + t63
-    t266 = t253 - t263*t264
-    t267 = t260*(t64 + t257*t263)
-    t268 = -t267 + t64
-    t269 = t260*(t28 + t25*t263)
-    t270 = -t269 + t28
-    t271 = t260*(t26 - c234*t262 + t29*t263)
-    t272 = -t271 + t26
-    t273 = t260*(mu_dot0 + mu_dot5*t262 + t263*mu_dot1)
-    t274 = -t273 + mu_dot0
-    t275 = t262*t267
-    t276 = t257 - t22*t275
-    t277 = t262*t269
-    t278 = t25 - t22*t277
-    t279 = t262*t271
-    t280 = t29 - t22*t279
-    t281 = c234 + t279
-    t282 = t262**2
-    t283 = xp.sqrt(t31 + t33 + t45 + t266**2 + t282*t264**2)
-    t284 = t283*xp.where(xp.greater_equal(t266, 0), xp.asarray(1, dtype=dtype), -1)
-    t285 = t11*t260
-    t286 = t282*t285
-    t287 = t22*t286
-    t288 = -t11
-    t289 = t286 + t288
-    t290 = t262*t273
-    t291 = mu_dot1 - t22*t290
-    t292 = -t290 + mu_dot5
-    t293 = xp.greater(t283, 0)
-    t294 = xp.where(t293, 1/(t266 + t284), 0)
-    t295 = xp.where(t293, 1 + xp.abs(t266)/t283, 0)
-    t296 = t24*t294
-    t297 = t264*t294
-    t298 = t282*t297
-    t299 = t31*t294 + t33*t294
-    t300 = t295*(t299 + t276 + t20*t296 + t298*t267)
-    t301 = -t300 + t276
-    t302 = t20 - t296*t300
-    t303 = t295*(t299 + t278 + t9*t296 + t298*t269)
-    t304 = -t303 + t278
-    t305 = t9 - t296*t303
-    t306 = t294*t300
-    t307 = s1 - s1*t306
-    t308 = -c1
-    t309 = t308 + c1*t306
-    t310 = t262*t264
-    t311 = -t275 + t306*t310
-    t312 = xp.sqrt(t302**2 + t307**2 + t309**2 + t311**2)
-    t313 = t312*xp.where(xp.greater_equal(t302, 0), xp.asarray(1, dtype=dtype), -1)
-    t314 = t294*t303
-    t315 = s1 - s1*t314
-    t316 = t308 + c1*t314
-    t317 = -t277 + t310*t314
-    t318 = t297*t262
-    t319 = t295*(t280 + t10*t296 + t318*t281)
-    t320 = -t319 + t280
-    t321 = t10 - t296*t319
-    t322 = t294*t319
-    t323 = t3 - s1*t322
-    t324 = t6 + c1*t322
-    t325 = -t281 + t310*t322
-    t326 = s1*t294
-    t327 = c1*t294
-    t328 = t295*(t287 + t1*t326 + t2*t327 - t318*t289)
-    t329 = -t328 + t287
-    t330 = t1 - t326*t328
-    t331 = t289 + t318*t328
-    t332 = t295*(t291 + t296*mu_dot2 + t326*mu_dot3 - t327*mu_dot4 - t318*t292)
-    t333 = -t332 + t291
-    t334 = mu_dot2 - t296*t332
-    t335 = mu_dot3 - t326*t332
-    t336 = mu_dot4 + t327*t332
-    t337 = t292 + t318*t332
-    t338 = -t2
-    t339 = t338 + t327*t328
-    t340 = 1 - c234 + q1 + q2 + q3 + q4 + q5 + t1 + q6 + t22 + t3 + t6 + t25 + t28 + t26 + t29 + t24 + t20 + t9 + t10 + t63 + t64 + t73 + t253 + t257 + t261 + t288 + t338 - 3*c1 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t341 = xp.greater(t312, 0)
-    t342 = xp.where(t341, 1/(t302 + t313), 0)
-    t343 = xp.where(t341, 1 + xp.abs(t302)/t312, 0)
-    t344 = t307*t342
-    t345 = t309*t342
-    t346 = t311*t342
-    t347 = t343*(t305 + t344*t315 + t345*t316 + t346*t317)
-    t348 = -t347 + t305
-    t349 = t315 - t344*t347
-    t350 = t316 - t345*t347
-    t351 = t317 - t346*t347
-    t352 = t343*(t321 + t344*t323 + t345*t324 + t346*t325)
-    t353 = -t352 + t321
-    t354 = t323 - t344*t352
-    t355 = t324 - t345*t352
-    t356 = t325 - t346*t352
-    t357 = t343*(t334 + t344*t335 + t345*t336 + t346*t337)
-    t358 = -t357 + t334
-    t359 = t335 - t344*t357
-    t360 = t336 - t345*t357
-    t361 = t337 - t346*t357
-    t362 = xp.sqrt(t349**2 + t350**2 + t351**2)
-    t363 = t362*xp.where(xp.greater_equal(t349, 0), xp.asarray(1, dtype=dtype), -1)
-    t364 = t296*t328
-    t365 = t343*(-t364 + t344*t330 + t345*t339 + t346*t331)
-    t366 = t364 + t365
-    t367 = t330 - t344*t365
-    t368 = t339 - t345*t365
-    t369 = t331 - t346*t365
-    t370 = xp.greater(t362, 0)
-    t371 = xp.where(t370, 1/(t349 + t363), 0)
-    t372 = xp.where(t370, 1 + xp.abs(t349)/t362, 0)
-    t373 = t350*t371
-    t374 = t351*t371
-    t375 = t372*(t354 + t373*t355 + t374*t356)
-    t376 = -t375 + t354
-    t377 = t355 - t373*t375
-    t378 = t356 - t374*t375
-    t379 = t372*(t367 + t373*t368 + t374*t369)
-    t380 = -t379 + t367
-    t381 = t368 - t373*t379
-    t382 = t369 - t374*t379
-    t383 = t372*(t359 + t373*t360 + t374*t361)
-    t384 = -t383 + t359
-    t385 = t360 - t373*t383
-    t386 = t361 - t374*t383
-    t387 = xp.sqrt(t377**2 + t378**2)
-    t388 = t387*xp.where(xp.greater_equal(t377, 0), xp.asarray(1, dtype=dtype), -1)
-    t389 = xp.greater(t387, 0)
-    t390 = xp.where(t389, 1/(t377 + t388), 0)
-    t391 = xp.where(t389, 1 + xp.abs(t377)/t387, 0)
-    t392 = t378*t390
-    t393 = t391*(t381 + t392*t382)
-    t394 = -t393 + t381
-    t395 = t382 - t392*t393
-    t396 = t391*(t385 + t392*t386)
-    t397 = -t396 + t385
-    t398 = t386 - t392*t396
-    t399 = xp.abs(t395)
-    t400 = t399*xp.where(xp.greater_equal(t395, 0), xp.asarray(1, dtype=dtype), -1)
-    t401 = xp.where(xp.greater(t399, 0), xp.asarray(2, dtype=dtype), 0)
-    t402 = t398 - t398*t401
-    t403 = xp.where(xp.not_equal(t400, 0), -t402/t400, 0)
-    t404 = xp.where(xp.not_equal(t388, 0), -(t397 - t394*t403)/t388, 0)
-    t405 = xp.where(xp.not_equal(t363, 0), -(-(t376*t404 + t380*t403) + t384)/t363, 0)
-    t406 = xp.where(xp.not_equal(t313, 0), -(-(t348*t405 + t353*t404 - t366*t403) + t358)/t313, 0)
-    t407 = xp.where(xp.not_equal(t284, 0), -(-(t301*t406 + t304*t405 + t320*t404 + t329*t403) + t333)/t284, 0)
-    t408 = xp.where(xp.not_equal(t44, 0), -(-(t265*t407 + t268*t406 + t270*t405 + t272*t404 + t285*t262*t403) + t274)/t44, 0)
-    t409 = xp.isfinite(t340)
-    t410 = xp.greater_equal(damping, 0)
-    t411 = xp.greater(damping, 0)
-    t412 = 1e-12*t90
-    t413 = 1e-12*t54
-    t414 = (t411 & (xp.less_equal(t83, t412) | xp.less_equal(t127, t412) | xp.less_equal(t181, t412) | xp.less_equal(t209, t412) | xp.less_equal(t228, t412) | xp.less_equal(t240, t412))) | (xp.less_equal(damping, 0) & (xp.less_equal(t43, t413) | xp.less_equal(t283, t413) | xp.less_equal(t312, t413) | xp.less_equal(t362, t413) | xp.less_equal(t387, t413) | xp.less_equal(t399, t413)))
-    t415 = t409 & t410 & xp.logical_not(t414)
+    t38 = 1 + c234**2 + s5**2*t35
+    t39 = t22**2
+    t40 = t23**2
+    t41 = t39 + t40
+    t42 = xp.sqrt(1 + t41)
+    t43 = xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)*t42
+    t44 = t24**2
+    t45 = t44 + t20**2 + t9**2 + t10**2
+    t46 = t14**2
+    t47 = t13**2
+    t48 = t12**2
+    t49 = t26**2 + t33*t46 + t33*t47 + t33*t48
+    t50 = t40 + t49
+    t51 = t29**2 + t31*t46 + t31*t47 + t31*t48
+    t52 = xp.sqrt(t36 + t37 + t38 + t41 + t45 + t49 + t51)
+    t53 = t39 + t51
+    t54 = c1*s1
+    t55 = t48*t54 - t22*t23 + t26*t29 + t46*t54 + t47*t54
+    t56 = c1*t24
+    t57 = c1*t20
+    t58 = c1*t9
+    t59 = t26*t10 + t14*t56 + t13*t57 + t12*t58
+    t60 = t56 + t57 + t58 - t6*t10
+    t61 = c1*t14
+    t62 = c1*t13
+    t63 = s1*t28 + s1*t62 + s1*t61
+    t64 = t63 + t3*t26
+    t65 = t63 - t6*t29
+    t66 = s1*t24
+    t67 = s1*t20
+    t68 = s1*t9
+    t69 = t29*t10 + t14*t66 + t13*t67 + t12*t68
+    t70 = t66 + t67 + t68 + t3*t10
+    t71 = 3*s1
+    t72 = t1*t2 + c1*t71 - t35*t54
+    t73 = damping**2
+    t74 = _symmetric_solve6(xp, 1, (t73 + t50, t55, t59, t64, -t34, -t27, t73 + t53, t69, t32, -t65, t30, t45 + t73, t70, -t60, -c234*t10, t36 + t73, -t72, -t15, t37 + t73, t16, t38 + t73, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t75 = t74[5]
+    t76 = t74[0]
+    t77 = t74[1]
+    t78 = t75 - t23*t76 + t22*t77
+    t79 = s1*t14
+    t80 = t74[2]
+    t81 = t74[3]
+    t82 = t74[4]
+    t83 = t26*t76 + t29*t77 + t10*t80 + t3*t81 + t6*t82 - c234*t75
+    t84 = -t1*t81 + t2*t82 + t11*t75
+    t85 = s1*t81 - c1*t82
+    t86 = t85 + t61*t76 + t77*t79 + t24*t80
+    t87 = t85 + t28*t76 + t25*t77 + t9*t80
+    t88 = s1*t13
+    t89 = t85 + t62*t76 + t77*t88 + t20*t80
+    t90 = xp.greater(t42, 0)
+    t91 = xp.where(t90, 1 + xp.abs(t23)/t42, 0)
+    t92 = -t23
+    t93 = xp.where(t90, 1/(t92 + t43), 0)
+    t94 = t22*t93
+    t95 = t91*(t61 + t79*t94)
+    t96 = -t95 + t61
+    t97 = t79 - t94*t95
+    t98 = t91*(t62 + t88*t94)
+    t99 = -t98 + t62
+    t100 = t91*(t28 + t25*t94)
+    t101 = -t100 + t28
+    t102 = t91*(t26 - c234*t93 + t29*t94)
+    t103 = -t102 + t26
+    t104 = t91*(mu_dot0 + mu_dot5*t93 + t94*mu_dot1)
+    t105 = -t104 + mu_dot0
+    t106 = t93*t98
+    t107 = t88 - t22*t106
+    t108 = t93*t100
+    t109 = t25 - t22*t108
+    t110 = t93*t102
+    t111 = t29 - t22*t110
+    t112 = c234 + t110
+    t113 = t93**2
+    t114 = xp.sqrt(t31 + t33 + t44 + t97**2 + t113*t95**2)
+    t115 = t114*xp.where(xp.greater_equal(t97, 0), xp.asarray(1, dtype=dtype), -1)
+    t116 = t11*t91
+    t117 = t113*t116
+    t118 = t22*t117
+    t119 = -t11
+    t120 = t117 + t119
+    t121 = t93*t104
+    t122 = mu_dot1 - t22*t121
+    t123 = -t121 + mu_dot5
+    t124 = xp.greater(t114, 0)
+    t125 = xp.where(t124, 1/(t97 + t115), 0)
+    t126 = xp.where(t124, 1 + xp.abs(t97)/t114, 0)
+    t127 = t24*t125
+    t128 = t95*t125
+    t129 = t113*t128
+    t130 = t31*t125 + t33*t125
+    t131 = t126*(t130 + t107 + t20*t127 + t129*t98)
+    t132 = -t131 + t107
+    t133 = t20 - t127*t131
+    t134 = t126*(t130 + t109 + t9*t127 + t129*t100)
+    t135 = -t134 + t109
+    t136 = t9 - t127*t134
+    t137 = t125*t131
+    t138 = s1 - s1*t137
+    t139 = -c1
+    t140 = t139 + c1*t137
+    t141 = t93*t95
+    t142 = -t106 + t137*t141
+    t143 = xp.sqrt(t133**2 + t138**2 + t140**2 + t142**2)
+    t144 = t143*xp.where(xp.greater_equal(t133, 0), xp.asarray(1, dtype=dtype), -1)
+    t145 = t125*t134
+    t146 = s1 - s1*t145
+    t147 = t139 + c1*t145
+    t148 = -t108 + t141*t145
+    t149 = t128*t93
+    t150 = t126*(t111 + t10*t127 + t149*t112)
+    t151 = -t150 + t111
+    t152 = t10 - t127*t150
+    t153 = t125*t150
+    t154 = t3 - s1*t153
+    t155 = t6 + c1*t153
+    t156 = -t112 + t141*t153
+    t157 = s1*t125
+    t158 = c1*t125
+    t159 = t126*(t118 + t1*t157 + t2*t158 - t149*t120)
+    t160 = -t159 + t118
+    t161 = t1 - t157*t159
+    t162 = t120 + t149*t159
+    t163 = t126*(t122 + t127*mu_dot2 + t157*mu_dot3 - t158*mu_dot4 - t149*t123)
+    t164 = -t163 + t122
+    t165 = mu_dot2 - t127*t163
+    t166 = mu_dot3 - t157*t163
+    t167 = mu_dot4 + t158*t163
+    t168 = t123 + t149*t163
+    t169 = -t2
+    t170 = t169 + t158*t159
+    t171 = 1 - c234 + q1 + q2 + q3 + q4 + q5 + t1 + q6 + t22 + t3 + t6 + t25 + t28 + t26 + t29 + t24 + t20 + t9 + t10 + t61 + t62 + t71 + t79 + t88 + t92 + t119 + t169 - 3*c1 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
+    t172 = xp.greater(t143, 0)
+    t173 = xp.where(t172, 1/(t133 + t144), 0)
+    t174 = xp.where(t172, 1 + xp.abs(t133)/t143, 0)
+    t175 = t138*t173
+    t176 = t140*t173
+    t177 = t142*t173
+    t178 = t174*(t136 + t175*t146 + t176*t147 + t177*t148)
+    t179 = -t178 + t136
+    t180 = t146 - t175*t178
+    t181 = t147 - t176*t178
+    t182 = t148 - t177*t178
+    t183 = t174*(t152 + t175*t154 + t176*t155 + t177*t156)
+    t184 = -t183 + t152
+    t185 = t154 - t175*t183
+    t186 = t155 - t176*t183
+    t187 = t156 - t177*t183
+    t188 = t174*(t165 + t175*t166 + t176*t167 + t177*t168)
+    t189 = -t188 + t165
+    t190 = t166 - t175*t188
+    t191 = t167 - t176*t188
+    t192 = t168 - t177*t188
+    t193 = xp.sqrt(t180**2 + t181**2 + t182**2)
+    t194 = t193*xp.where(xp.greater_equal(t180, 0), xp.asarray(1, dtype=dtype), -1)
+    t195 = t127*t159
+    t196 = t174*(-t195 + t175*t161 + t176*t170 + t177*t162)
+    t197 = t195 + t196
+    t198 = t161 - t175*t196
+    t199 = t170 - t176*t196
+    t200 = t162 - t177*t196
+    t201 = xp.greater(t193, 0)
+    t202 = xp.where(t201, 1/(t180 + t194), 0)
+    t203 = xp.where(t201, 1 + xp.abs(t180)/t193, 0)
+    t204 = t181*t202
+    t205 = t182*t202
+    t206 = t203*(t185 + t204*t186 + t205*t187)
+    t207 = -t206 + t185
+    t208 = t186 - t204*t206
+    t209 = t187 - t205*t206
+    t210 = t203*(t198 + t204*t199 + t205*t200)
+    t211 = -t210 + t198
+    t212 = t199 - t204*t210
+    t213 = t200 - t205*t210
+    t214 = t203*(t190 + t204*t191 + t205*t192)
+    t215 = -t214 + t190
+    t216 = t191 - t204*t214
+    t217 = t192 - t205*t214
+    t218 = xp.sqrt(t208**2 + t209**2)
+    t219 = t218*xp.where(xp.greater_equal(t208, 0), xp.asarray(1, dtype=dtype), -1)
+    t220 = xp.greater(t218, 0)
+    t221 = xp.where(t220, 1/(t208 + t219), 0)
+    t222 = xp.where(t220, 1 + xp.abs(t208)/t218, 0)
+    t223 = t209*t221
+    t224 = t222*(t212 + t223*t213)
+    t225 = -t224 + t212
+    t226 = t213 - t223*t224
+    t227 = t222*(t216 + t223*t217)
+    t228 = -t227 + t216
+    t229 = t217 - t223*t227
+    t230 = xp.abs(t226)
+    t231 = t230*xp.where(xp.greater_equal(t226, 0), xp.asarray(1, dtype=dtype), -1)
+    t232 = xp.where(xp.greater(t230, 0), xp.asarray(2, dtype=dtype), 0)
+    t233 = t229 - t229*t232
+    t234 = xp.where(xp.not_equal(t231, 0), -t233/t231, 0)
+    t235 = xp.where(xp.not_equal(t219, 0), -(t228 - t225*t234)/t219, 0)
+    t236 = xp.where(xp.not_equal(t194, 0), -(-(t207*t235 + t211*t234) + t215)/t194, 0)
+    t237 = xp.where(xp.not_equal(t144, 0), -(-(t179*t236 + t184*t235 - t197*t234) + t189)/t144, 0)
+    t238 = xp.where(xp.not_equal(t115, 0), -(-(t132*t237 + t135*t236 + t151*t235 + t160*t234) + t164)/t115, 0)
+    t239 = xp.where(xp.not_equal(t43, 0), -(-(t96*t238 + t99*t237 + t101*t236 + t103*t235 + t116*t93*t234) + t105)/t43, 0)
+    t240 = xp.isfinite(t171)
+    t241 = xp.greater_equal(damping, 0)
+    t242 = xp.greater(damping, 0)
+    t243 = 1e-12*t52
+    t244 = (t242 & xp.greater(t74[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t42, t243) | xp.less_equal(t114, t243) | xp.less_equal(t143, t243) | xp.less_equal(t193, t243) | xp.less_equal(t218, t243) | xp.less_equal(t230, t243)))
+    t245 = t240 & t241 & xp.logical_not(t244)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t415, xp.where(t411, t250, t408), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t415, xp.where(t411, t255, t407), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t415, xp.where(t411, t258, t406), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t415, xp.where(t411, t256, t405), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t415, xp.where(t411, t251, t404), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t415, xp.where(t411, -t252, t403), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t245, xp.where(t242, t78, t239), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t245, xp.where(t242, t86, t238), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t245, xp.where(t242, t89, t237), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t245, xp.where(t242, t87, t236), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t245, xp.where(t242, t83, t235), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t245, xp.where(t242, -t84, t234), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t409 & t410), 2, xp.where(t414, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t240 & t241), 2, xp.where(t244, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
-    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1280 operations."""
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1284 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("z", z, (6,)), ("damping", damping, ()))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -4012,399 +4093,229 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     t35 = s234**2
     t36 = t1**2 + 3*t31 + t33*t35
     t37 = t2**2 + 3*t33 + t31*t35
-    t38 = c234**2
-    t39 = 1 + t38 + s5**2*t35
-    t40 = t22**2
-    t41 = t23**2
-    t42 = t40 + t41
-    t43 = xp.sqrt(1 + t42)
-    t44 = xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)*t43
-    t45 = t24**2
-    t46 = t10**2
-    t47 = t45 + t46 + t20**2 + t9**2
-    t48 = t14**2
-    t49 = t13**2
-    t50 = t12**2
-    t51 = t26**2 + t33*t48 + t33*t49 + t33*t50
-    t52 = t41 + t51
-    t53 = t29**2 + t31*t48 + t31*t49 + t31*t50
-    t54 = xp.sqrt(t36 + t37 + t39 + t42 + t47 + t51 + t53)
-    t55 = t40 + t53
-    t56 = c1*s1
-    t57 = t50*t56 - t22*t23 + t26*t29 + t48*t56 + t49*t56
-    t58 = c1*t24
-    t59 = c1*t20
-    t60 = c1*t9
-    t61 = t13*t59 + t26*t10 + t14*t58 + t12*t60
-    t62 = t58 + t59 + t60 - t6*t10
-    t63 = c1*t14
-    t64 = c1*t13
-    t65 = s1*t28 + s1*t63 + s1*t64
-    t66 = t65 + t3*t26
-    t67 = t65 - t6*t29
-    t68 = s1*t24
-    t69 = s1*t20
-    t70 = s1*t9
-    t71 = t29*t10 + t14*t68 + t13*t69 + t12*t70
-    t72 = t68 + t69 + t70 + t3*t10
-    t73 = 3*s1
-    t74 = t1*t2 + c1*t73 - t35*t56
-    t75 = t57**2
-    t76 = t61**2
-    t77 = t66**2
-    t78 = t34**2
-    t79 = t27**2
-    t80 = damping**2
-    t81 = t80 + t52
-    t82 = t81**2
-    t83 = xp.sqrt(t75 + t76 + t77 + t78 + t79 + t82)
-    t84 = t83*xp.where(xp.greater_equal(t81, 0), xp.asarray(1, dtype=dtype), -1)
-    t85 = t80 + t55
-    t86 = t47 + t80
-    t87 = t36 + t80
-    t88 = t37 + t80
-    t89 = t39 + t80
-    t90 = xp.sqrt(2*t75 + 2*t76 + 2*t71**2 + 2*t77 + 2*t32**2 + 2*t72**2 + 2*t78 + 2*t67**2 + 2*t62**2 + 2*t74**2 + 2*t79 + 2*t30**2 + 2*t15**2 + 2*t16**2 + t82 + t85**2 + t86**2 + t87**2 + t88**2 + t89**2 + 2*t38*t46)
-    t91 = xp.greater(t83, 0)
-    t92 = xp.where(t91, 1/(t81 + t84), 0)
-    t93 = xp.where(t91, 1 + xp.abs(t81)/t83, 0)
-    t94 = t57*t92
-    t95 = t61*t92
-    t96 = t66*t92
-    t97 = t34*t92
-    t98 = t27*t92
-    t99 = t93*(t57 + t85*t94 + t95*t71 + t96*t32 + t97*t67 - t98*t30)
-    t100 = -t99 + t57
-    t101 = t85 - t94*t99
-    t102 = t71 - t95*t99
-    t103 = t32 - t96*t99
-    t104 = -t67 + t97*t99
-    t105 = t30 + t98*t99
-    t106 = t93*(t66 + t94*t32 + t95*t72 + t87*t96 + t97*t74 + t98*t15)
-    t107 = -t106 + t66
-    t108 = t32 - t94*t106
-    t109 = t72 - t95*t106
-    t110 = t87 - t96*t106
-    t111 = -t74 + t97*t106
-    t112 = -t15 + t98*t106
-    t113 = -t93*(t34 + t94*t67 + t95*t62 + t96*t74 + t88*t97 + t98*t16)
-    t114 = t34 + t113
-    t115 = t67 + t94*t113
-    t116 = t62 + t95*t113
-    t117 = t74 + t96*t113
-    t118 = t88 + t97*t113
-    t119 = t16 + t98*t113
-    t120 = t93*(mu_dot0 + t94*mu_dot1 + t95*mu_dot2 + t96*mu_dot3 - t97*mu_dot4 - t98*mu_dot5)
-    t121 = -t120 + mu_dot0
-    t122 = mu_dot1 - t94*t120
-    t123 = mu_dot2 - t95*t120
-    t124 = mu_dot3 - t96*t120
-    t125 = mu_dot4 + t97*t120
-    t126 = mu_dot5 + t98*t120
-    t127 = xp.sqrt(t101**2 + t102**2 + t103**2 + t104**2 + t105**2)
-    t128 = t127*xp.where(xp.greater_equal(t101, 0), xp.asarray(1, dtype=dtype), -1)
-    t129 = c234*t10
-    t130 = t93*(t61 + t94*t71 + t86*t95 + t96*t72 + t97*t62 + t98*t129)
-    t131 = -t130 + t61
-    t132 = t71 - t94*t130
-    t133 = t86 - t95*t130
-    t134 = t72 - t96*t130
-    t135 = -t62 + t97*t130
-    t136 = -t129 + t98*t130
-    t137 = -t93*(t27 - t94*t30 + t95*t129 + t96*t15 + t97*t16 + t89*t98)
-    t138 = t27 + t137
-    t139 = t30 - t94*t137
-    t140 = t129 + t95*t137
-    t141 = t15 + t96*t137
-    t142 = t16 + t97*t137
-    t143 = t89 + t98*t137
-    t144 = xp.greater(t127, 0)
-    t145 = xp.where(t144, 1/(t101 + t128), 0)
-    t146 = xp.where(t144, 1 + xp.abs(t101)/t127, 0)
-    t147 = t102*t145
-    t148 = t103*t145
-    t149 = t104*t145
-    t150 = t105*t145
-    t151 = t146*(t132 + t147*t133 + t148*t134 + t149*t135 + t150*t136)
-    t152 = -t151 + t132
-    t153 = t133 - t147*t151
-    t154 = t134 - t148*t151
-    t155 = t135 - t149*t151
-    t156 = t136 - t150*t151
-    t157 = t146*(t108 + t147*t109 + t148*t110 + t149*t111 + t150*t112)
-    t158 = -t157 + t108
-    t159 = t109 - t147*t157
-    t160 = t110 - t148*t157
-    t161 = t111 - t149*t157
-    t162 = t112 - t150*t157
-    t163 = -t146*(t115 + t147*t116 + t148*t117 - t149*t118 - t150*t119)
-    t164 = t115 + t163
-    t165 = t116 + t147*t163
-    t166 = t117 + t148*t163
-    t167 = t118 - t149*t163
-    t168 = t119 - t150*t163
-    t169 = t146*(t139 - t147*t140 - t148*t141 + t149*t142 + t150*t143)
-    t170 = -t169 + t139
-    t171 = t140 + t147*t169
-    t172 = t141 + t148*t169
-    t173 = t142 - t149*t169
-    t174 = t143 - t150*t169
-    t175 = t146*(t122 + t147*t123 + t148*t124 + t149*t125 + t150*t126)
-    t176 = -t175 + t122
-    t177 = t123 - t147*t175
-    t178 = t124 - t148*t175
-    t179 = t125 - t149*t175
-    t180 = t126 - t150*t175
-    t181 = xp.sqrt(t153**2 + t154**2 + t155**2 + t156**2)
-    t182 = t181*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
-    t183 = xp.greater(t181, 0)
-    t184 = xp.where(t183, 1/(t153 + t182), 0)
-    t185 = xp.where(t183, 1 + xp.abs(t153)/t181, 0)
-    t186 = t154*t184
-    t187 = t155*t184
-    t188 = t156*t184
-    t189 = t185*(t159 + t186*t160 + t187*t161 + t188*t162)
-    t190 = -t189 + t159
-    t191 = t160 - t186*t189
-    t192 = t161 - t187*t189
-    t193 = t162 - t188*t189
-    t194 = t185*(-t165 - t186*t166 + t187*t167 + t188*t168)
-    t195 = t165 + t194
-    t196 = t166 + t186*t194
-    t197 = t167 - t187*t194
-    t198 = t168 - t188*t194
-    t199 = t185*(-t171 - t186*t172 + t187*t173 + t188*t174)
-    t200 = t171 + t199
-    t201 = t172 + t186*t199
-    t202 = t173 - t187*t199
-    t203 = t174 - t188*t199
-    t204 = t185*(t177 + t186*t178 + t187*t179 + t188*t180)
-    t205 = -t204 + t177
-    t206 = t178 - t186*t204
-    t207 = t179 - t187*t204
-    t208 = t180 - t188*t204
-    t209 = xp.sqrt(t191**2 + t192**2 + t193**2)
-    t210 = t209*xp.where(xp.greater_equal(t191, 0), xp.asarray(1, dtype=dtype), -1)
-    t211 = xp.greater(t209, 0)
-    t212 = xp.where(t211, 1/(t191 + t210), 0)
-    t213 = xp.where(t211, 1 + xp.abs(t191)/t209, 0)
-    t214 = t192*t212
-    t215 = t193*t212
-    t216 = t213*(-t196 + t214*t197 + t215*t198)
-    t217 = t196 + t216
-    t218 = t197 - t214*t216
-    t219 = t198 - t215*t216
-    t220 = t213*(-t201 + t214*t202 + t215*t203)
-    t221 = t201 + t220
-    t222 = t202 - t214*t220
-    t223 = t203 - t215*t220
-    t224 = t213*(t206 + t214*t207 + t215*t208)
-    t225 = -t224 + t206
-    t226 = t207 - t214*t224
-    t227 = t208 - t215*t224
-    t228 = xp.sqrt(t218**2 + t219**2)
-    t229 = t228*xp.where(xp.greater_equal(t218, 0), xp.asarray(1, dtype=dtype), -1)
-    t230 = xp.greater(t228, 0)
-    t231 = xp.where(t230, 1/(t218 + t229), 0)
-    t232 = xp.where(t230, 1 + xp.abs(t218)/t228, 0)
-    t233 = t219*t231
-    t234 = t232*(t222 + t233*t223)
-    t235 = -t234 + t222
-    t236 = t223 - t233*t234
-    t237 = t232*(t226 + t233*t227)
-    t238 = -t237 + t226
-    t239 = t227 - t233*t237
-    t240 = xp.abs(t236)
-    t241 = t240*xp.where(xp.greater_equal(t236, 0), xp.asarray(1, dtype=dtype), -1)
-    t242 = xp.where(xp.greater(t240, 0), xp.asarray(2, dtype=dtype), 0)
-    t243 = t239 - t239*t242
-    t244 = xp.where(xp.not_equal(t241, 0), -t243/t241, 0)
-    t245 = xp.where(xp.not_equal(t229, 0), -(t238 - t235*t244)/t229, 0)
-    t246 = xp.where(xp.not_equal(t210, 0), -(t225 + t217*t245 + t221*t244)/t210, 0)
-    t247 = xp.where(xp.not_equal(t182, 0), -(t205 + t195*t245 + t200*t244 - t190*t246)/t182, 0)
-    t248 = xp.where(xp.not_equal(t128, 0), -(-(t152*t247 + t158*t246 - t164*t245 + t170*t244) + t176)/t128, 0)
-    t249 = xp.where(xp.not_equal(t84, 0), -(-(t100*t248 + t131*t247 + t107*t246 - t114*t245 - t138*t244) + t121)/t84, 0)
-    t250 = t244 - t23*t249 + t22*t248
-    t251 = t26*t249 + t29*t248 + t10*t247 - c234*t244 + t3*t246 + t6*t245
-    t252 = t2*t245 - t1*t246 + t11*t244
-    t253 = s1*t14
-    t254 = s1*t246 - c1*t245
-    t255 = t254 + t24*t247 + t63*t249 + t253*t248
-    t256 = t254 + t9*t247 + t28*t249 + t25*t248
-    t257 = s1*t13
-    t258 = t254 + t20*t247 + t64*t249 + t257*t248
-    t259 = xp.greater(t43, 0)
-    t260 = xp.where(t259, 1 + xp.abs(t23)/t43, 0)
-    t261 = -t23
-    t262 = xp.where(t259, 1/(t261 + t44), 0)
-    t263 = t22*t262
-    t264 = t260*(t63 + t253*t263)
-    t265 = -t264 + t63
-    t266 = t253 - t263*t264
-    t267 = t260*(t64 + t257*t263)
-    t268 = -t267 + t64
-    t269 = t260*(t28 + t25*t263)
-    t270 = -t269 + t28
-    t271 = t260*(t26 - c234*t262 + t29*t263)
-    t272 = -t271 + t26
-    t273 = t260*(mu_dot0 + mu_dot5*t262 + t263*mu_dot1)
-    t274 = -t273 + mu_dot0
-    t275 = t262*t267
-    t276 = t257 - t22*t275
-    t277 = t262*t269
-    t278 = t25 - t22*t277
-    t279 = t262*t271
-    t280 = t29 - t22*t279
-    t281 = c234 + t279
-    t282 = t262**2
-    t283 = xp.sqrt(t31 + t33 + t45 + t266**2 + t282*t264**2)
-    t284 = t283*xp.where(xp.greater_equal(t266, 0), xp.asarray(1, dtype=dtype), -1)
-    t285 = t11*t260
-    t286 = t282*t285
-    t287 = t22*t286
-    t288 = -t11
-    t289 = t286 + t288
-    t290 = t262*t273
-    t291 = mu_dot1 - t22*t290
-    t292 = -t290 + mu_dot5
-    t293 = xp.greater(t283, 0)
-    t294 = xp.where(t293, 1/(t266 + t284), 0)
-    t295 = xp.where(t293, 1 + xp.abs(t266)/t283, 0)
-    t296 = t24*t294
-    t297 = t264*t294
-    t298 = t282*t297
-    t299 = t31*t294 + t33*t294
-    t300 = t295*(t299 + t276 + t20*t296 + t298*t267)
-    t301 = -t300 + t276
-    t302 = t20 - t296*t300
-    t303 = t295*(t299 + t278 + t9*t296 + t298*t269)
-    t304 = -t303 + t278
-    t305 = t9 - t296*t303
-    t306 = t294*t300
-    t307 = s1 - s1*t306
-    t308 = -c1
-    t309 = t308 + c1*t306
-    t310 = t262*t264
-    t311 = -t275 + t306*t310
-    t312 = xp.sqrt(t302**2 + t307**2 + t309**2 + t311**2)
-    t313 = t312*xp.where(xp.greater_equal(t302, 0), xp.asarray(1, dtype=dtype), -1)
-    t314 = t294*t303
-    t315 = s1 - s1*t314
-    t316 = t308 + c1*t314
-    t317 = -t277 + t310*t314
-    t318 = t297*t262
-    t319 = t295*(t280 + t10*t296 + t318*t281)
-    t320 = -t319 + t280
-    t321 = t10 - t296*t319
-    t322 = t294*t319
-    t323 = t3 - s1*t322
-    t324 = t6 + c1*t322
-    t325 = -t281 + t310*t322
-    t326 = s1*t294
-    t327 = c1*t294
-    t328 = t295*(t287 + t1*t326 + t2*t327 - t318*t289)
-    t329 = -t328 + t287
-    t330 = t1 - t326*t328
-    t331 = t289 + t318*t328
-    t332 = t295*(t291 + t296*mu_dot2 + t326*mu_dot3 - t327*mu_dot4 - t318*t292)
-    t333 = -t332 + t291
-    t334 = mu_dot2 - t296*t332
-    t335 = mu_dot3 - t326*t332
-    t336 = mu_dot4 + t327*t332
-    t337 = t292 + t318*t332
-    t338 = -t2
-    t339 = t338 + t327*t328
-    t340 = 1 - c234 + q1 + q2 + q3 + q4 + q5 + t1 + q6 + t22 + t3 + t6 + t25 + t28 + t26 + t29 + t24 + t20 + t9 + t10 + t63 + t64 + t73 + t253 + t257 + t261 + t288 + t338 - 3*c1 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6
-    t341 = xp.greater(t312, 0)
-    t342 = xp.where(t341, 1/(t302 + t313), 0)
-    t343 = xp.where(t341, 1 + xp.abs(t302)/t312, 0)
-    t344 = t307*t342
-    t345 = t309*t342
-    t346 = t311*t342
-    t347 = t343*(t305 + t344*t315 + t345*t316 + t346*t317)
-    t348 = -t347 + t305
-    t349 = t315 - t344*t347
-    t350 = t316 - t345*t347
-    t351 = t317 - t346*t347
-    t352 = t343*(t321 + t344*t323 + t345*t324 + t346*t325)
-    t353 = -t352 + t321
-    t354 = t323 - t344*t352
-    t355 = t324 - t345*t352
-    t356 = t325 - t346*t352
-    t357 = t343*(t334 + t344*t335 + t345*t336 + t346*t337)
-    t358 = -t357 + t334
-    t359 = t335 - t344*t357
-    t360 = t336 - t345*t357
-    t361 = t337 - t346*t357
-    t362 = xp.sqrt(t349**2 + t350**2 + t351**2)
-    t363 = t362*xp.where(xp.greater_equal(t349, 0), xp.asarray(1, dtype=dtype), -1)
-    t364 = t296*t328
-    t365 = t343*(-t364 + t344*t330 + t345*t339 + t346*t331)
-    t366 = t364 + t365
-    t367 = t330 - t344*t365
-    t368 = t339 - t345*t365
-    t369 = t331 - t346*t365
-    t370 = xp.greater(t362, 0)
-    t371 = xp.where(t370, 1/(t349 + t363), 0)
-    t372 = xp.where(t370, 1 + xp.abs(t349)/t362, 0)
-    t373 = t350*t371
-    t374 = t351*t371
-    t375 = t372*(t354 + t373*t355 + t374*t356)
-    t376 = -t375 + t354
-    t377 = t355 - t373*t375
-    t378 = t356 - t374*t375
-    t379 = t372*(t367 + t373*t368 + t374*t369)
-    t380 = -t379 + t367
-    t381 = t368 - t373*t379
-    t382 = t369 - t374*t379
-    t383 = t372*(t359 + t373*t360 + t374*t361)
-    t384 = -t383 + t359
-    t385 = t360 - t373*t383
-    t386 = t361 - t374*t383
-    t387 = xp.sqrt(t377**2 + t378**2)
-    t388 = t387*xp.where(xp.greater_equal(t377, 0), xp.asarray(1, dtype=dtype), -1)
-    t389 = xp.greater(t387, 0)
-    t390 = xp.where(t389, 1/(t377 + t388), 0)
-    t391 = xp.where(t389, 1 + xp.abs(t377)/t387, 0)
-    t392 = t378*t390
-    t393 = t391*(t381 + t392*t382)
-    t394 = -t393 + t381
-    t395 = t382 - t392*t393
-    t396 = t391*(t385 + t392*t386)
-    t397 = -t396 + t385
-    t398 = t386 - t392*t396
-    t399 = xp.abs(t395)
-    t400 = t399*xp.where(xp.greater_equal(t395, 0), xp.asarray(1, dtype=dtype), -1)
-    t401 = xp.where(xp.greater(t399, 0), xp.asarray(2, dtype=dtype), 0)
-    t402 = t398 - t398*t401
-    t403 = xp.where(xp.not_equal(t400, 0), -t402/t400, 0)
-    t404 = xp.where(xp.not_equal(t388, 0), -(t397 - t394*t403)/t388, 0)
-    t405 = xp.where(xp.not_equal(t363, 0), -(-(t376*t404 + t380*t403) + t384)/t363, 0)
-    t406 = xp.where(xp.not_equal(t313, 0), -(-(t348*t405 + t353*t404 - t366*t403) + t358)/t313, 0)
-    t407 = xp.where(xp.not_equal(t284, 0), -(-(t301*t406 + t304*t405 + t320*t404 + t329*t403) + t333)/t284, 0)
-    t408 = xp.where(xp.not_equal(t44, 0), -(-(t265*t407 + t268*t406 + t270*t405 + t272*t404 + t285*t262*t403) + t274)/t44, 0)
-    t409 = xp.isfinite(t340)
-    t410 = xp.greater_equal(damping, 0)
-    t411 = xp.greater(damping, 0)
-    t412 = 1e-12*t90
-    t413 = 1e-12*t54
-    t414 = (t411 & (xp.less_equal(t83, t412) | xp.less_equal(t127, t412) | xp.less_equal(t181, t412) | xp.less_equal(t209, t412) | xp.less_equal(t228, t412) | xp.less_equal(t240, t412))) | (xp.less_equal(damping, 0) & (xp.less_equal(t43, t413) | xp.less_equal(t283, t413) | xp.less_equal(t312, t413) | xp.less_equal(t362, t413) | xp.less_equal(t387, t413) | xp.less_equal(t399, t413)))
-    t415 = t409 & t410 & xp.logical_not(t414)
+    t38 = 1 + c234**2 + s5**2*t35
+    t39 = t22**2
+    t40 = t23**2
+    t41 = t39 + t40
+    t42 = xp.sqrt(1 + t41)
+    t43 = xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)*t42
+    t44 = t24**2
+    t45 = t44 + t20**2 + t9**2 + t10**2
+    t46 = t14**2
+    t47 = t13**2
+    t48 = t12**2
+    t49 = t26**2 + t33*t46 + t33*t47 + t33*t48
+    t50 = t40 + t49
+    t51 = t29**2 + t31*t46 + t31*t47 + t31*t48
+    t52 = xp.sqrt(t36 + t37 + t38 + t41 + t45 + t49 + t51)
+    t53 = t39 + t51
+    t54 = c1*s1
+    t55 = t48*t54 - t22*t23 + t26*t29 + t46*t54 + t47*t54
+    t56 = c1*t24
+    t57 = c1*t20
+    t58 = c1*t9
+    t59 = t26*t10 + t14*t56 + t13*t57 + t12*t58
+    t60 = t56 + t57 + t58 - t6*t10
+    t61 = c1*t14
+    t62 = c1*t13
+    t63 = s1*t28 + s1*t62 + s1*t61
+    t64 = t63 + t3*t26
+    t65 = t63 - t6*t29
+    t66 = s1*t24
+    t67 = s1*t20
+    t68 = s1*t9
+    t69 = t29*t10 + t14*t66 + t13*t67 + t12*t68
+    t70 = t66 + t67 + t68 + t3*t10
+    t71 = 3*s1
+    t72 = t1*t2 + c1*t71 - t35*t54
+    t73 = damping**2
+    t74 = _symmetric_solve6(xp, 1, (t73 + t50, t55, t59, t64, -t34, -t27, t73 + t53, t69, t32, -t65, t30, t45 + t73, t70, -t60, -c234*t10, t36 + t73, -t72, -t15, t37 + t73, t16, t38 + t73, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t75 = t74[5]
+    t76 = t74[0]
+    t77 = t74[1]
+    t78 = t75 - t23*t76 + t22*t77
+    t79 = s1*t14
+    t80 = t74[2]
+    t81 = t74[3]
+    t82 = t74[4]
+    t83 = t26*t76 + t29*t77 + t10*t80 + t3*t81 + t6*t82 - c234*t75
+    t84 = -t1*t81 + t2*t82 + t11*t75
+    t85 = s1*t81 - c1*t82
+    t86 = t85 + t61*t76 + t77*t79 + t24*t80
+    t87 = t85 + t28*t76 + t25*t77 + t9*t80
+    t88 = s1*t13
+    t89 = t85 + t62*t76 + t77*t88 + t20*t80
+    t90 = xp.greater(t42, 0)
+    t91 = xp.where(t90, 1 + xp.abs(t23)/t42, 0)
+    t92 = -t23
+    t93 = xp.where(t90, 1/(t92 + t43), 0)
+    t94 = t22*t93
+    t95 = t91*(t61 + t79*t94)
+    t96 = -t95 + t61
+    t97 = t79 - t94*t95
+    t98 = t91*(t62 + t88*t94)
+    t99 = -t98 + t62
+    t100 = t91*(t28 + t25*t94)
+    t101 = -t100 + t28
+    t102 = t91*(t26 - c234*t93 + t29*t94)
+    t103 = -t102 + t26
+    t104 = t91*(mu_dot0 + mu_dot5*t93 + t94*mu_dot1)
+    t105 = -t104 + mu_dot0
+    t106 = t93*t98
+    t107 = t88 - t22*t106
+    t108 = t93*t100
+    t109 = t25 - t22*t108
+    t110 = t93*t102
+    t111 = t29 - t22*t110
+    t112 = c234 + t110
+    t113 = t93**2
+    t114 = xp.sqrt(t31 + t33 + t44 + t97**2 + t113*t95**2)
+    t115 = t114*xp.where(xp.greater_equal(t97, 0), xp.asarray(1, dtype=dtype), -1)
+    t116 = t11*t91
+    t117 = t113*t116
+    t118 = t22*t117
+    t119 = -t11
+    t120 = t117 + t119
+    t121 = t93*t104
+    t122 = mu_dot1 - t22*t121
+    t123 = -t121 + mu_dot5
+    t124 = xp.greater(t114, 0)
+    t125 = xp.where(t124, 1/(t97 + t115), 0)
+    t126 = xp.where(t124, 1 + xp.abs(t97)/t114, 0)
+    t127 = t24*t125
+    t128 = t95*t125
+    t129 = t113*t128
+    t130 = t31*t125 + t33*t125
+    t131 = t126*(t130 + t107 + t20*t127 + t129*t98)
+    t132 = -t131 + t107
+    t133 = t20 - t127*t131
+    t134 = t126*(t130 + t109 + t9*t127 + t129*t100)
+    t135 = -t134 + t109
+    t136 = t9 - t127*t134
+    t137 = t125*t131
+    t138 = s1 - s1*t137
+    t139 = -c1
+    t140 = t139 + c1*t137
+    t141 = t93*t95
+    t142 = -t106 + t137*t141
+    t143 = xp.sqrt(t133**2 + t138**2 + t140**2 + t142**2)
+    t144 = t143*xp.where(xp.greater_equal(t133, 0), xp.asarray(1, dtype=dtype), -1)
+    t145 = t125*t134
+    t146 = s1 - s1*t145
+    t147 = t139 + c1*t145
+    t148 = -t108 + t141*t145
+    t149 = t128*t93
+    t150 = t126*(t111 + t10*t127 + t149*t112)
+    t151 = -t150 + t111
+    t152 = t10 - t127*t150
+    t153 = t125*t150
+    t154 = t3 - s1*t153
+    t155 = t6 + c1*t153
+    t156 = -t112 + t141*t153
+    t157 = s1*t125
+    t158 = c1*t125
+    t159 = t126*(t118 + t1*t157 + t2*t158 - t149*t120)
+    t160 = -t159 + t118
+    t161 = t1 - t157*t159
+    t162 = t120 + t149*t159
+    t163 = t126*(t122 + t127*mu_dot2 + t157*mu_dot3 - t158*mu_dot4 - t149*t123)
+    t164 = -t163 + t122
+    t165 = mu_dot2 - t127*t163
+    t166 = mu_dot3 - t157*t163
+    t167 = mu_dot4 + t158*t163
+    t168 = t123 + t149*t163
+    t169 = -t2
+    t170 = t169 + t158*t159
+    t171 = 1 - c234 + q1 + q2 + q3 + q4 + q5 + t1 + q6 + t22 + t3 + t6 + t25 + t28 + t26 + t29 + t24 + t20 + t9 + t10 + t61 + t62 + t71 + t79 + t88 + t92 + t119 + t169 - 3*c1 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6
+    t172 = xp.greater(t143, 0)
+    t173 = xp.where(t172, 1/(t133 + t144), 0)
+    t174 = xp.where(t172, 1 + xp.abs(t133)/t143, 0)
+    t175 = t138*t173
+    t176 = t140*t173
+    t177 = t142*t173
+    t178 = t174*(t136 + t175*t146 + t176*t147 + t177*t148)
+    t179 = -t178 + t136
+    t180 = t146 - t175*t178
+    t181 = t147 - t176*t178
+    t182 = t148 - t177*t178
+    t183 = t174*(t152 + t175*t154 + t176*t155 + t177*t156)
+    t184 = -t183 + t152
+    t185 = t154 - t175*t183
+    t186 = t155 - t176*t183
+    t187 = t156 - t177*t183
+    t188 = t174*(t165 + t175*t166 + t176*t167 + t177*t168)
+    t189 = -t188 + t165
+    t190 = t166 - t175*t188
+    t191 = t167 - t176*t188
+    t192 = t168 - t177*t188
+    t193 = xp.sqrt(t180**2 + t181**2 + t182**2)
+    t194 = t193*xp.where(xp.greater_equal(t180, 0), xp.asarray(1, dtype=dtype), -1)
+    t195 = t127*t159
+    t196 = t174*(-t195 + t175*t161 + t176*t170 + t177*t162)
+    t197 = t195 + t196
+    t198 = t161 - t175*t196
+    t199 = t170 - t176*t196
+    t200 = t162 - t177*t196
+    t201 = xp.greater(t193, 0)
+    t202 = xp.where(t201, 1/(t180 + t194), 0)
+    t203 = xp.where(t201, 1 + xp.abs(t180)/t193, 0)
+    t204 = t181*t202
+    t205 = t182*t202
+    t206 = t203*(t185 + t204*t186 + t205*t187)
+    t207 = -t206 + t185
+    t208 = t186 - t204*t206
+    t209 = t187 - t205*t206
+    t210 = t203*(t198 + t204*t199 + t205*t200)
+    t211 = -t210 + t198
+    t212 = t199 - t204*t210
+    t213 = t200 - t205*t210
+    t214 = t203*(t190 + t204*t191 + t205*t192)
+    t215 = -t214 + t190
+    t216 = t191 - t204*t214
+    t217 = t192 - t205*t214
+    t218 = xp.sqrt(t208**2 + t209**2)
+    t219 = t218*xp.where(xp.greater_equal(t208, 0), xp.asarray(1, dtype=dtype), -1)
+    t220 = xp.greater(t218, 0)
+    t221 = xp.where(t220, 1/(t208 + t219), 0)
+    t222 = xp.where(t220, 1 + xp.abs(t208)/t218, 0)
+    t223 = t209*t221
+    t224 = t222*(t212 + t223*t213)
+    t225 = -t224 + t212
+    t226 = t213 - t223*t224
+    t227 = t222*(t216 + t223*t217)
+    t228 = -t227 + t216
+    t229 = t217 - t223*t227
+    t230 = xp.abs(t226)
+    t231 = t230*xp.where(xp.greater_equal(t226, 0), xp.asarray(1, dtype=dtype), -1)
+    t232 = xp.where(xp.greater(t230, 0), xp.asarray(2, dtype=dtype), 0)
+    t233 = t229 - t229*t232
+    t234 = xp.where(xp.not_equal(t231, 0), -t233/t231, 0)
+    t235 = xp.where(xp.not_equal(t219, 0), -(t228 - t225*t234)/t219, 0)
+    t236 = xp.where(xp.not_equal(t194, 0), -(-(t207*t235 + t211*t234) + t215)/t194, 0)
+    t237 = xp.where(xp.not_equal(t144, 0), -(-(t179*t236 + t184*t235 - t197*t234) + t189)/t144, 0)
+    t238 = xp.where(xp.not_equal(t115, 0), -(-(t132*t237 + t135*t236 + t151*t235 + t160*t234) + t164)/t115, 0)
+    t239 = xp.where(xp.not_equal(t43, 0), -(-(t96*t238 + t99*t237 + t101*t236 + t103*t235 + t116*t93*t234) + t105)/t43, 0)
+    t240 = xp.isfinite(t171)
+    t241 = xp.greater_equal(damping, 0)
+    t242 = xp.greater(damping, 0)
+    t243 = 1e-12*t52
+    t244 = (t242 & xp.greater(t74[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t42, t243) | xp.less_equal(t114, t243) | xp.less_equal(t143, t243) | xp.less_equal(t193, t243) | xp.less_equal(t218, t243) | xp.less_equal(t230, t243)))
+    t245 = t240 & t241 & xp.logical_not(t244)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t415, xp.where(t411, t250, t408), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t415, xp.where(t411, t255, t407), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t415, xp.where(t411, t258, t406), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t415, xp.where(t411, t256, t405), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t415, xp.where(t411, t251, t404), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t415, xp.where(t411, -t252, t403), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t245, xp.where(t242, t78, t239), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t245, xp.where(t242, t86, t238), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t245, xp.where(t242, t89, t237), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t245, xp.where(t242, t87, t236), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t245, xp.where(t242, t83, t235), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t245, xp.where(t242, -t84, t234), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t409 & t410), 2, xp.where(t414, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t240 & t241), 2, xp.where(t244, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1438 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1442 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (6,)), ("target", target, (4, 4)), ("target_rate", target_rate, (6,)), ("gain", gain, (6,)), ("z", z, (6,)), ("damping", damping, ()), every=("gain", ))
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -4525,419 +4436,249 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t63 = s234**2
     t64 = t6**2 + 3*t59 + t61*t63
     t65 = t3**2 + 3*t61 + t59*t63
-    t66 = c234**2
-    t67 = 1 + t66 + s5**2*t63
-    t68 = t49**2
-    t69 = t50**2
-    t70 = t68 + t69
-    t71 = xp.sqrt(1 + t70)
-    t72 = xp.where(xp.less_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)*t71
-    t73 = t51**2
-    t74 = t22**2
-    t75 = t73 + t74 + t47**2 + t21**2
-    t76 = t33**2
-    t77 = t32**2
-    t78 = t31**2
-    t79 = t54**2 + t61*t77 + t61*t76 + t61*t78
-    t80 = t69 + t79
-    t81 = t57**2 + t59*t76 + t59*t77 + t59*t78
-    t82 = xp.sqrt(t64 + t65 + t67 + t70 + t75 + t79 + t81)
-    t83 = t68 + t81
-    t84 = c1*s1
-    t85 = -t49*t50 + t54*t57 + t76*t84 + t77*t84 + t78*t84
-    t86 = c1*t51
-    t87 = c1*t47
-    t88 = c1*t21
-    t89 = t54*t22 + t33*t86 + t32*t87 + t31*t88
-    t90 = t86 + t87 + t88 - t16*t22
-    t91 = c1*t33
-    t92 = c1*t32
-    t93 = s1*t56 + s1*t91 + s1*t92
-    t94 = t93 + t8*t54
-    t95 = t93 - t16*t57
-    t96 = s1*t51
-    t97 = s1*t47
-    t98 = s1*t21
-    t99 = t57*t22 + t33*t96 + t32*t97 + t31*t98
-    t100 = t96 + t97 + t98 + t8*t22
-    t101 = 3*s1
-    t102 = t6*t3 + c1*t101 - t63*t84
-    t103 = t85**2
-    t104 = t89**2
-    t105 = t94**2
-    t106 = t62**2
-    t107 = t55**2
-    t108 = damping**2
-    t109 = t108 + t80
-    t110 = t109**2
-    t111 = xp.sqrt(t103 + t104 + t105 + t106 + t107 + t110)
-    t112 = t111*xp.where(xp.greater_equal(t109, 0), xp.asarray(1, dtype=dtype), -1)
-    t113 = t108 + t83
-    t114 = t75 + t108
-    t115 = t64 + t108
-    t116 = t65 + t108
-    t117 = t67 + t108
-    t118 = xp.sqrt(2*t103 + 2*t104 + 2*t99**2 + 2*t105 + 2*t60**2 + 2*t100**2 + 2*t106 + 2*t95**2 + 2*t90**2 + 2*t102**2 + 2*t107 + 2*t58**2 + 2*t35**2 + 2*t36**2 + t110 + t113**2 + t114**2 + t115**2 + t116**2 + t117**2 + 2*t66*t74)
-    t119 = xp.greater(t111, 0)
-    t120 = xp.where(t119, 1/(t109 + t112), 0)
-    t121 = xp.where(t119, 1 + xp.abs(t109)/t111, 0)
-    t122 = t85*t120
-    t123 = t89*t120
-    t124 = t94*t120
-    t125 = t62*t120
-    t126 = t55*t120
-    t127 = t121*(t85 + t113*t122 + t123*t99 + t124*t60 + t125*t95 - t126*t58)
-    t128 = -t127 + t85
-    t129 = t113 - t122*t127
-    t130 = t99 - t123*t127
-    t131 = t60 - t124*t127
-    t132 = -t95 + t125*t127
-    t133 = t58 + t126*t127
-    t134 = t121*(t94 + t122*t60 + t123*t100 + t115*t124 + t125*t102 + t126*t35)
-    t135 = -t134 + t94
-    t136 = t60 - t122*t134
-    t137 = t100 - t123*t134
-    t138 = t115 - t124*t134
-    t139 = -t102 + t125*t134
-    t140 = -t35 + t126*t134
-    t141 = -t121*(t62 + t122*t95 + t123*t90 + t124*t102 + t116*t125 + t126*t36)
-    t142 = t62 + t141
-    t143 = t95 + t122*t141
-    t144 = t90 + t123*t141
-    t145 = t102 + t124*t141
-    t146 = t116 + t125*t141
-    t147 = t36 + t126*t141
-    t148 = xp.sqrt(t129**2 + t130**2 + t131**2 + t132**2 + t133**2)
-    t149 = t148*xp.where(xp.greater_equal(t129, 0), xp.asarray(1, dtype=dtype), -1)
-    t150 = c234*t22
-    t151 = t121*(t89 + t122*t99 + t114*t123 + t124*t100 + t125*t90 + t126*t150)
-    t152 = -t151 + t89
-    t153 = t99 - t122*t151
-    t154 = t114 - t123*t151
-    t155 = t100 - t124*t151
-    t156 = -t90 + t125*t151
-    t157 = -t150 + t126*t151
-    t158 = -t121*(t55 - t122*t58 + t123*t150 + t124*t35 + t125*t36 + t117*t126)
-    t159 = t55 + t158
-    t160 = t58 - t122*t158
-    t161 = t150 + t123*t158
-    t162 = t35 + t124*t158
-    t163 = t36 + t125*t158
-    t164 = t117 + t126*t158
-    t165 = xp.greater(t148, 0)
-    t166 = xp.where(t165, 1/(t129 + t149), 0)
-    t167 = xp.where(t165, 1 + xp.abs(t129)/t148, 0)
-    t168 = t130*t166
-    t169 = t131*t166
-    t170 = t132*t166
-    t171 = t133*t166
-    t172 = t167*(t153 + t168*t154 + t169*t155 + t170*t156 + t171*t157)
-    t173 = -t172 + t153
-    t174 = t154 - t168*t172
-    t175 = t155 - t169*t172
-    t176 = t156 - t170*t172
-    t177 = t157 - t171*t172
-    t178 = t167*(t136 + t168*t137 + t169*t138 + t170*t139 + t171*t140)
-    t179 = -t178 + t136
-    t180 = t137 - t168*t178
-    t181 = t138 - t169*t178
-    t182 = t139 - t170*t178
-    t183 = t140 - t171*t178
-    t184 = -t167*(t143 + t168*t144 + t169*t145 - t170*t146 - t171*t147)
-    t185 = t143 + t184
-    t186 = t144 + t168*t184
-    t187 = t145 + t169*t184
-    t188 = t146 - t170*t184
-    t189 = t147 - t171*t184
-    t190 = t167*(t160 - t168*t161 - t169*t162 + t170*t163 + t171*t164)
-    t191 = -t190 + t160
-    t192 = t161 + t168*t190
-    t193 = t162 + t169*t190
-    t194 = t163 - t170*t190
-    t195 = t164 - t171*t190
-    t196 = xp.sqrt(t174**2 + t175**2 + t176**2 + t177**2)
-    t197 = t196*xp.where(xp.greater_equal(t174, 0), xp.asarray(1, dtype=dtype), -1)
-    t198 = xp.greater(t196, 0)
-    t199 = xp.where(t198, 1/(t174 + t197), 0)
-    t200 = xp.where(t198, 1 + xp.abs(t174)/t196, 0)
-    t201 = t175*t199
-    t202 = t176*t199
-    t203 = t177*t199
-    t204 = t200*(t180 + t201*t181 + t202*t182 + t203*t183)
-    t205 = -t204 + t180
-    t206 = t181 - t201*t204
-    t207 = t182 - t202*t204
-    t208 = t183 - t203*t204
-    t209 = t200*(-t186 - t201*t187 + t202*t188 + t203*t189)
-    t210 = t186 + t209
-    t211 = t187 + t201*t209
-    t212 = t188 - t202*t209
-    t213 = t189 - t203*t209
-    t214 = t200*(-t192 - t201*t193 + t202*t194 + t203*t195)
-    t215 = t192 + t214
-    t216 = t193 + t201*t214
-    t217 = t194 - t202*t214
-    t218 = t195 - t203*t214
-    t219 = xp.sqrt(t206**2 + t207**2 + t208**2)
-    t220 = t219*xp.where(xp.greater_equal(t206, 0), xp.asarray(1, dtype=dtype), -1)
-    t221 = xp.greater(t219, 0)
-    t222 = xp.where(t221, 1/(t206 + t220), 0)
-    t223 = xp.where(t221, 1 + xp.abs(t206)/t219, 0)
-    t224 = t207*t222
-    t225 = t208*t222
-    t226 = t223*(-t211 + t224*t212 + t225*t213)
-    t227 = t211 + t226
-    t228 = t212 - t224*t226
-    t229 = t213 - t225*t226
-    t230 = t223*(-t216 + t224*t217 + t225*t218)
-    t231 = t216 + t230
-    t232 = t217 - t224*t230
-    t233 = t218 - t225*t230
-    t234 = xp.sqrt(t228**2 + t229**2)
-    t235 = t234*xp.where(xp.greater_equal(t228, 0), xp.asarray(1, dtype=dtype), -1)
-    t236 = xp.greater(t234, 0)
-    t237 = xp.where(t236, 1/(t228 + t235), 0)
-    t238 = xp.where(t236, 1 + xp.abs(t228)/t234, 0)
-    t239 = t229*t237
-    t240 = t238*(t232 + t239*t233)
-    t241 = -t240 + t232
-    t242 = t233 - t239*t240
-    t243 = xp.abs(t242)
-    t244 = t243*xp.where(xp.greater_equal(t242, 0), xp.asarray(1, dtype=dtype), -1)
-    t245 = xp.where(xp.greater(t243, 0), xp.asarray(2, dtype=dtype), 0)
-    t246 = xp.greater(t71, 0)
-    t247 = xp.where(t246, 1 + xp.abs(t50)/t71, 0)
-    t248 = -t50
-    t249 = xp.where(t246, 1/(t248 + t72), 0)
-    t250 = mu_dot1 + gain1*(t248 + T13)
-    t251 = s1*t33
-    t252 = t49*t249
-    t253 = t247*(t91 + t251*t252)
-    t254 = -t253 + t91
-    t255 = t251 - t252*t253
-    t256 = t247*(t56 + t53*t252)
-    t257 = -t256 + t56
-    t258 = t247*(t54 - c234*t249 + t57*t252)
-    t259 = -t258 + t54
-    t260 = s1*t32
-    t261 = t247*(t92 + t252*t260)
-    t262 = -t261 + t92
-    t263 = t249*t261
-    t264 = t260 - t49*t263
-    t265 = t249*t256
-    t266 = t53 - t49*t265
-    t267 = t249*t258
-    t268 = t57 - t49*t267
-    t269 = c234 + t267
-    t270 = t249**2
-    t271 = xp.sqrt(t59 + t61 + t73 + t255**2 + t270*t253**2)
-    t272 = t271*xp.where(xp.greater_equal(t255, 0), xp.asarray(1, dtype=dtype), -1)
-    t273 = t30*t247
-    t274 = t270*t273
-    t275 = t49*t274
-    t276 = -t30
-    t277 = t274 + t276
-    t278 = xp.greater(t271, 0)
-    t279 = xp.where(t278, 1/(t255 + t272), 0)
-    t280 = xp.where(t278, 1 + xp.abs(t255)/t271, 0)
-    t281 = t51*t279
-    t282 = t253*t279
-    t283 = t270*t282
-    t284 = t59*t279 + t61*t279
-    t285 = t280*(t284 + t264 + t47*t281 + t283*t261)
-    t286 = -t285 + t264
-    t287 = t47 - t281*t285
-    t288 = t280*(t284 + t266 + t21*t281 + t283*t256)
-    t289 = -t288 + t266
-    t290 = t21 - t281*t288
-    t291 = t279*t285
-    t292 = s1 - s1*t291
-    t293 = -c1
-    t294 = t293 + c1*t291
-    t295 = t249*t253
-    t296 = -t263 + t291*t295
-    t297 = xp.sqrt(t287**2 + t292**2 + t294**2 + t296**2)
-    t298 = t297*xp.where(xp.greater_equal(t287, 0), xp.asarray(1, dtype=dtype), -1)
-    t299 = t279*t288
-    t300 = s1 - s1*t299
-    t301 = t293 + c1*t299
-    t302 = -t265 + t295*t299
-    t303 = t282*t249
-    t304 = t280*(t268 + t22*t281 + t303*t269)
-    t305 = -t304 + t268
-    t306 = t22 - t281*t304
-    t307 = t279*t304
-    t308 = t8 - s1*t307
-    t309 = t16 + c1*t307
-    t310 = -t269 + t295*t307
-    t311 = s1*t279
-    t312 = c1*t279
-    t313 = t280*(t275 + t6*t311 + t3*t312 - t303*t277)
-    t314 = -t313 + t275
-    t315 = t6 - t311*t313
-    t316 = t277 + t303*t313
-    t317 = -t3
-    t318 = t317 + t312*t313
-    t319 = xp.greater(t297, 0)
-    t320 = xp.where(t319, 1/(t287 + t298), 0)
-    t321 = xp.where(t319, 1 + xp.abs(t287)/t297, 0)
-    t322 = t292*t320
-    t323 = t294*t320
-    t324 = t296*t320
-    t325 = t321*(t290 + t322*t300 + t323*t301 + t324*t302)
-    t326 = -t325 + t290
-    t327 = t300 - t322*t325
-    t328 = t301 - t323*t325
-    t329 = t302 - t324*t325
-    t330 = t321*(t306 + t322*t308 + t323*t309 + t324*t310)
-    t331 = -t330 + t306
-    t332 = t308 - t322*t330
-    t333 = t309 - t323*t330
-    t334 = t310 - t324*t330
-    t335 = xp.sqrt(t327**2 + t328**2 + t329**2)
-    t336 = t335*xp.where(xp.greater_equal(t327, 0), xp.asarray(1, dtype=dtype), -1)
-    t337 = t281*t313
-    t338 = t321*(-t337 + t322*t315 + t323*t318 + t324*t316)
-    t339 = t337 + t338
-    t340 = t315 - t322*t338
-    t341 = t318 - t323*t338
-    t342 = t316 - t324*t338
-    t343 = xp.greater(t335, 0)
-    t344 = xp.where(t343, 1/(t327 + t336), 0)
-    t345 = xp.where(t343, 1 + xp.abs(t327)/t335, 0)
-    t346 = t328*t344
-    t347 = t329*t344
-    t348 = t345*(t332 + t346*t333 + t347*t334)
-    t349 = -t348 + t332
-    t350 = t333 - t346*t348
-    t351 = t334 - t347*t348
-    t352 = t345*(t340 + t346*t341 + t347*t342)
-    t353 = -t352 + t340
-    t354 = t341 - t346*t352
-    t355 = t342 - t347*t352
-    t356 = xp.sqrt(t350**2 + t351**2)
-    t357 = t356*xp.where(xp.greater_equal(t350, 0), xp.asarray(1, dtype=dtype), -1)
-    t358 = xp.greater(t356, 0)
-    t359 = xp.where(t358, 1/(t350 + t357), 0)
-    t360 = xp.where(t358, 1 + xp.abs(t350)/t356, 0)
-    t361 = t351*t359
-    t362 = t360*(t354 + t361*t355)
-    t363 = -t362 + t354
-    t364 = t355 - t361*t362
-    t365 = xp.abs(t364)
-    t366 = t365*xp.where(xp.greater_equal(t364, 0), xp.asarray(1, dtype=dtype), -1)
-    t367 = xp.where(xp.greater(t365, 0), xp.asarray(2, dtype=dtype), 0)
-    t368 = -t24
-    t369 = 0.5*(-1 + t368 + t13 + t39)
-    t370 = xp.atan2(t42, t369)
-    t371 = xp.where(xp.greater(t42, 0), t370/t42, 1)
-    t372 = xp.greater_equal(t13, t368) & xp.greater_equal(t13, t39)
-    t373 = xp.greater_equal(t368, t39)
-    t374 = xp.where(t372, 0.5*(1 + t13), xp.where(t373, -0.5*t23, 0.5*t37))
-    t375 = xp.where(t372, 0.5*t14, xp.where(t373, 0.5*(1 + t368), 0.5*t38))
-    t376 = xp.where(t372, 0.5*t15, xp.where(t373, -0.5*t25, 0.5*(1 + t39)))
-    t377 = xp.sqrt(t374**2 + t375**2 + t376**2)
-    t378 = xp.where(xp.greater_equal(t40*t374 + t41*t375 + t26*t376, 0), xp.asarray(1, dtype=dtype), -1)
-    t379 = xp.greater(t42, 1e-06) | xp.greater(t369, 0)
-    t380 = t370*t378/t377
-    t381 = xp.where(t379, t40*t371, t380*t374)
-    t382 = xp.where(t379, t41*t371, t380*t375)
-    t383 = xp.where(t379, t26*t371, t380*t376)
-    t384 = mu_dot3 + t381*gain3
-    t385 = mu_dot4 + t382*gain4
-    t386 = mu_dot5 + t383*gain5
-    t387 = t121*(t52 + t122*t250 + t123*t43 + t124*t384 - t125*t385 - t126*t386)
-    t388 = -t387 + t52
-    t389 = t250 - t122*t387
-    t390 = t43 - t123*t387
-    t391 = t384 - t124*t387
-    t392 = t385 + t125*t387
-    t393 = t386 + t126*t387
-    t394 = t167*(t389 + t168*t390 + t169*t391 + t170*t392 + t171*t393)
-    t395 = -t394 + t389
-    t396 = t390 - t168*t394
-    t397 = t391 - t169*t394
-    t398 = t392 - t170*t394
-    t399 = t393 - t171*t394
-    t400 = t200*(t396 + t201*t397 + t202*t398 + t203*t399)
-    t401 = -t400 + t396
-    t402 = t397 - t201*t400
-    t403 = t398 - t202*t400
-    t404 = t399 - t203*t400
-    t405 = t223*(t402 + t224*t403 + t225*t404)
-    t406 = -t405 + t402
-    t407 = t403 - t224*t405
-    t408 = t404 - t225*t405
-    t409 = t238*(t407 + t239*t408)
-    t410 = -t409 + t407
-    t411 = t408 - t239*t409
-    t412 = t411 - t245*t411
-    t413 = xp.where(xp.not_equal(t244, 0), -t412/t244, 0)
-    t414 = xp.where(xp.not_equal(t235, 0), -(t410 - t241*t413)/t235, 0)
-    t415 = xp.where(xp.not_equal(t220, 0), -(t406 + t227*t414 + t231*t413)/t220, 0)
-    t416 = xp.where(xp.not_equal(t197, 0), -(t401 + t210*t414 + t215*t413 - t205*t415)/t197, 0)
-    t417 = xp.where(xp.not_equal(t149, 0), -(-(t173*t416 + t179*t415 - t185*t414 + t191*t413) + t395)/t149, 0)
-    t418 = xp.where(xp.not_equal(t112, 0), -(-(t128*t417 + t152*t416 + t135*t415 - t142*t414 - t159*t413) + t388)/t112, 0)
-    t419 = t413 - t50*t418 + t49*t417
-    t420 = t54*t418 + t57*t417 + t22*t416 - c234*t413 + t8*t415 + t16*t414
-    t421 = t3*t414 - t6*t415 + t30*t413
-    t422 = t247*(t52 + t249*t386 + t252*t250)
-    t423 = -t422 + t52
-    t424 = 1 - c234 + q1 + q2 + q3 + q4 + q5 + t6 + q6 + t49 + t8 + t16 + t53 + t56 + t54 + t57 + t51 + t47 + t21 + t22 + t91 + t92 + t101 + t248 + t251 + t260 + t276 + t317 - 3*c1 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t52 + t250 + t43 + t384 + t385 + t386
-    t425 = s1*t415 - c1*t414
-    t426 = t425 + t51*t416 + t91*t418 + t251*t417
-    t427 = t425 + t47*t416 + t92*t418 + t260*t417
-    t428 = t425 + t21*t416 + t56*t418 + t53*t417
-    t429 = t249*t422
-    t430 = t250 - t49*t429
-    t431 = -t429 + t386
-    t432 = t280*(t430 + t281*t43 + t311*t384 - t312*t385 - t303*t431)
-    t433 = -t432 + t430
-    t434 = t43 - t281*t432
-    t435 = t384 - t311*t432
-    t436 = t385 + t312*t432
-    t437 = t431 + t303*t432
-    t438 = t321*(t434 + t322*t435 + t323*t436 + t324*t437)
-    t439 = -t438 + t434
-    t440 = t435 - t322*t438
-    t441 = t436 - t323*t438
-    t442 = t437 - t324*t438
-    t443 = t345*(t440 + t346*t441 + t347*t442)
-    t444 = -t443 + t440
-    t445 = t441 - t346*t443
-    t446 = t442 - t347*t443
-    t447 = t360*(t445 + t361*t446)
-    t448 = -t447 + t445
-    t449 = t446 - t361*t447
-    t450 = t449 - t367*t449
-    t451 = xp.where(xp.not_equal(t366, 0), -t450/t366, 0)
-    t452 = xp.where(xp.not_equal(t357, 0), -(t448 - t363*t451)/t357, 0)
-    t453 = xp.where(xp.not_equal(t336, 0), -(-(t349*t452 + t353*t451) + t444)/t336, 0)
-    t454 = xp.where(xp.not_equal(t298, 0), -(-(t326*t453 + t331*t452 - t339*t451) + t439)/t298, 0)
-    t455 = xp.where(xp.not_equal(t272, 0), -(-(t286*t454 + t289*t453 + t305*t452 + t314*t451) + t433)/t272, 0)
-    t456 = xp.where(xp.not_equal(t72, 0), -(-(t254*t455 + t262*t454 + t257*t453 + t259*t452 + t273*t249*t451) + t423)/t72, 0)
-    t457 = xp.isfinite(t424)
-    t458 = xp.greater_equal(damping, 0)
-    t459 = xp.greater(damping, 0)
-    t460 = 1e-12*t118
-    t461 = 1e-12*t82
-    t462 = (t459 & (xp.less_equal(t111, t460) | xp.less_equal(t148, t460) | xp.less_equal(t196, t460) | xp.less_equal(t219, t460) | xp.less_equal(t234, t460) | xp.less_equal(t243, t460))) | (xp.less_equal(damping, 0) & (xp.less_equal(t71, t461) | xp.less_equal(t271, t461) | xp.less_equal(t297, t461) | xp.less_equal(t335, t461) | xp.less_equal(t356, t461) | xp.less_equal(t365, t461)))
-    t463 = t457 & t458 & xp.logical_not(t462)
+    t66 = 1 + c234**2 + s5**2*t63
+    t67 = t49**2
+    t68 = t50**2
+    t69 = t67 + t68
+    t70 = xp.sqrt(1 + t69)
+    t71 = xp.where(xp.less_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)*t70
+    t72 = t51**2
+    t73 = t72 + t47**2 + t21**2 + t22**2
+    t74 = t33**2
+    t75 = t32**2
+    t76 = t31**2
+    t77 = t54**2 + t61*t75 + t61*t74 + t61*t76
+    t78 = t68 + t77
+    t79 = t57**2 + t59*t74 + t59*t75 + t59*t76
+    t80 = xp.sqrt(t64 + t65 + t66 + t69 + t73 + t77 + t79)
+    t81 = t67 + t79
+    t82 = c1*s1
+    t83 = -t49*t50 + t54*t57 + t74*t82 + t75*t82 + t76*t82
+    t84 = c1*t51
+    t85 = c1*t47
+    t86 = c1*t21
+    t87 = t54*t22 + t33*t84 + t32*t85 + t31*t86
+    t88 = t84 + t85 + t86 - t16*t22
+    t89 = c1*t33
+    t90 = c1*t32
+    t91 = s1*t56 + s1*t89 + s1*t90
+    t92 = t91 + t8*t54
+    t93 = t91 - t16*t57
+    t94 = s1*t51
+    t95 = s1*t47
+    t96 = s1*t21
+    t97 = t57*t22 + t33*t94 + t32*t95 + t31*t96
+    t98 = t94 + t95 + t96 + t8*t22
+    t99 = 3*s1
+    t100 = t6*t3 + c1*t99 - t63*t82
+    t101 = xp.greater(t70, 0)
+    t102 = xp.where(t101, 1 + xp.abs(t50)/t70, 0)
+    t103 = -t50
+    t104 = xp.where(t101, 1/(t103 + t71), 0)
+    t105 = mu_dot1 + gain1*(t103 + T13)
+    t106 = s1*t33
+    t107 = t49*t104
+    t108 = t102*(t89 + t106*t107)
+    t109 = -t108 + t89
+    t110 = t106 - t107*t108
+    t111 = t102*(t56 + t53*t107)
+    t112 = -t111 + t56
+    t113 = t102*(t54 - c234*t104 + t57*t107)
+    t114 = -t113 + t54
+    t115 = s1*t32
+    t116 = t102*(t90 + t107*t115)
+    t117 = -t116 + t90
+    t118 = t104*t116
+    t119 = t115 - t49*t118
+    t120 = t104*t111
+    t121 = t53 - t49*t120
+    t122 = t104*t113
+    t123 = t57 - t49*t122
+    t124 = c234 + t122
+    t125 = t104**2
+    t126 = xp.sqrt(t59 + t61 + t72 + t110**2 + t125*t108**2)
+    t127 = t126*xp.where(xp.greater_equal(t110, 0), xp.asarray(1, dtype=dtype), -1)
+    t128 = t30*t102
+    t129 = t125*t128
+    t130 = t49*t129
+    t131 = -t30
+    t132 = t129 + t131
+    t133 = xp.greater(t126, 0)
+    t134 = xp.where(t133, 1/(t110 + t127), 0)
+    t135 = xp.where(t133, 1 + xp.abs(t110)/t126, 0)
+    t136 = t51*t134
+    t137 = t108*t134
+    t138 = t125*t137
+    t139 = t59*t134 + t61*t134
+    t140 = t135*(t139 + t119 + t47*t136 + t138*t116)
+    t141 = -t140 + t119
+    t142 = t47 - t136*t140
+    t143 = t135*(t139 + t121 + t21*t136 + t138*t111)
+    t144 = -t143 + t121
+    t145 = t21 - t136*t143
+    t146 = t134*t140
+    t147 = s1 - s1*t146
+    t148 = -c1
+    t149 = t148 + c1*t146
+    t150 = t104*t108
+    t151 = -t118 + t146*t150
+    t152 = xp.sqrt(t142**2 + t147**2 + t149**2 + t151**2)
+    t153 = t152*xp.where(xp.greater_equal(t142, 0), xp.asarray(1, dtype=dtype), -1)
+    t154 = t134*t143
+    t155 = s1 - s1*t154
+    t156 = t148 + c1*t154
+    t157 = -t120 + t150*t154
+    t158 = t137*t104
+    t159 = t135*(t123 + t22*t136 + t158*t124)
+    t160 = -t159 + t123
+    t161 = t22 - t136*t159
+    t162 = t134*t159
+    t163 = t8 - s1*t162
+    t164 = t16 + c1*t162
+    t165 = -t124 + t150*t162
+    t166 = s1*t134
+    t167 = c1*t134
+    t168 = t135*(t130 + t6*t166 + t3*t167 - t158*t132)
+    t169 = -t168 + t130
+    t170 = t6 - t166*t168
+    t171 = t132 + t158*t168
+    t172 = -t3
+    t173 = t172 + t167*t168
+    t174 = xp.greater(t152, 0)
+    t175 = xp.where(t174, 1/(t142 + t153), 0)
+    t176 = xp.where(t174, 1 + xp.abs(t142)/t152, 0)
+    t177 = t147*t175
+    t178 = t149*t175
+    t179 = t151*t175
+    t180 = t176*(t145 + t177*t155 + t178*t156 + t179*t157)
+    t181 = -t180 + t145
+    t182 = t155 - t177*t180
+    t183 = t156 - t178*t180
+    t184 = t157 - t179*t180
+    t185 = t176*(t161 + t177*t163 + t178*t164 + t179*t165)
+    t186 = -t185 + t161
+    t187 = t163 - t177*t185
+    t188 = t164 - t178*t185
+    t189 = t165 - t179*t185
+    t190 = xp.sqrt(t182**2 + t183**2 + t184**2)
+    t191 = t190*xp.where(xp.greater_equal(t182, 0), xp.asarray(1, dtype=dtype), -1)
+    t192 = t136*t168
+    t193 = t176*(-t192 + t177*t170 + t178*t173 + t179*t171)
+    t194 = t192 + t193
+    t195 = t170 - t177*t193
+    t196 = t173 - t178*t193
+    t197 = t171 - t179*t193
+    t198 = xp.greater(t190, 0)
+    t199 = xp.where(t198, 1/(t182 + t191), 0)
+    t200 = xp.where(t198, 1 + xp.abs(t182)/t190, 0)
+    t201 = t183*t199
+    t202 = t184*t199
+    t203 = t200*(t187 + t201*t188 + t202*t189)
+    t204 = -t203 + t187
+    t205 = t188 - t201*t203
+    t206 = t189 - t202*t203
+    t207 = t200*(t195 + t201*t196 + t202*t197)
+    t208 = -t207 + t195
+    t209 = t196 - t201*t207
+    t210 = t197 - t202*t207
+    t211 = xp.sqrt(t205**2 + t206**2)
+    t212 = t211*xp.where(xp.greater_equal(t205, 0), xp.asarray(1, dtype=dtype), -1)
+    t213 = xp.greater(t211, 0)
+    t214 = xp.where(t213, 1/(t205 + t212), 0)
+    t215 = xp.where(t213, 1 + xp.abs(t205)/t211, 0)
+    t216 = t206*t214
+    t217 = t215*(t209 + t216*t210)
+    t218 = -t217 + t209
+    t219 = t210 - t216*t217
+    t220 = xp.abs(t219)
+    t221 = t220*xp.where(xp.greater_equal(t219, 0), xp.asarray(1, dtype=dtype), -1)
+    t222 = xp.where(xp.greater(t220, 0), xp.asarray(2, dtype=dtype), 0)
+    t223 = -t24
+    t224 = 0.5*(-1 + t223 + t13 + t39)
+    t225 = xp.atan2(t42, t224)
+    t226 = xp.where(xp.greater(t42, 0), t225/t42, 1)
+    t227 = xp.greater_equal(t13, t223) & xp.greater_equal(t13, t39)
+    t228 = xp.greater_equal(t223, t39)
+    t229 = xp.where(t227, 0.5*(1 + t13), xp.where(t228, -0.5*t23, 0.5*t37))
+    t230 = xp.where(t227, 0.5*t14, xp.where(t228, 0.5*(1 + t223), 0.5*t38))
+    t231 = xp.where(t227, 0.5*t15, xp.where(t228, -0.5*t25, 0.5*(1 + t39)))
+    t232 = xp.sqrt(t229**2 + t230**2 + t231**2)
+    t233 = xp.where(xp.greater_equal(t40*t229 + t41*t230 + t26*t231, 0), xp.asarray(1, dtype=dtype), -1)
+    t234 = xp.greater(t42, 1e-06) | xp.greater(t224, 0)
+    t235 = t225*t233/t232
+    t236 = xp.where(t234, t40*t226, t235*t229)
+    t237 = xp.where(t234, t41*t226, t235*t230)
+    t238 = xp.where(t234, t26*t226, t235*t231)
+    t239 = mu_dot3 + t236*gain3
+    t240 = mu_dot4 + t237*gain4
+    t241 = mu_dot5 + t238*gain5
+    t242 = t102*(t52 + t104*t241 + t107*t105)
+    t243 = -t242 + t52
+    t244 = 1 - c234 + q1 + q2 + q3 + q4 + q5 + t6 + q6 + t49 + t8 + t16 + t53 + t56 + t54 + t57 + t51 + t47 + t21 + t22 + t89 + t90 + t99 + t103 + t106 + t115 + t131 + t172 - 3*c1 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t52 + t105 + t43 + t239 + t240 + t241
+    t245 = damping**2
+    t246 = _symmetric_solve6(xp, 1, (t245 + t78, t83, t87, t92, -t62, -t55, t245 + t81, t97, t60, -t93, t58, t73 + t245, t98, -t88, -c234*t22, t64 + t245, -t100, -t35, t65 + t245, t36, t66 + t245, t52, t105, t43, t239, t240, t241,))
+    t247 = t246[5]
+    t248 = t246[0]
+    t249 = t246[1]
+    t250 = t247 - t50*t248 + t49*t249
+    t251 = t246[2]
+    t252 = t246[3]
+    t253 = t246[4]
+    t254 = t54*t248 + t57*t249 + t22*t251 + t8*t252 + t16*t253 - c234*t247
+    t255 = -t6*t252 + t3*t253 + t30*t247
+    t256 = s1*t252 - c1*t253
+    t257 = t256 + t89*t248 + t106*t249 + t51*t251
+    t258 = t256 + t90*t248 + t115*t249 + t47*t251
+    t259 = t256 + t56*t248 + t53*t249 + t21*t251
+    t260 = t104*t242
+    t261 = t105 - t49*t260
+    t262 = -t260 + t241
+    t263 = t135*(t261 + t136*t43 + t166*t239 - t167*t240 - t158*t262)
+    t264 = -t263 + t261
+    t265 = t43 - t136*t263
+    t266 = t239 - t166*t263
+    t267 = t240 + t167*t263
+    t268 = t262 + t158*t263
+    t269 = t176*(t265 + t177*t266 + t178*t267 + t179*t268)
+    t270 = -t269 + t265
+    t271 = t266 - t177*t269
+    t272 = t267 - t178*t269
+    t273 = t268 - t179*t269
+    t274 = t200*(t271 + t201*t272 + t202*t273)
+    t275 = -t274 + t271
+    t276 = t272 - t201*t274
+    t277 = t273 - t202*t274
+    t278 = t215*(t276 + t216*t277)
+    t279 = -t278 + t276
+    t280 = t277 - t216*t278
+    t281 = t280 - t222*t280
+    t282 = xp.where(xp.not_equal(t221, 0), -t281/t221, 0)
+    t283 = xp.where(xp.not_equal(t212, 0), -(t279 - t218*t282)/t212, 0)
+    t284 = xp.where(xp.not_equal(t191, 0), -(-(t204*t283 + t208*t282) + t275)/t191, 0)
+    t285 = xp.where(xp.not_equal(t153, 0), -(-(t181*t284 + t186*t283 - t194*t282) + t270)/t153, 0)
+    t286 = xp.where(xp.not_equal(t127, 0), -(-(t141*t285 + t144*t284 + t160*t283 + t169*t282) + t264)/t127, 0)
+    t287 = xp.where(xp.not_equal(t71, 0), -(-(t109*t286 + t117*t285 + t112*t284 + t114*t283 + t128*t104*t282) + t243)/t71, 0)
+    t288 = xp.isfinite(t244)
+    t289 = xp.greater_equal(damping, 0)
+    t290 = xp.greater(damping, 0)
+    t291 = 1e-12*t80
+    t292 = (t290 & xp.greater(t246[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t70, t291) | xp.less_equal(t126, t291) | xp.less_equal(t152, t291) | xp.less_equal(t190, t291) | xp.less_equal(t211, t291) | xp.less_equal(t220, t291)))
+    t293 = t288 & t289 & xp.logical_not(t292)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t463, xp.where(t459, t419, t456), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t463, xp.where(t459, t426, t455), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t463, xp.where(t459, t427, t454), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t463, xp.where(t459, t428, t453), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t463, xp.where(t459, t420, t452), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t463, xp.where(t459, -t421, t451), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t293, xp.where(t290, t250, t287), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t293, xp.where(t290, t257, t286), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t293, xp.where(t290, t258, t285), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t293, xp.where(t290, t259, t284), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t293, xp.where(t290, t254, t283), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t293, xp.where(t290, -t255, t282), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t457 & t458), 2, xp.where(t462, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t288 & t289), 2, xp.where(t292, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 937 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 1000 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (6,)), ("damping", damping, ()))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
@@ -5056,7 +4797,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t74 = t73 + t9*t36
     t75 = t73 - t17*t37
     t76 = s1**2
-    t77 = t52**2 + t37**2 + t64*t76 + t62*t76 + t63*t76
+    t77 = t52**2 + t37**2 + t62*t76 + t63*t76 + t64*t76
     t78 = t34*t76 + t33*t76 + t32*t76 + t9*t37
     t79 = s1*t54
     t80 = s1*t50
@@ -5085,182 +4826,22 @@ def ik_numeric_step(target, q, damping=0.0):
     t103 = xp.where(t100, t44*t92, t101*t96)
     t104 = xp.where(t100, t27*t92, t101*t97)
     t105 = t102**2 + t103**2 + t104**2 + t58**2 + t59**2 + t46**2
-    t106 = damping + t65
-    t107 = xp.sqrt(t106**2 + t67**2 + t71**2 + t74**2 + t61**2 + t55**2)
-    t108 = t107*xp.where(xp.greater_equal(t106, 0), xp.asarray(1, dtype=dtype), -1)
-    t109 = xp.greater(t107, 0)
-    t110 = xp.where(t109, 1/(t106 + t108), 0)
-    t111 = xp.where(t109, 1 + xp.abs(t106)/t107, 0)
-    t112 = damping + t77
-    t113 = t67*t110
-    t114 = t71*t110
-    t115 = t74*t110
-    t116 = t61*t110
-    t117 = t55*t110
-    t118 = t111*(t67 + t112*t113 + t114*t82 + t115*t78 + t116*t75 - t117*t56)
-    t119 = -t118 + t67
-    t120 = t112 - t113*t118
-    t121 = t82 - t114*t118
-    t122 = t78 - t115*t118
-    t123 = -t75 + t116*t118
-    t124 = t56 + t117*t118
-    t125 = t111*(t58 + t113*t59 + t114*t46 + t115*t102 - t116*t103 - t117*t104)
-    t126 = -t125 + t58
-    t127 = t59 - t113*t125
-    t128 = t46 - t114*t125
-    t129 = t102 - t115*t125
-    t130 = t103 + t116*t125
-    t131 = t104 + t117*t125
-    t132 = xp.sqrt(t120**2 + t121**2 + t122**2 + t123**2 + t124**2)
-    t133 = t132*xp.where(xp.greater_equal(t120, 0), xp.asarray(1, dtype=dtype), -1)
-    t134 = damping + t57
-    t135 = c234*t23
-    t136 = t111*(t114*t134 + t71 + t113*t82 + t115*t83 + t116*t72 + t117*t135)
-    t137 = -t136 + t71
-    t138 = t82 - t113*t136
-    t139 = t134 - t114*t136
-    t140 = t83 - t115*t136
-    t141 = -t72 + t116*t136
-    t142 = -t135 + t117*t136
-    t143 = damping + t85
-    t144 = t111*(t74 + t113*t78 + t114*t83 + t115*t143 + t116*t86 + t117*t38)
-    t145 = -t144 + t74
-    t146 = t78 - t113*t144
-    t147 = t83 - t114*t144
-    t148 = t143 - t115*t144
-    t149 = -t86 + t116*t144
-    t150 = -t38 + t117*t144
-    t151 = damping + t87
-    t152 = -t111*(t61 + t113*t75 + t114*t72 + t115*t86 + t116*t151 + t117*t39)
-    t153 = t61 + t152
-    t154 = t75 + t113*t152
-    t155 = t72 + t114*t152
-    t156 = t86 + t115*t152
-    t157 = t151 + t116*t152
-    t158 = t39 + t117*t152
-    t159 = damping + t88
-    t160 = -t111*(t55 - t113*t56 + t114*t135 + t115*t38 + t116*t39 + t117*t159)
-    t161 = t55 + t160
-    t162 = t56 - t113*t160
-    t163 = t135 + t114*t160
-    t164 = t38 + t115*t160
-    t165 = t39 + t116*t160
-    t166 = t159 + t117*t160
-    t167 = xp.greater(t132, 0)
-    t168 = xp.where(t167, 1/(t120 + t133), 0)
-    t169 = xp.where(t167, 1 + xp.abs(t120)/t132, 0)
-    t170 = t121*t168
-    t171 = t122*t168
-    t172 = t123*t168
-    t173 = t124*t168
-    t174 = t169*(t138 + t170*t139 + t171*t140 + t172*t141 + t173*t142)
-    t175 = -t174 + t138
-    t176 = t139 - t170*t174
-    t177 = t140 - t171*t174
-    t178 = t141 - t172*t174
-    t179 = t142 - t173*t174
-    t180 = t169*(t146 + t170*t147 + t171*t148 + t172*t149 + t173*t150)
-    t181 = -t180 + t146
-    t182 = t147 - t170*t180
-    t183 = t148 - t171*t180
-    t184 = t149 - t172*t180
-    t185 = t150 - t173*t180
-    t186 = -t169*(t154 + t170*t155 + t171*t156 - t172*t157 - t173*t158)
-    t187 = t154 + t186
-    t188 = t155 + t170*t186
-    t189 = t156 + t171*t186
-    t190 = t157 - t172*t186
-    t191 = t158 - t173*t186
-    t192 = t169*(t162 - t170*t163 - t171*t164 + t172*t165 + t173*t166)
-    t193 = -t192 + t162
-    t194 = t163 + t170*t192
-    t195 = t164 + t171*t192
-    t196 = t165 - t172*t192
-    t197 = t166 - t173*t192
-    t198 = t169*(t127 + t170*t128 + t171*t129 + t172*t130 + t173*t131)
-    t199 = -t198 + t127
-    t200 = t128 - t170*t198
-    t201 = t129 - t171*t198
-    t202 = t130 - t172*t198
-    t203 = t131 - t173*t198
-    t204 = xp.sqrt(t176**2 + t177**2 + t178**2 + t179**2)
-    t205 = t204*xp.where(xp.greater_equal(t176, 0), xp.asarray(1, dtype=dtype), -1)
-    t206 = xp.greater(t204, 0)
-    t207 = xp.where(t206, 1/(t176 + t205), 0)
-    t208 = xp.where(t206, 1 + xp.abs(t176)/t204, 0)
-    t209 = t177*t207
-    t210 = t178*t207
-    t211 = t179*t207
-    t212 = t208*(t182 + t209*t183 + t210*t184 + t211*t185)
-    t213 = -t212 + t182
-    t214 = t183 - t209*t212
-    t215 = t184 - t210*t212
-    t216 = t185 - t211*t212
-    t217 = t208*(-t188 - t209*t189 + t210*t190 + t211*t191)
-    t218 = t188 + t217
-    t219 = t189 + t209*t217
-    t220 = t190 - t210*t217
-    t221 = t191 - t211*t217
-    t222 = t208*(-t194 - t209*t195 + t210*t196 + t211*t197)
-    t223 = t194 + t222
-    t224 = t195 + t209*t222
-    t225 = t196 - t210*t222
-    t226 = t197 - t211*t222
-    t227 = t208*(t200 + t209*t201 + t210*t202 + t211*t203)
-    t228 = -t227 + t200
-    t229 = t201 - t209*t227
-    t230 = t202 - t210*t227
-    t231 = t203 - t211*t227
-    t232 = xp.sqrt(t214**2 + t215**2 + t216**2)
-    t233 = t232*xp.where(xp.greater_equal(t214, 0), xp.asarray(1, dtype=dtype), -1)
-    t234 = xp.greater(t232, 0)
-    t235 = xp.where(t234, 1/(t214 + t233), 0)
-    t236 = xp.where(t234, 1 + xp.abs(t214)/t232, 0)
-    t237 = t215*t235
-    t238 = t216*t235
-    t239 = t236*(-t219 + t237*t220 + t238*t221)
-    t240 = t219 + t239
-    t241 = t220 - t237*t239
-    t242 = t221 - t238*t239
-    t243 = t236*(-t224 + t237*t225 + t238*t226)
-    t244 = t224 + t243
-    t245 = t225 - t237*t243
-    t246 = t226 - t238*t243
-    t247 = t236*(t229 + t237*t230 + t238*t231)
-    t248 = -t247 + t229
-    t249 = t230 - t237*t247
-    t250 = t231 - t238*t247
-    t251 = xp.sqrt(t241**2 + t242**2)
-    t252 = t251*xp.where(xp.greater_equal(t241, 0), xp.asarray(1, dtype=dtype), -1)
-    t253 = xp.greater(t251, 0)
-    t254 = xp.where(t253, 1/(t241 + t252), 0)
-    t255 = xp.where(t253, 1 + xp.abs(t241)/t251, 0)
-    t256 = t242*t254
-    t257 = t255*(t245 + t256*t246)
-    t258 = -t257 + t245
-    t259 = t246 - t256*t257
-    t260 = t255*(t249 + t256*t250)
-    t261 = -t260 + t249
-    t262 = t250 - t256*t260
-    t263 = xp.abs(t259)
-    t264 = t263*xp.where(xp.greater_equal(t259, 0), xp.asarray(1, dtype=dtype), -1)
-    t265 = xp.where(xp.greater(t263, 0), xp.asarray(2, dtype=dtype), 0)
-    t266 = t262 - t262*t265
-    t267 = xp.where(xp.not_equal(t264, 0), -t266/t264, 0)
-    t268 = xp.where(xp.not_equal(t252, 0), -(t261 - t258*t267)/t252, 0)
-    t269 = xp.where(xp.not_equal(t233, 0), -(t248 + t240*t268 + t244*t267)/t233, 0)
-    t270 = xp.where(xp.not_equal(t205, 0), -(t228 + t218*t268 + t223*t267 - t213*t269)/t205, 0)
-    t271 = xp.where(xp.not_equal(t133, 0), -(-(t175*t270 + t181*t269 - t187*t268 + t193*t267) + t199)/t133, 0)
-    t272 = xp.where(xp.not_equal(t108, 0), -(-(t119*t271 + t137*t270 + t145*t269 - t153*t268 - t161*t267) + t126)/t108, 0)
-    t273 = q1 + t267 - t53*t272 + t52*t271
-    t274 = q5 + t36*t272 + t37*t271 + t23*t270 - c234*t267 + t9*t269 + t17*t268
-    t275 = q6 + t7*t269 - t4*t268 - t31*t267
-    t276 = c1*t272
-    t277 = s1*t271
-    t278 = s1*t269 - c1*t268
-    t279 = q2 + t278 + t54*t270 + t34*t276 + t34*t277
-    t280 = q3 + t278 + t50*t270 + t33*t276 + t33*t277
-    t281 = q4 + t278 + t22*t270 + t32*t276 + t32*t277
+    t106 = _symmetric_solve6(xp, 1, (damping + t65, t67, t71, t74, -t61, -t55, damping + t77, t82, t78, -t75, t56, damping + t57, t83, -t72, -c234*t23, damping + t85, -t86, -t38, damping + t87, t39, damping + t88, t58, t59, t46, t102, t103, t104,))
+    t107 = t106[5]
+    t108 = t106[0]
+    t109 = t106[1]
+    t110 = q1 + t107 - t53*t108 + t52*t109
+    t111 = c1*t108
+    t112 = s1*t109
+    t113 = t106[2]
+    t114 = t106[3]
+    t115 = t106[4]
+    t116 = q5 + t36*t108 + t37*t109 + t23*t113 + t9*t114 + t17*t115 - c234*t107
+    t117 = q6 + t7*t114 - t4*t115 - t31*t107
+    t118 = s1*t114 - c1*t115
+    t119 = q2 + t118 + t34*t111 + t34*t112 + t54*t113
+    t120 = q3 + t118 + t33*t111 + t33*t112 + t50*t113
+    t121 = q4 + t118 + t32*t111 + t32*t112 + t22*t113
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -5270,12 +4851,12 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q6, batch),  # 5
     ], (6,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t273, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t273, 6.283185307179586), 6.283185307179586, t273)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t279, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t279, 6.283185307179586), 6.283185307179586, t279)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t280, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t280, 6.283185307179586), 6.283185307179586, t280)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t281, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t281, 6.283185307179586), 6.283185307179586, t281)), batch),  # 3
-        xp.broadcast_to(xp.where(xp.less(t274, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t274, 6.283185307179586), 6.283185307179586, t274)), batch),  # 4
-        xp.broadcast_to(xp.where(xp.less(t275, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t275, 6.283185307179586), 6.283185307179586, t275)), batch),  # 5
+        xp.broadcast_to(xp.where(xp.less(t110, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t110, 6.283185307179586), 6.283185307179586, t110)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t119, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t119, 6.283185307179586), 6.283185307179586, t119)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t120, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t120, 6.283185307179586), 6.283185307179586, t120)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t121, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t121, 6.283185307179586), 6.283185307179586, t121)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t116, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t116, 6.283185307179586), 6.283185307179586, t116)), batch),  # 4
+        xp.broadcast_to(xp.where(xp.less(t117, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t117, 6.283185307179586), 6.283185307179586, t117)), batch),  # 5
     ], (6,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t0), t105, -1), batch)
     return q_start, q_next, cost
@@ -5844,7 +5425,7 @@ def ik_branches(T):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 963 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 962 operations."""
     xp, dtype, device, batch, (T, q_seed, weights,) = _arguments(("T", T, (4, 4)), ("q_seed", q_seed, (6,)), ("weights", weights, (6,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(T)
     T00 = T[..., 0, 0]
@@ -5935,366 +5516,27 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     lb5 = branches_in_limits[..., 5]
     lb6 = branches_in_limits[..., 6]
     lb7 = branches_in_limits[..., 7]
-    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
-    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
-    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
-    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
-    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
-    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
-    t6 = xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0)
-    t7 = xp.where(xp.greater(t6, 0), xp.asarray(1, dtype=dtype), 0)
-    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
-    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
-    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
-    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
-    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
-    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
-    t14 = xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0)
-    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
-    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
-    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
-    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
-    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
-    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
-    t21 = xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0)
-    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
-    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
-    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
-    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
-    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
-    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
-    t28 = xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0)
-    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
-    t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
-    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
-    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
-    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
-    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
-    t35 = xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0)
-    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
-    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
-    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
-    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
-    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
-    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
-    t42 = xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0)
-    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
-    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
-    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
-    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
-    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
-    t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
-    t49 = xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0)
-    t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
-    t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
-    t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
-    t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
-    t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
-    t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
-    t56 = xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0)
-    t57 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
-    t58 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t59 = t58 + t0
-    t60 = -t58 + t0
-    t61 = xp.where(xp.greater_equal(t0, -6.283185307179586) & xp.less_equal(t0, 6.283185307179586), t0, xp.where(xp.greater_equal(t59, -6.283185307179586) & xp.less_equal(t59, 6.283185307179586), t59, xp.where(xp.greater_equal(t60, -6.283185307179586) & xp.less_equal(t60, 6.283185307179586), t60, qb0_0)))
-    t62 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t63 = t62 + t1
-    t64 = -t62 + t1
-    t65 = xp.where(xp.greater_equal(t1, -6.283185307179586) & xp.less_equal(t1, 6.283185307179586), t1, xp.where(xp.greater_equal(t63, -6.283185307179586) & xp.less_equal(t63, 6.283185307179586), t63, xp.where(xp.greater_equal(t64, -6.283185307179586) & xp.less_equal(t64, 6.283185307179586), t64, qb0_1)))
-    t66 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t67 = t66 + t2
-    t68 = -t66 + t2
-    t69 = xp.where(xp.greater_equal(t2, -6.283185307179586) & xp.less_equal(t2, 6.283185307179586), t2, xp.where(xp.greater_equal(t67, -6.283185307179586) & xp.less_equal(t67, 6.283185307179586), t67, xp.where(xp.greater_equal(t68, -6.283185307179586) & xp.less_equal(t68, 6.283185307179586), t68, qb0_2)))
-    t70 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t71 = t70 + t3
-    t72 = -t70 + t3
-    t73 = xp.where(xp.greater_equal(t3, -6.283185307179586) & xp.less_equal(t3, 6.283185307179586), t3, xp.where(xp.greater_equal(t71, -6.283185307179586) & xp.less_equal(t71, 6.283185307179586), t71, xp.where(xp.greater_equal(t72, -6.283185307179586) & xp.less_equal(t72, 6.283185307179586), t72, qb0_3)))
-    t74 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t75 = t74 + t4
-    t76 = -t74 + t4
-    t77 = xp.where(xp.greater_equal(t4, -6.283185307179586) & xp.less_equal(t4, 6.283185307179586), t4, xp.where(xp.greater_equal(t75, -6.283185307179586) & xp.less_equal(t75, 6.283185307179586), t75, xp.where(xp.greater_equal(t76, -6.283185307179586) & xp.less_equal(t76, 6.283185307179586), t76, qb0_4)))
-    t78 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t79 = t78 + t5
-    t80 = -t78 + t5
-    t81 = xp.where(xp.greater_equal(t5, -6.283185307179586) & xp.less_equal(t5, 6.283185307179586), t5, xp.where(xp.greater_equal(t79, -6.283185307179586) & xp.less_equal(t79, 6.283185307179586), t79, xp.where(xp.greater_equal(t80, -6.283185307179586) & xp.less_equal(t80, 6.283185307179586), t80, qb0_5)))
-    t82 = -qn1
-    t83 = -qn2
-    t84 = -qn3
-    t85 = -qn4
-    t86 = -qn5
-    t87 = -qn6
-    t88 = qw1*(t82 + t61)**2 + qw2*(t83 + t65)**2 + qw3*(t84 + t69)**2 + qw4*(t85 + t73)**2 + qw5*(t86 + t77)**2 + qw6*(t87 + t81)**2
-    t89 = xp.greater(t7, 0)
-    t90 = xp.where(t89, t61, qn1)
-    t91 = xp.where(t89, t65, qn2)
-    t92 = xp.where(t89, t69, qn3)
-    t93 = xp.where(t89, t73, qn4)
-    t94 = xp.where(t89, t77, qn5)
-    t95 = xp.where(t89, t81, qn6)
-    t96 = xp.where(t89, t88, 0)
-    t97 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t98 = t97 + t8
-    t99 = -t97 + t8
-    t100 = xp.where(xp.greater_equal(t8, -6.283185307179586) & xp.less_equal(t8, 6.283185307179586), t8, xp.where(xp.greater_equal(t98, -6.283185307179586) & xp.less_equal(t98, 6.283185307179586), t98, xp.where(xp.greater_equal(t99, -6.283185307179586) & xp.less_equal(t99, 6.283185307179586), t99, qb1_0)))
-    t101 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t102 = t101 + t9
-    t103 = -t101 + t9
-    t104 = xp.where(xp.greater_equal(t9, -6.283185307179586) & xp.less_equal(t9, 6.283185307179586), t9, xp.where(xp.greater_equal(t102, -6.283185307179586) & xp.less_equal(t102, 6.283185307179586), t102, xp.where(xp.greater_equal(t103, -6.283185307179586) & xp.less_equal(t103, 6.283185307179586), t103, qb1_1)))
-    t105 = xp.where(xp.less(t10, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t106 = t105 + t10
-    t107 = -t105 + t10
-    t108 = xp.where(xp.greater_equal(t10, -6.283185307179586) & xp.less_equal(t10, 6.283185307179586), t10, xp.where(xp.greater_equal(t106, -6.283185307179586) & xp.less_equal(t106, 6.283185307179586), t106, xp.where(xp.greater_equal(t107, -6.283185307179586) & xp.less_equal(t107, 6.283185307179586), t107, qb1_2)))
-    t109 = xp.where(xp.less(t11, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t110 = t109 + t11
-    t111 = -t109 + t11
-    t112 = xp.where(xp.greater_equal(t11, -6.283185307179586) & xp.less_equal(t11, 6.283185307179586), t11, xp.where(xp.greater_equal(t110, -6.283185307179586) & xp.less_equal(t110, 6.283185307179586), t110, xp.where(xp.greater_equal(t111, -6.283185307179586) & xp.less_equal(t111, 6.283185307179586), t111, qb1_3)))
-    t113 = xp.where(xp.less(t12, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t114 = t113 + t12
-    t115 = -t113 + t12
-    t116 = xp.where(xp.greater_equal(t12, -6.283185307179586) & xp.less_equal(t12, 6.283185307179586), t12, xp.where(xp.greater_equal(t114, -6.283185307179586) & xp.less_equal(t114, 6.283185307179586), t114, xp.where(xp.greater_equal(t115, -6.283185307179586) & xp.less_equal(t115, 6.283185307179586), t115, qb1_4)))
-    t117 = xp.where(xp.less(t13, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t118 = t117 + t13
-    t119 = -t117 + t13
-    t120 = xp.where(xp.greater_equal(t13, -6.283185307179586) & xp.less_equal(t13, 6.283185307179586), t13, xp.where(xp.greater_equal(t118, -6.283185307179586) & xp.less_equal(t118, 6.283185307179586), t118, xp.where(xp.greater_equal(t119, -6.283185307179586) & xp.less_equal(t119, 6.283185307179586), t119, qb1_5)))
-    t121 = qw1*(t82 + t100)**2 + qw2*(t83 + t104)**2 + qw3*(t84 + t108)**2 + qw4*(t85 + t112)**2 + qw5*(t86 + t116)**2 + qw6*(t87 + t120)**2
-    t122 = xp.greater(t14, 0)
-    t123 = xp.where(t122 & (xp.less(t7, 1) | xp.less(t121, t96)), xp.asarray(1, dtype=dtype), 0)
-    t124 = xp.where(t122, 1, t7)
-    t125 = xp.greater(t123, 0)
-    t126 = xp.where(t125, t100, t90)
-    t127 = xp.where(t125, t104, t91)
-    t128 = xp.where(t125, t108, t92)
-    t129 = xp.where(t125, t112, t93)
-    t130 = xp.where(t125, t116, t94)
-    t131 = xp.where(t125, t120, t95)
-    t132 = xp.where(t125, t121, t96)
-    t133 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t134 = t133 + t15
-    t135 = -t133 + t15
-    t136 = xp.where(xp.greater_equal(t15, -6.283185307179586) & xp.less_equal(t15, 6.283185307179586), t15, xp.where(xp.greater_equal(t134, -6.283185307179586) & xp.less_equal(t134, 6.283185307179586), t134, xp.where(xp.greater_equal(t135, -6.283185307179586) & xp.less_equal(t135, 6.283185307179586), t135, qb2_0)))
-    t137 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t138 = t137 + t16
-    t139 = -t137 + t16
-    t140 = xp.where(xp.greater_equal(t16, -6.283185307179586) & xp.less_equal(t16, 6.283185307179586), t16, xp.where(xp.greater_equal(t138, -6.283185307179586) & xp.less_equal(t138, 6.283185307179586), t138, xp.where(xp.greater_equal(t139, -6.283185307179586) & xp.less_equal(t139, 6.283185307179586), t139, qb2_1)))
-    t141 = xp.where(xp.less(t17, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t142 = t141 + t17
-    t143 = -t141 + t17
-    t144 = xp.where(xp.greater_equal(t17, -6.283185307179586) & xp.less_equal(t17, 6.283185307179586), t17, xp.where(xp.greater_equal(t142, -6.283185307179586) & xp.less_equal(t142, 6.283185307179586), t142, xp.where(xp.greater_equal(t143, -6.283185307179586) & xp.less_equal(t143, 6.283185307179586), t143, qb2_2)))
-    t145 = xp.where(xp.less(t18, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t146 = t145 + t18
-    t147 = -t145 + t18
-    t148 = xp.where(xp.greater_equal(t18, -6.283185307179586) & xp.less_equal(t18, 6.283185307179586), t18, xp.where(xp.greater_equal(t146, -6.283185307179586) & xp.less_equal(t146, 6.283185307179586), t146, xp.where(xp.greater_equal(t147, -6.283185307179586) & xp.less_equal(t147, 6.283185307179586), t147, qb2_3)))
-    t149 = xp.where(xp.less(t19, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t150 = t149 + t19
-    t151 = -t149 + t19
-    t152 = xp.where(xp.greater_equal(t19, -6.283185307179586) & xp.less_equal(t19, 6.283185307179586), t19, xp.where(xp.greater_equal(t150, -6.283185307179586) & xp.less_equal(t150, 6.283185307179586), t150, xp.where(xp.greater_equal(t151, -6.283185307179586) & xp.less_equal(t151, 6.283185307179586), t151, qb2_4)))
-    t153 = xp.where(xp.less(t20, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t154 = t153 + t20
-    t155 = -t153 + t20
-    t156 = xp.where(xp.greater_equal(t20, -6.283185307179586) & xp.less_equal(t20, 6.283185307179586), t20, xp.where(xp.greater_equal(t154, -6.283185307179586) & xp.less_equal(t154, 6.283185307179586), t154, xp.where(xp.greater_equal(t155, -6.283185307179586) & xp.less_equal(t155, 6.283185307179586), t155, qb2_5)))
-    t157 = qw1*(t82 + t136)**2 + qw2*(t83 + t140)**2 + qw3*(t84 + t144)**2 + qw4*(t85 + t148)**2 + qw5*(t86 + t152)**2 + qw6*(t87 + t156)**2
-    t158 = xp.greater(t21, 0)
-    t159 = xp.where(t158 & (xp.less(t124, 1) | xp.less(t157, t132)), xp.asarray(1, dtype=dtype), 0)
-    t160 = xp.where(t158, 1, t124)
-    t161 = xp.greater(t159, 0)
-    t162 = xp.where(t161, t136, t126)
-    t163 = xp.where(t161, t140, t127)
-    t164 = xp.where(t161, t144, t128)
-    t165 = xp.where(t161, t148, t129)
-    t166 = xp.where(t161, t152, t130)
-    t167 = xp.where(t161, t156, t131)
-    t168 = xp.where(t161, t157, t132)
-    t169 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t170 = t169 + t22
-    t171 = -t169 + t22
-    t172 = xp.where(xp.greater_equal(t22, -6.283185307179586) & xp.less_equal(t22, 6.283185307179586), t22, xp.where(xp.greater_equal(t170, -6.283185307179586) & xp.less_equal(t170, 6.283185307179586), t170, xp.where(xp.greater_equal(t171, -6.283185307179586) & xp.less_equal(t171, 6.283185307179586), t171, qb3_0)))
-    t173 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t174 = t173 + t23
-    t175 = -t173 + t23
-    t176 = xp.where(xp.greater_equal(t23, -6.283185307179586) & xp.less_equal(t23, 6.283185307179586), t23, xp.where(xp.greater_equal(t174, -6.283185307179586) & xp.less_equal(t174, 6.283185307179586), t174, xp.where(xp.greater_equal(t175, -6.283185307179586) & xp.less_equal(t175, 6.283185307179586), t175, qb3_1)))
-    t177 = xp.where(xp.less(t24, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t178 = t177 + t24
-    t179 = -t177 + t24
-    t180 = xp.where(xp.greater_equal(t24, -6.283185307179586) & xp.less_equal(t24, 6.283185307179586), t24, xp.where(xp.greater_equal(t178, -6.283185307179586) & xp.less_equal(t178, 6.283185307179586), t178, xp.where(xp.greater_equal(t179, -6.283185307179586) & xp.less_equal(t179, 6.283185307179586), t179, qb3_2)))
-    t181 = xp.where(xp.less(t25, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t182 = t181 + t25
-    t183 = -t181 + t25
-    t184 = xp.where(xp.greater_equal(t25, -6.283185307179586) & xp.less_equal(t25, 6.283185307179586), t25, xp.where(xp.greater_equal(t182, -6.283185307179586) & xp.less_equal(t182, 6.283185307179586), t182, xp.where(xp.greater_equal(t183, -6.283185307179586) & xp.less_equal(t183, 6.283185307179586), t183, qb3_3)))
-    t185 = xp.where(xp.less(t26, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t186 = t185 + t26
-    t187 = -t185 + t26
-    t188 = xp.where(xp.greater_equal(t26, -6.283185307179586) & xp.less_equal(t26, 6.283185307179586), t26, xp.where(xp.greater_equal(t186, -6.283185307179586) & xp.less_equal(t186, 6.283185307179586), t186, xp.where(xp.greater_equal(t187, -6.283185307179586) & xp.less_equal(t187, 6.283185307179586), t187, qb3_4)))
-    t189 = xp.where(xp.less(t27, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t190 = t189 + t27
-    t191 = -t189 + t27
-    t192 = xp.where(xp.greater_equal(t27, -6.283185307179586) & xp.less_equal(t27, 6.283185307179586), t27, xp.where(xp.greater_equal(t190, -6.283185307179586) & xp.less_equal(t190, 6.283185307179586), t190, xp.where(xp.greater_equal(t191, -6.283185307179586) & xp.less_equal(t191, 6.283185307179586), t191, qb3_5)))
-    t193 = qw1*(t82 + t172)**2 + qw2*(t83 + t176)**2 + qw3*(t84 + t180)**2 + qw4*(t85 + t184)**2 + qw5*(t86 + t188)**2 + qw6*(t87 + t192)**2
-    t194 = xp.greater(t28, 0)
-    t195 = xp.where(t194 & (xp.less(t160, 1) | xp.less(t193, t168)), xp.asarray(1, dtype=dtype), 0)
-    t196 = xp.where(t194, 1, t160)
-    t197 = xp.greater(t195, 0)
-    t198 = xp.where(t197, t172, t162)
-    t199 = xp.where(t197, t176, t163)
-    t200 = xp.where(t197, t180, t164)
-    t201 = xp.where(t197, t184, t165)
-    t202 = xp.where(t197, t188, t166)
-    t203 = xp.where(t197, t192, t167)
-    t204 = xp.where(t197, t193, t168)
-    t205 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t206 = t205 + t29
-    t207 = -t205 + t29
-    t208 = xp.where(xp.greater_equal(t29, -6.283185307179586) & xp.less_equal(t29, 6.283185307179586), t29, xp.where(xp.greater_equal(t206, -6.283185307179586) & xp.less_equal(t206, 6.283185307179586), t206, xp.where(xp.greater_equal(t207, -6.283185307179586) & xp.less_equal(t207, 6.283185307179586), t207, qb4_0)))
-    t209 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t210 = t209 + t30
-    t211 = -t209 + t30
-    t212 = xp.where(xp.greater_equal(t30, -6.283185307179586) & xp.less_equal(t30, 6.283185307179586), t30, xp.where(xp.greater_equal(t210, -6.283185307179586) & xp.less_equal(t210, 6.283185307179586), t210, xp.where(xp.greater_equal(t211, -6.283185307179586) & xp.less_equal(t211, 6.283185307179586), t211, qb4_1)))
-    t213 = xp.where(xp.less(t31, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t214 = t213 + t31
-    t215 = -t213 + t31
-    t216 = xp.where(xp.greater_equal(t31, -6.283185307179586) & xp.less_equal(t31, 6.283185307179586), t31, xp.where(xp.greater_equal(t214, -6.283185307179586) & xp.less_equal(t214, 6.283185307179586), t214, xp.where(xp.greater_equal(t215, -6.283185307179586) & xp.less_equal(t215, 6.283185307179586), t215, qb4_2)))
-    t217 = xp.where(xp.less(t32, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t218 = t217 + t32
-    t219 = -t217 + t32
-    t220 = xp.where(xp.greater_equal(t32, -6.283185307179586) & xp.less_equal(t32, 6.283185307179586), t32, xp.where(xp.greater_equal(t218, -6.283185307179586) & xp.less_equal(t218, 6.283185307179586), t218, xp.where(xp.greater_equal(t219, -6.283185307179586) & xp.less_equal(t219, 6.283185307179586), t219, qb4_3)))
-    t221 = xp.where(xp.less(t33, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t222 = t221 + t33
-    t223 = -t221 + t33
-    t224 = xp.where(xp.greater_equal(t33, -6.283185307179586) & xp.less_equal(t33, 6.283185307179586), t33, xp.where(xp.greater_equal(t222, -6.283185307179586) & xp.less_equal(t222, 6.283185307179586), t222, xp.where(xp.greater_equal(t223, -6.283185307179586) & xp.less_equal(t223, 6.283185307179586), t223, qb4_4)))
-    t225 = xp.where(xp.less(t34, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t226 = t225 + t34
-    t227 = -t225 + t34
-    t228 = xp.where(xp.greater_equal(t34, -6.283185307179586) & xp.less_equal(t34, 6.283185307179586), t34, xp.where(xp.greater_equal(t226, -6.283185307179586) & xp.less_equal(t226, 6.283185307179586), t226, xp.where(xp.greater_equal(t227, -6.283185307179586) & xp.less_equal(t227, 6.283185307179586), t227, qb4_5)))
-    t229 = qw1*(t82 + t208)**2 + qw2*(t83 + t212)**2 + qw3*(t84 + t216)**2 + qw4*(t85 + t220)**2 + qw5*(t86 + t224)**2 + qw6*(t87 + t228)**2
-    t230 = xp.greater(t35, 0)
-    t231 = xp.where(t230 & (xp.less(t196, 1) | xp.less(t229, t204)), xp.asarray(1, dtype=dtype), 0)
-    t232 = xp.where(t230, 1, t196)
-    t233 = xp.greater(t231, 0)
-    t234 = xp.where(t233, t208, t198)
-    t235 = xp.where(t233, t212, t199)
-    t236 = xp.where(t233, t216, t200)
-    t237 = xp.where(t233, t220, t201)
-    t238 = xp.where(t233, t224, t202)
-    t239 = xp.where(t233, t228, t203)
-    t240 = xp.where(t233, t229, t204)
-    t241 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t242 = t241 + t36
-    t243 = -t241 + t36
-    t244 = xp.where(xp.greater_equal(t36, -6.283185307179586) & xp.less_equal(t36, 6.283185307179586), t36, xp.where(xp.greater_equal(t242, -6.283185307179586) & xp.less_equal(t242, 6.283185307179586), t242, xp.where(xp.greater_equal(t243, -6.283185307179586) & xp.less_equal(t243, 6.283185307179586), t243, qb5_0)))
-    t245 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t246 = t245 + t37
-    t247 = -t245 + t37
-    t248 = xp.where(xp.greater_equal(t37, -6.283185307179586) & xp.less_equal(t37, 6.283185307179586), t37, xp.where(xp.greater_equal(t246, -6.283185307179586) & xp.less_equal(t246, 6.283185307179586), t246, xp.where(xp.greater_equal(t247, -6.283185307179586) & xp.less_equal(t247, 6.283185307179586), t247, qb5_1)))
-    t249 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t250 = t249 + t38
-    t251 = -t249 + t38
-    t252 = xp.where(xp.greater_equal(t38, -6.283185307179586) & xp.less_equal(t38, 6.283185307179586), t38, xp.where(xp.greater_equal(t250, -6.283185307179586) & xp.less_equal(t250, 6.283185307179586), t250, xp.where(xp.greater_equal(t251, -6.283185307179586) & xp.less_equal(t251, 6.283185307179586), t251, qb5_2)))
-    t253 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t254 = t253 + t39
-    t255 = -t253 + t39
-    t256 = xp.where(xp.greater_equal(t39, -6.283185307179586) & xp.less_equal(t39, 6.283185307179586), t39, xp.where(xp.greater_equal(t254, -6.283185307179586) & xp.less_equal(t254, 6.283185307179586), t254, xp.where(xp.greater_equal(t255, -6.283185307179586) & xp.less_equal(t255, 6.283185307179586), t255, qb5_3)))
-    t257 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t258 = t257 + t40
-    t259 = -t257 + t40
-    t260 = xp.where(xp.greater_equal(t40, -6.283185307179586) & xp.less_equal(t40, 6.283185307179586), t40, xp.where(xp.greater_equal(t258, -6.283185307179586) & xp.less_equal(t258, 6.283185307179586), t258, xp.where(xp.greater_equal(t259, -6.283185307179586) & xp.less_equal(t259, 6.283185307179586), t259, qb5_4)))
-    t261 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t262 = t261 + t41
-    t263 = -t261 + t41
-    t264 = xp.where(xp.greater_equal(t41, -6.283185307179586) & xp.less_equal(t41, 6.283185307179586), t41, xp.where(xp.greater_equal(t262, -6.283185307179586) & xp.less_equal(t262, 6.283185307179586), t262, xp.where(xp.greater_equal(t263, -6.283185307179586) & xp.less_equal(t263, 6.283185307179586), t263, qb5_5)))
-    t265 = qw1*(t82 + t244)**2 + qw2*(t83 + t248)**2 + qw3*(t84 + t252)**2 + qw4*(t85 + t256)**2 + qw5*(t86 + t260)**2 + qw6*(t87 + t264)**2
-    t266 = xp.greater(t42, 0)
-    t267 = xp.where(t266 & (xp.less(t232, 1) | xp.less(t265, t240)), xp.asarray(1, dtype=dtype), 0)
-    t268 = xp.where(t266, 1, t232)
-    t269 = xp.greater(t267, 0)
-    t270 = xp.where(t269, t244, t234)
-    t271 = xp.where(t269, t248, t235)
-    t272 = xp.where(t269, t252, t236)
-    t273 = xp.where(t269, t256, t237)
-    t274 = xp.where(t269, t260, t238)
-    t275 = xp.where(t269, t264, t239)
-    t276 = xp.where(t269, t265, t240)
-    t277 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t278 = t277 + t43
-    t279 = -t277 + t43
-    t280 = xp.where(xp.greater_equal(t43, -6.283185307179586) & xp.less_equal(t43, 6.283185307179586), t43, xp.where(xp.greater_equal(t278, -6.283185307179586) & xp.less_equal(t278, 6.283185307179586), t278, xp.where(xp.greater_equal(t279, -6.283185307179586) & xp.less_equal(t279, 6.283185307179586), t279, qb6_0)))
-    t281 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t282 = t281 + t44
-    t283 = -t281 + t44
-    t284 = xp.where(xp.greater_equal(t44, -6.283185307179586) & xp.less_equal(t44, 6.283185307179586), t44, xp.where(xp.greater_equal(t282, -6.283185307179586) & xp.less_equal(t282, 6.283185307179586), t282, xp.where(xp.greater_equal(t283, -6.283185307179586) & xp.less_equal(t283, 6.283185307179586), t283, qb6_1)))
-    t285 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t286 = t285 + t45
-    t287 = -t285 + t45
-    t288 = xp.where(xp.greater_equal(t45, -6.283185307179586) & xp.less_equal(t45, 6.283185307179586), t45, xp.where(xp.greater_equal(t286, -6.283185307179586) & xp.less_equal(t286, 6.283185307179586), t286, xp.where(xp.greater_equal(t287, -6.283185307179586) & xp.less_equal(t287, 6.283185307179586), t287, qb6_2)))
-    t289 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t290 = t289 + t46
-    t291 = -t289 + t46
-    t292 = xp.where(xp.greater_equal(t46, -6.283185307179586) & xp.less_equal(t46, 6.283185307179586), t46, xp.where(xp.greater_equal(t290, -6.283185307179586) & xp.less_equal(t290, 6.283185307179586), t290, xp.where(xp.greater_equal(t291, -6.283185307179586) & xp.less_equal(t291, 6.283185307179586), t291, qb6_3)))
-    t293 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t294 = t293 + t47
-    t295 = -t293 + t47
-    t296 = xp.where(xp.greater_equal(t47, -6.283185307179586) & xp.less_equal(t47, 6.283185307179586), t47, xp.where(xp.greater_equal(t294, -6.283185307179586) & xp.less_equal(t294, 6.283185307179586), t294, xp.where(xp.greater_equal(t295, -6.283185307179586) & xp.less_equal(t295, 6.283185307179586), t295, qb6_4)))
-    t297 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t298 = t297 + t48
-    t299 = -t297 + t48
-    t300 = xp.where(xp.greater_equal(t48, -6.283185307179586) & xp.less_equal(t48, 6.283185307179586), t48, xp.where(xp.greater_equal(t298, -6.283185307179586) & xp.less_equal(t298, 6.283185307179586), t298, xp.where(xp.greater_equal(t299, -6.283185307179586) & xp.less_equal(t299, 6.283185307179586), t299, qb6_5)))
-    t301 = qw1*(t82 + t280)**2 + qw2*(t83 + t284)**2 + qw3*(t84 + t288)**2 + qw4*(t85 + t292)**2 + qw5*(t86 + t296)**2 + qw6*(t87 + t300)**2
-    t302 = xp.greater(t49, 0)
-    t303 = xp.where(t302 & (xp.less(t268, 1) | xp.less(t301, t276)), xp.asarray(1, dtype=dtype), 0)
-    t304 = xp.where(t302, 1, t268)
-    t305 = xp.greater(t303, 0)
-    t306 = xp.where(t305, t280, t270)
-    t307 = xp.where(t305, t284, t271)
-    t308 = xp.where(t305, t288, t272)
-    t309 = xp.where(t305, t292, t273)
-    t310 = xp.where(t305, t296, t274)
-    t311 = xp.where(t305, t300, t275)
-    t312 = xp.where(t305, t301, t276)
-    t313 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t314 = t313 + t50
-    t315 = -t313 + t50
-    t316 = xp.where(xp.greater_equal(t50, -6.283185307179586) & xp.less_equal(t50, 6.283185307179586), t50, xp.where(xp.greater_equal(t314, -6.283185307179586) & xp.less_equal(t314, 6.283185307179586), t314, xp.where(xp.greater_equal(t315, -6.283185307179586) & xp.less_equal(t315, 6.283185307179586), t315, qb7_0)))
-    t317 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t318 = t317 + t51
-    t319 = -t317 + t51
-    t320 = xp.where(xp.greater_equal(t51, -6.283185307179586) & xp.less_equal(t51, 6.283185307179586), t51, xp.where(xp.greater_equal(t318, -6.283185307179586) & xp.less_equal(t318, 6.283185307179586), t318, xp.where(xp.greater_equal(t319, -6.283185307179586) & xp.less_equal(t319, 6.283185307179586), t319, qb7_1)))
-    t321 = xp.where(xp.less(t52, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t322 = t321 + t52
-    t323 = -t321 + t52
-    t324 = xp.where(xp.greater_equal(t52, -6.283185307179586) & xp.less_equal(t52, 6.283185307179586), t52, xp.where(xp.greater_equal(t322, -6.283185307179586) & xp.less_equal(t322, 6.283185307179586), t322, xp.where(xp.greater_equal(t323, -6.283185307179586) & xp.less_equal(t323, 6.283185307179586), t323, qb7_2)))
-    t325 = xp.where(xp.less(t53, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t326 = t325 + t53
-    t327 = -t325 + t53
-    t328 = xp.where(xp.greater_equal(t53, -6.283185307179586) & xp.less_equal(t53, 6.283185307179586), t53, xp.where(xp.greater_equal(t326, -6.283185307179586) & xp.less_equal(t326, 6.283185307179586), t326, xp.where(xp.greater_equal(t327, -6.283185307179586) & xp.less_equal(t327, 6.283185307179586), t327, qb7_3)))
-    t329 = xp.where(xp.less(t54, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t330 = t329 + t54
-    t331 = -t329 + t54
-    t332 = xp.where(xp.greater_equal(t54, -6.283185307179586) & xp.less_equal(t54, 6.283185307179586), t54, xp.where(xp.greater_equal(t330, -6.283185307179586) & xp.less_equal(t330, 6.283185307179586), t330, xp.where(xp.greater_equal(t331, -6.283185307179586) & xp.less_equal(t331, 6.283185307179586), t331, qb7_4)))
-    t333 = xp.where(xp.less(t55, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t334 = t333 + t55
-    t335 = -t333 + t55
-    t336 = xp.where(xp.greater_equal(t55, -6.283185307179586) & xp.less_equal(t55, 6.283185307179586), t55, xp.where(xp.greater_equal(t334, -6.283185307179586) & xp.less_equal(t334, 6.283185307179586), t334, xp.where(xp.greater_equal(t335, -6.283185307179586) & xp.less_equal(t335, 6.283185307179586), t335, qb7_5)))
-    t337 = qw1*(t82 + t316)**2 + qw2*(t83 + t320)**2 + qw3*(t84 + t324)**2 + qw4*(t85 + t328)**2 + qw5*(t86 + t332)**2 + qw6*(t87 + t336)**2
-    t338 = xp.greater(t56, 0)
-    t339 = xp.where(t338 & (xp.less(t304, 1) | xp.less(t337, t312)), xp.asarray(1, dtype=dtype), 0)
-    t340 = xp.where(t338, 1, t304)
-    t341 = xp.greater(t339, 0)
-    t342 = xp.where(t341, t316, t306)
-    t343 = xp.where(t341, t320, t307)
-    t344 = xp.where(t341, t324, t308)
-    t345 = xp.where(t341, t328, t309)
-    t346 = xp.where(t341, t332, t310)
-    t347 = xp.where(t341, t336, t311)
-    t348 = xp.greater(t340, 0)
-    t349 = xp.isfinite(t57)
-    t350 = t348 & t349
+    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
+    t1 = _nearer_branch(xp, 1, (qb0_0, qb0_1, qb0_2, qb0_3, qb0_4, qb0_5, xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, qn1, qn2, qn3, qn4, qn5, qn6, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
+    t2 = _nearer_branch(xp, 1, (qb1_0, qb1_1, qb1_2, qb1_3, qb1_4, qb1_5, xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t1[0], t1[1], t1[2], t1[3], t1[4], t1[5], t1[6], t1[7],))
+    t3 = _nearer_branch(xp, 1, (qb2_0, qb2_1, qb2_2, qb2_3, qb2_4, qb2_5, xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t2[0], t2[1], t2[2], t2[3], t2[4], t2[5], t2[6], t2[7],))
+    t4 = _nearer_branch(xp, 1, (qb3_0, qb3_1, qb3_2, qb3_3, qb3_4, qb3_5, xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t3[0], t3[1], t3[2], t3[3], t3[4], t3[5], t3[6], t3[7],))
+    t5 = _nearer_branch(xp, 1, (qb4_0, qb4_1, qb4_2, qb4_3, qb4_4, qb4_5, xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t4[0], t4[1], t4[2], t4[3], t4[4], t4[5], t4[6], t4[7],))
+    t6 = _nearer_branch(xp, 1, (qb5_0, qb5_1, qb5_2, qb5_3, qb5_4, qb5_5, xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t5[0], t5[1], t5[2], t5[3], t5[4], t5[5], t5[6], t5[7],))
+    t7 = _nearer_branch(xp, 1, (qb6_0, qb6_1, qb6_2, qb6_3, qb6_4, qb6_5, xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t6[0], t6[1], t6[2], t6[3], t6[4], t6[5], t6[6], t6[7],))
+    t8 = _nearer_branch(xp, 1, (qb7_0, qb7_1, qb7_2, qb7_3, qb7_4, qb7_5, xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t7[0], t7[1], t7[2], t7[3], t7[4], t7[5], t7[6], t7[7],))
+    t9 = xp.greater(t8[7], 0)
+    t10 = xp.isfinite(t0)
+    t11 = t9 & t10
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t350, t342, qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t350, t343, qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t350, t344, qn3), batch),  # 2
-        xp.broadcast_to(xp.where(t350, t345, qn4), batch),  # 3
-        xp.broadcast_to(xp.where(t350, t346, qn5), batch),  # 4
-        xp.broadcast_to(xp.where(t350, t347, qn6), batch),  # 5
+        xp.broadcast_to(xp.where(t11, t8[0], qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t11, t8[1], qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t11, t8[2], qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t11, t8[3], qn4), batch),  # 3
+        xp.broadcast_to(xp.where(t11, t8[4], qn5), batch),  # 4
+        xp.broadcast_to(xp.where(t11, t8[5], qn6), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t349), 2, xp.where(t348, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t10), 2, xp.where(t9, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

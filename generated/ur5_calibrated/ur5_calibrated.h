@@ -125,7 +125,7 @@ int ur5_calibrated_velocity_ik_nullspace(const ur5_calibrated_real q[UR5_CALIBRA
 int ur5_calibrated_resolved_rate(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], const ur5_calibrated_real target[16], const ur5_calibrated_real target_rate[UR5_CALIBRATED_TASK_DIM], const ur5_calibrated_real gain[UR5_CALIBRATED_TASK_DIM], const ur5_calibrated_real z[UR5_CALIBRATED_DOF], ur5_calibrated_real damping, ur5_calibrated_real q_dot[UR5_CALIBRATED_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
- * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1238 operations. */
+ * Result: q_start[i], i < 6; q_next[i], i < 6; returned as a scalar. 1297 operations. */
 ur5_calibrated_real ur5_calibrated_ik_numeric_step(const ur5_calibrated_real target[16], const ur5_calibrated_real q[UR5_CALIBRATED_DOF], ur5_calibrated_real damping, ur5_calibrated_real q_start[UR5_CALIBRATED_DOF], ur5_calibrated_real q_next[UR5_CALIBRATED_DOF]);
 
 /* The general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9).
@@ -149,7 +149,7 @@ int ur5_calibrated_ik_general_limits(const ur5_calibrated_real q_solution[UR5_CA
 int ur5_calibrated_ik_general_nominal(const ur5_calibrated_real T[16], ur5_calibrated_real q[48], int valid[8]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 6; returned as a scalar. 1891 operations. */
+ * Result: q[i], i < 6; returned as a scalar. 1890 operations. */
 int ur5_calibrated_ik_nearest(const ur5_calibrated_real T[16], const ur5_calibrated_real q_seed[UR5_CALIBRATED_DOF], const ur5_calibrated_real weights[UR5_CALIBRATED_DOF], ur5_calibrated_real q[UR5_CALIBRATED_DOF]);
 
 /* Statuses of ur5_calibrated_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -82,6 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -335,6 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi6_rows(xp, count, state):
     """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
     state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2 + w4**2 + w5**2
@@ -896,6 +898,255 @@ def _jacobi6_rows(xp, count, state):
             t489,
             t493,
             t497,
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _symmetric_solve6(xp, count, state):
+    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w1**2
+        t1 = w2**2
+        t2 = w3**2
+        t3 = w4**2
+        t4 = w5**2
+        t5 = w0**2
+        t6 = xp.sqrt(t5 + 2*t0 + 2*t1 + 2*w7**2 + 2*t2 + 2*w8**2 + 2*w12**2 + 2*t3 + 2*w9**2 + 2*w13**2 + 2*w16**2 + 2*t4 + 2*w10**2 + 2*w14**2 + 2*w17**2 + 2*w19**2 + w6**2 + w11**2 + w15**2 + w18**2 + w20**2)
+        t7 = xp.sqrt(t0 + t1 + t2 + t3 + t4 + t5)
+        t8 = t7*xp.where(xp.greater_equal(w0, 0), xp.asarray(1, dtype=dtype), -1)
+        t9 = xp.greater(t7, 0)
+        t10 = xp.where(t9, 1/(w0 + t8), 0)
+        t11 = xp.where(t9, 1 + xp.abs(w0)/t7, 0)
+        t12 = w1*t10
+        t13 = w2*t10
+        t14 = w3*t10
+        t15 = w4*t10
+        t16 = w5*t10
+        t17 = t11*(w1 + t12*w6 + t13*w7 + t14*w8 + t15*w9 + t16*w10)
+        t18 = -t17 + w1
+        t19 = w6 - t12*t17
+        t20 = w7 - t13*t17
+        t21 = w8 - t14*t17
+        t22 = w9 - t15*t17
+        t23 = w10 - t16*t17
+        t24 = t11*(w2 + t12*w7 + t13*w11 + t14*w12 + t15*w13 + t16*w14)
+        t25 = -t24 + w2
+        t26 = w7 - t12*t24
+        t27 = w11 - t13*t24
+        t28 = w12 - t14*t24
+        t29 = w13 - t15*t24
+        t30 = w14 - t16*t24
+        t31 = t11*(w3 + t12*w8 + t13*w12 + t14*w15 + t15*w16 + t16*w17)
+        t32 = -t31 + w3
+        t33 = w8 - t12*t31
+        t34 = w12 - t13*t31
+        t35 = w15 - t14*t31
+        t36 = w16 - t15*t31
+        t37 = w17 - t16*t31
+        t38 = t11*(w4 + t12*w9 + t13*w13 + t14*w16 + t15*w18 + t16*w19)
+        t39 = -t38 + w4
+        t40 = w9 - t12*t38
+        t41 = w13 - t13*t38
+        t42 = w16 - t14*t38
+        t43 = w18 - t15*t38
+        t44 = w19 - t16*t38
+        t45 = t11*(w5 + t12*w10 + t13*w14 + t14*w17 + t15*w19 + t16*w20)
+        t46 = -t45 + w5
+        t47 = w10 - t12*t45
+        t48 = w14 - t13*t45
+        t49 = w17 - t14*t45
+        t50 = w19 - t15*t45
+        t51 = w20 - t16*t45
+        t52 = t11*(w21 + t12*w22 + t13*w23 + t14*w24 + t15*w25 + t16*w26)
+        t53 = -t52 + w21
+        t54 = w22 - t12*t52
+        t55 = w23 - t13*t52
+        t56 = w24 - t14*t52
+        t57 = w25 - t15*t52
+        t58 = w26 - t16*t52
+        t59 = xp.sqrt(t19**2 + t20**2 + t21**2 + t22**2 + t23**2)
+        t60 = t59*xp.where(xp.greater_equal(t19, 0), xp.asarray(1, dtype=dtype), -1)
+        t61 = xp.greater(t59, 0)
+        t62 = xp.where(t61, 1/(t19 + t60), 0)
+        t63 = xp.where(t61, 1 + xp.abs(t19)/t59, 0)
+        t64 = t20*t62
+        t65 = t21*t62
+        t66 = t22*t62
+        t67 = t23*t62
+        t68 = t63*(t26 + t64*t27 + t65*t28 + t66*t29 + t67*t30)
+        t69 = -t68 + t26
+        t70 = t27 - t64*t68
+        t71 = t28 - t65*t68
+        t72 = t29 - t66*t68
+        t73 = t30 - t67*t68
+        t74 = t63*(t33 + t64*t34 + t65*t35 + t66*t36 + t67*t37)
+        t75 = -t74 + t33
+        t76 = t34 - t64*t74
+        t77 = t35 - t65*t74
+        t78 = t36 - t66*t74
+        t79 = t37 - t67*t74
+        t80 = t63*(t40 + t64*t41 + t65*t42 + t66*t43 + t67*t44)
+        t81 = -t80 + t40
+        t82 = t41 - t64*t80
+        t83 = t42 - t65*t80
+        t84 = t43 - t66*t80
+        t85 = t44 - t67*t80
+        t86 = t63*(t47 + t64*t48 + t65*t49 + t66*t50 + t67*t51)
+        t87 = -t86 + t47
+        t88 = t48 - t64*t86
+        t89 = t49 - t65*t86
+        t90 = t50 - t66*t86
+        t91 = t51 - t67*t86
+        t92 = t63*(t54 + t64*t55 + t65*t56 + t66*t57 + t67*t58)
+        t93 = -t92 + t54
+        t94 = t55 - t64*t92
+        t95 = t56 - t65*t92
+        t96 = t57 - t66*t92
+        t97 = t58 - t67*t92
+        t98 = xp.sqrt(t70**2 + t71**2 + t72**2 + t73**2)
+        t99 = t98*xp.where(xp.greater_equal(t70, 0), xp.asarray(1, dtype=dtype), -1)
+        t100 = xp.greater(t98, 0)
+        t101 = xp.where(t100, 1/(t70 + t99), 0)
+        t102 = xp.where(t100, 1 + xp.abs(t70)/t98, 0)
+        t103 = t71*t101
+        t104 = t72*t101
+        t105 = t73*t101
+        t106 = t102*(t76 + t103*t77 + t104*t78 + t105*t79)
+        t107 = -t106 + t76
+        t108 = t77 - t103*t106
+        t109 = t78 - t104*t106
+        t110 = t79 - t105*t106
+        t111 = t102*(t82 + t103*t83 + t104*t84 + t105*t85)
+        t112 = -t111 + t82
+        t113 = t83 - t103*t111
+        t114 = t84 - t104*t111
+        t115 = t85 - t105*t111
+        t116 = t102*(t88 + t103*t89 + t104*t90 + t105*t91)
+        t117 = -t116 + t88
+        t118 = t89 - t103*t116
+        t119 = t90 - t104*t116
+        t120 = t91 - t105*t116
+        t121 = t102*(t94 + t103*t95 + t104*t96 + t105*t97)
+        t122 = -t121 + t94
+        t123 = t95 - t103*t121
+        t124 = t96 - t104*t121
+        t125 = t97 - t105*t121
+        t126 = xp.sqrt(t108**2 + t109**2 + t110**2)
+        t127 = t126*xp.where(xp.greater_equal(t108, 0), xp.asarray(1, dtype=dtype), -1)
+        t128 = xp.greater(t126, 0)
+        t129 = xp.where(t128, 1/(t108 + t127), 0)
+        t130 = xp.where(t128, 1 + xp.abs(t108)/t126, 0)
+        t131 = t109*t129
+        t132 = t110*t129
+        t133 = t130*(t113 + t131*t114 + t132*t115)
+        t134 = -t133 + t113
+        t135 = t114 - t131*t133
+        t136 = t115 - t132*t133
+        t137 = t130*(t118 + t131*t119 + t132*t120)
+        t138 = -t137 + t118
+        t139 = t119 - t131*t137
+        t140 = t120 - t132*t137
+        t141 = t130*(t123 + t131*t124 + t132*t125)
+        t142 = -t141 + t123
+        t143 = t124 - t131*t141
+        t144 = t125 - t132*t141
+        t145 = xp.sqrt(t135**2 + t136**2)
+        t146 = t145*xp.where(xp.greater_equal(t135, 0), xp.asarray(1, dtype=dtype), -1)
+        t147 = xp.greater(t145, 0)
+        t148 = xp.where(t147, 1/(t135 + t146), 0)
+        t149 = xp.where(t147, 1 + xp.abs(t135)/t145, 0)
+        t150 = t136*t148
+        t151 = t149*(t139 + t150*t140)
+        t152 = -t151 + t139
+        t153 = t140 - t150*t151
+        t154 = t149*(t143 + t150*t144)
+        t155 = -t154 + t143
+        t156 = t144 - t150*t154
+        t157 = xp.abs(t153)
+        t158 = t157*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
+        t159 = xp.where(xp.greater(t157, 0), xp.asarray(2, dtype=dtype), 0)
+        t160 = t156 - t156*t159
+        t161 = xp.where(xp.not_equal(t158, 0), -t160/t158, 0)
+        t162 = xp.where(xp.not_equal(t146, 0), -(t155 - t152*t161)/t146, 0)
+        t163 = xp.where(xp.not_equal(t127, 0), -(-(t134*t162 + t138*t161) + t142)/t127, 0)
+        t164 = xp.where(xp.not_equal(t99, 0), -(-(t107*t163 + t112*t162 + t117*t161) + t122)/t99, 0)
+        t165 = xp.where(xp.not_equal(t60, 0), -(-(t69*t164 + t75*t163 + t81*t162 + t87*t161) + t93)/t60, 0)
+        t166 = xp.where(xp.not_equal(t8, 0), -(-(t18*t165 + t25*t164 + t32*t163 + t39*t162 + t46*t161) + t53)/t8, 0)
+        t167 = 1e-12*t6
+        state = (
+            t166,
+            t165,
+            t164,
+            t163,
+            t162,
+            t161,
+            xp.where(xp.less_equal(t7, t167) | xp.less_equal(t59, t167) | xp.less_equal(t98, t167) | xp.less_equal(t126, t167) | xp.less_equal(t145, t167) | xp.less_equal(t157, t167), xp.asarray(1, dtype=dtype), 0),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _nearer_branch(xp, count, state):
+    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 114 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype = state[0].dtype
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
+        t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w7))
+        t1 = w1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w1 + w8))
+        t2 = w2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w2 + w9))
+        t3 = w3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w3 + w10))
+        t4 = w4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w4 + w11))
+        t5 = w5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w5 + w12))
+        t6 = xp.where(xp.less(t0, w7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t7 = t6 + t0
+        t8 = -t6 + t0
+        t9 = xp.where(xp.greater_equal(t0, -6.283185307179586) & xp.less_equal(t0, 6.283185307179586), t0, xp.where(xp.greater_equal(t7, -6.283185307179586) & xp.less_equal(t7, 6.283185307179586), t7, xp.where(xp.greater_equal(t8, -6.283185307179586) & xp.less_equal(t8, 6.283185307179586), t8, w0)))
+        t10 = xp.where(xp.less(t1, w8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t11 = t10 + t1
+        t12 = -t10 + t1
+        t13 = xp.where(xp.greater_equal(t1, -6.283185307179586) & xp.less_equal(t1, 6.283185307179586), t1, xp.where(xp.greater_equal(t11, -6.283185307179586) & xp.less_equal(t11, 6.283185307179586), t11, xp.where(xp.greater_equal(t12, -6.283185307179586) & xp.less_equal(t12, 6.283185307179586), t12, w1)))
+        t14 = xp.where(xp.less(t2, w9), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t15 = t14 + t2
+        t16 = -t14 + t2
+        t17 = xp.where(xp.greater_equal(t2, -6.283185307179586) & xp.less_equal(t2, 6.283185307179586), t2, xp.where(xp.greater_equal(t15, -6.283185307179586) & xp.less_equal(t15, 6.283185307179586), t15, xp.where(xp.greater_equal(t16, -6.283185307179586) & xp.less_equal(t16, 6.283185307179586), t16, w2)))
+        t18 = xp.where(xp.less(t3, w10), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t19 = t18 + t3
+        t20 = -t18 + t3
+        t21 = xp.where(xp.greater_equal(t3, -6.283185307179586) & xp.less_equal(t3, 6.283185307179586), t3, xp.where(xp.greater_equal(t19, -6.283185307179586) & xp.less_equal(t19, 6.283185307179586), t19, xp.where(xp.greater_equal(t20, -6.283185307179586) & xp.less_equal(t20, 6.283185307179586), t20, w3)))
+        t22 = xp.where(xp.less(t4, w11), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t23 = t22 + t4
+        t24 = -t22 + t4
+        t25 = xp.where(xp.greater_equal(t4, -6.283185307179586) & xp.less_equal(t4, 6.283185307179586), t4, xp.where(xp.greater_equal(t23, -6.283185307179586) & xp.less_equal(t23, 6.283185307179586), t23, xp.where(xp.greater_equal(t24, -6.283185307179586) & xp.less_equal(t24, 6.283185307179586), t24, w4)))
+        t26 = xp.where(xp.less(t5, w12), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+        t27 = t26 + t5
+        t28 = -t26 + t5
+        t29 = xp.where(xp.greater_equal(t5, -6.283185307179586) & xp.less_equal(t5, 6.283185307179586), t5, xp.where(xp.greater_equal(t27, -6.283185307179586) & xp.less_equal(t27, 6.283185307179586), t27, xp.where(xp.greater_equal(t28, -6.283185307179586) & xp.less_equal(t28, 6.283185307179586), t28, w5)))
+        t30 = w13*(-w7 + t9)**2 + w14*(-w8 + t13)**2 + w15*(-w9 + t17)**2 + w16*(-w10 + t21)**2 + w17*(-w11 + t25)**2 + w18*(-w12 + t29)**2
+        t31 = xp.greater(w6, 0)
+        t32 = xp.where(t31 & (xp.less(w26, 1) | xp.less(t30, w25)), xp.asarray(1, dtype=dtype), 0)
+        t33 = xp.where(t31, 1, w26)
+        t34 = xp.greater(t32, 0)
+        t35 = xp.where(t34, t9, w19)
+        t36 = xp.where(t34, t13, w20)
+        t37 = xp.where(t34, t17, w21)
+        t38 = xp.where(t34, t21, w22)
+        t39 = xp.where(t34, t25, w23)
+        t40 = xp.where(t34, t29, w24)
+        t41 = xp.where(t34, t30, w25)
+        state = (
+            t35,
+            t36,
+            t37,
+            t38,
+            t39,
+            t40,
+            t41,
+            t33,
         )
     return state
 
@@ -5542,344 +5793,177 @@ def velocity_ik(q, mu_dot, damping=0.0):
     t146 = -t102
     t147 = 0.0009999730384501195*t103 + t146 + t17*t104 + t38*t105 + t59*t106 + t81*t107
     t148 = 0.9990000269615499 - t103 - t1 + q1 + t0 + q2 + q3 + q4 + q5 + q6 + t101 + t15 + t16 + t17 + t36 + t37 + t38 + t57 + t58 + t59 + t78 + t79 + t81 + t146 + t104 + t105 + t106 + t107 + t108 + t109 + t110 + t111 + t112 + t113 + t114 + t115 + t116 + t117 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t149 = t118**2
-    t150 = t119**2
-    t151 = t120**2
-    t152 = t121**2
-    t153 = t147**2
-    t154 = damping**2
-    t155 = t154 + t142
-    t156 = t155**2
-    t157 = xp.sqrt(t149 + t150 + t151 + t152 + t153 + t156)
-    t158 = t157*xp.where(xp.greater_equal(t155, 0), xp.asarray(1, dtype=dtype), -1)
-    t159 = t154 + t145
-    t160 = t135 + t154
-    t161 = t137 + t154
-    t162 = t139 + t154
-    t163 = t140 + t154
-    t164 = xp.sqrt(t156 + t159**2 + 2*t149 + 2*t150 + 2*t122**2 + 2*t151 + 2*t123**2 + 2*t126**2 + 2*t152 + 2*t124**2 + 2*t127**2 + 2*t80**2 + 2*t153 + 2*t125**2 + 2*t128**2 + 2*t82**2 + 2*t83**2 + t160**2 + t161**2 + t162**2 + t163**2)
-    t165 = xp.greater(t157, 0)
-    t166 = xp.where(t165, 1/(t155 + t158), 0)
-    t167 = xp.where(t165, 1 + xp.abs(t155)/t157, 0)
-    t168 = t118*t166
-    t169 = t119*t166
-    t170 = t120*t166
-    t171 = t121*t166
-    t172 = t147*t166
-    t173 = t167*(t118 + t159*t168 + t169*t122 + t170*t123 + t171*t124 + t172*t125)
-    t174 = -t173 + t118
-    t175 = t159 - t168*t173
-    t176 = t122 - t169*t173
-    t177 = t123 - t170*t173
-    t178 = t124 - t171*t173
-    t179 = t125 - t172*t173
-    t180 = t167*(t119 + t168*t122 + t160*t169 + t170*t126 + t171*t127 + t172*t128)
-    t181 = -t180 + t119
-    t182 = t122 - t168*t180
-    t183 = t160 - t169*t180
-    t184 = t126 - t170*t180
-    t185 = t127 - t171*t180
-    t186 = t128 - t172*t180
-    t187 = t167*(t120 + t168*t123 + t169*t126 + t161*t170 + t171*t80 + t172*t82)
-    t188 = -t187 + t120
-    t189 = t123 - t168*t187
-    t190 = t126 - t169*t187
-    t191 = t161 - t170*t187
-    t192 = t80 - t171*t187
-    t193 = t82 - t172*t187
-    t194 = t167*(t121 + t168*t124 + t169*t127 + t170*t80 + t162*t171 + t172*t83)
-    t195 = -t194 + t121
-    t196 = t124 - t168*t194
-    t197 = t127 - t169*t194
-    t198 = t80 - t170*t194
-    t199 = t162 - t171*t194
-    t200 = t83 - t172*t194
-    t201 = t167*(t147 + t168*t125 + t169*t128 + t170*t82 + t171*t83 + t163*t172)
-    t202 = -t201 + t147
-    t203 = t125 - t168*t201
-    t204 = t128 - t169*t201
-    t205 = t82 - t170*t201
-    t206 = t83 - t171*t201
-    t207 = t163 - t172*t201
-    t208 = t167*(mu_dot0 + t168*mu_dot1 + t169*mu_dot2 + t170*mu_dot3 + t171*mu_dot4 + t172*mu_dot5)
-    t209 = -t208 + mu_dot0
-    t210 = mu_dot1 - t168*t208
-    t211 = mu_dot2 - t169*t208
-    t212 = mu_dot3 - t170*t208
-    t213 = mu_dot4 - t171*t208
-    t214 = mu_dot5 - t172*t208
-    t215 = xp.sqrt(t175**2 + t176**2 + t177**2 + t178**2 + t179**2)
-    t216 = t215*xp.where(xp.greater_equal(t175, 0), xp.asarray(1, dtype=dtype), -1)
-    t217 = xp.greater(t215, 0)
-    t218 = xp.where(t217, 1/(t175 + t216), 0)
-    t219 = xp.where(t217, 1 + xp.abs(t175)/t215, 0)
-    t220 = t176*t218
-    t221 = t177*t218
-    t222 = t178*t218
-    t223 = t179*t218
-    t224 = t219*(t182 + t220*t183 + t221*t184 + t222*t185 + t223*t186)
-    t225 = -t224 + t182
-    t226 = t183 - t220*t224
-    t227 = t184 - t221*t224
-    t228 = t185 - t222*t224
-    t229 = t186 - t223*t224
-    t230 = t219*(t189 + t220*t190 + t221*t191 + t222*t192 + t223*t193)
-    t231 = -t230 + t189
-    t232 = t190 - t220*t230
-    t233 = t191 - t221*t230
-    t234 = t192 - t222*t230
-    t235 = t193 - t223*t230
-    t236 = t219*(t196 + t220*t197 + t221*t198 + t222*t199 + t223*t200)
-    t237 = -t236 + t196
-    t238 = t197 - t220*t236
-    t239 = t198 - t221*t236
-    t240 = t199 - t222*t236
-    t241 = t200 - t223*t236
-    t242 = t219*(t203 + t220*t204 + t221*t205 + t222*t206 + t223*t207)
-    t243 = -t242 + t203
-    t244 = t204 - t220*t242
-    t245 = t205 - t221*t242
-    t246 = t206 - t222*t242
-    t247 = t207 - t223*t242
-    t248 = t219*(t210 + t220*t211 + t221*t212 + t222*t213 + t223*t214)
-    t249 = -t248 + t210
-    t250 = t211 - t220*t248
-    t251 = t212 - t221*t248
-    t252 = t213 - t222*t248
-    t253 = t214 - t223*t248
-    t254 = xp.sqrt(t226**2 + t227**2 + t228**2 + t229**2)
-    t255 = t254*xp.where(xp.greater_equal(t226, 0), xp.asarray(1, dtype=dtype), -1)
-    t256 = xp.greater(t254, 0)
-    t257 = xp.where(t256, 1/(t226 + t255), 0)
-    t258 = xp.where(t256, 1 + xp.abs(t226)/t254, 0)
-    t259 = t227*t257
-    t260 = t228*t257
-    t261 = t229*t257
-    t262 = t258*(t232 + t259*t233 + t260*t234 + t261*t235)
-    t263 = -t262 + t232
-    t264 = t233 - t259*t262
-    t265 = t234 - t260*t262
-    t266 = t235 - t261*t262
-    t267 = t258*(t238 + t259*t239 + t260*t240 + t261*t241)
-    t268 = -t267 + t238
-    t269 = t239 - t259*t267
-    t270 = t240 - t260*t267
-    t271 = t241 - t261*t267
-    t272 = t258*(t244 + t259*t245 + t260*t246 + t261*t247)
-    t273 = -t272 + t244
-    t274 = t245 - t259*t272
-    t275 = t246 - t260*t272
-    t276 = t247 - t261*t272
-    t277 = t258*(t250 + t259*t251 + t260*t252 + t261*t253)
-    t278 = -t277 + t250
-    t279 = t251 - t259*t277
-    t280 = t252 - t260*t277
-    t281 = t253 - t261*t277
-    t282 = xp.sqrt(t264**2 + t265**2 + t266**2)
-    t283 = t282*xp.where(xp.greater_equal(t264, 0), xp.asarray(1, dtype=dtype), -1)
-    t284 = xp.greater(t282, 0)
-    t285 = xp.where(t284, 1/(t264 + t283), 0)
-    t286 = xp.where(t284, 1 + xp.abs(t264)/t282, 0)
-    t287 = t265*t285
-    t288 = t266*t285
-    t289 = t286*(t269 + t287*t270 + t288*t271)
-    t290 = -t289 + t269
-    t291 = t270 - t287*t289
-    t292 = t271 - t288*t289
-    t293 = t286*(t274 + t287*t275 + t288*t276)
-    t294 = -t293 + t274
-    t295 = t275 - t287*t293
-    t296 = t276 - t288*t293
-    t297 = t286*(t279 + t287*t280 + t288*t281)
-    t298 = -t297 + t279
-    t299 = t280 - t287*t297
-    t300 = t281 - t288*t297
-    t301 = xp.sqrt(t291**2 + t292**2)
-    t302 = t301*xp.where(xp.greater_equal(t291, 0), xp.asarray(1, dtype=dtype), -1)
-    t303 = xp.greater(t301, 0)
-    t304 = xp.where(t303, 1/(t291 + t302), 0)
-    t305 = xp.where(t303, 1 + xp.abs(t291)/t301, 0)
-    t306 = t292*t304
-    t307 = t305*(t295 + t306*t296)
-    t308 = -t307 + t295
-    t309 = t296 - t306*t307
-    t310 = t305*(t299 + t306*t300)
-    t311 = -t310 + t299
-    t312 = t300 - t306*t310
-    t313 = xp.abs(t309)
-    t314 = t313*xp.where(xp.greater_equal(t309, 0), xp.asarray(1, dtype=dtype), -1)
-    t315 = xp.where(xp.greater(t313, 0), xp.asarray(2, dtype=dtype), 0)
-    t316 = t312 - t312*t315
-    t317 = xp.where(xp.not_equal(t314, 0), -t316/t314, 0)
-    t318 = xp.where(xp.not_equal(t302, 0), -(t311 - t308*t317)/t302, 0)
-    t319 = xp.where(xp.not_equal(t283, 0), -(-(t290*t318 + t294*t317) + t298)/t283, 0)
-    t320 = xp.where(xp.not_equal(t255, 0), -(-(t263*t319 + t268*t318 + t273*t317) + t278)/t255, 0)
-    t321 = xp.where(xp.not_equal(t216, 0), -(-(t225*t320 + t231*t319 + t237*t318 + t243*t317) + t249)/t216, 0)
-    t322 = xp.where(xp.not_equal(t158, 0), -(-(t174*t321 + t181*t320 + t188*t319 + t195*t318 + t202*t317) + t209)/t158, 0)
-    t323 = t317 - t102*t322 + t101*t321
-    t324 = -0.0009999730384501195*t317 - t103*t322 + t108*t321 + t113*t320 + t0*t319 - t1*t318
-    t325 = t104*t322 + t109*t321 + t114*t320 + t15*t319 + t16*t318 + t17*t317
-    t326 = t105*t322 + t110*t321 + t115*t320 + t36*t319 + t37*t318 + t38*t317
-    t327 = t106*t322 + t111*t321 + t116*t320 + t57*t319 + t58*t318 + t59*t317
-    t328 = t107*t322 + t112*t321 + t117*t320 + t78*t319 + t79*t318 + t81*t317
-    t329 = xp.greater(t132, 0)
-    t330 = xp.where(t329, 1/(t146 + t133), 0)
-    t331 = xp.where(t329, 1 + xp.abs(t102)/t132, 0)
-    t332 = t101*t330
-    t333 = -t331*(0.0009999730384501195*t330 + t103 - t108*t332)
-    t334 = t103 + t333
-    t335 = t331*(t104 + t109*t332 + t17*t330)
-    t336 = -t335 + t104
-    t337 = t331*(t105 + t110*t332 + t38*t330)
-    t338 = -t337 + t105
-    t339 = t331*(t106 + t111*t332 + t59*t330)
-    t340 = -t339 + t106
-    t341 = t331*(t107 + t112*t332 + t81*t330)
-    t342 = -t341 + t107
-    t343 = t331*(mu_dot0 + mu_dot5*t330 + t332*mu_dot1)
-    t344 = -t343 + mu_dot0
-    t345 = t330*t333
-    t346 = t108 - t101*t345
-    t347 = -(0.0009999730384501195 + t345)
-    t348 = xp.sqrt(t134 + t136 + t138 + t346**2 + t347**2)
-    t349 = t348*xp.where(xp.greater_equal(t346, 0), xp.asarray(1, dtype=dtype), -1)
-    t350 = t330*t335
-    t351 = t109 - t101*t350
-    t352 = -t350 + t17
-    t353 = t330*t337
-    t354 = t110 - t101*t353
-    t355 = -t353 + t38
-    t356 = t330*t339
-    t357 = t111 - t101*t356
-    t358 = -t356 + t59
-    t359 = t330*t341
-    t360 = t112 - t101*t359
-    t361 = -t359 + t81
-    t362 = t330*t343
-    t363 = mu_dot1 - t101*t362
-    t364 = -t362 + mu_dot5
-    t365 = xp.greater(t348, 0)
-    t366 = xp.where(t365, 1/(t346 + t349), 0)
-    t367 = xp.where(t365, 1 + xp.abs(t346)/t348, 0)
-    t368 = t113*t366
-    t369 = t0*t366
-    t370 = t1*t366
-    t371 = t347*t366
-    t372 = t367*(t351 + t114*t368 + t371*t352 + t15*t369 - t16*t370)
-    t373 = -t372 + t351
-    t374 = t114 - t368*t372
-    t375 = t15 - t369*t372
-    t376 = t16 + t370*t372
-    t377 = t352 - t371*t372
-    t378 = t367*(t354 + t115*t368 + t371*t355 + t36*t369 - t37*t370)
-    t379 = -t378 + t354
-    t380 = t115 - t368*t378
-    t381 = t36 - t369*t378
-    t382 = t37 + t370*t378
-    t383 = t355 - t371*t378
-    t384 = t367*(t357 + t116*t368 + t371*t358 + t57*t369 - t58*t370)
-    t385 = -t384 + t357
-    t386 = t116 - t368*t384
-    t387 = t57 - t369*t384
-    t388 = t58 + t370*t384
-    t389 = t358 - t371*t384
-    t390 = t367*(t360 + t117*t368 + t371*t361 + t78*t369 - t79*t370)
-    t391 = -t390 + t360
-    t392 = t117 - t368*t390
-    t393 = t78 - t369*t390
-    t394 = t79 + t370*t390
-    t395 = t361 - t371*t390
-    t396 = t367*(t363 + t368*mu_dot2 + t369*mu_dot3 - t370*mu_dot4 + t371*t364)
-    t397 = -t396 + t363
-    t398 = mu_dot2 - t368*t396
-    t399 = mu_dot3 - t369*t396
-    t400 = mu_dot4 + t370*t396
-    t401 = t364 - t371*t396
-    t402 = xp.sqrt(t374**2 + t375**2 + t376**2 + t377**2)
-    t403 = t402*xp.where(xp.greater_equal(t374, 0), xp.asarray(1, dtype=dtype), -1)
-    t404 = xp.greater(t402, 0)
-    t405 = xp.where(t404, 1/(t374 + t403), 0)
-    t406 = xp.where(t404, 1 + xp.abs(t374)/t402, 0)
-    t407 = t375*t405
-    t408 = t376*t405
-    t409 = t377*t405
-    t410 = t406*(t380 + t407*t381 + t408*t382 + t409*t383)
-    t411 = -t410 + t380
-    t412 = t381 - t407*t410
-    t413 = t382 - t408*t410
-    t414 = t383 - t409*t410
-    t415 = t406*(t386 + t407*t387 + t408*t388 + t409*t389)
-    t416 = -t415 + t386
-    t417 = t387 - t407*t415
-    t418 = t388 - t408*t415
-    t419 = t389 - t409*t415
-    t420 = t406*(t392 + t407*t393 + t408*t394 + t409*t395)
-    t421 = -t420 + t392
-    t422 = t393 - t407*t420
-    t423 = t394 - t408*t420
-    t424 = t395 - t409*t420
-    t425 = t406*(t398 + t407*t399 + t408*t400 + t409*t401)
-    t426 = -t425 + t398
-    t427 = t399 - t407*t425
-    t428 = t400 - t408*t425
-    t429 = t401 - t409*t425
-    t430 = xp.sqrt(t412**2 + t413**2 + t414**2)
-    t431 = t430*xp.where(xp.greater_equal(t412, 0), xp.asarray(1, dtype=dtype), -1)
-    t432 = xp.greater(t430, 0)
-    t433 = xp.where(t432, 1/(t412 + t431), 0)
-    t434 = xp.where(t432, 1 + xp.abs(t412)/t430, 0)
-    t435 = t413*t433
-    t436 = t414*t433
-    t437 = t434*(t417 + t435*t418 + t436*t419)
-    t438 = -t437 + t417
-    t439 = t418 - t435*t437
-    t440 = t419 - t436*t437
-    t441 = t434*(t422 + t435*t423 + t436*t424)
-    t442 = -t441 + t422
-    t443 = t423 - t435*t441
-    t444 = t424 - t436*t441
-    t445 = t434*(t427 + t435*t428 + t436*t429)
-    t446 = -t445 + t427
-    t447 = t428 - t435*t445
-    t448 = t429 - t436*t445
-    t449 = xp.sqrt(t439**2 + t440**2)
-    t450 = t449*xp.where(xp.greater_equal(t439, 0), xp.asarray(1, dtype=dtype), -1)
-    t451 = xp.greater(t449, 0)
-    t452 = xp.where(t451, 1/(t439 + t450), 0)
-    t453 = xp.where(t451, 1 + xp.abs(t439)/t449, 0)
-    t454 = t440*t452
-    t455 = t453*(t443 + t454*t444)
-    t456 = -t455 + t443
-    t457 = t444 - t454*t455
-    t458 = t453*(t447 + t454*t448)
-    t459 = -t458 + t447
-    t460 = t448 - t454*t458
-    t461 = xp.abs(t457)
-    t462 = t461*xp.where(xp.greater_equal(t457, 0), xp.asarray(1, dtype=dtype), -1)
-    t463 = xp.where(xp.greater(t461, 0), xp.asarray(2, dtype=dtype), 0)
-    t464 = t460 - t460*t463
-    t465 = xp.where(xp.not_equal(t462, 0), -t464/t462, 0)
-    t466 = xp.where(xp.not_equal(t450, 0), -(t459 - t456*t465)/t450, 0)
-    t467 = xp.where(xp.not_equal(t431, 0), -(-(t438*t466 + t442*t465) + t446)/t431, 0)
-    t468 = xp.where(xp.not_equal(t403, 0), -(-(t411*t467 + t416*t466 + t421*t465) + t426)/t403, 0)
-    t469 = xp.where(xp.not_equal(t349, 0), -(-(t373*t468 + t379*t467 + t385*t466 + t391*t465) + t397)/t349, 0)
-    t470 = xp.where(xp.not_equal(t133, 0), -(-(-t334*t469 + t336*t468 + t338*t467 + t340*t466 + t342*t465) + t344)/t133, 0)
-    t471 = xp.isfinite(t148)
-    t472 = xp.greater_equal(damping, 0)
-    t473 = xp.greater(damping, 0)
-    t474 = 1e-12*t164
-    t475 = 1e-12*t144
-    t476 = (t473 & (xp.less_equal(t157, t474) | xp.less_equal(t215, t474) | xp.less_equal(t254, t474) | xp.less_equal(t282, t474) | xp.less_equal(t301, t474) | xp.less_equal(t313, t474))) | (xp.less_equal(damping, 0) & (xp.less_equal(t132, t475) | xp.less_equal(t348, t475) | xp.less_equal(t402, t475) | xp.less_equal(t430, t475) | xp.less_equal(t449, t475) | xp.less_equal(t461, t475)))
-    t477 = t471 & t472 & xp.logical_not(t476)
+    t149 = damping**2
+    t150 = _symmetric_solve6(xp, 1, (t149 + t142, t118, t119, t120, t121, t147, t149 + t145, t122, t123, t124, t125, t135 + t149, t126, t127, t128, t137 + t149, t80, t82, t139 + t149, t83, t140 + t149, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t151 = t150[5]
+    t152 = t150[0]
+    t153 = t150[1]
+    t154 = t151 - t102*t152 + t101*t153
+    t155 = t150[2]
+    t156 = t150[3]
+    t157 = t150[4]
+    t158 = -0.0009999730384501195*t151 + t153*t108 + t155*t113 - t152*t103 + t0*t156 - t1*t157
+    t159 = t152*t104 + t153*t109 + t155*t114 + t15*t156 + t16*t157 + t17*t151
+    t160 = t153*t110 + t152*t105 + t155*t115 + t36*t156 + t37*t157 + t38*t151
+    t161 = t155*t116 + t59*t151 + t152*t106 + t153*t111 + t57*t156 + t58*t157
+    t162 = t155*t117 + t152*t107 + t153*t112 + t78*t156 + t79*t157 + t81*t151
+    t163 = xp.greater(t132, 0)
+    t164 = xp.where(t163, 1/(t146 + t133), 0)
+    t165 = xp.where(t163, 1 + xp.abs(t102)/t132, 0)
+    t166 = t101*t164
+    t167 = -t165*(0.0009999730384501195*t164 + t103 - t108*t166)
+    t168 = t103 + t167
+    t169 = t165*(t104 + t109*t166 + t17*t164)
+    t170 = -t169 + t104
+    t171 = t165*(t105 + t110*t166 + t38*t164)
+    t172 = -t171 + t105
+    t173 = t165*(t106 + t111*t166 + t59*t164)
+    t174 = -t173 + t106
+    t175 = t165*(t107 + t112*t166 + t81*t164)
+    t176 = -t175 + t107
+    t177 = t165*(mu_dot0 + mu_dot5*t164 + t166*mu_dot1)
+    t178 = -t177 + mu_dot0
+    t179 = t164*t167
+    t180 = t108 - t101*t179
+    t181 = -(0.0009999730384501195 + t179)
+    t182 = xp.sqrt(t134 + t136 + t138 + t180**2 + t181**2)
+    t183 = t182*xp.where(xp.greater_equal(t180, 0), xp.asarray(1, dtype=dtype), -1)
+    t184 = t164*t169
+    t185 = t109 - t101*t184
+    t186 = -t184 + t17
+    t187 = t164*t171
+    t188 = t110 - t101*t187
+    t189 = -t187 + t38
+    t190 = t164*t173
+    t191 = t111 - t101*t190
+    t192 = -t190 + t59
+    t193 = t164*t175
+    t194 = t112 - t101*t193
+    t195 = -t193 + t81
+    t196 = t164*t177
+    t197 = mu_dot1 - t101*t196
+    t198 = -t196 + mu_dot5
+    t199 = xp.greater(t182, 0)
+    t200 = xp.where(t199, 1/(t180 + t183), 0)
+    t201 = xp.where(t199, 1 + xp.abs(t180)/t182, 0)
+    t202 = t113*t200
+    t203 = t0*t200
+    t204 = t1*t200
+    t205 = t181*t200
+    t206 = t201*(t185 + t114*t202 + t205*t186 + t15*t203 - t16*t204)
+    t207 = -t206 + t185
+    t208 = t114 - t202*t206
+    t209 = t15 - t203*t206
+    t210 = t16 + t204*t206
+    t211 = t186 - t205*t206
+    t212 = t201*(t115*t202 + t188 + t205*t189 + t36*t203 - t37*t204)
+    t213 = -t212 + t188
+    t214 = t115 - t202*t212
+    t215 = t36 - t203*t212
+    t216 = t37 + t204*t212
+    t217 = t189 - t205*t212
+    t218 = t201*(t191 + t116*t202 + t205*t192 + t57*t203 - t58*t204)
+    t219 = -t218 + t191
+    t220 = t116 - t202*t218
+    t221 = t57 - t203*t218
+    t222 = t58 + t204*t218
+    t223 = t192 - t205*t218
+    t224 = t201*(t117*t202 + t194 + t205*t195 + t78*t203 - t79*t204)
+    t225 = -t224 + t194
+    t226 = t117 - t202*t224
+    t227 = t78 - t203*t224
+    t228 = t79 + t204*t224
+    t229 = t195 - t205*t224
+    t230 = t201*(t197 + t202*mu_dot2 + t203*mu_dot3 - t204*mu_dot4 + t205*t198)
+    t231 = -t230 + t197
+    t232 = mu_dot2 - t202*t230
+    t233 = mu_dot3 - t203*t230
+    t234 = mu_dot4 + t204*t230
+    t235 = t198 - t205*t230
+    t236 = xp.sqrt(t208**2 + t209**2 + t210**2 + t211**2)
+    t237 = t236*xp.where(xp.greater_equal(t208, 0), xp.asarray(1, dtype=dtype), -1)
+    t238 = xp.greater(t236, 0)
+    t239 = xp.where(t238, 1/(t208 + t237), 0)
+    t240 = xp.where(t238, 1 + xp.abs(t208)/t236, 0)
+    t241 = t209*t239
+    t242 = t210*t239
+    t243 = t211*t239
+    t244 = t240*(t214 + t241*t215 + t242*t216 + t243*t217)
+    t245 = -t244 + t214
+    t246 = t215 - t241*t244
+    t247 = t216 - t242*t244
+    t248 = t217 - t243*t244
+    t249 = t240*(t220 + t241*t221 + t242*t222 + t243*t223)
+    t250 = -t249 + t220
+    t251 = t221 - t241*t249
+    t252 = t222 - t242*t249
+    t253 = t223 - t243*t249
+    t254 = t240*(t226 + t241*t227 + t242*t228 + t243*t229)
+    t255 = -t254 + t226
+    t256 = t227 - t241*t254
+    t257 = t228 - t242*t254
+    t258 = t229 - t243*t254
+    t259 = t240*(t232 + t241*t233 + t242*t234 + t243*t235)
+    t260 = -t259 + t232
+    t261 = t233 - t241*t259
+    t262 = t234 - t242*t259
+    t263 = t235 - t243*t259
+    t264 = xp.sqrt(t246**2 + t247**2 + t248**2)
+    t265 = t264*xp.where(xp.greater_equal(t246, 0), xp.asarray(1, dtype=dtype), -1)
+    t266 = xp.greater(t264, 0)
+    t267 = xp.where(t266, 1/(t246 + t265), 0)
+    t268 = xp.where(t266, 1 + xp.abs(t246)/t264, 0)
+    t269 = t247*t267
+    t270 = t248*t267
+    t271 = t268*(t251 + t269*t252 + t270*t253)
+    t272 = -t271 + t251
+    t273 = t252 - t269*t271
+    t274 = t253 - t270*t271
+    t275 = t268*(t256 + t269*t257 + t270*t258)
+    t276 = -t275 + t256
+    t277 = t257 - t269*t275
+    t278 = t258 - t270*t275
+    t279 = t268*(t261 + t269*t262 + t270*t263)
+    t280 = -t279 + t261
+    t281 = t262 - t269*t279
+    t282 = t263 - t270*t279
+    t283 = xp.sqrt(t273**2 + t274**2)
+    t284 = t283*xp.where(xp.greater_equal(t273, 0), xp.asarray(1, dtype=dtype), -1)
+    t285 = xp.greater(t283, 0)
+    t286 = xp.where(t285, 1/(t273 + t284), 0)
+    t287 = xp.where(t285, 1 + xp.abs(t273)/t283, 0)
+    t288 = t274*t286
+    t289 = t287*(t277 + t288*t278)
+    t290 = -t289 + t277
+    t291 = t278 - t288*t289
+    t292 = t287*(t281 + t288*t282)
+    t293 = -t292 + t281
+    t294 = t282 - t288*t292
+    t295 = xp.abs(t291)
+    t296 = t295*xp.where(xp.greater_equal(t291, 0), xp.asarray(1, dtype=dtype), -1)
+    t297 = xp.where(xp.greater(t295, 0), xp.asarray(2, dtype=dtype), 0)
+    t298 = t294 - t294*t297
+    t299 = xp.where(xp.not_equal(t296, 0), -t298/t296, 0)
+    t300 = xp.where(xp.not_equal(t284, 0), -(t293 - t290*t299)/t284, 0)
+    t301 = xp.where(xp.not_equal(t265, 0), -(-(t272*t300 + t276*t299) + t280)/t265, 0)
+    t302 = xp.where(xp.not_equal(t237, 0), -(-(t245*t301 + t250*t300 + t255*t299) + t260)/t237, 0)
+    t303 = xp.where(xp.not_equal(t183, 0), -(-(t207*t302 + t213*t301 + t219*t300 + t225*t299) + t231)/t183, 0)
+    t304 = xp.where(xp.not_equal(t133, 0), -(-(-t168*t303 + t170*t302 + t172*t301 + t174*t300 + t176*t299) + t178)/t133, 0)
+    t305 = xp.isfinite(t148)
+    t306 = xp.greater_equal(damping, 0)
+    t307 = xp.greater(damping, 0)
+    t308 = 1e-12*t144
+    t309 = (t307 & xp.greater(t150[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t132, t308) | xp.less_equal(t182, t308) | xp.less_equal(t236, t308) | xp.less_equal(t264, t308) | xp.less_equal(t283, t308) | xp.less_equal(t295, t308)))
+    t310 = t305 & t306 & xp.logical_not(t309)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t477, xp.where(t473, t323, t470), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t477, xp.where(t473, t324, t469), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t477, xp.where(t473, t325, t468), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t477, xp.where(t473, t326, t467), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t477, xp.where(t473, t327, t466), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t477, xp.where(t473, t328, t465), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t310, xp.where(t307, t154, t304), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t310, xp.where(t307, t158, t303), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t310, xp.where(t307, t159, t302), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t310, xp.where(t307, t160, t301), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t310, xp.where(t307, t161, t300), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t310, xp.where(t307, t162, t299), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t471 & t472), 2, xp.where(t476, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t305 & t306), 2, xp.where(t309, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -6067,344 +6151,177 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     t146 = -t102
     t147 = 0.0009999730384501195*t103 + t146 + t17*t104 + t38*t105 + t59*t106 + t81*t107
     t148 = 0.9990000269615499 - t103 - t1 + q1 + t0 + q2 + q3 + q4 + q5 + q6 + t101 + t15 + t16 + t17 + t36 + t37 + t38 + t57 + t58 + t59 + t78 + t79 + t81 + t146 + t104 + t105 + t106 + t107 + t108 + t109 + t110 + t111 + t112 + t113 + t114 + t115 + t116 + t117 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6
-    t149 = t118**2
-    t150 = t119**2
-    t151 = t120**2
-    t152 = t121**2
-    t153 = t147**2
-    t154 = damping**2
-    t155 = t154 + t142
-    t156 = t155**2
-    t157 = xp.sqrt(t149 + t150 + t151 + t152 + t153 + t156)
-    t158 = t157*xp.where(xp.greater_equal(t155, 0), xp.asarray(1, dtype=dtype), -1)
-    t159 = t154 + t145
-    t160 = t135 + t154
-    t161 = t137 + t154
-    t162 = t139 + t154
-    t163 = t140 + t154
-    t164 = xp.sqrt(t156 + t159**2 + 2*t149 + 2*t150 + 2*t122**2 + 2*t151 + 2*t123**2 + 2*t126**2 + 2*t152 + 2*t124**2 + 2*t127**2 + 2*t80**2 + 2*t153 + 2*t125**2 + 2*t128**2 + 2*t82**2 + 2*t83**2 + t160**2 + t161**2 + t162**2 + t163**2)
-    t165 = xp.greater(t157, 0)
-    t166 = xp.where(t165, 1/(t155 + t158), 0)
-    t167 = xp.where(t165, 1 + xp.abs(t155)/t157, 0)
-    t168 = t118*t166
-    t169 = t119*t166
-    t170 = t120*t166
-    t171 = t121*t166
-    t172 = t147*t166
-    t173 = t167*(t118 + t159*t168 + t169*t122 + t170*t123 + t171*t124 + t172*t125)
-    t174 = -t173 + t118
-    t175 = t159 - t168*t173
-    t176 = t122 - t169*t173
-    t177 = t123 - t170*t173
-    t178 = t124 - t171*t173
-    t179 = t125 - t172*t173
-    t180 = t167*(t119 + t168*t122 + t160*t169 + t170*t126 + t171*t127 + t172*t128)
-    t181 = -t180 + t119
-    t182 = t122 - t168*t180
-    t183 = t160 - t169*t180
-    t184 = t126 - t170*t180
-    t185 = t127 - t171*t180
-    t186 = t128 - t172*t180
-    t187 = t167*(t120 + t168*t123 + t169*t126 + t161*t170 + t171*t80 + t172*t82)
-    t188 = -t187 + t120
-    t189 = t123 - t168*t187
-    t190 = t126 - t169*t187
-    t191 = t161 - t170*t187
-    t192 = t80 - t171*t187
-    t193 = t82 - t172*t187
-    t194 = t167*(t121 + t168*t124 + t169*t127 + t170*t80 + t162*t171 + t172*t83)
-    t195 = -t194 + t121
-    t196 = t124 - t168*t194
-    t197 = t127 - t169*t194
-    t198 = t80 - t170*t194
-    t199 = t162 - t171*t194
-    t200 = t83 - t172*t194
-    t201 = t167*(t147 + t168*t125 + t169*t128 + t170*t82 + t171*t83 + t163*t172)
-    t202 = -t201 + t147
-    t203 = t125 - t168*t201
-    t204 = t128 - t169*t201
-    t205 = t82 - t170*t201
-    t206 = t83 - t171*t201
-    t207 = t163 - t172*t201
-    t208 = t167*(mu_dot0 + t168*mu_dot1 + t169*mu_dot2 + t170*mu_dot3 + t171*mu_dot4 + t172*mu_dot5)
-    t209 = -t208 + mu_dot0
-    t210 = mu_dot1 - t168*t208
-    t211 = mu_dot2 - t169*t208
-    t212 = mu_dot3 - t170*t208
-    t213 = mu_dot4 - t171*t208
-    t214 = mu_dot5 - t172*t208
-    t215 = xp.sqrt(t175**2 + t176**2 + t177**2 + t178**2 + t179**2)
-    t216 = t215*xp.where(xp.greater_equal(t175, 0), xp.asarray(1, dtype=dtype), -1)
-    t217 = xp.greater(t215, 0)
-    t218 = xp.where(t217, 1/(t175 + t216), 0)
-    t219 = xp.where(t217, 1 + xp.abs(t175)/t215, 0)
-    t220 = t176*t218
-    t221 = t177*t218
-    t222 = t178*t218
-    t223 = t179*t218
-    t224 = t219*(t182 + t220*t183 + t221*t184 + t222*t185 + t223*t186)
-    t225 = -t224 + t182
-    t226 = t183 - t220*t224
-    t227 = t184 - t221*t224
-    t228 = t185 - t222*t224
-    t229 = t186 - t223*t224
-    t230 = t219*(t189 + t220*t190 + t221*t191 + t222*t192 + t223*t193)
-    t231 = -t230 + t189
-    t232 = t190 - t220*t230
-    t233 = t191 - t221*t230
-    t234 = t192 - t222*t230
-    t235 = t193 - t223*t230
-    t236 = t219*(t196 + t220*t197 + t221*t198 + t222*t199 + t223*t200)
-    t237 = -t236 + t196
-    t238 = t197 - t220*t236
-    t239 = t198 - t221*t236
-    t240 = t199 - t222*t236
-    t241 = t200 - t223*t236
-    t242 = t219*(t203 + t220*t204 + t221*t205 + t222*t206 + t223*t207)
-    t243 = -t242 + t203
-    t244 = t204 - t220*t242
-    t245 = t205 - t221*t242
-    t246 = t206 - t222*t242
-    t247 = t207 - t223*t242
-    t248 = t219*(t210 + t220*t211 + t221*t212 + t222*t213 + t223*t214)
-    t249 = -t248 + t210
-    t250 = t211 - t220*t248
-    t251 = t212 - t221*t248
-    t252 = t213 - t222*t248
-    t253 = t214 - t223*t248
-    t254 = xp.sqrt(t226**2 + t227**2 + t228**2 + t229**2)
-    t255 = t254*xp.where(xp.greater_equal(t226, 0), xp.asarray(1, dtype=dtype), -1)
-    t256 = xp.greater(t254, 0)
-    t257 = xp.where(t256, 1/(t226 + t255), 0)
-    t258 = xp.where(t256, 1 + xp.abs(t226)/t254, 0)
-    t259 = t227*t257
-    t260 = t228*t257
-    t261 = t229*t257
-    t262 = t258*(t232 + t259*t233 + t260*t234 + t261*t235)
-    t263 = -t262 + t232
-    t264 = t233 - t259*t262
-    t265 = t234 - t260*t262
-    t266 = t235 - t261*t262
-    t267 = t258*(t238 + t259*t239 + t260*t240 + t261*t241)
-    t268 = -t267 + t238
-    t269 = t239 - t259*t267
-    t270 = t240 - t260*t267
-    t271 = t241 - t261*t267
-    t272 = t258*(t244 + t259*t245 + t260*t246 + t261*t247)
-    t273 = -t272 + t244
-    t274 = t245 - t259*t272
-    t275 = t246 - t260*t272
-    t276 = t247 - t261*t272
-    t277 = t258*(t250 + t259*t251 + t260*t252 + t261*t253)
-    t278 = -t277 + t250
-    t279 = t251 - t259*t277
-    t280 = t252 - t260*t277
-    t281 = t253 - t261*t277
-    t282 = xp.sqrt(t264**2 + t265**2 + t266**2)
-    t283 = t282*xp.where(xp.greater_equal(t264, 0), xp.asarray(1, dtype=dtype), -1)
-    t284 = xp.greater(t282, 0)
-    t285 = xp.where(t284, 1/(t264 + t283), 0)
-    t286 = xp.where(t284, 1 + xp.abs(t264)/t282, 0)
-    t287 = t265*t285
-    t288 = t266*t285
-    t289 = t286*(t269 + t287*t270 + t288*t271)
-    t290 = -t289 + t269
-    t291 = t270 - t287*t289
-    t292 = t271 - t288*t289
-    t293 = t286*(t274 + t287*t275 + t288*t276)
-    t294 = -t293 + t274
-    t295 = t275 - t287*t293
-    t296 = t276 - t288*t293
-    t297 = t286*(t279 + t287*t280 + t288*t281)
-    t298 = -t297 + t279
-    t299 = t280 - t287*t297
-    t300 = t281 - t288*t297
-    t301 = xp.sqrt(t291**2 + t292**2)
-    t302 = t301*xp.where(xp.greater_equal(t291, 0), xp.asarray(1, dtype=dtype), -1)
-    t303 = xp.greater(t301, 0)
-    t304 = xp.where(t303, 1/(t291 + t302), 0)
-    t305 = xp.where(t303, 1 + xp.abs(t291)/t301, 0)
-    t306 = t292*t304
-    t307 = t305*(t295 + t306*t296)
-    t308 = -t307 + t295
-    t309 = t296 - t306*t307
-    t310 = t305*(t299 + t306*t300)
-    t311 = -t310 + t299
-    t312 = t300 - t306*t310
-    t313 = xp.abs(t309)
-    t314 = t313*xp.where(xp.greater_equal(t309, 0), xp.asarray(1, dtype=dtype), -1)
-    t315 = xp.where(xp.greater(t313, 0), xp.asarray(2, dtype=dtype), 0)
-    t316 = t312 - t312*t315
-    t317 = xp.where(xp.not_equal(t314, 0), -t316/t314, 0)
-    t318 = xp.where(xp.not_equal(t302, 0), -(t311 - t308*t317)/t302, 0)
-    t319 = xp.where(xp.not_equal(t283, 0), -(-(t290*t318 + t294*t317) + t298)/t283, 0)
-    t320 = xp.where(xp.not_equal(t255, 0), -(-(t263*t319 + t268*t318 + t273*t317) + t278)/t255, 0)
-    t321 = xp.where(xp.not_equal(t216, 0), -(-(t225*t320 + t231*t319 + t237*t318 + t243*t317) + t249)/t216, 0)
-    t322 = xp.where(xp.not_equal(t158, 0), -(-(t174*t321 + t181*t320 + t188*t319 + t195*t318 + t202*t317) + t209)/t158, 0)
-    t323 = t317 - t102*t322 + t101*t321
-    t324 = -0.0009999730384501195*t317 - t103*t322 + t108*t321 + t113*t320 + t0*t319 - t1*t318
-    t325 = t104*t322 + t109*t321 + t114*t320 + t15*t319 + t16*t318 + t17*t317
-    t326 = t105*t322 + t110*t321 + t115*t320 + t36*t319 + t37*t318 + t38*t317
-    t327 = t106*t322 + t111*t321 + t116*t320 + t57*t319 + t58*t318 + t59*t317
-    t328 = t107*t322 + t112*t321 + t117*t320 + t78*t319 + t79*t318 + t81*t317
-    t329 = xp.greater(t132, 0)
-    t330 = xp.where(t329, 1/(t146 + t133), 0)
-    t331 = xp.where(t329, 1 + xp.abs(t102)/t132, 0)
-    t332 = t101*t330
-    t333 = -t331*(0.0009999730384501195*t330 + t103 - t108*t332)
-    t334 = t103 + t333
-    t335 = t331*(t104 + t109*t332 + t17*t330)
-    t336 = -t335 + t104
-    t337 = t331*(t105 + t110*t332 + t38*t330)
-    t338 = -t337 + t105
-    t339 = t331*(t106 + t111*t332 + t59*t330)
-    t340 = -t339 + t106
-    t341 = t331*(t107 + t112*t332 + t81*t330)
-    t342 = -t341 + t107
-    t343 = t331*(mu_dot0 + mu_dot5*t330 + t332*mu_dot1)
-    t344 = -t343 + mu_dot0
-    t345 = t330*t333
-    t346 = t108 - t101*t345
-    t347 = -(0.0009999730384501195 + t345)
-    t348 = xp.sqrt(t134 + t136 + t138 + t346**2 + t347**2)
-    t349 = t348*xp.where(xp.greater_equal(t346, 0), xp.asarray(1, dtype=dtype), -1)
-    t350 = t330*t335
-    t351 = t109 - t101*t350
-    t352 = -t350 + t17
-    t353 = t330*t337
-    t354 = t110 - t101*t353
-    t355 = -t353 + t38
-    t356 = t330*t339
-    t357 = t111 - t101*t356
-    t358 = -t356 + t59
-    t359 = t330*t341
-    t360 = t112 - t101*t359
-    t361 = -t359 + t81
-    t362 = t330*t343
-    t363 = mu_dot1 - t101*t362
-    t364 = -t362 + mu_dot5
-    t365 = xp.greater(t348, 0)
-    t366 = xp.where(t365, 1/(t346 + t349), 0)
-    t367 = xp.where(t365, 1 + xp.abs(t346)/t348, 0)
-    t368 = t113*t366
-    t369 = t0*t366
-    t370 = t1*t366
-    t371 = t347*t366
-    t372 = t367*(t351 + t114*t368 + t371*t352 + t15*t369 - t16*t370)
-    t373 = -t372 + t351
-    t374 = t114 - t368*t372
-    t375 = t15 - t369*t372
-    t376 = t16 + t370*t372
-    t377 = t352 - t371*t372
-    t378 = t367*(t354 + t115*t368 + t371*t355 + t36*t369 - t37*t370)
-    t379 = -t378 + t354
-    t380 = t115 - t368*t378
-    t381 = t36 - t369*t378
-    t382 = t37 + t370*t378
-    t383 = t355 - t371*t378
-    t384 = t367*(t357 + t116*t368 + t371*t358 + t57*t369 - t58*t370)
-    t385 = -t384 + t357
-    t386 = t116 - t368*t384
-    t387 = t57 - t369*t384
-    t388 = t58 + t370*t384
-    t389 = t358 - t371*t384
-    t390 = t367*(t360 + t117*t368 + t371*t361 + t78*t369 - t79*t370)
-    t391 = -t390 + t360
-    t392 = t117 - t368*t390
-    t393 = t78 - t369*t390
-    t394 = t79 + t370*t390
-    t395 = t361 - t371*t390
-    t396 = t367*(t363 + t368*mu_dot2 + t369*mu_dot3 - t370*mu_dot4 + t371*t364)
-    t397 = -t396 + t363
-    t398 = mu_dot2 - t368*t396
-    t399 = mu_dot3 - t369*t396
-    t400 = mu_dot4 + t370*t396
-    t401 = t364 - t371*t396
-    t402 = xp.sqrt(t374**2 + t375**2 + t376**2 + t377**2)
-    t403 = t402*xp.where(xp.greater_equal(t374, 0), xp.asarray(1, dtype=dtype), -1)
-    t404 = xp.greater(t402, 0)
-    t405 = xp.where(t404, 1/(t374 + t403), 0)
-    t406 = xp.where(t404, 1 + xp.abs(t374)/t402, 0)
-    t407 = t375*t405
-    t408 = t376*t405
-    t409 = t377*t405
-    t410 = t406*(t380 + t407*t381 + t408*t382 + t409*t383)
-    t411 = -t410 + t380
-    t412 = t381 - t407*t410
-    t413 = t382 - t408*t410
-    t414 = t383 - t409*t410
-    t415 = t406*(t386 + t407*t387 + t408*t388 + t409*t389)
-    t416 = -t415 + t386
-    t417 = t387 - t407*t415
-    t418 = t388 - t408*t415
-    t419 = t389 - t409*t415
-    t420 = t406*(t392 + t407*t393 + t408*t394 + t409*t395)
-    t421 = -t420 + t392
-    t422 = t393 - t407*t420
-    t423 = t394 - t408*t420
-    t424 = t395 - t409*t420
-    t425 = t406*(t398 + t407*t399 + t408*t400 + t409*t401)
-    t426 = -t425 + t398
-    t427 = t399 - t407*t425
-    t428 = t400 - t408*t425
-    t429 = t401 - t409*t425
-    t430 = xp.sqrt(t412**2 + t413**2 + t414**2)
-    t431 = t430*xp.where(xp.greater_equal(t412, 0), xp.asarray(1, dtype=dtype), -1)
-    t432 = xp.greater(t430, 0)
-    t433 = xp.where(t432, 1/(t412 + t431), 0)
-    t434 = xp.where(t432, 1 + xp.abs(t412)/t430, 0)
-    t435 = t413*t433
-    t436 = t414*t433
-    t437 = t434*(t417 + t435*t418 + t436*t419)
-    t438 = -t437 + t417
-    t439 = t418 - t435*t437
-    t440 = t419 - t436*t437
-    t441 = t434*(t422 + t435*t423 + t436*t424)
-    t442 = -t441 + t422
-    t443 = t423 - t435*t441
-    t444 = t424 - t436*t441
-    t445 = t434*(t427 + t435*t428 + t436*t429)
-    t446 = -t445 + t427
-    t447 = t428 - t435*t445
-    t448 = t429 - t436*t445
-    t449 = xp.sqrt(t439**2 + t440**2)
-    t450 = t449*xp.where(xp.greater_equal(t439, 0), xp.asarray(1, dtype=dtype), -1)
-    t451 = xp.greater(t449, 0)
-    t452 = xp.where(t451, 1/(t439 + t450), 0)
-    t453 = xp.where(t451, 1 + xp.abs(t439)/t449, 0)
-    t454 = t440*t452
-    t455 = t453*(t443 + t454*t444)
-    t456 = -t455 + t443
-    t457 = t444 - t454*t455
-    t458 = t453*(t447 + t454*t448)
-    t459 = -t458 + t447
-    t460 = t448 - t454*t458
-    t461 = xp.abs(t457)
-    t462 = t461*xp.where(xp.greater_equal(t457, 0), xp.asarray(1, dtype=dtype), -1)
-    t463 = xp.where(xp.greater(t461, 0), xp.asarray(2, dtype=dtype), 0)
-    t464 = t460 - t460*t463
-    t465 = xp.where(xp.not_equal(t462, 0), -t464/t462, 0)
-    t466 = xp.where(xp.not_equal(t450, 0), -(t459 - t456*t465)/t450, 0)
-    t467 = xp.where(xp.not_equal(t431, 0), -(-(t438*t466 + t442*t465) + t446)/t431, 0)
-    t468 = xp.where(xp.not_equal(t403, 0), -(-(t411*t467 + t416*t466 + t421*t465) + t426)/t403, 0)
-    t469 = xp.where(xp.not_equal(t349, 0), -(-(t373*t468 + t379*t467 + t385*t466 + t391*t465) + t397)/t349, 0)
-    t470 = xp.where(xp.not_equal(t133, 0), -(-(-t334*t469 + t336*t468 + t338*t467 + t340*t466 + t342*t465) + t344)/t133, 0)
-    t471 = xp.isfinite(t148)
-    t472 = xp.greater_equal(damping, 0)
-    t473 = xp.greater(damping, 0)
-    t474 = 1e-12*t164
-    t475 = 1e-12*t144
-    t476 = (t473 & (xp.less_equal(t157, t474) | xp.less_equal(t215, t474) | xp.less_equal(t254, t474) | xp.less_equal(t282, t474) | xp.less_equal(t301, t474) | xp.less_equal(t313, t474))) | (xp.less_equal(damping, 0) & (xp.less_equal(t132, t475) | xp.less_equal(t348, t475) | xp.less_equal(t402, t475) | xp.less_equal(t430, t475) | xp.less_equal(t449, t475) | xp.less_equal(t461, t475)))
-    t477 = t471 & t472 & xp.logical_not(t476)
+    t149 = damping**2
+    t150 = _symmetric_solve6(xp, 1, (t149 + t142, t118, t119, t120, t121, t147, t149 + t145, t122, t123, t124, t125, t135 + t149, t126, t127, t128, t137 + t149, t80, t82, t139 + t149, t83, t140 + t149, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
+    t151 = t150[5]
+    t152 = t150[0]
+    t153 = t150[1]
+    t154 = t151 - t102*t152 + t101*t153
+    t155 = t150[2]
+    t156 = t150[3]
+    t157 = t150[4]
+    t158 = -0.0009999730384501195*t151 + t153*t108 + t155*t113 - t152*t103 + t0*t156 - t1*t157
+    t159 = t152*t104 + t153*t109 + t155*t114 + t15*t156 + t16*t157 + t17*t151
+    t160 = t153*t110 + t152*t105 + t155*t115 + t36*t156 + t37*t157 + t38*t151
+    t161 = t155*t116 + t59*t151 + t152*t106 + t153*t111 + t57*t156 + t58*t157
+    t162 = t155*t117 + t152*t107 + t153*t112 + t78*t156 + t79*t157 + t81*t151
+    t163 = xp.greater(t132, 0)
+    t164 = xp.where(t163, 1/(t146 + t133), 0)
+    t165 = xp.where(t163, 1 + xp.abs(t102)/t132, 0)
+    t166 = t101*t164
+    t167 = -t165*(0.0009999730384501195*t164 + t103 - t108*t166)
+    t168 = t103 + t167
+    t169 = t165*(t104 + t109*t166 + t17*t164)
+    t170 = -t169 + t104
+    t171 = t165*(t105 + t110*t166 + t38*t164)
+    t172 = -t171 + t105
+    t173 = t165*(t106 + t111*t166 + t59*t164)
+    t174 = -t173 + t106
+    t175 = t165*(t107 + t112*t166 + t81*t164)
+    t176 = -t175 + t107
+    t177 = t165*(mu_dot0 + mu_dot5*t164 + t166*mu_dot1)
+    t178 = -t177 + mu_dot0
+    t179 = t164*t167
+    t180 = t108 - t101*t179
+    t181 = -(0.0009999730384501195 + t179)
+    t182 = xp.sqrt(t134 + t136 + t138 + t180**2 + t181**2)
+    t183 = t182*xp.where(xp.greater_equal(t180, 0), xp.asarray(1, dtype=dtype), -1)
+    t184 = t164*t169
+    t185 = t109 - t101*t184
+    t186 = -t184 + t17
+    t187 = t164*t171
+    t188 = t110 - t101*t187
+    t189 = -t187 + t38
+    t190 = t164*t173
+    t191 = t111 - t101*t190
+    t192 = -t190 + t59
+    t193 = t164*t175
+    t194 = t112 - t101*t193
+    t195 = -t193 + t81
+    t196 = t164*t177
+    t197 = mu_dot1 - t101*t196
+    t198 = -t196 + mu_dot5
+    t199 = xp.greater(t182, 0)
+    t200 = xp.where(t199, 1/(t180 + t183), 0)
+    t201 = xp.where(t199, 1 + xp.abs(t180)/t182, 0)
+    t202 = t113*t200
+    t203 = t0*t200
+    t204 = t1*t200
+    t205 = t181*t200
+    t206 = t201*(t185 + t114*t202 + t205*t186 + t15*t203 - t16*t204)
+    t207 = -t206 + t185
+    t208 = t114 - t202*t206
+    t209 = t15 - t203*t206
+    t210 = t16 + t204*t206
+    t211 = t186 - t205*t206
+    t212 = t201*(t115*t202 + t188 + t205*t189 + t36*t203 - t37*t204)
+    t213 = -t212 + t188
+    t214 = t115 - t202*t212
+    t215 = t36 - t203*t212
+    t216 = t37 + t204*t212
+    t217 = t189 - t205*t212
+    t218 = t201*(t191 + t116*t202 + t205*t192 + t57*t203 - t58*t204)
+    t219 = -t218 + t191
+    t220 = t116 - t202*t218
+    t221 = t57 - t203*t218
+    t222 = t58 + t204*t218
+    t223 = t192 - t205*t218
+    t224 = t201*(t117*t202 + t194 + t205*t195 + t78*t203 - t79*t204)
+    t225 = -t224 + t194
+    t226 = t117 - t202*t224
+    t227 = t78 - t203*t224
+    t228 = t79 + t204*t224
+    t229 = t195 - t205*t224
+    t230 = t201*(t197 + t202*mu_dot2 + t203*mu_dot3 - t204*mu_dot4 + t205*t198)
+    t231 = -t230 + t197
+    t232 = mu_dot2 - t202*t230
+    t233 = mu_dot3 - t203*t230
+    t234 = mu_dot4 + t204*t230
+    t235 = t198 - t205*t230
+    t236 = xp.sqrt(t208**2 + t209**2 + t210**2 + t211**2)
+    t237 = t236*xp.where(xp.greater_equal(t208, 0), xp.asarray(1, dtype=dtype), -1)
+    t238 = xp.greater(t236, 0)
+    t239 = xp.where(t238, 1/(t208 + t237), 0)
+    t240 = xp.where(t238, 1 + xp.abs(t208)/t236, 0)
+    t241 = t209*t239
+    t242 = t210*t239
+    t243 = t211*t239
+    t244 = t240*(t214 + t241*t215 + t242*t216 + t243*t217)
+    t245 = -t244 + t214
+    t246 = t215 - t241*t244
+    t247 = t216 - t242*t244
+    t248 = t217 - t243*t244
+    t249 = t240*(t220 + t241*t221 + t242*t222 + t243*t223)
+    t250 = -t249 + t220
+    t251 = t221 - t241*t249
+    t252 = t222 - t242*t249
+    t253 = t223 - t243*t249
+    t254 = t240*(t226 + t241*t227 + t242*t228 + t243*t229)
+    t255 = -t254 + t226
+    t256 = t227 - t241*t254
+    t257 = t228 - t242*t254
+    t258 = t229 - t243*t254
+    t259 = t240*(t232 + t241*t233 + t242*t234 + t243*t235)
+    t260 = -t259 + t232
+    t261 = t233 - t241*t259
+    t262 = t234 - t242*t259
+    t263 = t235 - t243*t259
+    t264 = xp.sqrt(t246**2 + t247**2 + t248**2)
+    t265 = t264*xp.where(xp.greater_equal(t246, 0), xp.asarray(1, dtype=dtype), -1)
+    t266 = xp.greater(t264, 0)
+    t267 = xp.where(t266, 1/(t246 + t265), 0)
+    t268 = xp.where(t266, 1 + xp.abs(t246)/t264, 0)
+    t269 = t247*t267
+    t270 = t248*t267
+    t271 = t268*(t251 + t269*t252 + t270*t253)
+    t272 = -t271 + t251
+    t273 = t252 - t269*t271
+    t274 = t253 - t270*t271
+    t275 = t268*(t256 + t269*t257 + t270*t258)
+    t276 = -t275 + t256
+    t277 = t257 - t269*t275
+    t278 = t258 - t270*t275
+    t279 = t268*(t261 + t269*t262 + t270*t263)
+    t280 = -t279 + t261
+    t281 = t262 - t269*t279
+    t282 = t263 - t270*t279
+    t283 = xp.sqrt(t273**2 + t274**2)
+    t284 = t283*xp.where(xp.greater_equal(t273, 0), xp.asarray(1, dtype=dtype), -1)
+    t285 = xp.greater(t283, 0)
+    t286 = xp.where(t285, 1/(t273 + t284), 0)
+    t287 = xp.where(t285, 1 + xp.abs(t273)/t283, 0)
+    t288 = t274*t286
+    t289 = t287*(t277 + t288*t278)
+    t290 = -t289 + t277
+    t291 = t278 - t288*t289
+    t292 = t287*(t281 + t288*t282)
+    t293 = -t292 + t281
+    t294 = t282 - t288*t292
+    t295 = xp.abs(t291)
+    t296 = t295*xp.where(xp.greater_equal(t291, 0), xp.asarray(1, dtype=dtype), -1)
+    t297 = xp.where(xp.greater(t295, 0), xp.asarray(2, dtype=dtype), 0)
+    t298 = t294 - t294*t297
+    t299 = xp.where(xp.not_equal(t296, 0), -t298/t296, 0)
+    t300 = xp.where(xp.not_equal(t284, 0), -(t293 - t290*t299)/t284, 0)
+    t301 = xp.where(xp.not_equal(t265, 0), -(-(t272*t300 + t276*t299) + t280)/t265, 0)
+    t302 = xp.where(xp.not_equal(t237, 0), -(-(t245*t301 + t250*t300 + t255*t299) + t260)/t237, 0)
+    t303 = xp.where(xp.not_equal(t183, 0), -(-(t207*t302 + t213*t301 + t219*t300 + t225*t299) + t231)/t183, 0)
+    t304 = xp.where(xp.not_equal(t133, 0), -(-(-t168*t303 + t170*t302 + t172*t301 + t174*t300 + t176*t299) + t178)/t133, 0)
+    t305 = xp.isfinite(t148)
+    t306 = xp.greater_equal(damping, 0)
+    t307 = xp.greater(damping, 0)
+    t308 = 1e-12*t144
+    t309 = (t307 & xp.greater(t150[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t132, t308) | xp.less_equal(t182, t308) | xp.less_equal(t236, t308) | xp.less_equal(t264, t308) | xp.less_equal(t283, t308) | xp.less_equal(t295, t308)))
+    t310 = t305 & t306 & xp.logical_not(t309)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t477, xp.where(t473, t323, t470), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t477, xp.where(t473, t324, t469), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t477, xp.where(t473, t325, t468), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t477, xp.where(t473, t326, t467), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t477, xp.where(t473, t327, t466), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t477, xp.where(t473, t328, t465), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t310, xp.where(t307, t154, t304), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t310, xp.where(t307, t158, t303), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t310, xp.where(t307, t159, t302), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t310, xp.where(t307, t160, t301), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t310, xp.where(t307, t161, t300), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t310, xp.where(t307, t162, t299), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t471 & t472), 2, xp.where(t476, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t305 & t306), 2, xp.where(t309, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
@@ -6648,366 +6565,199 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t184 = -t113
     t185 = 0.0009999730384501195*t139 + t184 + t17*t140 + t38*t141 + t59*t142 + t81*t143
     t186 = mu_dot1 + gain1*(t184 + T13)
-    t187 = t149**2
-    t188 = t150**2
-    t189 = t151**2
-    t190 = t152**2
-    t191 = t185**2
-    t192 = damping**2
-    t193 = t192 + t180
-    t194 = t193**2
-    t195 = xp.sqrt(t187 + t188 + t189 + t190 + t191 + t194)
-    t196 = t195*xp.where(xp.greater_equal(t193, 0), xp.asarray(1, dtype=dtype), -1)
-    t197 = t192 + t183
-    t198 = t173 + t192
-    t199 = t175 + t192
-    t200 = t177 + t192
-    t201 = t178 + t192
-    t202 = xp.sqrt(2*t187 + 2*t188 + 2*t153**2 + 2*t189 + 2*t154**2 + 2*t119**2 + 2*t190 + 2*t155**2 + 2*t120**2 + 2*t80**2 + 2*t191 + 2*t156**2 + 2*t121**2 + 2*t82**2 + 2*t83**2 + t194 + t197**2 + t198**2 + t199**2 + t200**2 + t201**2)
-    t203 = xp.greater(t195, 0)
-    t204 = xp.where(t203, 1/(t193 + t196), 0)
-    t205 = xp.where(t203, 1 + xp.abs(t193)/t195, 0)
-    t206 = t149*t204
-    t207 = t150*t204
-    t208 = t151*t204
-    t209 = t152*t204
-    t210 = t185*t204
-    t211 = t205*(t149 + t197*t206 + t207*t153 + t208*t154 + t209*t155 + t210*t156)
-    t212 = -t211 + t149
-    t213 = t197 - t206*t211
-    t214 = t153 - t207*t211
-    t215 = t154 - t208*t211
-    t216 = t155 - t209*t211
-    t217 = t156 - t210*t211
-    t218 = t205*(t150 + t206*t153 + t198*t207 + t208*t119 + t209*t120 + t210*t121)
-    t219 = -t218 + t150
-    t220 = t153 - t206*t218
-    t221 = t198 - t207*t218
-    t222 = t119 - t208*t218
-    t223 = t120 - t209*t218
-    t224 = t121 - t210*t218
-    t225 = t205*(t151 + t206*t154 + t207*t119 + t199*t208 + t209*t80 + t210*t82)
-    t226 = -t225 + t151
-    t227 = t154 - t206*t225
-    t228 = t119 - t207*t225
-    t229 = t199 - t208*t225
-    t230 = t80 - t209*t225
-    t231 = t82 - t210*t225
-    t232 = t205*(t152 + t206*t155 + t207*t120 + t208*t80 + t200*t209 + t210*t83)
-    t233 = -t232 + t152
-    t234 = t155 - t206*t232
-    t235 = t120 - t207*t232
-    t236 = t80 - t208*t232
-    t237 = t200 - t209*t232
-    t238 = t83 - t210*t232
-    t239 = t205*(t185 + t206*t156 + t207*t121 + t208*t82 + t209*t83 + t201*t210)
-    t240 = -t239 + t185
-    t241 = t156 - t206*t239
-    t242 = t121 - t207*t239
-    t243 = t82 - t208*t239
-    t244 = t83 - t209*t239
-    t245 = t201 - t210*t239
-    t246 = xp.sqrt(t213**2 + t214**2 + t215**2 + t216**2 + t217**2)
-    t247 = t246*xp.where(xp.greater_equal(t213, 0), xp.asarray(1, dtype=dtype), -1)
-    t248 = xp.greater(t246, 0)
-    t249 = xp.where(t248, 1/(t213 + t247), 0)
-    t250 = xp.where(t248, 1 + xp.abs(t213)/t246, 0)
-    t251 = t214*t249
-    t252 = t215*t249
-    t253 = t216*t249
-    t254 = t217*t249
-    t255 = t250*(t220 + t251*t221 + t252*t222 + t253*t223 + t254*t224)
-    t256 = -t255 + t220
-    t257 = t221 - t251*t255
-    t258 = t222 - t252*t255
-    t259 = t223 - t253*t255
-    t260 = t224 - t254*t255
-    t261 = t250*(t227 + t251*t228 + t252*t229 + t253*t230 + t254*t231)
-    t262 = -t261 + t227
-    t263 = t228 - t251*t261
-    t264 = t229 - t252*t261
-    t265 = t230 - t253*t261
-    t266 = t231 - t254*t261
-    t267 = t250*(t234 + t251*t235 + t252*t236 + t253*t237 + t254*t238)
-    t268 = -t267 + t234
-    t269 = t235 - t251*t267
-    t270 = t236 - t252*t267
-    t271 = t237 - t253*t267
-    t272 = t238 - t254*t267
-    t273 = t250*(t241 + t251*t242 + t252*t243 + t253*t244 + t254*t245)
-    t274 = -t273 + t241
-    t275 = t242 - t251*t273
-    t276 = t243 - t252*t273
-    t277 = t244 - t253*t273
-    t278 = t245 - t254*t273
-    t279 = xp.sqrt(t257**2 + t258**2 + t259**2 + t260**2)
-    t280 = t279*xp.where(xp.greater_equal(t257, 0), xp.asarray(1, dtype=dtype), -1)
-    t281 = xp.greater(t279, 0)
-    t282 = xp.where(t281, 1/(t257 + t280), 0)
-    t283 = xp.where(t281, 1 + xp.abs(t257)/t279, 0)
-    t284 = t258*t282
-    t285 = t259*t282
-    t286 = t260*t282
-    t287 = t283*(t263 + t284*t264 + t285*t265 + t286*t266)
-    t288 = -t287 + t263
-    t289 = t264 - t284*t287
-    t290 = t265 - t285*t287
-    t291 = t266 - t286*t287
-    t292 = t283*(t269 + t284*t270 + t285*t271 + t286*t272)
-    t293 = -t292 + t269
-    t294 = t270 - t284*t292
-    t295 = t271 - t285*t292
-    t296 = t272 - t286*t292
-    t297 = t283*(t275 + t284*t276 + t285*t277 + t286*t278)
-    t298 = -t297 + t275
-    t299 = t276 - t284*t297
-    t300 = t277 - t285*t297
-    t301 = t278 - t286*t297
-    t302 = xp.sqrt(t289**2 + t290**2 + t291**2)
-    t303 = t302*xp.where(xp.greater_equal(t289, 0), xp.asarray(1, dtype=dtype), -1)
-    t304 = xp.greater(t302, 0)
-    t305 = xp.where(t304, 1/(t289 + t303), 0)
-    t306 = xp.where(t304, 1 + xp.abs(t289)/t302, 0)
-    t307 = t290*t305
-    t308 = t291*t305
-    t309 = t306*(t294 + t307*t295 + t308*t296)
-    t310 = -t309 + t294
-    t311 = t295 - t307*t309
-    t312 = t296 - t308*t309
-    t313 = t306*(t299 + t307*t300 + t308*t301)
-    t314 = -t313 + t299
-    t315 = t300 - t307*t313
-    t316 = t301 - t308*t313
-    t317 = xp.sqrt(t311**2 + t312**2)
-    t318 = t317*xp.where(xp.greater_equal(t311, 0), xp.asarray(1, dtype=dtype), -1)
-    t319 = xp.greater(t317, 0)
-    t320 = xp.where(t319, 1/(t311 + t318), 0)
-    t321 = xp.where(t319, 1 + xp.abs(t311)/t317, 0)
-    t322 = t312*t320
-    t323 = t321*(t315 + t322*t316)
-    t324 = -t323 + t315
-    t325 = t316 - t322*t323
-    t326 = xp.abs(t325)
-    t327 = t326*xp.where(xp.greater_equal(t325, 0), xp.asarray(1, dtype=dtype), -1)
-    t328 = xp.where(xp.greater(t326, 0), xp.asarray(2, dtype=dtype), 0)
-    t329 = xp.greater(t170, 0)
-    t330 = xp.where(t329, 1/(t184 + t171), 0)
-    t331 = xp.where(t329, 1 + xp.abs(t113)/t170, 0)
-    t332 = t96*t330
-    t333 = -t331*(0.0009999730384501195*t330 + t139 - t144*t332)
-    t334 = t139 + t333
-    t335 = t331*(t140 + t17*t330 + t145*t332)
-    t336 = -t335 + t140
-    t337 = t331*(t141 + t38*t330 + t146*t332)
-    t338 = -t337 + t141
-    t339 = t331*(t142 + t59*t330 + t147*t332)
-    t340 = -t339 + t142
-    t341 = t331*(t143 + t81*t330 + t148*t332)
-    t342 = -t341 + t143
-    t343 = t330*t333
-    t344 = t144 - t96*t343
-    t345 = -(0.0009999730384501195 + t343)
-    t346 = xp.sqrt(t172 + t174 + t176 + t344**2 + t345**2)
-    t347 = t346*xp.where(xp.greater_equal(t344, 0), xp.asarray(1, dtype=dtype), -1)
-    t348 = t330*t335
-    t349 = t145 - t96*t348
-    t350 = -t348 + t17
-    t351 = t330*t337
-    t352 = t146 - t96*t351
-    t353 = -t351 + t38
-    t354 = t330*t339
-    t355 = t147 - t96*t354
-    t356 = -t354 + t59
-    t357 = t330*t341
-    t358 = t148 - t96*t357
-    t359 = -t357 + t81
-    t360 = xp.greater(t346, 0)
-    t361 = xp.where(t360, 1/(t344 + t347), 0)
-    t362 = xp.where(t360, 1 + xp.abs(t344)/t346, 0)
-    t363 = t114*t361
-    t364 = t0*t361
-    t365 = t1*t361
-    t366 = t345*t361
-    t367 = t362*(t349 + t115*t363 + t366*t350 + t15*t364 - t16*t365)
-    t368 = -t367 + t349
-    t369 = t115 - t363*t367
-    t370 = t15 - t364*t367
-    t371 = t16 + t365*t367
-    t372 = t350 - t366*t367
-    t373 = t362*(t352 + t116*t363 + t366*t353 + t36*t364 - t37*t365)
-    t374 = -t373 + t352
-    t375 = t116 - t363*t373
-    t376 = t36 - t364*t373
-    t377 = t37 + t365*t373
-    t378 = t353 - t366*t373
-    t379 = t362*(t355 + t117*t363 + t366*t356 + t57*t364 - t58*t365)
-    t380 = -t379 + t355
-    t381 = t117 - t363*t379
-    t382 = t57 - t364*t379
-    t383 = t58 + t365*t379
-    t384 = t356 - t366*t379
-    t385 = t362*(t358 + t118*t363 + t366*t359 + t78*t364 - t79*t365)
-    t386 = -t385 + t358
-    t387 = t118 - t363*t385
-    t388 = t78 - t364*t385
-    t389 = t79 + t365*t385
-    t390 = t359 - t366*t385
-    t391 = xp.sqrt(t369**2 + t370**2 + t371**2 + t372**2)
-    t392 = t391*xp.where(xp.greater_equal(t369, 0), xp.asarray(1, dtype=dtype), -1)
-    t393 = xp.greater(t391, 0)
-    t394 = xp.where(t393, 1/(t369 + t392), 0)
-    t395 = xp.where(t393, 1 + xp.abs(t369)/t391, 0)
-    t396 = t370*t394
-    t397 = t371*t394
-    t398 = t372*t394
-    t399 = t395*(t375 + t396*t376 + t397*t377 + t398*t378)
-    t400 = -t399 + t375
-    t401 = t376 - t396*t399
-    t402 = t377 - t397*t399
-    t403 = t378 - t398*t399
-    t404 = t395*(t381 + t396*t382 + t397*t383 + t398*t384)
-    t405 = -t404 + t381
-    t406 = t382 - t396*t404
-    t407 = t383 - t397*t404
-    t408 = t384 - t398*t404
-    t409 = t395*(t387 + t396*t388 + t397*t389 + t398*t390)
-    t410 = -t409 + t387
-    t411 = t388 - t396*t409
-    t412 = t389 - t397*t409
-    t413 = t390 - t398*t409
-    t414 = xp.sqrt(t401**2 + t402**2 + t403**2)
-    t415 = t414*xp.where(xp.greater_equal(t401, 0), xp.asarray(1, dtype=dtype), -1)
-    t416 = xp.greater(t414, 0)
-    t417 = xp.where(t416, 1/(t401 + t415), 0)
-    t418 = xp.where(t416, 1 + xp.abs(t401)/t414, 0)
-    t419 = t402*t417
-    t420 = t403*t417
-    t421 = t418*(t406 + t419*t407 + t420*t408)
-    t422 = -t421 + t406
-    t423 = t407 - t419*t421
-    t424 = t408 - t420*t421
-    t425 = t418*(t411 + t419*t412 + t420*t413)
-    t426 = -t425 + t411
-    t427 = t412 - t419*t425
-    t428 = t413 - t420*t425
-    t429 = xp.sqrt(t423**2 + t424**2)
-    t430 = t429*xp.where(xp.greater_equal(t423, 0), xp.asarray(1, dtype=dtype), -1)
-    t431 = xp.greater(t429, 0)
-    t432 = xp.where(t431, 1/(t423 + t430), 0)
-    t433 = xp.where(t431, 1 + xp.abs(t423)/t429, 0)
-    t434 = t424*t432
-    t435 = t433*(t427 + t434*t428)
-    t436 = -t435 + t427
-    t437 = t428 - t434*t435
-    t438 = xp.abs(t437)
-    t439 = t438*xp.where(xp.greater_equal(t437, 0), xp.asarray(1, dtype=dtype), -1)
-    t440 = xp.where(xp.greater(t438, 0), xp.asarray(2, dtype=dtype), 0)
-    t441 = xp.greater_equal(t97, t123) & xp.greater_equal(t97, t159)
-    t442 = xp.greater_equal(t123, t159)
-    t443 = xp.where(t441, 0.5*(1 + t97), xp.where(t442, 0.5*t122, 0.5*t157))
-    t444 = xp.where(t441, 0.5*t98, xp.where(t442, 0.5*(1 + t123), 0.5*t158))
-    t445 = xp.where(t441, 0.5*t99, xp.where(t442, 0.5*t124, 0.5*(1 + t159)))
-    t446 = xp.sqrt(t443**2 + t444**2 + t445**2)
-    t447 = xp.where(xp.greater_equal(t160*t443 + t161*t444 + t125*t445, 0), xp.asarray(1, dtype=dtype), -1)
-    t448 = xp.greater(t163, 1e-06) | xp.greater(t162, 0)
-    t449 = t164*t447/t446
-    t450 = xp.where(t448, t160*t165, t449*t443)
-    t451 = xp.where(t448, t161*t165, t449*t444)
-    t452 = xp.where(t448, t125*t165, t449*t445)
-    t453 = mu_dot3 + t450*gain3
-    t454 = mu_dot4 + t451*gain4
-    t455 = mu_dot5 + t452*gain5
-    t456 = t205*(t100 + t206*t186 + t207*t166 + t208*t453 + t209*t454 + t210*t455)
-    t457 = -t456 + t100
-    t458 = t186 - t206*t456
-    t459 = t166 - t207*t456
-    t460 = t453 - t208*t456
-    t461 = t454 - t209*t456
-    t462 = t455 - t210*t456
-    t463 = t250*(t458 + t251*t459 + t252*t460 + t253*t461 + t254*t462)
-    t464 = -t463 + t458
-    t465 = t459 - t251*t463
-    t466 = t460 - t252*t463
-    t467 = t461 - t253*t463
-    t468 = t462 - t254*t463
-    t469 = t283*(t465 + t284*t466 + t285*t467 + t286*t468)
-    t470 = -t469 + t465
-    t471 = t466 - t284*t469
-    t472 = t467 - t285*t469
-    t473 = t468 - t286*t469
-    t474 = t306*(t471 + t307*t472 + t308*t473)
-    t475 = -t474 + t471
-    t476 = t472 - t307*t474
-    t477 = t473 - t308*t474
-    t478 = t321*(t476 + t322*t477)
-    t479 = -t478 + t476
-    t480 = t477 - t322*t478
-    t481 = t480 - t328*t480
-    t482 = xp.where(xp.not_equal(t327, 0), -t481/t327, 0)
-    t483 = xp.where(xp.not_equal(t318, 0), -(t479 - t324*t482)/t318, 0)
-    t484 = xp.where(xp.not_equal(t303, 0), -(-(t310*t483 + t314*t482) + t475)/t303, 0)
-    t485 = xp.where(xp.not_equal(t280, 0), -(-(t288*t484 + t293*t483 + t298*t482) + t470)/t280, 0)
-    t486 = xp.where(xp.not_equal(t247, 0), -(-(t256*t485 + t262*t484 + t268*t483 + t274*t482) + t464)/t247, 0)
-    t487 = xp.where(xp.not_equal(t196, 0), -(-(t212*t486 + t219*t485 + t226*t484 + t233*t483 + t240*t482) + t457)/t196, 0)
-    t488 = t482 - t113*t487 + t96*t486
-    t489 = -0.0009999730384501195*t482 - t139*t487 + t144*t486 + t114*t485 + t0*t484 - t1*t483
-    t490 = t140*t487 + t145*t486 + t115*t485 + t15*t484 + t16*t483 + t17*t482
-    t491 = t141*t487 + t146*t486 + t116*t485 + t36*t484 + t37*t483 + t38*t482
-    t492 = t142*t487 + t147*t486 + t117*t485 + t57*t484 + t58*t483 + t59*t482
-    t493 = t143*t487 + t148*t486 + t118*t485 + t78*t484 + t79*t483 + t81*t482
-    t494 = t331*(t100 + t330*t455 + t332*t186)
-    t495 = -t494 + t100
-    t496 = 0.9990000269615499 - t139 - t1 + q1 + t0 + q2 + q3 + q4 + q5 + q6 + t96 + t15 + t16 + t17 + t36 + t37 + t38 + t57 + t58 + t59 + t78 + t79 + t81 + t184 + t140 + t141 + t142 + t143 + t144 + t145 + t146 + t147 + t148 + t114 + t115 + t116 + t117 + t118 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t100 + t186 + t166 + t453 + t454 + t455
-    t497 = t330*t494
-    t498 = t186 - t96*t497
-    t499 = -t497 + t455
-    t500 = t362*(t498 + t363*t166 + t364*t453 - t365*t454 + t366*t499)
-    t501 = -t500 + t498
-    t502 = t166 - t363*t500
-    t503 = t453 - t364*t500
-    t504 = t454 + t365*t500
-    t505 = t499 - t366*t500
-    t506 = t395*(t502 + t396*t503 + t397*t504 + t398*t505)
-    t507 = -t506 + t502
-    t508 = t503 - t396*t506
-    t509 = t504 - t397*t506
-    t510 = t505 - t398*t506
-    t511 = t418*(t508 + t419*t509 + t420*t510)
-    t512 = -t511 + t508
-    t513 = t509 - t419*t511
-    t514 = t510 - t420*t511
-    t515 = t433*(t513 + t434*t514)
-    t516 = -t515 + t513
-    t517 = t514 - t434*t515
-    t518 = t517 - t440*t517
-    t519 = xp.where(xp.not_equal(t439, 0), -t518/t439, 0)
-    t520 = xp.where(xp.not_equal(t430, 0), -(t516 - t436*t519)/t430, 0)
-    t521 = xp.where(xp.not_equal(t415, 0), -(-(t422*t520 + t426*t519) + t512)/t415, 0)
-    t522 = xp.where(xp.not_equal(t392, 0), -(-(t400*t521 + t405*t520 + t410*t519) + t507)/t392, 0)
-    t523 = xp.where(xp.not_equal(t347, 0), -(-(t368*t522 + t374*t521 + t380*t520 + t386*t519) + t501)/t347, 0)
-    t524 = xp.where(xp.not_equal(t171, 0), -(-(-t334*t523 + t336*t522 + t338*t521 + t340*t520 + t342*t519) + t495)/t171, 0)
-    t525 = xp.isfinite(t496)
-    t526 = xp.greater_equal(damping, 0)
-    t527 = xp.greater(damping, 0)
-    t528 = 1e-12*t202
-    t529 = 1e-12*t182
-    t530 = (t527 & (xp.less_equal(t195, t528) | xp.less_equal(t246, t528) | xp.less_equal(t279, t528) | xp.less_equal(t302, t528) | xp.less_equal(t317, t528) | xp.less_equal(t326, t528))) | (xp.less_equal(damping, 0) & (xp.less_equal(t170, t529) | xp.less_equal(t346, t529) | xp.less_equal(t391, t529) | xp.less_equal(t414, t529) | xp.less_equal(t429, t529) | xp.less_equal(t438, t529)))
-    t531 = t525 & t526 & xp.logical_not(t530)
+    t187 = xp.greater(t170, 0)
+    t188 = xp.where(t187, 1/(t184 + t171), 0)
+    t189 = xp.where(t187, 1 + xp.abs(t113)/t170, 0)
+    t190 = t96*t188
+    t191 = -t189*(0.0009999730384501195*t188 + t139 - t190*t144)
+    t192 = t139 + t191
+    t193 = t189*(t140 + t17*t188 + t190*t145)
+    t194 = -t193 + t140
+    t195 = t189*(t141 + t38*t188 + t190*t146)
+    t196 = -t195 + t141
+    t197 = t189*(t142 + t59*t188 + t190*t147)
+    t198 = -t197 + t142
+    t199 = t189*(t143 + t81*t188 + t190*t148)
+    t200 = -t199 + t143
+    t201 = t188*t191
+    t202 = t144 - t96*t201
+    t203 = -(0.0009999730384501195 + t201)
+    t204 = xp.sqrt(t172 + t174 + t176 + t202**2 + t203**2)
+    t205 = t204*xp.where(xp.greater_equal(t202, 0), xp.asarray(1, dtype=dtype), -1)
+    t206 = t188*t193
+    t207 = t145 - t96*t206
+    t208 = -t206 + t17
+    t209 = t188*t195
+    t210 = t146 - t96*t209
+    t211 = -t209 + t38
+    t212 = t188*t197
+    t213 = t147 - t96*t212
+    t214 = -t212 + t59
+    t215 = t188*t199
+    t216 = t148 - t96*t215
+    t217 = -t215 + t81
+    t218 = xp.greater(t204, 0)
+    t219 = xp.where(t218, 1/(t202 + t205), 0)
+    t220 = xp.where(t218, 1 + xp.abs(t202)/t204, 0)
+    t221 = t114*t219
+    t222 = t0*t219
+    t223 = t1*t219
+    t224 = t203*t219
+    t225 = t220*(t207 + t115*t221 + t224*t208 + t15*t222 - t16*t223)
+    t226 = -t225 + t207
+    t227 = t115 - t221*t225
+    t228 = t15 - t222*t225
+    t229 = t16 + t223*t225
+    t230 = t208 - t224*t225
+    t231 = t220*(t210 + t116*t221 + t224*t211 + t36*t222 - t37*t223)
+    t232 = -t231 + t210
+    t233 = t116 - t221*t231
+    t234 = t36 - t222*t231
+    t235 = t37 + t223*t231
+    t236 = t211 - t224*t231
+    t237 = t220*(t213 + t117*t221 + t224*t214 + t57*t222 - t58*t223)
+    t238 = -t237 + t213
+    t239 = t117 - t221*t237
+    t240 = t57 - t222*t237
+    t241 = t58 + t223*t237
+    t242 = t214 - t224*t237
+    t243 = t220*(t216 + t118*t221 + t224*t217 + t78*t222 - t79*t223)
+    t244 = -t243 + t216
+    t245 = t118 - t221*t243
+    t246 = t78 - t222*t243
+    t247 = t79 + t223*t243
+    t248 = t217 - t224*t243
+    t249 = xp.sqrt(t227**2 + t228**2 + t229**2 + t230**2)
+    t250 = t249*xp.where(xp.greater_equal(t227, 0), xp.asarray(1, dtype=dtype), -1)
+    t251 = xp.greater(t249, 0)
+    t252 = xp.where(t251, 1/(t227 + t250), 0)
+    t253 = xp.where(t251, 1 + xp.abs(t227)/t249, 0)
+    t254 = t228*t252
+    t255 = t229*t252
+    t256 = t230*t252
+    t257 = t253*(t233 + t254*t234 + t255*t235 + t256*t236)
+    t258 = -t257 + t233
+    t259 = t234 - t254*t257
+    t260 = t235 - t255*t257
+    t261 = t236 - t256*t257
+    t262 = t253*(t239 + t254*t240 + t255*t241 + t256*t242)
+    t263 = -t262 + t239
+    t264 = t240 - t254*t262
+    t265 = t241 - t255*t262
+    t266 = t242 - t256*t262
+    t267 = t253*(t245 + t254*t246 + t255*t247 + t256*t248)
+    t268 = -t267 + t245
+    t269 = t246 - t254*t267
+    t270 = t247 - t255*t267
+    t271 = t248 - t256*t267
+    t272 = xp.sqrt(t259**2 + t260**2 + t261**2)
+    t273 = t272*xp.where(xp.greater_equal(t259, 0), xp.asarray(1, dtype=dtype), -1)
+    t274 = xp.greater(t272, 0)
+    t275 = xp.where(t274, 1/(t259 + t273), 0)
+    t276 = xp.where(t274, 1 + xp.abs(t259)/t272, 0)
+    t277 = t260*t275
+    t278 = t261*t275
+    t279 = t276*(t264 + t277*t265 + t278*t266)
+    t280 = -t279 + t264
+    t281 = t265 - t277*t279
+    t282 = t266 - t278*t279
+    t283 = t276*(t269 + t277*t270 + t278*t271)
+    t284 = -t283 + t269
+    t285 = t270 - t277*t283
+    t286 = t271 - t278*t283
+    t287 = xp.sqrt(t281**2 + t282**2)
+    t288 = t287*xp.where(xp.greater_equal(t281, 0), xp.asarray(1, dtype=dtype), -1)
+    t289 = xp.greater(t287, 0)
+    t290 = xp.where(t289, 1/(t281 + t288), 0)
+    t291 = xp.where(t289, 1 + xp.abs(t281)/t287, 0)
+    t292 = t282*t290
+    t293 = t291*(t285 + t292*t286)
+    t294 = -t293 + t285
+    t295 = t286 - t292*t293
+    t296 = xp.abs(t295)
+    t297 = t296*xp.where(xp.greater_equal(t295, 0), xp.asarray(1, dtype=dtype), -1)
+    t298 = xp.where(xp.greater(t296, 0), xp.asarray(2, dtype=dtype), 0)
+    t299 = xp.greater_equal(t97, t123) & xp.greater_equal(t97, t159)
+    t300 = xp.greater_equal(t123, t159)
+    t301 = xp.where(t299, 0.5*(1 + t97), xp.where(t300, 0.5*t122, 0.5*t157))
+    t302 = xp.where(t299, 0.5*t98, xp.where(t300, 0.5*(1 + t123), 0.5*t158))
+    t303 = xp.where(t299, 0.5*t99, xp.where(t300, 0.5*t124, 0.5*(1 + t159)))
+    t304 = xp.sqrt(t301**2 + t302**2 + t303**2)
+    t305 = xp.where(xp.greater_equal(t160*t301 + t161*t302 + t125*t303, 0), xp.asarray(1, dtype=dtype), -1)
+    t306 = xp.greater(t163, 1e-06) | xp.greater(t162, 0)
+    t307 = t164*t305/t304
+    t308 = xp.where(t306, t160*t165, t307*t301)
+    t309 = xp.where(t306, t161*t165, t307*t302)
+    t310 = xp.where(t306, t125*t165, t307*t303)
+    t311 = mu_dot3 + t308*gain3
+    t312 = mu_dot4 + t309*gain4
+    t313 = mu_dot5 + t310*gain5
+    t314 = t189*(t100 + t188*t313 + t190*t186)
+    t315 = -t314 + t100
+    t316 = 0.9990000269615499 - t139 - t1 + q1 + t0 + q2 + q3 + q4 + q5 + q6 + t96 + t15 + t16 + t17 + t36 + t37 + t38 + t57 + t58 + t59 + t78 + t79 + t81 + t184 + t140 + t141 + t142 + t143 + t144 + t145 + t146 + t147 + t148 + t114 + t115 + t116 + t117 + t118 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t100 + t186 + t166 + t311 + t312 + t313
+    t317 = damping**2
+    t318 = _symmetric_solve6(xp, 1, (t317 + t180, t149, t150, t151, t152, t185, t317 + t183, t153, t154, t155, t156, t173 + t317, t119, t120, t121, t175 + t317, t80, t82, t177 + t317, t83, t178 + t317, t100, t186, t166, t311, t312, t313,))
+    t319 = t318[5]
+    t320 = t318[0]
+    t321 = t318[1]
+    t322 = t319 - t113*t320 + t96*t321
+    t323 = t318[2]
+    t324 = t318[3]
+    t325 = t318[4]
+    t326 = -0.0009999730384501195*t319 - t139*t320 + t144*t321 + t114*t323 + t0*t324 - t1*t325
+    t327 = t140*t320 + t145*t321 + t115*t323 + t15*t324 + t16*t325 + t17*t319
+    t328 = t141*t320 + t146*t321 + t116*t323 + t36*t324 + t37*t325 + t38*t319
+    t329 = t142*t320 + t147*t321 + t117*t323 + t57*t324 + t58*t325 + t59*t319
+    t330 = t143*t320 + t148*t321 + t118*t323 + t78*t324 + t79*t325 + t81*t319
+    t331 = t188*t314
+    t332 = t186 - t96*t331
+    t333 = -t331 + t313
+    t334 = t220*(t332 + t221*t166 + t222*t311 - t223*t312 + t224*t333)
+    t335 = -t334 + t332
+    t336 = t166 - t221*t334
+    t337 = t311 - t222*t334
+    t338 = t312 + t223*t334
+    t339 = t333 - t224*t334
+    t340 = t253*(t336 + t254*t337 + t255*t338 + t256*t339)
+    t341 = -t340 + t336
+    t342 = t337 - t254*t340
+    t343 = t338 - t255*t340
+    t344 = t339 - t256*t340
+    t345 = t276*(t342 + t277*t343 + t278*t344)
+    t346 = -t345 + t342
+    t347 = t343 - t277*t345
+    t348 = t344 - t278*t345
+    t349 = t291*(t347 + t292*t348)
+    t350 = -t349 + t347
+    t351 = t348 - t292*t349
+    t352 = t351 - t298*t351
+    t353 = xp.where(xp.not_equal(t297, 0), -t352/t297, 0)
+    t354 = xp.where(xp.not_equal(t288, 0), -(t350 - t294*t353)/t288, 0)
+    t355 = xp.where(xp.not_equal(t273, 0), -(-(t280*t354 + t284*t353) + t346)/t273, 0)
+    t356 = xp.where(xp.not_equal(t250, 0), -(-(t258*t355 + t263*t354 + t268*t353) + t341)/t250, 0)
+    t357 = xp.where(xp.not_equal(t205, 0), -(-(t226*t356 + t232*t355 + t238*t354 + t244*t353) + t335)/t205, 0)
+    t358 = xp.where(xp.not_equal(t171, 0), -(-(-t192*t357 + t194*t356 + t196*t355 + t198*t354 + t200*t353) + t315)/t171, 0)
+    t359 = xp.isfinite(t316)
+    t360 = xp.greater_equal(damping, 0)
+    t361 = xp.greater(damping, 0)
+    t362 = 1e-12*t182
+    t363 = (t361 & xp.greater(t318[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t170, t362) | xp.less_equal(t204, t362) | xp.less_equal(t249, t362) | xp.less_equal(t272, t362) | xp.less_equal(t287, t362) | xp.less_equal(t296, t362)))
+    t364 = t359 & t360 & xp.logical_not(t363)
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t531, xp.where(t527, t488, t524), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t531, xp.where(t527, t489, t523), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t531, xp.where(t527, t490, t522), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t531, xp.where(t527, t491, t521), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t531, xp.where(t527, t492, t520), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t531, xp.where(t527, t493, t519), 0), batch),  # 5
+        xp.broadcast_to(xp.where(t364, xp.where(t361, t322, t358), 0), batch),  # 0
+        xp.broadcast_to(xp.where(t364, xp.where(t361, t326, t357), 0), batch),  # 1
+        xp.broadcast_to(xp.where(t364, xp.where(t361, t327, t356), 0), batch),  # 2
+        xp.broadcast_to(xp.where(t364, xp.where(t361, t328, t355), 0), batch),  # 3
+        xp.broadcast_to(xp.where(t364, xp.where(t361, t329, t354), 0), batch),  # 4
+        xp.broadcast_to(xp.where(t364, xp.where(t361, t330, t353), 0), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t525 & t526), 2, xp.where(t530, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t359 & t360), 2, xp.where(t363, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_numeric_step(target, q, damping=0.0):
-    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 1238 operations."""
+    """one step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite): (6 x 1 and 6 x 1 and 1 x 1), 1297 operations."""
     xp, dtype, device, batch, (target, q, damping,) = _arguments(("target", target, (4, 4)), ("q", q, (6,)), ("damping", damping, ()))
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
@@ -7235,178 +6985,19 @@ def ik_numeric_step(target, q, damping=0.0):
     t187 = xp.where(t184, t168*t172, t185*t180)
     t188 = xp.where(t184, t130*t172, t185*t181)
     t189 = t186**2 + t187**2 + t188**2 + t104**2 + t176**2 + t173**2
-    t190 = damping + t154
-    t191 = xp.sqrt(t190**2 + t155**2 + t156**2 + t157**2 + t158**2 + t175**2)
-    t192 = t191*xp.where(xp.greater_equal(t190, 0), xp.asarray(1, dtype=dtype), -1)
-    t193 = xp.greater(t191, 0)
-    t194 = xp.where(t193, 1/(t190 + t192), 0)
-    t195 = xp.where(t193, 1 + xp.abs(t190)/t191, 0)
-    t196 = damping + t159
-    t197 = t155*t194
-    t198 = t156*t194
-    t199 = t157*t194
-    t200 = t158*t194
-    t201 = t175*t194
-    t202 = t195*(t155 + t196*t197 + t198*t160 + t199*t161 + t200*t162 + t201*t163)
-    t203 = -t202 + t155
-    t204 = t196 - t197*t202
-    t205 = t160 - t198*t202
-    t206 = t161 - t199*t202
-    t207 = t162 - t200*t202
-    t208 = t163 - t201*t202
-    t209 = t195*(t104 + t197*t176 + t198*t173 + t199*t186 + t200*t187 + t201*t188)
-    t210 = -t209 + t104
-    t211 = t176 - t197*t209
-    t212 = t173 - t198*t209
-    t213 = t186 - t199*t209
-    t214 = t187 - t200*t209
-    t215 = t188 - t201*t209
-    t216 = xp.sqrt(t204**2 + t205**2 + t206**2 + t207**2 + t208**2)
-    t217 = t216*xp.where(xp.greater_equal(t204, 0), xp.asarray(1, dtype=dtype), -1)
-    t218 = damping + t123
-    t219 = t195*(t156 + t197*t160 + t198*t218 + t199*t124 + t200*t125 + t201*t126)
-    t220 = -t219 + t156
-    t221 = t160 - t197*t219
-    t222 = t218 - t198*t219
-    t223 = t124 - t199*t219
-    t224 = t125 - t200*t219
-    t225 = t126 - t201*t219
-    t226 = damping + t80
-    t227 = t195*(t157 + t197*t161 + t198*t124 + t199*t226 + t200*t82 + t201*t85)
-    t228 = -t227 + t157
-    t229 = t161 - t197*t227
-    t230 = t124 - t198*t227
-    t231 = t226 - t199*t227
-    t232 = t82 - t200*t227
-    t233 = t85 - t201*t227
-    t234 = damping + t83
-    t235 = t195*(t158 + t197*t162 + t198*t125 + t199*t82 + t200*t234 + t201*t86)
-    t236 = -t235 + t158
-    t237 = t162 - t197*t235
-    t238 = t125 - t198*t235
-    t239 = t82 - t199*t235
-    t240 = t234 - t200*t235
-    t241 = t86 - t201*t235
-    t242 = damping + t87
-    t243 = t195*(t201*t242 + t175 + t197*t163 + t198*t126 + t199*t85 + t200*t86)
-    t244 = -t243 + t175
-    t245 = t163 - t197*t243
-    t246 = t126 - t198*t243
-    t247 = t85 - t199*t243
-    t248 = t86 - t200*t243
-    t249 = t242 - t201*t243
-    t250 = xp.greater(t216, 0)
-    t251 = xp.where(t250, 1/(t204 + t217), 0)
-    t252 = xp.where(t250, 1 + xp.abs(t204)/t216, 0)
-    t253 = t205*t251
-    t254 = t206*t251
-    t255 = t207*t251
-    t256 = t208*t251
-    t257 = t252*(t221 + t253*t222 + t254*t223 + t255*t224 + t256*t225)
-    t258 = -t257 + t221
-    t259 = t222 - t253*t257
-    t260 = t223 - t254*t257
-    t261 = t224 - t255*t257
-    t262 = t225 - t256*t257
-    t263 = t252*(t229 + t253*t230 + t254*t231 + t255*t232 + t256*t233)
-    t264 = -t263 + t229
-    t265 = t230 - t253*t263
-    t266 = t231 - t254*t263
-    t267 = t232 - t255*t263
-    t268 = t233 - t256*t263
-    t269 = t252*(t237 + t253*t238 + t254*t239 + t255*t240 + t256*t241)
-    t270 = -t269 + t237
-    t271 = t238 - t253*t269
-    t272 = t239 - t254*t269
-    t273 = t240 - t255*t269
-    t274 = t241 - t256*t269
-    t275 = t252*(t245 + t253*t246 + t254*t247 + t255*t248 + t256*t249)
-    t276 = -t275 + t245
-    t277 = t246 - t253*t275
-    t278 = t247 - t254*t275
-    t279 = t248 - t255*t275
-    t280 = t249 - t256*t275
-    t281 = t252*(t211 + t253*t212 + t254*t213 + t255*t214 + t256*t215)
-    t282 = -t281 + t211
-    t283 = t212 - t253*t281
-    t284 = t213 - t254*t281
-    t285 = t214 - t255*t281
-    t286 = t215 - t256*t281
-    t287 = xp.sqrt(t259**2 + t260**2 + t261**2 + t262**2)
-    t288 = t287*xp.where(xp.greater_equal(t259, 0), xp.asarray(1, dtype=dtype), -1)
-    t289 = xp.greater(t287, 0)
-    t290 = xp.where(t289, 1/(t259 + t288), 0)
-    t291 = xp.where(t289, 1 + xp.abs(t259)/t287, 0)
-    t292 = t260*t290
-    t293 = t261*t290
-    t294 = t262*t290
-    t295 = t291*(t265 + t292*t266 + t293*t267 + t294*t268)
-    t296 = -t295 + t265
-    t297 = t266 - t292*t295
-    t298 = t267 - t293*t295
-    t299 = t268 - t294*t295
-    t300 = t291*(t271 + t292*t272 + t293*t273 + t294*t274)
-    t301 = -t300 + t271
-    t302 = t272 - t292*t300
-    t303 = t273 - t293*t300
-    t304 = t274 - t294*t300
-    t305 = t291*(t277 + t292*t278 + t293*t279 + t294*t280)
-    t306 = -t305 + t277
-    t307 = t278 - t292*t305
-    t308 = t279 - t293*t305
-    t309 = t280 - t294*t305
-    t310 = t291*(t283 + t292*t284 + t293*t285 + t294*t286)
-    t311 = -t310 + t283
-    t312 = t284 - t292*t310
-    t313 = t285 - t293*t310
-    t314 = t286 - t294*t310
-    t315 = xp.sqrt(t297**2 + t298**2 + t299**2)
-    t316 = t315*xp.where(xp.greater_equal(t297, 0), xp.asarray(1, dtype=dtype), -1)
-    t317 = xp.greater(t315, 0)
-    t318 = xp.where(t317, 1/(t297 + t316), 0)
-    t319 = xp.where(t317, 1 + xp.abs(t297)/t315, 0)
-    t320 = t298*t318
-    t321 = t299*t318
-    t322 = t319*(t302 + t320*t303 + t321*t304)
-    t323 = -t322 + t302
-    t324 = t303 - t320*t322
-    t325 = t304 - t321*t322
-    t326 = t319*(t307 + t320*t308 + t321*t309)
-    t327 = -t326 + t307
-    t328 = t308 - t320*t326
-    t329 = t309 - t321*t326
-    t330 = t319*(t312 + t320*t313 + t321*t314)
-    t331 = -t330 + t312
-    t332 = t313 - t320*t330
-    t333 = t314 - t321*t330
-    t334 = xp.sqrt(t324**2 + t325**2)
-    t335 = t334*xp.where(xp.greater_equal(t324, 0), xp.asarray(1, dtype=dtype), -1)
-    t336 = xp.greater(t334, 0)
-    t337 = xp.where(t336, 1/(t324 + t335), 0)
-    t338 = xp.where(t336, 1 + xp.abs(t324)/t334, 0)
-    t339 = t325*t337
-    t340 = t338*(t328 + t339*t329)
-    t341 = -t340 + t328
-    t342 = t329 - t339*t340
-    t343 = t338*(t332 + t339*t333)
-    t344 = -t343 + t332
-    t345 = t333 - t339*t343
-    t346 = xp.abs(t342)
-    t347 = t346*xp.where(xp.greater_equal(t342, 0), xp.asarray(1, dtype=dtype), -1)
-    t348 = xp.where(xp.greater(t346, 0), xp.asarray(2, dtype=dtype), 0)
-    t349 = t345 - t345*t348
-    t350 = xp.where(xp.not_equal(t347, 0), -t349/t347, 0)
-    t351 = xp.where(xp.not_equal(t335, 0), -(t344 - t341*t350)/t335, 0)
-    t352 = xp.where(xp.not_equal(t316, 0), -(-(t323*t351 + t327*t350) + t331)/t316, 0)
-    t353 = xp.where(xp.not_equal(t288, 0), -(-(t296*t352 + t301*t351 + t306*t350) + t311)/t288, 0)
-    t354 = xp.where(xp.not_equal(t217, 0), -(-(t258*t353 + t264*t352 + t270*t351 + t276*t350) + t282)/t217, 0)
-    t355 = xp.where(xp.not_equal(t192, 0), -(-(t203*t354 + t220*t353 + t228*t352 + t236*t351 + t244*t350) + t210)/t192, 0)
-    t356 = q1 + t350 - t117*t355 + t100*t354
-    t357 = -0.0009999730384501195*t350 + q2 - t144*t355 + t149*t354 + t118*t353 + t0*t352 - t1*t351
-    t358 = q3 + t145*t355 + t150*t354 + t119*t353 + t16*t352 + t17*t351 + t18*t350
-    t359 = q4 + t146*t355 + t151*t354 + t120*t353 + t37*t352 + t38*t351 + t39*t350
-    t360 = q5 + t147*t355 + t152*t354 + t121*t353 + t58*t352 + t59*t351 + t60*t350
-    t361 = q6 + t148*t355 + t153*t354 + t122*t353 + t79*t352 + t81*t351 + t84*t350
+    t190 = _symmetric_solve6(xp, 1, (damping + t154, t155, t156, t157, t158, t175, damping + t159, t160, t161, t162, t163, damping + t123, t124, t125, t126, damping + t80, t82, t85, damping + t83, t86, damping + t87, t104, t176, t173, t186, t187, t188,))
+    t191 = t190[5]
+    t192 = t190[0]
+    t193 = t190[1]
+    t194 = q1 + t191 - t117*t192 + t100*t193
+    t195 = t190[2]
+    t196 = t190[3]
+    t197 = t190[4]
+    t198 = -0.0009999730384501195*t191 + q2 + t195*t118 - t192*t144 + t193*t149 + t0*t196 - t1*t197
+    t199 = q3 + t18*t191 + t192*t145 + t193*t150 + t195*t119 + t16*t196 + t17*t197
+    t200 = q4 + t195*t120 + t192*t146 + t193*t151 + t37*t196 + t38*t197 + t39*t191
+    t201 = q5 + t192*t147 + t193*t152 + t195*t121 + t58*t196 + t59*t197 + t60*t191
+    t202 = q6 + t195*t122 + t192*t148 + t193*t153 + t79*t196 + t81*t197 + t84*t191
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
         xp.broadcast_to(q2, batch),  # 1
@@ -7416,12 +7007,12 @@ def ik_numeric_step(target, q, damping=0.0):
         xp.broadcast_to(q6, batch),  # 5
     ], (6,))
     q_next = _stack(xp, [
-        xp.broadcast_to(xp.where(xp.less(t356, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t356, 6.283185307179586), 6.283185307179586, t356)), batch),  # 0
-        xp.broadcast_to(xp.where(xp.less(t357, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t357, 6.283185307179586), 6.283185307179586, t357)), batch),  # 1
-        xp.broadcast_to(xp.where(xp.less(t358, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t358, 6.283185307179586), 6.283185307179586, t358)), batch),  # 2
-        xp.broadcast_to(xp.where(xp.less(t359, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t359, 6.283185307179586), 6.283185307179586, t359)), batch),  # 3
-        xp.broadcast_to(xp.where(xp.less(t360, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t360, 6.283185307179586), 6.283185307179586, t360)), batch),  # 4
-        xp.broadcast_to(xp.where(xp.less(t361, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t361, 6.283185307179586), 6.283185307179586, t361)), batch),  # 5
+        xp.broadcast_to(xp.where(xp.less(t194, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t194, 6.283185307179586), 6.283185307179586, t194)), batch),  # 0
+        xp.broadcast_to(xp.where(xp.less(t198, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t198, 6.283185307179586), 6.283185307179586, t198)), batch),  # 1
+        xp.broadcast_to(xp.where(xp.less(t199, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t199, 6.283185307179586), 6.283185307179586, t199)), batch),  # 2
+        xp.broadcast_to(xp.where(xp.less(t200, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t200, 6.283185307179586), 6.283185307179586, t200)), batch),  # 3
+        xp.broadcast_to(xp.where(xp.less(t201, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t201, 6.283185307179586), 6.283185307179586, t201)), batch),  # 4
+        xp.broadcast_to(xp.where(xp.less(t202, -6.283185307179586), -6.283185307179586, xp.where(xp.greater(t202, 6.283185307179586), 6.283185307179586, t202)), batch),  # 5
     ], (6,))
     cost = xp.broadcast_to(xp.where(xp.isfinite(t5), t189, -1), batch)
     return q_start, q_next, cost
@@ -11932,7 +11523,7 @@ def ik_general_nominal(T):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 1891 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 1890 operations."""
     xp, dtype, device, batch, (T, q_seed, weights,) = _arguments(("T", T, (4, 4)), ("q_seed", q_seed, (6,)), ("weights", weights, (6,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(T)
     T00 = T[..., 0, 0]
@@ -12087,710 +11678,35 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     lb13 = branches_in_limits[..., 13]
     lb14 = branches_in_limits[..., 14]
     lb15 = branches_in_limits[..., 15]
-    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
-    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
-    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
-    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
-    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
-    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
-    t6 = xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0)
-    t7 = xp.where(xp.greater(t6, 0), xp.asarray(1, dtype=dtype), 0)
-    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
-    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
-    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
-    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
-    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
-    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
-    t14 = xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0)
-    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
-    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
-    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
-    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
-    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
-    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
-    t21 = xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0)
-    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
-    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
-    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
-    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
-    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
-    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
-    t28 = xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0)
-    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
-    t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
-    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
-    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
-    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
-    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
-    t35 = xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0)
-    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
-    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
-    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
-    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
-    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
-    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
-    t42 = xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0)
-    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
-    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
-    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
-    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
-    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
-    t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
-    t49 = xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0)
-    t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
-    t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
-    t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
-    t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
-    t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
-    t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
-    t56 = xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0)
-    t57 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_0 + qn1)) + qb8_0
-    t58 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_1 + qn2)) + qb8_1
-    t59 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_2 + qn3)) + qb8_2
-    t60 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_3 + qn4)) + qb8_3
-    t61 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_4 + qn5)) + qb8_4
-    t62 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_5 + qn6)) + qb8_5
-    t63 = xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0)
-    t64 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_0 + qn1)) + qb9_0
-    t65 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_1 + qn2)) + qb9_1
-    t66 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_2 + qn3)) + qb9_2
-    t67 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_3 + qn4)) + qb9_3
-    t68 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_4 + qn5)) + qb9_4
-    t69 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_5 + qn6)) + qb9_5
-    t70 = xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0)
-    t71 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_0 + qn1)) + qb10_0
-    t72 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_1 + qn2)) + qb10_1
-    t73 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_2 + qn3)) + qb10_2
-    t74 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_3 + qn4)) + qb10_3
-    t75 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_4 + qn5)) + qb10_4
-    t76 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_5 + qn6)) + qb10_5
-    t77 = xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0)
-    t78 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_0 + qn1)) + qb11_0
-    t79 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_1 + qn2)) + qb11_1
-    t80 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_2 + qn3)) + qb11_2
-    t81 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_3 + qn4)) + qb11_3
-    t82 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_4 + qn5)) + qb11_4
-    t83 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_5 + qn6)) + qb11_5
-    t84 = xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0)
-    t85 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_0 + qn1)) + qb12_0
-    t86 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_1 + qn2)) + qb12_1
-    t87 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_2 + qn3)) + qb12_2
-    t88 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_3 + qn4)) + qb12_3
-    t89 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_4 + qn5)) + qb12_4
-    t90 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_5 + qn6)) + qb12_5
-    t91 = xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0)
-    t92 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_0 + qn1)) + qb13_0
-    t93 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_1 + qn2)) + qb13_1
-    t94 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_2 + qn3)) + qb13_2
-    t95 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_3 + qn4)) + qb13_3
-    t96 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_4 + qn5)) + qb13_4
-    t97 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_5 + qn6)) + qb13_5
-    t98 = xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0)
-    t99 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_0 + qn1)) + qb14_0
-    t100 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_1 + qn2)) + qb14_1
-    t101 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_2 + qn3)) + qb14_2
-    t102 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_3 + qn4)) + qb14_3
-    t103 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_4 + qn5)) + qb14_4
-    t104 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_5 + qn6)) + qb14_5
-    t105 = xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0)
-    t106 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_0 + qn1)) + qb15_0
-    t107 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_1 + qn2)) + qb15_1
-    t108 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_2 + qn3)) + qb15_2
-    t109 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_3 + qn4)) + qb15_3
-    t110 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_4 + qn5)) + qb15_4
-    t111 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_5 + qn6)) + qb15_5
-    t112 = xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0)
-    t113 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
-    t114 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t115 = t114 + t0
-    t116 = -t114 + t0
-    t117 = xp.where(xp.greater_equal(t0, -6.283185307179586) & xp.less_equal(t0, 6.283185307179586), t0, xp.where(xp.greater_equal(t115, -6.283185307179586) & xp.less_equal(t115, 6.283185307179586), t115, xp.where(xp.greater_equal(t116, -6.283185307179586) & xp.less_equal(t116, 6.283185307179586), t116, qb0_0)))
-    t118 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t119 = t118 + t1
-    t120 = -t118 + t1
-    t121 = xp.where(xp.greater_equal(t1, -6.283185307179586) & xp.less_equal(t1, 6.283185307179586), t1, xp.where(xp.greater_equal(t119, -6.283185307179586) & xp.less_equal(t119, 6.283185307179586), t119, xp.where(xp.greater_equal(t120, -6.283185307179586) & xp.less_equal(t120, 6.283185307179586), t120, qb0_1)))
-    t122 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t123 = t122 + t2
-    t124 = -t122 + t2
-    t125 = xp.where(xp.greater_equal(t2, -6.283185307179586) & xp.less_equal(t2, 6.283185307179586), t2, xp.where(xp.greater_equal(t123, -6.283185307179586) & xp.less_equal(t123, 6.283185307179586), t123, xp.where(xp.greater_equal(t124, -6.283185307179586) & xp.less_equal(t124, 6.283185307179586), t124, qb0_2)))
-    t126 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t127 = t126 + t3
-    t128 = -t126 + t3
-    t129 = xp.where(xp.greater_equal(t3, -6.283185307179586) & xp.less_equal(t3, 6.283185307179586), t3, xp.where(xp.greater_equal(t127, -6.283185307179586) & xp.less_equal(t127, 6.283185307179586), t127, xp.where(xp.greater_equal(t128, -6.283185307179586) & xp.less_equal(t128, 6.283185307179586), t128, qb0_3)))
-    t130 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t131 = t130 + t4
-    t132 = -t130 + t4
-    t133 = xp.where(xp.greater_equal(t4, -6.283185307179586) & xp.less_equal(t4, 6.283185307179586), t4, xp.where(xp.greater_equal(t131, -6.283185307179586) & xp.less_equal(t131, 6.283185307179586), t131, xp.where(xp.greater_equal(t132, -6.283185307179586) & xp.less_equal(t132, 6.283185307179586), t132, qb0_4)))
-    t134 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t135 = t134 + t5
-    t136 = -t134 + t5
-    t137 = xp.where(xp.greater_equal(t5, -6.283185307179586) & xp.less_equal(t5, 6.283185307179586), t5, xp.where(xp.greater_equal(t135, -6.283185307179586) & xp.less_equal(t135, 6.283185307179586), t135, xp.where(xp.greater_equal(t136, -6.283185307179586) & xp.less_equal(t136, 6.283185307179586), t136, qb0_5)))
-    t138 = -qn1
-    t139 = -qn2
-    t140 = -qn3
-    t141 = -qn4
-    t142 = -qn5
-    t143 = -qn6
-    t144 = qw1*(t138 + t117)**2 + qw2*(t139 + t121)**2 + qw3*(t140 + t125)**2 + qw4*(t141 + t129)**2 + qw5*(t142 + t133)**2 + qw6*(t143 + t137)**2
-    t145 = xp.greater(t7, 0)
-    t146 = xp.where(t145, t117, qn1)
-    t147 = xp.where(t145, t121, qn2)
-    t148 = xp.where(t145, t125, qn3)
-    t149 = xp.where(t145, t129, qn4)
-    t150 = xp.where(t145, t133, qn5)
-    t151 = xp.where(t145, t137, qn6)
-    t152 = xp.where(t145, t144, 0)
-    t153 = xp.where(xp.less(t8, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t154 = t153 + t8
-    t155 = -t153 + t8
-    t156 = xp.where(xp.greater_equal(t8, -6.283185307179586) & xp.less_equal(t8, 6.283185307179586), t8, xp.where(xp.greater_equal(t154, -6.283185307179586) & xp.less_equal(t154, 6.283185307179586), t154, xp.where(xp.greater_equal(t155, -6.283185307179586) & xp.less_equal(t155, 6.283185307179586), t155, qb1_0)))
-    t157 = xp.where(xp.less(t9, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t158 = t157 + t9
-    t159 = -t157 + t9
-    t160 = xp.where(xp.greater_equal(t9, -6.283185307179586) & xp.less_equal(t9, 6.283185307179586), t9, xp.where(xp.greater_equal(t158, -6.283185307179586) & xp.less_equal(t158, 6.283185307179586), t158, xp.where(xp.greater_equal(t159, -6.283185307179586) & xp.less_equal(t159, 6.283185307179586), t159, qb1_1)))
-    t161 = xp.where(xp.less(t10, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t162 = t161 + t10
-    t163 = -t161 + t10
-    t164 = xp.where(xp.greater_equal(t10, -6.283185307179586) & xp.less_equal(t10, 6.283185307179586), t10, xp.where(xp.greater_equal(t162, -6.283185307179586) & xp.less_equal(t162, 6.283185307179586), t162, xp.where(xp.greater_equal(t163, -6.283185307179586) & xp.less_equal(t163, 6.283185307179586), t163, qb1_2)))
-    t165 = xp.where(xp.less(t11, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t166 = t165 + t11
-    t167 = -t165 + t11
-    t168 = xp.where(xp.greater_equal(t11, -6.283185307179586) & xp.less_equal(t11, 6.283185307179586), t11, xp.where(xp.greater_equal(t166, -6.283185307179586) & xp.less_equal(t166, 6.283185307179586), t166, xp.where(xp.greater_equal(t167, -6.283185307179586) & xp.less_equal(t167, 6.283185307179586), t167, qb1_3)))
-    t169 = xp.where(xp.less(t12, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t170 = t169 + t12
-    t171 = -t169 + t12
-    t172 = xp.where(xp.greater_equal(t12, -6.283185307179586) & xp.less_equal(t12, 6.283185307179586), t12, xp.where(xp.greater_equal(t170, -6.283185307179586) & xp.less_equal(t170, 6.283185307179586), t170, xp.where(xp.greater_equal(t171, -6.283185307179586) & xp.less_equal(t171, 6.283185307179586), t171, qb1_4)))
-    t173 = xp.where(xp.less(t13, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t174 = t173 + t13
-    t175 = -t173 + t13
-    t176 = xp.where(xp.greater_equal(t13, -6.283185307179586) & xp.less_equal(t13, 6.283185307179586), t13, xp.where(xp.greater_equal(t174, -6.283185307179586) & xp.less_equal(t174, 6.283185307179586), t174, xp.where(xp.greater_equal(t175, -6.283185307179586) & xp.less_equal(t175, 6.283185307179586), t175, qb1_5)))
-    t177 = qw1*(t138 + t156)**2 + qw2*(t139 + t160)**2 + qw3*(t140 + t164)**2 + qw4*(t141 + t168)**2 + qw5*(t142 + t172)**2 + qw6*(t143 + t176)**2
-    t178 = xp.greater(t14, 0)
-    t179 = xp.where(t178 & (xp.less(t7, 1) | xp.less(t177, t152)), xp.asarray(1, dtype=dtype), 0)
-    t180 = xp.where(t178, 1, t7)
-    t181 = xp.greater(t179, 0)
-    t182 = xp.where(t181, t156, t146)
-    t183 = xp.where(t181, t160, t147)
-    t184 = xp.where(t181, t164, t148)
-    t185 = xp.where(t181, t168, t149)
-    t186 = xp.where(t181, t172, t150)
-    t187 = xp.where(t181, t176, t151)
-    t188 = xp.where(t181, t177, t152)
-    t189 = xp.where(xp.less(t15, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t190 = t189 + t15
-    t191 = -t189 + t15
-    t192 = xp.where(xp.greater_equal(t15, -6.283185307179586) & xp.less_equal(t15, 6.283185307179586), t15, xp.where(xp.greater_equal(t190, -6.283185307179586) & xp.less_equal(t190, 6.283185307179586), t190, xp.where(xp.greater_equal(t191, -6.283185307179586) & xp.less_equal(t191, 6.283185307179586), t191, qb2_0)))
-    t193 = xp.where(xp.less(t16, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t194 = t193 + t16
-    t195 = -t193 + t16
-    t196 = xp.where(xp.greater_equal(t16, -6.283185307179586) & xp.less_equal(t16, 6.283185307179586), t16, xp.where(xp.greater_equal(t194, -6.283185307179586) & xp.less_equal(t194, 6.283185307179586), t194, xp.where(xp.greater_equal(t195, -6.283185307179586) & xp.less_equal(t195, 6.283185307179586), t195, qb2_1)))
-    t197 = xp.where(xp.less(t17, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t198 = t197 + t17
-    t199 = -t197 + t17
-    t200 = xp.where(xp.greater_equal(t17, -6.283185307179586) & xp.less_equal(t17, 6.283185307179586), t17, xp.where(xp.greater_equal(t198, -6.283185307179586) & xp.less_equal(t198, 6.283185307179586), t198, xp.where(xp.greater_equal(t199, -6.283185307179586) & xp.less_equal(t199, 6.283185307179586), t199, qb2_2)))
-    t201 = xp.where(xp.less(t18, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t202 = t201 + t18
-    t203 = -t201 + t18
-    t204 = xp.where(xp.greater_equal(t18, -6.283185307179586) & xp.less_equal(t18, 6.283185307179586), t18, xp.where(xp.greater_equal(t202, -6.283185307179586) & xp.less_equal(t202, 6.283185307179586), t202, xp.where(xp.greater_equal(t203, -6.283185307179586) & xp.less_equal(t203, 6.283185307179586), t203, qb2_3)))
-    t205 = xp.where(xp.less(t19, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t206 = t205 + t19
-    t207 = -t205 + t19
-    t208 = xp.where(xp.greater_equal(t19, -6.283185307179586) & xp.less_equal(t19, 6.283185307179586), t19, xp.where(xp.greater_equal(t206, -6.283185307179586) & xp.less_equal(t206, 6.283185307179586), t206, xp.where(xp.greater_equal(t207, -6.283185307179586) & xp.less_equal(t207, 6.283185307179586), t207, qb2_4)))
-    t209 = xp.where(xp.less(t20, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t210 = t209 + t20
-    t211 = -t209 + t20
-    t212 = xp.where(xp.greater_equal(t20, -6.283185307179586) & xp.less_equal(t20, 6.283185307179586), t20, xp.where(xp.greater_equal(t210, -6.283185307179586) & xp.less_equal(t210, 6.283185307179586), t210, xp.where(xp.greater_equal(t211, -6.283185307179586) & xp.less_equal(t211, 6.283185307179586), t211, qb2_5)))
-    t213 = qw1*(t138 + t192)**2 + qw2*(t139 + t196)**2 + qw3*(t140 + t200)**2 + qw4*(t141 + t204)**2 + qw5*(t142 + t208)**2 + qw6*(t143 + t212)**2
-    t214 = xp.greater(t21, 0)
-    t215 = xp.where(t214 & (xp.less(t180, 1) | xp.less(t213, t188)), xp.asarray(1, dtype=dtype), 0)
-    t216 = xp.where(t214, 1, t180)
-    t217 = xp.greater(t215, 0)
-    t218 = xp.where(t217, t192, t182)
-    t219 = xp.where(t217, t196, t183)
-    t220 = xp.where(t217, t200, t184)
-    t221 = xp.where(t217, t204, t185)
-    t222 = xp.where(t217, t208, t186)
-    t223 = xp.where(t217, t212, t187)
-    t224 = xp.where(t217, t213, t188)
-    t225 = xp.where(xp.less(t22, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t226 = t225 + t22
-    t227 = -t225 + t22
-    t228 = xp.where(xp.greater_equal(t22, -6.283185307179586) & xp.less_equal(t22, 6.283185307179586), t22, xp.where(xp.greater_equal(t226, -6.283185307179586) & xp.less_equal(t226, 6.283185307179586), t226, xp.where(xp.greater_equal(t227, -6.283185307179586) & xp.less_equal(t227, 6.283185307179586), t227, qb3_0)))
-    t229 = xp.where(xp.less(t23, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t230 = t229 + t23
-    t231 = -t229 + t23
-    t232 = xp.where(xp.greater_equal(t23, -6.283185307179586) & xp.less_equal(t23, 6.283185307179586), t23, xp.where(xp.greater_equal(t230, -6.283185307179586) & xp.less_equal(t230, 6.283185307179586), t230, xp.where(xp.greater_equal(t231, -6.283185307179586) & xp.less_equal(t231, 6.283185307179586), t231, qb3_1)))
-    t233 = xp.where(xp.less(t24, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t234 = t233 + t24
-    t235 = -t233 + t24
-    t236 = xp.where(xp.greater_equal(t24, -6.283185307179586) & xp.less_equal(t24, 6.283185307179586), t24, xp.where(xp.greater_equal(t234, -6.283185307179586) & xp.less_equal(t234, 6.283185307179586), t234, xp.where(xp.greater_equal(t235, -6.283185307179586) & xp.less_equal(t235, 6.283185307179586), t235, qb3_2)))
-    t237 = xp.where(xp.less(t25, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t238 = t237 + t25
-    t239 = -t237 + t25
-    t240 = xp.where(xp.greater_equal(t25, -6.283185307179586) & xp.less_equal(t25, 6.283185307179586), t25, xp.where(xp.greater_equal(t238, -6.283185307179586) & xp.less_equal(t238, 6.283185307179586), t238, xp.where(xp.greater_equal(t239, -6.283185307179586) & xp.less_equal(t239, 6.283185307179586), t239, qb3_3)))
-    t241 = xp.where(xp.less(t26, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t242 = t241 + t26
-    t243 = -t241 + t26
-    t244 = xp.where(xp.greater_equal(t26, -6.283185307179586) & xp.less_equal(t26, 6.283185307179586), t26, xp.where(xp.greater_equal(t242, -6.283185307179586) & xp.less_equal(t242, 6.283185307179586), t242, xp.where(xp.greater_equal(t243, -6.283185307179586) & xp.less_equal(t243, 6.283185307179586), t243, qb3_4)))
-    t245 = xp.where(xp.less(t27, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t246 = t245 + t27
-    t247 = -t245 + t27
-    t248 = xp.where(xp.greater_equal(t27, -6.283185307179586) & xp.less_equal(t27, 6.283185307179586), t27, xp.where(xp.greater_equal(t246, -6.283185307179586) & xp.less_equal(t246, 6.283185307179586), t246, xp.where(xp.greater_equal(t247, -6.283185307179586) & xp.less_equal(t247, 6.283185307179586), t247, qb3_5)))
-    t249 = qw1*(t138 + t228)**2 + qw2*(t139 + t232)**2 + qw3*(t140 + t236)**2 + qw4*(t141 + t240)**2 + qw5*(t142 + t244)**2 + qw6*(t143 + t248)**2
-    t250 = xp.greater(t28, 0)
-    t251 = xp.where(t250 & (xp.less(t216, 1) | xp.less(t249, t224)), xp.asarray(1, dtype=dtype), 0)
-    t252 = xp.where(t250, 1, t216)
-    t253 = xp.greater(t251, 0)
-    t254 = xp.where(t253, t228, t218)
-    t255 = xp.where(t253, t232, t219)
-    t256 = xp.where(t253, t236, t220)
-    t257 = xp.where(t253, t240, t221)
-    t258 = xp.where(t253, t244, t222)
-    t259 = xp.where(t253, t248, t223)
-    t260 = xp.where(t253, t249, t224)
-    t261 = xp.where(xp.less(t29, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t262 = t261 + t29
-    t263 = -t261 + t29
-    t264 = xp.where(xp.greater_equal(t29, -6.283185307179586) & xp.less_equal(t29, 6.283185307179586), t29, xp.where(xp.greater_equal(t262, -6.283185307179586) & xp.less_equal(t262, 6.283185307179586), t262, xp.where(xp.greater_equal(t263, -6.283185307179586) & xp.less_equal(t263, 6.283185307179586), t263, qb4_0)))
-    t265 = xp.where(xp.less(t30, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t266 = t265 + t30
-    t267 = -t265 + t30
-    t268 = xp.where(xp.greater_equal(t30, -6.283185307179586) & xp.less_equal(t30, 6.283185307179586), t30, xp.where(xp.greater_equal(t266, -6.283185307179586) & xp.less_equal(t266, 6.283185307179586), t266, xp.where(xp.greater_equal(t267, -6.283185307179586) & xp.less_equal(t267, 6.283185307179586), t267, qb4_1)))
-    t269 = xp.where(xp.less(t31, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t270 = t269 + t31
-    t271 = -t269 + t31
-    t272 = xp.where(xp.greater_equal(t31, -6.283185307179586) & xp.less_equal(t31, 6.283185307179586), t31, xp.where(xp.greater_equal(t270, -6.283185307179586) & xp.less_equal(t270, 6.283185307179586), t270, xp.where(xp.greater_equal(t271, -6.283185307179586) & xp.less_equal(t271, 6.283185307179586), t271, qb4_2)))
-    t273 = xp.where(xp.less(t32, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t274 = t273 + t32
-    t275 = -t273 + t32
-    t276 = xp.where(xp.greater_equal(t32, -6.283185307179586) & xp.less_equal(t32, 6.283185307179586), t32, xp.where(xp.greater_equal(t274, -6.283185307179586) & xp.less_equal(t274, 6.283185307179586), t274, xp.where(xp.greater_equal(t275, -6.283185307179586) & xp.less_equal(t275, 6.283185307179586), t275, qb4_3)))
-    t277 = xp.where(xp.less(t33, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t278 = t277 + t33
-    t279 = -t277 + t33
-    t280 = xp.where(xp.greater_equal(t33, -6.283185307179586) & xp.less_equal(t33, 6.283185307179586), t33, xp.where(xp.greater_equal(t278, -6.283185307179586) & xp.less_equal(t278, 6.283185307179586), t278, xp.where(xp.greater_equal(t279, -6.283185307179586) & xp.less_equal(t279, 6.283185307179586), t279, qb4_4)))
-    t281 = xp.where(xp.less(t34, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t282 = t281 + t34
-    t283 = -t281 + t34
-    t284 = xp.where(xp.greater_equal(t34, -6.283185307179586) & xp.less_equal(t34, 6.283185307179586), t34, xp.where(xp.greater_equal(t282, -6.283185307179586) & xp.less_equal(t282, 6.283185307179586), t282, xp.where(xp.greater_equal(t283, -6.283185307179586) & xp.less_equal(t283, 6.283185307179586), t283, qb4_5)))
-    t285 = qw1*(t138 + t264)**2 + qw2*(t139 + t268)**2 + qw3*(t140 + t272)**2 + qw4*(t141 + t276)**2 + qw5*(t142 + t280)**2 + qw6*(t143 + t284)**2
-    t286 = xp.greater(t35, 0)
-    t287 = xp.where(t286 & (xp.less(t252, 1) | xp.less(t285, t260)), xp.asarray(1, dtype=dtype), 0)
-    t288 = xp.where(t286, 1, t252)
-    t289 = xp.greater(t287, 0)
-    t290 = xp.where(t289, t264, t254)
-    t291 = xp.where(t289, t268, t255)
-    t292 = xp.where(t289, t272, t256)
-    t293 = xp.where(t289, t276, t257)
-    t294 = xp.where(t289, t280, t258)
-    t295 = xp.where(t289, t284, t259)
-    t296 = xp.where(t289, t285, t260)
-    t297 = xp.where(xp.less(t36, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t298 = t297 + t36
-    t299 = -t297 + t36
-    t300 = xp.where(xp.greater_equal(t36, -6.283185307179586) & xp.less_equal(t36, 6.283185307179586), t36, xp.where(xp.greater_equal(t298, -6.283185307179586) & xp.less_equal(t298, 6.283185307179586), t298, xp.where(xp.greater_equal(t299, -6.283185307179586) & xp.less_equal(t299, 6.283185307179586), t299, qb5_0)))
-    t301 = xp.where(xp.less(t37, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t302 = t301 + t37
-    t303 = -t301 + t37
-    t304 = xp.where(xp.greater_equal(t37, -6.283185307179586) & xp.less_equal(t37, 6.283185307179586), t37, xp.where(xp.greater_equal(t302, -6.283185307179586) & xp.less_equal(t302, 6.283185307179586), t302, xp.where(xp.greater_equal(t303, -6.283185307179586) & xp.less_equal(t303, 6.283185307179586), t303, qb5_1)))
-    t305 = xp.where(xp.less(t38, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t306 = t305 + t38
-    t307 = -t305 + t38
-    t308 = xp.where(xp.greater_equal(t38, -6.283185307179586) & xp.less_equal(t38, 6.283185307179586), t38, xp.where(xp.greater_equal(t306, -6.283185307179586) & xp.less_equal(t306, 6.283185307179586), t306, xp.where(xp.greater_equal(t307, -6.283185307179586) & xp.less_equal(t307, 6.283185307179586), t307, qb5_2)))
-    t309 = xp.where(xp.less(t39, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t310 = t309 + t39
-    t311 = -t309 + t39
-    t312 = xp.where(xp.greater_equal(t39, -6.283185307179586) & xp.less_equal(t39, 6.283185307179586), t39, xp.where(xp.greater_equal(t310, -6.283185307179586) & xp.less_equal(t310, 6.283185307179586), t310, xp.where(xp.greater_equal(t311, -6.283185307179586) & xp.less_equal(t311, 6.283185307179586), t311, qb5_3)))
-    t313 = xp.where(xp.less(t40, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t314 = t313 + t40
-    t315 = -t313 + t40
-    t316 = xp.where(xp.greater_equal(t40, -6.283185307179586) & xp.less_equal(t40, 6.283185307179586), t40, xp.where(xp.greater_equal(t314, -6.283185307179586) & xp.less_equal(t314, 6.283185307179586), t314, xp.where(xp.greater_equal(t315, -6.283185307179586) & xp.less_equal(t315, 6.283185307179586), t315, qb5_4)))
-    t317 = xp.where(xp.less(t41, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t318 = t317 + t41
-    t319 = -t317 + t41
-    t320 = xp.where(xp.greater_equal(t41, -6.283185307179586) & xp.less_equal(t41, 6.283185307179586), t41, xp.where(xp.greater_equal(t318, -6.283185307179586) & xp.less_equal(t318, 6.283185307179586), t318, xp.where(xp.greater_equal(t319, -6.283185307179586) & xp.less_equal(t319, 6.283185307179586), t319, qb5_5)))
-    t321 = qw1*(t138 + t300)**2 + qw2*(t139 + t304)**2 + qw3*(t140 + t308)**2 + qw4*(t141 + t312)**2 + qw5*(t142 + t316)**2 + qw6*(t143 + t320)**2
-    t322 = xp.greater(t42, 0)
-    t323 = xp.where(t322 & (xp.less(t288, 1) | xp.less(t321, t296)), xp.asarray(1, dtype=dtype), 0)
-    t324 = xp.where(t322, 1, t288)
-    t325 = xp.greater(t323, 0)
-    t326 = xp.where(t325, t300, t290)
-    t327 = xp.where(t325, t304, t291)
-    t328 = xp.where(t325, t308, t292)
-    t329 = xp.where(t325, t312, t293)
-    t330 = xp.where(t325, t316, t294)
-    t331 = xp.where(t325, t320, t295)
-    t332 = xp.where(t325, t321, t296)
-    t333 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t334 = t333 + t43
-    t335 = -t333 + t43
-    t336 = xp.where(xp.greater_equal(t43, -6.283185307179586) & xp.less_equal(t43, 6.283185307179586), t43, xp.where(xp.greater_equal(t334, -6.283185307179586) & xp.less_equal(t334, 6.283185307179586), t334, xp.where(xp.greater_equal(t335, -6.283185307179586) & xp.less_equal(t335, 6.283185307179586), t335, qb6_0)))
-    t337 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t338 = t337 + t44
-    t339 = -t337 + t44
-    t340 = xp.where(xp.greater_equal(t44, -6.283185307179586) & xp.less_equal(t44, 6.283185307179586), t44, xp.where(xp.greater_equal(t338, -6.283185307179586) & xp.less_equal(t338, 6.283185307179586), t338, xp.where(xp.greater_equal(t339, -6.283185307179586) & xp.less_equal(t339, 6.283185307179586), t339, qb6_1)))
-    t341 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t342 = t341 + t45
-    t343 = -t341 + t45
-    t344 = xp.where(xp.greater_equal(t45, -6.283185307179586) & xp.less_equal(t45, 6.283185307179586), t45, xp.where(xp.greater_equal(t342, -6.283185307179586) & xp.less_equal(t342, 6.283185307179586), t342, xp.where(xp.greater_equal(t343, -6.283185307179586) & xp.less_equal(t343, 6.283185307179586), t343, qb6_2)))
-    t345 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t346 = t345 + t46
-    t347 = -t345 + t46
-    t348 = xp.where(xp.greater_equal(t46, -6.283185307179586) & xp.less_equal(t46, 6.283185307179586), t46, xp.where(xp.greater_equal(t346, -6.283185307179586) & xp.less_equal(t346, 6.283185307179586), t346, xp.where(xp.greater_equal(t347, -6.283185307179586) & xp.less_equal(t347, 6.283185307179586), t347, qb6_3)))
-    t349 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t350 = t349 + t47
-    t351 = -t349 + t47
-    t352 = xp.where(xp.greater_equal(t47, -6.283185307179586) & xp.less_equal(t47, 6.283185307179586), t47, xp.where(xp.greater_equal(t350, -6.283185307179586) & xp.less_equal(t350, 6.283185307179586), t350, xp.where(xp.greater_equal(t351, -6.283185307179586) & xp.less_equal(t351, 6.283185307179586), t351, qb6_4)))
-    t353 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t354 = t353 + t48
-    t355 = -t353 + t48
-    t356 = xp.where(xp.greater_equal(t48, -6.283185307179586) & xp.less_equal(t48, 6.283185307179586), t48, xp.where(xp.greater_equal(t354, -6.283185307179586) & xp.less_equal(t354, 6.283185307179586), t354, xp.where(xp.greater_equal(t355, -6.283185307179586) & xp.less_equal(t355, 6.283185307179586), t355, qb6_5)))
-    t357 = qw1*(t138 + t336)**2 + qw2*(t139 + t340)**2 + qw3*(t140 + t344)**2 + qw4*(t141 + t348)**2 + qw5*(t142 + t352)**2 + qw6*(t143 + t356)**2
-    t358 = xp.greater(t49, 0)
-    t359 = xp.where(t358 & (xp.less(t324, 1) | xp.less(t357, t332)), xp.asarray(1, dtype=dtype), 0)
-    t360 = xp.where(t358, 1, t324)
-    t361 = xp.greater(t359, 0)
-    t362 = xp.where(t361, t336, t326)
-    t363 = xp.where(t361, t340, t327)
-    t364 = xp.where(t361, t344, t328)
-    t365 = xp.where(t361, t348, t329)
-    t366 = xp.where(t361, t352, t330)
-    t367 = xp.where(t361, t356, t331)
-    t368 = xp.where(t361, t357, t332)
-    t369 = xp.where(xp.less(t50, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t370 = t369 + t50
-    t371 = -t369 + t50
-    t372 = xp.where(xp.greater_equal(t50, -6.283185307179586) & xp.less_equal(t50, 6.283185307179586), t50, xp.where(xp.greater_equal(t370, -6.283185307179586) & xp.less_equal(t370, 6.283185307179586), t370, xp.where(xp.greater_equal(t371, -6.283185307179586) & xp.less_equal(t371, 6.283185307179586), t371, qb7_0)))
-    t373 = xp.where(xp.less(t51, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t374 = t373 + t51
-    t375 = -t373 + t51
-    t376 = xp.where(xp.greater_equal(t51, -6.283185307179586) & xp.less_equal(t51, 6.283185307179586), t51, xp.where(xp.greater_equal(t374, -6.283185307179586) & xp.less_equal(t374, 6.283185307179586), t374, xp.where(xp.greater_equal(t375, -6.283185307179586) & xp.less_equal(t375, 6.283185307179586), t375, qb7_1)))
-    t377 = xp.where(xp.less(t52, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t378 = t377 + t52
-    t379 = -t377 + t52
-    t380 = xp.where(xp.greater_equal(t52, -6.283185307179586) & xp.less_equal(t52, 6.283185307179586), t52, xp.where(xp.greater_equal(t378, -6.283185307179586) & xp.less_equal(t378, 6.283185307179586), t378, xp.where(xp.greater_equal(t379, -6.283185307179586) & xp.less_equal(t379, 6.283185307179586), t379, qb7_2)))
-    t381 = xp.where(xp.less(t53, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t382 = t381 + t53
-    t383 = -t381 + t53
-    t384 = xp.where(xp.greater_equal(t53, -6.283185307179586) & xp.less_equal(t53, 6.283185307179586), t53, xp.where(xp.greater_equal(t382, -6.283185307179586) & xp.less_equal(t382, 6.283185307179586), t382, xp.where(xp.greater_equal(t383, -6.283185307179586) & xp.less_equal(t383, 6.283185307179586), t383, qb7_3)))
-    t385 = xp.where(xp.less(t54, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t386 = t385 + t54
-    t387 = -t385 + t54
-    t388 = xp.where(xp.greater_equal(t54, -6.283185307179586) & xp.less_equal(t54, 6.283185307179586), t54, xp.where(xp.greater_equal(t386, -6.283185307179586) & xp.less_equal(t386, 6.283185307179586), t386, xp.where(xp.greater_equal(t387, -6.283185307179586) & xp.less_equal(t387, 6.283185307179586), t387, qb7_4)))
-    t389 = xp.where(xp.less(t55, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t390 = t389 + t55
-    t391 = -t389 + t55
-    t392 = xp.where(xp.greater_equal(t55, -6.283185307179586) & xp.less_equal(t55, 6.283185307179586), t55, xp.where(xp.greater_equal(t390, -6.283185307179586) & xp.less_equal(t390, 6.283185307179586), t390, xp.where(xp.greater_equal(t391, -6.283185307179586) & xp.less_equal(t391, 6.283185307179586), t391, qb7_5)))
-    t393 = qw1*(t138 + t372)**2 + qw2*(t139 + t376)**2 + qw3*(t140 + t380)**2 + qw4*(t141 + t384)**2 + qw5*(t142 + t388)**2 + qw6*(t143 + t392)**2
-    t394 = xp.greater(t56, 0)
-    t395 = xp.where(t394 & (xp.less(t360, 1) | xp.less(t393, t368)), xp.asarray(1, dtype=dtype), 0)
-    t396 = xp.where(t394, 1, t360)
-    t397 = xp.greater(t395, 0)
-    t398 = xp.where(t397, t372, t362)
-    t399 = xp.where(t397, t376, t363)
-    t400 = xp.where(t397, t380, t364)
-    t401 = xp.where(t397, t384, t365)
-    t402 = xp.where(t397, t388, t366)
-    t403 = xp.where(t397, t392, t367)
-    t404 = xp.where(t397, t393, t368)
-    t405 = xp.where(xp.less(t57, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t406 = t405 + t57
-    t407 = -t405 + t57
-    t408 = xp.where(xp.greater_equal(t57, -6.283185307179586) & xp.less_equal(t57, 6.283185307179586), t57, xp.where(xp.greater_equal(t406, -6.283185307179586) & xp.less_equal(t406, 6.283185307179586), t406, xp.where(xp.greater_equal(t407, -6.283185307179586) & xp.less_equal(t407, 6.283185307179586), t407, qb8_0)))
-    t409 = xp.where(xp.less(t58, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t410 = t409 + t58
-    t411 = -t409 + t58
-    t412 = xp.where(xp.greater_equal(t58, -6.283185307179586) & xp.less_equal(t58, 6.283185307179586), t58, xp.where(xp.greater_equal(t410, -6.283185307179586) & xp.less_equal(t410, 6.283185307179586), t410, xp.where(xp.greater_equal(t411, -6.283185307179586) & xp.less_equal(t411, 6.283185307179586), t411, qb8_1)))
-    t413 = xp.where(xp.less(t59, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t414 = t413 + t59
-    t415 = -t413 + t59
-    t416 = xp.where(xp.greater_equal(t59, -6.283185307179586) & xp.less_equal(t59, 6.283185307179586), t59, xp.where(xp.greater_equal(t414, -6.283185307179586) & xp.less_equal(t414, 6.283185307179586), t414, xp.where(xp.greater_equal(t415, -6.283185307179586) & xp.less_equal(t415, 6.283185307179586), t415, qb8_2)))
-    t417 = xp.where(xp.less(t60, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t418 = t417 + t60
-    t419 = -t417 + t60
-    t420 = xp.where(xp.greater_equal(t60, -6.283185307179586) & xp.less_equal(t60, 6.283185307179586), t60, xp.where(xp.greater_equal(t418, -6.283185307179586) & xp.less_equal(t418, 6.283185307179586), t418, xp.where(xp.greater_equal(t419, -6.283185307179586) & xp.less_equal(t419, 6.283185307179586), t419, qb8_3)))
-    t421 = xp.where(xp.less(t61, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t422 = t421 + t61
-    t423 = -t421 + t61
-    t424 = xp.where(xp.greater_equal(t61, -6.283185307179586) & xp.less_equal(t61, 6.283185307179586), t61, xp.where(xp.greater_equal(t422, -6.283185307179586) & xp.less_equal(t422, 6.283185307179586), t422, xp.where(xp.greater_equal(t423, -6.283185307179586) & xp.less_equal(t423, 6.283185307179586), t423, qb8_4)))
-    t425 = xp.where(xp.less(t62, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t426 = t425 + t62
-    t427 = -t425 + t62
-    t428 = xp.where(xp.greater_equal(t62, -6.283185307179586) & xp.less_equal(t62, 6.283185307179586), t62, xp.where(xp.greater_equal(t426, -6.283185307179586) & xp.less_equal(t426, 6.283185307179586), t426, xp.where(xp.greater_equal(t427, -6.283185307179586) & xp.less_equal(t427, 6.283185307179586), t427, qb8_5)))
-    t429 = qw1*(t138 + t408)**2 + qw2*(t139 + t412)**2 + qw3*(t140 + t416)**2 + qw4*(t141 + t420)**2 + qw5*(t142 + t424)**2 + qw6*(t143 + t428)**2
-    t430 = xp.greater(t63, 0)
-    t431 = xp.where(t430 & (xp.less(t396, 1) | xp.less(t429, t404)), xp.asarray(1, dtype=dtype), 0)
-    t432 = xp.where(t430, 1, t396)
-    t433 = xp.greater(t431, 0)
-    t434 = xp.where(t433, t408, t398)
-    t435 = xp.where(t433, t412, t399)
-    t436 = xp.where(t433, t416, t400)
-    t437 = xp.where(t433, t420, t401)
-    t438 = xp.where(t433, t424, t402)
-    t439 = xp.where(t433, t428, t403)
-    t440 = xp.where(t433, t429, t404)
-    t441 = xp.where(xp.less(t64, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t442 = t441 + t64
-    t443 = -t441 + t64
-    t444 = xp.where(xp.greater_equal(t64, -6.283185307179586) & xp.less_equal(t64, 6.283185307179586), t64, xp.where(xp.greater_equal(t442, -6.283185307179586) & xp.less_equal(t442, 6.283185307179586), t442, xp.where(xp.greater_equal(t443, -6.283185307179586) & xp.less_equal(t443, 6.283185307179586), t443, qb9_0)))
-    t445 = xp.where(xp.less(t65, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t446 = t445 + t65
-    t447 = -t445 + t65
-    t448 = xp.where(xp.greater_equal(t65, -6.283185307179586) & xp.less_equal(t65, 6.283185307179586), t65, xp.where(xp.greater_equal(t446, -6.283185307179586) & xp.less_equal(t446, 6.283185307179586), t446, xp.where(xp.greater_equal(t447, -6.283185307179586) & xp.less_equal(t447, 6.283185307179586), t447, qb9_1)))
-    t449 = xp.where(xp.less(t66, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t450 = t449 + t66
-    t451 = -t449 + t66
-    t452 = xp.where(xp.greater_equal(t66, -6.283185307179586) & xp.less_equal(t66, 6.283185307179586), t66, xp.where(xp.greater_equal(t450, -6.283185307179586) & xp.less_equal(t450, 6.283185307179586), t450, xp.where(xp.greater_equal(t451, -6.283185307179586) & xp.less_equal(t451, 6.283185307179586), t451, qb9_2)))
-    t453 = xp.where(xp.less(t67, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t454 = t453 + t67
-    t455 = -t453 + t67
-    t456 = xp.where(xp.greater_equal(t67, -6.283185307179586) & xp.less_equal(t67, 6.283185307179586), t67, xp.where(xp.greater_equal(t454, -6.283185307179586) & xp.less_equal(t454, 6.283185307179586), t454, xp.where(xp.greater_equal(t455, -6.283185307179586) & xp.less_equal(t455, 6.283185307179586), t455, qb9_3)))
-    t457 = xp.where(xp.less(t68, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t458 = t457 + t68
-    t459 = -t457 + t68
-    t460 = xp.where(xp.greater_equal(t68, -6.283185307179586) & xp.less_equal(t68, 6.283185307179586), t68, xp.where(xp.greater_equal(t458, -6.283185307179586) & xp.less_equal(t458, 6.283185307179586), t458, xp.where(xp.greater_equal(t459, -6.283185307179586) & xp.less_equal(t459, 6.283185307179586), t459, qb9_4)))
-    t461 = xp.where(xp.less(t69, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t462 = t461 + t69
-    t463 = -t461 + t69
-    t464 = xp.where(xp.greater_equal(t69, -6.283185307179586) & xp.less_equal(t69, 6.283185307179586), t69, xp.where(xp.greater_equal(t462, -6.283185307179586) & xp.less_equal(t462, 6.283185307179586), t462, xp.where(xp.greater_equal(t463, -6.283185307179586) & xp.less_equal(t463, 6.283185307179586), t463, qb9_5)))
-    t465 = qw1*(t138 + t444)**2 + qw2*(t139 + t448)**2 + qw3*(t140 + t452)**2 + qw4*(t141 + t456)**2 + qw5*(t142 + t460)**2 + qw6*(t143 + t464)**2
-    t466 = xp.greater(t70, 0)
-    t467 = xp.where(t466 & (xp.less(t432, 1) | xp.less(t465, t440)), xp.asarray(1, dtype=dtype), 0)
-    t468 = xp.where(t466, 1, t432)
-    t469 = xp.greater(t467, 0)
-    t470 = xp.where(t469, t444, t434)
-    t471 = xp.where(t469, t448, t435)
-    t472 = xp.where(t469, t452, t436)
-    t473 = xp.where(t469, t456, t437)
-    t474 = xp.where(t469, t460, t438)
-    t475 = xp.where(t469, t464, t439)
-    t476 = xp.where(t469, t465, t440)
-    t477 = xp.where(xp.less(t71, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t478 = t477 + t71
-    t479 = -t477 + t71
-    t480 = xp.where(xp.greater_equal(t71, -6.283185307179586) & xp.less_equal(t71, 6.283185307179586), t71, xp.where(xp.greater_equal(t478, -6.283185307179586) & xp.less_equal(t478, 6.283185307179586), t478, xp.where(xp.greater_equal(t479, -6.283185307179586) & xp.less_equal(t479, 6.283185307179586), t479, qb10_0)))
-    t481 = xp.where(xp.less(t72, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t482 = t481 + t72
-    t483 = -t481 + t72
-    t484 = xp.where(xp.greater_equal(t72, -6.283185307179586) & xp.less_equal(t72, 6.283185307179586), t72, xp.where(xp.greater_equal(t482, -6.283185307179586) & xp.less_equal(t482, 6.283185307179586), t482, xp.where(xp.greater_equal(t483, -6.283185307179586) & xp.less_equal(t483, 6.283185307179586), t483, qb10_1)))
-    t485 = xp.where(xp.less(t73, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t486 = t485 + t73
-    t487 = -t485 + t73
-    t488 = xp.where(xp.greater_equal(t73, -6.283185307179586) & xp.less_equal(t73, 6.283185307179586), t73, xp.where(xp.greater_equal(t486, -6.283185307179586) & xp.less_equal(t486, 6.283185307179586), t486, xp.where(xp.greater_equal(t487, -6.283185307179586) & xp.less_equal(t487, 6.283185307179586), t487, qb10_2)))
-    t489 = xp.where(xp.less(t74, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t490 = t489 + t74
-    t491 = -t489 + t74
-    t492 = xp.where(xp.greater_equal(t74, -6.283185307179586) & xp.less_equal(t74, 6.283185307179586), t74, xp.where(xp.greater_equal(t490, -6.283185307179586) & xp.less_equal(t490, 6.283185307179586), t490, xp.where(xp.greater_equal(t491, -6.283185307179586) & xp.less_equal(t491, 6.283185307179586), t491, qb10_3)))
-    t493 = xp.where(xp.less(t75, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t494 = t493 + t75
-    t495 = -t493 + t75
-    t496 = xp.where(xp.greater_equal(t75, -6.283185307179586) & xp.less_equal(t75, 6.283185307179586), t75, xp.where(xp.greater_equal(t494, -6.283185307179586) & xp.less_equal(t494, 6.283185307179586), t494, xp.where(xp.greater_equal(t495, -6.283185307179586) & xp.less_equal(t495, 6.283185307179586), t495, qb10_4)))
-    t497 = xp.where(xp.less(t76, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t498 = t497 + t76
-    t499 = -t497 + t76
-    t500 = xp.where(xp.greater_equal(t76, -6.283185307179586) & xp.less_equal(t76, 6.283185307179586), t76, xp.where(xp.greater_equal(t498, -6.283185307179586) & xp.less_equal(t498, 6.283185307179586), t498, xp.where(xp.greater_equal(t499, -6.283185307179586) & xp.less_equal(t499, 6.283185307179586), t499, qb10_5)))
-    t501 = qw1*(t138 + t480)**2 + qw2*(t139 + t484)**2 + qw3*(t140 + t488)**2 + qw4*(t141 + t492)**2 + qw5*(t142 + t496)**2 + qw6*(t143 + t500)**2
-    t502 = xp.greater(t77, 0)
-    t503 = xp.where(t502 & (xp.less(t468, 1) | xp.less(t501, t476)), xp.asarray(1, dtype=dtype), 0)
-    t504 = xp.where(t502, 1, t468)
-    t505 = xp.greater(t503, 0)
-    t506 = xp.where(t505, t480, t470)
-    t507 = xp.where(t505, t484, t471)
-    t508 = xp.where(t505, t488, t472)
-    t509 = xp.where(t505, t492, t473)
-    t510 = xp.where(t505, t496, t474)
-    t511 = xp.where(t505, t500, t475)
-    t512 = xp.where(t505, t501, t476)
-    t513 = xp.where(xp.less(t78, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t514 = t513 + t78
-    t515 = -t513 + t78
-    t516 = xp.where(xp.greater_equal(t78, -6.283185307179586) & xp.less_equal(t78, 6.283185307179586), t78, xp.where(xp.greater_equal(t514, -6.283185307179586) & xp.less_equal(t514, 6.283185307179586), t514, xp.where(xp.greater_equal(t515, -6.283185307179586) & xp.less_equal(t515, 6.283185307179586), t515, qb11_0)))
-    t517 = xp.where(xp.less(t79, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t518 = t517 + t79
-    t519 = -t517 + t79
-    t520 = xp.where(xp.greater_equal(t79, -6.283185307179586) & xp.less_equal(t79, 6.283185307179586), t79, xp.where(xp.greater_equal(t518, -6.283185307179586) & xp.less_equal(t518, 6.283185307179586), t518, xp.where(xp.greater_equal(t519, -6.283185307179586) & xp.less_equal(t519, 6.283185307179586), t519, qb11_1)))
-    t521 = xp.where(xp.less(t80, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t522 = t521 + t80
-    t523 = -t521 + t80
-    t524 = xp.where(xp.greater_equal(t80, -6.283185307179586) & xp.less_equal(t80, 6.283185307179586), t80, xp.where(xp.greater_equal(t522, -6.283185307179586) & xp.less_equal(t522, 6.283185307179586), t522, xp.where(xp.greater_equal(t523, -6.283185307179586) & xp.less_equal(t523, 6.283185307179586), t523, qb11_2)))
-    t525 = xp.where(xp.less(t81, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t526 = t525 + t81
-    t527 = -t525 + t81
-    t528 = xp.where(xp.greater_equal(t81, -6.283185307179586) & xp.less_equal(t81, 6.283185307179586), t81, xp.where(xp.greater_equal(t526, -6.283185307179586) & xp.less_equal(t526, 6.283185307179586), t526, xp.where(xp.greater_equal(t527, -6.283185307179586) & xp.less_equal(t527, 6.283185307179586), t527, qb11_3)))
-    t529 = xp.where(xp.less(t82, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t530 = t529 + t82
-    t531 = -t529 + t82
-    t532 = xp.where(xp.greater_equal(t82, -6.283185307179586) & xp.less_equal(t82, 6.283185307179586), t82, xp.where(xp.greater_equal(t530, -6.283185307179586) & xp.less_equal(t530, 6.283185307179586), t530, xp.where(xp.greater_equal(t531, -6.283185307179586) & xp.less_equal(t531, 6.283185307179586), t531, qb11_4)))
-    t533 = xp.where(xp.less(t83, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t534 = t533 + t83
-    t535 = -t533 + t83
-    t536 = xp.where(xp.greater_equal(t83, -6.283185307179586) & xp.less_equal(t83, 6.283185307179586), t83, xp.where(xp.greater_equal(t534, -6.283185307179586) & xp.less_equal(t534, 6.283185307179586), t534, xp.where(xp.greater_equal(t535, -6.283185307179586) & xp.less_equal(t535, 6.283185307179586), t535, qb11_5)))
-    t537 = qw1*(t138 + t516)**2 + qw2*(t139 + t520)**2 + qw3*(t140 + t524)**2 + qw4*(t141 + t528)**2 + qw5*(t142 + t532)**2 + qw6*(t143 + t536)**2
-    t538 = xp.greater(t84, 0)
-    t539 = xp.where(t538 & (xp.less(t504, 1) | xp.less(t537, t512)), xp.asarray(1, dtype=dtype), 0)
-    t540 = xp.where(t538, 1, t504)
-    t541 = xp.greater(t539, 0)
-    t542 = xp.where(t541, t516, t506)
-    t543 = xp.where(t541, t520, t507)
-    t544 = xp.where(t541, t524, t508)
-    t545 = xp.where(t541, t528, t509)
-    t546 = xp.where(t541, t532, t510)
-    t547 = xp.where(t541, t536, t511)
-    t548 = xp.where(t541, t537, t512)
-    t549 = xp.where(xp.less(t85, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t550 = t549 + t85
-    t551 = -t549 + t85
-    t552 = xp.where(xp.greater_equal(t85, -6.283185307179586) & xp.less_equal(t85, 6.283185307179586), t85, xp.where(xp.greater_equal(t550, -6.283185307179586) & xp.less_equal(t550, 6.283185307179586), t550, xp.where(xp.greater_equal(t551, -6.283185307179586) & xp.less_equal(t551, 6.283185307179586), t551, qb12_0)))
-    t553 = xp.where(xp.less(t86, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t554 = t553 + t86
-    t555 = -t553 + t86
-    t556 = xp.where(xp.greater_equal(t86, -6.283185307179586) & xp.less_equal(t86, 6.283185307179586), t86, xp.where(xp.greater_equal(t554, -6.283185307179586) & xp.less_equal(t554, 6.283185307179586), t554, xp.where(xp.greater_equal(t555, -6.283185307179586) & xp.less_equal(t555, 6.283185307179586), t555, qb12_1)))
-    t557 = xp.where(xp.less(t87, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t558 = t557 + t87
-    t559 = -t557 + t87
-    t560 = xp.where(xp.greater_equal(t87, -6.283185307179586) & xp.less_equal(t87, 6.283185307179586), t87, xp.where(xp.greater_equal(t558, -6.283185307179586) & xp.less_equal(t558, 6.283185307179586), t558, xp.where(xp.greater_equal(t559, -6.283185307179586) & xp.less_equal(t559, 6.283185307179586), t559, qb12_2)))
-    t561 = xp.where(xp.less(t88, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t562 = t561 + t88
-    t563 = -t561 + t88
-    t564 = xp.where(xp.greater_equal(t88, -6.283185307179586) & xp.less_equal(t88, 6.283185307179586), t88, xp.where(xp.greater_equal(t562, -6.283185307179586) & xp.less_equal(t562, 6.283185307179586), t562, xp.where(xp.greater_equal(t563, -6.283185307179586) & xp.less_equal(t563, 6.283185307179586), t563, qb12_3)))
-    t565 = xp.where(xp.less(t89, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t566 = t565 + t89
-    t567 = -t565 + t89
-    t568 = xp.where(xp.greater_equal(t89, -6.283185307179586) & xp.less_equal(t89, 6.283185307179586), t89, xp.where(xp.greater_equal(t566, -6.283185307179586) & xp.less_equal(t566, 6.283185307179586), t566, xp.where(xp.greater_equal(t567, -6.283185307179586) & xp.less_equal(t567, 6.283185307179586), t567, qb12_4)))
-    t569 = xp.where(xp.less(t90, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t570 = t569 + t90
-    t571 = -t569 + t90
-    t572 = xp.where(xp.greater_equal(t90, -6.283185307179586) & xp.less_equal(t90, 6.283185307179586), t90, xp.where(xp.greater_equal(t570, -6.283185307179586) & xp.less_equal(t570, 6.283185307179586), t570, xp.where(xp.greater_equal(t571, -6.283185307179586) & xp.less_equal(t571, 6.283185307179586), t571, qb12_5)))
-    t573 = qw1*(t138 + t552)**2 + qw2*(t139 + t556)**2 + qw3*(t140 + t560)**2 + qw4*(t141 + t564)**2 + qw5*(t142 + t568)**2 + qw6*(t143 + t572)**2
-    t574 = xp.greater(t91, 0)
-    t575 = xp.where(t574 & (xp.less(t540, 1) | xp.less(t573, t548)), xp.asarray(1, dtype=dtype), 0)
-    t576 = xp.where(t574, 1, t540)
-    t577 = xp.greater(t575, 0)
-    t578 = xp.where(t577, t552, t542)
-    t579 = xp.where(t577, t556, t543)
-    t580 = xp.where(t577, t560, t544)
-    t581 = xp.where(t577, t564, t545)
-    t582 = xp.where(t577, t568, t546)
-    t583 = xp.where(t577, t572, t547)
-    t584 = xp.where(t577, t573, t548)
-    t585 = xp.where(xp.less(t92, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t586 = t585 + t92
-    t587 = -t585 + t92
-    t588 = xp.where(xp.greater_equal(t92, -6.283185307179586) & xp.less_equal(t92, 6.283185307179586), t92, xp.where(xp.greater_equal(t586, -6.283185307179586) & xp.less_equal(t586, 6.283185307179586), t586, xp.where(xp.greater_equal(t587, -6.283185307179586) & xp.less_equal(t587, 6.283185307179586), t587, qb13_0)))
-    t589 = xp.where(xp.less(t93, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t590 = t589 + t93
-    t591 = -t589 + t93
-    t592 = xp.where(xp.greater_equal(t93, -6.283185307179586) & xp.less_equal(t93, 6.283185307179586), t93, xp.where(xp.greater_equal(t590, -6.283185307179586) & xp.less_equal(t590, 6.283185307179586), t590, xp.where(xp.greater_equal(t591, -6.283185307179586) & xp.less_equal(t591, 6.283185307179586), t591, qb13_1)))
-    t593 = xp.where(xp.less(t94, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t594 = t593 + t94
-    t595 = -t593 + t94
-    t596 = xp.where(xp.greater_equal(t94, -6.283185307179586) & xp.less_equal(t94, 6.283185307179586), t94, xp.where(xp.greater_equal(t594, -6.283185307179586) & xp.less_equal(t594, 6.283185307179586), t594, xp.where(xp.greater_equal(t595, -6.283185307179586) & xp.less_equal(t595, 6.283185307179586), t595, qb13_2)))
-    t597 = xp.where(xp.less(t95, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t598 = t597 + t95
-    t599 = -t597 + t95
-    t600 = xp.where(xp.greater_equal(t95, -6.283185307179586) & xp.less_equal(t95, 6.283185307179586), t95, xp.where(xp.greater_equal(t598, -6.283185307179586) & xp.less_equal(t598, 6.283185307179586), t598, xp.where(xp.greater_equal(t599, -6.283185307179586) & xp.less_equal(t599, 6.283185307179586), t599, qb13_3)))
-    t601 = xp.where(xp.less(t96, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t602 = t601 + t96
-    t603 = -t601 + t96
-    t604 = xp.where(xp.greater_equal(t96, -6.283185307179586) & xp.less_equal(t96, 6.283185307179586), t96, xp.where(xp.greater_equal(t602, -6.283185307179586) & xp.less_equal(t602, 6.283185307179586), t602, xp.where(xp.greater_equal(t603, -6.283185307179586) & xp.less_equal(t603, 6.283185307179586), t603, qb13_4)))
-    t605 = xp.where(xp.less(t97, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t606 = t605 + t97
-    t607 = -t605 + t97
-    t608 = xp.where(xp.greater_equal(t97, -6.283185307179586) & xp.less_equal(t97, 6.283185307179586), t97, xp.where(xp.greater_equal(t606, -6.283185307179586) & xp.less_equal(t606, 6.283185307179586), t606, xp.where(xp.greater_equal(t607, -6.283185307179586) & xp.less_equal(t607, 6.283185307179586), t607, qb13_5)))
-    t609 = qw1*(t138 + t588)**2 + qw2*(t139 + t592)**2 + qw3*(t140 + t596)**2 + qw4*(t141 + t600)**2 + qw5*(t142 + t604)**2 + qw6*(t143 + t608)**2
-    t610 = xp.greater(t98, 0)
-    t611 = xp.where(t610 & (xp.less(t576, 1) | xp.less(t609, t584)), xp.asarray(1, dtype=dtype), 0)
-    t612 = xp.where(t610, 1, t576)
-    t613 = xp.greater(t611, 0)
-    t614 = xp.where(t613, t588, t578)
-    t615 = xp.where(t613, t592, t579)
-    t616 = xp.where(t613, t596, t580)
-    t617 = xp.where(t613, t600, t581)
-    t618 = xp.where(t613, t604, t582)
-    t619 = xp.where(t613, t608, t583)
-    t620 = xp.where(t613, t609, t584)
-    t621 = xp.where(xp.less(t99, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t622 = t621 + t99
-    t623 = -t621 + t99
-    t624 = xp.where(xp.greater_equal(t99, -6.283185307179586) & xp.less_equal(t99, 6.283185307179586), t99, xp.where(xp.greater_equal(t622, -6.283185307179586) & xp.less_equal(t622, 6.283185307179586), t622, xp.where(xp.greater_equal(t623, -6.283185307179586) & xp.less_equal(t623, 6.283185307179586), t623, qb14_0)))
-    t625 = xp.where(xp.less(t100, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t626 = t625 + t100
-    t627 = -t625 + t100
-    t628 = xp.where(xp.greater_equal(t100, -6.283185307179586) & xp.less_equal(t100, 6.283185307179586), t100, xp.where(xp.greater_equal(t626, -6.283185307179586) & xp.less_equal(t626, 6.283185307179586), t626, xp.where(xp.greater_equal(t627, -6.283185307179586) & xp.less_equal(t627, 6.283185307179586), t627, qb14_1)))
-    t629 = xp.where(xp.less(t101, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t630 = t629 + t101
-    t631 = -t629 + t101
-    t632 = xp.where(xp.greater_equal(t101, -6.283185307179586) & xp.less_equal(t101, 6.283185307179586), t101, xp.where(xp.greater_equal(t630, -6.283185307179586) & xp.less_equal(t630, 6.283185307179586), t630, xp.where(xp.greater_equal(t631, -6.283185307179586) & xp.less_equal(t631, 6.283185307179586), t631, qb14_2)))
-    t633 = xp.where(xp.less(t102, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t634 = t633 + t102
-    t635 = -t633 + t102
-    t636 = xp.where(xp.greater_equal(t102, -6.283185307179586) & xp.less_equal(t102, 6.283185307179586), t102, xp.where(xp.greater_equal(t634, -6.283185307179586) & xp.less_equal(t634, 6.283185307179586), t634, xp.where(xp.greater_equal(t635, -6.283185307179586) & xp.less_equal(t635, 6.283185307179586), t635, qb14_3)))
-    t637 = xp.where(xp.less(t103, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t638 = t637 + t103
-    t639 = -t637 + t103
-    t640 = xp.where(xp.greater_equal(t103, -6.283185307179586) & xp.less_equal(t103, 6.283185307179586), t103, xp.where(xp.greater_equal(t638, -6.283185307179586) & xp.less_equal(t638, 6.283185307179586), t638, xp.where(xp.greater_equal(t639, -6.283185307179586) & xp.less_equal(t639, 6.283185307179586), t639, qb14_4)))
-    t641 = xp.where(xp.less(t104, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t642 = t641 + t104
-    t643 = -t641 + t104
-    t644 = xp.where(xp.greater_equal(t104, -6.283185307179586) & xp.less_equal(t104, 6.283185307179586), t104, xp.where(xp.greater_equal(t642, -6.283185307179586) & xp.less_equal(t642, 6.283185307179586), t642, xp.where(xp.greater_equal(t643, -6.283185307179586) & xp.less_equal(t643, 6.283185307179586), t643, qb14_5)))
-    t645 = qw1*(t138 + t624)**2 + qw2*(t139 + t628)**2 + qw3*(t140 + t632)**2 + qw4*(t141 + t636)**2 + qw5*(t142 + t640)**2 + qw6*(t143 + t644)**2
-    t646 = xp.greater(t105, 0)
-    t647 = xp.where(t646 & (xp.less(t612, 1) | xp.less(t645, t620)), xp.asarray(1, dtype=dtype), 0)
-    t648 = xp.where(t646, 1, t612)
-    t649 = xp.greater(t647, 0)
-    t650 = xp.where(t649, t624, t614)
-    t651 = xp.where(t649, t628, t615)
-    t652 = xp.where(t649, t632, t616)
-    t653 = xp.where(t649, t636, t617)
-    t654 = xp.where(t649, t640, t618)
-    t655 = xp.where(t649, t644, t619)
-    t656 = xp.where(t649, t645, t620)
-    t657 = xp.where(xp.less(t106, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t658 = t657 + t106
-    t659 = -t657 + t106
-    t660 = xp.where(xp.greater_equal(t106, -6.283185307179586) & xp.less_equal(t106, 6.283185307179586), t106, xp.where(xp.greater_equal(t658, -6.283185307179586) & xp.less_equal(t658, 6.283185307179586), t658, xp.where(xp.greater_equal(t659, -6.283185307179586) & xp.less_equal(t659, 6.283185307179586), t659, qb15_0)))
-    t661 = xp.where(xp.less(t107, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t662 = t661 + t107
-    t663 = -t661 + t107
-    t664 = xp.where(xp.greater_equal(t107, -6.283185307179586) & xp.less_equal(t107, 6.283185307179586), t107, xp.where(xp.greater_equal(t662, -6.283185307179586) & xp.less_equal(t662, 6.283185307179586), t662, xp.where(xp.greater_equal(t663, -6.283185307179586) & xp.less_equal(t663, 6.283185307179586), t663, qb15_1)))
-    t665 = xp.where(xp.less(t108, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t666 = t665 + t108
-    t667 = -t665 + t108
-    t668 = xp.where(xp.greater_equal(t108, -6.283185307179586) & xp.less_equal(t108, 6.283185307179586), t108, xp.where(xp.greater_equal(t666, -6.283185307179586) & xp.less_equal(t666, 6.283185307179586), t666, xp.where(xp.greater_equal(t667, -6.283185307179586) & xp.less_equal(t667, 6.283185307179586), t667, qb15_2)))
-    t669 = xp.where(xp.less(t109, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t670 = t669 + t109
-    t671 = -t669 + t109
-    t672 = xp.where(xp.greater_equal(t109, -6.283185307179586) & xp.less_equal(t109, 6.283185307179586), t109, xp.where(xp.greater_equal(t670, -6.283185307179586) & xp.less_equal(t670, 6.283185307179586), t670, xp.where(xp.greater_equal(t671, -6.283185307179586) & xp.less_equal(t671, 6.283185307179586), t671, qb15_3)))
-    t673 = xp.where(xp.less(t110, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t674 = t673 + t110
-    t675 = -t673 + t110
-    t676 = xp.where(xp.greater_equal(t110, -6.283185307179586) & xp.less_equal(t110, 6.283185307179586), t110, xp.where(xp.greater_equal(t674, -6.283185307179586) & xp.less_equal(t674, 6.283185307179586), t674, xp.where(xp.greater_equal(t675, -6.283185307179586) & xp.less_equal(t675, 6.283185307179586), t675, qb15_4)))
-    t677 = xp.where(xp.less(t111, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-    t678 = t677 + t111
-    t679 = -t677 + t111
-    t680 = xp.where(xp.greater_equal(t111, -6.283185307179586) & xp.less_equal(t111, 6.283185307179586), t111, xp.where(xp.greater_equal(t678, -6.283185307179586) & xp.less_equal(t678, 6.283185307179586), t678, xp.where(xp.greater_equal(t679, -6.283185307179586) & xp.less_equal(t679, 6.283185307179586), t679, qb15_5)))
-    t681 = qw1*(t138 + t660)**2 + qw2*(t139 + t664)**2 + qw3*(t140 + t668)**2 + qw4*(t141 + t672)**2 + qw5*(t142 + t676)**2 + qw6*(t143 + t680)**2
-    t682 = xp.greater(t112, 0)
-    t683 = xp.where(t682 & (xp.less(t648, 1) | xp.less(t681, t656)), xp.asarray(1, dtype=dtype), 0)
-    t684 = xp.where(t682, 1, t648)
-    t685 = xp.greater(t683, 0)
-    t686 = xp.where(t685, t660, t650)
-    t687 = xp.where(t685, t664, t651)
-    t688 = xp.where(t685, t668, t652)
-    t689 = xp.where(t685, t672, t653)
-    t690 = xp.where(t685, t676, t654)
-    t691 = xp.where(t685, t680, t655)
-    t692 = xp.greater(t684, 0)
-    t693 = xp.isfinite(t113)
-    t694 = t692 & t693
+    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
+    t1 = _nearer_branch(xp, 1, (qb0_0, qb0_1, qb0_2, qb0_3, qb0_4, qb0_5, xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, qn1, qn2, qn3, qn4, qn5, qn6, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
+    t2 = _nearer_branch(xp, 1, (qb1_0, qb1_1, qb1_2, qb1_3, qb1_4, qb1_5, xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t1[0], t1[1], t1[2], t1[3], t1[4], t1[5], t1[6], t1[7],))
+    t3 = _nearer_branch(xp, 1, (qb2_0, qb2_1, qb2_2, qb2_3, qb2_4, qb2_5, xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t2[0], t2[1], t2[2], t2[3], t2[4], t2[5], t2[6], t2[7],))
+    t4 = _nearer_branch(xp, 1, (qb3_0, qb3_1, qb3_2, qb3_3, qb3_4, qb3_5, xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t3[0], t3[1], t3[2], t3[3], t3[4], t3[5], t3[6], t3[7],))
+    t5 = _nearer_branch(xp, 1, (qb4_0, qb4_1, qb4_2, qb4_3, qb4_4, qb4_5, xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t4[0], t4[1], t4[2], t4[3], t4[4], t4[5], t4[6], t4[7],))
+    t6 = _nearer_branch(xp, 1, (qb5_0, qb5_1, qb5_2, qb5_3, qb5_4, qb5_5, xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t5[0], t5[1], t5[2], t5[3], t5[4], t5[5], t5[6], t5[7],))
+    t7 = _nearer_branch(xp, 1, (qb6_0, qb6_1, qb6_2, qb6_3, qb6_4, qb6_5, xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t6[0], t6[1], t6[2], t6[3], t6[4], t6[5], t6[6], t6[7],))
+    t8 = _nearer_branch(xp, 1, (qb7_0, qb7_1, qb7_2, qb7_3, qb7_4, qb7_5, xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t7[0], t7[1], t7[2], t7[3], t7[4], t7[5], t7[6], t7[7],))
+    t9 = _nearer_branch(xp, 1, (qb8_0, qb8_1, qb8_2, qb8_3, qb8_4, qb8_5, xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t8[0], t8[1], t8[2], t8[3], t8[4], t8[5], t8[6], t8[7],))
+    t10 = _nearer_branch(xp, 1, (qb9_0, qb9_1, qb9_2, qb9_3, qb9_4, qb9_5, xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t9[0], t9[1], t9[2], t9[3], t9[4], t9[5], t9[6], t9[7],))
+    t11 = _nearer_branch(xp, 1, (qb10_0, qb10_1, qb10_2, qb10_3, qb10_4, qb10_5, xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t10[0], t10[1], t10[2], t10[3], t10[4], t10[5], t10[6], t10[7],))
+    t12 = _nearer_branch(xp, 1, (qb11_0, qb11_1, qb11_2, qb11_3, qb11_4, qb11_5, xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t11[0], t11[1], t11[2], t11[3], t11[4], t11[5], t11[6], t11[7],))
+    t13 = _nearer_branch(xp, 1, (qb12_0, qb12_1, qb12_2, qb12_3, qb12_4, qb12_5, xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t12[0], t12[1], t12[2], t12[3], t12[4], t12[5], t12[6], t12[7],))
+    t14 = _nearer_branch(xp, 1, (qb13_0, qb13_1, qb13_2, qb13_3, qb13_4, qb13_5, xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t13[0], t13[1], t13[2], t13[3], t13[4], t13[5], t13[6], t13[7],))
+    t15 = _nearer_branch(xp, 1, (qb14_0, qb14_1, qb14_2, qb14_3, qb14_4, qb14_5, xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t14[0], t14[1], t14[2], t14[3], t14[4], t14[5], t14[6], t14[7],))
+    t16 = _nearer_branch(xp, 1, (qb15_0, qb15_1, qb15_2, qb15_3, qb15_4, qb15_5, xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t15[0], t15[1], t15[2], t15[3], t15[4], t15[5], t15[6], t15[7],))
+    t17 = xp.greater(t16[7], 0)
+    t18 = xp.isfinite(t0)
+    t19 = t17 & t18
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t694, t686, qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t694, t687, qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t694, t688, qn3), batch),  # 2
-        xp.broadcast_to(xp.where(t694, t689, qn4), batch),  # 3
-        xp.broadcast_to(xp.where(t694, t690, qn5), batch),  # 4
-        xp.broadcast_to(xp.where(t694, t691, qn6), batch),  # 5
+        xp.broadcast_to(xp.where(t19, t16[0], qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t19, t16[1], qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t19, t16[2], qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t19, t16[3], qn4), batch),  # 3
+        xp.broadcast_to(xp.where(t19, t16[4], qn5), batch),  # 4
+        xp.broadcast_to(xp.where(t19, t16[5], qn6), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t693), 2, xp.where(t692, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t18), 2, xp.where(t17, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

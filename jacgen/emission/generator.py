@@ -114,7 +114,8 @@ class Generator:
         table_q, table_valid, table_inside = (result.symbols for result in table.results)
         read = target.symbols[:3, :] if form.target == "pose" else target.symbols
         closest, outcome = ik_limits.nearest(self.robot, sp, table_q, list(table_valid), list(table_inside),
-                                             list(seed.symbols), list(weights.symbols), form.free, list(read))
+                                             list(seed.symbols), list(weights.symbols), form.free, list(read),
+                                             self.lowering.called)
         nearest = self.function("ik_nearest", "the closed-form ik solution inside the joint limits nearest q_seed "
                                 "(sum of weights_j (q_j - q_seed_j)^2), and the status", vector("q", closest),
                                 status("status", outcome), arguments=(target, seed, *free, weights), calls=(table,))
@@ -174,7 +175,7 @@ class Generator:
         mu_dot = Argument("mu_dot", sympy.Matrix([generated_symbol("mu_dot", i) for i in range(m)]))
         damping = self.damping_argument()
         q_dot, outcome = differential.velocity_ik(js, list(self.q), list(mu_dot.symbols), damping.symbols[0],
-                                                  self.graph, self.name_node)
+                                                  self.graph, self.name_node, self.lowering.called)
         form = "Js^-1 mu_dot (damping 0) or " if m == n else ""
         form += ("Js^T (Js Js^T + damping^2 I)^-1 mu_dot" if m <= n else "(Js^T Js + damping^2 I)^-1 Js^T mu_dot")
         return self.function("velocity_ik", f"joint rates q_dot solving Js q_dot = mu_dot: {form}; and the status",
@@ -192,7 +193,7 @@ class Generator:
                     for qi, given_i, bounds in zip(self.q, given.symbols, limits)}
         error, jacobian = self._task_error(target, task_jacobian)
         trial, cost = differential.ik_numeric_step(error, jacobian, list(self.q), damping.symbols[0], limits,
-                                                   self.graph, self.name_node)
+                                                   self.graph, self.name_node, self.lowering.called)
         read = target.symbols[:3, :] if len(robot.task) == 6 else target.symbols
         cost = differential.flagged_cost(cost, [*given.symbols, *read], self.graph, self.name_node)
         step = "J^T (J J^T + damping I)^-1 e" if jacobian.rows <= n else "(J^T J + damping I)^-1 J^T e"

@@ -171,7 +171,7 @@ def _rate_functions(generator, js: sympy.Matrix, task_jacobian: sympy.Matrix,
     if generator.generates("velocity_ik_nullspace"):
         mu_dot = Argument("mu_dot", sympy.Matrix([generated_symbol("mu_dot", i) for i in range(m)]))
         q_dot, outcome = differential.velocity_ik(js, list(generator.q), list(mu_dot.symbols), damping.symbols[0],
-                                                  g, name, list(z.symbols))
+                                                  g, name, generator.lowering.called, list(z.symbols))
         made.append(generator.function("velocity_ik_nullspace", f"velocity_ik plus null-space motion: {solve}, Js# "
                                        "velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*)",
                                        vector("q_dot", q_dot), status("status", outcome),
@@ -184,7 +184,7 @@ def _rate_functions(generator, js: sympy.Matrix, task_jacobian: sympy.Matrix,
             error = feedback_error(generator, target, task_jacobian)
         command = [name(g.value(r) + g.value(k) * g.value(e)) for r, k, e in zip(rate.symbols, gain.symbols, error)]
         q_dot, outcome = differential.velocity_ik(js, list(generator.q), command, damping.symbols[0], g, name,
-                                                  list(z.symbols))
+                                                  generator.lowering.called, list(z.symbols))
         made.append(generator.function("resolved_rate", "resolved-rate control: q_dot = Js# (target_rate + gain e) "
                                        f"+ (I - Js# Js) z, e ik_numeric's task error at q; and the status "
                                        "(VELOCITY_IK_*)", vector("q_dot", q_dot), status("status", outcome),

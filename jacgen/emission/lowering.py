@@ -5,8 +5,9 @@ value with `Lowering.name`, so that no expression they build grows with the chai
 function's outputs are then lowered to a `Body` on the value graph (`graph.py`): the named
 values and trig symbols they read, common-subexpression elimination (`cse.py`), temporaries
 numbered in a fixed order (the output does not depend on hashing). A body that runs a fixed
-number of times is a kernel (`repeated`), lowered once and run by REPEAT nodes. Every printer
-turns a Body into its language; `operation_count.py` counts it.
+number of times (`repeated`), or that several places compute on other values (`called`), is a
+kernel, lowered once and run by REPEAT nodes. Every printer turns a Body into its language;
+`operation_count.py` counts it.
 """
 
 import heapq
@@ -119,6 +120,17 @@ class Lowering:
             for _ in range(count):
                 state = [graph.value(value) for value in step(state)]
             return state
+        return self._run(name, summary, count, step, state)
+
+    def called(self, name: str, summary: str, step: Callable[[list[Node]], list[Node]],
+               arguments: list[Node]) -> list[Node]:
+        """`step`'s outputs from `arguments`, as one run of the kernel `name`: a body that several
+        functions, or one function twice, compute on other values (a solve of one size), written
+        once in each file and called. Its outputs need not be as many as its arguments."""
+        return self._run(name, summary, 1, step, [self.graph.value(value) for value in arguments])
+
+    def _run(self, name: str, summary: str, count: int, step: Callable, state: list[Node]) -> list[Node]:
+        graph = self.graph
         kernel = self._kernels.get(name)
         if kernel is None:
             symbols = tuple(sympy.Symbol(f"{names.INTERNAL_PREFIX}w{k}", real=True) for k in range(len(state)))
@@ -128,10 +140,11 @@ class Lowering:
                 raise ValueError(f"kernel {name}'s step reads {sorted(map(str, outer))} besides its state")
             body = replace(body, names=body.names | {symbol: f"w{k}" for k, symbol in enumerate(symbols)})
             kernel = self._kernels[name] = Kernel(name, summary, symbols, body)
-        if len(kernel.state) != len(state):
-            raise ValueError(f"kernel {name} has a state of {len(kernel.state)}, given {len(state)}")
+        if len(kernel.state) != len(state) or (count > 1 and len(kernel.body.outputs) != len(state)):
+            raise ValueError(f"kernel {name} maps {len(kernel.state)} values to {len(kernel.body.outputs)}, "
+                             f"given {len(state)} to run {count} times")
         run = graph.node(REPEAT, tuple(state), (kernel, count))
-        return [graph.node(PART, (run,), k) for k in range(len(state))]
+        return [graph.node(PART, (run,), k) for k in range(len(kernel.body.outputs))]
 
     def lower(self, outputs: list[sympy.Basic], bindings: dict | None = None) -> Body:
         """`_lower`, once per outputs and bindings (jacobian_det's determinant is lowered to

@@ -99,8 +99,26 @@ def householder_solve(A, b, g: Graph, name: Callable) -> tuple[list, Node]:
     return x, g.logic(OR, *(g.relation("<=", norm, g.symbol(RANK) * scale) for norm in norms))
 
 
+def symmetric_solve(A, b, g: Graph, name: Callable, call: Callable) -> tuple[list, Node]:
+    """householder_solve of a symmetric A (a Gram matrix), as the kernel symmetric_solve{k}
+    (`call`: `Lowering.called`): each generated file writes it once, and every such k x k
+    system of its functions calls it with A's upper triangle."""
+    k = len(A)
+    upper = [(r, c) for r in range(k) for c in range(r, k)]
+    index = {pair: n for n, pair in enumerate(upper)}
+
+    def step(values: list[Node]) -> list[Node]:
+        rows = [[values[index[min(r, c), max(r, c)]] for c in range(k)] for r in range(k)]
+        x, singular = householder_solve(rows, values[len(upper):], g, name)
+        return x + [g.select(singular, g.number(1), g.number(0))]
+
+    values = call(f"symmetric_solve{k}", f"x solving a symmetric {k} x {k} system A x = b (A's upper triangle) by "
+                  "Householder QR, and 1 where A is numerically singular", step, [A[r][c] for r, c in upper] + list(b))
+    return values[:k], g.relation(">", values[k], g.number(0))
+
+
 def velocity_ik(js: sympy.Matrix, q: list, mu_dot: list, damping: sympy.Symbol, g: Graph,
-                name: Callable, z: list | None = None) -> tuple[list, Node]:
+                name: Callable, call: Callable, z: list | None = None) -> tuple[list, Node]:
     """q_dot solving Js q_dot = mu_dot (Js at q) and the status; with joint rates `z`, plus
     their projection onto the null space of Js, (I - Js# Js) z.
 
@@ -117,7 +135,7 @@ def velocity_ik(js: sympy.Matrix, q: list, mu_dot: list, damping: sympy.Symbol, 
     moved = z is not None and m < n  # the self-motion's task velocity, taken out of the solve
     rhs = (list(elementwise(name, mu_dot - js @ z)) if moved else list(mu_dot)) if m <= n \
         else list(elementwise(name, js.T @ mu_dot))
-    x, singular = householder_solve(gram.tolist(), rhs, g, name)
+    x, singular = symmetric_solve(gram.tolist(), rhs, g, name, call)
     q_dot = list(elementwise(name, js.T @ numpy.array(x, dtype=object))) if m <= n else x
     if moved:
         q_dot = [name(rate + zi) for rate, zi in zip(q_dot, z)]
@@ -160,7 +178,7 @@ def rotation_vector(E, g: Graph, name: Callable) -> list[Node]:
 
 
 def ik_numeric_step(error: list, jacobian: sympy.Matrix, q: list, damping: sympy.Symbol, limits: list,
-                    g: Graph, name: Callable) -> tuple[list, Node]:
+                    g: Graph, name: Callable, call: Callable) -> tuple[list, Node]:
     """One damped least-squares step on the task error e at q: (clamp(clamp(q) + step), |e|^2),
     the step J^T (J J^T + damping I)^-1 e (m <= n) or (J^T J + damping I)^-1 J^T e,
     the joints clamped to `limits` ((low, high), None: none). `error` and `jacobian` are
@@ -170,11 +188,11 @@ def ik_numeric_step(error: list, jacobian: sympy.Matrix, q: list, damping: sympy
     damping = g.value(damping)
     if m <= n:
         gram = elementwise(name, jacobian @ jacobian.T) + numpy.eye(m, dtype=int) * damping
-        x, _ = householder_solve(gram.tolist(), list(error), g, name)
+        x, _ = symmetric_solve(gram.tolist(), list(error), g, name, call)
         step = list(jacobian.T @ numpy.array(x, dtype=object))
     else:
         gram = elementwise(name, jacobian.T @ jacobian) + numpy.eye(n, dtype=int) * damping
-        step, _ = householder_solve(gram.tolist(), list(elementwise(name, jacobian.T @ error)), g, name)
+        step, _ = symmetric_solve(gram.tolist(), list(elementwise(name, jacobian.T @ error)), g, name, call)
     trial = [clamp(name(g.value(qi) + si), bounds, g) for qi, si, bounds in zip(q, step, limits)]
     return trial, name(sum(e**2 for e in error))
 

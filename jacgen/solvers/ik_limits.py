@@ -3,6 +3,8 @@ moved by whole turns into the limits), whether it is inside the limits, and ik_n
 choice of the solution nearest a seed. On the value graph, like the solvers of `ik.py`.
 """
 
+from typing import Callable
+
 import sympy
 
 from jacgen.model.node import AND, OR, Node
@@ -72,28 +74,40 @@ def _nearest_equivalent(sp: Subproblems, value: Node, given: Node, seed: Node, j
 
 
 def nearest(robot, sp: Subproblems, q, valid: list, inside: list, seed, weights,
-            free: int | None, read: list) -> tuple[list, Node]:
+            free: int | None, read: list, call: Callable) -> tuple[list, Node]:
     """ik_nearest: of the valid branches inside the limits, the one nearest the seed by
     sum_j weights_j (q_j - seed_j)^2, each revolute joint at its equivalent nearest the seed
     inside the limits; and the status. No solution, or an entry of the target `read`, a seed
-    or a weight that is not finite: q = seed."""
+    or a weight that is not finite: q = seed.
+
+    The running minimum over the rows is one body, the kernel nearer_branch (`call`:
+    `Lowering.called`), called for each row: (row, allowed, seed, weights, best, distance,
+    found) to the next (best, distance, found). Truth values are carried as 0/1 numbers."""
     g = sp.graph
     zero, one = g.number(0), g.number(1)
+    n = robot.dof
     q, valid, inside = g.values(q).tolist(), list(g.values(valid)), list(g.values(inside))
     seed, weights, read = list(g.values(seed)), list(g.values(weights)), list(g.values(read))
-    # The running minimum over the rows; truth values carried as named 0/1 numbers, so that
-    # no condition grows with the number of rows.
-    best, found, distance = list(seed), zero, zero
-    for row, row_valid, row_inside in zip(q, valid, inside):
-        candidate = [sp.name(value if j == free else _nearest_equivalent(sp, sp.name(value), value, seed[j], joint))
+
+    def step(values: list[Node]) -> list[Node]:
+        row, allowed, seed, weights = values[:n], values[n], values[n + 1:2 * n + 1], values[2 * n + 1:3 * n + 1]
+        best, distance, found = values[3 * n + 1:4 * n + 1], values[4 * n + 1], values[4 * n + 2]
+        candidate = [sp.name(value if j == free else _nearest_equivalent(sp, value, value, seed[j], joint))
                      for j, (value, joint) in enumerate(zip(row, robot.joints))]
         cost = sp.name(sum(w * (x - s) ** 2 for w, x, s in zip(weights, candidate, seed)))
-        allowed = g.relation(">", sp.name(g.select(g.logic(AND, row_valid, row_inside), one, zero)), zero)
         closer = g.logic(OR, g.relation("<", found, one), g.relation("<", cost, distance))
-        take = g.relation(">", sp.name(g.select(g.logic(AND, allowed, closer), one, zero)), zero)
-        best = [sp.name(g.select(take, x, b)) for x, b in zip(candidate, best)]
-        distance = sp.name(g.select(take, cost, distance))
-        found = sp.name(g.select(allowed, one, found))
+        take = g.relation(">", sp.name(g.select(g.logic(AND, g.relation(">", allowed, zero), closer), one, zero)),
+                          zero)
+        return [*(sp.name(g.select(take, x, b)) for x, b in zip(candidate, best)),
+                sp.name(g.select(take, cost, distance)), sp.name(g.select(g.relation(">", allowed, zero), one, found))]
+
+    best, distance, found = list(seed), zero, zero
+    for row, row_valid, row_inside in zip(q, valid, inside):
+        allowed = g.select(g.logic(AND, row_valid, row_inside), one, zero)
+        state = call("nearer_branch", "the nearer of the best branch so far and the next one, in the limits and "
+                     "nearest the seed by its joints' equivalents", step,
+                     [*row, allowed, *seed, *weights, *best, distance, found])
+        best, distance, found = state[:n], state[n], state[n + 1]
     inputs_finite = g.finite(sp.name(sum([*read, *seed, *weights])))
     status = g.select(g.negation(inputs_finite), g.number(IK_NEAREST_NOT_FINITE),
                       g.select(g.relation(">", found, zero), g.number(IK_NEAREST_OK), g.number(IK_NEAREST_NO_SOLUTION)))

@@ -12,7 +12,7 @@ from jacgen.emission.generator import Generator
 from jacgen.emission.printers import AND, ATOM, MATH_FUNCTIONS, PRODUCT, RELATION, Printer
 from jacgen.inputs import names
 from jacgen.inputs.robot import Robot
-from jacgen.model.node import REPEAT
+from jacgen.model.node import REPEAT, Node
 from jacgen.model.tolerance_symbols import TOLERANCES
 
 _FLOAT_MAX = float(numpy.finfo(numpy.float32).max)
@@ -73,8 +73,9 @@ class CPrinter(Printer):
         return f"isfinite({text})"
 
     def repeat(self, kernel, count, state):
-        """A kernel's state is a struct, so that its run is an expression: (`kernel_type`)."""
-        return f"{kernel_function(kernel)}({count}, ({kernel_type(kernel)}){{{{{', '.join(state)}}}}})"
+        """The starting state, a struct (`kernel_type`) that the kernel's function then changes
+        in place (`kernel_run`): a run is always a temporary of its own."""
+        return f"{{{{{', '.join(state)}}}}}"
 
     def part(self, state, index):
         return f"{state}.w[{index}]"
@@ -88,6 +89,14 @@ def kernel_function(kernel: str) -> str:
 def kernel_type(kernel: str) -> str:
     """The C struct of a kernel's state."""
     return f"{kernel_function(kernel)}_state"
+
+
+def kernel_run(run: Node, symbol: str) -> str | None:
+    """The statement that runs a kernel on the state `symbol` (None for any other value)."""
+    if run.kind != REPEAT:
+        return None
+    kernel, count = run.value
+    return f"{kernel_function(kernel.name)}({count}, &{symbol})"
 
 
 # The contract's C array extent of each argument and output (`function.output`, or the function
@@ -163,7 +172,8 @@ def _c_function(function: Function, robot: Robot, printer: CPrinter, macros: dic
         "inputs": [(types.get(argument.name, real), str(symbol), f"{argument.name}[{row * argument.symbols.cols + col}]")
                    for symbol, argument, row, col in inputs] + [(real, name, f"p->{name}") for name in parameters],
         "definitions": [("int" if e.boolean else kernel_type(e.value[0].name) if e.kind == REPEAT else real,
-                         body.name(symbol), text) for (symbol, e), text in zip(body.definitions, definitions)],
+                         body.name(symbol), text, kernel_run(e, body.name(symbol)))
+                        for (symbol, e), text in zip(body.definitions, definitions)],
         "outputs": [(f"{output.name}[{k}]", text) for output in arrays for k, text in enumerate(values[output])],
         "result": values[returned][0] if returned else None,
     }

@@ -55,7 +55,7 @@ def kernels_context(generator: Generator, functions: list, printer) -> list[dict
         made.append({
             "name": kernel.name,
             "summary": sentence(kernel.summary),
-            "size": len(kernel.state),
+            "size": max(len(kernel.state), len(body.outputs)),  # the state, and a call's outputs
             "names": [body.name(symbol) for symbol in kernel.state],
             "operations": body.operation_count,
             "state": [(body.name(symbol), k) for k, symbol in enumerate(kernel.state) if symbol in body.read],
