@@ -111,15 +111,15 @@ void iiwa_velocity_ellipsoid(const iiwa_real q[IIWA_DOF], iiwa_real U_v[9], iiwa
 iiwa_real iiwa_condition_number(const iiwa_real q[IIWA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 7; returned as a scalar. 1013 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1103 operations. */
 int iiwa_velocity_ik(const iiwa_real q[IIWA_DOF], const iiwa_real mu_dot[IIWA_TASK_DIM], iiwa_real damping, iiwa_real q_dot[IIWA_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 7; returned as a scalar. 1096 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1103 operations. */
 int iiwa_velocity_ik_nullspace(const iiwa_real q[IIWA_DOF], const iiwa_real mu_dot[IIWA_TASK_DIM], const iiwa_real z[IIWA_DOF], iiwa_real damping, iiwa_real q_dot[IIWA_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 7; returned as a scalar. 1253 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1334 operations. */
 int iiwa_resolved_rate(const iiwa_real q[IIWA_DOF], const iiwa_real target[16], const iiwa_real target_rate[IIWA_TASK_DIM], const iiwa_real gain[IIWA_TASK_DIM], const iiwa_real z[IIWA_DOF], iiwa_real damping, iiwa_real q_dot[IIWA_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).

@@ -82,7 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -336,7 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi6_rows(xp, count, state):
     """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2 + w4**2 + w5**2
@@ -904,9 +904,9 @@ def _jacobi6_rows(xp, count, state):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _symmetric_solve6(xp, count, state):
-    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    """The solution x of a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
         t0 = w1**2
@@ -1090,10 +1090,146 @@ def _symmetric_solve6(xp, count, state):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _velocity_solve(xp, count, state):
+    """The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status, `count` times: 1089 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, = state
+        t0 = w1*w5
+        t1 = w0*w4
+        t2 = -t0 + w2*t1
+        t3 = t1 - w2*t0
+        t4 = w1*w4
+        t5 = w5*w0
+        t6 = t4 + w2*t5
+        t7 = t5 + w2*t4
+        t8 = w0*w3
+        t9 = t2*w6 + w7*t8
+        t10 = -t2*w7 + w6*t8
+        t11 = t9*w8 - t6*w9
+        t12 = t9*w9 + t6*w8
+        t13 = t10*w10 + t11*w11
+        t14 = w1*w3
+        t15 = t7*w6 + w7*t14
+        t16 = -t7*w7 + w6*t14
+        t17 = t15*w8 + t3*w9
+        t18 = t3*w8 - t15*w9
+        t19 = t16*w10 + t17*w11
+        t20 = w4*w3
+        t21 = w2*w7 - w6*t20
+        t22 = w2*w6 + w7*t20
+        t23 = w5*w3
+        t24 = t21*w8 + w9*t23
+        t25 = -t21*w9 + w8*t23
+        t26 = t22*w10 + t24*w11
+        t27 = t10*t22 - t12*t25 + t13*t26 + w2*t8 - t6*t23
+        t28 = t16*t22 + t18*t25 + t19*t26 + w2*t14 + t3*t23
+        t29 = -(w21 + w2*w23 + t22*w25 + t25*w26 + t26*w27 - t23*w24) + w19
+        t30 = 0.126*t13
+        t31 = 0.4*t10 + t30
+        t32 = 0.42*t8 + t31
+        t33 = 0.126*t19
+        t34 = 0.4*t16 + t33
+        t35 = 0.42*t14 + t34
+        t36 = w0*t32 + w1*t35
+        t37 = t35*t8 - t32*t14
+        t38 = t3*t31 + t6*t34
+        t39 = t10*t34 - t16*t31
+        t40 = t12*t33 + t18*t30
+        t41 = t36**2 + t37**2 + t38**2 + t39**2 + t40**2
+        t42 = w2*t37 + t22*t39 - t25*t40 - t23*t38
+        t43 = -(-t36*w22 + t37*w23 + t38*w24 + t39*w25 - t40*w26) + w16
+        t44 = 0.126*t26
+        t45 = 0.4*t22 + t44
+        t46 = 0.42*w2 + t45
+        t47 = -w2*t35 + t46*t14
+        t48 = -t3*t45 + t34*t23
+        t49 = t16*t45 - t22*t34
+        t50 = -t25*t33 + t18*t44
+        t51 = w2*t32 - t46*t8
+        t52 = t6*t45 + t31*t23
+        t53 = t22*t31 - t10*t45
+        t54 = t12*t44 + t25*t30
+        t55 = t32 + w2*t51 + t22*t53 + t25*t54 + t23*t52
+        t56 = w0**2
+        t57 = -t3*t48 + t16*t49 + t18*t50 + t46*t56 + t14*t47
+        t58 = t46**2
+        t59 = t35**2 + t47**2 + t48**2 + t49**2 + t50**2 + t56*t58
+        t60 = w1*w0
+        t61 = t58*t60 - t32*t35 + t47*t51 - t48*t52 + t49*t53 + t50*t54
+        t62 = w0*t36
+        t63 = t47*t37 + t48*t38 + t49*t39 - t50*t40 - t46*t62
+        t64 = t62 + t3*t38 + t18*t40 - t16*t39 - t14*t37
+        t65 = t46*t60
+        t66 = -t65 + t6*t48 + t10*t49 - t12*t50 + t8*t47
+        t67 = t65 + t3*t52 + t16*t53 + t18*t54 + t14*t51
+        t68 = -t35
+        t69 = t68 + w2*t47 + t22*t49 + t25*t50 - t23*t48
+        t70 = w1**2
+        t71 = t32**2 + t51**2 + t52**2 + t53**2 + t54**2 + t58*t70
+        t72 = t6*t52 + t12*t54 + t46*t70 - t10*t53 - t8*t51
+        t73 = w1*t36
+        t74 = t52*t38 + t54*t40 - t51*t37 - t53*t39 + t46*t73
+        t75 = t73 + t6*t38 + t10*t39 + t12*t40 + t8*t37
+        t76 = w3**2
+        t77 = t6**2 + t10**2 + t12**2 + t13**2 + t70 + t56*t76
+        t78 = -t60 - t6*t3 + t10*t16 - t12*t18 + t13*t19 + t60*t76
+        t79 = t3**2 + t16**2 + t18**2 + t19**2 + t56 + t70*t76
+        t80 = 1 + w2**2 + t22**2 + t25**2 + t26**2 + w5**2*t76
+        t81 = w0*w22
+        t82 = -(-t35*w21 + t47*w23 + t48*w24 + t49*w25 + t50*w26 + t46*t81) + w14
+        t83 = -(t81 - t3*w24 + t16*w25 + t18*w26 + t19*w27 + t14*w23) + w18
+        t84 = w1*w22
+        t85 = -(t32*w21 + t51*w23 - t52*w24 + t53*w25 + t54*w26 + t46*t84) + w15
+        t86 = -(-t84 + t6*w24 + t10*w25 - t12*w26 + t13*w27 + t8*w23) + w17
+        t87 = w20**2
+        t88 = _symmetric_solve6(xp, 1, (t87 + t59, t61, t63, t66, t57, t69, t87 + t71, -t74, -t72, t67, t55, t87 + t41, t75, -t64, t42, t87 + t77, t78, t27, t87 + t79, t28, t87 + t80, t82, t85, t43, t86, t83, t29,))
+        t89 = t88[5]
+        t90 = t88[0]
+        t91 = t88[1]
+        t92 = t89 - t35*t90 + t32*t91
+        t93 = w21 + t92
+        t94 = w0*t46
+        t95 = w1*t46
+        t96 = 1 - t52 - t36 - t40 - t12 - t3 - t23 + w5 + w4 + t6 + w6 + w3 + w7 + t10 + t16 + t22 + w8 + w9 + t18 + t25 + w10 + w11 + t13 + t19 + t26 + w12 + w13 + t32 + t8 + t14 + t68 + t47 + t48 + t49 + t50 + t51 + t53 + t54 + t37 + t38 + t39 + 2*w2 + 2*w0 + t94 + t95 + w14 + w15 + w16 + w17 + w18 + w19 + w20 + w21 + w22 + w23 + w24 + w25 + w26 + w27
+        t97 = t88[2]
+        t98 = t88[3]
+        t99 = t88[4]
+        t100 = t90*t94 + t91*t95 - t36*t97 - w1*t98 + w0*t99
+        t101 = t51*t91 + w2*t89 + t37*t97 + t90*t47 + t8*t98 + t14*t99
+        t102 = t90*t48 - t52*t91 + t38*t97 + t6*t98 - t3*t99 - t23*t89
+        t103 = t39*t97 + t16*t99 + t90*t49 + t53*t91 + t10*t98 + t22*t89
+        t104 = t25*t89 + t90*t50 + t54*t91 - t40*t97 - t12*t98 + t18*t99
+        t105 = t26*t89 + t13*t98 + t19*t99
+        t106 = w22 + t100
+        t107 = w23 + t101
+        t108 = w24 + t102
+        t109 = w25 + t103
+        t110 = w26 + t104
+        t111 = w27 + t105
+        t112 = xp.isfinite(t96)
+        t113 = xp.greater_equal(w20, 0)
+        t114 = t88[6]
+        t115 = t112 & t113 & xp.less_equal(t114, 0)
+        state = (
+            xp.where(t115, t93, 0),
+            xp.where(t115, t106, 0),
+            xp.where(t115, t107, 0),
+            xp.where(t115, t108, 0),
+            xp.where(t115, t109, 0),
+            xp.where(t115, t110, 0),
+            xp.where(t115, t111, 0),
+            xp.where(xp.logical_not(t112 & t113), 2, xp.where(xp.greater(t114, 0), xp.asarray(1, dtype=dtype), 0)),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _nearer_branch(xp, count, state):
     """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 119 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, = state
         t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w8))
@@ -4551,17 +4687,9 @@ def condition_number(q):
     return kappa
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (7 x 1 and 1 x 1), 1013 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (7 x 1 and 1 x 1), 1103 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (7,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
-    q7 = q[..., 6]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
@@ -4581,131 +4709,25 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = s1*s3
-    t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
-    t4 = s1*c3
-    t5 = s3*c1
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
-    t8 = c1*s2
-    t9 = t2*c4 + s4*t8
-    t10 = -t2*s4 + c4*t8
-    t11 = t9*c5 - t6*s5
-    t12 = t9*s5 + t6*c5
-    t13 = t10*c6 + t11*s6
-    t14 = s1*s2
-    t15 = t7*c4 + s4*t14
-    t16 = -t7*s4 + c4*t14
-    t17 = t15*c5 + t3*s5
-    t18 = t3*c5 - t15*s5
-    t19 = t16*c6 + t17*s6
-    t20 = c3*s2
-    t21 = c2*s4 - c4*t20
-    t22 = c2*c4 + s4*t20
-    t23 = s3*s2
-    t24 = t21*c5 + s5*t23
-    t25 = -t21*s5 + c5*t23
-    t26 = t22*c6 + t24*s6
-    t27 = t10*t22 - t12*t25 + t13*t26 + c2*t8 - t6*t23
-    t28 = t16*t22 + t18*t25 + t19*t26 + c2*t14 + t3*t23
-    t29 = 0.126*t13
-    t30 = 0.4*t10 + t29
-    t31 = 0.42*t8 + t30
-    t32 = 0.126*t19
-    t33 = 0.4*t16 + t32
-    t34 = 0.42*t14 + t33
-    t35 = c1*t31 + s1*t34
-    t36 = t34*t8 - t31*t14
-    t37 = t3*t30 + t6*t33
-    t38 = t10*t33 - t16*t30
-    t39 = t12*t32 + t18*t29
-    t40 = t35**2 + t36**2 + t37**2 + t38**2 + t39**2
-    t41 = c2*t36 + t22*t38 - t25*t39 - t23*t37
-    t42 = 0.126*t26
-    t43 = 0.4*t22 + t42
-    t44 = 0.42*c2 + t43
-    t45 = -c2*t34 + t44*t14
-    t46 = -t3*t43 + t33*t23
-    t47 = t16*t43 - t22*t33
-    t48 = -t25*t32 + t18*t42
-    t49 = c2*t31 - t44*t8
-    t50 = t6*t43 + t30*t23
-    t51 = t22*t30 - t10*t43
-    t52 = t12*t42 + t25*t29
-    t53 = t31 + c2*t49 + t22*t51 + t25*t52 + t23*t50
-    t54 = c1**2
-    t55 = -t3*t46 + t16*t47 + t18*t48 + t44*t54 + t14*t45
-    t56 = t44**2
-    t57 = t34**2 + t45**2 + t46**2 + t47**2 + t48**2 + t54*t56
-    t58 = s1*c1
-    t59 = t56*t58 - t31*t34 + t45*t49 - t46*t50 + t47*t51 + t48*t52
-    t60 = c1*t35
-    t61 = t45*t36 + t46*t37 + t47*t38 - t48*t39 - t44*t60
-    t62 = t60 + t3*t37 + t18*t39 - t16*t38 - t14*t36
-    t63 = t44*t58
-    t64 = -t63 + t6*t46 + t10*t47 - t12*t48 + t8*t45
-    t65 = t63 + t3*t50 + t16*t51 + t18*t52 + t14*t49
-    t66 = -t34
-    t67 = t66 + c2*t45 + t22*t47 + t25*t48 - t23*t46
-    t68 = s1**2
-    t69 = t31**2 + t49**2 + t50**2 + t51**2 + t52**2 + t56*t68
-    t70 = t6*t50 + t12*t52 + t44*t68 - t10*t51 - t8*t49
-    t71 = s1*t35
-    t72 = t50*t37 + t52*t39 - t49*t36 - t51*t38 + t44*t71
-    t73 = t71 + t6*t37 + t10*t38 + t12*t39 + t8*t36
-    t74 = s2**2
-    t75 = t6**2 + t10**2 + t12**2 + t13**2 + t68 + t54*t74
-    t76 = -t58 - t6*t3 + t10*t16 - t12*t18 + t13*t19 + t58*t74
-    t77 = t3**2 + t16**2 + t18**2 + t19**2 + t54 + t68*t74
-    t78 = 1 + c2**2 + t22**2 + t25**2 + t26**2 + s3**2*t74
-    t79 = damping**2
-    t80 = _symmetric_solve6(xp, 1, (t79 + t57, t59, t61, t64, t55, t67, t79 + t69, -t72, -t70, t65, t53, t79 + t40, t73, -t62, t41, t79 + t75, t76, t27, t79 + t77, t28, t79 + t78, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
-    t81 = t80[5]
-    t82 = t80[0]
-    t83 = t80[1]
-    t84 = t81 - t34*t82 + t31*t83
-    t85 = c1*t44
-    t86 = s1*t44
-    t87 = 1 - t50 - t35 - t39 - s1 - t12 - t3 - t23 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t10 + t16 + t22 + q5 + t18 + t25 + q6 + t13 + t19 + t26 + q7 + t31 + t8 + t14 + t66 + t85 + t45 + t46 + t47 + t48 + t49 + t51 + t52 + t36 + t37 + t38 + t86 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t88 = t80[2]
-    t89 = t80[3]
-    t90 = t80[4]
-    t91 = t82*t85 + t83*t86 - t35*t88 - s1*t89 + c1*t90
-    t92 = t36*t88 + t82*t45 + t83*t49 + t8*t89 + t14*t90 + c2*t81
-    t93 = t82*t46 - t83*t50 + t37*t88 + t6*t89 - t3*t90 - t23*t81
-    t94 = t10*t89 + t82*t47 + t83*t51 + t38*t88 + t16*t90 + t22*t81
-    t95 = -t12*t89 + t82*t48 + t83*t52 - t39*t88 + t18*t90 + t25*t81
-    t96 = t26*t81 + t13*t89 + t19*t90
-    t97 = xp.isfinite(t87)
-    t98 = xp.greater_equal(damping, 0)
-    t99 = t80[6]
-    t100 = t97 & t98 & xp.less_equal(t99, 0)
+    c7 = trig[..., 12]
+    s7 = trig[..., 13]
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, c7, s7, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5, damping, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t100, t84, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t100, t91, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t100, t92, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t100, t93, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t100, t94, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t100, t95, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t100, t96, 0), batch),  # 6
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
+        xp.broadcast_to(t0[4], batch),  # 4
+        xp.broadcast_to(t0[5], batch),  # 5
+        xp.broadcast_to(t0[6], batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t97 & t98), 2, xp.where(xp.greater(t99, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[7], batch), xp.int32)
     return q_dot, status
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
-    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1096 operations."""
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1103 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (7,)), ("mu_dot", mu_dot, (6,)), ("z", z, (7,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
-    q7 = q[..., 6]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
@@ -4732,146 +4754,26 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = s1*s3
-    t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
-    t4 = s1*c3
-    t5 = s3*c1
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
-    t8 = c1*s2
-    t9 = t2*c4 + s4*t8
-    t10 = -t2*s4 + c4*t8
-    t11 = t9*c5 - t6*s5
-    t12 = t9*s5 + t6*c5
-    t13 = t10*c6 + t11*s6
-    t14 = s1*s2
-    t15 = t7*c4 + s4*t14
-    t16 = -t7*s4 + c4*t14
-    t17 = t15*c5 + t3*s5
-    t18 = t3*c5 - t15*s5
-    t19 = t16*c6 + t17*s6
-    t20 = c3*s2
-    t21 = c2*s4 - c4*t20
-    t22 = c2*c4 + s4*t20
-    t23 = s3*s2
-    t24 = t21*c5 + s5*t23
-    t25 = -t21*s5 + c5*t23
-    t26 = t22*c6 + t24*s6
-    t27 = t10*t22 - t12*t25 + t13*t26 + c2*t8 - t6*t23
-    t28 = t16*t22 + t18*t25 + t19*t26 + c2*t14 + t3*t23
-    t29 = -(qz1 + c2*qz3 + t22*qz5 + t25*qz6 + t26*qz7 - t23*qz4) + mu_dot5
-    t30 = 0.126*t13
-    t31 = 0.4*t10 + t30
-    t32 = 0.42*t8 + t31
-    t33 = 0.126*t19
-    t34 = 0.4*t16 + t33
-    t35 = 0.42*t14 + t34
-    t36 = c1*t32 + s1*t35
-    t37 = t35*t8 - t32*t14
-    t38 = t3*t31 + t6*t34
-    t39 = t10*t34 - t16*t31
-    t40 = t12*t33 + t18*t30
-    t41 = t36**2 + t37**2 + t38**2 + t39**2 + t40**2
-    t42 = c2*t37 + t22*t39 - t25*t40 - t23*t38
-    t43 = -(-t36*qz2 + t37*qz3 + t38*qz4 + t39*qz5 - t40*qz6) + mu_dot2
-    t44 = 0.126*t26
-    t45 = 0.4*t22 + t44
-    t46 = 0.42*c2 + t45
-    t47 = -c2*t35 + t46*t14
-    t48 = -t3*t45 + t34*t23
-    t49 = t16*t45 - t22*t34
-    t50 = -t25*t33 + t18*t44
-    t51 = c2*t32 - t46*t8
-    t52 = t6*t45 + t31*t23
-    t53 = t22*t31 - t10*t45
-    t54 = t12*t44 + t25*t30
-    t55 = t32 + c2*t51 + t22*t53 + t25*t54 + t23*t52
-    t56 = c1**2
-    t57 = -t3*t48 + t16*t49 + t18*t50 + t46*t56 + t14*t47
-    t58 = t46**2
-    t59 = t35**2 + t47**2 + t48**2 + t49**2 + t50**2 + t56*t58
-    t60 = s1*c1
-    t61 = t58*t60 - t32*t35 + t47*t51 - t48*t52 + t49*t53 + t50*t54
-    t62 = c1*t36
-    t63 = t47*t37 + t48*t38 + t49*t39 - t50*t40 - t46*t62
-    t64 = t62 + t3*t38 + t18*t40 - t16*t39 - t14*t37
-    t65 = t46*t60
-    t66 = -t65 + t6*t48 + t10*t49 - t12*t50 + t8*t47
-    t67 = t65 + t3*t52 + t16*t53 + t18*t54 + t14*t51
-    t68 = -t35
-    t69 = t68 + c2*t47 + t22*t49 + t25*t50 - t23*t48
-    t70 = s1**2
-    t71 = t32**2 + t51**2 + t52**2 + t53**2 + t54**2 + t58*t70
-    t72 = t6*t52 + t12*t54 + t46*t70 - t10*t53 - t8*t51
-    t73 = s1*t36
-    t74 = t52*t38 + t54*t40 - t51*t37 - t53*t39 + t46*t73
-    t75 = t73 + t6*t38 + t10*t39 + t12*t40 + t8*t37
-    t76 = s2**2
-    t77 = t6**2 + t10**2 + t12**2 + t13**2 + t70 + t56*t76
-    t78 = -t60 - t6*t3 + t10*t16 - t12*t18 + t13*t19 + t60*t76
-    t79 = t3**2 + t16**2 + t18**2 + t19**2 + t56 + t70*t76
-    t80 = 1 + c2**2 + t22**2 + t25**2 + t26**2 + s3**2*t76
-    t81 = c1*qz2
-    t82 = -(-t35*qz1 + t47*qz3 + t48*qz4 + t49*qz5 + t50*qz6 + t46*t81) + mu_dot0
-    t83 = -(t81 - t3*qz4 + t16*qz5 + t18*qz6 + t19*qz7 + t14*qz3) + mu_dot4
-    t84 = s1*qz2
-    t85 = -(t32*qz1 + t51*qz3 - t52*qz4 + t53*qz5 + t54*qz6 + t46*t84) + mu_dot1
-    t86 = -(-t84 + t6*qz4 + t10*qz5 - t12*qz6 + t13*qz7 + t8*qz3) + mu_dot3
-    t87 = damping**2
-    t88 = _symmetric_solve6(xp, 1, (t87 + t59, t61, t63, t66, t57, t69, t87 + t71, -t74, -t72, t67, t55, t87 + t41, t75, -t64, t42, t87 + t77, t78, t27, t87 + t79, t28, t87 + t80, t82, t85, t43, t86, t83, t29,))
-    t89 = t88[5]
-    t90 = t88[0]
-    t91 = t88[1]
-    t92 = t89 - t35*t90 + t32*t91
-    t93 = qz1 + t92
-    t94 = c1*t46
-    t95 = s1*t46
-    t96 = 1 - t52 - t36 - t40 - s1 - t12 - t3 - t23 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t10 + t16 + t22 + q5 + t18 + t25 + q6 + t13 + t19 + t26 + q7 + t32 + t8 + t14 + t68 + t47 + t48 + t49 + t50 + t51 + t53 + t54 + t37 + t38 + t39 + t94 + t95 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7
-    t97 = t88[2]
-    t98 = t88[3]
-    t99 = t88[4]
-    t100 = t90*t94 + t91*t95 - t36*t97 - s1*t98 + c1*t99
-    t101 = t51*t91 + c2*t89 + t37*t97 + t90*t47 + t8*t98 + t14*t99
-    t102 = t90*t48 - t52*t91 + t38*t97 + t6*t98 - t3*t99 - t23*t89
-    t103 = t39*t97 + t16*t99 + t90*t49 + t53*t91 + t10*t98 + t22*t89
-    t104 = t25*t89 + t90*t50 + t54*t91 - t40*t97 - t12*t98 + t18*t99
-    t105 = t26*t89 + t13*t98 + t19*t99
-    t106 = qz2 + t100
-    t107 = qz3 + t101
-    t108 = qz4 + t102
-    t109 = qz5 + t103
-    t110 = qz6 + t104
-    t111 = qz7 + t105
-    t112 = xp.isfinite(t96)
-    t113 = xp.greater_equal(damping, 0)
-    t114 = t88[6]
-    t115 = t112 & t113 & xp.less_equal(t114, 0)
+    c7 = trig[..., 12]
+    s7 = trig[..., 13]
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, c7, s7, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5, damping, qz1, qz2, qz3, qz4, qz5, qz6, qz7,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t115, t93, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t115, t106, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t115, t107, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t115, t108, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t115, t109, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t115, t110, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t115, t111, 0), batch),  # 6
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
+        xp.broadcast_to(t0[4], batch),  # 4
+        xp.broadcast_to(t0[5], batch),  # 5
+        xp.broadcast_to(t0[6], batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t112 & t113), 2, xp.where(xp.greater(t114, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[7], batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1253 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1334 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (7,)), ("target", target, (4, 4)), ("target_rate", target_rate, (6,)), ("gain", gain, (6,)), ("z", z, (7,)), ("damping", damping, ()), every=("gain", ))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
-    q7 = q[..., 6]
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
     T02 = target[..., 0, 2]
@@ -4935,159 +4837,77 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t14 = t10*c6 + t11*s6
     t15 = t13*c7 - t12*s7
     t16 = t12*c7 + t13*s7
-    t17 = t15*T00 - t16*T01 + t14*T02
-    t18 = t15*T10 - t16*T11 + t14*T12
-    t19 = t15*T20 - t16*T21 + t14*T22
-    t20 = s1*s2
-    t21 = t7*c4 + s4*t20
-    t22 = -t7*s4 + c4*t20
-    t23 = t21*c5 + t3*s5
-    t24 = t3*c5 - t21*s5
-    t25 = t23*c6 - t22*s6
-    t26 = t22*c6 + t23*s6
-    t27 = t24*s7 + t25*c7
-    t28 = t24*c7 - t25*s7
-    t29 = t27*T00 + t28*T01 + t26*T02
-    t30 = t27*T10 + t28*T11 + t26*T12
-    t31 = t27*T20 + t28*T21 + t26*T22
-    t32 = 0.5*(-t29 + t18)
-    t33 = c3*s2
-    t34 = c2*s4 - c4*t33
-    t35 = c2*c4 + s4*t33
-    t36 = s3*s2
-    t37 = t34*c5 + s5*t36
-    t38 = -t34*s5 + c5*t36
-    t39 = t37*c6 - t35*s6
-    t40 = t35*c6 + t37*s6
-    t41 = t38*s7 + t39*c7
-    t42 = t38*c7 - t39*s7
-    t43 = t10*t35 - t12*t38 + t14*t40 + c2*t8 - t6*t36
-    t44 = t22*t35 + t24*t38 + t26*t40 + c2*t20 + t3*t36
-    t45 = t41*T00 + t42*T01 + t40*T02
-    t46 = t41*T10 + t42*T11 + t40*T12
-    t47 = t41*T20 + t42*T21 + t40*T22
-    t48 = 0.5*(-t46 + t31)
-    t49 = 0.5*(-t19 + t45)
-    t50 = 0.5*(-1 + t17 + t30 + t47)
-    t51 = xp.sqrt(t48**2 + t49**2 + t32**2)
-    t52 = xp.atan2(t51, t50)
-    t53 = xp.where(xp.greater(t51, 0), t52/t51, 1)
-    t54 = 0.126*t14
-    t55 = 0.4*t10 + t54
-    t56 = 0.42*t8 + t55
-    t57 = mu_dot0 + gain0*(-t56 + T03)
-    t58 = 0.126*t26
-    t59 = 0.4*t22 + t58
-    t60 = 0.42*t20 + t59
-    t61 = c1*t56 + s1*t60
-    t62 = t60*t8 - t56*t20
-    t63 = t3*t55 + t6*t59
-    t64 = t10*t59 - t22*t55
-    t65 = t12*t58 + t24*t54
-    t66 = t61**2 + t62**2 + t63**2 + t64**2 + t65**2
-    t67 = c2*t62 + t35*t64 - t38*t65 - t36*t63
-    t68 = 0.126*t40
-    t69 = 0.4*t35 + t68
-    t70 = 0.42*c2 + t69
-    t71 = 0.36 + t70
-    t72 = -c2*t60 + t70*t20
-    t73 = -t3*t69 + t59*t36
-    t74 = t22*t69 - t35*t59
-    t75 = -t38*t58 + t24*t68
-    t76 = c2*t56 - t70*t8
-    t77 = t6*t69 + t55*t36
-    t78 = t35*t55 - t10*t69
-    t79 = t12*t68 + t38*t54
-    t80 = t56 + c2*t76 + t35*t78 + t38*t79 + t36*t77
-    t81 = mu_dot2 + gain2*(-t71 + T23)
-    t82 = -(-t61*qz2 + t62*qz3 + t63*qz4 + t64*qz5 - t65*qz6) + t81
-    t83 = c1**2
-    t84 = -t3*t73 + t22*t74 + t24*t75 + t70*t83 + t20*t72
-    t85 = t70**2
-    t86 = t60**2 + t72**2 + t73**2 + t74**2 + t75**2 + t83*t85
-    t87 = s1*c1
-    t88 = t85*t87 - t56*t60 + t72*t76 - t73*t77 + t74*t78 + t75*t79
-    t89 = c1*t61
-    t90 = t72*t62 + t73*t63 + t74*t64 - t75*t65 - t70*t89
-    t91 = t89 + t3*t63 + t24*t65 - t22*t64 - t20*t62
-    t92 = t70*t87
-    t93 = -t92 + t6*t73 + t10*t74 - t12*t75 + t8*t72
-    t94 = t92 + t3*t77 + t22*t78 + t24*t79 + t20*t76
-    t95 = -t60
-    t96 = t95 + c2*t72 + t35*t74 + t38*t75 - t36*t73
-    t97 = mu_dot1 + gain1*(t95 + T13)
-    t98 = s1**2
-    t99 = t56**2 + t76**2 + t77**2 + t78**2 + t79**2 + t85*t98
-    t100 = t6*t77 + t12*t79 + t70*t98 - t10*t78 - t8*t76
-    t101 = s1*t61
-    t102 = t77*t63 + t79*t65 - t76*t62 - t78*t64 + t70*t101
-    t103 = t101 + t6*t63 + t10*t64 + t12*t65 + t8*t62
-    t104 = s2**2
-    t105 = t6**2 + t10**2 + t12**2 + t14**2 + t98 + t83*t104
-    t106 = -t87 - t6*t3 + t10*t22 - t12*t24 + t14*t26 + t87*t104
-    t107 = t3**2 + t22**2 + t24**2 + t26**2 + t83 + t98*t104
-    t108 = 1 + c2**2 + t35**2 + t38**2 + t40**2 + s3**2*t104
-    t109 = xp.greater_equal(t17, t30) & xp.greater_equal(t17, t47)
-    t110 = xp.greater_equal(t30, t47)
-    t111 = xp.where(t109, 0.5*(1 + t17), xp.where(t110, 0.5*t29, 0.5*t45))
-    t112 = xp.where(t109, 0.5*t18, xp.where(t110, 0.5*(1 + t30), 0.5*t46))
-    t113 = xp.where(t109, 0.5*t19, xp.where(t110, 0.5*t31, 0.5*(1 + t47)))
-    t114 = xp.sqrt(t111**2 + t112**2 + t113**2)
-    t115 = xp.where(xp.greater_equal(t48*t111 + t49*t112 + t32*t113, 0), xp.asarray(1, dtype=dtype), -1)
-    t116 = xp.greater(t51, 1e-06) | xp.greater(t50, 0)
-    t117 = t52*t115/t114
-    t118 = xp.where(t116, t48*t53, t117*t111)
-    t119 = xp.where(t116, t49*t53, t117*t112)
-    t120 = xp.where(t116, t32*t53, t117*t113)
-    t121 = mu_dot3 + t118*gain3
-    t122 = mu_dot4 + t119*gain4
-    t123 = mu_dot5 + t120*gain5
-    t124 = -(qz1 + c2*qz3 + t35*qz5 + t38*qz6 + t40*qz7 - t36*qz4) + t123
-    t125 = c1*qz2
-    t126 = -(-t60*qz1 + t72*qz3 + t73*qz4 + t74*qz5 + t75*qz6 + t70*t125) + t57
-    t127 = -(t125 - t3*qz4 + t22*qz5 + t24*qz6 + t26*qz7 + t20*qz3) + t122
-    t128 = s1*qz2
-    t129 = -(t70*t128 + t56*qz1 + t76*qz3 - t77*qz4 + t78*qz5 + t79*qz6) + t97
-    t130 = -(-t128 + t6*qz4 + t10*qz5 - t12*qz6 + t14*qz7 + t8*qz3) + t121
-    t131 = damping**2
-    t132 = _symmetric_solve6(xp, 1, (t131 + t86, t88, t90, t93, t84, t96, t131 + t99, -t102, -t100, t94, t80, t131 + t66, t103, -t91, t67, t131 + t105, t106, t43, t131 + t107, t44, t131 + t108, t126, t129, t82, t130, t127, t124,))
-    t133 = t132[5]
-    t134 = t132[0]
-    t135 = t132[1]
-    t136 = t133 - t60*t134 + t56*t135
-    t137 = qz1 + t136
-    t138 = c1*t70
-    t139 = s1*t70
-    t140 = 1 - t77 - t61 - t65 - s1 - t12 - t3 - t36 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t10 + t22 + t35 + q5 + t24 + t38 + q6 + t14 + t26 + t40 + q7 + t56 + t8 + t20 + t95 + t72 + t73 + t74 + t75 + t76 + t78 + t79 + t62 + t63 + t64 + t138 + t139 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7 + t57 + t97 + t81 + t121 + t122 + t123
-    t141 = t132[2]
-    t142 = t132[3]
-    t143 = t132[4]
-    t144 = t134*t138 + t135*t139 - t61*t141 - s1*t142 + c1*t143
-    t145 = t72*t134 + t76*t135 + t62*t141 + t8*t142 + t20*t143 + c2*t133
-    t146 = t73*t134 - t77*t135 + t63*t141 + t6*t142 - t3*t143 - t36*t133
-    t147 = t74*t134 + t78*t135 + t64*t141 + t10*t142 + t22*t143 + t35*t133
-    t148 = t79*t135 + t75*t134 - t65*t141 - t12*t142 + t24*t143 + t38*t133
-    t149 = t14*t142 + t26*t143 + t40*t133
-    t150 = qz2 + t144
-    t151 = qz3 + t145
-    t152 = qz4 + t146
-    t153 = qz5 + t147
-    t154 = qz6 + t148
-    t155 = qz7 + t149
-    t156 = xp.isfinite(t140)
-    t157 = xp.greater_equal(damping, 0)
-    t158 = t132[6]
-    t159 = t156 & t157 & xp.less_equal(t158, 0)
+    t17 = 0.4*t10 + 0.126*t14
+    t18 = 0.42*t8 + t17
+    t19 = t15*T00 - t16*T01 + t14*T02
+    t20 = t15*T10 - t16*T11 + t14*T12
+    t21 = t15*T20 - t16*T21 + t14*T22
+    t22 = mu_dot0 + gain0*(-t18 + T03)
+    t23 = s1*s2
+    t24 = t7*c4 + s4*t23
+    t25 = -t7*s4 + c4*t23
+    t26 = t24*c5 + t3*s5
+    t27 = t3*c5 - t24*s5
+    t28 = t26*c6 - t25*s6
+    t29 = t25*c6 + t26*s6
+    t30 = t27*s7 + t28*c7
+    t31 = t27*c7 - t28*s7
+    t32 = 0.4*t25 + 0.126*t29
+    t33 = 0.42*t23 + t32
+    t34 = t30*T00 + t31*T01 + t29*T02
+    t35 = t30*T10 + t31*T11 + t29*T12
+    t36 = t30*T20 + t31*T21 + t29*T22
+    t37 = 0.5*(-t34 + t20)
+    t38 = mu_dot1 + gain1*(-t33 + T13)
+    t39 = c3*s2
+    t40 = c2*s4 - c4*t39
+    t41 = c2*c4 + s4*t39
+    t42 = s3*s2
+    t43 = t40*c5 + s5*t42
+    t44 = -t40*s5 + c5*t42
+    t45 = t43*c6 - t41*s6
+    t46 = t41*c6 + t43*s6
+    t47 = t44*s7 + t45*c7
+    t48 = t44*c7 - t45*s7
+    t49 = 0.4*t41 + 0.126*t46
+    t50 = 0.42*c2 + t49
+    t51 = 0.36 + t50
+    t52 = t47*T00 + t48*T01 + t46*T02
+    t53 = t47*T10 + t48*T11 + t46*T12
+    t54 = t47*T20 + t48*T21 + t46*T22
+    t55 = 0.5*(-t53 + t36)
+    t56 = 0.5*(-t21 + t52)
+    t57 = 0.5*(-1 + t19 + t35 + t54)
+    t58 = xp.sqrt(t55**2 + t56**2 + t37**2)
+    t59 = xp.atan2(t58, t57)
+    t60 = xp.where(xp.greater(t58, 0), t59/t58, 1)
+    t61 = mu_dot2 + gain2*(-t51 + T23)
+    t62 = xp.greater_equal(t19, t35) & xp.greater_equal(t19, t54)
+    t63 = xp.greater_equal(t35, t54)
+    t64 = xp.where(t62, 0.5*(1 + t19), xp.where(t63, 0.5*t34, 0.5*t52))
+    t65 = xp.where(t62, 0.5*t20, xp.where(t63, 0.5*(1 + t35), 0.5*t53))
+    t66 = xp.where(t62, 0.5*t21, xp.where(t63, 0.5*t36, 0.5*(1 + t54)))
+    t67 = xp.sqrt(t64**2 + t65**2 + t66**2)
+    t68 = xp.where(xp.greater_equal(t55*t64 + t56*t65 + t37*t66, 0), xp.asarray(1, dtype=dtype), -1)
+    t69 = xp.greater(t58, 1e-06) | xp.greater(t57, 0)
+    t70 = t59*t68/t67
+    t71 = xp.where(t69, t55*t60, t70*t64)
+    t72 = xp.where(t69, t56*t60, t70*t65)
+    t73 = xp.where(t69, t37*t60, t70*t66)
+    t74 = mu_dot3 + t71*gain3
+    t75 = mu_dot4 + t72*gain4
+    t76 = mu_dot5 + t73*gain5
+    t77 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, c7, s7, t22, t38, t61, t74, t75, t76, damping, qz1, qz2, qz3, qz4, qz5, qz6, qz7,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t159, t137, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t159, t150, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t159, t151, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t159, t152, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t159, t153, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t159, t154, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t159, t155, 0), batch),  # 6
+        xp.broadcast_to(t77[0], batch),  # 0
+        xp.broadcast_to(t77[1], batch),  # 1
+        xp.broadcast_to(t77[2], batch),  # 2
+        xp.broadcast_to(t77[3], batch),  # 3
+        xp.broadcast_to(t77[4], batch),  # 4
+        xp.broadcast_to(t77[5], batch),  # 5
+        xp.broadcast_to(t77[6], batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t156 & t157), 2, xp.where(xp.greater(t158, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t77[7], batch), xp.int32)
     return q_dot, status
 
 

@@ -113,15 +113,15 @@ void jaco_velocity_ellipsoid(const jaco_real q[JACO_DOF], jaco_real U_v[9], jaco
 jaco_real jaco_condition_number(const jaco_real q[JACO_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1432 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1443 operations. */
 int jaco_velocity_ik(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TASK_DIM], jaco_real damping, jaco_real q_dot[JACO_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1438 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1443 operations. */
 int jaco_velocity_ik_nullspace(const jaco_real q[JACO_DOF], const jaco_real mu_dot[JACO_TASK_DIM], const jaco_real z[JACO_DOF], jaco_real damping, jaco_real q_dot[JACO_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1612 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1711 operations. */
 int jaco_resolved_rate(const jaco_real q[JACO_DOF], const jaco_real target[16], const jaco_real target_rate[JACO_TASK_DIM], const jaco_real gain[JACO_TASK_DIM], const jaco_real z[JACO_DOF], jaco_real damping, jaco_real q_dot[JACO_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
@@ -145,7 +145,7 @@ void jaco_ik_general_residual(const jaco_real target[16], const jaco_real q[JACO
 int jaco_ik_general_limits(const jaco_real q_solution[JACO_DOF], jaco_real q[JACO_DOF]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 6; returned as a scalar. 1218 operations. */
+ * Result: q[i], i < 6; returned as a scalar. 1219 operations. */
 int jaco_ik_nearest(const jaco_real T[16], const jaco_real q_seed[JACO_DOF], const jaco_real weights[JACO_DOF], jaco_real q[JACO_DOF]);
 
 /* Statuses of jaco_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -82,7 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -336,7 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi6_rows(xp, count, state):
     """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2 + w4**2 + w5**2
@@ -904,9 +904,9 @@ def _jacobi6_rows(xp, count, state):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _symmetric_solve6(xp, count, state):
-    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    """The solution x of a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
         t0 = w1**2
@@ -1090,39 +1090,292 @@ def _symmetric_solve6(xp, count, state):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
-def _nearer_branch(xp, count, state):
-    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 72 operations a run."""
+def _velocity_solve(xp, count, state):
+    """The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status, `count` times: 1424 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
-        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
-        t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w7))
-        t1 = w1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w1 + w8))
-        t2 = w2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w2 + w9))
-        t3 = w3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w3 + w10))
-        t4 = w4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w4 + w11))
-        t5 = w5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w5 + w12))
-        t6 = w13*(-w7 + t0)**2 + w14*(-w8 + t1)**2 + w15*(-w9 + t2)**2 + w16*(-w10 + t3)**2 + w17*(-w11 + t4)**2 + w18*(-w12 + t5)**2
-        t7 = xp.greater(w6, 0)
-        t8 = xp.where(t7 & (xp.less(w26, 1) | xp.less(t6, w25)), xp.asarray(1, dtype=dtype), 0)
-        t9 = xp.where(t7, 1, w26)
-        t10 = xp.greater(t8, 0)
-        t11 = xp.where(t10, t0, w19)
-        t12 = xp.where(t10, t1, w20)
-        t13 = xp.where(t10, t2, w21)
-        t14 = xp.where(t10, t3, w22)
-        t15 = xp.where(t10, t4, w23)
-        t16 = xp.where(t10, t5, w24)
-        t17 = xp.where(t10, t6, w25)
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, = state
+        t0 = w2*w4
+        t1 = w3*w5
+        t2 = w0*t0 + w0*t1
+        t3 = w1*t0 + w1*t1
+        t4 = t0 + t1
+        t5 = t2*w6 + w1*w7
+        t6 = w1*w6 - t2*w7
+        t7 = w0*w7 - t3*w6
+        t8 = t3*w7 + w0*w6
+        t9 = -0.25019712500078917*t4
+        t10 = w3*w4
+        t11 = w2*w5
+        t12 = w0*t10 - w0*t11
+        t13 = w1*t11 - w1*t10
+        t14 = -t11 + t10
+        t15 = -0.25019712500078917*t12
+        t16 = -0.25019712500078917*t13
+        t17 = (0.5*t6 - 0.8660254037844386*t12)*w8 - t5*w9
+        t18 = (0.5*t8 - 0.8660254037844386*t13)*w8 - t7*w9
+        t19 = 0.5*t12 + 0.8660254037844386*t6
+        t20 = -0.08579425000157839*t19
+        t21 = 0.5*t13 + 0.8660254037844386*t8
+        t22 = -0.08579425000157839*t21
+        t23 = t14*w7
+        t24 = -t14*w6*w9 + w8*(-0.5*t23 + 0.8660254037844386*t4)
+        t25 = 0.5*t4 + 0.8660254037844386*t23
+        t26 = 0.08579425000157839*t25
+        t27 = 0.5*t19 + 0.8660254037844386*t17
+        t28 = 0.2115971250007892*t27
+        t29 = -t20 + t28
+        t30 = -t15 + t29
+        t31 = -0.0098*w1 + t30
+        t32 = 0.5*t21 + 0.8660254037844386*t18
+        t33 = 0.2115971250007892*t32
+        t34 = -t22 + t33
+        t35 = -t16 + t34
+        t36 = -0.0098*w0 + t35
+        t37 = w1*t36 - w0*t31
+        t38 = t13*t30 - t12*t35
+        t39 = t29*t21 - t34*t19
+        t40 = t28*t32 - t33*t27
+        t41 = 0.5*t25 - 0.8660254037844386*t24
+        t42 = -0.2115971250007892*t41
+        t43 = -t26 + t42
+        t44 = t9 + t43
+        t45 = 0.41*w3 + t44
+        t46 = t13*t44 + t4*t35
+        t47 = t43*t21 + t34*t25
+        t48 = t42*t32 + t33*t41
+        t49 = t4*t30 + t12*t44
+        t50 = t43*t19 + t29*t25
+        t51 = t42*t27 + t28*t41
+        t52 = t4*t38 + t25*t39 + t41*t40
+        t53 = t12*t4 + t19*t25 + t27*t41
+        t54 = t13*t4 + t21*t25 + t32*t41
+        t55 = 0.41*w2
+        t56 = t31 + w0*t55
+        t57 = t36 - w1*t55
+        t58 = w0*t56 - w1*t57
+        t59 = t57 + t4*t46 + t25*t47 + t41*t48
+        t60 = t56 + t4*t49 + t25*t50 + t41*t51
+        t61 = t56**2
+        t62 = t57**2
+        t63 = 1 + t61 + t62
+        t64 = xp.sqrt(t63)
+        t65 = xp.where(xp.greater_equal(t57, 0), xp.asarray(1, dtype=dtype), -1)*t64
+        t66 = w1**2
+        t67 = t12*t49 + t44*t66 + t19*t50 + t27*t51 + t45*t66
+        t68 = t12**2 + t19**2 + t27**2 + 2*t66
+        t69 = w0**2
+        t70 = t13*t46 + t44*t69 + t21*t47 + t32*t48 + t45*t69
+        t71 = t13**2 + t21**2 + t32**2 + 2*t69
+        t72 = t4**2 + t25**2 + t41**2
+        t73 = 1 + t72
+        t74 = t58**2
+        t75 = t74 + t37**2 + t38**2 + t39**2 + t40**2
+        t76 = t45**2
+        t77 = t44**2
+        t78 = t46**2 + t47**2 + t48**2 + t69*t76 + t69*t77
+        t79 = t62 + t78
+        t80 = t49**2 + t50**2 + t51**2 + t66*t76 + t66*t77
+        t81 = xp.sqrt(t63 + t68 + t71 + t72 + t75 + t78 + t80)
+        t82 = t61 + t80
+        t83 = w0*w1
+        t84 = t56*t57 + t46*t49 + t47*t50 + t48*t51 + t76*t83 + t77*t83
+        t85 = 2*t83 + t12*t13 + t19*t21 + t27*t32
+        t86 = w0*t58
+        t87 = w0*t37
+        t88 = t46*t38 + t47*t39 + t48*t40 + t45*t86 - t44*t87
+        t89 = -t87 + t86 + t13*t38 + t21*t39 + t32*t40
+        t90 = w0*t45
+        t91 = w0*t44
+        t92 = w1*t90 + w1*t91
+        t93 = t92 + t12*t46 + t19*t47 + t27*t48
+        t94 = t92 + t13*t49 + t21*t50 + t32*t51
+        t95 = w1*t58
+        t96 = w1*t37
+        t97 = t45*t95 - t44*t96 + t49*t38 + t50*t39 + t51*t40
+        t98 = -t96 + t95 + t12*t38 + t19*t39 + t27*t40
+        t99 = w18**2
+        t100 = _symmetric_solve6(xp, 1, (t99 + t79, -t84, -t88, t93, t70, -t59, t99 + t82, t97, -t67, -t94, t60, t75 + t99, -t98, -t89, t52, t68 + t99, t85, -t53, t71 + t99, -t54, t99 + t73, w12, w13, w14, w15, w16, w17,))
+        t101 = t100[5]
+        t102 = t100[0]
+        t103 = t100[1]
+        t104 = t101 - t57*t102 + t56*t103
+        t105 = w1*t45
+        t106 = t100[2]
+        t107 = t100[3]
+        t108 = t100[4]
+        t109 = -t102*t46 + t103*t49 + t38*t106 - t12*t107 - t13*t108 + t4*t101
+        t110 = -t102*t47 + t103*t50 + t39*t106 - t19*t107 - t21*t108 + t25*t101
+        t111 = t40*t106 - t102*t48 + t103*t51 - t27*t107 - t32*t108 + t41*t101
+        t112 = w1*t107 + w0*t108
+        t113 = t112 + t90*t102 - t103*t105 - t58*t106
+        t114 = w1*t44
+        t115 = t112 + t37*t106 + t91*t102 - t103*t114
+        t116 = xp.greater(t64, 0)
+        t117 = xp.where(t116, 1/(t57 + t65), 0)
+        t118 = xp.where(t116, 1 + xp.abs(t57)/t64, 0)
+        t119 = t56*t117
+        t120 = -t118*(t90 + t105*t119)
+        t121 = t90 + t120
+        t122 = t105 + t119*t120
+        t123 = t118*(t91 + t114*t119)
+        t124 = -t123 + t91
+        t125 = -t118*(t46 + t49*t119 + t4*t117)
+        t126 = t46 + t125
+        t127 = -t118*(t47 + t50*t119 + t25*t117)
+        t128 = t47 + t127
+        t129 = -t118*(t48 + t51*t119 + t41*t117)
+        t130 = t48 + t129
+        t131 = -t118*(-w12 + w17*t117 + t119*w13)
+        t132 = -t131 + w12
+        t133 = -t114
+        t134 = t117*t123
+        t135 = t133 + t56*t134
+        t136 = t117*t125
+        t137 = t49 + t56*t136
+        t138 = t4 + t136
+        t139 = t117*t127
+        t140 = t50 + t56*t139
+        t141 = t25 + t139
+        t142 = t117*t129
+        t143 = t51 + t56*t142
+        t144 = t41 + t142
+        t145 = t117*t131
+        t146 = w13 + t56*t145
+        t147 = t145 + w17
+        t148 = t117**2
+        t149 = xp.sqrt(t66 + t69 + t74 + t122**2 + t148*t120**2)
+        t150 = t149*xp.where(xp.greater_equal(t122, 0), xp.asarray(1, dtype=dtype), -1)
+        t151 = xp.greater(t149, 0)
+        t152 = xp.where(t151, 1/(t122 + t150), 0)
+        t153 = xp.where(t151, 1 + xp.abs(t122)/t149, 0)
+        t154 = t58*t152
+        t155 = t120*t152
+        t156 = t153*(t135 + t37*t154 - t66*t152 - t69*t152 + t148*t155*t123)
+        t157 = -t156 + t135
+        t158 = t37 - t154*t156
+        t159 = t152*t156
+        t160 = w1 + w1*t159
+        t161 = w0 + w0*t159
+        t162 = w1*t152
+        t163 = w0*t152
+        t164 = t155*t117
+        t165 = t134 - t164*t156
+        t166 = t153*(t137 + t38*t154 + t12*t162 + t13*t163 + t164*t138)
+        t167 = -t166 + t137
+        t168 = t38 - t154*t166
+        t169 = t138 - t164*t166
+        t170 = t153*(t140 + t39*t154 + t164*t141 + t19*t162 + t21*t163)
+        t171 = -t170 + t140
+        t172 = t39 - t154*t170
+        t173 = t141 - t164*t170
+        t174 = t153*(t143 + t40*t154 + t164*t144 + t27*t162 + t32*t163)
+        t175 = -t174 + t143
+        t176 = t40 - t154*t174
+        t177 = t144 - t164*t174
+        t178 = t153*(t146 + t154*w14 - t162*w15 - t163*w16 + t164*t147)
+        t179 = -t178 + t146
+        t180 = w14 - t154*t178
+        t181 = w15 + t162*t178
+        t182 = w16 + t163*t178
+        t183 = t147 - t164*t178
+        t184 = xp.sqrt(t158**2 + t160**2 + t161**2 + t165**2)
+        t185 = t184*xp.where(xp.greater_equal(t158, 0), xp.asarray(1, dtype=dtype), -1)
+        t186 = -t12
+        t187 = t186 + t162*t166
+        t188 = -t13
+        t189 = t188 + t163*t166
+        t190 = -t19
+        t191 = t190 + t162*t170
+        t192 = -t21
+        t193 = t192 + t163*t170
+        t194 = -t27
+        t195 = t194 + t162*t174
+        t196 = -t32
+        t197 = t196 + t163*t174
+        t198 = -1 - t46 - t47 - t48 - t56 - t90 + w3 + w0 + w2 + w4 + w5 + w1 + t4 + w6 + w7 + w8 + w9 + w10 + w11 + t57 + t25 + t41 + t91 + t49 + t50 + t51 + t58 + t37 + t38 + t39 + t40 + t105 + t133 + t186 + t188 + t190 + t192 + t194 + t196 + w12 + w13 + w14 + w15 + w16 + w17 + w18
+        t199 = xp.greater(t184, 0)
+        t200 = xp.where(t199, 1/(t158 + t185), 0)
+        t201 = xp.where(t199, 1 + xp.abs(t158)/t184, 0)
+        t202 = t160*t200
+        t203 = t161*t200
+        t204 = t165*t200
+        t205 = t201*(t168 + t202*t187 + t203*t189 + t204*t169)
+        t206 = -t205 + t168
+        t207 = t187 - t202*t205
+        t208 = t189 - t203*t205
+        t209 = t169 - t204*t205
+        t210 = t201*(t172 + t202*t191 + t203*t193 + t204*t173)
+        t211 = -t210 + t172
+        t212 = t191 - t202*t210
+        t213 = t193 - t203*t210
+        t214 = t173 - t204*t210
+        t215 = t201*(t176 + t202*t195 + t203*t197 + t204*t177)
+        t216 = -t215 + t176
+        t217 = t195 - t202*t215
+        t218 = t197 - t203*t215
+        t219 = t177 - t204*t215
+        t220 = t201*(t180 + t202*t181 + t203*t182 + t204*t183)
+        t221 = -t220 + t180
+        t222 = t181 - t202*t220
+        t223 = t182 - t203*t220
+        t224 = t183 - t204*t220
+        t225 = xp.sqrt(t207**2 + t208**2 + t209**2)
+        t226 = t225*xp.where(xp.greater_equal(t207, 0), xp.asarray(1, dtype=dtype), -1)
+        t227 = xp.greater(t225, 0)
+        t228 = xp.where(t227, 1/(t207 + t226), 0)
+        t229 = xp.where(t227, 1 + xp.abs(t207)/t225, 0)
+        t230 = t208*t228
+        t231 = t209*t228
+        t232 = t229*(t212 + t230*t213 + t231*t214)
+        t233 = -t232 + t212
+        t234 = t213 - t230*t232
+        t235 = t214 - t231*t232
+        t236 = t229*(t217 + t230*t218 + t231*t219)
+        t237 = -t236 + t217
+        t238 = t218 - t230*t236
+        t239 = t219 - t231*t236
+        t240 = t229*(t222 + t230*t223 + t231*t224)
+        t241 = -t240 + t222
+        t242 = t223 - t230*t240
+        t243 = t224 - t231*t240
+        t244 = xp.sqrt(t234**2 + t235**2)
+        t245 = t244*xp.where(xp.greater_equal(t234, 0), xp.asarray(1, dtype=dtype), -1)
+        t246 = xp.greater(t244, 0)
+        t247 = xp.where(t246, 1/(t234 + t245), 0)
+        t248 = xp.where(t246, 1 + xp.abs(t234)/t244, 0)
+        t249 = t235*t247
+        t250 = t248*(t238 + t249*t239)
+        t251 = -t250 + t238
+        t252 = t239 - t249*t250
+        t253 = t248*(t242 + t249*t243)
+        t254 = -t253 + t242
+        t255 = t243 - t249*t253
+        t256 = xp.abs(t252)
+        t257 = t256*xp.where(xp.greater_equal(t252, 0), xp.asarray(1, dtype=dtype), -1)
+        t258 = xp.where(xp.greater(t256, 0), xp.asarray(2, dtype=dtype), 0)
+        t259 = t255 - t255*t258
+        t260 = xp.where(xp.not_equal(t257, 0), -t259/t257, 0)
+        t261 = xp.where(xp.not_equal(t245, 0), -(t254 - t251*t260)/t245, 0)
+        t262 = xp.where(xp.not_equal(t226, 0), -(-(t233*t261 + t237*t260) + t241)/t226, 0)
+        t263 = xp.where(xp.not_equal(t185, 0), -(-(t206*t262 + t211*t261 + t216*t260) + t221)/t185, 0)
+        t264 = xp.where(xp.not_equal(t150, 0), -(-(t157*t263 + t167*t262 + t171*t261 + t175*t260) + t179)/t150, 0)
+        t265 = xp.where(xp.not_equal(t65, 0), -(t132 + t121*t264 + t126*t262 + t128*t261 + t130*t260 - t124*t263)/t65, 0)
+        t266 = xp.isfinite(t198)
+        t267 = xp.greater_equal(w18, 0)
+        t268 = xp.greater(w18, 0)
+        t269 = 1e-12*t81
+        t270 = (t268 & xp.greater(t100[6], 0)) | (xp.less_equal(w18, 0) & (xp.less_equal(t64, t269) | xp.less_equal(t149, t269) | xp.less_equal(t184, t269) | xp.less_equal(t225, t269) | xp.less_equal(t244, t269) | xp.less_equal(t256, t269)))
+        t271 = t266 & t267 & xp.logical_not(t270)
         state = (
-            t11,
-            t12,
-            t13,
-            t14,
-            t15,
-            t16,
-            t17,
-            t9,
+            xp.where(t271, xp.where(t268, -t104, t265), 0),
+            xp.where(t271, xp.where(t268, -t113, t264), 0),
+            xp.where(t271, xp.where(t268, t115, t263), 0),
+            xp.where(t271, xp.where(t268, t109, t262), 0),
+            xp.where(t271, xp.where(t268, t110, t261), 0),
+            xp.where(t271, xp.where(t268, t111, t260), 0),
+            xp.where(xp.logical_not(t266 & t267), 2, xp.where(t270, xp.asarray(1, dtype=dtype), 0)),
         )
     return state
 
@@ -4235,23 +4488,16 @@ def condition_number(q):
     return kappa
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1432 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1443 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
     mu_dot3 = mu_dot[..., 3]
     mu_dot4 = mu_dot[..., 4]
     mu_dot5 = mu_dot[..., 5]
-    trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
+    trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.17453292519943295), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
     c2 = trig[..., 3]
@@ -4262,313 +4508,31 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s4 = trig[..., 7]
     c5 = -trig[..., 8]
     s5 = -trig[..., 9]
-    t0 = c2*c3
-    t1 = s2*s3
-    t2 = c1*t0 + c1*t1
-    t3 = s1*t0 + s1*t1
-    t4 = t0 + t1
-    t5 = t2*c4 + s1*s4
-    t6 = s1*c4 - t2*s4
-    t7 = c1*s4 - t3*c4
-    t8 = t3*s4 + c1*c4
-    t9 = -0.25019712500078917*t4
-    t10 = s2*c3
-    t11 = c2*s3
-    t12 = c1*t10 - c1*t11
-    t13 = s1*t11 - s1*t10
-    t14 = -t11 + t10
-    t15 = -0.25019712500078917*t12
-    t16 = -0.25019712500078917*t13
-    t17 = (0.5*t6 - 0.8660254037844386*t12)*c5 - t5*s5
-    t18 = (0.5*t8 - 0.8660254037844386*t13)*c5 - t7*s5
-    t19 = 0.5*t12 + 0.8660254037844386*t6
-    t20 = -0.08579425000157839*t19
-    t21 = 0.5*t13 + 0.8660254037844386*t8
-    t22 = -0.08579425000157839*t21
-    t23 = t14*s4
-    t24 = -t14*c4*s5 + c5*(-0.5*t23 + 0.8660254037844386*t4)
-    t25 = 0.5*t4 + 0.8660254037844386*t23
-    t26 = 0.08579425000157839*t25
-    t27 = 0.5*t19 + 0.8660254037844386*t17
-    t28 = 0.2115971250007892*t27
-    t29 = -t20 + t28
-    t30 = -t15 + t29
-    t31 = -0.0098*s1 + t30
-    t32 = 0.5*t21 + 0.8660254037844386*t18
-    t33 = 0.2115971250007892*t32
-    t34 = -t22 + t33
-    t35 = -t16 + t34
-    t36 = -0.0098*c1 + t35
-    t37 = s1*t36 - c1*t31
-    t38 = t13*t30 - t12*t35
-    t39 = t29*t21 - t34*t19
-    t40 = t28*t32 - t33*t27
-    t41 = 0.5*t25 - 0.8660254037844386*t24
-    t42 = -0.2115971250007892*t41
-    t43 = -t26 + t42
-    t44 = t9 + t43
-    t45 = 0.41*s2 + t44
-    t46 = t13*t44 + t4*t35
-    t47 = t43*t21 + t34*t25
-    t48 = t42*t32 + t33*t41
-    t49 = t4*t30 + t12*t44
-    t50 = t43*t19 + t29*t25
-    t51 = t42*t27 + t28*t41
-    t52 = t4*t38 + t25*t39 + t41*t40
-    t53 = t12*t4 + t19*t25 + t27*t41
-    t54 = t13*t4 + t21*t25 + t32*t41
-    t55 = 0.41*c2
-    t56 = t31 + c1*t55
-    t57 = t36 - s1*t55
-    t58 = c1*t56 - s1*t57
-    t59 = t57 + t4*t46 + t25*t47 + t41*t48
-    t60 = t56 + t4*t49 + t25*t50 + t41*t51
-    t61 = t56**2
-    t62 = t57**2
-    t63 = 1 + t61 + t62
-    t64 = xp.sqrt(t63)
-    t65 = xp.where(xp.greater_equal(t57, 0), xp.asarray(1, dtype=dtype), -1)*t64
-    t66 = s1**2
-    t67 = t12*t49 + t44*t66 + t19*t50 + t27*t51 + t45*t66
-    t68 = t12**2 + t19**2 + t27**2 + 2*t66
-    t69 = c1**2
-    t70 = t13*t46 + t44*t69 + t21*t47 + t32*t48 + t45*t69
-    t71 = t13**2 + t21**2 + t32**2 + 2*t69
-    t72 = t4**2 + t25**2 + t41**2
-    t73 = 1 + t72
-    t74 = t58**2
-    t75 = t74 + t37**2 + t38**2 + t39**2 + t40**2
-    t76 = t45**2
-    t77 = t44**2
-    t78 = t46**2 + t47**2 + t48**2 + t69*t76 + t69*t77
-    t79 = t62 + t78
-    t80 = t49**2 + t50**2 + t51**2 + t66*t76 + t66*t77
-    t81 = xp.sqrt(t63 + t68 + t71 + t72 + t75 + t78 + t80)
-    t82 = t61 + t80
-    t83 = c1*s1
-    t84 = t56*t57 + t46*t49 + t47*t50 + t48*t51 + t76*t83 + t77*t83
-    t85 = 2*t83 + t12*t13 + t19*t21 + t27*t32
-    t86 = c1*t58
-    t87 = c1*t37
-    t88 = t46*t38 + t47*t39 + t48*t40 + t45*t86 - t44*t87
-    t89 = -t87 + t86 + t13*t38 + t21*t39 + t32*t40
-    t90 = c1*t45
-    t91 = c1*t44
-    t92 = s1*t90 + s1*t91
-    t93 = t92 + t12*t46 + t19*t47 + t27*t48
-    t94 = t92 + t13*t49 + t21*t50 + t32*t51
-    t95 = s1*t58
-    t96 = s1*t37
-    t97 = t45*t95 - t44*t96 + t49*t38 + t50*t39 + t51*t40
-    t98 = -t96 + t95 + t12*t38 + t19*t39 + t27*t40
-    t99 = damping**2
-    t100 = _symmetric_solve6(xp, 1, (t99 + t79, -t84, -t88, t93, t70, -t59, t99 + t82, t97, -t67, -t94, t60, t75 + t99, -t98, -t89, t52, t68 + t99, t85, -t53, t71 + t99, -t54, t99 + t73, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
-    t101 = t100[5]
-    t102 = t100[0]
-    t103 = t100[1]
-    t104 = t101 - t57*t102 + t56*t103
-    t105 = s1*t45
-    t106 = t100[2]
-    t107 = t100[3]
-    t108 = t100[4]
-    t109 = -t102*t46 + t103*t49 + t38*t106 - t12*t107 - t13*t108 + t4*t101
-    t110 = -t102*t47 + t103*t50 + t39*t106 - t19*t107 - t21*t108 + t25*t101
-    t111 = t40*t106 - t102*t48 + t103*t51 - t27*t107 - t32*t108 + t41*t101
-    t112 = s1*t107 + c1*t108
-    t113 = t112 + t90*t102 - t103*t105 - t58*t106
-    t114 = s1*t44
-    t115 = t112 + t37*t106 + t91*t102 - t103*t114
-    t116 = xp.greater(t64, 0)
-    t117 = xp.where(t116, 1/(t57 + t65), 0)
-    t118 = xp.where(t116, 1 + xp.abs(t57)/t64, 0)
-    t119 = t56*t117
-    t120 = -t118*(t90 + t105*t119)
-    t121 = t90 + t120
-    t122 = t105 + t119*t120
-    t123 = t118*(t91 + t114*t119)
-    t124 = -t123 + t91
-    t125 = -t118*(t46 + t49*t119 + t4*t117)
-    t126 = t46 + t125
-    t127 = -t118*(t47 + t50*t119 + t25*t117)
-    t128 = t47 + t127
-    t129 = -t118*(t48 + t51*t119 + t41*t117)
-    t130 = t48 + t129
-    t131 = -t118*(-mu_dot0 + mu_dot5*t117 + t119*mu_dot1)
-    t132 = -t131 + mu_dot0
-    t133 = -t114
-    t134 = t117*t123
-    t135 = t133 + t56*t134
-    t136 = t117*t125
-    t137 = t49 + t56*t136
-    t138 = t4 + t136
-    t139 = t117*t127
-    t140 = t50 + t56*t139
-    t141 = t25 + t139
-    t142 = t117*t129
-    t143 = t51 + t56*t142
-    t144 = t41 + t142
-    t145 = t117*t131
-    t146 = mu_dot1 + t56*t145
-    t147 = t145 + mu_dot5
-    t148 = t117**2
-    t149 = xp.sqrt(t66 + t69 + t74 + t122**2 + t148*t120**2)
-    t150 = t149*xp.where(xp.greater_equal(t122, 0), xp.asarray(1, dtype=dtype), -1)
-    t151 = xp.greater(t149, 0)
-    t152 = xp.where(t151, 1/(t122 + t150), 0)
-    t153 = xp.where(t151, 1 + xp.abs(t122)/t149, 0)
-    t154 = t58*t152
-    t155 = t120*t152
-    t156 = t153*(t135 + t37*t154 - t66*t152 - t69*t152 + t148*t155*t123)
-    t157 = -t156 + t135
-    t158 = t37 - t154*t156
-    t159 = t152*t156
-    t160 = s1 + s1*t159
-    t161 = c1 + c1*t159
-    t162 = s1*t152
-    t163 = c1*t152
-    t164 = t155*t117
-    t165 = t134 - t164*t156
-    t166 = t153*(t137 + t38*t154 + t12*t162 + t13*t163 + t164*t138)
-    t167 = -t166 + t137
-    t168 = t38 - t154*t166
-    t169 = t138 - t164*t166
-    t170 = t153*(t140 + t39*t154 + t164*t141 + t19*t162 + t21*t163)
-    t171 = -t170 + t140
-    t172 = t39 - t154*t170
-    t173 = t141 - t164*t170
-    t174 = t153*(t143 + t40*t154 + t164*t144 + t27*t162 + t32*t163)
-    t175 = -t174 + t143
-    t176 = t40 - t154*t174
-    t177 = t144 - t164*t174
-    t178 = t153*(t146 + t154*mu_dot2 - t162*mu_dot3 - t163*mu_dot4 + t164*t147)
-    t179 = -t178 + t146
-    t180 = mu_dot2 - t154*t178
-    t181 = mu_dot3 + t162*t178
-    t182 = mu_dot4 + t163*t178
-    t183 = t147 - t164*t178
-    t184 = xp.sqrt(t158**2 + t160**2 + t161**2 + t165**2)
-    t185 = t184*xp.where(xp.greater_equal(t158, 0), xp.asarray(1, dtype=dtype), -1)
-    t186 = -t12
-    t187 = t186 + t162*t166
-    t188 = -t13
-    t189 = t188 + t163*t166
-    t190 = -t19
-    t191 = t190 + t162*t170
-    t192 = -t21
-    t193 = t192 + t163*t170
-    t194 = -t27
-    t195 = t194 + t162*t174
-    t196 = -t32
-    t197 = t196 + t163*t174
-    t198 = -1 - t46 - t47 - t48 - t56 - t90 + q1 + q2 + q3 + t4 + q4 + q5 + q6 + t57 + t25 + t41 + t91 + t49 + t50 + t51 + t58 + t37 + t38 + t39 + t40 + t105 + t133 + t186 + t188 + t190 + t192 + t194 + t196 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t199 = xp.greater(t184, 0)
-    t200 = xp.where(t199, 1/(t158 + t185), 0)
-    t201 = xp.where(t199, 1 + xp.abs(t158)/t184, 0)
-    t202 = t160*t200
-    t203 = t161*t200
-    t204 = t165*t200
-    t205 = t201*(t168 + t202*t187 + t203*t189 + t204*t169)
-    t206 = -t205 + t168
-    t207 = t187 - t202*t205
-    t208 = t189 - t203*t205
-    t209 = t169 - t204*t205
-    t210 = t201*(t172 + t202*t191 + t203*t193 + t204*t173)
-    t211 = -t210 + t172
-    t212 = t191 - t202*t210
-    t213 = t193 - t203*t210
-    t214 = t173 - t204*t210
-    t215 = t201*(t176 + t202*t195 + t203*t197 + t204*t177)
-    t216 = -t215 + t176
-    t217 = t195 - t202*t215
-    t218 = t197 - t203*t215
-    t219 = t177 - t204*t215
-    t220 = t201*(t180 + t202*t181 + t203*t182 + t204*t183)
-    t221 = -t220 + t180
-    t222 = t181 - t202*t220
-    t223 = t182 - t203*t220
-    t224 = t183 - t204*t220
-    t225 = xp.sqrt(t207**2 + t208**2 + t209**2)
-    t226 = t225*xp.where(xp.greater_equal(t207, 0), xp.asarray(1, dtype=dtype), -1)
-    t227 = xp.greater(t225, 0)
-    t228 = xp.where(t227, 1/(t207 + t226), 0)
-    t229 = xp.where(t227, 1 + xp.abs(t207)/t225, 0)
-    t230 = t208*t228
-    t231 = t209*t228
-    t232 = t229*(t212 + t230*t213 + t231*t214)
-    t233 = -t232 + t212
-    t234 = t213 - t230*t232
-    t235 = t214 - t231*t232
-    t236 = t229*(t217 + t230*t218 + t231*t219)
-    t237 = -t236 + t217
-    t238 = t218 - t230*t236
-    t239 = t219 - t231*t236
-    t240 = t229*(t222 + t230*t223 + t231*t224)
-    t241 = -t240 + t222
-    t242 = t223 - t230*t240
-    t243 = t224 - t231*t240
-    t244 = xp.sqrt(t234**2 + t235**2)
-    t245 = t244*xp.where(xp.greater_equal(t234, 0), xp.asarray(1, dtype=dtype), -1)
-    t246 = xp.greater(t244, 0)
-    t247 = xp.where(t246, 1/(t234 + t245), 0)
-    t248 = xp.where(t246, 1 + xp.abs(t234)/t244, 0)
-    t249 = t235*t247
-    t250 = t248*(t238 + t249*t239)
-    t251 = -t250 + t238
-    t252 = t239 - t249*t250
-    t253 = t248*(t242 + t249*t243)
-    t254 = -t253 + t242
-    t255 = t243 - t249*t253
-    t256 = xp.abs(t252)
-    t257 = t256*xp.where(xp.greater_equal(t252, 0), xp.asarray(1, dtype=dtype), -1)
-    t258 = xp.where(xp.greater(t256, 0), xp.asarray(2, dtype=dtype), 0)
-    t259 = t255 - t255*t258
-    t260 = xp.where(xp.not_equal(t257, 0), -t259/t257, 0)
-    t261 = xp.where(xp.not_equal(t245, 0), -(t254 - t251*t260)/t245, 0)
-    t262 = xp.where(xp.not_equal(t226, 0), -(-(t233*t261 + t237*t260) + t241)/t226, 0)
-    t263 = xp.where(xp.not_equal(t185, 0), -(-(t206*t262 + t211*t261 + t216*t260) + t221)/t185, 0)
-    t264 = xp.where(xp.not_equal(t150, 0), -(-(t157*t263 + t167*t262 + t171*t261 + t175*t260) + t179)/t150, 0)
-    t265 = xp.where(xp.not_equal(t65, 0), -(t132 + t121*t264 + t126*t262 + t128*t261 + t130*t260 - t124*t263)/t65, 0)
-    t266 = xp.isfinite(t198)
-    t267 = xp.greater_equal(damping, 0)
-    t268 = xp.greater(damping, 0)
-    t269 = 1e-12*t81
-    t270 = (t268 & xp.greater(t100[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t64, t269) | xp.less_equal(t149, t269) | xp.less_equal(t184, t269) | xp.less_equal(t225, t269) | xp.less_equal(t244, t269) | xp.less_equal(t256, t269)))
-    t271 = t266 & t267 & xp.logical_not(t270)
+    c6 = -trig[..., 11]
+    s6 = trig[..., 10]
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t271, xp.where(t268, -t104, t265), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t271, xp.where(t268, -t113, t264), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t271, xp.where(t268, t115, t263), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t271, xp.where(t268, t109, t262), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t271, xp.where(t268, t110, t261), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t271, xp.where(t268, t111, t260), 0), batch),  # 5
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
+        xp.broadcast_to(t0[4], batch),  # 4
+        xp.broadcast_to(t0[5], batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t266 & t267), 2, xp.where(t270, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[6], batch), xp.int32)
     return q_dot, status
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
-    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1438 operations."""
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1443 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("z", z, (6,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
     mu_dot3 = mu_dot[..., 3]
     mu_dot4 = mu_dot[..., 4]
     mu_dot5 = mu_dot[..., 5]
-    qz1 = z[..., 0]
-    qz2 = z[..., 1]
-    qz3 = z[..., 2]
-    qz4 = z[..., 3]
-    qz5 = z[..., 4]
-    qz6 = z[..., 5]
-    trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
+    trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.17453292519943295), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
     c2 = trig[..., 3]
@@ -4579,300 +4543,25 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     s4 = trig[..., 7]
     c5 = -trig[..., 8]
     s5 = -trig[..., 9]
-    t0 = c2*c3
-    t1 = s2*s3
-    t2 = c1*t0 + c1*t1
-    t3 = s1*t0 + s1*t1
-    t4 = t0 + t1
-    t5 = t2*c4 + s1*s4
-    t6 = s1*c4 - t2*s4
-    t7 = c1*s4 - t3*c4
-    t8 = t3*s4 + c1*c4
-    t9 = -0.25019712500078917*t4
-    t10 = s2*c3
-    t11 = c2*s3
-    t12 = c1*t10 - c1*t11
-    t13 = s1*t11 - s1*t10
-    t14 = -t11 + t10
-    t15 = -0.25019712500078917*t12
-    t16 = -0.25019712500078917*t13
-    t17 = (0.5*t6 - 0.8660254037844386*t12)*c5 - t5*s5
-    t18 = (0.5*t8 - 0.8660254037844386*t13)*c5 - t7*s5
-    t19 = 0.5*t12 + 0.8660254037844386*t6
-    t20 = -0.08579425000157839*t19
-    t21 = 0.5*t13 + 0.8660254037844386*t8
-    t22 = -0.08579425000157839*t21
-    t23 = t14*s4
-    t24 = -t14*c4*s5 + c5*(-0.5*t23 + 0.8660254037844386*t4)
-    t25 = 0.5*t4 + 0.8660254037844386*t23
-    t26 = 0.08579425000157839*t25
-    t27 = 0.5*t19 + 0.8660254037844386*t17
-    t28 = 0.2115971250007892*t27
-    t29 = -t20 + t28
-    t30 = -t15 + t29
-    t31 = -0.0098*s1 + t30
-    t32 = 0.5*t21 + 0.8660254037844386*t18
-    t33 = 0.2115971250007892*t32
-    t34 = -t22 + t33
-    t35 = -t16 + t34
-    t36 = -0.0098*c1 + t35
-    t37 = s1*t36 - c1*t31
-    t38 = t13*t30 - t12*t35
-    t39 = t29*t21 - t34*t19
-    t40 = t28*t32 - t33*t27
-    t41 = 0.5*t25 - 0.8660254037844386*t24
-    t42 = -0.2115971250007892*t41
-    t43 = -t26 + t42
-    t44 = t9 + t43
-    t45 = 0.41*s2 + t44
-    t46 = t13*t44 + t4*t35
-    t47 = t43*t21 + t34*t25
-    t48 = t42*t32 + t33*t41
-    t49 = t4*t30 + t12*t44
-    t50 = t43*t19 + t29*t25
-    t51 = t42*t27 + t28*t41
-    t52 = t4*t38 + t25*t39 + t41*t40
-    t53 = t12*t4 + t19*t25 + t27*t41
-    t54 = t13*t4 + t21*t25 + t32*t41
-    t55 = 0.41*c2
-    t56 = t31 + c1*t55
-    t57 = t36 - s1*t55
-    t58 = c1*t56 - s1*t57
-    t59 = t57 + t4*t46 + t25*t47 + t41*t48
-    t60 = t56 + t4*t49 + t25*t50 + t41*t51
-    t61 = t56**2
-    t62 = t57**2
-    t63 = 1 + t61 + t62
-    t64 = xp.sqrt(t63)
-    t65 = xp.where(xp.greater_equal(t57, 0), xp.asarray(1, dtype=dtype), -1)*t64
-    t66 = s1**2
-    t67 = t12*t49 + t44*t66 + t19*t50 + t27*t51 + t45*t66
-    t68 = t12**2 + t19**2 + t27**2 + 2*t66
-    t69 = c1**2
-    t70 = t13*t46 + t44*t69 + t21*t47 + t32*t48 + t45*t69
-    t71 = t13**2 + t21**2 + t32**2 + 2*t69
-    t72 = t4**2 + t25**2 + t41**2
-    t73 = 1 + t72
-    t74 = t58**2
-    t75 = t74 + t37**2 + t38**2 + t39**2 + t40**2
-    t76 = t45**2
-    t77 = t44**2
-    t78 = t46**2 + t47**2 + t48**2 + t69*t76 + t69*t77
-    t79 = t62 + t78
-    t80 = t49**2 + t50**2 + t51**2 + t66*t76 + t66*t77
-    t81 = xp.sqrt(t63 + t68 + t71 + t72 + t75 + t78 + t80)
-    t82 = t61 + t80
-    t83 = c1*s1
-    t84 = t56*t57 + t46*t49 + t47*t50 + t48*t51 + t76*t83 + t77*t83
-    t85 = 2*t83 + t12*t13 + t19*t21 + t27*t32
-    t86 = c1*t58
-    t87 = c1*t37
-    t88 = t46*t38 + t47*t39 + t48*t40 + t45*t86 - t44*t87
-    t89 = -t87 + t86 + t13*t38 + t21*t39 + t32*t40
-    t90 = c1*t45
-    t91 = c1*t44
-    t92 = s1*t90 + s1*t91
-    t93 = t92 + t12*t46 + t19*t47 + t27*t48
-    t94 = t92 + t13*t49 + t21*t50 + t32*t51
-    t95 = s1*t58
-    t96 = s1*t37
-    t97 = t45*t95 - t44*t96 + t49*t38 + t50*t39 + t51*t40
-    t98 = -t96 + t95 + t12*t38 + t19*t39 + t27*t40
-    t99 = damping**2
-    t100 = _symmetric_solve6(xp, 1, (t99 + t79, -t84, -t88, t93, t70, -t59, t99 + t82, t97, -t67, -t94, t60, t75 + t99, -t98, -t89, t52, t68 + t99, t85, -t53, t71 + t99, -t54, t99 + t73, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
-    t101 = t100[5]
-    t102 = t100[0]
-    t103 = t100[1]
-    t104 = t101 - t57*t102 + t56*t103
-    t105 = s1*t45
-    t106 = t100[2]
-    t107 = t100[3]
-    t108 = t100[4]
-    t109 = -t102*t46 + t103*t49 + t38*t106 - t12*t107 - t13*t108 + t4*t101
-    t110 = -t102*t47 + t103*t50 + t39*t106 - t19*t107 - t21*t108 + t25*t101
-    t111 = t40*t106 - t102*t48 + t103*t51 - t27*t107 - t32*t108 + t41*t101
-    t112 = s1*t107 + c1*t108
-    t113 = t112 + t90*t102 - t103*t105 - t58*t106
-    t114 = s1*t44
-    t115 = t112 + t37*t106 + t91*t102 - t103*t114
-    t116 = xp.greater(t64, 0)
-    t117 = xp.where(t116, 1/(t57 + t65), 0)
-    t118 = xp.where(t116, 1 + xp.abs(t57)/t64, 0)
-    t119 = t56*t117
-    t120 = -t118*(t90 + t105*t119)
-    t121 = t90 + t120
-    t122 = t105 + t119*t120
-    t123 = t118*(t91 + t114*t119)
-    t124 = -t123 + t91
-    t125 = -t118*(t46 + t49*t119 + t4*t117)
-    t126 = t46 + t125
-    t127 = -t118*(t47 + t50*t119 + t25*t117)
-    t128 = t47 + t127
-    t129 = -t118*(t48 + t51*t119 + t41*t117)
-    t130 = t48 + t129
-    t131 = -t118*(-mu_dot0 + mu_dot5*t117 + t119*mu_dot1)
-    t132 = -t131 + mu_dot0
-    t133 = -t114
-    t134 = t117*t123
-    t135 = t133 + t56*t134
-    t136 = t117*t125
-    t137 = t49 + t56*t136
-    t138 = t4 + t136
-    t139 = t117*t127
-    t140 = t50 + t56*t139
-    t141 = t25 + t139
-    t142 = t117*t129
-    t143 = t51 + t56*t142
-    t144 = t41 + t142
-    t145 = t117*t131
-    t146 = mu_dot1 + t56*t145
-    t147 = t145 + mu_dot5
-    t148 = t117**2
-    t149 = xp.sqrt(t66 + t69 + t74 + t122**2 + t148*t120**2)
-    t150 = t149*xp.where(xp.greater_equal(t122, 0), xp.asarray(1, dtype=dtype), -1)
-    t151 = xp.greater(t149, 0)
-    t152 = xp.where(t151, 1/(t122 + t150), 0)
-    t153 = xp.where(t151, 1 + xp.abs(t122)/t149, 0)
-    t154 = t58*t152
-    t155 = t120*t152
-    t156 = t153*(t135 + t37*t154 - t66*t152 - t69*t152 + t148*t155*t123)
-    t157 = -t156 + t135
-    t158 = t37 - t154*t156
-    t159 = t152*t156
-    t160 = s1 + s1*t159
-    t161 = c1 + c1*t159
-    t162 = s1*t152
-    t163 = c1*t152
-    t164 = t155*t117
-    t165 = t134 - t164*t156
-    t166 = t153*(t137 + t38*t154 + t12*t162 + t13*t163 + t164*t138)
-    t167 = -t166 + t137
-    t168 = t38 - t154*t166
-    t169 = t138 - t164*t166
-    t170 = t153*(t140 + t39*t154 + t164*t141 + t19*t162 + t21*t163)
-    t171 = -t170 + t140
-    t172 = t39 - t154*t170
-    t173 = t141 - t164*t170
-    t174 = t153*(t143 + t40*t154 + t164*t144 + t27*t162 + t32*t163)
-    t175 = -t174 + t143
-    t176 = t40 - t154*t174
-    t177 = t144 - t164*t174
-    t178 = t153*(t146 + t154*mu_dot2 - t162*mu_dot3 - t163*mu_dot4 + t164*t147)
-    t179 = -t178 + t146
-    t180 = mu_dot2 - t154*t178
-    t181 = mu_dot3 + t162*t178
-    t182 = mu_dot4 + t163*t178
-    t183 = t147 - t164*t178
-    t184 = xp.sqrt(t158**2 + t160**2 + t161**2 + t165**2)
-    t185 = t184*xp.where(xp.greater_equal(t158, 0), xp.asarray(1, dtype=dtype), -1)
-    t186 = -t12
-    t187 = t186 + t162*t166
-    t188 = -t13
-    t189 = t188 + t163*t166
-    t190 = -t19
-    t191 = t190 + t162*t170
-    t192 = -t21
-    t193 = t192 + t163*t170
-    t194 = -t27
-    t195 = t194 + t162*t174
-    t196 = -t32
-    t197 = t196 + t163*t174
-    t198 = -1 - t46 - t47 - t48 - t56 - t90 + q1 + q2 + q3 + t4 + q4 + q5 + q6 + t57 + t25 + t41 + t91 + t49 + t50 + t51 + t58 + t37 + t38 + t39 + t40 + t105 + t133 + t186 + t188 + t190 + t192 + t194 + t196 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6
-    t199 = xp.greater(t184, 0)
-    t200 = xp.where(t199, 1/(t158 + t185), 0)
-    t201 = xp.where(t199, 1 + xp.abs(t158)/t184, 0)
-    t202 = t160*t200
-    t203 = t161*t200
-    t204 = t165*t200
-    t205 = t201*(t168 + t202*t187 + t203*t189 + t204*t169)
-    t206 = -t205 + t168
-    t207 = t187 - t202*t205
-    t208 = t189 - t203*t205
-    t209 = t169 - t204*t205
-    t210 = t201*(t172 + t202*t191 + t203*t193 + t204*t173)
-    t211 = -t210 + t172
-    t212 = t191 - t202*t210
-    t213 = t193 - t203*t210
-    t214 = t173 - t204*t210
-    t215 = t201*(t176 + t202*t195 + t203*t197 + t204*t177)
-    t216 = -t215 + t176
-    t217 = t195 - t202*t215
-    t218 = t197 - t203*t215
-    t219 = t177 - t204*t215
-    t220 = t201*(t180 + t202*t181 + t203*t182 + t204*t183)
-    t221 = -t220 + t180
-    t222 = t181 - t202*t220
-    t223 = t182 - t203*t220
-    t224 = t183 - t204*t220
-    t225 = xp.sqrt(t207**2 + t208**2 + t209**2)
-    t226 = t225*xp.where(xp.greater_equal(t207, 0), xp.asarray(1, dtype=dtype), -1)
-    t227 = xp.greater(t225, 0)
-    t228 = xp.where(t227, 1/(t207 + t226), 0)
-    t229 = xp.where(t227, 1 + xp.abs(t207)/t225, 0)
-    t230 = t208*t228
-    t231 = t209*t228
-    t232 = t229*(t212 + t230*t213 + t231*t214)
-    t233 = -t232 + t212
-    t234 = t213 - t230*t232
-    t235 = t214 - t231*t232
-    t236 = t229*(t217 + t230*t218 + t231*t219)
-    t237 = -t236 + t217
-    t238 = t218 - t230*t236
-    t239 = t219 - t231*t236
-    t240 = t229*(t222 + t230*t223 + t231*t224)
-    t241 = -t240 + t222
-    t242 = t223 - t230*t240
-    t243 = t224 - t231*t240
-    t244 = xp.sqrt(t234**2 + t235**2)
-    t245 = t244*xp.where(xp.greater_equal(t234, 0), xp.asarray(1, dtype=dtype), -1)
-    t246 = xp.greater(t244, 0)
-    t247 = xp.where(t246, 1/(t234 + t245), 0)
-    t248 = xp.where(t246, 1 + xp.abs(t234)/t244, 0)
-    t249 = t235*t247
-    t250 = t248*(t238 + t249*t239)
-    t251 = -t250 + t238
-    t252 = t239 - t249*t250
-    t253 = t248*(t242 + t249*t243)
-    t254 = -t253 + t242
-    t255 = t243 - t249*t253
-    t256 = xp.abs(t252)
-    t257 = t256*xp.where(xp.greater_equal(t252, 0), xp.asarray(1, dtype=dtype), -1)
-    t258 = xp.where(xp.greater(t256, 0), xp.asarray(2, dtype=dtype), 0)
-    t259 = t255 - t255*t258
-    t260 = xp.where(xp.not_equal(t257, 0), -t259/t257, 0)
-    t261 = xp.where(xp.not_equal(t245, 0), -(t254 - t251*t260)/t245, 0)
-    t262 = xp.where(xp.not_equal(t226, 0), -(-(t233*t261 + t237*t260) + t241)/t226, 0)
-    t263 = xp.where(xp.not_equal(t185, 0), -(-(t206*t262 + t211*t261 + t216*t260) + t221)/t185, 0)
-    t264 = xp.where(xp.not_equal(t150, 0), -(-(t157*t263 + t167*t262 + t171*t261 + t175*t260) + t179)/t150, 0)
-    t265 = xp.where(xp.not_equal(t65, 0), -(t132 + t121*t264 + t126*t262 + t128*t261 + t130*t260 - t124*t263)/t65, 0)
-    t266 = xp.isfinite(t198)
-    t267 = xp.greater_equal(damping, 0)
-    t268 = xp.greater(damping, 0)
-    t269 = 1e-12*t81
-    t270 = (t268 & xp.greater(t100[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t64, t269) | xp.less_equal(t149, t269) | xp.less_equal(t184, t269) | xp.less_equal(t225, t269) | xp.less_equal(t244, t269) | xp.less_equal(t256, t269)))
-    t271 = t266 & t267 & xp.logical_not(t270)
+    c6 = -trig[..., 11]
+    s6 = trig[..., 10]
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t271, xp.where(t268, -t104, t265), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t271, xp.where(t268, -t113, t264), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t271, xp.where(t268, t115, t263), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t271, xp.where(t268, t109, t262), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t271, xp.where(t268, t110, t261), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t271, xp.where(t268, t111, t260), 0), batch),  # 5
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
+        xp.broadcast_to(t0[4], batch),  # 4
+        xp.broadcast_to(t0[5], batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t266 & t267), 2, xp.where(t270, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[6], batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1612 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1711 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (6,)), ("target", target, (4, 4)), ("target_rate", target_rate, (6,)), ("gain", gain, (6,)), ("z", z, (6,)), ("damping", damping, ()), every=("gain", ))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
     T02 = target[..., 0, 2]
@@ -4897,12 +4586,6 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     gain3 = gain[..., 3]
     gain4 = gain[..., 4]
     gain5 = gain[..., 5]
-    qz1 = z[..., 0]
-    qz2 = z[..., 1]
-    qz3 = z[..., 2]
-    qz4 = z[..., 3]
-    qz5 = z[..., 4]
-    qz6 = z[..., 5]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.17453292519943295), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
@@ -4960,296 +4643,69 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t41 = -t20 + t40
     t42 = -t16 + t41
     t43 = -0.0098*c1 + t42
-    t44 = s1*t43 - c1*t38
-    t45 = t13*t37 - t12*t42
-    t46 = t36*t19 - t41*t17
-    t47 = t35*t39 - t40*t34
-    t48 = 0.5*t22 - 0.8660254037844386*t33
-    t49 = -0.2115971250007892*t48
-    t50 = -t23 + t49
-    t51 = t9 + t50
-    t52 = 0.41*s2 + t51
-    t53 = 0.2755 + t52
-    t54 = t13*t51 + t4*t42
-    t55 = t50*t19 + t41*t22
-    t56 = t49*t39 + t40*t48
-    t57 = t4*t37 + t12*t51
-    t58 = t50*t17 + t36*t22
-    t59 = t49*t34 + t35*t48
-    t60 = t4*t45 + t22*t46 + t48*t47
-    t61 = t34*t48 + t12*t4 + t17*t22
-    t62 = t39*t48 + t13*t4 + t19*t22
-    t63 = mu_dot2 + gain2*(-t53 + T23)
-    t64 = 0.5*t26 - 0.8660254037844386*t17
-    t65 = t25*c6 + s6*t64
-    t66 = -t25*s6 + c6*t64
-    t67 = t65*T00 - t66*T01 + t34*T02
-    t68 = t65*T10 - t66*T11 + t34*T12
-    t69 = t65*T20 - t66*T21 + t34*T22
-    t70 = 0.5*t29 - 0.8660254037844386*t19
-    t71 = t28*c6 + s6*t70
-    t72 = -t28*s6 + c6*t70
-    t73 = t71*T00 - t72*T01 + t39*T02
-    t74 = t71*T10 - t72*T11 + t39*T12
-    t75 = t71*T20 - t72*T21 + t39*T22
-    t76 = 0.5*(-t73 + t68)
-    t77 = 0.5*t33 + 0.8660254037844386*t22
-    t78 = t32*c6 + s6*t77
-    t79 = -t32*s6 + c6*t77
-    t80 = t79*T01 - t78*T00 + t48*T02
-    t81 = t79*T11 - t78*T10 + t48*T12
-    t82 = t79*T21 - t78*T20 + t48*T22
-    t83 = 0.5*(t81 + t75)
-    t84 = -0.5*(t80 + t69)
-    t85 = xp.sqrt(t83**2 + t84**2 + t76**2)
-    t86 = 0.41*c2
-    t87 = t38 + c1*t86
-    t88 = t43 - s1*t86
-    t89 = c1*t87 - s1*t88
-    t90 = t88 + t4*t54 + t22*t55 + t48*t56
-    t91 = t87 + t4*t57 + t22*t58 + t48*t59
-    t92 = mu_dot1 + gain1*(-t88 + T13)
-    t93 = t87**2
-    t94 = t88**2
-    t95 = 1 + t93 + t94
-    t96 = xp.sqrt(t95)
-    t97 = xp.where(xp.greater_equal(t88, 0), xp.asarray(1, dtype=dtype), -1)*t96
-    t98 = s1**2
-    t99 = t12*t57 + t17*t58 + t52*t98 + t51*t98 + t34*t59
-    t100 = t12**2 + t17**2 + t34**2 + 2*t98
-    t101 = c1**2
-    t102 = t13*t54 + t52*t101 + t51*t101 + t19*t55 + t39*t56
-    t103 = t13**2 + t19**2 + t39**2 + 2*t101
-    t104 = t4**2 + t22**2 + t48**2
-    t105 = 1 + t104
-    t106 = t89**2
-    t107 = t106 + t44**2 + t45**2 + t46**2 + t47**2
-    t108 = t52**2
-    t109 = t51**2
-    t110 = t54**2 + t55**2 + t56**2 + t101*t108 + t101*t109
-    t111 = t94 + t110
-    t112 = t57**2 + t58**2 + t59**2 + t98*t108 + t98*t109
-    t113 = xp.sqrt(t95 + t100 + t103 + t104 + t107 + t110 + t112)
-    t114 = t93 + t112
-    t115 = c1*s1
-    t116 = t87*t88 + t54*t57 + t55*t58 + t56*t59 + t108*t115 + t109*t115
-    t117 = 2*t115 + t34*t39 + t12*t13 + t17*t19
-    t118 = c1*t89
-    t119 = c1*t44
-    t120 = t52*t118 - t51*t119 + t54*t45 + t55*t46 + t56*t47
-    t121 = -t119 + t118 + t13*t45 + t19*t46 + t39*t47
-    t122 = c1*t52
-    t123 = c1*t51
-    t124 = s1*t122 + s1*t123
-    t125 = t124 + t12*t54 + t17*t55 + t34*t56
-    t126 = t124 + t13*t57 + t19*t58 + t39*t59
-    t127 = s1*t89
-    t128 = s1*t44
-    t129 = t57*t45 + t58*t46 + t59*t47 + t52*t127 - t51*t128
-    t130 = -t128 + t12*t45 + t127 + t17*t46 + t34*t47
-    t131 = xp.greater(t96, 0)
-    t132 = xp.where(t131, 1/(t88 + t97), 0)
-    t133 = xp.where(t131, 1 + xp.abs(t88)/t96, 0)
-    t134 = s1*t52
-    t135 = t87*t132
-    t136 = -t133*(t122 + t134*t135)
-    t137 = t122 + t136
-    t138 = t134 + t135*t136
-    t139 = -t133*(t54 + t4*t132 + t57*t135)
-    t140 = t54 + t139
-    t141 = -t133*(t55 + t22*t132 + t58*t135)
-    t142 = t55 + t141
-    t143 = -t133*(t56 + t59*t135 + t48*t132)
-    t144 = t56 + t143
-    t145 = s1*t51
-    t146 = t133*(t123 + t135*t145)
-    t147 = -t146 + t123
-    t148 = -t145
-    t149 = t132*t146
-    t150 = t148 + t87*t149
-    t151 = t132*t139
-    t152 = t57 + t87*t151
-    t153 = t4 + t151
-    t154 = t132*t141
-    t155 = t58 + t87*t154
-    t156 = t22 + t154
-    t157 = t132*t143
-    t158 = t59 + t87*t157
-    t159 = t48 + t157
-    t160 = t132**2
-    t161 = xp.sqrt(t98 + t101 + t106 + t138**2 + t160*t136**2)
-    t162 = t161*xp.where(xp.greater_equal(t138, 0), xp.asarray(1, dtype=dtype), -1)
-    t163 = xp.greater(t161, 0)
-    t164 = xp.where(t163, 1/(t138 + t162), 0)
-    t165 = xp.where(t163, 1 + xp.abs(t138)/t161, 0)
-    t166 = t89*t164
-    t167 = t136*t164
-    t168 = t165*(t44*t166 + t150 - t98*t164 - t101*t164 + t160*t167*t146)
-    t169 = -t168 + t150
-    t170 = t44 - t166*t168
-    t171 = t164*t168
-    t172 = s1 + s1*t171
-    t173 = c1 + c1*t171
-    t174 = s1*t164
-    t175 = c1*t164
-    t176 = t167*t132
-    t177 = t149 - t176*t168
-    t178 = t165*(t45*t166 + t152 + t12*t174 + t13*t175 + t176*t153)
-    t179 = -t178 + t152
-    t180 = t45 - t166*t178
-    t181 = t153 - t176*t178
-    t182 = t165*(t155 + t46*t166 + t176*t156 + t17*t174 + t19*t175)
-    t183 = -t182 + t155
-    t184 = t46 - t166*t182
-    t185 = t156 - t176*t182
-    t186 = t165*(t47*t166 + t158 + t176*t159 + t34*t174 + t39*t175)
-    t187 = -t186 + t158
-    t188 = t47 - t166*t186
-    t189 = t159 - t176*t186
-    t190 = xp.sqrt(t170**2 + t172**2 + t173**2 + t177**2)
-    t191 = t190*xp.where(xp.greater_equal(t170, 0), xp.asarray(1, dtype=dtype), -1)
-    t192 = -t12
-    t193 = t192 + t174*t178
-    t194 = -t13
-    t195 = t194 + t175*t178
-    t196 = -t17
-    t197 = t196 + t174*t182
-    t198 = -t19
-    t199 = t198 + t175*t182
-    t200 = -t34
-    t201 = t200 + t174*t186
-    t202 = -t39
-    t203 = t202 + t175*t186
-    t204 = xp.greater(t190, 0)
-    t205 = xp.where(t204, 1/(t170 + t191), 0)
-    t206 = xp.where(t204, 1 + xp.abs(t170)/t190, 0)
-    t207 = t172*t205
-    t208 = t173*t205
-    t209 = t177*t205
-    t210 = t206*(t180 + t207*t193 + t208*t195 + t209*t181)
-    t211 = -t210 + t180
-    t212 = t193 - t207*t210
-    t213 = t195 - t208*t210
-    t214 = t181 - t209*t210
-    t215 = t206*(t184 + t207*t197 + t208*t199 + t209*t185)
-    t216 = -t215 + t184
-    t217 = t197 - t207*t215
-    t218 = t199 - t208*t215
-    t219 = t185 - t209*t215
-    t220 = t206*(t188 + t207*t201 + t208*t203 + t209*t189)
-    t221 = -t220 + t188
-    t222 = t201 - t207*t220
-    t223 = t203 - t208*t220
-    t224 = t189 - t209*t220
-    t225 = xp.sqrt(t212**2 + t213**2 + t214**2)
-    t226 = t225*xp.where(xp.greater_equal(t212, 0), xp.asarray(1, dtype=dtype), -1)
-    t227 = xp.greater(t225, 0)
-    t228 = xp.where(t227, 1/(t212 + t226), 0)
-    t229 = xp.where(t227, 1 + xp.abs(t212)/t225, 0)
-    t230 = t213*t228
-    t231 = t214*t228
-    t232 = t229*(t217 + t230*t218 + t231*t219)
-    t233 = -t232 + t217
-    t234 = t218 - t230*t232
-    t235 = t219 - t231*t232
-    t236 = t229*(t222 + t230*t223 + t231*t224)
-    t237 = -t236 + t222
-    t238 = t223 - t230*t236
-    t239 = t224 - t231*t236
-    t240 = xp.sqrt(t234**2 + t235**2)
-    t241 = t240*xp.where(xp.greater_equal(t234, 0), xp.asarray(1, dtype=dtype), -1)
-    t242 = xp.greater(t240, 0)
-    t243 = xp.where(t242, 1/(t234 + t241), 0)
-    t244 = xp.where(t242, 1 + xp.abs(t234)/t240, 0)
-    t245 = t235*t243
-    t246 = t244*(t238 + t245*t239)
-    t247 = -t246 + t238
-    t248 = t239 - t245*t246
-    t249 = xp.abs(t248)
-    t250 = t249*xp.where(xp.greater_equal(t248, 0), xp.asarray(1, dtype=dtype), -1)
-    t251 = xp.where(xp.greater(t249, 0), xp.asarray(2, dtype=dtype), 0)
-    t252 = -t82
-    t253 = 0.5*(-1 + t252 + t67 + t74)
-    t254 = xp.atan2(t85, t253)
-    t255 = xp.where(xp.greater(t85, 0), t254/t85, 1)
-    t256 = xp.greater_equal(t67, t74) & xp.greater_equal(t67, t252)
-    t257 = xp.greater_equal(t74, t252)
-    t258 = xp.where(t256, 0.5*(1 + t67), xp.where(t257, 0.5*t73, -0.5*t80))
-    t259 = xp.where(t256, 0.5*t68, xp.where(t257, 0.5*(1 + t74), -0.5*t81))
-    t260 = xp.where(t256, 0.5*t69, xp.where(t257, 0.5*t75, 0.5*(1 + t252)))
-    t261 = xp.sqrt(t258**2 + t259**2 + t260**2)
-    t262 = xp.where(xp.greater_equal(t83*t258 + t84*t259 + t76*t260, 0), xp.asarray(1, dtype=dtype), -1)
-    t263 = xp.greater(t85, 1e-06) | xp.greater(t253, 0)
-    t264 = t254*t262/t261
-    t265 = xp.where(t263, t83*t255, t264*t258)
-    t266 = xp.where(t263, t84*t255, t264*t259)
-    t267 = xp.where(t263, t76*t255, t264*t260)
-    t268 = mu_dot3 + t265*gain3
-    t269 = mu_dot4 + t266*gain4
-    t270 = mu_dot5 + t267*gain5
-    t271 = -t87
-    t272 = mu_dot0 + gain0*(t271 + T03)
-    t273 = -t133*(-t272 + t132*t270 + t135*t92)
-    t274 = -t273 + t272
-    t275 = -1 - t54 - t55 - t56 - t122 + q1 + q2 + q3 + t4 + q4 + q5 + q6 + t88 + t22 + t48 + t123 + t57 + t58 + t59 + t89 + t44 + t45 + t46 + t47 + t134 + t148 + t192 + t194 + t196 + t198 + t200 + t202 + t271 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t272 + t92 + t63 + t268 + t269 + t270
-    t276 = damping**2
-    t277 = _symmetric_solve6(xp, 1, (t276 + t111, -t116, -t120, t125, t102, -t90, t276 + t114, t129, -t99, -t126, t91, t107 + t276, -t130, -t121, t60, t100 + t276, t117, -t61, t103 + t276, -t62, t276 + t105, t272, t92, t63, t268, t269, t270,))
-    t278 = t277[5]
-    t279 = t277[0]
-    t280 = t277[1]
-    t281 = t278 - t88*t279 + t87*t280
-    t282 = t277[2]
-    t283 = t277[3]
-    t284 = t277[4]
-    t285 = -t54*t279 + t57*t280 + t45*t282 - t12*t283 - t13*t284 + t4*t278
-    t286 = -t55*t279 + t58*t280 + t46*t282 - t17*t283 - t19*t284 + t22*t278
-    t287 = -t56*t279 + t59*t280 + t47*t282 - t34*t283 - t39*t284 + t48*t278
-    t288 = s1*t283 + c1*t284
-    t289 = t288 + t122*t279 - t134*t280 - t89*t282
-    t290 = t288 + t123*t279 - t145*t280 + t44*t282
-    t291 = t132*t273
-    t292 = t92 + t87*t291
-    t293 = t291 + t270
-    t294 = t165*(t292 + t166*t63 - t174*t268 - t175*t269 + t176*t293)
-    t295 = -t294 + t292
-    t296 = t63 - t166*t294
-    t297 = t268 + t174*t294
-    t298 = t269 + t175*t294
-    t299 = t293 - t176*t294
-    t300 = t206*(t296 + t207*t297 + t208*t298 + t209*t299)
-    t301 = -t300 + t296
-    t302 = t297 - t207*t300
-    t303 = t298 - t208*t300
-    t304 = t299 - t209*t300
-    t305 = t229*(t302 + t230*t303 + t231*t304)
-    t306 = -t305 + t302
-    t307 = t303 - t230*t305
-    t308 = t304 - t231*t305
-    t309 = t244*(t307 + t245*t308)
-    t310 = -t309 + t307
-    t311 = t308 - t245*t309
-    t312 = t311 - t251*t311
-    t313 = xp.where(xp.not_equal(t250, 0), -t312/t250, 0)
-    t314 = xp.where(xp.not_equal(t241, 0), -(t310 - t247*t313)/t241, 0)
-    t315 = xp.where(xp.not_equal(t226, 0), -(-(t233*t314 + t237*t313) + t306)/t226, 0)
-    t316 = xp.where(xp.not_equal(t191, 0), -(-(t211*t315 + t216*t314 + t221*t313) + t301)/t191, 0)
-    t317 = xp.where(xp.not_equal(t162, 0), -(-(t169*t316 + t179*t315 + t183*t314 + t187*t313) + t295)/t162, 0)
-    t318 = xp.where(xp.not_equal(t97, 0), -(t274 + t137*t317 + t140*t315 + t142*t314 + t144*t313 - t147*t316)/t97, 0)
-    t319 = xp.isfinite(t275)
-    t320 = xp.greater_equal(damping, 0)
-    t321 = xp.greater(damping, 0)
-    t322 = 1e-12*t113
-    t323 = (t321 & xp.greater(t277[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t96, t322) | xp.less_equal(t161, t322) | xp.less_equal(t190, t322) | xp.less_equal(t225, t322) | xp.less_equal(t240, t322) | xp.less_equal(t249, t322)))
-    t324 = t319 & t320 & xp.logical_not(t323)
+    t44 = 0.5*t22 - 0.8660254037844386*t33
+    t45 = -0.2115971250007892*t44
+    t46 = -t23 + t45
+    t47 = t9 + t46
+    t48 = 0.41*s2 + t47
+    t49 = 0.2755 + t48
+    t50 = mu_dot2 + gain2*(-t49 + T23)
+    t51 = 0.5*t26 - 0.8660254037844386*t17
+    t52 = t25*c6 + s6*t51
+    t53 = -t25*s6 + c6*t51
+    t54 = t52*T00 - t53*T01 + t34*T02
+    t55 = t52*T10 - t53*T11 + t34*T12
+    t56 = t52*T20 - t53*T21 + t34*T22
+    t57 = 0.5*t29 - 0.8660254037844386*t19
+    t58 = t28*c6 + s6*t57
+    t59 = -t28*s6 + c6*t57
+    t60 = t58*T00 - t59*T01 + t39*T02
+    t61 = t58*T10 - t59*T11 + t39*T12
+    t62 = t58*T20 - t59*T21 + t39*T22
+    t63 = 0.5*(-t60 + t55)
+    t64 = 0.5*t33 + 0.8660254037844386*t22
+    t65 = t32*c6 + s6*t64
+    t66 = -t32*s6 + c6*t64
+    t67 = t66*T01 - t65*T00 + t44*T02
+    t68 = t66*T11 - t65*T10 + t44*T12
+    t69 = t66*T21 - t65*T20 + t44*T22
+    t70 = 0.5*(t68 + t62)
+    t71 = -0.5*(t67 + t56)
+    t72 = xp.sqrt(t70**2 + t71**2 + t63**2)
+    t73 = 0.41*c2
+    t74 = t38 + c1*t73
+    t75 = t43 - s1*t73
+    t76 = mu_dot0 + gain0*(-t74 + T03)
+    t77 = mu_dot1 + gain1*(-t75 + T13)
+    t78 = -t69
+    t79 = 0.5*(-1 + t78 + t54 + t61)
+    t80 = xp.atan2(t72, t79)
+    t81 = xp.where(xp.greater(t72, 0), t80/t72, 1)
+    t82 = xp.greater_equal(t54, t61) & xp.greater_equal(t54, t78)
+    t83 = xp.greater_equal(t61, t78)
+    t84 = xp.where(t82, 0.5*(1 + t54), xp.where(t83, 0.5*t60, -0.5*t67))
+    t85 = xp.where(t82, 0.5*t55, xp.where(t83, 0.5*(1 + t61), -0.5*t68))
+    t86 = xp.where(t82, 0.5*t56, xp.where(t83, 0.5*t62, 0.5*(1 + t78)))
+    t87 = xp.sqrt(t84**2 + t85**2 + t86**2)
+    t88 = xp.where(xp.greater_equal(t70*t84 + t71*t85 + t63*t86, 0), xp.asarray(1, dtype=dtype), -1)
+    t89 = xp.greater(t72, 1e-06) | xp.greater(t79, 0)
+    t90 = t80*t88/t87
+    t91 = xp.where(t89, t70*t81, t90*t84)
+    t92 = xp.where(t89, t71*t81, t90*t85)
+    t93 = xp.where(t89, t63*t81, t90*t86)
+    t94 = mu_dot3 + t91*gain3
+    t95 = mu_dot4 + t92*gain4
+    t96 = mu_dot5 + t93*gain5
+    t97 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, t76, t77, t50, t94, t95, t96, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t324, xp.where(t321, -t281, t318), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t324, xp.where(t321, -t289, t317), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t324, xp.where(t321, t290, t316), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t324, xp.where(t321, t285, t315), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t324, xp.where(t321, t286, t314), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t324, xp.where(t321, t287, t313), 0), batch),  # 5
+        xp.broadcast_to(t97[0], batch),  # 0
+        xp.broadcast_to(t97[1], batch),  # 1
+        xp.broadcast_to(t97[2], batch),  # 2
+        xp.broadcast_to(t97[3], batch),  # 3
+        xp.broadcast_to(t97[4], batch),  # 4
+        xp.broadcast_to(t97[5], batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t319 & t320), 2, xp.where(t323, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t97[6], batch), xp.int32)
     return q_dot, status
 
 
@@ -5408,7 +4864,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t112 = t110 + t14*t58 + t20*t59 + t40*t60
     t113 = s1**2
     t114 = t89**2 + t58**2 + t59**2 + t60**2 + t100*t113 + t101*t113
-    t115 = t13*t58 + t18*t59 + t35*t60 + t53*t113 + t52*t113
+    t115 = t13*t58 + t18*t59 + t53*t113 + t52*t113 + t35*t60
     t116 = t13**2 + t18**2 + t35**2 + 2*t113
     t117 = s1*t91
     t118 = s1*t45
@@ -5446,7 +4902,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t150 = q5 + t47*t145 - t18*t146 - t140*t56 + t141*t59 - t20*t148 + t23*t139
     t151 = q6 + t49*t139 + t141*t60 + t48*t145 - t140*t57 - t35*t146 - t40*t148
     t152 = c1*t148
-    t153 = -t147 - t152 + q2 + t91*t145 + t53*t144 - t53*t143
+    t153 = -t147 - t152 + q2 + t91*t145 - t53*t143 + t53*t144
     t154 = q3 + t147 + t152 + t45*t145 + t52*t143 - t52*t144
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0
@@ -6305,7 +5761,7 @@ def ik_general_limits(q_solution):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 1218 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 1219 operations."""
     xp, dtype, device, batch, (T, q_seed, weights,) = _arguments(("T", T, (4, 4)), ("q_seed", q_seed, (6,)), ("weights", weights, (6,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(T)
     T00 = T[..., 0, 0]
@@ -6460,35 +5916,310 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     lb13 = branches_in_limits[..., 13]
     lb14 = branches_in_limits[..., 14]
     lb15 = branches_in_limits[..., 15]
-    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
-    t1 = _nearer_branch(xp, 1, (qb0_0, qb0_1, qb0_2, qb0_3, qb0_4, qb0_5, xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, qn1, qn2, qn3, qn4, qn5, qn6, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
-    t2 = _nearer_branch(xp, 1, (qb1_0, qb1_1, qb1_2, qb1_3, qb1_4, qb1_5, xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t1[0], t1[1], t1[2], t1[3], t1[4], t1[5], t1[6], t1[7],))
-    t3 = _nearer_branch(xp, 1, (qb2_0, qb2_1, qb2_2, qb2_3, qb2_4, qb2_5, xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t2[0], t2[1], t2[2], t2[3], t2[4], t2[5], t2[6], t2[7],))
-    t4 = _nearer_branch(xp, 1, (qb3_0, qb3_1, qb3_2, qb3_3, qb3_4, qb3_5, xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t3[0], t3[1], t3[2], t3[3], t3[4], t3[5], t3[6], t3[7],))
-    t5 = _nearer_branch(xp, 1, (qb4_0, qb4_1, qb4_2, qb4_3, qb4_4, qb4_5, xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t4[0], t4[1], t4[2], t4[3], t4[4], t4[5], t4[6], t4[7],))
-    t6 = _nearer_branch(xp, 1, (qb5_0, qb5_1, qb5_2, qb5_3, qb5_4, qb5_5, xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t5[0], t5[1], t5[2], t5[3], t5[4], t5[5], t5[6], t5[7],))
-    t7 = _nearer_branch(xp, 1, (qb6_0, qb6_1, qb6_2, qb6_3, qb6_4, qb6_5, xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t6[0], t6[1], t6[2], t6[3], t6[4], t6[5], t6[6], t6[7],))
-    t8 = _nearer_branch(xp, 1, (qb7_0, qb7_1, qb7_2, qb7_3, qb7_4, qb7_5, xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t7[0], t7[1], t7[2], t7[3], t7[4], t7[5], t7[6], t7[7],))
-    t9 = _nearer_branch(xp, 1, (qb8_0, qb8_1, qb8_2, qb8_3, qb8_4, qb8_5, xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t8[0], t8[1], t8[2], t8[3], t8[4], t8[5], t8[6], t8[7],))
-    t10 = _nearer_branch(xp, 1, (qb9_0, qb9_1, qb9_2, qb9_3, qb9_4, qb9_5, xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t9[0], t9[1], t9[2], t9[3], t9[4], t9[5], t9[6], t9[7],))
-    t11 = _nearer_branch(xp, 1, (qb10_0, qb10_1, qb10_2, qb10_3, qb10_4, qb10_5, xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t10[0], t10[1], t10[2], t10[3], t10[4], t10[5], t10[6], t10[7],))
-    t12 = _nearer_branch(xp, 1, (qb11_0, qb11_1, qb11_2, qb11_3, qb11_4, qb11_5, xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t11[0], t11[1], t11[2], t11[3], t11[4], t11[5], t11[6], t11[7],))
-    t13 = _nearer_branch(xp, 1, (qb12_0, qb12_1, qb12_2, qb12_3, qb12_4, qb12_5, xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t12[0], t12[1], t12[2], t12[3], t12[4], t12[5], t12[6], t12[7],))
-    t14 = _nearer_branch(xp, 1, (qb13_0, qb13_1, qb13_2, qb13_3, qb13_4, qb13_5, xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t13[0], t13[1], t13[2], t13[3], t13[4], t13[5], t13[6], t13[7],))
-    t15 = _nearer_branch(xp, 1, (qb14_0, qb14_1, qb14_2, qb14_3, qb14_4, qb14_5, xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t14[0], t14[1], t14[2], t14[3], t14[4], t14[5], t14[6], t14[7],))
-    t16 = _nearer_branch(xp, 1, (qb15_0, qb15_1, qb15_2, qb15_3, qb15_4, qb15_5, xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t15[0], t15[1], t15[2], t15[3], t15[4], t15[5], t15[6], t15[7],))
-    t17 = xp.greater(t16[7], 0)
-    t18 = xp.isfinite(t0)
-    t19 = t17 & t18
+    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
+    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
+    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
+    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
+    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
+    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
+    t6 = xp.where(xp.greater(xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), 0), xp.asarray(1, dtype=dtype), 0)
+    t7 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
+    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
+    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
+    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
+    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
+    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
+    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
+    t14 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
+    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
+    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
+    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
+    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
+    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
+    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
+    t21 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
+    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
+    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
+    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
+    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
+    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
+    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
+    t28 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
+    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
+    t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
+    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
+    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
+    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
+    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
+    t35 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
+    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
+    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
+    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
+    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
+    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
+    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
+    t42 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
+    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
+    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
+    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
+    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
+    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
+    t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
+    t49 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_0 + qn1)) + qb8_0
+    t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_1 + qn2)) + qb8_1
+    t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_2 + qn3)) + qb8_2
+    t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_3 + qn4)) + qb8_3
+    t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_4 + qn5)) + qb8_4
+    t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_5 + qn6)) + qb8_5
+    t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_0 + qn1)) + qb9_0
+    t56 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_1 + qn2)) + qb9_1
+    t57 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_2 + qn3)) + qb9_2
+    t58 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_3 + qn4)) + qb9_3
+    t59 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_4 + qn5)) + qb9_4
+    t60 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_5 + qn6)) + qb9_5
+    t61 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_0 + qn1)) + qb10_0
+    t62 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_1 + qn2)) + qb10_1
+    t63 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_2 + qn3)) + qb10_2
+    t64 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_3 + qn4)) + qb10_3
+    t65 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_4 + qn5)) + qb10_4
+    t66 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_5 + qn6)) + qb10_5
+    t67 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_0 + qn1)) + qb11_0
+    t68 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_1 + qn2)) + qb11_1
+    t69 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_2 + qn3)) + qb11_2
+    t70 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_3 + qn4)) + qb11_3
+    t71 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_4 + qn5)) + qb11_4
+    t72 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_5 + qn6)) + qb11_5
+    t73 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_0 + qn1)) + qb12_0
+    t74 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_1 + qn2)) + qb12_1
+    t75 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_2 + qn3)) + qb12_2
+    t76 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_3 + qn4)) + qb12_3
+    t77 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_4 + qn5)) + qb12_4
+    t78 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_5 + qn6)) + qb12_5
+    t79 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_0 + qn1)) + qb13_0
+    t80 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_1 + qn2)) + qb13_1
+    t81 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_2 + qn3)) + qb13_2
+    t82 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_3 + qn4)) + qb13_3
+    t83 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_4 + qn5)) + qb13_4
+    t84 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_5 + qn6)) + qb13_5
+    t85 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_0 + qn1)) + qb14_0
+    t86 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_1 + qn2)) + qb14_1
+    t87 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_2 + qn3)) + qb14_2
+    t88 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_3 + qn4)) + qb14_3
+    t89 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_4 + qn5)) + qb14_4
+    t90 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_5 + qn6)) + qb14_5
+    t91 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_0 + qn1)) + qb15_0
+    t92 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_1 + qn2)) + qb15_1
+    t93 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_2 + qn3)) + qb15_2
+    t94 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_3 + qn4)) + qb15_3
+    t95 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_4 + qn5)) + qb15_4
+    t96 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_5 + qn6)) + qb15_5
+    t97 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
+    t98 = -qn1
+    t99 = -qn2
+    t100 = -qn3
+    t101 = -qn4
+    t102 = -qn5
+    t103 = -qn6
+    t104 = qw1*(t98 + t0)**2 + qw2*(t99 + t1)**2 + qw3*(t100 + t2)**2 + qw4*(t101 + t3)**2 + qw5*(t102 + t4)**2 + qw6*(t103 + t5)**2
+    t105 = qw1*(t98 + t7)**2 + qw2*(t99 + t8)**2 + qw3*(t100 + t9)**2 + qw4*(t101 + t10)**2 + qw5*(t102 + t11)**2 + qw6*(t103 + t12)**2
+    t106 = qw1*(t98 + t13)**2 + qw2*(t99 + t14)**2 + qw3*(t100 + t15)**2 + qw4*(t101 + t16)**2 + qw5*(t102 + t17)**2 + qw6*(t103 + t18)**2
+    t107 = qw1*(t98 + t19)**2 + qw2*(t99 + t20)**2 + qw3*(t100 + t21)**2 + qw4*(t101 + t22)**2 + qw5*(t102 + t23)**2 + qw6*(t103 + t24)**2
+    t108 = qw1*(t98 + t25)**2 + qw2*(t99 + t26)**2 + qw3*(t100 + t27)**2 + qw4*(t101 + t28)**2 + qw5*(t102 + t29)**2 + qw6*(t103 + t30)**2
+    t109 = qw1*(t98 + t31)**2 + qw2*(t99 + t32)**2 + qw3*(t100 + t33)**2 + qw4*(t101 + t34)**2 + qw5*(t102 + t35)**2 + qw6*(t103 + t36)**2
+    t110 = qw1*(t98 + t37)**2 + qw2*(t99 + t38)**2 + qw3*(t100 + t39)**2 + qw4*(t101 + t40)**2 + qw5*(t102 + t41)**2 + qw6*(t103 + t42)**2
+    t111 = qw1*(t98 + t43)**2 + qw2*(t99 + t44)**2 + qw3*(t100 + t45)**2 + qw4*(t101 + t46)**2 + qw5*(t102 + t47)**2 + qw6*(t103 + t48)**2
+    t112 = qw1*(t98 + t49)**2 + qw2*(t99 + t50)**2 + qw3*(t100 + t51)**2 + qw4*(t101 + t52)**2 + qw5*(t102 + t53)**2 + qw6*(t103 + t54)**2
+    t113 = qw1*(t98 + t55)**2 + qw2*(t99 + t56)**2 + qw3*(t100 + t57)**2 + qw4*(t101 + t58)**2 + qw5*(t102 + t59)**2 + qw6*(t103 + t60)**2
+    t114 = qw1*(t98 + t61)**2 + qw2*(t99 + t62)**2 + qw3*(t100 + t63)**2 + qw4*(t101 + t64)**2 + qw5*(t102 + t65)**2 + qw6*(t103 + t66)**2
+    t115 = qw1*(t98 + t67)**2 + qw2*(t99 + t68)**2 + qw3*(t100 + t69)**2 + qw4*(t101 + t70)**2 + qw5*(t102 + t71)**2 + qw6*(t103 + t72)**2
+    t116 = qw1*(t98 + t73)**2 + qw2*(t99 + t74)**2 + qw3*(t100 + t75)**2 + qw4*(t101 + t76)**2 + qw5*(t102 + t77)**2 + qw6*(t103 + t78)**2
+    t117 = qw1*(t98 + t79)**2 + qw2*(t99 + t80)**2 + qw3*(t100 + t81)**2 + qw4*(t101 + t82)**2 + qw5*(t102 + t83)**2 + qw6*(t103 + t84)**2
+    t118 = qw1*(t98 + t85)**2 + qw2*(t99 + t86)**2 + qw3*(t100 + t87)**2 + qw4*(t101 + t88)**2 + qw5*(t102 + t89)**2 + qw6*(t103 + t90)**2
+    t119 = qw1*(t98 + t91)**2 + qw2*(t99 + t92)**2 + qw3*(t100 + t93)**2 + qw4*(t101 + t94)**2 + qw5*(t102 + t95)**2 + qw6*(t103 + t96)**2
+    t120 = xp.greater(t6, 0)
+    t121 = xp.where(t120, t0, qn1)
+    t122 = xp.where(t120, t1, qn2)
+    t123 = xp.where(t120, t2, qn3)
+    t124 = xp.where(t120, t3, qn4)
+    t125 = xp.where(t120, t4, qn5)
+    t126 = xp.where(t120, t5, qn6)
+    t127 = xp.where(t120, t104, 0)
+    t128 = xp.greater(xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), 0)
+    t129 = xp.where(t128 & (xp.less(t6, 1) | xp.less(t105, t127)), xp.asarray(1, dtype=dtype), 0)
+    t130 = xp.where(t128, 1, t6)
+    t131 = xp.greater(t129, 0)
+    t132 = xp.where(t131, t7, t121)
+    t133 = xp.where(t131, t8, t122)
+    t134 = xp.where(t131, t9, t123)
+    t135 = xp.where(t131, t10, t124)
+    t136 = xp.where(t131, t11, t125)
+    t137 = xp.where(t131, t12, t126)
+    t138 = xp.where(t131, t105, t127)
+    t139 = xp.greater(xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0), 0)
+    t140 = xp.where(t139 & (xp.less(t130, 1) | xp.less(t106, t138)), xp.asarray(1, dtype=dtype), 0)
+    t141 = xp.where(t139, 1, t130)
+    t142 = xp.greater(t140, 0)
+    t143 = xp.where(t142, t13, t132)
+    t144 = xp.where(t142, t14, t133)
+    t145 = xp.where(t142, t15, t134)
+    t146 = xp.where(t142, t16, t135)
+    t147 = xp.where(t142, t17, t136)
+    t148 = xp.where(t142, t18, t137)
+    t149 = xp.where(t142, t106, t138)
+    t150 = xp.greater(xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0), 0)
+    t151 = xp.where(t150 & (xp.less(t141, 1) | xp.less(t107, t149)), xp.asarray(1, dtype=dtype), 0)
+    t152 = xp.where(t150, 1, t141)
+    t153 = xp.greater(t151, 0)
+    t154 = xp.where(t153, t19, t143)
+    t155 = xp.where(t153, t20, t144)
+    t156 = xp.where(t153, t21, t145)
+    t157 = xp.where(t153, t22, t146)
+    t158 = xp.where(t153, t23, t147)
+    t159 = xp.where(t153, t24, t148)
+    t160 = xp.where(t153, t107, t149)
+    t161 = xp.greater(xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0), 0)
+    t162 = xp.where(t161 & (xp.less(t152, 1) | xp.less(t108, t160)), xp.asarray(1, dtype=dtype), 0)
+    t163 = xp.where(t161, 1, t152)
+    t164 = xp.greater(t162, 0)
+    t165 = xp.where(t164, t25, t154)
+    t166 = xp.where(t164, t26, t155)
+    t167 = xp.where(t164, t27, t156)
+    t168 = xp.where(t164, t28, t157)
+    t169 = xp.where(t164, t29, t158)
+    t170 = xp.where(t164, t30, t159)
+    t171 = xp.where(t164, t108, t160)
+    t172 = xp.greater(xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0), 0)
+    t173 = xp.where(t172 & (xp.less(t163, 1) | xp.less(t109, t171)), xp.asarray(1, dtype=dtype), 0)
+    t174 = xp.where(t172, 1, t163)
+    t175 = xp.greater(t173, 0)
+    t176 = xp.where(t175, t31, t165)
+    t177 = xp.where(t175, t32, t166)
+    t178 = xp.where(t175, t33, t167)
+    t179 = xp.where(t175, t34, t168)
+    t180 = xp.where(t175, t35, t169)
+    t181 = xp.where(t175, t36, t170)
+    t182 = xp.where(t175, t109, t171)
+    t183 = xp.greater(xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0), 0)
+    t184 = xp.where(t183 & (xp.less(t174, 1) | xp.less(t110, t182)), xp.asarray(1, dtype=dtype), 0)
+    t185 = xp.where(t183, 1, t174)
+    t186 = xp.greater(t184, 0)
+    t187 = xp.where(t186, t37, t176)
+    t188 = xp.where(t186, t38, t177)
+    t189 = xp.where(t186, t39, t178)
+    t190 = xp.where(t186, t40, t179)
+    t191 = xp.where(t186, t41, t180)
+    t192 = xp.where(t186, t42, t181)
+    t193 = xp.where(t186, t110, t182)
+    t194 = xp.greater(xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0), 0)
+    t195 = xp.where(t194 & (xp.less(t185, 1) | xp.less(t111, t193)), xp.asarray(1, dtype=dtype), 0)
+    t196 = xp.where(t194, 1, t185)
+    t197 = xp.greater(t195, 0)
+    t198 = xp.where(t197, t43, t187)
+    t199 = xp.where(t197, t44, t188)
+    t200 = xp.where(t197, t45, t189)
+    t201 = xp.where(t197, t46, t190)
+    t202 = xp.where(t197, t47, t191)
+    t203 = xp.where(t197, t48, t192)
+    t204 = xp.where(t197, t111, t193)
+    t205 = xp.greater(xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0), 0)
+    t206 = xp.where(t205 & (xp.less(t196, 1) | xp.less(t112, t204)), xp.asarray(1, dtype=dtype), 0)
+    t207 = xp.where(t205, 1, t196)
+    t208 = xp.greater(t206, 0)
+    t209 = xp.where(t208, t49, t198)
+    t210 = xp.where(t208, t50, t199)
+    t211 = xp.where(t208, t51, t200)
+    t212 = xp.where(t208, t52, t201)
+    t213 = xp.where(t208, t53, t202)
+    t214 = xp.where(t208, t54, t203)
+    t215 = xp.where(t208, t112, t204)
+    t216 = xp.greater(xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0), 0)
+    t217 = xp.where(t216 & (xp.less(t207, 1) | xp.less(t113, t215)), xp.asarray(1, dtype=dtype), 0)
+    t218 = xp.where(t216, 1, t207)
+    t219 = xp.greater(t217, 0)
+    t220 = xp.where(t219, t55, t209)
+    t221 = xp.where(t219, t56, t210)
+    t222 = xp.where(t219, t57, t211)
+    t223 = xp.where(t219, t58, t212)
+    t224 = xp.where(t219, t59, t213)
+    t225 = xp.where(t219, t60, t214)
+    t226 = xp.where(t219, t113, t215)
+    t227 = xp.greater(xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0), 0)
+    t228 = xp.where(t227 & (xp.less(t218, 1) | xp.less(t114, t226)), xp.asarray(1, dtype=dtype), 0)
+    t229 = xp.where(t227, 1, t218)
+    t230 = xp.greater(t228, 0)
+    t231 = xp.where(t230, t61, t220)
+    t232 = xp.where(t230, t62, t221)
+    t233 = xp.where(t230, t63, t222)
+    t234 = xp.where(t230, t64, t223)
+    t235 = xp.where(t230, t65, t224)
+    t236 = xp.where(t230, t66, t225)
+    t237 = xp.where(t230, t114, t226)
+    t238 = xp.greater(xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0), 0)
+    t239 = xp.where(t238 & (xp.less(t229, 1) | xp.less(t115, t237)), xp.asarray(1, dtype=dtype), 0)
+    t240 = xp.where(t238, 1, t229)
+    t241 = xp.greater(t239, 0)
+    t242 = xp.where(t241, t67, t231)
+    t243 = xp.where(t241, t68, t232)
+    t244 = xp.where(t241, t69, t233)
+    t245 = xp.where(t241, t70, t234)
+    t246 = xp.where(t241, t71, t235)
+    t247 = xp.where(t241, t72, t236)
+    t248 = xp.where(t241, t115, t237)
+    t249 = xp.greater(xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0), 0)
+    t250 = xp.where(t249 & (xp.less(t240, 1) | xp.less(t116, t248)), xp.asarray(1, dtype=dtype), 0)
+    t251 = xp.where(t249, 1, t240)
+    t252 = xp.greater(t250, 0)
+    t253 = xp.where(t252, t73, t242)
+    t254 = xp.where(t252, t74, t243)
+    t255 = xp.where(t252, t75, t244)
+    t256 = xp.where(t252, t76, t245)
+    t257 = xp.where(t252, t77, t246)
+    t258 = xp.where(t252, t78, t247)
+    t259 = xp.where(t252, t116, t248)
+    t260 = xp.greater(xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0), 0)
+    t261 = xp.where(t260 & (xp.less(t251, 1) | xp.less(t117, t259)), xp.asarray(1, dtype=dtype), 0)
+    t262 = xp.where(t260, 1, t251)
+    t263 = xp.greater(t261, 0)
+    t264 = xp.where(t263, t79, t253)
+    t265 = xp.where(t263, t80, t254)
+    t266 = xp.where(t263, t81, t255)
+    t267 = xp.where(t263, t82, t256)
+    t268 = xp.where(t263, t83, t257)
+    t269 = xp.where(t263, t84, t258)
+    t270 = xp.where(t263, t117, t259)
+    t271 = xp.greater(xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0), 0)
+    t272 = xp.where(t271 & (xp.less(t262, 1) | xp.less(t118, t270)), xp.asarray(1, dtype=dtype), 0)
+    t273 = xp.where(t271, 1, t262)
+    t274 = xp.greater(t272, 0)
+    t275 = xp.where(t274, t85, t264)
+    t276 = xp.where(t274, t86, t265)
+    t277 = xp.where(t274, t87, t266)
+    t278 = xp.where(t274, t88, t267)
+    t279 = xp.where(t274, t89, t268)
+    t280 = xp.where(t274, t90, t269)
+    t281 = xp.where(t274, t118, t270)
+    t282 = xp.greater(xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0), 0)
+    t283 = xp.where(t282 & (xp.less(t273, 1) | xp.less(t119, t281)), xp.asarray(1, dtype=dtype), 0)
+    t284 = xp.where(t282, 1, t273)
+    t285 = xp.greater(t283, 0)
+    t286 = xp.where(t285, t91, t275)
+    t287 = xp.where(t285, t92, t276)
+    t288 = xp.where(t285, t93, t277)
+    t289 = xp.where(t285, t94, t278)
+    t290 = xp.where(t285, t95, t279)
+    t291 = xp.where(t285, t96, t280)
+    t292 = xp.greater(t284, 0)
+    t293 = xp.isfinite(t97)
+    t294 = t292 & t293
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t19, t16[0], qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t19, t16[1], qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t19, t16[2], qn3), batch),  # 2
-        xp.broadcast_to(xp.where(t19, t16[3], qn4), batch),  # 3
-        xp.broadcast_to(xp.where(t19, t16[4], qn5), batch),  # 4
-        xp.broadcast_to(xp.where(t19, t16[5], qn6), batch),  # 5
+        xp.broadcast_to(xp.where(t294, t286, qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t294, t287, qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t294, t288, qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t294, t289, qn4), batch),  # 3
+        xp.broadcast_to(xp.where(t294, t290, qn5), batch),  # 4
+        xp.broadcast_to(xp.where(t294, t291, qn6), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t18), 2, xp.where(t17, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t293), 2, xp.where(t292, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

@@ -113,7 +113,7 @@ void kr5_velocity_ellipsoid(const kr5_real q[KR5_DOF], kr5_real U_v[9], kr5_real
 kr5_real kr5_condition_number(const kr5_real q[KR5_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1321 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1327 operations. */
 int kr5_velocity_ik(const kr5_real q[KR5_DOF], const kr5_real mu_dot[KR5_TASK_DIM], kr5_real damping, kr5_real q_dot[KR5_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
@@ -121,7 +121,7 @@ int kr5_velocity_ik(const kr5_real q[KR5_DOF], const kr5_real mu_dot[KR5_TASK_DI
 int kr5_velocity_ik_nullspace(const kr5_real q[KR5_DOF], const kr5_real mu_dot[KR5_TASK_DIM], const kr5_real z[KR5_DOF], kr5_real damping, kr5_real q_dot[KR5_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1488 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1544 operations. */
 int kr5_resolved_rate(const kr5_real q[KR5_DOF], const kr5_real target[16], const kr5_real target_rate[KR5_TASK_DIM], const kr5_real gain[KR5_TASK_DIM], const kr5_real z[KR5_DOF], kr5_real damping, kr5_real q_dot[KR5_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).

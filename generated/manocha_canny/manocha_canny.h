@@ -113,7 +113,7 @@ void manocha_canny_velocity_ellipsoid(const manocha_canny_real q[MANOCHA_CANNY_D
 manocha_canny_real manocha_canny_condition_number(const manocha_canny_real q[MANOCHA_CANNY_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1344 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1350 operations. */
 int manocha_canny_velocity_ik(const manocha_canny_real q[MANOCHA_CANNY_DOF], const manocha_canny_real mu_dot[MANOCHA_CANNY_TASK_DIM], manocha_canny_real damping, manocha_canny_real q_dot[MANOCHA_CANNY_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
@@ -121,7 +121,7 @@ int manocha_canny_velocity_ik(const manocha_canny_real q[MANOCHA_CANNY_DOF], con
 int manocha_canny_velocity_ik_nullspace(const manocha_canny_real q[MANOCHA_CANNY_DOF], const manocha_canny_real mu_dot[MANOCHA_CANNY_TASK_DIM], const manocha_canny_real z[MANOCHA_CANNY_DOF], manocha_canny_real damping, manocha_canny_real q_dot[MANOCHA_CANNY_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1523 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1623 operations. */
 int manocha_canny_resolved_rate(const manocha_canny_real q[MANOCHA_CANNY_DOF], const manocha_canny_real target[16], const manocha_canny_real target_rate[MANOCHA_CANNY_TASK_DIM], const manocha_canny_real gain[MANOCHA_CANNY_TASK_DIM], const manocha_canny_real z[MANOCHA_CANNY_DOF], manocha_canny_real damping, manocha_canny_real q_dot[MANOCHA_CANNY_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
@@ -145,7 +145,7 @@ void manocha_canny_ik_general_residual(const manocha_canny_real target[16], cons
 int manocha_canny_ik_general_limits(const manocha_canny_real q_solution[MANOCHA_CANNY_DOF], manocha_canny_real q[MANOCHA_CANNY_DOF]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 6; returned as a scalar. 1218 operations. */
+ * Result: q[i], i < 6; returned as a scalar. 1219 operations. */
 int manocha_canny_ik_nearest(const manocha_canny_real T[16], const manocha_canny_real q_seed[MANOCHA_CANNY_DOF], const manocha_canny_real weights[MANOCHA_CANNY_DOF], manocha_canny_real q[MANOCHA_CANNY_DOF]);
 
 /* Statuses of manocha_canny_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

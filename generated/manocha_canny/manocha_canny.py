@@ -82,7 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -336,7 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi6_rows(xp, count, state):
     """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2 + w4**2 + w5**2
@@ -904,9 +904,9 @@ def _jacobi6_rows(xp, count, state):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _symmetric_solve6(xp, count, state):
-    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    """The solution x of a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
         t0 = w1**2
@@ -1090,39 +1090,282 @@ def _symmetric_solve6(xp, count, state):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
-def _nearer_branch(xp, count, state):
-    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 72 operations a run."""
+def _velocity_solve(xp, count, state):
+    """The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status, `count` times: 1338 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
-        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
-        t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w7))
-        t1 = w1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w1 + w8))
-        t2 = w2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w2 + w9))
-        t3 = w3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w3 + w10))
-        t4 = w4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w4 + w11))
-        t5 = w5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w5 + w12))
-        t6 = w13*(-w7 + t0)**2 + w14*(-w8 + t1)**2 + w15*(-w9 + t2)**2 + w16*(-w10 + t3)**2 + w17*(-w11 + t4)**2 + w18*(-w12 + t5)**2
-        t7 = xp.greater(w6, 0)
-        t8 = xp.where(t7 & (xp.less(w26, 1) | xp.less(t6, w25)), xp.asarray(1, dtype=dtype), 0)
-        t9 = xp.where(t7, 1, w26)
-        t10 = xp.greater(t8, 0)
-        t11 = xp.where(t10, t0, w19)
-        t12 = xp.where(t10, t1, w20)
-        t13 = xp.where(t10, t2, w21)
-        t14 = xp.where(t10, t3, w22)
-        t15 = xp.where(t10, t4, w23)
-        t16 = xp.where(t10, t5, w24)
-        t17 = xp.where(t10, t6, w25)
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, = state
+        t0 = 0.01745240643728351*w2
+        t1 = 0.0034904812874567027*w2
+        t2 = 0.9998476951563913*w1
+        t3 = 0.01745240643728351*w0
+        t4 = t2 + w3*t3
+        t5 = 0.2*t4
+        t6 = 0.9998476951563913*w0
+        t7 = 0.01745240643728351*w1
+        t8 = -t6 + w3*t7
+        t9 = 0.2*t8
+        t10 = t7 - w3*t6
+        t11 = w0*w2
+        t12 = w5*t10 + w4*t11
+        t13 = w4*t10 - w5*t11
+        t14 = -t12*w7 + w6*t4
+        t15 = 0.9998476951563913*t13 + 0.01745240643728351*t14
+        t16 = -(t3 + w3*t2)
+        t17 = w2*w1
+        t18 = w5*t16 + w4*t17
+        t19 = w4*t16 - w5*t17
+        t20 = -t18*w7 + w6*t8
+        t21 = 0.9998476951563913*t19 + 0.01745240643728351*t20
+        t22 = 0.9998476951563913*w2
+        t23 = w3*w4 + w5*t22
+        t24 = -w3*w5 + w4*t22
+        t25 = t0*w6 + t23*w7
+        t26 = 0.01745240643728351*t25 - 0.9998476951563913*t24
+        t27 = t12*w6
+        t28 = w7*t4
+        t29 = t27 + t28
+        t30 = 1.5*t27 + 1.5*t28
+        t31 = (0.9998476951563913*t14 - 0.01745240643728351*t13)*w8 - t29*w9
+        t32 = t5 + t30
+        t33 = t32 + t11
+        t34 = 0.3*w0 + t33
+        t35 = t18*w6
+        t36 = w7*t8
+        t37 = t35 + t36
+        t38 = 1.5*t35 + 1.5*t36
+        t39 = (0.9998476951563913*t20 - 0.01745240643728351*t19)*w8 - t37*w9
+        t40 = t9 + t38
+        t41 = t40 + t17
+        t42 = 0.3*w1 + t41
+        t43 = w0*t33 + w1*t41
+        t44 = t40*t4 - t32*t8
+        t45 = t19*t30 - t13*t38
+        t46 = t0*t44 + t24*t45
+        t47 = t23*w6
+        t48 = t0*w7
+        t49 = -t48 + t47
+        t50 = 1.5*t47 - 1.5*t48
+        t51 = -t49*w9 - (0.9998476951563913*t25 + 0.01745240643728351*t24)*w8
+        t52 = -t1 + t50
+        t53 = w3 + t52
+        t54 = t0*t40 + t52*t8
+        t55 = t24*t38 - t19*t50
+        t56 = t0*t32 + t52*t4
+        t57 = t13*t50 - t24*t30
+        t58 = t42 + t0*t54 + t24*t55
+        t59 = t34 + t0*t56 - t24*t57
+        t60 = t13*t24 - t15*t26 + t31*t51 - t0*t4
+        t61 = t19*t24 - t21*t26 + t39*t51 - t0*t8
+        t62 = t43**2
+        t63 = t62 + t44**2 + t45**2
+        t64 = t34**2
+        t65 = t42**2
+        t66 = 1 + t64 + t65
+        t67 = xp.sqrt(t66)
+        t68 = xp.where(xp.less_equal(t42, 0), xp.asarray(1, dtype=dtype), -1)*t67
+        t69 = w0**2
+        t70 = -t19*t55 + t53*t69 + t8*t54
+        t71 = t53**2
+        t72 = t54**2 + t55**2 + t69*t71
+        t73 = t65 + t72
+        t74 = w1**2
+        t75 = t13*t57 + t4*t56 + t53*t74
+        t76 = t56**2 + t57**2 + t71*t74
+        t77 = t64 + t76
+        t78 = t13**2 + t15**2 + t31**2 + t4**2 + t74
+        t79 = t19**2 + t21**2 + t39**2 + t8**2 + t69
+        t80 = t0**2 + t24**2 + t26**2 + t51**2
+        t81 = xp.sqrt(t63 + t66 + t72 + t76 + t78 + t79 + t80)
+        t82 = 1 + t80
+        t83 = w0*w1
+        t84 = -t34*t42 - t54*t56 + t55*t57 + t71*t83
+        t85 = -t83 + t13*t19 + t15*t21 + t31*t39 + t4*t8
+        t86 = w0*t43
+        t87 = t54*t44 + t55*t45 - t53*t86
+        t88 = t19*t45 + t86 - t8*t44
+        t89 = t53*t83
+        t90 = t89 + t13*t55 - t4*t54
+        t91 = -t89 + t19*t57 + t8*t56
+        t92 = w1*t43
+        t93 = t56*t44 - t57*t45 + t53*t92
+        t94 = -t13*t45 + t92 + t4*t44
+        t95 = w18**2
+        t96 = _symmetric_solve6(xp, 1, (t95 + t73, t84, t87, -t90, t70, -t58, t95 + t77, -t93, -t75, -t91, t59, t63 + t95, t94, -t88, -t46, t78 + t95, t85, t60, t79 + t95, t61, t95 + t82, w12, w13, w14, w15, w16, w17,))
+        t97 = t96[5]
+        t98 = t96[0]
+        t99 = t96[1]
+        t100 = t97 - t42*t98 + t34*t99
+        t101 = w0*t53
+        t102 = w1*t53
+        t103 = t96[2]
+        t104 = t96[3]
+        t105 = t96[4]
+        t106 = t98*t101 + t99*t102 - t43*t103 - w1*t104 + w0*t105
+        t107 = t54*t98 - t56*t99 + t44*t103 - t0*t97 + t4*t104 + t8*t105
+        t108 = t55*t98 + t57*t99 + t45*t103 - t13*t104 - t19*t105 - t24*t97
+        t109 = t15*t104 + t21*t105 - t26*t97
+        t110 = t39*t105 + t31*t104 + t51*t97
+        t111 = xp.greater(t67, 0)
+        t112 = xp.where(t111, 1 + xp.abs(t42)/t67, 0)
+        t113 = -t42
+        t114 = xp.where(t111, 1/(t113 + t68), 0)
+        t115 = t34*t114
+        t116 = -t112*(t101 + t102*t115)
+        t117 = t101 + t116
+        t118 = t102 + t115*t116
+        t119 = -t112*(-t54 + t0*t114 + t56*t115)
+        t120 = -t119 + t54
+        t121 = t112*(t55 - t24*t114 + t57*t115)
+        t122 = -t121 + t55
+        t123 = t112*(w12 + w17*t114 + t115*w13)
+        t124 = -t123 + w12
+        t125 = t114*t119
+        t126 = t56 + t34*t125
+        t127 = t0 + t125
+        t128 = t114*t121
+        t129 = t57 - t34*t128
+        t130 = t24 + t128
+        t131 = t114**2
+        t132 = xp.sqrt(t62 + t69 + t74 + t118**2 + t131*t116**2)
+        t133 = t132*xp.where(xp.less_equal(t118, 0), xp.asarray(1, dtype=dtype), -1)
+        t134 = t131*t112
+        t135 = t26*t134
+        t136 = t34*t135
+        t137 = -t135 + t26
+        t138 = t51*t134
+        t139 = t34*t138
+        t140 = -t51
+        t141 = t138 + t140
+        t142 = t114*t123
+        t143 = w13 - t34*t142
+        t144 = -t142 + w17
+        t145 = xp.greater(t132, 0)
+        t146 = xp.where(t145, 1/(-t118 + t133), 0)
+        t147 = xp.where(t145, 1 + xp.abs(t118)/t132, 0)
+        t148 = t43*t146
+        t149 = w1*t146
+        t150 = w0*t146
+        t151 = t114*t116*t146
+        t152 = t147*(-t126 + t44*t148 + t151*t127 + t4*t149 - t8*t150)
+        t153 = t126 + t152
+        t154 = t44 - t148*t152
+        t155 = t4 - t149*t152
+        t156 = t8 + t150*t152
+        t157 = -t127 + t151*t152
+        t158 = t147*(t129 + t45*t148 - t13*t149 + t19*t150 + t151*t130)
+        t159 = -t158 + t129
+        t160 = t45 - t148*t158
+        t161 = t13 + t149*t158
+        t162 = -t130 + t151*t158
+        t163 = -t147*(t136 + t15*t149 - t21*t150 + t151*t137)
+        t164 = t136 + t163
+        t165 = t15 + t149*t163
+        t166 = t137 + t151*t163
+        t167 = t147*(t139 - t31*t149 + t39*t150 - t151*t141)
+        t168 = -t167 + t139
+        t169 = t31 + t149*t167
+        t170 = t141 + t151*t167
+        t171 = t147*(t143 + t148*w14 + t149*w15 - t150*w16 - t151*t144)
+        t172 = -t171 + t143
+        t173 = w14 - t148*t171
+        t174 = w15 - t149*t171
+        t175 = w16 + t150*t171
+        t176 = t144 + t151*t171
+        t177 = xp.sqrt(t154**2 + t155**2 + t156**2 + t157**2)
+        t178 = t177*xp.where(xp.greater_equal(t154, 0), xp.asarray(1, dtype=dtype), -1)
+        t179 = -t19
+        t180 = t179 + t150*t158
+        t181 = -t21
+        t182 = t181 + t150*t163
+        t183 = -t39
+        t184 = t183 + t150*t167
+        t185 = 1 - t56 - t13 - t15 - t31 - t0 - t24 - t101 - t102 + w2 + w3 + w5 + w4 + w6 + w7 + t26 + w8 + w9 + w10 + w11 + t34 + t4 + t8 + t54 + t55 + t57 + t43 + t44 + t45 + 2*w1 + t113 + t140 + t179 + t181 + t183 + w12 + w13 + w14 + w15 + w16 + w17 + w18
+        t186 = xp.greater(t177, 0)
+        t187 = xp.where(t186, 1/(t154 + t178), 0)
+        t188 = xp.where(t186, 1 + xp.abs(t154)/t177, 0)
+        t189 = t155*t187
+        t190 = t156*t187
+        t191 = t157*t187
+        t192 = t188*(t160 - t189*t161 + t190*t180 + t191*t162)
+        t193 = -t192 + t160
+        t194 = t161 + t189*t192
+        t195 = t180 - t190*t192
+        t196 = t162 - t191*t192
+        t197 = t188*(t173 + t189*t174 + t190*t175 + t191*t176)
+        t198 = -t197 + t173
+        t199 = t174 - t189*t197
+        t200 = t175 - t190*t197
+        t201 = t176 - t191*t197
+        t202 = xp.sqrt(t194**2 + t195**2 + t196**2)
+        t203 = t202*xp.where(xp.less_equal(t194, 0), xp.asarray(1, dtype=dtype), -1)
+        t204 = t148*t163
+        t205 = t188*(-t204 - t189*t165 + t190*t182 + t191*t166)
+        t206 = t204 + t205
+        t207 = t165 + t189*t205
+        t208 = t182 - t190*t205
+        t209 = t166 - t191*t205
+        t210 = t148*t167
+        t211 = t188*(-t210 - t189*t169 + t190*t184 + t191*t170)
+        t212 = t210 + t211
+        t213 = t169 + t189*t211
+        t214 = t184 - t190*t211
+        t215 = t170 - t191*t211
+        t216 = xp.greater(t202, 0)
+        t217 = xp.where(t216, 1/(-t194 + t203), 0)
+        t218 = xp.where(t216, 1 + xp.abs(t194)/t202, 0)
+        t219 = t195*t217
+        t220 = t196*t217
+        t221 = t218*(-t207 + t219*t208 + t220*t209)
+        t222 = t207 + t221
+        t223 = t208 - t219*t221
+        t224 = t209 - t220*t221
+        t225 = t218*(-t213 + t219*t214 + t220*t215)
+        t226 = t213 + t225
+        t227 = t214 - t219*t225
+        t228 = t215 - t220*t225
+        t229 = t218*(t199 + t219*t200 + t220*t201)
+        t230 = -t229 + t199
+        t231 = t200 - t219*t229
+        t232 = t201 - t220*t229
+        t233 = xp.sqrt(t223**2 + t224**2)
+        t234 = t233*xp.where(xp.greater_equal(t223, 0), xp.asarray(1, dtype=dtype), -1)
+        t235 = xp.greater(t233, 0)
+        t236 = xp.where(t235, 1/(t223 + t234), 0)
+        t237 = xp.where(t235, 1 + xp.abs(t223)/t233, 0)
+        t238 = t224*t236
+        t239 = t237*(t227 + t238*t228)
+        t240 = -t239 + t227
+        t241 = t228 - t238*t239
+        t242 = t237*(t231 + t238*t232)
+        t243 = -t242 + t231
+        t244 = t232 - t238*t242
+        t245 = xp.abs(t241)
+        t246 = t245*xp.where(xp.greater_equal(t241, 0), xp.asarray(1, dtype=dtype), -1)
+        t247 = xp.where(xp.greater(t245, 0), xp.asarray(2, dtype=dtype), 0)
+        t248 = t244 - t244*t247
+        t249 = xp.where(xp.not_equal(t246, 0), -t248/t246, 0)
+        t250 = xp.where(xp.not_equal(t234, 0), -(t243 - t240*t249)/t234, 0)
+        t251 = xp.where(xp.not_equal(t203, 0), -(t230 + t222*t250 + t226*t249)/t203, 0)
+        t252 = xp.where(xp.not_equal(t178, 0), -(t198 + t206*t250 + t212*t249 - t193*t251)/t178, 0)
+        t253 = xp.where(xp.not_equal(t133, 0), -(-(-t153*t252 + t159*t251 - t164*t250 + t168*t249) + t172)/t133, 0)
+        t254 = t114*t112
+        t255 = xp.where(xp.not_equal(t68, 0), -(-(-t117*t253 + t120*t252 + t122*t251 - t26*t254*t250 + t51*t254*t249) + t124)/t68, 0)
+        t256 = xp.isfinite(t185)
+        t257 = xp.greater_equal(w18, 0)
+        t258 = xp.greater(w18, 0)
+        t259 = 1e-12*t81
+        t260 = (t258 & xp.greater(t96[6], 0)) | (xp.less_equal(w18, 0) & (xp.less_equal(t67, t259) | xp.less_equal(t132, t259) | xp.less_equal(t177, t259) | xp.less_equal(t202, t259) | xp.less_equal(t233, t259) | xp.less_equal(t245, t259)))
+        t261 = t256 & t257 & xp.logical_not(t260)
         state = (
-            t11,
-            t12,
-            t13,
-            t14,
-            t15,
-            t16,
-            t17,
-            t9,
+            xp.where(t261, xp.where(t258, t100, t255), 0),
+            xp.where(t261, xp.where(t258, -t106, t253), 0),
+            xp.where(t261, xp.where(t258, t107, t252), 0),
+            xp.where(t261, xp.where(t258, t108, t251), 0),
+            xp.where(t261, xp.where(t258, -t109, t250), 0),
+            xp.where(t261, xp.where(t258, -t110, t249), 0),
+            xp.where(xp.logical_not(t256 & t257), 2, xp.where(t260, xp.asarray(1, dtype=dtype), 0)),
         )
     return state
 
@@ -4055,16 +4298,9 @@ def condition_number(q):
     return kappa
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1344 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1350 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
@@ -4082,302 +4318,30 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = 0.01745240643728351*c2
-    t1 = 0.0034904812874567027*c2
-    t2 = 0.9998476951563913*s1
-    t3 = 0.01745240643728351*c1
-    t4 = t2 + s2*t3
-    t5 = 0.2*t4
-    t6 = 0.9998476951563913*c1
-    t7 = 0.01745240643728351*s1
-    t8 = -t6 + s2*t7
-    t9 = 0.2*t8
-    t10 = t7 - s2*t6
-    t11 = c1*c2
-    t12 = s3*t10 + c3*t11
-    t13 = c3*t10 - s3*t11
-    t14 = -t12*s4 + c4*t4
-    t15 = 0.9998476951563913*t13 + 0.01745240643728351*t14
-    t16 = -(t3 + s2*t2)
-    t17 = c2*s1
-    t18 = s3*t16 + c3*t17
-    t19 = c3*t16 - s3*t17
-    t20 = -t18*s4 + c4*t8
-    t21 = 0.9998476951563913*t19 + 0.01745240643728351*t20
-    t22 = 0.9998476951563913*c2
-    t23 = s2*c3 + s3*t22
-    t24 = -s2*s3 + c3*t22
-    t25 = t0*c4 + t23*s4
-    t26 = 0.01745240643728351*t25 - 0.9998476951563913*t24
-    t27 = t12*c4
-    t28 = s4*t4
-    t29 = t27 + t28
-    t30 = 1.5*t27 + 1.5*t28
-    t31 = (0.9998476951563913*t14 - 0.01745240643728351*t13)*c5 - t29*s5
-    t32 = t5 + t30
-    t33 = t32 + t11
-    t34 = 0.3*c1 + t33
-    t35 = t18*c4
-    t36 = s4*t8
-    t37 = t35 + t36
-    t38 = 1.5*t35 + 1.5*t36
-    t39 = (0.9998476951563913*t20 - 0.01745240643728351*t19)*c5 - t37*s5
-    t40 = t9 + t38
-    t41 = t40 + t17
-    t42 = 0.3*s1 + t41
-    t43 = c1*t33 + s1*t41
-    t44 = t40*t4 - t32*t8
-    t45 = t19*t30 - t13*t38
-    t46 = t0*t44 + t24*t45
-    t47 = t23*c4
-    t48 = t0*s4
-    t49 = -t48 + t47
-    t50 = 1.5*t47 - 1.5*t48
-    t51 = -t49*s5 - (0.9998476951563913*t25 + 0.01745240643728351*t24)*c5
-    t52 = -t1 + t50
-    t53 = s2 + t52
-    t54 = t0*t40 + t52*t8
-    t55 = t24*t38 - t19*t50
-    t56 = t0*t32 + t52*t4
-    t57 = t13*t50 - t24*t30
-    t58 = t42 + t0*t54 + t24*t55
-    t59 = t34 + t0*t56 - t24*t57
-    t60 = t13*t24 - t15*t26 + t31*t51 - t0*t4
-    t61 = t19*t24 - t21*t26 + t39*t51 - t0*t8
-    t62 = t43**2
-    t63 = t62 + t44**2 + t45**2
-    t64 = t34**2
-    t65 = t42**2
-    t66 = 1 + t64 + t65
-    t67 = xp.sqrt(t66)
-    t68 = xp.where(xp.less_equal(t42, 0), xp.asarray(1, dtype=dtype), -1)*t67
-    t69 = c1**2
-    t70 = -t19*t55 + t53*t69 + t8*t54
-    t71 = t53**2
-    t72 = t54**2 + t55**2 + t69*t71
-    t73 = t65 + t72
-    t74 = s1**2
-    t75 = t13*t57 + t4*t56 + t53*t74
-    t76 = t56**2 + t57**2 + t71*t74
-    t77 = t64 + t76
-    t78 = t13**2 + t15**2 + t31**2 + t4**2 + t74
-    t79 = t19**2 + t21**2 + t39**2 + t8**2 + t69
-    t80 = t0**2 + t24**2 + t26**2 + t51**2
-    t81 = xp.sqrt(t63 + t66 + t72 + t76 + t78 + t79 + t80)
-    t82 = 1 + t80
-    t83 = c1*s1
-    t84 = -t34*t42 - t54*t56 + t55*t57 + t71*t83
-    t85 = -t83 + t13*t19 + t15*t21 + t31*t39 + t4*t8
-    t86 = c1*t43
-    t87 = t54*t44 + t55*t45 - t53*t86
-    t88 = t19*t45 + t86 - t8*t44
-    t89 = t53*t83
-    t90 = t89 + t13*t55 - t4*t54
-    t91 = -t89 + t19*t57 + t8*t56
-    t92 = s1*t43
-    t93 = t56*t44 - t57*t45 + t53*t92
-    t94 = -t13*t45 + t92 + t4*t44
-    t95 = damping**2
-    t96 = _symmetric_solve6(xp, 1, (t95 + t73, t84, t87, -t90, t70, -t58, t95 + t77, -t93, -t75, -t91, t59, t63 + t95, t94, -t88, -t46, t78 + t95, t85, t60, t79 + t95, t61, t95 + t82, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
-    t97 = t96[5]
-    t98 = t96[0]
-    t99 = t96[1]
-    t100 = t97 - t42*t98 + t34*t99
-    t101 = c1*t53
-    t102 = s1*t53
-    t103 = t96[2]
-    t104 = t96[3]
-    t105 = t96[4]
-    t106 = t98*t101 + t99*t102 - t43*t103 - s1*t104 + c1*t105
-    t107 = t54*t98 - t56*t99 + t44*t103 - t0*t97 + t4*t104 + t8*t105
-    t108 = t55*t98 + t57*t99 + t45*t103 - t13*t104 - t19*t105 - t24*t97
-    t109 = t15*t104 + t21*t105 - t26*t97
-    t110 = t39*t105 + t31*t104 + t51*t97
-    t111 = xp.greater(t67, 0)
-    t112 = xp.where(t111, 1 + xp.abs(t42)/t67, 0)
-    t113 = -t42
-    t114 = xp.where(t111, 1/(t113 + t68), 0)
-    t115 = t34*t114
-    t116 = -t112*(t101 + t102*t115)
-    t117 = t101 + t116
-    t118 = t102 + t115*t116
-    t119 = -t112*(-t54 + t0*t114 + t56*t115)
-    t120 = -t119 + t54
-    t121 = t112*(t55 - t24*t114 + t57*t115)
-    t122 = -t121 + t55
-    t123 = t112*(mu_dot0 + mu_dot5*t114 + t115*mu_dot1)
-    t124 = -t123 + mu_dot0
-    t125 = t114*t119
-    t126 = t56 + t34*t125
-    t127 = t0 + t125
-    t128 = t114*t121
-    t129 = t57 - t34*t128
-    t130 = t24 + t128
-    t131 = t114**2
-    t132 = xp.sqrt(t62 + t69 + t74 + t118**2 + t131*t116**2)
-    t133 = t132*xp.where(xp.less_equal(t118, 0), xp.asarray(1, dtype=dtype), -1)
-    t134 = t131*t112
-    t135 = t26*t134
-    t136 = t34*t135
-    t137 = -t135 + t26
-    t138 = t51*t134
-    t139 = t34*t138
-    t140 = -t51
-    t141 = t138 + t140
-    t142 = t114*t123
-    t143 = mu_dot1 - t34*t142
-    t144 = -t142 + mu_dot5
-    t145 = xp.greater(t132, 0)
-    t146 = xp.where(t145, 1/(-t118 + t133), 0)
-    t147 = xp.where(t145, 1 + xp.abs(t118)/t132, 0)
-    t148 = t43*t146
-    t149 = s1*t146
-    t150 = c1*t146
-    t151 = t114*t116*t146
-    t152 = t147*(-t126 + t44*t148 + t151*t127 + t4*t149 - t8*t150)
-    t153 = t126 + t152
-    t154 = t44 - t148*t152
-    t155 = t4 - t149*t152
-    t156 = t8 + t150*t152
-    t157 = -t127 + t151*t152
-    t158 = t147*(t129 + t45*t148 - t13*t149 + t19*t150 + t151*t130)
-    t159 = -t158 + t129
-    t160 = t45 - t148*t158
-    t161 = t13 + t149*t158
-    t162 = -t130 + t151*t158
-    t163 = -t147*(t136 + t15*t149 - t21*t150 + t151*t137)
-    t164 = t136 + t163
-    t165 = t15 + t149*t163
-    t166 = t137 + t151*t163
-    t167 = t147*(t139 - t31*t149 + t39*t150 - t151*t141)
-    t168 = -t167 + t139
-    t169 = t31 + t149*t167
-    t170 = t141 + t151*t167
-    t171 = t147*(t143 + t148*mu_dot2 + t149*mu_dot3 - t150*mu_dot4 - t151*t144)
-    t172 = -t171 + t143
-    t173 = mu_dot2 - t148*t171
-    t174 = mu_dot3 - t149*t171
-    t175 = mu_dot4 + t150*t171
-    t176 = t144 + t151*t171
-    t177 = xp.sqrt(t154**2 + t155**2 + t156**2 + t157**2)
-    t178 = t177*xp.where(xp.greater_equal(t154, 0), xp.asarray(1, dtype=dtype), -1)
-    t179 = -t19
-    t180 = t179 + t150*t158
-    t181 = -t21
-    t182 = t181 + t150*t163
-    t183 = -t39
-    t184 = t183 + t150*t167
-    t185 = 1 - t56 - t13 - t15 - t31 - c1 - t0 - t24 - t101 - t102 + q1 + q2 + s1 + q3 + q4 + t26 + q5 + q6 + t34 + t4 + t8 + t54 + t55 + t57 + t43 + t44 + t45 + t113 + t140 + t179 + t181 + t183 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t186 = xp.greater(t177, 0)
-    t187 = xp.where(t186, 1/(t154 + t178), 0)
-    t188 = xp.where(t186, 1 + xp.abs(t154)/t177, 0)
-    t189 = t155*t187
-    t190 = t156*t187
-    t191 = t157*t187
-    t192 = t188*(t160 - t189*t161 + t190*t180 + t191*t162)
-    t193 = -t192 + t160
-    t194 = t161 + t189*t192
-    t195 = t180 - t190*t192
-    t196 = t162 - t191*t192
-    t197 = t188*(t173 + t189*t174 + t190*t175 + t191*t176)
-    t198 = -t197 + t173
-    t199 = t174 - t189*t197
-    t200 = t175 - t190*t197
-    t201 = t176 - t191*t197
-    t202 = xp.sqrt(t194**2 + t195**2 + t196**2)
-    t203 = t202*xp.where(xp.less_equal(t194, 0), xp.asarray(1, dtype=dtype), -1)
-    t204 = t148*t163
-    t205 = t188*(-t204 - t189*t165 + t190*t182 + t191*t166)
-    t206 = t204 + t205
-    t207 = t165 + t189*t205
-    t208 = t182 - t190*t205
-    t209 = t166 - t191*t205
-    t210 = t148*t167
-    t211 = t188*(-t210 - t189*t169 + t190*t184 + t191*t170)
-    t212 = t210 + t211
-    t213 = t169 + t189*t211
-    t214 = t184 - t190*t211
-    t215 = t170 - t191*t211
-    t216 = xp.greater(t202, 0)
-    t217 = xp.where(t216, 1/(-t194 + t203), 0)
-    t218 = xp.where(t216, 1 + xp.abs(t194)/t202, 0)
-    t219 = t195*t217
-    t220 = t196*t217
-    t221 = t218*(-t207 + t219*t208 + t220*t209)
-    t222 = t207 + t221
-    t223 = t208 - t219*t221
-    t224 = t209 - t220*t221
-    t225 = t218*(-t213 + t219*t214 + t220*t215)
-    t226 = t213 + t225
-    t227 = t214 - t219*t225
-    t228 = t215 - t220*t225
-    t229 = t218*(t199 + t219*t200 + t220*t201)
-    t230 = -t229 + t199
-    t231 = t200 - t219*t229
-    t232 = t201 - t220*t229
-    t233 = xp.sqrt(t223**2 + t224**2)
-    t234 = t233*xp.where(xp.greater_equal(t223, 0), xp.asarray(1, dtype=dtype), -1)
-    t235 = xp.greater(t233, 0)
-    t236 = xp.where(t235, 1/(t223 + t234), 0)
-    t237 = xp.where(t235, 1 + xp.abs(t223)/t233, 0)
-    t238 = t224*t236
-    t239 = t237*(t227 + t238*t228)
-    t240 = -t239 + t227
-    t241 = t228 - t238*t239
-    t242 = t237*(t231 + t238*t232)
-    t243 = -t242 + t231
-    t244 = t232 - t238*t242
-    t245 = xp.abs(t241)
-    t246 = t245*xp.where(xp.greater_equal(t241, 0), xp.asarray(1, dtype=dtype), -1)
-    t247 = xp.where(xp.greater(t245, 0), xp.asarray(2, dtype=dtype), 0)
-    t248 = t244 - t244*t247
-    t249 = xp.where(xp.not_equal(t246, 0), -t248/t246, 0)
-    t250 = xp.where(xp.not_equal(t234, 0), -(t243 - t240*t249)/t234, 0)
-    t251 = xp.where(xp.not_equal(t203, 0), -(t230 + t222*t250 + t226*t249)/t203, 0)
-    t252 = xp.where(xp.not_equal(t178, 0), -(t198 + t206*t250 + t212*t249 - t193*t251)/t178, 0)
-    t253 = xp.where(xp.not_equal(t133, 0), -(-(-t153*t252 + t159*t251 - t164*t250 + t168*t249) + t172)/t133, 0)
-    t254 = t114*t112
-    t255 = xp.where(xp.not_equal(t68, 0), -(-(-t117*t253 + t120*t252 + t122*t251 - t26*t254*t250 + t51*t254*t249) + t124)/t68, 0)
-    t256 = xp.isfinite(t185)
-    t257 = xp.greater_equal(damping, 0)
-    t258 = xp.greater(damping, 0)
-    t259 = 1e-12*t81
-    t260 = (t258 & xp.greater(t96[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t67, t259) | xp.less_equal(t132, t259) | xp.less_equal(t177, t259) | xp.less_equal(t202, t259) | xp.less_equal(t233, t259) | xp.less_equal(t245, t259)))
-    t261 = t256 & t257 & xp.logical_not(t260)
+    c6 = trig[..., 10]
+    s6 = trig[..., 11]
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t261, xp.where(t258, t100, t255), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t261, xp.where(t258, -t106, t253), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t261, xp.where(t258, t107, t252), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t261, xp.where(t258, t108, t251), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t261, xp.where(t258, -t109, t250), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t261, xp.where(t258, -t110, t249), 0), batch),  # 5
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
+        xp.broadcast_to(t0[4], batch),  # 4
+        xp.broadcast_to(t0[5], batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t256 & t257), 2, xp.where(t260, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[6], batch), xp.int32)
     return q_dot, status
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1350 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("z", z, (6,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
     mu_dot3 = mu_dot[..., 3]
     mu_dot4 = mu_dot[..., 4]
     mu_dot5 = mu_dot[..., 5]
-    qz1 = z[..., 0]
-    qz2 = z[..., 1]
-    qz3 = z[..., 2]
-    qz4 = z[..., 3]
-    qz5 = z[..., 4]
-    qz6 = z[..., 5]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
@@ -4389,290 +4353,25 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = 0.01745240643728351*c2
-    t1 = 0.0034904812874567027*c2
-    t2 = 0.9998476951563913*s1
-    t3 = 0.01745240643728351*c1
-    t4 = t2 + s2*t3
-    t5 = 0.2*t4
-    t6 = 0.9998476951563913*c1
-    t7 = 0.01745240643728351*s1
-    t8 = -t6 + s2*t7
-    t9 = 0.2*t8
-    t10 = t7 - s2*t6
-    t11 = c1*c2
-    t12 = s3*t10 + c3*t11
-    t13 = c3*t10 - s3*t11
-    t14 = -t12*s4 + c4*t4
-    t15 = 0.9998476951563913*t13 + 0.01745240643728351*t14
-    t16 = -(t3 + s2*t2)
-    t17 = c2*s1
-    t18 = s3*t16 + c3*t17
-    t19 = c3*t16 - s3*t17
-    t20 = -t18*s4 + c4*t8
-    t21 = 0.9998476951563913*t19 + 0.01745240643728351*t20
-    t22 = 0.9998476951563913*c2
-    t23 = s2*c3 + s3*t22
-    t24 = -s2*s3 + c3*t22
-    t25 = t0*c4 + t23*s4
-    t26 = 0.01745240643728351*t25 - 0.9998476951563913*t24
-    t27 = t12*c4
-    t28 = s4*t4
-    t29 = t27 + t28
-    t30 = 1.5*t27 + 1.5*t28
-    t31 = (0.9998476951563913*t14 - 0.01745240643728351*t13)*c5 - t29*s5
-    t32 = t5 + t30
-    t33 = t32 + t11
-    t34 = 0.3*c1 + t33
-    t35 = t18*c4
-    t36 = s4*t8
-    t37 = t35 + t36
-    t38 = 1.5*t35 + 1.5*t36
-    t39 = (0.9998476951563913*t20 - 0.01745240643728351*t19)*c5 - t37*s5
-    t40 = t9 + t38
-    t41 = t40 + t17
-    t42 = 0.3*s1 + t41
-    t43 = c1*t33 + s1*t41
-    t44 = t40*t4 - t32*t8
-    t45 = t19*t30 - t13*t38
-    t46 = t0*t44 + t24*t45
-    t47 = t23*c4
-    t48 = t0*s4
-    t49 = -t48 + t47
-    t50 = 1.5*t47 - 1.5*t48
-    t51 = -t49*s5 - (0.9998476951563913*t25 + 0.01745240643728351*t24)*c5
-    t52 = -t1 + t50
-    t53 = s2 + t52
-    t54 = t0*t40 + t52*t8
-    t55 = t24*t38 - t19*t50
-    t56 = t0*t32 + t52*t4
-    t57 = t13*t50 - t24*t30
-    t58 = t42 + t0*t54 + t24*t55
-    t59 = t34 + t0*t56 - t24*t57
-    t60 = t13*t24 - t15*t26 + t31*t51 - t0*t4
-    t61 = t19*t24 - t21*t26 + t39*t51 - t0*t8
-    t62 = t43**2
-    t63 = t62 + t44**2 + t45**2
-    t64 = t34**2
-    t65 = t42**2
-    t66 = 1 + t64 + t65
-    t67 = xp.sqrt(t66)
-    t68 = xp.where(xp.less_equal(t42, 0), xp.asarray(1, dtype=dtype), -1)*t67
-    t69 = c1**2
-    t70 = -t19*t55 + t53*t69 + t8*t54
-    t71 = t53**2
-    t72 = t54**2 + t55**2 + t69*t71
-    t73 = t65 + t72
-    t74 = s1**2
-    t75 = t13*t57 + t4*t56 + t53*t74
-    t76 = t56**2 + t57**2 + t71*t74
-    t77 = t64 + t76
-    t78 = t13**2 + t15**2 + t31**2 + t4**2 + t74
-    t79 = t19**2 + t21**2 + t39**2 + t8**2 + t69
-    t80 = t0**2 + t24**2 + t26**2 + t51**2
-    t81 = xp.sqrt(t63 + t66 + t72 + t76 + t78 + t79 + t80)
-    t82 = 1 + t80
-    t83 = c1*s1
-    t84 = -t34*t42 - t54*t56 + t55*t57 + t71*t83
-    t85 = -t83 + t13*t19 + t15*t21 + t31*t39 + t4*t8
-    t86 = c1*t43
-    t87 = t54*t44 + t55*t45 - t53*t86
-    t88 = t19*t45 + t86 - t8*t44
-    t89 = t53*t83
-    t90 = t89 + t13*t55 - t4*t54
-    t91 = -t89 + t19*t57 + t8*t56
-    t92 = s1*t43
-    t93 = t56*t44 - t57*t45 + t53*t92
-    t94 = -t13*t45 + t92 + t4*t44
-    t95 = damping**2
-    t96 = _symmetric_solve6(xp, 1, (t95 + t73, t84, t87, -t90, t70, -t58, t95 + t77, -t93, -t75, -t91, t59, t63 + t95, t94, -t88, -t46, t78 + t95, t85, t60, t79 + t95, t61, t95 + t82, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
-    t97 = t96[5]
-    t98 = t96[0]
-    t99 = t96[1]
-    t100 = t97 - t42*t98 + t34*t99
-    t101 = c1*t53
-    t102 = s1*t53
-    t103 = t96[2]
-    t104 = t96[3]
-    t105 = t96[4]
-    t106 = t98*t101 + t99*t102 - t43*t103 - s1*t104 + c1*t105
-    t107 = t54*t98 - t56*t99 + t44*t103 - t0*t97 + t4*t104 + t8*t105
-    t108 = t55*t98 + t57*t99 + t45*t103 - t13*t104 - t19*t105 - t24*t97
-    t109 = t15*t104 + t21*t105 - t26*t97
-    t110 = t39*t105 + t31*t104 + t51*t97
-    t111 = xp.greater(t67, 0)
-    t112 = xp.where(t111, 1 + xp.abs(t42)/t67, 0)
-    t113 = -t42
-    t114 = xp.where(t111, 1/(t113 + t68), 0)
-    t115 = t34*t114
-    t116 = -t112*(t101 + t102*t115)
-    t117 = t101 + t116
-    t118 = t102 + t115*t116
-    t119 = -t112*(-t54 + t0*t114 + t56*t115)
-    t120 = -t119 + t54
-    t121 = t112*(t55 - t24*t114 + t57*t115)
-    t122 = -t121 + t55
-    t123 = t112*(mu_dot0 + mu_dot5*t114 + t115*mu_dot1)
-    t124 = -t123 + mu_dot0
-    t125 = t114*t119
-    t126 = t56 + t34*t125
-    t127 = t0 + t125
-    t128 = t114*t121
-    t129 = t57 - t34*t128
-    t130 = t24 + t128
-    t131 = t114**2
-    t132 = xp.sqrt(t62 + t69 + t74 + t118**2 + t131*t116**2)
-    t133 = t132*xp.where(xp.less_equal(t118, 0), xp.asarray(1, dtype=dtype), -1)
-    t134 = t131*t112
-    t135 = t26*t134
-    t136 = t34*t135
-    t137 = -t135 + t26
-    t138 = t51*t134
-    t139 = t34*t138
-    t140 = -t51
-    t141 = t138 + t140
-    t142 = t114*t123
-    t143 = mu_dot1 - t34*t142
-    t144 = -t142 + mu_dot5
-    t145 = xp.greater(t132, 0)
-    t146 = xp.where(t145, 1/(-t118 + t133), 0)
-    t147 = xp.where(t145, 1 + xp.abs(t118)/t132, 0)
-    t148 = t43*t146
-    t149 = s1*t146
-    t150 = c1*t146
-    t151 = t114*t116*t146
-    t152 = t147*(-t126 + t44*t148 + t151*t127 + t4*t149 - t8*t150)
-    t153 = t126 + t152
-    t154 = t44 - t148*t152
-    t155 = t4 - t149*t152
-    t156 = t8 + t150*t152
-    t157 = -t127 + t151*t152
-    t158 = t147*(t129 + t45*t148 - t13*t149 + t19*t150 + t151*t130)
-    t159 = -t158 + t129
-    t160 = t45 - t148*t158
-    t161 = t13 + t149*t158
-    t162 = -t130 + t151*t158
-    t163 = -t147*(t136 + t15*t149 - t21*t150 + t151*t137)
-    t164 = t136 + t163
-    t165 = t15 + t149*t163
-    t166 = t137 + t151*t163
-    t167 = t147*(t139 - t31*t149 + t39*t150 - t151*t141)
-    t168 = -t167 + t139
-    t169 = t31 + t149*t167
-    t170 = t141 + t151*t167
-    t171 = t147*(t143 + t148*mu_dot2 + t149*mu_dot3 - t150*mu_dot4 - t151*t144)
-    t172 = -t171 + t143
-    t173 = mu_dot2 - t148*t171
-    t174 = mu_dot3 - t149*t171
-    t175 = mu_dot4 + t150*t171
-    t176 = t144 + t151*t171
-    t177 = xp.sqrt(t154**2 + t155**2 + t156**2 + t157**2)
-    t178 = t177*xp.where(xp.greater_equal(t154, 0), xp.asarray(1, dtype=dtype), -1)
-    t179 = -t19
-    t180 = t179 + t150*t158
-    t181 = -t21
-    t182 = t181 + t150*t163
-    t183 = -t39
-    t184 = t183 + t150*t167
-    t185 = 1 - t56 - t13 - t15 - t31 - c1 - t0 - t24 - t101 - t102 + q1 + q2 + s1 + q3 + q4 + t26 + q5 + q6 + t34 + t4 + t8 + t54 + t55 + t57 + t43 + t44 + t45 + t113 + t140 + t179 + t181 + t183 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6
-    t186 = xp.greater(t177, 0)
-    t187 = xp.where(t186, 1/(t154 + t178), 0)
-    t188 = xp.where(t186, 1 + xp.abs(t154)/t177, 0)
-    t189 = t155*t187
-    t190 = t156*t187
-    t191 = t157*t187
-    t192 = t188*(t160 - t189*t161 + t190*t180 + t191*t162)
-    t193 = -t192 + t160
-    t194 = t161 + t189*t192
-    t195 = t180 - t190*t192
-    t196 = t162 - t191*t192
-    t197 = t188*(t173 + t189*t174 + t190*t175 + t191*t176)
-    t198 = -t197 + t173
-    t199 = t174 - t189*t197
-    t200 = t175 - t190*t197
-    t201 = t176 - t191*t197
-    t202 = xp.sqrt(t194**2 + t195**2 + t196**2)
-    t203 = t202*xp.where(xp.less_equal(t194, 0), xp.asarray(1, dtype=dtype), -1)
-    t204 = t148*t163
-    t205 = t188*(-t204 - t189*t165 + t190*t182 + t191*t166)
-    t206 = t204 + t205
-    t207 = t165 + t189*t205
-    t208 = t182 - t190*t205
-    t209 = t166 - t191*t205
-    t210 = t148*t167
-    t211 = t188*(-t210 - t189*t169 + t190*t184 + t191*t170)
-    t212 = t210 + t211
-    t213 = t169 + t189*t211
-    t214 = t184 - t190*t211
-    t215 = t170 - t191*t211
-    t216 = xp.greater(t202, 0)
-    t217 = xp.where(t216, 1/(-t194 + t203), 0)
-    t218 = xp.where(t216, 1 + xp.abs(t194)/t202, 0)
-    t219 = t195*t217
-    t220 = t196*t217
-    t221 = t218*(-t207 + t219*t208 + t220*t209)
-    t222 = t207 + t221
-    t223 = t208 - t219*t221
-    t224 = t209 - t220*t221
-    t225 = t218*(-t213 + t219*t214 + t220*t215)
-    t226 = t213 + t225
-    t227 = t214 - t219*t225
-    t228 = t215 - t220*t225
-    t229 = t218*(t199 + t219*t200 + t220*t201)
-    t230 = -t229 + t199
-    t231 = t200 - t219*t229
-    t232 = t201 - t220*t229
-    t233 = xp.sqrt(t223**2 + t224**2)
-    t234 = t233*xp.where(xp.greater_equal(t223, 0), xp.asarray(1, dtype=dtype), -1)
-    t235 = xp.greater(t233, 0)
-    t236 = xp.where(t235, 1/(t223 + t234), 0)
-    t237 = xp.where(t235, 1 + xp.abs(t223)/t233, 0)
-    t238 = t224*t236
-    t239 = t237*(t227 + t238*t228)
-    t240 = -t239 + t227
-    t241 = t228 - t238*t239
-    t242 = t237*(t231 + t238*t232)
-    t243 = -t242 + t231
-    t244 = t232 - t238*t242
-    t245 = xp.abs(t241)
-    t246 = t245*xp.where(xp.greater_equal(t241, 0), xp.asarray(1, dtype=dtype), -1)
-    t247 = xp.where(xp.greater(t245, 0), xp.asarray(2, dtype=dtype), 0)
-    t248 = t244 - t244*t247
-    t249 = xp.where(xp.not_equal(t246, 0), -t248/t246, 0)
-    t250 = xp.where(xp.not_equal(t234, 0), -(t243 - t240*t249)/t234, 0)
-    t251 = xp.where(xp.not_equal(t203, 0), -(t230 + t222*t250 + t226*t249)/t203, 0)
-    t252 = xp.where(xp.not_equal(t178, 0), -(t198 + t206*t250 + t212*t249 - t193*t251)/t178, 0)
-    t253 = xp.where(xp.not_equal(t133, 0), -(-(-t153*t252 + t159*t251 - t164*t250 + t168*t249) + t172)/t133, 0)
-    t254 = t114*t112
-    t255 = xp.where(xp.not_equal(t68, 0), -(-(-t117*t253 + t120*t252 + t122*t251 - t26*t254*t250 + t51*t254*t249) + t124)/t68, 0)
-    t256 = xp.isfinite(t185)
-    t257 = xp.greater_equal(damping, 0)
-    t258 = xp.greater(damping, 0)
-    t259 = 1e-12*t81
-    t260 = (t258 & xp.greater(t96[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t67, t259) | xp.less_equal(t132, t259) | xp.less_equal(t177, t259) | xp.less_equal(t202, t259) | xp.less_equal(t233, t259) | xp.less_equal(t245, t259)))
-    t261 = t256 & t257 & xp.logical_not(t260)
+    c6 = trig[..., 10]
+    s6 = trig[..., 11]
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t261, xp.where(t258, t100, t255), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t261, xp.where(t258, -t106, t253), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t261, xp.where(t258, t107, t252), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t261, xp.where(t258, t108, t251), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t261, xp.where(t258, -t109, t250), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t261, xp.where(t258, -t110, t249), 0), batch),  # 5
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
+        xp.broadcast_to(t0[4], batch),  # 4
+        xp.broadcast_to(t0[5], batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t256 & t257), 2, xp.where(t260, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[6], batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1523 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1623 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (6,)), ("target", target, (4, 4)), ("target_rate", target_rate, (6,)), ("gain", gain, (6,)), ("z", z, (6,)), ("damping", damping, ()), every=("gain", ))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
     T02 = target[..., 0, 2]
@@ -4697,12 +4396,6 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     gain3 = gain[..., 3]
     gain4 = gain[..., 4]
     gain5 = gain[..., 5]
-    qz1 = z[..., 0]
-    qz2 = z[..., 1]
-    qz3 = z[..., 2]
-    qz4 = z[..., 3]
-    qz5 = z[..., 4]
-    qz6 = z[..., 5]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
@@ -4758,287 +4451,76 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t39 = t9 + t38
     t40 = t39 + t17
     t41 = 0.3*s1 + t40
-    t42 = c1*t32 + s1*t40
-    t43 = t39*t4 - t31*t8
-    t44 = t19*t30 - t13*t38
-    t45 = t0*t43 + t24*t44
-    t46 = t23*c4
-    t47 = t0*s4
-    t48 = -t47 + t46
-    t49 = 1.5*t46 - 1.5*t47
-    t50 = -t1 + t49
-    t51 = s2 + t50
-    t52 = t0*t39 + t50*t8
-    t53 = t24*t38 - t19*t49
-    t54 = t0*t31 + t50*t4
-    t55 = t13*t49 - t24*t30
-    t56 = t41 + t0*t52 + t24*t53
-    t57 = t33 + t0*t54 - t24*t55
-    t58 = mu_dot2 + gain2*(-t51 + T23)
-    t59 = 0.9998476951563913*t14 - 0.01745240643728351*t13
-    t60 = t29*c5 + s5*t59
-    t61 = -t29*s5 + c5*t59
-    t62 = t60*c6 - t15*s6
-    t63 = t15*c6 + t60*s6
-    t64 = 0.9998476951563913*t63 + 0.01745240643728351*t61
-    t65 = 0.01745240643728351*t63 - 0.9998476951563913*t61
-    t66 = t62*T00 - t64*T01 + t65*T02
-    t67 = t62*T10 - t64*T11 + t65*T12
-    t68 = t62*T20 - t64*T21 + t65*T22
-    t69 = 0.9998476951563913*t20 - 0.01745240643728351*t19
-    t70 = t37*c5 + s5*t69
-    t71 = -t37*s5 + c5*t69
-    t72 = t70*c6 - t21*s6
-    t73 = t21*c6 + t70*s6
-    t74 = 0.9998476951563913*t73 + 0.01745240643728351*t71
-    t75 = 0.01745240643728351*t73 - 0.9998476951563913*t71
-    t76 = t72*T00 - t74*T01 + t75*T02
-    t77 = t72*T10 - t74*T11 + t75*T12
-    t78 = t72*T20 - t74*T21 + t75*T22
-    t79 = 0.5*(-t76 + t67)
-    t80 = -(0.9998476951563913*t25 + 0.01745240643728351*t24)
-    t81 = t48*c5 + s5*t80
-    t82 = -t48*s5 + c5*t80
-    t83 = t26*s6 + t81*c6
-    t84 = t26*c6 - t81*s6
-    t85 = 0.9998476951563913*t84 - 0.01745240643728351*t82
-    t86 = 0.9998476951563913*t82 + 0.01745240643728351*t84
-    t87 = t13*t24 - t15*t26 + t61*t82 - t0*t4
-    t88 = t19*t24 - t21*t26 + t71*t82 - t0*t8
-    t89 = t83*T00 + t85*T01 - t86*T02
-    t90 = t83*T10 + t85*T11 - t86*T12
-    t91 = t83*T20 + t85*T21 - t86*T22
-    t92 = 0.5*(-t90 + t78)
-    t93 = 0.5*(-t68 + t89)
-    t94 = 0.5*(-1 + t66 + t77 + t91)
-    t95 = xp.sqrt(t92**2 + t93**2 + t79**2)
-    t96 = xp.atan2(t95, t94)
-    t97 = xp.where(xp.greater(t95, 0), t96/t95, 1)
-    t98 = t42**2
-    t99 = t98 + t43**2 + t44**2
-    t100 = t33**2
-    t101 = t41**2
-    t102 = 1 + t100 + t101
-    t103 = xp.sqrt(t102)
-    t104 = xp.where(xp.less_equal(t41, 0), xp.asarray(1, dtype=dtype), -1)*t103
-    t105 = c1**2
-    t106 = -t19*t53 + t8*t52 + t51*t105
-    t107 = t51**2
-    t108 = t52**2 + t53**2 + t105*t107
-    t109 = t101 + t108
-    t110 = s1**2
-    t111 = t13*t55 + t51*t110 + t4*t54
-    t112 = t54**2 + t55**2 + t107*t110
-    t113 = t100 + t112
-    t114 = t13**2 + t15**2 + t61**2 + t4**2 + t110
-    t115 = t19**2 + t21**2 + t71**2 + t8**2 + t105
-    t116 = t0**2 + t24**2 + t26**2 + t82**2
-    t117 = xp.sqrt(t99 + t102 + t108 + t112 + t114 + t115 + t116)
-    t118 = 1 + t116
-    t119 = c1*s1
-    t120 = -t33*t41 - t52*t54 + t53*t55 + t107*t119
-    t121 = -t119 + t13*t19 + t15*t21 + t61*t71 + t4*t8
-    t122 = c1*t42
-    t123 = t52*t43 + t53*t44 - t51*t122
-    t124 = t19*t44 + t122 - t8*t43
-    t125 = t51*t119
-    t126 = t125 + t13*t53 - t4*t52
-    t127 = -t125 + t19*t55 + t8*t54
-    t128 = s1*t42
-    t129 = t54*t43 - t55*t44 + t51*t128
-    t130 = -t13*t44 + t128 + t4*t43
-    t131 = xp.greater(t103, 0)
-    t132 = xp.where(t131, 1 + xp.abs(t41)/t103, 0)
-    t133 = -t41
-    t134 = xp.where(t131, 1/(t133 + t104), 0)
-    t135 = mu_dot1 + gain1*(t133 + T13)
-    t136 = c1*t51
-    t137 = s1*t51
-    t138 = t33*t134
-    t139 = -t132*(t136 + t137*t138)
-    t140 = t136 + t139
-    t141 = t137 + t138*t139
-    t142 = -t132*(-t52 + t0*t134 + t54*t138)
-    t143 = -t142 + t52
-    t144 = t132*(t53 - t24*t134 + t55*t138)
-    t145 = -t144 + t53
-    t146 = t134*t142
-    t147 = t54 + t33*t146
-    t148 = t0 + t146
-    t149 = t134*t144
-    t150 = t55 - t33*t149
-    t151 = t24 + t149
-    t152 = t134**2
-    t153 = xp.sqrt(t98 + t105 + t110 + t141**2 + t152*t139**2)
-    t154 = t153*xp.where(xp.less_equal(t141, 0), xp.asarray(1, dtype=dtype), -1)
-    t155 = t152*t132
-    t156 = t26*t155
-    t157 = t33*t156
-    t158 = -t156 + t26
-    t159 = t82*t155
-    t160 = t33*t159
-    t161 = -t82
-    t162 = t159 + t161
-    t163 = xp.greater(t153, 0)
-    t164 = xp.where(t163, 1/(-t141 + t154), 0)
-    t165 = xp.where(t163, 1 + xp.abs(t141)/t153, 0)
-    t166 = t42*t164
-    t167 = s1*t164
-    t168 = c1*t164
-    t169 = t134*t139*t164
-    t170 = t165*(-t147 + t43*t166 + t169*t148 + t4*t167 - t8*t168)
-    t171 = t147 + t170
-    t172 = t43 - t166*t170
-    t173 = t4 - t167*t170
-    t174 = t8 + t168*t170
-    t175 = -t148 + t169*t170
-    t176 = t165*(t150 + t44*t166 - t13*t167 + t19*t168 + t169*t151)
-    t177 = -t176 + t150
-    t178 = t44 - t166*t176
-    t179 = t13 + t167*t176
-    t180 = -t151 + t169*t176
-    t181 = -t165*(t157 + t15*t167 - t21*t168 + t169*t158)
-    t182 = t157 + t181
-    t183 = t15 + t167*t181
-    t184 = t158 + t169*t181
-    t185 = t165*(t160 - t61*t167 + t71*t168 - t169*t162)
-    t186 = -t185 + t160
-    t187 = t61 + t167*t185
-    t188 = t162 + t169*t185
-    t189 = xp.sqrt(t172**2 + t173**2 + t174**2 + t175**2)
-    t190 = t189*xp.where(xp.greater_equal(t172, 0), xp.asarray(1, dtype=dtype), -1)
-    t191 = -t19
-    t192 = t191 + t168*t176
-    t193 = -t21
-    t194 = t193 + t168*t181
-    t195 = -t71
-    t196 = t195 + t168*t185
-    t197 = xp.greater(t189, 0)
-    t198 = xp.where(t197, 1/(t172 + t190), 0)
-    t199 = xp.where(t197, 1 + xp.abs(t172)/t189, 0)
-    t200 = t173*t198
-    t201 = t174*t198
-    t202 = t175*t198
-    t203 = t199*(t178 - t200*t179 + t201*t192 + t202*t180)
-    t204 = -t203 + t178
-    t205 = t179 + t200*t203
-    t206 = t192 - t201*t203
-    t207 = t180 - t202*t203
-    t208 = xp.sqrt(t205**2 + t206**2 + t207**2)
-    t209 = t208*xp.where(xp.less_equal(t205, 0), xp.asarray(1, dtype=dtype), -1)
-    t210 = t166*t181
-    t211 = t199*(-t210 - t200*t183 + t201*t194 + t202*t184)
-    t212 = t210 + t211
-    t213 = t183 + t200*t211
-    t214 = t194 - t201*t211
-    t215 = t184 - t202*t211
-    t216 = t166*t185
-    t217 = t199*(-t216 - t200*t187 + t201*t196 + t202*t188)
-    t218 = t216 + t217
-    t219 = t187 + t200*t217
-    t220 = t196 - t201*t217
-    t221 = t188 - t202*t217
-    t222 = xp.greater(t208, 0)
-    t223 = xp.where(t222, 1/(-t205 + t209), 0)
-    t224 = xp.where(t222, 1 + xp.abs(t205)/t208, 0)
-    t225 = t206*t223
-    t226 = t207*t223
-    t227 = t224*(-t213 + t225*t214 + t226*t215)
-    t228 = t213 + t227
-    t229 = t214 - t225*t227
-    t230 = t215 - t226*t227
-    t231 = t224*(-t219 + t225*t220 + t226*t221)
-    t232 = t219 + t231
-    t233 = t220 - t225*t231
-    t234 = t221 - t226*t231
-    t235 = xp.sqrt(t229**2 + t230**2)
-    t236 = t235*xp.where(xp.greater_equal(t229, 0), xp.asarray(1, dtype=dtype), -1)
-    t237 = xp.greater(t235, 0)
-    t238 = xp.where(t237, 1/(t229 + t236), 0)
-    t239 = xp.where(t237, 1 + xp.abs(t229)/t235, 0)
-    t240 = t230*t238
-    t241 = t239*(t233 + t240*t234)
-    t242 = -t241 + t233
-    t243 = t234 - t240*t241
-    t244 = xp.abs(t243)
-    t245 = t244*xp.where(xp.greater_equal(t243, 0), xp.asarray(1, dtype=dtype), -1)
-    t246 = xp.where(xp.greater(t244, 0), xp.asarray(2, dtype=dtype), 0)
-    t247 = xp.greater_equal(t66, t77) & xp.greater_equal(t66, t91)
-    t248 = xp.greater_equal(t77, t91)
-    t249 = xp.where(t247, 0.5*(1 + t66), xp.where(t248, 0.5*t76, 0.5*t89))
-    t250 = xp.where(t247, 0.5*t67, xp.where(t248, 0.5*(1 + t77), 0.5*t90))
-    t251 = xp.where(t247, 0.5*t68, xp.where(t248, 0.5*t78, 0.5*(1 + t91)))
-    t252 = xp.sqrt(t249**2 + t250**2 + t251**2)
-    t253 = xp.where(xp.greater_equal(t92*t249 + t93*t250 + t79*t251, 0), xp.asarray(1, dtype=dtype), -1)
-    t254 = xp.greater(t95, 1e-06) | xp.greater(t94, 0)
-    t255 = t96*t253/t252
-    t256 = xp.where(t254, t92*t97, t255*t249)
-    t257 = xp.where(t254, t93*t97, t255*t250)
-    t258 = xp.where(t254, t79*t97, t255*t251)
-    t259 = mu_dot3 + t256*gain3
-    t260 = mu_dot4 + t257*gain4
-    t261 = mu_dot5 + t258*gain5
-    t262 = t132*(t34 + t134*t261 + t138*t135)
-    t263 = -t262 + t34
-    t264 = 1 - t54 - t13 - t15 - t61 - c1 - t0 - t24 - t136 - t137 + q1 + q2 + s1 + q3 + q4 + t26 + q5 + q6 + t33 + t4 + t8 + t52 + t53 + t55 + t42 + t43 + t44 + t133 + t161 + t191 + t193 + t195 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t34 + t135 + t58 + t259 + t260 + t261
-    t265 = damping**2
-    t266 = _symmetric_solve6(xp, 1, (t265 + t109, t120, t123, -t126, t106, -t56, t265 + t113, -t129, -t111, -t127, t57, t99 + t265, t130, -t124, -t45, t114 + t265, t121, t87, t115 + t265, t88, t265 + t118, t34, t135, t58, t259, t260, t261,))
-    t267 = t266[5]
-    t268 = t266[0]
-    t269 = t266[1]
-    t270 = t267 - t41*t268 + t33*t269
-    t271 = t266[2]
-    t272 = t266[3]
-    t273 = t266[4]
-    t274 = t136*t268 + t137*t269 - t42*t271 - s1*t272 + c1*t273
-    t275 = t52*t268 - t54*t269 + t43*t271 - t0*t267 + t4*t272 + t8*t273
-    t276 = t53*t268 + t55*t269 + t44*t271 - t13*t272 - t19*t273 - t24*t267
-    t277 = t15*t272 + t21*t273 - t26*t267
-    t278 = t61*t272 + t71*t273 + t82*t267
-    t279 = t134*t262
-    t280 = t135 - t33*t279
-    t281 = -t279 + t261
-    t282 = t165*(t280 + t166*t58 + t167*t259 - t168*t260 - t169*t281)
-    t283 = -t282 + t280
-    t284 = t58 - t166*t282
-    t285 = t259 - t167*t282
-    t286 = t260 + t168*t282
-    t287 = t281 + t169*t282
-    t288 = t199*(t284 + t200*t285 + t201*t286 + t202*t287)
-    t289 = -t288 + t284
-    t290 = t285 - t200*t288
-    t291 = t286 - t201*t288
-    t292 = t287 - t202*t288
-    t293 = t224*(t290 + t225*t291 + t226*t292)
-    t294 = -t293 + t290
-    t295 = t291 - t225*t293
-    t296 = t292 - t226*t293
-    t297 = t239*(t295 + t240*t296)
-    t298 = -t297 + t295
-    t299 = t296 - t240*t297
-    t300 = t299 - t246*t299
-    t301 = xp.where(xp.not_equal(t245, 0), -t300/t245, 0)
-    t302 = xp.where(xp.not_equal(t236, 0), -(t298 - t242*t301)/t236, 0)
-    t303 = xp.where(xp.not_equal(t209, 0), -(t294 + t228*t302 + t232*t301)/t209, 0)
-    t304 = xp.where(xp.not_equal(t190, 0), -(t289 + t212*t302 + t218*t301 - t204*t303)/t190, 0)
-    t305 = xp.where(xp.not_equal(t154, 0), -(-(-t171*t304 + t177*t303 - t182*t302 + t186*t301) + t283)/t154, 0)
-    t306 = t134*t132
-    t307 = xp.where(xp.not_equal(t104, 0), -(-(-t140*t305 + t143*t304 + t145*t303 - t26*t306*t302 + t82*t306*t301) + t263)/t104, 0)
-    t308 = xp.isfinite(t264)
-    t309 = xp.greater_equal(damping, 0)
-    t310 = xp.greater(damping, 0)
-    t311 = 1e-12*t117
-    t312 = (t310 & xp.greater(t266[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t103, t311) | xp.less_equal(t153, t311) | xp.less_equal(t189, t311) | xp.less_equal(t208, t311) | xp.less_equal(t235, t311) | xp.less_equal(t244, t311)))
-    t313 = t308 & t309 & xp.logical_not(t312)
+    t42 = mu_dot1 + gain1*(-t41 + T13)
+    t43 = t23*c4
+    t44 = t0*s4
+    t45 = -t44 + t43
+    t46 = 1.5*t43 - 1.5*t44
+    t47 = -t1 + t46
+    t48 = s2 + t47
+    t49 = mu_dot2 + gain2*(-t48 + T23)
+    t50 = 0.9998476951563913*t14 - 0.01745240643728351*t13
+    t51 = t29*c5 + s5*t50
+    t52 = -t29*s5 + c5*t50
+    t53 = t51*c6 - t15*s6
+    t54 = t15*c6 + t51*s6
+    t55 = 0.9998476951563913*t54 + 0.01745240643728351*t52
+    t56 = 0.01745240643728351*t54 - 0.9998476951563913*t52
+    t57 = t53*T00 - t55*T01 + t56*T02
+    t58 = t53*T10 - t55*T11 + t56*T12
+    t59 = t53*T20 - t55*T21 + t56*T22
+    t60 = 0.9998476951563913*t20 - 0.01745240643728351*t19
+    t61 = t37*c5 + s5*t60
+    t62 = -t37*s5 + c5*t60
+    t63 = t61*c6 - t21*s6
+    t64 = t21*c6 + t61*s6
+    t65 = 0.9998476951563913*t64 + 0.01745240643728351*t62
+    t66 = 0.01745240643728351*t64 - 0.9998476951563913*t62
+    t67 = t63*T00 - t65*T01 + t66*T02
+    t68 = t63*T10 - t65*T11 + t66*T12
+    t69 = t63*T20 - t65*T21 + t66*T22
+    t70 = 0.5*(-t67 + t58)
+    t71 = -(0.9998476951563913*t25 + 0.01745240643728351*t24)
+    t72 = t45*c5 + s5*t71
+    t73 = -t45*s5 + c5*t71
+    t74 = t26*s6 + t72*c6
+    t75 = t26*c6 - t72*s6
+    t76 = 0.9998476951563913*t75 - 0.01745240643728351*t73
+    t77 = 0.9998476951563913*t73 + 0.01745240643728351*t75
+    t78 = t74*T00 + t76*T01 - t77*T02
+    t79 = t74*T10 + t76*T11 - t77*T12
+    t80 = t74*T20 + t76*T21 - t77*T22
+    t81 = 0.5*(-t79 + t69)
+    t82 = 0.5*(-t59 + t78)
+    t83 = 0.5*(-1 + t57 + t68 + t80)
+    t84 = xp.sqrt(t81**2 + t82**2 + t70**2)
+    t85 = xp.atan2(t84, t83)
+    t86 = xp.where(xp.greater(t84, 0), t85/t84, 1)
+    t87 = xp.greater_equal(t57, t68) & xp.greater_equal(t57, t80)
+    t88 = xp.greater_equal(t68, t80)
+    t89 = xp.where(t87, 0.5*(1 + t57), xp.where(t88, 0.5*t67, 0.5*t78))
+    t90 = xp.where(t87, 0.5*t58, xp.where(t88, 0.5*(1 + t68), 0.5*t79))
+    t91 = xp.where(t87, 0.5*t59, xp.where(t88, 0.5*t69, 0.5*(1 + t80)))
+    t92 = xp.sqrt(t89**2 + t90**2 + t91**2)
+    t93 = xp.where(xp.greater_equal(t81*t89 + t82*t90 + t70*t91, 0), xp.asarray(1, dtype=dtype), -1)
+    t94 = xp.greater(t84, 1e-06) | xp.greater(t83, 0)
+    t95 = t85*t93/t92
+    t96 = xp.where(t94, t81*t86, t95*t89)
+    t97 = xp.where(t94, t82*t86, t95*t90)
+    t98 = xp.where(t94, t70*t86, t95*t91)
+    t99 = mu_dot3 + t96*gain3
+    t100 = mu_dot4 + t97*gain4
+    t101 = mu_dot5 + t98*gain5
+    t102 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, t34, t42, t49, t99, t100, t101, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t313, xp.where(t310, t270, t307), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t313, xp.where(t310, -t274, t305), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t313, xp.where(t310, t275, t304), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t313, xp.where(t310, t276, t303), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t313, xp.where(t310, -t277, t302), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t313, xp.where(t310, -t278, t301), 0), batch),  # 5
+        xp.broadcast_to(t102[0], batch),  # 0
+        xp.broadcast_to(t102[1], batch),  # 1
+        xp.broadcast_to(t102[2], batch),  # 2
+        xp.broadcast_to(t102[3], batch),  # 3
+        xp.broadcast_to(t102[4], batch),  # 4
+        xp.broadcast_to(t102[5], batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t308 & t309), 2, xp.where(t312, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t102[6], batch), xp.int32)
     return q_dot, status
 
 
@@ -6098,7 +5580,7 @@ def ik_general_limits(q_solution):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 1218 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 1219 operations."""
     xp, dtype, device, batch, (T, q_seed, weights,) = _arguments(("T", T, (4, 4)), ("q_seed", q_seed, (6,)), ("weights", weights, (6,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(T)
     T00 = T[..., 0, 0]
@@ -6253,35 +5735,310 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     lb13 = branches_in_limits[..., 13]
     lb14 = branches_in_limits[..., 14]
     lb15 = branches_in_limits[..., 15]
-    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
-    t1 = _nearer_branch(xp, 1, (qb0_0, qb0_1, qb0_2, qb0_3, qb0_4, qb0_5, xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, qn1, qn2, qn3, qn4, qn5, qn6, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
-    t2 = _nearer_branch(xp, 1, (qb1_0, qb1_1, qb1_2, qb1_3, qb1_4, qb1_5, xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t1[0], t1[1], t1[2], t1[3], t1[4], t1[5], t1[6], t1[7],))
-    t3 = _nearer_branch(xp, 1, (qb2_0, qb2_1, qb2_2, qb2_3, qb2_4, qb2_5, xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t2[0], t2[1], t2[2], t2[3], t2[4], t2[5], t2[6], t2[7],))
-    t4 = _nearer_branch(xp, 1, (qb3_0, qb3_1, qb3_2, qb3_3, qb3_4, qb3_5, xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t3[0], t3[1], t3[2], t3[3], t3[4], t3[5], t3[6], t3[7],))
-    t5 = _nearer_branch(xp, 1, (qb4_0, qb4_1, qb4_2, qb4_3, qb4_4, qb4_5, xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t4[0], t4[1], t4[2], t4[3], t4[4], t4[5], t4[6], t4[7],))
-    t6 = _nearer_branch(xp, 1, (qb5_0, qb5_1, qb5_2, qb5_3, qb5_4, qb5_5, xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t5[0], t5[1], t5[2], t5[3], t5[4], t5[5], t5[6], t5[7],))
-    t7 = _nearer_branch(xp, 1, (qb6_0, qb6_1, qb6_2, qb6_3, qb6_4, qb6_5, xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t6[0], t6[1], t6[2], t6[3], t6[4], t6[5], t6[6], t6[7],))
-    t8 = _nearer_branch(xp, 1, (qb7_0, qb7_1, qb7_2, qb7_3, qb7_4, qb7_5, xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t7[0], t7[1], t7[2], t7[3], t7[4], t7[5], t7[6], t7[7],))
-    t9 = _nearer_branch(xp, 1, (qb8_0, qb8_1, qb8_2, qb8_3, qb8_4, qb8_5, xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t8[0], t8[1], t8[2], t8[3], t8[4], t8[5], t8[6], t8[7],))
-    t10 = _nearer_branch(xp, 1, (qb9_0, qb9_1, qb9_2, qb9_3, qb9_4, qb9_5, xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t9[0], t9[1], t9[2], t9[3], t9[4], t9[5], t9[6], t9[7],))
-    t11 = _nearer_branch(xp, 1, (qb10_0, qb10_1, qb10_2, qb10_3, qb10_4, qb10_5, xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t10[0], t10[1], t10[2], t10[3], t10[4], t10[5], t10[6], t10[7],))
-    t12 = _nearer_branch(xp, 1, (qb11_0, qb11_1, qb11_2, qb11_3, qb11_4, qb11_5, xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t11[0], t11[1], t11[2], t11[3], t11[4], t11[5], t11[6], t11[7],))
-    t13 = _nearer_branch(xp, 1, (qb12_0, qb12_1, qb12_2, qb12_3, qb12_4, qb12_5, xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t12[0], t12[1], t12[2], t12[3], t12[4], t12[5], t12[6], t12[7],))
-    t14 = _nearer_branch(xp, 1, (qb13_0, qb13_1, qb13_2, qb13_3, qb13_4, qb13_5, xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t13[0], t13[1], t13[2], t13[3], t13[4], t13[5], t13[6], t13[7],))
-    t15 = _nearer_branch(xp, 1, (qb14_0, qb14_1, qb14_2, qb14_3, qb14_4, qb14_5, xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t14[0], t14[1], t14[2], t14[3], t14[4], t14[5], t14[6], t14[7],))
-    t16 = _nearer_branch(xp, 1, (qb15_0, qb15_1, qb15_2, qb15_3, qb15_4, qb15_5, xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t15[0], t15[1], t15[2], t15[3], t15[4], t15[5], t15[6], t15[7],))
-    t17 = xp.greater(t16[7], 0)
-    t18 = xp.isfinite(t0)
-    t19 = t17 & t18
+    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
+    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
+    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
+    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
+    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
+    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
+    t6 = xp.where(xp.greater(xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), 0), xp.asarray(1, dtype=dtype), 0)
+    t7 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
+    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
+    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
+    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
+    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
+    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
+    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
+    t14 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
+    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
+    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
+    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
+    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
+    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
+    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
+    t21 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
+    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
+    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
+    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
+    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
+    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
+    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
+    t28 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
+    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
+    t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
+    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
+    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
+    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
+    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
+    t35 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
+    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
+    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
+    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
+    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
+    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
+    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
+    t42 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
+    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
+    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
+    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
+    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
+    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
+    t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
+    t49 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_0 + qn1)) + qb8_0
+    t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_1 + qn2)) + qb8_1
+    t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_2 + qn3)) + qb8_2
+    t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_3 + qn4)) + qb8_3
+    t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_4 + qn5)) + qb8_4
+    t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_5 + qn6)) + qb8_5
+    t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_0 + qn1)) + qb9_0
+    t56 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_1 + qn2)) + qb9_1
+    t57 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_2 + qn3)) + qb9_2
+    t58 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_3 + qn4)) + qb9_3
+    t59 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_4 + qn5)) + qb9_4
+    t60 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_5 + qn6)) + qb9_5
+    t61 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_0 + qn1)) + qb10_0
+    t62 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_1 + qn2)) + qb10_1
+    t63 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_2 + qn3)) + qb10_2
+    t64 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_3 + qn4)) + qb10_3
+    t65 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_4 + qn5)) + qb10_4
+    t66 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_5 + qn6)) + qb10_5
+    t67 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_0 + qn1)) + qb11_0
+    t68 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_1 + qn2)) + qb11_1
+    t69 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_2 + qn3)) + qb11_2
+    t70 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_3 + qn4)) + qb11_3
+    t71 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_4 + qn5)) + qb11_4
+    t72 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_5 + qn6)) + qb11_5
+    t73 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_0 + qn1)) + qb12_0
+    t74 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_1 + qn2)) + qb12_1
+    t75 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_2 + qn3)) + qb12_2
+    t76 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_3 + qn4)) + qb12_3
+    t77 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_4 + qn5)) + qb12_4
+    t78 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_5 + qn6)) + qb12_5
+    t79 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_0 + qn1)) + qb13_0
+    t80 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_1 + qn2)) + qb13_1
+    t81 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_2 + qn3)) + qb13_2
+    t82 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_3 + qn4)) + qb13_3
+    t83 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_4 + qn5)) + qb13_4
+    t84 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_5 + qn6)) + qb13_5
+    t85 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_0 + qn1)) + qb14_0
+    t86 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_1 + qn2)) + qb14_1
+    t87 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_2 + qn3)) + qb14_2
+    t88 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_3 + qn4)) + qb14_3
+    t89 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_4 + qn5)) + qb14_4
+    t90 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_5 + qn6)) + qb14_5
+    t91 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_0 + qn1)) + qb15_0
+    t92 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_1 + qn2)) + qb15_1
+    t93 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_2 + qn3)) + qb15_2
+    t94 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_3 + qn4)) + qb15_3
+    t95 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_4 + qn5)) + qb15_4
+    t96 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_5 + qn6)) + qb15_5
+    t97 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
+    t98 = -qn1
+    t99 = -qn2
+    t100 = -qn3
+    t101 = -qn4
+    t102 = -qn5
+    t103 = -qn6
+    t104 = qw1*(t98 + t0)**2 + qw2*(t99 + t1)**2 + qw3*(t100 + t2)**2 + qw4*(t101 + t3)**2 + qw5*(t102 + t4)**2 + qw6*(t103 + t5)**2
+    t105 = qw1*(t98 + t7)**2 + qw2*(t99 + t8)**2 + qw3*(t100 + t9)**2 + qw4*(t101 + t10)**2 + qw5*(t102 + t11)**2 + qw6*(t103 + t12)**2
+    t106 = qw1*(t98 + t13)**2 + qw2*(t99 + t14)**2 + qw3*(t100 + t15)**2 + qw4*(t101 + t16)**2 + qw5*(t102 + t17)**2 + qw6*(t103 + t18)**2
+    t107 = qw1*(t98 + t19)**2 + qw2*(t99 + t20)**2 + qw3*(t100 + t21)**2 + qw4*(t101 + t22)**2 + qw5*(t102 + t23)**2 + qw6*(t103 + t24)**2
+    t108 = qw1*(t98 + t25)**2 + qw2*(t99 + t26)**2 + qw3*(t100 + t27)**2 + qw4*(t101 + t28)**2 + qw5*(t102 + t29)**2 + qw6*(t103 + t30)**2
+    t109 = qw1*(t98 + t31)**2 + qw2*(t99 + t32)**2 + qw3*(t100 + t33)**2 + qw4*(t101 + t34)**2 + qw5*(t102 + t35)**2 + qw6*(t103 + t36)**2
+    t110 = qw1*(t98 + t37)**2 + qw2*(t99 + t38)**2 + qw3*(t100 + t39)**2 + qw4*(t101 + t40)**2 + qw5*(t102 + t41)**2 + qw6*(t103 + t42)**2
+    t111 = qw1*(t98 + t43)**2 + qw2*(t99 + t44)**2 + qw3*(t100 + t45)**2 + qw4*(t101 + t46)**2 + qw5*(t102 + t47)**2 + qw6*(t103 + t48)**2
+    t112 = qw1*(t98 + t49)**2 + qw2*(t99 + t50)**2 + qw3*(t100 + t51)**2 + qw4*(t101 + t52)**2 + qw5*(t102 + t53)**2 + qw6*(t103 + t54)**2
+    t113 = qw1*(t98 + t55)**2 + qw2*(t99 + t56)**2 + qw3*(t100 + t57)**2 + qw4*(t101 + t58)**2 + qw5*(t102 + t59)**2 + qw6*(t103 + t60)**2
+    t114 = qw1*(t98 + t61)**2 + qw2*(t99 + t62)**2 + qw3*(t100 + t63)**2 + qw4*(t101 + t64)**2 + qw5*(t102 + t65)**2 + qw6*(t103 + t66)**2
+    t115 = qw1*(t98 + t67)**2 + qw2*(t99 + t68)**2 + qw3*(t100 + t69)**2 + qw4*(t101 + t70)**2 + qw5*(t102 + t71)**2 + qw6*(t103 + t72)**2
+    t116 = qw1*(t98 + t73)**2 + qw2*(t99 + t74)**2 + qw3*(t100 + t75)**2 + qw4*(t101 + t76)**2 + qw5*(t102 + t77)**2 + qw6*(t103 + t78)**2
+    t117 = qw1*(t98 + t79)**2 + qw2*(t99 + t80)**2 + qw3*(t100 + t81)**2 + qw4*(t101 + t82)**2 + qw5*(t102 + t83)**2 + qw6*(t103 + t84)**2
+    t118 = qw1*(t98 + t85)**2 + qw2*(t99 + t86)**2 + qw3*(t100 + t87)**2 + qw4*(t101 + t88)**2 + qw5*(t102 + t89)**2 + qw6*(t103 + t90)**2
+    t119 = qw1*(t98 + t91)**2 + qw2*(t99 + t92)**2 + qw3*(t100 + t93)**2 + qw4*(t101 + t94)**2 + qw5*(t102 + t95)**2 + qw6*(t103 + t96)**2
+    t120 = xp.greater(t6, 0)
+    t121 = xp.where(t120, t0, qn1)
+    t122 = xp.where(t120, t1, qn2)
+    t123 = xp.where(t120, t2, qn3)
+    t124 = xp.where(t120, t3, qn4)
+    t125 = xp.where(t120, t4, qn5)
+    t126 = xp.where(t120, t5, qn6)
+    t127 = xp.where(t120, t104, 0)
+    t128 = xp.greater(xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), 0)
+    t129 = xp.where(t128 & (xp.less(t6, 1) | xp.less(t105, t127)), xp.asarray(1, dtype=dtype), 0)
+    t130 = xp.where(t128, 1, t6)
+    t131 = xp.greater(t129, 0)
+    t132 = xp.where(t131, t7, t121)
+    t133 = xp.where(t131, t8, t122)
+    t134 = xp.where(t131, t9, t123)
+    t135 = xp.where(t131, t10, t124)
+    t136 = xp.where(t131, t11, t125)
+    t137 = xp.where(t131, t12, t126)
+    t138 = xp.where(t131, t105, t127)
+    t139 = xp.greater(xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0), 0)
+    t140 = xp.where(t139 & (xp.less(t130, 1) | xp.less(t106, t138)), xp.asarray(1, dtype=dtype), 0)
+    t141 = xp.where(t139, 1, t130)
+    t142 = xp.greater(t140, 0)
+    t143 = xp.where(t142, t13, t132)
+    t144 = xp.where(t142, t14, t133)
+    t145 = xp.where(t142, t15, t134)
+    t146 = xp.where(t142, t16, t135)
+    t147 = xp.where(t142, t17, t136)
+    t148 = xp.where(t142, t18, t137)
+    t149 = xp.where(t142, t106, t138)
+    t150 = xp.greater(xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0), 0)
+    t151 = xp.where(t150 & (xp.less(t141, 1) | xp.less(t107, t149)), xp.asarray(1, dtype=dtype), 0)
+    t152 = xp.where(t150, 1, t141)
+    t153 = xp.greater(t151, 0)
+    t154 = xp.where(t153, t19, t143)
+    t155 = xp.where(t153, t20, t144)
+    t156 = xp.where(t153, t21, t145)
+    t157 = xp.where(t153, t22, t146)
+    t158 = xp.where(t153, t23, t147)
+    t159 = xp.where(t153, t24, t148)
+    t160 = xp.where(t153, t107, t149)
+    t161 = xp.greater(xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0), 0)
+    t162 = xp.where(t161 & (xp.less(t152, 1) | xp.less(t108, t160)), xp.asarray(1, dtype=dtype), 0)
+    t163 = xp.where(t161, 1, t152)
+    t164 = xp.greater(t162, 0)
+    t165 = xp.where(t164, t25, t154)
+    t166 = xp.where(t164, t26, t155)
+    t167 = xp.where(t164, t27, t156)
+    t168 = xp.where(t164, t28, t157)
+    t169 = xp.where(t164, t29, t158)
+    t170 = xp.where(t164, t30, t159)
+    t171 = xp.where(t164, t108, t160)
+    t172 = xp.greater(xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0), 0)
+    t173 = xp.where(t172 & (xp.less(t163, 1) | xp.less(t109, t171)), xp.asarray(1, dtype=dtype), 0)
+    t174 = xp.where(t172, 1, t163)
+    t175 = xp.greater(t173, 0)
+    t176 = xp.where(t175, t31, t165)
+    t177 = xp.where(t175, t32, t166)
+    t178 = xp.where(t175, t33, t167)
+    t179 = xp.where(t175, t34, t168)
+    t180 = xp.where(t175, t35, t169)
+    t181 = xp.where(t175, t36, t170)
+    t182 = xp.where(t175, t109, t171)
+    t183 = xp.greater(xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0), 0)
+    t184 = xp.where(t183 & (xp.less(t174, 1) | xp.less(t110, t182)), xp.asarray(1, dtype=dtype), 0)
+    t185 = xp.where(t183, 1, t174)
+    t186 = xp.greater(t184, 0)
+    t187 = xp.where(t186, t37, t176)
+    t188 = xp.where(t186, t38, t177)
+    t189 = xp.where(t186, t39, t178)
+    t190 = xp.where(t186, t40, t179)
+    t191 = xp.where(t186, t41, t180)
+    t192 = xp.where(t186, t42, t181)
+    t193 = xp.where(t186, t110, t182)
+    t194 = xp.greater(xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0), 0)
+    t195 = xp.where(t194 & (xp.less(t185, 1) | xp.less(t111, t193)), xp.asarray(1, dtype=dtype), 0)
+    t196 = xp.where(t194, 1, t185)
+    t197 = xp.greater(t195, 0)
+    t198 = xp.where(t197, t43, t187)
+    t199 = xp.where(t197, t44, t188)
+    t200 = xp.where(t197, t45, t189)
+    t201 = xp.where(t197, t46, t190)
+    t202 = xp.where(t197, t47, t191)
+    t203 = xp.where(t197, t48, t192)
+    t204 = xp.where(t197, t111, t193)
+    t205 = xp.greater(xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0), 0)
+    t206 = xp.where(t205 & (xp.less(t196, 1) | xp.less(t112, t204)), xp.asarray(1, dtype=dtype), 0)
+    t207 = xp.where(t205, 1, t196)
+    t208 = xp.greater(t206, 0)
+    t209 = xp.where(t208, t49, t198)
+    t210 = xp.where(t208, t50, t199)
+    t211 = xp.where(t208, t51, t200)
+    t212 = xp.where(t208, t52, t201)
+    t213 = xp.where(t208, t53, t202)
+    t214 = xp.where(t208, t54, t203)
+    t215 = xp.where(t208, t112, t204)
+    t216 = xp.greater(xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0), 0)
+    t217 = xp.where(t216 & (xp.less(t207, 1) | xp.less(t113, t215)), xp.asarray(1, dtype=dtype), 0)
+    t218 = xp.where(t216, 1, t207)
+    t219 = xp.greater(t217, 0)
+    t220 = xp.where(t219, t55, t209)
+    t221 = xp.where(t219, t56, t210)
+    t222 = xp.where(t219, t57, t211)
+    t223 = xp.where(t219, t58, t212)
+    t224 = xp.where(t219, t59, t213)
+    t225 = xp.where(t219, t60, t214)
+    t226 = xp.where(t219, t113, t215)
+    t227 = xp.greater(xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0), 0)
+    t228 = xp.where(t227 & (xp.less(t218, 1) | xp.less(t114, t226)), xp.asarray(1, dtype=dtype), 0)
+    t229 = xp.where(t227, 1, t218)
+    t230 = xp.greater(t228, 0)
+    t231 = xp.where(t230, t61, t220)
+    t232 = xp.where(t230, t62, t221)
+    t233 = xp.where(t230, t63, t222)
+    t234 = xp.where(t230, t64, t223)
+    t235 = xp.where(t230, t65, t224)
+    t236 = xp.where(t230, t66, t225)
+    t237 = xp.where(t230, t114, t226)
+    t238 = xp.greater(xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0), 0)
+    t239 = xp.where(t238 & (xp.less(t229, 1) | xp.less(t115, t237)), xp.asarray(1, dtype=dtype), 0)
+    t240 = xp.where(t238, 1, t229)
+    t241 = xp.greater(t239, 0)
+    t242 = xp.where(t241, t67, t231)
+    t243 = xp.where(t241, t68, t232)
+    t244 = xp.where(t241, t69, t233)
+    t245 = xp.where(t241, t70, t234)
+    t246 = xp.where(t241, t71, t235)
+    t247 = xp.where(t241, t72, t236)
+    t248 = xp.where(t241, t115, t237)
+    t249 = xp.greater(xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0), 0)
+    t250 = xp.where(t249 & (xp.less(t240, 1) | xp.less(t116, t248)), xp.asarray(1, dtype=dtype), 0)
+    t251 = xp.where(t249, 1, t240)
+    t252 = xp.greater(t250, 0)
+    t253 = xp.where(t252, t73, t242)
+    t254 = xp.where(t252, t74, t243)
+    t255 = xp.where(t252, t75, t244)
+    t256 = xp.where(t252, t76, t245)
+    t257 = xp.where(t252, t77, t246)
+    t258 = xp.where(t252, t78, t247)
+    t259 = xp.where(t252, t116, t248)
+    t260 = xp.greater(xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0), 0)
+    t261 = xp.where(t260 & (xp.less(t251, 1) | xp.less(t117, t259)), xp.asarray(1, dtype=dtype), 0)
+    t262 = xp.where(t260, 1, t251)
+    t263 = xp.greater(t261, 0)
+    t264 = xp.where(t263, t79, t253)
+    t265 = xp.where(t263, t80, t254)
+    t266 = xp.where(t263, t81, t255)
+    t267 = xp.where(t263, t82, t256)
+    t268 = xp.where(t263, t83, t257)
+    t269 = xp.where(t263, t84, t258)
+    t270 = xp.where(t263, t117, t259)
+    t271 = xp.greater(xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0), 0)
+    t272 = xp.where(t271 & (xp.less(t262, 1) | xp.less(t118, t270)), xp.asarray(1, dtype=dtype), 0)
+    t273 = xp.where(t271, 1, t262)
+    t274 = xp.greater(t272, 0)
+    t275 = xp.where(t274, t85, t264)
+    t276 = xp.where(t274, t86, t265)
+    t277 = xp.where(t274, t87, t266)
+    t278 = xp.where(t274, t88, t267)
+    t279 = xp.where(t274, t89, t268)
+    t280 = xp.where(t274, t90, t269)
+    t281 = xp.where(t274, t118, t270)
+    t282 = xp.greater(xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0), 0)
+    t283 = xp.where(t282 & (xp.less(t273, 1) | xp.less(t119, t281)), xp.asarray(1, dtype=dtype), 0)
+    t284 = xp.where(t282, 1, t273)
+    t285 = xp.greater(t283, 0)
+    t286 = xp.where(t285, t91, t275)
+    t287 = xp.where(t285, t92, t276)
+    t288 = xp.where(t285, t93, t277)
+    t289 = xp.where(t285, t94, t278)
+    t290 = xp.where(t285, t95, t279)
+    t291 = xp.where(t285, t96, t280)
+    t292 = xp.greater(t284, 0)
+    t293 = xp.isfinite(t97)
+    t294 = t292 & t293
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t19, t16[0], qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t19, t16[1], qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t19, t16[2], qn3), batch),  # 2
-        xp.broadcast_to(xp.where(t19, t16[3], qn4), batch),  # 3
-        xp.broadcast_to(xp.where(t19, t16[4], qn5), batch),  # 4
-        xp.broadcast_to(xp.where(t19, t16[5], qn6), batch),  # 5
+        xp.broadcast_to(xp.where(t294, t286, qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t294, t287, qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t294, t288, qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t294, t289, qn4), batch),  # 3
+        xp.broadcast_to(xp.where(t294, t290, qn5), batch),  # 4
+        xp.broadcast_to(xp.where(t294, t291, qn6), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t18), 2, xp.where(t17, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t293), 2, xp.where(t292, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

@@ -113,15 +113,15 @@ void mico_velocity_ellipsoid(const mico_real q[MICO_DOF], mico_real U_v[9], mico
 mico_real mico_condition_number(const mico_real q[MICO_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1432 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1443 operations. */
 int mico_velocity_ik(const mico_real q[MICO_DOF], const mico_real mu_dot[MICO_TASK_DIM], mico_real damping, mico_real q_dot[MICO_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1438 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1443 operations. */
 int mico_velocity_ik_nullspace(const mico_real q[MICO_DOF], const mico_real mu_dot[MICO_TASK_DIM], const mico_real z[MICO_DOF], mico_real damping, mico_real q_dot[MICO_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1612 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1711 operations. */
 int mico_resolved_rate(const mico_real q[MICO_DOF], const mico_real target[16], const mico_real target_rate[MICO_TASK_DIM], const mico_real gain[MICO_TASK_DIM], const mico_real z[MICO_DOF], mico_real damping, mico_real q_dot[MICO_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
@@ -145,7 +145,7 @@ void mico_ik_general_residual(const mico_real target[16], const mico_real q[MICO
 int mico_ik_general_limits(const mico_real q_solution[MICO_DOF], mico_real q[MICO_DOF]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 6; returned as a scalar. 1218 operations. */
+ * Result: q[i], i < 6; returned as a scalar. 1219 operations. */
 int mico_ik_nearest(const mico_real T[16], const mico_real q_seed[MICO_DOF], const mico_real weights[MICO_DOF], mico_real q[MICO_DOF]);
 
 /* Statuses of mico_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -111,15 +111,15 @@ void panda_velocity_ellipsoid(const panda_real q[PANDA_DOF], panda_real U_v[9], 
 panda_real panda_condition_number(const panda_real q[PANDA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 7; returned as a scalar. 1041 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1130 operations. */
 int panda_velocity_ik(const panda_real q[PANDA_DOF], const panda_real mu_dot[PANDA_TASK_DIM], panda_real damping, panda_real q_dot[PANDA_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 7; returned as a scalar. 1123 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1130 operations. */
 int panda_velocity_ik_nullspace(const panda_real q[PANDA_DOF], const panda_real mu_dot[PANDA_TASK_DIM], const panda_real z[PANDA_DOF], panda_real damping, panda_real q_dot[PANDA_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 7; returned as a scalar. 1284 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1392 operations. */
 int panda_resolved_rate(const panda_real q[PANDA_DOF], const panda_real target[16], const panda_real target_rate[PANDA_TASK_DIM], const panda_real gain[PANDA_TASK_DIM], const panda_real z[PANDA_DOF], panda_real damping, panda_real q_dot[PANDA_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).

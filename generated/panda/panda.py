@@ -82,7 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -336,7 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi6_rows(xp, count, state):
     """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2 + w4**2 + w5**2
@@ -904,9 +904,9 @@ def _jacobi6_rows(xp, count, state):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _symmetric_solve6(xp, count, state):
-    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    """The solution x of a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
         t0 = w1**2
@@ -1090,10 +1090,154 @@ def _symmetric_solve6(xp, count, state):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _velocity_solve(xp, count, state):
+    """The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status, `count` times: 1116 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, = state
+        t0 = w1*w5
+        t1 = w0*w4
+        t2 = -t0 + w2*t1
+        t3 = t1 - w2*t0
+        t4 = w1*w4
+        t5 = w5*w0
+        t6 = t4 + w2*t5
+        t7 = t5 + w2*t4
+        t8 = w0*w3
+        t9 = 0.0825*t2 + 0.316*t8
+        t10 = t2*w6 + w7*t8
+        t11 = -t2*w7 + w6*t8
+        t12 = t10*w8 - t6*w9
+        t13 = t10*w9 + t6*w8
+        t14 = t11*w11 + t12*w10
+        t15 = t11*w10 - t12*w11
+        t16 = 0.088*t14 - 0.21*t15
+        t17 = 0.384*t11 + t16
+        t18 = -0.0825*t10 + t17
+        t19 = t9 + t18
+        t20 = w1*w3
+        t21 = 0.0825*t7 + 0.316*t20
+        t22 = t7*w6 + w7*t20
+        t23 = -t7*w7 + w6*t20
+        t24 = t22*w8 + t3*w9
+        t25 = t3*w8 - t22*w9
+        t26 = t23*w11 + t24*w10
+        t27 = t23*w10 - t24*w11
+        t28 = 0.088*t26 - 0.21*t27
+        t29 = 0.384*t23 + t28
+        t30 = -0.0825*t22 + t29
+        t31 = t21 + t30
+        t32 = w0*t19 + w1*t31
+        t33 = t31*t8 - t19*t20
+        t34 = t3*t18 + t6*t30
+        t35 = t11*t29 - t23*t17
+        t36 = t13*t28 + t25*t16
+        t37 = t32**2 + t33**2 + t34**2 + t35**2 + t36**2
+        t38 = -(-t32*w22 + t33*w23 + t34*w24 + t35*w25 + t36*w26) + w16
+        t39 = w4*w3
+        t40 = 0.316*w2 - 0.0825*t39
+        t41 = w2*w7 - w6*t39
+        t42 = w2*w6 + w7*t39
+        t43 = w5*w3
+        t44 = t41*w8 + w9*t43
+        t45 = -t41*w9 + w8*t43
+        t46 = t42*w11 + t44*w10
+        t47 = t42*w10 - t44*w11
+        t48 = 0.088*t46 - 0.21*t47
+        t49 = 0.384*t42 + t48
+        t50 = -0.0825*t41 + t49
+        t51 = t40 + t50
+        t52 = -w2*t31 + t51*t20
+        t53 = -t3*t50 + t30*t43
+        t54 = t23*t49 - t42*t29
+        t55 = t45*t28 - t25*t48
+        t56 = w2*t19 - t51*t8
+        t57 = t6*t50 + t18*t43
+        t58 = t42*t17 - t11*t49
+        t59 = t13*t48 + t45*t16
+        t60 = t31 + t45*t55 + t43*t53 - w2*t52 - t42*t54
+        t61 = t19 + w2*t56 + t42*t58 + t45*t59 + t43*t57
+        t62 = w2*t33 + t42*t35 - t45*t36 - t43*t34
+        t63 = t11*t42 - t13*t45 + t15*t47 + w2*t8 - t6*t43
+        t64 = t23*t42 + t25*t45 + t27*t47 + w2*t20 + t3*t43
+        t65 = -(w21 + w2*w23 + t42*w25 - t45*w26 - t47*w27 - t43*w24) + w19
+        t66 = w0**2
+        t67 = -t3*t53 + t23*t54 - t25*t55 + t51*t66 + t20*t52
+        t68 = t51**2
+        t69 = t31**2 + t52**2 + t53**2 + t54**2 + t55**2 + t66*t68
+        t70 = w1*w0
+        t71 = t68*t70 - t19*t31 + t52*t56 - t53*t57 + t54*t58 - t55*t59
+        t72 = w0*t32
+        t73 = t52*t33 + t53*t34 + t54*t35 + t55*t36 - t51*t72
+        t74 = t72 + t3*t34 + t25*t36 - t23*t35 - t20*t33
+        t75 = t51*t70
+        t76 = -t75 + t6*t53 + t11*t54 + t13*t55 + t8*t52
+        t77 = t75 + t3*t57 + t23*t58 + t25*t59 + t20*t56
+        t78 = w1**2
+        t79 = t19**2 + t56**2 + t57**2 + t58**2 + t59**2 + t68*t78
+        t80 = t6*t57 + t13*t59 - t11*t58 + t51*t78 - t8*t56
+        t81 = w1*t32
+        t82 = t51*t81 + t57*t34 + t59*t36 - t56*t33 - t58*t35
+        t83 = t81 + t6*t34 + t11*t35 + t13*t36 + t8*t33
+        t84 = w3**2
+        t85 = t6**2 + t11**2 + t13**2 + t15**2 + t78 + t66*t84
+        t86 = -t70 - t6*t3 + t11*t23 - t13*t25 + t15*t27 + t70*t84
+        t87 = t3**2 + t23**2 + t25**2 + t27**2 + t66 + t78*t84
+        t88 = 1 + w2**2 + t42**2 + t45**2 + t47**2 + w5**2*t84
+        t89 = w0*w22
+        t90 = -(-t31*w21 + t52*w23 + t53*w24 + t54*w25 + t55*w26 + t51*t89) + w14
+        t91 = -(t89 - t3*w24 + t23*w25 - t25*w26 - t27*w27 + t20*w23) + w18
+        t92 = w1*w22
+        t93 = -(t19*w21 + t56*w23 - t57*w24 + t58*w25 - t59*w26 + t51*t92) + w15
+        t94 = -(-t92 + t6*w24 + t11*w25 + t13*w26 - t15*w27 + t8*w23) + w17
+        t95 = w20**2
+        t96 = _symmetric_solve6(xp, 1, (t95 + t69, t71, t73, t76, t67, -t60, t95 + t79, -t82, -t80, t77, t61, t95 + t37, t83, -t74, t62, t95 + t85, t86, t63, t95 + t87, t64, t95 + t88, t90, t93, t38, t94, t91, t65,))
+        t97 = t96[5]
+        t98 = t96[0]
+        t99 = t96[1]
+        t100 = t97 - t31*t98 + t19*t99
+        t101 = w21 + t100
+        t102 = w0*t51
+        t103 = w1*t51
+        t104 = 1 - t31 - t57 - t59 - t32 - t15 - t3 - t25 - t27 - t45 - t47 - t43 + w5 + w4 + t6 + w3 + w6 + w7 + t11 + t23 + t42 + w8 + w9 + t13 + w11 + w10 + w13 + w12 + t19 + t8 + t20 + t102 + t103 + t52 + t53 + t54 + t55 + t56 + t58 + t33 + t34 + t35 + t36 + 2*w2 + 2*w0 + w14 + w15 + w16 + w17 + w18 + w19 + w20 + w21 + w22 + w23 + w24 + w25 + w26 + w27
+        t105 = t96[2]
+        t106 = t96[3]
+        t107 = t96[4]
+        t108 = t98*t102 + t99*t103 - t105*t32 - w1*t106 + w0*t107
+        t109 = t98*t52 + t99*t56 + t105*t33 + t8*t106 + t20*t107 + w2*t97
+        t110 = -t3*t107 + t98*t53 - t99*t57 + t105*t34 + t6*t106 - t43*t97
+        t111 = t11*t106 + t98*t54 + t99*t58 + t105*t35 + t23*t107 + t42*t97
+        t112 = t13*t106 + t98*t55 - t99*t59 + t105*t36 - t25*t107 - t45*t97
+        t113 = t47*t97 + t15*t106 + t27*t107
+        t114 = w22 + t108
+        t115 = w23 + t109
+        t116 = w24 + t110
+        t117 = w25 + t111
+        t118 = w26 + t112
+        t119 = -t113 + w27
+        t120 = xp.isfinite(t104)
+        t121 = xp.greater_equal(w20, 0)
+        t122 = t96[6]
+        t123 = t120 & t121 & xp.less_equal(t122, 0)
+        state = (
+            xp.where(t123, t101, 0),
+            xp.where(t123, t114, 0),
+            xp.where(t123, t115, 0),
+            xp.where(t123, t116, 0),
+            xp.where(t123, t117, 0),
+            xp.where(t123, t118, 0),
+            xp.where(t123, t119, 0),
+            xp.where(xp.logical_not(t120 & t121), 2, xp.where(xp.greater(t122, 0), xp.asarray(1, dtype=dtype), 0)),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _nearer_branch(xp, count, state):
     """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 119 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, = state
         t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w8))
@@ -4793,17 +4937,9 @@ def condition_number(q):
     return kappa
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (7 x 1 and 1 x 1), 1041 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (7 x 1 and 1 x 1), 1130 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (7,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
-    q7 = q[..., 6]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
@@ -4823,139 +4959,25 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = s1*s3
-    t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
-    t4 = s1*c3
-    t5 = s3*c1
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
-    t8 = c1*s2
-    t9 = 0.0825*t2 + 0.316*t8
-    t10 = t2*c4 + s4*t8
-    t11 = -t2*s4 + c4*t8
-    t12 = t10*c5 - t6*s5
-    t13 = t10*s5 + t6*c5
-    t14 = t11*s6 + t12*c6
-    t15 = t11*c6 - t12*s6
-    t16 = 0.088*t14 - 0.21*t15
-    t17 = 0.384*t11 + t16
-    t18 = -0.0825*t10 + t17
-    t19 = t9 + t18
-    t20 = s1*s2
-    t21 = 0.0825*t7 + 0.316*t20
-    t22 = t7*c4 + s4*t20
-    t23 = -t7*s4 + c4*t20
-    t24 = t22*c5 + t3*s5
-    t25 = t3*c5 - t22*s5
-    t26 = t23*s6 + t24*c6
-    t27 = t23*c6 - t24*s6
-    t28 = 0.088*t26 - 0.21*t27
-    t29 = 0.384*t23 + t28
-    t30 = -0.0825*t22 + t29
-    t31 = t21 + t30
-    t32 = c1*t19 + s1*t31
-    t33 = t31*t8 - t19*t20
-    t34 = t3*t18 + t6*t30
-    t35 = t11*t29 - t23*t17
-    t36 = t13*t28 + t25*t16
-    t37 = t32**2 + t33**2 + t34**2 + t35**2 + t36**2
-    t38 = c3*s2
-    t39 = 0.316*c2 - 0.0825*t38
-    t40 = c2*s4 - c4*t38
-    t41 = c2*c4 + s4*t38
-    t42 = s3*s2
-    t43 = t40*c5 + s5*t42
-    t44 = -t40*s5 + c5*t42
-    t45 = t41*s6 + t43*c6
-    t46 = t41*c6 - t43*s6
-    t47 = 0.088*t45 - 0.21*t46
-    t48 = 0.384*t41 + t47
-    t49 = -0.0825*t40 + t48
-    t50 = t39 + t49
-    t51 = -c2*t31 + t50*t20
-    t52 = -t3*t49 + t30*t42
-    t53 = t23*t48 - t41*t29
-    t54 = t44*t28 - t25*t47
-    t55 = c2*t19 - t50*t8
-    t56 = t6*t49 + t18*t42
-    t57 = t41*t17 - t11*t48
-    t58 = t13*t47 + t44*t16
-    t59 = t31 + t44*t54 + t42*t52 - c2*t51 - t41*t53
-    t60 = t19 + c2*t55 + t41*t57 + t44*t58 + t42*t56
-    t61 = c2*t33 + t41*t35 - t44*t36 - t42*t34
-    t62 = t11*t41 - t13*t44 + t15*t46 + c2*t8 - t6*t42
-    t63 = t23*t41 + t25*t44 + t27*t46 + c2*t20 + t3*t42
-    t64 = c1**2
-    t65 = -t3*t52 + t23*t53 - t25*t54 + t50*t64 + t20*t51
-    t66 = t50**2
-    t67 = t31**2 + t51**2 + t52**2 + t53**2 + t54**2 + t64*t66
-    t68 = s1*c1
-    t69 = t66*t68 - t19*t31 + t51*t55 - t52*t56 + t53*t57 - t54*t58
-    t70 = c1*t32
-    t71 = t51*t33 + t52*t34 + t53*t35 + t54*t36 - t50*t70
-    t72 = t70 + t3*t34 + t25*t36 - t23*t35 - t20*t33
-    t73 = t50*t68
-    t74 = -t73 + t6*t52 + t11*t53 + t13*t54 + t8*t51
-    t75 = t73 + t3*t56 + t23*t57 + t25*t58 + t20*t55
-    t76 = s1**2
-    t77 = t19**2 + t55**2 + t56**2 + t57**2 + t58**2 + t66*t76
-    t78 = t6*t56 + t13*t58 - t11*t57 + t50*t76 - t8*t55
-    t79 = s1*t32
-    t80 = t50*t79 + t56*t34 + t58*t36 - t55*t33 - t57*t35
-    t81 = t79 + t6*t34 + t11*t35 + t13*t36 + t8*t33
-    t82 = s2**2
-    t83 = t6**2 + t11**2 + t13**2 + t15**2 + t76 + t64*t82
-    t84 = -t68 - t6*t3 + t11*t23 - t13*t25 + t15*t27 + t68*t82
-    t85 = t3**2 + t23**2 + t25**2 + t27**2 + t64 + t76*t82
-    t86 = 1 + c2**2 + t41**2 + t44**2 + t46**2 + s3**2*t82
-    t87 = damping**2
-    t88 = _symmetric_solve6(xp, 1, (t87 + t67, t69, t71, t74, t65, -t59, t87 + t77, -t80, -t78, t75, t60, t87 + t37, t81, -t72, t61, t87 + t83, t84, t62, t87 + t85, t63, t87 + t86, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
-    t89 = t88[5]
-    t90 = t88[0]
-    t91 = t88[1]
-    t92 = t89 + t19*t91 - t31*t90
-    t93 = c1*t50
-    t94 = s1*t50
-    t95 = 1 - t31 - t56 - t58 - t32 - s1 - t15 - t3 - t25 - t27 - t44 - t46 - t42 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t11 + t23 + t41 + q5 + t13 + q6 + q7 + t19 + t8 + t20 + t93 + t94 + t51 + t52 + t53 + t54 + t55 + t57 + t33 + t34 + t35 + t36 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t96 = t88[2]
-    t97 = t88[3]
-    t98 = t88[4]
-    t99 = c1*t98 + t90*t93 + t91*t94 - t96*t32 - s1*t97
-    t100 = t90*t51 + t91*t55 + t96*t33 + t8*t97 + t20*t98 + c2*t89
-    t101 = -t42*t89 + t90*t52 - t91*t56 + t96*t34 + t6*t97 - t3*t98
-    t102 = t90*t53 + t91*t57 + t96*t35 + t11*t97 + t23*t98 + t41*t89
-    t103 = -t91*t58 - t44*t89 + t90*t54 + t96*t36 + t13*t97 - t25*t98
-    t104 = t15*t97 + t27*t98 + t46*t89
-    t105 = xp.isfinite(t95)
-    t106 = xp.greater_equal(damping, 0)
-    t107 = t88[6]
-    t108 = t105 & t106 & xp.less_equal(t107, 0)
+    c7 = trig[..., 12]
+    s7 = trig[..., 13]
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, c7, s7, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5, damping, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t108, t92, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t108, t99, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t108, t100, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t108, t101, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t108, t102, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t108, t103, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t108, -t104, 0), batch),  # 6
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
+        xp.broadcast_to(t0[4], batch),  # 4
+        xp.broadcast_to(t0[5], batch),  # 5
+        xp.broadcast_to(t0[6], batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t105 & t106), 2, xp.where(xp.greater(t107, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[7], batch), xp.int32)
     return q_dot, status
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
-    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1123 operations."""
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1130 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (7,)), ("mu_dot", mu_dot, (6,)), ("z", z, (7,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
-    q7 = q[..., 6]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
@@ -4982,154 +5004,26 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = s1*s3
-    t1 = c1*c3
-    t2 = -t0 + c2*t1
-    t3 = t1 - c2*t0
-    t4 = s1*c3
-    t5 = s3*c1
-    t6 = t4 + c2*t5
-    t7 = t5 + c2*t4
-    t8 = c1*s2
-    t9 = 0.0825*t2 + 0.316*t8
-    t10 = t2*c4 + s4*t8
-    t11 = -t2*s4 + c4*t8
-    t12 = t10*c5 - t6*s5
-    t13 = t10*s5 + t6*c5
-    t14 = t11*s6 + t12*c6
-    t15 = t11*c6 - t12*s6
-    t16 = 0.088*t14 - 0.21*t15
-    t17 = 0.384*t11 + t16
-    t18 = -0.0825*t10 + t17
-    t19 = t9 + t18
-    t20 = s1*s2
-    t21 = 0.0825*t7 + 0.316*t20
-    t22 = t7*c4 + s4*t20
-    t23 = -t7*s4 + c4*t20
-    t24 = t22*c5 + t3*s5
-    t25 = t3*c5 - t22*s5
-    t26 = t23*s6 + t24*c6
-    t27 = t23*c6 - t24*s6
-    t28 = 0.088*t26 - 0.21*t27
-    t29 = 0.384*t23 + t28
-    t30 = -0.0825*t22 + t29
-    t31 = t21 + t30
-    t32 = c1*t19 + s1*t31
-    t33 = t31*t8 - t19*t20
-    t34 = t3*t18 + t6*t30
-    t35 = t11*t29 - t23*t17
-    t36 = t13*t28 + t25*t16
-    t37 = t32**2 + t33**2 + t34**2 + t35**2 + t36**2
-    t38 = -(-t32*qz2 + t33*qz3 + t34*qz4 + t35*qz5 + t36*qz6) + mu_dot2
-    t39 = c3*s2
-    t40 = 0.316*c2 - 0.0825*t39
-    t41 = c2*s4 - c4*t39
-    t42 = c2*c4 + s4*t39
-    t43 = s3*s2
-    t44 = t41*c5 + s5*t43
-    t45 = -t41*s5 + c5*t43
-    t46 = t42*s6 + t44*c6
-    t47 = t42*c6 - t44*s6
-    t48 = 0.088*t46 - 0.21*t47
-    t49 = 0.384*t42 + t48
-    t50 = -0.0825*t41 + t49
-    t51 = t40 + t50
-    t52 = -c2*t31 + t51*t20
-    t53 = -t3*t50 + t30*t43
-    t54 = t23*t49 - t42*t29
-    t55 = t45*t28 - t25*t48
-    t56 = c2*t19 - t51*t8
-    t57 = t6*t50 + t18*t43
-    t58 = t42*t17 - t11*t49
-    t59 = t13*t48 + t45*t16
-    t60 = t31 + t45*t55 + t43*t53 - c2*t52 - t42*t54
-    t61 = t19 + c2*t56 + t42*t58 + t45*t59 + t43*t57
-    t62 = c2*t33 + t42*t35 - t45*t36 - t43*t34
-    t63 = t11*t42 - t13*t45 + t15*t47 + c2*t8 - t6*t43
-    t64 = t23*t42 + t25*t45 + t27*t47 + c2*t20 + t3*t43
-    t65 = -(qz1 + c2*qz3 + t42*qz5 - t45*qz6 - t47*qz7 - t43*qz4) + mu_dot5
-    t66 = c1**2
-    t67 = -t3*t53 + t23*t54 - t25*t55 + t51*t66 + t20*t52
-    t68 = t51**2
-    t69 = t31**2 + t52**2 + t53**2 + t54**2 + t55**2 + t66*t68
-    t70 = s1*c1
-    t71 = t68*t70 - t19*t31 + t52*t56 - t53*t57 + t54*t58 - t55*t59
-    t72 = c1*t32
-    t73 = t52*t33 + t53*t34 + t54*t35 + t55*t36 - t51*t72
-    t74 = t72 + t3*t34 + t25*t36 - t23*t35 - t20*t33
-    t75 = t51*t70
-    t76 = -t75 + t6*t53 + t11*t54 + t13*t55 + t8*t52
-    t77 = t75 + t3*t57 + t23*t58 + t25*t59 + t20*t56
-    t78 = s1**2
-    t79 = t19**2 + t56**2 + t57**2 + t58**2 + t59**2 + t68*t78
-    t80 = t6*t57 + t13*t59 - t11*t58 + t51*t78 - t8*t56
-    t81 = s1*t32
-    t82 = t51*t81 + t57*t34 + t59*t36 - t56*t33 - t58*t35
-    t83 = t81 + t6*t34 + t11*t35 + t13*t36 + t8*t33
-    t84 = s2**2
-    t85 = t6**2 + t11**2 + t13**2 + t15**2 + t78 + t66*t84
-    t86 = -t70 - t6*t3 + t11*t23 - t13*t25 + t15*t27 + t70*t84
-    t87 = t3**2 + t23**2 + t25**2 + t27**2 + t66 + t78*t84
-    t88 = 1 + c2**2 + t42**2 + t45**2 + t47**2 + s3**2*t84
-    t89 = c1*qz2
-    t90 = -(-t31*qz1 + t52*qz3 + t53*qz4 + t54*qz5 + t55*qz6 + t51*t89) + mu_dot0
-    t91 = -(t89 - t3*qz4 + t23*qz5 - t25*qz6 - t27*qz7 + t20*qz3) + mu_dot4
-    t92 = s1*qz2
-    t93 = -(t19*qz1 + t56*qz3 - t57*qz4 + t58*qz5 - t59*qz6 + t51*t92) + mu_dot1
-    t94 = -(-t92 + t6*qz4 + t11*qz5 + t13*qz6 - t15*qz7 + t8*qz3) + mu_dot3
-    t95 = damping**2
-    t96 = _symmetric_solve6(xp, 1, (t95 + t69, t71, t73, t76, t67, -t60, t95 + t79, -t82, -t80, t77, t61, t95 + t37, t83, -t74, t62, t95 + t85, t86, t63, t95 + t87, t64, t95 + t88, t90, t93, t38, t94, t91, t65,))
-    t97 = t96[5]
-    t98 = t96[0]
-    t99 = t96[1]
-    t100 = t97 - t31*t98 + t19*t99
-    t101 = qz1 + t100
-    t102 = c1*t51
-    t103 = s1*t51
-    t104 = 1 - t31 - t57 - t59 - t32 - s1 - t15 - t3 - t25 - t27 - t45 - t47 - t43 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t11 + t23 + t42 + q5 + t13 + q6 + q7 + t19 + t8 + t20 + t102 + t103 + t52 + t53 + t54 + t55 + t56 + t58 + t33 + t34 + t35 + t36 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7
-    t105 = t96[2]
-    t106 = t96[3]
-    t107 = t96[4]
-    t108 = t98*t102 + t99*t103 - t105*t32 - s1*t106 + c1*t107
-    t109 = t98*t52 + t99*t56 + t105*t33 + t8*t106 + t20*t107 + c2*t97
-    t110 = -t3*t107 + t98*t53 - t99*t57 + t105*t34 + t6*t106 - t43*t97
-    t111 = t11*t106 + t98*t54 + t99*t58 + t105*t35 + t23*t107 + t42*t97
-    t112 = t13*t106 + t98*t55 - t99*t59 + t105*t36 - t25*t107 - t45*t97
-    t113 = t47*t97 + t15*t106 + t27*t107
-    t114 = qz2 + t108
-    t115 = qz3 + t109
-    t116 = qz4 + t110
-    t117 = qz5 + t111
-    t118 = qz6 + t112
-    t119 = -t113 + qz7
-    t120 = xp.isfinite(t104)
-    t121 = xp.greater_equal(damping, 0)
-    t122 = t96[6]
-    t123 = t120 & t121 & xp.less_equal(t122, 0)
+    c7 = trig[..., 12]
+    s7 = trig[..., 13]
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, c7, s7, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5, damping, qz1, qz2, qz3, qz4, qz5, qz6, qz7,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t123, t101, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t123, t114, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t123, t115, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t123, t116, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t123, t117, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t123, t118, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t123, t119, 0), batch),  # 6
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
+        xp.broadcast_to(t0[4], batch),  # 4
+        xp.broadcast_to(t0[5], batch),  # 5
+        xp.broadcast_to(t0[6], batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t120 & t121), 2, xp.where(xp.greater(t122, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[7], batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1284 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1392 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (7,)), ("target", target, (4, 4)), ("target_rate", target_rate, (6,)), ("gain", gain, (6,)), ("z", z, (7,)), ("damping", damping, ()), every=("gain", ))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
-    q7 = q[..., 6]
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
     T02 = target[..., 0, 2]
@@ -5184,186 +5078,108 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t5 = s3*c1
     t6 = t4 + c2*t5
     t7 = t5 + c2*t4
-    t8 = c1*s2
-    t9 = 0.0825*t2 + 0.316*t8
-    t10 = t2*c4 + s4*t8
-    t11 = -t2*s4 + c4*t8
-    t12 = t10*c5 - t6*s5
-    t13 = t10*s5 + t6*c5
-    t14 = t11*s6 + t12*c6
-    t15 = t11*c6 - t12*s6
-    t16 = t13*s7 + t14*c7
-    t17 = t13*c7 - t14*s7
-    t18 = 0.088*t14 - 0.21*t15
-    t19 = 0.384*t11 + t18
-    t20 = -0.0825*t10 + t19
-    t21 = t9 + t20
-    t22 = mu_dot0 + gain0*(-t21 + T03)
-    t23 = s1*s2
-    t24 = 0.0825*t7 + 0.316*t23
-    t25 = t7*c4 + s4*t23
-    t26 = -t7*s4 + c4*t23
-    t27 = t25*c5 + t3*s5
-    t28 = t3*c5 - t25*s5
-    t29 = t26*s6 + t27*c6
-    t30 = t26*c6 - t27*s6
-    t31 = t29*c7 - t28*s7
-    t32 = t28*c7 + t29*s7
-    t33 = 0.088*t29 - 0.21*t30
-    t34 = 0.384*t26 + t33
-    t35 = -0.0825*t25 + t34
-    t36 = t24 + t35
-    t37 = c1*t21 + s1*t36
-    t38 = t36*t8 - t21*t23
-    t39 = t3*t20 + t6*t35
-    t40 = t11*t34 - t26*t19
-    t41 = t13*t33 + t28*t18
-    t42 = t37**2 + t38**2 + t39**2 + t40**2 + t41**2
-    t43 = c3*s2
-    t44 = 0.316*c2 - 0.0825*t43
-    t45 = c2*s4 - c4*t43
-    t46 = c2*c4 + s4*t43
-    t47 = s3*s2
-    t48 = t45*c5 + s5*t47
-    t49 = -t45*s5 + c5*t47
-    t50 = t46*s6 + t48*c6
-    t51 = t46*c6 - t48*s6
-    t52 = t50*c7 - t49*s7
-    t53 = t49*c7 + t50*s7
-    t54 = 0.088*t50 - 0.21*t51
-    t55 = 0.384*t46 + t54
-    t56 = -0.0825*t45 + t55
-    t57 = t44 + t56
-    t58 = 0.333 + t57
-    t59 = -c2*t36 + t57*t23
-    t60 = -t3*t56 + t35*t47
-    t61 = t26*t55 - t46*t34
-    t62 = t49*t33 - t28*t54
-    t63 = c2*t21 - t57*t8
-    t64 = t6*t56 + t20*t47
-    t65 = t46*t19 - t11*t55
-    t66 = t13*t54 + t49*t18
-    t67 = t36 + t49*t62 + t47*t60 - c2*t59 - t46*t61
-    t68 = t21 + c2*t63 + t46*t65 + t49*t66 + t47*t64
-    t69 = c2*t38 + t46*t40 - t49*t41 - t47*t39
-    t70 = t11*t46 - t13*t49 + t15*t51 + c2*t8 - t6*t47
-    t71 = t26*t46 + t28*t49 + t30*t51 + c2*t23 + t3*t47
-    t72 = mu_dot2 + gain2*(-t58 + T23)
-    t73 = -(-t37*qz2 + t38*qz3 + t39*qz4 + t40*qz5 + t41*qz6) + t72
-    t74 = 0.7071067811865476*t16
-    t75 = 0.7071067811865476*t17
-    t76 = -t75 + t74
-    t77 = t74 + t75
-    t78 = t76*T00 + t77*T01 - t15*T02
-    t79 = t76*T10 + t77*T11 - t15*T12
-    t80 = t76*T20 + t77*T21 - t15*T22
-    t81 = 0.7071067811865476*t31
-    t82 = 0.7071067811865476*t32
-    t83 = t81 + t82
-    t84 = -t82 + t81
-    t85 = t83*T00 + t84*T01 - t30*T02
-    t86 = t83*T10 + t84*T11 - t30*T12
-    t87 = t83*T20 + t84*T21 - t30*T22
-    t88 = 0.5*(-t85 + t79)
-    t89 = 0.7071067811865476*t52
-    t90 = 0.7071067811865476*t53
-    t91 = t89 + t90
-    t92 = -t90 + t89
-    t93 = t91*T00 + t92*T01 - t51*T02
-    t94 = t91*T10 + t92*T11 - t51*T12
-    t95 = t91*T20 + t92*T21 - t51*T22
-    t96 = 0.5*(-t94 + t87)
-    t97 = 0.5*(-t80 + t93)
-    t98 = 0.5*(-1 + t78 + t86 + t95)
-    t99 = xp.sqrt(t96**2 + t97**2 + t88**2)
-    t100 = xp.atan2(t99, t98)
-    t101 = xp.where(xp.greater(t99, 0), t100/t99, 1)
-    t102 = c1**2
-    t103 = -t3*t60 + t26*t61 - t28*t62 + t57*t102 + t23*t59
-    t104 = t57**2
-    t105 = t36**2 + t59**2 + t60**2 + t61**2 + t62**2 + t102*t104
-    t106 = s1*c1
-    t107 = -t21*t36 + t59*t63 - t60*t64 + t61*t65 - t62*t66 + t104*t106
-    t108 = c1*t37
-    t109 = t59*t38 + t60*t39 + t61*t40 + t62*t41 - t57*t108
-    t110 = t108 + t3*t39 + t28*t41 - t26*t40 - t23*t38
-    t111 = t57*t106
-    t112 = -t111 + t6*t60 + t11*t61 + t13*t62 + t8*t59
-    t113 = t111 + t3*t64 + t26*t65 + t28*t66 + t23*t63
-    t114 = s1**2
-    t115 = t21**2 + t63**2 + t64**2 + t65**2 + t66**2 + t104*t114
-    t116 = t6*t64 + t13*t66 - t11*t65 - t8*t63 + t57*t114
-    t117 = s1*t37
-    t118 = t64*t39 + t66*t41 - t63*t38 - t65*t40 + t57*t117
-    t119 = t117 + t6*t39 + t11*t40 + t13*t41 + t8*t38
-    t120 = s2**2
-    t121 = t6**2 + t11**2 + t13**2 + t15**2 + t114 + t102*t120
-    t122 = -t106 - t6*t3 + t11*t26 - t13*t28 + t15*t30 + t106*t120
-    t123 = t3**2 + t26**2 + t28**2 + t30**2 + t102 + t114*t120
-    t124 = 1 + c2**2 + t46**2 + t49**2 + t51**2 + s3**2*t120
-    t125 = xp.greater_equal(t78, t86) & xp.greater_equal(t78, t95)
-    t126 = xp.greater_equal(t86, t95)
-    t127 = xp.where(t125, 0.5*(1 + t78), xp.where(t126, 0.5*t85, 0.5*t93))
-    t128 = xp.where(t125, 0.5*t79, xp.where(t126, 0.5*(1 + t86), 0.5*t94))
-    t129 = xp.where(t125, 0.5*t80, xp.where(t126, 0.5*t87, 0.5*(1 + t95)))
-    t130 = xp.sqrt(t127**2 + t128**2 + t129**2)
-    t131 = xp.where(xp.greater_equal(t96*t127 + t97*t128 + t88*t129, 0), xp.asarray(1, dtype=dtype), -1)
-    t132 = xp.greater(t99, 1e-06) | xp.greater(t98, 0)
-    t133 = t100*t131/t130
-    t134 = xp.where(t132, t96*t101, t133*t127)
-    t135 = xp.where(t132, t97*t101, t133*t128)
-    t136 = xp.where(t132, t88*t101, t133*t129)
-    t137 = mu_dot3 + t134*gain3
-    t138 = mu_dot4 + t135*gain4
-    t139 = mu_dot5 + t136*gain5
-    t140 = -(qz1 + c2*qz3 + t46*qz5 - t49*qz6 - t51*qz7 - t47*qz4) + t139
-    t141 = -t36
-    t142 = mu_dot1 + gain1*(t141 + T13)
-    t143 = c1*qz2
-    t144 = -(-t36*qz1 + t59*qz3 + t60*qz4 + t61*qz5 + t62*qz6 + t57*t143) + t22
-    t145 = -(t143 - t3*qz4 + t26*qz5 - t28*qz6 - t30*qz7 + t23*qz3) + t138
-    t146 = s1*qz2
-    t147 = -(t21*qz1 + t63*qz3 - t64*qz4 + t65*qz5 - t66*qz6 + t57*t146) + t142
-    t148 = -(-t146 + t6*qz4 + t11*qz5 + t13*qz6 - t15*qz7 + t8*qz3) + t137
-    t149 = damping**2
-    t150 = _symmetric_solve6(xp, 1, (t149 + t105, t107, t109, t112, t103, -t67, t149 + t115, -t118, -t116, t113, t68, t149 + t42, t119, -t110, t69, t149 + t121, t122, t70, t149 + t123, t71, t149 + t124, t144, t147, t73, t148, t145, t140,))
-    t151 = t150[5]
-    t152 = t150[0]
-    t153 = t150[1]
-    t154 = t151 - t36*t152 + t21*t153
-    t155 = qz1 + t154
-    t156 = c1*t57
-    t157 = s1*t57
-    t158 = 1 - t64 - t66 - t37 - s1 - t15 - t3 - t28 - t30 - t49 - t51 - t47 + q1 + q2 + q3 + c1 + c2 + t6 + q4 + t11 + t26 + t46 + q5 + t13 + q6 + q7 + t21 + t8 + t23 + t141 + t59 + t60 + t61 + t62 + t63 + t65 + t38 + t39 + t40 + t41 + t156 + t157 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7 + t22 + t142 + t72 + t137 + t138 + t139
-    t159 = t150[2]
-    t160 = t150[3]
-    t161 = t150[4]
-    t162 = t152*t156 + t153*t157 - t37*t159 - s1*t160 + c1*t161
-    t163 = c2*t151 + t59*t152 + t63*t153 + t38*t159 + t8*t160 + t23*t161
-    t164 = t60*t152 - t64*t153 + t39*t159 + t6*t160 - t3*t161 - t47*t151
-    t165 = t46*t151 + t61*t152 + t65*t153 + t40*t159 + t11*t160 + t26*t161
-    t166 = -t66*t153 + t62*t152 + t41*t159 + t13*t160 - t28*t161 - t49*t151
-    t167 = t51*t151 + t15*t160 + t30*t161
-    t168 = qz2 + t162
-    t169 = qz3 + t163
-    t170 = qz4 + t164
-    t171 = qz5 + t165
-    t172 = qz6 + t166
-    t173 = -t167 + qz7
-    t174 = xp.isfinite(t158)
-    t175 = xp.greater_equal(damping, 0)
-    t176 = t150[6]
-    t177 = t174 & t175 & xp.less_equal(t176, 0)
+    t8 = 0.316*s2
+    t9 = 0.0825*t2 + c1*t8
+    t10 = 0.0825*t7 + s1*t8
+    t11 = c3*s2
+    t12 = 0.316*c2 - 0.0825*t11
+    t13 = c2*s4 - c4*t11
+    t14 = c2*c4 + s4*t11
+    t15 = c1*s2
+    t16 = t2*c4 + s4*t15
+    t17 = -t2*s4 + c4*t15
+    t18 = t16*c5 - t6*s5
+    t19 = t16*s5 + t6*c5
+    t20 = t17*s6 + t18*c6
+    t21 = t17*c6 - t18*s6
+    t22 = t19*s7 + t20*c7
+    t23 = t19*c7 - t20*s7
+    t24 = 0.088*t20 - 0.21*t21
+    t25 = 0.384*t17 + t24
+    t26 = -0.0825*t16 + t25
+    t27 = t9 + t26
+    t28 = mu_dot0 + gain0*(-t27 + T03)
+    t29 = s1*s2
+    t30 = t7*c4 + s4*t29
+    t31 = -t7*s4 + c4*t29
+    t32 = t30*c5 + t3*s5
+    t33 = t3*c5 - t30*s5
+    t34 = t31*s6 + t32*c6
+    t35 = t31*c6 - t32*s6
+    t36 = t34*c7 - t33*s7
+    t37 = t33*c7 + t34*s7
+    t38 = 0.088*t34 - 0.21*t35
+    t39 = 0.384*t31 + t38
+    t40 = -0.0825*t30 + t39
+    t41 = t10 + t40
+    t42 = mu_dot1 + gain1*(-t41 + T13)
+    t43 = s3*s2
+    t44 = t13*c5 + s5*t43
+    t45 = -t13*s5 + c5*t43
+    t46 = t14*s6 + t44*c6
+    t47 = t14*c6 - t44*s6
+    t48 = t46*c7 - t45*s7
+    t49 = t45*c7 + t46*s7
+    t50 = 0.088*t46 - 0.21*t47
+    t51 = 0.384*t14 + t50
+    t52 = -0.0825*t13 + t51
+    t53 = t12 + t52
+    t54 = 0.333 + t53
+    t55 = mu_dot2 + gain2*(-t54 + T23)
+    t56 = 0.7071067811865476*t22
+    t57 = 0.7071067811865476*t23
+    t58 = -t57 + t56
+    t59 = t56 + t57
+    t60 = t58*T00 + t59*T01 - t21*T02
+    t61 = t58*T10 + t59*T11 - t21*T12
+    t62 = t58*T20 + t59*T21 - t21*T22
+    t63 = 0.7071067811865476*t36
+    t64 = 0.7071067811865476*t37
+    t65 = t63 + t64
+    t66 = -t64 + t63
+    t67 = t65*T00 + t66*T01 - t35*T02
+    t68 = t65*T10 + t66*T11 - t35*T12
+    t69 = t65*T20 + t66*T21 - t35*T22
+    t70 = 0.5*(-t67 + t61)
+    t71 = 0.7071067811865476*t48
+    t72 = 0.7071067811865476*t49
+    t73 = t71 + t72
+    t74 = -t72 + t71
+    t75 = t73*T00 + t74*T01 - t47*T02
+    t76 = t73*T10 + t74*T11 - t47*T12
+    t77 = t73*T20 + t74*T21 - t47*T22
+    t78 = 0.5*(-t76 + t69)
+    t79 = 0.5*(-t62 + t75)
+    t80 = 0.5*(-1 + t60 + t68 + t77)
+    t81 = xp.sqrt(t78**2 + t79**2 + t70**2)
+    t82 = xp.atan2(t81, t80)
+    t83 = xp.where(xp.greater(t81, 0), t82/t81, 1)
+    t84 = xp.greater_equal(t60, t68) & xp.greater_equal(t60, t77)
+    t85 = xp.greater_equal(t68, t77)
+    t86 = xp.where(t84, 0.5*(1 + t60), xp.where(t85, 0.5*t67, 0.5*t75))
+    t87 = xp.where(t84, 0.5*t61, xp.where(t85, 0.5*(1 + t68), 0.5*t76))
+    t88 = xp.where(t84, 0.5*t62, xp.where(t85, 0.5*t69, 0.5*(1 + t77)))
+    t89 = xp.sqrt(t86**2 + t87**2 + t88**2)
+    t90 = xp.where(xp.greater_equal(t78*t86 + t79*t87 + t70*t88, 0), xp.asarray(1, dtype=dtype), -1)
+    t91 = xp.greater(t81, 1e-06) | xp.greater(t80, 0)
+    t92 = t82*t90/t89
+    t93 = xp.where(t91, t78*t83, t92*t86)
+    t94 = xp.where(t91, t79*t83, t92*t87)
+    t95 = xp.where(t91, t70*t83, t92*t88)
+    t96 = mu_dot3 + t93*gain3
+    t97 = mu_dot4 + t94*gain4
+    t98 = mu_dot5 + t95*gain5
+    t99 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, c7, s7, t28, t42, t55, t96, t97, t98, damping, qz1, qz2, qz3, qz4, qz5, qz6, qz7,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t177, t155, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t177, t168, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t177, t169, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t177, t170, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t177, t171, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t177, t172, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t177, t173, 0), batch),  # 6
+        xp.broadcast_to(t99[0], batch),  # 0
+        xp.broadcast_to(t99[1], batch),  # 1
+        xp.broadcast_to(t99[2], batch),  # 2
+        xp.broadcast_to(t99[3], batch),  # 3
+        xp.broadcast_to(t99[4], batch),  # 4
+        xp.broadcast_to(t99[5], batch),  # 5
+        xp.broadcast_to(t99[6], batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t174 & t175), 2, xp.where(xp.greater(t176, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t99[7], batch), xp.int32)
     return q_dot, status
 
 

@@ -111,15 +111,15 @@ void panda_calibrated_velocity_ellipsoid(const panda_calibrated_real q[PANDA_CAL
 panda_calibrated_real panda_calibrated_condition_number(const panda_calibrated_real q[PANDA_CALIBRATED_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 7; returned as a scalar. 1283 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1388 operations. */
 int panda_calibrated_velocity_ik(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real mu_dot[PANDA_CALIBRATED_TASK_DIM], panda_calibrated_real damping, panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 7; returned as a scalar. 1379 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1388 operations. */
 int panda_calibrated_velocity_ik_nullspace(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real mu_dot[PANDA_CALIBRATED_TASK_DIM], const panda_calibrated_real z[PANDA_CALIBRATED_DOF], panda_calibrated_real damping, panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 7; returned as a scalar. 1554 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1817 operations. */
 int panda_calibrated_resolved_rate(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], const panda_calibrated_real target[16], const panda_calibrated_real target_rate[PANDA_CALIBRATED_TASK_DIM], const panda_calibrated_real gain[PANDA_CALIBRATED_TASK_DIM], const panda_calibrated_real z[PANDA_CALIBRATED_DOF], panda_calibrated_real damping, panda_calibrated_real q_dot[PANDA_CALIBRATED_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
@@ -147,7 +147,7 @@ int panda_calibrated_ik_general_limits(const panda_calibrated_real q_solution[PA
 int panda_calibrated_ik_general_nominal(const panda_calibrated_real T[16], panda_calibrated_real q_free, panda_calibrated_real q[56], int valid[8]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 7; returned as a scalar. 1973 operations. */
+ * Result: q[i], i < 7; returned as a scalar. 1975 operations. */
 int panda_calibrated_ik_nearest(const panda_calibrated_real T[16], const panda_calibrated_real q_seed[PANDA_CALIBRATED_DOF], panda_calibrated_real q_free, const panda_calibrated_real weights[PANDA_CALIBRATED_DOF], panda_calibrated_real q[PANDA_CALIBRATED_DOF]);
 
 /* Statuses of panda_calibrated_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -299,7 +299,7 @@ static void jacgen_jacobi3_columns_2(int count, jacgen_jacobi3_columns_2_state *
 
 typedef struct { planar_2r_real w[5]; } jacgen_symmetric_solve2_state;
 
-/* X solving a symmetric 2 x 2 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular: 53 operations a run. */
+/* The solution x of a symmetric 2 x 2 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular: 53 operations a run. */
 static void jacgen_symmetric_solve2(int count, jacgen_symmetric_solve2_state *state)
 {
     JACGEN_KERNEL_LOOP
@@ -334,6 +334,70 @@ static void jacgen_symmetric_solve2(int count, jacgen_symmetric_solve2_state *st
         state->w[0] = t20;
         state->w[1] = t19;
         state->w[2] = ((t3 <= t21) || (t15 <= t21) ? 1 : 0);
+    }
+}
+
+typedef struct { planar_2r_real w[7]; } jacgen_velocity_solve_state;
+
+/* The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status: 157 operations a run. */
+static void jacgen_velocity_solve(int count, jacgen_velocity_solve_state *state)
+{
+    JACGEN_KERNEL_LOOP
+    for (int run = 0; run < count; run++) {
+        const planar_2r_real w0 = state->w[0];
+        const planar_2r_real w1 = state->w[1];
+        const planar_2r_real w2 = state->w[2];
+        const planar_2r_real w3 = state->w[3];
+        const planar_2r_real w4 = state->w[4];
+        const planar_2r_real w5 = state->w[5];
+        const planar_2r_real w6 = state->w[6];
+        const planar_2r_real c12 = w0*w2 - w1*w3;
+        const planar_2r_real s12 = w0*w3 + w2*w1;
+        const planar_2r_real t0 = w1 + s12;
+        const planar_2r_real t1 = w0 + c12;
+        const planar_2r_real t2 = c12*s12 + t0*t1;
+        const planar_2r_real t3 = (t0*t0);
+        const planar_2r_real t4 = (s12*s12) + t3;
+        const planar_2r_real t5 = (t1*t1);
+        const planar_2r_real t6 = sqrt(t3 + t5);
+        const planar_2r_real t7 = (t0 <= 0 ? 1 : -1)*t6;
+        const planar_2r_real t8 = (c12*c12) + t5;
+        const planar_2r_real t9 = sqrt(t4 + t8);
+        const planar_2r_real t10 = (w6*w6);
+        jacgen_symmetric_solve2_state t11 = {{t4 + t10, -t2, t8 + t10, w4, w5}};
+        jacgen_symmetric_solve2(1, &t11);
+        const planar_2r_real t12 = t11.w[0];
+        const planar_2r_real t13 = t11.w[1];
+        const planar_2r_real t14 = -t0*t12 + t1*t13;
+        const planar_2r_real t15 = -s12*t12 + c12*t13;
+        const int t16 = t6 > 0;
+        const planar_2r_real t17 = (t16 ? 1 + fabs(t0)/t6 : 0);
+        const planar_2r_real t18 = -t0;
+        const planar_2r_real t19 = (t16 ? 1.0/(t18 + t7) : 0);
+        const planar_2r_real t20 = -s12;
+        const planar_2r_real t21 = w2 + w1 + w3 + 2*t1 + t18 + t20 + w4 + w5 + w6;
+        const planar_2r_real t22 = t1*t19;
+        const planar_2r_real t23 = t17*(t20 + c12*t22);
+        const planar_2r_real t24 = s12 + t23;
+        const planar_2r_real t25 = c12 - t22*t23;
+        const planar_2r_real t26 = t17*(w4 + t22*w5);
+        const planar_2r_real t27 = -t26 + w4;
+        const planar_2r_real t28 = w5 - t22*t26;
+        const planar_2r_real t29 = fabs(t25);
+        const planar_2r_real t30 = t29*(t25 >= 0 ? 1 : -1);
+        const planar_2r_real t31 = (t29 > 0 ? 2 : 0);
+        const planar_2r_real t32 = t28 - t28*t31;
+        const planar_2r_real t33 = (t30 != 0 ? -t32/t30 : 0);
+        const planar_2r_real t34 = (t7 != 0 ? -(t27 + t24*t33)/t7 : 0);
+        const int t35 = isfinite(t21);
+        const int t36 = w6 >= 0;
+        const int t37 = w6 > 0;
+        const planar_2r_real t38 = 1e-12*t9;
+        const int t39 = (t37 && t11.w[2] > 0) || (w6 <= 0 && ((t6 <= t38) || (t29 <= t38)));
+        const int t40 = t35 && t36 && !t39;
+        state->w[0] = (t40 ? (t37 ? t14 : t34) : 0);
+        state->w[1] = (t40 ? (t37 ? t15 : t33) : 0);
+        state->w[2] = (!(t35 && t36) ? 2 : (t39 ? 1 : 0));
     }
 }
 
@@ -1179,7 +1243,7 @@ planar_2r_real planar_2r_condition_number(const planar_2r_real q[PLANAR_2R_DOF])
 
 int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real mu_dot[PLANAR_2R_TASK_DIM], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF])
 {
-    /* 160 operations */
+    /* 161 operations */
 
     /* Inputs */
     const planar_2r_real q1 = q[0];
@@ -1192,128 +1256,44 @@ int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r
     const planar_2r_real s1 = sin(q1);
     const planar_2r_real c2 = cos(q2);
     const planar_2r_real s2 = sin(q2);
-    const planar_2r_real c12 = c1*c2 - s1*s2;
-    const planar_2r_real s12 = c1*s2 + c2*s1;
-    const planar_2r_real t0 = c1 + c12;
-    const planar_2r_real t1 = s1 + s12;
-    const planar_2r_real t2 = t0*t1 + c12*s12;
-    const planar_2r_real t3 = (t1*t1);
-    const planar_2r_real t4 = (s12*s12) + t3;
-    const planar_2r_real t5 = (t0*t0);
-    const planar_2r_real t6 = sqrt(t3 + t5);
-    const planar_2r_real t7 = (t1 <= 0 ? 1 : -1)*t6;
-    const planar_2r_real t8 = (c12*c12) + t5;
-    const planar_2r_real t9 = sqrt(t4 + t8);
-    const planar_2r_real t10 = (damping*damping);
-    jacgen_symmetric_solve2_state t11 = {{t4 + t10, -t2, t8 + t10, mu_dot0, mu_dot1}};
-    jacgen_symmetric_solve2(1, &t11);
-    const planar_2r_real t12 = t11.w[0];
-    const planar_2r_real t13 = t11.w[1];
-    const planar_2r_real t14 = -t1*t12 + t0*t13;
-    const planar_2r_real t15 = -s12*t12 + c12*t13;
-    const int t16 = t6 > 0;
-    const planar_2r_real t17 = (t16 ? 1 + fabs(t1)/t6 : 0);
-    const planar_2r_real t18 = -t1;
-    const planar_2r_real t19 = (t16 ? 1.0/(t18 + t7) : 0);
-    const planar_2r_real t20 = -s12;
-    const planar_2r_real t21 = q1 + q2 + c12 + t0 + t18 + t20 + mu_dot0 + mu_dot1 + damping;
-    const planar_2r_real t22 = t0*t19;
-    const planar_2r_real t23 = t17*(t20 + c12*t22);
-    const planar_2r_real t24 = s12 + t23;
-    const planar_2r_real t25 = c12 - t22*t23;
-    const planar_2r_real t26 = t17*(mu_dot0 + t22*mu_dot1);
-    const planar_2r_real t27 = -t26 + mu_dot0;
-    const planar_2r_real t28 = mu_dot1 - t22*t26;
-    const planar_2r_real t29 = fabs(t25);
-    const planar_2r_real t30 = t29*(t25 >= 0 ? 1 : -1);
-    const planar_2r_real t31 = (t29 > 0 ? 2 : 0);
-    const planar_2r_real t32 = t28 - t28*t31;
-    const planar_2r_real t33 = (t30 != 0 ? -t32/t30 : 0);
-    const planar_2r_real t34 = (t7 != 0 ? -(t27 + t24*t33)/t7 : 0);
-    const int t35 = isfinite(t21);
-    const int t36 = damping >= 0;
-    const int t37 = damping > 0;
-    const planar_2r_real t38 = 1e-12*t9;
-    const int t39 = (t37 && t11.w[2] > 0) || (damping <= 0 && ((t6 <= t38) || (t29 <= t38)));
-    const int t40 = t35 && t36 && !t39;
+    jacgen_velocity_solve_state t0 = {{c1, s1, c2, s2, mu_dot0, mu_dot1, damping}};
+    jacgen_velocity_solve(1, &t0);
 
     /* Outputs */
-    q_dot[0] = (t40 ? (t37 ? t14 : t34) : 0);
-    q_dot[1] = (t40 ? (t37 ? t15 : t33) : 0);
-    return (!(t35 && t36) ? 2 : (t39 ? 1 : 0));
+    q_dot[0] = t0.w[0];
+    q_dot[1] = t0.w[1];
+    return (int)t0.w[2];
 }
 
 int planar_2r_velocity_ik_nullspace(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real mu_dot[PLANAR_2R_TASK_DIM], const planar_2r_real z[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF])
 {
-    /* 162 operations */
+    /* 161 operations */
+    (void)z;
 
     /* Inputs */
     const planar_2r_real q1 = q[0];
     const planar_2r_real q2 = q[1];
     const planar_2r_real mu_dot0 = mu_dot[0];
     const planar_2r_real mu_dot1 = mu_dot[1];
-    const planar_2r_real qz1 = z[0];
-    const planar_2r_real qz2 = z[1];
 
     /* Intermediate terms */
     const planar_2r_real c1 = cos(q1);
     const planar_2r_real s1 = sin(q1);
     const planar_2r_real c2 = cos(q2);
     const planar_2r_real s2 = sin(q2);
-    const planar_2r_real c12 = c1*c2 - s1*s2;
-    const planar_2r_real s12 = c1*s2 + c2*s1;
-    const planar_2r_real t0 = c1 + c12;
-    const planar_2r_real t1 = s1 + s12;
-    const planar_2r_real t2 = t0*t1 + c12*s12;
-    const planar_2r_real t3 = (t1*t1);
-    const planar_2r_real t4 = (s12*s12) + t3;
-    const planar_2r_real t5 = (t0*t0);
-    const planar_2r_real t6 = sqrt(t3 + t5);
-    const planar_2r_real t7 = (t1 <= 0 ? 1 : -1)*t6;
-    const planar_2r_real t8 = (c12*c12) + t5;
-    const planar_2r_real t9 = sqrt(t4 + t8);
-    const planar_2r_real t10 = (damping*damping);
-    jacgen_symmetric_solve2_state t11 = {{t4 + t10, -t2, t8 + t10, mu_dot0, mu_dot1}};
-    jacgen_symmetric_solve2(1, &t11);
-    const planar_2r_real t12 = t11.w[0];
-    const planar_2r_real t13 = t11.w[1];
-    const planar_2r_real t14 = -t1*t12 + t0*t13;
-    const planar_2r_real t15 = -s12*t12 + c12*t13;
-    const int t16 = t6 > 0;
-    const planar_2r_real t17 = (t16 ? 1 + fabs(t1)/t6 : 0);
-    const planar_2r_real t18 = -t1;
-    const planar_2r_real t19 = (t16 ? 1.0/(t18 + t7) : 0);
-    const planar_2r_real t20 = -s12;
-    const planar_2r_real t21 = q1 + q2 + c12 + t0 + t18 + t20 + mu_dot0 + mu_dot1 + damping + qz1 + qz2;
-    const planar_2r_real t22 = t0*t19;
-    const planar_2r_real t23 = t17*(t20 + c12*t22);
-    const planar_2r_real t24 = s12 + t23;
-    const planar_2r_real t25 = c12 - t22*t23;
-    const planar_2r_real t26 = t17*(mu_dot0 + t22*mu_dot1);
-    const planar_2r_real t27 = -t26 + mu_dot0;
-    const planar_2r_real t28 = mu_dot1 - t22*t26;
-    const planar_2r_real t29 = fabs(t25);
-    const planar_2r_real t30 = t29*(t25 >= 0 ? 1 : -1);
-    const planar_2r_real t31 = (t29 > 0 ? 2 : 0);
-    const planar_2r_real t32 = t28 - t28*t31;
-    const planar_2r_real t33 = (t30 != 0 ? -t32/t30 : 0);
-    const planar_2r_real t34 = (t7 != 0 ? -(t27 + t24*t33)/t7 : 0);
-    const int t35 = isfinite(t21);
-    const int t36 = damping >= 0;
-    const int t37 = damping > 0;
-    const planar_2r_real t38 = 1e-12*t9;
-    const int t39 = (t37 && t11.w[2] > 0) || (damping <= 0 && ((t6 <= t38) || (t29 <= t38)));
-    const int t40 = t35 && t36 && !t39;
+    jacgen_velocity_solve_state t0 = {{c1, s1, c2, s2, mu_dot0, mu_dot1, damping}};
+    jacgen_velocity_solve(1, &t0);
 
     /* Outputs */
-    q_dot[0] = (t40 ? (t37 ? t14 : t34) : 0);
-    q_dot[1] = (t40 ? (t37 ? t15 : t33) : 0);
-    return (!(t35 && t36) ? 2 : (t39 ? 1 : 0));
+    q_dot[0] = t0.w[0];
+    q_dot[1] = t0.w[1];
+    return (int)t0.w[2];
 }
 
 int planar_2r_resolved_rate(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real target_rate[PLANAR_2R_TASK_DIM], const planar_2r_real gain[PLANAR_2R_TASK_DIM], const planar_2r_real z[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF])
 {
-    /* 168 operations */
+    /* 175 operations */
+    (void)z;
 
     /* Inputs */
     const planar_2r_real q1 = q[0];
@@ -1324,8 +1304,6 @@ int planar_2r_resolved_rate(const planar_2r_real q[PLANAR_2R_DOF], const planar_
     const planar_2r_real mu_dot1 = target_rate[1];
     const planar_2r_real gain0 = gain[0];
     const planar_2r_real gain1 = gain[1];
-    const planar_2r_real qz1 = z[0];
-    const planar_2r_real qz2 = z[1];
 
     /* Intermediate terms */
     const planar_2r_real c1 = cos(q1);
@@ -1336,53 +1314,15 @@ int planar_2r_resolved_rate(const planar_2r_real q[PLANAR_2R_DOF], const planar_
     const planar_2r_real s12 = c1*s2 + c2*s1;
     const planar_2r_real t0 = c1 + c12;
     const planar_2r_real t1 = s1 + s12;
-    const planar_2r_real t2 = t0*t1 + c12*s12;
-    const planar_2r_real t3 = mu_dot0 + gain0*(-t0 + mu0);
-    const planar_2r_real t4 = (t1*t1);
-    const planar_2r_real t5 = (s12*s12) + t4;
-    const planar_2r_real t6 = (t0*t0);
-    const planar_2r_real t7 = sqrt(t4 + t6);
-    const planar_2r_real t8 = (t1 <= 0 ? 1 : -1)*t7;
-    const planar_2r_real t9 = (c12*c12) + t6;
-    const planar_2r_real t10 = sqrt(t5 + t9);
-    const int t11 = t7 > 0;
-    const planar_2r_real t12 = (t11 ? 1 + fabs(t1)/t7 : 0);
-    const planar_2r_real t13 = -t1;
-    const planar_2r_real t14 = (t11 ? 1.0/(t13 + t8) : 0);
-    const planar_2r_real t15 = mu_dot1 + gain1*(t13 + mu1);
-    const planar_2r_real t16 = -s12;
-    const planar_2r_real t17 = q1 + q2 + c12 + t0 + t13 + t16 + damping + qz1 + qz2 + t3 + t15;
-    const planar_2r_real t18 = t0*t14;
-    const planar_2r_real t19 = t12*(t16 + c12*t18);
-    const planar_2r_real t20 = s12 + t19;
-    const planar_2r_real t21 = c12 - t18*t19;
-    const planar_2r_real t22 = t12*(t3 + t18*t15);
-    const planar_2r_real t23 = -t22 + t3;
-    const planar_2r_real t24 = t15 - t18*t22;
-    const planar_2r_real t25 = fabs(t21);
-    const planar_2r_real t26 = t25*(t21 >= 0 ? 1 : -1);
-    const planar_2r_real t27 = (t25 > 0 ? 2 : 0);
-    const planar_2r_real t28 = t24 - t27*t24;
-    const planar_2r_real t29 = (t26 != 0 ? -t28/t26 : 0);
-    const planar_2r_real t30 = (t8 != 0 ? -(t23 + t20*t29)/t8 : 0);
-    const planar_2r_real t31 = (damping*damping);
-    jacgen_symmetric_solve2_state t32 = {{t5 + t31, -t2, t9 + t31, t3, t15}};
-    jacgen_symmetric_solve2(1, &t32);
-    const planar_2r_real t33 = t32.w[0];
-    const planar_2r_real t34 = t32.w[1];
-    const planar_2r_real t35 = -t1*t33 + t0*t34;
-    const planar_2r_real t36 = -s12*t33 + c12*t34;
-    const int t37 = isfinite(t17);
-    const int t38 = damping >= 0;
-    const int t39 = damping > 0;
-    const planar_2r_real t40 = 1e-12*t10;
-    const int t41 = (t39 && t32.w[2] > 0) || (damping <= 0 && ((t7 <= t40) || (t25 <= t40)));
-    const int t42 = t37 && t38 && !t41;
+    const planar_2r_real t2 = mu_dot0 + gain0*(-t0 + mu0);
+    const planar_2r_real t3 = mu_dot1 + gain1*(-t1 + mu1);
+    jacgen_velocity_solve_state t4 = {{c1, s1, c2, s2, t2, t3, damping}};
+    jacgen_velocity_solve(1, &t4);
 
     /* Outputs */
-    q_dot[0] = (t42 ? (t39 ? t35 : t30) : 0);
-    q_dot[1] = (t42 ? (t39 ? t36 : t29) : 0);
-    return (!(t37 && t38) ? 2 : (t41 ? 1 : 0));
+    q_dot[0] = t4.w[0];
+    q_dot[1] = t4.w[1];
+    return (int)t4.w[2];
 }
 
 planar_2r_real planar_2r_ik_numeric_step(const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_start[PLANAR_2R_DOF], planar_2r_real q_next[PLANAR_2R_DOF])

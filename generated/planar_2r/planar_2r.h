@@ -108,15 +108,15 @@ void planar_2r_velocity_ellipsoid(const planar_2r_real q[PLANAR_2R_DOF], planar_
 planar_2r_real planar_2r_condition_number(const planar_2r_real q[PLANAR_2R_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 2; returned as a scalar. 160 operations. */
+ * Result: q_dot[i], i < 2; returned as a scalar. 161 operations. */
 int planar_2r_velocity_ik(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real mu_dot[PLANAR_2R_TASK_DIM], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 2; returned as a scalar. 162 operations. */
+ * Result: q_dot[i], i < 2; returned as a scalar. 161 operations. */
 int planar_2r_velocity_ik_nullspace(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real mu_dot[PLANAR_2R_TASK_DIM], const planar_2r_real z[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 2; returned as a scalar. 168 operations. */
+ * Result: q_dot[i], i < 2; returned as a scalar. 175 operations. */
 int planar_2r_resolved_rate(const planar_2r_real q[PLANAR_2R_DOF], const planar_2r_real target[PLANAR_2R_TASK_DIM], const planar_2r_real target_rate[PLANAR_2R_TASK_DIM], const planar_2r_real gain[PLANAR_2R_TASK_DIM], const planar_2r_real z[PLANAR_2R_DOF], planar_2r_real damping, planar_2r_real q_dot[PLANAR_2R_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).

@@ -82,7 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -334,9 +334,9 @@ def _jacobi3_columns_2(xp, count, state):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _symmetric_solve2(xp, count, state):
-    """X solving a symmetric 2 x 2 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 53 operations a run."""
+    """The solution x of a symmetric 2 x 2 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 53 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, = state
         t0 = w1**2
@@ -370,10 +370,68 @@ def _symmetric_solve2(xp, count, state):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _velocity_solve(xp, count, state):
+    """The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status, `count` times: 157 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, = state
+        c12 = w0*w2 - w1*w3
+        s12 = w0*w3 + w2*w1
+        t0 = w1 + s12
+        t1 = w0 + c12
+        t2 = c12*s12 + t0*t1
+        t3 = t0**2
+        t4 = s12**2 + t3
+        t5 = t1**2
+        t6 = xp.sqrt(t3 + t5)
+        t7 = xp.where(xp.less_equal(t0, 0), xp.asarray(1, dtype=dtype), -1)*t6
+        t8 = c12**2 + t5
+        t9 = xp.sqrt(t4 + t8)
+        t10 = w6**2
+        t11 = _symmetric_solve2(xp, 1, (t4 + t10, -t2, t8 + t10, w4, w5,))
+        t12 = t11[0]
+        t13 = t11[1]
+        t14 = -t0*t12 + t1*t13
+        t15 = -s12*t12 + c12*t13
+        t16 = xp.greater(t6, 0)
+        t17 = xp.where(t16, 1 + xp.abs(t0)/t6, 0)
+        t18 = -t0
+        t19 = xp.where(t16, 1/(t18 + t7), 0)
+        t20 = -s12
+        t21 = w2 + w1 + w3 + 2*t1 + t18 + t20 + w4 + w5 + w6
+        t22 = t1*t19
+        t23 = t17*(t20 + c12*t22)
+        t24 = s12 + t23
+        t25 = c12 - t22*t23
+        t26 = t17*(w4 + t22*w5)
+        t27 = -t26 + w4
+        t28 = w5 - t22*t26
+        t29 = xp.abs(t25)
+        t30 = t29*xp.where(xp.greater_equal(t25, 0), xp.asarray(1, dtype=dtype), -1)
+        t31 = xp.where(xp.greater(t29, 0), xp.asarray(2, dtype=dtype), 0)
+        t32 = t28 - t28*t31
+        t33 = xp.where(xp.not_equal(t30, 0), -t32/t30, 0)
+        t34 = xp.where(xp.not_equal(t7, 0), -(t27 + t24*t33)/t7, 0)
+        t35 = xp.isfinite(t21)
+        t36 = xp.greater_equal(w6, 0)
+        t37 = xp.greater(w6, 0)
+        t38 = 1e-12*t9
+        t39 = (t37 & xp.greater(t11[2], 0)) | (xp.less_equal(w6, 0) & (xp.less_equal(t6, t38) | xp.less_equal(t29, t38)))
+        t40 = t35 & t36 & xp.logical_not(t39)
+        state = (
+            xp.where(t40, xp.where(t37, t14, t34), 0),
+            xp.where(t40, xp.where(t37, t15, t33), 0),
+            xp.where(xp.logical_not(t35 & t36), 2, xp.where(t39, xp.asarray(1, dtype=dtype), 0)),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _nearer_branch(xp, count, state):
     """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 28 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, = state
         t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w3))
@@ -1135,12 +1193,9 @@ def condition_number(q):
     return kappa
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (2 x 1 and 1 x 1), 160 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (2 x 1 and 1 x 1), 161 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (2,)), ("mu_dot", mu_dot, (2,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     trig = _cos_sin(xp, q, (0.0, 0.0), device)
@@ -1148,137 +1203,43 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s1 = trig[..., 1]
     c2 = trig[..., 2]
     s2 = trig[..., 3]
-    c12 = c1*c2 - s1*s2
-    s12 = c1*s2 + c2*s1
-    t0 = c1 + c12
-    t1 = s1 + s12
-    t2 = t0*t1 + c12*s12
-    t3 = t1**2
-    t4 = s12**2 + t3
-    t5 = t0**2
-    t6 = xp.sqrt(t3 + t5)
-    t7 = xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)*t6
-    t8 = c12**2 + t5
-    t9 = xp.sqrt(t4 + t8)
-    t10 = damping**2
-    t11 = _symmetric_solve2(xp, 1, (t4 + t10, -t2, t8 + t10, mu_dot0, mu_dot1,))
-    t12 = t11[0]
-    t13 = t11[1]
-    t14 = -t1*t12 + t0*t13
-    t15 = -s12*t12 + c12*t13
-    t16 = xp.greater(t6, 0)
-    t17 = xp.where(t16, 1 + xp.abs(t1)/t6, 0)
-    t18 = -t1
-    t19 = xp.where(t16, 1/(t18 + t7), 0)
-    t20 = -s12
-    t21 = q1 + q2 + c12 + t0 + t18 + t20 + mu_dot0 + mu_dot1 + damping
-    t22 = t0*t19
-    t23 = t17*(t20 + c12*t22)
-    t24 = s12 + t23
-    t25 = c12 - t22*t23
-    t26 = t17*(mu_dot0 + t22*mu_dot1)
-    t27 = -t26 + mu_dot0
-    t28 = mu_dot1 - t22*t26
-    t29 = xp.abs(t25)
-    t30 = t29*xp.where(xp.greater_equal(t25, 0), xp.asarray(1, dtype=dtype), -1)
-    t31 = xp.where(xp.greater(t29, 0), xp.asarray(2, dtype=dtype), 0)
-    t32 = t28 - t28*t31
-    t33 = xp.where(xp.not_equal(t30, 0), -t32/t30, 0)
-    t34 = xp.where(xp.not_equal(t7, 0), -(t27 + t24*t33)/t7, 0)
-    t35 = xp.isfinite(t21)
-    t36 = xp.greater_equal(damping, 0)
-    t37 = xp.greater(damping, 0)
-    t38 = 1e-12*t9
-    t39 = (t37 & xp.greater(t11[2], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t6, t38) | xp.less_equal(t29, t38)))
-    t40 = t35 & t36 & xp.logical_not(t39)
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, mu_dot0, mu_dot1, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t40, xp.where(t37, t14, t34), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t40, xp.where(t37, t15, t33), 0), batch),  # 1
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
     ], (2,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t35 & t36), 2, xp.where(t39, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[2], batch), xp.int32)
     return q_dot, status
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
-    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (2 x 1 and 1 x 1), 162 operations."""
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (2 x 1 and 1 x 1), 161 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (2,)), ("mu_dot", mu_dot, (2,)), ("z", z, (2,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
-    qz1 = z[..., 0]
-    qz2 = z[..., 1]
     trig = _cos_sin(xp, q, (0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
     c2 = trig[..., 2]
     s2 = trig[..., 3]
-    c12 = c1*c2 - s1*s2
-    s12 = c1*s2 + c2*s1
-    t0 = c1 + c12
-    t1 = s1 + s12
-    t2 = t0*t1 + c12*s12
-    t3 = t1**2
-    t4 = s12**2 + t3
-    t5 = t0**2
-    t6 = xp.sqrt(t3 + t5)
-    t7 = xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)*t6
-    t8 = c12**2 + t5
-    t9 = xp.sqrt(t4 + t8)
-    t10 = damping**2
-    t11 = _symmetric_solve2(xp, 1, (t4 + t10, -t2, t8 + t10, mu_dot0, mu_dot1,))
-    t12 = t11[0]
-    t13 = t11[1]
-    t14 = -t1*t12 + t0*t13
-    t15 = -s12*t12 + c12*t13
-    t16 = xp.greater(t6, 0)
-    t17 = xp.where(t16, 1 + xp.abs(t1)/t6, 0)
-    t18 = -t1
-    t19 = xp.where(t16, 1/(t18 + t7), 0)
-    t20 = -s12
-    t21 = q1 + q2 + c12 + t0 + t18 + t20 + mu_dot0 + mu_dot1 + damping + qz1 + qz2
-    t22 = t0*t19
-    t23 = t17*(t20 + c12*t22)
-    t24 = s12 + t23
-    t25 = c12 - t22*t23
-    t26 = t17*(mu_dot0 + t22*mu_dot1)
-    t27 = -t26 + mu_dot0
-    t28 = mu_dot1 - t22*t26
-    t29 = xp.abs(t25)
-    t30 = t29*xp.where(xp.greater_equal(t25, 0), xp.asarray(1, dtype=dtype), -1)
-    t31 = xp.where(xp.greater(t29, 0), xp.asarray(2, dtype=dtype), 0)
-    t32 = t28 - t28*t31
-    t33 = xp.where(xp.not_equal(t30, 0), -t32/t30, 0)
-    t34 = xp.where(xp.not_equal(t7, 0), -(t27 + t24*t33)/t7, 0)
-    t35 = xp.isfinite(t21)
-    t36 = xp.greater_equal(damping, 0)
-    t37 = xp.greater(damping, 0)
-    t38 = 1e-12*t9
-    t39 = (t37 & xp.greater(t11[2], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t6, t38) | xp.less_equal(t29, t38)))
-    t40 = t35 & t36 & xp.logical_not(t39)
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, mu_dot0, mu_dot1, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t40, xp.where(t37, t14, t34), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t40, xp.where(t37, t15, t33), 0), batch),  # 1
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
     ], (2,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t35 & t36), 2, xp.where(t39, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[2], batch), xp.int32)
     return q_dot, status
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (2 x 1 and 1 x 1), 168 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (2 x 1 and 1 x 1), 175 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (2,)), ("target", target, (2,)), ("target_rate", target_rate, (2,)), ("gain", gain, (2,)), ("z", z, (2,)), ("damping", damping, ()), every=("gain", ))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
     mu0 = target[..., 0]
     mu1 = target[..., 1]
     mu_dot0 = target_rate[..., 0]
     mu_dot1 = target_rate[..., 1]
     gain0 = gain[..., 0]
     gain1 = gain[..., 1]
-    qz1 = z[..., 0]
-    qz2 = z[..., 1]
     trig = _cos_sin(xp, q, (0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
@@ -1288,52 +1249,14 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = t0*t1 + c12*s12
-    t3 = mu_dot0 + gain0*(-t0 + mu0)
-    t4 = t1**2
-    t5 = s12**2 + t4
-    t6 = t0**2
-    t7 = xp.sqrt(t4 + t6)
-    t8 = xp.where(xp.less_equal(t1, 0), xp.asarray(1, dtype=dtype), -1)*t7
-    t9 = c12**2 + t6
-    t10 = xp.sqrt(t5 + t9)
-    t11 = xp.greater(t7, 0)
-    t12 = xp.where(t11, 1 + xp.abs(t1)/t7, 0)
-    t13 = -t1
-    t14 = xp.where(t11, 1/(t13 + t8), 0)
-    t15 = mu_dot1 + gain1*(t13 + mu1)
-    t16 = -s12
-    t17 = q1 + q2 + c12 + t0 + t13 + t16 + damping + qz1 + qz2 + t3 + t15
-    t18 = t0*t14
-    t19 = t12*(t16 + c12*t18)
-    t20 = s12 + t19
-    t21 = c12 - t18*t19
-    t22 = t12*(t3 + t18*t15)
-    t23 = -t22 + t3
-    t24 = t15 - t18*t22
-    t25 = xp.abs(t21)
-    t26 = t25*xp.where(xp.greater_equal(t21, 0), xp.asarray(1, dtype=dtype), -1)
-    t27 = xp.where(xp.greater(t25, 0), xp.asarray(2, dtype=dtype), 0)
-    t28 = t24 - t27*t24
-    t29 = xp.where(xp.not_equal(t26, 0), -t28/t26, 0)
-    t30 = xp.where(xp.not_equal(t8, 0), -(t23 + t20*t29)/t8, 0)
-    t31 = damping**2
-    t32 = _symmetric_solve2(xp, 1, (t5 + t31, -t2, t9 + t31, t3, t15,))
-    t33 = t32[0]
-    t34 = t32[1]
-    t35 = -t1*t33 + t0*t34
-    t36 = -s12*t33 + c12*t34
-    t37 = xp.isfinite(t17)
-    t38 = xp.greater_equal(damping, 0)
-    t39 = xp.greater(damping, 0)
-    t40 = 1e-12*t10
-    t41 = (t39 & xp.greater(t32[2], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t7, t40) | xp.less_equal(t25, t40)))
-    t42 = t37 & t38 & xp.logical_not(t41)
+    t2 = mu_dot0 + gain0*(-t0 + mu0)
+    t3 = mu_dot1 + gain1*(-t1 + mu1)
+    t4 = _velocity_solve(xp, 1, (c1, s1, c2, s2, t2, t3, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t42, xp.where(t39, t35, t30), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t42, xp.where(t39, t36, t29), 0), batch),  # 1
+        xp.broadcast_to(t4[0], batch),  # 0
+        xp.broadcast_to(t4[1], batch),  # 1
     ], (2,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t37 & t38), 2, xp.where(t41, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t4[2], batch), xp.int32)
     return q_dot, status
 
 

@@ -270,7 +270,7 @@ def _jacobi3_columns_2(count, state):
 
 
 def _symmetric_solve2(count, state):
-    """X solving a symmetric 2 x 2 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 53 operations a run."""
+    """The solution x of a symmetric 2 x 2 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 53 operations a run."""
     for _ in range(count):
         w0, w1, w2, w3, w4, = state
         t0 = w1**2
@@ -299,6 +299,61 @@ def _symmetric_solve2(count, state):
             t20,
             t19,
             casadi.if_else(casadi.logic_or((t3 <= t21), (t15 <= t21)), 1, 0),
+        )
+    return state
+
+
+def _velocity_solve(count, state):
+    """The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status, `count` times: 157 operations a run."""
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, = state
+        c12 = w0*w2 - w1*w3
+        s12 = w0*w3 + w2*w1
+        t0 = w1 + s12
+        t1 = w0 + c12
+        t2 = c12*s12 + t0*t1
+        t3 = t0**2
+        t4 = s12**2 + t3
+        t5 = t1**2
+        t6 = casadi.sqrt(t3 + t5)
+        t7 = casadi.if_else((t0 <= 0), 1, -1)*t6
+        t8 = c12**2 + t5
+        t9 = casadi.sqrt(t4 + t8)
+        t10 = w6**2
+        t11 = _symmetric_solve2(1, (t4 + t10, -t2, t8 + t10, w4, w5,))
+        t12 = t11[0]
+        t13 = t11[1]
+        t14 = -t0*t12 + t1*t13
+        t15 = -s12*t12 + c12*t13
+        t16 = (t6 > 0)
+        t17 = casadi.if_else(t16, 1 + casadi.fabs(t0)/t6, 0)
+        t18 = -t0
+        t19 = casadi.if_else(t16, 1/(t18 + t7), 0)
+        t20 = -s12
+        t21 = w2 + w1 + w3 + 2*t1 + t18 + t20 + w4 + w5 + w6
+        t22 = t1*t19
+        t23 = t17*(t20 + c12*t22)
+        t24 = s12 + t23
+        t25 = c12 - t22*t23
+        t26 = t17*(w4 + t22*w5)
+        t27 = -t26 + w4
+        t28 = w5 - t22*t26
+        t29 = casadi.fabs(t25)
+        t30 = t29*casadi.if_else((t25 >= 0), 1, -1)
+        t31 = casadi.if_else((t29 > 0), 2, 0)
+        t32 = t28 - t28*t31
+        t33 = casadi.if_else((t30 != 0), -t32/t30, 0)
+        t34 = casadi.if_else((t7 != 0), -(t27 + t24*t33)/t7, 0)
+        t35 = (casadi.fabs(t21) < casadi.inf)
+        t36 = (w6 >= 0)
+        t37 = (w6 > 0)
+        t38 = 1e-12*t9
+        t39 = casadi.logic_or(casadi.logic_and(t37, (t11[2] > 0)), casadi.logic_and((w6 <= 0), casadi.logic_or((t6 <= t38), (t29 <= t38))))
+        t40 = casadi.logic_and(casadi.logic_and(t35, t36), casadi.logic_not(t39))
+        state = (
+            casadi.if_else(t40, casadi.if_else(t37, t14, t34), 0),
+            casadi.if_else(t40, casadi.if_else(t37, t15, t33), 0),
+            casadi.if_else(casadi.logic_not(casadi.logic_and(t35, t36)), 2, casadi.if_else(t39, 1, 0)),
         )
     return state
 
@@ -939,7 +994,7 @@ def _condition_number(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 160 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 161 operations."""
     q1 = q[0]
     q2 = q[1]
     mu_dot0 = mu_dot[0]
@@ -948,122 +1003,36 @@ def _velocity_ik(q, mu_dot, damping):
     s1 = casadi.sin(q1)
     c2 = casadi.cos(q2)
     s2 = casadi.sin(q2)
-    c12 = c1*c2 - s1*s2
-    s12 = c1*s2 + c2*s1
-    t0 = c1 + c12
-    t1 = s1 + s12
-    t2 = t0*t1 + c12*s12
-    t3 = t1**2
-    t4 = s12**2 + t3
-    t5 = t0**2
-    t6 = casadi.sqrt(t3 + t5)
-    t7 = casadi.if_else((t1 <= 0), 1, -1)*t6
-    t8 = c12**2 + t5
-    t9 = casadi.sqrt(t4 + t8)
-    t10 = damping**2
-    t11 = _symmetric_solve2(1, (t4 + t10, -t2, t8 + t10, mu_dot0, mu_dot1,))
-    t12 = t11[0]
-    t13 = t11[1]
-    t14 = -t1*t12 + t0*t13
-    t15 = -s12*t12 + c12*t13
-    t16 = (t6 > 0)
-    t17 = casadi.if_else(t16, 1 + casadi.fabs(t1)/t6, 0)
-    t18 = -t1
-    t19 = casadi.if_else(t16, 1/(t18 + t7), 0)
-    t20 = -s12
-    t21 = q1 + q2 + c12 + t0 + t18 + t20 + mu_dot0 + mu_dot1 + damping
-    t22 = t0*t19
-    t23 = t17*(t20 + c12*t22)
-    t24 = s12 + t23
-    t25 = c12 - t22*t23
-    t26 = t17*(mu_dot0 + t22*mu_dot1)
-    t27 = -t26 + mu_dot0
-    t28 = mu_dot1 - t22*t26
-    t29 = casadi.fabs(t25)
-    t30 = t29*casadi.if_else((t25 >= 0), 1, -1)
-    t31 = casadi.if_else((t29 > 0), 2, 0)
-    t32 = t28 - t28*t31
-    t33 = casadi.if_else((t30 != 0), -t32/t30, 0)
-    t34 = casadi.if_else((t7 != 0), -(t27 + t24*t33)/t7, 0)
-    t35 = (casadi.fabs(t21) < casadi.inf)
-    t36 = (damping >= 0)
-    t37 = (damping > 0)
-    t38 = 1e-12*t9
-    t39 = casadi.logic_or(casadi.logic_and(t37, (t11[2] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or((t6 <= t38), (t29 <= t38))))
-    t40 = casadi.logic_and(casadi.logic_and(t35, t36), casadi.logic_not(t39))
+    t0 = _velocity_solve(1, (c1, s1, c2, s2, mu_dot0, mu_dot1, damping,))
     q_dot = casadi.SX(2, 1)
-    q_dot[0, 0] = casadi.if_else(t40, casadi.if_else(t37, t14, t34), 0)
-    q_dot[1, 0] = casadi.if_else(t40, casadi.if_else(t37, t15, t33), 0)
+    q_dot[0, 0] = t0[0]
+    q_dot[1, 0] = t0[1]
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t35, t36)), 2, casadi.if_else(t39, 1, 0))
+    status[0, 0] = t0[2]
     return [q_dot, status]
 
 
 def _velocity_ik_nullspace(q, mu_dot, z, damping):
-    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 162 operations."""
+    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 161 operations."""
     q1 = q[0]
     q2 = q[1]
     mu_dot0 = mu_dot[0]
     mu_dot1 = mu_dot[1]
-    qz1 = z[0]
-    qz2 = z[1]
     c1 = casadi.cos(q1)
     s1 = casadi.sin(q1)
     c2 = casadi.cos(q2)
     s2 = casadi.sin(q2)
-    c12 = c1*c2 - s1*s2
-    s12 = c1*s2 + c2*s1
-    t0 = c1 + c12
-    t1 = s1 + s12
-    t2 = t0*t1 + c12*s12
-    t3 = t1**2
-    t4 = s12**2 + t3
-    t5 = t0**2
-    t6 = casadi.sqrt(t3 + t5)
-    t7 = casadi.if_else((t1 <= 0), 1, -1)*t6
-    t8 = c12**2 + t5
-    t9 = casadi.sqrt(t4 + t8)
-    t10 = damping**2
-    t11 = _symmetric_solve2(1, (t4 + t10, -t2, t8 + t10, mu_dot0, mu_dot1,))
-    t12 = t11[0]
-    t13 = t11[1]
-    t14 = -t1*t12 + t0*t13
-    t15 = -s12*t12 + c12*t13
-    t16 = (t6 > 0)
-    t17 = casadi.if_else(t16, 1 + casadi.fabs(t1)/t6, 0)
-    t18 = -t1
-    t19 = casadi.if_else(t16, 1/(t18 + t7), 0)
-    t20 = -s12
-    t21 = q1 + q2 + c12 + t0 + t18 + t20 + mu_dot0 + mu_dot1 + damping + qz1 + qz2
-    t22 = t0*t19
-    t23 = t17*(t20 + c12*t22)
-    t24 = s12 + t23
-    t25 = c12 - t22*t23
-    t26 = t17*(mu_dot0 + t22*mu_dot1)
-    t27 = -t26 + mu_dot0
-    t28 = mu_dot1 - t22*t26
-    t29 = casadi.fabs(t25)
-    t30 = t29*casadi.if_else((t25 >= 0), 1, -1)
-    t31 = casadi.if_else((t29 > 0), 2, 0)
-    t32 = t28 - t28*t31
-    t33 = casadi.if_else((t30 != 0), -t32/t30, 0)
-    t34 = casadi.if_else((t7 != 0), -(t27 + t24*t33)/t7, 0)
-    t35 = (casadi.fabs(t21) < casadi.inf)
-    t36 = (damping >= 0)
-    t37 = (damping > 0)
-    t38 = 1e-12*t9
-    t39 = casadi.logic_or(casadi.logic_and(t37, (t11[2] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or((t6 <= t38), (t29 <= t38))))
-    t40 = casadi.logic_and(casadi.logic_and(t35, t36), casadi.logic_not(t39))
+    t0 = _velocity_solve(1, (c1, s1, c2, s2, mu_dot0, mu_dot1, damping,))
     q_dot = casadi.SX(2, 1)
-    q_dot[0, 0] = casadi.if_else(t40, casadi.if_else(t37, t14, t34), 0)
-    q_dot[1, 0] = casadi.if_else(t40, casadi.if_else(t37, t15, t33), 0)
+    q_dot[0, 0] = t0[0]
+    q_dot[1, 0] = t0[1]
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t35, t36)), 2, casadi.if_else(t39, 1, 0))
+    status[0, 0] = t0[2]
     return [q_dot, status]
 
 
 def _resolved_rate(q, target, target_rate, gain, z, damping):
-    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 168 operations."""
+    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 175 operations."""
     q1 = q[0]
     q2 = q[1]
     mu0 = target[0]
@@ -1072,8 +1041,6 @@ def _resolved_rate(q, target, target_rate, gain, z, damping):
     mu_dot1 = target_rate[1]
     gain0 = gain[0]
     gain1 = gain[1]
-    qz1 = z[0]
-    qz2 = z[1]
     c1 = casadi.cos(q1)
     s1 = casadi.sin(q1)
     c2 = casadi.cos(q2)
@@ -1082,52 +1049,14 @@ def _resolved_rate(q, target, target_rate, gain, z, damping):
     s12 = c1*s2 + c2*s1
     t0 = c1 + c12
     t1 = s1 + s12
-    t2 = t0*t1 + c12*s12
-    t3 = mu_dot0 + gain0*(-t0 + mu0)
-    t4 = t1**2
-    t5 = s12**2 + t4
-    t6 = t0**2
-    t7 = casadi.sqrt(t4 + t6)
-    t8 = casadi.if_else((t1 <= 0), 1, -1)*t7
-    t9 = c12**2 + t6
-    t10 = casadi.sqrt(t5 + t9)
-    t11 = (t7 > 0)
-    t12 = casadi.if_else(t11, 1 + casadi.fabs(t1)/t7, 0)
-    t13 = -t1
-    t14 = casadi.if_else(t11, 1/(t13 + t8), 0)
-    t15 = mu_dot1 + gain1*(t13 + mu1)
-    t16 = -s12
-    t17 = q1 + q2 + c12 + t0 + t13 + t16 + damping + qz1 + qz2 + t3 + t15
-    t18 = t0*t14
-    t19 = t12*(t16 + c12*t18)
-    t20 = s12 + t19
-    t21 = c12 - t18*t19
-    t22 = t12*(t3 + t18*t15)
-    t23 = -t22 + t3
-    t24 = t15 - t18*t22
-    t25 = casadi.fabs(t21)
-    t26 = t25*casadi.if_else((t21 >= 0), 1, -1)
-    t27 = casadi.if_else((t25 > 0), 2, 0)
-    t28 = t24 - t27*t24
-    t29 = casadi.if_else((t26 != 0), -t28/t26, 0)
-    t30 = casadi.if_else((t8 != 0), -(t23 + t20*t29)/t8, 0)
-    t31 = damping**2
-    t32 = _symmetric_solve2(1, (t5 + t31, -t2, t9 + t31, t3, t15,))
-    t33 = t32[0]
-    t34 = t32[1]
-    t35 = -t1*t33 + t0*t34
-    t36 = -s12*t33 + c12*t34
-    t37 = (casadi.fabs(t17) < casadi.inf)
-    t38 = (damping >= 0)
-    t39 = (damping > 0)
-    t40 = 1e-12*t10
-    t41 = casadi.logic_or(casadi.logic_and(t39, (t32[2] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or((t7 <= t40), (t25 <= t40))))
-    t42 = casadi.logic_and(casadi.logic_and(t37, t38), casadi.logic_not(t41))
+    t2 = mu_dot0 + gain0*(-t0 + mu0)
+    t3 = mu_dot1 + gain1*(-t1 + mu1)
+    t4 = _velocity_solve(1, (c1, s1, c2, s2, t2, t3, damping,))
     q_dot = casadi.SX(2, 1)
-    q_dot[0, 0] = casadi.if_else(t42, casadi.if_else(t39, t35, t30), 0)
-    q_dot[1, 0] = casadi.if_else(t42, casadi.if_else(t39, t36, t29), 0)
+    q_dot[0, 0] = t4[0]
+    q_dot[1, 0] = t4[1]
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t37, t38)), 2, casadi.if_else(t41, 1, 0))
+    status[0, 0] = t4[2]
     return [q_dot, status]
 
 

@@ -394,7 +394,7 @@ static void jacgen_jacobi3_rows(int count, jacgen_jacobi3_rows_state *state)
 
 typedef struct { planar_3r_real w[9]; } jacgen_symmetric_solve3_state;
 
-/* X solving a symmetric 3 x 3 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular: 118 operations a run. */
+/* The solution x of a symmetric 3 x 3 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular: 118 operations a run. */
 static void jacgen_symmetric_solve3(int count, jacgen_symmetric_solve3_state *state)
 {
     JACGEN_KERNEL_LOOP
@@ -455,6 +455,106 @@ static void jacgen_symmetric_solve3(int count, jacgen_symmetric_solve3_state *st
         state->w[1] = t40;
         state->w[2] = t39;
         state->w[3] = ((t4 <= t42) || (t23 <= t42) || (t35 <= t42) ? 1 : 0);
+    }
+}
+
+typedef struct { planar_3r_real w[10]; } jacgen_velocity_solve_state;
+
+/* The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status: 311 operations a run. */
+static void jacgen_velocity_solve(int count, jacgen_velocity_solve_state *state)
+{
+    JACGEN_KERNEL_LOOP
+    for (int run = 0; run < count; run++) {
+        const planar_3r_real w0 = state->w[0];
+        const planar_3r_real w1 = state->w[1];
+        const planar_3r_real w2 = state->w[2];
+        const planar_3r_real w3 = state->w[3];
+        const planar_3r_real w4 = state->w[4];
+        const planar_3r_real w5 = state->w[5];
+        const planar_3r_real w6 = state->w[6];
+        const planar_3r_real w7 = state->w[7];
+        const planar_3r_real w8 = state->w[8];
+        const planar_3r_real w9 = state->w[9];
+        const planar_3r_real c12 = w0*w2 - w1*w3;
+        const planar_3r_real s12 = w0*w3 + w2*w1;
+        const planar_3r_real c123 = c12*w4 - s12*w5;
+        const planar_3r_real s123 = c12*w5 + s12*w4;
+        const planar_3r_real t0 = c12 + c123;
+        const planar_3r_real t1 = s12 + s123;
+        const planar_3r_real t2 = w1 + t1;
+        const planar_3r_real t3 = t2 + t1 + s123;
+        const planar_3r_real t4 = w0 + t0;
+        const planar_3r_real t5 = t0*t1 + c123*s123 + t2*t4;
+        const planar_3r_real t6 = (t2*t2);
+        const planar_3r_real t7 = (s123*s123) + (t1*t1) + t6;
+        const planar_3r_real t8 = (t4*t4);
+        const planar_3r_real t9 = sqrt(1 + t6 + t8);
+        const planar_3r_real t10 = (t2 <= 0 ? 1 : -1)*t9;
+        const planar_3r_real t11 = (c123*c123) + (t0*t0) + t8;
+        const planar_3r_real t12 = sqrt(3 + t7 + t11);
+        const planar_3r_real t13 = c123 + t4;
+        const planar_3r_real t14 = t0 + t13;
+        const planar_3r_real t15 = (w9*w9);
+        jacgen_symmetric_solve3_state t16 = {{t7 + t15, -t5, -t3, t11 + t15, t14, 3 + t15, w6, w7, w8}};
+        jacgen_symmetric_solve3(1, &t16);
+        const planar_3r_real t17 = t16.w[2];
+        const planar_3r_real t18 = t16.w[0];
+        const planar_3r_real t19 = t16.w[1];
+        const planar_3r_real t20 = t17 - t2*t18 + t4*t19;
+        const planar_3r_real t21 = t17 - t1*t18 + t0*t19;
+        const planar_3r_real t22 = t17 - s123*t18 + c123*t19;
+        const int t23 = t9 > 0;
+        const planar_3r_real t24 = (t23 ? 1 + fabs(t2)/t9 : 0);
+        const planar_3r_real t25 = -t2;
+        const planar_3r_real t26 = (t23 ? 1.0/(t25 + t10) : 0);
+        const planar_3r_real t27 = -t1;
+        const planar_3r_real t28 = t4*t26;
+        const planar_3r_real t29 = t24*(t27 + t26 + t0*t28);
+        const planar_3r_real t30 = t1 + t29;
+        const planar_3r_real t31 = t24*(w6 + w8*t26 + t28*w7);
+        const planar_3r_real t32 = -t31 + w6;
+        const planar_3r_real t33 = t26*t29;
+        const planar_3r_real t34 = t0 - t4*t33;
+        const planar_3r_real t35 = 1 - t33;
+        const planar_3r_real t36 = sqrt((t34*t34) + (t35*t35));
+        const planar_3r_real t37 = t36*(t34 >= 0 ? 1 : -1);
+        const planar_3r_real t38 = -s123;
+        const planar_3r_real t39 = t24*(t38 + t26 + c123*t28);
+        const planar_3r_real t40 = s123 + t39;
+        const planar_3r_real t41 = 3 + w2 + w1 + w3 + w4 + w5 + t4 + t13 + t25 + t27 + t38 + w6 + w7 + w8 + w9;
+        const planar_3r_real t42 = t26*t39;
+        const planar_3r_real t43 = c123 - t4*t42;
+        const planar_3r_real t44 = 1 - t42;
+        const planar_3r_real t45 = t26*t31;
+        const planar_3r_real t46 = w7 - t4*t45;
+        const planar_3r_real t47 = -t45 + w8;
+        const int t48 = t36 > 0;
+        const planar_3r_real t49 = (t48 ? 1.0/(t34 + t37) : 0);
+        const planar_3r_real t50 = (t48 ? 1 + fabs(t34)/t36 : 0);
+        const planar_3r_real t51 = t35*t49;
+        const planar_3r_real t52 = t50*(t43 + t51*t44);
+        const planar_3r_real t53 = -t52 + t43;
+        const planar_3r_real t54 = t44 - t51*t52;
+        const planar_3r_real t55 = t50*(t46 + t51*t47);
+        const planar_3r_real t56 = -t55 + t46;
+        const planar_3r_real t57 = t47 - t51*t55;
+        const planar_3r_real t58 = fabs(t54);
+        const planar_3r_real t59 = t58*(t54 >= 0 ? 1 : -1);
+        const planar_3r_real t60 = (t58 > 0 ? 2 : 0);
+        const planar_3r_real t61 = t57 - t57*t60;
+        const planar_3r_real t62 = (t59 != 0 ? -t61/t59 : 0);
+        const planar_3r_real t63 = (t37 != 0 ? -(t56 - t53*t62)/t37 : 0);
+        const planar_3r_real t64 = (t10 != 0 ? -(t32 + t30*t63 + t40*t62)/t10 : 0);
+        const int t65 = isfinite(t41);
+        const int t66 = w9 >= 0;
+        const int t67 = w9 > 0;
+        const planar_3r_real t68 = 1e-12*t12;
+        const int t69 = (t67 && t16.w[3] > 0) || (w9 <= 0 && ((t9 <= t68) || (t36 <= t68) || (t58 <= t68)));
+        const int t70 = t65 && t66 && !t69;
+        state->w[0] = (t70 ? (t67 ? t20 : t64) : 0);
+        state->w[1] = (t70 ? (t67 ? t21 : t63) : 0);
+        state->w[2] = (t70 ? (t67 ? t22 : t62) : 0);
+        state->w[3] = (!(t65 && t66) ? 2 : (t69 ? 1 : 0));
     }
 }
 
@@ -1606,108 +1706,6 @@ planar_3r_real planar_3r_condition_number(const planar_3r_real q[PLANAR_3R_DOF])
 
 int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF])
 {
-    /* 314 operations */
-
-    /* Inputs */
-    const planar_3r_real q1 = q[0];
-    const planar_3r_real q2 = q[1];
-    const planar_3r_real q3 = q[2];
-    const planar_3r_real mu_dot0 = mu_dot[0];
-    const planar_3r_real mu_dot1 = mu_dot[1];
-    const planar_3r_real mu_dot2 = mu_dot[2];
-
-    /* Intermediate terms */
-    const planar_3r_real c1 = cos(q1);
-    const planar_3r_real s1 = sin(q1);
-    const planar_3r_real c2 = cos(q2);
-    const planar_3r_real s2 = sin(q2);
-    const planar_3r_real c12 = c1*c2 - s1*s2;
-    const planar_3r_real s12 = c1*s2 + c2*s1;
-    const planar_3r_real c3 = cos(q3);
-    const planar_3r_real s3 = sin(q3);
-    const planar_3r_real c123 = c12*c3 - s12*s3;
-    const planar_3r_real s123 = c12*s3 + s12*c3;
-    const planar_3r_real t0 = c12 + c123;
-    const planar_3r_real t1 = s12 + s123;
-    const planar_3r_real t2 = c1 + t0;
-    const planar_3r_real t3 = s1 + t1;
-    const planar_3r_real t4 = t2*t3 + t0*t1 + c123*s123;
-    const planar_3r_real t5 = t3 + t1 + s123;
-    const planar_3r_real t6 = (t3*t3);
-    const planar_3r_real t7 = (s123*s123) + (t1*t1) + t6;
-    const planar_3r_real t8 = (t2*t2);
-    const planar_3r_real t9 = sqrt(1 + t6 + t8);
-    const planar_3r_real t10 = (t3 <= 0 ? 1 : -1)*t9;
-    const planar_3r_real t11 = (c123*c123) + (t0*t0) + t8;
-    const planar_3r_real t12 = sqrt(3 + t7 + t11);
-    const planar_3r_real t13 = c123 + t0 + t2;
-    const planar_3r_real t14 = (damping*damping);
-    jacgen_symmetric_solve3_state t15 = {{t7 + t14, -t4, -t5, t11 + t14, t13, 3 + t14, mu_dot0, mu_dot1, mu_dot2}};
-    jacgen_symmetric_solve3(1, &t15);
-    const planar_3r_real t16 = t15.w[2];
-    const planar_3r_real t17 = t15.w[0];
-    const planar_3r_real t18 = t15.w[1];
-    const planar_3r_real t19 = t16 - t3*t17 + t2*t18;
-    const planar_3r_real t20 = t16 - t1*t17 + t0*t18;
-    const planar_3r_real t21 = t16 - s123*t17 + c123*t18;
-    const int t22 = t9 > 0;
-    const planar_3r_real t23 = (t22 ? 1 + fabs(t3)/t9 : 0);
-    const planar_3r_real t24 = -t3;
-    const planar_3r_real t25 = (t22 ? 1.0/(t24 + t10) : 0);
-    const planar_3r_real t26 = -t1;
-    const planar_3r_real t27 = t2*t25;
-    const planar_3r_real t28 = t23*(t26 + t25 + t0*t27);
-    const planar_3r_real t29 = t1 + t28;
-    const planar_3r_real t30 = t23*(mu_dot0 + mu_dot2*t25 + t27*mu_dot1);
-    const planar_3r_real t31 = -t30 + mu_dot0;
-    const planar_3r_real t32 = t25*t28;
-    const planar_3r_real t33 = t0 - t2*t32;
-    const planar_3r_real t34 = 1 - t32;
-    const planar_3r_real t35 = sqrt((t33*t33) + (t34*t34));
-    const planar_3r_real t36 = t35*(t33 >= 0 ? 1 : -1);
-    const planar_3r_real t37 = -s123;
-    const planar_3r_real t38 = t23*(t37 + t25 + c123*t27);
-    const planar_3r_real t39 = s123 + t38;
-    const planar_3r_real t40 = 3 + q1 + q2 + q3 + t13 + t24 + t26 + t37 + mu_dot0 + mu_dot1 + mu_dot2 + damping;
-    const planar_3r_real t41 = t25*t38;
-    const planar_3r_real t42 = c123 - t2*t41;
-    const planar_3r_real t43 = 1 - t41;
-    const planar_3r_real t44 = t25*t30;
-    const planar_3r_real t45 = mu_dot1 - t2*t44;
-    const planar_3r_real t46 = -t44 + mu_dot2;
-    const int t47 = t35 > 0;
-    const planar_3r_real t48 = (t47 ? 1.0/(t33 + t36) : 0);
-    const planar_3r_real t49 = (t47 ? 1 + fabs(t33)/t35 : 0);
-    const planar_3r_real t50 = t34*t48;
-    const planar_3r_real t51 = t49*(t42 + t50*t43);
-    const planar_3r_real t52 = -t51 + t42;
-    const planar_3r_real t53 = t43 - t50*t51;
-    const planar_3r_real t54 = t49*(t45 + t50*t46);
-    const planar_3r_real t55 = -t54 + t45;
-    const planar_3r_real t56 = t46 - t50*t54;
-    const planar_3r_real t57 = fabs(t53);
-    const planar_3r_real t58 = t57*(t53 >= 0 ? 1 : -1);
-    const planar_3r_real t59 = (t57 > 0 ? 2 : 0);
-    const planar_3r_real t60 = t56 - t56*t59;
-    const planar_3r_real t61 = (t58 != 0 ? -t60/t58 : 0);
-    const planar_3r_real t62 = (t36 != 0 ? -(t55 - t52*t61)/t36 : 0);
-    const planar_3r_real t63 = (t10 != 0 ? -(t31 + t29*t62 + t39*t61)/t10 : 0);
-    const int t64 = isfinite(t40);
-    const int t65 = damping >= 0;
-    const int t66 = damping > 0;
-    const planar_3r_real t67 = 1e-12*t12;
-    const int t68 = (t66 && t15.w[3] > 0) || (damping <= 0 && ((t9 <= t67) || (t35 <= t67) || (t57 <= t67)));
-    const int t69 = t64 && t65 && !t68;
-
-    /* Outputs */
-    q_dot[0] = (t69 ? (t66 ? t19 : t63) : 0);
-    q_dot[1] = (t69 ? (t66 ? t20 : t62) : 0);
-    q_dot[2] = (t69 ? (t66 ? t21 : t61) : 0);
-    return (!(t64 && t65) ? 2 : (t68 ? 1 : 0));
-}
-
-int planar_3r_velocity_ik_nullspace(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], const planar_3r_real z[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF])
-{
     /* 317 operations */
 
     /* Inputs */
@@ -1717,103 +1715,58 @@ int planar_3r_velocity_ik_nullspace(const planar_3r_real q[PLANAR_3R_DOF], const
     const planar_3r_real mu_dot0 = mu_dot[0];
     const planar_3r_real mu_dot1 = mu_dot[1];
     const planar_3r_real mu_dot2 = mu_dot[2];
-    const planar_3r_real qz1 = z[0];
-    const planar_3r_real qz2 = z[1];
-    const planar_3r_real qz3 = z[2];
 
     /* Intermediate terms */
     const planar_3r_real c1 = cos(q1);
     const planar_3r_real s1 = sin(q1);
     const planar_3r_real c2 = cos(q2);
     const planar_3r_real s2 = sin(q2);
-    const planar_3r_real c12 = c1*c2 - s1*s2;
-    const planar_3r_real s12 = c1*s2 + c2*s1;
     const planar_3r_real c3 = cos(q3);
     const planar_3r_real s3 = sin(q3);
-    const planar_3r_real c123 = c12*c3 - s12*s3;
-    const planar_3r_real s123 = c12*s3 + s12*c3;
-    const planar_3r_real t0 = c12 + c123;
-    const planar_3r_real t1 = s12 + s123;
-    const planar_3r_real t2 = c1 + t0;
-    const planar_3r_real t3 = s1 + t1;
-    const planar_3r_real t4 = t2*t3 + t0*t1 + c123*s123;
-    const planar_3r_real t5 = t3 + t1 + s123;
-    const planar_3r_real t6 = (t3*t3);
-    const planar_3r_real t7 = (s123*s123) + (t1*t1) + t6;
-    const planar_3r_real t8 = (t2*t2);
-    const planar_3r_real t9 = sqrt(1 + t6 + t8);
-    const planar_3r_real t10 = (t3 <= 0 ? 1 : -1)*t9;
-    const planar_3r_real t11 = (c123*c123) + (t0*t0) + t8;
-    const planar_3r_real t12 = sqrt(3 + t7 + t11);
-    const planar_3r_real t13 = c123 + t0 + t2;
-    const planar_3r_real t14 = (damping*damping);
-    jacgen_symmetric_solve3_state t15 = {{t7 + t14, -t4, -t5, t11 + t14, t13, 3 + t14, mu_dot0, mu_dot1, mu_dot2}};
-    jacgen_symmetric_solve3(1, &t15);
-    const planar_3r_real t16 = t15.w[2];
-    const planar_3r_real t17 = t15.w[0];
-    const planar_3r_real t18 = t15.w[1];
-    const planar_3r_real t19 = t16 - t3*t17 + t2*t18;
-    const planar_3r_real t20 = t16 - t1*t17 + t0*t18;
-    const planar_3r_real t21 = t16 - s123*t17 + c123*t18;
-    const int t22 = t9 > 0;
-    const planar_3r_real t23 = (t22 ? 1 + fabs(t3)/t9 : 0);
-    const planar_3r_real t24 = -t3;
-    const planar_3r_real t25 = (t22 ? 1.0/(t24 + t10) : 0);
-    const planar_3r_real t26 = -t1;
-    const planar_3r_real t27 = t2*t25;
-    const planar_3r_real t28 = t23*(t26 + t25 + t0*t27);
-    const planar_3r_real t29 = t1 + t28;
-    const planar_3r_real t30 = t23*(mu_dot0 + mu_dot2*t25 + t27*mu_dot1);
-    const planar_3r_real t31 = -t30 + mu_dot0;
-    const planar_3r_real t32 = t25*t28;
-    const planar_3r_real t33 = t0 - t2*t32;
-    const planar_3r_real t34 = 1 - t32;
-    const planar_3r_real t35 = sqrt((t33*t33) + (t34*t34));
-    const planar_3r_real t36 = t35*(t33 >= 0 ? 1 : -1);
-    const planar_3r_real t37 = -s123;
-    const planar_3r_real t38 = t23*(t37 + t25 + c123*t27);
-    const planar_3r_real t39 = s123 + t38;
-    const planar_3r_real t40 = 3 + q1 + q2 + q3 + t13 + t24 + t26 + t37 + mu_dot0 + mu_dot1 + mu_dot2 + damping + qz1 + qz2 + qz3;
-    const planar_3r_real t41 = t25*t38;
-    const planar_3r_real t42 = c123 - t2*t41;
-    const planar_3r_real t43 = 1 - t41;
-    const planar_3r_real t44 = t25*t30;
-    const planar_3r_real t45 = mu_dot1 - t2*t44;
-    const planar_3r_real t46 = -t44 + mu_dot2;
-    const int t47 = t35 > 0;
-    const planar_3r_real t48 = (t47 ? 1.0/(t33 + t36) : 0);
-    const planar_3r_real t49 = (t47 ? 1 + fabs(t33)/t35 : 0);
-    const planar_3r_real t50 = t34*t48;
-    const planar_3r_real t51 = t49*(t42 + t50*t43);
-    const planar_3r_real t52 = -t51 + t42;
-    const planar_3r_real t53 = t43 - t50*t51;
-    const planar_3r_real t54 = t49*(t45 + t50*t46);
-    const planar_3r_real t55 = -t54 + t45;
-    const planar_3r_real t56 = t46 - t50*t54;
-    const planar_3r_real t57 = fabs(t53);
-    const planar_3r_real t58 = t57*(t53 >= 0 ? 1 : -1);
-    const planar_3r_real t59 = (t57 > 0 ? 2 : 0);
-    const planar_3r_real t60 = t56 - t56*t59;
-    const planar_3r_real t61 = (t58 != 0 ? -t60/t58 : 0);
-    const planar_3r_real t62 = (t36 != 0 ? -(t55 - t52*t61)/t36 : 0);
-    const planar_3r_real t63 = (t10 != 0 ? -(t31 + t29*t62 + t39*t61)/t10 : 0);
-    const int t64 = isfinite(t40);
-    const int t65 = damping >= 0;
-    const int t66 = damping > 0;
-    const planar_3r_real t67 = 1e-12*t12;
-    const int t68 = (t66 && t15.w[3] > 0) || (damping <= 0 && ((t9 <= t67) || (t35 <= t67) || (t57 <= t67)));
-    const int t69 = t64 && t65 && !t68;
+    jacgen_velocity_solve_state t0 = {{c1, s1, c2, s2, c3, s3, mu_dot0, mu_dot1, mu_dot2, damping}};
+    jacgen_velocity_solve(1, &t0);
 
     /* Outputs */
-    q_dot[0] = (t69 ? (t66 ? t19 : t63) : 0);
-    q_dot[1] = (t69 ? (t66 ? t20 : t62) : 0);
-    q_dot[2] = (t69 ? (t66 ? t21 : t61) : 0);
-    return (!(t64 && t65) ? 2 : (t68 ? 1 : 0));
+    q_dot[0] = t0.w[0];
+    q_dot[1] = t0.w[1];
+    q_dot[2] = t0.w[2];
+    return (int)t0.w[3];
+}
+
+int planar_3r_velocity_ik_nullspace(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], const planar_3r_real z[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF])
+{
+    /* 317 operations */
+    (void)z;
+
+    /* Inputs */
+    const planar_3r_real q1 = q[0];
+    const planar_3r_real q2 = q[1];
+    const planar_3r_real q3 = q[2];
+    const planar_3r_real mu_dot0 = mu_dot[0];
+    const planar_3r_real mu_dot1 = mu_dot[1];
+    const planar_3r_real mu_dot2 = mu_dot[2];
+
+    /* Intermediate terms */
+    const planar_3r_real c1 = cos(q1);
+    const planar_3r_real s1 = sin(q1);
+    const planar_3r_real c2 = cos(q2);
+    const planar_3r_real s2 = sin(q2);
+    const planar_3r_real c3 = cos(q3);
+    const planar_3r_real s3 = sin(q3);
+    jacgen_velocity_solve_state t0 = {{c1, s1, c2, s2, c3, s3, mu_dot0, mu_dot1, mu_dot2, damping}};
+    jacgen_velocity_solve(1, &t0);
+
+    /* Outputs */
+    q_dot[0] = t0.w[0];
+    q_dot[1] = t0.w[1];
+    q_dot[2] = t0.w[2];
+    return (int)t0.w[3];
 }
 
 int planar_3r_resolved_rate(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real target_rate[PLANAR_3R_TASK_DIM], const planar_3r_real gain[PLANAR_3R_TASK_DIM], const planar_3r_real z[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF])
 {
-    /* 333 operations */
+    /* 349 operations */
+    (void)z;
 
     /* Inputs */
     const planar_3r_real q1 = q[0];
@@ -1828,9 +1781,6 @@ int planar_3r_resolved_rate(const planar_3r_real q[PLANAR_3R_DOF], const planar_
     const planar_3r_real gain0 = gain[0];
     const planar_3r_real gain1 = gain[1];
     const planar_3r_real gain2 = gain[2];
-    const planar_3r_real qz1 = z[0];
-    const planar_3r_real qz2 = z[1];
-    const planar_3r_real qz3 = z[2];
 
     /* Intermediate terms */
     const planar_3r_real c1 = cos(q1);
@@ -1847,83 +1797,18 @@ int planar_3r_resolved_rate(const planar_3r_real q[PLANAR_3R_DOF], const planar_
     const planar_3r_real t1 = s12 + s123;
     const planar_3r_real t2 = c1 + t0;
     const planar_3r_real t3 = s1 + t1;
-    const planar_3r_real t4 = t2*t3 + t0*t1 + c123*s123;
-    const planar_3r_real t5 = t3 + t1 + s123;
-    const planar_3r_real t6 = mu_dot0 + gain0*(-t2 + mu0);
-    const planar_3r_real t7 = (t3*t3);
-    const planar_3r_real t8 = (s123*s123) + (t1*t1) + t7;
-    const planar_3r_real t9 = (t2*t2);
-    const planar_3r_real t10 = sqrt(1 + t7 + t9);
-    const planar_3r_real t11 = (t3 <= 0 ? 1 : -1)*t10;
-    const planar_3r_real t12 = (c123*c123) + (t0*t0) + t9;
-    const planar_3r_real t13 = sqrt(3 + t8 + t12);
-    const planar_3r_real t14 = c123 + t0 + t2;
-    const int t15 = t10 > 0;
-    const planar_3r_real t16 = (t15 ? 1 + fabs(t3)/t10 : 0);
-    const planar_3r_real t17 = -t3;
-    const planar_3r_real t18 = (t15 ? 1.0/(t17 + t11) : 0);
-    const planar_3r_real t19 = mu_dot1 + gain1*(t17 + mu1);
-    const planar_3r_real t20 = -t1;
-    const planar_3r_real t21 = t2*t18;
-    const planar_3r_real t22 = t16*(t20 + t18 + t0*t21);
-    const planar_3r_real t23 = t1 + t22;
-    const planar_3r_real t24 = t18*t22;
-    const planar_3r_real t25 = t0 - t2*t24;
-    const planar_3r_real t26 = 1 - t24;
-    const planar_3r_real t27 = sqrt((t25*t25) + (t26*t26));
-    const planar_3r_real t28 = t27*(t25 >= 0 ? 1 : -1);
-    const planar_3r_real t29 = -s123;
-    const planar_3r_real t30 = t16*(t29 + t18 + c123*t21);
-    const planar_3r_real t31 = s123 + t30;
-    const planar_3r_real t32 = t18*t30;
-    const planar_3r_real t33 = c123 - t2*t32;
-    const planar_3r_real t34 = 1 - t32;
-    const int t35 = t27 > 0;
-    const planar_3r_real t36 = (t35 ? 1.0/(t25 + t28) : 0);
-    const planar_3r_real t37 = (t35 ? 1 + fabs(t25)/t27 : 0);
-    const planar_3r_real t38 = t26*t36;
-    const planar_3r_real t39 = t37*(t33 + t38*t34);
-    const planar_3r_real t40 = -t39 + t33;
-    const planar_3r_real t41 = t34 - t38*t39;
-    const planar_3r_real t42 = fabs(t41);
-    const planar_3r_real t43 = t42*(t41 >= 0 ? 1 : -1);
-    const planar_3r_real t44 = (t42 > 0 ? 2 : 0);
-    const planar_3r_real t45 = -mu2 + atan2(s123, c123);
-    const planar_3r_real t46 = mu_dot2 - gain2*(t45 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t45)));
-    const planar_3r_real t47 = t16*(t6 + t18*t46 + t21*t19);
-    const planar_3r_real t48 = -t47 + t6;
-    const planar_3r_real t49 = 3 + q1 + q2 + q3 + t14 + t17 + t20 + t29 + damping + qz1 + qz2 + qz3 + t6 + t19 + t46;
-    const planar_3r_real t50 = (damping*damping);
-    jacgen_symmetric_solve3_state t51 = {{t8 + t50, -t4, -t5, t12 + t50, t14, 3 + t50, t6, t19, t46}};
-    jacgen_symmetric_solve3(1, &t51);
-    const planar_3r_real t52 = t51.w[2];
-    const planar_3r_real t53 = t51.w[0];
-    const planar_3r_real t54 = t51.w[1];
-    const planar_3r_real t55 = t52 - t3*t53 + t2*t54;
-    const planar_3r_real t56 = t52 - t1*t53 + t0*t54;
-    const planar_3r_real t57 = t52 - s123*t53 + c123*t54;
-    const planar_3r_real t58 = t18*t47;
-    const planar_3r_real t59 = t19 - t2*t58;
-    const planar_3r_real t60 = -t58 + t46;
-    const planar_3r_real t61 = t37*(t59 + t38*t60);
-    const planar_3r_real t62 = -t61 + t59;
-    const planar_3r_real t63 = t60 - t38*t61;
-    const planar_3r_real t64 = t63 - t44*t63;
-    const planar_3r_real t65 = (t43 != 0 ? -t64/t43 : 0);
-    const planar_3r_real t66 = (t28 != 0 ? -(t62 - t40*t65)/t28 : 0);
-    const planar_3r_real t67 = (t11 != 0 ? -(t48 + t23*t66 + t31*t65)/t11 : 0);
-    const int t68 = isfinite(t49);
-    const int t69 = damping >= 0;
-    const int t70 = damping > 0;
-    const planar_3r_real t71 = 1e-12*t13;
-    const int t72 = (t70 && t51.w[3] > 0) || (damping <= 0 && ((t10 <= t71) || (t27 <= t71) || (t42 <= t71)));
-    const int t73 = t68 && t69 && !t72;
+    const planar_3r_real t4 = mu_dot0 + gain0*(-t2 + mu0);
+    const planar_3r_real t5 = mu_dot1 + gain1*(-t3 + mu1);
+    const planar_3r_real t6 = -mu2 + atan2(s123, c123);
+    const planar_3r_real t7 = mu_dot2 - gain2*(t6 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t6)));
+    jacgen_velocity_solve_state t8 = {{c1, s1, c2, s2, c3, s3, t4, t5, t7, damping}};
+    jacgen_velocity_solve(1, &t8);
 
     /* Outputs */
-    q_dot[0] = (t73 ? (t70 ? t55 : t67) : 0);
-    q_dot[1] = (t73 ? (t70 ? t56 : t66) : 0);
-    q_dot[2] = (t73 ? (t70 ? t57 : t65) : 0);
-    return (!(t68 && t69) ? 2 : (t72 ? 1 : 0));
+    q_dot[0] = t8.w[0];
+    q_dot[1] = t8.w[1];
+    q_dot[2] = t8.w[2];
+    return (int)t8.w[3];
 }
 
 planar_3r_real planar_3r_ik_numeric_step(const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real q[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_start[PLANAR_3R_DOF], planar_3r_real q_next[PLANAR_3R_DOF])

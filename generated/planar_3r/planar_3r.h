@@ -110,7 +110,7 @@ void planar_3r_velocity_ellipsoid(const planar_3r_real q[PLANAR_3R_DOF], planar_
 planar_3r_real planar_3r_condition_number(const planar_3r_real q[PLANAR_3R_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 3; returned as a scalar. 314 operations. */
+ * Result: q_dot[i], i < 3; returned as a scalar. 317 operations. */
 int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
@@ -118,7 +118,7 @@ int planar_3r_velocity_ik(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r
 int planar_3r_velocity_ik_nullspace(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real mu_dot[PLANAR_3R_TASK_DIM], const planar_3r_real z[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 3; returned as a scalar. 333 operations. */
+ * Result: q_dot[i], i < 3; returned as a scalar. 349 operations. */
 int planar_3r_resolved_rate(const planar_3r_real q[PLANAR_3R_DOF], const planar_3r_real target[PLANAR_3R_TASK_DIM], const planar_3r_real target_rate[PLANAR_3R_TASK_DIM], const planar_3r_real gain[PLANAR_3R_TASK_DIM], const planar_3r_real z[PLANAR_3R_DOF], planar_3r_real damping, planar_3r_real q_dot[PLANAR_3R_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).

@@ -82,7 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -336,7 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi3_rows(xp, count, state):
     """One-sided Jacobi sweep of a 3 x 3 matrix (its rows), `count` times: 152 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -422,9 +422,9 @@ def _jacobi3_rows(xp, count, state):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _symmetric_solve3(xp, count, state):
-    """X solving a symmetric 3 x 3 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 118 operations a run."""
+    """The solution x of a symmetric 3 x 3 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 118 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, = state
         t0 = w1**2
@@ -480,10 +480,101 @@ def _symmetric_solve3(xp, count, state):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _velocity_solve(xp, count, state):
+    """The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status, `count` times: 311 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, = state
+        c12 = w0*w2 - w1*w3
+        s12 = w0*w3 + w2*w1
+        c123 = c12*w4 - s12*w5
+        s123 = c12*w5 + s12*w4
+        t0 = c12 + c123
+        t1 = s12 + s123
+        t2 = w1 + t1
+        t3 = t2 + t1 + s123
+        t4 = w0 + t0
+        t5 = t0*t1 + c123*s123 + t2*t4
+        t6 = t2**2
+        t7 = s123**2 + t1**2 + t6
+        t8 = t4**2
+        t9 = xp.sqrt(1 + t6 + t8)
+        t10 = xp.where(xp.less_equal(t2, 0), xp.asarray(1, dtype=dtype), -1)*t9
+        t11 = c123**2 + t0**2 + t8
+        t12 = xp.sqrt(3 + t7 + t11)
+        t13 = c123 + t4
+        t14 = t0 + t13
+        t15 = w9**2
+        t16 = _symmetric_solve3(xp, 1, (t7 + t15, -t5, -t3, t11 + t15, t14, 3 + t15, w6, w7, w8,))
+        t17 = t16[2]
+        t18 = t16[0]
+        t19 = t16[1]
+        t20 = t17 - t2*t18 + t4*t19
+        t21 = t17 - t1*t18 + t0*t19
+        t22 = t17 - s123*t18 + c123*t19
+        t23 = xp.greater(t9, 0)
+        t24 = xp.where(t23, 1 + xp.abs(t2)/t9, 0)
+        t25 = -t2
+        t26 = xp.where(t23, 1/(t25 + t10), 0)
+        t27 = -t1
+        t28 = t4*t26
+        t29 = t24*(t27 + t26 + t0*t28)
+        t30 = t1 + t29
+        t31 = t24*(w6 + w8*t26 + t28*w7)
+        t32 = -t31 + w6
+        t33 = t26*t29
+        t34 = t0 - t4*t33
+        t35 = 1 - t33
+        t36 = xp.sqrt(t34**2 + t35**2)
+        t37 = t36*xp.where(xp.greater_equal(t34, 0), xp.asarray(1, dtype=dtype), -1)
+        t38 = -s123
+        t39 = t24*(t38 + t26 + c123*t28)
+        t40 = s123 + t39
+        t41 = 3 + w2 + w1 + w3 + w4 + w5 + t4 + t13 + t25 + t27 + t38 + w6 + w7 + w8 + w9
+        t42 = t26*t39
+        t43 = c123 - t4*t42
+        t44 = 1 - t42
+        t45 = t26*t31
+        t46 = w7 - t4*t45
+        t47 = -t45 + w8
+        t48 = xp.greater(t36, 0)
+        t49 = xp.where(t48, 1/(t34 + t37), 0)
+        t50 = xp.where(t48, 1 + xp.abs(t34)/t36, 0)
+        t51 = t35*t49
+        t52 = t50*(t43 + t51*t44)
+        t53 = -t52 + t43
+        t54 = t44 - t51*t52
+        t55 = t50*(t46 + t51*t47)
+        t56 = -t55 + t46
+        t57 = t47 - t51*t55
+        t58 = xp.abs(t54)
+        t59 = t58*xp.where(xp.greater_equal(t54, 0), xp.asarray(1, dtype=dtype), -1)
+        t60 = xp.where(xp.greater(t58, 0), xp.asarray(2, dtype=dtype), 0)
+        t61 = t57 - t57*t60
+        t62 = xp.where(xp.not_equal(t59, 0), -t61/t59, 0)
+        t63 = xp.where(xp.not_equal(t37, 0), -(t56 - t53*t62)/t37, 0)
+        t64 = xp.where(xp.not_equal(t10, 0), -(t32 + t30*t63 + t40*t62)/t10, 0)
+        t65 = xp.isfinite(t41)
+        t66 = xp.greater_equal(w9, 0)
+        t67 = xp.greater(w9, 0)
+        t68 = 1e-12*t12
+        t69 = (t67 & xp.greater(t16[3], 0)) | (xp.less_equal(w9, 0) & (xp.less_equal(t9, t68) | xp.less_equal(t36, t68) | xp.less_equal(t58, t68)))
+        t70 = t65 & t66 & xp.logical_not(t69)
+        state = (
+            xp.where(t70, xp.where(t67, t20, t64), 0),
+            xp.where(t70, xp.where(t67, t21, t63), 0),
+            xp.where(t70, xp.where(t67, t22, t62), 0),
+            xp.where(xp.logical_not(t65 & t66), 2, xp.where(t69, xp.asarray(1, dtype=dtype), 0)),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _nearer_branch(xp, count, state):
     """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 39 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, = state
         t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w4))
@@ -1526,13 +1617,9 @@ def condition_number(q):
     return kappa
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (3 x 1 and 1 x 1), 314 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (3 x 1 and 1 x 1), 317 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (3,)), ("mu_dot", mu_dot, (3,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
@@ -1541,201 +1628,44 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s1 = trig[..., 1]
     c2 = trig[..., 2]
     s2 = trig[..., 3]
-    c12 = c1*c2 - s1*s2
-    s12 = c1*s2 + c2*s1
     c3 = trig[..., 4]
     s3 = trig[..., 5]
-    c123 = c12*c3 - s12*s3
-    s123 = c12*s3 + s12*c3
-    t0 = c12 + c123
-    t1 = s12 + s123
-    t2 = c1 + t0
-    t3 = s1 + t1
-    t4 = t2*t3 + t0*t1 + c123*s123
-    t5 = t3 + t1 + s123
-    t6 = t3**2
-    t7 = s123**2 + t1**2 + t6
-    t8 = t2**2
-    t9 = xp.sqrt(1 + t6 + t8)
-    t10 = xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)*t9
-    t11 = c123**2 + t0**2 + t8
-    t12 = xp.sqrt(3 + t7 + t11)
-    t13 = c123 + t0 + t2
-    t14 = damping**2
-    t15 = _symmetric_solve3(xp, 1, (t7 + t14, -t4, -t5, t11 + t14, t13, 3 + t14, mu_dot0, mu_dot1, mu_dot2,))
-    t16 = t15[2]
-    t17 = t15[0]
-    t18 = t15[1]
-    t19 = t16 - t3*t17 + t2*t18
-    t20 = t16 - t1*t17 + t0*t18
-    t21 = t16 - s123*t17 + c123*t18
-    t22 = xp.greater(t9, 0)
-    t23 = xp.where(t22, 1 + xp.abs(t3)/t9, 0)
-    t24 = -t3
-    t25 = xp.where(t22, 1/(t24 + t10), 0)
-    t26 = -t1
-    t27 = t2*t25
-    t28 = t23*(t26 + t25 + t0*t27)
-    t29 = t1 + t28
-    t30 = t23*(mu_dot0 + mu_dot2*t25 + t27*mu_dot1)
-    t31 = -t30 + mu_dot0
-    t32 = t25*t28
-    t33 = t0 - t2*t32
-    t34 = 1 - t32
-    t35 = xp.sqrt(t33**2 + t34**2)
-    t36 = t35*xp.where(xp.greater_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)
-    t37 = -s123
-    t38 = t23*(t37 + t25 + c123*t27)
-    t39 = s123 + t38
-    t40 = 3 + q1 + q2 + q3 + t13 + t24 + t26 + t37 + mu_dot0 + mu_dot1 + mu_dot2 + damping
-    t41 = t25*t38
-    t42 = c123 - t2*t41
-    t43 = 1 - t41
-    t44 = t25*t30
-    t45 = mu_dot1 - t2*t44
-    t46 = -t44 + mu_dot2
-    t47 = xp.greater(t35, 0)
-    t48 = xp.where(t47, 1/(t33 + t36), 0)
-    t49 = xp.where(t47, 1 + xp.abs(t33)/t35, 0)
-    t50 = t34*t48
-    t51 = t49*(t42 + t50*t43)
-    t52 = -t51 + t42
-    t53 = t43 - t50*t51
-    t54 = t49*(t45 + t50*t46)
-    t55 = -t54 + t45
-    t56 = t46 - t50*t54
-    t57 = xp.abs(t53)
-    t58 = t57*xp.where(xp.greater_equal(t53, 0), xp.asarray(1, dtype=dtype), -1)
-    t59 = xp.where(xp.greater(t57, 0), xp.asarray(2, dtype=dtype), 0)
-    t60 = t56 - t56*t59
-    t61 = xp.where(xp.not_equal(t58, 0), -t60/t58, 0)
-    t62 = xp.where(xp.not_equal(t36, 0), -(t55 - t52*t61)/t36, 0)
-    t63 = xp.where(xp.not_equal(t10, 0), -(t31 + t29*t62 + t39*t61)/t10, 0)
-    t64 = xp.isfinite(t40)
-    t65 = xp.greater_equal(damping, 0)
-    t66 = xp.greater(damping, 0)
-    t67 = 1e-12*t12
-    t68 = (t66 & xp.greater(t15[3], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t9, t67) | xp.less_equal(t35, t67) | xp.less_equal(t57, t67)))
-    t69 = t64 & t65 & xp.logical_not(t68)
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, mu_dot0, mu_dot1, mu_dot2, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t69, xp.where(t66, t19, t63), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t69, xp.where(t66, t20, t62), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t69, xp.where(t66, t21, t61), 0), batch),  # 2
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
     ], (3,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t64 & t65), 2, xp.where(t68, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[3], batch), xp.int32)
     return q_dot, status
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (3 x 1 and 1 x 1), 317 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (3,)), ("mu_dot", mu_dot, (3,)), ("z", z, (3,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
-    qz1 = z[..., 0]
-    qz2 = z[..., 1]
-    qz3 = z[..., 2]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
     c2 = trig[..., 2]
     s2 = trig[..., 3]
-    c12 = c1*c2 - s1*s2
-    s12 = c1*s2 + c2*s1
     c3 = trig[..., 4]
     s3 = trig[..., 5]
-    c123 = c12*c3 - s12*s3
-    s123 = c12*s3 + s12*c3
-    t0 = c12 + c123
-    t1 = s12 + s123
-    t2 = c1 + t0
-    t3 = s1 + t1
-    t4 = t2*t3 + t0*t1 + c123*s123
-    t5 = t3 + t1 + s123
-    t6 = t3**2
-    t7 = s123**2 + t1**2 + t6
-    t8 = t2**2
-    t9 = xp.sqrt(1 + t6 + t8)
-    t10 = xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)*t9
-    t11 = c123**2 + t0**2 + t8
-    t12 = xp.sqrt(3 + t7 + t11)
-    t13 = c123 + t0 + t2
-    t14 = damping**2
-    t15 = _symmetric_solve3(xp, 1, (t7 + t14, -t4, -t5, t11 + t14, t13, 3 + t14, mu_dot0, mu_dot1, mu_dot2,))
-    t16 = t15[2]
-    t17 = t15[0]
-    t18 = t15[1]
-    t19 = t16 - t3*t17 + t2*t18
-    t20 = t16 - t1*t17 + t0*t18
-    t21 = t16 - s123*t17 + c123*t18
-    t22 = xp.greater(t9, 0)
-    t23 = xp.where(t22, 1 + xp.abs(t3)/t9, 0)
-    t24 = -t3
-    t25 = xp.where(t22, 1/(t24 + t10), 0)
-    t26 = -t1
-    t27 = t2*t25
-    t28 = t23*(t26 + t25 + t0*t27)
-    t29 = t1 + t28
-    t30 = t23*(mu_dot0 + mu_dot2*t25 + t27*mu_dot1)
-    t31 = -t30 + mu_dot0
-    t32 = t25*t28
-    t33 = t0 - t2*t32
-    t34 = 1 - t32
-    t35 = xp.sqrt(t33**2 + t34**2)
-    t36 = t35*xp.where(xp.greater_equal(t33, 0), xp.asarray(1, dtype=dtype), -1)
-    t37 = -s123
-    t38 = t23*(t37 + t25 + c123*t27)
-    t39 = s123 + t38
-    t40 = 3 + q1 + q2 + q3 + t13 + t24 + t26 + t37 + mu_dot0 + mu_dot1 + mu_dot2 + damping + qz1 + qz2 + qz3
-    t41 = t25*t38
-    t42 = c123 - t2*t41
-    t43 = 1 - t41
-    t44 = t25*t30
-    t45 = mu_dot1 - t2*t44
-    t46 = -t44 + mu_dot2
-    t47 = xp.greater(t35, 0)
-    t48 = xp.where(t47, 1/(t33 + t36), 0)
-    t49 = xp.where(t47, 1 + xp.abs(t33)/t35, 0)
-    t50 = t34*t48
-    t51 = t49*(t42 + t50*t43)
-    t52 = -t51 + t42
-    t53 = t43 - t50*t51
-    t54 = t49*(t45 + t50*t46)
-    t55 = -t54 + t45
-    t56 = t46 - t50*t54
-    t57 = xp.abs(t53)
-    t58 = t57*xp.where(xp.greater_equal(t53, 0), xp.asarray(1, dtype=dtype), -1)
-    t59 = xp.where(xp.greater(t57, 0), xp.asarray(2, dtype=dtype), 0)
-    t60 = t56 - t56*t59
-    t61 = xp.where(xp.not_equal(t58, 0), -t60/t58, 0)
-    t62 = xp.where(xp.not_equal(t36, 0), -(t55 - t52*t61)/t36, 0)
-    t63 = xp.where(xp.not_equal(t10, 0), -(t31 + t29*t62 + t39*t61)/t10, 0)
-    t64 = xp.isfinite(t40)
-    t65 = xp.greater_equal(damping, 0)
-    t66 = xp.greater(damping, 0)
-    t67 = 1e-12*t12
-    t68 = (t66 & xp.greater(t15[3], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t9, t67) | xp.less_equal(t35, t67) | xp.less_equal(t57, t67)))
-    t69 = t64 & t65 & xp.logical_not(t68)
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, mu_dot0, mu_dot1, mu_dot2, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t69, xp.where(t66, t19, t63), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t69, xp.where(t66, t20, t62), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t69, xp.where(t66, t21, t61), 0), batch),  # 2
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
     ], (3,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t64 & t65), 2, xp.where(t68, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[3], batch), xp.int32)
     return q_dot, status
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (3 x 1 and 1 x 1), 333 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (3 x 1 and 1 x 1), 349 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (3,)), ("target", target, (3,)), ("target_rate", target_rate, (3,)), ("gain", gain, (3,)), ("z", z, (3,)), ("damping", damping, ()), every=("gain", ))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
     mu0 = target[..., 0]
     mu1 = target[..., 1]
     mu2 = target[..., 2]
@@ -1745,9 +1675,6 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     gain0 = gain[..., 0]
     gain1 = gain[..., 1]
     gain2 = gain[..., 2]
-    qz1 = z[..., 0]
-    qz2 = z[..., 1]
-    qz3 = z[..., 2]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
@@ -1763,82 +1690,17 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t1 = s12 + s123
     t2 = c1 + t0
     t3 = s1 + t1
-    t4 = t2*t3 + t0*t1 + c123*s123
-    t5 = t3 + t1 + s123
-    t6 = mu_dot0 + gain0*(-t2 + mu0)
-    t7 = t3**2
-    t8 = s123**2 + t1**2 + t7
-    t9 = t2**2
-    t10 = xp.sqrt(1 + t7 + t9)
-    t11 = xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)*t10
-    t12 = c123**2 + t0**2 + t9
-    t13 = xp.sqrt(3 + t8 + t12)
-    t14 = c123 + t0 + t2
-    t15 = xp.greater(t10, 0)
-    t16 = xp.where(t15, 1 + xp.abs(t3)/t10, 0)
-    t17 = -t3
-    t18 = xp.where(t15, 1/(t17 + t11), 0)
-    t19 = mu_dot1 + gain1*(t17 + mu1)
-    t20 = -t1
-    t21 = t2*t18
-    t22 = t16*(t20 + t18 + t0*t21)
-    t23 = t1 + t22
-    t24 = t18*t22
-    t25 = t0 - t2*t24
-    t26 = 1 - t24
-    t27 = xp.sqrt(t25**2 + t26**2)
-    t28 = t27*xp.where(xp.greater_equal(t25, 0), xp.asarray(1, dtype=dtype), -1)
-    t29 = -s123
-    t30 = t16*(t29 + t18 + c123*t21)
-    t31 = s123 + t30
-    t32 = t18*t30
-    t33 = c123 - t2*t32
-    t34 = 1 - t32
-    t35 = xp.greater(t27, 0)
-    t36 = xp.where(t35, 1/(t25 + t28), 0)
-    t37 = xp.where(t35, 1 + xp.abs(t25)/t27, 0)
-    t38 = t26*t36
-    t39 = t37*(t33 + t38*t34)
-    t40 = -t39 + t33
-    t41 = t34 - t38*t39
-    t42 = xp.abs(t41)
-    t43 = t42*xp.where(xp.greater_equal(t41, 0), xp.asarray(1, dtype=dtype), -1)
-    t44 = xp.where(xp.greater(t42, 0), xp.asarray(2, dtype=dtype), 0)
-    t45 = -mu2 + xp.atan2(s123, c123)
-    t46 = mu_dot2 - gain2*(t45 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t45)))
-    t47 = t16*(t6 + t18*t46 + t21*t19)
-    t48 = -t47 + t6
-    t49 = 3 + q1 + q2 + q3 + t14 + t17 + t20 + t29 + damping + qz1 + qz2 + qz3 + t6 + t19 + t46
-    t50 = damping**2
-    t51 = _symmetric_solve3(xp, 1, (t8 + t50, -t4, -t5, t12 + t50, t14, 3 + t50, t6, t19, t46,))
-    t52 = t51[2]
-    t53 = t51[0]
-    t54 = t51[1]
-    t55 = t52 - t3*t53 + t2*t54
-    t56 = t52 - t1*t53 + t0*t54
-    t57 = t52 - s123*t53 + c123*t54
-    t58 = t18*t47
-    t59 = t19 - t2*t58
-    t60 = -t58 + t46
-    t61 = t37*(t59 + t38*t60)
-    t62 = -t61 + t59
-    t63 = t60 - t38*t61
-    t64 = t63 - t44*t63
-    t65 = xp.where(xp.not_equal(t43, 0), -t64/t43, 0)
-    t66 = xp.where(xp.not_equal(t28, 0), -(t62 - t40*t65)/t28, 0)
-    t67 = xp.where(xp.not_equal(t11, 0), -(t48 + t23*t66 + t31*t65)/t11, 0)
-    t68 = xp.isfinite(t49)
-    t69 = xp.greater_equal(damping, 0)
-    t70 = xp.greater(damping, 0)
-    t71 = 1e-12*t13
-    t72 = (t70 & xp.greater(t51[3], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t10, t71) | xp.less_equal(t27, t71) | xp.less_equal(t42, t71)))
-    t73 = t68 & t69 & xp.logical_not(t72)
+    t4 = mu_dot0 + gain0*(-t2 + mu0)
+    t5 = mu_dot1 + gain1*(-t3 + mu1)
+    t6 = -mu2 + xp.atan2(s123, c123)
+    t7 = mu_dot2 - gain2*(t6 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t6)))
+    t8 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, t4, t5, t7, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t73, xp.where(t70, t55, t67), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t73, xp.where(t70, t56, t66), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t73, xp.where(t70, t57, t65), 0), batch),  # 2
+        xp.broadcast_to(t8[0], batch),  # 0
+        xp.broadcast_to(t8[1], batch),  # 1
+        xp.broadcast_to(t8[2], batch),  # 2
     ], (3,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t68 & t69), 2, xp.where(t72, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t8[3], batch), xp.int32)
     return q_dot, status
 
 

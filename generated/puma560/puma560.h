@@ -113,7 +113,7 @@ void puma560_velocity_ellipsoid(const puma560_real q[PUMA560_DOF], puma560_real 
 puma560_real puma560_condition_number(const puma560_real q[PUMA560_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1211 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1217 operations. */
 int puma560_velocity_ik(const puma560_real q[PUMA560_DOF], const puma560_real mu_dot[PUMA560_TASK_DIM], puma560_real damping, puma560_real q_dot[PUMA560_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
@@ -121,7 +121,7 @@ int puma560_velocity_ik(const puma560_real q[PUMA560_DOF], const puma560_real mu
 int puma560_velocity_ik_nullspace(const puma560_real q[PUMA560_DOF], const puma560_real mu_dot[PUMA560_TASK_DIM], const puma560_real z[PUMA560_DOF], puma560_real damping, puma560_real q_dot[PUMA560_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1378 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1428 operations. */
 int puma560_resolved_rate(const puma560_real q[PUMA560_DOF], const puma560_real target[16], const puma560_real target_rate[PUMA560_TASK_DIM], const puma560_real gain[PUMA560_TASK_DIM], const puma560_real z[PUMA560_DOF], puma560_real damping, puma560_real q_dot[PUMA560_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).

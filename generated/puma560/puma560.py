@@ -82,7 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -336,7 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi6_rows(xp, count, state):
     """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2 + w4**2 + w5**2
@@ -904,9 +904,9 @@ def _jacobi6_rows(xp, count, state):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _symmetric_solve6(xp, count, state):
-    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    """The solution x of a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
         t0 = w1**2
@@ -1090,10 +1090,261 @@ def _symmetric_solve6(xp, count, state):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _velocity_solve(xp, count, state):
+    """The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status, `count` times: 1205 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, = state
+        c23 = w2*w4 - w3*w5
+        s23 = w2*w5 + w3*w4
+        t0 = c23*w8 - s23*w6*w9
+        t1 = 0.4318*c23 + 0.0203*s23
+        t2 = 0.4318*w3 + t1
+        t3 = 0.0203*c23
+        t4 = 0.15005*w1 + w0*t3
+        t5 = -0.15005*w0 + w1*t3
+        t6 = w1*w7
+        t7 = w0*w6
+        t8 = -t6 + c23*t7
+        t9 = t7 - c23*t6
+        t10 = w1*w6
+        t11 = w0*w7
+        t12 = t10 + c23*t11
+        t13 = t11 + c23*t10
+        t14 = w0*s23
+        t15 = t8*w9 + w8*t14
+        t16 = -0.4318*t14 + t4
+        t17 = w1*s23
+        t18 = t13*w9 + w8*t17
+        t19 = -0.4318*t17 + t5
+        t20 = w0*t16 + w1*t19
+        t21 = 0.4318*w2
+        t22 = t16 + w0*t21
+        t23 = t19 + w1*t21
+        t24 = w0*t22 + w1*t23
+        t25 = t24**2
+        t26 = t25 + t20**2
+        t27 = t23**2
+        t28 = w0**2
+        t29 = t2*t28 + t1*t28
+        t30 = t2**2
+        t31 = t1**2
+        t32 = t27 + t28*t30 + t28*t31
+        t33 = t22**2
+        t34 = xp.sqrt(1 + t27 + t33)
+        t35 = xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)*t34
+        t36 = w1**2
+        t37 = t2*t36 + t1*t36
+        t38 = t33 + t30*t36 + t31*t36
+        t39 = s23**2
+        t40 = t12**2 + t15**2 + 2*t36 + t28*t39
+        t41 = t9**2 + t18**2 + 2*t28 + t36*t39
+        t42 = 1 + c23**2 + t0**2 + w7**2*t39
+        t43 = xp.sqrt(t26 + t32 + t38 + t40 + t41 + t42)
+        t44 = w1*w0
+        t45 = -t22*t23 + t30*t44 + t31*t44
+        t46 = -2*t44 - t12*t9 + t15*t18 + t39*t44
+        t47 = w0*t24
+        t48 = w0*t20
+        t49 = t1*t48 + t2*t47
+        t50 = t47 + t48
+        t51 = w0*t2
+        t52 = w0*t1
+        t53 = w1*t51 + w1*t52
+        t54 = w1*t24
+        t55 = w1*t20
+        t56 = t1*t55 + t2*t54
+        t57 = t54 + t55
+        t58 = s23*w7
+        t59 = c23*t14 + t15*t0 - t12*t58
+        t60 = c23*t17 + t9*t58 + t18*t0
+        t61 = w18**2
+        t62 = -t23
+        t63 = _symmetric_solve6(xp, 1, (t32 + t61, t45, -t49, -t53, t29, t62, t38 + t61, -t56, -t37, t53, t22, t26 + t61, t57, -t50, xp.full(batch, 0, dtype=dtype, device=device), t40 + t61, t46, -t59, t41 + t61, -t60, t42 + t61, w12, w13, w14, w15, w16, w17,))
+        t64 = t63[5]
+        t65 = t63[0]
+        t66 = t63[1]
+        t67 = t64 - t23*t65 + t22*t66
+        t68 = w1*t2
+        t69 = t63[2]
+        t70 = t63[3]
+        t71 = t63[4]
+        t72 = t14*t70 + t17*t71 - c23*t64
+        t73 = t12*t70 - t9*t71 + t58*t64
+        t74 = t15*t70 + t18*t71 - t0*t64
+        t75 = -w1*t70 + w0*t71
+        t76 = t75 + t51*t65 + t66*t68 - t24*t69
+        t77 = w1*t1
+        t78 = t75 + t52*t65 + t66*t77 - t20*t69
+        t79 = xp.greater(t34, 0)
+        t80 = xp.where(t79, 1/(t62 + t35), 0)
+        t81 = xp.where(t79, 1 + xp.abs(t23)/t34, 0)
+        t82 = t22*t80
+        t83 = -t81*(t51 + t68*t82)
+        t84 = t51 + t83
+        t85 = t68 + t82*t83
+        t86 = -t81*(t52 + t77*t82)
+        t87 = t52 + t86
+        t88 = t81*(w12 + w17*t80 + t82*w13)
+        t89 = -t88 + w12
+        t90 = t80*t86
+        t91 = t77 + t22*t90
+        t92 = t80**2
+        t93 = xp.sqrt(t25 + t28 + t36 + t85**2 + t92*t83**2)
+        t94 = t93*xp.where(xp.less_equal(t85, 0), xp.asarray(1, dtype=dtype), -1)
+        t95 = t92*t81
+        t96 = c23*t95
+        t97 = t22*t96
+        t98 = -t96 + c23
+        t99 = t58*t95
+        t100 = t22*t99
+        t101 = -t99 + t58
+        t102 = t0*t95
+        t103 = t22*t102
+        t104 = -t102 + t0
+        t105 = t80*t88
+        t106 = w13 - t22*t105
+        t107 = -t105 + w17
+        t108 = xp.greater(t93, 0)
+        t109 = xp.where(t108, 1/(-t85 + t94), 0)
+        t110 = xp.where(t108, 1 + xp.abs(t85)/t93, 0)
+        t111 = t24*t109
+        t112 = t83*t109
+        t113 = t110*(-t91 + t20*t111 + t36*t109 + t28*t109 + t92*t112*t86)
+        t114 = t91 + t113
+        t115 = t20 - t111*t113
+        t116 = t109*t113
+        t117 = w1 - w1*t116
+        t118 = -w0
+        t119 = t118 + w0*t116
+        t120 = t80*t83
+        t121 = -t90 + t116*t120
+        t122 = xp.sqrt(t115**2 + t117**2 + t119**2 + t121**2)
+        t123 = t122*xp.where(xp.greater_equal(t115, 0), xp.asarray(1, dtype=dtype), -1)
+        t124 = t112*t80
+        t125 = -t110*(t97 + t124*t98)
+        t126 = t97 + t125
+        t127 = t109*t125
+        t128 = t14 + w1*t127
+        t129 = t98 + t120*t127
+        t130 = -t17
+        t131 = t130 + w0*t127
+        t132 = w1*t109
+        t133 = w0*t109
+        t134 = t110*(-t100 + t12*t132 + t9*t133 - t124*t101)
+        t135 = t100 + t134
+        t136 = t12 - t132*t134
+        t137 = t101 + t124*t134
+        t138 = -t110*(t103 + t15*t132 - t18*t133 + t124*t104)
+        t139 = t103 + t138
+        t140 = t15 + t132*t138
+        t141 = t104 + t124*t138
+        t142 = t110*(t106 + t111*w14 + t132*w15 - t133*w16 - t124*t107)
+        t143 = -t142 + t106
+        t144 = w14 - t111*t142
+        t145 = w15 - t132*t142
+        t146 = w16 + t133*t142
+        t147 = t107 + t124*t142
+        t148 = -t9
+        t149 = t148 + t133*t134
+        t150 = -t18
+        t151 = t150 + t133*t138
+        t152 = 1 - t15 - t51 - t52 - t68 - t77 - t14 + w3 + w2 + w4 + w5 + c23 + w7 + w6 + t12 + w8 + w9 + t0 + w10 + w11 + t22 + t24 + t20 + t58 + t62 + t118 + t130 + t148 + t150 + w12 + w13 + w14 + w15 + w16 + w17 + w18 + 3*w1
+        t153 = xp.greater(t122, 0)
+        t154 = xp.where(t153, 1/(t115 + t123), 0)
+        t155 = xp.where(t153, 1 + xp.abs(t115)/t122, 0)
+        t156 = t111*t125
+        t157 = t117*t154
+        t158 = t119*t154
+        t159 = t121*t154
+        t160 = t155*(-t156 - t157*t128 + t158*t131 + t159*t129)
+        t161 = t156 + t160
+        t162 = t128 + t157*t160
+        t163 = t131 - t158*t160
+        t164 = t129 - t159*t160
+        t165 = t155*(t144 + t157*t145 + t158*t146 + t159*t147)
+        t166 = -t165 + t144
+        t167 = t145 - t157*t165
+        t168 = t146 - t158*t165
+        t169 = t147 - t159*t165
+        t170 = xp.sqrt(t162**2 + t163**2 + t164**2)
+        t171 = t170*xp.where(xp.less_equal(t162, 0), xp.asarray(1, dtype=dtype), -1)
+        t172 = t111*t134
+        t173 = t155*(-t172 + t157*t136 + t158*t149 + t159*t137)
+        t174 = t172 + t173
+        t175 = t136 - t157*t173
+        t176 = t149 - t158*t173
+        t177 = t137 - t159*t173
+        t178 = t111*t138
+        t179 = t155*(-t178 - t157*t140 + t158*t151 + t159*t141)
+        t180 = t178 + t179
+        t181 = t140 + t157*t179
+        t182 = t151 - t158*t179
+        t183 = t141 - t159*t179
+        t184 = xp.greater(t170, 0)
+        t185 = xp.where(t184, 1/(-t162 + t171), 0)
+        t186 = xp.where(t184, 1 + xp.abs(t162)/t170, 0)
+        t187 = t163*t185
+        t188 = t164*t185
+        t189 = t186*(t175 + t187*t176 + t188*t177)
+        t190 = -t189 + t175
+        t191 = t176 - t187*t189
+        t192 = t177 - t188*t189
+        t193 = t186*(-t181 + t187*t182 + t188*t183)
+        t194 = t181 + t193
+        t195 = t182 - t187*t193
+        t196 = t183 - t188*t193
+        t197 = t186*(t167 + t187*t168 + t188*t169)
+        t198 = -t197 + t167
+        t199 = t168 - t187*t197
+        t200 = t169 - t188*t197
+        t201 = xp.sqrt(t191**2 + t192**2)
+        t202 = t201*xp.where(xp.greater_equal(t191, 0), xp.asarray(1, dtype=dtype), -1)
+        t203 = xp.greater(t201, 0)
+        t204 = xp.where(t203, 1/(t191 + t202), 0)
+        t205 = xp.where(t203, 1 + xp.abs(t191)/t201, 0)
+        t206 = t192*t204
+        t207 = t205*(t195 + t206*t196)
+        t208 = -t207 + t195
+        t209 = t196 - t206*t207
+        t210 = t205*(t199 + t206*t200)
+        t211 = -t210 + t199
+        t212 = t200 - t206*t210
+        t213 = xp.abs(t209)
+        t214 = t213*xp.where(xp.greater_equal(t209, 0), xp.asarray(1, dtype=dtype), -1)
+        t215 = xp.where(xp.greater(t213, 0), xp.asarray(2, dtype=dtype), 0)
+        t216 = t212 - t212*t215
+        t217 = xp.where(xp.not_equal(t214, 0), -t216/t214, 0)
+        t218 = xp.where(xp.not_equal(t202, 0), -(t211 - t208*t217)/t202, 0)
+        t219 = xp.where(xp.not_equal(t171, 0), -(-(t190*t218 - t194*t217) + t198)/t171, 0)
+        t220 = xp.where(xp.not_equal(t123, 0), -(t166 + t161*t219 + t174*t218 + t180*t217)/t123, 0)
+        t221 = xp.where(xp.not_equal(t94, 0), -(t143 + t114*t220 + t126*t219 + t135*t218 + t139*t217)/t94, 0)
+        t222 = t80*t81
+        t223 = xp.where(xp.not_equal(t35, 0), -(t89 + t84*t221 + t87*t220 + c23*t222*t219 + t58*t222*t218 + t0*t222*t217)/t35, 0)
+        t224 = xp.isfinite(t152)
+        t225 = xp.greater_equal(w18, 0)
+        t226 = xp.greater(w18, 0)
+        t227 = 1e-12*t43
+        t228 = (t226 & xp.greater(t63[6], 0)) | (xp.less_equal(w18, 0) & (xp.less_equal(t34, t227) | xp.less_equal(t93, t227) | xp.less_equal(t122, t227) | xp.less_equal(t170, t227) | xp.less_equal(t201, t227) | xp.less_equal(t213, t227)))
+        t229 = t224 & t225 & xp.logical_not(t228)
+        state = (
+            xp.where(t229, xp.where(t226, t67, t223), 0),
+            xp.where(t229, xp.where(t226, -t76, t221), 0),
+            xp.where(t229, xp.where(t226, -t78, t220), 0),
+            xp.where(t229, xp.where(t226, -t72, t219), 0),
+            xp.where(t229, xp.where(t226, t73, t218), 0),
+            xp.where(t229, xp.where(t226, -t74, t217), 0),
+            xp.where(xp.logical_not(t224 & t225), 2, xp.where(t228, xp.asarray(1, dtype=dtype), 0)),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _nearer_branch(xp, count, state):
     """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 114 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
         t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w7))
@@ -3439,16 +3690,9 @@ def condition_number(q):
     return kappa
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1211 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1217 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
@@ -3462,276 +3706,34 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s2 = trig[..., 3]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
-    c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = c23*c5 - s23*c4*s5
-    t1 = 0.4318*c23 + 0.0203*s23
-    t2 = 0.4318*s2 + t1
-    t3 = 0.0203*c23
-    t4 = 0.15005*s1 + c1*t3
-    t5 = -0.15005*c1 + s1*t3
-    t6 = s1*s4
-    t7 = c1*c4
-    t8 = -t6 + c23*t7
-    t9 = t7 - c23*t6
-    t10 = s1*c4
-    t11 = c1*s4
-    t12 = t10 + c23*t11
-    t13 = t11 + c23*t10
-    t14 = c1*s23
-    t15 = t8*s5 + c5*t14
-    t16 = -0.4318*t14 + t4
-    t17 = s1*s23
-    t18 = t13*s5 + c5*t17
-    t19 = -0.4318*t17 + t5
-    t20 = c1*t16 + s1*t19
-    t21 = 0.4318*c2
-    t22 = t16 + c1*t21
-    t23 = t19 + s1*t21
-    t24 = c1*t22 + s1*t23
-    t25 = t24**2
-    t26 = t25 + t20**2
-    t27 = t23**2
-    t28 = c1**2
-    t29 = t2*t28 + t1*t28
-    t30 = t2**2
-    t31 = t1**2
-    t32 = t27 + t28*t30 + t28*t31
-    t33 = t22**2
-    t34 = xp.sqrt(1 + t27 + t33)
-    t35 = xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)*t34
-    t36 = s1**2
-    t37 = t2*t36 + t1*t36
-    t38 = t33 + t30*t36 + t31*t36
-    t39 = s23**2
-    t40 = t12**2 + t15**2 + 2*t36 + t28*t39
-    t41 = t9**2 + t18**2 + 2*t28 + t36*t39
-    t42 = 1 + c23**2 + t0**2 + s4**2*t39
-    t43 = xp.sqrt(t26 + t32 + t38 + t40 + t41 + t42)
-    t44 = s1*c1
-    t45 = -t22*t23 + t30*t44 + t31*t44
-    t46 = c1*t24
-    t47 = c1*t20
-    t48 = t1*t47 + t2*t46
-    t49 = t46 + t47
-    t50 = c1*t2
-    t51 = c1*t1
-    t52 = s1*t50 + s1*t51
-    t53 = s1*t24
-    t54 = s1*t20
-    t55 = t1*t54 + t2*t53
-    t56 = t53 + t54
-    t57 = 2*s1
-    t58 = -t12*t9 + t15*t18 - c1*t57 + t39*t44
-    t59 = s23*s4
-    t60 = c23*t14 + t15*t0 - t12*t59
-    t61 = c23*t17 + t18*t0 + t9*t59
-    t62 = damping**2
-    t63 = -t23
-    t64 = _symmetric_solve6(xp, 1, (t32 + t62, t45, -t48, -t52, t29, t63, t38 + t62, -t55, -t37, t52, t22, t26 + t62, t56, -t49, xp.full(batch, 0, dtype=dtype, device=device), t40 + t62, t58, -t60, t41 + t62, -t61, t42 + t62, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
-    t65 = t64[5]
-    t66 = t64[0]
-    t67 = t64[1]
-    t68 = t65 - t23*t66 + t22*t67
-    t69 = s1*t2
-    t70 = t64[2]
-    t71 = t64[3]
-    t72 = t64[4]
-    t73 = t14*t71 + t17*t72 - c23*t65
-    t74 = t12*t71 - t9*t72 + t59*t65
-    t75 = t15*t71 + t18*t72 - t0*t65
-    t76 = -s1*t71 + c1*t72
-    t77 = t76 + t50*t66 + t67*t69 - t24*t70
-    t78 = s1*t1
-    t79 = t76 + t51*t66 + t67*t78 - t20*t70
-    t80 = xp.greater(t34, 0)
-    t81 = xp.where(t80, 1/(t63 + t35), 0)
-    t82 = xp.where(t80, 1 + xp.abs(t23)/t34, 0)
-    t83 = t22*t81
-    t84 = -t82*(t50 + t69*t83)
-    t85 = t50 + t84
-    t86 = t69 + t83*t84
-    t87 = -t82*(t51 + t78*t83)
-    t88 = t51 + t87
-    t89 = t82*(mu_dot0 + mu_dot5*t81 + t83*mu_dot1)
-    t90 = -t89 + mu_dot0
-    t91 = t81*t87
-    t92 = t78 + t22*t91
-    t93 = t81**2
-    t94 = xp.sqrt(t25 + t28 + t36 + t86**2 + t93*t84**2)
-    t95 = t94*xp.where(xp.less_equal(t86, 0), xp.asarray(1, dtype=dtype), -1)
-    t96 = t93*t82
-    t97 = c23*t96
-    t98 = t22*t97
-    t99 = -t97 + c23
-    t100 = t59*t96
-    t101 = t22*t100
-    t102 = -t100 + t59
-    t103 = t0*t96
-    t104 = t22*t103
-    t105 = -t103 + t0
-    t106 = t81*t89
-    t107 = mu_dot1 - t22*t106
-    t108 = -t106 + mu_dot5
-    t109 = xp.greater(t94, 0)
-    t110 = xp.where(t109, 1/(-t86 + t95), 0)
-    t111 = xp.where(t109, 1 + xp.abs(t86)/t94, 0)
-    t112 = t24*t110
-    t113 = t84*t110
-    t114 = t111*(-t92 + t20*t112 + t36*t110 + t28*t110 + t93*t113*t87)
-    t115 = t92 + t114
-    t116 = t20 - t112*t114
-    t117 = t110*t114
-    t118 = s1 - s1*t117
-    t119 = -c1 + c1*t117
-    t120 = t81*t84
-    t121 = -t91 + t117*t120
-    t122 = xp.sqrt(t116**2 + t118**2 + t119**2 + t121**2)
-    t123 = t122*xp.where(xp.greater_equal(t116, 0), xp.asarray(1, dtype=dtype), -1)
-    t124 = t113*t81
-    t125 = -t111*(t98 + t124*t99)
-    t126 = t98 + t125
-    t127 = t110*t125
-    t128 = t14 + s1*t127
-    t129 = t99 + t120*t127
-    t130 = -t17
-    t131 = t130 + c1*t127
-    t132 = s1*t110
-    t133 = c1*t110
-    t134 = t111*(-t101 + t12*t132 + t9*t133 - t124*t102)
-    t135 = t101 + t134
-    t136 = t12 - t132*t134
-    t137 = t102 + t124*t134
-    t138 = -t111*(t104 + t15*t132 - t18*t133 + t124*t105)
-    t139 = t104 + t138
-    t140 = t15 + t132*t138
-    t141 = t105 + t124*t138
-    t142 = t111*(t107 + t112*mu_dot2 + t132*mu_dot3 - t133*mu_dot4 - t124*t108)
-    t143 = -t142 + t107
-    t144 = mu_dot2 - t112*t142
-    t145 = mu_dot3 - t132*t142
-    t146 = mu_dot4 + t133*t142
-    t147 = t108 + t124*t142
-    t148 = -t9
-    t149 = t148 + t133*t134
-    t150 = -t18
-    t151 = t150 + t133*t138
-    t152 = 1 - t15 - t50 - t51 - t69 - t78 - t14 + q1 + q2 + q3 + c23 + q4 + t12 + q5 + t0 + q6 + t22 + t24 + t20 - 2*c1 + t57 + t59 + t63 + t130 + t148 + t150 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t153 = xp.greater(t122, 0)
-    t154 = xp.where(t153, 1/(t116 + t123), 0)
-    t155 = xp.where(t153, 1 + xp.abs(t116)/t122, 0)
-    t156 = t112*t125
-    t157 = t118*t154
-    t158 = t119*t154
-    t159 = t121*t154
-    t160 = t155*(-t156 - t157*t128 + t158*t131 + t159*t129)
-    t161 = t156 + t160
-    t162 = t128 + t157*t160
-    t163 = t131 - t158*t160
-    t164 = t129 - t159*t160
-    t165 = t155*(t144 + t157*t145 + t158*t146 + t159*t147)
-    t166 = -t165 + t144
-    t167 = t145 - t157*t165
-    t168 = t146 - t158*t165
-    t169 = t147 - t159*t165
-    t170 = xp.sqrt(t162**2 + t163**2 + t164**2)
-    t171 = t170*xp.where(xp.less_equal(t162, 0), xp.asarray(1, dtype=dtype), -1)
-    t172 = t112*t134
-    t173 = t155*(-t172 + t157*t136 + t158*t149 + t159*t137)
-    t174 = t172 + t173
-    t175 = t136 - t157*t173
-    t176 = t149 - t158*t173
-    t177 = t137 - t159*t173
-    t178 = t112*t138
-    t179 = t155*(-t178 - t157*t140 + t158*t151 + t159*t141)
-    t180 = t178 + t179
-    t181 = t140 + t157*t179
-    t182 = t151 - t158*t179
-    t183 = t141 - t159*t179
-    t184 = xp.greater(t170, 0)
-    t185 = xp.where(t184, 1/(-t162 + t171), 0)
-    t186 = xp.where(t184, 1 + xp.abs(t162)/t170, 0)
-    t187 = t163*t185
-    t188 = t164*t185
-    t189 = t186*(t175 + t187*t176 + t188*t177)
-    t190 = -t189 + t175
-    t191 = t176 - t187*t189
-    t192 = t177 - t188*t189
-    t193 = t186*(-t181 + t187*t182 + t188*t183)
-    t194 = t181 + t193
-    t195 = t182 - t187*t193
-    t196 = t183 - t188*t193
-    t197 = t186*(t167 + t187*t168 + t188*t169)
-    t198 = -t197 + t167
-    t199 = t168 - t187*t197
-    t200 = t169 - t188*t197
-    t201 = xp.sqrt(t191**2 + t192**2)
-    t202 = t201*xp.where(xp.greater_equal(t191, 0), xp.asarray(1, dtype=dtype), -1)
-    t203 = xp.greater(t201, 0)
-    t204 = xp.where(t203, 1/(t191 + t202), 0)
-    t205 = xp.where(t203, 1 + xp.abs(t191)/t201, 0)
-    t206 = t192*t204
-    t207 = t205*(t195 + t206*t196)
-    t208 = -t207 + t195
-    t209 = t196 - t206*t207
-    t210 = t205*(t199 + t206*t200)
-    t211 = -t210 + t199
-    t212 = t200 - t206*t210
-    t213 = xp.abs(t209)
-    t214 = t213*xp.where(xp.greater_equal(t209, 0), xp.asarray(1, dtype=dtype), -1)
-    t215 = xp.where(xp.greater(t213, 0), xp.asarray(2, dtype=dtype), 0)
-    t216 = t212 - t212*t215
-    t217 = xp.where(xp.not_equal(t214, 0), -t216/t214, 0)
-    t218 = xp.where(xp.not_equal(t202, 0), -(t211 - t208*t217)/t202, 0)
-    t219 = xp.where(xp.not_equal(t171, 0), -(-(t190*t218 - t194*t217) + t198)/t171, 0)
-    t220 = xp.where(xp.not_equal(t123, 0), -(t166 + t161*t219 + t174*t218 + t180*t217)/t123, 0)
-    t221 = xp.where(xp.not_equal(t95, 0), -(t143 + t115*t220 + t126*t219 + t135*t218 + t139*t217)/t95, 0)
-    t222 = t81*t82
-    t223 = xp.where(xp.not_equal(t35, 0), -(t90 + t85*t221 + t88*t220 + c23*t222*t219 + t59*t222*t218 + t0*t222*t217)/t35, 0)
-    t224 = xp.isfinite(t152)
-    t225 = xp.greater_equal(damping, 0)
-    t226 = xp.greater(damping, 0)
-    t227 = 1e-12*t43
-    t228 = (t226 & xp.greater(t64[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t34, t227) | xp.less_equal(t94, t227) | xp.less_equal(t122, t227) | xp.less_equal(t170, t227) | xp.less_equal(t201, t227) | xp.less_equal(t213, t227)))
-    t229 = t224 & t225 & xp.logical_not(t228)
+    c6 = trig[..., 10]
+    s6 = trig[..., 11]
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t229, xp.where(t226, t68, t223), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t229, xp.where(t226, -t77, t221), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t229, xp.where(t226, -t79, t220), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t229, xp.where(t226, -t73, t219), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t229, xp.where(t226, t74, t218), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t229, xp.where(t226, -t75, t217), 0), batch),  # 5
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
+        xp.broadcast_to(t0[4], batch),  # 4
+        xp.broadcast_to(t0[5], batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t224 & t225), 2, xp.where(t228, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[6], batch), xp.int32)
     return q_dot, status
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1217 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("z", z, (6,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
     mu_dot3 = mu_dot[..., 3]
     mu_dot4 = mu_dot[..., 4]
     mu_dot5 = mu_dot[..., 5]
-    qz1 = z[..., 0]
-    qz2 = z[..., 1]
-    qz3 = z[..., 2]
-    qz4 = z[..., 3]
-    qz5 = z[..., 4]
-    qz6 = z[..., 5]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
@@ -3739,264 +3741,29 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     s2 = trig[..., 3]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
-    c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = c23*c5 - s23*c4*s5
-    t1 = 0.4318*c23 + 0.0203*s23
-    t2 = 0.4318*s2 + t1
-    t3 = 0.0203*c23
-    t4 = 0.15005*s1 + c1*t3
-    t5 = -0.15005*c1 + s1*t3
-    t6 = s1*s4
-    t7 = c1*c4
-    t8 = -t6 + c23*t7
-    t9 = t7 - c23*t6
-    t10 = s1*c4
-    t11 = c1*s4
-    t12 = t10 + c23*t11
-    t13 = t11 + c23*t10
-    t14 = c1*s23
-    t15 = t8*s5 + c5*t14
-    t16 = -0.4318*t14 + t4
-    t17 = s1*s23
-    t18 = t13*s5 + c5*t17
-    t19 = -0.4318*t17 + t5
-    t20 = c1*t16 + s1*t19
-    t21 = 0.4318*c2
-    t22 = t16 + c1*t21
-    t23 = t19 + s1*t21
-    t24 = c1*t22 + s1*t23
-    t25 = t24**2
-    t26 = t25 + t20**2
-    t27 = t23**2
-    t28 = c1**2
-    t29 = t2*t28 + t1*t28
-    t30 = t2**2
-    t31 = t1**2
-    t32 = t27 + t28*t30 + t28*t31
-    t33 = t22**2
-    t34 = xp.sqrt(1 + t27 + t33)
-    t35 = xp.where(xp.less_equal(t23, 0), xp.asarray(1, dtype=dtype), -1)*t34
-    t36 = s1**2
-    t37 = t2*t36 + t1*t36
-    t38 = t33 + t30*t36 + t31*t36
-    t39 = s23**2
-    t40 = t12**2 + t15**2 + 2*t36 + t28*t39
-    t41 = t9**2 + t18**2 + 2*t28 + t36*t39
-    t42 = 1 + c23**2 + t0**2 + s4**2*t39
-    t43 = xp.sqrt(t26 + t32 + t38 + t40 + t41 + t42)
-    t44 = s1*c1
-    t45 = -t22*t23 + t30*t44 + t31*t44
-    t46 = c1*t24
-    t47 = c1*t20
-    t48 = t1*t47 + t2*t46
-    t49 = t46 + t47
-    t50 = c1*t2
-    t51 = c1*t1
-    t52 = s1*t50 + s1*t51
-    t53 = s1*t24
-    t54 = s1*t20
-    t55 = t1*t54 + t2*t53
-    t56 = t53 + t54
-    t57 = 2*s1
-    t58 = -t12*t9 + t15*t18 - c1*t57 + t39*t44
-    t59 = s23*s4
-    t60 = c23*t14 + t15*t0 - t12*t59
-    t61 = c23*t17 + t18*t0 + t9*t59
-    t62 = damping**2
-    t63 = -t23
-    t64 = _symmetric_solve6(xp, 1, (t32 + t62, t45, -t48, -t52, t29, t63, t38 + t62, -t55, -t37, t52, t22, t26 + t62, t56, -t49, xp.full(batch, 0, dtype=dtype, device=device), t40 + t62, t58, -t60, t41 + t62, -t61, t42 + t62, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
-    t65 = t64[5]
-    t66 = t64[0]
-    t67 = t64[1]
-    t68 = t65 - t23*t66 + t22*t67
-    t69 = s1*t2
-    t70 = t64[2]
-    t71 = t64[3]
-    t72 = t64[4]
-    t73 = t14*t71 + t17*t72 - c23*t65
-    t74 = t12*t71 - t9*t72 + t59*t65
-    t75 = t15*t71 + t18*t72 - t0*t65
-    t76 = -s1*t71 + c1*t72
-    t77 = t76 + t50*t66 + t67*t69 - t24*t70
-    t78 = s1*t1
-    t79 = t76 + t51*t66 + t67*t78 - t20*t70
-    t80 = xp.greater(t34, 0)
-    t81 = xp.where(t80, 1/(t63 + t35), 0)
-    t82 = xp.where(t80, 1 + xp.abs(t23)/t34, 0)
-    t83 = t22*t81
-    t84 = -t82*(t50 + t69*t83)
-    t85 = t50 + t84
-    t86 = t69 + t83*t84
-    t87 = -t82*(t51 + t78*t83)
-    t88 = t51 + t87
-    t89 = t82*(mu_dot0 + mu_dot5*t81 + t83*mu_dot1)
-    t90 = -t89 + mu_dot0
-    t91 = t81*t87
-    t92 = t78 + t22*t91
-    t93 = t81**2
-    t94 = xp.sqrt(t25 + t28 + t36 + t86**2 + t93*t84**2)
-    t95 = t94*xp.where(xp.less_equal(t86, 0), xp.asarray(1, dtype=dtype), -1)
-    t96 = t93*t82
-    t97 = c23*t96
-    t98 = t22*t97
-    t99 = -t97 + c23
-    t100 = t59*t96
-    t101 = t22*t100
-    t102 = -t100 + t59
-    t103 = t0*t96
-    t104 = t22*t103
-    t105 = -t103 + t0
-    t106 = t81*t89
-    t107 = mu_dot1 - t22*t106
-    t108 = -t106 + mu_dot5
-    t109 = xp.greater(t94, 0)
-    t110 = xp.where(t109, 1/(-t86 + t95), 0)
-    t111 = xp.where(t109, 1 + xp.abs(t86)/t94, 0)
-    t112 = t24*t110
-    t113 = t84*t110
-    t114 = t111*(-t92 + t20*t112 + t36*t110 + t28*t110 + t93*t113*t87)
-    t115 = t92 + t114
-    t116 = t20 - t112*t114
-    t117 = t110*t114
-    t118 = s1 - s1*t117
-    t119 = -c1 + c1*t117
-    t120 = t81*t84
-    t121 = -t91 + t117*t120
-    t122 = xp.sqrt(t116**2 + t118**2 + t119**2 + t121**2)
-    t123 = t122*xp.where(xp.greater_equal(t116, 0), xp.asarray(1, dtype=dtype), -1)
-    t124 = t113*t81
-    t125 = -t111*(t98 + t124*t99)
-    t126 = t98 + t125
-    t127 = t110*t125
-    t128 = t14 + s1*t127
-    t129 = t99 + t120*t127
-    t130 = -t17
-    t131 = t130 + c1*t127
-    t132 = s1*t110
-    t133 = c1*t110
-    t134 = t111*(-t101 + t12*t132 + t9*t133 - t124*t102)
-    t135 = t101 + t134
-    t136 = t12 - t132*t134
-    t137 = t102 + t124*t134
-    t138 = -t111*(t104 + t15*t132 - t18*t133 + t124*t105)
-    t139 = t104 + t138
-    t140 = t15 + t132*t138
-    t141 = t105 + t124*t138
-    t142 = t111*(t107 + t112*mu_dot2 + t132*mu_dot3 - t133*mu_dot4 - t124*t108)
-    t143 = -t142 + t107
-    t144 = mu_dot2 - t112*t142
-    t145 = mu_dot3 - t132*t142
-    t146 = mu_dot4 + t133*t142
-    t147 = t108 + t124*t142
-    t148 = -t9
-    t149 = t148 + t133*t134
-    t150 = -t18
-    t151 = t150 + t133*t138
-    t152 = 1 - t15 - t50 - t51 - t69 - t78 - t14 + q1 + q2 + q3 + c23 + q4 + t12 + q5 + t0 + q6 + t22 + t24 + t20 - 2*c1 + t57 + t59 + t63 + t130 + t148 + t150 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6
-    t153 = xp.greater(t122, 0)
-    t154 = xp.where(t153, 1/(t116 + t123), 0)
-    t155 = xp.where(t153, 1 + xp.abs(t116)/t122, 0)
-    t156 = t112*t125
-    t157 = t118*t154
-    t158 = t119*t154
-    t159 = t121*t154
-    t160 = t155*(-t156 - t157*t128 + t158*t131 + t159*t129)
-    t161 = t156 + t160
-    t162 = t128 + t157*t160
-    t163 = t131 - t158*t160
-    t164 = t129 - t159*t160
-    t165 = t155*(t144 + t157*t145 + t158*t146 + t159*t147)
-    t166 = -t165 + t144
-    t167 = t145 - t157*t165
-    t168 = t146 - t158*t165
-    t169 = t147 - t159*t165
-    t170 = xp.sqrt(t162**2 + t163**2 + t164**2)
-    t171 = t170*xp.where(xp.less_equal(t162, 0), xp.asarray(1, dtype=dtype), -1)
-    t172 = t112*t134
-    t173 = t155*(-t172 + t157*t136 + t158*t149 + t159*t137)
-    t174 = t172 + t173
-    t175 = t136 - t157*t173
-    t176 = t149 - t158*t173
-    t177 = t137 - t159*t173
-    t178 = t112*t138
-    t179 = t155*(-t178 - t157*t140 + t158*t151 + t159*t141)
-    t180 = t178 + t179
-    t181 = t140 + t157*t179
-    t182 = t151 - t158*t179
-    t183 = t141 - t159*t179
-    t184 = xp.greater(t170, 0)
-    t185 = xp.where(t184, 1/(-t162 + t171), 0)
-    t186 = xp.where(t184, 1 + xp.abs(t162)/t170, 0)
-    t187 = t163*t185
-    t188 = t164*t185
-    t189 = t186*(t175 + t187*t176 + t188*t177)
-    t190 = -t189 + t175
-    t191 = t176 - t187*t189
-    t192 = t177 - t188*t189
-    t193 = t186*(-t181 + t187*t182 + t188*t183)
-    t194 = t181 + t193
-    t195 = t182 - t187*t193
-    t196 = t183 - t188*t193
-    t197 = t186*(t167 + t187*t168 + t188*t169)
-    t198 = -t197 + t167
-    t199 = t168 - t187*t197
-    t200 = t169 - t188*t197
-    t201 = xp.sqrt(t191**2 + t192**2)
-    t202 = t201*xp.where(xp.greater_equal(t191, 0), xp.asarray(1, dtype=dtype), -1)
-    t203 = xp.greater(t201, 0)
-    t204 = xp.where(t203, 1/(t191 + t202), 0)
-    t205 = xp.where(t203, 1 + xp.abs(t191)/t201, 0)
-    t206 = t192*t204
-    t207 = t205*(t195 + t206*t196)
-    t208 = -t207 + t195
-    t209 = t196 - t206*t207
-    t210 = t205*(t199 + t206*t200)
-    t211 = -t210 + t199
-    t212 = t200 - t206*t210
-    t213 = xp.abs(t209)
-    t214 = t213*xp.where(xp.greater_equal(t209, 0), xp.asarray(1, dtype=dtype), -1)
-    t215 = xp.where(xp.greater(t213, 0), xp.asarray(2, dtype=dtype), 0)
-    t216 = t212 - t212*t215
-    t217 = xp.where(xp.not_equal(t214, 0), -t216/t214, 0)
-    t218 = xp.where(xp.not_equal(t202, 0), -(t211 - t208*t217)/t202, 0)
-    t219 = xp.where(xp.not_equal(t171, 0), -(-(t190*t218 - t194*t217) + t198)/t171, 0)
-    t220 = xp.where(xp.not_equal(t123, 0), -(t166 + t161*t219 + t174*t218 + t180*t217)/t123, 0)
-    t221 = xp.where(xp.not_equal(t95, 0), -(t143 + t115*t220 + t126*t219 + t135*t218 + t139*t217)/t95, 0)
-    t222 = t81*t82
-    t223 = xp.where(xp.not_equal(t35, 0), -(t90 + t85*t221 + t88*t220 + c23*t222*t219 + t59*t222*t218 + t0*t222*t217)/t35, 0)
-    t224 = xp.isfinite(t152)
-    t225 = xp.greater_equal(damping, 0)
-    t226 = xp.greater(damping, 0)
-    t227 = 1e-12*t43
-    t228 = (t226 & xp.greater(t64[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t34, t227) | xp.less_equal(t94, t227) | xp.less_equal(t122, t227) | xp.less_equal(t170, t227) | xp.less_equal(t201, t227) | xp.less_equal(t213, t227)))
-    t229 = t224 & t225 & xp.logical_not(t228)
+    c6 = trig[..., 10]
+    s6 = trig[..., 11]
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t229, xp.where(t226, t68, t223), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t229, xp.where(t226, -t77, t221), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t229, xp.where(t226, -t79, t220), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t229, xp.where(t226, -t73, t219), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t229, xp.where(t226, t74, t218), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t229, xp.where(t226, -t75, t217), 0), batch),  # 5
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
+        xp.broadcast_to(t0[4], batch),  # 4
+        xp.broadcast_to(t0[5], batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t224 & t225), 2, xp.where(t228, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[6], batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1378 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1428 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (6,)), ("target", target, (4, 4)), ("target_rate", target_rate, (6,)), ("gain", gain, (6,)), ("z", z, (6,)), ("damping", damping, ()), every=("gain", ))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
     T02 = target[..., 0, 2]
@@ -4021,12 +3788,6 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     gain3 = gain[..., 3]
     gain4 = gain[..., 4]
     gain5 = gain[..., 5]
-    qz1 = z[..., 0]
-    qz2 = z[..., 1]
-    qz3 = z[..., 2]
-    qz4 = z[..., 3]
-    qz5 = z[..., 4]
-    qz6 = z[..., 5]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
@@ -4072,261 +3833,56 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t27 = t10*s6 + t25*c6
     t28 = t10*c6 - t25*s6
     t29 = -0.4318*t24 + t6
-    t30 = c1*t20 + s1*t29
-    t31 = t27*T00 + t28*T01 - t26*T02
-    t32 = t27*T10 + t28*T11 - t26*T12
-    t33 = t27*T20 + t28*T21 - t26*T22
-    t34 = -0.5*(t22 + t31)
-    t35 = s23*c4
-    t36 = c23*s5 + c5*t35
-    t37 = c23*c5 - s5*t35
-    t38 = s23*s4
-    t39 = t36*c6 - s6*t38
-    t40 = t36*s6 + c6*t38
-    t41 = c23*t15 + t17*t37 - t13*t38
-    t42 = c23*t24 + t26*t37 + t10*t38
-    t43 = t39*T00 - t40*T01 + t37*T02
-    t44 = t39*T10 - t40*T11 + t37*T12
-    t45 = t39*T20 - t40*T21 + t37*T22
-    t46 = 0.5*(-t44 + t33)
-    t47 = 0.5*(t43 + t23)
-    t48 = xp.sqrt(t46**2 + t47**2 + t34**2)
-    t49 = 0.4318*c2
-    t50 = t20 + c1*t49
-    t51 = t29 + s1*t49
-    t52 = c1*t50 + s1*t51
-    t53 = mu_dot0 + gain0*(-t50 + T03)
-    t54 = t52**2
-    t55 = t54 + t30**2
-    t56 = t51**2
-    t57 = c1**2
-    t58 = t0*t57 + t1*t57
-    t59 = t1**2
-    t60 = t0**2
-    t61 = t56 + t57*t59 + t57*t60
-    t62 = t50**2
-    t63 = xp.sqrt(1 + t56 + t62)
-    t64 = xp.where(xp.less_equal(t51, 0), xp.asarray(1, dtype=dtype), -1)*t63
-    t65 = s1**2
-    t66 = t1*t65 + t0*t65
-    t67 = t62 + t59*t65 + t60*t65
-    t68 = s23**2
-    t69 = t13**2 + t17**2 + 2*t65 + t57*t68
-    t70 = t10**2 + t26**2 + 2*t57 + t65*t68
-    t71 = 1 + c23**2 + t37**2 + s4**2*t68
-    t72 = xp.sqrt(t55 + t61 + t67 + t69 + t70 + t71)
-    t73 = s1*c1
-    t74 = -t50*t51 + t59*t73 + t60*t73
-    t75 = c1*t52
-    t76 = c1*t30
-    t77 = t1*t75 + t0*t76
-    t78 = t75 + t76
-    t79 = c1*t1
-    t80 = c1*t0
-    t81 = s1*t79 + s1*t80
-    t82 = s1*t52
-    t83 = s1*t30
-    t84 = t1*t82 + t0*t83
-    t85 = t82 + t83
-    t86 = 2*s1
-    t87 = -t13*t10 + t17*t26 - c1*t86 + t68*t73
-    t88 = xp.greater(t63, 0)
-    t89 = xp.where(t88, 1 + xp.abs(t51)/t63, 0)
-    t90 = -t51
-    t91 = xp.where(t88, 1/(t90 + t64), 0)
-    t92 = mu_dot1 + gain1*(t90 + T13)
-    t93 = s1*t1
-    t94 = t50*t91
-    t95 = -t89*(t79 + t93*t94)
-    t96 = t79 + t95
-    t97 = t93 + t94*t95
-    t98 = s1*t0
-    t99 = -t89*(t80 + t94*t98)
-    t100 = t80 + t99
-    t101 = t91*t99
-    t102 = t98 + t50*t101
-    t103 = t91**2
-    t104 = xp.sqrt(t54 + t57 + t65 + t97**2 + t103*t95**2)
-    t105 = t104*xp.where(xp.less_equal(t97, 0), xp.asarray(1, dtype=dtype), -1)
-    t106 = t103*t89
-    t107 = c23*t106
-    t108 = t50*t107
-    t109 = -t107 + c23
-    t110 = t38*t106
-    t111 = t50*t110
-    t112 = -t110 + t38
-    t113 = t37*t106
-    t114 = t50*t113
-    t115 = -t113 + t37
-    t116 = xp.greater(t104, 0)
-    t117 = xp.where(t116, 1/(-t97 + t105), 0)
-    t118 = xp.where(t116, 1 + xp.abs(t97)/t104, 0)
-    t119 = t52*t117
-    t120 = t95*t117
-    t121 = t118*(-t102 + t30*t119 + t65*t117 + t57*t117 + t103*t120*t99)
-    t122 = t102 + t121
-    t123 = t30 - t119*t121
-    t124 = t117*t121
-    t125 = s1 - s1*t124
-    t126 = -c1 + c1*t124
-    t127 = t91*t95
-    t128 = -t101 + t124*t127
-    t129 = xp.sqrt(t123**2 + t125**2 + t126**2 + t128**2)
-    t130 = t129*xp.where(xp.greater_equal(t123, 0), xp.asarray(1, dtype=dtype), -1)
-    t131 = t120*t91
-    t132 = -t118*(t108 + t131*t109)
-    t133 = t108 + t132
-    t134 = t117*t132
-    t135 = t15 + s1*t134
-    t136 = t109 + t127*t134
-    t137 = -t24
-    t138 = t137 + c1*t134
-    t139 = s1*t117
-    t140 = c1*t117
-    t141 = t118*(-t111 + t13*t139 + t10*t140 - t131*t112)
-    t142 = t111 + t141
-    t143 = t13 - t139*t141
-    t144 = t112 + t131*t141
-    t145 = -t118*(t114 + t17*t139 - t26*t140 + t131*t115)
-    t146 = t114 + t145
-    t147 = t17 + t139*t145
-    t148 = t115 + t131*t145
-    t149 = -t10
-    t150 = t149 + t140*t141
-    t151 = -t26
-    t152 = t151 + t140*t145
-    t153 = xp.greater(t129, 0)
-    t154 = xp.where(t153, 1/(t123 + t130), 0)
-    t155 = xp.where(t153, 1 + xp.abs(t123)/t129, 0)
-    t156 = t119*t132
-    t157 = t125*t154
-    t158 = t126*t154
-    t159 = t128*t154
-    t160 = t155*(-t156 - t157*t135 + t158*t138 + t159*t136)
-    t161 = t156 + t160
-    t162 = t135 + t157*t160
-    t163 = t138 - t158*t160
-    t164 = t136 - t159*t160
-    t165 = xp.sqrt(t162**2 + t163**2 + t164**2)
-    t166 = t165*xp.where(xp.less_equal(t162, 0), xp.asarray(1, dtype=dtype), -1)
-    t167 = t119*t141
-    t168 = t155*(-t167 + t157*t143 + t158*t150 + t159*t144)
-    t169 = t167 + t168
-    t170 = t143 - t157*t168
-    t171 = t150 - t158*t168
-    t172 = t144 - t159*t168
-    t173 = t119*t145
-    t174 = t155*(-t173 - t157*t147 + t158*t152 + t159*t148)
-    t175 = t173 + t174
-    t176 = t147 + t157*t174
-    t177 = t152 - t158*t174
-    t178 = t148 - t159*t174
-    t179 = xp.greater(t165, 0)
-    t180 = xp.where(t179, 1/(-t162 + t166), 0)
-    t181 = xp.where(t179, 1 + xp.abs(t162)/t165, 0)
-    t182 = t163*t180
-    t183 = t164*t180
-    t184 = t181*(t170 + t182*t171 + t183*t172)
-    t185 = -t184 + t170
-    t186 = t171 - t182*t184
-    t187 = t172 - t183*t184
-    t188 = t181*(-t176 + t182*t177 + t183*t178)
-    t189 = t176 + t188
-    t190 = t177 - t182*t188
-    t191 = t178 - t183*t188
-    t192 = xp.sqrt(t186**2 + t187**2)
-    t193 = t192*xp.where(xp.greater_equal(t186, 0), xp.asarray(1, dtype=dtype), -1)
-    t194 = xp.greater(t192, 0)
-    t195 = xp.where(t194, 1/(t186 + t193), 0)
-    t196 = xp.where(t194, 1 + xp.abs(t186)/t192, 0)
-    t197 = t187*t195
-    t198 = t196*(t190 + t197*t191)
-    t199 = -t198 + t190
-    t200 = t191 - t197*t198
-    t201 = xp.abs(t200)
-    t202 = t201*xp.where(xp.greater_equal(t200, 0), xp.asarray(1, dtype=dtype), -1)
-    t203 = xp.where(xp.greater(t201, 0), xp.asarray(2, dtype=dtype), 0)
-    t204 = -t21
-    t205 = 0.5*(-1 + t204 + t32 + t45)
-    t206 = xp.atan2(t48, t205)
-    t207 = xp.where(xp.greater(t48, 0), t206/t48, 1)
-    t208 = xp.greater_equal(t204, t32) & xp.greater_equal(t204, t45)
-    t209 = xp.greater_equal(t32, t45)
-    t210 = xp.where(t208, 0.5*(1 + t204), xp.where(t209, 0.5*t31, 0.5*t43))
-    t211 = xp.where(t208, -0.5*t22, xp.where(t209, 0.5*(1 + t32), 0.5*t44))
-    t212 = xp.where(t208, -0.5*t23, xp.where(t209, 0.5*t33, 0.5*(1 + t45)))
-    t213 = xp.sqrt(t210**2 + t211**2 + t212**2)
-    t214 = xp.where(xp.greater_equal(t46*t210 + t47*t211 + t34*t212, 0), xp.asarray(1, dtype=dtype), -1)
-    t215 = xp.greater(t48, 1e-06) | xp.greater(t205, 0)
-    t216 = t206*t214/t213
-    t217 = xp.where(t215, t46*t207, t216*t210)
-    t218 = xp.where(t215, t47*t207, t216*t211)
-    t219 = xp.where(t215, t34*t207, t216*t212)
-    t220 = mu_dot3 + t217*gain3
-    t221 = mu_dot4 + t218*gain4
-    t222 = mu_dot5 + t219*gain5
-    t223 = t89*(t53 + t91*t222 + t94*t92)
-    t224 = -t223 + t53
-    t225 = 1 - t17 - t79 - t80 - t93 - t98 - t15 + q1 + q2 + q3 + c23 + q4 + t13 + q5 + t37 + q6 + t50 + t38 + t52 + t30 - 2*c1 + t86 + t90 + t137 + t149 + t151 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t53 + t92 + t3 + t220 + t221 + t222
-    t226 = damping**2
-    t227 = _symmetric_solve6(xp, 1, (t61 + t226, t74, -t77, -t81, t58, t90, t67 + t226, -t84, -t66, t81, t50, t55 + t226, t85, -t78, xp.full(batch, 0, dtype=dtype, device=device), t69 + t226, t87, -t41, t70 + t226, -t42, t71 + t226, t53, t92, t3, t220, t221, t222,))
-    t228 = t227[5]
-    t229 = t227[0]
-    t230 = t227[1]
-    t231 = t228 - t51*t229 + t50*t230
-    t232 = t227[2]
-    t233 = t227[3]
-    t234 = t227[4]
-    t235 = t15*t233 + t24*t234 - c23*t228
-    t236 = t13*t233 - t10*t234 + t38*t228
-    t237 = t17*t233 + t26*t234 - t37*t228
-    t238 = -s1*t233 + c1*t234
-    t239 = t238 + t79*t229 + t93*t230 - t52*t232
-    t240 = t238 + t80*t229 + t98*t230 - t30*t232
-    t241 = t91*t223
-    t242 = t92 - t50*t241
-    t243 = -t241 + t222
-    t244 = t118*(t242 + t119*t3 + t139*t220 - t140*t221 - t131*t243)
-    t245 = -t244 + t242
-    t246 = t3 - t119*t244
-    t247 = t220 - t139*t244
-    t248 = t221 + t140*t244
-    t249 = t243 + t131*t244
-    t250 = t155*(t246 + t157*t247 + t158*t248 + t159*t249)
-    t251 = -t250 + t246
-    t252 = t247 - t157*t250
-    t253 = t248 - t158*t250
-    t254 = t249 - t159*t250
-    t255 = t181*(t252 + t182*t253 + t183*t254)
-    t256 = -t255 + t252
-    t257 = t253 - t182*t255
-    t258 = t254 - t183*t255
-    t259 = t196*(t257 + t197*t258)
-    t260 = -t259 + t257
-    t261 = t258 - t197*t259
-    t262 = t261 - t203*t261
-    t263 = xp.where(xp.not_equal(t202, 0), -t262/t202, 0)
-    t264 = xp.where(xp.not_equal(t193, 0), -(t260 - t199*t263)/t193, 0)
-    t265 = xp.where(xp.not_equal(t166, 0), -(-(t185*t264 - t189*t263) + t256)/t166, 0)
-    t266 = xp.where(xp.not_equal(t130, 0), -(t251 + t161*t265 + t169*t264 + t175*t263)/t130, 0)
-    t267 = xp.where(xp.not_equal(t105, 0), -(t245 + t122*t266 + t133*t265 + t142*t264 + t146*t263)/t105, 0)
-    t268 = t91*t89
-    t269 = xp.where(xp.not_equal(t64, 0), -(t224 + t96*t267 + t100*t266 + c23*t268*t265 + t38*t268*t264 + t37*t268*t263)/t64, 0)
-    t270 = xp.isfinite(t225)
-    t271 = xp.greater_equal(damping, 0)
-    t272 = xp.greater(damping, 0)
-    t273 = 1e-12*t72
-    t274 = (t272 & xp.greater(t227[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t63, t273) | xp.less_equal(t104, t273) | xp.less_equal(t129, t273) | xp.less_equal(t165, t273) | xp.less_equal(t192, t273) | xp.less_equal(t201, t273)))
-    t275 = t270 & t271 & xp.logical_not(t274)
+    t30 = t27*T00 + t28*T01 - t26*T02
+    t31 = t27*T10 + t28*T11 - t26*T12
+    t32 = t27*T20 + t28*T21 - t26*T22
+    t33 = -0.5*(t22 + t30)
+    t34 = s23*c4
+    t35 = c23*s5 + c5*t34
+    t36 = c23*c5 - s5*t34
+    t37 = s23*s4
+    t38 = t35*c6 - s6*t37
+    t39 = t35*s6 + c6*t37
+    t40 = t38*T00 - t39*T01 + t36*T02
+    t41 = t38*T10 - t39*T11 + t36*T12
+    t42 = t38*T20 - t39*T21 + t36*T22
+    t43 = 0.5*(-t41 + t32)
+    t44 = 0.5*(t40 + t23)
+    t45 = xp.sqrt(t43**2 + t44**2 + t33**2)
+    t46 = 0.4318*c2
+    t47 = t20 + c1*t46
+    t48 = t29 + s1*t46
+    t49 = mu_dot0 + gain0*(-t47 + T03)
+    t50 = mu_dot1 + gain1*(-t48 + T13)
+    t51 = -t21
+    t52 = 0.5*(-1 + t51 + t31 + t42)
+    t53 = xp.atan2(t45, t52)
+    t54 = xp.where(xp.greater(t45, 0), t53/t45, 1)
+    t55 = xp.greater_equal(t51, t31) & xp.greater_equal(t51, t42)
+    t56 = xp.greater_equal(t31, t42)
+    t57 = xp.where(t55, 0.5*(1 + t51), xp.where(t56, 0.5*t30, 0.5*t40))
+    t58 = xp.where(t55, -0.5*t22, xp.where(t56, 0.5*(1 + t31), 0.5*t41))
+    t59 = xp.where(t55, -0.5*t23, xp.where(t56, 0.5*t32, 0.5*(1 + t42)))
+    t60 = xp.sqrt(t57**2 + t58**2 + t59**2)
+    t61 = xp.where(xp.greater_equal(t43*t57 + t44*t58 + t33*t59, 0), xp.asarray(1, dtype=dtype), -1)
+    t62 = xp.greater(t45, 1e-06) | xp.greater(t52, 0)
+    t63 = t53*t61/t60
+    t64 = xp.where(t62, t43*t54, t63*t57)
+    t65 = xp.where(t62, t44*t54, t63*t58)
+    t66 = xp.where(t62, t33*t54, t63*t59)
+    t67 = mu_dot3 + t64*gain3
+    t68 = mu_dot4 + t65*gain4
+    t69 = mu_dot5 + t66*gain5
+    t70 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, t49, t50, t3, t67, t68, t69, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t275, xp.where(t272, t231, t269), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t275, xp.where(t272, -t239, t267), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t275, xp.where(t272, -t240, t266), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t275, xp.where(t272, -t235, t265), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t275, xp.where(t272, t236, t264), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t275, xp.where(t272, -t237, t263), 0), batch),  # 5
+        xp.broadcast_to(t70[0], batch),  # 0
+        xp.broadcast_to(t70[1], batch),  # 1
+        xp.broadcast_to(t70[2], batch),  # 2
+        xp.broadcast_to(t70[3], batch),  # 3
+        xp.broadcast_to(t70[4], batch),  # 4
+        xp.broadcast_to(t70[5], batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t270 & t271), 2, xp.where(t274, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t70[6], batch), xp.int32)
     return q_dot, status
 
 

@@ -501,7 +501,7 @@ static void jacgen_jacobi4_rows(int count, jacgen_jacobi4_rows_state *state)
 
 typedef struct { rexarm_real w[14]; } jacgen_symmetric_solve4_state;
 
-/* X solving a symmetric 4 x 4 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular: 217 operations a run. */
+/* The solution x of a symmetric 4 x 4 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular: 217 operations a run. */
 static void jacgen_symmetric_solve4(int count, jacgen_symmetric_solve4_state *state)
 {
     JACGEN_KERNEL_LOOP
@@ -598,6 +598,161 @@ static void jacgen_symmetric_solve4(int count, jacgen_symmetric_solve4_state *st
         state->w[2] = t69;
         state->w[3] = t68;
         state->w[4] = ((t5 <= t72) || (t33 <= t72) || (t52 <= t72) || (t64 <= t72) ? 1 : 0);
+    }
+}
+
+typedef struct { rexarm_real w[13]; } jacgen_velocity_solve_state;
+
+/* The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status: 571 operations a run. */
+static void jacgen_velocity_solve(int count, jacgen_velocity_solve_state *state)
+{
+    JACGEN_KERNEL_LOOP
+    for (int run = 0; run < count; run++) {
+        const rexarm_real w0 = state->w[0];
+        const rexarm_real w1 = state->w[1];
+        const rexarm_real w2 = state->w[2];
+        const rexarm_real w3 = state->w[3];
+        const rexarm_real w4 = state->w[4];
+        const rexarm_real w5 = state->w[5];
+        const rexarm_real w6 = state->w[6];
+        const rexarm_real w7 = state->w[7];
+        const rexarm_real w8 = state->w[8];
+        const rexarm_real w9 = state->w[9];
+        const rexarm_real w10 = state->w[10];
+        const rexarm_real w11 = state->w[11];
+        const rexarm_real w12 = state->w[12];
+        const rexarm_real c23 = w2*w4 - w3*w5;
+        const rexarm_real s23 = w2*w5 + w3*w4;
+        const rexarm_real c234 = c23*w6 - s23*w7;
+        const rexarm_real s234 = c23*w7 + s23*w6;
+        const rexarm_real t0 = 0.1*w0;
+        const rexarm_real t1 = c23*t0 + c234*t0;
+        const rexarm_real t2 = t1 + w2*t0;
+        const rexarm_real t3 = 0.1*w1;
+        const rexarm_real t4 = c23*t3 + c234*t3;
+        const rexarm_real t5 = t4 + w2*t3;
+        const rexarm_real t6 = w0*t2 + w1*t5;
+        const rexarm_real t7 = w0*t1 + w1*t4;
+        const rexarm_real t8 = 0.1*s234;
+        const rexarm_real t9 = 0.1*s23 + t8;
+        const rexarm_real t10 = 0.1*w3 + t9;
+        const rexarm_real t11 = (w0*w0);
+        const rexarm_real t12 = c234*t11;
+        const rexarm_real t13 = (w1*w1);
+        const rexarm_real t14 = c234*t13;
+        const rexarm_real t15 = 0.1*t12 + 0.1*t14;
+        const rexarm_real t16 = (c234*c234);
+        const rexarm_real t17 = -(t12 + t14)/sqrt(t11*t16 + t13*t16);
+        const rexarm_real t18 = t7*t17 + t15*t17 + t6*t17;
+        const rexarm_real t19 = (t17*t17);
+        const rexarm_real t20 = 3*t19;
+        const rexarm_real t21 = (t2*t2);
+        const rexarm_real t22 = (t5*t5);
+        const rexarm_real t23 = t21 + t22;
+        const rexarm_real t24 = sqrt(t23);
+        const rexarm_real t25 = (t5 <= 0 ? 1 : -1)*t24;
+        const rexarm_real t26 = (t6*t6);
+        const rexarm_real t27 = t26 + (t7*t7) + (t15*t15);
+        const rexarm_real t28 = (t10*t10);
+        const rexarm_real t29 = (t9*t9);
+        const rexarm_real t30 = 0.01*(s234*s234);
+        const rexarm_real t31 = t11*t28 + t11*t30 + t11*t29;
+        const rexarm_real t32 = t22 + t31;
+        const rexarm_real t33 = t13*t28 + t13*t29 + t13*t30;
+        const rexarm_real t34 = sqrt(t20 + t23 + t27 + t31 + t33);
+        const rexarm_real t35 = t21 + t33;
+        const rexarm_real t36 = w0*w1;
+        const rexarm_real t37 = -t2*t5 + t28*t36 + t29*t36 + t30*t36;
+        const rexarm_real t38 = w0*t10;
+        const rexarm_real t39 = w0*t9;
+        const rexarm_real t40 = w0*t8;
+        const rexarm_real t41 = t6*t38 + t7*t39 + t15*t40;
+        const rexarm_real t42 = t40*t17 + t38*t17 + t39*t17;
+        const rexarm_real t43 = w1*t10;
+        const rexarm_real t44 = w1*t9;
+        const rexarm_real t45 = w1*t8;
+        const rexarm_real t46 = t6*t43 + t7*t44 + t15*t45;
+        const rexarm_real t47 = t17*t45 + t44*t17 + t43*t17;
+        const rexarm_real t48 = (w12*w12);
+        jacgen_symmetric_solve4_state t49 = {{t48 + t32, t37, -t41, -t42, t48 + t35, -t46, -t47, t27 + t48, t18, t20 + t48, w8, w9, w10, w11}};
+        jacgen_symmetric_solve4(1, &t49);
+        const rexarm_real t50 = t49.w[0];
+        const rexarm_real t51 = t49.w[1];
+        const rexarm_real t52 = -t5*t50 + t2*t51;
+        const rexarm_real t53 = t49.w[2];
+        const rexarm_real t54 = t17*t49.w[3];
+        const rexarm_real t55 = t54 - t38*t50 - t43*t51 + t6*t53;
+        const rexarm_real t56 = t54 - t39*t50 - t44*t51 + t7*t53;
+        const rexarm_real t57 = t54 - t40*t50 - t45*t51 + t15*t53;
+        const int t58 = t24 > 0;
+        const rexarm_real t59 = (t58 ? 1 + fabs(t5)/t24 : 0);
+        const rexarm_real t60 = -t5;
+        const rexarm_real t61 = (t58 ? 1.0/(t60 + t25) : 0);
+        const rexarm_real t62 = -t38 - t39 - t40 - t43 - t44 - t45 + w3 + w2 + w4 + w5 + w0 + w1 + w6 + w7 + t2 + t6 + t7 + t15 + 3*t17 + t60 + w8 + w9 + w10 + w11 + w12;
+        const rexarm_real t63 = t2*t61;
+        const rexarm_real t64 = -t59*(t38 + t43*t63);
+        const rexarm_real t65 = t38 + t64;
+        const rexarm_real t66 = t43 + t63*t64;
+        const rexarm_real t67 = -t59*(t39 + t44*t63);
+        const rexarm_real t68 = t39 + t67;
+        const rexarm_real t69 = t44 + t63*t67;
+        const rexarm_real t70 = -t59*(t40 + t45*t63);
+        const rexarm_real t71 = t40 + t70;
+        const rexarm_real t72 = t45 + t63*t70;
+        const rexarm_real t73 = t59*(w8 + t63*w9);
+        const rexarm_real t74 = -t73 + w8;
+        const rexarm_real t75 = w9 - t63*t73;
+        const rexarm_real t76 = sqrt(t19 + t26 + (t66*t66));
+        const rexarm_real t77 = t76*(t66 <= 0 ? 1 : -1);
+        const int t78 = t76 > 0;
+        const rexarm_real t79 = (t78 ? 1.0/(-t66 + t77) : 0);
+        const rexarm_real t80 = (t78 ? 1 + fabs(t66)/t76 : 0);
+        const rexarm_real t81 = t6*t79;
+        const rexarm_real t82 = t19*t79;
+        const rexarm_real t83 = t80*(-t69 + t82 + t7*t81);
+        const rexarm_real t84 = t69 + t83;
+        const rexarm_real t85 = t7 - t81*t83;
+        const rexarm_real t86 = t80*(-t72 + t82 + t15*t81);
+        const rexarm_real t87 = t72 + t86;
+        const rexarm_real t88 = t15 - t81*t86;
+        const rexarm_real t89 = t17*t79;
+        const rexarm_real t90 = t17 - t89*t83;
+        const rexarm_real t91 = t17 - t89*t86;
+        const rexarm_real t92 = t80*(t75 + t81*w10 + t89*w11);
+        const rexarm_real t93 = -t92 + t75;
+        const rexarm_real t94 = w10 - t81*t92;
+        const rexarm_real t95 = w11 - t89*t92;
+        const rexarm_real t96 = sqrt((t85*t85) + (t90*t90));
+        const rexarm_real t97 = t96*(t85 >= 0 ? 1 : -1);
+        const int t98 = t96 > 0;
+        const rexarm_real t99 = (t98 ? 1.0/(t85 + t97) : 0);
+        const rexarm_real t100 = (t98 ? 1 + fabs(t85)/t96 : 0);
+        const rexarm_real t101 = t90*t99;
+        const rexarm_real t102 = t100*(t88 + t101*t91);
+        const rexarm_real t103 = -t102 + t88;
+        const rexarm_real t104 = t91 - t101*t102;
+        const rexarm_real t105 = t100*(t94 + t101*t95);
+        const rexarm_real t106 = -t105 + t94;
+        const rexarm_real t107 = t95 - t101*t105;
+        const rexarm_real t108 = fabs(t104);
+        const rexarm_real t109 = t108*(t104 >= 0 ? 1 : -1);
+        const rexarm_real t110 = (t108 > 0 ? 2 : 0);
+        const rexarm_real t111 = t107 - t107*t110;
+        const rexarm_real t112 = (t109 != 0 ? -t111/t109 : 0);
+        const rexarm_real t113 = (t97 != 0 ? -(t106 - t103*t112)/t97 : 0);
+        const rexarm_real t114 = (t77 != 0 ? -(t93 + t84*t113 + t87*t112)/t77 : 0);
+        const rexarm_real t115 = (t25 != 0 ? -(t74 + t65*t114 + t68*t113 + t71*t112)/t25 : 0);
+        const int t116 = isfinite(t62);
+        const int t117 = w12 >= 0;
+        const int t118 = w12 > 0;
+        const rexarm_real t119 = 1e-12*t34;
+        const int t120 = (t118 && t49.w[4] > 0) || (w12 <= 0 && ((t24 <= t119) || (t76 <= t119) || (t96 <= t119) || (t108 <= t119)));
+        const int t121 = t116 && t117 && !t120;
+        state->w[0] = (t121 ? (t118 ? t52 : t115) : 0);
+        state->w[1] = (t121 ? (t118 ? t55 : t114) : 0);
+        state->w[2] = (t121 ? (t118 ? t56 : t113) : 0);
+        state->w[3] = (t121 ? (t118 ? t57 : t112) : 0);
+        state->w[4] = (!(t116 && t117) ? 2 : (t120 ? 1 : 0));
     }
 }
 
@@ -2404,165 +2559,6 @@ rexarm_real rexarm_condition_number(const rexarm_real q[REXARM_DOF])
 
 int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], rexarm_real damping, rexarm_real q_dot[REXARM_DOF])
 {
-    /* 576 operations */
-
-    /* Inputs */
-    const rexarm_real q1 = q[0];
-    const rexarm_real q2 = q[1];
-    const rexarm_real q3 = q[2];
-    const rexarm_real q4 = q[3];
-    const rexarm_real mu_dot0 = mu_dot[0];
-    const rexarm_real mu_dot1 = mu_dot[1];
-    const rexarm_real mu_dot2 = mu_dot[2];
-    const rexarm_real mu_dot3 = mu_dot[3];
-
-    /* Intermediate terms */
-    const rexarm_real c1 = cos(q1);
-    const rexarm_real s1 = sin(q1);
-    const rexarm_real c2 = -sin(q2);
-    const rexarm_real s2 = cos(q2);
-    const rexarm_real c3 = cos(q3);
-    const rexarm_real s3 = sin(q3);
-    const rexarm_real c23 = c2*c3 - s2*s3;
-    const rexarm_real s23 = c2*s3 + s2*c3;
-    const rexarm_real c4 = cos(q4);
-    const rexarm_real s4 = sin(q4);
-    const rexarm_real c234 = c23*c4 - s23*s4;
-    const rexarm_real s234 = c23*s4 + s23*c4;
-    const rexarm_real t0 = 0.1*c1;
-    const rexarm_real t1 = c23*t0 + c234*t0;
-    const rexarm_real t2 = t1 + c2*t0;
-    const rexarm_real t3 = 0.1*s1;
-    const rexarm_real t4 = c23*t3 + c234*t3;
-    const rexarm_real t5 = t4 + c2*t3;
-    const rexarm_real t6 = c1*t2 + s1*t5;
-    const rexarm_real t7 = c1*t1 + s1*t4;
-    const rexarm_real t8 = 0.1*s234;
-    const rexarm_real t9 = 0.1*s23 + t8;
-    const rexarm_real t10 = 0.1*s2 + t9;
-    const rexarm_real t11 = (c1*c1);
-    const rexarm_real t12 = c234*t11;
-    const rexarm_real t13 = (s1*s1);
-    const rexarm_real t14 = c234*t13;
-    const rexarm_real t15 = 0.1*t12 + 0.1*t14;
-    const rexarm_real t16 = (c234*c234);
-    const rexarm_real t17 = -(t12 + t14)/sqrt(t11*t16 + t13*t16);
-    const rexarm_real t18 = t7*t17 + t15*t17 + t6*t17;
-    const rexarm_real t19 = (t17*t17);
-    const rexarm_real t20 = 3*t19;
-    const rexarm_real t21 = (t2*t2);
-    const rexarm_real t22 = (t5*t5);
-    const rexarm_real t23 = t21 + t22;
-    const rexarm_real t24 = sqrt(t23);
-    const rexarm_real t25 = (t5 <= 0 ? 1 : -1)*t24;
-    const rexarm_real t26 = (t6*t6);
-    const rexarm_real t27 = t26 + (t7*t7) + (t15*t15);
-    const rexarm_real t28 = (t10*t10);
-    const rexarm_real t29 = (t9*t9);
-    const rexarm_real t30 = 0.01*(s234*s234);
-    const rexarm_real t31 = t11*t28 + t11*t30 + t11*t29;
-    const rexarm_real t32 = t22 + t31;
-    const rexarm_real t33 = t13*t28 + t13*t29 + t13*t30;
-    const rexarm_real t34 = sqrt(t20 + t23 + t27 + t31 + t33);
-    const rexarm_real t35 = t21 + t33;
-    const rexarm_real t36 = c1*s1;
-    const rexarm_real t37 = -t2*t5 + t28*t36 + t29*t36 + t30*t36;
-    const rexarm_real t38 = c1*t10;
-    const rexarm_real t39 = c1*t9;
-    const rexarm_real t40 = c1*t8;
-    const rexarm_real t41 = t6*t38 + t7*t39 + t15*t40;
-    const rexarm_real t42 = t40*t17 + t38*t17 + t39*t17;
-    const rexarm_real t43 = s1*t10;
-    const rexarm_real t44 = s1*t9;
-    const rexarm_real t45 = s1*t8;
-    const rexarm_real t46 = t6*t43 + t7*t44 + t15*t45;
-    const rexarm_real t47 = t17*t45 + t44*t17 + t43*t17;
-    const rexarm_real t48 = (damping*damping);
-    jacgen_symmetric_solve4_state t49 = {{t48 + t32, t37, -t41, -t42, t48 + t35, -t46, -t47, t27 + t48, t18, t20 + t48, mu_dot0, mu_dot1, mu_dot2, mu_dot3}};
-    jacgen_symmetric_solve4(1, &t49);
-    const rexarm_real t50 = t49.w[0];
-    const rexarm_real t51 = t49.w[1];
-    const rexarm_real t52 = -t5*t50 + t2*t51;
-    const rexarm_real t53 = t49.w[2];
-    const rexarm_real t54 = t17*t49.w[3];
-    const rexarm_real t55 = t54 - t38*t50 - t43*t51 + t6*t53;
-    const rexarm_real t56 = t54 - t39*t50 - t44*t51 + t7*t53;
-    const rexarm_real t57 = t54 - t40*t50 - t45*t51 + t15*t53;
-    const int t58 = t24 > 0;
-    const rexarm_real t59 = (t58 ? 1 + fabs(t5)/t24 : 0);
-    const rexarm_real t60 = -t5;
-    const rexarm_real t61 = (t58 ? 1.0/(t60 + t25) : 0);
-    const rexarm_real t62 = -t38 - t39 - t40 - t43 - t44 - t45 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + 3*t17 + t60 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping;
-    const rexarm_real t63 = t2*t61;
-    const rexarm_real t64 = -t59*(t38 + t43*t63);
-    const rexarm_real t65 = t38 + t64;
-    const rexarm_real t66 = t43 + t63*t64;
-    const rexarm_real t67 = -t59*(t39 + t44*t63);
-    const rexarm_real t68 = t39 + t67;
-    const rexarm_real t69 = t44 + t63*t67;
-    const rexarm_real t70 = -t59*(t40 + t45*t63);
-    const rexarm_real t71 = t40 + t70;
-    const rexarm_real t72 = t45 + t63*t70;
-    const rexarm_real t73 = t59*(mu_dot0 + t63*mu_dot1);
-    const rexarm_real t74 = -t73 + mu_dot0;
-    const rexarm_real t75 = mu_dot1 - t63*t73;
-    const rexarm_real t76 = sqrt(t19 + t26 + (t66*t66));
-    const rexarm_real t77 = t76*(t66 <= 0 ? 1 : -1);
-    const int t78 = t76 > 0;
-    const rexarm_real t79 = (t78 ? 1.0/(-t66 + t77) : 0);
-    const rexarm_real t80 = (t78 ? 1 + fabs(t66)/t76 : 0);
-    const rexarm_real t81 = t6*t79;
-    const rexarm_real t82 = t19*t79;
-    const rexarm_real t83 = t80*(-t69 + t82 + t7*t81);
-    const rexarm_real t84 = t69 + t83;
-    const rexarm_real t85 = t7 - t81*t83;
-    const rexarm_real t86 = t80*(-t72 + t82 + t15*t81);
-    const rexarm_real t87 = t72 + t86;
-    const rexarm_real t88 = t15 - t81*t86;
-    const rexarm_real t89 = t17*t79;
-    const rexarm_real t90 = t17 - t89*t83;
-    const rexarm_real t91 = t17 - t89*t86;
-    const rexarm_real t92 = t80*(t75 + t81*mu_dot2 + t89*mu_dot3);
-    const rexarm_real t93 = -t92 + t75;
-    const rexarm_real t94 = mu_dot2 - t81*t92;
-    const rexarm_real t95 = mu_dot3 - t89*t92;
-    const rexarm_real t96 = sqrt((t85*t85) + (t90*t90));
-    const rexarm_real t97 = t96*(t85 >= 0 ? 1 : -1);
-    const int t98 = t96 > 0;
-    const rexarm_real t99 = (t98 ? 1.0/(t85 + t97) : 0);
-    const rexarm_real t100 = (t98 ? 1 + fabs(t85)/t96 : 0);
-    const rexarm_real t101 = t90*t99;
-    const rexarm_real t102 = t100*(t88 + t101*t91);
-    const rexarm_real t103 = -t102 + t88;
-    const rexarm_real t104 = t91 - t101*t102;
-    const rexarm_real t105 = t100*(t94 + t101*t95);
-    const rexarm_real t106 = -t105 + t94;
-    const rexarm_real t107 = t95 - t101*t105;
-    const rexarm_real t108 = fabs(t104);
-    const rexarm_real t109 = t108*(t104 >= 0 ? 1 : -1);
-    const rexarm_real t110 = (t108 > 0 ? 2 : 0);
-    const rexarm_real t111 = t107 - t107*t110;
-    const rexarm_real t112 = (t109 != 0 ? -t111/t109 : 0);
-    const rexarm_real t113 = (t97 != 0 ? -(t106 - t103*t112)/t97 : 0);
-    const rexarm_real t114 = (t77 != 0 ? -(t93 + t84*t113 + t87*t112)/t77 : 0);
-    const rexarm_real t115 = (t25 != 0 ? -(t74 + t65*t114 + t68*t113 + t71*t112)/t25 : 0);
-    const int t116 = isfinite(t62);
-    const int t117 = damping >= 0;
-    const int t118 = damping > 0;
-    const rexarm_real t119 = 1e-12*t34;
-    const int t120 = (t118 && t49.w[4] > 0) || (damping <= 0 && ((t24 <= t119) || (t76 <= t119) || (t96 <= t119) || (t108 <= t119)));
-    const int t121 = t116 && t117 && !t120;
-
-    /* Outputs */
-    q_dot[0] = (t121 ? (t118 ? t52 : t115) : 0);
-    q_dot[1] = (t121 ? (t118 ? t55 : t114) : 0);
-    q_dot[2] = (t121 ? (t118 ? t56 : t113) : 0);
-    q_dot[3] = (t121 ? (t118 ? t57 : t112) : 0);
-    return (!(t116 && t117) ? 2 : (t120 ? 1 : 0));
-}
-
-int rexarm_velocity_ik_nullspace(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], const rexarm_real z[REXARM_DOF], rexarm_real damping, rexarm_real q_dot[REXARM_DOF])
-{
     /* 580 operations */
 
     /* Inputs */
@@ -2574,10 +2570,6 @@ int rexarm_velocity_ik_nullspace(const rexarm_real q[REXARM_DOF], const rexarm_r
     const rexarm_real mu_dot1 = mu_dot[1];
     const rexarm_real mu_dot2 = mu_dot[2];
     const rexarm_real mu_dot3 = mu_dot[3];
-    const rexarm_real qz1 = z[0];
-    const rexarm_real qz2 = z[1];
-    const rexarm_real qz3 = z[2];
-    const rexarm_real qz4 = z[3];
 
     /* Intermediate terms */
     const rexarm_real c1 = cos(q1);
@@ -2586,147 +2578,58 @@ int rexarm_velocity_ik_nullspace(const rexarm_real q[REXARM_DOF], const rexarm_r
     const rexarm_real s2 = cos(q2);
     const rexarm_real c3 = cos(q3);
     const rexarm_real s3 = sin(q3);
-    const rexarm_real c23 = c2*c3 - s2*s3;
-    const rexarm_real s23 = c2*s3 + s2*c3;
     const rexarm_real c4 = cos(q4);
     const rexarm_real s4 = sin(q4);
-    const rexarm_real c234 = c23*c4 - s23*s4;
-    const rexarm_real s234 = c23*s4 + s23*c4;
-    const rexarm_real t0 = 0.1*c1;
-    const rexarm_real t1 = c23*t0 + c234*t0;
-    const rexarm_real t2 = t1 + c2*t0;
-    const rexarm_real t3 = 0.1*s1;
-    const rexarm_real t4 = c23*t3 + c234*t3;
-    const rexarm_real t5 = t4 + c2*t3;
-    const rexarm_real t6 = c1*t2 + s1*t5;
-    const rexarm_real t7 = c1*t1 + s1*t4;
-    const rexarm_real t8 = 0.1*s234;
-    const rexarm_real t9 = 0.1*s23 + t8;
-    const rexarm_real t10 = 0.1*s2 + t9;
-    const rexarm_real t11 = (c1*c1);
-    const rexarm_real t12 = c234*t11;
-    const rexarm_real t13 = (s1*s1);
-    const rexarm_real t14 = c234*t13;
-    const rexarm_real t15 = 0.1*t12 + 0.1*t14;
-    const rexarm_real t16 = (c234*c234);
-    const rexarm_real t17 = -(t12 + t14)/sqrt(t11*t16 + t13*t16);
-    const rexarm_real t18 = t7*t17 + t15*t17 + t6*t17;
-    const rexarm_real t19 = (t17*t17);
-    const rexarm_real t20 = 3*t19;
-    const rexarm_real t21 = (t2*t2);
-    const rexarm_real t22 = (t5*t5);
-    const rexarm_real t23 = t21 + t22;
-    const rexarm_real t24 = sqrt(t23);
-    const rexarm_real t25 = (t5 <= 0 ? 1 : -1)*t24;
-    const rexarm_real t26 = (t6*t6);
-    const rexarm_real t27 = t26 + (t7*t7) + (t15*t15);
-    const rexarm_real t28 = (t10*t10);
-    const rexarm_real t29 = (t9*t9);
-    const rexarm_real t30 = 0.01*(s234*s234);
-    const rexarm_real t31 = t11*t28 + t11*t30 + t11*t29;
-    const rexarm_real t32 = t22 + t31;
-    const rexarm_real t33 = t13*t28 + t13*t29 + t13*t30;
-    const rexarm_real t34 = sqrt(t20 + t23 + t27 + t31 + t33);
-    const rexarm_real t35 = t21 + t33;
-    const rexarm_real t36 = c1*s1;
-    const rexarm_real t37 = -t2*t5 + t28*t36 + t29*t36 + t30*t36;
-    const rexarm_real t38 = c1*t10;
-    const rexarm_real t39 = c1*t9;
-    const rexarm_real t40 = c1*t8;
-    const rexarm_real t41 = t6*t38 + t7*t39 + t15*t40;
-    const rexarm_real t42 = t40*t17 + t38*t17 + t39*t17;
-    const rexarm_real t43 = s1*t10;
-    const rexarm_real t44 = s1*t9;
-    const rexarm_real t45 = s1*t8;
-    const rexarm_real t46 = t6*t43 + t7*t44 + t15*t45;
-    const rexarm_real t47 = t17*t45 + t44*t17 + t43*t17;
-    const rexarm_real t48 = (damping*damping);
-    jacgen_symmetric_solve4_state t49 = {{t48 + t32, t37, -t41, -t42, t48 + t35, -t46, -t47, t27 + t48, t18, t20 + t48, mu_dot0, mu_dot1, mu_dot2, mu_dot3}};
-    jacgen_symmetric_solve4(1, &t49);
-    const rexarm_real t50 = t49.w[0];
-    const rexarm_real t51 = t49.w[1];
-    const rexarm_real t52 = -t5*t50 + t2*t51;
-    const rexarm_real t53 = t49.w[2];
-    const rexarm_real t54 = t17*t49.w[3];
-    const rexarm_real t55 = t54 - t38*t50 - t43*t51 + t6*t53;
-    const rexarm_real t56 = t54 - t39*t50 - t44*t51 + t7*t53;
-    const rexarm_real t57 = t54 - t40*t50 - t45*t51 + t15*t53;
-    const int t58 = t24 > 0;
-    const rexarm_real t59 = (t58 ? 1 + fabs(t5)/t24 : 0);
-    const rexarm_real t60 = -t5;
-    const rexarm_real t61 = (t58 ? 1.0/(t60 + t25) : 0);
-    const rexarm_real t62 = -t38 - t39 - t40 - t43 - t44 - t45 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + 3*t17 + t60 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + qz1 + qz2 + qz3 + qz4;
-    const rexarm_real t63 = t2*t61;
-    const rexarm_real t64 = -t59*(t38 + t43*t63);
-    const rexarm_real t65 = t38 + t64;
-    const rexarm_real t66 = t43 + t63*t64;
-    const rexarm_real t67 = -t59*(t39 + t44*t63);
-    const rexarm_real t68 = t39 + t67;
-    const rexarm_real t69 = t44 + t63*t67;
-    const rexarm_real t70 = -t59*(t40 + t45*t63);
-    const rexarm_real t71 = t40 + t70;
-    const rexarm_real t72 = t45 + t63*t70;
-    const rexarm_real t73 = t59*(mu_dot0 + t63*mu_dot1);
-    const rexarm_real t74 = -t73 + mu_dot0;
-    const rexarm_real t75 = mu_dot1 - t63*t73;
-    const rexarm_real t76 = sqrt(t19 + t26 + (t66*t66));
-    const rexarm_real t77 = t76*(t66 <= 0 ? 1 : -1);
-    const int t78 = t76 > 0;
-    const rexarm_real t79 = (t78 ? 1.0/(-t66 + t77) : 0);
-    const rexarm_real t80 = (t78 ? 1 + fabs(t66)/t76 : 0);
-    const rexarm_real t81 = t6*t79;
-    const rexarm_real t82 = t19*t79;
-    const rexarm_real t83 = t80*(-t69 + t82 + t7*t81);
-    const rexarm_real t84 = t69 + t83;
-    const rexarm_real t85 = t7 - t81*t83;
-    const rexarm_real t86 = t80*(-t72 + t82 + t15*t81);
-    const rexarm_real t87 = t72 + t86;
-    const rexarm_real t88 = t15 - t81*t86;
-    const rexarm_real t89 = t17*t79;
-    const rexarm_real t90 = t17 - t89*t83;
-    const rexarm_real t91 = t17 - t89*t86;
-    const rexarm_real t92 = t80*(t75 + t81*mu_dot2 + t89*mu_dot3);
-    const rexarm_real t93 = -t92 + t75;
-    const rexarm_real t94 = mu_dot2 - t81*t92;
-    const rexarm_real t95 = mu_dot3 - t89*t92;
-    const rexarm_real t96 = sqrt((t85*t85) + (t90*t90));
-    const rexarm_real t97 = t96*(t85 >= 0 ? 1 : -1);
-    const int t98 = t96 > 0;
-    const rexarm_real t99 = (t98 ? 1.0/(t85 + t97) : 0);
-    const rexarm_real t100 = (t98 ? 1 + fabs(t85)/t96 : 0);
-    const rexarm_real t101 = t90*t99;
-    const rexarm_real t102 = t100*(t88 + t101*t91);
-    const rexarm_real t103 = -t102 + t88;
-    const rexarm_real t104 = t91 - t101*t102;
-    const rexarm_real t105 = t100*(t94 + t101*t95);
-    const rexarm_real t106 = -t105 + t94;
-    const rexarm_real t107 = t95 - t101*t105;
-    const rexarm_real t108 = fabs(t104);
-    const rexarm_real t109 = t108*(t104 >= 0 ? 1 : -1);
-    const rexarm_real t110 = (t108 > 0 ? 2 : 0);
-    const rexarm_real t111 = t107 - t107*t110;
-    const rexarm_real t112 = (t109 != 0 ? -t111/t109 : 0);
-    const rexarm_real t113 = (t97 != 0 ? -(t106 - t103*t112)/t97 : 0);
-    const rexarm_real t114 = (t77 != 0 ? -(t93 + t84*t113 + t87*t112)/t77 : 0);
-    const rexarm_real t115 = (t25 != 0 ? -(t74 + t65*t114 + t68*t113 + t71*t112)/t25 : 0);
-    const int t116 = isfinite(t62);
-    const int t117 = damping >= 0;
-    const int t118 = damping > 0;
-    const rexarm_real t119 = 1e-12*t34;
-    const int t120 = (t118 && t49.w[4] > 0) || (damping <= 0 && ((t24 <= t119) || (t76 <= t119) || (t96 <= t119) || (t108 <= t119)));
-    const int t121 = t116 && t117 && !t120;
+    jacgen_velocity_solve_state t0 = {{c1, s1, c2, s2, c3, s3, c4, s4, mu_dot0, mu_dot1, mu_dot2, mu_dot3, damping}};
+    jacgen_velocity_solve(1, &t0);
 
     /* Outputs */
-    q_dot[0] = (t121 ? (t118 ? t52 : t115) : 0);
-    q_dot[1] = (t121 ? (t118 ? t55 : t114) : 0);
-    q_dot[2] = (t121 ? (t118 ? t56 : t113) : 0);
-    q_dot[3] = (t121 ? (t118 ? t57 : t112) : 0);
-    return (!(t116 && t117) ? 2 : (t120 ? 1 : 0));
+    q_dot[0] = t0.w[0];
+    q_dot[1] = t0.w[1];
+    q_dot[2] = t0.w[2];
+    q_dot[3] = t0.w[3];
+    return (int)t0.w[4];
+}
+
+int rexarm_velocity_ik_nullspace(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], const rexarm_real z[REXARM_DOF], rexarm_real damping, rexarm_real q_dot[REXARM_DOF])
+{
+    /* 580 operations */
+    (void)z;
+
+    /* Inputs */
+    const rexarm_real q1 = q[0];
+    const rexarm_real q2 = q[1];
+    const rexarm_real q3 = q[2];
+    const rexarm_real q4 = q[3];
+    const rexarm_real mu_dot0 = mu_dot[0];
+    const rexarm_real mu_dot1 = mu_dot[1];
+    const rexarm_real mu_dot2 = mu_dot[2];
+    const rexarm_real mu_dot3 = mu_dot[3];
+
+    /* Intermediate terms */
+    const rexarm_real c1 = cos(q1);
+    const rexarm_real s1 = sin(q1);
+    const rexarm_real c2 = -sin(q2);
+    const rexarm_real s2 = cos(q2);
+    const rexarm_real c3 = cos(q3);
+    const rexarm_real s3 = sin(q3);
+    const rexarm_real c4 = cos(q4);
+    const rexarm_real s4 = sin(q4);
+    jacgen_velocity_solve_state t0 = {{c1, s1, c2, s2, c3, s3, c4, s4, mu_dot0, mu_dot1, mu_dot2, mu_dot3, damping}};
+    jacgen_velocity_solve(1, &t0);
+
+    /* Outputs */
+    q_dot[0] = t0.w[0];
+    q_dot[1] = t0.w[1];
+    q_dot[2] = t0.w[2];
+    q_dot[3] = t0.w[3];
+    return (int)t0.w[4];
 }
 
 int rexarm_resolved_rate(const rexarm_real q[REXARM_DOF], const rexarm_real target[REXARM_TASK_DIM], const rexarm_real target_rate[REXARM_TASK_DIM], const rexarm_real gain[REXARM_TASK_DIM], const rexarm_real z[REXARM_DOF], rexarm_real damping, rexarm_real q_dot[REXARM_DOF])
 {
-    /* 601 operations */
+    /* 638 operations */
+    (void)z;
 
     /* Inputs */
     const rexarm_real q1 = q[0];
@@ -2745,10 +2648,6 @@ int rexarm_resolved_rate(const rexarm_real q[REXARM_DOF], const rexarm_real targ
     const rexarm_real gain1 = gain[1];
     const rexarm_real gain2 = gain[2];
     const rexarm_real gain3 = gain[3];
-    const rexarm_real qz1 = z[0];
-    const rexarm_real qz2 = z[1];
-    const rexarm_real qz3 = z[2];
-    const rexarm_real qz4 = z[3];
 
     /* Intermediate terms */
     const rexarm_real c1 = cos(q1);
@@ -2763,143 +2662,30 @@ int rexarm_resolved_rate(const rexarm_real q[REXARM_DOF], const rexarm_real targ
     const rexarm_real s4 = sin(q4);
     const rexarm_real c234 = c23*c4 - s23*s4;
     const rexarm_real s234 = c23*s4 + s23*c4;
-    const rexarm_real t0 = 0.1*c1;
-    const rexarm_real t1 = c23*t0 + c234*t0;
-    const rexarm_real t2 = t1 + c2*t0;
-    const rexarm_real t3 = mu_dot0 + gain0*(-t2 + mu0);
-    const rexarm_real t4 = 0.1*s1;
+    const rexarm_real t0 = 0.1*s23 + 0.1*s234;
+    const rexarm_real t1 = 0.1*s2 + t0;
+    const rexarm_real t2 = 0.12 + t1;
+    const rexarm_real t3 = mu_dot2 + gain2*(-t2 + mu2);
+    const rexarm_real t4 = 0.1*c1;
     const rexarm_real t5 = c23*t4 + c234*t4;
     const rexarm_real t6 = t5 + c2*t4;
-    const rexarm_real t7 = c1*t2 + s1*t6;
-    const rexarm_real t8 = c1*t1 + s1*t5;
-    const rexarm_real t9 = 0.1*s234;
-    const rexarm_real t10 = 0.1*s23 + t9;
-    const rexarm_real t11 = 0.1*s2 + t10;
-    const rexarm_real t12 = 0.12 + t11;
-    const rexarm_real t13 = mu_dot2 + gain2*(-t12 + mu2);
-    const rexarm_real t14 = (c1*c1);
-    const rexarm_real t15 = c234*t14;
-    const rexarm_real t16 = (s1*s1);
-    const rexarm_real t17 = c234*t16;
-    const rexarm_real t18 = 0.1*t15 + 0.1*t17;
-    const rexarm_real t19 = (c234*c234);
-    const rexarm_real t20 = sqrt(t14*t19 + t16*t19);
-    const rexarm_real t21 = -(t15 + t17)/t20;
-    const rexarm_real t22 = t8*t21 + t18*t21 + t7*t21;
-    const rexarm_real t23 = (t21*t21);
-    const rexarm_real t24 = 3*t23;
-    const rexarm_real t25 = (t2*t2);
-    const rexarm_real t26 = (t6*t6);
-    const rexarm_real t27 = t25 + t26;
-    const rexarm_real t28 = sqrt(t27);
-    const rexarm_real t29 = (t6 <= 0 ? 1 : -1)*t28;
-    const rexarm_real t30 = (t7*t7);
-    const rexarm_real t31 = t30 + (t8*t8) + (t18*t18);
-    const rexarm_real t32 = (t11*t11);
-    const rexarm_real t33 = (t10*t10);
-    const rexarm_real t34 = 0.01*(s234*s234);
-    const rexarm_real t35 = t14*t33 + t14*t32 + t14*t34;
-    const rexarm_real t36 = t26 + t35;
-    const rexarm_real t37 = t16*t32 + t16*t33 + t16*t34;
-    const rexarm_real t38 = sqrt(t24 + t27 + t31 + t35 + t37);
-    const rexarm_real t39 = t25 + t37;
-    const rexarm_real t40 = c1*s1;
-    const rexarm_real t41 = t34*t40 - t2*t6 + t32*t40 + t33*t40;
-    const rexarm_real t42 = c1*t11;
-    const rexarm_real t43 = c1*t10;
-    const rexarm_real t44 = c1*t9;
-    const rexarm_real t45 = t7*t42 + t8*t43 + t18*t44;
-    const rexarm_real t46 = t43*t21 + t44*t21 + t42*t21;
-    const rexarm_real t47 = s1*t11;
-    const rexarm_real t48 = s1*t10;
-    const rexarm_real t49 = s1*t9;
-    const rexarm_real t50 = t7*t47 + t8*t48 + t18*t49;
-    const rexarm_real t51 = t21*t48 + t21*t49 + t47*t21;
-    const int t52 = t28 > 0;
-    const rexarm_real t53 = (t52 ? 1 + fabs(t6)/t28 : 0);
-    const rexarm_real t54 = -t6;
-    const rexarm_real t55 = (t52 ? 1.0/(t54 + t29) : 0);
-    const rexarm_real t56 = mu_dot1 + gain1*(t54 + mu1);
-    const rexarm_real t57 = t2*t55;
-    const rexarm_real t58 = -t53*(t42 + t47*t57);
-    const rexarm_real t59 = t42 + t58;
-    const rexarm_real t60 = t47 + t57*t58;
-    const rexarm_real t61 = -t53*(t43 + t48*t57);
-    const rexarm_real t62 = t43 + t61;
-    const rexarm_real t63 = t48 + t57*t61;
-    const rexarm_real t64 = -t53*(t44 + t49*t57);
-    const rexarm_real t65 = t44 + t64;
-    const rexarm_real t66 = t49 + t57*t64;
-    const rexarm_real t67 = sqrt(t23 + t30 + (t60*t60));
-    const rexarm_real t68 = t67*(t60 <= 0 ? 1 : -1);
-    const rexarm_real t69 = t53*(t3 + t57*t56);
-    const rexarm_real t70 = -t69 + t3;
-    const rexarm_real t71 = t56 - t57*t69;
-    const int t72 = t67 > 0;
-    const rexarm_real t73 = (t72 ? 1.0/(-t60 + t68) : 0);
-    const rexarm_real t74 = (t72 ? 1 + fabs(t60)/t67 : 0);
-    const rexarm_real t75 = t7*t73;
-    const rexarm_real t76 = t23*t73;
-    const rexarm_real t77 = t74*(-t63 + t76 + t8*t75);
-    const rexarm_real t78 = t63 + t77;
-    const rexarm_real t79 = t8 - t75*t77;
-    const rexarm_real t80 = t74*(-t66 + t76 + t18*t75);
-    const rexarm_real t81 = t66 + t80;
-    const rexarm_real t82 = t18 - t75*t80;
-    const rexarm_real t83 = t21*t73;
-    const rexarm_real t84 = t21 - t83*t77;
-    const rexarm_real t85 = t21 - t83*t80;
-    const rexarm_real t86 = sqrt((t79*t79) + (t84*t84));
-    const rexarm_real t87 = t86*(t79 >= 0 ? 1 : -1);
-    const int t88 = t86 > 0;
-    const rexarm_real t89 = (t88 ? 1.0/(t79 + t87) : 0);
-    const rexarm_real t90 = (t88 ? 1 + fabs(t79)/t86 : 0);
-    const rexarm_real t91 = t84*t89;
-    const rexarm_real t92 = t90*(t82 + t91*t85);
-    const rexarm_real t93 = -t92 + t82;
-    const rexarm_real t94 = t85 - t91*t92;
-    const rexarm_real t95 = fabs(t94);
-    const rexarm_real t96 = t95*(t94 >= 0 ? 1 : -1);
-    const rexarm_real t97 = (t95 > 0 ? 2 : 0);
-    const rexarm_real t98 = -mu3 + atan2(-s234, t20);
-    const rexarm_real t99 = mu_dot3 - gain3*(t98 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t98)));
-    const rexarm_real t100 = t74*(t71 + t75*t13 + t83*t99);
-    const rexarm_real t101 = -t100 + t71;
-    const rexarm_real t102 = t13 - t75*t100;
-    const rexarm_real t103 = t99 - t83*t100;
-    const rexarm_real t104 = t90*(t102 + t91*t103);
-    const rexarm_real t105 = -t104 + t102;
-    const rexarm_real t106 = t103 - t91*t104;
-    const rexarm_real t107 = t106 - t97*t106;
-    const rexarm_real t108 = (t96 != 0 ? -t107/t96 : 0);
-    const rexarm_real t109 = (t87 != 0 ? -(t105 - t93*t108)/t87 : 0);
-    const rexarm_real t110 = (t68 != 0 ? -(t101 + t78*t109 + t81*t108)/t68 : 0);
-    const rexarm_real t111 = (t29 != 0 ? -(t70 + t59*t110 + t62*t109 + t65*t108)/t29 : 0);
-    const rexarm_real t112 = -t42 - t43 - t44 - t47 - t48 - t49 + q1 + q2 + q3 + q4 + t2 + t7 + t8 + t18 + 3*t21 + t54 + damping + qz1 + qz2 + qz3 + qz4 + t3 + t56 + t13 + t99;
-    const rexarm_real t113 = (damping*damping);
-    jacgen_symmetric_solve4_state t114 = {{t113 + t36, t41, -t45, -t46, t113 + t39, -t50, -t51, t31 + t113, t22, t24 + t113, t3, t56, t13, t99}};
-    jacgen_symmetric_solve4(1, &t114);
-    const rexarm_real t115 = t114.w[0];
-    const rexarm_real t116 = t114.w[1];
-    const rexarm_real t117 = -t6*t115 + t2*t116;
-    const rexarm_real t118 = t114.w[2];
-    const rexarm_real t119 = t21*t114.w[3];
-    const rexarm_real t120 = t119 - t42*t115 - t47*t116 + t7*t118;
-    const rexarm_real t121 = t119 - t43*t115 - t48*t116 + t8*t118;
-    const rexarm_real t122 = t119 - t44*t115 - t49*t116 + t18*t118;
-    const int t123 = isfinite(t112);
-    const int t124 = damping >= 0;
-    const int t125 = damping > 0;
-    const rexarm_real t126 = 1e-12*t38;
-    const int t127 = (t125 && t114.w[4] > 0) || (damping <= 0 && ((t28 <= t126) || (t67 <= t126) || (t86 <= t126) || (t95 <= t126)));
-    const int t128 = t123 && t124 && !t127;
+    const rexarm_real t7 = mu_dot0 + gain0*(-t6 + mu0);
+    const rexarm_real t8 = 0.1*s1;
+    const rexarm_real t9 = c23*t8 + c234*t8;
+    const rexarm_real t10 = t9 + c2*t8;
+    const rexarm_real t11 = mu_dot1 + gain1*(-t10 + mu1);
+    const rexarm_real t12 = (c234*c234);
+    const rexarm_real t13 = -mu3 + atan2(-s234, sqrt((c1*c1)*t12 + (s1*s1)*t12));
+    const rexarm_real t14 = mu_dot3 - gain3*(t13 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t13)));
+    jacgen_velocity_solve_state t15 = {{c1, s1, c2, s2, c3, s3, c4, s4, t7, t11, t3, t14, damping}};
+    jacgen_velocity_solve(1, &t15);
 
     /* Outputs */
-    q_dot[0] = (t128 ? (t125 ? t117 : t111) : 0);
-    q_dot[1] = (t128 ? (t125 ? t120 : t110) : 0);
-    q_dot[2] = (t128 ? (t125 ? t121 : t109) : 0);
-    q_dot[3] = (t128 ? (t125 ? t122 : t108) : 0);
-    return (!(t123 && t124) ? 2 : (t127 ? 1 : 0));
+    q_dot[0] = t15.w[0];
+    q_dot[1] = t15.w[1];
+    q_dot[2] = t15.w[2];
+    q_dot[3] = t15.w[3];
+    return (int)t15.w[4];
 }
 
 rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], const rexarm_real q[REXARM_DOF], rexarm_real damping, rexarm_real q_start[REXARM_DOF], rexarm_real q_next[REXARM_DOF])
@@ -2988,7 +2774,7 @@ rexarm_real rexarm_ik_numeric_step(const rexarm_real target[REXARM_TASK_DIM], co
     const rexarm_real t51 = t47.w[2];
     const rexarm_real t52 = t24*t47.w[3];
     const rexarm_real t53 = q2 + t52 - t34*t48 - t39*t49 + t8*t51;
-    const rexarm_real t54 = q3 + t52 + t9*t51 - t35*t48 - t40*t49;
+    const rexarm_real t54 = q3 + t52 - t35*t48 - t40*t49 + t9*t51;
     const rexarm_real t55 = q4 + t52 + t20*t51 - t36*t48 - t41*t49;
 
     /* Outputs */

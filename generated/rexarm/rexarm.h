@@ -111,7 +111,7 @@ void rexarm_velocity_ellipsoid(const rexarm_real q[REXARM_DOF], rexarm_real U_v[
 rexarm_real rexarm_condition_number(const rexarm_real q[REXARM_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 4; returned as a scalar. 576 operations. */
+ * Result: q_dot[i], i < 4; returned as a scalar. 580 operations. */
 int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], rexarm_real damping, rexarm_real q_dot[REXARM_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
@@ -119,7 +119,7 @@ int rexarm_velocity_ik(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot
 int rexarm_velocity_ik_nullspace(const rexarm_real q[REXARM_DOF], const rexarm_real mu_dot[REXARM_TASK_DIM], const rexarm_real z[REXARM_DOF], rexarm_real damping, rexarm_real q_dot[REXARM_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 4; returned as a scalar. 601 operations. */
+ * Result: q_dot[i], i < 4; returned as a scalar. 638 operations. */
 int rexarm_resolved_rate(const rexarm_real q[REXARM_DOF], const rexarm_real target[REXARM_TASK_DIM], const rexarm_real target_rate[REXARM_TASK_DIM], const rexarm_real gain[REXARM_TASK_DIM], const rexarm_real z[REXARM_DOF], rexarm_real damping, rexarm_real q_dot[REXARM_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).

@@ -82,7 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -336,7 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi4_rows(xp, count, state):
     """One-sided Jacobi sweep of a 4 x 4 matrix (its rows), `count` times: 352 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2
@@ -522,9 +522,9 @@ def _jacobi4_rows(xp, count, state):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _symmetric_solve4(xp, count, state):
-    """X solving a symmetric 4 x 4 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 217 operations a run."""
+    """The solution x of a symmetric 4 x 4 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 217 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, = state
         t0 = w1**2
@@ -611,10 +611,153 @@ def _symmetric_solve4(xp, count, state):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _velocity_solve(xp, count, state):
+    """The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status, `count` times: 571 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, = state
+        c23 = w2*w4 - w3*w5
+        s23 = w2*w5 + w3*w4
+        c234 = c23*w6 - s23*w7
+        s234 = c23*w7 + s23*w6
+        t0 = 0.1*w0
+        t1 = c23*t0 + c234*t0
+        t2 = t1 + w2*t0
+        t3 = 0.1*w1
+        t4 = c23*t3 + c234*t3
+        t5 = t4 + w2*t3
+        t6 = w0*t2 + w1*t5
+        t7 = w0*t1 + w1*t4
+        t8 = 0.1*s234
+        t9 = 0.1*s23 + t8
+        t10 = 0.1*w3 + t9
+        t11 = w0**2
+        t12 = c234*t11
+        t13 = w1**2
+        t14 = c234*t13
+        t15 = 0.1*t12 + 0.1*t14
+        t16 = c234**2
+        t17 = -(t12 + t14)/xp.sqrt(t11*t16 + t13*t16)
+        t18 = t7*t17 + t15*t17 + t6*t17
+        t19 = t17**2
+        t20 = 3*t19
+        t21 = t2**2
+        t22 = t5**2
+        t23 = t21 + t22
+        t24 = xp.sqrt(t23)
+        t25 = xp.where(xp.less_equal(t5, 0), xp.asarray(1, dtype=dtype), -1)*t24
+        t26 = t6**2
+        t27 = t26 + t7**2 + t15**2
+        t28 = t10**2
+        t29 = t9**2
+        t30 = 0.01*s234**2
+        t31 = t11*t28 + t11*t30 + t11*t29
+        t32 = t22 + t31
+        t33 = t13*t28 + t13*t29 + t13*t30
+        t34 = xp.sqrt(t20 + t23 + t27 + t31 + t33)
+        t35 = t21 + t33
+        t36 = w0*w1
+        t37 = -t2*t5 + t28*t36 + t29*t36 + t30*t36
+        t38 = w0*t10
+        t39 = w0*t9
+        t40 = w0*t8
+        t41 = t6*t38 + t7*t39 + t15*t40
+        t42 = t40*t17 + t38*t17 + t39*t17
+        t43 = w1*t10
+        t44 = w1*t9
+        t45 = w1*t8
+        t46 = t6*t43 + t7*t44 + t15*t45
+        t47 = t17*t45 + t44*t17 + t43*t17
+        t48 = w12**2
+        t49 = _symmetric_solve4(xp, 1, (t48 + t32, t37, -t41, -t42, t48 + t35, -t46, -t47, t27 + t48, t18, t20 + t48, w8, w9, w10, w11,))
+        t50 = t49[0]
+        t51 = t49[1]
+        t52 = -t5*t50 + t2*t51
+        t53 = t49[2]
+        t54 = t17*t49[3]
+        t55 = t54 - t38*t50 - t43*t51 + t6*t53
+        t56 = t54 - t39*t50 - t44*t51 + t7*t53
+        t57 = t54 - t40*t50 - t45*t51 + t15*t53
+        t58 = xp.greater(t24, 0)
+        t59 = xp.where(t58, 1 + xp.abs(t5)/t24, 0)
+        t60 = -t5
+        t61 = xp.where(t58, 1/(t60 + t25), 0)
+        t62 = -t38 - t39 - t40 - t43 - t44 - t45 + w3 + w2 + w4 + w5 + w0 + w1 + w6 + w7 + t2 + t6 + t7 + t15 + 3*t17 + t60 + w8 + w9 + w10 + w11 + w12
+        t63 = t2*t61
+        t64 = -t59*(t38 + t43*t63)
+        t65 = t38 + t64
+        t66 = t43 + t63*t64
+        t67 = -t59*(t39 + t44*t63)
+        t68 = t39 + t67
+        t69 = t44 + t63*t67
+        t70 = -t59*(t40 + t45*t63)
+        t71 = t40 + t70
+        t72 = t45 + t63*t70
+        t73 = t59*(w8 + t63*w9)
+        t74 = -t73 + w8
+        t75 = w9 - t63*t73
+        t76 = xp.sqrt(t19 + t26 + t66**2)
+        t77 = t76*xp.where(xp.less_equal(t66, 0), xp.asarray(1, dtype=dtype), -1)
+        t78 = xp.greater(t76, 0)
+        t79 = xp.where(t78, 1/(-t66 + t77), 0)
+        t80 = xp.where(t78, 1 + xp.abs(t66)/t76, 0)
+        t81 = t6*t79
+        t82 = t19*t79
+        t83 = t80*(-t69 + t82 + t7*t81)
+        t84 = t69 + t83
+        t85 = t7 - t81*t83
+        t86 = t80*(-t72 + t82 + t15*t81)
+        t87 = t72 + t86
+        t88 = t15 - t81*t86
+        t89 = t17*t79
+        t90 = t17 - t89*t83
+        t91 = t17 - t89*t86
+        t92 = t80*(t75 + t81*w10 + t89*w11)
+        t93 = -t92 + t75
+        t94 = w10 - t81*t92
+        t95 = w11 - t89*t92
+        t96 = xp.sqrt(t85**2 + t90**2)
+        t97 = t96*xp.where(xp.greater_equal(t85, 0), xp.asarray(1, dtype=dtype), -1)
+        t98 = xp.greater(t96, 0)
+        t99 = xp.where(t98, 1/(t85 + t97), 0)
+        t100 = xp.where(t98, 1 + xp.abs(t85)/t96, 0)
+        t101 = t90*t99
+        t102 = t100*(t88 + t101*t91)
+        t103 = -t102 + t88
+        t104 = t91 - t101*t102
+        t105 = t100*(t94 + t101*t95)
+        t106 = -t105 + t94
+        t107 = t95 - t101*t105
+        t108 = xp.abs(t104)
+        t109 = t108*xp.where(xp.greater_equal(t104, 0), xp.asarray(1, dtype=dtype), -1)
+        t110 = xp.where(xp.greater(t108, 0), xp.asarray(2, dtype=dtype), 0)
+        t111 = t107 - t107*t110
+        t112 = xp.where(xp.not_equal(t109, 0), -t111/t109, 0)
+        t113 = xp.where(xp.not_equal(t97, 0), -(t106 - t103*t112)/t97, 0)
+        t114 = xp.where(xp.not_equal(t77, 0), -(t93 + t84*t113 + t87*t112)/t77, 0)
+        t115 = xp.where(xp.not_equal(t25, 0), -(t74 + t65*t114 + t68*t113 + t71*t112)/t25, 0)
+        t116 = xp.isfinite(t62)
+        t117 = xp.greater_equal(w12, 0)
+        t118 = xp.greater(w12, 0)
+        t119 = 1e-12*t34
+        t120 = (t118 & xp.greater(t49[4], 0)) | (xp.less_equal(w12, 0) & (xp.less_equal(t24, t119) | xp.less_equal(t76, t119) | xp.less_equal(t96, t119) | xp.less_equal(t108, t119)))
+        t121 = t116 & t117 & xp.logical_not(t120)
+        state = (
+            xp.where(t121, xp.where(t118, t52, t115), 0),
+            xp.where(t121, xp.where(t118, t55, t114), 0),
+            xp.where(t121, xp.where(t118, t56, t113), 0),
+            xp.where(t121, xp.where(t118, t57, t112), 0),
+            xp.where(xp.logical_not(t116 & t117), 2, xp.where(t120, xp.asarray(1, dtype=dtype), 0)),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _nearer_branch(xp, count, state):
     """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 78 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, = state
         t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w5))
@@ -2288,14 +2431,9 @@ def condition_number(q):
     return kappa
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 576 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 580 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (4,)), ("mu_dot", mu_dot, (4,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
@@ -2307,160 +2445,26 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s2 = trig[..., 2]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
-    c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + s23*c4
-    t0 = 0.1*c1
-    t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
-    t3 = 0.1*s1
-    t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
-    t6 = c1*t2 + s1*t5
-    t7 = c1*t1 + s1*t4
-    t8 = 0.1*s234
-    t9 = 0.1*s23 + t8
-    t10 = 0.1*s2 + t9
-    t11 = c1**2
-    t12 = c234*t11
-    t13 = s1**2
-    t14 = c234*t13
-    t15 = 0.1*t12 + 0.1*t14
-    t16 = c234**2
-    t17 = -(t12 + t14)/xp.sqrt(t11*t16 + t13*t16)
-    t18 = t7*t17 + t15*t17 + t6*t17
-    t19 = t17**2
-    t20 = 3*t19
-    t21 = t2**2
-    t22 = t5**2
-    t23 = t21 + t22
-    t24 = xp.sqrt(t23)
-    t25 = xp.where(xp.less_equal(t5, 0), xp.asarray(1, dtype=dtype), -1)*t24
-    t26 = t6**2
-    t27 = t26 + t7**2 + t15**2
-    t28 = t10**2
-    t29 = t9**2
-    t30 = 0.01*s234**2
-    t31 = t11*t28 + t11*t30 + t11*t29
-    t32 = t22 + t31
-    t33 = t13*t28 + t13*t29 + t13*t30
-    t34 = xp.sqrt(t20 + t23 + t27 + t31 + t33)
-    t35 = t21 + t33
-    t36 = c1*s1
-    t37 = -t2*t5 + t28*t36 + t29*t36 + t30*t36
-    t38 = c1*t10
-    t39 = c1*t9
-    t40 = c1*t8
-    t41 = t6*t38 + t7*t39 + t15*t40
-    t42 = t40*t17 + t38*t17 + t39*t17
-    t43 = s1*t10
-    t44 = s1*t9
-    t45 = s1*t8
-    t46 = t6*t43 + t7*t44 + t15*t45
-    t47 = t17*t45 + t44*t17 + t43*t17
-    t48 = damping**2
-    t49 = _symmetric_solve4(xp, 1, (t48 + t32, t37, -t41, -t42, t48 + t35, -t46, -t47, t27 + t48, t18, t20 + t48, mu_dot0, mu_dot1, mu_dot2, mu_dot3,))
-    t50 = t49[0]
-    t51 = t49[1]
-    t52 = -t5*t50 + t2*t51
-    t53 = t49[2]
-    t54 = t17*t49[3]
-    t55 = t54 - t38*t50 - t43*t51 + t6*t53
-    t56 = t54 - t39*t50 - t44*t51 + t7*t53
-    t57 = t54 - t40*t50 - t45*t51 + t15*t53
-    t58 = xp.greater(t24, 0)
-    t59 = xp.where(t58, 1 + xp.abs(t5)/t24, 0)
-    t60 = -t5
-    t61 = xp.where(t58, 1/(t60 + t25), 0)
-    t62 = -t38 - t39 - t40 - t43 - t44 - t45 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + 3*t17 + t60 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping
-    t63 = t2*t61
-    t64 = -t59*(t38 + t43*t63)
-    t65 = t38 + t64
-    t66 = t43 + t63*t64
-    t67 = -t59*(t39 + t44*t63)
-    t68 = t39 + t67
-    t69 = t44 + t63*t67
-    t70 = -t59*(t40 + t45*t63)
-    t71 = t40 + t70
-    t72 = t45 + t63*t70
-    t73 = t59*(mu_dot0 + t63*mu_dot1)
-    t74 = -t73 + mu_dot0
-    t75 = mu_dot1 - t63*t73
-    t76 = xp.sqrt(t19 + t26 + t66**2)
-    t77 = t76*xp.where(xp.less_equal(t66, 0), xp.asarray(1, dtype=dtype), -1)
-    t78 = xp.greater(t76, 0)
-    t79 = xp.where(t78, 1/(-t66 + t77), 0)
-    t80 = xp.where(t78, 1 + xp.abs(t66)/t76, 0)
-    t81 = t6*t79
-    t82 = t19*t79
-    t83 = t80*(-t69 + t82 + t7*t81)
-    t84 = t69 + t83
-    t85 = t7 - t81*t83
-    t86 = t80*(-t72 + t82 + t15*t81)
-    t87 = t72 + t86
-    t88 = t15 - t81*t86
-    t89 = t17*t79
-    t90 = t17 - t89*t83
-    t91 = t17 - t89*t86
-    t92 = t80*(t75 + t81*mu_dot2 + t89*mu_dot3)
-    t93 = -t92 + t75
-    t94 = mu_dot2 - t81*t92
-    t95 = mu_dot3 - t89*t92
-    t96 = xp.sqrt(t85**2 + t90**2)
-    t97 = t96*xp.where(xp.greater_equal(t85, 0), xp.asarray(1, dtype=dtype), -1)
-    t98 = xp.greater(t96, 0)
-    t99 = xp.where(t98, 1/(t85 + t97), 0)
-    t100 = xp.where(t98, 1 + xp.abs(t85)/t96, 0)
-    t101 = t90*t99
-    t102 = t100*(t88 + t101*t91)
-    t103 = -t102 + t88
-    t104 = t91 - t101*t102
-    t105 = t100*(t94 + t101*t95)
-    t106 = -t105 + t94
-    t107 = t95 - t101*t105
-    t108 = xp.abs(t104)
-    t109 = t108*xp.where(xp.greater_equal(t104, 0), xp.asarray(1, dtype=dtype), -1)
-    t110 = xp.where(xp.greater(t108, 0), xp.asarray(2, dtype=dtype), 0)
-    t111 = t107 - t107*t110
-    t112 = xp.where(xp.not_equal(t109, 0), -t111/t109, 0)
-    t113 = xp.where(xp.not_equal(t97, 0), -(t106 - t103*t112)/t97, 0)
-    t114 = xp.where(xp.not_equal(t77, 0), -(t93 + t84*t113 + t87*t112)/t77, 0)
-    t115 = xp.where(xp.not_equal(t25, 0), -(t74 + t65*t114 + t68*t113 + t71*t112)/t25, 0)
-    t116 = xp.isfinite(t62)
-    t117 = xp.greater_equal(damping, 0)
-    t118 = xp.greater(damping, 0)
-    t119 = 1e-12*t34
-    t120 = (t118 & xp.greater(t49[4], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t24, t119) | xp.less_equal(t76, t119) | xp.less_equal(t96, t119) | xp.less_equal(t108, t119)))
-    t121 = t116 & t117 & xp.logical_not(t120)
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, mu_dot0, mu_dot1, mu_dot2, mu_dot3, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t121, xp.where(t118, t52, t115), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t121, xp.where(t118, t55, t114), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t121, xp.where(t118, t56, t113), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t121, xp.where(t118, t57, t112), 0), batch),  # 3
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t116 & t117), 2, xp.where(t120, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[4], batch), xp.int32)
     return q_dot, status
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 580 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (4,)), ("mu_dot", mu_dot, (4,)), ("z", z, (4,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
     mu_dot3 = mu_dot[..., 3]
-    qz1 = z[..., 0]
-    qz2 = z[..., 1]
-    qz3 = z[..., 2]
-    qz4 = z[..., 3]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
@@ -2468,152 +2472,22 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     s2 = trig[..., 2]
     c3 = trig[..., 4]
     s3 = trig[..., 5]
-    c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + s2*c3
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + s23*c4
-    t0 = 0.1*c1
-    t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
-    t3 = 0.1*s1
-    t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
-    t6 = c1*t2 + s1*t5
-    t7 = c1*t1 + s1*t4
-    t8 = 0.1*s234
-    t9 = 0.1*s23 + t8
-    t10 = 0.1*s2 + t9
-    t11 = c1**2
-    t12 = c234*t11
-    t13 = s1**2
-    t14 = c234*t13
-    t15 = 0.1*t12 + 0.1*t14
-    t16 = c234**2
-    t17 = -(t12 + t14)/xp.sqrt(t11*t16 + t13*t16)
-    t18 = t7*t17 + t15*t17 + t6*t17
-    t19 = t17**2
-    t20 = 3*t19
-    t21 = t2**2
-    t22 = t5**2
-    t23 = t21 + t22
-    t24 = xp.sqrt(t23)
-    t25 = xp.where(xp.less_equal(t5, 0), xp.asarray(1, dtype=dtype), -1)*t24
-    t26 = t6**2
-    t27 = t26 + t7**2 + t15**2
-    t28 = t10**2
-    t29 = t9**2
-    t30 = 0.01*s234**2
-    t31 = t11*t28 + t11*t30 + t11*t29
-    t32 = t22 + t31
-    t33 = t13*t28 + t13*t29 + t13*t30
-    t34 = xp.sqrt(t20 + t23 + t27 + t31 + t33)
-    t35 = t21 + t33
-    t36 = c1*s1
-    t37 = -t2*t5 + t28*t36 + t29*t36 + t30*t36
-    t38 = c1*t10
-    t39 = c1*t9
-    t40 = c1*t8
-    t41 = t6*t38 + t7*t39 + t15*t40
-    t42 = t40*t17 + t38*t17 + t39*t17
-    t43 = s1*t10
-    t44 = s1*t9
-    t45 = s1*t8
-    t46 = t6*t43 + t7*t44 + t15*t45
-    t47 = t17*t45 + t44*t17 + t43*t17
-    t48 = damping**2
-    t49 = _symmetric_solve4(xp, 1, (t48 + t32, t37, -t41, -t42, t48 + t35, -t46, -t47, t27 + t48, t18, t20 + t48, mu_dot0, mu_dot1, mu_dot2, mu_dot3,))
-    t50 = t49[0]
-    t51 = t49[1]
-    t52 = -t5*t50 + t2*t51
-    t53 = t49[2]
-    t54 = t17*t49[3]
-    t55 = t54 - t38*t50 - t43*t51 + t6*t53
-    t56 = t54 - t39*t50 - t44*t51 + t7*t53
-    t57 = t54 - t40*t50 - t45*t51 + t15*t53
-    t58 = xp.greater(t24, 0)
-    t59 = xp.where(t58, 1 + xp.abs(t5)/t24, 0)
-    t60 = -t5
-    t61 = xp.where(t58, 1/(t60 + t25), 0)
-    t62 = -t38 - t39 - t40 - t43 - t44 - t45 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + 3*t17 + t60 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + qz1 + qz2 + qz3 + qz4
-    t63 = t2*t61
-    t64 = -t59*(t38 + t43*t63)
-    t65 = t38 + t64
-    t66 = t43 + t63*t64
-    t67 = -t59*(t39 + t44*t63)
-    t68 = t39 + t67
-    t69 = t44 + t63*t67
-    t70 = -t59*(t40 + t45*t63)
-    t71 = t40 + t70
-    t72 = t45 + t63*t70
-    t73 = t59*(mu_dot0 + t63*mu_dot1)
-    t74 = -t73 + mu_dot0
-    t75 = mu_dot1 - t63*t73
-    t76 = xp.sqrt(t19 + t26 + t66**2)
-    t77 = t76*xp.where(xp.less_equal(t66, 0), xp.asarray(1, dtype=dtype), -1)
-    t78 = xp.greater(t76, 0)
-    t79 = xp.where(t78, 1/(-t66 + t77), 0)
-    t80 = xp.where(t78, 1 + xp.abs(t66)/t76, 0)
-    t81 = t6*t79
-    t82 = t19*t79
-    t83 = t80*(-t69 + t82 + t7*t81)
-    t84 = t69 + t83
-    t85 = t7 - t81*t83
-    t86 = t80*(-t72 + t82 + t15*t81)
-    t87 = t72 + t86
-    t88 = t15 - t81*t86
-    t89 = t17*t79
-    t90 = t17 - t89*t83
-    t91 = t17 - t89*t86
-    t92 = t80*(t75 + t81*mu_dot2 + t89*mu_dot3)
-    t93 = -t92 + t75
-    t94 = mu_dot2 - t81*t92
-    t95 = mu_dot3 - t89*t92
-    t96 = xp.sqrt(t85**2 + t90**2)
-    t97 = t96*xp.where(xp.greater_equal(t85, 0), xp.asarray(1, dtype=dtype), -1)
-    t98 = xp.greater(t96, 0)
-    t99 = xp.where(t98, 1/(t85 + t97), 0)
-    t100 = xp.where(t98, 1 + xp.abs(t85)/t96, 0)
-    t101 = t90*t99
-    t102 = t100*(t88 + t101*t91)
-    t103 = -t102 + t88
-    t104 = t91 - t101*t102
-    t105 = t100*(t94 + t101*t95)
-    t106 = -t105 + t94
-    t107 = t95 - t101*t105
-    t108 = xp.abs(t104)
-    t109 = t108*xp.where(xp.greater_equal(t104, 0), xp.asarray(1, dtype=dtype), -1)
-    t110 = xp.where(xp.greater(t108, 0), xp.asarray(2, dtype=dtype), 0)
-    t111 = t107 - t107*t110
-    t112 = xp.where(xp.not_equal(t109, 0), -t111/t109, 0)
-    t113 = xp.where(xp.not_equal(t97, 0), -(t106 - t103*t112)/t97, 0)
-    t114 = xp.where(xp.not_equal(t77, 0), -(t93 + t84*t113 + t87*t112)/t77, 0)
-    t115 = xp.where(xp.not_equal(t25, 0), -(t74 + t65*t114 + t68*t113 + t71*t112)/t25, 0)
-    t116 = xp.isfinite(t62)
-    t117 = xp.greater_equal(damping, 0)
-    t118 = xp.greater(damping, 0)
-    t119 = 1e-12*t34
-    t120 = (t118 & xp.greater(t49[4], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t24, t119) | xp.less_equal(t76, t119) | xp.less_equal(t96, t119) | xp.less_equal(t108, t119)))
-    t121 = t116 & t117 & xp.logical_not(t120)
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, mu_dot0, mu_dot1, mu_dot2, mu_dot3, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t121, xp.where(t118, t52, t115), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t121, xp.where(t118, t55, t114), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t121, xp.where(t118, t56, t113), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t121, xp.where(t118, t57, t112), 0), batch),  # 3
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t116 & t117), 2, xp.where(t120, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[4], batch), xp.int32)
     return q_dot, status
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 601 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 638 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (4,)), ("target", target, (4,)), ("target_rate", target_rate, (4,)), ("gain", gain, (4,)), ("z", z, (4,)), ("damping", damping, ()), every=("gain", ))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
     mu0 = target[..., 0]
     mu1 = target[..., 1]
     mu2 = target[..., 2]
@@ -2626,10 +2500,6 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     gain1 = gain[..., 1]
     gain2 = gain[..., 2]
     gain3 = gain[..., 3]
-    qz1 = z[..., 0]
-    qz2 = z[..., 1]
-    qz3 = z[..., 2]
-    qz4 = z[..., 3]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
@@ -2643,142 +2513,29 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     s4 = trig[..., 7]
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + s23*c4
-    t0 = 0.1*c1
-    t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
-    t3 = mu_dot0 + gain0*(-t2 + mu0)
-    t4 = 0.1*s1
+    t0 = 0.1*s23 + 0.1*s234
+    t1 = 0.1*s2 + t0
+    t2 = 0.12 + t1
+    t3 = mu_dot2 + gain2*(-t2 + mu2)
+    t4 = 0.1*c1
     t5 = c23*t4 + c234*t4
     t6 = t5 + c2*t4
-    t7 = c1*t2 + s1*t6
-    t8 = c1*t1 + s1*t5
-    t9 = 0.1*s234
-    t10 = 0.1*s23 + t9
-    t11 = 0.1*s2 + t10
-    t12 = 0.12 + t11
-    t13 = mu_dot2 + gain2*(-t12 + mu2)
-    t14 = c1**2
-    t15 = c234*t14
-    t16 = s1**2
-    t17 = c234*t16
-    t18 = 0.1*t15 + 0.1*t17
-    t19 = c234**2
-    t20 = xp.sqrt(t14*t19 + t16*t19)
-    t21 = -(t15 + t17)/t20
-    t22 = t8*t21 + t18*t21 + t7*t21
-    t23 = t21**2
-    t24 = 3*t23
-    t25 = t2**2
-    t26 = t6**2
-    t27 = t25 + t26
-    t28 = xp.sqrt(t27)
-    t29 = xp.where(xp.less_equal(t6, 0), xp.asarray(1, dtype=dtype), -1)*t28
-    t30 = t7**2
-    t31 = t30 + t8**2 + t18**2
-    t32 = t11**2
-    t33 = t10**2
-    t34 = 0.01*s234**2
-    t35 = t14*t33 + t14*t32 + t14*t34
-    t36 = t26 + t35
-    t37 = t16*t32 + t16*t33 + t16*t34
-    t38 = xp.sqrt(t24 + t27 + t31 + t35 + t37)
-    t39 = t25 + t37
-    t40 = c1*s1
-    t41 = t34*t40 - t2*t6 + t32*t40 + t33*t40
-    t42 = c1*t11
-    t43 = c1*t10
-    t44 = c1*t9
-    t45 = t7*t42 + t8*t43 + t18*t44
-    t46 = t43*t21 + t44*t21 + t42*t21
-    t47 = s1*t11
-    t48 = s1*t10
-    t49 = s1*t9
-    t50 = t7*t47 + t8*t48 + t18*t49
-    t51 = t21*t48 + t21*t49 + t47*t21
-    t52 = xp.greater(t28, 0)
-    t53 = xp.where(t52, 1 + xp.abs(t6)/t28, 0)
-    t54 = -t6
-    t55 = xp.where(t52, 1/(t54 + t29), 0)
-    t56 = mu_dot1 + gain1*(t54 + mu1)
-    t57 = t2*t55
-    t58 = -t53*(t42 + t47*t57)
-    t59 = t42 + t58
-    t60 = t47 + t57*t58
-    t61 = -t53*(t43 + t48*t57)
-    t62 = t43 + t61
-    t63 = t48 + t57*t61
-    t64 = -t53*(t44 + t49*t57)
-    t65 = t44 + t64
-    t66 = t49 + t57*t64
-    t67 = xp.sqrt(t23 + t30 + t60**2)
-    t68 = t67*xp.where(xp.less_equal(t60, 0), xp.asarray(1, dtype=dtype), -1)
-    t69 = t53*(t3 + t57*t56)
-    t70 = -t69 + t3
-    t71 = t56 - t57*t69
-    t72 = xp.greater(t67, 0)
-    t73 = xp.where(t72, 1/(-t60 + t68), 0)
-    t74 = xp.where(t72, 1 + xp.abs(t60)/t67, 0)
-    t75 = t7*t73
-    t76 = t23*t73
-    t77 = t74*(-t63 + t76 + t8*t75)
-    t78 = t63 + t77
-    t79 = t8 - t75*t77
-    t80 = t74*(-t66 + t76 + t18*t75)
-    t81 = t66 + t80
-    t82 = t18 - t75*t80
-    t83 = t21*t73
-    t84 = t21 - t83*t77
-    t85 = t21 - t83*t80
-    t86 = xp.sqrt(t79**2 + t84**2)
-    t87 = t86*xp.where(xp.greater_equal(t79, 0), xp.asarray(1, dtype=dtype), -1)
-    t88 = xp.greater(t86, 0)
-    t89 = xp.where(t88, 1/(t79 + t87), 0)
-    t90 = xp.where(t88, 1 + xp.abs(t79)/t86, 0)
-    t91 = t84*t89
-    t92 = t90*(t82 + t91*t85)
-    t93 = -t92 + t82
-    t94 = t85 - t91*t92
-    t95 = xp.abs(t94)
-    t96 = t95*xp.where(xp.greater_equal(t94, 0), xp.asarray(1, dtype=dtype), -1)
-    t97 = xp.where(xp.greater(t95, 0), xp.asarray(2, dtype=dtype), 0)
-    t98 = -mu3 + xp.atan2(-s234, t20)
-    t99 = mu_dot3 - gain3*(t98 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t98)))
-    t100 = t74*(t71 + t75*t13 + t83*t99)
-    t101 = -t100 + t71
-    t102 = t13 - t75*t100
-    t103 = t99 - t83*t100
-    t104 = t90*(t102 + t91*t103)
-    t105 = -t104 + t102
-    t106 = t103 - t91*t104
-    t107 = t106 - t97*t106
-    t108 = xp.where(xp.not_equal(t96, 0), -t107/t96, 0)
-    t109 = xp.where(xp.not_equal(t87, 0), -(t105 - t93*t108)/t87, 0)
-    t110 = xp.where(xp.not_equal(t68, 0), -(t101 + t78*t109 + t81*t108)/t68, 0)
-    t111 = xp.where(xp.not_equal(t29, 0), -(t70 + t59*t110 + t62*t109 + t65*t108)/t29, 0)
-    t112 = -t42 - t43 - t44 - t47 - t48 - t49 + q1 + q2 + q3 + q4 + t2 + t7 + t8 + t18 + 3*t21 + t54 + damping + qz1 + qz2 + qz3 + qz4 + t3 + t56 + t13 + t99
-    t113 = damping**2
-    t114 = _symmetric_solve4(xp, 1, (t113 + t36, t41, -t45, -t46, t113 + t39, -t50, -t51, t31 + t113, t22, t24 + t113, t3, t56, t13, t99,))
-    t115 = t114[0]
-    t116 = t114[1]
-    t117 = -t6*t115 + t2*t116
-    t118 = t114[2]
-    t119 = t21*t114[3]
-    t120 = t119 - t42*t115 - t47*t116 + t7*t118
-    t121 = t119 - t43*t115 - t48*t116 + t8*t118
-    t122 = t119 - t44*t115 - t49*t116 + t18*t118
-    t123 = xp.isfinite(t112)
-    t124 = xp.greater_equal(damping, 0)
-    t125 = xp.greater(damping, 0)
-    t126 = 1e-12*t38
-    t127 = (t125 & xp.greater(t114[4], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t28, t126) | xp.less_equal(t67, t126) | xp.less_equal(t86, t126) | xp.less_equal(t95, t126)))
-    t128 = t123 & t124 & xp.logical_not(t127)
+    t7 = mu_dot0 + gain0*(-t6 + mu0)
+    t8 = 0.1*s1
+    t9 = c23*t8 + c234*t8
+    t10 = t9 + c2*t8
+    t11 = mu_dot1 + gain1*(-t10 + mu1)
+    t12 = c234**2
+    t13 = -mu3 + xp.atan2(-s234, xp.sqrt(c1**2*t12 + s1**2*t12))
+    t14 = mu_dot3 - gain3*(t13 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t13)))
+    t15 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, t7, t11, t3, t14, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t128, xp.where(t125, t117, t111), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t128, xp.where(t125, t120, t110), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t128, xp.where(t125, t121, t109), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t128, xp.where(t125, t122, t108), 0), batch),  # 3
+        xp.broadcast_to(t15[0], batch),  # 0
+        xp.broadcast_to(t15[1], batch),  # 1
+        xp.broadcast_to(t15[2], batch),  # 2
+        xp.broadcast_to(t15[3], batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t123 & t124), 2, xp.where(t127, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t15[4], batch), xp.int32)
     return q_dot, status
 
 
@@ -2864,7 +2621,7 @@ def ik_numeric_step(target, q, damping=0.0):
     t51 = t47[2]
     t52 = t24*t47[3]
     t53 = q2 + t52 - t34*t48 - t39*t49 + t8*t51
-    t54 = q3 + t52 + t9*t51 - t35*t48 - t40*t49
+    t54 = q3 + t52 - t35*t48 - t40*t49 + t9*t51
     t55 = q4 + t52 + t20*t51 - t36*t48 - t41*t49
     q_start = _stack(xp, [
         xp.broadcast_to(q1, batch),  # 0

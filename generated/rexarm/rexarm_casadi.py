@@ -455,7 +455,7 @@ def _jacobi4_rows(count, state):
 
 
 def _symmetric_solve4(count, state):
-    """X solving a symmetric 4 x 4 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 217 operations a run."""
+    """The solution x of a symmetric 4 x 4 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 217 operations a run."""
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, = state
         t0 = w1**2
@@ -537,6 +537,146 @@ def _symmetric_solve4(count, state):
             t69,
             t68,
             casadi.if_else(casadi.logic_or(casadi.logic_or(casadi.logic_or((t5 <= t72), (t33 <= t72)), (t52 <= t72)), (t64 <= t72)), 1, 0),
+        )
+    return state
+
+
+def _velocity_solve(count, state):
+    """The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status, `count` times: 571 operations a run."""
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, = state
+        c23 = w2*w4 - w3*w5
+        s23 = w2*w5 + w3*w4
+        c234 = c23*w6 - s23*w7
+        s234 = c23*w7 + s23*w6
+        t0 = 0.1*w0
+        t1 = c23*t0 + c234*t0
+        t2 = t1 + w2*t0
+        t3 = 0.1*w1
+        t4 = c23*t3 + c234*t3
+        t5 = t4 + w2*t3
+        t6 = w0*t2 + w1*t5
+        t7 = w0*t1 + w1*t4
+        t8 = 0.1*s234
+        t9 = 0.1*s23 + t8
+        t10 = 0.1*w3 + t9
+        t11 = w0**2
+        t12 = c234*t11
+        t13 = w1**2
+        t14 = c234*t13
+        t15 = 0.1*t12 + 0.1*t14
+        t16 = c234**2
+        t17 = -(t12 + t14)/casadi.sqrt(t11*t16 + t13*t16)
+        t18 = t7*t17 + t15*t17 + t6*t17
+        t19 = t17**2
+        t20 = 3*t19
+        t21 = t2**2
+        t22 = t5**2
+        t23 = t21 + t22
+        t24 = casadi.sqrt(t23)
+        t25 = casadi.if_else((t5 <= 0), 1, -1)*t24
+        t26 = t6**2
+        t27 = t26 + t7**2 + t15**2
+        t28 = t10**2
+        t29 = t9**2
+        t30 = 0.01*s234**2
+        t31 = t11*t28 + t11*t30 + t11*t29
+        t32 = t22 + t31
+        t33 = t13*t28 + t13*t29 + t13*t30
+        t34 = casadi.sqrt(t20 + t23 + t27 + t31 + t33)
+        t35 = t21 + t33
+        t36 = w0*w1
+        t37 = -t2*t5 + t28*t36 + t29*t36 + t30*t36
+        t38 = w0*t10
+        t39 = w0*t9
+        t40 = w0*t8
+        t41 = t6*t38 + t7*t39 + t15*t40
+        t42 = t40*t17 + t38*t17 + t39*t17
+        t43 = w1*t10
+        t44 = w1*t9
+        t45 = w1*t8
+        t46 = t6*t43 + t7*t44 + t15*t45
+        t47 = t17*t45 + t44*t17 + t43*t17
+        t48 = w12**2
+        t49 = _symmetric_solve4(1, (t48 + t32, t37, -t41, -t42, t48 + t35, -t46, -t47, t27 + t48, t18, t20 + t48, w8, w9, w10, w11,))
+        t50 = t49[0]
+        t51 = t49[1]
+        t52 = -t5*t50 + t2*t51
+        t53 = t49[2]
+        t54 = t17*t49[3]
+        t55 = t54 - t38*t50 - t43*t51 + t6*t53
+        t56 = t54 - t39*t50 - t44*t51 + t7*t53
+        t57 = t54 - t40*t50 - t45*t51 + t15*t53
+        t58 = (t24 > 0)
+        t59 = casadi.if_else(t58, 1 + casadi.fabs(t5)/t24, 0)
+        t60 = -t5
+        t61 = casadi.if_else(t58, 1/(t60 + t25), 0)
+        t62 = -t38 - t39 - t40 - t43 - t44 - t45 + w3 + w2 + w4 + w5 + w0 + w1 + w6 + w7 + t2 + t6 + t7 + t15 + 3*t17 + t60 + w8 + w9 + w10 + w11 + w12
+        t63 = t2*t61
+        t64 = -t59*(t38 + t43*t63)
+        t65 = t38 + t64
+        t66 = t43 + t63*t64
+        t67 = -t59*(t39 + t44*t63)
+        t68 = t39 + t67
+        t69 = t44 + t63*t67
+        t70 = -t59*(t40 + t45*t63)
+        t71 = t40 + t70
+        t72 = t45 + t63*t70
+        t73 = t59*(w8 + t63*w9)
+        t74 = -t73 + w8
+        t75 = w9 - t63*t73
+        t76 = casadi.sqrt(t19 + t26 + t66**2)
+        t77 = t76*casadi.if_else((t66 <= 0), 1, -1)
+        t78 = (t76 > 0)
+        t79 = casadi.if_else(t78, 1/(-t66 + t77), 0)
+        t80 = casadi.if_else(t78, 1 + casadi.fabs(t66)/t76, 0)
+        t81 = t6*t79
+        t82 = t19*t79
+        t83 = t80*(-t69 + t82 + t7*t81)
+        t84 = t69 + t83
+        t85 = t7 - t81*t83
+        t86 = t80*(-t72 + t82 + t15*t81)
+        t87 = t72 + t86
+        t88 = t15 - t81*t86
+        t89 = t17*t79
+        t90 = t17 - t89*t83
+        t91 = t17 - t89*t86
+        t92 = t80*(t75 + t81*w10 + t89*w11)
+        t93 = -t92 + t75
+        t94 = w10 - t81*t92
+        t95 = w11 - t89*t92
+        t96 = casadi.sqrt(t85**2 + t90**2)
+        t97 = t96*casadi.if_else((t85 >= 0), 1, -1)
+        t98 = (t96 > 0)
+        t99 = casadi.if_else(t98, 1/(t85 + t97), 0)
+        t100 = casadi.if_else(t98, 1 + casadi.fabs(t85)/t96, 0)
+        t101 = t90*t99
+        t102 = t100*(t88 + t101*t91)
+        t103 = -t102 + t88
+        t104 = t91 - t101*t102
+        t105 = t100*(t94 + t101*t95)
+        t106 = -t105 + t94
+        t107 = t95 - t101*t105
+        t108 = casadi.fabs(t104)
+        t109 = t108*casadi.if_else((t104 >= 0), 1, -1)
+        t110 = casadi.if_else((t108 > 0), 2, 0)
+        t111 = t107 - t107*t110
+        t112 = casadi.if_else((t109 != 0), -t111/t109, 0)
+        t113 = casadi.if_else((t97 != 0), -(t106 - t103*t112)/t97, 0)
+        t114 = casadi.if_else((t77 != 0), -(t93 + t84*t113 + t87*t112)/t77, 0)
+        t115 = casadi.if_else((t25 != 0), -(t74 + t65*t114 + t68*t113 + t71*t112)/t25, 0)
+        t116 = (casadi.fabs(t62) < casadi.inf)
+        t117 = (w12 >= 0)
+        t118 = (w12 > 0)
+        t119 = 1e-12*t34
+        t120 = casadi.logic_or(casadi.logic_and(t118, (t49[4] > 0)), casadi.logic_and((w12 <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t24 <= t119), (t76 <= t119)), (t96 <= t119)), (t108 <= t119))))
+        t121 = casadi.logic_and(casadi.logic_and(t116, t117), casadi.logic_not(t120))
+        state = (
+            casadi.if_else(t121, casadi.if_else(t118, t52, t115), 0),
+            casadi.if_else(t121, casadi.if_else(t118, t55, t114), 0),
+            casadi.if_else(t121, casadi.if_else(t118, t56, t113), 0),
+            casadi.if_else(t121, casadi.if_else(t118, t57, t112), 0),
+            casadi.if_else(casadi.logic_not(casadi.logic_and(t116, t117)), 2, casadi.if_else(t120, 1, 0)),
         )
     return state
 
@@ -2107,7 +2247,7 @@ def _condition_number(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 576 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 580 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -2122,141 +2262,16 @@ def _velocity_ik(q, mu_dot, damping):
     s2 = casadi.cos(q2)
     c3 = casadi.cos(q3)
     s3 = casadi.sin(q3)
-    c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + s2*c3
     c4 = casadi.cos(q4)
     s4 = casadi.sin(q4)
-    c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + s23*c4
-    t0 = 0.1*c1
-    t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
-    t3 = 0.1*s1
-    t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
-    t6 = c1*t2 + s1*t5
-    t7 = c1*t1 + s1*t4
-    t8 = 0.1*s234
-    t9 = 0.1*s23 + t8
-    t10 = 0.1*s2 + t9
-    t11 = c1**2
-    t12 = c234*t11
-    t13 = s1**2
-    t14 = c234*t13
-    t15 = 0.1*t12 + 0.1*t14
-    t16 = c234**2
-    t17 = -(t12 + t14)/casadi.sqrt(t11*t16 + t13*t16)
-    t18 = t7*t17 + t15*t17 + t6*t17
-    t19 = t17**2
-    t20 = 3*t19
-    t21 = t2**2
-    t22 = t5**2
-    t23 = t21 + t22
-    t24 = casadi.sqrt(t23)
-    t25 = casadi.if_else((t5 <= 0), 1, -1)*t24
-    t26 = t6**2
-    t27 = t26 + t7**2 + t15**2
-    t28 = t10**2
-    t29 = t9**2
-    t30 = 0.01*s234**2
-    t31 = t11*t28 + t11*t30 + t11*t29
-    t32 = t22 + t31
-    t33 = t13*t28 + t13*t29 + t13*t30
-    t34 = casadi.sqrt(t20 + t23 + t27 + t31 + t33)
-    t35 = t21 + t33
-    t36 = c1*s1
-    t37 = -t2*t5 + t28*t36 + t29*t36 + t30*t36
-    t38 = c1*t10
-    t39 = c1*t9
-    t40 = c1*t8
-    t41 = t6*t38 + t7*t39 + t15*t40
-    t42 = t40*t17 + t38*t17 + t39*t17
-    t43 = s1*t10
-    t44 = s1*t9
-    t45 = s1*t8
-    t46 = t6*t43 + t7*t44 + t15*t45
-    t47 = t17*t45 + t44*t17 + t43*t17
-    t48 = damping**2
-    t49 = _symmetric_solve4(1, (t48 + t32, t37, -t41, -t42, t48 + t35, -t46, -t47, t27 + t48, t18, t20 + t48, mu_dot0, mu_dot1, mu_dot2, mu_dot3,))
-    t50 = t49[0]
-    t51 = t49[1]
-    t52 = -t5*t50 + t2*t51
-    t53 = t49[2]
-    t54 = t17*t49[3]
-    t55 = t54 - t38*t50 - t43*t51 + t6*t53
-    t56 = t54 - t39*t50 - t44*t51 + t7*t53
-    t57 = t54 - t40*t50 - t45*t51 + t15*t53
-    t58 = (t24 > 0)
-    t59 = casadi.if_else(t58, 1 + casadi.fabs(t5)/t24, 0)
-    t60 = -t5
-    t61 = casadi.if_else(t58, 1/(t60 + t25), 0)
-    t62 = -t38 - t39 - t40 - t43 - t44 - t45 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + 3*t17 + t60 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping
-    t63 = t2*t61
-    t64 = -t59*(t38 + t43*t63)
-    t65 = t38 + t64
-    t66 = t43 + t63*t64
-    t67 = -t59*(t39 + t44*t63)
-    t68 = t39 + t67
-    t69 = t44 + t63*t67
-    t70 = -t59*(t40 + t45*t63)
-    t71 = t40 + t70
-    t72 = t45 + t63*t70
-    t73 = t59*(mu_dot0 + t63*mu_dot1)
-    t74 = -t73 + mu_dot0
-    t75 = mu_dot1 - t63*t73
-    t76 = casadi.sqrt(t19 + t26 + t66**2)
-    t77 = t76*casadi.if_else((t66 <= 0), 1, -1)
-    t78 = (t76 > 0)
-    t79 = casadi.if_else(t78, 1/(-t66 + t77), 0)
-    t80 = casadi.if_else(t78, 1 + casadi.fabs(t66)/t76, 0)
-    t81 = t6*t79
-    t82 = t19*t79
-    t83 = t80*(-t69 + t82 + t7*t81)
-    t84 = t69 + t83
-    t85 = t7 - t81*t83
-    t86 = t80*(-t72 + t82 + t15*t81)
-    t87 = t72 + t86
-    t88 = t15 - t81*t86
-    t89 = t17*t79
-    t90 = t17 - t89*t83
-    t91 = t17 - t89*t86
-    t92 = t80*(t75 + t81*mu_dot2 + t89*mu_dot3)
-    t93 = -t92 + t75
-    t94 = mu_dot2 - t81*t92
-    t95 = mu_dot3 - t89*t92
-    t96 = casadi.sqrt(t85**2 + t90**2)
-    t97 = t96*casadi.if_else((t85 >= 0), 1, -1)
-    t98 = (t96 > 0)
-    t99 = casadi.if_else(t98, 1/(t85 + t97), 0)
-    t100 = casadi.if_else(t98, 1 + casadi.fabs(t85)/t96, 0)
-    t101 = t90*t99
-    t102 = t100*(t88 + t101*t91)
-    t103 = -t102 + t88
-    t104 = t91 - t101*t102
-    t105 = t100*(t94 + t101*t95)
-    t106 = -t105 + t94
-    t107 = t95 - t101*t105
-    t108 = casadi.fabs(t104)
-    t109 = t108*casadi.if_else((t104 >= 0), 1, -1)
-    t110 = casadi.if_else((t108 > 0), 2, 0)
-    t111 = t107 - t107*t110
-    t112 = casadi.if_else((t109 != 0), -t111/t109, 0)
-    t113 = casadi.if_else((t97 != 0), -(t106 - t103*t112)/t97, 0)
-    t114 = casadi.if_else((t77 != 0), -(t93 + t84*t113 + t87*t112)/t77, 0)
-    t115 = casadi.if_else((t25 != 0), -(t74 + t65*t114 + t68*t113 + t71*t112)/t25, 0)
-    t116 = (casadi.fabs(t62) < casadi.inf)
-    t117 = (damping >= 0)
-    t118 = (damping > 0)
-    t119 = 1e-12*t34
-    t120 = casadi.logic_or(casadi.logic_and(t118, (t49[4] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t24 <= t119), (t76 <= t119)), (t96 <= t119)), (t108 <= t119))))
-    t121 = casadi.logic_and(casadi.logic_and(t116, t117), casadi.logic_not(t120))
+    t0 = _velocity_solve(1, (c1, s1, c2, s2, c3, s3, c4, s4, mu_dot0, mu_dot1, mu_dot2, mu_dot3, damping,))
     q_dot = casadi.SX(4, 1)
-    q_dot[0, 0] = casadi.if_else(t121, casadi.if_else(t118, t52, t115), 0)
-    q_dot[1, 0] = casadi.if_else(t121, casadi.if_else(t118, t55, t114), 0)
-    q_dot[2, 0] = casadi.if_else(t121, casadi.if_else(t118, t56, t113), 0)
-    q_dot[3, 0] = casadi.if_else(t121, casadi.if_else(t118, t57, t112), 0)
+    q_dot[0, 0] = t0[0]
+    q_dot[1, 0] = t0[1]
+    q_dot[2, 0] = t0[2]
+    q_dot[3, 0] = t0[3]
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t116, t117)), 2, casadi.if_else(t120, 1, 0))
+    status[0, 0] = t0[4]
     return [q_dot, status]
 
 
@@ -2270,156 +2285,27 @@ def _velocity_ik_nullspace(q, mu_dot, z, damping):
     mu_dot1 = mu_dot[1]
     mu_dot2 = mu_dot[2]
     mu_dot3 = mu_dot[3]
-    qz1 = z[0]
-    qz2 = z[1]
-    qz3 = z[2]
-    qz4 = z[3]
     c1 = casadi.cos(q1)
     s1 = casadi.sin(q1)
     c2 = -casadi.sin(q2)
     s2 = casadi.cos(q2)
     c3 = casadi.cos(q3)
     s3 = casadi.sin(q3)
-    c23 = c2*c3 - s2*s3
-    s23 = c2*s3 + s2*c3
     c4 = casadi.cos(q4)
     s4 = casadi.sin(q4)
-    c234 = c23*c4 - s23*s4
-    s234 = c23*s4 + s23*c4
-    t0 = 0.1*c1
-    t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
-    t3 = 0.1*s1
-    t4 = c23*t3 + c234*t3
-    t5 = t4 + c2*t3
-    t6 = c1*t2 + s1*t5
-    t7 = c1*t1 + s1*t4
-    t8 = 0.1*s234
-    t9 = 0.1*s23 + t8
-    t10 = 0.1*s2 + t9
-    t11 = c1**2
-    t12 = c234*t11
-    t13 = s1**2
-    t14 = c234*t13
-    t15 = 0.1*t12 + 0.1*t14
-    t16 = c234**2
-    t17 = -(t12 + t14)/casadi.sqrt(t11*t16 + t13*t16)
-    t18 = t7*t17 + t15*t17 + t6*t17
-    t19 = t17**2
-    t20 = 3*t19
-    t21 = t2**2
-    t22 = t5**2
-    t23 = t21 + t22
-    t24 = casadi.sqrt(t23)
-    t25 = casadi.if_else((t5 <= 0), 1, -1)*t24
-    t26 = t6**2
-    t27 = t26 + t7**2 + t15**2
-    t28 = t10**2
-    t29 = t9**2
-    t30 = 0.01*s234**2
-    t31 = t11*t28 + t11*t30 + t11*t29
-    t32 = t22 + t31
-    t33 = t13*t28 + t13*t29 + t13*t30
-    t34 = casadi.sqrt(t20 + t23 + t27 + t31 + t33)
-    t35 = t21 + t33
-    t36 = c1*s1
-    t37 = -t2*t5 + t28*t36 + t29*t36 + t30*t36
-    t38 = c1*t10
-    t39 = c1*t9
-    t40 = c1*t8
-    t41 = t6*t38 + t7*t39 + t15*t40
-    t42 = t40*t17 + t38*t17 + t39*t17
-    t43 = s1*t10
-    t44 = s1*t9
-    t45 = s1*t8
-    t46 = t6*t43 + t7*t44 + t15*t45
-    t47 = t17*t45 + t44*t17 + t43*t17
-    t48 = damping**2
-    t49 = _symmetric_solve4(1, (t48 + t32, t37, -t41, -t42, t48 + t35, -t46, -t47, t27 + t48, t18, t20 + t48, mu_dot0, mu_dot1, mu_dot2, mu_dot3,))
-    t50 = t49[0]
-    t51 = t49[1]
-    t52 = -t5*t50 + t2*t51
-    t53 = t49[2]
-    t54 = t17*t49[3]
-    t55 = t54 - t38*t50 - t43*t51 + t6*t53
-    t56 = t54 - t39*t50 - t44*t51 + t7*t53
-    t57 = t54 - t40*t50 - t45*t51 + t15*t53
-    t58 = (t24 > 0)
-    t59 = casadi.if_else(t58, 1 + casadi.fabs(t5)/t24, 0)
-    t60 = -t5
-    t61 = casadi.if_else(t58, 1/(t60 + t25), 0)
-    t62 = -t38 - t39 - t40 - t43 - t44 - t45 + q1 + q2 + q3 + q4 + t2 + t6 + t7 + t15 + 3*t17 + t60 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + qz1 + qz2 + qz3 + qz4
-    t63 = t2*t61
-    t64 = -t59*(t38 + t43*t63)
-    t65 = t38 + t64
-    t66 = t43 + t63*t64
-    t67 = -t59*(t39 + t44*t63)
-    t68 = t39 + t67
-    t69 = t44 + t63*t67
-    t70 = -t59*(t40 + t45*t63)
-    t71 = t40 + t70
-    t72 = t45 + t63*t70
-    t73 = t59*(mu_dot0 + t63*mu_dot1)
-    t74 = -t73 + mu_dot0
-    t75 = mu_dot1 - t63*t73
-    t76 = casadi.sqrt(t19 + t26 + t66**2)
-    t77 = t76*casadi.if_else((t66 <= 0), 1, -1)
-    t78 = (t76 > 0)
-    t79 = casadi.if_else(t78, 1/(-t66 + t77), 0)
-    t80 = casadi.if_else(t78, 1 + casadi.fabs(t66)/t76, 0)
-    t81 = t6*t79
-    t82 = t19*t79
-    t83 = t80*(-t69 + t82 + t7*t81)
-    t84 = t69 + t83
-    t85 = t7 - t81*t83
-    t86 = t80*(-t72 + t82 + t15*t81)
-    t87 = t72 + t86
-    t88 = t15 - t81*t86
-    t89 = t17*t79
-    t90 = t17 - t89*t83
-    t91 = t17 - t89*t86
-    t92 = t80*(t75 + t81*mu_dot2 + t89*mu_dot3)
-    t93 = -t92 + t75
-    t94 = mu_dot2 - t81*t92
-    t95 = mu_dot3 - t89*t92
-    t96 = casadi.sqrt(t85**2 + t90**2)
-    t97 = t96*casadi.if_else((t85 >= 0), 1, -1)
-    t98 = (t96 > 0)
-    t99 = casadi.if_else(t98, 1/(t85 + t97), 0)
-    t100 = casadi.if_else(t98, 1 + casadi.fabs(t85)/t96, 0)
-    t101 = t90*t99
-    t102 = t100*(t88 + t101*t91)
-    t103 = -t102 + t88
-    t104 = t91 - t101*t102
-    t105 = t100*(t94 + t101*t95)
-    t106 = -t105 + t94
-    t107 = t95 - t101*t105
-    t108 = casadi.fabs(t104)
-    t109 = t108*casadi.if_else((t104 >= 0), 1, -1)
-    t110 = casadi.if_else((t108 > 0), 2, 0)
-    t111 = t107 - t107*t110
-    t112 = casadi.if_else((t109 != 0), -t111/t109, 0)
-    t113 = casadi.if_else((t97 != 0), -(t106 - t103*t112)/t97, 0)
-    t114 = casadi.if_else((t77 != 0), -(t93 + t84*t113 + t87*t112)/t77, 0)
-    t115 = casadi.if_else((t25 != 0), -(t74 + t65*t114 + t68*t113 + t71*t112)/t25, 0)
-    t116 = (casadi.fabs(t62) < casadi.inf)
-    t117 = (damping >= 0)
-    t118 = (damping > 0)
-    t119 = 1e-12*t34
-    t120 = casadi.logic_or(casadi.logic_and(t118, (t49[4] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t24 <= t119), (t76 <= t119)), (t96 <= t119)), (t108 <= t119))))
-    t121 = casadi.logic_and(casadi.logic_and(t116, t117), casadi.logic_not(t120))
+    t0 = _velocity_solve(1, (c1, s1, c2, s2, c3, s3, c4, s4, mu_dot0, mu_dot1, mu_dot2, mu_dot3, damping,))
     q_dot = casadi.SX(4, 1)
-    q_dot[0, 0] = casadi.if_else(t121, casadi.if_else(t118, t52, t115), 0)
-    q_dot[1, 0] = casadi.if_else(t121, casadi.if_else(t118, t55, t114), 0)
-    q_dot[2, 0] = casadi.if_else(t121, casadi.if_else(t118, t56, t113), 0)
-    q_dot[3, 0] = casadi.if_else(t121, casadi.if_else(t118, t57, t112), 0)
+    q_dot[0, 0] = t0[0]
+    q_dot[1, 0] = t0[1]
+    q_dot[2, 0] = t0[2]
+    q_dot[3, 0] = t0[3]
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t116, t117)), 2, casadi.if_else(t120, 1, 0))
+    status[0, 0] = t0[4]
     return [q_dot, status]
 
 
 def _resolved_rate(q, target, target_rate, gain, z, damping):
-    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 601 operations."""
+    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 638 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -2436,10 +2322,6 @@ def _resolved_rate(q, target, target_rate, gain, z, damping):
     gain1 = gain[1]
     gain2 = gain[2]
     gain3 = gain[3]
-    qz1 = z[0]
-    qz2 = z[1]
-    qz3 = z[2]
-    qz4 = z[3]
     c1 = casadi.cos(q1)
     s1 = casadi.sin(q1)
     c2 = -casadi.sin(q2)
@@ -2452,142 +2334,29 @@ def _resolved_rate(q, target, target_rate, gain, z, damping):
     s4 = casadi.sin(q4)
     c234 = c23*c4 - s23*s4
     s234 = c23*s4 + s23*c4
-    t0 = 0.1*c1
-    t1 = c23*t0 + c234*t0
-    t2 = t1 + c2*t0
-    t3 = mu_dot0 + gain0*(-t2 + mu0)
-    t4 = 0.1*s1
+    t0 = 0.1*s23 + 0.1*s234
+    t1 = 0.1*s2 + t0
+    t2 = 0.12 + t1
+    t3 = mu_dot2 + gain2*(-t2 + mu2)
+    t4 = 0.1*c1
     t5 = c23*t4 + c234*t4
     t6 = t5 + c2*t4
-    t7 = c1*t2 + s1*t6
-    t8 = c1*t1 + s1*t5
-    t9 = 0.1*s234
-    t10 = 0.1*s23 + t9
-    t11 = 0.1*s2 + t10
-    t12 = 0.12 + t11
-    t13 = mu_dot2 + gain2*(-t12 + mu2)
-    t14 = c1**2
-    t15 = c234*t14
-    t16 = s1**2
-    t17 = c234*t16
-    t18 = 0.1*t15 + 0.1*t17
-    t19 = c234**2
-    t20 = casadi.sqrt(t14*t19 + t16*t19)
-    t21 = -(t15 + t17)/t20
-    t22 = t8*t21 + t18*t21 + t7*t21
-    t23 = t21**2
-    t24 = 3*t23
-    t25 = t2**2
-    t26 = t6**2
-    t27 = t25 + t26
-    t28 = casadi.sqrt(t27)
-    t29 = casadi.if_else((t6 <= 0), 1, -1)*t28
-    t30 = t7**2
-    t31 = t30 + t8**2 + t18**2
-    t32 = t11**2
-    t33 = t10**2
-    t34 = 0.01*s234**2
-    t35 = t14*t33 + t14*t32 + t14*t34
-    t36 = t26 + t35
-    t37 = t16*t32 + t16*t33 + t16*t34
-    t38 = casadi.sqrt(t24 + t27 + t31 + t35 + t37)
-    t39 = t25 + t37
-    t40 = c1*s1
-    t41 = t34*t40 - t2*t6 + t32*t40 + t33*t40
-    t42 = c1*t11
-    t43 = c1*t10
-    t44 = c1*t9
-    t45 = t7*t42 + t8*t43 + t18*t44
-    t46 = t43*t21 + t44*t21 + t42*t21
-    t47 = s1*t11
-    t48 = s1*t10
-    t49 = s1*t9
-    t50 = t7*t47 + t8*t48 + t18*t49
-    t51 = t21*t48 + t21*t49 + t47*t21
-    t52 = (t28 > 0)
-    t53 = casadi.if_else(t52, 1 + casadi.fabs(t6)/t28, 0)
-    t54 = -t6
-    t55 = casadi.if_else(t52, 1/(t54 + t29), 0)
-    t56 = mu_dot1 + gain1*(t54 + mu1)
-    t57 = t2*t55
-    t58 = -t53*(t42 + t47*t57)
-    t59 = t42 + t58
-    t60 = t47 + t57*t58
-    t61 = -t53*(t43 + t48*t57)
-    t62 = t43 + t61
-    t63 = t48 + t57*t61
-    t64 = -t53*(t44 + t49*t57)
-    t65 = t44 + t64
-    t66 = t49 + t57*t64
-    t67 = casadi.sqrt(t23 + t30 + t60**2)
-    t68 = t67*casadi.if_else((t60 <= 0), 1, -1)
-    t69 = t53*(t3 + t57*t56)
-    t70 = -t69 + t3
-    t71 = t56 - t57*t69
-    t72 = (t67 > 0)
-    t73 = casadi.if_else(t72, 1/(-t60 + t68), 0)
-    t74 = casadi.if_else(t72, 1 + casadi.fabs(t60)/t67, 0)
-    t75 = t7*t73
-    t76 = t23*t73
-    t77 = t74*(-t63 + t76 + t8*t75)
-    t78 = t63 + t77
-    t79 = t8 - t75*t77
-    t80 = t74*(-t66 + t76 + t18*t75)
-    t81 = t66 + t80
-    t82 = t18 - t75*t80
-    t83 = t21*t73
-    t84 = t21 - t83*t77
-    t85 = t21 - t83*t80
-    t86 = casadi.sqrt(t79**2 + t84**2)
-    t87 = t86*casadi.if_else((t79 >= 0), 1, -1)
-    t88 = (t86 > 0)
-    t89 = casadi.if_else(t88, 1/(t79 + t87), 0)
-    t90 = casadi.if_else(t88, 1 + casadi.fabs(t79)/t86, 0)
-    t91 = t84*t89
-    t92 = t90*(t82 + t91*t85)
-    t93 = -t92 + t82
-    t94 = t85 - t91*t92
-    t95 = casadi.fabs(t94)
-    t96 = t95*casadi.if_else((t94 >= 0), 1, -1)
-    t97 = casadi.if_else((t95 > 0), 2, 0)
-    t98 = -mu3 + casadi.atan2(-s234, t20)
-    t99 = mu_dot3 - gain3*(t98 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t98)))
-    t100 = t74*(t71 + t75*t13 + t83*t99)
-    t101 = -t100 + t71
-    t102 = t13 - t75*t100
-    t103 = t99 - t83*t100
-    t104 = t90*(t102 + t91*t103)
-    t105 = -t104 + t102
-    t106 = t103 - t91*t104
-    t107 = t106 - t97*t106
-    t108 = casadi.if_else((t96 != 0), -t107/t96, 0)
-    t109 = casadi.if_else((t87 != 0), -(t105 - t93*t108)/t87, 0)
-    t110 = casadi.if_else((t68 != 0), -(t101 + t78*t109 + t81*t108)/t68, 0)
-    t111 = casadi.if_else((t29 != 0), -(t70 + t59*t110 + t62*t109 + t65*t108)/t29, 0)
-    t112 = -t42 - t43 - t44 - t47 - t48 - t49 + q1 + q2 + q3 + q4 + t2 + t7 + t8 + t18 + 3*t21 + t54 + damping + qz1 + qz2 + qz3 + qz4 + t3 + t56 + t13 + t99
-    t113 = damping**2
-    t114 = _symmetric_solve4(1, (t113 + t36, t41, -t45, -t46, t113 + t39, -t50, -t51, t31 + t113, t22, t24 + t113, t3, t56, t13, t99,))
-    t115 = t114[0]
-    t116 = t114[1]
-    t117 = -t6*t115 + t2*t116
-    t118 = t114[2]
-    t119 = t21*t114[3]
-    t120 = t119 - t42*t115 - t47*t116 + t7*t118
-    t121 = t119 - t43*t115 - t48*t116 + t8*t118
-    t122 = t119 - t44*t115 - t49*t116 + t18*t118
-    t123 = (casadi.fabs(t112) < casadi.inf)
-    t124 = (damping >= 0)
-    t125 = (damping > 0)
-    t126 = 1e-12*t38
-    t127 = casadi.logic_or(casadi.logic_and(t125, (t114[4] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t28 <= t126), (t67 <= t126)), (t86 <= t126)), (t95 <= t126))))
-    t128 = casadi.logic_and(casadi.logic_and(t123, t124), casadi.logic_not(t127))
+    t7 = mu_dot0 + gain0*(-t6 + mu0)
+    t8 = 0.1*s1
+    t9 = c23*t8 + c234*t8
+    t10 = t9 + c2*t8
+    t11 = mu_dot1 + gain1*(-t10 + mu1)
+    t12 = c234**2
+    t13 = -mu3 + casadi.atan2(-s234, casadi.sqrt(c1**2*t12 + s1**2*t12))
+    t14 = mu_dot3 - gain3*(t13 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t13)))
+    t15 = _velocity_solve(1, (c1, s1, c2, s2, c3, s3, c4, s4, t7, t11, t3, t14, damping,))
     q_dot = casadi.SX(4, 1)
-    q_dot[0, 0] = casadi.if_else(t128, casadi.if_else(t125, t117, t111), 0)
-    q_dot[1, 0] = casadi.if_else(t128, casadi.if_else(t125, t120, t110), 0)
-    q_dot[2, 0] = casadi.if_else(t128, casadi.if_else(t125, t121, t109), 0)
-    q_dot[3, 0] = casadi.if_else(t128, casadi.if_else(t125, t122, t108), 0)
+    q_dot[0, 0] = t15[0]
+    q_dot[1, 0] = t15[1]
+    q_dot[2, 0] = t15[2]
+    q_dot[3, 0] = t15[3]
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t123, t124)), 2, casadi.if_else(t127, 1, 0))
+    status[0, 0] = t15[4]
     return [q_dot, status]
 
 
@@ -2671,7 +2440,7 @@ def _ik_numeric_step(target, q, damping):
     t51 = t47[2]
     t52 = t24*t47[3]
     t53 = q2 + t52 - t34*t48 - t39*t49 + t8*t51
-    t54 = q3 + t52 + t9*t51 - t35*t48 - t40*t49
+    t54 = q3 + t52 - t35*t48 - t40*t49 + t9*t51
     t55 = q4 + t52 + t20*t51 - t36*t48 - t41*t49
     q_start = casadi.SX(4, 1)
     q_start[0, 0] = q1

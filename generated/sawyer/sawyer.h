@@ -111,15 +111,15 @@ void sawyer_velocity_ellipsoid(const sawyer_real q[SAWYER_DOF], sawyer_real U_v[
 sawyer_real sawyer_condition_number(const sawyer_real q[SAWYER_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 7; returned as a scalar. 1034 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1121 operations. */
 int sawyer_velocity_ik(const sawyer_real q[SAWYER_DOF], const sawyer_real mu_dot[SAWYER_TASK_DIM], sawyer_real damping, sawyer_real q_dot[SAWYER_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 7; returned as a scalar. 1116 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1121 operations. */
 int sawyer_velocity_ik_nullspace(const sawyer_real q[SAWYER_DOF], const sawyer_real mu_dot[SAWYER_TASK_DIM], const sawyer_real z[SAWYER_DOF], sawyer_real damping, sawyer_real q_dot[SAWYER_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 7; returned as a scalar. 1278 operations. */
+ * Result: q_dot[i], i < 7; returned as a scalar. 1376 operations. */
 int sawyer_resolved_rate(const sawyer_real q[SAWYER_DOF], const sawyer_real target[16], const sawyer_real target_rate[SAWYER_TASK_DIM], const sawyer_real gain[SAWYER_TASK_DIM], const sawyer_real z[SAWYER_DOF], sawyer_real damping, sawyer_real q_dot[SAWYER_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
@@ -143,7 +143,7 @@ void sawyer_ik_general_residual(const sawyer_real target[16], const sawyer_real 
 int sawyer_ik_general_limits(const sawyer_real q_solution[SAWYER_DOF], sawyer_real q[SAWYER_DOF]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 7; returned as a scalar. 1973 operations. */
+ * Result: q[i], i < 7; returned as a scalar. 1975 operations. */
 int sawyer_ik_nearest(const sawyer_real T[16], const sawyer_real q_seed[SAWYER_DOF], sawyer_real q_free, const sawyer_real weights[SAWYER_DOF], sawyer_real q[SAWYER_DOF]);
 
 /* Statuses of sawyer_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

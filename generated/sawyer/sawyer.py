@@ -82,7 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -336,7 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi6_rows(xp, count, state):
     """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2 + w4**2 + w5**2
@@ -904,9 +904,9 @@ def _jacobi6_rows(xp, count, state):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _symmetric_solve6(xp, count, state):
-    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    """The solution x of a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
         t0 = w1**2
@@ -1090,65 +1090,143 @@ def _symmetric_solve6(xp, count, state):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
-def _nearer_branch(xp, count, state):
-    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 119 operations a run."""
+def _velocity_solve(xp, count, state):
+    """The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status, `count` times: 1107 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
-        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, = state
-        t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w8))
-        t1 = w1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w1 + w9))
-        t2 = w2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w2 + w10))
-        t3 = w3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w3 + w11))
-        t4 = w4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w4 + w12))
-        t5 = w5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w5 + w13))
-        t6 = xp.where(xp.less(t0, w8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-        t7 = t6 + t0
-        t8 = -t6 + t0
-        t9 = xp.where(xp.greater_equal(t0, -3.0543261909900767) & xp.less_equal(t0, 3.0543261909900767), t0, xp.where(xp.greater_equal(t7, -3.0543261909900767) & xp.less_equal(t7, 3.0543261909900767), t7, xp.where(xp.greater_equal(t8, -3.0543261909900767) & xp.less_equal(t8, 3.0543261909900767), t8, w0)))
-        t10 = xp.where(xp.less(t1, w9), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-        t11 = t10 + t1
-        t12 = -t10 + t1
-        t13 = xp.where(xp.greater_equal(t1, -3.822271061867582) & xp.less_equal(t1, 2.2863813201125716), t1, xp.where(xp.greater_equal(t11, -3.822271061867582) & xp.less_equal(t11, 2.2863813201125716), t11, xp.where(xp.greater_equal(t12, -3.822271061867582) & xp.less_equal(t12, 2.2863813201125716), t12, w1)))
-        t14 = xp.where(xp.less(t2, w10), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-        t15 = t14 + t2
-        t16 = -t14 + t2
-        t17 = xp.where(xp.greater_equal(t2, -3.0543261909900767) & xp.less_equal(t2, 3.0543261909900767), t2, xp.where(xp.greater_equal(t15, -3.0543261909900767) & xp.less_equal(t15, 3.0543261909900767), t15, xp.where(xp.greater_equal(t16, -3.0543261909900767) & xp.less_equal(t16, 3.0543261909900767), t16, w2)))
-        t18 = xp.where(xp.less(t3, w11), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-        t19 = t18 + t3
-        t20 = -t18 + t3
-        t21 = xp.where(xp.greater_equal(t3, -3.0543261909900767) & xp.less_equal(t3, 3.0543261909900767), t3, xp.where(xp.greater_equal(t19, -3.0543261909900767) & xp.less_equal(t19, 3.0543261909900767), t19, xp.where(xp.greater_equal(t20, -3.0543261909900767) & xp.less_equal(t20, 3.0543261909900767), t20, w3)))
-        t22 = xp.where(xp.less(t4, w12), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-        t23 = t22 + t4
-        t24 = -t22 + t4
-        t25 = xp.where(xp.greater_equal(t4, -2.9670597283903604) & xp.less_equal(t4, 2.9670597283903604), t4, xp.where(xp.greater_equal(t23, -2.9670597283903604) & xp.less_equal(t23, 2.9670597283903604), t23, xp.where(xp.greater_equal(t24, -2.9670597283903604) & xp.less_equal(t24, 2.9670597283903604), t24, w4)))
-        t26 = xp.where(xp.less(t5, w13), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-        t27 = t26 + t5
-        t28 = -t26 + t5
-        t29 = xp.where(xp.greater_equal(t5, -2.9670597283903604) & xp.less_equal(t5, 2.9670597283903604), t5, xp.where(xp.greater_equal(t27, -2.9670597283903604) & xp.less_equal(t27, 2.9670597283903604), t27, xp.where(xp.greater_equal(t28, -2.9670597283903604) & xp.less_equal(t28, 2.9670597283903604), t28, w5)))
-        t30 = w15*(-w8 + t9)**2 + w16*(-w9 + t13)**2 + w17*(-w10 + t17)**2 + w18*(-w11 + t21)**2 + w19*(-w12 + t25)**2 + w20*(-w13 + t29)**2 + w21*(-w14 + w6)**2
-        t31 = xp.greater(w7, 0)
-        t32 = xp.where(t31 & (xp.less(w30, 1) | xp.less(t30, w29)), xp.asarray(1, dtype=dtype), 0)
-        t33 = xp.where(t31, 1, w30)
-        t34 = xp.greater(t32, 0)
-        t35 = xp.where(t34, t9, w22)
-        t36 = xp.where(t34, t13, w23)
-        t37 = xp.where(t34, t17, w24)
-        t38 = xp.where(t34, t21, w25)
-        t39 = xp.where(t34, t25, w26)
-        t40 = xp.where(t34, t29, w27)
-        t41 = xp.where(t34, w6, w28)
-        t42 = xp.where(t34, t30, w29)
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, = state
+        t0 = w1*w5
+        t1 = w0*w4
+        t2 = t0 + w2*t1
+        t3 = t1 + w2*t0
+        t4 = w1*w4
+        t5 = w0*w5
+        t6 = t4 - w2*t5
+        t7 = -t5 + w2*t4
+        t8 = w0*w3
+        t9 = t2*w6 + w7*t8
+        t10 = -t2*w7 + w6*t8
+        t11 = t9*w8 - t6*w9
+        t12 = t9*w9 + t6*w8
+        t13 = t10*w10 + t11*w11
+        t14 = 0.1363*t12 + 0.13375*t13
+        t15 = -t14 + 0.4*t10
+        t16 = 0.1685*t6 + t15
+        t17 = -0.4*t8 + t16
+        t18 = -0.1925*w1 + t17
+        t19 = 0.081*w0 + t18
+        t20 = w1*w3
+        t21 = t7*w6 + w7*t20
+        t22 = -t7*w7 + w6*t20
+        t23 = t3*w9 + t21*w8
+        t24 = t3*w8 - t21*w9
+        t25 = t22*w10 + t23*w11
+        t26 = 0.1363*t24 - 0.13375*t25
+        t27 = 0.4*t22 + t26
+        t28 = -0.1685*t3 + t27
+        t29 = -0.4*t20 + t28
+        t30 = 0.1925*w0 + t29
+        t31 = 0.081*w1 + t30
+        t32 = w0*t18 + w1*t30
+        t33 = t17*t20 - t29*t8
+        t34 = t3*t16 + t6*t28
+        t35 = t10*t27 - t22*t15
+        t36 = t24*t14 - t12*t26
+        t37 = t32**2 + t33**2 + t34**2 + t35**2 + t36**2
+        t38 = -(-t32*w22 + t33*w23 + t34*w24 + t35*w25 + t36*w26) + w16
+        t39 = w4*w3
+        t40 = w2*w7 - w6*t39
+        t41 = w2*w6 + w7*t39
+        t42 = w5*w3
+        t43 = t40*w8 - w9*t42
+        t44 = t40*w9 + w8*t42
+        t45 = t41*w10 + t43*w11
+        t46 = 0.1363*t44 + 0.13375*t45
+        t47 = -t46 + 0.4*t41
+        t48 = 0.1685*t42 + t47
+        t49 = -0.4*w2 + t48
+        t50 = t3*t48 + t28*t42
+        t51 = t22*t47 - t41*t27
+        t52 = t44*t26 - t24*t46
+        t53 = -t6*t48 + t16*t42
+        t54 = t41*t15 - t10*t47
+        t55 = t44*t14 - t12*t46
+        t56 = -w2*t33 + t41*t35 - t44*t36 + t42*t34
+        t57 = w2*t8 + t10*t41 + t12*t44 + t13*t45 + t6*t42
+        t58 = w2*t20 + t22*t41 - t24*t44 + t25*t45 - t3*t42
+        t59 = -(w21 - w2*w23 + t41*w25 - t44*w26 - t45*w27 + t42*w24) + w19
+        t60 = w1*t49
+        t61 = w2*t29 - w3*t60
+        t62 = t31 + w2*t61 + t44*t52 + t42*t50 - t41*t51
+        t63 = w0*t49
+        t64 = -w2*t17 + w3*t63
+        t65 = t19 - w2*t64 + t41*t54 - t44*t55 + t42*t53
+        t66 = 1 - t31 - t50 - t32 - t12 - t13 - t3 - t25 - t44 - t45 - t8 - t20 + w5 + w4 + t6 + w3 + w6 + w7 + t10 + t22 + t41 + w8 + w9 + t24 + w10 + w11 + w13 + w12 + t19 + t42 + t60 + t63 + t61 + t51 + t52 + t64 + t53 + t54 + t55 + t33 + t34 + t35 + t36 + 2*w0 + w14 + w15 + w16 + w17 + w18 + w19 + w20 + w21 + w22 + w23 + w24 + w25 + w26 + w27
+        t67 = w0**2
+        t68 = t3*t50 + t22*t51 + t24*t52 + t49*t67 - t20*t61
+        t69 = t49**2
+        t70 = t31**2 + t61**2 + t50**2 + t51**2 + t52**2 + t67*t69
+        t71 = w1*w0
+        t72 = t69*t71 - t19*t31 + t61*t64 - t50*t53 + t51*t54 + t52*t55
+        t73 = w0*t32
+        t74 = -t49*t73 + t61*t33 - t50*t34 + t51*t35 + t52*t36
+        t75 = t73 + t3*t34 + t20*t33 - t22*t35 - t24*t36
+        t76 = t49*t71
+        t77 = t76 + t6*t50 + t12*t52 - t10*t51 + t8*t61
+        t78 = t76 - t3*t53 + t22*t54 + t24*t55 - t20*t64
+        t79 = w1**2
+        t80 = t19**2 + t64**2 + t53**2 + t54**2 + t55**2 + t69*t79
+        t81 = t12*t55 + t8*t64 - t6*t53 - t10*t54 + t49*t79
+        t82 = w1*t32
+        t83 = t64*t33 + t53*t34 + t54*t35 + t55*t36 - t49*t82
+        t84 = t82 + t6*t34 + t10*t35 - t12*t36 - t8*t33
+        t85 = w3**2
+        t86 = t6**2 + t10**2 + t12**2 + t13**2 + t79 + t67*t85
+        t87 = -t71 - t6*t3 + t10*t22 - t12*t24 + t13*t25 + t71*t85
+        t88 = t3**2 + t22**2 + t24**2 + t25**2 + t67 + t79*t85
+        t89 = 1 + w2**2 + t41**2 + t44**2 + t45**2 + w5**2*t85
+        t90 = w0*w22
+        t91 = -(-t31*w21 + t61*w23 - t50*w24 + t51*w25 + t52*w26 + t49*t90) + w14
+        t92 = -(t90 - t3*w24 + t22*w25 + t24*w26 - t25*w27 - t20*w23) + w18
+        t93 = w1*w22
+        t94 = -(t19*w21 + t64*w23 + t53*w24 + t54*w25 + t55*w26 + t49*t93) + w15
+        t95 = t93 + w17 + t12*w26 + t13*w27 + t8*w23 - t6*w24 - t10*w25
+        t96 = w20**2
+        t97 = _symmetric_solve6(xp, 1, (t96 + t70, t72, t74, -t77, t68, -t62, t96 + t80, t83, -t81, t78, t65, t96 + t37, t84, -t75, t56, t96 + t86, t87, t57, t96 + t88, t58, t96 + t89, t91, t94, t38, t95, t92, t59,))
+        t98 = t97[5]
+        t99 = t97[0]
+        t100 = t97[1]
+        t101 = t98 - t31*t99 + t19*t100
+        t102 = w21 + t101
+        t103 = t97[2]
+        t104 = t97[3]
+        t105 = t97[4]
+        t106 = t63*t99 + t60*t100 - t32*t103 - w1*t104 + w0*t105
+        t107 = -w2*t98 + t61*t99 + t64*t100 + t33*t103 - t8*t104 - t20*t105
+        t108 = -t3*t105 - t50*t99 + t53*t100 + t34*t103 + t6*t104 + t42*t98
+        t109 = t41*t98 + t51*t99 + t54*t100 + t35*t103 + t10*t104 + t22*t105
+        t110 = t36*t103 + t52*t99 + t55*t100 - t12*t104 + t24*t105 - t44*t98
+        t111 = t45*t98 + t13*t104 + t25*t105
+        t112 = w22 + t106
+        t113 = w23 + t107
+        t114 = w24 + t108
+        t115 = w25 + t109
+        t116 = w26 + t110
+        t117 = -t111 + w27
+        t118 = xp.isfinite(t66)
+        t119 = xp.greater_equal(w20, 0)
+        t120 = t97[6]
+        t121 = t118 & t119 & xp.less_equal(t120, 0)
         state = (
-            t35,
-            t36,
-            t37,
-            t38,
-            t39,
-            t40,
-            t41,
-            t42,
-            t33,
+            xp.where(t121, t102, 0),
+            xp.where(t121, t112, 0),
+            xp.where(t121, t113, 0),
+            xp.where(t121, t114, 0),
+            xp.where(t121, t115, 0),
+            xp.where(t121, t116, 0),
+            xp.where(t121, t117, 0),
+            xp.where(xp.logical_not(t118 & t119), 2, xp.where(xp.greater(t120, 0), xp.asarray(1, dtype=dtype), 0)),
         )
     return state
 
@@ -4720,17 +4798,9 @@ def condition_number(q):
     return kappa
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (7 x 1 and 1 x 1), 1034 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (7 x 1 and 1 x 1), 1121 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (7,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
-    q7 = q[..., 6]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
@@ -4750,137 +4820,25 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = s1*s3
-    t1 = c1*c3
-    t2 = t0 + c2*t1
-    t3 = t1 + c2*t0
-    t4 = s1*c3
-    t5 = c1*s3
-    t6 = t4 - c2*t5
-    t7 = -t5 + c2*t4
-    t8 = c1*s2
-    t9 = t2*c4 + s4*t8
-    t10 = -t2*s4 + c4*t8
-    t11 = t9*c5 - t6*s5
-    t12 = t9*s5 + t6*c5
-    t13 = t10*c6 + t11*s6
-    t14 = 0.1363*t12 + 0.13375*t13
-    t15 = -t14 + 0.4*t10
-    t16 = 0.1685*t6 + t15
-    t17 = -0.4*t8 + t16
-    t18 = -0.1925*s1 + t17
-    t19 = 0.081*c1 + t18
-    t20 = s1*s2
-    t21 = t7*c4 + s4*t20
-    t22 = -t7*s4 + c4*t20
-    t23 = t3*s5 + t21*c5
-    t24 = t3*c5 - t21*s5
-    t25 = t22*c6 + t23*s6
-    t26 = 0.1363*t24 - 0.13375*t25
-    t27 = 0.4*t22 + t26
-    t28 = -0.1685*t3 + t27
-    t29 = -0.4*t20 + t28
-    t30 = 0.1925*c1 + t29
-    t31 = 0.081*s1 + t30
-    t32 = c1*t18 + s1*t30
-    t33 = t17*t20 - t29*t8
-    t34 = t3*t16 + t6*t28
-    t35 = t10*t27 - t22*t15
-    t36 = t24*t14 - t12*t26
-    t37 = t32**2 + t33**2 + t34**2 + t35**2 + t36**2
-    t38 = c3*s2
-    t39 = c2*s4 - c4*t38
-    t40 = c2*c4 + s4*t38
-    t41 = s3*s2
-    t42 = t39*c5 - s5*t41
-    t43 = t39*s5 + c5*t41
-    t44 = t40*c6 + t42*s6
-    t45 = 0.1363*t43 + 0.13375*t44
-    t46 = -t45 + 0.4*t40
-    t47 = 0.1685*t41 + t46
-    t48 = -0.4*c2 + t47
-    t49 = t3*t47 + t28*t41
-    t50 = t22*t46 - t40*t27
-    t51 = t43*t26 - t24*t45
-    t52 = -t6*t47 + t16*t41
-    t53 = t40*t15 - t10*t46
-    t54 = t43*t14 - t12*t45
-    t55 = -c2*t33 + t40*t35 - t43*t36 + t41*t34
-    t56 = c2*t8 + t10*t40 + t12*t43 + t13*t44 + t6*t41
-    t57 = c2*t20 + t22*t40 - t24*t43 + t25*t44 - t3*t41
-    t58 = s1*t48
-    t59 = c2*t29 - s2*t58
-    t60 = t31 + c2*t59 + t43*t51 + t41*t49 - t40*t50
-    t61 = c1*t48
-    t62 = -c2*t17 + s2*t61
-    t63 = t19 - c2*t62 + t40*t53 - t43*t54 + t41*t52
-    t64 = 1 - t31 - t49 - t32 - s1 - t12 - t13 - t3 - t25 - c2 - t43 - t44 - t8 - t20 + q1 + q2 + c1 + q3 + t6 + q4 + t10 + t22 + t40 + q5 + t24 + q6 + q7 + t19 + t41 + t58 + t61 + t59 + t50 + t51 + t62 + t52 + t53 + t54 + t33 + t34 + t35 + t36 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t65 = c1**2
-    t66 = t3*t49 + t22*t50 + t24*t51 + t48*t65 - t20*t59
-    t67 = t48**2
-    t68 = t31**2 + t59**2 + t49**2 + t50**2 + t51**2 + t65*t67
-    t69 = s1*c1
-    t70 = t67*t69 - t19*t31 + t59*t62 - t49*t52 + t50*t53 + t51*t54
-    t71 = c1*t32
-    t72 = -t48*t71 + t59*t33 - t49*t34 + t50*t35 + t51*t36
-    t73 = t71 + t3*t34 + t20*t33 - t22*t35 - t24*t36
-    t74 = t48*t69
-    t75 = t74 + t6*t49 + t12*t51 - t10*t50 + t8*t59
-    t76 = t74 - t3*t52 + t22*t53 + t24*t54 - t20*t62
-    t77 = s1**2
-    t78 = t19**2 + t62**2 + t52**2 + t53**2 + t54**2 + t67*t77
-    t79 = t12*t54 + t8*t62 - t6*t52 - t10*t53 + t48*t77
-    t80 = s1*t32
-    t81 = t62*t33 + t52*t34 + t53*t35 + t54*t36 - t48*t80
-    t82 = t80 + t6*t34 + t10*t35 - t12*t36 - t8*t33
-    t83 = s2**2
-    t84 = t6**2 + t10**2 + t12**2 + t13**2 + t77 + t65*t83
-    t85 = -t69 - t6*t3 + t10*t22 - t12*t24 + t13*t25 + t69*t83
-    t86 = t3**2 + t22**2 + t24**2 + t25**2 + t65 + t77*t83
-    t87 = 1 + c2**2 + t40**2 + t43**2 + t44**2 + s3**2*t83
-    t88 = damping**2
-    t89 = _symmetric_solve6(xp, 1, (t88 + t68, t70, t72, -t75, t66, -t60, t88 + t78, t81, -t79, t76, t63, t88 + t37, t82, -t73, t55, t88 + t84, t85, t56, t88 + t86, t57, t88 + t87, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
-    t90 = t89[5]
-    t91 = t89[0]
-    t92 = t89[1]
-    t93 = t90 - t31*t91 + t19*t92
-    t94 = t89[2]
-    t95 = t89[3]
-    t96 = t89[4]
-    t97 = c1*t96 + t61*t91 + t58*t92 - t32*t94 - s1*t95
-    t98 = t33*t94 + t91*t59 + t92*t62 - t8*t95 - t20*t96 - c2*t90
-    t99 = t34*t94 - t91*t49 + t92*t52 + t6*t95 - t3*t96 + t41*t90
-    t100 = t91*t50 + t92*t53 + t35*t94 + t10*t95 + t22*t96 + t40*t90
-    t101 = t91*t51 + t92*t54 + t36*t94 - t12*t95 + t24*t96 - t43*t90
-    t102 = t13*t95 + t25*t96 + t44*t90
-    t103 = xp.isfinite(t64)
-    t104 = xp.greater_equal(damping, 0)
-    t105 = t89[6]
-    t106 = t103 & t104 & xp.less_equal(t105, 0)
+    c7 = trig[..., 12]
+    s7 = trig[..., 13]
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, c7, s7, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5, damping, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t106, t93, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t106, t97, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t106, t98, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t106, t99, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t106, t100, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t106, t101, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t106, -t102, 0), batch),  # 6
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
+        xp.broadcast_to(t0[4], batch),  # 4
+        xp.broadcast_to(t0[5], batch),  # 5
+        xp.broadcast_to(t0[6], batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t103 & t104), 2, xp.where(xp.greater(t105, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[7], batch), xp.int32)
     return q_dot, status
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
-    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1116 operations."""
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z, Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1121 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (7,)), ("mu_dot", mu_dot, (6,)), ("z", z, (7,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
-    q7 = q[..., 6]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
@@ -4907,152 +4865,26 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = s1*s3
-    t1 = c1*c3
-    t2 = t0 + c2*t1
-    t3 = t1 + c2*t0
-    t4 = s1*c3
-    t5 = c1*s3
-    t6 = t4 - c2*t5
-    t7 = -t5 + c2*t4
-    t8 = c1*s2
-    t9 = t2*c4 + s4*t8
-    t10 = -t2*s4 + c4*t8
-    t11 = t9*c5 - t6*s5
-    t12 = t9*s5 + t6*c5
-    t13 = t10*c6 + t11*s6
-    t14 = 0.1363*t12 + 0.13375*t13
-    t15 = -t14 + 0.4*t10
-    t16 = 0.1685*t6 + t15
-    t17 = -0.4*t8 + t16
-    t18 = -0.1925*s1 + t17
-    t19 = 0.081*c1 + t18
-    t20 = s1*s2
-    t21 = t7*c4 + s4*t20
-    t22 = -t7*s4 + c4*t20
-    t23 = t3*s5 + t21*c5
-    t24 = t3*c5 - t21*s5
-    t25 = t22*c6 + t23*s6
-    t26 = 0.1363*t24 - 0.13375*t25
-    t27 = 0.4*t22 + t26
-    t28 = -0.1685*t3 + t27
-    t29 = -0.4*t20 + t28
-    t30 = 0.1925*c1 + t29
-    t31 = 0.081*s1 + t30
-    t32 = c1*t18 + s1*t30
-    t33 = t17*t20 - t29*t8
-    t34 = t3*t16 + t6*t28
-    t35 = t10*t27 - t22*t15
-    t36 = t24*t14 - t12*t26
-    t37 = t32**2 + t33**2 + t34**2 + t35**2 + t36**2
-    t38 = -(-t32*qz2 + t33*qz3 + t34*qz4 + t35*qz5 + t36*qz6) + mu_dot2
-    t39 = c3*s2
-    t40 = c2*s4 - c4*t39
-    t41 = c2*c4 + s4*t39
-    t42 = s3*s2
-    t43 = t40*c5 - s5*t42
-    t44 = t40*s5 + c5*t42
-    t45 = t41*c6 + t43*s6
-    t46 = 0.1363*t44 + 0.13375*t45
-    t47 = -t46 + 0.4*t41
-    t48 = 0.1685*t42 + t47
-    t49 = -0.4*c2 + t48
-    t50 = t3*t48 + t28*t42
-    t51 = t22*t47 - t41*t27
-    t52 = t44*t26 - t24*t46
-    t53 = -t6*t48 + t16*t42
-    t54 = t41*t15 - t10*t47
-    t55 = t44*t14 - t12*t46
-    t56 = -c2*t33 + t41*t35 - t44*t36 + t42*t34
-    t57 = c2*t8 + t10*t41 + t12*t44 + t13*t45 + t6*t42
-    t58 = c2*t20 + t22*t41 - t24*t44 + t25*t45 - t3*t42
-    t59 = -(qz1 - c2*qz3 + t41*qz5 - t44*qz6 - t45*qz7 + t42*qz4) + mu_dot5
-    t60 = s1*t49
-    t61 = c2*t29 - s2*t60
-    t62 = t31 + c2*t61 + t44*t52 + t42*t50 - t41*t51
-    t63 = c1*t49
-    t64 = -c2*t17 + s2*t63
-    t65 = t19 - c2*t64 + t41*t54 - t44*t55 + t42*t53
-    t66 = 1 - t31 - t50 - t32 - s1 - t12 - t13 - t3 - t25 - c2 - t44 - t45 - t8 - t20 + q1 + q2 + c1 + q3 + t6 + q4 + t10 + t22 + t41 + q5 + t24 + q6 + q7 + t19 + t42 + t60 + t63 + t61 + t51 + t52 + t64 + t53 + t54 + t55 + t33 + t34 + t35 + t36 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7
-    t67 = c1**2
-    t68 = t3*t50 + t22*t51 + t24*t52 + t49*t67 - t20*t61
-    t69 = t49**2
-    t70 = t31**2 + t61**2 + t50**2 + t51**2 + t52**2 + t67*t69
-    t71 = s1*c1
-    t72 = t69*t71 - t19*t31 + t61*t64 - t50*t53 + t51*t54 + t52*t55
-    t73 = c1*t32
-    t74 = -t49*t73 + t61*t33 - t50*t34 + t51*t35 + t52*t36
-    t75 = t73 + t3*t34 + t20*t33 - t22*t35 - t24*t36
-    t76 = t49*t71
-    t77 = t76 + t6*t50 + t12*t52 - t10*t51 + t8*t61
-    t78 = t76 - t3*t53 + t22*t54 + t24*t55 - t20*t64
-    t79 = s1**2
-    t80 = t19**2 + t64**2 + t53**2 + t54**2 + t55**2 + t69*t79
-    t81 = t12*t55 + t8*t64 - t6*t53 - t10*t54 + t49*t79
-    t82 = s1*t32
-    t83 = t64*t33 + t53*t34 + t54*t35 + t55*t36 - t49*t82
-    t84 = t82 + t6*t34 + t10*t35 - t12*t36 - t8*t33
-    t85 = s2**2
-    t86 = t6**2 + t10**2 + t12**2 + t13**2 + t79 + t67*t85
-    t87 = -t71 - t6*t3 + t10*t22 - t12*t24 + t13*t25 + t71*t85
-    t88 = t3**2 + t22**2 + t24**2 + t25**2 + t67 + t79*t85
-    t89 = 1 + c2**2 + t41**2 + t44**2 + t45**2 + s3**2*t85
-    t90 = c1*qz2
-    t91 = -(-t31*qz1 + t61*qz3 - t50*qz4 + t51*qz5 + t52*qz6 + t49*t90) + mu_dot0
-    t92 = -(t90 - t3*qz4 + t22*qz5 + t24*qz6 - t25*qz7 - t20*qz3) + mu_dot4
-    t93 = s1*qz2
-    t94 = -(t19*qz1 + t64*qz3 + t53*qz4 + t54*qz5 + t55*qz6 + t49*t93) + mu_dot1
-    t95 = t93 + mu_dot3 + t12*qz6 + t13*qz7 + t8*qz3 - t6*qz4 - t10*qz5
-    t96 = damping**2
-    t97 = _symmetric_solve6(xp, 1, (t96 + t70, t72, t74, -t77, t68, -t62, t96 + t80, t83, -t81, t78, t65, t96 + t37, t84, -t75, t56, t96 + t86, t87, t57, t96 + t88, t58, t96 + t89, t91, t94, t38, t95, t92, t59,))
-    t98 = t97[5]
-    t99 = t97[0]
-    t100 = t97[1]
-    t101 = t98 - t31*t99 + t19*t100
-    t102 = qz1 + t101
-    t103 = t97[2]
-    t104 = t97[3]
-    t105 = t97[4]
-    t106 = t63*t99 + t60*t100 - t32*t103 - s1*t104 + c1*t105
-    t107 = -c2*t98 + t61*t99 + t64*t100 + t33*t103 - t8*t104 - t20*t105
-    t108 = -t3*t105 - t50*t99 + t53*t100 + t34*t103 + t6*t104 + t42*t98
-    t109 = t41*t98 + t51*t99 + t54*t100 + t35*t103 + t10*t104 + t22*t105
-    t110 = t36*t103 + t52*t99 + t55*t100 - t12*t104 + t24*t105 - t44*t98
-    t111 = t45*t98 + t13*t104 + t25*t105
-    t112 = qz2 + t106
-    t113 = qz3 + t107
-    t114 = qz4 + t108
-    t115 = qz5 + t109
-    t116 = qz6 + t110
-    t117 = -t111 + qz7
-    t118 = xp.isfinite(t66)
-    t119 = xp.greater_equal(damping, 0)
-    t120 = t97[6]
-    t121 = t118 & t119 & xp.less_equal(t120, 0)
+    c7 = trig[..., 12]
+    s7 = trig[..., 13]
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, c7, s7, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5, damping, qz1, qz2, qz3, qz4, qz5, qz6, qz7,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t121, t102, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t121, t112, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t121, t113, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t121, t114, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t121, t115, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t121, t116, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t121, t117, 0), batch),  # 6
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
+        xp.broadcast_to(t0[4], batch),  # 4
+        xp.broadcast_to(t0[5], batch),  # 5
+        xp.broadcast_to(t0[6], batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t118 & t119), 2, xp.where(xp.greater(t120, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[7], batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1278 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (7 x 1 and 1 x 1), 1376 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (7,)), ("target", target, (4, 4)), ("target_rate", target_rate, (6,)), ("gain", gain, (6,)), ("z", z, (7,)), ("damping", damping, ()), every=("gain", ))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
-    q7 = q[..., 6]
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
     T02 = target[..., 0, 2]
@@ -5141,142 +4973,63 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t39 = -0.4*t27 + t38
     t40 = 0.1925*c1 + t39
     t41 = 0.081*s1 + t40
-    t42 = c1*t21 + s1*t40
-    t43 = t20*t27 - t39*t8
-    t44 = t3*t19 + t6*t38
-    t45 = t10*t37 - t29*t18
-    t46 = t31*t17 - t12*t36
-    t47 = t42**2 + t43**2 + t44**2 + t45**2 + t46**2
-    t48 = t35*T01 + t33*T02 - t34*T00
-    t49 = t35*T11 + t33*T12 - t34*T10
-    t50 = t35*T21 + t33*T22 - t34*T20
-    t51 = 0.5*(t48 + t24)
-    t52 = c3*s2
-    t53 = c2*s4 - c4*t52
-    t54 = c2*c4 + s4*t52
-    t55 = s3*s2
-    t56 = t53*c5 - s5*t55
-    t57 = t53*s5 + c5*t55
-    t58 = t56*c6 - t54*s6
-    t59 = t54*c6 + t56*s6
-    t60 = t57*s7 + t58*c7
-    t61 = t57*c7 - t58*s7
-    t62 = 0.1363*t57 + 0.13375*t59
-    t63 = -t62 + 0.4*t54
-    t64 = 0.1685*t55 + t63
-    t65 = -0.4*c2 + t64
-    t66 = 0.317 + t65
-    t67 = t3*t64 + t38*t55
-    t68 = t29*t63 - t54*t37
-    t69 = t57*t36 - t31*t62
-    t70 = -t6*t64 + t19*t55
-    t71 = t54*t18 - t10*t63
-    t72 = t57*t17 - t12*t62
-    t73 = -c2*t43 + t54*t45 - t57*t46 + t55*t44
-    t74 = c2*t8 + t10*t54 + t12*t57 + t14*t59 + t6*t55
-    t75 = c2*t27 + t29*t54 - t31*t57 + t33*t59 - t3*t55
-    t76 = t60*T00 + t61*T01 - t59*T02
-    t77 = t60*T10 + t61*T11 - t59*T12
-    t78 = t60*T20 + t61*T21 - t59*T22
-    t79 = -0.5*(t50 + t77)
-    t80 = 0.5*(-t25 + t76)
-    t81 = xp.sqrt(t79**2 + t80**2 + t51**2)
-    t82 = mu_dot2 + gain2*(-t66 + T23)
-    t83 = -(-t42*qz2 + t43*qz3 + t44*qz4 + t45*qz5 + t46*qz6) + t82
-    t84 = s1*t65
-    t85 = c2*t39 - s2*t84
-    t86 = t41 + c2*t85 + t57*t69 + t55*t67 - t54*t68
-    t87 = c1*t65
-    t88 = -c2*t20 + s2*t87
-    t89 = t22 - c2*t88 + t54*t71 - t57*t72 + t55*t70
-    t90 = c1**2
-    t91 = t3*t67 + t29*t68 + t31*t69 + t65*t90 - t27*t85
-    t92 = t65**2
-    t93 = t41**2 + t85**2 + t67**2 + t68**2 + t69**2 + t90*t92
-    t94 = s1*c1
-    t95 = t92*t94 - t22*t41 + t85*t88 - t67*t70 + t68*t71 + t69*t72
-    t96 = c1*t42
-    t97 = -t65*t96 + t85*t43 - t67*t44 + t68*t45 + t69*t46
-    t98 = t96 + t3*t44 + t27*t43 - t29*t45 - t31*t46
-    t99 = t65*t94
-    t100 = t99 + t6*t67 + t12*t69 - t10*t68 + t8*t85
-    t101 = t99 - t3*t70 + t29*t71 + t31*t72 - t27*t88
-    t102 = s1**2
-    t103 = t22**2 + t88**2 + t70**2 + t71**2 + t72**2 + t92*t102
-    t104 = t12*t72 + t8*t88 - t6*t70 - t10*t71 + t65*t102
-    t105 = s1*t42
-    t106 = t88*t43 + t70*t44 + t71*t45 + t72*t46 - t65*t105
-    t107 = t105 + t6*t44 + t10*t45 - t12*t46 - t8*t43
-    t108 = s2**2
-    t109 = t6**2 + t10**2 + t12**2 + t14**2 + t102 + t90*t108
-    t110 = -t94 - t6*t3 + t10*t29 - t12*t31 + t14*t33 + t94*t108
-    t111 = t3**2 + t29**2 + t31**2 + t33**2 + t90 + t102*t108
-    t112 = 1 + c2**2 + t54**2 + t57**2 + t59**2 + s3**2*t108
-    t113 = -t49
-    t114 = 0.5*(-1 + t113 + t23 + t78)
-    t115 = xp.atan2(t81, t114)
-    t116 = xp.where(xp.greater(t81, 0), t115/t81, 1)
-    t117 = xp.greater_equal(t23, t113) & xp.greater_equal(t23, t78)
-    t118 = xp.greater_equal(t113, t78)
-    t119 = xp.where(t117, 0.5*(1 + t23), xp.where(t118, -0.5*t48, 0.5*t76))
-    t120 = xp.where(t117, 0.5*t24, xp.where(t118, 0.5*(1 + t113), 0.5*t77))
-    t121 = xp.where(t117, 0.5*t25, xp.where(t118, -0.5*t50, 0.5*(1 + t78)))
-    t122 = xp.sqrt(t119**2 + t120**2 + t121**2)
-    t123 = xp.where(xp.greater_equal(t79*t119 + t80*t120 + t51*t121, 0), xp.asarray(1, dtype=dtype), -1)
-    t124 = xp.greater(t81, 1e-06) | xp.greater(t114, 0)
-    t125 = t115*t123/t122
-    t126 = xp.where(t124, t79*t116, t125*t119)
-    t127 = xp.where(t124, t80*t116, t125*t120)
-    t128 = xp.where(t124, t51*t116, t125*t121)
-    t129 = mu_dot3 + t126*gain3
-    t130 = mu_dot4 + t127*gain4
-    t131 = mu_dot5 + t128*gain5
-    t132 = -(qz1 - c2*qz3 + t54*qz5 - t57*qz6 - t59*qz7 + t55*qz4) + t131
-    t133 = -t41
-    t134 = mu_dot1 + gain1*(t133 + T13)
-    t135 = 1 - t67 - t42 - s1 - t12 - t14 - t3 - t33 - c2 - t57 - t59 - t8 - t27 + q1 + q2 + c1 + q3 + t6 + q4 + t10 + t29 + t54 + q5 + t31 + q6 + q7 + t22 + t55 + t84 + t87 + t85 + t68 + t69 + t88 + t70 + t71 + t72 + t43 + t44 + t45 + t46 + t133 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + qz7 + t26 + t134 + t82 + t129 + t130 + t131
-    t136 = c1*qz2
-    t137 = -(t65*t136 - t41*qz1 + t85*qz3 - t67*qz4 + t68*qz5 + t69*qz6) + t26
-    t138 = -(t136 - t3*qz4 + t29*qz5 + t31*qz6 - t33*qz7 - t27*qz3) + t130
-    t139 = s1*qz2
-    t140 = -(t65*t139 + t22*qz1 + t88*qz3 + t70*qz4 + t71*qz5 + t72*qz6) + t134
-    t141 = t139 + t12*qz6 + t14*qz7 + t8*qz3 - t6*qz4 - t10*qz5 + t129
-    t142 = damping**2
-    t143 = _symmetric_solve6(xp, 1, (t142 + t93, t95, t97, -t100, t91, -t86, t142 + t103, t106, -t104, t101, t89, t142 + t47, t107, -t98, t73, t142 + t109, t110, t74, t142 + t111, t75, t142 + t112, t137, t140, t83, t141, t138, t132,))
-    t144 = t143[5]
-    t145 = t143[0]
-    t146 = t143[1]
-    t147 = t144 - t41*t145 + t22*t146
-    t148 = qz1 + t147
-    t149 = t143[2]
-    t150 = t143[3]
-    t151 = t143[4]
-    t152 = t87*t145 + t84*t146 - t42*t149 - s1*t150 + c1*t151
-    t153 = t85*t145 + t88*t146 + t43*t149 - t8*t150 - t27*t151 - c2*t144
-    t154 = t44*t149 - t67*t145 + t70*t146 + t6*t150 - t3*t151 + t55*t144
-    t155 = t45*t149 + t54*t144 + t68*t145 + t71*t146 + t10*t150 + t29*t151
-    t156 = t69*t145 + t72*t146 + t46*t149 - t12*t150 + t31*t151 - t57*t144
-    t157 = t14*t150 + t33*t151 + t59*t144
-    t158 = qz2 + t152
-    t159 = qz3 + t153
-    t160 = qz4 + t154
-    t161 = qz5 + t155
-    t162 = qz6 + t156
-    t163 = -t157 + qz7
-    t164 = xp.isfinite(t135)
-    t165 = xp.greater_equal(damping, 0)
-    t166 = t143[6]
-    t167 = t164 & t165 & xp.less_equal(t166, 0)
+    t42 = t35*T01 + t33*T02 - t34*T00
+    t43 = t35*T11 + t33*T12 - t34*T10
+    t44 = t35*T21 + t33*T22 - t34*T20
+    t45 = 0.5*(t42 + t24)
+    t46 = mu_dot1 + gain1*(-t41 + T13)
+    t47 = c3*s2
+    t48 = c2*s4 - c4*t47
+    t49 = c2*c4 + s4*t47
+    t50 = s3*s2
+    t51 = t48*c5 - s5*t50
+    t52 = t48*s5 + c5*t50
+    t53 = t51*c6 - t49*s6
+    t54 = t49*c6 + t51*s6
+    t55 = t52*s7 + t53*c7
+    t56 = t52*c7 - t53*s7
+    t57 = 0.1363*t52 + 0.13375*t54
+    t58 = -t57 + 0.4*t49
+    t59 = 0.1685*t50 + t58
+    t60 = -0.4*c2 + t59
+    t61 = 0.317 + t60
+    t62 = t55*T00 + t56*T01 - t54*T02
+    t63 = t55*T10 + t56*T11 - t54*T12
+    t64 = t55*T20 + t56*T21 - t54*T22
+    t65 = -0.5*(t44 + t63)
+    t66 = 0.5*(-t25 + t62)
+    t67 = xp.sqrt(t65**2 + t66**2 + t45**2)
+    t68 = mu_dot2 + gain2*(-t61 + T23)
+    t69 = -t43
+    t70 = 0.5*(-1 + t69 + t23 + t64)
+    t71 = xp.atan2(t67, t70)
+    t72 = xp.where(xp.greater(t67, 0), t71/t67, 1)
+    t73 = xp.greater_equal(t23, t69) & xp.greater_equal(t23, t64)
+    t74 = xp.greater_equal(t69, t64)
+    t75 = xp.where(t73, 0.5*(1 + t23), xp.where(t74, -0.5*t42, 0.5*t62))
+    t76 = xp.where(t73, 0.5*t24, xp.where(t74, 0.5*(1 + t69), 0.5*t63))
+    t77 = xp.where(t73, 0.5*t25, xp.where(t74, -0.5*t44, 0.5*(1 + t64)))
+    t78 = xp.sqrt(t75**2 + t76**2 + t77**2)
+    t79 = xp.where(xp.greater_equal(t65*t75 + t66*t76 + t45*t77, 0), xp.asarray(1, dtype=dtype), -1)
+    t80 = xp.greater(t67, 1e-06) | xp.greater(t70, 0)
+    t81 = t71*t79/t78
+    t82 = xp.where(t80, t65*t72, t81*t75)
+    t83 = xp.where(t80, t66*t72, t81*t76)
+    t84 = xp.where(t80, t45*t72, t81*t77)
+    t85 = mu_dot3 + t82*gain3
+    t86 = mu_dot4 + t83*gain4
+    t87 = mu_dot5 + t84*gain5
+    t88 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, c7, s7, t26, t46, t68, t85, t86, t87, damping, qz1, qz2, qz3, qz4, qz5, qz6, qz7,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t167, t148, 0), batch),  # 0
-        xp.broadcast_to(xp.where(t167, t158, 0), batch),  # 1
-        xp.broadcast_to(xp.where(t167, t159, 0), batch),  # 2
-        xp.broadcast_to(xp.where(t167, t160, 0), batch),  # 3
-        xp.broadcast_to(xp.where(t167, t161, 0), batch),  # 4
-        xp.broadcast_to(xp.where(t167, t162, 0), batch),  # 5
-        xp.broadcast_to(xp.where(t167, t163, 0), batch),  # 6
+        xp.broadcast_to(t88[0], batch),  # 0
+        xp.broadcast_to(t88[1], batch),  # 1
+        xp.broadcast_to(t88[2], batch),  # 2
+        xp.broadcast_to(t88[3], batch),  # 3
+        xp.broadcast_to(t88[4], batch),  # 4
+        xp.broadcast_to(t88[5], batch),  # 5
+        xp.broadcast_to(t88[6], batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t164 & t165), 2, xp.where(xp.greater(t166, 0), xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t88[7], batch), xp.int32)
     return q_dot, status
 
 
@@ -6400,7 +6153,7 @@ def ik_general_limits(q_solution):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (7 x 1 and 1 x 1), 1973 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (7 x 1 and 1 x 1), 1975 operations."""
     xp, dtype, device, batch, (T, q_seed, q_free, weights,) = _arguments(("T", T, (4, 4)), ("q_seed", q_seed, (7,)), ("q_free", q_free, ()), ("weights", weights, (7,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(T, q_free)
     T00 = T[..., 0, 0]
@@ -6573,36 +6326,712 @@ def ik_nearest(T, q_seed, q_free, weights=(1.0,) * DOF):
     lb13 = branches_in_limits[..., 13]
     lb14 = branches_in_limits[..., 14]
     lb15 = branches_in_limits[..., 15]
-    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7
-    t1 = _nearer_branch(xp, 1, (qb0_0, qb0_1, qb0_2, qb0_3, qb0_4, qb0_5, qb0_6, xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, qn1, qn2, qn3, qn4, qn5, qn6, qn7, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
-    t2 = _nearer_branch(xp, 1, (qb1_0, qb1_1, qb1_2, qb1_3, qb1_4, qb1_5, qb1_6, xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t1[0], t1[1], t1[2], t1[3], t1[4], t1[5], t1[6], t1[7], t1[8],))
-    t3 = _nearer_branch(xp, 1, (qb2_0, qb2_1, qb2_2, qb2_3, qb2_4, qb2_5, qb2_6, xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t2[0], t2[1], t2[2], t2[3], t2[4], t2[5], t2[6], t2[7], t2[8],))
-    t4 = _nearer_branch(xp, 1, (qb3_0, qb3_1, qb3_2, qb3_3, qb3_4, qb3_5, qb3_6, xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t3[0], t3[1], t3[2], t3[3], t3[4], t3[5], t3[6], t3[7], t3[8],))
-    t5 = _nearer_branch(xp, 1, (qb4_0, qb4_1, qb4_2, qb4_3, qb4_4, qb4_5, qb4_6, xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t4[0], t4[1], t4[2], t4[3], t4[4], t4[5], t4[6], t4[7], t4[8],))
-    t6 = _nearer_branch(xp, 1, (qb5_0, qb5_1, qb5_2, qb5_3, qb5_4, qb5_5, qb5_6, xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t5[0], t5[1], t5[2], t5[3], t5[4], t5[5], t5[6], t5[7], t5[8],))
-    t7 = _nearer_branch(xp, 1, (qb6_0, qb6_1, qb6_2, qb6_3, qb6_4, qb6_5, qb6_6, xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t6[0], t6[1], t6[2], t6[3], t6[4], t6[5], t6[6], t6[7], t6[8],))
-    t8 = _nearer_branch(xp, 1, (qb7_0, qb7_1, qb7_2, qb7_3, qb7_4, qb7_5, qb7_6, xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t7[0], t7[1], t7[2], t7[3], t7[4], t7[5], t7[6], t7[7], t7[8],))
-    t9 = _nearer_branch(xp, 1, (qb8_0, qb8_1, qb8_2, qb8_3, qb8_4, qb8_5, qb8_6, xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t8[0], t8[1], t8[2], t8[3], t8[4], t8[5], t8[6], t8[7], t8[8],))
-    t10 = _nearer_branch(xp, 1, (qb9_0, qb9_1, qb9_2, qb9_3, qb9_4, qb9_5, qb9_6, xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t9[0], t9[1], t9[2], t9[3], t9[4], t9[5], t9[6], t9[7], t9[8],))
-    t11 = _nearer_branch(xp, 1, (qb10_0, qb10_1, qb10_2, qb10_3, qb10_4, qb10_5, qb10_6, xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t10[0], t10[1], t10[2], t10[3], t10[4], t10[5], t10[6], t10[7], t10[8],))
-    t12 = _nearer_branch(xp, 1, (qb11_0, qb11_1, qb11_2, qb11_3, qb11_4, qb11_5, qb11_6, xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t11[0], t11[1], t11[2], t11[3], t11[4], t11[5], t11[6], t11[7], t11[8],))
-    t13 = _nearer_branch(xp, 1, (qb12_0, qb12_1, qb12_2, qb12_3, qb12_4, qb12_5, qb12_6, xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t12[0], t12[1], t12[2], t12[3], t12[4], t12[5], t12[6], t12[7], t12[8],))
-    t14 = _nearer_branch(xp, 1, (qb13_0, qb13_1, qb13_2, qb13_3, qb13_4, qb13_5, qb13_6, xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t13[0], t13[1], t13[2], t13[3], t13[4], t13[5], t13[6], t13[7], t13[8],))
-    t15 = _nearer_branch(xp, 1, (qb14_0, qb14_1, qb14_2, qb14_3, qb14_4, qb14_5, qb14_6, xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t14[0], t14[1], t14[2], t14[3], t14[4], t14[5], t14[6], t14[7], t14[8],))
-    t16 = _nearer_branch(xp, 1, (qb15_0, qb15_1, qb15_2, qb15_3, qb15_4, qb15_5, qb15_6, xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qn7, qw1, qw2, qw3, qw4, qw5, qw6, qw7, t15[0], t15[1], t15[2], t15[3], t15[4], t15[5], t15[6], t15[7], t15[8],))
-    t17 = xp.greater(t16[8], 0)
-    t18 = xp.isfinite(t0)
-    t19 = t17 & t18
+    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
+    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
+    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
+    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
+    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
+    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
+    t6 = xp.where(xp.greater(xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), 0), xp.asarray(1, dtype=dtype), 0)
+    t7 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
+    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
+    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
+    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
+    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
+    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
+    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
+    t14 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
+    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
+    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
+    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
+    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
+    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
+    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
+    t21 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
+    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
+    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
+    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
+    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
+    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
+    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
+    t28 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
+    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
+    t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
+    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
+    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
+    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
+    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
+    t35 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
+    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
+    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
+    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
+    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
+    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
+    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
+    t42 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
+    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
+    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
+    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
+    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
+    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
+    t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
+    t49 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_0 + qn1)) + qb8_0
+    t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_1 + qn2)) + qb8_1
+    t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_2 + qn3)) + qb8_2
+    t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_3 + qn4)) + qb8_3
+    t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_4 + qn5)) + qb8_4
+    t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_5 + qn6)) + qb8_5
+    t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_0 + qn1)) + qb9_0
+    t56 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_1 + qn2)) + qb9_1
+    t57 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_2 + qn3)) + qb9_2
+    t58 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_3 + qn4)) + qb9_3
+    t59 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_4 + qn5)) + qb9_4
+    t60 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_5 + qn6)) + qb9_5
+    t61 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_0 + qn1)) + qb10_0
+    t62 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_1 + qn2)) + qb10_1
+    t63 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_2 + qn3)) + qb10_2
+    t64 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_3 + qn4)) + qb10_3
+    t65 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_4 + qn5)) + qb10_4
+    t66 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_5 + qn6)) + qb10_5
+    t67 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_0 + qn1)) + qb11_0
+    t68 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_1 + qn2)) + qb11_1
+    t69 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_2 + qn3)) + qb11_2
+    t70 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_3 + qn4)) + qb11_3
+    t71 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_4 + qn5)) + qb11_4
+    t72 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_5 + qn6)) + qb11_5
+    t73 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_0 + qn1)) + qb12_0
+    t74 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_1 + qn2)) + qb12_1
+    t75 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_2 + qn3)) + qb12_2
+    t76 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_3 + qn4)) + qb12_3
+    t77 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_4 + qn5)) + qb12_4
+    t78 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_5 + qn6)) + qb12_5
+    t79 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_0 + qn1)) + qb13_0
+    t80 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_1 + qn2)) + qb13_1
+    t81 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_2 + qn3)) + qb13_2
+    t82 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_3 + qn4)) + qb13_3
+    t83 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_4 + qn5)) + qb13_4
+    t84 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_5 + qn6)) + qb13_5
+    t85 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_0 + qn1)) + qb14_0
+    t86 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_1 + qn2)) + qb14_1
+    t87 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_2 + qn3)) + qb14_2
+    t88 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_3 + qn4)) + qb14_3
+    t89 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_4 + qn5)) + qb14_4
+    t90 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_5 + qn6)) + qb14_5
+    t91 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_0 + qn1)) + qb15_0
+    t92 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_1 + qn2)) + qb15_1
+    t93 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_2 + qn3)) + qb15_2
+    t94 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_3 + qn4)) + qb15_3
+    t95 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_4 + qn5)) + qb15_4
+    t96 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_5 + qn6)) + qb15_5
+    t97 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qn7 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6 + qw7
+    t98 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t99 = t98 + t0
+    t100 = -t98 + t0
+    t101 = xp.where(xp.greater_equal(t0, -3.0543261909900767) & xp.less_equal(t0, 3.0543261909900767), t0, xp.where(xp.greater_equal(t99, -3.0543261909900767) & xp.less_equal(t99, 3.0543261909900767), t99, xp.where(xp.greater_equal(t100, -3.0543261909900767) & xp.less_equal(t100, 3.0543261909900767), t100, qb0_0)))
+    t102 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t103 = t102 + t1
+    t104 = -t102 + t1
+    t105 = xp.where(xp.greater_equal(t1, -3.822271061867582) & xp.less_equal(t1, 2.2863813201125716), t1, xp.where(xp.greater_equal(t103, -3.822271061867582) & xp.less_equal(t103, 2.2863813201125716), t103, xp.where(xp.greater_equal(t104, -3.822271061867582) & xp.less_equal(t104, 2.2863813201125716), t104, qb0_1)))
+    t106 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t107 = t106 + t2
+    t108 = -t106 + t2
+    t109 = xp.where(xp.greater_equal(t2, -3.0543261909900767) & xp.less_equal(t2, 3.0543261909900767), t2, xp.where(xp.greater_equal(t107, -3.0543261909900767) & xp.less_equal(t107, 3.0543261909900767), t107, xp.where(xp.greater_equal(t108, -3.0543261909900767) & xp.less_equal(t108, 3.0543261909900767), t108, qb0_2)))
+    t110 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t111 = t110 + t3
+    t112 = -t110 + t3
+    t113 = xp.where(xp.greater_equal(t3, -3.0543261909900767) & xp.less_equal(t3, 3.0543261909900767), t3, xp.where(xp.greater_equal(t111, -3.0543261909900767) & xp.less_equal(t111, 3.0543261909900767), t111, xp.where(xp.greater_equal(t112, -3.0543261909900767) & xp.less_equal(t112, 3.0543261909900767), t112, qb0_3)))
+    t114 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t115 = t114 + t4
+    t116 = -t114 + t4
+    t117 = xp.where(xp.greater_equal(t4, -2.9670597283903604) & xp.less_equal(t4, 2.9670597283903604), t4, xp.where(xp.greater_equal(t115, -2.9670597283903604) & xp.less_equal(t115, 2.9670597283903604), t115, xp.where(xp.greater_equal(t116, -2.9670597283903604) & xp.less_equal(t116, 2.9670597283903604), t116, qb0_4)))
+    t118 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t119 = t118 + t5
+    t120 = -t118 + t5
+    t121 = xp.where(xp.greater_equal(t5, -2.9670597283903604) & xp.less_equal(t5, 2.9670597283903604), t5, xp.where(xp.greater_equal(t119, -2.9670597283903604) & xp.less_equal(t119, 2.9670597283903604), t119, xp.where(xp.greater_equal(t120, -2.9670597283903604) & xp.less_equal(t120, 2.9670597283903604), t120, qb0_5)))
+    t122 = -qn1
+    t123 = -qn2
+    t124 = -qn3
+    t125 = -qn4
+    t126 = -qn5
+    t127 = -qn6
+    t128 = -qn7
+    t129 = qw1*(t122 + t101)**2 + qw2*(t123 + t105)**2 + qw3*(t124 + t109)**2 + qw4*(t125 + t113)**2 + qw5*(t126 + t117)**2 + qw6*(t127 + t121)**2 + qw7*(t128 + qb0_6)**2
+    t130 = xp.greater(t6, 0)
+    t131 = xp.where(t130, t101, qn1)
+    t132 = xp.where(t130, t105, qn2)
+    t133 = xp.where(t130, t109, qn3)
+    t134 = xp.where(t130, t113, qn4)
+    t135 = xp.where(t130, t117, qn5)
+    t136 = xp.where(t130, t121, qn6)
+    t137 = xp.where(t130, qb0_6, qn7)
+    t138 = xp.where(t130, t129, 0)
+    t139 = xp.where(xp.less(t7, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t140 = t139 + t7
+    t141 = -t139 + t7
+    t142 = xp.where(xp.greater_equal(t7, -3.0543261909900767) & xp.less_equal(t7, 3.0543261909900767), t7, xp.where(xp.greater_equal(t140, -3.0543261909900767) & xp.less_equal(t140, 3.0543261909900767), t140, xp.where(xp.greater_equal(t141, -3.0543261909900767) & xp.less_equal(t141, 3.0543261909900767), t141, qb1_0)))
+    t143 = xp.where(xp.less(t8, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t144 = t143 + t8
+    t145 = -t143 + t8
+    t146 = xp.where(xp.greater_equal(t8, -3.822271061867582) & xp.less_equal(t8, 2.2863813201125716), t8, xp.where(xp.greater_equal(t144, -3.822271061867582) & xp.less_equal(t144, 2.2863813201125716), t144, xp.where(xp.greater_equal(t145, -3.822271061867582) & xp.less_equal(t145, 2.2863813201125716), t145, qb1_1)))
+    t147 = xp.where(xp.less(t9, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t148 = t147 + t9
+    t149 = -t147 + t9
+    t150 = xp.where(xp.greater_equal(t9, -3.0543261909900767) & xp.less_equal(t9, 3.0543261909900767), t9, xp.where(xp.greater_equal(t148, -3.0543261909900767) & xp.less_equal(t148, 3.0543261909900767), t148, xp.where(xp.greater_equal(t149, -3.0543261909900767) & xp.less_equal(t149, 3.0543261909900767), t149, qb1_2)))
+    t151 = xp.where(xp.less(t10, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t152 = t151 + t10
+    t153 = -t151 + t10
+    t154 = xp.where(xp.greater_equal(t10, -3.0543261909900767) & xp.less_equal(t10, 3.0543261909900767), t10, xp.where(xp.greater_equal(t152, -3.0543261909900767) & xp.less_equal(t152, 3.0543261909900767), t152, xp.where(xp.greater_equal(t153, -3.0543261909900767) & xp.less_equal(t153, 3.0543261909900767), t153, qb1_3)))
+    t155 = xp.where(xp.less(t11, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t156 = t155 + t11
+    t157 = -t155 + t11
+    t158 = xp.where(xp.greater_equal(t11, -2.9670597283903604) & xp.less_equal(t11, 2.9670597283903604), t11, xp.where(xp.greater_equal(t156, -2.9670597283903604) & xp.less_equal(t156, 2.9670597283903604), t156, xp.where(xp.greater_equal(t157, -2.9670597283903604) & xp.less_equal(t157, 2.9670597283903604), t157, qb1_4)))
+    t159 = xp.where(xp.less(t12, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t160 = t159 + t12
+    t161 = -t159 + t12
+    t162 = xp.where(xp.greater_equal(t12, -2.9670597283903604) & xp.less_equal(t12, 2.9670597283903604), t12, xp.where(xp.greater_equal(t160, -2.9670597283903604) & xp.less_equal(t160, 2.9670597283903604), t160, xp.where(xp.greater_equal(t161, -2.9670597283903604) & xp.less_equal(t161, 2.9670597283903604), t161, qb1_5)))
+    t163 = qw1*(t122 + t142)**2 + qw2*(t123 + t146)**2 + qw3*(t124 + t150)**2 + qw4*(t125 + t154)**2 + qw5*(t126 + t158)**2 + qw6*(t127 + t162)**2 + qw7*(t128 + qb1_6)**2
+    t164 = xp.greater(xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), 0)
+    t165 = xp.where(t164 & (xp.less(t6, 1) | xp.less(t163, t138)), xp.asarray(1, dtype=dtype), 0)
+    t166 = xp.where(t164, 1, t6)
+    t167 = xp.greater(t165, 0)
+    t168 = xp.where(t167, t142, t131)
+    t169 = xp.where(t167, t146, t132)
+    t170 = xp.where(t167, t150, t133)
+    t171 = xp.where(t167, t154, t134)
+    t172 = xp.where(t167, t158, t135)
+    t173 = xp.where(t167, t162, t136)
+    t174 = xp.where(t167, qb1_6, t137)
+    t175 = xp.where(t167, t163, t138)
+    t176 = xp.where(xp.less(t13, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t177 = t176 + t13
+    t178 = -t176 + t13
+    t179 = xp.where(xp.greater_equal(t13, -3.0543261909900767) & xp.less_equal(t13, 3.0543261909900767), t13, xp.where(xp.greater_equal(t177, -3.0543261909900767) & xp.less_equal(t177, 3.0543261909900767), t177, xp.where(xp.greater_equal(t178, -3.0543261909900767) & xp.less_equal(t178, 3.0543261909900767), t178, qb2_0)))
+    t180 = xp.where(xp.less(t14, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t181 = t180 + t14
+    t182 = -t180 + t14
+    t183 = xp.where(xp.greater_equal(t14, -3.822271061867582) & xp.less_equal(t14, 2.2863813201125716), t14, xp.where(xp.greater_equal(t181, -3.822271061867582) & xp.less_equal(t181, 2.2863813201125716), t181, xp.where(xp.greater_equal(t182, -3.822271061867582) & xp.less_equal(t182, 2.2863813201125716), t182, qb2_1)))
+    t184 = xp.where(xp.less(t15, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t185 = t184 + t15
+    t186 = -t184 + t15
+    t187 = xp.where(xp.greater_equal(t15, -3.0543261909900767) & xp.less_equal(t15, 3.0543261909900767), t15, xp.where(xp.greater_equal(t185, -3.0543261909900767) & xp.less_equal(t185, 3.0543261909900767), t185, xp.where(xp.greater_equal(t186, -3.0543261909900767) & xp.less_equal(t186, 3.0543261909900767), t186, qb2_2)))
+    t188 = xp.where(xp.less(t16, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t189 = t188 + t16
+    t190 = -t188 + t16
+    t191 = xp.where(xp.greater_equal(t16, -3.0543261909900767) & xp.less_equal(t16, 3.0543261909900767), t16, xp.where(xp.greater_equal(t189, -3.0543261909900767) & xp.less_equal(t189, 3.0543261909900767), t189, xp.where(xp.greater_equal(t190, -3.0543261909900767) & xp.less_equal(t190, 3.0543261909900767), t190, qb2_3)))
+    t192 = xp.where(xp.less(t17, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t193 = t192 + t17
+    t194 = -t192 + t17
+    t195 = xp.where(xp.greater_equal(t17, -2.9670597283903604) & xp.less_equal(t17, 2.9670597283903604), t17, xp.where(xp.greater_equal(t193, -2.9670597283903604) & xp.less_equal(t193, 2.9670597283903604), t193, xp.where(xp.greater_equal(t194, -2.9670597283903604) & xp.less_equal(t194, 2.9670597283903604), t194, qb2_4)))
+    t196 = xp.where(xp.less(t18, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t197 = t196 + t18
+    t198 = -t196 + t18
+    t199 = xp.where(xp.greater_equal(t18, -2.9670597283903604) & xp.less_equal(t18, 2.9670597283903604), t18, xp.where(xp.greater_equal(t197, -2.9670597283903604) & xp.less_equal(t197, 2.9670597283903604), t197, xp.where(xp.greater_equal(t198, -2.9670597283903604) & xp.less_equal(t198, 2.9670597283903604), t198, qb2_5)))
+    t200 = qw1*(t122 + t179)**2 + qw2*(t123 + t183)**2 + qw3*(t124 + t187)**2 + qw4*(t125 + t191)**2 + qw5*(t126 + t195)**2 + qw6*(t127 + t199)**2 + qw7*(t128 + qb2_6)**2
+    t201 = xp.greater(xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0), 0)
+    t202 = xp.where(t201 & (xp.less(t166, 1) | xp.less(t200, t175)), xp.asarray(1, dtype=dtype), 0)
+    t203 = xp.where(t201, 1, t166)
+    t204 = xp.greater(t202, 0)
+    t205 = xp.where(t204, t179, t168)
+    t206 = xp.where(t204, t183, t169)
+    t207 = xp.where(t204, t187, t170)
+    t208 = xp.where(t204, t191, t171)
+    t209 = xp.where(t204, t195, t172)
+    t210 = xp.where(t204, t199, t173)
+    t211 = xp.where(t204, qb2_6, t174)
+    t212 = xp.where(t204, t200, t175)
+    t213 = xp.where(xp.less(t19, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t214 = t213 + t19
+    t215 = -t213 + t19
+    t216 = xp.where(xp.greater_equal(t19, -3.0543261909900767) & xp.less_equal(t19, 3.0543261909900767), t19, xp.where(xp.greater_equal(t214, -3.0543261909900767) & xp.less_equal(t214, 3.0543261909900767), t214, xp.where(xp.greater_equal(t215, -3.0543261909900767) & xp.less_equal(t215, 3.0543261909900767), t215, qb3_0)))
+    t217 = xp.where(xp.less(t20, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t218 = t217 + t20
+    t219 = -t217 + t20
+    t220 = xp.where(xp.greater_equal(t20, -3.822271061867582) & xp.less_equal(t20, 2.2863813201125716), t20, xp.where(xp.greater_equal(t218, -3.822271061867582) & xp.less_equal(t218, 2.2863813201125716), t218, xp.where(xp.greater_equal(t219, -3.822271061867582) & xp.less_equal(t219, 2.2863813201125716), t219, qb3_1)))
+    t221 = xp.where(xp.less(t21, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t222 = t221 + t21
+    t223 = -t221 + t21
+    t224 = xp.where(xp.greater_equal(t21, -3.0543261909900767) & xp.less_equal(t21, 3.0543261909900767), t21, xp.where(xp.greater_equal(t222, -3.0543261909900767) & xp.less_equal(t222, 3.0543261909900767), t222, xp.where(xp.greater_equal(t223, -3.0543261909900767) & xp.less_equal(t223, 3.0543261909900767), t223, qb3_2)))
+    t225 = xp.where(xp.less(t22, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t226 = t225 + t22
+    t227 = -t225 + t22
+    t228 = xp.where(xp.greater_equal(t22, -3.0543261909900767) & xp.less_equal(t22, 3.0543261909900767), t22, xp.where(xp.greater_equal(t226, -3.0543261909900767) & xp.less_equal(t226, 3.0543261909900767), t226, xp.where(xp.greater_equal(t227, -3.0543261909900767) & xp.less_equal(t227, 3.0543261909900767), t227, qb3_3)))
+    t229 = xp.where(xp.less(t23, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t230 = t229 + t23
+    t231 = -t229 + t23
+    t232 = xp.where(xp.greater_equal(t23, -2.9670597283903604) & xp.less_equal(t23, 2.9670597283903604), t23, xp.where(xp.greater_equal(t230, -2.9670597283903604) & xp.less_equal(t230, 2.9670597283903604), t230, xp.where(xp.greater_equal(t231, -2.9670597283903604) & xp.less_equal(t231, 2.9670597283903604), t231, qb3_4)))
+    t233 = xp.where(xp.less(t24, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t234 = t233 + t24
+    t235 = -t233 + t24
+    t236 = xp.where(xp.greater_equal(t24, -2.9670597283903604) & xp.less_equal(t24, 2.9670597283903604), t24, xp.where(xp.greater_equal(t234, -2.9670597283903604) & xp.less_equal(t234, 2.9670597283903604), t234, xp.where(xp.greater_equal(t235, -2.9670597283903604) & xp.less_equal(t235, 2.9670597283903604), t235, qb3_5)))
+    t237 = qw1*(t122 + t216)**2 + qw2*(t123 + t220)**2 + qw3*(t124 + t224)**2 + qw4*(t125 + t228)**2 + qw5*(t126 + t232)**2 + qw6*(t127 + t236)**2 + qw7*(t128 + qb3_6)**2
+    t238 = xp.greater(xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0), 0)
+    t239 = xp.where(t238 & (xp.less(t203, 1) | xp.less(t237, t212)), xp.asarray(1, dtype=dtype), 0)
+    t240 = xp.where(t238, 1, t203)
+    t241 = xp.greater(t239, 0)
+    t242 = xp.where(t241, t216, t205)
+    t243 = xp.where(t241, t220, t206)
+    t244 = xp.where(t241, t224, t207)
+    t245 = xp.where(t241, t228, t208)
+    t246 = xp.where(t241, t232, t209)
+    t247 = xp.where(t241, t236, t210)
+    t248 = xp.where(t241, qb3_6, t211)
+    t249 = xp.where(t241, t237, t212)
+    t250 = xp.where(xp.less(t25, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t251 = t250 + t25
+    t252 = -t250 + t25
+    t253 = xp.where(xp.greater_equal(t25, -3.0543261909900767) & xp.less_equal(t25, 3.0543261909900767), t25, xp.where(xp.greater_equal(t251, -3.0543261909900767) & xp.less_equal(t251, 3.0543261909900767), t251, xp.where(xp.greater_equal(t252, -3.0543261909900767) & xp.less_equal(t252, 3.0543261909900767), t252, qb4_0)))
+    t254 = xp.where(xp.less(t26, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t255 = t254 + t26
+    t256 = -t254 + t26
+    t257 = xp.where(xp.greater_equal(t26, -3.822271061867582) & xp.less_equal(t26, 2.2863813201125716), t26, xp.where(xp.greater_equal(t255, -3.822271061867582) & xp.less_equal(t255, 2.2863813201125716), t255, xp.where(xp.greater_equal(t256, -3.822271061867582) & xp.less_equal(t256, 2.2863813201125716), t256, qb4_1)))
+    t258 = xp.where(xp.less(t27, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t259 = t258 + t27
+    t260 = -t258 + t27
+    t261 = xp.where(xp.greater_equal(t27, -3.0543261909900767) & xp.less_equal(t27, 3.0543261909900767), t27, xp.where(xp.greater_equal(t259, -3.0543261909900767) & xp.less_equal(t259, 3.0543261909900767), t259, xp.where(xp.greater_equal(t260, -3.0543261909900767) & xp.less_equal(t260, 3.0543261909900767), t260, qb4_2)))
+    t262 = xp.where(xp.less(t28, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t263 = t262 + t28
+    t264 = -t262 + t28
+    t265 = xp.where(xp.greater_equal(t28, -3.0543261909900767) & xp.less_equal(t28, 3.0543261909900767), t28, xp.where(xp.greater_equal(t263, -3.0543261909900767) & xp.less_equal(t263, 3.0543261909900767), t263, xp.where(xp.greater_equal(t264, -3.0543261909900767) & xp.less_equal(t264, 3.0543261909900767), t264, qb4_3)))
+    t266 = xp.where(xp.less(t29, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t267 = t266 + t29
+    t268 = -t266 + t29
+    t269 = xp.where(xp.greater_equal(t29, -2.9670597283903604) & xp.less_equal(t29, 2.9670597283903604), t29, xp.where(xp.greater_equal(t267, -2.9670597283903604) & xp.less_equal(t267, 2.9670597283903604), t267, xp.where(xp.greater_equal(t268, -2.9670597283903604) & xp.less_equal(t268, 2.9670597283903604), t268, qb4_4)))
+    t270 = xp.where(xp.less(t30, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t271 = t270 + t30
+    t272 = -t270 + t30
+    t273 = xp.where(xp.greater_equal(t30, -2.9670597283903604) & xp.less_equal(t30, 2.9670597283903604), t30, xp.where(xp.greater_equal(t271, -2.9670597283903604) & xp.less_equal(t271, 2.9670597283903604), t271, xp.where(xp.greater_equal(t272, -2.9670597283903604) & xp.less_equal(t272, 2.9670597283903604), t272, qb4_5)))
+    t274 = qw1*(t122 + t253)**2 + qw2*(t123 + t257)**2 + qw3*(t124 + t261)**2 + qw4*(t125 + t265)**2 + qw5*(t126 + t269)**2 + qw6*(t127 + t273)**2 + qw7*(t128 + qb4_6)**2
+    t275 = xp.greater(xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0), 0)
+    t276 = xp.where(t275 & (xp.less(t240, 1) | xp.less(t274, t249)), xp.asarray(1, dtype=dtype), 0)
+    t277 = xp.where(t275, 1, t240)
+    t278 = xp.greater(t276, 0)
+    t279 = xp.where(t278, t253, t242)
+    t280 = xp.where(t278, t257, t243)
+    t281 = xp.where(t278, t261, t244)
+    t282 = xp.where(t278, t265, t245)
+    t283 = xp.where(t278, t269, t246)
+    t284 = xp.where(t278, t273, t247)
+    t285 = xp.where(t278, qb4_6, t248)
+    t286 = xp.where(t278, t274, t249)
+    t287 = xp.where(xp.less(t31, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t288 = t287 + t31
+    t289 = -t287 + t31
+    t290 = xp.where(xp.greater_equal(t31, -3.0543261909900767) & xp.less_equal(t31, 3.0543261909900767), t31, xp.where(xp.greater_equal(t288, -3.0543261909900767) & xp.less_equal(t288, 3.0543261909900767), t288, xp.where(xp.greater_equal(t289, -3.0543261909900767) & xp.less_equal(t289, 3.0543261909900767), t289, qb5_0)))
+    t291 = xp.where(xp.less(t32, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t292 = t291 + t32
+    t293 = -t291 + t32
+    t294 = xp.where(xp.greater_equal(t32, -3.822271061867582) & xp.less_equal(t32, 2.2863813201125716), t32, xp.where(xp.greater_equal(t292, -3.822271061867582) & xp.less_equal(t292, 2.2863813201125716), t292, xp.where(xp.greater_equal(t293, -3.822271061867582) & xp.less_equal(t293, 2.2863813201125716), t293, qb5_1)))
+    t295 = xp.where(xp.less(t33, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t296 = t295 + t33
+    t297 = -t295 + t33
+    t298 = xp.where(xp.greater_equal(t33, -3.0543261909900767) & xp.less_equal(t33, 3.0543261909900767), t33, xp.where(xp.greater_equal(t296, -3.0543261909900767) & xp.less_equal(t296, 3.0543261909900767), t296, xp.where(xp.greater_equal(t297, -3.0543261909900767) & xp.less_equal(t297, 3.0543261909900767), t297, qb5_2)))
+    t299 = xp.where(xp.less(t34, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t300 = t299 + t34
+    t301 = -t299 + t34
+    t302 = xp.where(xp.greater_equal(t34, -3.0543261909900767) & xp.less_equal(t34, 3.0543261909900767), t34, xp.where(xp.greater_equal(t300, -3.0543261909900767) & xp.less_equal(t300, 3.0543261909900767), t300, xp.where(xp.greater_equal(t301, -3.0543261909900767) & xp.less_equal(t301, 3.0543261909900767), t301, qb5_3)))
+    t303 = xp.where(xp.less(t35, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t304 = t303 + t35
+    t305 = -t303 + t35
+    t306 = xp.where(xp.greater_equal(t35, -2.9670597283903604) & xp.less_equal(t35, 2.9670597283903604), t35, xp.where(xp.greater_equal(t304, -2.9670597283903604) & xp.less_equal(t304, 2.9670597283903604), t304, xp.where(xp.greater_equal(t305, -2.9670597283903604) & xp.less_equal(t305, 2.9670597283903604), t305, qb5_4)))
+    t307 = xp.where(xp.less(t36, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t308 = t307 + t36
+    t309 = -t307 + t36
+    t310 = xp.where(xp.greater_equal(t36, -2.9670597283903604) & xp.less_equal(t36, 2.9670597283903604), t36, xp.where(xp.greater_equal(t308, -2.9670597283903604) & xp.less_equal(t308, 2.9670597283903604), t308, xp.where(xp.greater_equal(t309, -2.9670597283903604) & xp.less_equal(t309, 2.9670597283903604), t309, qb5_5)))
+    t311 = qw1*(t122 + t290)**2 + qw2*(t123 + t294)**2 + qw3*(t124 + t298)**2 + qw4*(t125 + t302)**2 + qw5*(t126 + t306)**2 + qw6*(t127 + t310)**2 + qw7*(t128 + qb5_6)**2
+    t312 = xp.greater(xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0), 0)
+    t313 = xp.where(t312 & (xp.less(t277, 1) | xp.less(t311, t286)), xp.asarray(1, dtype=dtype), 0)
+    t314 = xp.where(t312, 1, t277)
+    t315 = xp.greater(t313, 0)
+    t316 = xp.where(t315, t290, t279)
+    t317 = xp.where(t315, t294, t280)
+    t318 = xp.where(t315, t298, t281)
+    t319 = xp.where(t315, t302, t282)
+    t320 = xp.where(t315, t306, t283)
+    t321 = xp.where(t315, t310, t284)
+    t322 = xp.where(t315, qb5_6, t285)
+    t323 = xp.where(t315, t311, t286)
+    t324 = xp.where(xp.less(t37, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t325 = t324 + t37
+    t326 = -t324 + t37
+    t327 = xp.where(xp.greater_equal(t37, -3.0543261909900767) & xp.less_equal(t37, 3.0543261909900767), t37, xp.where(xp.greater_equal(t325, -3.0543261909900767) & xp.less_equal(t325, 3.0543261909900767), t325, xp.where(xp.greater_equal(t326, -3.0543261909900767) & xp.less_equal(t326, 3.0543261909900767), t326, qb6_0)))
+    t328 = xp.where(xp.less(t38, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t329 = t328 + t38
+    t330 = -t328 + t38
+    t331 = xp.where(xp.greater_equal(t38, -3.822271061867582) & xp.less_equal(t38, 2.2863813201125716), t38, xp.where(xp.greater_equal(t329, -3.822271061867582) & xp.less_equal(t329, 2.2863813201125716), t329, xp.where(xp.greater_equal(t330, -3.822271061867582) & xp.less_equal(t330, 2.2863813201125716), t330, qb6_1)))
+    t332 = xp.where(xp.less(t39, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t333 = t332 + t39
+    t334 = -t332 + t39
+    t335 = xp.where(xp.greater_equal(t39, -3.0543261909900767) & xp.less_equal(t39, 3.0543261909900767), t39, xp.where(xp.greater_equal(t333, -3.0543261909900767) & xp.less_equal(t333, 3.0543261909900767), t333, xp.where(xp.greater_equal(t334, -3.0543261909900767) & xp.less_equal(t334, 3.0543261909900767), t334, qb6_2)))
+    t336 = xp.where(xp.less(t40, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t337 = t336 + t40
+    t338 = -t336 + t40
+    t339 = xp.where(xp.greater_equal(t40, -3.0543261909900767) & xp.less_equal(t40, 3.0543261909900767), t40, xp.where(xp.greater_equal(t337, -3.0543261909900767) & xp.less_equal(t337, 3.0543261909900767), t337, xp.where(xp.greater_equal(t338, -3.0543261909900767) & xp.less_equal(t338, 3.0543261909900767), t338, qb6_3)))
+    t340 = xp.where(xp.less(t41, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t341 = t340 + t41
+    t342 = -t340 + t41
+    t343 = xp.where(xp.greater_equal(t41, -2.9670597283903604) & xp.less_equal(t41, 2.9670597283903604), t41, xp.where(xp.greater_equal(t341, -2.9670597283903604) & xp.less_equal(t341, 2.9670597283903604), t341, xp.where(xp.greater_equal(t342, -2.9670597283903604) & xp.less_equal(t342, 2.9670597283903604), t342, qb6_4)))
+    t344 = xp.where(xp.less(t42, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t345 = t344 + t42
+    t346 = -t344 + t42
+    t347 = xp.where(xp.greater_equal(t42, -2.9670597283903604) & xp.less_equal(t42, 2.9670597283903604), t42, xp.where(xp.greater_equal(t345, -2.9670597283903604) & xp.less_equal(t345, 2.9670597283903604), t345, xp.where(xp.greater_equal(t346, -2.9670597283903604) & xp.less_equal(t346, 2.9670597283903604), t346, qb6_5)))
+    t348 = qw1*(t122 + t327)**2 + qw2*(t123 + t331)**2 + qw3*(t124 + t335)**2 + qw4*(t125 + t339)**2 + qw5*(t126 + t343)**2 + qw6*(t127 + t347)**2 + qw7*(t128 + qb6_6)**2
+    t349 = xp.greater(xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0), 0)
+    t350 = xp.where(t349 & (xp.less(t314, 1) | xp.less(t348, t323)), xp.asarray(1, dtype=dtype), 0)
+    t351 = xp.where(t349, 1, t314)
+    t352 = xp.greater(t350, 0)
+    t353 = xp.where(t352, t327, t316)
+    t354 = xp.where(t352, t331, t317)
+    t355 = xp.where(t352, t335, t318)
+    t356 = xp.where(t352, t339, t319)
+    t357 = xp.where(t352, t343, t320)
+    t358 = xp.where(t352, t347, t321)
+    t359 = xp.where(t352, qb6_6, t322)
+    t360 = xp.where(t352, t348, t323)
+    t361 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t362 = t361 + t43
+    t363 = -t361 + t43
+    t364 = xp.where(xp.greater_equal(t43, -3.0543261909900767) & xp.less_equal(t43, 3.0543261909900767), t43, xp.where(xp.greater_equal(t362, -3.0543261909900767) & xp.less_equal(t362, 3.0543261909900767), t362, xp.where(xp.greater_equal(t363, -3.0543261909900767) & xp.less_equal(t363, 3.0543261909900767), t363, qb7_0)))
+    t365 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t366 = t365 + t44
+    t367 = -t365 + t44
+    t368 = xp.where(xp.greater_equal(t44, -3.822271061867582) & xp.less_equal(t44, 2.2863813201125716), t44, xp.where(xp.greater_equal(t366, -3.822271061867582) & xp.less_equal(t366, 2.2863813201125716), t366, xp.where(xp.greater_equal(t367, -3.822271061867582) & xp.less_equal(t367, 2.2863813201125716), t367, qb7_1)))
+    t369 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t370 = t369 + t45
+    t371 = -t369 + t45
+    t372 = xp.where(xp.greater_equal(t45, -3.0543261909900767) & xp.less_equal(t45, 3.0543261909900767), t45, xp.where(xp.greater_equal(t370, -3.0543261909900767) & xp.less_equal(t370, 3.0543261909900767), t370, xp.where(xp.greater_equal(t371, -3.0543261909900767) & xp.less_equal(t371, 3.0543261909900767), t371, qb7_2)))
+    t373 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t374 = t373 + t46
+    t375 = -t373 + t46
+    t376 = xp.where(xp.greater_equal(t46, -3.0543261909900767) & xp.less_equal(t46, 3.0543261909900767), t46, xp.where(xp.greater_equal(t374, -3.0543261909900767) & xp.less_equal(t374, 3.0543261909900767), t374, xp.where(xp.greater_equal(t375, -3.0543261909900767) & xp.less_equal(t375, 3.0543261909900767), t375, qb7_3)))
+    t377 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t378 = t377 + t47
+    t379 = -t377 + t47
+    t380 = xp.where(xp.greater_equal(t47, -2.9670597283903604) & xp.less_equal(t47, 2.9670597283903604), t47, xp.where(xp.greater_equal(t378, -2.9670597283903604) & xp.less_equal(t378, 2.9670597283903604), t378, xp.where(xp.greater_equal(t379, -2.9670597283903604) & xp.less_equal(t379, 2.9670597283903604), t379, qb7_4)))
+    t381 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t382 = t381 + t48
+    t383 = -t381 + t48
+    t384 = xp.where(xp.greater_equal(t48, -2.9670597283903604) & xp.less_equal(t48, 2.9670597283903604), t48, xp.where(xp.greater_equal(t382, -2.9670597283903604) & xp.less_equal(t382, 2.9670597283903604), t382, xp.where(xp.greater_equal(t383, -2.9670597283903604) & xp.less_equal(t383, 2.9670597283903604), t383, qb7_5)))
+    t385 = qw1*(t122 + t364)**2 + qw2*(t123 + t368)**2 + qw3*(t124 + t372)**2 + qw4*(t125 + t376)**2 + qw5*(t126 + t380)**2 + qw6*(t127 + t384)**2 + qw7*(t128 + qb7_6)**2
+    t386 = xp.greater(xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0), 0)
+    t387 = xp.where(t386 & (xp.less(t351, 1) | xp.less(t385, t360)), xp.asarray(1, dtype=dtype), 0)
+    t388 = xp.where(t386, 1, t351)
+    t389 = xp.greater(t387, 0)
+    t390 = xp.where(t389, t364, t353)
+    t391 = xp.where(t389, t368, t354)
+    t392 = xp.where(t389, t372, t355)
+    t393 = xp.where(t389, t376, t356)
+    t394 = xp.where(t389, t380, t357)
+    t395 = xp.where(t389, t384, t358)
+    t396 = xp.where(t389, qb7_6, t359)
+    t397 = xp.where(t389, t385, t360)
+    t398 = xp.where(xp.less(t49, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t399 = t398 + t49
+    t400 = -t398 + t49
+    t401 = xp.where(xp.greater_equal(t49, -3.0543261909900767) & xp.less_equal(t49, 3.0543261909900767), t49, xp.where(xp.greater_equal(t399, -3.0543261909900767) & xp.less_equal(t399, 3.0543261909900767), t399, xp.where(xp.greater_equal(t400, -3.0543261909900767) & xp.less_equal(t400, 3.0543261909900767), t400, qb8_0)))
+    t402 = xp.where(xp.less(t50, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t403 = t402 + t50
+    t404 = -t402 + t50
+    t405 = xp.where(xp.greater_equal(t50, -3.822271061867582) & xp.less_equal(t50, 2.2863813201125716), t50, xp.where(xp.greater_equal(t403, -3.822271061867582) & xp.less_equal(t403, 2.2863813201125716), t403, xp.where(xp.greater_equal(t404, -3.822271061867582) & xp.less_equal(t404, 2.2863813201125716), t404, qb8_1)))
+    t406 = xp.where(xp.less(t51, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t407 = t406 + t51
+    t408 = -t406 + t51
+    t409 = xp.where(xp.greater_equal(t51, -3.0543261909900767) & xp.less_equal(t51, 3.0543261909900767), t51, xp.where(xp.greater_equal(t407, -3.0543261909900767) & xp.less_equal(t407, 3.0543261909900767), t407, xp.where(xp.greater_equal(t408, -3.0543261909900767) & xp.less_equal(t408, 3.0543261909900767), t408, qb8_2)))
+    t410 = xp.where(xp.less(t52, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t411 = t410 + t52
+    t412 = -t410 + t52
+    t413 = xp.where(xp.greater_equal(t52, -3.0543261909900767) & xp.less_equal(t52, 3.0543261909900767), t52, xp.where(xp.greater_equal(t411, -3.0543261909900767) & xp.less_equal(t411, 3.0543261909900767), t411, xp.where(xp.greater_equal(t412, -3.0543261909900767) & xp.less_equal(t412, 3.0543261909900767), t412, qb8_3)))
+    t414 = xp.where(xp.less(t53, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t415 = t414 + t53
+    t416 = -t414 + t53
+    t417 = xp.where(xp.greater_equal(t53, -2.9670597283903604) & xp.less_equal(t53, 2.9670597283903604), t53, xp.where(xp.greater_equal(t415, -2.9670597283903604) & xp.less_equal(t415, 2.9670597283903604), t415, xp.where(xp.greater_equal(t416, -2.9670597283903604) & xp.less_equal(t416, 2.9670597283903604), t416, qb8_4)))
+    t418 = xp.where(xp.less(t54, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t419 = t418 + t54
+    t420 = -t418 + t54
+    t421 = xp.where(xp.greater_equal(t54, -2.9670597283903604) & xp.less_equal(t54, 2.9670597283903604), t54, xp.where(xp.greater_equal(t419, -2.9670597283903604) & xp.less_equal(t419, 2.9670597283903604), t419, xp.where(xp.greater_equal(t420, -2.9670597283903604) & xp.less_equal(t420, 2.9670597283903604), t420, qb8_5)))
+    t422 = qw1*(t122 + t401)**2 + qw2*(t123 + t405)**2 + qw3*(t124 + t409)**2 + qw4*(t125 + t413)**2 + qw5*(t126 + t417)**2 + qw6*(t127 + t421)**2 + qw7*(t128 + qb8_6)**2
+    t423 = xp.greater(xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0), 0)
+    t424 = xp.where(t423 & (xp.less(t388, 1) | xp.less(t422, t397)), xp.asarray(1, dtype=dtype), 0)
+    t425 = xp.where(t423, 1, t388)
+    t426 = xp.greater(t424, 0)
+    t427 = xp.where(t426, t401, t390)
+    t428 = xp.where(t426, t405, t391)
+    t429 = xp.where(t426, t409, t392)
+    t430 = xp.where(t426, t413, t393)
+    t431 = xp.where(t426, t417, t394)
+    t432 = xp.where(t426, t421, t395)
+    t433 = xp.where(t426, qb8_6, t396)
+    t434 = xp.where(t426, t422, t397)
+    t435 = xp.where(xp.less(t55, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t436 = t435 + t55
+    t437 = -t435 + t55
+    t438 = xp.where(xp.greater_equal(t55, -3.0543261909900767) & xp.less_equal(t55, 3.0543261909900767), t55, xp.where(xp.greater_equal(t436, -3.0543261909900767) & xp.less_equal(t436, 3.0543261909900767), t436, xp.where(xp.greater_equal(t437, -3.0543261909900767) & xp.less_equal(t437, 3.0543261909900767), t437, qb9_0)))
+    t439 = xp.where(xp.less(t56, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t440 = t439 + t56
+    t441 = -t439 + t56
+    t442 = xp.where(xp.greater_equal(t56, -3.822271061867582) & xp.less_equal(t56, 2.2863813201125716), t56, xp.where(xp.greater_equal(t440, -3.822271061867582) & xp.less_equal(t440, 2.2863813201125716), t440, xp.where(xp.greater_equal(t441, -3.822271061867582) & xp.less_equal(t441, 2.2863813201125716), t441, qb9_1)))
+    t443 = xp.where(xp.less(t57, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t444 = t443 + t57
+    t445 = -t443 + t57
+    t446 = xp.where(xp.greater_equal(t57, -3.0543261909900767) & xp.less_equal(t57, 3.0543261909900767), t57, xp.where(xp.greater_equal(t444, -3.0543261909900767) & xp.less_equal(t444, 3.0543261909900767), t444, xp.where(xp.greater_equal(t445, -3.0543261909900767) & xp.less_equal(t445, 3.0543261909900767), t445, qb9_2)))
+    t447 = xp.where(xp.less(t58, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t448 = t447 + t58
+    t449 = -t447 + t58
+    t450 = xp.where(xp.greater_equal(t58, -3.0543261909900767) & xp.less_equal(t58, 3.0543261909900767), t58, xp.where(xp.greater_equal(t448, -3.0543261909900767) & xp.less_equal(t448, 3.0543261909900767), t448, xp.where(xp.greater_equal(t449, -3.0543261909900767) & xp.less_equal(t449, 3.0543261909900767), t449, qb9_3)))
+    t451 = xp.where(xp.less(t59, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t452 = t451 + t59
+    t453 = -t451 + t59
+    t454 = xp.where(xp.greater_equal(t59, -2.9670597283903604) & xp.less_equal(t59, 2.9670597283903604), t59, xp.where(xp.greater_equal(t452, -2.9670597283903604) & xp.less_equal(t452, 2.9670597283903604), t452, xp.where(xp.greater_equal(t453, -2.9670597283903604) & xp.less_equal(t453, 2.9670597283903604), t453, qb9_4)))
+    t455 = xp.where(xp.less(t60, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t456 = t455 + t60
+    t457 = -t455 + t60
+    t458 = xp.where(xp.greater_equal(t60, -2.9670597283903604) & xp.less_equal(t60, 2.9670597283903604), t60, xp.where(xp.greater_equal(t456, -2.9670597283903604) & xp.less_equal(t456, 2.9670597283903604), t456, xp.where(xp.greater_equal(t457, -2.9670597283903604) & xp.less_equal(t457, 2.9670597283903604), t457, qb9_5)))
+    t459 = qw1*(t122 + t438)**2 + qw2*(t123 + t442)**2 + qw3*(t124 + t446)**2 + qw4*(t125 + t450)**2 + qw5*(t126 + t454)**2 + qw6*(t127 + t458)**2 + qw7*(t128 + qb9_6)**2
+    t460 = xp.greater(xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0), 0)
+    t461 = xp.where(t460 & (xp.less(t425, 1) | xp.less(t459, t434)), xp.asarray(1, dtype=dtype), 0)
+    t462 = xp.where(t460, 1, t425)
+    t463 = xp.greater(t461, 0)
+    t464 = xp.where(t463, t438, t427)
+    t465 = xp.where(t463, t442, t428)
+    t466 = xp.where(t463, t446, t429)
+    t467 = xp.where(t463, t450, t430)
+    t468 = xp.where(t463, t454, t431)
+    t469 = xp.where(t463, t458, t432)
+    t470 = xp.where(t463, qb9_6, t433)
+    t471 = xp.where(t463, t459, t434)
+    t472 = xp.where(xp.less(t61, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t473 = t472 + t61
+    t474 = -t472 + t61
+    t475 = xp.where(xp.greater_equal(t61, -3.0543261909900767) & xp.less_equal(t61, 3.0543261909900767), t61, xp.where(xp.greater_equal(t473, -3.0543261909900767) & xp.less_equal(t473, 3.0543261909900767), t473, xp.where(xp.greater_equal(t474, -3.0543261909900767) & xp.less_equal(t474, 3.0543261909900767), t474, qb10_0)))
+    t476 = xp.where(xp.less(t62, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t477 = t476 + t62
+    t478 = -t476 + t62
+    t479 = xp.where(xp.greater_equal(t62, -3.822271061867582) & xp.less_equal(t62, 2.2863813201125716), t62, xp.where(xp.greater_equal(t477, -3.822271061867582) & xp.less_equal(t477, 2.2863813201125716), t477, xp.where(xp.greater_equal(t478, -3.822271061867582) & xp.less_equal(t478, 2.2863813201125716), t478, qb10_1)))
+    t480 = xp.where(xp.less(t63, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t481 = t480 + t63
+    t482 = -t480 + t63
+    t483 = xp.where(xp.greater_equal(t63, -3.0543261909900767) & xp.less_equal(t63, 3.0543261909900767), t63, xp.where(xp.greater_equal(t481, -3.0543261909900767) & xp.less_equal(t481, 3.0543261909900767), t481, xp.where(xp.greater_equal(t482, -3.0543261909900767) & xp.less_equal(t482, 3.0543261909900767), t482, qb10_2)))
+    t484 = xp.where(xp.less(t64, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t485 = t484 + t64
+    t486 = -t484 + t64
+    t487 = xp.where(xp.greater_equal(t64, -3.0543261909900767) & xp.less_equal(t64, 3.0543261909900767), t64, xp.where(xp.greater_equal(t485, -3.0543261909900767) & xp.less_equal(t485, 3.0543261909900767), t485, xp.where(xp.greater_equal(t486, -3.0543261909900767) & xp.less_equal(t486, 3.0543261909900767), t486, qb10_3)))
+    t488 = xp.where(xp.less(t65, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t489 = t488 + t65
+    t490 = -t488 + t65
+    t491 = xp.where(xp.greater_equal(t65, -2.9670597283903604) & xp.less_equal(t65, 2.9670597283903604), t65, xp.where(xp.greater_equal(t489, -2.9670597283903604) & xp.less_equal(t489, 2.9670597283903604), t489, xp.where(xp.greater_equal(t490, -2.9670597283903604) & xp.less_equal(t490, 2.9670597283903604), t490, qb10_4)))
+    t492 = xp.where(xp.less(t66, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t493 = t492 + t66
+    t494 = -t492 + t66
+    t495 = xp.where(xp.greater_equal(t66, -2.9670597283903604) & xp.less_equal(t66, 2.9670597283903604), t66, xp.where(xp.greater_equal(t493, -2.9670597283903604) & xp.less_equal(t493, 2.9670597283903604), t493, xp.where(xp.greater_equal(t494, -2.9670597283903604) & xp.less_equal(t494, 2.9670597283903604), t494, qb10_5)))
+    t496 = qw1*(t122 + t475)**2 + qw2*(t123 + t479)**2 + qw3*(t124 + t483)**2 + qw4*(t125 + t487)**2 + qw5*(t126 + t491)**2 + qw6*(t127 + t495)**2 + qw7*(t128 + qb10_6)**2
+    t497 = xp.greater(xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0), 0)
+    t498 = xp.where(t497 & (xp.less(t462, 1) | xp.less(t496, t471)), xp.asarray(1, dtype=dtype), 0)
+    t499 = xp.where(t497, 1, t462)
+    t500 = xp.greater(t498, 0)
+    t501 = xp.where(t500, t475, t464)
+    t502 = xp.where(t500, t479, t465)
+    t503 = xp.where(t500, t483, t466)
+    t504 = xp.where(t500, t487, t467)
+    t505 = xp.where(t500, t491, t468)
+    t506 = xp.where(t500, t495, t469)
+    t507 = xp.where(t500, qb10_6, t470)
+    t508 = xp.where(t500, t496, t471)
+    t509 = xp.where(xp.less(t67, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t510 = t509 + t67
+    t511 = -t509 + t67
+    t512 = xp.where(xp.greater_equal(t67, -3.0543261909900767) & xp.less_equal(t67, 3.0543261909900767), t67, xp.where(xp.greater_equal(t510, -3.0543261909900767) & xp.less_equal(t510, 3.0543261909900767), t510, xp.where(xp.greater_equal(t511, -3.0543261909900767) & xp.less_equal(t511, 3.0543261909900767), t511, qb11_0)))
+    t513 = xp.where(xp.less(t68, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t514 = t513 + t68
+    t515 = -t513 + t68
+    t516 = xp.where(xp.greater_equal(t68, -3.822271061867582) & xp.less_equal(t68, 2.2863813201125716), t68, xp.where(xp.greater_equal(t514, -3.822271061867582) & xp.less_equal(t514, 2.2863813201125716), t514, xp.where(xp.greater_equal(t515, -3.822271061867582) & xp.less_equal(t515, 2.2863813201125716), t515, qb11_1)))
+    t517 = xp.where(xp.less(t69, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t518 = t517 + t69
+    t519 = -t517 + t69
+    t520 = xp.where(xp.greater_equal(t69, -3.0543261909900767) & xp.less_equal(t69, 3.0543261909900767), t69, xp.where(xp.greater_equal(t518, -3.0543261909900767) & xp.less_equal(t518, 3.0543261909900767), t518, xp.where(xp.greater_equal(t519, -3.0543261909900767) & xp.less_equal(t519, 3.0543261909900767), t519, qb11_2)))
+    t521 = xp.where(xp.less(t70, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t522 = t521 + t70
+    t523 = -t521 + t70
+    t524 = xp.where(xp.greater_equal(t70, -3.0543261909900767) & xp.less_equal(t70, 3.0543261909900767), t70, xp.where(xp.greater_equal(t522, -3.0543261909900767) & xp.less_equal(t522, 3.0543261909900767), t522, xp.where(xp.greater_equal(t523, -3.0543261909900767) & xp.less_equal(t523, 3.0543261909900767), t523, qb11_3)))
+    t525 = xp.where(xp.less(t71, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t526 = t525 + t71
+    t527 = -t525 + t71
+    t528 = xp.where(xp.greater_equal(t71, -2.9670597283903604) & xp.less_equal(t71, 2.9670597283903604), t71, xp.where(xp.greater_equal(t526, -2.9670597283903604) & xp.less_equal(t526, 2.9670597283903604), t526, xp.where(xp.greater_equal(t527, -2.9670597283903604) & xp.less_equal(t527, 2.9670597283903604), t527, qb11_4)))
+    t529 = xp.where(xp.less(t72, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t530 = t529 + t72
+    t531 = -t529 + t72
+    t532 = xp.where(xp.greater_equal(t72, -2.9670597283903604) & xp.less_equal(t72, 2.9670597283903604), t72, xp.where(xp.greater_equal(t530, -2.9670597283903604) & xp.less_equal(t530, 2.9670597283903604), t530, xp.where(xp.greater_equal(t531, -2.9670597283903604) & xp.less_equal(t531, 2.9670597283903604), t531, qb11_5)))
+    t533 = qw1*(t122 + t512)**2 + qw2*(t123 + t516)**2 + qw3*(t124 + t520)**2 + qw4*(t125 + t524)**2 + qw5*(t126 + t528)**2 + qw6*(t127 + t532)**2 + qw7*(t128 + qb11_6)**2
+    t534 = xp.greater(xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0), 0)
+    t535 = xp.where(t534 & (xp.less(t499, 1) | xp.less(t533, t508)), xp.asarray(1, dtype=dtype), 0)
+    t536 = xp.where(t534, 1, t499)
+    t537 = xp.greater(t535, 0)
+    t538 = xp.where(t537, t512, t501)
+    t539 = xp.where(t537, t516, t502)
+    t540 = xp.where(t537, t520, t503)
+    t541 = xp.where(t537, t524, t504)
+    t542 = xp.where(t537, t528, t505)
+    t543 = xp.where(t537, t532, t506)
+    t544 = xp.where(t537, qb11_6, t507)
+    t545 = xp.where(t537, t533, t508)
+    t546 = xp.where(xp.less(t73, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t547 = t546 + t73
+    t548 = -t546 + t73
+    t549 = xp.where(xp.greater_equal(t73, -3.0543261909900767) & xp.less_equal(t73, 3.0543261909900767), t73, xp.where(xp.greater_equal(t547, -3.0543261909900767) & xp.less_equal(t547, 3.0543261909900767), t547, xp.where(xp.greater_equal(t548, -3.0543261909900767) & xp.less_equal(t548, 3.0543261909900767), t548, qb12_0)))
+    t550 = xp.where(xp.less(t74, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t551 = t550 + t74
+    t552 = -t550 + t74
+    t553 = xp.where(xp.greater_equal(t74, -3.822271061867582) & xp.less_equal(t74, 2.2863813201125716), t74, xp.where(xp.greater_equal(t551, -3.822271061867582) & xp.less_equal(t551, 2.2863813201125716), t551, xp.where(xp.greater_equal(t552, -3.822271061867582) & xp.less_equal(t552, 2.2863813201125716), t552, qb12_1)))
+    t554 = xp.where(xp.less(t75, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t555 = t554 + t75
+    t556 = -t554 + t75
+    t557 = xp.where(xp.greater_equal(t75, -3.0543261909900767) & xp.less_equal(t75, 3.0543261909900767), t75, xp.where(xp.greater_equal(t555, -3.0543261909900767) & xp.less_equal(t555, 3.0543261909900767), t555, xp.where(xp.greater_equal(t556, -3.0543261909900767) & xp.less_equal(t556, 3.0543261909900767), t556, qb12_2)))
+    t558 = xp.where(xp.less(t76, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t559 = t558 + t76
+    t560 = -t558 + t76
+    t561 = xp.where(xp.greater_equal(t76, -3.0543261909900767) & xp.less_equal(t76, 3.0543261909900767), t76, xp.where(xp.greater_equal(t559, -3.0543261909900767) & xp.less_equal(t559, 3.0543261909900767), t559, xp.where(xp.greater_equal(t560, -3.0543261909900767) & xp.less_equal(t560, 3.0543261909900767), t560, qb12_3)))
+    t562 = xp.where(xp.less(t77, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t563 = t562 + t77
+    t564 = -t562 + t77
+    t565 = xp.where(xp.greater_equal(t77, -2.9670597283903604) & xp.less_equal(t77, 2.9670597283903604), t77, xp.where(xp.greater_equal(t563, -2.9670597283903604) & xp.less_equal(t563, 2.9670597283903604), t563, xp.where(xp.greater_equal(t564, -2.9670597283903604) & xp.less_equal(t564, 2.9670597283903604), t564, qb12_4)))
+    t566 = xp.where(xp.less(t78, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t567 = t566 + t78
+    t568 = -t566 + t78
+    t569 = xp.where(xp.greater_equal(t78, -2.9670597283903604) & xp.less_equal(t78, 2.9670597283903604), t78, xp.where(xp.greater_equal(t567, -2.9670597283903604) & xp.less_equal(t567, 2.9670597283903604), t567, xp.where(xp.greater_equal(t568, -2.9670597283903604) & xp.less_equal(t568, 2.9670597283903604), t568, qb12_5)))
+    t570 = qw1*(t122 + t549)**2 + qw2*(t123 + t553)**2 + qw3*(t124 + t557)**2 + qw4*(t125 + t561)**2 + qw5*(t126 + t565)**2 + qw6*(t127 + t569)**2 + qw7*(t128 + qb12_6)**2
+    t571 = xp.greater(xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0), 0)
+    t572 = xp.where(t571 & (xp.less(t536, 1) | xp.less(t570, t545)), xp.asarray(1, dtype=dtype), 0)
+    t573 = xp.where(t571, 1, t536)
+    t574 = xp.greater(t572, 0)
+    t575 = xp.where(t574, t549, t538)
+    t576 = xp.where(t574, t553, t539)
+    t577 = xp.where(t574, t557, t540)
+    t578 = xp.where(t574, t561, t541)
+    t579 = xp.where(t574, t565, t542)
+    t580 = xp.where(t574, t569, t543)
+    t581 = xp.where(t574, qb12_6, t544)
+    t582 = xp.where(t574, t570, t545)
+    t583 = xp.where(xp.less(t79, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t584 = t583 + t79
+    t585 = -t583 + t79
+    t586 = xp.where(xp.greater_equal(t79, -3.0543261909900767) & xp.less_equal(t79, 3.0543261909900767), t79, xp.where(xp.greater_equal(t584, -3.0543261909900767) & xp.less_equal(t584, 3.0543261909900767), t584, xp.where(xp.greater_equal(t585, -3.0543261909900767) & xp.less_equal(t585, 3.0543261909900767), t585, qb13_0)))
+    t587 = xp.where(xp.less(t80, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t588 = t587 + t80
+    t589 = -t587 + t80
+    t590 = xp.where(xp.greater_equal(t80, -3.822271061867582) & xp.less_equal(t80, 2.2863813201125716), t80, xp.where(xp.greater_equal(t588, -3.822271061867582) & xp.less_equal(t588, 2.2863813201125716), t588, xp.where(xp.greater_equal(t589, -3.822271061867582) & xp.less_equal(t589, 2.2863813201125716), t589, qb13_1)))
+    t591 = xp.where(xp.less(t81, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t592 = t591 + t81
+    t593 = -t591 + t81
+    t594 = xp.where(xp.greater_equal(t81, -3.0543261909900767) & xp.less_equal(t81, 3.0543261909900767), t81, xp.where(xp.greater_equal(t592, -3.0543261909900767) & xp.less_equal(t592, 3.0543261909900767), t592, xp.where(xp.greater_equal(t593, -3.0543261909900767) & xp.less_equal(t593, 3.0543261909900767), t593, qb13_2)))
+    t595 = xp.where(xp.less(t82, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t596 = t595 + t82
+    t597 = -t595 + t82
+    t598 = xp.where(xp.greater_equal(t82, -3.0543261909900767) & xp.less_equal(t82, 3.0543261909900767), t82, xp.where(xp.greater_equal(t596, -3.0543261909900767) & xp.less_equal(t596, 3.0543261909900767), t596, xp.where(xp.greater_equal(t597, -3.0543261909900767) & xp.less_equal(t597, 3.0543261909900767), t597, qb13_3)))
+    t599 = xp.where(xp.less(t83, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t600 = t599 + t83
+    t601 = -t599 + t83
+    t602 = xp.where(xp.greater_equal(t83, -2.9670597283903604) & xp.less_equal(t83, 2.9670597283903604), t83, xp.where(xp.greater_equal(t600, -2.9670597283903604) & xp.less_equal(t600, 2.9670597283903604), t600, xp.where(xp.greater_equal(t601, -2.9670597283903604) & xp.less_equal(t601, 2.9670597283903604), t601, qb13_4)))
+    t603 = xp.where(xp.less(t84, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t604 = t603 + t84
+    t605 = -t603 + t84
+    t606 = xp.where(xp.greater_equal(t84, -2.9670597283903604) & xp.less_equal(t84, 2.9670597283903604), t84, xp.where(xp.greater_equal(t604, -2.9670597283903604) & xp.less_equal(t604, 2.9670597283903604), t604, xp.where(xp.greater_equal(t605, -2.9670597283903604) & xp.less_equal(t605, 2.9670597283903604), t605, qb13_5)))
+    t607 = qw1*(t122 + t586)**2 + qw2*(t123 + t590)**2 + qw3*(t124 + t594)**2 + qw4*(t125 + t598)**2 + qw5*(t126 + t602)**2 + qw6*(t127 + t606)**2 + qw7*(t128 + qb13_6)**2
+    t608 = xp.greater(xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0), 0)
+    t609 = xp.where(t608 & (xp.less(t573, 1) | xp.less(t607, t582)), xp.asarray(1, dtype=dtype), 0)
+    t610 = xp.where(t608, 1, t573)
+    t611 = xp.greater(t609, 0)
+    t612 = xp.where(t611, t586, t575)
+    t613 = xp.where(t611, t590, t576)
+    t614 = xp.where(t611, t594, t577)
+    t615 = xp.where(t611, t598, t578)
+    t616 = xp.where(t611, t602, t579)
+    t617 = xp.where(t611, t606, t580)
+    t618 = xp.where(t611, qb13_6, t581)
+    t619 = xp.where(t611, t607, t582)
+    t620 = xp.where(xp.less(t85, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t621 = t620 + t85
+    t622 = -t620 + t85
+    t623 = xp.where(xp.greater_equal(t85, -3.0543261909900767) & xp.less_equal(t85, 3.0543261909900767), t85, xp.where(xp.greater_equal(t621, -3.0543261909900767) & xp.less_equal(t621, 3.0543261909900767), t621, xp.where(xp.greater_equal(t622, -3.0543261909900767) & xp.less_equal(t622, 3.0543261909900767), t622, qb14_0)))
+    t624 = xp.where(xp.less(t86, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t625 = t624 + t86
+    t626 = -t624 + t86
+    t627 = xp.where(xp.greater_equal(t86, -3.822271061867582) & xp.less_equal(t86, 2.2863813201125716), t86, xp.where(xp.greater_equal(t625, -3.822271061867582) & xp.less_equal(t625, 2.2863813201125716), t625, xp.where(xp.greater_equal(t626, -3.822271061867582) & xp.less_equal(t626, 2.2863813201125716), t626, qb14_1)))
+    t628 = xp.where(xp.less(t87, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t629 = t628 + t87
+    t630 = -t628 + t87
+    t631 = xp.where(xp.greater_equal(t87, -3.0543261909900767) & xp.less_equal(t87, 3.0543261909900767), t87, xp.where(xp.greater_equal(t629, -3.0543261909900767) & xp.less_equal(t629, 3.0543261909900767), t629, xp.where(xp.greater_equal(t630, -3.0543261909900767) & xp.less_equal(t630, 3.0543261909900767), t630, qb14_2)))
+    t632 = xp.where(xp.less(t88, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t633 = t632 + t88
+    t634 = -t632 + t88
+    t635 = xp.where(xp.greater_equal(t88, -3.0543261909900767) & xp.less_equal(t88, 3.0543261909900767), t88, xp.where(xp.greater_equal(t633, -3.0543261909900767) & xp.less_equal(t633, 3.0543261909900767), t633, xp.where(xp.greater_equal(t634, -3.0543261909900767) & xp.less_equal(t634, 3.0543261909900767), t634, qb14_3)))
+    t636 = xp.where(xp.less(t89, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t637 = t636 + t89
+    t638 = -t636 + t89
+    t639 = xp.where(xp.greater_equal(t89, -2.9670597283903604) & xp.less_equal(t89, 2.9670597283903604), t89, xp.where(xp.greater_equal(t637, -2.9670597283903604) & xp.less_equal(t637, 2.9670597283903604), t637, xp.where(xp.greater_equal(t638, -2.9670597283903604) & xp.less_equal(t638, 2.9670597283903604), t638, qb14_4)))
+    t640 = xp.where(xp.less(t90, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t641 = t640 + t90
+    t642 = -t640 + t90
+    t643 = xp.where(xp.greater_equal(t90, -2.9670597283903604) & xp.less_equal(t90, 2.9670597283903604), t90, xp.where(xp.greater_equal(t641, -2.9670597283903604) & xp.less_equal(t641, 2.9670597283903604), t641, xp.where(xp.greater_equal(t642, -2.9670597283903604) & xp.less_equal(t642, 2.9670597283903604), t642, qb14_5)))
+    t644 = qw1*(t122 + t623)**2 + qw2*(t123 + t627)**2 + qw3*(t124 + t631)**2 + qw4*(t125 + t635)**2 + qw5*(t126 + t639)**2 + qw6*(t127 + t643)**2 + qw7*(t128 + qb14_6)**2
+    t645 = xp.greater(xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0), 0)
+    t646 = xp.where(t645 & (xp.less(t610, 1) | xp.less(t644, t619)), xp.asarray(1, dtype=dtype), 0)
+    t647 = xp.where(t645, 1, t610)
+    t648 = xp.greater(t646, 0)
+    t649 = xp.where(t648, t623, t612)
+    t650 = xp.where(t648, t627, t613)
+    t651 = xp.where(t648, t631, t614)
+    t652 = xp.where(t648, t635, t615)
+    t653 = xp.where(t648, t639, t616)
+    t654 = xp.where(t648, t643, t617)
+    t655 = xp.where(t648, qb14_6, t618)
+    t656 = xp.where(t648, t644, t619)
+    t657 = xp.where(xp.less(t91, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t658 = t657 + t91
+    t659 = -t657 + t91
+    t660 = xp.where(xp.greater_equal(t91, -3.0543261909900767) & xp.less_equal(t91, 3.0543261909900767), t91, xp.where(xp.greater_equal(t658, -3.0543261909900767) & xp.less_equal(t658, 3.0543261909900767), t658, xp.where(xp.greater_equal(t659, -3.0543261909900767) & xp.less_equal(t659, 3.0543261909900767), t659, qb15_0)))
+    t661 = xp.where(xp.less(t92, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t662 = t661 + t92
+    t663 = -t661 + t92
+    t664 = xp.where(xp.greater_equal(t92, -3.822271061867582) & xp.less_equal(t92, 2.2863813201125716), t92, xp.where(xp.greater_equal(t662, -3.822271061867582) & xp.less_equal(t662, 2.2863813201125716), t662, xp.where(xp.greater_equal(t663, -3.822271061867582) & xp.less_equal(t663, 2.2863813201125716), t663, qb15_1)))
+    t665 = xp.where(xp.less(t93, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t666 = t665 + t93
+    t667 = -t665 + t93
+    t668 = xp.where(xp.greater_equal(t93, -3.0543261909900767) & xp.less_equal(t93, 3.0543261909900767), t93, xp.where(xp.greater_equal(t666, -3.0543261909900767) & xp.less_equal(t666, 3.0543261909900767), t666, xp.where(xp.greater_equal(t667, -3.0543261909900767) & xp.less_equal(t667, 3.0543261909900767), t667, qb15_2)))
+    t669 = xp.where(xp.less(t94, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t670 = t669 + t94
+    t671 = -t669 + t94
+    t672 = xp.where(xp.greater_equal(t94, -3.0543261909900767) & xp.less_equal(t94, 3.0543261909900767), t94, xp.where(xp.greater_equal(t670, -3.0543261909900767) & xp.less_equal(t670, 3.0543261909900767), t670, xp.where(xp.greater_equal(t671, -3.0543261909900767) & xp.less_equal(t671, 3.0543261909900767), t671, qb15_3)))
+    t673 = xp.where(xp.less(t95, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t674 = t673 + t95
+    t675 = -t673 + t95
+    t676 = xp.where(xp.greater_equal(t95, -2.9670597283903604) & xp.less_equal(t95, 2.9670597283903604), t95, xp.where(xp.greater_equal(t674, -2.9670597283903604) & xp.less_equal(t674, 2.9670597283903604), t674, xp.where(xp.greater_equal(t675, -2.9670597283903604) & xp.less_equal(t675, 2.9670597283903604), t675, qb15_4)))
+    t677 = xp.where(xp.less(t96, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t678 = t677 + t96
+    t679 = -t677 + t96
+    t680 = xp.where(xp.greater_equal(t96, -2.9670597283903604) & xp.less_equal(t96, 2.9670597283903604), t96, xp.where(xp.greater_equal(t678, -2.9670597283903604) & xp.less_equal(t678, 2.9670597283903604), t678, xp.where(xp.greater_equal(t679, -2.9670597283903604) & xp.less_equal(t679, 2.9670597283903604), t679, qb15_5)))
+    t681 = qw1*(t122 + t660)**2 + qw2*(t123 + t664)**2 + qw3*(t124 + t668)**2 + qw4*(t125 + t672)**2 + qw5*(t126 + t676)**2 + qw6*(t127 + t680)**2 + qw7*(t128 + qb15_6)**2
+    t682 = xp.greater(xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0), 0)
+    t683 = xp.where(t682 & (xp.less(t647, 1) | xp.less(t681, t656)), xp.asarray(1, dtype=dtype), 0)
+    t684 = xp.where(t682, 1, t647)
+    t685 = xp.greater(t683, 0)
+    t686 = xp.where(t685, t660, t649)
+    t687 = xp.where(t685, t664, t650)
+    t688 = xp.where(t685, t668, t651)
+    t689 = xp.where(t685, t672, t652)
+    t690 = xp.where(t685, t676, t653)
+    t691 = xp.where(t685, t680, t654)
+    t692 = xp.where(t685, qb15_6, t655)
+    t693 = xp.greater(t684, 0)
+    t694 = xp.isfinite(t97)
+    t695 = t693 & t694
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t19, t16[0], qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t19, t16[1], qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t19, t16[2], qn3), batch),  # 2
-        xp.broadcast_to(xp.where(t19, t16[3], qn4), batch),  # 3
-        xp.broadcast_to(xp.where(t19, t16[4], qn5), batch),  # 4
-        xp.broadcast_to(xp.where(t19, t16[5], qn6), batch),  # 5
-        xp.broadcast_to(xp.where(t19, t16[6], qn7), batch),  # 6
+        xp.broadcast_to(xp.where(t695, t686, qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t695, t687, qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t695, t688, qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t695, t689, qn4), batch),  # 3
+        xp.broadcast_to(xp.where(t695, t690, qn5), batch),  # 4
+        xp.broadcast_to(xp.where(t695, t691, qn6), batch),  # 5
+        xp.broadcast_to(xp.where(t695, t692, qn7), batch),  # 6
     ], (7,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t18), 2, xp.where(t17, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t694), 2, xp.where(t693, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

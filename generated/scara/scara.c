@@ -501,7 +501,7 @@ static void jacgen_jacobi4_rows(int count, jacgen_jacobi4_rows_state *state)
 
 typedef struct { scara_real w[14]; } jacgen_symmetric_solve4_state;
 
-/* X solving a symmetric 4 x 4 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular: 217 operations a run. */
+/* The solution x of a symmetric 4 x 4 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular: 217 operations a run. */
 static void jacgen_symmetric_solve4(int count, jacgen_symmetric_solve4_state *state)
 {
     JACGEN_KERNEL_LOOP
@@ -598,6 +598,103 @@ static void jacgen_symmetric_solve4(int count, jacgen_symmetric_solve4_state *st
         state->w[2] = t69;
         state->w[3] = t68;
         state->w[4] = ((t5 <= t72) || (t33 <= t72) || (t52 <= t72) || (t64 <= t72) ? 1 : 0);
+    }
+}
+
+typedef struct { scara_real w[12]; } jacgen_velocity_solve_state;
+
+/* The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status: 399 operations a run. */
+static void jacgen_velocity_solve(int count, jacgen_velocity_solve_state *state)
+{
+    JACGEN_KERNEL_LOOP
+    for (int run = 0; run < count; run++) {
+        const scara_real w0 = state->w[0];
+        const scara_real w1 = state->w[1];
+        const scara_real w2 = state->w[2];
+        const scara_real w3 = state->w[3];
+        const scara_real w4 = state->w[4];
+        const scara_real w5 = state->w[5];
+        const scara_real w6 = state->w[6];
+        const scara_real w7 = state->w[7];
+        const scara_real w8 = state->w[8];
+        const scara_real w9 = state->w[9];
+        const scara_real w10 = state->w[10];
+        const scara_real w11 = state->w[11];
+        const scara_real c12 = w0*w2 - w1*w3;
+        const scara_real s12 = w0*w3 + w2*w1;
+        const scara_real t0 = 0.275*c12;
+        const scara_real t1 = 0.325*w0 + t0;
+        const scara_real t2 = 0.275*s12;
+        const scara_real t3 = 0.325*w1 + t2;
+        const scara_real t4 = t1*t3 + 0.075625*c12*s12;
+        const scara_real t5 = t3 + t2;
+        const scara_real t6 = (t3*t3);
+        const scara_real t7 = t6 + 0.075625*(s12*s12);
+        const scara_real t8 = (t1*t1);
+        const scara_real t9 = sqrt(1 + t6 + t8);
+        const scara_real t10 = (t3 <= 0 ? 1 : -1)*t9;
+        const scara_real t11 = t8 + 0.075625*(c12*c12);
+        const scara_real t12 = sqrt(4 + t7 + t11);
+        const scara_real t13 = t1 + t0;
+        const scara_real t14 = (w11*w11);
+        jacgen_symmetric_solve4_state t15 = {{t7 + t14, -t4, 0, -t5, t11 + t14, 0, t13, 1 + t14, 0, 3 + t14, w7, w8, w9, w10}};
+        jacgen_symmetric_solve4(1, &t15);
+        const scara_real t16 = t15.w[2];
+        const scara_real t17 = t15.w[3];
+        const scara_real t18 = t15.w[0];
+        const scara_real t19 = t15.w[1];
+        const scara_real t20 = t17 - t3*t18 + t1*t19;
+        const scara_real t21 = t17 - t2*t18 + t0*t19;
+        const int t22 = t9 > 0;
+        const scara_real t23 = (t22 ? 1 + fabs(t3)/t9 : 0);
+        const scara_real t24 = -t3;
+        const scara_real t25 = (t22 ? 1.0/(t24 + t10) : 0);
+        const scara_real t26 = -t2;
+        const scara_real t27 = w0 + w2 + w1 + w3 + w4 + w5 + w6 + t13 + t24 + t26 + w7 + w8 + w9 + w10 + w11;
+        const scara_real t28 = t1*t25;
+        const scara_real t29 = t23*(t26 + t25 + t0*t28);
+        const scara_real t30 = t2 + t29;
+        const scara_real t31 = t23*(w7 + w10*t25 + t28*w8);
+        const scara_real t32 = -t31 + w7;
+        const scara_real t33 = t25*t29;
+        const scara_real t34 = t0 - t1*t33;
+        const scara_real t35 = 1 - t33;
+        const scara_real t36 = sqrt((t34*t34) + (t35*t35));
+        const scara_real t37 = t36*(t34 >= 0 ? 1 : -1);
+        const scara_real t38 = (t25*t25)*t23;
+        const scara_real t39 = t1*t38;
+        const scara_real t40 = -1 + t38;
+        const scara_real t41 = t25*t31;
+        const scara_real t42 = w8 - t1*t41;
+        const scara_real t43 = -t41 + w10;
+        const int t44 = t36 > 0;
+        const scara_real t45 = (t44 ? 1.0/(t34 + t37) : 0);
+        const scara_real t46 = (t44 ? 1 + fabs(t34)/t36 : 0);
+        const scara_real t47 = t35*t45;
+        const scara_real t48 = t46*(t39 + t47*t40);
+        const scara_real t49 = -t48 + t39;
+        const scara_real t50 = t40 - t47*t48;
+        const scara_real t51 = t46*(t42 + t47*t43);
+        const scara_real t52 = -t51 + t42;
+        const scara_real t53 = t43 - t47*t51;
+        const scara_real t54 = fabs(t50);
+        const scara_real t55 = t54*(t50 >= 0 ? 1 : -1);
+        const scara_real t56 = (t54 > 0 ? 2 : 0);
+        const scara_real t57 = t53 - t53*t56;
+        const scara_real t58 = (t55 != 0 ? -t57/t55 : 0);
+        const scara_real t59 = (t37 != 0 ? -(t52 - t49*t58)/t37 : 0);
+        const scara_real t60 = (t10 != 0 ? -(-(-t30*t59 + t25*t23*t58) + t32)/t10 : 0);
+        const int t61 = isfinite(t27);
+        const int t62 = w11 >= 0;
+        const int t63 = w11 > 0;
+        const scara_real t64 = 1e-12*t12;
+        const int t65 = (t63 && t15.w[4] > 0) || (w11 <= 0 && ((t9 <= t64) || (t36 <= t64) || (1 <= t64) || (t54 <= t64)));
+        const int t66 = t61 && t62 && !t65;
+        state->w[0] = (t66 ? (t63 ? t20 : t60) : 0);
+        state->w[1] = (t66 ? (t63 ? t21 : t59) : 0);
+        state->w[2] = (t66 ? (t63 ? -t16 : -w9) : 0);
+        state->w[3] = (t66 ? (t63 ? -t17 : t58) : 0);
+        state->w[4] = (!(t61 && t62) ? 2 : (t65 ? 1 : 0));
     }
 }
 
@@ -1764,7 +1861,7 @@ scara_real scara_condition_number(const scara_real q[SCARA_DOF])
 
 int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], scara_real damping, scara_real q_dot[SCARA_DOF])
 {
-    /* 400 operations */
+    /* 405 operations */
 
     /* Inputs */
     const scara_real q1 = q[0];
@@ -1781,88 +1878,23 @@ int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCA
     const scara_real s1 = sin(q1);
     const scara_real c2 = cos(q2);
     const scara_real s2 = sin(q2);
-    const scara_real c12 = c1*c2 - s1*s2;
-    const scara_real s12 = c1*s2 + c2*s1;
-    const scara_real t0 = 0.275*c12;
-    const scara_real t1 = 0.325*c1 + t0;
-    const scara_real t2 = 0.275*s12;
-    const scara_real t3 = 0.325*s1 + t2;
-    const scara_real t4 = t1*t3 + 0.075625*c12*s12;
-    const scara_real t5 = t3 + t2;
-    const scara_real t6 = (t3*t3);
-    const scara_real t7 = t6 + 0.075625*(s12*s12);
-    const scara_real t8 = (t1*t1);
-    const scara_real t9 = sqrt(1 + t6 + t8);
-    const scara_real t10 = (t3 <= 0 ? 1 : -1)*t9;
-    const scara_real t11 = t8 + 0.075625*(c12*c12);
-    const scara_real t12 = sqrt(4 + t7 + t11);
-    const scara_real t13 = t1 + t0;
-    const scara_real t14 = (damping*damping);
-    jacgen_symmetric_solve4_state t15 = {{t7 + t14, -t4, 0, -t5, t11 + t14, 0, t13, 1 + t14, 0, 3 + t14, mu_dot0, mu_dot1, mu_dot2, mu_dot3}};
-    jacgen_symmetric_solve4(1, &t15);
-    const scara_real t16 = t15.w[2];
-    const scara_real t17 = t15.w[3];
-    const scara_real t18 = t15.w[0];
-    const scara_real t19 = t15.w[1];
-    const scara_real t20 = t17 - t3*t18 + t1*t19;
-    const scara_real t21 = t17 - t2*t18 + t0*t19;
-    const int t22 = t9 > 0;
-    const scara_real t23 = (t22 ? 1 + fabs(t3)/t9 : 0);
-    const scara_real t24 = -t3;
-    const scara_real t25 = (t22 ? 1.0/(t24 + t10) : 0);
-    const scara_real t26 = -t2;
-    const scara_real t27 = q1 + q2 + q3 + q4 + t13 + t24 + t26 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping;
-    const scara_real t28 = t1*t25;
-    const scara_real t29 = t23*(t26 + t25 + t0*t28);
-    const scara_real t30 = t2 + t29;
-    const scara_real t31 = t23*(mu_dot0 + mu_dot3*t25 + t28*mu_dot1);
-    const scara_real t32 = -t31 + mu_dot0;
-    const scara_real t33 = t25*t29;
-    const scara_real t34 = t0 - t1*t33;
-    const scara_real t35 = 1 - t33;
-    const scara_real t36 = sqrt((t34*t34) + (t35*t35));
-    const scara_real t37 = t36*(t34 >= 0 ? 1 : -1);
-    const scara_real t38 = (t25*t25)*t23;
-    const scara_real t39 = t1*t38;
-    const scara_real t40 = -1 + t38;
-    const scara_real t41 = t25*t31;
-    const scara_real t42 = mu_dot1 - t1*t41;
-    const scara_real t43 = -t41 + mu_dot3;
-    const int t44 = t36 > 0;
-    const scara_real t45 = (t44 ? 1.0/(t34 + t37) : 0);
-    const scara_real t46 = (t44 ? 1 + fabs(t34)/t36 : 0);
-    const scara_real t47 = t35*t45;
-    const scara_real t48 = t46*(t39 + t47*t40);
-    const scara_real t49 = -t48 + t39;
-    const scara_real t50 = t40 - t47*t48;
-    const scara_real t51 = t46*(t42 + t47*t43);
-    const scara_real t52 = -t51 + t42;
-    const scara_real t53 = t43 - t47*t51;
-    const scara_real t54 = fabs(t50);
-    const scara_real t55 = t54*(t50 >= 0 ? 1 : -1);
-    const scara_real t56 = (t54 > 0 ? 2 : 0);
-    const scara_real t57 = t53 - t53*t56;
-    const scara_real t58 = (t55 != 0 ? -t57/t55 : 0);
-    const scara_real t59 = (t37 != 0 ? -(t52 - t49*t58)/t37 : 0);
-    const scara_real t60 = (t10 != 0 ? -(-(-t30*t59 + t25*t23*t58) + t32)/t10 : 0);
-    const int t61 = isfinite(t27);
-    const int t62 = damping >= 0;
-    const int t63 = damping > 0;
-    const scara_real t64 = 1e-12*t12;
-    const int t65 = (t63 && t15.w[4] > 0) || (damping <= 0 && ((t9 <= t64) || (t36 <= t64) || (1 <= t64) || (t54 <= t64)));
-    const int t66 = t61 && t62 && !t65;
+    const scara_real c4 = cos(q4);
+    const scara_real s4 = sin(q4);
+    jacgen_velocity_solve_state t0 = {{c1, s1, c2, s2, q3, c4, s4, mu_dot0, mu_dot1, mu_dot2, mu_dot3, damping}};
+    jacgen_velocity_solve(1, &t0);
 
     /* Outputs */
-    q_dot[0] = (t66 ? (t63 ? t20 : t60) : 0);
-    q_dot[1] = (t66 ? (t63 ? t21 : t59) : 0);
-    q_dot[2] = (t66 ? (t63 ? -t16 : -mu_dot2) : 0);
-    q_dot[3] = (t66 ? (t63 ? -t17 : t58) : 0);
-    return (!(t61 && t62) ? 2 : (t65 ? 1 : 0));
+    q_dot[0] = t0.w[0];
+    q_dot[1] = t0.w[1];
+    q_dot[2] = t0.w[2];
+    q_dot[3] = t0.w[3];
+    return (int)t0.w[4];
 }
 
 int scara_velocity_ik_nullspace(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], const scara_real z[SCARA_DOF], scara_real damping, scara_real q_dot[SCARA_DOF])
 {
-    /* 404 operations */
+    /* 405 operations */
+    (void)z;
 
     /* Inputs */
     const scara_real q1 = q[0];
@@ -1873,98 +1905,29 @@ int scara_velocity_ik_nullspace(const scara_real q[SCARA_DOF], const scara_real 
     const scara_real mu_dot1 = mu_dot[1];
     const scara_real mu_dot2 = mu_dot[2];
     const scara_real mu_dot3 = mu_dot[3];
-    const scara_real qz1 = z[0];
-    const scara_real qz2 = z[1];
-    const scara_real qz3 = z[2];
-    const scara_real qz4 = z[3];
 
     /* Intermediate terms */
     const scara_real c1 = cos(q1);
     const scara_real s1 = sin(q1);
     const scara_real c2 = cos(q2);
     const scara_real s2 = sin(q2);
-    const scara_real c12 = c1*c2 - s1*s2;
-    const scara_real s12 = c1*s2 + c2*s1;
-    const scara_real t0 = 0.275*c12;
-    const scara_real t1 = 0.325*c1 + t0;
-    const scara_real t2 = 0.275*s12;
-    const scara_real t3 = 0.325*s1 + t2;
-    const scara_real t4 = t1*t3 + 0.075625*c12*s12;
-    const scara_real t5 = t3 + t2;
-    const scara_real t6 = (t3*t3);
-    const scara_real t7 = t6 + 0.075625*(s12*s12);
-    const scara_real t8 = (t1*t1);
-    const scara_real t9 = sqrt(1 + t6 + t8);
-    const scara_real t10 = (t3 <= 0 ? 1 : -1)*t9;
-    const scara_real t11 = t8 + 0.075625*(c12*c12);
-    const scara_real t12 = sqrt(4 + t7 + t11);
-    const scara_real t13 = t1 + t0;
-    const scara_real t14 = (damping*damping);
-    jacgen_symmetric_solve4_state t15 = {{t7 + t14, -t4, 0, -t5, t11 + t14, 0, t13, 1 + t14, 0, 3 + t14, mu_dot0, mu_dot1, mu_dot2, mu_dot3}};
-    jacgen_symmetric_solve4(1, &t15);
-    const scara_real t16 = t15.w[2];
-    const scara_real t17 = t15.w[3];
-    const scara_real t18 = t15.w[0];
-    const scara_real t19 = t15.w[1];
-    const scara_real t20 = t17 - t3*t18 + t1*t19;
-    const scara_real t21 = t17 - t2*t18 + t0*t19;
-    const int t22 = t9 > 0;
-    const scara_real t23 = (t22 ? 1 + fabs(t3)/t9 : 0);
-    const scara_real t24 = -t3;
-    const scara_real t25 = (t22 ? 1.0/(t24 + t10) : 0);
-    const scara_real t26 = -t2;
-    const scara_real t27 = q1 + q2 + q3 + q4 + t13 + t24 + t26 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + qz1 + qz2 + qz3 + qz4;
-    const scara_real t28 = t1*t25;
-    const scara_real t29 = t23*(t26 + t25 + t0*t28);
-    const scara_real t30 = t2 + t29;
-    const scara_real t31 = t23*(mu_dot0 + mu_dot3*t25 + t28*mu_dot1);
-    const scara_real t32 = -t31 + mu_dot0;
-    const scara_real t33 = t25*t29;
-    const scara_real t34 = t0 - t1*t33;
-    const scara_real t35 = 1 - t33;
-    const scara_real t36 = sqrt((t34*t34) + (t35*t35));
-    const scara_real t37 = t36*(t34 >= 0 ? 1 : -1);
-    const scara_real t38 = (t25*t25)*t23;
-    const scara_real t39 = t1*t38;
-    const scara_real t40 = -1 + t38;
-    const scara_real t41 = t25*t31;
-    const scara_real t42 = mu_dot1 - t1*t41;
-    const scara_real t43 = -t41 + mu_dot3;
-    const int t44 = t36 > 0;
-    const scara_real t45 = (t44 ? 1.0/(t34 + t37) : 0);
-    const scara_real t46 = (t44 ? 1 + fabs(t34)/t36 : 0);
-    const scara_real t47 = t35*t45;
-    const scara_real t48 = t46*(t39 + t47*t40);
-    const scara_real t49 = -t48 + t39;
-    const scara_real t50 = t40 - t47*t48;
-    const scara_real t51 = t46*(t42 + t47*t43);
-    const scara_real t52 = -t51 + t42;
-    const scara_real t53 = t43 - t47*t51;
-    const scara_real t54 = fabs(t50);
-    const scara_real t55 = t54*(t50 >= 0 ? 1 : -1);
-    const scara_real t56 = (t54 > 0 ? 2 : 0);
-    const scara_real t57 = t53 - t53*t56;
-    const scara_real t58 = (t55 != 0 ? -t57/t55 : 0);
-    const scara_real t59 = (t37 != 0 ? -(t52 - t49*t58)/t37 : 0);
-    const scara_real t60 = (t10 != 0 ? -(-(-t30*t59 + t25*t23*t58) + t32)/t10 : 0);
-    const int t61 = isfinite(t27);
-    const int t62 = damping >= 0;
-    const int t63 = damping > 0;
-    const scara_real t64 = 1e-12*t12;
-    const int t65 = (t63 && t15.w[4] > 0) || (damping <= 0 && ((t9 <= t64) || (t36 <= t64) || (1 <= t64) || (t54 <= t64)));
-    const int t66 = t61 && t62 && !t65;
+    const scara_real c4 = cos(q4);
+    const scara_real s4 = sin(q4);
+    jacgen_velocity_solve_state t0 = {{c1, s1, c2, s2, q3, c4, s4, mu_dot0, mu_dot1, mu_dot2, mu_dot3, damping}};
+    jacgen_velocity_solve(1, &t0);
 
     /* Outputs */
-    q_dot[0] = (t66 ? (t63 ? t20 : t60) : 0);
-    q_dot[1] = (t66 ? (t63 ? t21 : t59) : 0);
-    q_dot[2] = (t66 ? (t63 ? -t16 : -mu_dot2) : 0);
-    q_dot[3] = (t66 ? (t63 ? -t17 : t58) : 0);
-    return (!(t61 && t62) ? 2 : (t65 ? 1 : 0));
+    q_dot[0] = t0.w[0];
+    q_dot[1] = t0.w[1];
+    q_dot[2] = t0.w[2];
+    q_dot[3] = t0.w[3];
+    return (int)t0.w[4];
 }
 
 int scara_resolved_rate(const scara_real q[SCARA_DOF], const scara_real target[SCARA_TASK_DIM], const scara_real target_rate[SCARA_TASK_DIM], const scara_real gain[SCARA_TASK_DIM], const scara_real z[SCARA_DOF], scara_real damping, scara_real q_dot[SCARA_DOF])
 {
-    /* 432 operations */
+    /* 443 operations */
+    (void)z;
 
     /* Inputs */
     const scara_real q1 = q[0];
@@ -1983,10 +1946,6 @@ int scara_resolved_rate(const scara_real q[SCARA_DOF], const scara_real target[S
     const scara_real gain1 = gain[1];
     const scara_real gain2 = gain[2];
     const scara_real gain3 = gain[3];
-    const scara_real qz1 = z[0];
-    const scara_real qz2 = z[1];
-    const scara_real qz3 = z[2];
-    const scara_real qz4 = z[3];
 
     /* Intermediate terms */
     const scara_real c1 = cos(q1);
@@ -1997,89 +1956,25 @@ int scara_resolved_rate(const scara_real q[SCARA_DOF], const scara_real target[S
     const scara_real s12 = c1*s2 + c2*s1;
     const scara_real c4 = cos(q4);
     const scara_real s4 = sin(q4);
-    const scara_real t0 = 0.387 - q3;
-    const scara_real t1 = c12*c4 + s12*s4;
-    const scara_real t2 = s12*c4 - c12*s4;
-    const scara_real t3 = mu_dot2 + gain2*(-t0 + mu2);
-    const scara_real t4 = 0.275*c12;
-    const scara_real t5 = 0.325*c1 + t4;
-    const scara_real t6 = mu_dot0 + gain0*(-t5 + mu0);
-    const scara_real t7 = 0.275*s12;
-    const scara_real t8 = 0.325*s1 + t7;
-    const scara_real t9 = t5*t8 + 0.075625*c12*s12;
-    const scara_real t10 = t8 + t7;
-    const scara_real t11 = (t8*t8);
-    const scara_real t12 = t11 + 0.075625*(s12*s12);
-    const scara_real t13 = (t5*t5);
-    const scara_real t14 = sqrt(1 + t11 + t13);
-    const scara_real t15 = (t8 <= 0 ? 1 : -1)*t14;
-    const scara_real t16 = t13 + 0.075625*(c12*c12);
-    const scara_real t17 = sqrt(4 + t12 + t16);
-    const scara_real t18 = t5 + t4;
-    const int t19 = t14 > 0;
-    const scara_real t20 = (t19 ? 1 + fabs(t8)/t14 : 0);
-    const scara_real t21 = -t8;
-    const scara_real t22 = (t19 ? 1.0/(t21 + t15) : 0);
-    const scara_real t23 = mu_dot1 + gain1*(t21 + mu1);
-    const scara_real t24 = -t7;
-    const scara_real t25 = t5*t22;
-    const scara_real t26 = t20*(t24 + t22 + t4*t25);
-    const scara_real t27 = t7 + t26;
-    const scara_real t28 = t22*t26;
-    const scara_real t29 = t4 - t5*t28;
-    const scara_real t30 = 1 - t28;
-    const scara_real t31 = sqrt((t29*t29) + (t30*t30));
-    const scara_real t32 = t31*(t29 >= 0 ? 1 : -1);
-    const scara_real t33 = (t22*t22)*t20;
-    const scara_real t34 = t5*t33;
-    const scara_real t35 = -1 + t33;
-    const int t36 = t31 > 0;
-    const scara_real t37 = (t36 ? 1.0/(t29 + t32) : 0);
-    const scara_real t38 = (t36 ? 1 + fabs(t29)/t31 : 0);
-    const scara_real t39 = t30*t37;
-    const scara_real t40 = t38*(t34 + t39*t35);
-    const scara_real t41 = -t40 + t34;
-    const scara_real t42 = t35 - t39*t40;
-    const scara_real t43 = fabs(t42);
-    const scara_real t44 = t43*(t42 >= 0 ? 1 : -1);
-    const scara_real t45 = (t43 > 0 ? 2 : 0);
-    const scara_real t46 = -mu3 + atan2(t2, t1);
-    const scara_real t47 = mu_dot3 - gain3*(t46 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t46)));
-    const scara_real t48 = t20*(t6 + t22*t47 + t25*t23);
-    const scara_real t49 = -t48 + t6;
-    const scara_real t50 = q1 + q2 + q3 + q4 + t18 + t21 + t24 + damping + qz1 + qz2 + qz3 + qz4 + t6 + t23 + t3 + t47;
-    const scara_real t51 = (damping*damping);
-    jacgen_symmetric_solve4_state t52 = {{t12 + t51, -t9, 0, -t10, t16 + t51, 0, t18, 1 + t51, 0, 3 + t51, t6, t23, t3, t47}};
-    jacgen_symmetric_solve4(1, &t52);
-    const scara_real t53 = t52.w[2];
-    const scara_real t54 = t52.w[3];
-    const scara_real t55 = t52.w[0];
-    const scara_real t56 = t52.w[1];
-    const scara_real t57 = t54 - t8*t55 + t5*t56;
-    const scara_real t58 = t54 - t7*t55 + t4*t56;
-    const scara_real t59 = t22*t48;
-    const scara_real t60 = t23 - t5*t59;
-    const scara_real t61 = -t59 + t47;
-    const scara_real t62 = t38*(t60 + t39*t61);
-    const scara_real t63 = -t62 + t60;
-    const scara_real t64 = t61 - t39*t62;
-    const scara_real t65 = t64 - t45*t64;
-    const scara_real t66 = (t44 != 0 ? -t65/t44 : 0);
-    const scara_real t67 = (t32 != 0 ? -(t63 - t41*t66)/t32 : 0);
-    const scara_real t68 = (t15 != 0 ? -(-(-t27*t67 + t22*t20*t66) + t49)/t15 : 0);
-    const int t69 = isfinite(t50);
-    const int t70 = damping >= 0;
-    const int t71 = damping > 0;
-    const scara_real t72 = 1e-12*t17;
-    const int t73 = (t71 && t52.w[4] > 0) || (damping <= 0 && ((t14 <= t72) || (t31 <= t72) || (1 <= t72) || (t43 <= t72)));
-    const int t74 = t69 && t70 && !t73;
+    const scara_real t0 = 0.275*c12 + 0.325*c1;
+    const scara_real t1 = 0.275*s12 + 0.325*s1;
+    const scara_real t2 = 0.387 - q3;
+    const scara_real t3 = c12*c4 + s12*s4;
+    const scara_real t4 = s12*c4 - c12*s4;
+    const scara_real t5 = mu_dot0 + gain0*(-t0 + mu0);
+    const scara_real t6 = mu_dot1 + gain1*(-t1 + mu1);
+    const scara_real t7 = mu_dot2 + gain2*(-t2 + mu2);
+    const scara_real t8 = -mu3 + atan2(t4, t3);
+    const scara_real t9 = mu_dot3 - gain3*(t8 + 6.283185307179586*ceil(-0.15915494309189535*(3.141592653589793 + t8)));
+    jacgen_velocity_solve_state t10 = {{c1, s1, c2, s2, q3, c4, s4, t5, t6, t7, t9, damping}};
+    jacgen_velocity_solve(1, &t10);
 
     /* Outputs */
-    q_dot[0] = (t74 ? (t71 ? t57 : t68) : 0);
-    q_dot[1] = (t74 ? (t71 ? t58 : t67) : 0);
-    q_dot[2] = (t74 ? (t71 ? -t53 : -t3) : 0);
-    q_dot[3] = (t74 ? (t71 ? -t54 : t66) : 0);
-    return (!(t69 && t70) ? 2 : (t73 ? 1 : 0));
+    q_dot[0] = t10.w[0];
+    q_dot[1] = t10.w[1];
+    q_dot[2] = t10.w[2];
+    q_dot[3] = t10.w[3];
+    return (int)t10.w[4];
 }
 
 scara_real scara_ik_numeric_step(const scara_real target[SCARA_TASK_DIM], const scara_real q[SCARA_DOF], scara_real damping, scara_real q_start[SCARA_DOF], scara_real q_next[SCARA_DOF])

@@ -111,15 +111,15 @@ void scara_velocity_ellipsoid(const scara_real q[SCARA_DOF], scara_real U_v[9], 
 scara_real scara_condition_number(const scara_real q[SCARA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 4; returned as a scalar. 400 operations. */
+ * Result: q_dot[i], i < 4; returned as a scalar. 405 operations. */
 int scara_velocity_ik(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], scara_real damping, scara_real q_dot[SCARA_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 4; returned as a scalar. 404 operations. */
+ * Result: q_dot[i], i < 4; returned as a scalar. 405 operations. */
 int scara_velocity_ik_nullspace(const scara_real q[SCARA_DOF], const scara_real mu_dot[SCARA_TASK_DIM], const scara_real z[SCARA_DOF], scara_real damping, scara_real q_dot[SCARA_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 4; returned as a scalar. 432 operations. */
+ * Result: q_dot[i], i < 4; returned as a scalar. 443 operations. */
 int scara_resolved_rate(const scara_real q[SCARA_DOF], const scara_real target[SCARA_TASK_DIM], const scara_real target_rate[SCARA_TASK_DIM], const scara_real gain[SCARA_TASK_DIM], const scara_real z[SCARA_DOF], scara_real damping, scara_real q_dot[SCARA_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).

@@ -82,7 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -336,7 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi4_rows(xp, count, state):
     """One-sided Jacobi sweep of a 4 x 4 matrix (its rows), `count` times: 352 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2
@@ -522,9 +522,9 @@ def _jacobi4_rows(xp, count, state):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _symmetric_solve4(xp, count, state):
-    """X solving a symmetric 4 x 4 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 217 operations a run."""
+    """The solution x of a symmetric 4 x 4 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 217 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, = state
         t0 = w1**2
@@ -611,10 +611,96 @@ def _symmetric_solve4(xp, count, state):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _velocity_solve(xp, count, state):
+    """The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status, `count` times: 399 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, = state
+        c12 = w0*w2 - w1*w3
+        s12 = w0*w3 + w2*w1
+        t0 = 0.275*c12
+        t1 = 0.325*w0 + t0
+        t2 = 0.275*s12
+        t3 = 0.325*w1 + t2
+        t4 = t1*t3 + 0.075625*c12*s12
+        t5 = t3 + t2
+        t6 = t3**2
+        t7 = t6 + 0.075625*s12**2
+        t8 = t1**2
+        t9 = xp.sqrt(1 + t6 + t8)
+        t10 = xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)*t9
+        t11 = t8 + 0.075625*c12**2
+        t12 = xp.sqrt(4 + t7 + t11)
+        t13 = t1 + t0
+        t14 = w11**2
+        t15 = _symmetric_solve4(xp, 1, (t7 + t14, -t4, xp.full(batch, 0, dtype=dtype, device=device), -t5, t11 + t14, xp.full(batch, 0, dtype=dtype, device=device), t13, 1 + t14, xp.full(batch, 0, dtype=dtype, device=device), 3 + t14, w7, w8, w9, w10,))
+        t16 = t15[2]
+        t17 = t15[3]
+        t18 = t15[0]
+        t19 = t15[1]
+        t20 = t17 - t3*t18 + t1*t19
+        t21 = t17 - t2*t18 + t0*t19
+        t22 = xp.greater(t9, 0)
+        t23 = xp.where(t22, 1 + xp.abs(t3)/t9, 0)
+        t24 = -t3
+        t25 = xp.where(t22, 1/(t24 + t10), 0)
+        t26 = -t2
+        t27 = w0 + w2 + w1 + w3 + w4 + w5 + w6 + t13 + t24 + t26 + w7 + w8 + w9 + w10 + w11
+        t28 = t1*t25
+        t29 = t23*(t26 + t25 + t0*t28)
+        t30 = t2 + t29
+        t31 = t23*(w7 + w10*t25 + t28*w8)
+        t32 = -t31 + w7
+        t33 = t25*t29
+        t34 = t0 - t1*t33
+        t35 = 1 - t33
+        t36 = xp.sqrt(t34**2 + t35**2)
+        t37 = t36*xp.where(xp.greater_equal(t34, 0), xp.asarray(1, dtype=dtype), -1)
+        t38 = t25**2*t23
+        t39 = t1*t38
+        t40 = -1 + t38
+        t41 = t25*t31
+        t42 = w8 - t1*t41
+        t43 = -t41 + w10
+        t44 = xp.greater(t36, 0)
+        t45 = xp.where(t44, 1/(t34 + t37), 0)
+        t46 = xp.where(t44, 1 + xp.abs(t34)/t36, 0)
+        t47 = t35*t45
+        t48 = t46*(t39 + t47*t40)
+        t49 = -t48 + t39
+        t50 = t40 - t47*t48
+        t51 = t46*(t42 + t47*t43)
+        t52 = -t51 + t42
+        t53 = t43 - t47*t51
+        t54 = xp.abs(t50)
+        t55 = t54*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
+        t56 = xp.where(xp.greater(t54, 0), xp.asarray(2, dtype=dtype), 0)
+        t57 = t53 - t53*t56
+        t58 = xp.where(xp.not_equal(t55, 0), -t57/t55, 0)
+        t59 = xp.where(xp.not_equal(t37, 0), -(t52 - t49*t58)/t37, 0)
+        t60 = xp.where(xp.not_equal(t10, 0), -(-(-t30*t59 + t25*t23*t58) + t32)/t10, 0)
+        t61 = xp.isfinite(t27)
+        t62 = xp.greater_equal(w11, 0)
+        t63 = xp.greater(w11, 0)
+        t64 = 1e-12*t12
+        t65 = (t63 & xp.greater(t15[4], 0)) | (xp.less_equal(w11, 0) & (xp.less_equal(t9, t64) | xp.less_equal(t36, t64) | xp.less_equal(1, t64) | xp.less_equal(t54, t64)))
+        t66 = t61 & t62 & xp.logical_not(t65)
+        state = (
+            xp.where(t66, xp.where(t63, t20, t60), 0),
+            xp.where(t66, xp.where(t63, t21, t59), 0),
+            xp.where(t66, xp.where(t63, -t16, -w9), 0),
+            xp.where(t66, xp.where(t63, -t17, t58), 0),
+            xp.where(xp.logical_not(t61 & t62), 2, xp.where(t65, xp.asarray(1, dtype=dtype), 0)),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _nearer_branch(xp, count, state):
     """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 65 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, = state
         t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w5))
@@ -1680,14 +1766,10 @@ def condition_number(q):
     return kappa
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 400 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (4 x 1 and 1 x 1), 405 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (4,)), ("mu_dot", mu_dot, (4,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
     q3 = q[..., 2]
-    q4 = q[..., 3]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
@@ -1697,193 +1779,49 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s1 = trig[..., 1]
     c2 = trig[..., 2]
     s2 = trig[..., 3]
-    c12 = c1*c2 - s1*s2
-    s12 = c1*s2 + c2*s1
-    t0 = 0.275*c12
-    t1 = 0.325*c1 + t0
-    t2 = 0.275*s12
-    t3 = 0.325*s1 + t2
-    t4 = t1*t3 + 0.075625*c12*s12
-    t5 = t3 + t2
-    t6 = t3**2
-    t7 = t6 + 0.075625*s12**2
-    t8 = t1**2
-    t9 = xp.sqrt(1 + t6 + t8)
-    t10 = xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)*t9
-    t11 = t8 + 0.075625*c12**2
-    t12 = xp.sqrt(4 + t7 + t11)
-    t13 = t1 + t0
-    t14 = damping**2
-    t15 = _symmetric_solve4(xp, 1, (t7 + t14, -t4, xp.full(batch, 0, dtype=dtype, device=device), -t5, t11 + t14, xp.full(batch, 0, dtype=dtype, device=device), t13, 1 + t14, xp.full(batch, 0, dtype=dtype, device=device), 3 + t14, mu_dot0, mu_dot1, mu_dot2, mu_dot3,))
-    t16 = t15[2]
-    t17 = t15[3]
-    t18 = t15[0]
-    t19 = t15[1]
-    t20 = t17 - t3*t18 + t1*t19
-    t21 = t17 - t2*t18 + t0*t19
-    t22 = xp.greater(t9, 0)
-    t23 = xp.where(t22, 1 + xp.abs(t3)/t9, 0)
-    t24 = -t3
-    t25 = xp.where(t22, 1/(t24 + t10), 0)
-    t26 = -t2
-    t27 = q1 + q2 + q3 + q4 + t13 + t24 + t26 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping
-    t28 = t1*t25
-    t29 = t23*(t26 + t25 + t0*t28)
-    t30 = t2 + t29
-    t31 = t23*(mu_dot0 + mu_dot3*t25 + t28*mu_dot1)
-    t32 = -t31 + mu_dot0
-    t33 = t25*t29
-    t34 = t0 - t1*t33
-    t35 = 1 - t33
-    t36 = xp.sqrt(t34**2 + t35**2)
-    t37 = t36*xp.where(xp.greater_equal(t34, 0), xp.asarray(1, dtype=dtype), -1)
-    t38 = t25**2*t23
-    t39 = t1*t38
-    t40 = -1 + t38
-    t41 = t25*t31
-    t42 = mu_dot1 - t1*t41
-    t43 = -t41 + mu_dot3
-    t44 = xp.greater(t36, 0)
-    t45 = xp.where(t44, 1/(t34 + t37), 0)
-    t46 = xp.where(t44, 1 + xp.abs(t34)/t36, 0)
-    t47 = t35*t45
-    t48 = t46*(t39 + t47*t40)
-    t49 = -t48 + t39
-    t50 = t40 - t47*t48
-    t51 = t46*(t42 + t47*t43)
-    t52 = -t51 + t42
-    t53 = t43 - t47*t51
-    t54 = xp.abs(t50)
-    t55 = t54*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
-    t56 = xp.where(xp.greater(t54, 0), xp.asarray(2, dtype=dtype), 0)
-    t57 = t53 - t53*t56
-    t58 = xp.where(xp.not_equal(t55, 0), -t57/t55, 0)
-    t59 = xp.where(xp.not_equal(t37, 0), -(t52 - t49*t58)/t37, 0)
-    t60 = xp.where(xp.not_equal(t10, 0), -(-(-t30*t59 + t25*t23*t58) + t32)/t10, 0)
-    t61 = xp.isfinite(t27)
-    t62 = xp.greater_equal(damping, 0)
-    t63 = xp.greater(damping, 0)
-    t64 = 1e-12*t12
-    t65 = (t63 & xp.greater(t15[4], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t9, t64) | xp.less_equal(t36, t64) | xp.less_equal(1, t64) | xp.less_equal(t54, t64)))
-    t66 = t61 & t62 & xp.logical_not(t65)
+    c4 = trig[..., 6]
+    s4 = trig[..., 7]
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, q3, c4, s4, mu_dot0, mu_dot1, mu_dot2, mu_dot3, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t66, xp.where(t63, t20, t60), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t66, xp.where(t63, t21, t59), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t66, xp.where(t63, -t16, -mu_dot2), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t66, xp.where(t63, -t17, t58), 0), batch),  # 3
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t61 & t62), 2, xp.where(t65, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[4], batch), xp.int32)
     return q_dot, status
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
-    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 404 operations."""
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 405 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (4,)), ("mu_dot", mu_dot, (4,)), ("z", z, (4,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
     q3 = q[..., 2]
-    q4 = q[..., 3]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
     mu_dot3 = mu_dot[..., 3]
-    qz1 = z[..., 0]
-    qz2 = z[..., 1]
-    qz3 = z[..., 2]
-    qz4 = z[..., 3]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
     c2 = trig[..., 2]
     s2 = trig[..., 3]
-    c12 = c1*c2 - s1*s2
-    s12 = c1*s2 + c2*s1
-    t0 = 0.275*c12
-    t1 = 0.325*c1 + t0
-    t2 = 0.275*s12
-    t3 = 0.325*s1 + t2
-    t4 = t1*t3 + 0.075625*c12*s12
-    t5 = t3 + t2
-    t6 = t3**2
-    t7 = t6 + 0.075625*s12**2
-    t8 = t1**2
-    t9 = xp.sqrt(1 + t6 + t8)
-    t10 = xp.where(xp.less_equal(t3, 0), xp.asarray(1, dtype=dtype), -1)*t9
-    t11 = t8 + 0.075625*c12**2
-    t12 = xp.sqrt(4 + t7 + t11)
-    t13 = t1 + t0
-    t14 = damping**2
-    t15 = _symmetric_solve4(xp, 1, (t7 + t14, -t4, xp.full(batch, 0, dtype=dtype, device=device), -t5, t11 + t14, xp.full(batch, 0, dtype=dtype, device=device), t13, 1 + t14, xp.full(batch, 0, dtype=dtype, device=device), 3 + t14, mu_dot0, mu_dot1, mu_dot2, mu_dot3,))
-    t16 = t15[2]
-    t17 = t15[3]
-    t18 = t15[0]
-    t19 = t15[1]
-    t20 = t17 - t3*t18 + t1*t19
-    t21 = t17 - t2*t18 + t0*t19
-    t22 = xp.greater(t9, 0)
-    t23 = xp.where(t22, 1 + xp.abs(t3)/t9, 0)
-    t24 = -t3
-    t25 = xp.where(t22, 1/(t24 + t10), 0)
-    t26 = -t2
-    t27 = q1 + q2 + q3 + q4 + t13 + t24 + t26 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + qz1 + qz2 + qz3 + qz4
-    t28 = t1*t25
-    t29 = t23*(t26 + t25 + t0*t28)
-    t30 = t2 + t29
-    t31 = t23*(mu_dot0 + mu_dot3*t25 + t28*mu_dot1)
-    t32 = -t31 + mu_dot0
-    t33 = t25*t29
-    t34 = t0 - t1*t33
-    t35 = 1 - t33
-    t36 = xp.sqrt(t34**2 + t35**2)
-    t37 = t36*xp.where(xp.greater_equal(t34, 0), xp.asarray(1, dtype=dtype), -1)
-    t38 = t25**2*t23
-    t39 = t1*t38
-    t40 = -1 + t38
-    t41 = t25*t31
-    t42 = mu_dot1 - t1*t41
-    t43 = -t41 + mu_dot3
-    t44 = xp.greater(t36, 0)
-    t45 = xp.where(t44, 1/(t34 + t37), 0)
-    t46 = xp.where(t44, 1 + xp.abs(t34)/t36, 0)
-    t47 = t35*t45
-    t48 = t46*(t39 + t47*t40)
-    t49 = -t48 + t39
-    t50 = t40 - t47*t48
-    t51 = t46*(t42 + t47*t43)
-    t52 = -t51 + t42
-    t53 = t43 - t47*t51
-    t54 = xp.abs(t50)
-    t55 = t54*xp.where(xp.greater_equal(t50, 0), xp.asarray(1, dtype=dtype), -1)
-    t56 = xp.where(xp.greater(t54, 0), xp.asarray(2, dtype=dtype), 0)
-    t57 = t53 - t53*t56
-    t58 = xp.where(xp.not_equal(t55, 0), -t57/t55, 0)
-    t59 = xp.where(xp.not_equal(t37, 0), -(t52 - t49*t58)/t37, 0)
-    t60 = xp.where(xp.not_equal(t10, 0), -(-(-t30*t59 + t25*t23*t58) + t32)/t10, 0)
-    t61 = xp.isfinite(t27)
-    t62 = xp.greater_equal(damping, 0)
-    t63 = xp.greater(damping, 0)
-    t64 = 1e-12*t12
-    t65 = (t63 & xp.greater(t15[4], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t9, t64) | xp.less_equal(t36, t64) | xp.less_equal(1, t64) | xp.less_equal(t54, t64)))
-    t66 = t61 & t62 & xp.logical_not(t65)
+    c4 = trig[..., 6]
+    s4 = trig[..., 7]
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, q3, c4, s4, mu_dot0, mu_dot1, mu_dot2, mu_dot3, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t66, xp.where(t63, t20, t60), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t66, xp.where(t63, t21, t59), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t66, xp.where(t63, -t16, -mu_dot2), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t66, xp.where(t63, -t17, t58), 0), batch),  # 3
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t61 & t62), 2, xp.where(t65, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[4], batch), xp.int32)
     return q_dot, status
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 432 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 443 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (4,)), ("target", target, (4,)), ("target_rate", target_rate, (4,)), ("gain", gain, (4,)), ("z", z, (4,)), ("damping", damping, ()), every=("gain", ))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
     q3 = q[..., 2]
-    q4 = q[..., 3]
     mu0 = target[..., 0]
     mu1 = target[..., 1]
     mu2 = target[..., 2]
@@ -1896,10 +1834,6 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     gain1 = gain[..., 1]
     gain2 = gain[..., 2]
     gain3 = gain[..., 3]
-    qz1 = z[..., 0]
-    qz2 = z[..., 1]
-    qz3 = z[..., 2]
-    qz4 = z[..., 3]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
@@ -1909,88 +1843,24 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     s12 = c1*s2 + c2*s1
     c4 = trig[..., 6]
     s4 = trig[..., 7]
-    t0 = 0.387 - q3
-    t1 = c12*c4 + s12*s4
-    t2 = s12*c4 - c12*s4
-    t3 = mu_dot2 + gain2*(-t0 + mu2)
-    t4 = 0.275*c12
-    t5 = 0.325*c1 + t4
-    t6 = mu_dot0 + gain0*(-t5 + mu0)
-    t7 = 0.275*s12
-    t8 = 0.325*s1 + t7
-    t9 = t5*t8 + 0.075625*c12*s12
-    t10 = t8 + t7
-    t11 = t8**2
-    t12 = t11 + 0.075625*s12**2
-    t13 = t5**2
-    t14 = xp.sqrt(1 + t11 + t13)
-    t15 = xp.where(xp.less_equal(t8, 0), xp.asarray(1, dtype=dtype), -1)*t14
-    t16 = t13 + 0.075625*c12**2
-    t17 = xp.sqrt(4 + t12 + t16)
-    t18 = t5 + t4
-    t19 = xp.greater(t14, 0)
-    t20 = xp.where(t19, 1 + xp.abs(t8)/t14, 0)
-    t21 = -t8
-    t22 = xp.where(t19, 1/(t21 + t15), 0)
-    t23 = mu_dot1 + gain1*(t21 + mu1)
-    t24 = -t7
-    t25 = t5*t22
-    t26 = t20*(t24 + t22 + t4*t25)
-    t27 = t7 + t26
-    t28 = t22*t26
-    t29 = t4 - t5*t28
-    t30 = 1 - t28
-    t31 = xp.sqrt(t29**2 + t30**2)
-    t32 = t31*xp.where(xp.greater_equal(t29, 0), xp.asarray(1, dtype=dtype), -1)
-    t33 = t22**2*t20
-    t34 = t5*t33
-    t35 = -1 + t33
-    t36 = xp.greater(t31, 0)
-    t37 = xp.where(t36, 1/(t29 + t32), 0)
-    t38 = xp.where(t36, 1 + xp.abs(t29)/t31, 0)
-    t39 = t30*t37
-    t40 = t38*(t34 + t39*t35)
-    t41 = -t40 + t34
-    t42 = t35 - t39*t40
-    t43 = xp.abs(t42)
-    t44 = t43*xp.where(xp.greater_equal(t42, 0), xp.asarray(1, dtype=dtype), -1)
-    t45 = xp.where(xp.greater(t43, 0), xp.asarray(2, dtype=dtype), 0)
-    t46 = -mu3 + xp.atan2(t2, t1)
-    t47 = mu_dot3 - gain3*(t46 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t46)))
-    t48 = t20*(t6 + t22*t47 + t25*t23)
-    t49 = -t48 + t6
-    t50 = q1 + q2 + q3 + q4 + t18 + t21 + t24 + damping + qz1 + qz2 + qz3 + qz4 + t6 + t23 + t3 + t47
-    t51 = damping**2
-    t52 = _symmetric_solve4(xp, 1, (t12 + t51, -t9, xp.full(batch, 0, dtype=dtype, device=device), -t10, t16 + t51, xp.full(batch, 0, dtype=dtype, device=device), t18, 1 + t51, xp.full(batch, 0, dtype=dtype, device=device), 3 + t51, t6, t23, t3, t47,))
-    t53 = t52[2]
-    t54 = t52[3]
-    t55 = t52[0]
-    t56 = t52[1]
-    t57 = t54 - t8*t55 + t5*t56
-    t58 = t54 - t7*t55 + t4*t56
-    t59 = t22*t48
-    t60 = t23 - t5*t59
-    t61 = -t59 + t47
-    t62 = t38*(t60 + t39*t61)
-    t63 = -t62 + t60
-    t64 = t61 - t39*t62
-    t65 = t64 - t45*t64
-    t66 = xp.where(xp.not_equal(t44, 0), -t65/t44, 0)
-    t67 = xp.where(xp.not_equal(t32, 0), -(t63 - t41*t66)/t32, 0)
-    t68 = xp.where(xp.not_equal(t15, 0), -(-(-t27*t67 + t22*t20*t66) + t49)/t15, 0)
-    t69 = xp.isfinite(t50)
-    t70 = xp.greater_equal(damping, 0)
-    t71 = xp.greater(damping, 0)
-    t72 = 1e-12*t17
-    t73 = (t71 & xp.greater(t52[4], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t14, t72) | xp.less_equal(t31, t72) | xp.less_equal(1, t72) | xp.less_equal(t43, t72)))
-    t74 = t69 & t70 & xp.logical_not(t73)
+    t0 = 0.275*c12 + 0.325*c1
+    t1 = 0.275*s12 + 0.325*s1
+    t2 = 0.387 - q3
+    t3 = c12*c4 + s12*s4
+    t4 = s12*c4 - c12*s4
+    t5 = mu_dot0 + gain0*(-t0 + mu0)
+    t6 = mu_dot1 + gain1*(-t1 + mu1)
+    t7 = mu_dot2 + gain2*(-t2 + mu2)
+    t8 = -mu3 + xp.atan2(t4, t3)
+    t9 = mu_dot3 - gain3*(t8 + 6.283185307179586*xp.ceil(-0.15915494309189535*(3.141592653589793 + t8)))
+    t10 = _velocity_solve(xp, 1, (c1, s1, c2, s2, q3, c4, s4, t5, t6, t7, t9, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t74, xp.where(t71, t57, t68), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t74, xp.where(t71, t58, t67), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t74, xp.where(t71, -t53, -t3), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t74, xp.where(t71, -t54, t66), 0), batch),  # 3
+        xp.broadcast_to(t10[0], batch),  # 0
+        xp.broadcast_to(t10[1], batch),  # 1
+        xp.broadcast_to(t10[2], batch),  # 2
+        xp.broadcast_to(t10[3], batch),  # 3
     ], (4,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t69 & t70), 2, xp.where(t73, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t10[4], batch), xp.int32)
     return q_dot, status
 
 

@@ -455,7 +455,7 @@ def _jacobi4_rows(count, state):
 
 
 def _symmetric_solve4(count, state):
-    """X solving a symmetric 4 x 4 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 217 operations a run."""
+    """The solution x of a symmetric 4 x 4 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 217 operations a run."""
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, = state
         t0 = w1**2
@@ -537,6 +537,89 @@ def _symmetric_solve4(count, state):
             t69,
             t68,
             casadi.if_else(casadi.logic_or(casadi.logic_or(casadi.logic_or((t5 <= t72), (t33 <= t72)), (t52 <= t72)), (t64 <= t72)), 1, 0),
+        )
+    return state
+
+
+def _velocity_solve(count, state):
+    """The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status, `count` times: 399 operations a run."""
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, = state
+        c12 = w0*w2 - w1*w3
+        s12 = w0*w3 + w2*w1
+        t0 = 0.275*c12
+        t1 = 0.325*w0 + t0
+        t2 = 0.275*s12
+        t3 = 0.325*w1 + t2
+        t4 = t1*t3 + 0.075625*c12*s12
+        t5 = t3 + t2
+        t6 = t3**2
+        t7 = t6 + 0.075625*s12**2
+        t8 = t1**2
+        t9 = casadi.sqrt(1 + t6 + t8)
+        t10 = casadi.if_else((t3 <= 0), 1, -1)*t9
+        t11 = t8 + 0.075625*c12**2
+        t12 = casadi.sqrt(4 + t7 + t11)
+        t13 = t1 + t0
+        t14 = w11**2
+        t15 = _symmetric_solve4(1, (t7 + t14, -t4, 0, -t5, t11 + t14, 0, t13, 1 + t14, 0, 3 + t14, w7, w8, w9, w10,))
+        t16 = t15[2]
+        t17 = t15[3]
+        t18 = t15[0]
+        t19 = t15[1]
+        t20 = t17 - t3*t18 + t1*t19
+        t21 = t17 - t2*t18 + t0*t19
+        t22 = (t9 > 0)
+        t23 = casadi.if_else(t22, 1 + casadi.fabs(t3)/t9, 0)
+        t24 = -t3
+        t25 = casadi.if_else(t22, 1/(t24 + t10), 0)
+        t26 = -t2
+        t27 = w0 + w2 + w1 + w3 + w4 + w5 + w6 + t13 + t24 + t26 + w7 + w8 + w9 + w10 + w11
+        t28 = t1*t25
+        t29 = t23*(t26 + t25 + t0*t28)
+        t30 = t2 + t29
+        t31 = t23*(w7 + w10*t25 + t28*w8)
+        t32 = -t31 + w7
+        t33 = t25*t29
+        t34 = t0 - t1*t33
+        t35 = 1 - t33
+        t36 = casadi.sqrt(t34**2 + t35**2)
+        t37 = t36*casadi.if_else((t34 >= 0), 1, -1)
+        t38 = t25**2*t23
+        t39 = t1*t38
+        t40 = -1 + t38
+        t41 = t25*t31
+        t42 = w8 - t1*t41
+        t43 = -t41 + w10
+        t44 = (t36 > 0)
+        t45 = casadi.if_else(t44, 1/(t34 + t37), 0)
+        t46 = casadi.if_else(t44, 1 + casadi.fabs(t34)/t36, 0)
+        t47 = t35*t45
+        t48 = t46*(t39 + t47*t40)
+        t49 = -t48 + t39
+        t50 = t40 - t47*t48
+        t51 = t46*(t42 + t47*t43)
+        t52 = -t51 + t42
+        t53 = t43 - t47*t51
+        t54 = casadi.fabs(t50)
+        t55 = t54*casadi.if_else((t50 >= 0), 1, -1)
+        t56 = casadi.if_else((t54 > 0), 2, 0)
+        t57 = t53 - t53*t56
+        t58 = casadi.if_else((t55 != 0), -t57/t55, 0)
+        t59 = casadi.if_else((t37 != 0), -(t52 - t49*t58)/t37, 0)
+        t60 = casadi.if_else((t10 != 0), -(-(-t30*t59 + t25*t23*t58) + t32)/t10, 0)
+        t61 = (casadi.fabs(t27) < casadi.inf)
+        t62 = (w11 >= 0)
+        t63 = (w11 > 0)
+        t64 = 1e-12*t12
+        t65 = casadi.logic_or(casadi.logic_and(t63, (t15[4] > 0)), casadi.logic_and((w11 <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t9 <= t64), (t36 <= t64)), (1 <= t64)), (t54 <= t64))))
+        t66 = casadi.logic_and(casadi.logic_and(t61, t62), casadi.logic_not(t65))
+        state = (
+            casadi.if_else(t66, casadi.if_else(t63, t20, t60), 0),
+            casadi.if_else(t66, casadi.if_else(t63, t21, t59), 0),
+            casadi.if_else(t66, casadi.if_else(t63, -t16, -w9), 0),
+            casadi.if_else(t66, casadi.if_else(t63, -t17, t58), 0),
+            casadi.if_else(casadi.logic_not(casadi.logic_and(t61, t62)), 2, casadi.if_else(t65, 1, 0)),
         )
     return state
 
@@ -1331,7 +1414,7 @@ def _condition_number(q):
 
 
 def _velocity_ik(q, mu_dot, damping):
-    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 400 operations."""
+    """Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: 405 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1344,87 +1427,21 @@ def _velocity_ik(q, mu_dot, damping):
     s1 = casadi.sin(q1)
     c2 = casadi.cos(q2)
     s2 = casadi.sin(q2)
-    c12 = c1*c2 - s1*s2
-    s12 = c1*s2 + c2*s1
-    t0 = 0.275*c12
-    t1 = 0.325*c1 + t0
-    t2 = 0.275*s12
-    t3 = 0.325*s1 + t2
-    t4 = t1*t3 + 0.075625*c12*s12
-    t5 = t3 + t2
-    t6 = t3**2
-    t7 = t6 + 0.075625*s12**2
-    t8 = t1**2
-    t9 = casadi.sqrt(1 + t6 + t8)
-    t10 = casadi.if_else((t3 <= 0), 1, -1)*t9
-    t11 = t8 + 0.075625*c12**2
-    t12 = casadi.sqrt(4 + t7 + t11)
-    t13 = t1 + t0
-    t14 = damping**2
-    t15 = _symmetric_solve4(1, (t7 + t14, -t4, 0, -t5, t11 + t14, 0, t13, 1 + t14, 0, 3 + t14, mu_dot0, mu_dot1, mu_dot2, mu_dot3,))
-    t16 = t15[2]
-    t17 = t15[3]
-    t18 = t15[0]
-    t19 = t15[1]
-    t20 = t17 - t3*t18 + t1*t19
-    t21 = t17 - t2*t18 + t0*t19
-    t22 = (t9 > 0)
-    t23 = casadi.if_else(t22, 1 + casadi.fabs(t3)/t9, 0)
-    t24 = -t3
-    t25 = casadi.if_else(t22, 1/(t24 + t10), 0)
-    t26 = -t2
-    t27 = q1 + q2 + q3 + q4 + t13 + t24 + t26 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping
-    t28 = t1*t25
-    t29 = t23*(t26 + t25 + t0*t28)
-    t30 = t2 + t29
-    t31 = t23*(mu_dot0 + mu_dot3*t25 + t28*mu_dot1)
-    t32 = -t31 + mu_dot0
-    t33 = t25*t29
-    t34 = t0 - t1*t33
-    t35 = 1 - t33
-    t36 = casadi.sqrt(t34**2 + t35**2)
-    t37 = t36*casadi.if_else((t34 >= 0), 1, -1)
-    t38 = t25**2*t23
-    t39 = t1*t38
-    t40 = -1 + t38
-    t41 = t25*t31
-    t42 = mu_dot1 - t1*t41
-    t43 = -t41 + mu_dot3
-    t44 = (t36 > 0)
-    t45 = casadi.if_else(t44, 1/(t34 + t37), 0)
-    t46 = casadi.if_else(t44, 1 + casadi.fabs(t34)/t36, 0)
-    t47 = t35*t45
-    t48 = t46*(t39 + t47*t40)
-    t49 = -t48 + t39
-    t50 = t40 - t47*t48
-    t51 = t46*(t42 + t47*t43)
-    t52 = -t51 + t42
-    t53 = t43 - t47*t51
-    t54 = casadi.fabs(t50)
-    t55 = t54*casadi.if_else((t50 >= 0), 1, -1)
-    t56 = casadi.if_else((t54 > 0), 2, 0)
-    t57 = t53 - t53*t56
-    t58 = casadi.if_else((t55 != 0), -t57/t55, 0)
-    t59 = casadi.if_else((t37 != 0), -(t52 - t49*t58)/t37, 0)
-    t60 = casadi.if_else((t10 != 0), -(-(-t30*t59 + t25*t23*t58) + t32)/t10, 0)
-    t61 = (casadi.fabs(t27) < casadi.inf)
-    t62 = (damping >= 0)
-    t63 = (damping > 0)
-    t64 = 1e-12*t12
-    t65 = casadi.logic_or(casadi.logic_and(t63, (t15[4] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t9 <= t64), (t36 <= t64)), (1 <= t64)), (t54 <= t64))))
-    t66 = casadi.logic_and(casadi.logic_and(t61, t62), casadi.logic_not(t65))
+    c4 = casadi.cos(q4)
+    s4 = casadi.sin(q4)
+    t0 = _velocity_solve(1, (c1, s1, c2, s2, q3, c4, s4, mu_dot0, mu_dot1, mu_dot2, mu_dot3, damping,))
     q_dot = casadi.SX(4, 1)
-    q_dot[0, 0] = casadi.if_else(t66, casadi.if_else(t63, t20, t60), 0)
-    q_dot[1, 0] = casadi.if_else(t66, casadi.if_else(t63, t21, t59), 0)
-    q_dot[2, 0] = casadi.if_else(t66, casadi.if_else(t63, -t16, -mu_dot2), 0)
-    q_dot[3, 0] = casadi.if_else(t66, casadi.if_else(t63, -t17, t58), 0)
+    q_dot[0, 0] = t0[0]
+    q_dot[1, 0] = t0[1]
+    q_dot[2, 0] = t0[2]
+    q_dot[3, 0] = t0[3]
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t61, t62)), 2, casadi.if_else(t65, 1, 0))
+    status[0, 0] = t0[4]
     return [q_dot, status]
 
 
 def _velocity_ik_nullspace(q, mu_dot, z, damping):
-    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 404 operations."""
+    """Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): 405 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1433,95 +1450,25 @@ def _velocity_ik_nullspace(q, mu_dot, z, damping):
     mu_dot1 = mu_dot[1]
     mu_dot2 = mu_dot[2]
     mu_dot3 = mu_dot[3]
-    qz1 = z[0]
-    qz2 = z[1]
-    qz3 = z[2]
-    qz4 = z[3]
     c1 = casadi.cos(q1)
     s1 = casadi.sin(q1)
     c2 = casadi.cos(q2)
     s2 = casadi.sin(q2)
-    c12 = c1*c2 - s1*s2
-    s12 = c1*s2 + c2*s1
-    t0 = 0.275*c12
-    t1 = 0.325*c1 + t0
-    t2 = 0.275*s12
-    t3 = 0.325*s1 + t2
-    t4 = t1*t3 + 0.075625*c12*s12
-    t5 = t3 + t2
-    t6 = t3**2
-    t7 = t6 + 0.075625*s12**2
-    t8 = t1**2
-    t9 = casadi.sqrt(1 + t6 + t8)
-    t10 = casadi.if_else((t3 <= 0), 1, -1)*t9
-    t11 = t8 + 0.075625*c12**2
-    t12 = casadi.sqrt(4 + t7 + t11)
-    t13 = t1 + t0
-    t14 = damping**2
-    t15 = _symmetric_solve4(1, (t7 + t14, -t4, 0, -t5, t11 + t14, 0, t13, 1 + t14, 0, 3 + t14, mu_dot0, mu_dot1, mu_dot2, mu_dot3,))
-    t16 = t15[2]
-    t17 = t15[3]
-    t18 = t15[0]
-    t19 = t15[1]
-    t20 = t17 - t3*t18 + t1*t19
-    t21 = t17 - t2*t18 + t0*t19
-    t22 = (t9 > 0)
-    t23 = casadi.if_else(t22, 1 + casadi.fabs(t3)/t9, 0)
-    t24 = -t3
-    t25 = casadi.if_else(t22, 1/(t24 + t10), 0)
-    t26 = -t2
-    t27 = q1 + q2 + q3 + q4 + t13 + t24 + t26 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + damping + qz1 + qz2 + qz3 + qz4
-    t28 = t1*t25
-    t29 = t23*(t26 + t25 + t0*t28)
-    t30 = t2 + t29
-    t31 = t23*(mu_dot0 + mu_dot3*t25 + t28*mu_dot1)
-    t32 = -t31 + mu_dot0
-    t33 = t25*t29
-    t34 = t0 - t1*t33
-    t35 = 1 - t33
-    t36 = casadi.sqrt(t34**2 + t35**2)
-    t37 = t36*casadi.if_else((t34 >= 0), 1, -1)
-    t38 = t25**2*t23
-    t39 = t1*t38
-    t40 = -1 + t38
-    t41 = t25*t31
-    t42 = mu_dot1 - t1*t41
-    t43 = -t41 + mu_dot3
-    t44 = (t36 > 0)
-    t45 = casadi.if_else(t44, 1/(t34 + t37), 0)
-    t46 = casadi.if_else(t44, 1 + casadi.fabs(t34)/t36, 0)
-    t47 = t35*t45
-    t48 = t46*(t39 + t47*t40)
-    t49 = -t48 + t39
-    t50 = t40 - t47*t48
-    t51 = t46*(t42 + t47*t43)
-    t52 = -t51 + t42
-    t53 = t43 - t47*t51
-    t54 = casadi.fabs(t50)
-    t55 = t54*casadi.if_else((t50 >= 0), 1, -1)
-    t56 = casadi.if_else((t54 > 0), 2, 0)
-    t57 = t53 - t53*t56
-    t58 = casadi.if_else((t55 != 0), -t57/t55, 0)
-    t59 = casadi.if_else((t37 != 0), -(t52 - t49*t58)/t37, 0)
-    t60 = casadi.if_else((t10 != 0), -(-(-t30*t59 + t25*t23*t58) + t32)/t10, 0)
-    t61 = (casadi.fabs(t27) < casadi.inf)
-    t62 = (damping >= 0)
-    t63 = (damping > 0)
-    t64 = 1e-12*t12
-    t65 = casadi.logic_or(casadi.logic_and(t63, (t15[4] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t9 <= t64), (t36 <= t64)), (1 <= t64)), (t54 <= t64))))
-    t66 = casadi.logic_and(casadi.logic_and(t61, t62), casadi.logic_not(t65))
+    c4 = casadi.cos(q4)
+    s4 = casadi.sin(q4)
+    t0 = _velocity_solve(1, (c1, s1, c2, s2, q3, c4, s4, mu_dot0, mu_dot1, mu_dot2, mu_dot3, damping,))
     q_dot = casadi.SX(4, 1)
-    q_dot[0, 0] = casadi.if_else(t66, casadi.if_else(t63, t20, t60), 0)
-    q_dot[1, 0] = casadi.if_else(t66, casadi.if_else(t63, t21, t59), 0)
-    q_dot[2, 0] = casadi.if_else(t66, casadi.if_else(t63, -t16, -mu_dot2), 0)
-    q_dot[3, 0] = casadi.if_else(t66, casadi.if_else(t63, -t17, t58), 0)
+    q_dot[0, 0] = t0[0]
+    q_dot[1, 0] = t0[1]
+    q_dot[2, 0] = t0[2]
+    q_dot[3, 0] = t0[3]
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t61, t62)), 2, casadi.if_else(t65, 1, 0))
+    status[0, 0] = t0[4]
     return [q_dot, status]
 
 
 def _resolved_rate(q, target, target_rate, gain, z, damping):
-    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 432 operations."""
+    """Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): 443 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1538,10 +1485,6 @@ def _resolved_rate(q, target, target_rate, gain, z, damping):
     gain1 = gain[1]
     gain2 = gain[2]
     gain3 = gain[3]
-    qz1 = z[0]
-    qz2 = z[1]
-    qz3 = z[2]
-    qz4 = z[3]
     c1 = casadi.cos(q1)
     s1 = casadi.sin(q1)
     c2 = casadi.cos(q2)
@@ -1550,88 +1493,24 @@ def _resolved_rate(q, target, target_rate, gain, z, damping):
     s12 = c1*s2 + c2*s1
     c4 = casadi.cos(q4)
     s4 = casadi.sin(q4)
-    t0 = 0.387 - q3
-    t1 = c12*c4 + s12*s4
-    t2 = s12*c4 - c12*s4
-    t3 = mu_dot2 + gain2*(-t0 + mu2)
-    t4 = 0.275*c12
-    t5 = 0.325*c1 + t4
-    t6 = mu_dot0 + gain0*(-t5 + mu0)
-    t7 = 0.275*s12
-    t8 = 0.325*s1 + t7
-    t9 = t5*t8 + 0.075625*c12*s12
-    t10 = t8 + t7
-    t11 = t8**2
-    t12 = t11 + 0.075625*s12**2
-    t13 = t5**2
-    t14 = casadi.sqrt(1 + t11 + t13)
-    t15 = casadi.if_else((t8 <= 0), 1, -1)*t14
-    t16 = t13 + 0.075625*c12**2
-    t17 = casadi.sqrt(4 + t12 + t16)
-    t18 = t5 + t4
-    t19 = (t14 > 0)
-    t20 = casadi.if_else(t19, 1 + casadi.fabs(t8)/t14, 0)
-    t21 = -t8
-    t22 = casadi.if_else(t19, 1/(t21 + t15), 0)
-    t23 = mu_dot1 + gain1*(t21 + mu1)
-    t24 = -t7
-    t25 = t5*t22
-    t26 = t20*(t24 + t22 + t4*t25)
-    t27 = t7 + t26
-    t28 = t22*t26
-    t29 = t4 - t5*t28
-    t30 = 1 - t28
-    t31 = casadi.sqrt(t29**2 + t30**2)
-    t32 = t31*casadi.if_else((t29 >= 0), 1, -1)
-    t33 = t22**2*t20
-    t34 = t5*t33
-    t35 = -1 + t33
-    t36 = (t31 > 0)
-    t37 = casadi.if_else(t36, 1/(t29 + t32), 0)
-    t38 = casadi.if_else(t36, 1 + casadi.fabs(t29)/t31, 0)
-    t39 = t30*t37
-    t40 = t38*(t34 + t39*t35)
-    t41 = -t40 + t34
-    t42 = t35 - t39*t40
-    t43 = casadi.fabs(t42)
-    t44 = t43*casadi.if_else((t42 >= 0), 1, -1)
-    t45 = casadi.if_else((t43 > 0), 2, 0)
-    t46 = -mu3 + casadi.atan2(t2, t1)
-    t47 = mu_dot3 - gain3*(t46 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t46)))
-    t48 = t20*(t6 + t22*t47 + t25*t23)
-    t49 = -t48 + t6
-    t50 = q1 + q2 + q3 + q4 + t18 + t21 + t24 + damping + qz1 + qz2 + qz3 + qz4 + t6 + t23 + t3 + t47
-    t51 = damping**2
-    t52 = _symmetric_solve4(1, (t12 + t51, -t9, 0, -t10, t16 + t51, 0, t18, 1 + t51, 0, 3 + t51, t6, t23, t3, t47,))
-    t53 = t52[2]
-    t54 = t52[3]
-    t55 = t52[0]
-    t56 = t52[1]
-    t57 = t54 - t8*t55 + t5*t56
-    t58 = t54 - t7*t55 + t4*t56
-    t59 = t22*t48
-    t60 = t23 - t5*t59
-    t61 = -t59 + t47
-    t62 = t38*(t60 + t39*t61)
-    t63 = -t62 + t60
-    t64 = t61 - t39*t62
-    t65 = t64 - t45*t64
-    t66 = casadi.if_else((t44 != 0), -t65/t44, 0)
-    t67 = casadi.if_else((t32 != 0), -(t63 - t41*t66)/t32, 0)
-    t68 = casadi.if_else((t15 != 0), -(-(-t27*t67 + t22*t20*t66) + t49)/t15, 0)
-    t69 = (casadi.fabs(t50) < casadi.inf)
-    t70 = (damping >= 0)
-    t71 = (damping > 0)
-    t72 = 1e-12*t17
-    t73 = casadi.logic_or(casadi.logic_and(t71, (t52[4] > 0)), casadi.logic_and((damping <= 0), casadi.logic_or(casadi.logic_or(casadi.logic_or((t14 <= t72), (t31 <= t72)), (1 <= t72)), (t43 <= t72))))
-    t74 = casadi.logic_and(casadi.logic_and(t69, t70), casadi.logic_not(t73))
+    t0 = 0.275*c12 + 0.325*c1
+    t1 = 0.275*s12 + 0.325*s1
+    t2 = 0.387 - q3
+    t3 = c12*c4 + s12*s4
+    t4 = s12*c4 - c12*s4
+    t5 = mu_dot0 + gain0*(-t0 + mu0)
+    t6 = mu_dot1 + gain1*(-t1 + mu1)
+    t7 = mu_dot2 + gain2*(-t2 + mu2)
+    t8 = -mu3 + casadi.atan2(t4, t3)
+    t9 = mu_dot3 - gain3*(t8 + 6.283185307179586*casadi.ceil(-0.15915494309189535*(3.141592653589793 + t8)))
+    t10 = _velocity_solve(1, (c1, s1, c2, s2, q3, c4, s4, t5, t6, t7, t9, damping,))
     q_dot = casadi.SX(4, 1)
-    q_dot[0, 0] = casadi.if_else(t74, casadi.if_else(t71, t57, t68), 0)
-    q_dot[1, 0] = casadi.if_else(t74, casadi.if_else(t71, t58, t67), 0)
-    q_dot[2, 0] = casadi.if_else(t74, casadi.if_else(t71, -t53, -t3), 0)
-    q_dot[3, 0] = casadi.if_else(t74, casadi.if_else(t71, -t54, t66), 0)
+    q_dot[0, 0] = t10[0]
+    q_dot[1, 0] = t10[1]
+    q_dot[2, 0] = t10[2]
+    q_dot[3, 0] = t10[3]
     status = casadi.SX(1, 1)
-    status[0, 0] = casadi.if_else(casadi.logic_not(casadi.logic_and(t69, t70)), 2, casadi.if_else(t73, 1, 0))
+    status[0, 0] = t10[4]
     return [q_dot, status]
 
 

@@ -113,15 +113,15 @@ void stanford_velocity_ellipsoid(const stanford_real q[STANFORD_DOF], stanford_r
 stanford_real stanford_condition_number(const stanford_real q[STANFORD_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1153 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1157 operations. */
 int stanford_velocity_ik(const stanford_real q[STANFORD_DOF], const stanford_real mu_dot[STANFORD_TASK_DIM], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1159 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1157 operations. */
 int stanford_velocity_ik_nullspace(const stanford_real q[STANFORD_DOF], const stanford_real mu_dot[STANFORD_TASK_DIM], const stanford_real z[STANFORD_DOF], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1320 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1349 operations. */
 int stanford_resolved_rate(const stanford_real q[STANFORD_DOF], const stanford_real target[16], const stanford_real target_rate[STANFORD_TASK_DIM], const stanford_real gain[STANFORD_TASK_DIM], const stanford_real z[STANFORD_DOF], stanford_real damping, stanford_real q_dot[STANFORD_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).

@@ -82,7 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -336,7 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi6_rows(xp, count, state):
     """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2 + w4**2 + w5**2
@@ -904,9 +904,9 @@ def _jacobi6_rows(xp, count, state):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _symmetric_solve6(xp, count, state):
-    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    """The solution x of a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
         t0 = w1**2
@@ -1090,10 +1090,250 @@ def _symmetric_solve6(xp, count, state):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _velocity_solve(xp, count, state):
+    """The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status, `count` times: 1147 operations a run."""
+    state = xp.broadcast_arrays(*state)
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, = state
+        t0 = -w2*w7 + w3*w6*w8
+        t1 = w0*w3
+        t2 = -0.1337*w1 + w4*t1
+        t3 = w1*w3
+        t4 = 0.1337*w0 + w4*t3
+        t5 = w0*t2 + w1*t4
+        t6 = w1*w5
+        t7 = w0*w6
+        t8 = t6 + w2*t7
+        t9 = w2*t6 + t7
+        t10 = t8*w8 + w7*t1
+        t11 = w1*w6
+        t12 = w0*w5
+        t13 = -t11 + w2*t12
+        t14 = -t12 + w2*t11
+        t15 = t14*w8 + w7*t3
+        t16 = t5**2
+        t17 = w2**2
+        t18 = t16 + t17
+        t19 = w0**2
+        t20 = w3**2
+        t21 = t19*t20
+        t22 = w1**2
+        t23 = t20*t22
+        t24 = t4**2
+        t25 = w4**2*t17
+        t26 = t24 + t19*t25
+        t27 = t21 + t26
+        t28 = t2**2
+        t29 = xp.sqrt(1 + t24 + t28)
+        t30 = xp.where(xp.less_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)*t29
+        t31 = t28 + t22*t25
+        t32 = t23 + t31
+        t33 = t13**2 + t10**2 + t22
+        t34 = t21 + t33
+        t35 = t9**2 + t15**2 + t19
+        t36 = t23 + t35
+        t37 = 1 + t0**2 + w5**2*t20
+        t38 = xp.sqrt(t16 + t26 + 2*t17 + 2*t21 + 2*t23 + t31 + t33 + t35 + t37)
+        t39 = t17 + t37
+        t40 = w1*w0
+        t41 = t20*t40
+        t42 = t41 - t2*t4 + t25*t40
+        t43 = -t40 + t41 + t13*t9 + t10*t15
+        t44 = w0*t5
+        t45 = w4*w2
+        t46 = t19*t45
+        t47 = t22*t45
+        t48 = w2*t1
+        t49 = t48 - t44*t45
+        t50 = w1*t5
+        t51 = w2*t3
+        t52 = t51 - t45*t50
+        t53 = w3*w5
+        t54 = -t48 + t10*t0 + t13*t53
+        t55 = -t51 + t15*t0 + t9*t53
+        t56 = w17**2
+        t57 = t40*t45
+        t58 = -t4
+        t59 = _symmetric_solve6(xp, 1, (t56 + t27, t42, t49, -t57, t46, t58, t56 + t32, t52, -t47, t57, t2, t56 + t18, t50, -t44, xp.full(batch, 0, dtype=dtype, device=device), t56 + t34, t43, -t54, t56 + t36, -t55, t56 + t39, w11, w12, w13, w14, w15, w16,))
+        t60 = t59[5]
+        t61 = t59[0]
+        t62 = t59[1]
+        t63 = t60 - t4*t61 + t2*t62
+        t64 = w0*t45
+        t65 = w1*t45
+        t66 = t59[2]
+        t67 = t1*t61 + t3*t62 + w2*t66
+        t68 = t59[3]
+        t69 = t59[4]
+        t70 = t61*t64 + t62*t65 - t5*t66 - w1*t68 + w0*t69
+        t71 = t1*t68 + t3*t69 + w2*t60
+        t72 = t13*t68 + t9*t69 - t53*t60
+        t73 = t10*t68 + t15*t69 - t0*t60
+        t74 = xp.greater(t29, 0)
+        t75 = xp.where(t74, 1/(t58 + t30), 0)
+        t76 = xp.where(t74, 1 + xp.abs(t4)/t29, 0)
+        t77 = t2*t75
+        t78 = t76*(t64 + t65*t77)
+        t79 = -t78 + t64
+        t80 = t65 - t77*t78
+        t81 = t76*(t1 + t3*t77)
+        t82 = -t81 + t1
+        t83 = t76*(w11 + w16*t75 + t77*w12)
+        t84 = -t83 + w11
+        t85 = t75*t81
+        t86 = t3 - t2*t85
+        t87 = t75**2
+        t88 = xp.sqrt(t16 + t19 + t22 + t80**2 + t87*t78**2)
+        t89 = t88*xp.where(xp.greater_equal(t80, 0), xp.asarray(1, dtype=dtype), -1)
+        t90 = t87*t76
+        t91 = w2*t90
+        t92 = t2*t91
+        t93 = -t91 + w2
+        t94 = t53*t90
+        t95 = t2*t94
+        t96 = -t53
+        t97 = t94 + t96
+        t98 = t0*t90
+        t99 = t2*t98
+        t100 = -t0
+        t101 = t98 + t100
+        t102 = 1 - t5 + w4 + w3 + t2 + w5 + w6 + t13 + t9 + w7 + w8 + t10 + t15 + w10 + w9 + 2*w0 + 2*t1 + 2*t3 + t58 + t64 + t65 + t96 + t100 + w11 + w12 + w13 + w14 + w15 + w16 + w17 + 3*w2
+        t103 = t75*t83
+        t104 = w12 - t2*t103
+        t105 = -t103 + w16
+        t106 = xp.greater(t88, 0)
+        t107 = xp.where(t106, 1/(t80 + t89), 0)
+        t108 = xp.where(t106, 1 + xp.abs(t80)/t88, 0)
+        t109 = t5*t107
+        t110 = t78*t107
+        t111 = t108*(t86 - w2*t109 + t87*t110*t81)
+        t112 = -t111 + t86
+        t113 = w2 + t109*t111
+        t114 = t110*t75
+        t115 = -t85 + t114*t111
+        t116 = -t108*(t92 + t114*t93)
+        t117 = t92 + t116
+        t118 = t93 + t114*t116
+        t119 = t107*t116
+        t120 = t1 + w1*t119
+        t121 = t3 - w0*t119
+        t122 = w1*t107
+        t123 = w0*t107
+        t124 = t108*(t95 - t13*t122 + t9*t123 - t114*t97)
+        t125 = -t124 + t95
+        t126 = t13 + t122*t124
+        t127 = t9 - t123*t124
+        t128 = t97 + t114*t124
+        t129 = t108*(t99 - t10*t122 + t15*t123 - t114*t101)
+        t130 = -t129 + t99
+        t131 = t10 + t122*t129
+        t132 = t15 - t123*t129
+        t133 = t101 + t114*t129
+        t134 = -t108*(-t104 + t109*w13 + t122*w14 - t123*w15 + t114*t105)
+        t135 = -t134 + t104
+        t136 = w13 + t109*t134
+        t137 = w14 + t122*t134
+        t138 = w15 - t123*t134
+        t139 = t105 + t114*t134
+        t140 = t107**2*t111**2
+        t141 = xp.sqrt(t113**2 + t115**2 + t22*t140 + t19*t140)
+        t142 = t141*xp.where(xp.greater_equal(t113, 0), xp.asarray(1, dtype=dtype), -1)
+        t143 = xp.greater(t141, 0)
+        t144 = xp.where(t143, 1/(t113 + t142), 0)
+        t145 = xp.where(t143, 1 + xp.abs(t113)/t141, 0)
+        t146 = t109*t116
+        t147 = t111*t144
+        t148 = t122*t147
+        t149 = t123*t147
+        t150 = t115*t144
+        t151 = t145*(t146 + t148*t120 - t149*t121 + t150*t118)
+        t152 = -t151 + t146
+        t153 = t120 - t148*t151
+        t154 = t121 + t149*t151
+        t155 = t118 - t150*t151
+        t156 = t145*(t136 + t148*t137 - t149*t138 + t150*t139)
+        t157 = -t156 + t136
+        t158 = t137 - t148*t156
+        t159 = t138 + t149*t156
+        t160 = t139 - t150*t156
+        t161 = xp.sqrt(t153**2 + t154**2 + t155**2)
+        t162 = t161*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
+        t163 = t109*t124
+        t164 = t145*(t163 + t148*t126 - t149*t127 + t150*t128)
+        t165 = -t164 + t163
+        t166 = t126 - t148*t164
+        t167 = t127 + t149*t164
+        t168 = t128 - t150*t164
+        t169 = t109*t129
+        t170 = t145*(t169 + t148*t131 - t149*t132 + t150*t133)
+        t171 = -t170 + t169
+        t172 = t131 - t148*t170
+        t173 = t132 + t149*t170
+        t174 = t133 - t150*t170
+        t175 = xp.greater(t161, 0)
+        t176 = xp.where(t175, 1/(t153 + t162), 0)
+        t177 = xp.where(t175, 1 + xp.abs(t153)/t161, 0)
+        t178 = t154*t176
+        t179 = t155*t176
+        t180 = t177*(t166 + t178*t167 + t179*t168)
+        t181 = -t180 + t166
+        t182 = t167 - t178*t180
+        t183 = t168 - t179*t180
+        t184 = t177*(t172 + t178*t173 + t179*t174)
+        t185 = -t184 + t172
+        t186 = t173 - t178*t184
+        t187 = t174 - t179*t184
+        t188 = t177*(t158 + t178*t159 + t179*t160)
+        t189 = -t188 + t158
+        t190 = t159 - t178*t188
+        t191 = t160 - t179*t188
+        t192 = xp.sqrt(t182**2 + t183**2)
+        t193 = t192*xp.where(xp.greater_equal(t182, 0), xp.asarray(1, dtype=dtype), -1)
+        t194 = xp.greater(t192, 0)
+        t195 = xp.where(t194, 1/(t182 + t193), 0)
+        t196 = xp.where(t194, 1 + xp.abs(t182)/t192, 0)
+        t197 = t183*t195
+        t198 = t196*(t186 + t197*t187)
+        t199 = -t198 + t186
+        t200 = t187 - t197*t198
+        t201 = t196*(t190 + t197*t191)
+        t202 = -t201 + t190
+        t203 = t191 - t197*t201
+        t204 = xp.abs(t200)
+        t205 = t204*xp.where(xp.greater_equal(t200, 0), xp.asarray(1, dtype=dtype), -1)
+        t206 = xp.where(xp.greater(t204, 0), xp.asarray(2, dtype=dtype), 0)
+        t207 = t203 - t203*t206
+        t208 = xp.where(xp.not_equal(t205, 0), -t207/t205, 0)
+        t209 = xp.where(xp.not_equal(t193, 0), -(t202 - t199*t208)/t193, 0)
+        t210 = xp.where(xp.not_equal(t162, 0), -(-(t181*t209 + t185*t208) + t189)/t162, 0)
+        t211 = xp.where(xp.not_equal(t142, 0), -(-(t152*t210 + t165*t209 + t171*t208) + t157)/t142, 0)
+        t212 = xp.where(xp.not_equal(t89, 0), -(-(t112*t211 - t117*t210 + t125*t209 + t130*t208) + t135)/t89, 0)
+        t213 = t75*t76
+        t214 = xp.where(xp.not_equal(t30, 0), -(-(t79*t212 + t82*t211 - w2*t213*t210 + t53*t213*t209 + t0*t213*t208) + t84)/t30, 0)
+        t215 = xp.isfinite(t102)
+        t216 = xp.greater_equal(w17, 0)
+        t217 = xp.greater(w17, 0)
+        t218 = 1e-12*t38
+        t219 = (t217 & xp.greater(t59[6], 0)) | (xp.less_equal(w17, 0) & (xp.less_equal(t29, t218) | xp.less_equal(t88, t218) | xp.less_equal(t141, t218) | xp.less_equal(t161, t218) | xp.less_equal(t192, t218) | xp.less_equal(t204, t218)))
+        t220 = t215 & t216 & xp.logical_not(t219)
+        state = (
+            xp.where(t220, xp.where(t217, t63, t214), 0),
+            xp.where(t220, xp.where(t217, t70, t212), 0),
+            xp.where(t220, xp.where(t217, t67, t211), 0),
+            xp.where(t220, xp.where(t217, t71, t210), 0),
+            xp.where(t220, xp.where(t217, t72, t209), 0),
+            xp.where(t220, xp.where(t217, t73, t208), 0),
+            xp.where(xp.logical_not(t215 & t216), 2, xp.where(t219, xp.asarray(1, dtype=dtype), 0)),
+        )
+    return state
+
+
+@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _nearer_branch(xp, count, state):
     """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 101 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
         t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w7))
@@ -3190,16 +3430,10 @@ def condition_number(q):
     return kappa
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1153 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1157 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
     q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
@@ -3215,261 +3449,31 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = -c2*c5 + s2*s4*s5
-    t1 = c1*s2
-    t2 = -0.1337*s1 + q3*t1
-    t3 = s1*s2
-    t4 = 0.1337*c1 + q3*t3
-    t5 = c1*t2 + s1*t4
-    t6 = s1*c4
-    t7 = c1*s4
-    t8 = t6 + c2*t7
-    t9 = c2*t6 + t7
-    t10 = t8*s5 + c5*t1
-    t11 = s1*s4
-    t12 = c1*c4
-    t13 = -t11 + c2*t12
-    t14 = -t12 + c2*t11
-    t15 = t14*s5 + c5*t3
-    t16 = t5**2
-    t17 = c2**2
-    t18 = t16 + t17
-    t19 = c1**2
-    t20 = s2**2
-    t21 = t19*t20
-    t22 = s1**2
-    t23 = t20*t22
-    t24 = t4**2
-    t25 = q3**2*t17
-    t26 = t24 + t19*t25
-    t27 = t21 + t26
-    t28 = t2**2
-    t29 = xp.sqrt(1 + t24 + t28)
-    t30 = xp.where(xp.less_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)*t29
-    t31 = t28 + t22*t25
-    t32 = t23 + t31
-    t33 = t13**2 + t10**2 + t22
-    t34 = t21 + t33
-    t35 = t9**2 + t15**2 + t19
-    t36 = t23 + t35
-    t37 = 1 + t0**2 + c4**2*t20
-    t38 = xp.sqrt(t16 + t26 + 2*t17 + 2*t21 + 2*t23 + t31 + t33 + t35 + t37)
-    t39 = t17 + t37
-    t40 = s1*c1
-    t41 = t20*t40
-    t42 = t41 - t2*t4 + t25*t40
-    t43 = -t40 + t41 + t13*t9 + t10*t15
-    t44 = c1*t5
-    t45 = q3*c2
-    t46 = t19*t45
-    t47 = t22*t45
-    t48 = c2*t1
-    t49 = t48 - t44*t45
-    t50 = s1*t5
-    t51 = c2*t3
-    t52 = t51 - t45*t50
-    t53 = s2*c4
-    t54 = -t48 + t10*t0 + t13*t53
-    t55 = -t51 + t15*t0 + t9*t53
-    t56 = damping**2
-    t57 = t40*t45
-    t58 = -t4
-    t59 = _symmetric_solve6(xp, 1, (t56 + t27, t42, t49, -t57, t46, t58, t56 + t32, t52, -t47, t57, t2, t56 + t18, t50, -t44, xp.full(batch, 0, dtype=dtype, device=device), t56 + t34, t43, -t54, t56 + t36, -t55, t56 + t39, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
-    t60 = t59[5]
-    t61 = t59[0]
-    t62 = t59[1]
-    t63 = t60 - t4*t61 + t2*t62
-    t64 = c1*t45
-    t65 = s1*t45
-    t66 = t59[2]
-    t67 = t1*t61 + t3*t62 + c2*t66
-    t68 = t59[3]
-    t69 = t59[4]
-    t70 = t61*t64 + t62*t65 - t5*t66 - s1*t68 + c1*t69
-    t71 = t1*t68 + t3*t69 + c2*t60
-    t72 = t13*t68 + t9*t69 - t53*t60
-    t73 = t10*t68 + t15*t69 - t0*t60
-    t74 = xp.greater(t29, 0)
-    t75 = xp.where(t74, 1/(t58 + t30), 0)
-    t76 = xp.where(t74, 1 + xp.abs(t4)/t29, 0)
-    t77 = t2*t75
-    t78 = t76*(t64 + t65*t77)
-    t79 = -t78 + t64
-    t80 = t65 - t77*t78
-    t81 = t76*(t1 + t3*t77)
-    t82 = -t81 + t1
-    t83 = t76*(mu_dot0 + mu_dot5*t75 + t77*mu_dot1)
-    t84 = -t83 + mu_dot0
-    t85 = t75*t81
-    t86 = t3 - t2*t85
-    t87 = t75**2
-    t88 = xp.sqrt(t16 + t19 + t22 + t80**2 + t87*t78**2)
-    t89 = t88*xp.where(xp.greater_equal(t80, 0), xp.asarray(1, dtype=dtype), -1)
-    t90 = t87*t76
-    t91 = c2*t90
-    t92 = t2*t91
-    t93 = -t91 + c2
-    t94 = t53*t90
-    t95 = t2*t94
-    t96 = -t53
-    t97 = t94 + t96
-    t98 = t0*t90
-    t99 = t2*t98
-    t100 = -t0
-    t101 = t98 + t100
-    t102 = 1 - t5 - s1 + q1 + q2 + c1 + q3 + t2 + q4 + t13 + t9 + q5 + t10 + t15 + q6 + 2*c2 + 2*t1 + 2*t3 + t58 + t64 + t65 + t96 + t100 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t103 = t75*t83
-    t104 = mu_dot1 - t2*t103
-    t105 = -t103 + mu_dot5
-    t106 = xp.greater(t88, 0)
-    t107 = xp.where(t106, 1/(t80 + t89), 0)
-    t108 = xp.where(t106, 1 + xp.abs(t80)/t88, 0)
-    t109 = t5*t107
-    t110 = t78*t107
-    t111 = t108*(t86 - c2*t109 + t87*t110*t81)
-    t112 = -t111 + t86
-    t113 = c2 + t109*t111
-    t114 = t110*t75
-    t115 = -t85 + t114*t111
-    t116 = -t108*(t92 + t114*t93)
-    t117 = t92 + t116
-    t118 = t93 + t114*t116
-    t119 = t107*t116
-    t120 = t1 + s1*t119
-    t121 = t3 - c1*t119
-    t122 = s1*t107
-    t123 = c1*t107
-    t124 = t108*(t95 - t13*t122 + t9*t123 - t114*t97)
-    t125 = -t124 + t95
-    t126 = t13 + t122*t124
-    t127 = t9 - t123*t124
-    t128 = t97 + t114*t124
-    t129 = t108*(t99 - t10*t122 + t15*t123 - t114*t101)
-    t130 = -t129 + t99
-    t131 = t10 + t122*t129
-    t132 = t15 - t123*t129
-    t133 = t101 + t114*t129
-    t134 = -t108*(-t104 + t109*mu_dot2 + t122*mu_dot3 - t123*mu_dot4 + t114*t105)
-    t135 = -t134 + t104
-    t136 = mu_dot2 + t109*t134
-    t137 = mu_dot3 + t122*t134
-    t138 = mu_dot4 - t123*t134
-    t139 = t105 + t114*t134
-    t140 = t107**2*t111**2
-    t141 = xp.sqrt(t113**2 + t115**2 + t22*t140 + t19*t140)
-    t142 = t141*xp.where(xp.greater_equal(t113, 0), xp.asarray(1, dtype=dtype), -1)
-    t143 = xp.greater(t141, 0)
-    t144 = xp.where(t143, 1/(t113 + t142), 0)
-    t145 = xp.where(t143, 1 + xp.abs(t113)/t141, 0)
-    t146 = t109*t116
-    t147 = t111*t144
-    t148 = t122*t147
-    t149 = t123*t147
-    t150 = t115*t144
-    t151 = t145*(t146 + t148*t120 - t149*t121 + t150*t118)
-    t152 = -t151 + t146
-    t153 = t120 - t148*t151
-    t154 = t121 + t149*t151
-    t155 = t118 - t150*t151
-    t156 = t145*(t136 + t148*t137 - t149*t138 + t150*t139)
-    t157 = -t156 + t136
-    t158 = t137 - t148*t156
-    t159 = t138 + t149*t156
-    t160 = t139 - t150*t156
-    t161 = xp.sqrt(t153**2 + t154**2 + t155**2)
-    t162 = t161*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
-    t163 = t109*t124
-    t164 = t145*(t163 + t148*t126 - t149*t127 + t150*t128)
-    t165 = -t164 + t163
-    t166 = t126 - t148*t164
-    t167 = t127 + t149*t164
-    t168 = t128 - t150*t164
-    t169 = t109*t129
-    t170 = t145*(t169 + t148*t131 - t149*t132 + t150*t133)
-    t171 = -t170 + t169
-    t172 = t131 - t148*t170
-    t173 = t132 + t149*t170
-    t174 = t133 - t150*t170
-    t175 = xp.greater(t161, 0)
-    t176 = xp.where(t175, 1/(t153 + t162), 0)
-    t177 = xp.where(t175, 1 + xp.abs(t153)/t161, 0)
-    t178 = t154*t176
-    t179 = t155*t176
-    t180 = t177*(t166 + t178*t167 + t179*t168)
-    t181 = -t180 + t166
-    t182 = t167 - t178*t180
-    t183 = t168 - t179*t180
-    t184 = t177*(t172 + t178*t173 + t179*t174)
-    t185 = -t184 + t172
-    t186 = t173 - t178*t184
-    t187 = t174 - t179*t184
-    t188 = t177*(t158 + t178*t159 + t179*t160)
-    t189 = -t188 + t158
-    t190 = t159 - t178*t188
-    t191 = t160 - t179*t188
-    t192 = xp.sqrt(t182**2 + t183**2)
-    t193 = t192*xp.where(xp.greater_equal(t182, 0), xp.asarray(1, dtype=dtype), -1)
-    t194 = xp.greater(t192, 0)
-    t195 = xp.where(t194, 1/(t182 + t193), 0)
-    t196 = xp.where(t194, 1 + xp.abs(t182)/t192, 0)
-    t197 = t183*t195
-    t198 = t196*(t186 + t197*t187)
-    t199 = -t198 + t186
-    t200 = t187 - t197*t198
-    t201 = t196*(t190 + t197*t191)
-    t202 = -t201 + t190
-    t203 = t191 - t197*t201
-    t204 = xp.abs(t200)
-    t205 = t204*xp.where(xp.greater_equal(t200, 0), xp.asarray(1, dtype=dtype), -1)
-    t206 = xp.where(xp.greater(t204, 0), xp.asarray(2, dtype=dtype), 0)
-    t207 = t203 - t203*t206
-    t208 = xp.where(xp.not_equal(t205, 0), -t207/t205, 0)
-    t209 = xp.where(xp.not_equal(t193, 0), -(t202 - t199*t208)/t193, 0)
-    t210 = xp.where(xp.not_equal(t162, 0), -(-(t181*t209 + t185*t208) + t189)/t162, 0)
-    t211 = xp.where(xp.not_equal(t142, 0), -(-(t152*t210 + t165*t209 + t171*t208) + t157)/t142, 0)
-    t212 = xp.where(xp.not_equal(t89, 0), -(-(t112*t211 - t117*t210 + t125*t209 + t130*t208) + t135)/t89, 0)
-    t213 = t75*t76
-    t214 = xp.where(xp.not_equal(t30, 0), -(-(t79*t212 + t82*t211 - c2*t213*t210 + t53*t213*t209 + t0*t213*t208) + t84)/t30, 0)
-    t215 = xp.isfinite(t102)
-    t216 = xp.greater_equal(damping, 0)
-    t217 = xp.greater(damping, 0)
-    t218 = 1e-12*t38
-    t219 = (t217 & xp.greater(t59[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t29, t218) | xp.less_equal(t88, t218) | xp.less_equal(t141, t218) | xp.less_equal(t161, t218) | xp.less_equal(t192, t218) | xp.less_equal(t204, t218)))
-    t220 = t215 & t216 & xp.logical_not(t219)
+    c6 = trig[..., 10]
+    s6 = trig[..., 11]
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, q3, c4, s4, c5, s5, c6, s6, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t220, xp.where(t217, t63, t214), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t220, xp.where(t217, t70, t212), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t220, xp.where(t217, t67, t211), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t220, xp.where(t217, t71, t210), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t220, xp.where(t217, t72, t209), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t220, xp.where(t217, t73, t208), 0), batch),  # 5
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
+        xp.broadcast_to(t0[4], batch),  # 4
+        xp.broadcast_to(t0[5], batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t215 & t216), 2, xp.where(t219, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[6], batch), xp.int32)
     return q_dot, status
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
-    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1159 operations."""
+    """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1157 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("z", z, (6,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
     q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
     mu_dot3 = mu_dot[..., 3]
     mu_dot4 = mu_dot[..., 4]
     mu_dot5 = mu_dot[..., 5]
-    qz1 = z[..., 0]
-    qz2 = z[..., 1]
-    qz3 = z[..., 2]
-    qz4 = z[..., 3]
-    qz5 = z[..., 4]
-    qz6 = z[..., 5]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
@@ -3479,249 +3483,26 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     s4 = trig[..., 7]
     c5 = trig[..., 8]
     s5 = trig[..., 9]
-    t0 = -c2*c5 + s2*s4*s5
-    t1 = c1*s2
-    t2 = -0.1337*s1 + q3*t1
-    t3 = s1*s2
-    t4 = 0.1337*c1 + q3*t3
-    t5 = c1*t2 + s1*t4
-    t6 = s1*c4
-    t7 = c1*s4
-    t8 = t6 + c2*t7
-    t9 = c2*t6 + t7
-    t10 = t8*s5 + c5*t1
-    t11 = s1*s4
-    t12 = c1*c4
-    t13 = -t11 + c2*t12
-    t14 = -t12 + c2*t11
-    t15 = t14*s5 + c5*t3
-    t16 = t5**2
-    t17 = c2**2
-    t18 = t16 + t17
-    t19 = c1**2
-    t20 = s2**2
-    t21 = t19*t20
-    t22 = s1**2
-    t23 = t20*t22
-    t24 = t4**2
-    t25 = q3**2*t17
-    t26 = t24 + t19*t25
-    t27 = t21 + t26
-    t28 = t2**2
-    t29 = xp.sqrt(1 + t24 + t28)
-    t30 = xp.where(xp.less_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)*t29
-    t31 = t28 + t22*t25
-    t32 = t23 + t31
-    t33 = t13**2 + t10**2 + t22
-    t34 = t21 + t33
-    t35 = t9**2 + t15**2 + t19
-    t36 = t23 + t35
-    t37 = 1 + t0**2 + c4**2*t20
-    t38 = xp.sqrt(t16 + t26 + 2*t17 + 2*t21 + 2*t23 + t31 + t33 + t35 + t37)
-    t39 = t17 + t37
-    t40 = s1*c1
-    t41 = t20*t40
-    t42 = t41 - t2*t4 + t25*t40
-    t43 = -t40 + t41 + t13*t9 + t10*t15
-    t44 = c1*t5
-    t45 = q3*c2
-    t46 = t19*t45
-    t47 = t22*t45
-    t48 = c2*t1
-    t49 = t48 - t44*t45
-    t50 = s1*t5
-    t51 = c2*t3
-    t52 = t51 - t45*t50
-    t53 = s2*c4
-    t54 = -t48 + t10*t0 + t13*t53
-    t55 = -t51 + t15*t0 + t9*t53
-    t56 = damping**2
-    t57 = t40*t45
-    t58 = -t4
-    t59 = _symmetric_solve6(xp, 1, (t56 + t27, t42, t49, -t57, t46, t58, t56 + t32, t52, -t47, t57, t2, t56 + t18, t50, -t44, xp.full(batch, 0, dtype=dtype, device=device), t56 + t34, t43, -t54, t56 + t36, -t55, t56 + t39, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
-    t60 = t59[5]
-    t61 = t59[0]
-    t62 = t59[1]
-    t63 = t60 - t4*t61 + t2*t62
-    t64 = c1*t45
-    t65 = s1*t45
-    t66 = t59[2]
-    t67 = t1*t61 + t3*t62 + c2*t66
-    t68 = t59[3]
-    t69 = t59[4]
-    t70 = t61*t64 + t62*t65 - t5*t66 - s1*t68 + c1*t69
-    t71 = t1*t68 + t3*t69 + c2*t60
-    t72 = t13*t68 + t9*t69 - t53*t60
-    t73 = t10*t68 + t15*t69 - t0*t60
-    t74 = xp.greater(t29, 0)
-    t75 = xp.where(t74, 1/(t58 + t30), 0)
-    t76 = xp.where(t74, 1 + xp.abs(t4)/t29, 0)
-    t77 = t2*t75
-    t78 = t76*(t64 + t65*t77)
-    t79 = -t78 + t64
-    t80 = t65 - t77*t78
-    t81 = t76*(t1 + t3*t77)
-    t82 = -t81 + t1
-    t83 = t76*(mu_dot0 + mu_dot5*t75 + t77*mu_dot1)
-    t84 = -t83 + mu_dot0
-    t85 = t75*t81
-    t86 = t3 - t2*t85
-    t87 = t75**2
-    t88 = xp.sqrt(t16 + t19 + t22 + t80**2 + t87*t78**2)
-    t89 = t88*xp.where(xp.greater_equal(t80, 0), xp.asarray(1, dtype=dtype), -1)
-    t90 = t87*t76
-    t91 = c2*t90
-    t92 = t2*t91
-    t93 = -t91 + c2
-    t94 = t53*t90
-    t95 = t2*t94
-    t96 = -t53
-    t97 = t94 + t96
-    t98 = t0*t90
-    t99 = t2*t98
-    t100 = -t0
-    t101 = t98 + t100
-    t102 = 1 - t5 - s1 + q1 + q2 + c1 + q3 + t2 + q4 + t13 + t9 + q5 + t10 + t15 + q6 + 2*c2 + 2*t1 + 2*t3 + t58 + t64 + t65 + t96 + t100 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6
-    t103 = t75*t83
-    t104 = mu_dot1 - t2*t103
-    t105 = -t103 + mu_dot5
-    t106 = xp.greater(t88, 0)
-    t107 = xp.where(t106, 1/(t80 + t89), 0)
-    t108 = xp.where(t106, 1 + xp.abs(t80)/t88, 0)
-    t109 = t5*t107
-    t110 = t78*t107
-    t111 = t108*(t86 - c2*t109 + t87*t110*t81)
-    t112 = -t111 + t86
-    t113 = c2 + t109*t111
-    t114 = t110*t75
-    t115 = -t85 + t114*t111
-    t116 = -t108*(t92 + t114*t93)
-    t117 = t92 + t116
-    t118 = t93 + t114*t116
-    t119 = t107*t116
-    t120 = t1 + s1*t119
-    t121 = t3 - c1*t119
-    t122 = s1*t107
-    t123 = c1*t107
-    t124 = t108*(t95 - t13*t122 + t9*t123 - t114*t97)
-    t125 = -t124 + t95
-    t126 = t13 + t122*t124
-    t127 = t9 - t123*t124
-    t128 = t97 + t114*t124
-    t129 = t108*(t99 - t10*t122 + t15*t123 - t114*t101)
-    t130 = -t129 + t99
-    t131 = t10 + t122*t129
-    t132 = t15 - t123*t129
-    t133 = t101 + t114*t129
-    t134 = -t108*(-t104 + t109*mu_dot2 + t122*mu_dot3 - t123*mu_dot4 + t114*t105)
-    t135 = -t134 + t104
-    t136 = mu_dot2 + t109*t134
-    t137 = mu_dot3 + t122*t134
-    t138 = mu_dot4 - t123*t134
-    t139 = t105 + t114*t134
-    t140 = t107**2*t111**2
-    t141 = xp.sqrt(t113**2 + t115**2 + t22*t140 + t19*t140)
-    t142 = t141*xp.where(xp.greater_equal(t113, 0), xp.asarray(1, dtype=dtype), -1)
-    t143 = xp.greater(t141, 0)
-    t144 = xp.where(t143, 1/(t113 + t142), 0)
-    t145 = xp.where(t143, 1 + xp.abs(t113)/t141, 0)
-    t146 = t109*t116
-    t147 = t111*t144
-    t148 = t122*t147
-    t149 = t123*t147
-    t150 = t115*t144
-    t151 = t145*(t146 + t148*t120 - t149*t121 + t150*t118)
-    t152 = -t151 + t146
-    t153 = t120 - t148*t151
-    t154 = t121 + t149*t151
-    t155 = t118 - t150*t151
-    t156 = t145*(t136 + t148*t137 - t149*t138 + t150*t139)
-    t157 = -t156 + t136
-    t158 = t137 - t148*t156
-    t159 = t138 + t149*t156
-    t160 = t139 - t150*t156
-    t161 = xp.sqrt(t153**2 + t154**2 + t155**2)
-    t162 = t161*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
-    t163 = t109*t124
-    t164 = t145*(t163 + t148*t126 - t149*t127 + t150*t128)
-    t165 = -t164 + t163
-    t166 = t126 - t148*t164
-    t167 = t127 + t149*t164
-    t168 = t128 - t150*t164
-    t169 = t109*t129
-    t170 = t145*(t169 + t148*t131 - t149*t132 + t150*t133)
-    t171 = -t170 + t169
-    t172 = t131 - t148*t170
-    t173 = t132 + t149*t170
-    t174 = t133 - t150*t170
-    t175 = xp.greater(t161, 0)
-    t176 = xp.where(t175, 1/(t153 + t162), 0)
-    t177 = xp.where(t175, 1 + xp.abs(t153)/t161, 0)
-    t178 = t154*t176
-    t179 = t155*t176
-    t180 = t177*(t166 + t178*t167 + t179*t168)
-    t181 = -t180 + t166
-    t182 = t167 - t178*t180
-    t183 = t168 - t179*t180
-    t184 = t177*(t172 + t178*t173 + t179*t174)
-    t185 = -t184 + t172
-    t186 = t173 - t178*t184
-    t187 = t174 - t179*t184
-    t188 = t177*(t158 + t178*t159 + t179*t160)
-    t189 = -t188 + t158
-    t190 = t159 - t178*t188
-    t191 = t160 - t179*t188
-    t192 = xp.sqrt(t182**2 + t183**2)
-    t193 = t192*xp.where(xp.greater_equal(t182, 0), xp.asarray(1, dtype=dtype), -1)
-    t194 = xp.greater(t192, 0)
-    t195 = xp.where(t194, 1/(t182 + t193), 0)
-    t196 = xp.where(t194, 1 + xp.abs(t182)/t192, 0)
-    t197 = t183*t195
-    t198 = t196*(t186 + t197*t187)
-    t199 = -t198 + t186
-    t200 = t187 - t197*t198
-    t201 = t196*(t190 + t197*t191)
-    t202 = -t201 + t190
-    t203 = t191 - t197*t201
-    t204 = xp.abs(t200)
-    t205 = t204*xp.where(xp.greater_equal(t200, 0), xp.asarray(1, dtype=dtype), -1)
-    t206 = xp.where(xp.greater(t204, 0), xp.asarray(2, dtype=dtype), 0)
-    t207 = t203 - t203*t206
-    t208 = xp.where(xp.not_equal(t205, 0), -t207/t205, 0)
-    t209 = xp.where(xp.not_equal(t193, 0), -(t202 - t199*t208)/t193, 0)
-    t210 = xp.where(xp.not_equal(t162, 0), -(-(t181*t209 + t185*t208) + t189)/t162, 0)
-    t211 = xp.where(xp.not_equal(t142, 0), -(-(t152*t210 + t165*t209 + t171*t208) + t157)/t142, 0)
-    t212 = xp.where(xp.not_equal(t89, 0), -(-(t112*t211 - t117*t210 + t125*t209 + t130*t208) + t135)/t89, 0)
-    t213 = t75*t76
-    t214 = xp.where(xp.not_equal(t30, 0), -(-(t79*t212 + t82*t211 - c2*t213*t210 + t53*t213*t209 + t0*t213*t208) + t84)/t30, 0)
-    t215 = xp.isfinite(t102)
-    t216 = xp.greater_equal(damping, 0)
-    t217 = xp.greater(damping, 0)
-    t218 = 1e-12*t38
-    t219 = (t217 & xp.greater(t59[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t29, t218) | xp.less_equal(t88, t218) | xp.less_equal(t141, t218) | xp.less_equal(t161, t218) | xp.less_equal(t192, t218) | xp.less_equal(t204, t218)))
-    t220 = t215 & t216 & xp.logical_not(t219)
+    c6 = trig[..., 10]
+    s6 = trig[..., 11]
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, q3, c4, s4, c5, s5, c6, s6, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t220, xp.where(t217, t63, t214), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t220, xp.where(t217, t70, t212), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t220, xp.where(t217, t67, t211), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t220, xp.where(t217, t71, t210), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t220, xp.where(t217, t72, t209), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t220, xp.where(t217, t73, t208), 0), batch),  # 5
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
+        xp.broadcast_to(t0[4], batch),  # 4
+        xp.broadcast_to(t0[5], batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t215 & t216), 2, xp.where(t219, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[6], batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1320 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1349 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (6,)), ("target", target, (4, 4)), ("target_rate", target_rate, (6,)), ("gain", gain, (6,)), ("z", z, (6,)), ("damping", damping, ()), every=("gain", ))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
     q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
     T02 = target[..., 0, 2]
@@ -3746,12 +3527,6 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     gain3 = gain[..., 3]
     gain4 = gain[..., 4]
     gain5 = gain[..., 5]
-    qz1 = z[..., 0]
-    qz2 = z[..., 1]
-    qz3 = z[..., 2]
-    qz4 = z[..., 3]
-    qz5 = z[..., 4]
-    qz6 = z[..., 5]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
@@ -3763,38 +3538,38 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = c1*s2
-    t1 = -0.1337*s1 + q3*t0
-    t2 = mu_dot0 + gain0*(-t1 + T03)
-    t3 = s1*s2
-    t4 = 0.1337*c1 + q3*t3
-    t5 = c1*t1 + s1*t4
-    t6 = q3*c2
-    t7 = 0.412 + t6
-    t8 = mu_dot2 + gain2*(-t7 + T23)
-    t9 = s1*c4
-    t10 = c1*s4
-    t11 = t9 + c2*t10
-    t12 = t10 + c2*t9
-    t13 = t11*c5 - s5*t0
-    t14 = t11*s5 + c5*t0
-    t15 = s1*s4
-    t16 = c1*c4
-    t17 = -t15 + c2*t16
-    t18 = -t16 + c2*t15
-    t19 = t18*c5 - s5*t3
-    t20 = t18*s5 + c5*t3
-    t21 = t17*s6 + t13*c6
-    t22 = t17*c6 - t13*s6
-    t23 = t12*s6 + t19*c6
-    t24 = t12*c6 - t19*s6
-    t25 = t21*T00 + t22*T01 + t14*T02
-    t26 = t23*T00 + t24*T01 + t20*T02
-    t27 = t21*T10 + t22*T11 + t14*T12
-    t28 = t23*T10 + t24*T11 + t20*T12
-    t29 = t21*T20 + t22*T21 + t14*T22
-    t30 = t23*T20 + t24*T21 + t20*T22
-    t31 = 0.5*(-t26 + t27)
+    t0 = 0.412 + q3*c2
+    t1 = mu_dot2 + gain2*(-t0 + T23)
+    t2 = q3*s2
+    t3 = -0.1337*s1 + c1*t2
+    t4 = 0.1337*c1 + s1*t2
+    t5 = mu_dot0 + gain0*(-t3 + T03)
+    t6 = mu_dot1 + gain1*(-t4 + T13)
+    t7 = s1*c4
+    t8 = c1*s4
+    t9 = t7 + c2*t8
+    t10 = t8 + c2*t7
+    t11 = s1*s4
+    t12 = c1*c4
+    t13 = -t11 + c2*t12
+    t14 = -t12 + c2*t11
+    t15 = c1*s2
+    t16 = t9*c5 - s5*t15
+    t17 = t9*s5 + c5*t15
+    t18 = t13*s6 + t16*c6
+    t19 = t13*c6 - t16*s6
+    t20 = t18*T00 + t19*T01 + t17*T02
+    t21 = t18*T10 + t19*T11 + t17*T12
+    t22 = t18*T20 + t19*T21 + t17*T22
+    t23 = s1*s2
+    t24 = t14*c5 - s5*t23
+    t25 = t14*s5 + c5*t23
+    t26 = t10*s6 + t24*c6
+    t27 = t10*c6 - t24*s6
+    t28 = t26*T00 + t27*T01 + t25*T02
+    t29 = t26*T10 + t27*T11 + t25*T12
+    t30 = t26*T20 + t27*T21 + t25*T22
+    t31 = 0.5*(-t28 + t21)
     t32 = s2*s4
     t33 = c2*s5 + c5*t32
     t34 = -c2*c5 + s5*t32
@@ -3805,240 +3580,37 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t39 = t36*T10 + t34*T12 - t37*T11
     t40 = t36*T20 + t34*T22 - t37*T21
     t41 = 0.5*(t39 + t30)
-    t42 = -0.5*(t38 + t29)
+    t42 = -0.5*(t38 + t22)
     t43 = xp.sqrt(t41**2 + t42**2 + t31**2)
-    t44 = t5**2
-    t45 = c2**2
-    t46 = t44 + t45
-    t47 = c1**2
-    t48 = t6*t47
-    t49 = s2**2
-    t50 = t47*t49
-    t51 = s1**2
-    t52 = t6*t51
-    t53 = t49*t51
-    t54 = t4**2
-    t55 = q3**2*t45
-    t56 = t54 + t47*t55
-    t57 = t50 + t56
-    t58 = t1**2
-    t59 = xp.sqrt(1 + t54 + t58)
-    t60 = xp.where(xp.less_equal(t4, 0), xp.asarray(1, dtype=dtype), -1)*t59
-    t61 = t58 + t51*t55
-    t62 = t53 + t61
-    t63 = t17**2 + t14**2 + t51
-    t64 = t50 + t63
-    t65 = t12**2 + t20**2 + t47
-    t66 = t53 + t65
-    t67 = 1 + t34**2 + c4**2*t49
-    t68 = xp.sqrt(t44 + 2*t45 + 2*t50 + 2*t53 + t56 + t61 + t63 + t65 + t67)
-    t69 = t45 + t67
-    t70 = s1*c1
-    t71 = t49*t70
-    t72 = t71 + t55*t70 - t1*t4
-    t73 = -t70 + t71 + t17*t12 + t14*t20
-    t74 = c1*t5
-    t75 = c2*t0
-    t76 = t75 - t6*t74
-    t77 = -t75 + t14*t34 + t17*t35
-    t78 = s1*t5
-    t79 = c2*t3
-    t80 = t79 - t6*t78
-    t81 = -t79 + t20*t34 + t12*t35
-    t82 = xp.greater(t59, 0)
-    t83 = xp.where(t82, 1 + xp.abs(t4)/t59, 0)
-    t84 = -t4
-    t85 = xp.where(t82, 1/(t84 + t60), 0)
-    t86 = mu_dot1 + gain1*(t84 + T13)
-    t87 = c1*t6
-    t88 = s1*t6
-    t89 = t1*t85
-    t90 = t83*(t87 + t88*t89)
-    t91 = -t90 + t87
-    t92 = t88 - t89*t90
-    t93 = t83*(t0 + t3*t89)
-    t94 = -t93 + t0
-    t95 = t85*t93
-    t96 = t3 - t1*t95
-    t97 = t85**2
-    t98 = xp.sqrt(t44 + t47 + t51 + t92**2 + t97*t90**2)
-    t99 = t98*xp.where(xp.greater_equal(t92, 0), xp.asarray(1, dtype=dtype), -1)
-    t100 = t97*t83
-    t101 = c2*t100
-    t102 = t1*t101
-    t103 = -t101 + c2
-    t104 = t35*t100
-    t105 = t1*t104
-    t106 = -t35
-    t107 = t104 + t106
-    t108 = t34*t100
-    t109 = t1*t108
-    t110 = -t34
-    t111 = t108 + t110
-    t112 = xp.greater(t98, 0)
-    t113 = xp.where(t112, 1/(t92 + t99), 0)
-    t114 = xp.where(t112, 1 + xp.abs(t92)/t98, 0)
-    t115 = t5*t113
-    t116 = t90*t113
-    t117 = t114*(t96 - c2*t115 + t97*t116*t93)
-    t118 = -t117 + t96
-    t119 = c2 + t115*t117
-    t120 = t116*t85
-    t121 = -t95 + t120*t117
-    t122 = -t114*(t102 + t120*t103)
-    t123 = t102 + t122
-    t124 = t103 + t120*t122
-    t125 = t113*t122
-    t126 = t0 + s1*t125
-    t127 = t3 - c1*t125
-    t128 = s1*t113
-    t129 = c1*t113
-    t130 = t114*(t105 - t17*t128 + t12*t129 - t120*t107)
-    t131 = -t130 + t105
-    t132 = t17 + t128*t130
-    t133 = t12 - t129*t130
-    t134 = t107 + t120*t130
-    t135 = t114*(t109 - t14*t128 + t20*t129 - t120*t111)
-    t136 = -t135 + t109
-    t137 = t14 + t128*t135
-    t138 = t20 - t129*t135
-    t139 = t111 + t120*t135
-    t140 = t113**2*t117**2
-    t141 = xp.sqrt(t119**2 + t121**2 + t51*t140 + t47*t140)
-    t142 = t141*xp.where(xp.greater_equal(t119, 0), xp.asarray(1, dtype=dtype), -1)
-    t143 = xp.greater(t141, 0)
-    t144 = xp.where(t143, 1/(t119 + t142), 0)
-    t145 = xp.where(t143, 1 + xp.abs(t119)/t141, 0)
-    t146 = t115*t122
-    t147 = t117*t144
-    t148 = t128*t147
-    t149 = t129*t147
-    t150 = t121*t144
-    t151 = t145*(t146 + t148*t126 - t149*t127 + t150*t124)
-    t152 = -t151 + t146
-    t153 = t126 - t148*t151
-    t154 = t127 + t149*t151
-    t155 = t124 - t150*t151
-    t156 = xp.sqrt(t153**2 + t154**2 + t155**2)
-    t157 = t156*xp.where(xp.greater_equal(t153, 0), xp.asarray(1, dtype=dtype), -1)
-    t158 = t115*t130
-    t159 = t145*(t158 + t148*t132 - t149*t133 + t150*t134)
-    t160 = -t159 + t158
-    t161 = t132 - t148*t159
-    t162 = t133 + t149*t159
-    t163 = t134 - t150*t159
-    t164 = t115*t135
-    t165 = t145*(t164 + t148*t137 - t149*t138 + t150*t139)
-    t166 = -t165 + t164
-    t167 = t137 - t148*t165
-    t168 = t138 + t149*t165
-    t169 = t139 - t150*t165
-    t170 = xp.greater(t156, 0)
-    t171 = xp.where(t170, 1/(t153 + t157), 0)
-    t172 = xp.where(t170, 1 + xp.abs(t153)/t156, 0)
-    t173 = t154*t171
-    t174 = t155*t171
-    t175 = t172*(t161 + t173*t162 + t174*t163)
-    t176 = -t175 + t161
-    t177 = t162 - t173*t175
-    t178 = t163 - t174*t175
-    t179 = t172*(t167 + t173*t168 + t174*t169)
-    t180 = -t179 + t167
-    t181 = t168 - t173*t179
-    t182 = t169 - t174*t179
-    t183 = xp.sqrt(t177**2 + t178**2)
-    t184 = t183*xp.where(xp.greater_equal(t177, 0), xp.asarray(1, dtype=dtype), -1)
-    t185 = xp.greater(t183, 0)
-    t186 = xp.where(t185, 1/(t177 + t184), 0)
-    t187 = xp.where(t185, 1 + xp.abs(t177)/t183, 0)
-    t188 = t178*t186
-    t189 = t187*(t181 + t188*t182)
-    t190 = -t189 + t181
-    t191 = t182 - t188*t189
-    t192 = xp.abs(t191)
-    t193 = t192*xp.where(xp.greater_equal(t191, 0), xp.asarray(1, dtype=dtype), -1)
-    t194 = xp.where(xp.greater(t192, 0), xp.asarray(2, dtype=dtype), 0)
-    t195 = -t40
-    t196 = 0.5*(-1 + t195 + t25 + t28)
-    t197 = xp.atan2(t43, t196)
-    t198 = xp.where(xp.greater(t43, 0), t197/t43, 1)
-    t199 = xp.greater_equal(t25, t28) & xp.greater_equal(t25, t195)
-    t200 = xp.greater_equal(t28, t195)
-    t201 = xp.where(t199, 0.5*(1 + t25), xp.where(t200, 0.5*t26, -0.5*t38))
-    t202 = xp.where(t199, 0.5*t27, xp.where(t200, 0.5*(1 + t28), -0.5*t39))
-    t203 = xp.where(t199, 0.5*t29, xp.where(t200, 0.5*t30, 0.5*(1 + t195)))
-    t204 = xp.sqrt(t201**2 + t202**2 + t203**2)
-    t205 = xp.where(xp.greater_equal(t41*t201 + t42*t202 + t31*t203, 0), xp.asarray(1, dtype=dtype), -1)
-    t206 = xp.greater(t43, 1e-06) | xp.greater(t196, 0)
-    t207 = t197*t205/t204
-    t208 = xp.where(t206, t41*t198, t207*t201)
-    t209 = xp.where(t206, t42*t198, t207*t202)
-    t210 = xp.where(t206, t31*t198, t207*t203)
-    t211 = mu_dot3 + t208*gain3
-    t212 = mu_dot4 + t209*gain4
-    t213 = mu_dot5 + t210*gain5
-    t214 = t83*(t2 + t85*t213 + t89*t86)
-    t215 = -t214 + t2
-    t216 = 1 - t5 - s1 + q1 + q2 + c1 + q3 + t1 + q4 + t17 + t12 + q5 + t14 + t20 + q6 + 2*c2 + 2*t0 + 2*t3 + t84 + t87 + t88 + t106 + t110 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t2 + t86 + t8 + t211 + t212 + t213
-    t217 = damping**2
-    t218 = t6*t70
-    t219 = _symmetric_solve6(xp, 1, (t217 + t57, t72, t76, -t218, t48, t84, t217 + t62, t80, -t52, t218, t1, t217 + t46, t78, -t74, xp.full(batch, 0, dtype=dtype, device=device), t217 + t64, t73, -t77, t217 + t66, -t81, t217 + t69, t2, t86, t8, t211, t212, t213,))
-    t220 = t219[5]
-    t221 = t219[0]
-    t222 = t219[1]
-    t223 = t220 - t4*t221 + t1*t222
-    t224 = t219[2]
-    t225 = t0*t221 + t3*t222 + c2*t224
-    t226 = t219[3]
-    t227 = t219[4]
-    t228 = t87*t221 + t88*t222 - t5*t224 - s1*t226 + c1*t227
-    t229 = t0*t226 + t3*t227 + c2*t220
-    t230 = t17*t226 + t12*t227 - t35*t220
-    t231 = t14*t226 + t20*t227 - t34*t220
-    t232 = t85*t214
-    t233 = t86 - t1*t232
-    t234 = -t232 + t213
-    t235 = -t114*(-t233 + t115*t8 + t128*t211 - t129*t212 + t120*t234)
-    t236 = -t235 + t233
-    t237 = t8 + t115*t235
-    t238 = t211 + t128*t235
-    t239 = t212 - t129*t235
-    t240 = t234 + t120*t235
-    t241 = t145*(t237 + t148*t238 - t149*t239 + t150*t240)
-    t242 = -t241 + t237
-    t243 = t238 - t148*t241
-    t244 = t239 + t149*t241
-    t245 = t240 - t150*t241
-    t246 = t172*(t243 + t173*t244 + t174*t245)
-    t247 = -t246 + t243
-    t248 = t244 - t173*t246
-    t249 = t245 - t174*t246
-    t250 = t187*(t248 + t188*t249)
-    t251 = -t250 + t248
-    t252 = t249 - t188*t250
-    t253 = t252 - t194*t252
-    t254 = xp.where(xp.not_equal(t193, 0), -t253/t193, 0)
-    t255 = xp.where(xp.not_equal(t184, 0), -(t251 - t190*t254)/t184, 0)
-    t256 = xp.where(xp.not_equal(t157, 0), -(-(t176*t255 + t180*t254) + t247)/t157, 0)
-    t257 = xp.where(xp.not_equal(t142, 0), -(-(t152*t256 + t160*t255 + t166*t254) + t242)/t142, 0)
-    t258 = xp.where(xp.not_equal(t99, 0), -(-(t118*t257 - t123*t256 + t131*t255 + t136*t254) + t236)/t99, 0)
-    t259 = t85*t83
-    t260 = xp.where(xp.not_equal(t60, 0), -(-(t91*t258 + t94*t257 - c2*t259*t256 + t35*t259*t255 + t34*t259*t254) + t215)/t60, 0)
-    t261 = xp.isfinite(t216)
-    t262 = xp.greater_equal(damping, 0)
-    t263 = xp.greater(damping, 0)
-    t264 = 1e-12*t68
-    t265 = (t263 & xp.greater(t219[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t59, t264) | xp.less_equal(t98, t264) | xp.less_equal(t141, t264) | xp.less_equal(t156, t264) | xp.less_equal(t183, t264) | xp.less_equal(t192, t264)))
-    t266 = t261 & t262 & xp.logical_not(t265)
+    t44 = -t40
+    t45 = 0.5*(-1 + t44 + t20 + t29)
+    t46 = xp.atan2(t43, t45)
+    t47 = xp.where(xp.greater(t43, 0), t46/t43, 1)
+    t48 = xp.greater_equal(t20, t29) & xp.greater_equal(t20, t44)
+    t49 = xp.greater_equal(t29, t44)
+    t50 = xp.where(t48, 0.5*(1 + t20), xp.where(t49, 0.5*t28, -0.5*t38))
+    t51 = xp.where(t48, 0.5*t21, xp.where(t49, 0.5*(1 + t29), -0.5*t39))
+    t52 = xp.where(t48, 0.5*t22, xp.where(t49, 0.5*t30, 0.5*(1 + t44)))
+    t53 = xp.sqrt(t50**2 + t51**2 + t52**2)
+    t54 = xp.where(xp.greater_equal(t41*t50 + t42*t51 + t31*t52, 0), xp.asarray(1, dtype=dtype), -1)
+    t55 = xp.greater(t43, 1e-06) | xp.greater(t45, 0)
+    t56 = t46*t54/t53
+    t57 = xp.where(t55, t41*t47, t56*t50)
+    t58 = xp.where(t55, t42*t47, t56*t51)
+    t59 = xp.where(t55, t31*t47, t56*t52)
+    t60 = mu_dot3 + t57*gain3
+    t61 = mu_dot4 + t58*gain4
+    t62 = mu_dot5 + t59*gain5
+    t63 = _velocity_solve(xp, 1, (c1, s1, c2, s2, q3, c4, s4, c5, s5, c6, s6, t5, t6, t1, t60, t61, t62, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t266, xp.where(t263, t223, t260), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t266, xp.where(t263, t228, t258), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t266, xp.where(t263, t225, t257), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t266, xp.where(t263, t229, t256), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t266, xp.where(t263, t230, t255), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t266, xp.where(t263, t231, t254), 0), batch),  # 5
+        xp.broadcast_to(t63[0], batch),  # 0
+        xp.broadcast_to(t63[1], batch),  # 1
+        xp.broadcast_to(t63[2], batch),  # 2
+        xp.broadcast_to(t63[3], batch),  # 3
+        xp.broadcast_to(t63[4], batch),  # 4
+        xp.broadcast_to(t63[5], batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t261 & t262), 2, xp.where(t265, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t63[6], batch), xp.int32)
     return q_dot, status
 
 

@@ -113,7 +113,7 @@ void ur5_velocity_ellipsoid(const ur5_real q[UR5_DOF], ur5_real U_v[9], ur5_real
 ur5_real ur5_condition_number(const ur5_real q[UR5_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1278 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1284 operations. */
 int ur5_velocity_ik(const ur5_real q[UR5_DOF], const ur5_real mu_dot[UR5_TASK_DIM], ur5_real damping, ur5_real q_dot[UR5_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
@@ -121,7 +121,7 @@ int ur5_velocity_ik(const ur5_real q[UR5_DOF], const ur5_real mu_dot[UR5_TASK_DI
 int ur5_velocity_ik_nullspace(const ur5_real q[UR5_DOF], const ur5_real mu_dot[UR5_TASK_DIM], const ur5_real z[UR5_DOF], ur5_real damping, ur5_real q_dot[UR5_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1442 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1489 operations. */
 int ur5_resolved_rate(const ur5_real q[UR5_DOF], const ur5_real target[16], const ur5_real target_rate[UR5_TASK_DIM], const ur5_real gain[UR5_TASK_DIM], const ur5_real z[UR5_DOF], ur5_real damping, ur5_real q_dot[UR5_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).

@@ -113,7 +113,7 @@ void ur5_calibrated_velocity_ellipsoid(const ur5_calibrated_real q[UR5_CALIBRATE
 ur5_calibrated_real ur5_calibrated_condition_number(const ur5_calibrated_real q[UR5_CALIBRATED_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.
- * Result: q_dot[i], i < 6; returned as a scalar. 1587 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1593 operations. */
 int ur5_calibrated_velocity_ik(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], const ur5_calibrated_real mu_dot[UR5_CALIBRATED_TASK_DIM], ur5_calibrated_real damping, ur5_calibrated_real q_dot[UR5_CALIBRATED_DOF]);
 
 /* Velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*).
@@ -121,7 +121,7 @@ int ur5_calibrated_velocity_ik(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], 
 int ur5_calibrated_velocity_ik_nullspace(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], const ur5_calibrated_real mu_dot[UR5_CALIBRATED_TASK_DIM], const ur5_calibrated_real z[UR5_CALIBRATED_DOF], ur5_calibrated_real damping, ur5_calibrated_real q_dot[UR5_CALIBRATED_DOF]);
 
 /* Resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*).
- * Result: q_dot[i], i < 6; returned as a scalar. 1755 operations. */
+ * Result: q_dot[i], i < 6; returned as a scalar. 1985 operations. */
 int ur5_calibrated_resolved_rate(const ur5_calibrated_real q[UR5_CALIBRATED_DOF], const ur5_calibrated_real target[16], const ur5_calibrated_real target_rate[UR5_CALIBRATED_TASK_DIM], const ur5_calibrated_real gain[UR5_CALIBRATED_TASK_DIM], const ur5_calibrated_real z[UR5_CALIBRATED_DOF], ur5_calibrated_real damping, ur5_calibrated_real q_dot[UR5_CALIBRATED_DOF]);
 
 /* One step of ik_numeric: q clamped to the limits, then q + J^T (J J^T + damping I)^-1 e clamped, and |e|^2 at the clamped q (-1 when target or q is not finite).
@@ -149,7 +149,7 @@ int ur5_calibrated_ik_general_limits(const ur5_calibrated_real q_solution[UR5_CA
 int ur5_calibrated_ik_general_nominal(const ur5_calibrated_real T[16], ur5_calibrated_real q[48], int valid[8]);
 
 /* The closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status.
- * Result: q[i], i < 6; returned as a scalar. 1890 operations. */
+ * Result: q[i], i < 6; returned as a scalar. 1891 operations. */
 int ur5_calibrated_ik_nearest(const ur5_calibrated_real T[16], const ur5_calibrated_real q_seed[UR5_CALIBRATED_DOF], const ur5_calibrated_real weights[UR5_CALIBRATED_DOF], ur5_calibrated_real q[UR5_CALIBRATED_DOF]);
 
 /* Statuses of ur5_calibrated_velocity_ik: OK, singular (a diagonal entry of the QR factor R of the

@@ -82,7 +82,7 @@ def _stack(xp, values, shape):
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -336,7 +336,7 @@ def _jacobi3_columns_2(xp, count, state):
 def _jacobi6_rows(xp, count, state):
     """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2 + w4**2 + w5**2
@@ -904,9 +904,9 @@ def _jacobi6_rows(xp, count, state):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _symmetric_solve6(xp, count, state):
-    """X solving a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
+    """The solution x of a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
         t0 = w1**2
@@ -1090,63 +1090,331 @@ def _symmetric_solve6(xp, count, state):
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
-def _nearer_branch(xp, count, state):
-    """The nearer of the best branch so far and the next one, in the limits and nearest the seed by its joints' equivalents, `count` times: 114 operations a run."""
+def _velocity_solve(xp, count, state):
+    """The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status, `count` times: 1581 operations a run."""
     state = xp.broadcast_arrays(*state)
-    dtype = state[0].dtype
+    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
     for _ in range(count):
-        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
-        t0 = w0 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w0 + w7))
-        t1 = w1 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w1 + w8))
-        t2 = w2 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w2 + w9))
-        t3 = w3 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w3 + w10))
-        t4 = w4 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w4 + w11))
-        t5 = w5 + 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-w5 + w12))
-        t6 = xp.where(xp.less(t0, w7), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-        t7 = t6 + t0
-        t8 = -t6 + t0
-        t9 = xp.where(xp.greater_equal(t0, -6.283185307179586) & xp.less_equal(t0, 6.283185307179586), t0, xp.where(xp.greater_equal(t7, -6.283185307179586) & xp.less_equal(t7, 6.283185307179586), t7, xp.where(xp.greater_equal(t8, -6.283185307179586) & xp.less_equal(t8, 6.283185307179586), t8, w0)))
-        t10 = xp.where(xp.less(t1, w8), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-        t11 = t10 + t1
-        t12 = -t10 + t1
-        t13 = xp.where(xp.greater_equal(t1, -6.283185307179586) & xp.less_equal(t1, 6.283185307179586), t1, xp.where(xp.greater_equal(t11, -6.283185307179586) & xp.less_equal(t11, 6.283185307179586), t11, xp.where(xp.greater_equal(t12, -6.283185307179586) & xp.less_equal(t12, 6.283185307179586), t12, w1)))
-        t14 = xp.where(xp.less(t2, w9), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-        t15 = t14 + t2
-        t16 = -t14 + t2
-        t17 = xp.where(xp.greater_equal(t2, -6.283185307179586) & xp.less_equal(t2, 6.283185307179586), t2, xp.where(xp.greater_equal(t15, -6.283185307179586) & xp.less_equal(t15, 6.283185307179586), t15, xp.where(xp.greater_equal(t16, -6.283185307179586) & xp.less_equal(t16, 6.283185307179586), t16, w2)))
-        t18 = xp.where(xp.less(t3, w10), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-        t19 = t18 + t3
-        t20 = -t18 + t3
-        t21 = xp.where(xp.greater_equal(t3, -6.283185307179586) & xp.less_equal(t3, 6.283185307179586), t3, xp.where(xp.greater_equal(t19, -6.283185307179586) & xp.less_equal(t19, 6.283185307179586), t19, xp.where(xp.greater_equal(t20, -6.283185307179586) & xp.less_equal(t20, 6.283185307179586), t20, w3)))
-        t22 = xp.where(xp.less(t4, w11), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-        t23 = t22 + t4
-        t24 = -t22 + t4
-        t25 = xp.where(xp.greater_equal(t4, -6.283185307179586) & xp.less_equal(t4, 6.283185307179586), t4, xp.where(xp.greater_equal(t23, -6.283185307179586) & xp.less_equal(t23, 6.283185307179586), t23, xp.where(xp.greater_equal(t24, -6.283185307179586) & xp.less_equal(t24, 6.283185307179586), t24, w4)))
-        t26 = xp.where(xp.less(t5, w12), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
-        t27 = t26 + t5
-        t28 = -t26 + t5
-        t29 = xp.where(xp.greater_equal(t5, -6.283185307179586) & xp.less_equal(t5, 6.283185307179586), t5, xp.where(xp.greater_equal(t27, -6.283185307179586) & xp.less_equal(t27, 6.283185307179586), t27, xp.where(xp.greater_equal(t28, -6.283185307179586) & xp.less_equal(t28, 6.283185307179586), t28, w5)))
-        t30 = w13*(-w7 + t9)**2 + w14*(-w8 + t13)**2 + w15*(-w9 + t17)**2 + w16*(-w10 + t21)**2 + w17*(-w11 + t25)**2 + w18*(-w12 + t29)**2
-        t31 = xp.greater(w6, 0)
-        t32 = xp.where(t31 & (xp.less(w26, 1) | xp.less(t30, w25)), xp.asarray(1, dtype=dtype), 0)
-        t33 = xp.where(t31, 1, w26)
-        t34 = xp.greater(t32, 0)
-        t35 = xp.where(t34, t9, w19)
-        t36 = xp.where(t34, t13, w20)
-        t37 = xp.where(t34, t17, w21)
-        t38 = xp.where(t34, t21, w22)
-        t39 = xp.where(t34, t25, w23)
-        t40 = xp.where(t34, t29, w24)
-        t41 = xp.where(t34, t30, w25)
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, = state
+        t0 = 0.9999995000268362*w1
+        t1 = 0.9999995000268362*w0
+        t2 = 0.9999995000268362*w3
+        t3 = 0.9999995000268362*w2
+        t4 = -(9.999730384501195e-08 + 0.4250997874614081*w3)
+        t5 = w0*w2
+        t6 = w1*w3
+        t7 = 0.0009999730384501195*t6 + t5
+        t8 = -(0.0009999730384501195*t5 + t6)
+        t9 = -(0.4251*t5 - 9.999995000268362e-05*w1 + 0.0004250885386451458*t6)
+        t10 = w0*w3
+        t11 = w1*w2
+        t12 = -0.0009999730384501195*t11 + t10
+        t13 = -0.0009999730384501195*t10 + t11
+        t14 = 9.999995000268362e-05*w0 + 0.4251*t11 - 0.0004250885386451458*t10
+        t15 = 0.9999995000000417*t0 - 0.0009999998333333417*t12
+        t16 = -0.9999995000000417*t1 + 0.0009999998333333417*t8
+        t17 = -0.000999972538463642 + 0.0009999998333333417*t3
+        t18 = t7*w4
+        t19 = -(0.9999995000000417*t12 + 0.0009999998333333417*t0)
+        t20 = -t7*w5 + w4*t19
+        t21 = w5*t19
+        t22 = t18 + t21
+        t23 = 0.0001*t15 + 0.3921*t18 + 0.3921*t21
+        t24 = t13*w4
+        t25 = 0.9999995000000417*t8 + 0.0009999998333333417*t1
+        t26 = -t13*w5 + w4*t25
+        t27 = w5*t25
+        t28 = t24 + t27
+        t29 = 0.0001*t16 + 0.3921*t24 + 0.3921*t27
+        t30 = t2*w4
+        t31 = 9.999728717879548e-07 + 0.9999995000000417*t3
+        t32 = -t2*w5 + w4*t31
+        t33 = w5*t31
+        t34 = t30 + t33
+        t35 = 0.0001*t17 + 0.3921*t30 + 0.3921*t33
+        t36 = 0.9999995000000417*t15 - 0.0009999998333333417*t20
+        t37 = 0.9999995000000417*t16 - 0.0009999998333333417*t26
+        t38 = 0.9999995000000417*t17 - 0.0009999998333333417*t32
+        t39 = t22*w6
+        t40 = 0.9999995000000417*t20 + 0.0009999998333333417*t15
+        t41 = -t22*w7 + w6*t40
+        t42 = w7*t40
+        t43 = t39 + t42
+        t44 = 0.0001*t39 + 0.0001*t42 - 0.10925*t36
+        t45 = t28*w6
+        t46 = 0.9999995000000417*t26 + 0.0009999998333333417*t16
+        t47 = -t28*w7 + w6*t46
+        t48 = w7*t46
+        t49 = t45 + t48
+        t50 = 0.0001*t45 + 0.0001*t48 - 0.10925*t37
+        t51 = t34*w6
+        t52 = 0.9999995000000417*t32 + 0.0009999998333333417*t17
+        t53 = -t34*w7 + w6*t52
+        t54 = w7*t52
+        t55 = t51 + t54
+        t56 = 0.0001*t51 + 0.0001*t54 - 0.10925*t38
+        t57 = 0.0010000266282165632*t36 - 0.9999994999732464*t41
+        t58 = 0.0010000266282165632*t37 - 0.9999994999732464*t47
+        t59 = 0.0010000266282165632*t38 - 0.9999994999732464*t53
+        t60 = t43*w8
+        t61 = 0.9999994999732464*t36 + 0.0010000266282165632*t41
+        t62 = -t43*w9 + w8*t61
+        t63 = w9*t61
+        t64 = t60 + t63
+        t65 = 0.0001*t60 + 0.0001*t63 + 0.09455*t57
+        t66 = t49*w8
+        t67 = 0.9999994999732464*t37 + 0.0010000266282165632*t47
+        t68 = -t49*w9 + w8*t67
+        t69 = w9*t67
+        t70 = t66 + t69
+        t71 = 0.0001*t66 + 0.0001*t69 + 0.09455*t58
+        t72 = t55*w8
+        t73 = 0.9999994999732464*t38 + 0.0010000266282165632*t53
+        t74 = -t55*w9 + w8*t73
+        t75 = w9*t73
+        t76 = t72 + t75
+        t77 = 0.0001*t72 + 0.0001*t75 + 0.09455*t59
+        t78 = 0.9999994999732464*t62 + 0.0010000266282165632*t57
+        t79 = 0.9999994999732464*t68 + 0.0010000266282165632*t58
+        t80 = -t0*t1 + t15*t16 + t36*t37 + t57*t58 + t78*t79
+        t81 = 0.9999994999732464*t74 + 0.0010000266282165632*t59
+        t82 = -0.0009999730384501195*t0 + t15*t17 + t36*t38 + t57*t59 + t78*t81
+        t83 = 0.0009999730384501195*t1 + t16*t17 + t37*t38 + t58*t59 + t79*t81
+        t84 = 0.0001*w10
+        t85 = 0.0001*w11
+        t86 = 0.0824*t78 + t64*t84 + t85*(0.0010000266282165632*t62 - 0.9999994999732464*t57)
+        t87 = 0.0824*t79 + t70*t84 + t85*(0.0010000266282165632*t68 - 0.9999994999732464*t58)
+        t88 = 0.0824*t81 + t76*t84 + t85*(0.0010000266282165632*t74 - 0.9999994999732464*t59)
+        t89 = t65 + t86
+        t90 = t71 + t87
+        t91 = t77 + t88
+        t92 = -t44 + t89
+        t93 = -t50 + t90
+        t94 = -t56 + t91
+        t95 = -t23 + t92
+        t96 = -t29 + t93
+        t97 = -t35 + t94
+        t98 = t9 + t95
+        t99 = -t14 + t96
+        t100 = t4 + t97
+        t101 = 0.0001*w0 + t98
+        t102 = 0.0001*w1 + t99
+        t103 = -0.0009999730384501195*t99 + t1*t100
+        t104 = t97*t16 - t96*t17
+        t105 = t94*t37 - t93*t38
+        t106 = t91*t58 - t90*t59
+        t107 = t88*t79 - t87*t81
+        t108 = -(0.0009999730384501195*t98 + t0*t100)
+        t109 = t95*t17 - t97*t15
+        t110 = t92*t38 - t94*t36
+        t111 = t89*t59 - t91*t57
+        t112 = t86*t81 - t88*t78
+        t113 = t1*t98 + t0*t99
+        t114 = t96*t15 - t95*t16
+        t115 = t93*t36 - t92*t37
+        t116 = t90*t57 - t89*t58
+        t117 = t87*t78 - t86*t79
+        t118 = -t101*t102 - t103*t108 + t104*t109 + t105*t110 + t106*t111 + t107*t112
+        t119 = -t103*t113 + t104*t114 + t105*t115 + t106*t116 + t107*t117
+        t120 = -t0*t103 + t15*t104 + t36*t105 + t57*t106 + t78*t107
+        t121 = t1*t103 + t16*t104 + t37*t105 + t58*t106 + t79*t107
+        t122 = t108*t113 + t109*t114 + t110*t115 + t111*t116 + t112*t117
+        t123 = t0*t108 + t15*t109 + t36*t110 + t57*t111 + t78*t112
+        t124 = -t1*t108 + t16*t109 + t37*t110 + t58*t111 + t79*t112
+        t125 = -0.0009999730384501195*t108 + t101 + t17*t109 + t38*t110 + t59*t111 + t81*t112
+        t126 = t0*t113 + t15*t114 + t36*t115 + t57*t116 + t78*t117
+        t127 = -t1*t113 + t16*t114 + t37*t115 + t58*t116 + t79*t117
+        t128 = -0.0009999730384501195*t113 + t17*t114 + t38*t115 + t59*t116 + t81*t117
+        t129 = t101**2
+        t130 = t102**2
+        t131 = t129 + t130
+        t132 = xp.sqrt(1 + t131)
+        t133 = xp.where(xp.less_equal(t102, 0), xp.asarray(1, dtype=dtype), -1)*t132
+        t134 = t113**2
+        t135 = t134 + t114**2 + t115**2 + t116**2 + t117**2
+        t136 = t0**2
+        t137 = t15**2 + t36**2 + t57**2 + t78**2 + t136
+        t138 = t1**2
+        t139 = t16**2 + t37**2 + t58**2 + t79**2 + t138
+        t140 = 1.0000009999460777 + t17**2 + t38**2 + t59**2 + t81**2
+        t141 = t103**2 + t104**2 + t105**2 + t106**2 + t107**2
+        t142 = t130 + t141
+        t143 = t108**2 + t109**2 + t110**2 + t111**2 + t112**2
+        t144 = xp.sqrt(t131 + t135 + t137 + t139 + t140 + t141 + t143)
+        t145 = t129 + t143
+        t146 = -t102
+        t147 = 0.0009999730384501195*t103 + t146 + t17*t104 + t38*t105 + t59*t106 + t81*t107
+        t148 = 0.9990000269615499 - t103 - t1 + w1 + t0 + w0 + w2 + w3 + w4 + w5 + w6 + w7 + w8 + w9 + w10 + w11 + t101 + t15 + t16 + t17 + t36 + t37 + t38 + t57 + t58 + t59 + t78 + t79 + t81 + t146 + t104 + t105 + t106 + t107 + t108 + t109 + t110 + t111 + t112 + t113 + t114 + t115 + t116 + t117 + w12 + w13 + w14 + w15 + w16 + w17 + w18
+        t149 = w18**2
+        t150 = _symmetric_solve6(xp, 1, (t149 + t142, t118, t119, t120, t121, t147, t149 + t145, t122, t123, t124, t125, t135 + t149, t126, t127, t128, t137 + t149, t80, t82, t139 + t149, t83, t140 + t149, w12, w13, w14, w15, w16, w17,))
+        t151 = t150[5]
+        t152 = t150[0]
+        t153 = t150[1]
+        t154 = t151 - t102*t152 + t101*t153
+        t155 = t150[2]
+        t156 = t150[3]
+        t157 = t150[4]
+        t158 = -0.0009999730384501195*t151 + t153*t108 + t155*t113 - t152*t103 + t0*t156 - t1*t157
+        t159 = t152*t104 + t153*t109 + t155*t114 + t15*t156 + t16*t157 + t17*t151
+        t160 = t153*t110 + t152*t105 + t155*t115 + t36*t156 + t37*t157 + t38*t151
+        t161 = t155*t116 + t59*t151 + t152*t106 + t153*t111 + t57*t156 + t58*t157
+        t162 = t155*t117 + t152*t107 + t153*t112 + t78*t156 + t79*t157 + t81*t151
+        t163 = xp.greater(t132, 0)
+        t164 = xp.where(t163, 1/(t146 + t133), 0)
+        t165 = xp.where(t163, 1 + xp.abs(t102)/t132, 0)
+        t166 = t101*t164
+        t167 = -t165*(0.0009999730384501195*t164 + t103 - t108*t166)
+        t168 = t103 + t167
+        t169 = t165*(t104 + t109*t166 + t17*t164)
+        t170 = -t169 + t104
+        t171 = t165*(t105 + t110*t166 + t38*t164)
+        t172 = -t171 + t105
+        t173 = t165*(t106 + t111*t166 + t59*t164)
+        t174 = -t173 + t106
+        t175 = t165*(t107 + t112*t166 + t81*t164)
+        t176 = -t175 + t107
+        t177 = t165*(w12 + w17*t164 + t166*w13)
+        t178 = -t177 + w12
+        t179 = t164*t167
+        t180 = t108 - t101*t179
+        t181 = -(0.0009999730384501195 + t179)
+        t182 = xp.sqrt(t134 + t136 + t138 + t180**2 + t181**2)
+        t183 = t182*xp.where(xp.greater_equal(t180, 0), xp.asarray(1, dtype=dtype), -1)
+        t184 = t164*t169
+        t185 = t109 - t101*t184
+        t186 = -t184 + t17
+        t187 = t164*t171
+        t188 = t110 - t101*t187
+        t189 = -t187 + t38
+        t190 = t164*t173
+        t191 = t111 - t101*t190
+        t192 = -t190 + t59
+        t193 = t164*t175
+        t194 = t112 - t101*t193
+        t195 = -t193 + t81
+        t196 = t164*t177
+        t197 = w13 - t101*t196
+        t198 = -t196 + w17
+        t199 = xp.greater(t182, 0)
+        t200 = xp.where(t199, 1/(t180 + t183), 0)
+        t201 = xp.where(t199, 1 + xp.abs(t180)/t182, 0)
+        t202 = t113*t200
+        t203 = t0*t200
+        t204 = t1*t200
+        t205 = t181*t200
+        t206 = t201*(t185 + t114*t202 + t205*t186 + t15*t203 - t16*t204)
+        t207 = -t206 + t185
+        t208 = t114 - t202*t206
+        t209 = t15 - t203*t206
+        t210 = t16 + t204*t206
+        t211 = t186 - t205*t206
+        t212 = t201*(t115*t202 + t188 + t205*t189 + t36*t203 - t37*t204)
+        t213 = -t212 + t188
+        t214 = t115 - t202*t212
+        t215 = t36 - t203*t212
+        t216 = t37 + t204*t212
+        t217 = t189 - t205*t212
+        t218 = t201*(t191 + t116*t202 + t205*t192 + t57*t203 - t58*t204)
+        t219 = -t218 + t191
+        t220 = t116 - t202*t218
+        t221 = t57 - t203*t218
+        t222 = t58 + t204*t218
+        t223 = t192 - t205*t218
+        t224 = t201*(t117*t202 + t194 + t205*t195 + t78*t203 - t79*t204)
+        t225 = -t224 + t194
+        t226 = t117 - t202*t224
+        t227 = t78 - t203*t224
+        t228 = t79 + t204*t224
+        t229 = t195 - t205*t224
+        t230 = t201*(t197 + t202*w14 + t203*w15 - t204*w16 + t205*t198)
+        t231 = -t230 + t197
+        t232 = w14 - t202*t230
+        t233 = w15 - t203*t230
+        t234 = w16 + t204*t230
+        t235 = t198 - t205*t230
+        t236 = xp.sqrt(t208**2 + t209**2 + t210**2 + t211**2)
+        t237 = t236*xp.where(xp.greater_equal(t208, 0), xp.asarray(1, dtype=dtype), -1)
+        t238 = xp.greater(t236, 0)
+        t239 = xp.where(t238, 1/(t208 + t237), 0)
+        t240 = xp.where(t238, 1 + xp.abs(t208)/t236, 0)
+        t241 = t209*t239
+        t242 = t210*t239
+        t243 = t211*t239
+        t244 = t240*(t214 + t241*t215 + t242*t216 + t243*t217)
+        t245 = -t244 + t214
+        t246 = t215 - t241*t244
+        t247 = t216 - t242*t244
+        t248 = t217 - t243*t244
+        t249 = t240*(t220 + t241*t221 + t242*t222 + t243*t223)
+        t250 = -t249 + t220
+        t251 = t221 - t241*t249
+        t252 = t222 - t242*t249
+        t253 = t223 - t243*t249
+        t254 = t240*(t226 + t241*t227 + t242*t228 + t243*t229)
+        t255 = -t254 + t226
+        t256 = t227 - t241*t254
+        t257 = t228 - t242*t254
+        t258 = t229 - t243*t254
+        t259 = t240*(t232 + t241*t233 + t242*t234 + t243*t235)
+        t260 = -t259 + t232
+        t261 = t233 - t241*t259
+        t262 = t234 - t242*t259
+        t263 = t235 - t243*t259
+        t264 = xp.sqrt(t246**2 + t247**2 + t248**2)
+        t265 = t264*xp.where(xp.greater_equal(t246, 0), xp.asarray(1, dtype=dtype), -1)
+        t266 = xp.greater(t264, 0)
+        t267 = xp.where(t266, 1/(t246 + t265), 0)
+        t268 = xp.where(t266, 1 + xp.abs(t246)/t264, 0)
+        t269 = t247*t267
+        t270 = t248*t267
+        t271 = t268*(t251 + t269*t252 + t270*t253)
+        t272 = -t271 + t251
+        t273 = t252 - t269*t271
+        t274 = t253 - t270*t271
+        t275 = t268*(t256 + t269*t257 + t270*t258)
+        t276 = -t275 + t256
+        t277 = t257 - t269*t275
+        t278 = t258 - t270*t275
+        t279 = t268*(t261 + t269*t262 + t270*t263)
+        t280 = -t279 + t261
+        t281 = t262 - t269*t279
+        t282 = t263 - t270*t279
+        t283 = xp.sqrt(t273**2 + t274**2)
+        t284 = t283*xp.where(xp.greater_equal(t273, 0), xp.asarray(1, dtype=dtype), -1)
+        t285 = xp.greater(t283, 0)
+        t286 = xp.where(t285, 1/(t273 + t284), 0)
+        t287 = xp.where(t285, 1 + xp.abs(t273)/t283, 0)
+        t288 = t274*t286
+        t289 = t287*(t277 + t288*t278)
+        t290 = -t289 + t277
+        t291 = t278 - t288*t289
+        t292 = t287*(t281 + t288*t282)
+        t293 = -t292 + t281
+        t294 = t282 - t288*t292
+        t295 = xp.abs(t291)
+        t296 = t295*xp.where(xp.greater_equal(t291, 0), xp.asarray(1, dtype=dtype), -1)
+        t297 = xp.where(xp.greater(t295, 0), xp.asarray(2, dtype=dtype), 0)
+        t298 = t294 - t294*t297
+        t299 = xp.where(xp.not_equal(t296, 0), -t298/t296, 0)
+        t300 = xp.where(xp.not_equal(t284, 0), -(t293 - t290*t299)/t284, 0)
+        t301 = xp.where(xp.not_equal(t265, 0), -(-(t272*t300 + t276*t299) + t280)/t265, 0)
+        t302 = xp.where(xp.not_equal(t237, 0), -(-(t245*t301 + t250*t300 + t255*t299) + t260)/t237, 0)
+        t303 = xp.where(xp.not_equal(t183, 0), -(-(t207*t302 + t213*t301 + t219*t300 + t225*t299) + t231)/t183, 0)
+        t304 = xp.where(xp.not_equal(t133, 0), -(-(-t168*t303 + t170*t302 + t172*t301 + t174*t300 + t176*t299) + t178)/t133, 0)
+        t305 = xp.isfinite(t148)
+        t306 = xp.greater_equal(w18, 0)
+        t307 = xp.greater(w18, 0)
+        t308 = 1e-12*t144
+        t309 = (t307 & xp.greater(t150[6], 0)) | (xp.less_equal(w18, 0) & (xp.less_equal(t132, t308) | xp.less_equal(t182, t308) | xp.less_equal(t236, t308) | xp.less_equal(t264, t308) | xp.less_equal(t283, t308) | xp.less_equal(t295, t308)))
+        t310 = t305 & t306 & xp.logical_not(t309)
         state = (
-            t35,
-            t36,
-            t37,
-            t38,
-            t39,
-            t40,
-            t41,
-            t33,
+            xp.where(t310, xp.where(t307, t154, t304), 0),
+            xp.where(t310, xp.where(t307, t158, t303), 0),
+            xp.where(t310, xp.where(t307, t159, t302), 0),
+            xp.where(t310, xp.where(t307, t160, t301), 0),
+            xp.where(t310, xp.where(t307, t161, t300), 0),
+            xp.where(t310, xp.where(t307, t162, t299), 0),
+            xp.where(xp.logical_not(t305 & t306), 2, xp.where(t309, xp.asarray(1, dtype=dtype), 0)),
         )
     return state
 
@@ -5615,16 +5883,9 @@ def condition_number(q):
     return kappa
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik(q, mu_dot, damping=0.0):
-    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1587 operations."""
+    """joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status: (6 x 1 and 1 x 1), 1593 operations."""
     xp, dtype, device, batch, (q, mu_dot, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
@@ -5644,351 +5905,28 @@ def velocity_ik(q, mu_dot, damping=0.0):
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = 0.9999995000268362*s1
-    t1 = 0.9999995000268362*c1
-    t2 = 0.9999995000268362*s2
-    t3 = 0.9999995000268362*c2
-    t4 = -(9.999730384501195e-08 + 0.4250997874614081*s2)
-    t5 = c1*c2
-    t6 = s1*s2
-    t7 = 0.0009999730384501195*t6 + t5
-    t8 = -(0.0009999730384501195*t5 + t6)
-    t9 = -(0.4251*t5 - 9.999995000268362e-05*s1 + 0.0004250885386451458*t6)
-    t10 = c1*s2
-    t11 = s1*c2
-    t12 = -0.0009999730384501195*t11 + t10
-    t13 = -0.0009999730384501195*t10 + t11
-    t14 = 9.999995000268362e-05*c1 + 0.4251*t11 - 0.0004250885386451458*t10
-    t15 = 0.9999995000000417*t0 - 0.0009999998333333417*t12
-    t16 = -0.9999995000000417*t1 + 0.0009999998333333417*t8
-    t17 = -0.000999972538463642 + 0.0009999998333333417*t3
-    t18 = t7*c3
-    t19 = -(0.9999995000000417*t12 + 0.0009999998333333417*t0)
-    t20 = -t7*s3 + c3*t19
-    t21 = s3*t19
-    t22 = t18 + t21
-    t23 = 0.0001*t15 + 0.3921*t18 + 0.3921*t21
-    t24 = t13*c3
-    t25 = 0.9999995000000417*t8 + 0.0009999998333333417*t1
-    t26 = -t13*s3 + c3*t25
-    t27 = s3*t25
-    t28 = t24 + t27
-    t29 = 0.0001*t16 + 0.3921*t24 + 0.3921*t27
-    t30 = t2*c3
-    t31 = 9.999728717879548e-07 + 0.9999995000000417*t3
-    t32 = -t2*s3 + c3*t31
-    t33 = s3*t31
-    t34 = t30 + t33
-    t35 = 0.0001*t17 + 0.3921*t30 + 0.3921*t33
-    t36 = 0.9999995000000417*t15 - 0.0009999998333333417*t20
-    t37 = 0.9999995000000417*t16 - 0.0009999998333333417*t26
-    t38 = 0.9999995000000417*t17 - 0.0009999998333333417*t32
-    t39 = t22*c4
-    t40 = 0.9999995000000417*t20 + 0.0009999998333333417*t15
-    t41 = -t22*s4 + c4*t40
-    t42 = s4*t40
-    t43 = t39 + t42
-    t44 = 0.0001*t39 + 0.0001*t42 - 0.10925*t36
-    t45 = t28*c4
-    t46 = 0.9999995000000417*t26 + 0.0009999998333333417*t16
-    t47 = -t28*s4 + c4*t46
-    t48 = s4*t46
-    t49 = t45 + t48
-    t50 = 0.0001*t45 + 0.0001*t48 - 0.10925*t37
-    t51 = t34*c4
-    t52 = 0.9999995000000417*t32 + 0.0009999998333333417*t17
-    t53 = -t34*s4 + c4*t52
-    t54 = s4*t52
-    t55 = t51 + t54
-    t56 = 0.0001*t51 + 0.0001*t54 - 0.10925*t38
-    t57 = 0.0010000266282165632*t36 - 0.9999994999732464*t41
-    t58 = 0.0010000266282165632*t37 - 0.9999994999732464*t47
-    t59 = 0.0010000266282165632*t38 - 0.9999994999732464*t53
-    t60 = t43*c5
-    t61 = 0.9999994999732464*t36 + 0.0010000266282165632*t41
-    t62 = -t43*s5 + c5*t61
-    t63 = s5*t61
-    t64 = t60 + t63
-    t65 = 0.0001*t60 + 0.0001*t63 + 0.09455*t57
-    t66 = t49*c5
-    t67 = 0.9999994999732464*t37 + 0.0010000266282165632*t47
-    t68 = -t49*s5 + c5*t67
-    t69 = s5*t67
-    t70 = t66 + t69
-    t71 = 0.0001*t66 + 0.0001*t69 + 0.09455*t58
-    t72 = t55*c5
-    t73 = 0.9999994999732464*t38 + 0.0010000266282165632*t53
-    t74 = -t55*s5 + c5*t73
-    t75 = s5*t73
-    t76 = t72 + t75
-    t77 = 0.0001*t72 + 0.0001*t75 + 0.09455*t59
-    t78 = 0.9999994999732464*t62 + 0.0010000266282165632*t57
-    t79 = 0.9999994999732464*t68 + 0.0010000266282165632*t58
-    t80 = -t0*t1 + t15*t16 + t36*t37 + t57*t58 + t78*t79
-    t81 = 0.9999994999732464*t74 + 0.0010000266282165632*t59
-    t82 = -0.0009999730384501195*t0 + t15*t17 + t36*t38 + t57*t59 + t78*t81
-    t83 = 0.0009999730384501195*t1 + t16*t17 + t37*t38 + t58*t59 + t79*t81
-    t84 = 0.0001*c6
-    t85 = 0.0001*s6
-    t86 = 0.0824*t78 + t64*t84 + t85*(0.0010000266282165632*t62 - 0.9999994999732464*t57)
-    t87 = 0.0824*t79 + t70*t84 + t85*(0.0010000266282165632*t68 - 0.9999994999732464*t58)
-    t88 = 0.0824*t81 + t76*t84 + t85*(0.0010000266282165632*t74 - 0.9999994999732464*t59)
-    t89 = t65 + t86
-    t90 = t71 + t87
-    t91 = t77 + t88
-    t92 = -t44 + t89
-    t93 = -t50 + t90
-    t94 = -t56 + t91
-    t95 = -t23 + t92
-    t96 = -t29 + t93
-    t97 = -t35 + t94
-    t98 = t9 + t95
-    t99 = -t14 + t96
-    t100 = t4 + t97
-    t101 = 0.0001*c1 + t98
-    t102 = 0.0001*s1 + t99
-    t103 = -0.0009999730384501195*t99 + t1*t100
-    t104 = t97*t16 - t96*t17
-    t105 = t94*t37 - t93*t38
-    t106 = t91*t58 - t90*t59
-    t107 = t88*t79 - t87*t81
-    t108 = -(0.0009999730384501195*t98 + t0*t100)
-    t109 = t95*t17 - t97*t15
-    t110 = t92*t38 - t94*t36
-    t111 = t89*t59 - t91*t57
-    t112 = t86*t81 - t88*t78
-    t113 = t1*t98 + t0*t99
-    t114 = t96*t15 - t95*t16
-    t115 = t93*t36 - t92*t37
-    t116 = t90*t57 - t89*t58
-    t117 = t87*t78 - t86*t79
-    t118 = -t101*t102 - t103*t108 + t104*t109 + t105*t110 + t106*t111 + t107*t112
-    t119 = -t103*t113 + t104*t114 + t105*t115 + t106*t116 + t107*t117
-    t120 = -t0*t103 + t15*t104 + t36*t105 + t57*t106 + t78*t107
-    t121 = t1*t103 + t16*t104 + t37*t105 + t58*t106 + t79*t107
-    t122 = t108*t113 + t109*t114 + t110*t115 + t111*t116 + t112*t117
-    t123 = t0*t108 + t15*t109 + t36*t110 + t57*t111 + t78*t112
-    t124 = -t1*t108 + t16*t109 + t37*t110 + t58*t111 + t79*t112
-    t125 = -0.0009999730384501195*t108 + t101 + t17*t109 + t38*t110 + t59*t111 + t81*t112
-    t126 = t0*t113 + t15*t114 + t36*t115 + t57*t116 + t78*t117
-    t127 = -t1*t113 + t16*t114 + t37*t115 + t58*t116 + t79*t117
-    t128 = -0.0009999730384501195*t113 + t17*t114 + t38*t115 + t59*t116 + t81*t117
-    t129 = t101**2
-    t130 = t102**2
-    t131 = t129 + t130
-    t132 = xp.sqrt(1 + t131)
-    t133 = xp.where(xp.less_equal(t102, 0), xp.asarray(1, dtype=dtype), -1)*t132
-    t134 = t113**2
-    t135 = t134 + t114**2 + t115**2 + t116**2 + t117**2
-    t136 = t0**2
-    t137 = t15**2 + t36**2 + t57**2 + t78**2 + t136
-    t138 = t1**2
-    t139 = t16**2 + t37**2 + t58**2 + t79**2 + t138
-    t140 = 1.0000009999460777 + t17**2 + t38**2 + t59**2 + t81**2
-    t141 = t103**2 + t104**2 + t105**2 + t106**2 + t107**2
-    t142 = t130 + t141
-    t143 = t108**2 + t109**2 + t110**2 + t111**2 + t112**2
-    t144 = xp.sqrt(t131 + t135 + t137 + t139 + t140 + t141 + t143)
-    t145 = t129 + t143
-    t146 = -t102
-    t147 = 0.0009999730384501195*t103 + t146 + t17*t104 + t38*t105 + t59*t106 + t81*t107
-    t148 = 0.9990000269615499 - t103 - t1 + q1 + t0 + q2 + q3 + q4 + q5 + q6 + t101 + t15 + t16 + t17 + t36 + t37 + t38 + t57 + t58 + t59 + t78 + t79 + t81 + t146 + t104 + t105 + t106 + t107 + t108 + t109 + t110 + t111 + t112 + t113 + t114 + t115 + t116 + t117 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping
-    t149 = damping**2
-    t150 = _symmetric_solve6(xp, 1, (t149 + t142, t118, t119, t120, t121, t147, t149 + t145, t122, t123, t124, t125, t135 + t149, t126, t127, t128, t137 + t149, t80, t82, t139 + t149, t83, t140 + t149, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
-    t151 = t150[5]
-    t152 = t150[0]
-    t153 = t150[1]
-    t154 = t151 - t102*t152 + t101*t153
-    t155 = t150[2]
-    t156 = t150[3]
-    t157 = t150[4]
-    t158 = -0.0009999730384501195*t151 + t153*t108 + t155*t113 - t152*t103 + t0*t156 - t1*t157
-    t159 = t152*t104 + t153*t109 + t155*t114 + t15*t156 + t16*t157 + t17*t151
-    t160 = t153*t110 + t152*t105 + t155*t115 + t36*t156 + t37*t157 + t38*t151
-    t161 = t155*t116 + t59*t151 + t152*t106 + t153*t111 + t57*t156 + t58*t157
-    t162 = t155*t117 + t152*t107 + t153*t112 + t78*t156 + t79*t157 + t81*t151
-    t163 = xp.greater(t132, 0)
-    t164 = xp.where(t163, 1/(t146 + t133), 0)
-    t165 = xp.where(t163, 1 + xp.abs(t102)/t132, 0)
-    t166 = t101*t164
-    t167 = -t165*(0.0009999730384501195*t164 + t103 - t108*t166)
-    t168 = t103 + t167
-    t169 = t165*(t104 + t109*t166 + t17*t164)
-    t170 = -t169 + t104
-    t171 = t165*(t105 + t110*t166 + t38*t164)
-    t172 = -t171 + t105
-    t173 = t165*(t106 + t111*t166 + t59*t164)
-    t174 = -t173 + t106
-    t175 = t165*(t107 + t112*t166 + t81*t164)
-    t176 = -t175 + t107
-    t177 = t165*(mu_dot0 + mu_dot5*t164 + t166*mu_dot1)
-    t178 = -t177 + mu_dot0
-    t179 = t164*t167
-    t180 = t108 - t101*t179
-    t181 = -(0.0009999730384501195 + t179)
-    t182 = xp.sqrt(t134 + t136 + t138 + t180**2 + t181**2)
-    t183 = t182*xp.where(xp.greater_equal(t180, 0), xp.asarray(1, dtype=dtype), -1)
-    t184 = t164*t169
-    t185 = t109 - t101*t184
-    t186 = -t184 + t17
-    t187 = t164*t171
-    t188 = t110 - t101*t187
-    t189 = -t187 + t38
-    t190 = t164*t173
-    t191 = t111 - t101*t190
-    t192 = -t190 + t59
-    t193 = t164*t175
-    t194 = t112 - t101*t193
-    t195 = -t193 + t81
-    t196 = t164*t177
-    t197 = mu_dot1 - t101*t196
-    t198 = -t196 + mu_dot5
-    t199 = xp.greater(t182, 0)
-    t200 = xp.where(t199, 1/(t180 + t183), 0)
-    t201 = xp.where(t199, 1 + xp.abs(t180)/t182, 0)
-    t202 = t113*t200
-    t203 = t0*t200
-    t204 = t1*t200
-    t205 = t181*t200
-    t206 = t201*(t185 + t114*t202 + t205*t186 + t15*t203 - t16*t204)
-    t207 = -t206 + t185
-    t208 = t114 - t202*t206
-    t209 = t15 - t203*t206
-    t210 = t16 + t204*t206
-    t211 = t186 - t205*t206
-    t212 = t201*(t115*t202 + t188 + t205*t189 + t36*t203 - t37*t204)
-    t213 = -t212 + t188
-    t214 = t115 - t202*t212
-    t215 = t36 - t203*t212
-    t216 = t37 + t204*t212
-    t217 = t189 - t205*t212
-    t218 = t201*(t191 + t116*t202 + t205*t192 + t57*t203 - t58*t204)
-    t219 = -t218 + t191
-    t220 = t116 - t202*t218
-    t221 = t57 - t203*t218
-    t222 = t58 + t204*t218
-    t223 = t192 - t205*t218
-    t224 = t201*(t117*t202 + t194 + t205*t195 + t78*t203 - t79*t204)
-    t225 = -t224 + t194
-    t226 = t117 - t202*t224
-    t227 = t78 - t203*t224
-    t228 = t79 + t204*t224
-    t229 = t195 - t205*t224
-    t230 = t201*(t197 + t202*mu_dot2 + t203*mu_dot3 - t204*mu_dot4 + t205*t198)
-    t231 = -t230 + t197
-    t232 = mu_dot2 - t202*t230
-    t233 = mu_dot3 - t203*t230
-    t234 = mu_dot4 + t204*t230
-    t235 = t198 - t205*t230
-    t236 = xp.sqrt(t208**2 + t209**2 + t210**2 + t211**2)
-    t237 = t236*xp.where(xp.greater_equal(t208, 0), xp.asarray(1, dtype=dtype), -1)
-    t238 = xp.greater(t236, 0)
-    t239 = xp.where(t238, 1/(t208 + t237), 0)
-    t240 = xp.where(t238, 1 + xp.abs(t208)/t236, 0)
-    t241 = t209*t239
-    t242 = t210*t239
-    t243 = t211*t239
-    t244 = t240*(t214 + t241*t215 + t242*t216 + t243*t217)
-    t245 = -t244 + t214
-    t246 = t215 - t241*t244
-    t247 = t216 - t242*t244
-    t248 = t217 - t243*t244
-    t249 = t240*(t220 + t241*t221 + t242*t222 + t243*t223)
-    t250 = -t249 + t220
-    t251 = t221 - t241*t249
-    t252 = t222 - t242*t249
-    t253 = t223 - t243*t249
-    t254 = t240*(t226 + t241*t227 + t242*t228 + t243*t229)
-    t255 = -t254 + t226
-    t256 = t227 - t241*t254
-    t257 = t228 - t242*t254
-    t258 = t229 - t243*t254
-    t259 = t240*(t232 + t241*t233 + t242*t234 + t243*t235)
-    t260 = -t259 + t232
-    t261 = t233 - t241*t259
-    t262 = t234 - t242*t259
-    t263 = t235 - t243*t259
-    t264 = xp.sqrt(t246**2 + t247**2 + t248**2)
-    t265 = t264*xp.where(xp.greater_equal(t246, 0), xp.asarray(1, dtype=dtype), -1)
-    t266 = xp.greater(t264, 0)
-    t267 = xp.where(t266, 1/(t246 + t265), 0)
-    t268 = xp.where(t266, 1 + xp.abs(t246)/t264, 0)
-    t269 = t247*t267
-    t270 = t248*t267
-    t271 = t268*(t251 + t269*t252 + t270*t253)
-    t272 = -t271 + t251
-    t273 = t252 - t269*t271
-    t274 = t253 - t270*t271
-    t275 = t268*(t256 + t269*t257 + t270*t258)
-    t276 = -t275 + t256
-    t277 = t257 - t269*t275
-    t278 = t258 - t270*t275
-    t279 = t268*(t261 + t269*t262 + t270*t263)
-    t280 = -t279 + t261
-    t281 = t262 - t269*t279
-    t282 = t263 - t270*t279
-    t283 = xp.sqrt(t273**2 + t274**2)
-    t284 = t283*xp.where(xp.greater_equal(t273, 0), xp.asarray(1, dtype=dtype), -1)
-    t285 = xp.greater(t283, 0)
-    t286 = xp.where(t285, 1/(t273 + t284), 0)
-    t287 = xp.where(t285, 1 + xp.abs(t273)/t283, 0)
-    t288 = t274*t286
-    t289 = t287*(t277 + t288*t278)
-    t290 = -t289 + t277
-    t291 = t278 - t288*t289
-    t292 = t287*(t281 + t288*t282)
-    t293 = -t292 + t281
-    t294 = t282 - t288*t292
-    t295 = xp.abs(t291)
-    t296 = t295*xp.where(xp.greater_equal(t291, 0), xp.asarray(1, dtype=dtype), -1)
-    t297 = xp.where(xp.greater(t295, 0), xp.asarray(2, dtype=dtype), 0)
-    t298 = t294 - t294*t297
-    t299 = xp.where(xp.not_equal(t296, 0), -t298/t296, 0)
-    t300 = xp.where(xp.not_equal(t284, 0), -(t293 - t290*t299)/t284, 0)
-    t301 = xp.where(xp.not_equal(t265, 0), -(-(t272*t300 + t276*t299) + t280)/t265, 0)
-    t302 = xp.where(xp.not_equal(t237, 0), -(-(t245*t301 + t250*t300 + t255*t299) + t260)/t237, 0)
-    t303 = xp.where(xp.not_equal(t183, 0), -(-(t207*t302 + t213*t301 + t219*t300 + t225*t299) + t231)/t183, 0)
-    t304 = xp.where(xp.not_equal(t133, 0), -(-(-t168*t303 + t170*t302 + t172*t301 + t174*t300 + t176*t299) + t178)/t133, 0)
-    t305 = xp.isfinite(t148)
-    t306 = xp.greater_equal(damping, 0)
-    t307 = xp.greater(damping, 0)
-    t308 = 1e-12*t144
-    t309 = (t307 & xp.greater(t150[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t132, t308) | xp.less_equal(t182, t308) | xp.less_equal(t236, t308) | xp.less_equal(t264, t308) | xp.less_equal(t283, t308) | xp.less_equal(t295, t308)))
-    t310 = t305 & t306 & xp.logical_not(t309)
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t310, xp.where(t307, t154, t304), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t310, xp.where(t307, t158, t303), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t310, xp.where(t307, t159, t302), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t310, xp.where(t307, t160, t301), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t310, xp.where(t307, t161, t300), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t310, xp.where(t307, t162, t299), 0), batch),  # 5
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
+        xp.broadcast_to(t0[4], batch),  # 4
+        xp.broadcast_to(t0[5], batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t305 & t306), 2, xp.where(t309, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[6], batch), xp.int32)
     return q_dot, status
 
 
-@numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     """velocity_ik plus null-space motion: Js# mu_dot + (I - Js# Js) z (Js has no null space: z is not used), Js# velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1593 operations."""
     xp, dtype, device, batch, (q, mu_dot, z, damping,) = _arguments(("q", q, (6,)), ("mu_dot", mu_dot, (6,)), ("z", z, (6,)), ("damping", damping, ()))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     mu_dot0 = mu_dot[..., 0]
     mu_dot1 = mu_dot[..., 1]
     mu_dot2 = mu_dot[..., 2]
     mu_dot3 = mu_dot[..., 3]
     mu_dot4 = mu_dot[..., 4]
     mu_dot5 = mu_dot[..., 5]
-    qz1 = z[..., 0]
-    qz2 = z[..., 1]
-    qz3 = z[..., 2]
-    qz4 = z[..., 3]
-    qz5 = z[..., 4]
-    qz6 = z[..., 5]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
@@ -6002,339 +5940,23 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
     s5 = trig[..., 9]
     c6 = trig[..., 10]
     s6 = trig[..., 11]
-    t0 = 0.9999995000268362*s1
-    t1 = 0.9999995000268362*c1
-    t2 = 0.9999995000268362*s2
-    t3 = 0.9999995000268362*c2
-    t4 = -(9.999730384501195e-08 + 0.4250997874614081*s2)
-    t5 = c1*c2
-    t6 = s1*s2
-    t7 = 0.0009999730384501195*t6 + t5
-    t8 = -(0.0009999730384501195*t5 + t6)
-    t9 = -(0.4251*t5 - 9.999995000268362e-05*s1 + 0.0004250885386451458*t6)
-    t10 = c1*s2
-    t11 = s1*c2
-    t12 = -0.0009999730384501195*t11 + t10
-    t13 = -0.0009999730384501195*t10 + t11
-    t14 = 9.999995000268362e-05*c1 + 0.4251*t11 - 0.0004250885386451458*t10
-    t15 = 0.9999995000000417*t0 - 0.0009999998333333417*t12
-    t16 = -0.9999995000000417*t1 + 0.0009999998333333417*t8
-    t17 = -0.000999972538463642 + 0.0009999998333333417*t3
-    t18 = t7*c3
-    t19 = -(0.9999995000000417*t12 + 0.0009999998333333417*t0)
-    t20 = -t7*s3 + c3*t19
-    t21 = s3*t19
-    t22 = t18 + t21
-    t23 = 0.0001*t15 + 0.3921*t18 + 0.3921*t21
-    t24 = t13*c3
-    t25 = 0.9999995000000417*t8 + 0.0009999998333333417*t1
-    t26 = -t13*s3 + c3*t25
-    t27 = s3*t25
-    t28 = t24 + t27
-    t29 = 0.0001*t16 + 0.3921*t24 + 0.3921*t27
-    t30 = t2*c3
-    t31 = 9.999728717879548e-07 + 0.9999995000000417*t3
-    t32 = -t2*s3 + c3*t31
-    t33 = s3*t31
-    t34 = t30 + t33
-    t35 = 0.0001*t17 + 0.3921*t30 + 0.3921*t33
-    t36 = 0.9999995000000417*t15 - 0.0009999998333333417*t20
-    t37 = 0.9999995000000417*t16 - 0.0009999998333333417*t26
-    t38 = 0.9999995000000417*t17 - 0.0009999998333333417*t32
-    t39 = t22*c4
-    t40 = 0.9999995000000417*t20 + 0.0009999998333333417*t15
-    t41 = -t22*s4 + c4*t40
-    t42 = s4*t40
-    t43 = t39 + t42
-    t44 = 0.0001*t39 + 0.0001*t42 - 0.10925*t36
-    t45 = t28*c4
-    t46 = 0.9999995000000417*t26 + 0.0009999998333333417*t16
-    t47 = -t28*s4 + c4*t46
-    t48 = s4*t46
-    t49 = t45 + t48
-    t50 = 0.0001*t45 + 0.0001*t48 - 0.10925*t37
-    t51 = t34*c4
-    t52 = 0.9999995000000417*t32 + 0.0009999998333333417*t17
-    t53 = -t34*s4 + c4*t52
-    t54 = s4*t52
-    t55 = t51 + t54
-    t56 = 0.0001*t51 + 0.0001*t54 - 0.10925*t38
-    t57 = 0.0010000266282165632*t36 - 0.9999994999732464*t41
-    t58 = 0.0010000266282165632*t37 - 0.9999994999732464*t47
-    t59 = 0.0010000266282165632*t38 - 0.9999994999732464*t53
-    t60 = t43*c5
-    t61 = 0.9999994999732464*t36 + 0.0010000266282165632*t41
-    t62 = -t43*s5 + c5*t61
-    t63 = s5*t61
-    t64 = t60 + t63
-    t65 = 0.0001*t60 + 0.0001*t63 + 0.09455*t57
-    t66 = t49*c5
-    t67 = 0.9999994999732464*t37 + 0.0010000266282165632*t47
-    t68 = -t49*s5 + c5*t67
-    t69 = s5*t67
-    t70 = t66 + t69
-    t71 = 0.0001*t66 + 0.0001*t69 + 0.09455*t58
-    t72 = t55*c5
-    t73 = 0.9999994999732464*t38 + 0.0010000266282165632*t53
-    t74 = -t55*s5 + c5*t73
-    t75 = s5*t73
-    t76 = t72 + t75
-    t77 = 0.0001*t72 + 0.0001*t75 + 0.09455*t59
-    t78 = 0.9999994999732464*t62 + 0.0010000266282165632*t57
-    t79 = 0.9999994999732464*t68 + 0.0010000266282165632*t58
-    t80 = -t0*t1 + t15*t16 + t36*t37 + t57*t58 + t78*t79
-    t81 = 0.9999994999732464*t74 + 0.0010000266282165632*t59
-    t82 = -0.0009999730384501195*t0 + t15*t17 + t36*t38 + t57*t59 + t78*t81
-    t83 = 0.0009999730384501195*t1 + t16*t17 + t37*t38 + t58*t59 + t79*t81
-    t84 = 0.0001*c6
-    t85 = 0.0001*s6
-    t86 = 0.0824*t78 + t64*t84 + t85*(0.0010000266282165632*t62 - 0.9999994999732464*t57)
-    t87 = 0.0824*t79 + t70*t84 + t85*(0.0010000266282165632*t68 - 0.9999994999732464*t58)
-    t88 = 0.0824*t81 + t76*t84 + t85*(0.0010000266282165632*t74 - 0.9999994999732464*t59)
-    t89 = t65 + t86
-    t90 = t71 + t87
-    t91 = t77 + t88
-    t92 = -t44 + t89
-    t93 = -t50 + t90
-    t94 = -t56 + t91
-    t95 = -t23 + t92
-    t96 = -t29 + t93
-    t97 = -t35 + t94
-    t98 = t9 + t95
-    t99 = -t14 + t96
-    t100 = t4 + t97
-    t101 = 0.0001*c1 + t98
-    t102 = 0.0001*s1 + t99
-    t103 = -0.0009999730384501195*t99 + t1*t100
-    t104 = t97*t16 - t96*t17
-    t105 = t94*t37 - t93*t38
-    t106 = t91*t58 - t90*t59
-    t107 = t88*t79 - t87*t81
-    t108 = -(0.0009999730384501195*t98 + t0*t100)
-    t109 = t95*t17 - t97*t15
-    t110 = t92*t38 - t94*t36
-    t111 = t89*t59 - t91*t57
-    t112 = t86*t81 - t88*t78
-    t113 = t1*t98 + t0*t99
-    t114 = t96*t15 - t95*t16
-    t115 = t93*t36 - t92*t37
-    t116 = t90*t57 - t89*t58
-    t117 = t87*t78 - t86*t79
-    t118 = -t101*t102 - t103*t108 + t104*t109 + t105*t110 + t106*t111 + t107*t112
-    t119 = -t103*t113 + t104*t114 + t105*t115 + t106*t116 + t107*t117
-    t120 = -t0*t103 + t15*t104 + t36*t105 + t57*t106 + t78*t107
-    t121 = t1*t103 + t16*t104 + t37*t105 + t58*t106 + t79*t107
-    t122 = t108*t113 + t109*t114 + t110*t115 + t111*t116 + t112*t117
-    t123 = t0*t108 + t15*t109 + t36*t110 + t57*t111 + t78*t112
-    t124 = -t1*t108 + t16*t109 + t37*t110 + t58*t111 + t79*t112
-    t125 = -0.0009999730384501195*t108 + t101 + t17*t109 + t38*t110 + t59*t111 + t81*t112
-    t126 = t0*t113 + t15*t114 + t36*t115 + t57*t116 + t78*t117
-    t127 = -t1*t113 + t16*t114 + t37*t115 + t58*t116 + t79*t117
-    t128 = -0.0009999730384501195*t113 + t17*t114 + t38*t115 + t59*t116 + t81*t117
-    t129 = t101**2
-    t130 = t102**2
-    t131 = t129 + t130
-    t132 = xp.sqrt(1 + t131)
-    t133 = xp.where(xp.less_equal(t102, 0), xp.asarray(1, dtype=dtype), -1)*t132
-    t134 = t113**2
-    t135 = t134 + t114**2 + t115**2 + t116**2 + t117**2
-    t136 = t0**2
-    t137 = t15**2 + t36**2 + t57**2 + t78**2 + t136
-    t138 = t1**2
-    t139 = t16**2 + t37**2 + t58**2 + t79**2 + t138
-    t140 = 1.0000009999460777 + t17**2 + t38**2 + t59**2 + t81**2
-    t141 = t103**2 + t104**2 + t105**2 + t106**2 + t107**2
-    t142 = t130 + t141
-    t143 = t108**2 + t109**2 + t110**2 + t111**2 + t112**2
-    t144 = xp.sqrt(t131 + t135 + t137 + t139 + t140 + t141 + t143)
-    t145 = t129 + t143
-    t146 = -t102
-    t147 = 0.0009999730384501195*t103 + t146 + t17*t104 + t38*t105 + t59*t106 + t81*t107
-    t148 = 0.9990000269615499 - t103 - t1 + q1 + t0 + q2 + q3 + q4 + q5 + q6 + t101 + t15 + t16 + t17 + t36 + t37 + t38 + t57 + t58 + t59 + t78 + t79 + t81 + t146 + t104 + t105 + t106 + t107 + t108 + t109 + t110 + t111 + t112 + t113 + t114 + t115 + t116 + t117 + mu_dot0 + mu_dot1 + mu_dot2 + mu_dot3 + mu_dot4 + mu_dot5 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6
-    t149 = damping**2
-    t150 = _symmetric_solve6(xp, 1, (t149 + t142, t118, t119, t120, t121, t147, t149 + t145, t122, t123, t124, t125, t135 + t149, t126, t127, t128, t137 + t149, t80, t82, t139 + t149, t83, t140 + t149, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5,))
-    t151 = t150[5]
-    t152 = t150[0]
-    t153 = t150[1]
-    t154 = t151 - t102*t152 + t101*t153
-    t155 = t150[2]
-    t156 = t150[3]
-    t157 = t150[4]
-    t158 = -0.0009999730384501195*t151 + t153*t108 + t155*t113 - t152*t103 + t0*t156 - t1*t157
-    t159 = t152*t104 + t153*t109 + t155*t114 + t15*t156 + t16*t157 + t17*t151
-    t160 = t153*t110 + t152*t105 + t155*t115 + t36*t156 + t37*t157 + t38*t151
-    t161 = t155*t116 + t59*t151 + t152*t106 + t153*t111 + t57*t156 + t58*t157
-    t162 = t155*t117 + t152*t107 + t153*t112 + t78*t156 + t79*t157 + t81*t151
-    t163 = xp.greater(t132, 0)
-    t164 = xp.where(t163, 1/(t146 + t133), 0)
-    t165 = xp.where(t163, 1 + xp.abs(t102)/t132, 0)
-    t166 = t101*t164
-    t167 = -t165*(0.0009999730384501195*t164 + t103 - t108*t166)
-    t168 = t103 + t167
-    t169 = t165*(t104 + t109*t166 + t17*t164)
-    t170 = -t169 + t104
-    t171 = t165*(t105 + t110*t166 + t38*t164)
-    t172 = -t171 + t105
-    t173 = t165*(t106 + t111*t166 + t59*t164)
-    t174 = -t173 + t106
-    t175 = t165*(t107 + t112*t166 + t81*t164)
-    t176 = -t175 + t107
-    t177 = t165*(mu_dot0 + mu_dot5*t164 + t166*mu_dot1)
-    t178 = -t177 + mu_dot0
-    t179 = t164*t167
-    t180 = t108 - t101*t179
-    t181 = -(0.0009999730384501195 + t179)
-    t182 = xp.sqrt(t134 + t136 + t138 + t180**2 + t181**2)
-    t183 = t182*xp.where(xp.greater_equal(t180, 0), xp.asarray(1, dtype=dtype), -1)
-    t184 = t164*t169
-    t185 = t109 - t101*t184
-    t186 = -t184 + t17
-    t187 = t164*t171
-    t188 = t110 - t101*t187
-    t189 = -t187 + t38
-    t190 = t164*t173
-    t191 = t111 - t101*t190
-    t192 = -t190 + t59
-    t193 = t164*t175
-    t194 = t112 - t101*t193
-    t195 = -t193 + t81
-    t196 = t164*t177
-    t197 = mu_dot1 - t101*t196
-    t198 = -t196 + mu_dot5
-    t199 = xp.greater(t182, 0)
-    t200 = xp.where(t199, 1/(t180 + t183), 0)
-    t201 = xp.where(t199, 1 + xp.abs(t180)/t182, 0)
-    t202 = t113*t200
-    t203 = t0*t200
-    t204 = t1*t200
-    t205 = t181*t200
-    t206 = t201*(t185 + t114*t202 + t205*t186 + t15*t203 - t16*t204)
-    t207 = -t206 + t185
-    t208 = t114 - t202*t206
-    t209 = t15 - t203*t206
-    t210 = t16 + t204*t206
-    t211 = t186 - t205*t206
-    t212 = t201*(t115*t202 + t188 + t205*t189 + t36*t203 - t37*t204)
-    t213 = -t212 + t188
-    t214 = t115 - t202*t212
-    t215 = t36 - t203*t212
-    t216 = t37 + t204*t212
-    t217 = t189 - t205*t212
-    t218 = t201*(t191 + t116*t202 + t205*t192 + t57*t203 - t58*t204)
-    t219 = -t218 + t191
-    t220 = t116 - t202*t218
-    t221 = t57 - t203*t218
-    t222 = t58 + t204*t218
-    t223 = t192 - t205*t218
-    t224 = t201*(t117*t202 + t194 + t205*t195 + t78*t203 - t79*t204)
-    t225 = -t224 + t194
-    t226 = t117 - t202*t224
-    t227 = t78 - t203*t224
-    t228 = t79 + t204*t224
-    t229 = t195 - t205*t224
-    t230 = t201*(t197 + t202*mu_dot2 + t203*mu_dot3 - t204*mu_dot4 + t205*t198)
-    t231 = -t230 + t197
-    t232 = mu_dot2 - t202*t230
-    t233 = mu_dot3 - t203*t230
-    t234 = mu_dot4 + t204*t230
-    t235 = t198 - t205*t230
-    t236 = xp.sqrt(t208**2 + t209**2 + t210**2 + t211**2)
-    t237 = t236*xp.where(xp.greater_equal(t208, 0), xp.asarray(1, dtype=dtype), -1)
-    t238 = xp.greater(t236, 0)
-    t239 = xp.where(t238, 1/(t208 + t237), 0)
-    t240 = xp.where(t238, 1 + xp.abs(t208)/t236, 0)
-    t241 = t209*t239
-    t242 = t210*t239
-    t243 = t211*t239
-    t244 = t240*(t214 + t241*t215 + t242*t216 + t243*t217)
-    t245 = -t244 + t214
-    t246 = t215 - t241*t244
-    t247 = t216 - t242*t244
-    t248 = t217 - t243*t244
-    t249 = t240*(t220 + t241*t221 + t242*t222 + t243*t223)
-    t250 = -t249 + t220
-    t251 = t221 - t241*t249
-    t252 = t222 - t242*t249
-    t253 = t223 - t243*t249
-    t254 = t240*(t226 + t241*t227 + t242*t228 + t243*t229)
-    t255 = -t254 + t226
-    t256 = t227 - t241*t254
-    t257 = t228 - t242*t254
-    t258 = t229 - t243*t254
-    t259 = t240*(t232 + t241*t233 + t242*t234 + t243*t235)
-    t260 = -t259 + t232
-    t261 = t233 - t241*t259
-    t262 = t234 - t242*t259
-    t263 = t235 - t243*t259
-    t264 = xp.sqrt(t246**2 + t247**2 + t248**2)
-    t265 = t264*xp.where(xp.greater_equal(t246, 0), xp.asarray(1, dtype=dtype), -1)
-    t266 = xp.greater(t264, 0)
-    t267 = xp.where(t266, 1/(t246 + t265), 0)
-    t268 = xp.where(t266, 1 + xp.abs(t246)/t264, 0)
-    t269 = t247*t267
-    t270 = t248*t267
-    t271 = t268*(t251 + t269*t252 + t270*t253)
-    t272 = -t271 + t251
-    t273 = t252 - t269*t271
-    t274 = t253 - t270*t271
-    t275 = t268*(t256 + t269*t257 + t270*t258)
-    t276 = -t275 + t256
-    t277 = t257 - t269*t275
-    t278 = t258 - t270*t275
-    t279 = t268*(t261 + t269*t262 + t270*t263)
-    t280 = -t279 + t261
-    t281 = t262 - t269*t279
-    t282 = t263 - t270*t279
-    t283 = xp.sqrt(t273**2 + t274**2)
-    t284 = t283*xp.where(xp.greater_equal(t273, 0), xp.asarray(1, dtype=dtype), -1)
-    t285 = xp.greater(t283, 0)
-    t286 = xp.where(t285, 1/(t273 + t284), 0)
-    t287 = xp.where(t285, 1 + xp.abs(t273)/t283, 0)
-    t288 = t274*t286
-    t289 = t287*(t277 + t288*t278)
-    t290 = -t289 + t277
-    t291 = t278 - t288*t289
-    t292 = t287*(t281 + t288*t282)
-    t293 = -t292 + t281
-    t294 = t282 - t288*t292
-    t295 = xp.abs(t291)
-    t296 = t295*xp.where(xp.greater_equal(t291, 0), xp.asarray(1, dtype=dtype), -1)
-    t297 = xp.where(xp.greater(t295, 0), xp.asarray(2, dtype=dtype), 0)
-    t298 = t294 - t294*t297
-    t299 = xp.where(xp.not_equal(t296, 0), -t298/t296, 0)
-    t300 = xp.where(xp.not_equal(t284, 0), -(t293 - t290*t299)/t284, 0)
-    t301 = xp.where(xp.not_equal(t265, 0), -(-(t272*t300 + t276*t299) + t280)/t265, 0)
-    t302 = xp.where(xp.not_equal(t237, 0), -(-(t245*t301 + t250*t300 + t255*t299) + t260)/t237, 0)
-    t303 = xp.where(xp.not_equal(t183, 0), -(-(t207*t302 + t213*t301 + t219*t300 + t225*t299) + t231)/t183, 0)
-    t304 = xp.where(xp.not_equal(t133, 0), -(-(-t168*t303 + t170*t302 + t172*t301 + t174*t300 + t176*t299) + t178)/t133, 0)
-    t305 = xp.isfinite(t148)
-    t306 = xp.greater_equal(damping, 0)
-    t307 = xp.greater(damping, 0)
-    t308 = 1e-12*t144
-    t309 = (t307 & xp.greater(t150[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t132, t308) | xp.less_equal(t182, t308) | xp.less_equal(t236, t308) | xp.less_equal(t264, t308) | xp.less_equal(t283, t308) | xp.less_equal(t295, t308)))
-    t310 = t305 & t306 & xp.logical_not(t309)
+    t0 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, mu_dot0, mu_dot1, mu_dot2, mu_dot3, mu_dot4, mu_dot5, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t310, xp.where(t307, t154, t304), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t310, xp.where(t307, t158, t303), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t310, xp.where(t307, t159, t302), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t310, xp.where(t307, t160, t301), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t310, xp.where(t307, t161, t300), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t310, xp.where(t307, t162, t299), 0), batch),  # 5
+        xp.broadcast_to(t0[0], batch),  # 0
+        xp.broadcast_to(t0[1], batch),  # 1
+        xp.broadcast_to(t0[2], batch),  # 2
+        xp.broadcast_to(t0[3], batch),  # 3
+        xp.broadcast_to(t0[4], batch),  # 4
+        xp.broadcast_to(t0[5], batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t305 & t306), 2, xp.where(t309, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t0[6], batch), xp.int32)
     return q_dot, status
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
-    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1755 operations."""
+    """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (6 x 1 and 1 x 1), 1985 operations."""
     xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (6,)), ("target", target, (4, 4)), ("target_rate", target_rate, (6,)), ("gain", gain, (6,)), ("z", z, (6,)), ("damping", damping, ()), every=("gain", ))
-    q1 = q[..., 0]
-    q2 = q[..., 1]
-    q3 = q[..., 2]
-    q4 = q[..., 3]
-    q5 = q[..., 4]
-    q6 = q[..., 5]
     T00 = target[..., 0, 0]
     T01 = target[..., 0, 1]
     T02 = target[..., 0, 2]
@@ -6359,12 +5981,6 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     gain3 = gain[..., 3]
     gain4 = gain[..., 4]
     gain5 = gain[..., 5]
-    qz1 = z[..., 0]
-    qz2 = z[..., 1]
-    qz3 = z[..., 2]
-    qz4 = z[..., 3]
-    qz5 = z[..., 4]
-    qz6 = z[..., 5]
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]
     s1 = trig[..., 1]
@@ -6458,300 +6074,90 @@ def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     t77 = 0.0001*t72 + 0.0001*t75 + 0.09455*t59
     t78 = 0.9999994999732464*t62 + 0.0010000266282165632*t57
     t79 = 0.9999994999732464*t68 + 0.0010000266282165632*t58
-    t80 = -t0*t1 + t15*t16 + t36*t37 + t57*t58 + t78*t79
-    t81 = 0.9999994999732464*t74 + 0.0010000266282165632*t59
-    t82 = -0.0009999730384501195*t0 + t15*t17 + t36*t38 + t57*t59 + t78*t81
-    t83 = 0.0009999730384501195*t1 + t16*t17 + t37*t38 + t58*t59 + t79*t81
-    t84 = t64*c6
-    t85 = 0.0010000266282165632*t62 - 0.9999994999732464*t57
-    t86 = -t64*s6 + c6*t85
-    t87 = 0.9999995000000417*t86 + 0.0009999998333333417*t78
-    t88 = 0.9999995000000417*t78 - 0.0009999998333333417*t86
-    t89 = s6*t85
-    t90 = t84 + t89
-    t91 = 0.0001*t84 + 0.0001*t89 + 0.0824*t78
-    t92 = t65 + t91
-    t93 = -t44 + t92
-    t94 = -t23 + t93
-    t95 = t9 + t94
-    t96 = 0.0001*c1 + t95
-    t97 = t90*T00 + t87*T01 + t88*T02
-    t98 = t90*T10 + t87*T11 + t88*T12
-    t99 = t90*T20 + t87*T21 + t88*T22
-    t100 = mu_dot0 + gain0*(-t96 + T03)
-    t101 = t70*c6
-    t102 = 0.0010000266282165632*t68 - 0.9999994999732464*t58
-    t103 = -t70*s6 + c6*t102
-    t104 = 0.9999995000000417*t103 + 0.0009999998333333417*t79
-    t105 = 0.9999995000000417*t79 - 0.0009999998333333417*t103
-    t106 = s6*t102
-    t107 = t101 + t106
-    t108 = 0.0001*t101 + 0.0001*t106 + 0.0824*t79
-    t109 = t71 + t108
-    t110 = -t50 + t109
-    t111 = -t29 + t110
-    t112 = -t14 + t111
-    t113 = 0.0001*s1 + t112
-    t114 = t1*t95 + t0*t112
-    t115 = t111*t15 - t94*t16
-    t116 = t110*t36 - t93*t37
-    t117 = t109*t57 - t92*t58
-    t118 = t108*t78 - t91*t79
-    t119 = t0*t114 + t15*t115 + t36*t116 + t57*t117 + t78*t118
-    t120 = -t1*t114 + t16*t115 + t37*t116 + t58*t117 + t79*t118
-    t121 = -0.0009999730384501195*t114 + t17*t115 + t38*t116 + t59*t117 + t81*t118
-    t122 = t107*T00 + t104*T01 + t105*T02
-    t123 = t107*T10 + t104*T11 + t105*T12
-    t124 = t107*T20 + t104*T21 + t105*T22
-    t125 = 0.5*(-t122 + t98)
-    t126 = t76*c6
-    t127 = 0.0010000266282165632*t74 - 0.9999994999732464*t59
-    t128 = -t76*s6 + c6*t127
-    t129 = 0.9999995000000417*t128 + 0.0009999998333333417*t81
-    t130 = 0.9999995000000417*t81 - 0.0009999998333333417*t128
-    t131 = s6*t127
-    t132 = t126 + t131
-    t133 = 0.0001*t126 + 0.0001*t131 + 0.0824*t81
-    t134 = t77 + t133
-    t135 = -t56 + t134
-    t136 = -t35 + t135
-    t137 = t4 + t136
-    t138 = 0.089359 + t137
-    t139 = -0.0009999730384501195*t112 + t1*t137
-    t140 = t136*t16 - t111*t17
-    t141 = t135*t37 - t110*t38
-    t142 = t134*t58 - t109*t59
-    t143 = t133*t79 - t108*t81
-    t144 = -(0.0009999730384501195*t95 + t0*t137)
-    t145 = t94*t17 - t136*t15
-    t146 = t93*t38 - t135*t36
-    t147 = t92*t59 - t134*t57
-    t148 = t91*t81 - t133*t78
-    t149 = -t96*t113 - t139*t144 + t140*t145 + t141*t146 + t142*t147 + t143*t148
-    t150 = -t139*t114 + t140*t115 + t141*t116 + t142*t117 + t143*t118
-    t151 = -t0*t139 + t15*t140 + t36*t141 + t57*t142 + t78*t143
-    t152 = t1*t139 + t16*t140 + t37*t141 + t58*t142 + t79*t143
-    t153 = t144*t114 + t145*t115 + t146*t116 + t147*t117 + t148*t118
-    t154 = t0*t144 + t15*t145 + t36*t146 + t57*t147 + t78*t148
-    t155 = -t1*t144 + t16*t145 + t37*t146 + t58*t147 + t79*t148
-    t156 = -0.0009999730384501195*t144 + t96 + t17*t145 + t38*t146 + t59*t147 + t81*t148
-    t157 = t132*T00 + t129*T01 + t130*T02
-    t158 = t132*T10 + t129*T11 + t130*T12
-    t159 = t132*T20 + t129*T21 + t130*T22
-    t160 = 0.5*(-t158 + t124)
-    t161 = 0.5*(-t99 + t157)
-    t162 = 0.5*(-1 + t97 + t123 + t159)
-    t163 = xp.sqrt(t160**2 + t161**2 + t125**2)
-    t164 = xp.atan2(t163, t162)
-    t165 = xp.where(xp.greater(t163, 0), t164/t163, 1)
-    t166 = mu_dot2 + gain2*(-t138 + T23)
-    t167 = t96**2
-    t168 = t113**2
-    t169 = t167 + t168
-    t170 = xp.sqrt(1 + t169)
-    t171 = xp.where(xp.less_equal(t113, 0), xp.asarray(1, dtype=dtype), -1)*t170
-    t172 = t114**2
-    t173 = t172 + t115**2 + t116**2 + t117**2 + t118**2
-    t174 = t0**2
-    t175 = t15**2 + t36**2 + t57**2 + t78**2 + t174
-    t176 = t1**2
-    t177 = t16**2 + t37**2 + t58**2 + t79**2 + t176
-    t178 = 1.0000009999460777 + t17**2 + t38**2 + t59**2 + t81**2
-    t179 = t139**2 + t140**2 + t141**2 + t142**2 + t143**2
-    t180 = t168 + t179
-    t181 = t144**2 + t145**2 + t146**2 + t147**2 + t148**2
-    t182 = xp.sqrt(t169 + t173 + t175 + t177 + t178 + t179 + t181)
-    t183 = t167 + t181
-    t184 = -t113
-    t185 = 0.0009999730384501195*t139 + t184 + t17*t140 + t38*t141 + t59*t142 + t81*t143
-    t186 = mu_dot1 + gain1*(t184 + T13)
-    t187 = xp.greater(t170, 0)
-    t188 = xp.where(t187, 1/(t184 + t171), 0)
-    t189 = xp.where(t187, 1 + xp.abs(t113)/t170, 0)
-    t190 = t96*t188
-    t191 = -t189*(0.0009999730384501195*t188 + t139 - t190*t144)
-    t192 = t139 + t191
-    t193 = t189*(t140 + t17*t188 + t190*t145)
-    t194 = -t193 + t140
-    t195 = t189*(t141 + t38*t188 + t190*t146)
-    t196 = -t195 + t141
-    t197 = t189*(t142 + t59*t188 + t190*t147)
-    t198 = -t197 + t142
-    t199 = t189*(t143 + t81*t188 + t190*t148)
-    t200 = -t199 + t143
-    t201 = t188*t191
-    t202 = t144 - t96*t201
-    t203 = -(0.0009999730384501195 + t201)
-    t204 = xp.sqrt(t172 + t174 + t176 + t202**2 + t203**2)
-    t205 = t204*xp.where(xp.greater_equal(t202, 0), xp.asarray(1, dtype=dtype), -1)
-    t206 = t188*t193
-    t207 = t145 - t96*t206
-    t208 = -t206 + t17
-    t209 = t188*t195
-    t210 = t146 - t96*t209
-    t211 = -t209 + t38
-    t212 = t188*t197
-    t213 = t147 - t96*t212
-    t214 = -t212 + t59
-    t215 = t188*t199
-    t216 = t148 - t96*t215
-    t217 = -t215 + t81
-    t218 = xp.greater(t204, 0)
-    t219 = xp.where(t218, 1/(t202 + t205), 0)
-    t220 = xp.where(t218, 1 + xp.abs(t202)/t204, 0)
-    t221 = t114*t219
-    t222 = t0*t219
-    t223 = t1*t219
-    t224 = t203*t219
-    t225 = t220*(t207 + t115*t221 + t224*t208 + t15*t222 - t16*t223)
-    t226 = -t225 + t207
-    t227 = t115 - t221*t225
-    t228 = t15 - t222*t225
-    t229 = t16 + t223*t225
-    t230 = t208 - t224*t225
-    t231 = t220*(t210 + t116*t221 + t224*t211 + t36*t222 - t37*t223)
-    t232 = -t231 + t210
-    t233 = t116 - t221*t231
-    t234 = t36 - t222*t231
-    t235 = t37 + t223*t231
-    t236 = t211 - t224*t231
-    t237 = t220*(t213 + t117*t221 + t224*t214 + t57*t222 - t58*t223)
-    t238 = -t237 + t213
-    t239 = t117 - t221*t237
-    t240 = t57 - t222*t237
-    t241 = t58 + t223*t237
-    t242 = t214 - t224*t237
-    t243 = t220*(t216 + t118*t221 + t224*t217 + t78*t222 - t79*t223)
-    t244 = -t243 + t216
-    t245 = t118 - t221*t243
-    t246 = t78 - t222*t243
-    t247 = t79 + t223*t243
-    t248 = t217 - t224*t243
-    t249 = xp.sqrt(t227**2 + t228**2 + t229**2 + t230**2)
-    t250 = t249*xp.where(xp.greater_equal(t227, 0), xp.asarray(1, dtype=dtype), -1)
-    t251 = xp.greater(t249, 0)
-    t252 = xp.where(t251, 1/(t227 + t250), 0)
-    t253 = xp.where(t251, 1 + xp.abs(t227)/t249, 0)
-    t254 = t228*t252
-    t255 = t229*t252
-    t256 = t230*t252
-    t257 = t253*(t233 + t254*t234 + t255*t235 + t256*t236)
-    t258 = -t257 + t233
-    t259 = t234 - t254*t257
-    t260 = t235 - t255*t257
-    t261 = t236 - t256*t257
-    t262 = t253*(t239 + t254*t240 + t255*t241 + t256*t242)
-    t263 = -t262 + t239
-    t264 = t240 - t254*t262
-    t265 = t241 - t255*t262
-    t266 = t242 - t256*t262
-    t267 = t253*(t245 + t254*t246 + t255*t247 + t256*t248)
-    t268 = -t267 + t245
-    t269 = t246 - t254*t267
-    t270 = t247 - t255*t267
-    t271 = t248 - t256*t267
-    t272 = xp.sqrt(t259**2 + t260**2 + t261**2)
-    t273 = t272*xp.where(xp.greater_equal(t259, 0), xp.asarray(1, dtype=dtype), -1)
-    t274 = xp.greater(t272, 0)
-    t275 = xp.where(t274, 1/(t259 + t273), 0)
-    t276 = xp.where(t274, 1 + xp.abs(t259)/t272, 0)
-    t277 = t260*t275
-    t278 = t261*t275
-    t279 = t276*(t264 + t277*t265 + t278*t266)
-    t280 = -t279 + t264
-    t281 = t265 - t277*t279
-    t282 = t266 - t278*t279
-    t283 = t276*(t269 + t277*t270 + t278*t271)
-    t284 = -t283 + t269
-    t285 = t270 - t277*t283
-    t286 = t271 - t278*t283
-    t287 = xp.sqrt(t281**2 + t282**2)
-    t288 = t287*xp.where(xp.greater_equal(t281, 0), xp.asarray(1, dtype=dtype), -1)
-    t289 = xp.greater(t287, 0)
-    t290 = xp.where(t289, 1/(t281 + t288), 0)
-    t291 = xp.where(t289, 1 + xp.abs(t281)/t287, 0)
-    t292 = t282*t290
-    t293 = t291*(t285 + t292*t286)
-    t294 = -t293 + t285
-    t295 = t286 - t292*t293
-    t296 = xp.abs(t295)
-    t297 = t296*xp.where(xp.greater_equal(t295, 0), xp.asarray(1, dtype=dtype), -1)
-    t298 = xp.where(xp.greater(t296, 0), xp.asarray(2, dtype=dtype), 0)
-    t299 = xp.greater_equal(t97, t123) & xp.greater_equal(t97, t159)
-    t300 = xp.greater_equal(t123, t159)
-    t301 = xp.where(t299, 0.5*(1 + t97), xp.where(t300, 0.5*t122, 0.5*t157))
-    t302 = xp.where(t299, 0.5*t98, xp.where(t300, 0.5*(1 + t123), 0.5*t158))
-    t303 = xp.where(t299, 0.5*t99, xp.where(t300, 0.5*t124, 0.5*(1 + t159)))
-    t304 = xp.sqrt(t301**2 + t302**2 + t303**2)
-    t305 = xp.where(xp.greater_equal(t160*t301 + t161*t302 + t125*t303, 0), xp.asarray(1, dtype=dtype), -1)
-    t306 = xp.greater(t163, 1e-06) | xp.greater(t162, 0)
-    t307 = t164*t305/t304
-    t308 = xp.where(t306, t160*t165, t307*t301)
-    t309 = xp.where(t306, t161*t165, t307*t302)
-    t310 = xp.where(t306, t125*t165, t307*t303)
-    t311 = mu_dot3 + t308*gain3
-    t312 = mu_dot4 + t309*gain4
-    t313 = mu_dot5 + t310*gain5
-    t314 = t189*(t100 + t188*t313 + t190*t186)
-    t315 = -t314 + t100
-    t316 = 0.9990000269615499 - t139 - t1 + q1 + t0 + q2 + q3 + q4 + q5 + q6 + t96 + t15 + t16 + t17 + t36 + t37 + t38 + t57 + t58 + t59 + t78 + t79 + t81 + t184 + t140 + t141 + t142 + t143 + t144 + t145 + t146 + t147 + t148 + t114 + t115 + t116 + t117 + t118 + damping + qz1 + qz2 + qz3 + qz4 + qz5 + qz6 + t100 + t186 + t166 + t311 + t312 + t313
-    t317 = damping**2
-    t318 = _symmetric_solve6(xp, 1, (t317 + t180, t149, t150, t151, t152, t185, t317 + t183, t153, t154, t155, t156, t173 + t317, t119, t120, t121, t175 + t317, t80, t82, t177 + t317, t83, t178 + t317, t100, t186, t166, t311, t312, t313,))
-    t319 = t318[5]
-    t320 = t318[0]
-    t321 = t318[1]
-    t322 = t319 - t113*t320 + t96*t321
-    t323 = t318[2]
-    t324 = t318[3]
-    t325 = t318[4]
-    t326 = -0.0009999730384501195*t319 - t139*t320 + t144*t321 + t114*t323 + t0*t324 - t1*t325
-    t327 = t140*t320 + t145*t321 + t115*t323 + t15*t324 + t16*t325 + t17*t319
-    t328 = t141*t320 + t146*t321 + t116*t323 + t36*t324 + t37*t325 + t38*t319
-    t329 = t142*t320 + t147*t321 + t117*t323 + t57*t324 + t58*t325 + t59*t319
-    t330 = t143*t320 + t148*t321 + t118*t323 + t78*t324 + t79*t325 + t81*t319
-    t331 = t188*t314
-    t332 = t186 - t96*t331
-    t333 = -t331 + t313
-    t334 = t220*(t332 + t221*t166 + t222*t311 - t223*t312 + t224*t333)
-    t335 = -t334 + t332
-    t336 = t166 - t221*t334
-    t337 = t311 - t222*t334
-    t338 = t312 + t223*t334
-    t339 = t333 - t224*t334
-    t340 = t253*(t336 + t254*t337 + t255*t338 + t256*t339)
-    t341 = -t340 + t336
-    t342 = t337 - t254*t340
-    t343 = t338 - t255*t340
-    t344 = t339 - t256*t340
-    t345 = t276*(t342 + t277*t343 + t278*t344)
-    t346 = -t345 + t342
-    t347 = t343 - t277*t345
-    t348 = t344 - t278*t345
-    t349 = t291*(t347 + t292*t348)
-    t350 = -t349 + t347
-    t351 = t348 - t292*t349
-    t352 = t351 - t298*t351
-    t353 = xp.where(xp.not_equal(t297, 0), -t352/t297, 0)
-    t354 = xp.where(xp.not_equal(t288, 0), -(t350 - t294*t353)/t288, 0)
-    t355 = xp.where(xp.not_equal(t273, 0), -(-(t280*t354 + t284*t353) + t346)/t273, 0)
-    t356 = xp.where(xp.not_equal(t250, 0), -(-(t258*t355 + t263*t354 + t268*t353) + t341)/t250, 0)
-    t357 = xp.where(xp.not_equal(t205, 0), -(-(t226*t356 + t232*t355 + t238*t354 + t244*t353) + t335)/t205, 0)
-    t358 = xp.where(xp.not_equal(t171, 0), -(-(-t192*t357 + t194*t356 + t196*t355 + t198*t354 + t200*t353) + t315)/t171, 0)
-    t359 = xp.isfinite(t316)
-    t360 = xp.greater_equal(damping, 0)
-    t361 = xp.greater(damping, 0)
-    t362 = 1e-12*t182
-    t363 = (t361 & xp.greater(t318[6], 0)) | (xp.less_equal(damping, 0) & (xp.less_equal(t170, t362) | xp.less_equal(t204, t362) | xp.less_equal(t249, t362) | xp.less_equal(t272, t362) | xp.less_equal(t287, t362) | xp.less_equal(t296, t362)))
-    t364 = t359 & t360 & xp.logical_not(t363)
+    t80 = 0.9999994999732464*t74 + 0.0010000266282165632*t59
+    t81 = t64*c6
+    t82 = 0.0010000266282165632*t62 - 0.9999994999732464*t57
+    t83 = -t64*s6 + c6*t82
+    t84 = 0.9999995000000417*t83 + 0.0009999998333333417*t78
+    t85 = 0.9999995000000417*t78 - 0.0009999998333333417*t83
+    t86 = s6*t82
+    t87 = t81 + t86
+    t88 = 0.0001*t81 + 0.0001*t86 + 0.0824*t78
+    t89 = t65 + t88
+    t90 = -t44 + t89
+    t91 = -t23 + t90
+    t92 = t9 + t91
+    t93 = 0.0001*c1 + t92
+    t94 = t87*T00 + t84*T01 + t85*T02
+    t95 = t87*T10 + t84*T11 + t85*T12
+    t96 = t87*T20 + t84*T21 + t85*T22
+    t97 = mu_dot0 + gain0*(-t93 + T03)
+    t98 = t70*c6
+    t99 = 0.0010000266282165632*t68 - 0.9999994999732464*t58
+    t100 = -t70*s6 + c6*t99
+    t101 = 0.9999995000000417*t100 + 0.0009999998333333417*t79
+    t102 = 0.9999995000000417*t79 - 0.0009999998333333417*t100
+    t103 = s6*t99
+    t104 = t98 + t103
+    t105 = 0.0001*t98 + 0.0001*t103 + 0.0824*t79
+    t106 = t71 + t105
+    t107 = -t50 + t106
+    t108 = -t29 + t107
+    t109 = -t14 + t108
+    t110 = 0.0001*s1 + t109
+    t111 = t104*T00 + t101*T01 + t102*T02
+    t112 = t104*T10 + t101*T11 + t102*T12
+    t113 = t104*T20 + t101*T21 + t102*T22
+    t114 = 0.5*(-t111 + t95)
+    t115 = mu_dot1 + gain1*(-t110 + T13)
+    t116 = t76*c6
+    t117 = 0.0010000266282165632*t74 - 0.9999994999732464*t59
+    t118 = -t76*s6 + c6*t117
+    t119 = 0.9999995000000417*t118 + 0.0009999998333333417*t80
+    t120 = 0.9999995000000417*t80 - 0.0009999998333333417*t118
+    t121 = s6*t117
+    t122 = t116 + t121
+    t123 = 0.0001*t116 + 0.0001*t121 + 0.0824*t80
+    t124 = t77 + t123
+    t125 = -t56 + t124
+    t126 = -t35 + t125
+    t127 = t4 + t126
+    t128 = 0.089359 + t127
+    t129 = t122*T00 + t119*T01 + t120*T02
+    t130 = t122*T10 + t119*T11 + t120*T12
+    t131 = t122*T20 + t119*T21 + t120*T22
+    t132 = 0.5*(-t130 + t113)
+    t133 = 0.5*(-t96 + t129)
+    t134 = 0.5*(-1 + t94 + t112 + t131)
+    t135 = xp.sqrt(t132**2 + t133**2 + t114**2)
+    t136 = xp.atan2(t135, t134)
+    t137 = xp.where(xp.greater(t135, 0), t136/t135, 1)
+    t138 = mu_dot2 + gain2*(-t128 + T23)
+    t139 = xp.greater_equal(t94, t112) & xp.greater_equal(t94, t131)
+    t140 = xp.greater_equal(t112, t131)
+    t141 = xp.where(t139, 0.5*(1 + t94), xp.where(t140, 0.5*t111, 0.5*t129))
+    t142 = xp.where(t139, 0.5*t95, xp.where(t140, 0.5*(1 + t112), 0.5*t130))
+    t143 = xp.where(t139, 0.5*t96, xp.where(t140, 0.5*t113, 0.5*(1 + t131)))
+    t144 = xp.sqrt(t141**2 + t142**2 + t143**2)
+    t145 = xp.where(xp.greater_equal(t132*t141 + t133*t142 + t114*t143, 0), xp.asarray(1, dtype=dtype), -1)
+    t146 = xp.greater(t135, 1e-06) | xp.greater(t134, 0)
+    t147 = t136*t145/t144
+    t148 = xp.where(t146, t132*t137, t147*t141)
+    t149 = xp.where(t146, t133*t137, t147*t142)
+    t150 = xp.where(t146, t114*t137, t147*t143)
+    t151 = mu_dot3 + t148*gain3
+    t152 = mu_dot4 + t149*gain4
+    t153 = mu_dot5 + t150*gain5
+    t154 = _velocity_solve(xp, 1, (c1, s1, c2, s2, c3, s3, c4, s4, c5, s5, c6, s6, t97, t115, t138, t151, t152, t153, damping,))
     q_dot = _stack(xp, [
-        xp.broadcast_to(xp.where(t364, xp.where(t361, t322, t358), 0), batch),  # 0
-        xp.broadcast_to(xp.where(t364, xp.where(t361, t326, t357), 0), batch),  # 1
-        xp.broadcast_to(xp.where(t364, xp.where(t361, t327, t356), 0), batch),  # 2
-        xp.broadcast_to(xp.where(t364, xp.where(t361, t328, t355), 0), batch),  # 3
-        xp.broadcast_to(xp.where(t364, xp.where(t361, t329, t354), 0), batch),  # 4
-        xp.broadcast_to(xp.where(t364, xp.where(t361, t330, t353), 0), batch),  # 5
+        xp.broadcast_to(t154[0], batch),  # 0
+        xp.broadcast_to(t154[1], batch),  # 1
+        xp.broadcast_to(t154[2], batch),  # 2
+        xp.broadcast_to(t154[3], batch),  # 3
+        xp.broadcast_to(t154[4], batch),  # 4
+        xp.broadcast_to(t154[5], batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t359 & t360), 2, xp.where(t363, xp.asarray(1, dtype=dtype), 0)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(t154[6], batch), xp.int32)
     return q_dot, status
 
 
@@ -11523,7 +10929,7 @@ def ik_general_nominal(T):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
-    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 1890 operations."""
+    """the closed-form ik solution inside the joint limits nearest q_seed (sum of weights_j (q_j - q_seed_j)^2), and the status: (6 x 1 and 1 x 1), 1891 operations."""
     xp, dtype, device, batch, (T, q_seed, weights,) = _arguments(("T", T, (4, 4)), ("q_seed", q_seed, (6,)), ("weights", weights, (6,)))
     branches_q, branches_valid, branches_in_limits = ik_branches(T)
     T00 = T[..., 0, 0]
@@ -11678,35 +11084,694 @@ def ik_nearest(T, q_seed, weights=(1.0,) * DOF):
     lb13 = branches_in_limits[..., 13]
     lb14 = branches_in_limits[..., 14]
     lb15 = branches_in_limits[..., 15]
-    t0 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
-    t1 = _nearer_branch(xp, 1, (qb0_0, qb0_1, qb0_2, qb0_3, qb0_4, qb0_5, xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, qn1, qn2, qn3, qn4, qn5, qn6, xp.full(batch, 0, dtype=dtype, device=device), xp.full(batch, 0, dtype=dtype, device=device),))
-    t2 = _nearer_branch(xp, 1, (qb1_0, qb1_1, qb1_2, qb1_3, qb1_4, qb1_5, xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t1[0], t1[1], t1[2], t1[3], t1[4], t1[5], t1[6], t1[7],))
-    t3 = _nearer_branch(xp, 1, (qb2_0, qb2_1, qb2_2, qb2_3, qb2_4, qb2_5, xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t2[0], t2[1], t2[2], t2[3], t2[4], t2[5], t2[6], t2[7],))
-    t4 = _nearer_branch(xp, 1, (qb3_0, qb3_1, qb3_2, qb3_3, qb3_4, qb3_5, xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t3[0], t3[1], t3[2], t3[3], t3[4], t3[5], t3[6], t3[7],))
-    t5 = _nearer_branch(xp, 1, (qb4_0, qb4_1, qb4_2, qb4_3, qb4_4, qb4_5, xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t4[0], t4[1], t4[2], t4[3], t4[4], t4[5], t4[6], t4[7],))
-    t6 = _nearer_branch(xp, 1, (qb5_0, qb5_1, qb5_2, qb5_3, qb5_4, qb5_5, xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t5[0], t5[1], t5[2], t5[3], t5[4], t5[5], t5[6], t5[7],))
-    t7 = _nearer_branch(xp, 1, (qb6_0, qb6_1, qb6_2, qb6_3, qb6_4, qb6_5, xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t6[0], t6[1], t6[2], t6[3], t6[4], t6[5], t6[6], t6[7],))
-    t8 = _nearer_branch(xp, 1, (qb7_0, qb7_1, qb7_2, qb7_3, qb7_4, qb7_5, xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t7[0], t7[1], t7[2], t7[3], t7[4], t7[5], t7[6], t7[7],))
-    t9 = _nearer_branch(xp, 1, (qb8_0, qb8_1, qb8_2, qb8_3, qb8_4, qb8_5, xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t8[0], t8[1], t8[2], t8[3], t8[4], t8[5], t8[6], t8[7],))
-    t10 = _nearer_branch(xp, 1, (qb9_0, qb9_1, qb9_2, qb9_3, qb9_4, qb9_5, xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t9[0], t9[1], t9[2], t9[3], t9[4], t9[5], t9[6], t9[7],))
-    t11 = _nearer_branch(xp, 1, (qb10_0, qb10_1, qb10_2, qb10_3, qb10_4, qb10_5, xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t10[0], t10[1], t10[2], t10[3], t10[4], t10[5], t10[6], t10[7],))
-    t12 = _nearer_branch(xp, 1, (qb11_0, qb11_1, qb11_2, qb11_3, qb11_4, qb11_5, xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t11[0], t11[1], t11[2], t11[3], t11[4], t11[5], t11[6], t11[7],))
-    t13 = _nearer_branch(xp, 1, (qb12_0, qb12_1, qb12_2, qb12_3, qb12_4, qb12_5, xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t12[0], t12[1], t12[2], t12[3], t12[4], t12[5], t12[6], t12[7],))
-    t14 = _nearer_branch(xp, 1, (qb13_0, qb13_1, qb13_2, qb13_3, qb13_4, qb13_5, xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t13[0], t13[1], t13[2], t13[3], t13[4], t13[5], t13[6], t13[7],))
-    t15 = _nearer_branch(xp, 1, (qb14_0, qb14_1, qb14_2, qb14_3, qb14_4, qb14_5, xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t14[0], t14[1], t14[2], t14[3], t14[4], t14[5], t14[6], t14[7],))
-    t16 = _nearer_branch(xp, 1, (qb15_0, qb15_1, qb15_2, qb15_3, qb15_4, qb15_5, xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0), qn1, qn2, qn3, qn4, qn5, qn6, qw1, qw2, qw3, qw4, qw5, qw6, t15[0], t15[1], t15[2], t15[3], t15[4], t15[5], t15[6], t15[7],))
-    t17 = xp.greater(t16[7], 0)
-    t18 = xp.isfinite(t0)
-    t19 = t17 & t18
+    t0 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_0 + qn1)) + qb0_0
+    t1 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_1 + qn2)) + qb0_1
+    t2 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_2 + qn3)) + qb0_2
+    t3 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_3 + qn4)) + qb0_3
+    t4 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_4 + qn5)) + qb0_4
+    t5 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb0_5 + qn6)) + qb0_5
+    t6 = xp.where(xp.greater(xp.where(vb0 & lb0, xp.asarray(1, dtype=dtype), 0), 0), xp.asarray(1, dtype=dtype), 0)
+    t7 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_0 + qn1)) + qb1_0
+    t8 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_1 + qn2)) + qb1_1
+    t9 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_2 + qn3)) + qb1_2
+    t10 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_3 + qn4)) + qb1_3
+    t11 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_4 + qn5)) + qb1_4
+    t12 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb1_5 + qn6)) + qb1_5
+    t13 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_0 + qn1)) + qb2_0
+    t14 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_1 + qn2)) + qb2_1
+    t15 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_2 + qn3)) + qb2_2
+    t16 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_3 + qn4)) + qb2_3
+    t17 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_4 + qn5)) + qb2_4
+    t18 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb2_5 + qn6)) + qb2_5
+    t19 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_0 + qn1)) + qb3_0
+    t20 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_1 + qn2)) + qb3_1
+    t21 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_2 + qn3)) + qb3_2
+    t22 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_3 + qn4)) + qb3_3
+    t23 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_4 + qn5)) + qb3_4
+    t24 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb3_5 + qn6)) + qb3_5
+    t25 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_0 + qn1)) + qb4_0
+    t26 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_1 + qn2)) + qb4_1
+    t27 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_2 + qn3)) + qb4_2
+    t28 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_3 + qn4)) + qb4_3
+    t29 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_4 + qn5)) + qb4_4
+    t30 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb4_5 + qn6)) + qb4_5
+    t31 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_0 + qn1)) + qb5_0
+    t32 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_1 + qn2)) + qb5_1
+    t33 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_2 + qn3)) + qb5_2
+    t34 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_3 + qn4)) + qb5_3
+    t35 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_4 + qn5)) + qb5_4
+    t36 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb5_5 + qn6)) + qb5_5
+    t37 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_0 + qn1)) + qb6_0
+    t38 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_1 + qn2)) + qb6_1
+    t39 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_2 + qn3)) + qb6_2
+    t40 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_3 + qn4)) + qb6_3
+    t41 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_4 + qn5)) + qb6_4
+    t42 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb6_5 + qn6)) + qb6_5
+    t43 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_0 + qn1)) + qb7_0
+    t44 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_1 + qn2)) + qb7_1
+    t45 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_2 + qn3)) + qb7_2
+    t46 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_3 + qn4)) + qb7_3
+    t47 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_4 + qn5)) + qb7_4
+    t48 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb7_5 + qn6)) + qb7_5
+    t49 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_0 + qn1)) + qb8_0
+    t50 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_1 + qn2)) + qb8_1
+    t51 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_2 + qn3)) + qb8_2
+    t52 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_3 + qn4)) + qb8_3
+    t53 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_4 + qn5)) + qb8_4
+    t54 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb8_5 + qn6)) + qb8_5
+    t55 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_0 + qn1)) + qb9_0
+    t56 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_1 + qn2)) + qb9_1
+    t57 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_2 + qn3)) + qb9_2
+    t58 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_3 + qn4)) + qb9_3
+    t59 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_4 + qn5)) + qb9_4
+    t60 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb9_5 + qn6)) + qb9_5
+    t61 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_0 + qn1)) + qb10_0
+    t62 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_1 + qn2)) + qb10_1
+    t63 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_2 + qn3)) + qb10_2
+    t64 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_3 + qn4)) + qb10_3
+    t65 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_4 + qn5)) + qb10_4
+    t66 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb10_5 + qn6)) + qb10_5
+    t67 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_0 + qn1)) + qb11_0
+    t68 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_1 + qn2)) + qb11_1
+    t69 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_2 + qn3)) + qb11_2
+    t70 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_3 + qn4)) + qb11_3
+    t71 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_4 + qn5)) + qb11_4
+    t72 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb11_5 + qn6)) + qb11_5
+    t73 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_0 + qn1)) + qb12_0
+    t74 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_1 + qn2)) + qb12_1
+    t75 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_2 + qn3)) + qb12_2
+    t76 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_3 + qn4)) + qb12_3
+    t77 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_4 + qn5)) + qb12_4
+    t78 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb12_5 + qn6)) + qb12_5
+    t79 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_0 + qn1)) + qb13_0
+    t80 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_1 + qn2)) + qb13_1
+    t81 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_2 + qn3)) + qb13_2
+    t82 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_3 + qn4)) + qb13_3
+    t83 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_4 + qn5)) + qb13_4
+    t84 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb13_5 + qn6)) + qb13_5
+    t85 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_0 + qn1)) + qb14_0
+    t86 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_1 + qn2)) + qb14_1
+    t87 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_2 + qn3)) + qb14_2
+    t88 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_3 + qn4)) + qb14_3
+    t89 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_4 + qn5)) + qb14_4
+    t90 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb14_5 + qn6)) + qb14_5
+    t91 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_0 + qn1)) + qb15_0
+    t92 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_1 + qn2)) + qb15_1
+    t93 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_2 + qn3)) + qb15_2
+    t94 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_3 + qn4)) + qb15_3
+    t95 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_4 + qn5)) + qb15_4
+    t96 = 6.283185307179586*xp.floor(0.5 + 0.15915494309189535*(-qb15_5 + qn6)) + qb15_5
+    t97 = T00 + T01 + T02 + T10 + T11 + T12 + T20 + T21 + T22 + T03 + T13 + T23 + qn1 + qn2 + qn3 + qn4 + qn5 + qn6 + qw1 + qw2 + qw3 + qw4 + qw5 + qw6
+    t98 = xp.where(xp.less(t0, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t99 = t98 + t0
+    t100 = -t98 + t0
+    t101 = xp.where(xp.greater_equal(t0, -6.283185307179586) & xp.less_equal(t0, 6.283185307179586), t0, xp.where(xp.greater_equal(t99, -6.283185307179586) & xp.less_equal(t99, 6.283185307179586), t99, xp.where(xp.greater_equal(t100, -6.283185307179586) & xp.less_equal(t100, 6.283185307179586), t100, qb0_0)))
+    t102 = xp.where(xp.less(t1, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t103 = t102 + t1
+    t104 = -t102 + t1
+    t105 = xp.where(xp.greater_equal(t1, -6.283185307179586) & xp.less_equal(t1, 6.283185307179586), t1, xp.where(xp.greater_equal(t103, -6.283185307179586) & xp.less_equal(t103, 6.283185307179586), t103, xp.where(xp.greater_equal(t104, -6.283185307179586) & xp.less_equal(t104, 6.283185307179586), t104, qb0_1)))
+    t106 = xp.where(xp.less(t2, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t107 = t106 + t2
+    t108 = -t106 + t2
+    t109 = xp.where(xp.greater_equal(t2, -6.283185307179586) & xp.less_equal(t2, 6.283185307179586), t2, xp.where(xp.greater_equal(t107, -6.283185307179586) & xp.less_equal(t107, 6.283185307179586), t107, xp.where(xp.greater_equal(t108, -6.283185307179586) & xp.less_equal(t108, 6.283185307179586), t108, qb0_2)))
+    t110 = xp.where(xp.less(t3, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t111 = t110 + t3
+    t112 = -t110 + t3
+    t113 = xp.where(xp.greater_equal(t3, -6.283185307179586) & xp.less_equal(t3, 6.283185307179586), t3, xp.where(xp.greater_equal(t111, -6.283185307179586) & xp.less_equal(t111, 6.283185307179586), t111, xp.where(xp.greater_equal(t112, -6.283185307179586) & xp.less_equal(t112, 6.283185307179586), t112, qb0_3)))
+    t114 = xp.where(xp.less(t4, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t115 = t114 + t4
+    t116 = -t114 + t4
+    t117 = xp.where(xp.greater_equal(t4, -6.283185307179586) & xp.less_equal(t4, 6.283185307179586), t4, xp.where(xp.greater_equal(t115, -6.283185307179586) & xp.less_equal(t115, 6.283185307179586), t115, xp.where(xp.greater_equal(t116, -6.283185307179586) & xp.less_equal(t116, 6.283185307179586), t116, qb0_4)))
+    t118 = xp.where(xp.less(t5, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t119 = t118 + t5
+    t120 = -t118 + t5
+    t121 = xp.where(xp.greater_equal(t5, -6.283185307179586) & xp.less_equal(t5, 6.283185307179586), t5, xp.where(xp.greater_equal(t119, -6.283185307179586) & xp.less_equal(t119, 6.283185307179586), t119, xp.where(xp.greater_equal(t120, -6.283185307179586) & xp.less_equal(t120, 6.283185307179586), t120, qb0_5)))
+    t122 = -qn1
+    t123 = -qn2
+    t124 = -qn3
+    t125 = -qn4
+    t126 = -qn5
+    t127 = -qn6
+    t128 = qw1*(t122 + t101)**2 + qw2*(t123 + t105)**2 + qw3*(t124 + t109)**2 + qw4*(t125 + t113)**2 + qw5*(t126 + t117)**2 + qw6*(t127 + t121)**2
+    t129 = xp.greater(t6, 0)
+    t130 = xp.where(t129, t101, qn1)
+    t131 = xp.where(t129, t105, qn2)
+    t132 = xp.where(t129, t109, qn3)
+    t133 = xp.where(t129, t113, qn4)
+    t134 = xp.where(t129, t117, qn5)
+    t135 = xp.where(t129, t121, qn6)
+    t136 = xp.where(t129, t128, 0)
+    t137 = xp.where(xp.less(t7, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t138 = t137 + t7
+    t139 = -t137 + t7
+    t140 = xp.where(xp.greater_equal(t7, -6.283185307179586) & xp.less_equal(t7, 6.283185307179586), t7, xp.where(xp.greater_equal(t138, -6.283185307179586) & xp.less_equal(t138, 6.283185307179586), t138, xp.where(xp.greater_equal(t139, -6.283185307179586) & xp.less_equal(t139, 6.283185307179586), t139, qb1_0)))
+    t141 = xp.where(xp.less(t8, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t142 = t141 + t8
+    t143 = -t141 + t8
+    t144 = xp.where(xp.greater_equal(t8, -6.283185307179586) & xp.less_equal(t8, 6.283185307179586), t8, xp.where(xp.greater_equal(t142, -6.283185307179586) & xp.less_equal(t142, 6.283185307179586), t142, xp.where(xp.greater_equal(t143, -6.283185307179586) & xp.less_equal(t143, 6.283185307179586), t143, qb1_1)))
+    t145 = xp.where(xp.less(t9, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t146 = t145 + t9
+    t147 = -t145 + t9
+    t148 = xp.where(xp.greater_equal(t9, -6.283185307179586) & xp.less_equal(t9, 6.283185307179586), t9, xp.where(xp.greater_equal(t146, -6.283185307179586) & xp.less_equal(t146, 6.283185307179586), t146, xp.where(xp.greater_equal(t147, -6.283185307179586) & xp.less_equal(t147, 6.283185307179586), t147, qb1_2)))
+    t149 = xp.where(xp.less(t10, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t150 = t149 + t10
+    t151 = -t149 + t10
+    t152 = xp.where(xp.greater_equal(t10, -6.283185307179586) & xp.less_equal(t10, 6.283185307179586), t10, xp.where(xp.greater_equal(t150, -6.283185307179586) & xp.less_equal(t150, 6.283185307179586), t150, xp.where(xp.greater_equal(t151, -6.283185307179586) & xp.less_equal(t151, 6.283185307179586), t151, qb1_3)))
+    t153 = xp.where(xp.less(t11, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t154 = t153 + t11
+    t155 = -t153 + t11
+    t156 = xp.where(xp.greater_equal(t11, -6.283185307179586) & xp.less_equal(t11, 6.283185307179586), t11, xp.where(xp.greater_equal(t154, -6.283185307179586) & xp.less_equal(t154, 6.283185307179586), t154, xp.where(xp.greater_equal(t155, -6.283185307179586) & xp.less_equal(t155, 6.283185307179586), t155, qb1_4)))
+    t157 = xp.where(xp.less(t12, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t158 = t157 + t12
+    t159 = -t157 + t12
+    t160 = xp.where(xp.greater_equal(t12, -6.283185307179586) & xp.less_equal(t12, 6.283185307179586), t12, xp.where(xp.greater_equal(t158, -6.283185307179586) & xp.less_equal(t158, 6.283185307179586), t158, xp.where(xp.greater_equal(t159, -6.283185307179586) & xp.less_equal(t159, 6.283185307179586), t159, qb1_5)))
+    t161 = qw1*(t122 + t140)**2 + qw2*(t123 + t144)**2 + qw3*(t124 + t148)**2 + qw4*(t125 + t152)**2 + qw5*(t126 + t156)**2 + qw6*(t127 + t160)**2
+    t162 = xp.greater(xp.where(vb1 & lb1, xp.asarray(1, dtype=dtype), 0), 0)
+    t163 = xp.where(t162 & (xp.less(t6, 1) | xp.less(t161, t136)), xp.asarray(1, dtype=dtype), 0)
+    t164 = xp.where(t162, 1, t6)
+    t165 = xp.greater(t163, 0)
+    t166 = xp.where(t165, t140, t130)
+    t167 = xp.where(t165, t144, t131)
+    t168 = xp.where(t165, t148, t132)
+    t169 = xp.where(t165, t152, t133)
+    t170 = xp.where(t165, t156, t134)
+    t171 = xp.where(t165, t160, t135)
+    t172 = xp.where(t165, t161, t136)
+    t173 = xp.where(xp.less(t13, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t174 = t173 + t13
+    t175 = -t173 + t13
+    t176 = xp.where(xp.greater_equal(t13, -6.283185307179586) & xp.less_equal(t13, 6.283185307179586), t13, xp.where(xp.greater_equal(t174, -6.283185307179586) & xp.less_equal(t174, 6.283185307179586), t174, xp.where(xp.greater_equal(t175, -6.283185307179586) & xp.less_equal(t175, 6.283185307179586), t175, qb2_0)))
+    t177 = xp.where(xp.less(t14, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t178 = t177 + t14
+    t179 = -t177 + t14
+    t180 = xp.where(xp.greater_equal(t14, -6.283185307179586) & xp.less_equal(t14, 6.283185307179586), t14, xp.where(xp.greater_equal(t178, -6.283185307179586) & xp.less_equal(t178, 6.283185307179586), t178, xp.where(xp.greater_equal(t179, -6.283185307179586) & xp.less_equal(t179, 6.283185307179586), t179, qb2_1)))
+    t181 = xp.where(xp.less(t15, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t182 = t181 + t15
+    t183 = -t181 + t15
+    t184 = xp.where(xp.greater_equal(t15, -6.283185307179586) & xp.less_equal(t15, 6.283185307179586), t15, xp.where(xp.greater_equal(t182, -6.283185307179586) & xp.less_equal(t182, 6.283185307179586), t182, xp.where(xp.greater_equal(t183, -6.283185307179586) & xp.less_equal(t183, 6.283185307179586), t183, qb2_2)))
+    t185 = xp.where(xp.less(t16, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t186 = t185 + t16
+    t187 = -t185 + t16
+    t188 = xp.where(xp.greater_equal(t16, -6.283185307179586) & xp.less_equal(t16, 6.283185307179586), t16, xp.where(xp.greater_equal(t186, -6.283185307179586) & xp.less_equal(t186, 6.283185307179586), t186, xp.where(xp.greater_equal(t187, -6.283185307179586) & xp.less_equal(t187, 6.283185307179586), t187, qb2_3)))
+    t189 = xp.where(xp.less(t17, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t190 = t189 + t17
+    t191 = -t189 + t17
+    t192 = xp.where(xp.greater_equal(t17, -6.283185307179586) & xp.less_equal(t17, 6.283185307179586), t17, xp.where(xp.greater_equal(t190, -6.283185307179586) & xp.less_equal(t190, 6.283185307179586), t190, xp.where(xp.greater_equal(t191, -6.283185307179586) & xp.less_equal(t191, 6.283185307179586), t191, qb2_4)))
+    t193 = xp.where(xp.less(t18, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t194 = t193 + t18
+    t195 = -t193 + t18
+    t196 = xp.where(xp.greater_equal(t18, -6.283185307179586) & xp.less_equal(t18, 6.283185307179586), t18, xp.where(xp.greater_equal(t194, -6.283185307179586) & xp.less_equal(t194, 6.283185307179586), t194, xp.where(xp.greater_equal(t195, -6.283185307179586) & xp.less_equal(t195, 6.283185307179586), t195, qb2_5)))
+    t197 = qw1*(t122 + t176)**2 + qw2*(t123 + t180)**2 + qw3*(t124 + t184)**2 + qw4*(t125 + t188)**2 + qw5*(t126 + t192)**2 + qw6*(t127 + t196)**2
+    t198 = xp.greater(xp.where(vb2 & lb2, xp.asarray(1, dtype=dtype), 0), 0)
+    t199 = xp.where(t198 & (xp.less(t164, 1) | xp.less(t197, t172)), xp.asarray(1, dtype=dtype), 0)
+    t200 = xp.where(t198, 1, t164)
+    t201 = xp.greater(t199, 0)
+    t202 = xp.where(t201, t176, t166)
+    t203 = xp.where(t201, t180, t167)
+    t204 = xp.where(t201, t184, t168)
+    t205 = xp.where(t201, t188, t169)
+    t206 = xp.where(t201, t192, t170)
+    t207 = xp.where(t201, t196, t171)
+    t208 = xp.where(t201, t197, t172)
+    t209 = xp.where(xp.less(t19, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t210 = t209 + t19
+    t211 = -t209 + t19
+    t212 = xp.where(xp.greater_equal(t19, -6.283185307179586) & xp.less_equal(t19, 6.283185307179586), t19, xp.where(xp.greater_equal(t210, -6.283185307179586) & xp.less_equal(t210, 6.283185307179586), t210, xp.where(xp.greater_equal(t211, -6.283185307179586) & xp.less_equal(t211, 6.283185307179586), t211, qb3_0)))
+    t213 = xp.where(xp.less(t20, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t214 = t213 + t20
+    t215 = -t213 + t20
+    t216 = xp.where(xp.greater_equal(t20, -6.283185307179586) & xp.less_equal(t20, 6.283185307179586), t20, xp.where(xp.greater_equal(t214, -6.283185307179586) & xp.less_equal(t214, 6.283185307179586), t214, xp.where(xp.greater_equal(t215, -6.283185307179586) & xp.less_equal(t215, 6.283185307179586), t215, qb3_1)))
+    t217 = xp.where(xp.less(t21, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t218 = t217 + t21
+    t219 = -t217 + t21
+    t220 = xp.where(xp.greater_equal(t21, -6.283185307179586) & xp.less_equal(t21, 6.283185307179586), t21, xp.where(xp.greater_equal(t218, -6.283185307179586) & xp.less_equal(t218, 6.283185307179586), t218, xp.where(xp.greater_equal(t219, -6.283185307179586) & xp.less_equal(t219, 6.283185307179586), t219, qb3_2)))
+    t221 = xp.where(xp.less(t22, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t222 = t221 + t22
+    t223 = -t221 + t22
+    t224 = xp.where(xp.greater_equal(t22, -6.283185307179586) & xp.less_equal(t22, 6.283185307179586), t22, xp.where(xp.greater_equal(t222, -6.283185307179586) & xp.less_equal(t222, 6.283185307179586), t222, xp.where(xp.greater_equal(t223, -6.283185307179586) & xp.less_equal(t223, 6.283185307179586), t223, qb3_3)))
+    t225 = xp.where(xp.less(t23, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t226 = t225 + t23
+    t227 = -t225 + t23
+    t228 = xp.where(xp.greater_equal(t23, -6.283185307179586) & xp.less_equal(t23, 6.283185307179586), t23, xp.where(xp.greater_equal(t226, -6.283185307179586) & xp.less_equal(t226, 6.283185307179586), t226, xp.where(xp.greater_equal(t227, -6.283185307179586) & xp.less_equal(t227, 6.283185307179586), t227, qb3_4)))
+    t229 = xp.where(xp.less(t24, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t230 = t229 + t24
+    t231 = -t229 + t24
+    t232 = xp.where(xp.greater_equal(t24, -6.283185307179586) & xp.less_equal(t24, 6.283185307179586), t24, xp.where(xp.greater_equal(t230, -6.283185307179586) & xp.less_equal(t230, 6.283185307179586), t230, xp.where(xp.greater_equal(t231, -6.283185307179586) & xp.less_equal(t231, 6.283185307179586), t231, qb3_5)))
+    t233 = qw1*(t122 + t212)**2 + qw2*(t123 + t216)**2 + qw3*(t124 + t220)**2 + qw4*(t125 + t224)**2 + qw5*(t126 + t228)**2 + qw6*(t127 + t232)**2
+    t234 = xp.greater(xp.where(vb3 & lb3, xp.asarray(1, dtype=dtype), 0), 0)
+    t235 = xp.where(t234 & (xp.less(t200, 1) | xp.less(t233, t208)), xp.asarray(1, dtype=dtype), 0)
+    t236 = xp.where(t234, 1, t200)
+    t237 = xp.greater(t235, 0)
+    t238 = xp.where(t237, t212, t202)
+    t239 = xp.where(t237, t216, t203)
+    t240 = xp.where(t237, t220, t204)
+    t241 = xp.where(t237, t224, t205)
+    t242 = xp.where(t237, t228, t206)
+    t243 = xp.where(t237, t232, t207)
+    t244 = xp.where(t237, t233, t208)
+    t245 = xp.where(xp.less(t25, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t246 = t245 + t25
+    t247 = -t245 + t25
+    t248 = xp.where(xp.greater_equal(t25, -6.283185307179586) & xp.less_equal(t25, 6.283185307179586), t25, xp.where(xp.greater_equal(t246, -6.283185307179586) & xp.less_equal(t246, 6.283185307179586), t246, xp.where(xp.greater_equal(t247, -6.283185307179586) & xp.less_equal(t247, 6.283185307179586), t247, qb4_0)))
+    t249 = xp.where(xp.less(t26, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t250 = t249 + t26
+    t251 = -t249 + t26
+    t252 = xp.where(xp.greater_equal(t26, -6.283185307179586) & xp.less_equal(t26, 6.283185307179586), t26, xp.where(xp.greater_equal(t250, -6.283185307179586) & xp.less_equal(t250, 6.283185307179586), t250, xp.where(xp.greater_equal(t251, -6.283185307179586) & xp.less_equal(t251, 6.283185307179586), t251, qb4_1)))
+    t253 = xp.where(xp.less(t27, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t254 = t253 + t27
+    t255 = -t253 + t27
+    t256 = xp.where(xp.greater_equal(t27, -6.283185307179586) & xp.less_equal(t27, 6.283185307179586), t27, xp.where(xp.greater_equal(t254, -6.283185307179586) & xp.less_equal(t254, 6.283185307179586), t254, xp.where(xp.greater_equal(t255, -6.283185307179586) & xp.less_equal(t255, 6.283185307179586), t255, qb4_2)))
+    t257 = xp.where(xp.less(t28, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t258 = t257 + t28
+    t259 = -t257 + t28
+    t260 = xp.where(xp.greater_equal(t28, -6.283185307179586) & xp.less_equal(t28, 6.283185307179586), t28, xp.where(xp.greater_equal(t258, -6.283185307179586) & xp.less_equal(t258, 6.283185307179586), t258, xp.where(xp.greater_equal(t259, -6.283185307179586) & xp.less_equal(t259, 6.283185307179586), t259, qb4_3)))
+    t261 = xp.where(xp.less(t29, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t262 = t261 + t29
+    t263 = -t261 + t29
+    t264 = xp.where(xp.greater_equal(t29, -6.283185307179586) & xp.less_equal(t29, 6.283185307179586), t29, xp.where(xp.greater_equal(t262, -6.283185307179586) & xp.less_equal(t262, 6.283185307179586), t262, xp.where(xp.greater_equal(t263, -6.283185307179586) & xp.less_equal(t263, 6.283185307179586), t263, qb4_4)))
+    t265 = xp.where(xp.less(t30, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t266 = t265 + t30
+    t267 = -t265 + t30
+    t268 = xp.where(xp.greater_equal(t30, -6.283185307179586) & xp.less_equal(t30, 6.283185307179586), t30, xp.where(xp.greater_equal(t266, -6.283185307179586) & xp.less_equal(t266, 6.283185307179586), t266, xp.where(xp.greater_equal(t267, -6.283185307179586) & xp.less_equal(t267, 6.283185307179586), t267, qb4_5)))
+    t269 = qw1*(t122 + t248)**2 + qw2*(t123 + t252)**2 + qw3*(t124 + t256)**2 + qw4*(t125 + t260)**2 + qw5*(t126 + t264)**2 + qw6*(t127 + t268)**2
+    t270 = xp.greater(xp.where(vb4 & lb4, xp.asarray(1, dtype=dtype), 0), 0)
+    t271 = xp.where(t270 & (xp.less(t236, 1) | xp.less(t269, t244)), xp.asarray(1, dtype=dtype), 0)
+    t272 = xp.where(t270, 1, t236)
+    t273 = xp.greater(t271, 0)
+    t274 = xp.where(t273, t248, t238)
+    t275 = xp.where(t273, t252, t239)
+    t276 = xp.where(t273, t256, t240)
+    t277 = xp.where(t273, t260, t241)
+    t278 = xp.where(t273, t264, t242)
+    t279 = xp.where(t273, t268, t243)
+    t280 = xp.where(t273, t269, t244)
+    t281 = xp.where(xp.less(t31, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t282 = t281 + t31
+    t283 = -t281 + t31
+    t284 = xp.where(xp.greater_equal(t31, -6.283185307179586) & xp.less_equal(t31, 6.283185307179586), t31, xp.where(xp.greater_equal(t282, -6.283185307179586) & xp.less_equal(t282, 6.283185307179586), t282, xp.where(xp.greater_equal(t283, -6.283185307179586) & xp.less_equal(t283, 6.283185307179586), t283, qb5_0)))
+    t285 = xp.where(xp.less(t32, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t286 = t285 + t32
+    t287 = -t285 + t32
+    t288 = xp.where(xp.greater_equal(t32, -6.283185307179586) & xp.less_equal(t32, 6.283185307179586), t32, xp.where(xp.greater_equal(t286, -6.283185307179586) & xp.less_equal(t286, 6.283185307179586), t286, xp.where(xp.greater_equal(t287, -6.283185307179586) & xp.less_equal(t287, 6.283185307179586), t287, qb5_1)))
+    t289 = xp.where(xp.less(t33, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t290 = t289 + t33
+    t291 = -t289 + t33
+    t292 = xp.where(xp.greater_equal(t33, -6.283185307179586) & xp.less_equal(t33, 6.283185307179586), t33, xp.where(xp.greater_equal(t290, -6.283185307179586) & xp.less_equal(t290, 6.283185307179586), t290, xp.where(xp.greater_equal(t291, -6.283185307179586) & xp.less_equal(t291, 6.283185307179586), t291, qb5_2)))
+    t293 = xp.where(xp.less(t34, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t294 = t293 + t34
+    t295 = -t293 + t34
+    t296 = xp.where(xp.greater_equal(t34, -6.283185307179586) & xp.less_equal(t34, 6.283185307179586), t34, xp.where(xp.greater_equal(t294, -6.283185307179586) & xp.less_equal(t294, 6.283185307179586), t294, xp.where(xp.greater_equal(t295, -6.283185307179586) & xp.less_equal(t295, 6.283185307179586), t295, qb5_3)))
+    t297 = xp.where(xp.less(t35, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t298 = t297 + t35
+    t299 = -t297 + t35
+    t300 = xp.where(xp.greater_equal(t35, -6.283185307179586) & xp.less_equal(t35, 6.283185307179586), t35, xp.where(xp.greater_equal(t298, -6.283185307179586) & xp.less_equal(t298, 6.283185307179586), t298, xp.where(xp.greater_equal(t299, -6.283185307179586) & xp.less_equal(t299, 6.283185307179586), t299, qb5_4)))
+    t301 = xp.where(xp.less(t36, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t302 = t301 + t36
+    t303 = -t301 + t36
+    t304 = xp.where(xp.greater_equal(t36, -6.283185307179586) & xp.less_equal(t36, 6.283185307179586), t36, xp.where(xp.greater_equal(t302, -6.283185307179586) & xp.less_equal(t302, 6.283185307179586), t302, xp.where(xp.greater_equal(t303, -6.283185307179586) & xp.less_equal(t303, 6.283185307179586), t303, qb5_5)))
+    t305 = qw1*(t122 + t284)**2 + qw2*(t123 + t288)**2 + qw3*(t124 + t292)**2 + qw4*(t125 + t296)**2 + qw5*(t126 + t300)**2 + qw6*(t127 + t304)**2
+    t306 = xp.greater(xp.where(vb5 & lb5, xp.asarray(1, dtype=dtype), 0), 0)
+    t307 = xp.where(t306 & (xp.less(t272, 1) | xp.less(t305, t280)), xp.asarray(1, dtype=dtype), 0)
+    t308 = xp.where(t306, 1, t272)
+    t309 = xp.greater(t307, 0)
+    t310 = xp.where(t309, t284, t274)
+    t311 = xp.where(t309, t288, t275)
+    t312 = xp.where(t309, t292, t276)
+    t313 = xp.where(t309, t296, t277)
+    t314 = xp.where(t309, t300, t278)
+    t315 = xp.where(t309, t304, t279)
+    t316 = xp.where(t309, t305, t280)
+    t317 = xp.where(xp.less(t37, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t318 = t317 + t37
+    t319 = -t317 + t37
+    t320 = xp.where(xp.greater_equal(t37, -6.283185307179586) & xp.less_equal(t37, 6.283185307179586), t37, xp.where(xp.greater_equal(t318, -6.283185307179586) & xp.less_equal(t318, 6.283185307179586), t318, xp.where(xp.greater_equal(t319, -6.283185307179586) & xp.less_equal(t319, 6.283185307179586), t319, qb6_0)))
+    t321 = xp.where(xp.less(t38, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t322 = t321 + t38
+    t323 = -t321 + t38
+    t324 = xp.where(xp.greater_equal(t38, -6.283185307179586) & xp.less_equal(t38, 6.283185307179586), t38, xp.where(xp.greater_equal(t322, -6.283185307179586) & xp.less_equal(t322, 6.283185307179586), t322, xp.where(xp.greater_equal(t323, -6.283185307179586) & xp.less_equal(t323, 6.283185307179586), t323, qb6_1)))
+    t325 = xp.where(xp.less(t39, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t326 = t325 + t39
+    t327 = -t325 + t39
+    t328 = xp.where(xp.greater_equal(t39, -6.283185307179586) & xp.less_equal(t39, 6.283185307179586), t39, xp.where(xp.greater_equal(t326, -6.283185307179586) & xp.less_equal(t326, 6.283185307179586), t326, xp.where(xp.greater_equal(t327, -6.283185307179586) & xp.less_equal(t327, 6.283185307179586), t327, qb6_2)))
+    t329 = xp.where(xp.less(t40, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t330 = t329 + t40
+    t331 = -t329 + t40
+    t332 = xp.where(xp.greater_equal(t40, -6.283185307179586) & xp.less_equal(t40, 6.283185307179586), t40, xp.where(xp.greater_equal(t330, -6.283185307179586) & xp.less_equal(t330, 6.283185307179586), t330, xp.where(xp.greater_equal(t331, -6.283185307179586) & xp.less_equal(t331, 6.283185307179586), t331, qb6_3)))
+    t333 = xp.where(xp.less(t41, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t334 = t333 + t41
+    t335 = -t333 + t41
+    t336 = xp.where(xp.greater_equal(t41, -6.283185307179586) & xp.less_equal(t41, 6.283185307179586), t41, xp.where(xp.greater_equal(t334, -6.283185307179586) & xp.less_equal(t334, 6.283185307179586), t334, xp.where(xp.greater_equal(t335, -6.283185307179586) & xp.less_equal(t335, 6.283185307179586), t335, qb6_4)))
+    t337 = xp.where(xp.less(t42, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t338 = t337 + t42
+    t339 = -t337 + t42
+    t340 = xp.where(xp.greater_equal(t42, -6.283185307179586) & xp.less_equal(t42, 6.283185307179586), t42, xp.where(xp.greater_equal(t338, -6.283185307179586) & xp.less_equal(t338, 6.283185307179586), t338, xp.where(xp.greater_equal(t339, -6.283185307179586) & xp.less_equal(t339, 6.283185307179586), t339, qb6_5)))
+    t341 = qw1*(t122 + t320)**2 + qw2*(t123 + t324)**2 + qw3*(t124 + t328)**2 + qw4*(t125 + t332)**2 + qw5*(t126 + t336)**2 + qw6*(t127 + t340)**2
+    t342 = xp.greater(xp.where(vb6 & lb6, xp.asarray(1, dtype=dtype), 0), 0)
+    t343 = xp.where(t342 & (xp.less(t308, 1) | xp.less(t341, t316)), xp.asarray(1, dtype=dtype), 0)
+    t344 = xp.where(t342, 1, t308)
+    t345 = xp.greater(t343, 0)
+    t346 = xp.where(t345, t320, t310)
+    t347 = xp.where(t345, t324, t311)
+    t348 = xp.where(t345, t328, t312)
+    t349 = xp.where(t345, t332, t313)
+    t350 = xp.where(t345, t336, t314)
+    t351 = xp.where(t345, t340, t315)
+    t352 = xp.where(t345, t341, t316)
+    t353 = xp.where(xp.less(t43, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t354 = t353 + t43
+    t355 = -t353 + t43
+    t356 = xp.where(xp.greater_equal(t43, -6.283185307179586) & xp.less_equal(t43, 6.283185307179586), t43, xp.where(xp.greater_equal(t354, -6.283185307179586) & xp.less_equal(t354, 6.283185307179586), t354, xp.where(xp.greater_equal(t355, -6.283185307179586) & xp.less_equal(t355, 6.283185307179586), t355, qb7_0)))
+    t357 = xp.where(xp.less(t44, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t358 = t357 + t44
+    t359 = -t357 + t44
+    t360 = xp.where(xp.greater_equal(t44, -6.283185307179586) & xp.less_equal(t44, 6.283185307179586), t44, xp.where(xp.greater_equal(t358, -6.283185307179586) & xp.less_equal(t358, 6.283185307179586), t358, xp.where(xp.greater_equal(t359, -6.283185307179586) & xp.less_equal(t359, 6.283185307179586), t359, qb7_1)))
+    t361 = xp.where(xp.less(t45, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t362 = t361 + t45
+    t363 = -t361 + t45
+    t364 = xp.where(xp.greater_equal(t45, -6.283185307179586) & xp.less_equal(t45, 6.283185307179586), t45, xp.where(xp.greater_equal(t362, -6.283185307179586) & xp.less_equal(t362, 6.283185307179586), t362, xp.where(xp.greater_equal(t363, -6.283185307179586) & xp.less_equal(t363, 6.283185307179586), t363, qb7_2)))
+    t365 = xp.where(xp.less(t46, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t366 = t365 + t46
+    t367 = -t365 + t46
+    t368 = xp.where(xp.greater_equal(t46, -6.283185307179586) & xp.less_equal(t46, 6.283185307179586), t46, xp.where(xp.greater_equal(t366, -6.283185307179586) & xp.less_equal(t366, 6.283185307179586), t366, xp.where(xp.greater_equal(t367, -6.283185307179586) & xp.less_equal(t367, 6.283185307179586), t367, qb7_3)))
+    t369 = xp.where(xp.less(t47, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t370 = t369 + t47
+    t371 = -t369 + t47
+    t372 = xp.where(xp.greater_equal(t47, -6.283185307179586) & xp.less_equal(t47, 6.283185307179586), t47, xp.where(xp.greater_equal(t370, -6.283185307179586) & xp.less_equal(t370, 6.283185307179586), t370, xp.where(xp.greater_equal(t371, -6.283185307179586) & xp.less_equal(t371, 6.283185307179586), t371, qb7_4)))
+    t373 = xp.where(xp.less(t48, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t374 = t373 + t48
+    t375 = -t373 + t48
+    t376 = xp.where(xp.greater_equal(t48, -6.283185307179586) & xp.less_equal(t48, 6.283185307179586), t48, xp.where(xp.greater_equal(t374, -6.283185307179586) & xp.less_equal(t374, 6.283185307179586), t374, xp.where(xp.greater_equal(t375, -6.283185307179586) & xp.less_equal(t375, 6.283185307179586), t375, qb7_5)))
+    t377 = qw1*(t122 + t356)**2 + qw2*(t123 + t360)**2 + qw3*(t124 + t364)**2 + qw4*(t125 + t368)**2 + qw5*(t126 + t372)**2 + qw6*(t127 + t376)**2
+    t378 = xp.greater(xp.where(vb7 & lb7, xp.asarray(1, dtype=dtype), 0), 0)
+    t379 = xp.where(t378 & (xp.less(t344, 1) | xp.less(t377, t352)), xp.asarray(1, dtype=dtype), 0)
+    t380 = xp.where(t378, 1, t344)
+    t381 = xp.greater(t379, 0)
+    t382 = xp.where(t381, t356, t346)
+    t383 = xp.where(t381, t360, t347)
+    t384 = xp.where(t381, t364, t348)
+    t385 = xp.where(t381, t368, t349)
+    t386 = xp.where(t381, t372, t350)
+    t387 = xp.where(t381, t376, t351)
+    t388 = xp.where(t381, t377, t352)
+    t389 = xp.where(xp.less(t49, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t390 = t389 + t49
+    t391 = -t389 + t49
+    t392 = xp.where(xp.greater_equal(t49, -6.283185307179586) & xp.less_equal(t49, 6.283185307179586), t49, xp.where(xp.greater_equal(t390, -6.283185307179586) & xp.less_equal(t390, 6.283185307179586), t390, xp.where(xp.greater_equal(t391, -6.283185307179586) & xp.less_equal(t391, 6.283185307179586), t391, qb8_0)))
+    t393 = xp.where(xp.less(t50, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t394 = t393 + t50
+    t395 = -t393 + t50
+    t396 = xp.where(xp.greater_equal(t50, -6.283185307179586) & xp.less_equal(t50, 6.283185307179586), t50, xp.where(xp.greater_equal(t394, -6.283185307179586) & xp.less_equal(t394, 6.283185307179586), t394, xp.where(xp.greater_equal(t395, -6.283185307179586) & xp.less_equal(t395, 6.283185307179586), t395, qb8_1)))
+    t397 = xp.where(xp.less(t51, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t398 = t397 + t51
+    t399 = -t397 + t51
+    t400 = xp.where(xp.greater_equal(t51, -6.283185307179586) & xp.less_equal(t51, 6.283185307179586), t51, xp.where(xp.greater_equal(t398, -6.283185307179586) & xp.less_equal(t398, 6.283185307179586), t398, xp.where(xp.greater_equal(t399, -6.283185307179586) & xp.less_equal(t399, 6.283185307179586), t399, qb8_2)))
+    t401 = xp.where(xp.less(t52, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t402 = t401 + t52
+    t403 = -t401 + t52
+    t404 = xp.where(xp.greater_equal(t52, -6.283185307179586) & xp.less_equal(t52, 6.283185307179586), t52, xp.where(xp.greater_equal(t402, -6.283185307179586) & xp.less_equal(t402, 6.283185307179586), t402, xp.where(xp.greater_equal(t403, -6.283185307179586) & xp.less_equal(t403, 6.283185307179586), t403, qb8_3)))
+    t405 = xp.where(xp.less(t53, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t406 = t405 + t53
+    t407 = -t405 + t53
+    t408 = xp.where(xp.greater_equal(t53, -6.283185307179586) & xp.less_equal(t53, 6.283185307179586), t53, xp.where(xp.greater_equal(t406, -6.283185307179586) & xp.less_equal(t406, 6.283185307179586), t406, xp.where(xp.greater_equal(t407, -6.283185307179586) & xp.less_equal(t407, 6.283185307179586), t407, qb8_4)))
+    t409 = xp.where(xp.less(t54, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t410 = t409 + t54
+    t411 = -t409 + t54
+    t412 = xp.where(xp.greater_equal(t54, -6.283185307179586) & xp.less_equal(t54, 6.283185307179586), t54, xp.where(xp.greater_equal(t410, -6.283185307179586) & xp.less_equal(t410, 6.283185307179586), t410, xp.where(xp.greater_equal(t411, -6.283185307179586) & xp.less_equal(t411, 6.283185307179586), t411, qb8_5)))
+    t413 = qw1*(t122 + t392)**2 + qw2*(t123 + t396)**2 + qw3*(t124 + t400)**2 + qw4*(t125 + t404)**2 + qw5*(t126 + t408)**2 + qw6*(t127 + t412)**2
+    t414 = xp.greater(xp.where(vb8 & lb8, xp.asarray(1, dtype=dtype), 0), 0)
+    t415 = xp.where(t414 & (xp.less(t380, 1) | xp.less(t413, t388)), xp.asarray(1, dtype=dtype), 0)
+    t416 = xp.where(t414, 1, t380)
+    t417 = xp.greater(t415, 0)
+    t418 = xp.where(t417, t392, t382)
+    t419 = xp.where(t417, t396, t383)
+    t420 = xp.where(t417, t400, t384)
+    t421 = xp.where(t417, t404, t385)
+    t422 = xp.where(t417, t408, t386)
+    t423 = xp.where(t417, t412, t387)
+    t424 = xp.where(t417, t413, t388)
+    t425 = xp.where(xp.less(t55, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t426 = t425 + t55
+    t427 = -t425 + t55
+    t428 = xp.where(xp.greater_equal(t55, -6.283185307179586) & xp.less_equal(t55, 6.283185307179586), t55, xp.where(xp.greater_equal(t426, -6.283185307179586) & xp.less_equal(t426, 6.283185307179586), t426, xp.where(xp.greater_equal(t427, -6.283185307179586) & xp.less_equal(t427, 6.283185307179586), t427, qb9_0)))
+    t429 = xp.where(xp.less(t56, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t430 = t429 + t56
+    t431 = -t429 + t56
+    t432 = xp.where(xp.greater_equal(t56, -6.283185307179586) & xp.less_equal(t56, 6.283185307179586), t56, xp.where(xp.greater_equal(t430, -6.283185307179586) & xp.less_equal(t430, 6.283185307179586), t430, xp.where(xp.greater_equal(t431, -6.283185307179586) & xp.less_equal(t431, 6.283185307179586), t431, qb9_1)))
+    t433 = xp.where(xp.less(t57, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t434 = t433 + t57
+    t435 = -t433 + t57
+    t436 = xp.where(xp.greater_equal(t57, -6.283185307179586) & xp.less_equal(t57, 6.283185307179586), t57, xp.where(xp.greater_equal(t434, -6.283185307179586) & xp.less_equal(t434, 6.283185307179586), t434, xp.where(xp.greater_equal(t435, -6.283185307179586) & xp.less_equal(t435, 6.283185307179586), t435, qb9_2)))
+    t437 = xp.where(xp.less(t58, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t438 = t437 + t58
+    t439 = -t437 + t58
+    t440 = xp.where(xp.greater_equal(t58, -6.283185307179586) & xp.less_equal(t58, 6.283185307179586), t58, xp.where(xp.greater_equal(t438, -6.283185307179586) & xp.less_equal(t438, 6.283185307179586), t438, xp.where(xp.greater_equal(t439, -6.283185307179586) & xp.less_equal(t439, 6.283185307179586), t439, qb9_3)))
+    t441 = xp.where(xp.less(t59, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t442 = t441 + t59
+    t443 = -t441 + t59
+    t444 = xp.where(xp.greater_equal(t59, -6.283185307179586) & xp.less_equal(t59, 6.283185307179586), t59, xp.where(xp.greater_equal(t442, -6.283185307179586) & xp.less_equal(t442, 6.283185307179586), t442, xp.where(xp.greater_equal(t443, -6.283185307179586) & xp.less_equal(t443, 6.283185307179586), t443, qb9_4)))
+    t445 = xp.where(xp.less(t60, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t446 = t445 + t60
+    t447 = -t445 + t60
+    t448 = xp.where(xp.greater_equal(t60, -6.283185307179586) & xp.less_equal(t60, 6.283185307179586), t60, xp.where(xp.greater_equal(t446, -6.283185307179586) & xp.less_equal(t446, 6.283185307179586), t446, xp.where(xp.greater_equal(t447, -6.283185307179586) & xp.less_equal(t447, 6.283185307179586), t447, qb9_5)))
+    t449 = qw1*(t122 + t428)**2 + qw2*(t123 + t432)**2 + qw3*(t124 + t436)**2 + qw4*(t125 + t440)**2 + qw5*(t126 + t444)**2 + qw6*(t127 + t448)**2
+    t450 = xp.greater(xp.where(vb9 & lb9, xp.asarray(1, dtype=dtype), 0), 0)
+    t451 = xp.where(t450 & (xp.less(t416, 1) | xp.less(t449, t424)), xp.asarray(1, dtype=dtype), 0)
+    t452 = xp.where(t450, 1, t416)
+    t453 = xp.greater(t451, 0)
+    t454 = xp.where(t453, t428, t418)
+    t455 = xp.where(t453, t432, t419)
+    t456 = xp.where(t453, t436, t420)
+    t457 = xp.where(t453, t440, t421)
+    t458 = xp.where(t453, t444, t422)
+    t459 = xp.where(t453, t448, t423)
+    t460 = xp.where(t453, t449, t424)
+    t461 = xp.where(xp.less(t61, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t462 = t461 + t61
+    t463 = -t461 + t61
+    t464 = xp.where(xp.greater_equal(t61, -6.283185307179586) & xp.less_equal(t61, 6.283185307179586), t61, xp.where(xp.greater_equal(t462, -6.283185307179586) & xp.less_equal(t462, 6.283185307179586), t462, xp.where(xp.greater_equal(t463, -6.283185307179586) & xp.less_equal(t463, 6.283185307179586), t463, qb10_0)))
+    t465 = xp.where(xp.less(t62, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t466 = t465 + t62
+    t467 = -t465 + t62
+    t468 = xp.where(xp.greater_equal(t62, -6.283185307179586) & xp.less_equal(t62, 6.283185307179586), t62, xp.where(xp.greater_equal(t466, -6.283185307179586) & xp.less_equal(t466, 6.283185307179586), t466, xp.where(xp.greater_equal(t467, -6.283185307179586) & xp.less_equal(t467, 6.283185307179586), t467, qb10_1)))
+    t469 = xp.where(xp.less(t63, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t470 = t469 + t63
+    t471 = -t469 + t63
+    t472 = xp.where(xp.greater_equal(t63, -6.283185307179586) & xp.less_equal(t63, 6.283185307179586), t63, xp.where(xp.greater_equal(t470, -6.283185307179586) & xp.less_equal(t470, 6.283185307179586), t470, xp.where(xp.greater_equal(t471, -6.283185307179586) & xp.less_equal(t471, 6.283185307179586), t471, qb10_2)))
+    t473 = xp.where(xp.less(t64, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t474 = t473 + t64
+    t475 = -t473 + t64
+    t476 = xp.where(xp.greater_equal(t64, -6.283185307179586) & xp.less_equal(t64, 6.283185307179586), t64, xp.where(xp.greater_equal(t474, -6.283185307179586) & xp.less_equal(t474, 6.283185307179586), t474, xp.where(xp.greater_equal(t475, -6.283185307179586) & xp.less_equal(t475, 6.283185307179586), t475, qb10_3)))
+    t477 = xp.where(xp.less(t65, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t478 = t477 + t65
+    t479 = -t477 + t65
+    t480 = xp.where(xp.greater_equal(t65, -6.283185307179586) & xp.less_equal(t65, 6.283185307179586), t65, xp.where(xp.greater_equal(t478, -6.283185307179586) & xp.less_equal(t478, 6.283185307179586), t478, xp.where(xp.greater_equal(t479, -6.283185307179586) & xp.less_equal(t479, 6.283185307179586), t479, qb10_4)))
+    t481 = xp.where(xp.less(t66, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t482 = t481 + t66
+    t483 = -t481 + t66
+    t484 = xp.where(xp.greater_equal(t66, -6.283185307179586) & xp.less_equal(t66, 6.283185307179586), t66, xp.where(xp.greater_equal(t482, -6.283185307179586) & xp.less_equal(t482, 6.283185307179586), t482, xp.where(xp.greater_equal(t483, -6.283185307179586) & xp.less_equal(t483, 6.283185307179586), t483, qb10_5)))
+    t485 = qw1*(t122 + t464)**2 + qw2*(t123 + t468)**2 + qw3*(t124 + t472)**2 + qw4*(t125 + t476)**2 + qw5*(t126 + t480)**2 + qw6*(t127 + t484)**2
+    t486 = xp.greater(xp.where(vb10 & lb10, xp.asarray(1, dtype=dtype), 0), 0)
+    t487 = xp.where(t486 & (xp.less(t452, 1) | xp.less(t485, t460)), xp.asarray(1, dtype=dtype), 0)
+    t488 = xp.where(t486, 1, t452)
+    t489 = xp.greater(t487, 0)
+    t490 = xp.where(t489, t464, t454)
+    t491 = xp.where(t489, t468, t455)
+    t492 = xp.where(t489, t472, t456)
+    t493 = xp.where(t489, t476, t457)
+    t494 = xp.where(t489, t480, t458)
+    t495 = xp.where(t489, t484, t459)
+    t496 = xp.where(t489, t485, t460)
+    t497 = xp.where(xp.less(t67, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t498 = t497 + t67
+    t499 = -t497 + t67
+    t500 = xp.where(xp.greater_equal(t67, -6.283185307179586) & xp.less_equal(t67, 6.283185307179586), t67, xp.where(xp.greater_equal(t498, -6.283185307179586) & xp.less_equal(t498, 6.283185307179586), t498, xp.where(xp.greater_equal(t499, -6.283185307179586) & xp.less_equal(t499, 6.283185307179586), t499, qb11_0)))
+    t501 = xp.where(xp.less(t68, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t502 = t501 + t68
+    t503 = -t501 + t68
+    t504 = xp.where(xp.greater_equal(t68, -6.283185307179586) & xp.less_equal(t68, 6.283185307179586), t68, xp.where(xp.greater_equal(t502, -6.283185307179586) & xp.less_equal(t502, 6.283185307179586), t502, xp.where(xp.greater_equal(t503, -6.283185307179586) & xp.less_equal(t503, 6.283185307179586), t503, qb11_1)))
+    t505 = xp.where(xp.less(t69, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t506 = t505 + t69
+    t507 = -t505 + t69
+    t508 = xp.where(xp.greater_equal(t69, -6.283185307179586) & xp.less_equal(t69, 6.283185307179586), t69, xp.where(xp.greater_equal(t506, -6.283185307179586) & xp.less_equal(t506, 6.283185307179586), t506, xp.where(xp.greater_equal(t507, -6.283185307179586) & xp.less_equal(t507, 6.283185307179586), t507, qb11_2)))
+    t509 = xp.where(xp.less(t70, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t510 = t509 + t70
+    t511 = -t509 + t70
+    t512 = xp.where(xp.greater_equal(t70, -6.283185307179586) & xp.less_equal(t70, 6.283185307179586), t70, xp.where(xp.greater_equal(t510, -6.283185307179586) & xp.less_equal(t510, 6.283185307179586), t510, xp.where(xp.greater_equal(t511, -6.283185307179586) & xp.less_equal(t511, 6.283185307179586), t511, qb11_3)))
+    t513 = xp.where(xp.less(t71, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t514 = t513 + t71
+    t515 = -t513 + t71
+    t516 = xp.where(xp.greater_equal(t71, -6.283185307179586) & xp.less_equal(t71, 6.283185307179586), t71, xp.where(xp.greater_equal(t514, -6.283185307179586) & xp.less_equal(t514, 6.283185307179586), t514, xp.where(xp.greater_equal(t515, -6.283185307179586) & xp.less_equal(t515, 6.283185307179586), t515, qb11_4)))
+    t517 = xp.where(xp.less(t72, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t518 = t517 + t72
+    t519 = -t517 + t72
+    t520 = xp.where(xp.greater_equal(t72, -6.283185307179586) & xp.less_equal(t72, 6.283185307179586), t72, xp.where(xp.greater_equal(t518, -6.283185307179586) & xp.less_equal(t518, 6.283185307179586), t518, xp.where(xp.greater_equal(t519, -6.283185307179586) & xp.less_equal(t519, 6.283185307179586), t519, qb11_5)))
+    t521 = qw1*(t122 + t500)**2 + qw2*(t123 + t504)**2 + qw3*(t124 + t508)**2 + qw4*(t125 + t512)**2 + qw5*(t126 + t516)**2 + qw6*(t127 + t520)**2
+    t522 = xp.greater(xp.where(vb11 & lb11, xp.asarray(1, dtype=dtype), 0), 0)
+    t523 = xp.where(t522 & (xp.less(t488, 1) | xp.less(t521, t496)), xp.asarray(1, dtype=dtype), 0)
+    t524 = xp.where(t522, 1, t488)
+    t525 = xp.greater(t523, 0)
+    t526 = xp.where(t525, t500, t490)
+    t527 = xp.where(t525, t504, t491)
+    t528 = xp.where(t525, t508, t492)
+    t529 = xp.where(t525, t512, t493)
+    t530 = xp.where(t525, t516, t494)
+    t531 = xp.where(t525, t520, t495)
+    t532 = xp.where(t525, t521, t496)
+    t533 = xp.where(xp.less(t73, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t534 = t533 + t73
+    t535 = -t533 + t73
+    t536 = xp.where(xp.greater_equal(t73, -6.283185307179586) & xp.less_equal(t73, 6.283185307179586), t73, xp.where(xp.greater_equal(t534, -6.283185307179586) & xp.less_equal(t534, 6.283185307179586), t534, xp.where(xp.greater_equal(t535, -6.283185307179586) & xp.less_equal(t535, 6.283185307179586), t535, qb12_0)))
+    t537 = xp.where(xp.less(t74, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t538 = t537 + t74
+    t539 = -t537 + t74
+    t540 = xp.where(xp.greater_equal(t74, -6.283185307179586) & xp.less_equal(t74, 6.283185307179586), t74, xp.where(xp.greater_equal(t538, -6.283185307179586) & xp.less_equal(t538, 6.283185307179586), t538, xp.where(xp.greater_equal(t539, -6.283185307179586) & xp.less_equal(t539, 6.283185307179586), t539, qb12_1)))
+    t541 = xp.where(xp.less(t75, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t542 = t541 + t75
+    t543 = -t541 + t75
+    t544 = xp.where(xp.greater_equal(t75, -6.283185307179586) & xp.less_equal(t75, 6.283185307179586), t75, xp.where(xp.greater_equal(t542, -6.283185307179586) & xp.less_equal(t542, 6.283185307179586), t542, xp.where(xp.greater_equal(t543, -6.283185307179586) & xp.less_equal(t543, 6.283185307179586), t543, qb12_2)))
+    t545 = xp.where(xp.less(t76, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t546 = t545 + t76
+    t547 = -t545 + t76
+    t548 = xp.where(xp.greater_equal(t76, -6.283185307179586) & xp.less_equal(t76, 6.283185307179586), t76, xp.where(xp.greater_equal(t546, -6.283185307179586) & xp.less_equal(t546, 6.283185307179586), t546, xp.where(xp.greater_equal(t547, -6.283185307179586) & xp.less_equal(t547, 6.283185307179586), t547, qb12_3)))
+    t549 = xp.where(xp.less(t77, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t550 = t549 + t77
+    t551 = -t549 + t77
+    t552 = xp.where(xp.greater_equal(t77, -6.283185307179586) & xp.less_equal(t77, 6.283185307179586), t77, xp.where(xp.greater_equal(t550, -6.283185307179586) & xp.less_equal(t550, 6.283185307179586), t550, xp.where(xp.greater_equal(t551, -6.283185307179586) & xp.less_equal(t551, 6.283185307179586), t551, qb12_4)))
+    t553 = xp.where(xp.less(t78, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t554 = t553 + t78
+    t555 = -t553 + t78
+    t556 = xp.where(xp.greater_equal(t78, -6.283185307179586) & xp.less_equal(t78, 6.283185307179586), t78, xp.where(xp.greater_equal(t554, -6.283185307179586) & xp.less_equal(t554, 6.283185307179586), t554, xp.where(xp.greater_equal(t555, -6.283185307179586) & xp.less_equal(t555, 6.283185307179586), t555, qb12_5)))
+    t557 = qw1*(t122 + t536)**2 + qw2*(t123 + t540)**2 + qw3*(t124 + t544)**2 + qw4*(t125 + t548)**2 + qw5*(t126 + t552)**2 + qw6*(t127 + t556)**2
+    t558 = xp.greater(xp.where(vb12 & lb12, xp.asarray(1, dtype=dtype), 0), 0)
+    t559 = xp.where(t558 & (xp.less(t524, 1) | xp.less(t557, t532)), xp.asarray(1, dtype=dtype), 0)
+    t560 = xp.where(t558, 1, t524)
+    t561 = xp.greater(t559, 0)
+    t562 = xp.where(t561, t536, t526)
+    t563 = xp.where(t561, t540, t527)
+    t564 = xp.where(t561, t544, t528)
+    t565 = xp.where(t561, t548, t529)
+    t566 = xp.where(t561, t552, t530)
+    t567 = xp.where(t561, t556, t531)
+    t568 = xp.where(t561, t557, t532)
+    t569 = xp.where(xp.less(t79, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t570 = t569 + t79
+    t571 = -t569 + t79
+    t572 = xp.where(xp.greater_equal(t79, -6.283185307179586) & xp.less_equal(t79, 6.283185307179586), t79, xp.where(xp.greater_equal(t570, -6.283185307179586) & xp.less_equal(t570, 6.283185307179586), t570, xp.where(xp.greater_equal(t571, -6.283185307179586) & xp.less_equal(t571, 6.283185307179586), t571, qb13_0)))
+    t573 = xp.where(xp.less(t80, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t574 = t573 + t80
+    t575 = -t573 + t80
+    t576 = xp.where(xp.greater_equal(t80, -6.283185307179586) & xp.less_equal(t80, 6.283185307179586), t80, xp.where(xp.greater_equal(t574, -6.283185307179586) & xp.less_equal(t574, 6.283185307179586), t574, xp.where(xp.greater_equal(t575, -6.283185307179586) & xp.less_equal(t575, 6.283185307179586), t575, qb13_1)))
+    t577 = xp.where(xp.less(t81, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t578 = t577 + t81
+    t579 = -t577 + t81
+    t580 = xp.where(xp.greater_equal(t81, -6.283185307179586) & xp.less_equal(t81, 6.283185307179586), t81, xp.where(xp.greater_equal(t578, -6.283185307179586) & xp.less_equal(t578, 6.283185307179586), t578, xp.where(xp.greater_equal(t579, -6.283185307179586) & xp.less_equal(t579, 6.283185307179586), t579, qb13_2)))
+    t581 = xp.where(xp.less(t82, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t582 = t581 + t82
+    t583 = -t581 + t82
+    t584 = xp.where(xp.greater_equal(t82, -6.283185307179586) & xp.less_equal(t82, 6.283185307179586), t82, xp.where(xp.greater_equal(t582, -6.283185307179586) & xp.less_equal(t582, 6.283185307179586), t582, xp.where(xp.greater_equal(t583, -6.283185307179586) & xp.less_equal(t583, 6.283185307179586), t583, qb13_3)))
+    t585 = xp.where(xp.less(t83, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t586 = t585 + t83
+    t587 = -t585 + t83
+    t588 = xp.where(xp.greater_equal(t83, -6.283185307179586) & xp.less_equal(t83, 6.283185307179586), t83, xp.where(xp.greater_equal(t586, -6.283185307179586) & xp.less_equal(t586, 6.283185307179586), t586, xp.where(xp.greater_equal(t587, -6.283185307179586) & xp.less_equal(t587, 6.283185307179586), t587, qb13_4)))
+    t589 = xp.where(xp.less(t84, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t590 = t589 + t84
+    t591 = -t589 + t84
+    t592 = xp.where(xp.greater_equal(t84, -6.283185307179586) & xp.less_equal(t84, 6.283185307179586), t84, xp.where(xp.greater_equal(t590, -6.283185307179586) & xp.less_equal(t590, 6.283185307179586), t590, xp.where(xp.greater_equal(t591, -6.283185307179586) & xp.less_equal(t591, 6.283185307179586), t591, qb13_5)))
+    t593 = qw1*(t122 + t572)**2 + qw2*(t123 + t576)**2 + qw3*(t124 + t580)**2 + qw4*(t125 + t584)**2 + qw5*(t126 + t588)**2 + qw6*(t127 + t592)**2
+    t594 = xp.greater(xp.where(vb13 & lb13, xp.asarray(1, dtype=dtype), 0), 0)
+    t595 = xp.where(t594 & (xp.less(t560, 1) | xp.less(t593, t568)), xp.asarray(1, dtype=dtype), 0)
+    t596 = xp.where(t594, 1, t560)
+    t597 = xp.greater(t595, 0)
+    t598 = xp.where(t597, t572, t562)
+    t599 = xp.where(t597, t576, t563)
+    t600 = xp.where(t597, t580, t564)
+    t601 = xp.where(t597, t584, t565)
+    t602 = xp.where(t597, t588, t566)
+    t603 = xp.where(t597, t592, t567)
+    t604 = xp.where(t597, t593, t568)
+    t605 = xp.where(xp.less(t85, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t606 = t605 + t85
+    t607 = -t605 + t85
+    t608 = xp.where(xp.greater_equal(t85, -6.283185307179586) & xp.less_equal(t85, 6.283185307179586), t85, xp.where(xp.greater_equal(t606, -6.283185307179586) & xp.less_equal(t606, 6.283185307179586), t606, xp.where(xp.greater_equal(t607, -6.283185307179586) & xp.less_equal(t607, 6.283185307179586), t607, qb14_0)))
+    t609 = xp.where(xp.less(t86, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t610 = t609 + t86
+    t611 = -t609 + t86
+    t612 = xp.where(xp.greater_equal(t86, -6.283185307179586) & xp.less_equal(t86, 6.283185307179586), t86, xp.where(xp.greater_equal(t610, -6.283185307179586) & xp.less_equal(t610, 6.283185307179586), t610, xp.where(xp.greater_equal(t611, -6.283185307179586) & xp.less_equal(t611, 6.283185307179586), t611, qb14_1)))
+    t613 = xp.where(xp.less(t87, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t614 = t613 + t87
+    t615 = -t613 + t87
+    t616 = xp.where(xp.greater_equal(t87, -6.283185307179586) & xp.less_equal(t87, 6.283185307179586), t87, xp.where(xp.greater_equal(t614, -6.283185307179586) & xp.less_equal(t614, 6.283185307179586), t614, xp.where(xp.greater_equal(t615, -6.283185307179586) & xp.less_equal(t615, 6.283185307179586), t615, qb14_2)))
+    t617 = xp.where(xp.less(t88, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t618 = t617 + t88
+    t619 = -t617 + t88
+    t620 = xp.where(xp.greater_equal(t88, -6.283185307179586) & xp.less_equal(t88, 6.283185307179586), t88, xp.where(xp.greater_equal(t618, -6.283185307179586) & xp.less_equal(t618, 6.283185307179586), t618, xp.where(xp.greater_equal(t619, -6.283185307179586) & xp.less_equal(t619, 6.283185307179586), t619, qb14_3)))
+    t621 = xp.where(xp.less(t89, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t622 = t621 + t89
+    t623 = -t621 + t89
+    t624 = xp.where(xp.greater_equal(t89, -6.283185307179586) & xp.less_equal(t89, 6.283185307179586), t89, xp.where(xp.greater_equal(t622, -6.283185307179586) & xp.less_equal(t622, 6.283185307179586), t622, xp.where(xp.greater_equal(t623, -6.283185307179586) & xp.less_equal(t623, 6.283185307179586), t623, qb14_4)))
+    t625 = xp.where(xp.less(t90, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t626 = t625 + t90
+    t627 = -t625 + t90
+    t628 = xp.where(xp.greater_equal(t90, -6.283185307179586) & xp.less_equal(t90, 6.283185307179586), t90, xp.where(xp.greater_equal(t626, -6.283185307179586) & xp.less_equal(t626, 6.283185307179586), t626, xp.where(xp.greater_equal(t627, -6.283185307179586) & xp.less_equal(t627, 6.283185307179586), t627, qb14_5)))
+    t629 = qw1*(t122 + t608)**2 + qw2*(t123 + t612)**2 + qw3*(t124 + t616)**2 + qw4*(t125 + t620)**2 + qw5*(t126 + t624)**2 + qw6*(t127 + t628)**2
+    t630 = xp.greater(xp.where(vb14 & lb14, xp.asarray(1, dtype=dtype), 0), 0)
+    t631 = xp.where(t630 & (xp.less(t596, 1) | xp.less(t629, t604)), xp.asarray(1, dtype=dtype), 0)
+    t632 = xp.where(t630, 1, t596)
+    t633 = xp.greater(t631, 0)
+    t634 = xp.where(t633, t608, t598)
+    t635 = xp.where(t633, t612, t599)
+    t636 = xp.where(t633, t616, t600)
+    t637 = xp.where(t633, t620, t601)
+    t638 = xp.where(t633, t624, t602)
+    t639 = xp.where(t633, t628, t603)
+    t640 = xp.where(t633, t629, t604)
+    t641 = xp.where(xp.less(t91, qn1), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t642 = t641 + t91
+    t643 = -t641 + t91
+    t644 = xp.where(xp.greater_equal(t91, -6.283185307179586) & xp.less_equal(t91, 6.283185307179586), t91, xp.where(xp.greater_equal(t642, -6.283185307179586) & xp.less_equal(t642, 6.283185307179586), t642, xp.where(xp.greater_equal(t643, -6.283185307179586) & xp.less_equal(t643, 6.283185307179586), t643, qb15_0)))
+    t645 = xp.where(xp.less(t92, qn2), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t646 = t645 + t92
+    t647 = -t645 + t92
+    t648 = xp.where(xp.greater_equal(t92, -6.283185307179586) & xp.less_equal(t92, 6.283185307179586), t92, xp.where(xp.greater_equal(t646, -6.283185307179586) & xp.less_equal(t646, 6.283185307179586), t646, xp.where(xp.greater_equal(t647, -6.283185307179586) & xp.less_equal(t647, 6.283185307179586), t647, qb15_1)))
+    t649 = xp.where(xp.less(t93, qn3), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t650 = t649 + t93
+    t651 = -t649 + t93
+    t652 = xp.where(xp.greater_equal(t93, -6.283185307179586) & xp.less_equal(t93, 6.283185307179586), t93, xp.where(xp.greater_equal(t650, -6.283185307179586) & xp.less_equal(t650, 6.283185307179586), t650, xp.where(xp.greater_equal(t651, -6.283185307179586) & xp.less_equal(t651, 6.283185307179586), t651, qb15_2)))
+    t653 = xp.where(xp.less(t94, qn4), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t654 = t653 + t94
+    t655 = -t653 + t94
+    t656 = xp.where(xp.greater_equal(t94, -6.283185307179586) & xp.less_equal(t94, 6.283185307179586), t94, xp.where(xp.greater_equal(t654, -6.283185307179586) & xp.less_equal(t654, 6.283185307179586), t654, xp.where(xp.greater_equal(t655, -6.283185307179586) & xp.less_equal(t655, 6.283185307179586), t655, qb15_3)))
+    t657 = xp.where(xp.less(t95, qn5), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t658 = t657 + t95
+    t659 = -t657 + t95
+    t660 = xp.where(xp.greater_equal(t95, -6.283185307179586) & xp.less_equal(t95, 6.283185307179586), t95, xp.where(xp.greater_equal(t658, -6.283185307179586) & xp.less_equal(t658, 6.283185307179586), t658, xp.where(xp.greater_equal(t659, -6.283185307179586) & xp.less_equal(t659, 6.283185307179586), t659, qb15_4)))
+    t661 = xp.where(xp.less(t96, qn6), xp.asarray(6.283185307179586, dtype=dtype), -6.283185307179586)
+    t662 = t661 + t96
+    t663 = -t661 + t96
+    t664 = xp.where(xp.greater_equal(t96, -6.283185307179586) & xp.less_equal(t96, 6.283185307179586), t96, xp.where(xp.greater_equal(t662, -6.283185307179586) & xp.less_equal(t662, 6.283185307179586), t662, xp.where(xp.greater_equal(t663, -6.283185307179586) & xp.less_equal(t663, 6.283185307179586), t663, qb15_5)))
+    t665 = qw1*(t122 + t644)**2 + qw2*(t123 + t648)**2 + qw3*(t124 + t652)**2 + qw4*(t125 + t656)**2 + qw5*(t126 + t660)**2 + qw6*(t127 + t664)**2
+    t666 = xp.greater(xp.where(vb15 & lb15, xp.asarray(1, dtype=dtype), 0), 0)
+    t667 = xp.where(t666 & (xp.less(t632, 1) | xp.less(t665, t640)), xp.asarray(1, dtype=dtype), 0)
+    t668 = xp.where(t666, 1, t632)
+    t669 = xp.greater(t667, 0)
+    t670 = xp.where(t669, t644, t634)
+    t671 = xp.where(t669, t648, t635)
+    t672 = xp.where(t669, t652, t636)
+    t673 = xp.where(t669, t656, t637)
+    t674 = xp.where(t669, t660, t638)
+    t675 = xp.where(t669, t664, t639)
+    t676 = xp.greater(t668, 0)
+    t677 = xp.isfinite(t97)
+    t678 = t676 & t677
     q = _stack(xp, [
-        xp.broadcast_to(xp.where(t19, t16[0], qn1), batch),  # 0
-        xp.broadcast_to(xp.where(t19, t16[1], qn2), batch),  # 1
-        xp.broadcast_to(xp.where(t19, t16[2], qn3), batch),  # 2
-        xp.broadcast_to(xp.where(t19, t16[3], qn4), batch),  # 3
-        xp.broadcast_to(xp.where(t19, t16[4], qn5), batch),  # 4
-        xp.broadcast_to(xp.where(t19, t16[5], qn6), batch),  # 5
+        xp.broadcast_to(xp.where(t678, t670, qn1), batch),  # 0
+        xp.broadcast_to(xp.where(t678, t671, qn2), batch),  # 1
+        xp.broadcast_to(xp.where(t678, t672, qn3), batch),  # 2
+        xp.broadcast_to(xp.where(t678, t673, qn4), batch),  # 3
+        xp.broadcast_to(xp.where(t678, t674, qn5), batch),  # 4
+        xp.broadcast_to(xp.where(t678, t675, qn6), batch),  # 5
     ], (6,))
-    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t18), 2, xp.where(t17, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
+    status = xp.astype(xp.broadcast_to(xp.where(xp.logical_not(t677), 2, xp.where(t676, xp.asarray(0, dtype=dtype), 1)), batch), xp.int32)
     return q, status
 
 

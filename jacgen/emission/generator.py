@@ -169,19 +169,6 @@ class Generator:
                                        arguments=(target, *free_input), bindings=bindings, part_of="ik_branches"))
         return parts
 
-    def velocity_ik_function(self, js: sympy.Matrix) -> Function:
-        """velocity_ik: q_dot solving Js q_dot = mu_dot, and the status (`differential`)."""
-        m, n = js.shape
-        mu_dot = Argument("mu_dot", sympy.Matrix([generated_symbol("mu_dot", i) for i in range(m)]))
-        damping = self.damping_argument()
-        q_dot, outcome = differential.velocity_ik(js, list(self.q), list(mu_dot.symbols), damping.symbols[0],
-                                                  self.graph, self.name_node, self.lowering.called)
-        form = "Js^-1 mu_dot (damping 0) or " if m == n else ""
-        form += ("Js^T (Js Js^T + damping^2 I)^-1 mu_dot" if m <= n else "(Js^T Js + damping^2 I)^-1 Js^T mu_dot")
-        return self.function("velocity_ik", f"joint rates q_dot solving Js q_dot = mu_dot: {form}; and the status",
-                             vector("q_dot", q_dot), status("status", outcome),
-                             arguments=(Argument("q", sympy.Matrix(self.q)), mu_dot, damping))
-
     def ik_numeric_step_function(self, task_jacobian: sympy.Matrix) -> Function:
         """ik_numeric_step: one damped least-squares step of ik_numeric from q (`differential`)."""
         robot, n = self.robot, self.robot.dof
@@ -429,7 +416,6 @@ class Generator:
             *self.second_order_functions(),
             *self.singularity_functions(js),
             *jacobian_uses.functions(self, js, task_jacobian),
-            self.velocity_ik_function(js) if self.generates("velocity_ik") else None,
             self.ik_numeric_step_function(task_jacobian) if self.generates("ik_numeric_step") else None,
             *self.ik_functions(),
         )

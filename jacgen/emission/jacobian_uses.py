@@ -1,6 +1,6 @@
 """What the Jacobian is for, as generated functions: the pose and velocity of every link, the
 velocity ellipsoids, the condition number, the manipulability gradient, null-space motion and
-resolved-rate control. Each is built from the Generator's chain and lowered by its `function`;
+resolved-rate control; and velocity_ik, whose solve the last two call. Each is built from the Generator's chain and lowered by its `function`;
 the algorithms are in `solvers/singular_values.py` and `solvers/differential.py`. `generator`
 is the `Generator` that calls them.
 """
@@ -16,10 +16,11 @@ from jacgen.model import kinematics
 from jacgen.model.graph import elementwise
 from jacgen.model.js_rank import singularity_rows
 from jacgen.model.kinematics import generated_symbol
-from jacgen.model.node import NUMBER
+from jacgen.model.node import NUMBER, Kernel, Node
 from jacgen.model.tolerance_symbols import EPS
 from jacgen.solvers import differential, singular_values
 
+# The uses of the Jacobian, as the report lists them (velocity_ik is among the inverses there).
 NAMES = ("link_poses", "link_velocities", "manipulability_gradient", "velocity_ellipsoid", "condition_number",
          "velocity_ik_nullspace", "resolved_rate")
 
@@ -104,7 +105,7 @@ def feedback_error(generator, target: Argument, task_jacobian: sympy.Matrix) -> 
 
 def functions(generator, js: sympy.Matrix, task_jacobian: sympy.Matrix) -> list[Function]:
     """Those of NAMES the generator generates, in the catalogue's order (sorted by the caller)."""
-    robot, g, name, n, m = generator.robot, generator.graph, generator.name_node, generator.robot.dof, js.rows
+    g, name, n = generator.graph, generator.name_node, generator.robot.dof
     q = Argument("q", sympy.Matrix(generator.q))
     q_dot = Argument("q_dot", sympy.Matrix([generated_symbol("qd", i + 1) for i in range(n)]))
     made = []
@@ -160,19 +161,61 @@ def condition_number_function(generator, js: sympy.Matrix) -> Function | None:
                               "rounding)", scalar("kappa", positive / smallest))
 
 
+def velocity_solve(generator, js: sympy.Matrix) -> Kernel:
+    """The solve of velocity_ik and its relatives (`differential.velocity_ik`): one kernel,
+    (joint values, mu_dot, damping[, z]) to (q_dot, status), that velocity_ik,
+    velocity_ik_nullspace and resolved_rate call (`_velocity_run`); z only where Js has a null
+    space (m < n). Its joint values (`_joint_values`) are what Js reads, which the callers
+    compute (resolved_rate's task error reads them too): a q that is not finite has a cos and
+    sin that are not."""
+    m, n = js.shape
+    mu_dot = [generated_symbol("mu_dot", i) for i in range(m)]
+    damping = generator.damping_argument().symbols[0]
+    z = [generated_symbol("qz", i + 1) for i in range(n)] if m < n else []
+
+    def solved() -> list:
+        q_dot, outcome = differential.velocity_ik(js, _joint_values(generator), mu_dot, damping, generator.graph,
+                                                  generator.name_node, generator.lowering.called, z or None)
+        return [*q_dot, outcome]
+
+    return generator.lowering.kernel("velocity_solve", "the joint rates q_dot solving Js q_dot = mu_dot (plus z's "
+                                     "motion in the null space of Js, if it has one), and velocity_ik's status",
+                                     [*_joint_values(generator), *mu_dot, damping, *z], solved)
+
+
+def _joint_values(generator) -> list[sympy.Symbol]:
+    """What the kinematics read: of q, each revolute joint's cos and sin and each prismatic q;
+    and the robot's symbolic parameters."""
+    return [symbol for i, joint in enumerate(generator.robot.joints)
+            for symbol in (generator.cos_sin((i,)) if joint.revolute else (generator.q[i],))] + \
+        [parameter.symbol for parameter in generator.robot.symbolic_parameters]
+
+
 def _rate_functions(generator, js: sympy.Matrix, task_jacobian: sympy.Matrix,
                     q: Argument) -> list[Function]:
-    """velocity_ik_nullspace and resolved_rate: velocity_ik's solve with null-space motion z."""
+    """velocity_ik, velocity_ik_nullspace and resolved_rate: each a run of velocity_solve."""
     g, name, n, m = generator.graph, generator.name_node, generator.robot.dof, js.rows
     z = Argument("z", sympy.Matrix([generated_symbol("qz", i + 1) for i in range(n)]))
     damping = generator.damping_argument()
-    solve = "Js# mu_dot + (I - Js# Js) z" + (" (Js has no null space: z is not used)" if m >= n else "")
+    form = "Js# mu_dot + (I - Js# Js) z" + (" (Js has no null space: z is not used)" if m >= n else "")
+
+    def solve(mu_dot: list, z: list) -> tuple[list, Node]:
+        solved = generator.lowering.run(velocity_solve(generator, js), 1,
+                                        [*_joint_values(generator), *mu_dot, *damping.symbols, *z[:n * (m < n)]])
+        return solved[:n], solved[n]
+
     made = []
+    mu_dot = Argument("mu_dot", sympy.Matrix([generated_symbol("mu_dot", i) for i in range(m)]))
+    if generator.generates("velocity_ik"):
+        q_dot, outcome = solve(list(mu_dot.symbols), [0] * n)
+        solution = "Js^-1 mu_dot (damping 0) or " if m == n else ""
+        solution += ("Js^T (Js Js^T + damping^2 I)^-1 mu_dot" if m <= n else "(Js^T Js + damping^2 I)^-1 Js^T mu_dot")
+        made.append(generator.function("velocity_ik", f"joint rates q_dot solving Js q_dot = mu_dot: {solution}; and "
+                                       "the status", vector("q_dot", q_dot), status("status", outcome),
+                                       arguments=(q, mu_dot, damping)))
     if generator.generates("velocity_ik_nullspace"):
-        mu_dot = Argument("mu_dot", sympy.Matrix([generated_symbol("mu_dot", i) for i in range(m)]))
-        q_dot, outcome = differential.velocity_ik(js, list(generator.q), list(mu_dot.symbols), damping.symbols[0],
-                                                  g, name, generator.lowering.called, list(z.symbols))
-        made.append(generator.function("velocity_ik_nullspace", f"velocity_ik plus null-space motion: {solve}, Js# "
+        q_dot, outcome = solve(list(mu_dot.symbols), list(z.symbols))
+        made.append(generator.function("velocity_ik_nullspace", f"velocity_ik plus null-space motion: {form}, Js# "
                                        "velocity_ik's (damped) inverse; and the status (VELOCITY_IK_*)",
                                        vector("q_dot", q_dot), status("status", outcome),
                                        arguments=(q, mu_dot, z, damping)))
@@ -183,10 +226,9 @@ def _rate_functions(generator, js: sympy.Matrix, task_jacobian: sympy.Matrix,
         with distribute(False):
             error = feedback_error(generator, target, task_jacobian)
         command = [name(g.value(r) + g.value(k) * g.value(e)) for r, k, e in zip(rate.symbols, gain.symbols, error)]
-        q_dot, outcome = differential.velocity_ik(js, list(generator.q), command, damping.symbols[0], g, name,
-                                                  generator.lowering.called, list(z.symbols))
+        q_dot, outcome = solve(command, list(z.symbols))
         made.append(generator.function("resolved_rate", "resolved-rate control: q_dot = Js# (target_rate + gain e) "
-                                       f"+ (I - Js# Js) z, e ik_numeric's task error at q; and the status "
+                                       "+ (I - Js# Js) z, e ik_numeric's task error at q; and the status "
                                        "(VELOCITY_IK_*)", vector("q_dot", q_dot), status("status", outcome),
                                        arguments=(q, target, rate, gain, z, damping)))
     return made

@@ -130,36 +130,50 @@ class Lowering:
         return self._run(name, summary, 1, step, [self.graph.value(value) for value in arguments])
 
     def _run(self, name: str, summary: str, count: int, step: Callable, state: list[Node]) -> list[Node]:
-        graph = self.graph
         kernel = self._kernels.get(name)
         if kernel is None:
-            symbols = tuple(sympy.Symbol(f"{names.INTERNAL_PREFIX}w{k}", real=True) for k in range(len(state)))
-            body = self.lower(step([graph.symbol(symbol) for symbol in symbols]))
-            outer = body.read - set(symbols) - TOLERANCE_SYMBOLS
+            symbols = [sympy.Symbol(f"{names.INTERNAL_PREFIX}w{k}", real=True) for k in range(len(state))]
+            kernel = self.kernel(name, summary, symbols, lambda: step([self.graph.symbol(symbol) for symbol in symbols]))
+        return self.run(kernel, count, state)
+
+    def kernel(self, name: str, summary: str, inputs: list[sympy.Symbol], outputs: Callable[[], list]) -> Kernel:
+        """The kernel `name`: the values `outputs()` builds, a function of the symbols `inputs`
+        (and of the tolerances), built and lowered on first use; its inputs are printed w0, w1, ..."""
+        if name not in self._kernels:
+            body = self.lower(outputs(), inputs=frozenset(inputs))
+            outer = body.read - set(inputs) - TOLERANCE_SYMBOLS
             if outer:
                 raise ValueError(f"kernel {name}'s step reads {sorted(map(str, outer))} besides its state")
-            body = replace(body, names=body.names | {symbol: f"w{k}" for k, symbol in enumerate(symbols)})
-            kernel = self._kernels[name] = Kernel(name, summary, symbols, body)
-        if len(kernel.state) != len(state) or (count > 1 and len(kernel.body.outputs) != len(state)):
-            raise ValueError(f"kernel {name} maps {len(kernel.state)} values to {len(kernel.body.outputs)}, "
-                             f"given {len(state)} to run {count} times")
-        run = graph.node(REPEAT, tuple(state), (kernel, count))
-        return [graph.node(PART, (run,), k) for k in range(len(kernel.body.outputs))]
+            body = replace(body, names=body.names | {symbol: f"w{k}" for k, symbol in enumerate(inputs)})
+            self._kernels[name] = Kernel(name, summary, tuple(inputs), body)
+        return self._kernels[name]
 
-    def lower(self, outputs: list[sympy.Basic], bindings: dict | None = None) -> Body:
-        """`_lower`, once per outputs and bindings (jacobian_det's determinant is lowered to
-        compare its two forms, then again as a function)."""
-        key = (tuple(outputs), tuple((bindings or {}).items()))
+    def run(self, kernel: Kernel, count: int, state: list) -> list[Node]:
+        """The outputs of `count` runs of `kernel` from `state` (nodes or numbers): a REPEAT,
+        read by PART nodes."""
+        state = [self.graph.value(value) for value in state]
+        if len(kernel.state) != len(state) or (count > 1 and len(kernel.body.outputs) != len(state)):
+            raise ValueError(f"kernel {kernel.name} maps {len(kernel.state)} values to {len(kernel.body.outputs)}, "
+                             f"given {len(state)} to run {count} times")
+        repeat = self.graph.node(REPEAT, tuple(state), (kernel, count))
+        return [self.graph.node(PART, (repeat,), k) for k in range(len(kernel.body.outputs))]
+
+    def lower(self, outputs: list[sympy.Basic], bindings: dict | None = None, inputs: frozenset = frozenset()
+              ) -> Body:
+        """`_lower`, once per outputs, bindings and inputs (jacobian_det's determinant is lowered
+        to compare its two forms, then again as a function)."""
+        key = (tuple(outputs), tuple((bindings or {}).items()), inputs)
         if key not in self._lowered:
-            self._lowered[key] = self._lower(outputs, bindings or {})
+            self._lowered[key] = self._lower(outputs, bindings or {}, inputs)
         return self._lowered[key]
 
-    def _lower(self, outputs: list[sympy.Basic], bindings: dict) -> Body:
+    def _lower(self, outputs: list[sympy.Basic], bindings: dict, inputs: frozenset) -> Body:
         """The outputs as straight-line code: the trig symbols and named values they need,
         then temporaries (t0, t1, ...) after common-subexpression elimination, in an order
-        that defines before use."""
+        that defines before use. Defined symbols among `inputs` (a kernel's: a joint's cos) are
+        read as they are."""
         graph = self.graph
-        values = dict(self.definitions)
+        values = {symbol: value for symbol, value in self.definitions if symbol not in inputs}
         values.update((symbol, graph.convert(value)) for symbol, value in bindings.items())
         outputs = [graph.value(e) for e in outputs]
         needed, frontier = set(), set().union(*(e.free_symbols for e in outputs))

@@ -15,6 +15,10 @@ IK_NEAREST_OK, IK_NEAREST_NO_SOLUTION, IK_NEAREST_NOT_FINITE = 0, 1, 2
 IK_NEAREST_STATUSES = (("OK", IK_NEAREST_OK), ("NO_SOLUTION", IK_NEAREST_NO_SOLUTION),
                        ("NOT_FINITE", IK_NEAREST_NOT_FINITE))  # as each backend names them, IK_NEAREST_OK ...
 TURN = 2 * sympy.pi
+# ik_nearest calls its step (a kernel) for each row of a table this long at most; each call keeps
+# its state on the C stack, and the general solver's 16 rows would pass the 4 KB a function may
+# take (tests/test_shipped_robots.py): there the step is written out for each row.
+CALLED_ROWS = 8
 
 
 def _inside(value: Node, limits: tuple[float, float]) -> Node:
@@ -82,7 +86,8 @@ def nearest(robot, sp: Subproblems, q, valid: list, inside: list, seed, weights,
 
     The running minimum over the rows is one body, the kernel nearer_branch (`call`:
     `Lowering.called`), called for each row: (row, allowed, seed, weights, best, distance,
-    found) to the next (best, distance, found). Truth values are carried as 0/1 numbers."""
+    found) to the next (best, distance, found); written out for each row of a table longer
+    than CALLED_ROWS. Truth values are carried as 0/1 numbers."""
     g = sp.graph
     zero, one = g.number(0), g.number(1)
     n = robot.dof
@@ -101,6 +106,9 @@ def nearest(robot, sp: Subproblems, q, valid: list, inside: list, seed, weights,
         return [*(sp.name(g.select(take, x, b)) for x, b in zip(candidate, best)),
                 sp.name(g.select(take, cost, distance)), sp.name(g.select(g.relation(">", allowed, zero), one, found))]
 
+    if len(q) > CALLED_ROWS:
+        def call(name, summary, step, values):  # the step written out in place
+            return step(values)
     best, distance, found = list(seed), zero, zero
     for row, row_valid, row_inside in zip(q, valid, inside):
         allowed = g.select(g.logic(AND, row_valid, row_inside), one, zero)

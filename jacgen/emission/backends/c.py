@@ -12,7 +12,7 @@ from jacgen.emission.generator import Generator
 from jacgen.emission.printers import AND, ATOM, MATH_FUNCTIONS, PRODUCT, RELATION, Printer
 from jacgen.inputs import names
 from jacgen.inputs.robot import Robot
-from jacgen.model.node import REPEAT, Node
+from jacgen.model.node import PART, REPEAT
 from jacgen.model.tolerance_symbols import TOLERANCES
 
 _FLOAT_MAX = float(numpy.finfo(numpy.float32).max)
@@ -91,12 +91,18 @@ def kernel_type(kernel: str) -> str:
     return f"{kernel_function(kernel)}_state"
 
 
-def kernel_run(run: Node, symbol: str) -> str | None:
-    """The statement that runs a kernel on the state `symbol` (None for any other value)."""
-    if run.kind != REPEAT:
-        return None
-    kernel, count = run.value
-    return f"{kernel_function(kernel.name)}({count}, &{symbol})"
+def c_definitions(body, texts: list[str], real: str) -> list[tuple]:
+    """A body's definitions as C declares them: (type, name, code, the statement that runs a
+    kernel on the state it starts, or None)."""
+    made = []
+    for (symbol, value), text in zip(body.definitions, texts):
+        if value.kind == REPEAT:
+            kernel, count = value.value
+            run = f"{kernel_function(kernel.name)}({count}, &{body.name(symbol)})"
+            made.append((kernel_type(kernel.name), body.name(symbol), text, run))
+        else:
+            made.append(("int" if value.boolean else real, body.name(symbol), text, None))
+    return made
 
 
 # The contract's C array extent of each argument and output (`function.output`, or the function
@@ -158,7 +164,10 @@ def _c_function(function: Function, robot: Robot, printer: CPrinter, macros: dic
               and not any(argument is a for _, argument, _, _ in inputs) and not (a.scalar and a.symbols[0] in body.read)]
     unused += ["p"] * bool(robot.symbolic_parameters and not parameters)
     definitions, outputs = printer.body(body)
-    values = dict(function.parts(outputs))
+    # a status or flag that a kernel computed is a real of its state, converted explicitly
+    values = {output: [f"(int){t}" if n.kind == PART and _c_type(output, real) == "int" else t
+                       for n, t in zip(nodes, texts)]
+              for (output, texts), (_, nodes) in zip(function.parts(outputs), function.parts(body.outputs))}
     types = {result.name: _c_type(output, real) for call in function.calls
              for result, output in zip(call.results, functions[call.function].outputs)}
     return {
@@ -171,9 +180,7 @@ def _c_function(function: Function, robot: Robot, printer: CPrinter, macros: dic
         "calls": [_c_call(call, functions[call.function], robot, macros) for call in function.calls],
         "inputs": [(types.get(argument.name, real), str(symbol), f"{argument.name}[{row * argument.symbols.cols + col}]")
                    for symbol, argument, row, col in inputs] + [(real, name, f"p->{name}") for name in parameters],
-        "definitions": [("int" if e.boolean else kernel_type(e.value[0].name) if e.kind == REPEAT else real,
-                         body.name(symbol), text, kernel_run(e, body.name(symbol)))
-                        for (symbol, e), text in zip(body.definitions, definitions)],
+        "definitions": c_definitions(body, definitions, real),
         "outputs": [(f"{output.name}[{k}]", text) for output in arrays for k, text in enumerate(values[output])],
         "result": values[returned][0] if returned else None,
     }
@@ -204,7 +211,8 @@ def c_context(robot: Robot, generator: Generator, printer: CPrinter, real: str) 
         "joint_lines": joint_lines(robot),
         "task_lines": task_lines(robot),
         "functions": [_c_function(f, robot, printer, macros, by_name) for f in functions],
-        "kernels": [kernel | {"function": kernel_function(kernel["name"]), "type": kernel_type(kernel["name"])}
+        "kernels": [kernel | {"function": kernel_function(kernel["name"]), "type": kernel_type(kernel["name"]),
+                              "definitions": c_definitions(kernel["body"], kernel["texts"], f"{robot.name}_real")}
                     for kernel in kernels_context(generator, functions, printer)],
         "ik": ik_context(robot, generator, real, printer.number, f"{robot.name.upper()}_MAX_IK_SOLUTIONS"),
         "ik_numeric": generator.generates("ik_numeric") and ik_numeric_context(robot, printer.number),

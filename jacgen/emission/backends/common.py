@@ -61,6 +61,8 @@ def kernels_context(generator: Generator, functions: list, printer) -> list[dict
             "state": [(body.name(symbol), k) for k, symbol in enumerate(kernel.state) if symbol in body.read],
             "definitions": [(value.boolean, body.name(symbol), text)
                             for (symbol, value), text in zip(body.definitions, definitions)],
+            "body": body,
+            "texts": definitions,
             "outputs": outputs,
             "selects": any(value.contains(SELECT) for value in values),
         })
