@@ -81,8 +81,10 @@ def _stack(xp, values, shape):
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _jacobi3_columns_2(xp, count, state):
     """One-sided Jacobi sweep of 2 3 x 3 matrices (its columns), with V, `count` times: 412 operations a run."""
-    state = xp.broadcast_arrays(*state)
-    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
+    batch = numpy.broadcast_shapes(*(getattr(value, "shape", ()) for value in state))
+    if count > 1:  # each entry a loop carries at the batch's shape (a call's broadcast as written out)
+        state = xp.broadcast_arrays(*state)
+    dtype, device = state[0].dtype, getattr(state[0], "device", None)  # as the function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2
@@ -335,8 +337,10 @@ def _jacobi3_columns_2(xp, count, state):
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _jacobi6_rows(xp, count, state):
     """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
-    state = xp.broadcast_arrays(*state)
-    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
+    batch = numpy.broadcast_shapes(*(getattr(value, "shape", ()) for value in state))
+    if count > 1:  # each entry a loop carries at the batch's shape (a call's broadcast as written out)
+        state = xp.broadcast_arrays(*state)
+    dtype, device = state[0].dtype, getattr(state[0], "device", None)  # as the function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2 + w4**2 + w5**2
@@ -905,8 +909,10 @@ def _jacobi6_rows(xp, count, state):
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _symmetric_solve6(xp, count, state):
     """The solution x of a symmetric 6 x 6 system A x = b (A's upper triangle) by Householder QR, and 1 where A is numerically singular, `count` times: 549 operations a run."""
-    state = xp.broadcast_arrays(*state)
-    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
+    batch = numpy.broadcast_shapes(*(getattr(value, "shape", ()) for value in state))
+    if count > 1:  # each entry a loop carries at the batch's shape (a call's broadcast as written out)
+        state = xp.broadcast_arrays(*state)
+    dtype, device = state[0].dtype, getattr(state[0], "device", None)  # as the function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, = state
         t0 = w1**2
@@ -1092,8 +1098,10 @@ def _symmetric_solve6(xp, count, state):
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def _velocity_solve(xp, count, state):
     """The joint rates q_dot solving Js q_dot = mu_dot (plus z's motion in the null space of Js, if it has one), and velocity_ik's status, `count` times: 1424 operations a run."""
-    state = xp.broadcast_arrays(*state)
-    dtype, device, batch = state[0].dtype, getattr(state[0], "device", None), state[0].shape  # as a function's
+    batch = numpy.broadcast_shapes(*(getattr(value, "shape", ()) for value in state))
+    if count > 1:  # each entry a loop carries at the batch's shape (a call's broadcast as written out)
+        state = xp.broadcast_arrays(*state)
+    dtype, device = state[0].dtype, getattr(state[0], "device", None)  # as the function's
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, = state
         t0 = w2*w4
