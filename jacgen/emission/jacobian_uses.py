@@ -1,8 +1,9 @@
 """What the Jacobian is for, as generated functions: the pose and velocity of every link, the
 velocity ellipsoids, the condition number, the manipulability gradient, null-space motion and
-resolved-rate control; and velocity_ik, whose solve the last two call. Each is built from the Generator's chain and lowered by its `function`;
-the algorithms are in `solvers/singular_values.py` and `solvers/differential.py`. `generator`
-is the `Generator` that calls them.
+resolved-rate control; and velocity_ik, whose solve the last two call. Each is built from the
+Generator's chain and lowered by its `function`; the algorithms are in
+`solvers/singular_values.py` and `solvers/differential.py`. `generator` is the `Generator`
+that calls them.
 """
 
 import numpy
@@ -164,8 +165,8 @@ def condition_number_function(generator, js: sympy.Matrix) -> Function | None:
 def velocity_solve(generator, js: sympy.Matrix) -> Kernel:
     """The solve of velocity_ik and its relatives (`differential.velocity_ik`): one kernel,
     (joint values, mu_dot, damping[, z]) to (q_dot, status), that velocity_ik,
-    velocity_ik_nullspace and resolved_rate call (`_velocity_run`); z only where Js has a null
-    space (m < n). Its joint values (`_joint_values`) are what Js reads, which the callers
+    velocity_ik_nullspace and resolved_rate call (`_rate_functions`); z only where Js has a
+    null space (m < n). Its joint values (`_joint_values`) are what Js reads, which the callers
     compute (resolved_rate's task error reads them too): a q that is not finite has a cos and
     sin that are not."""
     m, n = js.shape

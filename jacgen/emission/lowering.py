@@ -133,7 +133,8 @@ class Lowering:
         kernel = self._kernels.get(name)
         if kernel is None:
             symbols = [sympy.Symbol(f"{names.INTERNAL_PREFIX}w{k}", real=True) for k in range(len(state))]
-            kernel = self.kernel(name, summary, symbols, lambda: step([self.graph.symbol(symbol) for symbol in symbols]))
+            kernel = self.kernel(name, summary, symbols,
+                                 lambda: step([self.graph.symbol(symbol) for symbol in symbols]))
         return self.run(kernel, count, state)
 
     def kernel(self, name: str, summary: str, inputs: list[sympy.Symbol], outputs: Callable[[], list]) -> Kernel:

@@ -112,8 +112,9 @@ def symmetric_solve(A, b, g: Graph, name: Callable, call: Callable) -> tuple[lis
         x, singular = householder_solve(rows, values[len(upper):], g, name)
         return x + [g.select(singular, g.number(1), g.number(0))]
 
-    values = call(f"symmetric_solve{k}", f"the solution x of a symmetric {k} x {k} system A x = b (A's upper triangle) by "
-                  "Householder QR, and 1 where A is numerically singular", step, [A[r][c] for r, c in upper] + list(b))
+    values = call(f"symmetric_solve{k}", f"the solution x of a symmetric {k} x {k} system A x = b (A's upper "
+                  "triangle) by Householder QR, and 1 where A is numerically singular", step,
+                  [A[r][c] for r, c in upper] + list(b))
     return values[:k], g.relation(">", values[k], g.number(0))
 
 
