@@ -121,10 +121,11 @@ class Node:
 
 @dataclass(frozen=True, eq=False)
 class Kernel:
-    """A body that runs a fixed number of times: one step, straight-line code (`body`, a
-    lowered Body) from the state (`state`, symbols its body reads) to the next state (its
-    outputs). A REPEAT node runs it from a starting state; every backend prints it once per
-    file, as a loop (`Lowering.repeated` builds it)."""
+    """A body that runs a fixed number of times, or that several places call: one step,
+    straight-line code (`body`, a lowered Body) from the state (`state`, symbols its body
+    reads) to the next state, or a call's results (its outputs). A REPEAT node runs it from a
+    starting state; every backend prints it once per file, as a loop (`Lowering.repeated`,
+    `Lowering.called` and `Lowering.kernel` build it)."""
 
     name: str
     summary: str  # what one step does, for the reader of the generated code

@@ -212,7 +212,8 @@ def c_context(robot: Robot, generator: Generator, printer: CPrinter, real: str) 
         "task_lines": task_lines(robot),
         "functions": [_c_function(f, robot, printer, macros, by_name) for f in functions],
         "kernels": [kernel | {"function": kernel_function(kernel["name"]), "type": kernel_type(kernel["name"]),
-                              "definitions": c_definitions(kernel["body"], kernel["texts"], f"{robot.name}_real")}
+                              "definitions": c_definitions(kernel["body"], [text for *_, text in kernel["definitions"]],
+                                                           f"{robot.name}_real")}
                     for kernel in kernels_context(generator, functions, printer)],
         "ik": ik_context(robot, generator, real, printer.number, f"{robot.name.upper()}_MAX_IK_SOLUTIONS"),
         "ik_numeric": generator.generates("ik_numeric") and ik_numeric_context(robot, printer.number),

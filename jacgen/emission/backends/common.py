@@ -44,9 +44,10 @@ def common_context(robot: Robot) -> dict:
 
 
 def kernels_context(generator: Generator, functions: list, printer) -> list[dict]:
-    """The kernels the functions run (`Lowering.repeated`), each once, as its file defines them:
-    its step's definitions (flagged boolean) and the next state, over the state's entries
-    w0, w1, ... (`names`; `state`: those the step reads, with their index)."""
+    """The kernels the functions run (`Lowering.repeated`, `Lowering.called`), each once, as its
+    file defines them: its step's definitions (flagged boolean) and the next state, over the
+    state's entries w0, w1, ... (`names`; `state`: those the step reads, with their index), and
+    its `body` (the C declares a definition by its value's kind)."""
     made = []
     for kernel in kernels_of(function.body for function in functions):
         body = kernel.body
@@ -62,7 +63,6 @@ def kernels_context(generator: Generator, functions: list, printer) -> list[dict
             "definitions": [(value.boolean, body.name(symbol), text)
                             for (symbol, value), text in zip(body.definitions, definitions)],
             "body": body,
-            "texts": definitions,
             "outputs": outputs,
             "selects": any(value.contains(SELECT) for value in values),
         })

@@ -43,8 +43,9 @@ class PythonPrinter(Printer):
         return f"xp.isfinite({text})"
 
     def _state(self, node):
-        """A constant entry of a kernel's state as an array of the batch's shape, as the state's
-        every entry is (the kernel broadcasts the others), so that each part read is one."""
+        """A constant entry of a kernel's state as an array of the batch's shape, so that each
+        part read is one (a loop broadcasts the other entries; a call's compute at the shapes
+        of what they read, as written out)."""
         text = self.doprint(node)
         return f"xp.full(batch, {text}, dtype=dtype, device=device)" if node.constant else text
 
