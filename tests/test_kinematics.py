@@ -19,6 +19,18 @@ SMALL_ROBOTS = [name for name in ROBOT_NAMES if robot(name).dof <= 6
                 and all(float(joint.alpha.exact / sympy.pi * 2).is_integer() for joint in robot(name).joints)]
 
 
+def vanishes(matrix: sympy.Matrix, q) -> bool:
+    """Whether every entry of `matrix` is identically zero in the joint angles q: the sines and
+    cosines of joint sums expanded, then each angle written through t = tan(q/2) (cos = (1 -
+    t^2)/(1 + t^2), sin = 2t/(1 + t^2)), a rational function that cancels to 0 exactly when the
+    entry is zero. sympy.trigsimp decided planar_3r's in 4 s or in 122 s by the hash seed."""
+    half_angle = {}
+    for angle, t in zip(q, sympy.symbols(f"t1:{len(q) + 1}")):
+        half_angle[sympy.cos(angle)] = (1 - t**2) / (1 + t**2)
+        half_angle[sympy.sin(angle)] = 2 * t / (1 + t**2)
+    return all(sympy.cancel(sympy.expand_trig(entry).xreplace(half_angle)) == 0 for entry in matrix)
+
+
 def numeric(matrix: sympy.Matrix, symbols):
     function = sympy.lambdify(symbols, matrix, "numpy")
     return lambda values: np.array(function(*values), dtype=float)
@@ -56,8 +68,7 @@ def test_column_formula_agrees_with_velocity_propagation(name):
 def test_two_derivations_are_symbolically_equal(name):
     kin = Kinematics(robot(name))
     by_columns = kinematics.tool_frame(kin.jacobian, kin.fk)
-    difference = (by_columns - kin.jacobian_tool).applyfunc(kinematics.simplify_trig)
-    assert difference.applyfunc(sympy.trigsimp) == sympy.zeros(6, kin.robot.dof)
+    assert vanishes(by_columns - kin.jacobian_tool, kin.q)
 
 
 @pytest.mark.parametrize("name", ["planar_2r", "planar_3r", "scara", "rexarm", "puma560", "stanford", "ur5"])
