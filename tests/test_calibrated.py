@@ -18,10 +18,10 @@ from jacgen.model import structure
 from jacgen.model.node import NUMBER, TOLERANCE_VALUES, evaluate
 from jacgen.solvers import ik
 from jacgen.solvers.general6r_target import Certificate
-from jacgen.solvers.model import Model
 from jacgen.solvers.subproblems import Subproblems
 
 from conftest import GENERATED, robot
+from support.generated import model
 from support.ik import wrapped
 
 DATA = Path(__file__).parent / "data" / "calibrated"
@@ -50,7 +50,7 @@ def _eigenproblem_only(arm):
 
 def _free_angles(arm, q: np.ndarray) -> tuple:
     """The general solver's input angle of a 7R arm at configurations q, as ik_branches takes it."""
-    free = Model(arm).closed_form.free
+    free = model(arm).closed_form.free
     return () if free is None else (q[:, free],)
 
 
@@ -64,7 +64,7 @@ def _near_singular_configurations(arm, count: int, seed: int) -> np.ndarray:
     where it is straight or folded (where the least singular value of the Jacobian of the six
     joints ik solves is least along its turn): wrists near aligned, elbows near straight."""
     rng = np.random.default_rng(seed)
-    form = Model(arm).closed_form
+    form = model(arm).closed_form
     q = rng.uniform(-math.pi, math.pi, (arm.dof + 1, count, arm.dof))
     offsets = rng.choice([-1.0, 1.0], (arm.dof + 1, count)) * 10.0 ** rng.uniform(-12, -3, (arm.dof + 1, count))
     for joint in range(arm.dof):
@@ -109,16 +109,16 @@ def _differences(arm, poses, ours, valid, theirs, valid_theirs) -> tuple[int, in
 @pytest.mark.parametrize("name", ARMS)
 def test_the_nearest_special_class_snaps_the_fewest_values(name):
     arm = ARMS[name]
-    nominal = Model(arm).closed_form.fast_path.nominal
+    nominal = model(arm).closed_form.fast_path.nominal
     solver, snapped = NOMINAL[name]
     assert nominal.structure.solver == solver and len(nominal.snapped) == snapped
     assert structure.classify(arm).solver == "general_6r"
-    assert Model(_eigenproblem_only(arm)).closed_form.fast_path is None
-    assert Model(robot("jaco")).closed_form.fast_path is None  # the 60-degree wrist is not near a class
+    assert model(_eigenproblem_only(arm)).closed_form.fast_path is None
+    assert model(robot("jaco")).closed_form.fast_path is None  # the 60-degree wrist is not near a class
 
 
 def test_ur5_calibrated_snaps_its_two_twists_and_the_wrist_offset():
-    nominal = Model(robot("ur5_calibrated")).closed_form.fast_path.nominal
+    nominal = model(robot("ur5_calibrated")).closed_form.fast_path.nominal
     assert nominal.snapped == ("alpha2 -0.001 -> 0 rad", "alpha3 0.001 -> 0 rad", "a5 0.0001 -> 0 m")
     assert "path: calibrated fast path. Nearest special class: three_parallel" in \
         (GENERATED / "ur5_calibrated" / "ur5_calibrated.md").read_text()
@@ -149,7 +149,7 @@ def test_numpy_finds_what_the_eigenproblem_finds(name, generated):
 def test_arms_nobody_tuned_for(name, generated):
     """Shipped arms with twists off by up to 5e-3 rad and lengths by up to 0.5 mm: the same."""
     arm = PERTURBED[name]
-    assert Model(arm).closed_form.fast_path is not None
+    assert model(arm).closed_form.fast_path is not None
     fast = generated(arm, functions=("ik_branches",)).python
     general = generated(_eigenproblem_only(arm), functions=("ik_branches",)).python
     for q in (_random_configurations(arm, 4000, 3), _near_singular_configurations(arm, 300, 4)):
@@ -173,7 +173,7 @@ def test_the_mismatch_bound_holds():
     """The arms' mismatch (general6r.mismatch, summed from their DH differences) bounds the
     difference of their tool poses at 10^5 random configurations, and is within 3 x of it."""
     for arm in (*ARMS.values(), *PERTURBED.values()):
-        fast = Model(arm).closed_form.fast_path
+        fast = model(arm).closed_form.fast_path
         q = _random_configurations(arm, 100_000, 5)
         exact, nominal = reference.fk(arm, q), reference.fk(fast.nominal.robot, q)
         position = np.linalg.norm(exact[:, :3, 3] - nominal[:, :3, 3], axis=-1).max()
@@ -197,7 +197,7 @@ def test_the_certificates_assumption_holds_where_it_certifies(name):
     margin of the nominal closed form, evaluated from the value graph at 30 random poses and
     at 12 targets on the ball's boundary around each."""
     arm = ARMS[name]
-    generator = Generator(arm, selection=("ik_branches",))
+    generator = Generator(arm, model(arm), selection=("ik_branches",))
     fast = generator.closed_form.fast_path
     sp = Subproblems(generator.graph, generator.name_node)
     target = sympy.Matrix(4, 4, lambda i, j: sympy.Symbol(f"T{i}{j}", real=True))

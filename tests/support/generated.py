@@ -26,9 +26,13 @@ from jacgen.files import write_files
 from jacgen.emission.render import render_robot
 from jacgen.inputs.robot import Robot
 from jacgen.inputs.robot_file import load_robot
+from jacgen.solvers.model import Model
 
 ROOT = Path(__file__).resolve().parents[2]
 GENERATED = ROOT / "generated"
+# Each robot's Model (structure, closed form, singularities) once per test process, for every
+# module and test that asks: a general arm's elimination alone takes seconds.
+model = functools.cache(Model)
 
 
 class Code:
@@ -104,7 +108,7 @@ class GeneratedCode:
         key = (robot, tuple(languages), real, functions)
         if key not in self._code:
             if (robot, functions) not in self._generators:
-                self._generators[(robot, functions)] = Generator(robot, selection=functions)
+                self._generators[(robot, functions)] = Generator(robot, model(robot), selection=functions)
             generator = self._generators[(robot, functions)]
             folder = self.folder / f"{robot.name}_{len(self._code)}"
             write_files(render_robot(robot, key[1], real, generator), folder)
