@@ -69,7 +69,7 @@ class Code:
     def signatures(self, names=None) -> list:
         """The signatures of the functions named and their callees (every function: None), from
         the code's Generator, or for committed code from one made for them."""
-        generator = self.generator or Generator(self.robot, selection=names)
+        generator = self.generator or Generator(self.robot, model(self.robot), selection=names)
         wanted = None if names is None else with_callees(names)
         return [f for f in generator.signatures() if wanted is None or (f.part_of or f.name) in wanted]
 
