@@ -4,9 +4,10 @@
 named and their callees, or every function) into a folder of its own and returns a `Code`:
 the Python and CasADi modules are imported, and the C compiled with the contract's warning
 flags, when first asked for. One `Generator` per (robot, functions) serves every language
-and precision, so that the symbolic work is done once. `generated.committed(name)` is the
-same for the committed generated/NAME code of a shipped robot (tests/test_golden.py keeps it
-current): nothing rendered, its C (double) compiled once.
+and precision, so that the symbolic work is done once, and every Generator of a test process
+takes its robot's one `model(robot)`, so that no closed form is derived twice.
+`generated.committed(name)` is the same for the committed generated/NAME code of a shipped
+robot (tests/test_golden.py keeps it current): nothing rendered, its C (double) compiled once.
 
 The fixture is module-scoped: pytest-xdist's `--dist loadfile` keeps a test file on one
 worker, so each robot is generated and compiled once per file that asks for it.
