@@ -5,12 +5,14 @@ import math
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from scipy.optimize import brentq
 
 from jacgen.checking import reference, samples, verify
 from jacgen.cli import main
 from jacgen.checking.c_library import CompileError, compile_shared
 from jacgen.checking.generated_code import HOST_BACKENDS, TARGET_BACKENDS
 from jacgen.emission.generator import Generator, scalar
+from jacgen.inputs.robot_file import load_robot
 
 from conftest import robot as shipped_robot
 
@@ -122,3 +124,33 @@ def test_compile_error_is_one_line(tmp_path):
     source.write_text("int narrow(double x) { return x; }\n")
     with pytest.raises(CompileError, match=r"^gcc failed on bad\.c: .*bad\.c:1:\d+: error: conversion"):
         compile_shared([source], tmp_path / "bad.so")
+
+
+# A random arm (shared/tools/random_arm.py --seed 683826518) whose one-row Js (task [y]) vanishes
+# as a whole at q1 = -1.6335: there its float C's Js rounded to exactly 0 (kappa infinite) and the
+# double reference's to 5.6e-17 (kappa 1), and 2e-3 rad away the float C's Js of 3.4e-5 was
+# 2.5e-4 off, in velocity_ik's residual.
+VANISHING_JS_ARM = """name: arm_26518
+convention: modified
+angle_unit: rad
+joints:
+  - {type: revolute, a: -0.2884, alpha: "0", d: -0.3442, offset: "0", limits: [-2.8539, 1.6102]}
+  - {type: revolute, a: 0.0172, alpha: "pi", d: 0.0378, offset: "pi/2", limits: [-0.7887, 1.2682]}
+base: {xyz: [0.1008, 0.1193, 0.1801], rpy: [-0.3921, -0.8725, 0.0926]}
+tool: {xyz: [0, 0, 0.025], rpy: [0.4585, 0, 0]}
+task: [y]
+"""
+
+
+def test_a_js_that_vanishes_as_a_whole_is_singular(tmp_path):
+    """kappa is infinite where Js is zero to rounding, in every backend, and verify passes there."""
+    path = tmp_path / "arm_26518.yaml"
+    path.write_text(VANISHING_JS_ARM)
+    result = _verify(str(path), "--samples", "200")
+    assert result.exit_code == 0, result.output
+    arm = load_robot(path)
+    q1 = brentq(lambda angle: reference.singularity_jacobian(arm, np.array([angle, 0.4]))[0, 0], -1.7, -1.6)
+    q = np.array([q1, 0.4])
+    assert np.abs(reference.singularity_jacobian(arm, q)).max() < 1e-15
+    assert reference.condition_number(arm, q, 1.0, 1e-12) == math.inf
+    assert reference.condition_number(arm, q + [2e-3, 0], 1.0, 1e-6) == 1.0

@@ -4675,7 +4675,7 @@ void iiwa_velocity_ellipsoid(const iiwa_real q[IIWA_DOF], iiwa_real U_v[9], iiwa
 
 iiwa_real iiwa_condition_number(const iiwa_real q[IIWA_DOF])
 {
-    /* 8496 operations */
+    /* 8498 operations */
 
     /* Inputs */
     const iiwa_real q1 = q[0];
@@ -4903,7 +4903,7 @@ iiwa_real iiwa_condition_number(const iiwa_real q[IIWA_DOF])
     const iiwa_real t201 = (t192 < t199 ? t192 : t199);
     const iiwa_real t202 = (t193 > t200 ? t193 : t200);
     const iiwa_real t203 = (t193 < t201 ? t193 : t201);
-    const iiwa_real t204 = (t203 <= 1e-12*t202 ? 0 : t203);
+    const iiwa_real t204 = ((t203 <= 1e-12*t202) || (t202 <= 1.0796133373548741e-11) ? 0 : t203);
     const iiwa_real t205 = (t202 > 0 ? t202 : 1);
 
     /* Outputs */

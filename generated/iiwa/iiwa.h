@@ -106,8 +106,8 @@ void iiwa_manipulability_gradient(const iiwa_real q[IIWA_DOF], iiwa_real dw[IIWA
  * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2599 operations. */
 void iiwa_velocity_ellipsoid(const iiwa_real q[IIWA_DOF], iiwa_real U_v[9], iiwa_real s_v[3], iiwa_real U_w[9], iiwa_real s_w[3]);
 
-/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 8496 operations. */
+/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding).
+ * Result: returned as a scalar. 8498 operations. */
 iiwa_real iiwa_condition_number(const iiwa_real q[IIWA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

@@ -4206,7 +4206,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 8496 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): 8498 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -4429,7 +4429,7 @@ def _condition_number(q):
     t201 = casadi.if_else((t192 < t199), t192, t199)
     t202 = casadi.if_else((t193 > t200), t193, t200)
     t203 = casadi.if_else((t193 < t201), t193, t201)
-    t204 = casadi.if_else((t203 <= 1e-12*t202), 0, t203)
+    t204 = casadi.if_else(casadi.logic_or((t203 <= 1e-12*t202), (t202 <= 1.0796133373548741e-11)), 0, t203)
     t205 = casadi.if_else((t202 > 0), t202, 1)
     kappa = casadi.SX(1, 1)
     kappa[0, 0] = t205/t204

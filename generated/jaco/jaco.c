@@ -4905,7 +4905,7 @@ void jaco_velocity_ellipsoid(const jaco_real q[JACO_DOF], jaco_real U_v[9], jaco
 
 jaco_real jaco_condition_number(const jaco_real q[JACO_DOF])
 {
-    /* 8509 operations */
+    /* 8511 operations */
 
     /* Inputs */
     const jaco_real q1 = q[0];
@@ -5133,7 +5133,7 @@ jaco_real jaco_condition_number(const jaco_real q[JACO_DOF])
     const jaco_real t204 = (t195 < t202 ? t195 : t202);
     const jaco_real t205 = (t196 > t203 ? t196 : t203);
     const jaco_real t206 = (t196 < t204 ? t196 : t204);
-    const jaco_real t207 = (t206 <= 1e-12*t205 ? 0 : t206);
+    const jaco_real t207 = ((t206 <= 1e-12*t205) || (t205 <= 7.564218693304798e-12) ? 0 : t206);
     const jaco_real t208 = (t205 > 0 ? t205 : 1);
 
     /* Outputs */

@@ -4076,7 +4076,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 8509 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): 8511 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -4299,7 +4299,7 @@ def _condition_number(q):
     t204 = casadi.if_else((t195 < t202), t195, t202)
     t205 = casadi.if_else((t196 > t203), t196, t203)
     t206 = casadi.if_else((t196 < t204), t196, t204)
-    t207 = casadi.if_else((t206 <= 1e-12*t205), 0, t206)
+    t207 = casadi.if_else(casadi.logic_or((t206 <= 1e-12*t205), (t205 <= 7.564218693304798e-12)), 0, t206)
     t208 = casadi.if_else((t205 > 0), t205, 1)
     kappa = casadi.SX(1, 1)
     kappa[0, 0] = t208/t207

@@ -4106,7 +4106,7 @@ void kr5_velocity_ellipsoid(const kr5_real q[KR5_DOF], kr5_real U_v[9], kr5_real
 
 kr5_real kr5_condition_number(const kr5_real q[KR5_DOF])
 {
-    /* 8384 operations */
+    /* 8386 operations */
 
     /* Inputs */
     const kr5_real q1 = q[0];
@@ -4309,7 +4309,7 @@ kr5_real kr5_condition_number(const kr5_real q[KR5_DOF])
     const kr5_real t177 = (t168 < t175 ? t168 : t175);
     const kr5_real t178 = (t169 > t176 ? t169 : t176);
     const kr5_real t179 = (t169 < t177 ? t169 : t177);
-    const kr5_real t180 = (t179 <= 1e-12*t178 ? 0 : t179);
+    const kr5_real t180 = ((t179 <= 1e-12*t178) || (t178 <= 8.62290840956242e-12) ? 0 : t179);
     const kr5_real t181 = (t178 > 0 ? t178 : 1);
 
     /* Outputs */

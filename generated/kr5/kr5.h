@@ -108,8 +108,8 @@ void kr5_manipulability_gradient(const kr5_real q[KR5_DOF], kr5_real dw[KR5_DOF]
  * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2517 operations. */
 void kr5_velocity_ellipsoid(const kr5_real q[KR5_DOF], kr5_real U_v[9], kr5_real s_v[3], kr5_real U_w[9], kr5_real s_w[3]);
 
-/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 8384 operations. */
+/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding).
+ * Result: returned as a scalar. 8386 operations. */
 kr5_real kr5_condition_number(const kr5_real q[KR5_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

@@ -3679,7 +3679,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 8384 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): 8386 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -3877,7 +3877,7 @@ def _condition_number(q):
     t177 = casadi.if_else((t168 < t175), t168, t175)
     t178 = casadi.if_else((t169 > t176), t169, t176)
     t179 = casadi.if_else((t169 < t177), t169, t177)
-    t180 = casadi.if_else((t179 <= 1e-12*t178), 0, t179)
+    t180 = casadi.if_else(casadi.logic_or((t179 <= 1e-12*t178), (t178 <= 8.62290840956242e-12)), 0, t179)
     t181 = casadi.if_else((t178 > 0), t178, 1)
     kappa = casadi.SX(1, 1)
     kappa[0, 0] = t181/t180

@@ -4746,7 +4746,7 @@ void manocha_canny_velocity_ellipsoid(const manocha_canny_real q[MANOCHA_CANNY_D
 
 manocha_canny_real manocha_canny_condition_number(const manocha_canny_real q[MANOCHA_CANNY_DOF])
 {
-    /* 8365 operations */
+    /* 8367 operations */
 
     /* Inputs */
     const manocha_canny_real q1 = q[0];
@@ -4943,7 +4943,7 @@ manocha_canny_real manocha_canny_condition_number(const manocha_canny_real q[MAN
     const manocha_canny_real t173 = (t164 < t171 ? t164 : t171);
     const manocha_canny_real t174 = (t165 > t172 ? t165 : t172);
     const manocha_canny_real t175 = (t165 < t173 ? t165 : t173);
-    const manocha_canny_real t176 = (t175 <= 1e-12*t174 ? 0 : t175);
+    const manocha_canny_real t176 = ((t175 <= 1e-12*t174) || (t174 <= 5.972965715131118e-12) ? 0 : t175);
     const manocha_canny_real t177 = (t174 > 0 ? t174 : 1);
 
     /* Outputs */

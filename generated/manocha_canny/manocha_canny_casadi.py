@@ -3830,7 +3830,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 8365 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): 8367 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -4022,7 +4022,7 @@ def _condition_number(q):
     t173 = casadi.if_else((t164 < t171), t164, t171)
     t174 = casadi.if_else((t165 > t172), t165, t172)
     t175 = casadi.if_else((t165 < t173), t165, t173)
-    t176 = casadi.if_else((t175 <= 1e-12*t174), 0, t175)
+    t176 = casadi.if_else(casadi.logic_or((t175 <= 1e-12*t174), (t174 <= 5.972965715131118e-12)), 0, t175)
     t177 = casadi.if_else((t174 > 0), t174, 1)
     kappa = casadi.SX(1, 1)
     kappa[0, 0] = t177/t176

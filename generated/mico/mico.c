@@ -4905,7 +4905,7 @@ void mico_velocity_ellipsoid(const mico_real q[MICO_DOF], mico_real U_v[9], mico
 
 mico_real mico_condition_number(const mico_real q[MICO_DOF])
 {
-    /* 8509 operations */
+    /* 8511 operations */
 
     /* Inputs */
     const mico_real q1 = q[0];
@@ -5133,7 +5133,7 @@ mico_real mico_condition_number(const mico_real q[MICO_DOF])
     const mico_real t204 = (t195 < t202 ? t195 : t202);
     const mico_real t205 = (t196 > t203 ? t196 : t203);
     const mico_real t206 = (t196 < t204 ? t196 : t204);
-    const mico_real t207 = (t206 <= 1e-12*t205 ? 0 : t206);
+    const mico_real t207 = ((t206 <= 1e-12*t205) || (t205 <= 7.771771414498881e-12) ? 0 : t206);
     const mico_real t208 = (t205 > 0 ? t205 : 1);
 
     /* Outputs */

@@ -4916,7 +4916,7 @@ void panda_velocity_ellipsoid(const panda_real q[PANDA_DOF], panda_real U_v[9], 
 
 panda_real panda_condition_number(const panda_real q[PANDA_DOF])
 {
-    /* 8524 operations */
+    /* 8526 operations */
 
     /* Inputs */
     const panda_real q1 = q[0];
@@ -5153,7 +5153,7 @@ panda_real panda_condition_number(const panda_real q[PANDA_DOF])
     const panda_real t210 = (t201 < t208 ? t201 : t208);
     const panda_real t211 = (t202 > t209 ? t202 : t209);
     const panda_real t212 = (t202 < t210 ? t202 : t210);
-    const panda_real t213 = (t212 <= 1e-12*t211 ? 0 : t212);
+    const panda_real t213 = ((t212 <= 1e-12*t211) || (t211 <= 1.6417971573114916e-11) ? 0 : t212);
     const panda_real t214 = (t211 > 0 ? t211 : 1);
 
     /* Outputs */

@@ -4447,7 +4447,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 8524 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): 8526 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -4679,7 +4679,7 @@ def _condition_number(q):
     t210 = casadi.if_else((t201 < t208), t201, t208)
     t211 = casadi.if_else((t202 > t209), t202, t209)
     t212 = casadi.if_else((t202 < t210), t202, t210)
-    t213 = casadi.if_else((t212 <= 1e-12*t211), 0, t212)
+    t213 = casadi.if_else(casadi.logic_or((t212 <= 1e-12*t211), (t211 <= 1.6417971573114916e-11)), 0, t212)
     t214 = casadi.if_else((t211 > 0), t211, 1)
     kappa = casadi.SX(1, 1)
     kappa[0, 0] = t214/t213

@@ -6652,7 +6652,7 @@ void panda_calibrated_velocity_ellipsoid(const panda_calibrated_real q[PANDA_CAL
 
 panda_calibrated_real panda_calibrated_condition_number(const panda_calibrated_real q[PANDA_CALIBRATED_DOF])
 {
-    /* 8749 operations */
+    /* 8751 operations */
 
     /* Inputs */
     const panda_calibrated_real q1 = q[0];
@@ -6965,7 +6965,7 @@ panda_calibrated_real panda_calibrated_condition_number(const panda_calibrated_r
     const panda_calibrated_real t286 = (t277 < t284 ? t277 : t284);
     const panda_calibrated_real t287 = (t278 > t285 ? t278 : t285);
     const panda_calibrated_real t288 = (t278 < t286 ? t278 : t286);
-    const panda_calibrated_real t289 = (t288 <= 1e-12*t287 ? 0 : t288);
+    const panda_calibrated_real t289 = ((t288 <= 1e-12*t287) || (t287 <= 1.6415987553711658e-11) ? 0 : t288);
     const panda_calibrated_real t290 = (t287 > 0 ? t287 : 1);
 
     /* Outputs */

@@ -5844,7 +5844,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 8749 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): 8751 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -6152,7 +6152,7 @@ def _condition_number(q):
     t286 = casadi.if_else((t277 < t284), t277, t284)
     t287 = casadi.if_else((t278 > t285), t278, t285)
     t288 = casadi.if_else((t278 < t286), t278, t286)
-    t289 = casadi.if_else((t288 <= 1e-12*t287), 0, t288)
+    t289 = casadi.if_else(casadi.logic_or((t288 <= 1e-12*t287), (t287 <= 1.6415987553711658e-11)), 0, t288)
     t290 = casadi.if_else((t287 > 0), t287, 1)
     kappa = casadi.SX(1, 1)
     kappa[0, 0] = t290/t289

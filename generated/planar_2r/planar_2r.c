@@ -1187,7 +1187,7 @@ void planar_2r_velocity_ellipsoid(const planar_2r_real q[PLANAR_2R_DOF], planar_
 
 planar_2r_real planar_2r_condition_number(const planar_2r_real q[PLANAR_2R_DOF])
 {
-    /* 88 operations */
+    /* 90 operations */
 
     /* Inputs */
     const planar_2r_real q1 = q[0];
@@ -1234,7 +1234,7 @@ planar_2r_real planar_2r_condition_number(const planar_2r_real q[PLANAR_2R_DOF])
     const planar_2r_real t31 = sqrt((t28*t28) + t23*t29);
     const planar_2r_real t32 = (t31 > t30 ? t31 : t30);
     const planar_2r_real t33 = (t31 < t30 ? t31 : t30);
-    const planar_2r_real t34 = (t33 <= 1e-12*t32 ? 0 : t33);
+    const planar_2r_real t34 = ((t33 <= 1e-12*t32) || (t32 <= 4e-12) ? 0 : t33);
     const planar_2r_real t35 = (t32 > 0 ? t32 : 1);
 
     /* Outputs */

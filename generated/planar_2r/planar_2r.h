@@ -103,8 +103,8 @@ void planar_2r_manipulability_gradient(const planar_2r_real q[PLANAR_2R_DOF], pl
  * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2235 operations. */
 void planar_2r_velocity_ellipsoid(const planar_2r_real q[PLANAR_2R_DOF], planar_2r_real U_v[9], planar_2r_real s_v[3], planar_2r_real U_w[9], planar_2r_real s_w[3]);
 
-/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 88 operations. */
+/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding).
+ * Result: returned as a scalar. 90 operations. */
 planar_2r_real planar_2r_condition_number(const planar_2r_real q[PLANAR_2R_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

@@ -943,7 +943,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 88 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): 90 operations."""
     q1 = q[0]
     q2 = q[1]
     c1 = casadi.cos(q1)
@@ -986,7 +986,7 @@ def _condition_number(q):
     t31 = casadi.sqrt(t28**2 + t23*t29)
     t32 = casadi.if_else((t31 > t30), t31, t30)
     t33 = casadi.if_else((t31 < t30), t31, t30)
-    t34 = casadi.if_else((t33 <= 1e-12*t32), 0, t33)
+    t34 = casadi.if_else(casadi.logic_or((t33 <= 1e-12*t32), (t32 <= 4e-12)), 0, t33)
     t35 = casadi.if_else((t32 > 0), t32, 1)
     kappa = casadi.SX(1, 1)
     kappa[0, 0] = t35/t34

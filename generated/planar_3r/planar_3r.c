@@ -1636,7 +1636,7 @@ void planar_3r_velocity_ellipsoid(const planar_3r_real q[PLANAR_3R_DOF], planar_
 
 planar_3r_real planar_3r_condition_number(const planar_3r_real q[PLANAR_3R_DOF])
 {
-    /* 894 operations */
+    /* 896 operations */
 
     /* Inputs */
     const planar_3r_real q1 = q[0];
@@ -1697,7 +1697,7 @@ planar_3r_real planar_3r_condition_number(const planar_3r_real q[PLANAR_3R_DOF])
     const planar_3r_real t39 = (t36 < t35 ? t36 : t35);
     const planar_3r_real t40 = (t37 > t38 ? t37 : t38);
     const planar_3r_real t41 = (t37 < t39 ? t37 : t39);
-    const planar_3r_real t42 = (t41 <= 1e-12*t40 ? 0 : t41);
+    const planar_3r_real t42 = ((t41 <= 1e-12*t40) || (t40 <= 9.636361673554164e-12) ? 0 : t41);
     const planar_3r_real t43 = (t40 > 0 ? t40 : 1);
 
     /* Outputs */

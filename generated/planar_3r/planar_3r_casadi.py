@@ -1321,7 +1321,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 894 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): 896 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -1377,7 +1377,7 @@ def _condition_number(q):
     t39 = casadi.if_else((t36 < t35), t36, t35)
     t40 = casadi.if_else((t37 > t38), t37, t38)
     t41 = casadi.if_else((t37 < t39), t37, t39)
-    t42 = casadi.if_else((t41 <= 1e-12*t40), 0, t41)
+    t42 = casadi.if_else(casadi.logic_or((t41 <= 1e-12*t40), (t40 <= 9.636361673554164e-12)), 0, t41)
     t43 = casadi.if_else((t40 > 0), t40, 1)
     kappa = casadi.SX(1, 1)
     kappa[0, 0] = t43/t42

@@ -3722,7 +3722,7 @@ void puma560_velocity_ellipsoid(const puma560_real q[PUMA560_DOF], puma560_real 
 
 puma560_real puma560_condition_number(const puma560_real q[PUMA560_DOF])
 {
-    /* 8225 operations */
+    /* 8227 operations */
 
     /* Inputs */
     const puma560_real q1 = q[0];
@@ -3878,7 +3878,7 @@ puma560_real puma560_condition_number(const puma560_real q[PUMA560_DOF])
     const puma560_real t130 = (t121 < t128 ? t121 : t128);
     const puma560_real t131 = (t122 > t129 ? t122 : t129);
     const puma560_real t132 = (t122 < t130 ? t122 : t130);
-    const puma560_real t133 = (t132 <= 1e-12*t131 ? 0 : t132);
+    const puma560_real t133 = ((t132 <= 1e-12*t131) || (t131 <= 1.0285099052540912e-11) ? 0 : t132);
     const puma560_real t134 = (t131 > 0 ? t131 : 1);
 
     /* Outputs */

@@ -3205,7 +3205,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 8225 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): 8227 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -3356,7 +3356,7 @@ def _condition_number(q):
     t130 = casadi.if_else((t121 < t128), t121, t128)
     t131 = casadi.if_else((t122 > t129), t122, t129)
     t132 = casadi.if_else((t122 < t130), t122, t130)
-    t133 = casadi.if_else((t132 <= 1e-12*t131), 0, t132)
+    t133 = casadi.if_else(casadi.logic_or((t132 <= 1e-12*t131), (t131 <= 1.0285099052540912e-11)), 0, t132)
     t134 = casadi.if_else((t131 > 0), t131, 1)
     kappa = casadi.SX(1, 1)
     kappa[0, 0] = t134/t133

@@ -2438,7 +2438,7 @@ void rexarm_velocity_ellipsoid(const rexarm_real q[REXARM_DOF], rexarm_real U_v[
 
 rexarm_real rexarm_condition_number(const rexarm_real q[REXARM_DOF])
 {
-    /* 2729 operations */
+    /* 2731 operations */
 
     /* Inputs */
     const rexarm_real q1 = q[0];
@@ -2550,7 +2550,7 @@ rexarm_real rexarm_condition_number(const rexarm_real q[REXARM_DOF])
     const rexarm_real t87 = (t82 < t85 ? t82 : t85);
     const rexarm_real t88 = (t83 > t86 ? t83 : t86);
     const rexarm_real t89 = (t83 < t87 ? t83 : t87);
-    const rexarm_real t90 = (t89 <= 1e-12*t88 ? 0 : t89);
+    const rexarm_real t90 = ((t89 <= 1e-12*t88) || (t88 <= 2.4830341394813377e-11) ? 0 : t89);
     const rexarm_real t91 = (t88 > 0 ? t88 : 1);
 
     /* Outputs */

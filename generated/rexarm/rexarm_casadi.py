@@ -2132,7 +2132,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 2729 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): 2731 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -2239,7 +2239,7 @@ def _condition_number(q):
     t87 = casadi.if_else((t82 < t85), t82, t85)
     t88 = casadi.if_else((t83 > t86), t83, t86)
     t89 = casadi.if_else((t83 < t87), t83, t87)
-    t90 = casadi.if_else((t89 <= 1e-12*t88), 0, t89)
+    t90 = casadi.if_else(casadi.logic_or((t89 <= 1e-12*t88), (t88 <= 2.4830341394813377e-11)), 0, t89)
     t91 = casadi.if_else((t88 > 0), t88, 1)
     kappa = casadi.SX(1, 1)
     kappa[0, 0] = t91/t90

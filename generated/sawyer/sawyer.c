@@ -5229,7 +5229,7 @@ void sawyer_velocity_ellipsoid(const sawyer_real q[SAWYER_DOF], sawyer_real U_v[
 
 sawyer_real sawyer_condition_number(const sawyer_real q[SAWYER_DOF])
 {
-    /* 8520 operations */
+    /* 8522 operations */
 
     /* Inputs */
     const sawyer_real q1 = q[0];
@@ -5464,7 +5464,7 @@ sawyer_real sawyer_condition_number(const sawyer_real q[SAWYER_DOF])
     const sawyer_real t208 = (t199 < t206 ? t199 : t206);
     const sawyer_real t209 = (t200 > t207 ? t200 : t207);
     const sawyer_real t210 = (t200 < t208 ? t200 : t208);
-    const sawyer_real t211 = (t210 <= 1e-12*t209 ? 0 : t210);
+    const sawyer_real t211 = ((t210 <= 1e-12*t209) || (t209 <= 1.380820181276542e-11) ? 0 : t210);
     const sawyer_real t212 = (t209 > 0 ? t209 : 1);
 
     /* Outputs */

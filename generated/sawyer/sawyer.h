@@ -106,8 +106,8 @@ void sawyer_manipulability_gradient(const sawyer_real q[SAWYER_DOF], sawyer_real
  * Result: U_v: 3 x 3 row-major, element (r, c) at U_v[r * 3 + c]; s_v[i], i < 3; U_w: 3 x 3 row-major, element (r, c) at U_w[r * 3 + c]; s_w[i], i < 3. 2618 operations. */
 void sawyer_velocity_ellipsoid(const sawyer_real q[SAWYER_DOF], sawyer_real U_v[9], sawyer_real s_v[3], sawyer_real U_w[9], sawyer_real s_w[3]);
 
-/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding).
- * Result: returned as a scalar. 8520 operations. */
+/* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding).
+ * Result: returned as a scalar. 8522 operations. */
 sawyer_real sawyer_condition_number(const sawyer_real q[SAWYER_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

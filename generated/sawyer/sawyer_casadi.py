@@ -4322,7 +4322,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 8520 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): 8522 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -4552,7 +4552,7 @@ def _condition_number(q):
     t208 = casadi.if_else((t199 < t206), t199, t206)
     t209 = casadi.if_else((t200 > t207), t200, t207)
     t210 = casadi.if_else((t200 < t208), t200, t208)
-    t211 = casadi.if_else((t210 <= 1e-12*t209), 0, t210)
+    t211 = casadi.if_else(casadi.logic_or((t210 <= 1e-12*t209), (t209 <= 1.380820181276542e-11)), 0, t210)
     t212 = casadi.if_else((t209 > 0), t209, 1)
     kappa = casadi.SX(1, 1)
     kappa[0, 0] = t212/t211

@@ -1805,7 +1805,7 @@ void scara_velocity_ellipsoid(const scara_real q[SCARA_DOF], scara_real U_v[9], 
 
 scara_real scara_condition_number(const scara_real q[SCARA_DOF])
 {
-    /* 2571 operations */
+    /* 2573 operations */
 
     /* Inputs */
     const scara_real q1 = q[0];
@@ -1852,7 +1852,7 @@ scara_real scara_condition_number(const scara_real q[SCARA_DOF])
     const scara_real t30 = (t25 < t28 ? t25 : t28);
     const scara_real t31 = (t26 > t29 ? t26 : t29);
     const scara_real t32 = (t26 < t30 ? t26 : t30);
-    const scara_real t33 = (t32 <= 1e-12*t31 ? 0 : t32);
+    const scara_real t33 = ((t32 <= 1e-12*t31) || (t31 <= 5.135529411764706e-12) ? 0 : t32);
     const scara_real t34 = (t31 > 0 ? t31 : 1);
 
     /* Outputs */

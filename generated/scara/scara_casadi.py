@@ -1364,7 +1364,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 2571 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): 2573 operations."""
     q1 = q[0]
     q2 = q[1]
     c1 = casadi.cos(q1)
@@ -1406,7 +1406,7 @@ def _condition_number(q):
     t30 = casadi.if_else((t25 < t28), t25, t28)
     t31 = casadi.if_else((t26 > t29), t26, t29)
     t32 = casadi.if_else((t26 < t30), t26, t30)
-    t33 = casadi.if_else((t32 <= 1e-12*t31), 0, t32)
+    t33 = casadi.if_else(casadi.logic_or((t32 <= 1e-12*t31), (t31 <= 5.135529411764706e-12)), 0, t32)
     t34 = casadi.if_else((t31 > 0), t31, 1)
     kappa = casadi.SX(1, 1)
     kappa[0, 0] = t34/t33

@@ -3453,7 +3453,7 @@ void stanford_velocity_ellipsoid(const stanford_real q[STANFORD_DOF], stanford_r
 
 stanford_real stanford_condition_number(const stanford_real q[STANFORD_DOF])
 {
-    /* 8198 operations */
+    /* 8200 operations */
 
     /* Inputs */
     const stanford_real q1 = q[0];
@@ -3598,7 +3598,7 @@ stanford_real stanford_condition_number(const stanford_real q[STANFORD_DOF])
     const stanford_real t123 = (t114 < t121 ? t114 : t121);
     const stanford_real t124 = (t115 > t122 ? t115 : t122);
     const stanford_real t125 = (t115 < t123 ? t115 : t123);
-    const stanford_real t126 = (t125 <= 1e-12*t124 ? 0 : t125);
+    const stanford_real t126 = ((t125 <= 1e-12*t124) || (t124 <= 4.248309202917257e-12) ? 0 : t125);
     const stanford_real t127 = (t124 > 0 ? t124 : 1);
 
     /* Outputs */

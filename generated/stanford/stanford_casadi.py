@@ -2905,7 +2905,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 8198 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): 8200 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -3045,7 +3045,7 @@ def _condition_number(q):
     t123 = casadi.if_else((t114 < t121), t114, t121)
     t124 = casadi.if_else((t115 > t122), t115, t122)
     t125 = casadi.if_else((t115 < t123), t115, t123)
-    t126 = casadi.if_else((t125 <= 1e-12*t124), 0, t125)
+    t126 = casadi.if_else(casadi.logic_or((t125 <= 1e-12*t124), (t124 <= 4.248309202917257e-12)), 0, t125)
     t127 = casadi.if_else((t124 > 0), t124, 1)
     kappa = casadi.SX(1, 1)
     kappa[0, 0] = t127/t126

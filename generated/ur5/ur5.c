@@ -3994,7 +3994,7 @@ void ur5_velocity_ellipsoid(const ur5_real q[UR5_DOF], ur5_real U_v[9], ur5_real
 
 ur5_real ur5_condition_number(const ur5_real q[UR5_DOF])
 {
-    /* 8369 operations */
+    /* 8371 operations */
 
     /* Inputs */
     const ur5_real q1 = q[0];
@@ -4188,7 +4188,7 @@ ur5_real ur5_condition_number(const ur5_real q[UR5_DOF])
     const ur5_real t166 = (t157 < t164 ? t157 : t164);
     const ur5_real t167 = (t158 > t165 ? t158 : t165);
     const ur5_real t168 = (t158 < t166 ? t158 : t166);
-    const ur5_real t169 = (t168 <= 1e-12*t167 ? 0 : t168);
+    const ur5_real t169 = ((t168 <= 1e-12*t167) || (t167 <= 1.248530559440193e-11) ? 0 : t168);
     const ur5_real t170 = (t167 > 0 ? t167 : 1);
 
     /* Outputs */

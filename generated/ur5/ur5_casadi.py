@@ -3553,7 +3553,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 8369 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): 8371 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -3742,7 +3742,7 @@ def _condition_number(q):
     t166 = casadi.if_else((t157 < t164), t157, t164)
     t167 = casadi.if_else((t158 > t165), t158, t165)
     t168 = casadi.if_else((t158 < t166), t158, t166)
-    t169 = casadi.if_else((t168 <= 1e-12*t167), 0, t168)
+    t169 = casadi.if_else(casadi.logic_or((t168 <= 1e-12*t167), (t167 <= 1.248530559440193e-11)), 0, t168)
     t170 = casadi.if_else((t167 > 0), t167, 1)
     kappa = casadi.SX(1, 1)
     kappa[0, 0] = t170/t169

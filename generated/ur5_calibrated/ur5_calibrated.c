@@ -6259,7 +6259,7 @@ void ur5_calibrated_velocity_ellipsoid(const ur5_calibrated_real q[UR5_CALIBRATE
 
 ur5_calibrated_real ur5_calibrated_condition_number(const ur5_calibrated_real q[UR5_CALIBRATED_DOF])
 {
-    /* 8626 operations */
+    /* 8628 operations */
 
     /* Inputs */
     const ur5_calibrated_real q1 = q[0];
@@ -6542,7 +6542,7 @@ ur5_calibrated_real ur5_calibrated_condition_number(const ur5_calibrated_real q[
     const ur5_calibrated_real t256 = (t247 < t254 ? t247 : t254);
     const ur5_calibrated_real t257 = (t248 > t255 ? t248 : t255);
     const ur5_calibrated_real t258 = (t248 < t256 ? t248 : t256);
-    const ur5_calibrated_real t259 = (t258 <= 1e-12*t257 ? 0 : t258);
+    const ur5_calibrated_real t259 = ((t258 <= 1e-12*t257) || (t257 <= 1.2491015109285611e-11) ? 0 : t258);
     const ur5_calibrated_real t260 = (t257 > 0 ? t257 : 1);
 
     /* Outputs */

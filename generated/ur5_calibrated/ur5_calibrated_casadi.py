@@ -5449,7 +5449,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to rounding): 8626 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): 8628 operations."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -5727,7 +5727,7 @@ def _condition_number(q):
     t256 = casadi.if_else((t247 < t254), t247, t254)
     t257 = casadi.if_else((t248 > t255), t248, t255)
     t258 = casadi.if_else((t248 < t256), t248, t256)
-    t259 = casadi.if_else((t258 <= 1e-12*t257), 0, t258)
+    t259 = casadi.if_else(casadi.logic_or((t258 <= 1e-12*t257), (t257 <= 1.2491015109285611e-11)), 0, t258)
     t260 = casadi.if_else((t257 > 0), t257, 1)
     kappa = casadi.SX(1, 1)
     kappa[0, 0] = t260/t259

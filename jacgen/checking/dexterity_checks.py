@@ -8,7 +8,8 @@ reference: each is held to what characterises its answer.
 - velocity_ellipsoid: singular values against the reference's, U a rotation, and each singular
   vector within what its gap allows (`ellipsoid_error`).
 - condition_number: the dexterity index 1 / kappa (in [0, 1], well conditioned where kappa is
-  not: its relative error is ~ eps kappa), absolutely.
+  not: its relative error is ~ eps kappa), absolutely; 0 where Js is singular to the rounding
+  of the backend's real type (contract §2).
 - manipulability_gradient: entry by entry, but only where Js is regular: at a singularity the
   derivative of |sigma_min| has a kink.
 """
@@ -21,6 +22,7 @@ from jacgen.checking import reference
 from jacgen.checking.generated_code import GeneratedCode
 from jacgen.checking.result import Result, is_float
 from jacgen.inputs.robot import Robot
+from jacgen.model.tolerance_symbols import EPS, TOLERANCES
 from jacgen.solvers.model import Model
 
 # Functions of q that verify's comparison with the reference function of the same name leaves to this module.
@@ -49,10 +51,13 @@ def dexterity_results(robot: Robot, backends: GeneratedCode, q: np.ndarray, defi
                               "|u u^T - r r^T| gap / (1 + |J block|) (Wedin)"))
     if "condition_number" in generated:
         length = characteristic_length(robot)
-        expected = 1 / reference.condition_number(robot, q[defined], length)
+        # kappa is infinite where Js is singular to the rounding of the backend's real type (EPS)
+        expected = {real: 1 / reference.condition_number(robot, q[defined], length, float(TOLERANCES[real][EPS]))
+                    for real in ("double", "float")}
         with np.errstate(divide="ignore"):  # a kappa of 0 (wrong) is an infinite error
             errors = _per_backend(backends, "condition_number", lambda backend: _largest(np.abs(
-                1 / np.reshape(backends.call(backend, "condition_number", q[defined])[0], -1) - expected)))
+                1 / np.reshape(backends.call(backend, "condition_number", q[defined])[0], -1)
+                - expected["float" if is_float(backend) else "double"])))
         results.append(Result(robot.name, "condition_number", errors, tolerances,
                               f"|1/kappa - 1/kappa_ref| at {int(defined.sum())} samples, position rows / L = {length:.6g}"))
     if "manipulability_gradient" in generated:

@@ -247,13 +247,18 @@ def _left_singular(block):
     return U, values
 
 
-def condition_number(robot, q, length):
+def condition_number(robot, q, length, eps=0.0):
     """sigma_max / sigma_min of Js with its position rows divided by `length` (the characteristic
-    length, so the value has no unit); +inf where sigma_min is 0."""
+    length, so the value has no unit); +inf where Js is singular to `eps` (contract §2): where
+    sigma_min <= eps sigma_max, or where sigma_max <= eps (1 + (1 + reach) / length), a bound on
+    the scaled Js's entries (rotation rows 1, revolute columns' positions reach / length,
+    prismatic columns' 1 / length). With eps 0, where sigma_min is 0."""
     rows = np.array([1 / length if name in ("x", "y", "z") else 1.0 for name in robot.task])
     values = np.linalg.svd(singularity_jacobian(robot, q) * rows[:, None], compute_uv=False)
+    largest, smallest = values[..., 0], values[..., -1]
+    singular = (smallest <= eps * largest) | (largest <= eps * (1 + (1 + robot.reach) / length))
     with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(values[..., -1] > 0, values[..., 0] / values[..., -1], np.inf)
+        return np.where(singular, np.inf, largest / smallest)
 
 
 def _js_and_derivatives(robot, q):

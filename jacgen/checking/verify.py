@@ -52,11 +52,11 @@ from jacgen.tolerances import IK_NUMERIC_VERIFIED, VERIFIED
 # most 1/0.05^2 = 400-fold and the reference's central differences (step 1e-4) agree with
 # the exact rates to 3e-11; at 0.01 they were measured 4e-9 off (stanford).
 EULER_MARGIN = 0.05
-# Smallest / largest singular value of Js below which factors must vanish, and above which
-# velocity_ik is checked (there |q_dot| <~ 1e3 |mu_dot|, so the reference's finite-difference
-# error of 1e-11 in task_jacobian stays below the tolerance in the residual).
+# Smallest singular value of Js, over the largest or over what its entries can be (`_rank_ratios`),
+# below which factors must vanish, and above which velocity_ik is checked (there |q_dot| <~ 1e3
+# |mu_dot|, so the reference's finite-difference error of 1e-11 in task_jacobian stays below the
+# tolerance in the residual).
 SINGULAR_RANK, REGULAR_RANK = 1e-9, 1e-3
-ZERO_JACOBIAN = 1e-12
 # ik_numeric iterates in Python per target: enough targets to cover the workspace, few
 # enough to keep verify quick.
 NUMERIC_IK_SAMPLES = 20
@@ -165,9 +165,12 @@ def _wrapped(angles: np.ndarray) -> np.ndarray:
 
 
 def _rank_ratios(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """Smallest over largest singular value of the reference Js at each sample (NaN where
-    Js is undefined: Euler-angle rows at cos(pitch) < EULER_MARGIN), made free of the length
-    unit: position rows divided by the reach, prismatic columns multiplied by it."""
+    """Smallest singular value of the reference Js at each sample over its largest, or over 1
+    where the largest is less (NaN where Js is undefined: Euler-angle rows at cos(pitch) <
+    EULER_MARGIN), made free of the length unit: position rows divided by the reach, prismatic
+    columns multiplied by it, so that no entry can exceed about 1. A Js that is small as a whole
+    is near singular so: a one-row Js near where the joints cannot move its task (3e-5 there
+    left the float C a relative error of 2.5e-4 in it, and in velocity_ik's residual)."""
     ratios = np.full(len(q), np.nan)
     length = robot.reach or 1.0
     rows = np.array([length if component in ("x", "y", "z") else 1.0 for component in robot.task])
@@ -177,8 +180,7 @@ def _rank_ratios(robot: Robot, q: np.ndarray) -> np.ndarray:
         if js_rank.singularity_rows(robot) is None and np.hypot(rotation[0, 0], rotation[1, 0]) < EULER_MARGIN:
             continue
         values = np.linalg.svd(reference.singularity_jacobian(robot, row) * columns / rows[:, None], compute_uv=False)
-        # A Js that is zero to rounding (a 1 x 1 Js of a task the joint cannot move) is singular.
-        ratios[k] = values[-1] / values[0] if values[0] > ZERO_JACOBIAN * (1 + robot.reach) else 0.0
+        ratios[k] = values[-1] / max(values[0], 1.0)
     return ratios
 
 

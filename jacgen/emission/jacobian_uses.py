@@ -17,7 +17,7 @@ from jacgen.model import kinematics
 from jacgen.model.graph import elementwise
 from jacgen.model.js_rank import singularity_rows
 from jacgen.model.kinematics import generated_symbol
-from jacgen.model.node import NUMBER, Kernel, Node
+from jacgen.model.node import NUMBER, OR, Kernel, Node
 from jacgen.model.tolerance_symbols import EPS
 from jacgen.solvers import differential, singular_values
 
@@ -151,15 +151,28 @@ def condition_number_function(generator, js: sympy.Matrix) -> Function | None:
     for value in values[1:]:
         largest = name(g.select(g.relation(">", value, largest), value, largest))
         smallest = name(g.select(g.relation("<", value, smallest), value, smallest))
-    # sigma_min at most EPS sigma_max is rounding's: 0, and kappa infinite (x / 0 in IEEE arithmetic).
-    # A Js singular everywhere (a smallest value that is the number 0) gets no condition_number.
+    # Js is singular to rounding where sigma_min is at most EPS sigma_max, or where sigma_max is at
+    # most EPS of the largest an entry can be (a task the joints cannot move: a one-row Js
+    # vanishes where the joints' motion is square to it): then sigma_min is 0, and kappa infinite
+    # (x / 0 in IEEE arithmetic). A Js singular everywhere (a smallest value that is the number 0)
+    # gets no condition_number.
     if smallest.kind == NUMBER:
         return None
-    smallest = name(g.select(g.relation("<=", smallest, g.symbol(EPS) * largest), g.number(0), smallest))
+    zero = g.logic(OR, g.relation("<=", smallest, g.symbol(EPS) * largest),
+                   g.relation("<=", largest, g.symbol(EPS) * g.value(largest_entry(generator))))
+    smallest = name(g.select(zero, g.number(0), smallest))
     positive = name(g.select(g.relation(">", largest, g.number(0)), largest, g.number(1)))
     return generator.function("condition_number", "sigma_max / sigma_min of Js with its position rows divided by "
-                              "CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max (Js singular to "
-                              "rounding)", scalar("kappa", positive / smallest))
+                              "CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS "
+                              "times its largest entry's bound (Js singular to rounding)",
+                              scalar("kappa", positive / smallest))
+
+
+def largest_entry(generator) -> float:
+    """A bound on the entries of Js with its position rows divided by L (`scaled_js`): an
+    angular row's are at most 1, a revolute column's position entries at most reach / L, a
+    prismatic column's 1 / L (`reference.condition_number` reads the same bound)."""
+    return 1 + (1 + generator.robot.reach) / generator.model.dexterity.length
 
 
 def velocity_solve(generator, js: sympy.Matrix) -> Kernel:
