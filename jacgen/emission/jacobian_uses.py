@@ -175,26 +175,22 @@ def largest_entry(generator) -> float:
     return 1 + (1 + generator.robot.reach) / generator.model.dexterity.length
 
 
-def velocity_solve(generator, js: sympy.Matrix) -> Kernel:
+def velocity_solve(generator, js: sympy.Matrix, joints: list[sympy.Symbol], mu_dot: list[sympy.Symbol],
+                   damping: sympy.Symbol, z: list[sympy.Symbol]) -> Kernel:
     """The solve of velocity_ik and its relatives (`differential.velocity_ik`): one kernel,
     (joint values, mu_dot, damping[, z]) to (q_dot, status), that velocity_ik,
     velocity_ik_nullspace and resolved_rate call (`_rate_functions`); z only where Js has a
-    null space (m < n). Its joint values (`_joint_values`) are what Js reads, which the callers
-    compute (resolved_rate's task error reads them too): a q that is not finite has a cos and
-    sin that are not."""
-    m, n = js.shape
-    mu_dot = [generated_symbol("mu_dot", i) for i in range(m)]
-    damping = generator.damping_argument().symbols[0]
-    z = [generated_symbol("qz", i + 1) for i in range(n)] if m < n else []
-
+    null space (m < n; empty otherwise). Its joint values (`_joint_values`) are what Js reads,
+    which the callers compute (resolved_rate's task error reads them too): a q that is not
+    finite has a cos and sin that are not."""
     def solved() -> list:
-        q_dot, outcome = differential.velocity_ik(js, _joint_values(generator), mu_dot, damping, generator.graph,
-                                                  generator.name_node, generator.lowering.called, z or None)
+        q_dot, outcome = differential.velocity_ik(js, joints, mu_dot, damping, generator.graph, generator.name_node,
+                                                  generator.lowering.called, z or None)
         return [*q_dot, outcome]
 
     return generator.lowering.kernel("velocity_solve", "the joint rates q_dot solving Js q_dot = mu_dot (plus z's "
                                      "motion in the null space of Js, if it has one), and velocity_ik's status",
-                                     [*_joint_values(generator), *mu_dot, damping, *z], solved)
+                                     [*joints, *mu_dot, damping, *z], solved)
 
 
 def _joint_values(generator) -> list[sympy.Symbol]:
@@ -212,14 +208,15 @@ def _rate_functions(generator, js: sympy.Matrix, task_jacobian: sympy.Matrix,
     z = Argument("z", sympy.Matrix([generated_symbol("qz", i + 1) for i in range(n)]))
     damping = generator.damping_argument()
     form = "Js# mu_dot + (I - Js# Js) z" + (" (Js has no null space: z is not used)" if m >= n else "")
+    mu_dot = Argument("mu_dot", sympy.Matrix([generated_symbol("mu_dot", i) for i in range(m)]))
+    joints, null_space = _joint_values(generator), list(z.symbols) if m < n else []
 
-    def solve(mu_dot: list, z: list) -> tuple[list, Node]:
-        solved = generator.lowering.run(velocity_solve(generator, js), 1,
-                                        [*_joint_values(generator), *mu_dot, *damping.symbols, *z[:n * (m < n)]])
+    def solve(rates: list, motion: list) -> tuple[list, Node]:
+        kernel = velocity_solve(generator, js, joints, list(mu_dot.symbols), damping.symbols[0], null_space)
+        solved = generator.lowering.run(kernel, 1, [*joints, *rates, *damping.symbols, *motion[:len(null_space)]])
         return solved[:n], solved[n]
 
     made = []
-    mu_dot = Argument("mu_dot", sympy.Matrix([generated_symbol("mu_dot", i) for i in range(m)]))
     if generator.generates("velocity_ik"):
         q_dot, outcome = solve(list(mu_dot.symbols), [0] * n)
         solution = "Js^-1 mu_dot (damping 0) or " if m == n else ""
