@@ -8,6 +8,7 @@ from click.testing import CliRunner
 from scipy.optimize import brentq
 
 from jacgen.checking import reference, samples, verify
+from jacgen.checking.dexterity_checks import characteristic_length
 from jacgen.cli import main
 from jacgen.checking.c_library import CompileError, compile_shared
 from jacgen.checking.generated_code import HOST_BACKENDS, TARGET_BACKENDS
@@ -151,6 +152,7 @@ def test_a_js_that_vanishes_as_a_whole_is_singular(tmp_path):
     arm = load_robot(path)
     q1 = brentq(lambda angle: reference.singularity_jacobian(arm, np.array([angle, 0.4]))[0, 0], -1.7, -1.6)
     q = np.array([q1, 0.4])
+    length = characteristic_length(arm)
     assert np.abs(reference.singularity_jacobian(arm, q)).max() < 1e-15
-    assert reference.condition_number(arm, q, 1.0, 1e-12) == math.inf
-    assert reference.condition_number(arm, q + [2e-3, 0], 1.0, 1e-6) == 1.0
+    assert reference.condition_number(arm, q, length, 1e-12) == math.inf
+    assert reference.condition_number(arm, q + [2e-3, 0], length, 1e-6) == 1.0
