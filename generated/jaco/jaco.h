@@ -109,7 +109,7 @@ void jaco_manipulability_gradient(const jaco_real q[JACO_DOF], jaco_real dw[JACO
 void jaco_velocity_ellipsoid(const jaco_real q[JACO_DOF], jaco_real U_v[9], jaco_real s_v[3], jaco_real U_w[9], jaco_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding).
- * Result: returned as a scalar. 8511 operations. */
+ * Result: returned as a scalar. 8574 operations. */
 jaco_real jaco_condition_number(const jaco_real q[JACO_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

@@ -109,7 +109,7 @@ void kr5_manipulability_gradient(const kr5_real q[KR5_DOF], kr5_real dw[KR5_DOF]
 void kr5_velocity_ellipsoid(const kr5_real q[KR5_DOF], kr5_real U_v[9], kr5_real s_v[3], kr5_real U_w[9], kr5_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding).
- * Result: returned as a scalar. 8386 operations. */
+ * Result: returned as a scalar. 8449 operations. */
 kr5_real kr5_condition_number(const kr5_real q[KR5_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

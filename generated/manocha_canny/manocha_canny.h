@@ -109,7 +109,7 @@ void manocha_canny_manipulability_gradient(const manocha_canny_real q[MANOCHA_CA
 void manocha_canny_velocity_ellipsoid(const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real U_v[9], manocha_canny_real s_v[3], manocha_canny_real U_w[9], manocha_canny_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding).
- * Result: returned as a scalar. 8367 operations. */
+ * Result: returned as a scalar. 8430 operations. */
 manocha_canny_real manocha_canny_condition_number(const manocha_canny_real q[MANOCHA_CANNY_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

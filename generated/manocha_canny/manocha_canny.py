@@ -93,12 +93,12 @@ def _jacobi3_columns_2(xp, count, state):
         t3 = w9**2 + w10**2 + w11**2
         t4 = w12**2 + w13**2 + w14**2
         t5 = w15**2 + w16**2 + w17**2
-        t6 = w3*w6 + w4*w7 + w5*w8
-        t7 = w12*w15 + w13*w16 + w14*w17
-        t8 = -t1 + t2
+        t6 = w0*w3 + w1*w4 + w2*w5
+        t7 = w9*w12 + w10*w13 + w11*w14
+        t8 = -t0 + t1
         t9 = xp.sqrt(t8**2 + 4*t6**2)
         t10 = t9 + xp.abs(t8)
-        t11 = -t4 + t5
+        t11 = -t3 + t4
         t12 = xp.sqrt(4*t7**2 + t11**2)
         t13 = t12 + xp.abs(t11)
         t14 = xp.greater(t10, 0)
@@ -110,131 +110,131 @@ def _jacobi3_columns_2(xp, count, state):
         t20 = xp.where(t18, xp.where(xp.greater_equal(t11, 0), t19, -t19)/xp.where(t18, t13, 1), 0)
         t21 = 1/xp.sqrt(1 + t20**2)
         t22 = t6*t16
-        t23 = -t22 + t1
-        t24 = t22 + t2
-        t25 = -t0 + t24
-        t26 = w3*t17
-        t27 = w6*t17
+        t23 = -t22 + t0
+        t24 = t22 + t1
+        t25 = -t2 + t23
+        t26 = w0*t17
+        t27 = w3*t17
         t28 = t26 - t27*t16
         t29 = t27 + t26*t16
-        t30 = w4*t17
-        t31 = w7*t17
+        t30 = w1*t17
+        t31 = w4*t17
         t32 = t30 - t31*t16
         t33 = t31 + t30*t16
-        t34 = w5*t17
-        t35 = w8*t17
+        t34 = w2*t17
+        t35 = w5*t17
         t36 = t34 - t35*t16
         t37 = t35 + t34*t16
-        t38 = w0*t29 + w1*t33 + w2*t37
+        t38 = w6*t28 + w7*t32 + w8*t36
         t39 = xp.sqrt(4*t38**2 + t25**2)
         t40 = t39 + xp.abs(t25)
-        t41 = w21*t17
-        t42 = w24*t17
+        t41 = w18*t17
+        t42 = w21*t17
         t43 = t41 - t42*t16
         t44 = t42 + t41*t16
-        t45 = w22*t17
-        t46 = w25*t17
+        t45 = w19*t17
+        t46 = w22*t17
         t47 = t45 - t46*t16
         t48 = t46 + t45*t16
-        t49 = w23*t17
-        t50 = w26*t17
+        t49 = w20*t17
+        t50 = w23*t17
         t51 = t49 - t50*t16
         t52 = t50 + t49*t16
         t53 = t7*t20
-        t54 = -t53 + t4
-        t55 = t53 + t5
-        t56 = -t3 + t55
-        t57 = w12*t21
-        t58 = w15*t21
+        t54 = -t53 + t3
+        t55 = t53 + t4
+        t56 = -t5 + t54
+        t57 = w9*t21
+        t58 = w12*t21
         t59 = t57 - t58*t20
         t60 = t58 + t57*t20
-        t61 = w13*t21
-        t62 = w16*t21
+        t61 = w10*t21
+        t62 = w13*t21
         t63 = t61 - t62*t20
         t64 = t62 + t61*t20
-        t65 = w14*t21
-        t66 = w17*t21
+        t65 = w11*t21
+        t66 = w14*t21
         t67 = t65 - t66*t20
         t68 = t66 + t65*t20
-        t69 = w9*t60 + w10*t64 + w11*t68
+        t69 = w15*t59 + w16*t63 + w17*t67
         t70 = xp.sqrt(4*t69**2 + t56**2)
         t71 = t70 + xp.abs(t56)
-        t72 = w30*t21
-        t73 = w33*t21
+        t72 = w27*t21
+        t73 = w30*t21
         t74 = t72 - t73*t20
         t75 = t73 + t72*t20
-        t76 = w31*t21
-        t77 = w34*t21
+        t76 = w28*t21
+        t77 = w31*t21
         t78 = t76 - t77*t20
         t79 = t77 + t76*t20
-        t80 = w32*t21
-        t81 = w35*t21
+        t80 = w29*t21
+        t81 = w32*t21
         t82 = t80 - t81*t20
         t83 = t81 + t80*t20
         t84 = xp.greater(t40, 0)
         t85 = 2*t38
         t86 = xp.where(t84, xp.where(xp.greater_equal(t25, 0), t85, -t85)/xp.where(t84, t40, 1), 0)
         t87 = 1/xp.sqrt(1 + t86**2)
-        t88 = t0 - t38*t86
-        t89 = -t88 + t23
+        t88 = t2 - t38*t86
+        t89 = -t24 + t88
         t90 = xp.greater(t71, 0)
         t91 = 2*t69
         t92 = xp.where(t90, xp.where(xp.greater_equal(t56, 0), t91, -t91)/xp.where(t90, t71, 1), 0)
         t93 = 1/xp.sqrt(1 + t92**2)
-        t94 = t3 - t69*t92
-        t95 = -t94 + t54
-        t96 = w0*t87
-        t97 = t29*t87
+        t94 = t5 - t69*t92
+        t95 = -t55 + t94
+        t96 = w6*t87
+        t97 = t28*t87
         t98 = t96 - t97*t86
         t99 = t97 + t96*t86
-        t100 = w1*t87
-        t101 = t33*t87
+        t100 = w7*t87
+        t101 = t32*t87
         t102 = t100 - t101*t86
         t103 = t101 + t100*t86
-        t104 = w2*t87
-        t105 = t37*t87
+        t104 = w8*t87
+        t105 = t36*t87
         t106 = t104 - t105*t86
         t107 = t105 + t104*t86
-        t108 = t28*t98 + t32*t102 + t36*t106
+        t108 = t29*t98 + t33*t102 + t37*t106
         t109 = xp.sqrt(4*t108**2 + t89**2)
         t110 = t109 + xp.abs(t89)
-        t111 = w18*t87
-        t112 = t44*t87
+        t111 = w24*t87
+        t112 = t43*t87
         t113 = t111 - t112*t86
         t114 = t112 + t111*t86
-        t115 = w19*t87
-        t116 = t48*t87
+        t115 = w25*t87
+        t116 = t47*t87
         t117 = t115 - t116*t86
         t118 = t116 + t115*t86
-        t119 = w20*t87
-        t120 = t52*t87
+        t119 = w26*t87
+        t120 = t51*t87
         t121 = t119 - t120*t86
         t122 = t120 + t119*t86
-        t123 = w9*t93
-        t124 = t60*t93
+        t123 = w15*t93
+        t124 = t59*t93
         t125 = t123 - t124*t92
         t126 = t124 + t123*t92
-        t127 = w10*t93
-        t128 = t64*t93
+        t127 = w16*t93
+        t128 = t63*t93
         t129 = t127 - t128*t92
         t130 = t128 + t127*t92
-        t131 = w11*t93
-        t132 = t68*t93
+        t131 = w17*t93
+        t132 = t67*t93
         t133 = t131 - t132*t92
         t134 = t132 + t131*t92
-        t135 = t59*t125 + t63*t129 + t67*t133
+        t135 = t60*t125 + t64*t129 + t68*t133
         t136 = xp.sqrt(4*t135**2 + t95**2)
         t137 = t136 + xp.abs(t95)
-        t138 = w27*t93
-        t139 = t75*t93
+        t138 = w33*t93
+        t139 = t74*t93
         t140 = t138 - t139*t92
         t141 = t139 + t138*t92
-        t142 = w28*t93
-        t143 = t79*t93
+        t142 = w34*t93
+        t143 = t78*t93
         t144 = t142 - t143*t92
         t145 = t143 + t142*t92
-        t146 = w29*t93
-        t147 = t83*t93
+        t146 = w35*t93
+        t147 = t82*t93
         t148 = t146 - t147*t92
         t149 = t147 + t146*t92
         t150 = xp.greater(t110, 0)
@@ -245,98 +245,258 @@ def _jacobi3_columns_2(xp, count, state):
         t155 = 2*t135
         t156 = xp.where(t154, xp.where(xp.greater_equal(t95, 0), t155, -t155)/xp.where(t154, t137, 1), 0)
         t157 = 1/xp.sqrt(1 + t156**2)
-        t158 = t98*t153
-        t159 = t28*t153
+        t158 = t29*t153
+        t159 = t98*t153
         t160 = t158 - t159*t152
         t161 = t159 + t158*t152
-        t162 = t102*t153
-        t163 = t32*t153
+        t162 = t33*t153
+        t163 = t102*t153
         t164 = t162 - t163*t152
         t165 = t163 + t162*t152
-        t166 = t106*t153
-        t167 = t36*t153
+        t166 = t37*t153
+        t167 = t106*t153
         t168 = t166 - t167*t152
         t169 = t167 + t166*t152
-        t170 = t113*t153
-        t171 = t43*t153
+        t170 = t44*t153
+        t171 = t113*t153
         t172 = t170 - t171*t152
         t173 = t171 + t170*t152
-        t174 = t117*t153
-        t175 = t47*t153
+        t174 = t48*t153
+        t175 = t117*t153
         t176 = t174 - t175*t152
         t177 = t175 + t174*t152
-        t178 = t121*t153
-        t179 = t51*t153
+        t178 = t52*t153
+        t179 = t121*t153
         t180 = t178 - t179*t152
         t181 = t179 + t178*t152
-        t182 = t125*t157
-        t183 = t59*t157
+        t182 = t60*t157
+        t183 = t125*t157
         t184 = t182 - t183*t156
         t185 = t183 + t182*t156
-        t186 = t129*t157
-        t187 = t63*t157
+        t186 = t64*t157
+        t187 = t129*t157
         t188 = t186 - t187*t156
         t189 = t187 + t186*t156
-        t190 = t133*t157
-        t191 = t67*t157
+        t190 = t68*t157
+        t191 = t133*t157
         t192 = t190 - t191*t156
         t193 = t191 + t190*t156
-        t194 = t140*t157
-        t195 = t74*t157
+        t194 = t75*t157
+        t195 = t140*t157
         t196 = t194 - t195*t156
         t197 = t195 + t194*t156
-        t198 = t144*t157
-        t199 = t78*t157
+        t198 = t79*t157
+        t199 = t144*t157
         t200 = t198 - t199*t156
         t201 = t199 + t198*t156
-        t202 = t148*t157
-        t203 = t82*t157
+        t202 = t83*t157
+        t203 = t148*t157
         t204 = t202 - t203*t156
         t205 = t203 + t202*t156
         state = (
+            t99,
+            t103,
+            t107,
             t160,
             t164,
             t168,
             t161,
             t165,
             t169,
-            t99,
-            t103,
-            t107,
+            t126,
+            t130,
+            t134,
             t184,
             t188,
             t192,
             t185,
             t189,
             t193,
-            t126,
-            t130,
-            t134,
+            t114,
+            t118,
+            t122,
             t172,
             t176,
             t180,
             t173,
             t177,
             t181,
-            t114,
-            t118,
-            t122,
+            t141,
+            t145,
+            t149,
             t196,
             t200,
             t204,
             t197,
             t201,
             t205,
-            t141,
-            t145,
-            t149,
         )
     return state
 
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
+def _jacobi6_rows_round(xp, count, state):
+    """Round of Jacobi rotations of a 6 x 6 matrix (its rows), `count` times: 213 operations a run."""
+    batch = numpy.broadcast_shapes(*(getattr(value, "shape", ()) for value in state))
+    if count > 1:  # each entry a loop carries at the batch's shape (a call's broadcast as written out)
+        state = xp.broadcast_arrays(*state)
+    dtype, device = state[0].dtype, getattr(state[0], "device", None)  # as the function's
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, w36, w37, w38, w39, w40, w41, = state
+        t0 = w0*w30 + w1*w31 + w2*w32 + w3*w33 + w4*w34 + w5*w35
+        t1 = w6*w24 + w7*w25 + w8*w26 + w9*w27 + w10*w28 + w11*w29
+        t2 = w12*w18 + w13*w19 + w14*w20 + w15*w21 + w16*w22 + w17*w23
+        t3 = -w36 + w41
+        t4 = xp.sqrt(4*t0**2 + t3**2)
+        t5 = t4 + xp.abs(t3)
+        t6 = -w37 + w40
+        t7 = xp.sqrt(4*t1**2 + t6**2)
+        t8 = t7 + xp.abs(t6)
+        t9 = -w38 + w39
+        t10 = xp.sqrt(4*t2**2 + t9**2)
+        t11 = t10 + xp.abs(t9)
+        t12 = xp.greater(t5, 0)
+        t13 = 2*t0
+        t14 = xp.where(t12, xp.where(xp.greater_equal(t3, 0), t13, -t13)/xp.where(t12, t5, 1), 0)
+        t15 = 1/xp.sqrt(1 + t14**2)
+        t16 = xp.greater(t8, 0)
+        t17 = 2*t1
+        t18 = xp.where(t16, xp.where(xp.greater_equal(t6, 0), t17, -t17)/xp.where(t16, t8, 1), 0)
+        t19 = 1/xp.sqrt(1 + t18**2)
+        t20 = xp.greater(t11, 0)
+        t21 = 2*t2
+        t22 = xp.where(t20, xp.where(xp.greater_equal(t9, 0), t21, -t21)/xp.where(t20, t11, 1), 0)
+        t23 = 1/xp.sqrt(1 + t22**2)
+        t24 = t0*t14
+        t25 = -t24 + w36
+        t26 = t24 + w41
+        t27 = w0*t15
+        t28 = w30*t15
+        t29 = t27 - t28*t14
+        t30 = t28 + t27*t14
+        t31 = w1*t15
+        t32 = w31*t15
+        t33 = t31 - t32*t14
+        t34 = t32 + t31*t14
+        t35 = w2*t15
+        t36 = w32*t15
+        t37 = t35 - t36*t14
+        t38 = t36 + t35*t14
+        t39 = w3*t15
+        t40 = w33*t15
+        t41 = t39 - t40*t14
+        t42 = t40 + t39*t14
+        t43 = w4*t15
+        t44 = w34*t15
+        t45 = t43 - t44*t14
+        t46 = t44 + t43*t14
+        t47 = w5*t15
+        t48 = w35*t15
+        t49 = t47 - t48*t14
+        t50 = t48 + t47*t14
+        t51 = t1*t18
+        t52 = -t51 + w37
+        t53 = t51 + w40
+        t54 = w6*t19
+        t55 = w24*t19
+        t56 = t54 - t55*t18
+        t57 = t55 + t54*t18
+        t58 = w7*t19
+        t59 = w25*t19
+        t60 = t58 - t59*t18
+        t61 = t59 + t58*t18
+        t62 = w8*t19
+        t63 = w26*t19
+        t64 = t62 - t63*t18
+        t65 = t63 + t62*t18
+        t66 = w9*t19
+        t67 = w27*t19
+        t68 = t66 - t67*t18
+        t69 = t67 + t66*t18
+        t70 = w10*t19
+        t71 = w28*t19
+        t72 = t70 - t71*t18
+        t73 = t71 + t70*t18
+        t74 = w11*t19
+        t75 = w29*t19
+        t76 = t74 - t75*t18
+        t77 = t75 + t74*t18
+        t78 = t2*t22
+        t79 = -t78 + w38
+        t80 = t78 + w39
+        t81 = w12*t23
+        t82 = w18*t23
+        t83 = t81 - t82*t22
+        t84 = t82 + t81*t22
+        t85 = w13*t23
+        t86 = w19*t23
+        t87 = t85 - t86*t22
+        t88 = t86 + t85*t22
+        t89 = w14*t23
+        t90 = w20*t23
+        t91 = t89 - t90*t22
+        t92 = t90 + t89*t22
+        t93 = w15*t23
+        t94 = w21*t23
+        t95 = t93 - t94*t22
+        t96 = t94 + t93*t22
+        t97 = w16*t23
+        t98 = w22*t23
+        t99 = t97 - t98*t22
+        t100 = t98 + t97*t22
+        t101 = w17*t23
+        t102 = w23*t23
+        t103 = t101 - t102*t22
+        t104 = t102 + t101*t22
+        state = (
+            t29,
+            t33,
+            t37,
+            t41,
+            t45,
+            t49,
+            t30,
+            t34,
+            t38,
+            t42,
+            t46,
+            t50,
+            t56,
+            t60,
+            t64,
+            t68,
+            t72,
+            t76,
+            t83,
+            t87,
+            t91,
+            t95,
+            t99,
+            t103,
+            t84,
+            t88,
+            t92,
+            t96,
+            t100,
+            t104,
+            t57,
+            t61,
+            t65,
+            t69,
+            t73,
+            t77,
+            t25,
+            t26,
+            t52,
+            t79,
+            t80,
+            t53,
+        )
+    return state
+
+
 def _jacobi6_rows(xp, count, state):
-    """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1122 operations a run."""
+    """One-sided Jacobi sweep of a 6 x 6 matrix (its rows), `count` times: 1131 operations a run."""
     batch = numpy.broadcast_shapes(*(getattr(value, "shape", ()) for value in state))
     if count > 1:  # each entry a loop carries at the batch's shape (a call's broadcast as written out)
         state = xp.broadcast_arrays(*state)
@@ -349,559 +509,44 @@ def _jacobi6_rows(xp, count, state):
         t3 = w18**2 + w19**2 + w20**2 + w21**2 + w22**2 + w23**2
         t4 = w24**2 + w25**2 + w26**2 + w27**2 + w28**2 + w29**2
         t5 = w30**2 + w31**2 + w32**2 + w33**2 + w34**2 + w35**2
-        t6 = w0*w30 + w1*w31 + w2*w32 + w3*w33 + w4*w34 + w5*w35
-        t7 = w6*w24 + w7*w25 + w8*w26 + w9*w27 + w10*w28 + w11*w29
-        t8 = w12*w18 + w13*w19 + w14*w20 + w15*w21 + w16*w22 + w17*w23
-        t9 = -t0 + t5
-        t10 = xp.sqrt(4*t6**2 + t9**2)
-        t11 = t10 + xp.abs(t9)
-        t12 = -t1 + t4
-        t13 = xp.sqrt(4*t7**2 + t12**2)
-        t14 = t13 + xp.abs(t12)
-        t15 = -t2 + t3
-        t16 = xp.sqrt(4*t8**2 + t15**2)
-        t17 = t16 + xp.abs(t15)
-        t18 = xp.greater(t11, 0)
-        t19 = 2*t6
-        t20 = xp.where(t18, xp.where(xp.greater_equal(t9, 0), t19, -t19)/xp.where(t18, t11, 1), 0)
-        t21 = 1/xp.sqrt(1 + t20**2)
-        t22 = xp.greater(t14, 0)
-        t23 = 2*t7
-        t24 = xp.where(t22, xp.where(xp.greater_equal(t12, 0), t23, -t23)/xp.where(t22, t14, 1), 0)
-        t25 = 1/xp.sqrt(1 + t24**2)
-        t26 = xp.greater(t17, 0)
-        t27 = 2*t8
-        t28 = xp.where(t26, xp.where(xp.greater_equal(t15, 0), t27, -t27)/xp.where(t26, t17, 1), 0)
-        t29 = 1/xp.sqrt(1 + t28**2)
-        t30 = t6*t20
-        t31 = -t30 + t0
-        t32 = t30 + t5
-        t33 = w0*t21
-        t34 = w30*t21
-        t35 = t33 - t34*t20
-        t36 = t34 + t33*t20
-        t37 = w1*t21
-        t38 = w31*t21
-        t39 = t37 - t38*t20
-        t40 = t38 + t37*t20
-        t41 = w2*t21
-        t42 = w32*t21
-        t43 = t41 - t42*t20
-        t44 = t42 + t41*t20
-        t45 = w3*t21
-        t46 = w33*t21
-        t47 = t45 - t46*t20
-        t48 = t46 + t45*t20
-        t49 = w4*t21
-        t50 = w34*t21
-        t51 = t49 - t50*t20
-        t52 = t50 + t49*t20
-        t53 = w5*t21
-        t54 = w35*t21
-        t55 = t53 - t54*t20
-        t56 = t54 + t53*t20
-        t57 = t7*t24
-        t58 = -t57 + t1
-        t59 = t57 + t4
-        t60 = -t31 + t59
-        t61 = w6*t25
-        t62 = w24*t25
-        t63 = t61 - t62*t24
-        t64 = t62 + t61*t24
-        t65 = w7*t25
-        t66 = w25*t25
-        t67 = t65 - t66*t24
-        t68 = t66 + t65*t24
-        t69 = w8*t25
-        t70 = w26*t25
-        t71 = t69 - t70*t24
-        t72 = t70 + t69*t24
-        t73 = w9*t25
-        t74 = w27*t25
-        t75 = t73 - t74*t24
-        t76 = t74 + t73*t24
-        t77 = w10*t25
-        t78 = w28*t25
-        t79 = t77 - t78*t24
-        t80 = t78 + t77*t24
-        t81 = w11*t25
-        t82 = w29*t25
-        t83 = t81 - t82*t24
-        t84 = t82 + t81*t24
-        t85 = t35*t64 + t39*t68 + t43*t72 + t47*t76 + t51*t80 + t55*t84
-        t86 = xp.sqrt(4*t85**2 + t60**2)
-        t87 = t86 + xp.abs(t60)
-        t88 = t8*t28
-        t89 = -t88 + t2
-        t90 = t88 + t3
-        t91 = -t90 + t32
-        t92 = -t58 + t89
-        t93 = w12*t29
-        t94 = w18*t29
-        t95 = t93 - t94*t28
-        t96 = t94 + t93*t28
-        t97 = w13*t29
-        t98 = w19*t29
-        t99 = t97 - t98*t28
-        t100 = t98 + t97*t28
-        t101 = w14*t29
-        t102 = w20*t29
-        t103 = t101 - t102*t28
-        t104 = t102 + t101*t28
-        t105 = w15*t29
-        t106 = w21*t29
-        t107 = t105 - t106*t28
-        t108 = t106 + t105*t28
-        t109 = w16*t29
-        t110 = w22*t29
-        t111 = t109 - t110*t28
-        t112 = t110 + t109*t28
-        t113 = w17*t29
-        t114 = w23*t29
-        t115 = t113 - t114*t28
-        t116 = t114 + t113*t28
-        t117 = t36*t96 + t40*t100 + t44*t104 + t48*t108 + t52*t112 + t56*t116
-        t118 = t63*t95 + t67*t99 + t71*t103 + t75*t107 + t79*t111 + t83*t115
-        t119 = xp.sqrt(4*t117**2 + t91**2)
-        t120 = t119 + xp.abs(t91)
-        t121 = xp.sqrt(4*t118**2 + t92**2)
-        t122 = t121 + xp.abs(t92)
-        t123 = xp.greater(t87, 0)
-        t124 = 2*t85
-        t125 = xp.where(t123, xp.where(xp.greater_equal(t60, 0), t124, -t124)/xp.where(t123, t87, 1), 0)
-        t126 = 1/xp.sqrt(1 + t125**2)
-        t127 = xp.greater(t120, 0)
-        t128 = 2*t117
-        t129 = xp.where(t127, xp.where(xp.greater_equal(t91, 0), t128, -t128)/xp.where(t127, t120, 1), 0)
-        t130 = 1/xp.sqrt(1 + t129**2)
-        t131 = xp.greater(t122, 0)
-        t132 = 2*t118
-        t133 = xp.where(t131, xp.where(xp.greater_equal(t92, 0), t132, -t132)/xp.where(t131, t122, 1), 0)
-        t134 = 1/xp.sqrt(1 + t133**2)
-        t135 = t85*t125
-        t136 = -t135 + t31
-        t137 = t135 + t59
-        t138 = t35*t126
-        t139 = t64*t126
-        t140 = t138 - t139*t125
-        t141 = t139 + t138*t125
-        t142 = t39*t126
-        t143 = t68*t126
-        t144 = t142 - t143*t125
-        t145 = t143 + t142*t125
-        t146 = t43*t126
-        t147 = t72*t126
-        t148 = t146 - t147*t125
-        t149 = t147 + t146*t125
-        t150 = t47*t126
-        t151 = t76*t126
-        t152 = t150 - t151*t125
-        t153 = t151 + t150*t125
-        t154 = t51*t126
-        t155 = t80*t126
-        t156 = t154 - t155*t125
-        t157 = t155 + t154*t125
-        t158 = t55*t126
-        t159 = t84*t126
-        t160 = t158 - t159*t125
-        t161 = t159 + t158*t125
-        t162 = t117*t129
-        t163 = -t162 + t90
-        t164 = t162 + t32
-        t165 = -t136 + t163
-        t166 = t96*t130
-        t167 = t36*t130
-        t168 = t166 - t167*t129
-        t169 = t167 + t166*t129
-        t170 = t100*t130
-        t171 = t40*t130
-        t172 = t170 - t171*t129
-        t173 = t171 + t170*t129
-        t174 = t104*t130
-        t175 = t44*t130
-        t176 = t174 - t175*t129
-        t177 = t175 + t174*t129
-        t178 = t108*t130
-        t179 = t48*t130
-        t180 = t178 - t179*t129
-        t181 = t179 + t178*t129
-        t182 = t112*t130
-        t183 = t52*t130
-        t184 = t182 - t183*t129
-        t185 = t183 + t182*t129
-        t186 = t116*t130
-        t187 = t56*t130
-        t188 = t186 - t187*t129
-        t189 = t187 + t186*t129
-        t190 = t140*t168 + t144*t172 + t148*t176 + t152*t180 + t156*t184 + t160*t188
-        t191 = xp.sqrt(4*t190**2 + t165**2)
-        t192 = t191 + xp.abs(t165)
-        t193 = t118*t133
-        t194 = -t193 + t58
-        t195 = t193 + t89
-        t196 = -t195 + t137
-        t197 = -t194 + t164
-        t198 = t63*t134
-        t199 = t95*t134
-        t200 = t198 - t199*t133
-        t201 = t199 + t198*t133
-        t202 = t67*t134
-        t203 = t99*t134
-        t204 = t202 - t203*t133
-        t205 = t203 + t202*t133
-        t206 = t71*t134
-        t207 = t103*t134
-        t208 = t206 - t207*t133
-        t209 = t207 + t206*t133
-        t210 = t75*t134
-        t211 = t107*t134
-        t212 = t210 - t211*t133
-        t213 = t211 + t210*t133
-        t214 = t79*t134
-        t215 = t111*t134
-        t216 = t214 - t215*t133
-        t217 = t215 + t214*t133
-        t218 = t83*t134
-        t219 = t115*t134
-        t220 = t218 - t219*t133
-        t221 = t219 + t218*t133
-        t222 = t141*t201 + t145*t205 + t149*t209 + t153*t213 + t157*t217 + t161*t221
-        t223 = t169*t200 + t173*t204 + t177*t208 + t181*t212 + t185*t216 + t189*t220
-        t224 = xp.sqrt(4*t222**2 + t196**2)
-        t225 = t224 + xp.abs(t196)
-        t226 = xp.sqrt(4*t223**2 + t197**2)
-        t227 = t226 + xp.abs(t197)
-        t228 = xp.greater(t192, 0)
-        t229 = 2*t190
-        t230 = xp.where(t228, xp.where(xp.greater_equal(t165, 0), t229, -t229)/xp.where(t228, t192, 1), 0)
-        t231 = 1/xp.sqrt(1 + t230**2)
-        t232 = xp.greater(t225, 0)
-        t233 = 2*t222
-        t234 = xp.where(t232, xp.where(xp.greater_equal(t196, 0), t233, -t233)/xp.where(t232, t225, 1), 0)
-        t235 = 1/xp.sqrt(1 + t234**2)
-        t236 = xp.greater(t227, 0)
-        t237 = 2*t223
-        t238 = xp.where(t236, xp.where(xp.greater_equal(t197, 0), t237, -t237)/xp.where(t236, t227, 1), 0)
-        t239 = 1/xp.sqrt(1 + t238**2)
-        t240 = t190*t230
-        t241 = -t240 + t136
-        t242 = t240 + t163
-        t243 = t140*t231
-        t244 = t168*t231
-        t245 = t243 - t244*t230
-        t246 = t244 + t243*t230
-        t247 = t144*t231
-        t248 = t172*t231
-        t249 = t247 - t248*t230
-        t250 = t248 + t247*t230
-        t251 = t148*t231
-        t252 = t176*t231
-        t253 = t251 - t252*t230
-        t254 = t252 + t251*t230
-        t255 = t152*t231
-        t256 = t180*t231
-        t257 = t255 - t256*t230
-        t258 = t256 + t255*t230
-        t259 = t156*t231
-        t260 = t184*t231
-        t261 = t259 - t260*t230
-        t262 = t260 + t259*t230
-        t263 = t160*t231
-        t264 = t188*t231
-        t265 = t263 - t264*t230
-        t266 = t264 + t263*t230
-        t267 = t222*t234
-        t268 = -t267 + t195
-        t269 = t267 + t137
-        t270 = -t241 + t268
-        t271 = t201*t235
-        t272 = t141*t235
-        t273 = t271 - t272*t234
-        t274 = t272 + t271*t234
-        t275 = t205*t235
-        t276 = t145*t235
-        t277 = t275 - t276*t234
-        t278 = t276 + t275*t234
-        t279 = t209*t235
-        t280 = t149*t235
-        t281 = t279 - t280*t234
-        t282 = t280 + t279*t234
-        t283 = t213*t235
-        t284 = t153*t235
-        t285 = t283 - t284*t234
-        t286 = t284 + t283*t234
-        t287 = t217*t235
-        t288 = t157*t235
-        t289 = t287 - t288*t234
-        t290 = t288 + t287*t234
-        t291 = t221*t235
-        t292 = t161*t235
-        t293 = t291 - t292*t234
-        t294 = t292 + t291*t234
-        t295 = t245*t273 + t249*t277 + t253*t281 + t257*t285 + t261*t289 + t265*t293
-        t296 = xp.sqrt(4*t295**2 + t270**2)
-        t297 = t296 + xp.abs(t270)
-        t298 = t223*t238
-        t299 = -t298 + t194
-        t300 = t298 + t164
-        t301 = -t299 + t242
-        t302 = -t269 + t300
-        t303 = t200*t239
-        t304 = t169*t239
-        t305 = t303 - t238*t304
-        t306 = t304 + t238*t303
-        t307 = t204*t239
-        t308 = t173*t239
-        t309 = t307 - t238*t308
-        t310 = t308 + t238*t307
-        t311 = t208*t239
-        t312 = t177*t239
-        t313 = t311 - t238*t312
-        t314 = t312 + t238*t311
-        t315 = t212*t239
-        t316 = t181*t239
-        t317 = t315 - t238*t316
-        t318 = t316 + t238*t315
-        t319 = t216*t239
-        t320 = t185*t239
-        t321 = t319 - t238*t320
-        t322 = t320 + t238*t319
-        t323 = t220*t239
-        t324 = t189*t239
-        t325 = t323 - t238*t324
-        t326 = t324 + t238*t323
-        t327 = t246*t305 + t250*t309 + t254*t313 + t258*t317 + t262*t321 + t266*t325
-        t328 = t274*t306 + t278*t310 + t282*t314 + t286*t318 + t290*t322 + t294*t326
-        t329 = xp.sqrt(4*t327**2 + t301**2)
-        t330 = t329 + xp.abs(t301)
-        t331 = xp.sqrt(4*t328**2 + t302**2)
-        t332 = t331 + xp.abs(t302)
-        t333 = xp.greater(t297, 0)
-        t334 = 2*t295
-        t335 = xp.where(t333, xp.where(xp.greater_equal(t270, 0), t334, -t334)/xp.where(t333, t297, 1), 0)
-        t336 = 1/xp.sqrt(1 + t335**2)
-        t337 = xp.greater(t330, 0)
-        t338 = 2*t327
-        t339 = xp.where(t337, xp.where(xp.greater_equal(t301, 0), t338, -t338)/xp.where(t337, t330, 1), 0)
-        t340 = 1/xp.sqrt(1 + t339**2)
-        t341 = xp.greater(t332, 0)
-        t342 = 2*t328
-        t343 = xp.where(t341, xp.where(xp.greater_equal(t302, 0), t342, -t342)/xp.where(t341, t332, 1), 0)
-        t344 = 1/xp.sqrt(1 + t343**2)
-        t345 = t295*t335
-        t346 = -t345 + t241
-        t347 = t268 + t345
-        t348 = t245*t336
-        t349 = t273*t336
-        t350 = t348 - t335*t349
-        t351 = t349 + t335*t348
-        t352 = t249*t336
-        t353 = t277*t336
-        t354 = t352 - t335*t353
-        t355 = t353 + t335*t352
-        t356 = t253*t336
-        t357 = t281*t336
-        t358 = t356 - t335*t357
-        t359 = t357 + t335*t356
-        t360 = t257*t336
-        t361 = t285*t336
-        t362 = t360 - t335*t361
-        t363 = t361 + t335*t360
-        t364 = t261*t336
-        t365 = t289*t336
-        t366 = t364 - t335*t365
-        t367 = t365 + t335*t364
-        t368 = t265*t336
-        t369 = t293*t336
-        t370 = t368 - t335*t369
-        t371 = t369 + t335*t368
-        t372 = t327*t339
-        t373 = -t372 + t299
-        t374 = t242 + t372
-        t375 = -t346 + t373
-        t376 = t305*t340
-        t377 = t246*t340
-        t378 = t376 - t339*t377
-        t379 = t377 + t339*t376
-        t380 = t309*t340
-        t381 = t250*t340
-        t382 = t380 - t339*t381
-        t383 = t381 + t339*t380
-        t384 = t313*t340
-        t385 = t254*t340
-        t386 = t384 - t339*t385
-        t387 = t385 + t339*t384
-        t388 = t317*t340
-        t389 = t258*t340
-        t390 = t388 - t339*t389
-        t391 = t389 + t339*t388
-        t392 = t321*t340
-        t393 = t262*t340
-        t394 = t392 - t339*t393
-        t395 = t393 + t339*t392
-        t396 = t325*t340
-        t397 = t266*t340
-        t398 = t396 - t339*t397
-        t399 = t397 + t339*t396
-        t400 = t350*t378 + t354*t382 + t358*t386 + t362*t390 + t366*t394 + t370*t398
-        t401 = xp.sqrt(4*t400**2 + t375**2)
-        t402 = t401 + xp.abs(t375)
-        t403 = t328*t343
-        t404 = -t403 + t269
-        t405 = t300 + t403
-        t406 = -t347 + t405
-        t407 = -t374 + t404
-        t408 = t274*t344
-        t409 = t306*t344
-        t410 = t408 - t343*t409
-        t411 = t409 + t343*t408
-        t412 = t278*t344
-        t413 = t310*t344
-        t414 = t412 - t343*t413
-        t415 = t413 + t343*t412
-        t416 = t282*t344
-        t417 = t314*t344
-        t418 = t416 - t343*t417
-        t419 = t417 + t343*t416
-        t420 = t286*t344
-        t421 = t318*t344
-        t422 = t420 - t343*t421
-        t423 = t421 + t343*t420
-        t424 = t290*t344
-        t425 = t322*t344
-        t426 = t424 - t343*t425
-        t427 = t425 + t343*t424
-        t428 = t294*t344
-        t429 = t326*t344
-        t430 = t428 - t343*t429
-        t431 = t429 + t343*t428
-        t432 = t351*t411 + t355*t415 + t359*t419 + t363*t423 + t367*t427 + t371*t431
-        t433 = t379*t410 + t383*t414 + t387*t418 + t391*t422 + t395*t426 + t399*t430
-        t434 = xp.sqrt(4*t432**2 + t406**2)
-        t435 = t434 + xp.abs(t406)
-        t436 = xp.sqrt(4*t433**2 + t407**2)
-        t437 = t436 + xp.abs(t407)
-        t438 = xp.greater(t402, 0)
-        t439 = 2*t400
-        t440 = xp.where(t438, xp.where(xp.greater_equal(t375, 0), t439, -t439)/xp.where(t438, t402, 1), 0)
-        t441 = 1/xp.sqrt(1 + t440**2)
-        t442 = xp.greater(t435, 0)
-        t443 = 2*t432
-        t444 = xp.where(t442, xp.where(xp.greater_equal(t406, 0), t443, -t443)/xp.where(t442, t435, 1), 0)
-        t445 = 1/xp.sqrt(1 + t444**2)
-        t446 = xp.greater(t437, 0)
-        t447 = 2*t433
-        t448 = xp.where(t446, xp.where(xp.greater_equal(t407, 0), t447, -t447)/xp.where(t446, t437, 1), 0)
-        t449 = 1/xp.sqrt(1 + t448**2)
-        t450 = t350*t441
-        t451 = t378*t441
-        t452 = t450 - t440*t451
-        t453 = t451 + t440*t450
-        t454 = t354*t441
-        t455 = t382*t441
-        t456 = t454 - t440*t455
-        t457 = t455 + t440*t454
-        t458 = t358*t441
-        t459 = t386*t441
-        t460 = t458 - t440*t459
-        t461 = t459 + t440*t458
-        t462 = t362*t441
-        t463 = t390*t441
-        t464 = t462 - t440*t463
-        t465 = t463 + t440*t462
-        t466 = t366*t441
-        t467 = t394*t441
-        t468 = t466 - t440*t467
-        t469 = t467 + t440*t466
-        t470 = t370*t441
-        t471 = t398*t441
-        t472 = t470 - t440*t471
-        t473 = t471 + t440*t470
-        t474 = t351*t445
-        t475 = t411*t445
-        t476 = t474 - t444*t475
-        t477 = t475 + t444*t474
-        t478 = t355*t445
-        t479 = t415*t445
-        t480 = t478 - t444*t479
-        t481 = t479 + t444*t478
-        t482 = t359*t445
-        t483 = t419*t445
-        t484 = t482 - t444*t483
-        t485 = t483 + t444*t482
-        t486 = t363*t445
-        t487 = t423*t445
-        t488 = t486 - t444*t487
-        t489 = t487 + t444*t486
-        t490 = t367*t445
-        t491 = t427*t445
-        t492 = t490 - t444*t491
-        t493 = t491 + t444*t490
-        t494 = t371*t445
-        t495 = t431*t445
-        t496 = t494 - t444*t495
-        t497 = t495 + t444*t494
-        t498 = t379*t449
-        t499 = t410*t449
-        t500 = t498 - t448*t499
-        t501 = t499 + t448*t498
-        t502 = t383*t449
-        t503 = t414*t449
-        t504 = t502 - t448*t503
-        t505 = t503 + t448*t502
-        t506 = t387*t449
-        t507 = t418*t449
-        t508 = t506 - t448*t507
-        t509 = t507 + t448*t506
-        t510 = t391*t449
-        t511 = t422*t449
-        t512 = t510 - t448*t511
-        t513 = t511 + t448*t510
-        t514 = t395*t449
-        t515 = t426*t449
-        t516 = t514 - t448*t515
-        t517 = t515 + t448*t514
-        t518 = t399*t449
-        t519 = t430*t449
-        t520 = t518 - t448*t519
-        t521 = t519 + t448*t518
+        t6 = _jacobi6_rows_round(xp, 5, (w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, t0, t1, t2, t3, t4, t5,))
         state = (
-            t452,
-            t456,
-            t460,
-            t464,
-            t468,
-            t472,
-            t453,
-            t457,
-            t461,
-            t465,
-            t469,
-            t473,
-            t476,
-            t480,
-            t484,
-            t488,
-            t492,
-            t496,
-            t500,
-            t504,
-            t508,
-            t512,
-            t516,
-            t520,
-            t501,
-            t505,
-            t509,
-            t513,
-            t517,
-            t521,
-            t477,
-            t481,
-            t485,
-            t489,
-            t493,
-            t497,
+            t6[0],
+            t6[1],
+            t6[2],
+            t6[3],
+            t6[4],
+            t6[5],
+            t6[6],
+            t6[7],
+            t6[8],
+            t6[9],
+            t6[10],
+            t6[11],
+            t6[12],
+            t6[13],
+            t6[14],
+            t6[15],
+            t6[16],
+            t6[17],
+            t6[18],
+            t6[19],
+            t6[20],
+            t6[21],
+            t6[22],
+            t6[23],
+            t6[24],
+            t6[25],
+            t6[26],
+            t6[27],
+            t6[28],
+            t6[29],
+            t6[30],
+            t6[31],
+            t6[32],
+            t6[33],
+            t6[34],
+            t6[35],
         )
     return state
 
@@ -4111,7 +3756,7 @@ def velocity_ellipsoid(q):
 
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def condition_number(q):
-    """sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): (1 x 1), 8367 operations."""
+    """sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): (1 x 1), 8430 operations."""
     xp, dtype, device, batch, (q,) = _arguments(("q", q, (6,)))
     trig = _cos_sin(xp, q, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), device)
     c1 = trig[..., 0]

@@ -109,7 +109,7 @@ void mico_manipulability_gradient(const mico_real q[MICO_DOF], mico_real dw[MICO
 void mico_velocity_ellipsoid(const mico_real q[MICO_DOF], mico_real U_v[9], mico_real s_v[3], mico_real U_w[9], mico_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding).
- * Result: returned as a scalar. 8511 operations. */
+ * Result: returned as a scalar. 8574 operations. */
 mico_real mico_condition_number(const mico_real q[MICO_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

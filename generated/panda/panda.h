@@ -107,7 +107,7 @@ void panda_manipulability_gradient(const panda_real q[PANDA_DOF], panda_real dw[
 void panda_velocity_ellipsoid(const panda_real q[PANDA_DOF], panda_real U_v[9], panda_real s_v[3], panda_real U_w[9], panda_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding).
- * Result: returned as a scalar. 8526 operations. */
+ * Result: returned as a scalar. 8589 operations. */
 panda_real panda_condition_number(const panda_real q[PANDA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

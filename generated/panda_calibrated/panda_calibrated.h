@@ -107,7 +107,7 @@ void panda_calibrated_manipulability_gradient(const panda_calibrated_real q[PAND
 void panda_calibrated_velocity_ellipsoid(const panda_calibrated_real q[PANDA_CALIBRATED_DOF], panda_calibrated_real U_v[9], panda_calibrated_real s_v[3], panda_calibrated_real U_w[9], panda_calibrated_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding).
- * Result: returned as a scalar. 8751 operations. */
+ * Result: returned as a scalar. 8814 operations. */
 panda_calibrated_real panda_calibrated_condition_number(const panda_calibrated_real q[PANDA_CALIBRATED_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

@@ -109,7 +109,7 @@ void puma560_manipulability_gradient(const puma560_real q[PUMA560_DOF], puma560_
 void puma560_velocity_ellipsoid(const puma560_real q[PUMA560_DOF], puma560_real U_v[9], puma560_real s_v[3], puma560_real U_w[9], puma560_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding).
- * Result: returned as a scalar. 8227 operations. */
+ * Result: returned as a scalar. 8290 operations. */
 puma560_real puma560_condition_number(const puma560_real q[PUMA560_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

@@ -107,7 +107,7 @@ void rexarm_manipulability_gradient(const rexarm_real q[REXARM_DOF], rexarm_real
 void rexarm_velocity_ellipsoid(const rexarm_real q[REXARM_DOF], rexarm_real U_v[9], rexarm_real s_v[3], rexarm_real U_w[9], rexarm_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding).
- * Result: returned as a scalar. 2731 operations. */
+ * Result: returned as a scalar. 2773 operations. */
 rexarm_real rexarm_condition_number(const rexarm_real q[REXARM_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

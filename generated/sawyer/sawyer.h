@@ -107,7 +107,7 @@ void sawyer_manipulability_gradient(const sawyer_real q[SAWYER_DOF], sawyer_real
 void sawyer_velocity_ellipsoid(const sawyer_real q[SAWYER_DOF], sawyer_real U_v[9], sawyer_real s_v[3], sawyer_real U_w[9], sawyer_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding).
- * Result: returned as a scalar. 8522 operations. */
+ * Result: returned as a scalar. 8585 operations. */
 sawyer_real sawyer_condition_number(const sawyer_real q[SAWYER_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

@@ -107,7 +107,7 @@ void scara_manipulability_gradient(const scara_real q[SCARA_DOF], scara_real dw[
 void scara_velocity_ellipsoid(const scara_real q[SCARA_DOF], scara_real U_v[9], scara_real s_v[3], scara_real U_w[9], scara_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding).
- * Result: returned as a scalar. 2573 operations. */
+ * Result: returned as a scalar. 2615 operations. */
 scara_real scara_condition_number(const scara_real q[SCARA_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

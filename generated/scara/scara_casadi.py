@@ -28,12 +28,12 @@ def _jacobi3_columns_2(count, state):
         t3 = w9**2 + w10**2 + w11**2
         t4 = w12**2 + w13**2 + w14**2
         t5 = w15**2 + w16**2 + w17**2
-        t6 = w3*w6 + w4*w7 + w5*w8
-        t7 = w12*w15 + w13*w16 + w14*w17
-        t8 = -t1 + t2
+        t6 = w0*w3 + w1*w4 + w2*w5
+        t7 = w9*w12 + w10*w13 + w11*w14
+        t8 = -t0 + t1
         t9 = casadi.sqrt(4*t6**2 + t8**2)
         t10 = t9 + casadi.fabs(t8)
-        t11 = -t4 + t5
+        t11 = -t3 + t4
         t12 = casadi.sqrt(4*t7**2 + t11**2)
         t13 = t12 + casadi.fabs(t11)
         t14 = (t10 > 0)
@@ -45,131 +45,131 @@ def _jacobi3_columns_2(count, state):
         t20 = casadi.if_else(t18, casadi.if_else((t11 >= 0), t19, -t19)/casadi.if_else(t18, t13, 1), 0)
         t21 = 1/casadi.sqrt(1 + t20**2)
         t22 = t6*t16
-        t23 = -t22 + t1
-        t24 = t22 + t2
-        t25 = -t0 + t24
-        t26 = w3*t17
-        t27 = w6*t17
+        t23 = -t22 + t0
+        t24 = t22 + t1
+        t25 = -t2 + t23
+        t26 = w0*t17
+        t27 = w3*t17
         t28 = t26 - t27*t16
         t29 = t27 + t26*t16
-        t30 = w4*t17
-        t31 = w7*t17
+        t30 = w1*t17
+        t31 = w4*t17
         t32 = t30 - t31*t16
         t33 = t31 + t30*t16
-        t34 = w5*t17
-        t35 = w8*t17
+        t34 = w2*t17
+        t35 = w5*t17
         t36 = t34 - t35*t16
         t37 = t35 + t34*t16
-        t38 = w0*t29 + w1*t33 + w2*t37
+        t38 = w6*t28 + w7*t32 + w8*t36
         t39 = casadi.sqrt(4*t38**2 + t25**2)
         t40 = t39 + casadi.fabs(t25)
-        t41 = w21*t17
-        t42 = w24*t17
+        t41 = w18*t17
+        t42 = w21*t17
         t43 = t41 - t16*t42
         t44 = t42 + t41*t16
-        t45 = w22*t17
-        t46 = w25*t17
+        t45 = w19*t17
+        t46 = w22*t17
         t47 = t45 - t16*t46
         t48 = t46 + t16*t45
-        t49 = w23*t17
-        t50 = w26*t17
+        t49 = w20*t17
+        t50 = w23*t17
         t51 = t49 - t16*t50
         t52 = t50 + t16*t49
         t53 = t7*t20
-        t54 = -t53 + t4
-        t55 = t5 + t53
-        t56 = -t3 + t55
-        t57 = w12*t21
-        t58 = w15*t21
+        t54 = -t53 + t3
+        t55 = t4 + t53
+        t56 = -t5 + t54
+        t57 = w9*t21
+        t58 = w12*t21
         t59 = t57 - t20*t58
         t60 = t58 + t20*t57
-        t61 = w13*t21
-        t62 = w16*t21
+        t61 = w10*t21
+        t62 = w13*t21
         t63 = t61 - t20*t62
         t64 = t62 + t20*t61
-        t65 = w14*t21
-        t66 = w17*t21
+        t65 = w11*t21
+        t66 = w14*t21
         t67 = t65 - t20*t66
         t68 = t66 + t20*t65
-        t69 = w9*t60 + w10*t64 + w11*t68
+        t69 = w15*t59 + w16*t63 + w17*t67
         t70 = casadi.sqrt(4*t69**2 + t56**2)
         t71 = t70 + casadi.fabs(t56)
-        t72 = w30*t21
-        t73 = w33*t21
+        t72 = w27*t21
+        t73 = w30*t21
         t74 = t72 - t20*t73
         t75 = t73 + t20*t72
-        t76 = w31*t21
-        t77 = w34*t21
+        t76 = w28*t21
+        t77 = w31*t21
         t78 = t76 - t20*t77
         t79 = t77 + t20*t76
-        t80 = w32*t21
-        t81 = w35*t21
+        t80 = w29*t21
+        t81 = w32*t21
         t82 = t80 - t20*t81
         t83 = t81 + t20*t80
         t84 = (t40 > 0)
         t85 = 2*t38
         t86 = casadi.if_else(t84, casadi.if_else((t25 >= 0), t85, -t85)/casadi.if_else(t84, t40, 1), 0)
         t87 = 1/casadi.sqrt(1 + t86**2)
-        t88 = t0 - t38*t86
-        t89 = -t88 + t23
+        t88 = t2 - t38*t86
+        t89 = -t24 + t88
         t90 = (t71 > 0)
         t91 = 2*t69
         t92 = casadi.if_else(t90, casadi.if_else((t56 >= 0), t91, -t91)/casadi.if_else(t90, t71, 1), 0)
         t93 = 1/casadi.sqrt(1 + t92**2)
-        t94 = t3 - t69*t92
-        t95 = -t94 + t54
-        t96 = w0*t87
-        t97 = t29*t87
+        t94 = t5 - t69*t92
+        t95 = -t55 + t94
+        t96 = w6*t87
+        t97 = t28*t87
         t98 = t96 - t86*t97
         t99 = t97 + t86*t96
-        t100 = w1*t87
-        t101 = t33*t87
+        t100 = w7*t87
+        t101 = t32*t87
         t102 = t100 - t86*t101
         t103 = t101 + t86*t100
-        t104 = w2*t87
-        t105 = t37*t87
+        t104 = w8*t87
+        t105 = t36*t87
         t106 = t104 - t86*t105
         t107 = t105 + t86*t104
-        t108 = t28*t98 + t32*t102 + t36*t106
+        t108 = t29*t98 + t33*t102 + t37*t106
         t109 = casadi.sqrt(4*t108**2 + t89**2)
         t110 = t109 + casadi.fabs(t89)
-        t111 = w18*t87
-        t112 = t44*t87
+        t111 = w24*t87
+        t112 = t43*t87
         t113 = t111 - t86*t112
         t114 = t112 + t86*t111
-        t115 = w19*t87
-        t116 = t48*t87
+        t115 = w25*t87
+        t116 = t47*t87
         t117 = t115 - t86*t116
         t118 = t116 + t86*t115
-        t119 = w20*t87
-        t120 = t52*t87
+        t119 = w26*t87
+        t120 = t51*t87
         t121 = t119 - t86*t120
         t122 = t120 + t86*t119
-        t123 = w9*t93
-        t124 = t60*t93
+        t123 = w15*t93
+        t124 = t59*t93
         t125 = t123 - t92*t124
         t126 = t124 + t92*t123
-        t127 = w10*t93
-        t128 = t64*t93
+        t127 = w16*t93
+        t128 = t63*t93
         t129 = t127 - t92*t128
         t130 = t128 + t92*t127
-        t131 = w11*t93
-        t132 = t68*t93
+        t131 = w17*t93
+        t132 = t67*t93
         t133 = t131 - t92*t132
         t134 = t132 + t92*t131
-        t135 = t59*t125 + t63*t129 + t67*t133
+        t135 = t60*t125 + t64*t129 + t68*t133
         t136 = casadi.sqrt(4*t135**2 + t95**2)
         t137 = t136 + casadi.fabs(t95)
-        t138 = w27*t93
-        t139 = t75*t93
+        t138 = w33*t93
+        t139 = t74*t93
         t140 = t138 - t92*t139
         t141 = t139 + t92*t138
-        t142 = w28*t93
-        t143 = t79*t93
+        t142 = w34*t93
+        t143 = t78*t93
         t144 = t142 - t92*t143
         t145 = t143 + t92*t142
-        t146 = w29*t93
-        t147 = t83*t93
+        t146 = w35*t93
+        t147 = t82*t93
         t148 = t146 - t92*t147
         t149 = t147 + t92*t146
         t150 = (t110 > 0)
@@ -180,276 +180,204 @@ def _jacobi3_columns_2(count, state):
         t155 = 2*t135
         t156 = casadi.if_else(t154, casadi.if_else((t95 >= 0), t155, -t155)/casadi.if_else(t154, t137, 1), 0)
         t157 = 1/casadi.sqrt(1 + t156**2)
-        t158 = t98*t153
-        t159 = t28*t153
+        t158 = t29*t153
+        t159 = t98*t153
         t160 = t158 - t152*t159
         t161 = t159 + t152*t158
-        t162 = t102*t153
-        t163 = t32*t153
+        t162 = t33*t153
+        t163 = t102*t153
         t164 = t162 - t152*t163
         t165 = t163 + t152*t162
-        t166 = t106*t153
-        t167 = t36*t153
+        t166 = t37*t153
+        t167 = t106*t153
         t168 = t166 - t152*t167
         t169 = t167 + t152*t166
-        t170 = t113*t153
-        t171 = t43*t153
+        t170 = t44*t153
+        t171 = t113*t153
         t172 = t170 - t152*t171
         t173 = t171 + t152*t170
-        t174 = t117*t153
-        t175 = t47*t153
+        t174 = t48*t153
+        t175 = t117*t153
         t176 = t174 - t152*t175
         t177 = t175 + t152*t174
-        t178 = t121*t153
-        t179 = t51*t153
+        t178 = t52*t153
+        t179 = t121*t153
         t180 = t178 - t152*t179
         t181 = t179 + t152*t178
-        t182 = t125*t157
-        t183 = t59*t157
+        t182 = t60*t157
+        t183 = t125*t157
         t184 = t182 - t156*t183
         t185 = t183 + t156*t182
-        t186 = t129*t157
-        t187 = t63*t157
+        t186 = t64*t157
+        t187 = t129*t157
         t188 = t186 - t156*t187
         t189 = t187 + t156*t186
-        t190 = t133*t157
-        t191 = t67*t157
+        t190 = t68*t157
+        t191 = t133*t157
         t192 = t190 - t156*t191
         t193 = t191 + t156*t190
-        t194 = t140*t157
-        t195 = t74*t157
+        t194 = t75*t157
+        t195 = t140*t157
         t196 = t194 - t156*t195
         t197 = t195 + t156*t194
-        t198 = t144*t157
-        t199 = t78*t157
+        t198 = t79*t157
+        t199 = t144*t157
         t200 = t198 - t156*t199
         t201 = t199 + t156*t198
-        t202 = t148*t157
-        t203 = t82*t157
+        t202 = t83*t157
+        t203 = t148*t157
         t204 = t202 - t156*t203
         t205 = t203 + t156*t202
         state = (
+            t99,
+            t103,
+            t107,
             t160,
             t164,
             t168,
             t161,
             t165,
             t169,
-            t99,
-            t103,
-            t107,
+            t126,
+            t130,
+            t134,
             t184,
             t188,
             t192,
             t185,
             t189,
             t193,
-            t126,
-            t130,
-            t134,
+            t114,
+            t118,
+            t122,
             t172,
             t176,
             t180,
             t173,
             t177,
             t181,
-            t114,
-            t118,
-            t122,
+            t141,
+            t145,
+            t149,
             t196,
             t200,
             t204,
             t197,
             t201,
             t205,
-            t141,
-            t145,
-            t149,
+        )
+    return state
+
+
+def _jacobi4_rows_round(count, state):
+    """Round of Jacobi rotations of a 4 x 4 matrix (its rows), `count` times: 110 operations a run."""
+    for _ in range(count):
+        w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, = state
+        t0 = w0*w12 + w1*w13 + w2*w14 + w3*w15
+        t1 = w4*w8 + w5*w9 + w6*w10 + w7*w11
+        t2 = -w16 + w19
+        t3 = casadi.sqrt(4*t0**2 + t2**2)
+        t4 = t3 + casadi.fabs(t2)
+        t5 = -w17 + w18
+        t6 = casadi.sqrt(4*t1**2 + t5**2)
+        t7 = t6 + casadi.fabs(t5)
+        t8 = (t4 > 0)
+        t9 = 2*t0
+        t10 = casadi.if_else(t8, casadi.if_else((t2 >= 0), t9, -t9)/casadi.if_else(t8, t4, 1), 0)
+        t11 = 1/casadi.sqrt(1 + t10**2)
+        t12 = (t7 > 0)
+        t13 = 2*t1
+        t14 = casadi.if_else(t12, casadi.if_else((t5 >= 0), t13, -t13)/casadi.if_else(t12, t7, 1), 0)
+        t15 = 1/casadi.sqrt(1 + t14**2)
+        t16 = t0*t10
+        t17 = -t16 + w16
+        t18 = t16 + w19
+        t19 = w0*t11
+        t20 = w12*t11
+        t21 = t19 - t20*t10
+        t22 = t20 + t19*t10
+        t23 = w1*t11
+        t24 = w13*t11
+        t25 = t23 - t24*t10
+        t26 = t24 + t23*t10
+        t27 = w2*t11
+        t28 = w14*t11
+        t29 = t27 - t28*t10
+        t30 = t28 + t27*t10
+        t31 = w3*t11
+        t32 = w15*t11
+        t33 = t31 - t32*t10
+        t34 = t32 + t31*t10
+        t35 = t1*t14
+        t36 = -t35 + w17
+        t37 = w18 + t35
+        t38 = w4*t15
+        t39 = w8*t15
+        t40 = t38 - t39*t14
+        t41 = t39 + t38*t14
+        t42 = w5*t15
+        t43 = w9*t15
+        t44 = t42 - t43*t14
+        t45 = t43 + t42*t14
+        t46 = w6*t15
+        t47 = w10*t15
+        t48 = t46 - t47*t14
+        t49 = t47 + t46*t14
+        t50 = w7*t15
+        t51 = w11*t15
+        t52 = t50 - t51*t14
+        t53 = t51 + t50*t14
+        state = (
+            t21,
+            t25,
+            t29,
+            t33,
+            t22,
+            t26,
+            t30,
+            t34,
+            t40,
+            t44,
+            t48,
+            t52,
+            t41,
+            t45,
+            t49,
+            t53,
+            t17,
+            t18,
+            t36,
+            t37,
         )
     return state
 
 
 def _jacobi4_rows(count, state):
-    """One-sided Jacobi sweep of a 4 x 4 matrix (its rows), `count` times: 352 operations a run."""
+    """One-sided Jacobi sweep of a 4 x 4 matrix (its rows), `count` times: 358 operations a run."""
     for _ in range(count):
         w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, = state
         t0 = w0**2 + w1**2 + w2**2 + w3**2
         t1 = w4**2 + w5**2 + w6**2 + w7**2
         t2 = w8**2 + w9**2 + w10**2 + w11**2
         t3 = w12**2 + w13**2 + w14**2 + w15**2
-        t4 = w0*w12 + w1*w13 + w2*w14 + w3*w15
-        t5 = w4*w8 + w5*w9 + w6*w10 + w7*w11
-        t6 = -t0 + t3
-        t7 = casadi.sqrt(4*t4**2 + t6**2)
-        t8 = t7 + casadi.fabs(t6)
-        t9 = -t1 + t2
-        t10 = casadi.sqrt(4*t5**2 + t9**2)
-        t11 = t10 + casadi.fabs(t9)
-        t12 = (t8 > 0)
-        t13 = 2*t4
-        t14 = casadi.if_else(t12, casadi.if_else((t6 >= 0), t13, -t13)/casadi.if_else(t12, t8, 1), 0)
-        t15 = 1/casadi.sqrt(1 + t14**2)
-        t16 = (t11 > 0)
-        t17 = 2*t5
-        t18 = casadi.if_else(t16, casadi.if_else((t9 >= 0), t17, -t17)/casadi.if_else(t16, t11, 1), 0)
-        t19 = 1/casadi.sqrt(1 + t18**2)
-        t20 = t4*t14
-        t21 = -t20 + t0
-        t22 = t20 + t3
-        t23 = w0*t15
-        t24 = w12*t15
-        t25 = t23 - t24*t14
-        t26 = t24 + t23*t14
-        t27 = w1*t15
-        t28 = w13*t15
-        t29 = t27 - t28*t14
-        t30 = t28 + t27*t14
-        t31 = w2*t15
-        t32 = w14*t15
-        t33 = t31 - t32*t14
-        t34 = t32 + t31*t14
-        t35 = w3*t15
-        t36 = w15*t15
-        t37 = t35 - t36*t14
-        t38 = t36 + t35*t14
-        t39 = t5*t18
-        t40 = -t39 + t1
-        t41 = t39 + t2
-        t42 = -t21 + t41
-        t43 = -t40 + t22
-        t44 = w4*t19
-        t45 = w8*t19
-        t46 = t44 - t45*t18
-        t47 = t45 + t44*t18
-        t48 = w5*t19
-        t49 = w9*t19
-        t50 = t48 - t49*t18
-        t51 = t49 + t48*t18
-        t52 = w6*t19
-        t53 = w10*t19
-        t54 = t52 - t53*t18
-        t55 = t53 + t52*t18
-        t56 = w7*t19
-        t57 = w11*t19
-        t58 = t56 - t57*t18
-        t59 = t57 + t56*t18
-        t60 = t25*t47 + t29*t51 + t33*t55 + t37*t59
-        t61 = t26*t46 + t30*t50 + t34*t54 + t38*t58
-        t62 = casadi.sqrt(4*t60**2 + t42**2)
-        t63 = t62 + casadi.fabs(t42)
-        t64 = casadi.sqrt(4*t61**2 + t43**2)
-        t65 = t64 + casadi.fabs(t43)
-        t66 = (t63 > 0)
-        t67 = 2*t60
-        t68 = casadi.if_else(t66, casadi.if_else((t42 >= 0), t67, -t67)/casadi.if_else(t66, t63, 1), 0)
-        t69 = 1/casadi.sqrt(1 + t68**2)
-        t70 = (t65 > 0)
-        t71 = 2*t61
-        t72 = casadi.if_else(t70, casadi.if_else((t43 >= 0), t71, -t71)/casadi.if_else(t70, t65, 1), 0)
-        t73 = 1/casadi.sqrt(1 + t72**2)
-        t74 = t60*t68
-        t75 = -t74 + t21
-        t76 = t74 + t41
-        t77 = t25*t69
-        t78 = t47*t69
-        t79 = t77 - t78*t68
-        t80 = t78 + t77*t68
-        t81 = t29*t69
-        t82 = t51*t69
-        t83 = t81 - t82*t68
-        t84 = t82 + t81*t68
-        t85 = t33*t69
-        t86 = t55*t69
-        t87 = t85 - t86*t68
-        t88 = t86 + t85*t68
-        t89 = t37*t69
-        t90 = t59*t69
-        t91 = t89 - t90*t68
-        t92 = t90 + t89*t68
-        t93 = t61*t72
-        t94 = -t93 + t40
-        t95 = t93 + t22
-        t96 = -t75 + t94
-        t97 = -t76 + t95
-        t98 = t46*t73
-        t99 = t26*t73
-        t100 = t98 - t99*t72
-        t101 = t99 + t98*t72
-        t102 = t50*t73
-        t103 = t30*t73
-        t104 = t102 - t103*t72
-        t105 = t103 + t102*t72
-        t106 = t54*t73
-        t107 = t34*t73
-        t108 = t106 - t107*t72
-        t109 = t107 + t106*t72
-        t110 = t58*t73
-        t111 = t38*t73
-        t112 = t110 - t111*t72
-        t113 = t111 + t110*t72
-        t114 = t79*t100 + t83*t104 + t87*t108 + t91*t112
-        t115 = t80*t101 + t84*t105 + t88*t109 + t92*t113
-        t116 = casadi.sqrt(4*t114**2 + t96**2)
-        t117 = t116 + casadi.fabs(t96)
-        t118 = casadi.sqrt(4*t115**2 + t97**2)
-        t119 = t118 + casadi.fabs(t97)
-        t120 = (t117 > 0)
-        t121 = 2*t114
-        t122 = casadi.if_else(t120, casadi.if_else((t96 >= 0), t121, -t121)/casadi.if_else(t120, t117, 1), 0)
-        t123 = 1/casadi.sqrt(1 + t122**2)
-        t124 = (t119 > 0)
-        t125 = 2*t115
-        t126 = casadi.if_else(t124, casadi.if_else((t97 >= 0), t125, -t125)/casadi.if_else(t124, t119, 1), 0)
-        t127 = 1/casadi.sqrt(1 + t126**2)
-        t128 = t79*t123
-        t129 = t100*t123
-        t130 = t128 - t129*t122
-        t131 = t129 + t128*t122
-        t132 = t83*t123
-        t133 = t104*t123
-        t134 = t132 - t133*t122
-        t135 = t133 + t132*t122
-        t136 = t87*t123
-        t137 = t108*t123
-        t138 = t136 - t137*t122
-        t139 = t137 + t136*t122
-        t140 = t91*t123
-        t141 = t112*t123
-        t142 = t140 - t141*t122
-        t143 = t141 + t140*t122
-        t144 = t80*t127
-        t145 = t101*t127
-        t146 = t144 - t145*t126
-        t147 = t145 + t144*t126
-        t148 = t84*t127
-        t149 = t105*t127
-        t150 = t148 - t149*t126
-        t151 = t149 + t148*t126
-        t152 = t88*t127
-        t153 = t109*t127
-        t154 = t152 - t153*t126
-        t155 = t153 + t152*t126
-        t156 = t92*t127
-        t157 = t113*t127
-        t158 = t156 - t157*t126
-        t159 = t157 + t156*t126
+        t4 = _jacobi4_rows_round(3, (w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, t0, t1, t2, t3,))
         state = (
-            t130,
-            t134,
-            t138,
-            t142,
-            t131,
-            t135,
-            t139,
-            t143,
-            t146,
-            t150,
-            t154,
-            t158,
-            t147,
-            t151,
-            t155,
-            t159,
+            t4[0],
+            t4[1],
+            t4[2],
+            t4[3],
+            t4[4],
+            t4[5],
+            t4[6],
+            t4[7],
+            t4[8],
+            t4[9],
+            t4[10],
+            t4[11],
+            t4[12],
+            t4[13],
+            t4[14],
+            t4[15],
         )
     return state
 
@@ -1364,7 +1292,7 @@ def _velocity_ellipsoid(q):
 
 
 def _condition_number(q):
-    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): 2573 operations."""
+    """Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding): 2615 operations."""
     q1 = q[0]
     q2 = q[1]
     c1 = casadi.cos(q1)

@@ -109,7 +109,7 @@ void stanford_manipulability_gradient(const stanford_real q[STANFORD_DOF], stanf
 void stanford_velocity_ellipsoid(const stanford_real q[STANFORD_DOF], stanford_real U_v[9], stanford_real s_v[3], stanford_real U_w[9], stanford_real s_w[3]);
 
 /* Sigma_max / sigma_min of Js with its position rows divided by CHARACTERISTIC_LENGTH; infinite where sigma_min <= EPS sigma_max or sigma_max <= EPS times its largest entry's bound (Js singular to rounding).
- * Result: returned as a scalar. 8200 operations. */
+ * Result: returned as a scalar. 8263 operations. */
 stanford_real stanford_condition_number(const stanford_real q[STANFORD_DOF]);
 
 /* Joint rates q_dot solving Js q_dot = mu_dot: Js^-1 mu_dot (damping 0) or Js^T (Js Js^T + damping^2 I)^-1 mu_dot; and the status.

@@ -1,6 +1,7 @@
 """Singular values and vectors on the value graph: a Householder QR
-(`differential.triangulate`), then one-sided Jacobi rotations on the triangular factor, a
-sweep of them a kernel (`Lowering.repeated`) that the generated code runs in a loop.
+(`differential.triangulate`), then one-sided Jacobi rotations on the triangular factor: a
+sweep of them is a kernel (`Lowering.repeated`) that the generated code runs in a loop, and
+from 4 x 4 on, a round of its rotations is a kernel that the sweep runs in a loop.
 
 Both steps are backward stable on the matrix itself, so every singular value is accurate to a
 few roundings of its largest one, also where the smallest is 1e-8 or 0: the eigenvalues of
@@ -14,7 +15,7 @@ run, with no test, one more than the first count that reached rounding on every 
 matrix `bench/bench_jacobi_sweeps.py` tries (singular values random, spread over 1e-8 ... 1,
 one of 1e-16 ... 1e-6, clustered within 1e-12 ... 1e-2, two zeros; 2,000 of each for k = 3,
 500 for k = 6). The worst error relative to the largest value, after each sweep: turning R's
-columns, k = 3: 5e-2, 3e-6, 1e-15 after sweeps 2, 3, 4. Turning its rows, k = 3: 3e-3, 2e-12,
+columns, k = 3: 4e-2, 7e-7, 1e-15 after sweeps 2, 3, 4. Turning its rows, k = 3: 4e-3, 1e-12,
 1e-15 after sweeps 2, 3, 4; k = 6: 2e-3, 2e-7, 4e-11, 2e-15 after sweeps 3, 4, 5, 6. The extra
 sweep squares an error already at rounding: the margin for a matrix slower than those.
 """
@@ -32,18 +33,40 @@ from jacgen.solvers.differential import named, triangulate
 # 3 and 6 as measured (the module's docstring), 4 and 5 as 6.
 SWEEPS = {"columns": {1: 0, 2: 1, 3: 5}, "rows": {1: 0, 2: 1, 3: 5, 4: 7, 5: 7, 6: 7}}
 
+# From this k on, a sweep runs its rounds as a kernel of their own, in a loop: a 6 x 6 sweep
+# written out is 15 rotations (the M4F's condition_number: 12.9 KB of flash, 5.7 KB as rounds).
+# A round of 3 x 3 matrices rotates one pair of each, beside a state of 42 values that the loop
+# carries: as rounds, velocity_ellipsoid took 18 % more instructions on the M4F, so a 3 x 3
+# sweep writes its 3 rounds out.
+ROUND_KERNEL = 4
+
+
+def round_pairs(k: int) -> list[tuple[int, int]]:
+    """The disjoint pairs of slots that every round of a sweep over k columns rotates (the
+    circle method of a round-robin tournament, with the columns moved between rounds by
+    `next_round`): k even, slot 0 stays and is paired with k - 1, 1 with k - 2, ...; k odd,
+    every slot moves and the last one sits a round out."""
+    fixed = 1 - k % 2
+    return [(i, k - 2 + fixed - i) for i in range(k // 2)]
+
+
+def next_round(slots: list) -> list:
+    """The slots' contents in the next round's places: the circle method's turn, every slot but a
+    fixed first one (k even) one place on, the last to the front. After `len(rounds(k))` turns
+    every column is back in its own slot."""
+    fixed = 1 - len(slots) % 2
+    return slots[:fixed] + slots[-1:] + slots[fixed:-1]
+
 
 def rounds(k: int) -> list[list[tuple[int, int]]]:
-    """Every pair of k columns once, as k - 1 rounds (k odd: k) of disjoint pairs (the circle
-    method of a round-robin tournament): a round's rotations are independent of each other, so
-    the processor overlaps them, where the cyclic order's share a column, one after the other."""
-    players = list(range(k)) + ([None] if k % 2 else [])
-    count = len(players)
-    result = []
-    for _ in range(count - 1):
-        pairs = [(players[i], players[count - 1 - i]) for i in range(count // 2)]
-        result.append([(min(pair), max(pair)) for pair in pairs if None not in pair])
-        players = [players[0], players[-1]] + players[1:-1]
+    """Every pair of k columns once, as k - 1 rounds (k odd: k) of disjoint pairs: a round's
+    rotations are independent of each other, so the processor overlaps them, where the cyclic
+    order's share a column, one after the other. The generated code runs one round as a kernel
+    on fixed slots (`round_pairs`), and moves the columns between rounds (`next_round`)."""
+    columns, result = list(range(k)), []
+    for _ in range(k - 1 + k % 2):
+        result.append([tuple(sorted((columns[i], columns[j]))) for i, j in round_pairs(k)])
+        columns = next_round(columns)
     return result
 
 
@@ -57,46 +80,58 @@ def jacobi(matrices: list, g: Graph, name: Callable, repeat: Callable, vectors: 
 
     A sweep is one kernel (`repeat`: `Lowering.repeated`), run SWEEPS times on the state of
     every matrix's turned columns (and V's): the generated code loops over the sweeps, written
-    once. The matrices are rotated in lockstep, a round of `rounds` at a time, each step for
-    every rotation of the round before the next: the step is in the order the values are
-    built, so that the processor finds the independent rotations side by side, rather than
-    one rotation's chain of square roots and divisions after another's.
+    once. From k = ROUND_KERNEL on, a round is a kernel too, which the sweep runs once for each
+    of `rounds`: it rotates the pairs of fixed slots (`round_pairs`), then moves the columns to
+    the slots of the next round (`next_round`), so that the same code serves every round. The
+    matrices are rotated in lockstep, each step for every rotation of the round before the
+    next: the step is in the order the values are built, so that the processor finds the
+    independent rotations side by side, rather than one rotation's chain of square roots and
+    divisions after another's.
 
-    The squared column norms are summed afresh at the start of each sweep, and updated by each
-    rotation within it: an update a - t c carries an error of a rounding of a, which stalls the
-    convergence of two close values far below it where they came out of larger columns (sigma
-    1.02e-8 and 1.01e-8 beside 0.98, updated only: by 15 % a sweep, still 4e-12 off after 8).
-    Within a sweep, the updates of small columns are from small values."""
+    The squared column norms are summed afresh at the start of each sweep, carried through its
+    rounds and updated by each rotation: an update a - t c carries an error of a rounding of a,
+    which stalls the convergence of two close values far below it where they came out of larger
+    columns (sigma 1.02e-8 and 1.01e-8 beside 0.98, updated only: by 15 % a sweep, still 4e-12
+    off after 8). Within a sweep, the updates of small columns are from small values."""
     zero, one = g.number(0), g.number(1)
     k, many = len(matrices[0]), len(matrices)
     turned = [[[R[r][c] for r in range(k)] for c in range(k)] if vectors else [list(row) for row in R]
               for R in matrices]
     V = [[[one if r == c else zero for r in range(k)] for c in range(k)] for _ in matrices] if vectors else []
 
-    def sweep(state: list[Node]) -> list[Node]:
-        blocks = _blocks(state, k)
+    def turn(state: list[Node]) -> list[Node]:
+        """One round: the rotations of `round_pairs`, then the columns and their squares moved
+        to the next round's slots."""
+        blocks, sums = _blocks(state[:-many * k], k), state[-many * k:]
         turned, V = blocks[:many], blocks[many:]
-        squares = [[named(name, sum(e**2 for e in column)) for column in W] for W in turned]
-        for pairs in rounds(k):
-            work = [(m, i, j) for m in range(many) for i, j in pairs]
-            products = [named(name, sum(x * y for x, y in zip(turned[m][i], turned[m][j]))) for m, i, j in work]
-            angles = [rotation(squares[m][i], squares[m][j], c, g, name)
-                      for (m, i, j), c in zip(work, products)]
-            for (m, i, j), c, (cos, t) in zip(work, products, angles):
-                a, b = squares[m][i], squares[m][j]
-                squares[m][i], squares[m][j] = named(name, a - t * c), named(name, b + t * c)
-                sin = named(name, cos * t)
-                for columns in [turned[m]] + ([V[m]] if vectors else []):
-                    x, y = columns[i], columns[j]
-                    columns[i] = [named(name, cos * p - sin * r) for p, r in zip(x, y)]
-                    columns[j] = [named(name, sin * p + cos * r) for p, r in zip(x, y)]
-        return _flat(turned + V)
+        squares = [sums[m * k:(m + 1) * k] for m in range(many)]
+        work = [(m, i, j) for m in range(many) for i, j in round_pairs(k)]
+        products = [named(name, sum(x * y for x, y in zip(turned[m][i], turned[m][j]))) for m, i, j in work]
+        angles = [rotation(squares[m][i], squares[m][j], c, g, name) for (m, i, j), c in zip(work, products)]
+        for (m, i, j), c, (cos, t) in zip(work, products, angles):
+            a, b = squares[m][i], squares[m][j]
+            squares[m][i], squares[m][j] = named(name, a - t * c), named(name, b + t * c)
+            sin = named(name, cos * t)
+            for columns in [turned[m]] + ([V[m]] if vectors else []):
+                x, y = columns[i], columns[j]
+                columns[i] = [named(name, cos * p - sin * r) for p, r in zip(x, y)]
+                columns[j] = [named(name, sin * p + cos * r) for p, r in zip(x, y)]
+        return _flat([next_round(block) for block in turned + V]) + [e for block in squares for e in next_round(block)]
 
-    kind = "columns" if vectors else "rows"
-    state = repeat(f"jacobi{k}_{kind}" + (f"_{many}" if many > 1 else ""),
-                   f"one-sided Jacobi sweep of {f'{many} {k} x {k} matrices' if many > 1 else f'a {k} x {k} matrix'}"
-                   f" (its {kind})" + (", with V" if vectors else ""),
-                   SWEEPS[kind][k], sweep, _flat(turned + V))
+    def sweep(state: list[Node]) -> list[Node]:
+        state = state + [named(name, sum(e**2 for e in column)) for W in _blocks(state, k)[:many] for column in W]
+        if k >= ROUND_KERNEL:
+            state = repeat(f"jacobi{k}_{kind}_round" + suffix, f"round of Jacobi rotations of {what} (its {kind})",
+                           len(rounds(k)), turn, state)
+        else:
+            for _ in rounds(k):
+                state = turn(state)
+        return state[:-many * k]
+
+    kind, suffix = ("columns" if vectors else "rows"), (f"_{many}" if many > 1 else "")
+    what = f"{many} {k} x {k} matrices" if many > 1 else f"a {k} x {k} matrix"
+    state = repeat(f"jacobi{k}_{kind}" + suffix, f"one-sided Jacobi sweep of {what} (its {kind})"
+                   + (", with V" if vectors else ""), SWEEPS[kind][k], sweep, _flat(turned + V))
     blocks = _blocks(state, k)
     turned, V = blocks[:many], blocks[many:]
     norms = [[name(g.sqrt(sum(e**2 for e in column))) for column in W] for W in turned]
