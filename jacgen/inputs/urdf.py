@@ -121,7 +121,7 @@ class Snapper:
         return value
 
 
-def parse_xml(data: bytes, path: str) -> Element:
+def parse_xml(data: bytes, path: str, what: str = "a URDF") -> Element:
     """The element tree of `data`, read as UTF-8 whatever encoding it declares (ROS reads URDFs
     so); refuses a DOCTYPE, so entities can never be declared."""
     parser = expat.ParserCreate(encoding="utf-8")
@@ -133,7 +133,7 @@ def parse_xml(data: bytes, path: str) -> Element:
         return parser.CurrentLineNumber, parser.CurrentColumnNumber + 1
 
     def refuse_doctype(*_):
-        raise RobotFileError(path, *position(), "", "a DOCTYPE is not allowed in a URDF (its entities "
+        raise RobotFileError(path, *position(), "", f"a DOCTYPE is not allowed in {what} (its entities "
                              "could expand without bound or read other files)")
 
     def start(tag, attributes):
@@ -194,7 +194,7 @@ class _UrdfReader:
             children[parent].append(joint)
         roots = [name for name in links if name not in parent_joint]
         if len(roots) != 1:
-            what = "no link" if not roots else f"{len(roots)} links ({_listed(roots)})"
+            what = "no link" if not roots else f"{len(roots)} links ({listed(roots)})"
             raise self.error(root, "robot", f"{what} without a parent joint: a URDF has one root")
         reachable, pending = {roots[0]}, [roots[0]]
         while pending:
@@ -205,7 +205,7 @@ class _UrdfReader:
         if len(reachable) != len(links):
             loop = sorted(set(links) - reachable)
             raise self.error(joints[parent_joint[loop[0]].attributes["name"]], "robot",
-                             f"the joints of links {_listed(loop)} form a loop")
+                             f"the joints of links {listed(loop)} form a loop")
 
         base = base or roots[0]
         for option, name in (("--base", base), ("--tip", tip)):
@@ -265,7 +265,7 @@ class _UrdfReader:
             pending.extend(below)
         if len(leaves) != 1:
             raise RobotFileError(self.path, root.line, root.column, "--tip",
-                                 f"link {base!r} has {len(leaves)} leaves below it ({_listed(sorted(leaves))}): "
+                                 f"link {base!r} has {len(leaves)} leaves below it ({listed(sorted(leaves))}): "
                                  f"name the tool link with --tip")
         return leaves[0]
 
@@ -304,7 +304,7 @@ class _UrdfReader:
         rpy_text = (origin.attributes.get("rpy", "0 0 0") if origin is not None else "0 0 0").split()
         rpy = [self.snapper.angle(value, text) for value, text in
                zip(self.numbers(origin, f"{key}.origin", "rpy"), rpy_text)]
-        transform = xyz_rpy_transform(xyz, rpy, _cos_sin)
+        transform = xyz_rpy_transform(xyz, rpy, cos_sin)
         axis = Matrix([1, 0, 0])
         limits = None
         if kind in MOVABLE:
@@ -325,12 +325,7 @@ class _UrdfReader:
         return UrdfJoint(name, kind, transform, axis, limits)
 
     def number(self, text: str, element: Element, key: str) -> sympy.Rational:
-        """A decimal, exact, by the robot files' bounded number parser."""
-        try:
-            return values.number(text.strip(" \t\r\n")).exact
-        except ExpressionError as error:
-            hint = " (a xacro file? run xacro on it first)" if "$" in text else ""
-            raise self.error(element, key, f"{error}{hint}") from None
+        return number_of(text, lambda message: self.error(element, key, message))
 
     def numbers(self, element: Element | None, key: str, attribute: str) -> list[sympy.Rational]:
         if element is None or attribute not in element.attributes:
@@ -341,24 +336,41 @@ class _UrdfReader:
         return [self.number(part, element, f"{key}.{attribute}") for part in parts]
 
     def axis(self, element: Element, key: str) -> Matrix:
-        vector = Matrix(self.numbers(element, key, "xyz"))
-        length = math.sqrt(sum(float(v) ** 2 for v in vector))
-        if length < 1e-9:
+        axis = snapped_axis(Matrix(self.numbers(element, key, "xyz")), self.snapper)
+        if axis is None:
             raise self.error(element, f"{key}.xyz", "the axis is zero")
-        unit = [float(v) / length for v in vector]
-        for k in range(3):
-            for sign in (1, -1):
-                if self.snapper.close(math.dist(unit, [sign * (i == k) for i in range(3)]), self.snapper.written_tolerance()):
-                    return Matrix([sign * int(i == k) for i in range(3)])
-        return (vector / sympy.sqrt(sum(v**2 for v in vector))).evalf(DIGITS)
+        return axis
 
 
-def _listed(names: list[str], limit: int = 10) -> str:
+def number_of(text: str, error) -> sympy.Rational:
+    """A decimal, exact, by the robot files' bounded number parser; `error(message)` is raised."""
+    try:
+        return values.number(text.strip(" \t\r\n")).exact
+    except ExpressionError as problem:
+        hint = " (a xacro file? run xacro on it first)" if "$" in text else ""
+        raise error(f"{problem}{hint}") from None
+
+
+def snapped_axis(vector: Matrix, snapper: Snapper) -> Matrix | None:
+    """The unit axis along `vector`: +-x, +-y or +-z exactly where it is within the snapper's
+    written tolerance of one; None for a zero vector."""
+    length = math.sqrt(sum(float(v) ** 2 for v in vector))
+    if length < 1e-9:
+        return None
+    unit = [float(v) / length for v in vector]
+    for k in range(3):
+        for sign in (1, -1):
+            if snapper.close(math.dist(unit, [sign * (i == k) for i in range(3)]), snapper.written_tolerance()):
+                return Matrix([sign * int(i == k) for i in range(3)])
+    return (vector / sympy.sqrt(sum(v**2 for v in vector))).evalf(DIGITS)
+
+
+def listed(names: list[str], limit: int = 10) -> str:
     shown = ", ".join(repr(n) for n in names[:limit])
     return shown + (f" and {len(names) - limit} more" if len(names) > limit else "")
 
 
-def _cos_sin(angle: sympy.Expr) -> tuple[sympy.Expr, sympy.Expr]:
+def cos_sin(angle: sympy.Expr) -> tuple[sympy.Expr, sympy.Expr]:
     """Exact for multiples of pi/2 (which snapping made exact), 30 digits otherwise."""
     if (angle / (sympy.pi / 2)).is_integer:
         return sympy.cos(angle), sympy.sin(angle)
