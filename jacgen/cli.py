@@ -308,26 +308,55 @@ def verify(robot_files, samples, seed, target, sources, native, jobs):
         sys.exit(1)
 
 
+def _import_options(frames: str, frame: str, default_base: str, tip: str):
+    """The options import-urdf and import-mjcf share."""
+    def decorate(command):
+        for option in reversed((
+            click.option("--base", default=None, metavar=frame, help=f"First {frame.lower()} of the chain "
+                         f"(default: {default_base})."),
+            click.option("--tip", default=None, metavar=tip, help=f"Last {tip.lower()} of the chain (default: the one "
+                         f"leaf {frame.lower()} below the base)."),
+            click.option("--convention", type=click.Choice(["standard", "modified"]), default="standard",
+                         show_default=True, help="DH convention of the robot file."),
+            click.option("--name", default=None, help="Robot name (default: the file's, made a valid name)."),
+            click.option("--task", default=None, metavar="x,y,...", help="Task components (default: all six, or for "
+                         "fewer than six joints the first independent ones)."),
+            click.option("--snap", default=None, type=click.FloatRange(0, 0.01), metavar="RADIANS",
+                         help="Angles and axes this close to a multiple of 90 degrees become exact (default: an angle "
+                         f"that is one to the digits it is written with, as 1.5708; docs/{frames}.md)."),
+            click.option("-o", "--output", default=None, type=click.Path(dir_okay=False), metavar="FILE.yaml",
+                         help="Write the robot file here (default: standard output)."),
+        )):
+            command = option(command)
+        return command
+    return decorate
+
+
 @main.command("import-urdf")
 @click.argument("urdf_file", type=click.Path(dir_okay=False))
-@click.option("--base", default=None, metavar="LINK", help="First link of the chain (default: the root).")
-@click.option("--tip", default=None, metavar="LINK", help="Last link of the chain (default: the one leaf below the base).")
-@click.option("--convention", type=click.Choice(["standard", "modified"]), default="standard", show_default=True,
-              help="DH convention of the robot file.")
-@click.option("--name", default=None, help="Robot name (default: the URDF's, made a valid name).")
-@click.option("--task", default=None, metavar="x,y,...",
-              help="Task components (default: all six, or for fewer than six joints the first independent ones).")
-@click.option("--snap", default=None, type=click.FloatRange(0, 0.01), metavar="RADIANS",
-              help="Angles and axes this close to a multiple of 90 degrees become exact (default: an angle that is "
-                   "one to the digits it is written with, as 1.5708; docs/urdf.md).")
-@click.option("-o", "--output", default=None, type=click.Path(dir_okay=False), metavar="FILE.yaml",
-              help="Write the robot file here (default: standard output).")
+@_import_options("urdf", "LINK", "the root", "LINK")
 def import_urdf_command(urdf_file, base, tip, convention, name, task, snap, output):
     """Convert the serial chain of a URDF into a DH robot file, exactly."""
-    from jacgen.urdf_import import CHECK_CONFIGURATIONS, import_urdf
+    from jacgen.urdf_import import URDF
+
+    _import(URDF, urdf_file, base, tip, convention, name, task, snap, output)
+
+
+@main.command("import-mjcf")
+@click.argument("mjcf_file", type=click.Path(dir_okay=False))
+@_import_options("mjcf", "BODY", "the world", "BODY|SITE")
+def import_mjcf_command(mjcf_file, base, tip, convention, name, task, snap, output):
+    """Convert the serial chain of an MJCF file (MuJoCo) into a DH robot file, exactly."""
+    from jacgen.urdf_import import MJCF
+
+    _import(MJCF, mjcf_file, base, tip, convention, name, task, snap, output)
+
+
+def _import(form, path, base, tip, convention, name, task, snap, output) -> None:
+    from jacgen.urdf_import import CHECK_CONFIGURATIONS, import_description
 
     components = tuple(part.strip() for part in task.split(",")) if task else None
-    imported = import_urdf(urdf_file, base, tip, convention, name, components, snap)
+    imported = import_description(form, path, base, tip, convention, name, components, snap)
     if output:
         write_files({Path(output).name: imported.text}, Path(output).parent)
         click.echo(f"jacgen: wrote {output}", err=True)
@@ -337,8 +366,8 @@ def import_urdf_command(urdf_file, base, tip, convention, name, task, snap, outp
     changes += [f"{len(imported.zeroed)} length(s) of rounding level made 0"] if imported.zeroed else []
     changed = f" ({'; '.join(changes)})" if changes else ""
     click.echo(f"jacgen: {imported.robot.name}: {imported.robot.dof} joints; fk within "
-               f"{imported.fk_difference:.1g} of the URDF as written, at {CHECK_CONFIGURATIONS} random configurations"
-               f"{changed}", err=True)
+               f"{imported.fk_difference:.1g} of the {form.name} as written, at {CHECK_CONFIGURATIONS} random "
+               f"configurations{changed}", err=True)
 
 
 def _check_unique_names(robots: list[tuple[str, str]]) -> None:

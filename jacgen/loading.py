@@ -45,6 +45,8 @@ from jacgen.files import write_files
 BACKENDS = ("python", "native", "casadi", "auto")
 MODULES = {"python": "{name}", "casadi": "{name}_casadi", "native": "{name}_native"}
 FORMAT = 1
+# The robot descriptions jacgen.arm imports, by file suffix (urdf_import.FORMATS).
+DESCRIPTIONS = {".urdf": "urdf", ".xml": "mjcf", ".mjcf": "mjcf"}
 NO_BUILD = "JACGEN_NO_BUILD"
 URDF_OPTIONS = ("base", "tip", "convention", "name", "task", "snap")
 
@@ -82,7 +84,8 @@ def import_module(path: Path, module_name: str):
 def arm(source, *, backend: str = "python", functions=None, base=None, tip=None, convention="standard",
         name=None, task=None, snap=None, cache_folder=None):
     """The generated module of a robot: `source` is a robot file, a URDF (the chain from `base`
-    to `tip`, with import-urdf's other options) or the name of a shipped robot ("ur5").
+    to `tip`, with import-urdf's other options), an MJCF file (.xml: the chain from the body `base` to
+    the body or site `tip`, as import-mjcf) or the name of a shipped robot ("ur5").
 
     backend: "python" (NAME.py: numpy, JAX, PyTorch), "native" (NAME_native: the C, built
     here), "casadi", or "auto" (native where it builds, else python with one warning).
@@ -99,19 +102,21 @@ def arm(source, *, backend: str = "python", functions=None, base=None, tip=None,
             _warn_once(f"jacgen.arm: the Python module instead of the native one: {error}")
             backend = "python"
     path = robot_path(source)
-    urdf = {"base": base, "tip": tip, "convention": convention, "name": name,
-            "task": None if task is None else list(task), "snap": snap} if path.suffix.lower() == ".urdf" else None
-    if urdf is None and any(value is not None for value in (base, tip, name, task, snap)):
-        raise JacgenError(f"{path}: base, tip, name, task and snap are options of a URDF, not of a robot file")
+    form = DESCRIPTIONS.get(path.suffix.lower())
+    options = {form: {"base": base, "tip": tip, "convention": convention, "name": name,
+                      "task": None if task is None else list(task), "snap": snap}} if form else {}
+    if form is None and any(value is not None for value in (base, tip, name, task, snap)):
+        raise JacgenError(f"{path}: base, tip, name, task and snap are options of a URDF or an MJCF file, "
+                          "not of a robot file")
     functions = None if functions is None else [functions] if isinstance(functions, str) else list(functions)
-    key = _key(path, {"backend": backend, "functions": functions, "urdf": urdf})
+    key = _key(path, {"backend": backend, "functions": functions, **options})
     folder = Path(cache_folder) if cache_folder is not None else default_folder()
     entry = _hit(folder, key)
     if entry is None:
         if os.environ.get(NO_BUILD, "") not in ("", "0"):
             raise BuildError(f"{path}: no cached {backend} module and {NO_BUILD} is set "
                              f"(fill the cache with `jacgen build {path} --backend {backend}`)")
-        folder, entry = _build(folder, key, path, backend, functions, urdf)
+        folder, entry = _build(folder, key, path, backend, functions, options)
     return _load(folder, entry)
 
 
@@ -183,7 +188,7 @@ def _locked(path: Path):
             fcntl.flock(stream, fcntl.LOCK_UN)
 
 
-def _build(folder: Path, key: str, path: Path, backend: str, functions, urdf) -> tuple[Path, dict]:
+def _build(folder: Path, key: str, path: Path, backend: str, functions, options: dict) -> tuple[Path, dict]:
     """Renders (and builds) the entry in a private folder and renames it into place, holding
     the key's lock; a folder that cannot be written is replaced by a temporary one, with a
     warning. Returns the folder used and the entry's manifest."""
@@ -205,7 +210,7 @@ def _build(folder: Path, key: str, path: Path, backend: str, functions, urdf) ->
         private = Path(tempfile.mkdtemp(prefix=f".{_entry_name(key)}.", dir=arms))
         try:
             with Progress(path.name) as progress:
-                manifest = _render(private, key, path, backend, functions, urdf, progress)
+                manifest = _render(private, key, path, backend, functions, options, progress)
             final = arms / _entry_name(key)
             if final.exists():  # a corrupt entry: out of the way first
                 shutil.rmtree(final, ignore_errors=True)
@@ -215,7 +220,8 @@ def _build(folder: Path, key: str, path: Path, backend: str, functions, urdf) ->
     return folder, manifest
 
 
-def _render(entry: Path, key: str, path: Path, backend: str, functions, urdf, progress: "Progress") -> dict:
+def _render(entry: Path, key: str, path: Path, backend: str, functions, options: dict, progress: "Progress"
+            ) -> dict:
     """Writes the robot file, the generated files and (native) the built module into `entry`,
     then the manifest; returns it."""
     from jacgen.emission.generator import Generator
@@ -223,13 +229,14 @@ def _render(entry: Path, key: str, path: Path, backend: str, functions, urdf, pr
     from jacgen.inputs.robot_file import load_robot
 
     progress.show("generating")
-    if urdf is not None:
-        from jacgen.urdf_import import import_urdf
+    if options:
+        from jacgen import urdf_import
 
-        options = {option: value for option, value in urdf.items() if value is not None}
-        if "task" in options:
-            options["task"] = tuple(options["task"])
-        imported = import_urdf(str(path), **options)
+        (form, given), = options.items()
+        given = {option: value for option, value in given.items() if value is not None}
+        if "task" in given:
+            given["task"] = tuple(given["task"])
+        imported = urdf_import.import_description(urdf_import.FORMATS[form], str(path), **given)
         robot_file = entry / f"{imported.robot.name}.yaml"
         robot_file.write_text(imported.text, encoding="utf-8")
     else:

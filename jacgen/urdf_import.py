@@ -1,14 +1,16 @@
-"""`jacgen import-urdf`: a URDF chain -> the text of a robot file, checked before it is written.
+"""`jacgen import-urdf` and `import-mjcf`: a URDF's or an MJCF file's chain -> the text of a
+robot file, checked before it is written.
 
-Stages: urdf.read_chain (XML -> exact joint transforms), dh_fit.fit (axes -> DH table),
-then this module writes the robot file, chooses the task of an arm with fewer than six
-joints, and compares the file's fk with a plain walk of the URDF chain.
+Stages: urdf.read_chain or mjcf.read_mjcf_chain (XML -> exact joint transforms, one LinkChain),
+dh_fit.fit (axes -> DH table), then this module writes the robot file, chooses the task of an
+arm with fewer than six joints, and compares the file's fk with a plain walk of the chain.
 """
 
 import hashlib
 import re
 import math
 from dataclasses import dataclass, replace
+from typing import Callable
 from decimal import Context, Decimal
 from pathlib import Path
 
@@ -25,6 +27,7 @@ from jacgen.inputs.values import ExpressionError
 from jacgen.inputs.robot import TASK_COMPONENTS, Robot
 from jacgen.inputs.robot_file import (FORBIDDEN_IN_TEXT, IDENTIFIER_PATTERN, NAME_PATTERN, SMALLEST_LENGTH, parse_robot,
                                       task_problem)
+from jacgen.inputs.mjcf import read_mjcf_chain
 from jacgen.inputs.urdf import MOVABLE, LinkChain, Snapper, joint_axes, read_chain
 from jacgen.version import __version__
 
@@ -36,6 +39,22 @@ CHECK_SEED = 0
 NEARLY_PARALLEL = 1e-3
 FAR_NORMAL = 10
 MAX_SNAP = 1e-2
+
+
+@dataclass(frozen=True)
+class Format:
+    """A description format: its reader, command, the word for its frames, and its name."""
+
+    read: Callable  # (path, base, tip, snapper) -> LinkChain
+    command: str
+    frames: str
+    name: str
+    fixed: str  # what of the chain does not move
+
+
+URDF = Format(read_chain, "import-urdf", "links", "URDF", "fixed joints")
+MJCF = Format(read_mjcf_chain, "import-mjcf", "bodies", "MJCF file", "bodies, frames and sites without a joint")
+FORMATS = {"urdf": URDF, "mjcf": MJCF}
 
 
 @dataclass(frozen=True)
@@ -57,13 +76,28 @@ def import_urdf(path: str, base: str | None = None, tip: str | None = None, conv
                 snap: float | None = None) -> Imported:
     """The robot file for the chain of `path`, checked against the URDF's own fk. `snap` is the
     tolerance of the angles made exact (default: each URDF angle's own written digits, Snapper)."""
-    return _import(path, base, tip, convention, name, task, snap, suggest=True)
+    return import_description(URDF, path, base, tip, convention, name, task, snap)
 
 
-def _import(path, base, tip, convention, name, task, snap, suggest: bool) -> Imported:
+def import_mjcf(path: str, base: str | None = None, tip: str | None = None, convention: str = "standard",
+                name: str | None = None, task: tuple[str, ...] | None = None,
+                snap: float | None = None) -> Imported:
+    """import_urdf for an MJCF file: the chain from the body `base` (default: the world) to the
+    body or site `tip` (default: the one leaf body)."""
+    return import_description(MJCF, path, base, tip, convention, name, task, snap)
+
+
+def import_description(form: "Format", path: str, base: str | None = None, tip: str | None = None,
+                       convention: str = "standard", name: str | None = None, task: tuple[str, ...] | None = None,
+                       snap: float | None = None) -> Imported:
+    """import_urdf or import_mjcf, by `form` (URDF, MJCF)."""
+    return _import(form, path, base, tip, convention, name, task, snap, suggest=True)
+
+
+def _import(form: Format, path, base, tip, convention, name, task, snap, suggest: bool) -> Imported:
     snapper = Snapper(snap)
-    chain = read_chain(path, base, tip, snapper)
-    as_written = read_chain(path, base, tip, Snapper(0.0))
+    chain = form.read(path, base, tip, snapper)
+    as_written = form.read(path, base, tip, Snapper(0.0))
     axes, tip_frame = _axes(chain)
     table = fit(axes, tip_frame, convention, snapper)
     name = name or _robot_name(chain.robot_name)
@@ -75,18 +109,19 @@ def _import(path, base, tip, convention, name, task, snap, suggest: bool) -> Imp
     if task is not None and (problem := task_problem(list(task))):
         raise JacgenError(f"--task: {problem}")
     if far := _far_normal(chain, axes, table, snapper):
-        raise _nearly_parallel_error(path, far, (base, tip, convention, name, task) if suggest else None)
+        raise _nearly_parallel_error(form, path, far, (base, tip, convention, name, task) if suggest else None)
     digest = hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16]
     source = _text(Path(path).name)
     rule = (f"within {snap:g} rad of a multiple of 90 deg" if snap is not None
-            else "multiples of 90 deg to the digits the URDF writes them with")
-    description = f"{_text(chain.robot_name)} imported from {source} (links {_text(chain.base)} -> {_text(chain.tip)})"
+            else f"multiples of 90 deg to the digits the {form.name} writes them with")
+    frames = f"{form.frames} {_text(chain.base)} -> {_text(chain.tip)}"
+    description = f"{_text(chain.robot_name)} imported from {source} ({frames})"
 
     def text(table, zeroed, components, checked=""):
         header = [
-            f"Imported by jacgen {__version__} import-urdf from {source} (sha256 {digest}), "
-            f"robot {_text(chain.robot_name)!r}, links {_text(chain.base)} -> {_text(chain.tip)}.",
-            f"{len(axes)} moving joint(s); fixed joints folded into the DH, base and tool transforms: "
+            f"Imported by jacgen {__version__} {form.command} from {source} (sha256 {digest}), "
+            f"robot {_text(chain.robot_name)!r}, {frames}.",
+            f"{len(axes)} moving joint(s); {form.fixed} folded into the DH, base and tool transforms: "
             f"{_text(', '.join(chain.folded)) or 'none'}. DH frames as in docs/urdf.md.",
             f"Angles and axes {rule} were made exact; largest change {snapper.largest:.2g} rad.",
         ]
@@ -102,8 +137,8 @@ def _import(path, base, tip, convention, name, task, snap, suggest: bool) -> Imp
     if task is None:
         task = () if len(axes) >= 6 else _independent_task(_read_back(text(table, zeroed, TASK_COMPONENTS), path))
     difference = _fk_difference(_read_back(text(table, zeroed, task), path), as_written)
-    result = text(table, zeroed, task, f"Its fk differs from the URDF's as written by at most {difference:.2g} (an "
-                  f"entry of the 4x4 pose) at {CHECK_CONFIGURATIONS} random configurations within the limits.")
+    result = text(table, zeroed, task, f"Its fk differs from the {form.name}'s as written by at most {difference:.2g} "
+                  f"(an entry of the 4x4 pose) at {CHECK_CONFIGURATIONS} random configurations within the limits.")
     return Imported(result, _read_back(result, path), difference, snapper.largest, tuple(zeroed))
 
 
@@ -158,18 +193,18 @@ def _far_normal(chain: LinkChain, axes: list[Axis], table: Table, snapper: Snapp
     return min(far, key=lambda pair: pair.angle) if far else None
 
 
-def _nearly_parallel_error(path: str, far: _FarNormal, options) -> JacgenError:
+def _nearly_parallel_error(form: Format, path: str, far: _FarNormal, options) -> JacgenError:
     """The refusal of nearly parallel axes: which joints, how far from parallel, the DH length
     it would need, and the --snap value that imports the URDF with its effect on fk."""
     message = (f"{path}: joints {far.joints[0]!r} and {far.joints[1]!r}: their axes are {far.angle:.2g} rad from "
                f"parallel, so the DH common normal between them needs lengths of {far.length:.3g} m, where the "
-               f"URDF's chain spans {far.extent:.3g} m")
+               f"{form.name}'s chain spans {far.extent:.3g} m")
     snap = 10.0 ** math.ceil(math.log10(far.angle * 1.01))
     if options is not None and snap <= MAX_SNAP:
         try:
-            effect = _import(path, *options, snap, suggest=False).fk_difference
+            effect = _import(form, path, *options, snap, suggest=False).fk_difference
             message += (f"; if they are meant to be parallel, import with --snap {snap:g}, which makes them so and "
-                        f"moves fk by at most {effect:.2g} from the URDF as written")
+                        f"moves fk by at most {effect:.2g} from the {form.name} as written")
         except JacgenError:
             message += f"; --snap {snap:g} does not import it either"
     return JacgenError(message)
