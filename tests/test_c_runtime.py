@@ -32,7 +32,8 @@ int roots(const double *p, const double *q, double *angles) {
     static struct jacgen_g6_work work;
     for (int i = 0; i < 3 * 14 * 9; i++) pm[i / 126][i / 9 % 14][i % 9] = p[i];
     for (int i = 0; i < 14 * 8; i++) qm[i / 8][i % 8] = q[i];
-    int count = jacgen_general6r_roots(pm, qm, out, &work);
+    double condition;
+    int count = jacgen_general6r_roots(pm, qm, out, &work, &condition);
     for (int i = 0; i < count * 5; i++) angles[i] = out[i / 5][i % 5];
     return count;
 }

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import roboticstoolbox as rtb
 
-from jacgen.solvers import general6r
+from jacgen.solvers import general6r, general6r_plan
 from jacgen.checking import reference
 
 from support.general6r_arms import ARMS, JACO, Solver, multi_start, numeric, robot_of, solver_of
@@ -62,11 +62,11 @@ def test_the_textbook_split_is_singular_for_the_jaco_and_the_chosen_one_is_not()
     """Cut after q6 with tan(q3/2) hidden (Raghavan & Roth's), the Jaco's matrix polynomial is
     singular for every x; the split chosen is well conditioned."""
     robot = robot_of(JACO)
-    assert general6r.elimination(robot).condition < 1e4
+    assert general6r_plan.elimination(robot).condition < 1e4
     head, links, tail = general6r.chain_form(robot)
     textbook = general6r.equations(links, general6r.Split(backwards=False, free=5))
     theta = np.random.default_rng(2).uniform(-math.pi, math.pi, (1, 6))
-    n = general6r._numeric_chain(links, theta)[0]
+    n = general6r.chain_product(links, theta)[0]
     p0, ps, pc, q = textbook.evaluated(np.concatenate([n[:3, :3].ravel(), n[:3, 3]]))
     left_null = np.linalg.svd(q[:, :8])[0][:, 8:].T
     x = 0.37

@@ -5210,6 +5210,644 @@ def ik_general_start(T, angles):
     return q
 
 
+def ik_general_equations_fallback(T):
+    """the general 6R solver's equations at T, by the fallback elimination (for targets where the first's leading matrix is singular to rounding): (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9): (42 x 9 and 14 x 8), 611 operations."""
+    xp, dtype, device, batch, (T,) = _arguments(("T", T, (4, 4)))
+    T00 = T[..., 0, 0]
+    T01 = T[..., 0, 1]
+    T02 = T[..., 0, 2]
+    T03 = T[..., 0, 3]
+    T10 = T[..., 1, 0]
+    T11 = T[..., 1, 1]
+    T12 = T[..., 1, 2]
+    T13 = T[..., 1, 3]
+    T20 = T[..., 2, 0]
+    T21 = T[..., 2, 1]
+    T22 = T[..., 2, 2]
+    T23 = T[..., 2, 3]
+    t0 = -0.2115971250007892*T02 + T03
+    t1 = T13 - 0.2115971250007892*T12
+    t2 = T23 - 0.2115971250007892*T22
+    t3 = T00*t0 + T10*t1 + T20*t2
+    t4 = T01*t0 + T11*t1 + T21*t2
+    t5 = T02*t0 + T12*t1 + T22*t2
+    t6 = 0.8660254037844386*t5
+    t7 = 0.5*t5
+    t8 = t3**2
+    t9 = t4**2
+    t10 = t5**2
+    t11 = 0.023636315875434848*T22
+    t12 = 0.08579425000157839*t5
+    t13 = 0.551*T20
+    t14 = t13*t3
+    t15 = 0.551*T21
+    t16 = t15*t4
+    t17 = 0.551*T22
+    t18 = 0.5*T00
+    t19 = 0.5*T01
+    t20 = 0.5*T10
+    t21 = 0.5*T11
+    t22 = 0.8660254037844386*T02
+    t23 = 0.8660254037844386*T12
+    t24 = 0.8660254037844386*T00
+    t25 = 0.8660254037844386*T01
+    t26 = 0.8660254037844386*T10
+    t27 = 0.8660254037844386*T11
+    t28 = 0.5*T02
+    t29 = 0.5*T12
+    t30 = 0.2755*T21
+    t31 = 0.2755*T20
+    t32 = 0.0409393*T20
+    t33 = 0.1486*t3
+    t34 = 0.0409393*T21
+    t35 = 0.1486*t4
+    t36 = T00*t3
+    t37 = T01*t4
+    t38 = T02*t5
+    t39 = T10*t3
+    t40 = T11*t4
+    t41 = T12*t5
+    t42 = 0.2755*T11
+    t43 = T00*t5
+    t44 = T02*t3
+    t45 = 0.2755*T10
+    t46 = T01*t5
+    t47 = T02*t4
+    t48 = T12*t3
+    t49 = T10*t5
+    t50 = T12*t4
+    t51 = T11*t5
+    t52 = 0.023636315875434848*T02
+    t53 = t36*t4
+    t54 = t38*t4
+    t55 = t37*t3
+    t56 = t38*t3
+    t57 = 0.023636315875434848*T12
+    t58 = t39*t4
+    t59 = t41*t4
+    t60 = t40*t3
+    t61 = t41*t3
+    t62 = 0.047272631750869695*T02
+    t63 = 0.047272631750869695*T22
+    t64 = t30*t4
+    t65 = 0.2755*T22
+    t66 = t31*t3
+    t67 = 0.047272631750869695*T12
+    t68 = T22*t5
+    t69 = 0.4771799974852257*T22
+    t70 = t36*t5
+    t71 = t37*t5
+    t72 = 0.4771799974852257*T20
+    t73 = 0.4771799974852257*T21
+    t74 = t39*t5
+    t75 = t40*t5
+    t76 = t73*t4
+    t77 = t72*t3
+    P = _stack(xp, [
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
+        xp.full(batch, 0.8660254037844386, dtype=dtype, device=device),  # 2, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 7
+        t6 - 0.23858999874261286*T22,  # 4, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
+        xp.full(batch, 0.35507041555161983, dtype=dtype, device=device),  # 5, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4
+        xp.full(batch, -0.008487048957087498, dtype=dtype, device=device),  # 5, 5
+        xp.full(batch, 0.205, dtype=dtype, device=device),  # 5, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 7
+        0.21089281250197298 - t7 + 0.13775*T22,  # 5, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 5
+        xp.full(batch, 0.20516164250064714, dtype=dtype, device=device),  # 6, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 7
+        0.1475337380253272 - t8 - t9 - t10 - t11 + t12 + t14 + t16 + t17*t5,  # 6, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 7
+        xp.full(batch, -0.0098, dtype=dtype, device=device),  # 7, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 8
+        xp.full(batch, -0.35507041555161983, dtype=dtype, device=device),  # 10, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 3
+        xp.full(batch, -0.21667706620451413, dtype=dtype, device=device),  # 10, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 6
+        xp.full(batch, 0.205, dtype=dtype, device=device),  # 10, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 13, 0
+        xp.full(batch, 0.006959380144811749, dtype=dtype, device=device),  # 13, 1
+        xp.full(batch, 0.1776751942877016, dtype=dtype, device=device),  # 13, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 13, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 13, 4
+        xp.full(batch, 0.1997076763143598, dtype=dtype, device=device),  # 13, 5
+        xp.full(batch, 0.004018, dtype=dtype, device=device),  # 13, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 13, 7
+        xp.full(batch, 0.002451931825007734, dtype=dtype, device=device),  # 13, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 4
+        xp.full(batch, 0.5, dtype=dtype, device=device),  # 14, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 3
+        xp.full(batch, 1.0, dtype=dtype, device=device),  # 15, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 17, 0
+        xp.full(batch, 0.205, dtype=dtype, device=device),  # 17, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 17, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 17, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 17, 4
+        xp.full(batch, -0.0049, dtype=dtype, device=device),  # 17, 5
+        xp.full(batch, -0.35507041555161983, dtype=dtype, device=device),  # 17, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 17, 7
+        xp.full(batch, -0.21667706620451413, dtype=dtype, device=device),  # 17, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 2
+        xp.full(batch, -0.41, dtype=dtype, device=device),  # 18, 3
+        xp.full(batch, -0.0098, dtype=dtype, device=device),  # 18, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 8
+        xp.full(batch, -0.205, dtype=dtype, device=device),  # 22, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 22, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 22, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 22, 3
+        xp.full(batch, -0.12509856250039458, dtype=dtype, device=device),  # 22, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 22, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 22, 6
+        xp.full(batch, -0.35507041555161983, dtype=dtype, device=device),  # 22, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 22, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 23, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 23, 1
+        xp.full(batch, 0.41, dtype=dtype, device=device),  # 23, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 23, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 23, 4
+        xp.full(batch, 0.25019712500078917, dtype=dtype, device=device),  # 23, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 23, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 23, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 23, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 25, 0
+        xp.full(batch, 0.004018, dtype=dtype, device=device),  # 25, 1
+        xp.full(batch, 0.10258082125032357, dtype=dtype, device=device),  # 25, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 25, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 25, 4
+        xp.full(batch, 0.11530128067933026, dtype=dtype, device=device),  # 25, 5
+        xp.full(batch, -0.006959380144811749, dtype=dtype, device=device),  # 25, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 25, 7
+        xp.full(batch, -0.004246870497608477, dtype=dtype, device=device),  # 25, 8
+        xp.full(batch, 0.20516164250064714, dtype=dtype, device=device),  # 26, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 26, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 26, 2
+        xp.full(batch, -0.008036, dtype=dtype, device=device),  # 26, 3
+        xp.full(batch, 0.23060256135866053, dtype=dtype, device=device),  # 26, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 26, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 26, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 26, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 26, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 3
+        xp.full(batch, 1.0, dtype=dtype, device=device),  # 28, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 4
+        xp.full(batch, -0.5, dtype=dtype, device=device),  # 29, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 2
+        xp.full(batch, -0.41, dtype=dtype, device=device),  # 31, 3
+        xp.full(batch, -0.0098, dtype=dtype, device=device),  # 31, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 32, 0
+        xp.full(batch, -0.205, dtype=dtype, device=device),  # 32, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 32, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 32, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 32, 4
+        xp.full(batch, 0.0049, dtype=dtype, device=device),  # 32, 5
+        xp.full(batch, 0.35507041555161983, dtype=dtype, device=device),  # 32, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 32, 7
+        xp.full(batch, 0.21667706620451413, dtype=dtype, device=device),  # 32, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 36, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 36, 1
+        xp.full(batch, 0.41, dtype=dtype, device=device),  # 36, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 36, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 36, 4
+        xp.full(batch, 0.25019712500078917, dtype=dtype, device=device),  # 36, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 36, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 36, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 36, 8
+        xp.full(batch, 0.205, dtype=dtype, device=device),  # 37, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 37, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 37, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 37, 3
+        xp.full(batch, 0.12509856250039458, dtype=dtype, device=device),  # 37, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 37, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 37, 6
+        xp.full(batch, 0.35507041555161983, dtype=dtype, device=device),  # 37, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 37, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 8
+        xp.full(batch, 0.20516164250064714, dtype=dtype, device=device),  # 39, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 39, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 39, 2
+        xp.full(batch, -0.008036, dtype=dtype, device=device),  # 39, 3
+        xp.full(batch, 0.23060256135866053, dtype=dtype, device=device),  # 39, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 39, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 39, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 39, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 39, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 40, 0
+        xp.full(batch, -0.004018, dtype=dtype, device=device),  # 40, 1
+        xp.full(batch, -0.10258082125032357, dtype=dtype, device=device),  # 40, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 40, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 40, 4
+        xp.full(batch, -0.11530128067933026, dtype=dtype, device=device),  # 40, 5
+        xp.full(batch, 0.006959380144811749, dtype=dtype, device=device),  # 40, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 40, 7
+        xp.full(batch, 0.004246870497608477, dtype=dtype, device=device),  # 40, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 8
+    ], (42, 9))
+    Q = _stack(xp, [
+        -1.0*T01,  # 0, 0
+        T00,  # 0, 1
+        T11,  # 0, 2
+        -1.0*T10,  # 0, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 7
+        -t18,  # 1, 0
+        -t19,  # 1, 1
+        t20,  # 1, 2
+        t21,  # 1, 3
+        t22,  # 1, 4
+        -t23,  # 1, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 7
+        -t24,  # 2, 0
+        -t25,  # 2, 1
+        t26,  # 2, 2
+        t27,  # 2, 3
+        -t28,  # 2, 4
+        t29,  # 2, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5
+        -t30 + t4,  # 3, 6
+        t31 - 1.0*t3,  # 3, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5
+        0.5*t3 - 0.13775*T20,  # 4, 6
+        0.5*t4 - 0.13775*T21,  # 4, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5
+        0.8660254037844386*t3 - 0.23858999874261286*T20,  # 5, 6
+        0.8660254037844386*t4 - 0.23858999874261286*T21,  # 5, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 5
+        -t33 + t32,  # 6, 6
+        -t35 + t34,  # 6, 7
+        0.0743*T00,  # 7, 0
+        0.0743*T01,  # 7, 1
+        -0.0743*T10,  # 7, 2
+        -0.0743*T11,  # 7, 3
+        -(t36 + t37 + t38 - 0.042897125000789196*T02),  # 7, 4
+        t39 + t40 + t41 - 0.042897125000789196*T12,  # 7, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 7
+        -(-t43 + t42 + t44 + 0.042897125000789196*T00),  # 8, 0
+        -t47 + t45 + t46 - 0.042897125000789196*T01,  # 8, 1
+        -t49 + t48 + 0.042897125000789196*T10 - 0.2755*T01,  # 8, 2
+        -t51 + t50 + 0.2755*T00 + 0.042897125000789196*T11,  # 8, 3
+        0.0743*T02,  # 8, 4
+        -0.0743*T12,  # 8, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 7
+        0.08579425000157839*T01 - 0.13775*T10 + t28*t4 - t7*T01,  # 9, 0
+        -(0.08579425000157839*T00 - 0.5*t43 + 0.13775*T11 + t28*t3),  # 9, 1
+        -(0.08579425000157839*T11 - 0.5*t51 + 0.13775*T00 + t29*t4),  # 9, 2
+        0.08579425000157839*T10 - 0.13775*T01 + t29*t3 - t7*T10,  # 9, 3
+        0.23858999874261286*T12 + t24*t4 - t25*t3,  # 9, 4
+        0.23858999874261286*T02 + t27*t3 - t26*t4,  # 9, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 7
+        -(-0.8660254037844386*t47 + 0.23858999874261286*T10 + t6*T01),  # 10, 0
+        -(-0.8660254037844386*t43 + 0.23858999874261286*T11 + t22*t3),  # 10, 1
+        -(-0.8660254037844386*t51 + 0.23858999874261286*T00 + t23*t4),  # 10, 2
+        -(-0.8660254037844386*t48 + 0.23858999874261286*T01 + t6*T10),  # 10, 3
+        -(0.13775*T12 - 0.5*T01*t3 + t18*t4),  # 10, 4
+        -(0.13775*T02 - 0.5*T10*t4 + t21*t3),  # 10, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 7
+        -0.08579425000157839*t47 - 0.08326090333333333*T01 + 2.0*t53 + 2.0*t54 + t9*T01 + t12*T01 + t52*T21 - t8*T01 - t10*T01 - t11*T01 + t14*T01 + t17*t46 - t15*t36 - t15*t38,  # 11, 0
+        t13*t38 + 0.08579425000157839*t44 + 0.08326090333333333*T00 - 2.0*t55 - 2.0*t56 + t9*T00 + t10*T00 + t11*T00 - t8*T00 - t12*T00 - t52*T20 + t13*t37 - t16*T00 - t17*t43,  # 11, 1
+        t15*t39 + 0.08579425000157839*t50 + 0.08326090333333333*T11 - 2.0*t58 - 2.0*t59 + t8*T11 + t10*T11 + t11*T11 - t9*T11 - t12*T11 - t57*T21 + t15*t41 - t14*T11 - t17*t51,  # 11, 2
+        -0.08579425000157839*t48 - 0.08326090333333333*T10 + 2.0*t60 + 2.0*t61 + t8*T10 + t12*T10 + t57*T20 - t9*T10 - t10*T10 - t11*T10 + t16*T10 + t17*t49 - t13*t40 - t13*t41,  # 11, 3
+        t33*T01 + t34*T00 - t35*T00 - t32*T01,  # 11, 4
+        t35*T10 + t32*T11 - t33*T11 - t34*T10,  # 11, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 7
+        t55 + t56 + 0.17158850000315679*t43 - 0.041630451666666665*T00 - 0.17158850000315679*t44 + t8*t18 + t62*T20 - t9*t18 - t10*t18 - t63*T00 + t64*T00 + t43*t65 - t31*t37 - t31*t38,  # 12, 0
+        t53 + t54 - t10*t19 + 0.17158850000315679*t46 - 0.041630451666666665*T01 - 0.17158850000315679*t47 + t9*t19 + t62*T21 - t8*t19 - t63*T01 + t66*T01 + t46*t65 - t30*t36 - t30*t38,  # 12, 1
+        -t60 - t61 + 0.17158850000315679*t48 - 0.17158850000315679*t49 + 0.041630451666666665*T10 + t9*t20 + t10*t20 + t63*T10 - t8*t20 - t67*T20 + t31*t40 + t31*t41 - t64*T10 - t45*t68,  # 12, 2
+        -t58 - t59 + 0.17158850000315679*t50 - 0.17158850000315679*t51 + 0.041630451666666665*T11 + t8*t21 + t10*t21 + t63*T11 - t9*t21 - t67*T21 + t30*t39 + t30*t41 - t66*T11 - t42*t68,  # 12, 3
+        -1.7320508075688772*t70 - 1.7320508075688772*t71 + 0.07210605742870711*T02 + t8*t22 + t9*t22 - t10*t22 + t36*t69 + t37*t69 - t44*t72 - t47*t73,  # 12, 4
+        1.7320508075688772*t74 + 1.7320508075688772*t75 - 0.07210605742870711*T12 + t10*t23 - t8*t23 - t9*t23 + t48*t72 + t50*t73 - t39*t69 - t40*t69,  # 12, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 7
+        1.7320508075688772*t55 + 1.7320508075688772*t56 - 0.05935703187847256*T00 + t8*t24 - t9*t24 - t10*t24 + t76*T00 + t43*t69 - t37*t72 - t38*t72,  # 13, 0
+        1.7320508075688772*t53 + 1.7320508075688772*t54 - 0.05935703187847256*T01 + t9*t25 - t8*t25 - t10*t25 + t77*T01 + t46*t69 - t36*t73 - t38*t73,  # 13, 1
+        0.05935703187847256*T10 - 1.7320508075688772*t60 - 1.7320508075688772*t61 + t9*t26 + t10*t26 - t8*t26 + t40*t72 + t41*t72 - t76*T10 - t49*t69,  # 13, 2
+        t10*t27 + 0.05935703187847256*T11 - 1.7320508075688772*t58 - 1.7320508075688772*t59 + t8*t27 - t9*t27 + t39*t73 + t41*t73 - t77*T11 - t51*t69,  # 13, 3
+        -(-t70 - t71 + 0.17158850000315679*t36 + 0.17158850000315679*t37 + 0.17158850000315679*t38 + 0.03426979833333333*T02 - 0.5*t10*T02 + t8*t28 + t9*t28 + t36*t65 + t37*t65 - 0.2755*t44*T20 - 0.2755*t47*T21),  # 13, 4
+        -t74 - t75 + 0.17158850000315679*t39 + 0.17158850000315679*t40 + 0.17158850000315679*t41 + 0.03426979833333333*T12 + t8*t29 + t9*t29 - t10*t29 + t39*t65 + t40*t65 - t31*t48 - t30*t50,  # 13, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 13, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 13, 7
+    ], (14, 8))
+    return P, Q
+
+
+def ik_general_start_fallback(T, angles):
+    """the configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop), by the fallback elimination (for targets where the first's leading matrix is singular to rounding): (6 x 1), 62 operations."""
+    xp, dtype, device, batch, (T, angles,) = _arguments(("T", T, (4, 4)), ("angles", angles, (5,)))
+    T00 = T[..., 0, 0]
+    T01 = T[..., 0, 1]
+    T02 = T[..., 0, 2]
+    T10 = T[..., 1, 0]
+    T11 = T[..., 1, 1]
+    T12 = T[..., 1, 2]
+    T20 = T[..., 2, 0]
+    T21 = T[..., 2, 1]
+    T22 = T[..., 2, 2]
+    ga0 = angles[..., 0]
+    ga1 = angles[..., 1]
+    ga2 = angles[..., 2]
+    ga3 = angles[..., 3]
+    ga4 = angles[..., 4]
+    t0 = xp.cos(ga3)
+    t1 = xp.sin(ga3)
+    t2 = xp.cos(ga2)
+    t3 = xp.sin(ga2)
+    t4 = xp.cos(ga1)*t2
+    t5 = xp.sin(ga1)*t2
+    t6 = 0.5*t5 - 0.8660254037844386*t3
+    t7 = 0.5*t3 + 0.8660254037844386*t5
+    t8 = xp.cos(ga0)
+    t9 = xp.sin(ga0)
+    t10 = t8*t4 - t9*t6
+    t11 = t9*t4 + t8*t6
+    t12 = 0.5*t11 - 0.8660254037844386*t7
+    t13 = 0.5*t7 + 0.8660254037844386*t11
+    t14 = xp.cos(ga4)
+    t15 = xp.sin(ga4)
+    t16 = t14*t10 - t15*t12
+    t17 = t15*t10 + t14*t12
+    t18 = t16*(T00*t0 + T10*t1) - t17*(T01*t0 + T11*t1) + t13*(T02*t0 + T12*t1)
+    t19 = T20*t16 + T22*t13 - T21*t17
+    q = _stack(xp, [
+        xp.broadcast_to(-ga3, batch),  # 0
+        xp.broadcast_to(1.5707963267948966 + xp.atan2(t19, t18), batch),  # 1
+        xp.broadcast_to(-(1.5707963267948966 + ga2), batch),  # 2
+        xp.broadcast_to(-ga1, batch),  # 3
+        xp.broadcast_to(3.141592653589793 - ga0, batch),  # 4
+        xp.broadcast_to(-(1.7453292519943295 + ga4), batch),  # 5
+    ], (6,))
+    return q
+
+
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_general_residual(target, q):
     """the pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J of the six joints ik solves: the Newton step of the solver's polish is q + J^-1 e: (6 x 1 and 6 x 6), 324 operations."""
@@ -5891,6 +6529,7 @@ _ALONG_C, _ALONG_B = numpy.array([0, 1, 3, 4, 6, 7, 9, 10]), numpy.array([0, 1, 
 _NEWTON_STEPS = 6
 _TOLERANCE_SQUARED = 1e-18  # |pose error|^2 of a solution after the Newton steps
 _CONVERGED_SQUARED = 5.0305488234464105e-24  # |pose error|^2 at which the Newton steps stop
+_DEGENERATE = 10000000.0  # a leading matrix above this condition number takes the fallback elimination
 
 
 def _twelve(s):
@@ -5913,8 +6552,9 @@ def _ratio(w, starts, step):
 
 def _roots(P, Q):
     """The loop angles (a - shift, b, c, g, h) of the 16 eigenvalues nearest the real axis
-    (..., 16, 5) and which are real (..., 16), from the equations at the targets (P: ..., 3, 14,
-    9; Q: ..., 14, 8). Of the 24, eight are always +-i (the half-angle substitution's
+    (..., 16, 5), which are real (..., 16), and the leading matrix's 1-norm condition number
+    (...; infinite where it is singular), from the equations at the targets (P: ..., 3, 14, 9;
+    Q: ..., 14, 8). Of the 24, eight are always +-i (the half-angle substitution's
     (1 + x^2)^4), so the real ones are among those 16."""
     orthogonal, r = numpy.linalg.qr(Q, mode="complete")
     free = numpy.swapaxes(orthogonal[..., 8:], -1, -2)  # six combinations free of v_gh
@@ -5922,6 +6562,7 @@ def _roots(P, Q):
     m2, m1, m0 = _twelve(s0 - sc), _twelve(2.0 * ss), _twelve(s0 + sc)
     lead = numpy.abs(numpy.linalg.det(m2)) > 0.0
     m2 = numpy.where(lead[..., None, None], m2, numpy.eye(12))
+    condition = numpy.where(lead, numpy.linalg.cond(m2, 1), numpy.inf)
     companion = numpy.zeros((*m2.shape[:-2], 24, 24))
     companion[..., :12, 12:] = numpy.eye(12)
     companion[..., 12:, :12], companion[..., 12:, 12:] = -numpy.linalg.solve(m2, m0), -numpy.linalg.solve(m2, m1)
@@ -5944,7 +6585,16 @@ def _roots(P, Q):
     v_gh = numpy.swapaxes(numpy.linalg.solve(r8, numpy.swapaxes(projected, -1, -2)), -1, -2)
     angles = numpy.stack([a, b, c, numpy.arctan2(v_gh[..., 4], v_gh[..., 5]), numpy.arctan2(v_gh[..., 6], v_gh[..., 7])],
                          axis=-1)
-    return angles, real
+    return angles, real, condition
+
+
+def _eigenproblem(equations):
+    """_roots of the equations (P, Q) that ik_general_equations gives; a target that is not
+    finite has none (its P and Q zeros: a singular leading matrix)."""
+    P, Q = equations
+    finite = (numpy.isfinite(P).all(axis=(-2, -1)) & numpy.isfinite(Q).all(axis=(-2, -1)))[..., None, None]
+    P, Q = numpy.where(finite, P, 0.0), numpy.where(finite, Q, 0.0)
+    return _roots(numpy.reshape(P, (*P.shape[:-2], 3, 14, 9)), Q)
 
 
 def _newton(targets, q):
@@ -5970,12 +6620,14 @@ def _polish(targets, q, cost, steps):
 def _general_branches(T):
     """The eigenproblem's solutions at targets T (..., 4, 4): q (..., 16, DOF) and valid (..., 16),
     each solution once (the first of equal ones), after up to 6 Newton steps within 1e-09."""
-    P, Q = ik_general_equations(T)
-    finite = (numpy.isfinite(P).all(axis=(-2, -1)) & numpy.isfinite(Q).all(axis=(-2, -1)))[..., None, None]
-    P, Q = numpy.where(finite, P, 0.0), numpy.where(finite, Q, 0.0)  # no root: a singular leading matrix
-    angles, real = _roots(numpy.reshape(P, (*P.shape[:-2], 3, 14, 9)), Q)
+    angles, real, condition = _eigenproblem(ik_general_equations(T))
     targets = T[..., None, :, :]
     q = ik_general_start(targets, angles)
+    degenerate = ~(condition <= _DEGENERATE)  # a leading matrix singular to rounding: the fallback's roots
+    if degenerate.any():
+        T_d = T[degenerate]
+        angles_d, real[degenerate], _ = _eigenproblem(ik_general_equations_fallback(T_d))
+        q[degenerate] = ik_general_start_fallback(T_d[..., None, :, :], angles_d)
     cost, q = _newton(targets, q)
     cost, q = _polish(targets, q, cost, _NEWTON_STEPS)
     return q, _first_of_equals(q, real & (cost <= _TOLERANCE_SQUARED))

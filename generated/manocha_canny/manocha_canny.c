@@ -168,6 +168,7 @@ static int jacgen_eigenvalues(int n, double a[JACGEN_EIG_MAX][JACGEN_EIG_MAX], d
 
 
 #define JACGEN_G6_IMAGINARY 1e-05
+#define JACGEN_G6_DEGENERATE 10000000.0
 /* Runtime helper of the general 6R solver (included by robot.c.jinja for its robots): from
  * Raghavan & Roth's 14 equations at one target, (P0 + s Ps + c Pc) v_bc = Q v_gh with the hidden
  * angle's shift already applied (jacgen/general6r.py), the loop angles (a, b, c, g, h) of every
@@ -177,7 +178,9 @@ static int jacgen_eigenvalues(int n, double a[JACGEN_EIG_MAX][JACGEN_EIG_MAX], d
  * x = +-i for every target (jacgen_g6_spurious); the other 16 are those of the companion matrix
  * with them deflated (jacgen_g6_deflated, jacgen_eigenvalues). Per real root, the null vector of
  * M(x) (inverse iteration) gives x_b and x_c, and R^-1 (Q^T P v_bc)[0..7] gives v_gh. Fixed size,
- * no allocation, no recursion. Returns the number of roots (0 when M2 or R is singular).
+ * no allocation, no recursion. Returns the number of roots (0 when M2 or R is singular), and
+ * M2's 1-norm condition number in *condition (infinite when it is singular): above
+ * JACGEN_G6_DEGENERATE, its eigenvalues are noise and the caller takes its fallback elimination.
  * Defined before it: JACGEN_G6_IMAGINARY, an eigenvalue being a root when |imaginary part| <= that
  * (1 + |x|) (jacgen/general6r.py's IMAGINARY for the build's real type). */
 #define JACGEN_G6_ROOTS 16
@@ -337,12 +340,12 @@ static void jacgen_g6_pencil(double free[3][6][9], double m[3][12][12]) {
 }
 
 /* The kernel's working memory: the QR of Q, its left null space, the six v_gh-free equations, M0,
- * M1, M2, the null space of M(i) (u + i v), M2^-1 [M0 M1] at the deflated matrix's columns, the
- * deflated matrix (eigenvalues in re, im) and two 12 x 12 matrices (M(i); M2's LU; M(x) at each
- * root). */
+ * M1, M2, the null space of M(i) (u + i v), M2^-1 [M0 M1 I] (at the deflated matrix's columns,
+ * and M2's inverse), the deflated matrix (eigenvalues in re, im) and two 12 x 12 matrices (M(i);
+ * M2's LU; M(x) at each root). */
 struct jacgen_g6_work {
     double q[14][8], beta[8], rdiag[8], left_null[6][14], free[3][6][9], m[3][12][12];
-    double u[12][4], v[12][4], columns[12][16], square[2][12][12];
+    double u[12][4], v[12][4], columns[12][28], square[2][12][12];
     double deflated[JACGEN_EIG_MAX][JACGEN_EIG_MAX], re[JACGEN_EIG_MAX], im[JACGEN_EIG_MAX];
 };
 
@@ -413,13 +416,21 @@ static int jacgen_g6_spurious(double m[3][12][12], double re[12][12], double im[
  * basis is C[r][r'] - W[r] C[sel][r'] (sel: the identity's rows): with C[sel] = [0; -S[free]] at
  * the columns r', the rows [0 I] + v S[free] and -S + u S[free] at the pivot columns.
  * -1 when M2 is singular. */
-static int jacgen_g6_deflated(struct jacgen_g6_work *w, const int order[12]) {
-    double (*s)[16] = w->columns, (*lead)[12] = w->square[0];
+static int jacgen_g6_deflated(struct jacgen_g6_work *w, const int order[12], double *condition) {
+    double (*s)[28] = w->columns, (*lead)[12] = w->square[0];
+    double norm = 0.0, inverse_norm = 0.0;
     for (int i = 0; i < 12; i++) {
-        for (int j = 0; j < 12; j++) lead[i][j] = w->m[2][i][j];
+        for (int j = 0; j < 12; j++) { lead[i][j] = w->m[2][i][j]; s[i][16 + j] = i == j; }
         for (int b = 0; b < 8; b++) { s[i][b] = w->m[0][i][order[b]]; s[i][8 + b] = w->m[1][i][order[b]]; }
     }
-    if (jacgen_g6_solve(12, &lead[0][0], 16, &s[0][0]) != 0) return -1;
+    if (jacgen_g6_solve(12, &lead[0][0], 28, &s[0][0]) != 0) return -1;
+    for (int j = 0; j < 12; j++) {  /* M2's 1-norm condition number, from M2^-1 in columns 16.. */
+        double column = 0.0, inverse_column = 0.0;
+        for (int i = 0; i < 12; i++) { column += fabs(w->m[2][i][j]); inverse_column += fabs(s[i][16 + j]); }
+        if (column > norm) norm = column;
+        if (inverse_column > inverse_norm) inverse_norm = inverse_column;
+    }
+    *condition = norm * inverse_norm;
     for (int a = 0; a < 8; a++) {
         int r = order[a];
         for (int b = 0; b < 16; b++) {
@@ -436,7 +447,8 @@ static int jacgen_g6_deflated(struct jacgen_g6_work *w, const int order[12]) {
 }
 
 static int jacgen_general6r_roots(double p[3][14][9], double q_matrix[14][8],
-                                  double angles[JACGEN_G6_ROOTS][5], struct jacgen_g6_work *w) {
+                                  double angles[JACGEN_G6_ROOTS][5], struct jacgen_g6_work *w, double *condition) {
+    *condition = INFINITY;
     for (int i = 0; i < 14; i++)
         for (int j = 0; j < 8; j++) w->q[i][j] = q_matrix[i][j];
     if (jacgen_g6_qr(w->q, w->beta, w->rdiag) != 0) return 0;
@@ -450,7 +462,8 @@ static int jacgen_general6r_roots(double p[3][14][9], double q_matrix[14][8],
         }
     jacgen_g6_pencil(w->free, w->m);
     int order[12];
-    if (jacgen_g6_spurious(w->m, w->square[0], w->square[1], w->u, w->v, order) != 0 || jacgen_g6_deflated(w, order) != 0
+    if (jacgen_g6_spurious(w->m, w->square[0], w->square[1], w->u, w->v, order) != 0
+        || jacgen_g6_deflated(w, order, condition) != 0
         || jacgen_eigenvalues(JACGEN_G6_ROOTS, w->deflated, w->re, w->im) != 0) return 0;
     static const int along_c[8] = {0, 1, 3, 4, 6, 7, 9, 10};
     static const int along_b[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
@@ -5741,6 +5754,636 @@ void manocha_canny_ik_general_start(const manocha_canny_real T[16], const manoch
     q[5] = atan2(-t39, t45);
 }
 
+void manocha_canny_ik_general_equations_fallback(const manocha_canny_real T[16], manocha_canny_real P[378], manocha_canny_real Q[112])
+{
+    /* 202 operations */
+
+    /* Inputs */
+    const manocha_canny_real T00 = T[0];
+    const manocha_canny_real T01 = T[1];
+    const manocha_canny_real T02 = T[2];
+    const manocha_canny_real T03 = T[3];
+    const manocha_canny_real T10 = T[4];
+    const manocha_canny_real T11 = T[5];
+    const manocha_canny_real T12 = T[6];
+    const manocha_canny_real T13 = T[7];
+    const manocha_canny_real T20 = T[8];
+    const manocha_canny_real T21 = T[9];
+    const manocha_canny_real T22 = T[10];
+    const manocha_canny_real T23 = T[11];
+
+    /* Intermediate terms */
+    const manocha_canny_real t0 = 0.9998476951563913*T01 - 0.01745240643728351*T02;
+    const manocha_canny_real t1 = 0.01745240643728351*T01 + 0.9998476951563913*T02;
+    const manocha_canny_real t2 = 0.9998476951563913*T11 - 0.01745240643728351*T12;
+    const manocha_canny_real t3 = 0.01745240643728351*T11 + 0.9998476951563913*T12;
+    const manocha_canny_real t4 = 0.9998476951563913*T21 - 0.01745240643728351*T22;
+    const manocha_canny_real t5 = 0.01745240643728351*T21 + 0.9998476951563913*T22;
+    const manocha_canny_real t6 = T00*T03 + T10*T13 + T20*T23;
+    const manocha_canny_real t7 = T03*t0 + T13*t2 + T23*t4;
+    const manocha_canny_real t8 = T03*t1 + T13*t3 + T23*t5;
+    const manocha_canny_real t9 = (t6*t6);
+    const manocha_canny_real t10 = (t7*t7);
+    const manocha_canny_real t11 = (t8*t8);
+    const manocha_canny_real t12 = T00*t6;
+    const manocha_canny_real t13 = 0.6*t12;
+    const manocha_canny_real t14 = t0*t7;
+    const manocha_canny_real t15 = 0.6*t14;
+    const manocha_canny_real t16 = T10*t6;
+    const manocha_canny_real t17 = 0.6*t16;
+    const manocha_canny_real t18 = t2*t7;
+    const manocha_canny_real t19 = 0.6*t18;
+    const manocha_canny_real t20 = -1.0*t0;
+    const manocha_canny_real t21 = -1.0*t2;
+    const manocha_canny_real t22 = -0.3*t2;
+    const manocha_canny_real t23 = 0.3*T10;
+    const manocha_canny_real t24 = 0.3*t0;
+    const manocha_canny_real t25 = 0.3*T00;
+    const manocha_canny_real t26 = -1.0*t7;
+    const manocha_canny_real t27 = t3*t8;
+    const manocha_canny_real t28 = 0.6*t27;
+    const manocha_canny_real t29 = t1*t8;
+    const manocha_canny_real t30 = 0.6*t29;
+    const manocha_canny_real t31 = T00*t8 - t1*t6;
+    const manocha_canny_real t32 = t1*t7;
+    const manocha_canny_real t33 = t0*t8;
+    const manocha_canny_real t34 = T10*t8 - t3*t6;
+    const manocha_canny_real t35 = t3*t7;
+    const manocha_canny_real t36 = t2*t8;
+    const manocha_canny_real t37 = -0.3*t4;
+    const manocha_canny_real t38 = 0.3*T20;
+    const manocha_canny_real t39 = 2.0*t7;
+    const manocha_canny_real t40 = -0.09*t0 + t10*t0 - t9*t0 - t11*t0 + t12*t39 + t29*t39;
+    const manocha_canny_real t41 = 0.09*T00;
+    const manocha_canny_real t42 = t9*T00;
+    const manocha_canny_real t43 = t10*T00;
+    const manocha_canny_real t44 = t11*T00;
+    const manocha_canny_real t45 = 2.0*t6;
+    const manocha_canny_real t46 = t14*t45;
+    const manocha_canny_real t47 = t29*t45;
+    const manocha_canny_real t48 = -0.09*t2 + t10*t2 - t9*t2 - t11*t2 + t16*t39 + t27*t39;
+    const manocha_canny_real t49 = 0.09*T10;
+    const manocha_canny_real t50 = t9*T10;
+    const manocha_canny_real t51 = t10*T10;
+    const manocha_canny_real t52 = t11*T10;
+    const manocha_canny_real t53 = t18*t45;
+    const manocha_canny_real t54 = t27*t45;
+    const manocha_canny_real t55 = t13*t2 + t30*t2 - t17*t0 - t28*t0;
+    const manocha_canny_real t56 = t15*T10;
+    const manocha_canny_real t57 = t30*T10;
+    const manocha_canny_real t58 = t19*T00;
+    const manocha_canny_real t59 = t28*T00;
+    const manocha_canny_real t60 = 2.0*t8;
+
+    /* Outputs */
+    P[0] = 0;
+    P[1] = 0;
+    P[2] = 0;
+    P[3] = 0;
+    P[4] = 0;
+    P[5] = 0;
+    P[6] = 0;
+    P[7] = 0;
+    P[8] = 0;
+    P[9] = 0;
+    P[10] = 0;
+    P[11] = 0;
+    P[12] = 0;
+    P[13] = 0;
+    P[14] = 0;
+    P[15] = 0;
+    P[16] = 0;
+    P[17] = 0;
+    P[18] = 0.000304586490452135;
+    P[19] = 0;
+    P[20] = 0;
+    P[21] = 0;
+    P[22] = 0;
+    P[23] = -0.017449748351250485;
+    P[24] = 0;
+    P[25] = -0.017449748351250485;
+    P[26] = 0;
+    P[27] = 0;
+    P[28] = 0;
+    P[29] = 0;
+    P[30] = 0;
+    P[31] = 0;
+    P[32] = 0;
+    P[33] = 0;
+    P[34] = 0;
+    P[35] = 0;
+    P[36] = 0;
+    P[37] = 0;
+    P[38] = 0;
+    P[39] = 0;
+    P[40] = 0;
+    P[41] = 0;
+    P[42] = 0;
+    P[43] = 0;
+    P[44] = -1.0*t8;
+    P[45] = 0;
+    P[46] = 0.01745240643728351;
+    P[47] = 0;
+    P[48] = 0;
+    P[49] = 0;
+    P[50] = 0.0034904812874567027;
+    P[51] = 0.9998476951563913;
+    P[52] = 0;
+    P[53] = 0;
+    P[54] = 0;
+    P[55] = 0;
+    P[56] = 0;
+    P[57] = 3.0;
+    P[58] = -0.6;
+    P[59] = 0;
+    P[60] = 0;
+    P[61] = 0;
+    P[62] = -(-3.2 + t9 + t10 + t11);
+    P[63] = 0;
+    P[64] = 0;
+    P[65] = 0.02617860965592527;
+    P[66] = 0;
+    P[67] = 1.4997715427345868;
+    P[68] = 0;
+    P[69] = 0;
+    P[70] = 0;
+    P[71] = -0.19996953903127826;
+    P[72] = 0;
+    P[73] = 0;
+    P[74] = 0;
+    P[75] = 0;
+    P[76] = 0;
+    P[77] = 0;
+    P[78] = 0;
+    P[79] = 0;
+    P[80] = 0;
+    P[81] = 0;
+    P[82] = 0;
+    P[83] = 0;
+    P[84] = 0;
+    P[85] = 0;
+    P[86] = 0;
+    P[87] = 0;
+    P[88] = 0;
+    P[89] = -0.3*t5;
+    P[90] = 0.04362437087812621;
+    P[91] = -6.0917298090426996e-05;
+    P[92] = 0;
+    P[93] = 0;
+    P[94] = 0;
+    P[95] = -1.4992385337738696;
+    P[96] = -0.003489949670250097;
+    P[97] = -0.9992385337738696;
+    P[98] = 0;
+    P[99] = 0;
+    P[100] = 0;
+    P[101] = 0;
+    P[102] = 0;
+    P[103] = 0;
+    P[104] = 0;
+    P[105] = 0;
+    P[106] = 0;
+    P[107] = 0;
+    P[108] = 0;
+    P[109] = 0;
+    P[110] = 0;
+    P[111] = 0;
+    P[112] = 0;
+    P[113] = 0;
+    P[114] = 0;
+    P[115] = 0;
+    P[116] = t13*t3 + t15*t3 - t17*t1 - t19*t1;
+    P[117] = -2.998084150975056;
+    P[118] = 0.017449748351250485;
+    P[119] = 0;
+    P[120] = 0;
+    P[121] = 0;
+    P[122] = -0.10836293726126552;
+    P[123] = 0.39969541350954785;
+    P[124] = -0.10975891712936556;
+    P[125] = 0;
+    P[126] = 0.016121465349192895;
+    P[127] = 0;
+    P[128] = 0.006678746798450243;
+    P[129] = 0;
+    P[130] = 0.38262514782477175;
+    P[131] = -0.9235981312868786;
+    P[132] = 0;
+    P[133] = 0.000281401224408172;
+    P[134] = 0;
+    P[135] = 0.006677729592963602;
+    P[136] = 0;
+    P[137] = -0.01612392110047446;
+    P[138] = 0;
+    P[139] = -0.9237388211835743;
+    P[140] = -0.3825668721614715;
+    P[141] = 0;
+    P[142] = 0.00011656020361825967;
+    P[143] = 0;
+    P[144] = 0;
+    P[145] = 0;
+    P[146] = 0;
+    P[147] = 0;
+    P[148] = 0;
+    P[149] = 0;
+    P[150] = 0;
+    P[151] = 0;
+    P[152] = 0;
+    P[153] = 0;
+    P[154] = 0.9237388211835743;
+    P[155] = 0;
+    P[156] = 0.3826834323650898;
+    P[157] = -0.07653668647301795;
+    P[158] = 0.18474776423671485;
+    P[159] = -0.01612392110047446;
+    P[160] = 0;
+    P[161] = 0.5740251485476346;
+    P[162] = 0;
+    P[163] = 0.38262514782477175;
+    P[164] = 0;
+    P[165] = -0.9238795325112867;
+    P[166] = 0.18477590650225734;
+    P[167] = 0.07652502956495436;
+    P[168] = -0.006678746798450243;
+    P[169] = 0;
+    P[170] = -1.38581929876693;
+    P[171] = 0;
+    P[172] = 0;
+    P[173] = 0;
+    P[174] = 0;
+    P[175] = 0;
+    P[176] = 0;
+    P[177] = 0;
+    P[178] = 0;
+    P[179] = 0;
+    P[180] = 0;
+    P[181] = 0;
+    P[182] = 0;
+    P[183] = 0;
+    P[184] = 0;
+    P[185] = 0;
+    P[186] = 0;
+    P[187] = 0;
+    P[188] = 0;
+    P[189] = 0;
+    P[190] = 0;
+    P[191] = 0;
+    P[192] = 0;
+    P[193] = 0;
+    P[194] = 0;
+    P[195] = 0;
+    P[196] = 0;
+    P[197] = 0;
+    P[198] = 0.9231760294502663;
+    P[199] = -0.003224293069838579;
+    P[200] = 0.38262514782477175;
+    P[201] = -0.0013357493596900486;
+    P[202] = -0.006678746798450243;
+    P[203] = 0.04030366337298224;
+    P[204] = 5.6280244881634396e-05;
+    P[205] = 0.04030366337298224;
+    P[206] = 0;
+    P[207] = 0.38239203185604415;
+    P[208] = -0.0013355459185927204;
+    P[209] = -0.9237388211835743;
+    P[210] = 0.0032247842200948925;
+    P[211] = 0.01612392110047446;
+    P[212] = 0.016694323982409005;
+    P[213] = 2.3312040723651935e-05;
+    P[214] = 0.016694323982409005;
+    P[215] = 0;
+    P[216] = 0;
+    P[217] = 0;
+    P[218] = 0;
+    P[219] = 0;
+    P[220] = 0;
+    P[221] = 0;
+    P[222] = 0;
+    P[223] = 0;
+    P[224] = 0;
+    P[225] = 0.10140401704642331;
+    P[226] = 0.3692704117801065;
+    P[227] = -0.008081283626124794;
+    P[228] = 0.1530500591299087;
+    P[229] = -0.4935864406939556;
+    P[230] = -2.9639057977576555;
+    P[231] = -0.016121465349192895;
+    P[232] = -2.769868583832333;
+    P[233] = 0.22957508869486304;
+    P[234] = 0.04200291913974106;
+    P[235] = 0.15295681274241765;
+    P[236] = 0.019509944531574102;
+    P[237] = -0.3694955284734297;
+    P[238] = 1.1916230793268108;
+    P[239] = -1.227689979027469;
+    P[240] = -0.006677729592963602;
+    P[241] = -1.1473171334145105;
+    P[242] = -0.5542432927101446;
+    P[243] = 0;
+    P[244] = 0;
+    P[245] = 0;
+    P[246] = 0;
+    P[247] = 0;
+    P[248] = 0;
+    P[249] = 0;
+    P[250] = 0;
+    P[251] = 0;
+    P[252] = 0.006677729592963602;
+    P[253] = 0;
+    P[254] = -0.01612392110047446;
+    P[255] = 0;
+    P[256] = -0.9237388211835743;
+    P[257] = -0.3825668721614715;
+    P[258] = 0;
+    P[259] = 0.00011656020361825967;
+    P[260] = 0;
+    P[261] = -0.016121465349192895;
+    P[262] = 0;
+    P[263] = -0.006678746798450243;
+    P[264] = 0;
+    P[265] = -0.38262514782477175;
+    P[266] = 0.9235981312868786;
+    P[267] = 0;
+    P[268] = -0.000281401224408172;
+    P[269] = 0;
+    P[270] = 0;
+    P[271] = 0;
+    P[272] = 0;
+    P[273] = 0;
+    P[274] = 0;
+    P[275] = 0;
+    P[276] = 0;
+    P[277] = 0;
+    P[278] = 0;
+    P[279] = 0;
+    P[280] = 0.38262514782477175;
+    P[281] = 0;
+    P[282] = -0.9238795325112867;
+    P[283] = 0.18477590650225734;
+    P[284] = 0.07652502956495436;
+    P[285] = -0.006678746798450243;
+    P[286] = 0;
+    P[287] = -1.38581929876693;
+    P[288] = 0;
+    P[289] = -0.9237388211835743;
+    P[290] = 0;
+    P[291] = -0.3826834323650898;
+    P[292] = 0.07653668647301795;
+    P[293] = -0.18474776423671485;
+    P[294] = 0.01612392110047446;
+    P[295] = 0;
+    P[296] = -0.5740251485476346;
+    P[297] = 0;
+    P[298] = 0;
+    P[299] = 0;
+    P[300] = 0;
+    P[301] = 0;
+    P[302] = 0;
+    P[303] = 0;
+    P[304] = 0;
+    P[305] = 0;
+    P[306] = 0;
+    P[307] = 0;
+    P[308] = 0;
+    P[309] = 0;
+    P[310] = 0;
+    P[311] = 0;
+    P[312] = 0;
+    P[313] = 0;
+    P[314] = 0;
+    P[315] = 0;
+    P[316] = 0;
+    P[317] = 0;
+    P[318] = 0;
+    P[319] = 0;
+    P[320] = 0;
+    P[321] = 0;
+    P[322] = 0;
+    P[323] = 0;
+    P[324] = 0.38239203185604415;
+    P[325] = -0.0013355459185927204;
+    P[326] = -0.9237388211835743;
+    P[327] = 0.0032247842200948925;
+    P[328] = 0.01612392110047446;
+    P[329] = 0.016694323982409005;
+    P[330] = 2.3312040723651935e-05;
+    P[331] = 0.016694323982409005;
+    P[332] = 0;
+    P[333] = -0.9231760294502663;
+    P[334] = 0.003224293069838579;
+    P[335] = -0.38262514782477175;
+    P[336] = 0.0013357493596900486;
+    P[337] = 0.006678746798450243;
+    P[338] = -0.04030366337298224;
+    P[339] = -5.6280244881634396e-05;
+    P[340] = -0.04030366337298224;
+    P[341] = 0;
+    P[342] = 0;
+    P[343] = 0;
+    P[344] = 0;
+    P[345] = 0;
+    P[346] = 0;
+    P[347] = 0;
+    P[348] = 0;
+    P[349] = 0;
+    P[350] = 0;
+    P[351] = 0.04200291913974106;
+    P[352] = 0.15295681274241765;
+    P[353] = 0.019509944531574102;
+    P[354] = -0.3694955284734297;
+    P[355] = 1.1916230793268108;
+    P[356] = -1.227689979027469;
+    P[357] = -0.006677729592963602;
+    P[358] = -1.1473171334145105;
+    P[359] = -0.5542432927101446;
+    P[360] = -0.10140401704642331;
+    P[361] = -0.3692704117801065;
+    P[362] = 0.008081283626124794;
+    P[363] = -0.1530500591299087;
+    P[364] = 0.4935864406939556;
+    P[365] = 2.9639057977576555;
+    P[366] = 0.016121465349192895;
+    P[367] = 2.769868583832333;
+    P[368] = -0.22957508869486304;
+    P[369] = 0;
+    P[370] = 0;
+    P[371] = 0;
+    P[372] = 0;
+    P[373] = 0;
+    P[374] = 0;
+    P[375] = 0;
+    P[376] = 0;
+    P[377] = 0;
+    Q[0] = t20;
+    Q[1] = -1.0*T00;
+    Q[2] = t21;
+    Q[3] = -1.0*T10;
+    Q[4] = 0;
+    Q[5] = 0;
+    Q[6] = 0;
+    Q[7] = 0;
+    Q[8] = 0;
+    Q[9] = 0;
+    Q[10] = 0;
+    Q[11] = 0;
+    Q[12] = t1;
+    Q[13] = t3;
+    Q[14] = 0;
+    Q[15] = 0;
+    Q[16] = T00;
+    Q[17] = t20;
+    Q[18] = T10;
+    Q[19] = t21;
+    Q[20] = 0;
+    Q[21] = 0;
+    Q[22] = 0;
+    Q[23] = 0;
+    Q[24] = t22;
+    Q[25] = -t23;
+    Q[26] = t24;
+    Q[27] = t25;
+    Q[28] = 0;
+    Q[29] = 0;
+    Q[30] = t26;
+    Q[31] = -1.0*t6;
+    Q[32] = 0;
+    Q[33] = 0;
+    Q[34] = 0;
+    Q[35] = 0;
+    Q[36] = 0.3*t3;
+    Q[37] = -0.3*t1;
+    Q[38] = 0;
+    Q[39] = 0;
+    Q[40] = t23;
+    Q[41] = t22;
+    Q[42] = -t25;
+    Q[43] = t24;
+    Q[44] = 0;
+    Q[45] = 0;
+    Q[46] = t6;
+    Q[47] = t26;
+    Q[48] = 0;
+    Q[49] = 0;
+    Q[50] = 0;
+    Q[51] = 0;
+    Q[52] = t17 + t19 + t28;
+    Q[53] = -(t13 + t15 + t30);
+    Q[54] = 0;
+    Q[55] = 0;
+    Q[56] = 0;
+    Q[57] = 0;
+    Q[58] = 0;
+    Q[59] = 0;
+    Q[60] = t12 + t14 + t29;
+    Q[61] = t16 + t18 + t27;
+    Q[62] = 0;
+    Q[63] = 0;
+    Q[64] = t31;
+    Q[65] = -t33 + t32;
+    Q[66] = t34;
+    Q[67] = -t36 + t35;
+    Q[68] = 0;
+    Q[69] = 0;
+    Q[70] = t37;
+    Q[71] = -t38;
+    Q[72] = 0;
+    Q[73] = 0;
+    Q[74] = 0;
+    Q[75] = 0;
+    Q[76] = T00*t7 - t0*t6;
+    Q[77] = T10*t7 - t2*t6;
+    Q[78] = 0;
+    Q[79] = 0;
+    Q[80] = -t32 + t33;
+    Q[81] = t31;
+    Q[82] = -t35 + t36;
+    Q[83] = t34;
+    Q[84] = 0;
+    Q[85] = 0;
+    Q[86] = t38;
+    Q[87] = t37;
+    Q[88] = t40;
+    Q[89] = -t41 - t43 - t44 + t42 + t46 + t47;
+    Q[90] = t48;
+    Q[91] = -t49 - t51 - t52 + t50 + t53 + t54;
+    Q[92] = 0;
+    Q[93] = 0;
+    Q[94] = t55;
+    Q[95] = -t58 - t59 + t56 + t57;
+    Q[96] = 0;
+    Q[97] = 0;
+    Q[98] = 0;
+    Q[99] = 0;
+    Q[100] = t10*t1 - t11*t1 + t9*t1 + 0.09*t1 - t12*t60 - t14*t60;
+    Q[101] = t9*t3 - t11*t3 + t10*t3 + 0.09*t3 - t16*t60 - t18*t60;
+    Q[102] = 0;
+    Q[103] = 0;
+    Q[104] = -t42 - t46 - t47 + t41 + t43 + t44;
+    Q[105] = t40;
+    Q[106] = -t50 - t53 - t54 + t49 + t51 + t52;
+    Q[107] = t48;
+    Q[108] = 0;
+    Q[109] = 0;
+    Q[110] = -t56 - t57 + t58 + t59;
+    Q[111] = t55;
+}
+
+void manocha_canny_ik_general_start_fallback(const manocha_canny_real T[16], const manocha_canny_real angles[5], manocha_canny_real q[MANOCHA_CANNY_DOF])
+{
+    /* 74 operations */
+
+    /* Inputs */
+    const manocha_canny_real T00 = T[0];
+    const manocha_canny_real T01 = T[1];
+    const manocha_canny_real T02 = T[2];
+    const manocha_canny_real T10 = T[4];
+    const manocha_canny_real T11 = T[5];
+    const manocha_canny_real T12 = T[6];
+    const manocha_canny_real T20 = T[8];
+    const manocha_canny_real T21 = T[9];
+    const manocha_canny_real T22 = T[10];
+    const manocha_canny_real ga0 = angles[0];
+    const manocha_canny_real ga1 = angles[1];
+    const manocha_canny_real ga2 = angles[2];
+    const manocha_canny_real ga3 = angles[3];
+    const manocha_canny_real ga4 = angles[4];
+
+    /* Intermediate terms */
+    const manocha_canny_real t0 = 0.9998476951563913*T01 - 0.01745240643728351*T02;
+    const manocha_canny_real t1 = 0.01745240643728351*T01 + 0.9998476951563913*T02;
+    const manocha_canny_real t2 = 0.9998476951563913*T11 - 0.01745240643728351*T12;
+    const manocha_canny_real t3 = 0.01745240643728351*T11 + 0.9998476951563913*T12;
+    const manocha_canny_real t4 = 0.9998476951563913*T21 - 0.01745240643728351*T22;
+    const manocha_canny_real t5 = 0.01745240643728351*T21 + 0.9998476951563913*T22;
+    const manocha_canny_real t6 = cos(ga3);
+    const manocha_canny_real t7 = sin(ga3);
+    const manocha_canny_real t8 = cos(ga2);
+    const manocha_canny_real t9 = sin(ga2);
+    const manocha_canny_real t10 = cos(ga1)*t8;
+    const manocha_canny_real t11 = sin(ga1)*t8;
+    const manocha_canny_real t12 = 0.9998476951563913*t11 - 0.01745240643728351*t9;
+    const manocha_canny_real t13 = 0.01745240643728351*t11 + 0.9998476951563913*t9;
+    const manocha_canny_real t14 = 0.39269908169872414 + ga0;
+    const manocha_canny_real t15 = cos(t14);
+    const manocha_canny_real t16 = sin(t14);
+    const manocha_canny_real t17 = t15*t10 - t16*t12;
+    const manocha_canny_real t18 = t16*t10 + t15*t12;
+    const manocha_canny_real t19 = sin(ga4);
+    const manocha_canny_real t20 = cos(ga4);
+    const manocha_canny_real t21 = t19*t13 + t20*t17;
+    const manocha_canny_real t22 = t19*t17 - t20*t13;
+    const manocha_canny_real t23 = t21*(T00*t6 - T10*t7) + t22*(t0*t6 - t2*t7) - t18*(t1*t6 - t3*t7);
+    const manocha_canny_real t24 = T20*t21 + t4*t22 - t5*t18;
+
+    /* Outputs */
+    q[0] = -ga3;
+    q[1] = atan2(t24, t23);
+    q[2] = -ga2;
+    q[3] = -ga1;
+    q[4] = -t14;
+    q[5] = -ga4;
+}
+
 void manocha_canny_ik_general_residual(const manocha_canny_real target[16], const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real e[6], manocha_canny_real J[6 * 6])
 {
     /* 309 operations */
@@ -6473,7 +7116,7 @@ static manocha_canny_real manocha_canny_ik_general_polish(const manocha_canny_re
     return cost;
 }
 
-/* The general 6R solver's working memory: 21840 bytes in this build. A local of
+/* The general 6R solver's working memory: 22992 bytes in this build. A local of
  * manocha_canny_ik_branches (on its stack) unless MANOCHA_CANNY_IK_STATIC_WORK is defined: then one static
  * object, and manocha_canny_ik_branches (with manocha_canny_ik and manocha_canny_ik_nearest) is not reentrant. */
 struct manocha_canny_ik_work {
@@ -6487,7 +7130,9 @@ static struct manocha_canny_ik_work manocha_canny_ik_static_work;
 
 /* The general 6R solver: the equations at T, the kernel's
  * roots (jacgen_general6r_roots, in double), each completed to a configuration, polished by
- * Newton steps and kept when it reaches T, once; the valid rows first. */
+ * Newton steps and kept when it reaches T, once; the valid rows first. Where the leading
+ * matrix is singular to rounding (condition above JACGEN_G6_DEGENERATE), the roots are those of
+ * the fallback elimination, another joint hidden. */
 void manocha_canny_ik_branches(const manocha_canny_real T[16], manocha_canny_real q[MANOCHA_CANNY_MAX_IK_SOLUTIONS * MANOCHA_CANNY_DOF],
                      int valid[MANOCHA_CANNY_MAX_IK_SOLUTIONS], int in_limits[MANOCHA_CANNY_MAX_IK_SOLUTIONS])
 {
@@ -6497,15 +7142,26 @@ void manocha_canny_ik_branches(const manocha_canny_real T[16], manocha_canny_rea
     struct manocha_canny_ik_work work, *w = &work;
 #endif
     manocha_canny_real angles[5], x[MANOCHA_CANNY_DOF];
-    int count = 0, found, i, j, k;
+    double condition;
+    int count = 0, found, i, j, k, fallback;
     manocha_canny_ik_general_clear(q, valid, in_limits);
     manocha_canny_ik_general_equations(T, w->P, w->Q);
     for (i = 0; i < 378; ++i) w->p[i / 126][i / 9 % 14][i % 9] = (double)w->P[i];
     for (i = 0; i < 112; ++i) w->q[i / 8][i % 8] = (double)w->Q[i];
-    found = jacgen_general6r_roots(w->p, w->q, w->roots, &w->kernel);
+    found = jacgen_general6r_roots(w->p, w->q, w->roots, &w->kernel, &condition);
+    fallback = !(condition <= JACGEN_G6_DEGENERATE);
+    if (fallback) {
+        manocha_canny_ik_general_equations_fallback(T, w->P, w->Q);
+        for (i = 0; i < 378; ++i) w->p[i / 126][i / 9 % 14][i % 9] = (double)w->P[i];
+        for (i = 0; i < 112; ++i) w->q[i / 8][i % 8] = (double)w->Q[i];
+        found = jacgen_general6r_roots(w->p, w->q, w->roots, &w->kernel, &condition);
+    }
     for (k = 0; k < found && count < MANOCHA_CANNY_MAX_IK_SOLUTIONS; ++k) {
         for (j = 0; j < 5; ++j) angles[j] = (manocha_canny_real)w->roots[k][j];
-        manocha_canny_ik_general_start(T, angles, x);
+        if (fallback)
+            manocha_canny_ik_general_start_fallback(T, angles, x);
+        else
+            manocha_canny_ik_general_start(T, angles, x);
         if (!(manocha_canny_ik_general_polish(T, x, manocha_canny_ik_general_newton(T, x), 6)
               <= 1e-18)) continue;
         count += manocha_canny_ik_general_add(x, count, q, valid, in_limits);

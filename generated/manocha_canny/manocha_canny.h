@@ -136,6 +136,14 @@ void manocha_canny_ik_general_equations(const manocha_canny_real T[16], manocha_
  * Result: q[i], i < 6. 102 operations. */
 void manocha_canny_ik_general_start(const manocha_canny_real T[16], const manocha_canny_real angles[5], manocha_canny_real q[MANOCHA_CANNY_DOF]);
 
+/* The general 6R solver's equations at T, by the fallback elimination (for targets where the first's leading matrix is singular to rounding): (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9).
+ * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 202 operations. */
+void manocha_canny_ik_general_equations_fallback(const manocha_canny_real T[16], manocha_canny_real P[378], manocha_canny_real Q[112]);
+
+/* The configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop), by the fallback elimination (for targets where the first's leading matrix is singular to rounding).
+ * Result: q[i], i < 6. 74 operations. */
+void manocha_canny_ik_general_start_fallback(const manocha_canny_real T[16], const manocha_canny_real angles[5], manocha_canny_real q[MANOCHA_CANNY_DOF]);
+
 /* The pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J of the six joints ik solves: the Newton step of the solver's polish is q + J^-1 e.
  * Result: e[i], i < 6; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 309 operations. */
 void manocha_canny_ik_general_residual(const manocha_canny_real target[16], const manocha_canny_real q[MANOCHA_CANNY_DOF], manocha_canny_real e[6], manocha_canny_real J[6 * 6]);

@@ -5024,6 +5024,632 @@ def ik_general_start(T, angles):
     return q
 
 
+def ik_general_equations_fallback(T):
+    """the general 6R solver's equations at T, by the fallback elimination (for targets where the first's leading matrix is singular to rounding): (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9): (42 x 9 and 14 x 8), 202 operations."""
+    xp, dtype, device, batch, (T,) = _arguments(("T", T, (4, 4)))
+    T00 = T[..., 0, 0]
+    T01 = T[..., 0, 1]
+    T02 = T[..., 0, 2]
+    T03 = T[..., 0, 3]
+    T10 = T[..., 1, 0]
+    T11 = T[..., 1, 1]
+    T12 = T[..., 1, 2]
+    T13 = T[..., 1, 3]
+    T20 = T[..., 2, 0]
+    T21 = T[..., 2, 1]
+    T22 = T[..., 2, 2]
+    T23 = T[..., 2, 3]
+    t0 = 0.9998476951563913*T01 - 0.01745240643728351*T02
+    t1 = 0.01745240643728351*T01 + 0.9998476951563913*T02
+    t2 = 0.9998476951563913*T11 - 0.01745240643728351*T12
+    t3 = 0.01745240643728351*T11 + 0.9998476951563913*T12
+    t4 = 0.9998476951563913*T21 - 0.01745240643728351*T22
+    t5 = 0.01745240643728351*T21 + 0.9998476951563913*T22
+    t6 = T00*T03 + T10*T13 + T20*T23
+    t7 = T03*t0 + T13*t2 + T23*t4
+    t8 = T03*t1 + T13*t3 + T23*t5
+    t9 = t6**2
+    t10 = t7**2
+    t11 = t8**2
+    t12 = T00*t6
+    t13 = 0.6*t12
+    t14 = t0*t7
+    t15 = 0.6*t14
+    t16 = T10*t6
+    t17 = 0.6*t16
+    t18 = t2*t7
+    t19 = 0.6*t18
+    t20 = -1.0*t0
+    t21 = -1.0*t2
+    t22 = -0.3*t2
+    t23 = 0.3*T10
+    t24 = 0.3*t0
+    t25 = 0.3*T00
+    t26 = -1.0*t7
+    t27 = t3*t8
+    t28 = 0.6*t27
+    t29 = t1*t8
+    t30 = 0.6*t29
+    t31 = T00*t8 - t1*t6
+    t32 = t1*t7
+    t33 = t0*t8
+    t34 = T10*t8 - t3*t6
+    t35 = t3*t7
+    t36 = t2*t8
+    t37 = -0.3*t4
+    t38 = 0.3*T20
+    t39 = 2.0*t7
+    t40 = -0.09*t0 + t10*t0 - t9*t0 - t11*t0 + t12*t39 + t29*t39
+    t41 = 0.09*T00
+    t42 = t9*T00
+    t43 = t10*T00
+    t44 = t11*T00
+    t45 = 2.0*t6
+    t46 = t14*t45
+    t47 = t29*t45
+    t48 = -0.09*t2 + t10*t2 - t9*t2 - t11*t2 + t16*t39 + t27*t39
+    t49 = 0.09*T10
+    t50 = t9*T10
+    t51 = t10*T10
+    t52 = t11*T10
+    t53 = t18*t45
+    t54 = t27*t45
+    t55 = t13*t2 + t30*t2 - t17*t0 - t28*t0
+    t56 = t15*T10
+    t57 = t30*T10
+    t58 = t19*T00
+    t59 = t28*T00
+    t60 = 2.0*t8
+    P = _stack(xp, [
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 8
+        xp.full(batch, 0.000304586490452135, dtype=dtype, device=device),  # 2, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
+        xp.full(batch, -0.017449748351250485, dtype=dtype, device=device),  # 2, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
+        xp.full(batch, -0.017449748351250485, dtype=dtype, device=device),  # 2, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 7
+        -1.0*t8,  # 4, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
+        xp.full(batch, 0.01745240643728351, dtype=dtype, device=device),  # 5, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4
+        xp.full(batch, 0.0034904812874567027, dtype=dtype, device=device),  # 5, 5
+        xp.full(batch, 0.9998476951563913, dtype=dtype, device=device),  # 5, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 2
+        xp.full(batch, 3.0, dtype=dtype, device=device),  # 6, 3
+        xp.full(batch, -0.6, dtype=dtype, device=device),  # 6, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 7
+        -(-3.2 + t9 + t10 + t11),  # 6, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 1
+        xp.full(batch, 0.02617860965592527, dtype=dtype, device=device),  # 7, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 3
+        xp.full(batch, 1.4997715427345868, dtype=dtype, device=device),  # 7, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 7
+        xp.full(batch, -0.19996953903127826, dtype=dtype, device=device),  # 7, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 7
+        -0.3*t5,  # 9, 8
+        xp.full(batch, 0.04362437087812621, dtype=dtype, device=device),  # 10, 0
+        xp.full(batch, -6.0917298090426996e-05, dtype=dtype, device=device),  # 10, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 4
+        xp.full(batch, -1.4992385337738696, dtype=dtype, device=device),  # 10, 5
+        xp.full(batch, -0.003489949670250097, dtype=dtype, device=device),  # 10, 6
+        xp.full(batch, -0.9992385337738696, dtype=dtype, device=device),  # 10, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 7
+        t13*t3 + t15*t3 - t17*t1 - t19*t1,  # 12, 8
+        xp.full(batch, -2.998084150975056, dtype=dtype, device=device),  # 13, 0
+        xp.full(batch, 0.017449748351250485, dtype=dtype, device=device),  # 13, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 13, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 13, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 13, 4
+        xp.full(batch, -0.10836293726126552, dtype=dtype, device=device),  # 13, 5
+        xp.full(batch, 0.39969541350954785, dtype=dtype, device=device),  # 13, 6
+        xp.full(batch, -0.10975891712936556, dtype=dtype, device=device),  # 13, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 13, 8
+        xp.full(batch, 0.016121465349192895, dtype=dtype, device=device),  # 14, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 1
+        xp.full(batch, 0.006678746798450243, dtype=dtype, device=device),  # 14, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 3
+        xp.full(batch, 0.38262514782477175, dtype=dtype, device=device),  # 14, 4
+        xp.full(batch, -0.9235981312868786, dtype=dtype, device=device),  # 14, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 6
+        xp.full(batch, 0.000281401224408172, dtype=dtype, device=device),  # 14, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 8
+        xp.full(batch, 0.006677729592963602, dtype=dtype, device=device),  # 15, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 1
+        xp.full(batch, -0.01612392110047446, dtype=dtype, device=device),  # 15, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 3
+        xp.full(batch, -0.9237388211835743, dtype=dtype, device=device),  # 15, 4
+        xp.full(batch, -0.3825668721614715, dtype=dtype, device=device),  # 15, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 6
+        xp.full(batch, 0.00011656020361825967, dtype=dtype, device=device),  # 15, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 17, 0
+        xp.full(batch, 0.9237388211835743, dtype=dtype, device=device),  # 17, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 17, 2
+        xp.full(batch, 0.3826834323650898, dtype=dtype, device=device),  # 17, 3
+        xp.full(batch, -0.07653668647301795, dtype=dtype, device=device),  # 17, 4
+        xp.full(batch, 0.18474776423671485, dtype=dtype, device=device),  # 17, 5
+        xp.full(batch, -0.01612392110047446, dtype=dtype, device=device),  # 17, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 17, 7
+        xp.full(batch, 0.5740251485476346, dtype=dtype, device=device),  # 17, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 0
+        xp.full(batch, 0.38262514782477175, dtype=dtype, device=device),  # 18, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 2
+        xp.full(batch, -0.9238795325112867, dtype=dtype, device=device),  # 18, 3
+        xp.full(batch, 0.18477590650225734, dtype=dtype, device=device),  # 18, 4
+        xp.full(batch, 0.07652502956495436, dtype=dtype, device=device),  # 18, 5
+        xp.full(batch, -0.006678746798450243, dtype=dtype, device=device),  # 18, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 7
+        xp.full(batch, -1.38581929876693, dtype=dtype, device=device),  # 18, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 8
+        xp.full(batch, 0.9231760294502663, dtype=dtype, device=device),  # 22, 0
+        xp.full(batch, -0.003224293069838579, dtype=dtype, device=device),  # 22, 1
+        xp.full(batch, 0.38262514782477175, dtype=dtype, device=device),  # 22, 2
+        xp.full(batch, -0.0013357493596900486, dtype=dtype, device=device),  # 22, 3
+        xp.full(batch, -0.006678746798450243, dtype=dtype, device=device),  # 22, 4
+        xp.full(batch, 0.04030366337298224, dtype=dtype, device=device),  # 22, 5
+        xp.full(batch, 5.6280244881634396e-05, dtype=dtype, device=device),  # 22, 6
+        xp.full(batch, 0.04030366337298224, dtype=dtype, device=device),  # 22, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 22, 8
+        xp.full(batch, 0.38239203185604415, dtype=dtype, device=device),  # 23, 0
+        xp.full(batch, -0.0013355459185927204, dtype=dtype, device=device),  # 23, 1
+        xp.full(batch, -0.9237388211835743, dtype=dtype, device=device),  # 23, 2
+        xp.full(batch, 0.0032247842200948925, dtype=dtype, device=device),  # 23, 3
+        xp.full(batch, 0.01612392110047446, dtype=dtype, device=device),  # 23, 4
+        xp.full(batch, 0.016694323982409005, dtype=dtype, device=device),  # 23, 5
+        xp.full(batch, 2.3312040723651935e-05, dtype=dtype, device=device),  # 23, 6
+        xp.full(batch, 0.016694323982409005, dtype=dtype, device=device),  # 23, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 23, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 8
+        xp.full(batch, 0.10140401704642331, dtype=dtype, device=device),  # 25, 0
+        xp.full(batch, 0.3692704117801065, dtype=dtype, device=device),  # 25, 1
+        xp.full(batch, -0.008081283626124794, dtype=dtype, device=device),  # 25, 2
+        xp.full(batch, 0.1530500591299087, dtype=dtype, device=device),  # 25, 3
+        xp.full(batch, -0.4935864406939556, dtype=dtype, device=device),  # 25, 4
+        xp.full(batch, -2.9639057977576555, dtype=dtype, device=device),  # 25, 5
+        xp.full(batch, -0.016121465349192895, dtype=dtype, device=device),  # 25, 6
+        xp.full(batch, -2.769868583832333, dtype=dtype, device=device),  # 25, 7
+        xp.full(batch, 0.22957508869486304, dtype=dtype, device=device),  # 25, 8
+        xp.full(batch, 0.04200291913974106, dtype=dtype, device=device),  # 26, 0
+        xp.full(batch, 0.15295681274241765, dtype=dtype, device=device),  # 26, 1
+        xp.full(batch, 0.019509944531574102, dtype=dtype, device=device),  # 26, 2
+        xp.full(batch, -0.3694955284734297, dtype=dtype, device=device),  # 26, 3
+        xp.full(batch, 1.1916230793268108, dtype=dtype, device=device),  # 26, 4
+        xp.full(batch, -1.227689979027469, dtype=dtype, device=device),  # 26, 5
+        xp.full(batch, -0.006677729592963602, dtype=dtype, device=device),  # 26, 6
+        xp.full(batch, -1.1473171334145105, dtype=dtype, device=device),  # 26, 7
+        xp.full(batch, -0.5542432927101446, dtype=dtype, device=device),  # 26, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 8
+        xp.full(batch, 0.006677729592963602, dtype=dtype, device=device),  # 28, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 1
+        xp.full(batch, -0.01612392110047446, dtype=dtype, device=device),  # 28, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 3
+        xp.full(batch, -0.9237388211835743, dtype=dtype, device=device),  # 28, 4
+        xp.full(batch, -0.3825668721614715, dtype=dtype, device=device),  # 28, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 6
+        xp.full(batch, 0.00011656020361825967, dtype=dtype, device=device),  # 28, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 8
+        xp.full(batch, -0.016121465349192895, dtype=dtype, device=device),  # 29, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 1
+        xp.full(batch, -0.006678746798450243, dtype=dtype, device=device),  # 29, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 3
+        xp.full(batch, -0.38262514782477175, dtype=dtype, device=device),  # 29, 4
+        xp.full(batch, 0.9235981312868786, dtype=dtype, device=device),  # 29, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 6
+        xp.full(batch, -0.000281401224408172, dtype=dtype, device=device),  # 29, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 0
+        xp.full(batch, 0.38262514782477175, dtype=dtype, device=device),  # 31, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 2
+        xp.full(batch, -0.9238795325112867, dtype=dtype, device=device),  # 31, 3
+        xp.full(batch, 0.18477590650225734, dtype=dtype, device=device),  # 31, 4
+        xp.full(batch, 0.07652502956495436, dtype=dtype, device=device),  # 31, 5
+        xp.full(batch, -0.006678746798450243, dtype=dtype, device=device),  # 31, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 7
+        xp.full(batch, -1.38581929876693, dtype=dtype, device=device),  # 31, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 32, 0
+        xp.full(batch, -0.9237388211835743, dtype=dtype, device=device),  # 32, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 32, 2
+        xp.full(batch, -0.3826834323650898, dtype=dtype, device=device),  # 32, 3
+        xp.full(batch, 0.07653668647301795, dtype=dtype, device=device),  # 32, 4
+        xp.full(batch, -0.18474776423671485, dtype=dtype, device=device),  # 32, 5
+        xp.full(batch, 0.01612392110047446, dtype=dtype, device=device),  # 32, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 32, 7
+        xp.full(batch, -0.5740251485476346, dtype=dtype, device=device),  # 32, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 8
+        xp.full(batch, 0.38239203185604415, dtype=dtype, device=device),  # 36, 0
+        xp.full(batch, -0.0013355459185927204, dtype=dtype, device=device),  # 36, 1
+        xp.full(batch, -0.9237388211835743, dtype=dtype, device=device),  # 36, 2
+        xp.full(batch, 0.0032247842200948925, dtype=dtype, device=device),  # 36, 3
+        xp.full(batch, 0.01612392110047446, dtype=dtype, device=device),  # 36, 4
+        xp.full(batch, 0.016694323982409005, dtype=dtype, device=device),  # 36, 5
+        xp.full(batch, 2.3312040723651935e-05, dtype=dtype, device=device),  # 36, 6
+        xp.full(batch, 0.016694323982409005, dtype=dtype, device=device),  # 36, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 36, 8
+        xp.full(batch, -0.9231760294502663, dtype=dtype, device=device),  # 37, 0
+        xp.full(batch, 0.003224293069838579, dtype=dtype, device=device),  # 37, 1
+        xp.full(batch, -0.38262514782477175, dtype=dtype, device=device),  # 37, 2
+        xp.full(batch, 0.0013357493596900486, dtype=dtype, device=device),  # 37, 3
+        xp.full(batch, 0.006678746798450243, dtype=dtype, device=device),  # 37, 4
+        xp.full(batch, -0.04030366337298224, dtype=dtype, device=device),  # 37, 5
+        xp.full(batch, -5.6280244881634396e-05, dtype=dtype, device=device),  # 37, 6
+        xp.full(batch, -0.04030366337298224, dtype=dtype, device=device),  # 37, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 37, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 8
+        xp.full(batch, 0.04200291913974106, dtype=dtype, device=device),  # 39, 0
+        xp.full(batch, 0.15295681274241765, dtype=dtype, device=device),  # 39, 1
+        xp.full(batch, 0.019509944531574102, dtype=dtype, device=device),  # 39, 2
+        xp.full(batch, -0.3694955284734297, dtype=dtype, device=device),  # 39, 3
+        xp.full(batch, 1.1916230793268108, dtype=dtype, device=device),  # 39, 4
+        xp.full(batch, -1.227689979027469, dtype=dtype, device=device),  # 39, 5
+        xp.full(batch, -0.006677729592963602, dtype=dtype, device=device),  # 39, 6
+        xp.full(batch, -1.1473171334145105, dtype=dtype, device=device),  # 39, 7
+        xp.full(batch, -0.5542432927101446, dtype=dtype, device=device),  # 39, 8
+        xp.full(batch, -0.10140401704642331, dtype=dtype, device=device),  # 40, 0
+        xp.full(batch, -0.3692704117801065, dtype=dtype, device=device),  # 40, 1
+        xp.full(batch, 0.008081283626124794, dtype=dtype, device=device),  # 40, 2
+        xp.full(batch, -0.1530500591299087, dtype=dtype, device=device),  # 40, 3
+        xp.full(batch, 0.4935864406939556, dtype=dtype, device=device),  # 40, 4
+        xp.full(batch, 2.9639057977576555, dtype=dtype, device=device),  # 40, 5
+        xp.full(batch, 0.016121465349192895, dtype=dtype, device=device),  # 40, 6
+        xp.full(batch, 2.769868583832333, dtype=dtype, device=device),  # 40, 7
+        xp.full(batch, -0.22957508869486304, dtype=dtype, device=device),  # 40, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 8
+    ], (42, 9))
+    Q = _stack(xp, [
+        t20,  # 0, 0
+        -1.0*T00,  # 0, 1
+        t21,  # 0, 2
+        -1.0*T10,  # 0, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
+        t1,  # 1, 4
+        t3,  # 1, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 7
+        T00,  # 2, 0
+        t20,  # 2, 1
+        T10,  # 2, 2
+        t21,  # 2, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 7
+        t22,  # 3, 0
+        -t23,  # 3, 1
+        t24,  # 3, 2
+        t25,  # 3, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5
+        t26,  # 3, 6
+        -1.0*t6,  # 3, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3
+        0.3*t3,  # 4, 4
+        -0.3*t1,  # 4, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 7
+        t23,  # 5, 0
+        t22,  # 5, 1
+        -t25,  # 5, 2
+        t24,  # 5, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5
+        t6,  # 5, 6
+        t26,  # 5, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 3
+        t17 + t19 + t28,  # 6, 4
+        -(t13 + t15 + t30),  # 6, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 3
+        t12 + t14 + t29,  # 7, 4
+        t16 + t18 + t27,  # 7, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 7
+        t31,  # 8, 0
+        -t33 + t32,  # 8, 1
+        t34,  # 8, 2
+        -t36 + t35,  # 8, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 5
+        t37,  # 8, 6
+        -t38,  # 8, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 3
+        T00*t7 - t0*t6,  # 9, 4
+        T10*t7 - t2*t6,  # 9, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 7
+        -t32 + t33,  # 10, 0
+        t31,  # 10, 1
+        -t35 + t36,  # 10, 2
+        t34,  # 10, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 5
+        t38,  # 10, 6
+        t37,  # 10, 7
+        t40,  # 11, 0
+        -t41 - t43 - t44 + t42 + t46 + t47,  # 11, 1
+        t48,  # 11, 2
+        -t49 - t51 - t52 + t50 + t53 + t54,  # 11, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 5
+        t55,  # 11, 6
+        -t58 - t59 + t56 + t57,  # 11, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 3
+        t10*t1 - t11*t1 + t9*t1 + 0.09*t1 - t12*t60 - t14*t60,  # 12, 4
+        t9*t3 - t11*t3 + t10*t3 + 0.09*t3 - t16*t60 - t18*t60,  # 12, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 7
+        -t42 - t46 - t47 + t41 + t43 + t44,  # 13, 0
+        t40,  # 13, 1
+        -t50 - t53 - t54 + t49 + t51 + t52,  # 13, 2
+        t48,  # 13, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 13, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 13, 5
+        -t56 - t57 + t58 + t59,  # 13, 6
+        t55,  # 13, 7
+    ], (14, 8))
+    return P, Q
+
+
+def ik_general_start_fallback(T, angles):
+    """the configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop), by the fallback elimination (for targets where the first's leading matrix is singular to rounding): (6 x 1), 74 operations."""
+    xp, dtype, device, batch, (T, angles,) = _arguments(("T", T, (4, 4)), ("angles", angles, (5,)))
+    T00 = T[..., 0, 0]
+    T01 = T[..., 0, 1]
+    T02 = T[..., 0, 2]
+    T10 = T[..., 1, 0]
+    T11 = T[..., 1, 1]
+    T12 = T[..., 1, 2]
+    T20 = T[..., 2, 0]
+    T21 = T[..., 2, 1]
+    T22 = T[..., 2, 2]
+    ga0 = angles[..., 0]
+    ga1 = angles[..., 1]
+    ga2 = angles[..., 2]
+    ga3 = angles[..., 3]
+    ga4 = angles[..., 4]
+    t0 = 0.9998476951563913*T01 - 0.01745240643728351*T02
+    t1 = 0.01745240643728351*T01 + 0.9998476951563913*T02
+    t2 = 0.9998476951563913*T11 - 0.01745240643728351*T12
+    t3 = 0.01745240643728351*T11 + 0.9998476951563913*T12
+    t4 = 0.9998476951563913*T21 - 0.01745240643728351*T22
+    t5 = 0.01745240643728351*T21 + 0.9998476951563913*T22
+    t6 = xp.cos(ga3)
+    t7 = xp.sin(ga3)
+    t8 = xp.cos(ga2)
+    t9 = xp.sin(ga2)
+    t10 = xp.cos(ga1)*t8
+    t11 = xp.sin(ga1)*t8
+    t12 = 0.9998476951563913*t11 - 0.01745240643728351*t9
+    t13 = 0.01745240643728351*t11 + 0.9998476951563913*t9
+    t14 = 0.39269908169872414 + ga0
+    t15 = xp.cos(t14)
+    t16 = xp.sin(t14)
+    t17 = t15*t10 - t16*t12
+    t18 = t16*t10 + t15*t12
+    t19 = xp.sin(ga4)
+    t20 = xp.cos(ga4)
+    t21 = t19*t13 + t20*t17
+    t22 = t19*t17 - t20*t13
+    t23 = t21*(T00*t6 - T10*t7) + t22*(t0*t6 - t2*t7) - t18*(t1*t6 - t3*t7)
+    t24 = T20*t21 + t4*t22 - t5*t18
+    q = _stack(xp, [
+        xp.broadcast_to(-ga3, batch),  # 0
+        xp.broadcast_to(xp.atan2(t24, t23), batch),  # 1
+        xp.broadcast_to(-ga2, batch),  # 2
+        xp.broadcast_to(-ga1, batch),  # 3
+        xp.broadcast_to(-t14, batch),  # 4
+        xp.broadcast_to(-ga4, batch),  # 5
+    ], (6,))
+    return q
+
+
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_general_residual(target, q):
     """the pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J of the six joints ik solves: the Newton step of the solver's polish is q + J^-1 e: (6 x 1 and 6 x 6), 309 operations."""
@@ -5710,6 +6336,7 @@ _ALONG_C, _ALONG_B = numpy.array([0, 1, 3, 4, 6, 7, 9, 10]), numpy.array([0, 1, 
 _NEWTON_STEPS = 6
 _TOLERANCE_SQUARED = 1e-18  # |pose error|^2 of a solution after the Newton steps
 _CONVERGED_SQUARED = 1.6e-23  # |pose error|^2 at which the Newton steps stop
+_DEGENERATE = 10000000.0  # a leading matrix above this condition number takes the fallback elimination
 
 
 def _twelve(s):
@@ -5732,8 +6359,9 @@ def _ratio(w, starts, step):
 
 def _roots(P, Q):
     """The loop angles (a - shift, b, c, g, h) of the 16 eigenvalues nearest the real axis
-    (..., 16, 5) and which are real (..., 16), from the equations at the targets (P: ..., 3, 14,
-    9; Q: ..., 14, 8). Of the 24, eight are always +-i (the half-angle substitution's
+    (..., 16, 5), which are real (..., 16), and the leading matrix's 1-norm condition number
+    (...; infinite where it is singular), from the equations at the targets (P: ..., 3, 14, 9;
+    Q: ..., 14, 8). Of the 24, eight are always +-i (the half-angle substitution's
     (1 + x^2)^4), so the real ones are among those 16."""
     orthogonal, r = numpy.linalg.qr(Q, mode="complete")
     free = numpy.swapaxes(orthogonal[..., 8:], -1, -2)  # six combinations free of v_gh
@@ -5741,6 +6369,7 @@ def _roots(P, Q):
     m2, m1, m0 = _twelve(s0 - sc), _twelve(2.0 * ss), _twelve(s0 + sc)
     lead = numpy.abs(numpy.linalg.det(m2)) > 0.0
     m2 = numpy.where(lead[..., None, None], m2, numpy.eye(12))
+    condition = numpy.where(lead, numpy.linalg.cond(m2, 1), numpy.inf)
     companion = numpy.zeros((*m2.shape[:-2], 24, 24))
     companion[..., :12, 12:] = numpy.eye(12)
     companion[..., 12:, :12], companion[..., 12:, 12:] = -numpy.linalg.solve(m2, m0), -numpy.linalg.solve(m2, m1)
@@ -5763,7 +6392,16 @@ def _roots(P, Q):
     v_gh = numpy.swapaxes(numpy.linalg.solve(r8, numpy.swapaxes(projected, -1, -2)), -1, -2)
     angles = numpy.stack([a, b, c, numpy.arctan2(v_gh[..., 4], v_gh[..., 5]), numpy.arctan2(v_gh[..., 6], v_gh[..., 7])],
                          axis=-1)
-    return angles, real
+    return angles, real, condition
+
+
+def _eigenproblem(equations):
+    """_roots of the equations (P, Q) that ik_general_equations gives; a target that is not
+    finite has none (its P and Q zeros: a singular leading matrix)."""
+    P, Q = equations
+    finite = (numpy.isfinite(P).all(axis=(-2, -1)) & numpy.isfinite(Q).all(axis=(-2, -1)))[..., None, None]
+    P, Q = numpy.where(finite, P, 0.0), numpy.where(finite, Q, 0.0)
+    return _roots(numpy.reshape(P, (*P.shape[:-2], 3, 14, 9)), Q)
 
 
 def _newton(targets, q):
@@ -5789,12 +6427,14 @@ def _polish(targets, q, cost, steps):
 def _general_branches(T):
     """The eigenproblem's solutions at targets T (..., 4, 4): q (..., 16, DOF) and valid (..., 16),
     each solution once (the first of equal ones), after up to 6 Newton steps within 1e-09."""
-    P, Q = ik_general_equations(T)
-    finite = (numpy.isfinite(P).all(axis=(-2, -1)) & numpy.isfinite(Q).all(axis=(-2, -1)))[..., None, None]
-    P, Q = numpy.where(finite, P, 0.0), numpy.where(finite, Q, 0.0)  # no root: a singular leading matrix
-    angles, real = _roots(numpy.reshape(P, (*P.shape[:-2], 3, 14, 9)), Q)
+    angles, real, condition = _eigenproblem(ik_general_equations(T))
     targets = T[..., None, :, :]
     q = ik_general_start(targets, angles)
+    degenerate = ~(condition <= _DEGENERATE)  # a leading matrix singular to rounding: the fallback's roots
+    if degenerate.any():
+        T_d = T[degenerate]
+        angles_d, real[degenerate], _ = _eigenproblem(ik_general_equations_fallback(T_d))
+        q[degenerate] = ik_general_start_fallback(T_d[..., None, :, :], angles_d)
     cost, q = _newton(targets, q)
     cost, q = _polish(targets, q, cost, _NEWTON_STEPS)
     return q, _first_of_equals(q, real & (cost <= _TOLERANCE_SQUARED))

@@ -168,6 +168,7 @@ static int jacgen_eigenvalues(int n, double a[JACGEN_EIG_MAX][JACGEN_EIG_MAX], d
 
 
 #define JACGEN_G6_IMAGINARY 1e-05
+#define JACGEN_G6_DEGENERATE 10000000.0
 /* Runtime helper of the general 6R solver (included by robot.c.jinja for its robots): from
  * Raghavan & Roth's 14 equations at one target, (P0 + s Ps + c Pc) v_bc = Q v_gh with the hidden
  * angle's shift already applied (jacgen/general6r.py), the loop angles (a, b, c, g, h) of every
@@ -177,7 +178,9 @@ static int jacgen_eigenvalues(int n, double a[JACGEN_EIG_MAX][JACGEN_EIG_MAX], d
  * x = +-i for every target (jacgen_g6_spurious); the other 16 are those of the companion matrix
  * with them deflated (jacgen_g6_deflated, jacgen_eigenvalues). Per real root, the null vector of
  * M(x) (inverse iteration) gives x_b and x_c, and R^-1 (Q^T P v_bc)[0..7] gives v_gh. Fixed size,
- * no allocation, no recursion. Returns the number of roots (0 when M2 or R is singular).
+ * no allocation, no recursion. Returns the number of roots (0 when M2 or R is singular), and
+ * M2's 1-norm condition number in *condition (infinite when it is singular): above
+ * JACGEN_G6_DEGENERATE, its eigenvalues are noise and the caller takes its fallback elimination.
  * Defined before it: JACGEN_G6_IMAGINARY, an eigenvalue being a root when |imaginary part| <= that
  * (1 + |x|) (jacgen/general6r.py's IMAGINARY for the build's real type). */
 #define JACGEN_G6_ROOTS 16
@@ -337,12 +340,12 @@ static void jacgen_g6_pencil(double free[3][6][9], double m[3][12][12]) {
 }
 
 /* The kernel's working memory: the QR of Q, its left null space, the six v_gh-free equations, M0,
- * M1, M2, the null space of M(i) (u + i v), M2^-1 [M0 M1] at the deflated matrix's columns, the
- * deflated matrix (eigenvalues in re, im) and two 12 x 12 matrices (M(i); M2's LU; M(x) at each
- * root). */
+ * M1, M2, the null space of M(i) (u + i v), M2^-1 [M0 M1 I] (at the deflated matrix's columns,
+ * and M2's inverse), the deflated matrix (eigenvalues in re, im) and two 12 x 12 matrices (M(i);
+ * M2's LU; M(x) at each root). */
 struct jacgen_g6_work {
     double q[14][8], beta[8], rdiag[8], left_null[6][14], free[3][6][9], m[3][12][12];
-    double u[12][4], v[12][4], columns[12][16], square[2][12][12];
+    double u[12][4], v[12][4], columns[12][28], square[2][12][12];
     double deflated[JACGEN_EIG_MAX][JACGEN_EIG_MAX], re[JACGEN_EIG_MAX], im[JACGEN_EIG_MAX];
 };
 
@@ -413,13 +416,21 @@ static int jacgen_g6_spurious(double m[3][12][12], double re[12][12], double im[
  * basis is C[r][r'] - W[r] C[sel][r'] (sel: the identity's rows): with C[sel] = [0; -S[free]] at
  * the columns r', the rows [0 I] + v S[free] and -S + u S[free] at the pivot columns.
  * -1 when M2 is singular. */
-static int jacgen_g6_deflated(struct jacgen_g6_work *w, const int order[12]) {
-    double (*s)[16] = w->columns, (*lead)[12] = w->square[0];
+static int jacgen_g6_deflated(struct jacgen_g6_work *w, const int order[12], double *condition) {
+    double (*s)[28] = w->columns, (*lead)[12] = w->square[0];
+    double norm = 0.0, inverse_norm = 0.0;
     for (int i = 0; i < 12; i++) {
-        for (int j = 0; j < 12; j++) lead[i][j] = w->m[2][i][j];
+        for (int j = 0; j < 12; j++) { lead[i][j] = w->m[2][i][j]; s[i][16 + j] = i == j; }
         for (int b = 0; b < 8; b++) { s[i][b] = w->m[0][i][order[b]]; s[i][8 + b] = w->m[1][i][order[b]]; }
     }
-    if (jacgen_g6_solve(12, &lead[0][0], 16, &s[0][0]) != 0) return -1;
+    if (jacgen_g6_solve(12, &lead[0][0], 28, &s[0][0]) != 0) return -1;
+    for (int j = 0; j < 12; j++) {  /* M2's 1-norm condition number, from M2^-1 in columns 16.. */
+        double column = 0.0, inverse_column = 0.0;
+        for (int i = 0; i < 12; i++) { column += fabs(w->m[2][i][j]); inverse_column += fabs(s[i][16 + j]); }
+        if (column > norm) norm = column;
+        if (inverse_column > inverse_norm) inverse_norm = inverse_column;
+    }
+    *condition = norm * inverse_norm;
     for (int a = 0; a < 8; a++) {
         int r = order[a];
         for (int b = 0; b < 16; b++) {
@@ -436,7 +447,8 @@ static int jacgen_g6_deflated(struct jacgen_g6_work *w, const int order[12]) {
 }
 
 static int jacgen_general6r_roots(double p[3][14][9], double q_matrix[14][8],
-                                  double angles[JACGEN_G6_ROOTS][5], struct jacgen_g6_work *w) {
+                                  double angles[JACGEN_G6_ROOTS][5], struct jacgen_g6_work *w, double *condition) {
+    *condition = INFINITY;
     for (int i = 0; i < 14; i++)
         for (int j = 0; j < 8; j++) w->q[i][j] = q_matrix[i][j];
     if (jacgen_g6_qr(w->q, w->beta, w->rdiag) != 0) return 0;
@@ -450,7 +462,8 @@ static int jacgen_general6r_roots(double p[3][14][9], double q_matrix[14][8],
         }
     jacgen_g6_pencil(w->free, w->m);
     int order[12];
-    if (jacgen_g6_spurious(w->m, w->square[0], w->square[1], w->u, w->v, order) != 0 || jacgen_g6_deflated(w, order) != 0
+    if (jacgen_g6_spurious(w->m, w->square[0], w->square[1], w->u, w->v, order) != 0
+        || jacgen_g6_deflated(w, order, condition) != 0
         || jacgen_eigenvalues(JACGEN_G6_ROOTS, w->deflated, w->re, w->im) != 0) return 0;
     static const int along_c[8] = {0, 1, 3, 4, 6, 7, 9, 10};
     static const int along_b[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
@@ -5927,6 +5940,649 @@ void mico_ik_general_start(const mico_real T[16], const mico_real angles[5], mic
     q[5] = -1.7453292519943295 + ga3;
 }
 
+void mico_ik_general_equations_fallback(const mico_real T[16], mico_real P[378], mico_real Q[112])
+{
+    /* 611 operations */
+
+    /* Inputs */
+    const mico_real T00 = T[0];
+    const mico_real T01 = T[1];
+    const mico_real T02 = T[2];
+    const mico_real T03 = T[3];
+    const mico_real T10 = T[4];
+    const mico_real T11 = T[5];
+    const mico_real T12 = T[6];
+    const mico_real T13 = T[7];
+    const mico_real T20 = T[8];
+    const mico_real T21 = T[9];
+    const mico_real T22 = T[10];
+    const mico_real T23 = T[11];
+
+    /* Intermediate terms */
+    const mico_real t0 = -0.20278165494695127*T02 + T03;
+    const mico_real t1 = T13 - 0.20278165494695127*T12;
+    const mico_real t2 = T23 - 0.20278165494695127*T22;
+    const mico_real t3 = T00*t0 + T10*t1 + T20*t2;
+    const mico_real t4 = T01*t0 + T11*t1 + T21*t2;
+    const mico_real t5 = T02*t0 + T12*t1 + T22*t2;
+    const mico_real t6 = 0.8660254037844386*t5;
+    const mico_real t7 = 0.5*t5;
+    const mico_real t8 = (t3*t3);
+    const mico_real t9 = (t4*t4);
+    const mico_real t10 = (t5*t5);
+    const mico_real t11 = 0.02357269187577015*T22;
+    const mico_real t12 = 0.08556330989390254*t5;
+    const mico_real t13 = 0.551*T20;
+    const mico_real t14 = t13*t3;
+    const mico_real t15 = 0.551*T21;
+    const mico_real t16 = t15*t4;
+    const mico_real t17 = 0.551*T22;
+    const mico_real t18 = 0.5*T00;
+    const mico_real t19 = 0.5*T01;
+    const mico_real t20 = 0.5*T10;
+    const mico_real t21 = 0.5*T11;
+    const mico_real t22 = 0.8660254037844386*T02;
+    const mico_real t23 = 0.8660254037844386*T12;
+    const mico_real t24 = 0.8660254037844386*T00;
+    const mico_real t25 = 0.8660254037844386*T01;
+    const mico_real t26 = 0.8660254037844386*T10;
+    const mico_real t27 = 0.8660254037844386*T11;
+    const mico_real t28 = 0.5*T02;
+    const mico_real t29 = 0.5*T12;
+    const mico_real t30 = 0.2755*T21;
+    const mico_real t31 = 0.2755*T20;
+    const mico_real t32 = 0.0408291*T20;
+    const mico_real t33 = 0.1482*t3;
+    const mico_real t34 = 0.0408291*T21;
+    const mico_real t35 = 0.1482*t4;
+    const mico_real t36 = T00*t3;
+    const mico_real t37 = T01*t4;
+    const mico_real t38 = T02*t5;
+    const mico_real t39 = T10*t3;
+    const mico_real t40 = T11*t4;
+    const mico_real t41 = T12*t5;
+    const mico_real t42 = 0.2755*T11;
+    const mico_real t43 = T00*t5;
+    const mico_real t44 = T02*t3;
+    const mico_real t45 = 0.2755*T10;
+    const mico_real t46 = T01*t5;
+    const mico_real t47 = T02*t4;
+    const mico_real t48 = T12*t3;
+    const mico_real t49 = T10*t5;
+    const mico_real t50 = T12*t4;
+    const mico_real t51 = T11*t5;
+    const mico_real t52 = 0.02357269187577015*T02;
+    const mico_real t53 = t36*t4;
+    const mico_real t54 = t38*t4;
+    const mico_real t55 = t37*t3;
+    const mico_real t56 = t38*t3;
+    const mico_real t57 = 0.02357269187577015*T12;
+    const mico_real t58 = t39*t4;
+    const mico_real t59 = t41*t4;
+    const mico_real t60 = t40*t3;
+    const mico_real t61 = t41*t3;
+    const mico_real t62 = 0.0471453837515403*T02;
+    const mico_real t63 = 0.0471453837515403*T22;
+    const mico_real t64 = t30*t4;
+    const mico_real t65 = 0.2755*T22;
+    const mico_real t66 = t31*t3;
+    const mico_real t67 = 0.0471453837515403*T12;
+    const mico_real t68 = T22*t5;
+    const mico_real t69 = 0.4771799974852257*T22;
+    const mico_real t70 = t36*t5;
+    const mico_real t71 = t37*t5;
+    const mico_real t72 = 0.4771799974852257*T20;
+    const mico_real t73 = 0.4771799974852257*T21;
+    const mico_real t74 = t39*t5;
+    const mico_real t75 = t40*t5;
+    const mico_real t76 = t73*t4;
+    const mico_real t77 = t72*t3;
+
+    /* Outputs */
+    P[0] = 0;
+    P[1] = 0;
+    P[2] = 0;
+    P[3] = 0;
+    P[4] = 0;
+    P[5] = 0;
+    P[6] = 0;
+    P[7] = 0;
+    P[8] = 0;
+    P[9] = 0;
+    P[10] = 0;
+    P[11] = 0;
+    P[12] = 0;
+    P[13] = 0;
+    P[14] = 0;
+    P[15] = 0;
+    P[16] = 0;
+    P[17] = 0;
+    P[18] = 0;
+    P[19] = 0;
+    P[20] = 0;
+    P[21] = 0;
+    P[22] = 0;
+    P[23] = 0.8660254037844386;
+    P[24] = 0;
+    P[25] = 0;
+    P[26] = 0;
+    P[27] = 0;
+    P[28] = 0;
+    P[29] = 0;
+    P[30] = 0;
+    P[31] = 0;
+    P[32] = 0;
+    P[33] = 0;
+    P[34] = 0;
+    P[35] = 0;
+    P[36] = 0;
+    P[37] = 0;
+    P[38] = 0;
+    P[39] = 0;
+    P[40] = 0;
+    P[41] = 0;
+    P[42] = 0;
+    P[43] = 0;
+    P[44] = t6 - 0.23858999874261286*T22;
+    P[45] = 0;
+    P[46] = 0.2511473670974872;
+    P[47] = 0;
+    P[48] = 0;
+    P[49] = 0;
+    P[50] = -0.00606217782649107;
+    P[51] = 0.145;
+    P[52] = 0;
+    P[53] = 0.16860413736737817 - t7 + 0.13775*T22;
+    P[54] = 0;
+    P[55] = 0;
+    P[56] = 0;
+    P[57] = 0;
+    P[58] = 0;
+    P[59] = 0;
+    P[60] = 0.09632735986923173;
+    P[61] = 0;
+    P[62] = 0.028510786109918182 - t8 - t9 - t10 - t11 + t12 + t14 + t16 + t17*t5;
+    P[63] = 0;
+    P[64] = 0;
+    P[65] = 0;
+    P[66] = 0;
+    P[67] = 0;
+    P[68] = 0;
+    P[69] = 0;
+    P[70] = 0;
+    P[71] = -0.007;
+    P[72] = 0;
+    P[73] = 0;
+    P[74] = 0;
+    P[75] = 0;
+    P[76] = 0;
+    P[77] = 0;
+    P[78] = 0;
+    P[79] = 0;
+    P[80] = 0;
+    P[81] = 0;
+    P[82] = 0;
+    P[83] = 0;
+    P[84] = 0;
+    P[85] = 0;
+    P[86] = 0;
+    P[87] = 0;
+    P[88] = 0;
+    P[89] = 0;
+    P[90] = -0.2511473670974872;
+    P[91] = 0;
+    P[92] = 0;
+    P[93] = 0;
+    P[94] = -0.14383093228662128;
+    P[95] = 0;
+    P[96] = 0;
+    P[97] = 0.145;
+    P[98] = 0;
+    P[99] = 0;
+    P[100] = 0;
+    P[101] = 0;
+    P[102] = 0;
+    P[103] = 0;
+    P[104] = 0;
+    P[105] = 0;
+    P[106] = 0;
+    P[107] = 0;
+    P[108] = 0;
+    P[109] = 0;
+    P[110] = 0;
+    P[111] = 0;
+    P[112] = 0;
+    P[113] = 0;
+    P[114] = 0;
+    P[115] = 0;
+    P[116] = 0;
+    P[117] = 0;
+    P[118] = 0.0035160631393648207;
+    P[119] = 0.08342194072624035;
+    P[120] = 0;
+    P[121] = 0;
+    P[122] = 0.0966779804802108;
+    P[123] = 0.00203;
+    P[124] = 0;
+    P[125] = 0.001162571584628659;
+    P[126] = 0;
+    P[127] = 0;
+    P[128] = 0;
+    P[129] = 0;
+    P[130] = -0.9238795325112867;
+    P[131] = -0.19134171618254486;
+    P[132] = 0;
+    P[133] = 0;
+    P[134] = 0;
+    P[135] = 0;
+    P[136] = 0;
+    P[137] = 0;
+    P[138] = 0;
+    P[139] = -0.3826834323650897;
+    P[140] = 0.46193976625564337;
+    P[141] = 0;
+    P[142] = 0;
+    P[143] = 0;
+    P[144] = 0;
+    P[145] = 0;
+    P[146] = 0;
+    P[147] = 0;
+    P[148] = 0;
+    P[149] = 0;
+    P[150] = 0;
+    P[151] = 0;
+    P[152] = 0;
+    P[153] = 0;
+    P[154] = -0.055489097692938014;
+    P[155] = 0;
+    P[156] = 0.26792506442827313;
+    P[157] = 0.006467156727579007;
+    P[158] = 0.001339392013277814;
+    P[159] = 0.09610993647032161;
+    P[160] = 0;
+    P[161] = 0.055041714847715036;
+    P[162] = 0;
+    P[163] = 0.13396253221413656;
+    P[164] = 0;
+    P[165] = 0.11097819538587603;
+    P[166] = 0.002678784026555628;
+    P[167] = -0.0032335783637895037;
+    P[168] = -0.232029912105467;
+    P[169] = 0;
+    P[170] = -0.13288245448162622;
+    P[171] = 0;
+    P[172] = 0;
+    P[173] = 0;
+    P[174] = 0;
+    P[175] = 0;
+    P[176] = 0;
+    P[177] = 0;
+    P[178] = 0;
+    P[179] = 0;
+    P[180] = 0;
+    P[181] = 0;
+    P[182] = 0;
+    P[183] = 0;
+    P[184] = 0;
+    P[185] = 0;
+    P[186] = 0;
+    P[187] = 0;
+    P[188] = 0;
+    P[189] = 0;
+    P[190] = 0;
+    P[191] = 0;
+    P[192] = 0;
+    P[193] = 0;
+    P[194] = 0;
+    P[195] = 0;
+    P[196] = 0;
+    P[197] = 0;
+    P[198] = 0.055489097692938014;
+    P[199] = 0;
+    P[200] = -0.26792506442827313;
+    P[201] = 0;
+    P[202] = 0.031778348883986896;
+    P[203] = -0.15343944173109017;
+    P[204] = 0;
+    P[205] = 0.09610993647032161;
+    P[206] = 0;
+    P[207] = -0.13396253221413656;
+    P[208] = 0;
+    P[209] = -0.11097819538587603;
+    P[210] = 0;
+    P[211] = -0.07671972086554509;
+    P[212] = -0.06355669776797379;
+    P[213] = 0;
+    P[214] = -0.232029912105467;
+    P[215] = 0;
+    P[216] = 0;
+    P[217] = 0;
+    P[218] = 0;
+    P[219] = 0;
+    P[220] = 0;
+    P[221] = 0;
+    P[222] = 0;
+    P[223] = 0;
+    P[224] = 0;
+    P[225] = -0.0889948762040323;
+    P[226] = -0.0007768473677011321;
+    P[227] = -0.0184314423527124;
+    P[228] = 0.0037509509019958242;
+    P[229] = -0.10313647500394192;
+    P[230] = -0.021360263360993226;
+    P[231] = 0.0013455391105845025;
+    P[232] = 0;
+    P[233] = 0.0007705840078680105;
+    P[234] = -0.0368628847054248;
+    P[235] = 0.0018754754509979121;
+    P[236] = 0.04449743810201615;
+    P[237] = 0.0015536947354022643;
+    P[238] = -0.04272052672198645;
+    P[239] = 0.05156823750197096;
+    P[240] = -0.003248418769476538;
+    P[241] = 0;
+    P[242] = -0.0018603543627427669;
+    P[243] = 0;
+    P[244] = 0;
+    P[245] = 0;
+    P[246] = 0;
+    P[247] = 0;
+    P[248] = 0;
+    P[249] = 0;
+    P[250] = 0;
+    P[251] = 0;
+    P[252] = 0;
+    P[253] = 0;
+    P[254] = 0;
+    P[255] = 0;
+    P[256] = -0.3826834323650897;
+    P[257] = 0.46193976625564337;
+    P[258] = 0;
+    P[259] = 0;
+    P[260] = 0;
+    P[261] = 0;
+    P[262] = 0;
+    P[263] = 0;
+    P[264] = 0;
+    P[265] = 0.9238795325112867;
+    P[266] = 0.19134171618254486;
+    P[267] = 0;
+    P[268] = 0;
+    P[269] = 0;
+    P[270] = 0;
+    P[271] = 0;
+    P[272] = 0;
+    P[273] = 0;
+    P[274] = 0;
+    P[275] = 0;
+    P[276] = 0;
+    P[277] = 0;
+    P[278] = 0;
+    P[279] = 0;
+    P[280] = 0.13396253221413656;
+    P[281] = 0;
+    P[282] = 0.11097819538587603;
+    P[283] = 0.002678784026555628;
+    P[284] = -0.0032335783637895037;
+    P[285] = -0.232029912105467;
+    P[286] = 0;
+    P[287] = -0.13288245448162622;
+    P[288] = 0;
+    P[289] = 0.055489097692938014;
+    P[290] = 0;
+    P[291] = -0.26792506442827313;
+    P[292] = -0.006467156727579007;
+    P[293] = -0.001339392013277814;
+    P[294] = -0.09610993647032161;
+    P[295] = 0;
+    P[296] = -0.055041714847715036;
+    P[297] = 0;
+    P[298] = 0;
+    P[299] = 0;
+    P[300] = 0;
+    P[301] = 0;
+    P[302] = 0;
+    P[303] = 0;
+    P[304] = 0;
+    P[305] = 0;
+    P[306] = 0;
+    P[307] = 0;
+    P[308] = 0;
+    P[309] = 0;
+    P[310] = 0;
+    P[311] = 0;
+    P[312] = 0;
+    P[313] = 0;
+    P[314] = 0;
+    P[315] = 0;
+    P[316] = 0;
+    P[317] = 0;
+    P[318] = 0;
+    P[319] = 0;
+    P[320] = 0;
+    P[321] = 0;
+    P[322] = 0;
+    P[323] = 0;
+    P[324] = -0.13396253221413656;
+    P[325] = 0;
+    P[326] = -0.11097819538587603;
+    P[327] = 0;
+    P[328] = -0.07671972086554509;
+    P[329] = -0.06355669776797379;
+    P[330] = 0;
+    P[331] = -0.232029912105467;
+    P[332] = 0;
+    P[333] = -0.055489097692938014;
+    P[334] = 0;
+    P[335] = 0.26792506442827313;
+    P[336] = 0;
+    P[337] = -0.031778348883986896;
+    P[338] = 0.15343944173109017;
+    P[339] = 0;
+    P[340] = -0.09610993647032161;
+    P[341] = 0;
+    P[342] = 0;
+    P[343] = 0;
+    P[344] = 0;
+    P[345] = 0;
+    P[346] = 0;
+    P[347] = 0;
+    P[348] = 0;
+    P[349] = 0;
+    P[350] = 0;
+    P[351] = -0.0368628847054248;
+    P[352] = 0.0018754754509979121;
+    P[353] = 0.04449743810201615;
+    P[354] = 0.0015536947354022643;
+    P[355] = -0.04272052672198645;
+    P[356] = 0.05156823750197096;
+    P[357] = -0.003248418769476538;
+    P[358] = 0;
+    P[359] = -0.0018603543627427669;
+    P[360] = 0.0889948762040323;
+    P[361] = 0.0007768473677011321;
+    P[362] = 0.0184314423527124;
+    P[363] = -0.0037509509019958242;
+    P[364] = 0.10313647500394192;
+    P[365] = 0.021360263360993226;
+    P[366] = -0.0013455391105845025;
+    P[367] = 0;
+    P[368] = -0.0007705840078680105;
+    P[369] = 0;
+    P[370] = 0;
+    P[371] = 0;
+    P[372] = 0;
+    P[373] = 0;
+    P[374] = 0;
+    P[375] = 0;
+    P[376] = 0;
+    P[377] = 0;
+    Q[0] = -1.0*T01;
+    Q[1] = T00;
+    Q[2] = T11;
+    Q[3] = -1.0*T10;
+    Q[4] = 0;
+    Q[5] = 0;
+    Q[6] = 0;
+    Q[7] = 0;
+    Q[8] = -t18;
+    Q[9] = -t19;
+    Q[10] = t20;
+    Q[11] = t21;
+    Q[12] = t22;
+    Q[13] = -t23;
+    Q[14] = 0;
+    Q[15] = 0;
+    Q[16] = -t24;
+    Q[17] = -t25;
+    Q[18] = t26;
+    Q[19] = t27;
+    Q[20] = -t28;
+    Q[21] = t29;
+    Q[22] = 0;
+    Q[23] = 0;
+    Q[24] = 0;
+    Q[25] = 0;
+    Q[26] = 0;
+    Q[27] = 0;
+    Q[28] = 0;
+    Q[29] = 0;
+    Q[30] = -t30 + t4;
+    Q[31] = t31 - 1.0*t3;
+    Q[32] = 0;
+    Q[33] = 0;
+    Q[34] = 0;
+    Q[35] = 0;
+    Q[36] = 0;
+    Q[37] = 0;
+    Q[38] = 0.5*t3 - 0.13775*T20;
+    Q[39] = 0.5*t4 - 0.13775*T21;
+    Q[40] = 0;
+    Q[41] = 0;
+    Q[42] = 0;
+    Q[43] = 0;
+    Q[44] = 0;
+    Q[45] = 0;
+    Q[46] = 0.8660254037844386*t3 - 0.23858999874261286*T20;
+    Q[47] = 0.8660254037844386*t4 - 0.23858999874261286*T21;
+    Q[48] = 0;
+    Q[49] = 0;
+    Q[50] = 0;
+    Q[51] = 0;
+    Q[52] = 0;
+    Q[53] = 0;
+    Q[54] = -t33 + t32;
+    Q[55] = -t35 + t34;
+    Q[56] = 0.0741*T00;
+    Q[57] = 0.0741*T01;
+    Q[58] = -0.0741*T10;
+    Q[59] = -0.0741*T11;
+    Q[60] = -(t36 + t37 + t38 - 0.04278165494695127*T02);
+    Q[61] = t39 + t40 + t41 - 0.04278165494695127*T12;
+    Q[62] = 0;
+    Q[63] = 0;
+    Q[64] = -(-t43 + t42 + t44 + 0.04278165494695127*T00);
+    Q[65] = -t47 + t45 + t46 - 0.04278165494695127*T01;
+    Q[66] = -t49 + t48 + 0.04278165494695127*T10 - 0.2755*T01;
+    Q[67] = -t51 + t50 + 0.2755*T00 + 0.04278165494695127*T11;
+    Q[68] = 0.0741*T02;
+    Q[69] = -0.0741*T12;
+    Q[70] = 0;
+    Q[71] = 0;
+    Q[72] = 0.08556330989390254*T01 - 0.13775*T10 + t28*t4 - t7*T01;
+    Q[73] = -(0.08556330989390254*T00 - 0.5*t43 + 0.13775*T11 + t28*t3);
+    Q[74] = -(0.08556330989390254*T11 - 0.5*t51 + 0.13775*T00 + t29*t4);
+    Q[75] = 0.08556330989390254*T10 - 0.13775*T01 + t29*t3 - t7*T10;
+    Q[76] = 0.23858999874261286*T12 + t24*t4 - t25*t3;
+    Q[77] = 0.23858999874261286*T02 + t27*t3 - t26*t4;
+    Q[78] = 0;
+    Q[79] = 0;
+    Q[80] = -(-0.8660254037844386*t47 + 0.23858999874261286*T10 + t6*T01);
+    Q[81] = -(-0.8660254037844386*t43 + 0.23858999874261286*T11 + t22*t3);
+    Q[82] = -(-0.8660254037844386*t51 + 0.23858999874261286*T00 + t23*t4);
+    Q[83] = -(-0.8660254037844386*t48 + 0.23858999874261286*T01 + t6*T10);
+    Q[84] = -(0.13775*T12 - 0.5*T01*t3 + t18*t4);
+    Q[85] = -(0.13775*T02 - 0.5*T10*t4 + t21*t3);
+    Q[86] = 0;
+    Q[87] = 0;
+    Q[88] = -0.08556330989390254*t47 - 0.08322133*T01 + 2.0*t53 + 2.0*t54 + t9*T01 + t12*T01 + t52*T21 - t8*T01 - t10*T01 - t11*T01 + t14*T01 + t17*t46 - t15*t36 - t15*t38;
+    Q[89] = t13*t38 + 0.08556330989390254*t44 + 0.08322133*T00 - 2.0*t55 - 2.0*t56 + t9*T00 + t10*T00 + t11*T00 - t8*T00 - t12*T00 - t52*T20 + t13*t37 - t16*T00 - t17*t43;
+    Q[90] = t15*t39 + 0.08556330989390254*t50 + 0.08322133*T11 - 2.0*t58 - 2.0*t59 + t8*T11 + t10*T11 + t11*T11 - t9*T11 - t12*T11 - t57*T21 + t15*t41 - t14*T11 - t17*t51;
+    Q[91] = -0.08556330989390254*t48 - 0.08322133*T10 + 2.0*t60 + 2.0*t61 + t8*T10 + t12*T10 + t57*T20 - t9*T10 - t10*T10 - t11*T10 + t16*T10 + t17*t49 - t13*t40 - t13*t41;
+    Q[92] = t33*T01 + t34*T00 - t35*T00 - t32*T01;
+    Q[93] = t35*T10 + t32*T11 - t33*T11 - t34*T10;
+    Q[94] = 0;
+    Q[95] = 0;
+    Q[96] = t55 + t56 + 0.17112661978780508*t43 - 0.041610665*T00 - 0.17112661978780508*t44 + t8*t18 + t62*T20 - t9*t18 - t10*t18 - t63*T00 + t64*T00 + t43*t65 - t31*t37 - t31*t38;
+    Q[97] = t53 + t54 - t10*t19 + 0.17112661978780508*t46 - 0.041610665*T01 - 0.17112661978780508*t47 + t9*t19 + t62*T21 - t8*t19 - t63*T01 + t66*T01 + t46*t65 - t30*t36 - t30*t38;
+    Q[98] = -t60 - t61 + 0.17112661978780508*t48 - 0.17112661978780508*t49 + 0.041610665*T10 + t9*t20 + t10*t20 + t63*T10 - t8*t20 - t67*T20 + t31*t40 + t31*t41 - t64*T10 - t45*t68;
+    Q[99] = -t58 - t59 + 0.17112661978780508*t50 - 0.17112661978780508*t51 + 0.041610665*T11 + t8*t21 + t10*t21 + t63*T11 - t9*t21 - t67*T21 + t30*t39 + t30*t41 - t66*T11 - t42*t68;
+    Q[100] = -1.7320508075688772*t70 - 1.7320508075688772*t71 + 0.07207178591672801*T02 + t8*t22 + t9*t22 - t10*t22 + t36*t69 + t37*t69 - t44*t72 - t47*t73;
+    Q[101] = 1.7320508075688772*t74 + 1.7320508075688772*t75 - 0.07207178591672801*T12 + t10*t23 - t8*t23 - t9*t23 + t48*t72 + t50*t73 - t39*t69 - t40*t69;
+    Q[102] = 0;
+    Q[103] = 0;
+    Q[104] = 1.7320508075688772*t55 + 1.7320508075688772*t56 - 0.059391303390451664*T00 + t8*t24 - t9*t24 - t10*t24 + t76*T00 + t43*t69 - t37*t72 - t38*t72;
+    Q[105] = 1.7320508075688772*t53 + 1.7320508075688772*t54 - 0.059391303390451664*T01 + t9*t25 - t8*t25 - t10*t25 + t77*T01 + t46*t69 - t36*t73 - t38*t73;
+    Q[106] = 0.059391303390451664*T10 - 1.7320508075688772*t60 - 1.7320508075688772*t61 + t9*t26 + t10*t26 - t8*t26 + t40*t72 + t41*t72 - t76*T10 - t49*t69;
+    Q[107] = t10*t27 + 0.059391303390451664*T11 - 1.7320508075688772*t58 - 1.7320508075688772*t59 + t8*t27 - t9*t27 + t39*t73 + t41*t73 - t77*T11 - t51*t69;
+    Q[108] = -(-t70 - t71 + 0.17112661978780508*t36 + 0.17112661978780508*t37 + 0.17112661978780508*t38 + 0.034289585*T02 - 0.5*t10*T02 + t8*t28 + t9*t28 + t36*t65 + t37*t65 - 0.2755*t44*T20 - 0.2755*t47*T21);
+    Q[109] = -t74 - t75 + 0.17112661978780508*t39 + 0.17112661978780508*t40 + 0.17112661978780508*t41 + 0.034289585*T12 + t8*t29 + t9*t29 - t10*t29 + t39*t65 + t40*t65 - t31*t48 - t30*t50;
+    Q[110] = 0;
+    Q[111] = 0;
+}
+
+void mico_ik_general_start_fallback(const mico_real T[16], const mico_real angles[5], mico_real q[MICO_DOF])
+{
+    /* 63 operations */
+
+    /* Inputs */
+    const mico_real T00 = T[0];
+    const mico_real T01 = T[1];
+    const mico_real T02 = T[2];
+    const mico_real T10 = T[4];
+    const mico_real T11 = T[5];
+    const mico_real T12 = T[6];
+    const mico_real T20 = T[8];
+    const mico_real T21 = T[9];
+    const mico_real T22 = T[10];
+    const mico_real ga0 = angles[0];
+    const mico_real ga1 = angles[1];
+    const mico_real ga2 = angles[2];
+    const mico_real ga3 = angles[3];
+    const mico_real ga4 = angles[4];
+
+    /* Intermediate terms */
+    const mico_real t0 = cos(ga3);
+    const mico_real t1 = sin(ga3);
+    const mico_real t2 = cos(ga2);
+    const mico_real t3 = sin(ga2);
+    const mico_real t4 = cos(ga1)*t2;
+    const mico_real t5 = sin(ga1)*t2;
+    const mico_real t6 = 0.5*t5 - 0.8660254037844386*t3;
+    const mico_real t7 = 0.5*t3 + 0.8660254037844386*t5;
+    const mico_real t8 = 1.9634954084936207 + ga0;
+    const mico_real t9 = cos(t8);
+    const mico_real t10 = sin(t8);
+    const mico_real t11 = t9*t4 - t10*t6;
+    const mico_real t12 = t10*t4 + t9*t6;
+    const mico_real t13 = 0.5*t12 - 0.8660254037844386*t7;
+    const mico_real t14 = 0.5*t7 + 0.8660254037844386*t12;
+    const mico_real t15 = cos(ga4);
+    const mico_real t16 = sin(ga4);
+    const mico_real t17 = t15*t11 - t16*t13;
+    const mico_real t18 = t16*t11 + t15*t13;
+    const mico_real t19 = t17*(T00*t0 + T10*t1) - t18*(T01*t0 + T11*t1) + t14*(T02*t0 + T12*t1);
+    const mico_real t20 = T20*t17 + T22*t14 - T21*t18;
+
+    /* Outputs */
+    q[0] = -ga3;
+    q[1] = 1.5707963267948966 + atan2(t20, t19);
+    q[2] = -(1.5707963267948966 + ga2);
+    q[3] = -ga1;
+    q[4] = 1.1780972450961726 - ga0;
+    q[5] = -(1.7453292519943295 + ga4);
+}
+
 void mico_ik_general_residual(const mico_real target[16], const mico_real q[MICO_DOF], mico_real e[6], mico_real J[6 * 6])
 {
     /* 324 operations */
@@ -6654,7 +7310,7 @@ static mico_real mico_ik_general_polish(const mico_real T[16], mico_real x[MICO_
     return cost;
 }
 
-/* The general 6R solver's working memory: 21840 bytes in this build. A local of
+/* The general 6R solver's working memory: 22992 bytes in this build. A local of
  * mico_ik_branches (on its stack) unless MICO_IK_STATIC_WORK is defined: then one static
  * object, and mico_ik_branches (with mico_ik and mico_ik_nearest) is not reentrant. */
 struct mico_ik_work {
@@ -6668,7 +7324,9 @@ static struct mico_ik_work mico_ik_static_work;
 
 /* The general 6R solver: the equations at T, the kernel's
  * roots (jacgen_general6r_roots, in double), each completed to a configuration, polished by
- * Newton steps and kept when it reaches T, once; the valid rows first. */
+ * Newton steps and kept when it reaches T, once; the valid rows first. Where the leading
+ * matrix is singular to rounding (condition above JACGEN_G6_DEGENERATE), the roots are those of
+ * the fallback elimination, another joint hidden. */
 void mico_ik_branches(const mico_real T[16], mico_real q[MICO_MAX_IK_SOLUTIONS * MICO_DOF],
                      int valid[MICO_MAX_IK_SOLUTIONS], int in_limits[MICO_MAX_IK_SOLUTIONS])
 {
@@ -6678,15 +7336,26 @@ void mico_ik_branches(const mico_real T[16], mico_real q[MICO_MAX_IK_SOLUTIONS *
     struct mico_ik_work work, *w = &work;
 #endif
     mico_real angles[5], x[MICO_DOF];
-    int count = 0, found, i, j, k;
+    double condition;
+    int count = 0, found, i, j, k, fallback;
     mico_ik_general_clear(q, valid, in_limits);
     mico_ik_general_equations(T, w->P, w->Q);
     for (i = 0; i < 378; ++i) w->p[i / 126][i / 9 % 14][i % 9] = (double)w->P[i];
     for (i = 0; i < 112; ++i) w->q[i / 8][i % 8] = (double)w->Q[i];
-    found = jacgen_general6r_roots(w->p, w->q, w->roots, &w->kernel);
+    found = jacgen_general6r_roots(w->p, w->q, w->roots, &w->kernel, &condition);
+    fallback = !(condition <= JACGEN_G6_DEGENERATE);
+    if (fallback) {
+        mico_ik_general_equations_fallback(T, w->P, w->Q);
+        for (i = 0; i < 378; ++i) w->p[i / 126][i / 9 % 14][i % 9] = (double)w->P[i];
+        for (i = 0; i < 112; ++i) w->q[i / 8][i % 8] = (double)w->Q[i];
+        found = jacgen_general6r_roots(w->p, w->q, w->roots, &w->kernel, &condition);
+    }
     for (k = 0; k < found && count < MICO_MAX_IK_SOLUTIONS; ++k) {
         for (j = 0; j < 5; ++j) angles[j] = (mico_real)w->roots[k][j];
-        mico_ik_general_start(T, angles, x);
+        if (fallback)
+            mico_ik_general_start_fallback(T, angles, x);
+        else
+            mico_ik_general_start(T, angles, x);
         if (!(mico_ik_general_polish(T, x, mico_ik_general_newton(T, x), 6)
               <= 1e-18)) continue;
         count += mico_ik_general_add(x, count, q, valid, in_limits);

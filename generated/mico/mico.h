@@ -136,6 +136,14 @@ void mico_ik_general_equations(const mico_real T[16], mico_real P[378], mico_rea
  * Result: q[i], i < 6. 88 operations. */
 void mico_ik_general_start(const mico_real T[16], const mico_real angles[5], mico_real q[MICO_DOF]);
 
+/* The general 6R solver's equations at T, by the fallback elimination (for targets where the first's leading matrix is singular to rounding): (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9).
+ * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 611 operations. */
+void mico_ik_general_equations_fallback(const mico_real T[16], mico_real P[378], mico_real Q[112]);
+
+/* The configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop), by the fallback elimination (for targets where the first's leading matrix is singular to rounding).
+ * Result: q[i], i < 6. 63 operations. */
+void mico_ik_general_start_fallback(const mico_real T[16], const mico_real angles[5], mico_real q[MICO_DOF]);
+
 /* The pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J of the six joints ik solves: the Newton step of the solver's polish is q + J^-1 e.
  * Result: e[i], i < 6; J: 6 x 6 row-major, element (r, c) at J[r * 6 + c]. 324 operations. */
 void mico_ik_general_residual(const mico_real target[16], const mico_real q[MICO_DOF], mico_real e[6], mico_real J[6 * 6]);

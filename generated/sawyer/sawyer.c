@@ -168,6 +168,7 @@ static int jacgen_eigenvalues(int n, double a[JACGEN_EIG_MAX][JACGEN_EIG_MAX], d
 
 
 #define JACGEN_G6_IMAGINARY 1e-05
+#define JACGEN_G6_DEGENERATE 10000000.0
 /* Runtime helper of the general 6R solver (included by robot.c.jinja for its robots): from
  * Raghavan & Roth's 14 equations at one target, (P0 + s Ps + c Pc) v_bc = Q v_gh with the hidden
  * angle's shift already applied (jacgen/general6r.py), the loop angles (a, b, c, g, h) of every
@@ -177,7 +178,9 @@ static int jacgen_eigenvalues(int n, double a[JACGEN_EIG_MAX][JACGEN_EIG_MAX], d
  * x = +-i for every target (jacgen_g6_spurious); the other 16 are those of the companion matrix
  * with them deflated (jacgen_g6_deflated, jacgen_eigenvalues). Per real root, the null vector of
  * M(x) (inverse iteration) gives x_b and x_c, and R^-1 (Q^T P v_bc)[0..7] gives v_gh. Fixed size,
- * no allocation, no recursion. Returns the number of roots (0 when M2 or R is singular).
+ * no allocation, no recursion. Returns the number of roots (0 when M2 or R is singular), and
+ * M2's 1-norm condition number in *condition (infinite when it is singular): above
+ * JACGEN_G6_DEGENERATE, its eigenvalues are noise and the caller takes its fallback elimination.
  * Defined before it: JACGEN_G6_IMAGINARY, an eigenvalue being a root when |imaginary part| <= that
  * (1 + |x|) (jacgen/general6r.py's IMAGINARY for the build's real type). */
 #define JACGEN_G6_ROOTS 16
@@ -337,12 +340,12 @@ static void jacgen_g6_pencil(double free[3][6][9], double m[3][12][12]) {
 }
 
 /* The kernel's working memory: the QR of Q, its left null space, the six v_gh-free equations, M0,
- * M1, M2, the null space of M(i) (u + i v), M2^-1 [M0 M1] at the deflated matrix's columns, the
- * deflated matrix (eigenvalues in re, im) and two 12 x 12 matrices (M(i); M2's LU; M(x) at each
- * root). */
+ * M1, M2, the null space of M(i) (u + i v), M2^-1 [M0 M1 I] (at the deflated matrix's columns,
+ * and M2's inverse), the deflated matrix (eigenvalues in re, im) and two 12 x 12 matrices (M(i);
+ * M2's LU; M(x) at each root). */
 struct jacgen_g6_work {
     double q[14][8], beta[8], rdiag[8], left_null[6][14], free[3][6][9], m[3][12][12];
-    double u[12][4], v[12][4], columns[12][16], square[2][12][12];
+    double u[12][4], v[12][4], columns[12][28], square[2][12][12];
     double deflated[JACGEN_EIG_MAX][JACGEN_EIG_MAX], re[JACGEN_EIG_MAX], im[JACGEN_EIG_MAX];
 };
 
@@ -413,13 +416,21 @@ static int jacgen_g6_spurious(double m[3][12][12], double re[12][12], double im[
  * basis is C[r][r'] - W[r] C[sel][r'] (sel: the identity's rows): with C[sel] = [0; -S[free]] at
  * the columns r', the rows [0 I] + v S[free] and -S + u S[free] at the pivot columns.
  * -1 when M2 is singular. */
-static int jacgen_g6_deflated(struct jacgen_g6_work *w, const int order[12]) {
-    double (*s)[16] = w->columns, (*lead)[12] = w->square[0];
+static int jacgen_g6_deflated(struct jacgen_g6_work *w, const int order[12], double *condition) {
+    double (*s)[28] = w->columns, (*lead)[12] = w->square[0];
+    double norm = 0.0, inverse_norm = 0.0;
     for (int i = 0; i < 12; i++) {
-        for (int j = 0; j < 12; j++) lead[i][j] = w->m[2][i][j];
+        for (int j = 0; j < 12; j++) { lead[i][j] = w->m[2][i][j]; s[i][16 + j] = i == j; }
         for (int b = 0; b < 8; b++) { s[i][b] = w->m[0][i][order[b]]; s[i][8 + b] = w->m[1][i][order[b]]; }
     }
-    if (jacgen_g6_solve(12, &lead[0][0], 16, &s[0][0]) != 0) return -1;
+    if (jacgen_g6_solve(12, &lead[0][0], 28, &s[0][0]) != 0) return -1;
+    for (int j = 0; j < 12; j++) {  /* M2's 1-norm condition number, from M2^-1 in columns 16.. */
+        double column = 0.0, inverse_column = 0.0;
+        for (int i = 0; i < 12; i++) { column += fabs(w->m[2][i][j]); inverse_column += fabs(s[i][16 + j]); }
+        if (column > norm) norm = column;
+        if (inverse_column > inverse_norm) inverse_norm = inverse_column;
+    }
+    *condition = norm * inverse_norm;
     for (int a = 0; a < 8; a++) {
         int r = order[a];
         for (int b = 0; b < 16; b++) {
@@ -436,7 +447,8 @@ static int jacgen_g6_deflated(struct jacgen_g6_work *w, const int order[12]) {
 }
 
 static int jacgen_general6r_roots(double p[3][14][9], double q_matrix[14][8],
-                                  double angles[JACGEN_G6_ROOTS][5], struct jacgen_g6_work *w) {
+                                  double angles[JACGEN_G6_ROOTS][5], struct jacgen_g6_work *w, double *condition) {
+    *condition = INFINITY;
     for (int i = 0; i < 14; i++)
         for (int j = 0; j < 8; j++) w->q[i][j] = q_matrix[i][j];
     if (jacgen_g6_qr(w->q, w->beta, w->rdiag) != 0) return 0;
@@ -450,7 +462,8 @@ static int jacgen_general6r_roots(double p[3][14][9], double q_matrix[14][8],
         }
     jacgen_g6_pencil(w->free, w->m);
     int order[12];
-    if (jacgen_g6_spurious(w->m, w->square[0], w->square[1], w->u, w->v, order) != 0 || jacgen_g6_deflated(w, order) != 0
+    if (jacgen_g6_spurious(w->m, w->square[0], w->square[1], w->u, w->v, order) != 0
+        || jacgen_g6_deflated(w, order, condition) != 0
         || jacgen_eigenvalues(JACGEN_G6_ROOTS, w->deflated, w->re, w->im) != 0) return 0;
     static const int along_c[8] = {0, 1, 3, 4, 6, 7, 9, 10};
     static const int along_b[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
@@ -6317,6 +6330,640 @@ void sawyer_ik_general_start(const sawyer_real T[16], sawyer_real q_free, const 
     q[6] = q7;
 }
 
+void sawyer_ik_general_equations_fallback(const sawyer_real T[16], sawyer_real q_free, sawyer_real P[378], sawyer_real Q[112])
+{
+    /* 286 operations */
+
+    /* Inputs */
+    const sawyer_real T00 = T[0];
+    const sawyer_real T01 = T[1];
+    const sawyer_real T02 = T[2];
+    const sawyer_real T03 = T[3];
+    const sawyer_real T10 = T[4];
+    const sawyer_real T11 = T[5];
+    const sawyer_real T12 = T[6];
+    const sawyer_real T13 = T[7];
+    const sawyer_real T20 = T[8];
+    const sawyer_real T21 = T[9];
+    const sawyer_real T22 = T[10];
+    const sawyer_real T23 = T[11];
+
+    /* Intermediate terms */
+    const sawyer_real q7 = q_free;
+    const sawyer_real c7 = cos(q7);
+    const sawyer_real s7 = sin(q7);
+    const sawyer_real t0 = c7*T00 - s7*T01;
+    const sawyer_real t1 = c7*T10 - s7*T11;
+    const sawyer_real t2 = c7*T20 - s7*T21;
+    const sawyer_real t3 = 0.1363*s7;
+    const sawyer_real t4 = 0.1363*c7;
+    const sawyer_real t5 = -0.13375*T02 + T03 + t3*T00 + t4*T01;
+    const sawyer_real t6 = -0.13375*T12 + T13 + t3*T10 + t4*T11;
+    const sawyer_real t7 = -0.13375*T22 + T23 + t3*T20 + t4*T21;
+    const sawyer_real t8 = (t5*t5);
+    const sawyer_real t9 = (t6*t6);
+    const sawyer_real t10 = (t7*t7);
+    const sawyer_real t11 = 0.8*t7;
+    const sawyer_real t12 = -1.0*t1;
+    const sawyer_real t13 = -1.0*T12;
+    const sawyer_real t14 = 0.4*t1;
+    const sawyer_real t15 = 0.4*t0;
+    const sawyer_real t16 = 0.4*T12;
+    const sawyer_real t17 = 0.4*T02;
+    const sawyer_real t18 = t0*t5;
+    const sawyer_real t19 = t1*t6;
+    const sawyer_real t20 = T02*t5;
+    const sawyer_real t21 = T12*t6;
+    const sawyer_real t22 = 0.162*t6;
+    const sawyer_real t23 = 0.162*t5;
+    const sawyer_real t24 = 0.081*t1;
+    const sawyer_real t25 = 0.081*t0;
+    const sawyer_real t26 = 0.081*T12;
+    const sawyer_real t27 = 0.081*T02;
+    const sawyer_real t28 = t2*t7;
+    const sawyer_real t29 = T22*t7;
+    const sawyer_real t30 = t5*t2;
+    const sawyer_real t31 = t30 + 0.317*t0 - t0*t7;
+    const sawyer_real t32 = t1*t7;
+    const sawyer_real t33 = t6*t2;
+    const sawyer_real t34 = t33 + 0.317*t1;
+    const sawyer_real t35 = T22*t5;
+    const sawyer_real t36 = t35 + 0.317*T02 - T02*t7;
+    const sawyer_real t37 = T12*t7;
+    const sawyer_real t38 = T22*t6;
+    const sawyer_real t39 = t38 + 0.317*T12;
+    const sawyer_real t40 = 0.634*t7;
+    const sawyer_real t41 = 2.0*t6;
+    const sawyer_real t42 = -0.634*t33 + t40*t1 + t9*t1 - t8*t1 - t10*t1 + t18*t41 + t28*t41;
+    const sawyer_real t43 = t9*t0;
+    const sawyer_real t44 = t10*t0;
+    const sawyer_real t45 = 2.0*t5;
+    const sawyer_real t46 = -0.634*t30 + t40*t0 + t8*t0 + t19*t45 + t28*t45;
+    const sawyer_real t47 = -0.634*t38 + t9*T12 + t40*T12 - t8*T12 - t10*T12 + t20*t41 + t29*t41;
+    const sawyer_real t48 = t9*T02;
+    const sawyer_real t49 = t10*T02;
+    const sawyer_real t50 = -0.634*t35 + t8*T02 + t40*T02 + t21*t45 + t29*t45;
+    const sawyer_real t51 = 0.8*t6;
+    const sawyer_real t52 = 0.8*t5;
+    const sawyer_real t53 = 2.0*t7;
+
+    /* Outputs */
+    P[0] = 0;
+    P[1] = 0;
+    P[2] = 0;
+    P[3] = 0;
+    P[4] = 0;
+    P[5] = 0;
+    P[6] = 0;
+    P[7] = 0;
+    P[8] = 0;
+    P[9] = 0;
+    P[10] = 0;
+    P[11] = 0;
+    P[12] = 0;
+    P[13] = 0;
+    P[14] = 0;
+    P[15] = 0;
+    P[16] = 0;
+    P[17] = 0;
+    P[18] = 1.0;
+    P[19] = 0;
+    P[20] = 0;
+    P[21] = 0;
+    P[22] = 0;
+    P[23] = 0;
+    P[24] = 0;
+    P[25] = 0;
+    P[26] = 0;
+    P[27] = 0;
+    P[28] = 0;
+    P[29] = 0;
+    P[30] = 0;
+    P[31] = 0;
+    P[32] = 0;
+    P[33] = 0;
+    P[34] = 0;
+    P[35] = 0.081;
+    P[36] = 0;
+    P[37] = 0;
+    P[38] = 0;
+    P[39] = 0;
+    P[40] = 0;
+    P[41] = 0;
+    P[42] = 0;
+    P[43] = 0;
+    P[44] = -0.317 + t7;
+    P[45] = 0;
+    P[46] = 0;
+    P[47] = 0;
+    P[48] = 0;
+    P[49] = 0;
+    P[50] = -0.1685;
+    P[51] = 0;
+    P[52] = 0;
+    P[53] = 0.1925;
+    P[54] = 0;
+    P[55] = 0;
+    P[56] = 0;
+    P[57] = 0;
+    P[58] = 0;
+    P[59] = -0.0648725;
+    P[60] = 0;
+    P[61] = 0;
+    P[62] = -(0.0416015 + t8 + t9 + t10 - 0.634*t7);
+    P[63] = 0.1925;
+    P[64] = 0;
+    P[65] = 0;
+    P[66] = 0;
+    P[67] = 0;
+    P[68] = 0;
+    P[69] = 0;
+    P[70] = -0.4;
+    P[71] = 0.4;
+    P[72] = 0;
+    P[73] = 0;
+    P[74] = 0;
+    P[75] = 0;
+    P[76] = 0;
+    P[77] = 0;
+    P[78] = 0;
+    P[79] = 0;
+    P[80] = 0;
+    P[81] = 0;
+    P[82] = 0;
+    P[83] = 0;
+    P[84] = 0;
+    P[85] = 0;
+    P[86] = 0;
+    P[87] = 0;
+    P[88] = 0;
+    P[89] = 0;
+    P[90] = 0;
+    P[91] = 0.1685;
+    P[92] = 0.4;
+    P[93] = 0;
+    P[94] = 0;
+    P[95] = 0;
+    P[96] = 0;
+    P[97] = 0;
+    P[98] = 0;
+    P[99] = 0;
+    P[100] = 0;
+    P[101] = 0;
+    P[102] = 0;
+    P[103] = 0;
+    P[104] = 0;
+    P[105] = 0;
+    P[106] = 0;
+    P[107] = 0.0648;
+    P[108] = 0;
+    P[109] = 0;
+    P[110] = 0;
+    P[111] = 0;
+    P[112] = 0;
+    P[113] = 0;
+    P[114] = 0;
+    P[115] = 0;
+    P[116] = -0.2536 + t11;
+    P[117] = 0.151336;
+    P[118] = 0;
+    P[119] = 0;
+    P[120] = -0.1348;
+    P[121] = 0;
+    P[122] = 0;
+    P[123] = 0;
+    P[124] = 0.154;
+    P[125] = 0;
+    P[126] = 0;
+    P[127] = 0;
+    P[128] = 0.9238795325112867;
+    P[129] = 0;
+    P[130] = 0;
+    P[131] = 0;
+    P[132] = 0;
+    P[133] = 0.38268343236508984;
+    P[134] = 0;
+    P[135] = 0;
+    P[136] = 0;
+    P[137] = -0.38268343236508984;
+    P[138] = 0;
+    P[139] = 0;
+    P[140] = 0;
+    P[141] = 0;
+    P[142] = 0.9238795325112867;
+    P[143] = 0;
+    P[144] = 0;
+    P[145] = 0;
+    P[146] = 0;
+    P[147] = 0;
+    P[148] = 0;
+    P[149] = 0;
+    P[150] = 0;
+    P[151] = 0;
+    P[152] = 0;
+    P[153] = 0;
+    P[154] = 0;
+    P[155] = 0;
+    P[156] = 0;
+    P[157] = 0.15567370122815183;
+    P[158] = 0;
+    P[159] = 0;
+    P[160] = 0;
+    P[161] = -0.15307337294603593;
+    P[162] = 0;
+    P[163] = 0;
+    P[164] = 0;
+    P[165] = 0;
+    P[166] = -0.06448215835351764;
+    P[167] = 0;
+    P[168] = 0;
+    P[169] = 0;
+    P[170] = -0.3695518130045147;
+    P[171] = 0;
+    P[172] = 0;
+    P[173] = 0;
+    P[174] = 0;
+    P[175] = 0;
+    P[176] = 0;
+    P[177] = 0;
+    P[178] = 0;
+    P[179] = 0;
+    P[180] = 0;
+    P[181] = 0;
+    P[182] = 0;
+    P[183] = 0;
+    P[184] = 0;
+    P[185] = 0;
+    P[186] = 0;
+    P[187] = 0;
+    P[188] = 0;
+    P[189] = 0;
+    P[190] = 0;
+    P[191] = 0;
+    P[192] = 0;
+    P[193] = 0;
+    P[194] = 0;
+    P[195] = 0;
+    P[196] = 0;
+    P[197] = 0;
+    P[198] = -0.3695518130045147;
+    P[199] = 0;
+    P[200] = 0.07366656073027979;
+    P[201] = 0.15567370122815183;
+    P[202] = 0;
+    P[203] = 0;
+    P[204] = -0.06448215835351764;
+    P[205] = -0.1778468100084227;
+    P[206] = 0;
+    P[207] = 0.15307337294603593;
+    P[208] = 0;
+    P[209] = 0.1778468100084227;
+    P[210] = -0.06448215835351764;
+    P[211] = 0;
+    P[212] = 0;
+    P[213] = -0.15567370122815183;
+    P[214] = 0.07366656073027979;
+    P[215] = 0;
+    P[216] = 0;
+    P[217] = 0;
+    P[218] = 0;
+    P[219] = 0;
+    P[220] = 0;
+    P[221] = 0;
+    P[222] = 0;
+    P[223] = 0;
+    P[224] = 0;
+    P[225] = 0.05893324858422384;
+    P[226] = 0.12453896098252146;
+    P[227] = 0.20828725478537083;
+    P[228] = -0.02482563096610429;
+    P[229] = 0;
+    P[230] = 0;
+    P[231] = -0.05993437497283845;
+    P[232] = -0.03618329255526779;
+    P[233] = 0;
+    P[234] = 0.14227744800673817;
+    P[235] = -0.05158572668281411;
+    P[236] = -0.08627540580156096;
+    P[237] = -0.05993437497283845;
+    P[238] = 0;
+    P[239] = 0;
+    P[240] = 0.02482563096610429;
+    P[241] = -0.08735419561824093;
+    P[242] = 0;
+    P[243] = 0;
+    P[244] = 0;
+    P[245] = 0;
+    P[246] = 0;
+    P[247] = 0;
+    P[248] = 0;
+    P[249] = 0;
+    P[250] = 0;
+    P[251] = 0;
+    P[252] = 0;
+    P[253] = 0;
+    P[254] = -0.38268343236508984;
+    P[255] = 0;
+    P[256] = 0;
+    P[257] = 0;
+    P[258] = 0;
+    P[259] = 0.9238795325112867;
+    P[260] = 0;
+    P[261] = 0;
+    P[262] = 0;
+    P[263] = -0.9238795325112867;
+    P[264] = 0;
+    P[265] = 0;
+    P[266] = 0;
+    P[267] = 0;
+    P[268] = -0.38268343236508984;
+    P[269] = 0;
+    P[270] = 0;
+    P[271] = 0;
+    P[272] = 0;
+    P[273] = 0;
+    P[274] = 0;
+    P[275] = 0;
+    P[276] = 0;
+    P[277] = 0;
+    P[278] = 0;
+    P[279] = 0;
+    P[280] = 0;
+    P[281] = 0;
+    P[282] = 0;
+    P[283] = -0.06448215835351764;
+    P[284] = 0;
+    P[285] = 0;
+    P[286] = 0;
+    P[287] = -0.3695518130045147;
+    P[288] = 0;
+    P[289] = 0;
+    P[290] = 0;
+    P[291] = 0;
+    P[292] = -0.15567370122815183;
+    P[293] = 0;
+    P[294] = 0;
+    P[295] = 0;
+    P[296] = 0.15307337294603593;
+    P[297] = 0;
+    P[298] = 0;
+    P[299] = 0;
+    P[300] = 0;
+    P[301] = 0;
+    P[302] = 0;
+    P[303] = 0;
+    P[304] = 0;
+    P[305] = 0;
+    P[306] = 0;
+    P[307] = 0;
+    P[308] = 0;
+    P[309] = 0;
+    P[310] = 0;
+    P[311] = 0;
+    P[312] = 0;
+    P[313] = 0;
+    P[314] = 0;
+    P[315] = 0;
+    P[316] = 0;
+    P[317] = 0;
+    P[318] = 0;
+    P[319] = 0;
+    P[320] = 0;
+    P[321] = 0;
+    P[322] = 0;
+    P[323] = 0;
+    P[324] = 0.15307337294603593;
+    P[325] = 0;
+    P[326] = 0.1778468100084227;
+    P[327] = -0.06448215835351764;
+    P[328] = 0;
+    P[329] = 0;
+    P[330] = -0.15567370122815183;
+    P[331] = 0.07366656073027979;
+    P[332] = 0;
+    P[333] = 0.3695518130045147;
+    P[334] = 0;
+    P[335] = -0.07366656073027979;
+    P[336] = -0.15567370122815183;
+    P[337] = 0;
+    P[338] = 0;
+    P[339] = 0.06448215835351764;
+    P[340] = 0.1778468100084227;
+    P[341] = 0;
+    P[342] = 0;
+    P[343] = 0;
+    P[344] = 0;
+    P[345] = 0;
+    P[346] = 0;
+    P[347] = 0;
+    P[348] = 0;
+    P[349] = 0;
+    P[350] = 0;
+    P[351] = 0.14227744800673817;
+    P[352] = -0.05158572668281411;
+    P[353] = -0.08627540580156096;
+    P[354] = -0.05993437497283845;
+    P[355] = 0;
+    P[356] = 0;
+    P[357] = 0.02482563096610429;
+    P[358] = -0.08735419561824093;
+    P[359] = 0;
+    P[360] = -0.05893324858422384;
+    P[361] = -0.12453896098252146;
+    P[362] = -0.20828725478537083;
+    P[363] = 0.02482563096610429;
+    P[364] = 0;
+    P[365] = 0;
+    P[366] = 0.05993437497283845;
+    P[367] = 0.03618329255526779;
+    P[368] = 0;
+    P[369] = 0;
+    P[370] = 0;
+    P[371] = 0;
+    P[372] = 0;
+    P[373] = 0;
+    P[374] = 0;
+    P[375] = 0;
+    P[376] = 0;
+    P[377] = 0;
+    Q[0] = t12;
+    Q[1] = -1.0*t0;
+    Q[2] = t13;
+    Q[3] = -1.0*T02;
+    Q[4] = 0;
+    Q[5] = 0;
+    Q[6] = 0;
+    Q[7] = 0;
+    Q[8] = 0;
+    Q[9] = 0;
+    Q[10] = 0;
+    Q[11] = 0;
+    Q[12] = t2;
+    Q[13] = T22;
+    Q[14] = 0;
+    Q[15] = 0;
+    Q[16] = t0;
+    Q[17] = t12;
+    Q[18] = T02;
+    Q[19] = t13;
+    Q[20] = 0;
+    Q[21] = 0;
+    Q[22] = 0;
+    Q[23] = 0;
+    Q[24] = t14;
+    Q[25] = t15;
+    Q[26] = t16;
+    Q[27] = t17;
+    Q[28] = 0;
+    Q[29] = 0;
+    Q[30] = t6;
+    Q[31] = t5;
+    Q[32] = 0;
+    Q[33] = 0;
+    Q[34] = 0;
+    Q[35] = 0;
+    Q[36] = -0.4*t2;
+    Q[37] = -0.4*T22;
+    Q[38] = 0;
+    Q[39] = 0;
+    Q[40] = -t15;
+    Q[41] = t14;
+    Q[42] = -t17;
+    Q[43] = t16;
+    Q[44] = 0;
+    Q[45] = 0;
+    Q[46] = -1.0*t5;
+    Q[47] = t6;
+    Q[48] = -0.0648*t1;
+    Q[49] = -0.0648*t0;
+    Q[50] = -0.0648*T12;
+    Q[51] = -0.0648*T02;
+    Q[52] = 0.8*t18 + 0.8*t19 - 0.2536*t2 + t11*t2;
+    Q[53] = 0.8*t20 + 0.8*t21 - 0.2536*T22 + t11*T22;
+    Q[54] = -t22;
+    Q[55] = -t23;
+    Q[56] = t24;
+    Q[57] = t25;
+    Q[58] = t26;
+    Q[59] = t27;
+    Q[60] = -(t18 + t19 + t28 - 0.317*t2);
+    Q[61] = -(t20 + t21 + t29 - 0.317*T22);
+    Q[62] = 0;
+    Q[63] = 0;
+    Q[64] = t31;
+    Q[65] = -(-t32 + t34);
+    Q[66] = t36;
+    Q[67] = -(-t37 + t39);
+    Q[68] = 0;
+    Q[69] = 0;
+    Q[70] = 0;
+    Q[71] = 0;
+    Q[72] = t25;
+    Q[73] = -t24;
+    Q[74] = t27;
+    Q[75] = -t26;
+    Q[76] = t5*t1 - t0*t6;
+    Q[77] = T12*t5 - T02*t6;
+    Q[78] = 0;
+    Q[79] = 0;
+    Q[80] = -t32 + t34;
+    Q[81] = t31;
+    Q[82] = -t37 + t39;
+    Q[83] = t36;
+    Q[84] = -0.081*t2;
+    Q[85] = -0.081*T22;
+    Q[86] = 0;
+    Q[87] = 0;
+    Q[88] = t42 + 0.066072*t1;
+    Q[89] = -t43 - t44 + t46 + 0.066072*t0;
+    Q[90] = t47 + 0.066072*T12;
+    Q[91] = -t48 - t49 + t50 + 0.066072*T02;
+    Q[92] = -(0.162*t28 + t22*t1 - 0.051354*t2 + t23*t0);
+    Q[93] = -(0.162*t29 - 0.051354*T22 + t23*T02 + t22*T12);
+    Q[94] = t51;
+    Q[95] = t52;
+    Q[96] = -(-0.162*t32 + 0.051354*t1 + t22*t2);
+    Q[97] = -(0.051354*t0 - 0.162*t0*t7 + t23*t2);
+    Q[98] = -(-0.162*t37 + 0.051354*T12 + t22*T22);
+    Q[99] = -(0.051354*T02 - 0.162*T02*t7 + t23*T22);
+    Q[100] = 0.634*t18 + 0.634*t19 - 0.253928*t2 + t8*t2 + t9*t2 + t40*t2 - t10*t2 - t18*t53 - t19*t53;
+    Q[101] = 0.634*t20 + 0.634*t21 - 0.253928*T22 + t8*T22 + t9*T22 + t40*T22 - t10*T22 - t20*t53 - t21*t53;
+    Q[102] = 0;
+    Q[103] = 0;
+    Q[104] = -(-t43 - t44 + t46 + 0.05295*t0);
+    Q[105] = t42 + 0.05295*t1;
+    Q[106] = -(-t48 - t49 + t50 + 0.05295*T02);
+    Q[107] = t47 + 0.05295*T12;
+    Q[108] = t23*t1 - t22*t0;
+    Q[109] = t23*T12 - t22*T02;
+    Q[110] = -t52;
+    Q[111] = t51;
+}
+
+void sawyer_ik_general_start_fallback(const sawyer_real T[16], sawyer_real q_free, const sawyer_real angles[5], sawyer_real q[SAWYER_DOF])
+{
+    /* 76 operations */
+
+    /* Inputs */
+    const sawyer_real T00 = T[0];
+    const sawyer_real T01 = T[1];
+    const sawyer_real T02 = T[2];
+    const sawyer_real T10 = T[4];
+    const sawyer_real T11 = T[5];
+    const sawyer_real T12 = T[6];
+    const sawyer_real T20 = T[8];
+    const sawyer_real T21 = T[9];
+    const sawyer_real T22 = T[10];
+    const sawyer_real ga0 = angles[0];
+    const sawyer_real ga1 = angles[1];
+    const sawyer_real ga2 = angles[2];
+    const sawyer_real ga3 = angles[3];
+    const sawyer_real ga4 = angles[4];
+
+    /* Intermediate terms */
+    const sawyer_real q7 = q_free;
+    const sawyer_real c7 = cos(q7);
+    const sawyer_real s7 = sin(q7);
+    const sawyer_real t0 = c7*T00 - s7*T01;
+    const sawyer_real t1 = c7*T10 - s7*T11;
+    const sawyer_real t2 = c7*T20 - s7*T21;
+    const sawyer_real t3 = cos(ga3);
+    const sawyer_real t4 = sin(ga3);
+    const sawyer_real t5 = cos(ga4);
+    const sawyer_real t6 = sin(ga4);
+    const sawyer_real t7 = 1.1780972450961724 + ga0;
+    const sawyer_real t8 = cos(t7);
+    const sawyer_real t9 = t8*t5;
+    const sawyer_real t10 = t8*t6;
+    const sawyer_real t11 = sin(t7);
+    const sawyer_real t12 = t11*t5;
+    const sawyer_real t13 = t11*t6;
+    const sawyer_real t14 = sin(ga1);
+    const sawyer_real t15 = t11*t14;
+    const sawyer_real t16 = cos(ga1);
+    const sawyer_real t17 = t14*t6 + t16*t9;
+    const sawyer_real t18 = t16*t6 - t14*t9;
+    const sawyer_real t19 = t16*t10 - t14*t5;
+    const sawyer_real t20 = t16*t5 + t14*t10;
+    const sawyer_real t21 = t11*t16;
+    const sawyer_real t22 = -t3*(-t1*t20 + t0*t18 + t2*t15) + t4*(-T12*t20 + T02*t18 + T22*t15);
+    const sawyer_real t23 = sin(ga2);
+    const sawyer_real t24 = cos(ga2);
+    const sawyer_real t25 = t23*t12 + t24*t17;
+    const sawyer_real t26 = t23*t13 + t24*t19;
+    const sawyer_real t27 = -t24*t21 + t8*t23;
+    const sawyer_real t28 = t3*(t0*t25 + t1*t26 + t2*t27) - t4*(T02*t25 + T12*t26 + T22*t27);
+
+    /* Outputs */
+    q[0] = ga4;
+    q[1] = t7;
+    q[2] = ga1;
+    q[3] = ga2;
+    q[4] = atan2(t22, t28);
+    q[5] = ga3;
+    q[6] = q7;
+}
+
 void sawyer_ik_general_residual(const sawyer_real target[16], const sawyer_real q[SAWYER_DOF], sawyer_real e[6], sawyer_real J[6 * 6])
 {
     /* 306 operations */
@@ -7490,7 +8137,7 @@ static sawyer_real sawyer_ik_general_polish(const sawyer_real T[16], sawyer_real
     return cost;
 }
 
-/* The general 6R solver's working memory: 21840 bytes in this build. A local of
+/* The general 6R solver's working memory: 22992 bytes in this build. A local of
  * sawyer_ik_branches (on its stack) unless SAWYER_IK_STATIC_WORK is defined: then one static
  * object, and sawyer_ik_branches (with sawyer_ik and sawyer_ik_nearest) is not reentrant. */
 struct sawyer_ik_work {
@@ -7504,7 +8151,9 @@ static struct sawyer_ik_work sawyer_ik_static_work;
 
 /* The general 6R solver: the equations at T, the kernel's
  * roots (jacgen_general6r_roots, in double), each completed to a configuration, polished by
- * Newton steps and kept when it reaches T, once; the valid rows first. */
+ * Newton steps and kept when it reaches T, once; the valid rows first. Where the leading
+ * matrix is singular to rounding (condition above JACGEN_G6_DEGENERATE), the roots are those of
+ * the fallback elimination, another joint hidden. */
 void sawyer_ik_branches(const sawyer_real T[16], sawyer_real q_free, sawyer_real q[SAWYER_MAX_IK_SOLUTIONS * SAWYER_DOF],
                      int valid[SAWYER_MAX_IK_SOLUTIONS], int in_limits[SAWYER_MAX_IK_SOLUTIONS])
 {
@@ -7514,15 +8163,26 @@ void sawyer_ik_branches(const sawyer_real T[16], sawyer_real q_free, sawyer_real
     struct sawyer_ik_work work, *w = &work;
 #endif
     sawyer_real angles[5], x[SAWYER_DOF];
-    int count = 0, found, i, j, k;
+    double condition;
+    int count = 0, found, i, j, k, fallback;
     sawyer_ik_general_clear(q, valid, in_limits);
     sawyer_ik_general_equations(T, q_free, w->P, w->Q);
     for (i = 0; i < 378; ++i) w->p[i / 126][i / 9 % 14][i % 9] = (double)w->P[i];
     for (i = 0; i < 112; ++i) w->q[i / 8][i % 8] = (double)w->Q[i];
-    found = jacgen_general6r_roots(w->p, w->q, w->roots, &w->kernel);
+    found = jacgen_general6r_roots(w->p, w->q, w->roots, &w->kernel, &condition);
+    fallback = !(condition <= JACGEN_G6_DEGENERATE);
+    if (fallback) {
+        sawyer_ik_general_equations_fallback(T, q_free, w->P, w->Q);
+        for (i = 0; i < 378; ++i) w->p[i / 126][i / 9 % 14][i % 9] = (double)w->P[i];
+        for (i = 0; i < 112; ++i) w->q[i / 8][i % 8] = (double)w->Q[i];
+        found = jacgen_general6r_roots(w->p, w->q, w->roots, &w->kernel, &condition);
+    }
     for (k = 0; k < found && count < SAWYER_MAX_IK_SOLUTIONS; ++k) {
         for (j = 0; j < 5; ++j) angles[j] = (sawyer_real)w->roots[k][j];
-        sawyer_ik_general_start(T, q_free, angles, x);
+        if (fallback)
+            sawyer_ik_general_start_fallback(T, q_free, angles, x);
+        else
+            sawyer_ik_general_start(T, q_free, angles, x);
         if (!(sawyer_ik_general_polish(T, x, sawyer_ik_general_newton(T, x), 6)
               <= 1e-18)) continue;
         count += sawyer_ik_general_add(x, count, q, valid, in_limits);

@@ -5578,6 +5578,636 @@ def ik_general_start(T, q_free, angles):
     return q
 
 
+def ik_general_equations_fallback(T, q_free):
+    """the general 6R solver's equations at T, by the fallback elimination (for targets where the first's leading matrix is singular to rounding): (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9): (42 x 9 and 14 x 8), 286 operations."""
+    xp, dtype, device, batch, (T, q_free,) = _arguments(("T", T, (4, 4)), ("q_free", q_free, ()))
+    T00 = T[..., 0, 0]
+    T01 = T[..., 0, 1]
+    T02 = T[..., 0, 2]
+    T03 = T[..., 0, 3]
+    T10 = T[..., 1, 0]
+    T11 = T[..., 1, 1]
+    T12 = T[..., 1, 2]
+    T13 = T[..., 1, 3]
+    T20 = T[..., 2, 0]
+    T21 = T[..., 2, 1]
+    T22 = T[..., 2, 2]
+    T23 = T[..., 2, 3]
+    q7 = q_free
+    c7 = xp.cos(q7)
+    s7 = xp.sin(q7)
+    t0 = c7*T00 - s7*T01
+    t1 = c7*T10 - s7*T11
+    t2 = c7*T20 - s7*T21
+    t3 = 0.1363*s7
+    t4 = 0.1363*c7
+    t5 = -0.13375*T02 + T03 + t3*T00 + t4*T01
+    t6 = -0.13375*T12 + T13 + t3*T10 + t4*T11
+    t7 = -0.13375*T22 + T23 + t3*T20 + t4*T21
+    t8 = t5**2
+    t9 = t6**2
+    t10 = t7**2
+    t11 = 0.8*t7
+    t12 = -1.0*t1
+    t13 = -1.0*T12
+    t14 = 0.4*t1
+    t15 = 0.4*t0
+    t16 = 0.4*T12
+    t17 = 0.4*T02
+    t18 = t0*t5
+    t19 = t1*t6
+    t20 = T02*t5
+    t21 = T12*t6
+    t22 = 0.162*t6
+    t23 = 0.162*t5
+    t24 = 0.081*t1
+    t25 = 0.081*t0
+    t26 = 0.081*T12
+    t27 = 0.081*T02
+    t28 = t2*t7
+    t29 = T22*t7
+    t30 = t5*t2
+    t31 = t30 + 0.317*t0 - t0*t7
+    t32 = t1*t7
+    t33 = t6*t2
+    t34 = t33 + 0.317*t1
+    t35 = T22*t5
+    t36 = t35 + 0.317*T02 - T02*t7
+    t37 = T12*t7
+    t38 = T22*t6
+    t39 = t38 + 0.317*T12
+    t40 = 0.634*t7
+    t41 = 2.0*t6
+    t42 = -0.634*t33 + t40*t1 + t9*t1 - t8*t1 - t10*t1 + t18*t41 + t28*t41
+    t43 = t9*t0
+    t44 = t10*t0
+    t45 = 2.0*t5
+    t46 = -0.634*t30 + t40*t0 + t8*t0 + t19*t45 + t28*t45
+    t47 = -0.634*t38 + t9*T12 + t40*T12 - t8*T12 - t10*T12 + t20*t41 + t29*t41
+    t48 = t9*T02
+    t49 = t10*T02
+    t50 = -0.634*t35 + t8*T02 + t40*T02 + t21*t45 + t29*t45
+    t51 = 0.8*t6
+    t52 = 0.8*t5
+    t53 = 2.0*t7
+    P = _stack(xp, [
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 8
+        xp.full(batch, 1.0, dtype=dtype, device=device),  # 2, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 7
+        xp.full(batch, 0.081, dtype=dtype, device=device),  # 3, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 7
+        -0.317 + t7,  # 4, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4
+        xp.full(batch, -0.1685, dtype=dtype, device=device),  # 5, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 7
+        xp.full(batch, 0.1925, dtype=dtype, device=device),  # 5, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 4
+        xp.full(batch, -0.0648725, dtype=dtype, device=device),  # 6, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 6, 7
+        -(0.0416015 + t8 + t9 + t10 - 0.634*t7),  # 6, 8
+        xp.full(batch, 0.1925, dtype=dtype, device=device),  # 7, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 6
+        xp.full(batch, -0.4, dtype=dtype, device=device),  # 7, 7
+        xp.full(batch, 0.4, dtype=dtype, device=device),  # 7, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 0
+        xp.full(batch, 0.1685, dtype=dtype, device=device),  # 10, 1
+        xp.full(batch, 0.4, dtype=dtype, device=device),  # 10, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 11, 7
+        xp.full(batch, 0.0648, dtype=dtype, device=device),  # 11, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 7
+        -0.2536 + t11,  # 12, 8
+        xp.full(batch, 0.151336, dtype=dtype, device=device),  # 13, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 13, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 13, 2
+        xp.full(batch, -0.1348, dtype=dtype, device=device),  # 13, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 13, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 13, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 13, 6
+        xp.full(batch, 0.154, dtype=dtype, device=device),  # 13, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 13, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 1
+        xp.full(batch, 0.9238795325112867, dtype=dtype, device=device),  # 14, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 6
+        xp.full(batch, 0.38268343236508984, dtype=dtype, device=device),  # 14, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 1
+        xp.full(batch, -0.38268343236508984, dtype=dtype, device=device),  # 15, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 6
+        xp.full(batch, 0.9238795325112867, dtype=dtype, device=device),  # 15, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 16, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 17, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 17, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 17, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 17, 3
+        xp.full(batch, 0.15567370122815183, dtype=dtype, device=device),  # 17, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 17, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 17, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 17, 7
+        xp.full(batch, -0.15307337294603593, dtype=dtype, device=device),  # 17, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 3
+        xp.full(batch, -0.06448215835351764, dtype=dtype, device=device),  # 18, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 7
+        xp.full(batch, -0.3695518130045147, dtype=dtype, device=device),  # 18, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 19, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 20, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 21, 8
+        xp.full(batch, -0.3695518130045147, dtype=dtype, device=device),  # 22, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 22, 1
+        xp.full(batch, 0.07366656073027979, dtype=dtype, device=device),  # 22, 2
+        xp.full(batch, 0.15567370122815183, dtype=dtype, device=device),  # 22, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 22, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 22, 5
+        xp.full(batch, -0.06448215835351764, dtype=dtype, device=device),  # 22, 6
+        xp.full(batch, -0.1778468100084227, dtype=dtype, device=device),  # 22, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 22, 8
+        xp.full(batch, 0.15307337294603593, dtype=dtype, device=device),  # 23, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 23, 1
+        xp.full(batch, 0.1778468100084227, dtype=dtype, device=device),  # 23, 2
+        xp.full(batch, -0.06448215835351764, dtype=dtype, device=device),  # 23, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 23, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 23, 5
+        xp.full(batch, -0.15567370122815183, dtype=dtype, device=device),  # 23, 6
+        xp.full(batch, 0.07366656073027979, dtype=dtype, device=device),  # 23, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 23, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 24, 8
+        xp.full(batch, 0.05893324858422384, dtype=dtype, device=device),  # 25, 0
+        xp.full(batch, 0.12453896098252146, dtype=dtype, device=device),  # 25, 1
+        xp.full(batch, 0.20828725478537083, dtype=dtype, device=device),  # 25, 2
+        xp.full(batch, -0.02482563096610429, dtype=dtype, device=device),  # 25, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 25, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 25, 5
+        xp.full(batch, -0.05993437497283845, dtype=dtype, device=device),  # 25, 6
+        xp.full(batch, -0.03618329255526779, dtype=dtype, device=device),  # 25, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 25, 8
+        xp.full(batch, 0.14227744800673817, dtype=dtype, device=device),  # 26, 0
+        xp.full(batch, -0.05158572668281411, dtype=dtype, device=device),  # 26, 1
+        xp.full(batch, -0.08627540580156096, dtype=dtype, device=device),  # 26, 2
+        xp.full(batch, -0.05993437497283845, dtype=dtype, device=device),  # 26, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 26, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 26, 5
+        xp.full(batch, 0.02482563096610429, dtype=dtype, device=device),  # 26, 6
+        xp.full(batch, -0.08735419561824093, dtype=dtype, device=device),  # 26, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 26, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 27, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 1
+        xp.full(batch, -0.38268343236508984, dtype=dtype, device=device),  # 28, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 6
+        xp.full(batch, 0.9238795325112867, dtype=dtype, device=device),  # 28, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 1
+        xp.full(batch, -0.9238795325112867, dtype=dtype, device=device),  # 29, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 6
+        xp.full(batch, -0.38268343236508984, dtype=dtype, device=device),  # 29, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 30, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 3
+        xp.full(batch, -0.06448215835351764, dtype=dtype, device=device),  # 31, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 7
+        xp.full(batch, -0.3695518130045147, dtype=dtype, device=device),  # 31, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 32, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 32, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 32, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 32, 3
+        xp.full(batch, -0.15567370122815183, dtype=dtype, device=device),  # 32, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 32, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 32, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 32, 7
+        xp.full(batch, 0.15307337294603593, dtype=dtype, device=device),  # 32, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 33, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 34, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 35, 8
+        xp.full(batch, 0.15307337294603593, dtype=dtype, device=device),  # 36, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 36, 1
+        xp.full(batch, 0.1778468100084227, dtype=dtype, device=device),  # 36, 2
+        xp.full(batch, -0.06448215835351764, dtype=dtype, device=device),  # 36, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 36, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 36, 5
+        xp.full(batch, -0.15567370122815183, dtype=dtype, device=device),  # 36, 6
+        xp.full(batch, 0.07366656073027979, dtype=dtype, device=device),  # 36, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 36, 8
+        xp.full(batch, 0.3695518130045147, dtype=dtype, device=device),  # 37, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 37, 1
+        xp.full(batch, -0.07366656073027979, dtype=dtype, device=device),  # 37, 2
+        xp.full(batch, -0.15567370122815183, dtype=dtype, device=device),  # 37, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 37, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 37, 5
+        xp.full(batch, 0.06448215835351764, dtype=dtype, device=device),  # 37, 6
+        xp.full(batch, 0.1778468100084227, dtype=dtype, device=device),  # 37, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 37, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 38, 8
+        xp.full(batch, 0.14227744800673817, dtype=dtype, device=device),  # 39, 0
+        xp.full(batch, -0.05158572668281411, dtype=dtype, device=device),  # 39, 1
+        xp.full(batch, -0.08627540580156096, dtype=dtype, device=device),  # 39, 2
+        xp.full(batch, -0.05993437497283845, dtype=dtype, device=device),  # 39, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 39, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 39, 5
+        xp.full(batch, 0.02482563096610429, dtype=dtype, device=device),  # 39, 6
+        xp.full(batch, -0.08735419561824093, dtype=dtype, device=device),  # 39, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 39, 8
+        xp.full(batch, -0.05893324858422384, dtype=dtype, device=device),  # 40, 0
+        xp.full(batch, -0.12453896098252146, dtype=dtype, device=device),  # 40, 1
+        xp.full(batch, -0.20828725478537083, dtype=dtype, device=device),  # 40, 2
+        xp.full(batch, 0.02482563096610429, dtype=dtype, device=device),  # 40, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 40, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 40, 5
+        xp.full(batch, 0.05993437497283845, dtype=dtype, device=device),  # 40, 6
+        xp.full(batch, 0.03618329255526779, dtype=dtype, device=device),  # 40, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 40, 8
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 41, 8
+    ], (42, 9))
+    Q = _stack(xp, [
+        t12,  # 0, 0
+        -1.0*t0,  # 0, 1
+        t13,  # 0, 2
+        -1.0*T02,  # 0, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 0, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 3
+        t2,  # 1, 4
+        T22,  # 1, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 1, 7
+        t0,  # 2, 0
+        t12,  # 2, 1
+        T02,  # 2, 2
+        t13,  # 2, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 2, 7
+        t14,  # 3, 0
+        t15,  # 3, 1
+        t16,  # 3, 2
+        t17,  # 3, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 3, 5
+        t6,  # 3, 6
+        t5,  # 3, 7
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 0
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 1
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 2
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 3
+        -0.4*t2,  # 4, 4
+        -0.4*T22,  # 4, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 4, 7
+        -t15,  # 5, 0
+        t14,  # 5, 1
+        -t17,  # 5, 2
+        t16,  # 5, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 5, 5
+        -1.0*t5,  # 5, 6
+        t6,  # 5, 7
+        -0.0648*t1,  # 6, 0
+        -0.0648*t0,  # 6, 1
+        -0.0648*T12,  # 6, 2
+        -0.0648*T02,  # 6, 3
+        0.8*t18 + 0.8*t19 - 0.2536*t2 + t11*t2,  # 6, 4
+        0.8*t20 + 0.8*t21 - 0.2536*T22 + t11*T22,  # 6, 5
+        -t22,  # 6, 6
+        -t23,  # 6, 7
+        t24,  # 7, 0
+        t25,  # 7, 1
+        t26,  # 7, 2
+        t27,  # 7, 3
+        -(t18 + t19 + t28 - 0.317*t2),  # 7, 4
+        -(t20 + t21 + t29 - 0.317*T22),  # 7, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 7, 7
+        t31,  # 8, 0
+        -(-t32 + t34),  # 8, 1
+        t36,  # 8, 2
+        -(-t37 + t39),  # 8, 3
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 4
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 8, 7
+        t25,  # 9, 0
+        -t24,  # 9, 1
+        t27,  # 9, 2
+        -t26,  # 9, 3
+        t5*t1 - t0*t6,  # 9, 4
+        T12*t5 - T02*t6,  # 9, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 9, 7
+        -t32 + t34,  # 10, 0
+        t31,  # 10, 1
+        -t37 + t39,  # 10, 2
+        t36,  # 10, 3
+        -0.081*t2,  # 10, 4
+        -0.081*T22,  # 10, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 10, 7
+        t42 + 0.066072*t1,  # 11, 0
+        -t43 - t44 + t46 + 0.066072*t0,  # 11, 1
+        t47 + 0.066072*T12,  # 11, 2
+        -t48 - t49 + t50 + 0.066072*T02,  # 11, 3
+        -(0.162*t28 + t22*t1 - 0.051354*t2 + t23*t0),  # 11, 4
+        -(0.162*t29 - 0.051354*T22 + t23*T02 + t22*T12),  # 11, 5
+        t51,  # 11, 6
+        t52,  # 11, 7
+        -(-0.162*t32 + 0.051354*t1 + t22*t2),  # 12, 0
+        -(0.051354*t0 - 0.162*t0*t7 + t23*t2),  # 12, 1
+        -(-0.162*t37 + 0.051354*T12 + t22*T22),  # 12, 2
+        -(0.051354*T02 - 0.162*T02*t7 + t23*T22),  # 12, 3
+        0.634*t18 + 0.634*t19 - 0.253928*t2 + t8*t2 + t9*t2 + t40*t2 - t10*t2 - t18*t53 - t19*t53,  # 12, 4
+        0.634*t20 + 0.634*t21 - 0.253928*T22 + t8*T22 + t9*T22 + t40*T22 - t10*T22 - t20*t53 - t21*t53,  # 12, 5
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 6
+        xp.full(batch, 0, dtype=dtype, device=device),  # 12, 7
+        -(-t43 - t44 + t46 + 0.05295*t0),  # 13, 0
+        t42 + 0.05295*t1,  # 13, 1
+        -(-t48 - t49 + t50 + 0.05295*T02),  # 13, 2
+        t47 + 0.05295*T12,  # 13, 3
+        t23*t1 - t22*t0,  # 13, 4
+        t23*T12 - t22*T02,  # 13, 5
+        -t52,  # 13, 6
+        t51,  # 13, 7
+    ], (14, 8))
+    return P, Q
+
+
+def ik_general_start_fallback(T, q_free, angles):
+    """the configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop), by the fallback elimination (for targets where the first's leading matrix is singular to rounding): (7 x 1), 76 operations."""
+    xp, dtype, device, batch, (T, q_free, angles,) = _arguments(("T", T, (4, 4)), ("q_free", q_free, ()), ("angles", angles, (5,)))
+    T00 = T[..., 0, 0]
+    T01 = T[..., 0, 1]
+    T02 = T[..., 0, 2]
+    T10 = T[..., 1, 0]
+    T11 = T[..., 1, 1]
+    T12 = T[..., 1, 2]
+    T20 = T[..., 2, 0]
+    T21 = T[..., 2, 1]
+    T22 = T[..., 2, 2]
+    ga0 = angles[..., 0]
+    ga1 = angles[..., 1]
+    ga2 = angles[..., 2]
+    ga3 = angles[..., 3]
+    ga4 = angles[..., 4]
+    q7 = q_free
+    c7 = xp.cos(q7)
+    s7 = xp.sin(q7)
+    t0 = c7*T00 - s7*T01
+    t1 = c7*T10 - s7*T11
+    t2 = c7*T20 - s7*T21
+    t3 = xp.cos(ga3)
+    t4 = xp.sin(ga3)
+    t5 = xp.cos(ga4)
+    t6 = xp.sin(ga4)
+    t7 = 1.1780972450961724 + ga0
+    t8 = xp.cos(t7)
+    t9 = t8*t5
+    t10 = t8*t6
+    t11 = xp.sin(t7)
+    t12 = t11*t5
+    t13 = t11*t6
+    t14 = xp.sin(ga1)
+    t15 = t11*t14
+    t16 = xp.cos(ga1)
+    t17 = t14*t6 + t16*t9
+    t18 = t16*t6 - t14*t9
+    t19 = t16*t10 - t14*t5
+    t20 = t16*t5 + t14*t10
+    t21 = t11*t16
+    t22 = -t3*(-t1*t20 + t0*t18 + t2*t15) + t4*(-T12*t20 + T02*t18 + T22*t15)
+    t23 = xp.sin(ga2)
+    t24 = xp.cos(ga2)
+    t25 = t23*t12 + t24*t17
+    t26 = t23*t13 + t24*t19
+    t27 = -t24*t21 + t8*t23
+    t28 = t3*(t0*t25 + t1*t26 + t2*t27) - t4*(T02*t25 + T12*t26 + T22*t27)
+    q = _stack(xp, [
+        xp.broadcast_to(ga4, batch),  # 0
+        xp.broadcast_to(t7, batch),  # 1
+        xp.broadcast_to(ga1, batch),  # 2
+        xp.broadcast_to(ga2, batch),  # 3
+        xp.broadcast_to(xp.atan2(t22, t28), batch),  # 4
+        xp.broadcast_to(ga3, batch),  # 5
+        xp.broadcast_to(q7, batch),  # 6
+    ], (7,))
+    return q
+
+
 @numpy.errstate(invalid="ignore", divide="ignore")  # both sides of a select are computed
 def ik_general_residual(target, q):
     """the pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J of the six joints ik solves: the Newton step of the solver's polish is q + J^-1 e: (6 x 1 and 6 x 6), 306 operations."""
@@ -6704,6 +7334,7 @@ _ALONG_C, _ALONG_B = numpy.array([0, 1, 3, 4, 6, 7, 9, 10]), numpy.array([0, 1, 
 _NEWTON_STEPS = 6
 _TOLERANCE_SQUARED = 1e-18  # |pose error|^2 of a solution after the Newton steps
 _CONVERGED_SQUARED = 8.003523902500002e-24  # |pose error|^2 at which the Newton steps stop
+_DEGENERATE = 10000000.0  # a leading matrix above this condition number takes the fallback elimination
 
 
 def _twelve(s):
@@ -6726,8 +7357,9 @@ def _ratio(w, starts, step):
 
 def _roots(P, Q):
     """The loop angles (a - shift, b, c, g, h) of the 16 eigenvalues nearest the real axis
-    (..., 16, 5) and which are real (..., 16), from the equations at the targets (P: ..., 3, 14,
-    9; Q: ..., 14, 8). Of the 24, eight are always +-i (the half-angle substitution's
+    (..., 16, 5), which are real (..., 16), and the leading matrix's 1-norm condition number
+    (...; infinite where it is singular), from the equations at the targets (P: ..., 3, 14, 9;
+    Q: ..., 14, 8). Of the 24, eight are always +-i (the half-angle substitution's
     (1 + x^2)^4), so the real ones are among those 16."""
     orthogonal, r = numpy.linalg.qr(Q, mode="complete")
     free = numpy.swapaxes(orthogonal[..., 8:], -1, -2)  # six combinations free of v_gh
@@ -6735,6 +7367,7 @@ def _roots(P, Q):
     m2, m1, m0 = _twelve(s0 - sc), _twelve(2.0 * ss), _twelve(s0 + sc)
     lead = numpy.abs(numpy.linalg.det(m2)) > 0.0
     m2 = numpy.where(lead[..., None, None], m2, numpy.eye(12))
+    condition = numpy.where(lead, numpy.linalg.cond(m2, 1), numpy.inf)
     companion = numpy.zeros((*m2.shape[:-2], 24, 24))
     companion[..., :12, 12:] = numpy.eye(12)
     companion[..., 12:, :12], companion[..., 12:, 12:] = -numpy.linalg.solve(m2, m0), -numpy.linalg.solve(m2, m1)
@@ -6757,7 +7390,16 @@ def _roots(P, Q):
     v_gh = numpy.swapaxes(numpy.linalg.solve(r8, numpy.swapaxes(projected, -1, -2)), -1, -2)
     angles = numpy.stack([a, b, c, numpy.arctan2(v_gh[..., 4], v_gh[..., 5]), numpy.arctan2(v_gh[..., 6], v_gh[..., 7])],
                          axis=-1)
-    return angles, real
+    return angles, real, condition
+
+
+def _eigenproblem(equations):
+    """_roots of the equations (P, Q) that ik_general_equations gives; a target that is not
+    finite has none (its P and Q zeros: a singular leading matrix)."""
+    P, Q = equations
+    finite = (numpy.isfinite(P).all(axis=(-2, -1)) & numpy.isfinite(Q).all(axis=(-2, -1)))[..., None, None]
+    P, Q = numpy.where(finite, P, 0.0), numpy.where(finite, Q, 0.0)
+    return _roots(numpy.reshape(P, (*P.shape[:-2], 3, 14, 9)), Q)
 
 
 def _newton(targets, q):
@@ -6784,12 +7426,14 @@ def _polish(targets, q, cost, steps):
 def _general_branches(T, q_free):
     """The eigenproblem's solutions at targets T (..., 4, 4): q (..., 16, DOF) and valid (..., 16),
     each solution once (the first of equal ones), after up to 6 Newton steps within 1e-09."""
-    P, Q = ik_general_equations(T, q_free)
-    finite = (numpy.isfinite(P).all(axis=(-2, -1)) & numpy.isfinite(Q).all(axis=(-2, -1)))[..., None, None]
-    P, Q = numpy.where(finite, P, 0.0), numpy.where(finite, Q, 0.0)  # no root: a singular leading matrix
-    angles, real = _roots(numpy.reshape(P, (*P.shape[:-2], 3, 14, 9)), Q)
+    angles, real, condition = _eigenproblem(ik_general_equations(T, q_free))
     targets = T[..., None, :, :]
     q = ik_general_start(targets, q_free[..., None], angles)
+    degenerate = ~(condition <= _DEGENERATE)  # a leading matrix singular to rounding: the fallback's roots
+    if degenerate.any():
+        T_d, q_free_d = T[degenerate], numpy.broadcast_to(q_free, degenerate.shape)[degenerate]
+        angles_d, real[degenerate], _ = _eigenproblem(ik_general_equations_fallback(T_d, q_free_d))
+        q[degenerate] = ik_general_start_fallback(T_d[..., None, :, :], q_free_d[..., None], angles_d)
     cost, q = _newton(targets, q)
     cost, q = _polish(targets, q, cost, _NEWTON_STEPS)
     return q, _first_of_equals(q, real & (cost <= _TOLERANCE_SQUARED))

@@ -92,6 +92,7 @@ EXTENTS = {
     "ik_numeric_step.q_start": ("DOF",),
     "ik_numeric_step.q_next": ("DOF",),
     "ik_general_start.q": ("DOF",),
+    "ik_general_start_fallback.q": ("DOF",),
     "ik_general_residual.e": (6,),
     "ik_general_residual.J": (6, 6),
     "ik_general_limits.q": ("DOF",),

@@ -131,16 +131,23 @@ class Generator:
         joint (`free_input`, bound by `bindings`) is in the chain's head or tail."""
         form = self.closed_form
         six = form.joints  # the robot's joint of each of the chain's six
-        n, stacked, q = general6r_target.equations_at(self.robot, form, target.symbols, self.name)
-        equations_function = self.function(
-            "ik_general_equations", "the general 6R solver's equations at T: (P0 + s Ps + c Pc) v_bc = Q v_gh, "
-            "P = [P0; Ps; Pc] (42 x 9)", matrix("P", stacked), matrix("Q", q), arguments=(target, *free_input), bindings=bindings,
-            part_of="ik_branches")
         angles = Argument("angles", sympy.Matrix([generated_symbol("ga", k) for k in range(5)]))
-        q = general6r_target.loop_configuration(self.robot, form, n, angles.symbols, self.q, self.name)
-        start = self.function("ik_general_start", "the configuration of one root's loop angles (a - shift, b, c, "
-                              "g, h; the loop's free joint from the loop)", vector("q", q),
-                              arguments=(target, *free_input, angles), bindings=bindings, part_of="ik_branches")
+        plans = [("", form.elimination, "")]
+        if form.elimination.fallback is not None:
+            plans.append(("_fallback", form.elimination.fallback, ", by the fallback elimination (for targets where "
+                          "the first's leading matrix is singular to rounding)"))
+        parts = []
+        for suffix, plan, which in plans:
+            n, stacked, q = general6r_target.equations_at(self.robot, form, plan, target.symbols, self.name)
+            parts.append(self.function(
+                f"ik_general_equations{suffix}", f"the general 6R solver's equations at T{which}: (P0 + s Ps + c Pc) "
+                "v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9)", matrix("P", stacked), matrix("Q", q),
+                arguments=(target, *free_input), bindings=bindings, part_of="ik_branches"))
+            q = general6r_target.loop_configuration(self.robot, form, plan, n, angles.symbols, self.q, self.name)
+            parts.append(self.function(
+                f"ik_general_start{suffix}", f"the configuration of one root's loop angles (a - shift, b, c, g, h; "
+                f"the loop's free joint from the loop){which}", vector("q", q),
+                arguments=(target, *free_input, angles), bindings=bindings, part_of="ik_branches"))
         dof = self.robot.dof
         target_pose = self._ik_target()
         given = Argument("q", sympy.Matrix([generated_symbol("qs", i + 1) for i in range(dof)]))
@@ -157,7 +164,7 @@ class Generator:
                                "and whether it is inside the joint limits", vector("q", limited),
                                scalar("in_limits", inside), arguments=(given,),
                                part_of="ik_branches")
-        parts = [equations_function, start, step, limits]
+        parts += [step, limits]
         if form.fast_path:
             free_angle = None if form.free is None else self.q[form.free]
             q, valid, certified = general6r_target.nominal_branches(form, sp, target.symbols, free_angle,

@@ -157,7 +157,7 @@ def ik_lines(model: Model) -> list[str]:
     if structure.solver == "general_6r":
         if form is None:
             return [f"no closed form ({structure.reason}, but no split of its loop is conditioned well enough "
-                    f"for it: see general6r.WORST_CONDITION); ik_numeric only"]
+                    f"for it: see general6r_plan.WORST_CONDITION); ik_numeric only"]
         plan = form.elimination
         free = "" if form.free is None else f", joint {form.free + 1} free (an input of ik, q_free)"
         return [f"general 6R{free}: {info.max_solutions} solutions at most ({structure.reason})",

@@ -114,19 +114,23 @@ class Equations:
     terms: tuple[tuple[int, int, tuple[int, ...], object], ...]
 
     @cached_property
-    def _arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The terms' exponents and coefficients, sorted by the entry they add to; each entry
+        that has terms, and where its terms start."""
         matrix, entry, exponents, coefficients = zip(*self.terms)
-        return (np.array(exponents, dtype=float), np.array([float(c) for c in coefficients]),
-                np.array(matrix) * 14 * 9 + np.array(entry))
+        entries = np.array(matrix) * 14 * 9 + np.array(entry)
+        order = np.argsort(entries, kind="stable")
+        present, starts = np.unique(entries[order], return_index=True)
+        return (np.array(exponents, dtype=float)[order], np.array([float(c) for c in coefficients])[order], present,
+                starts)
 
     def evaluated(self, targets: np.ndarray) -> np.ndarray:
         """p0, ps, pc, q at a batch of V's (..., 12: rotation by rows, then translation), as an
         array (..., 4, 14, 9) (q's last column zero)."""
-        exponents, coefficients, entries = self._arrays
+        exponents, coefficients, present, starts = self._arrays
         values = coefficients * np.prod(targets[..., None, :] ** exponents, axis=-1)
         out = np.zeros((*targets.shape[:-1], 4 * 14 * 9))
-        for entry in np.unique(entries):  # a few hundred entries: sum their terms
-            out[..., entry] = values[..., entries == entry].sum(-1)
+        out[..., present] = np.add.reduceat(values, starts, axis=-1)  # each entry's terms summed
         return out.reshape(*targets.shape[:-1], 4, 14, 9)
 
     @cached_property
@@ -353,57 +357,7 @@ def shifted(ps: np.ndarray, pc: np.ndarray, shift: float) -> tuple[np.ndarray, n
     return cos * ps - sin * pc, sin * ps + cos * pc
 
 
-SAMPLES = 24  # random configurations that rate a split
-WORST_CONDITION = 1e8  # a robot whose best split rates worse gets no general solver (ik_numeric only)
-SHIFTS = 16  # origins of the hidden joint's half angle tried per split: multiples of 2 pi / SHIFTS
-TIE = 0.01  # a later candidate must rate 1% better: near ties (a shift and the shift + pi) go to the
-# first, not to rounding noise of the machine's LAPACK, so that generated code is the same everywhere
-
-
-@dataclass(frozen=True)
-class Elimination:
-    """A split's equations and the shift of its hidden angle (theta_a = shift + 2 atan(x)) that
-    make the leading matrix, Q and the null vector best conditioned: `condition` is the largest
-    of their median condition numbers over random configurations."""
-
-    equations: Equations
-    shift: float
-    condition: float
-
-
-def elimination(robot: Robot, free: int | None = None) -> Elimination:
-    """The best conditioned of the 12 splits and 16 shifts (a matrix polynomial singular for
-    every x, as the Jaco's is for the textbook split, rates as badly as a singular leading
-    matrix; so do a Q of rank below 8, from which v_gh cannot be read back, and equations
-whose null space at a root has more than one vector, from which v_bc cannot). Derivations are milliseconds each; the rating is a few hundred 12 x 12
-    condition numbers."""
-    head, links, tail = chain_form(robot, free)
-    theta = np.random.default_rng(0).uniform(-np.pi, np.pi, (SAMPLES, 6))
-    n = _numeric_chain(links, theta)
-    best = None
-    for split in SPLITS:
-        equations_ = equations(links, split)
-        v = np.linalg.inv(n) if split.target_inverted else n
-        p0, ps, pc, q = np.moveaxis(equations_.evaluated(np.concatenate([v[:, :3, :3].reshape(-1, 9), v[:, :3, 3]], 1)), 1, 0)
-        left, values = np.linalg.svd(q[..., :8])[:2]
-        left_null = np.swapaxes(left[..., 8:], -1, -2)
-        s0, ss, sc = left_null @ p0, left_null @ ps, left_null @ pc
-        pair = float(np.median(values[..., 0] / np.maximum(values[..., -1], 1e-300)))  # v_gh from Q's columns
-        # v_bc from the null vector of the equations at the configuration's own theta_a: one vector
-        hidden = theta[:, split.joint(split.hidden)] * (-1 if split.backwards else 1)
-        at_root = half_angle(s0 + np.sin(hidden)[:, None, None] * ss + np.cos(hidden)[:, None, None] * sc)
-        singular = np.linalg.svd(at_root, compute_uv=False)
-        vector = float(np.median(singular[..., 0] / np.maximum(singular[..., -2], 1e-300)))
-        for k in range(SHIFTS):
-            shift = 2 * np.pi * k / SHIFTS
-            leading = np.median(np.linalg.cond(half_angle(s0 - shifted(ss, sc, shift)[1])))
-            condition = float(max(leading, pair, vector))
-            if best is None or condition < best.condition * (1 - TIE):
-                best = Elimination(equations_, shift, condition)
-    return best
-
-
-def _numeric_chain(links: list[Link], theta: np.ndarray) -> np.ndarray:
+def chain_product(links: list[Link], theta: np.ndarray) -> np.ndarray:
     """Z1 C1 ... Zk Ck Zk+1 at a batch of joint angles (..., k + 1), in doubles (k = 5 for the
     loop): Z_i C_i is a standard DH link."""
     out = numeric_chain.standard_link(theta[..., len(links)], 0.0, 0.0, 0.0)
@@ -437,6 +391,6 @@ def work_bytes(real: str) -> int:
     the equations in the build's real type and in double, the kernel's matrices in double), as
     the contract documents it; tests/test_shipped_robots.py checks it against the compiler's."""
     reals = 378 + 112
-    doubles = 3 * 14 * 9 + 14 * 8 + 16 * 5 + (14 * 8 + 8 + 8 + 6 * 14 + 3 * 6 * 9 + 3 * 12 * 12 + 2 * 12 * 4 + 12 * 16
+    doubles = 3 * 14 * 9 + 14 * 8 + 16 * 5 + (14 * 8 + 8 + 8 + 6 * 14 + 3 * 6 * 9 + 3 * 12 * 12 + 2 * 12 * 4 + 12 * 28
                                            + 16 * 16 + 2 * 12 * 12 + 16 + 16)
     return reals * {"double": 8, "float": 4}[real] + doubles * 8

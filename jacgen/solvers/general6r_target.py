@@ -13,16 +13,16 @@ from jacgen.inputs.robot import Robot
 from jacgen.inputs.transforms import rigid_inverse, rot_z, twist
 from jacgen.model.node import AND, OR, Node
 from jacgen.model.tangents import Tangents
-from jacgen.solvers import general6r, ik
+from jacgen.solvers import general6r, general6r_plan, ik
 from jacgen.solvers.subproblems import CERTIFICATE, Fold, Subproblems, greatest
 
 
-def equations_at(robot: Robot, form: "ik.ClosedForm", target: sympy.Matrix, name) -> tuple[sympy.Matrix, ...]:
-    """(N, P, Q) at the target pose `target`: N = head^-1 T tail^-1, the loop's closing link;
-    P = [P0; Ps; Pc] (42 x 9) with the hidden angle's shift applied and Q (14 x 8), the
-    equations (P0 + s Ps + c Pc) v_bc = Q v_gh. `name` names the shared values. A 7R arm's
-    free joint is in the chain's head or tail."""
-    plan = form.elimination
+def equations_at(robot: Robot, form: "ik.ClosedForm", plan: "general6r_plan.Elimination", target: sympy.Matrix,
+                 name) -> tuple[sympy.Matrix, ...]:
+    """(N, P, Q) of the elimination `plan` (the form's, or its fallback) at the target pose
+    `target`: N = head^-1 T tail^-1, the loop's closing link; P = [P0; Ps; Pc] (42 x 9) with the
+    hidden angle's shift applied and Q (14 x 8), the equations (P0 + s Ps + c Pc) v_bc = Q v_gh.
+    `name` names the shared values. A 7R arm's free joint is in the chain's head or tail."""
     equations, split = plan.equations, plan.equations.split
     head, _, tail = general6r.chain_form(robot, form.free)
     with distribute(False):
@@ -36,12 +36,11 @@ def equations_at(robot: Robot, form: "ik.ClosedForm", target: sympy.Matrix, name
         return n, sympy.Matrix.vstack(p0, ps, pc), q
 
 
-def loop_configuration(robot: Robot, form: "ik.ClosedForm", n: sympy.Matrix, angles, joints: list,
-                       name) -> list:
+def loop_configuration(robot: Robot, form: "ik.ClosedForm", plan: "general6r_plan.Elimination", n: sympy.Matrix,
+                       angles, joints: list, name) -> list:
     """The robot's joint values (`joints`, the chain's joint symbols, of which a 7R arm's free
-    one stays) of one root's loop angles `angles` (a - shift, b, c, g, h), the loop's free joint
-    from the loop closed by N (`equations_at`)."""
-    plan = form.elimination
+    one stays) of one root's loop angles `angles` (a - shift, b, c, g, h) of the elimination
+    `plan`, the loop's free joint from the loop closed by N (`equations_at`)."""
     split = plan.equations.split
     _, links, _ = general6r.chain_form(robot, form.free)
     loop = dict(zip((*split.triple, *split.pair), angles))

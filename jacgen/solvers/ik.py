@@ -18,7 +18,7 @@ from jacgen.model.nearest_class import Nominal, nearest_class
 from jacgen.model.node import AND, Node
 from jacgen.model.structure import E_Z, SOLVERS, Geometry, SolverInfo, Structure, classify, is_zero, readable
 from jacgen.model.tolerance_symbols import EPS
-from jacgen.solvers import general6r
+from jacgen.solvers import general6r, general6r_plan
 from jacgen.solvers.ik_limits import limited
 from jacgen.solvers.subproblems import Angle, Root, Subproblems, relative, times, times_transposed
 
@@ -38,7 +38,7 @@ class ClosedForm:
     joints: tuple[int, ...]  # the robot's joint of each of the solver's joints
     signs: tuple[int, ...]  # -1 where the solver turns the robot's joint the other way (a reversed chain)
     free: int | None  # the joint ik takes as an input (a 7-joint arm), else None
-    elimination: "general6r.Elimination | None" = None  # the general 6R solver's split (solver general_6r)
+    elimination: "general6r_plan.Elimination | None" = None  # the general 6R solver's split (solver general_6r)
     fast_path: "FastPath | None" = None  # general_6r: a calibrated arm's nominal closed form
 
 
@@ -172,9 +172,9 @@ def _general(robot) -> ClosedForm | None:
     file's `ik.free_joint`, else the one whose split rates better); with the fast path when a
     special class is near. None when no split is conditioned well enough."""
     candidates = (None,) if robot.dof == 6 else (robot.free_joint,) if robot.free_joint is not None else (6, 0)
-    plan, free = min(((general6r.elimination(robot, free), free) for free in candidates),
+    plan, free = min(((general6r_plan.elimination(robot, free), free) for free in candidates),
                      key=lambda pair: pair[0].condition)
-    if plan.condition > general6r.WORST_CONDITION:
+    if plan.condition > general6r_plan.WORST_CONDITION:
         return None
     nominal = nearest_class(robot, free) if robot.nearest_class else None
     fast_path = nominal and FastPath(nominal, closed_form(nominal.robot, structure=nominal.structure),

@@ -7,7 +7,9 @@
  * x = +-i for every target (jacgen_g6_spurious); the other 16 are those of the companion matrix
  * with them deflated (jacgen_g6_deflated, jacgen_eigenvalues). Per real root, the null vector of
  * M(x) (inverse iteration) gives x_b and x_c, and R^-1 (Q^T P v_bc)[0..7] gives v_gh. Fixed size,
- * no allocation, no recursion. Returns the number of roots (0 when M2 or R is singular).
+ * no allocation, no recursion. Returns the number of roots (0 when M2 or R is singular), and
+ * M2's 1-norm condition number in *condition (infinite when it is singular): above
+ * JACGEN_G6_DEGENERATE, its eigenvalues are noise and the caller takes its fallback elimination.
  * Defined before it: JACGEN_G6_IMAGINARY, an eigenvalue being a root when |imaginary part| <= that
  * (1 + |x|) (jacgen/general6r.py's IMAGINARY for the build's real type). */
 #define JACGEN_G6_ROOTS 16
@@ -167,12 +169,12 @@ static void jacgen_g6_pencil(double free[3][6][9], double m[3][12][12]) {
 }
 
 /* The kernel's working memory: the QR of Q, its left null space, the six v_gh-free equations, M0,
- * M1, M2, the null space of M(i) (u + i v), M2^-1 [M0 M1] at the deflated matrix's columns, the
- * deflated matrix (eigenvalues in re, im) and two 12 x 12 matrices (M(i); M2's LU; M(x) at each
- * root). */
+ * M1, M2, the null space of M(i) (u + i v), M2^-1 [M0 M1 I] (at the deflated matrix's columns,
+ * and M2's inverse), the deflated matrix (eigenvalues in re, im) and two 12 x 12 matrices (M(i);
+ * M2's LU; M(x) at each root). */
 struct jacgen_g6_work {
     double q[14][8], beta[8], rdiag[8], left_null[6][14], free[3][6][9], m[3][12][12];
-    double u[12][4], v[12][4], columns[12][16], square[2][12][12];
+    double u[12][4], v[12][4], columns[12][28], square[2][12][12];
     double deflated[JACGEN_EIG_MAX][JACGEN_EIG_MAX], re[JACGEN_EIG_MAX], im[JACGEN_EIG_MAX];
 };
 
@@ -243,13 +245,21 @@ static int jacgen_g6_spurious(double m[3][12][12], double re[12][12], double im[
  * basis is C[r][r'] - W[r] C[sel][r'] (sel: the identity's rows): with C[sel] = [0; -S[free]] at
  * the columns r', the rows [0 I] + v S[free] and -S + u S[free] at the pivot columns.
  * -1 when M2 is singular. */
-static int jacgen_g6_deflated(struct jacgen_g6_work *w, const int order[12]) {
-    double (*s)[16] = w->columns, (*lead)[12] = w->square[0];
+static int jacgen_g6_deflated(struct jacgen_g6_work *w, const int order[12], double *condition) {
+    double (*s)[28] = w->columns, (*lead)[12] = w->square[0];
+    double norm = 0.0, inverse_norm = 0.0;
     for (int i = 0; i < 12; i++) {
-        for (int j = 0; j < 12; j++) lead[i][j] = w->m[2][i][j];
+        for (int j = 0; j < 12; j++) { lead[i][j] = w->m[2][i][j]; s[i][16 + j] = i == j; }
         for (int b = 0; b < 8; b++) { s[i][b] = w->m[0][i][order[b]]; s[i][8 + b] = w->m[1][i][order[b]]; }
     }
-    if (jacgen_g6_solve(12, &lead[0][0], 16, &s[0][0]) != 0) return -1;
+    if (jacgen_g6_solve(12, &lead[0][0], 28, &s[0][0]) != 0) return -1;
+    for (int j = 0; j < 12; j++) {  /* M2's 1-norm condition number, from M2^-1 in columns 16.. */
+        double column = 0.0, inverse_column = 0.0;
+        for (int i = 0; i < 12; i++) { column += fabs(w->m[2][i][j]); inverse_column += fabs(s[i][16 + j]); }
+        if (column > norm) norm = column;
+        if (inverse_column > inverse_norm) inverse_norm = inverse_column;
+    }
+    *condition = norm * inverse_norm;
     for (int a = 0; a < 8; a++) {
         int r = order[a];
         for (int b = 0; b < 16; b++) {
@@ -266,7 +276,8 @@ static int jacgen_g6_deflated(struct jacgen_g6_work *w, const int order[12]) {
 }
 
 static int jacgen_general6r_roots(double p[3][14][9], double q_matrix[14][8],
-                                  double angles[JACGEN_G6_ROOTS][5], struct jacgen_g6_work *w) {
+                                  double angles[JACGEN_G6_ROOTS][5], struct jacgen_g6_work *w, double *condition) {
+    *condition = INFINITY;
     for (int i = 0; i < 14; i++)
         for (int j = 0; j < 8; j++) w->q[i][j] = q_matrix[i][j];
     if (jacgen_g6_qr(w->q, w->beta, w->rdiag) != 0) return 0;
@@ -280,7 +291,8 @@ static int jacgen_general6r_roots(double p[3][14][9], double q_matrix[14][8],
         }
     jacgen_g6_pencil(w->free, w->m);
     int order[12];
-    if (jacgen_g6_spurious(w->m, w->square[0], w->square[1], w->u, w->v, order) != 0 || jacgen_g6_deflated(w, order) != 0
+    if (jacgen_g6_spurious(w->m, w->square[0], w->square[1], w->u, w->v, order) != 0
+        || jacgen_g6_deflated(w, order, condition) != 0
         || jacgen_eigenvalues(JACGEN_G6_ROOTS, w->deflated, w->re, w->im) != 0) return 0;
     static const int along_c[8] = {0, 1, 3, 4, 6, 7, 9, 10};
     static const int along_b[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import sympy
 
-from jacgen.solvers import general6r
+from jacgen.solvers import general6r, general6r_plan
 from jacgen.checking import reference
 from jacgen.inputs.robot_file import parse_robot
 
@@ -88,9 +88,9 @@ class Solver:
     def __init__(self, robot):
         self.robot = robot
         head, links, tail = general6r.chain_form(robot)
-        self.plan = general6r.elimination(robot)
+        self.plan = general6r_plan.elimination(robot)
         self.head_inverse, self.tail_inverse = np.linalg.inv(numeric(head)), np.linalg.inv(numeric(tail))
-        self.links = [general6r._numeric_chain([link], np.zeros((1, 2)))[0] for link in links]
+        self.links = [general6r.chain_product([link], np.zeros((1, 2)))[0] for link in links]
         self.offsets = np.array([joint.offset.approx for joint in robot.joints])
 
     def equations_at(self, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -14,7 +14,7 @@ from jacgen.model.node import SELECT
 from jacgen.model.tolerance_symbols import RANK, TOLERANCES
 from jacgen.reports import ik_documentation
 from jacgen.reports.description import characteristic_length_note
-from jacgen.solvers import differential, general6r
+from jacgen.solvers import differential, general6r, general6r_plan
 from jacgen.tolerances import REACHED
 
 
@@ -144,6 +144,8 @@ def ik_context(robot: Robot, generator: Generator, real: str, number: Callable, 
             "squared": number(REACHED[real] ** 2),
             "converged_squared": number((general6r.CONVERGED[real] * (1 + robot.reach)) ** 2),
             "work_bytes": general6r.work_bytes(real),
+            "degenerate": repr(general6r_plan.DEGENERATE),  # a double in every build (the eigenproblem is)
+            "fallback": form.elimination.fallback is not None,
             "joints": form.joints,
             "fast": form.fast_path and {
                 "rows": form.fast_path.form.info.max_solutions, "steps": general6r.FAST_STEPS}},
