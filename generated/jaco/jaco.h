@@ -141,7 +141,7 @@ void jaco_ik_general_start(const jaco_real T[16], const jaco_real angles[5], jac
 void jaco_ik_general_equations_fallback(const jaco_real T[16], jaco_real P[378], jaco_real Q[112]);
 
 /* The configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop), by the fallback elimination (for targets where the first's leading matrix is singular to rounding).
- * Result: q[i], i < 6. 62 operations. */
+ * Result: q[i], i < 6. 63 operations. */
 void jaco_ik_general_start_fallback(const jaco_real T[16], const jaco_real angles[5], jaco_real q[JACO_DOF]);
 
 /* The pose error e at q (the position error and the rotation vector of R_target R^T, world frame) and the geometric Jacobian J of the six joints ik solves: the Newton step of the solver's polish is q + J^-1 e.

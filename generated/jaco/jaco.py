@@ -5434,8 +5434,8 @@ def ik_general_equations_fallback(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 14, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 14, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 14, 3
-        xp.full(batch, 0, dtype=dtype, device=device),  # 14, 4
-        xp.full(batch, 0.5, dtype=dtype, device=device),  # 14, 5
+        xp.full(batch, -1.0, dtype=dtype, device=device),  # 14, 4
+        xp.full(batch, 3.061616997868383e-17, dtype=dtype, device=device),  # 14, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 14, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 14, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 14, 8
@@ -5443,8 +5443,8 @@ def ik_general_equations_fallback(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 15, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 15, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 15, 3
-        xp.full(batch, 1.0, dtype=dtype, device=device),  # 15, 4
-        xp.full(batch, 0, dtype=dtype, device=device),  # 15, 5
+        xp.full(batch, 6.123233995736766e-17, dtype=dtype, device=device),  # 15, 4
+        xp.full(batch, 0.5, dtype=dtype, device=device),  # 15, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 15, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 15, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 15, 8
@@ -5458,23 +5458,23 @@ def ik_general_equations_fallback(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 16, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 16, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 17, 0
-        xp.full(batch, 0.205, dtype=dtype, device=device),  # 17, 1
+        xp.full(batch, 1.255262969126037e-17, dtype=dtype, device=device),  # 17, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 17, 2
-        xp.full(batch, 0, dtype=dtype, device=device),  # 17, 3
-        xp.full(batch, 0, dtype=dtype, device=device),  # 17, 4
-        xp.full(batch, -0.0049, dtype=dtype, device=device),  # 17, 5
-        xp.full(batch, -0.35507041555161983, dtype=dtype, device=device),  # 17, 6
+        xp.full(batch, 0.41, dtype=dtype, device=device),  # 17, 3
+        xp.full(batch, 0.0098, dtype=dtype, device=device),  # 17, 4
+        xp.full(batch, -3.000384657911015e-19, dtype=dtype, device=device),  # 17, 5
+        xp.full(batch, -2.174179239386059e-17, dtype=dtype, device=device),  # 17, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 17, 7
-        xp.full(batch, -0.21667706620451413, dtype=dtype, device=device),  # 17, 8
+        xp.full(batch, -1.3267643778799868e-17, dtype=dtype, device=device),  # 17, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 18, 0
-        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 1
+        xp.full(batch, 0.205, dtype=dtype, device=device),  # 18, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 18, 2
-        xp.full(batch, -0.41, dtype=dtype, device=device),  # 18, 3
-        xp.full(batch, -0.0098, dtype=dtype, device=device),  # 18, 4
-        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 5
-        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 6
+        xp.full(batch, -2.510525938252074e-17, dtype=dtype, device=device),  # 18, 3
+        xp.full(batch, -6.00076931582203e-19, dtype=dtype, device=device),  # 18, 4
+        xp.full(batch, -0.0049, dtype=dtype, device=device),  # 18, 5
+        xp.full(batch, -0.35507041555161983, dtype=dtype, device=device),  # 18, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 18, 7
-        xp.full(batch, 0, dtype=dtype, device=device),  # 18, 8
+        xp.full(batch, -0.21667706620451413, dtype=dtype, device=device),  # 18, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 19, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 19, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 19, 2
@@ -5502,23 +5502,23 @@ def ik_general_equations_fallback(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 21, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 21, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 21, 8
-        xp.full(batch, -0.205, dtype=dtype, device=device),  # 22, 0
+        xp.full(batch, -1.255262969126037e-17, dtype=dtype, device=device),  # 22, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 22, 1
-        xp.full(batch, 0, dtype=dtype, device=device),  # 22, 2
+        xp.full(batch, -0.41, dtype=dtype, device=device),  # 22, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 22, 3
-        xp.full(batch, -0.12509856250039458, dtype=dtype, device=device),  # 22, 4
-        xp.full(batch, 0, dtype=dtype, device=device),  # 22, 5
+        xp.full(batch, -7.660077707202168e-18, dtype=dtype, device=device),  # 22, 4
+        xp.full(batch, -0.25019712500078917, dtype=dtype, device=device),  # 22, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 22, 6
-        xp.full(batch, -0.35507041555161983, dtype=dtype, device=device),  # 22, 7
+        xp.full(batch, -2.174179239386059e-17, dtype=dtype, device=device),  # 22, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 22, 8
-        xp.full(batch, 0, dtype=dtype, device=device),  # 23, 0
+        xp.full(batch, -0.205, dtype=dtype, device=device),  # 23, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 23, 1
-        xp.full(batch, 0.41, dtype=dtype, device=device),  # 23, 2
+        xp.full(batch, 2.510525938252074e-17, dtype=dtype, device=device),  # 23, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 23, 3
-        xp.full(batch, 0, dtype=dtype, device=device),  # 23, 4
-        xp.full(batch, 0.25019712500078917, dtype=dtype, device=device),  # 23, 5
+        xp.full(batch, -0.12509856250039458, dtype=dtype, device=device),  # 23, 4
+        xp.full(batch, 1.5320155414404335e-17, dtype=dtype, device=device),  # 23, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 23, 6
-        xp.full(batch, 0, dtype=dtype, device=device),  # 23, 7
+        xp.full(batch, -0.35507041555161983, dtype=dtype, device=device),  # 23, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 23, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 24, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 24, 1
@@ -5529,24 +5529,24 @@ def ik_general_equations_fallback(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 24, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 24, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 24, 8
-        xp.full(batch, 0, dtype=dtype, device=device),  # 25, 0
-        xp.full(batch, 0.004018, dtype=dtype, device=device),  # 25, 1
-        xp.full(batch, 0.10258082125032357, dtype=dtype, device=device),  # 25, 2
-        xp.full(batch, 0, dtype=dtype, device=device),  # 25, 3
-        xp.full(batch, 0, dtype=dtype, device=device),  # 25, 4
-        xp.full(batch, 0.11530128067933026, dtype=dtype, device=device),  # 25, 5
-        xp.full(batch, -0.006959380144811749, dtype=dtype, device=device),  # 25, 6
+        xp.full(batch, -0.20516164250064714, dtype=dtype, device=device),  # 25, 0
+        xp.full(batch, 2.4603154194870324e-19, dtype=dtype, device=device),  # 25, 1
+        xp.full(batch, 6.281263719905778e-18, dtype=dtype, device=device),  # 25, 2
+        xp.full(batch, 0.008036, dtype=dtype, device=device),  # 25, 3
+        xp.full(batch, -0.23060256135866053, dtype=dtype, device=device),  # 25, 4
+        xp.full(batch, 7.060167216076619e-18, dtype=dtype, device=device),  # 25, 5
+        xp.full(batch, -4.261391309196676e-19, dtype=dtype, device=device),  # 25, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 25, 7
-        xp.full(batch, -0.004246870497608477, dtype=dtype, device=device),  # 25, 8
-        xp.full(batch, 0.20516164250064714, dtype=dtype, device=device),  # 26, 0
-        xp.full(batch, 0, dtype=dtype, device=device),  # 26, 1
-        xp.full(batch, 0, dtype=dtype, device=device),  # 26, 2
-        xp.full(batch, -0.008036, dtype=dtype, device=device),  # 26, 3
-        xp.full(batch, 0.23060256135866053, dtype=dtype, device=device),  # 26, 4
-        xp.full(batch, 0, dtype=dtype, device=device),  # 26, 5
-        xp.full(batch, 0, dtype=dtype, device=device),  # 26, 6
+        xp.full(batch, -2.6004581806447743e-19, dtype=dtype, device=device),  # 25, 8
+        xp.full(batch, 1.2562527439811556e-17, dtype=dtype, device=device),  # 26, 0
+        xp.full(batch, 0.004018, dtype=dtype, device=device),  # 26, 1
+        xp.full(batch, 0.10258082125032357, dtype=dtype, device=device),  # 26, 2
+        xp.full(batch, -4.920630838974065e-19, dtype=dtype, device=device),  # 26, 3
+        xp.full(batch, 1.4120334432153238e-17, dtype=dtype, device=device),  # 26, 4
+        xp.full(batch, 0.11530128067933026, dtype=dtype, device=device),  # 26, 5
+        xp.full(batch, -0.006959380144811749, dtype=dtype, device=device),  # 26, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 26, 7
-        xp.full(batch, 0, dtype=dtype, device=device),  # 26, 8
+        xp.full(batch, -0.004246870497608477, dtype=dtype, device=device),  # 26, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 27, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 27, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 27, 2
@@ -5560,8 +5560,8 @@ def ik_general_equations_fallback(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 28, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 28, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 28, 3
-        xp.full(batch, 1.0, dtype=dtype, device=device),  # 28, 4
-        xp.full(batch, 0, dtype=dtype, device=device),  # 28, 5
+        xp.full(batch, 6.123233995736766e-17, dtype=dtype, device=device),  # 28, 4
+        xp.full(batch, 0.5, dtype=dtype, device=device),  # 28, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 28, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 28, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 28, 8
@@ -5569,8 +5569,8 @@ def ik_general_equations_fallback(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 29, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 29, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 29, 3
-        xp.full(batch, 0, dtype=dtype, device=device),  # 29, 4
-        xp.full(batch, -0.5, dtype=dtype, device=device),  # 29, 5
+        xp.full(batch, 1.0, dtype=dtype, device=device),  # 29, 4
+        xp.full(batch, -3.061616997868383e-17, dtype=dtype, device=device),  # 29, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 29, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 29, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 29, 8
@@ -5584,23 +5584,23 @@ def ik_general_equations_fallback(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 30, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 30, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 31, 0
-        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 1
+        xp.full(batch, 0.205, dtype=dtype, device=device),  # 31, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 31, 2
-        xp.full(batch, -0.41, dtype=dtype, device=device),  # 31, 3
-        xp.full(batch, -0.0098, dtype=dtype, device=device),  # 31, 4
-        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 5
-        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 6
+        xp.full(batch, -2.510525938252074e-17, dtype=dtype, device=device),  # 31, 3
+        xp.full(batch, -6.00076931582203e-19, dtype=dtype, device=device),  # 31, 4
+        xp.full(batch, -0.0049, dtype=dtype, device=device),  # 31, 5
+        xp.full(batch, -0.35507041555161983, dtype=dtype, device=device),  # 31, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 31, 7
-        xp.full(batch, 0, dtype=dtype, device=device),  # 31, 8
+        xp.full(batch, -0.21667706620451413, dtype=dtype, device=device),  # 31, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 32, 0
-        xp.full(batch, -0.205, dtype=dtype, device=device),  # 32, 1
+        xp.full(batch, -1.255262969126037e-17, dtype=dtype, device=device),  # 32, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 32, 2
-        xp.full(batch, 0, dtype=dtype, device=device),  # 32, 3
-        xp.full(batch, 0, dtype=dtype, device=device),  # 32, 4
-        xp.full(batch, 0.0049, dtype=dtype, device=device),  # 32, 5
-        xp.full(batch, 0.35507041555161983, dtype=dtype, device=device),  # 32, 6
+        xp.full(batch, -0.41, dtype=dtype, device=device),  # 32, 3
+        xp.full(batch, -0.0098, dtype=dtype, device=device),  # 32, 4
+        xp.full(batch, 3.000384657911015e-19, dtype=dtype, device=device),  # 32, 5
+        xp.full(batch, 2.174179239386059e-17, dtype=dtype, device=device),  # 32, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 32, 7
-        xp.full(batch, 0.21667706620451413, dtype=dtype, device=device),  # 32, 8
+        xp.full(batch, 1.3267643778799868e-17, dtype=dtype, device=device),  # 32, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 33, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 33, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 33, 2
@@ -5628,23 +5628,23 @@ def ik_general_equations_fallback(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 35, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 35, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 35, 8
-        xp.full(batch, 0, dtype=dtype, device=device),  # 36, 0
+        xp.full(batch, -0.205, dtype=dtype, device=device),  # 36, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 36, 1
-        xp.full(batch, 0.41, dtype=dtype, device=device),  # 36, 2
+        xp.full(batch, 2.510525938252074e-17, dtype=dtype, device=device),  # 36, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 36, 3
-        xp.full(batch, 0, dtype=dtype, device=device),  # 36, 4
-        xp.full(batch, 0.25019712500078917, dtype=dtype, device=device),  # 36, 5
+        xp.full(batch, -0.12509856250039458, dtype=dtype, device=device),  # 36, 4
+        xp.full(batch, 1.5320155414404335e-17, dtype=dtype, device=device),  # 36, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 36, 6
-        xp.full(batch, 0, dtype=dtype, device=device),  # 36, 7
+        xp.full(batch, -0.35507041555161983, dtype=dtype, device=device),  # 36, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 36, 8
-        xp.full(batch, 0.205, dtype=dtype, device=device),  # 37, 0
+        xp.full(batch, 1.255262969126037e-17, dtype=dtype, device=device),  # 37, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 37, 1
-        xp.full(batch, 0, dtype=dtype, device=device),  # 37, 2
+        xp.full(batch, 0.41, dtype=dtype, device=device),  # 37, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 37, 3
-        xp.full(batch, 0.12509856250039458, dtype=dtype, device=device),  # 37, 4
-        xp.full(batch, 0, dtype=dtype, device=device),  # 37, 5
+        xp.full(batch, 7.660077707202168e-18, dtype=dtype, device=device),  # 37, 4
+        xp.full(batch, 0.25019712500078917, dtype=dtype, device=device),  # 37, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 37, 6
-        xp.full(batch, 0.35507041555161983, dtype=dtype, device=device),  # 37, 7
+        xp.full(batch, 2.174179239386059e-17, dtype=dtype, device=device),  # 37, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 37, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 38, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 38, 1
@@ -5655,24 +5655,24 @@ def ik_general_equations_fallback(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 38, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 38, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 38, 8
-        xp.full(batch, 0.20516164250064714, dtype=dtype, device=device),  # 39, 0
-        xp.full(batch, 0, dtype=dtype, device=device),  # 39, 1
-        xp.full(batch, 0, dtype=dtype, device=device),  # 39, 2
-        xp.full(batch, -0.008036, dtype=dtype, device=device),  # 39, 3
-        xp.full(batch, 0.23060256135866053, dtype=dtype, device=device),  # 39, 4
-        xp.full(batch, 0, dtype=dtype, device=device),  # 39, 5
-        xp.full(batch, 0, dtype=dtype, device=device),  # 39, 6
+        xp.full(batch, 1.2562527439811556e-17, dtype=dtype, device=device),  # 39, 0
+        xp.full(batch, 0.004018, dtype=dtype, device=device),  # 39, 1
+        xp.full(batch, 0.10258082125032357, dtype=dtype, device=device),  # 39, 2
+        xp.full(batch, -4.920630838974065e-19, dtype=dtype, device=device),  # 39, 3
+        xp.full(batch, 1.4120334432153238e-17, dtype=dtype, device=device),  # 39, 4
+        xp.full(batch, 0.11530128067933026, dtype=dtype, device=device),  # 39, 5
+        xp.full(batch, -0.006959380144811749, dtype=dtype, device=device),  # 39, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 39, 7
-        xp.full(batch, 0, dtype=dtype, device=device),  # 39, 8
-        xp.full(batch, 0, dtype=dtype, device=device),  # 40, 0
-        xp.full(batch, -0.004018, dtype=dtype, device=device),  # 40, 1
-        xp.full(batch, -0.10258082125032357, dtype=dtype, device=device),  # 40, 2
-        xp.full(batch, 0, dtype=dtype, device=device),  # 40, 3
-        xp.full(batch, 0, dtype=dtype, device=device),  # 40, 4
-        xp.full(batch, -0.11530128067933026, dtype=dtype, device=device),  # 40, 5
-        xp.full(batch, 0.006959380144811749, dtype=dtype, device=device),  # 40, 6
+        xp.full(batch, -0.004246870497608477, dtype=dtype, device=device),  # 39, 8
+        xp.full(batch, 0.20516164250064714, dtype=dtype, device=device),  # 40, 0
+        xp.full(batch, -2.4603154194870324e-19, dtype=dtype, device=device),  # 40, 1
+        xp.full(batch, -6.281263719905778e-18, dtype=dtype, device=device),  # 40, 2
+        xp.full(batch, -0.008036, dtype=dtype, device=device),  # 40, 3
+        xp.full(batch, 0.23060256135866053, dtype=dtype, device=device),  # 40, 4
+        xp.full(batch, -7.060167216076619e-18, dtype=dtype, device=device),  # 40, 5
+        xp.full(batch, 4.261391309196676e-19, dtype=dtype, device=device),  # 40, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 40, 7
-        xp.full(batch, 0.004246870497608477, dtype=dtype, device=device),  # 40, 8
+        xp.full(batch, 2.6004581806447743e-19, dtype=dtype, device=device),  # 40, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 41, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 41, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 41, 2
@@ -5801,7 +5801,7 @@ def ik_general_equations_fallback(T):
 
 
 def ik_general_start_fallback(T, angles):
-    """the configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop), by the fallback elimination (for targets where the first's leading matrix is singular to rounding): (6 x 1), 62 operations."""
+    """the configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop), by the fallback elimination (for targets where the first's leading matrix is singular to rounding): (6 x 1), 63 operations."""
     xp, dtype, device, batch, (T, angles,) = _arguments(("T", T, (4, 4)), ("angles", angles, (5,)))
     T00 = T[..., 0, 0]
     T01 = T[..., 0, 1]
@@ -5825,24 +5825,25 @@ def ik_general_start_fallback(T, angles):
     t5 = xp.sin(ga1)*t2
     t6 = 0.5*t5 - 0.8660254037844386*t3
     t7 = 0.5*t3 + 0.8660254037844386*t5
-    t8 = xp.cos(ga0)
-    t9 = xp.sin(ga0)
-    t10 = t8*t4 - t9*t6
-    t11 = t9*t4 + t8*t6
-    t12 = 0.5*t11 - 0.8660254037844386*t7
-    t13 = 0.5*t7 + 0.8660254037844386*t11
-    t14 = xp.cos(ga4)
-    t15 = xp.sin(ga4)
-    t16 = t14*t10 - t15*t12
-    t17 = t15*t10 + t14*t12
-    t18 = t16*(T00*t0 + T10*t1) - t17*(T01*t0 + T11*t1) + t13*(T02*t0 + T12*t1)
-    t19 = T20*t16 + T22*t13 - T21*t17
+    t8 = 1.5707963267948966 + ga0
+    t9 = xp.cos(t8)
+    t10 = xp.sin(t8)
+    t11 = t9*t4 - t10*t6
+    t12 = t10*t4 + t9*t6
+    t13 = 0.5*t12 - 0.8660254037844386*t7
+    t14 = 0.5*t7 + 0.8660254037844386*t12
+    t15 = xp.cos(ga4)
+    t16 = xp.sin(ga4)
+    t17 = t15*t11 - t16*t13
+    t18 = t16*t11 + t15*t13
+    t19 = t17*(T00*t0 + T10*t1) - t18*(T01*t0 + T11*t1) + t14*(T02*t0 + T12*t1)
+    t20 = T20*t17 + T22*t14 - T21*t18
     q = _stack(xp, [
         xp.broadcast_to(-ga3, batch),  # 0
-        xp.broadcast_to(1.5707963267948966 + xp.atan2(t19, t18), batch),  # 1
+        xp.broadcast_to(1.5707963267948966 + xp.atan2(t20, t19), batch),  # 1
         xp.broadcast_to(-(1.5707963267948966 + ga2), batch),  # 2
         xp.broadcast_to(-ga1, batch),  # 3
-        xp.broadcast_to(3.141592653589793 - ga0, batch),  # 4
+        xp.broadcast_to(1.5707963267948968 - ga0, batch),  # 4
         xp.broadcast_to(-(1.7453292519943295 + ga4), batch),  # 5
     ], (6,))
     return q

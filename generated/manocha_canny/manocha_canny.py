@@ -5227,23 +5227,23 @@ def ik_general_equations_fallback(T):
         xp.full(batch, 0.39969541350954785, dtype=dtype, device=device),  # 13, 6
         xp.full(batch, -0.10975891712936556, dtype=dtype, device=device),  # 13, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 13, 8
-        xp.full(batch, 0.016121465349192895, dtype=dtype, device=device),  # 14, 0
+        xp.full(batch, 1.0684889232142856e-18, dtype=dtype, device=device),  # 14, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 14, 1
-        xp.full(batch, 0.006678746798450243, dtype=dtype, device=device),  # 14, 2
+        xp.full(batch, 0.01745240643728351, dtype=dtype, device=device),  # 14, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 14, 3
-        xp.full(batch, 0.38262514782477175, dtype=dtype, device=device),  # 14, 4
-        xp.full(batch, -0.9235981312868786, dtype=dtype, device=device),  # 14, 5
+        xp.full(batch, 0.9998476951563913, dtype=dtype, device=device),  # 14, 4
+        xp.full(batch, -6.121368941383788e-17, dtype=dtype, device=device),  # 14, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 14, 6
-        xp.full(batch, 0.000281401224408172, dtype=dtype, device=device),  # 14, 7
+        xp.full(batch, 1.865054352978665e-20, dtype=dtype, device=device),  # 14, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 14, 8
-        xp.full(batch, 0.006677729592963602, dtype=dtype, device=device),  # 15, 0
+        xp.full(batch, 0.017449748351250485, dtype=dtype, device=device),  # 15, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 15, 1
-        xp.full(batch, -0.01612392110047446, dtype=dtype, device=device),  # 15, 2
+        xp.full(batch, -1.0686516840418958e-18, dtype=dtype, device=device),  # 15, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 15, 3
-        xp.full(batch, -0.9237388211835743, dtype=dtype, device=device),  # 15, 4
-        xp.full(batch, -0.3825668721614715, dtype=dtype, device=device),  # 15, 5
+        xp.full(batch, -6.122301397540665e-17, dtype=dtype, device=device),  # 15, 4
+        xp.full(batch, -0.9996954135095478, dtype=dtype, device=device),  # 15, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 15, 6
-        xp.full(batch, 0.00011656020361825967, dtype=dtype, device=device),  # 15, 7
+        xp.full(batch, 0.000304586490452135, dtype=dtype, device=device),  # 15, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 15, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 16, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 16, 1
@@ -5255,23 +5255,23 @@ def ik_general_equations_fallback(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 16, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 16, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 17, 0
-        xp.full(batch, 0.9237388211835743, dtype=dtype, device=device),  # 17, 1
+        xp.full(batch, 6.122301397540665e-17, dtype=dtype, device=device),  # 17, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 17, 2
-        xp.full(batch, 0.3826834323650898, dtype=dtype, device=device),  # 17, 3
-        xp.full(batch, -0.07653668647301795, dtype=dtype, device=device),  # 17, 4
-        xp.full(batch, 0.18474776423671485, dtype=dtype, device=device),  # 17, 5
-        xp.full(batch, -0.01612392110047446, dtype=dtype, device=device),  # 17, 6
+        xp.full(batch, 1.0, dtype=dtype, device=device),  # 17, 3
+        xp.full(batch, -0.2, dtype=dtype, device=device),  # 17, 4
+        xp.full(batch, 1.2244602795081332e-17, dtype=dtype, device=device),  # 17, 5
+        xp.full(batch, -1.0686516840418958e-18, dtype=dtype, device=device),  # 17, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 17, 7
-        xp.full(batch, 0.5740251485476346, dtype=dtype, device=device),  # 17, 8
+        xp.full(batch, 1.5, dtype=dtype, device=device),  # 17, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 18, 0
-        xp.full(batch, 0.38262514782477175, dtype=dtype, device=device),  # 18, 1
+        xp.full(batch, 0.9998476951563913, dtype=dtype, device=device),  # 18, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 18, 2
-        xp.full(batch, -0.9238795325112867, dtype=dtype, device=device),  # 18, 3
-        xp.full(batch, 0.18477590650225734, dtype=dtype, device=device),  # 18, 4
-        xp.full(batch, 0.07652502956495436, dtype=dtype, device=device),  # 18, 5
-        xp.full(batch, -0.006678746798450243, dtype=dtype, device=device),  # 18, 6
+        xp.full(batch, -6.123233995736766e-17, dtype=dtype, device=device),  # 18, 3
+        xp.full(batch, 1.2246467991473533e-17, dtype=dtype, device=device),  # 18, 4
+        xp.full(batch, 0.19996953903127826, dtype=dtype, device=device),  # 18, 5
+        xp.full(batch, -0.01745240643728351, dtype=dtype, device=device),  # 18, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 18, 7
-        xp.full(batch, -1.38581929876693, dtype=dtype, device=device),  # 18, 8
+        xp.full(batch, -9.18485099360515e-17, dtype=dtype, device=device),  # 18, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 19, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 19, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 19, 2
@@ -5299,23 +5299,23 @@ def ik_general_equations_fallback(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 21, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 21, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 21, 8
-        xp.full(batch, 0.9231760294502663, dtype=dtype, device=device),  # 22, 0
-        xp.full(batch, -0.003224293069838579, dtype=dtype, device=device),  # 22, 1
-        xp.full(batch, 0.38262514782477175, dtype=dtype, device=device),  # 22, 2
-        xp.full(batch, -0.0013357493596900486, dtype=dtype, device=device),  # 22, 3
-        xp.full(batch, -0.006678746798450243, dtype=dtype, device=device),  # 22, 4
-        xp.full(batch, 0.04030366337298224, dtype=dtype, device=device),  # 22, 5
-        xp.full(batch, 5.6280244881634396e-05, dtype=dtype, device=device),  # 22, 6
-        xp.full(batch, 0.04030366337298224, dtype=dtype, device=device),  # 22, 7
+        xp.full(batch, 6.118571359854319e-17, dtype=dtype, device=device),  # 22, 0
+        xp.full(batch, -2.1369778464285711e-19, dtype=dtype, device=device),  # 22, 1
+        xp.full(batch, 0.9998476951563913, dtype=dtype, device=device),  # 22, 2
+        xp.full(batch, -0.0034904812874567027, dtype=dtype, device=device),  # 22, 3
+        xp.full(batch, -0.01745240643728351, dtype=dtype, device=device),  # 22, 4
+        xp.full(batch, 2.671222308035714e-18, dtype=dtype, device=device),  # 22, 5
+        xp.full(batch, 3.73010870595733e-21, dtype=dtype, device=device),  # 22, 6
+        xp.full(batch, 2.671222308035714e-18, dtype=dtype, device=device),  # 22, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 22, 8
-        xp.full(batch, 0.38239203185604415, dtype=dtype, device=device),  # 23, 0
-        xp.full(batch, -0.0013355459185927204, dtype=dtype, device=device),  # 23, 1
-        xp.full(batch, -0.9237388211835743, dtype=dtype, device=device),  # 23, 2
-        xp.full(batch, 0.0032247842200948925, dtype=dtype, device=device),  # 23, 3
-        xp.full(batch, 0.01612392110047446, dtype=dtype, device=device),  # 23, 4
-        xp.full(batch, 0.016694323982409005, dtype=dtype, device=device),  # 23, 5
-        xp.full(batch, 2.3312040723651935e-05, dtype=dtype, device=device),  # 23, 6
-        xp.full(batch, 0.016694323982409005, dtype=dtype, device=device),  # 23, 7
+        xp.full(batch, 0.9992385337738696, dtype=dtype, device=device),  # 23, 0
+        xp.full(batch, -0.003489949670250097, dtype=dtype, device=device),  # 23, 1
+        xp.full(batch, -6.122301397540665e-17, dtype=dtype, device=device),  # 23, 2
+        xp.full(batch, 2.1373033680837916e-19, dtype=dtype, device=device),  # 23, 3
+        xp.full(batch, 1.0686516840418958e-18, dtype=dtype, device=device),  # 23, 4
+        xp.full(batch, 0.04362437087812621, dtype=dtype, device=device),  # 23, 5
+        xp.full(batch, 6.0917298090426996e-05, dtype=dtype, device=device),  # 23, 6
+        xp.full(batch, 0.04362437087812621, dtype=dtype, device=device),  # 23, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 23, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 24, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 24, 1
@@ -5326,24 +5326,24 @@ def ik_general_equations_fallback(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 24, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 24, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 24, 8
-        xp.full(batch, 0.10140401704642331, dtype=dtype, device=device),  # 25, 0
-        xp.full(batch, 0.3692704117801065, dtype=dtype, device=device),  # 25, 1
-        xp.full(batch, -0.008081283626124794, dtype=dtype, device=device),  # 25, 2
-        xp.full(batch, 0.1530500591299087, dtype=dtype, device=device),  # 25, 3
-        xp.full(batch, -0.4935864406939556, dtype=dtype, device=device),  # 25, 4
-        xp.full(batch, -2.9639057977576555, dtype=dtype, device=device),  # 25, 5
-        xp.full(batch, -0.016121465349192895, dtype=dtype, device=device),  # 25, 6
-        xp.full(batch, -2.769868583832333, dtype=dtype, device=device),  # 25, 7
-        xp.full(batch, 0.22957508869486304, dtype=dtype, device=device),  # 25, 8
-        xp.full(batch, 0.04200291913974106, dtype=dtype, device=device),  # 26, 0
-        xp.full(batch, 0.15295681274241765, dtype=dtype, device=device),  # 26, 1
-        xp.full(batch, 0.019509944531574102, dtype=dtype, device=device),  # 26, 2
-        xp.full(batch, -0.3694955284734297, dtype=dtype, device=device),  # 26, 3
-        xp.full(batch, 1.1916230793268108, dtype=dtype, device=device),  # 26, 4
-        xp.full(batch, -1.227689979027469, dtype=dtype, device=device),  # 26, 5
-        xp.full(batch, -0.006677729592963602, dtype=dtype, device=device),  # 26, 6
-        xp.full(batch, -1.1473171334145105, dtype=dtype, device=device),  # 26, 7
-        xp.full(batch, -0.5542432927101446, dtype=dtype, device=device),  # 26, 8
+        xp.full(batch, 6.720795327017856e-18, dtype=dtype, device=device),  # 25, 0
+        xp.full(batch, 2.4474285439417278e-17, dtype=dtype, device=device),  # 25, 1
+        xp.full(batch, -0.021117411789113052, dtype=dtype, device=device),  # 25, 2
+        xp.full(batch, 0.3999390780625565, dtype=dtype, device=device),  # 25, 3
+        xp.full(batch, -1.2898035267517447, dtype=dtype, device=device),  # 25, 4
+        xp.full(batch, -1.9643999138783022e-16, dtype=dtype, device=device),  # 25, 5
+        xp.full(batch, -1.0684889232142856e-18, dtype=dtype, device=device),  # 25, 6
+        xp.full(batch, -1.8357970795330062e-16, dtype=dtype, device=device),  # 25, 7
+        xp.full(batch, 0.5999086170938347, dtype=dtype, device=device),  # 25, 8
+        xp.full(batch, 0.10975891712936556, dtype=dtype, device=device),  # 26, 0
+        xp.full(batch, 0.39969541350954785, dtype=dtype, device=device),  # 26, 1
+        xp.full(batch, 1.2930685376906938e-18, dtype=dtype, device=device),  # 26, 2
+        xp.full(batch, -2.4489205590162663e-17, dtype=dtype, device=device),  # 26, 3
+        xp.full(batch, 7.897768802827458e-17, dtype=dtype, device=device),  # 26, 4
+        xp.full(batch, -3.208108517894292, dtype=dtype, device=device),  # 26, 5
+        xp.full(batch, -0.017449748351250485, dtype=dtype, device=device),  # 26, 6
+        xp.full(batch, -2.998084150975056, dtype=dtype, device=device),  # 26, 7
+        xp.full(batch, -3.673380838524399e-17, dtype=dtype, device=device),  # 26, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 27, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 27, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 27, 2
@@ -5353,23 +5353,23 @@ def ik_general_equations_fallback(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 27, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 27, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 27, 8
-        xp.full(batch, 0.006677729592963602, dtype=dtype, device=device),  # 28, 0
+        xp.full(batch, 0.017449748351250485, dtype=dtype, device=device),  # 28, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 28, 1
-        xp.full(batch, -0.01612392110047446, dtype=dtype, device=device),  # 28, 2
+        xp.full(batch, -1.0686516840418958e-18, dtype=dtype, device=device),  # 28, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 28, 3
-        xp.full(batch, -0.9237388211835743, dtype=dtype, device=device),  # 28, 4
-        xp.full(batch, -0.3825668721614715, dtype=dtype, device=device),  # 28, 5
+        xp.full(batch, -6.122301397540665e-17, dtype=dtype, device=device),  # 28, 4
+        xp.full(batch, -0.9996954135095478, dtype=dtype, device=device),  # 28, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 28, 6
-        xp.full(batch, 0.00011656020361825967, dtype=dtype, device=device),  # 28, 7
+        xp.full(batch, 0.000304586490452135, dtype=dtype, device=device),  # 28, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 28, 8
-        xp.full(batch, -0.016121465349192895, dtype=dtype, device=device),  # 29, 0
+        xp.full(batch, -1.0684889232142856e-18, dtype=dtype, device=device),  # 29, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 29, 1
-        xp.full(batch, -0.006678746798450243, dtype=dtype, device=device),  # 29, 2
+        xp.full(batch, -0.01745240643728351, dtype=dtype, device=device),  # 29, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 29, 3
-        xp.full(batch, -0.38262514782477175, dtype=dtype, device=device),  # 29, 4
-        xp.full(batch, 0.9235981312868786, dtype=dtype, device=device),  # 29, 5
+        xp.full(batch, -0.9998476951563913, dtype=dtype, device=device),  # 29, 4
+        xp.full(batch, 6.121368941383788e-17, dtype=dtype, device=device),  # 29, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 29, 6
-        xp.full(batch, -0.000281401224408172, dtype=dtype, device=device),  # 29, 7
+        xp.full(batch, -1.865054352978665e-20, dtype=dtype, device=device),  # 29, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 29, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 30, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 30, 1
@@ -5381,23 +5381,23 @@ def ik_general_equations_fallback(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 30, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 30, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 31, 0
-        xp.full(batch, 0.38262514782477175, dtype=dtype, device=device),  # 31, 1
+        xp.full(batch, 0.9998476951563913, dtype=dtype, device=device),  # 31, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 31, 2
-        xp.full(batch, -0.9238795325112867, dtype=dtype, device=device),  # 31, 3
-        xp.full(batch, 0.18477590650225734, dtype=dtype, device=device),  # 31, 4
-        xp.full(batch, 0.07652502956495436, dtype=dtype, device=device),  # 31, 5
-        xp.full(batch, -0.006678746798450243, dtype=dtype, device=device),  # 31, 6
+        xp.full(batch, -6.123233995736766e-17, dtype=dtype, device=device),  # 31, 3
+        xp.full(batch, 1.2246467991473533e-17, dtype=dtype, device=device),  # 31, 4
+        xp.full(batch, 0.19996953903127826, dtype=dtype, device=device),  # 31, 5
+        xp.full(batch, -0.01745240643728351, dtype=dtype, device=device),  # 31, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 31, 7
-        xp.full(batch, -1.38581929876693, dtype=dtype, device=device),  # 31, 8
+        xp.full(batch, -9.18485099360515e-17, dtype=dtype, device=device),  # 31, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 32, 0
-        xp.full(batch, -0.9237388211835743, dtype=dtype, device=device),  # 32, 1
+        xp.full(batch, -6.122301397540665e-17, dtype=dtype, device=device),  # 32, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 32, 2
-        xp.full(batch, -0.3826834323650898, dtype=dtype, device=device),  # 32, 3
-        xp.full(batch, 0.07653668647301795, dtype=dtype, device=device),  # 32, 4
-        xp.full(batch, -0.18474776423671485, dtype=dtype, device=device),  # 32, 5
-        xp.full(batch, 0.01612392110047446, dtype=dtype, device=device),  # 32, 6
+        xp.full(batch, -1.0, dtype=dtype, device=device),  # 32, 3
+        xp.full(batch, 0.2, dtype=dtype, device=device),  # 32, 4
+        xp.full(batch, -1.2244602795081332e-17, dtype=dtype, device=device),  # 32, 5
+        xp.full(batch, 1.0686516840418958e-18, dtype=dtype, device=device),  # 32, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 32, 7
-        xp.full(batch, -0.5740251485476346, dtype=dtype, device=device),  # 32, 8
+        xp.full(batch, -1.5, dtype=dtype, device=device),  # 32, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 33, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 33, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 33, 2
@@ -5425,23 +5425,23 @@ def ik_general_equations_fallback(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 35, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 35, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 35, 8
-        xp.full(batch, 0.38239203185604415, dtype=dtype, device=device),  # 36, 0
-        xp.full(batch, -0.0013355459185927204, dtype=dtype, device=device),  # 36, 1
-        xp.full(batch, -0.9237388211835743, dtype=dtype, device=device),  # 36, 2
-        xp.full(batch, 0.0032247842200948925, dtype=dtype, device=device),  # 36, 3
-        xp.full(batch, 0.01612392110047446, dtype=dtype, device=device),  # 36, 4
-        xp.full(batch, 0.016694323982409005, dtype=dtype, device=device),  # 36, 5
-        xp.full(batch, 2.3312040723651935e-05, dtype=dtype, device=device),  # 36, 6
-        xp.full(batch, 0.016694323982409005, dtype=dtype, device=device),  # 36, 7
+        xp.full(batch, 0.9992385337738696, dtype=dtype, device=device),  # 36, 0
+        xp.full(batch, -0.003489949670250097, dtype=dtype, device=device),  # 36, 1
+        xp.full(batch, -6.122301397540665e-17, dtype=dtype, device=device),  # 36, 2
+        xp.full(batch, 2.1373033680837916e-19, dtype=dtype, device=device),  # 36, 3
+        xp.full(batch, 1.0686516840418958e-18, dtype=dtype, device=device),  # 36, 4
+        xp.full(batch, 0.04362437087812621, dtype=dtype, device=device),  # 36, 5
+        xp.full(batch, 6.0917298090426996e-05, dtype=dtype, device=device),  # 36, 6
+        xp.full(batch, 0.04362437087812621, dtype=dtype, device=device),  # 36, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 36, 8
-        xp.full(batch, -0.9231760294502663, dtype=dtype, device=device),  # 37, 0
-        xp.full(batch, 0.003224293069838579, dtype=dtype, device=device),  # 37, 1
-        xp.full(batch, -0.38262514782477175, dtype=dtype, device=device),  # 37, 2
-        xp.full(batch, 0.0013357493596900486, dtype=dtype, device=device),  # 37, 3
-        xp.full(batch, 0.006678746798450243, dtype=dtype, device=device),  # 37, 4
-        xp.full(batch, -0.04030366337298224, dtype=dtype, device=device),  # 37, 5
-        xp.full(batch, -5.6280244881634396e-05, dtype=dtype, device=device),  # 37, 6
-        xp.full(batch, -0.04030366337298224, dtype=dtype, device=device),  # 37, 7
+        xp.full(batch, -6.118571359854319e-17, dtype=dtype, device=device),  # 37, 0
+        xp.full(batch, 2.1369778464285711e-19, dtype=dtype, device=device),  # 37, 1
+        xp.full(batch, -0.9998476951563913, dtype=dtype, device=device),  # 37, 2
+        xp.full(batch, 0.0034904812874567027, dtype=dtype, device=device),  # 37, 3
+        xp.full(batch, 0.01745240643728351, dtype=dtype, device=device),  # 37, 4
+        xp.full(batch, -2.671222308035714e-18, dtype=dtype, device=device),  # 37, 5
+        xp.full(batch, -3.73010870595733e-21, dtype=dtype, device=device),  # 37, 6
+        xp.full(batch, -2.671222308035714e-18, dtype=dtype, device=device),  # 37, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 37, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 38, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 38, 1
@@ -5452,24 +5452,24 @@ def ik_general_equations_fallback(T):
         xp.full(batch, 0, dtype=dtype, device=device),  # 38, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 38, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 38, 8
-        xp.full(batch, 0.04200291913974106, dtype=dtype, device=device),  # 39, 0
-        xp.full(batch, 0.15295681274241765, dtype=dtype, device=device),  # 39, 1
-        xp.full(batch, 0.019509944531574102, dtype=dtype, device=device),  # 39, 2
-        xp.full(batch, -0.3694955284734297, dtype=dtype, device=device),  # 39, 3
-        xp.full(batch, 1.1916230793268108, dtype=dtype, device=device),  # 39, 4
-        xp.full(batch, -1.227689979027469, dtype=dtype, device=device),  # 39, 5
-        xp.full(batch, -0.006677729592963602, dtype=dtype, device=device),  # 39, 6
-        xp.full(batch, -1.1473171334145105, dtype=dtype, device=device),  # 39, 7
-        xp.full(batch, -0.5542432927101446, dtype=dtype, device=device),  # 39, 8
-        xp.full(batch, -0.10140401704642331, dtype=dtype, device=device),  # 40, 0
-        xp.full(batch, -0.3692704117801065, dtype=dtype, device=device),  # 40, 1
-        xp.full(batch, 0.008081283626124794, dtype=dtype, device=device),  # 40, 2
-        xp.full(batch, -0.1530500591299087, dtype=dtype, device=device),  # 40, 3
-        xp.full(batch, 0.4935864406939556, dtype=dtype, device=device),  # 40, 4
-        xp.full(batch, 2.9639057977576555, dtype=dtype, device=device),  # 40, 5
-        xp.full(batch, 0.016121465349192895, dtype=dtype, device=device),  # 40, 6
-        xp.full(batch, 2.769868583832333, dtype=dtype, device=device),  # 40, 7
-        xp.full(batch, -0.22957508869486304, dtype=dtype, device=device),  # 40, 8
+        xp.full(batch, 0.10975891712936556, dtype=dtype, device=device),  # 39, 0
+        xp.full(batch, 0.39969541350954785, dtype=dtype, device=device),  # 39, 1
+        xp.full(batch, 1.2930685376906938e-18, dtype=dtype, device=device),  # 39, 2
+        xp.full(batch, -2.4489205590162663e-17, dtype=dtype, device=device),  # 39, 3
+        xp.full(batch, 7.897768802827458e-17, dtype=dtype, device=device),  # 39, 4
+        xp.full(batch, -3.208108517894292, dtype=dtype, device=device),  # 39, 5
+        xp.full(batch, -0.017449748351250485, dtype=dtype, device=device),  # 39, 6
+        xp.full(batch, -2.998084150975056, dtype=dtype, device=device),  # 39, 7
+        xp.full(batch, -3.673380838524399e-17, dtype=dtype, device=device),  # 39, 8
+        xp.full(batch, -6.720795327017856e-18, dtype=dtype, device=device),  # 40, 0
+        xp.full(batch, -2.4474285439417278e-17, dtype=dtype, device=device),  # 40, 1
+        xp.full(batch, 0.021117411789113052, dtype=dtype, device=device),  # 40, 2
+        xp.full(batch, -0.3999390780625565, dtype=dtype, device=device),  # 40, 3
+        xp.full(batch, 1.2898035267517447, dtype=dtype, device=device),  # 40, 4
+        xp.full(batch, 1.9643999138783022e-16, dtype=dtype, device=device),  # 40, 5
+        xp.full(batch, 1.0684889232142856e-18, dtype=dtype, device=device),  # 40, 6
+        xp.full(batch, 1.8357970795330062e-16, dtype=dtype, device=device),  # 40, 7
+        xp.full(batch, -0.5999086170938347, dtype=dtype, device=device),  # 40, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 41, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 41, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 41, 2
@@ -5628,7 +5628,7 @@ def ik_general_start_fallback(T, angles):
     t11 = xp.sin(ga1)*t8
     t12 = 0.9998476951563913*t11 - 0.01745240643728351*t9
     t13 = 0.01745240643728351*t11 + 0.9998476951563913*t9
-    t14 = 0.39269908169872414 + ga0
+    t14 = 1.5707963267948966 + ga0
     t15 = xp.cos(t14)
     t16 = xp.sin(t14)
     t17 = t15*t10 - t16*t12

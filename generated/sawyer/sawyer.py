@@ -5779,21 +5779,21 @@ def ik_general_equations_fallback(T, q_free):
         xp.full(batch, 0, dtype=dtype, device=device),  # 13, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 14, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 14, 1
-        xp.full(batch, 0.9238795325112867, dtype=dtype, device=device),  # 14, 2
+        xp.full(batch, -0.7071067811865477, dtype=dtype, device=device),  # 14, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 14, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 14, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 14, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 14, 6
-        xp.full(batch, 0.38268343236508984, dtype=dtype, device=device),  # 14, 7
+        xp.full(batch, 0.7071067811865474, dtype=dtype, device=device),  # 14, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 14, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 15, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 15, 1
-        xp.full(batch, -0.38268343236508984, dtype=dtype, device=device),  # 15, 2
+        xp.full(batch, -0.7071067811865474, dtype=dtype, device=device),  # 15, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 15, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 15, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 15, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 15, 6
-        xp.full(batch, 0.9238795325112867, dtype=dtype, device=device),  # 15, 7
+        xp.full(batch, -0.7071067811865477, dtype=dtype, device=device),  # 15, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 15, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 16, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 16, 1
@@ -5808,20 +5808,20 @@ def ik_general_equations_fallback(T, q_free):
         xp.full(batch, 0, dtype=dtype, device=device),  # 17, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 17, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 17, 3
-        xp.full(batch, 0.15567370122815183, dtype=dtype, device=device),  # 17, 4
+        xp.full(batch, -0.11914749262993328, dtype=dtype, device=device),  # 17, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 17, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 17, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 17, 7
-        xp.full(batch, -0.15307337294603593, dtype=dtype, device=device),  # 17, 8
+        xp.full(batch, -0.28284271247461895, dtype=dtype, device=device),  # 17, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 18, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 18, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 18, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 18, 3
-        xp.full(batch, -0.06448215835351764, dtype=dtype, device=device),  # 18, 4
+        xp.full(batch, -0.11914749262993322, dtype=dtype, device=device),  # 18, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 18, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 18, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 18, 7
-        xp.full(batch, -0.3695518130045147, dtype=dtype, device=device),  # 18, 8
+        xp.full(batch, 0.28284271247461906, dtype=dtype, device=device),  # 18, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 19, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 19, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 19, 2
@@ -5849,23 +5849,23 @@ def ik_general_equations_fallback(T, q_free):
         xp.full(batch, 0, dtype=dtype, device=device),  # 21, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 21, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 21, 8
-        xp.full(batch, -0.3695518130045147, dtype=dtype, device=device),  # 22, 0
+        xp.full(batch, 0.28284271247461906, dtype=dtype, device=device),  # 22, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 22, 1
-        xp.full(batch, 0.07366656073027979, dtype=dtype, device=device),  # 22, 2
-        xp.full(batch, 0.15567370122815183, dtype=dtype, device=device),  # 22, 3
+        xp.full(batch, 0.13611805537841037, dtype=dtype, device=device),  # 22, 2
+        xp.full(batch, -0.11914749262993328, dtype=dtype, device=device),  # 22, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 22, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 22, 5
-        xp.full(batch, -0.06448215835351764, dtype=dtype, device=device),  # 22, 6
-        xp.full(batch, -0.1778468100084227, dtype=dtype, device=device),  # 22, 7
+        xp.full(batch, -0.11914749262993322, dtype=dtype, device=device),  # 22, 6
+        xp.full(batch, 0.13611805537841043, dtype=dtype, device=device),  # 22, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 22, 8
-        xp.full(batch, 0.15307337294603593, dtype=dtype, device=device),  # 23, 0
+        xp.full(batch, 0.28284271247461895, dtype=dtype, device=device),  # 23, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 23, 1
-        xp.full(batch, 0.1778468100084227, dtype=dtype, device=device),  # 23, 2
-        xp.full(batch, -0.06448215835351764, dtype=dtype, device=device),  # 23, 3
+        xp.full(batch, -0.13611805537841043, dtype=dtype, device=device),  # 23, 2
+        xp.full(batch, -0.11914749262993322, dtype=dtype, device=device),  # 23, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 23, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 23, 5
-        xp.full(batch, -0.15567370122815183, dtype=dtype, device=device),  # 23, 6
-        xp.full(batch, 0.07366656073027979, dtype=dtype, device=device),  # 23, 7
+        xp.full(batch, 0.11914749262993328, dtype=dtype, device=device),  # 23, 6
+        xp.full(batch, 0.13611805537841037, dtype=dtype, device=device),  # 23, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 23, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 24, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 24, 1
@@ -5876,23 +5876,23 @@ def ik_general_equations_fallback(T, q_free):
         xp.full(batch, 0, dtype=dtype, device=device),  # 24, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 24, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 24, 8
-        xp.full(batch, 0.05893324858422384, dtype=dtype, device=device),  # 25, 0
-        xp.full(batch, 0.12453896098252146, dtype=dtype, device=device),  # 25, 1
-        xp.full(batch, 0.20828725478537083, dtype=dtype, device=device),  # 25, 2
-        xp.full(batch, -0.02482563096610429, dtype=dtype, device=device),  # 25, 3
+        xp.full(batch, 0.1088944443027283, dtype=dtype, device=device),  # 25, 0
+        xp.full(batch, -0.09531799410394663, dtype=dtype, device=device),  # 25, 1
+        xp.full(batch, -0.1594161631583354, dtype=dtype, device=device),  # 25, 2
+        xp.full(batch, -0.04587178466252429, dtype=dtype, device=device),  # 25, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 25, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 25, 5
-        xp.full(batch, -0.05993437497283845, dtype=dtype, device=device),  # 25, 6
-        xp.full(batch, -0.03618329255526779, dtype=dtype, device=device),  # 25, 7
+        xp.full(batch, 0.04587178466252431, dtype=dtype, device=device),  # 25, 6
+        xp.full(batch, -0.06685800682135982, dtype=dtype, device=device),  # 25, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 25, 8
-        xp.full(batch, 0.14227744800673817, dtype=dtype, device=device),  # 26, 0
-        xp.full(batch, -0.05158572668281411, dtype=dtype, device=device),  # 26, 1
-        xp.full(batch, -0.08627540580156096, dtype=dtype, device=device),  # 26, 2
-        xp.full(batch, -0.05993437497283845, dtype=dtype, device=device),  # 26, 3
+        xp.full(batch, -0.10889444430272835, dtype=dtype, device=device),  # 26, 0
+        xp.full(batch, -0.09531799410394658, dtype=dtype, device=device),  # 26, 1
+        xp.full(batch, -0.15941616315833532, dtype=dtype, device=device),  # 26, 2
+        xp.full(batch, 0.04587178466252431, dtype=dtype, device=device),  # 26, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 26, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 26, 5
-        xp.full(batch, 0.02482563096610429, dtype=dtype, device=device),  # 26, 6
-        xp.full(batch, -0.08735419561824093, dtype=dtype, device=device),  # 26, 7
+        xp.full(batch, 0.04587178466252429, dtype=dtype, device=device),  # 26, 6
+        xp.full(batch, 0.06685800682135987, dtype=dtype, device=device),  # 26, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 26, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 27, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 27, 1
@@ -5905,21 +5905,21 @@ def ik_general_equations_fallback(T, q_free):
         xp.full(batch, 0, dtype=dtype, device=device),  # 27, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 28, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 28, 1
-        xp.full(batch, -0.38268343236508984, dtype=dtype, device=device),  # 28, 2
+        xp.full(batch, -0.7071067811865474, dtype=dtype, device=device),  # 28, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 28, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 28, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 28, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 28, 6
-        xp.full(batch, 0.9238795325112867, dtype=dtype, device=device),  # 28, 7
+        xp.full(batch, -0.7071067811865477, dtype=dtype, device=device),  # 28, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 28, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 29, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 29, 1
-        xp.full(batch, -0.9238795325112867, dtype=dtype, device=device),  # 29, 2
+        xp.full(batch, 0.7071067811865477, dtype=dtype, device=device),  # 29, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 29, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 29, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 29, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 29, 6
-        xp.full(batch, -0.38268343236508984, dtype=dtype, device=device),  # 29, 7
+        xp.full(batch, -0.7071067811865474, dtype=dtype, device=device),  # 29, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 29, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 30, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 30, 1
@@ -5934,20 +5934,20 @@ def ik_general_equations_fallback(T, q_free):
         xp.full(batch, 0, dtype=dtype, device=device),  # 31, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 31, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 31, 3
-        xp.full(batch, -0.06448215835351764, dtype=dtype, device=device),  # 31, 4
+        xp.full(batch, -0.11914749262993322, dtype=dtype, device=device),  # 31, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 31, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 31, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 31, 7
-        xp.full(batch, -0.3695518130045147, dtype=dtype, device=device),  # 31, 8
+        xp.full(batch, 0.28284271247461906, dtype=dtype, device=device),  # 31, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 32, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 32, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 32, 2
         xp.full(batch, 0, dtype=dtype, device=device),  # 32, 3
-        xp.full(batch, -0.15567370122815183, dtype=dtype, device=device),  # 32, 4
+        xp.full(batch, 0.11914749262993328, dtype=dtype, device=device),  # 32, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 32, 5
         xp.full(batch, 0, dtype=dtype, device=device),  # 32, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 32, 7
-        xp.full(batch, 0.15307337294603593, dtype=dtype, device=device),  # 32, 8
+        xp.full(batch, 0.28284271247461895, dtype=dtype, device=device),  # 32, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 33, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 33, 1
         xp.full(batch, 0, dtype=dtype, device=device),  # 33, 2
@@ -5975,23 +5975,23 @@ def ik_general_equations_fallback(T, q_free):
         xp.full(batch, 0, dtype=dtype, device=device),  # 35, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 35, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 35, 8
-        xp.full(batch, 0.15307337294603593, dtype=dtype, device=device),  # 36, 0
+        xp.full(batch, 0.28284271247461895, dtype=dtype, device=device),  # 36, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 36, 1
-        xp.full(batch, 0.1778468100084227, dtype=dtype, device=device),  # 36, 2
-        xp.full(batch, -0.06448215835351764, dtype=dtype, device=device),  # 36, 3
+        xp.full(batch, -0.13611805537841043, dtype=dtype, device=device),  # 36, 2
+        xp.full(batch, -0.11914749262993322, dtype=dtype, device=device),  # 36, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 36, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 36, 5
-        xp.full(batch, -0.15567370122815183, dtype=dtype, device=device),  # 36, 6
-        xp.full(batch, 0.07366656073027979, dtype=dtype, device=device),  # 36, 7
+        xp.full(batch, 0.11914749262993328, dtype=dtype, device=device),  # 36, 6
+        xp.full(batch, 0.13611805537841037, dtype=dtype, device=device),  # 36, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 36, 8
-        xp.full(batch, 0.3695518130045147, dtype=dtype, device=device),  # 37, 0
+        xp.full(batch, -0.28284271247461906, dtype=dtype, device=device),  # 37, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 37, 1
-        xp.full(batch, -0.07366656073027979, dtype=dtype, device=device),  # 37, 2
-        xp.full(batch, -0.15567370122815183, dtype=dtype, device=device),  # 37, 3
+        xp.full(batch, -0.13611805537841037, dtype=dtype, device=device),  # 37, 2
+        xp.full(batch, 0.11914749262993328, dtype=dtype, device=device),  # 37, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 37, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 37, 5
-        xp.full(batch, 0.06448215835351764, dtype=dtype, device=device),  # 37, 6
-        xp.full(batch, 0.1778468100084227, dtype=dtype, device=device),  # 37, 7
+        xp.full(batch, 0.11914749262993322, dtype=dtype, device=device),  # 37, 6
+        xp.full(batch, -0.13611805537841043, dtype=dtype, device=device),  # 37, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 37, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 38, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 38, 1
@@ -6002,23 +6002,23 @@ def ik_general_equations_fallback(T, q_free):
         xp.full(batch, 0, dtype=dtype, device=device),  # 38, 6
         xp.full(batch, 0, dtype=dtype, device=device),  # 38, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 38, 8
-        xp.full(batch, 0.14227744800673817, dtype=dtype, device=device),  # 39, 0
-        xp.full(batch, -0.05158572668281411, dtype=dtype, device=device),  # 39, 1
-        xp.full(batch, -0.08627540580156096, dtype=dtype, device=device),  # 39, 2
-        xp.full(batch, -0.05993437497283845, dtype=dtype, device=device),  # 39, 3
+        xp.full(batch, -0.10889444430272835, dtype=dtype, device=device),  # 39, 0
+        xp.full(batch, -0.09531799410394658, dtype=dtype, device=device),  # 39, 1
+        xp.full(batch, -0.15941616315833532, dtype=dtype, device=device),  # 39, 2
+        xp.full(batch, 0.04587178466252431, dtype=dtype, device=device),  # 39, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 39, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 39, 5
-        xp.full(batch, 0.02482563096610429, dtype=dtype, device=device),  # 39, 6
-        xp.full(batch, -0.08735419561824093, dtype=dtype, device=device),  # 39, 7
+        xp.full(batch, 0.04587178466252429, dtype=dtype, device=device),  # 39, 6
+        xp.full(batch, 0.06685800682135987, dtype=dtype, device=device),  # 39, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 39, 8
-        xp.full(batch, -0.05893324858422384, dtype=dtype, device=device),  # 40, 0
-        xp.full(batch, -0.12453896098252146, dtype=dtype, device=device),  # 40, 1
-        xp.full(batch, -0.20828725478537083, dtype=dtype, device=device),  # 40, 2
-        xp.full(batch, 0.02482563096610429, dtype=dtype, device=device),  # 40, 3
+        xp.full(batch, -0.1088944443027283, dtype=dtype, device=device),  # 40, 0
+        xp.full(batch, 0.09531799410394663, dtype=dtype, device=device),  # 40, 1
+        xp.full(batch, 0.1594161631583354, dtype=dtype, device=device),  # 40, 2
+        xp.full(batch, 0.04587178466252429, dtype=dtype, device=device),  # 40, 3
         xp.full(batch, 0, dtype=dtype, device=device),  # 40, 4
         xp.full(batch, 0, dtype=dtype, device=device),  # 40, 5
-        xp.full(batch, 0.05993437497283845, dtype=dtype, device=device),  # 40, 6
-        xp.full(batch, 0.03618329255526779, dtype=dtype, device=device),  # 40, 7
+        xp.full(batch, -0.04587178466252431, dtype=dtype, device=device),  # 40, 6
+        xp.full(batch, 0.06685800682135982, dtype=dtype, device=device),  # 40, 7
         xp.full(batch, 0, dtype=dtype, device=device),  # 40, 8
         xp.full(batch, 0, dtype=dtype, device=device),  # 41, 0
         xp.full(batch, 0, dtype=dtype, device=device),  # 41, 1
@@ -6174,7 +6174,7 @@ def ik_general_start_fallback(T, q_free, angles):
     t4 = xp.sin(ga3)
     t5 = xp.cos(ga4)
     t6 = xp.sin(ga4)
-    t7 = 1.1780972450961724 + ga0
+    t7 = 5.497787143782138 + ga0
     t8 = xp.cos(t7)
     t9 = t8*t5
     t10 = t8*t6

@@ -137,7 +137,7 @@ void ur5_calibrated_ik_general_equations(const ur5_calibrated_real T[16], ur5_ca
 void ur5_calibrated_ik_general_start(const ur5_calibrated_real T[16], const ur5_calibrated_real angles[5], ur5_calibrated_real q[UR5_CALIBRATED_DOF]);
 
 /* The general 6R solver's equations at T, by the fallback elimination (for targets where the first's leading matrix is singular to rounding): (P0 + s Ps + c Pc) v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9).
- * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 1853 operations. */
+ * Result: P: 42 x 9 row-major, element (r, c) at P[r * 9 + c]; Q: 14 x 8 row-major, element (r, c) at Q[r * 8 + c]. 1892 operations. */
 void ur5_calibrated_ik_general_equations_fallback(const ur5_calibrated_real T[16], ur5_calibrated_real P[378], ur5_calibrated_real Q[112]);
 
 /* The configuration of one root's loop angles (a - shift, b, c, g, h; the loop's free joint from the loop), by the fallback elimination (for targets where the first's leading matrix is singular to rounding).

@@ -42,7 +42,7 @@ class Elimination:
 # condition is 8e7 at every shift, and 2 to 4 are lost. 0.01 to 0.25 % of random targets are
 # above it (10^4 on each general and calibrated shipped arm), and pay the second eigenproblem.
 DEGENERATE = 1e7
-DEGENERATE_LINES = 48  # random lines in joint space searched for the first plan's degenerate set
+DEGENERATE_LINES = 24  # random lines in joint space searched for the first plan's degenerate set
 
 
 def elimination(robot: Robot, free: int | None = None) -> Elimination:
@@ -103,10 +103,10 @@ def leading_condition(equations_: Equations, links: list[Link], shift: float, th
 
 def degenerate_set(plan: Elimination, links: list[Link], lines: int, rng) -> np.ndarray:
     """Loop angles (k, 6) where the plan's leading matrix is singular: on random lines through
-    joint space, where its determinant changes sign between 33 points, bisected to rounding."""
+    joint space, where its determinant changes sign between 17 points, bisected to rounding."""
     starts, directions = rng.uniform(-np.pi, np.pi, (lines, 6)), rng.normal(size=(lines, 6))
     directions /= np.linalg.norm(directions, axis=-1, keepdims=True)
-    grid = np.linspace(-np.pi, np.pi, 33)
+    grid = np.linspace(-np.pi, np.pi, 17)
 
     def sign(t):
         s0, ss, sc, _ = _free_equations(plan.equations, links, starts + t[:, None] * directions)
@@ -117,7 +117,7 @@ def degenerate_set(plan: Elimination, links: list[Link], lines: int, rng) -> np.
     crossing = change.any(axis=1)
     first = np.argmax(change, axis=1)
     low, high, low_sign = grid[first], grid[first + 1], signs[np.arange(lines), first]
-    for _ in range(52):
+    for _ in range(42):  # to 2 pi / 16 / 2^42 = 9e-14 rad
         middle = 0.5 * (low + high)
         same = sign(middle) == low_sign
         low, high = np.where(same, middle, low), np.where(same, high, middle)
