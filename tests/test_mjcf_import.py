@@ -167,6 +167,8 @@ ARM = """<mujoco model="arm">
     ('<mujoco><include file="missing.xml"/></mujoco>', [], "arm.xml:1:9: include.file: cannot read 'missing.xml'"),
     (ARM.format(inside="").replace('<joint name="j2" axis="0 1 0"/>', '<joint name="j2" range="1 1"/>'), [],
      "body[link2].joint[j2].range: the range's low end 1 is not below its high end 1"),
+    (ARM.format(inside='<replicate count="2"><body name="copy"/></replicate>'), [],
+     "replicate: <replicate> makes bodies that jacgen does not read"),
 ])
 def test_what_cannot_be_read_is_one_line(text, arguments, expected, tmp_path):
     path = tmp_path / "arm.xml"
@@ -174,6 +176,16 @@ def test_what_cannot_be_read_is_one_line(text, arguments, expected, tmp_path):
     result = CliRunner().invoke(main, ["import-mjcf", str(path), *arguments])
     assert result.exit_code == 2, result.output
     assert len(result.output.strip().splitlines()) == 1 and expected in result.output, result.output
+
+
+def test_worldbody_sections_are_one(tmp_path):
+    """Bodies in a second <worldbody> (an included file's) are part of the tree: here the second
+    leaf, so that the tip must be named."""
+    path = tmp_path / "arm.xml"
+    path.write_text(ARM.format(inside="").replace("</mujoco>", '<worldbody><body name="table"/></worldbody></mujoco>'))
+    result = CliRunner().invoke(main, ["import-mjcf", str(path)])
+    assert result.exit_code == 2 and "the world has 2 leaf bodies below it ('link2', 'table')" in result.output
+    assert CliRunner().invoke(main, ["import-mjcf", str(path), "--tip", "tip"]).exit_code == 0
 
 
 def test_hostile_files(tmp_path):

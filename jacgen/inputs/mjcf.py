@@ -30,6 +30,7 @@ from jacgen.inputs.urdf import (DIGITS, MAX_URDF_BYTES, Element, LinkChain, Snap
 from jacgen.tolerances import WRITTEN_ANGLE_SNAP, WRITTEN_ANGLE_UNITS
 
 MAX_INCLUDES = 100
+GENERATING = ("replicate", "attach", "composite", "flexcomp")  # elements that make bodies: refused
 ORIENTATIONS = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
 DEFAULTED = {"joint": ("type", "pos", "axis", "range", "limited", "ref"), "site": ("pos",) + ORIENTATIONS}
 
@@ -145,9 +146,11 @@ class _MjcfReader:
 
     # -- the tree of bodies ----------------------------------------------------------------------
     def chain(self, root: Element, base: str | None, tip: str | None) -> LinkChain:
-        world = next((c for c in root.children if c.tag == "worldbody"), None)
-        if world is None:
+        worlds = [c for c in root.children if c.tag == "worldbody"]
+        if not worlds:
             raise self.error(root, "mujoco", "no <worldbody>")
+        world = Element("worldbody", {}, worlds[0].line, worlds[0].column,
+                        [child for w in worlds for child in w.children])  # a file's worldbody sections are one
         parent: dict[int, Element] = {}
         bodies: dict[str, Element] = {}
         sites: dict[str, Element] = {}
@@ -155,6 +158,9 @@ class _MjcfReader:
         while pending:
             element = pending.pop()
             for child in element.children:
+                if child.tag in GENERATING:
+                    raise self.error(child, child.tag, f"<{child.tag}> makes bodies that jacgen does not read: save "
+                                     "the model without it (MuJoCo's mj_saveLastXML writes it out) and import that")
                 if child.tag in ("body", "frame"):
                     parent[id(child)] = element
                     pending.append(child)
