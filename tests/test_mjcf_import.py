@@ -169,6 +169,8 @@ ARM = """<mujoco model="arm">
      "body[link2].joint[j2].range: the range's low end 1 is not below its high end 1"),
     (ARM.format(inside='<replicate count="2"><body name="copy"/></replicate>'), [],
      "replicate: <replicate> makes bodies that jacgen does not read"),
+    ('<mujoco><worldbody><body name="a"><body name="b"/></body></worldbody></mujoco>', [],
+     "arm.xml:1:1: no hinge or slide joint between the world and 'b'"),
 ])
 def test_what_cannot_be_read_is_one_line(text, arguments, expected, tmp_path):
     path = tmp_path / "arm.xml"

@@ -203,21 +203,21 @@ class _MjcfReader:
         while class_name == "main" and above is not None:
             class_name = above.attributes.get("childclass", "main")
             above = parent.get(id(above))
+        tip = tip or end.attributes.get("name", f"the body at line {end.line}")
+        moving = sum(c.tag in ("joint", "freejoint") for e in route if e.tag == "body" for c in e.children)
+        if not moving:  # counted before any pose is computed: a hostile chain is refused at once
+            raise RobotFileError(self.path, root.line, root.column, "", "no hinge or slide joint between "
+                                 f"{'the world' if base is None else repr(base)} and {tip!r}")
+        if moving > MAX_JOINTS:
+            raise RobotFileError(self.path, root.line, root.column, "", f"the chain has {moving} joints; "
+                                 f"a robot file holds at most {MAX_JOINTS}")
         joints: list[UrdfJoint] = []
         for element in reversed(route):
             joints += self.frame(element, class_name)
             class_name = element.attributes.get("childclass", class_name)
-        moving = [j for j in joints if j.kind != "fixed"]
-        if not moving:
-            raise RobotFileError(self.path, root.line, root.column, "", "no hinge or slide joint between "
-                                 f"{'the world' if base is None else repr(base)} and {tip!r}")
-        if len(moving) > MAX_JOINTS:
-            raise RobotFileError(self.path, root.line, root.column, "", f"the chain has {len(moving)} joints; "
-                                 f"a robot file holds at most {MAX_JOINTS}")
         folded = tuple(e.attributes.get("name", f"{e.tag}@{e.line}") for e in reversed(route)
                        if not any(c.tag in ("joint", "freejoint") for c in e.children))
-        return LinkChain(root.attributes.get("model", ""), base or "world",
-                         tip or end.attributes.get("name", "tip"), sympy.eye(4), tuple(joints), folded)
+        return LinkChain(root.attributes.get("model", ""), base or "world", tip, sympy.eye(4), tuple(joints), folded)
 
     @staticmethod
     def leaves(start: Element) -> list[Element]:
