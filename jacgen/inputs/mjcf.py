@@ -25,14 +25,15 @@ from sympy import Matrix
 from jacgen.errors import RobotFileError
 from jacgen.inputs.robot_file import MAX_JOINTS
 from jacgen.inputs.transforms import translation
-from jacgen.inputs.urdf import (DIGITS, MAX_URDF_BYTES, Element, LinkChain, Snapper, UrdfJoint, cos_sin, parse_xml,
-                                listed, number_of, snapped_axis)
+from jacgen.inputs.urdf import (DIGITS, Element, LinkChain, Snapper, UrdfJoint, cos_sin, listed, number_of,
+                                parse_xml, read_capped, snapped_axis)
 from jacgen.tolerances import WRITTEN_ANGLE_SNAP, WRITTEN_ANGLE_UNITS
 
 MAX_INCLUDES = 100
 GENERATING = ("replicate", "attach", "composite", "flexcomp")  # elements that make bodies: refused
 ORIENTATIONS = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
-DEFAULTED = {"joint": ("type", "pos", "axis", "range", "limited", "ref"), "site": ("pos",) + ORIENTATIONS}
+DEFAULTED = ("joint", "site")  # the elements whose <default> settings the reader takes
+JOINTS = ("joint", "freejoint")
 
 
 def read_mjcf_chain(path: str, base: str | None = None, tip: str | None = None,
@@ -67,16 +68,9 @@ class _MjcfReader:
 
     def parse(self, path: str, including: tuple[str, ...], include: Element | None = None) -> Element:
         """The file's tree with every include replaced by the included file's elements."""
-        try:
-            data = Path(path).read_bytes()
-        except OSError as error:
-            if include is not None:
-                raise self.error(include, "include.file", f"cannot read {include.attributes['file']!r}: "
-                                 f"{error.strerror or error}") from None
-            raise RobotFileError(path, 1, 1, "", f"cannot read file: {error.strerror or error}") from None
-        if len(data) > MAX_URDF_BYTES:
-            raise RobotFileError(path, 1, 1, "", f"file larger than {MAX_URDF_BYTES} bytes")
-        root = parse_xml(data, path, "an MJCF file")
+        if include is not None and not Path(path).is_file():
+            raise self.error(include, "include.file", f"cannot read {include.attributes['file']!r}: no such file")
+        root = parse_xml(read_capped(path), path, "an MJCF file")
         pending = [root]
         while pending:
             element = pending.pop()
@@ -204,7 +198,7 @@ class _MjcfReader:
             class_name = above.attributes.get("childclass", "main")
             above = parent.get(id(above))
         tip = tip or end.attributes.get("name", f"the body at line {end.line}")
-        moving = sum(c.tag in ("joint", "freejoint") for e in route if e.tag == "body" for c in e.children)
+        moving = sum(c.tag in JOINTS for e in route if e.tag == "body" for c in e.children)
         if not moving:  # counted before any pose is computed: a hostile chain is refused at once
             raise RobotFileError(self.path, root.line, root.column, "", "no hinge or slide joint between "
                                  f"{'the world' if base is None else repr(base)} and {tip!r}")
@@ -216,7 +210,7 @@ class _MjcfReader:
             joints += self.frame(element, class_name)
             class_name = element.attributes.get("childclass", class_name)
         folded = tuple(e.attributes.get("name", f"{e.tag}@{e.line}") for e in reversed(route)
-                       if not any(c.tag in ("joint", "freejoint") for c in e.children))
+                       if not any(c.tag in JOINTS for c in e.children))
         return LinkChain(root.attributes.get("model", ""), base or "world", tip, sympy.eye(4), tuple(joints), folded)
 
     @staticmethod
@@ -240,7 +234,7 @@ class _MjcfReader:
         entries = [UrdfJoint(name, "fixed", pose, Matrix([1, 0, 0]), None)]
         if element.tag != "body":
             return entries
-        joints = [c for c in element.children if c.tag in ("joint", "freejoint")]
+        joints = [c for c in element.children if c.tag in JOINTS]
         if len(joints) > 1:
             raise self.error(joints[1], key, f"body {name!r} has {len(joints)} joints: a DH row moves one joint "
                              "per body; give each joint a body of its own")
@@ -255,10 +249,11 @@ class _MjcfReader:
                              "of hinge (revolute) and slide (prismatic) joints")
         at = translation(*self.vector(joint, joint_key, "pos", own_class))
         axis = self.axis(joint, joint_key, own_class)
-        reference = self.number(self.attribute(joint, "ref", own_class) or "0", joint, f"{joint_key}.ref")
+        written = self.attribute(joint, "ref", own_class)
+        reference = self.number(written or "0", joint, f"{joint_key}.ref")
         limits = self.limits(joint, joint_key, kind, own_class)
         if kind == "hinge":
-            reference = self.angle(reference, self.attribute(joint, "ref", own_class))
+            reference = self.angle(reference, written)
             moved = rotation_about(axis, -reference) if reference != 0 else sympy.eye(4)
         else:
             moved = translation(*(-reference * axis))
@@ -285,9 +280,8 @@ class _MjcfReader:
 
     def angle(self, value: sympy.Expr, text: str | None) -> sympy.Expr:
         """An angle in the compiler's unit, in radians (exact k*pi/2 when so to its digits)."""
-        if self.angle_unit == "degree":
-            value = value * sympy.pi / 180
-            return self.snapper.angle(value, None) if value.is_Rational or (value / sympy.pi).is_Rational else value
+        if self.angle_unit == "degree":  # exact: a multiple of pi
+            return self.snapper.angle(value * sympy.pi / 180, None)
         return self.snapper.angle(value, text)
 
     def axis(self, joint: Element, key: str, class_name: str) -> Matrix:

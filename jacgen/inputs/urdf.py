@@ -155,13 +155,18 @@ def parse_xml(data: bytes, path: str, what: str = "a URDF") -> Element:
 def read_chain(path: str, base: str | None = None, tip: str | None = None, snapper: Snapper | None = None) -> LinkChain:
     """The chain of the URDF file at `path` from `base` (default: the root) to `tip`
     (default: the one leaf below `base`); `snapper` makes nearly exact angles and axes exact."""
+    return _UrdfReader(path, snapper or Snapper()).chain(parse_xml(read_capped(path), path), base, tip)
+
+
+def read_capped(path: str) -> bytes:
+    """The bytes of the XML file at `path`, refused (RobotFileError) past MAX_URDF_BYTES."""
     try:
         data = Path(path).read_bytes()
     except OSError as error:
         raise RobotFileError(path, 1, 1, "", f"cannot read file: {error.strerror or error}") from None
     if len(data) > MAX_URDF_BYTES:
         raise RobotFileError(path, 1, 1, "", f"file larger than {MAX_URDF_BYTES} bytes")
-    return _UrdfReader(path, snapper or Snapper()).chain(parse_xml(data, path), base, tip)
+    return data
 
 
 class _UrdfReader:

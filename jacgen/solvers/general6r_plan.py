@@ -4,7 +4,8 @@ the plan that the generated solvers take at a target where the first one's leadi
 singular to rounding (contract §2, "The fallback elimination").
 """
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -26,12 +27,19 @@ class Elimination:
     make the leading matrix, Q and the null vector best conditioned: `condition` is the largest
     of their median condition numbers over random configurations. `fallback`: the plan the
     solver takes at a target where this one's leading matrix is singular to rounding (its
-    condition number above DEGENERATE), or None."""
+    condition number above DEGENERATE), or None; chosen when first read, from `rated` (the
+    ratings of every split, `elimination` keeps them), so that a 7R arm rates both its free
+    joints but samples the degenerate set of the one it keeps only."""
 
     equations: Equations
     shift: float
     condition: float
-    fallback: "Elimination | None" = None
+    links: tuple = field(default=(), compare=False, repr=False)
+    rated: tuple = field(default=(), compare=False, repr=False)  # none for a fallback
+
+    @cached_property
+    def fallback(self) -> "Elimination | None":
+        return _fallback(list(self.links), self, self.rated) if self.rated else None
 
 
 # A target where the leading matrix M2 of the solver's plan has a 1-norm condition number above
@@ -55,13 +63,13 @@ def elimination(robot: Robot, free: int | None = None) -> Elimination:
     condition numbers."""
     _, links, _ = chain_form(robot, free)
     theta = np.random.default_rng(0).uniform(-np.pi, np.pi, (SAMPLES, 6))
-    rated = [_rated(links, split, theta) for split in SPLITS]
+    rated = tuple(_rated(links, split, theta) for split in SPLITS)
     best = None
     for equations_, conditions in rated:
         for shift, condition in conditions:
             if best is None or condition < best.condition * (1 - TIE):
-                best = Elimination(equations_, shift, condition)
-    return replace(best, fallback=_fallback(links, best, rated))
+                best = Elimination(equations_, shift, condition, tuple(links), rated)
+    return best
 
 
 def _rated(links: list[Link], split: Split, theta: np.ndarray) -> tuple[Equations, list[tuple[float, float]]]:
@@ -78,7 +86,7 @@ def _rated(links: list[Link], split: Split, theta: np.ndarray) -> tuple[Equation
     vector = float(np.median(singular[..., 0] / np.maximum(singular[..., -2], 1e-300)))
     made = []
     for shift in SHIFT_ANGLES:
-        leading = np.median(np.linalg.cond(half_angle(s0 - shifted(ss, sc, shift)[1])))
+        leading = np.median(np.linalg.cond(_leading(s0, ss, sc, shift)))
         made.append((shift, float(max(leading, pair, vector))))
     return equations_, made
 
@@ -97,8 +105,13 @@ def _free_equations(equations_: Equations, links: list[Link], theta: np.ndarray)
 def leading_condition(equations_: Equations, links: list[Link], shift: float, theta: np.ndarray) -> np.ndarray:
     """The 1-norm condition number of the leading matrix M2 at the loop angles theta (..., 6),
     as the generated solvers measure it."""
-    s0, ss, sc, _ = _free_equations(equations_, links, theta)
-    return np.linalg.cond(half_angle(s0 - shifted(ss, sc, shift)[1]), 1)
+    return np.linalg.cond(_leading(*_free_equations(equations_, links, theta)[:3], shift), 1)
+
+
+def _leading(s0: np.ndarray, ss: np.ndarray, sc: np.ndarray, shift: float) -> np.ndarray:
+    """The leading matrix M2 (..., 12, 12) of the pencil of the free equations S0, Ss, Sc, the
+    hidden angle's half angle taken from `shift`."""
+    return half_angle(s0 - shifted(ss, sc, shift)[1])
 
 
 def degenerate_set(plan: Elimination, links: list[Link], lines: int, rng) -> np.ndarray:
@@ -109,8 +122,8 @@ def degenerate_set(plan: Elimination, links: list[Link], lines: int, rng) -> np.
     grid = np.linspace(-np.pi, np.pi, 17)
 
     def sign(t):
-        s0, ss, sc, _ = _free_equations(plan.equations, links, starts + t[:, None] * directions)
-        return np.linalg.slogdet(half_angle(s0 - shifted(ss, sc, plan.shift)[1]))[0]
+        free = _free_equations(plan.equations, links, starts + t[:, None] * directions)[:3]
+        return np.linalg.slogdet(_leading(*free, plan.shift))[0]
 
     signs = np.stack([sign(np.full(lines, t)) for t in grid], axis=1)
     change = signs[:, :-1] * signs[:, 1:] < 0
@@ -124,7 +137,7 @@ def degenerate_set(plan: Elimination, links: list[Link], lines: int, rng) -> np.
     return (starts + 0.5 * (low + high)[:, None] * directions)[crossing]
 
 
-def _fallback(links: list[Link], first: Elimination, rated: list[tuple]) -> Elimination | None:
+def _fallback(links: list[Link], first: Elimination, rated: tuple) -> Elimination | None:
     """The plan for targets where `first` degenerates: of the other splits and their shifts, the
     one best by the larger of its rating and its worst leading-matrix condition on the first
     plan's degenerate set (`degenerate_set`, DEGENERATE_LINES lines). None where none is below
@@ -134,9 +147,9 @@ def _fallback(links: list[Link], first: Elimination, rated: list[tuple]) -> Elim
     for equations_, conditions in rated:
         if equations_.split == first.equations.split:
             continue
-        s0, ss, sc, _ = _free_equations(equations_, links, degenerate)
+        free = _free_equations(equations_, links, degenerate)[:3]
         for shift, condition in conditions:
-            worst = np.linalg.cond(half_angle(s0 - shifted(ss, sc, shift)[1]), 1).max(initial=0.0)
+            worst = np.linalg.cond(_leading(*free, shift), 1).max(initial=0.0)
             rating = max(condition, float(worst))
             if best_rating is None or rating < best_rating * (1 - TIE):
                 best, best_rating = Elimination(equations_, shift, condition), rating
