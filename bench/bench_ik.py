@@ -25,7 +25,10 @@ Puma 560 perturbed at random there (twists by up to 5e-3 rad, lengths by up to 0
 7-axis Sawyer and calibrated Panda with joint 7 free (at its generating value), on random
 poses (fk of uniform joint vectors): the C `NAME_ik` in a native loop (for a
 calibrated arm: with its fast path, with the eigenproblem alone, and the nominal arm's own
-closed form as the yardstick), the batched numpy `ik_branches` (all poses in one call), and ssik 8.2.0
+closed form as the yardstick; and the native module's `ik_branches` on the batch, one thread: the
+same C built as `jacgen.arm(..., backend="native")` builds it, vectorised for this machine, so that
+the fast path's 8 Newton rows run in vector lanes), the batched numpy `ik_branches` (all poses in
+one call), and ssik 8.2.0
 (`ssik.Manipulator.from_dh(...).solve`, its C++ path, when installed; its `prepare` takes
 30-60 s per arm and is not timed). Per solver: microseconds per pose, the mean number of
 solutions, the rate at which the generating configuration is among them, the rate of
@@ -44,6 +47,7 @@ from eaik.IK_DH import DhRobot
 from ik_geo import Robot as IkGeoRobot
 
 import common
+import jacgen
 from common import kinematic_chain, without_limits
 from jacgen.checking import reference
 from jacgen.checking.c_library import CLibrary
@@ -106,10 +110,14 @@ def _ssik_solver(robot):
     return solve
 
 
-def _general_arm(name: str):
-    """A shipped arm, or one of the calibrated arms of tests/data/calibrated/."""
+def _general_path(name: str) -> Path:
+    """A shipped arm's robot file, or one of the calibrated arms' of tests/data/calibrated/."""
     path = common.ROOT / "robots" / f"{name}.yaml"
-    return load_robot(path if path.exists() else common.ROOT / "tests" / "data" / "calibrated" / f"{name}.yaml")
+    return path if path.exists() else common.ROOT / "tests" / "data" / "calibrated" / f"{name}.yaml"
+
+
+def _general_arm(name: str):
+    return load_robot(_general_path(name))
 
 
 def valid_rows(library: CLibrary, T: np.ndarray, free: tuple) -> np.ndarray:
@@ -153,6 +161,12 @@ def general_table(targets_count: int, rounds: int, folder: Path) -> None:
             source = common.generate(nominal, folder) / f"{nominal.name}.c"
             micros, _ = common.native_ik(nominal, source, targets, rounds, folder, frees)
             rows["C native, nominal arm's closed form"] = (micros, None)
+            native = jacgen.arm(_general_path(name), backend="native", functions="ik_branches", cache_folder=folder)
+            timing = common.timed(lambda: native.ik_branches(targets, *([] if frees is None else [frees]), threads=1),
+                                  rounds)
+            branches, valid, _ = timing.result
+            rows[f"native module ({native.SIMD}), fast path"] = (timing.seconds * 1e6 / len(targets),
+                                                               [b[v] for b, v in zip(branches, valid)])
             decided = module._fast_branches(targets, *([] if frees is None else [frees]))[2].mean()
             print(f"{name:19s} the fast path decides {decided:.1%} of the poses; the rest go to the eigenproblem")
         batch = common.timed(lambda: module.ik_branches(targets, *([] if frees is None else [frees])), rounds)

@@ -275,6 +275,67 @@ static int jacgen_g6_solve(int n, double *a, int nb, double *b) {
     return 0;
 }
 
+/* The Newton steps' linear solves, JACGEN_G6_LANES 6 x 6 systems at once: lane k of a and b
+ * holds system k, a x = b, and x replaces b. The arithmetic and pivots of jacgen_g6_solve (each
+ * row swapped with the pivot row where its entry is larger, so the largest ends there first),
+ * but a swap is a select in every lane, never a jump: a compiler vectorises the loops over the
+ * lanes (JACGEN_SIMD_LOOP). solved[k] is 0 where a pivot is 0 (b is then not x). */
+#define JACGEN_G6_LANES 8
+#ifdef JACGEN_SIMD_LOOP  /* the native module's kernels define it (omp simd), JACGEN_SIMD_KERNEL (flatten) and JACGEN_KERNEL_LOOP (unroll) */
+#define JACGEN_SKIP_LANE(skip)  /* a vector computes every lane: a skipped one would take a branch */
+#else
+#define JACGEN_SIMD_LOOP
+#define JACGEN_SIMD_KERNEL
+#define JACGEN_KERNEL_LOOP
+#define JACGEN_SKIP_LANE(skip) if (skip) continue;
+#endif
+struct jacgen_g6_lanes {
+    double a[6][6][JACGEN_G6_LANES], b[6][JACGEN_G6_LANES];
+    int solved[JACGEN_G6_LANES];
+};
+
+static void jacgen_g6_solve_lanes(struct jacgen_g6_lanes *restrict s, const int *restrict moving) {
+    long k;
+    JACGEN_SIMD_LOOP
+    for (k = 0; k < JACGEN_G6_LANES; k++) {
+        JACGEN_SKIP_LANE(!moving[k])
+        int solved = 1;
+        JACGEN_KERNEL_LOOP
+        for (int c = 0; c < 6; c++) {
+            JACGEN_KERNEL_LOOP
+            for (int r = c + 1; r < 6; r++) {
+                int larger = fabs(s->a[r][c][k]) > fabs(s->a[c][c][k]);
+                JACGEN_KERNEL_LOOP
+                for (int j = c; j < 6; j++) {
+                    double pivot_row = s->a[c][j][k], row = s->a[r][j][k];
+                    s->a[c][j][k] = larger ? row : pivot_row;
+                    s->a[r][j][k] = larger ? pivot_row : row;
+                }
+                double pivot_row = s->b[c][k], row = s->b[r][k];
+                s->b[c][k] = larger ? row : pivot_row;
+                s->b[r][k] = larger ? pivot_row : row;
+            }
+            solved &= fabs(s->a[c][c][k]) > 0.0;
+            double inverse = s->a[c][c][k] = 1.0 / s->a[c][c][k];
+            JACGEN_KERNEL_LOOP
+            for (int r = c + 1; r < 6; r++) {
+                double f = s->a[r][c][k] * inverse;
+                JACGEN_KERNEL_LOOP
+                for (int j = c + 1; j < 6; j++) s->a[r][j][k] -= f * s->a[c][j][k];
+                s->b[r][k] -= f * s->b[c][k];
+            }
+        }
+        JACGEN_KERNEL_LOOP
+        for (int c = 5; c >= 0; c--) {
+            double sum = s->b[c][k];
+            JACGEN_KERNEL_LOOP
+            for (int j = c + 1; j < 6; j++) sum -= s->a[c][j][k] * s->b[j][k];
+            s->b[c][k] = sum * s->a[c][c][k];
+        }
+        s->solved[k] = solved;
+    }
+}
+
 /* The null vector of a (12 x 12, singular to rounding) by inverse iteration: LU with partial
  * pivoting, then U v = (1, ..., 1), the start vector L (1, ..., 1) being one whose component
  * along the null vector the elimination does not cancel (Wilkinson). A zero pivot is taken as
@@ -8109,41 +8170,73 @@ static int sawyer_ik_general_add(const sawyer_real x[SAWYER_DOF], int count, saw
     return 1;
 }
 
-/* |e|^2 at x; and unless x has converged (|e|^2 <= 8.003523902500002e-24), x moved by one Newton step
- * x + J^-1 e (in double; x stays where J is singular); J's columns are the joints other than the free one. */
-static sawyer_real sawyer_ik_general_newton(const sawyer_real T[16], sawyer_real x[SAWYER_DOF])
+/* The Newton steps' working memory: JACGEN_G6_LANES configurations, rows 8 apart in x and e and
+ * 64 apart in J (powers of two, which a compiler vectorises across rows), and their solves. */
+struct sawyer_ik_lanes {
+    sawyer_real x[JACGEN_G6_LANES * 8], e[JACGEN_G6_LANES * 8], J[JACGEN_G6_LANES * 64];
+    struct jacgen_g6_lanes solve;
+};
+
+/* The pose error e and the Jacobian J at the rows of x that moved, in one loop over the rows (a
+ * vector build computes every row: the others' x, so e and J, are what they were). */
+JACGEN_SIMD_KERNEL static void sawyer_ik_general_residuals(const sawyer_real *restrict T, const sawyer_real *restrict x,
+                                                        const int *restrict moved, sawyer_real *restrict e,
+                                                        sawyer_real *restrict J)
 {
-    sawyer_real e[6], J[36], cost = 0;
-    double a[36], b[6];
-    int i;
-    sawyer_ik_general_residual(T, x, e, J);
-    for (i = 0; i < 36; ++i) a[i] = (double)J[i];
-    for (i = 0; i < 6; ++i) {
-        b[i] = (double)e[i];
-        cost += e[i] * e[i];
+    long k;
+    JACGEN_SIMD_LOOP
+    for (k = 0; k < JACGEN_G6_LANES; k++) {
+        JACGEN_SKIP_LANE(!moved[k])
+        sawyer_ik_general_residual(T, x + 8 * k, e + 8 * k, J + 64 * k);
     }
-    static const int solved[6] = {0, 1, 2, 3, 4, 5};
-    if (!(cost <= 8.003523902500002e-24) && jacgen_g6_solve(6, a, 1, b) == 0)
-        for (i = 0; i < 6; ++i) x[solved[i]] += (sawyer_real)b[i];
-    return cost;
 }
 
-/* |e|^2 at x after up to `steps` more Newton steps from x, at which it is `cost` (fewer once x has
- * converged). */
-static sawyer_real sawyer_ik_general_polish(const sawyer_real T[16], sawyer_real x[SAWYER_DOF], sawyer_real cost, int steps)
+/* Newton steps on this arm from every row of l->x at once, each step x + J^-1 e (in double; a row
+ * stays where J is singular); J's columns are the joints other than the free one. A row
+ * moves while it is `active` and has not converged (|e|^2 > 8.003523902500002e-24), up to `moves` times;
+ * cost[k] is |e|^2 at row k's x, the last one computed (0 where not active). Every step runs over all
+ * rows with selects, not branches, so that a compiler vectorises the rows. */
+static void sawyer_ik_general_newton(const sawyer_real T[16], struct sawyer_ik_lanes *l, const int active[JACGEN_G6_LANES],
+                                  int moves, sawyer_real cost[JACGEN_G6_LANES])
 {
-    int s;
-    for (s = 0; s < steps && cost > 8.003523902500002e-24; ++s) cost = sawyer_ik_general_newton(T, x);
-    return cost;
+    static const int solved[6] = {0, 1, 2, 3, 4, 5};
+    int moving[JACGEN_G6_LANES], any, i, k, step;
+    for (k = 0; k < JACGEN_G6_LANES; ++k) {
+        moving[k] = active[k];
+        cost[k] = 0;
+    }
+    for (step = 0;; ++step) {
+        sawyer_ik_general_residuals(T, l->x, moving, l->e, l->J);
+        any = 0;
+        for (k = 0; k < JACGEN_G6_LANES; ++k) {
+            if (!moving[k]) continue;  /* it keeps its cost */
+            cost[k] = 0;
+            for (i = 0; i < 6; ++i) cost[k] += l->e[8 * k + i] * l->e[8 * k + i];
+            moving[k] = !(cost[k] <= 8.003523902500002e-24);
+            any |= moving[k];
+        }
+        if (!any || step == moves) return;
+        for (i = 0; i < 36; ++i)  /* (a row that was never computed: 0) */
+            for (k = 0; k < JACGEN_G6_LANES; ++k) l->solve.a[i / 6][i % 6][k] = moving[k] ? (double)l->J[64 * k + i] : 0.0;
+        for (i = 0; i < 6; ++i)
+            for (k = 0; k < JACGEN_G6_LANES; ++k) l->solve.b[i][k] = moving[k] ? (double)l->e[8 * k + i] : 0.0;
+        jacgen_g6_solve_lanes(&l->solve, moving);
+        for (i = 0; i < 6; ++i) {
+            JACGEN_SIMD_LOOP
+            for (k = 0; k < JACGEN_G6_LANES; ++k)
+                l->x[8 * k + solved[i]] += moving[k] && l->solve.solved[k] ? (sawyer_real)l->solve.b[i][k] : 0;
+        }
+    }
 }
 
-/* The general 6R solver's working memory: 22992 bytes in this build. A local of
+/* The general 6R solver's working memory: 30832 bytes in this build. A local of
  * sawyer_ik_branches (on its stack) unless SAWYER_IK_STATIC_WORK is defined: then one static
  * object, and sawyer_ik_branches (with sawyer_ik and sawyer_ik_nearest) is not reentrant. */
 struct sawyer_ik_work {
     sawyer_real P[378], Q[112];
     double p[3][14][9], q[14][8], roots[JACGEN_G6_ROOTS][5];
     struct jacgen_g6_work kernel;
+    struct sawyer_ik_lanes lanes;
 };
 #ifdef SAWYER_IK_STATIC_WORK
 static struct sawyer_ik_work sawyer_ik_static_work;
@@ -8162,9 +8255,10 @@ void sawyer_ik_branches(const sawyer_real T[16], sawyer_real q_free, sawyer_real
 #else
     struct sawyer_ik_work work, *w = &work;
 #endif
-    sawyer_real angles[5], x[SAWYER_DOF];
+    struct sawyer_ik_lanes *l = &w->lanes;
+    sawyer_real angles[5], cost[JACGEN_G6_LANES];
     double condition;
-    int count = 0, found, i, j, k, fallback;
+    int count = 0, found, i, j, k, first, active[JACGEN_G6_LANES], fallback;
     sawyer_ik_general_clear(q, valid, in_limits);
     sawyer_ik_general_equations(T, q_free, w->P, w->Q);
     for (i = 0; i < 378; ++i) w->p[i / 126][i / 9 % 14][i % 9] = (double)w->P[i];
@@ -8177,15 +8271,19 @@ void sawyer_ik_branches(const sawyer_real T[16], sawyer_real q_free, sawyer_real
         for (i = 0; i < 112; ++i) w->q[i / 8][i % 8] = (double)w->Q[i];
         found = jacgen_general6r_roots(w->p, w->q, w->roots, &w->kernel, &condition);
     }
-    for (k = 0; k < found && count < SAWYER_MAX_IK_SOLUTIONS; ++k) {
-        for (j = 0; j < 5; ++j) angles[j] = (sawyer_real)w->roots[k][j];
-        if (fallback)
-            sawyer_ik_general_start_fallback(T, q_free, angles, x);
-        else
-            sawyer_ik_general_start(T, q_free, angles, x);
-        if (!(sawyer_ik_general_polish(T, x, sawyer_ik_general_newton(T, x), 6)
-              <= 1e-18)) continue;
-        count += sawyer_ik_general_add(x, count, q, valid, in_limits);
+    for (first = 0; first < found; first += JACGEN_G6_LANES) {  /* the roots, JACGEN_G6_LANES at a time */
+        for (k = 0; k < JACGEN_G6_LANES; ++k) {
+            active[k] = first + k < found;
+            for (j = 0; j < 5; ++j) angles[j] = active[k] ? (sawyer_real)w->roots[first + k][j] : 0;
+            if (fallback)
+                sawyer_ik_general_start_fallback(T, q_free, angles, l->x + 8 * k);
+            else
+                sawyer_ik_general_start(T, q_free, angles, l->x + 8 * k);
+        }
+        sawyer_ik_general_newton(T, l, active, 6, cost);
+        for (k = 0; k < JACGEN_G6_LANES && count < SAWYER_MAX_IK_SOLUTIONS; ++k)
+            if (active[k] && cost[k] <= 1e-18)
+                count += sawyer_ik_general_add(l->x + 8 * k, count, q, valid, in_limits);
     }
 }
 

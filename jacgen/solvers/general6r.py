@@ -388,9 +388,11 @@ def mismatch(robot: Robot, nominal: Robot) -> tuple[float, float]:
 
 def work_bytes(real: str) -> int:
     """The size of the C solver's working memory (struct NAME_ik_work in templates/c/ik.c.jinja:
-    the equations in the build's real type and in double, the kernel's matrices in double), as
+    the equations in the build's real type and in double, the kernel's matrices in double, and
+    the Newton steps' 8 rows of x, e and J in the real type, with their solves in double), as
     the contract documents it; tests/test_shipped_robots.py checks it against the compiler's."""
-    reals = 378 + 112
+    lanes = 8  # JACGEN_G6_LANES
+    reals = 378 + 112 + lanes * (8 + 8 + 64)
     doubles = 3 * 14 * 9 + 14 * 8 + 16 * 5 + (14 * 8 + 8 + 8 + 6 * 14 + 3 * 6 * 9 + 3 * 12 * 12 + 2 * 12 * 4 + 12 * 28
-                                           + 16 * 16 + 2 * 12 * 12 + 16 + 16)
-    return reals * {"double": 8, "float": 4}[real] + doubles * 8
+                                           + 16 * 16 + 2 * 12 * 12 + 16 + 16) + lanes * (6 * 6 + 6)
+    return reals * {"double": 8, "float": 4}[real] + doubles * 8 + lanes * 4  # and the solves' int flags

@@ -104,6 +104,67 @@ static int jacgen_g6_solve(int n, double *a, int nb, double *b) {
     return 0;
 }
 
+/* The Newton steps' linear solves, JACGEN_G6_LANES 6 x 6 systems at once: lane k of a and b
+ * holds system k, a x = b, and x replaces b. The arithmetic and pivots of jacgen_g6_solve (each
+ * row swapped with the pivot row where its entry is larger, so the largest ends there first),
+ * but a swap is a select in every lane, never a jump: a compiler vectorises the loops over the
+ * lanes (JACGEN_SIMD_LOOP). solved[k] is 0 where a pivot is 0 (b is then not x). */
+#define JACGEN_G6_LANES 8
+#ifdef JACGEN_SIMD_LOOP  /* the native module's kernels define it (omp simd), JACGEN_SIMD_KERNEL (flatten) and JACGEN_KERNEL_LOOP (unroll) */
+#define JACGEN_SKIP_LANE(skip)  /* a vector computes every lane: a skipped one would take a branch */
+#else
+#define JACGEN_SIMD_LOOP
+#define JACGEN_SIMD_KERNEL
+#define JACGEN_KERNEL_LOOP
+#define JACGEN_SKIP_LANE(skip) if (skip) continue;
+#endif
+struct jacgen_g6_lanes {
+    double a[6][6][JACGEN_G6_LANES], b[6][JACGEN_G6_LANES];
+    int solved[JACGEN_G6_LANES];
+};
+
+static void jacgen_g6_solve_lanes(struct jacgen_g6_lanes *restrict s, const int *restrict moving) {
+    long k;
+    JACGEN_SIMD_LOOP
+    for (k = 0; k < JACGEN_G6_LANES; k++) {
+        JACGEN_SKIP_LANE(!moving[k])
+        int solved = 1;
+        JACGEN_KERNEL_LOOP
+        for (int c = 0; c < 6; c++) {
+            JACGEN_KERNEL_LOOP
+            for (int r = c + 1; r < 6; r++) {
+                int larger = fabs(s->a[r][c][k]) > fabs(s->a[c][c][k]);
+                JACGEN_KERNEL_LOOP
+                for (int j = c; j < 6; j++) {
+                    double pivot_row = s->a[c][j][k], row = s->a[r][j][k];
+                    s->a[c][j][k] = larger ? row : pivot_row;
+                    s->a[r][j][k] = larger ? pivot_row : row;
+                }
+                double pivot_row = s->b[c][k], row = s->b[r][k];
+                s->b[c][k] = larger ? row : pivot_row;
+                s->b[r][k] = larger ? pivot_row : row;
+            }
+            solved &= fabs(s->a[c][c][k]) > 0.0;
+            double inverse = s->a[c][c][k] = 1.0 / s->a[c][c][k];
+            JACGEN_KERNEL_LOOP
+            for (int r = c + 1; r < 6; r++) {
+                double f = s->a[r][c][k] * inverse;
+                JACGEN_KERNEL_LOOP
+                for (int j = c + 1; j < 6; j++) s->a[r][j][k] -= f * s->a[c][j][k];
+                s->b[r][k] -= f * s->b[c][k];
+            }
+        }
+        JACGEN_KERNEL_LOOP
+        for (int c = 5; c >= 0; c--) {
+            double sum = s->b[c][k];
+            JACGEN_KERNEL_LOOP
+            for (int j = c + 1; j < 6; j++) sum -= s->a[c][j][k] * s->b[j][k];
+            s->b[c][k] = sum * s->a[c][c][k];
+        }
+        s->solved[k] = solved;
+    }
+}
+
 /* The null vector of a (12 x 12, singular to rounding) by inverse iteration: LU with partial
  * pivoting, then U v = (1, ..., 1), the start vector L (1, ..., 1) being one whose component
  * along the null vector the elimination does not cancel (Wilkinson). A zero pivot is taken as
