@@ -110,14 +110,9 @@ def _ssik_solver(robot):
     return solve
 
 
-def _general_path(name: str) -> Path:
-    """A shipped arm's robot file, or one of the calibrated arms' of tests/data/calibrated/."""
-    path = common.ROOT / "robots" / f"{name}.yaml"
-    return path if path.exists() else common.ROOT / "tests" / "data" / "calibrated" / f"{name}.yaml"
-
-
 def _general_arm(name: str):
-    return load_robot(_general_path(name))
+    """A shipped arm, or one of the calibrated arms of tests/data/calibrated/."""
+    return load_robot(common.robot_path(name))
 
 
 def valid_rows(library: CLibrary, T: np.ndarray, free: tuple) -> np.ndarray:
@@ -161,7 +156,7 @@ def general_table(targets_count: int, rounds: int, folder: Path) -> None:
             source = common.generate(nominal, folder) / f"{nominal.name}.c"
             micros, _ = common.native_ik(nominal, source, targets, rounds, folder, frees)
             rows["C native, nominal arm's closed form"] = (micros, None)
-            native = jacgen.arm(_general_path(name), backend="native", functions="ik_branches", cache_folder=folder)
+            native = jacgen.arm(common.robot_path(name), backend="native", functions="ik_branches", cache_folder=folder)
             timing = common.timed(lambda: native.ik_branches(targets, *([] if frees is None else [frees]), threads=1),
                                   rounds)
             branches, valid, _ = timing.result

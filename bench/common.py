@@ -95,6 +95,12 @@ def shipped(name: str):
     return load_robot(ROOT / "robots" / f"{name}.yaml")
 
 
+def robot_path(name: str) -> Path:
+    """robots/NAME.yaml, or else the calibrated or perturbed arm tests/data/calibrated/NAME.yaml."""
+    path = ROOT / "robots" / f"{name}.yaml"
+    return path if path.exists() else ROOT / "tests" / "data" / "calibrated" / f"{name}.yaml"
+
+
 def generate(robot, folder: Path, languages=("c",), real: str = "double") -> Path:
     """Render `robot` in `languages` into folder/NAME/ and return that folder."""
     write_files(render_robot(robot, languages, real), folder)
