@@ -2,9 +2,9 @@
 
     PYTHONPATH=. python bench/bench_firmware.py [--samples 200]
 
-Needs arm-none-eabi-gcc, newlib and qemu-system-arm (`jacgen.target`). For the Puma 560, the
+Needs arm-none-eabi-gcc, newlib and qemu-system-arm (`jacgen.checking.cortex_m4f`). For the Puma 560, the
 UR5 and the Panda, both are built the same way in the same run (-O2, Cortex-M4F hard float,
-`jacgen.target`'s harness on QEMU mps2-an386) and called at the same random configurations:
+`jacgen.checking.cortex_m4f`'s harness on QEMU mps2-an386) and called at the same random configurations:
 
 - jacgen: `NAME_fk_jacobian` and `NAME_jacobian_det` (`NAME_manipulability` for the 7-axis
   Panda, which has no square Jacobian) as generated with `--real float`;

@@ -28,7 +28,7 @@ main printing `ROUND NS ROBOT VARIANT` per loop and round; `build` compiles it, 
 runs it and takes the medians. One set of flags, FLAGS (-O2 -DNDEBUG; C as -std=c99, C++
 as -std=c++17, linked with -lm), every source its own translation unit (no inlining across
 them); the shared libraries called through ctypes (`shared_library`) take the same FLAGS,
-beside jacgen.compile's warning flags.
+beside jacgen.checking.c_library's warning flags.
 """
 
 import importlib

@@ -4,7 +4,7 @@ construction (similarity transforms of block-diagonal matrices, companion matric
 polynomials with given roots, repeated ones included) and against LAPACK;
 templates/runtime/general6r.c (the elimination from the equations at a target to the loop
 angles) through whole solutions: the configurations its roots complete to reach the pose on
-the numpy reference, the generating one among them, as many as numpy's eigensolver gives; its tables are those of jacgen/general6r.py."""
+the numpy reference, the generating one among them, as many as numpy's eigensolver gives; its tables are those of jacgen/solvers/general6r.py."""
 
 import ctypes
 import math
@@ -192,7 +192,7 @@ def test_general6r_roots_complete_to_every_solution(library, name):
 
 
 def test_tables_are_those_of_the_numpy_solver(library):
-    """The C's MONOMIALS (written out) and ALONG_B, ALONG_C are jacgen/general6r.py's."""
+    """The C's MONOMIALS (written out) and ALONG_B, ALONG_C are jacgen/solvers/general6r.py's."""
     for k in range(9):
         unit, out = np.eye(9)[k], np.zeros(9)
         library.monomials(unit.ctypes.data_as(POINTER), out.ctypes.data_as(POINTER))

@@ -1,5 +1,5 @@
 """The generated float C on an emulated Cortex-M4F: `make -C examples/firmware check-m4`, which
-runs `jacgen verify --target cortex-m4f` (jacgen/target.py), passes on the C jacgen generates,
+runs `jacgen verify --target cortex-m4f` (jacgen/checking/cortex_m4f.py), passes on the C jacgen generates,
 fails when one constant of it is wrong, and reports the resources the contract bounds."""
 
 import re

@@ -171,8 +171,8 @@ static int jacgen_eigenvalues(int n, double a[JACGEN_EIG_MAX][JACGEN_EIG_MAX], d
 #define JACGEN_G6_DEGENERATE 10000000.0
 /* Runtime helper of the general 6R solver (included by robot.c.jinja for its robots): from
  * Raghavan & Roth's 14 equations at one target, (P0 + s Ps + c Pc) v_bc = Q v_gh with the hidden
- * angle's shift already applied (jacgen/general6r.py), the loop angles (a, b, c, g, h) of every
- * real root. Q = QR by Householder reflections: the rows 8..13 of Q^T P are the six equations
+ * angle's shift already applied (jacgen/solvers/general6r.py), the loop angles (a, b, c, g, h)
+ * of every real root. Q = QR by Householder reflections: the rows 8..13 of Q^T P are the six equations
  * free of v_gh; their twelve in the monomials x_b^i x_c^j (the six, and the six times x_b) give
  * M(x) = M0 + x M1 + x^2 M2, x = tan(a / 2). Of the 24 eigenvalues of its companion matrix, 8 are
  * x = +-i for every target (jacgen_g6_spurious); the other 16 are those of the companion matrix
@@ -182,11 +182,16 @@ static int jacgen_eigenvalues(int n, double a[JACGEN_EIG_MAX][JACGEN_EIG_MAX], d
  * M2's 1-norm condition number in *condition (infinite when it is singular): above
  * JACGEN_G6_DEGENERATE, its eigenvalues are noise and the caller takes its fallback elimination.
  * Defined before it: JACGEN_G6_IMAGINARY, an eigenvalue being a root when |imaginary part| <= that
- * (1 + |x|) (jacgen/general6r.py's IMAGINARY for the build's real type). */
+ * (1 + |x|) (jacgen/solvers/general6r.py's IMAGINARY for the build's real type). */
 #define JACGEN_G6_ROOTS 16
+/* The QR of Q (14 x 8) is singular where an entry of R's diagonal is below this times the largest. */
+#define JACGEN_G6_SINGULAR_R 1e-12
+/* The rounding a zero pivot of the null vector's LU stands for, relative to the largest pivot. */
+#define JACGEN_G6_ZERO_PIVOT 1e-16
 
 /* sum_k c[k] v_bc[k] times (1 + x_b^2) (1 + x_c^2) as a polynomial in x_b, x_c: its coefficient of
- * x_b^i x_c^j at 3 i + j (jacgen/general6r.py's MONOMIALS, written out without its zeros). */
+ * x_b^i x_c^j at 3 i + j (jacgen/solvers/general6r.py's MONOMIALS, written out without its
+ * zeros). */
 static void jacgen_g6_monomials(const double c[9], double out[9]) {
     out[0] = c[3] + c[5] + c[7] + c[8];
     out[1] = 2.0 * c[2] + 2.0 * c[6];
@@ -221,7 +226,7 @@ static int jacgen_g6_qr(double q[14][8], double beta[8], double rdiag[8]) {
     double largest = 0.0;
     for (int k = 0; k < 8; k++) largest = fmax(largest, fabs(rdiag[k]));
     for (int k = 0; k < 8; k++)
-        if (!(fabs(rdiag[k]) > 1e-12 * largest)) return -1;
+        if (!(fabs(rdiag[k]) > JACGEN_G6_SINGULAR_R * largest)) return -1;
     return 0;
 }
 
@@ -281,8 +286,10 @@ static int jacgen_g6_solve(int n, double *a, int nb, double *b) {
  * but a swap is a select in every lane, never a jump: a compiler vectorises the loops over the
  * lanes (JACGEN_SIMD_LOOP). solved[k] is 0 where a pivot is 0 (b is then not x). */
 #define JACGEN_G6_LANES 8
-#ifdef JACGEN_SIMD_LOOP  /* the native module's kernels define it (omp simd), JACGEN_SIMD_KERNEL (flatten) and JACGEN_KERNEL_LOOP (unroll) */
-#define JACGEN_SKIP_LANE(skip)  /* a vector computes every lane: a skipped one would take a branch */
+/* The native module's kernels define JACGEN_SIMD_LOOP (omp simd), JACGEN_SIMD_KERNEL (flatten)
+ * and JACGEN_KERNEL_LOOP (unroll). A vector computes every lane: none is skipped there. */
+#ifdef JACGEN_SIMD_LOOP
+#define JACGEN_SKIP_LANE(skip)
 #else
 #define JACGEN_SIMD_LOOP
 #define JACGEN_SIMD_KERNEL
@@ -339,7 +346,7 @@ static void jacgen_g6_solve_lanes(struct jacgen_g6_lanes *restrict s, const int 
 /* The null vector of a (12 x 12, singular to rounding) by inverse iteration: LU with partial
  * pivoting, then U v = (1, ..., 1), the start vector L (1, ..., 1) being one whose component
  * along the null vector the elimination does not cancel (Wilkinson). A zero pivot is taken as
- * the rounding that it is: 1e-16 times the largest pivot before it. Rows with a zero below the
+ * the rounding that it is: JACGEN_G6_ZERO_PIVOT times the largest pivot before it. Rows with a zero below the
  * pivot are skipped: M(x)'s rows 6..11 have none in columns 0..2. (a: overwritten, U with its
  * inverted diagonal.) */
 static void jacgen_g6_null_vector(double a[12][12], double v[12]) {
@@ -350,7 +357,7 @@ static void jacgen_g6_null_vector(double a[12][12], double v[12]) {
             if (fabs(a[i][k]) > fabs(a[p][k])) p = i;
         if (p != k)
             for (int j = k; j < 12; j++) { double t = a[k][j]; a[k][j] = a[p][j]; a[p][j] = t; }
-        if (a[k][k] == 0.0) a[k][k] = 1e-16 * largest;
+        if (a[k][k] == 0.0) a[k][k] = JACGEN_G6_ZERO_PIVOT * largest;
         else if (k == 0 || fabs(a[k][k]) > largest) largest = fabs(a[k][k]);
         double inverse = 1.0 / a[k][k];
         for (int i = k + 1; i < 12; i++) {

@@ -15,7 +15,7 @@ dexterity whose results are not unique or not well conditioned (the velocity ell
 condition number, ...) by what characterises them (`dexterity_checks`).
 
 `--target cortex-m4f` checks the float C alone, run on an emulated Cortex-M4F
-(`jacgen.target`), with the same samples, comparisons and tolerances.
+(`jacgen.checking.cortex_m4f`), with the same samples, comparisons and tolerances.
 """
 
 import inspect
@@ -303,7 +303,7 @@ def verify(robots: list[Robot], samples: int, seed: int,
     ROBOT/float/...) when one is given, to a temporary folder otherwise.
 
     With a `target` ("cortex-m4f"), only the float C is checked, run on the emulated target
-    (`jacgen.target`), one robot after the other: the C generated now, or NAME.h and NAME.c
+    (`jacgen.checking.cortex_m4f`), one robot after the other: the C generated now, or NAME.h and NAME.c
     from `sources`. Each robot's Emulator, with the instructions and stack it measured, is
     appended to `emulators`. With `native`, NAME_native is built and compared as well."""
     if target is None:
