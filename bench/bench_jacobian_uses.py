@@ -24,7 +24,7 @@ translation unit) times, per robot and round, after a warm-up round:
 
 The table gives medians over the rounds in ns per call and the ratios the issue bounds
 (resolved_rate / velocity_ik, link_poses / fk). Then NAME_native (built from `--lang native`
-in a temporary folder by `jacgen.loading.load_native`) on `--rows` configurations
+in a temporary folder by `jacgen.building.load_native`) on `--rows` configurations
 uniform within the limits: condition_number and manipulability_gradient as one batch each
 (its gufunc: SIMD kernels over every usable processor), median of `--batch-rounds`; beside
 them, for scale, rtb's `manipulability(q, method="invcondition")` and `jacobm(q)` per call
@@ -40,7 +40,7 @@ from pathlib import Path
 import numpy as np
 
 import common
-from jacgen.loading import load_native
+from jacgen.building import load_native
 
 ROBOTS = ("puma560", "ur5", "panda")
 OURS = ("fk", "link_poses", "link_velocities", "velocity_ellipsoid", "condition_number", "manipulability_gradient",

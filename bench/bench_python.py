@@ -4,7 +4,7 @@
                                  [--batch-rounds 3]
 
 At the start, `generate --lang native` is rendered for each robot into a temporary folder and
-built with `jacgen.loading.load_native` (the build time and `NAME_native.SIMD` are printed).
+built with `jacgen.building.load_native` (the build time and `NAME_native.SIMD` are printed).
 Then, for `fk`, `fk_jacobian`, `ik` and `velocity_ik` of each robot, one row per batch size
 (1: one call; then each of `--sizes`) and one column per implementation:
 
@@ -64,7 +64,7 @@ import numpy as np
 
 import common
 from jacgen.checking import reference
-from jacgen.loading import load_native
+from jacgen.building import load_native
 
 FUNCTIONS = ("fk", "fk_jacobian", "ik", "velocity_ik")
 PEERS = ("pinocchio", "rtb", "eaik", "casadi")

@@ -56,7 +56,7 @@ import sympy  # noqa: E402
 from jacgen.checking import reference  # noqa: E402
 from jacgen.checking.c_library import c_compiler, compile_shared  # noqa: E402
 from jacgen.files import write_files  # noqa: E402
-from jacgen.loading import import_module  # noqa: E402
+from jacgen.building import import_module  # noqa: E402
 from jacgen.emission.render import render_robot  # noqa: E402
 from jacgen.inputs.robot_file import load_robot  # noqa: E402
 
@@ -108,7 +108,7 @@ def generate(robot, folder: Path, languages=("c",), real: str = "double") -> Pat
 
 
 def load_module(path: Path, name: str | None = None):
-    """Import a generated Python file by its path (jacgen.loading.import_module)."""
+    """Import a generated Python file by its path (jacgen.building.import_module)."""
     return import_module(path, name or f"bench_{path.stem}")
 
 

@@ -19,7 +19,7 @@ from jacgen.version import __version__
 
 _HOMES = {"JacgenError": "errors", "RobotFileError": "errors", "Kinematics": "model.kinematics",
           "render_robot": "emission.render", "Robot": "inputs.robot", "load_robot": "inputs.robot_file",
-          "arm": "loading", "BuildError": "loading"}
+          "arm": "loading", "BuildError": "building"}
 
 __all__ = ["BuildError", "JacgenError", "Kinematics", "Robot", "RobotFileError", "load_robot", "render_robot", "__version__", "arm"]
 

@@ -13,7 +13,7 @@ import pytest
 from jacgen.checking import reference
 from jacgen.checking.c_library import CLibrary, c_compiler, compile_shared
 from jacgen.emission.generator import Generator
-from jacgen.loading import import_module
+from jacgen.building import import_module
 from jacgen.inputs.robot_file import load_robot
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from jacgen.checking import reference
-from jacgen.loading import import_module
+from jacgen.building import import_module
 from jacgen.inputs.robot_file import load_robot
 from conftest import ROOT
 

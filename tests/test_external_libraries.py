@@ -27,7 +27,7 @@ from numpy.testing import assert_allclose
 
 from jacgen.inputs import numeric_chain
 from jacgen.checking import reference
-from jacgen.loading import import_module
+from jacgen.building import import_module
 
 with warnings.catch_warnings():
     warnings.simplefilter("ignore")

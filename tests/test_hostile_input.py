@@ -36,7 +36,7 @@ from jacgen.checking.c_library import compile_shared
 from jacgen.errors import JacgenError
 from jacgen.emission.generator import Generator
 from jacgen.checking.generated_code import GeneratedCode
-from jacgen.loading import import_module
+from jacgen.building import import_module
 from jacgen.urdf_import import import_urdf
 from jacgen.inputs.robot_file import load_robot, parse_robot
 

@@ -24,7 +24,7 @@ from click.testing import CliRunner
 from jacgen.cli import main
 from jacgen.emission.generator import Generator
 from jacgen.checking.generated_code import NATIVE_BACKENDS
-from jacgen.loading import host_instruction_set, import_module
+from jacgen.building import host_instruction_set, import_module
 from jacgen.files import write_files
 from jacgen.emission.render import render_robot
 from jacgen.inputs.robot_file import load_robot, parse_robot

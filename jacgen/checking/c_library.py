@@ -16,7 +16,7 @@ import numpy as np
 from jacgen.emission.catalogue import Signature
 from jacgen.errors import JacgenError
 from jacgen.inputs.robot import Robot
-from jacgen.loading import first_error
+from jacgen.building import first_error
 
 # contract §3: the generated C compiles without a warning under these flags.
 WARNING_FLAGS = ("-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Wconversion", "-Wshadow",

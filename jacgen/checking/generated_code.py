@@ -11,7 +11,7 @@ from jacgen.checking.c_library import CLibrary
 from jacgen.checking.cortex_m4f import Emulator
 from jacgen.emission.catalogue import Signature
 from jacgen.inputs.robot import Robot
-from jacgen.loading import import_module
+from jacgen.building import import_module
 
 HOST_BACKENDS = ("python", "casadi", "c double", "c float")  # what `jacgen verify` compares on the host
 # NAME_native as `verify --native` calls it: batches of float64 (the double C) and float32 (the

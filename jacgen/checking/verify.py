@@ -39,7 +39,7 @@ from jacgen.emission.generator import Generator
 from jacgen.emission.render import render_robot
 from jacgen.files import write_files
 from jacgen.inputs.robot import EULER_ANGLES, Robot
-from jacgen.loading import load_native
+from jacgen.building import load_native
 from jacgen.model import js_rank
 from jacgen.parallel import for_each_robot
 from jacgen.solvers import ik

@@ -22,7 +22,7 @@ from jacgen.checking import generated_code
 from jacgen.checking.c_library import CLibrary, compile_shared
 from jacgen.emission.catalogue import with_callees
 from jacgen.emission.generator import Generator
-from jacgen.loading import import_module, load_native
+from jacgen.building import import_module, load_native
 from jacgen.files import write_files
 from jacgen.emission.render import render_robot
 from jacgen.inputs.robot import Robot
