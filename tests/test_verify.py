@@ -64,7 +64,7 @@ def test_the_summary_states_the_tolerances_of_the_builds_run():
         "tolerance x (1 + reach): float 1e-04; 0 of 1 functions above tolerance")
 
 
-def test_functions_without_reference_are_listed_not_compared(monkeypatch):
+def test_a_function_without_reference_fails_not_compared(monkeypatch):
     original = Generator.functions
 
     def functions(self):
@@ -73,9 +73,22 @@ def test_functions_without_reference_are_listed_not_compared(monkeypatch):
 
     monkeypatch.setattr(Generator, "functions", functions)
     result = _verify("robots/scara.yaml", "--samples", "5")
-    assert result.exit_code == 0, result.output
+    assert result.exit_code == 1, result.output
     cells = _rows(result.output)[("scara", "tool_height")]
     assert cells[:4] == ["-"] * 4 and " ".join(cells[5:]) == "not compared: no reference"
+    assert result.output.splitlines()[-1].endswith("0 of %d functions above tolerance, 1 not compared"
+                                                   % len(_rows(result.output)))
+
+
+def test_a_function_verify_has_no_check_of_fails(monkeypatch):
+    """ik_numeric_step (its arguments are neither q nor q, q_dot) without its check: a row that
+    says so, and exit 1."""
+    monkeypatch.setattr(verify, "_ik_numeric_step_result", lambda robot, backends, q, tolerances: verify.Result(
+        robot.name, "fk", dict.fromkeys(backends.names), tolerances, "(a second row of fk in its place)"))
+    result = _verify("robots/planar_2r.yaml", "--samples", "5")
+    assert result.exit_code == 1, result.output
+    cells = _rows(result.output)[("planar_2r", "ik_numeric_step")]
+    assert cells[:4] == ["-"] * 4 and " ".join(cells[5:]).startswith("not compared: verify has no check of it")
 
 
 def test_missing_compiler_and_compile_errors_exit_2():

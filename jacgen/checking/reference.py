@@ -318,10 +318,37 @@ def task_error(robot, q, target):
         position = np.stack([given.get(axis, pose[..., i, 3]) for i, axis in enumerate("xyz")], -1)
         goal = _rpy_rotation(given["roll"], given["pitch"], given["yaw"])[..., :3, :3]
     else:
-        difference = target - task(robot, q)
-        angular = [k for k, name in enumerate(robot.task) if name in ("roll", "pitch", "yaw")]
-        difference[..., angular] = np.pi - (np.pi - difference[..., angular]) % (2 * np.pi)
-        return difference
+        return _task_difference(robot, q, target)
     turn = rotation_vector(goal @ np.swapaxes(pose[..., :3, :3], -1, -2))
     full = np.concatenate([position - pose[..., :3, 3], turn], -1)
     return full[..., [TASK_COMPONENTS.index(name) for name in robot.task]]
+
+
+def ik_numeric_step(robot, target, q, damping):
+    """One damped least-squares step of ik_numeric (contract §2): q clamped to the joint limits
+    (a joint without limits is not), the error e there (a pose: the position error and the
+    rotation vector of R_target R^T with the geometric Jacobian J; else target - mu, Euler angles
+    wrapped, with the task Jacobian), q + J^T (J J^T + damping I)^-1 e (or (J^T J + damping I)^-1
+    J^T e where J is tall) clamped again; and |e|^2 at the clamped q: (q clamped, the next q, |e|^2)."""
+    low = np.array([joint.limits[0] if joint.limits else -np.inf for joint in robot.joints])
+    high = np.array([joint.limits[1] if joint.limits else np.inf for joint in robot.joints])
+    start = np.clip(q, low, high)
+    if len(robot.task) == 6:
+        error, J = task_error(robot, start, target), jacobian(robot, start)
+    else:
+        error, J = _task_difference(robot, start, np.asarray(target, dtype=float)), task_jacobian(robot, start)
+    m, n = J.shape[-2:]
+    transposed = np.swapaxes(J, -1, -2)
+    if m <= n:
+        step = transposed @ np.linalg.solve(J @ transposed + damping * np.eye(m), error[..., None])
+    else:
+        step = np.linalg.solve(transposed @ J + damping * np.eye(n), transposed @ error[..., None])
+    return start, np.clip(start + step[..., 0], low, high), np.sum(error * error, -1)
+
+
+def _task_difference(robot, q, target):
+    """target - mu(q), the Euler angles wrapped into (-pi, pi]."""
+    difference = target - task(robot, q)
+    angular = [k for k, name in enumerate(robot.task) if name in ("roll", "pitch", "yaw")]
+    difference[..., angular] = np.pi - (np.pi - difference[..., angular]) % (2 * np.pi)
+    return difference
