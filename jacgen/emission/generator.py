@@ -149,9 +149,9 @@ class Generator:
                 f"the loop's free joint from the loop){which}", vector("q", q),
                 arguments=(target, *free_input, angles), bindings=bindings, part_of="ik_branches"))
         dof = self.robot.dof
-        target_pose = self._ik_target()
+        target_pose = self.ik_target()
         given = Argument("q", sympy.Matrix([generated_symbol("qs", i + 1) for i in range(dof)]))
-        error, jacobian = self._task_error(target_pose, None)
+        error, jacobian = self.task_error(target_pose, None)
         step = self.function("ik_general_residual", "the pose error e at q (the position error and the rotation "
                              "vector of R_target R^T, world frame) and the geometric Jacobian J of the six joints "
                              "ik solves: the Newton step of the solver's polish is q + J^-1 e",
@@ -179,13 +179,13 @@ class Generator:
     def ik_numeric_step_function(self, task_jacobian: sympy.Matrix) -> Function:
         """ik_numeric_step: one damped least-squares step of ik_numeric from q (`differential`)."""
         robot, n = self.robot, self.robot.dof
-        target = self._ik_target()
+        target = self.ik_target()
         given = Argument("q", sympy.Matrix([generated_symbol("qs", i + 1) for i in range(n)]))
         damping = self.damping_argument()
         limits = [joint.limits for joint in robot.joints]
         bindings = {qi: differential.clamp(given_i, bounds, self.graph)
                     for qi, given_i, bounds in zip(self.q, given.symbols, limits)}
-        error, jacobian = self._task_error(target, task_jacobian)
+        error, jacobian = self.task_error(target, task_jacobian)
         trial, cost = differential.ik_numeric_step(error, jacobian, list(self.q), damping.symbols[0], limits,
                                                    self.graph, self.name_node, self.lowering.called)
         read = target.symbols[:3, :] if len(robot.task) == 6 else target.symbols
@@ -203,7 +203,7 @@ class Generator:
                             vector=False)
         return Argument(name or "mu", sympy.Matrix([generated_symbol("mu", i) for i in range(len(self.robot.task))]))
 
-    def _ik_target(self) -> Argument:
+    def ik_target(self) -> Argument:
         """ik_numeric's target: the 4x4 pose for a six-component task, else the task vector."""
         return self._target(len(self.robot.task) == 6, "target")
 
@@ -217,7 +217,7 @@ class Generator:
         """A 7-axis arm's free joint angle, an input of its closed form."""
         return Argument("q_free", sympy.Matrix([sympy.Symbol("q_free", real=True)]), scalar=True)
 
-    def _task_error(self, target: Argument, task_jacobian: sympy.Matrix | None) -> tuple[list, sympy.Matrix]:
+    def task_error(self, target: Argument, task_jacobian: sympy.Matrix | None) -> tuple[list, sympy.Matrix]:
         """The error e that ik's iterations drive to 0, at the chain's q, and its Jacobian: for a
         pose, the position error and the rotation vector of R_target R^T (world frame) with the
         geometric Jacobian; else the task error (Euler angles wrapped) with the task Jacobian."""
@@ -363,7 +363,7 @@ class Generator:
         made = []
         if self.generates("ik_numeric"):
             defaults = differential.IK_NUMERIC_DEFAULTS
-            arguments = (self._ik_target(), Argument("q0", sympy.Matrix(sympy.symbols(f"q0_:{n}", real=True))),
+            arguments = (self.ik_target(), Argument("q0", sympy.Matrix(sympy.symbols(f"q0_:{n}", real=True))),
                          Argument("max_iter", sympy.Matrix([sympy.Symbol("max_iter")]), scalar=True,
                                   default=repr(defaults["max_iter"]), integer=True),
                          Argument("tol", sympy.Matrix([sympy.Symbol("tol")]), scalar=True, default=repr(defaults["tol"])))

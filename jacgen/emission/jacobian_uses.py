@@ -94,7 +94,7 @@ def feedback_error(generator, target: Argument, task_jacobian: sympy.Matrix) -> 
     error and the rotation vector of the rotation the target's angles make, times R^T."""
     robot, g = generator.robot, generator.graph
     if len(robot.task) == 6 or singularity_rows(robot) is None or not set(EULER_ANGLES) <= set(robot.task):
-        return generator._task_error(target, task_jacobian)[0]
+        return generator.task_error(target, task_jacobian)[0]
     goal = dict(zip(robot.task, target.symbols))
     rotation = xyz_rpy_transform((0, 0, 0), [goal[angle] for angle in EULER_ANGLES])[:3, :3]
     tool = generator.chain.tool
@@ -231,7 +231,7 @@ def _rate_functions(generator, js: sympy.Matrix, task_jacobian: sympy.Matrix,
                                        vector("q_dot", q_dot), status("status", outcome),
                                        arguments=(q, mu_dot, z, damping)))
     if generator.generates("resolved_rate"):
-        target = generator._ik_target()
+        target = generator.ik_target()
         rate = Argument("target_rate", sympy.Matrix([generated_symbol("mu_dot", i) for i in range(m)]))
         gain = Argument("gain", sympy.Matrix([generated_symbol("gain", i) for i in range(m)]), every=True)
         with distribute(False):
