@@ -56,8 +56,8 @@ def test_functions_match_reference(name, generated):
             (output.rows, output.cols) for output in function.outputs]
         value = np.array([np.concatenate([np.asarray(result).ravel() for result in _as_list(generated_function(row))])
                           for row in q])
-        if all(hasattr(reference, output.equals or function.name) for output in function.outputs):
-            expected = np.array([np.concatenate([np.ravel(getattr(reference, output.equals or function.name)(robot, row))
+        if all(hasattr(reference, output.result_of or function.name) for output in function.outputs):
+            expected = np.array([np.concatenate([np.ravel(getattr(reference, output.result_of or function.name)(robot, row))
                                                  for output in function.outputs]) for row in q])
         else:
             expected = np.reshape(getattr(numpy_module, function.name)(q), value.shape)

@@ -71,7 +71,7 @@ STEP_DAMPING = 0.1
 def _reference(robot: Robot, function: Function, q: np.ndarray, *more: np.ndarray) -> np.ndarray | None:
     """The reference's values of each output side by side, None where it has no counterpart.
     Each reference function takes the arguments it needs: q, or q and q_dot."""
-    evaluators = [getattr(reference, output.equals or function.name, None) for output in function.outputs]
+    evaluators = [getattr(reference, output.result_of or function.name, None) for output in function.outputs]
     if not all(callable(evaluate) for evaluate in evaluators):
         return None
     needs = [sum(p.default is inspect.Parameter.empty for p in inspect.signature(e).parameters.values()) - 1

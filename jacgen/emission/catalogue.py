@@ -67,8 +67,8 @@ FUNCTION_NAMES = tuple(DECLARED)
 
 
 # The contract's extent of every array, in named dimensions (C's `double J[6 * NAME_DOF]`), by
-# argument name or "function.output", else by the function an output equals or belongs to; an
-# array not listed is a pose (16) or as long as it is.
+# argument name or "function.output", else by the function an output is the result of
+# (`result_of`) or belongs to; an array not listed is a pose (16) or as long as it is.
 EXTENTS = {
     "q": ("DOF",),
     "T": (16,),
@@ -163,7 +163,7 @@ class Output:
     cols: int
     scalar: bool = False
     vector: bool = False  # a column vector: numpy shape (rows,), even for one row
-    equals: str = ""  # the function whose result this is, when the function fuses several
+    result_of: str = ""  # the function whose result this is, when the function fuses several
     boolean: bool = False  # truth values
     integer: bool = False  # a status: an int in C and numpy
     layers: int = 1  # > 1: a stack of `layers` matrices of rows / layers x cols (the hessian)
@@ -264,10 +264,10 @@ class Function(Signature):
 Result = tuple[Output, list]
 
 
-def matrix(name: str, value, equals: str = "", layers: int = 1) -> Result:
+def matrix(name: str, value, result_of: str = "", layers: int = 1) -> Result:
     """A sympy Matrix, or a 2-D array of nodes (a stack of `layers` matrices: the hessian)."""
     rows, cols = value.shape
-    return (Output(name, rows, cols, equals=equals, layers=layers),
+    return (Output(name, rows, cols, result_of=result_of, layers=layers),
             list(value.flat) if isinstance(value, numpy.ndarray) else list(value))
 
 
@@ -276,9 +276,9 @@ def _entry(value):
     return value if isinstance(value, Node) else sympy.sympify(value)
 
 
-def vector(name: str, values, equals: str = "") -> Result:
+def vector(name: str, values, result_of: str = "") -> Result:
     values = [_entry(value) for value in values]
-    return Output(name, len(values), 1, vector=True, equals=equals), values
+    return Output(name, len(values), 1, vector=True, result_of=result_of), values
 
 
 def scalar(name: str, value) -> Result:

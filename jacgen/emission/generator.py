@@ -255,8 +255,8 @@ class Generator:
         hessian = numpy.concatenate(kinematics.hessian(robot, columns))
         return [
             self.function("fk_jacobian_dot", "fk, jacobian and bias_acceleration in one pass, sharing their terms",
-                          matrix("T", self.chain.tool, equals="fk"), matrix("J", self.jacobian, equals="jacobian"),
-                          vector("a", bias, equals="bias_acceleration"), arguments=arguments),
+                          matrix("T", self.chain.tool, result_of="fk"), matrix("J", self.jacobian, result_of="jacobian"),
+                          vector("a", bias, result_of="bias_acceleration"), arguments=arguments),
             self.function("jacobian_dot", "time derivative dJ/dt of the world geometric Jacobian along q_dot (6 x DOF)",
                           matrix("Jd", jacobian_dot), arguments=arguments),
             self.function("bias_acceleration", "J' q_dot: the tool's classical linear and angular acceleration "
@@ -332,7 +332,7 @@ class Generator:
             boolean = all(node.boolean for node in nodes)
             key = f"{name}.{output.name}"
             outputs.append(replace(output, vector=output.vector or boolean, boolean=boolean,
-                                   extent=extent_of(key if key in EXTENTS else output.equals or name, output.size)))
+                                   extent=extent_of(key if key in EXTENTS else output.result_of or name, output.size)))
             values += nodes
         return Function(name, summary, tuple(outputs), arguments or (Argument("q", sympy.Matrix(self.q)),),
                         body=self.lower(values, bindings or {}), calls=calls, part_of=part_of or "")
@@ -414,7 +414,7 @@ class Generator:
             self.function("jacobian", "geometric Jacobian in the world frame (6 x DOF, rows vx vy vz wx wy wz)",
                           matrix("J", self.jacobian)),
             self.function("fk_jacobian", "fk and jacobian in one pass, sharing their terms",
-                          matrix("T", pose, equals="fk"), matrix("J", self.jacobian, equals="jacobian")),
+                          matrix("T", pose, result_of="fk"), matrix("J", self.jacobian, result_of="jacobian")),
             self.function("jacobian_tool", "geometric Jacobian in the tool frame (6 x DOF, rows vx vy vz wx wy wz)",
                           matrix("J", kinematics.tool_frame(self.jacobian, pose))),
             self.function("task", f"task vector mu = ({', '.join(robot.task)})",
