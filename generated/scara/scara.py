@@ -38,11 +38,11 @@ def _namespace(values):
     return numpy
 
 
-def _arguments(*arguments, every=()):
+def _arguments(*arguments, scalar_allowed=()):
     """xp, dtype, device, the batch shape and the arrays of (name, value, shape) arguments:
     each of `shape` or a batch (..., *shape), all in the floating-point type of the arrays
-    among them (lists and numbers follow it); those named in `every` may be one number, which
-    stands for each of their components."""
+    among them (lists and numbers follow it); those named in `scalar_allowed` may be one number,
+    which stands for each of their components."""
     xp = _namespace(value for _, value, _ in arguments)
     given = [value for _, value, _ in arguments if hasattr(value, "dtype")]
     dtype = given[0].dtype if len({value.dtype for value in given}) == 1 else xp.result_type(*given, 1.0)
@@ -52,7 +52,7 @@ def _arguments(*arguments, every=()):
     arrays, batches = [], []
     for name, value, shape in arguments:
         value = xp.asarray(value, dtype=dtype, device=device)
-        if name in every and value.ndim == 0:
+        if name in scalar_allowed and value.ndim == 0:
             value = xp.broadcast_to(value, shape)
         if value.shape[value.ndim - len(shape):] != shape:
             batch = ", ".join(map(str, shape))
@@ -1762,7 +1762,7 @@ def velocity_ik_nullspace(q, mu_dot, z, damping=0.0):
 
 def resolved_rate(q, target, target_rate, gain, z, damping=0.0):
     """resolved-rate control: q_dot = Js# (target_rate + gain e) + (I - Js# Js) z, e ik_numeric's task error at q; and the status (VELOCITY_IK_*): (4 x 1 and 1 x 1), 443 operations."""
-    xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (4,)), ("target", target, (4,)), ("target_rate", target_rate, (4,)), ("gain", gain, (4,)), ("z", z, (4,)), ("damping", damping, ()), every=("gain", ))
+    xp, dtype, device, batch, (q, target, target_rate, gain, z, damping,) = _arguments(("q", q, (4,)), ("target", target, (4,)), ("target_rate", target_rate, (4,)), ("gain", gain, (4,)), ("z", z, (4,)), ("damping", damping, ()), scalar_allowed=("gain", ))
     q3 = q[..., 2]
     mu0 = target[..., 0]
     mu1 = target[..., 1]

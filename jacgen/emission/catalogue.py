@@ -138,7 +138,7 @@ class Argument:
     scalar: bool = False  # one number: by value in C, shape (...) in numpy, its symbol named as the argument
     default: str | None = None  # a scalar's default in Python
     integer: bool = False  # a count (ik_numeric's max_iter): an int in C
-    every: bool = False  # a vector that Python also takes as one number for every component (a gain)
+    scalar_allowed: bool = False  # a vector that Python also takes as one number for each component (a gain)
 
     @property
     def size(self) -> int:

@@ -233,7 +233,8 @@ def _rate_functions(generator, js: sympy.Matrix, task_jacobian: sympy.Matrix,
     if generator.generates("resolved_rate"):
         target = generator.ik_target()
         rate = Argument("target_rate", sympy.Matrix([generated_symbol("mu_dot", i) for i in range(m)]))
-        gain = Argument("gain", sympy.Matrix([generated_symbol("gain", i) for i in range(m)]), every=True)
+        gain = Argument("gain", sympy.Matrix([generated_symbol("gain", i) for i in range(m)]),
+                        scalar_allowed=True)
         with distribute(False):
             error = feedback_error(generator, target, task_jacobian)
         command = [name(g.value(r) + g.value(k) * g.value(e)) for r, k, e in zip(rate.symbols, gain.symbols, error)]

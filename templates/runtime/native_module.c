@@ -476,16 +476,16 @@ static PyObject *jacgen_many(const jacgen_function *f, int build, const jacgen_a
     return result;
 }
 
-/* A number given for an input that takes one for each component (`every`) becomes the list of
- * them, held in `lists` for the caller to release. */
-static int jacgen_every(const jacgen_function *f, jacgen_arguments *a, PyObject **lists)
+/* A number given for an input that takes one for each component (`scalar_allowed`) becomes the
+ * list of them, held in `lists` for the caller to release. */
+static int jacgen_spread_scalars(const jacgen_function *f, jacgen_arguments *a, PyObject **lists)
 {
     int k;
     Py_ssize_t i;
     for (k = 0; k < f->inputs; k++) {
         PyObject *value = a->value[k];
         lists[k] = NULL;
-        if (!f->operand[k].every || value == NULL
+        if (!f->operand[k].scalar_allowed || value == NULL
             || !(PyFloat_Check(value) || PyLong_Check(value) || PyArray_IsScalar(value, Generic)
                  || (PyArray_Check(value) && PyArray_NDIM((PyArrayObject *)value) == 0))) {
             continue;
@@ -509,7 +509,7 @@ static PyObject *jacgen_call(const jacgen_function *f, PyObject *const *args, Py
     if (jacgen_parse(f, args, nargs, kwnames, &a, 0) != 0) {
         return NULL;
     }
-    if (jacgen_every(f, &a, lists) == 0) {
+    if (jacgen_spread_scalars(f, &a, lists) == 0) {
         build = jacgen_build(f, &a);
         result = jacgen_one(f, build, &a);
         result = result != NULL || PyErr_Occurred() ? result : jacgen_many(f, build, &a);

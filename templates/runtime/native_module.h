@@ -35,7 +35,7 @@ typedef struct {
     npy_intp shape[3];
     npy_intp size, pad; /* elements, and the distance of two rows in a block */
     const char *default_value; /* a Python expression; NULL: required */
-    int every; /* a number stands for each component (resolved_rate's gain) */
+    int scalar_allowed; /* a number stands for each component (resolved_rate's gain) */
 } jacgen_operand;
 
 typedef struct {

@@ -45,13 +45,14 @@ def build_name(robot: Robot, build: str) -> str:
     return robot.name if build == "double" else f"{robot.name}_float"
 
 
-def _operand(name: str, shape: tuple, kind: str, default: str | None = None, every: bool = False) -> dict:
+def _operand(name: str, shape: tuple, kind: str, default: str | None = None,
+             scalar_allowed: bool = False) -> dict:
     """One input or output: kind "real", "int" (a status or count: C int, numpy int32) or
     "bool" (C int, numpy bool); its rows are `pad` apart in a block, a power of two, so that
-    gcc vectorises their accesses; `every`: one number stands for each component."""
+    gcc vectorises their accesses; `scalar_allowed`: one number stands for each component."""
     size = prod(shape)
     return {"name": name, "shape": list(shape), "size": size, "pad": 1 << (size - 1).bit_length(),
-            "kind": kind, "default": default, "every": every}
+            "kind": kind, "default": default, "scalar_allowed": scalar_allowed}
 
 
 def c_string(text: str) -> str:
@@ -97,7 +98,8 @@ def entries(generator: Generator, parameters: list[dict]) -> list[dict]:
     loops = {loop.name: loop for loop in generator.loops}
     made = []
     for f in (*generator.functions(), *(loop for loop in loops.values() if loop.name != "ik")):
-        inputs = [_operand(a.name, a.shape, "int" if a.integer else "real", a.default, a.every) for a in f.arguments]
+        inputs = [_operand(a.name, a.shape, "int" if a.integer else "real", a.default, a.scalar_allowed)
+                  for a in f.arguments]
         outputs = [_operand(o.name, o.shape, _kind(o)) for o in f.outputs]
         returned = next((k for k, o in enumerate(f.outputs) if o is f.returned), None)
         straight = isinstance(f, Function)

@@ -95,7 +95,7 @@ def _python_function(function: Function, printer: PythonPrinter, parameters: lis
         "shape": " and ".join(dimensions(o) for o in function.outputs),
         "operations": body.operation_count,
         # symbolic parameters are arguments of shape (): in the arguments' dtype, and broadcast with them
-        "every": [a.name for a in function.arguments if a.every],
+        "scalar_allowed": [a.name for a in function.arguments if a.scalar_allowed],
         "arguments": [(a.name, repr(shape)) for a, shape in zip(function.arguments, shapes)]
                      + [(p["name"], "()") for p in parameters],
         "signature": ", ".join([f"{a.name}={a.default}" if a.default else a.name for a in function.arguments] + ["*"] * bool(parameters)
