@@ -93,7 +93,7 @@ class Code:
         return generated_code.GeneratedCode(self.robot, self.signatures(), self.folder, {}, native=module)
 
 
-class GeneratedCode:
+class CodeCache:
     """The cache behind the `generated` fixture: one `Code` per (robot, languages, real,
     functions), under `folder`."""
 
@@ -132,6 +132,6 @@ def c_ik(library: CLibrary, target, *free, parameters=None):
 
 
 @pytest.fixture(scope="module")
-def generated(tmp_path_factory) -> GeneratedCode:
-    """Robots' code generated and compiled once per test module (see GeneratedCode)."""
-    return GeneratedCode(tmp_path_factory.mktemp("generated"))
+def generated(tmp_path_factory) -> CodeCache:
+    """Robots' code generated and compiled once per test module (see CodeCache)."""
+    return CodeCache(tmp_path_factory.mktemp("generated"))
