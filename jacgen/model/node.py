@@ -56,7 +56,8 @@ class Node:
 
     __slots__ = ("kind", "args", "value", "graph", "index", "_free")
 
-    def __init__(self, kind: str, args: tuple, value, graph: "Graph | None" = None, index: int = 0):
+    # Graph: jacgen.model.graph's, which imports this module (so it is not imported here).
+    def __init__(self, kind: str, args: tuple, value, graph: "Graph | None" = None, index: int = 0):  # noqa: F821
         self.kind, self.args, self.value, self.graph, self.index, self._free = kind, args, value, graph, index, None
 
     def __add__(self, other):

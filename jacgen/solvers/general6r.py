@@ -231,7 +231,7 @@ def equations(links: list[Link], split: Split) -> Equations:
         pl = _dot(h_point, h_axis) + _dot(offset, w_axis)
         inner_cross, offset_cross = turn(_cross(h_point, h_axis)), _cross(offset, w_axis)
         cross = through(outer, [inner_cross[i] + offset_cross[i] for i in range(3)], False)
-        return [*axis, *point, pp, pl, *cross, *(pp * l - 2 * pl * p for l, p in zip(axis, point))]
+        return [*axis, *point, pp, pl, *cross, *(pp * along - 2 * pl * at for along, at in zip(axis, point))]
 
     a, b, c = split.triple
     f, (g, h) = split.free, split.pair

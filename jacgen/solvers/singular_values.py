@@ -226,7 +226,7 @@ def adjugate_triangular(R: list, g: Graph, name: Callable) -> list:
     adjugate = [[zero] * k for _ in range(k)]
     for i in range(k):
         for j in range(i, k):
-            outside = [R[l][l] for l in range(k) if not i <= l <= j]
+            outside = [R[d][d] for d in range(k) if not i <= d <= j]
             adjugate[i][j] = name(N[i][j] * _product(outside, one))
     return adjugate
 

@@ -321,7 +321,6 @@ class Subproblems:
         are equal, a target near the base), where 1 - cos(alpha)^2 would lose them."""
         p_perp, q_perp = self.perpendicular(p, k), self.perpendicular(q, k)
         a, b = self.norm(p_perp), self.norm(q_perp)
-        g = self.graph
         dd, height = self.dot(d, d), self.name(self.dot(k, p) - self.dot(k, q))
         c = self.name(self.clamped_sqrt(self.name(dd - height**2)))
         spread = self.name((c - a + b) * (c + a - b) * (a + b - c) * (a + b + c) / 4)
