@@ -45,11 +45,11 @@ class Generator:
         self.selection = None if selection is None else with_callees(selection)
         self.q = kinematics.joint_symbols(robot)
         self.lowering = Lowering()
-        self.name, self.lower, self.graph = self.lowering.name, self.lowering.lower, self.lowering.graph
+        self.named, self.lower, self.graph = self.lowering.named, self.lowering.lower, self.lowering.graph
         self.name_node = self.lowering.name_node
         self._trig: dict[tuple[int, ...], tuple[sympy.Symbol, sympy.Symbol]] = {}  # each defined once
         with distribute(False):  # keep 0.0825*(a - b) whole, for CSE to share a - b
-            self.chain = kinematics.build_chain(robot, lambda i: self.cos_sin((i,)), self.q, simplify=self.name,
+            self.chain = kinematics.build_chain(robot, lambda i: self.cos_sin((i,)), self.q, simplify=self.named,
                                                angle_sum=self.cos_sin)
 
     def cos_sin(self, joints: tuple[int, ...]) -> tuple[sympy.Symbol, sympy.Symbol]:
@@ -138,12 +138,12 @@ class Generator:
                           "the first's leading matrix is singular to rounding)"))
         parts = []
         for suffix, plan, which in plans:
-            n, stacked, q = general6r_target.equations_at(self.robot, form, plan, target.symbols, self.name)
+            n, stacked, q = general6r_target.equations_at(self.robot, form, plan, target.symbols, self.named)
             parts.append(self.function(
                 f"ik_general_equations{suffix}", f"the general 6R solver's equations at T{which}: (P0 + s Ps + c Pc) "
                 "v_bc = Q v_gh, P = [P0; Ps; Pc] (42 x 9)", matrix("P", stacked), matrix("Q", q),
                 arguments=(target, *free_input), bindings=bindings, part_of="ik_branches"))
-            q = general6r_target.loop_configuration(self.robot, form, plan, n, angles.symbols, self.q, self.name)
+            q = general6r_target.loop_configuration(self.robot, form, plan, n, angles.symbols, self.q, self.named)
             parts.append(self.function(
                 f"ik_general_start{suffix}", f"the configuration of one root's loop angles (a - shift, b, c, g, h; "
                 f"the loop's free joint from the loop){which}", vector("q", q),

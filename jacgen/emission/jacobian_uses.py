@@ -37,7 +37,7 @@ def link_frames(generator) -> list[sympy.Matrix]:
         if robot.convention == "standard" and i + 1 < robot.dof:
             frames.append(chain.axes[i + 1])
         else:
-            frames.append((axis * after).applyfunc(generator.name))
+            frames.append((axis * after).applyfunc(generator.named))
     return frames
 
 

@@ -69,7 +69,7 @@ class Lowering:
         """The value a symbol is defined as, None for an input."""
         return self._values.get(symbol)
 
-    def name(self, value: sympy.Expr) -> sympy.Expr:
+    def named(self, value: sympy.Expr) -> sympy.Expr:
         """`name_node` for a sympy value (the chain's), as a sympy value: its symbol, or minus it.
         A product of sympy's atoms stays as it is; an exact irrational constant (cos(pi/180)) is
         no atom, so its products are named (computed once, not folded into every reader)."""
