@@ -70,7 +70,8 @@ RUNTIME = ROOT / "templates" / "runtime"
 def library(tmp_path_factory):
     folder = tmp_path_factory.mktemp("runtime")
     (folder / "harness.c").write_text(HARNESS)
-    flags = ("-O2", f"-I{RUNTIME}", f"-DJACGEN_G6_IMAGINARY={general6r.IMAGINARY['double']}")
+    flags = ("-O2", f"-I{RUNTIME}", f"-DJACGEN_G6_IMAGINARY={general6r.IMAGINARY['double']}",
+             f"-DJACGEN_G6_LANES={general6r.NEWTON_ROWS}")
     library = ctypes.CDLL(str(compile_shared([folder / "harness.c"], folder / "libruntime.so", flags)))
     library.monomials.argtypes = [POINTER, POINTER]
     library.eigenvalues.argtypes = [ctypes.c_int, POINTER, POINTER, POINTER]

@@ -14,6 +14,7 @@ import numpy
 import pytest
 
 from jacgen.checking.c_library import WARNING_FLAGS, c_compiler
+from jacgen.solvers import general6r
 
 from conftest import ROOT
 
@@ -45,7 +46,8 @@ def test_eigenvalues(tmp_path):
 def test_general6r(tmp_path, imaginary):
     """The kernel runs in double in both builds; the float build's IMAGINARY is another number."""
     compile_alone(c_compiler(), "general6r.c", [*INCLUDED, "-include", "math.h", "-include",
-                                                str(RUNTIME / "eigenvalues.c"), f"-DJACGEN_G6_IMAGINARY={imaginary}"],
+                                                str(RUNTIME / "eigenvalues.c"), f"-DJACGEN_G6_IMAGINARY={imaginary}",
+                                                f"-DJACGEN_G6_LANES={general6r.NEWTON_ROWS}"],
                   tmp_path)
 
 

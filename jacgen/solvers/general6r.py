@@ -326,6 +326,9 @@ MONOMIALS = np.array([np.outer(_HALF_ANGLE[b], _HALF_ANGLE[c]).ravel()
 ALONG_C = (0, 1, 3, 4, 6, 7, 9, 10)
 ALONG_B = tuple(range(9))
 NEWTON_STEPS = 6  # at most, on the pose, after the back-substitution (a near-double root needs more than 2)
+# The C takes its Newton steps on this many configurations at once (JACGEN_G6_LANES, templates/c/ik.c.jinja):
+# the roots a few batches at a time, a calibrated arm's branches (at most 8) in one.
+NEWTON_ROWS = 8
 # The fast path of a calibrated arm (a nearest_class.Nominal): the nominal arm's closed form, then up
 # to FAST_STEPS Newton steps on the exact arm from each branch that the target allows. Each must
 # reach T to CONVERGED (1 + reach), at a solution of its own, and the closed form's certificate
@@ -391,7 +394,7 @@ def work_bytes(real: str) -> int:
     the equations in the build's real type and in double, the kernel's matrices in double, and
     the Newton steps' 8 rows of x, e and J in the real type, with their solves in double), as
     the contract documents it; tests/test_shipped_robots.py checks it against the compiler's."""
-    lanes = 8  # JACGEN_G6_LANES
+    lanes = NEWTON_ROWS
     reals = 378 + 112 + lanes * (8 + 8 + 64)
     doubles = 3 * 14 * 9 + 14 * 8 + 16 * 5 + (14 * 8 + 8 + 8 + 6 * 14 + 3 * 6 * 9 + 3 * 12 * 12 + 2 * 12 * 4 + 12 * 28
                                            + 16 * 16 + 2 * 12 * 12 + 16 + 16) + lanes * (6 * 6 + 6)

@@ -113,8 +113,8 @@ static int jacgen_g6_solve(int n, double *a, int nb, double *b) {
  * holds system k, a x = b, and x replaces b. The arithmetic and pivots of jacgen_g6_solve (each
  * row swapped with the pivot row where its entry is larger, so the largest ends there first),
  * but a swap is a select in every lane, never a jump: a compiler vectorises the loops over the
- * lanes (JACGEN_SIMD_LOOP). solved[k] is 0 where a pivot is 0 (b is then not x). */
-#define JACGEN_G6_LANES 8
+ * lanes (JACGEN_SIMD_LOOP). solved[k] is 0 where a pivot is 0 (b is then not x). Defined before
+ * it: JACGEN_G6_LANES (jacgen/solvers/general6r.py's NEWTON_ROWS). */
 /* The native module's kernels define JACGEN_SIMD_LOOP (omp simd), JACGEN_SIMD_KERNEL (flatten)
  * and JACGEN_KERNEL_LOOP (unroll). A vector computes every lane: none is skipped there. */
 #ifdef JACGEN_SIMD_LOOP

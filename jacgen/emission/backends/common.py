@@ -144,6 +144,7 @@ def ik_context(robot: Robot, generator: Generator, real: str, number: Callable, 
             "squared": number(REACHED[real] ** 2),
             "converged_squared": number((general6r.CONVERGED[real] * (1 + robot.reach)) ** 2),
             "work_bytes": general6r.work_bytes(real),
+            "lanes": general6r.NEWTON_ROWS,
             "degenerate": repr(general6r_plan.DEGENERATE),  # a double in every build (the eigenproblem is)
             "fallback": form.elimination.fallback is not None,
             "joints": form.joints,
